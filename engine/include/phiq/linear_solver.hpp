@@ -1,0 +1,48 @@
+// Sparse LU behind one interface, in SuiteSparse's vocabulary: analyse (pattern, once per model) → factorise
+// (values, every Newton iteration) → solve.
+//
+// The symbolic object is immutable after analyse() and may be shared by any number of threads; each thread owns
+// its numeric object (make_numeric()). UMFPACK's "singular matrix" warning is reported as kSingular, distinct from
+// a failure of the library (kFailed: out of memory, invalid data).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "phiq/sparse_pattern.hpp"
+
+namespace phiq {
+
+enum class FactorStatus { kOk, kSingular, kFailed };
+const char* to_string(FactorStatus s);
+
+enum class LinearSolverKind {
+  kUmfpack,  // SuiteSparse UMFPACK: the default for the square driven system
+  kDense,    // Eigen's dense partial-pivoting LU of the same matrix: a reference for tests and small models
+};
+const char* to_string(LinearSolverKind k);
+
+class SparseLuNumeric {
+ public:
+  virtual ~SparseLuNumeric() = default;
+  // Numeric factorisation of the matrix with the analysed pattern and these CSC values.
+  virtual FactorStatus factorize(const double* values) = 0;
+  // x = A⁻¹ b with the last successful factorisation. x and b must not alias. Returns false on failure.
+  virtual bool solve(const double* b, double* x) = 0;
+  // Reciprocal condition estimate of the last factorisation (UMFPACK: min|U_ii| / max|U_ii|).
+  virtual double rcond() const = 0;
+  // Detail of the last failure, for diagnostics.
+  virtual std::string last_message() const = 0;
+};
+
+class SparseLuSymbolic {
+ public:
+  virtual ~SparseLuSymbolic() = default;
+  virtual LinearSolverKind kind() const = 0;
+  virtual std::unique_ptr<SparseLuNumeric> make_numeric() const = 0;
+};
+
+// Symbolic analysis of a square pattern. Throws phiq::Error when the pattern is not square or the library fails.
+std::shared_ptr<const SparseLuSymbolic> analyse(LinearSolverKind kind, std::shared_ptr<const CscPattern> pattern);
+
+}  // namespace phiq

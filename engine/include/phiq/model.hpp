@@ -1,0 +1,170 @@
+// The immutable description of a mechanism: generalized coordinates, constraint equations, the fixed sparsity
+// pattern of Φq, and the symbolic factorisation of that pattern. A Model is built once (ModelBuilder or a scene
+// file) and then only read: any number of threads may evaluate it and solve with it at once, each with its own
+// Workspace (workspace.hpp).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <typeindex>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "phiq/constraint_block.hpp"
+#include "phiq/linear_solver.hpp"
+#include "phiq/sparse_pattern.hpp"
+
+namespace phiq {
+
+struct ConstraintInfo {
+  std::string name;   // as given by the user (or "<kind>#<k>")
+  std::string kind;   // DistanceSpec::kKind, ...
+  Index first_row = 0;
+  int rows = 0;
+  bool depends_on_time = false;
+};
+
+class Model {
+ public:
+  Model(Model&&) noexcept = default;
+  Model& operator=(Model&&) noexcept = default;
+  Model(const Model&) = delete;
+  Model& operator=(const Model&) = delete;
+
+  Index num_coordinates() const { return static_cast<Index>(names_.size()); }
+  Index num_equations() const { return static_cast<Index>(row_constraint_.size()); }
+  const std::vector<std::string>& coordinate_names() const { return names_; }
+  // Index of a coordinate by name; throws phiq::Error for an unknown name.
+  Index coordinate_index(const std::string& name) const;
+  const Eigen::VectorXd& initial_positions() const { return initial_; }
+  Unit coordinate_unit(Index j) const { return coordinate_units_[static_cast<std::size_t>(j)]; }
+
+  const std::vector<ConstraintInfo>& constraints() const { return constraints_; }
+  Index constraint_of_row(Index row) const { return row_constraint_[static_cast<std::size_t>(row)]; }
+  Unit row_unit(Index row) const { return row_units_[static_cast<std::size_t>(row)]; }
+  // "name" for one-row constraints, "name[k]" for row k of a multi-row one.
+  std::string row_name(Index row) const;
+  bool has_time_dependence() const { return !time_blocks_.empty(); }
+
+  // Characteristic length of the model (metres): tolerances on lengths are relative to it.
+  double length_scale() const { return length_scale_; }
+  const CscPattern& jacobian_pattern() const { return *pattern_; }
+  LinearSolverKind linear_solver() const { return lu_kind_; }
+  // Symbolic analysis of Φq's pattern; nullptr when the model is not square (equations ≠ coordinates).
+  const SparseLuSymbolic* symbolic() const { return symbolic_.get(); }
+
+  // Earliest / latest time at which every driver is defined (tabulated laws have a finite range).
+  double time_domain_begin() const { return time_begin_; }
+  double time_domain_end() const { return time_end_; }
+  const std::string& time_domain_limiter() const { return time_limiter_; }
+
+  // Evaluation. Pre-conditions: q (and qd) have num_coordinates() entries; output arrays have num_equations()
+  // entries (csc_values: jacobian_pattern().nnz()). Thread-safe.
+  void residual(const double* q, double t, double* phi) const;
+  void jacobian(const double* q, double t, double* csc_values) const;
+  void phi_t(const double* q, double t, double* out) const;
+  void gamma(const double* q, const double* qd, double t, double* out) const;
+
+ private:
+  friend class ModelBuilder;
+  Model() = default;
+
+  std::vector<std::string> names_;
+  std::unordered_map<std::string, Index> index_of_;
+  Eigen::VectorXd initial_;
+  std::vector<Unit> coordinate_units_;
+  std::vector<std::unique_ptr<ConstraintBlock>> blocks_;
+  std::vector<const ConstraintBlock*> time_blocks_;
+  std::vector<ConstraintInfo> constraints_;
+  std::vector<Index> row_constraint_;
+  std::vector<Unit> row_units_;
+  std::shared_ptr<const CscPattern> pattern_ = std::make_shared<CscPattern>();
+  std::vector<Index> slot_of_entry_;
+  double length_scale_ = 1.0;
+  double time_begin_ = -1e308, time_end_ = 1e308;
+  std::string time_limiter_;
+  LinearSolverKind lu_kind_ = LinearSolverKind::kUmfpack;
+  std::shared_ptr<const SparseLuSymbolic> symbolic_;
+};
+
+// Builds a Model in code. Coordinates first (they are referenced by index), then constraints:
+//
+//   phiq::ModelBuilder b;
+//   auto th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3), ...;
+//   b.add("crank", phiq::PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, 0.3, S(th)});
+//   b.add_driver("motor", th, phiq::MotionLaw::linear(0.0, 2.0));
+//   phiq::Model model = std::move(b).build();
+//
+// Invalid data (unknown coordinate index, non-positive length, NaN, duplicate names) throws phiq::Error.
+class ModelBuilder {
+ public:
+  ModelBuilder();
+  ~ModelBuilder();
+  ModelBuilder(ModelBuilder&&) noexcept;
+
+  Index add_coordinate(const std::string& name, double initial);
+  Index num_coordinates() const { return static_cast<Index>(model_.names_.size()); }
+  // Index of a coordinate by name, or -1.
+  Index find_coordinate(const std::string& name) const;
+  // Sets a coordinate's initial guess (rough placement for assembly).
+  void set_initial(Index j, double value);
+
+  // Adds a constraint of any kind in constraint_kinds.hpp; its rows follow those added before. Returns its index.
+  template <class Spec>
+  Index add(const std::string& name, Spec spec);
+  // Shorthand for a CoordinateDriverSpec.
+  Index add_driver(const std::string& name, Index coordinate, MotionLaw law);
+
+  // Overrides the automatic length scale (largest length in the constraints' data, else the extent of the
+  // initial placement, else 1 m).
+  void set_length_scale(double metres);
+  void set_linear_solver(LinearSolverKind kind) { model_.lu_kind_ = kind; }
+
+  // Computes the pattern, units, scale and the symbolic analysis. The builder is consumed.
+  Model build() &&;
+
+ private:
+  Index add_info(const std::string& name, const char* kind, int rows, bool depends_on_time);
+  void check_slot(const Slot& s, const std::string& name) const;
+  template <class Spec>
+  TypedBlock<Spec>& block_for();
+  // Kind-specific validation and set-up at add time; kinds with nothing to check use the template.
+  template <class Spec>
+  void prepare(Spec&) const {}
+  void prepare(PointOnLineSpec& s) const;
+  void prepare(ConstantAngleSpec& s) const;
+  void prepare(PrismaticSpec& s) const;
+  void prepare(DistanceSpec& s) const;
+  void prepare(PolarSpec& s) const;
+  void prepare(CoordinateDriverSpec& s) const;
+  void prepare(EquationSpec& s) const;
+  void prepare(PinSpec& s) const;
+  void prepare(LoopSpec& s) const;
+
+  Model model_;
+  std::unordered_map<std::type_index, std::size_t> block_of_type_;
+  double length_scale_override_ = 0.0;
+};
+
+template <class Spec>
+TypedBlock<Spec>& ModelBuilder::block_for() {
+  auto [it, inserted] = block_of_type_.emplace(std::type_index(typeid(Spec)), model_.blocks_.size());
+  if (inserted) model_.blocks_.push_back(std::make_unique<TypedBlock<Spec>>());
+  return static_cast<TypedBlock<Spec>&>(*model_.blocks_[it->second]);
+}
+
+template <class Spec>
+Index ModelBuilder::add(const std::string& name, Spec spec) {
+  const std::string label = name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(model_.constraints_.size())
+                                         : name;
+  spec.for_each_slot([&](const Slot& s, Unit) { check_slot(s, label); });
+  prepare(spec);
+  const bool td = spec.depends_on_time();
+  const Index id = add_info(label, Spec::kKind, Spec::kRows, td);
+  block_for<Spec>().entries().push_back({std::move(spec), model_.constraints_[static_cast<std::size_t>(id)].first_row, 0});
+  return id;
+}
+
+}  // namespace phiq

@@ -1,0 +1,18 @@
+// phiq: sparse, large-scale multibody kinematics. One include for the whole public API.
+#pragma once
+
+#include "phiq/constraint_kinds.hpp"
+#include "phiq/csv_writer.hpp"
+#include "phiq/expression.hpp"
+#include "phiq/kinematics.hpp"
+#include "phiq/linear_solver.hpp"
+#include "phiq/model.hpp"
+#include "phiq/motion_law.hpp"
+#include "phiq/scene.hpp"
+#include "phiq/sweep.hpp"
+#include "phiq/workspace.hpp"
+
+namespace phiq {
+// Version of the library, the CSV columns and the scene format (semantic versioning).
+inline constexpr const char* kVersion = "0.1.0";
+}  // namespace phiq

@@ -1,0 +1,23 @@
+// The fixed compressed-sparse-column pattern of Φq, built once per model from the constraints' triplets.
+#pragma once
+
+#include <vector>
+
+#include "phiq/types.hpp"
+
+namespace phiq {
+
+struct CscPattern {
+  Index rows = 0, cols = 0;
+  std::vector<Index> col_ptr;  // size cols + 1
+  std::vector<Index> row_idx;  // size nnz, ascending within each column, no duplicates
+  Index nnz() const { return static_cast<Index>(row_idx.size()); }
+};
+
+// Builds the CSC pattern of the triplets (trip_rows[k], trip_cols[k]) and, in slot_of_triplet[k], the position of
+// triplet k in the CSC value array. Duplicated (row, col) pairs share one slot, so values are accumulated into it.
+// O(nnz + rows + cols), by two counting sorts; no comparison sort.
+CscPattern build_csc_pattern(Index rows, Index cols, const std::vector<Index>& trip_rows,
+                             const std::vector<Index>& trip_cols, std::vector<Index>* slot_of_triplet);
+
+}  // namespace phiq

@@ -1,0 +1,296 @@
+#include "phiq/kinematics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace phiq {
+
+const char* to_string(SolveStatus s) {
+  switch (s) {
+    case SolveStatus::kSuccess: return "success";
+    case SolveStatus::kNotConverged: return "not converged";
+    case SolveStatus::kSingularJacobian: return "singular Jacobian";
+    case SolveStatus::kLinearSolverFailed: return "linear solver failed";
+    case SolveStatus::kNonFinite: return "non-finite value";
+    case SolveStatus::kNotSquare: return "not square";
+    case SolveStatus::kOutsideTimeDomain: return "outside time domain";
+    case SolveStatus::kCancelled: return "cancelled";
+  }
+  return "?";
+}
+
+Workspace::Workspace(const Model& model) : model_(&model) {
+  const Index n = model.num_coordinates(), m = model.num_equations();
+  q = model.initial_positions();
+  qd = Eigen::VectorXd::Zero(n);
+  qdd = Eigen::VectorXd::Zero(n);
+  phi.resize(m);
+  rhs.resize(m);
+  step.resize(n);
+  trial.resize(n);
+  trial_phi.resize(m);
+  jacobian_values.assign(static_cast<std::size_t>(model.jacobian_pattern().nnz()), 0.0);
+  if (model.symbolic()) lu = model.symbolic()->make_numeric();
+}
+
+namespace {
+
+constexpr double kUlpFloor = 64.0 * std::numeric_limits<double>::epsilon();
+
+double unit_scale(Unit u, double length_scale) { return u == Unit::kLength ? length_scale : 1.0; }
+
+// Rounding floor of lengths and of other quantities at this q: a residual or a step cannot be resolved below a few
+// ulps of the coordinates it is computed from, wherever the origin is.
+struct Floors {
+  double length = 0.0, other = 0.0;
+};
+Floors rounding_floors(const Model& model, const Eigen::VectorXd& q) {
+  Floors f;
+  for (Index j = 0; j < q.size(); ++j) {
+    double a = std::fabs(q(j));
+    if (model.coordinate_unit(j) == Unit::kLength) f.length = std::max(f.length, a);
+    else f.other = std::max(f.other, a);
+  }
+  f.length *= kUlpFloor;
+  f.other *= kUlpFloor;
+  return f;
+}
+
+bool residual_within(const Model& model, const Eigen::VectorXd& phi, double tol, const Floors& fl) {
+  const double ls = model.length_scale();
+  for (Index i = 0; i < phi.size(); ++i) {
+    const Unit u = model.row_unit(i);
+    const double lim = tol * unit_scale(u, ls) + (u == Unit::kLength ? fl.length : fl.other);
+    if (!(std::fabs(phi(i)) <= lim)) return false;
+  }
+  return true;
+}
+
+bool step_within(const Model& model, const Eigen::VectorXd& dq, const Eigen::VectorXd& q, double tol) {
+  const double ls = model.length_scale();
+  for (Index j = 0; j < dq.size(); ++j) {
+    const double lim = tol * unit_scale(model.coordinate_unit(j), ls) + kUlpFloor * std::fabs(q(j));
+    if (!(std::fabs(dq(j)) <= lim)) return false;
+  }
+  return true;
+}
+
+double merit(const Model& model, const Eigen::VectorXd& phi) {
+  const double ls = model.length_scale();
+  double s = 0.0;
+  for (Index i = 0; i < phi.size(); ++i) {
+    double r = phi(i) / unit_scale(model.row_unit(i), ls);
+    s += r * r;
+  }
+  return 0.5 * s;
+}
+
+std::vector<std::pair<Index, double>> worst_rows(const Model& model, const Eigen::VectorXd& phi, int k) {
+  const double ls = model.length_scale();
+  std::vector<std::pair<Index, double>> rows;
+  for (Index i = 0; i < phi.size(); ++i) {
+    double r = std::fabs(phi(i)) / unit_scale(model.row_unit(i), ls);
+    if (std::isnan(r)) r = std::numeric_limits<double>::infinity();
+    rows.emplace_back(i, r);
+  }
+  const std::size_t kk = std::min<std::size_t>(static_cast<std::size_t>(k), rows.size());
+  std::partial_sort(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(kk), rows.end(),
+                    [](auto& a, auto& b) { return a.second > b.second; });
+  rows.resize(kk);
+  return rows;
+}
+
+std::string describe_rows(const Model& model, const std::vector<std::pair<Index, double>>& rows) {
+  std::ostringstream s;
+  s.precision(3);
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (k) s << ", ";
+    s << "'" << model.row_name(rows[k].first) << "' " << std::scientific << rows[k].second;
+  }
+  return s.str();
+}
+
+bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
+
+void check_workspace(const Model& model, const Workspace& ws) {
+  if (&ws.model() != &model) throw Error("workspace was made for another model");
+  const Index n = model.num_coordinates();
+  if (ws.q.size() != n || ws.qd.size() != n || ws.qdd.size() != n)
+    throw Error("workspace state has the wrong size (q, qd, qdd must have " + std::to_string(n) + " entries)");
+}
+
+// Factorises Φq at (ws.q, t) unless the current factorisation was made exactly there.
+SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond, std::string* message) {
+  if (!ws.lu) {
+    *message = "the model has " + std::to_string(model.num_equations()) + " equations for " +
+               std::to_string(model.num_coordinates()) + " coordinates";
+    return SolveStatus::kNotSquare;
+  }
+  if (ws.has_factorization && ws.factorized_t == t && ws.factorized_q == ws.q) {
+    *rcond = ws.lu->rcond();
+    return SolveStatus::kSuccess;
+  }
+  ws.has_factorization = false;
+  model.jacobian(ws.q.data(), t, ws.jacobian_values.data());
+  ++ws.counters.jacobian_evaluations;
+  FactorStatus fs = ws.lu->factorize(ws.jacobian_values.data());
+  ++ws.counters.factorizations;
+  *rcond = ws.lu->rcond();
+  if (fs == FactorStatus::kFailed) {
+    *message = "sparse LU failed: " + ws.lu->last_message();
+    return SolveStatus::kLinearSolverFailed;
+  }
+  if (fs == FactorStatus::kSingular) {
+    *message = "Jacobian is singular (a zero pivot): singular position, or redundant or missing constraints";
+    return SolveStatus::kSingularJacobian;
+  }
+  ws.factorized_q = ws.q;
+  ws.factorized_t = t;
+  ws.has_factorization = true;
+  return SolveStatus::kSuccess;
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << std::scientific << v;
+  return s.str();
+}
+
+}  // namespace
+
+double scaled_residual(const Model& model, const Eigen::VectorXd& phi) {
+  auto w = worst_rows(model, phi, 1);
+  return w.empty() ? 0.0 : w[0].second;
+}
+
+std::string PositionSummary::BriefReport() const {
+  std::ostringstream s;
+  s << "position: " << to_string(status) << ", " << iterations << " iterations, scaled residual " << fmt(residual);
+  if (!message.empty()) s << " (" << message << ")";
+  return s.str();
+}
+
+SolveStatus solve_position(const Model& model, double t, const NewtonOptions& opt, Workspace& ws,
+                           PositionSummary* summary) {
+  check_workspace(model, ws);
+  if (!(opt.tolerance > 0.0) || opt.max_iterations < 0) throw Error("NewtonOptions: tolerance must be > 0");
+  PositionSummary local;
+  PositionSummary& sum = summary ? *summary : local;
+  sum = PositionSummary{};
+
+  auto finish = [&](SolveStatus st, std::string msg) {
+    sum.status = st;
+    sum.residual = scaled_residual(model, ws.phi);
+    sum.worst_rows = worst_rows(model, ws.phi, 3);
+    if (st != SolveStatus::kSuccess) {
+      sum.message = std::move(msg);
+      if (!sum.worst_rows.empty()) sum.message += "; worst constraints: " + describe_rows(model, sum.worst_rows);
+    }
+    return st;
+  };
+
+  if (!ws.lu) {
+    model.residual(ws.q.data(), t, ws.phi.data());
+    return finish(SolveStatus::kNotSquare, "the model has " + std::to_string(model.num_equations()) +
+                                               " equations for " + std::to_string(model.num_coordinates()) +
+                                               " coordinates; the driven system must be square");
+  }
+  if (!all_finite(ws.q)) {
+    ws.phi.setConstant(std::numeric_limits<double>::quiet_NaN());
+    return finish(SolveStatus::kNonFinite, "starting point has non-finite coordinates");
+  }
+
+  model.residual(ws.q.data(), t, ws.phi.data());
+  ++ws.counters.residual_evaluations;
+  double f = merit(model, ws.phi);
+  bool step_ok = false;
+  for (int it = 0;; ++it) {
+    if (!all_finite(ws.phi)) return finish(SolveStatus::kNonFinite, "constraint residual is not finite");
+    const Floors fl = rounding_floors(model, ws.q);
+    if (residual_within(model, ws.phi, opt.tolerance, fl) && (it == 0 || step_ok)) {
+      return finish(SolveStatus::kSuccess, "");
+    }
+    if (it >= opt.max_iterations)
+      return finish(SolveStatus::kNotConverged,
+                    "Newton did not converge in " + std::to_string(opt.max_iterations) + " iterations");
+
+    std::string msg;
+    SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
+    if (st != SolveStatus::kSuccess) return finish(st, msg);
+    ws.rhs = -ws.phi;
+    if (!ws.lu->solve(ws.rhs.data(), ws.step.data()))
+      return finish(SolveStatus::kLinearSolverFailed, "sparse solve failed: " + ws.lu->last_message());
+    if (!all_finite(ws.step))
+      return finish(SolveStatus::kSingularJacobian, "Newton step is not finite (Jacobian numerically singular)");
+    ++ws.counters.newton_iterations;
+    ++sum.iterations;
+
+    // Backtracking on the scaled merit: a full step whenever it helps, a shorter one from a rough placement.
+    double alpha = 1.0, ftrial = 0.0;
+    for (int bt = 0;; ++bt) {
+      ws.trial = ws.q + alpha * ws.step;
+      model.residual(ws.trial.data(), t, ws.trial_phi.data());
+      ++ws.counters.residual_evaluations;
+      ftrial = merit(model, ws.trial_phi);
+      if (!opt.line_search || ftrial <= (1.0 - 1e-4 * alpha) * f ||
+          residual_within(model, ws.trial_phi, opt.tolerance, rounding_floors(model, ws.trial)))
+        break;
+      if (bt >= opt.max_backtracks) {
+        return finish(SolveStatus::kNotConverged,
+                      "no decrease of the residual along the Newton direction (the constraints may have no "
+                      "solution near this guess)");
+      }
+      alpha *= 0.5;
+      ++sum.backtracks;
+    }
+    ws.step *= alpha;
+    step_ok = step_within(model, ws.step, ws.trial, opt.tolerance);
+    ws.q.swap(ws.trial);
+    ws.phi.swap(ws.trial_phi);
+    f = ftrial;
+  }
+}
+
+SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
+  check_workspace(model, ws);
+  LinearSummary local;
+  LinearSummary& sum = summary ? *summary : local;
+  sum = LinearSummary{};
+  std::string msg;
+  SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
+  if (st == SolveStatus::kSingularJacobian) msg = "velocities are not unique here: " + msg;
+  if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
+  model.phi_t(ws.q.data(), t, ws.rhs.data());
+  ++ws.counters.phi_t_evaluations;
+  ws.rhs = -ws.rhs;
+  if (!ws.lu->solve(ws.rhs.data(), ws.qd.data()))
+    return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
+  ++ws.counters.velocity_solves;
+  if (!all_finite(ws.qd))
+    return sum.status = SolveStatus::kNonFinite, sum.message = "velocity is not finite", sum.status;
+  return SolveStatus::kSuccess;
+}
+
+SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
+  check_workspace(model, ws);
+  LinearSummary local;
+  LinearSummary& sum = summary ? *summary : local;
+  sum = LinearSummary{};
+  std::string msg;
+  SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
+  if (st == SolveStatus::kSingularJacobian) msg = "accelerations are not unique here: " + msg;
+  if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
+  model.gamma(ws.q.data(), ws.qd.data(), t, ws.rhs.data());
+  ++ws.counters.gamma_evaluations;
+  if (!ws.lu->solve(ws.rhs.data(), ws.qdd.data()))
+    return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
+  ++ws.counters.acceleration_solves;
+  if (!all_finite(ws.qdd))
+    return sum.status = SolveStatus::kNonFinite, sum.message = "acceleration is not finite", sum.status;
+  return SolveStatus::kSuccess;
+}
+
+}  // namespace phiq

@@ -1,0 +1,212 @@
+#include "phiq/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace phiq {
+
+const char* to_string(Unit u) {
+  switch (u) {
+    case Unit::kNone: return "none";
+    case Unit::kLength: return "length";
+    case Unit::kAngle: return "angle";
+  }
+  return "?";
+}
+
+// ---- Model ---------------------------------------------------------------------------------------------------
+
+Index Model::coordinate_index(const std::string& name) const {
+  auto it = index_of_.find(name);
+  if (it == index_of_.end()) throw Error("unknown coordinate '" + name + "'");
+  return it->second;
+}
+
+std::string Model::row_name(Index row) const {
+  const ConstraintInfo& c = constraints_[static_cast<std::size_t>(constraint_of_row(row))];
+  if (c.rows == 1) return c.name;
+  return c.name + "[" + std::to_string(row - c.first_row) + "]";
+}
+
+void Model::residual(const double* q, double t, double* phi) const {
+  for (const auto& b : blocks_) b->residual(0, b->size(), q, t, phi);
+}
+
+void Model::jacobian(const double* q, double t, double* csc_values) const {
+  std::fill(csc_values, csc_values + pattern_->nnz(), 0.0);
+  for (const auto& b : blocks_) b->jacobian(0, b->size(), q, t, slot_of_entry_.data(), csc_values);
+}
+
+void Model::phi_t(const double* q, double t, double* out) const {
+  std::fill(out, out + num_equations(), 0.0);
+  for (const ConstraintBlock* b : time_blocks_) b->phi_t(0, b->size(), q, t, out);
+}
+
+void Model::gamma(const double* q, const double* qd, double t, double* out) const {
+  for (const auto& b : blocks_) b->gamma(0, b->size(), q, qd, t, out);
+}
+
+// ---- ModelBuilder --------------------------------------------------------------------------------------------
+
+ModelBuilder::ModelBuilder() = default;
+ModelBuilder::~ModelBuilder() = default;
+ModelBuilder::ModelBuilder(ModelBuilder&&) noexcept = default;
+
+Index ModelBuilder::add_coordinate(const std::string& name, double initial) {
+  if (name.empty()) throw Error("coordinate name is empty");
+  if (!std::isfinite(initial)) throw Error("coordinate '" + name + "': initial value is not finite");
+  auto [it, inserted] = model_.index_of_.emplace(name, num_coordinates());
+  if (!inserted) throw Error("duplicate coordinate name '" + name + "'");
+  model_.names_.push_back(name);
+  const Index n = num_coordinates();
+  model_.initial_.conservativeResize(n);
+  model_.initial_(n - 1) = initial;
+  return n - 1;
+}
+
+Index ModelBuilder::find_coordinate(const std::string& name) const {
+  auto it = model_.index_of_.find(name);
+  return it == model_.index_of_.end() ? -1 : it->second;
+}
+
+void ModelBuilder::set_initial(Index j, double value) {
+  if (j < 0 || j >= num_coordinates()) throw Error("set_initial: coordinate index out of range");
+  if (!std::isfinite(value)) throw Error("coordinate '" + model_.names_[j] + "': initial value is not finite");
+  model_.initial_(j) = value;
+}
+
+void ModelBuilder::set_length_scale(double metres) {
+  if (!(metres > 0.0) || !std::isfinite(metres)) throw Error("length scale must be a positive finite number");
+  length_scale_override_ = metres;
+}
+
+Index ModelBuilder::add_driver(const std::string& name, Index coordinate, MotionLaw law) {
+  return add(name, CoordinateDriverSpec{Slot::coordinate(coordinate), std::move(law)});
+}
+
+void ModelBuilder::check_slot(const Slot& s, const std::string& name) const {
+  if (s.is_coordinate() && s.coord >= num_coordinates())
+    throw Error("constraint '" + name + "': coordinate index " + std::to_string(s.coord) + " out of range (" +
+                std::to_string(num_coordinates()) + " coordinates)");
+  if (!s.is_coordinate() && !std::isfinite(s.value))
+    throw Error("constraint '" + name + "': constant is not finite");
+}
+
+Index ModelBuilder::add_info(const std::string& name, const char* kind, int rows, bool depends_on_time) {
+  for (const ConstraintInfo& c : model_.constraints_)
+    if (c.name == name) throw Error("duplicate constraint name '" + name + "'");
+  ConstraintInfo info{name, kind, static_cast<Index>(model_.row_constraint_.size()), rows, depends_on_time};
+  const Index id = static_cast<Index>(model_.constraints_.size());
+  model_.constraints_.push_back(info);
+  for (int r = 0; r < rows; ++r) model_.row_constraint_.push_back(id);
+  return id;
+}
+
+namespace {
+double initial_length(const Point2& a, const Point2& b, const Eigen::VectorXd& q0) {
+  kin::V2 d = kin::pos(b, q0.data()) - kin::pos(a, q0.data());
+  return std::hypot(d.x, d.y);
+}
+void require(bool ok, const std::string& what) {
+  if (!ok) throw Error(what);
+}
+}  // namespace
+
+// Kind-specific checks and set-up done once at add time (scales from the initial placement, normalised axes).
+void ModelBuilder::prepare(DistanceSpec& s) const {
+  require(std::isfinite(s.length) && s.length > 0.0, "distance: length must be positive and finite");
+}
+void ModelBuilder::prepare(PolarSpec& s) const {
+  require(std::isfinite(s.length), "polar: length is not finite");
+}
+void ModelBuilder::prepare(PinSpec& s) const {
+  require(std::isfinite(s.sa.x) && std::isfinite(s.sa.y) && std::isfinite(s.sb.x) && std::isfinite(s.sb.y),
+          "pin: attachment point is not finite");
+}
+void ModelBuilder::prepare(PointOnLineSpec& s) const {
+  double l = initial_length(s.a, s.b, model_.initial_);
+  s.ref = (std::isfinite(l) && l > 0.0) ? l : 1.0;
+}
+void ModelBuilder::prepare(ConstantAngleSpec& s) const {
+  require(std::isfinite(s.angle), "constant_angle: angle is not finite");
+  double lu = initial_length(s.a, s.b, model_.initial_), lv = initial_length(s.c, s.d, model_.initial_);
+  s.ref = (lu > 0.0 && lv > 0.0 && std::isfinite(lu * lv)) ? lu * lv : 1.0;
+}
+void ModelBuilder::prepare(PrismaticSpec& s) const {
+  double n = std::hypot(s.axis.x, s.axis.y);
+  require(std::isfinite(n) && n > 0.0, "prismatic: axis must be a non-zero finite vector");
+  s.axis = (1.0 / n) * s.axis;
+  require(std::isfinite(s.angle), "prismatic: angle is not finite");
+}
+void ModelBuilder::prepare(LoopSpec& s) const {
+  require(!s.links.empty(), "loop: needs at least one link");
+  for (const auto& l : s.links) require(std::isfinite(l.offset), "loop: link offset is not finite");
+}
+void ModelBuilder::prepare(CoordinateDriverSpec& s) const {
+  require(s.coordinate.is_coordinate(), "driver: must act on a coordinate");
+}
+void ModelBuilder::prepare(EquationSpec& s) const { require(s.g != nullptr, "equation: no expression"); }
+
+Model ModelBuilder::build() && {
+  Model& m = model_;
+  const Index n = m.num_coordinates(), rows = m.num_equations();
+
+  // Sparsity pattern, fixed for the life of the model.
+  std::vector<Index> trip_rows, trip_cols;
+  for (auto& b : m.blocks_) b->build_pattern(trip_rows, trip_cols);
+  auto pattern = std::make_shared<CscPattern>(build_csc_pattern(rows, n, trip_rows, trip_cols, &m.slot_of_entry_));
+  m.pattern_ = pattern;
+
+  // Units and scales.
+  m.coordinate_units_.assign(static_cast<std::size_t>(n), Unit::kNone);
+  for (auto& b : m.blocks_) b->infer_coordinate_units(m.coordinate_units_);
+  m.row_units_.assign(static_cast<std::size_t>(rows), Unit::kNone);
+  for (auto& b : m.blocks_) b->row_units(m.coordinate_units_, m.row_units_);
+
+  double scale = length_scale_override_;
+  if (scale <= 0.0)
+    for (auto& b : m.blocks_) scale = std::max(scale, b->characteristic_length());
+  if (scale <= 0.0) {
+    // no length in the data: the extent of the initial placement of the length coordinates
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (Index j = 0; j < n; ++j)
+      if (m.coordinate_units_[j] == Unit::kLength) lo = std::min(lo, m.initial_(j)), hi = std::max(hi, m.initial_(j));
+    scale = hi > lo ? hi - lo : 1.0;
+  }
+  m.length_scale_ = scale;
+
+  for (auto& b : m.blocks_) {
+    bool td = false;
+    for (std::size_t i = 0; i < b->size() && !td; ++i) td = b->depends_on_time(i);
+    if (td) m.time_blocks_.push_back(b.get());
+  }
+
+  // Every driver's law must be defined on the sweep: keep the intersection of their domains.
+  if (auto it = block_of_type_.find(std::type_index(typeid(CoordinateDriverSpec))); it != block_of_type_.end()) {
+    auto& blk = static_cast<TypedBlock<CoordinateDriverSpec>&>(*m.blocks_[it->second]);
+    for (std::size_t i = 0; i < blk.size(); ++i) {
+      const MotionLaw& law = blk.spec(i).law;
+      const std::string& name = m.constraints_[m.constraint_of_row(blk.first_row(i))].name;
+      if (law.domain_begin() > m.time_begin_) m.time_begin_ = law.domain_begin(), m.time_limiter_ = name;
+      if (law.domain_end() < m.time_end_) m.time_end_ = law.domain_end(), m.time_limiter_ = name;
+    }
+  }
+  if (auto it = block_of_type_.find(std::type_index(typeid(EquationSpec))); it != block_of_type_.end()) {
+    auto& blk = static_cast<TypedBlock<EquationSpec>&>(*m.blocks_[it->second]);
+    for (std::size_t i = 0; i < blk.size(); ++i) {
+      if (!blk.spec(i).law) continue;
+      const MotionLaw& law = *blk.spec(i).law;
+      const std::string& name = m.constraints_[m.constraint_of_row(blk.first_row(i))].name;
+      if (law.domain_begin() > m.time_begin_) m.time_begin_ = law.domain_begin(), m.time_limiter_ = name;
+      if (law.domain_end() < m.time_end_) m.time_end_ = law.domain_end(), m.time_limiter_ = name;
+    }
+  }
+
+  // Symbolic analysis once per model; square systems only (redundant or under-determined models are analysed by
+  // the rank module, not by LU).
+  if (rows == n && n > 0) m.symbolic_ = analyse(m.lu_kind_, pattern);
+  return std::move(m);
+}
+
+}  // namespace phiq

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs phiq's build and test dependencies from Debian 12's packages (nothing else is downloaded).
+# Idempotent: does nothing when every package is already installed. Needs root (or sudo).
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libeigen3-dev        # Eigen 3.4: vectors, dense reference LU, splines for tabulated laws
+  libsuitesparse-dev   # SuiteSparse 5.12: UMFPACK, CHOLMOD, KLU, SPQR
+  libtbb-dev           # oneTBB: parallel drive steps
+  libyaml-cpp-dev      # scene parser (YAML, with line/column of every node)
+  libginac-dev         # exact symbolic derivatives of equation constraints
+  libcli11-dev         # command line parser
+  libgtest-dev         # GoogleTest
+  libbenchmark-dev     # Google Benchmark
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install_deps.sh: run as root (missing: ${missing[*]})" >&2; exit 1; }
+  SUDO=sudo
+fi
+echo "install_deps.sh: installing ${missing[*]}" >&2
+$SUDO apt-get update -q
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

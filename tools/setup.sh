@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# README command (1): install the dependencies, build phiq (Release, in build/), and run the default scene.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$root/tools/install_deps.sh"
+cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$root/build" -j "$(nproc)"
+scene="${1:-$root/models/seed/crank_slider_mixed.yaml}"
+out="$root/build/$(basename "${scene%.*}").csv"
+"$root/build/tools/phiq" check "$scene"
+"$root/build/tools/phiq" run "$scene" -o "$out"
+echo "first rows of $out:"
+head -n 4 "$out" | cut -c 1-160
