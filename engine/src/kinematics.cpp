@@ -213,6 +213,12 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     if (residual_within(model, ws.phi, opt.tolerance, fl) && (it == 0 || step_ok)) {
       return finish(SolveStatus::kSuccess, "");
     }
+    if (it >= opt.max_iterations && it > 0 && residual_within(model, ws.phi, opt.tolerance, fl)) {
+      sum.slow_convergence = true;
+      finish(SolveStatus::kSuccess, "");
+      sum.message = "residual within tolerance but Newton converged only linearly (singular position?)";
+      return SolveStatus::kSuccess;
+    }
     if (it >= opt.max_iterations)
       return finish(SolveStatus::kNotConverged,
                     "Newton did not converge in " + std::to_string(opt.max_iterations) + " iterations");

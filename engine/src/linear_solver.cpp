@@ -46,7 +46,7 @@ class UmfpackSymbolic;
 
 class UmfpackNumeric final : public SparseLuNumeric {
  public:
-  explicit UmfpackNumeric(const UmfpackSymbolic& sym);
+  explicit UmfpackNumeric(std::shared_ptr<const UmfpackSymbolic> sym);
   ~UmfpackNumeric() override {
     if (numeric_) umfpack_dl_free_numeric(&numeric_);
   }
@@ -56,6 +56,7 @@ class UmfpackNumeric final : public SparseLuNumeric {
   std::string last_message() const override { return message_; }
 
  private:
+  std::shared_ptr<const UmfpackSymbolic> keep_;  // co-owns the symbolic analysis it factorises with
   const UmfpackSymbolic& sym_;
   void* numeric_ = nullptr;
   const double* values_ = nullptr;  // refinement in solve() reads the matrix the factors came from
@@ -67,7 +68,7 @@ class UmfpackNumeric final : public SparseLuNumeric {
   std::string message_;
 };
 
-class UmfpackSymbolic final : public SparseLuSymbolic {
+class UmfpackSymbolic final : public SparseLuSymbolic, public std::enable_shared_from_this<UmfpackSymbolic> {
  public:
   explicit UmfpackSymbolic(std::shared_ptr<const CscPattern> pattern) : pattern_(std::move(pattern)) {
     const CscPattern& p = *pattern_;
@@ -83,17 +84,19 @@ class UmfpackSymbolic final : public SparseLuSymbolic {
     if (symbolic_) umfpack_dl_free_symbolic(&symbolic_);
   }
   LinearSolverKind kind() const override { return LinearSolverKind::kUmfpack; }
-  std::unique_ptr<SparseLuNumeric> make_numeric() const override { return std::make_unique<UmfpackNumeric>(*this); }
+  std::unique_ptr<SparseLuNumeric> make_numeric() const override {
+    return std::make_unique<UmfpackNumeric>(shared_from_this());
+  }
 
   std::shared_ptr<const CscPattern> pattern_;  // shared with the Model
   void* symbolic_ = nullptr;   // read-only after construction: shared by all numeric objects
   double control_[UMFPACK_CONTROL];
 };
 
-UmfpackNumeric::UmfpackNumeric(const UmfpackSymbolic& sym) : sym_(sym) {
-  std::copy(sym.control_, sym.control_ + UMFPACK_CONTROL, control_);
-  wi_.resize(static_cast<std::size_t>(sym.pattern_->cols));
-  w_.resize(5 * static_cast<std::size_t>(sym.pattern_->cols));
+UmfpackNumeric::UmfpackNumeric(std::shared_ptr<const UmfpackSymbolic> sym) : keep_(std::move(sym)), sym_(*keep_) {
+  std::copy(sym_.control_, sym_.control_ + UMFPACK_CONTROL, control_);
+  wi_.resize(static_cast<std::size_t>(sym_.pattern_->cols));
+  w_.resize(5 * static_cast<std::size_t>(sym_.pattern_->cols));
 }
 
 FactorStatus UmfpackNumeric::factorize(const double* values) {

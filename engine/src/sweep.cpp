@@ -59,10 +59,10 @@ class Sweeper {
     return true;
   }
 
-  bool fail(SolveStatus st, double t, const std::string& why) {
+  // Records the cause; run_sweep prefixes the step and its grid time (the sub-step time, if any, is in `why`).
+  bool fail(SolveStatus st, double, const std::string& why) {
     sum_.status = st;
-    sum_.failed_time = t;
-    sum_.message = "t = " + fmt_t(t) + ": " + why;
+    sum_.message = why;
     return false;
   }
 
@@ -70,6 +70,7 @@ class Sweeper {
   bool assemble(double t) {
     SolveStatus st = solve_position(model_, t, opt_.assembly, ws_, &sum_.assembly);
     if (st != SolveStatus::kSuccess) return fail(st, t, "initial assembly failed: " + sum_.assembly.message);
+    note(t, sum_.assembly);
     if (!derivatives(t)) return false;
     remember(t);
     return true;
@@ -84,6 +85,7 @@ class Sweeper {
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t1, opt_.newton, ws_, &ps);
     if (st == SolveStatus::kSuccess) {
+      note(t1, ps);
       if (!derivatives(t1)) return false;
       remember(t1);
       return true;
@@ -91,9 +93,9 @@ class Sweeper {
     // Retry as two half steps from the last good state; a singular or non-finite point is not cured by that
     // unless the sub-steps avoid it, so all statuses are retried.
     if (depth >= opt_.max_subdivisions) {
-      return fail(st, t1, "no converged position after " + std::to_string(opt_.max_subdivisions) +
-                              " step subdivisions (the drive may leave the reachable range here, or the mechanism "
-                              "passes a singular position): " + ps.message);
+      return fail(st, t1, "no assembly beyond t = " + fmt_t(from.t) + " (sub-steps down to t = " + fmt_t(t1) +
+                              " tried: the drive leaves the reachable range, or the mechanism passes a singular "
+                              "position): " + ps.message);
     }
     restore(from, have_prev, prev);
     ++sum_.subdivisions;
@@ -104,6 +106,9 @@ class Sweeper {
   const State& current() const { return current_; }
 
  private:
+  void note(double t, const PositionSummary& ps) {
+    if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
+  }
   void predict(double t1) {
     const double h = t1 - current_.t;
     switch (predictor_) {
@@ -155,6 +160,7 @@ std::string SweepSummary::BriefReport() const {
     << " Newton iterations, " << counters.factorizations << " factorizations, " << counters.velocity_solves
     << " velocity and " << counters.acceleration_solves << " acceleration solves";
   if (subdivisions) s << ", " << subdivisions << " step subdivisions";
+  if (!warnings.empty()) s << ", " << warnings.size() << " warnings (first at t = " << warnings[0].t << ")";
   s.precision(3);
   s << ", " << std::scientific << solve_seconds << " s";
   if (!message.empty()) s << " — " << message;
@@ -206,7 +212,8 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
     const bool ok = k == 0 ? sw.assemble(t) : sw.advance(t, 0);
     if (!ok) {
       sum.failed_step = k;
-      sum.message = "step " + std::to_string(k) + ", " + sum.message;
+      sum.failed_time = t;
+      sum.message = "step " + std::to_string(k) + ", t = " + fmt_t(t) + ": " + sum.message;
       return done(sum.status);
     }
     StepView view{k, t, ws.q, opt.velocities ? &ws.qd : nullptr, opt.accelerations ? &ws.qdd : nullptr};

@@ -41,9 +41,13 @@ struct PositionSummary {
   int backtracks = 0;
   double residual = 0.0;  // max_i |Φ_i| / scale_i at the end
   double rcond = 0.0;     // of the last factorisation (0 if none)
+  // Success at the iteration limit with the residual within tolerance but steps still above it: the linear
+  // convergence of Newton at a singular position (a dead point, a bifurcation). The constraints hold to tolerance;
+  // the position itself is less accurate (about √tol). message says so.
+  bool slow_convergence = false;
   // The worst rows at the end (row, |Φ_i| / scale_i), largest first, at most 3.
   std::vector<std::pair<Index, double>> worst_rows;
-  std::string message;  // one line, empty on success
+  std::string message;  // one line; empty on a clean success
   std::string BriefReport() const;
 };
 

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "phiq/kinematics.hpp"
 
@@ -40,6 +41,13 @@ struct StepView {
   const Eigen::VectorXd* qdd;
 };
 
+// Something the caller should know about a delivered row (the row itself is within tolerance).
+struct SweepWarning {
+  double t;
+  std::string kind;  // "slow_convergence": Newton converged only linearly (singular position nearby)
+  std::string message;
+};
+
 struct SweepSummary {
   SolveStatus status = SolveStatus::kSuccess;
   std::string message;       // one line naming the step, time, cause and constraints; empty on success
@@ -51,6 +59,7 @@ struct SweepSummary {
   Index subdivisions = 0;    // sub-steps inserted after Newton failures
   double min_rcond = 0.0;    // smallest reciprocal condition estimate seen (0 if none)
   double min_rcond_time = 0.0;
+  std::vector<SweepWarning> warnings;
   double solve_seconds = 0.0;
   std::string BriefReport() const;
 };
