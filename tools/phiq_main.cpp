@@ -76,6 +76,8 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
     return fail(e.what(), 3);
   }
   if (!quiet) {
+    for (const auto& w : summary.warnings)
+      std::cerr << "phiq: " << scene_path << ": warning: t = " << w.t << ": " << w.kind << ": " << w.message << "\n";
     std::cerr << "phiq: " << scene_path << ": " << summary.BriefReport();
     if (summary.min_rcond > 0) std::cerr << ", min rcond " << sci(summary.min_rcond) << " at t = " << summary.min_rcond_time;
     if (file) std::cerr << "; wrote " << out_path;
