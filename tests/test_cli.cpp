@@ -1,0 +1,141 @@
+// The phiq command: exit status, CSV header and rows, no output file on failure, one-line errors.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "test_support.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("phiq_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string(PHIQ_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const int st = std::system(cmd.c_str());
+    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(out), slurp(err)};
+  }
+  fs::path write(const std::string& name, const std::string& text) {
+    fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+  // The directory holds nothing but the named files (no partial or temporary output).
+  std::vector<std::string> files() const {
+    std::vector<std::string> v;
+    for (auto& e : fs::directory_iterator(dir_)) v.push_back(e.path().filename().string());
+    std::sort(v.begin(), v.end());
+    return v;
+  }
+  fs::path dir_;
+};
+
+TEST_F(Cli, RunWritesTheCsvWithTheDocumentedColumns) {
+  const fs::path out = dir_ / "cs.csv";
+  Result r = run("run " + phiq::test::model_path("seed/crank_slider_mixed.yaml") + " -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out);
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header, "t,theta2,xA,yA,xB,theta2.v,xA.v,yA.v,xB.v,theta2.a,xA.a,yA.a,xB.a");
+  int rows = 0;
+  std::string last;
+  while (std::getline(in, line)) ++rows, last = line;
+  EXPECT_EQ(rows, 181);
+  // last row: t = π, θ2 = 2π, x_B = L2 + L3
+  std::stringstream ls(last);
+  std::vector<double> v;
+  for (std::string cell; std::getline(ls, cell, ',');) v.push_back(std::stod(cell));
+  ASSERT_EQ(v.size(), 13u);
+  EXPECT_DOUBLE_EQ(v[0], M_PI);
+  EXPECT_NEAR(v[1], 2 * M_PI, 1e-12);
+  EXPECT_NEAR(v[4], 1.3, 1e-12);
+  EXPECT_NE(r.err.find("181 steps"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, RunWithoutOutputFileWritesToStandardOutput) {
+  Result r = run("run -q " + phiq::test::model_path("seed/crank_slider_mixed.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("t,theta2,xA,yA,xB,", 0), 0u);
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 182);
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST_F(Cli, BadSceneExitsNonZeroWithOneLineAndNoFile) {
+  fs::path scene = write("bad.yaml", "coordinates: {x: 0}\ntime: {start: 0, end: 1, steps: 2}\nbogus: 1\n");
+  Result r = run("run " + scene.string() + " -o " + (dir_ / "out.csv").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("bad.yaml:3:1: bogus: unknown field 'bogus'"), std::string::npos) << r.err;
+  EXPECT_EQ(files(), (std::vector<std::string>{"bad.yaml", "stderr.txt", "stdout.txt"}));
+}
+
+TEST_F(Cli, UnreachableDriveRangeFailsWithoutTouchingAnExistingFile) {
+  // The crank-slider driven by its slider beyond L2 + L3: no assembly past x_B = 1.3.
+  fs::path scene = write("reach.yaml", R"(coordinates: {theta2: 0.5, xA: 0.26, yA: 0.14, xB: 1.2}
+points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: 0.3, angle: theta2}
+  - {name: rod, type: distance, points: [A, B], length: 1.0}
+drivers:
+  - {name: slide, coordinate: xB, law: {type: linear, initial: 1.2, rate: 0.2}}
+time: {start: 0, end: 1, steps: 10}
+)");
+  const fs::path out = dir_ / "keep.csv";
+  write("keep.csv", "previous good result\n");
+  Result r = run("run " + scene.string() + " -o " + out.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  // x_B = 1.3 at t = 0.5 is the dead point, still assembled (slowly: a double root); t = 0.6 is beyond reach
+  EXPECT_NE(r.err.find("step 6, t = 0.6: no assembly beyond t = 0.5"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no output written"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(out), "previous good result\n");
+  EXPECT_EQ(files(), (std::vector<std::string>{"keep.csv", "reach.yaml", "stderr.txt", "stdout.txt"}));
+}
+
+TEST_F(Cli, CheckReportsCountsAndAssembly) {
+  Result r = run("check " + phiq::test::model_path("seed/fourbar_reference_point.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("coordinates   9"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("equations     9 (8 kinematic, 1 rheonomic)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("assembly      success"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, UsageErrorsAndHelp) {
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("frobnicate x").code, 2);
+  EXPECT_EQ(run("run").code, 2);
+  Result h = run("run --help");
+  EXPECT_EQ(h.code, 0);
+  EXPECT_NE(h.out.find("--output"), std::string::npos);
+  EXPECT_EQ(run("--version").out, "phiq 0.1.0\n");
+}
+
+}  // namespace

@@ -1,0 +1,113 @@
+// Equation constraints from text: parsing, exact derivatives, the compiled tape, errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "phiq/expression.hpp"
+
+namespace phiq {
+namespace {
+
+// q = [theta2, xA, yA]; L2 = 0.3.
+std::optional<NameBinding> resolve(const std::string& n) {
+  if (n == "theta2") return NameBinding{NameBinding::Kind::kCoordinate, 0};
+  if (n == "xA") return NameBinding{NameBinding::Kind::kCoordinate, 1};
+  if (n == "yA") return NameBinding{NameBinding::Kind::kCoordinate, 2};
+  if (n == "unused") return NameBinding{NameBinding::Kind::kCoordinate, 7};
+  if (n == "L2") return NameBinding{NameBinding::Kind::kConstant, -1, 0.3};
+  if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+  return std::nullopt;
+}
+
+TEST(Expression, ValueGradientAndGammaOfTheNotesCrankRow) {
+  auto e = CompiledExpression::compile("xA - L2*cos(theta2)", resolve);
+  EXPECT_EQ(e->coordinates(), (std::vector<Index>{0, 1}));
+  EXPECT_FALSE(e->depends_on_time());
+  const double q[3] = {0.7, 0.2, -0.1}, qd[3] = {2.0, 0.5, 0.0};
+  EXPECT_DOUBLE_EQ(e->value(q, 0.0), 0.2 - 0.3 * std::cos(0.7));
+  double g[2];
+  e->gradient(q, 0.0, g);
+  EXPECT_DOUBLE_EQ(g[0], 0.3 * std::sin(0.7));  // the notes' Φq row: [L2 sin θ2, 1, 0, 0]
+  EXPECT_DOUBLE_EQ(g[1], 1.0);
+  // γ = −θ̇² L2 cos θ2 (notes, worked example)
+  EXPECT_NEAR(e->gamma(q, qd, 0.0), -4.0 * 0.3 * std::cos(0.7), 1e-15);
+}
+
+TEST(Expression, TimeDerivativesAreExact) {
+  auto e = CompiledExpression::compile("xA*t^2 + sin(3*t)*yA", resolve);
+  EXPECT_TRUE(e->depends_on_time());
+  EXPECT_EQ(e->coordinates(), (std::vector<Index>{1, 2}));
+  const double q[3] = {0, 1.5, -2.0}, qd[3] = {0, 0.4, 0.7}, t = 0.8;
+  // Φt = 2 xA t + 3 cos(3t) yA
+  EXPECT_NEAR(e->partial_t(q, t), 2 * 1.5 * t + 3 * std::cos(3 * t) * -2.0, 1e-14);
+  // γ = −(2 Φ_{q t} q̇ + Φtt) = −(2 (2t ẋA + 3 cos 3t ẏA) + 2 xA − 9 sin 3t yA)
+  const double expect = -(2 * (2 * t * 0.4 + 3 * std::cos(3 * t) * 0.7) + 2 * 1.5 - 9 * std::sin(3 * t) * -2.0);
+  EXPECT_NEAR(e->gamma(q, qd, t), expect, 1e-13);
+}
+
+TEST(Expression, SecondDerivativesAgainstFiniteDifferences) {
+  auto e = CompiledExpression::compile("atan2(yA, xA) * sqrt(xA^2 + yA^2) + exp(-theta2) / (1 + xA^2) + abs(yA)^3", resolve);
+  const double q[3] = {0.3, 0.8, -0.6}, qd[3] = {-1.1, 0.7, 0.4};
+  // −γ = d²/ds² g(q + s q̇) at s = 0 (no t); Richardson on central differences
+  auto g_at = [&](double s) {
+    double x[3] = {q[0] + s * qd[0], q[1] + s * qd[1], q[2] + s * qd[2]};
+    return e->value(x, 0.0);
+  };
+  auto d2 = [&](double h) { return (g_at(h) - 2 * g_at(0) + g_at(-h)) / (h * h); };
+  const double rich = (4 * d2(1e-3) - d2(2e-3)) / 3;
+  EXPECT_NEAR(-e->gamma(q, qd, 0.0), rich, 1e-8);
+  double grad[3];
+  e->gradient(q, 0.0, grad);
+  for (int j = 0; j < 3; ++j) {
+    double a[3] = {q[0], q[1], q[2]}, b[3] = {q[0], q[1], q[2]};
+    a[j] += 1e-6, b[j] -= 1e-6;
+    EXPECT_NEAR(grad[j], (e->value(a, 0) - e->value(b, 0)) / 2e-6, 1e-8) << j;
+  }
+}
+
+TEST(Expression, CommonSubexpressionsAreSharedOnTheTape) {
+  // cos(theta2) appears four times in the text; the value tape computes it once.
+  auto a = CompiledExpression::compile("cos(theta2) + cos(theta2)*xA + cos(theta2)*yA + cos(theta2)^2", resolve);
+  auto b = CompiledExpression::compile("cos(theta2)", resolve);
+  const double q[3] = {0.4, 2.0, 3.0};
+  const double c = std::cos(0.4);
+  EXPECT_DOUBLE_EQ(a->value(q, 0), c + c * 2 + c * 3 + c * c);
+  EXPECT_EQ(b->value(q, 0), c);
+}
+
+TEST(Expression, UnusedNamesDoNotBecomeColumns) {
+  auto e = CompiledExpression::compile("xA + 0*unused", resolve);
+  EXPECT_EQ(e->coordinates(), (std::vector<Index>{1}));
+}
+
+TEST(Expression, ErrorsNameTheTextAndTheProblem) {
+  auto message = [](const std::string& text, bool allow_time = true) {
+    try {
+      CompiledExpression::compile(text, resolve, allow_time);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message("xA - L3"), "expression \"xA - L3\": unknown name 'L3'");
+  EXPECT_NE(message("xA - (yA").find("expression \"xA - (yA\""), std::string::npos);
+  EXPECT_NE(message("xA - frob(yA)").find("frob"), std::string::npos);
+  EXPECT_EQ(message("xA*t", false), "expression \"xA*t\": time 't' is not allowed here");
+  EXPECT_EQ(message("   "), "expression is empty");
+  // 1e-3 is a number, not the name 'e'
+  EXPECT_NO_THROW(CompiledExpression::compile("1e-3*xA + 2.5E+2*yA", resolve));
+}
+
+TEST(Expression, ConstantExpressions) {
+  auto c = [](const std::string& n) -> std::optional<double> {
+    if (n == "L") return 2.0;
+    return std::nullopt;
+  };
+  EXPECT_DOUBLE_EQ(evaluate_constant_expression("2*pi", c), 2 * M_PI);
+  EXPECT_DOUBLE_EQ(evaluate_constant_expression("-L/2 + sqrt(9)", c), 2.0);
+  EXPECT_THROW(evaluate_constant_expression("t + 1", c), Error);
+  EXPECT_THROW(evaluate_constant_expression("M", c), Error);
+}
+
+}  // namespace
+}  // namespace phiq

@@ -1,0 +1,209 @@
+// solve_position / solve_velocity / solve_acceleration against closed forms, finite differences and each other.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+constexpr double kL2 = 0.3, kL3 = 1.0;
+
+// The notes' crank-slider built in code: q = [theta2, xA, yA, xB], theta2 = theta0 + omega t.
+Model crank_slider(double omega, double theta0, LinearSolverKind lu = LinearSolverKind::kUmfpack) {
+  ModelBuilder b;
+  Index th = b.add_coordinate("theta2", theta0), xa = b.add_coordinate("xA", 0.25),
+        ya = b.add_coordinate("yA", 0.05), xb = b.add_coordinate("xB", 1.2);
+  auto S = Slot::coordinate;
+  auto C = Slot::constant;
+  b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, kL2, S(th)});
+  b.add("rod", DistanceSpec{{S(xa), S(ya)}, {S(xb), C(0)}, kL3});
+  b.add_driver("motor", th, MotionLaw::linear(theta0, omega));
+  b.set_linear_solver(lu);
+  return std::move(b).build();
+}
+
+// Closed form x_B(θ) = L2 cos θ + sqrt(L3² − L2² sin² θ) and its θ-derivatives.
+struct SliderRef {
+  double x, dx, ddx;
+};
+SliderRef slider(double th) {
+  const double s = std::sin(th), c = std::cos(th);
+  const double S = std::sqrt(kL3 * kL3 - kL2 * kL2 * s * s);
+  const double dS = -kL2 * kL2 * s * c / S;
+  const double ddS = -kL2 * kL2 * (c * c - s * s) / S - std::pow(kL2 * kL2 * s * c, 2) / (S * S * S);
+  return {kL2 * c + S, -kL2 * s + dS, -kL2 * c + ddS};
+}
+
+TEST(Kinematics, CrankSliderMatchesClosedFormOverHalfTurnOfTime) {
+  // Also a non-constant crank speed would need θ̈; here θ̇ = ω, θ̈ = 0: ẋ = x' ω, ẍ = x'' ω².
+  const double omega = 2.0;
+  Model m = crank_slider(omega, 0.0);
+  SweepOptions opt;
+  opt.t_begin = 0.0;
+  opt.t_end = M_PI;
+  opt.steps = 180;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, opt, &tr), SolveStatus::kSuccess);
+  ASSERT_EQ(tr.t.size(), 181u);
+  double worst_x = 0, worst_v = 0, worst_a = 0;
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    const double th = omega * tr.t[k];
+    SliderRef r = slider(th);
+    worst_x = std::max(worst_x, std::fabs(tr.q[k](3) - r.x));
+    worst_v = std::max(worst_v, std::fabs(tr.qd[k](3) - r.dx * omega));
+    worst_a = std::max(worst_a, std::fabs(tr.qdd[k](3) - r.ddx * omega * omega));
+    EXPECT_NEAR(tr.q[k](1), kL2 * std::cos(th), 1e-12);
+    EXPECT_NEAR(tr.qdd[k](0), 0.0, 1e-12);  // the notes' erratum: the driver row of γ is 0
+  }
+  EXPECT_LT(worst_x, 1e-10);
+  EXPECT_LT(worst_v, 1e-8);
+  EXPECT_LT(worst_a, 1e-8);
+}
+
+TEST(Kinematics, NotesWorkedExampleJacobianAndGamma) {
+  // Φq and γ at one state, entry by entry against the notes' matrices (with the distance row scaled by 1/(2 L3),
+  // phiq's normalisation, and the polar rows written as the notes write them).
+  Model m = crank_slider(2.0, 0.0);
+  Eigen::VectorXd q(4), qd(4);
+  const double th = 0.7, xa = kL2 * std::cos(th), ya = kL2 * std::sin(th), xb = 1.1;
+  q << th, xa, ya, xb;
+  qd << 2.0, 0.3, -0.4, 0.5;
+  std::vector<double> vals(static_cast<std::size_t>(m.jacobian_pattern().nnz()));
+  m.jacobian(q.data(), 0.1, vals.data());
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(4, 4);
+  const CscPattern& p = m.jacobian_pattern();
+  for (Index c = 0; c < p.cols; ++c)
+    for (Index k = p.col_ptr[c]; k < p.col_ptr[c + 1]; ++k) J(p.row_idx[k], c) = vals[k];
+  Eigen::MatrixXd notes(4, 4);
+  notes << kL2 * std::sin(th), 1, 0, 0,  //
+      -kL2 * std::cos(th), 0, 1, 0,       //
+      0, 2 * xa - 2 * xb, 2 * ya, 2 * xb - 2 * xa, 1, 0, 0, 0;
+  notes.row(2) /= 2 * kL3;
+  // phiq orders rows as added: crank (2 rows), rod, motor — the same order as the notes.
+  EXPECT_LT((J - notes).cwiseAbs().maxCoeff(), 1e-14);
+
+  Eigen::VectorXd gamma(4);
+  m.gamma(q.data(), qd.data(), 0.1, gamma.data());
+  Eigen::VectorXd g_notes(4);
+  g_notes << -qd(0) * qd(0) * kL2 * std::cos(th), -qd(0) * qd(0) * kL2 * std::sin(th),
+      -(2 * qd(1) * (qd(1) - qd(3)) + 2 * qd(2) * qd(2) + 2 * qd(3) * (qd(3) - qd(1))) / (2 * kL3), 0.0;
+  EXPECT_LT((gamma - g_notes).cwiseAbs().maxCoeff(), 1e-14);
+}
+
+TEST(Kinematics, DenseAndSparsePathsAgree) {
+  Model sparse = crank_slider(1.3, 0.2, LinearSolverKind::kUmfpack);
+  Model dense = crank_slider(1.3, 0.2, LinearSolverKind::kDense);
+  SweepOptions opt;
+  opt.t_end = 5.0;
+  opt.steps = 97;
+  test::Trace a, b;
+  ASSERT_EQ(test::sweep(sparse, opt, &a), SolveStatus::kSuccess);
+  ASSERT_EQ(test::sweep(dense, opt, &b), SolveStatus::kSuccess);
+  for (std::size_t k = 0; k < a.t.size(); ++k) {
+    EXPECT_LT((a.q[k] - b.q[k]).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT((a.qd[k] - b.qd[k]).cwiseAbs().maxCoeff(), 1e-11);
+    EXPECT_LT((a.qdd[k] - b.qdd[k]).cwiseAbs().maxCoeff(), 1e-10);
+  }
+}
+
+TEST(Kinematics, AssemblyFromRoughPlacementIsTheNearbySolution) {
+  Model m = crank_slider(2.0, 0.4);
+  Workspace ws(m);
+  ws.q << 0.1, 0.5, -0.2, 0.7;  // far from the solution, θ2 off by 0.3 rad
+  PositionSummary s;
+  ASSERT_EQ(solve_position(m, 0.0, NewtonOptions{}, ws, &s), SolveStatus::kSuccess) << s.message;
+  EXPECT_NEAR(ws.q(0), 0.4, 1e-12);
+  EXPECT_NEAR(ws.q(3), slider(0.4).x, 1e-10);
+  EXPECT_LE(s.residual, 1e-10);
+  EXPECT_GT(s.iterations, 2);
+}
+
+TEST(Kinematics, VelocityAndAccelerationAreTimeDerivativesOfPosition) {
+  // Independent of any closed form: central differences of the converged positions in time.
+  Model m = crank_slider(1.7, 0.3);
+  Workspace ws(m);
+  auto position_at = [&](double t) {
+    ws.q(0) = 0.3 + 1.7 * t;  // good guess
+    EXPECT_EQ(solve_position(m, t, NewtonOptions{1e-14, 30}, ws), SolveStatus::kSuccess);
+    return Eigen::VectorXd(ws.q);
+  };
+  const double t = 0.9, h = 1e-4;
+  Eigen::VectorXd qm = position_at(t - h), qp = position_at(t + h), q0 = position_at(t);
+  ASSERT_EQ(solve_velocity(m, t, ws), SolveStatus::kSuccess);
+  ASSERT_EQ(solve_acceleration(m, t, ws), SolveStatus::kSuccess);
+  EXPECT_LT(((qp - qm) / (2 * h) - ws.qd).cwiseAbs().maxCoeff(), 1e-7);
+  EXPECT_LT(((qp - 2 * q0 + qm) / (h * h) - ws.qdd).cwiseAbs().maxCoeff(), 1e-5);
+}
+
+TEST(Kinematics, VelocityReusesTheFactorisationAtTheConvergedPoint) {
+  Model m = crank_slider(2.0, 0.0);
+  Workspace ws(m);
+  ASSERT_EQ(solve_position(m, 0.2, NewtonOptions{}, ws), SolveStatus::kSuccess);
+  const Index f0 = ws.counters.factorizations;
+  ASSERT_EQ(solve_velocity(m, 0.2, ws), SolveStatus::kSuccess);
+  ASSERT_EQ(solve_acceleration(m, 0.2, ws), SolveStatus::kSuccess);
+  // exactly one factorisation at the converged q, shared by velocity and acceleration
+  EXPECT_EQ(ws.counters.factorizations, f0 + 1);
+  EXPECT_EQ(ws.counters.velocity_solves, 1);
+  EXPECT_EQ(ws.counters.acceleration_solves, 1);
+}
+
+TEST(Kinematics, SingularJacobianIsAStatusNotACrash) {
+  // Drive the slider coordinate xB instead of the crank: at the dead centre θ = 0 the crank angle is not
+  // determined to first order by xB and Φq is singular.
+  ModelBuilder b;
+  Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", kL2), ya = b.add_coordinate("yA", 0.0),
+        xb = b.add_coordinate("xB", kL2 + kL3);
+  auto S = Slot::coordinate;
+  auto C = Slot::constant;
+  b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, kL2, S(th)});
+  b.add("rod", DistanceSpec{{S(xa), S(ya)}, {S(xb), C(0)}, kL3});
+  b.add_driver("slide", xb, MotionLaw::linear(kL2 + kL3, 0.0));
+  Model m = std::move(b).build();
+  Workspace ws(m);
+  ASSERT_EQ(solve_position(m, 0.0, NewtonOptions{}, ws), SolveStatus::kSuccess);  // already at the solution
+  LinearSummary ls;
+  EXPECT_EQ(solve_velocity(m, 0.0, ws, &ls), SolveStatus::kSingularJacobian);
+  EXPECT_NE(ls.message.find("not unique"), std::string::npos) << ls.message;
+}
+
+TEST(Kinematics, NonSquareModelIsReportedWithCounts) {
+  ModelBuilder b;
+  Index x = b.add_coordinate("x", 0.0);
+  b.add_coordinate("y", 0.0);
+  b.add_driver("d", x, MotionLaw::linear(0, 1));
+  Model m = std::move(b).build();
+  Workspace ws(m);
+  PositionSummary s;
+  EXPECT_EQ(solve_position(m, 0.0, NewtonOptions{}, ws, &s), SolveStatus::kNotSquare);
+  EXPECT_NE(s.message.find("1 equations for 2 coordinates"), std::string::npos) << s.message;
+}
+
+TEST(Kinematics, ConvergenceDoesNotDependOnTheOrigin) {
+  // The same crank-slider translated by 10^6 m along x (ground pivot and slider line moved): converges, and
+  // the positions relative to the pivot agree with the untranslated run to the relative tolerance.
+  for (double shift : {0.0, 1e6}) {
+    ModelBuilder b;
+    Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", shift + 0.25),
+          ya = b.add_coordinate("yA", 0.05), xb = b.add_coordinate("xB", shift + 1.2);
+    auto S = Slot::coordinate;
+    auto C = Slot::constant;
+    b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(shift), C(0)}, kL2, S(th)});
+    b.add("rod", DistanceSpec{{S(xa), S(ya)}, {S(xb), C(0)}, kL3});
+    b.add_driver("motor", th, MotionLaw::linear(0.0, 2.0));
+    Model m = std::move(b).build();
+    SweepOptions opt;
+    opt.t_end = 1.0;
+    opt.steps = 20;
+    test::Trace tr;
+    ASSERT_EQ(test::sweep(m, opt, &tr), SolveStatus::kSuccess) << "shift " << shift;
+    for (std::size_t k = 0; k < tr.t.size(); ++k)
+      EXPECT_NEAR(tr.q[k](3) - shift, slider(2.0 * tr.t[k]).x, 1e-8) << "shift " << shift;
+  }
+}
+
+}  // namespace
+}  // namespace phiq

@@ -1,0 +1,85 @@
+// Motion laws: values and exact derivatives.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "phiq/motion_law.hpp"
+
+namespace phiq {
+namespace {
+
+void check_derivatives(const MotionLaw& law, double t, double tol) {
+  const double h = 1e-5;
+  LawValue v = law.evaluate(t), p = law.evaluate(t + h), m = law.evaluate(t - h);
+  EXPECT_NEAR(v.df, (p.f - m.f) / (2 * h), tol) << law.description() << " at " << t;
+  EXPECT_NEAR(v.ddf, (p.df - m.df) / (2 * h), tol) << law.description() << " at " << t;
+}
+
+TEST(MotionLaw, LinearPolynomialHarmonic) {
+  MotionLaw lin = MotionLaw::linear(0.5, 2.0);
+  EXPECT_DOUBLE_EQ(lin.evaluate(3.0).f, 6.5);
+  EXPECT_DOUBLE_EQ(lin.evaluate(3.0).df, 2.0);
+  EXPECT_DOUBLE_EQ(lin.evaluate(3.0).ddf, 0.0);
+  MotionLaw poly = MotionLaw::polynomial({1.0, -2.0, 0.5, 0.25});
+  LawValue v = poly.evaluate(2.0);
+  EXPECT_DOUBLE_EQ(v.f, 1 - 4 + 2 + 2);
+  EXPECT_DOUBLE_EQ(v.df, -2 + 2 + 3);
+  EXPECT_DOUBLE_EQ(v.ddf, 1 + 3);
+  MotionLaw harm = MotionLaw::harmonic(0.1, 0.5, 3.0, 0.2);
+  EXPECT_NEAR(harm.evaluate(0.7).f, 0.1 + 0.5 * std::sin(2.3), 1e-15);
+  EXPECT_NEAR(harm.evaluate(0.7).ddf, -4.5 * std::sin(2.3), 1e-14);
+  for (double t : {0.0, 0.3, 1.7}) {
+    check_derivatives(poly, t, 1e-7);
+    check_derivatives(harm, t, 1e-7);
+  }
+}
+
+TEST(MotionLaw, TableInterpolatesItsPointsAndIsExactForCubics) {
+  std::vector<double> t = {0.0, 0.5, 1.2, 2.0, 2.5, 3.0}, v;
+  for (double x : t) v.push_back(1.0 - x + 0.5 * x * x - 0.1 * x * x * x);
+  MotionLaw tab = MotionLaw::table(t, v);
+  for (std::size_t k = 0; k < t.size(); ++k) EXPECT_NEAR(tab.evaluate(t[k]).f, v[k], 1e-12);
+  // a cubic is reproduced with its derivatives (not-a-knot-like B-spline interpolation)
+  for (double x : {0.1, 0.9, 1.9, 2.8}) {
+    LawValue l = tab.evaluate(x);
+    EXPECT_NEAR(l.f, 1.0 - x + 0.5 * x * x - 0.1 * x * x * x, 1e-12);
+    EXPECT_NEAR(l.df, -1.0 + x - 0.3 * x * x, 1e-11);
+    EXPECT_NEAR(l.ddf, 1.0 - 0.6 * x, 1e-10);
+  }
+  EXPECT_DOUBLE_EQ(tab.domain_begin(), 0.0);
+  EXPECT_DOUBLE_EQ(tab.domain_end(), 3.0);
+  EXPECT_TRUE(std::isnan(tab.evaluate(3.5).f));
+}
+
+TEST(MotionLaw, TableOfNonPolynomialDataHasConsistentDerivatives) {
+  std::vector<double> t, v;
+  for (int k = 0; k <= 12; ++k) t.push_back(0.25 * k), v.push_back(std::sin(t.back()));
+  MotionLaw tab = MotionLaw::table(t, v);
+  for (double x : {0.4, 1.3, 2.2}) {
+    check_derivatives(tab, x, 1e-6);
+    EXPECT_NEAR(tab.evaluate(x).f, std::sin(x), 1e-3);
+  }
+}
+
+TEST(MotionLaw, ExpressionLaw) {
+  auto f = CompiledExpression::compile("0.1*t^3 + cos(2*t)", [](const std::string& n) -> std::optional<NameBinding> {
+    if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+    return std::nullopt;
+  });
+  MotionLaw law = MotionLaw::expression(f);
+  LawValue v = law.evaluate(0.6);
+  EXPECT_NEAR(v.f, 0.1 * 0.216 + std::cos(1.2), 1e-15);
+  EXPECT_NEAR(v.df, 0.3 * 0.36 - 2 * std::sin(1.2), 1e-14);
+  EXPECT_NEAR(v.ddf, 0.6 * 0.6 - 4 * std::cos(1.2), 1e-14);
+}
+
+TEST(MotionLaw, InvalidData) {
+  EXPECT_THROW(MotionLaw::table({0.0, 1.0, 1.0}, {0, 1, 2}), Error);
+  EXPECT_THROW(MotionLaw::table({0.0}, {0}), Error);
+  EXPECT_THROW(MotionLaw::table({0.0, 1.0}, {0}), Error);
+  EXPECT_THROW(MotionLaw::linear(NAN, 1.0), Error);
+  EXPECT_THROW(MotionLaw::polynomial({}), Error);
+}
+
+}  // namespace
+}  // namespace phiq

@@ -1,0 +1,197 @@
+// Scene loading: valid scenes build the right model; bad scenes give one-line errors naming file, line, field.
+#include <gtest/gtest.h>
+
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+const char* kGood = R"(phiq: 1
+parameters: {L2: 0.3, L3: 2*L2 + 0.4}
+coordinates:
+  theta2: 0
+  xA: 0.3
+  yA: 0
+  xB: 1.3
+points:
+  O: [0, 0]
+  A: [xA, yA]
+  B: [xB, 0]
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: rod, type: distance, points: [A, B], length: L3}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
+time: {start: 0, end: pi/2, steps: 4}
+output: {velocities: true}
+)";
+
+// Replaces the first occurrence of `from` in the good scene.
+std::string variant(const std::string& from, const std::string& to) {
+  std::string s = kGood;
+  auto p = s.find(from);
+  EXPECT_NE(p, std::string::npos) << from;
+  return s.replace(p, from.size(), to);
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_scene(text, "bad.yaml");
+  } catch (const SceneError& e) {
+    std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+    EXPECT_EQ(m.rfind("bad.yaml:", 0), 0u) << m;
+    return m;
+  }
+  ADD_FAILURE() << "no error for:\n" << text;
+  return "";
+}
+
+#define EXPECT_HAS(msg, part) EXPECT_NE((msg).find(part), std::string::npos) << (msg)
+
+TEST(Scene, GoodSceneBuildsTheModelItDescribes) {
+  Scene s = parse_scene(kGood, "good.yaml");
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 4);
+  EXPECT_EQ(m.num_equations(), 4);
+  ASSERT_EQ(m.constraints().size(), 3u);
+  EXPECT_EQ(m.constraints()[0].name, "crank");
+  EXPECT_EQ(m.constraints()[0].kind, "polar");
+  EXPECT_EQ(m.constraints()[2].name, "motor");
+  EXPECT_TRUE(m.constraints()[2].depends_on_time);
+  EXPECT_EQ(m.coordinate_unit(0), Unit::kAngle);
+  EXPECT_EQ(m.coordinate_unit(3), Unit::kLength);
+  EXPECT_DOUBLE_EQ(m.length_scale(), 1.0);  // L3 = 2*0.3 + 0.4, the longest link
+  EXPECT_DOUBLE_EQ(s.sweep.t_end, M_PI / 2);
+  EXPECT_EQ(s.sweep.steps, 4);
+  EXPECT_TRUE(s.sweep.velocities);
+  EXPECT_FALSE(s.sweep.accelerations);
+  EXPECT_EQ(s.output_coordinates.size(), 4u);
+  // the polar row is a length, the driver row has the unit of its coordinate
+  EXPECT_EQ(m.row_unit(0), Unit::kLength);
+  EXPECT_EQ(m.row_unit(3), Unit::kAngle);
+}
+
+TEST(Scene, YamlSyntaxErrorHasLineAndColumn) {
+  std::string m = error_of(variant("points:\n  O: [0, 0]", "points:\n  O: [0, 0"));
+  EXPECT_HAS(m, "YAML syntax error");
+  EXPECT_HAS(m, "bad.yaml:");
+}
+
+TEST(Scene, UnknownFieldIsNamedWithItsPathAndLine) {
+  std::string m = error_of(variant("time: {start: 0,", "time: {begin: 0, start: 0,"));
+  EXPECT_HAS(m, "bad.yaml:17:");
+  EXPECT_HAS(m, "time.begin");
+  EXPECT_HAS(m, "unknown field 'begin'");
+}
+
+TEST(Scene, UnknownTopLevelField) {
+  std::string m = error_of(std::string(kGood) + "outputs: {}\n");
+  EXPECT_HAS(m, "unknown field 'outputs'");
+  EXPECT_HAS(m, "bad.yaml:19:");
+}
+
+TEST(Scene, DuplicateCoordinateName) {
+  std::string m = error_of(variant("  yA: 0\n", "  yA: 0\n  xA: 0.1\n"));
+  EXPECT_HAS(m, "duplicate name 'xA'");
+  EXPECT_HAS(m, "bad.yaml:7:");
+}
+
+TEST(Scene, DuplicateConstraintName) {
+  std::string m = error_of(variant("{name: rod,", "{name: crank,"));
+  EXPECT_HAS(m, "duplicate constraint or driver name 'crank'");
+  EXPECT_HAS(m, "constraints[1].name");
+}
+
+TEST(Scene, UnknownPointAndCoordinateNames) {
+  EXPECT_HAS(error_of(variant("points: [A, B]", "points: [A, Q]")), "unknown point 'Q'");
+  std::string m = error_of(variant("coordinate: theta2", "coordinate: theta9"));
+  EXPECT_HAS(m, "drivers[0].coordinate");
+  EXPECT_HAS(m, "unknown coordinate 'theta9'");
+  EXPECT_HAS(m, "bad.yaml:16:");
+  EXPECT_HAS(error_of(variant("B: [xB, 0]", "B: [xQ, 0]")), "unknown name 'xQ'");
+}
+
+TEST(Scene, NanAndInfiniteNumbersAreRefused) {
+  std::string m = error_of(variant("xA: 0.3", "xA: .nan"));
+  EXPECT_HAS(m, "coordinates.xA");
+  EXPECT_HAS(m, "not a finite number");
+  EXPECT_HAS(error_of(variant("length: L3", "length: .inf")), "not a finite number");
+  EXPECT_HAS(error_of(variant("L2: 0.3", "L2: 1e999")), "not a finite number");
+}
+
+TEST(Scene, ImpossibleValuesAreRefused) {
+  std::string m = error_of(variant("length: L3", "length: -1"));
+  EXPECT_HAS(m, "constraints[1].length");
+  EXPECT_HAS(m, "must be positive");
+  EXPECT_HAS(error_of(variant("steps: 4", "steps: -4")), "time.steps");
+  EXPECT_HAS(error_of(variant("steps: 4", "steps: 2.5")), "expected a whole number");
+  EXPECT_HAS(error_of(variant("end: pi/2", "end: 0")), "end equals start");
+}
+
+TEST(Scene, WrongTypes) {
+  EXPECT_HAS(error_of(variant("points: [A, B]", "points: A")), "a segment is [from, to]");
+  EXPECT_HAS(error_of(variant("O: [0, 0]", "O: [0, 0, 0]")), "a point is [x, y]");
+  EXPECT_HAS(error_of(variant("velocities: true", "velocities: maybe")), "expected true or false");
+  EXPECT_HAS(error_of(variant("output: {velocities: true}", "output: [velocities]")), "expected a mapping");
+  EXPECT_HAS(error_of(variant("{name: crank, type: polar", "{name: [crank], type: polar")), "expected a single value");
+}
+
+TEST(Scene, UnknownKindsAndLaws) {
+  EXPECT_HAS(error_of(variant("type: distance", "type: distanse")), "unknown constraint type 'distanse'");
+  EXPECT_HAS(error_of(variant("type: linear", "type: linaer")), "unknown law type 'linaer'");
+}
+
+TEST(Scene, MissingSectionsAndFields) {
+  std::string s = kGood;
+  s = s.substr(0, s.find("time:"));
+  EXPECT_HAS(error_of(s), "missing field 'time'");
+  EXPECT_HAS(error_of(variant(", length: L3}", "}")), "missing field 'length'");
+}
+
+TEST(Scene, EquationErrorsNameTheExpression) {
+  std::string base = variant("  - {name: rod, type: distance, points: [A, B], length: L3}",
+                             "  - {name: rod, type: equation, expr: \"(xA - xB)^2 + yA^2 - L3^2\"}");
+  EXPECT_NO_THROW(parse_scene(base, "ok.yaml"));
+  std::string m = error_of(variant("  - {name: rod, type: distance, points: [A, B], length: L3}",
+                                   "  - {name: rod, type: equation, expr: \"(xA - xB)^2 + foo^2 - L3^2\"}"));
+  EXPECT_HAS(m, "constraints[1]");
+  EXPECT_HAS(m, "unknown name 'foo'");
+  EXPECT_HAS(error_of(variant("  - {name: rod, type: distance, points: [A, B], length: L3}",
+                              "  - {name: rod, type: equation, expr: \"(xA - xB\"}")),
+             "constraints[1].expr");
+  EXPECT_HAS(error_of(variant("  - {name: rod, type: distance, points: [A, B], length: L3}",
+                              "  - {name: rod, type: equation, expr: \"gamma(xA)\"}")),
+             "constraints[1].expr");
+}
+
+TEST(Scene, NonSquareModelIsAModellingError) {
+  std::string m = error_of(variant("drivers:\n  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}\n", ""));
+  EXPECT_HAS(m, "4 coordinates but 3 constraint equations");
+}
+
+TEST(Scene, ReservedAndInvalidNames) {
+  EXPECT_HAS(error_of(variant("  xB: 1.3\n", "  xB: 1.3\n  t: 0\n")), "'t' is reserved");
+  EXPECT_HAS(error_of(variant("  xB: 1.3\n", "  xB: 1.3\n  x.v: 0\n")), "not a valid coordinate name");
+}
+
+TEST(Scene, FileErrors) {
+  try {
+    load_scene("/nonexistent/scene.yaml");
+    ADD_FAILURE();
+  } catch (const SceneError& e) {
+    EXPECT_HAS(std::string(e.what()), "/nonexistent/scene.yaml: cannot open");
+  }
+  EXPECT_HAS(error_of(""), "the scene is empty");
+}
+
+TEST(Scene, EverySeedSceneLoads) {
+  for (const char* f : {"crank_slider_mixed.yaml", "crank_slider_equations.yaml", "fourbar_relative.yaml",
+                        "fourbar_reference_point.yaml", "fourbar_natural.yaml", "fourbar_mixed.yaml"}) {
+    EXPECT_NO_THROW(load_scene(test::model_path(std::string("seed/") + f))) << f;
+  }
+}
+
+}  // namespace
+}  // namespace phiq

@@ -1,0 +1,177 @@
+// run_sweep: predictors, step subdivision, failures that stop with a diagnosis, cancellation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+auto S = Slot::coordinate;
+auto C = Slot::constant;
+
+// Crank-rocker four-bar in natural coordinates (O=(0,0), C=(1,0); a=0.4, b=1.2, c=1.0), driven by the rocker angle
+// theta4 of segment C→B. The rocker can only swing between θ4 = acos(0.28) (crank and coupler stretched out,
+// |OB| = 1.6) and acos(−0.68) (folded, |OB| = 0.8).
+Model rocker_driven(double from, double rate) {
+  ModelBuilder b;
+  Index xa = b.add_coordinate("xA", 0.1), ya = b.add_coordinate("yA", 0.4), xb = b.add_coordinate("xB", 1.0 + std::cos(from)),
+        yb = b.add_coordinate("yB", std::sin(from)), th4 = b.add_coordinate("theta4", from);
+  Point2 O{C(0), C(0)}, A{S(xa), S(ya)}, B{S(xb), S(yb)}, Cc{C(1), C(0)};
+  b.add("crank", DistanceSpec{O, A, 0.4});
+  b.add("coupler", DistanceSpec{A, B, 1.2});
+  b.add("rocker", DistanceSpec{Cc, B, 1.0});
+  b.add("rocker_angle", SegmentAngleSpec{Cc, B, S(th4)});
+  b.add_driver("rocker_motor", th4, MotionLaw::linear(from, rate));
+  return std::move(b).build();
+}
+
+TEST(Sweep, DriveBeyondTheReachableRangeStopsWithADiagnosis) {
+  const double limit = std::acos(-0.68);  // 2.3462 rad
+  Model m = rocker_driven(1.5, 1.0);
+  SweepOptions opt;
+  opt.t_end = 1.1;  // θ4 up to 2.6 rad
+  opt.steps = 110;
+  test::Trace tr;
+  SweepSummary sum;
+  EXPECT_NE(test::sweep(m, opt, &tr, &sum), SolveStatus::kSuccess);
+  // every delivered row is inside the range, and the run stopped at the first step beyond it
+  ASSERT_FALSE(tr.t.empty());
+  EXPECT_LE(1.5 + tr.t.back(), limit + 1e-12);
+  EXPECT_GT(1.5 + sum.failed_time, limit);
+  EXPECT_LT(1.5 + sum.failed_time, limit + 0.01 + 1e-12);
+  EXPECT_EQ(sum.failed_step, static_cast<Index>(tr.t.size()));
+  EXPECT_NE(sum.message.find("step " + std::to_string(sum.failed_step)), std::string::npos) << sum.message;
+  EXPECT_NE(sum.message.find("t = "), std::string::npos) << sum.message;
+  // the diagnosis names constraints
+  EXPECT_NE(sum.message.find("'"), std::string::npos) << sum.message;
+}
+
+TEST(Sweep, TableOutsideItsRangeIsRefusedBeforeSolving) {
+  ModelBuilder b;
+  Index x = b.add_coordinate("x", 0.0);
+  b.add_driver("lift", x, MotionLaw::table({0.0, 1.0, 2.0}, {0.0, 0.5, 0.7}));
+  Model m = std::move(b).build();
+  SweepOptions opt;
+  opt.t_end = 3.0;
+  opt.steps = 3;
+  test::Trace tr;
+  SweepSummary sum;
+  EXPECT_EQ(test::sweep(m, opt, &tr, &sum), SolveStatus::kOutsideTimeDomain);
+  EXPECT_TRUE(tr.t.empty());
+  EXPECT_NE(sum.message.find("'lift'"), std::string::npos) << sum.message;
+  EXPECT_NE(sum.message.find("t = 3"), std::string::npos) << sum.message;
+}
+
+Model crank_slider() {
+  ModelBuilder b;
+  Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3), ya = b.add_coordinate("yA", 0.0),
+        xb = b.add_coordinate("xB", 1.3);
+  b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, 0.3, S(th)});
+  b.add("rod", DistanceSpec{{S(xa), S(ya)}, {S(xb), C(0)}, 1.0});
+  b.add_driver("motor", th, MotionLaw::linear(0.0, 1.0));
+  return std::move(b).build();
+}
+
+double slider_x(double th) { return 0.3 * std::cos(th) + std::sqrt(1.0 - 0.09 * std::sin(th) * std::sin(th)); }
+
+TEST(Sweep, FailedStepsAreSubdividedAndTheSweepContinues) {
+  Model m = crank_slider();
+  SweepOptions opt;
+  opt.t_end = M_PI;
+  opt.steps = 6;  // 30° steps
+  opt.velocities = opt.accelerations = false;
+  opt.predictor = Predictor::kPrevious;
+  opt.newton.max_iterations = 3;  // too few for a 30° jump from the previous position
+  test::Trace tr;
+  SweepSummary sum;
+  ASSERT_EQ(test::sweep(m, opt, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+  EXPECT_GT(sum.subdivisions, 0);
+  ASSERT_EQ(tr.t.size(), 7u);
+  for (std::size_t k = 0; k < tr.t.size(); ++k) EXPECT_NEAR(tr.q[k](3), slider_x(tr.t[k]), 1e-9);
+}
+
+TEST(Sweep, PredictorsReachTheSameSolutions) {
+  Model m = crank_slider();
+  for (Predictor p : {Predictor::kPrevious, Predictor::kSecant, Predictor::kLinear, Predictor::kQuadratic}) {
+    SweepOptions opt;
+    opt.t_end = 2 * M_PI;
+    opt.steps = 72;
+    opt.predictor = p;
+    test::Trace tr;
+    SweepSummary sum;
+    ASSERT_EQ(test::sweep(m, opt, &tr, &sum), SolveStatus::kSuccess) << to_string(p) << sum.message;
+    for (std::size_t k = 0; k < tr.t.size(); ++k) EXPECT_NEAR(tr.q[k](3), slider_x(tr.t[k]), 1e-10) << to_string(p);
+  }
+}
+
+TEST(Sweep, BetterPredictorsNeedFewerNewtonIterations) {
+  Model m = crank_slider();
+  auto iterations = [&](Predictor p) {
+    SweepOptions opt;
+    opt.t_end = 2 * M_PI;
+    opt.steps = 360;
+    opt.predictor = p;
+    test::Trace tr;
+    SweepSummary sum;
+    EXPECT_EQ(test::sweep(m, opt, &tr, &sum), SolveStatus::kSuccess);
+    return sum.counters.newton_iterations;
+  };
+  EXPECT_LT(iterations(Predictor::kQuadratic), iterations(Predictor::kPrevious));
+}
+
+TEST(Sweep, PositionOnlySweepDoesNoVelocityOrAccelerationWork) {
+  Model m = crank_slider();
+  SweepOptions opt;
+  opt.t_end = 1.0;
+  opt.steps = 10;
+  opt.velocities = opt.accelerations = false;
+  test::Trace tr;
+  SweepSummary sum;
+  ASSERT_EQ(test::sweep(m, opt, &tr, &sum), SolveStatus::kSuccess);
+  EXPECT_EQ(sum.counters.velocity_solves, 0);
+  EXPECT_EQ(sum.counters.acceleration_solves, 0);
+  EXPECT_EQ(sum.counters.phi_t_evaluations, 0);
+  EXPECT_EQ(sum.counters.gamma_evaluations, 0);
+  EXPECT_TRUE(tr.qd.empty());
+  // with velocities and accelerations: exactly one solve of each per row
+  opt.velocities = opt.accelerations = true;
+  test::Trace tr2;
+  ASSERT_EQ(test::sweep(m, opt, &tr2, &sum), SolveStatus::kSuccess);
+  EXPECT_EQ(sum.counters.velocity_solves, 11);
+  EXPECT_EQ(sum.counters.acceleration_solves, 11);
+  EXPECT_EQ(sum.counters.gamma_evaluations, 11);
+}
+
+TEST(Sweep, CallbackCanStopTheSweep) {
+  Model m = crank_slider();
+  Workspace ws(m);
+  SweepOptions opt;
+  opt.steps = 50;
+  int rows = 0;
+  SweepSummary sum;
+  EXPECT_EQ(run_sweep(m, opt, ws, [&](const StepView&) { return ++rows < 5; }, &sum), SolveStatus::kCancelled);
+  EXPECT_EQ(rows, 5);
+}
+
+TEST(Sweep, ReverseTimeAndSingleStepSweeps) {
+  Model m = crank_slider();
+  SweepOptions opt;
+  opt.t_begin = 1.0;
+  opt.t_end = 0.0;
+  opt.steps = 10;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, opt, &tr), SolveStatus::kSuccess);
+  EXPECT_DOUBLE_EQ(tr.t.front(), 1.0);
+  EXPECT_DOUBLE_EQ(tr.t.back(), 0.0);
+  EXPECT_NEAR(tr.q.back()(3), 1.3, 1e-12);
+  opt.steps = 0;
+  test::Trace one;
+  ASSERT_EQ(test::sweep(m, opt, &one), SolveStatus::kSuccess);
+  EXPECT_EQ(one.t.size(), 1u);
+}
+
+}  // namespace
+}  // namespace phiq
