@@ -73,6 +73,10 @@ class UmfpackSymbolic final : public SparseLuSymbolic, public std::enable_shared
   explicit UmfpackSymbolic(std::shared_ptr<const CscPattern> pattern) : pattern_(std::move(pattern)) {
     const CscPattern& p = *pattern_;
     umfpack_dl_defaults(control_);
+    // No iterative refinement: Newton corrects its own steps, and for velocity/acceleration on a non-singular Φq
+    // the direct solve is accurate to cond·eps. Refinement (the default, up to 2 steps) cost ~25 % of a sweep step
+    // on nfourbar (bench/README.md) and changed no test result.
+    control_[UMFPACK_IRSTEP] = 0;
     double info[UMFPACK_INFO];
     // Pattern-only analysis (Ax = NULL): the column pre-ordering depends on the pattern, which is fixed per model;
     // the numeric factorisation still pivots on the values of every iteration.

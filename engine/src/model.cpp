@@ -94,8 +94,7 @@ void ModelBuilder::check_slot(const Slot& s, const std::string& name) const {
 }
 
 Index ModelBuilder::add_info(const std::string& name, const char* kind, int rows, bool depends_on_time) {
-  for (const ConstraintInfo& c : model_.constraints_)
-    if (c.name == name) throw Error("duplicate constraint name '" + name + "'");
+  if (!constraint_names_.insert(name).second) throw Error("duplicate constraint name '" + name + "'");
   ConstraintInfo info{name, kind, static_cast<Index>(model_.row_constraint_.size()), rows, depends_on_time};
   const Index id = static_cast<Index>(model_.constraints_.size());
   model_.constraints_.push_back(info);

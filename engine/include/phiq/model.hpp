@@ -8,6 +8,7 @@
 #include <string>
 #include <typeindex>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include <Eigen/Core>
@@ -145,6 +146,7 @@ class ModelBuilder {
 
   Model model_;
   std::unordered_map<std::type_index, std::size_t> block_of_type_;
+  std::unordered_set<std::string> constraint_names_;  // duplicate check in O(1): models reach 10^6 constraints
   double length_scale_override_ = 0.0;
 };
 
