@@ -11,18 +11,8 @@ namespace {
 
 constexpr double kL2 = 0.3, kL3 = 1.0;
 
-// The notes' crank-slider built in code: q = [theta2, xA, yA, xB], theta2 = theta0 + omega t.
 Model crank_slider(double omega, double theta0, LinearSolverKind lu = LinearSolverKind::kUmfpack) {
-  ModelBuilder b;
-  Index th = b.add_coordinate("theta2", theta0), xa = b.add_coordinate("xA", 0.25),
-        ya = b.add_coordinate("yA", 0.05), xb = b.add_coordinate("xB", 1.2);
-  auto S = Slot::coordinate;
-  auto C = Slot::constant;
-  b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, kL2, S(th)});
-  b.add("rod", DistanceSpec{{S(xa), S(ya)}, {S(xb), C(0)}, kL3});
-  b.add_driver("motor", th, MotionLaw::linear(theta0, omega));
-  b.set_linear_solver(lu);
-  return std::move(b).build();
+  return test::crank_slider_model(omega, theta0, lu);
 }
 
 // Closed form x_B(θ) = L2 cos θ + sqrt(L3² − L2² sin² θ) and its θ-derivatives.

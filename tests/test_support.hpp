@@ -33,6 +33,22 @@ inline SolveStatus sweep(const Model& model, const SweepOptions& opt, Trace* tra
       summary);
 }
 
+// The notes' crank-slider built in code: q = [theta2, xA, yA, xB], L2 = 0.3, L3 = 1.0, theta2 = theta0 + omega t,
+// from a rough placement.
+inline Model crank_slider_model(double omega = 1.0, double theta0 = 0.0,
+                                LinearSolverKind lu = LinearSolverKind::kUmfpack) {
+  ModelBuilder b;
+  Index th = b.add_coordinate("theta2", theta0), xa = b.add_coordinate("xA", 0.25),
+        ya = b.add_coordinate("yA", 0.05), xb = b.add_coordinate("xB", 1.2);
+  auto S = Slot::coordinate;
+  auto C = Slot::constant;
+  b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, 0.3, S(th)});
+  b.add("rod", DistanceSpec{{S(xa), S(ya)}, {S(xb), C(0)}, 1.0});
+  b.add_driver("motor", th, MotionLaw::linear(theta0, omega));
+  b.set_linear_solver(lu);
+  return std::move(b).build();
+}
+
 // Difference of two angles, wrapped to (-pi, pi].
 inline double angle_diff(double a, double b) { return std::remainder(a - b, 2.0 * M_PI); }
 

@@ -65,15 +65,7 @@ TEST(Sweep, TableOutsideItsRangeIsRefusedBeforeSolving) {
   EXPECT_NE(sum.message.find("t = 3"), std::string::npos) << sum.message;
 }
 
-Model crank_slider() {
-  ModelBuilder b;
-  Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3), ya = b.add_coordinate("yA", 0.0),
-        xb = b.add_coordinate("xB", 1.3);
-  b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, 0.3, S(th)});
-  b.add("rod", DistanceSpec{{S(xa), S(ya)}, {S(xb), C(0)}, 1.0});
-  b.add_driver("motor", th, MotionLaw::linear(0.0, 1.0));
-  return std::move(b).build();
-}
+Model crank_slider() { return test::crank_slider_model(); }
 
 double slider_x(double th) { return 0.3 * std::cos(th) + std::sqrt(1.0 - 0.09 * std::sin(th) * std::sin(th)); }
 

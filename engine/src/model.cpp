@@ -182,24 +182,19 @@ Model ModelBuilder::build() && {
   }
 
   // Every driver's law must be defined on the sweep: keep the intersection of their domains.
+  auto limit_time = [&](const MotionLaw& law, Index row) {
+    const std::string& name = m.constraints_[static_cast<std::size_t>(m.constraint_of_row(row))].name;
+    if (law.domain_begin() > m.time_begin_) m.time_begin_ = law.domain_begin(), m.time_limiter_ = name;
+    if (law.domain_end() < m.time_end_) m.time_end_ = law.domain_end(), m.time_limiter_ = name;
+  };
   if (auto it = block_of_type_.find(std::type_index(typeid(CoordinateDriverSpec))); it != block_of_type_.end()) {
     auto& blk = static_cast<TypedBlock<CoordinateDriverSpec>&>(*m.blocks_[it->second]);
-    for (std::size_t i = 0; i < blk.size(); ++i) {
-      const MotionLaw& law = blk.spec(i).law;
-      const std::string& name = m.constraints_[m.constraint_of_row(blk.first_row(i))].name;
-      if (law.domain_begin() > m.time_begin_) m.time_begin_ = law.domain_begin(), m.time_limiter_ = name;
-      if (law.domain_end() < m.time_end_) m.time_end_ = law.domain_end(), m.time_limiter_ = name;
-    }
+    for (std::size_t i = 0; i < blk.size(); ++i) limit_time(blk.spec(i).law, blk.first_row(i));
   }
   if (auto it = block_of_type_.find(std::type_index(typeid(EquationSpec))); it != block_of_type_.end()) {
     auto& blk = static_cast<TypedBlock<EquationSpec>&>(*m.blocks_[it->second]);
-    for (std::size_t i = 0; i < blk.size(); ++i) {
-      if (!blk.spec(i).law) continue;
-      const MotionLaw& law = *blk.spec(i).law;
-      const std::string& name = m.constraints_[m.constraint_of_row(blk.first_row(i))].name;
-      if (law.domain_begin() > m.time_begin_) m.time_begin_ = law.domain_begin(), m.time_limiter_ = name;
-      if (law.domain_end() < m.time_end_) m.time_end_ = law.domain_end(), m.time_limiter_ = name;
-    }
+    for (std::size_t i = 0; i < blk.size(); ++i)
+      if (blk.spec(i).law) limit_time(*blk.spec(i).law, blk.first_row(i));
   }
 
   // Symbolic analysis once per model; square systems only (redundant or under-determined models are analysed by
