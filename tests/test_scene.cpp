@@ -73,6 +73,25 @@ TEST(Scene, GoodSceneBuildsTheModelItDescribes) {
   EXPECT_EQ(m.row_unit(3), Unit::kAngle);
 }
 
+TEST(Scene, JsonIsReadAsWellAndGivesTheSameModel) {
+  const char* json = R"({"parameters": {"L2": 0.3, "L3": "2*L2 + 0.4"},
+ "coordinates": {"theta2": 0, "xA": 0.3, "yA": 0, "xB": 1.3},
+ "points": {"O": [0, 0], "A": ["xA", "yA"], "B": ["xB", 0]},
+ "constraints": [{"name": "crank", "type": "polar", "point": "A", "origin": "O", "length": "L2", "angle": "theta2"},
+                 {"name": "rod", "type": "distance", "points": ["A", "B"], "length": "L3"}],
+ "drivers": [{"name": "motor", "coordinate": "theta2", "law": {"type": "linear", "initial": 0, "rate": 2}}],
+ "time": {"start": 0, "end": "pi/2", "steps": 4}, "output": {"velocities": true}})";
+  Scene a = parse_scene(kGood, "good.yaml"), b = parse_scene(json, "good.json");
+  test::Trace ta, tb;
+  ASSERT_EQ(test::sweep(*a.model, a.sweep, &ta), SolveStatus::kSuccess);
+  ASSERT_EQ(test::sweep(*b.model, b.sweep, &tb), SolveStatus::kSuccess);
+  ASSERT_EQ(ta.q.size(), tb.q.size());
+  for (std::size_t k = 0; k < ta.q.size(); ++k) {
+    EXPECT_EQ(ta.q[k], tb.q[k]);  // bit for bit: the same model
+    EXPECT_EQ(ta.qd[k], tb.qd[k]);
+  }
+}
+
 TEST(Scene, YamlSyntaxErrorHasLineAndColumn) {
   std::string m = error_of(variant("points:\n  O: [0, 0]", "points:\n  O: [0, 0"));
   EXPECT_HAS(m, "YAML syntax error");
