@@ -78,6 +78,9 @@ TEST_F(Cli, RunWritesTheCsvWithTheDocumentedColumns) {
   EXPECT_NEAR(v[1], 2 * M_PI, 1e-12);
   EXPECT_NEAR(v[4], 1.3, 1e-12);
   EXPECT_NE(r.err.find("181 steps"), std::string::npos) << r.err;
+  const std::string all = slurp(out);
+  EXPECT_EQ(all.find(",-0,"), std::string::npos) << "negative zeros are written as 0";
+  EXPECT_NE(all.find("\n0,0,0.3,0,1.3,2,0,0.6,0,0,-1.2,0,-1.56\n"), std::string::npos) << "first row at t = 0";
 }
 
 TEST_F(Cli, RunWithoutOutputFileWritesToStandardOutput) {

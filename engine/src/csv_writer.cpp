@@ -28,6 +28,7 @@ std::string CsvFormat::header() const {
 
 namespace {
 inline void put(double v, std::string& out) {
+  if (v == 0.0) v = 0.0;  // −0 → 0: same value, and text diffs of results stay quiet
   char buf[32];
   auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
   out.append(buf, p);
