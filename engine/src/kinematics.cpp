@@ -77,6 +77,13 @@ bool step_within(const Model& model, const Eigen::VectorXd& dq, const Eigen::Vec
   return true;
 }
 
+double max_scaled(const Model& model, const Eigen::VectorXd& phi) {
+  const double ls = model.length_scale();
+  double m = 0.0;
+  for (Index i = 0; i < phi.size(); ++i) m = std::max(m, std::fabs(phi(i)) / unit_scale(model.row_unit(i), ls));
+  return m;
+}
+
 double merit(const Model& model, const Eigen::VectorXd& phi) {
   const double ls = model.length_scale();
   double s = 0.0;
@@ -161,10 +168,7 @@ std::string fmt(double v) {
 
 }  // namespace
 
-double scaled_residual(const Model& model, const Eigen::VectorXd& phi) {
-  auto w = worst_rows(model, phi, 1);
-  return w.empty() ? 0.0 : w[0].second;
-}
+double scaled_residual(const Model& model, const Eigen::VectorXd& phi) { return max_scaled(model, phi); }
 
 std::string PositionSummary::BriefReport() const {
   std::ostringstream s;
@@ -183,12 +187,14 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
 
   auto finish = [&](SolveStatus st, std::string msg) {
     sum.status = st;
-    sum.residual = scaled_residual(model, ws.phi);
-    sum.worst_rows = worst_rows(model, ws.phi, 3);
-    if (st != SolveStatus::kSuccess) {
-      sum.message = std::move(msg);
-      if (!sum.worst_rows.empty()) sum.message += "; worst constraints: " + describe_rows(model, sum.worst_rows);
+    if (st == SolveStatus::kSuccess) {
+      sum.residual = max_scaled(model, ws.phi);  // O(m), no allocation: this runs once per drive step
+      return st;
     }
+    sum.worst_rows = worst_rows(model, ws.phi, 3);
+    sum.residual = sum.worst_rows.empty() ? 0.0 : sum.worst_rows[0].second;
+    sum.message = std::move(msg);
+    if (!sum.worst_rows.empty()) sum.message += "; worst constraints: " + describe_rows(model, sum.worst_rows);
     return st;
   };
 

@@ -49,9 +49,9 @@ class Sweeper {
   // Derivatives at the converged ws.q, as asked for. Returns false (summary filled) on failure.
   bool derivatives(double t) {
     LinearSummary ls;
-    if (need_v_ && solve_velocity(model_, t, ws_, &ls) != SolveStatus::kSuccess) return fail(ls.status, t, ls.message);
+    if (need_v_ && solve_velocity(model_, t, ws_, &ls) != SolveStatus::kSuccess) return fail(ls.status, ls.message);
     if (need_a_ && solve_acceleration(model_, t, ws_, &ls) != SolveStatus::kSuccess)
-      return fail(ls.status, t, ls.message);
+      return fail(ls.status, ls.message);
     if (need_v_ && ws_.lu) {
       double rc = ws_.lu->rcond();
       if (sum_.min_rcond == 0.0 || rc < sum_.min_rcond) sum_.min_rcond = rc, sum_.min_rcond_time = t;
@@ -60,7 +60,7 @@ class Sweeper {
   }
 
   // Records the cause; run_sweep prefixes the step and its grid time (the sub-step time, if any, is in `why`).
-  bool fail(SolveStatus st, double, const std::string& why) {
+  bool fail(SolveStatus st, const std::string& why) {
     sum_.status = st;
     sum_.message = why;
     return false;
@@ -69,18 +69,16 @@ class Sweeper {
   // Initial position problem from the rough placement in ws.q.
   bool assemble(double t) {
     SolveStatus st = solve_position(model_, t, opt_.assembly, ws_, &sum_.assembly);
-    if (st != SolveStatus::kSuccess) return fail(st, t, "initial assembly failed: " + sum_.assembly.message);
+    if (st != SolveStatus::kSuccess) return fail(st, "initial assembly failed: " + sum_.assembly.message);
     note(t, sum_.assembly);
     if (!derivatives(t)) return false;
     remember(t);
     return true;
   }
 
-  // From the converged state at current_.t to t1, subdividing on failure.
+  // From the converged state at current_.t to t1, subdividing on failure. current_ (and prev_) change only on
+  // success, so a failed attempt restores from them without copying any state on the way.
   bool advance(double t1, int depth) {
-    const State from = current_;
-    const bool have_prev = has_prev_;
-    const State prev = prev_;
     predict(t1);
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t1, opt_.newton, ws_, &ps);
@@ -93,13 +91,13 @@ class Sweeper {
     // Retry as two half steps from the last good state; a singular or non-finite point is not cured by that
     // unless the sub-steps avoid it, so all statuses are retried.
     if (depth >= opt_.max_subdivisions) {
-      return fail(st, t1, "no assembly beyond t = " + fmt_t(from.t) + " (sub-steps down to t = " + fmt_t(t1) +
-                              " tried: the drive leaves the reachable range, or the mechanism passes a singular "
-                              "position): " + ps.message);
+      return fail(st, "no assembly beyond t = " + fmt_t(current_.t) + " (sub-steps down to t = " + fmt_t(t1) +
+                          " tried: the drive leaves the reachable range, or the mechanism passes a singular "
+                          "position): " + ps.message);
     }
-    restore(from, have_prev, prev);
+    restore();
     ++sum_.subdivisions;
-    const double tm = 0.5 * (from.t + t1);
+    const double tm = 0.5 * (current_.t + t1);
     return advance(tm, depth + 1) && advance(t1, depth + 1);
   }
 
@@ -125,7 +123,7 @@ class Sweeper {
   }
   void remember(double t) {
     if (predictor_ == Predictor::kSecant) {
-      prev_ = std::move(current_);
+      std::swap(prev_, current_);  // current_ now holds prev's buffers: assigned below without allocating
       has_prev_ = true;
     }
     current_.t = t;
@@ -133,13 +131,10 @@ class Sweeper {
     if (need_v_) current_.qd = ws_.qd;
     if (need_a_) current_.qdd = ws_.qdd;
   }
-  void restore(const State& from, bool have_prev, const State& prev) {
-    current_ = from;
-    has_prev_ = have_prev;
-    prev_ = prev;
-    ws_.q = from.q;
-    if (need_v_) ws_.qd = from.qd;
-    if (need_a_) ws_.qdd = from.qdd;
+  void restore() {
+    ws_.q = current_.q;
+    if (need_v_) ws_.qd = current_.qd;
+    if (need_a_) ws_.qdd = current_.qdd;
   }
 
   const Model& model_;
