@@ -18,6 +18,7 @@
 #include <memory>
 #include <optional>
 #include <random>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -80,11 +81,14 @@ class StateGenerator {
 };
 
 std::string Describe(const State& s) {
-  std::string out = "state: t = " + std::to_string(s.t) + ", q = [";
-  for (double v : s.q) out += " " + std::to_string(v);
-  out += " ], qd = [";
-  for (double v : s.qd) out += " " + std::to_string(v);
-  return out + " ]";
+  // a stream, not string concatenation: GCC 12 warns falsely (-Wrestrict, PR 105329) on "literal" + std::string
+  std::ostringstream out;
+  out << "state: t = " << s.t << ", q = [";
+  for (double v : s.q) out << ' ' << v;
+  out << " ], qd = [";
+  for (double v : s.qd) out << ' ' << v;
+  out << " ]";
+  return out.str();
 }
 
 // ---- spec-level evaluation ------------------------------------------------------------------------------------
