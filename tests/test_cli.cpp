@@ -3,6 +3,7 @@
 
 #include <sys/wait.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -36,9 +37,10 @@ class Cli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  Result run(const std::string& args) {
+  Result run(const std::string& args) { return run_prefixed("", args); }
+  Result run_prefixed(const std::string& prefix, const std::string& args) {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(PHIQ_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const std::string cmd = prefix + std::string(PHIQ_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
     const int st = std::system(cmd.c_str());
     return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(out), slurp(err)};
   }
@@ -131,6 +133,68 @@ TEST_F(Cli, CheckReportsCountsAndAssembly) {
   EXPECT_NE(r.out.find("assembly      success"), std::string::npos) << r.out;
 }
 
+TEST_F(Cli, CheckJsonIsOneVersionedObject) {
+  Result r = run("check --json " + phiq::test::model_path("seed/fourbar_natural.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  // key order and values, without a JSON library in the test: the format is documented line by line
+  for (const char* part : {"\"format\": 1", "\"coordinates\": 5", "\"equations\": 5", "\"kinematic_equations\": 4",
+                           "\"driver_equations\": 1", "\"status\": \"success\"", "\"worst\": []"})
+    EXPECT_NE(r.out.find(part), std::string::npos) << part << "\n" << r.out;
+  EXPECT_EQ(r.out.front(), '{');
+  EXPECT_EQ(r.out.substr(r.out.size() - 2), "}\n");
+}
+
+TEST_F(Cli, CheckJsonNamesTheWorstConstraintsWhenAssemblyFails) {
+  // a coupler too short to close the loop: no assembly exists
+  std::string scene = slurp(phiq::test::model_path("seed/fourbar_natural.yaml"));
+  scene.replace(scene.find("L3: 1.2"), 7, "L3: 0.1");
+  fs::path p = write("open.yaml", scene);
+  Result r = run("check --json " + p.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.out.find("\"status\": \"not converged\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"constraint\": \""), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, InterruptStopsCleanlyWithoutOutput) {
+  // a sweep of 10^7 steps runs for minutes; SIGINT after half a second
+  std::string scene = slurp(phiq::test::model_path("seed/crank_slider_mixed.yaml"));
+  scene.replace(scene.find("steps: 180"), 10, "steps: 10000000");
+  fs::path p = write("long.yaml", scene);
+  const auto t0 = std::chrono::steady_clock::now();
+  Result r = run_prefixed("timeout --preserve-status -s INT 0.5 ", "run " + p.string() + " -o " + (dir_ / "out.csv").string());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.code, 130) << r.err;
+  EXPECT_LT(seconds, 5.0);
+  EXPECT_NE(r.err.find("interrupted; no output written"), std::string::npos) << r.err;
+  EXPECT_EQ(files(), (std::vector<std::string>{"long.yaml", "stderr.txt", "stdout.txt"}));
+}
+
+TEST_F(Cli, CompareExitStatusAndWorstCell) {
+  const std::string ref = phiq::test::model_path("seed/reference/crank_slider_mixed.csv");
+  const fs::path out = dir_ / "cs.csv";
+  ASSERT_EQ(run("run -q " + phiq::test::model_path("seed/crank_slider_mixed.yaml") + " -o " + out.string()).code, 0);
+  Result same = run("compare " + ref + " " + out.string());
+  EXPECT_EQ(same.code, 0) << same.err;
+  // perturb one acceleration cell by 1e-6 relative
+  std::string text = slurp(out);
+  const std::size_t row = text.find("\n0.5061454830783556,");
+  ASSERT_NE(row, std::string::npos);
+  const std::size_t last = text.find('\n', row + 1), comma = text.rfind(',', last);
+  const double v = std::stod(text.substr(comma + 1, last - comma - 1));
+  std::ostringstream nv;
+  nv.precision(17);
+  nv << v * (1 + 1e-6);
+  text.replace(comma + 1, last - comma - 1, nv.str());
+  fs::path bad = write("bad.csv", text);
+  Result diff = run("compare " + ref + " " + bad.string());
+  EXPECT_EQ(diff.code, 1);
+  EXPECT_NE(diff.err.find("xB.a"), std::string::npos) << diff.err;
+  EXPECT_NE(diff.err.find("0.5061454830783556"), std::string::npos) << diff.err;  // the time of the worst row
+  EXPECT_EQ(run("compare --rtol 1e-5 " + ref + " " + bad.string()).code, 0);
+  EXPECT_EQ(run("compare " + ref + " /nonexistent.csv").code, 2);
+  EXPECT_EQ(run("compare --columns t,nope " + ref + " " + out.string()).code, 2);
+}
+
 TEST_F(Cli, UsageErrorsAndHelp) {
   EXPECT_EQ(run("").code, 2);
   EXPECT_EQ(run("frobnicate x").code, 2);
@@ -138,7 +202,7 @@ TEST_F(Cli, UsageErrorsAndHelp) {
   Result h = run("run --help");
   EXPECT_EQ(h.code, 0);
   EXPECT_NE(h.out.find("--output"), std::string::npos);
-  EXPECT_EQ(run("--version").out, "phiq 0.1.0\n");
+  EXPECT_EQ(run("--version").out, "phiq 0.1.0 (scene format 1, CSV format 1, check --json format 1)\n");
 }
 
 }  // namespace

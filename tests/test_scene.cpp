@@ -205,6 +205,50 @@ TEST(Scene, FileErrors) {
   EXPECT_HAS(error_of(""), "the scene is empty");
 }
 
+TEST(Scene, HostileShapesAreRefusedBeforeTheTreeIsBuilt) {
+  std::string deep = "coordinates: {x: 0}\nname: " + std::string(200, '[') + std::string(200, ']') + "\n";
+  EXPECT_HAS(error_of(deep), "nested more than 32 levels deep");
+  EXPECT_HAS(error_of(std::string(kGood) + "description: &a hello\nname: *a\n"), "aliases (*name) are not supported");
+  EXPECT_HAS(error_of(std::string(kGood) + "---\nname: two\n"), "a scene is one YAML document");
+  EXPECT_HAS(error_of(std::string(kGood) + "description: \"" + std::string(20000, 'x') + "\"\n"),
+             "a value of 20000 bytes; the limit is 16384");
+  EXPECT_HAS(error_of(std::string("name: a\0b\n", 11)), "contains a NUL byte");
+  SceneLimits tiny;
+  tiny.max_file_bytes = 100;
+  try {
+    parse_scene(kGood, "big.yaml", tiny);
+    ADD_FAILURE();
+  } catch (const SceneError& e) {
+    EXPECT_HAS(std::string(e.what()), "big.yaml: the scene is 0 MiB; the limit is 0 MiB");
+  }
+  SceneLimits few;
+  few.max_nodes = 20;
+  try {
+    parse_scene(kGood, "many.yaml", few);
+    ADD_FAILURE();
+  } catch (const SceneError& e) {
+    EXPECT_HAS(std::string(e.what()), "more than 20 values; the scene is too large");
+  }
+}
+
+TEST(Scene, HostileExpressionsAreRefused) {
+  auto with = [](const std::string& expr) {
+    return variant("  - {name: rod, type: distance, points: [A, B], length: L3}",
+                   "  - {name: rod, type: equation, expr: \"" + expr + "\"}");
+  };
+  EXPECT_HAS(error_of(with("xA" + std::string(4200, '+') + "xB")), "the limit is 4096");
+  EXPECT_HAS(error_of(with(std::string(100, '(') + "xA" + std::string(100, ')'))), "parentheses deep");
+  // a product of 340 factors fits in 4096 characters, but its gradient needs ~n²/2 instructions
+  std::string product = "(xA+xB+1)";
+  for (int k = 2; k <= 340; ++k) product += "*(xA+xB+" + std::to_string(k) + ")";
+  const std::string m = error_of(with(product));
+  EXPECT_HAS(m, "instructions; the limit is 50000");
+  // ... while a product of 60 is an ordinary (if long) constraint, compiled in milliseconds
+  std::string shorter = "(xA+xB+1)";
+  for (int k = 2; k <= 60; ++k) shorter += "*(xA+xB+" + std::to_string(k) + ")";
+  EXPECT_NO_THROW(parse_scene(with(shorter), "ok.yaml"));
+}
+
 TEST(Scene, EverySeedSceneLoads) {
   for (const char* f : {"crank_slider_mixed.yaml", "crank_slider_equations.yaml", "fourbar_relative.yaml",
                         "fourbar_reference_point.yaml", "fourbar_natural.yaml", "fourbar_mixed.yaml"}) {

@@ -11,6 +11,9 @@ packages=(
   libyaml-cpp-dev      # scene parser (YAML, with line/column of every node)
   libginac-dev         # exact symbolic derivatives of equation constraints
   libcli11-dev         # command line parser
+  nlohmann-json3-dev   # JSON output (check --json)
+  clang libclang-rt-14-dev  # libFuzzer + AddressSanitizer/UndefinedBehaviorSanitizer build (tests/fuzz)
+  doxygen              # API reference (target phiq_docs)
   libgtest-dev         # GoogleTest
   libbenchmark-dev     # Google Benchmark
 )

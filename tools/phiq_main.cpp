@@ -1,8 +1,10 @@
 // phiq — command line front end. See tools/README.md.
 //
-// Exit status: 0 success; 1 the mechanism could not be solved (the message names step, time and constraints);
-// 2 bad input (scene or command line); 3 an output file could not be written; 130 interrupted.
+// Exit status: 0 success; 1 the mechanism could not be solved (the message names step, time and constraints), or
+// `compare` found a difference; 2 bad input (scene, CSV or command line); 3 an output file could not be written;
+// 130 interrupted.
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include <atomic>
 #include <csignal>
@@ -10,6 +12,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 
 namespace {
@@ -40,20 +43,36 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   phiq::Workspace ws(model);
   phiq::CsvFormat csv(model, scene.output_coordinates, scene.sweep.velocities, scene.sweep.accelerations);
 
+  // Where the CSV goes: a file that appears only when complete, or standard output after success, spooled through
+  // an anonymous temporary file so that memory stays bounded however long the sweep is.
   std::unique_ptr<phiq::AtomicOutputFile> file;
+  std::FILE* spool = nullptr;
   std::string buffer = csv.header();
   try {
     if (!out_path.empty()) file = std::make_unique<phiq::AtomicOutputFile>(out_path);
+    else if (!(spool = std::tmpfile())) throw phiq::Error("cannot create a temporary file for standard output");
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
   }
+  struct CloseSpool {
+    std::FILE* f;
+    ~CloseSpool() {
+      if (f) std::fclose(f);
+    }
+  } close_spool{spool};
+  auto flush = [&] {
+    if (file) file->write(buffer);
+    else if (std::fwrite(buffer.data(), 1, buffer.size(), spool) != buffer.size())
+      throw phiq::Error("cannot write the temporary file for standard output");
+    buffer.clear();
+  };
 
   std::signal(SIGINT, on_sigint);
   phiq::SweepSummary summary;
   try {
     phiq::run_sweep(model, scene.sweep, ws, [&](const phiq::StepView& step) {
       csv.append_row(step, buffer);
-      if (file && buffer.size() > (1u << 20)) file->write(buffer), buffer.clear();
+      if (buffer.size() > (1u << 20)) flush();
       return !g_interrupted.load();
     }, &summary);
   } catch (const phiq::Error& e) {
@@ -65,12 +84,15 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   if (summary.status != phiq::SolveStatus::kSuccess)
     return fail(scene_path + ": " + summary.message + (out_path.empty() ? "" : "; no output written"), 1);
   try {
+    flush();
     if (file) {
-      file->write(buffer);
       file->commit();
     } else {
-      std::fwrite(buffer.data(), 1, buffer.size(), stdout);
-      std::fflush(stdout);
+      std::rewind(spool);
+      char chunk[1 << 16];
+      for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, spool)) > 0;)
+        if (std::fwrite(chunk, 1, n, stdout) != n) throw phiq::Error("cannot write to standard output");
+      if (std::fflush(stdout) != 0) throw phiq::Error("cannot write to standard output");
     }
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
@@ -86,7 +108,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   return 0;
 }
 
-int cmd_check(const std::string& scene_path) {
+int cmd_check(const std::string& scene_path, bool json) {
   phiq::Scene scene;
   try {
     scene = phiq::load_scene(scene_path);
@@ -96,6 +118,50 @@ int cmd_check(const std::string& scene_path) {
   const phiq::Model& model = *scene.model;
   int drivers = 0;
   for (const auto& c : model.constraints()) drivers += c.depends_on_time ? c.rows : 0;
+
+  phiq::Workspace ws(model);
+  phiq::PositionSummary ps;
+  const double t0 = scene.sweep.t_begin;
+  const bool defined = t0 >= model.time_domain_begin() && t0 <= model.time_domain_end();
+  if (defined) phiq::solve_position(model, t0, scene.sweep.assembly, ws, &ps);
+  else {
+    ps.status = phiq::SolveStatus::kOutsideTimeDomain;
+    ps.message = "driver '" + model.time_domain_limiter() + "' is not defined at t = " + std::to_string(t0);
+  }
+  const bool ok = ps.status == phiq::SolveStatus::kSuccess;
+
+  if (json) {
+    // `phiq check --json`, format version 1 (tools/README.md): one object on standard output.
+    nlohmann::ordered_json j;
+    j["format"] = phiq::kCheckJsonFormat;
+    j["phiq"] = phiq::kVersion;
+    j["scene"] = scene_path;
+    j["name"] = scene.name;
+    j["coordinates"] = model.num_coordinates();
+    j["equations"] = model.num_equations();
+    j["kinematic_equations"] = model.num_equations() - drivers;
+    j["driver_equations"] = drivers;
+    j["constraints"] = model.constraints().size();
+    j["nonzeros"] = model.jacobian_pattern().nnz();
+    j["length_scale"] = model.length_scale();
+    j["linear_solver"] = phiq::to_string(model.linear_solver());
+    nlohmann::ordered_json a;
+    a["time"] = t0;
+    a["status"] = phiq::to_string(ps.status);
+    a["iterations"] = ps.iterations;
+    a["residual"] = ps.residual;
+    a["tolerance"] = scene.sweep.assembly.tolerance;
+    a["message"] = ps.message;
+    a["worst"] = nlohmann::ordered_json::array();
+    for (const auto& [row, value] : ps.worst_rows)
+      a["worst"].push_back({{"constraint", model.constraints()[model.constraint_of_row(row)].name},
+                            {"row", row},
+                            {"residual", value}});
+    j["assembly"] = a;
+    std::cout << j.dump(2) << "\n";
+    return ok ? 0 : 1;
+  }
+
   std::cout << "scene         " << scene_path << (scene.name.empty() ? "" : " (" + scene.name + ")") << "\n"
             << "coordinates   " << model.num_coordinates() << "\n"
             << "equations     " << model.num_equations() << " (" << model.num_equations() - drivers
@@ -105,30 +171,40 @@ int cmd_check(const std::string& scene_path) {
             << model.jacobian_pattern().nnz() << " non-zeros\n"
             << "length scale  " << model.length_scale() << " m\n"
             << "linear solver " << phiq::to_string(model.linear_solver()) << "\n";
-  phiq::Workspace ws(model);
-  phiq::PositionSummary ps;
-  const double t0 = scene.sweep.t_begin;
-  if (t0 < model.time_domain_begin() || t0 > model.time_domain_end()) {
-    std::cout << "assembly      not attempted: driver '" << model.time_domain_limiter() << "' is not defined at t = "
-              << t0 << "\n";
+  if (!defined) {
+    std::cout << "assembly      not attempted: " << ps.message << "\n";
     return 1;
   }
-  phiq::solve_position(model, t0, scene.sweep.assembly, ws, &ps);
   std::cout << "assembly      " << phiq::to_string(ps.status) << " at t = " << t0 << " in " << ps.iterations
             << " iterations, scaled residual " << sci(ps.residual) << " (tolerance "
             << sci(scene.sweep.assembly.tolerance) << ")\n";
-  if (ps.status != phiq::SolveStatus::kSuccess) {
-    std::cout << "diagnosis     " << ps.message << "\n";
-    return 1;
+  if (!ok) std::cout << "diagnosis     " << ps.message << "\n";
+  return ok ? 0 : 1;
+}
+
+int cmd_compare(const std::string& a_path, const std::string& b_path, const phiq::CompareOptions& options) {
+  phiq::CompareResult r;
+  try {
+    const phiq::CsvTable a = phiq::read_csv_table(a_path), b = phiq::read_csv_table(b_path);
+    r = phiq::compare_csv(a, b, options);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 2);
   }
-  return 0;
+  if (r.equal) {
+    std::cerr << "phiq: compare " << a_path << " " << b_path << ": " << r.summary() << "\n";
+    return 0;
+  }
+  return fail("compare " + a_path + " " + b_path + ": " + r.summary(), 1);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"phiq: sparse, large-scale multibody kinematics"};
-  app.set_version_flag("--version", std::string("phiq ") + phiq::kVersion);
+  app.set_version_flag("--version", std::string("phiq ") + phiq::kVersion + " (scene format " +
+                                        std::to_string(phiq::kSceneFormat) + ", CSV format " +
+                                        std::to_string(phiq::kCsvFormat) + ", check --json format " +
+                                        std::to_string(phiq::kCheckJsonFormat) + ")");
   app.require_subcommand(1);
 
   std::string scene_path, out_path;
@@ -139,8 +215,22 @@ int main(int argc, char** argv) {
   run->add_flag("-q,--quiet", quiet, "Do not print the run summary on standard error");
 
   std::string check_path;
+  bool check_json = false;
   CLI::App* check = app.add_subcommand("check", "Count coordinates and equations and try the initial assembly");
   check->add_option("scene", check_path, "Scene file (YAML)")->required();
+  check->add_flag("--json", check_json, "Print one JSON object (format: tools/README.md)");
+
+  std::string cmp_a, cmp_b;
+  phiq::CompareOptions cmp;
+  CLI::App* compare = app.add_subcommand("compare", "Compare two result CSVs column by column within tolerances");
+  compare->add_option("a", cmp_a, "First CSV (e.g. the reference)")->required();
+  compare->add_option("b", cmp_b, "Second CSV")->required();
+  compare->add_option("--rtol", cmp.rtol, "Relative tolerance: |a-b| <= atol + rtol*max(|a|,|b|)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  compare->add_option("--atol", cmp.atol, "Absolute tolerance")->capture_default_str()->check(CLI::NonNegativeNumber);
+  compare->add_option("--columns", cmp.columns, "Compare only these columns (default: all; headers must match)")
+      ->delimiter(',');
 
   try {
     app.parse(argc, argv);
@@ -149,7 +239,8 @@ int main(int argc, char** argv) {
   }
   try {
     if (*run) return cmd_run(scene_path, out_path, quiet);
-    if (*check) return cmd_check(check_path);
+    if (*check) return cmd_check(check_path, check_json);
+    if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
   } catch (const std::exception& e) {
     return fail(std::string("internal error: ") + e.what(), 4);
   }

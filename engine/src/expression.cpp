@@ -3,11 +3,13 @@
 
 #include <ginac/ginac.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
 #include <sstream>
 #include <tuple>
+#include <unordered_map>
 
 namespace phiq {
 
@@ -64,6 +66,104 @@ void Tape::evaluate(const double* q, const double* qd, double t, double* out) co
   for (std::size_t k = 0; k < outputs_.size(); ++k) out[k] = r[outputs_[k]];
 }
 
+void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) const {
+  // Each register holds (w0, w1, w2): w(s) = w0 + w1 s + w2 s² + O(s³). Unary functions use
+  // w1 = f'(a0) a1, w2 = f'(a0) a2 + ½ f''(a0) a1².
+  struct J {
+    double v, d, h;  // w0, w1, w2
+  };
+  thread_local std::vector<J> r;
+  if (r.size() < code_.size()) r.resize(code_.size());
+  auto unary = [](const J& a, double f, double f1, double f2) { return J{f, f1 * a.d, f1 * a.h + 0.5 * f2 * a.d * a.d}; };
+  const std::size_t n = code_.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const Instr& in = code_[i];
+    const J& a = r[in.a];
+    const J& b = r[in.b];
+    J w;
+    switch (in.op) {
+      case Op::kConst: w = {in.imm, 0.0, 0.0}; break;
+      case Op::kLoadQ: w = {q[in.a], qd[in.a], 0.0}; break;
+      case Op::kLoadQd: w = {qd[in.a], 0.0, 0.0}; break;  // q̇ is held fixed along the direction (q̈ = 0)
+      case Op::kLoadT: w = {t, 1.0, 0.0}; break;
+      case Op::kAdd: w = {a.v + b.v, a.d + b.d, a.h + b.h}; break;
+      case Op::kSub: w = {a.v - b.v, a.d - b.d, a.h - b.h}; break;
+      case Op::kNeg: w = {-a.v, -a.d, -a.h}; break;
+      case Op::kMul: w = {a.v * b.v, a.v * b.d + a.d * b.v, a.v * b.h + a.d * b.d + a.h * b.v}; break;
+      case Op::kDiv: {
+        const double w0 = a.v / b.v, w1 = (a.d - w0 * b.d) / b.v;
+        w = {w0, w1, (a.h - w0 * b.h - w1 * b.d) / b.v};
+        break;
+      }
+      case Op::kPowInt: {
+        const double k = in.imm;
+        const double p2 = std::pow(a.v, k - 2.0);  // x^(k-2), then x^(k-1) and x^k from it
+        w = unary(a, p2 * a.v * a.v, k * p2 * a.v, k * (k - 1.0) * p2);
+        break;
+      }
+      case Op::kPow: {  // a^b = exp(b ln a)
+        const J l = unary(a, std::log(a.v), 1.0 / a.v, -1.0 / (a.v * a.v));
+        const J m{b.v * l.v, b.v * l.d + b.d * l.v, b.v * l.h + b.d * l.d + b.h * l.v};
+        const double e = std::exp(m.v);
+        w = unary(m, e, e, e);
+        break;
+      }
+      case Op::kSqrt: {
+        const double s0 = std::sqrt(a.v);
+        w = unary(a, s0, 0.5 / s0, -0.25 / (s0 * a.v));
+        break;
+      }
+      case Op::kSin: w = unary(a, std::sin(a.v), std::cos(a.v), -std::sin(a.v)); break;
+      case Op::kCos: w = unary(a, std::cos(a.v), -std::sin(a.v), -std::cos(a.v)); break;
+      case Op::kTan: {
+        const double tn = std::tan(a.v), sec2 = 1.0 + tn * tn;
+        w = unary(a, tn, sec2, 2.0 * tn * sec2);
+        break;
+      }
+      case Op::kAsin: {
+        const double u = 1.0 - a.v * a.v, is = 1.0 / std::sqrt(u);
+        w = unary(a, std::asin(a.v), is, a.v * is / u);
+        break;
+      }
+      case Op::kAcos: {
+        const double u = 1.0 - a.v * a.v, is = 1.0 / std::sqrt(u);
+        w = unary(a, std::acos(a.v), -is, -a.v * is / u);
+        break;
+      }
+      case Op::kAtan: {
+        const double u = 1.0 / (1.0 + a.v * a.v);
+        w = unary(a, std::atan(a.v), u, -2.0 * a.v * u * u);
+        break;
+      }
+      case Op::kAtan2: {  // w' = (x y' − y x') / (x² + y²), y = a, x = b
+        const double R = b.v * b.v + a.v * a.v, dR = 2.0 * (b.v * b.d + a.v * a.d);
+        const double N = b.v * a.d - a.v * b.d, dN = 2.0 * (b.v * a.h - a.v * b.h);
+        w = {std::atan2(a.v, b.v), N / R, (dN * R - N * dR) / (2.0 * R * R)};
+        break;
+      }
+      case Op::kExp: {
+        const double e = std::exp(a.v);
+        w = unary(a, e, e, e);
+        break;
+      }
+      case Op::kLog: w = unary(a, std::log(a.v), 1.0 / a.v, -1.0 / (a.v * a.v)); break;
+      case Op::kSinh: w = unary(a, std::sinh(a.v), std::cosh(a.v), std::sinh(a.v)); break;
+      case Op::kCosh: w = unary(a, std::cosh(a.v), std::sinh(a.v), std::cosh(a.v)); break;
+      case Op::kTanh: {
+        const double th = std::tanh(a.v), s2 = 1.0 - th * th;
+        w = unary(a, th, s2, -2.0 * th * s2);
+        break;
+      }
+      case Op::kAbs: w = unary(a, std::fabs(a.v), (a.v > 0) - (a.v < 0), 0.0); break;
+      case Op::kSign: w = {static_cast<double>((a.v > 0) - (a.v < 0)), 0.0, 0.0}; break;
+      default: w = {std::nan(""), std::nan(""), std::nan("")}; break;
+    }
+    r[i] = w;
+  }
+  const J& o = r[outputs_.at(0)];
+  out[0] = o.v, out[1] = o.d, out[2] = o.h;
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // GiNaC expression -> tape, with common subexpressions shared by hashing each instruction.
 
@@ -79,6 +179,9 @@ class TapeBuilder {
   using Op = Tape::Op;
 
   std::uint32_t push(Op op, std::uint32_t a = 0, std::uint32_t b = 0, double imm = 0.0) {
+    if (tape_.code_.size() >= CompiledExpression::kMaxTapeSize)
+      fail("its derivatives compile to more than " + std::to_string(CompiledExpression::kMaxTapeSize) +
+           " instructions; the limit is " + std::to_string(CompiledExpression::kMaxTapeSize));
     std::uint64_t bits;
     std::memcpy(&bits, &imm, sizeof bits);
     auto key = std::make_tuple(static_cast<int>(op), a, b, bits);
@@ -95,7 +198,17 @@ class TapeBuilder {
     throw Error("expression \"" + text_ + "\": " + what);
   }
 
+  // GiNaC expressions are DAGs with shared subexpressions: memoise on the node so that each is emitted once
+  // (a tree walk would revisit shared subtrees, exponentially in the worst case).
   std::uint32_t emit(const GiNaC::ex& e) {
+    auto it = memo_.find(e);
+    if (it != memo_.end()) return it->second;
+    const std::uint32_t reg = emit_node(e);
+    memo_.emplace(e, reg);
+    return reg;
+  }
+
+  std::uint32_t emit_node(const GiNaC::ex& e) {
     using namespace GiNaC;
     if (is_a<numeric>(e)) {
       const numeric& n = ex_to<numeric>(e);
@@ -185,6 +298,7 @@ class TapeBuilder {
   const std::string& text_;
   Tape tape_;
   std::map<std::tuple<int, std::uint32_t, std::uint32_t, std::uint64_t>, std::uint32_t> cse_;
+  std::unordered_map<GiNaC::ex, std::uint32_t, std::hash<GiNaC::ex>, GiNaC::ex_is_equal> memo_;
 };
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -227,6 +341,14 @@ std::vector<std::string> variable_names(const std::string& text) {
   return names;
 }
 
+// "expression "<first 40 characters>...": <what>" — built with a stream: GCC 12 warns falsely (-Wrestrict,
+// PR 105329) on "literal" + std::string temporaries.
+Error expression_error(const std::string& text, const std::string& what) {
+  std::ostringstream s;
+  s << "expression \"" << text.substr(0, 40) << (text.size() > 40 ? "..." : "") << "\": " << what;
+  return Error(s.str());
+}
+
 std::string first_line(const std::string& s) {
   auto p = s.find('\n');
   return p == std::string::npos ? s : s.substr(0, p);
@@ -249,6 +371,19 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
                                                                       bool allow_time) {
   using namespace GiNaC;
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw Error("expression is empty");
+  if (text.size() > kMaxTextLength)
+    throw Error("expression of " + std::to_string(text.size()) + " characters; the limit is " +
+                std::to_string(kMaxTextLength));
+  {
+    // The parser recurses per nesting level: bound it before parsing.
+    int depth = 0, worst = 0;
+    for (char c : text) {
+      if (c == '(') worst = std::max(worst, ++depth);
+      if (c == ')') --depth;
+    }
+    if (worst > kMaxNesting)
+      throw expression_error(text, "nested more than " + std::to_string(kMaxNesting) + " parentheses deep");
+  }
   auto out = std::make_shared<CompiledExpression>();
   out->text_ = text;
 
@@ -300,35 +435,21 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
     if (g.has(s)) used.emplace_back(s, i);
   out->depends_on_time_ = g.has(tsym);
 
-  // Velocity symbols for γ, bound by name in TapeBuilder ("qd:<index>").
-  std::vector<realsymbol> qd;
-  for (auto& [s, i] : used) qd.emplace_back("qd:" + std::to_string(i));
-
   try {
-    // ψ = ġ with q̈ = 0 treated as a function of (q, q̇, t); then γ = −(Σ_k ψ_qk q̇k + ψ_t).
     std::vector<ex> grad;
-    ex psi = g.diff(tsym);
-    for (std::size_t k = 0; k < used.size(); ++k) {
-      grad.push_back(g.diff(used[k].first));
-      psi += grad.back() * qd[k];
-    }
-    ex gamma = psi.diff(tsym);
-    for (std::size_t k = 0; k < used.size(); ++k) gamma += psi.diff(used[k].first) * qd[k];
-    gamma = -gamma;
-
-    auto build = [&](std::initializer_list<ex> outs) {
+    for (std::size_t k = 0; k < used.size(); ++k) grad.push_back(g.diff(used[k].first));
+    auto build = [&](const std::vector<ex>& outs) {
       TapeBuilder b(coord_of_symbol, out->text_);
       for (const ex& e : outs) b.add_output(e);
       return b.take();
     };
     out->value_ = build({g});
-    {
-      TapeBuilder b(coord_of_symbol, out->text_);
-      for (const ex& d : grad) b.add_output(d);
-      out->gradient_ = b.take();
-    }
+    out->gradient_ = build(grad);
     out->partial_t_ = build({g.diff(tsym)});
-    out->gamma_ = build({gamma});
+    const std::size_t size = out->value_.size() + out->gradient_.size() + out->partial_t_.size();
+    if (size > kMaxTapeSize)
+      throw expression_error(text, "its derivatives compile to " + std::to_string(size) +
+                                       " instructions; the limit is " + std::to_string(kMaxTapeSize));
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
@@ -355,9 +476,10 @@ double CompiledExpression::partial_t(const double* q, double t) const {
 }
 
 double CompiledExpression::gamma(const double* q, const double* qd, double t) const {
-  double v;
-  gamma_.evaluate(q, qd, t, &v);
-  return v;
+  // γ = −d²/ds² g(q + s q̇, t + s) at s = 0 (with q̈ = 0) = −2 w2
+  double w[3];
+  value_.taylor2(q, qd, t, w);
+  return -2.0 * w[2];
 }
 
 double evaluate_constant_expression(const std::string& text,

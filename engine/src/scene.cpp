@@ -1,6 +1,7 @@
 // Scene loader: YAML (yaml-cpp) → ModelBuilder + SweepOptions, with every error located in the file.
 #include "phiq/scene.hpp"
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <charconv>
@@ -595,18 +596,82 @@ class SceneReader {
   bool predictor_given() const { return predictor_field_; }
 };
 
+// First pass over the YAML events, before any node tree is built: refuses what a scene never needs and what
+// could exhaust memory or stack (deep nesting, aliases, several documents, too many nodes, huge values).
+class ShapeGuard final : public YAML::EventHandler {
+ public:
+  ShapeGuard(const std::string& path, const SceneLimits& limits) : path_(path), limits_(limits) {}
+  void OnDocumentStart(const YAML::Mark& m) override {
+    if (++documents_ > 1) fail(m, "a scene is one YAML document (found a second '---')");
+  }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& m, YAML::anchor_t) override { count(m); }
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override {
+    fail(m, "YAML aliases (*name) are not supported in scenes");
+  }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string& value) override {
+    count(m);
+    if (value.size() > limits_.max_scalar_bytes)
+      fail(m, "a value of " + std::to_string(value.size()) + " bytes; the limit is " +
+                  std::to_string(limits_.max_scalar_bytes));
+  }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    enter(m);
+  }
+  void OnSequenceEnd() override { --depth_; }
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    enter(m);
+  }
+  void OnMapEnd() override { --depth_; }
+
+ private:
+  void count(const YAML::Mark& m) {
+    if (++nodes_ > limits_.max_nodes)
+      fail(m, "more than " + std::to_string(limits_.max_nodes) + " values; the scene is too large");
+  }
+  void enter(const YAML::Mark& m) {
+    count(m);
+    if (++depth_ > limits_.max_depth)
+      fail(m, "nested more than " + std::to_string(limits_.max_depth) + " levels deep");
+  }
+  [[noreturn]] void fail(const YAML::Mark& m, const std::string& what) const {
+    throw SceneError(path_ + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1) + ": " + what);
+  }
+  const std::string& path_;
+  const SceneLimits& limits_;
+  int documents_ = 0, depth_ = 0;
+  std::size_t nodes_ = 0;
+};
+
+std::string yaml_error(const std::string& path, const YAML::Exception& e) {
+  std::ostringstream s;
+  s << path;
+  if (e.mark.line >= 0) s << ":" << e.mark.line + 1 << ":" << e.mark.column + 1;
+  s << ": YAML syntax error: " << e.msg;
+  return s.str();
+}
+
 }  // namespace
 
-Scene parse_scene(const std::string& text, const std::string& path) {
+Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits) {
+  if (text.size() > limits.max_file_bytes)
+    throw SceneError(path + ": the scene is " + std::to_string(text.size() >> 20) + " MiB; the limit is " +
+                     std::to_string(limits.max_file_bytes >> 20) + " MiB");
+  if (text.find('\0') != std::string::npos) throw SceneError(path + ": the scene is not text (contains a NUL byte)");
+  try {
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    ShapeGuard guard(path, limits);
+    while (parser.HandleNextDocument(guard)) {
+    }
+  } catch (const YAML::Exception& e) {
+    throw SceneError(yaml_error(path, e));
+  }
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    std::ostringstream s;
-    s << path;
-    if (e.mark.line >= 0) s << ":" << e.mark.line + 1 << ":" << e.mark.column + 1;
-    s << ": YAML syntax error: " << e.msg;
-    throw SceneError(s.str());
+    throw SceneError(yaml_error(path, e));
   }
   SceneReader reader(path);
   Scene scene = reader.read(root);
@@ -621,13 +686,21 @@ Scene parse_scene(const std::string& text, const std::string& path) {
   return scene;
 }
 
-Scene load_scene(const std::string& path) {
+Scene load_scene(const std::string& path, const SceneLimits& limits) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path + ": cannot open the scene file");
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  if (in.bad()) throw SceneError(path + ": cannot read the scene file");
-  return parse_scene(buf.str(), path);
+  // size first: a huge file is refused before it is read into memory
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw SceneError(path + ": cannot read the scene file (not a regular file?)");
+  if (static_cast<std::uint64_t>(size) > limits.max_file_bytes)
+    throw SceneError(path + ": the scene is " + std::to_string(size >> 20) + " MiB; the limit is " +
+                     std::to_string(limits.max_file_bytes >> 20) + " MiB");
+  in.seekg(0, std::ios::beg);
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), size);
+  if (in.gcount() != size) throw SceneError(path + ": cannot read the scene file");
+  return parse_scene(text, path, limits);
 }
 
 }  // namespace phiq

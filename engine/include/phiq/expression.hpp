@@ -1,8 +1,10 @@
 // Equation constraints written as text, exactly as the notes write Φ: "xA - L2*cos(theta2)".
 //
-// The text is parsed and differentiated exactly by GiNaC once, when the model is built; every derived quantity
-// (value, gradient, ∂/∂t, γ) is then compiled into a flat register tape with common subexpressions shared, so that
-// evaluation inside the Newton loop never touches the symbolic engine and never re-parses.
+// The text is parsed and differentiated exactly by GiNaC once, when the model is built; the value, the gradient
+// and ∂/∂t are compiled into flat register tapes with common subexpressions shared, so that evaluation inside the
+// Newton loop never touches the symbolic engine and never re-parses. γ needs second derivatives: it is computed
+// exactly by second-order forward (Taylor-mode) automatic differentiation of the value tape along (q̇, 1), which
+// costs a few passes over the tape, where symbolic second derivatives can grow with the cube of a product's length.
 #pragma once
 
 #include <cstdint>
@@ -32,6 +34,9 @@ class Tape {
 
   // Evaluates the program; out[k] receives register outputs()[k]. Thread-safe (scratch is thread-local).
   void evaluate(const double* q, const double* qd, double t, double* out) const;
+  // Second-order Taylor coefficients of output 0 along s ↦ (q + s q̇, t + s): value, d/ds and ½ d²/ds² at s = 0.
+  // Exact (no truncation). Thread-safe.
+  void taylor2(const double* q, const double* qd, double t, double out[3]) const;
 
   std::size_t size() const { return code_.size(); }
   std::size_t num_outputs() const { return outputs_.size(); }
@@ -55,6 +60,11 @@ using NameResolver = std::function<std::optional<NameBinding>(const std::string&
 // The compiled form of a scalar function g(q, t) together with its exact derivatives.
 class CompiledExpression {
  public:
+  // Hostile-input limits: longer or deeper texts, or derivatives that compile to more instructions, are refused.
+  static constexpr std::size_t kMaxTextLength = 4096;
+  static constexpr int kMaxNesting = 64;                    // parentheses
+  static constexpr std::size_t kMaxTapeSize = 50000;        // instructions over value, gradient and Φt
+
   // Parses and differentiates `text`. Throws phiq::Error with a one-line message naming the expression and the
   // offending name or token when the text is malformed, uses an unknown name or an unsupported function.
   // `allow_time` false rejects `t` (e.g. for constant fields).
@@ -76,7 +86,7 @@ class CompiledExpression {
   std::string text_;
   std::vector<Index> coords_;
   bool depends_on_time_ = false;
-  Tape value_, gradient_, partial_t_, gamma_;
+  Tape value_, gradient_, partial_t_;
 };
 
 // Evaluates a constant expression (numbers, named constants, pi, functions), e.g. "L2/2" or "2*pi".

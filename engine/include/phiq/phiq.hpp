@@ -10,9 +10,5 @@
 #include "phiq/motion_law.hpp"
 #include "phiq/scene.hpp"
 #include "phiq/sweep.hpp"
+#include "phiq/version.hpp"
 #include "phiq/workspace.hpp"
-
-namespace phiq {
-// Version of the library, the CSV columns and the scene format (semantic versioning).
-inline constexpr const char* kVersion = "0.1.0";
-}  // namespace phiq

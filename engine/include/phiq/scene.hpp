@@ -17,6 +17,15 @@ class SceneError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Limits that refuse huge or hostile scenes with a clear error before memory or stack is exhausted. The node
+// count bounds the memory of the YAML tree (about 0.5 KiB a node in yaml-cpp 0.7, see models/README.md).
+struct SceneLimits {
+  std::size_t max_file_bytes = std::size_t{128} << 20;  // 128 MiB
+  int max_depth = 32;                                    // nesting of maps and lists
+  std::size_t max_nodes = 20'000'000;                    // scalars + maps + lists
+  std::size_t max_scalar_bytes = 16384;                  // one value (expressions are shorter still, see expression.hpp)
+};
+
 struct Scene {
   std::string path;
   std::string name;
@@ -27,8 +36,8 @@ struct Scene {
 
 // Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,
 // unknown or duplicate fields and names, wrong types, NaN or infinite numbers and impossible values.
-Scene load_scene(const std::string& path);
+Scene load_scene(const std::string& path, const SceneLimits& limits = {});
 // The same from text; `path` is used in messages only.
-Scene parse_scene(const std::string& text, const std::string& path);
+Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits = {});
 
 }  // namespace phiq

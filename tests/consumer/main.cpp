@@ -1,0 +1,55 @@
+// An embedding simulator in miniature, built against the installed phiq package: it builds a four-bar in code
+// (natural coordinates + a driven crank angle), advances its own clock, calls the position, velocity and
+// acceleration solves each tick, and checks the results against Freudenstein's closed form and finite
+// differences of its own positions. Exit 0 when every check holds.
+#include <phiq/phiq.hpp>
+
+#include <cmath>
+#include <cstdio>
+
+int main() {
+  using namespace phiq;
+  const double a = 0.4, b = 1.2, c = 1.0, d = 1.0, omega = 1.5;  // crank, coupler, rocker, ground; rad/s
+  ModelBuilder mb;
+  const Index xa = mb.add_coordinate("xA", 0.38), ya = mb.add_coordinate("yA", 0.05),
+              xb = mb.add_coordinate("xB", 1.1), yb = mb.add_coordinate("yB", 0.95),
+              th = mb.add_coordinate("theta2", 0.0);
+  const auto S = Slot::coordinate;
+  const auto C = Slot::constant;
+  const Point2 O{C(0), C(0)}, A{S(xa), S(ya)}, B{S(xb), S(yb)}, Cc{C(d), C(0)};
+  mb.add("crank", DistanceSpec{O, A, a});
+  mb.add("coupler", DistanceSpec{A, B, b});
+  mb.add("rocker", DistanceSpec{Cc, B, c});
+  mb.add("crank_angle", SegmentAngleSpec{O, A, S(th)});
+  mb.add_driver("motor", th, MotionLaw::linear(0.0, omega));
+  const Model model = std::move(mb).build();
+  Workspace ws(model);
+
+  const double K1 = d / a, K2 = d / c, K3 = (a * a - b * b + c * c + d * d) / (2 * a * c);
+  double worst_angle = 0, worst_vel = 0;
+  double xb_2 = 0, xb_1 = 0, vb_1 = 0;  // x_B two ticks ago, one tick ago, and ẋ_B one tick ago
+  int ticks = 0;
+  for (int k = 0; k <= 400; ++k) {  // the simulator's own clock
+    const double t = 0.01 * k;
+    if (solve_position(model, t, NewtonOptions{}, ws) != SolveStatus::kSuccess ||
+        solve_velocity(model, t, ws) != SolveStatus::kSuccess ||
+        solve_acceleration(model, t, ws) != SolveStatus::kSuccess) {
+      std::fprintf(stderr, "consumer: solve failed at t = %g\n", t);
+      return 1;
+    }
+    const double th2 = ws.q(th);
+    const double A_ = std::cos(th2) - K1 - K2 * std::cos(th2) + K3, B_ = -2 * std::sin(th2),
+                 C_ = K1 - (K2 + 1) * std::cos(th2) + K3;
+    const double th4 = 2 * std::atan2(-B_ - std::sqrt(B_ * B_ - 4 * A_ * C_), 2 * A_);  // open branch
+    worst_angle = std::max(worst_angle, std::fabs(std::remainder(std::atan2(ws.q(yb), ws.q(xb) - d) - th4, 2 * M_PI)));
+    if (k >= 2)  // ẋ_B one tick ago against the central difference of the positions around it (O(h²))
+      worst_vel = std::max(worst_vel, std::fabs((ws.q(xb) - xb_2) / 0.02 - vb_1));
+    xb_2 = xb_1;
+    xb_1 = ws.q(xb);
+    vb_1 = ws.qd(xb);
+    ++ticks;
+  }
+  std::printf("consumer: phiq %s, %d ticks, worst rocker angle error %.2e rad, velocity vs difference %.2e\n",
+              kVersion, ticks, worst_angle, worst_vel);
+  return (ticks == 401 && worst_angle < 1e-10 && worst_vel < 1e-3) ? 0 : 1;
+}

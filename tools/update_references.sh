@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Regenerates the reference results beside every scene that has one: models/<dir>/reference/<scene>.csv.
+# Run it only when a change of numbers is intended and understood; say why in the commit. The regression tests
+# (ctest -R regression) compare each scene's run against its reference with `phiq compare`.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+phiq="${PHIQ:-$root/build/tools/phiq}"
+for scene in "$root"/models/*/*.yaml; do
+  dir="$(dirname "$scene")/reference"
+  mkdir -p "$dir"
+  "$phiq" run -q "$scene" -o "$dir/$(basename "${scene%.yaml}").csv"
+  echo "updated $dir/$(basename "${scene%.yaml}").csv"
+done
