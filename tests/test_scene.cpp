@@ -1,6 +1,8 @@
 // Scene loading: valid scenes build the right model; bad scenes give one-line errors naming file, line, field.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
 
@@ -247,6 +249,30 @@ TEST(Scene, HostileExpressionsAreRefused) {
   std::string shorter = "(xA+xB+1)";
   for (int k = 2; k <= 60; ++k) shorter += "*(xA+xB+" + std::to_string(k) + ")";
   EXPECT_NO_THROW(parse_scene(with(shorter), "ok.yaml"));
+}
+
+TEST(Scene, ErrorsQuotingMultiLineTextStayOneLine) {
+  // a double-quoted YAML value may span lines; the error quotes it (found by the fuzzer)
+  std::string m = error_of(variant("  - {name: rod, type: distance, points: [A, B], length: L3}",
+                                   "  - {name: rod, type: equation, expr: \"xA - \\n\\t bogus\"}"));
+  EXPECT_HAS(m, "unknown name 'bogus'");
+  EXPECT_HAS(m, "\\n");  // escaped, not a line break
+}
+
+// Inputs the fuzzer once found a defect with (tests/fuzz/regressions/): each must load or fail with one line.
+TEST(Scene, FuzzerRegressionInputs) {
+  int n = 0;
+  for (const auto& f : std::filesystem::directory_iterator(std::string(PHIQ_SOURCE_DIR) + "/tests/fuzz/regressions")) {
+    ++n;
+    try {
+      load_scene(f.path().string());
+    } catch (const SceneError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.find('\n'), std::string::npos) << f.path() << ": " << m;
+      EXPECT_EQ(m.rfind(f.path().string(), 0), 0u) << m;
+    }
+  }
+  EXPECT_GE(n, 1);
 }
 
 TEST(Scene, EverySeedSceneLoads) {

@@ -167,6 +167,10 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
 // ---------------------------------------------------------------------------------------------------------------
 // GiNaC expression -> tape, with common subexpressions shared by hashing each instruction.
 
+namespace {
+Error expression_error(const std::string& text, const std::string& what);  // defined with the parsing helpers
+}  // namespace
+
 class TapeBuilder {
  public:
   TapeBuilder(const std::map<std::string, Index>& coord_of_symbol, const std::string& text)
@@ -194,9 +198,7 @@ class TapeBuilder {
   }
   std::uint32_t constant(double v) { return push(Op::kConst, 0, 0, v); }
 
-  [[noreturn]] void fail(const std::string& what) const {
-    throw Error("expression \"" + text_ + "\": " + what);
-  }
+  [[noreturn]] void fail(const std::string& what) const { throw expression_error(text_, what); }
 
   // GiNaC expressions are DAGs with shared subexpressions: memoise on the node so that each is emitted once
   // (a tree walk would revisit shared subtrees, exponentially in the worst case).
@@ -345,7 +347,8 @@ std::vector<std::string> variable_names(const std::string& text) {
 // PR 105329) on "literal" + std::string temporaries.
 Error expression_error(const std::string& text, const std::string& what) {
   std::ostringstream s;
-  s << "expression \"" << text.substr(0, 40) << (text.size() > 40 ? "..." : "") << "\": " << what;
+  s << "expression \"" << single_line(text.substr(0, 60)) << (text.size() > 60 ? "..." : "") << "\": "
+    << single_line(what);
   return Error(s.str());
 }
 
@@ -396,16 +399,16 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
     if (name == "pi") { table[name] = Pi; continue; }
     std::optional<NameBinding> b = resolve(name);
     if (!b) {
-      if (name == "t" && !allow_time) throw Error("expression \"" + text + "\": time 't' is not allowed here");
-      throw Error("expression \"" + text + "\": unknown name '" + name + "'");
+      if (name == "t" && !allow_time) throw expression_error(text, "time 't' is not allowed here");
+      throw expression_error(text, "unknown name '" + name + "'");
     }
     switch (b->kind) {
       case NameBinding::Kind::kTime:
-        if (!allow_time) throw Error("expression \"" + text + "\": time 't' is not allowed here");
+        if (!allow_time) throw expression_error(text, "time 't' is not allowed here");
         table[name] = tsym;
         break;
       case NameBinding::Kind::kConstant:
-        if (!std::isfinite(b->value)) throw Error("expression \"" + text + "\": '" + name + "' is not finite");
+        if (!std::isfinite(b->value)) throw expression_error(text, "'" + name + "' is not finite");
         table[name] = numeric(b->value);
         break;
       case NameBinding::Kind::kCoordinate: {
@@ -425,7 +428,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
     reader.strict = true;
     g = reader(text);
   } catch (const std::exception& e) {
-    throw Error("expression \"" + text + "\": " + clean_ginac_message(e.what()));
+    throw expression_error(text, clean_ginac_message(e.what()));
   }
 
   // Keep only the coordinates the expression really depends on, in ascending index order.
@@ -453,7 +456,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
-    throw Error("expression \"" + text + "\": " + clean_ginac_message(e.what()));
+    throw expression_error(text, clean_ginac_message(e.what()));
   }
   for (auto& [s, i] : used) out->coords_.push_back(i);
   return out;

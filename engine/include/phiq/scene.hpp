@@ -14,7 +14,8 @@ namespace phiq {
 // A scene that cannot be used. what() is one line: "FILE:LINE:COL: FIELD.PATH: message".
 class SceneError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  // The message is made one line whatever user text it quotes (single_line()).
+  explicit SceneError(const std::string& message) : std::runtime_error(single_line(message)) {}
 };
 
 // Limits that refuse huge or hostile scenes with a clear error before memory or stack is exhausted. The node

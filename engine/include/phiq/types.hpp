@@ -19,6 +19,10 @@ class Error : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// `text` made fit for a one-line message: control characters escaped (\n, \t, \xNN). User text quoted in errors
+// (expressions, names from a scene) may contain them.
+std::string single_line(const std::string& text);
+
 // What a coordinate or a constraint row measures. Tolerances are dimensional: a length is compared with
 // tol * length_scale, an angle with tol (radians), a quantity of unknown unit with tol.
 enum class Unit : std::uint8_t { kNone = 0, kLength = 1, kAngle = 2 };
