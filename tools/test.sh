@@ -1,9 +1,26 @@
 #!/usr/bin/env bash
-# README command (2): build (if needed) and run the whole test suite with ctest. .ci/run calls this script.
+# README command (2): the whole test suite. .ci/run calls it.
+#   tools/test.sh            1. Release build (build/) and its ctest suite, with the installed-package consumer,
+#                               the regression comparisons and the benchmark smoke run;
+#                            2. the same suite built with clang under AddressSanitizer + UndefinedBehaviorSanitizer
+#                               (build-asan/), preceded by a bounded libFuzzer run of the scene loader (60 s).
+#   tools/test.sh --quick    step 1 only (the inner loop while developing)
+#   PHIQ_FUZZ_SECONDS=N      fuzzing time (default 60)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+quick=0
+if [ "${1:-}" = "--quick" ]; then quick=1; shift; fi
+jobs="$(nproc)"
+
 "$root/tools/install_deps.sh"
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$root/build" -j "$(nproc)"
-cd "$root/build"
-ctest --output-on-failure -j "$(nproc)" "$@"
+cmake --build "$root/build" -j "$jobs"
+(cd "$root/build" && ctest --output-on-failure -j "$jobs" "$@")
+[ "$quick" = 1 ] && exit 0
+
+echo "== sanitizers: clang, AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/)"
+CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DPHIQ_SANITIZE=ON -DPHIQ_FUZZ=ON -DPHIQ_BUILD_BENCH=OFF >/dev/null
+cmake --build "$root/build-asan" -j "$jobs"
+"$root/tools/fuzz.sh" "${PHIQ_FUZZ_SECONDS:-60}" "$root/build-asan"
+(cd "$root/build-asan" && ctest --output-on-failure -j "$jobs" "$@")

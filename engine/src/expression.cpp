@@ -320,13 +320,20 @@ std::vector<std::string> variable_names(const std::string& text) {
     char c = text[i];
     if (std::isdigit(static_cast<unsigned char>(c)) || (c == '.' && i + 1 < text.size() &&
                                                          std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
+      const std::size_t start = i;
       while (i < text.size() && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.')) ++i;
       if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
         std::size_t j = i + 1;
         if (j < text.size() && (text[j] == '+' || text[j] == '-')) ++j;
         if (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) {
+          const std::size_t digits = j;
           i = j;
           while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
+          // The symbolic engine represents literals exactly: 1e3082222222 would be a number of 3·10^9 digits.
+          // Anything beyond a double's exponent range is refused here (found by the fuzzer: a hang in GMP).
+          if (i - digits > 4 || std::stoi(text.substr(digits, i - digits)) > 400)
+            throw expression_error(text, "number '" + text.substr(start, std::min<std::size_t>(i - start, 40)) +
+                                             "' is out of the range of a double");
         }
       }
     } else if (is_ident_start(c)) {

@@ -137,6 +137,9 @@ class Cursor {
   YAML::Mark parent_mark_;
 };
 
+// A YAML number as a double; nullopt when `s` is not a plain number (then it may be a constant expression).
+// Throws SceneError-free Error for a number out of the range of a double: never hand those to the symbolic engine,
+// which would try to represent 1e3082222222 exactly (found by the fuzzer: a hang in GMP).
 std::optional<double> plain_number(const std::string& s) {
   if (s == ".nan" || s == ".NaN" || s == ".NAN") return std::numeric_limits<double>::quiet_NaN();
   if (s == ".inf" || s == ".Inf" || s == ".INF" || s == "+.inf") return std::numeric_limits<double>::infinity();
@@ -147,6 +150,13 @@ std::optional<double> plain_number(const std::string& s) {
   double v = 0.0;
   auto [p, ec] = std::from_chars(b, e, v);
   if (ec == std::errc() && p == e) return v;
+  if (ec == std::errc::result_out_of_range && p == e) {
+    // from_chars reports underflow and overflow alike: underflow is 0, overflow is not a finite number
+    const auto epos = s.find_first_of("eE");
+    const bool negative_exponent = epos != std::string::npos && epos + 1 < s.size() && s[epos + 1] == '-';
+    if (negative_exponent) return 0.0;
+    throw Error("'" + s.substr(0, 40) + (s.size() > 40 ? "..." : "") + "' is out of the range of a double");
+  }
   return std::nullopt;
 }
 
@@ -206,7 +216,13 @@ class SceneReader {
     if (!c.present()) c.fail("missing number");
     const std::string s = c.text();
     double v;
-    if (auto p = plain_number(s)) {
+    std::optional<double> p;
+    try {
+      p = plain_number(s);
+    } catch (const Error& e) {
+      c.fail(e.what());
+    }
+    if (p) {
       v = *p;
     } else {
       try {

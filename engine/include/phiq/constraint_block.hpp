@@ -1,5 +1,6 @@
-// Constraint blocks: all constraints of one kind, evaluated in one loop (one virtual call per block and operation,
-// not per constraint). The solver sees only ConstraintBlock.
+/// @file
+/// Constraint blocks: all constraints of one kind, evaluated in one loop (one virtual call per block and operation,
+/// not per constraint). The solver sees only ConstraintBlock.
 #pragma once
 
 #include <algorithm>
@@ -10,38 +11,71 @@
 
 namespace phiq {
 
+/// The constraints of one kind, behind the one interface the Model and the solvers see. Constraint i of the block
+/// (0 ≤ i < size()) owns the rows_per_constraint() consecutive global rows that start at first_row(i).
+///
+/// The evaluation functions (residual(), jacobian(), phi_t(), gamma()) take a range [begin, end) of the block's
+/// constraints, 0 ≤ begin ≤ end ≤ size(), and write the rows of those constraints only, at their global row offsets,
+/// into an output that spans all rows of the model (all Jacobian entries for jacobian()). `q` and `qd` span all
+/// coordinates of the model. Constraints own disjoint rows, so disjoint ranges touch disjoint outputs.
+///
+/// Thread safety: the const functions are thread-safe (the specs are read-only; EquationSpec uses thread-local
+/// scratch), so disjoint ranges may be evaluated by different threads into the same arrays. build_pattern() and
+/// TypedBlock::entries() modify the block; they are used once, while the model is built.
 class ConstraintBlock {
  public:
   virtual ~ConstraintBlock() = default;
+  /// Name of the constraint kind of this block (the spec's kKind, e.g. "distance"); a static string.
   virtual const char* kind() const = 0;
+  /// Number of constraints in the block.
   virtual std::size_t size() const = 0;
+  /// Number of rows each constraint owns (the spec's kRows).
   virtual int rows_per_constraint() const = 0;
+  /// Global index of the first row of constraint `i` (0 ≤ i < size()); its rows are first_row(i) …
+  /// first_row(i) + rows_per_constraint() − 1.
   virtual Index first_row(std::size_t i) const = 0;
 
-  // Each writes the rows of constraints [begin, end) at their global row offsets.
+  /// Writes Φ(q, t) of constraints [begin, end) into `phi` at their global row offsets (DistanceSpec::residual()).
+  /// `phi` has one entry per row of the model; other rows are left untouched. Thread-safe.
   virtual void residual(std::size_t begin, std::size_t end, const double* q, double t, double* phi) const = 0;
-  // Accumulates Φq values into the CSC value array through slot_of_entry (one slot per emitted entry).
+  /// Accumulates (adds) the Φq values of constraints [begin, end) into `csc_values`, the value array of the model's
+  /// CSC Jacobian pattern: the k-th entry of the model's triplet list (as appended by build_pattern()) is added at
+  /// `csc_values[slot_of_entry[k]]` (entries sharing a (row, column) share a slot). The caller zeroes
+  /// `csc_values` first; entries of other constraints are left untouched. Requires build_pattern() to have run.
+  /// Thread-safe.
   virtual void jacobian(std::size_t begin, std::size_t end, const double* q, double t, const Index* slot_of_entry,
                         double* csc_values) const = 0;
-  // Φt of the time-dependent constraints only (the others' rows are left untouched: they are zero).
+  /// Writes Φt = ∂Φ/∂t of the time-dependent constraints in [begin, end) into `out` at their global row offsets;
+  /// the rows of the others are left untouched (their Φt is zero: the caller zero-fills `out`). Thread-safe.
   virtual void phi_t(std::size_t begin, std::size_t end, const double* q, double t, double* out) const = 0;
+  /// Writes γ = −(Φq q̇)q q̇ − 2 Φqt q̇ − Φtt of constraints [begin, end) into `out` at their global row offsets,
+  /// the right-hand side of Φq q̈ = γ (DistanceSpec::gamma()). `qd` is q̇, indexed like `q`. Thread-safe.
   virtual void gamma(std::size_t begin, std::size_t end, const double* q, const double* qd, double t,
                      double* out) const = 0;
+  /// Whether constraint `i` (0 ≤ i < size()) depends explicitly on time (DistanceSpec::depends_on_time()).
   virtual bool depends_on_time(std::size_t i) const = 0;
 
-  // Used once, while the model is built:
-  // appends the (row, column) of every Jacobian entry and records where each constraint's entries start;
+  /// Appends the (row, column) of every Jacobian entry of every constraint that falls on a coordinate to `rows` and
+  /// `cols` (the model's triplet list, in evaluation order), and records where each constraint's entries start, so
+  /// that jacobian() finds their slots. Used once, while the model is built, before any jacobian(); not
+  /// thread-safe (it modifies the block).
   virtual void build_pattern(std::vector<Index>& rows, std::vector<Index>& cols) = 0;
-  // marks the unit of every coordinate the constraints read (kNone where they do not tell);
+  /// Marks the unit of every coordinate the constraints read (DistanceSpec::for_each_slot()): a coordinate still
+  /// Unit::kNone in `units` takes the unit a constraint gives it; one given a unit other than the one it has falls
+  /// back to Unit::kNone (compared with the plain tolerance). Slots read with Unit::kNone change nothing. `units`
+  /// has one entry per coordinate. Used once, while the model is built.
   virtual void infer_coordinate_units(std::vector<Unit>& units) const = 0;
-  // writes the unit of every row, given the coordinates' units;
+  /// Writes the unit of every row of the block's constraints into `units` (one entry per row of the model, indexed
+  /// by global row), given the units of the coordinates (DistanceSpec::row_unit()). Used once, while the model is
+  /// built.
   virtual void row_units(const std::vector<Unit>& coordinate_units, std::vector<Unit>& units) const = 0;
-  // the largest length the constraints carry as data (link lengths, attachment arms), 0 if none.
+  /// The largest length the constraints carry as data (link lengths, attachment arms), 0 if none
+  /// (DistanceSpec::characteristic_length()). Used once, while the model is built, for the model's length scale.
   virtual double characteristic_length() const = 0;
 };
 
 namespace detail {
-// Pattern mode: records the column of every entry that falls on a coordinate.
+/// Pattern mode: records the column of every entry that falls on a coordinate.
 struct PatternSink {
   Index row0;
   std::vector<Index>* rows;
@@ -50,7 +84,7 @@ struct PatternSink {
     if (s.is_coordinate()) rows->push_back(row0 + row), cols->push_back(s.coord);
   }
 };
-// Value mode: same entries, same order, values accumulated into their CSC slots.
+/// Value mode: same entries, same order, values accumulated into their CSC slots.
 struct ValueSink {
   const Index* slot;
   double* values;
@@ -60,6 +94,9 @@ struct ValueSink {
 };
 }  // namespace detail
 
+/// The largest coordinate index that `spec` reads (over its for_each_slot()), or −1 if it reads only constants.
+/// The arrays q and qd passed to the spec's functions need at least max_coordinate(spec) + 1 entries. Thread-safe.
+/// @tparam Spec a constraint kind of constraint_kinds.hpp (DistanceSpec, PinSpec, ...).
 template <class Spec>
 Index max_coordinate(const Spec& spec) {
   Index m = -1;
@@ -67,20 +104,29 @@ Index max_coordinate(const Spec& spec) {
   return m;
 }
 
+/// The ConstraintBlock of one constraint kind `Spec`: it stores the constraints' specs contiguously and evaluates
+/// them in plain loops over the range, so the per-constraint calls are resolved at compile time and inlined. The
+/// ModelBuilder keeps one block per kind. The overrides behave as documented on ConstraintBlock.
+/// @tparam Spec a constraint kind of constraint_kinds.hpp (DistanceSpec, PinSpec, ...), with the interface
+/// documented on DistanceSpec.
 template <class Spec>
 class TypedBlock final : public ConstraintBlock {
  public:
+  /// One constraint of the block: its data and where its rows and Jacobian entries are in the model.
   struct Entry {
-    Spec spec;
-    Index row0;  // first global row
-    Index nz0;   // first entry in the model's triplet list
+    Spec spec;  ///< the constraint's data and equations
+    Index row0;  ///< first global row (the constraint owns rows row0 … row0 + Spec::kRows − 1)
+    Index nz0;   ///< index of its first Jacobian entry in the model's triplet list, set by build_pattern()
   };
 
   const char* kind() const override { return Spec::kKind; }
   std::size_t size() const override { return entries_.size(); }
   int rows_per_constraint() const override { return Spec::kRows; }
   Index first_row(std::size_t i) const override { return entries_[i].row0; }
+  /// The spec of constraint `i` (0 ≤ i < size()). Thread-safe.
   const Spec& spec(std::size_t i) const { return entries_[i].spec; }
+  /// The constraints, for ModelBuilder to append to while the model is built (before build_pattern()). Not
+  /// thread-safe.
   std::vector<Entry>& entries() { return entries_; }
 
   void residual(std::size_t begin, std::size_t end, const double* q, double t, double* phi) const override {

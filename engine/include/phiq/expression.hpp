@@ -1,10 +1,11 @@
-// Equation constraints written as text, exactly as the notes write Φ: "xA - L2*cos(theta2)".
-//
-// The text is parsed and differentiated exactly by GiNaC once, when the model is built; the value, the gradient
-// and ∂/∂t are compiled into flat register tapes with common subexpressions shared, so that evaluation inside the
-// Newton loop never touches the symbolic engine and never re-parses. γ needs second derivatives: it is computed
-// exactly by second-order forward (Taylor-mode) automatic differentiation of the value tape along (q̇, 1), which
-// costs a few passes over the tape, where symbolic second derivatives can grow with the cube of a product's length.
+/// @file
+/// Equation constraints written as text, exactly as the notes write Φ: "xA - L2*cos(theta2)".
+///
+/// The text is parsed and differentiated exactly by GiNaC once, when the model is built; the value, the gradient
+/// and ∂/∂t are compiled into flat register tapes with common subexpressions shared, so that evaluation inside the
+/// Newton loop never touches the symbolic engine and never re-parses. γ needs second derivatives: it is computed
+/// exactly by second-order forward (Taylor-mode) automatic differentiation of the value tape along (q̇, 1), which
+/// costs a few passes over the tape, where symbolic second derivatives can grow with the cube of a product's length.
 #pragma once
 
 #include <cstdint>
@@ -18,28 +19,31 @@
 
 namespace phiq {
 
-// One compiled straight-line program over doubles. Inputs are read from q (coordinates), qd (velocities) and t.
+/// One compiled straight-line program over doubles. Inputs are read from q (coordinates), qd (velocities) and t.
 class Tape {
  public:
+  /// Instruction codes: loads of inputs, arithmetic, and the supported functions (kSign is csgn).
   enum class Op : std::uint8_t {
     kConst, kLoadQ, kLoadQd, kLoadT,
     kAdd, kSub, kMul, kDiv, kNeg, kPowInt, kPow, kSqrt,
     kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2, kExp, kLog, kSinh, kCosh, kTanh, kAbs, kSign,
   };
+  /// One instruction; its result is the register with its own index (static single assignment).
   struct Instr {
-    Op op;
-    std::uint32_t a = 0, b = 0;  // operand registers (or the input index for loads)
-    double imm = 0.0;            // constant value, or integer exponent for kPowInt
+    Op op;                 ///< what it computes
+    std::uint32_t a = 0;   ///< first operand register (or the input index for loads)
+    std::uint32_t b = 0;   ///< second operand register
+    double imm = 0.0;      ///< constant value, or integer exponent for kPowInt
   };
 
-  // Evaluates the program; out[k] receives register outputs()[k]. Thread-safe (scratch is thread-local).
+  /// Evaluates the program; out[k] receives register outputs()[k]. Thread-safe (scratch is thread-local).
   void evaluate(const double* q, const double* qd, double t, double* out) const;
-  // Second-order Taylor coefficients of output 0 along s ↦ (q + s q̇, t + s): value, d/ds and ½ d²/ds² at s = 0.
-  // Exact (no truncation). Thread-safe.
+  /// Second-order Taylor coefficients of output 0 along s ↦ (q + s q̇, t + s): value, d/ds and ½ d²/ds² at s = 0.
+  /// Exact (no truncation). Thread-safe.
   void taylor2(const double* q, const double* qd, double t, double out[3]) const;
 
-  std::size_t size() const { return code_.size(); }
-  std::size_t num_outputs() const { return outputs_.size(); }
+  std::size_t size() const { return code_.size(); }  ///< number of instructions
+  std::size_t num_outputs() const { return outputs_.size(); }  ///< number of outputs
 
  private:
   friend class TapeBuilder;
@@ -47,39 +51,50 @@ class Tape {
   std::vector<std::uint32_t> outputs_;
 };
 
-// What a name in an expression stands for.
+/// What a name in an expression stands for.
 struct NameBinding {
-  enum class Kind { kCoordinate, kConstant, kTime } kind;
-  Index coordinate = -1;  // for kCoordinate
-  double value = 0.0;     // for kConstant
+  /// The three things a name can be.
+  enum class Kind {
+    kCoordinate,  ///< a generalized coordinate (index in q)
+    kConstant,    ///< a parameter, substituted by its value
+    kTime,        ///< the time t
+  };
+  Kind kind;              ///< what the name is
+  Index coordinate = -1;  ///< for kCoordinate
+  double value = 0.0;     ///< for kConstant
 };
 
-// Resolves a name to a binding, or returns nullopt when the name is unknown.
+/// Resolves a name to a binding, or returns nullopt when the name is unknown.
 using NameResolver = std::function<std::optional<NameBinding>(const std::string&)>;
 
-// The compiled form of a scalar function g(q, t) together with its exact derivatives.
+/// The compiled form of a scalar function g(q, t) together with its exact derivatives.
 class CompiledExpression {
  public:
-  // Hostile-input limits: longer or deeper texts, or derivatives that compile to more instructions, are refused.
-  static constexpr std::size_t kMaxTextLength = 4096;
-  static constexpr int kMaxNesting = 64;                    // parentheses
-  static constexpr std::size_t kMaxTapeSize = 50000;        // instructions over value, gradient and Φt
+  /// Hostile-input limits: longer or deeper texts, or derivatives that compile to more instructions, are refused.
+  static constexpr std::size_t kMaxTextLength = 4096;       ///< characters
+  static constexpr int kMaxNesting = 64;                    ///< parentheses
+  static constexpr std::size_t kMaxTapeSize = 50000;        ///< instructions over value, gradient and Φt
 
-  // Parses and differentiates `text`. Throws phiq::Error with a one-line message naming the expression and the
-  // offending name or token when the text is malformed, uses an unknown name or an unsupported function.
-  // `allow_time` false rejects `t` (e.g. for constant fields).
+  /// Parses and differentiates `text`. Throws phiq::Error with a one-line message naming the expression and the
+  /// offending name or token when the text is malformed, uses an unknown name or an unsupported function.
+  /// `allow_time` false rejects `t` (e.g. for constant fields).
   static std::shared_ptr<const CompiledExpression> compile(const std::string& text, const NameResolver& resolve,
                                                            bool allow_time = true);
 
+  /// The text it was compiled from.
   const std::string& text() const { return text_; }
-  // Coordinates g depends on, ascending; gradient() writes ∂g/∂q for these, in this order.
+  /// Coordinates g depends on, ascending; gradient() writes ∂g/∂q for these, in this order.
   const std::vector<Index>& coordinates() const { return coords_; }
+  /// True when g depends on t explicitly.
   bool depends_on_time() const { return depends_on_time_; }
 
+  /// g(q, t). Pre-condition: q has an entry for every index in coordinates(). Thread-safe (as all below).
   double value(const double* q, double t) const;
+  /// ∂g/∂q_j for j in coordinates(), in that order, into dg_dq.
   void gradient(const double* q, double t, double* dg_dq) const;
+  /// ∂g/∂t.
   double partial_t(const double* q, double t) const;
-  // γ contribution: −( Σ_jk g_qjqk q̇j q̇k + 2 Σ_j g_qjt q̇j + g_tt ).
+  /// γ contribution: −( Σ_jk g_qjqk q̇j q̇k + 2 Σ_j g_qjt q̇j + g_tt ).
   double gamma(const double* q, const double* qd, double t) const;
 
  private:
@@ -89,7 +104,7 @@ class CompiledExpression {
   Tape value_, gradient_, partial_t_;
 };
 
-// Evaluates a constant expression (numbers, named constants, pi, functions), e.g. "L2/2" or "2*pi".
+/// Evaluates a constant expression (numbers, named constants, pi, functions), e.g. "L2/2" or "2*pi".
 double evaluate_constant_expression(const std::string& text,
                                     const std::function<std::optional<double>(const std::string&)>& constant);
 

@@ -1,8 +1,9 @@
-// The three problems of the notes, as free functions over (Model, Workspace):
-//   position      Φ(q, t) = 0                          Newton-Raphson (damped by a line search)
-//   velocity      Φq q̇ = −Φt                            linear, same matrix
-//   acceleration  Φq q̈ = γ = −(Φq q̇)q q̇ − 2Φqt q̇ − Φtt    linear, same matrix
-// Numerical outcomes are statuses the caller can act on; only violated pre-conditions (wrong sizes) throw.
+/// @file
+/// The three problems of the notes, as free functions over (Model, Workspace):
+///   position      Φ(q, t) = 0                          Newton-Raphson (damped by a line search)
+///   velocity      Φq q̇ = −Φt                            linear, same matrix
+///   acceleration  Φq q̈ = γ = −(Φq q̇)q q̇ − 2Φqt q̇ − Φtt    linear, same matrix
+/// Numerical outcomes are statuses the caller can act on; only violated pre-conditions (wrong sizes) throw.
 #pragma once
 
 #include <string>
@@ -13,63 +14,72 @@
 
 namespace phiq {
 
+/// Outcome of a solve: what the caller can act on. Only kSuccess leaves a valid solution in the workspace.
 enum class SolveStatus {
-  kSuccess,
-  kNotConverged,        // Newton reached its iteration limit, or could not decrease the residual
-  kSingularJacobian,    // Φq is singular here (singular position, redundant or missing constraints)
-  kLinearSolverFailed,  // the sparse library failed (out of memory, invalid data)
-  kNonFinite,           // NaN or Inf in Φ, Φq or a solution (e.g. a law outside its table, sqrt of a negative)
-  kNotSquare,           // equations ≠ coordinates: not solvable by the square driven-system path
-  kOutsideTimeDomain,   // a driver's law is not defined at the requested time
-  kCancelled,           // the caller's step callback asked to stop
+  kSuccess,             ///< solved to tolerance
+  kNotConverged,        ///< Newton reached its iteration limit, or could not decrease the residual
+  kSingularJacobian,    ///< Φq is singular here (singular position, redundant or missing constraints)
+  kLinearSolverFailed,  ///< the sparse library failed (out of memory, invalid data)
+  kNonFinite,           ///< NaN or Inf in Φ, Φq or a solution (e.g. a law outside its table, sqrt of a negative)
+  kNotSquare,           ///< equations ≠ coordinates: not solvable by the square driven-system path
+  kOutsideTimeDomain,   ///< a driver's law is not defined at the requested time
+  kCancelled,           ///< the caller's step callback asked to stop
 };
+/// Lower-case words, e.g. "singular Jacobian".
 const char* to_string(SolveStatus s);
 
+/// Settings of the Newton-Raphson position solve.
 struct NewtonOptions {
-  // Convergence: every row |Φ_i| ≤ tol · scale_i and the last step |Δq_j| ≤ tol · scale_j, where scale is the
-  // model's length_scale() for lengths and 1 for angles and unitless rows (plus a floor of a few ulps of |q|, so
-  // that the test stays reachable far from the origin).
+  /// Convergence: every row |Φ_i| ≤ tol · scale_i and the last step |Δq_j| ≤ tol · scale_j, where scale is the
+  /// model's length_scale() for lengths and 1 for angles and unitless rows (plus a floor of a few ulps of |q|, so
+  /// that the test stays reachable far from the origin).
   double tolerance = 1e-10;
-  int max_iterations = 20;
-  bool line_search = true;  // backtracking on ½‖Φ/scale‖² (always on for assembly from a rough placement)
-  int max_backtracks = 12;
+  int max_iterations = 20;  ///< Newton iterations before giving up (kNotConverged)
+  bool line_search = true;  ///< backtracking on ½‖Φ/scale‖² (always on for assembly from a rough placement)
+  int max_backtracks = 12;  ///< halvings of the step before the line search gives up
 };
 
+/// What solve_position did (Ceres-style summary).
 struct PositionSummary {
-  SolveStatus status = SolveStatus::kNotConverged;
-  int iterations = 0;
-  int backtracks = 0;
-  double residual = 0.0;  // max_i |Φ_i| / scale_i at the end
-  double rcond = 0.0;     // of the last factorisation (0 if none)
-  // Success at the iteration limit with the residual within tolerance but steps still above it: the linear
-  // convergence of Newton at a singular position (a dead point, a bifurcation). The constraints hold to tolerance;
-  // the position itself is less accurate (about √tol). message says so.
+  SolveStatus status = SolveStatus::kNotConverged;  ///< the outcome
+  int iterations = 0;                               ///< Newton steps taken (= factorisations)
+  int backtracks = 0;                               ///< step halvings by the line search
+  double residual = 0.0;  ///< max_i |Φ_i| / scale_i at the end
+  double rcond = 0.0;     ///< of the last factorisation (0 if none)
+  /// Success at the iteration limit with the residual within tolerance but steps still above it: the linear
+  /// convergence of Newton at a singular position (a dead point, a bifurcation). The constraints hold to tolerance;
+  /// the position itself is less accurate (about √tol). message says so.
   bool slow_convergence = false;
-  // The worst rows at the end (row, |Φ_i| / scale_i), largest first, at most 3.
+  /// The worst rows at the end (row, |Φ_i| / scale_i), largest first, at most 3.
   std::vector<std::pair<Index, double>> worst_rows;
-  std::string message;  // one line; empty on a clean success
+  std::string message;  ///< one line; empty on a clean success
+  /// One line: status, iterations, residual, message.
   std::string BriefReport() const;
 };
 
+/// What solve_velocity or solve_acceleration did.
 struct LinearSummary {
-  SolveStatus status = SolveStatus::kSuccess;
-  double rcond = 0.0;
-  std::string message;
+  SolveStatus status = SolveStatus::kSuccess;  ///< kSuccess, kSingularJacobian (not unique), kNotSquare, ...
+  double rcond = 0.0;                          ///< reciprocal condition estimate of the factorisation used
+  std::string message;                         ///< one line; empty on success
 };
 
-// Solves Φ(q, t) = 0 starting from ws.q; on success ws.q holds the solution, otherwise the last iterate.
-// Pre-condition: ws was made for `model`. Thread-safe for distinct workspaces.
+/// Solves Φ(q, t) = 0 starting from ws.q; on success ws.q holds the solution, otherwise the last iterate.
+/// Pre-condition: ws was made for `model` and its vectors keep their sizes. Throws phiq::Error when a
+/// pre-condition or `options` is violated; every numerical outcome is the returned status (also in `summary`).
+/// Thread-safe for distinct workspaces.
 SolveStatus solve_position(const Model& model, double t, const NewtonOptions& options, Workspace& ws,
                            PositionSummary* summary = nullptr);
 
-// Solves Φq q̇ = −Φt at ws.q into ws.qd. Pre-condition: ws.q solves the position problem at t. Reuses the
-// factorisation when it was made at exactly (ws.q, t).
+/// Solves Φq q̇ = −Φt at ws.q into ws.qd. Pre-condition: ws.q solves the position problem at t. Reuses the
+/// factorisation when it was made at exactly (ws.q, t). kSingularJacobian: the velocity is not unique there.
+/// Throws phiq::Error only for violated pre-conditions (workspace of another model, wrong sizes).
 SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary = nullptr);
 
-// Solves Φq q̈ = γ(q, q̇, t) into ws.qdd. Pre-condition: ws.q and ws.qd solve position and velocity at t.
+/// Solves Φq q̈ = γ(q, q̇, t) into ws.qdd. Pre-condition: ws.q and ws.qd solve position and velocity at t.
 SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, LinearSummary* summary = nullptr);
 
-// max_i |Φ_i| / scale_i, the measure the convergence test uses (0 for an empty model).
+/// max_i |Φ_i| / scale_i, the measure the convergence test uses (0 for an empty model).
 double scaled_residual(const Model& model, const Eigen::VectorXd& phi);
 
 }  // namespace phiq

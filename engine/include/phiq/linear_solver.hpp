@@ -1,9 +1,10 @@
-// Sparse LU behind one interface, in SuiteSparse's vocabulary: analyse (pattern, once per model) → factorise
-// (values, every Newton iteration) → solve.
-//
-// The symbolic object is immutable after analyse() and may be shared by any number of threads; each thread owns
-// its numeric object (make_numeric()), which co-owns the symbolic object it was made from. UMFPACK's "singular matrix" warning is reported as kSingular, distinct from
-// a failure of the library (kFailed: out of memory, invalid data).
+/// @file
+/// Sparse LU behind one interface, in SuiteSparse's vocabulary: analyse (pattern, once per model) → factorise
+/// (values, every Newton iteration) → solve.
+///
+/// The symbolic object is immutable after analyse() and may be shared by any number of threads; each thread owns
+/// its numeric object (make_numeric()), which co-owns the symbolic object it was made from. UMFPACK's "singular matrix" warning is reported as kSingular, distinct from
+/// a failure of the library (kFailed: out of memory, invalid data).
 #pragma once
 
 #include <memory>
@@ -13,36 +14,48 @@
 
 namespace phiq {
 
-enum class FactorStatus { kOk, kSingular, kFailed };
+/// Outcome of a numeric factorisation.
+enum class FactorStatus {
+  kOk,        ///< factors computed, the matrix is non-singular
+  kSingular,  ///< factors computed but U has a zero pivot (UMFPACK's warning): solves are not meaningful
+  kFailed,    ///< the library failed (out of memory, invalid data): no factors
+};
+/// "ok", "singular" or "failed".
 const char* to_string(FactorStatus s);
 
+/// Which sparse LU to use for the square driven system.
 enum class LinearSolverKind {
-  kUmfpack,  // SuiteSparse UMFPACK: the default for the square driven system
-  kDense,    // Eigen's dense partial-pivoting LU of the same matrix: a reference for tests and small models
+  kUmfpack,  ///< SuiteSparse UMFPACK: the default for the square driven system
+  kDense,    ///< Eigen's dense partial-pivoting LU of the same matrix: a reference for tests and small models
 };
+/// "umfpack" or "dense".
 const char* to_string(LinearSolverKind k);
 
+/// Numeric factors of one matrix with an analysed pattern. One per thread (not thread-safe).
 class SparseLuNumeric {
  public:
-  virtual ~SparseLuNumeric() = default;
-  // Numeric factorisation of the matrix with the analysed pattern and these CSC values.
+  virtual ~SparseLuNumeric() = default;  ///< frees the factors
+  /// Numeric factorisation of the matrix with the analysed pattern and these CSC values.
   virtual FactorStatus factorize(const double* values) = 0;
-  // x = A⁻¹ b with the last successful factorisation. x and b must not alias. Returns false on failure.
+  /// x = A⁻¹ b with the last successful factorisation. x and b must not alias. Returns false on failure.
   virtual bool solve(const double* b, double* x) = 0;
-  // Reciprocal condition estimate of the last factorisation (UMFPACK: min|U_ii| / max|U_ii|).
+  /// Reciprocal condition estimate of the last factorisation (UMFPACK: min|U_ii| / max|U_ii|).
   virtual double rcond() const = 0;
-  // Detail of the last failure, for diagnostics.
+  /// Detail of the last failure, for diagnostics.
   virtual std::string last_message() const = 0;
 };
 
+/// Symbolic analysis of a pattern (orderings, once per model). Immutable and thread-safe: share it.
 class SparseLuSymbolic {
  public:
-  virtual ~SparseLuSymbolic() = default;
+  virtual ~SparseLuSymbolic() = default;  ///< frees the analysis once no numeric object uses it
+  /// The library behind it.
   virtual LinearSolverKind kind() const = 0;
+  /// A new numeric object for this pattern (co-owns this analysis). Thread-safe.
   virtual std::unique_ptr<SparseLuNumeric> make_numeric() const = 0;
 };
 
-// Symbolic analysis of a square pattern. Throws phiq::Error when the pattern is not square or the library fails.
+/// Symbolic analysis of a square pattern. Throws phiq::Error when the pattern is not square or the library fails.
 std::shared_ptr<const SparseLuSymbolic> analyse(LinearSolverKind kind, std::shared_ptr<const CscPattern> pattern);
 
 }  // namespace phiq

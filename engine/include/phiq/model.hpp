@@ -1,7 +1,8 @@
-// The immutable description of a mechanism: generalized coordinates, constraint equations, the fixed sparsity
-// pattern of Φq, and the symbolic factorisation of that pattern. A Model is built once (ModelBuilder or a scene
-// file) and then only read: any number of threads may evaluate it and solve with it at once, each with its own
-// Workspace (workspace.hpp).
+/// @file
+/// The immutable description of a mechanism: generalized coordinates, constraint equations, the fixed sparsity
+/// pattern of Φq, and the symbolic factorisation of that pattern. A Model is built once (ModelBuilder or a scene
+/// file) and then only read: any number of threads may evaluate it and solve with it at once, each with its own
+/// Workspace (workspace.hpp).
 #pragma once
 
 #include <memory>
@@ -19,53 +20,71 @@
 
 namespace phiq {
 
+/// One constraint of a model, as diagnostics name it.
 struct ConstraintInfo {
-  std::string name;   // as given by the user (or "<kind>#<k>")
-  std::string kind;   // DistanceSpec::kKind, ...
-  Index first_row = 0;
-  int rows = 0;
-  bool depends_on_time = false;
+  std::string name;              ///< as given by the user (or "<kind>#<k>")
+  std::string kind;              ///< DistanceSpec::kKind, ...
+  Index first_row = 0;           ///< its first row in Φ
+  int rows = 0;                  ///< how many rows it owns
+  bool depends_on_time = false;  ///< rheonomic (a driver, or an equation in t)
 };
 
+/// An immutable mechanism: coordinates, constraints, the fixed CSC pattern of Φq and its symbolic analysis.
+/// Built by ModelBuilder or load_scene(). Every const member function is thread-safe. Movable, not copyable;
+/// Workspaces keep its address, so it must not move while they exist.
 class Model {
  public:
-  Model(Model&&) noexcept = default;
-  Model& operator=(Model&&) noexcept = default;
+  Model(Model&&) noexcept = default;             ///< only before any Workspace refers to it
+  Model& operator=(Model&&) noexcept = default;  ///< only before any Workspace refers to it
   Model(const Model&) = delete;
   Model& operator=(const Model&) = delete;
 
+  /// n, the size of q.
   Index num_coordinates() const { return static_cast<Index>(names_.size()); }
+  /// m, the number of rows of Φ (kinematic and rheonomic).
   Index num_equations() const { return static_cast<Index>(row_constraint_.size()); }
+  /// Coordinate names, in the order of q.
   const std::vector<std::string>& coordinate_names() const { return names_; }
-  // Index of a coordinate by name; throws phiq::Error for an unknown name.
+  /// Index of a coordinate by name; throws phiq::Error for an unknown name.
   Index coordinate_index(const std::string& name) const;
+  /// The initial guesses (rough placement) of q.
   const Eigen::VectorXd& initial_positions() const { return initial_; }
+  /// Unit of coordinate j, inferred from the constraints that read it. Pre-condition: 0 ≤ j < n.
   Unit coordinate_unit(Index j) const { return coordinate_units_[static_cast<std::size_t>(j)]; }
 
+  /// The constraints, in the order they were added (rows follow that order).
   const std::vector<ConstraintInfo>& constraints() const { return constraints_; }
+  /// Index into constraints() of the constraint owning `row`. Pre-condition: 0 ≤ row < m.
   Index constraint_of_row(Index row) const { return row_constraint_[static_cast<std::size_t>(row)]; }
+  /// Unit of a row of Φ (for its tolerance). Pre-condition: 0 ≤ row < m.
   Unit row_unit(Index row) const { return row_units_[static_cast<std::size_t>(row)]; }
-  // "name" for one-row constraints, "name[k]" for row k of a multi-row one.
+  /// "name" for one-row constraints, "name[k]" for row k of a multi-row one.
   std::string row_name(Index row) const;
+  /// True when some constraint depends on t (then Φt is not identically zero).
   bool has_time_dependence() const { return !time_blocks_.empty(); }
 
-  // Characteristic length of the model (metres): tolerances on lengths are relative to it.
+  /// Characteristic length of the model (metres): tolerances on lengths are relative to it.
   double length_scale() const { return length_scale_; }
+  /// The fixed pattern of Φq (m × n); Jacobian values are stored in its order.
   const CscPattern& jacobian_pattern() const { return *pattern_; }
+  /// The sparse LU the model was analysed for.
   LinearSolverKind linear_solver() const { return lu_kind_; }
-  // Symbolic analysis of Φq's pattern; nullptr when the model is not square (equations ≠ coordinates).
+  /// Symbolic analysis of Φq's pattern; nullptr when the model is not square (equations ≠ coordinates).
   const SparseLuSymbolic* symbolic() const { return symbolic_.get(); }
 
-  // Earliest / latest time at which every driver is defined (tabulated laws have a finite range).
+  /// Earliest / latest time at which every driver is defined (tabulated laws have a finite range).
   double time_domain_begin() const { return time_begin_; }
-  double time_domain_end() const { return time_end_; }
+  double time_domain_end() const { return time_end_; }  ///< see time_domain_begin()
+  /// Name of the driver that limits the time domain (empty when none does).
   const std::string& time_domain_limiter() const { return time_limiter_; }
 
-  // Evaluation. Pre-conditions: q (and qd) have num_coordinates() entries; output arrays have num_equations()
-  // entries (csc_values: jacobian_pattern().nnz()). Thread-safe.
+  /// Φ(q, t) into phi (m entries). Pre-condition: q has n entries. Thread-safe.
   void residual(const double* q, double t, double* phi) const;
+  /// Φq(q, t) values into csc_values (jacobian_pattern().nnz() entries, in pattern order). Thread-safe.
   void jacobian(const double* q, double t, double* csc_values) const;
+  /// ∂Φ/∂t into out (m entries; zero rows for constraints that do not depend on t). Thread-safe.
   void phi_t(const double* q, double t, double* out) const;
+  /// γ = −(Φq q̇)q q̇ − 2Φqt q̇ − Φtt into out (m entries). Pre-condition: qd has n entries. Thread-safe.
   void gamma(const double* q, const double* qd, double t, double* out) const;
 
  private:
@@ -90,40 +109,44 @@ class Model {
   std::shared_ptr<const SparseLuSymbolic> symbolic_;
 };
 
-// Builds a Model in code. Coordinates first (they are referenced by index), then constraints:
-//
-//   phiq::ModelBuilder b;
-//   auto th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3), ...;
-//   b.add("crank", phiq::PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, 0.3, S(th)});
-//   b.add_driver("motor", th, phiq::MotionLaw::linear(0.0, 2.0));
-//   phiq::Model model = std::move(b).build();
-//
-// Invalid data (unknown coordinate index, non-positive length, NaN, duplicate names) throws phiq::Error.
+/// Builds a Model in code. Coordinates first (they are referenced by index), then constraints:
+///
+///   phiq::ModelBuilder b;
+///   auto th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3), ...;
+///   b.add("crank", phiq::PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, 0.3, S(th)});
+///   b.add_driver("motor", th, phiq::MotionLaw::linear(0.0, 2.0));
+///   phiq::Model model = std::move(b).build();
+///
+/// Invalid data (unknown coordinate index, non-positive length, NaN, duplicate names) throws phiq::Error.
 class ModelBuilder {
  public:
-  ModelBuilder();
-  ~ModelBuilder();
-  ModelBuilder(ModelBuilder&&) noexcept;
+  ModelBuilder();                          ///< an empty model
+  ~ModelBuilder();                         ///< discards an unbuilt model
+  ModelBuilder(ModelBuilder&&) noexcept;   ///< moves the model being built
 
+  /// Adds coordinate `name` with its initial guess; returns its index in q. Throws phiq::Error for an empty or
+  /// duplicate name or a non-finite value.
   Index add_coordinate(const std::string& name, double initial);
+  /// Coordinates added so far.
   Index num_coordinates() const { return static_cast<Index>(model_.names_.size()); }
-  // Index of a coordinate by name, or -1.
+  /// Index of a coordinate by name, or -1.
   Index find_coordinate(const std::string& name) const;
-  // Sets a coordinate's initial guess (rough placement for assembly).
+  /// Sets a coordinate's initial guess (rough placement for assembly).
   void set_initial(Index j, double value);
 
-  // Adds a constraint of any kind in constraint_kinds.hpp; its rows follow those added before. Returns its index.
+  /// Adds a constraint of any kind in constraint_kinds.hpp; its rows follow those added before. Returns its index.
   template <class Spec>
   Index add(const std::string& name, Spec spec);
-  // Shorthand for a CoordinateDriverSpec.
+  /// Shorthand for a CoordinateDriverSpec.
   Index add_driver(const std::string& name, Index coordinate, MotionLaw law);
 
-  // Overrides the automatic length scale (largest length in the constraints' data, else the extent of the
-  // initial placement, else 1 m).
+  /// Overrides the automatic length scale (largest length in the constraints' data, else the extent of the
+  /// initial placement, else 1 m).
   void set_length_scale(double metres);
+  /// Chooses the sparse LU (default UMFPACK).
   void set_linear_solver(LinearSolverKind kind) { model_.lu_kind_ = kind; }
 
-  // Computes the pattern, units, scale and the symbolic analysis. The builder is consumed.
+  /// Computes the pattern, units, scale and the symbolic analysis. The builder is consumed.
   Model build() &&;
 
  private:
@@ -131,7 +154,8 @@ class ModelBuilder {
   void check_slot(const Slot& s, const std::string& name) const;
   template <class Spec>
   TypedBlock<Spec>& block_for();
-  // Kind-specific validation and set-up at add time; kinds with nothing to check use the template.
+  /// @cond internal
+  /// Kind-specific validation and set-up at add time; kinds with nothing to check use the template.
   template <class Spec>
   void prepare(Spec&) const {}
   void prepare(PointOnLineSpec& s) const;
@@ -143,10 +167,11 @@ class ModelBuilder {
   void prepare(EquationSpec& s) const;
   void prepare(PinSpec& s) const;
   void prepare(LoopSpec& s) const;
+  /// @endcond
 
   Model model_;
   std::unordered_map<std::type_index, std::size_t> block_of_type_;
-  std::unordered_set<std::string> constraint_names_;  // duplicate check in O(1): models reach 10^6 constraints
+  std::unordered_set<std::string> constraint_names_;  ///< duplicate check in O(1): models reach 10^6 constraints
   double length_scale_override_ = 0.0;
 };
 

@@ -1,4 +1,5 @@
-// Motion laws f(t) of rheonomic driving constraints, with exact first and second derivatives.
+/// @file
+/// Motion laws f(t) of rheonomic driving constraints, with exact first and second derivatives.
 #pragma once
 
 #include <memory>
@@ -9,31 +10,40 @@
 
 namespace phiq {
 
+/// A motion law and its derivatives at one time.
 struct LawValue {
-  double f = 0.0, df = 0.0, ddf = 0.0;  // f(t), f'(t), f''(t)
+  double f = 0.0;    ///< f(t)
+  double df = 0.0;   ///< f'(t)
+  double ddf = 0.0;  ///< f''(t)
 };
 
+/// A driver's motion law f(t). A value type (cheap to copy: the data is shared, immutable); thread-safe.
+/// The factory functions throw phiq::Error for non-finite or inconsistent data.
 class MotionLaw {
  public:
-  // f = initial + rate * t
+  /// f = initial + rate * t
   static MotionLaw linear(double initial, double rate);
-  // f = Σ_k c_k t^k
+  /// f = Σ_k c_k t^k
   static MotionLaw polynomial(std::vector<double> coefficients);
-  // f = offset + amplitude * sin(frequency * t + phase)   (frequency in rad/s)
+  /// f = offset + amplitude * sin(frequency * t + phase)   (frequency in rad/s)
   static MotionLaw harmonic(double offset, double amplitude, double frequency, double phase);
-  // C² cubic spline through (t_k, value_k) (Eigen's interpolating B-spline; exact for cubics); t strictly
-  // increasing, at least 2 points (fewer than 4 lower the degree). Defined on [t_0, t_last] only.
+  /// C² cubic spline through (t_k, value_k) (Eigen's interpolating B-spline; exact for cubics); t strictly
+  /// increasing, at least 2 points (fewer than 4 lower the degree). Defined on [t_0, t_last] only.
   static MotionLaw table(std::vector<double> t, std::vector<double> values);
-  // Any function of t written as text, e.g. "0.1*t^2 + sin(t)"; derivatives are exact (see expression.hpp).
+  /// Any function of t written as text, e.g. "0.1*t^2 + sin(t)"; derivatives are exact (see expression.hpp).
   static MotionLaw expression(std::shared_ptr<const CompiledExpression> f_of_t);
 
+  /// f, f', f'' at t; NaN outside [domain_begin(), domain_end()]. Throws phiq::Error on a default-constructed law.
   LawValue evaluate(double t) const;
-  // Interval on which the law is defined: infinite for analytic laws, the table's range for tables.
+  /// Interval on which the law is defined: infinite for analytic laws, the table's range for tables.
   double domain_begin() const;
-  double domain_end() const;
+  double domain_end() const;  ///< see domain_begin()
+  /// Short human-readable form, e.g. "linear 0 + 2*t".
   const std::string& description() const { return description_; }
 
+  /// @cond internal
   struct Impl;
+  /// @endcond
 
  private:
   std::shared_ptr<const Impl> impl_;

@@ -1,4 +1,5 @@
-// phiq: sparse, large-scale multibody kinematics. One include for the whole public API.
+/// @file
+/// phiq: sparse, large-scale multibody kinematics. One include for the whole public API.
 #pragma once
 
 #include "phiq/constraint_kinds.hpp"

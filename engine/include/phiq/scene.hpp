@@ -1,4 +1,5 @@
-// Scene files: a mechanism, its drivers, the time sweep and the outputs, in YAML (format: models/README.md).
+/// @file
+/// Scene files: a mechanism, its drivers, the time sweep and the outputs, in YAML (format: models/README.md).
 #pragma once
 
 #include <memory>
@@ -11,34 +12,35 @@
 
 namespace phiq {
 
-// A scene that cannot be used. what() is one line: "FILE:LINE:COL: FIELD.PATH: message".
+/// A scene that cannot be used. what() is one line: "FILE:LINE:COL: FIELD.PATH: message".
 class SceneError : public std::runtime_error {
  public:
-  // The message is made one line whatever user text it quotes (single_line()).
+  /// The message is made one line whatever user text it quotes (single_line()).
   explicit SceneError(const std::string& message) : std::runtime_error(single_line(message)) {}
 };
 
-// Limits that refuse huge or hostile scenes with a clear error before memory or stack is exhausted. The node
-// count bounds the memory of the YAML tree (about 0.5 KiB a node in yaml-cpp 0.7, see models/README.md).
+/// Limits that refuse huge or hostile scenes with a clear error before memory or stack is exhausted. The node
+/// count bounds the memory of the YAML tree (about 0.5 KiB a node in yaml-cpp 0.7, see models/README.md).
 struct SceneLimits {
-  std::size_t max_file_bytes = std::size_t{128} << 20;  // 128 MiB
-  int max_depth = 32;                                    // nesting of maps and lists
-  std::size_t max_nodes = 20'000'000;                    // scalars + maps + lists
-  std::size_t max_scalar_bytes = 16384;                  // one value (expressions are shorter still, see expression.hpp)
+  std::size_t max_file_bytes = std::size_t{128} << 20;  ///< 128 MiB
+  int max_depth = 32;                                    ///< nesting of maps and lists
+  std::size_t max_nodes = 20'000'000;                    ///< scalars + maps + lists
+  std::size_t max_scalar_bytes = 16384;                  ///< one value (expressions are shorter still, see expression.hpp)
 };
 
+/// A loaded scene: the model, the sweep and what to output.
 struct Scene {
-  std::string path;
-  std::string name;
-  std::unique_ptr<Model> model;
-  SweepOptions sweep;
-  std::vector<Index> output_coordinates;  // columns written, in scene order (default: all coordinates)
+  std::string path;              ///< the file it was read from (or the name given to parse_scene)
+  std::string name;              ///< the scene's `name` field (may be empty)
+  std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: workspaces keep its address)
+  SweepOptions sweep;            ///< time sweep, outputs asked for, and solver settings
+  std::vector<Index> output_coordinates;  ///< columns written, in scene order (default: all coordinates)
 };
 
-// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,
-// unknown or duplicate fields and names, wrong types, NaN or infinite numbers and impossible values.
+/// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,
+/// unknown or duplicate fields and names, wrong types, NaN or infinite numbers and impossible values.
 Scene load_scene(const std::string& path, const SceneLimits& limits = {});
-// The same from text; `path` is used in messages only.
+/// The same from text; `path` is used in messages only.
 Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits = {});
 
 }  // namespace phiq

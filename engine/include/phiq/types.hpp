@@ -1,4 +1,5 @@
-// Basic vocabulary shared by every part of phiq: indices, slots, units and the API error type.
+/// @file
+/// Basic vocabulary shared by every part of phiq: indices, slots, units and the API error type.
 #pragma once
 
 #include <cstdint>
@@ -7,51 +8,63 @@
 
 namespace phiq {
 
-// Indices are 64-bit: SuiteSparse's "l" interfaces (UMFPACK dl, KLU l, CHOLMOD long) take SuiteSparse_long, and
-// 10^6-coordinate models have more than 2^31 Jacobian entries in some of their derived products.
+/// Indices are 64-bit: SuiteSparse's "l" interfaces (UMFPACK dl, KLU l, CHOLMOD long) take SuiteSparse_long, and
+/// 10^6-coordinate models have more than 2^31 Jacobian entries in some of their derived products.
 using Index = std::int64_t;
 
-// Thrown at the API boundary for programming errors (wrong sizes, unknown names, out-of-range indices, calling
-// an algorithm before its pre-condition holds) and for invalid model data. Numerical outcomes are never
-// exceptions: they are statuses (see kinematics.hpp).
+/// Thrown at the API boundary for programming errors (wrong sizes, unknown names, out-of-range indices, calling
+/// an algorithm before its pre-condition holds) and for invalid model data. Numerical outcomes are never
+/// exceptions: they are statuses (see kinematics.hpp).
 class Error : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
 };
 
-// `text` made fit for a one-line message: control characters escaped (\n, \t, \xNN). User text quoted in errors
-// (expressions, names from a scene) may contain them.
+/// `text` made fit for a one-line message: control characters escaped as `\\n`, `\\t`, `\\xNN`. User text quoted in
+/// errors (expressions, names from a scene) may contain them. Thread-safe.
 std::string single_line(const std::string& text);
 
-// What a coordinate or a constraint row measures. Tolerances are dimensional: a length is compared with
-// tol * length_scale, an angle with tol (radians), a quantity of unknown unit with tol.
-enum class Unit : std::uint8_t { kNone = 0, kLength = 1, kAngle = 2 };
+/// What a coordinate or a constraint row measures. Tolerances are dimensional: a length is compared with
+/// tol * length_scale, an angle with tol (radians), a quantity of unknown unit with tol.
+enum class Unit : std::uint8_t {
+  kNone = 0,    ///< unknown or unitless: compared with tol
+  kLength = 1,  ///< metres: compared with tol · length_scale
+  kAngle = 2,   ///< radians: compared with tol
+};
 
+/// "none", "length" or "angle".
 const char* to_string(Unit u);
 
-// A scalar that a constraint reads: either generalized coordinate `coord` or the constant `value`. Fixed points
-// and ground are made of constant slots, so constraints never need separate "grounded" variants.
+/// A scalar that a constraint reads: either generalized coordinate `coord` or the constant `value`. Fixed points
+/// and ground are made of constant slots, so constraints never need separate "grounded" variants.
 struct Slot {
-  Index coord = -1;
-  double value = 0.0;
+  Index coord = -1;    ///< index of the coordinate in q, or -1 for a constant
+  double value = 0.0;  ///< the constant (unused for a coordinate)
 
+  /// The slot of coordinate `i` (an index into q; checked when the constraint is added to a ModelBuilder).
   static Slot coordinate(Index i) { return Slot{i, 0.0}; }
+  /// A constant slot.
   static Slot constant(double v) { return Slot{-1, v}; }
+  /// True for a coordinate, false for a constant.
   bool is_coordinate() const { return coord >= 0; }
+  /// Its value at q (q must have more than `coord` entries).
   double of(const double* q) const { return coord >= 0 ? q[coord] : value; }
-  // Time derivative: constants do not move.
+  /// Time derivative: constants do not move.
   double rate(const double* qd) const { return coord >= 0 ? qd[coord] : 0.0; }
 };
 
-// A planar point given by two slots (natural coordinates, or a fixed point, or a mix such as (xB, 0)).
+/// A planar point given by two slots (natural coordinates, or a fixed point, or a mix such as (xB, 0)).
 struct Point2 {
-  Slot x, y;
+  Slot x;  ///< x coordinate (m)
+  Slot y;  ///< y coordinate (m)
 };
 
-// A planar body frame in reference-point coordinates: position of its reference point and orientation angle.
-// Ground is a frame of constants.
+/// A planar body frame in reference-point coordinates: position of its reference point and orientation angle.
+/// Ground is a frame of constants.
 struct Frame2 {
-  Slot x, y, psi;
+  Slot x;    ///< x of the reference point (m)
+  Slot y;    ///< y of the reference point (m)
+  Slot psi;  ///< orientation (rad)
 };
 
 }  // namespace phiq

@@ -1,6 +1,7 @@
-// Per-thread data for the algorithms of kinematics.hpp: the state (q, q̇, q̈), the Jacobian values, the numeric LU
-// factorisation and scratch vectors. A Workspace belongs to one thread at a time; the Model it was made for is
-// shared and must outlive it (and must not be moved while it exists).
+/// @file
+/// Per-thread data for the algorithms of kinematics.hpp: the state (q, q̇, q̈), the Jacobian values, the numeric LU
+/// factorisation and scratch vectors. A Workspace belongs to one thread at a time; the Model it was made for is
+/// shared and must outlive it (and must not be moved while it exists).
 #pragma once
 
 #include <Eigen/Core>
@@ -11,37 +12,49 @@
 
 namespace phiq {
 
-// Work done, counted where it happens (for summaries and for tests that the engine computes only what is asked).
+/// Work done, counted where it happens (for summaries and for tests that the engine computes only what is asked).
 struct WorkCounters {
-  Index newton_iterations = 0;
-  Index residual_evaluations = 0;
-  Index jacobian_evaluations = 0;
-  Index factorizations = 0;
-  Index velocity_solves = 0;
-  Index acceleration_solves = 0;
-  Index phi_t_evaluations = 0;
-  Index gamma_evaluations = 0;
+  Index newton_iterations = 0;     ///< Newton steps (each one factorisation)
+  Index residual_evaluations = 0;  ///< evaluations of Φ (including line-search trials)
+  Index jacobian_evaluations = 0;  ///< evaluations of Φq values
+  Index factorizations = 0;        ///< numeric LU factorisations
+  Index velocity_solves = 0;       ///< solves of Φq q̇ = −Φt
+  Index acceleration_solves = 0;   ///< solves of Φq q̈ = γ
+  Index phi_t_evaluations = 0;     ///< evaluations of Φt (velocity right-hand sides)
+  Index gamma_evaluations = 0;     ///< evaluations of γ (acceleration right-hand sides)
 };
 
+/// Per-thread data of the algorithms in kinematics.hpp and sweep.hpp. Not thread-safe: one thread at a time.
 class Workspace {
  public:
+  /// Sized for `model`, with q at its initial positions and its own numeric LU object (sharing the model's
+  /// symbolic analysis). The model must outlive the workspace and not move.
   explicit Workspace(const Model& model);
+  /// The model it was made for.
   const Model& model() const { return *model_; }
 
-  // State. q starts at the model's initial positions; q̇ and q̈ at zero. Algorithms read and write them; so may
-  // the caller (e.g. to give a better starting guess).
-  Eigen::VectorXd q, qd, qdd;
-  WorkCounters counters;
+  /// Generalized coordinates. Starts at the model's initial positions; algorithms read and write it, and so may
+  /// the caller (e.g. to give a better starting guess). Keep its size.
+  Eigen::VectorXd q;
+  Eigen::VectorXd qd;      ///< velocities q̇ (written by solve_velocity; starts at zero)
+  Eigen::VectorXd qdd;     ///< accelerations q̈ (written by solve_acceleration; starts at zero)
+  WorkCounters counters;   ///< work done with this workspace so far (never reset by the algorithms)
 
-  // ---- used by the algorithms (kinematics.cpp); not needed by callers ----
-  Eigen::VectorXd phi, rhs, step, trial, trial_phi;
-  std::vector<double> jacobian_values;
-  std::unique_ptr<SparseLuNumeric> lu;  // null for non-square models
-  // The point (q, t) of the current factorisation, so that velocity and acceleration reuse it exactly when it is
-  // still valid and refactorise otherwise.
+  /// @name Scratch of the algorithms (kinematics.cpp); callers need not touch it
+  ///@{
+  Eigen::VectorXd phi;                   ///< Φ at q
+  Eigen::VectorXd rhs;                   ///< right-hand side of the last linear solve
+  Eigen::VectorXd step;                  ///< last Newton step
+  Eigen::VectorXd trial;                 ///< line-search trial point
+  Eigen::VectorXd trial_phi;             ///< Φ at the trial point
+  std::vector<double> jacobian_values;   ///< Φq values in jacobian_pattern() order
+  std::unique_ptr<SparseLuNumeric> lu;   ///< numeric factors; null for non-square models
+  /// The point (q, t) of the current factorisation, so that velocity and acceleration reuse it exactly when it is
+  /// still valid and refactorise otherwise.
   Eigen::VectorXd factorized_q;
-  double factorized_t = 0.0;
-  bool has_factorization = false;
+  double factorized_t = 0.0;             ///< see factorized_q
+  bool has_factorization = false;        ///< lu holds valid factors at (factorized_q, factorized_t)
+  ///@}
 
  private:
   const Model* model_;
