@@ -25,8 +25,9 @@ std::string indexed(const char* prefix, Index i) {
 // IFToMM-style N four-bar in natural coordinates: cranks of length 1 pinned at (i, 0), i = 0..N, tips P_i joined by
 // N couplers of length 1; crank 0 carries the angle coordinate theta that is driven. Starts on the parallelogram
 // solution P_i = (i + cos θ, sin θ). 2N + 3 coordinates.
-Model nfourbar(Index n, double theta0, double rate) {
+Model nfourbar(Index n, double theta0, double rate, LinearSolverKind kind = LinearSolverKind::kKlu) {
   ModelBuilder b;
+  b.set_linear_solver(kind);
   auto S = Slot::coordinate;
   auto C = Slot::constant;
   std::vector<Point2> tip;
@@ -118,6 +119,8 @@ void run_steps(benchmark::State& state, const Model& m, Index steps, double t_en
   state.counters["step_per_kernel"] = (sweep_s / static_cast<double>(rows)) / (kernel_s / static_cast<double>(kernels));
   state.counters["newton_per_step"] = static_cast<double>(sum.counters.newton_iterations) / (steps + 1);
   state.counters["factorizations_per_step"] = static_cast<double>(sum.counters.factorizations) / (steps + 1);
+  state.counters["pivoting_per_step"] = static_cast<double>(ws.lu->pivoting_factorizations()) /
+                                        static_cast<double>(state.iterations() * (steps + 1));
   state.counters["coordinates"] = static_cast<double>(m.num_coordinates());
 }
 
@@ -127,18 +130,26 @@ void BM_CrankSliderSweepStep(benchmark::State& state) {
 }
 BENCHMARK(BM_CrankSliderSweepStep)->UseManualTime();
 
-// nfourbar, a quarter turn (π/4 → 3π/4) in 50 steps per iteration.
+// Second benchmark argument: the sparse LU.
+LinearSolverKind kind_arg(const benchmark::State& state) { return static_cast<LinearSolverKind>(state.range(1)); }
+void solver_args(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"N", "lu"});
+  for (int64_t n = 10; n <= 100000; n *= 10)
+    for (LinearSolverKind k : {LinearSolverKind::kKlu, LinearSolverKind::kUmfpack}) b->Args({n, static_cast<int64_t>(k)});
+}
+
+// nfourbar, a quarter turn (π/4 → 3π/4) in 50 steps per iteration. lu: 0 UMFPACK, 1 KLU.
 void BM_NFourBarSweepStep(benchmark::State& state) {
-  Model m = nfourbar(state.range(0), M_PI / 4, M_PI / 2);
+  Model m = nfourbar(state.range(0), M_PI / 4, M_PI / 2, kind_arg(state));
   run_steps(state, m, 50, 1.0);
 }
-BENCHMARK(BM_NFourBarSweepStep)->RangeMultiplier(10)->Range(10, 100000)->Unit(benchmark::kMillisecond)->UseManualTime();
+BENCHMARK(BM_NFourBarSweepStep)->Apply(solver_args)->Unit(benchmark::kMillisecond)->UseManualTime();
 
 // Engine cost around the kernel: one engine Newton iteration (residual, Jacobian in place, factorise, solve,
 // line-search residual, convergence tests) against one bare factorise+solve of the same matrix, interleaved in
 // the same loop. Reports both times and iteration_per_kernel.
 void BM_NFourBarNewtonIterationVsKernel(benchmark::State& state) {
-  Model m = nfourbar(state.range(0), M_PI / 4, M_PI / 2);
+  Model m = nfourbar(state.range(0), M_PI / 4, M_PI / 2, kind_arg(state));
   Workspace ws(m);
   Kernel kernel(m);
   const Eigen::VectorXd start = m.initial_positions() + Eigen::VectorXd::Constant(m.num_coordinates(), 1e-3);
@@ -159,11 +170,7 @@ void BM_NFourBarNewtonIterationVsKernel(benchmark::State& state) {
   state.counters["kernel_us"] = 1e6 * kernel_s / static_cast<double>(state.iterations());
   state.counters["iteration_per_kernel"] = engine_s / kernel_s;
 }
-BENCHMARK(BM_NFourBarNewtonIterationVsKernel)
-    ->RangeMultiplier(10)
-    ->Range(10, 100000)
-    ->Unit(benchmark::kMicrosecond)
-    ->UseManualTime();
+BENCHMARK(BM_NFourBarNewtonIterationVsKernel)->Apply(solver_args)->Unit(benchmark::kMicrosecond)->UseManualTime();
 
 }  // namespace
 

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <cmath>
 #include <random>
 
 #include "phiq/linear_solver.hpp"
@@ -35,9 +36,11 @@ Sys random_system(Index n, unsigned seed) {
   return s;
 }
 
-TEST(LinearSolver, UmfpackMatchesDenseLuAndReusesTheSymbolicAnalysis) {
+class SparseLu : public ::testing::TestWithParam<LinearSolverKind> {};
+
+TEST_P(SparseLu, MatchesDenseLuAndReusesTheSymbolicAnalysis) {
   Sys s = random_system(200, 3);
-  auto sym = analyse(LinearSolverKind::kUmfpack, s.p);
+  auto sym = analyse(GetParam(), s.p);
   auto a = sym->make_numeric(), b = sym->make_numeric();  // two numeric objects share one symbolic
   Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(200, -1, 1), x(200), y(200);
   ASSERT_EQ(a->factorize(s.values.data()), FactorStatus::kOk);
@@ -51,6 +54,48 @@ TEST(LinearSolver, UmfpackMatchesDenseLuAndReusesTheSymbolicAnalysis) {
   ASSERT_EQ(b->factorize(v2.data()), FactorStatus::kOk);
   ASSERT_TRUE(b->solve(rhs.data(), y.data()));
   EXPECT_LT((y - ref / 1.5).cwiseAbs().maxCoeff(), 1e-12);
+  // refactorising the first object with new values
+  ASSERT_EQ(a->factorize(v2.data()), FactorStatus::kOk);
+  ASSERT_TRUE(a->solve(rhs.data(), x.data()));
+  EXPECT_LT((x - ref / 1.5).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, SparseLu, ::testing::Values(LinearSolverKind::kUmfpack, LinearSolverKind::kKlu),
+                         [](const auto& info) { return std::string(to_string(info.param)); });
+
+TEST(LinearSolver, KluRefactorisesWithTheOldPivotsWhileTheyHold) {
+  Sys s = random_system(300, 5);
+  auto n = analyse(LinearSolverKind::kKlu, s.p)->make_numeric();
+  Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(300, 1, 2), x(300);
+  ASSERT_EQ(n->factorize(s.values.data()), FactorStatus::kOk);
+  for (int k = 1; k <= 5; ++k) {  // small changes of values, as between Newton iterations
+    std::vector<double> v = s.values;
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] *= 1.0 + 0.01 * k * std::sin(static_cast<double>(i));
+    ASSERT_EQ(n->factorize(v.data()), FactorStatus::kOk);
+    ASSERT_TRUE(n->solve(rhs.data(), x.data()));
+    Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(300, 300);
+    for (Index c = 0; c < 300; ++c)
+      for (Index i = s.p->col_ptr[c]; i < s.p->col_ptr[c + 1]; ++i) dense(s.p->row_idx[i], c) = v[i];
+    EXPECT_LT((dense * x - rhs).cwiseAbs().maxCoeff(), 1e-12);
+  }
+  EXPECT_EQ(n->pivoting_factorizations(), 1);  // five refactorisations, no new pivot search
+}
+
+TEST(LinearSolver, KluSearchesPivotsAgainWhenTheOldOnesDegrade) {
+  // full 2 x 2: first diagonally dominant (diagonal pivots), then with a tiny (1,1) entry, where the old pivot
+  // order would divide by 1e-14
+  auto p = std::make_shared<CscPattern>();
+  std::vector<Index> slot;
+  *p = build_csc_pattern(2, 2, {0, 1, 0, 1}, {0, 0, 1, 1}, &slot);
+  auto n = analyse(LinearSolverKind::kKlu, p)->make_numeric();
+  std::vector<double> a = {2, 1, 1, 2}, b = {1e-14, 1, 1, 1};  // column-major
+  ASSERT_EQ(n->factorize(a.data()), FactorStatus::kOk);
+  ASSERT_EQ(n->factorize(b.data()), FactorStatus::kOk);
+  EXPECT_EQ(n->pivoting_factorizations(), 2);
+  double rhs[2] = {1, 2}, x[2];
+  ASSERT_TRUE(n->solve(rhs, x));
+  EXPECT_NEAR(1e-14 * x[0] + x[1], 1.0, 1e-14);
+  EXPECT_NEAR(x[0] + x[1], 2.0, 1e-14);
 }
 
 TEST(LinearSolver, SingularIsAWarningNotAFailure) {
@@ -59,7 +104,7 @@ TEST(LinearSolver, SingularIsAWarningNotAFailure) {
   std::vector<Index> slot;
   *p = build_csc_pattern(2, 2, {0, 1, 0, 1}, {0, 0, 1, 1}, &slot);
   std::vector<double> v = {1, 2, 2, 4};
-  for (LinearSolverKind k : {LinearSolverKind::kUmfpack, LinearSolverKind::kDense}) {
+  for (LinearSolverKind k : {LinearSolverKind::kUmfpack, LinearSolverKind::kKlu, LinearSolverKind::kDense}) {
     auto n = analyse(k, p)->make_numeric();
     EXPECT_EQ(n->factorize(v.data()), FactorStatus::kSingular) << to_string(k);
     EXPECT_EQ(n->rcond(), 0.0) << to_string(k);

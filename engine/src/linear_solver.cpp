@@ -1,5 +1,6 @@
 #include "phiq/linear_solver.hpp"
 
+#include <klu.h>
 #include <umfpack.h>
 
 #include <Eigen/Dense>
@@ -20,6 +21,7 @@ const char* to_string(FactorStatus s) {
 const char* to_string(LinearSolverKind k) {
   switch (k) {
     case LinearSolverKind::kUmfpack: return "umfpack";
+    case LinearSolverKind::kKlu: return "klu";
     case LinearSolverKind::kDense: return "dense";
   }
   return "?";
@@ -54,8 +56,10 @@ class UmfpackNumeric final : public SparseLuNumeric {
   bool solve(const double* b, double* x) override;
   double rcond() const override { return rcond_; }
   std::string last_message() const override { return message_; }
+  std::int64_t pivoting_factorizations() const override { return factorizations_; }
 
  private:
+  std::int64_t factorizations_ = 0;
   std::shared_ptr<const UmfpackSymbolic> keep_;  // co-owns the symbolic analysis it factorises with
   const UmfpackSymbolic& sym_;
   void* numeric_ = nullptr;
@@ -106,6 +110,7 @@ UmfpackNumeric::UmfpackNumeric(std::shared_ptr<const UmfpackSymbolic> sym) : kee
 FactorStatus UmfpackNumeric::factorize(const double* values) {
   if (numeric_) umfpack_dl_free_numeric(&numeric_);
   values_ = values;
+  ++factorizations_;
   const CscPattern& p = *sym_.pattern_;
   int status = umfpack_dl_numeric(p.col_ptr.data(), p.row_idx.data(), values, sym_.symbolic_, &numeric_, control_,
                                   info_);
@@ -143,6 +148,7 @@ class DenseNumeric final : public SparseLuNumeric {
  public:
   explicit DenseNumeric(std::shared_ptr<const CscPattern> p) : p_(*p), keep_(std::move(p)), a_(p_.rows, p_.cols) {}
   FactorStatus factorize(const double* values) override {
+    ++factorizations_;
     a_.setZero();
     for (Index c = 0; c < p_.cols; ++c)
       for (Index k = p_.col_ptr[c]; k < p_.col_ptr[c + 1]; ++k) a_(p_.row_idx[k], c) = values[k];
@@ -161,6 +167,7 @@ class DenseNumeric final : public SparseLuNumeric {
   }
   double rcond() const override { return rcond_; }
   std::string last_message() const override { return rcond_ == 0.0 ? "singular matrix" : ""; }
+  std::int64_t pivoting_factorizations() const override { return factorizations_; }
 
  private:
   const CscPattern& p_;
@@ -168,7 +175,126 @@ class DenseNumeric final : public SparseLuNumeric {
   Eigen::MatrixXd a_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   double rcond_ = 0.0;
+  std::int64_t factorizations_ = 0;
 };
+
+// ---- KLU ------------------------------------------------------------------------------------------------------
+
+class KluSymbolic;
+
+class KluNumeric final : public SparseLuNumeric {
+ public:
+  explicit KluNumeric(std::shared_ptr<const KluSymbolic> sym);
+  ~KluNumeric() override;
+  FactorStatus factorize(const double* values) override;
+  bool solve(const double* b, double* x) override;
+  double rcond() const override { return rcond_; }
+  std::string last_message() const override { return message_; }
+  std::int64_t pivoting_factorizations() const override { return pivoting_; }
+
+  // A refactorisation keeps the pivot order of the last pivoting factorisation; when its reciprocal pivot ratio
+  // falls below this fraction of the one measured right after pivoting, the pivots have degraded (the matrix moved
+  // far from the one they were chosen for) and the matrix is factorised again with a pivot search.
+  static constexpr double kDegradation = 1e-3;
+
+ private:
+  FactorStatus factor_with_pivoting(const double* values);
+  std::shared_ptr<const KluSymbolic> keep_;
+  const KluSymbolic& sym_;
+  mutable klu_l_common common_;
+  klu_l_numeric* numeric_ = nullptr;
+  double rcond_ = 0.0, rcond_at_pivoting_ = 0.0;
+  std::int64_t pivoting_ = 0;
+  std::string message_;
+};
+
+class KluSymbolic final : public SparseLuSymbolic, public std::enable_shared_from_this<KluSymbolic> {
+ public:
+  explicit KluSymbolic(std::shared_ptr<const CscPattern> pattern) : pattern_(std::move(pattern)) {
+    klu_l_common common;
+    klu_l_defaults(&common);
+    // BTF + AMD on the pattern only: the orderings are fixed per model.
+    symbolic_ = klu_l_analyze(pattern_->cols, const_cast<SuiteSparse_long*>(pattern_->col_ptr.data()),
+                              const_cast<SuiteSparse_long*>(pattern_->row_idx.data()), &common);
+    if (!symbolic_) throw Error("KLU symbolic analysis failed (status " + std::to_string(common.status) + ")");
+  }
+  ~KluSymbolic() override {
+    klu_l_common common;
+    klu_l_defaults(&common);
+    klu_l_free_symbolic(&symbolic_, &common);
+  }
+  LinearSolverKind kind() const override { return LinearSolverKind::kKlu; }
+  std::unique_ptr<SparseLuNumeric> make_numeric() const override {
+    return std::make_unique<KluNumeric>(shared_from_this());
+  }
+
+  std::shared_ptr<const CscPattern> pattern_;
+  klu_l_symbolic* symbolic_ = nullptr;  // read-only after construction: shared by all numeric objects
+};
+
+KluNumeric::KluNumeric(std::shared_ptr<const KluSymbolic> sym) : keep_(std::move(sym)), sym_(*keep_) {
+  klu_l_defaults(&common_);
+}
+
+KluNumeric::~KluNumeric() {
+  if (numeric_) klu_l_free_numeric(&numeric_, &common_);
+}
+
+FactorStatus KluNumeric::factor_with_pivoting(const double* values) {
+  if (numeric_) klu_l_free_numeric(&numeric_, &common_);
+  const CscPattern& p = *sym_.pattern_;
+  ++pivoting_;
+  numeric_ = klu_l_factor(const_cast<SuiteSparse_long*>(p.col_ptr.data()), const_cast<SuiteSparse_long*>(p.row_idx.data()),
+                          const_cast<double*>(values), sym_.symbolic_, &common_);
+  if (!numeric_) {
+    rcond_ = 0.0;
+    // halt_if_singular (the default): a zero pivot frees the factors and reports KLU_SINGULAR
+    if (common_.status == KLU_SINGULAR) {
+      message_ = "singular matrix";
+      return FactorStatus::kSingular;
+    }
+    message_ = "KLU factorisation failed (status " + std::to_string(common_.status) + ")";
+    return FactorStatus::kFailed;
+  }
+  klu_l_rcond(sym_.symbolic_, numeric_, &common_);
+  rcond_ = rcond_at_pivoting_ = common_.rcond;
+  message_.clear();
+  return FactorStatus::kOk;
+}
+
+FactorStatus KluNumeric::factorize(const double* values) {
+  if (numeric_) {
+    const CscPattern& p = *sym_.pattern_;
+    const bool ok = klu_l_refactor(const_cast<SuiteSparse_long*>(p.col_ptr.data()),
+                                   const_cast<SuiteSparse_long*>(p.row_idx.data()), const_cast<double*>(values),
+                                   sym_.symbolic_, numeric_, &common_) &&
+                    common_.status == KLU_OK;
+    if (ok) {
+      klu_l_rcond(sym_.symbolic_, numeric_, &common_);
+      if (common_.rcond >= kDegradation * rcond_at_pivoting_) {
+        rcond_ = common_.rcond;
+        message_.clear();
+        return FactorStatus::kOk;
+      }
+    }
+    // refactorisation failed, hit a zero pivot, or its pivots degraded: search for pivots again
+  }
+  return factor_with_pivoting(values);
+}
+
+bool KluNumeric::solve(const double* b, double* x) {
+  if (!numeric_) {
+    message_ = "solve before a successful factorisation";
+    return false;
+  }
+  const Index n = sym_.pattern_->cols;
+  std::copy(b, b + n, x);
+  if (!klu_l_solve(sym_.symbolic_, numeric_, n, 1, x, &common_)) {
+    message_ = "KLU solve failed (status " + std::to_string(common_.status) + ")";
+    return false;
+  }
+  return true;
+}
 
 class DenseSymbolic final : public SparseLuSymbolic {
  public:
@@ -189,6 +315,7 @@ std::shared_ptr<const SparseLuSymbolic> analyse(LinearSolverKind kind, std::shar
                 std::to_string(pattern->cols));
   switch (kind) {
     case LinearSolverKind::kUmfpack: return std::make_shared<UmfpackSymbolic>(pattern);
+    case LinearSolverKind::kKlu: return std::make_shared<KluSymbolic>(pattern);
     case LinearSolverKind::kDense: return std::make_shared<DenseSymbolic>(pattern);
   }
   throw Error("unknown linear solver kind");

@@ -593,8 +593,9 @@ class SceneReader {
     if (auto v = c.field("linear_solver"); v.present()) {
       const std::string s = v.text();
       if (s == "umfpack") builder_.set_linear_solver(LinearSolverKind::kUmfpack);
+      else if (s == "klu") builder_.set_linear_solver(LinearSolverKind::kKlu);
       else if (s == "dense") builder_.set_linear_solver(LinearSolverKind::kDense);
-      else v.fail("linear_solver is umfpack or dense");
+      else v.fail("linear_solver is umfpack, klu or dense");
     }
     predictor_field_ = c.field("predictor").present();
   }

@@ -122,10 +122,13 @@ class Sweeper {
     }
   }
   void remember(double t) {
-    if (predictor_ == Predictor::kSecant) {
+    // Only a state that was really converged becomes the secant's previous point (the default-constructed one
+    // has no q: found by the fuzzer with a sweep starting away from t = 0).
+    if (predictor_ == Predictor::kSecant && has_current_) {
       std::swap(prev_, current_);  // current_ now holds prev's buffers: assigned below without allocating
       has_prev_ = true;
     }
+    has_current_ = true;
     current_.t = t;
     current_.q = ws_.q;
     if (need_v_) current_.qd = ws_.qd;
@@ -144,7 +147,7 @@ class Sweeper {
   bool need_v_ = false, need_a_ = false;
   Predictor predictor_;
   State current_, prev_;
-  bool has_prev_ = false;
+  bool has_current_ = false, has_prev_ = false;
 };
 
 }  // namespace

@@ -7,6 +7,7 @@
 /// a failure of the library (kFailed: out of memory, invalid data).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -25,10 +26,11 @@ const char* to_string(FactorStatus s);
 
 /// Which sparse LU to use for the square driven system.
 enum class LinearSolverKind {
-  kUmfpack,  ///< SuiteSparse UMFPACK: the default for the square driven system
+  kUmfpack,  ///< SuiteSparse UMFPACK: multifrontal LU, pivot search at every factorisation
+  kKlu,      ///< SuiteSparse KLU: refactorisation with the previous pivot order, re-pivoting when pivots degrade
   kDense,    ///< Eigen's dense partial-pivoting LU of the same matrix: a reference for tests and small models
 };
-/// "umfpack" or "dense".
+/// "umfpack", "klu" or "dense".
 const char* to_string(LinearSolverKind k);
 
 /// Numeric factors of one matrix with an analysed pattern. One per thread (not thread-safe).
@@ -43,6 +45,9 @@ class SparseLuNumeric {
   virtual double rcond() const = 0;
   /// Detail of the last failure, for diagnostics.
   virtual std::string last_message() const = 0;
+  /// Factorisations so far that searched for pivots (for KLU: not a refactorisation with the old pivot order).
+  /// Equal to the number of factorize() calls for libraries that always pivot.
+  virtual std::int64_t pivoting_factorizations() const = 0;
 };
 
 /// Symbolic analysis of a pattern (orderings, once per model). Immutable and thread-safe: share it.
