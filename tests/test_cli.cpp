@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "test_support.hpp"
@@ -193,6 +194,76 @@ TEST_F(Cli, CompareExitStatusAndWorstCell) {
   EXPECT_EQ(run("compare --rtol 1e-5 " + ref + " " + bad.string()).code, 0);
   EXPECT_EQ(run("compare " + ref + " /nonexistent.csv").code, 2);
   EXPECT_EQ(run("compare --columns t,nope " + ref + " " + out.string()).code, 2);
+}
+
+// Reads a CSV written by phiq into columns by name.
+std::map<std::string, std::vector<double>> columns_of(const std::string& text) {
+  std::stringstream in(text);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream hs(line);
+  for (std::string c; std::getline(hs, c, ',');) names.push_back(c);
+  std::map<std::string, std::vector<double>> cols;
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::size_t k = 0;
+    for (std::string c; std::getline(ls, c, ','); ++k) cols[names.at(k)].push_back(std::stod(c));
+  }
+  return cols;
+}
+
+TEST_F(Cli, GeneratedNFourBarStaysOnTheParallelogramBranch) {
+  // N = 6 four-bars over the default quarter turn: every crank stays parallel to crank 0 at θ(t) = π/4 + π/2 t
+  for (const char* coords : {"natural", "reference-point"}) {
+    const fs::path scene = dir_ / (std::string(coords) + ".yaml"), out = dir_ / (std::string(coords) + ".csv");
+    ASSERT_EQ(run(std::string("generate nfourbar 6 --steps 40 --coords ") + coords + " -o " + scene.string()).code, 0);
+    Result r = run("run -q " + scene.string() + " -o " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto c = columns_of(slurp(out));
+    ASSERT_EQ(c["t"].size(), 41u) << coords;
+    double worst = 0.0;
+    for (std::size_t k = 0; k < c["t"].size(); ++k) {
+      const double th = M_PI / 4 + M_PI / 2 * c["t"][k];
+      for (int i = 0; i <= 6; ++i) {
+        const std::string n = std::to_string(i);
+        if (std::string(coords) == "natural") {
+          worst = std::max(worst, std::fabs(c["x" + n][k] - (i + std::cos(th))));
+          worst = std::max(worst, std::fabs(c["y" + n][k] - std::sin(th)));
+        } else {
+          worst = std::max(worst, std::fabs(c["psi" + n][k] - th));
+          worst = std::max(worst, std::fabs(c["xc" + n][k] - (i + 0.5 * std::cos(th))));
+        }
+      }
+    }
+    EXPECT_LT(worst, 1e-9) << coords;
+  }
+}
+
+TEST_F(Cli, SummaryJsonCountsWhatWasComputed) {
+  const fs::path scene = dir_ / "p.yaml", sum = dir_ / "sum.json";
+  ASSERT_EQ(run("generate nfourbar 3 --steps 10 --outputs q -o " + scene.string()).code, 0);
+  Result r = run("run -q " + scene.string() + " -o " + (dir_ / "p.csv").string() + " --summary " + sum.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string j = slurp(sum);
+  for (const char* part : {"\"steps\": 11", "\"threads\": 1", "\"velocity_solves\": 0", "\"acceleration_solves\": 0",
+                           "\"gamma_evaluations\": 0", "\"phi_t_evaluations\": 0", "\"load_seconds\": ",
+                           "\"solve_seconds\": ", "\"write_seconds\": ", "\"linear_solver\": \"klu\"", "\"warnings\": []"})
+    EXPECT_NE(j.find(part), std::string::npos) << part << "\n" << j;
+  // with velocities and accelerations: one of each per row
+  ASSERT_EQ(run("generate nfourbar 3 --steps 10 -o " + scene.string()).code, 0);
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + (dir_ / "p.csv").string() + " --summary " + sum.string()).code, 0);
+  const std::string j2 = slurp(sum);
+  EXPECT_NE(j2.find("\"velocity_solves\": 11"), std::string::npos) << j2;
+  EXPECT_NE(j2.find("\"acceleration_solves\": 11"), std::string::npos) << j2;
+}
+
+TEST_F(Cli, GenerateRefusesBadOptions) {
+  EXPECT_EQ(run("generate gears 5 -o " + (dir_ / "x.yaml").string()).code, 2);
+  EXPECT_EQ(run("generate nfourbar 0 -o " + (dir_ / "x.yaml").string()).code, 2);
+  EXPECT_EQ(run("generate nfourbar 5 --coords polar -o " + (dir_ / "x.yaml").string()).code, 2);
+  EXPECT_EQ(run("generate nfourbar 5 --outputs q,w -o " + (dir_ / "x.yaml").string()).code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
 }
 
 TEST_F(Cli, UsageErrorsAndHelp) {

@@ -7,11 +7,14 @@
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <csignal>
+#include <fstream>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
 
+#include "generate.hpp"
 #include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 
@@ -32,13 +35,56 @@ std::string sci(double v) {
   return s.str();
 }
 
-int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet) {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// `phiq run --summary FILE.json`: the run summary, format version 1 (tools/README.md).
+bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq::Workspace& ws,
+                   const phiq::SweepSummary& s, double load_s, double solve_s, double write_s) {
+  nlohmann::ordered_json j;
+  j["format"] = 1;
+  j["scene"] = scene.path;
+  j["status"] = phiq::to_string(s.status);
+  j["message"] = s.message;
+  j["steps"] = s.steps_completed;
+  j["threads"] = 1;
+  j["coordinates"] = scene.model->num_coordinates();
+  j["linear_solver"] = phiq::to_string(scene.model->linear_solver());
+  j["load_seconds"] = load_s;
+  j["solve_seconds"] = solve_s;
+  j["write_seconds"] = write_s;
+  j["newton_iterations"] = s.counters.newton_iterations;
+  j["factorizations"] = s.counters.factorizations;
+  j["pivoting_factorizations"] = ws.lu ? ws.lu->pivoting_factorizations() : 0;
+  j["velocity_solves"] = s.counters.velocity_solves;
+  j["acceleration_solves"] = s.counters.acceleration_solves;
+  j["phi_t_evaluations"] = s.counters.phi_t_evaluations;
+  j["gamma_evaluations"] = s.counters.gamma_evaluations;
+  j["residual_evaluations"] = s.counters.residual_evaluations;
+  j["subdivisions"] = s.subdivisions;
+  j["min_rcond"] = s.min_rcond;
+  j["warnings"] = nlohmann::ordered_json::array();
+  for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});
+  try {
+    phiq::AtomicOutputFile f(path);
+    f.write(j.dump(2) + "\n");
+    f.commit();
+  } catch (const phiq::Error& e) {
+    std::cerr << "phiq: " << e.what() << "\n";
+    return false;
+  }
+  return true;
+}
+
+int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path) {
   phiq::Scene scene;
+  const auto load_start = Clock::now();
   try {
     scene = phiq::load_scene(scene_path);
   } catch (const phiq::SceneError& e) {
     return fail(e.what(), 2);
   }
+  const double load_s = since(load_start);
   const phiq::Model& model = *scene.model;
   phiq::Workspace ws(model);
   phiq::CsvFormat csv(model, scene.output_coordinates, scene.sweep.velocities, scene.sweep.accelerations);
@@ -69,10 +115,13 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
 
   std::signal(SIGINT, on_sigint);
   phiq::SweepSummary summary;
+  double write_s = 0.0;  // formatting and writing rows, timed inside the step callback
   try {
     phiq::run_sweep(model, scene.sweep, ws, [&](const phiq::StepView& step) {
+      const auto w0 = Clock::now();
       csv.append_row(step, buffer);
       if (buffer.size() > (1u << 20)) flush();
+      write_s += since(w0);
       return !g_interrupted.load();
     }, &summary);
   } catch (const phiq::Error& e) {
@@ -83,6 +132,8 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   if (summary.status == phiq::SolveStatus::kCancelled) return fail(scene_path + ": interrupted; no output written", 130);
   if (summary.status != phiq::SolveStatus::kSuccess)
     return fail(scene_path + ": " + summary.message + (out_path.empty() ? "" : "; no output written"), 1);
+  const double solve_s = summary.solve_seconds - write_s;
+  const auto final_write = Clock::now();
   try {
     flush();
     if (file) {
@@ -97,6 +148,8 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
   }
+  write_s += since(final_write);
+  if (!summary_path.empty() && !write_summary(summary_path, scene, ws, summary, load_s, solve_s, write_s)) return 3;
   if (!quiet) {
     for (const auto& w : summary.warnings)
       std::cerr << "phiq: " << scene_path << ": warning: t = " << w.t << ": " << w.kind << ": " << w.message << "\n";
@@ -207,12 +260,26 @@ int main(int argc, char** argv) {
                                         std::to_string(phiq::kCheckJsonFormat) + ")");
   app.require_subcommand(1);
 
-  std::string scene_path, out_path;
+  std::string scene_path, out_path, summary_path;
   bool quiet = false;
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
   run->add_option("scene", scene_path, "Scene file (YAML)")->required();
   run->add_option("-o,--output", out_path, "CSV file to write (default: standard output)");
   run->add_flag("-q,--quiet", quiet, "Do not print the run summary on standard error");
+  run->add_option("--summary", summary_path, "Write the run summary as JSON (counts and timings) to this file");
+
+  phiq::tools::GenerateOptions gen;
+  std::string gen_out, gen_outputs = "q,v,a";
+  CLI::App* generate = app.add_subcommand("generate", "Write a scalable scene (nfourbar)");
+  generate->add_option("kind", gen.kind, "nfourbar")->required();
+  generate->add_option("N", gen.n, "Size: number of four-bars")->required();
+  generate->add_option("-o,--output", gen_out, "Scene file to write")->required();
+  generate->add_option("--steps", gen.steps, "Sweep intervals")->capture_default_str();
+  generate->add_option("--from", gen.from, "Driven value at t = 0 (rad)")->capture_default_str();
+  generate->add_option("--to", gen.to, "Driven value at t = 1 (rad)")->capture_default_str();
+  generate->add_option("--coords", gen.coords, "natural or reference-point")->capture_default_str();
+  generate->add_option("--outputs", gen_outputs, "Which of q (positions), v, a the scene asks for")
+      ->capture_default_str();
 
   std::string check_path;
   bool check_json = false;
@@ -238,7 +305,31 @@ int main(int argc, char** argv) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), 2);
   }
   try {
-    if (*run) return cmd_run(scene_path, out_path, quiet);
+    if (*run) return cmd_run(scene_path, out_path, quiet, summary_path);
+    if (*generate) {
+      gen.q = gen.v = gen.a = false;
+      std::stringstream ss(gen_outputs);
+      for (std::string item; std::getline(ss, item, ',');) {
+        if (item == "q") gen.q = true;
+        else if (item == "v") gen.v = true;
+        else if (item == "a") gen.a = true;
+        else return fail("generate: --outputs: unknown output '" + item + "' (q, v, a)", 2);
+      }
+      std::string text;
+      try {
+        text = phiq::tools::generate_scene(gen);
+      } catch (const std::invalid_argument& e) {
+        return fail(std::string("generate: ") + e.what(), 2);
+      }
+      try {
+        phiq::AtomicOutputFile f(gen_out);
+        f.write(text);
+        f.commit();
+      } catch (const phiq::Error& e) {
+        return fail(e.what(), 3);
+      }
+      return 0;
+    }
     if (*check) return cmd_check(check_path, check_json);
     if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
   } catch (const std::exception& e) {
