@@ -39,66 +39,52 @@ namespace {
 
 constexpr double kUlpFloor = 64.0 * std::numeric_limits<double>::epsilon();
 
-double unit_scale(Unit u, double length_scale) { return u == Unit::kLength ? length_scale : 1.0; }
-
 // Rounding floor of lengths and of other quantities at this q: a residual or a step cannot be resolved below a few
 // ulps of the coordinates it is computed from, wherever the origin is.
 struct Floors {
   double length = 0.0, other = 0.0;
 };
+// The tests below run every Newton iteration: one vectorised pass each over the model's precomputed scales.
 Floors rounding_floors(const Model& model, const Eigen::VectorXd& q) {
   Floors f;
-  for (Index j = 0; j < q.size(); ++j) {
-    double a = std::fabs(q(j));
-    if (model.coordinate_unit(j) == Unit::kLength) f.length = std::max(f.length, a);
-    else f.other = std::max(f.other, a);
-  }
-  f.length *= kUlpFloor;
-  f.other *= kUlpFloor;
+  if (q.size() == 0) return f;
+  const auto& len = model.tolerance_scales().coordinate_is_length.array();
+  f.length = kUlpFloor * (q.array().abs() * len).maxCoeff();
+  f.other = kUlpFloor * (q.array().abs() * (1.0 - len)).maxCoeff();
   return f;
 }
 
+// Every row |Φ_i| ≤ tol · scale_i + floor_i (false on NaN).
 bool residual_within(const Model& model, const Eigen::VectorXd& phi, double tol, const Floors& fl) {
-  const double ls = model.length_scale();
-  for (Index i = 0; i < phi.size(); ++i) {
-    const Unit u = model.row_unit(i);
-    const double lim = tol * unit_scale(u, ls) + (u == Unit::kLength ? fl.length : fl.other);
-    if (!(std::fabs(phi(i)) <= lim)) return false;
-  }
-  return true;
+  const ToleranceScales& s = model.tolerance_scales();
+  return (phi.array().abs() <=
+          tol * s.row_scale.array() + fl.other + (fl.length - fl.other) * s.row_is_length.array())
+      .all();
 }
 
 bool step_within(const Model& model, const Eigen::VectorXd& dq, const Eigen::VectorXd& q, double tol) {
-  const double ls = model.length_scale();
-  for (Index j = 0; j < dq.size(); ++j) {
-    const double lim = tol * unit_scale(model.coordinate_unit(j), ls) + kUlpFloor * std::fabs(q(j));
-    if (!(std::fabs(dq(j)) <= lim)) return false;
-  }
-  return true;
+  return (dq.array().abs() <=
+          tol * model.tolerance_scales().coordinate_scale.array() + kUlpFloor * q.array().abs())
+      .all();
 }
 
+// max_i |Φ_i| / scale_i, NaN rows ignored (they are reported by the finiteness check).
 double max_scaled(const Model& model, const Eigen::VectorXd& phi) {
-  const double ls = model.length_scale();
+  const Eigen::VectorXd& rs = model.tolerance_scales().row_scale;
   double m = 0.0;
-  for (Index i = 0; i < phi.size(); ++i) m = std::max(m, std::fabs(phi(i)) / unit_scale(model.row_unit(i), ls));
+  for (Index i = 0; i < phi.size(); ++i) m = std::max(m, std::fabs(phi(i)) / rs(i));
   return m;
 }
 
 double merit(const Model& model, const Eigen::VectorXd& phi) {
-  const double ls = model.length_scale();
-  double s = 0.0;
-  for (Index i = 0; i < phi.size(); ++i) {
-    double r = phi(i) / unit_scale(model.row_unit(i), ls);
-    s += r * r;
-  }
-  return 0.5 * s;
+  return 0.5 * (phi.array() / model.tolerance_scales().row_scale.array()).square().sum();
 }
 
 std::vector<std::pair<Index, double>> worst_rows(const Model& model, const Eigen::VectorXd& phi, int k) {
-  const double ls = model.length_scale();
+  const Eigen::VectorXd& rs = model.tolerance_scales().row_scale;
   std::vector<std::pair<Index, double>> rows;
   for (Index i = 0; i < phi.size(); ++i) {
-    double r = std::fabs(phi(i)) / unit_scale(model.row_unit(i), ls);
+    double r = std::fabs(phi(i)) / rs(i);
     if (std::isnan(r)) r = std::numeric_limits<double>::infinity();
     rows.emplace_back(i, r);
   }

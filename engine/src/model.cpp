@@ -193,6 +193,14 @@ Model ModelBuilder::build() && {
     scale = hi > lo ? hi - lo : 1.0;
   }
   m.length_scale_ = scale;
+  auto is_length = [](Unit u) { return u == Unit::kLength ? 1.0 : 0.0; };
+  m.scales_.row_is_length.resize(rows);
+  for (Index i = 0; i < rows; ++i) m.scales_.row_is_length(i) = is_length(m.row_units_[static_cast<std::size_t>(i)]);
+  m.scales_.coordinate_is_length.resize(n);
+  for (Index j = 0; j < n; ++j)
+    m.scales_.coordinate_is_length(j) = is_length(m.coordinate_units_[static_cast<std::size_t>(j)]);
+  m.scales_.row_scale = 1.0 + (scale - 1.0) * m.scales_.row_is_length.array();
+  m.scales_.coordinate_scale = 1.0 + (scale - 1.0) * m.scales_.coordinate_is_length.array();
 
   for (auto& b : m.blocks_) {
     bool td = false;

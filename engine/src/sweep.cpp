@@ -101,8 +101,6 @@ class Sweeper {
     return advance(tm, depth + 1) && advance(t1, depth + 1);
   }
 
-  const State& current() const { return current_; }
-
  private:
   void note(double t, const PositionSummary& ps) {
     if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});

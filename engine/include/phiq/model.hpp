@@ -29,6 +29,15 @@ struct ConstraintInfo {
   bool depends_on_time = false;  ///< rheonomic (a driver, or an equation in t)
 };
 
+/// The per-row and per-coordinate scales of the dimensional tolerances, fixed per model (computed by
+/// ModelBuilder::build() so that the Newton loop only reads them).
+struct ToleranceScales {
+  Eigen::VectorXd row_scale;              ///< length_scale() for length rows, 1 for angle and unitless rows
+  Eigen::VectorXd row_is_length;          ///< 1 for length rows, 0 otherwise (which rounding floor applies)
+  Eigen::VectorXd coordinate_scale;       ///< length_scale() for length coordinates, 1 otherwise
+  Eigen::VectorXd coordinate_is_length;   ///< 1 for length coordinates, 0 otherwise
+};
+
 /// An immutable mechanism: coordinates, constraints, the fixed CSC pattern of Φq and its symbolic analysis.
 /// Built by ModelBuilder or load_scene(). Every const member function is thread-safe. Movable, not copyable;
 /// Workspaces keep its address, so it must not move while they exist.
@@ -65,6 +74,8 @@ class Model {
 
   /// Characteristic length of the model (metres): tolerances on lengths are relative to it.
   double length_scale() const { return length_scale_; }
+  /// The tolerance scale of every row and coordinate (from their units and length_scale()).
+  const ToleranceScales& tolerance_scales() const { return scales_; }
   /// The fixed pattern of Φq (m × n); Jacobian values are stored in its order.
   const CscPattern& jacobian_pattern() const { return *pattern_; }
   /// The sparse LU the model was analysed for.
@@ -103,6 +114,7 @@ class Model {
   std::shared_ptr<const CscPattern> pattern_ = std::make_shared<CscPattern>();
   std::vector<Index> slot_of_entry_;
   double length_scale_ = 1.0;
+  ToleranceScales scales_;
   double time_begin_ = -1e308, time_end_ = 1e308;
   std::string time_limiter_;
   // KLU by default: its refactorisation is 10-12x cheaper per drive step than UMFPACK on nfourbar from 10^3 to
