@@ -166,5 +166,94 @@ TEST(Sweep, ReverseTimeAndSingleStepSweeps) {
   EXPECT_EQ(one.t.size(), 1u);
 }
 
+
+// ---- parallel drive steps -------------------------------------------------------------------------------------
+
+// The parallel sweep delivers the same rows as the sequential one, to the solver tolerance, whatever the thread
+// count and chunk size; every chunk is accepted on this regular motion.
+TEST(ParallelSweep, EqualsTheSequentialSweepForAnyThreadCount) {
+  Model m = test::nfourbar_model(40, M_PI / 4, M_PI / 2);  // a quarter turn, away from singular positions
+  SweepOptions opt;
+  opt.steps = 300;
+  test::Trace seq;
+  SweepSummary ss;
+  ASSERT_EQ(test::sweep(m, opt, &seq, &ss), SolveStatus::kSuccess) << ss.message;
+  EXPECT_EQ(ss.threads, 1);
+  EXPECT_EQ(ss.parallel_chunks, 0);
+  for (int threads : {2, 3, 4}) {
+    for (Index chunk : {Index{1}, Index{7}, Index{64}}) {
+      opt.threads = threads;
+      opt.chunk_steps = chunk;
+      test::Trace par;
+      SweepSummary ps;
+      ASSERT_EQ(test::sweep(m, opt, &par, &ps), SolveStatus::kSuccess) << ps.message;
+      EXPECT_EQ(ps.threads, threads);
+      EXPECT_EQ(ps.parallel_chunks, (opt.steps + chunk - 1) / chunk) << threads << " threads, chunks of " << chunk;
+      EXPECT_EQ(ps.steps_completed, opt.steps + 1);
+      // positions to 1e-10 × scale each; velocities and accelerations inherit it (|q̇| ~ 1.6, |q̈| ~ 2.5)
+      EXPECT_LT(test::max_difference(seq, par, 0), 1e-9) << threads << " threads, chunks of " << chunk;
+      EXPECT_LT(test::max_difference(seq, par, 1), 1e-8) << threads << " threads, chunks of " << chunk;
+      EXPECT_LT(test::max_difference(seq, par, 2), 1e-8) << threads << " threads, chunks of " << chunk;
+      EXPECT_TRUE(ps.warnings.empty());
+      EXPECT_EQ(ps.counters.velocity_solves, ss.counters.velocity_solves + (ps.parallel_chunks - 1))
+          << "each chunk but the last solves one step more, the seam its successor's first row is checked against";
+    }
+  }
+}
+
+// Through singular positions (a full turn of the N four-bar: the cranks are horizontal twice, where the dof jumps),
+// the result must still be the sequential sweep's, however the seeds behave there.
+TEST(ParallelSweep, ThroughSingularPositionsMatchesTheSequentialSweep) {
+  Model m = test::nfourbar_model(10, 0.1, 2 * M_PI);
+  SweepOptions opt;
+  opt.steps = 400;
+  test::Trace seq, par;
+  SweepSummary ss, ps;
+  ASSERT_EQ(test::sweep(m, opt, &seq, &ss), SolveStatus::kSuccess) << ss.message;
+  opt.threads = 2;
+  opt.chunk_steps = 25;
+  ASSERT_EQ(test::sweep(m, opt, &par, &ps), SolveStatus::kSuccess) << ps.message;
+  EXPECT_GT(ps.parallel_chunks, 0);
+  EXPECT_LT(test::max_difference(seq, par, 0), 1e-8);
+  // near the singular positions Φq is ill-conditioned (rcond ~1e-5 a step away), which amplifies the 1e-10
+  // differences of q into q̇ and q̈
+  EXPECT_LT(test::max_difference(seq, par, 1), 1e-5);
+  EXPECT_LT(test::max_difference(seq, par, 2), 1e-3);
+  // and both stay on the parallelogram branch
+  for (std::size_t k = 0; k < par.t.size(); ++k) {
+    const double th = par.q[k](22);
+    for (Index i = 0; i <= 10; ++i) EXPECT_NEAR(par.q[k](2 * i + 1), std::sin(th), 1e-8) << "row " << k;
+  }
+}
+
+// A drive that leaves the reachable range: the parallel sweep reports the same failure, at the same step, as the
+// sequential one, after delivering the same rows.
+TEST(ParallelSweep, AFailureIsReportedAsInTheSequentialSweep) {
+  // slider driven: the crank-slider with L2 = 0.3, L3 = 1 reaches x_B only in [0.7, 1.3]
+  ModelBuilder b;
+  auto S = Slot::coordinate;
+  auto C = Slot::constant;
+  Index th = b.add_coordinate("theta2", 0.5), xa = b.add_coordinate("xA", 0.26), ya = b.add_coordinate("yA", 0.14),
+        xb = b.add_coordinate("xB", 1.2);
+  b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, 0.3, S(th)});
+  b.add("rod", DistanceSpec{{S(xa), S(ya)}, {S(xb), C(0)}, 1.0});
+  b.add_driver("slider", xb, MotionLaw::linear(1.2, 0.3));  // x_B = 1.2 + 0.3 t passes 1.3 at t = 1/3
+  Model m = std::move(b).build();
+  SweepOptions opt;
+  opt.steps = 200;
+  test::Trace seq, par;
+  SweepSummary ss, ps;
+  EXPECT_NE(test::sweep(m, opt, &seq, &ss), SolveStatus::kSuccess);
+  opt.threads = 2;
+  opt.chunk_steps = 10;
+  EXPECT_EQ(test::sweep(m, opt, &par, &ps), ss.status);
+  EXPECT_EQ(ps.message, ss.message);
+  EXPECT_EQ(ps.failed_step, ss.failed_step);
+  EXPECT_EQ(par.t.size(), seq.t.size());
+  EXPECT_GT(ps.parallel_chunks, 0);
+  EXPECT_LT(test::max_difference(seq, par, 0), 1e-9);
+  EXPECT_LT(test::max_difference(seq, par, 1), 1e-6);  // approaching the dead point, q̇ grows as 1/sin
+}
+
 }  // namespace
 }  // namespace phiq

@@ -47,7 +47,8 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
   j["status"] = phiq::to_string(s.status);
   j["message"] = s.message;
   j["steps"] = s.steps_completed;
-  j["threads"] = 1;
+  j["threads"] = s.threads;
+  j["parallel_chunks"] = s.parallel_chunks;
   j["coordinates"] = scene.model->num_coordinates();
   j["linear_solver"] = phiq::to_string(scene.model->linear_solver());
   j["load_seconds"] = load_s;
@@ -76,7 +77,8 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
   return true;
 }
 
-int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path) {
+int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
+            int threads) {
   phiq::Scene scene;
   const auto load_start = Clock::now();
   try {
@@ -86,6 +88,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   }
   const double load_s = since(load_start);
   const phiq::Model& model = *scene.model;
+  scene.sweep.threads = threads;
   phiq::Workspace ws(model);
   phiq::CsvFormat csv(model, scene.output_coordinates, scene.sweep.velocities, scene.sweep.accelerations);
 
@@ -267,6 +270,10 @@ int main(int argc, char** argv) {
   run->add_option("-o,--output", out_path, "CSV file to write (default: standard output)");
   run->add_flag("-q,--quiet", quiet, "Do not print the run summary on standard error");
   run->add_option("--summary", summary_path, "Write the run summary as JSON (counts and timings) to this file");
+  int threads = 0;
+  run->add_option("--threads", threads, "Threads for the drive steps (0: all cores; 1: in order)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
 
   phiq::tools::GenerateOptions gen;
   std::string gen_out, gen_outputs = "q,v,a";
@@ -305,7 +312,7 @@ int main(int argc, char** argv) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), 2);
   }
   try {
-    if (*run) return cmd_run(scene_path, out_path, quiet, summary_path);
+    if (*run) return cmd_run(scene_path, out_path, quiet, summary_path, threads);
     if (*generate) {
       gen.q = gen.v = gen.a = false;
       std::stringstream ss(gen_outputs);

@@ -7,6 +7,10 @@
 
 namespace phiq {
 
+const char* to_string(JacobianUpdate u) {
+  return u == JacobianUpdate::kEveryIteration ? "every_iteration" : "when_slow";
+}
+
 const char* to_string(SolveStatus s) {
   switch (s) {
     case SolveStatus::kSuccess: return "success";
@@ -62,10 +66,15 @@ bool residual_within(const Model& model, const Eigen::VectorXd& phi, double tol,
       .all();
 }
 
-bool step_within(const Model& model, const Eigen::VectorXd& dq, const Eigen::VectorXd& q, double tol) {
-  return (dq.array().abs() <=
-          tol * model.tolerance_scales().coordinate_scale.array() + kUlpFloor * q.array().abs())
-      .all();
+// max_j |Δq_j| / (tol · scale_j + floor_j): ≤ 1 when the step is within the tolerance (NaN propagates as > 1).
+// With tol = 1 it is the size of the step in the tolerance-scaled norm (the floor is then negligible).
+template <class Step>
+double step_ratio(const Model& model, const Step& dq, const Eigen::VectorXd& q, double tol) {
+  if (q.size() == 0) return 0.0;
+  const double r = (dq.array().abs() /
+                    (tol * model.tolerance_scales().coordinate_scale.array() + kUlpFloor * q.array().abs()))
+                       .maxCoeff();
+  return std::isnan(r) ? std::numeric_limits<double>::infinity() : r;
 }
 
 // max_i |Φ_i| / scale_i, NaN rows ignored (they are reported by the finiteness check).
@@ -167,14 +176,25 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
                            PositionSummary* summary) {
   check_workspace(model, ws);
   if (!(opt.tolerance > 0.0) || opt.max_iterations < 0) throw Error("NewtonOptions: tolerance must be > 0");
+  if (!(opt.max_contraction > 0.0 && opt.max_contraction < 1.0))
+    throw Error("NewtonOptions: max_contraction must be in (0, 1)");
   PositionSummary local;
   PositionSummary& sum = summary ? *summary : local;
   sum = PositionSummary{};
+  // The contraction observed with the reused factorisation in the previous solve, if any: it estimates the error of
+  // the first step of this one (same age of the matrix in a sweep); it is consumed here, measured afresh below.
+  const double carried_theta = ws.newton_contraction;
+  ws.newton_contraction = -1.0;
 
   auto finish = [&](SolveStatus st, std::string msg) {
     sum.status = st;
     if (st == SolveStatus::kSuccess) {
       sum.residual = max_scaled(model, ws.phi);  // O(m), no allocation: this runs once per drive step
+      // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
+      // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
+      if (ws.has_factorization && ws.factorized_t == t &&
+          step_ratio(model, ws.q - ws.factorized_q, ws.q, opt.tolerance) <= 1.0)
+        ws.factorized_q = ws.q;
       return st;
     }
     sum.worst_rows = worst_rows(model, ws.phi, 3);
@@ -199,10 +219,20 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   ++ws.counters.residual_evaluations;
   double f = merit(model, ws.phi);
   bool step_ok = false;
-  for (int it = 0;; ++it) {
+  // Modified Newton reuses the workspace's factorisation until it contracts badly; then (and always for full
+  // Newton) every iteration factorises at its iterate.
+  bool reuse = opt.jacobian_update == JacobianUpdate::kWhenSlow && ws.has_factorization;
+  double prev_norm = -1.0;   // scaled size of the previous step taken with the same kind of matrix
+  double theta_seen = -1.0;  // largest contraction observed with the reused matrix in this solve
+  int reused_steps = 1;      // steps taken with the reused matrix once a contraction is known
+  constexpr int kMaxReusedSteps = 4;
+  // The iteration limit counts steps taken; a step discarded to refresh a reused factorisation does not count.
+  for (;;) {
+    const int it = sum.iterations;
     if (!all_finite(ws.phi)) return finish(SolveStatus::kNonFinite, "constraint residual is not finite");
     const Floors fl = rounding_floors(model, ws.q);
     if (residual_within(model, ws.phi, opt.tolerance, fl) && (it == 0 || step_ok)) {
+      if (theta_seen >= 0.0) ws.newton_contraction = theta_seen;
       return finish(SolveStatus::kSuccess, "");
     }
     if (it >= opt.max_iterations && it > 0 && residual_within(model, ws.phi, opt.tolerance, fl)) {
@@ -216,18 +246,46 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
                     "Newton did not converge in " + std::to_string(opt.max_iterations) + " iterations");
 
     std::string msg;
-    SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
-    if (st != SolveStatus::kSuccess) return finish(st, msg);
+    if (!reuse) {
+      const Index before = ws.counters.factorizations;
+      SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
+      if (st != SolveStatus::kSuccess) return finish(st, msg);
+      sum.factorizations += static_cast<int>(ws.counters.factorizations - before);
+    } else {
+      sum.rcond = ws.lu->rcond();
+    }
     ws.rhs = -ws.phi;
     if (!ws.lu->solve(ws.rhs.data(), ws.step.data()))
       return finish(SolveStatus::kLinearSolverFailed, "sparse solve failed: " + ws.lu->last_message());
-    if (!all_finite(ws.step))
+    if (!all_finite(ws.step)) {
+      if (reuse) {  // an old factorisation may be singular where the current iterate is not
+        reuse = false, prev_norm = -1.0;
+        continue;
+      }
       return finish(SolveStatus::kSingularJacobian, "Newton step is not finite (Jacobian numerically singular)");
-    ++ws.counters.newton_iterations;
-    ++sum.iterations;
+    }
+    // Contraction θ = ‖Δq_k‖ / ‖Δq_k−1‖ in the tolerance-scaled norm. A reused matrix that contracts worse than
+    // max_contraction is replaced by a fresh one at this iterate (the step just computed is discarded).
+    const double norm = step_ratio(model, ws.step, ws.q, 1.0);
+    double theta = prev_norm > 0.0 ? norm / prev_norm : (reuse && carried_theta >= 0.0 ? 2.0 * carried_theta : -1.0);
+    if (reuse && prev_norm > 0.0) {
+      theta_seen = std::max(theta_seen, theta);
+      // Refresh on a slow contraction, or when the steps left (the iteration limit, or kMaxReusedSteps: a
+      // factorisation costs about two solves) cannot reach the tolerance at this rate: after j more steps the
+      // error is about θ^(j+1)/(1−θ)·|Δq| (Hairer & Wanner IV.8).
+      ++reused_steps;
+      const int left = std::min(opt.max_iterations - sum.iterations - 1, kMaxReusedSteps - reused_steps);
+      if (theta > opt.max_contraction || left < 0 ||
+          std::pow(theta, left + 1) / (1.0 - theta) * step_ratio(model, ws.step, ws.q, opt.tolerance) > 1.0) {
+        reuse = false, prev_norm = -1.0;
+        continue;
+      }
+    }
 
-    // Backtracking on the scaled merit: a full step whenever it helps, a shorter one from a rough placement.
+    // Backtracking on the scaled merit: a full step whenever it helps, a shorter one from a rough placement. A
+    // reused matrix whose full step does not decrease the merit is refreshed rather than backtracked along.
     double alpha = 1.0, ftrial = 0.0;
+    bool refresh = false;
     for (int bt = 0;; ++bt) {
       ws.trial = ws.q + alpha * ws.step;
       model.residual(ws.trial.data(), t, ws.trial_phi.data());
@@ -236,6 +294,10 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       if (!opt.line_search || ftrial <= (1.0 - 1e-4 * alpha) * f ||
           residual_within(model, ws.trial_phi, opt.tolerance, rounding_floors(model, ws.trial)))
         break;
+      if (reuse) {
+        refresh = true;
+        break;
+      }
       if (bt >= opt.max_backtracks) {
         return finish(SolveStatus::kNotConverged,
                       "no decrease of the residual along the Newton direction (the constraints may have no "
@@ -244,8 +306,17 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       alpha *= 0.5;
       ++sum.backtracks;
     }
+    if (refresh) {
+      reuse = false, prev_norm = -1.0;
+      continue;
+    }
+    ++ws.counters.newton_iterations;
+    ++sum.iterations;
     ws.step *= alpha;
-    step_ok = step_within(model, ws.step, ws.trial, opt.tolerance);
+    // Error of the new iterate: θ/(1−θ)·|Δq| where a contraction is known, else the step itself.
+    const double eta = (theta >= 0.0 && theta < 1.0) ? theta / (1.0 - theta) : 1.0;
+    step_ok = std::min(eta, 1.0) * step_ratio(model, ws.step, ws.trial, opt.tolerance) <= 1.0;
+    prev_norm = alpha == 1.0 ? norm : -1.0;  // a shortened step says nothing about the contraction
     ws.q.swap(ws.trial);
     ws.phi.swap(ws.trial_phi);
     f = ftrial;

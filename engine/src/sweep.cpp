@@ -2,7 +2,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <sstream>
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace phiq {
 
@@ -64,6 +70,26 @@ class Sweeper {
     sum_.status = st;
     sum_.message = why;
     return false;
+  }
+
+  // First row of a parallel chunk: the position at t from a seed that solves it (up to the seeding pass's
+  // tolerance), then the derivatives, as any converged step.
+  bool start_from(double t, const Eigen::VectorXd& seed) {
+    ws_.q = seed;
+    PositionSummary ps;
+    SolveStatus st = solve_position(model_, t, opt_.newton, ws_, &ps);
+    if (st != SolveStatus::kSuccess) return fail(st, ps.message);
+    note(t, ps);
+    if (!derivatives(t)) return false;
+    remember(t);
+    return true;
+  }
+
+  // Continues from the converged state in ws (q, and q̇, q̈ where asked for) at t, as if this sweeper had reached
+  // it (the secant predictor's history starts anew).
+  void adopt(double t) {
+    has_current_ = has_prev_ = false;
+    remember(t);
   }
 
   // Initial position problem from the rough placement in ws.q.
@@ -156,6 +182,7 @@ std::string SweepSummary::BriefReport() const {
     << " Newton iterations, " << counters.factorizations << " factorizations, " << counters.velocity_solves
     << " velocity and " << counters.acceleration_solves << " acceleration solves";
   if (subdivisions) s << ", " << subdivisions << " step subdivisions";
+  if (threads > 1) s << ", " << threads << " threads (" << parallel_chunks << " parallel chunks)";
   if (!warnings.empty()) s << ", " << warnings.size() << " warnings (first at t = " << warnings[0].t << ")";
   s.precision(3);
   s << ", " << std::scientific << solve_seconds << " s";
@@ -163,27 +190,103 @@ std::string SweepSummary::BriefReport() const {
   return s.str();
 }
 
+namespace {
+
+// The per-run bookkeeping shared by the sequential and parallel paths.
+struct Run {
+  const SweepOptions& opt;
+  const std::function<bool(const StepView&)>& on_step;
+  SweepSummary& sum;
+  double h = 0.0;
+
+  // t_k computed from k, not accumulated, so that the last point is t_end exactly
+  double time_of(Index k) const {
+    return k == opt.steps ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
+  }
+  // Delivers row k; false when the caller stops the sweep (status and message set).
+  bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+    StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr};
+    ++sum.steps_completed;
+    if (on_step && !on_step(view)) {
+      sum.status = SolveStatus::kCancelled;
+      sum.message = "stopped by the caller after step " + std::to_string(k);
+      return false;
+    }
+    return true;
+  }
+  // A failed step: the summary names the step, its grid time and the cause (already in sum.message).
+  void failed(Index k) {
+    sum.failed_step = k;
+    sum.failed_time = time_of(k);
+    sum.message = "step " + std::to_string(k) + ", t = " + fmt_t(time_of(k)) + ": " + sum.message;
+  }
+  // Steps k0 … steps in order with `sw`, whose state in ws is row k0 − 1. False on failure or cancellation.
+  bool sequential(Sweeper& sw, Workspace& ws, Index k0) {
+    for (Index k = k0; k <= opt.steps; ++k) {
+      if (!sw.advance(time_of(k), 0)) {
+        failed(k);
+        return false;
+      }
+      if (!deliver(k, ws.q, ws.qd, ws.qdd)) return false;
+    }
+    return true;
+  }
+};
+
+// Adds the work counted in `now` since `before` to `into`.
+void add_counters(WorkCounters& into, const WorkCounters& now, const WorkCounters& before) {
+  into.newton_iterations += now.newton_iterations - before.newton_iterations;
+  into.residual_evaluations += now.residual_evaluations - before.residual_evaluations;
+  into.jacobian_evaluations += now.jacobian_evaluations - before.jacobian_evaluations;
+  into.factorizations += now.factorizations - before.factorizations;
+  into.velocity_solves += now.velocity_solves - before.velocity_solves;
+  into.acceleration_solves += now.acceleration_solves - before.acceleration_solves;
+  into.phi_t_evaluations += now.phi_t_evaluations - before.phi_t_evaluations;
+  into.gamma_evaluations += now.gamma_evaluations - before.gamma_evaluations;
+}
+
+// Two solutions of the same position problem are the same one if they differ by less than 100 tolerances in
+// every coordinate (each is within about one of the exact root; another branch is a finite distance away).
+bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b, double tol) {
+  const ToleranceScales& s = model.tolerance_scales();
+  constexpr double kUlp = 64.0 * std::numeric_limits<double>::epsilon();
+  for (Index j = 0; j < a.size(); ++j) {
+    const double d = std::fabs(a(j) - b[j]);
+    if (!(d <= 100.0 * tol * s.coordinate_scale(j) + kUlp * std::fabs(a(j)))) return false;
+  }
+  return true;
+}
+
+// One parallel chunk: rows k0 … k1 computed from a seed at t_k0 (chunk 0: from row 0), then the sweep continued
+// in order one step further (the seam), which the next chunk's first row must match.
+struct Chunk {
+  Index k0 = 0, k1 = 0;
+  std::vector<double> rows;  // (k1 − k0 + 1) rows of [q | q̇ | q̈], as asked for
+  SweepSummary sum;          // status, message, warnings, subdivisions, rcond and work of this chunk
+  bool ok = false;
+  bool has_seam = false;
+  Eigen::VectorXd seam_q;    // the position at t_{k1+1} reached by continuing in order
+};
+
+}  // namespace
+
 SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws,
                       const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
   if (&ws.model() != &model) throw Error("workspace was made for another model");
   if (opt.steps < 0) throw Error("SweepOptions: steps must be >= 0");
   if (!std::isfinite(opt.t_begin) || !std::isfinite(opt.t_end)) throw Error("SweepOptions: times must be finite");
+  if (opt.threads < 0) throw Error("SweepOptions: threads must be >= 0 (0: all cores)");
+  if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
   SweepSummary local;
   SweepSummary& sum = summary ? *summary : local;
   sum = SweepSummary{};
   const auto start = std::chrono::steady_clock::now();
   const WorkCounters before = ws.counters;
+  WorkCounters others;  // work done in the seeding and chunk workspaces
   auto done = [&](SolveStatus st) {
     sum.status = st;
-    const WorkCounters& c = ws.counters;
-    sum.counters = WorkCounters{c.newton_iterations - before.newton_iterations,
-                                c.residual_evaluations - before.residual_evaluations,
-                                c.jacobian_evaluations - before.jacobian_evaluations,
-                                c.factorizations - before.factorizations,
-                                c.velocity_solves - before.velocity_solves,
-                                c.acceleration_solves - before.acceleration_solves,
-                                c.phi_t_evaluations - before.phi_t_evaluations,
-                                c.gamma_evaluations - before.gamma_evaluations};
+    sum.counters = others;
+    add_counters(sum.counters, ws.counters, before);
     sum.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return st;
   };
@@ -200,26 +303,152 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
     return done(SolveStatus::kOutsideTimeDomain);
   }
 
+  Run run{opt, on_step, sum};
+  run.h = opt.steps > 0 ? (opt.t_end - opt.t_begin) / static_cast<double>(opt.steps) : 0.0;
   Sweeper sw(model, opt, ws, sum);
-  const double h = opt.steps > 0 ? (opt.t_end - opt.t_begin) / static_cast<double>(opt.steps) : 0.0;
-  for (Index k = 0; k <= opt.steps; ++k) {
-    // t_k computed from k, not accumulated, so that the last point is t_end exactly
-    const double t = k == opt.steps ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
-    const bool ok = k == 0 ? sw.assemble(t) : sw.advance(t, 0);
-    if (!ok) {
-      sum.failed_step = k;
-      sum.failed_time = t;
-      sum.message = "step " + std::to_string(k) + ", t = " + fmt_t(t) + ": " + sum.message;
-      return done(sum.status);
-    }
-    StepView view{k, t, ws.q, opt.velocities ? &ws.qd : nullptr, opt.accelerations ? &ws.qdd : nullptr};
-    ++sum.steps_completed;
-    if (on_step && !on_step(view)) {
-      sum.message = "stopped by the caller after step " + std::to_string(k);
-      return done(SolveStatus::kCancelled);
+  if (!sw.assemble(run.time_of(0))) {
+    run.failed(0);
+    return done(sum.status);
+  }
+  if (!run.deliver(0, ws.q, ws.qd, ws.qdd)) return done(sum.status);
+
+  const int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
+  const Index n = model.num_coordinates();
+  // Rows keep q̇ whenever it is solved (q̈ needs it, and so does an ordered continuation's predictor).
+  const bool need_v = opt.velocities || opt.accelerations, need_a = opt.accelerations;
+  const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0));
+  Index chunk = opt.chunk_steps;
+  if (chunk == 0) {
+    const double fit = 512.0 * 1024 * 1024 / (8.0 * static_cast<double>(std::max<Index>(width, 1)) * threads);
+    chunk = std::max<Index>(1, std::min<Index>(64, static_cast<Index>(fit)));
+  }
+  const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
+  if (threads <= 1 || n_chunks < 2 || !ws.lu) {
+    run.sequential(sw, ws, 1);
+    return done(sum.status);
+  }
+
+  // ---- parallel drive steps ------------------------------------------------------------------------------
+  sum.threads = threads;
+  auto first_row = [&](Index c) { return 1 + c * chunk; };
+  auto last_row = [&](Index c) { return std::min(opt.steps, (c + 1) * chunk); };
+
+  // Seeds: the position at each chunk's first row, found in order with the chunk's span as the step (positions
+  // only, the secant predictor, subdivision on failure). A failure ends the seeding; the chunks after it run in
+  // order below, where the failure is reported as the sequential sweep reports it.
+  std::vector<Eigen::VectorXd> seeds(1);  // chunk 0 starts from row 0 itself
+  {
+    SweepOptions so = opt;
+    so.velocities = so.accelerations = false;
+    so.predictor = Predictor::kSecant;
+    SweepSummary ss;
+    Workspace sws(model);
+    sws.q = ws.q;
+    Sweeper seeder(model, so, sws, ss);
+    seeder.adopt(run.time_of(0));
+    for (Index c = 1; c < n_chunks && seeder.advance(run.time_of(first_row(c)), 0); ++c) seeds.push_back(sws.q);
+    add_counters(others, sws.counters, WorkCounters{});
+  }
+  const Index seeded = static_cast<Index>(seeds.size());
+
+  std::vector<std::unique_ptr<Workspace>> workers;
+  for (int j = 0; j < threads; ++j) workers.push_back(std::make_unique<Workspace>(model));
+  tbb::task_arena arena(threads);
+  // The last delivered row (the state an ordered continuation starts from) and the position the sweep reaches
+  // one step after it when continued in order (the previous chunk's seam), if known.
+  Index resume = 1;
+  Eigen::VectorXd last_q = ws.q, last_qd = ws.qd, last_qdd = ws.qdd;
+  bool seam_known = false;
+  Eigen::VectorXd seam_q;
+  bool fallback = false;
+  for (Index c0 = 0; c0 < seeded && !fallback; c0 += threads) {
+    const Index c1 = std::min<Index>(seeded, c0 + threads);
+    std::vector<Chunk> chunks(static_cast<std::size_t>(c1 - c0));
+    arena.execute([&] {
+      tbb::parallel_for(c0, c1, [&](Index c) {
+        Chunk& ch = chunks[static_cast<std::size_t>(c - c0)];
+        Workspace& w = *workers[static_cast<std::size_t>(c - c0)];
+        const WorkCounters w0 = w.counters;
+        ch.k0 = first_row(c), ch.k1 = last_row(c);
+        Sweeper s(model, opt, w, ch.sum);
+        ch.rows.resize(static_cast<std::size_t>((ch.k1 - ch.k0 + 1) * width));
+        double* out = ch.rows.data();
+        auto keep = [&] {
+          out = std::copy(w.q.data(), w.q.data() + n, out);
+          if (need_v) out = std::copy(w.qd.data(), w.qd.data() + n, out);
+          if (need_a) out = std::copy(w.qdd.data(), w.qdd.data() + n, out);
+        };
+        if (c == 0) {  // continues row 0 in order: the sequential sweep itself
+          w.q = last_q, w.qd = last_qd, w.qdd = last_qdd;
+          s.adopt(run.time_of(0));
+          ch.ok = s.advance(run.time_of(ch.k0), 0);
+        } else {
+          ch.ok = s.start_from(run.time_of(ch.k0), seeds[static_cast<std::size_t>(c)]);
+        }
+        if (ch.ok) keep();
+        for (Index k = ch.k0 + 1; ch.ok && k <= ch.k1; ++k)
+          if ((ch.ok = s.advance(run.time_of(k), 0))) keep();
+        if (ch.ok && ch.k1 < opt.steps) {
+          // the seam row belongs to the next chunk: its warnings and sub-steps are counted there
+          const std::size_t warnings = ch.sum.warnings.size();
+          const Index subdivisions = ch.sum.subdivisions;
+          const SweepSummary kept = ch.sum;
+          if (s.advance(run.time_of(ch.k1 + 1), 0)) {
+            ch.has_seam = true;
+            ch.seam_q = w.q;
+          }
+          ch.sum.warnings.resize(warnings);
+          ch.sum.subdivisions = subdivisions;
+          ch.sum.status = kept.status, ch.sum.message = kept.message;
+          ch.sum.min_rcond = kept.min_rcond, ch.sum.min_rcond_time = kept.min_rcond_time;
+        }
+        add_counters(ch.sum.counters, w.counters, w0);
+      });
+    });
+    for (Chunk& ch : chunks) {
+      add_counters(others, ch.sum.counters, WorkCounters{});
+      // A chunk is the sequential sweep's continuation if it starts where the sweep, continued in order from
+      // the last delivered row, arrives (chunk 0 is that continuation by construction).
+      const bool accept =
+          ch.ok && (ch.k0 == 1 || (seam_known && same_solution(model, seam_q, ch.rows.data(), opt.newton.tolerance)));
+      if (!accept) {
+        fallback = true;
+        break;
+      }
+      const double* r = ch.rows.data();
+      for (Index k = ch.k0; k <= ch.k1; ++k, r += width) {
+        last_q = Eigen::Map<const Eigen::VectorXd>(r, n);
+        if (need_v) last_qd = Eigen::Map<const Eigen::VectorXd>(r + n, n);
+        if (need_a) last_qdd = Eigen::Map<const Eigen::VectorXd>(r + 2 * n, n);
+        if (!run.deliver(k, last_q, last_qd, last_qdd)) return done(sum.status);
+      }
+      resume = ch.k1 + 1;
+      seam_known = ch.has_seam;
+      if (seam_known) seam_q.swap(ch.seam_q);
+      sum.subdivisions += ch.sum.subdivisions;
+      sum.warnings.insert(sum.warnings.end(), ch.sum.warnings.begin(), ch.sum.warnings.end());
+      if (ch.sum.min_rcond > 0.0 && (sum.min_rcond == 0.0 || ch.sum.min_rcond < sum.min_rcond))
+        sum.min_rcond = ch.sum.min_rcond, sum.min_rcond_time = ch.sum.min_rcond_time;
+      ++sum.parallel_chunks;
     }
   }
-  return done(SolveStatus::kSuccess);
+  // The caller's workspace ends at the last delivered row, as after a sequential sweep.
+  ws.q = last_q;
+  if (need_v) ws.qd = last_qd;
+  if (need_a) ws.qdd = last_qdd;
+  if (resume <= opt.steps) {
+    // In order from the last delivered row: the unseeded chunks, or everything after a chunk that did not
+    // continue the sweep's branch or failed (the failure is then found, and reported, in order).
+    if (fallback)
+      sum.warnings.push_back({run.time_of(resume), "parallel_fallback",
+                              "the parallel chunk starting at t = " + fmt_t(run.time_of(resume)) +
+                                  " did not continue the sweep in order (another branch, or a failure); the "
+                                  "remaining steps ran in order"});
+    Sweeper rest(model, opt, ws, sum);
+    rest.adopt(run.time_of(resume - 1));
+    run.sequential(rest, ws, resume);
+  }
+  return done(sum.status);
 }
 
 }  // namespace phiq

@@ -29,20 +29,40 @@ enum class SolveStatus {
 const char* to_string(SolveStatus s);
 
 /// Settings of the Newton-Raphson position solve.
+/// Which matrix each Newton iteration solves with.
+enum class JacobianUpdate {
+  /// Full Newton: Φq is evaluated and factorised at every iterate (quadratic convergence).
+  kEveryIteration,
+  /// Modified (simplified) Newton: the factorisation already in the workspace is reused — across iterations and
+  /// across drive steps, wherever it was made — while it contracts well (‖Δq_k‖ / ‖Δq_k−1‖ ≤ max_contraction);
+  /// when it slows, diverges or stops decreasing the residual, Φq is refactorised at the current iterate and the
+  /// solve continues as full Newton. Each iteration then costs a solve instead of a factorisation.
+  kWhenSlow,
+};
+/// "every_iteration" or "when_slow".
+const char* to_string(JacobianUpdate u);
+
+/// Newton-Raphson settings for solve_position().
 struct NewtonOptions {
-  /// Convergence: every row |Φ_i| ≤ tol · scale_i and the last step |Δq_j| ≤ tol · scale_j, where scale is the
-  /// model's length_scale() for lengths and 1 for angles and unitless rows (plus a floor of a few ulps of |q|, so
-  /// that the test stays reachable far from the origin).
+  /// Convergence: every row |Φ_i| ≤ tol · scale_i, and the estimated error of q after the last step is within
+  /// tol · scale_j for every coordinate j, where scale is the model's length_scale() for lengths and 1 for angles
+  /// and unitless rows (plus a floor of a few ulps of |q|, so that the test stays reachable far from the origin).
+  /// The error estimate is θ/(1−θ)·|Δq_j| with θ the observed contraction ‖Δq_k‖/‖Δq_k−1‖ (Deuflhard; Hairer &
+  /// Wanner IV.8); where no contraction has been observed yet it is |Δq_j| itself (the step must be small).
   double tolerance = 1e-10;
   int max_iterations = 20;  ///< Newton iterations before giving up (kNotConverged)
   bool line_search = true;  ///< backtracking on ½‖Φ/scale‖² (always on for assembly from a rough placement)
   int max_backtracks = 12;  ///< halvings of the step before the line search gives up
+  JacobianUpdate jacobian_update = JacobianUpdate::kEveryIteration;  ///< full or modified Newton
+  /// Modified Newton: refactorise when the observed contraction exceeds this (0 < max_contraction < 1).
+  double max_contraction = 0.25;
 };
 
 /// What solve_position did (Ceres-style summary).
 struct PositionSummary {
   SolveStatus status = SolveStatus::kNotConverged;  ///< the outcome
-  int iterations = 0;                               ///< Newton steps taken (= factorisations)
+  int iterations = 0;                               ///< Newton steps taken (linear solves)
+  int factorizations = 0;                           ///< of them, steps with a fresh factorisation of Φq
   int backtracks = 0;                               ///< step halvings by the line search
   double residual = 0.0;  ///< max_i |Φ_i| / scale_i at the end
   double rcond = 0.0;     ///< of the last factorisation (0 if none)
@@ -72,7 +92,9 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
                            PositionSummary* summary = nullptr);
 
 /// Solves Φq q̇ = −Φt at ws.q into ws.qd. Pre-condition: ws.q solves the position problem at t. Reuses the
-/// factorisation when it was made at exactly (ws.q, t). kSingularJacobian: the velocity is not unique there.
+/// factorisation when it was made at time t at a point within the position tolerance of ws.q (the last Newton
+/// step was below the tolerance; the difference is below the accuracy of q itself), and otherwise factorises Φq at
+/// (ws.q, t). kSingularJacobian: the velocity is not unique there.
 /// Throws phiq::Error only for violated pre-conditions (workspace of another model, wrong sizes).
 SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary = nullptr);
 

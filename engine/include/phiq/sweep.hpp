@@ -31,9 +31,22 @@ struct SweepOptions {
   bool velocities = true;     ///< solve and deliver q̇ at every time point
   bool accelerations = true;  ///< solve and deliver q̈ (q̇ is then solved too, but delivered only if asked)
   Predictor predictor = Predictor::kAuto;  ///< start of each successive position
-  NewtonOptions newton;                                      ///< successive positions
+  /// Successive positions: modified Newton, reusing the factorisation made for the previous step's velocity and
+  /// acceleration (or the previous position) while it contracts well — one factorisation per drive step instead
+  /// of three (bench/README.md).
+  NewtonOptions newton{1e-10, 20, true, 12, JacobianUpdate::kWhenSlow};
   NewtonOptions assembly{1e-10, 100, true, 30};              ///< initial position from the rough placement
   int max_subdivisions = 8;  ///< a failed step is retried as 2, 4, … sub-steps, down to h / 2^max_subdivisions
+  /// Threads for the drive steps: 1 runs them in order; N > 1 runs chunks of chunk_steps steps in parallel on N
+  /// threads; 0 uses all cores. Each chunk starts from a seed found by a sequential pass over the chunk starts
+  /// (positions only, every chunk_steps-th time point), and is accepted only if the sequential sweep, continued
+  /// one step past the previous chunk, reaches the same position there to within 100 × the tolerance: otherwise
+  /// the rest of the sweep runs in order (warning "parallel_fallback"). Rows are delivered in time order in any
+  /// case, and equal the sequential sweep's to the solver tolerance.
+  int threads = 1;
+  /// Steps per parallel chunk; 0 picks 64, fewer when the rows a wave of chunks buffers (threads × chunk_steps
+  /// rows of q, q̇, q̈) would exceed 512 MiB.
+  Index chunk_steps = 0;
 };
 
 /// What the step callback sees. qd / qdd are null when not computed.
@@ -66,6 +79,8 @@ struct SweepSummary {
   double min_rcond_time = 0.0;         ///< where min_rcond was seen
   std::vector<SweepWarning> warnings;  ///< in time order
   double solve_seconds = 0.0;          ///< wall time of the sweep, the callback's own work included
+  int threads = 1;                     ///< threads the drive steps ran on
+  Index parallel_chunks = 0;           ///< chunks run in parallel and accepted (0 for a sequential sweep)
   /// One line: status, steps, iterations, factorisations, solves, subdivisions, warnings, time, message.
   std::string BriefReport() const;
 };
