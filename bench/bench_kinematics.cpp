@@ -5,6 +5,9 @@
 // Models are built in code (no scene loading in the timed region).
 #include <benchmark/benchmark.h>
 
+#include <klu.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -171,6 +174,264 @@ void BM_NFourBarNewtonIterationVsKernel(benchmark::State& state) {
   state.counters["iteration_per_kernel"] = engine_s / kernel_s;
 }
 BENCHMARK(BM_NFourBarNewtonIterationVsKernel)->Apply(solver_args)->Unit(benchmark::kMicrosecond)->UseManualTime();
+
+// ---- The bare loop: hand-written Newton over KLU refactor -----------------------------------------------
+//
+// What a careful user writes by hand for nfourbar without phiq: Φ, Φq (CSC, pattern and klu_l_analyze once, values
+// in place), Newton from the previous position until max |Δq| ≤ 1e-10 (2–3 iterations), then one more refactor at
+// the converged position for velocity (Φq q̇ = −Φt) and acceleration (Φq q̈ = γ). Coordinates as nfourbar():
+// x0, y0, …, xN, yN, θ; rows: crank i, coupler i, the crank-0 angle, the driver. Unscaled equations (‖·‖² − 1).
+class BareLoop {
+ public:
+  BareLoop(Index n, double theta0, double rate) : n_(n), theta0_(theta0), rate_(rate) {
+    const Index nc = 2 * (n + 1) + 1;
+    dim_ = nc;
+    // pattern: column-wise lists of (row) built from the row structure
+    std::vector<std::vector<Index>> rows_of_col(static_cast<std::size_t>(nc));
+    auto put = [&](Index r, Index c) { rows_of_col[static_cast<std::size_t>(c)].push_back(r); };
+    Index r = 0;
+    for (Index i = 0; i <= n; ++i, ++r) put(r, 2 * i), put(r, 2 * i + 1);                       // cranks
+    for (Index i = 0; i < n; ++i, ++r) put(r, 2 * i), put(r, 2 * i + 1), put(r, 2 * i + 2), put(r, 2 * i + 3);  // couplers
+    put(r, 0), put(r, 1), put(r, nc - 1), ++r;  // angle of crank 0
+    put(r, nc - 1);                              // driver
+    colp_.assign(static_cast<std::size_t>(nc + 1), 0);
+    for (Index c = 0; c < nc; ++c) {
+      std::sort(rows_of_col[static_cast<std::size_t>(c)].begin(), rows_of_col[static_cast<std::size_t>(c)].end());
+      colp_[static_cast<std::size_t>(c + 1)] = colp_[static_cast<std::size_t>(c)] +
+                                               static_cast<Index>(rows_of_col[static_cast<std::size_t>(c)].size());
+      for (Index rr : rows_of_col[static_cast<std::size_t>(c)]) rowi_.push_back(rr);
+    }
+    val_.assign(rowi_.size(), 0.0);
+    klu_l_defaults(&common_);
+    symbolic_ = klu_l_analyze(nc, colp_.data(), rowi_.data(), &common_);
+    q_.resize(static_cast<std::size_t>(nc)), qd_ = q_, qdd_ = q_, phi_ = q_, dq_ = q_;
+    reset();
+  }
+  ~BareLoop() {
+    if (numeric_) klu_l_free_numeric(&numeric_, &common_);
+    klu_l_free_symbolic(&symbolic_, &common_);
+  }
+  void reset() {
+    for (Index i = 0; i <= n_; ++i) q_[2 * i] = static_cast<double>(i) + std::cos(theta0_), q_[2 * i + 1] = std::sin(theta0_);
+    q_[static_cast<std::size_t>(dim_ - 1)] = theta0_;
+  }
+  // One drive step to time t: Newton from the previous position, then velocity and acceleration. Returns the
+  // Newton iterations.
+  int step(double t) {
+    int it = 0;
+    for (; it < 20; ++it) {
+      residual(t);
+      factor();
+      for (Index i = 0; i < dim_; ++i) dq_[i] = -phi_[i];
+      klu_l_solve(symbolic_, numeric_, dim_, 1, dq_.data(), &common_);
+      double m = 0;
+      for (Index i = 0; i < dim_; ++i) q_[i] += dq_[i], m = std::max(m, std::fabs(dq_[i]));
+      if (m <= 1e-10) break;
+    }
+    factor();  // at the converged position
+    for (Index i = 0; i < dim_; ++i) qd_[i] = 0.0;
+    qd_[static_cast<std::size_t>(dim_ - 1)] = rate_;  // −Φt: only the driver row depends on t
+    klu_l_solve(symbolic_, numeric_, dim_, 1, qd_.data(), &common_);
+    gamma();
+    klu_l_solve(symbolic_, numeric_, dim_, 1, qdd_.data(), &common_);
+    return it + 1;
+  }
+  double position_error(double t) const {  // against the parallelogram solution
+    const double th = theta0_ + rate_ * t;
+    double e = 0;
+    for (Index i = 0; i <= n_; ++i)
+      e = std::max({e, std::fabs(q_[2 * i] - static_cast<double>(i) - std::cos(th)), std::fabs(q_[2 * i + 1] - std::sin(th))});
+    return e;
+  }
+
+ private:
+  void residual(double t) {
+    Index r = 0;
+    const double th = q_[static_cast<std::size_t>(dim_ - 1)];
+    for (Index i = 0; i <= n_; ++i, ++r) {
+      const double dx = q_[2 * i] - static_cast<double>(i), dy = q_[2 * i + 1];
+      phi_[r] = dx * dx + dy * dy - 1.0;
+    }
+    for (Index i = 0; i < n_; ++i, ++r) {
+      const double dx = q_[2 * i + 2] - q_[2 * i], dy = q_[2 * i + 3] - q_[2 * i + 1];
+      phi_[r] = dx * dx + dy * dy - 1.0;
+    }
+    phi_[r++] = q_[0] * std::sin(th) - q_[1] * std::cos(th);
+    phi_[r] = th - (theta0_ + rate_ * t);
+  }
+  // Φq values in place (column by column, rows ascending as in the pattern), then factor: refactor after the first.
+  void factor() {
+    std::vector<double>& v = val_;
+    const double th = q_[static_cast<std::size_t>(dim_ - 1)], s = std::sin(th), c = std::cos(th);
+    const Index angle_row = 2 * n_ + 1;
+    for (Index col = 0; col < dim_; ++col) {
+      for (Index k = colp_[col]; k < colp_[col + 1]; ++k) {
+        const Index r = rowi_[k];
+        double d;
+        if (col == dim_ - 1) {
+          d = r == angle_row ? q_[0] * c + q_[1] * s : 1.0;
+        } else if (r == angle_row) {
+          d = col == 0 ? s : -c;
+        } else if (r <= n_) {  // crank r: 2 (P_r − (r, 0))
+          d = 2.0 * (col % 2 == 0 ? q_[col] - static_cast<double>(r) : q_[col]);
+        } else {  // coupler i = r − n − 1 between P_i and P_{i+1}
+          const Index i = r - n_ - 1, node = col / 2;
+          const Index comp = col % 2;
+          const double diff = q_[2 * (i + 1) + comp] - q_[2 * i + comp];
+          d = 2.0 * (node == i + 1 ? diff : -diff);
+        }
+        v[k] = d;
+      }
+    }
+    if (!numeric_) numeric_ = klu_l_factor(colp_.data(), rowi_.data(), v.data(), symbolic_, &common_);
+    else klu_l_refactor(colp_.data(), rowi_.data(), v.data(), symbolic_, numeric_, &common_);
+  }
+  void gamma() {
+    Index r = 0;
+    for (Index i = 0; i <= n_; ++i, ++r) qdd_[r] = -2.0 * (qd_[2 * i] * qd_[2 * i] + qd_[2 * i + 1] * qd_[2 * i + 1]);
+    for (Index i = 0; i < n_; ++i, ++r) {
+      const double dx = qd_[2 * i + 2] - qd_[2 * i], dy = qd_[2 * i + 3] - qd_[2 * i + 1];
+      qdd_[r] = -2.0 * (dx * dx + dy * dy);
+    }
+    const double th = q_[static_cast<std::size_t>(dim_ - 1)], w = qd_[static_cast<std::size_t>(dim_ - 1)];
+    const double s = std::sin(th), c = std::cos(th);
+    qdd_[r++] = -(2.0 * qd_[0] * c * w + 2.0 * qd_[1] * s * w - q_[0] * s * w * w + q_[1] * c * w * w);
+    qdd_[r] = 0.0;  // linear drive
+  }
+
+  Index n_, dim_ = 0;
+  double theta0_, rate_;
+  std::vector<SuiteSparse_long> colp_, rowi_;
+  std::vector<double> val_, q_, qd_, qdd_, phi_, dq_;
+  klu_l_common common_;
+  klu_l_symbolic* symbolic_ = nullptr;
+  klu_l_numeric* numeric_ = nullptr;
+};
+
+// phiq's full step (modified Newton, the default; and full Newton) against the bare loop on the same nfourbar
+// quarter turn, 50 steps, interleaved in one benchmark loop. Accuracy: both to 1e-10 (phiq: residual and error
+// estimate; bare: max |Δq|), both checked against the parallelogram solution (counters *_error).
+void BM_NFourBarStepVsBareLoop(benchmark::State& state) {
+  const Index n = state.range(0), steps = 50;
+  Model m = nfourbar(n, M_PI / 4, M_PI / 2);
+  Workspace ws(m);
+  BareLoop bare(n, M_PI / 4, M_PI / 2);
+  SweepOptions modified, full;
+  modified.steps = full.steps = steps;
+  full.newton.jacobian_update = JacobianUpdate::kEveryIteration;
+  double phiq_s = 0, full_s = 0, bare_s = 0, phiq_err = 0, bare_err = 0;
+  Index bare_it = 0, phiq_fact = 0, full_fact = 0;
+  for (auto _ : state) {
+    SweepSummary sum;
+    auto track = [&](const StepView& v) {
+      const double th = v.q(2 * (n + 1));
+      for (Index i = 0; i <= n; i += std::max<Index>(1, n / 64))
+        phiq_err = std::max(phiq_err, std::fabs(v.q(2 * i + 1) - std::sin(th)));
+      return true;
+    };
+    ws.q = m.initial_positions();
+    auto t0 = Clock::now();
+    run_sweep(m, modified, ws, track, &sum);
+    const double e = seconds_since(t0);
+    phiq_s += e, phiq_fact += sum.counters.factorizations;
+    ws.q = m.initial_positions();
+    t0 = Clock::now();
+    run_sweep(m, full, ws, track, &sum);
+    full_s += seconds_since(t0), full_fact += sum.counters.factorizations;
+    bare.reset();
+    t0 = Clock::now();
+    for (Index k = 0; k <= steps; ++k) bare_it += bare.step(static_cast<double>(k) / steps);
+    bare_s += seconds_since(t0);
+    bare_err = std::max(bare_err, bare.position_error(1.0));
+    state.SetIterationTime(e);
+  }
+  const double rows = static_cast<double>(state.iterations() * (steps + 1));
+  state.counters["phiq_us"] = 1e6 * phiq_s / rows;
+  state.counters["phiq_full_us"] = 1e6 * full_s / rows;
+  state.counters["bare_us"] = 1e6 * bare_s / rows;
+  state.counters["phiq_per_bare"] = phiq_s / bare_s;
+  state.counters["full_per_bare"] = full_s / bare_s;
+  state.counters["phiq_fact_per_step"] = static_cast<double>(phiq_fact) / rows;
+  state.counters["full_fact_per_step"] = static_cast<double>(full_fact) / rows;
+  state.counters["bare_fact_per_step"] = static_cast<double>(bare_it) / rows + 1.0;
+  state.counters["phiq_error"] = phiq_err;
+  state.counters["bare_error"] = bare_err;
+}
+BENCHMARK(BM_NFourBarStepVsBareLoop)->ArgName("N")->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseManualTime();
+
+// Symbolic reuse: one factorisation as phiq does it (refactor with the pivots of the once-analysed pattern) against
+// re-analysing the pattern and factorising with pivoting, at the same matrix, interleaved. The sweep needs
+// `factorizations_per_step` of them per step (measured), so re-analysing would cost (reanalyse − refactor) ×
+// that per step more: reported as step_speedup = (step + extra) / step.
+void BM_NFourBarSymbolicReuse(benchmark::State& state) {
+  const Index n = state.range(0);
+  Model m = nfourbar(n, M_PI / 4, M_PI / 2);
+  Workspace ws(m);
+  SweepOptions opt;
+  opt.steps = 50;
+  SweepSummary sum;
+  const auto s0 = Clock::now();
+  run_sweep(m, opt, ws, nullptr, &sum);
+  const double step_s = seconds_since(s0) / static_cast<double>(opt.steps + 1);
+  const double fact_per_step = static_cast<double>(sum.counters.factorizations) / static_cast<double>(opt.steps + 1);
+  std::vector<double> values(static_cast<std::size_t>(m.jacobian_pattern().nnz()));
+  m.jacobian(ws.q.data(), 1.0, values.data());
+  auto reuse = m.symbolic()->make_numeric();
+  reuse->factorize(values.data());
+  double reuse_s = 0, fresh_s = 0;
+  for (auto _ : state) {
+    auto t0 = Clock::now();
+    reuse->factorize(values.data());
+    reuse_s += seconds_since(t0);
+    t0 = Clock::now();
+    auto sym = analyse(LinearSolverKind::kKlu, std::make_shared<CscPattern>(m.jacobian_pattern()));
+    auto num = sym->make_numeric();
+    num->factorize(values.data());
+    const double f = seconds_since(t0);
+    fresh_s += f;
+    state.SetIterationTime(f);
+  }
+  const double it = static_cast<double>(state.iterations());
+  state.counters["refactor_us"] = 1e6 * reuse_s / it;
+  state.counters["analyse_factor_us"] = 1e6 * fresh_s / it;
+  state.counters["factor_ratio"] = fresh_s / reuse_s;
+  state.counters["step_us"] = 1e6 * step_s;
+  state.counters["step_speedup"] = (step_s + fact_per_step * (fresh_s - reuse_s) / it) / step_s;
+}
+BENCHMARK(BM_NFourBarSymbolicReuse)->ArgName("N")->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMicrosecond)->UseManualTime();
+
+// Parallel drive steps: a 1000-step sweep (q, q̇, q̈) on 1 thread and on 2, interleaved; speedup = t1 / t2, and
+// the share of the 2-thread run spent in the sequential seeding pass (for the projection to more cores in
+// bench/README.md).
+void BM_NFourBarParallelSweep(benchmark::State& state) {
+  const Index n = state.range(0);
+  Model m = nfourbar(n, M_PI / 4, M_PI / 2);
+  Workspace ws(m);
+  SweepOptions one, two;
+  one.steps = two.steps = 1000;
+  two.threads = 2;
+  double t1 = 0, t2 = 0, seed = 0, assembly = 0;
+  for (auto _ : state) {
+    SweepSummary sum;
+    ws.q = m.initial_positions();
+    auto t0 = Clock::now();
+    run_sweep(m, one, ws, nullptr, &sum);
+    t1 += seconds_since(t0);
+    ws.q = m.initial_positions();
+    t0 = Clock::now();
+    run_sweep(m, two, ws, nullptr, &sum);
+    const double e = seconds_since(t0);
+    t2 += e, seed += sum.seed_seconds;
+    if (sum.parallel_chunks == 0) state.SkipWithError("no parallel chunks");
+    state.SetIterationTime(e);
+  }
+  (void)assembly;
+  state.counters["one_thread_ms"] = 1e3 * t1 / static_cast<double>(state.iterations());
+  state.counters["two_threads_ms"] = 1e3 * t2 / static_cast<double>(state.iterations());
+  state.counters["speedup"] = t1 / t2;
+  state.counters["seed_share"] = seed / t2;
+}
+BENCHMARK(BM_NFourBarParallelSweep)->ArgName("N")->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(3);
 
 }  // namespace
 

@@ -338,6 +338,7 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   // order below, where the failure is reported as the sequential sweep reports it.
   std::vector<Eigen::VectorXd> seeds(1);  // chunk 0 starts from row 0 itself
   {
+    const auto seed_start = std::chrono::steady_clock::now();
     SweepOptions so = opt;
     so.velocities = so.accelerations = false;
     so.predictor = Predictor::kSecant;
@@ -348,6 +349,7 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
     seeder.adopt(run.time_of(0));
     for (Index c = 1; c < n_chunks && seeder.advance(run.time_of(first_row(c)), 0); ++c) seeds.push_back(sws.q);
     add_counters(others, sws.counters, WorkCounters{});
+    sum.seed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
   }
   const Index seeded = static_cast<Index>(seeds.size());
 
