@@ -258,7 +258,19 @@ Model ModelBuilder::build() && {
 
   // Symbolic analysis once per model; square systems only (redundant or under-determined models are analysed by
   // the rank module, not by LU).
-  if (rows == n && n > 0) m.symbolic_ = analyse(m.lu_kind_, pattern);
+  if (rows == n && n > 0) {
+    // Batch mode: a model of the same structure (the same scene with other parameter values) shares the other's
+    // pattern and analysis read-only instead of analysing again.
+    const Model* other = share_analysis_with_;
+    if (other && other->symbolic_ && other->lu_kind_ == m.lu_kind_ && other->pattern_->rows == pattern->rows &&
+        other->pattern_->cols == pattern->cols && other->pattern_->col_ptr == pattern->col_ptr &&
+        other->pattern_->row_idx == pattern->row_idx) {
+      m.pattern_ = other->pattern_;
+      m.symbolic_ = other->symbolic_;
+    } else {
+      m.symbolic_ = analyse(m.lu_kind_, pattern);
+    }
+  }
   return std::move(m);
 }
 

@@ -159,6 +159,11 @@ class ModelBuilder {
   void set_length_scale(double metres);
   /// Chooses the sparse LU (default KLU; see bench/README.md for why).
   void set_linear_solver(LinearSolverKind kind) { model_.lu_kind_ = kind; }
+  /// Batch mode: if the built model has the same Jacobian pattern and linear solver as `other` (e.g. the same
+  /// scene with other parameter values), it shares other's pattern and symbolic analysis (read-only, reference
+  /// counted) instead of analysing again; otherwise it is analysed as usual. Model::symbolic() tells which.
+  /// `other` must outlive build().
+  void share_analysis_with(const Model& other) { share_analysis_with_ = &other; }
 
   /// Computes the pattern, units, scale and the symbolic analysis. The builder is consumed.
   Model build() &&;
@@ -187,6 +192,7 @@ class ModelBuilder {
   std::unordered_map<std::type_index, std::size_t> block_of_type_;
   std::unordered_set<std::string> constraint_names_;  ///< duplicate check in O(1): models reach 10^6 constraints
   double length_scale_override_ = 0.0;
+  const Model* share_analysis_with_ = nullptr;
 };
 
 template <class Spec>

@@ -2,6 +2,7 @@
 /// phiq: sparse, large-scale multibody kinematics. One include for the whole public API.
 #pragma once
 
+#include "phiq/batch.hpp"
 #include "phiq/constraint_kinds.hpp"
 #include "phiq/csv_writer.hpp"
 #include "phiq/expression.hpp"

@@ -1,0 +1,41 @@
+#include "phiq/batch.hpp"
+
+#include <atomic>
+#include <chrono>
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+namespace phiq {
+
+BatchSummary run_batch(const std::vector<const Model*>& models, const SweepOptions& options, int threads,
+                       const std::function<bool(std::size_t, const StepView&)>& on_step) {
+  for (const Model* m : models)
+    if (!m) throw Error("run_batch: null model");
+  if (threads < 0) throw Error("run_batch: threads must be >= 0 (0: all cores)");
+  BatchSummary out;
+  out.cases.resize(models.size());
+  out.threads = threads == 0 ? tbb::info::default_concurrency() : threads;
+  const auto start = std::chrono::steady_clock::now();
+  SweepOptions one = options;
+  one.threads = 1;  // parallel over cases, not within one
+  tbb::task_arena arena(out.threads);
+  arena.execute([&] {
+    // one case per task: cases are whole sweeps, far above any scheduling cost
+    tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t c) {
+      Workspace ws(*models[c]);
+      run_sweep(*models[c], one, ws, on_step ? [&](const StepView& s) { return on_step(c, s); }
+                                             : std::function<bool(const StepView&)>{},
+                &out.cases[c]);
+    });
+  });
+  for (std::size_t c = 0; c < models.size(); ++c) {
+    if (out.cases[c].status != SolveStatus::kSuccess) ++out.failed;
+    if (c > 0 && models[c]->symbolic() && models[c]->symbolic() == models[0]->symbolic()) ++out.shared_analyses;
+  }
+  out.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace phiq
