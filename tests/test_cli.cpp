@@ -274,6 +274,43 @@ TEST_F(Cli, GenerateRefusesBadOptions) {
   EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
 }
 
+TEST_F(Cli, GeneratedScissorAndGridRunOverTheirDefaultRanges) {
+  // without --from/--to: the scissor's bars from 0.3 to 1.2 rad, the grid's rows between π/4 and 3π/4
+  for (const char* kind : {"scissor", "grid"})
+    for (const char* coords : {"natural", "reference-point"}) {
+      const fs::path scene = dir_ / "s.yaml", out = dir_ / "s.csv";
+      const std::string args = std::string(kind) + " 5 --steps 30 --coords " + coords;
+      ASSERT_EQ(run("generate " + args + " -o " + scene.string()).code, 0);
+      const std::string text = slurp(scene);
+      const std::string law = std::string(kind) == "scissor" ? "initial: 0.3, rate: 0.8999999999999999"
+                                                             : "initial: 0.7853981633974483, rate: 1.5707963267948966";
+      EXPECT_NE(text.find(law), std::string::npos) << kind << "\n" << text;
+      Result r = run("run -q " + scene.string() + " -o " + out.string());
+      ASSERT_EQ(r.code, 0) << kind << " " << coords << ": " << r.err;
+      EXPECT_EQ(columns_of(slurp(out))["t"].size(), 31u);
+    }
+  // an explicit range replaces the default
+  const fs::path scene = dir_ / "s.yaml";
+  ASSERT_EQ(run("generate scissor 2 --from 0.5 --to 1 -o " + scene.string()).code, 0);
+  EXPECT_NE(slurp(scene).find("initial: 0.5, rate: 0.5"), std::string::npos);
+}
+
+TEST_F(Cli, GenerateScissorAndGridRefuseBadOptions) {
+  const std::string x = " -o " + (dir_ / "x.yaml").string();
+  for (const char* kind : {"scissor", "grid"}) {
+    EXPECT_EQ(run(std::string("generate ") + kind + " 0" + x).code, 2);
+    EXPECT_EQ(run(std::string("generate ") + kind + " 5 --coords polar" + x).code, 2);
+    EXPECT_EQ(run(std::string("generate ") + kind + " 5 --outputs q,w" + x).code, 2);
+    EXPECT_EQ(run(std::string("generate ") + kind + " 5 --steps -1" + x).code, 2);
+    Result r = run(std::string("generate ") + kind + " 5 --from 0" + x);  // flat: singular
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("generate: --from and --to: "), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(run("generate scissor 5 --to 1.6" + x).code, 2);  // beyond vertical
+  EXPECT_NE(run("generate gears 5" + x).err.find("available: nfourbar, scissor, grid"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
+}
+
 TEST_F(Cli, UsageErrorsAndHelp) {
   EXPECT_EQ(run("").code, 2);
   EXPECT_EQ(run("frobnicate x").code, 2);

@@ -1,4 +1,5 @@
 #include "generate.hpp"
+#include "generate_linkages.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -118,7 +119,9 @@ std::string generate_scene(const GenerateOptions& o) {
     if (o.coords == "reference-point") return nfourbar_reference_point(o);
     throw std::invalid_argument("--coords is natural or reference-point");
   }
-  throw std::invalid_argument("unknown kind '" + o.kind + "' (available: nfourbar)");
+  if (o.kind == "scissor") return scissor_scene(o);
+  if (o.kind == "grid") return grid_scene(o);
+  throw std::invalid_argument("unknown kind '" + o.kind + "' (available: nfourbar, scissor, grid)");
 }
 
 }  // namespace phiq::tools

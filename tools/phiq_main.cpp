@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "generate.hpp"
+#include "generate_linkages.hpp"
 #include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 
@@ -277,13 +278,14 @@ int main(int argc, char** argv) {
 
   phiq::tools::GenerateOptions gen;
   std::string gen_out, gen_outputs = "q,v,a";
-  CLI::App* generate = app.add_subcommand("generate", "Write a scalable scene (nfourbar)");
-  generate->add_option("kind", gen.kind, "nfourbar")->required();
-  generate->add_option("N", gen.n, "Size: number of four-bars")->required();
+  CLI::App* generate = app.add_subcommand("generate", "Write a scalable scene (nfourbar, scissor, grid)");
+  generate->add_option("kind", gen.kind, "nfourbar, scissor or grid")->required();
+  generate->add_option("N", gen.n, "Size: four-bars (nfourbar), stages (scissor), cells (grid)")->required();
   generate->add_option("-o,--output", gen_out, "Scene file to write")->required();
   generate->add_option("--steps", gen.steps, "Sweep intervals")->capture_default_str();
-  generate->add_option("--from", gen.from, "Driven value at t = 0 (rad)")->capture_default_str();
-  generate->add_option("--to", gen.to, "Driven value at t = 1 (rad)")->capture_default_str();
+  CLI::Option* gen_from =
+      generate->add_option("--from", gen.from, "Driven angle at t = 0 (rad; default pi/4, scissor 0.3)");
+  CLI::Option* gen_to = generate->add_option("--to", gen.to, "Driven angle at t = 1 (rad; default 3pi/4, scissor 1.2)");
   generate->add_option("--coords", gen.coords, "natural or reference-point")->capture_default_str();
   generate->add_option("--outputs", gen_outputs, "Which of q (positions), v, a the scene asks for")
       ->capture_default_str();
@@ -314,6 +316,10 @@ int main(int argc, char** argv) {
   try {
     if (*run) return cmd_run(scene_path, out_path, quiet, summary_path, threads);
     if (*generate) {
+      if (auto range = phiq::tools::kind_default_range(gen.kind)) {  // kinds whose default range differs
+        if (gen_from->count() == 0) gen.from = range->from;
+        if (gen_to->count() == 0) gen.to = range->to;
+      }
       gen.q = gen.v = gen.a = false;
       std::stringstream ss(gen_outputs);
       for (std::string item; std::getline(ss, item, ',');) {

@@ -1,0 +1,391 @@
+// `phiq generate scissor` and `phiq generate grid`: the scenes load, are square with the stated counts, and their
+// sweeps follow the closed forms of tools/README.md (positions, velocities, accelerations) in both coordinate
+// styles, which agree with each other; generation is linear in N.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "generate.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+using tools::GenerateOptions;
+
+GenerateOptions options(const std::string& kind, std::int64_t n, const std::string& coords, double from, double to,
+                        std::int64_t steps = 24) {
+  GenerateOptions o;
+  o.kind = kind;
+  o.n = n;
+  o.coords = coords;
+  o.from = from;
+  o.to = to;
+  o.steps = steps;
+  return o;
+}
+
+// A closed form: c + Σ (A cos θ_k + B sin θ_k + D θ_k) over driven angles θ_k(t) = θ_k(0) + r_k t.
+struct Term {
+  std::size_t angle;
+  double cos_coef, sin_coef, lin_coef;
+};
+struct ClosedForm {
+  double c = 0.0;
+  std::vector<Term> terms;
+};
+struct Angles {
+  std::vector<double> initial, rate;
+};
+
+struct Value {
+  double q, v, a;
+};
+Value evaluate(const ClosedForm& f, const Angles& ang, double t) {
+  Value r{f.c, 0.0, 0.0};
+  for (const Term& k : f.terms) {
+    const double w = ang.rate[k.angle], th = ang.initial[k.angle] + w * t, c = std::cos(th), s = std::sin(th);
+    r.q += k.cos_coef * c + k.sin_coef * s + k.lin_coef * th;
+    r.v += (-k.cos_coef * s + k.sin_coef * c + k.lin_coef) * w;
+    r.a += (-k.cos_coef * c - k.sin_coef * s) * w * w;
+  }
+  return r;
+}
+
+// What a generated scene should be: its counts and the closed form of every coordinate.
+struct Expected {
+  Index coordinates = 0, kinematic = 0, drivers = 0;
+  Angles angles;
+  std::map<std::string, ClosedForm> q;
+};
+
+std::string nm(const std::string& f, std::int64_t i) { return f + std::to_string(i); }
+std::string nm(const std::string& f, std::int64_t i, std::int64_t j) {
+  return f + std::to_string(i) + "_" + std::to_string(j);
+}
+
+// Scissor: bars at θ; L_k = (0, k s), R_k = (c, k s), M_k = (c/2, (k + 1/2) s).
+Expected scissor_expected(const GenerateOptions& o) {
+  Expected e;
+  const std::int64_t n = o.n;
+  e.angles = {{o.from}, {o.to - o.from}};
+  auto cs = [](double a, double b, double c = 0.0, double d = 0.0) { return ClosedForm{c, {{0, a, b, d}}}; };
+  e.drivers = 1;
+  if (o.coords == "natural") {
+    e.coordinates = 6 * n + 2;
+    e.kinematic = 6 * n + 1;
+    e.q["theta"] = cs(0, 0, 0, 1);
+    e.q["xr0"] = cs(1, 0);
+    for (std::int64_t k = 0; k < n; ++k) {
+      e.q[nm("xm", k)] = cs(0.5, 0);
+      e.q[nm("ym", k)] = cs(0, k + 0.5);
+      e.q[nm("xl", k + 1)] = cs(0, 0);
+      e.q[nm("yl", k + 1)] = cs(0, k + 1.0);
+      e.q[nm("xr", k + 1)] = cs(1, 0);
+      e.q[nm("yr", k + 1)] = cs(0, k + 1.0);
+    }
+  } else {
+    e.coordinates = 6 * n + 3;
+    e.kinematic = 6 * n + 2;
+    e.q["xs"] = cs(1, 0);
+    e.q["ys"] = cs(0, 0);
+    e.q["psis"] = cs(0, 0);
+    for (std::int64_t k = 0; k < n; ++k) {
+      for (const char* bar : {"a", "b"}) {
+        e.q[nm(std::string("x") + bar, k)] = cs(0.5, 0);
+        e.q[nm(std::string("y") + bar, k)] = cs(0, k + 0.5);
+      }
+      e.q[nm("psia", k)] = cs(0, 0, 0, 1);
+      e.q[nm("psib", k)] = cs(0, 0, M_PI, -1);
+    }
+  }
+  return e;
+}
+
+// Grid: N cells in rows of C = ceil(sqrt N), the top row holding the rest; row j's angle runs from → to in even
+// rows, to → from in odd rows; node (i, j) = (i + Σ_{k<j} cos θ_k, Σ_{k<j} sin θ_k).
+struct Shape {
+  std::int64_t cols, rows, last;
+  std::int64_t width(std::int64_t j) const { return j + 1 < rows ? cols : last; }
+};
+Shape shape_of(std::int64_t n) {
+  std::int64_t c = 1;
+  while (c * c < n) ++c;
+  const std::int64_t r = (n + c - 1) / c;
+  return {c, r, n - (r - 1) * c};
+}
+
+Expected grid_expected(const GenerateOptions& o) {
+  Expected e;
+  const Shape g = shape_of(o.n);
+  const std::int64_t n = o.n, r = g.rows;
+  for (std::int64_t j = 0; j < r; ++j) {
+    e.angles.initial.push_back(j % 2 ? o.to : o.from);
+    e.angles.rate.push_back(j % 2 ? o.from - o.to : o.to - o.from);
+  }
+  auto node_x = [&](std::int64_t i, std::int64_t j, double extra) {  // i + extra + Σ_{k<j} cos θ_k
+    ClosedForm f{static_cast<double>(i) + extra, {}};
+    for (std::int64_t k = 0; k < j; ++k) f.terms.push_back({static_cast<std::size_t>(k), 1, 0, 0});
+    return f;
+  };
+  auto node_y = [&](std::int64_t j) {
+    ClosedForm f;
+    for (std::int64_t k = 0; k < j; ++k) f.terms.push_back({static_cast<std::size_t>(k), 0, 1, 0});
+    return f;
+  };
+  e.drivers = r;
+  if (o.coords == "natural") {
+    e.coordinates = 2 * n + 3 * r;
+    e.kinematic = 2 * n + 2 * r;
+    for (std::int64_t j = 0; j < r; ++j) {
+      e.q[nm("theta", j)] = ClosedForm{0, {{static_cast<std::size_t>(j), 0, 0, 1}}};
+      for (std::int64_t i = 0; i <= g.width(j); ++i) {
+        e.q[nm("x", i, j + 1)] = node_x(i, j + 1, 0);
+        e.q[nm("y", i, j + 1)] = node_y(j + 1);
+      }
+    }
+  } else {
+    e.coordinates = 6 * n + 3 * r;
+    e.kinematic = 6 * n + 2 * r;
+    for (std::int64_t j = 0; j < r; ++j) {
+      const auto a = static_cast<std::size_t>(j);
+      for (std::int64_t i = 0; i <= g.width(j); ++i) {
+        ClosedForm x = node_x(i, j, 0), y = node_y(j);
+        x.terms.push_back({a, 0.5, 0, 0});
+        y.terms.push_back({a, 0, 0.5, 0});
+        e.q[nm("xv", i, j)] = x;
+        e.q[nm("yv", i, j)] = y;
+        e.q[nm("psiv", i, j)] = ClosedForm{0, {{a, 0, 0, 1}}};
+      }
+      for (std::int64_t i = 0; i < g.width(j); ++i) {
+        e.q[nm("xh", i, j + 1)] = node_x(i, j + 1, 0.5);
+        e.q[nm("yh", i, j + 1)] = node_y(j + 1);
+        e.q[nm("psih", i, j + 1)] = ClosedForm{};
+      }
+    }
+  }
+  return e;
+}
+
+Expected expected_for(const GenerateOptions& o) { return o.kind == "scissor" ? scissor_expected(o) : grid_expected(o); }
+
+struct SweptScene {
+  Scene scene;
+  test::Trace trace;
+  std::map<std::string, Index> column;
+  double at(const std::vector<Eigen::VectorXd>& rows, std::size_t k, const std::string& name) const {
+    return rows[k](column.at(name));
+  }
+};
+
+// Generates, loads, checks the counts, sweeps and compares every coordinate with the closed form at every step.
+SweptScene check_against_closed_form(const GenerateOptions& o) {
+  SCOPED_TRACE(o.kind + " " + std::to_string(o.n) + " " + o.coords);
+  SweptScene run{parse_scene(tools::generate_scene(o), o.kind + ".yaml"), {}, {}};
+  const Model& m = *run.scene.model;
+  const Expected e = expected_for(o);
+  EXPECT_EQ(m.num_coordinates(), e.coordinates);
+  EXPECT_EQ(m.num_equations(), e.coordinates);  // square
+  Index kinematic = 0, drivers = 0;
+  for (const ConstraintInfo& c : m.constraints()) (c.depends_on_time ? drivers : kinematic) += c.rows;
+  EXPECT_EQ(kinematic, e.kinematic);
+  EXPECT_EQ(drivers, e.drivers);
+  EXPECT_EQ(run.scene.sweep.steps, o.steps);
+  EXPECT_TRUE(run.scene.sweep.velocities);
+  EXPECT_TRUE(run.scene.sweep.accelerations);
+  EXPECT_EQ(e.q.size(), static_cast<std::size_t>(e.coordinates));  // the closed form covers every coordinate
+  for (Index j = 0; j < m.num_coordinates(); ++j) run.column[m.coordinate_names()[static_cast<std::size_t>(j)]] = j;
+
+  SweepSummary summary;
+  EXPECT_EQ(test::sweep(m, run.scene.sweep, &run.trace, &summary), SolveStatus::kSuccess) << summary.message;
+  EXPECT_TRUE(summary.warnings.empty());
+  EXPECT_EQ(run.trace.t.size(), static_cast<std::size_t>(o.steps + 1));
+  EXPECT_EQ(run.trace.qd.size(), run.trace.t.size());
+  EXPECT_EQ(run.trace.qdd.size(), run.trace.t.size());
+  double worst[3] = {0, 0, 0};
+  std::string where[3];
+  for (std::size_t k = 0; k < run.trace.t.size() && k < run.trace.qdd.size(); ++k) {
+    for (const auto& [name, form] : e.q) {
+      const Index j = m.coordinate_index(name);
+      const Value want = evaluate(form, e.angles, run.trace.t[k]);
+      const double got[3] = {run.trace.q[k](j), run.trace.qd[k](j), run.trace.qdd[k](j)};
+      const double ref[3] = {want.q, want.v, want.a};
+      for (int d = 0; d < 3; ++d) {
+        const double err = std::fabs(got[d] - ref[d]);
+        if (err > worst[d]) worst[d] = err, where[d] = name + " at t = " + std::to_string(run.trace.t[k]);
+      }
+    }
+  }
+  EXPECT_LT(worst[0], 1e-9) << "position " << where[0];
+  EXPECT_LT(worst[1], 1e-9) << "velocity " << where[1];
+  EXPECT_LT(worst[2], 1e-9) << "acceleration " << where[2];
+  return run;
+}
+
+constexpr std::int64_t kSizes[] = {1, 2, 5, 7};
+
+TEST(GenerateScissor, BothCoordinateStylesFollowTheClosedFormAndAgree) {
+  for (std::int64_t n : kSizes) {
+    const SweptScene nat = check_against_closed_form(options("scissor", n, "natural", 0.3, 1.2));
+    const SweptScene ref = check_against_closed_form(options("scissor", n, "reference-point", 0.3, 1.2));
+    // shared quantities: the lift's height (top joint) and the crossing pins, with their velocities
+    ASSERT_EQ(nat.trace.t.size(), ref.trace.t.size());
+    double worst = 0.0;
+    for (std::size_t k = 0; k < nat.trace.t.size() && k < nat.trace.qd.size() && k < ref.trace.qd.size(); ++k) {
+      const std::string top = nm("psia", n - 1);
+      const double psi = ref.at(ref.trace.q, k, top), psid = ref.at(ref.trace.qd, k, top);
+      const double h_ref = ref.at(ref.trace.q, k, nm("ya", n - 1)) + 0.5 * std::sin(psi);
+      const double hd_ref = ref.at(ref.trace.qd, k, nm("ya", n - 1)) + 0.5 * std::cos(psi) * psid;
+      worst = std::max(worst, std::fabs(nat.at(nat.trace.q, k, nm("yl", n)) - h_ref));
+      worst = std::max(worst, std::fabs(nat.at(nat.trace.q, k, nm("yr", n)) - h_ref));
+      worst = std::max(worst, std::fabs(nat.at(nat.trace.qd, k, nm("yl", n)) - hd_ref));
+      for (std::int64_t s = 0; s < n; ++s)
+        for (const char* c : {"x", "y"}) {
+          for (const char* bar : {"a", "b"}) {
+            const std::string r = nm(std::string(c) + bar, s), p = nm(std::string(c) + "m", s);
+            worst = std::max(worst, std::fabs(nat.at(nat.trace.q, k, p) - ref.at(ref.trace.q, k, r)));
+            worst = std::max(worst, std::fabs(nat.at(nat.trace.qd, k, p) - ref.at(ref.trace.qd, k, r)));
+          }
+        }
+      // and the closed form of the height: N sin θ
+      const double th = 0.3 + 0.9 * nat.trace.t[k];
+      worst = std::max(worst, std::fabs(h_ref - static_cast<double>(n) * std::sin(th)));
+    }
+    EXPECT_LT(worst, 1e-9) << "N = " << n;
+  }
+}
+
+TEST(GenerateGrid, BothCoordinateStylesFollowTheClosedFormAndAgree) {
+  for (std::int64_t n : kSizes) {
+    const SweptScene nat = check_against_closed_form(options("grid", n, "natural", M_PI / 4, 3 * M_PI / 4));
+    const SweptScene ref = check_against_closed_form(options("grid", n, "reference-point", M_PI / 4, 3 * M_PI / 4));
+    // shared quantities: every node above ground, natural (x, y) against the top of the vertical bar below it
+    const Shape g = shape_of(n);
+    ASSERT_EQ(nat.trace.t.size(), ref.trace.t.size());
+    double worst = 0.0;
+    for (std::size_t k = 0; k < nat.trace.t.size() && k < nat.trace.qd.size() && k < ref.trace.qd.size(); ++k)
+      for (std::int64_t j = 0; j < g.rows; ++j)
+        for (std::int64_t i = 0; i <= g.width(j); ++i) {
+          const double psi = ref.at(ref.trace.q, k, nm("psiv", i, j)), psid = ref.at(ref.trace.qd, k, nm("psiv", i, j));
+          const double x = ref.at(ref.trace.q, k, nm("xv", i, j)) + 0.5 * std::cos(psi);
+          const double y = ref.at(ref.trace.q, k, nm("yv", i, j)) + 0.5 * std::sin(psi);
+          const double yd = ref.at(ref.trace.qd, k, nm("yv", i, j)) + 0.5 * std::cos(psi) * psid;
+          worst = std::max(worst, std::fabs(nat.at(nat.trace.q, k, nm("x", i, j + 1)) - x));
+          worst = std::max(worst, std::fabs(nat.at(nat.trace.q, k, nm("y", i, j + 1)) - y));
+          worst = std::max(worst, std::fabs(nat.at(nat.trace.qd, k, nm("y", i, j + 1)) - yd));
+        }
+    EXPECT_LT(worst, 1e-9) << "N = " << n;
+  }
+}
+
+TEST(GenerateGrid, ShapeHasExactlyNCells) {
+  // C = ceil(sqrt N) cells per row, R rows, the top row the rest (at least one)
+  struct Case {
+    std::int64_t n, cols, rows, last;
+  };
+  for (Case c : {Case{1, 1, 1, 1}, Case{2, 2, 1, 2}, Case{3, 2, 2, 1}, Case{5, 3, 2, 2}, Case{7, 3, 3, 1},
+                 Case{9, 3, 3, 3}, Case{100000, 317, 316, 145}}) {
+    const Shape s = shape_of(c.n);
+    EXPECT_EQ(s.cols, c.cols) << c.n;
+    EXPECT_EQ(s.rows, c.rows) << c.n;
+    EXPECT_EQ(s.last, c.last) << c.n;
+    const std::string text = tools::generate_scene(options("grid", c.n, "natural", 1.0, 2.0, 1));
+    const std::string shape = std::to_string(c.rows) + " rows of " + std::to_string(c.cols) + " cells";
+    EXPECT_NE(text.find(shape), std::string::npos) << text.substr(0, 400);
+  }
+}
+
+TEST(Generate, HeaderStatesTheCounts) {
+  const std::string s = tools::generate_scene(options("scissor", 5, "natural", 0.3, 1.2));
+  EXPECT_NE(s.find("# Counts: 32 coordinates, 31 kinematic equations + 1 driver = 32 equations; 1 dof\n"),
+            std::string::npos)
+      << s.substr(0, 800);
+  const std::string g = tools::generate_scene(options("grid", 5, "reference-point", 0.5, 2.5));
+  EXPECT_NE(g.find("# Counts: 36 coordinates, 34 kinematic equations + 2 drivers = 36 equations; 2 dof\n"),
+            std::string::npos)
+      << g.substr(0, 800);
+}
+
+TEST(Generate, OutputsAndStepsReachTheScene) {
+  for (const char* kind : {"scissor", "grid"}) {
+    GenerateOptions o = options(kind, 3, "reference-point", 0.4, 1.0, 7);
+    o.v = false;
+    o.a = false;
+    Scene s = parse_scene(tools::generate_scene(o), "s.yaml");
+    EXPECT_EQ(s.sweep.steps, 7);
+    EXPECT_FALSE(s.sweep.velocities) << kind;
+    EXPECT_FALSE(s.sweep.accelerations) << kind;
+    o.v = true;
+    Scene s2 = parse_scene(tools::generate_scene(o), "s.yaml");
+    EXPECT_TRUE(s2.sweep.velocities) << kind;
+    EXPECT_FALSE(s2.sweep.accelerations) << kind;
+  }
+}
+
+// Lines of a generated scene: 12 fixed (6 header, 4 section keys, time, output) plus one per coordinate, point or
+// body, constraint and driver (tools/README.md gives the counts).
+std::int64_t expected_lines(const std::string& kind, const std::string& coords, std::int64_t n) {
+  if (kind == "scissor") return coords == "natural" ? 15 * n + 18 : 11 * n + 18;
+  const std::int64_t r = shape_of(n).rows;
+  return coords == "natural" ? 5 * n + 7 * r + 12 : 11 * n + 6 * r + 12;
+}
+
+TEST(Generate, LargeScenesAreLinearInN) {
+  // N = 10^5 is generated in a fraction of a second (not timed here): one line per element, lines of bounded length
+  for (const char* kind : {"scissor", "grid"})
+    for (const char* coords : {"natural", "reference-point"})
+      for (std::int64_t n : {1, 2, 7, 1000, 100000}) {
+        const std::string s = tools::generate_scene(options(kind, n, coords, 0.5, 1.0, 10));
+        const auto lines = static_cast<std::int64_t>(std::count(s.begin(), s.end(), '\n'));
+        EXPECT_EQ(lines, expected_lines(kind, coords, n)) << kind << " " << coords << " " << n;
+        if (n >= 1000) {
+          EXPECT_LT(s.size(), static_cast<std::size_t>(lines) * 100) << kind << " " << coords;
+        }
+      }
+}
+
+TEST(Generate, RefusesBadOptionsLikeNFourBar) {
+  auto message = [](GenerateOptions o) -> std::string {
+    try {
+      tools::generate_scene(o);
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  for (const char* kind : {"nfourbar", "scissor", "grid"}) {
+    GenerateOptions o = options(kind, 3, "natural", 0.5, 1.0);
+    o.n = 0;
+    EXPECT_EQ(message(o), "N must be at least 1") << kind;
+    o = options(kind, 3, "polar", 0.5, 1.0);
+    EXPECT_EQ(message(o), "--coords is natural or reference-point") << kind;
+    o = options(kind, 3, "natural", 0.5, 1.0, -1);
+    EXPECT_EQ(message(o), "--steps must be >= 0") << kind;
+    o = options(kind, 3, "natural", 0.5, NAN);
+    EXPECT_EQ(message(o), "--from and --to must be finite") << kind;
+    o = options(kind, 3, "natural", 0.5, 1.0);
+    o.q = false;
+    EXPECT_EQ(message(o), "--outputs must include q (positions are always written)") << kind;
+  }
+  EXPECT_EQ(message(options("gears", 3, "natural", 0.5, 1.0)),
+            "unknown kind 'gears' (available: nfourbar, scissor, grid)");
+  // driven ranges that reach a singular position
+  for (double bad : {0.0, -0.1, M_PI / 2, 2.0}) {
+    EXPECT_NE(message(options("scissor", 3, "natural", bad, 1.0)).find("strictly between 0 (flat) and pi/2"),
+              std::string::npos);
+    EXPECT_NE(message(options("scissor", 3, "reference-point", 0.5, bad)).find("--from and --to"), std::string::npos);
+  }
+  for (double bad : {0.0, M_PI, 4.0}) {
+    EXPECT_NE(message(options("grid", 3, "natural", bad, 1.0)).find("strictly between 0 and pi"), std::string::npos);
+    EXPECT_NE(message(options("grid", 3, "natural", 1.0, bad)).find("--from and --to"), std::string::npos);
+  }
+  EXPECT_EQ(message(options("grid", 3, "natural", 2.0, 3.0)), "(no error)");  // beyond π/2 is fine for the grid
+}
+
+}  // namespace
+}  // namespace phiq

@@ -1,0 +1,26 @@
+// `phiq generate scissor` and `phiq generate grid` (tools/generate_linkages.cpp; formats in tools/README.md).
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "generate.hpp"
+
+namespace phiq::tools {
+
+// A scissor lift of o.n stages, 1 dof, driven by the bars' angle to the horizontal. Throws std::invalid_argument
+// for a bad --coords or a driven range that reaches a singular position (0 flat, π/2 vertical).
+std::string scissor_scene(const GenerateOptions& o);
+
+// A lattice of exactly o.n parallelogram cells in rows, one dof (and one driver) per row. Throws
+// std::invalid_argument for a bad --coords or a driven range that reaches a singular position (0 or π: flat).
+std::string grid_scene(const GenerateOptions& o);
+
+// The driven range used when --from / --to are not given, for the kinds whose default differs from
+// GenerateOptions' (π/4 → 3π/4): scissor 0.3 → 1.2 rad. Empty for the other kinds.
+struct DrivenRange {
+  double from, to;
+};
+std::optional<DrivenRange> kind_default_range(const std::string& kind);
+
+}  // namespace phiq::tools
