@@ -226,6 +226,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   double theta_seen = -1.0;  // largest contraction observed with the reused matrix in this solve
   int reused_steps = 1;      // steps taken with the reused matrix once a contraction is known
   constexpr int kMaxReusedSteps = 4;
+  int stagnant = 0;  // consecutive fresh-matrix steps that contracted by ½ or worse
   // The iteration limit counts steps taken; a step discarded to refresh a reused factorisation does not count.
   for (;;) {
     const int it = sum.iterations;
@@ -235,10 +236,14 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       if (theta_seen >= 0.0) ws.newton_contraction = theta_seen;
       return finish(SolveStatus::kSuccess, "");
     }
-    if (it >= opt.max_iterations && it > 0 && residual_within(model, ws.phi, opt.tolerance, fl)) {
+    // The residual holds but the steps have stopped shrinking fast: full-Newton steps contracting by ½ or worse
+    // twice in a row (linear convergence at a singular position, or steps at the rounding level of an
+    // ill-conditioned Φq), or the iteration limit reached. More iterations would not make q more accurate.
+    if (it > 0 && (it >= opt.max_iterations || stagnant >= 2) && residual_within(model, ws.phi, opt.tolerance, fl)) {
       sum.slow_convergence = true;
       finish(SolveStatus::kSuccess, "");
-      sum.message = "residual within tolerance but Newton converged only linearly (singular position?)";
+      sum.message = "residual within tolerance but the Newton steps stopped converging quadratically (a singular "
+                    "position, or Φq too ill-conditioned for this tolerance)";
       return SolveStatus::kSuccess;
     }
     if (it >= opt.max_iterations)
@@ -316,6 +321,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     // Error of the new iterate: θ/(1−θ)·|Δq| where a contraction is known, else the step itself.
     const double eta = (theta >= 0.0 && theta < 1.0) ? theta / (1.0 - theta) : 1.0;
     step_ok = std::min(eta, 1.0) * step_ratio(model, ws.step, ws.trial, opt.tolerance) <= 1.0;
+    stagnant = (!reuse && alpha == 1.0 && prev_norm > 0.0 && theta >= 0.5) ? stagnant + 1 : 0;
     prev_norm = alpha == 1.0 ? norm : -1.0;  // a shortened step says nothing about the contraction
     ws.q.swap(ws.trial);
     ws.phi.swap(ws.trial_phi);
