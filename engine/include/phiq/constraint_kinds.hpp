@@ -44,6 +44,11 @@ inline V2 rotate(double psi, V2 s) {
 }
 inline V2 pos(const Point2& p, const double* q) { return {p.x.of(q), p.y.of(q)}; }
 inline V2 vel(const Point2& p, const double* qd) { return {p.x.rate(qd), p.y.rate(qd)}; }
+/// |s| when the frame moves (any of x, y, ψ is a coordinate), 0 for a fixed frame (see PinSpec).
+inline double moving_arm(const Frame2& f, V2 s) {
+  const bool fixed = !f.x.is_coordinate() && !f.y.is_coordinate() && !f.psi.is_coordinate();
+  return fixed ? 0.0 : std::hypot(s.x, s.y);
+}
 }  // namespace kin
 
 /// Distance between two points (natural coordinates): rigid-body condition of a bar.
@@ -186,8 +191,10 @@ struct PinSpec {
   /// Both rows of a pin are lengths.
   Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kLength; }
   /// @copydoc DistanceSpec::characteristic_length
-  /// For a pin: the longer arm, max(|s_a|, |s_b|).
-  double characteristic_length() const { return std::max(std::hypot(sa.x, sa.y), std::hypot(sb.x, sb.y)); }
+  /// For a pin: the longer arm, max(|s_a|, |s_b|), of the frames that move. An attachment on a fixed frame
+  /// (ground: x, y, ψ all constants) is a position in the plane, not a link dimension: the 10^6-th pivot of a chain
+  /// on the ground at (10^6, 0) must not make the model's length scale 10^6 m.
+  double characteristic_length() const { return std::max(kin::moving_arm(a, sa), kin::moving_arm(b, sb)); }
   /// @copydoc DistanceSpec::for_each_slot
   /// @par Pin
   /// A pin reads x, y (lengths) and ψ (an angle) of frame a, then of frame b.
@@ -260,8 +267,10 @@ struct PrismaticSpec {
   /// For a prismatic pair, row 0 (relative rotation) is an angle and row 1 (distance from the line) a length.
   Unit row_unit(int row, const std::vector<Unit>&) const { return row == 0 ? Unit::kAngle : Unit::kLength; }
   /// @copydoc DistanceSpec::characteristic_length
-  /// For a prismatic pair: the longer arm, max(|s_a|, |s_b|).
-  double characteristic_length() const { return std::max(std::hypot(sa.x, sa.y), std::hypot(sb.x, sb.y)); }
+  /// For a prismatic pair: the longer arm, max(|s_a|, |s_b|), of the frames that move. An attachment on a fixed frame
+  /// (ground: x, y, ψ all constants) is a position in the plane, not a link dimension: the 10^6-th pivot of a chain
+  /// on the ground at (10^6, 0) must not make the model's length scale 10^6 m.
+  double characteristic_length() const { return std::max(kin::moving_arm(a, sa), kin::moving_arm(b, sb)); }
   /// @copydoc DistanceSpec::for_each_slot
   /// @par Prismatic pair
   /// A prismatic pair reads x, y (lengths) and ψ (an angle) of frame a, then of frame b.

@@ -1,0 +1,73 @@
+// Time per drive step (position + velocity + acceleration) of the generated models — nfourbar, scissor, grid — from
+// 10^2 to 10^6 coordinates, through the whole public path: `phiq generate` text → scene loader → run_sweep.
+//
+//   ./build/bench/phiq_bench_scale --benchmark_out=bench/results/scale.json --benchmark_out_format=json
+//
+// Generation and loading are outside the timed region (load_s reports the loading). Arguments: N (the
+// generator's size) and coords (0 natural, 1 reference-point).
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "generate.hpp"
+#include "generate_linkages.hpp"
+#include "phiq/phiq.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+void run(benchmark::State& state, const char* kind) {
+  phiq::tools::GenerateOptions g;
+  g.kind = kind;
+  g.n = state.range(0);
+  g.coords = state.range(1) == 0 ? "natural" : "reference-point";
+  // a short sweep per iteration: 10 steps of the generator's default range over 1000 steps (the step size of
+  // the default scene), so that every size sees the same step
+  g.steps = 1000;
+  if (auto r = phiq::tools::kind_default_range(kind)) g.from = r->from, g.to = r->to;
+  const auto l0 = Clock::now();
+  phiq::Scene scene = phiq::parse_scene(phiq::tools::generate_scene(g), std::string(kind) + ".yaml");
+  const double load_s = seconds_since(l0);
+  const phiq::Model& m = *scene.model;
+  phiq::SweepOptions opt = scene.sweep;
+  opt.steps = 10;
+  opt.t_end = opt.t_begin + 10 * (scene.sweep.t_end - scene.sweep.t_begin) / 1000.0;
+  opt.threads = 1;
+  phiq::Workspace ws(m);
+  phiq::SweepSummary sum;
+  double solve_s = 0;
+  for (auto _ : state) {
+    ws.q = m.initial_positions();
+    const auto t0 = Clock::now();
+    phiq::run_sweep(m, opt, ws, nullptr, &sum);
+    const double e = seconds_since(t0);
+    solve_s += e;
+    state.SetIterationTime(e / static_cast<double>(opt.steps + 1));
+    if (sum.status != phiq::SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
+  }
+  state.counters["coordinates"] = static_cast<double>(m.num_coordinates());
+  state.counters["load_s"] = load_s;
+  state.counters["newton_per_step"] = static_cast<double>(sum.counters.newton_iterations) / (opt.steps + 1);
+  state.counters["factorizations_per_step"] = static_cast<double>(sum.counters.factorizations) / (opt.steps + 1);
+  state.counters["warnings"] = static_cast<double>(sum.warnings.size());
+}
+
+void sizes(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"N", "coords"});
+  for (int64_t n = 100; n <= 1000000; n *= 10) b->Args({n, 0});
+  for (int64_t n = 100; n <= 100000; n *= 10) b->Args({n, 1});
+}
+
+void BM_NFourBarStep(benchmark::State& s) { run(s, "nfourbar"); }
+void BM_ScissorStep(benchmark::State& s) { run(s, "scissor"); }
+void BM_GridStep(benchmark::State& s) { run(s, "grid"); }
+BENCHMARK(BM_NFourBarStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.2);
+BENCHMARK(BM_ScissorStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.2);
+BENCHMARK(BM_GridStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.2);
+
+}  // namespace
+
+BENCHMARK_MAIN();
