@@ -150,11 +150,14 @@ class TypedBlock final : public ConstraintBlock {
   bool depends_on_time(std::size_t i) const override { return entries_[i].spec.depends_on_time(); }
 
   void build_pattern(std::vector<Index>& rows, std::vector<Index>& cols) override {
+    // values are ignored in pattern mode; evaluate at a harmless point (entries never depend on values). One
+    // point for the whole block: a point per constraint, sized by the coordinates it reads, cost O(n) each.
+    Index top = -1;
+    for (const Entry& e : entries_) top = std::max(top, max_coordinate(e.spec));
+    const std::vector<double> zeros(static_cast<std::size_t>(top + 1), 0.0);
     for (Entry& e : entries_) {
       e.nz0 = static_cast<Index>(rows.size());
       detail::PatternSink sink{e.row0, &rows, &cols};
-      std::vector<double> zeros(static_cast<std::size_t>(max_coordinate(e.spec) + 1), 0.0);
-      // values are ignored in pattern mode; evaluate at a harmless point (entries never depend on values)
       e.spec.jacobian(zeros.data(), 0.0, sink);
     }
   }
