@@ -3,12 +3,14 @@
 
 #include <sys/wait.h>
 
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <tuple>
 
 #include "test_support.hpp"
 
@@ -245,6 +247,112 @@ TEST_F(Cli, GeneratedNFourBarStaysOnTheParallelogramBranch) {
       }
     }
     EXPECT_LT(worst, 1e-9) << coords;
+  }
+}
+
+// The nfourbar scenes as `phiq generate` wrote them before families: every coordinate, point, body and
+// constraint listed one by one (the generator's former code, kept here as the reference of the compact form).
+std::string shortest(double v) {
+  if (v == 0.0) v = 0.0;
+  char buf[32];
+  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, p);
+}
+std::string explicit_nfourbar(std::int64_t n, const std::string& coords, double from, double to) {
+  const double c = std::cos(from), sn = std::sin(from);
+  std::string s = "phiq: 1\n";
+  if (coords == "natural") {
+    s += "coordinates:\n";
+    for (std::int64_t i = 0; i <= n; ++i) {
+      s += "  x" + std::to_string(i) + ": " + shortest(static_cast<double>(i) + c) + "\n";
+      s += "  y" + std::to_string(i) + ": " + shortest(sn) + "\n";
+    }
+    s += "  theta: " + shortest(from) + "\n";
+    s += "points:\n  O: [0, 0]\n";
+    for (std::int64_t i = 0; i <= n; ++i) {
+      const std::string k = std::to_string(i);
+      s += "  P" + k + ": [x" + k + ", y" + k + "]\n";
+    }
+    s += "constraints:\n";
+    for (std::int64_t i = 0; i <= n; ++i) {
+      const std::string k = std::to_string(i);
+      s += "  - {name: crank" + k + ", type: distance, points: [[" + k + ", 0], P" + k + "], length: 1}\n";
+    }
+    for (std::int64_t i = 0; i < n; ++i) {
+      const std::string k = std::to_string(i), k1 = std::to_string(i + 1);
+      s += "  - {name: coupler" + k + ", type: distance, points: [P" + k + ", P" + k1 + "], length: 1}\n";
+    }
+    s += "  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}\n";
+  } else {
+    s += "coordinates:\n";
+    for (std::int64_t i = 0; i <= n; ++i) {
+      const std::string k = std::to_string(i);
+      s += "  xc" + k + ": " + shortest(static_cast<double>(i) + 0.5 * c) + "\n  yc" + k + ": " + shortest(0.5 * sn) +
+           "\n  psi" + k + ": " + shortest(from) + "\n";
+    }
+    for (std::int64_t i = 0; i < n; ++i) {
+      const std::string k = std::to_string(i);
+      s += "  xk" + k + ": " + shortest(static_cast<double>(i) + 0.5 + c) + "\n  yk" + k + ": " + shortest(sn) +
+           "\n  phi" + k + ": 0\n";
+    }
+    s += "bodies:\n";
+    for (std::int64_t i = 0; i <= n; ++i) {
+      const std::string k = std::to_string(i);
+      s += "  crank" + k + ": [xc" + k + ", yc" + k + ", psi" + k + "]\n";
+    }
+    for (std::int64_t i = 0; i < n; ++i) {
+      const std::string k = std::to_string(i);
+      s += "  coupler" + k + ": [xk" + k + ", yk" + k + ", phi" + k + "]\n";
+    }
+    s += "constraints:\n";
+    for (std::int64_t i = 0; i <= n; ++i) {
+      const std::string k = std::to_string(i);
+      s += "  - {name: pivot" + k + ", type: revolute, between: [{body: crank" + k +
+           ", at: [-0.5, 0]}, {body: ground, at: [" + k + ", 0]}]}\n";
+    }
+    for (std::int64_t i = 0; i < n; ++i) {
+      const std::string k = std::to_string(i), k1 = std::to_string(i + 1);
+      s += "  - {name: left" + k + ", type: revolute, between: [{body: crank" + k + ", at: [0.5, 0]}, {body: coupler" +
+           k + ", at: [-0.5, 0]}]}\n";
+      s += "  - {name: right" + k + ", type: revolute, between: [{body: crank" + k1 +
+           ", at: [0.5, 0]}, {body: coupler" + k + ", at: [0.5, 0]}]}\n";
+    }
+  }
+  const std::string driven = coords == "natural" ? "theta" : "psi0";
+  s += "drivers:\n  - {name: motor, coordinate: " + driven + ", law: {type: linear, initial: " + shortest(from) +
+       ", rate: " + shortest(to - from) + "}}\n";
+  s += "time: {start: 0, end: 1, steps: 10}\n";
+  return s;
+}
+
+TEST_F(Cli, GeneratedFamiliesAreTheModelListedOneByOne) {
+  // the same coordinates (names, order, initial values bit for bit), constraints, pattern, Φ, Φq, Φt and γ
+  for (const char* coords : {"natural", "reference-point"}) {
+    for (const auto& [n, from, to] : {std::tuple<int, double, double>{3, 0.7853981633974483, 2.356194490192345},
+                                      std::tuple<int, double, double>{37, 0.3, 1.1}}) {
+      const fs::path p = dir_ / "compact.yaml";
+      std::ostringstream args;
+      args.precision(17);
+      args << "generate nfourbar " << n << " --steps 10 --coords " << coords << " --from " << from << " --to " << to
+           << " -o " << p.string();
+      ASSERT_EQ(run(args.str()).code, 0) << args.str();
+      phiq::Scene compact = phiq::load_scene(p.string());
+      phiq::Scene listed = phiq::parse_scene(explicit_nfourbar(n, coords, from, to), "listed.yaml");
+      SCOPED_TRACE(std::string(coords) + " N = " + std::to_string(n));
+      phiq::test::expect_same_model(*compact.model, *listed.model);
+      EXPECT_EQ(compact.model->time_domain_end(), listed.model->time_domain_end());
+    }
+  }
+}
+
+TEST_F(Cli, GeneratedSceneSizeDoesNotDependOnN) {
+  for (const char* coords : {"natural", "reference-point"}) {
+    const fs::path small = dir_ / "small.yaml", large = dir_ / "large.yaml";
+    ASSERT_EQ(run(std::string("generate nfourbar 10 --coords ") + coords + " -o " + small.string()).code, 0);
+    ASSERT_EQ(run(std::string("generate nfourbar 1000000 --coords ") + coords + " -o " + large.string()).code, 0);
+    // N is written three times (comment, name, parameter): 5 more digits each
+    EXPECT_EQ(fs::file_size(large), fs::file_size(small) + 15) << coords;
+    EXPECT_LT(fs::file_size(large), 4096u) << coords;
   }
 }
 

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "phiq/phiq.hpp"
 
 namespace phiq::test {
@@ -83,6 +85,37 @@ inline double max_difference(const Trace& a, const Trace& b, int order = 0) {
   double d = 0;
   for (std::size_t k = 0; k < va.size(); ++k) d = std::max(d, (va[k] - vb[k]).cwiseAbs().maxCoeff());
   return d;
+}
+
+// Two models are the same model: coordinates (names, order, initial values), constraints (names, kinds, rows), the
+// Jacobian pattern, and bit for bit the same Φ, Φq, Φt and γ at the initial point (q̇ = 1).
+inline void expect_same_model(const Model& a, const Model& b) {
+  ASSERT_EQ(a.coordinate_names(), b.coordinate_names());
+  ASSERT_EQ(a.num_equations(), b.num_equations());
+  for (Index j = 0; j < a.num_coordinates(); ++j)
+    EXPECT_EQ(a.initial_positions()(j), b.initial_positions()(j)) << a.coordinate_names()[static_cast<std::size_t>(j)];
+  ASSERT_EQ(a.constraints().size(), b.constraints().size());
+  for (std::size_t k = 0; k < a.constraints().size(); ++k) {
+    EXPECT_EQ(a.constraints()[k].name, b.constraints()[k].name);
+    EXPECT_EQ(a.constraints()[k].kind, b.constraints()[k].kind);
+    EXPECT_EQ(a.constraints()[k].first_row, b.constraints()[k].first_row);
+  }
+  EXPECT_EQ(a.jacobian_pattern().col_ptr, b.jacobian_pattern().col_ptr);
+  EXPECT_EQ(a.jacobian_pattern().row_idx, b.jacobian_pattern().row_idx);
+  EXPECT_EQ(a.length_scale(), b.length_scale());
+  const Eigen::VectorXd& q = a.initial_positions();
+  const Eigen::VectorXd qd = Eigen::VectorXd::Ones(q.size());
+  const auto m = static_cast<std::size_t>(a.num_equations());
+  const auto nnz = static_cast<std::size_t>(a.jacobian_pattern().nnz());
+  std::vector<double> ra(m), rb(m), ja(nnz, 0.0), jb(nnz, 0.0), ta(m), tb(m), ga(m), gb(m);
+  a.residual(q.data(), 0.0, ra.data()), b.residual(q.data(), 0.0, rb.data());
+  a.jacobian(q.data(), 0.0, ja.data()), b.jacobian(q.data(), 0.0, jb.data());
+  a.phi_t(q.data(), 0.0, ta.data()), b.phi_t(q.data(), 0.0, tb.data());
+  a.gamma(q.data(), qd.data(), 0.0, ga.data()), b.gamma(q.data(), qd.data(), 0.0, gb.data());
+  EXPECT_EQ(ra, rb);
+  EXPECT_EQ(ja, jb);
+  EXPECT_EQ(ta, tb);
+  EXPECT_EQ(ga, gb);
 }
 
 // Difference of two angles, wrapped to (-pi, pi].

@@ -31,33 +31,32 @@ void footer(std::string& s, const GenerateOptions& o, const std::string& driven)
        (o.a ? "true" : "false") + "}\n";
 }
 
+// The scenes are written with indexed families (`for i in 0..N`, models/README.md), so their size does not depend
+// on N; they describe exactly the model the explicit listing (x0: ..., x1: ..., ...) did: the same names, order and
+// initial values. Every per-member number is written as the sum the explicit listing computed (i + c, with the
+// constant c a parameter written in full), which the loader evaluates in double precision in the order written:
+// the same bits.
+
 // IFToMM N four-bar: N+1 unit cranks pinned at (i, 0), tips P_i joined by N unit couplers; crank 0 driven by its
 // angle from `from` at t = 0 to `to` at t = 1. Placed on the parallelogram solution at t = 0 (all cranks parallel).
 std::string nfourbar_natural(const GenerateOptions& o) {
   const double c = std::cos(o.from), sn = std::sin(o.from);
   std::string s;
-  s.reserve(static_cast<std::size_t>(o.n) * 160 + 1024);
   header(s, o, "IFToMM N four-bar, natural coordinates (crank tips P_i = (x_i, y_i)), 1 dof");
+  s += "parameters:\n";
+  s += "  N: " + std::to_string(o.n) + "\n";
+  s += "  c: " + num(c) + "    # cos(from): crank tip i starts at (i + c, s)\n";
+  s += "  s: " + num(sn) + "    # sin(from)\n";
   s += "coordinates:\n";
-  for (std::int64_t i = 0; i <= o.n; ++i) {
-    s += "  x" + std::to_string(i) + ": " + num(static_cast<double>(i) + c) + "\n";
-    s += "  y" + std::to_string(i) + ": " + num(sn) + "\n";
-  }
+  s += "  for i in 0..N:\n    x{i}: i + c\n    y{i}: s\n";
   s += "  theta: " + num(o.from) + "\n";
   s += "points:\n  O: [0, 0]\n";
-  for (std::int64_t i = 0; i <= o.n; ++i) {
-    const std::string k = std::to_string(i);
-    s += "  P" + k + ": [x" + k + ", y" + k + "]\n";
-  }
+  s += "  for i in 0..N:\n    P{i}: [\"x{i}\", \"y{i}\"]\n";
   s += "constraints:\n";
-  for (std::int64_t i = 0; i <= o.n; ++i) {
-    const std::string k = std::to_string(i);
-    s += "  - {name: crank" + k + ", type: distance, points: [[" + k + ", 0], P" + k + "], length: 1}\n";
-  }
-  for (std::int64_t i = 0; i < o.n; ++i) {
-    const std::string k = std::to_string(i), k1 = std::to_string(i + 1);
-    s += "  - {name: coupler" + k + ", type: distance, points: [P" + k + ", P" + k1 + "], length: 1}\n";
-  }
+  s += "  - for i in 0..N:\n";
+  s += "      - {name: \"crank{i}\", type: distance, points: [[i, 0], \"P{i}\"], length: 1}\n";
+  s += "  - for i in 0..N-1:\n";
+  s += "      - {name: \"coupler{i}\", type: distance, points: [\"P{i}\", \"P{i+1}\"], length: 1}\n";
   s += "  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}\n";
   footer(s, o, "theta");
   return s;
@@ -68,41 +67,29 @@ std::string nfourbar_natural(const GenerateOptions& o) {
 std::string nfourbar_reference_point(const GenerateOptions& o) {
   const double c = std::cos(o.from), sn = std::sin(o.from);
   std::string s;
-  s.reserve(static_cast<std::size_t>(o.n) * 400 + 1024);
   header(s, o, "IFToMM N four-bar, reference-point coordinates, 1 dof");
+  s += "parameters:\n";
+  s += "  N: " + std::to_string(o.n) + "\n";
+  s += "  c: " + num(c) + "    # cos(from): coupler i starts at (i + 0.5 + c, s)\n";
+  s += "  s: " + num(sn) + "    # sin(from)\n";
+  s += "  hc: " + num(0.5 * c) + "    # crank i starts at (i + hc, hs), angle from\n";
+  s += "  hs: " + num(0.5 * sn) + "\n";
+  s += "  from: " + num(o.from) + "\n";
   s += "coordinates:\n";
-  for (std::int64_t i = 0; i <= o.n; ++i) {
-    const std::string k = std::to_string(i);
-    s += "  xc" + k + ": " + num(static_cast<double>(i) + 0.5 * c) + "\n  yc" + k + ": " + num(0.5 * sn) +
-         "\n  psi" + k + ": " + num(o.from) + "\n";
-  }
-  for (std::int64_t i = 0; i < o.n; ++i) {
-    const std::string k = std::to_string(i);
-    s += "  xk" + k + ": " + num(static_cast<double>(i) + 0.5 + c) + "\n  yk" + k + ": " + num(sn) + "\n  phi" + k +
-         ": 0\n";
-  }
+  s += "  for i in 0..N:\n    xc{i}: i + hc\n    yc{i}: hs\n    psi{i}: from\n";
+  s += "  for i in 0..N-1:\n    xk{i}: i + 0.5 + c\n    yk{i}: s\n    phi{i}: 0\n";
   s += "bodies:\n";
-  for (std::int64_t i = 0; i <= o.n; ++i) {
-    const std::string k = std::to_string(i);
-    s += "  crank" + k + ": [xc" + k + ", yc" + k + ", psi" + k + "]\n";
-  }
-  for (std::int64_t i = 0; i < o.n; ++i) {
-    const std::string k = std::to_string(i);
-    s += "  coupler" + k + ": [xk" + k + ", yk" + k + ", phi" + k + "]\n";
-  }
+  s += "  for i in 0..N:\n    crank{i}: [\"xc{i}\", \"yc{i}\", \"psi{i}\"]\n";
+  s += "  for i in 0..N-1:\n    coupler{i}: [\"xk{i}\", \"yk{i}\", \"phi{i}\"]\n";
   s += "constraints:\n";
-  for (std::int64_t i = 0; i <= o.n; ++i) {
-    const std::string k = std::to_string(i);
-    s += "  - {name: pivot" + k + ", type: revolute, between: [{body: crank" + k + ", at: [-0.5, 0]}, {body: ground, at: [" +
-         k + ", 0]}]}\n";
-  }
-  for (std::int64_t i = 0; i < o.n; ++i) {
-    const std::string k = std::to_string(i), k1 = std::to_string(i + 1);
-    s += "  - {name: left" + k + ", type: revolute, between: [{body: crank" + k + ", at: [0.5, 0]}, {body: coupler" + k +
-         ", at: [-0.5, 0]}]}\n";
-    s += "  - {name: right" + k + ", type: revolute, between: [{body: crank" + k1 + ", at: [0.5, 0]}, {body: coupler" +
-         k + ", at: [0.5, 0]}]}\n";
-  }
+  s += "  - for i in 0..N:\n";
+  s += "      - {name: \"pivot{i}\", type: revolute, between: [{body: \"crank{i}\", at: [-0.5, 0]}, {body: ground, "
+       "at: [i, 0]}]}\n";
+  s += "  - for i in 0..N-1:\n";
+  s += "      - {name: \"left{i}\", type: revolute, between: [{body: \"crank{i}\", at: [0.5, 0]}, {body: "
+       "\"coupler{i}\", at: [-0.5, 0]}]}\n";
+  s += "      - {name: \"right{i}\", type: revolute, between: [{body: \"crank{i+1}\", at: [0.5, 0]}, {body: "
+       "\"coupler{i}\", at: [0.5, 0]}]}\n";
   footer(s, o, "psi0");
   return s;
 }

@@ -492,6 +492,54 @@ double CompiledExpression::gamma(const double* q, const double* qd, double t) co
   return -2.0 * w[2];
 }
 
+std::shared_ptr<const CompiledExpression> CompiledExpression::rebind(const std::vector<Index>& target,
+                                                                     const std::vector<double>& value,
+                                                                     std::string text) const {
+  if (value.size() < target.size()) throw Error("rebind: fewer values than targets");
+  auto out = std::make_shared<CompiledExpression>();
+  out->text_ = std::move(text);
+  out->depends_on_time_ = depends_on_time_;
+  auto patch = [&](const Tape& in) {
+    Tape tape = in;
+    for (Tape::Instr& ins : tape.code_) {
+      if (ins.op != Tape::Op::kLoadQ) continue;
+      if (ins.a >= target.size()) throw Error("rebind: compiled coordinate index out of range");
+      const Index j = target[ins.a];
+      if (j >= 0) {
+        ins.a = static_cast<std::uint32_t>(j);
+      } else {
+        ins.op = Tape::Op::kConst;
+        ins.imm = value[ins.a];
+        ins.a = 0;
+      }
+    }
+    return tape;
+  };
+  out->value_ = patch(value_);
+  out->partial_t_ = patch(partial_t_);
+  Tape grad = patch(gradient_);
+  // one gradient output per distinct target coordinate, ascending; constants drop out
+  std::vector<std::pair<Index, std::uint32_t>> cols;
+  for (std::size_t k = 0; k < coords_.size(); ++k) {
+    const auto c = static_cast<std::size_t>(coords_[k]);
+    if (c >= target.size()) throw Error("rebind: compiled coordinate index out of range");
+    if (target[c] >= 0) cols.emplace_back(target[c], grad.outputs_[k]);
+  }
+  std::stable_sort(cols.begin(), cols.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  grad.outputs_.clear();
+  for (std::size_t k = 0; k < cols.size(); ++k) {
+    if (!out->coords_.empty() && out->coords_.back() == cols[k].first) {
+      grad.code_.push_back(Tape::Instr{Tape::Op::kAdd, grad.outputs_.back(), cols[k].second, 0.0});
+      grad.outputs_.back() = static_cast<std::uint32_t>(grad.code_.size() - 1);
+    } else {
+      out->coords_.push_back(cols[k].first);
+      grad.outputs_.push_back(cols[k].second);
+    }
+  }
+  out->gradient_ = std::move(grad);
+  return out;
+}
+
 double evaluate_constant_expression(const std::string& text,
                                     const std::function<std::optional<double>(const std::string&)>& constant) {
   auto expr = CompiledExpression::compile(

@@ -111,9 +111,33 @@ Index ModelBuilder::add_coordinate(const std::string& name, double initial) {
   if (!inserted) throw Error("duplicate coordinate name '" + name + "'");
   model_.names_.push_back(name);
   const Index n = num_coordinates();
-  model_.initial_.conservativeResize(n);
+  // room grows geometrically (a resize per coordinate would copy the vector each time); build() trims it
+  if (model_.initial_.size() < n) model_.initial_.conservativeResize(std::max<Index>(n, 2 * model_.initial_.size()));
   model_.initial_(n - 1) = initial;
   return n - 1;
+}
+
+void ModelBuilder::reserve(Index more_coordinates, Index more_constraints) {
+  // grow only: reserving less than a hash table holds would shrink its buckets, and a vector's reserve of a little
+  // more each time would copy it each time
+  auto grow_table = [](auto& table, std::size_t n) {
+    if (static_cast<double>(n) > static_cast<double>(table.bucket_count()) * table.max_load_factor()) table.reserve(n);
+  };
+  auto grow_vector = [](auto& v, std::size_t n) {
+    if (n > v.capacity()) v.reserve(std::max(n, 2 * v.capacity()));
+  };
+  if (more_coordinates > 0) {
+    const auto n = static_cast<std::size_t>(num_coordinates() + more_coordinates);
+    grow_table(model_.index_of_, n);
+    grow_vector(model_.names_, n);
+    if (model_.initial_.size() < static_cast<Index>(n)) model_.initial_.conservativeResize(static_cast<Index>(n));
+  }
+  if (more_constraints > 0) {
+    const auto n = model_.constraints_.size() + static_cast<std::size_t>(more_constraints);
+    grow_table(constraint_names_, n);
+    grow_vector(model_.constraints_, n);
+    grow_vector(model_.row_constraint_, std::max(n, model_.row_constraint_.size()));
+  }
 }
 
 Index ModelBuilder::find_coordinate(const std::string& name) const {
@@ -146,9 +170,9 @@ void ModelBuilder::check_slot(const Slot& s, const std::string& name) const {
 
 Index ModelBuilder::add_info(const std::string& name, const char* kind, int rows, bool depends_on_time) {
   if (!constraint_names_.insert(name).second) throw Error("duplicate constraint name '" + name + "'");
-  ConstraintInfo info{name, kind, static_cast<Index>(model_.row_constraint_.size()), rows, depends_on_time};
   const Index id = static_cast<Index>(model_.constraints_.size());
-  model_.constraints_.push_back(info);
+  model_.constraints_.push_back(
+      ConstraintInfo{name, kind, static_cast<Index>(model_.row_constraint_.size()), rows, depends_on_time});
   for (int r = 0; r < rows; ++r) model_.row_constraint_.push_back(id);
   return id;
 }
@@ -201,6 +225,8 @@ void ModelBuilder::prepare(EquationSpec& s) const { require(s.g != nullptr, "equ
 Model ModelBuilder::build() && {
   Model& m = model_;
   const Index n = m.num_coordinates(), rows = m.num_equations();
+  m.initial_.conservativeResize(n);  // add_coordinate() and reserve() leave room beyond n
+  std::unordered_set<std::string>().swap(constraint_names_);  // only needed while adding: free it now
 
   // Sparsity pattern, fixed for the life of the model.
   std::vector<Index> trip_rows, trip_cols;

@@ -6,11 +6,15 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <type_traits>
 #include <unordered_map>
 
 namespace phiq {
@@ -18,6 +22,35 @@ namespace phiq {
 namespace {
 
 const char* const kGround = "ground";
+
+// In a field path, this character stands for the member of the enclosing family: messages render it "[i=17]".
+constexpr char kMemberMark = '\x01';
+
+[[noreturn]] void fail_at(const std::string& file, YAML::Mark m, const std::string& path, const std::string& what) {
+  std::ostringstream s;
+  s << file;
+  if (m.line >= 0) s << ":" << m.line + 1 << ":" << m.column + 1;
+  s << ": " << (path.empty() ? "(top level)" : path) << ": " << what;
+  throw SceneError(s.str());
+}
+
+bool valid_name(const std::string& s) {
+  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  for (char c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+  return true;
+}
+
+std::string allowed_list(std::initializer_list<const char*> allowed) {
+  std::string list;
+  for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+  return list;
+}
+
+// A key that opens an indexed family: "for NAME in A..B".
+bool is_family_key(const std::string& k) {
+  return k.size() > 3 && k.compare(0, 3, "for") == 0 && std::isspace(static_cast<unsigned char>(k[3]));
+}
 
 // A YAML node with the dotted path that led to it, for messages.
 class Cursor {
@@ -31,16 +64,14 @@ class Cursor {
   bool is_map() const { return node_.IsMap(); }
   bool is_sequence() const { return node_.IsSequence(); }
   bool is_scalar() const { return node_.IsScalar(); }
-
-  [[noreturn]] void fail(const std::string& what) const {
+  // Where a message about this node points: the node, else (missing or unmarked) the map or key above it.
+  YAML::Mark mark() const {
     YAML::Mark m = node_.IsDefined() ? node_.Mark() : parent_mark_;
     if (m.line < 0) m = parent_mark_;
-    std::ostringstream s;
-    s << *file_;
-    if (m.line >= 0) s << ":" << m.line + 1 << ":" << m.column + 1;
-    s << ": " << (path_.empty() ? "(top level)" : path_) << ": " << what;
-    throw SceneError(s.str());
+    return m;
   }
+
+  [[noreturn]] void fail(const std::string& what) const { fail_at(*file_, mark(), path_, what); }
 
   // Map access: only the listed keys are allowed; duplicates are rejected.
   void expect_map(std::initializer_list<const char*> allowed) const {
@@ -53,11 +84,9 @@ class Cursor {
       if (!seen.insert(k).second) Cursor(it->first, join(k), file_, node_.Mark()).fail("duplicate field '" + k + "'");
       bool ok = false;
       for (const char* a : allowed) ok = ok || k == a;
-      if (!ok) {
-        std::string list;
-        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        Cursor(it->first, join(k), file_, node_.Mark()).fail("unknown field '" + k + "' (allowed: " + list + ")");
-      }
+      if (!ok)
+        Cursor(it->first, join(k), file_, node_.Mark())
+            .fail("unknown field '" + k + "' (allowed: " + allowed_list(allowed) + ")");
     }
   }
   Cursor field(const char* key) const {
@@ -81,20 +110,10 @@ class Cursor {
     for (std::size_t i = 0; i < node_.size(); ++i) v.push_back(at(i));
     return v;
   }
+  // One (key, value) pair of a map whose keys are user names.
+  struct Entry;
   // Ordered (key, value) pairs of a map whose keys are user names.
-  std::vector<std::pair<std::string, Cursor>> entries() const {
-    if (!node_.IsMap()) fail("expected a mapping (name: value)");
-    std::vector<std::pair<std::string, Cursor>> v;
-    std::set<std::string> seen;
-    for (auto it = node_.begin(); it != node_.end(); ++it) {
-      if (!it->first.IsScalar()) Cursor(it->first, path_, file_, node_.Mark()).fail("names must be plain scalars");
-      const std::string k = it->first.Scalar();
-      Cursor value(it->second, join(k), file_, it->first.Mark());
-      if (!seen.insert(k).second) Cursor(it->first, join(k), file_, node_.Mark()).fail("duplicate name '" + k + "'");
-      v.emplace_back(k, value);
-    }
-    return v;
-  }
+  std::vector<Entry> entries() const;
   std::string text() const {
     if (!node_.IsScalar()) fail("expected a single value");
     return node_.Scalar();
@@ -120,22 +139,37 @@ class Cursor {
     return v;
   }
 
-  static bool valid_name(const std::string& s) {
-    if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
-    for (char c : s)
-      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
-    return true;
-  }
+  static bool valid_name(const std::string& s) { return phiq::valid_name(s); }
 
   const std::string* file() const { return file_; }
+  std::string join(const std::string& k) const { return path_.empty() ? k : path_ + "." + k; }
 
  private:
-  std::string join(const std::string& k) const { return path_.empty() ? k : path_ + "." + k; }
   YAML::Node node_;
   std::string path_;
   const std::string* file_;
   YAML::Mark parent_mark_;
 };
+
+struct Cursor::Entry {
+  std::string name;
+  YAML::Mark key_mark;
+  Cursor value;
+};
+
+std::vector<Cursor::Entry> Cursor::entries() const {
+  if (!node_.IsMap()) fail("expected a mapping (name: value)");
+  std::vector<Entry> v;
+  std::set<std::string> seen;
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    if (!it->first.IsScalar()) Cursor(it->first, path_, file_, node_.Mark()).fail("names must be plain scalars");
+    const std::string k = it->first.Scalar();
+    Cursor value(it->second, join(k), file_, it->first.Mark());
+    if (!seen.insert(k).second) Cursor(it->first, join(k), file_, node_.Mark()).fail("duplicate name '" + k + "'");
+    v.push_back(Entry{k, it->first.Mark(), value});
+  }
+  return v;
+}
 
 // A YAML number as a double; nullopt when `s` is not a plain number (then it may be a constant expression).
 // Throws SceneError-free Error for a number out of the range of a double: never hand those to the symbolic engine,
@@ -160,9 +194,683 @@ std::optional<double> plain_number(const std::string& s) {
   return std::nullopt;
 }
 
+// ==============================================================================================================
+// Indexed families (`for i in A..B`, models/README.md). A family's body is copied once out of the YAML tree into
+// compact nodes (TNode) that know their field path; the texts in it — names with {templates}, numbers that use
+// the indices, equations — are compiled on first use and afterwards only evaluated, once per member: no YAML walk,
+// no parsing and no symbolic work per member. Numbers that use an index are evaluated in double precision in the
+// order written (so that a generator that writes `i + c` gets exactly the double it would have computed).
+
+bool is_ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+bool is_digit(char c) { return std::isdigit(static_cast<unsigned char>(c)); }
+
+std::string clip(const std::string& text, std::size_t n = 60) {
+  return text.size() > n ? text.substr(0, n) + "..." : text;
+}
+// Labels of family texts in messages, worded as the symbolic front end words its own ("expression "...": ...").
+std::string expression_label(const std::string& text) {
+  std::string s = "expression \"";
+  s += clip(text);
+  s += "\"";
+  return s;
+}
+std::string template_label(const std::string& text) {
+  std::string s = "template '";
+  s += clip(text);
+  s += "'";
+  return s;
+}
+Error labelled(const std::string& label, const std::string& what) {
+  std::string s = label;
+  s += ": ";
+  s += what;
+  return Error(s);
+}
+
+// Shortest decimal that reads back as v.
+std::string shortest(double v) {
+  char buf[32];
+  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, p) : std::string("?");
+}
+
+// End of the name that starts at text[i]: letters, digits, '_' and {template} groups ("node{i}_{j+1}").
+std::size_t name_end(const std::string& text, std::size_t i, const std::string& label) {
+  std::size_t j = i;
+  while (j < text.size()) {
+    if (is_ident_char(text[j])) {
+      ++j;
+    } else if (text[j] == '{') {
+      const std::size_t close = text.find_first_of("{}", j + 1);
+      if (close == std::string::npos || text[close] == '{') throw labelled(label, "unbalanced '{'");
+      j = close + 1;
+    } else {
+      break;
+    }
+  }
+  return j;
+}
+
+// End of the number that starts at text[i] (digits, '.', an exponent), as the expression parser reads numbers.
+std::size_t number_end(const std::string& text, std::size_t i) {
+  while (i < text.size() && (is_digit(text[i]) || text[i] == '.')) ++i;
+  if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
+    std::size_t j = i + 1;
+    if (j < text.size() && (text[j] == '+' || text[j] == '-')) ++j;
+    if (j < text.size() && is_digit(text[j])) {
+      i = j;
+      while (i < text.size() && is_digit(text[i])) ++i;
+    }
+  }
+  return i;
+}
+
+// The names used in a text, as [begin, end) ranges (numbers skipped whole); `call` when followed by '('.
+struct NameToken {
+  std::size_t begin, end;
+  bool call;
+  bool templated;
+};
+std::vector<NameToken> name_tokens(const std::string& text, const std::string& label) {
+  std::vector<NameToken> v;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    const char c = text[i];
+    if (is_digit(c) || (c == '.' && i + 1 < text.size() && is_digit(text[i + 1]))) {
+      i = number_end(text, i);
+    } else if (is_ident_start(c)) {
+      const std::size_t j = name_end(text, i, label);
+      std::size_t k = j;
+      while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
+      const bool templated = text.find('{', i) < j;
+      v.push_back({i, j, k < text.size() && text[k] == '(', templated});
+      i = j;
+    } else {
+      ++i;
+    }
+  }
+  return v;
+}
+
+// What a name means in a family text.
+struct Meaning {
+  enum class Kind { kIndex, kConstant, kUnknown };
+  Kind kind = Kind::kUnknown;
+  int depth = 0;        // kIndex: the family level of the index (0 = outermost)
+  double value = 0.0;   // kConstant: parameters and pi
+  std::string message;  // kUnknown: what to say
+};
+using Meanings = std::function<Meaning(const std::string&)>;
+
+// The values a family text is evaluated with: the current index of each family level, and the parameters
+// (templated names such as L{i} are looked up among them per member).
+struct Env {
+  const double* index;
+  const std::unordered_map<std::string, double>* parameters;
+};
+
+class NameTemplate;
+
+// A number in a family: a small stack program over doubles, compiled once from the text and evaluated per member.
+// The language is that of constant expressions (numbers, + - * / ^, parentheses, pi, parameters, the functions of
+// equation expressions) plus the indices in scope and templated parameter names (L{i}).
+class IndexExpr {
+ public:
+  IndexExpr(const std::string& text, const std::string& label, const Meanings& meaning, bool allow_templates);
+  double eval(const Env& env) const;
+  bool uses_index() const { return uses_index_; }
+
+ private:
+  friend class IndexParser;
+  enum class Op : std::uint8_t { kConst, kIndex, kName, kAdd, kSub, kMul, kDiv, kPow, kNeg, kFn, kAtan2 };
+  enum class Fn : std::uint8_t { kSin, kCos, kTan, kAsin, kAcos, kAtan, kExp, kLog, kSqrt, kSinh, kCosh, kTanh, kAbs };
+  struct Instr {
+    Op op;
+    Fn fn = Fn::kSin;
+    std::uint32_t a = 0;  // index level (kIndex), template (kName)
+    double imm = 0.0;     // kConst
+  };
+  std::string label_;
+  std::vector<Instr> code_;
+  std::vector<std::shared_ptr<const NameTemplate>> templates_;
+  std::size_t max_stack_ = 0;
+  bool uses_index_ = false;
+};
+
+// A name with {templates} ("x{i}", "P{i+1}", "node{i}_{j}"): literal text and integer expressions, rendered per
+// member. A template must give a whole number.
+class NameTemplate {
+ public:
+  NameTemplate(const std::string& text, const Meanings& meaning) : text_(text) {
+    const std::string label = template_label(text);
+    std::string literal;
+    std::size_t i = 0;
+    while (i < text.size()) {
+      const char c = text[i];
+      if (c == '}') throw labelled(label, "unbalanced '}'");
+      if (c != '{') {
+        literal += c;
+        ++i;
+        continue;
+      }
+      const std::size_t close = text.find_first_of("{}", i + 1);
+      if (close == std::string::npos || text[close] == '{') throw labelled(label, "unbalanced '{'");
+      const std::string inner = text.substr(i + 1, close - i - 1);
+      if (inner.find_first_not_of(" \t") == std::string::npos) throw labelled(label, "empty '{}'");
+      if (!literal.empty()) parts_.push_back({std::move(literal), nullptr, {}}), literal.clear();
+      parts_.push_back({{}, std::make_shared<IndexExpr>(inner, label, meaning, false), "{" + inner + "}"});
+      i = close + 1;
+    }
+    if (!literal.empty()) parts_.push_back({std::move(literal), nullptr, {}});
+  }
+  const std::string& text() const { return text_; }
+  void render(const Env& env, std::string& out) const {
+    out.clear();
+    for (const Part& p : parts_) {
+      if (!p.expr) {
+        out += p.literal;
+        continue;
+      }
+      const double v = p.expr->eval(env);
+      if (!(std::floor(v) == v && std::fabs(v) <= 9007199254740992.0))
+        throw labelled(template_label(text_), p.expr_text + " is " + shortest(v) + ", not a whole number");
+      char buf[24];
+      auto [end, ec] = std::to_chars(buf, buf + sizeof buf, static_cast<std::int64_t>(v));
+      out.append(buf, end);
+    }
+  }
+
+ private:
+  struct Part {
+    std::string literal;
+    std::shared_ptr<const IndexExpr> expr;  // null for a literal
+    std::string expr_text;                  // "{i+1}", for messages
+  };
+  std::string text_;
+  std::vector<Part> parts_;
+};
+
+// Recursive descent over one text, emitting IndexExpr's stack program.
+class IndexParser {
+ public:
+  IndexParser(IndexExpr& out, const std::string& text, const Meanings& meaning, bool allow_templates)
+      : out_(out), text_(text), meaning_(meaning), allow_templates_(allow_templates) {}
+
+  void parse() {
+    if (text_.find_first_not_of(" \t\r\n") == std::string::npos) fail("expression is empty");
+    if (text_.size() > CompiledExpression::kMaxTextLength)
+      fail("of " + std::to_string(text_.size()) + " characters; the limit is " +
+           std::to_string(CompiledExpression::kMaxTextLength));
+    sum();
+    skip();
+    if (pos_ < text_.size()) fail("unexpected '" + std::string(1, text_[pos_]) + "'");
+  }
+
+ private:
+  using Op = IndexExpr::Op;
+  using Fn = IndexExpr::Fn;
+
+  [[noreturn]] void fail(const std::string& what) const { throw labelled(out_.label_, what); }
+  void skip() {
+    while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+  }
+  bool take(char c) {
+    skip();
+    if (pos_ < text_.size() && text_[pos_] == c) return ++pos_, true;
+    return false;
+  }
+  void emit(IndexExpr::Instr in, int stack_change) {
+    out_.code_.push_back(in);
+    depth_ += stack_change;
+    out_.max_stack_ = std::max(out_.max_stack_, static_cast<std::size_t>(depth_));
+  }
+
+  void sum() {
+    product();
+    for (;;) {
+      if (take('+')) product(), emit({Op::kAdd}, -1);
+      else if (take('-')) product(), emit({Op::kSub}, -1);
+      else return;
+    }
+  }
+  void product() {
+    unary();
+    for (;;) {
+      if (take('*')) unary(), emit({Op::kMul}, -1);
+      else if (take('/')) unary(), emit({Op::kDiv}, -1);
+      else return;
+    }
+  }
+  // Signs, then a power: -x^2 is -(x^2), 2^-1 is 2^(-1), a^b^c is a^(b^c).
+  void unary() {
+    if (++nesting_ > kMaxNesting) fail("nested more than " + std::to_string(kMaxNesting) + " levels deep");
+    bool negative = false;
+    for (;;) {
+      if (take('-')) negative = !negative;
+      else if (!take('+')) break;
+    }
+    primary();
+    if (take('^')) unary(), emit({Op::kPow}, -1);
+    if (negative) emit({Op::kNeg}, 0);
+    --nesting_;
+  }
+  void primary() {
+    skip();
+    if (pos_ >= text_.size()) fail("unexpected end");
+    const char c = text_[pos_];
+    if (c == '(') {
+      ++pos_;
+      sum();
+      if (!take(')')) fail("missing ')'");
+      return;
+    }
+    if (is_digit(c) || c == '.') {
+      const std::size_t end = number_end(text_, pos_);
+      const std::string s = text_.substr(pos_, end - pos_);
+      pos_ = end;
+      double v = 0.0;
+      auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+      if (ec == std::errc::result_out_of_range && p == s.data() + s.size()) {
+        const auto e = s.find_first_of("eE");
+        if (!(e != std::string::npos && e + 1 < s.size() && s[e + 1] == '-'))
+          fail("number '" + clip(s, 40) + "' is out of the range of a double");
+        v = 0.0;  // underflow, as a double would have it
+      } else if (ec != std::errc() || p != s.data() + s.size()) {
+        fail("malformed number '" + clip(s, 40) + "'");
+      }
+      emit({Op::kConst, Fn::kSin, 0, v}, 1);
+      return;
+    }
+    if (!is_ident_start(c)) fail("unexpected '" + std::string(1, c) + "'");
+    const std::size_t end = name_end(text_, pos_, out_.label_);
+    const std::string name = text_.substr(pos_, end - pos_);
+    pos_ = end;
+    if (take('(')) return call(name);
+    if (name.find('{') != std::string::npos) {
+      if (!allow_templates_) fail("a templated name is not allowed here ('" + name + "')");
+      out_.templates_.push_back(std::make_shared<NameTemplate>(name, meaning_));
+      emit({Op::kName, Fn::kSin, static_cast<std::uint32_t>(out_.templates_.size() - 1)}, 1);
+      out_.uses_index_ = true;  // depends on the member
+      return;
+    }
+    if (name == "pi") return emit({Op::kConst, Fn::kSin, 0, M_PI}, 1);
+    const Meaning m = meaning_(name);
+    if (m.kind == Meaning::Kind::kIndex) {
+      out_.uses_index_ = true;
+      return emit({Op::kIndex, Fn::kSin, static_cast<std::uint32_t>(m.depth)}, 1);
+    }
+    if (m.kind == Meaning::Kind::kConstant) return emit({Op::kConst, Fn::kSin, 0, m.value}, 1);
+    fail(m.message);
+  }
+  void call(const std::string& name) {
+    static const std::map<std::string, Fn> functions = {
+        {"sin", Fn::kSin},   {"cos", Fn::kCos},   {"tan", Fn::kTan},   {"asin", Fn::kAsin}, {"acos", Fn::kAcos},
+        {"atan", Fn::kAtan}, {"exp", Fn::kExp},   {"log", Fn::kLog},   {"sqrt", Fn::kSqrt}, {"sinh", Fn::kSinh},
+        {"cosh", Fn::kCosh}, {"tanh", Fn::kTanh}, {"abs", Fn::kAbs}};
+    if (name == "atan2") {
+      sum();
+      if (!take(',')) fail("atan2 takes two arguments");
+      sum();
+      if (!take(')')) fail("missing ')'");
+      return emit({Op::kAtan2}, -1);
+    }
+    auto it = functions.find(name);
+    if (it == functions.end())
+      fail("function '" + name + "' is not supported (supported: sin cos tan asin acos atan atan2 exp log sqrt "
+           "sinh cosh tanh abs)");
+    sum();
+    if (!take(')')) fail("missing ')' (" + name + " takes one argument)");
+    emit({Op::kFn, it->second}, 0);
+  }
+
+  static constexpr int kMaxNesting = 3 * CompiledExpression::kMaxNesting;
+  IndexExpr& out_;
+  const std::string& text_;
+  const Meanings& meaning_;
+  bool allow_templates_;
+  std::size_t pos_ = 0;
+  int depth_ = 0, nesting_ = 0;
+};
+
+IndexExpr::IndexExpr(const std::string& text, const std::string& label, const Meanings& meaning,
+                     bool allow_templates)
+    : label_(label) {
+  IndexParser(*this, text, meaning, allow_templates).parse();
+}
+
+double IndexExpr::eval(const Env& env) const {
+  if (code_.size() == 1 && code_[0].op == Op::kIndex) return env.index[code_[0].a];  // the common "i"
+  // Reentrant (a templated name evaluates its own templates): the stack is local.
+  double small[32];
+  std::vector<double> large;
+  double* s = small;
+  if (max_stack_ > 32) large.resize(max_stack_), s = large.data();
+  std::size_t n = 0;
+  std::string name;
+  for (const Instr& in : code_) {
+    switch (in.op) {
+      case Op::kConst: s[n++] = in.imm; break;
+      case Op::kIndex: s[n++] = env.index[in.a]; break;
+      case Op::kName: {
+        const NameTemplate& t = *templates_[in.a];
+        t.render(env, name);
+        auto it = env.parameters->find(name);
+        if (it == env.parameters->end()) throw labelled(label_, "unknown name '" + name + "'");
+        s[n++] = it->second;
+        break;
+      }
+      case Op::kAdd: --n, s[n - 1] = s[n - 1] + s[n]; break;
+      case Op::kSub: --n, s[n - 1] = s[n - 1] - s[n]; break;
+      case Op::kMul: --n, s[n - 1] = s[n - 1] * s[n]; break;
+      case Op::kDiv: --n, s[n - 1] = s[n - 1] / s[n]; break;
+      case Op::kPow: --n, s[n - 1] = std::pow(s[n - 1], s[n]); break;
+      case Op::kAtan2: --n, s[n - 1] = std::atan2(s[n - 1], s[n]); break;
+      case Op::kNeg: s[n - 1] = -s[n - 1]; break;
+      case Op::kFn: {
+        double& x = s[n - 1];
+        switch (in.fn) {
+          case Fn::kSin: x = std::sin(x); break;
+          case Fn::kCos: x = std::cos(x); break;
+          case Fn::kTan: x = std::tan(x); break;
+          case Fn::kAsin: x = std::asin(x); break;
+          case Fn::kAcos: x = std::acos(x); break;
+          case Fn::kAtan: x = std::atan(x); break;
+          case Fn::kExp: x = std::exp(x); break;
+          case Fn::kLog: x = std::log(x); break;
+          case Fn::kSqrt: x = std::sqrt(x); break;
+          case Fn::kSinh: x = std::sinh(x); break;
+          case Fn::kCosh: x = std::cosh(x); break;
+          case Fn::kTanh: x = std::tanh(x); break;
+          case Fn::kAbs: x = std::fabs(x); break;
+        }
+        break;
+      }
+    }
+  }
+  return s[0];
+}
+
+struct Family;
+
+// The compiled forms of one scalar of a family body, made on first use (a node is used in one role only).
+struct ScalarPlan {
+  std::shared_ptr<const NameTemplate> name;  // text(): the scalar as a name with templates
+  bool number_ready = false;                 // number():
+  bool number_constant = false;              //   the same for every member: number_value
+  double number_value = 0.0;
+  std::shared_ptr<const IndexExpr> number;   //   else evaluated per member
+  static constexpr Index kNotLooked = -2;
+  Index entity = kNotLooked;                 // a coordinate, point or body named without template: its index
+  Index last = -1, stride = 1;               // a templated reference: the last index found, the step before it
+  struct Equation;
+  std::shared_ptr<Equation> equation;        // equation and law expressions
+};
+
+// An equation or law expression in a family. Either the same for every member (`shared`), or compiled once with
+// placeholder coordinate indices — one per templated name, per coordinate and per index it uses — and rebound per
+// member (CompiledExpression::rebind) to the member's coordinates and index values.
+struct ScalarPlan::Equation {
+  std::shared_ptr<const CompiledExpression> shared;
+  std::shared_ptr<const CompiledExpression> compiled;
+  struct Placeholder {
+    enum class Kind { kCoordinate, kIndex, kTemplate } kind;
+    Index coordinate = -1;  // kCoordinate
+    int depth = 0;          // kIndex
+    std::size_t name = 0;   // kTemplate: index into names
+  };
+  std::vector<Placeholder> placeholders;
+  std::vector<std::shared_ptr<const NameTemplate>> names;
+  bool allow_coordinates = true;
+};
+
+// A family body, copied out of the YAML tree.
+struct TNode {
+  enum class Kind : std::uint8_t { kNull, kScalar, kMap, kSeq };
+  struct Entry {
+    std::string key;
+    YAML::Mark key_mark;
+    bool key_scalar = true;
+    std::shared_ptr<TNode> value;
+    std::shared_ptr<Family> family;                        // a nested `for` entry (map sections)
+    mutable std::shared_ptr<const NameTemplate> name;      // the key as a name, compiled on first use
+  };
+  Kind kind = Kind::kNull;
+  bool templated = false;  // a scalar with braces
+  YAML::Mark mark;         // where messages about it point
+  std::string path;        // field path as written, with kMemberMark after each enclosing family's key
+  std::string text;        // scalar
+  std::vector<Entry> map;
+  std::vector<TNode> seq;
+  std::shared_ptr<Family> family;  // a list item that is a nested family {for ...: [...]}
+  mutable std::uintptr_t checked_fields = 0;  // expect_map() passed for this list of fields
+  mutable std::shared_ptr<ScalarPlan> plan;
+};
+
+// One `for NAME in A..B` with its body (a map in map sections, a list in list sections).
+struct Family {
+  std::string key;    // as written
+  std::string index;  // NAME
+  std::string lo_text, hi_text;
+  std::shared_ptr<const IndexExpr> lo, hi;
+  std::string path;   // of the key, with the marks of the enclosing families
+  YAML::Mark mark;    // of the key
+  int depth = 0;      // 0 for a family in a section, 1 inside it, ...
+  TNode body;
+};
+
+// The state of the expansion: the member of each family level being read, and what family texts see.
+struct Families {
+  const std::string* file = nullptr;
+  const std::unordered_map<std::string, double>* parameters = nullptr;
+  struct Frame {
+    const Family* family;
+    std::int64_t value;
+  };
+  std::vector<Frame> frames;  // outermost first; frames[k].family->depth == k
+  std::vector<double> index;  // frames[k].value as a double, for evaluation
+  std::size_t budget = 0;     // entries families may still make (SceneLimits::max_family_instances)
+
+  Env env() const { return Env{index.data(), parameters}; }
+  // The path with each member mark replaced by "[i=17]" for the member being read.
+  std::string render(const std::string& path) const {
+    std::string out;
+    std::size_t level = 0;
+    for (char c : path) {
+      if (c != kMemberMark) {
+        out += c;
+        continue;
+      }
+      if (level < frames.size())
+        out += "[" + frames[level].family->index + "=" + std::to_string(frames[level].value) + "]";
+      ++level;
+    }
+    return out;
+  }
+};
+
+// A Cursor over a family body, for the member being read: the same interface, so that the scene reader reads a
+// member exactly as it reads a plain entry; text() renders templates; paths name the member.
+class TCursor {
+ public:
+  TCursor(const TNode* node, Families* fx, const TNode* parent = nullptr, const char* key = nullptr)
+      : node_(node), parent_(parent), key_(key), fx_(fx) {}
+
+  const TNode* node() const { return node_; }
+  Families& families() const { return *fx_; }
+  bool present() const { return node_ && node_->kind != TNode::Kind::kNull; }
+  bool is_map() const { return node_ && node_->kind == TNode::Kind::kMap; }
+  bool is_sequence() const { return node_ && node_->kind == TNode::Kind::kSeq; }
+  bool is_scalar() const { return node_ && node_->kind == TNode::Kind::kScalar; }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    if (node_) fail_at(*fx_->file, node_->mark, fx_->render(node_->path), what);
+    fail_at(*fx_->file, parent_->mark, fx_->render(parent_->path + "." + key_), what);
+  }
+
+  void expect_map(std::initializer_list<const char*> allowed) const {
+    if (!is_map()) fail("expected a mapping (key: value)");
+    // the fields of a body are the same for every member: checked once per list of allowed fields
+    std::uintptr_t sig = allowed.size();
+    for (const char* a : allowed) sig = sig * 1000003u + reinterpret_cast<std::uintptr_t>(a);
+    if (node_->checked_fields == sig) return;
+    std::set<std::string> seen;
+    for (const TNode::Entry& e : node_->map) {
+      if (!e.key_scalar) fail_at(*fx_->file, e.key_mark, fx_->render(node_->path), "keys must be plain names");
+      const std::string where = fx_->render(node_->path + "." + e.key);
+      if (!seen.insert(e.key).second) fail_at(*fx_->file, e.key_mark, where, "duplicate field '" + e.key + "'");
+      bool ok = false;
+      for (const char* a : allowed) ok = ok || e.key == a;
+      if (!ok)
+        fail_at(*fx_->file, e.key_mark, where,
+                "unknown field '" + e.key + "' (allowed: " + allowed_list(allowed) + ")");
+    }
+    node_->checked_fields = sig;
+  }
+  TCursor field(const char* key) const {
+    if (is_map())
+      for (const TNode::Entry& e : node_->map)
+        if (e.value && e.key == key) return TCursor(e.value.get(), fx_);
+    return TCursor(nullptr, fx_, node_ ? node_ : parent_, key);
+  }
+  TCursor require(const char* key) const {
+    TCursor c = field(key);
+    if (!c.node_) fail(std::string("missing field '") + key + "'");
+    if (c.node_->kind == TNode::Kind::kNull) c.fail("has no value");
+    return c;
+  }
+  std::size_t size() const {
+    if (!node_) return 0;
+    return node_->kind == TNode::Kind::kSeq ? node_->seq.size() : node_->map.size();
+  }
+  TCursor at(std::size_t i) const {
+    if (is_sequence() && i < node_->seq.size()) return TCursor(&node_->seq[i], fx_);
+    return TCursor(nullptr, fx_, node_, "?");
+  }
+  std::vector<TCursor> items() const {
+    if (!is_sequence()) fail("expected a list");
+    std::vector<TCursor> v;
+    v.reserve(node_->seq.size());
+    for (const TNode& n : node_->seq) v.emplace_back(&n, fx_);
+    return v;
+  }
+  // The scalar as written (templates unrendered).
+  const std::string& raw() const {
+    if (!is_scalar()) fail("expected a single value");
+    return node_->text;
+  }
+  // The scalar with its templates rendered for the member.
+  std::string text() const {
+    const std::string& s = raw();
+    if (!node_->templated) return s;
+    ScalarPlan& p = plan();
+    std::string out;
+    try {
+      if (!p.name) p.name = std::make_shared<NameTemplate>(s, meanings());
+      p.name->render(fx_->env(), out);
+    } catch (const Error& e) {
+      fail(e.what());
+    }
+    return out;
+  }
+  std::string name() const {
+    std::string s = text();
+    if (!valid_name(s))
+      fail("'" + s + "' is not a valid name (letters, digits and '_', not starting with a digit)");
+    return s;
+  }
+  bool boolean() const {
+    std::string s = text();
+    if (s == "true" || s == "yes" || s == "on") return true;
+    if (s == "false" || s == "no" || s == "off") return false;
+    fail("expected true or false, got '" + s + "'");
+  }
+  std::int64_t integer(std::int64_t lo, std::int64_t hi) const {
+    std::string s = text();
+    std::int64_t v = 0;
+    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || p != s.data() + s.size()) fail("expected a whole number, got '" + s + "'");
+    if (v < lo || v > hi) fail("must be between " + std::to_string(lo) + " and " + std::to_string(hi));
+    return v;
+  }
+
+  ScalarPlan& plan() const {
+    if (!node_->plan) node_->plan = std::make_shared<ScalarPlan>();
+    return *node_->plan;
+  }
+  // Names in templates and numbers: the indices in scope (innermost first), parameters, else unknown.
+  Meanings meanings() const {
+    const Families* fx = fx_;
+    return [fx](const std::string& n) {
+      Meaning m;
+      for (std::size_t k = fx->frames.size(); k-- > 0;)
+        if (fx->frames[k].family->index == n) {
+          m.kind = Meaning::Kind::kIndex;
+          m.depth = static_cast<int>(k);
+          return m;
+        }
+      if (auto it = fx->parameters->find(n); it != fx->parameters->end()) {
+        m.kind = Meaning::Kind::kConstant;
+        m.value = it->second;
+        return m;
+      }
+      m.message = n == "t" ? "time 't' is not allowed here" : "unknown name '" + n + "'";
+      return m;
+    };
+  }
+
+ private:
+  const TNode* node_;
+  const TNode* parent_;  // for a missing field: the map it is missing from
+  const char* key_;
+  Families* fx_;
+};
+
+template <class C>
+inline constexpr bool kInFamily = std::is_same_v<C, TCursor>;
+
+// Points and bodies by name, in order of definition (families look references up by guessing the next index).
+template <class T>
+class NameTable {
+ public:
+  // Adds a name with a default value; returns its index, or -1 when the name exists.
+  Index add(const std::string& name) {
+    auto [it, fresh] = index_.try_emplace(name, static_cast<Index>(values_.size()));
+    if (!fresh) return -1;
+    values_.emplace_back();
+    names_.push_back(&it->first);
+    return it->second;
+  }
+  bool contains(const std::string& name) const { return index_.count(name) != 0; }
+  Index find(const std::string& name) const {
+    auto it = index_.find(name);
+    return it == index_.end() ? -1 : it->second;
+  }
+  Index size() const { return static_cast<Index>(values_.size()); }
+  // Room for `more` entries (grow only: a smaller reserve would shrink the hash table's buckets).
+  void reserve(std::size_t more) {
+    const std::size_t n = values_.size() + more;
+    if (static_cast<double>(n) > static_cast<double>(index_.bucket_count()) * index_.max_load_factor())
+      index_.reserve(n);
+    if (n > values_.capacity()) values_.reserve(std::max(n, 2 * values_.capacity())), names_.reserve(values_.capacity());
+  }
+  const std::string& name(Index k) const { return *names_[static_cast<std::size_t>(k)]; }
+  T& operator[](Index k) { return values_[static_cast<std::size_t>(k)]; }
+  const T& operator[](Index k) const { return values_[static_cast<std::size_t>(k)]; }
+
+ private:
+  std::unordered_map<std::string, Index> index_;
+  std::vector<T> values_;
+  std::vector<const std::string*> names_;  // keys of index_ (node-based: stable)
+};
+
 class SceneReader {
  public:
-  SceneReader(const std::string& file) : file_(file) {}
+  SceneReader(const std::string& file, const SceneLimits& limits) : file_(file), limits_(limits) {
+    families_.file = &file_;
+    families_.parameters = &parameters_;
+    families_.budget = limits.max_family_instances;
+  }
 
   Scene read(const YAML::Node& root) {
     Cursor top(root, "", &file_, YAML::Mark());
@@ -182,13 +890,14 @@ class SceneReader {
     if (auto b = top.field("bodies"); b.present()) read_bodies(b);
     read_solver(top.field("solver"), scene.sweep);  // before constraints: length scale, linear solver
 
+    reserve_ = [&](std::size_t more) { builder_.reserve(0, static_cast<Index>(more)); };
     if (auto c = top.field("constraints"); c.present())
-      for (const Cursor& item : c.items()) read_constraint(item);
-    if (auto d = top.field("drivers"); d.present())
-      for (const Cursor& item : d.items()) read_driver(item);
+      read_list(c, [&](const auto& item) { read_constraint(item); });
+    if (auto d = top.field("drivers"); d.present()) read_list(d, [&](const auto& item) { read_driver(item); });
 
     read_time(top.require("time"), scene.sweep);
     read_output(top.field("output"), scene);
+    points_ = {}, bodies_ = {};  // not needed any more: their memory is free for the model
 
     try {
       scene.model = std::make_unique<Model>(std::move(builder_).build());
@@ -211,67 +920,423 @@ class SceneReader {
     return it->second;
   }
 
-  // A number: a YAML number, or a constant expression of parameters and pi ("L2/2", "2*pi").
-  double number(const Cursor& c) const {
-    if (!c.present()) c.fail("missing number");
-    const std::string s = c.text();
-    double v;
-    std::optional<double> p;
+  // A constant expression of parameters and pi ("L2/2", "2*pi"), exactly (symbolic engine), with the hint that a
+  // coordinate is not a constant.
+  template <class C>
+  double constant_expression(const C& c, const std::string& s) const {
     try {
-      p = plain_number(s);
+      return evaluate_constant_expression(s, [&](const std::string& n) { return parameter(n); });
+    } catch (const Error& e) {
+      if (builder_.find_coordinate(s) >= 0) c.fail("'" + s + "' is a coordinate; a constant is expected here");
+      c.fail(e.what());
+    }
+  }
+
+  // A number: a YAML number, or a constant expression of parameters and pi ("L2/2", "2*pi"); in a family, also of
+  // the indices ("i + 0.5", "0.1*i") and of templated parameter names ("L{i}").
+  template <class C>
+  double number(const C& c) const {
+    if (!c.present()) c.fail("missing number");
+    if constexpr (kInFamily<C>) {
+      const std::string& s = c.raw();
+      ScalarPlan& p = c.plan();
+      if (!p.number_ready) {
+        std::optional<double> v;
+        try {
+          v = plain_number(s);
+        } catch (const Error& e) {
+          c.fail(e.what());
+        }
+        if (v) {
+          p.number_constant = true, p.number_value = *v;
+        } else if (uses_member(c, s)) {
+          try {
+            p.number = std::make_shared<IndexExpr>(s, expression_label(s), member_meanings(c), true);
+          } catch (const Error& e) {
+            c.fail(e.what());
+          }
+        } else {
+          p.number_constant = true, p.number_value = constant_expression(c, s);  // the same as outside a family
+        }
+        p.number_ready = true;
+      }
+      double v = p.number_value;
+      if (!p.number_constant) {
+        try {
+          v = p.number->eval(c.families().env());
+        } catch (const Error& e) {
+          c.fail(e.what());
+        }
+      }
+      if (!std::isfinite(v)) c.fail("'" + s + "' is not a finite number");
+      return v;
+    } else {
+      const std::string s = c.text();
+      double v;
+      std::optional<double> p;
+      try {
+        p = plain_number(s);
+      } catch (const Error& e) {
+        c.fail(e.what());
+      }
+      v = p ? *p : constant_expression(c, s);
+      if (!std::isfinite(v)) c.fail("'" + s + "' is not a finite number");
+      return v;
+    }
+  }
+  // True when a family text uses an index in scope or a template (then it is evaluated per member).
+  bool uses_member(const TCursor& c, const std::string& s) const {
+    std::vector<NameToken> tokens;
+    try {
+      tokens = name_tokens(s, expression_label(s));
     } catch (const Error& e) {
       c.fail(e.what());
     }
-    if (p) {
-      v = *p;
-    } else {
-      try {
-        v = evaluate_constant_expression(s, [&](const std::string& n) { return parameter(n); });
-      } catch (const Error& e) {
-        if (builder_.find_coordinate(s) >= 0)
-          c.fail("'" + s + "' is a coordinate; a constant is expected here");
-        c.fail(e.what());
-      }
+    for (const NameToken& t : tokens) {
+      if (t.templated) return true;
+      const std::string n = s.substr(t.begin, t.end - t.begin);
+      for (const auto& f : families_.frames)
+        if (f.family->index == n) return true;
     }
-    if (!std::isfinite(v)) c.fail("'" + s + "' is not a finite number");
-    return v;
+    return false;
   }
-  double positive(const Cursor& c) const {
+  Meanings member_meanings(const TCursor& c) const {
+    Meanings base = c.meanings();
+    const ModelBuilder* b = &builder_;
+    return [base, b](const std::string& n) {
+      Meaning m = base(n);
+      if (m.kind == Meaning::Kind::kUnknown && b->find_coordinate(n) >= 0)
+        m.message = "'" + n + "' is a coordinate; a constant is expected here";
+      return m;
+    };
+  }
+
+  template <class C>
+  double positive(const C& c) const {
     double v = number(c);
-    if (!(v > 0.0)) c.fail("must be positive, got " + c.text());
+    if (!(v > 0.0)) {
+      if constexpr (kInFamily<C>)
+        if (!plain_number(c.raw())) c.fail("must be positive, got " + c.raw() + " = " + shortest(v));
+      c.fail("must be positive, got " + c.text());
+    }
     return v;
   }
-  std::vector<double> numbers(const Cursor& c, std::size_t n) const {
+  template <class C>
+  std::vector<double> numbers(const C& c, std::size_t n) const {
     auto items = c.items();
     if (n && items.size() != n) c.fail("expected a list of " + std::to_string(n) + " numbers");
     std::vector<double> v;
-    for (const Cursor& i : items) v.push_back(number(i));
+    for (const auto& i : items) v.push_back(number(i));
     return v;
   }
-  kin::V2 vec2(const Cursor& c) const {
-    auto v = numbers(c, 2);
-    return {v[0], v[1]};
+  template <class C>
+  kin::V2 vec2(const C& c) const {
+    if (!c.is_sequence()) c.fail("expected a list");
+    if (c.size() != 2) c.fail("expected a list of 2 numbers");
+    return {number(c.at(0)), number(c.at(1))};
   }
 
-  Index coordinate(const Cursor& c) const {
+  template <class C>
+  Index coordinate(const C& c) const {
     const std::string s = c.name();
-    Index j = builder_.find_coordinate(s);
+    Index j = coordinate_at(c, s);
     if (j < 0) c.fail("unknown coordinate '" + s + "'");
     return j;
   }
+
+  // The index of the entry `name` that the reference at c names, or -1. In a family, a reference written without
+  // template is looked up once; a templated one first tries the entry one step (the step between the last two
+  // found) after the last one found, verified by name: families mostly walk their tables in order, and a hash
+  // lookup in a table of millions of names costs cache misses.
+  template <class C, class Find, class NameAt>
+  Index lookup(const C& c, const std::string& name, Index size, const Find& find, const NameAt& name_at) const {
+    if constexpr (kInFamily<C>) {
+      ScalarPlan& p = c.plan();
+      if (!c.node()->templated) {
+        if (p.entity == ScalarPlan::kNotLooked) p.entity = find(name);
+        return p.entity;
+      }
+      if (p.last >= 0) {
+        const Index k = p.last + p.stride;
+        if (k >= 0 && k < size && name_at(k) == name) return p.last = k;
+      }
+      const Index j = find(name);
+      if (j >= 0) {
+        if (p.last >= 0) p.stride = j - p.last;
+        p.last = j;
+      }
+      return j;
+    } else {
+      (void)c, (void)size, (void)name_at;
+      return find(name);
+    }
+  }
+  template <class C>
+  Index coordinate_at(const C& c, const std::string& name) const {
+    return lookup(
+        c, name, builder_.num_coordinates(), [&](const std::string& n) { return builder_.find_coordinate(n); },
+        [&](Index k) -> const std::string& { return builder_.coordinate_name(k); });
+  }
+  template <class C, class T>
+  Index entry_at(const C& c, const std::string& name, const NameTable<T>& table) const {
+    return lookup(
+        c, name, table.size(), [&](const std::string& n) { return table.find(n); },
+        [&](Index k) -> const std::string& { return table.name(k); });
+  }
   // A slot: a coordinate name or a constant (number or constant expression).
-  Slot slot(const Cursor& c) const {
+  template <class C>
+  Slot slot(const C& c) const {
     if (c.is_scalar()) {
-      Index j = builder_.find_coordinate(c.text());
-      if (j >= 0) return Slot::coordinate(j);
+      if constexpr (kInFamily<C>) {
+        const Index j = c.node()->templated ? coordinate_at(c, c.text()) : coordinate_at(c, c.raw());
+        if (j >= 0) return Slot::coordinate(j);
+      } else {
+        Index j = builder_.find_coordinate(c.text());
+        if (j >= 0) return Slot::coordinate(j);
+      }
     }
     return Slot::constant(number(c));
+  }
+
+  // ---- families -----------------------------------------------------------------------------------------------
+  // Reads "for NAME in A..B" and copies the body out of the YAML tree. `path` is the key's field path, `enclosing`
+  // the indices of the families around it (outermost first), `list` whether the body is a list of items.
+  std::shared_ptr<Family> parse_family(const std::string& key, const YAML::Mark& key_mark, const YAML::Node& body,
+                                       const std::string& path, const std::vector<std::string>& enclosing,
+                                       bool list) {
+    auto f = std::make_shared<Family>();
+    f->key = key, f->path = path, f->mark = key_mark, f->depth = static_cast<int>(enclosing.size());
+    auto fail = [&](const std::string& what) { fail_at(file_, key_mark, families_.render(path), what); };
+    // for NAME in A..B
+    std::istringstream words(key);
+    std::string w_for, w_in;
+    words >> w_for >> f->index >> w_in;
+    std::string range;
+    std::getline(words, range);
+    const std::size_t dots = range.find("..");
+    if (w_for != "for" || w_in != "in" || dots == std::string::npos)
+      fail("a family is 'for NAME in A..B' (A and B whole numbers, B included)");
+    f->lo_text = range.substr(0, dots), f->hi_text = range.substr(dots + 2);
+    auto trim = [](std::string& s) {
+      s.erase(0, s.find_first_not_of(" \t"));
+      s.erase(s.find_last_not_of(" \t") + 1);
+    };
+    trim(f->lo_text), trim(f->hi_text);
+    if (f->lo_text.empty() || f->hi_text.empty())
+      fail("a family is 'for NAME in A..B' (A and B whole numbers, B included)");
+    const std::string& n = f->index;
+    if (!valid_name(n)) fail("'" + n + "' is not a valid index name");
+    if (n == "t" || n == "pi") fail("index '" + n + "' is reserved");
+    if (parameters_.count(n)) fail("index '" + n + "' shadows the parameter '" + n + "'");
+    for (const std::string& e : enclosing)
+      if (e == n) fail("index '" + n + "' shadows the index of an enclosing family");
+    if (builder_.find_coordinate(n) >= 0) fail("index '" + n + "' shadows the coordinate '" + n + "'");
+    if (f->depth >= limits_.max_family_depth)
+      fail("families nested more than " + std::to_string(limits_.max_family_depth) + " deep");
+    // the range: whole-number expressions of the parameters and the enclosing indices
+    Meanings meaning = [&](const std::string& name) {
+      Meaning m;
+      for (std::size_t k = enclosing.size(); k-- > 0;)
+        if (enclosing[k] == name) return m.kind = Meaning::Kind::kIndex, m.depth = static_cast<int>(k), m;
+      if (auto p = parameter(name)) return m.kind = Meaning::Kind::kConstant, m.value = *p, m;
+      m.message = "unknown name '" + name + "'";
+      return m;
+    };
+    try {
+      f->lo = std::make_shared<IndexExpr>(f->lo_text, "range bound '" + clip(f->lo_text) + "'", meaning, false);
+      f->hi = std::make_shared<IndexExpr>(f->hi_text, "range bound '" + clip(f->hi_text) + "'", meaning, false);
+    } catch (const Error& e) {
+      fail(e.what());
+    }
+    // the body
+    std::vector<std::string> inner = enclosing;
+    inner.push_back(n);
+    const std::string body_path = path + kMemberMark;
+    if (list) {
+      if (!body.IsSequence()) fail("the body of a family in a list is a list of items: {" + key + ": [...]}");
+      f->body.kind = TNode::Kind::kSeq;
+      f->body.mark = body.Mark();
+      f->body.path = body_path;
+      const bool several = body.size() > 1;
+      for (std::size_t i = 0; i < body.size(); ++i) {
+        const std::string item_path = several ? body_path + "[" + std::to_string(i) + "]" : body_path;
+        const YAML::Node& item = body[i];
+        if (auto fk = family_item_key(item, item_path)) {
+          TNode t;
+          t.kind = TNode::Kind::kMap, t.mark = item.Mark(), t.path = item_path;
+          const auto it = item.begin();
+          t.family = parse_family(*fk, it->first.Mark(), it->second, item_path + "." + *fk, inner, true);
+          f->body.seq.push_back(std::move(t));
+        } else {
+          f->body.seq.push_back(copy(item, item_path, body.Mark()));
+        }
+      }
+    } else {
+      if (!body.IsMap()) fail("the body of a family in a map is a map of entries: {" + key + ": {NAME: VALUE, ...}}");
+      f->body.kind = TNode::Kind::kMap;
+      f->body.mark = body.Mark();
+      f->body.path = body_path;
+      std::set<std::string> seen;
+      for (auto it = body.begin(); it != body.end(); ++it) {
+        const std::string here = families_.render(body_path);
+        if (!it->first.IsScalar()) fail_at(file_, it->first.Mark(), here, "names must be plain scalars");
+        const std::string k = it->first.Scalar();
+        if (!seen.insert(k).second)
+          fail_at(file_, it->first.Mark(), families_.render(body_path + "." + k), "duplicate name '" + k + "'");
+        TNode::Entry e;
+        e.key = k, e.key_mark = it->first.Mark();
+        if (is_family_key(k))
+          e.family = parse_family(k, it->first.Mark(), it->second, body_path + "." + k, inner, false);
+        else
+          e.value = std::make_shared<TNode>(copy(it->second, body_path + "." + k, it->first.Mark()));
+        f->body.map.push_back(std::move(e));
+      }
+    }
+    return f;
+  }
+
+  // The key of a list item {for NAME in A..B: [...]}, or nullopt when the item is not a family.
+  std::optional<std::string> family_item_key(const YAML::Node& item, const std::string& path) const {
+    if (!item.IsMap()) return std::nullopt;
+    std::optional<std::string> key;
+    for (auto it = item.begin(); it != item.end(); ++it)
+      if (it->first.IsScalar() && is_family_key(it->first.Scalar())) key = it->first.Scalar();
+    if (key && item.size() != 1)
+      fail_at(file_, item.Mark(), families_.render(path),
+              "a family item is a map with the one key 'for NAME in A..B' and nothing beside it");
+    return key;
+  }
+
+  // A plain YAML subtree as a TNode (no families inside: those are only items of lists and entries of maps).
+  TNode copy(const YAML::Node& n, const std::string& path, const YAML::Mark& parent_mark) const {
+    TNode t;
+    t.path = path;
+    t.mark = n.IsDefined() ? n.Mark() : parent_mark;
+    if (t.mark.line < 0) t.mark = parent_mark;
+    if (!n.IsDefined() || n.IsNull()) return t;
+    if (n.IsScalar()) {
+      t.kind = TNode::Kind::kScalar;
+      t.text = n.Scalar();
+      t.templated = t.text.find_first_of("{}") != std::string::npos;
+    } else if (n.IsSequence()) {
+      t.kind = TNode::Kind::kSeq;
+      for (std::size_t i = 0; i < n.size(); ++i) t.seq.push_back(copy(n[i], path + "[" + std::to_string(i) + "]", n.Mark()));
+    } else if (n.IsMap()) {
+      t.kind = TNode::Kind::kMap;
+      for (auto it = n.begin(); it != n.end(); ++it) {
+        TNode::Entry e;
+        e.key_scalar = it->first.IsScalar();
+        e.key = e.key_scalar ? it->first.Scalar() : std::string();
+        e.key_mark = it->first.Mark();
+        e.value = std::make_shared<TNode>(copy(it->second, path + "." + e.key, n.Mark()));
+        t.map.push_back(std::move(e));
+      }
+    }
+    return t;
+  }
+
+  // Calls each() once per member of f, with the member's index in families_; checks the range and the budget.
+  template <class Each>
+  void for_each_member(const Family& f, Each&& each) {
+    auto fail = [&](const std::string& what) { fail_at(file_, f.mark, families_.render(f.path), what); };
+    auto bound = [&](const IndexExpr& e, const std::string& text) -> std::int64_t {
+      double v = 0.0;
+      try {
+        v = e.eval(families_.env());
+      } catch (const Error& x) {
+        fail(x.what());
+      }
+      if (!(std::floor(v) == v && std::fabs(v) <= 4503599627370496.0))
+        fail("range bound '" + clip(text) + "' is " + shortest(v) + ", not a whole number");
+      return static_cast<std::int64_t>(v);
+    };
+    const std::int64_t lo = bound(*f.lo, f.lo_text), hi = bound(*f.hi, f.hi_text);
+    const std::size_t entries = f.body.kind == TNode::Kind::kSeq ? f.body.seq.size() : f.body.map.size();
+    if (hi < lo || entries == 0) return;
+    const auto members = static_cast<std::uint64_t>(hi - lo) + 1;
+    if (members > families_.budget / entries)
+      fail("the family would make " + std::to_string(members) + " x " + std::to_string(entries) +
+           " entries; families may make " + std::to_string(limits_.max_family_instances) + " entries in all and " +
+           std::to_string(families_.budget) + " are left (SceneLimits::max_family_instances)");
+    families_.budget -= members * entries;
+    if (f.depth == 0 && reserve_) reserve_(members * entries);  // the tables grow once, not by doubling
+    families_.frames.push_back({&f, lo});
+    if (families_.index.size() < families_.frames.size()) families_.index.resize(families_.frames.size());
+    const std::size_t level = families_.frames.size() - 1;
+    for (std::int64_t v = lo;; ++v) {
+      families_.frames[level].value = v;
+      families_.index[level] = static_cast<double>(v);
+      each();
+      if (v == hi) break;
+    }
+    families_.frames.pop_back();
+  }
+
+  // The members' entries of a family in a map section: each(name, value cursor) in order.
+  template <class Each>
+  void expand_map(const Family& f, Each& each) {
+    for_each_member(f, [&] {
+      for (const TNode::Entry& e : f.body.map) {
+        if (e.family) {
+          expand_map(*e.family, each);
+          continue;
+        }
+        TCursor value(e.value.get(), &families_);
+        std::string name = e.key;
+        if (e.key.find_first_of("{}") != std::string::npos) {
+          try {
+            if (!e.name) e.name = std::make_shared<NameTemplate>(e.key, value.meanings());
+            e.name->render(families_.env(), name);
+          } catch (const Error& x) {
+            value.fail(x.what());
+          }
+        }
+        each(name, value);
+      }
+    });
+  }
+
+  // The entries of a map section, plain ones and families' members, in order: each(name, cursor).
+  template <class Each>
+  void read_map(const std::vector<Cursor::Entry>& entries, Each each) {
+    for (auto& [name, key_mark, value] : entries) {
+      if (is_family_key(name)) {
+        auto f = parse_family(name, key_mark, value.node(), value.path(), {}, false);
+        expand_map(*f, each);
+      } else {
+        each(name, value);
+      }
+    }
+  }
+
+  // The items of a list section, plain ones and families' members, in order.
+  template <class Each>
+  void read_list(const Cursor& c, Each each) {
+    const std::vector<Cursor> items = c.items();
+    for (const Cursor& item : items) {
+      if (auto key = family_item_key(item.node(), item.path())) {
+        const auto it = item.node().begin();
+        auto f = parse_family(*key, it->first.Mark(), it->second, item.path() + "." + *key, {}, true);
+        expand_list(*f, each);
+      } else {
+        each(item);
+      }
+    }
+  }
+  template <class Each>
+  void expand_list(const Family& f, Each& each) {
+    for_each_member(f, [&] {
+      for (const TNode& item : f.body.seq) {
+        if (item.family) expand_list(*item.family, each);
+        else each(TCursor(&item, &families_));
+      }
+    });
   }
 
   // ---- top-level sections -------------------------------------------------------------------------------------
   void read_parameters(const Cursor& c) {
     if (!c.present()) return;
-    for (auto& [name, value] : c.entries()) {
+    for (auto& [name, key_mark, value] : c.entries()) {
       if (!Cursor::valid_name(name)) value.fail("'" + name + "' is not a valid parameter name");
       if (name == "t" || name == "pi") value.fail("'" + name + "' is reserved");
       parameters_[name] = number(value);  // may use the parameters above it
@@ -279,62 +1344,79 @@ class SceneReader {
   }
 
   void read_coordinates(const Cursor& c) {
-    auto entries = c.entries();
+    const auto entries = c.entries();
     if (entries.empty()) c.fail("at least one coordinate is needed");
-    for (auto& [name, value] : entries) {
+    reserve_ = [&](std::size_t more) { builder_.reserve(static_cast<Index>(more), 0); };
+    read_map(entries, [&](const std::string& name, const auto& value) {
       if (!Cursor::valid_name(name)) value.fail("'" + name + "' is not a valid coordinate name");
       if (name == "t" || name == "pi") value.fail("'" + name + "' is reserved");
       if (parameters_.count(name)) value.fail("'" + name + "' is already a parameter");
-      builder_.add_coordinate(name, number(value));
-    }
+      const double v = number(value);
+      try {
+        builder_.add_coordinate(name, v);  // v is finite: a duplicate name is its only error
+      } catch (const Error&) {
+        value.fail("duplicate name '" + name + "'");
+      }
+    });
+    if (builder_.num_coordinates() == 0) c.fail("at least one coordinate is needed");
   }
 
-  void check_new_entity(const Cursor& where, const std::string& name) const {
+  // A new point or body: its index in `table`, after the checks (valid, not yet a point or a body).
+  template <class C, class T, class U>
+  Index new_entity(const C& where, const std::string& name, NameTable<T>& table, const NameTable<U>& other) {
     if (!Cursor::valid_name(name)) where.fail("'" + name + "' is not a valid name");
-    if (points_.count(name) || bodies_.count(name)) where.fail("duplicate point or body name '" + name + "'");
+    const Index k = other.contains(name) ? -1 : table.add(name);
+    if (k < 0) where.fail("duplicate point or body name '" + name + "'");
+    return k;
   }
 
   void read_points(const Cursor& c) {
-    for (auto& [name, value] : c.entries()) {
-      check_new_entity(value, name);
+    reserve_ = [&](std::size_t more) { points_.reserve(more); };
+    read_map(c.entries(), [&](const std::string& name, const auto& value) {
+      const Index k = new_entity(value, name, points_, bodies_);
       if (value.size() != 2 || !value.is_sequence()) value.fail("a point is [x, y]");
-      points_[name] = Point2{slot(value.at(0)), slot(value.at(1))};
-    }
+      points_[k] = Point2{slot(value.at(0)), slot(value.at(1))};
+    });
   }
 
   void read_bodies(const Cursor& c) {
-    for (auto& [name, value] : c.entries()) {
+    reserve_ = [&](std::size_t more) { bodies_.reserve(more); };
+    read_map(c.entries(), [&](const std::string& name, const auto& value) {
       if (name == kGround) value.fail("'ground' is predefined (the fixed frame)");
-      check_new_entity(value, name);
+      const Index k = new_entity(value, name, bodies_, points_);
       if (value.size() != 3 || !value.is_sequence()) value.fail("a body is [x, y, psi]");
-      bodies_[name] = Frame2{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
-    }
+      bodies_[k] = Frame2{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
+    });
   }
 
   // A point reference: a point name or an inline [x, y].
-  Point2 point(const Cursor& c) const {
+  template <class C>
+  Point2 point(const C& c) const {
     if (c.is_sequence()) {
       if (c.size() != 2) c.fail("an inline point is [x, y]");
       return Point2{slot(c.at(0)), slot(c.at(1))};
     }
     const std::string s = c.name();
-    auto it = points_.find(s);
-    if (it == points_.end()) c.fail("unknown point '" + s + "'");
-    return it->second;
+    const Index k = entry_at(c, s, points_);
+    if (k < 0) c.fail("unknown point '" + s + "'");
+    return points_[k];
   }
-  std::pair<Point2, Point2> segment(const Cursor& c) const {
+  template <class C>
+  std::pair<Point2, Point2> segment(const C& c) const {
     if (!c.is_sequence() || c.size() != 2) c.fail("a segment is [from, to]");
     return {point(c.at(0)), point(c.at(1))};
   }
-  Frame2 body(const Cursor& c) const {
+  template <class C>
+  Frame2 body(const C& c) const {
     const std::string s = c.name();
     if (s == kGround) return Frame2{Slot::constant(0), Slot::constant(0), Slot::constant(0)};
-    auto it = bodies_.find(s);
-    if (it == bodies_.end()) c.fail("unknown body '" + s + "'");
-    return it->second;
+    const Index k = entry_at(c, s, bodies_);
+    if (k < 0) c.fail("unknown body '" + s + "'");
+    return bodies_[k];
   }
   // An attachment of a revolute or prismatic pair: {body: B, at: [x, y]} (local point) or {point: P}.
-  std::pair<Frame2, kin::V2> attachment(const Cursor& c) const {
+  template <class C>
+  std::pair<Frame2, kin::V2> attachment(const C& c) const {
     if (!c.is_map()) c.fail("expected {body: NAME, at: [x, y]} or {point: NAME}");
     if (c.field("point").present()) {
       c.expect_map({"point"});
@@ -348,7 +1430,8 @@ class SceneReader {
     return {f, at};
   }
 
-  void read_constraint(const Cursor& c) {
+  template <class C>
+  void read_constraint(const C& c) {
     if (!c.is_map()) c.fail("a constraint is a mapping with a 'type'");
     const std::string type = c.require("type").text();
     std::string name;
@@ -370,7 +1453,7 @@ class SceneReader {
         add(c, name, PointOnLineSpec{point(c.require("point")), a, b, 1.0});
       } else if (type == "constant_angle") {
         c.expect_map({"type", "name", "segments", "angle"});
-        Cursor segs = c.require("segments");
+        auto segs = c.require("segments");
         if (!segs.is_sequence() || segs.size() != 2) segs.fail("expected two segments [[A, B], [C, D]]");
         auto [a, b] = segment(segs.at(0));
         auto [cc, d] = segment(segs.at(1));
@@ -385,14 +1468,14 @@ class SceneReader {
                                slot(c.require("angle"))});
       } else if (type == "revolute") {
         c.expect_map({"type", "name", "between"});
-        Cursor between = c.require("between");
+        auto between = c.require("between");
         if (!between.is_sequence() || between.size() != 2) between.fail("a revolute joins two attachments");
         auto [fa, sa] = attachment(between.at(0));
         auto [fb, sb] = attachment(between.at(1));
         add(c, name, PinSpec{fa, fb, sa, sb});
       } else if (type == "prismatic") {
         c.expect_map({"type", "name", "between", "axis", "angle"});
-        Cursor between = c.require("between");
+        auto between = c.require("between");
         if (!between.is_sequence() || between.size() != 2) between.fail("a prismatic pair joins two attachments");
         auto [fa, sa] = attachment(between.at(0));
         auto [fb, sb] = attachment(between.at(1));
@@ -406,13 +1489,13 @@ class SceneReader {
       } else if (type == "loop") {
         c.expect_map({"type", "name", "links", "closure"});
         LoopSpec spec;
-        for (const Cursor& l : c.require("links").items()) {
+        for (const auto& l : c.require("links").items()) {
           l.expect_map({"length", "angles", "offset"});
           LoopSpec::Link link;
           link.length = slot(l.require("length"));
           if (auto o = l.field("offset"); o.present()) link.offset = number(o);
           if (auto as = l.field("angles"); as.present()) {
-            for (const Cursor& a : as.items()) {
+            for (const auto& a : as.items()) {
               std::string s = a.text();
               double sign = 1.0;
               if (!s.empty() && (s[0] == '-' || s[0] == '+')) sign = s[0] == '-' ? -1.0 : 1.0, s = s.substr(1);
@@ -440,7 +1523,8 @@ class SceneReader {
     }
   }
 
-  void read_driver(const Cursor& c) {
+  template <class C>
+  void read_driver(const C& c) {
     if (!c.is_map()) c.fail("a driver is a mapping with 'coordinate' or 'expr', and a 'law'");
     c.expect_map({"name", "coordinate", "expr", "unit", "law"});
     std::string name;
@@ -460,7 +1544,8 @@ class SceneReader {
     }
   }
 
-  MotionLaw motion_law(const Cursor& c) const {
+  template <class C>
+  MotionLaw motion_law(const C& c) const {
     if (!c.is_map()) c.fail("a law is a mapping with a 'type'");
     const std::string type = c.require("type").text();
     try {
@@ -491,12 +1576,17 @@ class SceneReader {
       }
       if (type == "expression") {
         c.expect_map({"type", "f"});
-        Cursor f = c.require("f");
-        auto expr = CompiledExpression::compile(f.text(), [&](const std::string& n) -> std::optional<NameBinding> {
-          if (n == "t") return NameBinding{NameBinding::Kind::kTime};
-          if (auto p = parameter(n)) return NameBinding{NameBinding::Kind::kConstant, -1, *p};
-          return std::nullopt;
-        });
+        auto f = c.require("f");
+        std::shared_ptr<const CompiledExpression> expr;
+        if constexpr (kInFamily<C>) {
+          expr = family_expression(f, true, false);
+        } else {
+          expr = CompiledExpression::compile(f.text(), [&](const std::string& n) -> std::optional<NameBinding> {
+            if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+            if (auto p = parameter(n)) return NameBinding{NameBinding::Kind::kConstant, -1, *p};
+            return std::nullopt;
+          });
+        }
         return MotionLaw::expression(expr);
       }
     } catch (const Error& e) {
@@ -505,24 +1595,123 @@ class SceneReader {
     c.require("type").fail("unknown law type '" + type + "' (linear, polynomial, harmonic, table, expression)");
   }
 
-  std::shared_ptr<const CompiledExpression> compile(const Cursor& c, bool allow_time) const {
+  template <class C>
+  std::shared_ptr<const CompiledExpression> compile(const C& c, bool allow_time) const {
     try {
-      return CompiledExpression::compile(
-          c.text(),
-          [&](const std::string& n) -> std::optional<NameBinding> {
-            if (n == "t") return NameBinding{NameBinding::Kind::kTime};
-            Index j = builder_.find_coordinate(n);
-            if (j >= 0) return NameBinding{NameBinding::Kind::kCoordinate, j};
-            if (auto p = parameter(n)) return NameBinding{NameBinding::Kind::kConstant, -1, *p};
-            return std::nullopt;
-          },
-          allow_time);
+      if constexpr (kInFamily<C>) {
+        return family_expression(c, allow_time, true);
+      } else {
+        return CompiledExpression::compile(c.text(), resolver(true), allow_time);
+      }
     } catch (const Error& e) {
       c.fail(e.what());
     }
   }
+  // Names of equation expressions: t, coordinates (when allowed), parameters.
+  NameResolver resolver(bool coordinates) const {
+    return [this, coordinates](const std::string& n) -> std::optional<NameBinding> {
+      if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+      if (coordinates)
+        if (Index j = builder_.find_coordinate(n); j >= 0) return NameBinding{NameBinding::Kind::kCoordinate, j};
+      if (auto p = parameter(n)) return NameBinding{NameBinding::Kind::kConstant, -1, *p};
+      return std::nullopt;
+    };
+  }
 
-  Unit unit(const Cursor& c) const {
+  // An equation (or law) expression of a family member: compiled once per body, rebound per member. Throws Error.
+  std::shared_ptr<const CompiledExpression> family_expression(const TCursor& c, bool allow_time,
+                                                              bool allow_coordinates) const {
+    const std::string& text = c.raw();
+    ScalarPlan& plan = c.plan();
+    if (!plan.equation) {
+      auto eq = std::make_shared<ScalarPlan::Equation>();
+      eq->allow_coordinates = allow_coordinates;
+      if (!uses_member(c, text)) {
+        eq->shared = CompiledExpression::compile(text, resolver(allow_coordinates), allow_time);
+      } else {
+        // each templated name becomes a placeholder identifier that the text cannot already contain
+        const std::vector<NameToken> tokens = name_tokens(text, expression_label(text));
+        std::string prefix = "phiq_template_";
+        while (text.find(prefix) != std::string::npos) prefix += "_";
+        std::string rewritten;
+        std::map<std::string, std::string> placeholder_of;  // token -> placeholder identifier
+        std::vector<std::pair<std::string, std::string>> back;  // placeholder identifier -> token
+        std::size_t last = 0;
+        for (const NameToken& t : tokens) {
+          if (!t.templated) continue;
+          const std::string token = text.substr(t.begin, t.end - t.begin);
+          if (t.call) throw labelled(expression_label(text), "'" + token + "' is not a function");
+          auto [it, fresh] = placeholder_of.emplace(token, prefix + std::to_string(placeholder_of.size()) + "_");
+          if (fresh) {
+            eq->names.push_back(std::make_shared<NameTemplate>(token, c.meanings()));
+            back.emplace_back(it->second, token);
+          }
+          rewritten += text.substr(last, t.begin - last) + it->second;
+          last = t.end;
+        }
+        rewritten += text.substr(last);
+        // compiled indices: one per placeholder, index and coordinate the text names
+        std::map<std::string, Index> compiled_index;
+        const Families& fx = c.families();
+        auto add = [&](const std::string& n, ScalarPlan::Equation::Placeholder p) {
+          auto [it, fresh] = compiled_index.emplace(n, static_cast<Index>(eq->placeholders.size()));
+          if (fresh) eq->placeholders.push_back(p);
+          return it->second;
+        };
+        NameResolver resolve = [&](const std::string& n) -> std::optional<NameBinding> {
+          using P = ScalarPlan::Equation::Placeholder;
+          for (std::size_t k = 0; k < back.size(); ++k)
+            if (back[k].first == n)
+              return NameBinding{NameBinding::Kind::kCoordinate, add(n, P{P::Kind::kTemplate, -1, 0, k})};
+          for (std::size_t k = fx.frames.size(); k-- > 0;)
+            if (fx.frames[k].family->index == n)
+              return NameBinding{NameBinding::Kind::kCoordinate,
+                                 add(n, P{P::Kind::kIndex, -1, static_cast<int>(k), 0})};
+          if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+          if (allow_coordinates)
+            if (Index j = builder_.find_coordinate(n); j >= 0)
+              return NameBinding{NameBinding::Kind::kCoordinate, add(n, P{P::Kind::kCoordinate, j, 0, 0})};
+          if (auto p = parameter(n)) return NameBinding{NameBinding::Kind::kConstant, -1, *p};
+          return std::nullopt;
+        };
+        try {
+          eq->compiled = CompiledExpression::compile(rewritten, resolve, allow_time);
+        } catch (const Error& e) {
+          // say it with the text as written
+          std::string m = e.what();
+          for (const auto& [placeholder, token] : back)
+            for (std::size_t p = m.find(placeholder); p != std::string::npos; p = m.find(placeholder, p + token.size()))
+              m.replace(p, placeholder.size(), token);
+          throw Error(m);
+        }
+      }
+      plan.equation = eq;
+    }
+    const ScalarPlan::Equation& eq = *plan.equation;
+    if (eq.shared) return eq.shared;
+    const Families& fx = c.families();
+    std::vector<Index> target(eq.placeholders.size(), -1);
+    std::vector<double> value(eq.placeholders.size(), 0.0);
+    std::string name;
+    for (std::size_t k = 0; k < eq.placeholders.size(); ++k) {
+      const auto& p = eq.placeholders[k];
+      using K = ScalarPlan::Equation::Placeholder::Kind;
+      if (p.kind == K::kCoordinate) {
+        target[k] = p.coordinate;
+      } else if (p.kind == K::kIndex) {
+        value[k] = fx.index[static_cast<std::size_t>(p.depth)];
+      } else {
+        eq.names[p.name]->render(fx.env(), name);
+        if (Index j = eq.allow_coordinates ? builder_.find_coordinate(name) : -1; j >= 0) target[k] = j;
+        else if (auto v = parameter(name)) value[k] = *v;
+        else throw labelled(expression_label(text), "unknown name '" + name + "'");
+      }
+    }
+    return eq.compiled->rebind(target, value, text);
+  }
+
+  template <class C>
+  Unit unit(const C& c) const {
     if (!c.present()) return Unit::kNone;
     const std::string s = c.text();
     if (s == "length") return Unit::kLength;
@@ -531,11 +1720,18 @@ class SceneReader {
     c.fail("unit is length, angle or none, got '" + s + "'");
   }
 
-  template <class Spec>
-  void add(const Cursor& c, const std::string& name, Spec spec) {
-    std::string label = name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(++unnamed_) : name;
-    if (!names_.insert(label).second) c.field("name").fail("duplicate constraint or driver name '" + label + "'");
-    builder_.add(label, std::move(spec));
+  template <class C, class Spec>
+  void add(const C& c, const std::string& name, Spec spec) {
+    const std::string label = name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(++unnamed_) : name;
+    try {
+      builder_.add(label, std::move(spec));
+    } catch (const Error&) {
+      // the builder registers the name only when it adds the constraint: a name it has is a duplicate (reported
+      // before anything else wrong with the constraint, as a check before adding would)
+      if (builder_.has_constraint(label))
+        c.field("name").fail("duplicate constraint or driver name '" + label + "'");
+      throw;
+    }
   }
 
   void read_time(const Cursor& c, SweepOptions& o) const {
@@ -601,11 +1797,13 @@ class SceneReader {
   }
 
   const std::string& file_;
+  const SceneLimits& limits_;
   ModelBuilder builder_;
   std::unordered_map<std::string, double> parameters_;
-  std::unordered_map<std::string, Point2> points_;
-  std::unordered_map<std::string, Frame2> bodies_;
-  std::set<std::string> names_;
+  NameTable<Point2> points_;
+  NameTable<Frame2> bodies_;
+  Families families_;
+  std::function<void(std::size_t)> reserve_;  // room for that many more entries of the section being read
   int unnamed_ = 0;
   bool predictor_field_ = false;
 
@@ -690,7 +1888,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
   } catch (const YAML::Exception& e) {
     throw SceneError(yaml_error(path, e));
   }
-  SceneReader reader(path);
+  SceneReader reader(path, limits);
   Scene scene = reader.read(root);
   // A predictor that needs derivatives the scene does not output would compute extra work silently: refuse.
   if (reader.predictor_given()) {

@@ -47,6 +47,7 @@ class Tape {
 
  private:
   friend class TapeBuilder;
+  friend class CompiledExpression;
   std::vector<Instr> code_;
   std::vector<std::uint32_t> outputs_;
 };
@@ -96,6 +97,15 @@ class CompiledExpression {
   double partial_t(const double* q, double t) const;
   /// γ contribution: −( Σ_jk g_qjqk q̇j q̇k + 2 Σ_j g_qjt q̇j + g_tt ).
   double gamma(const double* q, const double* qd, double t) const;
+
+  /// The same function with the coordinate indices it was compiled with reinterpreted, without symbolic work (the
+  /// tapes are copied and patched): compiled index k reads q[target[k]] when target[k] ≥ 0 and is the constant
+  /// value[k] when target[k] < 0. The derivatives stay exact; coordinates that coincide after the mapping have
+  /// their gradient entries summed. Used by scene families (`for`): one expression is compiled once with
+  /// placeholder indices and instantiated per member. `text` is the text of the result. Throws phiq::Error when
+  /// a compiled index has no entry in `target` (or `value` is shorter than `target`).
+  std::shared_ptr<const CompiledExpression> rebind(const std::vector<Index>& target, const std::vector<double>& value,
+                                                   std::string text) const;
 
  private:
   std::string text_;

@@ -145,6 +145,13 @@ class ModelBuilder {
   Index num_coordinates() const { return static_cast<Index>(model_.names_.size()); }
   /// Index of a coordinate by name, or -1.
   Index find_coordinate(const std::string& name) const;
+  /// Name of coordinate j. Pre-condition: 0 ≤ j < num_coordinates().
+  const std::string& coordinate_name(Index j) const { return model_.names_[static_cast<std::size_t>(j)]; }
+  /// True when a constraint of that name has been added.
+  bool has_constraint(const std::string& name) const { return constraint_names_.count(name) != 0; }
+  /// Makes room for that many more coordinates and constraints (an optimisation for large generated models, e.g.
+  /// the members of a scene family; never required).
+  void reserve(Index more_coordinates, Index more_constraints);
   /// Sets a coordinate's initial guess (rough placement for assembly).
   void set_initial(Index j, double value);
 
@@ -197,7 +204,8 @@ class ModelBuilder {
 
 template <class Spec>
 TypedBlock<Spec>& ModelBuilder::block_for() {
-  auto [it, inserted] = block_of_type_.emplace(std::type_index(typeid(Spec)), model_.blocks_.size());
+  // try_emplace: no node is allocated when the block exists (one lookup per added constraint)
+  auto [it, inserted] = block_of_type_.try_emplace(std::type_index(typeid(Spec)), model_.blocks_.size());
   if (inserted) model_.blocks_.push_back(std::make_unique<TypedBlock<Spec>>());
   return static_cast<TypedBlock<Spec>&>(*model_.blocks_[it->second]);
 }

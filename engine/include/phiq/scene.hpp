@@ -26,6 +26,10 @@ struct SceneLimits {
   int max_depth = 32;                                    ///< nesting of maps and lists
   std::size_t max_nodes = 20'000'000;                    ///< scalars + maps + lists
   std::size_t max_scalar_bytes = 16384;                  ///< one value (expressions are shorter still, see expression.hpp)
+  /// Entries (coordinates, points, bodies, constraints, drivers) that indexed families (`for i in A..B`) may make
+  /// in all; a nested family counts as one entry of its parent per member, plus what it makes.
+  std::size_t max_family_instances = 50'000'000;
+  int max_family_depth = 8;                              ///< families nested in families
 };
 
 /// A loaded scene: the model, the sweep and what to output.
