@@ -9,15 +9,22 @@
 // iteration also runs phiq over the very same steps with the same start in the same loop and reports the ratio
 // (`per_phiq`), which is the figure that survives this noisy machine.
 //
+// Clock: the thread's CPU time (CLOCK_THREAD_CPUTIME_ID). All three run on one thread (Eigen without OpenMP, KLU,
+// Simbody's matter subsystem over Debian's reference BLAS/LAPACK), and on this shared 2-core machine the wall clock
+// also counts the time the process waits for a core (wall ÷ CPU was 1.2–1.5 in a run at load 4). The wall-clock
+// figure is reported too (wall_us_per_step); phiq_bench uses the wall clock (equal on an idle machine).
+//
 //   build/bench/phiq_bench_peers --benchmark_out=bench/results/peers.json --benchmark_out_format=json
 //
-// Counters: us_per_step (µs per drive step; the figure bench/README.md and tools/plot_bench.py use), steps (timed
-// per iteration), newton_per_step (Newton iterations; Simbody: projectQ iterations), max_position_error,
+// Counters: us_per_step (CPU µs per drive step; the figure bench/README.md and tools/plot_bench.py use),
+// wall_us_per_step, steps (timed per iteration), newton_per_step (Newton iterations; Simbody: projectQ iterations), max_position_error,
 // max_velocity_error, max_acceleration_error (against P_i = (i + cos θ, sin θ); a peer above 1e-8 fails the
 // benchmark), phiq_us_per_step and per_phiq (phiq on the same steps in the same loop, and the peer's time ÷ phiq's).
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Dense>
+#include <time.h>
+
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -32,7 +39,25 @@ namespace {
 
 using namespace phiq_bench;
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Both clocks at once: the thread's CPU time, the one the figures use, and the wall clock.
+struct Stamp {
+  Clock::time_point wall;
+  double cpu;
+};
+Stamp now() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return {Clock::now(), static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec)};
+}
+struct Elapsed {
+  double cpu = 0.0, wall = 0.0;
+  void add(const Stamp& from, const Stamp& to) {
+    cpu += to.cpu - from.cpu;
+    wall += std::chrono::duration<double>(to.wall - from.wall).count();
+  }
+  Elapsed& operator+=(const Elapsed& o) { return cpu += o.cpu, wall += o.wall, *this; }
+};
 
 // ---------------------------------------------------------------------------------------------------------------
 // The classic course approach: Φ(q, t) and Φq(q, t) as dense matrices, a Newton loop with an LU of Φq per iteration
@@ -159,8 +184,8 @@ class PhiqNFourBar {
       : n_(n), predictor_(start == Start::kPrevious ? phiq::Predictor::kPrevious : phiq::Predictor::kQuadratic),
         model_(nfourbar(n, kTheta0, kRate)), ws_(model_) {}
 
-  // Runs `steps` drive steps from t = 0; returns the time of the drive steps (s) and merges into dev.
-  double run(int steps, Deviation& dev) {
+  // Runs `steps` drive steps from t = 0; returns the time of the drive steps and merges into dev.
+  Elapsed run(int steps, Deviation& dev) {
     phiq::SweepOptions opt;
     opt.t_begin = 0.0;
     opt.t_end = steps * kStep;
@@ -168,11 +193,11 @@ class PhiqNFourBar {
     opt.newton.tolerance = kTolerance;
     opt.predictor = predictor_;
     ws_.q = model_.initial_positions();
-    double timed = 0.0;
-    Clock::time_point mark;
+    Elapsed timed;
+    Stamp mark{};
     phiq::SweepSummary sum;
     phiq::run_sweep(model_, opt, ws_, [&](const phiq::StepView& s) {
-      if (s.step > 0) timed += seconds_since(mark);
+      if (s.step > 0) timed.add(mark, now());
       Deviation d;
       for (int i = 0; i <= n_; ++i) {
         const ExactTip e = exact_tip(i, s.t);
@@ -182,7 +207,7 @@ class PhiqNFourBar {
             std::max({d.acceleration, std::abs((*s.qdd)[2 * i] - e.ax), std::abs((*s.qdd)[2 * i + 1] - e.ay)});
       }
       dev.merge(d);
-      mark = Clock::now();
+      mark = now();
       return true;
     }, &sum);
     if (sum.status != phiq::SolveStatus::kSuccess) throw std::runtime_error("phiq: " + sum.message);
@@ -199,24 +224,41 @@ class PhiqNFourBar {
   long long newton_ = 0;
 };
 
+// Simbody's messages span lines: one line, runs of white space collapsed.
+std::string one_line(const char* what) {
+  std::string out;
+  for (const char* c = what; *c; ++c) {
+    const bool space = *c == ' ' || *c == '\n' || *c == '\t' || *c == '\r';
+    if (!space) out += *c;
+    else if (!out.empty() && out.back() != ' ') out += ' ';
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
 // Drive steps timed per iteration: the whole quarter turn where a peer is fast enough, a few steps at N = 1000 where
 // a dense step takes a second and more (the time per step does not depend on where in the quarter turn it is).
 int steps_for(int n) { return n >= 1000 ? 4 : kStepsPerSweep; }
+// phiq's runs per peer iteration: at least a quarter turn of steps, so that its side of the ratio is not 4 steps.
+int phiq_repeats(int n) { return (kStepsPerSweep + steps_for(n) - 1) / steps_for(n); }
 
 Start start_arg(const benchmark::State& state) { return static_cast<Start>(state.range(1)); }
 
-void report(benchmark::State& state, int n, long long steps, double peer_s, double phiq_s, long long newton,
-            const Deviation& dev) {
-  state.counters["us_per_step"] = 1e6 * peer_s / static_cast<double>(steps);
+// peer: its timed drive steps (`steps` in all); phiq: phiq's on the same steps (`phiq_steps` in all), or none.
+void report(benchmark::State& state, int n, long long steps, const Elapsed& peer, long long phiq_steps,
+            const Elapsed& phiq, long long newton, const Deviation& dev) {
+  state.counters["us_per_step"] = 1e6 * peer.cpu / static_cast<double>(steps);
+  state.counters["wall_us_per_step"] = 1e6 * peer.wall / static_cast<double>(steps);
   state.counters["steps"] = static_cast<double>(steps_for(n));
   state.counters["newton_per_step"] = static_cast<double>(newton) / static_cast<double>(steps);
   state.counters["max_position_error"] = dev.position;
   state.counters["max_velocity_error"] = dev.velocity;
   state.counters["max_acceleration_error"] = dev.acceleration;
   state.counters["coordinates"] = 2.0 * n + 3.0;
-  if (phiq_s > 0.0) {
-    state.counters["phiq_us_per_step"] = 1e6 * phiq_s / static_cast<double>(steps);
-    state.counters["per_phiq"] = peer_s / phiq_s;
+  if (phiq_steps > 0) {
+    const double phiq_step = phiq.cpu / static_cast<double>(phiq_steps);
+    state.counters["phiq_us_per_step"] = 1e6 * phiq_step;
+    state.counters["per_phiq"] = (peer.cpu / static_cast<double>(steps)) / phiq_step;
   }
   if (!(dev.worst() <= kCheckTolerance)) {
     const std::string msg = "deviates from the exact solution by " + std::to_string(dev.worst()) + " > 1e-8";
@@ -224,36 +266,37 @@ void report(benchmark::State& state, int n, long long steps, double peer_s, doub
   }
 }
 
-// One benchmark iteration: phiq over the steps, then the peer over the same steps (its reset is not timed).
+// One benchmark iteration: phiq over the steps (repeated up to a quarter turn of steps), then the peer over the same
+// steps (its reset is not timed).
 template <class Peer, class Newton>
 void run_peer(benchmark::State& state, Peer& peer, Newton newton_of) {
   const int n = static_cast<int>(state.range(0)), steps = steps_for(n);
   PhiqNFourBar phiq(n, start_arg(state));
   Deviation dev, phiq_dev;
-  double peer_s = 0.0, phiq_s = 0.0;
-  long long total = 0;
+  Elapsed peer_t, phiq_t;
+  long long total = 0, phiq_total = 0;
   const long long newton0 = newton_of(peer);
   try {
     for (auto _ : state) {
-      phiq_s += phiq.run(steps, phiq_dev);
+      for (int r = 0; r < phiq_repeats(n); ++r) phiq_t += phiq.run(steps, phiq_dev), phiq_total += steps;
       peer.reset();
-      double s = 0.0;
+      Elapsed e;
       for (int k = 1; k <= steps; ++k) {
-        const auto t0 = Clock::now();
+        const Stamp t0 = now();
         peer.step(k * kStep);
-        s += seconds_since(t0);
+        e.add(t0, now());
         dev.merge(peer.deviation());
       }
-      state.SetIterationTime(s);
-      peer_s += s;
+      state.SetIterationTime(e.cpu);
+      peer_t += e;
       total += steps;
     }
   } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
+    state.SkipWithError(one_line(e.what()).c_str());
     return;
   }
   if (!(phiq_dev.worst() <= kCheckTolerance)) return state.SkipWithError("phiq deviates from the exact solution");
-  report(state, n, total, peer_s, phiq_s, newton_of(peer) - newton0, dev);
+  report(state, n, total, peer_t, phiq_total, phiq_t, newton_of(peer) - newton0, dev);
 }
 
 void sizes(benchmark::internal::Benchmark* b) {
@@ -274,7 +317,7 @@ void BM_NFourBarStepSimbody(benchmark::State& state) {
   try {
     peer = std::make_unique<SimbodyNFourBar>(static_cast<int>(state.range(0)), start_arg(state));
   } catch (const std::exception& e) {  // Simbody's exceptions (a failed projection) derive from std::exception
-    state.SkipWithError(e.what());
+    state.SkipWithError(one_line(e.what()).c_str());
     return;
   }
   run_peer(state, *peer, [](const SimbodyNFourBar& p) { return p.projection_iterations(); });
@@ -294,20 +337,20 @@ void BM_NFourBarStepPhiqKlu(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   PhiqNFourBar phiq(n, start_arg(state));
   Deviation dev;
-  double total_s = 0.0;
+  Elapsed total;
   long long steps = 0;
   try {
     for (auto _ : state) {
-      const double s = phiq.run(kStepsPerSweep, dev);
-      state.SetIterationTime(s);
-      total_s += s;
+      const Elapsed e = phiq.run(kStepsPerSweep, dev);
+      state.SetIterationTime(e.cpu);
+      total += e;
       steps += kStepsPerSweep;
     }
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
     return;
   }
-  report(state, n, steps, total_s, 0.0, phiq.newton_iterations(), dev);
+  report(state, n, steps, total, 0, Elapsed{}, phiq.newton_iterations(), dev);
   state.counters["steps"] = kStepsPerSweep;
 }
 BENCHMARK(BM_NFourBarStepPhiqKlu)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime();

@@ -71,7 +71,7 @@ class SimbodyNFourBar {
   // acceleration).
   Deviation deviation() const;
   long long projection_iterations() const;  // projectQ Newton iterations since construction
-  double acceleration_seconds() const;      // time spent realising accelerations since construction (s)
+  double acceleration_seconds() const;      // thread CPU time spent realising accelerations (s), drive steps only
   int mobilities() const;                   // 2N + 1
   int constraint_equations() const;         // 2N
 
