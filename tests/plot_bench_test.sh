@@ -15,18 +15,20 @@ done
   { echo "plot_bench_test: SKIP: no python3 with matplotlib (Debian: python3-matplotlib, tools/install_deps.sh)"; exit 77; }
 
 mkdir -p "$dir" && rm -f "$dir"/*.svg "$dir"/*.png "$dir"/err.txt
-"$py" "$script" "$fixture" -o "$dir/fixture.svg" --png "$dir/fixture.png" || fail "exit status $? on the fixture"
+fixture_rt=$(dirname "$fixture")/bench_fixture_real_time.json  # no per-step counter: real_time per step
+"$py" "$script" "$fixture" "$fixture_rt" -o "$dir/fixture.svg" --png "$dir/fixture.png" ||
+  fail "exit status $? on the fixtures"
 [ -s "$dir/fixture.svg" ] || fail "no SVG written"
 [ -s "$dir/fixture.png" ] || fail "no PNG written"
 for label in 'phiq KLU, quadratic predictor' 'dense Eigen LU, from previous' 'Simbody, quadratic predictor' \
-             'phiq UMFPACK' 'time per drive step'; do
+             'phiq UMFPACK (bench_fixture)' 'FixtureRealTime (bench_fixture_real_time)' 'time per drive step'; do
   grep -q "$label" "$dir/fixture.svg" || fail "label '$label' missing from the SVG"
 done
-for absent in FixtureAggregate FixtureBroken FixtureWithoutN; do
+for absent in FixtureAggregate FixtureBroken FixtureWithoutN FixtureNotPerStep; do
   grep -q "$absent" "$dir/fixture.svg" && fail "'$absent' should have been skipped"
 done
 # the same input writes the same file
-"$py" "$script" "$fixture" -o "$dir/again.svg" 2>/dev/null || fail "second run"
+"$py" "$script" "$fixture" "$fixture_rt" -o "$dir/again.svg" 2>/dev/null || fail "second run"
 cmp -s "$dir/fixture.svg" "$dir/again.svg" || fail "the SVG differs between two runs on the same input"
 
 # errors: one line on stderr, exit status 1

@@ -3,12 +3,14 @@
 
 One curve per benchmark family: the benchmark name without its N argument, with its other arguments (lu, pred)
 spelled out, e.g. "phiq KLU", "phiq UMFPACK", "dense Eigen LU, from previous", "Simbody, quadratic predictor".
-When the same label comes from several files, the file's name is added to it.
+With several files, each label ends with its file's name: "phiq KLU (klu_vs_umfpack)".
 
 Time per step: the benchmark's per-step counter when it has one (us_per_step, ms_per_step, ns_per_step,
-step_seconds or seconds_per_step), else its real_time in its time_unit (one iteration taken as one step).
-Aggregates (mean, median, stddev of repetitions), benchmarks that failed (error_occurred) and benchmarks without an
-N argument (BM_Name/N:123/... or a first numeric argument, BM_Name/123/...) are skipped.
+step_seconds or seconds_per_step), else its real_time in its time_unit (one iteration taken as one step) -- but
+only in a file where no benchmark has such a counter: where some do, those without one are not per-step benchmarks
+(phiq_bench's BM_NFourBarNewtonIterationVsKernel times one Newton iteration) and are left out. Skipped as well:
+aggregates (mean, median, stddev of repetitions), benchmarks that failed (error_occurred), benchmarks without an N
+argument (BM_Name/N:123/... or a first numeric argument, BM_Name/123/...), and what --exclude matches.
 
 Writes an SVG (text kept as text, no timestamp: the same input gives the same file), and a PNG with --png.
 Errors (unreadable file, invalid JSON, nothing to plot, unwritable output) are one line on stderr, exit status 1.
@@ -98,17 +100,22 @@ def family_label(base, args):
     return ", ".join([label] + words)
 
 
-def step_seconds(b):
+def step_counter(b):
+    """Time per step (s) from a per-step counter, or None."""
     for key, scale in STEP_COUNTERS.items():
         if key in b:
             return float(b[key]) * scale
+    return None
+
+
+def real_time(b):
     unit = b.get("time_unit", "ns")
     if unit not in TIME_UNITS or "real_time" not in b:
         return None
     return float(b["real_time"]) * TIME_UNITS[unit]
 
 
-def load(path):
+def load(path, exclude=None):
     """Returns ({label: {N: [seconds, ...]}}, skipped) for one file."""
     try:
         with open(path, encoding="utf-8") as f:
@@ -121,21 +128,39 @@ def load(path):
         raise PlotError("%s: not valid JSON: %s" % (path, e))
     if not isinstance(data, dict) or not isinstance(data.get("benchmarks"), list):
         raise PlotError("%s: not a Google Benchmark JSON file (no 'benchmarks' list)" % path)
-    curves, skipped = {}, 0
-    for b in data["benchmarks"]:
+    entries = data["benchmarks"]
+    for b in entries:
         if not isinstance(b, dict) or not isinstance(b.get("name"), str):
             raise PlotError("%s: a benchmark entry without a name" % path)
-        if b.get("run_type") == "aggregate" or "aggregate_name" in b or b.get("error_occurred"):
-            skipped += 1
+    counters_here = any(any(k in b for k in STEP_COUNTERS) for b in entries)
+    curves, skipped = {}, {}
+
+    def skip(why):
+        skipped[why] = skipped.get(why, 0) + 1
+
+    for b in entries:
+        if b.get("run_type") == "aggregate" or "aggregate_name" in b:
+            skip("aggregate")
+            continue
+        if b.get("error_occurred"):
+            skip("failed")
+            continue
+        if exclude and exclude.search(b["name"]):
+            skip("excluded")
             continue
         base, n, args = parse_name(b.get("run_name") or b["name"])
         try:
             n = int(n) if n is not None else None
-            t = step_seconds(b)
+            t = step_counter(b)
+            if t is None and not counters_here:
+                t = real_time(b)
         except (TypeError, ValueError):
             raise PlotError("%s: %s: non-numeric N or time" % (path, b["name"]))
-        if n is None or n <= 0 or t is None or not (t > 0 and math.isfinite(t)):
-            skipped += 1
+        if n is None or n <= 0:
+            skip("no N")
+            continue
+        if t is None or not (t > 0 and math.isfinite(t)):
+            skip("not per step")
             continue
         curves.setdefault(family_label(base, args), {}).setdefault(n, []).append(t)
     return curves, skipped
@@ -155,20 +180,21 @@ def main(argv):
                     help="SVG to write (default: time_per_step.svg)")
     ap.add_argument("--png", metavar="OUT.png", help="also write a PNG")
     ap.add_argument("--filter", metavar="REGEX", help="only curves whose label matches REGEX (re.search)")
+    ap.add_argument("--exclude", metavar="REGEX", help="leave out benchmarks whose name matches REGEX")
     ap.add_argument("--title", help="title of the figure", default="nfourbar: time per drive step (position, velocity, acceleration)")
     args = ap.parse_args(argv)
 
     try:
-        per_file = [(p, load(p)) for p in args.json]
-        sources = {}
-        for p, (curves, _) in per_file:
-            for label in curves:
-                sources.setdefault(label, set()).add(p)
+        try:
+            exclude = re.compile(args.exclude) if args.exclude else None
+        except re.error as e:
+            raise PlotError("--exclude: invalid regular expression: %s" % e)
+        per_file = [(p, load(p, exclude)) for p in args.json]
         merged = {}
         for p, (curves, _) in per_file:
             stem = os.path.splitext(os.path.basename(p))[0]
             for label, points in curves.items():
-                name = label if len(sources[label]) == 1 else "%s (%s)" % (label, stem)
+                name = label if len(args.json) == 1 else "%s (%s)" % (label, stem)
                 for n, ts in points.items():
                     merged.setdefault(name, {}).setdefault(n, []).extend(ts)
         if args.filter:
@@ -191,11 +217,13 @@ def main(argv):
         matplotlib.rcParams["svg.fonttype"] = "none"     # labels stay text: searchable, smaller
         matplotlib.rcParams["svg.hashsalt"] = "phiq"     # stable ids: the same input writes the same file
 
-        fig, ax = plt.subplots(figsize=(8, 5.5))
+        fig, ax = plt.subplots(figsize=(10, 5.5))
         markers = "os^vD<>phX*"
+        colors = plt.get_cmap("tab20").colors
         for i, (label, points) in enumerate(sorted(merged.items())):
             ns = sorted(points)
-            ax.plot(ns, [median(points[n]) for n in ns], marker=markers[i % len(markers)], label=label,
+            color = colors[(2 * i) % 20 + (i // 10) % 2]  # the 10 dark ones of tab20 first, then the light ones
+            ax.plot(ns, [median(points[n]) for n in ns], marker=markers[i % len(markers)], label=label, color=color,
                     linestyle="--" if "from previous" in label else "-")
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -203,16 +231,21 @@ def main(argv):
         ax.set_ylabel("time per drive step (s)")
         ax.set_title(args.title, fontsize=10)
         ax.grid(True, which="both", linewidth=0.3, alpha=0.6)
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
         fig.tight_layout()
         for path, fmt in [(args.output, "svg")] + ([(args.png, "png")] if args.png else []):
             try:
                 fig.savefig(path, format=fmt, metadata={"Date": None} if fmt == "svg" else None, dpi=120)
             except OSError as e:
                 raise PlotError("%s: cannot write: %s" % (path, e.strerror or e))
-        skipped = sum(s for _, (_, s) in per_file)
-        print("%s: %d curves -> %s%s (%d benchmarks skipped: aggregates, errors or no N)" %
-              (PROG, len(merged), args.output, " and " + args.png if args.png else "", skipped), file=sys.stderr)
+        skipped = {}
+        for _, (_, sk) in per_file:
+            for why, k in sk.items():
+                skipped[why] = skipped.get(why, 0) + k
+        print("%s: %d curves -> %s%s%s" % (
+            PROG, len(merged), args.output, " and " + args.png if args.png else "",
+            "; skipped: " + ", ".join("%d %s" % (k, why) for why, k in sorted(skipped.items())) if skipped else ""),
+            file=sys.stderr)
         return 0
     except PlotError as e:
         print("%s: %s" % (PROG, e), file=sys.stderr)
