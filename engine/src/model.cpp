@@ -41,9 +41,9 @@ std::string single_line(const std::string& text) {
 // ---- Model ---------------------------------------------------------------------------------------------------
 
 Index Model::coordinate_index(const std::string& name) const {
-  auto it = index_of_.find(name);
-  if (it == index_of_.end()) throw Error("unknown coordinate '" + name + "'");
-  return it->second;
+  const Index j = index_of_.find(name, [this](Index k) -> const std::string& { return names_[static_cast<std::size_t>(k)]; });
+  if (j < 0) throw Error("unknown coordinate '" + name + "'");
+  return j;
 }
 
 std::string Model::row_name(Index row) const {
@@ -107,8 +107,10 @@ ModelBuilder::ModelBuilder(ModelBuilder&&) noexcept = default;
 Index ModelBuilder::add_coordinate(const std::string& name, double initial) {
   if (name.empty()) throw Error("coordinate name is empty");
   if (!std::isfinite(initial)) throw Error("coordinate '" + name + "': initial value is not finite");
-  auto [it, inserted] = model_.index_of_.emplace(name, num_coordinates());
-  if (!inserted) throw Error("duplicate coordinate name '" + name + "'");
+  if (!model_.index_of_.insert(name, num_coordinates(), [this](Index k) -> const std::string& {
+        return model_.names_[static_cast<std::size_t>(k)];
+      }))
+    throw Error("duplicate coordinate name '" + name + "'");
   model_.names_.push_back(name);
   const Index n = num_coordinates();
   // room grows geometrically (a resize per coordinate would copy the vector each time); build() trims it
@@ -118,31 +120,28 @@ Index ModelBuilder::add_coordinate(const std::string& name, double initial) {
 }
 
 void ModelBuilder::reserve(Index more_coordinates, Index more_constraints) {
-  // grow only: reserving less than a hash table holds would shrink its buckets, and a vector's reserve of a little
-  // more each time would copy it each time
-  auto grow_table = [](auto& table, std::size_t n) {
-    if (static_cast<double>(n) > static_cast<double>(table.bucket_count()) * table.max_load_factor()) table.reserve(n);
-  };
+  // grow only: a vector's reserve of a little more each time would copy it each time
   auto grow_vector = [](auto& v, std::size_t n) {
     if (n > v.capacity()) v.reserve(std::max(n, 2 * v.capacity()));
   };
   if (more_coordinates > 0) {
     const auto n = static_cast<std::size_t>(num_coordinates() + more_coordinates);
-    grow_table(model_.index_of_, n);
+    model_.index_of_.reserve(n);
     grow_vector(model_.names_, n);
     if (model_.initial_.size() < static_cast<Index>(n)) model_.initial_.conservativeResize(static_cast<Index>(n));
   }
   if (more_constraints > 0) {
     const auto n = model_.constraints_.size() + static_cast<std::size_t>(more_constraints);
-    grow_table(constraint_names_, n);
+    constraint_names_.reserve(n);
     grow_vector(model_.constraints_, n);
     grow_vector(model_.row_constraint_, std::max(n, model_.row_constraint_.size()));
   }
 }
 
 Index ModelBuilder::find_coordinate(const std::string& name) const {
-  auto it = model_.index_of_.find(name);
-  return it == model_.index_of_.end() ? -1 : it->second;
+  return model_.index_of_.find(name, [this](Index k) -> const std::string& {
+    return model_.names_[static_cast<std::size_t>(k)];
+  });
 }
 
 void ModelBuilder::set_initial(Index j, double value) {
@@ -169,7 +168,10 @@ void ModelBuilder::check_slot(const Slot& s, const std::string& name) const {
 }
 
 Index ModelBuilder::add_info(const std::string& name, const char* kind, int rows, bool depends_on_time) {
-  if (!constraint_names_.insert(name).second) throw Error("duplicate constraint name '" + name + "'");
+  if (!constraint_names_.insert(name, static_cast<Index>(model_.constraints_.size()), [this](Index k) -> const std::string& {
+        return model_.constraints_[static_cast<std::size_t>(k)].name;
+      }))
+    throw Error("duplicate constraint name '" + name + "'");
   const Index id = static_cast<Index>(model_.constraints_.size());
   model_.constraints_.push_back(
       ConstraintInfo{name, kind, static_cast<Index>(model_.row_constraint_.size()), rows, depends_on_time});
@@ -226,7 +228,7 @@ Model ModelBuilder::build() && {
   Model& m = model_;
   const Index n = m.num_coordinates(), rows = m.num_equations();
   m.initial_.conservativeResize(n);  // add_coordinate() and reserve() leave room beyond n
-  std::unordered_set<std::string>().swap(constraint_names_);  // only needed while adding: free it now
+  constraint_names_.clear();  // only needed while adding: free it now
 
   // Sparsity pattern, fixed for the life of the model.
   std::vector<Index> trip_rows, trip_cols;

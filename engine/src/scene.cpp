@@ -34,10 +34,13 @@ constexpr char kMemberMark = '\x01';
   throw SceneError(s.str());
 }
 
+// Letters, digits and '_', not starting with a digit (ASCII: the "C" locale's isalpha/isalnum, without a call per
+// character — families check millions of names).
 bool valid_name(const std::string& s) {
-  if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
+  auto letter = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
+  if (s.empty() || !letter(s[0])) return false;
   for (char c : s)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return false;
+    if (!(letter(c) || (c >= '0' && c <= '9'))) return false;
   return true;
 }
 
