@@ -12,6 +12,8 @@
 #include <sstream>
 #include <tuple>
 
+#include "phiq/csv_compare.hpp"
+
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -94,6 +96,41 @@ TEST_F(Cli, RunWritesTheCsvWithTheDocumentedColumns) {
   for (std::string cell; std::getline(first, cell, ',');) f.push_back(std::stod(cell));
   ASSERT_EQ(f.size(), 13u);
   EXPECT_NEAR(f[12], -1.56, 1e-12);
+}
+
+// phiq batch: one CSV per case, each the closed form of its own crank length; a case that cannot run writes
+// nothing and makes the exit status 1, without stopping the others.
+TEST_F(Cli, BatchSweepsEveryParameterSetInParallel) {
+  const fs::path cases = write("cases.csv", "L2,L3\n0.2,1.0\n0.3,1.0\n0.4,1.2\n1.5,1.0\n");
+  const fs::path out = dir_ / "out";
+  Result r = run("batch " + phiq::test::model_path("seed/crank_slider_mixed.yaml") + " " + cases.string() + " -o " +
+                 out.string() + " --threads 2");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("case 3: step "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("3 of 4 cases"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("4 cases on one symbolic analysis"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "case3.csv"));
+  const double l2[] = {0.2, 0.3, 0.4}, l3[] = {1.0, 1.0, 1.2};
+  for (int k = 0; k < 3; ++k) {
+    const phiq::CsvTable t = phiq::read_csv_table((out / ("case" + std::to_string(k) + ".csv")).string());
+    ASSERT_EQ(t.rows.size(), 181u);
+    ASSERT_EQ(t.columns[1], "theta2");
+    ASSERT_EQ(t.columns[4], "xB");
+    double worst = 0;
+    for (const auto& row : t.rows) {
+      const double th = row[1], s = std::sin(th);
+      worst = std::max(worst, std::fabs(row[4] - (l2[k] * std::cos(th) + std::sqrt(l3[k] * l3[k] - l2[k] * l2[k] * s * s))));
+    }
+    EXPECT_LT(worst, 1e-9) << "case " << k;
+  }
+  // a column that is not a parameter of the scene: one line naming it and the case, nothing written
+  const fs::path bad = write("bad.csv", "L2,L9\n0.2,1\n");
+  r = run("batch " + phiq::test::model_path("seed/crank_slider_mixed.yaml") + " " + bad.string() + " -o " +
+          (dir_ / "bad").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("'L9' (given for this run) is not a parameter of the scene (case 0 of"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "bad"));
 }
 
 TEST_F(Cli, RunWithoutOutputFileWritesToStandardOutput) {

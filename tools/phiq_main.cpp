@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <filesystem>
 #include <fstream>
 #include <cstdio>
 #include <iostream>
@@ -165,6 +166,105 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   return 0;
 }
 
+// `phiq batch SCENE CASES.csv -o DIR`: the scene swept once per row of CASES.csv (columns: parameter names), the
+// cases in parallel, sharing one symbolic analysis; DIR/case<k>.csv per successful case (k from 0, the row order).
+int cmd_batch(const std::string& scene_path, const std::string& cases_path, const std::string& dir, bool quiet,
+              int threads) {
+  std::string text;
+  {
+    std::ifstream in(scene_path, std::ios::binary);
+    if (!in) return fail(scene_path + ": cannot open the scene file", 2);
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  phiq::CsvTable cases;
+  try {
+    cases = phiq::read_csv_table(cases_path);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 2);
+  }
+  if (cases.rows.empty()) return fail(cases_path + ": no cases (one row per parameter set)", 2);
+  // Build every case's model (in order: each shares the first one's analysis), then sweep them in parallel.
+  std::vector<phiq::Scene> scenes;
+  scenes.reserve(cases.rows.size());
+  const auto load_start = Clock::now();
+  for (std::size_t k = 0; k < cases.rows.size(); ++k) {
+    phiq::SceneOverrides o;
+    for (std::size_t c = 0; c < cases.columns.size(); ++c) o.parameters.emplace_back(cases.columns[c], cases.rows[k][c]);
+    if (!scenes.empty()) o.share_analysis_with = scenes.front().model.get();
+    try {
+      scenes.push_back(phiq::parse_scene(text, scene_path, phiq::SceneLimits{}, o));
+    } catch (const phiq::SceneError& e) {
+      return fail(std::string(e.what()) + " (case " + std::to_string(k) + " of " + cases_path + ", line " +
+                      std::to_string(k + 2) + ")",
+                  2);
+    }
+  }
+  const double load_s = since(load_start);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return fail(dir + ": cannot create the output directory: " + ec.message(), 3);
+  std::vector<const phiq::Model*> models;
+  std::vector<phiq::CsvFormat> formats;
+  std::vector<std::string> buffers(scenes.size());
+  std::vector<std::unique_ptr<phiq::AtomicOutputFile>> files(scenes.size());
+  std::vector<std::string> write_errors(scenes.size());
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    const phiq::Scene& sc = scenes[k];
+    models.push_back(sc.model.get());
+    formats.emplace_back(*sc.model, sc.output_coordinates, sc.sweep.velocities, sc.sweep.accelerations);
+    buffers[k] = formats[k].header();
+    try {
+      files[k] = std::make_unique<phiq::AtomicOutputFile>(dir + "/case" + std::to_string(k) + ".csv");
+    } catch (const phiq::Error& e) {
+      return fail(e.what(), 3);
+    }
+  }
+  std::signal(SIGINT, on_sigint);
+  // Each case touches only its own buffer and file: the callback is safe across cases without a lock.
+  const phiq::BatchSummary sum = phiq::run_batch(models, scenes.front().sweep, threads, [&](std::size_t k, const phiq::StepView& step) {
+    formats[k].append_row(step, buffers[k]);
+    if (buffers[k].size() > (1u << 20)) {
+      try {
+        files[k]->write(buffers[k]);
+      } catch (const phiq::Error& e) {
+        write_errors[k] = e.what();
+        return false;
+      }
+      buffers[k].clear();
+    }
+    return !g_interrupted.load();
+  });
+  std::signal(SIGINT, SIG_DFL);
+  if (g_interrupted) return fail(scene_path + ": interrupted; no output written", 130);
+  int failed = 0;
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    const phiq::SweepSummary& s = sum.cases[k];
+    std::string why = !write_errors[k].empty() ? write_errors[k] : s.status != phiq::SolveStatus::kSuccess ? s.message : "";
+    if (why.empty()) {
+      try {
+        files[k]->write(buffers[k]);
+        files[k]->commit();
+      } catch (const phiq::Error& e) {
+        why = e.what();
+      }
+    }
+    if (!why.empty()) {
+      ++failed;
+      std::cerr << "phiq: " << scene_path << ": case " << k << ": " << why << "; no output written\n";
+    } else if (!quiet) {
+      std::cerr << "phiq: " << scene_path << ": case " << k << ": " << s.BriefReport() << "\n";
+    }
+  }
+  if (!quiet)
+    std::cerr << "phiq: " << scene_path << ": " << scenes.size() - failed << " of " << scenes.size() << " cases in "
+              << dir << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
+              << " cases on one symbolic analysis, load " << sci(load_s) << " s, solve " << sci(sum.solve_seconds)
+              << " s\n";
+  return failed ? 1 : 0;
+}
+
 int cmd_check(const std::string& scene_path, bool json) {
   phiq::Scene scene;
   try {
@@ -292,6 +392,17 @@ int main(int argc, char** argv) {
 
   std::string check_path;
   bool check_json = false;
+  CLI::App* batch = app.add_subcommand("batch", "Sweep the scene once per parameter set of a CSV, the cases in parallel");
+  std::string batch_scene, batch_cases, batch_dir;
+  bool batch_quiet = false;
+  int batch_threads = 0;
+  batch->add_option("scene", batch_scene, "Scene file (YAML)")->required();
+  batch->add_option("cases", batch_cases, "CSV: a header of parameter names, one row of values per case")->required();
+  batch->add_option("-o,--output", batch_dir, "Directory for case<k>.csv (k = row, from 0)")->required();
+  batch->add_flag("-q,--quiet", batch_quiet, "Print only failures on standard error");
+  batch->add_option("--threads", batch_threads, "Threads for the cases (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   CLI::App* check = app.add_subcommand("check", "Count coordinates and equations and try the initial assembly");
   check->add_option("scene", check_path, "Scene file (YAML)")->required();
   check->add_flag("--json", check_json, "Print one JSON object (format: tools/README.md)");
@@ -344,6 +455,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*check) return cmd_check(check_path, check_json);
+    if (*batch) return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, batch_threads);
     if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
   } catch (const std::exception& e) {
     return fail(std::string("internal error: ") + e.what(), 4);

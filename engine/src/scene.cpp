@@ -887,6 +887,7 @@ class SceneReader {
     if (auto n = top.field("name"); n.present()) scene.name = n.text();
     if (auto d = top.field("description"); d.present()) (void)d.text();
 
+    if (overrides_ && overrides_->share_analysis_with) builder_.share_analysis_with(*overrides_->share_analysis_with);
     read_parameters(top.field("parameters"));
     read_coordinates(top.require("coordinates"));
     if (auto p = top.field("points"); p.present()) read_points(p);
@@ -1338,12 +1339,22 @@ class SceneReader {
 
   // ---- top-level sections -------------------------------------------------------------------------------------
   void read_parameters(const Cursor& c) {
-    if (!c.present()) return;
+    if (!c.present()) {
+      if (overrides_ && !overrides_->parameters.empty())
+        c.fail("'" + overrides_->parameters[0].first + "' (given for this run) is not a parameter of the scene");
+      return;
+    }
     for (auto& [name, key_mark, value] : c.entries()) {
       if (!Cursor::valid_name(name)) value.fail("'" + name + "' is not a valid parameter name");
       if (name == "t" || name == "pi") value.fail("'" + name + "' is reserved");
       parameters_[name] = number(value);  // may use the parameters above it
+      if (overrides_)
+        for (const auto& [n, v] : overrides_->parameters)
+          if (n == name) parameters_[name] = v;
     }
+    if (overrides_)
+      for (const auto& [n, v] : overrides_->parameters)
+        if (!parameters_.count(n)) c.fail("'" + n + "' (given for this run) is not a parameter of the scene");
   }
 
   void read_coordinates(const Cursor& c) {
@@ -1802,6 +1813,11 @@ class SceneReader {
   const std::string& file_;
   const SceneLimits& limits_;
   ModelBuilder builder_;
+
+ public:
+  const SceneOverrides* overrides_ = nullptr;  ///< the caller's changes, if any
+
+ private:
   std::unordered_map<std::string, double> parameters_;
   NameTable<Point2> points_;
   NameTable<Frame2> bodies_;
@@ -1872,6 +1888,11 @@ std::string yaml_error(const std::string& path, const YAML::Exception& e) {
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits) {
+  return parse_scene(text, path, limits, SceneOverrides{});
+}
+
+Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits,
+                  const SceneOverrides& overrides) {
   if (text.size() > limits.max_file_bytes)
     throw SceneError(path + ": the scene is " + std::to_string(text.size() >> 20) + " MiB; the limit is " +
                      std::to_string(limits.max_file_bytes >> 20) + " MiB");
@@ -1892,6 +1913,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
     throw SceneError(yaml_error(path, e));
   }
   SceneReader reader(path, limits);
+  reader.overrides_ = &overrides;
   Scene scene = reader.read(root);
   // A predictor that needs derivatives the scene does not output would compute extra work silently: refuse.
   if (reader.predictor_given()) {

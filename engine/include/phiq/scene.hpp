@@ -43,8 +43,22 @@ struct Scene {
 
 /// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,
 /// unknown or duplicate fields and names, wrong types, NaN or infinite numbers and impossible values.
+/// Changes to a scene made by the caller rather than the file (batch mode, `phiq batch`).
+struct SceneOverrides {
+  /// Parameter values replacing the file's, by name; each must be a parameter of the scene (else SceneError). A
+  /// replaced parameter is seen by every parameter, number and family after it, as if the file had said so.
+  std::vector<std::pair<std::string, double>> parameters;
+  /// If set, the model shares this model's pattern and symbolic analysis when its structure is the same
+  /// (ModelBuilder::share_analysis_with()); it must outlive the call.
+  const Model* share_analysis_with = nullptr;
+};
+
 Scene load_scene(const std::string& path, const SceneLimits& limits = {});
 /// The same from text; `path` is used in messages only.
 Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits = {});
+/// parse_scene() with the caller's overrides (batch mode). Throws SceneError as parse_scene() does, and for an
+/// override naming no parameter of the scene.
+Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits,
+                  const SceneOverrides& overrides);
 
 }  // namespace phiq
