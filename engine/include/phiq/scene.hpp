@@ -41,8 +41,6 @@ struct Scene {
   std::vector<Index> output_coordinates;  ///< columns written, in scene order (default: all coordinates)
 };
 
-/// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,
-/// unknown or duplicate fields and names, wrong types, NaN or infinite numbers and impossible values.
 /// Changes to a scene made by the caller rather than the file (batch mode, `phiq batch`).
 struct SceneOverrides {
   /// Parameter values replacing the file's, by name; each must be a parameter of the scene (else SceneError). A
@@ -53,6 +51,8 @@ struct SceneOverrides {
   const Model* share_analysis_with = nullptr;
 };
 
+/// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,
+/// unknown or duplicate fields and names, wrong types, NaN or infinite numbers and impossible values.
 Scene load_scene(const std::string& path, const SceneLimits& limits = {});
 /// The same from text; `path` is used in messages only.
 Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits = {});
