@@ -56,6 +56,31 @@ bool is_family_key(const std::string& k) {
 }
 
 // A YAML node with the dotted path that led to it, for messages.
+// Typed reads of a scalar, shared by the cursor over the YAML tree (Cursor) and over a family's copied body
+// (TCursor): `c` supplies text() and fail().
+template <class C>
+std::string scalar_name(const C& c) {
+  std::string s = c.text();
+  if (!valid_name(s)) c.fail("'" + s + "' is not a valid name (letters, digits and '_', not starting with a digit)");
+  return s;
+}
+template <class C>
+bool scalar_boolean(const C& c) {
+  std::string s = c.text();
+  if (s == "true" || s == "yes" || s == "on") return true;
+  if (s == "false" || s == "no" || s == "off") return false;
+  c.fail("expected true or false, got '" + s + "'");
+}
+template <class C>
+std::int64_t scalar_integer(const C& c, std::int64_t lo, std::int64_t hi) {
+  std::string s = c.text();
+  std::int64_t v = 0;
+  auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || p != s.data() + s.size()) c.fail("expected a whole number, got '" + s + "'");
+  if (v < lo || v > hi) c.fail("must be between " + std::to_string(lo) + " and " + std::to_string(hi));
+  return v;
+}
+
 class Cursor {
  public:
   Cursor(YAML::Node node, std::string path, const std::string* file, YAML::Mark parent_mark)
@@ -121,26 +146,9 @@ class Cursor {
     if (!node_.IsScalar()) fail("expected a single value");
     return node_.Scalar();
   }
-  std::string name() const {
-    std::string s = text();
-    if (!valid_name(s))
-      fail("'" + s + "' is not a valid name (letters, digits and '_', not starting with a digit)");
-    return s;
-  }
-  bool boolean() const {
-    std::string s = text();
-    if (s == "true" || s == "yes" || s == "on") return true;
-    if (s == "false" || s == "no" || s == "off") return false;
-    fail("expected true or false, got '" + s + "'");
-  }
-  std::int64_t integer(std::int64_t lo, std::int64_t hi) const {
-    std::string s = text();
-    std::int64_t v = 0;
-    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || p != s.data() + s.size()) fail("expected a whole number, got '" + s + "'");
-    if (v < lo || v > hi) fail("must be between " + std::to_string(lo) + " and " + std::to_string(hi));
-    return v;
-  }
+  std::string name() const { return scalar_name(*this); }
+  bool boolean() const { return scalar_boolean(*this); }
+  std::int64_t integer(std::int64_t lo, std::int64_t hi) const { return scalar_integer(*this, lo, hi); }
 
   static bool valid_name(const std::string& s) { return phiq::valid_name(s); }
 
@@ -776,26 +784,9 @@ class TCursor {
     }
     return out;
   }
-  std::string name() const {
-    std::string s = text();
-    if (!valid_name(s))
-      fail("'" + s + "' is not a valid name (letters, digits and '_', not starting with a digit)");
-    return s;
-  }
-  bool boolean() const {
-    std::string s = text();
-    if (s == "true" || s == "yes" || s == "on") return true;
-    if (s == "false" || s == "no" || s == "off") return false;
-    fail("expected true or false, got '" + s + "'");
-  }
-  std::int64_t integer(std::int64_t lo, std::int64_t hi) const {
-    std::string s = text();
-    std::int64_t v = 0;
-    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || p != s.data() + s.size()) fail("expected a whole number, got '" + s + "'");
-    if (v < lo || v > hi) fail("must be between " + std::to_string(lo) + " and " + std::to_string(hi));
-    return v;
-  }
+  std::string name() const { return scalar_name(*this); }
+  bool boolean() const { return scalar_boolean(*this); }
+  std::int64_t integer(std::int64_t lo, std::int64_t hi) const { return scalar_integer(*this, lo, hi); }
 
   ScalarPlan& plan() const {
     if (!node_->plan) node_->plan = std::make_shared<ScalarPlan>();
