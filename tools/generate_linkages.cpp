@@ -1,6 +1,6 @@
 // `phiq generate scissor N` and `phiq generate grid N`: linkages of any size with a closed-form solution, for tests
-// and benchmarks. Geometry, names and closed forms: tools/README.md. Every piece of text goes through the emitters
-// of scene_writer.hpp.
+// and benchmarks. Geometry, names and closed forms: tools/README.md. Single entries go through the emitters of
+// scene_writer.hpp; the indexed families (`for k in ...`) are built here and written with SceneText::raw.
 #include "generate_linkages.hpp"
 
 #include <charconv>
