@@ -1,6 +1,7 @@
 // `phiq generate scissor` and `phiq generate grid`: the scenes load, are square with the stated counts, and their
 // sweeps follow the closed forms of tools/README.md (positions, velocities, accelerations) in both coordinate
-// styles, which agree with each other; generation is linear in N.
+// styles, which agree with each other; they are written with indexed families (size independent of N) and are
+// the model of the explicit listing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,10 +9,13 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "generate.hpp"
 #include "test_support.hpp"
+
+#include "explicit_linkages.inc"
 
 namespace phiq {
 namespace {
@@ -327,25 +331,39 @@ TEST(Generate, OutputsAndStepsReachTheScene) {
   }
 }
 
-// Lines of a generated scene: 12 fixed (6 header, 4 section keys, time, output) plus one per coordinate, point or
-// body, constraint and driver (tools/README.md gives the counts).
-std::int64_t expected_lines(const std::string& kind, const std::string& coords, std::int64_t n) {
-  if (kind == "scissor") return coords == "natural" ? 15 * n + 18 : 11 * n + 18;
-  const std::int64_t r = shape_of(n).rows;
-  return coords == "natural" ? 5 * n + 7 * r + 12 : 11 * n + 6 * r + 12;
+TEST(Generate, SceneSizeDoesNotGrowWithN) {
+  // Written with indexed families: sizes differ only in a few digits (counts, ranges, parameters). The grid's text
+  // has one shape per parity of its row count and whether the last row is short: N = 14 (4 rows of 4, the last 2)
+  // has the shape of N = 10^5 (316 rows of 317, the last 145); any N stays under 8 KB.
+  for (const char* kind : {"scissor", "grid"})
+    for (const char* coords : {"natural", "reference-point"}) {
+      auto size = [&](std::int64_t n) { return tools::generate_scene(options(kind, n, coords, 0.5, 1.0, 10)).size(); };
+      const std::size_t small = size(std::string(kind) == "grid" ? 14 : 10), large = size(100000);
+      EXPECT_LT(std::max(small, large) - std::min(small, large), 100u) << kind << " " << coords;
+      for (std::int64_t n : {1, 2, 3, 7, 10, 1000000, 10000000}) EXPECT_LT(size(n), 8192u) << kind << " " << coords;
+    }
 }
 
-TEST(Generate, LargeScenesAreLinearInN) {
-  // N = 10^5 is generated in a fraction of a second (not timed here): one line per element, lines of bounded length
-  for (const char* kind : {"scissor", "grid"})
+// The family form is the model the explicit listing (explicit_linkages.inc) describes: names, order, initial values,
+// constraints and drivers bit for bit, with the grid's last row short or full and odd and even rows.
+TEST(Generate, FamilyFormIsTheExplicitModel) {
+  struct Case {
+    const char* kind;
+    std::int64_t n;
+  };
+  for (Case c : {Case{"scissor", 1}, Case{"scissor", 2}, Case{"scissor", 7}, Case{"grid", 1}, Case{"grid", 2},
+                 Case{"grid", 3}, Case{"grid", 5}, Case{"grid", 7}, Case{"grid", 9}, Case{"grid", 10},
+                 Case{"grid", 13}, Case{"grid", 20}, Case{"grid", 30}})
     for (const char* coords : {"natural", "reference-point"})
-      for (std::int64_t n : {1, 2, 7, 1000, 100000}) {
-        const std::string s = tools::generate_scene(options(kind, n, coords, 0.5, 1.0, 10));
-        const auto lines = static_cast<std::int64_t>(std::count(s.begin(), s.end(), '\n'));
-        EXPECT_EQ(lines, expected_lines(kind, coords, n)) << kind << " " << coords << " " << n;
-        if (n >= 1000) {
-          EXPECT_LT(s.size(), static_cast<std::size_t>(lines) * 100) << kind << " " << coords;
-        }
+      for (auto [from, to] : {std::pair{0.3, 1.2}, std::pair{1.1, 0.4}}) {
+        SCOPED_TRACE(std::string(c.kind) + " " + std::to_string(c.n) + " " + coords + " " + std::to_string(from));
+        const GenerateOptions o = options(c.kind, c.n, coords, from, to, 5);
+        const std::string families = tools::generate_scene(o), listed = test::explicit_linkages::scene(o);
+        EXPECT_NE(families.find("for k in"), std::string::npos);
+        EXPECT_EQ(listed.find(" in 0.."), std::string::npos);
+        Scene a = parse_scene(families, "families.yaml"), b = parse_scene(listed, "listed.yaml");
+        test::expect_same_model(*a.model, *b.model);
+        EXPECT_EQ(a.sweep.steps, b.sweep.steps);
       }
 }
 

@@ -1,6 +1,6 @@
 // `phiq generate scissor N` and `phiq generate grid N`: linkages of any size with a closed-form solution, for tests
-// and benchmarks. Geometry, names and closed forms: tools/README.md. Every piece of text goes through the emitters
-// of scene_writer.hpp.
+// and benchmarks. Geometry, names and closed forms: tools/README.md. Single entries go through the emitters of
+// scene_writer.hpp; the indexed families (`for k in ...`) are built here and written with SceneText::raw.
 #include "generate_linkages.hpp"
 
 #include <charconv>
@@ -60,10 +60,6 @@ void footer(SceneText& t, const GenerateOptions& o) {
   t.output(o.v, o.a);
 }
 
-std::size_t reserve(std::int64_t n, std::size_t bytes_per_unit) {
-  return static_cast<std::size_t>(n) * bytes_per_unit + 4096;
-}
-
 // ---------------------------------------------------------------------------------------------------------------
 // Scissor lift: stage k (0 ≤ k < N) has bar a_k from L_k up to R_{k+1} and bar b_k from R_k up to L_{k+1}, both of
 // length 1, pinned together at their midpoints M_k. L_0 is pinned to ground at the origin, R_0 slides along the
@@ -77,47 +73,46 @@ std::string scissor_drive(const GenerateOptions& o, const std::string& coordinat
          " at t = 0 to " + num(o.to) + " at t = 1";
 }
 
+// The scenes are written with indexed families (`for k in 0..N-1`, models/README.md), so that their size does not
+// depend on N, and describe exactly the model listing every entry would: the same names and order, and initial
+// values written as expressions of the index and of parameters holding the doubles used here, which the loader
+// evaluates in double precision in the order written ((k + 0.5)*s is the double (k + 0.5) * s computed here).
+
 // Natural coordinates: the joints L_k, R_k (k ≥ 1) and the crossing pins M_k; R_0 = (xr0, 0) on the ground.
 // Per stage 6 coordinates and 6 equations: the two bars (distance), the pin half a bar from each lower end
 // (distance), and on each bar's line (point_on_line). With θ and xr0: n = 6N + 2, m = 6N + 1 + 1 driver.
 std::string scissor_natural(const GenerateOptions& o) {
   const std::int64_t n = o.n;
   const double c = std::cos(o.from), s = std::sin(o.from);
-  SceneText t(reserve(n, 900));
+  SceneText t(4096);
   header(t, o, kScissorWhat, scissor_drive(o, "theta"), 6 * n + 2, 6 * n + 1, 1,
          "points L<k> = (xl<k>, yl<k>) and R<k> = (xr<k>, yr<k>) are the left and right joints at level k "
          "(L0 = origin, R0 = (xr0, 0) the slider), M<k> = (xm<k>, ym<k>) the crossing pin of stage k; "
          "bar a<k> joins L<k> to R<k+1>, bar b<k> joins R<k> to L<k+1>");
+  t.raw("parameters:\n  N: " + str(n) + "\n  c: " + num(c) + "    # cos(from)\n  s: " + num(s) +
+        "    # sin(from)\n  hc: " + num(0.5 * c) + "    # c/2\n");
   t.section("coordinates");
   t.coordinate(Name{"xr", 0}, c);
-  for (std::int64_t k = 0; k < n; ++k) {
-    const double level = static_cast<double>(k + 1) * s;
-    t.coordinate(Name{"xm", k}, 0.5 * c);
-    t.coordinate(Name{"ym", k}, (static_cast<double>(k) + 0.5) * s);
-    t.coordinate(Name{"xl", k + 1}, 0.0);
-    t.coordinate(Name{"yl", k + 1}, level);
-    t.coordinate(Name{"xr", k + 1}, c);
-    t.coordinate(Name{"yr", k + 1}, level);
-  }
+  t.raw("  for k in 0..N-1:\n"
+        "    xm{k}: hc\n    ym{k}: (k + 0.5)*s\n"
+        "    xl{k+1}: 0\n    yl{k+1}: (k+1)*s\n"
+        "    xr{k+1}: c\n    yr{k+1}: (k+1)*s\n");
   t.coordinate(Name{"theta"}, o.from);
   t.section("points");
   t.point(Name{"L", 0}, Component::of(0.0), Component::of(0.0));
   t.point(Name{"R", 0}, Name{"xr", 0}, Component::of(0.0));
-  for (std::int64_t k = 0; k < n; ++k) {
-    t.point(Name{"M", k}, Name{"xm", k}, Name{"ym", k});
-    t.point(Name{"L", k + 1}, Name{"xl", k + 1}, Name{"yl", k + 1});
-    t.point(Name{"R", k + 1}, Name{"xr", k + 1}, Name{"yr", k + 1});
-  }
+  t.raw("  for k in 0..N-1:\n"
+        "    M{k}: [\"xm{k}\", \"ym{k}\"]\n"
+        "    L{k+1}: [\"xl{k+1}\", \"yl{k+1}\"]\n"
+        "    R{k+1}: [\"xr{k+1}\", \"yr{k+1}\"]\n");
   t.section("constraints");
-  for (std::int64_t k = 0; k < n; ++k) {
-    const Name l{"L", k}, r{"R", k}, m{"M", k}, l1{"L", k + 1}, r1{"R", k + 1};
-    t.distance(Name{"a", k}, l, r1, 1.0);
-    t.distance(Name{"b", k}, r, l1, 1.0);
-    t.distance(Name{"mida", k}, l, m, 0.5);
-    t.distance(Name{"midb", k}, r, m, 0.5);
-    t.point_on_line(Name{"ona", k}, m, l, r1);
-    t.point_on_line(Name{"onb", k}, m, r, l1);
-  }
+  t.raw("  - for k in 0..N-1:\n"
+        "      - {name: \"a{k}\", type: distance, points: [\"L{k}\", \"R{k+1}\"], length: 1}\n"
+        "      - {name: \"b{k}\", type: distance, points: [\"R{k}\", \"L{k+1}\"], length: 1}\n"
+        "      - {name: \"mida{k}\", type: distance, points: [\"L{k}\", \"M{k}\"], length: 0.5}\n"
+        "      - {name: \"midb{k}\", type: distance, points: [\"R{k}\", \"M{k}\"], length: 0.5}\n"
+        "      - {name: \"ona{k}\", type: point_on_line, point: \"M{k}\", line: [\"L{k}\", \"R{k+1}\"]}\n"
+        "      - {name: \"onb{k}\", type: point_on_line, point: \"M{k}\", line: [\"R{k}\", \"L{k+1}\"]}\n");
   t.segment_angle(Name{"angle"}, Name{"L", 0}, Name{"R", 1}, Name{"theta"});
   t.section("drivers");
   t.linear_driver(Name{"motor"}, Name{"theta"}, o.from, o.to - o.from);
@@ -132,43 +127,38 @@ std::string scissor_natural(const GenerateOptions& o) {
 std::string scissor_reference_point(const GenerateOptions& o) {
   const std::int64_t n = o.n;
   const double c = std::cos(o.from), s = std::sin(o.from);
-  SceneText t(reserve(n, 750));
+  SceneText t(4096);
   header(t, o, kScissorWhat, scissor_drive(o, "psia0"), 6 * n + 3, 6 * n + 2, 1,
          "bodies a<k> = (xa<k>, ya<k>, psia<k>) and b<k> = (xb<k>, yb<k>, psib<k>) are the bars of stage k "
          "(a rises to the right from the left joint, b to the left from the right joint; reference point at the "
          "middle = the crossing pin), s = (xs, ys, psis) the slider");
+  t.raw("parameters:\n  N: " + str(n) + "\n  s: " + num(s) + "    # sin(from)\n  hc: " + num(0.5 * c) +
+        "    # cos(from)/2\n  from: " + num(o.from) + "\n  pmf: " + num(kPi - o.from) + "    # pi - from\n");
   t.section("coordinates");
   t.coordinate(Name{"xs"}, c);
   t.coordinate(Name{"ys"}, 0.0);
   t.coordinate(Name{"psis"}, 0.0);
-  for (std::int64_t k = 0; k < n; ++k) {
-    const double ym = (static_cast<double>(k) + 0.5) * s;
-    t.coordinate(Name{"xa", k}, 0.5 * c);
-    t.coordinate(Name{"ya", k}, ym);
-    t.coordinate(Name{"psia", k}, o.from);
-    t.coordinate(Name{"xb", k}, 0.5 * c);
-    t.coordinate(Name{"yb", k}, ym);
-    t.coordinate(Name{"psib", k}, kPi - o.from);
-  }
+  t.raw("  for k in 0..N-1:\n"
+        "    xa{k}: hc\n    ya{k}: (k + 0.5)*s\n    psia{k}: from\n"
+        "    xb{k}: hc\n    yb{k}: (k + 0.5)*s\n    psib{k}: pmf\n");
   t.section("bodies");
   t.body(Name{"s"}, Name{"xs"}, Name{"ys"}, Name{"psis"});
-  for (std::int64_t k = 0; k < n; ++k) {
-    t.body(Name{"a", k}, Name{"xa", k}, Name{"ya", k}, Name{"psia", k});
-    t.body(Name{"b", k}, Name{"xb", k}, Name{"yb", k}, Name{"psib", k});
-  }
+  t.raw("  for k in 0..N-1:\n"
+        "    a{k}: [\"xa{k}\", \"ya{k}\", \"psia{k}\"]\n"
+        "    b{k}: [\"xb{k}\", \"yb{k}\", \"psib{k}\"]\n");
   t.section("constraints");
   const Name ground{"ground"};
   t.revolute(Name{"pivot"}, Attach{Name{"a", 0}, -0.5, 0.0}, Attach{ground, 0.0, 0.0});
   t.prismatic(Name{"guide"}, Attach{ground, 0.0, 0.0}, Attach{Name{"s"}, 0.0, 0.0});
   t.revolute(Name{"slide"}, Attach{Name{"b", 0}, -0.5, 0.0}, Attach{Name{"s"}, 0.0, 0.0});
-  for (std::int64_t k = 0; k < n; ++k) {
-    const Name a{"a", k}, b{"b", k};
-    t.revolute(Name{"cross", k}, Attach{a, 0.0, 0.0}, Attach{b, 0.0, 0.0});
-    if (k + 1 < n) {
-      t.revolute(Name{"right", k + 1}, Attach{a, 0.5, 0.0}, Attach{Name{"b", k + 1}, -0.5, 0.0});
-      t.revolute(Name{"left", k + 1}, Attach{b, 0.5, 0.0}, Attach{Name{"a", k + 1}, -0.5, 0.0});
-    }
-  }
+  t.raw("  - for k in 0..N-2:\n"
+        "      - {name: \"cross{k}\", type: revolute, between: [{body: \"a{k}\", at: [0, 0]}, {body: \"b{k}\", "
+        "at: [0, 0]}]}\n"
+        "      - {name: \"right{k+1}\", type: revolute, between: [{body: \"a{k}\", at: [0.5, 0]}, {body: "
+        "\"b{k+1}\", at: [-0.5, 0]}]}\n"
+        "      - {name: \"left{k+1}\", type: revolute, between: [{body: \"b{k}\", at: [0.5, 0]}, {body: "
+        "\"a{k+1}\", at: [-0.5, 0]}]}\n");
+  t.revolute(Name{"cross", n - 1}, Attach{Name{"a", n - 1}, 0.0, 0.0}, Attach{Name{"b", n - 1}, 0.0, 0.0});
   t.section("drivers");
   t.linear_driver(Name{"motor"}, Name{"psia", 0}, o.from, o.to - o.from);
   footer(t, o);
@@ -215,45 +205,91 @@ std::string grid_shape_text(const GridShape& g) {
          (g.last == g.cols ? std::string() : " (the top row " + str(g.last) + ")");
 }
 
+// Families of the grid. Even rows j = 2k start at `from`, odd rows 2k + 1 at `to`, so the coordinates are written
+// by pairs of rows (`for k in ...`, rows 2k and 2k + 1), the last (shorter) row in a family of one member k. The sum
+// over rows below of the row angles' cosines (sines) is written in closed form, e·ca + o·cb with e even and o odd
+// rows (sums()), the double the loader computes from the same expression.
+
+// The text of a number of ne even and no odd rows, for the expression (ne)*a + (no)*b: "(k+1)*ca + k*cb".
+std::string sums(const std::string& ne, const std::string& no, const char* a, const char* b) {
+  return "(" + ne + ")*" + a + " + (" + no + ")*" + b;
+}
+
+// Rows 0 … R−2 are full (C cells), row R−1 holds `last`. Pairs of rows k = 0 … P−1 are full; the tail is the
+// family k = P … P: row 2P alone (the last row, R odd), or rows 2P (full) and 2P + 1 (the last row, R even).
+struct RowPairs {
+  std::int64_t pairs;  // P
+  bool odd_tail;       // R even: the tail has an odd row too
+};
+RowPairs row_pairs(const GridShape& g) { return {(g.rows - 1) / 2, g.rows % 2 == 0}; }
+
+std::string range(std::int64_t a, std::int64_t b) { return str(a) + ".." + str(b); }
+
+// Parameters of both grid styles: the shape and the row angles at t = 0.
+void grid_parameters(SceneText& t, const GenerateOptions& o, const GridShape& g) {
+  t.raw("parameters:\n  N: " + str(o.n) + "\n  C: " + str(g.cols) + "    # cells per row\n  L: " + str(g.last) +
+        "    # cells of the last row\n  R: " + str(g.rows) + "    # rows\n  from: " + num(o.from) + "\n  to: " +
+        num(o.to) + "\n  ca: " + num(std::cos(o.from)) + "\n  sa: " + num(std::sin(o.from)) + "\n  cb: " +
+        num(std::cos(o.to)) + "\n  sb: " + num(std::sin(o.to)) + "\n  hca: " + num(0.5 * std::cos(o.from)) +
+        "\n  hsa: " + num(0.5 * std::sin(o.from)) + "\n  hcb: " + num(0.5 * std::cos(o.to)) + "\n  hsb: " +
+        num(0.5 * std::sin(o.to)) + "\n");
+}
+
+// The drivers: motor<j> drives row j's angle from `from` (even j) or `to` (odd j) at the rate of row_rate.
+void grid_drivers(SceneText& t, const GenerateOptions& o, const GridShape& g, const std::string& coordinate) {
+  const RowPairs p = row_pairs(g);
+  auto law = [&](const std::string& jt, std::int64_t parity) {
+    return "      - {name: \"motor" + jt + "\", coordinate: \"" + coordinate + jt + "\", law: {type: linear, "
+           "initial: " + num(row_initial(o, parity)) + ", rate: " + num(row_rate(o, parity)) + "}}\n";
+  };
+  t.section("drivers");
+  t.raw("  - for k in " + range(0, p.pairs - 1) + ":\n" + law("{2*k}", 0) + law("{2*k+1}", 1));
+  t.raw("  - for k in " + range(p.pairs, p.pairs) + ":\n" + law("{2*k}", 0) + (p.odd_tail ? law("{2*k+1}", 1) : ""));
+}
+
 // Natural coordinates: the nodes above ground and the row angles. n = 2N + 3R, m = 2N + 2R + R drivers.
 std::string grid_natural(const GenerateOptions& o) {
   const GridShape g = grid_shape(o.n);
   const std::int64_t n = o.n, r = g.rows;
-  SceneText t(reserve(n, 320) + static_cast<std::size_t>(r) * 400);
+  const RowPairs p = row_pairs(g);
+  SceneText t(8192);
   header(t, o, std::string(kGridWhat) + ": " + grid_shape_text(g), grid_drive(o, "theta<j>"), 2 * n + 3 * r,
          2 * n + 2 * r, r,
          "point P<i>_<j> = (x<i>_<j>, y<i>_<j>) is node (i, j) for j >= 1 (node (i, 0) is ground at [i, 0]); "
          "constraints v<i>_<j> (bar from node (i, j) up to (i, j+1)), h<i>_<j> (bar from node (i, j) to (i+1, j)), "
          "row<j> (angle of v0_<j> = theta<j>)");
+  grid_parameters(t, o, g);
   t.section("coordinates");
-  double sx = 0.0, sy = 0.0;  // Σ_{k<j} (cos θ_k, sin θ_k) at t = 0
-  for (std::int64_t j = 0; j < r; ++j) {
-    const double th = row_initial(o, j);
-    sx += std::cos(th);
-    sy += std::sin(th);
-    t.coordinate(Name{"theta", j}, th);
-    for (std::int64_t i = 0; i <= g.width(j); ++i) {
-      t.coordinate(Name{"x", i, j + 1}, static_cast<double>(i) + sx);
-      t.coordinate(Name{"y", i, j + 1}, sy);
-    }
-  }
-  t.section("points");
-  for (std::int64_t j = 0; j < r; ++j)
-    for (std::int64_t i = 0; i <= g.width(j); ++i)
-      t.point(Name{"P", i, j + 1}, Name{"x", i, j + 1}, Name{"y", i, j + 1});
-  t.section("constraints");
-  auto node = [](std::int64_t i, std::int64_t j) {
-    return j == 0 ? PointRef::at(static_cast<double>(i), 0.0) : PointRef(Name{"P", i, j});
+  // Row j = 2k (+1 if odd) of width w: theta<j>, then node row j + 1 at Σ_{rows ≤ j} (cos, sin) θ.
+  auto row = [](bool odd, const std::string& w, const char* idx) {
+    const std::string j = odd ? "{2*k+1}" : "{2*k}", j1 = odd ? "{2*k+2}" : "{2*k+1}";
+    const std::string ne = "k+1", no = odd ? "k+1" : "k", i = idx;
+    return "    theta" + j + ": " + (odd ? "to" : "from") + "\n    for " + i + " in 0.." + w + ":\n      x{" + i +
+           "}_" + j1 + ": " + i + " + (" + sums(ne, no, "ca", "cb") + ")\n      y{" + i + "}_" + j1 + ": " +
+           sums(ne, no, "sa", "sb") + "\n";
   };
-  for (std::int64_t j = 0; j < r; ++j) {
-    const std::int64_t w = g.width(j);
-    t.segment_angle(Name{"row", j}, node(0, j), node(0, j + 1), Name{"theta", j});
-    for (std::int64_t i = 0; i <= w; ++i) t.distance(Name{"v", i, j}, node(i, j), node(i, j + 1), 1.0);
-    for (std::int64_t i = 0; i < w; ++i) t.distance(Name{"h", i, j + 1}, node(i, j + 1), node(i + 1, j + 1), 1.0);
-  }
-  t.section("drivers");
-  for (std::int64_t j = 0; j < r; ++j)
-    t.linear_driver(Name{"motor", j}, Name{"theta", j}, row_initial(o, j), row_rate(o, j));
+  t.raw("  for k in " + range(0, p.pairs - 1) + ":    # rows 2k and 2k+1\n" + row(false, "C", "i") +
+        row(true, "C", "m"));
+  t.raw("  for k in " + range(p.pairs, p.pairs) + ":    # the last row" + (p.odd_tail ? "s" : "") + "\n" +
+        (p.odd_tail ? row(false, "C", "i") + row(true, "L", "m") : row(false, "L", "i")));
+  t.section("points");
+  t.raw("  for j in " + range(0, r - 2) + ":\n    for i in 0..C:\n      P{i}_{j+1}: [\"x{i}_{j+1}\", \"y{i}_{j+1}\"]\n");
+  t.raw("  for i in 0..L:\n    P{i}_" + str(r) + ": [\"x{i}_" + str(r) + "\", \"y{i}_" + str(r) + "\"]\n");
+  t.section("constraints");
+  // Row j (text jt, j + 1 text j1t) of width w; node row j is ground for j = 0.
+  auto crow = [](const std::string& ind, const std::string& jt, const std::string& j1t, const std::string& w,
+                 bool ground) {
+    const std::string a0 = ground ? "[0, 0]" : "\"P0_" + jt + "\"", ai = ground ? "[i, 0]" : "\"P{i}_" + jt + "\"";
+    return ind + "- {name: \"row" + jt + "\", type: segment_angle, segment: [" + a0 + ", \"P0_" + j1t +
+           "\"], angle: \"theta" + jt + "\"}\n" + ind + "- for i in 0.." + w + ":\n" + ind + "    - {name: \"v{i}_" +
+           jt + "\", type: distance, points: [" + ai + ", \"P{i}_" + j1t + "\"], length: 1}\n" + ind +
+           "- for i in 0.." + w + "-1:\n" + ind + "    - {name: \"h{i}_" + j1t +
+           "\", type: distance, points: [\"P{i}_" + j1t + "\", \"P{i+1}_" + j1t + "\"], length: 1}\n";
+  };
+  t.raw(crow("  ", "0", "1", r > 1 ? "C" : "L", true));
+  t.raw("  - for j in " + range(1, r - 2) + ":\n" + crow("      ", "{j}", "{j+1}", "C", false));
+  if (r > 1) t.raw("  - for j in " + range(r - 1, r - 1) + ":\n" + crow("      ", "{j}", "{j+1}", "L", false));
+  grid_drivers(t, o, g, "theta");
   footer(t, o);
   return t.take();
 }
@@ -266,53 +302,77 @@ std::string grid_natural(const GenerateOptions& o) {
 std::string grid_reference_point(const GenerateOptions& o) {
   const GridShape g = grid_shape(o.n);
   const std::int64_t n = o.n, r = g.rows;
-  SceneText t(reserve(n, 750) + static_cast<std::size_t>(r) * 400);
+  const RowPairs p = row_pairs(g);
+  SceneText t(16384);
   header(t, o, std::string(kGridWhat) + ": " + grid_shape_text(g), grid_drive(o, "psiv0_<j>"), 6 * n + 3 * r,
          6 * n + 2 * r, r,
          "bodies v<i>_<j> = (xv<i>_<j>, yv<i>_<j>, psiv<i>_<j>): bar from node (i, j) up to (i, j+1); "
          "h<i>_<j> = (xh<i>_<j>, yh<i>_<j>, psih<i>_<j>): bar from node (i, j) to (i+1, j); reference points at "
          "the middles; pairs pin<i> (to ground), up<i>_<j>, left<i>_<j>, right<i>_<j> (at node (i, j))");
+  grid_parameters(t, o, g);
   t.section("coordinates");
-  double sx = 0.0, sy = 0.0;  // node (0, j) at t = 0
-  for (std::int64_t j = 0; j < r; ++j) {
-    const double th = row_initial(o, j), c = std::cos(th), s = std::sin(th);
-    for (std::int64_t i = 0; i <= g.width(j); ++i) {
-      t.coordinate(Name{"xv", i, j}, static_cast<double>(i) + sx + 0.5 * c);
-      t.coordinate(Name{"yv", i, j}, sy + 0.5 * s);
-      t.coordinate(Name{"psiv", i, j}, th);
-    }
-    sx += c;
-    sy += s;
-    for (std::int64_t i = 0; i < g.width(j); ++i) {
-      t.coordinate(Name{"xh", i, j + 1}, static_cast<double>(i) + sx + 0.5);
-      t.coordinate(Name{"yh", i, j + 1}, sy);
-      t.coordinate(Name{"psih", i, j + 1}, 0.0);
-    }
-  }
+  // Row j = 2k (+1 if odd) of width w: its vertical bars from node row j (at the sums over rows < j), then the
+  // horizontal bars of node row j + 1 (sums over rows ≤ j).
+  auto row = [](bool odd, const std::string& w, const char* idx) {
+    const std::string j = odd ? "{2*k+1}" : "{2*k}", j1 = odd ? "{2*k+2}" : "{2*k+1}", i = idx;
+    const std::string bx = sums(odd ? "k+1" : "k", "k", "ca", "cb"), by = sums(odd ? "k+1" : "k", "k", "sa", "sb");
+    const std::string ax = sums("k+1", odd ? "k+1" : "k", "ca", "cb"), ay = sums("k+1", odd ? "k+1" : "k", "sa", "sb");
+    const std::string hc = odd ? "hcb" : "hca", hs = odd ? "hsb" : "hsa", th = odd ? "to" : "from";
+    return "    for " + i + " in 0.." + w + ":\n      xv{" + i + "}_" + j + ": " + i + " + (" + bx + ") + " + hc +
+           "\n      yv{" + i + "}_" + j + ": (" + by + ") + " + hs + "\n      psiv{" + i + "}_" + j + ": " + th +
+           "\n    for " + i + " in 0.." + w + "-1:\n      xh{" + i + "}_" + j1 + ": " + i + " + (" + ax +
+           ") + 0.5\n      yh{" + i + "}_" + j1 + ": " + ay + "\n      psih{" + i + "}_" + j1 + ": 0\n";
+  };
+  t.raw("  for k in " + range(0, p.pairs - 1) + ":    # rows 2k and 2k+1\n" + row(false, "C", "i") +
+        row(true, "C", "m"));
+  t.raw("  for k in " + range(p.pairs, p.pairs) + ":    # the last row" + (p.odd_tail ? "s" : "") + "\n" +
+        (p.odd_tail ? row(false, "C", "i") + row(true, "L", "m") : row(false, "L", "i")));
   t.section("bodies");
-  for (std::int64_t j = 0; j < r; ++j) {
-    for (std::int64_t i = 0; i <= g.width(j); ++i)
-      t.body(Name{"v", i, j}, Name{"xv", i, j}, Name{"yv", i, j}, Name{"psiv", i, j});
-    for (std::int64_t i = 0; i < g.width(j); ++i)
-      t.body(Name{"h", i, j + 1}, Name{"xh", i, j + 1}, Name{"yh", i, j + 1}, Name{"psih", i, j + 1});
-  }
+  auto brow = [](const std::string& ind, const std::string& jt, const std::string& j1t, const std::string& w) {
+    return ind + "for i in 0.." + w + ":\n" + ind + "  v{i}_" + jt + ": [\"xv{i}_" + jt + "\", \"yv{i}_" + jt +
+           "\", \"psiv{i}_" + jt + "\"]\n" + ind + "for i in 0.." + w + "-1:\n" + ind + "  h{i}_" + j1t +
+           ": [\"xh{i}_" + j1t + "\", \"yh{i}_" + j1t + "\", \"psih{i}_" + j1t + "\"]\n";
+  };
+  t.raw("  for j in " + range(0, r - 2) + ":\n" + brow("    ", "{j}", "{j+1}", "C"));
+  t.raw("  for j in " + range(r - 1, r - 1) + ":\n" + brow("    ", "{j}", "{j+1}", "L"));
   t.section("constraints");
-  const Name ground{"ground"};
-  for (std::int64_t i = 0; i <= g.width(0); ++i)
-    t.revolute(Name{"pin", i}, Attach{Name{"v", i, 0}, -0.5, 0.0}, Attach{ground, static_cast<double>(i), 0.0});
-  for (std::int64_t j = 0; j < r; ++j) {
-    const std::int64_t w = g.width(j);
-    for (std::int64_t i = 0; i <= w; ++i) {  // node (i, j + 1), on top of v<i>_<j>
-      const Attach top{Name{"v", i, j}, 0.5, 0.0};
-      if (j + 1 < r && i <= g.width(j + 1))
-        t.revolute(Name{"up", i, j + 1}, top, Attach{Name{"v", i, j + 1}, -0.5, 0.0});
-      if (i > 0) t.revolute(Name{"left", i, j + 1}, top, Attach{Name{"h", i - 1, j + 1}, 0.5, 0.0});
-      if (i < w) t.revolute(Name{"right", i, j + 1}, top, Attach{Name{"h", i, j + 1}, -0.5, 0.0});
+  t.raw(std::string("  - for i in 0..") + (r > 1 ? "C" : "L") +
+        ":\n      - {name: \"pin{i}\", type: revolute, between: [{body: \"v{i}_0\", at: [-0.5, 0]}, {body: ground, "
+        "at: [i, 0]}]}\n");
+  // The pairs at node row j + 1, on top of the vertical bars of row j (width w): up (to the vertical bar above, if
+  // node (i, j + 1) has one: i ≤ wn), left (i > 0), right (i < w), in this order for each i. Written as families
+  // over the runs of i with the same pairs.
+  auto crow = [](const std::string& ind, const std::string& jt, const std::string& j1t, std::int64_t w,
+                 std::int64_t wn) {
+    const std::string top = "{body: \"v{i}_" + jt + "\", at: [0.5, 0]}";
+    auto pairs_at = [&](std::int64_t i) {
+      return std::string(i <= wn ? "u" : "") + (i > 0 ? "l" : "") + (i < w ? "r" : "");
+    };
+    std::string s;
+    for (std::int64_t a = 0; a <= w;) {
+      std::int64_t b = a;
+      while (b < w && pairs_at(b + 1) == pairs_at(a)) ++b;
+      s += ind + "- for i in " + range(a, b) + ":\n";
+      for (char c : pairs_at(a)) {
+        if (c == 'u')
+          s += ind + "    - {name: \"up{i}_" + j1t + "\", type: revolute, between: [" + top + ", {body: \"v{i}_" +
+               j1t + "\", at: [-0.5, 0]}]}\n";
+        if (c == 'l')
+          s += ind + "    - {name: \"left{i}_" + j1t + "\", type: revolute, between: [" + top +
+               ", {body: \"h{i-1}_" + j1t + "\", at: [0.5, 0]}]}\n";
+        if (c == 'r')
+          s += ind + "    - {name: \"right{i}_" + j1t + "\", type: revolute, between: [" + top +
+               ", {body: \"h{i}_" + j1t + "\", at: [-0.5, 0]}]}\n";
+      }
+      a = b + 1;
     }
-  }
-  t.section("drivers");
-  for (std::int64_t j = 0; j < r; ++j)
-    t.linear_driver(Name{"motor", j}, Name{"psiv", 0, j}, row_initial(o, j), row_rate(o, j));
+    return s;
+  };
+  t.raw("  - for j in " + range(0, r - 3) + ":\n" + crow("      ", "{j}", "{j+1}", g.cols, g.cols));
+  // Rows R−2 and R−1 in families of one member each, so that their number is written once.
+  if (r > 1) t.raw("  - for j in " + range(r - 2, r - 2) + ":\n" + crow("      ", "{j}", "{j+1}", g.cols, g.last));
+  t.raw("  - for j in " + range(r - 1, r - 1) + ":\n" + crow("      ", "{j}", "{j+1}", g.last, -1));
+  grid_drivers(t, o, g, "psiv0_");
   footer(t, o);
   return t.take();
 }

@@ -1,7 +1,8 @@
 // Emitters of scene text for the generators (`phiq generate`, tools/README.md). Every piece of scene syntax a
 // generator writes (a coordinate, a point, a body, one constraint of each kind, a driver, the footer) is written by
 // one member function here, so that a change of syntax, such as the compact "indexed family" form of the scale
-// issue, is a change of this file only. Names are systematic: a family and up to two indices (Name).
+// issue, is a change of this file only. The indexed families (`for i in A..B`) the generators now write are built
+// by the generators themselves and written with raw(). Names are systematic: a family and up to two indices (Name).
 #pragma once
 
 #include <charconv>
@@ -62,6 +63,8 @@ class SceneText {
   void comment(std::string_view line) { w("# ", line, '\n'); }
   void field(std::string_view key, std::string_view value) { w(key, ": ", value, '\n'); }
   void section(std::string_view key) { w(key, ":\n"); }
+  // Text written as given (indexed families, built by the generator: tools/generate_linkages.cpp).
+  void raw(std::string_view text) { put(text); }
 
   // Under `coordinates:`.
   void coordinate(Name n, double initial) { w("  ", n, ": ", initial, '\n'); }
