@@ -4,10 +4,13 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <sstream>
 
+#include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
 namespace phiq {
@@ -333,105 +336,152 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   auto first_row = [&](Index c) { return 1 + c * chunk; };
   auto last_row = [&](Index c) { return std::min(opt.steps, (c + 1) * chunk); };
 
-  // Seeds: the position at each chunk's first row, found in order with the chunk's span as the step (positions
-  // only, the secant predictor, subdivision on failure). A failure ends the seeding; the chunks after it run in
-  // order below, where the failure is reported as the sequential sweep reports it.
-  std::vector<Eigen::VectorXd> seeds(1);  // chunk 0 starts from row 0 itself
-  {
-    const auto seed_start = std::chrono::steady_clock::now();
-    SweepOptions so = opt;
-    so.velocities = so.accelerations = false;
-    so.predictor = Predictor::kSecant;
-    SweepSummary ss;
-    Workspace sws(model);
-    sws.q = ws.q;
-    Sweeper seeder(model, so, sws, ss);
-    seeder.adopt(run.time_of(0));
-    for (Index c = 1; c < n_chunks && seeder.advance(run.time_of(first_row(c)), 0); ++c) seeds.push_back(sws.q);
-    add_counters(others, sws.counters, WorkCounters{});
-    sum.seed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
-  }
-  const Index seeded = static_cast<Index>(seeds.size());
+  // Workspaces for the chunks, taken from a pool for the time of one chunk. Not one per thread index: a thread
+  // waiting inside a nested parallel evaluation (large models) may start another chunk meanwhile, which then
+  // needs a workspace of its own.
+  std::vector<std::unique_ptr<Workspace>> pool;
+  std::mutex pool_mutex;
+  auto acquire = [&] {
+    std::lock_guard<std::mutex> lock(pool_mutex);
+    if (pool.empty()) return std::make_unique<Workspace>(model);
+    auto w = std::move(pool.back());
+    pool.pop_back();
+    return w;
+  };
+  auto release = [&](std::unique_ptr<Workspace> w) {
+    std::lock_guard<std::mutex> lock(pool_mutex);
+    pool.push_back(std::move(w));
+  };
 
-  std::vector<std::unique_ptr<Workspace>> workers;
-  for (int j = 0; j < threads; ++j) workers.push_back(std::make_unique<Workspace>(model));
-  tbb::task_arena arena(threads);
   // The last delivered row (the state an ordered continuation starts from) and the position the sweep reaches
   // one step after it when continued in order (the previous chunk's seam), if known.
   Index resume = 1;
   Eigen::VectorXd last_q = ws.q, last_qd = ws.qd, last_qdd = ws.qdd;
   bool seam_known = false;
   Eigen::VectorXd seam_q;
+  std::vector<Eigen::VectorXd> seeds(1);  // chunk 0 starts from row 0 itself
+
+  // Chunk c: its rows from its seed (chunk 0: in order from row 0), then the seam step.
+  auto run_chunk = [&](Index c, Chunk& ch) {
+    std::unique_ptr<Workspace> held = acquire();
+    Workspace& w = *held;
+    const WorkCounters w0 = w.counters;
+    ch.k0 = first_row(c), ch.k1 = last_row(c);
+    Sweeper s(model, opt, w, ch.sum);
+    ch.rows.resize(static_cast<std::size_t>((ch.k1 - ch.k0 + 1) * width));
+    double* out = ch.rows.data();
+    auto keep = [&] {
+      out = std::copy(w.q.data(), w.q.data() + n, out);
+      if (need_v) out = std::copy(w.qd.data(), w.qd.data() + n, out);
+      if (need_a) out = std::copy(w.qdd.data(), w.qdd.data() + n, out);
+    };
+    if (c == 0) {  // continues row 0 in order: the sequential sweep itself
+      w.q = last_q, w.qd = last_qd, w.qdd = last_qdd;
+      s.adopt(run.time_of(0));
+      ch.ok = s.advance(run.time_of(ch.k0), 0);
+    } else {
+      ch.ok = s.start_from(run.time_of(ch.k0), seeds[static_cast<std::size_t>(c)]);
+    }
+    if (ch.ok) keep();
+    for (Index k = ch.k0 + 1; ch.ok && k <= ch.k1; ++k)
+      if ((ch.ok = s.advance(run.time_of(k), 0))) keep();
+    if (ch.ok && ch.k1 < opt.steps) {
+      // the seam row belongs to the next chunk: its warnings and sub-steps are counted there
+      const SweepSummary kept = ch.sum;
+      if (s.advance(run.time_of(ch.k1 + 1), 0)) {
+        ch.has_seam = true;
+        ch.seam_q = w.q;
+      }
+      ch.sum.warnings = kept.warnings;
+      ch.sum.subdivisions = kept.subdivisions;
+      ch.sum.status = kept.status, ch.sum.message = kept.message;
+      ch.sum.min_rcond = kept.min_rcond, ch.sum.min_rcond_time = kept.min_rcond_time;
+    }
+    add_counters(ch.sum.counters, w.counters, w0);
+    release(std::move(held));
+  };
+
+  // Accepts and delivers a computed chunk: 0 delivered, 1 rejected (the rest runs in order), 2 stopped by the
+  // caller. A chunk is the sequential sweep's continuation if it starts where the sweep, continued in order from
+  // the last delivered row, arrives (chunk 0 is that continuation by construction).
+  auto deliver_chunk = [&](Chunk& ch) {
+    add_counters(others, ch.sum.counters, WorkCounters{});
+    const bool accept =
+        ch.ok && (ch.k0 == 1 || (seam_known && same_solution(model, seam_q, ch.rows.data(), opt.newton.tolerance)));
+    if (!accept) return 1;
+    const double* r = ch.rows.data();
+    for (Index k = ch.k0; k <= ch.k1; ++k, r += width) {
+      last_q = Eigen::Map<const Eigen::VectorXd>(r, n);
+      if (need_v) last_qd = Eigen::Map<const Eigen::VectorXd>(r + n, n);
+      if (need_a) last_qdd = Eigen::Map<const Eigen::VectorXd>(r + 2 * n, n);
+      if (!run.deliver(k, last_q, last_qd, last_qdd)) return 2;
+    }
+    resume = ch.k1 + 1;
+    seam_known = ch.has_seam;
+    if (seam_known) seam_q.swap(ch.seam_q);
+    sum.subdivisions += ch.sum.subdivisions;
+    sum.warnings.insert(sum.warnings.end(), ch.sum.warnings.begin(), ch.sum.warnings.end());
+    if (ch.sum.min_rcond > 0.0 && (sum.min_rcond == 0.0 || ch.sum.min_rcond < sum.min_rcond))
+      sum.min_rcond = ch.sum.min_rcond, sum.min_rcond_time = ch.sum.min_rcond_time;
+    ++sum.parallel_chunks;
+    return 0;
+  };
+
+  // Seeds: the position at each chunk's first row, found in order with the chunk's span as the step (positions
+  // only, the secant predictor, subdivision on failure), while chunk 0, which needs none, runs on another thread.
+  // A failure ends the seeding; the chunks after it run in order below, where the failure is reported as the
+  // sequential sweep reports it.
+  tbb::task_arena arena(threads);
+  Chunk first;
+  WorkCounters seeding;
+  arena.execute([&] {
+    tbb::parallel_invoke(
+        [&] {
+          const auto seed_start = std::chrono::steady_clock::now();
+          SweepOptions so = opt;
+          so.velocities = so.accelerations = false;
+          so.predictor = Predictor::kSecant;
+          SweepSummary ss;
+          Workspace sws(model);
+          sws.q = last_q;
+          Sweeper seeder(model, so, sws, ss);
+          seeder.adopt(run.time_of(0));
+          for (Index c = 1; c < n_chunks && seeder.advance(run.time_of(first_row(c)), 0); ++c) seeds.push_back(sws.q);
+          seeding = sws.counters;
+          sum.seed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
+        },
+        [&] { run_chunk(0, first); });
+  });
+  add_counters(others, seeding, WorkCounters{});
   bool fallback = false;
-  for (Index c0 = 0; c0 < seeded && !fallback; c0 += threads) {
-    const Index c1 = std::min<Index>(seeded, c0 + threads);
+  if (const int d = deliver_chunk(first); d == 2) return done(sum.status);
+  else fallback = d == 1;
+  const Index seeded = static_cast<Index>(seeds.size());
+
+  // Chunks per wave: as many as the row buffer allows (512 MiB), at least one per thread, so that TBB balances
+  // the chunks of a wave across the threads and the waves' barriers are few.
+  const double chunk_bytes = 8.0 * static_cast<double>(std::max<Index>(width, 1)) * static_cast<double>(chunk);
+  const Index per_wave = std::max<Index>(threads, static_cast<Index>(512.0 * 1024 * 1024 / chunk_bytes));
+  for (Index c0 = 1; c0 < seeded && !fallback; c0 += per_wave) {
+    const Index c1 = std::min<Index>(seeded, c0 + per_wave);
     std::vector<Chunk> chunks(static_cast<std::size_t>(c1 - c0));
     arena.execute([&] {
-      tbb::parallel_for(c0, c1, [&](Index c) {
-        Chunk& ch = chunks[static_cast<std::size_t>(c - c0)];
-        Workspace& w = *workers[static_cast<std::size_t>(c - c0)];
-        const WorkCounters w0 = w.counters;
-        ch.k0 = first_row(c), ch.k1 = last_row(c);
-        Sweeper s(model, opt, w, ch.sum);
-        ch.rows.resize(static_cast<std::size_t>((ch.k1 - ch.k0 + 1) * width));
-        double* out = ch.rows.data();
-        auto keep = [&] {
-          out = std::copy(w.q.data(), w.q.data() + n, out);
-          if (need_v) out = std::copy(w.qd.data(), w.qd.data() + n, out);
-          if (need_a) out = std::copy(w.qdd.data(), w.qdd.data() + n, out);
-        };
-        if (c == 0) {  // continues row 0 in order: the sequential sweep itself
-          w.q = last_q, w.qd = last_qd, w.qdd = last_qdd;
-          s.adopt(run.time_of(0));
-          ch.ok = s.advance(run.time_of(ch.k0), 0);
-        } else {
-          ch.ok = s.start_from(run.time_of(ch.k0), seeds[static_cast<std::size_t>(c)]);
-        }
-        if (ch.ok) keep();
-        for (Index k = ch.k0 + 1; ch.ok && k <= ch.k1; ++k)
-          if ((ch.ok = s.advance(run.time_of(k), 0))) keep();
-        if (ch.ok && ch.k1 < opt.steps) {
-          // the seam row belongs to the next chunk: its warnings and sub-steps are counted there
-          const std::size_t warnings = ch.sum.warnings.size();
-          const Index subdivisions = ch.sum.subdivisions;
-          const SweepSummary kept = ch.sum;
-          if (s.advance(run.time_of(ch.k1 + 1), 0)) {
-            ch.has_seam = true;
-            ch.seam_q = w.q;
-          }
-          ch.sum.warnings.resize(warnings);
-          ch.sum.subdivisions = subdivisions;
-          ch.sum.status = kept.status, ch.sum.message = kept.message;
-          ch.sum.min_rcond = kept.min_rcond, ch.sum.min_rcond_time = kept.min_rcond_time;
-        }
-        add_counters(ch.sum.counters, w.counters, w0);
-      });
+      // one task per chunk (chunks are large, uneven units of work; TBB's default partitioner may run
+      // neighbouring chunks as one task on one thread)
+      tbb::parallel_for(
+          tbb::blocked_range<Index>(c0, c1, 1),
+          [&](const tbb::blocked_range<Index>& r) {
+            for (Index c = r.begin(); c < r.end(); ++c) run_chunk(c, chunks[static_cast<std::size_t>(c - c0)]);
+          },
+          tbb::simple_partitioner());
     });
     for (Chunk& ch : chunks) {
-      add_counters(others, ch.sum.counters, WorkCounters{});
-      // A chunk is the sequential sweep's continuation if it starts where the sweep, continued in order from
-      // the last delivered row, arrives (chunk 0 is that continuation by construction).
-      const bool accept =
-          ch.ok && (ch.k0 == 1 || (seam_known && same_solution(model, seam_q, ch.rows.data(), opt.newton.tolerance)));
-      if (!accept) {
+      const int d = deliver_chunk(ch);
+      if (d == 2) return done(sum.status);
+      if (d == 1) {
         fallback = true;
         break;
       }
-      const double* r = ch.rows.data();
-      for (Index k = ch.k0; k <= ch.k1; ++k, r += width) {
-        last_q = Eigen::Map<const Eigen::VectorXd>(r, n);
-        if (need_v) last_qd = Eigen::Map<const Eigen::VectorXd>(r + n, n);
-        if (need_a) last_qdd = Eigen::Map<const Eigen::VectorXd>(r + 2 * n, n);
-        if (!run.deliver(k, last_q, last_qd, last_qdd)) return done(sum.status);
-      }
-      resume = ch.k1 + 1;
-      seam_known = ch.has_seam;
-      if (seam_known) seam_q.swap(ch.seam_q);
-      sum.subdivisions += ch.sum.subdivisions;
-      sum.warnings.insert(sum.warnings.end(), ch.sum.warnings.begin(), ch.sum.warnings.end());
-      if (ch.sum.min_rcond > 0.0 && (sum.min_rcond == 0.0 || ch.sum.min_rcond < sum.min_rcond))
-        sum.min_rcond = ch.sum.min_rcond, sum.min_rcond_time = ch.sum.min_rcond_time;
-      ++sum.parallel_chunks;
     }
   }
   // The caller's workspace ends at the last delivered row, as after a sequential sweep.
