@@ -21,8 +21,12 @@ void check_line(const std::string& m, const char* what) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   phiq::Scene scene;
+  // Families let a few bytes ask for millions of entities (the scale issue's 10^6 models): legitimate, but not
+  // what a fuzzer iteration should build. Above this the loader refuses with its one-line limit error.
+  phiq::SceneLimits limits;
+  limits.max_family_instances = 20000;
   try {
-    scene = phiq::parse_scene(text, "fuzz.yaml");
+    scene = phiq::parse_scene(text, "fuzz.yaml", limits);
   } catch (const phiq::SceneError& e) {
     const std::string m = e.what();
     check_line(m, "scene error");
