@@ -547,3 +547,26 @@ TEST(Scene, EverySeedSceneLoads) {
 
 }  // namespace
 }  // namespace phiq
+
+namespace phiq {
+namespace {
+
+TEST(SceneSolver, NewtonModeIsASetting) {
+  const std::string base =
+      "coordinates: {x: 0.1}\ndrivers: [{coordinate: x, law: {type: linear, initial: 0, rate: 1}}]\n"
+      "time: {start: 0, end: 1, steps: 2}\n";
+  EXPECT_EQ(parse_scene(base, "s.yaml").sweep.newton.jacobian_update, JacobianUpdate::kWhenSlow);
+  EXPECT_EQ(parse_scene(base + "solver: {newton: full}\n", "s.yaml").sweep.newton.jacobian_update,
+            JacobianUpdate::kEveryIteration);
+  EXPECT_EQ(parse_scene(base + "solver: {newton: modified}\n", "s.yaml").sweep.newton.jacobian_update,
+            JacobianUpdate::kWhenSlow);
+  try {
+    parse_scene(base + "solver: {newton: quasi}\n", "s.yaml");
+    ADD_FAILURE() << "accepted newton: quasi";
+  } catch (const SceneError& e) {
+    EXPECT_STREQ(e.what(), "s.yaml:4:18: solver.newton: newton is modified or full");
+  }
+}
+
+}  // namespace
+}  // namespace phiq

@@ -1769,7 +1769,7 @@ class SceneReader {
   void read_solver(const Cursor& c, SweepOptions& o) {
     if (!c.present()) return;
     c.expect_map({"tolerance", "max_iterations", "assembly_max_iterations", "line_search", "predictor",
-                  "max_subdivisions", "length_scale", "linear_solver"});
+                  "max_subdivisions", "length_scale", "linear_solver", "newton"});
     if (auto v = c.field("tolerance"); v.present()) {
       double tol = positive(v);
       if (tol >= 1.0) v.fail("tolerance must be below 1");
@@ -1780,6 +1780,12 @@ class SceneReader {
       o.assembly.max_iterations = static_cast<int>(v.integer(1, 10000));
     if (auto v = c.field("line_search"); v.present()) o.newton.line_search = v.boolean();
     if (auto v = c.field("max_subdivisions"); v.present()) o.max_subdivisions = static_cast<int>(v.integer(0, 30));
+    if (auto v = c.field("newton"); v.present()) {
+      const std::string s = v.text();
+      if (s == "modified") o.newton.jacobian_update = JacobianUpdate::kWhenSlow;
+      else if (s == "full") o.newton.jacobian_update = JacobianUpdate::kEveryIteration;
+      else v.fail("newton is modified or full");
+    }
     if (auto v = c.field("predictor"); v.present()) {
       static const std::map<std::string, Predictor> m = {{"auto", Predictor::kAuto},
                                                          {"previous", Predictor::kPrevious},
