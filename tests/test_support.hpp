@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "phiq/phiq.hpp"
+#include "../bench/nfourbar_model.hpp"
 
 namespace phiq::test {
 
@@ -51,29 +52,10 @@ inline Model crank_slider_model(double omega = 1.0, double theta0 = 0.0,
   return std::move(b).build();
 }
 
-// IFToMM N four-bar in natural coordinates: cranks of length 1 pinned at (i, 0), i = 0..N, tips P_i = (x_i, y_i)
-// joined by N unit couplers; crank 0 carries the angle theta, driven as theta0 + rate t. Placed on the
-// parallelogram solution P_i = (i + cos θ, sin θ) at θ = theta0 (exact for all t: every crank stays parallel).
-// Coordinates x0, y0, …, xN, yN, theta.
+// IFToMM N four-bar in natural coordinates (x0, y0, …, xN, yN, theta), placed on the parallelogram solution, which
+// is exact for all t: the benchmarks' very model (bench/nfourbar_model.hpp).
 inline Model nfourbar_model(Index n, double theta0, double rate, LinearSolverKind lu = LinearSolverKind::kKlu) {
-  ModelBuilder b;
-  b.set_linear_solver(lu);
-  auto S = Slot::coordinate;
-  auto C = Slot::constant;
-  std::vector<Point2> tip;
-  for (Index i = 0; i <= n; ++i) {
-    const std::string k = std::to_string(i);
-    Index x = b.add_coordinate("x" + k, static_cast<double>(i) + std::cos(theta0));
-    Index y = b.add_coordinate("y" + k, std::sin(theta0));
-    tip.push_back({S(x), S(y)});
-  }
-  Index th = b.add_coordinate("theta", theta0);
-  for (Index i = 0; i <= n; ++i)
-    b.add("crank" + std::to_string(i), DistanceSpec{{C(static_cast<double>(i)), C(0)}, tip[i], 1.0});
-  for (Index i = 0; i < n; ++i) b.add("coupler" + std::to_string(i), DistanceSpec{tip[i], tip[i + 1], 1.0});
-  b.add("crank0_angle", SegmentAngleSpec{{C(0), C(0)}, tip[0], S(th)});
-  b.add_driver("motor", th, MotionLaw::linear(theta0, rate));
-  return std::move(b).build();
+  return phiq_bench::nfourbar(n, theta0, rate, lu);
 }
 
 // Largest difference between the rows of two traces in positions (order 0), velocities (1) or accelerations (2);
