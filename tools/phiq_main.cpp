@@ -170,14 +170,6 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
 // cases in parallel, sharing one symbolic analysis; DIR/case<k>.csv per successful case (k from 0, the row order).
 int cmd_batch(const std::string& scene_path, const std::string& cases_path, const std::string& dir, bool quiet,
               int threads) {
-  std::string text;
-  {
-    std::ifstream in(scene_path, std::ios::binary);
-    if (!in) return fail(scene_path + ": cannot open the scene file", 2);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    text = ss.str();
-  }
   phiq::CsvTable cases;
   try {
     cases = phiq::read_csv_table(cases_path);
@@ -194,7 +186,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     for (std::size_t c = 0; c < cases.columns.size(); ++c) o.parameters.emplace_back(cases.columns[c], cases.rows[k][c]);
     if (!scenes.empty()) o.share_analysis_with = scenes.front().model.get();
     try {
-      scenes.push_back(phiq::parse_scene(text, scene_path, phiq::SceneLimits{}, o));
+      scenes.push_back(phiq::load_scene(scene_path, phiq::SceneLimits{}, o));
     } catch (const phiq::SceneError& e) {
       return fail(std::string(e.what()) + " (case " + std::to_string(k) + " of " + cases_path + ", line " +
                       std::to_string(k + 2) + ")",

@@ -165,6 +165,11 @@ std::string fmt(double v) {
 
 double scaled_residual(const Model& model, const Eigen::VectorXd& phi) { return max_scaled(model, phi); }
 
+double scaled_step(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& dq, const Eigen::VectorXd& q,
+                   double tol) {
+  return step_ratio(model, dq, q, tol);
+}
+
 std::string PositionSummary::BriefReport() const {
   std::ostringstream s;
   s << "position: " << to_string(status) << ", " << iterations << " iterations, scaled residual " << fmt(residual);

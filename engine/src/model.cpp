@@ -41,7 +41,7 @@ std::string single_line(const std::string& text) {
 // ---- Model ---------------------------------------------------------------------------------------------------
 
 Index Model::coordinate_index(const std::string& name) const {
-  const Index j = index_of_.find(name, [this](Index k) -> const std::string& { return names_[static_cast<std::size_t>(k)]; });
+  const Index j = index_of_.find(name, coordinate_name_of());
   if (j < 0) throw Error("unknown coordinate '" + name + "'");
   return j;
 }
@@ -107,9 +107,7 @@ ModelBuilder::ModelBuilder(ModelBuilder&&) noexcept = default;
 Index ModelBuilder::add_coordinate(const std::string& name, double initial) {
   if (name.empty()) throw Error("coordinate name is empty");
   if (!std::isfinite(initial)) throw Error("coordinate '" + name + "': initial value is not finite");
-  if (!model_.index_of_.insert(name, num_coordinates(), [this](Index k) -> const std::string& {
-        return model_.names_[static_cast<std::size_t>(k)];
-      }))
+  if (!model_.index_of_.insert(name, num_coordinates(), model_.coordinate_name_of()))
     throw Error("duplicate coordinate name '" + name + "'");
   model_.names_.push_back(name);
   const Index n = num_coordinates();
@@ -139,9 +137,7 @@ void ModelBuilder::reserve(Index more_coordinates, Index more_constraints) {
 }
 
 Index ModelBuilder::find_coordinate(const std::string& name) const {
-  return model_.index_of_.find(name, [this](Index k) -> const std::string& {
-    return model_.names_[static_cast<std::size_t>(k)];
-  });
+  return model_.index_of_.find(name, model_.coordinate_name_of());
 }
 
 void ModelBuilder::set_initial(Index j, double value) {
@@ -168,9 +164,7 @@ void ModelBuilder::check_slot(const Slot& s, const std::string& name) const {
 }
 
 Index ModelBuilder::add_info(const std::string& name, const char* kind, int rows, bool depends_on_time) {
-  if (!constraint_names_.insert(name, static_cast<Index>(model_.constraints_.size()), [this](Index k) -> const std::string& {
-        return model_.constraints_[static_cast<std::size_t>(k)].name;
-      }))
+  if (!constraint_names_.insert(name, static_cast<Index>(model_.constraints_.size()), model_.constraint_name_of()))
     throw Error("duplicate constraint name '" + name + "'");
   const Index id = static_cast<Index>(model_.constraints_.size());
   model_.constraints_.push_back(

@@ -1924,6 +1924,10 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
 }
 
 Scene load_scene(const std::string& path, const SceneLimits& limits) {
+  return load_scene(path, limits, SceneOverrides{});
+}
+
+Scene load_scene(const std::string& path, const SceneLimits& limits, const SceneOverrides& overrides) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError(path + ": cannot open the scene file");
   // size first: a huge file is refused before it is read into memory
@@ -1937,7 +1941,7 @@ Scene load_scene(const std::string& path, const SceneLimits& limits) {
   std::string text(static_cast<std::size_t>(size), '\0');
   in.read(text.data(), size);
   if (in.gcount() != size) throw SceneError(path + ": cannot read the scene file");
-  return parse_scene(text, path, limits);
+  return parse_scene(text, path, limits, overrides);
 }
 
 }  // namespace phiq

@@ -2,7 +2,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -82,10 +81,7 @@ class Sweeper {
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t, opt_.newton, ws_, &ps);
     if (st != SolveStatus::kSuccess) return fail(st, ps.message);
-    note(t, ps);
-    if (!derivatives(t)) return false;
-    remember(t);
-    return true;
+    return converged(t, ps);
   }
 
   // Continues from the converged state in ws (q, and q̇, q̈ where asked for) at t, as if this sweeper had reached
@@ -99,10 +95,7 @@ class Sweeper {
   bool assemble(double t) {
     SolveStatus st = solve_position(model_, t, opt_.assembly, ws_, &sum_.assembly);
     if (st != SolveStatus::kSuccess) return fail(st, "initial assembly failed: " + sum_.assembly.message);
-    note(t, sum_.assembly);
-    if (!derivatives(t)) return false;
-    remember(t);
-    return true;
+    return converged(t, sum_.assembly);
   }
 
   // From the converged state at current_.t to t1, subdividing on failure. current_ (and prev_) change only on
@@ -111,12 +104,7 @@ class Sweeper {
     predict(t1);
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t1, opt_.newton, ws_, &ps);
-    if (st == SolveStatus::kSuccess) {
-      note(t1, ps);
-      if (!derivatives(t1)) return false;
-      remember(t1);
-      return true;
-    }
+    if (st == SolveStatus::kSuccess) return converged(t1, ps);
     // Retry as two half steps from the last good state; a singular or non-finite point is not cured by that
     // unless the sub-steps avoid it, so all statuses are retried.
     if (depth >= opt_.max_subdivisions) {
@@ -131,8 +119,12 @@ class Sweeper {
   }
 
  private:
-  void note(double t, const PositionSummary& ps) {
+  // A position converged at t: its warning, the derivatives asked for, and it becomes the current state.
+  bool converged(double t, const PositionSummary& ps) {
     if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
+    if (!derivatives(t)) return false;
+    remember(t);
+    return true;
   }
   void predict(double t1) {
     const double h = t1 - current_.t;
@@ -251,17 +243,14 @@ void add_counters(WorkCounters& into, const WorkCounters& now, const WorkCounter
 // Two solutions of the same position problem are the same one if they differ by less than 100 tolerances in
 // every coordinate (each is within about one of the exact root; another branch is a finite distance away).
 bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b, double tol) {
-  const ToleranceScales& s = model.tolerance_scales();
-  constexpr double kUlp = 64.0 * std::numeric_limits<double>::epsilon();
-  for (Index j = 0; j < a.size(); ++j) {
-    const double d = std::fabs(a(j) - b[j]);
-    if (!(d <= 100.0 * tol * s.coordinate_scale(j) + kUlp * std::fabs(a(j)))) return false;
-  }
-  return true;
+  return scaled_step(model, a - Eigen::Map<const Eigen::VectorXd>(b, a.size()), a, tol) <= 100.0;
 }
 
 // One parallel chunk: rows k0 … k1 computed from a seed at t_k0 (chunk 0: from row 0), then the sweep continued
 // in order one step further (the seam), which the next chunk's first row must match.
+// Rows a parallel sweep may hold at once before delivering them in order (all waves' chunks together).
+constexpr double kRowBufferBytes = 512.0 * 1024 * 1024;
+
 struct Chunk {
   Index k0 = 0, k1 = 0;
   std::vector<double> rows;  // (k1 − k0 + 1) rows of [q | q̇ | q̈], as asked for
@@ -322,7 +311,7 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0));
   Index chunk = opt.chunk_steps;
   if (chunk == 0) {
-    const double fit = 512.0 * 1024 * 1024 / (8.0 * static_cast<double>(std::max<Index>(width, 1)) * threads);
+    const double fit = kRowBufferBytes / (8.0 * static_cast<double>(std::max<Index>(width, 1)) * threads);
     chunk = std::max<Index>(1, std::min<Index>(64, static_cast<Index>(fit)));
   }
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
@@ -461,7 +450,7 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   // Chunks per wave: as many as the row buffer allows (512 MiB), at least one per thread, so that TBB balances
   // the chunks of a wave across the threads and the waves' barriers are few.
   const double chunk_bytes = 8.0 * static_cast<double>(std::max<Index>(width, 1)) * static_cast<double>(chunk);
-  const Index per_wave = std::max<Index>(threads, static_cast<Index>(512.0 * 1024 * 1024 / chunk_bytes));
+  const Index per_wave = std::max<Index>(threads, static_cast<Index>(kRowBufferBytes / chunk_bytes));
   for (Index c0 = 1; c0 < seeded && !fallback; c0 += per_wave) {
     const Index c1 = std::min<Index>(seeded, c0 + per_wave);
     std::vector<Chunk> chunks(static_cast<std::size_t>(c1 - c0));

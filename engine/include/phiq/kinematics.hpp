@@ -104,4 +104,10 @@ SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, Line
 /// max_i |Φ_i| / scale_i, the measure the convergence test uses (0 for an empty model).
 double scaled_residual(const Model& model, const Eigen::VectorXd& phi);
 
+/// max_j |Δq_j| / (tol · scale_j + floor_j), the measure of a change of q that the convergence test uses: ≤ 1 when
+/// `dq` is within the tolerance `tol` of the coordinates `q` (scale as in NewtonOptions::tolerance, floor a few ulps
+/// of |q_j|); NaN counts as infinitely large. Pre-condition: dq and q have num_coordinates() entries.
+double scaled_step(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& dq, const Eigen::VectorXd& q,
+                   double tol);
+
 }  // namespace phiq

@@ -168,6 +168,14 @@ class Model {
  private:
   friend class ModelBuilder;
   Model() = default;
+  /// The name of coordinate k, as index_of_ reads it.
+  auto coordinate_name_of() const {
+    return [this](Index k) -> const std::string& { return names_[static_cast<std::size_t>(k)]; };
+  }
+  /// The name of constraint k, as the builder's constraint_names_ reads it.
+  auto constraint_name_of() const {
+    return [this](Index k) -> const std::string& { return constraints_[static_cast<std::size_t>(k)].name; };
+  }
 
   std::vector<std::string> names_;
   detail::NameIndex index_of_;  ///< coordinate names → indices (names in names_)
@@ -216,9 +224,7 @@ class ModelBuilder {
   const std::string& coordinate_name(Index j) const { return model_.names_[static_cast<std::size_t>(j)]; }
   /// True when a constraint of that name has been added.
   bool has_constraint(const std::string& name) const {
-    return constraint_names_.find(name, [this](Index k) -> const std::string& {
-      return model_.constraints_[static_cast<std::size_t>(k)].name;
-    }) >= 0;
+    return constraint_names_.find(name, model_.constraint_name_of()) >= 0;
   }
   /// Makes room for that many more coordinates and constraints (an optimisation for large generated models, e.g.
   /// the members of a scene family; never required).

@@ -54,6 +54,8 @@ struct SceneOverrides {
 /// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,
 /// unknown or duplicate fields and names, wrong types, NaN or infinite numbers and impossible values.
 Scene load_scene(const std::string& path, const SceneLimits& limits = {});
+/// load_scene() with the caller's overrides (batch mode), as parse_scene() with overrides.
+Scene load_scene(const std::string& path, const SceneLimits& limits, const SceneOverrides& overrides);
 /// The same from text; `path` is used in messages only.
 Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits = {});
 /// parse_scene() with the caller's overrides (batch mode). Throws SceneError as parse_scene() does, and for an
