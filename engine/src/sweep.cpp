@@ -416,43 +416,51 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
     return 0;
   };
 
+  // Chunks per wave: as many as the row buffer allows, at least one per thread so that TBB balances the chunks of
+  // a wave, and at most 16 per thread so that rows are delivered (and Ctrl-C seen) every few thousand steps
+  // however long the sweep.
+  const double chunk_bytes = 8.0 * static_cast<double>(std::max<Index>(width, 1)) * static_cast<double>(chunk);
+  const Index per_wave = std::max<Index>(
+      threads, std::min<Index>(16 * threads, static_cast<Index>(kRowBufferBytes / chunk_bytes)));
+
   // Seeds: the position at each chunk's first row, found in order with the chunk's span as the step (positions
-  // only, the secant predictor, subdivision on failure), while chunk 0, which needs none, runs on another thread.
+  // only, the secant predictor, subdivision on failure), wave by wave, just ahead of the chunks that need them.
   // A failure ends the seeding; the chunks after it run in order below, where the failure is reported as the
   // sequential sweep reports it.
+  SweepOptions seed_options = opt;
+  seed_options.velocities = seed_options.accelerations = false;
+  seed_options.predictor = Predictor::kSecant;
+  SweepSummary seed_summary;
+  Workspace sws(model);
+  sws.q = last_q;
+  Sweeper seeder(model, seed_options, sws, seed_summary);
+  seeder.adopt(run.time_of(0));
+  bool seeding_ok = true;
+  auto seed_until = [&](Index c_end) {  // seeds for the chunks below c_end
+    const auto seed_start = std::chrono::steady_clock::now();
+    for (Index c = static_cast<Index>(seeds.size()); seeding_ok && c < std::min(c_end, n_chunks); ++c) {
+      seeding_ok = seeder.advance(run.time_of(first_row(c)), 0);
+      if (seeding_ok) seeds.push_back(sws.q);
+    }
+    sum.seed_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
+  };
+
+  // The first wave's seeds are found while chunk 0, which needs none, runs on another thread.
   tbb::task_arena arena(threads);
   Chunk first;
-  WorkCounters seeding;
-  arena.execute([&] {
-    tbb::parallel_invoke(
-        [&] {
-          const auto seed_start = std::chrono::steady_clock::now();
-          SweepOptions so = opt;
-          so.velocities = so.accelerations = false;
-          so.predictor = Predictor::kSecant;
-          SweepSummary ss;
-          Workspace sws(model);
-          sws.q = last_q;
-          Sweeper seeder(model, so, sws, ss);
-          seeder.adopt(run.time_of(0));
-          for (Index c = 1; c < n_chunks && seeder.advance(run.time_of(first_row(c)), 0); ++c) seeds.push_back(sws.q);
-          seeding = sws.counters;
-          sum.seed_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
-        },
-        [&] { run_chunk(0, first); });
-  });
-  add_counters(others, seeding, WorkCounters{});
+  arena.execute([&] { tbb::parallel_invoke([&] { seed_until(1 + per_wave); }, [&] { run_chunk(0, first); }); });
   bool fallback = false;
-  if (const int d = deliver_chunk(first); d == 2) return done(sum.status);
-  else fallback = d == 1;
-  const Index seeded = static_cast<Index>(seeds.size());
+  if (const int d = deliver_chunk(first); d == 2) {
+    add_counters(others, sws.counters, WorkCounters{});
+    return done(sum.status);
+  } else {
+    fallback = d == 1;
+  }
 
-  // Chunks per wave: as many as the row buffer allows (512 MiB), at least one per thread, so that TBB balances
-  // the chunks of a wave across the threads and the waves' barriers are few.
-  const double chunk_bytes = 8.0 * static_cast<double>(std::max<Index>(width, 1)) * static_cast<double>(chunk);
-  const Index per_wave = std::max<Index>(threads, static_cast<Index>(kRowBufferBytes / chunk_bytes));
-  for (Index c0 = 1; c0 < seeded && !fallback; c0 += per_wave) {
-    const Index c1 = std::min<Index>(seeded, c0 + per_wave);
+  for (Index c0 = 1; !fallback; c0 += per_wave) {
+    seed_until(c0 + per_wave);
+    const Index c1 = std::min<Index>(static_cast<Index>(seeds.size()), c0 + per_wave);
+    if (c0 >= c1) break;  // all chunks done, or the seeding stopped: the rest runs in order
     std::vector<Chunk> chunks(static_cast<std::size_t>(c1 - c0));
     arena.execute([&] {
       // one task per chunk (chunks are large, uneven units of work; TBB's default partitioner may run
@@ -464,15 +472,20 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
           },
           tbb::simple_partitioner());
     });
+    for (Index c = c0; c < c1; ++c) seeds[static_cast<std::size_t>(c)] = Eigen::VectorXd();  // used: free
     for (Chunk& ch : chunks) {
       const int d = deliver_chunk(ch);
-      if (d == 2) return done(sum.status);
+      if (d == 2) {
+        add_counters(others, sws.counters, WorkCounters{});
+        return done(sum.status);
+      }
       if (d == 1) {
         fallback = true;
         break;
       }
     }
   }
+  add_counters(others, sws.counters, WorkCounters{});
   // The caller's workspace ends at the last delivered row, as after a sequential sweep.
   ws.q = last_q;
   if (need_v) ws.qd = last_qd;
