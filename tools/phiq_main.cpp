@@ -64,6 +64,7 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
   j["phi_t_evaluations"] = s.counters.phi_t_evaluations;
   j["gamma_evaluations"] = s.counters.gamma_evaluations;
   j["residual_evaluations"] = s.counters.residual_evaluations;
+  j["point_evaluations"] = s.counters.point_evaluations;
   j["subdivisions"] = s.subdivisions;
   j["min_rcond"] = s.min_rcond;
   j["warnings"] = nlohmann::ordered_json::array();
@@ -92,7 +93,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   const phiq::Model& model = *scene.model;
   scene.sweep.threads = threads;
   phiq::Workspace ws(model);
-  phiq::CsvFormat csv(model, scene.output_coordinates, scene.sweep.velocities, scene.sweep.accelerations);
+  phiq::CsvFormat csv(scene);
 
   // Where the CSV goes: a file that appears only when complete, or standard output after success, spooled through
   // an anonymous temporary file so that memory stays bounded however long the sweep is.
@@ -205,7 +206,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   for (std::size_t k = 0; k < scenes.size(); ++k) {
     const phiq::Scene& sc = scenes[k];
     models.push_back(sc.model.get());
-    formats.emplace_back(*sc.model, sc.output_coordinates, sc.sweep.velocities, sc.sweep.accelerations);
+    formats.emplace_back(sc);
     buffers[k] = formats[k].header();
     try {
       files[k] = std::make_unique<phiq::AtomicOutputFile>(dir + "/case" + std::to_string(k) + ".csv");

@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 
 namespace phiq {
@@ -14,14 +16,45 @@ CsvFormat::CsvFormat(const Model& model, std::vector<Index> columns, bool veloci
     if (j < 0 || j >= model.num_coordinates()) throw Error("CsvFormat: column index out of range");
 }
 
-std::string CsvFormat::header() const {
-  std::string h = "t";
+CsvFormat::CsvFormat(const Scene& scene)
+    : CsvFormat(*scene.model, scene.output_coordinates, scene.sweep.velocities, scene.sweep.accelerations) {
+  scene_ = &scene;
+  for (Index c : scene.output_residuals)
+    if (c < 0 || c >= static_cast<Index>(model_.constraints().size()))
+      throw Error("CsvFormat: residual constraint index out of range");
+}
+
+std::vector<std::string> CsvFormat::column_names() const {
+  std::vector<std::string> h{"t"};
   const auto& names = model_.coordinate_names();
-  for (Index j : columns_) h += "," + names[j];
+  for (Index j : columns_) h.push_back(names[j]);
   if (velocities_)
-    for (Index j : columns_) h += "," + names[j] + ".v";
+    for (Index j : columns_) h.push_back(names[j] + ".v");
   if (accelerations_)
-    for (Index j : columns_) h += "," + names[j] + ".a";
+    for (Index j : columns_) h.push_back(names[j] + ".a");
+  if (!scene_) return h;
+  static const char* const axis[] = {"x", "y", "z"};
+  for (const OutputPoint& p : scene_->sweep.points) {
+    for (int d = 0; d < p.dimension(); ++d) h.push_back(p.name + "." + axis[d]);
+    if (velocities_)
+      for (int d = 0; d < p.dimension(); ++d) h.push_back(p.name + ".v" + axis[d]);
+    if (accelerations_)
+      for (int d = 0; d < p.dimension(); ++d) h.push_back(p.name + ".a" + axis[d]);
+  }
+  for (const OutputDriver& d : scene_->output_drivers) {
+    h.push_back(d.name + ".f");
+    if (velocities_) h.push_back(d.name + ".df");
+    if (accelerations_) h.push_back(d.name + ".ddf");
+  }
+  for (Index c : scene_->output_residuals) h.push_back(model_.constraints()[c].name + ".residual");
+  if (scene_->output_max_residual) h.push_back("residual");
+  if (scene_->sweep.condition) h.push_back("rcond");
+  return h;
+}
+
+std::string CsvFormat::header() const {
+  std::string h;
+  for (const std::string& c : column_names()) h += (h.empty() ? "" : ",") + c;
   h += "\n";
   return h;
 }
@@ -35,6 +68,39 @@ inline void put(double v, std::string& out) {
 }
 }  // namespace
 
+void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
+  const auto& points = scene_->sweep.points;
+  if (!points.empty() && !s.points) throw Error("CsvFormat: step has no point motions");
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const PointMotion& m = s.points[i];
+    const int dim = points[i].dimension();
+    for (int d = 0; d < dim; ++d) out += ',', put(m.r[d], out);
+    if (velocities_)
+      for (int d = 0; d < dim; ++d) out += ',', put(m.v[d], out);
+    if (accelerations_)
+      for (int d = 0; d < dim; ++d) out += ',', put(m.a[d], out);
+  }
+  for (const OutputDriver& d : scene_->output_drivers) {
+    const LawValue v = d.law.evaluate(s.t);
+    out += ',', put(v.f, out);
+    if (velocities_) out += ',', put(v.df, out);
+    if (accelerations_) out += ',', put(v.ddf, out);
+  }
+  if (!scene_->output_residuals.empty() || scene_->output_max_residual) {
+    if (!s.phi) throw Error("CsvFormat: step has no residuals");
+    const Eigen::VectorXd& rs = model_.tolerance_scales().row_scale;
+    for (Index c : scene_->output_residuals) {
+      // the measure of the convergence test: |Φ_i| / scale_i, the largest over the constraint's rows
+      const ConstraintInfo& ci = model_.constraints()[c];
+      double r = 0.0;
+      for (Index i = ci.first_row; i < ci.first_row + ci.rows; ++i) r = std::max(r, std::fabs((*s.phi)(i)) / rs(i));
+      out += ',', put(r, out);
+    }
+    if (scene_->output_max_residual) out += ',', put(scaled_residual(model_, *s.phi), out);
+  }
+  if (scene_->sweep.condition) out += ',', put(s.rcond, out);
+}
+
 void CsvFormat::append_row(const StepView& s, std::string& out) const {
   put(s.t, out);
   for (Index j : columns_) out += ',', put(s.q(j), out);
@@ -46,6 +112,7 @@ void CsvFormat::append_row(const StepView& s, std::string& out) const {
     if (!s.qdd) throw Error("CsvFormat: step has no accelerations");
     for (Index j : columns_) out += ',', put((*s.qdd)(j), out);
   }
+  if (scene_) append_outputs(s, out);
   out += '\n';
 }
 

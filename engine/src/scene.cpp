@@ -893,6 +893,7 @@ class SceneReader {
     read_time(top.require("time"), scene.sweep);
     read_output(top.field("output"), scene);
     points_ = {}, bodies_ = {};  // not needed any more: their memory is free for the model
+    driver_laws_ = {};
 
     try {
       scene.model = std::make_unique<Model>(std::move(builder_).build());
@@ -904,6 +905,7 @@ class SceneReader {
                std::to_string(scene.model->num_equations()) +
                " constraint equations (kinematic + drivers); the driven system must be square");
     }
+    resolve_output_residuals(scene);
     return scene;
   }
 
@@ -1535,6 +1537,7 @@ class SceneReader {
     std::string name;
     if (auto n = c.field("name"); n.present()) name = n.name();
     MotionLaw law = motion_law(c.require("law"));
+    if (!name.empty()) driver_laws_.emplace(name, law);  // for `output: drivers` (shared data: a cheap copy)
     const bool by_coordinate = c.field("coordinate").present(), by_expr = c.field("expr").present();
     if (by_coordinate == by_expr) c.fail("a driver has either 'coordinate' or 'expr'");
     try {
@@ -1747,23 +1750,90 @@ class SceneReader {
     if (o.steps > 0 && o.t_end == o.t_begin) c.require("end").fail("end equals start but steps > 0");
   }
 
-  void read_output(const Cursor& c, Scene& scene) const {
+  // The output list, and from it the sweep's plan: derivatives, points, residuals and the condition estimate are
+  // computed only when listed here (models/README.md, `output`).
+  void read_output(const Cursor& c, Scene& scene) {
     scene.sweep.velocities = scene.sweep.accelerations = false;
+    bool coordinates_listed = false;
     if (c.present()) {
-      c.expect_map({"velocities", "accelerations", "coordinates"});
+      c.expect_map({"velocities", "accelerations", "coordinates", "points", "drivers", "residuals", "max_residual",
+                    "rcond"});
       if (auto v = c.field("velocities"); v.present()) scene.sweep.velocities = v.boolean();
       if (auto a = c.field("accelerations"); a.present()) scene.sweep.accelerations = a.boolean();
       if (auto cs = c.field("coordinates"); cs.present()) {
+        coordinates_listed = true;
         std::set<Index> seen;
         for (const Cursor& i : cs.items()) {
           Index j = coordinate(i);
           if (!seen.insert(j).second) i.fail("coordinate listed twice");
           scene.output_coordinates.push_back(j);
         }
-        return;
       }
+      if (auto ps = c.field("points"); ps.present()) {
+        std::set<std::string> seen;
+        for (const Cursor& i : ps.items()) {
+          OutputPoint p = output_point(i);
+          if (!seen.insert(p.name).second) i.fail("output point '" + p.name + "' listed twice");
+          scene.sweep.points.push_back(std::move(p));
+        }
+      }
+      if (auto ds = c.field("drivers"); ds.present()) {
+        std::set<std::string> seen;
+        for (const Cursor& i : ds.items()) {
+          const std::string n = i.name();
+          auto it = driver_laws_.find(n);
+          if (it == driver_laws_.end()) i.fail("unknown driver '" + n + "' (a named entry of `drivers`)");
+          if (!seen.insert(n).second) i.fail("driver listed twice");
+          scene.output_drivers.push_back({n, it->second});
+        }
+      }
+      if (auto rs = c.field("residuals"); rs.present()) {
+        std::set<std::string> seen;
+        for (const Cursor& i : rs.items()) {
+          const std::string n = i.name();
+          if (!builder_.has_constraint(n)) i.fail("unknown constraint or driver '" + n + "'");
+          if (!seen.insert(n).second) i.fail("constraint listed twice");
+          residual_names_.push_back(n);
+        }
+      }
+      if (auto v = c.field("max_residual"); v.present()) scene.output_max_residual = v.boolean();
+      if (auto v = c.field("rcond"); v.present()) scene.sweep.condition = v.boolean();
+      scene.sweep.residuals = scene.output_max_residual || !residual_names_.empty();
     }
-    for (Index j = 0; j < builder_.num_coordinates(); ++j) scene.output_coordinates.push_back(j);
+    if (!coordinates_listed)
+      for (Index j = 0; j < builder_.num_coordinates(); ++j) scene.output_coordinates.push_back(j);
+    // the columns `residual` and `rcond` must not collide with a coordinate's
+    for (Index j : scene.output_coordinates) {
+      const std::string& n = builder_.coordinate_name(j);
+      if ((n == "residual" && scene.output_max_residual) || (n == "rcond" && scene.sweep.condition))
+        c.fail("coordinate '" + n + "' and the column '" + n + "' would share a name: leave it out of coordinates");
+    }
+  }
+  // An output point: a point name, or {name: P, body: B, at: [x, y]} (a point fixed on body B, in B's frame).
+  OutputPoint output_point(const Cursor& c) const {
+    if (!c.is_map()) {
+      const std::string n = c.name();
+      const Index k = entry_at(c, n, points_);
+      if (k < 0) c.fail("unknown point '" + n + "' (or write {name: P, body: B, at: [x, y]})");
+      return planar_point(n, points_[k]);
+    }
+    c.expect_map({"name", "body", "at"});
+    const std::string n = c.require("name").name();
+    if (!Cursor::valid_name(n)) c.require("name").fail("'" + n + "' is not a valid name");
+    const Frame2 f = body(c.require("body"));
+    kin::V2 at{0, 0};
+    if (auto a = c.field("at"); a.present()) at = vec2(a);
+    return planar_body_point(n, f, at.x, at.y);
+  }
+  // Constraint names of `output: residuals` to indices, once the model is built (one pass over the constraints).
+  void resolve_output_residuals(Scene& scene) const {
+    if (residual_names_.empty()) return;
+    std::unordered_map<std::string, Index> wanted;
+    for (const std::string& n : residual_names_) wanted.emplace(n, -1);
+    const auto& cs = scene.model->constraints();
+    for (std::size_t k = 0; k < cs.size(); ++k)
+      if (auto it = wanted.find(cs[k].name); it != wanted.end()) it->second = static_cast<Index>(k);
+    for (const std::string& n : residual_names_) scene.output_residuals.push_back(wanted.at(n));
   }
 
   void read_solver(const Cursor& c, SweepOptions& o) {
@@ -1822,6 +1892,8 @@ class SceneReader {
   std::function<void(std::size_t)> reserve_;  // room for that many more entries of the section being read
   int unnamed_ = 0;
   bool predictor_field_ = false;
+  std::unordered_map<std::string, MotionLaw> driver_laws_;  // named drivers, for `output: drivers`
+  std::vector<std::string> residual_names_;                 // `output: residuals`, resolved after the build
 
  public:
   bool predictor_given() const { return predictor_field_; }

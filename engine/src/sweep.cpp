@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -66,6 +67,20 @@ class Sweeper {
     }
     return true;
   }
+
+  // The outputs of a delivered row beyond q, q̇, q̈, from the converged state in ws: the listed points' motions
+  // (counted) and the condition estimate (Φ is ws.phi already). Only delivered rows pay for them: sub-steps and
+  // the seam steps of parallel chunks do not.
+  void row_outputs() {
+    const double* qd = need_v_ ? ws_.qd.data() : nullptr;
+    const double* qdd = need_a_ ? ws_.qdd.data() : nullptr;
+    for (std::size_t i = 0; i < opt_.points.size(); ++i)
+      points_[i] = evaluate_point(opt_.points[i], ws_.q.data(), qd, qdd);
+    ws_.counters.point_evaluations += static_cast<Index>(opt_.points.size());
+    rcond_ = opt_.condition && ws_.lu ? ws_.lu->rcond() : 0.0;
+  }
+  const PointMotion* point_motions() const { return points_.empty() ? nullptr : points_.data(); }
+  double rcond() const { return rcond_; }
 
   // Records the cause; run_sweep prefixes the step and its grid time (the sub-step time, if any, is in `why`).
   bool fail(SolveStatus st, const std::string& why) {
@@ -167,6 +182,8 @@ class Sweeper {
   Predictor predictor_;
   State current_, prev_;
   bool has_current_ = false, has_prev_ = false;
+  std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
+  double rcond_ = 0.0;
 };
 
 }  // namespace
@@ -199,8 +216,10 @@ struct Run {
     return k == opt.steps ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
   }
   // Delivers row k; false when the caller stops the sweep (status and message set).
-  bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
-    StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr};
+  bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
+               const PointMotion* points, const Eigen::VectorXd& phi, double rcond) {
+    StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
+                  points, opt.residuals ? &phi : nullptr, opt.condition ? rcond : 0.0};
     ++sum.steps_completed;
     if (on_step && !on_step(view)) {
       sum.status = SolveStatus::kCancelled;
@@ -222,7 +241,8 @@ struct Run {
         failed(k);
         return false;
       }
-      if (!deliver(k, ws.q, ws.qd, ws.qdd)) return false;
+      sw.row_outputs();
+      if (!deliver(k, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond())) return false;
     }
     return true;
   }
@@ -238,6 +258,7 @@ void add_counters(WorkCounters& into, const WorkCounters& now, const WorkCounter
   into.acceleration_solves += now.acceleration_solves - before.acceleration_solves;
   into.phi_t_evaluations += now.phi_t_evaluations - before.phi_t_evaluations;
   into.gamma_evaluations += now.gamma_evaluations - before.gamma_evaluations;
+  into.point_evaluations += now.point_evaluations - before.point_evaluations;
 }
 
 // Two solutions of the same position problem are the same one if they differ by less than 100 tolerances in
@@ -253,7 +274,7 @@ constexpr double kRowBufferBytes = 512.0 * 1024 * 1024;
 
 struct Chunk {
   Index k0 = 0, k1 = 0;
-  std::vector<double> rows;  // (k1 − k0 + 1) rows of [q | q̇ | q̈], as asked for
+  std::vector<double> rows;  // (k1 − k0 + 1) rows of [q | q̇ | q̈ | Φ | rcond | point motions], as asked for
   SweepSummary sum;          // status, message, warnings, subdivisions, rcond and work of this chunk
   bool ok = false;
   bool has_seam = false;
@@ -269,6 +290,9 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   if (!std::isfinite(opt.t_begin) || !std::isfinite(opt.t_end)) throw Error("SweepOptions: times must be finite");
   if (opt.threads < 0) throw Error("SweepOptions: threads must be >= 0 (0: all cores)");
   if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
+  for (const OutputPoint& p : opt.points)
+    if (p.max_coordinate() >= model.num_coordinates())
+      throw Error("SweepOptions: output point '" + p.name + "' reads a coordinate the model does not have");
   SweepSummary local;
   SweepSummary& sum = summary ? *summary : local;
   sum = SweepSummary{};
@@ -302,13 +326,20 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
     run.failed(0);
     return done(sum.status);
   }
-  if (!run.deliver(0, ws.q, ws.qd, ws.qdd)) return done(sum.status);
+  sw.row_outputs();
+  if (!run.deliver(0, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond())) return done(sum.status);
 
   const int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
   const Index n = model.num_coordinates();
   // Rows keep q̇ whenever it is solved (q̈ needs it, and so does an ordered continuation's predictor).
   const bool need_v = opt.velocities || opt.accelerations, need_a = opt.accelerations;
-  const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0));
+  // a row's layout in the chunk buffers: q, q̇, q̈ as solved, then Φ, rcond and the point motions as asked
+  const Index m = model.num_equations();
+  const Index n_phi = opt.residuals ? m : 0, n_rcond = opt.condition ? 1 : 0;
+  const Index n_points = static_cast<Index>(opt.points.size());
+  constexpr Index kMotionDoubles = static_cast<Index>(sizeof(PointMotion) / sizeof(double));
+  static_assert(sizeof(PointMotion) == 9 * sizeof(double), "PointMotion is stored as 9 doubles in chunk rows");
+  const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles;
   Index chunk = opt.chunk_steps;
   if (chunk == 0) {
     const double fit = kRowBufferBytes / (8.0 * static_cast<double>(std::max<Index>(width, 1)) * threads);
@@ -346,6 +377,8 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   // one step after it when continued in order (the previous chunk's seam), if known.
   Index resume = 1;
   Eigen::VectorXd last_q = ws.q, last_qd = ws.qd, last_qdd = ws.qdd;
+  Eigen::VectorXd last_phi = ws.phi;                        // Φ of the row being delivered, when asked
+  std::vector<PointMotion> last_points(opt.points.size());  // its point motions
   bool seam_known = false;
   Eigen::VectorXd seam_q;
   std::vector<Eigen::VectorXd> seeds(1);  // chunk 0 starts from row 0 itself
@@ -363,6 +396,13 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
       out = std::copy(w.q.data(), w.q.data() + n, out);
       if (need_v) out = std::copy(w.qd.data(), w.qd.data() + n, out);
       if (need_a) out = std::copy(w.qdd.data(), w.qdd.data() + n, out);
+      s.row_outputs();
+      if (n_phi) out = std::copy(w.phi.data(), w.phi.data() + m, out);
+      if (n_rcond) *out++ = s.rcond();
+      if (n_points) {
+        std::memcpy(out, s.point_motions(), sizeof(PointMotion) * opt.points.size());
+        out += n_points * kMotionDoubles;
+      }
     };
     if (c == 0) {  // continues row 0 in order: the sequential sweep itself
       w.q = last_q, w.qd = last_qd, w.qdd = last_qdd;
@@ -403,7 +443,11 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
       last_q = Eigen::Map<const Eigen::VectorXd>(r, n);
       if (need_v) last_qd = Eigen::Map<const Eigen::VectorXd>(r + n, n);
       if (need_a) last_qdd = Eigen::Map<const Eigen::VectorXd>(r + 2 * n, n);
-      if (!run.deliver(k, last_q, last_qd, last_qdd)) return 2;
+      const double* extra = r + n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0));
+      if (n_phi) last_phi = Eigen::Map<const Eigen::VectorXd>(extra, m);
+      const double rc = n_rcond ? extra[n_phi] : 0.0;
+      if (n_points) std::memcpy(static_cast<void*>(last_points.data()), extra + n_phi + n_rcond, sizeof(PointMotion) * opt.points.size());
+      if (!run.deliver(k, last_q, last_qd, last_qdd, n_points ? last_points.data() : nullptr, last_phi, rc)) return 2;
     }
     resume = ch.k1 + 1;
     seam_known = ch.has_seam;
@@ -430,6 +474,7 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   SweepOptions seed_options = opt;
   seed_options.velocities = seed_options.accelerations = false;
   seed_options.predictor = Predictor::kSecant;
+  seed_options.points.clear(), seed_options.residuals = seed_options.condition = false;  // seeds deliver no rows
   SweepSummary seed_summary;
   Workspace sws(model);
   sws.q = last_q;

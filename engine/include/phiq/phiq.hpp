@@ -10,6 +10,7 @@
 #include "phiq/linear_solver.hpp"
 #include "phiq/model.hpp"
 #include "phiq/motion_law.hpp"
+#include "phiq/output_points.hpp"
 #include "phiq/scene.hpp"
 #include "phiq/sweep.hpp"
 #include "phiq/version.hpp"

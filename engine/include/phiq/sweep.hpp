@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "phiq/kinematics.hpp"
+#include "phiq/output_points.hpp"
 
 namespace phiq {
 
@@ -47,6 +48,19 @@ struct SweepOptions {
   /// Steps per parallel chunk; 0 picks 64, fewer when the rows a wave of chunks buffers (threads × chunk_steps
   /// rows of q, q̇, q̈) would exceed 512 MiB.
   Index chunk_steps = 0;
+
+  // Outputs beyond q, q̇, q̈: the sweep computes only what is listed (models/README.md, `output`).
+
+  /// Points whose motion is evaluated at every delivered row (StepView::points): position always, velocity when
+  /// q̇ is solved, acceleration when q̈ is. Nothing is evaluated for points not listed.
+  std::vector<OutputPoint> points;
+  /// Deliver Φ(q, t) at every row (StepView::phi). Free: Newton's convergence test has just evaluated it.
+  bool residuals = false;
+  /// Deliver the reciprocal condition estimate of the last factorisation of Φq (StepView::rcond). Free with KLU
+  /// and UMFPACK (the pivot ratio is computed with every factorisation). It is of Φq at the delivered q when
+  /// velocities or accelerations are solved; in a positions-only sweep it is of the factorisation modified Newton
+  /// last made (at this step or a few before), which is what the positions were solved with.
+  bool condition = false;
 };
 
 /// What the step callback sees. qd / qdd are null when not computed.
@@ -56,6 +70,11 @@ struct StepView {
   const Eigen::VectorXd& q;    ///< positions (valid during the callback only)
   const Eigen::VectorXd* qd;   ///< velocities, or null when not asked for
   const Eigen::VectorXd* qdd;  ///< accelerations, or null when not asked for
+  /// Motions of SweepOptions::points, in that order (null when none are listed); velocity / acceleration
+  /// components are filled when q̇ / q̈ are solved.
+  const PointMotion* points = nullptr;
+  const Eigen::VectorXd* phi = nullptr;  ///< Φ(q, t) when SweepOptions::residuals, else null
+  double rcond = 0.0;                    ///< when SweepOptions::condition (see there), else 0
 };
 
 /// Something the caller should know about a delivered row (the row itself is within tolerance).

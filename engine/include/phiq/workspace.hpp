@@ -22,6 +22,7 @@ struct WorkCounters {
   Index acceleration_solves = 0;   ///< solves of Φq q̈ = γ
   Index phi_t_evaluations = 0;     ///< evaluations of Φt (velocity right-hand sides)
   Index gamma_evaluations = 0;     ///< evaluations of γ (acceleration right-hand sides)
+  Index point_evaluations = 0;     ///< output point motions evaluated (one per point and delivered row)
 };
 
 /// Per-thread data of the algorithms in kinematics.hpp and sweep.hpp. Not thread-safe: one thread at a time.

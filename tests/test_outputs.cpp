@@ -1,0 +1,251 @@
+// Outputs a scene lists (points, drivers, residuals, rcond) and the work the sweep does for them: exact counts of
+// solves and evaluations, point motions against closed forms and finite differences.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+// The seed four-bar in mixed coordinates (coupler as a body), with every kind of output listed. Crank tip A is at
+// 0.4 (cos t, sin t) exactly.
+std::string fourbar_scene(const std::string& output, int steps = 36) {
+  return R"(
+phiq: 1
+parameters: {L1: 1.0, L2: 0.4, L3: 1.2, L4: 1.0}
+coordinates: {theta2: 0.0, xA: 0.4, yA: 0.0, x3: 0.7, y3: 0.5, psi3: 1.0, xB: 1.1, yB: 1.0}
+points: {O: [0, 0], A: [xA, yA], B: [xB, yB], C: [L1, 0]}
+bodies: {coupler: [x3, y3, psi3]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: A, type: revolute, between: [{body: coupler, at: [-L3/2, 0]}, {point: A}]}
+  - {name: B, type: revolute, between: [{body: coupler, at: [L3/2, 0]}, {point: B}]}
+  - {name: rocker, type: distance, points: [C, B], length: L4}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: harmonic, offset: 0.5, amplitude: 2, frequency: 1.5}}
+time: {start: 0, end: 2, steps: )" + std::to_string(steps) + R"(}
+output: )" + output + "\n";
+}
+
+struct Rows {
+  std::vector<double> t;
+  std::vector<Eigen::VectorXd> q;
+  std::vector<std::vector<PointMotion>> points;
+  std::vector<Eigen::VectorXd> phi;
+  std::vector<double> rcond;
+};
+
+Rows sweep_scene(const Scene& scene, SweepSummary* sum, int threads = 1, Index chunk = 0) {
+  Rows r;
+  SweepOptions opt = scene.sweep;
+  opt.threads = threads;
+  opt.chunk_steps = chunk;
+  Workspace ws(*scene.model);
+  const SolveStatus st = run_sweep(*scene.model, opt, ws, [&](const StepView& s) {
+    r.t.push_back(s.t);
+    r.q.push_back(s.q);
+    if (s.points) r.points.emplace_back(s.points, s.points + opt.points.size());
+    if (s.phi) r.phi.push_back(*s.phi);
+    r.rcond.push_back(s.rcond);
+    return true;
+  }, sum);
+  EXPECT_EQ(st, SolveStatus::kSuccess) << sum->message;
+  return r;
+}
+
+TEST(OutputPoints, PlanarBodyPointMatchesTheClosedForm) {
+  // body at (1, 2), ψ = 0.3, ψ̇ = 2, ψ̈ = −1, ṙ = (0.5, −0.25), r̈ = (0.1, 0.2); s = (0.4, −0.3)
+  const double q[] = {1, 2, 0.3}, qd[] = {0.5, -0.25, 2}, qdd[] = {0.1, 0.2, -1};
+  auto S = Slot::coordinate;
+  OutputPoint p = planar_body_point("P", Frame2{S(0), S(1), S(2)}, 0.4, -0.3);
+  PointMotion m = evaluate_point(p, q, qd, qdd);
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  const double rx = c * 0.4 + s * 0.3, ry = s * 0.4 - c * 0.3;  // R(ψ) s
+  EXPECT_DOUBLE_EQ(m.r[0], 1 + rx);
+  EXPECT_DOUBLE_EQ(m.r[1], 2 + ry);
+  EXPECT_DOUBLE_EQ(m.v[0], 0.5 - 2 * ry);
+  EXPECT_DOUBLE_EQ(m.v[1], -0.25 + 2 * rx);
+  EXPECT_DOUBLE_EQ(m.a[0], 0.1 + ry - 4 * rx);
+  EXPECT_DOUBLE_EQ(m.a[1], 0.2 - rx - 4 * ry);
+  EXPECT_EQ(m.r[2], 0.0);
+  // without q̇ only the position is evaluated
+  PointMotion only = evaluate_point(p, q, nullptr, nullptr);
+  EXPECT_EQ(only.v[0], 0.0);
+  EXPECT_EQ(only.a[1], 0.0);
+  // a fixed point (constant slots) does not move
+  PointMotion fixed = evaluate_point(planar_point("C", Point2{Slot::constant(1), Slot::constant(0)}), q, qd, qdd);
+  EXPECT_EQ(fixed.r[0], 1.0);
+  EXPECT_EQ(fixed.v[0], 0.0);
+}
+
+TEST(OutputPoints, SweepPointsAreExactAndTheirDerivativesMatchFiniteDifferences) {
+  const int steps = 2000;  // h = 1e-3: central differences to ~h² = 1e-6
+  Scene scene = parse_scene(fourbar_scene("{velocities: true, accelerations: true, points: [A, "
+                                          "{name: P, body: coupler, at: [0.1, 0.3]}]}", steps), "fourbar.yaml");
+  ASSERT_EQ(scene.sweep.points.size(), 2u);
+  SweepSummary sum;
+  Rows r = sweep_scene(scene, &sum);
+  ASSERT_EQ(r.points.size(), static_cast<std::size_t>(steps + 1));
+  const double h = r.t[1] - r.t[0];
+  double worst_v = 0, worst_a = 0;
+  for (std::size_t k = 0; k < r.t.size(); ++k) {
+    // A is the crank tip: 0.4 (cos θ, sin θ), θ = 0.5 + 2 sin(1.5 t)
+    const double t = r.t[k], th = 0.5 + 2 * std::sin(1.5 * t), w = 3 * std::cos(1.5 * t),
+                 al = -4.5 * std::sin(1.5 * t);
+    const PointMotion& a = r.points[k][0];
+    ASSERT_NEAR(a.r[0], 0.4 * std::cos(th), 1e-9);
+    ASSERT_NEAR(a.r[1], 0.4 * std::sin(th), 1e-9);
+    ASSERT_NEAR(a.v[0], -0.4 * w * std::sin(th), 1e-8);
+    ASSERT_NEAR(a.a[1], 0.4 * (al * std::cos(th) - w * w * std::sin(th)), 1e-7);
+    // P on the coupler: its position is r3 + R(ψ3) s from the row's coordinates
+    const Eigen::VectorXd& q = r.q[k];
+    const double c = std::cos(q(5)), s = std::sin(q(5));
+    ASSERT_DOUBLE_EQ(r.points[k][1].r[0], q(3) + c * 0.1 - s * 0.3);
+    ASSERT_DOUBLE_EQ(r.points[k][1].r[1], q(4) + s * 0.1 + c * 0.3);
+    if (k == 0 || k + 1 == r.t.size()) continue;
+    for (int d = 0; d < 2; ++d) {
+      const PointMotion &prev = r.points[k - 1][1], &cur = r.points[k][1], &next = r.points[k + 1][1];
+      worst_v = std::max(worst_v, std::fabs((next.r[d] - prev.r[d]) / (2 * h) - cur.v[d]));
+      worst_a = std::max(worst_a, std::fabs((next.v[d] - prev.v[d]) / (2 * h) - cur.a[d]));
+    }
+  }
+  EXPECT_LT(worst_v, 1e-4);
+  EXPECT_LT(worst_a, 1e-3);
+  EXPECT_GT(worst_v, 0.0);  // the differences are real numbers, not copies of the evaluated derivatives
+  EXPECT_EQ(sum.counters.point_evaluations, 2 * (steps + 1));
+}
+
+// Exact counts of the work each output list causes, sequential and parallel. Full Newton and a fixed predictor
+// make the position work independent of the outputs, so the counts below are exact.
+struct Plan {
+  const char* output;
+  bool v, a;        // q̇ and q̈ solved
+  Index points;     // output points
+};
+
+TEST(OutputPlan, TheSweepDoesOnlyTheWorkTheOutputListsAsksFor) {
+  const int steps = 40;
+  const Plan plans[] = {
+      {"{coordinates: [theta2]}", false, false, 0},
+      {"{velocities: true}", true, false, 0},
+      {"{accelerations: true}", true, true, 0},  // q̈ needs q̇: solved, not delivered
+      {"{velocities: true, accelerations: true, points: [B, {name: P, body: coupler}]}", true, true, 2},
+      {"{points: [B], drivers: [motor], residuals: [rocker], max_residual: true, rcond: true}", false, false, 1},
+  };
+  for (const Plan& p : plans) {
+    Scene scene = parse_scene(fourbar_scene(p.output, steps), "fourbar.yaml");
+    scene.sweep.newton.jacobian_update = JacobianUpdate::kEveryIteration;
+    scene.sweep.predictor = Predictor::kPrevious;
+    for (int threads : {1, 2}) {
+      SweepSummary sum;
+      const Index chunk = 8;
+      Rows r = sweep_scene(scene, &sum, threads, chunk);
+      const Index rows = steps + 1;
+      ASSERT_EQ(static_cast<Index>(r.t.size()), rows);
+      // a parallel sweep solves one step more per chunk but the last: the seam its successor is checked against
+      const Index seams = threads > 1 ? sum.parallel_chunks - 1 : 0;
+      if (threads > 1) {
+        EXPECT_EQ(sum.parallel_chunks, (steps + chunk - 1) / chunk) << p.output;
+      }
+      const Index solved = rows + seams;
+      const WorkCounters& c = sum.counters;
+      EXPECT_EQ(c.velocity_solves, p.v ? solved : 0) << p.output << ", " << threads << " threads";
+      EXPECT_EQ(c.phi_t_evaluations, p.v ? solved : 0) << p.output << ", " << threads << " threads";
+      EXPECT_EQ(c.acceleration_solves, p.a ? solved : 0) << p.output << ", " << threads << " threads";
+      EXPECT_EQ(c.gamma_evaluations, p.a ? solved : 0) << p.output << ", " << threads << " threads";
+      // points only at delivered rows: not at seams, sub-steps or seeds
+      EXPECT_EQ(c.point_evaluations, p.points * rows) << p.output << ", " << threads << " threads";
+      EXPECT_EQ(sum.subdivisions, 0);
+    }
+  }
+}
+
+TEST(OutputPlan, ResidualsAndConditionAreDeliveredWithoutExtraEvaluations) {
+  const int steps = 30;
+  Scene plain = parse_scene(fourbar_scene("{velocities: true}", steps), "fourbar.yaml");
+  Scene asked = parse_scene(fourbar_scene("{velocities: true, residuals: [rocker, A], max_residual: true, "
+                                          "rcond: true}", steps), "fourbar.yaml");
+  EXPECT_TRUE(asked.sweep.residuals);
+  EXPECT_TRUE(asked.sweep.condition);
+  ASSERT_EQ(asked.output_residuals.size(), 2u);
+  EXPECT_EQ(asked.model->constraints()[asked.output_residuals[0]].name, "rocker");
+  for (int threads : {1, 2}) {
+    SweepSummary s0, s1;
+    Rows r0 = sweep_scene(plain, &s0, threads, 4), r1 = sweep_scene(asked, &s1, threads, 4);
+    EXPECT_TRUE(r0.phi.empty());
+    ASSERT_EQ(r1.phi.size(), r1.t.size());
+    // Φ is the one Newton's convergence test evaluated: no residual or Jacobian evaluation more (in order: a
+    // parallel sweep's chunks take pooled workspaces whose old factorisations modified Newton may reuse, so its
+    // counts depend on the scheduling)
+    if (threads == 1) {
+      EXPECT_EQ(s1.counters.residual_evaluations, s0.counters.residual_evaluations);
+      EXPECT_EQ(s1.counters.factorizations, s0.counters.factorizations);
+    }
+    Eigen::VectorXd phi(asked.model->num_equations());
+    double min_rcond = INFINITY;
+    for (std::size_t k = 0; k < r1.t.size(); ++k) {
+      asked.model->residual(r1.q[k].data(), r1.t[k], phi.data());
+      EXPECT_EQ(phi, r1.phi[k]) << "row " << k;  // Φ at the delivered q, bit for bit
+      EXPECT_LE(scaled_residual(*asked.model, phi), 1e-10);
+      EXPECT_TRUE(r1.rcond[k] > 0.0 && r1.rcond[k] <= 1.0);
+      EXPECT_EQ(r0.rcond[k], 0.0);  // not asked: not delivered
+      min_rcond = std::min(min_rcond, r1.rcond[k]);
+    }
+    // with velocities the factorisation is at the delivered q: the column's minimum is the summary's
+    EXPECT_EQ(min_rcond, s1.min_rcond);
+  }
+}
+
+TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
+  Scene scene = parse_scene(fourbar_scene("{velocities: true, coordinates: [theta2], points: [B, {name: P, body: "
+                                          "coupler, at: [0, 0.3]}], drivers: [motor], residuals: [rocker], "
+                                          "max_residual: true, rcond: true}", 4), "fourbar.yaml");
+  CsvFormat csv(scene);
+  EXPECT_EQ(csv.header(),
+            "t,theta2,theta2.v,B.x,B.y,B.vx,B.vy,P.x,P.y,P.vx,P.vy,motor.f,motor.df,rocker.residual,residual,rcond\n");
+  // the driver's columns are its law f(t) = 0.5 + 2 sin(1.5 t) and f'(t)
+  std::string row;
+  SweepSummary sum;
+  Workspace ws(*scene.model);
+  run_sweep(*scene.model, scene.sweep, ws, [&](const StepView& s) {
+    if (s.step == 1) csv.append_row(s, row);
+    return true;
+  }, &sum);
+  std::vector<double> v;
+  std::stringstream in(row);
+  for (std::string cell; std::getline(in, cell, ',');) v.push_back(std::stod(cell));
+  ASSERT_EQ(v.size(), 16u);
+  EXPECT_DOUBLE_EQ(v[11], 0.5 + 2 * std::sin(1.5 * v[0]));
+  EXPECT_DOUBLE_EQ(v[12], 3 * std::cos(1.5 * v[0]));
+  EXPECT_DOUBLE_EQ(v[1], v[11]);  // the driven coordinate is f(t) to the tolerance... and here exactly
+}
+
+TEST(OutputPlan, BadOutputListsAreOneLineErrorsNamingTheField) {
+  auto error_of = [](const std::string& output) {
+    try {
+      parse_scene(fourbar_scene(output), "fourbar.yaml");
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error_of("{points: [Q]}").find("output.points[0]: unknown point 'Q'"), std::string::npos)
+      << error_of("{points: [Q]}");
+  EXPECT_NE(error_of("{points: [{name: P, body: crank}]}").find("unknown body 'crank'"), std::string::npos);
+  EXPECT_NE(error_of("{points: [A, A]}").find("listed twice"), std::string::npos);
+  EXPECT_NE(error_of("{drivers: [crank]}").find("unknown driver 'crank'"), std::string::npos);
+  EXPECT_NE(error_of("{residuals: [nothing]}").find("unknown constraint or driver 'nothing'"), std::string::npos);
+  EXPECT_NE(error_of("{rcond: maybe}").find("output.rcond"), std::string::npos) << error_of("{rcond: maybe}");
+  EXPECT_NE(error_of("{pionts: [A]}").find("pionts"), std::string::npos);
+  // today's form keeps working: no points, no residuals, all coordinates
+  Scene s = parse_scene(fourbar_scene("{velocities: true, accelerations: true}"), "fourbar.yaml");
+  EXPECT_TRUE(s.sweep.points.empty());
+  EXPECT_FALSE(s.sweep.residuals || s.sweep.condition);
+  EXPECT_EQ(s.output_coordinates.size(), 8u);
+}
+
+}  // namespace
+}  // namespace phiq
