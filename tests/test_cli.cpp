@@ -3,6 +3,7 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
@@ -409,6 +410,139 @@ TEST_F(Cli, SummaryJsonCountsWhatWasComputed) {
   const std::string j2 = slurp(sum);
   EXPECT_NE(j2.find("\"velocity_solves\": 11"), std::string::npos) << j2;
   EXPECT_NE(j2.find("\"acceleration_solves\": 11"), std::string::npos) << j2;
+}
+
+// The four-bar of models/seed/fourbar_mixed.yaml with every kind of output: two points (B, natural; P on the
+// coupler body), the driver, residuals and rcond.
+const char* kFourbarOutputs = R"(phiq: 1
+name: fourbar_outputs
+parameters: {L1: 1.0, L2: 0.4, L3: 1.2, L4: 1.0}
+coordinates: {theta2: 0.0, xA: 0.4, yA: 0.0, x3: 0.7, y3: 0.5, psi3: 1.0, xB: 1.1, yB: 1.0}
+points: {O: [0, 0], A: [xA, yA], B: [xB, yB], C: [L1, 0]}
+bodies: {coupler: [x3, y3, psi3]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: A, type: revolute, between: [{body: coupler, at: [-L3/2, 0]}, {point: A}]}
+  - {name: B, type: revolute, between: [{body: coupler, at: [L3/2, 0]}, {point: B}]}
+  - {name: rocker, type: distance, points: [C, B], length: L4}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 2*pi, steps: 72}
+output:
+  velocities: true
+  points: [B, {name: P, body: coupler, at: [0, 0.3]}]
+  drivers: [motor]
+  residuals: [rocker]
+  max_residual: true
+  rcond: true
+)";
+
+TEST_F(Cli, RunWritesTheListedOutputsAndCountsThem) {
+  const fs::path scene = write("f.yaml", kFourbarOutputs), csv = dir_ / "f.csv", sum = dir_ / "sum.json";
+  Result r = run("run -q --threads 1 " + scene.string() + " -o " + csv.string() + " --summary " + sum.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const phiq::CsvTable t = phiq::read_csv_table(csv.string());
+  const std::vector<std::string> tail = {"B.x", "B.y", "B.vx", "B.vy", "P.x", "P.y", "P.vx", "P.vy", "motor.f",
+                                         "motor.df", "rocker.residual", "residual", "rcond"};
+  ASSERT_EQ(t.columns.size(), 1 + 16 + tail.size());
+  EXPECT_TRUE(std::equal(tail.begin(), tail.end(), t.columns.end() - static_cast<long>(tail.size())));
+  ASSERT_EQ(t.rows.size(), 73u);
+  for (const auto& row : t.rows) {
+    EXPECT_EQ(row[17], row[7]);   // B.x is xB
+    EXPECT_EQ(row[19], row[15]);  // B.vx is xB.v
+    EXPECT_EQ(row[25], row[0]);   // motor.f = t
+    EXPECT_EQ(row[26], 1.0);      // motor.df
+    EXPECT_LE(row[28], 1e-10);    // residual within the tolerance
+    EXPECT_GT(row[29], 0.0);      // rcond
+  }
+  const std::string j = slurp(sum);
+  for (const char* part : {"\"steps\": 73", "\"velocity_solves\": 73", "\"phi_t_evaluations\": 73",
+                           "\"acceleration_solves\": 0", "\"gamma_evaluations\": 0", "\"point_evaluations\": 146"})
+    EXPECT_NE(j.find(part), std::string::npos) << part << "\n" << j;
+}
+
+TEST_F(Cli, ProgressBarOnlyOnATerminalOrWhenAsked) {
+  const fs::path scene = dir_ / "p.yaml";
+  ASSERT_EQ(run("generate nfourbar 20 --steps 400 --outputs q -o " + scene.string()).code, 0);
+  // stderr is a file here: no bar, only the summary line
+  Result r = run("run " + scene.string() + " -o " + (dir_ / "p.csv").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("rows,"), std::string::npos) << r.err;
+  // forced: drawn from the first row, erased before the summary
+  r = run("run --progress always " + scene.string() + " -o " + (dir_ / "p.csv").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("\rphiq: ["), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("100% 401/401 rows"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("\r\033[Kphiq: "), std::string::npos) << "the summary starts on an erased line";
+  EXPECT_EQ(run("run --progress sometimes " + scene.string()).code, 2);
+  // on a terminal (a pseudo-terminal from util-linux's script), a sweep longer than the bar's delay shows it
+  if (std::system("command -v script >/dev/null 2>&1") == 0) {
+    ASSERT_EQ(run("generate nfourbar 100 --steps 12000 --outputs q -o " + scene.string()).code, 0);
+    const fs::path log = dir_ / "tty.txt";
+    const std::string cmd = "script -qec \"" + std::string(PHIQ_CLI) + " run --threads 1 " + scene.string() + " -o " +
+                            (dir_ / "p.csv").string() + "\" /dev/null >" + log.string() + " 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    EXPECT_NE(slurp(log).find("rows,"), std::string::npos) << slurp(log);
+  }
+}
+
+TEST_F(Cli, PlotDrawsTheMechanismTracesAndColumns) {
+  const fs::path scene = write("f.yaml", kFourbarOutputs), csv = dir_ / "f.csv", svg = dir_ / "f.svg";
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
+  Result r = run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string() + " --columns theta2,P.x,P.vx");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string s = slurp(svg);
+  EXPECT_EQ(s.rfind("<?xml", 0), 0u);
+  EXPECT_NE(s.find("<svg xmlns=\"http://www.w3.org/2000/svg\""), std::string::npos);
+  EXPECT_EQ(s.substr(s.size() - 7), "</svg>\n");
+  auto count = [&](const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+    return n;
+  };
+  // 5 positions × 4 lines (crank O–A, the coupler's two arms, rocker C–B); 2 traced points; 3 columns
+  EXPECT_EQ(count("<polyline class=\"mechanism\""), 20u);
+  EXPECT_EQ(count("<polyline class=\"trace\""), 2u);
+  EXPECT_EQ(count("<polyline class=\"series\""), 3u);
+  EXPECT_EQ(count("<polyline"), 25u);
+  EXPECT_EQ(count("<g"), count("</g>"));
+  // each trace has a vertex per row
+  const std::size_t p = s.find("data-point=\"P\" points=\"");
+  ASSERT_NE(p, std::string::npos);
+  const std::string pts = s.substr(p, s.find('"', p + 23) - p);
+  EXPECT_EQ(static_cast<std::size_t>(std::count(pts.begin(), pts.end(), ',')), 73u);
+  // default columns: the coordinates (at most 6)
+  ASSERT_EQ(run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string() + " --positions 3").code, 0);
+  const std::string d = slurp(svg);
+  std::size_t series = 0, mech = 0;
+  for (std::size_t q = d.find("class=\"series\""); q != std::string::npos; q = d.find("class=\"series\"", q + 1)) ++series;
+  for (std::size_t q = d.find("class=\"mechanism\""); q != std::string::npos; q = d.find("class=\"mechanism\"", q + 1)) ++mech;
+  EXPECT_EQ(series, 6u);
+  EXPECT_EQ(mech, 12u);
+}
+
+TEST_F(Cli, PlotRefusesBadInputWithOneLineAndNoFile) {
+  const fs::path scene = write("f.yaml", kFourbarOutputs), csv = dir_ / "f.csv", svg = dir_ / "f.svg";
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
+  auto one_line_failure = [&](const std::string& args, const std::string& says) {
+    Result r = run("plot " + args + " -o " + svg.string());
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(svg)) << args;
+  };
+  one_line_failure(scene.string() + " " + csv.string() + " --columns theta2,nope", "no column 'nope'");
+  // a CSV of another scene (here: positions only, the coordinates alone)
+  std::string other = kFourbarOutputs;
+  other = other.substr(0, other.find("output:")) + "output: {coordinates: [theta2]}\n";
+  const fs::path other_scene = write("g.yaml", other), other_csv = dir_ / "g.csv";
+  ASSERT_EQ(run("run -q " + other_scene.string() + " -o " + other_csv.string()).code, 0);
+  one_line_failure(scene.string() + " " + other_csv.string(), "its columns are not the output of");
+  // the scene's own CSV, but without the coordinates the drawing needs
+  one_line_failure(other_scene.string() + " " + other_csv.string(), "no column 'xA'");
+  one_line_failure(scene.string() + " " + (dir_ / "missing.csv").string(), "missing.csv");
+  one_line_failure((dir_ / "missing.yaml").string() + " " + csv.string(), "missing.yaml");
 }
 
 TEST_F(Cli, GenerateRefusesBadOptions) {

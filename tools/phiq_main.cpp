@@ -17,6 +17,8 @@
 
 #include "generate.hpp"
 #include "generate_linkages.hpp"
+#include "plot_svg.hpp"
+#include "progress_bar.hpp"
 #include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 
@@ -81,7 +83,7 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
 }
 
 int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
-            int threads) {
+            int threads, phiq::tools::ProgressBar::Mode progress_mode) {
   phiq::Scene scene;
   const auto load_start = Clock::now();
   try {
@@ -122,17 +124,22 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   std::signal(SIGINT, on_sigint);
   phiq::SweepSummary summary;
   double write_s = 0.0;  // formatting and writing rows, timed inside the step callback
+  phiq::tools::ProgressBar progress(scene.sweep.steps + 1,
+                                    quiet ? phiq::tools::ProgressBar::Mode::kNever : progress_mode);
   try {
     phiq::run_sweep(model, scene.sweep, ws, [&](const phiq::StepView& step) {
       const auto w0 = Clock::now();
       csv.append_row(step, buffer);
       if (buffer.size() > (1u << 20)) flush();
+      progress.update(step.step + 1);
       write_s += since(w0);
       return !g_interrupted.load();
     }, &summary);
   } catch (const phiq::Error& e) {
+    progress.finish();
     return fail(scene_path + ": " + e.what(), 3);
   }
+  progress.finish();
   std::signal(SIGINT, SIG_DFL);
 
   if (summary.status == phiq::SolveStatus::kCancelled) return fail(scene_path + ": interrupted; no output written", 130);
@@ -368,6 +375,10 @@ int main(int argc, char** argv) {
   run->add_option("--threads", threads, "Threads for the drive steps (0: all cores; 1: in order)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  std::string progress = "auto";
+  run->add_option("--progress", progress, "Progress bar on standard error: auto (when it is a terminal), always, never")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "always", "never"}));
 
   phiq::tools::GenerateOptions gen;
   std::string gen_out, gen_outputs = "q,v,a";
@@ -400,6 +411,18 @@ int main(int argc, char** argv) {
   check->add_option("scene", check_path, "Scene file (YAML)")->required();
   check->add_flag("--json", check_json, "Print one JSON object (format: tools/README.md)");
 
+  phiq::tools::PlotOptions plot_options;
+  CLI::App* plot = app.add_subcommand("plot", "Draw the mechanism at a few positions with its traced points, and "
+                                              "columns against time, as SVG");
+  plot->add_option("scene", plot_options.scene, "Scene file (YAML)")->required();
+  plot->add_option("result", plot_options.csv, "CSV written by `phiq run` for this scene")->required();
+  plot->add_option("-o,--output", plot_options.out, "SVG file to write")->required();
+  plot->add_option("--columns", plot_options.columns, "Columns to plot against t (default: the coordinates, at most 6)")
+      ->delimiter(',');
+  plot->add_option("--positions", plot_options.positions, "Rows at which the mechanism is drawn, evenly spread")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 50));
+
   std::string cmp_a, cmp_b;
   phiq::CompareOptions cmp;
   CLI::App* compare = app.add_subcommand("compare", "Compare two result CSVs column by column within tolerances");
@@ -418,7 +441,11 @@ int main(int argc, char** argv) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), 2);
   }
   try {
-    if (*run) return cmd_run(scene_path, out_path, quiet, summary_path, threads);
+    if (*run) {
+      using Mode = phiq::tools::ProgressBar::Mode;
+      return cmd_run(scene_path, out_path, quiet, summary_path, threads,
+                     progress == "always" ? Mode::kAlways : progress == "never" ? Mode::kNever : Mode::kAuto);
+    }
     if (*generate) {
       if (auto range = phiq::tools::kind_default_range(gen.kind)) {  // kinds whose default range differs
         if (gen_from->count() == 0) gen.from = range->from;
@@ -450,6 +477,7 @@ int main(int argc, char** argv) {
     if (*check) return cmd_check(check_path, check_json);
     if (*batch) return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, batch_threads);
     if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
+    if (*plot) return phiq::tools::plot_svg(plot_options);
   } catch (const std::exception& e) {
     return fail(std::string("internal error: ") + e.what(), 4);
   }

@@ -130,6 +130,8 @@ class Model {
 
   /// The constraints, in the order they were added (rows follow that order).
   const std::vector<ConstraintInfo>& constraints() const { return constraints_; }
+  /// The constraint blocks, one per kind, for tools that read the constraints' data (mechanism_sketch.hpp).
+  const std::vector<std::unique_ptr<ConstraintBlock>>& blocks() const { return blocks_; }
   /// Index into constraints() of the constraint owning `row`. Pre-condition: 0 ≤ row < m.
   Index constraint_of_row(Index row) const { return row_constraint_[static_cast<std::size_t>(row)]; }
   /// Unit of a row of Φ (for its tolerance). Pre-condition: 0 ≤ row < m.

@@ -8,6 +8,7 @@
 #include "phiq/expression.hpp"
 #include "phiq/kinematics.hpp"
 #include "phiq/linear_solver.hpp"
+#include "phiq/mechanism_sketch.hpp"
 #include "phiq/model.hpp"
 #include "phiq/motion_law.hpp"
 #include "phiq/output_points.hpp"
