@@ -461,6 +461,25 @@ TEST_F(Cli, RunWritesTheListedOutputsAndCountsThem) {
     EXPECT_NE(j.find(part), std::string::npos) << part << "\n" << j;
 }
 
+// Batch cases each get their own output points: a point placed by a parameter moves with it.
+TEST_F(Cli, BatchCasesWriteTheirOwnOutputPoints) {
+  std::string text = kFourbarOutputs;
+  text.replace(text.find("parameters: {"), 13, "parameters: {h: 0.3, ");
+  text.replace(text.find("at: [0, 0.3]"), 12, "at: [0, h]");
+  const fs::path scene = write("f.yaml", text), cases = write("cases.csv", "h\n0.1\n0.5\n");
+  Result r = run("batch -q " + scene.string() + " " + cases.string() + " -o " + (dir_ / "out").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (int k = 0; k < 2; ++k) {
+    const double h = k == 0 ? 0.1 : 0.5;
+    const phiq::CsvTable t = phiq::read_csv_table((dir_ / "out" / ("case" + std::to_string(k) + ".csv")).string());
+    ASSERT_EQ(t.columns[21], "P.x");
+    for (const auto& row : t.rows) {  // P = r3 + R(ψ3) (0, h)
+      EXPECT_NEAR(row[21], row[4] - std::sin(row[6]) * h, 1e-12) << "case " << k;
+      EXPECT_NEAR(row[22], row[5] + std::cos(row[6]) * h, 1e-12) << "case " << k;
+    }
+  }
+}
+
 TEST_F(Cli, ProgressBarOnlyOnATerminalOrWhenAsked) {
   const fs::path scene = dir_ / "p.yaml";
   ASSERT_EQ(run("generate nfourbar 20 --steps 400 --outputs q -o " + scene.string()).code, 0);

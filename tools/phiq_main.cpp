@@ -223,7 +223,10 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   }
   std::signal(SIGINT, on_sigint);
   // Each case touches only its own buffer and file: the callback is safe across cases without a lock.
-  const phiq::BatchSummary sum = phiq::run_batch(models, scenes.front().sweep, threads, [&](std::size_t k, const phiq::StepView& step) {
+  // each case's own sweep: its output points (and time range) may depend on its parameters
+  std::vector<phiq::SweepOptions> sweeps;
+  for (const phiq::Scene& sc : scenes) sweeps.push_back(sc.sweep);
+  const phiq::BatchSummary sum = phiq::run_batch(models, sweeps, threads, [&](std::size_t k, const phiq::StepView& step) {
     formats[k].append_row(step, buffers[k]);
     if (buffers[k].size() > (1u << 20)) {
       try {

@@ -11,6 +11,12 @@ namespace phiq {
 
 BatchSummary run_batch(const std::vector<const Model*>& models, const SweepOptions& options, int threads,
                        const std::function<bool(std::size_t, const StepView&)>& on_step) {
+  return run_batch(models, std::vector<SweepOptions>(models.size(), options), threads, on_step);
+}
+
+BatchSummary run_batch(const std::vector<const Model*>& models, const std::vector<SweepOptions>& options,
+                       int threads, const std::function<bool(std::size_t, const StepView&)>& on_step) {
+  if (options.size() != models.size()) throw Error("run_batch: one SweepOptions per model is needed");
   for (const Model* m : models)
     if (!m) throw Error("run_batch: null model");
   if (threads < 0) throw Error("run_batch: threads must be >= 0 (0: all cores)");
@@ -18,13 +24,13 @@ BatchSummary run_batch(const std::vector<const Model*>& models, const SweepOptio
   out.cases.resize(models.size());
   out.threads = threads == 0 ? tbb::info::default_concurrency() : threads;
   const auto start = std::chrono::steady_clock::now();
-  SweepOptions one = options;
-  one.threads = 1;  // parallel over cases, not within one
   tbb::task_arena arena(out.threads);
   arena.execute([&] {
     // one case per task: cases are whole sweeps, far above any scheduling cost
     tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t c) {
       Workspace ws(*models[c]);
+      SweepOptions one = options[c];
+      one.threads = 1;  // parallel over cases, not within one
       run_sweep(*models[c], one, ws, on_step ? [&](const StepView& s) { return on_step(c, s); }
                                              : std::function<bool(const StepView&)>{},
                 &out.cases[c]);

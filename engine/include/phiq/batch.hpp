@@ -27,5 +27,9 @@ struct BatchSummary {
 /// Pre-conditions (phiq::Error): no null model; threads ≥ 0.
 BatchSummary run_batch(const std::vector<const Model*>& models, const SweepOptions& options, int threads,
                        const std::function<bool(std::size_t, const StepView&)>& on_step);
+/// run_batch() with options per case (`options[c]` for `models[c]`; as many as models, else phiq::Error): for cases
+/// whose sweep or outputs depend on their parameters (a time range, an output point at a parameter's distance).
+BatchSummary run_batch(const std::vector<const Model*>& models, const std::vector<SweepOptions>& options,
+                       int threads, const std::function<bool(std::size_t, const StepView&)>& on_step);
 
 }  // namespace phiq
