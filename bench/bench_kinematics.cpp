@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 #include "nfourbar_model.hpp"
 #include "phiq/phiq.hpp"
@@ -409,6 +410,77 @@ void BM_NFourBarParallelSweep(benchmark::State& state) {
   state.counters["seed_share"] = seed / t2;
 }
 BENCHMARK(BM_NFourBarParallelSweep)->ArgName("N")->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(3);
+
+// What outputs cost (issue 5, section 3): the same nfourbar sweep (a quarter turn in 200 steps) with the output
+// lists a scene can have, timed interleaved in one loop, per step. The engine plans the work from the list, so the
+// positions-only sweep solves no q̇ or q̈, and asking for residuals and rcond adds nothing but copying what the
+// solve has. With the default (auto) predictor, derivatives also buy a better start for Newton: the `secant`
+// variant is q, q̇, q̈ with the positions-only predictor, for the cost of the derivatives alone.
+void BM_NFourBarOutputCost(benchmark::State& state) {
+  const Index n = state.range(0), steps = 200;
+  Model m = nfourbar(n, M_PI / 4, M_PI / 2);
+  Workspace ws(m);
+  struct Variant {
+    const char* name;
+    SweepOptions opt;
+    double seconds = 0;
+    Index newton = 0;
+    std::vector<double> per_q;  // this variant's time ÷ the positions-only time, per iteration
+  };
+  auto make = [&](bool v, bool a) {
+    SweepOptions o;
+    o.steps = steps;
+    o.velocities = v, o.accelerations = a;
+    return o;
+  };
+  std::vector<Variant> variants;
+  for (const auto& [name, v, a] : {std::tuple{"q", false, false}, {"q_res_rcond", false, false}, {"qv", true, false},
+                                   {"qva", true, true}, {"qva_points", true, true}, {"qva_secant", true, true}})
+    variants.push_back(Variant{name, make(v, a), 0.0, 0, {}});
+  variants[1].opt.residuals = variants[1].opt.condition = true;
+  for (Index i = 0; i <= n; ++i)  // every crank tip: an upper bound of what points cost
+    variants[4].opt.points.push_back(
+        planar_point(phiq_bench::indexed("P", i), Point2{Slot::coordinate(2 * i), Slot::coordinate(2 * i + 1)}));
+  variants[5].opt.predictor = Predictor::kSecant;
+  double checksum = 0;
+  auto consume = [&](const StepView& s) {  // reads what was delivered, as a writer would
+    checksum += s.q(0) + (s.points ? s.points[0].r[0] : 0.0) + (s.phi ? (*s.phi)(0) : 0.0) + s.rcond;
+    return true;
+  };
+  // The machine is shared and noisy: all variants run back to back in every iteration, in an order rotated from one
+  // iteration to the next, and the ratios reported are the medians of the per-iteration ratios.
+  std::size_t rotation = 0;
+  for (auto _ : state) {
+    double total = 0;
+    std::vector<double> t(variants.size());
+    for (std::size_t r = 0; r < variants.size(); ++r) {
+      const std::size_t k = (r + rotation) % variants.size();
+      Variant& v = variants[k];
+      SweepSummary sum;
+      ws.q = m.initial_positions();
+      ws.has_factorization = false;
+      const auto t0 = Clock::now();
+      run_sweep(m, v.opt, ws, consume, &sum);
+      const double e = seconds_since(t0);
+      if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
+      v.seconds += e, total += e, t[k] = e;
+      v.newton += sum.counters.newton_iterations;
+    }
+    ++rotation;
+    for (std::size_t k = 0; k < variants.size(); ++k) variants[k].per_q.push_back(t[k] / t[0]);
+    state.SetIterationTime(total);
+  }
+  benchmark::DoNotOptimize(checksum);
+  const double it = static_cast<double>(state.iterations()), rows = static_cast<double>(steps + 1);
+  for (Variant& v : variants) {
+    state.counters[std::string(v.name) + "_us"] = 1e6 * v.seconds / (it * rows);
+    state.counters[std::string(v.name) + "_newton"] = static_cast<double>(v.newton) / (it * rows);
+    if (&v == &variants[0]) continue;
+    std::sort(v.per_q.begin(), v.per_q.end());
+    state.counters[std::string(v.name) + "_per_q"] = v.per_q[v.per_q.size() / 2];
+  }
+}
+BENCHMARK(BM_NFourBarOutputCost)->ArgName("N")->Arg(10)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(7);
 
 }  // namespace
 
