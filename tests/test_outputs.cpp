@@ -116,6 +116,20 @@ TEST(OutputPoints, SweepPointsAreExactAndTheirDerivativesMatchFiniteDifferences)
   EXPECT_LT(worst_a, 1e-3);
   EXPECT_GT(worst_v, 0.0);  // the differences are real numbers, not copies of the evaluated derivatives
   EXPECT_EQ(sum.counters.point_evaluations, 2 * (steps + 1));
+  // a parallel sweep delivers the same motions, evaluated in the chunks, in time order
+  SweepSummary par_sum;
+  Rows par = sweep_scene(scene, &par_sum, 2, 64);
+  EXPECT_GT(par_sum.parallel_chunks, 1);
+  ASSERT_EQ(par.t, r.t);
+  double worst = 0;
+  for (std::size_t k = 0; k < r.t.size(); ++k)
+    for (int i = 0; i < 2; ++i)
+      for (int d = 0; d < 2; ++d)
+        worst = std::max({worst, std::fabs(par.points[k][i].r[d] - r.points[k][i].r[d]),
+                          std::fabs(par.points[k][i].v[d] - r.points[k][i].v[d]),
+                          std::fabs(par.points[k][i].a[d] - r.points[k][i].a[d])});
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_EQ(par_sum.counters.point_evaluations, 2 * (steps + 1));
 }
 
 // Exact counts of the work each output list causes, sequential and parallel. Full Newton and a fixed predictor
@@ -210,17 +224,27 @@ TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
   std::string row;
   SweepSummary sum;
   Workspace ws(*scene.model);
+  double rocker = -1;
   run_sweep(*scene.model, scene.sweep, ws, [&](const StepView& s) {
-    if (s.step == 1) csv.append_row(s, row);
+    if (s.step == 1) {
+      csv.append_row(s, row);
+      // the rocker's one row (a length), scaled by the model's length scale
+      const ConstraintInfo& c = scene.model->constraints()[scene.output_residuals[0]];
+      rocker = std::fabs((*s.phi)(c.first_row)) / scene.model->length_scale();
+    }
     return true;
   }, &sum);
+  EXPECT_EQ(scene.model->length_scale(), 1.0);  // the largest length in the constraints' data: the rocker's
   std::vector<double> v;
   std::stringstream in(row);
   for (std::string cell; std::getline(in, cell, ',');) v.push_back(std::stod(cell));
   ASSERT_EQ(v.size(), 16u);
   EXPECT_DOUBLE_EQ(v[11], 0.5 + 2 * std::sin(1.5 * v[0]));
   EXPECT_DOUBLE_EQ(v[12], 3 * std::cos(1.5 * v[0]));
-  EXPECT_DOUBLE_EQ(v[1], v[11]);  // the driven coordinate is f(t) to the tolerance... and here exactly
+  EXPECT_NEAR(v[1], v[11], 1e-12);  // the driven coordinate is f(t), to the tolerance
+  EXPECT_DOUBLE_EQ(v[13], rocker);
+  EXPECT_GE(v[14], v[13]);  // the largest over all rows is at least the rocker's
+  EXPECT_LE(v[14], 1e-10);
 }
 
 TEST(OutputPlan, BadOutputListsAreOneLineErrorsNamingTheField) {
