@@ -2,6 +2,7 @@
 // solves and evaluations, point motions against closed forms and finite differences.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "phiq/phiq.hpp"
@@ -269,6 +270,38 @@ TEST(OutputPlan, BadOutputListsAreOneLineErrorsNamingTheField) {
   EXPECT_TRUE(s.sweep.points.empty());
   EXPECT_FALSE(s.sweep.residuals || s.sweep.condition);
   EXPECT_EQ(s.output_coordinates.size(), 8u);
+}
+
+// The drawing's lines come from the constraints: each bar once, body arms to their pair attachments.
+TEST(MechanismSketch, LinesFollowTheConstraintsEachOnce) {
+  // natural four-bar: crank O–A is named twice (distance and segment angle), drawn once
+  Scene natural = load_scene(test::model_path("seed/fourbar_natural.yaml"));
+  const std::vector<SketchSegment> n = sketch_segments(*natural.model);
+  ASSERT_EQ(n.size(), 3u);
+  // at the assembled position the lines have the links' lengths: crank 0.4, coupler 1.2, rocker 1.0
+  Workspace ws(*natural.model);
+  ASSERT_EQ(solve_position(*natural.model, 0.0, natural.sweep.assembly, ws), SolveStatus::kSuccess);
+  std::vector<double> lengths;
+  for (const SketchSegment& s : n) {
+    const PointMotion a = evaluate_point(s.from, ws.q.data(), nullptr, nullptr),
+                      b = evaluate_point(s.to, ws.q.data(), nullptr, nullptr);
+    lengths.push_back(std::hypot(b.r[0] - a.r[0], b.r[1] - a.r[1]));
+  }
+  std::sort(lengths.begin(), lengths.end());
+  EXPECT_NEAR(lengths[0], 0.4, 1e-9);
+  EXPECT_NEAR(lengths[1], 1.0, 1e-9);
+  EXPECT_NEAR(lengths[2], 1.2, 1e-9);
+  // mixed: the coupler body is drawn as two arms from its reference point to the revolutes (0.6 each)
+  Scene mixed = load_scene(test::model_path("seed/fourbar_mixed.yaml"));
+  const std::vector<SketchSegment> m = sketch_segments(*mixed.model);
+  ASSERT_EQ(m.size(), 4u);
+  int arms = 0;
+  for (const SketchSegment& s : m)
+    if (s.to.kind == OutputPointKind::kPlanarBodyPoint) {
+      ++arms;
+      EXPECT_DOUBLE_EQ(std::hypot(s.to.local_x, s.to.local_y), 0.6);
+    }
+  EXPECT_EQ(arms, 2);
 }
 
 }  // namespace

@@ -193,6 +193,7 @@ std::string SweepSummary::BriefReport() const {
   s << to_string(status) << ": " << steps_completed << " steps, " << counters.newton_iterations
     << " Newton iterations, " << counters.factorizations << " factorizations, " << counters.velocity_solves
     << " velocity and " << counters.acceleration_solves << " acceleration solves";
+  if (counters.point_evaluations) s << ", " << counters.point_evaluations << " point evaluations";
   if (subdivisions) s << ", " << subdivisions << " step subdivisions";
   if (threads > 1) s << ", " << threads << " threads (" << parallel_chunks << " parallel chunks)";
   if (!warnings.empty()) s << ", " << warnings.size() << " warnings (first at t = " << warnings[0].t << ")";

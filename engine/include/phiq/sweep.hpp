@@ -101,7 +101,8 @@ struct SweepSummary {
   int threads = 1;                     ///< threads the drive steps ran on
   Index parallel_chunks = 0;           ///< chunks run in parallel and accepted (0 for a sequential sweep)
   double seed_seconds = 0.0;           ///< wall time of the sequential seeding pass of a parallel sweep
-  /// One line: status, steps, iterations, factorisations, solves, subdivisions, warnings, time, message.
+  /// One line: status, steps, iterations, factorisations, solves, point evaluations, subdivisions, warnings, time,
+  /// message.
   std::string BriefReport() const;
 };
 
