@@ -558,8 +558,21 @@ TEST_F(Cli, PlotRefusesBadInputWithOneLineAndNoFile) {
   const fs::path other_scene = write("g.yaml", other), other_csv = dir_ / "g.csv";
   ASSERT_EQ(run("run -q " + other_scene.string() + " -o " + other_csv.string()).code, 0);
   one_line_failure(scene.string() + " " + other_csv.string(), "its columns are not the output of");
-  // the scene's own CSV, but without the coordinates the drawing needs
-  one_line_failure(other_scene.string() + " " + other_csv.string(), "no column 'xA'");
+  // a CSV without the coordinates the drawing needs: the positions are solved again, and checked against the
+  // columns it has
+  Result ok = run("plot " + other_scene.string() + " " + other_csv.string() + " -o " + svg.string());
+  ASSERT_EQ(ok.code, 0) << ok.err;
+  const std::string drawn = slurp(svg);
+  std::size_t lines = 0;
+  for (std::size_t q = drawn.find("class=\"mechanism\""); q != std::string::npos; q = drawn.find("class=\"mechanism\"", q + 1))
+    ++lines;
+  EXPECT_EQ(lines, 20u);
+  fs::remove(svg);
+  std::string tampered = slurp(other_csv);
+  const std::size_t row3 = tampered.find('\n', tampered.find('\n', tampered.find('\n') + 1) + 1) + 1;
+  tampered.replace(tampered.find(',', row3) + 1, tampered.find('\n', row3) - tampered.find(',', row3) - 1, "0.5");
+  const fs::path bad_csv = write("bad.csv", tampered);
+  one_line_failure(other_scene.string() + " " + bad_csv.string(), "is not the result of");
   one_line_failure(scene.string() + " " + (dir_ / "missing.csv").string(), "missing.csv");
   one_line_failure((dir_ / "missing.yaml").string() + " " + csv.string(), "missing.yaml");
 }

@@ -121,11 +121,8 @@ int plot_svg(const PlotOptions& o) {
   for (const SketchSegment& s : segments) need(s.from), need(s.to);
   std::sort(needed.begin(), needed.end());
   needed.erase(std::unique(needed.begin(), needed.end()), needed.end());
-  for (Index j : needed)
-    if (!col.count(model.coordinate_names()[j]))
-      return fail(o.csv + ": no column '" + model.coordinate_names()[j] +
-                      "', which the drawing of the mechanism needs (list it in the scene's output.coordinates)",
-                  2);
+  bool all_in_csv = true;
+  for (Index j : needed) all_in_csv = all_in_csv && col.count(model.coordinate_names()[j]);
 
   // Rows drawn: evenly spread, first and last included.
   const std::size_t n_rows = table.rows.size();
@@ -138,8 +135,45 @@ int plot_svg(const PlotOptions& o) {
                                                                                  (positions - 1)));
     if (drawn.empty() || drawn.back() != r) drawn.push_back(r);
   }
+  // The positions at the drawn rows: from the CSV when it has every coordinate the drawing reads; otherwise (the
+  // output lists only some, e.g. a coupler curve) by sweeping the scene again, as `phiq run` did, positions kept
+  // at the drawn rows, every row checked against the coordinate columns the CSV does have.
+  std::map<std::size_t, Eigen::VectorXd> solved;
+  if (!all_in_csv) {
+    if (static_cast<Index>(n_rows) != scene.sweep.steps + 1)
+      return fail(o.csv + ": " + std::to_string(n_rows) + " rows, but " + o.scene + " sweeps " +
+                      std::to_string(scene.sweep.steps + 1) + " time points",
+                  2);
+    SweepOptions opt = scene.sweep;  // the same outputs, so the same predictor and path as the run
+    opt.points.clear(), opt.residuals = opt.condition = false;
+    opt.threads = 0;
+    Workspace ws(model);
+    SweepSummary sum;
+    std::string mismatch;
+    run_sweep(model, opt, ws, [&](const StepView& v) {
+      const auto row = static_cast<std::size_t>(v.step);
+      for (Index j = 0; j < model.num_coordinates(); ++j) {
+        auto c = col.find(model.coordinate_names()[j]);
+        const double mine = v.q(j);
+        if (c != col.end() && !(std::fabs(table.rows[row][c->second] - mine) <= 1e-6 * (1.0 + std::fabs(mine))))
+          mismatch = "row " + std::to_string(row + 2) + ", column '" + c->first + "': " + label(table.rows[row][c->second]) +
+                     ", the scene gives " + label(mine);
+      }
+      if (!(std::fabs(table.rows[row][0] - v.t) <= 1e-12 * (1.0 + std::fabs(v.t))))
+        mismatch = "row " + std::to_string(row + 2) + ": t = " + label(table.rows[row][0]) + ", the scene gives " +
+                   label(v.t);
+      if (std::binary_search(drawn.begin(), drawn.end(), row)) solved[row] = v.q;
+      return mismatch.empty();
+    }, &sum);
+    if (!mismatch.empty()) return fail(o.csv + " is not the result of " + o.scene + ": " + mismatch, 2);
+    if (sum.status != SolveStatus::kSuccess) return fail(o.scene + ": " + sum.message, 1);
+  }
   Eigen::VectorXd q = model.initial_positions();
   auto load_row = [&](std::size_t r) {
+    if (!all_in_csv) {
+      q = solved.at(r);
+      return;
+    }
     for (Index j : needed) q(j) = table.rows[r][col[model.coordinate_names()[j]]];
   };
   // The lines at each drawn row, and the traces of the output points, in data coordinates.
