@@ -106,6 +106,8 @@ int plot_svg(const PlotOptions& o) {
   if (series.empty())
     for (std::size_t k = 0; k < scene.output_coordinates.size() && k < 6; ++k)
       series.push_back(model.coordinate_names()[scene.output_coordinates[k]]);
+  if (series.empty())  // no coordinate written (e.g. a coupler curve alone): the first columns after t
+    for (std::size_t c = 1; c < table.columns.size() && c <= 6; ++c) series.push_back(table.columns[c]);
   for (const std::string& c : series)
     if (!col.count(c) || c == "t") return fail("--columns: no column '" + c + "' in " + o.csv, 2);
 

@@ -12,7 +12,7 @@ struct PlotOptions {
   std::string scene;                 // the scene the result was computed from
   std::string csv;                   // `phiq run` output for that scene
   std::string out;                   // the SVG to write
-  std::vector<std::string> columns;  // plotted against t; empty: the coordinate columns, at most 6
+  std::vector<std::string> columns;  // plotted against t; empty: the coordinate columns (else the first), at most 6
   int positions = 5;                 // rows at which the mechanism is drawn, evenly spread, first and last included
 };
 
