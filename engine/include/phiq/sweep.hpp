@@ -59,7 +59,8 @@ struct SweepOptions {
   /// Deliver the reciprocal condition estimate of the last factorisation of Φq (StepView::rcond). Free with KLU
   /// and UMFPACK (the pivot ratio is computed with every factorisation). It is of Φq at the delivered q when
   /// velocities or accelerations are solved; in a positions-only sweep it is of the factorisation modified Newton
-  /// last made (at this step or a few before), which is what the positions were solved with.
+  /// last made (at this step or a few before; at the first rows of a parallel chunk possibly one its pooled
+  /// workspace made for another chunk), which is what the positions were solved with.
   bool condition = false;
 };
 
