@@ -62,10 +62,83 @@ std::vector<std::pair<Index, double>> worst(const Eigen::VectorXd& scaled, const
   return rows;
 }
 
+// Gauss-Newton on all rows at once, in least squares: Δ = −D (J̃ᵀJ̃ + μI)⁻¹ J̃ᵀ Φ̃ (CHOLMOD on J̃ᵀJ̃, analysed once),
+// backtracking on ½‖Φ̃‖². It needs no choice of rows, so redundant equations and drivers are treated alike from a
+// rough placement, where which rows are redundant is not yet known (a braced chain off its motion is a locked
+// structure). μ is 1e-10 (relative to the O(1) scaled entries: the step tends to the minimum-norm least-squares step
+// J̃⁺Φ̃, through rank-deficient and under-driven models) and grows tenfold from ‖Φ̃‖∞ while steps fail to decrease the
+// merit (Levenberg-Marquardt). Returns kSuccess when every row holds, kNotConverged at a least-squares minimum that
+// is not a solution (inconsistent or impossible: the caller finds out which).
+SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& opt, Eigen::VectorXd& q,
+                           AssemblySummary& sum, std::string* why) {
+  const Index n = model.num_coordinates(), m = model.num_equations();
+  if (m == 0) return SolveStatus::kSuccess;
+  const ToleranceScales& sc = model.tolerance_scales();
+  std::vector<Index> all(static_cast<std::size_t>(m));
+  for (Index i = 0; i < m; ++i) all[static_cast<std::size_t>(i)] = i;
+  CscPattern jp;
+  std::vector<double> jv, tv;
+  scaled_jacobian_rows(model, q, t, all, &jp, &jv);
+  std::vector<Index> from;
+  auto at = std::make_shared<CscPattern>(transpose_pattern(jp, &from));  // J̃ᵀ: CHOLMOD factorises J̃ᵀ J̃ + μI
+  MinNormSolver normal(at);
+  Eigen::VectorXd phi(m), b(m), bt(m), g(n), d(n), trial(n);
+  auto scaled = [&](const Eigen::VectorXd& full, Eigen::VectorXd& out) { out = full.cwiseQuotient(sc.row_scale); };
+  model.residual(q.data(), t, phi.data());
+  scaled(phi, b);
+  double f = 0.5 * b.squaredNorm(), mu = 0.0;
+  while (sum.iterations < opt.max_iterations) {
+    if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
+    if (b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q)) return SolveStatus::kSuccess;
+    scaled_jacobian_rows(model, q, t, all, &jp, &jv);
+    tv.resize(from.size());
+    for (std::size_t k = 0; k < from.size(); ++k) tv[k] = jv[static_cast<std::size_t>(from[k])];
+    const FactorStatus fs = normal.factorize(tv.data(), std::max(mu, 1e-10));
+    ++sum.factorizations;
+    if (fs != FactorStatus::kOk) return *why = normal.last_message(), SolveStatus::kLinearSolverFailed;
+    // g = J̃ᵀ b (the columns of J̃ᵀ are the rows)
+    g.setZero();
+    for (Index c = 0; c < at->cols; ++c)
+      for (Index e = at->col_ptr[c]; e < at->col_ptr[c + 1]; ++e) g(at->row_idx[e]) += tv[static_cast<std::size_t>(e)] * b(c);
+    if (!normal.solve(g.data(), d.data())) return *why = normal.last_message(), SolveStatus::kLinearSolverFailed;
+    d = -d.cwiseProduct(sc.coordinate_scale);
+    if (!d.allFinite()) return *why = "Gauss-Newton step is not finite", SolveStatus::kNonFinite;
+    ++sum.iterations;
+    double alpha = 1.0, ft = 0.0;
+    bool decreased = false;
+    for (int bt_count = 0;; ++bt_count) {
+      trial = q + alpha * d;
+      model.residual(trial.data(), t, phi.data());
+      scaled(phi, bt);
+      ft = 0.5 * bt.squaredNorm();
+      decreased = ft <= (1.0 - 1e-4 * alpha) * f;
+      if (decreased || bt_count >= opt.max_backtracks) break;
+      alpha *= 0.5;
+    }
+    const bool tiny = scaled_step(model, alpha * d, trial, opt.tolerance) <= 1.0;
+    if (decreased) q.swap(trial), b.swap(bt), f = ft;
+    if (decreased && !tiny) {
+      if (alpha == 1.0) mu *= 0.1;
+      continue;
+    }
+    if (b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q)) return SolveStatus::kSuccess;
+    if (mu < 1e6) {  // regularise more, then give up: a least-squares minimum
+      mu = mu == 0.0 ? std::max(b.cwiseAbs().maxCoeff(), 1e-8) : 10.0 * mu;
+      continue;
+    }
+    *why = "no assembly near this placement: the residual stopped decreasing";
+    return SolveStatus::kNotConverged;
+  }
+  *why = "did not converge in " + std::to_string(opt.max_iterations) + " iterations";
+  return SolveStatus::kNotConverged;
+}
+
 // Minimum-norm Gauss-Newton on the rows `kept` from q, in two phases.
-//  1. Correction (while the kept rows are not within tolerance): Δ = −D Ãᵀ (Ã Ãᵀ + μI)⁻¹ Φ̃ with μ = ‖Φ̃‖
-//     (Levenberg-Marquardt, Fan & Yuan), backtracking on ½‖Φ̃‖². Stops when the merit cannot decrease: a
-//     least-squares minimum that is not a solution (kNotConverged).
+//  1. Correction (while the kept rows are not within tolerance): Δ = −D Ãᵀ (Ã Ãᵀ + μI)⁻¹ Φ̃, backtracking on
+//     ½‖Φ̃‖². μ = 0 (Gauss-Newton: quadratic convergence, and no damping of the soft modes of long chains, whose
+//     smallest singular values are ~1/N) while it works; μ = ‖Φ̃‖∞ and growing (Levenberg-Marquardt) when the kept
+//     rows lose rank on the way or a step does not decrease the merit. Stops when even that fails: a least-squares
+//     minimum that is not a solution (kNotConverged).
 //  2. Projection (once they are): the step of the linearised problem min ‖D⁻¹(q + Δ − q₀)‖ s.t. Φ + Φq Δ = 0,
 //     Δ = D (p − Ãᵀ (Ã Ãᵀ)⁻¹ (Φ̃ + Ã p)) with p = D⁻¹(q₀ − q): a correction plus the pull back towards the
 //     placement along the mechanism's free motion. Its fixed point is the assembled position nearest to q₀
@@ -89,14 +162,18 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
   model.residual(q.data(), t, phi.data());
   kept_scaled(phi, b);
   double f = 0.5 * b.squaredNorm();
+  double mu = 0.0;  // Levenberg-Marquardt regularisation, only while plain Gauss-Newton fails
   while (sum.iterations < opt.max_iterations) {
     if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
     const bool within = b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q);
     scaled_jacobian_rows(model, q, t, kept, pattern.get(), &values);
     if (!solver) solver = std::make_unique<MinNormSolver>(pattern);  // pattern fixed for this set of rows
-    const double mu = within ? 0.0 : b.norm();
+    if (within) mu = 0.0;
     FactorStatus fs = solver->factorize(values.data(), mu);
-    if (fs == FactorStatus::kSingular && within) fs = solver->factorize(values.data(), 1e-14);  // rank lost at q
+    if (fs == FactorStatus::kSingular) {  // the kept rows lost rank here: regularise
+      mu = within ? 1e-14 : std::max(b.cwiseAbs().maxCoeff(), 1e-14);
+      fs = solver->factorize(values.data(), mu);
+    }
     ++sum.factorizations;
     if (fs != FactorStatus::kOk)
       return *why = solver->last_message(), fs == FactorStatus::kFailed ? SolveStatus::kLinearSolverFailed
@@ -134,14 +211,22 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
       if (decreased || bt_count >= opt.max_backtracks) break;
       alpha *= 0.5;
     }
-    // Steps below the tolerance while the residual is not, or no decrease at all: a least-squares minimum of the
-    // kept rows that is not a solution.
-    if (!decreased || scaled_step(model, alpha * d, trial, opt.tolerance) <= 1.0) {
-      if (decreased) q.swap(trial), b.swap(bt), f = ft;
-      *why = "no assembly near this placement: the residual stopped decreasing";
-      return SolveStatus::kNotConverged;
+    const bool tiny = scaled_step(model, alpha * d, trial, opt.tolerance) <= 1.0;
+    if (decreased && !tiny) {
+      q.swap(trial), b.swap(bt), f = ft;
+      mu = alpha == 1.0 ? 0.0 : mu;  // a full step: plain Gauss-Newton again
+      continue;
     }
-    q.swap(trial), b.swap(bt), f = ft;
+    // No decrease, or steps below the tolerance while the residual is not. With plain Gauss-Newton, try the
+    // regularised step (far from a solution, or near a rank loss of the kept rows); if that fails too, this is a
+    // least-squares minimum of the kept rows that is not a solution.
+    if (decreased) q.swap(trial), b.swap(bt), f = ft;
+    if (mu < b.cwiseAbs().maxCoeff()) {
+      mu = std::max(10.0 * mu, b.cwiseAbs().maxCoeff());
+      continue;
+    }
+    *why = "no assembly near this placement: the residual stopped decreasing";
+    return SolveStatus::kNotConverged;
   }
   // The projection phase converges linearly: if its budget ran out with the rows within tolerance, the position is
   // assembled, only not the nearest one to the last digit.
@@ -185,8 +270,14 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
                   "driver '" + model.time_domain_limiter() + "' is not defined at t = " + std::to_string(t));
   if (!q.allFinite()) return finish(SolveStatus::kNonFinite, "starting point has non-finite coordinates");
 
-  sum.rank = analyse_rank(model, q, t, opt.rank);
+  // 1. All rows in least squares from the placement (no choice of rows needed), 2. the rank analysis where that
+  // ends, 3. its independent rows solved to rounding level and moved to the nearest assembled position, 4. the
+  // redundant rows checked.
   std::string why;
+  const SolveStatus first = solve_all_rows(model, t, opt, q, sum, &why);
+  if (first == SolveStatus::kNonFinite || first == SolveStatus::kLinearSolverFailed) return finish(first, why);
+  if (!q.allFinite()) return finish(SolveStatus::kNonFinite, "non-finite coordinates");
+  sum.rank = analyse_rank(model, q, t, opt.rank);
   for (;;) {
     const std::vector<Index> kept = sum.rank.independent_rows;
     const SolveStatus st = solve_kept(model, t, opt, kept, q0, q, sum, &why);

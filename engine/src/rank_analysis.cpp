@@ -1,6 +1,7 @@
 #include "phiq/rank_analysis.hpp"
 
 #include <SuiteSparseQR.hpp>
+#include <ccolamd.h>
 
 #include <Eigen/Dense>
 #include <Eigen/SVD>
@@ -62,22 +63,12 @@ void scaled_jacobian_rows(const Model& model, const Eigen::VectorXd& q, double t
 
 namespace {
 
-// The transpose of a CSC matrix, as CSC (i.e. the CSR form of the original).
+// The transpose of a CSC matrix with its values.
 void transpose(const CscPattern& a, const std::vector<double>& av, CscPattern* t, std::vector<double>* tv) {
-  t->rows = a.cols;
-  t->cols = a.rows;
-  t->col_ptr.assign(static_cast<std::size_t>(a.rows) + 1, 0);
-  for (Index r : a.row_idx) ++t->col_ptr[static_cast<std::size_t>(r) + 1];
-  for (Index i = 0; i < a.rows; ++i) t->col_ptr[i + 1] += t->col_ptr[i];
-  t->row_idx.assign(static_cast<std::size_t>(a.nnz()), 0);
-  tv->assign(static_cast<std::size_t>(a.nnz()), 0.0);
-  std::vector<Index> next(t->col_ptr.begin(), t->col_ptr.end() - 1);
-  for (Index j = 0; j < a.cols; ++j)
-    for (Index k = a.col_ptr[j]; k < a.col_ptr[j + 1]; ++k) {
-      const Index dst = next[static_cast<std::size_t>(a.row_idx[k])]++;
-      t->row_idx[dst] = j;
-      (*tv)[dst] = av[k];
-    }
+  std::vector<Index> from;
+  *t = transpose_pattern(a, &from);
+  tv->resize(from.size());
+  for (std::size_t k = 0; k < from.size(); ++k) (*tv)[k] = av[static_cast<std::size_t>(from[k])];
 }
 
 // RAII for CHOLMOD's workspace, the way SuiteSparseQR takes it.
@@ -111,6 +102,7 @@ cholmod_sparse view(const CscPattern& p, const std::vector<double>& v) {
 struct SparseRank {
   std::vector<char> live;        // per column of A (an equation)
   Index rank = 0;
+  bool order_kept = true;        // SuiteSparseQR pivoted the columns in the given order (no singleton moved ahead)
   double smallest_pivot = 1.0;   // min |R_kk| of the live columns (absolute)
 };
 
@@ -141,6 +133,7 @@ SparseRank sparse_rank(const CscPattern& a, const std::vector<double>& av, doubl
     for (SuiteSparse_long k = rp[j]; k < rp[j + 1]; ++k)
       if (ri[k] == row) has = true, pivot = std::fabs(rx[k]);
     const Index col = E ? static_cast<Index>(E[j]) : j;
+    if (col != j) out.order_kept = false;
     if (has && pivot > tol) {
       out.live[static_cast<std::size_t>(col)] = 1;
       out.smallest_pivot = std::min(out.smallest_pivot, pivot);
@@ -152,6 +145,31 @@ SparseRank sparse_rank(const CscPattern& a, const std::vector<double>& av, doubl
   if (E) cholmod_l_free(static_cast<std::size_t>(a.cols), sizeof(SuiteSparse_long), E, &c.cc);
   if (out.rank != rank) throw Error("SuiteSparseQR: rank " + std::to_string(rank) + " but " +
                                     std::to_string(out.rank) + " live pivots found in R");
+  return out;
+}
+
+// CCOLAMD's fill-reducing order of the equations `order` (the columns of J̃ᵀ) with the first `kinematic` of them kept
+// ahead of the others (constraint sets 0 and 1). Only the pattern matters: values are not read.
+std::vector<Index> fill_reducing(const Model& model, const Eigen::VectorXd& q, double t, const std::vector<Index>& order,
+                                 Index kinematic) {
+  CscPattern jp, at;
+  std::vector<double> jv, atv;
+  scaled_jacobian_rows(model, q, t, order, &jp, &jv);
+  transpose(jp, jv, &at, &atv);
+  const SuiteSparse_long nr = at.rows, nc = at.cols, nnz = at.nnz();
+  const std::size_t alen = ccolamd_l_recommended(nnz, nr, nc);
+  if (alen == 0) throw Error("CCOLAMD: invalid matrix");
+  std::vector<SuiteSparse_long> A(alen), p(static_cast<std::size_t>(nc) + 1), cmember(static_cast<std::size_t>(nc));
+  std::copy(at.row_idx.begin(), at.row_idx.end(), A.begin());
+  std::copy(at.col_ptr.begin(), at.col_ptr.end(), p.begin());
+  for (SuiteSparse_long k = 0; k < nc; ++k) cmember[static_cast<std::size_t>(k)] = k < kinematic ? 0 : 1;
+  double knobs[CCOLAMD_KNOBS];
+  SuiteSparse_long stats[CCOLAMD_STATS];
+  ccolamd_l_set_defaults(knobs);
+  if (!ccolamd_l(nr, nc, static_cast<SuiteSparse_long>(alen), A.data(), p.data(), knobs, stats, cmember.data()))
+    throw Error("CCOLAMD failed (status " + std::to_string(stats[CCOLAMD_STATUS]) + ")");
+  std::vector<Index> out(order.size());
+  for (SuiteSparse_long k = 0; k < nc; ++k) out[static_cast<std::size_t>(k)] = order[static_cast<std::size_t>(p[k])];
   return out;
 }
 
@@ -179,6 +197,11 @@ RankReport analyse_rank(const Model& model, const Eigen::VectorXd& q, double t, 
       ++rep.kinematic_equations;
   rep.driver_equations = m - rep.kinematic_equations;
 
+  rep.ordering = options.ordering == RankOrdering::kAuto
+                     ? (m <= 20000 ? RankOrdering::kModelOrder : RankOrdering::kFillReducing)
+                     : options.ordering;
+  if (rep.ordering == RankOrdering::kFillReducing && m > 0)
+    order = fill_reducing(model, q, t, order, rep.kinematic_equations);
   CscPattern jp, at;
   std::vector<double> jv, atv;
   scaled_jacobian_rows(model, q, t, order, &jp, &jv);
@@ -192,14 +215,27 @@ RankReport analyse_rank(const Model& model, const Eigen::VectorXd& q, double t, 
   if (!(largest > 0.0)) largest = 1.0;  // no entry at all: every equation is (trivially) dependent
   const double tol = options.tolerance * largest;
 
-  // The kinematic rows alone, for the mechanism's degrees of freedom; then all rows, for what to keep.
-  CscPattern kin = at;
-  kin.cols = rep.kinematic_equations;
-  kin.col_ptr.resize(static_cast<std::size_t>(kin.cols) + 1);
-  kin.row_idx.resize(static_cast<std::size_t>(kin.col_ptr.back()));
-  std::vector<double> kinv(atv.begin(), atv.begin() + kin.col_ptr.back());
-  const SparseRank kr = sparse_rank(kin, kinv, tol);
-  const SparseRank all = rep.driver_equations ? sparse_rank(at, atv, tol) : kr;
+  // All rows, greedily in `order`: the kinematic rows come first, so the live ones among them are the rank of the
+  // kinematic rows (the mechanism's degrees of freedom) — unless SuiteSparseQR moved a column ahead (a singleton),
+  // in which case the kinematic rows are factorised again on their own.
+  const SparseRank all = sparse_rank(at, atv, tol);
+  SparseRank kr;
+  if (rep.driver_equations == 0 || all.order_kept) {
+    kr.rank = 0;
+    for (Index k = 0; k < rep.kinematic_equations; ++k) kr.rank += all.live[static_cast<std::size_t>(k)];
+    kr.smallest_pivot = all.smallest_pivot;
+  } else {
+    // the kinematic columns on their own (the first block of `at`)
+    const Index k0 = 0, k1 = rep.kinematic_equations;
+    CscPattern kin;
+    kin.rows = at.rows;
+    kin.cols = rep.kinematic_equations;
+    const Index e0 = at.col_ptr[k0];
+    for (Index k = k0; k <= k1; ++k) kin.col_ptr.push_back(at.col_ptr[k] - e0);
+    kin.row_idx.assign(at.row_idx.begin() + e0, at.row_idx.begin() + at.col_ptr[k1]);
+    std::vector<double> kinv(atv.begin() + e0, atv.begin() + at.col_ptr[k1]);
+    kr = sparse_rank(kin, kinv, tol);
+  }
   rep.rank = kr.rank;
   rep.dof = n - kr.rank;
   rep.driven_rank = all.rank;

@@ -7,9 +7,9 @@
 /// conflict are named).
 ///
 /// Ã is the scaled Jacobian of the kept rows (rank_analysis.hpp), D the coordinate scales: the step is the smallest in
-/// the norm that weighs a metre of the model's length scale like a radian. μ = ‖Φ̃‖ (Levenberg-Marquardt with the
-/// regularisation of Fan & Yuan, 2005) keeps the steps bounded far from the solution and vanishes at it, where the
-/// convergence is quadratic even if the kept rows lose rank on the way.
+/// the norm that weighs a metre of the model's length scale like a radian. μ = 0 (Gauss-Newton) while its steps
+/// decrease ‖Φ̃‖; μ > 0 (Levenberg-Marquardt) only when they do not or the kept rows lose rank on the way. Once the
+/// equations hold, projection steps move to the assembled position nearest to q₀ (assembly.cpp).
 #pragma once
 
 #include <memory>

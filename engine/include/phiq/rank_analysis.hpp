@@ -5,11 +5,13 @@
 /// change point loses rank only there, a parallelogram with a fifth bar everywhere on its motion.
 ///
 /// Method: a rank-revealing sparse QR (SuiteSparseQR, Heath's method) of the scaled transposed Jacobian
-/// J̃ᵀ = (D_r⁻¹ Φq D_c)ᵀ, whose columns are the equations in model order (kinematic rows first, then the rheonomic
-/// ones: a driver is only called redundant when the kinematic rows already fix what it drives). D_r and D_c are the
+/// J̃ᵀ = (D_r⁻¹ Φq D_c)ᵀ, whose columns are the equations, kinematic rows first, then the rheonomic ones (a driver
+/// is only called redundant when the kinematic rows already fix what it drives), each group in model order or in a
+/// fill-reducing order (RankOrdering). D_r and D_c are the
 /// model's tolerance scales (length scale for lengths, 1 for angles and unitless rows), so that the rank does not
 /// depend on units or on where the origin is. With the fixed column order the factorisation takes the equations
-/// greedily: an equation is redundant when it is (within the tolerance) a combination of equations before it.
+/// greedily: an equation is redundant when it is (within the tolerance) a combination of equations before it in
+/// that order.
 #pragma once
 
 #include <optional>
@@ -22,8 +24,20 @@
 
 namespace phiq {
 
+/// In which order the rank analysis takes the equations (it keeps an equation unless it combines those before it).
+enum class RankOrdering {
+  kAuto,          ///< kModelOrder up to 20000 equations, kFillReducing beyond
+  kModelOrder,    ///< scene order (kinematic rows, then rheonomic): the later of two dependent equations is redundant
+  kFillReducing,  ///< CCOLAMD's fill-reducing order within the kinematic rows, then within the rheonomic ones
+};
+
 /// Settings of analyse_rank().
 struct RankOptions {
+  /// Order of the greedy choice. The model order names the redundant equations the way a user reads the scene (the
+  /// third hinge, not the first), but the QR of a long chain taken in that order fills in quadratically; the
+  /// fill-reducing order keeps the analysis of 10^5–10^6 equations near linear (bench/README.md) and still keeps
+  /// every driver after the kinematic rows.
+  RankOrdering ordering = RankOrdering::kAuto;
   /// Relative rank tolerance δ: an equation is redundant when the part of its scaled Jacobian row not spanned by
   /// the rows before it has a 2-norm ≤ δ · (largest scaled row norm). 1e-8 ≈ √ε: at a position solved to a
   /// tolerance of 1e-10 the Jacobian itself is only known to about that relative accuracy, so dependencies closer
@@ -53,6 +67,7 @@ struct RankReport {
   std::vector<Index> redundant_rows;    ///< the other rows, ascending
   std::vector<std::string> redundant;   ///< names of the constraints owning redundant rows, in model order, once each
   double tolerance = 0.0;          ///< δ used
+  RankOrdering ordering = RankOrdering::kModelOrder;  ///< the order used (kAuto resolved)
   double smallest_pivot = 0.0;     ///< smallest |R_kk| / largest row norm of an independent equation (1 if none)
   bool dense_checked = false;      ///< the dense cross-check ran
   Index dense_rank = -1;           ///< its rank of all rows (−1 when it did not run)
