@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "phiq/csv_compare.hpp"
@@ -149,10 +150,23 @@ int plot_svg(const PlotOptions& o) {
     SweepOptions opt = scene.sweep;  // the same outputs, so the same predictor and path as the run
     opt.points.clear(), opt.residuals = opt.condition = false;
     opt.threads = 0;
-    Workspace ws(model);
+    // a redundant model is solved as `phiq run` solves it: assembled by minimum norm, swept on its independent rows
+    std::unique_ptr<Model> square;
+    Eigen::VectorXd start = model.initial_positions();
+    if (model.num_equations() != model.num_coordinates()) {
+      AssemblyOptions ao;
+      ao.tolerance = scene.sweep.assembly.tolerance;
+      ao.max_iterations = scene.sweep.assembly.max_iterations;
+      AssemblySummary as;
+      if (prepare_square(model, scene.sweep.t_begin, ao, start, &square, &as) != SolveStatus::kSuccess)
+        return fail(o.scene + ": " + as.message, 1);
+    }
+    const Model& swept = square ? *square : model;
+    Workspace ws(swept);
+    ws.q = start;
     SweepSummary sum;
     std::string mismatch;
-    run_sweep(model, opt, ws, [&](const StepView& v) {
+    run_sweep(swept, opt, ws, [&](const StepView& v) {
       const auto row = static_cast<std::size_t>(v.step);
       for (Index j = 0; j < model.num_coordinates(); ++j) {
         auto c = col.find(model.coordinate_names()[j]);

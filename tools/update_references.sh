@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the reference results beside every scene that has one: models/<dir>/reference/<scene>.csv.
+# Regenerates the reference results beside every scene that runs: models/<dir>/reference/<scene>.csv.
 # Run it only when a change of numbers is intended and understood; say why in the commit. The regression tests
 # (ctest -R regression) compare each scene's run against its reference with `phiq compare`.
 set -euo pipefail
@@ -8,6 +8,10 @@ phiq="${PHIQ:-$root/build/tools/phiq}"
 for scene in "$root"/models/*/*.yaml; do
   dir="$(dirname "$scene")/reference"
   mkdir -p "$dir"
-  "$phiq" run -q "$scene" -o "$dir/$(basename "${scene%.yaml}").csv"
-  echo "updated $dir/$(basename "${scene%.yaml}").csv"
+  # scenes that are meant to fail (e.g. models/redundant/door_misaligned: inconsistent) have no reference
+  if "$phiq" run -q "$scene" -o "$dir/$(basename "${scene%.yaml}").csv"; then
+    echo "updated $dir/$(basename "${scene%.yaml}").csv"
+  else
+    echo "no reference for $scene: it does not run (see the message above)"
+  fi
 done

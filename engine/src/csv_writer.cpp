@@ -88,15 +88,23 @@ void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
   }
   if (!scene_->output_residuals.empty() || scene_->output_max_residual) {
     if (!s.phi) throw Error("CsvFormat: step has no residuals");
+    // A model solved on its independent rows (a redundant scene: Model::without_rows) delivers the Φ of those rows:
+    // the scene's constraints are then evaluated on the whole scene model, the left-out rows included.
+    const Eigen::VectorXd* phi = s.phi;
+    if (phi->size() != model_.num_equations()) {
+      full_phi_.resize(model_.num_equations());
+      model_.residual(s.q.data(), s.t, full_phi_.data());
+      phi = &full_phi_;
+    }
     const Eigen::VectorXd& rs = model_.tolerance_scales().row_scale;
     for (Index c : scene_->output_residuals) {
       // the measure of the convergence test: |Φ_i| / scale_i, the largest over the constraint's rows
       const ConstraintInfo& ci = model_.constraints()[c];
       double r = 0.0;
-      for (Index i = ci.first_row; i < ci.first_row + ci.rows; ++i) r = std::max(r, std::fabs((*s.phi)(i)) / rs(i));
+      for (Index i = ci.first_row; i < ci.first_row + ci.rows; ++i) r = std::max(r, std::fabs((*phi)(i)) / rs(i));
       out += ',', put(r, out);
     }
-    if (scene_->output_max_residual) out += ',', put(scaled_residual(model_, *s.phi), out);
+    if (scene_->output_max_residual) out += ',', put(scaled_residual(model_, *phi), out);
   }
   if (scene_->sweep.condition) out += ',', put(s.rcond, out);
 }

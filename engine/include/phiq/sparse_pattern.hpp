@@ -26,4 +26,8 @@ struct CscPattern {
 CscPattern build_csc_pattern(Index rows, Index cols, const std::vector<Index>& trip_rows,
                              const std::vector<Index>& trip_cols, std::vector<Index>* slot_of_triplet);
 
+/// The pattern of Aᵀ (A.cols × A.rows) and, in source_entry[k], the position in A's value array of Aᵀ's entry k, so
+/// that Aᵀ's values are a gather of A's: tv[k] = av[source_entry[k]]. O(nnz + rows + cols). Thread-safe.
+CscPattern transpose_pattern(const CscPattern& a, std::vector<Index>* source_entry);
+
 }  // namespace phiq
