@@ -16,7 +16,8 @@ with ringed points; the fronts of the other step counts are dotted grey. The sce
 
 On standard error, per scene and error: whether the default is on its step count's front, and if not, the fastest
 setting that dominates it; and the same over all step counts. With --markdown FILE, the positions' front of every
-scene (at its default step count) as a Markdown table (the table of bench/README.md), the default's row marked.
+scene (at its default step count) as a Markdown table (the table of bench/README.md), the default's row marked,
+and a second table: every predictor, Newton mode and LU at the default's tolerance and step count.
 
 Rows whose status is not "ok" (failed sweeps) are counted and left out. Errors of exactly 0 are drawn at 1e-17.
 Writes an SVG (text kept as text, no timestamp: the same input gives the same file), and a PNG with --png.
@@ -151,6 +152,22 @@ def markdown(scenes):
                 scene, fmt(r["tolerance"]), r["steps"], r["predictor"], r["newton"], r["linear_solver"].upper(),
                 errs[0], errs[1], errs[2], r["iterations_per_step"], r["factorizations_per_step"], r["us_per_step"],
                 mark))
+    out += ["", "At the default's tolerance and step count, every predictor, Newton mode and LU:", "",
+            "| scene | predictor | Newton | LU | err_q | err_v | err_a | iterations / step | factorisations / step | "
+            "µs / step | ÷ default |",
+            "| --- | --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    for scene, rows in scenes:
+        d = [r for r in rows if r["default"]]
+        if not d:
+            continue
+        d = d[0]
+        same = [r for r in rows if r["tolerance"] == d["tolerance"] and r["steps"] == d["steps"]]
+        for r in sorted(same, key=lambda r: (r["linear_solver"] != d["linear_solver"], r["us_per_step"])):
+            errs = ["%.1e" % r[k] if r[k] is not None else "—" for k, _ in ERRORS]
+            out.append("| %s | %s | %s | %s | %s | %s | %s | %.2f | %.2f | %.3g | %s |" % (
+                scene, r["predictor"] + (" (**default**)" if r["default"] else ""), r["newton"],
+                r["linear_solver"].upper(), errs[0], errs[1], errs[2], r["iterations_per_step"],
+                r["factorizations_per_step"], r["us_per_step"], "%.2f" % (r["us_per_step"] / d["us_per_step"])))
     return "\n".join(out) + "\n"
 
 
@@ -206,13 +223,18 @@ def main(argv):
                             transform=ax.transAxes, fontsize=9)
                     ax.set_axis_off()
                     continue
+                # one scatter per marker style (predictor, Newton, LU, steps), colours per point; the cloud is
+                # rasterised inside the SVG (a thousand settings as vector markers make a megabyte), the fronts, the
+                # default and all text stay vectors
+                groups = {}
                 for r in pts:
-                    c = colour(r["tolerance"])
-                    size = 18 + 30 * steps.index(r["steps"])
-                    filled = r["newton"] == "modified"
-                    ax.scatter([r["us_per_step"]], [max(r[key], FLOOR)], s=size, marker=SHAPES.get(r["predictor"], "x"),
-                               facecolors=c if filled else "none", edgecolors=c, linewidths=1.0,
-                               alpha=ALPHA.get(r["linear_solver"], 0.5), zorder=2)
+                    groups.setdefault((r["predictor"], r["newton"], r["linear_solver"], r["steps"]), []).append(r)
+                for (pred, newton, lu, st), g in sorted(groups.items()):
+                    cs = [colour(r["tolerance"]) for r in g]
+                    ax.scatter([r["us_per_step"] for r in g], [max(r[key], FLOOR) for r in g],
+                               s=18 + 30 * steps.index(st), marker=SHAPES.get(pred, "x"),
+                               facecolors=cs if newton == "modified" else "none", edgecolors=cs, linewidths=1.0,
+                               alpha=ALPHA.get(lu, 0.5), zorder=2, rasterized=True)
                 black = main_steps(pts)
                 for st in steps:
                     group = [r for r in pts if r["steps"] == st]
@@ -243,7 +265,7 @@ def main(argv):
                     lambda v, _: "%g" % v if round(v / 10 ** math.floor(math.log10(v) + 1e-9)) in (2, 5) else ""))
                 ax.grid(True, which="both", linewidth=0.3, alpha=0.6)
                 ax.set_title("%s: %s" % (scene, what), fontsize=9)
-                ax.set_xlabel("time per drive step (µs, best of repetitions)", fontsize=8)
+                ax.set_xlabel("time per drive step (µs, best of the timing rounds)", fontsize=8)
                 ax.set_ylabel("worst error (%s)" % {"err_q": "scaled by the length scale",
                                                    "err_v": "1/s, scaled", "err_a": "1/s², scaled"}[key], fontsize=8)
                 ax.tick_params(labelsize=7)
@@ -271,7 +293,8 @@ def main(argv):
         fig.tight_layout(rect=(0, 0.06 if len(scenes) > 1 else 0.1, 1, 0.97))
         for path, form in [(args.output, "svg")] + ([(args.png, "png")] if args.png else []):
             try:
-                fig.savefig(path, format=form, metadata={"Date": None} if form == "svg" else None, dpi=110)
+                fig.savefig(path, format=form, metadata={"Date": None} if form == "svg" else None,
+                            dpi=72 if form == "svg" else 110)  # svg: the resolution of the rasterised cloud
             except OSError as e:
                 raise PlotError("%s: cannot write: %s" % (path, e.strerror or e))
         if args.markdown:

@@ -12,6 +12,7 @@
 #include <memory>
 #include <numeric>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "closed_forms.hpp"
@@ -329,6 +330,11 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
   const Eigen::VectorXd& scale = model.tolerance_scales().coordinate_scale;
   std::vector<double> rq(n), rv(n), ra(n);
   std::size_t total = tols.size() * steps.size() * preds.size() * newtons.size() * lus.size(), done = 0;
+  struct Timed {
+    std::size_t row;     // index into rep.rows
+    SweepOptions options;
+  };
+  std::vector<Timed> timed;  // the settings whose sweep succeeded, timed after all the error runs
   // Step counts outermost: the numerical reference is computed once per step count.
   for (Index st : steps)
     for (Predictor p : preds)
@@ -391,28 +397,41 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
                 static_cast<double>(sum.counters.newton_iterations - sum.assembly.iterations) / steps_d;
             row.factorizations_per_step =
                 static_cast<double>(sum.counters.factorizations - sum.assembly.factorizations) / steps_d;
-            // Timed runs: best of `repeat`, the workspace made outside the clock, the callback empty. Sweeps of a few
-            // microseconds (the seed models) are repeated until 20 ms have been timed: one preemption on a shared
-            // machine would otherwise be the whole measurement.
-            double best = INFINITY, timed = 0.0;
-            for (int r = 0; r < opt.repeat || (timed < 0.02 && r < 1000); ++r) {
-              Workspace ws(model);
-              ws.lu = numeric(lu);
-              ws.q = start;
-              SweepSummary s2;
-              const auto t0 = Clock::now();
-              run_sweep(model, o, ws, [](const StepView&) { return true; }, &s2);
-              const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
-              best = std::min(best, dt);
-              timed += dt;
+            if (progress) {
+              // a stream: GCC 12 warns (-Wrestrict, a false positive) on "/" + std::to_string(...)
+              std::ostringstream line;
+              line << done << "/" << total << " " << setting_text(set) << ": err_q " << short_num(row.err_q, 2)
+                   << ", " << short_num(row.iterations_per_step, 3) << " iterations per step";
+              progress(line.str());
             }
-            row.us_per_step = best / steps_d * 1e6;
-            if (progress)
-              progress("[" + std::to_string(done) + "/" + std::to_string(total) + "] " + setting_text(set) +
-                       ": err_q " + short_num(row.err_q, 2) + ", " + short_num(row.iterations_per_step, 3) +
-                       " iterations, " + short_num(row.us_per_step, 3) + " us per step");
+            timed.push_back({rep.rows.size(), o});
             rep.rows.push_back(row);
           }
+
+  // Timing: `repeat` rounds over all the settings, each setting's best kept. Rounds rather than back-to-back
+  // repetitions, so that a burst of load on a shared machine hits one sample of many settings instead of every
+  // sample of one. Within a round a sweep of a few microseconds (the seed models) is repeated until 10 ms have
+  // been timed, so that one preemption is not the whole sample. The workspace is made outside the clock and the
+  // callback is empty.
+  for (auto& t : timed) rep.rows[t.row].us_per_step = INFINITY;
+  for (int round = 0; round < opt.repeat; ++round) {
+    if (progress) progress("timing round " + std::to_string(round + 1) + " of " + std::to_string(opt.repeat));
+    for (const auto& t : timed) {
+      AccuracyRow& row = rep.rows[t.row];
+      double spent = 0.0;
+      for (int r = 0; r == 0 || (spent < 0.01 && r < 1000); ++r) {
+        Workspace ws(model);
+        ws.lu = numeric(row.setting.linear_solver);
+        ws.q = start;
+        SweepSummary s2;
+        const auto t0 = Clock::now();
+        run_sweep(model, t.options, ws, [](const StepView&) { return true; }, &s2);
+        const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+        spent += dt;
+        row.us_per_step = std::min(row.us_per_step, dt / static_cast<double>(row.setting.steps) * 1e6);
+      }
+    }
+  }
   return rep;
 }
 

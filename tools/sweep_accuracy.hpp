@@ -30,7 +30,7 @@ struct AccuracyRow {
   double err_q = 0.0, err_v = 0.0, err_a = 0.0;
   double iterations_per_step = 0.0;       // Newton iterations of the drive steps (the assembly left out)
   double factorizations_per_step = 0.0;   // numeric LU factorisations, including those for q̇ and q̈
-  double us_per_step = 0.0;               // best wall time of run_sweep over the repetitions ÷ steps, µs
+  double us_per_step = 0.0;               // best wall time of run_sweep over the timing rounds ÷ steps, µs
   std::string status = "ok";              // "ok", or the solver's status words when the sweep failed
   bool is_default = false;                // the scene's own settings (predictor auto resolved)
 };
@@ -46,7 +46,8 @@ struct AccuracyOptions {
   // "numerical" (the same scene at tolerance 1e-14, full Newton, reference_substeps sub-steps per step), or
   // "closed-form:KIND[:NAME=VALUE,...]" (closed_forms.hpp).
   std::string reference = "auto";
-  // Timed runs per setting (best of; more until 20 ms are timed), after one untimed run that measures the errors.
+  // Timing rounds over the whole grid (best of), after one untimed run per setting that measures the errors; in
+  // each round a sweep is repeated until 10 ms are timed.
   int repeat = 3;
   int reference_substeps = 4;  // numerical reference: sub-steps per step of the setting
 };
