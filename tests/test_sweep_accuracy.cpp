@@ -5,6 +5,7 @@
 
 #include <sys/wait.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -201,6 +202,38 @@ TEST(SweepAccuracyLists, ParseAndRefuse) {
   EXPECT_THROW(tools::parse_tolerances("1e-6x"), std::invalid_argument);
   EXPECT_THROW(tools::parse_steps("-3"), std::invalid_argument);
   EXPECT_THROW(tools::parse_steps(""), std::invalid_argument);
+}
+
+TEST(SweepAccuracyApi, AStopRequestEndsTheMeasurement) {
+  Scene s = load_scene(test::model_path("seed/crank_slider_mixed.yaml"));
+  tools::AccuracyOptions o;
+  o.tolerances = {1e-6};
+  std::atomic<bool> stop{true};
+  o.stop = &stop;
+  EXPECT_THROW(tools::measure_accuracy(s, o), tools::AccuracyCancelled);
+  o.reference = "numerical";  // stopped inside the reference run as well
+  EXPECT_THROW(tools::measure_accuracy(s, o), tools::AccuracyCancelled);
+  stop = false;
+  o.steps = {10};
+  o.predictors = {Predictor::kQuadratic};
+  o.repeat = 1;
+  EXPECT_EQ(tools::measure_accuracy(s, o).rows.size(), 4u);  // newton × LU
+}
+
+TEST_F(SweepAccuracy, CtrlCWritesNothing) {
+  // nfourbar 200 over a long grid, interrupted after a moment: exit 130, no file, no temporary left
+  const fs::path scene = dir_ / "nf.yaml", csv = dir_ / "acc.csv";
+  ASSERT_EQ(std::system((std::string(PHIQ_CLI) + " generate nfourbar 200 --steps 400 -o " + scene.string()).c_str()), 0);
+  const std::string cmd = "sh -c '" + std::string(PHIQ_CLI) + " sweep-accuracy " + scene.string() + " -o " +
+                          csv.string() + " 2>" + (dir_ / "err.txt").string() + " & pid=$!; sleep 1; kill -INT $pid;" +
+                          " wait $pid; echo $? >" + (dir_ / "status.txt").string() + "'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_EQ(slurp(dir_ / "status.txt"), "130\n") << slurp(dir_ / "err.txt");
+  EXPECT_NE(slurp(dir_ / "err.txt").find("interrupted; no output written"), std::string::npos);
+  std::vector<std::string> left;
+  for (auto& e : fs::directory_iterator(dir_)) left.push_back(e.path().filename().string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"err.txt", "nf.yaml", "status.txt"}));
 }
 
 TEST(SweepAccuracyApi, DefaultGridSkipsPredictorsTheSceneCannotFeed) {

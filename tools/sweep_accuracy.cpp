@@ -6,6 +6,7 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -64,6 +65,8 @@ Predictor resolved(Predictor p, const SweepOptions& o) {
   return o.accelerations ? Predictor::kQuadratic : (o.velocities ? Predictor::kLinear : Predictor::kSecant);
 }
 
+bool stopped(const std::atomic<bool>* stop) { return stop && stop->load(); }
+
 // Largest of the errors seen; NaN (a non-finite result) counts as infinitely large.
 void worst(double& e, double x) { e = std::isnan(x) ? INFINITY : std::max(e, x); }
 
@@ -90,8 +93,9 @@ class ClosedFormReference final : public Reference {
 // up to rounding of the step; the reference is taken at its own t, which differs from the setting's by an ulp).
 class NumericalReference final : public Reference {
  public:
-  NumericalReference(const Model& m, const SweepOptions& scene, const Eigen::VectorXd& start, int substeps)
-      : model_(m), scene_(scene), start_(start), substeps_(substeps) {}
+  NumericalReference(const Model& m, const SweepOptions& scene, const Eigen::VectorXd& start, int substeps,
+                     const std::atomic<bool>* stop)
+      : model_(m), scene_(scene), start_(start), substeps_(substeps), stop_(stop) {}
   void at(Index steps, Index k, double, double* q, double* v, double* a) override {
     const Rows& r = rows(steps);
     const auto n = static_cast<std::size_t>(model_.num_coordinates()), row = static_cast<std::size_t>(k) * n;
@@ -120,12 +124,14 @@ class NumericalReference final : public Reference {
     Rows r;
     SweepSummary sum;
     run_sweep(model_, o, ws, [&](const StepView& s) {
+      if (stopped(stop_)) return false;
       if (s.step % substeps_ != 0) return true;
       r.q.insert(r.q.end(), s.q.data(), s.q.data() + s.q.size());
       if (s.qd) r.v.insert(r.v.end(), s.qd->data(), s.qd->data() + s.qd->size());
       if (s.qdd) r.a.insert(r.a.end(), s.qdd->data(), s.qdd->data() + s.qdd->size());
       return true;
     }, &sum);
+    if (sum.status == SolveStatus::kCancelled) throw AccuracyCancelled();
     if (sum.status != SolveStatus::kSuccess)
       throw std::runtime_error("the numerical reference (tolerance 1e-14, full Newton, " + std::to_string(o.steps) +
                                " steps) failed: " + sum.message);
@@ -135,6 +141,7 @@ class NumericalReference final : public Reference {
   SweepOptions scene_;
   Eigen::VectorXd start_;
   int substeps_;
+  const std::atomic<bool>* stop_;
   std::map<Index, Rows> cache_;
 };
 
@@ -164,6 +171,10 @@ std::string csv_field(const std::string& s) {
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + "\"";
 }
+
+std::atomic<bool> g_interrupted{false};
+// extern "C" names ignore namespaces: this one must differ from phiq_main.cpp's on_sigint
+extern "C" void sweep_accuracy_on_sigint(int) { g_interrupted = true; }
 
 }  // namespace
 
@@ -313,7 +324,7 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
     rep.reference = "numerical: the same scene at tolerance 1e-14, full Newton, " +
                     std::to_string(opt.reference_substeps) + " sub-steps per step";
     rep.reference_kind = "numerical";
-    ref = std::make_unique<NumericalReference>(model, so, start, opt.reference_substeps);
+    ref = std::make_unique<NumericalReference>(model, so, start, opt.reference_substeps, opt.stop);
   }
 
   // One numeric LU per linear solver: the model's own analysis, or the same pattern analysed for the other library
@@ -378,9 +389,10 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
                   if (s.qd) worst(ev, std::fabs((*s.qd)(jj) - rv[j]) / scale(jj));
                   if (s.qdd) worst(ea, std::fabs((*s.qdd)(jj) - ra[j]) / scale(jj));
                 }
-                return true;
+                return !stopped(opt.stop);
               }, &sum);
             }
+            if (sum.status == SolveStatus::kCancelled) throw AccuracyCancelled();
             if (sum.status != SolveStatus::kSuccess) {
               row.status = to_string(sum.status);
               row.err_q = row.err_v = row.err_a = NAN;
@@ -425,7 +437,8 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
         ws.q = start;
         SweepSummary s2;
         const auto t0 = Clock::now();
-        run_sweep(model, t.options, ws, [](const StepView&) { return true; }, &s2);
+        run_sweep(model, t.options, ws, [&](const StepView&) { return !stopped(opt.stop); }, &s2);
+        if (s2.status == SolveStatus::kCancelled) throw AccuracyCancelled();
         const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
         spent += dt;
         row.us_per_step = std::min(row.us_per_step, dt / static_cast<double>(row.setting.steps) * 1e6);
@@ -503,6 +516,13 @@ int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
   }
   o.reference = a.reference;
   o.repeat = a.repeat;
+  // Ctrl-C stops the running sweep; the temporary output files are then removed (nothing is written). Installed
+  // before the files are created, so that no moment leaves a temporary behind.
+  o.stop = &g_interrupted;
+  std::signal(SIGINT, sweep_accuracy_on_sigint);
+  struct RestoreSignal {
+    ~RestoreSignal() { std::signal(SIGINT, SIG_DFL); }
+  } restore;
   Scene scene;
   try {
     scene = load_scene(a.scene);
@@ -524,6 +544,8 @@ int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
                                       std::cerr << "phiq: sweep-accuracy: " << l << "\n";
                                     })
                                                : std::function<void(const std::string&)>());
+  } catch (const AccuracyCancelled&) {
+    return fail(a.scene + ": interrupted; no output written", 130);
   } catch (const std::invalid_argument& e) {
     return fail(a.scene + ": " + e.what(), 2);
   } catch (const std::runtime_error& e) {

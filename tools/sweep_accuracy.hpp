@@ -4,7 +4,9 @@
 // and factorisations per step, and the best time per step of a few repetitions.
 #pragma once
 
+#include <atomic>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,13 @@ struct AccuracyOptions {
   // each round a sweep is repeated until 10 ms are timed.
   int repeat = 3;
   int reference_substeps = 4;  // numerical reference: sub-steps per step of the setting
+  // When set and it becomes true (Ctrl-C), the running sweep stops and measure_accuracy throws AccuracyCancelled.
+  const std::atomic<bool>* stop = nullptr;
+};
+
+// measure_accuracy was stopped through AccuracyOptions::stop.
+struct AccuracyCancelled : std::runtime_error {
+  AccuracyCancelled() : std::runtime_error("interrupted") {}
 };
 
 struct AccuracyReport {
@@ -94,7 +103,7 @@ struct SweepAccuracyArgs {
 };
 
 // Runs the command: exit status 0, 1 (the reference could not be computed), 2 (bad input: scene, option, a
-// reference that does not fit), 3 (an output could not be written). Errors are one line on stderr ("phiq: ...").
+// reference that does not fit), 3 (an output could not be written), 130 (interrupted by Ctrl-C: nothing written). Errors are one line on stderr ("phiq: ...").
 // Without -o and --json the CSV goes to standard output; files are written whole or not at all.
 int run_sweep_accuracy_command(const SweepAccuracyArgs& args);
 
