@@ -172,6 +172,7 @@ TEST_F(SweepAccuracy, BadInputIsOneLineAndWritesNothing) {
       {cs + " --reference closed-form:fourbar", "does not satisfy"},     // the wrong mechanism, asked for explicitly
       {cs + " --reference closed-form:crank-slider:omega=3", "does not satisfy"},  // the wrong drive
       {cs + " --reference closed-form:pendulum", "unknown closed form"},
+      {seed("fourbar_natural") + " --reference closed-form:fourbar:branch=-1", "another assembly branch"},
       {cs + " --reference exact", "--reference"},
       {(dir_ / "missing.yaml").string(), "cannot open"},
   };

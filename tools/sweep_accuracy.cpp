@@ -28,6 +28,9 @@ constexpr double kReferenceTolerance = 1e-14;
 // A closed form fits a scene when the scene's own constraints hold at its positions to this scaled residual (the
 // closed forms are exact to rounding, ~1e-15): a wrong mechanism, drive or branch misses by far more.
 constexpr double kFitResidual = 1e-8;
+// ... and its positions at the first time are the scene's assembly (to 1e-14) within this scaled distance: the other
+// branch of a four-bar is a finite distance away.
+constexpr double kFitBranch = 1e-6;
 
 using Clock = std::chrono::steady_clock;
 
@@ -158,6 +161,22 @@ double fit_residual(const Model& m, ClosedForm& f, const SweepOptions& o) {
     worst(worst_r, scaled_residual(m, phi));
   }
   return worst_r;
+}
+
+// Largest scaled difference between the closed form's positions at t and q (angles modulo 2π).
+double branch_distance(const Model& m, const ClosedForm& f, double t, const Eigen::VectorXd& q) {
+  const auto n = static_cast<std::size_t>(m.num_coordinates());
+  std::vector<double> rq(n), rv(n), ra(n);
+  f.evaluate(t, rq.data(), rv.data(), ra.data());
+  const Eigen::VectorXd& scale = m.tolerance_scales().coordinate_scale;
+  double d = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const auto jj = static_cast<Index>(j);
+    double x = q(jj) - rq[j];
+    if (f.is_angle(j)) x = std::remainder(x, kTwoPi);
+    worst(d, std::fabs(x) / scale(jj));
+  }
+  return d;
 }
 
 std::string setting_text(const AccuracySetting& s) {
@@ -302,7 +321,11 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
       const double r = fit_residual(model, *f, so);
       if (!(r <= kFitResidual))
         misfit = f->describe() + " does not satisfy the scene's constraints (scaled residual " + short_num(r, 3) +
-                 "): another mechanism, drive or branch; give its parameters, e.g. closed-form:fourbar:branch=-1";
+                 "): another mechanism or drive; give its parameters, e.g. closed-form:crank-slider:omega=1";
+      // Both assembly branches satisfy the constraints: the scene's is the one it assembles into at t_begin.
+      else if (const double d = branch_distance(model, *f, so.t_begin, start); !(d <= kFitBranch))
+        misfit = f->describe() + " is another assembly branch than the scene's (scaled distance " + short_num(d, 3) +
+                 " at t = " + short_num(so.t_begin, 6) + "), e.g. closed-form:fourbar:branch=-1";
     } catch (const std::invalid_argument& e) {
       misfit = e.what();
     }
