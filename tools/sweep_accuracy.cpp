@@ -356,7 +356,7 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
   auto numeric = [&](LinearSolverKind k) {
     if (k == model.linear_solver()) return model.symbolic()->make_numeric();
     auto& a = analyses[k];
-    if (!a) a = analyse(k, std::make_shared<CscPattern>(model.jacobian_pattern()));
+    if (!a) a = analyse(k, std::make_shared<CscPattern>(model.solve_pattern()));  // the square system solved
     return a->make_numeric();
   };
 
