@@ -17,6 +17,7 @@
 
 #include "generate.hpp"
 #include "generate_linkages.hpp"
+#include "sweep_accuracy.hpp"
 #include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 
@@ -517,6 +518,21 @@ int main(int argc, char** argv) {
   compare->add_option("--columns", cmp.columns, "Compare only these columns (default: all; headers must match)")
       ->delimiter(',');
 
+  phiq::tools::SweepAccuracyArgs acc;  // `phiq sweep-accuracy`: tools/sweep_accuracy.hpp
+  CLI::App* accuracy = app.add_subcommand("sweep-accuracy", "Error against a reference and time per step, per solver setting");
+  accuracy->add_option("scene", acc.scene, "Scene file (YAML)")->required();
+  accuracy->add_option("-o,--output", acc.csv_path, "CSV to write (default: standard output unless --json)");
+  accuracy->add_option("--json", acc.json_path, "JSON to write");
+  accuracy->add_option("--tolerances", acc.tolerances, "Newton tolerances (default 1e-4,1e-5,...,1e-14)");
+  accuracy->add_option("--steps-list", acc.steps, "Step counts (default: the scene's x 1/4, 1, 4)");
+  accuracy->add_option("--predictors", acc.predictors, "Of previous,secant,linear,quadratic,auto (default: the first four)");
+  accuracy->add_option("--newton", acc.newton, "Of modified,full (default: both)");
+  accuracy->add_option("--linear-solvers", acc.linear_solvers, "Of klu,umfpack,dense (default: klu,umfpack)");
+  accuracy->add_option("--reference", acc.reference, "auto, numerical or closed-form:KIND[:NAME=VALUE,...]")->capture_default_str();
+  accuracy->add_option("--repeat", acc.repeat, "Timed runs per setting (best of)")->capture_default_str();
+  accuracy->add_flag("-q,--quiet", acc.quiet, "Print only errors on standard error");
+  accuracy->add_flag("-v,--verbose", acc.verbose, "One line per setting on standard error");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -556,6 +572,7 @@ int main(int argc, char** argv) {
     if (*assemble_cmd) return cmd_assemble(asm_path, asm_out, asm_quiet);
     if (*batch) return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, batch_threads);
     if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
+    if (*accuracy) return phiq::tools::run_sweep_accuracy_command(acc);
   } catch (const std::exception& e) {
     return fail(std::string("internal error: ") + e.what(), 4);
   }
