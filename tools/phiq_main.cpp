@@ -13,6 +13,7 @@
 #include <fstream>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "generate.hpp"
@@ -299,7 +300,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   return failed ? 1 : 0;
 }
 
-int cmd_check(const std::string& scene_path, bool json) {
+int cmd_check(const std::string& scene_path, bool json, std::optional<double> at) {
   phiq::Scene scene;
   try {
     scene = phiq::load_scene(scene_path);
@@ -314,7 +315,7 @@ int cmd_check(const std::string& scene_path, bool json) {
   // stopped): works for square, redundant and under-driven models alike.
   Eigen::VectorXd q = model.initial_positions();
   phiq::AssemblySummary as;
-  const double t0 = scene.sweep.t_begin;
+  const double t0 = at ? *at : scene.sweep.t_begin;  // rank belongs to a configuration: `--time` picks another
   phiq::assemble(model, t0, assembly_options(scene), q, &as);
   const bool ok = as.status == phiq::SolveStatus::kSuccess;
   const bool analysed = as.rank.coordinates == model.num_coordinates() && as.status != phiq::SolveStatus::kOutsideTimeDomain;
@@ -505,6 +506,9 @@ int main(int argc, char** argv) {
   CLI::App* check = app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
   check->add_option("scene", check_path, "Scene file (YAML)")->required();
   check->add_flag("--json", check_json, "Print one JSON object (format: tools/README.md)");
+  double check_time = 0.0;
+  CLI::Option* check_at =
+      check->add_option("--time", check_time, "Assemble and analyse at this time instead of time.start");
 
   std::string cmp_a, cmp_b;
   phiq::CompareOptions cmp;
@@ -568,7 +572,8 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
-    if (*check) return cmd_check(check_path, check_json);
+    if (*check)
+      return cmd_check(check_path, check_json, check_at->count() ? std::optional<double>(check_time) : std::nullopt);
     if (*assemble_cmd) return cmd_assemble(asm_path, asm_out, asm_quiet);
     if (*batch) return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, batch_threads);
     if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
