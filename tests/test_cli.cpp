@@ -716,4 +716,18 @@ TEST_F(Cli, AssembleWritesTheAssembledCoordinatesAsOneCsvRow) {
   EXPECT_FALSE(fs::exists(dir_ / "door.csv"));
 }
 
+
+TEST_F(Cli, CheckAnalysesTheConfigurationAtTheTimeAsked) {
+  const std::string scene = phiq::test::model_path("redundant/parallelogram_change_point.yaml");
+  Result normal = run("check --json " + scene);
+  ASSERT_EQ(normal.code, 0) << normal.err;
+  EXPECT_NE(normal.out.find("\"rank\": 8"), std::string::npos) << normal.out;
+  EXPECT_NE(normal.out.find("\"rank_uncertain\": false"), std::string::npos) << normal.out;
+  // the crank driven to 0: flat, a change point; assembled only to about 1e-6 there, which the analysis reports
+  Result flat = run("check --json --time -1.0471975511965976 " + scene);
+  EXPECT_NE(flat.out.find("\"time\": -1.0471975511965976"), std::string::npos) << flat.out;
+  EXPECT_NE(flat.out.find("\"rank_uncertain\": true"), std::string::npos) << flat.out;
+  EXPECT_NE(flat.out.find("singular value"), std::string::npos) << flat.out;
+}
+
 }  // namespace

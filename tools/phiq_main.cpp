@@ -13,12 +13,14 @@
 #include <fstream>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "generate.hpp"
 #include "generate_linkages.hpp"
 #include "plot_svg.hpp"
 #include "progress_bar.hpp"
+#include "sweep_accuracy.hpp"
 #include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 
@@ -311,7 +313,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   return failed ? 1 : 0;
 }
 
-int cmd_check(const std::string& scene_path, bool json) {
+int cmd_check(const std::string& scene_path, bool json, std::optional<double> at) {
   phiq::Scene scene;
   try {
     scene = phiq::load_scene(scene_path);
@@ -326,7 +328,7 @@ int cmd_check(const std::string& scene_path, bool json) {
   // stopped): works for square, redundant and under-driven models alike.
   Eigen::VectorXd q = model.initial_positions();
   phiq::AssemblySummary as;
-  const double t0 = scene.sweep.t_begin;
+  const double t0 = at ? *at : scene.sweep.t_begin;  // rank belongs to a configuration: `--time` picks another
   phiq::assemble(model, t0, assembly_options(scene), q, &as);
   const bool ok = as.status == phiq::SolveStatus::kSuccess;
   const bool analysed = as.rank.coordinates == model.num_coordinates() && as.status != phiq::SolveStatus::kOutsideTimeDomain;
@@ -521,6 +523,9 @@ int main(int argc, char** argv) {
   CLI::App* check = app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
   check->add_option("scene", check_path, "Scene file (YAML)")->required();
   check->add_flag("--json", check_json, "Print one JSON object (format: tools/README.md)");
+  double check_time = 0.0;
+  CLI::Option* check_at =
+      check->add_option("--time", check_time, "Assemble and analyse at this time instead of time.start");
 
   phiq::tools::PlotOptions plot_options;
   CLI::App* plot = app.add_subcommand("plot", "Draw the mechanism at a few positions with its traced points, and "
@@ -545,6 +550,21 @@ int main(int argc, char** argv) {
   compare->add_option("--atol", cmp.atol, "Absolute tolerance")->capture_default_str()->check(CLI::NonNegativeNumber);
   compare->add_option("--columns", cmp.columns, "Compare only these columns (default: all; headers must match)")
       ->delimiter(',');
+
+  phiq::tools::SweepAccuracyArgs acc;  // `phiq sweep-accuracy`: tools/sweep_accuracy.hpp
+  CLI::App* accuracy = app.add_subcommand("sweep-accuracy", "Error against a reference and time per step, per solver setting");
+  accuracy->add_option("scene", acc.scene, "Scene file (YAML)")->required();
+  accuracy->add_option("-o,--output", acc.csv_path, "CSV to write (default: standard output unless --json)");
+  accuracy->add_option("--json", acc.json_path, "JSON to write");
+  accuracy->add_option("--tolerances", acc.tolerances, "Newton tolerances (default 1e-4,1e-5,...,1e-14)");
+  accuracy->add_option("--steps-list", acc.steps, "Step counts (default: the scene's x 1/4, 1, 4)");
+  accuracy->add_option("--predictors", acc.predictors, "Of previous,secant,linear,quadratic,auto (default: the first four)");
+  accuracy->add_option("--newton", acc.newton, "Of modified,full (default: both)");
+  accuracy->add_option("--linear-solvers", acc.linear_solvers, "Of klu,umfpack,dense (default: klu,umfpack)");
+  accuracy->add_option("--reference", acc.reference, "auto, numerical or closed-form:KIND[:NAME=VALUE,...]")->capture_default_str();
+  accuracy->add_option("--repeat", acc.repeat, "Timed runs per setting (best of)")->capture_default_str();
+  accuracy->add_flag("-q,--quiet", acc.quiet, "Print only errors on standard error");
+  accuracy->add_flag("-v,--verbose", acc.verbose, "One line per setting on standard error");
 
   try {
     app.parse(argc, argv);
@@ -585,11 +605,13 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
-    if (*check) return cmd_check(check_path, check_json);
+    if (*check)
+      return cmd_check(check_path, check_json, check_at->count() ? std::optional<double>(check_time) : std::nullopt);
     if (*assemble_cmd) return cmd_assemble(asm_path, asm_out, asm_quiet);
     if (*batch) return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, batch_threads);
     if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
     if (*plot) return phiq::tools::plot_svg(plot_options);
+    if (*accuracy) return phiq::tools::run_sweep_accuracy_command(acc);
   } catch (const std::exception& e) {
     return fail(std::string("internal error: ") + e.what(), 4);
   }

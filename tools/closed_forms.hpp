@@ -1,0 +1,66 @@
+// Closed-form kinematics of the mechanisms phiq's accuracy is measured on (`phiq sweep-accuracy`, tools/README.md):
+// the seed crank-slider, the seed four-bar (any of its four formulations) and the generated nfourbar. Derived from
+// the geometry alone (circle intersections and their time derivatives), never from phiq's solver, so that they are
+// an independent reference.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace phiq::tools {
+
+// A quantity and its first two time derivatives.
+struct Motion {
+  double q = 0.0, v = 0.0, a = 0.0;
+};
+
+// The exact motion of a mechanism driven by one angle θ(t) = theta0 + omega·t. Each model coordinate, named as the
+// seed scenes and the generator name them, is a sum of terms in the mechanism's link angles (a constant, an angle,
+// or a length times the cosine or sine of an angle), so that positions, velocities and accelerations follow from
+// the angles' motions by the chain rule.
+class ClosedForm {
+ public:
+  virtual ~ClosedForm() = default;
+  // "crank-slider", "fourbar" or "nfourbar", with the parameters in use: "fourbar:L1=1,L2=0.4,...".
+  virtual std::string describe() const = 0;
+  // Binds the coordinates of a model, in order; afterwards evaluate() fills one entry per bound name. Throws
+  // std::invalid_argument naming the first coordinate this mechanism does not have.
+  void bind(const std::vector<std::string>& coordinates);
+  // Whether bound coordinate j is an angle (compare it modulo 2π).
+  bool is_angle(std::size_t j) const { return bound_[j].angle; }
+  // Positions, velocities and accelerations of the bound coordinates at time t.
+  void evaluate(double t, double* q, double* v, double* a) const;
+
+ protected:
+  // One term of a coordinate: coef · f(angle k), f the identity, cos or sin; angle −1 is the constant coef.
+  struct Term {
+    enum Kind { kConstant, kAngle, kCos, kSin } kind;
+    int angle;
+    double coef;
+  };
+  struct Binding {
+    std::vector<Term> terms;
+    bool angle = false;
+  };
+  // The terms of coordinate `name`, or false if the mechanism has no such coordinate.
+  virtual bool terms_of(const std::string& name, Binding& out) const = 0;
+  // Called by bind() before terms_of(): a mechanism whose formulations share names tells them apart here.
+  virtual void prepare(const std::vector<std::string>& /*coordinates*/) {}
+  // The link angles at time t, with their derivatives.
+  virtual void angles(double t, std::vector<Motion>& out) const = 0;
+
+ private:
+  std::vector<Binding> bound_;
+  mutable std::vector<Motion> angles_;
+};
+
+// Parses "KIND[:NAME=VALUE,...]" (KIND crank-slider, fourbar or nfourbar; parameters in describe() order, defaults
+// those of models/seed/ and of `phiq generate nfourbar`). Throws std::invalid_argument for an unknown kind or
+// parameter, a value that is not a finite number, or impossible geometry.
+std::unique_ptr<ClosedForm> make_closed_form(const std::string& spec);
+
+// The closed form a scene's `name` suggests ("crank_slider_*", "fourbar_*", "nfourbar_*"), or "" if none.
+std::string closed_form_for_scene_name(const std::string& scene_name);
+
+}  // namespace phiq::tools
