@@ -210,5 +210,36 @@ TEST(SpatialScenes, RssrSweepsAndAgreesWithItsClosedForm) {
   }
 }
 
+TEST(SpatialScenes, RssrInReferencePointAndNaturalCoordinatesAgree) {
+  const Scene rp = load_scene(test::model_path("spatial/rssr.yaml"));
+  const Scene nat = load_scene(test::model_path("spatial/rssr_natural.yaml"));
+  EXPECT_FALSE(nat.model->grubler().has_value());  // natural coordinates: not made of joints
+  test::Trace a, n;
+  ASSERT_EQ(test::sweep(*rp.model, rp.sweep, &a), SolveStatus::kSuccess);
+  ASSERT_EQ(test::sweep(*nat.model, nat.sweep, &n), SolveStatus::kSuccess);
+  ASSERT_EQ(a.t.size(), n.t.size());
+  ASSERT_EQ(a.qdd.size(), a.t.size());
+  ASSERT_EQ(n.qdd.size(), n.t.size());
+  const Model& m = *rp.model;
+  const Index r = m.coordinate_index("rocker_x");
+  Frame3 f;
+  Slot* slots[] = {&f.x, &f.y, &f.z, &f.e0, &f.e1, &f.e2, &f.e3};
+  for (Index k = 0; k < 7; ++k) *slots[k] = Slot::coordinate(r + k);
+  const Attachment3 B = Attachment3::body_point(f, kin3::V3{0, 0.5, 0});
+  const Index yb = nat.model->coordinate_index("yB"), zb = nat.model->coordinate_index("zB");
+  for (std::size_t k = 0; k < a.t.size(); ++k) {
+    SCOPED_TRACE("t = " + std::to_string(a.t[k]));
+    const kin3::V3 p = B.value(a.q[k].data()), v = B.rate(a.q[k].data(), a.qd[k].data());
+    // B̈ = (the part linear in q̈) + (the q̈-free part)
+    const kin3::V3 acc = B.rate(a.q[k].data(), a.qdd[k].data()) + B.bias(a.qd[k].data());
+    EXPECT_NEAR(p.y, n.q[k](yb), 1e-9);
+    EXPECT_NEAR(p.z, n.q[k](zb), 1e-9);
+    EXPECT_NEAR(v.y, n.qd[k](yb), 1e-9);
+    EXPECT_NEAR(v.z, n.qd[k](zb), 1e-9);
+    EXPECT_NEAR(acc.y, n.qdd[k](yb), 1e-8);
+    EXPECT_NEAR(acc.z, n.qdd[k](zb), 1e-8);
+  }
+}
+
 }  // namespace
 }  // namespace phiq
