@@ -239,29 +239,27 @@ void ModelBuilder::count_joint(const JointCount& c) {
   removed_[d] += c.freedoms;
 }
 
-namespace {
-template <class Frame>
-void check_body(const std::string& name, const Frame& f, Index n, std::unordered_set<std::string>& names,
-                std::initializer_list<Slot> slots) {
-  (void)f;
+void ModelBuilder::check_body(const std::string& name, std::initializer_list<Slot> slots) {
   if (name.empty()) throw Error("body name is empty");
   for (const Slot& s : slots) {
-    if (s.is_coordinate() && s.coord >= n) throw Error("body '" + name + "': coordinate index out of range");
+    if (s.is_coordinate() && s.coord >= num_coordinates())
+      throw Error("body '" + name + "': coordinate index out of range");
     if (!s.is_coordinate() && !std::isfinite(s.value)) throw Error("body '" + name + "': constant is not finite");
   }
-  if (!names.insert(name).second) throw Error("duplicate body name '" + name + "'");
+  const auto name_of = [this](Index k) -> const std::string& { return model_.body_names_[static_cast<std::size_t>(k)]; };
+  if (!body_names_.insert(name, static_cast<Index>(model_.body_names_.size()), name_of))
+    throw Error("duplicate body name '" + name + "'");
 }
-}  // namespace
 
 Index ModelBuilder::add_body(const std::string& name, const Frame2& f) {
-  check_body(name, f, num_coordinates(), body_names_, {f.x, f.y, f.psi});
+  check_body(name, {f.x, f.y, f.psi});
   model_.body_names_.push_back(name);
   ++bodies_[0];
   return static_cast<Index>(model_.body_names_.size()) - 1;
 }
 
 Index ModelBuilder::add_body(const std::string& name, const Frame3& f) {
-  check_body(name, f, num_coordinates(), body_names_, {f.x, f.y, f.z, f.e0, f.e1, f.e2, f.e3});
+  check_body(name, {f.x, f.y, f.z, f.e0, f.e1, f.e2, f.e3});
   if (f.e0.is_coordinate() || f.e1.is_coordinate() || f.e2.is_coordinate() || f.e3.is_coordinate())
     add(name + ".euler", EulerParametersSpec{{f.e0, f.e1, f.e2, f.e3}});
   model_.body_names_.push_back(name);
@@ -278,6 +276,7 @@ Model ModelBuilder::build() && {
   const Index n = m.num_coordinates(), rows = m.num_equations();
   m.initial_.conservativeResize(n);  // add_coordinate() and reserve() leave room beyond n
   constraint_names_.clear();  // only needed while adding: free it now
+  body_names_.clear();
 
   // Sparsity pattern, fixed for the life of the model.
   std::vector<Index> trip_rows, trip_cols;
