@@ -241,5 +241,31 @@ TEST(SpatialScenes, RssrInReferencePointAndNaturalCoordinatesAgree) {
   }
 }
 
+TEST(SpatialScenes, NaturalSpatialCrankSliderIsTheClosedForm) {
+  const Scene s = load_scene(test::model_path("spatial/crank_slider_natural.yaml"));
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 6);
+  EXPECT_EQ(m.num_equations(), 6);  // w.unit, crank, w_across_crank, w_in_plane, rod, motor
+  EXPECT_FALSE(m.grubler().has_value());
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
+  ASSERT_EQ(tr.t.size(), 61u);
+  ASSERT_EQ(tr.qdd.size(), 61u);
+  const double a = 0.3, L = 1.0, h = 0.1, c = 0.2;
+  // x_B(θ) = a cos θ + S, S = sqrt(L² − c² − (h − a sin θ)²); ẋ_B = −a sin θ + a cos θ (h − a sin θ) / S (θ̇ = 1)
+  auto xb = [&](double th) { return a * std::cos(th) + std::sqrt(L * L - c * c - std::pow(h - a * std::sin(th), 2)); };
+  auto xbd = [&](double th) {
+    const double S = std::sqrt(L * L - c * c - std::pow(h - a * std::sin(th), 2));
+    return -a * std::sin(th) + a * std::cos(th) * (h - a * std::sin(th)) / S;
+  };
+  const Index j = m.coordinate_index("xB");
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    const double th = tr.t[k], dh = 1e-5;
+    EXPECT_NEAR(tr.q[k](j), xb(th), 1e-9) << th;
+    EXPECT_NEAR(tr.qd[k](j), xbd(th), 1e-9) << th;
+    EXPECT_NEAR(tr.qdd[k](j), (xbd(th + dh) - xbd(th - dh)) / (2 * dh), 1e-8) << th;
+  }
+}
+
 }  // namespace
 }  // namespace phiq
