@@ -3,7 +3,9 @@
 // plane.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "phiq/phiq.hpp"
 
@@ -135,6 +137,61 @@ time: {start: 0, end: 1, steps: 1}
   EXPECT_EQ(*m.grubler(), 18 - 3 - 8);
   EXPECT_EQ(m.body_names(), (std::vector<std::string>{"B1", "B2", "B3"}));
   EXPECT_EQ(m.constraints()[4].name, "link1");
+}
+
+// A screw-like motion: a body on a cylindrical joint to ground along the axis (1, 1, 0)/√2, its turn and its travel
+// driven separately (7 coordinates: 1 normalisation + 4 + 2 drivers); and a slider on a prismatic joint driven by
+// its travel. Swept by the square solver; the body's origin must be at d · axis, turned by θ about the axis.
+TEST(Scene3d, JointDriversTurnAndSlide) {
+  const char* text = R"(phiq: 1
+dimension: 3
+parameters: {s: 0.7071067811865476}
+coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0, px: 0, py: 0, pz: 0, p0: 1, p1: 0, p2: 0, p3: 0}
+bodies:
+  screw: [x, y, z, e0, e1, e2, e3]
+  slider: [px, py, pz, p0, p1, p2, p3]
+constraints:
+  - {name: cyl, type: cylindrical, between: [{body: ground, axis: [s, s, 0]}, {body: screw, axis: [s, s, 0]}]}
+  - {name: rail, type: prismatic, between: [{body: ground, at: [0, 0, 1], axis: [0, 0, 1]}, {body: slider, axis: [0, 0, 1]}]}
+drivers:
+  - {name: turn, joint: cyl, measure: angle, law: {type: linear, initial: 0, rate: 2}}
+  - {name: travel, joint: cyl, measure: distance, law: {type: linear, initial: 0, rate: 0.5}}
+  - {name: lift, joint: rail, law: {type: polynomial, coefficients: [0, 0, 1]}}
+time: {start: 0, end: 2, steps: 20}
+output: {velocities: true}
+)";
+  Scene sc = parse_scene(text, "screw.yaml");
+  const Model& m = *sc.model;
+  EXPECT_EQ(m.num_coordinates(), 14);
+  EXPECT_EQ(m.num_equations(), 14);
+  EXPECT_EQ(*m.grubler(), 12 - 4 - 5);  // 3: the three drivers take them
+  EXPECT_EQ(m.constraints()[5].kind, "joint_distance_driver");
+  Workspace ws(m);
+  std::vector<std::vector<double>> q, qd;
+  const auto keep = [&](const StepView& v) {
+    q.emplace_back(v.q.data(), v.q.data() + 14);
+    qd.emplace_back(v.qd->data(), v.qd->data() + 14);
+    return true;
+  };
+  ASSERT_EQ(run_sweep(m, sc.sweep, ws, keep, nullptr), SolveStatus::kSuccess);
+  ASSERT_EQ(q.size(), 21u);
+  const double s = std::sqrt(0.5);
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    const double t = 0.1 * static_cast<double>(k), th = 2 * t, d = 0.5 * t;
+    SCOPED_TRACE("t = " + std::to_string(t));
+    EXPECT_NEAR(q[k][0], d * s, 1e-10);
+    EXPECT_NEAR(q[k][1], d * s, 1e-10);
+    EXPECT_NEAR(q[k][2], 0.0, 1e-10);
+    // Euler parameters of a turn θ about the axis, up to the sign of the whole quaternion
+    const double e[4] = {std::cos(th / 2), s * std::sin(th / 2), s * std::sin(th / 2), 0.0};
+    const double sign = q[k][3] * e[0] + q[k][4] * e[1] + q[k][5] * e[2] + q[k][6] * e[3] < 0 ? -1.0 : 1.0;
+    for (int i = 0; i < 4; ++i) EXPECT_NEAR(sign * q[k][3 + i], e[i], 1e-10) << "e" << i;
+    EXPECT_NEAR(qd[k][0], 0.5 * s, 1e-10);  // the travel's rate along the axis
+    // the slider: lifted to 1 + t² along z, not turned
+    EXPECT_NEAR(q[k][9], 1.0 + t * t, 1e-10);
+    EXPECT_NEAR(qd[k][9], 2 * t, 1e-10);
+    EXPECT_NEAR(std::fabs(q[k][10]), 1.0, 1e-10);
+  }
 }
 
 TEST(Scene3d, BadInputIsOneLineNamingTheField) {
