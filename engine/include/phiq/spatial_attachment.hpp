@@ -81,15 +81,6 @@ struct Attachment3 {
 
   /// Whether R(p) s varies: s ≠ 0 (decided by the data, so the Jacobian's entry set never depends on values).
   bool rotates() const { return !kin3::is_zero(s); }
-  /// Whether any slot is a coordinate.
-  bool moves() const {
-    for (const Slot& v : r)
-      if (v.is_coordinate()) return true;
-    if (rotates())
-      for (const Slot& v : p)
-        if (v.is_coordinate()) return true;
-    return false;
-  }
   /// X at q.
   kin3::V3 value(const double* q) const {
     kin3::V3 x{r[0].of(q), r[1].of(q), r[2].of(q)};
