@@ -466,4 +466,72 @@ TEST_F(Cli, UsageErrorsAndHelp) {
   EXPECT_EQ(run("--version").out, "phiq 0.1.0 (scene format 1, CSV format 1, check --json format 1)\n");
 }
 
+
+// ---- redundancy (issue 3): check, assemble, run through consistent redundancy, refuse inconsistent ----------------
+
+const char* kPlanarDoorMisaligned = R"(phiq: 1
+coordinates: {x: 0.01, y: -0.02, psi: 0.1}
+bodies: {door: [x, y, psi]}
+constraints:
+  - {name: pin1, type: revolute, between: [{body: door, at: [0, 0]}, {body: ground, at: [0, 0]}]}
+  - {name: pin2, type: revolute, between: [{body: door, at: [0, 0]}, {body: ground, at: [0.001, 0]}]}
+drivers:
+  - {name: motor, coordinate: psi, law: {type: linear, initial: 0.2, rate: 1}}
+time: {start: 0, end: 1, steps: 10}
+)";
+
+TEST_F(Cli, CheckJsonReportsRankDofAndRedundantConstraints) {
+  Result r = run("check --json " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  for (const char* part : {"\"coordinates\": 12", "\"equations\": 13", "\"rank\": 11", "\"dof\": 1",
+                           "\"driven_dof\": 0", "\"grubler\": ", "\"redundant\": [\n    \"A3\"\n  ]",
+                           "\"name\": \"A3[1]\"", "\"consistent\": true", "\"conflicts\": []",
+                           "\"rank_uncertain\": false"})
+    EXPECT_NE(r.out.find(part), std::string::npos) << part << "\n" << r.out;
+  Result text = run("check " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  EXPECT_NE(text.out.find("redundant     A3\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("dof           1 (0 not driven)\n"), std::string::npos) << text.out;
+}
+
+TEST_F(Cli, CheckNamesTheConflictsOfInconsistentRedundancy) {
+  fs::path p = write("door.yaml", kPlanarDoorMisaligned);
+  Result r = run("check --json " + p.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.out.find("\"consistent\": false"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"conflicts\": [\n    \"pin1\",\n    \"pin2\"\n  ]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"status\": \"inconsistent redundant constraints\""), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, RunRefusesInconsistentRedundancyInOneLineAndWritesNothing) {
+  fs::path p = write("door.yaml", kPlanarDoorMisaligned);
+  Result r = run("run " + p.string() + " -o " + (dir_ / "out.csv").string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("t = 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("conflicting constraints: pin1, pin2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no output written"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
+}
+
+TEST_F(Cli, AssembleWritesTheAssembledCoordinatesAsOneCsvRow) {
+  const fs::path out = dir_ / "q.csv";
+  Result r = run("assemble " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml") + " -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string text = slurp(out);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2) << text;
+  EXPECT_EQ(text.substr(0, text.find('\n')), "t,x1,y1,psi1,x2,y2,psi2,x3,y3,psi3,xc,yc,psic");
+  // the row: every crank at pi/3 (the motor at t = 0), the coupler's left end at (cos, sin) of it
+  std::vector<double> v;
+  std::stringstream row(text.substr(text.find('\n') + 1));
+  for (std::string cell; std::getline(row, cell, ',');) v.push_back(std::stod(cell));
+  ASSERT_EQ(v.size(), 13u);
+  for (int k : {3, 6, 9}) EXPECT_NEAR(v[k], M_PI / 3, 1e-10);
+  EXPECT_NEAR(v[10], 0.5, 1e-10);
+  EXPECT_NEAR(v[11], std::sqrt(3.0) / 2, 1e-10);
+  // an inconsistent model: exit 1, nothing written
+  fs::path p = write("door.yaml", kPlanarDoorMisaligned);
+  EXPECT_EQ(run("assemble " + p.string() + " -o " + (dir_ / "door.csv").string()).code, 1);
+  EXPECT_FALSE(fs::exists(dir_ / "door.csv"));
+}
+
 }  // namespace

@@ -187,9 +187,24 @@ TEST(Scene, EquationErrorsNameTheExpression) {
              "constraints[1].expr");
 }
 
-TEST(Scene, NonSquareModelIsAModellingError) {
-  std::string m = error_of(variant("drivers:\n  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}\n", ""));
-  EXPECT_HAS(m, "4 coordinates but 3 constraint equations");
+TEST(Scene, NonSquareModelLoadsAndTheAssemblySaysWhatIsMissing) {
+  // Under-driven (no motor): loads; the square solve refuses it with both counts, the assembly names the freedom.
+  Scene sc = parse_scene(
+      variant("drivers:\n  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}\n", ""),
+      "undriven.yaml");
+  EXPECT_EQ(sc.model->num_coordinates(), 4);
+  EXPECT_EQ(sc.model->num_equations(), 3);
+  Workspace ws(*sc.model);
+  PositionSummary ps;
+  EXPECT_EQ(solve_position(*sc.model, 0.0, sc.sweep.assembly, ws, &ps), SolveStatus::kNotSquare);
+  EXPECT_NE(ps.message.find("3 equations for 4 coordinates"), std::string::npos) << ps.message;
+  Eigen::VectorXd q = sc.model->initial_positions();
+  std::unique_ptr<Model> solved;
+  AssemblySummary as;
+  EXPECT_EQ(prepare_square(*sc.model, 0.0, {}, q, &solved, &as), SolveStatus::kNotSquare);
+  EXPECT_EQ(as.rank.dof, 1);
+  EXPECT_EQ(as.rank.driven_dof, 1);
+  EXPECT_NE(as.message.find("1 degree(s) of freedom not driven"), std::string::npos) << as.message;
 }
 
 TEST(Scene, ReservedAndInvalidNames) {

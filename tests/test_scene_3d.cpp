@@ -90,9 +90,7 @@ drivers:
   - {name: lock, coordinate: ux, law: {type: linear, initial: 0, rate: 0}}
 time: {start: 0, end: 1, steps: 2}
 )";
-  SceneOverrides o;
-  o.allow_non_square = true;  // u.unit and `up` say the same: 7 equations for 6 coordinates
-  Scene s = parse_scene(text, "natural.yaml", SceneLimits{}, o);
+  Scene s = parse_scene(text, "natural.yaml");  // u.unit and `up` say the same: 7 equations for 6 coordinates
   const Model& m = *s.model;
   EXPECT_EQ(m.num_coordinates(), 6);
   EXPECT_EQ(m.num_equations(), 7);
@@ -103,7 +101,6 @@ time: {start: 0, end: 1, steps: 2}
   Eigen::VectorXd phi(7);
   m.residual(q.data(), 1.2, phi.data());
   EXPECT_LT(phi.lpNorm<Eigen::Infinity>(), 1e-15);  // ay = 0.5 · 1.2
-  EXPECT_THROW(parse_scene(text, "natural.yaml"), SceneError);  // not square without the override
 }
 
 TEST(Scene3d, FamiliesMakeChainsOfBodies) {
@@ -128,9 +125,7 @@ constraints:
       - {name: "link{i}", type: universal, between: [{body: "B{i}", at: [1, 0, 0], axis: [0, 0, 1]}, {body: "B{i+1}", axis: [0, 1, 0]}]}
 time: {start: 0, end: 1, steps: 1}
 )";
-  SceneOverrides o;
-  o.allow_non_square = true;
-  Scene s = parse_scene(text, "chain.yaml", SceneLimits{}, o);
+  Scene s = parse_scene(text, "chain.yaml");
   const Model& m = *s.model;
   EXPECT_EQ(m.num_coordinates(), 21);
   EXPECT_EQ(m.num_equations(), 3 + 3 + 2 * 4);

@@ -17,14 +17,7 @@
 namespace phiq {
 namespace {
 
-Scene Load(const std::string& rel) {
-  SceneOverrides o;
-  o.allow_non_square = true;  // the redundant scenes have more equations than coordinates
-  std::ifstream in(test::model_path(rel));
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_scene(text.str(), rel, SceneLimits{}, o);
-}
+Scene Load(const std::string& rel) { return load_scene(test::model_path(rel)); }
 
 Eigen::MatrixXd DenseJacobian(const Model& m, const Eigen::VectorXd& q, double t) {
   const CscPattern& p = m.jacobian_pattern();
@@ -265,6 +258,20 @@ TEST(SpatialScenes, NaturalSpatialCrankSliderIsTheClosedForm) {
     EXPECT_NEAR(tr.qd[k](j), xbd(th), 1e-9) << th;
     EXPECT_NEAR(tr.qdd[k](j), (xbd(th + dh) - xbd(th - dh)) / (2 * dh), 1e-8) << th;
   }
+}
+
+}  // namespace
+}  // namespace phiq
+
+namespace phiq {
+namespace {
+
+// The planar redundant scene of models/redundant/: four reference-point bodies and six pins, 3 · 4 − 6 · 2 = 0,
+// although the parallelogram moves with one degree of freedom.
+TEST(RedundantScenes, ParallelogramWithFifthBarCountsZero) {
+  const Scene s = load_scene(test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  ASSERT_TRUE(s.model->grubler().has_value());
+  EXPECT_EQ(*s.model->grubler(), 0);
 }
 
 }  // namespace

@@ -40,6 +40,21 @@ std::string sci(double v) {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// The scene's assembly settings (tolerance, iteration budget) for the minimum-norm assembly.
+phiq::AssemblyOptions assembly_options(const phiq::Scene& scene) {
+  phiq::AssemblyOptions o;
+  o.tolerance = scene.sweep.assembly.tolerance;
+  o.max_iterations = scene.sweep.assembly.max_iterations;
+  return o;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+
 // `phiq run --summary FILE.json`: the run summary, format version 1 (tools/README.md).
 bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq::Workspace& ws,
                    const phiq::SweepSummary& s, double load_s, double solve_s, double write_s) {
@@ -89,9 +104,21 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
     return fail(e.what(), 2);
   }
   const double load_s = since(load_start);
-  const phiq::Model& model = *scene.model;
+  // A model that is not square (redundant constraints) is assembled by minimum norm and solved on its independent
+  // rows; inconsistent or under-driven models stop here, naming the constraints.
+  std::unique_ptr<phiq::Model> solved;
+  Eigen::VectorXd start = scene.model->initial_positions();
+  phiq::AssemblySummary redundancy;
+  if (scene.model->num_equations() != scene.model->num_coordinates()) {
+    if (phiq::prepare_square(*scene.model, scene.sweep.t_begin, assembly_options(scene), start, &solved,
+                             &redundancy) != phiq::SolveStatus::kSuccess)
+      return fail(scene_path + ": t = " + std::to_string(scene.sweep.t_begin) + ": " + redundancy.message +
+                      (out_path.empty() ? "" : "; no output written"), 1);
+  }
+  const phiq::Model& model = solved ? *solved : *scene.model;
   scene.sweep.threads = threads;
   phiq::Workspace ws(model);
+  ws.q = start;
   phiq::CsvFormat csv(model, scene.output_coordinates, scene.sweep.velocities, scene.sweep.accelerations);
 
   // Where the CSV goes: a file that appears only when complete, or standard output after success, spooled through
@@ -135,8 +162,19 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   std::signal(SIGINT, SIG_DFL);
 
   if (summary.status == phiq::SolveStatus::kCancelled) return fail(scene_path + ": interrupted; no output written", 130);
-  if (summary.status != phiq::SolveStatus::kSuccess)
-    return fail(scene_path + ": " + summary.message + (out_path.empty() ? "" : "; no output written"), 1);
+  if (summary.status != phiq::SolveStatus::kSuccess) {
+    std::string why = summary.message;
+    // A square model singular at its first position: redundant constraints and missing drivers in equal numbers,
+    // or a singular placement. The rank analysis says which.
+    if (summary.failed_step == 0 && summary.status == phiq::SolveStatus::kSingularJacobian && !solved) {
+      Eigen::VectorXd q = scene.model->initial_positions();
+      phiq::AssemblySummary as;
+      if (phiq::prepare_square(*scene.model, scene.sweep.t_begin, assembly_options(scene), q, &solved, &as) !=
+          phiq::SolveStatus::kSuccess)
+        why += "; rank analysis: " + as.message;
+    }
+    return fail(scene_path + ": " + why + (out_path.empty() ? "" : "; no output written"), 1);
+  }
   const double solve_s = summary.solve_seconds - write_s;
   const auto final_write = Clock::now();
   try {
@@ -156,6 +194,9 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   write_s += since(final_write);
   if (!summary_path.empty() && !write_summary(summary_path, scene, ws, summary, load_s, solve_s, write_s)) return 3;
   if (!quiet) {
+    if (!redundancy.rank.redundant.empty())
+      std::cerr << "phiq: " << scene_path << ": redundant equations left out of the solve (consistent): "
+                << joined(redundancy.rank.redundant) << "\n";
     for (const auto& w : summary.warnings)
       std::cerr << "phiq: " << scene_path << ": warning: t = " << w.t << ": " << w.kind << ": " << w.message << "\n";
     std::cerr << "phiq: " << scene_path << ": " << summary.BriefReport();
@@ -268,16 +309,15 @@ int cmd_check(const std::string& scene_path, bool json) {
   int drivers = 0;
   for (const auto& c : model.constraints()) drivers += c.depends_on_time ? c.rows : 0;
 
-  phiq::Workspace ws(model);
-  phiq::PositionSummary ps;
+  // Minimum-norm assembly from the rough placement, with the rank analysis at the assembled position (or where it
+  // stopped): works for square, redundant and under-driven models alike.
+  Eigen::VectorXd q = model.initial_positions();
+  phiq::AssemblySummary as;
   const double t0 = scene.sweep.t_begin;
-  const bool defined = t0 >= model.time_domain_begin() && t0 <= model.time_domain_end();
-  if (defined) phiq::solve_position(model, t0, scene.sweep.assembly, ws, &ps);
-  else {
-    ps.status = phiq::SolveStatus::kOutsideTimeDomain;
-    ps.message = "driver '" + model.time_domain_limiter() + "' is not defined at t = " + std::to_string(t0);
-  }
-  const bool ok = ps.status == phiq::SolveStatus::kSuccess;
+  phiq::assemble(model, t0, assembly_options(scene), q, &as);
+  const bool ok = as.status == phiq::SolveStatus::kSuccess;
+  const bool analysed = as.rank.coordinates == model.num_coordinates() && as.status != phiq::SolveStatus::kOutsideTimeDomain;
+  const phiq::RankReport& rk = as.rank;
 
   if (json) {
     // `phiq check --json`, format version 1 (tools/README.md): one object on standard output.
@@ -296,17 +336,34 @@ int cmd_check(const std::string& scene_path, bool json) {
     j["linear_solver"] = phiq::to_string(model.linear_solver());
     nlohmann::ordered_json a;
     a["time"] = t0;
-    a["status"] = phiq::to_string(ps.status);
-    a["iterations"] = ps.iterations;
-    a["residual"] = ps.residual;
+    a["status"] = phiq::to_string(as.status);
+    a["iterations"] = as.iterations;
+    a["residual"] = as.residual;
     a["tolerance"] = scene.sweep.assembly.tolerance;
-    a["message"] = ps.message;
+    a["message"] = as.message;
     a["worst"] = nlohmann::ordered_json::array();
-    for (const auto& [row, value] : ps.worst_rows)
+    for (const auto& [row, value] : as.worst_rows)
       a["worst"].push_back({{"constraint", model.constraints()[model.constraint_of_row(row)].name},
                             {"row", row},
                             {"residual", value}});
     j["assembly"] = a;
+    // The redundancy analysis at the assembled position (or where the assembly stopped); null when not run.
+    auto or_null = [&](auto v) { return analysed ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+    j["rank"] = or_null(rk.rank);
+    j["dof"] = or_null(rk.dof);
+    j["driven_dof"] = or_null(rk.driven_dof);
+    j["grubler"] = rk.grubler ? nlohmann::ordered_json(*rk.grubler) : nlohmann::ordered_json();
+    j["redundant"] = rk.redundant;
+    j["redundant_rows"] = nlohmann::ordered_json::array();
+    for (phiq::Index r : rk.redundant_rows)
+      j["redundant_rows"].push_back({{"constraint", model.constraints()[model.constraint_of_row(r)].name},
+                                     {"row", r},
+                                     {"name", model.row_name(r)}});
+    j["consistent"] = as.consistent;
+    j["conflicts"] = as.conflicts;
+    j["rank_tolerance"] = rk.tolerance;
+    j["rank_uncertain"] = rk.uncertain;
+    j["rank_message"] = rk.message;
     std::cout << j.dump(2) << "\n";
     return ok ? 0 : 1;
   }
@@ -320,15 +377,57 @@ int cmd_check(const std::string& scene_path, bool json) {
             << model.jacobian_pattern().nnz() << " non-zeros\n"
             << "length scale  " << model.length_scale() << " m\n"
             << "linear solver " << phiq::to_string(model.linear_solver()) << "\n";
-  if (!defined) {
-    std::cout << "assembly      not attempted: " << ps.message << "\n";
+  if (!analysed) {
+    std::cout << "assembly      not attempted: " << as.message << "\n";
     return 1;
   }
-  std::cout << "assembly      " << phiq::to_string(ps.status) << " at t = " << t0 << " in " << ps.iterations
-            << " iterations, scaled residual " << sci(ps.residual) << " (tolerance "
-            << sci(scene.sweep.assembly.tolerance) << ")\n";
-  if (!ok) std::cout << "diagnosis     " << ps.message << "\n";
+  std::cout << "assembly      " << phiq::to_string(as.status) << " at t = " << t0 << " in " << as.iterations
+            << " iterations, scaled residual " << sci(as.residual) << " (tolerance "
+            << sci(scene.sweep.assembly.tolerance) << ")\n"
+            << "rank          " << rk.rank << " of " << rk.kinematic_equations << " kinematic equations ("
+            << rk.driven_rank << " of " << rk.equations << " with the drivers)\n"
+            << "dof           " << rk.dof << " (" << rk.driven_dof << " not driven)\n"
+            << "grubler       " << (rk.grubler ? std::to_string(*rk.grubler) : std::string("not defined")) << "\n"
+            << "redundant     " << (rk.redundant.empty() ? "none" : joined(rk.redundant)) << "\n"
+            << "consistent    " << (as.consistent ? "yes" : "no: conflicting " + joined(as.conflicts)) << "\n";
+  if (rk.uncertain) std::cout << "uncertain     " << rk.message << "\n";
+  if (!ok) std::cout << "diagnosis     " << as.message << "\n";
   return ok ? 0 : 1;
+}
+
+// `phiq assemble SCENE [-o OUT.csv]`: the assembled position at time.start as a one-row CSV (the columns of
+// `phiq run`'s positions). Nothing is written when the assembly fails.
+int cmd_assemble(const std::string& scene_path, const std::string& out_path, bool quiet) {
+  phiq::Scene scene;
+  try {
+    scene = phiq::load_scene(scene_path);
+  } catch (const phiq::SceneError& e) {
+    return fail(e.what(), 2);
+  }
+  const phiq::Model& model = *scene.model;
+  Eigen::VectorXd q = model.initial_positions();
+  phiq::AssemblySummary as;
+  const double t0 = scene.sweep.t_begin;
+  if (phiq::assemble(model, t0, assembly_options(scene), q, &as) != phiq::SolveStatus::kSuccess)
+    return fail(scene_path + ": t = " + std::to_string(t0) + ": " + as.message + "; no output written", 1);
+  std::vector<phiq::Index> all(static_cast<std::size_t>(model.num_coordinates()));
+  for (std::size_t j = 0; j < all.size(); ++j) all[j] = static_cast<phiq::Index>(j);
+  phiq::CsvFormat csv(model, all, false, false);
+  std::string text = csv.header();
+  csv.append_row(phiq::StepView{0, t0, q, nullptr, nullptr}, text);
+  try {
+    if (out_path.empty()) {
+      std::cout << text << std::flush;
+    } else {
+      phiq::AtomicOutputFile f(out_path);
+      f.write(text);
+      f.commit();
+    }
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  if (!quiet) std::cerr << "phiq: " << scene_path << ": " << as.BriefReport() << ", moved " << sci(as.moved) << "\n";
+  return 0;
 }
 
 int cmd_compare(const std::string& a_path, const std::string& b_path, const phiq::CompareOptions& options) {
@@ -395,7 +494,14 @@ int main(int argc, char** argv) {
   batch->add_option("--threads", batch_threads, "Threads for the cases (0: all cores)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  CLI::App* check = app.add_subcommand("check", "Count coordinates and equations and try the initial assembly");
+  std::string asm_path, asm_out;
+  bool asm_quiet = false;
+  CLI::App* assemble_cmd =
+      app.add_subcommand("assemble", "Assemble the rough placement (minimum-norm) and write the coordinates as CSV");
+  assemble_cmd->add_option("scene", asm_path, "Scene file (YAML)")->required();
+  assemble_cmd->add_option("-o,--output", asm_out, "CSV file to write (default: standard output)");
+  assemble_cmd->add_flag("-q,--quiet", asm_quiet, "Do not print the summary on standard error");
+  CLI::App* check = app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
   check->add_option("scene", check_path, "Scene file (YAML)")->required();
   check->add_flag("--json", check_json, "Print one JSON object (format: tools/README.md)");
 
@@ -447,6 +553,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*check) return cmd_check(check_path, check_json);
+    if (*assemble_cmd) return cmd_assemble(asm_path, asm_out, asm_quiet);
     if (*batch) return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, batch_threads);
     if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
   } catch (const std::exception& e) {

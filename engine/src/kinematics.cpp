@@ -21,6 +21,7 @@ const char* to_string(SolveStatus s) {
     case SolveStatus::kNotSquare: return "not square";
     case SolveStatus::kOutsideTimeDomain: return "outside time domain";
     case SolveStatus::kCancelled: return "cancelled";
+    case SolveStatus::kInconsistent: return "inconsistent redundant constraints";
   }
   return "?";
 }
@@ -36,6 +37,10 @@ Workspace::Workspace(const Model& model) : model_(&model) {
   trial.resize(n);
   trial_phi.resize(m);
   jacobian_values.assign(static_cast<std::size_t>(model.jacobian_pattern().nnz()), 0.0);
+  if (!model.dropped_rows().empty()) {
+    solve_values.assign(model.solve_entries().size(), 0.0);
+    solve_rhs.resize(static_cast<Index>(model.solve_rows().size()));
+  }
   if (model.symbolic()) lu = model.symbolic()->make_numeric();
 }
 
@@ -123,11 +128,19 @@ void check_workspace(const Model& model, const Workspace& ws) {
     throw Error("workspace state has the wrong size (q, qd, qdd must have " + std::to_string(n) + " entries)");
 }
 
+std::string not_square_message(const Model& model) {
+  const std::size_t kept = model.solve_rows().size();
+  std::string s = "the model has " + std::to_string(kept) + " equations for " +
+                  std::to_string(model.num_coordinates()) + " coordinates";
+  if (!model.dropped_rows().empty())
+    s += " (after leaving out " + std::to_string(model.dropped_rows().size()) + " redundant rows)";
+  return s + "; the driven system must be square (assemble() and analyse_rank() handle other models)";
+}
+
 // Factorises Φq at (ws.q, t) unless the current factorisation was made exactly there.
 SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond, std::string* message) {
   if (!ws.lu) {
-    *message = "the model has " + std::to_string(model.num_equations()) + " equations for " +
-               std::to_string(model.num_coordinates()) + " coordinates";
+    *message = not_square_message(model);
     return SolveStatus::kNotSquare;
   }
   if (ws.has_factorization && ws.factorized_t == t && ws.factorized_q == ws.q) {
@@ -137,7 +150,13 @@ SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, doubl
   ws.has_factorization = false;
   model.jacobian(ws.q.data(), t, ws.jacobian_values.data());
   ++ws.counters.jacobian_evaluations;
-  FactorStatus fs = ws.lu->factorize(ws.jacobian_values.data());
+  const double* values = ws.jacobian_values.data();
+  if (!model.dropped_rows().empty()) {  // the kept rows only (Model::without_rows())
+    const std::vector<Index>& from = model.solve_entries();
+    for (std::size_t k = 0; k < from.size(); ++k) ws.solve_values[k] = ws.jacobian_values[static_cast<std::size_t>(from[k])];
+    values = ws.solve_values.data();
+  }
+  FactorStatus fs = ws.lu->factorize(values);
   ++ws.counters.factorizations;
   *rcond = ws.lu->rcond();
   if (fs == FactorStatus::kFailed) {
@@ -152,6 +171,14 @@ SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, doubl
   ws.factorized_t = t;
   ws.has_factorization = true;
   return SolveStatus::kSuccess;
+}
+
+// The right-hand side the LU solves with: ws.rhs itself, or its kept rows for a model with dropped rows.
+const double* solve_rhs(const Model& model, Workspace& ws) {
+  if (model.dropped_rows().empty()) return ws.rhs.data();
+  const std::vector<Index>& rows = model.solve_rows();
+  for (std::size_t i = 0; i < rows.size(); ++i) ws.solve_rhs(static_cast<Index>(i)) = ws.rhs(rows[i]);
+  return ws.solve_rhs.data();
 }
 
 std::string fmt(double v) {
@@ -211,9 +238,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
 
   if (!ws.lu) {
     model.residual(ws.q.data(), t, ws.phi.data());
-    return finish(SolveStatus::kNotSquare, "the model has " + std::to_string(model.num_equations()) +
-                                               " equations for " + std::to_string(model.num_coordinates()) +
-                                               " coordinates; the driven system must be square");
+    return finish(SolveStatus::kNotSquare, not_square_message(model));
   }
   if (!all_finite(ws.q)) {
     ws.phi.setConstant(std::numeric_limits<double>::quiet_NaN());
@@ -265,7 +290,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       sum.rcond = ws.lu->rcond();
     }
     ws.rhs = -ws.phi;
-    if (!ws.lu->solve(ws.rhs.data(), ws.step.data()))
+    if (!ws.lu->solve(solve_rhs(model, ws), ws.step.data()))
       return finish(SolveStatus::kLinearSolverFailed, "sparse solve failed: " + ws.lu->last_message());
     if (!all_finite(ws.step)) {
       if (reuse) {  // an old factorisation may be singular where the current iterate is not
@@ -346,7 +371,7 @@ SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSu
   model.phi_t(ws.q.data(), t, ws.rhs.data());
   ++ws.counters.phi_t_evaluations;
   ws.rhs = -ws.rhs;
-  if (!ws.lu->solve(ws.rhs.data(), ws.qd.data()))
+  if (!ws.lu->solve(solve_rhs(model, ws), ws.qd.data()))
     return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
   ++ws.counters.velocity_solves;
   if (!all_finite(ws.qd))
@@ -365,7 +390,7 @@ SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, Line
   if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
   model.gamma(ws.q.data(), ws.qd.data(), t, ws.rhs.data());
   ++ws.counters.gamma_evaluations;
-  if (!ws.lu->solve(ws.rhs.data(), ws.qdd.data()))
+  if (!ws.lu->solve(solve_rhs(model, ws), ws.qdd.data()))
     return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
   ++ws.counters.acceleration_solves;
   if (!all_finite(ws.qdd))

@@ -98,6 +98,59 @@ void Model::gamma(const double* q, const double* qd, double t, double* out) cons
   for_each_range(blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) { b.gamma(i0, i1, q, qd, t, out); });
 }
 
+Model Model::without_rows(std::vector<Index> rows) const {
+  const Index m = num_equations(), n = num_coordinates();
+  std::sort(rows.begin(), rows.end());
+  if (std::adjacent_find(rows.begin(), rows.end()) != rows.end())
+    throw Error("without_rows: row " + std::to_string(*std::adjacent_find(rows.begin(), rows.end())) + " repeated");
+  if (!rows.empty() && (rows.front() < 0 || rows.back() >= m))
+    throw Error("without_rows: row out of range (the model has " + std::to_string(m) + " rows)");
+  Model out(*this);
+  out.dropped_rows_ = rows;
+  out.solve_entries_.clear();
+  out.solve_rows_.clear();
+  if (rows.empty()) {  // nothing left out: the full system, with its own analysis
+    out.solve_pattern_ = pattern_;
+    out.solve_rows_.resize(static_cast<std::size_t>(m));
+    for (Index i = 0; i < m; ++i) out.solve_rows_[static_cast<std::size_t>(i)] = i;
+    if (solve_pattern_ != pattern_) {
+      out.symbolic_.reset();
+      if (m == n && n > 0) out.symbolic_ = analyse(lu_kind_, pattern_);
+    }
+    return out;
+  }
+  {
+    // new row numbers: kept rows in order, dropped rows -1
+    std::vector<Index> renumber(static_cast<std::size_t>(m), -1);
+    std::size_t d = 0;
+    for (Index i = 0; i < m; ++i) {
+      if (d < rows.size() && rows[d] == i) {
+        ++d;
+        continue;
+      }
+      renumber[static_cast<std::size_t>(i)] = static_cast<Index>(out.solve_rows_.size());
+      out.solve_rows_.push_back(i);
+    }
+    auto p = std::make_shared<CscPattern>();
+    p->rows = static_cast<Index>(out.solve_rows_.size());
+    p->cols = n;
+    p->col_ptr.assign(static_cast<std::size_t>(n) + 1, 0);
+    for (Index j = 0; j < n; ++j) {
+      for (Index k = pattern_->col_ptr[j]; k < pattern_->col_ptr[j + 1]; ++k) {
+        const Index r = renumber[static_cast<std::size_t>(pattern_->row_idx[k])];
+        if (r < 0) continue;
+        p->row_idx.push_back(r);
+        out.solve_entries_.push_back(k);
+      }
+      p->col_ptr[static_cast<std::size_t>(j) + 1] = p->nnz();
+    }
+    out.solve_pattern_ = p;
+  }
+  out.symbolic_.reset();
+  if (out.solve_pattern_->rows == n && n > 0) out.symbolic_ = analyse(lu_kind_, out.solve_pattern_);
+  return out;
+}
+
 // ---- ModelBuilder --------------------------------------------------------------------------------------------
 
 ModelBuilder::ModelBuilder() = default;
@@ -283,6 +336,9 @@ Model ModelBuilder::build() && {
   for (auto& b : m.blocks_) b->build_pattern(trip_rows, trip_cols);
   auto pattern = std::make_shared<CscPattern>(build_csc_pattern(rows, n, trip_rows, trip_cols, &m.slot_of_entry_));
   m.pattern_ = pattern;
+  m.solve_pattern_ = pattern;
+  m.solve_rows_.resize(static_cast<std::size_t>(rows));
+  for (Index i = 0; i < rows; ++i) m.solve_rows_[static_cast<std::size_t>(i)] = i;
 
   // Units and scales.
   m.coordinate_units_.assign(static_cast<std::size_t>(n), Unit::kNone);
@@ -346,10 +402,10 @@ Model ModelBuilder::build() && {
     if (other && other->symbolic_ && other->lu_kind_ == m.lu_kind_ && other->pattern_->rows == pattern->rows &&
         other->pattern_->cols == pattern->cols && other->pattern_->col_ptr == pattern->col_ptr &&
         other->pattern_->row_idx == pattern->row_idx) {
-      m.pattern_ = other->pattern_;
+      m.pattern_ = m.solve_pattern_ = other->pattern_;
       m.symbolic_ = other->symbolic_;
     } else {
-      m.symbolic_ = analyse(m.lu_kind_, pattern);
+      m.symbolic_ = analyse(m.lu_kind_, m.solve_pattern_);
     }
   }
   return std::move(m);

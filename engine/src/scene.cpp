@@ -906,12 +906,8 @@ class SceneReader {
     } catch (const Error& e) {
       top.fail(e.what());
     }
-    if (!(overrides_ && overrides_->allow_non_square) &&
-        scene.model->num_equations() != scene.model->num_coordinates()) {
-      top.fail("the model has " + std::to_string(scene.model->num_coordinates()) + " coordinates but " +
-               std::to_string(scene.model->num_equations()) +
-               " constraint equations (kinematic + drivers); the driven system must be square");
-    }
+    // Models that are not square (redundant constraints, missing drivers) load: the rank analysis and the
+    // minimum-norm assembly (assembly.hpp) tell what they are, and `phiq run` solves the redundant ones.
     return scene;
   }
 

@@ -24,6 +24,7 @@ enum class SolveStatus {
   kNotSquare,           ///< equations ≠ coordinates: not solvable by the square driven-system path
   kOutsideTimeDomain,   ///< a driver's law is not defined at the requested time
   kCancelled,           ///< the caller's step callback asked to stop
+  kInconsistent,        ///< redundant constraints that cannot hold together (assembly.hpp names them)
 };
 /// Lower-case words, e.g. "singular Jacobian".
 const char* to_string(SolveStatus s);

@@ -176,7 +176,6 @@ class Model {
  public:
   Model(Model&&) noexcept = default;             ///< only before any Workspace refers to it
   Model& operator=(Model&&) noexcept = default;  ///< only before any Workspace refers to it
-  Model(const Model&) = delete;
   Model& operator=(const Model&) = delete;
 
   /// n, the size of q.
@@ -219,8 +218,31 @@ class Model {
   const CscPattern& jacobian_pattern() const { return *pattern_; }
   /// The sparse LU the model was analysed for.
   LinearSolverKind linear_solver() const { return lu_kind_; }
-  /// Symbolic analysis of Φq's pattern; nullptr when the model is not square (equations ≠ coordinates).
+  /// Symbolic analysis of the square system the solvers factorise (solve_pattern()); nullptr when it is not square
+  /// (solve rows ≠ coordinates).
   const SparseLuSymbolic* symbolic() const { return symbolic_.get(); }
+
+  // Redundant rows left out of the square solves. A model whose equations are redundant (more rows than their
+  // rank) is solved on a maximal independent set of rows (rank_analysis.hpp): without_rows() makes that model.
+  // Φ, Φq, Φt and γ are still evaluated for every row (the convergence test checks the rows left out too:
+  // consistent redundant rows hold wherever the kept rows do); the LU factorises and solves with the kept rows only.
+
+  /// A model equal to this one that leaves `rows` out of its square solves: same coordinates, constraints,
+  /// evaluation and tolerances (the constraint data is shared, read-only), its own pattern of the kept rows and
+  /// symbolic analysis (when they are square). Rows are ascending or not, without repeats, 0 ≤ row < m; an empty
+  /// list gives back the full model. Throws phiq::Error for rows out of range or repeated. Thread-safe.
+  Model without_rows(std::vector<Index> rows) const;
+  /// Rows left out of the square solves, ascending (empty for a model built by ModelBuilder).
+  const std::vector<Index>& dropped_rows() const { return dropped_rows_; }
+  /// Rows the square solves use, ascending: all rows when none is dropped.
+  const std::vector<Index>& solve_rows() const { return solve_rows_; }
+  /// The pattern of Φq restricted to solve_rows() (rows renumbered 0 …); the same object as jacobian_pattern()
+  /// when no row is dropped.
+  const CscPattern& solve_pattern() const { return *solve_pattern_; }
+  /// For each entry k of solve_pattern(), its position in jacobian_pattern()'s value array (empty when no row is
+  /// dropped: the arrays are the same).
+  const std::vector<Index>& solve_entries() const { return solve_entries_; }
+
 
   /// Earliest / latest time at which every driver is defined (tabulated laws have a finite range).
   double time_domain_begin() const { return time_begin_; }
@@ -240,6 +262,7 @@ class Model {
  private:
   friend class ModelBuilder;
   Model() = default;
+  Model(const Model&) = default;  // without_rows() only: the constraint blocks are shared, not copied
   /// The name of coordinate k, as index_of_ reads it.
   auto coordinate_name_of() const {
     return [this](Index k) -> const std::string& { return names_[static_cast<std::size_t>(k)]; };
@@ -253,7 +276,7 @@ class Model {
   detail::NameIndex index_of_;  ///< coordinate names → indices (names in names_)
   Eigen::VectorXd initial_;
   std::vector<Unit> coordinate_units_;
-  std::vector<std::unique_ptr<ConstraintBlock>> blocks_;
+  std::vector<std::shared_ptr<ConstraintBlock>> blocks_;  ///< read-only once built (shared by without_rows())
   std::vector<const ConstraintBlock*> time_blocks_;
   std::vector<ConstraintInfo> constraints_;
   std::vector<Index> row_constraint_;
@@ -268,6 +291,9 @@ class Model {
   // 10^5 four-bars (bench/README.md).
   LinearSolverKind lu_kind_ = LinearSolverKind::kKlu;
   std::shared_ptr<const SparseLuSymbolic> symbolic_;
+  std::vector<Index> dropped_rows_, solve_rows_;
+  std::shared_ptr<const CscPattern> solve_pattern_ = pattern_;
+  std::vector<Index> solve_entries_;
   std::optional<Index> grubler_;
   std::vector<std::string> body_names_;
 };
@@ -381,7 +407,7 @@ template <class Spec>
 TypedBlock<Spec>& ModelBuilder::block_for() {
   // try_emplace: no node is allocated when the block exists (one lookup per added constraint)
   auto [it, inserted] = block_of_type_.try_emplace(std::type_index(typeid(Spec)), model_.blocks_.size());
-  if (inserted) model_.blocks_.push_back(std::make_unique<TypedBlock<Spec>>());
+  if (inserted) model_.blocks_.push_back(std::make_shared<TypedBlock<Spec>>());
   return static_cast<TypedBlock<Spec>&>(*model_.blocks_[it->second]);
 }
 

@@ -2,6 +2,7 @@
 /// phiq: sparse, large-scale multibody kinematics. One include for the whole public API.
 #pragma once
 
+#include "phiq/assembly.hpp"
 #include "phiq/batch.hpp"
 #include "phiq/constraint_kinds.hpp"
 #include "phiq/constraint_kinds_3d.hpp"
@@ -10,7 +11,9 @@
 #include "phiq/kinematics.hpp"
 #include "phiq/linear_solver.hpp"
 #include "phiq/model.hpp"
+#include "phiq/min_norm_solver.hpp"
 #include "phiq/motion_law.hpp"
+#include "phiq/rank_analysis.hpp"
 #include "phiq/scene.hpp"
 #include "phiq/sweep.hpp"
 #include "phiq/version.hpp"

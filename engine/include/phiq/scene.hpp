@@ -49,10 +49,6 @@ struct SceneOverrides {
   /// If set, the model shares this model's pattern and symbolic analysis when its structure is the same
   /// (ModelBuilder::share_analysis_with()); it must outlive the call.
   const Model* share_analysis_with = nullptr;
-  /// Load models whose equations (kinematic + drivers) are more or fewer than their coordinates — redundant or
-  /// under-determined — instead of refusing them: for the rank analysis and assembly. The sweep still needs a
-  /// square model (SolveStatus::kNotSquare).
-  bool allow_non_square = false;
 };
 
 /// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,

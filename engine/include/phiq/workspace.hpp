@@ -48,6 +48,10 @@ class Workspace {
   Eigen::VectorXd trial;                 ///< line-search trial point
   Eigen::VectorXd trial_phi;             ///< Φ at the trial point
   std::vector<double> jacobian_values;   ///< Φq values in jacobian_pattern() order
+  /// Models with dropped rows (Model::without_rows()): the values of the kept rows in solve_pattern() order, and
+  /// the right-hand side of the kept rows; empty otherwise.
+  std::vector<double> solve_values;
+  Eigen::VectorXd solve_rhs;             ///< see solve_values
   std::unique_ptr<SparseLuNumeric> lu;   ///< numeric factors; null for non-square models
   /// The point (q, t) of the current factorisation, so that velocity and acceleration reuse it exactly when it is
   /// still valid and refactorise otherwise.

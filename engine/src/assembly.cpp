@@ -1,0 +1,251 @@
+#include "phiq/assembly.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "phiq/min_norm_solver.hpp"
+
+namespace phiq {
+
+std::string AssemblySummary::BriefReport() const {
+  std::ostringstream s;
+  s.precision(3);
+  s << "assembly: " << to_string(status) << ", " << iterations << " iterations, scaled residual " << std::scientific
+    << residual << std::defaultfloat << "; " << rank.BriefReport();
+  if (!conflicts.empty()) {
+    s << "; conflicting:";
+    for (std::size_t k = 0; k < conflicts.size(); ++k) s << (k ? ", " : " ") << conflicts[k];
+  }
+  if (!message.empty()) s << " (" << message << ")";
+  return s.str();
+}
+
+namespace {
+
+// Scaled residual |Φ_i| / scale_i of every row, NaN as +inf.
+Eigen::VectorXd scaled_rows(const Model& model, const Eigen::VectorXd& phi) {
+  Eigen::VectorXd r = phi.cwiseAbs().cwiseQuotient(model.tolerance_scales().row_scale);
+  for (Index i = 0; i < r.size(); ++i)
+    if (std::isnan(r(i))) r(i) = std::numeric_limits<double>::infinity();
+  return r;
+}
+
+// The tolerance of every row at q: tol plus the rounding floor of the coordinates' magnitude (as Newton's test).
+double row_floor(const Model& model, const Eigen::VectorXd& q) {
+  if (q.size() == 0) return 0.0;
+  const double big = (q.cwiseAbs().cwiseQuotient(model.tolerance_scales().coordinate_scale)).maxCoeff();
+  return 64.0 * std::numeric_limits<double>::epsilon() * big;
+}
+
+std::string describe(const Model& model, const std::vector<std::pair<Index, double>>& rows) {
+  std::ostringstream s;
+  s.precision(3);
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    s << (k ? ", " : "") << "'" << model.row_name(rows[k].first) << "' " << std::scientific << rows[k].second;
+  return s.str();
+}
+
+std::vector<std::pair<Index, double>> worst(const Eigen::VectorXd& scaled, const std::vector<Index>* among, int k) {
+  std::vector<std::pair<Index, double>> rows;
+  if (among) {
+    for (Index r : *among) rows.emplace_back(r, scaled(r));
+  } else {
+    for (Index r = 0; r < scaled.size(); ++r) rows.emplace_back(r, scaled(r));
+  }
+  const std::size_t kk = std::min<std::size_t>(static_cast<std::size_t>(k), rows.size());
+  std::partial_sort(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(kk), rows.end(),
+                    [](const auto& a, const auto& b) { return a.second > b.second; });
+  rows.resize(kk);
+  return rows;
+}
+
+// Minimum-norm Gauss-Newton on the rows `kept` from q, in two phases.
+//  1. Correction (while the kept rows are not within tolerance): Δ = −D Ãᵀ (Ã Ãᵀ + μI)⁻¹ Φ̃ with μ = ‖Φ̃‖
+//     (Levenberg-Marquardt, Fan & Yuan), backtracking on ½‖Φ̃‖². Stops when the merit cannot decrease: a
+//     least-squares minimum that is not a solution (kNotConverged).
+//  2. Projection (once they are): the step of the linearised problem min ‖D⁻¹(q + Δ − q₀)‖ s.t. Φ + Φq Δ = 0,
+//     Δ = D (p − Ãᵀ (Ã Ãᵀ)⁻¹ (Φ̃ + Ã p)) with p = D⁻¹(q₀ − q): a correction plus the pull back towards the
+//     placement along the mechanism's free motion. Its fixed point is the assembled position nearest to q₀
+//     (q₀ − q ∈ range(D² Φqᵀ)), and converging it drives Φ to rounding level, so that redundant rows are checked
+//     against kept rows that hold far below the tolerance. It converges linearly (at a rate set by the curvature
+//     of the constraints times the distance moved); steps are taken in full, the correction phase resumes if one
+//     leaves the tolerance.
+SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt, const std::vector<Index>& kept,
+                       const Eigen::VectorXd& q0, Eigen::VectorXd& q, AssemblySummary& sum, std::string* why) {
+  const Index n = model.num_coordinates(), k = static_cast<Index>(kept.size());
+  if (k == 0) return SolveStatus::kSuccess;  // nothing to satisfy (a model without equations)
+  const ToleranceScales& sc = model.tolerance_scales();
+  Eigen::VectorXd phi(model.num_equations()), b(k), bt(k), rhs(k), d(n), trial(n), pull(n);
+  auto kept_scaled = [&](const Eigen::VectorXd& full, Eigen::VectorXd& out) {
+    for (Index i = 0; i < k; ++i) out(i) = full(kept[i]) / sc.row_scale(kept[i]);
+  };
+  auto pattern = std::make_shared<CscPattern>();
+  std::vector<double> values;
+  std::unique_ptr<MinNormSolver> solver;
+
+  model.residual(q.data(), t, phi.data());
+  kept_scaled(phi, b);
+  double f = 0.5 * b.squaredNorm();
+  while (sum.iterations < opt.max_iterations) {
+    if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
+    const bool within = b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q);
+    scaled_jacobian_rows(model, q, t, kept, pattern.get(), &values);
+    if (!solver) solver = std::make_unique<MinNormSolver>(pattern);  // pattern fixed for this set of rows
+    const double mu = within ? 0.0 : b.norm();
+    FactorStatus fs = solver->factorize(values.data(), mu);
+    if (fs == FactorStatus::kSingular && within) fs = solver->factorize(values.data(), 1e-14);  // rank lost at q
+    ++sum.factorizations;
+    if (fs != FactorStatus::kOk)
+      return *why = solver->last_message(), fs == FactorStatus::kFailed ? SolveStatus::kLinearSolverFailed
+                                                                        : SolveStatus::kSingularJacobian;
+    ++sum.iterations;
+    if (within) {
+      pull = (q0 - q).cwiseQuotient(sc.coordinate_scale);
+      rhs = b;
+      for (Index j = 0; j < n; ++j)
+        for (Index e = pattern->col_ptr[j]; e < pattern->col_ptr[j + 1]; ++e)
+          rhs(pattern->row_idx[e]) += values[static_cast<std::size_t>(e)] * pull(j);
+      if (!solver->min_norm(rhs.data(), d.data())) return *why = solver->last_message(), SolveStatus::kLinearSolverFailed;
+      d = (pull - d).cwiseProduct(sc.coordinate_scale);
+      if (!d.allFinite()) return *why = "projection step is not finite", SolveStatus::kNonFinite;
+      q += d;
+      model.residual(q.data(), t, phi.data());
+      kept_scaled(phi, b);
+      f = 0.5 * b.squaredNorm();
+      if (scaled_step(model, d, q, opt.tolerance) <= 1.0 && b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q))
+        return SolveStatus::kSuccess;
+      continue;
+    }
+
+    if (!solver->min_norm(b.data(), d.data())) return *why = solver->last_message(), SolveStatus::kLinearSolverFailed;
+    d = -d.cwiseProduct(sc.coordinate_scale);
+    if (!d.allFinite()) return *why = "Gauss-Newton step is not finite", SolveStatus::kNonFinite;
+    double alpha = 1.0, ft = 0.0;
+    bool decreased = false;
+    for (int bt_count = 0;; ++bt_count) {
+      trial = q + alpha * d;
+      model.residual(trial.data(), t, phi.data());
+      kept_scaled(phi, bt);
+      ft = 0.5 * bt.squaredNorm();
+      decreased = ft <= (1.0 - 1e-4 * alpha) * f;
+      if (decreased || bt_count >= opt.max_backtracks) break;
+      alpha *= 0.5;
+    }
+    // Steps below the tolerance while the residual is not, or no decrease at all: a least-squares minimum of the
+    // kept rows that is not a solution.
+    if (!decreased || scaled_step(model, alpha * d, trial, opt.tolerance) <= 1.0) {
+      if (decreased) q.swap(trial), b.swap(bt), f = ft;
+      *why = "no assembly near this placement: the residual stopped decreasing";
+      return SolveStatus::kNotConverged;
+    }
+    q.swap(trial), b.swap(bt), f = ft;
+  }
+  // The projection phase converges linearly: if its budget ran out with the rows within tolerance, the position is
+  // assembled, only not the nearest one to the last digit.
+  if (b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q)) return SolveStatus::kSuccess;
+  *why = "did not converge in " + std::to_string(opt.max_iterations) + " iterations";
+  return SolveStatus::kNotConverged;
+}
+
+}  // namespace
+
+SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, Eigen::VectorXd& q,
+                     AssemblySummary* summary) {
+  const Index n = model.num_coordinates(), m = model.num_equations();
+  if (q.size() != n) throw Error("assemble: q must have " + std::to_string(n) + " entries");
+  if (!(opt.tolerance > 0.0) || opt.max_iterations < 0 || opt.max_backtracks < 0 || opt.max_rank_updates < 0)
+    throw Error("AssemblyOptions: tolerance must be > 0 and the limits ≥ 0");
+  AssemblySummary local;
+  AssemblySummary& sum = summary ? *summary : local;
+  sum = AssemblySummary{};
+  const Eigen::VectorXd q0 = q;
+  Eigen::VectorXd phi(m);
+
+  auto finish = [&](SolveStatus st, std::string msg) {
+    sum.status = st;
+    model.residual(q.data(), t, phi.data());
+    const Eigen::VectorXd scaled = scaled_rows(model, phi);
+    sum.residual = m ? scaled.maxCoeff() : 0.0;
+    sum.moved = n ? ((q - q0).cwiseAbs().cwiseQuotient(model.tolerance_scales().coordinate_scale)).maxCoeff() : 0.0;
+    if (st != SolveStatus::kSuccess) {
+      sum.worst_rows = worst(scaled, nullptr, 3);
+      if (msg.empty()) msg = to_string(st);
+      if (!sum.worst_rows.empty() && st != SolveStatus::kInconsistent)
+        msg += "; worst constraints: " + describe(model, sum.worst_rows);
+    }
+    sum.message = std::move(msg);
+    return st;
+  };
+
+  if (t < model.time_domain_begin() || t > model.time_domain_end())
+    return finish(SolveStatus::kOutsideTimeDomain,
+                  "driver '" + model.time_domain_limiter() + "' is not defined at t = " + std::to_string(t));
+  if (!q.allFinite()) return finish(SolveStatus::kNonFinite, "starting point has non-finite coordinates");
+
+  sum.rank = analyse_rank(model, q, t, opt.rank);
+  std::string why;
+  for (;;) {
+    const std::vector<Index> kept = sum.rank.independent_rows;
+    const SolveStatus st = solve_kept(model, t, opt, kept, q0, q, sum, &why);
+    if (!q.allFinite()) return finish(SolveStatus::kNonFinite, "non-finite coordinates");
+    // Rank belongs to the configuration: choose the independent rows again where the solve ended.
+    sum.rank = analyse_rank(model, q, t, opt.rank);
+    model.residual(q.data(), t, phi.data());
+    const Eigen::VectorXd scaled = scaled_rows(model, phi);
+    const double tol = opt.tolerance + row_floor(model, q);
+    const bool all_within = m == 0 || scaled.maxCoeff() <= tol;
+    if (st == SolveStatus::kSuccess && all_within) return finish(SolveStatus::kSuccess, "");
+    if (st == SolveStatus::kNonFinite || st == SolveStatus::kLinearSolverFailed) return finish(st, why);
+    // The independent equations now hold (or stall) but others do not. If the rows found independent here differ
+    // from those just solved, solve again with them; otherwise the violated redundant rows conflict.
+    if (sum.rank.independent_rows != kept && sum.rank_updates < opt.max_rank_updates) {
+      ++sum.rank_updates;
+      continue;
+    }
+    const std::vector<Index>& ind = sum.rank.independent_rows;
+    bool kept_within = true;
+    for (Index r : ind) kept_within = kept_within && scaled(r) <= tol;
+    for (Index r : sum.rank.redundant_rows)
+      if (scaled(r) > tol) sum.violated_rows.push_back(r);
+    if (!kept_within || sum.violated_rows.empty()) return finish(SolveStatus::kNotConverged, why);
+
+    // Inconsistent: each violated redundant row is a combination of independent rows, which it contradicts.
+    sum.consistent = false;
+    std::vector<Index> involved = sum.violated_rows;
+    for (const RowCombination& c : combinations_of(model, q, t, ind, sum.violated_rows))
+      involved.insert(involved.end(), c.basis.begin(), c.basis.end());
+    std::vector<Index> cons;
+    for (Index r : involved) cons.push_back(model.constraint_of_row(r));
+    std::sort(cons.begin(), cons.end());
+    cons.erase(std::unique(cons.begin(), cons.end()), cons.end());
+    for (Index c : cons) sum.conflicts.push_back(model.constraints()[static_cast<std::size_t>(c)].name);
+    const auto w = worst(scaled, &sum.violated_rows, 3);
+    std::string msg = "inconsistent redundant constraints: " + describe(model, w) +
+                      " cannot hold where the independent equations do; conflicting constraints:";
+    for (std::size_t k = 0; k < sum.conflicts.size(); ++k) msg += (k ? ", " : " ") + sum.conflicts[k];
+    return finish(SolveStatus::kInconsistent, msg);
+  }
+}
+
+SolveStatus prepare_square(const Model& model, double t, const AssemblyOptions& options, Eigen::VectorXd& q,
+                           std::unique_ptr<Model>* solved, AssemblySummary* summary) {
+  if (!solved) throw Error("prepare_square: solved must not be null");
+  AssemblySummary local;
+  AssemblySummary& sum = summary ? *summary : local;
+  const SolveStatus st = assemble(model, t, options, q, &sum);
+  if (st != SolveStatus::kSuccess) return st;
+  if (sum.rank.driven_dof > 0) {
+    sum.status = SolveStatus::kNotSquare;
+    sum.message = std::to_string(sum.rank.driven_dof) + " degree(s) of freedom not driven: the mechanism has " +
+                  std::to_string(sum.rank.dof) + " and the drivers fix " +
+                  std::to_string(sum.rank.driven_rank - sum.rank.rank);
+    return sum.status;
+  }
+  *solved = std::make_unique<Model>(model.without_rows(sum.rank.redundant_rows));
+  return SolveStatus::kSuccess;
+}
+
+}  // namespace phiq

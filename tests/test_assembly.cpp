@@ -1,0 +1,184 @@
+// The minimum-norm assembly and the square solve through redundancy (engine/include/phiq/assembly.hpp): closed-form
+// positions, the nearest-point property, consistent against inconsistent redundancy, and sweeps that stay exact.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <Eigen/Dense>
+
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+
+TEST(Assembly, FifthBarAssemblesDropsItsRedundantRowAndSweepsExactly) {
+  Scene sc = load_scene(test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  const Model& full = *sc.model;
+  Eigen::VectorXd q = full.initial_positions();
+  std::unique_ptr<Model> solved;
+  AssemblySummary as;
+  ASSERT_EQ(prepare_square(full, 0.0, {}, q, &solved, &as), SolveStatus::kSuccess) << as.BriefReport();
+  EXPECT_TRUE(as.consistent);
+  EXPECT_TRUE(as.conflicts.empty());
+  EXPECT_EQ(as.rank.dof, 1);
+  EXPECT_EQ(as.rank.redundant, std::vector<std::string>{"A3"});
+  ASSERT_EQ(solved->dropped_rows().size(), 1u);
+  EXPECT_EQ(full.row_name(solved->dropped_rows()[0]), "A3[1]");
+  ASSERT_NE(solved->symbolic(), nullptr);  // 12 kept rows for 12 coordinates: square
+  const double th0 = M_PI / 3;
+  EXPECT_NEAR(q(full.coordinate_index("psi3")), th0, 1e-9);
+  EXPECT_NEAR(q(full.coordinate_index("xc")), std::cos(th0), 1e-9);
+  EXPECT_NEAR(q(full.coordinate_index("yc")), std::sin(th0), 1e-9);
+  EXPECT_NEAR(q(full.coordinate_index("psic")), 0.0, 1e-9);
+
+  // The sweep on the kept rows: every crank at th0 + t, the coupler translating on a unit circle; the left-out
+  // row holds at every step (consistent redundancy), and velocities and accelerations are exact.
+  Workspace ws(*solved);
+  ws.q = q;
+  SweepSummary sum;
+  Eigen::VectorXd phi(full.num_equations());
+  int rows = 0;
+  const SolveStatus st = run_sweep(*solved, sc.sweep, ws, [&](const StepView& s) {
+    const double th = th0 + s.t;
+    EXPECT_NEAR(s.q(full.coordinate_index("psi2")), th, 1e-9);
+    EXPECT_NEAR(s.q(full.coordinate_index("psi3")), th, 1e-9);
+    EXPECT_NEAR(s.q(full.coordinate_index("xc")), std::cos(th), 1e-9);
+    EXPECT_NEAR((*s.qd)(full.coordinate_index("psi3")), 1.0, 1e-8);
+    EXPECT_NEAR((*s.qd)(full.coordinate_index("xc")), -std::sin(th), 1e-8);
+    EXPECT_NEAR((*s.qd)(full.coordinate_index("yc")), std::cos(th), 1e-8);
+    EXPECT_NEAR((*s.qdd)(full.coordinate_index("xc")), -std::cos(th), 1e-7);
+    EXPECT_NEAR((*s.qdd)(full.coordinate_index("yc")), -std::sin(th), 1e-7);
+    EXPECT_NEAR((*s.qdd)(full.coordinate_index("psi3")), 0.0, 1e-7);
+    full.residual(s.q.data(), s.t, phi.data());
+    EXPECT_LE(scaled_residual(full, phi), 1e-9) << s.t;
+    ++rows;
+    return true;
+  }, &sum);
+  ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
+  EXPECT_EQ(rows, 101);
+}
+
+// A planar door: one body pinned to ground twice at its hinge. With both ground points equal, the second pin is
+// consistent redundancy; displaced by 1e-12 it is still consistent within the tolerance; by 1e-3 the model is
+// inconsistent and both pins are named.
+Scene planar_door(double offset) {
+  char text[1024];
+  std::snprintf(text, sizeof text, R"(phiq: 1
+coordinates: {x: 0.01, y: -0.02, psi: 0.1}
+bodies: {door: [x, y, psi]}
+constraints:
+  - {name: pin1, type: revolute, between: [{body: door, at: [0, 0]}, {body: ground, at: [0, 0]}]}
+  - {name: pin2, type: revolute, between: [{body: door, at: [0, 0]}, {body: ground, at: [%.17g, 0]}]}
+  - {name: tip, type: equation, expr: "0*x"}
+drivers:
+  - {name: motor, coordinate: psi, law: {type: linear, initial: 0.2, rate: 1}}
+time: {start: 0, end: 1, steps: 10}
+)", offset);
+  return parse_scene(text, "planar_door.yaml");
+}
+
+TEST(Assembly, ConsistentAndInconsistentRedundancyAreToldApart) {
+  for (double offset : {0.0, 1e-12}) {
+    Scene sc = planar_door(offset);
+    Eigen::VectorXd q = sc.model->initial_positions();
+    AssemblySummary as;
+    EXPECT_EQ(assemble(*sc.model, 0.0, {}, q, &as), SolveStatus::kSuccess) << offset << ": " << as.BriefReport();
+    EXPECT_TRUE(as.consistent) << offset;
+    EXPECT_EQ(as.rank.dof, 1) << offset;  // 3 coordinates, rank 2 (the zero equation adds nothing)
+    EXPECT_TRUE(has(as.rank.redundant, "pin2")) << offset;
+    EXPECT_TRUE(has(as.rank.redundant, "tip")) << offset;  // 0 = 0: always redundant, always consistent
+    EXPECT_NEAR(q(2), 0.2, 1e-10);
+    EXPECT_LE(std::hypot(q(0), q(1)), 1e-10);
+  }
+  Scene sc = planar_door(1e-3);
+  Eigen::VectorXd q = sc.model->initial_positions();
+  AssemblySummary as;
+  ASSERT_EQ(assemble(*sc.model, 0.0, {}, q, &as), SolveStatus::kInconsistent) << as.BriefReport();
+  EXPECT_FALSE(as.consistent);
+  EXPECT_TRUE(has(as.conflicts, "pin1"));
+  EXPECT_TRUE(has(as.conflicts, "pin2"));
+  EXPECT_FALSE(has(as.conflicts, "motor"));  // the driver is independent of the pins' conflict
+  EXPECT_FALSE(has(as.conflicts, "tip"));
+  EXPECT_NE(as.message.find("pin2"), std::string::npos) << as.message;
+  std::unique_ptr<Model> solved;
+  q = sc.model->initial_positions();
+  EXPECT_EQ(prepare_square(*sc.model, 0.0, {}, q, &solved, &as), SolveStatus::kInconsistent);
+  EXPECT_EQ(solved, nullptr);
+}
+
+// An under-driven four-bar (no motor): the assembly lands on the position of Φ = 0 nearest to the rough placement,
+// in the scaled norm: q₀ − q is orthogonal to the mechanism's motion (in range(D² Φqᵀ)).
+TEST(Assembly, UnderDrivenPlacementMovesToTheNearestAssembledPosition) {
+  Scene sc = load_scene(test::model_path("seed/fourbar_natural.yaml"));
+  // drop the motor: the same mechanism with one free dof
+  const Model& driven = *sc.model;
+  std::vector<Index> motor_rows;
+  for (const auto& c : driven.constraints())
+    if (c.depends_on_time)
+      for (int r = 0; r < c.rows; ++r) motor_rows.push_back(c.first_row + r);
+  ASSERT_EQ(motor_rows.size(), 1u);
+  // Assemble the full model from a placement that contradicts nothing but the closure: with the motor
+  // left out of the solve through a model that has no motor row at all.
+  std::string text;
+  {
+    std::FILE* f = std::fopen(test::model_path("seed/fourbar_natural.yaml").c_str(), "r");
+    ASSERT_NE(f, nullptr);
+    char buf[4096];
+    std::size_t k;
+    while ((k = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, k);
+    std::fclose(f);
+  }
+  const std::size_t d = text.find("drivers:");
+  ASSERT_NE(d, std::string::npos);
+  const std::size_t end = text.find("\ntime:", d);
+  text.erase(d, end + 1 - d);
+  Scene free_sc = parse_scene(text, "fourbar_free.yaml");
+  const Model& m = *free_sc.model;
+  Eigen::VectorXd q0 = m.initial_positions(), q = q0;
+  AssemblySummary as;
+  ASSERT_EQ(assemble(m, 0.0, {}, q, &as), SolveStatus::kSuccess) << as.BriefReport();
+  EXPECT_EQ(as.rank.dof, 1);  // the four-bar's own freedom, undriven
+  Eigen::VectorXd phi(m.num_equations());
+  m.residual(q.data(), 0.0, phi.data());
+  EXPECT_LE(scaled_residual(m, phi), 1e-10);
+  // Dense check of the optimality condition: the part of D⁻¹(q₀ − q) outside range(J̃ᵀ) vanishes.
+  CscPattern p;
+  std::vector<double> v;
+  std::vector<Index> all(static_cast<std::size_t>(m.num_equations()));
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Index>(i);
+  scaled_jacobian_rows(m, q, 0.0, all, &p, &v);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(p.rows, p.cols);
+  for (Index j = 0; j < p.cols; ++j)
+    for (Index e = p.col_ptr[j]; e < p.col_ptr[j + 1]; ++e) J(p.row_idx[e], j) = v[static_cast<std::size_t>(e)];
+  const Eigen::VectorXd w = (q0 - q).cwiseQuotient(m.tolerance_scales().coordinate_scale);
+  ASSERT_GT(w.norm(), 1e-3);  // the placement really moved
+  const Eigen::VectorXd in_range = J.transpose() * J.transpose().colPivHouseholderQr().solve(w);
+  EXPECT_LE((w - in_range).norm(), 1e-8 * w.norm());
+}
+
+TEST(Assembly, ImpossibleGeometryIsNotAssembledAndNamesTheConstraints) {
+  // A four-bar whose coupler is too long to close (crank 0.4 + coupler 3 > ground 1 + rocker 1): no assembly.
+  Scene sc = parse_scene(R"(phiq: 1
+coordinates: {xA: 0.3, yA: 0.3, xB: 1.5, yB: 0.5}
+points: {O: [0, 0], A: [xA, yA], B: [xB, yB], C: [1, 0]}
+constraints:
+  - {name: crank, type: distance, points: [O, A], length: 0.4}
+  - {name: coupler, type: distance, points: [A, B], length: 3}
+  - {name: rocker, type: distance, points: [C, B], length: 1}
+time: {start: 0, end: 0, steps: 0}
+)", "impossible.yaml");
+  Eigen::VectorXd q = sc.model->initial_positions();
+  AssemblySummary as;
+  const SolveStatus st = assemble(*sc.model, 0.0, {}, q, &as);
+  EXPECT_NE(st, SolveStatus::kSuccess);
+  EXPECT_GT(as.residual, 0.01);  // 1.6 m are missing, spread over the three links (length scale 3 m)
+  EXPECT_NE(as.message.find("coupler"), std::string::npos) << as.message;
+}
+
+}  // namespace
+}  // namespace phiq
