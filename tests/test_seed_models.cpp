@@ -136,3 +136,22 @@ TEST(SeedModels, CrankSliderSceneMatchesClosedForm) {
 
 }  // namespace
 }  // namespace phiq
+
+namespace phiq {
+namespace {
+
+// The Grübler–Kutzbach count is defined for the formulation made of bodies and joints only: 3 · 3 − 4 · 2 = 1 for
+// the reference-point four-bar; the natural, mixed (a body pinned to natural points) and relative ones are not
+// made of joints, and the count is null.
+TEST(SeedModels, GrublerOfTheFourBarFormulations) {
+  const Scene rp = load_scene(test::model_path("seed/fourbar_reference_point.yaml"));
+  ASSERT_TRUE(rp.model->grubler().has_value());
+  EXPECT_EQ(*rp.model->grubler(), 1);
+  EXPECT_EQ(rp.model->body_names(), (std::vector<std::string>{"crank", "coupler", "rocker"}));
+  for (const char* f : {"fourbar_natural.yaml", "fourbar_mixed.yaml", "fourbar_relative.yaml",
+                        "crank_slider_mixed.yaml", "crank_slider_equations.yaml"})
+    EXPECT_FALSE(load_scene(test::model_path(std::string("seed/") + f)).model->grubler().has_value()) << f;
+}
+
+}  // namespace
+}  // namespace phiq

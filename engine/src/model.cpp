@@ -270,12 +270,66 @@ void ModelBuilder::prepare(CoordinateDriverSpec& s) const {
   require(s.coordinate.is_coordinate(), "driver: must act on a coordinate");
 }
 void ModelBuilder::prepare(EquationSpec& s) const { require(s.g != nullptr, "equation: no expression"); }
+void ModelBuilder::prepare(SpatialDistanceSpec& s) const {
+  require(std::isfinite(s.length) && s.length > 0.0, "distance: length must be positive and finite");
+  for (const Attachment3& e : s.ends)
+    require(std::isfinite(e.s.x) && std::isfinite(e.s.y) && std::isfinite(e.s.z), "distance: point is not finite");
+}
+void ModelBuilder::prepare(DotSpec& s) const {
+  require(std::isfinite(s.value), "dot: value is not finite");
+  const double* q0 = model_.initial_.data();
+  // |D1|₀ |D2|₀ at the initial placement: the row is then ≈ a change of the cosine, whatever the segments' lengths
+  const double l1 = kin3::norm(s.ends[0].value(q0) - s.ends[1].value(q0));
+  const double l2 = kin3::norm(s.ends[2].value(q0) - s.ends[3].value(q0));
+  s.ref = (l1 > 0.0 && l2 > 0.0 && std::isfinite(l1 * l2)) ? l1 * l2 : 1.0;
+}
+
+void ModelBuilder::count_joint(const JointCount& c) {
+  if (c.role == JointCount::Role::kOther) non_joint_ = true;
+  if (c.role != JointCount::Role::kJoint) return;
+  const int d = c.dimension == 3 ? 1 : 0;
+  joints_of_dimension_[d] = true;
+  removed_[d] += c.freedoms;
+}
+
+void ModelBuilder::check_body(const std::string& name, std::initializer_list<Slot> slots) {
+  if (name.empty()) throw Error("body name is empty");
+  for (const Slot& s : slots) {
+    if (s.is_coordinate() && s.coord >= num_coordinates())
+      throw Error("body '" + name + "': coordinate index out of range");
+    if (!s.is_coordinate() && !std::isfinite(s.value)) throw Error("body '" + name + "': constant is not finite");
+  }
+  const auto name_of = [this](Index k) -> const std::string& { return model_.body_names_[static_cast<std::size_t>(k)]; };
+  if (!body_names_.insert(name, static_cast<Index>(model_.body_names_.size()), name_of))
+    throw Error("duplicate body name '" + name + "'");
+}
+
+Index ModelBuilder::add_body(const std::string& name, const Frame2& f) {
+  check_body(name, {f.x, f.y, f.psi});
+  model_.body_names_.push_back(name);
+  ++bodies_[0];
+  return static_cast<Index>(model_.body_names_.size()) - 1;
+}
+
+Index ModelBuilder::add_body(const std::string& name, const Frame3& f) {
+  check_body(name, {f.x, f.y, f.z, f.e0, f.e1, f.e2, f.e3});
+  if (f.e0.is_coordinate() || f.e1.is_coordinate() || f.e2.is_coordinate() || f.e3.is_coordinate())
+    add(name + ".euler", EulerParametersSpec{{f.e0, f.e1, f.e2, f.e3}});
+  model_.body_names_.push_back(name);
+  ++bodies_[1];
+  return static_cast<Index>(model_.body_names_.size()) - 1;
+}
+
+Index ModelBuilder::add_unit_vector(const std::string& name, const Point3& v) {
+  return add(name + ".unit", UnitVectorSpec{v});
+}
 
 Model ModelBuilder::build() && {
   Model& m = model_;
   const Index n = m.num_coordinates(), rows = m.num_equations();
   m.initial_.conservativeResize(n);  // add_coordinate() and reserve() leave room beyond n
   constraint_names_.clear();  // only needed while adding: free it now
+  body_names_.clear();
 
   // Sparsity pattern, fixed for the life of the model.
   std::vector<Index> trip_rows, trip_cols;
@@ -333,6 +387,11 @@ Model ModelBuilder::build() && {
     for (std::size_t i = 0; i < blk.size(); ++i)
       if (blk.spec(i).law) limit_time(*blk.spec(i).law, blk.first_row(i));
   }
+
+  // Grübler–Kutzbach: defined for bodies of one dimension joined only by joints of that dimension.
+  const int dim = bodies_[1] > 0 ? 1 : 0;
+  if ((bodies_[0] > 0) != (bodies_[1] > 0) && !non_joint_ && !joints_of_dimension_[1 - dim])
+    m.grubler_ = (dim == 1 ? 6 : 3) * bodies_[dim] - removed_[dim];
 
   // Symbolic analysis once per model; square systems only (redundant or under-determined models are analysed by
   // the rank module, not by LU).

@@ -14,6 +14,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <tuple>
 #include <type_traits>
 #include <unordered_map>
 
@@ -869,8 +870,8 @@ class SceneReader {
   Scene read(const YAML::Node& root) {
     Cursor top(root, "", &file_, YAML::Mark());
     if (!root.IsDefined() || root.IsNull()) top.fail("the scene is empty");
-    top.expect_map({"phiq", "name", "description", "parameters", "coordinates", "points", "bodies", "constraints",
-                    "drivers", "time", "output", "solver"});
+    top.expect_map({"phiq", "name", "description", "dimension", "parameters", "coordinates", "points", "bodies",
+                    "vectors", "constraints", "drivers", "time", "output", "solver"});
     if (auto v = top.field("phiq"); v.present() && v.integer(1, 1) != 1) v.fail("unsupported format version");
 
     Scene scene;
@@ -879,10 +880,15 @@ class SceneReader {
     if (auto d = top.field("description"); d.present()) (void)d.text();
 
     if (overrides_ && overrides_->share_analysis_with) builder_.share_analysis_with(*overrides_->share_analysis_with);
+    if (auto d = top.field("dimension"); d.present()) spatial_ = d.integer(2, 3) == 3;
     read_parameters(top.field("parameters"));
     read_coordinates(top.require("coordinates"));
     if (auto p = top.field("points"); p.present()) read_points(p);
     if (auto b = top.field("bodies"); b.present()) read_bodies(b);
+    if (auto v = top.field("vectors"); v.present()) {
+      if (!spatial_) v.fail("natural unit vectors need 'dimension: 3'");
+      read_vectors(v);
+    }
     read_solver(top.field("solver"), scene.sweep);  // before constraints: length scale, linear solver
 
     reserve_ = [&](std::size_t more) { builder_.reserve(0, static_cast<Index>(more)); };
@@ -894,6 +900,7 @@ class SceneReader {
     read_output(top.field("output"), scene);
     points_ = {}, bodies_ = {};  // not needed any more: their memory is free for the model
     driver_laws_ = {};
+    points3_ = {}, bodies3_ = {}, vectors_ = {}, joints3_.clear();
 
     try {
       scene.model = std::make_unique<Model>(std::move(builder_).build());
@@ -1374,7 +1381,26 @@ class SceneReader {
     return k;
   }
 
+  // A new spatial point, body or vector: its index in `table`, after the checks (valid, not yet any of them).
+  template <class C, class T>
+  Index new_entity3(const C& where, const std::string& name, NameTable<T>& table) {
+    if (!Cursor::valid_name(name)) where.fail("'" + name + "' is not a valid name");
+    const bool taken = points3_.contains(name) || bodies3_.contains(name) || vectors_.contains(name);
+    const Index k = taken ? -1 : table.add(name);
+    if (k < 0) where.fail("duplicate point, body or vector name '" + name + "'");
+    return k;
+  }
+
   void read_points(const Cursor& c) {
+    if (spatial_) {
+      reserve_ = [&](std::size_t more) { points3_.reserve(more); };
+      read_map(c.entries(), [&](const std::string& name, const auto& value) {
+        const Index k = new_entity3(value, name, points3_);
+        if (value.size() != 3 || !value.is_sequence()) value.fail("a point is [x, y, z] (dimension: 3)");
+        points3_[k] = Point3{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
+      });
+      return;
+    }
     reserve_ = [&](std::size_t more) { points_.reserve(more); };
     read_map(c.entries(), [&](const std::string& name, const auto& value) {
       const Index k = new_entity(value, name, points_, bodies_);
@@ -1383,13 +1409,53 @@ class SceneReader {
     });
   }
 
+  // Bodies that move are recorded for the Grübler–Kutzbach count (a body of constants is a fixed frame, as ground);
+  // a spatial body's Euler normalisation `NAME.euler` is added with it.
   void read_bodies(const Cursor& c) {
+    if (spatial_) {
+      reserve_ = [&](std::size_t more) { bodies3_.reserve(more); };
+      read_map(c.entries(), [&](const std::string& name, const auto& value) {
+        if (name == kGround) value.fail("'ground' is predefined (the fixed frame)");
+        const Index k = new_entity3(value, name, bodies3_);
+        if (value.size() != 7 || !value.is_sequence()) value.fail("a body is [x, y, z, e0, e1, e2, e3] (dimension: 3)");
+        Slot v[7];
+        for (int i = 0; i < 7; ++i) v[i] = slot(value.at(static_cast<std::size_t>(i)));
+        const Frame3 f{v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+        bodies3_[k] = f;
+        if (!f.is_fixed()) {
+          try {
+            builder_.add_body(name, f);
+          } catch (const Error& e) {
+            value.fail(e.what());
+          }
+        }
+      });
+      return;
+    }
     reserve_ = [&](std::size_t more) { bodies_.reserve(more); };
     read_map(c.entries(), [&](const std::string& name, const auto& value) {
       if (name == kGround) value.fail("'ground' is predefined (the fixed frame)");
       const Index k = new_entity(value, name, bodies_, points_);
       if (value.size() != 3 || !value.is_sequence()) value.fail("a body is [x, y, psi]");
-      bodies_[k] = Frame2{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
+      const Frame2 f{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
+      bodies_[k] = f;
+      if (f.x.is_coordinate() || f.y.is_coordinate() || f.psi.is_coordinate()) builder_.add_body(name, f);
+    });
+  }
+
+  // Natural unit vectors (dimension 3), each with its unit-norm constraint `NAME.unit`.
+  void read_vectors(const Cursor& c) {
+    reserve_ = [&](std::size_t more) { vectors_.reserve(more); };
+    read_map(c.entries(), [&](const std::string& name, const auto& value) {
+      const Index k = new_entity3(value, name, vectors_);
+      if (value.size() != 3 || !value.is_sequence()) value.fail("a vector is [ux, uy, uz]");
+      const Point3 u{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
+      vectors_[k] = u;
+      try {
+        builder_.add_unit_vector(name, u);
+      } catch (const Error& e) {
+        value.fail(e.what());
+      }
     });
   }
 
@@ -1440,6 +1506,11 @@ class SceneReader {
     const std::string type = c.require("type").text();
     std::string name;
     if (auto n = c.field("name"); n.present()) name = n.name();
+    if (spatial_) return read_constraint_3d(c, type, name);
+    static const std::set<std::string> spatial_only = {"spherical", "cylindrical", "universal", "planar",
+                                                       "rigid",     "point_on_plane", "dot"};
+    if (spatial_only.count(type))
+      c.require("type").fail("'" + type + "' is a spatial constraint: it needs 'dimension: 3'");
     try {
       if (type == "distance") {
         c.expect_map({"type", "name", "points", "length"});
@@ -1527,18 +1598,212 @@ class SceneReader {
     }
   }
 
+  // ---- dimension 3 ------------------------------------------------------------------------------------------------
+  template <class C>
+  kin3::V3 vec3(const C& c) const {
+    if (!c.is_sequence() || c.size() != 3) c.fail("expected a list of 3 numbers");
+    return {number(c.at(0)), number(c.at(1)), number(c.at(2))};
+  }
+  // A spatial point reference: a point name or an inline [x, y, z].
+  template <class C>
+  Point3 point3(const C& c) const {
+    if (c.is_sequence()) {
+      if (c.size() != 3) c.fail("an inline point is [x, y, z] (dimension: 3)");
+      return Point3{slot(c.at(0)), slot(c.at(1)), slot(c.at(2))};
+    }
+    const std::string s = c.name();
+    const Index k = entry_at(c, s, points3_);
+    if (k < 0) c.fail("unknown point '" + s + "'");
+    return points3_[k];
+  }
+  template <class C>
+  Point3 vector3(const C& c) const {
+    const std::string s = c.name();
+    const Index k = entry_at(c, s, vectors_);
+    if (k < 0) c.fail("unknown vector '" + s + "'");
+    return vectors_[k];
+  }
+  template <class C>
+  Frame3 body3(const C& c) const {
+    const std::string s = c.name();
+    if (s == kGround) return Frame3::ground();
+    const Index k = entry_at(c, s, bodies3_);
+    if (k < 0) c.fail("unknown body '" + s + "'");
+    return bodies3_[k];
+  }
+  // A non-zero finite direction.
+  template <class C>
+  kin3::V3 direction3(const C& c) const {
+    const kin3::V3 v = vec3(c);
+    if (kin3::is_zero(v)) c.fail("must not be the zero vector");
+    return v;
+  }
+  // A side of a spatial joint: {body: B, at: [x, y, z], axis: [..], ref: [..]} or {point: P, vector: u}.
+  template <class C>
+  JointSide3 side3(const C& c) const {
+    if (!c.is_map()) c.fail("expected {body: NAME, at: [x, y, z], axis: [x, y, z], ref: [x, y, z]} or {point: NAME, vector: NAME}");
+    if (c.field("point").present()) {
+      c.expect_map({"point", "vector"});
+      std::optional<Point3> v;
+      if (auto u = c.field("vector"); u.present()) v = vector3(u);
+      return JointSide3::natural_point(point3(c.field("point")), v);
+    }
+    c.expect_map({"body", "at", "axis", "ref"});
+    JointSide3 s = JointSide3::body(body3(c.require("body")), kin3::V3{});
+    if (auto a = c.field("at"); a.present()) s.at = vec3(a);
+    if (auto a = c.field("axis"); a.present()) s.axis = direction3(a);
+    if (auto r = c.field("ref"); r.present()) s.ref = direction3(r);
+    return s;
+  }
+  template <class C>
+  std::pair<JointSide3, JointSide3> sides3(const C& c, const std::string& type) const {
+    auto between = c.require("between");
+    if (!between.is_sequence() || between.size() != 2) between.fail("a " + type + " joint joins two attachments");
+    return {side3(between.at(0)), side3(between.at(1))};
+  }
+  // A direction of a dot product: a vector name, or a segment [A, B] of points (B − A).
+  template <class C>
+  std::pair<Attachment3, Attachment3> dot_direction(const C& c, Unit& unit) const {
+    if (c.is_sequence()) {
+      if (c.size() != 2) c.fail("a direction is a vector name or a segment [A, B]");
+      unit = Unit::kLength;
+      return {Attachment3::natural(point3(c.at(1))), Attachment3::natural(point3(c.at(0)))};
+    }
+    unit = Unit::kNone;
+    return {Attachment3::natural(vector3(c)), Attachment3::zero()};
+  }
+
+  template <class Spec, class C>
+  void add_joint3(const C& c, const std::string& name, const std::string& type) {
+    c.expect_map({"type", "name", "between"});
+    Spec spec;
+    std::tie(spec.a, spec.b) = sides3(c, type);
+    if (!name.empty()) joints3_[name] = Joint3{type, spec.a, spec.b};
+    add(c, name, std::move(spec));
+  }
+
+  template <class C>
+  void read_constraint_3d(const C& c, const std::string& type, const std::string& name) {
+    try {
+      if (type == "distance") {
+        c.expect_map({"type", "name", "points", "between", "length"});
+        SpatialDistanceSpec spec;
+        if (c.field("points").present() == c.field("between").present())
+          c.fail("a distance has either 'points' (natural points) or 'between' (attachments)");
+        if (auto pts = c.field("points"); pts.present()) {
+          if (!pts.is_sequence() || pts.size() != 2) pts.fail("a distance joins two points [A, B]");
+          spec.ends[0] = Attachment3::natural(point3(pts.at(0)));
+          spec.ends[1] = Attachment3::natural(point3(pts.at(1)));
+        } else {
+          auto [a, b] = sides3(c, "distance");
+          spec.ends[0] = Attachment3::body_point(a.frame, a.at);
+          spec.ends[1] = Attachment3::body_point(b.frame, b.at);
+        }
+        spec.length = positive(c.require("length"));
+        add(c, name, spec);
+      } else if (type == "fixed_point") {
+        c.expect_map({"type", "name", "point", "at"});
+        SphericalSpec spec;
+        spec.a = JointSide3::natural_point(point3(c.require("point")));
+        spec.b = JointSide3::body(Frame3::ground(), vec3(c.require("at")));
+        add(c, name, std::move(spec));
+      } else if (type == "dot") {
+        c.expect_map({"type", "name", "directions", "value"});
+        auto dirs = c.require("directions");
+        if (!dirs.is_sequence() || dirs.size() != 2) dirs.fail("a dot product has two directions [D1, D2]");
+        DotSpec spec;
+        std::tie(spec.ends[0], spec.ends[1]) = dot_direction(dirs.at(0), spec.end_units[0]);
+        std::tie(spec.ends[2], spec.ends[3]) = dot_direction(dirs.at(1), spec.end_units[1]);
+        spec.value = number(c.require("value"));
+        add(c, name, spec);
+      } else if (type == "spherical") {
+        add_joint3<SphericalSpec>(c, name, type);
+      } else if (type == "revolute") {
+        add_joint3<SpatialRevoluteSpec>(c, name, type);
+      } else if (type == "prismatic") {
+        add_joint3<SpatialPrismaticSpec>(c, name, type);
+      } else if (type == "cylindrical") {
+        add_joint3<CylindricalSpec>(c, name, type);
+      } else if (type == "universal") {
+        add_joint3<UniversalSpec>(c, name, type);
+      } else if (type == "planar") {
+        add_joint3<PlanarSpec>(c, name, type);
+      } else if (type == "rigid") {
+        add_joint3<RigidSpec>(c, name, type);
+      } else if (type == "point_on_line") {
+        add_joint3<SpatialPointOnLineSpec>(c, name, type);
+      } else if (type == "point_on_plane") {
+        add_joint3<PointOnPlaneSpec>(c, name, type);
+      } else if (type == "equation") {
+        c.expect_map({"type", "name", "expr", "unit"});
+        add(c, name, EquationSpec{compile(c.require("expr"), true), std::nullopt, unit(c.field("unit"))});
+      } else if (type == "polar" || type == "segment_angle" || type == "constant_angle" || type == "loop") {
+        c.require("type").fail("'" + type + "' is a planar constraint; this scene has 'dimension: 3'");
+      } else {
+        c.require("type").fail("unknown constraint type '" + type +
+                               "' (dimension 3: distance, fixed_point, dot, spherical, revolute, prismatic, "
+                               "cylindrical, universal, planar, rigid, point_on_line, point_on_plane, equation)");
+      }
+    } catch (const Error& e) {
+      c.fail(e.what());
+    }
+  }
+
+  // {joint: NAME, measure: angle | distance, law}: the rotation of a revolute or cylindrical joint, the
+  // translation of a prismatic or cylindrical one.
+  template <class C>
+  void read_joint_driver(const C& c, const std::string& name, MotionLaw law) {
+    auto j = c.field("joint");
+    if (!spatial_) j.fail("joint drivers need 'dimension: 3' (in the plane, drive a coordinate)");
+    const std::string joint = j.name();
+    auto it = joints3_.find(joint);
+    if (it == joints3_.end()) j.fail("unknown joint '" + joint + "' (a named spatial joint of 'constraints')");
+    const Joint3& J = it->second;
+    std::string measure;
+    if (auto m = c.field("measure"); m.present()) {
+      measure = m.text();
+      if (measure != "angle" && measure != "distance") m.fail("measure is angle or distance");
+    } else if (J.type == "revolute") {
+      measure = "angle";
+    } else if (J.type == "prismatic") {
+      measure = "distance";
+    } else if (J.type == "cylindrical") {
+      c.fail("a cylindrical joint's driver needs 'measure: angle' or 'measure: distance'");
+    }
+    const bool angle_ok = J.type == "revolute" || J.type == "cylindrical";
+    const bool distance_ok = J.type == "prismatic" || J.type == "cylindrical";
+    if ((measure == "angle" && !angle_ok) || (measure == "distance" && !distance_ok) || measure.empty())
+      j.fail("joint '" + joint + "' is a " + J.type + " joint: drivers measure the angle of a revolute or " +
+             "cylindrical joint, or the distance of a prismatic or cylindrical one");
+    if (measure == "angle") {
+      JointAngleDriverSpec d;
+      d.a = J.a, d.b = J.b, d.law = std::move(law);
+      add(c, name, std::move(d));
+    } else {
+      JointDistanceDriverSpec d;
+      d.a = J.a, d.b = J.b, d.law = std::move(law);
+      add(c, name, std::move(d));
+    }
+  }
+
   template <class C>
   void read_driver(const C& c) {
-    if (!c.is_map()) c.fail("a driver is a mapping with 'coordinate' or 'expr', and a 'law'");
-    c.expect_map({"name", "coordinate", "expr", "unit", "law"});
+    if (!c.is_map()) c.fail("a driver is a mapping with 'coordinate', 'expr' or 'joint', and a 'law'");
+    c.expect_map({"name", "coordinate", "expr", "unit", "joint", "measure", "law"});
     std::string name;
     if (auto n = c.field("name"); n.present()) name = n.name();
     MotionLaw law = motion_law(c.require("law"));
     if (!name.empty()) driver_laws_.emplace(name, law);  // for `output: drivers` (shared data: a cheap copy)
-    const bool by_coordinate = c.field("coordinate").present(), by_expr = c.field("expr").present();
-    if (by_coordinate == by_expr) c.fail("a driver has either 'coordinate' or 'expr'");
+    const bool by_coordinate = c.field("coordinate").present(), by_expr = c.field("expr").present(),
+               by_joint = c.field("joint").present();
+    if (int(by_coordinate) + int(by_expr) + int(by_joint) != 1)
+      c.fail("a driver has one of 'coordinate', 'expr' or 'joint'");
+    if (c.field("measure").present() && !by_joint) c.field("measure").fail("'measure' goes with 'joint'");
     try {
-      if (by_coordinate) {
+      if (by_joint) {
+        if (c.field("unit").present()) c.field("unit").fail("'unit' goes with 'expr' (a joint driver has its own)");
+        read_joint_driver(c, name, std::move(law));
+      } else if (by_coordinate) {
         if (c.field("unit").present()) c.field("unit").fail("'unit' goes with 'expr' (a coordinate has its own)");
         add(c, name, CoordinateDriverSpec{Slot::coordinate(coordinate(c.field("coordinate"))), std::move(law)});
       } else {
@@ -1885,6 +2150,16 @@ class SceneReader {
   std::unordered_map<std::string, double> parameters_;
   NameTable<Point2> points_;
   NameTable<Frame2> bodies_;
+  bool spatial_ = false;  // dimension: 3
+  NameTable<Point3> points3_;
+  NameTable<Frame3> bodies3_;
+  NameTable<Point3> vectors_;
+  // Named spatial joints, for the drivers that measure them.
+  struct Joint3 {
+    std::string type;
+    JointSide3 a, b;
+  };
+  std::unordered_map<std::string, Joint3> joints3_;
   Families families_;
   std::function<void(std::size_t)> reserve_;  // room for that many more entries of the section being read
   int unnamed_ = 0;

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <type_traits>
 #include <string>
 #include <string_view>
 #include <typeindex>
@@ -18,6 +19,7 @@
 #include <Eigen/Core>
 
 #include "phiq/constraint_block.hpp"
+#include "phiq/constraint_kinds_3d.hpp"
 #include "phiq/linear_solver.hpp"
 #include "phiq/sparse_pattern.hpp"
 
@@ -88,6 +90,67 @@ class NameIndex {
 };
 }  // namespace detail
 
+/// What a constraint counts for in the Grübler–Kutzbach formula (Model::grubler()).
+struct JointCount {
+  /// The role of the constraint in the count.
+  enum class Role {
+    kOther,    ///< not a joint between bodies (natural coordinates, equations, …): the count is not defined
+    kJoint,    ///< a joint between bodies or ground: removes `freedoms`
+    kDriver,   ///< a driver: not counted
+    kBodyOwn,  ///< a body's own constraint (Euler-parameter normalisation): not counted
+  };
+  Role role = Role::kOther;  ///< its role
+  int dimension = 0;         ///< 2 (planar joint) or 3 (spatial joint), for kJoint
+  int freedoms = 0;          ///< freedoms the joint removes, for kJoint
+};
+
+namespace detail {
+/// JointCount of a constraint (the role of its kind, and for joints whether both sides are bodies or ground).
+template <class Spec>
+JointCount joint_count(const Spec&) {
+  return {};
+}
+/// A planar frame is a body's (ψ a coordinate) or ground (all constants); else a natural point.
+inline bool body_or_ground(const Frame2& f) {
+  return f.psi.is_coordinate() || (!f.x.is_coordinate() && !f.y.is_coordinate());
+}
+inline JointCount joint_count(const PinSpec& s) {
+  if (!body_or_ground(s.a) || !body_or_ground(s.b)) return {};
+  return {JointCount::Role::kJoint, 2, 2};
+}
+inline JointCount joint_count(const PrismaticSpec& s) {
+  if (!body_or_ground(s.a) || !body_or_ground(s.b)) return {};
+  return {JointCount::Role::kJoint, 2, 2};
+}
+template <class Traits>
+JointCount joint_count(const SpatialJointSpec<Traits>& s) {
+  if (s.a.natural || s.b.natural) return {};
+  return {JointCount::Role::kJoint, 3, Traits::kRows};
+}
+/// A spatial distance between two body (or ground) points: a bar with two ball joints, removing one freedom.
+inline JointCount joint_count(const SpatialDistanceSpec& s) {
+  for (const Attachment3& e : s.ends) {
+    bool body = false, fixed = true;
+    for (const Slot& v : e.p) body = body || v.is_coordinate();
+    for (const Slot& v : e.r) fixed = fixed && !v.is_coordinate();
+    if (!body && !fixed) return {};
+  }
+  return {JointCount::Role::kJoint, 3, 1};
+}
+inline JointCount joint_count(const EulerParametersSpec&) { return {JointCount::Role::kBodyOwn, 0, 0}; }
+inline JointCount joint_count(const CoordinateDriverSpec&) { return {JointCount::Role::kDriver, 0, 0}; }
+inline JointCount joint_count(const JointAngleDriverSpec&) { return {JointCount::Role::kDriver, 0, 0}; }
+inline JointCount joint_count(const JointDistanceDriverSpec&) { return {JointCount::Role::kDriver, 0, 0}; }
+inline JointCount joint_count(const EquationSpec& s) {
+  return s.law ? JointCount{JointCount::Role::kDriver, 0, 0} : JointCount{};
+}
+/// Whether a kind derives data from its inputs with a setup() member (the spatial joints and joint drivers).
+template <class T, class = void>
+struct HasSetup : std::false_type {};
+template <class T>
+struct HasSetup<T, std::void_t<decltype(std::declval<T&>().setup())>> : std::true_type {};
+}  // namespace detail
+
 /// One constraint of a model, as diagnostics name it.
 struct ConstraintInfo {
   std::string name;              ///< as given by the user (or "<kind>#<k>")
@@ -138,6 +201,14 @@ class Model {
   Unit row_unit(Index row) const { return row_units_[static_cast<std::size_t>(row)]; }
   /// "name" for one-row constraints, "name[k]" for row k of a multi-row one.
   std::string row_name(Index row) const;
+  /// The Grübler–Kutzbach count of the model's joints: 3 (nb − 1) − Σ c_i for planar bodies, 6 (nb − 1) − Σ c_i for
+  /// spatial bodies, nb counting ground and c_i the freedoms joint i removes (drivers and the bodies' Euler
+  /// normalisations are not counted). std::nullopt where it is not defined: no bodies (ModelBuilder::add_body), a
+  /// constraint that is not a joint between bodies or ground (natural coordinates, equations, …), or planar and
+  /// spatial parts mixed. A lower count than the degrees of freedom n − rank shows redundant joints.
+  std::optional<Index> grubler() const { return grubler_; }
+  /// Names of the bodies recorded with ModelBuilder::add_body(), in order.
+  const std::vector<std::string>& body_names() const { return body_names_; }
   /// True when some constraint depends on t (then Φt is not identically zero).
   bool has_time_dependence() const { return !time_blocks_.empty(); }
 
@@ -174,9 +245,6 @@ class Model {
   /// dropped: the arrays are the same).
   const std::vector<Index>& solve_entries() const { return solve_entries_; }
 
-  /// The Grübler–Kutzbach count of the mechanism from its joints, when it is made of joints between bodies;
-  /// std::nullopt otherwise (e.g. natural coordinates).
-  std::optional<Index> grubler() const { return grubler_; }
 
   /// Earliest / latest time at which every driver is defined (tabulated laws have a finite range).
   double time_domain_begin() const { return time_begin_; }
@@ -229,6 +297,7 @@ class Model {
   std::shared_ptr<const CscPattern> solve_pattern_ = pattern_;
   std::vector<Index> solve_entries_;
   std::optional<Index> grubler_;
+  std::vector<std::string> body_names_;
 };
 
 /// Builds a Model in code. Coordinates first (they are referenced by index), then constraints:
@@ -268,6 +337,17 @@ class ModelBuilder {
   /// Adds a constraint of any kind in constraint_kinds.hpp; its rows follow those added before. Returns its index.
   template <class Spec>
   Index add(const std::string& name, Spec spec);
+  /// Records a planar rigid body in reference-point coordinates, for the Grübler–Kutzbach count (Model::grubler());
+  /// adds no coordinate and no constraint. Returns its index among the bodies. Throws phiq::Error for an empty or
+  /// duplicate body name, or a frame whose slots are not coordinates of the model.
+  Index add_body(const std::string& name, const Frame2& frame);
+  /// Records a spatial rigid body (position and Euler parameters) for the Grübler–Kutzbach count and adds its
+  /// normalisation constraint (EulerParametersSpec) named `name.euler` when any Euler parameter is a coordinate.
+  /// Returns its index among the bodies. Throws phiq::Error as the planar overload.
+  Index add_body(const std::string& name, const Frame3& frame);
+  /// Adds the unit-norm constraint of a natural unit vector (UnitVectorSpec), named `name.unit`. Returns the
+  /// constraint's index.
+  Index add_unit_vector(const std::string& name, const Point3& vector);
   /// Shorthand for a CoordinateDriverSpec.
   Index add_driver(const std::string& name, Index coordinate, MotionLaw law);
 
@@ -293,7 +373,13 @@ class ModelBuilder {
   /// @cond internal
   /// Kind-specific validation and set-up at add time; kinds with nothing to check use the template.
   template <class Spec>
-  void prepare(Spec&) const {}
+  void prepare(Spec& s) const {
+    if constexpr (detail::HasSetup<Spec>::value) s.setup();
+  }
+  void prepare(SpatialDistanceSpec& s) const;
+  void prepare(DotSpec& s) const;
+  void count_joint(const JointCount& c);
+  void check_body(const std::string& name, std::initializer_list<Slot> slots);
   void prepare(PointOnLineSpec& s) const;
   void prepare(ConstantAngleSpec& s) const;
   void prepare(PrismaticSpec& s) const;
@@ -310,6 +396,13 @@ class ModelBuilder {
   detail::NameIndex constraint_names_;  ///< duplicate check in O(1): models reach 10^6 constraints
   double length_scale_override_ = 0.0;
   const Model* share_analysis_with_ = nullptr;
+  // The Grübler–Kutzbach count, gathered while adding: bodies per dimension, freedoms removed by joints per
+  // dimension, and whether a constraint that is not a joint was added.
+  Index bodies_[2] = {0, 0};     ///< planar, spatial
+  Index removed_[2] = {0, 0};    ///< by planar joints, by spatial joints
+  bool joints_of_dimension_[2] = {false, false};
+  bool non_joint_ = false;
+  detail::NameIndex body_names_;  ///< duplicate check in O(1) without a node per name: scenes reach 10^6 bodies
 };
 
 template <class Spec>
@@ -328,6 +421,7 @@ Index ModelBuilder::add(const std::string& name, Spec spec) {
   prepare(spec);
   const bool td = spec.depends_on_time();
   const Index id = add_info(label, Spec::kKind, Spec::kRows, td);
+  count_joint(detail::joint_count(spec));
   block_for<Spec>().entries().push_back({std::move(spec), model_.constraints_[static_cast<std::size_t>(id)].first_row, 0});
   return id;
 }

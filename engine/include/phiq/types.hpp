@@ -67,4 +67,34 @@ struct Frame2 {
   Slot psi;  ///< orientation (rad)
 };
 
+/// A spatial point given by three slots (natural coordinates, or a fixed point): also a natural unit vector's
+/// components (ux, uy, uz).
+struct Point3 {
+  Slot x;  ///< x coordinate (m; unitless for a vector)
+  Slot y;  ///< y coordinate
+  Slot z;  ///< z coordinate
+};
+
+/// A spatial body frame in reference-point coordinates: position of its reference point and its orientation as
+/// Euler parameters (a unit quaternion, e0 the scalar part). Ground is a frame of constants with e = (1, 0, 0, 0).
+struct Frame3 {
+  Slot x;   ///< x of the reference point (m)
+  Slot y;   ///< y of the reference point (m)
+  Slot z;   ///< z of the reference point (m)
+  Slot e0;  ///< Euler parameter e0 (scalar part; unitless): e0² + e1² + e2² + e3² = 1 is the body's own constraint
+  Slot e1;  ///< Euler parameter e1
+  Slot e2;  ///< Euler parameter e2
+  Slot e3;  ///< Euler parameter e3
+  /// The fixed frame: origin, no rotation.
+  static Frame3 ground() {
+    const Slot o = Slot::constant(0.0), one = Slot::constant(1.0);
+    return Frame3{o, o, o, one, o, o, o};
+  }
+  /// True when every slot is a constant (ground or a fixed frame).
+  bool is_fixed() const {
+    return !x.is_coordinate() && !y.is_coordinate() && !z.is_coordinate() && !e0.is_coordinate() &&
+           !e1.is_coordinate() && !e2.is_coordinate() && !e3.is_coordinate();
+  }
+};
+
 }  // namespace phiq

@@ -1,0 +1,582 @@
+/// @file
+/// The spatial (3D) constraint kinds: the normalisation of a body's Euler parameters and of a natural unit vector,
+/// the rigid-body conditions of 3D natural coordinates (distance, constant dot product), the joints (spherical,
+/// revolute, prismatic, cylindrical, universal, planar, rigid, point on line, point on plane) and the drivers on
+/// joint angles and joint distances. Same contract as the planar kinds (documented on DistanceSpec in
+/// constraint_kinds.hpp): residual, exact Jacobian entries through a sink with a value-independent entry set, Φt, γ,
+/// row units, characteristic length.
+///
+/// Every joint is written with one device: each row is w (X · Y − c), X and Y sums of attachments
+/// (spatial_attachment.hpp: X = r + R(p) s) or a constant unit axis. So the Jacobian, Φt and γ of every joint come
+/// from one set of formulas (detail3 below):
+///
+///     Φ̇ = w (Ẋ · Y + X · Ẏ),     γ = −w (a_X · Y + 2 Ẋ · Ẏ + X · a_Y)      (a = the q̈-free part of the acceleration)
+///
+/// A joint joins two sides (JointSide3): a body with a local point `at`, a local axis z and a local reference
+/// direction x ⟂ z (y = z × x completes the joint frame); or ground; or a natural point, with a natural unit vector
+/// as its axis. Rows that need x or y of a side (the alignment of two axes, the lock of a rotation) need a body or
+/// ground on that side: a natural vector fixes no perpendicular direction.
+///
+/// Rows are lengths (point gaps, offsets of a point from a line or a plane) or angles (x_a · z_b ≈ the
+/// misalignment of two axes, in radians), so that one tolerance serves any size of mechanism (models/README.md).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "phiq/motion_law.hpp"
+#include "phiq/spatial_attachment.hpp"
+#include "phiq/types.hpp"
+
+namespace phiq {
+
+/// Normalisation of a body's Euler parameters, added automatically for every spatial body:
+///   Φ = (p · p − 1) / 2
+/// Unitless and ≈ |p| − 1 near the solution (so a rough initial guess of p is enough). Scene: automatic, named
+/// `BODY.euler`.
+struct EulerParametersSpec {
+  static constexpr int kRows = 1;  ///< one row, unitless
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "euler_parameters";
+  Slot e[4];  ///< e0 … e3 of the body
+
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return false; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kNone; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return 0.0; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    for (const Slot& s : e) f(s, Unit::kNone);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double, double* phi) const {
+    double n = 0.0;
+    for (const Slot& s : e) n += s.of(q) * s.of(q);
+    phi[0] = 0.5 * (n - 1.0);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& s) const {
+    for (const Slot& v : e) s(0, v, v.of(q));
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double*, const double* qd, double, double* out) const {
+    double g = 0.0;
+    for (const Slot& s : e) g -= s.rate(qd) * s.rate(qd);
+    out[0] = g;
+  }
+};
+
+/// Unit norm of a natural unit vector (3D natural coordinates), added automatically for every scene `vectors`
+/// entry:
+///   Φ = (u · u − 1) / 2
+/// Unitless. Scene: automatic, named `VECTOR.unit`.
+struct UnitVectorSpec {
+  static constexpr int kRows = 1;  ///< one row, unitless
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "unit_vector";
+  Point3 u;  ///< the vector's three components
+
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return false; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kNone; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return 0.0; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    f(u.x, Unit::kNone), f(u.y, Unit::kNone), f(u.z, Unit::kNone);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double, double* phi) const {
+    const double x = u.x.of(q), y = u.y.of(q), z = u.z.of(q);
+    phi[0] = 0.5 * (x * x + y * y + z * z - 1.0);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& s) const {
+    s(0, u.x, u.x.of(q)), s(0, u.y, u.y.of(q)), s(0, u.z, u.z.of(q));
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double*, const double* qd, double, double* out) const {
+    const double x = u.x.rate(qd), y = u.y.rate(qd), z = u.z.rate(qd);
+    out[0] = -(x * x + y * y + z * z);
+  }
+};
+
+/// One side of a spatial joint, as given: a body (or ground) with a local point and a local axis and reference
+/// direction, or a natural point with an optional natural unit vector. Build it with the factories.
+struct JointSide3 {
+  Frame3 frame = Frame3::ground();  ///< the body; for a natural point, x, y, z are the point and p is constant
+  kin3::V3 at;                      ///< the joint point in the body's frame (m); 0 for a natural point
+  kin3::V3 axis{0, 0, 1};           ///< the joint axis z in the body's frame (normalised by setup)
+  std::optional<kin3::V3> ref;      ///< the reference direction x in the body's frame (its part ⟂ z is used);
+                                    ///< default: x, or y when the axis is within 25° of x
+  bool natural = false;             ///< a natural point (and vector): no perpendicular directions
+  std::optional<Point3> vector;     ///< a natural side's axis: a natural unit vector
+
+  /// A body side.
+  static JointSide3 body(const Frame3& f, kin3::V3 at, kin3::V3 axis = {0, 0, 1},
+                         std::optional<kin3::V3> ref = std::nullopt) {
+    JointSide3 s;
+    s.frame = f, s.at = at, s.axis = axis, s.ref = ref;
+    return s;
+  }
+  /// A natural point, with an optional natural unit vector as axis.
+  static JointSide3 natural_point(const Point3& p, std::optional<Point3> vector = std::nullopt) {
+    JointSide3 s;
+    s.frame = Frame3{p.x, p.y, p.z, Slot::constant(1), Slot::constant(0), Slot::constant(0), Slot::constant(0)};
+    s.natural = true, s.vector = vector;
+    return s;
+  }
+};
+
+namespace detail3 {
+/// Indices of the attachments of a joint (SpatialJointSpec::att): the two points, then the joint frames' x, y, z.
+enum Attach : std::int8_t { kPa = 0, kPb, kXa, kYa, kZa, kXb, kYb, kZb, kCount };
+/// A vector term of a row: att[plus] − att[minus] (either may be absent, −1), or the constant unit axis `axis`.
+struct Term {
+  std::int8_t plus = -1, minus = -1, axis = -1;
+};
+constexpr Term T(int plus, int minus = -1) {
+  return Term{static_cast<std::int8_t>(plus), static_cast<std::int8_t>(minus), -1};
+}
+constexpr Term Axis(int k) { return Term{-1, -1, static_cast<std::int8_t>(k)}; }
+/// A row w (X · Y − c) and the unit of its residual.
+struct RowDef {
+  Term x, y;
+  Unit unit;
+};
+
+inline kin3::V3 value(const Attachment3* a, Term t, const double* q) {
+  if (t.axis >= 0) return kin3::unit_axis(t.axis);
+  kin3::V3 v;
+  if (t.plus >= 0) v = a[t.plus].value(q);
+  if (t.minus >= 0) v = v - a[t.minus].value(q);
+  return v;
+}
+inline kin3::V3 rate(const Attachment3* a, Term t, const double* q, const double* qd) {
+  kin3::V3 v;
+  if (t.plus >= 0) v = a[t.plus].rate(q, qd);
+  if (t.minus >= 0) v = v - a[t.minus].rate(q, qd);
+  return v;
+}
+inline kin3::V3 bias(const Attachment3* a, Term t, const double* qd) {
+  kin3::V3 v;
+  if (t.plus >= 0) v = a[t.plus].bias(qd);
+  if (t.minus >= 0) v = v - a[t.minus].bias(qd);
+  return v;
+}
+/// Entries of ∂(w · term)/∂q; `only` as in Attachment3::emit.
+template <class Sink>
+void emit(const Attachment3* a, Term t, Sink& s, int row, kin3::V3 w, const double* q, int only) {
+  if (t.plus >= 0) a[t.plus].emit(s, row, w, q, only);
+  if (t.minus >= 0) a[t.minus].emit(s, row, -w, q, only);
+}
+/// w (X · Y − c)
+inline double row_value(const Attachment3* a, const RowDef& d, const double* q, double w, double c) {
+  return w * (kin3::dot(value(a, d.x, q), value(a, d.y, q)) - c);
+}
+/// Entries of w ∂(X · Y)/∂q: X's with weight w Y, then Y's with weight w X. A constant axis on one side makes all
+/// but one r-component of the other's weight zero: only that one is emitted.
+template <class Sink>
+void row_jacobian(const Attachment3* a, const RowDef& d, const double* q, Sink& s, int row, double w) {
+  const kin3::V3 x = value(a, d.x, q), y = value(a, d.y, q);
+  emit(a, d.x, s, row, w * y, q, d.y.axis);
+  emit(a, d.y, s, row, w * x, q, d.x.axis);
+}
+/// Ẋ · Y + X · Ẏ (times w)
+inline double row_rate(const Attachment3* a, const RowDef& d, const double* q, const double* qd, double w) {
+  return w * (kin3::dot(rate(a, d.x, q, qd), value(a, d.y, q)) + kin3::dot(value(a, d.x, q), rate(a, d.y, q, qd)));
+}
+/// −w (a_X · Y + 2 Ẋ · Ẏ + X · a_Y)
+inline double row_gamma(const Attachment3* a, const RowDef& d, const double* q, const double* qd, double w) {
+  const kin3::V3 x = value(a, d.x, q), y = value(a, d.y, q);
+  return -w * (kin3::dot(bias(a, d.x, qd), y) + 2.0 * kin3::dot(rate(a, d.x, q, qd), rate(a, d.y, q, qd)) +
+               kin3::dot(x, bias(a, d.y, qd)));
+}
+
+/// The attachments of a joint between sides a and b, for the rows `defs` (which say what is needed). Normalises
+/// the axes, makes the reference directions perpendicular. Throws phiq::Error (naming `kind`) for a zero or
+/// non-finite axis, a reference along the axis, non-finite points, and rows that need the perpendicular
+/// directions of a natural side or the axis of a natural point without a vector.
+std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const JointSide3& b, const RowDef* defs,
+                                                  int rows, const char* kind);
+/// The longer arm |at| of the sides whose body moves (the characteristic length of a joint; see PinSpec).
+inline double joint_arm(const JointSide3& a, const JointSide3& b) {
+  const double la = a.frame.is_fixed() ? 0.0 : kin3::norm(a.at), lb = b.frame.is_fixed() ? 0.0 : kin3::norm(b.at);
+  return std::max(la, lb);
+}
+/// Reports the slots of a side: its position (lengths), Euler parameters and vector (unitless).
+template <class F>
+void side_slots(const JointSide3& s, F& f) {
+  f(s.frame.x, Unit::kLength), f(s.frame.y, Unit::kLength), f(s.frame.z, Unit::kLength);
+  f(s.frame.e0, Unit::kNone), f(s.frame.e1, Unit::kNone), f(s.frame.e2, Unit::kNone), f(s.frame.e3, Unit::kNone);
+  if (s.vector) f(s.vector->x, Unit::kNone), f(s.vector->y, Unit::kNone), f(s.vector->z, Unit::kNone);
+}
+}  // namespace detail3
+
+/// A spatial joint between two sides, its rows given by `Traits` (one struct per joint type below). The sides
+/// are data; setup() (called by ModelBuilder::add, or by hand before evaluating a spec built in code) validates
+/// them and derives the attachments the rows read.
+template <class Traits>
+struct SpatialJointSpec {
+  static constexpr int kRows = Traits::kRows;  ///< the freedoms the joint removes
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = Traits::kKind;
+  /// @var a
+  /// @brief Side a: its joint frame carries the axis of one-sided rows (lines, planes).
+  JointSide3 a, b;  ///< side b
+  std::array<Attachment3, detail3::kCount> att{};  ///< derived by setup()
+
+  /// Validates the sides and derives `att`. Throws phiq::Error.
+  void setup() { att = detail3::joint_attachments(a, b, Traits::kRowDefs, kRows, kKind); }
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return false; }
+  /// @copydoc DistanceSpec::row_unit
+  /// Point gaps and offsets from lines and planes are lengths; products of axes are angles.
+  Unit row_unit(int r, const std::vector<Unit>&) const { return Traits::kRowDefs[r].unit; }
+  /// @copydoc DistanceSpec::characteristic_length
+  /// For a joint: the longer arm |at| of a moving side.
+  double characteristic_length() const { return detail3::joint_arm(a, b); }
+  /// @copydoc DistanceSpec::for_each_slot
+  /// A joint reports the frame (and vector) slots of side a, then of side b.
+  template <class F>
+  void for_each_slot(F&& f) const {
+    detail3::side_slots(a, f), detail3::side_slots(b, f);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double, double* phi) const {
+    for (int r = 0; r < kRows; ++r) phi[r] = detail3::row_value(att.data(), Traits::kRowDefs[r], q, 1.0, 0.0);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& s) const {
+    for (int r = 0; r < kRows; ++r) detail3::row_jacobian(att.data(), Traits::kRowDefs[r], q, s, r, 1.0);
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double, double* out) const {
+    for (int r = 0; r < kRows; ++r) out[r] = 0.0;
+  }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double* q, const double* qd, double, double* out) const {
+    for (int r = 0; r < kRows; ++r) out[r] = detail3::row_gamma(att.data(), Traits::kRowDefs[r], q, qd, 1.0);
+  }
+};
+
+namespace joint3 {
+using detail3::Axis;
+using detail3::RowDef;
+using detail3::T;
+using namespace detail3;  // the attachment indices kPa …
+inline constexpr Unit kL = Unit::kLength;  ///< shorthand for the row tables: a length row
+inline constexpr Unit kA = Unit::kAngle;   ///< shorthand for the row tables: an angle row
+
+/// Spherical joint (ball): the points coincide.   Φ = P_a − P_b   (3 rows, lengths)
+struct Spherical {
+  static constexpr int kRows = 3;  ///< rows: the freedoms it removes
+  static constexpr const char* kKind = "spherical";  ///< scene type and diagnostics name
+  /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
+  static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL},
+                                             {Axis(2), T(kPa, kPb), kL}};
+};
+/// Revolute joint: spherical, and the axes parallel.
+///   Φ = [P_a − P_b;  x_a · z_b;  y_a · z_b]   (5 rows: 3 lengths, 2 angles)
+struct Revolute {
+  static constexpr int kRows = 5;  ///< rows: the freedoms it removes
+  static constexpr const char* kKind = "revolute";  ///< scene type and diagnostics name
+  /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
+  static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL},
+                                             {Axis(2), T(kPa, kPb), kL}, {T(kXa), T(kZb), kA},
+                                             {T(kYa), T(kZb), kA}};
+};
+/// Cylindrical joint: the axes parallel, and P_b on the line of a (through P_a along z_a).
+///   Φ = [x_a · z_b;  y_a · z_b;  x_a · (P_b − P_a);  y_a · (P_b − P_a)]   (4 rows: 2 angles, 2 lengths)
+struct Cylindrical {
+  static constexpr int kRows = 4;  ///< rows: the freedoms it removes
+  static constexpr const char* kKind = "cylindrical";  ///< scene type and diagnostics name
+  /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
+  static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kZb), kA}, {T(kYa), T(kZb), kA},
+                                             {T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL}};
+};
+/// Prismatic joint: cylindrical, and no rotation about the axis (x_b stays along x_a).
+///   Φ = [x_a · z_b;  y_a · z_b;  x_a · (P_b − P_a);  y_a · (P_b − P_a);  y_a · x_b]   (5 rows)
+struct Prismatic {
+  static constexpr int kRows = 5;  ///< rows: the freedoms it removes
+  static constexpr const char* kKind = "prismatic";  ///< scene type and diagnostics name
+  /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
+  static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kZb), kA}, {T(kYa), T(kZb), kA},
+                                             {T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL},
+                                             {T(kYa), T(kXb), kA}};
+};
+/// Universal (Hooke) joint: spherical, and the two axes kept perpendicular (the cross).
+///   Φ = [P_a − P_b;  z_a · z_b]   (4 rows: 3 lengths, 1 angle)
+struct Universal {
+  static constexpr int kRows = 4;  ///< rows: the freedoms it removes
+  static constexpr const char* kKind = "universal";  ///< scene type and diagnostics name
+  /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
+  static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL},
+                                             {Axis(2), T(kPa, kPb), kL}, {T(kZa), T(kZb), kA}};
+};
+/// Planar joint: the normals parallel, and P_b in the plane of a (through P_a, normal z_a).
+///   Φ = [x_a · z_b;  y_a · z_b;  z_a · (P_b − P_a)]   (3 rows: 2 angles, 1 length)
+struct Planar {
+  static constexpr int kRows = 3;  ///< rows: the freedoms it removes
+  static constexpr const char* kKind = "planar";  ///< scene type and diagnostics name
+  /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
+  static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kZb), kA}, {T(kYa), T(kZb), kA}, {T(kZa), T(kPb, kPa), kL}};
+};
+/// Rigid joint (weld): the points coincide and the joint frames stay aligned (x_b ∥ x_a, y_b ∥ y_a, z_b ∥ z_a).
+///   Φ = [P_a − P_b;  x_a · y_b;  y_a · z_b;  z_a · x_b]   (6 rows: 3 lengths, 3 angles)
+struct Rigid {
+  static constexpr int kRows = 6;  ///< rows: the freedoms it removes
+  static constexpr const char* kKind = "rigid";  ///< scene type and diagnostics name
+  /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
+  static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL},
+                                             {Axis(2), T(kPa, kPb), kL}, {T(kXa), T(kYb), kA},
+                                             {T(kYa), T(kZb), kA},       {T(kZa), T(kXb), kA}};
+};
+/// Point on line: P_b on the line of a (through P_a along z_a).
+///   Φ = [x_a · (P_b − P_a);  y_a · (P_b − P_a)]   (2 rows, lengths)
+struct PointOnLine {
+  static constexpr int kRows = 2;  ///< rows: the freedoms it removes
+  static constexpr const char* kKind = "point_on_line";  ///< scene type and diagnostics name
+  /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
+  static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL}};
+};
+/// Point on plane: P_b in the plane of a (through P_a, normal z_a).
+///   Φ = z_a · (P_b − P_a)   (1 row, a length)
+struct PointOnPlane {
+  static constexpr int kRows = 1;  ///< rows: the freedoms it removes
+  static constexpr const char* kKind = "point_on_plane";  ///< scene type and diagnostics name
+  /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
+  static constexpr RowDef kRowDefs[kRows] = {{T(kZa), T(kPb, kPa), kL}};
+};
+}  // namespace joint3
+
+using SphericalSpec = SpatialJointSpec<joint3::Spherical>;              ///< scene type `spherical` (dimension 3)
+using SpatialRevoluteSpec = SpatialJointSpec<joint3::Revolute>;         ///< scene type `revolute` (dimension 3)
+using CylindricalSpec = SpatialJointSpec<joint3::Cylindrical>;          ///< scene type `cylindrical`
+using SpatialPrismaticSpec = SpatialJointSpec<joint3::Prismatic>;       ///< scene type `prismatic` (dimension 3)
+using UniversalSpec = SpatialJointSpec<joint3::Universal>;              ///< scene type `universal`
+using PlanarSpec = SpatialJointSpec<joint3::Planar>;                    ///< scene type `planar`
+using RigidSpec = SpatialJointSpec<joint3::Rigid>;                      ///< scene type `rigid`
+using SpatialPointOnLineSpec = SpatialJointSpec<joint3::PointOnLine>;   ///< scene type `point_on_line` (dim. 3)
+using PointOnPlaneSpec = SpatialJointSpec<joint3::PointOnPlane>;        ///< scene type `point_on_plane`
+
+/// Distance between two spatial points (natural points, or points of bodies: a massless bar with a ball joint at
+/// each end):
+///   Φ = (|B − A|² − L²) / (2L)        (1 row, a length ≈ |B − A| − L)
+/// Scene type `distance` (dimension 3).
+struct SpatialDistanceSpec {
+  static constexpr int kRows = 1;  ///< one row, a length
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "distance";
+  Attachment3 ends[2];  ///< A, B
+  double length = 1.0;  ///< L > 0 (checked when added)
+
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return false; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kLength; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return length; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    ends[0].for_each_slot(f, Unit::kLength), ends[1].for_each_slot(f, Unit::kLength);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double, double* phi) const {
+    phi[0] = detail3::row_value(ends, kDef, q, 0.5 / length, length * length);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& s) const {
+    detail3::row_jacobian(ends, kDef, q, s, 0, 0.5 / length);
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double* q, const double* qd, double, double* out) const {
+    out[0] = detail3::row_gamma(ends, kDef, q, qd, 0.5 / length);
+  }
+
+ private:
+  static constexpr detail3::RowDef kDef = {detail3::T(1, 0), detail3::T(1, 0), Unit::kLength};
+};
+
+/// Constant dot product of two directions (3D natural coordinates: the angle between two unit vectors, between a
+/// vector and a segment, or between two segments, of one rigid body). A direction is head − tail: a natural unit
+/// vector (tail the origin) or a segment between two points.
+///   Φ = (D1 · D2 − c) / ref,   ref = |D1|₀ |D2|₀ at the initial placement (1 when that is 0)
+/// Unitless (≈ a change of cos of the angle between them). Scene type `dot`.
+struct DotSpec {
+  static constexpr int kRows = 1;  ///< one row, unitless
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "dot";
+  Attachment3 ends[4];  ///< D1 = ends[0] − ends[1], D2 = ends[2] − ends[3]
+  Unit end_units[2] = {Unit::kLength, Unit::kLength};  ///< what D1's and D2's ends measure (kNone for vectors)
+  double value = 0.0;  ///< c, in the product of the directions' units
+  double ref = 1.0;    ///< set by ModelBuilder::add from the initial placement
+
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return false; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kNone; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return 0.0; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    for (int k = 0; k < 4; ++k) ends[k].for_each_slot(f, end_units[k / 2]);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double, double* phi) const {
+    phi[0] = detail3::row_value(ends, kDef, q, 1.0 / ref, value);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& s) const {
+    detail3::row_jacobian(ends, kDef, q, s, 0, 1.0 / ref);
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double* q, const double* qd, double, double* out) const {
+    out[0] = detail3::row_gamma(ends, kDef, q, qd, 1.0 / ref);
+  }
+
+ private:
+  static constexpr detail3::RowDef kDef = {detail3::T(0, 1), detail3::T(2, 3), Unit::kNone};
+};
+
+/// Driver on the translation of a prismatic or cylindrical joint: the distance of P_b from P_a along z_a.
+///   Φ = z_a · (P_b − P_a) − f(t),   Φt = −f'(t)        (1 row, a length)
+/// Scene: a driver `{joint: NAME, measure: distance}`.
+struct JointDistanceDriverSpec {
+  static constexpr int kRows = 1;  ///< one row, a length
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "joint_distance_driver";
+  /// @var a
+  /// @brief Side a of the driven joint.
+  JointSide3 a, b;  ///< side b of the driven joint
+  MotionLaw law;    ///< f(t), metres
+  std::array<Attachment3, detail3::kCount> att{};  ///< derived by setup()
+
+  /// Validates the sides and derives `att`. Throws phiq::Error.
+  void setup() { att = detail3::joint_attachments(a, b, &kDef, 1, kKind); }
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return true; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kLength; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return 0.0; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    detail3::side_slots(a, f), detail3::side_slots(b, f);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double t, double* phi) const {
+    phi[0] = detail3::row_value(att.data(), kDef, q, 1.0, law.evaluate(t).f);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& s) const {
+    detail3::row_jacobian(att.data(), kDef, q, s, 0, 1.0);
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double t, double* out) const { out[0] = -law.evaluate(t).df; }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double* q, const double* qd, double t, double* out) const {
+    out[0] = detail3::row_gamma(att.data(), kDef, q, qd, 1.0) + law.evaluate(t).ddf;
+  }
+
+ private:
+  static constexpr detail3::RowDef kDef = {detail3::T(detail3::kZa), detail3::T(detail3::kPb, detail3::kPa),
+                                           Unit::kLength};
+};
+
+/// Driver on the rotation of a revolute or cylindrical joint: the angle θ of x_b about z_a measured from x_a,
+/// with c = x_a · x_b and s = y_a · x_b (so x_b = cos θ x_a + sin θ y_a when the axes are aligned):
+///   Φ = atan2(s cos f − c sin f,  c cos f + s sin f)     = θ − f(t) wrapped to (−π, π]
+/// The difference is taken as the angle of (c, s) turned back by f, not as atan2(s, c) − f: smooth at any θ, so a
+/// driver runs through any number of turns. Φq = (c ∂s − s ∂c) / (c² + s²), Φt = −f'(t).
+/// Both sides must be bodies or ground. Scene: a driver `{joint: NAME}` (`measure: angle`).
+struct JointAngleDriverSpec {
+  static constexpr int kRows = 1;  ///< one row, an angle
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "joint_angle_driver";
+  /// @var a
+  /// @brief Side a of the driven joint.
+  JointSide3 a, b;  ///< side b of the driven joint
+  MotionLaw law;    ///< f(t), radians
+  std::array<Attachment3, detail3::kCount> att{};  ///< derived by setup()
+
+  /// Validates the sides and derives `att`. Throws phiq::Error.
+  void setup() { att = detail3::joint_attachments(a, b, kDefs, 2, kKind); }
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return true; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kAngle; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return 0.0; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    detail3::side_slots(a, f), detail3::side_slots(b, f);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double t, double* phi) const {
+    const double c = detail3::row_value(att.data(), kDefs[0], q, 1.0, 0.0);
+    const double s = detail3::row_value(att.data(), kDefs[1], q, 1.0, 0.0);
+    const double f = law.evaluate(t).f, cf = std::cos(f), sf = std::sin(f);
+    phi[0] = std::atan2(s * cf - c * sf, c * cf + s * sf);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  /// @par Joint angle driver
+  /// The entries of ∂c (scaled by −s/ρ) and then of ∂s (scaled by c/ρ), ρ = c² + s²; x_b appears in both and its
+  /// entries add up.
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& sink) const {
+    const double c = detail3::row_value(att.data(), kDefs[0], q, 1.0, 0.0);
+    const double s = detail3::row_value(att.data(), kDefs[1], q, 1.0, 0.0);
+    const double rho = c * c + s * s;
+    detail3::row_jacobian(att.data(), kDefs[0], q, sink, 0, -s / rho);
+    detail3::row_jacobian(att.data(), kDefs[1], q, sink, 0, c / rho);
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double t, double* out) const { out[0] = -law.evaluate(t).df; }
+  /// @copydoc DistanceSpec::gamma
+  /// @par Joint angle driver
+  /// θ̈ = (c s̈ − s c̈)/ρ − (c ṡ − s ċ) ρ̇/ρ², ρ̇ = 2 (c ċ + s ṡ); γ keeps the q̈-free parts of c̈, s̈, plus f''(t).
+  void gamma(const double* q, const double* qd, double t, double* out) const {
+    const Attachment3* a3 = att.data();
+    const double c = detail3::row_value(a3, kDefs[0], q, 1.0, 0.0), s = detail3::row_value(a3, kDefs[1], q, 1.0, 0.0);
+    const double cd = detail3::row_rate(a3, kDefs[0], q, qd, 1.0), sd = detail3::row_rate(a3, kDefs[1], q, qd, 1.0);
+    // row_gamma is −(q̈-free part of the second derivative)
+    const double cb = -detail3::row_gamma(a3, kDefs[0], q, qd, 1.0), sb = -detail3::row_gamma(a3, kDefs[1], q, qd, 1.0);
+    const double rho = c * c + s * s, rhod = 2.0 * (c * cd + s * sd);
+    out[0] = -(c * sb - s * cb) / rho + (c * sd - s * cd) * rhod / (rho * rho) + law.evaluate(t).ddf;
+  }
+
+ private:
+  static constexpr detail3::RowDef kDefs[2] = {{detail3::T(detail3::kXa), detail3::T(detail3::kXb), Unit::kNone},
+                                               {detail3::T(detail3::kYa), detail3::T(detail3::kXb), Unit::kNone}};
+};
+
+}  // namespace phiq

@@ -1,0 +1,72 @@
+// Set-up of the spatial joints: from the sides as given (a body with a local point, axis and reference direction;
+// ground; a natural point and vector) to the attachments their rows read.
+#include "phiq/constraint_kinds_3d.hpp"
+
+namespace phiq::detail3 {
+
+namespace {
+
+bool finite(kin3::V3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// The joint frame (x, y, z) of a body side in the body's frame: z the unit axis, x the unit part of the reference
+// direction perpendicular to z, y = z × x.
+struct LocalFrame {
+  kin3::V3 x, y, z;
+};
+
+LocalFrame local_frame(const JointSide3& s, const std::string& who) {
+  if (!finite(s.axis)) throw Error(who + ": axis is not finite");
+  const double n = kin3::norm(s.axis);
+  if (!(n > 0.0)) throw Error(who + ": axis must not be zero");
+  LocalFrame f;
+  f.z = (1.0 / n) * s.axis;
+  // default reference: x, or y when the axis is within 25° of x (so that the perpendicular part is well defined)
+  kin3::V3 ref = s.ref ? *s.ref : (std::fabs(f.z.x) < std::cos(25.0 * M_PI / 180.0) ? kin3::V3{1, 0, 0}
+                                                                                       : kin3::V3{0, 1, 0});
+  if (!finite(ref)) throw Error(who + ": ref is not finite");
+  const kin3::V3 perp = ref - kin3::dot(ref, f.z) * f.z;
+  const double m = kin3::norm(perp), r = kin3::norm(ref);
+  if (!(r > 0.0) || !(m > 1e-6 * r)) throw Error(who + ": ref must not be zero or along the axis");
+  f.x = (1.0 / m) * perp;
+  f.y = kin3::cross(f.z, f.x);
+  return f;
+}
+
+}  // namespace
+
+std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const JointSide3& b, const RowDef* defs,
+                                                  int rows, const char* kind) {
+  bool used[kCount] = {};
+  for (int r = 0; r < rows; ++r)
+    for (const Term& t : {defs[r].x, defs[r].y}) {
+      if (t.plus >= 0) used[t.plus] = true;
+      if (t.minus >= 0) used[t.minus] = true;
+    }
+  std::array<Attachment3, kCount> att{};
+  const JointSide3* sides[2] = {&a, &b};
+  for (int k = 0; k < 2; ++k) {
+    const JointSide3& s = *sides[k];
+    const std::string who = std::string(kind) + ": side " + (k == 0 ? "a" : "b");
+    const int P = k == 0 ? kPa : kPb, X = k == 0 ? kXa : kXb, Y = k == 0 ? kYa : kYb, Z = k == 0 ? kZa : kZb;
+    if (!finite(s.at)) throw Error(who + ": point is not finite");
+    att[P] = Attachment3::body_point(s.frame, s.at);
+    const bool frame_needed = used[X] || used[Y], axis_needed = used[Z];
+    if (s.natural) {
+      if (frame_needed)
+        throw Error(who + ": needs a body or ground (a natural point and vector define no perpendicular directions)");
+      if (axis_needed) {
+        if (!s.vector) throw Error(who + ": needs an axis (a natural vector, or a body)");
+        att[Z] = Attachment3::natural(*s.vector);
+      }
+      continue;
+    }
+    if (!frame_needed && !axis_needed) continue;
+    const LocalFrame f = local_frame(s, who);
+    att[X] = Attachment3::body_vector(s.frame, f.x);
+    att[Y] = Attachment3::body_vector(s.frame, f.y);
+    att[Z] = Attachment3::body_vector(s.frame, f.z);
+  }
+  return att;
+}
+
+}  // namespace phiq::detail3

@@ -1,0 +1,347 @@
+// Derivative checks of every spatial kind in constraint_kinds_3d.hpp (as test_constraint_kinds.cpp does for the
+// planar ones, with the same machinery: constraint_check.hpp): Jacobian entries, Φt and γ against finite
+// differences at random states (random, unnormalised Euler parameters, random local points, axes and reference
+// directions), the entry sequence independent of the values. Then what the rows mean at exact configurations
+// (a revolute about its axis, an angle over several turns), the errors of bad sides, a whole Model through its CSC
+// pattern, and the Grübler–Kutzbach count of Model::grubler().
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "constraint_check.hpp"
+#include "phiq/constraint_kinds.hpp"
+#include "phiq/constraint_kinds_3d.hpp"
+#include "phiq/model.hpp"
+#include "phiq/motion_law.hpp"
+
+namespace {
+
+using phiq::Frame3;
+using phiq::JointSide3;
+using phiq::Point3;
+using phiq::kin3::V3;
+
+Slot S(Index i) { return Slot::coordinate(i); }
+Slot C(double v) { return Slot::constant(v); }
+
+// Coordinates of the random states: body 0 at 0..6, body 1 at 7..13 (x, y, z, e0..e3), a natural point at 14..16,
+// a natural vector at 17..19, a second natural point at 20..22.
+constexpr int kN = 23;
+Frame3 Body(Index first) {
+  return Frame3{S(first), S(first + 1), S(first + 2), S(first + 3), S(first + 4), S(first + 5), S(first + 6)};
+}
+Point3 Nat(Index first) { return Point3{S(first), S(first + 1), S(first + 2)}; }
+
+// Local data of a side, fixed per test from its own seed: points in [-1, 1]³, axes and references random.
+V3 RandomVector(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  return V3{u(rng), u(rng), u(rng)};
+}
+JointSide3 BodySide(Index first, std::mt19937& rng) {
+  return JointSide3::body(Body(first), RandomVector(rng), RandomVector(rng), RandomVector(rng));
+}
+JointSide3 GroundSide(std::mt19937& rng) {
+  return JointSide3::body(Frame3::ground(), RandomVector(rng), RandomVector(rng), RandomVector(rng));
+}
+
+template <class Spec>
+Spec Joint(const JointSide3& a, const JointSide3& b) {
+  Spec s;
+  s.a = a, s.b = b;
+  s.setup();
+  return s;
+}
+
+// Every joint type between two moving bodies, and with ground on either side.
+template <class Spec>
+void CheckJoint(std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  {
+    SCOPED_TRACE("body - body");
+    CheckSpec(Joint<Spec>(BodySide(0, rng), BodySide(7, rng)), kN, Opts(seed));
+  }
+  {
+    SCOPED_TRACE("ground - body");
+    CheckSpec(Joint<Spec>(GroundSide(rng), BodySide(7, rng)), kN, Opts(seed + 1));
+  }
+  {
+    SCOPED_TRACE("body - ground");
+    CheckSpec(Joint<Spec>(BodySide(0, rng), GroundSide(rng)), kN, Opts(seed + 2));
+  }
+}
+
+// ---- normalisations ---------------------------------------------------------------------------------------------
+
+TEST(ConstraintKinds3d, EulerParameters) {
+  CheckSpec(phiq::EulerParametersSpec{{S(3), S(4), S(5), S(6)}}, 7, Opts(301));
+  // the row is (|p|² − 1) / 2: zero on the unit sphere, whatever the orientation
+  const phiq::EulerParametersSpec e{{S(0), S(1), S(2), S(3)}};
+  const double q[4] = {0.5, -0.5, 0.5, 0.5}, q2[4] = {2, 0, 0, 0};
+  double phi = 1.0;
+  e.residual(q, 0.0, &phi);
+  EXPECT_EQ(phi, 0.0);
+  e.residual(q2, 0.0, &phi);
+  EXPECT_EQ(phi, 1.5);
+}
+
+TEST(ConstraintKinds3d, UnitVector) { CheckSpec(phiq::UnitVectorSpec{Nat(17)}, kN, Opts(302)); }
+
+// ---- joints -----------------------------------------------------------------------------------------------------
+
+TEST(ConstraintKinds3d, Spherical) { CheckJoint<phiq::SphericalSpec>(310); }
+TEST(ConstraintKinds3d, Revolute) { CheckJoint<phiq::SpatialRevoluteSpec>(320); }
+TEST(ConstraintKinds3d, Prismatic) { CheckJoint<phiq::SpatialPrismaticSpec>(330); }
+TEST(ConstraintKinds3d, Cylindrical) { CheckJoint<phiq::CylindricalSpec>(340); }
+TEST(ConstraintKinds3d, Universal) { CheckJoint<phiq::UniversalSpec>(350); }
+TEST(ConstraintKinds3d, Planar) { CheckJoint<phiq::PlanarSpec>(360); }
+TEST(ConstraintKinds3d, Rigid) { CheckJoint<phiq::RigidSpec>(370); }
+TEST(ConstraintKinds3d, PointOnLine) { CheckJoint<phiq::SpatialPointOnLineSpec>(380); }
+TEST(ConstraintKinds3d, PointOnPlane) { CheckJoint<phiq::PointOnPlaneSpec>(390); }
+
+TEST(ConstraintKinds3d, JointsWithNaturalSides) {
+  std::mt19937 rng(400);
+  // a body point pinned to a natural point (mixed coordinates)
+  CheckSpec(Joint<phiq::SphericalSpec>(BodySide(0, rng), JointSide3::natural_point(Nat(14))), kN, Opts(401));
+  // two natural points
+  CheckSpec(Joint<phiq::SphericalSpec>(JointSide3::natural_point(Nat(20)), JointSide3::natural_point(Nat(14))), kN,
+            Opts(402));
+  // a revolute whose side b is a natural point and vector
+  CheckSpec(Joint<phiq::SpatialRevoluteSpec>(BodySide(0, rng), JointSide3::natural_point(Nat(14), Nat(17))), kN,
+            Opts(403));
+  // a universal joint between two natural vectors' ends (the cross: u · v = 0)
+  CheckSpec(Joint<phiq::UniversalSpec>(JointSide3::natural_point(Nat(20), Nat(17)), BodySide(7, rng)), kN,
+            Opts(404));
+  // a natural point on a body's plane, on a body's line
+  CheckSpec(Joint<phiq::PointOnPlaneSpec>(BodySide(0, rng), JointSide3::natural_point(Nat(14))), kN, Opts(405));
+  CheckSpec(Joint<phiq::SpatialPointOnLineSpec>(BodySide(7, rng), JointSide3::natural_point(Nat(20))), kN,
+            Opts(406));
+}
+
+// ---- natural-coordinate rigid-body conditions ---------------------------------------------------------------------
+
+TEST(ConstraintKinds3d, Distance) {
+  phiq::SpatialDistanceSpec between_points{
+      {phiq::Attachment3::natural(Nat(14)), phiq::Attachment3::natural(Point3{S(20), C(0.3), S(22)})}, 1.7};
+  CheckSpec(between_points, kN, Opts(410));
+  // a bar with ball joints at two body points
+  phiq::SpatialDistanceSpec between_bodies{
+      {phiq::Attachment3::body_point(Body(0), V3{0.3, -0.2, 0.5}), phiq::Attachment3::body_point(Body(7), V3{-1, 0.4, 0})},
+      0.45};
+  CheckSpec(between_bodies, kN, Opts(411));
+}
+
+TEST(ConstraintKinds3d, DotOfVectorsAndSegments) {
+  using phiq::Attachment3;
+  phiq::DotSpec vv;  // u · v = cos α between two natural vectors
+  vv.ends[0] = Attachment3::natural(Nat(17)), vv.ends[1] = Attachment3::zero();
+  vv.ends[2] = Attachment3::natural(Nat(14)), vv.ends[3] = Attachment3::zero();
+  vv.end_units[0] = vv.end_units[1] = phiq::Unit::kNone;
+  vv.value = 0.3;
+  CheckSpec(vv, kN, Opts(420));
+  phiq::DotSpec vs;  // u · (B − A), with a ref as the builder sets it
+  vs.ends[0] = Attachment3::natural(Nat(17)), vs.ends[1] = Attachment3::zero();
+  vs.ends[2] = Attachment3::natural(Nat(20)), vs.ends[3] = Attachment3::natural(Nat(14));
+  vs.end_units[0] = phiq::Unit::kNone;
+  vs.value = -0.8, vs.ref = 1.3;
+  CheckSpec(vs, kN, Opts(421));
+}
+
+// ---- drivers ------------------------------------------------------------------------------------------------------
+
+TEST(ConstraintKinds3d, JointAngleDriver) {
+  std::mt19937 rng(430);
+  phiq::JointAngleDriverSpec d;
+  d.a = BodySide(0, rng), d.b = BodySide(7, rng);
+  d.law = phiq::MotionLaw::harmonic(0.4, 2.5, 1.3, 0.2);
+  d.setup();
+  CheckSpec(d, kN, Opts(431, true));
+  d.a = GroundSide(rng);
+  d.law = phiq::MotionLaw::polynomial({0.1, -3.0, 0.7});
+  d.setup();
+  CheckSpec(d, kN, Opts(432, true));
+}
+
+TEST(ConstraintKinds3d, JointDistanceDriver) {
+  std::mt19937 rng(440);
+  phiq::JointDistanceDriverSpec d;
+  d.a = BodySide(0, rng), d.b = BodySide(7, rng);
+  d.law = phiq::MotionLaw::harmonic(0.1, 0.5, 2.0, 0.0);
+  d.setup();
+  CheckSpec(d, kN, Opts(441, true));
+}
+
+// ---- what the rows mean -------------------------------------------------------------------------------------------
+
+// Euler parameters of a rotation by `angle` about the unit axis u.
+std::vector<double> Quaternion(V3 u, double angle) {
+  const double s = std::sin(angle / 2);
+  return {std::cos(angle / 2), s * u.x, s * u.y, s * u.z};
+}
+
+TEST(ConstraintKinds3d, RevoluteHoldsAboutItsAxisAndTheDriverMeasuresFullTurns) {
+  // body about the ground axis (1, 2, 2)/3 through (0.5, −1, 2); the body's local point is (0.5, −1, 2) − r
+  const V3 axis{1.0 / 3, 2.0 / 3, 2.0 / 3}, pivot{0.5, -1.0, 2.0};
+  for (double angle : {0.0, 1.0, 3.0, -3.0, 7.0, -12.5}) {
+    SCOPED_TRACE("angle " + std::to_string(angle));
+    // body frame: reference point r0 = pivot + R (−local), with local = (0.2, 0.1, −0.3) in the body
+    const std::vector<double> p = Quaternion(axis, angle);
+    const V3 local{0.2, 0.1, -0.3};
+    const V3 r = pivot - phiq::kin3::rotate(p.data(), local);
+    const std::vector<double> q = {r.x, r.y, r.z, p[0], p[1], p[2], p[3]};
+    JointSide3 g = JointSide3::body(Frame3::ground(), pivot, axis, V3{0, 1, -1});
+    JointSide3 b = JointSide3::body(Body(0), local, axis, V3{0, 1, -1});
+    auto rev = Joint<phiq::SpatialRevoluteSpec>(g, b);
+    double phi[5];
+    rev.residual(q.data(), 0.0, phi);
+    for (double v : phi) EXPECT_NEAR(v, 0.0, 1e-14);
+    // the angle driver with f = angle is zero; with f = angle + 0.25 it is −0.25 (wrapped differences are exact)
+    phiq::JointAngleDriverSpec d;
+    d.a = g, d.b = b, d.law = phiq::MotionLaw::linear(angle, 0.0);
+    d.setup();
+    double a = 1.0;
+    d.residual(q.data(), 0.0, &a);
+    EXPECT_NEAR(a, 0.0, 1e-13);
+    d.law = phiq::MotionLaw::linear(angle + 0.25, 0.0);
+    d.residual(q.data(), 0.0, &a);
+    EXPECT_NEAR(a, -0.25, 1e-13);
+    // a prismatic on the same axis is violated only by the rotation: y_a · x_b = sin(angle)
+    auto pri = Joint<phiq::SpatialPrismaticSpec>(g, b);
+    double pp[5];
+    pri.residual(q.data(), 0.0, pp);
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(pp[k], 0.0, 1e-14);
+    EXPECT_NEAR(pp[4], std::sin(angle), 1e-14);
+  }
+}
+
+TEST(ConstraintKinds3d, BadSidesAreErrors) {
+  auto setup_error = [](auto spec) -> std::string {
+    try {
+      spec.setup();
+    } catch (const phiq::Error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  phiq::SpatialRevoluteSpec r;
+  r.a = JointSide3::body(Frame3::ground(), V3{}, V3{0, 0, 0});
+  r.b = JointSide3::body(Body(0), V3{});
+  EXPECT_NE(setup_error(r).find("revolute: side a: axis must not be zero"), std::string::npos) << setup_error(r);
+  r.a = JointSide3::body(Frame3::ground(), V3{}, V3{0, 0, 1}, V3{0, 0, 2});
+  EXPECT_NE(setup_error(r).find("ref must not be zero or along the axis"), std::string::npos);
+  r.a = JointSide3::natural_point(Nat(14), Nat(17));
+  EXPECT_NE(setup_error(r).find("side a: needs a body or ground"), std::string::npos);
+  r.a = JointSide3::body(Frame3::ground(), V3{});
+  r.b = JointSide3::natural_point(Nat(14));
+  EXPECT_NE(setup_error(r).find("side b: needs an axis"), std::string::npos);
+  r.b = JointSide3::body(Body(0), V3{std::nan(""), 0, 0});
+  EXPECT_NE(setup_error(r).find("point is not finite"), std::string::npos);
+}
+
+// ---- Model plumbing and the Grübler–Kutzbach count -------------------------------------------------------------
+
+phiq::Frame3 AddBody(phiq::ModelBuilder& b, const std::string& name) {
+  Index i = b.add_coordinate(name + "_x", 0.1);
+  for (const char* c : {"_y", "_z", "_e0", "_e1", "_e2", "_e3"}) b.add_coordinate(name + c, 0.2);
+  const Frame3 f = Body(i);
+  b.add_body(name, f);
+  return f;
+}
+
+TEST(ConstraintKinds3d, ModelOfSpatialKindsThroughItsPattern) {
+  phiq::ModelBuilder b;
+  const Frame3 crank = AddBody(b, "crank"), rocker = AddBody(b, "rocker");
+  b.add("hinge", phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{0, 0, 0}),
+                                           JointSide3::body(crank, V3{0, 0, 0}), {}});
+  b.add("pivot", phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{1, 0.5, 0}, V3{1, 0, 0}),
+                                           JointSide3::body(rocker, V3{0, 0, 0}, V3{1, 0, 0}), {}});
+  b.add("coupler", phiq::SpatialDistanceSpec{{phiq::Attachment3::body_point(crank, V3{0.2, 0, 0}),
+                                              phiq::Attachment3::body_point(rocker, V3{0, 0.6, 0})},
+                                             0.9});
+  phiq::JointAngleDriverSpec motor;
+  motor.a = JointSide3::body(Frame3::ground(), V3{}), motor.b = JointSide3::body(crank, V3{});
+  motor.law = phiq::MotionLaw::linear(0.0, 1.0);
+  b.add("motor", motor);
+  const phiq::Model m = std::move(b).build();
+  EXPECT_EQ(m.num_coordinates(), 14);
+  EXPECT_EQ(m.num_equations(), 14);  // 2 normalisations + 5 + 5 + 1 + driver
+  EXPECT_EQ(m.constraints()[0].name, "crank.euler");
+  EXPECT_EQ(m.constraints()[0].kind, "euler_parameters");
+  EXPECT_EQ(m.row_unit(m.constraints()[2].first_row + 3), phiq::Unit::kAngle);  // hinge's x_a · z_b
+  EXPECT_EQ(m.row_unit(m.constraints()[2].first_row), phiq::Unit::kLength);
+  EXPECT_EQ(m.coordinate_unit(0), phiq::Unit::kLength);
+  EXPECT_EQ(m.coordinate_unit(3), phiq::Unit::kNone);
+  // RSSR: 6 · 2 − 5 − 5 − 1 = 1 (the driver is not counted)
+  ASSERT_TRUE(m.grubler().has_value());
+  EXPECT_EQ(*m.grubler(), 1);
+  EXPECT_EQ(m.body_names(), (std::vector<std::string>{"crank", "rocker"}));
+  CheckModel(m, 450);
+}
+
+TEST(Grubler, PlanarReferencePointFourBarIsOne) {
+  phiq::ModelBuilder b;
+  std::vector<phiq::Frame2> f;
+  for (const char* n : {"crank", "coupler", "rocker"}) {
+    Index i = b.add_coordinate(std::string(n) + "_x", 0.0);
+    b.add_coordinate(std::string(n) + "_y", 0.0), b.add_coordinate(std::string(n) + "_psi", 0.0);
+    f.push_back(phiq::Frame2{S(i), S(i + 1), S(i + 2)});
+    b.add_body(n, f.back());
+  }
+  const phiq::Frame2 ground{C(0), C(0), C(0)};
+  b.add("O", phiq::PinSpec{ground, f[0], {0, 0}, {-0.5, 0}});
+  b.add("A", phiq::PinSpec{f[0], f[1], {0.5, 0}, {-1, 0}});
+  b.add("B", phiq::PinSpec{f[1], f[2], {1, 0}, {0.5, 0}});
+  b.add("C", phiq::PinSpec{f[2], ground, {-0.5, 0}, {2, 0}});
+  b.add_driver("motor", 2, phiq::MotionLaw::linear(0, 1));
+  const phiq::Model m = std::move(b).build();
+  ASSERT_TRUE(m.grubler().has_value());
+  EXPECT_EQ(*m.grubler(), 1);  // 3 · 3 − 4 · 2
+}
+
+TEST(Grubler, UndefinedWithoutBodiesOrWithNonJoints) {
+  {  // natural coordinates: no bodies
+    phiq::ModelBuilder b;
+    b.add_coordinate("x", 1), b.add_coordinate("y", 0);
+    b.add("bar", phiq::DistanceSpec{{C(0), C(0)}, {S(0), S(1)}, 1.0});
+    b.add_driver("motor", 0, phiq::MotionLaw::linear(1, 0));
+    EXPECT_FALSE(std::move(b).build().grubler().has_value());
+  }
+  {  // a body with a joint and a natural point joined to it: the pin to a natural point is not a joint
+    phiq::ModelBuilder b;
+    b.add_coordinate("x", 0), b.add_coordinate("y", 0), b.add_coordinate("psi", 0);
+    b.add_coordinate("px", 1), b.add_coordinate("py", 0);
+    const phiq::Frame2 f{S(0), S(1), S(2)};
+    b.add_body("bar", f);
+    b.add("O", phiq::PinSpec{phiq::Frame2{C(0), C(0), C(0)}, f, {0, 0}, {0, 0}});
+    b.add("P", phiq::PinSpec{f, phiq::Frame2{S(3), S(4), C(0)}, {1, 0}, {0, 0}});
+    EXPECT_FALSE(std::move(b).build().grubler().has_value());
+  }
+  {  // a spatial body and a planar joint mixed
+    phiq::ModelBuilder b;
+    const Frame3 f = AddBody(b, "door");
+    b.add("hinge", phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{}),
+                                             JointSide3::body(f, V3{}), {}});
+    b.add("flat", phiq::PinSpec{phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{S(0), S(1), S(4)}, {0, 0}, {0, 0}});
+    EXPECT_FALSE(std::move(b).build().grubler().has_value());
+  }
+  {  // a spatial door on three hinges: 6 − 15
+    phiq::ModelBuilder b;
+    const Frame3 f = AddBody(b, "door");
+    for (int k = 0; k < 3; ++k)
+      b.add("hinge" + std::to_string(k), phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{0, 0, 1.0 * k}),
+                                                                   JointSide3::body(f, V3{0, 0, 1.0 * k}), {}});
+    const phiq::Model m = std::move(b).build();
+    ASSERT_TRUE(m.grubler().has_value());
+    EXPECT_EQ(*m.grubler(), -9);
+  }
+}
+
+TEST(Grubler, DuplicateBodyNameIsAnError) {
+  phiq::ModelBuilder b;
+  AddBody(b, "door");
+  EXPECT_THROW(b.add_body("door", phiq::Frame2{C(0), C(0), C(0)}), phiq::Error);
+}
+
+}  // namespace

@@ -1,0 +1,243 @@
+// Scenes of dimension 3: what a good scene builds (bodies with their Euler normalisation, natural points and unit
+// vectors, joints, joint drivers, families) and the one-line errors of bad ones, as test_scene.cpp does in the
+// plane.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "phiq/phiq.hpp"
+
+namespace phiq {
+namespace {
+
+// A door on one hinge, driven by its angle; a natural point and vector beside it.
+const char* kGood = R"(phiq: 1
+dimension: 3
+parameters: {h: 2}
+coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}
+bodies:
+  door: [x, y, z, e0, e1, e2, e3]
+constraints:
+  - {name: hinge, type: revolute, between: [{body: ground, at: [0, 0, h], axis: [0, 0, 1]}, {body: door, at: [0, 0, h]}]}
+drivers:
+  - {name: open, joint: hinge, law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 1, steps: 4}
+)";
+
+std::string variant(const std::string& from, const std::string& to) {
+  std::string s = kGood;
+  auto p = s.find(from);
+  EXPECT_NE(p, std::string::npos) << from;
+  return s.replace(p, from.size(), to);
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_scene(text, "bad.yaml");
+  } catch (const SceneError& e) {
+    std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+    EXPECT_EQ(m.rfind("bad.yaml:", 0), 0u) << m;
+    return m;
+  }
+  ADD_FAILURE() << "no error for:\n" << text;
+  return "";
+}
+
+#define EXPECT_HAS(msg, part) EXPECT_NE((msg).find(part), std::string::npos) << (msg)
+
+TEST(Scene3d, GoodSceneBuildsBodiesJointsAndDrivers) {
+  Scene s = parse_scene(kGood, "good.yaml");
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 7);
+  EXPECT_EQ(m.num_equations(), 7);
+  ASSERT_EQ(m.constraints().size(), 3u);
+  EXPECT_EQ(m.constraints()[0].name, "door.euler");
+  EXPECT_EQ(m.constraints()[0].kind, "euler_parameters");
+  EXPECT_EQ(m.constraints()[1].kind, "revolute");
+  EXPECT_EQ(m.constraints()[1].rows, 5);
+  EXPECT_EQ(m.constraints()[2].kind, "joint_angle_driver");
+  EXPECT_EQ(*m.grubler(), 1);
+  // it runs: the door turns by t about z
+  Workspace ws(m);
+  std::vector<double> last;
+  const auto keep_last = [&](const StepView& v) {
+    last.assign(v.q.data(), v.q.data() + 7);
+    return true;
+  };
+  ASSERT_EQ(run_sweep(m, s.sweep, ws, keep_last, nullptr), SolveStatus::kSuccess);
+  ASSERT_EQ(last.size(), 7u);
+  EXPECT_NEAR(std::fabs(last[3]), std::cos(0.5), 1e-10);  // a turn of 1 rad about z at t = 1 (p up to sign)
+  EXPECT_NEAR(std::fabs(last[6]), std::sin(0.5), 1e-10);
+}
+
+TEST(Scene3d, NaturalPointsVectorsDotAndDistance) {
+  // a rigid body in 3D natural coordinates: two points and a unit vector, the point O fixed
+  const char* text = R"(phiq: 1
+dimension: 3
+coordinates: {ax: 1, ay: 0, az: 0, ux: 0, uy: 0, uz: 1}
+points: {O: [0, 0, 0], A: [ax, ay, az]}
+vectors: {u: [ux, uy, uz]}
+constraints:
+  - {name: bar, type: distance, points: [O, A], length: 1}
+  - {name: square, type: dot, directions: [u, [O, A]], value: 0}
+  - {name: plane, type: equation, expr: "az", unit: length}
+  - {name: up, type: dot, directions: [u, u], value: 1}
+drivers:
+  - {name: turn, expr: "ay", unit: length, law: {type: linear, initial: 0, rate: 0.5}}
+  - {name: lock, coordinate: ux, law: {type: linear, initial: 0, rate: 0}}
+time: {start: 0, end: 1, steps: 2}
+)";
+  Scene s = parse_scene(text, "natural.yaml");  // u.unit and `up` say the same: 7 equations for 6 coordinates
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 6);
+  EXPECT_EQ(m.num_equations(), 7);
+  EXPECT_EQ(m.constraints()[0].name, "u.unit");
+  EXPECT_FALSE(m.grubler().has_value());  // natural coordinates: no joints
+  Eigen::VectorXd q(6);
+  q << 0.8, 0.6, 0, 0, 0, 1;
+  Eigen::VectorXd phi(7);
+  m.residual(q.data(), 1.2, phi.data());
+  EXPECT_LT(phi.lpNorm<Eigen::Infinity>(), 1e-15);  // ay = 0.5 · 1.2
+}
+
+TEST(Scene3d, FamiliesMakeChainsOfBodies) {
+  const char* text = R"(phiq: 1
+dimension: 3
+parameters: {N: 3}
+coordinates:
+  for i in 1..N:
+    x{i}: i - 1
+    y{i}: 0
+    z{i}: 0
+    p{i}: 1
+    q{i}: 0
+    r{i}: 0
+    s{i}: 0
+bodies:
+  for i in 1..N:
+    B{i}: ["x{i}", "y{i}", "z{i}", "p{i}", "q{i}", "r{i}", "s{i}"]
+constraints:
+  - {name: base, type: spherical, between: [{body: ground}, {body: B1}]}
+  - for i in 1..N-1:
+      - {name: "link{i}", type: universal, between: [{body: "B{i}", at: [1, 0, 0], axis: [0, 0, 1]}, {body: "B{i+1}", axis: [0, 1, 0]}]}
+time: {start: 0, end: 1, steps: 1}
+)";
+  Scene s = parse_scene(text, "chain.yaml");
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 21);
+  EXPECT_EQ(m.num_equations(), 3 + 3 + 2 * 4);
+  EXPECT_EQ(*m.grubler(), 18 - 3 - 8);
+  EXPECT_EQ(m.body_names(), (std::vector<std::string>{"B1", "B2", "B3"}));
+  EXPECT_EQ(m.constraints()[4].name, "link1");
+}
+
+// A screw-like motion: a body on a cylindrical joint to ground along the axis (1, 1, 0)/√2, its turn and its travel
+// driven separately (7 coordinates: 1 normalisation + 4 + 2 drivers); and a slider on a prismatic joint driven by
+// its travel. Swept by the square solver; the body's origin must be at d · axis, turned by θ about the axis.
+TEST(Scene3d, JointDriversTurnAndSlide) {
+  const char* text = R"(phiq: 1
+dimension: 3
+parameters: {s: 0.7071067811865476}
+coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0, px: 0, py: 0, pz: 0, p0: 1, p1: 0, p2: 0, p3: 0}
+bodies:
+  screw: [x, y, z, e0, e1, e2, e3]
+  slider: [px, py, pz, p0, p1, p2, p3]
+constraints:
+  - {name: cyl, type: cylindrical, between: [{body: ground, axis: [s, s, 0]}, {body: screw, axis: [s, s, 0]}]}
+  - {name: rail, type: prismatic, between: [{body: ground, at: [0, 0, 1], axis: [0, 0, 1]}, {body: slider, axis: [0, 0, 1]}]}
+drivers:
+  - {name: turn, joint: cyl, measure: angle, law: {type: linear, initial: 0, rate: 2}}
+  - {name: travel, joint: cyl, measure: distance, law: {type: linear, initial: 0, rate: 0.5}}
+  - {name: lift, joint: rail, law: {type: polynomial, coefficients: [0, 0, 1]}}
+time: {start: 0, end: 2, steps: 20}
+output: {velocities: true}
+)";
+  Scene sc = parse_scene(text, "screw.yaml");
+  const Model& m = *sc.model;
+  EXPECT_EQ(m.num_coordinates(), 14);
+  EXPECT_EQ(m.num_equations(), 14);
+  EXPECT_EQ(*m.grubler(), 12 - 4 - 5);  // 3: the three drivers take them
+  EXPECT_EQ(m.constraints()[5].kind, "joint_distance_driver");
+  Workspace ws(m);
+  std::vector<std::vector<double>> q, qd;
+  const auto keep = [&](const StepView& v) {
+    q.emplace_back(v.q.data(), v.q.data() + 14);
+    qd.emplace_back(v.qd->data(), v.qd->data() + 14);
+    return true;
+  };
+  ASSERT_EQ(run_sweep(m, sc.sweep, ws, keep, nullptr), SolveStatus::kSuccess);
+  ASSERT_EQ(q.size(), 21u);
+  const double s = std::sqrt(0.5);
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    const double t = 0.1 * static_cast<double>(k), th = 2 * t, d = 0.5 * t;
+    SCOPED_TRACE("t = " + std::to_string(t));
+    EXPECT_NEAR(q[k][0], d * s, 1e-10);
+    EXPECT_NEAR(q[k][1], d * s, 1e-10);
+    EXPECT_NEAR(q[k][2], 0.0, 1e-10);
+    // Euler parameters of a turn θ about the axis, up to the sign of the whole quaternion
+    const double e[4] = {std::cos(th / 2), s * std::sin(th / 2), s * std::sin(th / 2), 0.0};
+    const double sign = q[k][3] * e[0] + q[k][4] * e[1] + q[k][5] * e[2] + q[k][6] * e[3] < 0 ? -1.0 : 1.0;
+    for (int i = 0; i < 4; ++i) EXPECT_NEAR(sign * q[k][3 + i], e[i], 1e-10) << "e" << i;
+    EXPECT_NEAR(qd[k][0], 0.5 * s, 1e-10);  // the travel's rate along the axis
+    // the slider: lifted to 1 + t² along z, not turned
+    EXPECT_NEAR(q[k][9], 1.0 + t * t, 1e-10);
+    EXPECT_NEAR(qd[k][9], 2 * t, 1e-10);
+    EXPECT_NEAR(std::fabs(q[k][10]), 1.0, 1e-10);
+  }
+}
+
+TEST(Scene3d, BadInputIsOneLineNamingTheField) {
+  EXPECT_HAS(error_of(variant("axis: [0, 0, 1]}", "axis: [0, 0, 0]}")), "between[0].axis: must not be the zero vector");
+  EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: dor, at: [0, 0, h]}")), "unknown body 'dor'");
+  EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: door, at: [0, h]}")),
+             "between[1].at: expected a list of 3 numbers");
+  EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: door, ref: [0, 0, 3]}")),
+             "ref must not be zero or along the axis");
+  EXPECT_HAS(error_of(variant("door: [x, y, z, e0, e1, e2, e3]", "door: [x, y, z]")),
+             "a body is [x, y, z, e0, e1, e2, e3] (dimension: 3)");
+  EXPECT_HAS(error_of(variant("type: revolute", "type: polar")), "'polar' is a planar constraint");
+  EXPECT_HAS(error_of(variant("type: revolute", "type: hinge")), "unknown constraint type 'hinge'");
+  EXPECT_HAS(error_of(variant("joint: hinge", "joint: hing")), "drivers[0].joint: unknown joint 'hing'");
+  EXPECT_HAS(error_of(variant("joint: hinge,", "joint: hinge, measure: distance,")),
+             "joint 'hinge' is a revolute joint");
+  EXPECT_HAS(error_of(variant("type: revolute", "type: cylindrical")), "needs 'measure: angle' or 'measure: distance'");
+  EXPECT_HAS(error_of(variant("type: revolute", "type: spherical")), "joint 'hinge' is a spherical joint");
+  EXPECT_HAS(error_of(variant("joint: hinge,", "joint: hinge, coordinate: x,")), "one of 'coordinate', 'expr' or 'joint'");
+  EXPECT_HAS(error_of(variant("{body: ground, at: [0, 0, h], axis: [0, 0, 1]}", "{point: P}")), "unknown point 'P'");
+  const std::string with_point = variant("bodies:", "points: {P: [1, 2, 3]}\nbodies:");
+  const std::string natural_a = with_point.substr(0, with_point.find("{body: ground")) + "{point: P}" +
+                                with_point.substr(with_point.find(", {body: door"));
+  EXPECT_HAS(error_of(natural_a), "side a: needs a body or ground");
+  EXPECT_HAS(error_of(variant("bodies:", "points: {P: [1, 2]}\nbodies:")), "a point is [x, y, z] (dimension: 3)");
+  EXPECT_HAS(error_of(variant("bodies:", "vectors: {u: [1, 2]}\nbodies:")), "a vector is [ux, uy, uz]");
+  EXPECT_HAS(error_of(variant("bodies:", "points: {door: [1, 2, 3]}\nbodies:")), "duplicate point, body or vector name");
+  EXPECT_HAS(error_of(variant("dimension: 3", "dimension: 4")), "dimension");
+}
+
+TEST(Scene3d, SpatialInputInAPlanarSceneIsAnError) {
+  const std::string planar = R"(phiq: 1
+coordinates: {x: 0, y: 0, psi: 0}
+bodies: {B: [x, y, psi]}
+constraints:
+  - {name: pin, type: revolute, between: [{body: ground}, {body: B}]}
+drivers:
+  - {name: motor, coordinate: psi, law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 1, steps: 1}
+)";
+  auto planar_variant = [&](const std::string& from, const std::string& to) {
+    std::string s = planar;
+    return s.replace(s.find(from), from.size(), to);
+  };
+  EXPECT_HAS(error_of(planar_variant("type: revolute", "type: spherical")),
+             "'spherical' is a spatial constraint: it needs 'dimension: 3'");
+  EXPECT_HAS(error_of(planar_variant("bodies:", "vectors: {u: [1, 0, 0]}\nbodies:")), "need 'dimension: 3'");
+  EXPECT_HAS(error_of(planar_variant("coordinate: psi,", "joint: pin,")), "joint drivers need 'dimension: 3'");
+  // a planar reference-point body is counted: one body, one pin: 3 − 2 = 1
+  EXPECT_EQ(*parse_scene(planar, "planar.yaml").model->grubler(), 1);
+}
+
+}  // namespace
+}  // namespace phiq

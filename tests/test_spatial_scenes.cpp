@@ -1,0 +1,278 @@
+// The spatial scenes of models/: they load with the expected counts and Grübler number, their residuals vanish at
+// configurations known in closed form and Φq q̇ + Φt = 0 holds with closed-form velocities; a dense SVD of Φq
+// (independent of the engine's sparse solvers) shows the one degree of freedom of the redundant ones; the RSSR
+// four-bar, not redundant, is swept end to end and agrees with its closed form.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+Scene Load(const std::string& rel) { return load_scene(test::model_path(rel)); }
+
+Eigen::MatrixXd DenseJacobian(const Model& m, const Eigen::VectorXd& q, double t) {
+  const CscPattern& p = m.jacobian_pattern();
+  std::vector<double> v(static_cast<std::size_t>(p.nnz()));
+  m.jacobian(q.data(), t, v.data());
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(m.num_equations(), m.num_coordinates());
+  for (Index j = 0; j < p.cols; ++j)
+    for (Index k = p.col_ptr[j]; k < p.col_ptr[j + 1]; ++k) J(p.row_idx[k], j) = v[k];
+  return J;
+}
+
+Eigen::VectorXd Residual(const Model& m, const Eigen::VectorXd& q, double t) {
+  Eigen::VectorXd phi(m.num_equations());
+  m.residual(q.data(), t, phi.data());
+  return phi;
+}
+
+// Φq q̇ + Φt, which vanishes for the velocity of a motion that keeps Φ = 0.
+Eigen::VectorXd VelocityResidual(const Model& m, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t) {
+  Eigen::VectorXd pt(m.num_equations());
+  m.phi_t(q.data(), t, pt.data());
+  return DenseJacobian(m, q, t) * qd + pt;
+}
+
+// Numerical rank of the kinematic rows (all but the drivers, which are the last `drivers` rows) by dense SVD,
+// relative tolerance 1e-9.
+Index KinematicRank(const Model& m, const Eigen::VectorXd& q, Index drivers) {
+  const Eigen::MatrixXd J = DenseJacobian(m, q, 0.0).topRows(m.num_equations() - drivers);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(J);
+  const Eigen::VectorXd s = svd.singularValues();
+  Index r = 0;
+  for (Index i = 0; i < s.size(); ++i) r += s(i) > 1e-9 * s(0) ? 1 : 0;
+  return r;
+}
+
+// Position, then Euler parameters of a rotation by `angle` about z, into q at `first`.
+void PutBody(Eigen::VectorXd& q, Index first, double x, double y, double angle) {
+  q.segment(first, 7) << x, y, 0.0, std::cos(angle / 2), 0.0, 0.0, std::sin(angle / 2);
+}
+// Their time derivatives for a body moving at (vx, vy) and turning at rate w about z.
+void PutBodyRate(Eigen::VectorXd& qd, Index first, double vx, double vy, double angle, double w) {
+  qd.segment(first, 7) << vx, vy, 0.0, -0.5 * w * std::sin(angle / 2), 0.0, 0.0, 0.5 * w * std::cos(angle / 2);
+}
+
+// ---- the notes' 3D crank-slider -------------------------------------------------------------------------------
+
+TEST(SpatialScenes, CrankSlider3dIsTheClosedFormCrankSlider) {
+  const Scene s = Load("redundant/crank_slider_3d.yaml");
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 21);
+  EXPECT_EQ(m.num_equations(), 24);  // 3 normalisations + 3 · 5 + 5 + the driver
+  ASSERT_TRUE(m.grubler().has_value());
+  EXPECT_EQ(*m.grubler(), -2);
+  const double L2 = 0.3, L3 = 1.0, omega = 2.0;
+  const Index crank = m.coordinate_index("crank_x"), rod = m.coordinate_index("rod_x"),
+              slider = m.coordinate_index("slider_x");
+  for (double t : {0.0, 0.35, 1.2, 2.0, 3.0}) {
+    SCOPED_TRACE("t = " + std::to_string(t));
+    // closed form: θ = 2t, A = L2 (cos θ, sin θ), rod angle β = −asin(L2 sin θ / L3), x_B = L2 cos θ + L3 cos β
+    const double th = omega * t, c = std::cos(th), sn = std::sin(th);
+    const double beta = -std::asin(L2 * sn / L3), xb = L2 * c + L3 * std::cos(beta);
+    // velocities: β̇ = −L2 cos θ θ̇ / (L3 cos β), ẋ_B = −L2 sin θ θ̇ − L3 sin β β̇
+    const double betad = -L2 * c * omega / (L3 * std::cos(beta)), xbd = -L2 * sn * omega - L3 * std::sin(beta) * betad;
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(21), qd = Eigen::VectorXd::Zero(21);
+    PutBody(q, crank, 0, 0, th), PutBody(q, rod, L2 * c, L2 * sn, beta), PutBody(q, slider, xb, 0, 0);
+    PutBodyRate(qd, crank, 0, 0, th, omega), PutBodyRate(qd, rod, -L2 * sn * omega, L2 * c * omega, beta, betad);
+    PutBodyRate(qd, slider, xbd, 0, 0, 0);
+    EXPECT_LT(Residual(m, q, t).lpNorm<Eigen::Infinity>(), 1e-12);
+    EXPECT_LT(VelocityResidual(m, q, qd, t).lpNorm<Eigen::Infinity>(), 1e-12);
+    // the wrong velocity is seen: the slider a little faster
+    qd(slider) += 1e-3;
+    EXPECT_GT(VelocityResidual(m, q, qd, t).lpNorm<Eigen::Infinity>(), 1e-4);
+    // 23 kinematic rows of rank 20: 21 − 20 = 1 degree of freedom where Grübler says −2
+    EXPECT_EQ(KinematicRank(m, q, 1), 20);
+  }
+}
+
+// ---- the door -------------------------------------------------------------------------------------------------
+
+TEST(SpatialScenes, DoorOnThreeHingesHoldsAtAnyAngle) {
+  const Scene s = Load("redundant/door_three_hinges.yaml");
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 7);
+  EXPECT_EQ(m.num_equations(), 17);
+  ASSERT_TRUE(m.grubler().has_value());
+  EXPECT_EQ(*m.grubler(), -9);
+  for (double t : {0.0, 0.8, 1.5}) {  // the driver: angle = t, rate 1
+    Eigen::VectorXd q(7), qd(7);
+    PutBody(q, 0, 0, 0, t), PutBodyRate(qd, 0, 0, 0, t, 1.0);
+    EXPECT_LT(Residual(m, q, t).lpNorm<Eigen::Infinity>(), 1e-12) << t;
+    EXPECT_LT(VelocityResidual(m, q, qd, t).lpNorm<Eigen::Infinity>(), 1e-12) << t;
+    EXPECT_EQ(KinematicRank(m, q, 1), 6) << t;  // 16 rows, rank 6: dof 1, 10 redundant equations
+  }
+}
+
+TEST(SpatialScenes, MisalignedDoorViolatesOnlyItsThirdHinge) {
+  const Scene s = Load("redundant/door_misaligned.yaml");
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 7);
+  EXPECT_EQ(m.num_equations(), 17);
+  EXPECT_EQ(*m.grubler(), -9);
+  Eigen::VectorXd q(7);
+  PutBody(q, 0, 0, 0, 0.4);
+  const Eigen::VectorXd phi = Residual(m, q, 0.4);
+  for (Index r = 0; r < m.num_equations(); ++r) {
+    const std::string row = m.row_name(r);
+    if (row == "hinge3[0]") EXPECT_NEAR(phi(r), 0.01, 1e-15);  // ground point 1 cm along x: Φ = P_a − P_b
+    else EXPECT_LT(std::fabs(phi(r)), 1e-12) << row;
+  }
+}
+
+// ---- Bricard --------------------------------------------------------------------------------------------------
+
+TEST(SpatialScenes, BricardHoldsInItsSquareConfigurationAndFollowsItsDriver) {
+  const Scene s = Load("benchmarks/bricard.yaml");
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 35);
+  EXPECT_EQ(m.num_equations(), 36);  // 5 normalisations + 6 · 5 + the driver
+  ASSERT_TRUE(m.grubler().has_value());
+  EXPECT_EQ(*m.grubler(), 0);
+  Eigen::VectorXd q = m.initial_positions();  // the square configuration, exact
+  EXPECT_LT(Residual(m, q, 0.0).lpNorm<Eigen::Infinity>(), 1e-15);
+  EXPECT_EQ(KinematicRank(m, q, 1), 34);  // 35 rows, one redundant: dof 1 where Grübler says 0
+  // Gauss–Newton with least-squares steps (dense, complete orthogonal decomposition) follows the driver through
+  // a radian of J1: the loop does move, with every equation satisfied.
+  for (int k = 1; k <= 10; ++k) {
+    const double t = 0.1 * k;
+    for (int it = 0; it < 20; ++it) {
+      const Eigen::VectorXd phi = Residual(m, q, t);
+      if (phi.lpNorm<Eigen::Infinity>() < 1e-13) break;
+      q -= DenseJacobian(m, q, t).completeOrthogonalDecomposition().solve(phi);
+    }
+    EXPECT_LT(Residual(m, q, t).lpNorm<Eigen::Infinity>(), 1e-12) << "t = " << t;
+  }
+  // J1 turned by 1 rad: link1's Euler parameters are a rotation by 1 rad about y
+  const Index l1 = m.coordinate_index("link1_e0");
+  const double sign = q(l1) < 0 ? -1.0 : 1.0;  // p and −p are the same rotation
+  EXPECT_NEAR(sign * q(l1), std::cos(0.5), 1e-12);
+  EXPECT_NEAR(sign * q(l1 + 2), std::sin(0.5), 1e-12);
+}
+
+// ---- RSSR: swept by the square solver, against its closed form --------------------------------------------------
+
+TEST(SpatialScenes, RssrSweepsAndAgreesWithItsClosedForm) {
+  const Scene s = load_scene(test::model_path("spatial/rssr.yaml"));
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 14);
+  EXPECT_EQ(m.num_equations(), 14);
+  ASSERT_TRUE(m.grubler().has_value());
+  EXPECT_EQ(*m.grubler(), 1);
+  test::Trace tr;
+  SweepOptions opt = s.sweep;
+  ASSERT_EQ(test::sweep(m, opt, &tr), SolveStatus::kSuccess);
+  ASSERT_EQ(tr.t.size(), 73u);
+  ASSERT_EQ(tr.qd.size(), 73u);
+  const double a = 0.2, b = 0.5, d = 0.5, e = 0.6, L = 0.92;
+  auto slots = [&](const std::string& body) {
+    const Index i = m.coordinate_index(body + "_x");
+    return Frame3{Slot::coordinate(i),     Slot::coordinate(i + 1), Slot::coordinate(i + 2), Slot::coordinate(i + 3),
+                  Slot::coordinate(i + 4), Slot::coordinate(i + 5), Slot::coordinate(i + 6)};
+  };
+  const Attachment3 A = Attachment3::body_point(slots("crank"), kin3::V3{a, 0, 0});
+  const Attachment3 B = Attachment3::body_point(slots("rocker"), kin3::V3{0, b, 0});
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    const double th = tr.t[k], c = std::cos(th), sn = std::sin(th);
+    SCOPED_TRACE("t = " + std::to_string(th));
+    // closed form of the rocker angle φ ∈ (0, π) and its rate (θ̇ = 1)
+    const double N = L * L - (d - a * c) * (d - a * c) - (e - a * sn) * (e - a * sn) - b * b;
+    const double D = 2 * b * (e - a * sn), Nd = -2 * a * sn * (d - a * c) + 2 * a * c * (e - a * sn),
+                 Dd = -2 * b * a * c;
+    const double phi = std::acos(N / D), phid = -((Nd * D - N * Dd) / (D * D)) / std::sin(phi);
+    const kin3::V3 pa = A.value(tr.q[k].data()), pb = B.value(tr.q[k].data());
+    EXPECT_NEAR(pa.x, a * c, 1e-9);
+    EXPECT_NEAR(pa.y, a * sn, 1e-9);
+    EXPECT_NEAR(pa.z, 0.0, 1e-9);
+    EXPECT_NEAR(pb.x, d, 1e-9);
+    EXPECT_NEAR(pb.y, e + b * std::cos(phi), 1e-9);
+    EXPECT_NEAR(pb.z, b * std::sin(phi), 1e-9);
+    const kin3::V3 vb = B.rate(tr.q[k].data(), tr.qd[k].data());
+    EXPECT_NEAR(vb.x, 0.0, 1e-8);
+    EXPECT_NEAR(vb.y, -b * std::sin(phi) * phid, 1e-8);
+    EXPECT_NEAR(vb.z, b * std::cos(phi) * phid, 1e-8);
+  }
+}
+
+TEST(SpatialScenes, RssrInReferencePointAndNaturalCoordinatesAgree) {
+  const Scene rp = load_scene(test::model_path("spatial/rssr.yaml"));
+  const Scene nat = load_scene(test::model_path("spatial/rssr_natural.yaml"));
+  EXPECT_FALSE(nat.model->grubler().has_value());  // natural coordinates: not made of joints
+  test::Trace a, n;
+  ASSERT_EQ(test::sweep(*rp.model, rp.sweep, &a), SolveStatus::kSuccess);
+  ASSERT_EQ(test::sweep(*nat.model, nat.sweep, &n), SolveStatus::kSuccess);
+  ASSERT_EQ(a.t.size(), n.t.size());
+  ASSERT_EQ(a.qdd.size(), a.t.size());
+  ASSERT_EQ(n.qdd.size(), n.t.size());
+  const Model& m = *rp.model;
+  const Index r = m.coordinate_index("rocker_x");
+  Frame3 f;
+  Slot* slots[] = {&f.x, &f.y, &f.z, &f.e0, &f.e1, &f.e2, &f.e3};
+  for (Index k = 0; k < 7; ++k) *slots[k] = Slot::coordinate(r + k);
+  const Attachment3 B = Attachment3::body_point(f, kin3::V3{0, 0.5, 0});
+  const Index yb = nat.model->coordinate_index("yB"), zb = nat.model->coordinate_index("zB");
+  for (std::size_t k = 0; k < a.t.size(); ++k) {
+    SCOPED_TRACE("t = " + std::to_string(a.t[k]));
+    const kin3::V3 p = B.value(a.q[k].data()), v = B.rate(a.q[k].data(), a.qd[k].data());
+    // B̈ = (the part linear in q̈) + (the q̈-free part)
+    const kin3::V3 acc = B.rate(a.q[k].data(), a.qdd[k].data()) + B.bias(a.qd[k].data());
+    EXPECT_NEAR(p.y, n.q[k](yb), 1e-9);
+    EXPECT_NEAR(p.z, n.q[k](zb), 1e-9);
+    EXPECT_NEAR(v.y, n.qd[k](yb), 1e-9);
+    EXPECT_NEAR(v.z, n.qd[k](zb), 1e-9);
+    EXPECT_NEAR(acc.y, n.qdd[k](yb), 1e-8);
+    EXPECT_NEAR(acc.z, n.qdd[k](zb), 1e-8);
+  }
+}
+
+TEST(SpatialScenes, NaturalSpatialCrankSliderIsTheClosedForm) {
+  const Scene s = load_scene(test::model_path("spatial/crank_slider_natural.yaml"));
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 6);
+  EXPECT_EQ(m.num_equations(), 6);  // w.unit, crank, w_across_crank, w_in_plane, rod, motor
+  EXPECT_FALSE(m.grubler().has_value());
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
+  ASSERT_EQ(tr.t.size(), 61u);
+  ASSERT_EQ(tr.qdd.size(), 61u);
+  const double a = 0.3, L = 1.0, h = 0.1, c = 0.2;
+  // x_B(θ) = a cos θ + S, S = sqrt(L² − c² − (h − a sin θ)²); ẋ_B = −a sin θ + a cos θ (h − a sin θ) / S (θ̇ = 1)
+  auto xb = [&](double th) { return a * std::cos(th) + std::sqrt(L * L - c * c - std::pow(h - a * std::sin(th), 2)); };
+  auto xbd = [&](double th) {
+    const double S = std::sqrt(L * L - c * c - std::pow(h - a * std::sin(th), 2));
+    return -a * std::sin(th) + a * std::cos(th) * (h - a * std::sin(th)) / S;
+  };
+  const Index j = m.coordinate_index("xB");
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    const double th = tr.t[k], dh = 1e-5;
+    EXPECT_NEAR(tr.q[k](j), xb(th), 1e-9) << th;
+    EXPECT_NEAR(tr.qd[k](j), xbd(th), 1e-9) << th;
+    EXPECT_NEAR(tr.qdd[k](j), (xbd(th + dh) - xbd(th - dh)) / (2 * dh), 1e-8) << th;
+  }
+}
+
+}  // namespace
+}  // namespace phiq
+
+namespace phiq {
+namespace {
+
+// The planar redundant scene of models/redundant/: four reference-point bodies and six pins, 3 · 4 − 6 · 2 = 0,
+// although the parallelogram moves with one degree of freedom.
+TEST(RedundantScenes, ParallelogramWithFifthBarCountsZero) {
+  const Scene s = load_scene(test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  ASSERT_TRUE(s.model->grubler().has_value());
+  EXPECT_EQ(*s.model->grubler(), 0);
+}
+
+}  // namespace
+}  // namespace phiq
