@@ -62,6 +62,25 @@ std::vector<std::pair<Index, double>> worst(const Eigen::VectorXd& scaled, const
   return rows;
 }
 
+// Backtracking (Armijo) along d from q on ½‖b‖², b = rows(Φ) scaled by `rows`: halves α until the merit decreases
+// enough or the budget runs out. Leaves the last trial point in `trial`, its scaled rows in `bt`, its merit in *ft;
+// returns whether it decreased.
+template <class Rows>
+bool backtrack(const Model& model, double t, const AssemblyOptions& opt, const Eigen::VectorXd& q,
+               const Eigen::VectorXd& d, double f, const Rows& rows, Eigen::VectorXd& phi, Eigen::VectorXd& trial,
+               Eigen::VectorXd& bt, double* alpha, double* ft) {
+  *alpha = 1.0;
+  for (int count = 0;; ++count) {
+    trial = q + *alpha * d;
+    model.residual(trial.data(), t, phi.data());
+    rows(phi, bt);
+    *ft = 0.5 * bt.squaredNorm();
+    if (*ft <= (1.0 - 1e-4 * *alpha) * f) return true;
+    if (count >= opt.max_backtracks) return false;
+    *alpha *= 0.5;
+  }
+}
+
 // Gauss-Newton on all rows at once, in least squares: Δ = −D (J̃ᵀJ̃ + μI)⁻¹ J̃ᵀ Φ̃ (CHOLMOD on J̃ᵀJ̃, analysed once),
 // backtracking on ½‖Φ̃‖². It needs no choice of rows, so redundant equations and drivers are treated alike from a
 // rough placement, where which rows are redundant is not yet known (a braced chain off its motion is a locked
@@ -105,16 +124,7 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
     if (!d.allFinite()) return *why = "Gauss-Newton step is not finite", SolveStatus::kNonFinite;
     ++sum.iterations;
     double alpha = 1.0, ft = 0.0;
-    bool decreased = false;
-    for (int bt_count = 0;; ++bt_count) {
-      trial = q + alpha * d;
-      model.residual(trial.data(), t, phi.data());
-      scaled(phi, bt);
-      ft = 0.5 * bt.squaredNorm();
-      decreased = ft <= (1.0 - 1e-4 * alpha) * f;
-      if (decreased || bt_count >= opt.max_backtracks) break;
-      alpha *= 0.5;
-    }
+    const bool decreased = backtrack(model, t, opt, q, d, f, scaled, phi, trial, bt, &alpha, &ft);
     const bool tiny = scaled_step(model, alpha * d, trial, opt.tolerance) <= 1.0;
     if (decreased) q.swap(trial), b.swap(bt), f = ft;
     if (decreased && !tiny) {
@@ -201,16 +211,7 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
     d = -d.cwiseProduct(sc.coordinate_scale);
     if (!d.allFinite()) return *why = "Gauss-Newton step is not finite", SolveStatus::kNonFinite;
     double alpha = 1.0, ft = 0.0;
-    bool decreased = false;
-    for (int bt_count = 0;; ++bt_count) {
-      trial = q + alpha * d;
-      model.residual(trial.data(), t, phi.data());
-      kept_scaled(phi, bt);
-      ft = 0.5 * bt.squaredNorm();
-      decreased = ft <= (1.0 - 1e-4 * alpha) * f;
-      if (decreased || bt_count >= opt.max_backtracks) break;
-      alpha *= 0.5;
-    }
+    const bool decreased = backtrack(model, t, opt, q, d, f, kept_scaled, phi, trial, bt, &alpha, &ft);
     const bool tiny = scaled_step(model, alpha * d, trial, opt.tolerance) <= 1.0;
     if (decreased && !tiny) {
       q.swap(trial), b.swap(bt), f = ft;
