@@ -27,6 +27,19 @@ Eigen::VectorXd exact(const Model& m, Index n, double th) {
   return q;
 }
 
+// The braced model assembled at its exact position, and the model its square solves use (redundant rows left out).
+struct Solved {
+  std::unique_ptr<Model> full, solved;
+  Eigen::VectorXd q;
+};
+Solved solved_braced(Index n) {
+  Solved s{braced(n), nullptr, {}};
+  s.q = exact(*s.full, n, kTheta0);
+  AssemblySummary a;
+  if (prepare_square(*s.full, 0.0, {}, s.q, &s.solved, &a) != SolveStatus::kSuccess) s.solved.reset();
+  return s;
+}
+
 void BM_RankAnalysisBraced(benchmark::State& st) {
   const Index n = st.range(0);
   auto m = braced(n);
@@ -72,13 +85,9 @@ void sweep_steps(benchmark::State& st, const Model& m) {
   st.counters["us_per_step"] = 1e6 * seconds / static_cast<double>(st.iterations() * (o.steps + 1));
 }
 void BM_StepBracedReduced(benchmark::State& st) {
-  const Index n = st.range(0);
-  auto m = braced(n);
-  Eigen::VectorXd q = exact(*m, n, kTheta0);
-  std::unique_ptr<Model> solved;
-  AssemblySummary a;
-  if (prepare_square(*m, 0.0, {}, q, &solved, &a) != SolveStatus::kSuccess) return st.SkipWithError(a.message.c_str());
-  sweep_steps(st, *solved);
+  const Solved s = solved_braced(st.range(0));
+  if (!s.solved) return st.SkipWithError("the braced model did not assemble");
+  sweep_steps(st, *s.solved);
 }
 void BM_StepPlain(benchmark::State& st) {
   const Model m = phiq_bench::nfourbar(st.range(0), kTheta0, 1.0);
@@ -90,13 +99,11 @@ void BM_StepPlain(benchmark::State& st) {
 // by CHOLMOD (analysis once) and solved. Both give the same step on a consistent position.
 void BM_IterationDropRowsKlu(benchmark::State& st) {
   const Index n = st.range(0);
-  auto m = braced(n);
-  Eigen::VectorXd q = exact(*m, n, kTheta0);
-  std::unique_ptr<Model> solved;
-  AssemblySummary a;
-  if (prepare_square(*m, 0.0, {}, q, &solved, &a) != SolveStatus::kSuccess) return st.SkipWithError(a.message.c_str());
+  const Solved s = solved_braced(n);
+  if (!s.solved) return st.SkipWithError("the braced model did not assemble");
+  const Model* solved = s.solved.get();
   Workspace ws(*solved);
-  ws.q = q;
+  ws.q = s.q;
   ws.q(2 * n + 2) += 1e-3;  // off the solution, so that the step is not zero
   for (auto _ : st) {
     ws.has_factorization = false;
@@ -111,31 +118,19 @@ void BM_IterationNormalEquationsCholmod(benchmark::State& st) {
   auto m = braced(n);
   Eigen::VectorXd q = exact(*m, n, kTheta0);
   q(2 * n + 2) += 1e-3;
-  const CscPattern& jp = m->jacobian_pattern();
   // Φqᵀ as a CSC pattern (n × m) and where each of its entries comes from in Φq's value array: fixed once.
-  auto at = std::make_shared<CscPattern>();
-  at->rows = jp.cols, at->cols = jp.rows;
-  at->col_ptr.assign(static_cast<std::size_t>(jp.rows) + 1, 0);
-  for (Index r : jp.row_idx) ++at->col_ptr[static_cast<std::size_t>(r) + 1];
-  for (Index i = 0; i < jp.rows; ++i) at->col_ptr[i + 1] += at->col_ptr[i];
-  at->row_idx.resize(static_cast<std::size_t>(jp.nnz()));
-  std::vector<Index> from(static_cast<std::size_t>(jp.nnz())), next(at->col_ptr.begin(), at->col_ptr.end() - 1);
-  for (Index j = 0; j < jp.cols; ++j)
-    for (Index k = jp.col_ptr[j]; k < jp.col_ptr[j + 1]; ++k) {
-      const Index d = next[static_cast<std::size_t>(jp.row_idx[k])]++;
-      at->row_idx[d] = j, from[d] = k;
-    }
+  std::vector<Index> from;
+  auto at = std::make_shared<CscPattern>(transpose_pattern(m->jacobian_pattern(), &from));
   MinNormSolver normal(at);  // A = Φqᵀ: CHOLMOD factorises A Aᵀ = Φqᵀ Φq
-  std::vector<double> values(static_cast<std::size_t>(jp.nnz())), tv(values.size());
+  std::vector<double> values(from.size()), tv(values.size());
   Eigen::VectorXd phi(m->num_equations()), rhs(m->num_coordinates()), step(m->num_coordinates());
   for (auto _ : st) {
     m->jacobian(q.data(), 0.0, values.data());
     for (std::size_t k = 0; k < tv.size(); ++k) tv[k] = values[static_cast<std::size_t>(from[k])];
     if (normal.factorize(tv.data()) != FactorStatus::kOk) st.SkipWithError("normal equations singular");
     m->residual(q.data(), 0.0, phi.data());
-    rhs.setZero();  // −Φqᵀ Φ
-    for (Index c = 0; c < at->cols; ++c)
-      for (Index e = at->col_ptr[c]; e < at->col_ptr[c + 1]; ++e) rhs(at->row_idx[e]) -= tv[static_cast<std::size_t>(e)] * phi(c);
+    rhs.setZero();
+    normal.multiply_add(phi.data(), rhs.data());  // Φqᵀ Φ (the step is minus its solve: the sign costs nothing here)
     normal.solve(rhs.data(), step.data());
     benchmark::DoNotOptimize(step.data());
   }

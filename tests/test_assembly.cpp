@@ -14,36 +14,32 @@
 namespace phiq {
 namespace {
 
-bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
+bool has(const std::vector<std::string>& v, const std::string& s) { return test::contains(v, s); }
 
 TEST(Assembly, FifthBarAssemblesDropsItsRedundantRowAndSweepsExactly) {
-  Scene sc = load_scene(test::model_path("redundant/parallelogram_fifth_bar.yaml"));
-  const Model& full = *sc.model;
-  Eigen::VectorXd q = full.initial_positions();
-  std::unique_ptr<Model> solved;
-  AssemblySummary as;
-  ASSERT_EQ(prepare_square(full, 0.0, {}, q, &solved, &as), SolveStatus::kSuccess) << as.BriefReport();
+  test::Prepared p = test::prepare("redundant/parallelogram_fifth_bar.yaml");
+  const Model& full = *p.scene.model;
+  const AssemblySummary& as = p.assembly;
+  ASSERT_EQ(as.status, SolveStatus::kSuccess) << as.BriefReport();
   EXPECT_TRUE(as.consistent);
   EXPECT_TRUE(as.conflicts.empty());
   EXPECT_EQ(as.rank.dof, 1);
   EXPECT_EQ(as.rank.redundant, std::vector<std::string>{"A3"});
-  ASSERT_EQ(solved->dropped_rows().size(), 1u);
-  EXPECT_EQ(full.row_name(solved->dropped_rows()[0]), "A3[1]");
-  ASSERT_NE(solved->symbolic(), nullptr);  // 12 kept rows for 12 coordinates: square
+  ASSERT_EQ(p.solved->dropped_rows().size(), 1u);
+  EXPECT_EQ(full.row_name(p.solved->dropped_rows()[0]), "A3[1]");
+  ASSERT_NE(p.solved->symbolic(), nullptr);  // 12 kept rows for 12 coordinates: square
   const double th0 = M_PI / 3;
+  const Eigen::VectorXd& q = p.q;
   EXPECT_NEAR(q(full.coordinate_index("psi3")), th0, 1e-9);
   EXPECT_NEAR(q(full.coordinate_index("xc")), std::cos(th0), 1e-9);
   EXPECT_NEAR(q(full.coordinate_index("yc")), std::sin(th0), 1e-9);
   EXPECT_NEAR(q(full.coordinate_index("psic")), 0.0, 1e-9);
+  EXPECT_EQ(p.scene.sweep.steps + 1, 101);
 
   // The sweep on the kept rows: every crank at th0 + t, the coupler translating on a unit circle; the left-out
-  // row holds at every step (consistent redundancy), and velocities and accelerations are exact.
-  Workspace ws(*solved);
-  ws.q = q;
-  SweepSummary sum;
-  Eigen::VectorXd phi(full.num_equations());
-  int rows = 0;
-  const SolveStatus st = run_sweep(*solved, sc.sweep, ws, [&](const StepView& s) {
+  // row holds at every step (consistent redundancy: sweep_prepared checks every row of the full model), and
+  // velocities and accelerations are exact.
+  test::sweep_prepared(p, [&](const StepView& s) {
     const double th = th0 + s.t;
     EXPECT_NEAR(s.q(full.coordinate_index("psi2")), th, 1e-9);
     EXPECT_NEAR(s.q(full.coordinate_index("psi3")), th, 1e-9);
@@ -54,13 +50,7 @@ TEST(Assembly, FifthBarAssemblesDropsItsRedundantRowAndSweepsExactly) {
     EXPECT_NEAR((*s.qdd)(full.coordinate_index("xc")), -std::cos(th), 1e-7);
     EXPECT_NEAR((*s.qdd)(full.coordinate_index("yc")), -std::sin(th), 1e-7);
     EXPECT_NEAR((*s.qdd)(full.coordinate_index("psi3")), 0.0, 1e-7);
-    full.residual(s.q.data(), s.t, phi.data());
-    EXPECT_LE(scaled_residual(full, phi), 1e-9) << s.t;
-    ++rows;
-    return true;
-  }, &sum);
-  ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
-  EXPECT_EQ(rows, 101);
+  });
 }
 
 // A planar door: one body pinned to ground twice at its hinge. With both ground points equal, the second pin is

@@ -14,43 +14,12 @@
 namespace phiq {
 namespace {
 
-bool has(const std::vector<std::string>& v, const std::string& s) { return std::find(v.begin(), v.end(), s) != v.end(); }
-
-struct Prepared {
-  Scene scene;
-  AssemblySummary assembly;
-  std::unique_ptr<Model> solved;
-  Eigen::VectorXd q;
-};
-
-Prepared prepare(const std::string& rel) {
-  Prepared p;
-  p.scene = load_scene(test::model_path(rel));
-  p.q = p.scene.model->initial_positions();
-  prepare_square(*p.scene.model, p.scene.sweep.t_begin, {}, p.q, &p.solved, &p.assembly);
-  return p;
-}
-
-// Sweeps the prepared model; calls check(step) at every row and asserts that every row of the full model (left-out
-// rows included) holds to the tolerance.
+using test::prepare;
+using test::Prepared;
+bool has(const std::vector<std::string>& v, const std::string& s) { return test::contains(v, s); }
 template <class Check>
 void sweep(Prepared& p, Check check) {
-  ASSERT_NE(p.solved, nullptr) << p.assembly.BriefReport();
-  const Model& full = *p.scene.model;
-  Workspace ws(*p.solved);
-  ws.q = p.q;
-  SweepSummary sum;
-  Eigen::VectorXd phi(full.num_equations());
-  Index rows = 0;
-  const SolveStatus st = run_sweep(*p.solved, p.scene.sweep, ws, [&](const StepView& s) {
-    full.residual(s.q.data(), s.t, phi.data());
-    EXPECT_LE(scaled_residual(full, phi), 1e-9) << "t = " << s.t;
-    check(s);
-    ++rows;
-    return true;
-  }, &sum);
-  ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
-  EXPECT_EQ(rows, p.scene.sweep.steps + 1);
+  test::sweep_prepared(p, check);
 }
 
 TEST(RedundantScenes, CrankSlider3dHasGrublerMinusTwoMovesWithOneDofAndIsTheCrankSlider) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "phiq/phiq.hpp"
+#include "test_support.hpp"
 
 namespace phiq {
 namespace {
@@ -26,27 +27,8 @@ drivers:
 time: {start: 0, end: 1, steps: 4}
 )";
 
-std::string variant(const std::string& from, const std::string& to) {
-  std::string s = kGood;
-  auto p = s.find(from);
-  EXPECT_NE(p, std::string::npos) << from;
-  return s.replace(p, from.size(), to);
-}
-
-std::string error_of(const std::string& text) {
-  try {
-    parse_scene(text, "bad.yaml");
-  } catch (const SceneError& e) {
-    std::string m = e.what();
-    EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
-    EXPECT_EQ(m.rfind("bad.yaml:", 0), 0u) << m;
-    return m;
-  }
-  ADD_FAILURE() << "no error for:\n" << text;
-  return "";
-}
-
-#define EXPECT_HAS(msg, part) EXPECT_NE((msg).find(part), std::string::npos) << (msg)
+std::string variant(const std::string& from, const std::string& to) { return test::replace_first(kGood, from, to); }
+std::string error_of(const std::string& text) { return test::scene_error(text); }
 
 TEST(Scene3d, GoodSceneBuildsBodiesJointsAndDrivers) {
   Scene s = parse_scene(kGood, "good.yaml");

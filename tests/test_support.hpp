@@ -1,7 +1,9 @@
 // Helpers shared by the test files.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,72 @@
 namespace phiq::test {
 
 inline std::string model_path(const std::string& rel) { return std::string(PHIQ_MODELS_DIR) + "/" + rel; }
+
+// `text` with its first occurrence of `from` replaced by `to` (a failure, and `text` unchanged, if it has none).
+inline std::string replace_first(std::string text, const std::string& from, const std::string& to) {
+  const auto p = text.find(from);
+  EXPECT_NE(p, std::string::npos) << from;
+  return p == std::string::npos ? text : text.replace(p, from.size(), to);
+}
+
+// The SceneError of a scene read as "bad.yaml": one line, starting with the file name (a failure if it loads).
+inline std::string scene_error(const std::string& text) {
+  try {
+    parse_scene(text, "bad.yaml");
+  } catch (const SceneError& e) {
+    std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
+    EXPECT_EQ(m.rfind("bad.yaml:", 0), 0u) << m;
+    return m;
+  }
+  ADD_FAILURE() << "no error for:\n" << text;
+  return "";
+}
+
+#define EXPECT_HAS(msg, part) EXPECT_NE((msg).find(part), std::string::npos) << (msg)
+
+inline bool contains(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+// A scene of models/ prepared as `phiq run` prepares it (prepare_square with default assembly settings): the
+// full scene model, the assembly, and the model its square solves use (null when the preparation failed).
+struct Prepared {
+  Scene scene;
+  AssemblySummary assembly;
+  std::unique_ptr<Model> solved;
+  Eigen::VectorXd q;  // the assembled position
+};
+
+inline Prepared prepare(const std::string& rel) {
+  Prepared p;
+  p.scene = load_scene(model_path(rel));
+  p.q = p.scene.model->initial_positions();
+  prepare_square(*p.scene.model, p.scene.sweep.t_begin, {}, p.q, &p.solved, &p.assembly);
+  return p;
+}
+
+// Sweeps a prepared scene; calls check(step) at every row and asserts that every row of the full model (left-out
+// rows included) holds to 1e-9 (scaled) and that every time point is delivered.
+template <class Check>
+void sweep_prepared(Prepared& p, Check check) {
+  ASSERT_NE(p.solved, nullptr) << p.assembly.BriefReport();
+  const Model& full = *p.scene.model;
+  Workspace ws(*p.solved);
+  ws.q = p.q;
+  SweepSummary sum;
+  Eigen::VectorXd phi(full.num_equations());
+  Index rows = 0;
+  const SolveStatus st = run_sweep(*p.solved, p.scene.sweep, ws, [&](const StepView& s) {
+    full.residual(s.q.data(), s.t, phi.data());
+    EXPECT_LE(scaled_residual(full, phi), 1e-9) << "t = " << s.t;
+    check(s);
+    ++rows;
+    return true;
+  }, &sum);
+  ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
+  EXPECT_EQ(rows, p.scene.sweep.steps + 1);
+}
 
 // All rows of a sweep, kept in memory.
 struct Trace {

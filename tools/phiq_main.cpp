@@ -45,12 +45,7 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The scene's assembly settings (tolerance, iteration budget) for the minimum-norm assembly.
-phiq::AssemblyOptions assembly_options(const phiq::Scene& scene) {
-  phiq::AssemblyOptions o;
-  o.tolerance = scene.sweep.assembly.tolerance;
-  o.max_iterations = scene.sweep.assembly.max_iterations;
-  return o;
-}
+phiq::AssemblyOptions assembly_options(const phiq::Scene& scene) { return phiq::assembly_options(scene.sweep.assembly); }
 
 std::string joined(const std::vector<std::string>& names) {
   std::string s;
@@ -111,19 +106,15 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   const double load_s = since(load_start);
   // A model that is not square (redundant constraints) is assembled by minimum norm and solved on its independent
   // rows; inconsistent or under-driven models stop here, naming the constraints.
-  std::unique_ptr<phiq::Model> solved;
-  Eigen::VectorXd start = scene.model->initial_positions();
-  phiq::AssemblySummary redundancy;
-  if (scene.model->num_equations() != scene.model->num_coordinates()) {
-    if (phiq::prepare_square(*scene.model, scene.sweep.t_begin, assembly_options(scene), start, &solved,
-                             &redundancy) != phiq::SolveStatus::kSuccess)
-      return fail(scene_path + ": t = " + std::to_string(scene.sweep.t_begin) + ": " + redundancy.message +
-                      (out_path.empty() ? "" : "; no output written"), 1);
-  }
-  const phiq::Model& model = solved ? *solved : *scene.model;
+  phiq::SquareScene square;
+  if (phiq::prepare_scene(*scene.model, scene.sweep.t_begin, scene.sweep.assembly, &square) != phiq::SolveStatus::kSuccess)
+    return fail(scene_path + ": t = " + std::to_string(scene.sweep.t_begin) + ": " + square.assembly.message +
+                    (out_path.empty() ? "" : "; no output written"), 1);
+  const phiq::AssemblySummary& redundancy = square.assembly;
+  const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;
   phiq::Workspace ws(model);
-  ws.q = start;
+  ws.q = square.start;
   // columns from the scene (its constraints and outputs); residuals of a model solved on its independent rows
   // are evaluated on the whole scene model (CsvFormat)
   phiq::CsvFormat csv(scene);
@@ -178,10 +169,11 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
     std::string why = summary.message;
     // A square model singular at its first position: redundant constraints and missing drivers in equal numbers,
     // or a singular placement. The rank analysis says which.
-    if (summary.failed_step == 0 && summary.status == phiq::SolveStatus::kSingularJacobian && !solved) {
+    if (summary.failed_step == 0 && summary.status == phiq::SolveStatus::kSingularJacobian && !square.reduced) {
       Eigen::VectorXd q = scene.model->initial_positions();
       phiq::AssemblySummary as;
-      if (phiq::prepare_square(*scene.model, scene.sweep.t_begin, assembly_options(scene), q, &solved, &as) !=
+      std::unique_ptr<phiq::Model> unused;
+      if (phiq::prepare_square(*scene.model, scene.sweep.t_begin, assembly_options(scene), q, &unused, &as) !=
           phiq::SolveStatus::kSuccess)
         why += "; rank analysis: " + as.message;
     }

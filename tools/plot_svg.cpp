@@ -151,29 +151,25 @@ int plot_svg(const PlotOptions& o) {
     opt.points.clear(), opt.residuals = opt.condition = false;
     opt.threads = 0;
     // a redundant model is solved as `phiq run` solves it: assembled by minimum norm, swept on its independent rows
-    std::unique_ptr<Model> square;
-    Eigen::VectorXd start = model.initial_positions();
-    if (model.num_equations() != model.num_coordinates()) {
-      AssemblyOptions ao;
-      ao.tolerance = scene.sweep.assembly.tolerance;
-      ao.max_iterations = scene.sweep.assembly.max_iterations;
-      AssemblySummary as;
-      if (prepare_square(model, scene.sweep.t_begin, ao, start, &square, &as) != SolveStatus::kSuccess)
-        return fail(o.scene + ": " + as.message, 1);
-    }
-    const Model& swept = square ? *square : model;
+    SquareScene square;
+    if (prepare_scene(model, scene.sweep.t_begin, scene.sweep.assembly, &square) != SolveStatus::kSuccess)
+      return fail(o.scene + ": " + square.assembly.message, 1);
+    const Model& swept = square.model(model);
     Workspace ws(swept);
-    ws.q = start;
+    ws.q = square.start;
+    // the CSV column of each coordinate (or none), looked up once rather than per row
+    std::vector<std::pair<Index, std::size_t>> checked;  // (coordinate, column)
+    for (Index j = 0; j < model.num_coordinates(); ++j)
+      if (auto c = col.find(model.coordinate_names()[j]); c != col.end()) checked.emplace_back(j, c->second);
     SweepSummary sum;
     std::string mismatch;
     run_sweep(swept, opt, ws, [&](const StepView& v) {
       const auto row = static_cast<std::size_t>(v.step);
-      for (Index j = 0; j < model.num_coordinates(); ++j) {
-        auto c = col.find(model.coordinate_names()[j]);
+      for (const auto& [j, c] : checked) {
         const double mine = v.q(j);
-        if (c != col.end() && !(std::fabs(table.rows[row][c->second] - mine) <= 1e-6 * (1.0 + std::fabs(mine))))
-          mismatch = "row " + std::to_string(row + 2) + ", column '" + c->first + "': " + label(table.rows[row][c->second]) +
-                     ", the scene gives " + label(mine);
+        if (!(std::fabs(table.rows[row][c] - mine) <= 1e-6 * (1.0 + std::fabs(mine))))
+          mismatch = "row " + std::to_string(row + 2) + ", column '" + model.coordinate_names()[j] +
+                     "': " + label(table.rows[row][c]) + ", the scene gives " + label(mine);
       }
       if (!(std::fabs(table.rows[row][0] - v.t) <= 1e-12 * (1.0 + std::fabs(v.t))))
         mismatch = "row " + std::to_string(row + 2) + ": t = " + label(table.rows[row][0]) + ", the scene gives " +
@@ -268,9 +264,11 @@ int plot_svg(const PlotOptions& o) {
     double tmin = table.rows.front()[0], tmax = table.rows.back()[0];
     if (tmin > tmax) std::swap(tmin, tmax);
     double vmin = INFINITY, vmax = -INFINITY;
-    for (const std::string& c : series)
+    for (const std::string& name : series) {
+      const std::size_t c = col.at(name);  // once per column, not per row
       for (const auto& row : table.rows)
-        if (std::isfinite(row[col[c]])) vmin = std::min(vmin, row[col[c]]), vmax = std::max(vmax, row[col[c]]);
+        if (std::isfinite(row[c])) vmin = std::min(vmin, row[c]), vmax = std::max(vmax, row[c]);
+    }
     if (!(vmax >= vmin)) vmin = 0, vmax = 1;
     if (!(tmax > tmin)) tmin -= 0.5, tmax += 0.5;
     widen(vmin, vmax);
@@ -283,7 +281,7 @@ int plot_svg(const PlotOptions& o) {
           << px(b.sy(0)) << "\" stroke=\"#ddd\"/>\n";
     for (std::size_t k = 0; k < series.size(); ++k) {
       Line p;
-      const std::size_t c = col[series[k]];
+      const std::size_t c = col.at(series[k]);
       for (const auto& row : table.rows)
         if (std::isfinite(row[c])) p.push_back({b.sx(row[0]), b.sy(row[c])});
       svg << polyline("series", kPalette[k % 8], 1.5, p, " data-column=\"" + escape(series[k]) + "\"");

@@ -7,8 +7,12 @@
 #include <sstream>
 
 #include "phiq/min_norm_solver.hpp"
+#include "tolerance_tests.hpp"
 
 namespace phiq {
+
+using detail::rounding_floors;
+using detail::scaled_rows_within;
 
 std::string AssemblySummary::BriefReport() const {
   std::ostringstream s;
@@ -31,35 +35,6 @@ Eigen::VectorXd scaled_rows(const Model& model, const Eigen::VectorXd& phi) {
   for (Index i = 0; i < r.size(); ++i)
     if (std::isnan(r(i))) r(i) = std::numeric_limits<double>::infinity();
   return r;
-}
-
-// The tolerance of every row at q: tol plus the rounding floor of the coordinates' magnitude (as Newton's test).
-double row_floor(const Model& model, const Eigen::VectorXd& q) {
-  if (q.size() == 0) return 0.0;
-  const double big = (q.cwiseAbs().cwiseQuotient(model.tolerance_scales().coordinate_scale)).maxCoeff();
-  return 64.0 * std::numeric_limits<double>::epsilon() * big;
-}
-
-std::string describe(const Model& model, const std::vector<std::pair<Index, double>>& rows) {
-  std::ostringstream s;
-  s.precision(3);
-  for (std::size_t k = 0; k < rows.size(); ++k)
-    s << (k ? ", " : "") << "'" << model.row_name(rows[k].first) << "' " << std::scientific << rows[k].second;
-  return s.str();
-}
-
-std::vector<std::pair<Index, double>> worst(const Eigen::VectorXd& scaled, const std::vector<Index>* among, int k) {
-  std::vector<std::pair<Index, double>> rows;
-  if (among) {
-    for (Index r : *among) rows.emplace_back(r, scaled(r));
-  } else {
-    for (Index r = 0; r < scaled.size(); ++r) rows.emplace_back(r, scaled(r));
-  }
-  const std::size_t kk = std::min<std::size_t>(static_cast<std::size_t>(k), rows.size());
-  std::partial_sort(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(kk), rows.end(),
-                    [](const auto& a, const auto& b) { return a.second > b.second; });
-  rows.resize(kk);
-  return rows;
 }
 
 // Backtracking (Armijo) along d from q on ½‖b‖², b = rows(Φ) scaled by `rows`: halves α until the merit decreases
@@ -95,11 +70,10 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
   const ToleranceScales& sc = model.tolerance_scales();
   std::vector<Index> all(static_cast<std::size_t>(m));
   for (Index i = 0; i < m; ++i) all[static_cast<std::size_t>(i)] = i;
-  CscPattern jp;
+  ScaledJacobianRows jac(model, std::move(all));  // pattern once; values per iteration
   std::vector<double> jv, tv;
-  scaled_jacobian_rows(model, q, t, all, &jp, &jv);
   std::vector<Index> from;
-  auto at = std::make_shared<CscPattern>(transpose_pattern(jp, &from));  // J̃ᵀ: CHOLMOD factorises J̃ᵀ J̃ + μI
+  auto at = std::make_shared<CscPattern>(transpose_pattern(*jac.pattern(), &from));  // J̃ᵀ: CHOLMOD factorises J̃ᵀ J̃ + μI
   MinNormSolver normal(at);
   Eigen::VectorXd phi(m), b(m), bt(m), g(n), d(n), trial(n);
   auto scaled = [&](const Eigen::VectorXd& full, Eigen::VectorXd& out) { out = full.cwiseQuotient(sc.row_scale); };
@@ -108,17 +82,15 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
   double f = 0.5 * b.squaredNorm(), mu = 0.0;
   while (sum.iterations < opt.max_iterations) {
     if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
-    if (b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q)) return SolveStatus::kSuccess;
-    scaled_jacobian_rows(model, q, t, all, &jp, &jv);
+    if (scaled_rows_within(model, b, nullptr, opt.tolerance, rounding_floors(model, q))) return SolveStatus::kSuccess;
+    jac.evaluate(q, t, jv);
     tv.resize(from.size());
     for (std::size_t k = 0; k < from.size(); ++k) tv[k] = jv[static_cast<std::size_t>(from[k])];
     const FactorStatus fs = normal.factorize(tv.data(), std::max(mu, 1e-10));
     ++sum.factorizations;
     if (fs != FactorStatus::kOk) return *why = normal.last_message(), SolveStatus::kLinearSolverFailed;
-    // g = J̃ᵀ b (the columns of J̃ᵀ are the rows)
     g.setZero();
-    for (Index c = 0; c < at->cols; ++c)
-      for (Index e = at->col_ptr[c]; e < at->col_ptr[c + 1]; ++e) g(at->row_idx[e]) += tv[static_cast<std::size_t>(e)] * b(c);
+    normal.multiply_add(b.data(), g.data());  // g = J̃ᵀ b
     if (!normal.solve(g.data(), d.data())) return *why = normal.last_message(), SolveStatus::kLinearSolverFailed;
     d = -d.cwiseProduct(sc.coordinate_scale);
     if (!d.allFinite()) return *why = "Gauss-Newton step is not finite", SolveStatus::kNonFinite;
@@ -131,7 +103,7 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
       if (alpha == 1.0) mu *= 0.1;
       continue;
     }
-    if (b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q)) return SolveStatus::kSuccess;
+    if (scaled_rows_within(model, b, nullptr, opt.tolerance, rounding_floors(model, q))) return SolveStatus::kSuccess;
     if (mu < 1e6) {  // regularise more, then give up: a least-squares minimum
       mu = mu == 0.0 ? std::max(b.cwiseAbs().maxCoeff(), 1e-8) : 10.0 * mu;
       continue;
@@ -165,9 +137,11 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
   auto kept_scaled = [&](const Eigen::VectorXd& full, Eigen::VectorXd& out) {
     for (Index i = 0; i < k; ++i) out(i) = full(kept[i]) / sc.row_scale(kept[i]);
   };
-  auto pattern = std::make_shared<CscPattern>();
+  ScaledJacobianRows jac(model, kept);  // pattern once; values per iteration
   std::vector<double> values;
-  std::unique_ptr<MinNormSolver> solver;
+  MinNormSolver solver_of_kept(jac.pattern());
+  MinNormSolver* solver = &solver_of_kept;
+  auto kept_within = [&] { return scaled_rows_within(model, b, &kept, opt.tolerance, rounding_floors(model, q)); };
 
   model.residual(q.data(), t, phi.data());
   kept_scaled(phi, b);
@@ -175,9 +149,8 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
   double mu = 0.0;  // Levenberg-Marquardt regularisation, only while plain Gauss-Newton fails
   while (sum.iterations < opt.max_iterations) {
     if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
-    const bool within = b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q);
-    scaled_jacobian_rows(model, q, t, kept, pattern.get(), &values);
-    if (!solver) solver = std::make_unique<MinNormSolver>(pattern);  // pattern fixed for this set of rows
+    const bool within = kept_within();
+    jac.evaluate(q, t, values);
     if (within) mu = 0.0;
     FactorStatus fs = solver->factorize(values.data(), mu);
     if (fs == FactorStatus::kSingular) {  // the kept rows lost rank here: regularise
@@ -192,9 +165,7 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
     if (within) {
       pull = (q0 - q).cwiseQuotient(sc.coordinate_scale);
       rhs = b;
-      for (Index j = 0; j < n; ++j)
-        for (Index e = pattern->col_ptr[j]; e < pattern->col_ptr[j + 1]; ++e)
-          rhs(pattern->row_idx[e]) += values[static_cast<std::size_t>(e)] * pull(j);
+      solver->multiply_add(pull.data(), rhs.data());  // Φ̃ + Ã p
       if (!solver->min_norm(rhs.data(), d.data())) return *why = solver->last_message(), SolveStatus::kLinearSolverFailed;
       d = (pull - d).cwiseProduct(sc.coordinate_scale);
       if (!d.allFinite()) return *why = "projection step is not finite", SolveStatus::kNonFinite;
@@ -202,8 +173,7 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
       model.residual(q.data(), t, phi.data());
       kept_scaled(phi, b);
       f = 0.5 * b.squaredNorm();
-      if (scaled_step(model, d, q, opt.tolerance) <= 1.0 && b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q))
-        return SolveStatus::kSuccess;
+      if (scaled_step(model, d, q, opt.tolerance) <= 1.0 && kept_within()) return SolveStatus::kSuccess;
       continue;
     }
 
@@ -231,7 +201,7 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
   }
   // The projection phase converges linearly: if its budget ran out with the rows within tolerance, the position is
   // assembled, only not the nearest one to the last digit.
-  if (b.cwiseAbs().maxCoeff() <= opt.tolerance + row_floor(model, q)) return SolveStatus::kSuccess;
+  if (kept_within()) return SolveStatus::kSuccess;
   *why = "did not converge in " + std::to_string(opt.max_iterations) + " iterations";
   return SolveStatus::kNotConverged;
 }
@@ -257,10 +227,10 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     sum.residual = m ? scaled.maxCoeff() : 0.0;
     sum.moved = n ? ((q - q0).cwiseAbs().cwiseQuotient(model.tolerance_scales().coordinate_scale)).maxCoeff() : 0.0;
     if (st != SolveStatus::kSuccess) {
-      sum.worst_rows = worst(scaled, nullptr, 3);
+      sum.worst_rows = detail::worst_rows(model, phi, 3);
       if (msg.empty()) msg = to_string(st);
       if (!sum.worst_rows.empty() && st != SolveStatus::kInconsistent)
-        msg += "; worst constraints: " + describe(model, sum.worst_rows);
+        msg += "; worst constraints: " + detail::describe_rows(model, sum.worst_rows);
     }
     sum.message = std::move(msg);
     return st;
@@ -287,8 +257,9 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     sum.rank = analyse_rank(model, q, t, opt.rank);
     model.residual(q.data(), t, phi.data());
     const Eigen::VectorXd scaled = scaled_rows(model, phi);
-    const double tol = opt.tolerance + row_floor(model, q);
-    const bool all_within = m == 0 || scaled.maxCoeff() <= tol;
+    const detail::Floors floors = rounding_floors(model, q);
+    auto within = [&](Index r) { return detail::row_within(model, r, scaled(r), opt.tolerance, floors); };
+    const bool all_within = detail::residual_within(model, phi, opt.tolerance, floors);
     if (st == SolveStatus::kSuccess && all_within) return finish(SolveStatus::kSuccess, "");
     if (st == SolveStatus::kNonFinite || st == SolveStatus::kLinearSolverFailed) return finish(st, why);
     // The independent equations now hold (or stall) but others do not. If the rows found independent here differ
@@ -299,9 +270,9 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     }
     const std::vector<Index>& ind = sum.rank.independent_rows;
     bool kept_within = true;
-    for (Index r : ind) kept_within = kept_within && scaled(r) <= tol;
+    for (Index r : ind) kept_within = kept_within && within(r);
     for (Index r : sum.rank.redundant_rows)
-      if (scaled(r) > tol) sum.violated_rows.push_back(r);
+      if (!within(r)) sum.violated_rows.push_back(r);
     if (!kept_within || sum.violated_rows.empty()) return finish(SolveStatus::kNotConverged, why);
 
     // Inconsistent: each violated redundant row is a combination of independent rows, which it contradicts.
@@ -314,8 +285,8 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     std::sort(cons.begin(), cons.end());
     cons.erase(std::unique(cons.begin(), cons.end()), cons.end());
     for (Index c : cons) sum.conflicts.push_back(model.constraints()[static_cast<std::size_t>(c)].name);
-    const auto w = worst(scaled, &sum.violated_rows, 3);
-    std::string msg = "inconsistent redundant constraints: " + describe(model, w) +
+    const auto w = detail::worst_rows(model, phi, 3, &sum.violated_rows);
+    std::string msg = "inconsistent redundant constraints: " + detail::describe_rows(model, w) +
                       " cannot hold where the independent equations do; conflicting constraints:";
     for (std::size_t k = 0; k < sum.conflicts.size(); ++k) msg += (k ? ", " : " ") + sum.conflicts[k];
     return finish(SolveStatus::kInconsistent, msg);
@@ -338,6 +309,22 @@ SolveStatus prepare_square(const Model& model, double t, const AssemblyOptions& 
   }
   *solved = std::make_unique<Model>(model.without_rows(sum.rank.redundant_rows));
   return SolveStatus::kSuccess;
+}
+
+AssemblyOptions assembly_options(const NewtonOptions& newton) {
+  AssemblyOptions o;
+  o.tolerance = newton.tolerance;
+  o.max_iterations = newton.max_iterations;
+  return o;
+}
+
+SolveStatus prepare_scene(const Model& model, double t_begin, const NewtonOptions& assembly, SquareScene* out) {
+  if (!out) throw Error("prepare_scene: out must not be null");
+  out->reduced.reset();
+  out->assembly = AssemblySummary{};
+  out->start = model.initial_positions();
+  if (model.num_equations() == model.num_coordinates()) return SolveStatus::kSuccess;
+  return prepare_square(model, t_begin, assembly_options(assembly), out->start, &out->reduced, &out->assembly);
 }
 
 }  // namespace phiq

@@ -88,14 +88,9 @@ void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
   }
   if (!scene_->output_residuals.empty() || scene_->output_max_residual) {
     if (!s.phi) throw Error("CsvFormat: step has no residuals");
-    // A model solved on its independent rows (a redundant scene: Model::without_rows) delivers the Φ of those rows:
-    // the scene's constraints are then evaluated on the whole scene model, the left-out rows included.
+    // Φ of every row: a model solved on its independent rows (Model::without_rows) still evaluates all of them.
     const Eigen::VectorXd* phi = s.phi;
-    if (phi->size() != model_.num_equations()) {
-      full_phi_.resize(model_.num_equations());
-      model_.residual(s.q.data(), s.t, full_phi_.data());
-      phi = &full_phi_;
-    }
+    if (phi->size() != model_.num_equations()) throw Error("CsvFormat: step's Φ is not the scene model's");
     const Eigen::VectorXd& rs = model_.tolerance_scales().row_scale;
     for (Index c : scene_->output_residuals) {
       // the measure of the convergence test: |Φ_i| / scale_i, the largest over the constraint's rows

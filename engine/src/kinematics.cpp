@@ -1,5 +1,7 @@
 #include "phiq/kinematics.hpp"
 
+#include "tolerance_tests.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -39,37 +41,19 @@ Workspace::Workspace(const Model& model) : model_(&model) {
   jacobian_values.assign(static_cast<std::size_t>(model.jacobian_pattern().nnz()), 0.0);
   if (!model.dropped_rows().empty()) {
     solve_values.assign(model.solve_entries().size(), 0.0);
-    solve_rhs.resize(static_cast<Index>(model.solve_rows().size()));
+    solve_rhs.resize(model.num_solve_rows());
   }
   if (model.symbolic()) lu = model.symbolic()->make_numeric();
 }
 
 namespace {
 
-constexpr double kUlpFloor = 64.0 * std::numeric_limits<double>::epsilon();
-
-// Rounding floor of lengths and of other quantities at this q: a residual or a step cannot be resolved below a few
-// ulps of the coordinates it is computed from, wherever the origin is.
-struct Floors {
-  double length = 0.0, other = 0.0;
-};
-// The tests below run every Newton iteration: one vectorised pass each over the model's precomputed scales.
-Floors rounding_floors(const Model& model, const Eigen::VectorXd& q) {
-  Floors f;
-  if (q.size() == 0) return f;
-  const auto& len = model.tolerance_scales().coordinate_is_length.array();
-  f.length = kUlpFloor * (q.array().abs() * len).maxCoeff();
-  f.other = kUlpFloor * (q.array().abs() * (1.0 - len)).maxCoeff();
-  return f;
-}
-
-// Every row |Φ_i| ≤ tol · scale_i + floor_i (false on NaN).
-bool residual_within(const Model& model, const Eigen::VectorXd& phi, double tol, const Floors& fl) {
-  const ToleranceScales& s = model.tolerance_scales();
-  return (phi.array().abs() <=
-          tol * s.row_scale.array() + fl.other + (fl.length - fl.other) * s.row_is_length.array())
-      .all();
-}
+using detail::describe_rows;
+using detail::Floors;
+using detail::kUlpFloor;
+using detail::residual_within;
+using detail::rounding_floors;
+using detail::worst_rows;
 
 // max_j |Δq_j| / (tol · scale_j + floor_j): ≤ 1 when the step is within the tolerance (NaN propagates as > 1).
 // With tol = 1 it is the size of the step in the tolerance-scaled norm (the floor is then negligible).
@@ -94,31 +78,6 @@ double merit(const Model& model, const Eigen::VectorXd& phi) {
   return 0.5 * (phi.array() / model.tolerance_scales().row_scale.array()).square().sum();
 }
 
-std::vector<std::pair<Index, double>> worst_rows(const Model& model, const Eigen::VectorXd& phi, int k) {
-  const Eigen::VectorXd& rs = model.tolerance_scales().row_scale;
-  std::vector<std::pair<Index, double>> rows;
-  for (Index i = 0; i < phi.size(); ++i) {
-    double r = std::fabs(phi(i)) / rs(i);
-    if (std::isnan(r)) r = std::numeric_limits<double>::infinity();
-    rows.emplace_back(i, r);
-  }
-  const std::size_t kk = std::min<std::size_t>(static_cast<std::size_t>(k), rows.size());
-  std::partial_sort(rows.begin(), rows.begin() + static_cast<std::ptrdiff_t>(kk), rows.end(),
-                    [](auto& a, auto& b) { return a.second > b.second; });
-  rows.resize(kk);
-  return rows;
-}
-
-std::string describe_rows(const Model& model, const std::vector<std::pair<Index, double>>& rows) {
-  std::ostringstream s;
-  s.precision(3);
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    if (k) s << ", ";
-    s << "'" << model.row_name(rows[k].first) << "' " << std::scientific << rows[k].second;
-  }
-  return s.str();
-}
-
 bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
 
 void check_workspace(const Model& model, const Workspace& ws) {
@@ -129,8 +88,7 @@ void check_workspace(const Model& model, const Workspace& ws) {
 }
 
 std::string not_square_message(const Model& model) {
-  const std::size_t kept = model.solve_rows().size();
-  std::string s = "the model has " + std::to_string(kept) + " equations for " +
+  std::string s = "the model has " + std::to_string(model.num_solve_rows()) + " equations for " +
                   std::to_string(model.num_coordinates()) + " coordinates";
   if (!model.dropped_rows().empty())
     s += " (after leaving out " + std::to_string(model.dropped_rows().size()) + " redundant rows)";

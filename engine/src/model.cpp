@@ -111,8 +111,6 @@ Model Model::without_rows(std::vector<Index> rows) const {
   out.solve_rows_.clear();
   if (rows.empty()) {  // nothing left out: the full system, with its own analysis
     out.solve_pattern_ = pattern_;
-    out.solve_rows_.resize(static_cast<std::size_t>(m));
-    for (Index i = 0; i < m; ++i) out.solve_rows_[static_cast<std::size_t>(i)] = i;
     if (solve_pattern_ != pattern_) {
       out.symbolic_.reset();
       if (m == n && n > 0) out.symbolic_ = analyse(lu_kind_, pattern_);
@@ -337,8 +335,6 @@ Model ModelBuilder::build() && {
   auto pattern = std::make_shared<CscPattern>(build_csc_pattern(rows, n, trip_rows, trip_cols, &m.slot_of_entry_));
   m.pattern_ = pattern;
   m.solve_pattern_ = pattern;
-  m.solve_rows_.resize(static_cast<std::size_t>(rows));
-  for (Index i = 0; i < rows; ++i) m.solve_rows_[static_cast<std::size_t>(i)] = i;
 
   // Units and scales.
   m.coordinate_units_.assign(static_cast<std::size_t>(n), Unit::kNone);

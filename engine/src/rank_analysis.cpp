@@ -7,10 +7,10 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <sstream>
 
 #include "phiq/min_norm_solver.hpp"
+#include "cholmod_view.hpp"
 
 namespace phiq {
 
@@ -28,37 +28,60 @@ std::string RankReport::BriefReport() const {
   return s.str();
 }
 
-void scaled_jacobian_rows(const Model& model, const Eigen::VectorXd& q, double t, const std::vector<Index>& rows,
-                          CscPattern* pattern, std::vector<double>* values) {
+ScaledJacobianRows::ScaledJacobianRows(const Model& model, std::vector<Index> rows)
+    : model_(&model), rows_(std::move(rows)) {
   const Index n = model.num_coordinates(), m = model.num_equations();
-  if (q.size() != n) throw Error("scaled_jacobian_rows: q must have " + std::to_string(n) + " entries");
   const CscPattern& full = model.jacobian_pattern();
-  std::vector<double> v(static_cast<std::size_t>(full.nnz()));
-  model.jacobian(q.data(), t, v.data());
   std::vector<Index> pos(static_cast<std::size_t>(m), -1);
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    const Index r = rows[k];
-    if (r < 0 || r >= m) throw Error("scaled_jacobian_rows: row " + std::to_string(r) + " out of range");
+  for (std::size_t k = 0; k < rows_.size(); ++k) {
+    const Index r = rows_[k];
+    if (r < 0 || r >= m) throw Error("ScaledJacobianRows: row " + std::to_string(r) + " out of range");
     pos[static_cast<std::size_t>(r)] = static_cast<Index>(k);
   }
-  const ToleranceScales& s = model.tolerance_scales();
-  CscPattern& p = *pattern;
-  p.rows = static_cast<Index>(rows.size());
-  p.cols = n;
-  p.col_ptr.assign(static_cast<std::size_t>(n) + 1, 0);
-  p.row_idx.clear();
-  values->clear();
-  std::vector<std::pair<Index, double>> col;
+  auto p = std::make_shared<CscPattern>();
+  p->rows = static_cast<Index>(rows_.size());
+  p->cols = n;
+  p->col_ptr.assign(static_cast<std::size_t>(n) + 1, 0);
+  std::vector<std::pair<Index, Index>> col;  // (new row, source entry), sorted by new row within the column
   for (Index j = 0; j < n; ++j) {
     col.clear();
-    for (Index k = full.col_ptr[j]; k < full.col_ptr[j + 1]; ++k) {
-      const Index r = full.row_idx[k], to = pos[static_cast<std::size_t>(r)];
-      if (to >= 0) col.emplace_back(to, v[static_cast<std::size_t>(k)] * s.coordinate_scale(j) / s.row_scale(r));
-    }
+    for (Index k = full.col_ptr[j]; k < full.col_ptr[j + 1]; ++k)
+      if (const Index to = pos[static_cast<std::size_t>(full.row_idx[k])]; to >= 0) col.emplace_back(to, k);
     std::sort(col.begin(), col.end());
-    for (const auto& [r, x] : col) p.row_idx.push_back(r), values->push_back(x);
-    p.col_ptr[static_cast<std::size_t>(j) + 1] = p.nnz();
+    for (const auto& [r, k] : col) {
+      p->row_idx.push_back(r);
+      source_.push_back(k);
+    }
+    p->col_ptr[static_cast<std::size_t>(j) + 1] = p->nnz();
   }
+  pattern_ = std::move(p);
+}
+
+void ScaledJacobianRows::evaluate(const Eigen::VectorXd& q, double t, std::vector<double>& values) {
+  if (q.size() != model_->num_coordinates())
+    throw Error("ScaledJacobianRows: q must have " + std::to_string(model_->num_coordinates()) + " entries");
+  full_.resize(static_cast<std::size_t>(model_->jacobian_pattern().nnz()));
+  model_->jacobian(q.data(), t, full_.data());
+  gather(full_.data(), values);
+}
+
+void ScaledJacobianRows::gather(const double* jacobian_values, std::vector<double>& values) const {
+  values.resize(source_.size());
+  const ToleranceScales& s = model_->tolerance_scales();
+  const std::vector<Index>& full_rows = model_->jacobian_pattern().row_idx;
+  const CscPattern& p = *pattern_;
+  for (Index j = 0; j < p.cols; ++j)
+    for (Index k = p.col_ptr[j]; k < p.col_ptr[j + 1]; ++k) {
+      const Index src = source_[static_cast<std::size_t>(k)];
+      values[static_cast<std::size_t>(k)] = jacobian_values[src] * s.coordinate_scale(j) / s.row_scale(full_rows[src]);
+    }
+}
+
+void scaled_jacobian_rows(const Model& model, const Eigen::VectorXd& q, double t, const std::vector<Index>& rows,
+                          CscPattern* pattern, std::vector<double>* values) {
+  ScaledJacobianRows s(model, rows);
+  s.evaluate(q, t, *values);
+  *pattern = *s.pattern();
 }
 
 namespace {
@@ -69,34 +92,6 @@ void transpose(const CscPattern& a, const std::vector<double>& av, CscPattern* t
   *t = transpose_pattern(a, &from);
   tv->resize(from.size());
   for (std::size_t k = 0; k < from.size(); ++k) (*tv)[k] = av[static_cast<std::size_t>(from[k])];
-}
-
-// RAII for CHOLMOD's workspace, the way SuiteSparseQR takes it.
-struct Cholmod {
-  cholmod_common cc;
-  Cholmod() {
-    cholmod_l_start(&cc);
-    cc.print = 0;
-    cc.error_handler = nullptr;
-  }
-  ~Cholmod() { cholmod_l_finish(&cc); }
-};
-
-cholmod_sparse view(const CscPattern& p, const std::vector<double>& v) {
-  cholmod_sparse a;
-  std::memset(&a, 0, sizeof a);
-  a.nrow = static_cast<std::size_t>(p.rows);
-  a.ncol = static_cast<std::size_t>(p.cols);
-  a.nzmax = static_cast<std::size_t>(std::max<Index>(p.nnz(), 1));
-  a.p = const_cast<Index*>(p.col_ptr.data());
-  a.i = const_cast<Index*>(p.row_idx.data());
-  a.x = const_cast<double*>(v.data());
-  a.itype = CHOLMOD_LONG;
-  a.xtype = CHOLMOD_REAL;
-  a.dtype = CHOLMOD_DOUBLE;
-  a.sorted = 1;
-  a.packed = 1;
-  return a;
 }
 
 struct SparseRank {
@@ -114,8 +109,8 @@ SparseRank sparse_rank(const CscPattern& a, const std::vector<double>& av, doubl
   SparseRank out;
   out.live.assign(static_cast<std::size_t>(a.cols), 0);
   if (a.cols == 0 || a.rows == 0) return out;
-  Cholmod c;
-  cholmod_sparse A = view(a, av);
+  detail::CholmodCommon c;
+  cholmod_sparse A = detail::csc_view(a, av.data());
   cholmod_sparse* R = nullptr;
   SuiteSparse_long* E = nullptr;
   const SuiteSparse_long rank = SuiteSparseQR<double>(SPQR_ORDERING_FIXED, tol, 0, &A, &R, &E, &c.cc);
@@ -148,14 +143,9 @@ SparseRank sparse_rank(const CscPattern& a, const std::vector<double>& av, doubl
   return out;
 }
 
-// CCOLAMD's fill-reducing order of the equations `order` (the columns of J̃ᵀ) with the first `kinematic` of them kept
-// ahead of the others (constraint sets 0 and 1). Only the pattern matters: values are not read.
-std::vector<Index> fill_reducing(const Model& model, const Eigen::VectorXd& q, double t, const std::vector<Index>& order,
-                                 Index kinematic) {
-  CscPattern jp, at;
-  std::vector<double> jv, atv;
-  scaled_jacobian_rows(model, q, t, order, &jp, &jv);
-  transpose(jp, jv, &at, &atv);
+// CCOLAMD's fill-reducing order of the equations `order` (the columns of J̃ᵀ, whose pattern `at` is) with the
+// first `kinematic` of them kept ahead of the others (constraint sets 0 and 1). Only the pattern is read.
+std::vector<Index> fill_reducing(const CscPattern& at, const std::vector<Index>& order, Index kinematic) {
   const SuiteSparse_long nr = at.rows, nc = at.cols, nnz = at.nnz();
   const std::size_t alen = ccolamd_l_recommended(nnz, nr, nc);
   if (alen == 0) throw Error("CCOLAMD: invalid matrix");
@@ -200,11 +190,16 @@ RankReport analyse_rank(const Model& model, const Eigen::VectorXd& q, double t, 
   rep.ordering = options.ordering == RankOrdering::kAuto
                      ? (m <= 20000 ? RankOrdering::kModelOrder : RankOrdering::kFillReducing)
                      : options.ordering;
-  if (rep.ordering == RankOrdering::kFillReducing && m > 0)
-    order = fill_reducing(model, q, t, order, rep.kinematic_equations);
-  CscPattern jp, at;
+  if (rep.ordering == RankOrdering::kFillReducing && m > 0) {  // the order from the pattern alone
+    std::vector<Index> unused;
+    order = fill_reducing(transpose_pattern(*ScaledJacobianRows(model, order).pattern(), &unused), order,
+                          rep.kinematic_equations);
+  }
+  ScaledJacobianRows scaled(model, order);
   std::vector<double> jv, atv;
-  scaled_jacobian_rows(model, q, t, order, &jp, &jv);
+  scaled.evaluate(q, t, jv);
+  const CscPattern& jp = *scaled.pattern();
+  CscPattern at;
   transpose(jp, jv, &at, &atv);  // n × m: column k is equation order[k]
   double largest = 0.0;
   for (Index k = 0; k < at.cols; ++k) {
@@ -279,17 +274,21 @@ RankReport analyse_rank(const Model& model, const Eigen::VectorXd& q, double t, 
 std::vector<RowCombination> combinations_of(const Model& model, const Eigen::VectorXd& q, double t,
                                             const std::vector<Index>& basis, const std::vector<Index>& rows) {
   std::vector<RowCombination> out;
+  if (q.size() != model.num_coordinates())
+    throw Error("combinations_of: q must have " + std::to_string(model.num_coordinates()) + " entries");
   if (rows.empty()) return out;
-  auto bp = std::make_shared<CscPattern>();
-  std::vector<double> bv;
-  scaled_jacobian_rows(model, q, t, basis, bp.get(), &bv);
-  MinNormSolver solver(bp);
+  // one evaluation of Φq, gathered twice: the basis rows (factorised) and the rows to express in them
+  ScaledJacobianRows basis_rows(model, basis), fit_rows(model, rows);
+  std::vector<double> full(static_cast<std::size_t>(model.jacobian_pattern().nnz())), bv, rv, rtv;
+  model.jacobian(q.data(), t, full.data());
+  basis_rows.gather(full.data(), bv);
+  fit_rows.gather(full.data(), rv);
+  const CscPattern* bp = basis_rows.pattern().get();
+  MinNormSolver solver(basis_rows.pattern());
   if (solver.factorize(bv.data()) != FactorStatus::kOk)
     throw Error("combinations_of: the basis rows are dependent at this configuration");
-  CscPattern rp, rt;
-  std::vector<double> rv, rtv;
-  scaled_jacobian_rows(model, q, t, rows, &rp, &rv);
-  transpose(rp, rv, &rt, &rtv);  // column k: J̃ row rows[k]
+  CscPattern rt;
+  transpose(*fit_rows.pattern(), rv, &rt, &rtv);  // column k: J̃ row rows[k]
   const Index n = model.num_coordinates(), b = static_cast<Index>(basis.size());
   Eigen::VectorXd jr(n), rhs(b), c(b), fit(n);
   for (std::size_t k = 0; k < rows.size(); ++k) {

@@ -33,6 +33,10 @@ struct AssemblyOptions {
   RankOptions rank;  ///< rank tolerance and cross-checks
 };
 
+/// The assembly settings of a Newton solve's settings (tolerance and iteration budget; the rest as defaults): the
+/// minimum-norm assembly of a scene uses its `solver` section as the square assembly does (SweepOptions::assembly).
+AssemblyOptions assembly_options(const NewtonOptions& newton);
+
 /// What assemble() did.
 struct AssemblySummary {
   SolveStatus status = SolveStatus::kNotConverged;  ///< kSuccess, kInconsistent, kNotConverged, kNonFinite, ...
@@ -69,5 +73,20 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& option
 /// the message names the count). A workspace for the sweep is made for `**solved` and started from q.
 SolveStatus prepare_square(const Model& model, double t, const AssemblyOptions& options, Eigen::VectorXd& q,
                            std::unique_ptr<Model>* solved, AssemblySummary* summary = nullptr);
+
+/// The model a scene's sweep solves and where it starts, as `phiq run` prepares it.
+struct SquareScene {
+  std::unique_ptr<Model> reduced;  ///< the model without its redundant rows, when the scene's model is not square
+  Eigen::VectorXd start;           ///< the rough placement, or the assembled position when `reduced` was made
+  AssemblySummary assembly;        ///< the minimum-norm assembly, when it ran
+  /// The model to sweep: `reduced`, else the scene's own `model`.
+  const Model& model(const Model& scene_model) const { return reduced ? *reduced : scene_model; }
+};
+
+/// Prepares a scene's model for the square sweep: a square model is swept as it is, from its rough placement (the
+/// sweep assembles it); any other is assembled by minimum norm with the scene's assembly settings
+/// (`assembly`, SweepOptions::assembly) and reduced to its independent rows (prepare_square()). Returns kSuccess or
+/// prepare_square()'s failure (the summary's message names the constraints or the count).
+SolveStatus prepare_scene(const Model& model, double t_begin, const NewtonOptions& assembly, SquareScene* out);
 
 }  // namespace phiq

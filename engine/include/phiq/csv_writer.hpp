@@ -14,8 +14,7 @@
 
 namespace phiq {
 
-/// The columns of a result CSV (format version kCsvFormat) and the formatting of its rows. One per thread (its
-/// const functions share a scratch vector).
+/// The columns of a result CSV (format version kCsvFormat) and the formatting of its rows. Thread-safe (const).
 class CsvFormat {
  public:
   /// `columns`: coordinate indices to write, in order; `velocities` / `accelerations`: add the `.v` / `.a` groups.
@@ -38,7 +37,6 @@ class CsvFormat {
   bool velocities_, accelerations_;
   const Scene* scene_ = nullptr;  // the other outputs, when made from a scene
   void append_outputs(const StepView& step, std::string& out) const;  // the columns after the coordinates
-  mutable Eigen::VectorXd full_phi_;  // Φ of the whole scene model, for a sweep of a model without some rows
 };
 
 /// An output file that appears only when complete: written under a temporary name in the same directory and

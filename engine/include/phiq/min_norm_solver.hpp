@@ -35,8 +35,10 @@ class MinNormSolver {
   bool solve(const double* b, double* y);
   /// x = Aᵀ (A Aᵀ + β I)⁻¹ b (b has r entries, x has n): the minimum-norm solution of A x = b when β = 0.
   bool min_norm(const double* b, double* x);
-  /// x = Aᵀ y (y has r entries, x has n).
+  /// x = Aᵀ y (y has r entries, x has n), with the values of the last successful factorize().
   void multiply_transposed(const double* y, double* x) const;
+  /// y += A x (x has n entries, y has r), with the values of the last successful factorize().
+  void multiply_add(const double* x, double* y) const;
   /// CHOLMOD's reciprocal condition estimate of A Aᵀ + β I (min/max of the diagonal of L, squared): a cheap,
   /// rough figure; about rcond(A)².
   double rcond() const { return rcond_; }

@@ -236,8 +236,11 @@ class Model {
   Model without_rows(std::vector<Index> rows) const;
   /// Rows left out of the square solves, ascending (empty for a model built by ModelBuilder).
   const std::vector<Index>& dropped_rows() const { return dropped_rows_; }
-  /// Rows the square solves use, ascending: all rows when none is dropped.
+  /// Rows the square solves use, ascending, when some are dropped; empty when none is (then they are all rows, and
+  /// solve_pattern() is jacobian_pattern()).
   const std::vector<Index>& solve_rows() const { return solve_rows_; }
+  /// How many rows the square solves use: solve_pattern().rows.
+  Index num_solve_rows() const { return solve_pattern_->rows; }
   /// The pattern of Φq restricted to solve_rows() (rows renumbered 0 …); the same object as jacobian_pattern()
   /// when no row is dropped.
   const CscPattern& solve_pattern() const { return *solve_pattern_; }
@@ -293,7 +296,7 @@ class Model {
   // 10^5 four-bars (bench/README.md).
   LinearSolverKind lu_kind_ = LinearSolverKind::kKlu;
   std::shared_ptr<const SparseLuSymbolic> symbolic_;
-  std::vector<Index> dropped_rows_, solve_rows_;
+  std::vector<Index> dropped_rows_, solve_rows_;  ///< both empty unless rows are dropped (without_rows())
   std::shared_ptr<const CscPattern> solve_pattern_ = pattern_;
   std::vector<Index> solve_entries_;
   std::optional<Index> grubler_;

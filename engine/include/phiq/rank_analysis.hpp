@@ -14,6 +14,7 @@
 /// that order.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -96,8 +97,34 @@ struct RowCombination {
 std::vector<RowCombination> combinations_of(const Model& model, const Eigen::VectorXd& q, double t,
                                             const std::vector<Index>& basis, const std::vector<Index>& rows);
 
-/// The scaled Jacobian D_r⁻¹ Φq D_c at (q, t), restricted to `rows` (in that order), as a CSC pattern and values:
-/// what the rank analysis and the minimum-norm assembly factorise. Thread-safe.
+/// The scaled Jacobian D_r⁻¹ Φq D_c restricted to a list of rows — what the rank analysis and the minimum-norm
+/// assembly factorise. Set-up (the constructor) fixes its pattern and, for every entry, where it comes from in
+/// Φq's value array and its scale; an evaluation is then one Φq evaluation and a gather, with no allocation, so
+/// that iterative solvers pay for the pattern once. Not thread-safe (its Φq scratch): one object per thread.
+class ScaledJacobianRows {
+ public:
+  /// The rows `rows` of `model` (in that order: row k of the result is model row rows[k]). Throws phiq::Error for a
+  /// row out of range. The model must outlive the object.
+  ScaledJacobianRows(const Model& model, std::vector<Index> rows);
+  /// The rows, in the order of the pattern's rows.
+  const std::vector<Index>& rows() const { return rows_; }
+  /// The pattern (rows().size() × n); shared so that solvers can keep it.
+  const std::shared_ptr<const CscPattern>& pattern() const { return pattern_; }
+  /// The values at (q, t), in pattern order, into `values` (resized). Pre-condition: q has n entries.
+  void evaluate(const Eigen::VectorXd& q, double t, std::vector<double>& values);
+  /// The values from Φq's values already evaluated (jacobian_pattern() order), into `values` (resized).
+  void gather(const double* jacobian_values, std::vector<double>& values) const;
+
+ private:
+  const Model* model_;
+  std::vector<Index> rows_;
+  std::shared_ptr<const CscPattern> pattern_;
+  std::vector<Index> source_;    // entry k is Φq's value source_[k] · coordinate_scale(column) / row_scale(row)
+  std::vector<double> full_;     // Φq values (scratch of evaluate())
+};
+
+/// The scaled Jacobian at (q, t) restricted to `rows` (in that order), as a pattern and values: a one-off
+/// ScaledJacobianRows. Thread-safe.
 void scaled_jacobian_rows(const Model& model, const Eigen::VectorXd& q, double t, const std::vector<Index>& rows,
                           CscPattern* pattern, std::vector<double>* values);
 
