@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "phiq/expression.hpp"
+#include "test_support.hpp"
 
 namespace phiq {
 namespace {
@@ -96,6 +97,53 @@ TEST(Expression, ErrorsNameTheTextAndTheProblem) {
   EXPECT_EQ(message("   "), "expression is empty");
   // 1e-3 is a number, not the name 'e'
   EXPECT_NO_THROW(CompiledExpression::compile("1e-3*xA + 2.5E+2*yA", resolve));
+}
+
+TEST(Expression, ComplexOrHugeConstantsAreRefusedNotHandedToGiNaC) {
+  auto message = [](const std::string& text) {
+    try {
+      CompiledExpression::compile(text, resolve);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // Found by the fuzzer (CI): GiNaC recursed without bound differentiating atan2 times a complex constant, and
+  // exact big powers never finished. Numbers now reach GiNaC as real symbols and are folded in double precision.
+  EXPECT_HAS(message("sin(atan2(-1, t)*2*(-1)^(1/2)) + xA"), "not a finite real number");
+  EXPECT_HAS(message("tan(atan2(-3/4, t)*(-2.0)^0.5) + xA"), "not a finite real number");
+  EXPECT_HAS(message("xA - 9^(9^(9^9))"), "not a finite real number");
+  EXPECT_HAS(message("xA - sqrt(-1e-300)"), "not a finite real number");
+  EXPECT_HAS(message("xA/(1 - 1)"), "not a finite real number");
+  EXPECT_HAS(message("xA/0"), "division by zero");
+  // GiNaC reads x^-1 + y as x^(-1 + y): refused, with the form to write instead
+  EXPECT_HAS(message("theta2^-1 + xA"), "write a signed exponent in parentheses, as x^(-2)");
+  EXPECT_HAS(message("xA - 1e400"), "number '1e400' is out of the range of a double");
+  EXPECT_HAS(message("phiqK0 + xA"), "reserved");
+}
+
+TEST(Expression, LiteralsFoldToTheValuesTheTextMeans) {
+  // Powers written with integer exponents stay exact: the derivative of xA^2 at 0 is 0 (not 0·2/0), and of
+  // yA^(3) and theta2^(-1) the closed forms. Constant parts fold to their double values.
+  auto e = CompiledExpression::compile("xA^2 + yA^(3) + 2.5e-1*theta2^(-1) + 0*unused + (1/4)^(1/2)*L2 + pi", resolve);
+  EXPECT_EQ(e->coordinates(), (std::vector<Index>{0, 1, 2}));
+  const double q0[3] = {0.5, 0.0, 0.0};
+  double g[3];
+  e->gradient(q0, 0.0, g);
+  EXPECT_EQ(g[1], 0.0);
+  EXPECT_EQ(g[2], 0.0);
+  EXPECT_DOUBLE_EQ(g[0], -0.25 / (0.5 * 0.5));
+  const double q[3] = {0.5, -1.5, 2.0};
+  EXPECT_DOUBLE_EQ(e->value(q, 0.0), 2.25 + 8.0 + 0.5 + 0.5 * 0.3 + M_PI);
+  e->gradient(q, 0.0, g);
+  EXPECT_DOUBLE_EQ(g[1], -3.0);
+  EXPECT_DOUBLE_EQ(g[2], 12.0);
+  // a half-integer exponent through sqrt: d/dx x^1.5 = 1.5 sqrt(x)
+  auto h = CompiledExpression::compile("xA^1.5", resolve);
+  const double q1[3] = {0, 4.0, 0};
+  double gh[1];
+  h->gradient(q1, 0.0, gh);
+  EXPECT_DOUBLE_EQ(gh[0], 3.0);
 }
 
 TEST(Expression, ConstantExpressions) {

@@ -16,52 +16,66 @@ namespace phiq {
 // ---------------------------------------------------------------------------------------------------------------
 // Tape evaluation
 
+namespace {
+// One instruction on operand values a, b (loads excluded): shared by the evaluator and the builder's constant
+// folding, so that a folded constant is exactly what the tape would have computed.
+double apply(Tape::Op op, double a, double b, double imm) {
+  using Op = Tape::Op;
+  switch (op) {
+    case Op::kConst: return imm;
+    case Op::kAdd: return a + b;
+    case Op::kSub: return a - b;
+    case Op::kMul: return a * b;
+    case Op::kDiv: return a / b;
+    case Op::kNeg: return -a;
+    case Op::kPowInt: {
+      // exact repeated squaring for integer exponents (keeps x^2 and x^(-1) as accurate as a multiply)
+      long e = static_cast<long>(imm);
+      double base = a;
+      if (e < 0) { base = 1.0 / base; e = -e; }
+      double acc = 1.0;
+      while (e) { if (e & 1) acc *= base; base *= base; e >>= 1; }
+      return acc;
+    }
+    case Op::kPow: return std::pow(a, b);
+    case Op::kSqrt: return std::sqrt(a);
+    case Op::kSin: return std::sin(a);
+    case Op::kCos: return std::cos(a);
+    case Op::kTan: return std::tan(a);
+    case Op::kAsin: return std::asin(a);
+    case Op::kAcos: return std::acos(a);
+    case Op::kAtan: return std::atan(a);
+    case Op::kAtan2: return std::atan2(a, b);
+    case Op::kExp: return std::exp(a);
+    case Op::kLog: return std::log(a);
+    case Op::kSinh: return std::sinh(a);
+    case Op::kCosh: return std::cosh(a);
+    case Op::kTanh: return std::tanh(a);
+    case Op::kAbs: return std::fabs(a);
+    case Op::kSign: return (a > 0) - (a < 0);
+    default: return std::nan("");
+  }
+}
+
+bool is_binary(Tape::Op op) {
+  using Op = Tape::Op;
+  return op == Op::kAdd || op == Op::kSub || op == Op::kMul || op == Op::kDiv || op == Op::kPow ||
+         op == Op::kAtan2;
+}
+}  // namespace
+
 void Tape::evaluate(const double* q, const double* qd, double t, double* out) const {
   thread_local std::vector<double> r;
   if (r.size() < code_.size()) r.resize(code_.size());
   const std::size_t n = code_.size();
   for (std::size_t i = 0; i < n; ++i) {
     const Instr& in = code_[i];
-    double v;
     switch (in.op) {
-      case Op::kConst: v = in.imm; break;
-      case Op::kLoadQ: v = q[in.a]; break;
-      case Op::kLoadQd: v = qd[in.a]; break;
-      case Op::kLoadT: v = t; break;
-      case Op::kAdd: v = r[in.a] + r[in.b]; break;
-      case Op::kSub: v = r[in.a] - r[in.b]; break;
-      case Op::kMul: v = r[in.a] * r[in.b]; break;
-      case Op::kDiv: v = r[in.a] / r[in.b]; break;
-      case Op::kNeg: v = -r[in.a]; break;
-      case Op::kPowInt: {
-        // exact repeated squaring for integer exponents (keeps x^2 and x^-1 as accurate as a multiply)
-        long e = static_cast<long>(in.imm);
-        double base = r[in.a];
-        if (e < 0) { base = 1.0 / base; e = -e; }
-        double acc = 1.0;
-        while (e) { if (e & 1) acc *= base; base *= base; e >>= 1; }
-        v = acc;
-        break;
-      }
-      case Op::kPow: v = std::pow(r[in.a], r[in.b]); break;
-      case Op::kSqrt: v = std::sqrt(r[in.a]); break;
-      case Op::kSin: v = std::sin(r[in.a]); break;
-      case Op::kCos: v = std::cos(r[in.a]); break;
-      case Op::kTan: v = std::tan(r[in.a]); break;
-      case Op::kAsin: v = std::asin(r[in.a]); break;
-      case Op::kAcos: v = std::acos(r[in.a]); break;
-      case Op::kAtan: v = std::atan(r[in.a]); break;
-      case Op::kAtan2: v = std::atan2(r[in.a], r[in.b]); break;
-      case Op::kExp: v = std::exp(r[in.a]); break;
-      case Op::kLog: v = std::log(r[in.a]); break;
-      case Op::kSinh: v = std::sinh(r[in.a]); break;
-      case Op::kCosh: v = std::cosh(r[in.a]); break;
-      case Op::kTanh: v = std::tanh(r[in.a]); break;
-      case Op::kAbs: v = std::fabs(r[in.a]); break;
-      case Op::kSign: v = (r[in.a] > 0) - (r[in.a] < 0); break;
-      default: v = std::nan(""); break;
+      case Op::kLoadQ: r[i] = q[in.a]; break;
+      case Op::kLoadQd: r[i] = qd[in.a]; break;
+      case Op::kLoadT: r[i] = t; break;
+      default: r[i] = apply(in.op, r[in.a], r[in.b], in.imm); break;
     }
-    r[i] = v;
   }
   for (std::size_t k = 0; k < outputs_.size(); ++k) out[k] = r[outputs_[k]];
 }
@@ -173,8 +187,9 @@ Error expression_error(const std::string& text, const std::string& what);  // de
 
 class TapeBuilder {
  public:
-  TapeBuilder(const std::map<std::string, Index>& coord_of_symbol, const std::string& text)
-      : coord_of_symbol_(coord_of_symbol), text_(text) {}
+  TapeBuilder(const std::map<std::string, Index>& coord_of_symbol,
+              const std::map<std::string, double>& value_of_constant, const std::string& text)
+      : coord_of_symbol_(coord_of_symbol), value_of_constant_(value_of_constant), text_(text) {}
 
   void add_output(const GiNaC::ex& e) { tape_.outputs_.push_back(emit(e)); }
   Tape take() { return std::move(tape_); }
@@ -183,6 +198,17 @@ class TapeBuilder {
   using Op = Tape::Op;
 
   std::uint32_t push(Op op, std::uint32_t a = 0, std::uint32_t b = 0, double imm = 0.0) {
+    // Constant folding: numbers reach GiNaC as symbols (see compile()), so their arithmetic happens here, in
+    // double precision, exactly as the tape would do it. A constant part that is not a finite real (sqrt(-1),
+    // 1/0, exp(1000)) is refused at compile time rather than left as a NaN in the residual.
+    const bool loads = op == Op::kConst || op == Op::kLoadQ || op == Op::kLoadQd || op == Op::kLoadT;
+    if (!loads && is_const(a) && (!is_binary(op) || is_const(b))) {
+      const double v = apply(op, tape_.code_[a].imm, tape_.code_[b].imm, imm);
+      if (!std::isfinite(v))
+        fail(std::string("a constant part of it is not a finite real number (") +
+             (std::isnan(v) ? "NaN" : v > 0 ? "+inf" : "-inf") + ")");
+      op = Op::kConst, a = 0, b = 0, imm = v;
+    }
     if (tape_.code_.size() >= CompiledExpression::kMaxTapeSize)
       fail("its derivatives compile to more than " + std::to_string(CompiledExpression::kMaxTapeSize) +
            " instructions; the limit is " + std::to_string(CompiledExpression::kMaxTapeSize));
@@ -197,6 +223,7 @@ class TapeBuilder {
     return reg;
   }
   std::uint32_t constant(double v) { return push(Op::kConst, 0, 0, v); }
+  bool is_const(std::uint32_t r) const { return r < tape_.code_.size() && tape_.code_[r].op == Op::kConst; }
 
   [[noreturn]] void fail(const std::string& what) const { throw expression_error(text_, what); }
 
@@ -221,6 +248,7 @@ class TapeBuilder {
     if (is_a<symbol>(e)) {
       const std::string name = ex_to<symbol>(e).get_name();
       if (name == "t") return push(Op::kLoadT);
+      if (auto c = value_of_constant_.find(name); c != value_of_constant_.end()) return constant(c->second);
       if (name.rfind("qd:", 0) == 0) return push(Op::kLoadQd, static_cast<std::uint32_t>(std::stoll(name.substr(3))));
       auto it = coord_of_symbol_.find(name);
       if (it == coord_of_symbol_.end()) fail("internal: unbound symbol " + name);
@@ -245,7 +273,7 @@ class TapeBuilder {
       std::uint32_t acc = emit(e.op(0));
       for (std::size_t i = 1; i < e.nops(); ++i) {
         const ex& f = e.op(i);
-        // x * y^-1 is emitted as a division
+        // x * y^(-1) is emitted as a division
         if (is_a<power>(f) && f.op(1).is_equal(-1)) acc = push(Op::kDiv, acc, emit(f.op(0)));
         else acc = push(Op::kMul, acc, emit(f));
       }
@@ -253,26 +281,30 @@ class TapeBuilder {
     }
     if (is_a<power>(e)) {
       const ex& base = e.op(0);
-      const ex& expo = e.op(1);
-      if (is_a<numeric>(expo)) {
-        const numeric& n = ex_to<numeric>(expo);
-        if (n.is_integer()) {
-          long k = n.to_long();
+      const std::uint32_t expo = emit(e.op(1));
+      if (is_const(expo)) {
+        // integer and half-integer exponents (exact in the text, or folded from literals) by multiplication
+        // and sqrt, as accurate as the operations they stand for
+        const double x = tape_.code_[expo].imm;
+        auto small_int = [](double v) { return v == std::round(v) && std::fabs(v) <= 1024; };
+        if (small_int(x)) {
+          const long k = std::lround(x);
+          if (k == 0) return constant(1.0);
           if (k == 1) return emit(base);
           std::uint32_t b = emit(base);
           if (k == 2) return push(Op::kMul, b, b);
           if (k == -1) return push(Op::kDiv, constant(1.0), b);
           return push(Op::kPowInt, b, 0, static_cast<double>(k));
         }
-        if (n.is_rational() && n.denom().is_equal(2)) {
+        if (small_int(2 * x)) {
           std::uint32_t s = push(Op::kSqrt, emit(base));
-          long k = n.numer().to_long();
+          const long k = std::lround(2 * x);
           if (k == 1) return s;
           if (k == -1) return push(Op::kDiv, constant(1.0), s);
           return push(Op::kPowInt, s, 0, static_cast<double>(k));
         }
       }
-      return push(Op::kPow, emit(base), emit(expo));
+      return push(Op::kPow, emit(base), expo);
     }
     if (is_a<function>(e)) {
       const std::string name = ex_to<function>(e).get_name();
@@ -297,6 +329,7 @@ class TapeBuilder {
   }
 
   const std::map<std::string, Index>& coord_of_symbol_;
+  const std::map<std::string, double>& value_of_constant_;
   const std::string& text_;
   Tape tape_;
   std::map<std::tuple<int, std::uint32_t, std::uint32_t, std::uint64_t>, std::uint32_t> cse_;
@@ -311,43 +344,92 @@ namespace {
 bool is_ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
 bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
 
-// Names used as variables in `text` (identifiers not directly followed by '('); numbers are skipped whole so that
-// the 'e' of 1e-3 is not taken for a name.
-std::vector<std::string> variable_names(const std::string& text) {
-  std::vector<std::string> names;
+// The text as GiNaC is given it. GiNaC evaluates numbers exactly and eagerly as it builds an expression, and some
+// of that is unsafe on input a user (or a fuzzer) can write: complex intermediate values such as (-1)^(1/2) send
+// its atan2 and differentiation into unbounded recursion (a crash), and exact powers such as 9^9^9 never finish.
+// So every number literal is replaced by a real symbol whose value is folded back in double precision when the
+// tape is built (TapeBuilder::push); GiNaC only ever sees real symbols. Two kinds of literal stay exact because
+// they are safe and their exactness matters: 0 (so that 0*x does not make x a column) and a small integer
+// exponent written after '^' (so that d/dx x^2 is 2x and not x^2·2/x, which is NaN at x = 0).
+struct LexedText {
+  std::string text;                 // with literals replaced
+  std::vector<std::string> names;   // identifiers not directly followed by '(' (variables)
+  std::vector<double> literals;     // value of literal symbol kLiteralPrefix<i>
+};
+constexpr const char* kLiteralPrefix = "phiqK";
+
+LexedText lex_expression(const std::string& text) {
+  LexedText out;
+  const std::size_t n = text.size();
+  auto prev_non_space = [&](std::size_t i) -> std::ptrdiff_t {  // index of the previous non-space character, or -1
+    auto k = static_cast<std::ptrdiff_t>(i) - 1;
+    while (k >= 0 && std::isspace(static_cast<unsigned char>(text[static_cast<std::size_t>(k)]))) --k;
+    return k;
+  };
+  auto next_non_space = [&](std::size_t i) {
+    while (i < n && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    return i < n ? text[i] : '\0';
+  };
+  // a literal written directly as an exponent: x^2, x^(2), x^(-2)
+  auto is_exponent = [&](std::size_t start) {
+    std::ptrdiff_t k = prev_non_space(start);
+    if (k >= 0 && text[k] == '^') return true;
+    if (k >= 0 && (text[k] == '-' || text[k] == '+')) k = prev_non_space(static_cast<std::size_t>(k));
+    if (k < 0 || text[k] != '(') return false;
+    k = prev_non_space(static_cast<std::size_t>(k));
+    return k >= 0 && text[k] == '^';
+  };
   std::size_t i = 0;
-  while (i < text.size()) {
-    char c = text[i];
-    if (std::isdigit(static_cast<unsigned char>(c)) || (c == '.' && i + 1 < text.size() &&
-                                                         std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
+  while (i < n) {
+    const char c = text[i];
+    if (std::isdigit(static_cast<unsigned char>(c)) ||
+        (c == '.' && i + 1 < n && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
       const std::size_t start = i;
-      while (i < text.size() && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.')) ++i;
-      if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
+      while (i < n && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.')) ++i;
+      if (i < n && (text[i] == 'e' || text[i] == 'E')) {
         std::size_t j = i + 1;
-        if (j < text.size() && (text[j] == '+' || text[j] == '-')) ++j;
-        if (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j]))) {
-          const std::size_t digits = j;
+        if (j < n && (text[j] == '+' || text[j] == '-')) ++j;
+        if (j < n && std::isdigit(static_cast<unsigned char>(text[j]))) {
           i = j;
-          while (i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
-          // The symbolic engine represents literals exactly: 1e3082222222 would be a number of 3·10^9 digits.
-          // Anything beyond a double's exponent range is refused here (found by the fuzzer: a hang in GMP).
-          if (i - digits > 4 || std::stoi(text.substr(digits, i - digits)) > 400)
-            throw expression_error(text, "number '" + text.substr(start, std::min<std::size_t>(i - start, 40)) +
-                                             "' is out of the range of a double");
+          while (i < n && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
         }
+      }
+      const std::string literal = text.substr(start, i - start);
+      char* end = nullptr;
+      const double v = std::strtod(literal.c_str(), &end);
+      if (end != literal.c_str() + literal.size())
+        throw expression_error(text, "'" + literal.substr(0, 40) + "' is not a number");
+      if (!std::isfinite(v))
+        throw expression_error(text, "number '" + literal.substr(0, 40) + "' is out of the range of a double");
+      const char after = next_non_space(i);
+      if (v == 0.0) {
+        out.text += "0";
+      } else if (v == std::round(v) && v <= 1024 && after != '^' && after != '.' && is_exponent(start)) {
+        out.text += std::to_string(static_cast<long>(v));
+      } else {
+        out.text += kLiteralPrefix + std::to_string(out.literals.size());
+        out.literals.push_back(v);
       }
     } else if (is_ident_start(c)) {
       std::size_t j = i;
-      while (j < text.size() && is_ident_char(text[j])) ++j;
-      std::size_t k = j;
-      while (k < text.size() && std::isspace(static_cast<unsigned char>(text[k]))) ++k;
-      if (k >= text.size() || text[k] != '(') names.push_back(text.substr(i, j - i));
+      while (j < n && is_ident_char(text[j])) ++j;
+      const std::string name = text.substr(i, j - i);
+      if (name.rfind(kLiteralPrefix, 0) == 0)
+        throw expression_error(text, "names starting with '" + std::string(kLiteralPrefix) + "' are reserved");
+      if (next_non_space(j) != '(') out.names.push_back(name);
+      out.text += name;
       i = j;
     } else {
+      // GiNaC's parser takes everything after "^-" as the exponent: x^-1 + y is read as x^(-1 + y). Refuse the
+      // form rather than let it mean something else than it says.
+      if (c == '^' && (next_non_space(i + 1) == '-' || next_non_space(i + 1) == '+'))
+        throw expression_error(text, "write a signed exponent in parentheses, as x^(-2) (x^-2*y would be read "
+                                     "as x^(-2*y))");
+      out.text += c;
       ++i;
     }
   }
-  return names;
+  return out;
 }
 
 // "expression "<first 40 characters>...": <what>" — built with a stream: GCC 12 warns falsely (-Wrestrict,
@@ -397,13 +479,24 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   auto out = std::make_shared<CompiledExpression>();
   out->text_ = text;
 
+  const LexedText lexed = lex_expression(text);
   symtab table;
   std::map<std::string, Index> coord_of_symbol;  // symbol name -> coordinate index
+  std::map<std::string, double> value_of_constant;  // symbol name -> value folded in by the tape builder
   std::vector<std::pair<realsymbol, Index>> coord_symbols;
+  auto constant_symbol = [&](const std::string& symbol_name, double value) -> ex {
+    if (value == 0.0) return 0;
+    value_of_constant[symbol_name] = value;
+    return realsymbol(symbol_name);
+  };
+  for (std::size_t k = 0; k < lexed.literals.size(); ++k) {
+    const std::string name = kLiteralPrefix + std::to_string(k);
+    table[name] = constant_symbol(name, lexed.literals[k]);
+  }
   realsymbol tsym("t");
-  for (const std::string& name : variable_names(text)) {
+  for (const std::string& name : lexed.names) {
     if (table.count(name)) continue;
-    if (name == "pi") { table[name] = Pi; continue; }
+    if (name == "pi") { table[name] = constant_symbol("k:pi", M_PI); continue; }
     std::optional<NameBinding> b = resolve(name);
     if (!b) {
       if (name == "t" && !allow_time) throw expression_error(text, "time 't' is not allowed here");
@@ -416,7 +509,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
         break;
       case NameBinding::Kind::kConstant:
         if (!std::isfinite(b->value)) throw expression_error(text, "'" + name + "' is not finite");
-        table[name] = numeric(b->value);
+        table[name] = constant_symbol("k:" + name, b->value);
         break;
       case NameBinding::Kind::kCoordinate: {
         // symbol names are made unique per coordinate so that two names for one index could never alias wrongly
@@ -433,7 +526,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   try {
     parser reader(table);
     reader.strict = true;
-    g = reader(text);
+    g = reader(lexed.text);
   } catch (const std::exception& e) {
     throw expression_error(text, clean_ginac_message(e.what()));
   }
@@ -449,7 +542,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
     std::vector<ex> grad;
     for (std::size_t k = 0; k < used.size(); ++k) grad.push_back(g.diff(used[k].first));
     auto build = [&](const std::vector<ex>& outs) {
-      TapeBuilder b(coord_of_symbol, out->text_);
+      TapeBuilder b(coord_of_symbol, value_of_constant, out->text_);
       for (const ex& e : outs) b.add_output(e);
       return b.take();
     };
