@@ -80,6 +80,7 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
   j["residual_evaluations"] = s.counters.residual_evaluations;
   j["point_evaluations"] = s.counters.point_evaluations;
   j["subdivisions"] = s.subdivisions;
+  j["singular_positions"] = s.singular_positions;
   j["min_rcond"] = s.min_rcond;
   j["warnings"] = nlohmann::ordered_json::array();
   for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});

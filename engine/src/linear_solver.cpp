@@ -42,6 +42,20 @@ std::string umfpack_status_text(int status) {
   }
 }
 
+// Parity of a permutation of 0 … n−1 (+1 even, −1 odd), by its cycles; `seen` is scratch of n entries.
+template <typename Int>
+int permutation_sign(const Int* p, Index n, std::vector<char>& seen) {
+  seen.assign(static_cast<std::size_t>(n), 0);
+  int sign = 1;
+  for (Index i = 0; i < n; ++i) {
+    if (seen[static_cast<std::size_t>(i)]) continue;
+    Index len = 0;
+    for (Index j = i; !seen[static_cast<std::size_t>(j)]; j = static_cast<Index>(p[j])) seen[static_cast<std::size_t>(j)] = 1, ++len;
+    if (len % 2 == 0) sign = -sign;
+  }
+  return sign;
+}
+
 // ---- UMFPACK ------------------------------------------------------------------------------------------------
 
 class UmfpackSymbolic;
@@ -55,6 +69,12 @@ class UmfpackNumeric final : public SparseLuNumeric {
   FactorStatus factorize(const double* values) override;
   bool solve(const double* b, double* x) override;
   double rcond() const override { return rcond_; }
+  int determinant_sign() const override {
+    if (!numeric_ || rcond_ == 0.0) return 0;
+    double mx = 0.0;
+    if (umfpack_dl_get_determinant(&mx, nullptr, numeric_, nullptr) != UMFPACK_OK) return 0;
+    return (mx > 0) - (mx < 0);
+  }
   std::string last_message() const override { return message_; }
   std::int64_t pivoting_factorizations() const override { return factorizations_; }
 
@@ -166,6 +186,11 @@ class DenseNumeric final : public SparseLuNumeric {
     return true;
   }
   double rcond() const override { return rcond_; }
+  int determinant_sign() const override {
+    if (rcond_ == 0.0) return 0;
+    const double d = lu_.determinant();
+    return (d > 0) - (d < 0);
+  }
   std::string last_message() const override { return rcond_ == 0.0 ? "singular matrix" : ""; }
   std::int64_t pivoting_factorizations() const override { return factorizations_; }
 
@@ -189,6 +214,7 @@ class KluNumeric final : public SparseLuNumeric {
   FactorStatus factorize(const double* values) override;
   bool solve(const double* b, double* x) override;
   double rcond() const override { return rcond_; }
+  int determinant_sign() const override;
   std::string last_message() const override { return message_; }
   std::int64_t pivoting_factorizations() const override { return pivoting_; }
 
@@ -206,6 +232,7 @@ class KluNumeric final : public SparseLuNumeric {
   double rcond_ = 0.0, rcond_at_pivoting_ = 0.0;
   std::int64_t pivoting_ = 0;
   std::string message_;
+  mutable std::vector<char> seen_;  // scratch of determinant_sign()
 };
 
 class KluSymbolic final : public SparseLuSymbolic, public std::enable_shared_from_this<KluSymbolic> {
@@ -217,6 +244,8 @@ class KluSymbolic final : public SparseLuSymbolic, public std::enable_shared_fro
     symbolic_ = klu_l_analyze(pattern_->cols, const_cast<SuiteSparse_long*>(pattern_->col_ptr.data()),
                               const_cast<SuiteSparse_long*>(pattern_->row_idx.data()), &common);
     if (!symbolic_) throw Error("KLU symbolic analysis failed (status " + std::to_string(common.status) + ")");
+    std::vector<char> seen;
+    q_sign_ = permutation_sign(symbolic_->Q, pattern_->cols, seen);
   }
   ~KluSymbolic() override {
     klu_l_common common;
@@ -230,7 +259,22 @@ class KluSymbolic final : public SparseLuSymbolic, public std::enable_shared_fro
 
   std::shared_ptr<const CscPattern> pattern_;
   klu_l_symbolic* symbolic_ = nullptr;  // read-only after construction: shared by all numeric objects
+  int q_sign_ = 1;                      // parity of the fixed column permutation Q
 };
+
+// P R⁻¹ A Q = L U with L unit lower triangular and R > 0 (KLU's row scaling): sign det A = sign P · sign Q ·
+// Π sign U_ii. The final row permutation Pnum changes with each pivoting factorisation.
+int KluNumeric::determinant_sign() const {
+  if (!numeric_ || rcond_ == 0.0) return 0;
+  const Index n = sym_.pattern_->cols;
+  int sign = sym_.q_sign_ * permutation_sign(numeric_->Pnum, n, seen_);
+  const double* u = static_cast<const double*>(numeric_->Udiag);
+  for (Index i = 0; i < n; ++i) {
+    if (u[i] == 0.0) return 0;
+    if (u[i] < 0.0) sign = -sign;
+  }
+  return sign;
+}
 
 KluNumeric::KluNumeric(std::shared_ptr<const KluSymbolic> sym) : keep_(std::move(sym)), sym_(*keep_) {
   klu_l_defaults(&common_);

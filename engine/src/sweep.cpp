@@ -1,5 +1,7 @@
 #include "phiq/sweep.hpp"
 
+#include "phiq/assembly.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -55,16 +57,27 @@ class Sweeper {
       throw Error("the linear predictor needs velocities (SweepOptions::velocities)");
   }
 
-  // Derivatives at the converged ws.q, as asked for. Returns false (summary filled) on failure.
+  // Below this reciprocal condition estimate of Φq (KLU: min/max |U_ii|, UMFPACK alike) the position is taken
+  // as singular: a linear solve there loses more than ten digits, so the velocity the LU gives is rounding noise
+  // in the directions Φq no longer constrains. Regular positions of the models in models/ stay above 1e-6 at any
+  // size (nfourbar: 2.5e-4 … 2.5e-6 from N = 10 to 10^5, size-independent); the exactly singular ones of nfourbar
+  // fall to 1e-13.
+  static constexpr double kSingularRcond = 1e-10;
+  // Below this (and above kSingularRcond) the position is near-singular (a toggle position nearby): the results
+  // hold, but with fewer digits; a warning says so, once per stretch of such steps.
+  static constexpr double kIllConditionedRcond = 1e-7;
+
+  // Derivatives at the converged ws.q, as asked for. Returns false (summary filled) on failure. At a singular
+  // position they are not unique: see singular_point().
   bool derivatives(double t) {
+    if (!need_v_) return true;
     LinearSummary ls;
-    if (need_v_ && solve_velocity(model_, t, ws_, &ls) != SolveStatus::kSuccess) return fail(ls.status, ls.message);
-    if (need_a_ && solve_acceleration(model_, t, ws_, &ls) != SolveStatus::kSuccess)
-      return fail(ls.status, ls.message);
-    if (need_v_ && ws_.lu) {
-      double rc = ws_.lu->rcond();
-      if (sum_.min_rcond == 0.0 || rc < sum_.min_rcond) sum_.min_rcond = rc, sum_.min_rcond_time = t;
-    }
+    const SolveStatus st = lu_derivatives(t, need_a_, &ls);
+    if (!bracketing_ && ws_.lu && (st == SolveStatus::kSingularJacobian ||
+                                  (st == SolveStatus::kSuccess && ls.rcond < kSingularRcond)))
+      return singular_point(t, ls.rcond);
+    if (st != SolveStatus::kSuccess) return fail(st, ls.message);
+    note_condition(t, ls.rcond);
     return true;
   }
 
@@ -78,7 +91,11 @@ class Sweeper {
       points_[i] = evaluate_point(opt_.points[i], ws_.q.data(), qd, qdd);
     ws_.counters.point_evaluations += static_cast<Index>(opt_.points.size());
     rcond_ = opt_.condition && ws_.lu ? ws_.lu->rcond() : 0.0;
+    // With velocities the LU is the one at the converged position; positions only, Newton's last (at most a
+    // few steps old with modified Newton, so a sign change may be noticed a row late).
+    det_sign_ = singular_row_ || !ws_.lu ? 0 : ws_.lu->determinant_sign();
   }
+  int det_sign() const { return det_sign_; }
   const PointMotion* point_motions() const { return points_.empty() ? nullptr : points_.data(); }
   double rcond() const { return rcond_; }
 
@@ -106,6 +123,135 @@ class Sweeper {
     remember(t);
   }
 
+  // The LU's q̇ (and q̈) at ws.q.
+  SolveStatus lu_derivatives(double t, bool accelerations, LinearSummary* ls) {
+    SolveStatus st = solve_velocity(model_, t, ws_, ls);
+    if (st == SolveStatus::kSuccess && accelerations) st = solve_acceleration(model_, t, ws_, ls);
+    return st;
+  }
+
+  void note_condition(double t, double rc) {
+    if (sum_.min_rcond == 0.0 || rc < sum_.min_rcond) sum_.min_rcond = rc, sum_.min_rcond_time = t;
+    const bool ill = rc < kIllConditionedRcond;
+    if (ill && !ill_conditioned_) {
+      std::ostringstream m;
+      m.precision(2);
+      m << "Φq is near-singular (rcond " << rc << " < " << kIllConditionedRcond
+        << "): a toggle or singular position is near; velocities and accelerations keep about "
+        << static_cast<int>(std::floor(std::log10(rc / 2.2e-16))) << " digits";
+      sum_.warnings.push_back({t, "ill_conditioned", m.str()});
+    }
+    ill_conditioned_ = ill;
+  }
+
+  // Φq is singular at the converged position ws.q at t (rcond below kSingularRcond, or a zero pivot): a
+  // bifurcation, where branches of the motion cross and the mechanism momentarily gains degrees of freedom
+  // (nfourbar at its horizontal positions, a change-point four-bar). The velocity there is not unique, and the
+  // LU's answer is rounding noise in the directions Φq no longer constrains. The branch the sweep follows has its
+  // own velocity, the limit from both sides: reported is the Richardson extrapolation of the symmetric means of
+  // the derivatives at t ± δ and t ± 2δ (δ = 5 % of the step, all four regular), which differs from that limit
+  // by O(δ⁴), with a warning. The plus side is reached straight through from the minus side, so the sweep keeps
+  // its branch. When there is no
+  // position beyond (a dead point: the drive cannot go on) or the sides are singular too (the model is singular
+  // on an interval: redundant or missing constraints), the step fails with that diagnosis.
+  // `have_position`: false when Newton could not converge at t itself (a zero pivot exactly at the singular
+  // point); the position is then extrapolated the same way, to O(δ⁴), and checked against the tolerance.
+  bool singular_point(double t, double rc, bool have_position = true) {
+    struct Guard {
+      bool& b;
+      ~Guard() { b = false; }
+    } guard{bracketing_ = true};
+    const Eigen::VectorXd qs = ws_.q;
+    double step = has_current_ ? t - current_.t : default_step_;
+    if (step == 0.0) step = 1e-3;
+    const double d = 0.05 * step;
+    // Four regular points t − 2δ, t − δ, t + δ, t + 2δ, each predicted from the one before (the first from the
+    // last state of the sweep), so the plus side is reached straight through the singular point.
+    const double offset[4] = {-2 * d, -d, d, 2 * d};
+    State side[4];
+    LinearSummary ls;
+    PositionSummary ps;
+    // The sides are solved to rounding level: their derivatives divide O(δ) quantities by Φq's smallest
+    // singular value, O(δ), so a position error ε_q becomes a velocity error ε_q/δ (and worse in q̈).
+    NewtonOptions tight = opt_.newton;
+    tight.tolerance = std::max(1e-4 * opt_.newton.tolerance, 1e-15);
+    tight.jacobian_update = JacobianUpdate::kEveryIteration;
+    tight.max_iterations = std::max(tight.max_iterations, 30);
+    for (int k = 0; k < 4; ++k) {
+      const double ts = t + offset[k];
+      if (k == 0) {
+        if (has_current_) {
+          predict(ts);
+        } else {
+          // The sweep starts at the singular position: no past motion tells the branch, and Newton cannot
+          // start from a singular Φq. The assembly (least squares, then the solution nearest the placement)
+          // finds the side's position nearest the start.
+          ws_.q = qs;
+          AssemblyOptions ao;
+          ao.tolerance = opt_.newton.tolerance;
+          AssemblySummary as;
+          if (phiq::assemble(model_, ts, ao, ws_.q, &as) != SolveStatus::kSuccess) {
+            ws_.q = qs;
+            return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " +
+                                                            fmt_t(t) + "), and no position near it at t = " +
+                                                            fmt_t(ts) + " was found: " + as.message);
+          }
+        }
+      } else {
+        const double h = offset[k] - offset[k - 1];
+        ws_.q = side[k - 1].q + h * side[k - 1].qd + (0.5 * h * h) * side[k - 1].qdd;
+      }
+      SolveStatus st = solve_position(model_, ts, tight, ws_, &ps);
+      if (st == SolveStatus::kSuccess) st = lu_derivatives(ts, true, &ls);
+      if (st != SolveStatus::kSuccess || ls.rcond < kSingularRcond) {
+        ws_.q = qs;
+        std::ostringstream m;
+        m << "singular position at t = " << fmt_t(t) << " (Φq rcond " << rc << "): ";
+        if (k >= 2 && st != SolveStatus::kSuccess)
+          m << "no position beyond it on this branch (a dead point: the drive cannot go on)";
+        else if (st == SolveStatus::kSuccess)
+          m << "Φq stays singular around it (rcond " << ls.rcond << " at t = " << fmt_t(ts)
+            << "): redundant or missing constraints";
+        else
+          m << "the branch cannot be followed to it: " << ps.message;
+        return fail(SolveStatus::kSingularJacobian, m.str());
+      }
+      side[k].t = ts, side[k].q = ws_.q, side[k].qd = ws_.qd, side[k].qdd = ws_.qdd;
+    }
+    // Symmetric means over ±δ and ±2δ, combined by Richardson extrapolation: the branch's value at t to O(δ⁴).
+    auto at_t = [&](const Eigen::VectorXd State::*x) -> Eigen::VectorXd {
+      return (2.0 / 3.0) * (side[1].*x + side[2].*x) - (1.0 / 6.0) * (side[0].*x + side[3].*x);
+    };
+    ws_.q = have_position ? qs : at_t(&State::q);
+    if (!have_position) {
+      model_.residual(ws_.q.data(), t, ws_.phi.data());
+      ++ws_.counters.residual_evaluations;
+      if (!(scaled_residual(model_, ws_.phi) <= opt_.newton.tolerance)) {
+        std::ostringstream m;
+        m << "singular position at t = " << fmt_t(t) << ": Newton meets a zero pivot there, and the position "
+          << "interpolated from t ± " << d << " misses the tolerance (residual " << scaled_residual(model_, ws_.phi)
+          << ")";
+        return fail(SolveStatus::kSingularJacobian, m.str());
+      }
+    }
+    ws_.qd = at_t(&State::qd);
+    if (need_a_) ws_.qdd = at_t(&State::qdd);
+    ++sum_.singular_positions;
+    singular_row_ = true;
+    std::ostringstream m;
+    m.precision(3);
+    m << (has_current_ ? "bifurcation passed" : "the sweep starts at a bifurcation")
+      << ": Φq is singular here (rcond " << rc
+      << "), so the velocity is not unique; reported is the branch's own (extrapolated from t ± " << d
+      << " and t ± " << 2 * d << ")"
+      << (has_current_ ? ", and the sweep kept the branch it was on"
+                       : "; the branch followed is the one nearest the placement");
+    sum_.warnings.push_back({t, "bifurcation", m.str()});
+    if (sum_.min_rcond == 0.0 || rc < sum_.min_rcond) sum_.min_rcond = rc, sum_.min_rcond_time = t;
+    ill_conditioned_ = false;
+    return true;
+  }
+
   // Initial position problem from the rough placement in ws.q.
   bool assemble(double t) {
     SolveStatus st = solve_position(model_, t, opt_.assembly, ws_, &sum_.assembly);
@@ -119,7 +265,23 @@ class Sweeper {
     predict(t1);
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t1, opt_.newton, ws_, &ps);
+    if (st == SolveStatus::kSuccess && depth < opt_.max_subdivisions && jumped()) {
+      // Newton went much farther than the step itself: it has left the branch (near a toggle or a bifurcation
+      // a coarse step can land in the other branch's basin). Retried as half steps, as a failure is.
+      st = SolveStatus::kNotConverged;
+      ps.message = "Newton moved off the predicted path (another branch?)";
+    }
     if (st == SolveStatus::kSuccess) return converged(t1, ps);
+    if (st == SolveStatus::kSingularJacobian && has_current_ && !bracketing_) {
+      // a zero pivot exactly at a singular position: bracket it (position interpolated from both sides)
+      if (singular_point(t1, 0.0, /*have_position=*/false)) {
+        remember(t1);
+        return true;
+      }
+      ps.message = sum_.message;  // the diagnosis, should the sub-steps fail too
+      sum_.status = SolveStatus::kSuccess, sum_.message.clear();
+      restore();
+    }
     // Retry as two half steps from the last good state; a singular or non-finite point is not cured by that
     // unless the sub-steps avoid it, so all statuses are retried.
     if (depth >= opt_.max_subdivisions) {
@@ -136,12 +298,36 @@ class Sweeper {
  private:
   // A position converged at t: its warning, the derivatives asked for, and it becomes the current state.
   bool converged(double t, const PositionSummary& ps) {
+    singular_row_ = false;
     if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
+    if (!need_v_ && ps.rcond > 0.0 && ps.rcond < kSingularRcond) {
+      // positions only: nothing is computed from Φq here, but the user is told where the motion branches
+      ++sum_.singular_positions;
+      singular_row_ = true;
+      std::ostringstream m;
+      m.precision(3);
+      m << "singular position (Φq rcond " << ps.rcond << "): a bifurcation, velocities would not be unique here";
+      if (!has_current_) m << " (the sweep starts here: the branch is the one nearest the placement)";
+    sum_.warnings.push_back({t, "bifurcation", m.str()});
+    }
     if (!derivatives(t)) return false;
     remember(t);
     return true;
   }
+  // Whether the converged ws.q is farther from the prediction than the prediction is from the last state (in
+  // tolerance units, beyond a floor of 1000 tolerances): a predictor from q̇ or a secant errs by O(h²) of an O(h)
+  // move, so a correction as large as the move means another solution was found.
+  bool jumped() const {
+    if (predictor_ == Predictor::kPrevious || (predictor_ == Predictor::kSecant && !has_prev_)) return false;
+    const double move = scaled_step(model_, predicted_ - current_.q, current_.q, opt_.newton.tolerance);
+    const double correction = scaled_step(model_, ws_.q - predicted_, ws_.q, opt_.newton.tolerance);
+    return correction > 1000.0 && correction > 0.5 * move;
+  }
   void predict(double t1) {
+    predict_into(t1);
+    predicted_ = ws_.q;
+  }
+  void predict_into(double t1) {
     const double h = t1 - current_.t;
     switch (predictor_) {
       case Predictor::kQuadratic: ws_.q = current_.q + h * current_.qd + (0.5 * h * h) * current_.qdd; break;
@@ -184,6 +370,12 @@ class Sweeper {
   bool has_current_ = false, has_prev_ = false;
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
   double rcond_ = 0.0;
+  Eigen::VectorXd predicted_;       // the last prediction (for jumped())
+  bool bracketing_ = false;         // inside singular_point(): no nested bracketing
+  bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
+  int det_sign_ = 0;                // sign of det Φq at the last row (0: singular)
+  bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)
+  double default_step_ = (opt_.t_end - opt_.t_begin) / static_cast<double>(std::max<Index>(opt_.steps, 1));
 };
 
 }  // namespace
@@ -195,6 +387,7 @@ std::string SweepSummary::BriefReport() const {
     << " velocity and " << counters.acceleration_solves << " acceleration solves";
   if (counters.point_evaluations) s << ", " << counters.point_evaluations << " point evaluations";
   if (subdivisions) s << ", " << subdivisions << " step subdivisions";
+  if (singular_positions) s << ", " << singular_positions << " singular positions passed";
   if (threads > 1) s << ", " << threads << " threads (" << parallel_chunks << " parallel chunks)";
   if (!warnings.empty()) s << ", " << warnings.size() << " warnings (first at t = " << warnings[0].t << ")";
   s.precision(3);
@@ -217,8 +410,25 @@ struct Run {
     return k == opt.steps ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
   }
   // Delivers row k; false when the caller stops the sweep (status and message set).
+  // Sign of det Φq at the last delivered regular row, and whether a singular row (bracketed, with its own
+  // warning) was delivered since.
+  int last_sign = 0;
+  bool singular_since = false;
+
   bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
-               const PointMotion* points, const Eigen::VectorXd& phi, double rcond) {
+               const PointMotion* points, const Eigen::VectorXd& phi, double rcond, int det_sign) {
+    if (det_sign == 0) {
+      singular_since = true;
+    } else {
+      if (last_sign != 0 && det_sign != last_sign && !singular_since)
+        sum.warnings.push_back(
+            {time_of(k), "bifurcation",
+             "det Φq changed sign since t = " + fmt_t(time_of(k - 1)) +
+                 ": the motion passed a singular position between the two steps (a bifurcation, where branches "
+                 "cross); the sweep kept the branch it was on"});
+      last_sign = det_sign;
+      singular_since = false;
+    }
     StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
                   points, opt.residuals ? &phi : nullptr, opt.condition ? rcond : 0.0};
     ++sum.steps_completed;
@@ -243,7 +453,7 @@ struct Run {
         return false;
       }
       sw.row_outputs();
-      if (!deliver(k, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond())) return false;
+      if (!deliver(k, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign())) return false;
     }
     return true;
   }
@@ -328,7 +538,8 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
     return done(sum.status);
   }
   sw.row_outputs();
-  if (!run.deliver(0, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond())) return done(sum.status);
+  if (!run.deliver(0, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign()))
+    return done(sum.status);
 
   const int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
   const Index n = model.num_coordinates();
@@ -340,7 +551,7 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   const Index n_points = static_cast<Index>(opt.points.size());
   constexpr Index kMotionDoubles = static_cast<Index>(sizeof(PointMotion) / sizeof(double));
   static_assert(sizeof(PointMotion) == 9 * sizeof(double), "PointMotion is stored as 9 doubles in chunk rows");
-  const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles;
+  const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles + 1;
   Index chunk = opt.chunk_steps;
   if (chunk == 0) {
     const double fit = kRowBufferBytes / (8.0 * static_cast<double>(std::max<Index>(width, 1)) * threads);
@@ -404,6 +615,7 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
         std::memcpy(out, s.point_motions(), sizeof(PointMotion) * opt.points.size());
         out += n_points * kMotionDoubles;
       }
+      *out++ = s.det_sign();
     };
     if (c == 0) {  // continues row 0 in order: the sequential sweep itself
       w.q = last_q, w.qd = last_qd, w.qdd = last_qdd;
@@ -424,6 +636,7 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
       }
       ch.sum.warnings = kept.warnings;
       ch.sum.subdivisions = kept.subdivisions;
+      ch.sum.singular_positions = kept.singular_positions;
       ch.sum.status = kept.status, ch.sum.message = kept.message;
       ch.sum.min_rcond = kept.min_rcond, ch.sum.min_rcond_time = kept.min_rcond_time;
     }
@@ -448,12 +661,15 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
       if (n_phi) last_phi = Eigen::Map<const Eigen::VectorXd>(extra, m);
       const double rc = n_rcond ? extra[n_phi] : 0.0;
       if (n_points) std::memcpy(static_cast<void*>(last_points.data()), extra + n_phi + n_rcond, sizeof(PointMotion) * opt.points.size());
-      if (!run.deliver(k, last_q, last_qd, last_qdd, n_points ? last_points.data() : nullptr, last_phi, rc)) return 2;
+      const int sign = static_cast<int>(extra[n_phi + n_rcond + n_points * kMotionDoubles]);
+      if (!run.deliver(k, last_q, last_qd, last_qdd, n_points ? last_points.data() : nullptr, last_phi, rc, sign))
+        return 2;
     }
     resume = ch.k1 + 1;
     seam_known = ch.has_seam;
     if (seam_known) seam_q.swap(ch.seam_q);
     sum.subdivisions += ch.sum.subdivisions;
+    sum.singular_positions += ch.sum.singular_positions;
     sum.warnings.insert(sum.warnings.end(), ch.sum.warnings.begin(), ch.sum.warnings.end());
     if (ch.sum.min_rcond > 0.0 && (sum.min_rcond == 0.0 || ch.sum.min_rcond < sum.min_rcond))
       sum.min_rcond = ch.sum.min_rcond, sum.min_rcond_time = ch.sum.min_rcond_time;

@@ -43,6 +43,10 @@ class SparseLuNumeric {
   virtual bool solve(const double* b, double* x) = 0;
   /// Reciprocal condition estimate of the last factorisation (UMFPACK: min|U_ii| / max|U_ii|).
   virtual double rcond() const = 0;
+  /// Sign of det A from the last successful factorisation: +1 or −1, 0 when there are no factors or U has a
+  /// zero pivot. Along a branch of a driven motion det Φq changes sign exactly where the branch passes a singular
+  /// position (a bifurcation or a dead point), which is how a sweep notices one between two steps. O(n).
+  virtual int determinant_sign() const = 0;
   /// Detail of the last failure, for diagnostics.
   virtual std::string last_message() const = 0;
   /// Factorisations so far that searched for pivots (for KLU: not a refactorisation with the old pivot order).

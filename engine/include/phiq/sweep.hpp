@@ -81,7 +81,12 @@ struct StepView {
 /// Something the caller should know about a delivered row (the row itself is within tolerance).
 struct SweepWarning {
   double t;             ///< time of the row concerned
-  std::string kind;     ///< "slow_convergence": Newton converged only linearly (singular position nearby)
+  /// "slow_convergence": Newton converged only linearly (singular position nearby); "ill_conditioned": Φq is
+  /// near-singular (rcond below 1e-7; once per stretch of such rows); "bifurcation": Φq is singular at this row,
+  /// the velocity is not unique and the branch's own is reported; "parallel_fallback": the parallel sweep
+  /// continued in order
+  std::string kind;
+
   std::string message;  ///< one line
 };
 
@@ -95,6 +100,7 @@ struct SweepSummary {
   PositionSummary assembly;  ///< the initial position problem
   WorkCounters counters;     ///< work done by this sweep
   Index subdivisions = 0;    ///< sub-steps inserted after Newton failures
+  Index singular_positions = 0;  ///< rows at singular positions (bifurcations) passed, each with a warning
   double min_rcond = 0.0;    ///< smallest reciprocal condition estimate seen (0 if none)
   double min_rcond_time = 0.0;         ///< where min_rcond was seen
   std::vector<SweepWarning> warnings;  ///< in time order
