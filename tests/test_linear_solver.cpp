@@ -60,7 +60,30 @@ TEST_P(SparseLu, MatchesDenseLuAndReusesTheSymbolicAnalysis) {
   EXPECT_LT((x - ref / 1.5).cwiseAbs().maxCoeff(), 1e-12);
 }
 
-INSTANTIATE_TEST_SUITE_P(Kinds, SparseLu, ::testing::Values(LinearSolverKind::kUmfpack, LinearSolverKind::kKlu),
+TEST_P(SparseLu, TransposedSolveAndDeterminantSignMatchDenseLu) {
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    Sys s = random_system(60, seed);
+    // flip the sign of a random number of rows: det changes sign with each, whatever the pivot order
+    std::mt19937 rng(seed);
+    const int flips = static_cast<int>(rng() % 7);
+    for (int f = 0; f < flips; ++f) {
+      const Index row = static_cast<Index>(rng() % 60);
+      for (Index k = 0; k < s.p->nnz(); ++k)
+        if (s.p->row_idx[static_cast<std::size_t>(k)] == row) s.values[static_cast<std::size_t>(k)] *= -1;
+      s.dense.row(row) *= -1;
+    }
+    auto lu = analyse(GetParam(), s.p)->make_numeric();
+    ASSERT_EQ(lu->factorize(s.values.data()), FactorStatus::kOk);
+    const double det = s.dense.partialPivLu().determinant();
+    EXPECT_EQ(lu->determinant_sign(), det > 0 ? 1 : -1) << "seed " << seed;
+    Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(60, -1, 2), x(60);
+    ASSERT_TRUE(lu->solve_transposed(rhs.data(), x.data()));
+    EXPECT_LT((s.dense.transpose() * x - rhs).cwiseAbs().maxCoeff(), 1e-12) << "seed " << seed;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, SparseLu,
+                         ::testing::Values(LinearSolverKind::kUmfpack, LinearSolverKind::kKlu, LinearSolverKind::kDense),
                          [](const auto& info) { return std::string(to_string(info.param)); });
 
 TEST(LinearSolver, KluRefactorisesWithTheOldPivotsWhileTheyHold) {

@@ -67,7 +67,8 @@ class UmfpackNumeric final : public SparseLuNumeric {
     if (numeric_) umfpack_dl_free_numeric(&numeric_);
   }
   FactorStatus factorize(const double* values) override;
-  bool solve(const double* b, double* x) override;
+  bool solve(const double* b, double* x) override { return solve_system(UMFPACK_A, b, x); }
+  bool solve_transposed(const double* b, double* x) override { return solve_system(UMFPACK_At, b, x); }
   double rcond() const override { return rcond_; }
   int determinant_sign() const override {
     if (!numeric_ || rcond_ == 0.0) return 0;
@@ -79,6 +80,7 @@ class UmfpackNumeric final : public SparseLuNumeric {
   std::int64_t pivoting_factorizations() const override { return factorizations_; }
 
  private:
+  bool solve_system(int sys, const double* b, double* x);
   std::int64_t factorizations_ = 0;
   std::shared_ptr<const UmfpackSymbolic> keep_;  // co-owns the symbolic analysis it factorises with
   const UmfpackSymbolic& sym_;
@@ -145,13 +147,13 @@ FactorStatus UmfpackNumeric::factorize(const double* values) {
   return FactorStatus::kFailed;
 }
 
-bool UmfpackNumeric::solve(const double* b, double* x) {
+bool UmfpackNumeric::solve_system(int sys, const double* b, double* x) {
   if (!numeric_) {
     message_ = "solve before a successful factorisation";
     return false;
   }
   const CscPattern& p = *sym_.pattern_;
-  int status = umfpack_dl_wsolve(UMFPACK_A, p.col_ptr.data(), p.row_idx.data(), values_, x, b, numeric_, control_,
+  int status = umfpack_dl_wsolve(sys, p.col_ptr.data(), p.row_idx.data(), values_, x, b, numeric_, control_,
                                  info_, wi_.data(), w_.data());
   if (status != UMFPACK_OK) {
     message_ = umfpack_status_text(status);
@@ -185,6 +187,11 @@ class DenseNumeric final : public SparseLuNumeric {
     Eigen::Map<Eigen::VectorXd>(x, p_.cols) = lu_.solve(bb);
     return true;
   }
+  bool solve_transposed(const double* b, double* x) override {
+    Eigen::Map<const Eigen::VectorXd> bb(b, p_.cols);
+    Eigen::Map<Eigen::VectorXd>(x, p_.rows) = lu_.transpose().solve(bb);
+    return true;
+  }
   double rcond() const override { return rcond_; }
   int determinant_sign() const override {
     if (rcond_ == 0.0) return 0;
@@ -213,6 +220,7 @@ class KluNumeric final : public SparseLuNumeric {
   ~KluNumeric() override;
   FactorStatus factorize(const double* values) override;
   bool solve(const double* b, double* x) override;
+  bool solve_transposed(const double* b, double* x) override;
   double rcond() const override { return rcond_; }
   int determinant_sign() const override;
   std::string last_message() const override { return message_; }
@@ -334,6 +342,20 @@ bool KluNumeric::solve(const double* b, double* x) {
   const Index n = sym_.pattern_->cols;
   std::copy(b, b + n, x);
   if (!klu_l_solve(sym_.symbolic_, numeric_, n, 1, x, &common_)) {
+    message_ = "KLU solve failed (status " + std::to_string(common_.status) + ")";
+    return false;
+  }
+  return true;
+}
+
+bool KluNumeric::solve_transposed(const double* b, double* x) {
+  if (!numeric_) {
+    message_ = "solve before a successful factorisation";
+    return false;
+  }
+  const Index n = sym_.pattern_->cols;
+  std::copy(b, b + n, x);
+  if (!klu_l_tsolve(sym_.symbolic_, numeric_, n, 1, x, &common_)) {
     message_ = "KLU solve failed (status " + std::to_string(common_.status) + ")";
     return false;
   }

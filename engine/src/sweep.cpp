@@ -3,7 +3,9 @@
 #include "phiq/assembly.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <cstring>
 #include <memory>
 #include <mutex>
@@ -189,8 +191,13 @@ class Sweeper {
           ws_.q = qs;
           AssemblyOptions ao;
           ao.tolerance = opt_.newton.tolerance;
+          // Newton (regular at ts) finishes from wherever the assembly got, converged or not. Known limit: on
+          // a chain of N loops all flat at once (nfourbar starting at θ = 0), the least-squares steps move the
+          // far cranks off the flat position one loop per iteration, so beyond N ≈ 90 the start is not resolved
+          // and the sweep stops at t0 with the diagnosis.
           AssemblySummary as;
-          if (phiq::assemble(model_, ts, ao, ws_.q, &as) != SolveStatus::kSuccess) {
+          phiq::assemble(model_, ts, ao, ws_.q, &as);
+          if (!ws_.q.allFinite()) {
             ws_.q = qs;
             return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " +
                                                             fmt_t(t) + "), and no position near it at t = " +
@@ -252,6 +259,43 @@ class Sweeper {
     return true;
   }
 
+  // Why the sweep cannot go on from the last converged state (current_) towards t1, when it is a dead point (a
+  // turning point of the motion: the drive asks for positions that do not exist): Φq is near-singular there and
+  // the speed grows like 1/√(t* − t). Then q̈ ≈ q̇ / (2 (t* − t)) along q̇, so t* − t ≈ |q̇|² / (2 q̇·q̈), and the
+  // equations that line up are the support of Φq's left near-null vector, found by inverse iteration on Φqᵀ
+  // with the LU. Returns "" when the last state does not look like one (then the cause is left open).
+  std::string dead_point(double t1) {
+    ws_.q = current_.q;
+    LinearSummary ls;
+    if (lu_derivatives(current_.t, true, &ls) != SolveStatus::kSuccess) return "";
+    const double vv = ws_.qd.squaredNorm(), va = ws_.qd.dot(ws_.qdd);
+    const double tau = va != 0.0 ? vv / (2.0 * va) : 0.0;  // t* − t, signed like the drive direction
+    if (!(std::isfinite(tau) && tau * (t1 - current_.t) > 0 && std::fabs(tau) <= 2.0 * std::fabs(t1 - current_.t)))
+      return "";
+    const Index m = model_.num_solve_rows();
+    Eigen::VectorXd y = Eigen::VectorXd::Ones(m), z(m);
+    for (int it = 0; it < 4; ++it) {
+      if (!ws_.lu->solve_transposed(y.data(), z.data()) || !all_finite_vec(z)) return "";
+      y = z / z.cwiseAbs().maxCoeff();
+    }
+    std::vector<std::string> names;
+    for (Index i = 0; i < m; ++i) {
+      if (std::fabs(y[i]) < 0.05) continue;
+      const Index row = model_.dropped_rows().empty() ? i : model_.solve_rows()[static_cast<std::size_t>(i)];
+      const std::string name = model_.row_name(row);
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+    std::ostringstream s;
+    s.precision(6);
+    s << "a dead point near t = " << current_.t + tau << " (the drive asks for positions that do not exist; Φq rcond "
+      << std::setprecision(2) << ls.rcond << " at t = " << std::setprecision(10) << current_.t
+      << ", speed growing as 1/√(t* − t)), where these equations line up:";
+    for (std::size_t k = 0; k < names.size() && k < 8; ++k) s << (k ? ", '" : " '") << names[k] << "'";
+    if (names.size() > 8) s << " and " << names.size() - 8 << " more";
+    return s.str();
+  }
+  static bool all_finite_vec(const Eigen::VectorXd& v) { return v.allFinite(); }
+
   // Initial position problem from the rough placement in ws.q.
   bool assemble(double t) {
     SolveStatus st = solve_position(model_, t, opt_.assembly, ws_, &sum_.assembly);
@@ -285,9 +329,13 @@ class Sweeper {
     // Retry as two half steps from the last good state; a singular or non-finite point is not cured by that
     // unless the sub-steps avoid it, so all statuses are retried.
     if (depth >= opt_.max_subdivisions) {
+      const std::string why = ps.message;
+      const std::string dead = dead_point(t1);
       return fail(st, "no assembly beyond t = " + fmt_t(current_.t) + " (sub-steps down to t = " + fmt_t(t1) +
-                          " tried: the drive leaves the reachable range, or the mechanism passes a singular "
-                          "position): " + ps.message);
+                          " tried" + (dead.empty() ? ": the drive leaves the reachable range, or the mechanism "
+                                                     "passes a singular position): "
+                                                   : "): " + dead + "; ") +
+                          why);
     }
     restore();
     ++sum_.subdivisions;

@@ -41,6 +41,9 @@ class SparseLuNumeric {
   virtual FactorStatus factorize(const double* values) = 0;
   /// x = A⁻¹ b with the last successful factorisation. x and b must not alias. Returns false on failure.
   virtual bool solve(const double* b, double* x) = 0;
+  /// x = A⁻ᵀ b with the last successful factorisation (same rules as solve()). Used for diagnostics: inverse
+  /// iteration on Aᵀ finds which equations are nearly dependent at a near-singular position.
+  virtual bool solve_transposed(const double* b, double* x) = 0;
   /// Reciprocal condition estimate of the last factorisation (UMFPACK: min|U_ii| / max|U_ii|).
   virtual double rcond() const = 0;
   /// Sign of det A from the last successful factorisation: +1 or −1, 0 when there are no factors or U has a
