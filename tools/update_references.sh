@@ -8,7 +8,8 @@ phiq="${PHIQ:-$root/build/tools/phiq}"
 for scene in "$root"/models/*/*.yaml; do
   dir="$(dirname "$scene")/reference"
   mkdir -p "$dir"
-  # scenes that are meant to fail (e.g. models/redundant/door_misaligned: inconsistent) have no reference
+  # scenes that are meant to fail have no reference: models/redundant/door_misaligned (inconsistent),
+  # models/hard/crank_rocker_rocker_driven (driven beyond its dead point)
   if "$phiq" run -q "$scene" -o "$dir/$(basename "${scene%.yaml}").csv"; then
     echo "updated $dir/$(basename "${scene%.yaml}").csv"
   else
