@@ -233,6 +233,7 @@ class KluNumeric final : public SparseLuNumeric {
 
  private:
   FactorStatus factor_with_pivoting(const double* values);
+  bool solve_system(bool transposed, const double* b, double* x);
   std::shared_ptr<const KluSymbolic> keep_;
   const KluSymbolic& sym_;
   mutable klu_l_common common_;
@@ -334,28 +335,19 @@ FactorStatus KluNumeric::factorize(const double* values) {
   return factor_with_pivoting(values);
 }
 
-bool KluNumeric::solve(const double* b, double* x) {
-  if (!numeric_) {
-    message_ = "solve before a successful factorisation";
-    return false;
-  }
-  const Index n = sym_.pattern_->cols;
-  std::copy(b, b + n, x);
-  if (!klu_l_solve(sym_.symbolic_, numeric_, n, 1, x, &common_)) {
-    message_ = "KLU solve failed (status " + std::to_string(common_.status) + ")";
-    return false;
-  }
-  return true;
-}
+bool KluNumeric::solve(const double* b, double* x) { return solve_system(false, b, x); }
+bool KluNumeric::solve_transposed(const double* b, double* x) { return solve_system(true, b, x); }
 
-bool KluNumeric::solve_transposed(const double* b, double* x) {
+bool KluNumeric::solve_system(bool transposed, const double* b, double* x) {
   if (!numeric_) {
     message_ = "solve before a successful factorisation";
     return false;
   }
   const Index n = sym_.pattern_->cols;
   std::copy(b, b + n, x);
-  if (!klu_l_tsolve(sym_.symbolic_, numeric_, n, 1, x, &common_)) {
+  const bool ok = transposed ? klu_l_tsolve(sym_.symbolic_, numeric_, n, 1, x, &common_)
+                             : klu_l_solve(sym_.symbolic_, numeric_, n, 1, x, &common_);
+  if (!ok) {
     message_ = "KLU solve failed (status " + std::to_string(common_.status) + ")";
     return false;
   }
