@@ -11,7 +11,6 @@
 
 namespace phiq {
 
-using detail::rounding_floors;
 using detail::scaled_rows_within;
 
 std::string AssemblySummary::BriefReport() const {
@@ -82,7 +81,7 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
   double f = 0.5 * b.squaredNorm(), mu = 0.0;
   while (sum.iterations < opt.max_iterations) {
     if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
-    if (scaled_rows_within(model, b, nullptr, opt.tolerance, rounding_floors(model, q))) return SolveStatus::kSuccess;
+    if (scaled_rows_within(model, b, nullptr, opt.tolerance, q)) return SolveStatus::kSuccess;
     jac.evaluate(q, t, jv);
     tv.resize(from.size());
     for (std::size_t k = 0; k < from.size(); ++k) tv[k] = jv[static_cast<std::size_t>(from[k])];
@@ -103,7 +102,7 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
       if (alpha == 1.0) mu *= 0.1;
       continue;
     }
-    if (scaled_rows_within(model, b, nullptr, opt.tolerance, rounding_floors(model, q))) return SolveStatus::kSuccess;
+    if (scaled_rows_within(model, b, nullptr, opt.tolerance, q)) return SolveStatus::kSuccess;
     if (mu < 1e6) {  // regularise more, then give up: a least-squares minimum
       mu = mu == 0.0 ? std::max(b.cwiseAbs().maxCoeff(), 1e-8) : 10.0 * mu;
       continue;
@@ -141,15 +140,17 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
   std::vector<double> values;
   MinNormSolver solver_of_kept(jac.pattern());
   MinNormSolver* solver = &solver_of_kept;
-  auto kept_within = [&] { return scaled_rows_within(model, b, &kept, opt.tolerance, rounding_floors(model, q)); };
+  auto kept_within = [&] { return scaled_rows_within(model, b, &kept, opt.tolerance, q); };
 
   model.residual(q.data(), t, phi.data());
   kept_scaled(phi, b);
   double f = 0.5 * b.squaredNorm();
   double mu = 0.0;  // Levenberg-Marquardt regularisation, only while plain Gauss-Newton fails
+  Eigen::VectorXd assembled;  // the last iterate at which the kept rows held (empty if none yet)
   while (sum.iterations < opt.max_iterations) {
     if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
     const bool within = kept_within();
+    if (within) assembled = q;
     jac.evaluate(q, t, values);
     if (within) mu = 0.0;
     FactorStatus fs = solver->factorize(values.data(), mu);
@@ -200,8 +201,14 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
     return SolveStatus::kNotConverged;
   }
   // The projection phase converges linearly: if its budget ran out with the rows within tolerance, the position is
-  // assembled, only not the nearest one to the last digit.
+  // assembled, only not the nearest one to the last digit. Near a singular position (a change point) its steps may
+  // leave the tolerance and come back again and again: the last iterate that held is then the answer, rather than
+  // wherever the budget happened to end.
   if (kept_within()) return SolveStatus::kSuccess;
+  if (assembled.size() == n) {
+    q = assembled;
+    return SolveStatus::kSuccess;
+  }
   *why = "did not converge in " + std::to_string(opt.max_iterations) + " iterations";
   return SolveStatus::kNotConverged;
 }
@@ -257,9 +264,8 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     sum.rank = analyse_rank(model, q, t, opt.rank);
     model.residual(q.data(), t, phi.data());
     const Eigen::VectorXd scaled = scaled_rows(model, phi);
-    const detail::Floors floors = rounding_floors(model, q);
-    auto within = [&](Index r) { return detail::row_within(model, r, scaled(r), opt.tolerance, floors); };
-    const bool all_within = detail::residual_within(model, phi, opt.tolerance, floors);
+    auto within = [&](Index r) { return detail::row_within(model, r, scaled(r), opt.tolerance, q); };
+    const bool all_within = detail::residual_within(model, phi, opt.tolerance, q);
     if (st == SolveStatus::kSuccess && all_within) return finish(SolveStatus::kSuccess, "");
     if (st == SolveStatus::kNonFinite || st == SolveStatus::kLinearSolverFailed) return finish(st, why);
     // The independent equations now hold (or stall) but others do not. If the rows found independent here differ

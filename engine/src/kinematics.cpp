@@ -49,10 +49,8 @@ Workspace::Workspace(const Model& model) : model_(&model) {
 namespace {
 
 using detail::describe_rows;
-using detail::Floors;
 using detail::kUlpFloor;
 using detail::residual_within;
-using detail::rounding_floors;
 using detail::worst_rows;
 
 // max_j |Δq_j| / (tol · scale_j + floor_j): ≤ 1 when the step is within the tolerance (NaN propagates as > 1).
@@ -219,15 +217,15 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   for (;;) {
     const int it = sum.iterations;
     if (!all_finite(ws.phi)) return finish(SolveStatus::kNonFinite, "constraint residual is not finite");
-    const Floors fl = rounding_floors(model, ws.q);
-    if (residual_within(model, ws.phi, opt.tolerance, fl) && (it == 0 || step_ok)) {
+    const bool within = residual_within(model, ws.phi, opt.tolerance, ws.q);
+    if (within && (it == 0 || step_ok)) {
       if (theta_seen >= 0.0) ws.newton_contraction = theta_seen;
       return finish(SolveStatus::kSuccess, "");
     }
     // The residual holds but the steps have stopped shrinking fast: full-Newton steps contracting by ½ or worse
     // twice in a row (linear convergence at a singular position, or steps at the rounding level of an
     // ill-conditioned Φq), or the iteration limit reached. More iterations would not make q more accurate.
-    if (it > 0 && (it >= opt.max_iterations || stagnant >= 2) && residual_within(model, ws.phi, opt.tolerance, fl)) {
+    if (it > 0 && (it >= opt.max_iterations || stagnant >= 2) && within) {
       sum.slow_convergence = true;
       finish(SolveStatus::kSuccess, "");
       sum.message = "residual within tolerance but the Newton steps stopped converging quadratically (a singular "
@@ -285,7 +283,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       ++ws.counters.residual_evaluations;
       ftrial = merit(model, ws.trial_phi);
       if (!opt.line_search || ftrial <= (1.0 - 1e-4 * alpha) * f ||
-          residual_within(model, ws.trial_phi, opt.tolerance, rounding_floors(model, ws.trial)))
+          residual_within(model, ws.trial_phi, opt.tolerance, ws.trial))
         break;
       if (reuse) {
         refresh = true;

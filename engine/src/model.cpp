@@ -322,6 +322,93 @@ Index ModelBuilder::add_unit_vector(const std::string& name, const Point3& v) {
   return add(name + ".unit", UnitVectorSpec{v});
 }
 
+// ToleranceScales (model.hpp): each length row relative to its own link, each length coordinate to the shortest
+// link reading it; the rows' rounding-floor coordinates. `pattern` is the full Jacobian's.
+void ModelBuilder::tolerance_scales(const CscPattern& pattern) {
+  Model& m = model_;
+  ToleranceScales& sc = m.scales_;
+  const Index n = m.num_coordinates(), rows = m.num_equations();
+  const double fallback = m.length_scale_;
+  const auto length_row = [&](Index i) { return m.row_units_[static_cast<std::size_t>(i)] == Unit::kLength; };
+  const auto length_coordinate = [&](Index j) {
+    return m.coordinate_units_[static_cast<std::size_t>(j)] == Unit::kLength;
+  };
+  sc.row_is_length.resize(rows);
+  for (Index i = 0; i < rows; ++i) sc.row_is_length(i) = length_row(i) ? 1.0 : 0.0;
+  sc.coordinate_is_length.resize(n);
+  for (Index j = 0; j < n; ++j) sc.coordinate_is_length(j) = length_coordinate(j) ? 1.0 : 0.0;
+
+  // The pattern by rows (the columns of row i: cols[begin[i] … begin[i + 1] − 1]).
+  std::vector<Index> begin(static_cast<std::size_t>(rows) + 1, 0), cols(pattern.row_idx.size());
+  for (Index r : pattern.row_idx) ++begin[static_cast<std::size_t>(r) + 1];
+  for (Index i = 0; i < rows; ++i) begin[static_cast<std::size_t>(i) + 1] += begin[static_cast<std::size_t>(i)];
+  {
+    std::vector<Index> next(begin.begin(), begin.end() - 1);
+    for (Index j = 0; j < n; ++j)
+      for (Index k = pattern.col_ptr[j]; k < pattern.col_ptr[j + 1]; ++k)
+        cols[static_cast<std::size_t>(next[static_cast<std::size_t>(pattern.row_idx[k])]++)] = j;
+  }
+
+  if (length_scale_override_ > 0.0) {  // one scale for every length, as set
+    sc.row_scale = 1.0 + (fallback - 1.0) * sc.row_is_length.array();
+    sc.coordinate_scale = 1.0 + (fallback - 1.0) * sc.coordinate_is_length.array();
+  } else {
+    std::vector<double> own(static_cast<std::size_t>(rows), 0.0);
+    for (auto& b : m.blocks_) b->row_lengths(own);
+    constexpr double kUnset = std::numeric_limits<double>::infinity();
+    sc.row_scale = Eigen::VectorXd::Ones(rows);
+    sc.coordinate_scale = Eigen::VectorXd::Ones(n);
+    for (Index j = 0; j < n; ++j)
+      if (length_coordinate(j)) sc.coordinate_scale(j) = kUnset;
+    // 1. Length rows with a length of their own; length coordinates: the smallest among the rows reading them.
+    for (Index i = 0; i < rows; ++i) {
+      const double l = own[static_cast<std::size_t>(i)];
+      if (!length_row(i)) continue;
+      sc.row_scale(i) = l > 0.0 && std::isfinite(l) ? l : kUnset;
+      if (sc.row_scale(i) == kUnset) continue;
+      for (Index k = begin[static_cast<std::size_t>(i)]; k < begin[static_cast<std::size_t>(i) + 1]; ++k) {
+        const Index j = cols[static_cast<std::size_t>(k)];
+        if (length_coordinate(j)) sc.coordinate_scale(j) = std::min(sc.coordinate_scale(j), l);
+      }
+    }
+    // 2. Length rows without a length: the largest scale of the length coordinates they read.
+    for (Index i = 0; i < rows; ++i) {
+      if (sc.row_scale(i) != kUnset) continue;
+      double s = 0.0;
+      for (Index k = begin[static_cast<std::size_t>(i)]; k < begin[static_cast<std::size_t>(i) + 1]; ++k) {
+        const Index j = cols[static_cast<std::size_t>(k)];
+        if (length_coordinate(j) && sc.coordinate_scale(j) != kUnset) s = std::max(s, sc.coordinate_scale(j));
+      }
+      sc.row_scale(i) = s > 0.0 ? s : fallback;
+    }
+    // 3. Length coordinates read by no row with a length: the smallest scale of the length rows reading them.
+    for (Index j = 0; j < n; ++j) {
+      if (sc.coordinate_scale(j) != kUnset) continue;
+      double s = kUnset;
+      for (Index k = pattern.col_ptr[j]; k < pattern.col_ptr[j + 1]; ++k)
+        if (length_row(pattern.row_idx[k])) s = std::min(s, sc.row_scale(pattern.row_idx[k]));
+      sc.coordinate_scale(j) = s != kUnset ? s : fallback;
+    }
+  }
+
+  // Rounding floors: per row, the coordinates of its unit class (all of its coordinates when it reads none).
+  sc.floor_begin.assign(static_cast<std::size_t>(rows) + 1, 0);
+  sc.floor_coordinates.clear();
+  sc.floor_coordinates.reserve(cols.size());
+  for (Index i = 0; i < rows; ++i) {
+    const std::size_t first = sc.floor_coordinates.size();
+    for (Index k = begin[static_cast<std::size_t>(i)]; k < begin[static_cast<std::size_t>(i) + 1]; ++k) {
+      const Index j = cols[static_cast<std::size_t>(k)];
+      if (length_coordinate(j) == length_row(i)) sc.floor_coordinates.push_back(j);
+    }
+    if (sc.floor_coordinates.size() == first)
+      sc.floor_coordinates.insert(sc.floor_coordinates.end(), cols.begin() + begin[static_cast<std::size_t>(i)],
+                                  cols.begin() + begin[static_cast<std::size_t>(i) + 1]);
+    sc.floor_begin[static_cast<std::size_t>(i) + 1] = static_cast<Index>(sc.floor_coordinates.size());
+  }
+  sc.floor_coordinates.shrink_to_fit();
+}
+
 Model ModelBuilder::build() && {
   Model& m = model_;
   const Index n = m.num_coordinates(), rows = m.num_equations();
@@ -353,14 +440,7 @@ Model ModelBuilder::build() && {
     scale = hi > lo ? hi - lo : 1.0;
   }
   m.length_scale_ = scale;
-  auto is_length = [](Unit u) { return u == Unit::kLength ? 1.0 : 0.0; };
-  m.scales_.row_is_length.resize(rows);
-  for (Index i = 0; i < rows; ++i) m.scales_.row_is_length(i) = is_length(m.row_units_[static_cast<std::size_t>(i)]);
-  m.scales_.coordinate_is_length.resize(n);
-  for (Index j = 0; j < n; ++j)
-    m.scales_.coordinate_is_length(j) = is_length(m.coordinate_units_[static_cast<std::size_t>(j)]);
-  m.scales_.row_scale = 1.0 + (scale - 1.0) * m.scales_.row_is_length.array();
-  m.scales_.coordinate_scale = 1.0 + (scale - 1.0) * m.scales_.coordinate_is_length.array();
+  tolerance_scales(*pattern);
 
   for (auto& b : m.blocks_) {
     bool td = false;

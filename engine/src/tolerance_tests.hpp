@@ -14,41 +14,43 @@
 
 namespace phiq::detail {
 
-inline constexpr double kUlpFloor = 64.0 * std::numeric_limits<double>::epsilon();
+inline constexpr double kUlpFloor = ToleranceScales::kUlpFloor;
 
-// Rounding floor of lengths and of other quantities at this q: a residual or a step cannot be resolved below a few
-// ulps of the coordinates it is computed from, wherever the origin is.
-struct Floors {
-  double length = 0.0, other = 0.0;
-};
-// The tests below run every Newton iteration: one vectorised pass each over the model's precomputed scales.
-inline Floors rounding_floors(const Model& model, const Eigen::VectorXd& q) {
-  Floors f;
-  if (q.size() == 0) return f;
-  const auto& len = model.tolerance_scales().coordinate_is_length.array();
-  f.length = kUlpFloor * (q.array().abs() * len).maxCoeff();
-  f.other = kUlpFloor * (q.array().abs() * (1.0 - len)).maxCoeff();
-  return f;
-}
-
-// Every row |Φ_i| ≤ tol · scale_i + floor_i (false on NaN).
-inline bool residual_within(const Model& model, const Eigen::VectorXd& phi, double tol, const Floors& fl) {
+// Rounding floor of row i at q (ToleranceScales): kUlpFloor times the largest |q_j| over the row's floor
+// coordinates. A residual or a step cannot be resolved below a few ulps of the coordinates it is computed from,
+// wherever the origin is.
+inline double row_floor(const Model& model, Index i, const Eigen::VectorXd& q) {
   const ToleranceScales& s = model.tolerance_scales();
-  return (phi.array().abs() <= tol * s.row_scale.array() + fl.other + (fl.length - fl.other) * s.row_is_length.array())
-      .all();
+  double m = 0.0;
+  for (Index k = s.floor_begin[static_cast<std::size_t>(i)]; k < s.floor_begin[static_cast<std::size_t>(i) + 1]; ++k)
+    m = std::max(m, std::fabs(q(s.floor_coordinates[static_cast<std::size_t>(k)])));
+  return kUlpFloor * m;
 }
 
-// Row i with |Φ_i| / scale_i = `scaled` passes the same test (false on NaN).
-inline bool row_within(const Model& model, Index i, double scaled, double tol, const Floors& fl) {
-  const ToleranceScales& s = model.tolerance_scales();
-  return scaled <= tol + (s.row_is_length(i) > 0.0 ? fl.length : fl.other) / s.row_scale(i);
+// The tests below run every Newton iteration: the floor of a row is looked at only when the row fails without it.
+
+// Row i with |Φ_i| / scale_i = `scaled` is within tol · scale_i + floor_i at q (false on NaN).
+inline bool row_within(const Model& model, Index i, double scaled, double tol, const Eigen::VectorXd& q) {
+  if (scaled <= tol) return true;
+  return scaled <= tol + row_floor(model, i, q) / model.tolerance_scales().row_scale(i);
 }
 
-// The rows `rows` (rows k = 0 … when null) of a scaled residual b, b_k = Φ_row / scale_row, pass the test.
+// Every row |Φ_i| ≤ tol · scale_i + floor_i at q (false on NaN).
+inline bool residual_within(const Model& model, const Eigen::VectorXd& phi, double tol, const Eigen::VectorXd& q) {
+  const Eigen::VectorXd& rs = model.tolerance_scales().row_scale;
+  for (Index i = 0; i < phi.size(); ++i) {
+    const double a = std::fabs(phi(i));
+    if (a <= tol * rs(i)) continue;
+    if (!(a <= tol * rs(i) + row_floor(model, i, q))) return false;
+  }
+  return true;
+}
+
+// The rows `rows` (rows k = 0 … when null) of a scaled residual b, b_k = Φ_row / scale_row, pass the test at q.
 inline bool scaled_rows_within(const Model& model, const Eigen::VectorXd& b, const std::vector<Index>* rows, double tol,
-                               const Floors& fl) {
+                               const Eigen::VectorXd& q) {
   for (Index k = 0; k < b.size(); ++k)
-    if (!row_within(model, rows ? (*rows)[static_cast<std::size_t>(k)] : k, std::fabs(b(k)), tol, fl)) return false;
+    if (!row_within(model, rows ? (*rows)[static_cast<std::size_t>(k)] : k, std::fabs(b(k)), tol, q)) return false;
   return true;
 }
 

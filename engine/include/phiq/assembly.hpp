@@ -6,10 +6,12 @@
 /// redundant equations it left out: satisfied (consistent redundancy) or not (inconsistent: the constraints that
 /// conflict are named).
 ///
-/// Ã is the scaled Jacobian of the kept rows (rank_analysis.hpp), D the coordinate scales: the step is the smallest in
-/// the norm that weighs a metre of the model's length scale like a radian. μ = 0 (Gauss-Newton) while its steps
-/// decrease ‖Φ̃‖; μ > 0 (Levenberg-Marquardt) only when they do not or the kept rows lose rank on the way. Once the
-/// equations hold, projection steps move to the assembled position nearest to q₀ (assembly.cpp).
+/// Ã is the scaled Jacobian of the kept rows (rank_analysis.hpp), D the coordinate scales (ToleranceScales): the
+/// step is the smallest in the norm that weighs each coordinate's tolerance scale like a radian. μ = 0
+/// (Gauss-Newton) while its steps decrease ‖Φ̃‖; μ > 0 (Levenberg-Marquardt) only when they do not or the kept rows
+/// lose rank on the way. Once the equations hold, projection steps move to the assembled position nearest to q₀
+/// (assembly.cpp); if the iteration budget runs out before they settle (near a singular position they may leave
+/// the tolerance and come back repeatedly), the last iterate at which the equations held is the result.
 #pragma once
 
 #include <memory>

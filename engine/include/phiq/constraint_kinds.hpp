@@ -77,13 +77,13 @@ struct DistanceSpec {
   /// leaves the constraint's Φt rows at zero. The answer is fixed for the life of the spec.
   bool depends_on_time() const { return false; }
   /// The unit of residual row `row` (0 ≤ row < kRows): what the row measures, which chooses its tolerance (a length
-  /// is compared with tol · length scale, an angle with tol, Unit::kNone with tol). `coordinate_units` holds the
-  /// unit inferred for every coordinate of the model (from the for_each_slot() of all constraints); kinds whose rows
-  /// have a fixed unit ignore it. Called once, while the model is built.
+  /// is compared with tol · its tolerance scale (ToleranceScales), an angle with tol, Unit::kNone with tol).
+  /// `coordinate_units` holds the unit inferred for every coordinate of the model (from the for_each_slot() of all
+  /// constraints); kinds whose rows have a fixed unit ignore it. Called once, while the model is built.
   Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kLength; }
-  /// The largest length this constraint carries as data (m), 0 if it carries none. The model's length scale, which
-  /// scales the tolerance of every length row, is the largest of these over all constraints (unless set with
-  /// ModelBuilder::set_length_scale()). Called once, while the model is built.
+  /// The largest length this constraint carries as data (m), 0 if it carries none. It is the tolerance scale of
+  /// the constraint's own length rows (each row is held relative to its own link, ToleranceScales); the model's
+  /// length scale is the largest of these over all constraints. Called once, while the model is built.
   double characteristic_length() const { return length; }
   /// Calls `f(slot, unit)` for every scalar Slot this constraint reads, coordinates and constants alike, with the
   /// unit that the slot measures for this kind (Unit::kNone where the kind does not tell). The same slot may be

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <type_traits>
@@ -161,12 +162,35 @@ struct ConstraintInfo {
 };
 
 /// The per-row and per-coordinate scales of the dimensional tolerances, fixed per model (computed by
-/// ModelBuilder::build() so that the Newton loop only reads them).
+/// ModelBuilder::build() so that the Newton loop only reads them). A position is within the tolerance `tol` when
+/// every row |Φ_i| ≤ tol · row_scale_i + floor_i and the estimated error of every coordinate is within
+/// tol · coordinate_scale_j + floor_j (NewtonOptions::tolerance).
+///
+/// Lengths are relative to the links they belong to, so that one model may mix millimetres and kilometres: a
+/// length row is scaled by its own constraint's length (a distance's L, a crank's length, the moving arm of a pin:
+/// DistanceSpec::characteristic_length()); a length coordinate by the smallest of those among the rows that read it
+/// (a point is located as accurately as the shortest link attached to it needs); a length row that carries no
+/// length (a point on a line, a segment angle, an equation) by the largest scale of the length coordinates it
+/// reads. What is left (no length anywhere near it) falls back to length_scale(). With
+/// ModelBuilder::set_length_scale() (scene `solver.length_scale`) every length row and coordinate uses that one
+/// scale instead. Angle and unitless rows and coordinates: 1.
+///
+/// The rounding floor of a row is kUlpFloor (64 ulps) times the largest |q_j| among the coordinates it reads that
+/// have its unit class (length coordinates for length rows, the others for the others; all of them when it reads
+/// none of its class): a residual cannot be resolved below a few ulps of the coordinates it is computed from,
+/// wherever the origin is. floor_j of a coordinate is kUlpFloor · |q_j|.
 struct ToleranceScales {
-  Eigen::VectorXd row_scale;              ///< length_scale() for length rows, 1 for angle and unitless rows
-  Eigen::VectorXd row_is_length;          ///< 1 for length rows, 0 otherwise (which rounding floor applies)
-  Eigen::VectorXd coordinate_scale;       ///< length_scale() for length coordinates, 1 otherwise
+  Eigen::VectorXd row_scale;              ///< per row, metres for length rows, 1 for angle and unitless rows
+  Eigen::VectorXd row_is_length;          ///< 1 for length rows, 0 otherwise
+  Eigen::VectorXd coordinate_scale;       ///< per coordinate, metres for length coordinates, 1 otherwise
   Eigen::VectorXd coordinate_is_length;   ///< 1 for length coordinates, 0 otherwise
+  /// Where each row's floor coordinates start in floor_coordinates (m + 1 entries).
+  std::vector<Index> floor_begin;
+  /// The coordinates each row's rounding floor is taken over (see above): those of row i are
+  /// floor_coordinates[floor_begin[i] … floor_begin[i + 1] − 1].
+  std::vector<Index> floor_coordinates;
+  /// 64 ulps: the rounding floor per unit of |q| (see above).
+  static constexpr double kUlpFloor = 64.0 * std::numeric_limits<double>::epsilon();
 };
 
 /// An immutable mechanism: coordinates, constraints, the fixed CSC pattern of Φq and its symbolic analysis.
@@ -212,7 +236,9 @@ class Model {
   /// True when some constraint depends on t (then Φt is not identically zero).
   bool has_time_dependence() const { return !time_blocks_.empty(); }
 
-  /// Characteristic length of the model (metres): tolerances on lengths are relative to it.
+  /// Characteristic length of the model (metres): the largest length in the constraints' data, else the extent of
+  /// the initial placement, else 1 (or the one set with ModelBuilder::set_length_scale()). Each length row's and
+  /// coordinate's tolerance is relative to its own scale (tolerance_scales()); this one is their fallback.
   double length_scale() const { return length_scale_; }
   /// The tolerance scale of every row and coordinate (from their units and length_scale()).
   const ToleranceScales& tolerance_scales() const { return scales_; }
@@ -354,8 +380,8 @@ class ModelBuilder {
   /// Shorthand for a CoordinateDriverSpec.
   Index add_driver(const std::string& name, Index coordinate, MotionLaw law);
 
-  /// Overrides the automatic length scale (largest length in the constraints' data, else the extent of the
-  /// initial placement, else 1 m).
+  /// Overrides the automatic tolerance scales (ToleranceScales: each length row relative to its own link) with
+  /// one length scale for every length row and coordinate.
   void set_length_scale(double metres);
   /// Chooses the sparse LU (default KLU; see bench/README.md for why).
   void set_linear_solver(LinearSolverKind kind) { model_.lu_kind_ = kind; }
@@ -392,6 +418,7 @@ class ModelBuilder {
   void prepare(EquationSpec& s) const;
   void prepare(PinSpec& s) const;
   void prepare(LoopSpec& s) const;
+  void tolerance_scales(const CscPattern& pattern);  // model_.scales_ (ToleranceScales), once in build()
   /// @endcond
 
   Model model_;

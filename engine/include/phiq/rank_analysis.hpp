@@ -7,9 +7,9 @@
 /// Method: a rank-revealing sparse QR (SuiteSparseQR, Heath's method) of the scaled transposed Jacobian
 /// J̃ᵀ = (D_r⁻¹ Φq D_c)ᵀ, whose columns are the equations, kinematic rows first, then the rheonomic ones (a driver
 /// is only called redundant when the kinematic rows already fix what it drives), each group in model order or in a
-/// fill-reducing order (RankOrdering). D_r and D_c are the
-/// model's tolerance scales (length scale for lengths, 1 for angles and unitless rows), so that the rank does not
-/// depend on units or on where the origin is. With the fixed column order the factorisation takes the equations
+/// fill-reducing order (RankOrdering). D_r and D_c are the model's tolerance scales (ToleranceScales: lengths by
+/// their own links, 1 for angles and unitless rows), so that the rank does not depend on units or on where the
+/// origin is. With the fixed column order the factorisation takes the equations
 /// greedily: an equation is redundant when it is (within the tolerance) a combination of equations before it in
 /// that order.
 #pragma once

@@ -25,10 +25,11 @@ class Error : public std::invalid_argument {
 std::string single_line(const std::string& text);
 
 /// What a coordinate or a constraint row measures. Tolerances are dimensional: a length is compared with
-/// tol * length_scale, an angle with tol (radians), a quantity of unknown unit with tol.
+/// tol * its own tolerance scale (ToleranceScales: its link), an angle with tol (radians), a quantity of unknown unit
+/// with tol.
 enum class Unit : std::uint8_t {
   kNone = 0,    ///< unknown or unitless: compared with tol
-  kLength = 1,  ///< metres: compared with tol · length_scale
+  kLength = 1,  ///< metres: compared with tol · its tolerance scale (ToleranceScales)
   kAngle = 2,   ///< radians: compared with tol
 };
 

@@ -1,0 +1,102 @@
+// Very long chains do not drift (issue 5, "Hard cases stay numerically stable"): nfourbar with N = 10^5 four-bars
+// (200 003 coordinates) swept over 1000 steps of a quarter turn, θ = π/4 … 3π/4, each step started from the previous
+// solutions. The exact solution is the parallelogram x_i = i + cos θ, y_i = sin θ at every step; the counters are
+// the largest scaled residual max_i |Φ_i| / scale_i (metres: every link is 1 m) at the first and last drive steps
+// and over the first and last 100, and the largest deviation from the parallelogram over all steps. One iteration
+// (a single sweep; the figure is the drift, not the time). Figures and command: bench/README.md, "Long chains: no
+// drift". Arguments: N and derivs (0 positions only, 1 positions, velocities and accelerations).
+//
+//   ./build/bench/phiq_bench_long_chain --benchmark_filter=N:100000/ --benchmark_counters_tabular=true
+//
+// A run fails (SkipWithError, "ERROR OCCURRED") when the sweep fails, a value is not finite, a residual exceeds
+// the tolerance plus its rounding floor, or a coordinate is more than 1e-9 off the parallelogram (ten times the
+// tolerance; tests/test_hard_cases.cpp checks the same at N = 10^4).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "nfourbar_model.hpp"
+#include "phiq/phiq.hpp"
+
+namespace {
+
+using namespace phiq;
+
+double max_of(const std::vector<double>& v, std::size_t from, std::size_t to) {
+  return *std::max_element(v.begin() + static_cast<std::ptrdiff_t>(from), v.begin() + static_cast<std::ptrdiff_t>(to));
+}
+
+void BM_LongChainNoDrift(benchmark::State& state) {
+  const Index n = state.range(0);
+  const bool derivs = state.range(1) != 0;
+  constexpr Index kSteps = 1000;
+  const double w = M_PI / 2;
+  const Model m = phiq_bench::nfourbar(n, M_PI / 4, w);
+  SweepOptions opt;
+  opt.t_begin = 0.0;
+  opt.t_end = 1.0;
+  opt.steps = kSteps;
+  opt.velocities = opt.accelerations = derivs;
+  opt.residuals = true;
+  opt.threads = 1;
+  const Index th = m.coordinate_index("theta");
+  std::vector<double> residual, deviation;
+  double deviation_v = 0.0;
+  bool finite = true;
+  SweepSummary sum;
+  for (auto _ : state) {
+    residual.clear(), deviation.clear(), deviation_v = 0.0, finite = true;
+    Workspace ws(m);
+    run_sweep(m, opt, ws, [&](const StepView& s) {
+      const double theta = M_PI / 4 + w * s.t, c = std::cos(theta), sn = std::sin(theta);
+      finite = finite && s.q.allFinite() && s.phi && s.phi->allFinite() && (!s.qd || s.qd->allFinite()) &&
+               (!s.qdd || s.qdd->allFinite());
+      residual.push_back(s.phi ? scaled_residual(m, *s.phi) : INFINITY);
+      double d = std::fabs(s.q(th) - theta);
+      for (Index i = 0; i <= n; ++i)
+        d = std::max({d, std::fabs(s.q(2 * i) - (static_cast<double>(i) + c)), std::fabs(s.q(2 * i + 1) - sn)});
+      deviation.push_back(d);
+      if (s.qd && s.qdd) {
+        const Eigen::VectorXd &v = *s.qd, &a = *s.qdd;
+        for (Index i = 0; i <= n; ++i)
+          deviation_v = std::max({deviation_v, std::fabs(v(2 * i) + w * sn), std::fabs(v(2 * i + 1) - w * c),
+                                  std::fabs(a(2 * i) + w * w * c), std::fabs(a(2 * i + 1) + w * w * sn)});
+      }
+      return true;
+    }, &sum);
+    state.SetIterationTime(sum.solve_seconds);
+  }
+  if (sum.status != SolveStatus::kSuccess || residual.size() != static_cast<std::size_t>(kSteps + 1)) {
+    state.SkipWithError(sum.message.c_str());
+    return;
+  }
+  const double max_residual = max_of(residual, 0, residual.size());
+  const double max_deviation = max_of(deviation, 0, deviation.size());
+  state.counters["coordinates"] = static_cast<double>(m.num_coordinates());
+  state.counters["residual_first"] = residual[1];  // step 0 is the assembly from the exact placement
+  state.counters["residual_last"] = residual[kSteps];
+  state.counters["residual_max_first100"] = max_of(residual, 1, 101);
+  state.counters["residual_max_last100"] = max_of(residual, kSteps - 99, kSteps + 1);
+  state.counters["deviation_max"] = max_deviation;
+  state.counters["deviation_va_max"] = deviation_v;
+  state.counters["newton_per_step"] = static_cast<double>(sum.counters.newton_iterations) / kSteps;
+  state.counters["factorizations_per_step"] = static_cast<double>(sum.counters.factorizations) / kSteps;
+  state.counters["ms_per_step"] = 1e3 * sum.solve_seconds / (kSteps + 1);
+  const double floor = opt.newton.tolerance + ToleranceScales::kUlpFloor * static_cast<double>(n + 1);
+  if (!finite) state.SkipWithError("a value is not finite");
+  else if (max_residual > floor) state.SkipWithError("a residual exceeds the tolerance");
+  else if (max_deviation > 1e-9 || deviation_v > 1e-9) state.SkipWithError("off the parallelogram by more than 1e-9");
+}
+
+BENCHMARK(BM_LongChainNoDrift)
+    ->ArgNames({"N", "derivs"})
+    ->ArgsProduct({{100, 100000}, {0, 1}})
+    ->Unit(benchmark::kSecond)
+    ->UseManualTime()
+    ->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();

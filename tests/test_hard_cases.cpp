@@ -1,0 +1,273 @@
+// Hard cases stay numerically stable (issue 5): badly scaled models — millimetres and radians mixed, lengths from
+// 10^-3 to 10^3 m in one mechanism (models/hard/) — and very long chains (nfourbar N = 10^4 over 1000 steps).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "test_support.hpp"
+
+namespace {
+
+using namespace phiq;
+
+constexpr double kTol = 1e-10;  // the scenes' Newton tolerance (NewtonOptions / solver.tolerance default)
+
+// Every row of a sweep: q, q̇, q̈ and the largest scaled residual max_i |Φ_i| / scale_i of the delivered Φ.
+struct Rows {
+  test::Trace tr;
+  std::vector<double> residual;
+  SweepSummary sum;
+  SolveStatus status = SolveStatus::kNotConverged;
+};
+
+// Sweeps `sc` with its own settings on `threads` threads, asking for Φ at every row.
+Rows sweep_scene(const Scene& sc, int threads) {
+  SweepOptions opt = sc.sweep;
+  opt.threads = threads;
+  opt.residuals = true;
+  Rows r;
+  Workspace ws(*sc.model);
+  r.status = run_sweep(*sc.model, opt, ws, [&](const StepView& s) {
+    r.tr.t.push_back(s.t);
+    r.tr.q.push_back(s.q);
+    if (s.qd) r.tr.qd.push_back(*s.qd);
+    if (s.qdd) r.tr.qdd.push_back(*s.qdd);
+    r.residual.push_back(s.phi ? scaled_residual(*sc.model, *s.phi) : INFINITY);
+    return true;
+  }, &r.sum);
+  return r;
+}
+
+// No NaN or infinity anywhere, every row's every constraint within the tolerance, every time point delivered.
+void expect_sound(const Rows& r, const Scene& sc, const std::string& what) {
+  ASSERT_EQ(r.status, SolveStatus::kSuccess) << what << ": " << r.sum.message;
+  ASSERT_EQ(r.tr.t.size(), static_cast<std::size_t>(sc.sweep.steps + 1)) << what;
+  ASSERT_EQ(r.tr.qd.size(), r.tr.t.size()) << what;
+  ASSERT_EQ(r.tr.qdd.size(), r.tr.t.size()) << what;
+  for (std::size_t k = 0; k < r.tr.t.size(); ++k) {
+    EXPECT_TRUE(r.tr.q[k].allFinite() && r.tr.qd[k].allFinite() && r.tr.qdd[k].allFinite()) << what << " row " << k;
+    EXPECT_LE(r.residual[k], kTol) << what << " row " << k;  // NaN fails too
+  }
+}
+
+bool is_angle(const std::string& name) { return name == "theta2" || name == "psi3" || name == "phi4"; }
+
+// The four-bar in millimetres (models/hard/fourbar_mm.yaml) and in metres (fourbar_m.yaml): natural coordinates
+// and angles mixed, so the mm model's Jacobian has length columns 1000× the angle columns. Each length row and
+// coordinate is held relative to its own link (ToleranceScales), so the scales of the mm model are exactly 1000×
+// those of the m model and every decision of the solver (convergence, modified-Newton refreshes) is the same: in
+// order, the two runs take the same iterations and agree to rounding. Bounds, relative to the largest link
+// (1.2 m) for lengths and to 1 rad for angles (ω = 1 rad/s, so velocities and accelerations have the same scale):
+//  - in order: 1e-12 (measured 1.3e-15: rounding only; a decision taken differently would show as ~1e-10);
+//  - on 2 threads: 1e-9, ten times the tolerance: parallel chunks start from seeds and may stop a Newton solve at a
+//    different point within the tolerance (measured 1.3e-15 here; 3.6e-12 once through `phiq run`).
+TEST(HardCases, MillimetresAgreeWithMetres) {
+  const Scene m = load_scene(test::model_path("hard/fourbar_m.yaml"));
+  const Scene mm = load_scene(test::model_path("hard/fourbar_mm.yaml"));
+  const Model& a = *m.model;
+  const Model& b = *mm.model;
+  ASSERT_EQ(a.coordinate_names(), b.coordinate_names());
+  ASSERT_EQ(a.num_equations(), b.num_equations());
+  const Index n = a.num_coordinates();
+  std::vector<double> unit(static_cast<std::size_t>(n));  // metres (or radians) per model unit of the mm scene
+  for (Index j = 0; j < n; ++j) {
+    const std::string& name = a.coordinate_names()[static_cast<std::size_t>(j)];
+    ASSERT_EQ(a.coordinate_unit(j), is_angle(name) ? Unit::kAngle : Unit::kLength) << name;
+    ASSERT_EQ(b.coordinate_unit(j), a.coordinate_unit(j)) << name;
+    unit[static_cast<std::size_t>(j)] = is_angle(name) ? 1.0 : 1e-3;
+    // scales: the coordinate's shortest link, 1000× in millimetres
+    EXPECT_DOUBLE_EQ(b.tolerance_scales().coordinate_scale(j),
+                     (is_angle(name) ? 1.0 : 1000.0) * a.tolerance_scales().coordinate_scale(j)) << name;
+  }
+  for (Index i = 0; i < a.num_equations(); ++i)
+    EXPECT_DOUBLE_EQ(b.tolerance_scales().row_scale(i),
+                     (a.row_unit(i) == Unit::kLength ? 1000.0 : 1.0) * a.tolerance_scales().row_scale(i)) << a.row_name(i);
+  EXPECT_DOUBLE_EQ(a.tolerance_scales().row_scale(0), 0.4);  // crank[0]: its own length, not the model's 1.2 m
+
+  for (int threads : {1, 2}) {
+    const std::string what = threads == 1 ? "in order" : "on 2 threads";
+    const Rows ra = sweep_scene(m, threads), rb = sweep_scene(mm, threads);
+    expect_sound(ra, m, "m " + what);
+    expect_sound(rb, mm, "mm " + what);
+    if (HasFatalFailure()) return;
+    if (threads == 1) {  // scale-invariant decisions
+      EXPECT_EQ(ra.sum.counters.newton_iterations, rb.sum.counters.newton_iterations);
+      EXPECT_EQ(ra.sum.counters.factorizations, rb.sum.counters.factorizations);
+    }
+    const double bound = threads == 1 ? 1e-12 : 1e-9;
+    double worst[3] = {0, 0, 0};
+    ASSERT_EQ(ra.tr.t, rb.tr.t);
+    for (std::size_t k = 0; k < ra.tr.t.size(); ++k)
+      for (Index j = 0; j < n; ++j) {
+        const double s = unit[static_cast<std::size_t>(j)], ref = s == 1.0 ? 1.0 : 1.2;
+        worst[0] = std::max(worst[0], std::fabs(ra.tr.q[k](j) - s * rb.tr.q[k](j)) / ref);
+        worst[1] = std::max(worst[1], std::fabs(ra.tr.qd[k](j) - s * rb.tr.qd[k](j)) / ref);
+        worst[2] = std::max(worst[2], std::fabs(ra.tr.qdd[k](j) - s * rb.tr.qdd[k](j)) / ref);
+      }
+    std::printf("fourbar mm vs m, %s: positions %.3g, velocities %.3g, accelerations %.3g\n", what.c_str(), worst[0],
+                worst[1], worst[2]);
+    EXPECT_LE(worst[0], bound) << what << ": positions";
+    EXPECT_LE(worst[1], bound) << what << ": velocities";
+    EXPECT_LE(worst[2], bound) << what << ": accelerations";
+  }
+}
+
+// models/hard/crank_slider_span.yaml: a 1 mm crank and a 1 km rod (lengths from 10^-3 to 10^3 m), θ = 2t, against
+// the closed form x_B = r cos θ + √(L² − r² sin² θ) and its derivatives. With one tolerance scale for the whole
+// model (its largest length, 1000 m) the crank's rows were held to 1e-7 m, a ten-thousandth of the crank:
+// predicted positions were accepted without a Newton step, and the crank tip was up to 1e-4 r off (measured 1.0e-7 m
+// in order, 5.3e-8 m on 2 threads). Each row is now held relative to its own link: the crank tip to 1e-10 r, the
+// slider (on the 1 km rod only) to 1e-10 L.
+TEST(HardCases, LengthsFromMillimetresToKilometres) {
+  const Scene sc = load_scene(test::model_path("hard/crank_slider_span.yaml"));
+  const Model& m = *sc.model;
+  const double r = 1e-3, L = 1e3, w = 2.0;
+  const Index th = m.coordinate_index("theta2"), xa = m.coordinate_index("xA"), ya = m.coordinate_index("yA"),
+              xb = m.coordinate_index("xB");
+  const ToleranceScales& s = m.tolerance_scales();
+  EXPECT_EQ(m.length_scale(), L);
+  EXPECT_EQ(s.coordinate_scale(th), 1.0);
+  EXPECT_EQ(s.coordinate_scale(xa), r);  // the shortest link at A: the crank
+  EXPECT_EQ(s.coordinate_scale(ya), r);
+  EXPECT_EQ(s.coordinate_scale(xb), L);  // only the rod reaches B
+  for (Index i = 0; i < m.num_equations(); ++i) {
+    const std::string& c = m.constraints()[static_cast<std::size_t>(m.constraint_of_row(i))].name;
+    EXPECT_EQ(s.row_scale(i), c == "crank" ? r : c == "rod" ? L : 1.0) << m.row_name(i);
+  }
+
+  for (int threads : {1, 2}) {
+    const std::string what = threads == 1 ? "in order" : "on 2 threads";
+    const Rows run = sweep_scene(sc, threads);
+    expect_sound(run, sc, what);
+    if (HasFatalFailure()) return;
+    double e_a = 0, e_b = 0, e_v = 0, e_acc = 0;
+    for (std::size_t k = 0; k < run.tr.t.size(); ++k) {
+      const double t = run.tr.t[k], q = w * t, sn = std::sin(q), cs = std::cos(q);
+      const double d = std::sqrt(L * L - r * r * sn * sn);
+      const double x = r * cs + d;
+      const double v = -r * w * sn - r * r * w * sn * cs / d;
+      const double a = -r * w * w * cs - r * r * w * w * (cs * cs - sn * sn) / d -
+                       std::pow(r, 4) * w * w * sn * sn * cs * cs / (d * d * d);
+      const Eigen::VectorXd &Q = run.tr.q[k], &V = run.tr.qd[k], &A = run.tr.qdd[k];
+      EXPECT_NEAR(Q(th), q, 1e-15 * std::max(1.0, q)) << "driven exactly";
+      e_a = std::max({e_a, std::fabs(Q(xa) - r * cs), std::fabs(Q(ya) - r * sn)});
+      e_b = std::max(e_b, std::fabs(Q(xb) - x));
+      e_v = std::max({e_v, std::fabs(V(xa) + r * w * sn), std::fabs(V(ya) - r * w * cs), std::fabs(V(xb) - v)});
+      e_acc = std::max({e_acc, std::fabs(A(xa) + r * w * w * cs), std::fabs(A(ya) + r * w * w * sn),
+                        std::fabs(A(xb) - a)});
+    }
+    std::printf("crank_slider_span, %s: crank tip %.3g r, slider %.3g m, velocities %.3g r w, accelerations %.3g r w^2\n",
+                what.c_str(), e_a / r, e_b, e_v / (r * w), e_acc / (r * w * w));
+    // positions: each to the tolerance of its own link (crank tip measured 1e-16 r; slider 7.7e-12 m in order —
+    // the assembly, then 1 ulp of 1000 m —, 2.3e-9 m at the first row of a parallel chunk)
+    EXPECT_LE(e_a, kTol * r) << what;
+    EXPECT_LE(e_b, kTol * L) << what;
+    // velocities and accelerations: the linear solves on a Jacobian whose scaled condition is about 1 are exact to
+    // rounding (measured 0; 5e-11 relative with one model-wide scale); 1e-9 of the crank's r ω, r ω²
+    EXPECT_LE(e_v, 1e-9 * r * w) << what;
+    EXPECT_LE(e_acc, 1e-9 * r * w * w) << what;
+  }
+}
+
+// nfourbar with N = 10^4 four-bars (20 003 coordinates), a quarter turn θ = π/4 … 3π/4 in 1000 steps. The exact
+// solution is the parallelogram x_i = i + cos θ, y_i = sin θ (ẋ_i = −θ̇ sin θ, ẏ_i = θ̇ cos θ, ẍ_i = −θ̇² cos θ,
+// ÿ_i = −θ̇² sin θ) at every step; each step starts from the previous solutions, so a drift would show as a
+// residual or a deviation growing with the steps.
+struct ChainRun {
+  std::vector<double> residual;   // max_i |Φ_i| / scale_i over all rows, per step (all links 1 m: metres)
+  std::vector<double> deviation;  // max over the coordinates of |q − exact|, per step (m, rad)
+  double deviation_v = 0.0, deviation_a = 0.0;  // max over all steps and coordinates, velocities and accelerations
+  bool finite = true;
+  SweepSummary sum;
+};
+
+constexpr Index kChainN = 10000, kChainSteps = 1000;
+
+ChainRun long_chain(bool derivatives) {
+  const Model m = test::nfourbar_model(kChainN, M_PI / 4, M_PI / 2);
+  SweepOptions opt;
+  opt.t_begin = 0.0;
+  opt.t_end = 1.0;
+  opt.steps = kChainSteps;
+  opt.velocities = opt.accelerations = derivatives;
+  opt.residuals = true;
+  ChainRun r;
+  Workspace ws(m);
+  const Index th = m.coordinate_index("theta");
+  const double w = M_PI / 2;
+  const SolveStatus st = run_sweep(m, opt, ws, [&](const StepView& s) {
+    const double theta = M_PI / 4 + w * s.t, c = std::cos(theta), sn = std::sin(theta);
+    r.finite = r.finite && s.q.allFinite() && s.phi && s.phi->allFinite() && (!s.qd || s.qd->allFinite()) &&
+               (!s.qdd || s.qdd->allFinite());
+    r.residual.push_back(s.phi ? scaled_residual(m, *s.phi) : INFINITY);
+    double d = std::fabs(s.q(th) - theta);
+    for (Index i = 0; i <= kChainN; ++i)
+      d = std::max({d, std::fabs(s.q(2 * i) - (static_cast<double>(i) + c)), std::fabs(s.q(2 * i + 1) - sn)});
+    r.deviation.push_back(d);
+    if (s.qd && s.qdd) {
+      const Eigen::VectorXd &v = *s.qd, &a = *s.qdd;
+      r.deviation_v = std::max({r.deviation_v, std::fabs(v(th) - w), std::fabs(a(th))});
+      for (Index i = 0; i <= kChainN; ++i) {
+        r.deviation_v = std::max({r.deviation_v, std::fabs(v(2 * i) + w * sn), std::fabs(v(2 * i + 1) - w * c)});
+        r.deviation_a = std::max({r.deviation_a, std::fabs(a(2 * i) + w * w * c), std::fabs(a(2 * i + 1) + w * w * sn)});
+      }
+    }
+    return true;
+  }, &r.sum);
+  EXPECT_EQ(st, SolveStatus::kSuccess) << r.sum.message;
+  EXPECT_EQ(r.residual.size(), static_cast<std::size_t>(kChainSteps + 1));
+  EXPECT_TRUE(r.finite);
+  return r;
+}
+
+double max_of(const std::vector<double>& v, std::size_t from, std::size_t to) {
+  return *std::max_element(v.begin() + static_cast<std::ptrdiff_t>(from), v.begin() + static_cast<std::ptrdiff_t>(to));
+}
+
+// Common to both runs (step 0 is the assembly from the exact placement; the drive steps are 1 … 1000):
+//  - every row of every step within the tolerance plus its rounding floor (64 ulps of the coordinates it reads:
+//    1.4e-10 m for the far cranks at x ≈ 10^4, ToleranceScales);
+//  - no growth trend: the largest residual of the last 100 steps ≤ 10× that of the first 100;
+//  - every coordinate within 1e-9 of the parallelogram at every step: 10× the Newton tolerance (each coordinate's
+//    estimated error is within 1e-10 × its 1 m links; the exact value itself is rounded at 10^4: 1.8e-12).
+void expect_no_drift(const ChainRun& r, const char* what) {
+  if (r.residual.size() != static_cast<std::size_t>(kChainSteps + 1)) return;
+  const double floor = kTol + ToleranceScales::kUlpFloor * static_cast<double>(kChainN + 1);
+  EXPECT_LE(max_of(r.residual, 0, r.residual.size()), floor) << what;
+  const double first100 = max_of(r.residual, 1, 101), last100 = max_of(r.residual, kChainSteps - 99, kChainSteps + 1);
+  EXPECT_LE(last100, 10.0 * first100) << what << ": first 100 steps " << first100 << ", last 100 " << last100;
+  for (std::size_t k = 0; k < r.deviation.size(); ++k) EXPECT_LE(r.deviation[k], 1e-9) << what << " step " << k;
+  std::printf("%s: residual step 1 %.3g, step %ld %.3g, max of steps 1-100 %.3g, of the last 100 %.3g; deviation "
+              "max %.3g, velocities %.3g, accelerations %.3g; %ld Newton iterations, %ld factorisations, %.2f s\n",
+              what, r.residual[1], static_cast<long>(kChainSteps), r.residual[kChainSteps], first100, last100,
+              max_of(r.deviation, 0, r.deviation.size()), r.deviation_v, r.deviation_a,
+              static_cast<long>(r.sum.counters.newton_iterations), static_cast<long>(r.sum.counters.factorizations),
+              r.sum.solve_seconds);
+}
+
+// Positions, velocities and accelerations (the quadratic predictor; Φq factorised at every solution): the Newton
+// solves end at the rounding level, so the residual of a step is the rounding of its far coordinates (about
+// 1e-12 m, proportional to |cos θ| ulp(10^4)), and the last step's must not exceed 10× the first's. Velocities and
+// accelerations: the linear solves along the chain, within 1e-9 of the exact θ̇ = π/2 rad/s motion (measured
+// about 1e-12).
+TEST(HardCases, LongChainDoesNotDrift) {
+  const ChainRun r = long_chain(true);
+  expect_no_drift(r, "nfourbar 10^4, q v a");
+  if (r.residual.size() != static_cast<std::size_t>(kChainSteps + 1)) return;
+  EXPECT_LE(r.residual[kChainSteps], 10.0 * r.residual[1]);
+  EXPECT_LE(r.deviation_v, 1e-9);
+  EXPECT_LE(r.deviation_a, 1e-9);
+}
+
+// Positions only (what the scene asks for when it lists no derivatives; bench_long_chain.cpp at N = 10^5): the
+// secant predictor and modified Newton, which stops as soon as the estimated error is within the tolerance, so a
+// step's residual lies anywhere between rounding and the tolerance (one step against another says nothing); the
+// windows of 100 steps and the deviation at every step do.
+TEST(HardCases, LongChainPositionsOnlyDoNotDrift) {
+  const ChainRun r = long_chain(false);
+  expect_no_drift(r, "nfourbar 10^4, q only");
+}
+
+}  // namespace
