@@ -65,7 +65,9 @@ void full_turn_in_whole_degrees(Index n, int threads, double th0 = 0.0) {
     EXPECT_NEAR(bif[j].t, at[j], 1e-15);
     EXPECT_HAS(bif[j].message, "the velocity is not unique");
   }
-  if (th0 == 0.0) EXPECT_HAS(bif[0].message, "the sweep starts at a bifurcation");
+  if (th0 == 0.0) {
+    EXPECT_HAS(bif[0].message, "the sweep starts at a bifurcation");
+  }
   EXPECT_HAS(bif[1].message, "kept the branch it was on");
 }
 

@@ -404,7 +404,7 @@ LexedText lex_expression(const std::string& text) {
       const char after = next_non_space(i);
       if (v == 0.0) {
         out.text += "0";
-      } else if (v == std::round(v) && v <= 1024 && after != '^' && after != '.' && is_exponent(start)) {
+      } else if (v == std::round(v) && v <= 1024 && after != '^' && is_exponent(start)) {
         out.text += std::to_string(static_cast<long>(v));
       } else {
         out.text += kLiteralPrefix + std::to_string(out.literals.size());

@@ -42,10 +42,10 @@ std::string umfpack_status_text(int status) {
   }
 }
 
-// Parity of a permutation of 0 … n−1 (+1 even, −1 odd), by its cycles; `seen` is scratch of n entries.
+// Parity of a permutation of 0 … n−1 (+1 even, −1 odd), by its cycles. Once per pivot order, not per solve.
 template <typename Int>
-int permutation_sign(const Int* p, Index n, std::vector<char>& seen) {
-  seen.assign(static_cast<std::size_t>(n), 0);
+int permutation_sign(const Int* p, Index n) {
+  std::vector<char> seen(static_cast<std::size_t>(n), 0);
   int sign = 1;
   for (Index i = 0; i < n; ++i) {
     if (seen[static_cast<std::size_t>(i)]) continue;
@@ -241,7 +241,7 @@ class KluNumeric final : public SparseLuNumeric {
   double rcond_ = 0.0, rcond_at_pivoting_ = 0.0;
   std::int64_t pivoting_ = 0;
   std::string message_;
-  mutable std::vector<char> seen_;  // scratch of determinant_sign()
+  int p_sign_ = 1;  // parity of the row permutation Pnum of the last pivoting factorisation
 };
 
 class KluSymbolic final : public SparseLuSymbolic, public std::enable_shared_from_this<KluSymbolic> {
@@ -253,8 +253,7 @@ class KluSymbolic final : public SparseLuSymbolic, public std::enable_shared_fro
     symbolic_ = klu_l_analyze(pattern_->cols, const_cast<SuiteSparse_long*>(pattern_->col_ptr.data()),
                               const_cast<SuiteSparse_long*>(pattern_->row_idx.data()), &common);
     if (!symbolic_) throw Error("KLU symbolic analysis failed (status " + std::to_string(common.status) + ")");
-    std::vector<char> seen;
-    q_sign_ = permutation_sign(symbolic_->Q, pattern_->cols, seen);
+    q_sign_ = permutation_sign(symbolic_->Q, pattern_->cols);
   }
   ~KluSymbolic() override {
     klu_l_common common;
@@ -272,11 +271,11 @@ class KluSymbolic final : public SparseLuSymbolic, public std::enable_shared_fro
 };
 
 // P R⁻¹ A Q = L U with L unit lower triangular and R > 0 (KLU's row scaling): sign det A = sign P · sign Q ·
-// Π sign U_ii. The final row permutation Pnum changes with each pivoting factorisation.
+// Π sign U_ii. The final row permutation Pnum changes only with a pivoting factorisation (p_sign_).
 int KluNumeric::determinant_sign() const {
   if (!numeric_ || rcond_ == 0.0) return 0;
   const Index n = sym_.pattern_->cols;
-  int sign = sym_.q_sign_ * permutation_sign(numeric_->Pnum, n, seen_);
+  int sign = sym_.q_sign_ * p_sign_;
   const double* u = static_cast<const double*>(numeric_->Udiag);
   for (Index i = 0; i < n; ++i) {
     if (u[i] == 0.0) return 0;
@@ -311,6 +310,8 @@ FactorStatus KluNumeric::factor_with_pivoting(const double* values) {
   }
   klu_l_rcond(sym_.symbolic_, numeric_, &common_);
   rcond_ = rcond_at_pivoting_ = common_.rcond;
+  // the row permutation is fixed until the next pivot search: its parity once here, not per determinant_sign()
+  p_sign_ = permutation_sign(numeric_->Pnum, sym_.pattern_->cols);
   message_.clear();
   return FactorStatus::kOk;
 }

@@ -323,8 +323,9 @@ Index ModelBuilder::add_unit_vector(const std::string& name, const Point3& v) {
 }
 
 // ToleranceScales (model.hpp): each length row relative to its own link, each length coordinate to the shortest
-// link reading it; the rows' rounding-floor coordinates. `pattern` is the full Jacobian's.
-void ModelBuilder::tolerance_scales(const CscPattern& pattern) {
+// link reading it; the rows' rounding-floor coordinates. `pattern` is the full Jacobian's, `own` each row's own
+// length (ConstraintBlock::row_lengths()).
+void ModelBuilder::tolerance_scales(const CscPattern& pattern, const std::vector<double>& own) {
   Model& m = model_;
   ToleranceScales& sc = m.scales_;
   const Index n = m.num_coordinates(), rows = m.num_equations();
@@ -338,23 +339,15 @@ void ModelBuilder::tolerance_scales(const CscPattern& pattern) {
   sc.coordinate_is_length.resize(n);
   for (Index j = 0; j < n; ++j) sc.coordinate_is_length(j) = length_coordinate(j) ? 1.0 : 0.0;
 
-  // The pattern by rows (the columns of row i: cols[begin[i] … begin[i + 1] − 1]).
-  std::vector<Index> begin(static_cast<std::size_t>(rows) + 1, 0), cols(pattern.row_idx.size());
-  for (Index r : pattern.row_idx) ++begin[static_cast<std::size_t>(r) + 1];
-  for (Index i = 0; i < rows; ++i) begin[static_cast<std::size_t>(i) + 1] += begin[static_cast<std::size_t>(i)];
-  {
-    std::vector<Index> next(begin.begin(), begin.end() - 1);
-    for (Index j = 0; j < n; ++j)
-      for (Index k = pattern.col_ptr[j]; k < pattern.col_ptr[j + 1]; ++k)
-        cols[static_cast<std::size_t>(next[static_cast<std::size_t>(pattern.row_idx[k])]++)] = j;
-  }
+  // The pattern by rows, as Φqᵀ's: the columns of row i are cols[begin[i] … begin[i + 1] − 1].
+  const CscPattern by_rows = transpose_pattern(pattern, nullptr);
+  const std::vector<Index>& begin = by_rows.col_ptr;
+  const std::vector<Index>& cols = by_rows.row_idx;
 
   if (length_scale_override_ > 0.0) {  // one scale for every length, as set
     sc.row_scale = 1.0 + (fallback - 1.0) * sc.row_is_length.array();
     sc.coordinate_scale = 1.0 + (fallback - 1.0) * sc.coordinate_is_length.array();
   } else {
-    std::vector<double> own(static_cast<std::size_t>(rows), 0.0);
-    for (auto& b : m.blocks_) b->row_lengths(own);
     constexpr double kUnset = std::numeric_limits<double>::infinity();
     sc.row_scale = Eigen::VectorXd::Ones(rows);
     sc.coordinate_scale = Eigen::VectorXd::Ones(n);
@@ -429,9 +422,13 @@ Model ModelBuilder::build() && {
   m.row_units_.assign(static_cast<std::size_t>(rows), Unit::kNone);
   for (auto& b : m.blocks_) b->row_units(m.coordinate_units_, m.row_units_);
 
+  // Each row's own length (0 if its constraint carries none): the rows' tolerance scales, and their largest the
+  // model's length scale.
+  std::vector<double> own(static_cast<std::size_t>(rows), 0.0);
+  for (auto& b : m.blocks_) b->row_lengths(own);
   double scale = length_scale_override_;
   if (scale <= 0.0)
-    for (auto& b : m.blocks_) scale = std::max(scale, b->characteristic_length());
+    for (double l : own) scale = std::max(scale, l);
   if (scale <= 0.0) {
     // no length in the data: the extent of the initial placement of the length coordinates
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
@@ -440,7 +437,7 @@ Model ModelBuilder::build() && {
     scale = hi > lo ? hi - lo : 1.0;
   }
   m.length_scale_ = scale;
-  tolerance_scales(*pattern);
+  tolerance_scales(*pattern, own);
 
   for (auto& b : m.blocks_) {
     bool td = false;

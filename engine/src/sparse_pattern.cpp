@@ -51,13 +51,13 @@ CscPattern transpose_pattern(const CscPattern& a, std::vector<Index>* source_ent
   for (Index r : a.row_idx) ++t.col_ptr[static_cast<std::size_t>(r) + 1];
   for (Index i = 0; i < a.rows; ++i) t.col_ptr[static_cast<std::size_t>(i) + 1] += t.col_ptr[static_cast<std::size_t>(i)];
   t.row_idx.assign(static_cast<std::size_t>(a.nnz()), 0);
-  source_entry->assign(static_cast<std::size_t>(a.nnz()), 0);
+  if (source_entry) source_entry->assign(static_cast<std::size_t>(a.nnz()), 0);
   std::vector<Index> next(t.col_ptr.begin(), t.col_ptr.end() - 1);
   for (Index j = 0; j < a.cols; ++j)
     for (Index k = a.col_ptr[static_cast<std::size_t>(j)]; k < a.col_ptr[static_cast<std::size_t>(j) + 1]; ++k) {
       const Index d = next[static_cast<std::size_t>(a.row_idx[static_cast<std::size_t>(k)])]++;
       t.row_idx[static_cast<std::size_t>(d)] = j;
-      (*source_entry)[static_cast<std::size_t>(d)] = k;
+      if (source_entry) (*source_entry)[static_cast<std::size_t>(d)] = k;
     }
   return t;
 }

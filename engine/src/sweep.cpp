@@ -1,12 +1,10 @@
 #include "phiq/sweep.hpp"
 
-#include "phiq/assembly.hpp"
-
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
-#include <iomanip>
 #include <cstring>
+#include <iomanip>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -16,6 +14,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
+
+#include "phiq/assembly.hpp"
 
 namespace phiq {
 
@@ -132,8 +132,11 @@ class Sweeper {
     return st;
   }
 
-  void note_condition(double t, double rc) {
+  void note_min_rcond(double t, double rc) {
     if (sum_.min_rcond == 0.0 || rc < sum_.min_rcond) sum_.min_rcond = rc, sum_.min_rcond_time = t;
+  }
+  void note_condition(double t, double rc) {
+    note_min_rcond(t, rc);
     const bool ill = rc < kIllConditionedRcond;
     if (ill && !ill_conditioned_) {
       std::ostringstream m;
@@ -254,7 +257,7 @@ class Sweeper {
       << (has_current_ ? ", and the sweep kept the branch it was on"
                        : "; the branch followed is the one nearest the placement");
     sum_.warnings.push_back({t, "bifurcation", m.str()});
-    if (sum_.min_rcond == 0.0 || rc < sum_.min_rcond) sum_.min_rcond = rc, sum_.min_rcond_time = t;
+    note_min_rcond(t, rc);
     ill_conditioned_ = false;
     return true;
   }
@@ -275,7 +278,7 @@ class Sweeper {
     const Index m = model_.num_solve_rows();
     Eigen::VectorXd y = Eigen::VectorXd::Ones(m), z(m);
     for (int it = 0; it < 4; ++it) {
-      if (!ws_.lu->solve_transposed(y.data(), z.data()) || !all_finite_vec(z)) return "";
+      if (!ws_.lu->solve_transposed(y.data(), z.data()) || !z.allFinite()) return "";
       y = z / z.cwiseAbs().maxCoeff();
     }
     std::vector<std::string> names;
@@ -294,7 +297,6 @@ class Sweeper {
     if (names.size() > 8) s << " and " << names.size() - 8 << " more";
     return s.str();
   }
-  static bool all_finite_vec(const Eigen::VectorXd& v) { return v.allFinite(); }
 
   // Initial position problem from the rough placement in ws.q.
   bool assemble(double t) {
@@ -356,7 +358,7 @@ class Sweeper {
       m.precision(3);
       m << "singular position (Φq rcond " << ps.rcond << "): a bifurcation, velocities would not be unique here";
       if (!has_current_) m << " (the sweep starts here: the branch is the one nearest the placement)";
-    sum_.warnings.push_back({t, "bifurcation", m.str()});
+      sum_.warnings.push_back({t, "bifurcation", m.str()});
     }
     if (!derivatives(t)) return false;
     remember(t);
@@ -365,17 +367,18 @@ class Sweeper {
   // Whether the converged ws.q is farther from the prediction than the prediction is from the last state (in
   // tolerance units, beyond a floor of 1000 tolerances): a predictor from q̇ or a secant errs by O(h²) of an O(h)
   // move, so a correction as large as the move means another solution was found.
-  bool jumped() const {
+  // Runs every drive step: the differences go to a buffer sized once, and the move is only measured when the
+  // correction is large at all.
+  bool jumped() {
     if (predictor_ == Predictor::kPrevious || (predictor_ == Predictor::kSecant && !has_prev_)) return false;
-    const double move = scaled_step(model_, predicted_ - current_.q, current_.q, opt_.newton.tolerance);
-    const double correction = scaled_step(model_, ws_.q - predicted_, ws_.q, opt_.newton.tolerance);
-    return correction > 1000.0 && correction > 0.5 * move;
+    difference_ = ws_.q - predicted_;
+    const double correction = scaled_step(model_, difference_, ws_.q, opt_.newton.tolerance);
+    if (!(correction > 1000.0)) return false;
+    difference_ = predicted_ - current_.q;
+    return correction > 0.5 * scaled_step(model_, difference_, current_.q, opt_.newton.tolerance);
   }
+  // ws.q = the predictor's guess at t1 from the current state; kept in predicted_ for jumped().
   void predict(double t1) {
-    predict_into(t1);
-    predicted_ = ws_.q;
-  }
-  void predict_into(double t1) {
     const double h = t1 - current_.t;
     switch (predictor_) {
       case Predictor::kQuadratic: ws_.q = current_.q + h * current_.qd + (0.5 * h * h) * current_.qdd; break;
@@ -388,6 +391,7 @@ class Sweeper {
         break;
       default: ws_.q = current_.q; break;
     }
+    predicted_ = ws_.q;
   }
   void remember(double t) {
     // Only a state that was really converged becomes the secant's previous point (the default-constructed one
@@ -419,6 +423,7 @@ class Sweeper {
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
   double rcond_ = 0.0;
   Eigen::VectorXd predicted_;       // the last prediction (for jumped())
+  Eigen::VectorXd difference_;      // jumped()'s buffer
   bool bracketing_ = false;         // inside singular_point(): no nested bracketing
   bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
   int det_sign_ = 0;                // sign of det Φq at the last row (0: singular)
@@ -457,12 +462,14 @@ struct Run {
   double time_of(Index k) const {
     return k == opt.steps ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
   }
-  // Delivers row k; false when the caller stops the sweep (status and message set).
   // Sign of det Φq at the last delivered regular row, and whether a singular row (bracketed, with its own
   // warning) was delivered since.
   int last_sign = 0;
   bool singular_since = false;
 
+  // Delivers row k; false when the caller stops the sweep (status and message set). A change of det Φq's sign
+  // since the last regular row is a singular position passed between the two: warned here, in row order, so that
+  // sequential and parallel sweeps report it alike.
   bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
                const PointMotion* points, const Eigen::VectorXd& phi, double rcond, int det_sign) {
     if (det_sign == 0) {

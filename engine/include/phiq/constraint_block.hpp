@@ -69,13 +69,10 @@ class ConstraintBlock {
   /// by global row), given the units of the coordinates (DistanceSpec::row_unit()). Used once, while the model is
   /// built.
   virtual void row_units(const std::vector<Unit>& coordinate_units, std::vector<Unit>& units) const = 0;
-  /// The largest length the constraints carry as data (link lengths, attachment arms), 0 if none
-  /// (DistanceSpec::characteristic_length()). Used once, while the model is built, for the model's length scale
-  /// (Model::length_scale()).
-  virtual double characteristic_length() const = 0;
-  /// Writes each constraint's own characteristic length (DistanceSpec::characteristic_length(), 0 if it carries
-  /// none) into every row it owns: `lengths` has one entry per row of the model, indexed by global row. Used once,
-  /// while the model is built, for the rows' tolerance scales (ToleranceScales).
+  /// Writes each constraint's own characteristic length (DistanceSpec::characteristic_length(): link lengths,
+  /// attachment arms; 0 if it carries none) into every row it owns: `lengths` has one entry per row of the model,
+  /// indexed by global row. Used once, while the model is built, for the rows' tolerance scales (ToleranceScales)
+  /// and, their largest, the model's length scale (Model::length_scale()).
   virtual void row_lengths(std::vector<double>& lengths) const = 0;
 };
 
@@ -179,11 +176,6 @@ class TypedBlock final : public ConstraintBlock {
     for (const Entry& e : entries_)
       for (int r = 0; r < Spec::kRows; ++r)
         units[static_cast<std::size_t>(e.row0 + r)] = e.spec.row_unit(r, coordinate_units);
-  }
-  double characteristic_length() const override {
-    double l = 0.0;
-    for (const Entry& e : entries_) l = std::max(l, e.spec.characteristic_length());
-    return l;
   }
   void row_lengths(std::vector<double>& lengths) const override {
     for (const Entry& e : entries_)

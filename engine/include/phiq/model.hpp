@@ -418,7 +418,7 @@ class ModelBuilder {
   void prepare(EquationSpec& s) const;
   void prepare(PinSpec& s) const;
   void prepare(LoopSpec& s) const;
-  void tolerance_scales(const CscPattern& pattern);  // model_.scales_ (ToleranceScales), once in build()
+  void tolerance_scales(const CscPattern& pattern, const std::vector<double>& own);  // model_.scales_, in build()
   /// @endcond
 
   Model model_;

@@ -27,7 +27,8 @@ CscPattern build_csc_pattern(Index rows, Index cols, const std::vector<Index>& t
                              const std::vector<Index>& trip_cols, std::vector<Index>* slot_of_triplet);
 
 /// The pattern of Aᵀ (A.cols × A.rows) and, in source_entry[k], the position in A's value array of Aᵀ's entry k, so
-/// that Aᵀ's values are a gather of A's: tv[k] = av[source_entry[k]]. O(nnz + rows + cols). Thread-safe.
+/// that Aᵀ's values are a gather of A's: tv[k] = av[source_entry[k]] (null when only the pattern is wanted, e.g. A by
+/// rows). O(nnz + rows + cols). Thread-safe.
 CscPattern transpose_pattern(const CscPattern& a, std::vector<Index>* source_entry);
 
 }  // namespace phiq
