@@ -130,23 +130,11 @@ void expect_phiq_matches(const Scene& scene, const std::string& spec,
   ASSERT_EQ(test::sweep(m, o, &tr, &sum, &ws), SolveStatus::kSuccess) << scene.name << ": " << sum.message;
   ASSERT_EQ(tr.qd.size(), tr.t.size());
   ASSERT_EQ(tr.qdd.size(), tr.t.size());
-  const std::size_t n = static_cast<std::size_t>(m.num_coordinates());
-  const Eigen::VectorXd& scale = m.tolerance_scales().coordinate_scale;
-  double eq = 0, ev = 0, ea = 0;
-  for (std::size_t k = 0; k < tr.t.size(); ++k) {
-    const State s = eval(*f, n, tr.t[k]);
-    for (std::size_t j = 0; j < n; ++j) {
-      const auto jj = static_cast<Index>(j);
-      double d = tr.q[k](jj) - s.q[j];
-      if (f->is_angle(j)) d = test::angle_diff(d, 0.0);
-      eq = std::max(eq, std::fabs(d) / scale(jj));
-      ev = std::max(ev, std::fabs(tr.qd[k](jj) - s.v[j]) / scale(jj));
-      ea = std::max(ea, std::fabs(tr.qdd[k](jj) - s.a[j]) / scale(jj));
-    }
-  }
-  EXPECT_LT(eq, 1e-11) << scene.name;
-  EXPECT_LT(ev, 1e-10) << scene.name;
-  EXPECT_LT(ea, 1e-10) << scene.name;
+  tools::ClosedFormErrors err(*f, m.tolerance_scales().coordinate_scale.data());
+  for (std::size_t k = 0; k < tr.t.size(); ++k) err.add(tr.t[k], tr.q[k].data(), tr.qd[k].data(), tr.qdd[k].data());
+  EXPECT_LT(err.q_error, 1e-11) << scene.name;
+  EXPECT_LT(err.v_error, 1e-10) << scene.name;
+  EXPECT_LT(err.a_error, 1e-10) << scene.name;
 }
 
 TEST(ClosedForms, PhiqAtTightToleranceMatchesThemOnEverySeedScene) {

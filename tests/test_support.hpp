@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 
 #include "phiq/phiq.hpp"
 #include "../bench/nfourbar_model.hpp"
+#include "closed_forms.hpp"
 
 namespace phiq::test {
 
@@ -124,6 +126,16 @@ inline Model crank_slider_model(double omega = 1.0, double theta0 = 0.0,
 // is exact for all t: the benchmarks' very model (bench/nfourbar_model.hpp).
 inline Model nfourbar_model(Index n, double theta0, double rate, LinearSolverKind lu = LinearSolverKind::kKlu) {
   return phiq_bench::nfourbar(n, theta0, rate, lu);
+}
+
+// Its exact motion (the parallelogram, tools/closed_forms.hpp) bound to the model's coordinates, for t in [0, 1]
+// (θ = theta0 + rate·t).
+inline std::unique_ptr<tools::ClosedForm> nfourbar_exact(const Model& m, double theta0, double rate) {
+  char spec[96];
+  std::snprintf(spec, sizeof spec, "nfourbar:from=%.17g,to=%.17g", theta0, theta0 + rate);
+  auto f = tools::make_closed_form(spec);
+  f->bind(m.coordinate_names());
+  return f;
 }
 
 // Largest difference between the rows of two traces in positions (order 0), velocities (1) or accelerations (2);

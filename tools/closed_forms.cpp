@@ -1,5 +1,6 @@
 #include "closed_forms.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
@@ -240,6 +241,24 @@ void ClosedForm::evaluate(double t, double* q, double* v, double* a) const {
     }
     q[j] = m.q, v[j] = m.v, a[j] = m.a;
   }
+}
+
+ClosedFormErrors::ClosedFormErrors(const ClosedForm& f, const double* scale)
+    : f_(f), scale_(scale), rq_(f.size()), rv_(f.size()), ra_(f.size()) {}
+
+double ClosedFormErrors::add(double t, const double* q, const double* qd, const double* qdd) {
+  f_.evaluate(t, rq_.data(), rv_.data(), ra_.data());
+  double row = 0.0;
+  for (std::size_t j = 0; j < rq_.size(); ++j) {
+    const double s = scale_ ? scale_[j] : 1.0;
+    double d = q[j] - rq_[j];
+    if (f_.is_angle(j)) d = std::remainder(d, 2.0 * kPi);
+    row = std::max(row, std::fabs(d) / s);
+    if (qd) v_error = std::max(v_error, std::fabs(qd[j] - rv_[j]) / s);
+    if (qdd) a_error = std::max(a_error, std::fabs(qdd[j] - ra_[j]) / s);
+  }
+  q_error = std::max(q_error, row);
+  return row;
 }
 
 std::unique_ptr<ClosedForm> make_closed_form(const std::string& spec) {

@@ -27,6 +27,8 @@ class ClosedForm {
   // Binds the coordinates of a model, in order; afterwards evaluate() fills one entry per bound name. Throws
   // std::invalid_argument naming the first coordinate this mechanism does not have.
   void bind(const std::vector<std::string>& coordinates);
+  // How many coordinates are bound.
+  std::size_t size() const { return bound_.size(); }
   // Whether bound coordinate j is an angle (compare it modulo 2π).
   bool is_angle(std::size_t j) const { return bound_[j].angle; }
   // Positions, velocities and accelerations of the bound coordinates at time t.
@@ -53,6 +55,23 @@ class ClosedForm {
  private:
   std::vector<Binding> bound_;
   mutable std::vector<Motion> angles_;
+};
+
+// The worst differences between the rows of a computed motion and a closed form bound to its coordinates:
+// positions (angles modulo 2π), velocities and accelerations, over all rows added, each divided by a coordinate
+// scale when one is given (e.g. the model's tolerance scales).
+class ClosedFormErrors {
+ public:
+  // `scale`, if not null, has f.size() entries and outlives this object.
+  explicit ClosedFormErrors(const ClosedForm& f, const double* scale = nullptr);
+  // Adds the row at time t (qd, qdd null when not computed; each has f.size() entries); returns its position error.
+  double add(double t, const double* q, const double* qd, const double* qdd);
+  double q_error = 0.0, v_error = 0.0, a_error = 0.0;  // worst so far
+
+ private:
+  const ClosedForm& f_;
+  const double* scale_;
+  std::vector<double> rq_, rv_, ra_;  // the closed form at t
 };
 
 // Parses "KIND[:NAME=VALUE,...]" (KIND crank-slider, fourbar or nfourbar; parameters in describe() order, defaults
