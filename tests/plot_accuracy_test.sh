@@ -6,14 +6,8 @@
 # Usage: plot_accuracy_test.sh SCRIPT FIXTURE SCRATCH_DIR. Exit 77 (skipped) without python3 or matplotlib.
 set -u
 script=$1 fixture=$2 dir=$3
-fail() { echo "plot_accuracy_test: FAIL: $*" >&2; exit 1; }
-
-py=""
-for cand in ${PYTHON:-} python3 /usr/bin/python3; do
-  if command -v "$cand" >/dev/null 2>&1 && "$cand" -c 'import matplotlib' 2>/dev/null; then py=$cand; break; fi
-done
-[ -n "$py" ] ||
-  { echo "plot_accuracy_test: SKIP: no python3 with matplotlib (Debian: python3-matplotlib, tools/install_deps.sh)"; exit 77; }
+name=plot_accuracy_test
+. "$(dirname "$0")/plot_test_common.sh"
 
 mkdir -p "$dir" && rm -f "$dir"/*.svg "$dir"/*.png "$dir"/*.md "$dir"/*.txt "$dir"/*.csv
 "$py" "$script" "$fixture" -o "$dir/fixture.svg" --png "$dir/fixture.png" --markdown "$dir/front.md" 2>"$dir/log.txt" ||
@@ -46,14 +40,6 @@ grep -q '^| fixture_slider | previous | full | UMFPACK | 5.0e-11 | 4.0e-12 | 6.0
 cmp -s "$dir/fixture.svg" "$dir/again.svg" || fail "the SVG differs between two runs on the same input"
 
 # errors: one line on stderr, exit status 1, no SVG
-expect_error() {  # expect_error WHAT ARGS...
-  what=$1; shift
-  "$py" "$script" "$@" -o "$dir/error.svg" 2>"$dir/err.txt"; st=$?
-  [ "$st" -eq 1 ] || fail "$what: exit status $st, expected 1"
-  [ "$(wc -l <"$dir/err.txt")" -eq 1 ] || fail "$what: stderr is not one line: $(cat "$dir/err.txt")"
-  [ -e "$dir/error.svg" ] && fail "$what: an SVG was written"
-  return 0
-}
 expect_error "missing file" "$dir/no_such.csv"
 printf 't,x\n0,1\n' >"$dir/other.csv"
 expect_error "not a sweep-accuracy CSV" "$dir/other.csv"

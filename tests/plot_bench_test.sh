@@ -3,16 +3,8 @@
 # Usage: plot_bench_test.sh SCRIPT FIXTURE SCRATCH_DIR. Exit 77 (skipped) without python3 or matplotlib.
 set -u
 script=$1 fixture=$2 dir=$3
-fail() { echo "plot_bench_test: FAIL: $*" >&2; exit 1; }
-
-# The first Python 3 that has matplotlib: $PYTHON, python3 on PATH (may be a pyenv or venv one without it), then
-# Debian's /usr/bin/python3 (python3-matplotlib installs there).
-py=""
-for cand in ${PYTHON:-} python3 /usr/bin/python3; do
-  if command -v "$cand" >/dev/null 2>&1 && "$cand" -c 'import matplotlib' 2>/dev/null; then py=$cand; break; fi
-done
-[ -n "$py" ] ||
-  { echo "plot_bench_test: SKIP: no python3 with matplotlib (Debian: python3-matplotlib, tools/install_deps.sh)"; exit 77; }
+name=plot_bench_test
+. "$(dirname "$0")/plot_test_common.sh"
 
 mkdir -p "$dir" && rm -f "$dir"/*.svg "$dir"/*.png "$dir"/err.txt
 fixture_rt=$(dirname "$fixture")/bench_fixture_real_time.json  # no per-step counter: real_time per step
@@ -32,14 +24,6 @@ done
 cmp -s "$dir/fixture.svg" "$dir/again.svg" || fail "the SVG differs between two runs on the same input"
 
 # errors: one line on stderr, exit status 1
-expect_error() {  # expect_error WHAT ARGS...
-  what=$1; shift
-  "$py" "$script" "$@" -o "$dir/error.svg" 2>"$dir/err.txt"; st=$?
-  [ "$st" -eq 1 ] || fail "$what: exit status $st, expected 1"
-  [ "$(wc -l <"$dir/err.txt")" -eq 1 ] || fail "$what: stderr is not one line: $(cat "$dir/err.txt")"
-  [ -e "$dir/error.svg" ] && fail "$what: an SVG was written"
-  return 0
-}
 expect_error "missing file" "$dir/no_such.json"
 printf '{"benchmarks": [' >"$dir/truncated.json"
 expect_error "invalid JSON" "$dir/truncated.json"

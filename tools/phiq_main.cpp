@@ -34,6 +34,16 @@ int fail(const std::string& msg, int code) {
   return code;
 }
 
+// The scene at `path`; on a scene error its one line is printed and the result is empty (the command exits 2).
+std::optional<phiq::Scene> load_or_report(const std::string& path) {
+  try {
+    return phiq::load_scene(path);
+  } catch (const phiq::SceneError& e) {
+    fail(e.what(), 2);
+    return std::nullopt;
+  }
+}
+
 std::string sci(double v) {
   std::ostringstream s;
   s.precision(3);
@@ -97,13 +107,10 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
 
 int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
             int threads, phiq::tools::ProgressBar::Mode progress_mode) {
-  phiq::Scene scene;
   const auto load_start = Clock::now();
-  try {
-    scene = phiq::load_scene(scene_path);
-  } catch (const phiq::SceneError& e) {
-    return fail(e.what(), 2);
-  }
+  std::optional<phiq::Scene> loaded = load_or_report(scene_path);
+  if (!loaded) return 2;
+  phiq::Scene& scene = *loaded;
   const double load_s = since(load_start);
   // A model that is not square (redundant constraints) is assembled by minimum norm and solved on its independent
   // rows; inconsistent or under-driven models stop here, naming the constraints.
@@ -307,12 +314,9 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
 }
 
 int cmd_check(const std::string& scene_path, bool json, std::optional<double> at) {
-  phiq::Scene scene;
-  try {
-    scene = phiq::load_scene(scene_path);
-  } catch (const phiq::SceneError& e) {
-    return fail(e.what(), 2);
-  }
+  std::optional<phiq::Scene> loaded = load_or_report(scene_path);
+  if (!loaded) return 2;
+  const phiq::Scene& scene = *loaded;
   const phiq::Model& model = *scene.model;
   int drivers = 0;
   for (const auto& c : model.constraints()) drivers += c.depends_on_time ? c.rows : 0;
@@ -406,12 +410,9 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
 // `phiq assemble SCENE [-o OUT.csv]`: the assembled position at time.start as a one-row CSV (the columns of
 // `phiq run`'s positions). Nothing is written when the assembly fails.
 int cmd_assemble(const std::string& scene_path, const std::string& out_path, bool quiet) {
-  phiq::Scene scene;
-  try {
-    scene = phiq::load_scene(scene_path);
-  } catch (const phiq::SceneError& e) {
-    return fail(e.what(), 2);
-  }
+  std::optional<phiq::Scene> loaded = load_or_report(scene_path);
+  if (!loaded) return 2;
+  const phiq::Scene& scene = *loaded;
   const phiq::Model& model = *scene.model;
   Eigen::VectorXd q = model.initial_positions();
   phiq::AssemblySummary as;

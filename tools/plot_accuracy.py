@@ -34,6 +34,8 @@ import csv
 import math
 import sys
 
+from plot_common import PlotError, pyplot
+
 PROG = "plot_accuracy.py"
 COLUMNS = ["scene", "reference", "tolerance", "steps", "predictor", "newton", "linear_solver", "err_q", "err_v",
            "err_a", "iterations_per_step", "factorizations_per_step", "us_per_step", "status", "default"]
@@ -41,10 +43,6 @@ ERRORS = [("err_q", "positions"), ("err_v", "velocities"), ("err_a", "accelerati
 SHAPES = {"previous": "o", "secant": "s", "linear": "^", "quadratic": "D", "auto": "*"}
 ALPHA = {"klu": 0.95, "umfpack": 0.35, "dense": 0.2}
 FLOOR = 1e-17
-
-
-class PlotError(Exception):
-    """A one-line error for the user."""
 
 
 def load(path):
@@ -192,17 +190,9 @@ def main(argv):
             raise PlotError("nothing to plot: no successful row in %s" % ", ".join(args.csv))
         scenes = sorted(scenes.items())
 
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            from matplotlib import pyplot as plt
-            from matplotlib.lines import Line2D
-            from matplotlib.ticker import FuncFormatter
-        except ImportError:
-            raise PlotError("matplotlib is not installed for %s (Debian's python3-matplotlib, from "
-                            "tools/install_deps.sh, is for /usr/bin/python3)" % sys.executable)
-        matplotlib.rcParams["svg.fonttype"] = "none"  # labels stay text: searchable, smaller
-        matplotlib.rcParams["svg.hashsalt"] = "phiq"  # stable ids: the same input writes the same file
+        _, plt = pyplot()
+        from matplotlib.lines import Line2D
+        from matplotlib.ticker import FuncFormatter
 
         tols = sorted({r["tolerance"] for _, rows in scenes for r in rows})
         cmap = plt.get_cmap("viridis")

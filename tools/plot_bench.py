@@ -27,6 +27,8 @@ import os
 import re
 import sys
 
+from plot_common import PlotError, pyplot
+
 PROG = "plot_bench.py"
 
 # Per-step counters a benchmark may report, and their unit in seconds.
@@ -56,10 +58,6 @@ ARG_WORDS = {
     "lu": {"0": "UMFPACK", "1": "KLU"},
     "pred": {"0": "from previous", "1": "quadratic predictor"},
 }
-
-
-class PlotError(Exception):
-    """A one-line error for the user."""
 
 
 def parse_name(name):
@@ -207,15 +205,7 @@ def main(argv):
             raise PlotError("nothing to plot: no benchmark with an N argument and a time%s in %s" %
                             (" matching --filter" if args.filter else "", ", ".join(args.json)))
 
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            from matplotlib import pyplot as plt
-        except ImportError:
-            raise PlotError("matplotlib is not installed for %s (Debian's python3-matplotlib, from "
-                            "tools/install_deps.sh, is for /usr/bin/python3)" % sys.executable)
-        matplotlib.rcParams["svg.fonttype"] = "none"     # labels stay text: searchable, smaller
-        matplotlib.rcParams["svg.hashsalt"] = "phiq"     # stable ids: the same input writes the same file
+        _, plt = pyplot()
 
         fig, ax = plt.subplots(figsize=(10, 5.5))
         markers = "os^vD<>phX*"
