@@ -34,7 +34,7 @@ import csv
 import math
 import sys
 
-from plot_common import PlotError, pyplot
+from plot_common import PlotError, pyplot, run, save
 
 PROG = "plot_accuracy.py"
 COLUMNS = ["scene", "reference", "tolerance", "steps", "predictor", "newton", "linear_solver", "err_q", "err_v",
@@ -179,131 +179,122 @@ def main(argv):
     ap.add_argument("--title", default="phiq: error against time per drive step, per solver setting")
     args = ap.parse_args(argv)
 
-    try:
-        scenes, failed = {}, 0
-        for p in args.csv:
-            rows, f = load(p)
-            failed += f
-            for r in rows:
-                scenes.setdefault(r["scene"], []).append(r)
-        if not scenes:
-            raise PlotError("nothing to plot: no successful row in %s" % ", ".join(args.csv))
-        scenes = sorted(scenes.items())
+    scenes, failed = {}, 0
+    for p in args.csv:
+        rows, f = load(p)
+        failed += f
+        for r in rows:
+            scenes.setdefault(r["scene"], []).append(r)
+    if not scenes:
+        raise PlotError("nothing to plot: no successful row in %s" % ", ".join(args.csv))
+    scenes = sorted(scenes.items())
 
-        _, plt = pyplot()
-        from matplotlib.lines import Line2D
-        from matplotlib.ticker import FuncFormatter
+    _, plt = pyplot()
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import FuncFormatter
 
-        tols = sorted({r["tolerance"] for _, rows in scenes for r in rows})
-        cmap = plt.get_cmap("viridis")
-        lo, hi = math.log10(min(tols)), math.log10(max(tols))
+    tols = sorted({r["tolerance"] for _, rows in scenes for r in rows})
+    cmap = plt.get_cmap("viridis")
+    lo, hi = math.log10(min(tols)), math.log10(max(tols))
 
-        def colour(t):
-            return cmap(0.0 if hi == lo else 0.9 * (math.log10(t) - lo) / (hi - lo))
+    def colour(t):
+        return cmap(0.0 if hi == lo else 0.9 * (math.log10(t) - lo) / (hi - lo))
 
-        fig, axes = plt.subplots(len(scenes), 3, figsize=(15, 4.2 * len(scenes) + 1.2), squeeze=False)
-        messages = []
-        for row_i, (scene, rows) in enumerate(scenes):
-            steps = sorted({r["steps"] for r in rows})
-            for col, (key, what) in enumerate(ERRORS):
-                ax = axes[row_i][col]
-                pts = [r for r in rows if r[key] is not None]
-                if not pts:
-                    ax.text(0.5, 0.5, "%s not computed by this scene" % what, ha="center", va="center",
-                            transform=ax.transAxes, fontsize=9)
-                    ax.set_axis_off()
+    fig, axes = plt.subplots(len(scenes), 3, figsize=(15, 4.2 * len(scenes) + 1.2), squeeze=False)
+    messages = []
+    for row_i, (scene, rows) in enumerate(scenes):
+        steps = sorted({r["steps"] for r in rows})
+        for col, (key, what) in enumerate(ERRORS):
+            ax = axes[row_i][col]
+            pts = [r for r in rows if r[key] is not None]
+            if not pts:
+                ax.text(0.5, 0.5, "%s not computed by this scene" % what, ha="center", va="center",
+                        transform=ax.transAxes, fontsize=9)
+                ax.set_axis_off()
+                continue
+            # one scatter per marker style (predictor, Newton, LU, steps), colours per point; the cloud is
+            # rasterised inside the SVG (a thousand settings as vector markers make a megabyte), the fronts, the
+            # default and all text stay vectors
+            groups = {}
+            for r in pts:
+                groups.setdefault((r["predictor"], r["newton"], r["linear_solver"], r["steps"]), []).append(r)
+            for (pred, newton, lu, st), g in sorted(groups.items()):
+                cs = [colour(r["tolerance"]) for r in g]
+                ax.scatter([r["us_per_step"] for r in g], [max(r[key], FLOOR) for r in g],
+                           s=18 + 30 * steps.index(st), marker=SHAPES.get(pred, "x"),
+                           facecolors=cs if newton == "modified" else "none", edgecolors=cs, linewidths=1.0,
+                           alpha=ALPHA.get(lu, 0.5), zorder=2, rasterized=True)
+            black = main_steps(pts)
+            for st in steps:
+                group = [r for r in pts if r["steps"] == st]
+                if not group:
                     continue
-                # one scatter per marker style (predictor, Newton, LU, steps), colours per point; the cloud is
-                # rasterised inside the SVG (a thousand settings as vector markers make a megabyte), the fronts, the
-                # default and all text stay vectors
-                groups = {}
-                for r in pts:
-                    groups.setdefault((r["predictor"], r["newton"], r["linear_solver"], r["steps"]), []).append(r)
-                for (pred, newton, lu, st), g in sorted(groups.items()):
-                    cs = [colour(r["tolerance"]) for r in g]
-                    ax.scatter([r["us_per_step"] for r in g], [max(r[key], FLOOR) for r in g],
-                               s=18 + 30 * steps.index(st), marker=SHAPES.get(pred, "x"),
-                               facecolors=cs if newton == "modified" else "none", edgecolors=cs, linewidths=1.0,
-                               alpha=ALPHA.get(lu, 0.5), zorder=2, rasterized=True)
-                black = main_steps(pts)
-                for st in steps:
-                    group = [r for r in pts if r["steps"] == st]
-                    if not group:
-                        continue
-                    xy = [(r["us_per_step"], max(r[key], FLOOR)) for r in group]
-                    front = pareto(xy)
-                    fx = [xy[i][0] for i in front]
-                    fy = [xy[i][1] for i in front]
-                    if st == black:
-                        ax.step(fx, fy, where="post", color="black", linewidth=1.3, zorder=3)
-                        ax.scatter(fx, fy, s=90, facecolors="none", edgecolors="black", linewidths=1.2, zorder=4)
-                    else:
-                        ax.step(fx, fy, where="post", color="0.55", linewidth=0.9, linestyle=":", zorder=1)
-                for r in pts:
-                    if r["default"]:
-                        ax.scatter([r["us_per_step"]], [max(r[key], FLOOR)], s=260, facecolors="none",
-                                   edgecolors="red", linewidths=2.0, zorder=5)
-                for same in (True, False):
-                    msg = check_default(scene, pts, key, same)
-                    if msg:
-                        messages.append(msg)
-                ax.set_xscale("log")
-                ax.set_yscale("log")
-                # µs as plain numbers (0.5, 2, 300), labelled at 1, 2 and 5 of each decade
-                ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
-                ax.xaxis.set_minor_formatter(FuncFormatter(
-                    lambda v, _: "%g" % v if round(v / 10 ** math.floor(math.log10(v) + 1e-9)) in (2, 5) else ""))
-                ax.grid(True, which="both", linewidth=0.3, alpha=0.6)
-                ax.set_title("%s: %s" % (scene, what), fontsize=9)
-                ax.set_xlabel("time per drive step (µs, best of the timing rounds)", fontsize=8)
-                ax.set_ylabel("worst error (%s)" % {"err_q": "scaled by the length scale",
-                                                   "err_v": "1/s, scaled", "err_a": "1/s², scaled"}[key], fontsize=8)
-                ax.tick_params(labelsize=7)
+                xy = [(r["us_per_step"], max(r[key], FLOOR)) for r in group]
+                front = pareto(xy)
+                fx = [xy[i][0] for i in front]
+                fy = [xy[i][1] for i in front]
+                if st == black:
+                    ax.step(fx, fy, where="post", color="black", linewidth=1.3, zorder=3)
+                    ax.scatter(fx, fy, s=90, facecolors="none", edgecolors="black", linewidths=1.2, zorder=4)
+                else:
+                    ax.step(fx, fy, where="post", color="0.55", linewidth=0.9, linestyle=":", zorder=1)
+            for r in pts:
+                if r["default"]:
+                    ax.scatter([r["us_per_step"]], [max(r[key], FLOOR)], s=260, facecolors="none",
+                               edgecolors="red", linewidths=2.0, zorder=5)
+            for same in (True, False):
+                msg = check_default(scene, pts, key, same)
+                if msg:
+                    messages.append(msg)
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            # µs as plain numbers (0.5, 2, 300), labelled at 1, 2 and 5 of each decade
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
+            ax.xaxis.set_minor_formatter(FuncFormatter(
+                lambda v, _: "%g" % v if round(v / 10 ** math.floor(math.log10(v) + 1e-9)) in (2, 5) else ""))
+            ax.grid(True, which="both", linewidth=0.3, alpha=0.6)
+            ax.set_title("%s: %s" % (scene, what), fontsize=9)
+            ax.set_xlabel("time per drive step (µs, best of the timing rounds)", fontsize=8)
+            ax.set_ylabel("worst error (%s)" % {"err_q": "scaled by the length scale",
+                                               "err_v": "1/s, scaled", "err_a": "1/s², scaled"}[key], fontsize=8)
+            ax.tick_params(labelsize=7)
 
-        # One legend per knob, built from proxies.
-        grey = "0.3"
-        handles = [Line2D([], [], linestyle="", marker="o", markerfacecolor=colour(t), markeredgecolor=colour(t),
-                          label="tol %s" % fmt(t)) for t in tols]
-        handles += [Line2D([], [], linestyle="", marker=m, color=grey, label=p) for p, m in SHAPES.items()
-                    if any(r["predictor"] == p for _, rows in scenes for r in rows)]
-        handles += [Line2D([], [], linestyle="", marker="o", color=grey, label="modified Newton"),
-                    Line2D([], [], linestyle="", marker="o", markerfacecolor="none", markeredgecolor=grey,
-                           label="full Newton")]
-        handles += [Line2D([], [], linestyle="", marker="o", color=grey, alpha=a, label=lu.upper())
-                    for lu, a in ALPHA.items() if any(r["linear_solver"] == lu for _, rows in scenes for r in rows)]
-        handles += [Line2D([], [], linestyle="", marker="o", markersize=ms, color=grey, label=w)
-                    for ms, w in ((4, "fewer steps"), (9, "more steps"))]
-        handles += [Line2D([], [], color="black", marker="o", markerfacecolor="none",
-                           label="Pareto front (default's steps)"),
-                    Line2D([], [], color="0.55", linestyle=":", label="front, other steps"),
-                    Line2D([], [], linestyle="", marker="o", markersize=12, markerfacecolor="none",
-                           markeredgecolor="red", label="scene default")]
-        fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 11), fontsize=7, frameon=False)
-        fig.suptitle(args.title, fontsize=10)
-        fig.tight_layout(rect=(0, 0.06 if len(scenes) > 1 else 0.1, 1, 0.97))
-        for path, form in [(args.output, "svg")] + ([(args.png, "png")] if args.png else []):
-            try:
-                fig.savefig(path, format=form, metadata={"Date": None} if form == "svg" else None,
-                            dpi=72 if form == "svg" else 110)  # svg: the resolution of the rasterised cloud
-            except OSError as e:
-                raise PlotError("%s: cannot write: %s" % (path, e.strerror or e))
-        if args.markdown:
-            try:
-                with open(args.markdown, "w", encoding="utf-8") as f:
-                    f.write(markdown(scenes))
-            except OSError as e:
-                raise PlotError("%s: cannot write: %s" % (args.markdown, e.strerror or e))
-        for m in messages:
-            print("%s: %s" % (PROG, m), file=sys.stderr)
-        print("%s: %d scenes, %d settings -> %s%s%s" % (
-            PROG, len(scenes), sum(len(rows) for _, rows in scenes), args.output,
-            " and " + args.png if args.png else "", "; %d failed settings left out" % failed if failed else ""),
-            file=sys.stderr)
-        return 0
-    except PlotError as e:
-        print("%s: %s" % (PROG, e), file=sys.stderr)
-        return 1
+    # One legend per knob, built from proxies.
+    grey = "0.3"
+    handles = [Line2D([], [], linestyle="", marker="o", markerfacecolor=colour(t), markeredgecolor=colour(t),
+                      label="tol %s" % fmt(t)) for t in tols]
+    handles += [Line2D([], [], linestyle="", marker=m, color=grey, label=p) for p, m in SHAPES.items()
+                if any(r["predictor"] == p for _, rows in scenes for r in rows)]
+    handles += [Line2D([], [], linestyle="", marker="o", color=grey, label="modified Newton"),
+                Line2D([], [], linestyle="", marker="o", markerfacecolor="none", markeredgecolor=grey,
+                       label="full Newton")]
+    handles += [Line2D([], [], linestyle="", marker="o", color=grey, alpha=a, label=lu.upper())
+                for lu, a in ALPHA.items() if any(r["linear_solver"] == lu for _, rows in scenes for r in rows)]
+    handles += [Line2D([], [], linestyle="", marker="o", markersize=ms, color=grey, label=w)
+                for ms, w in ((4, "fewer steps"), (9, "more steps"))]
+    handles += [Line2D([], [], color="black", marker="o", markerfacecolor="none",
+                       label="Pareto front (default's steps)"),
+                Line2D([], [], color="0.55", linestyle=":", label="front, other steps"),
+                Line2D([], [], linestyle="", marker="o", markersize=12, markerfacecolor="none",
+                       markeredgecolor="red", label="scene default")]
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 11), fontsize=7, frameon=False)
+    fig.suptitle(args.title, fontsize=10)
+    fig.tight_layout(rect=(0, 0.06 if len(scenes) > 1 else 0.1, 1, 0.97))
+    save(fig, args.output, args.png, svg_dpi=72, png_dpi=110)  # svg: the resolution of the rasterised cloud
+    if args.markdown:
+        try:
+            with open(args.markdown, "w", encoding="utf-8") as f:
+                f.write(markdown(scenes))
+        except OSError as e:
+            raise PlotError("%s: cannot write: %s" % (args.markdown, e.strerror or e))
+    for m in messages:
+        print("%s: %s" % (PROG, m), file=sys.stderr)
+    print("%s: %d scenes, %d settings -> %s%s%s" % (
+        PROG, len(scenes), sum(len(rows) for _, rows in scenes), args.output,
+        " and " + args.png if args.png else "", "; %d failed settings left out" % failed if failed else ""),
+        file=sys.stderr)
+    return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(run(main, PROG, sys.argv[1:]))

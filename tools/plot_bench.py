@@ -27,7 +27,7 @@ import os
 import re
 import sys
 
-from plot_common import PlotError, pyplot
+from plot_common import PlotError, pyplot, run, save
 
 PROG = "plot_bench.py"
 
@@ -183,64 +183,56 @@ def main(argv):
     args = ap.parse_args(argv)
 
     try:
+        exclude = re.compile(args.exclude) if args.exclude else None
+    except re.error as e:
+        raise PlotError("--exclude: invalid regular expression: %s" % e)
+    per_file = [(p, load(p, exclude)) for p in args.json]
+    merged = {}
+    for p, (curves, _) in per_file:
+        stem = os.path.splitext(os.path.basename(p))[0]
+        for label, points in curves.items():
+            name = label if len(args.json) == 1 else "%s (%s)" % (label, stem)
+            for n, ts in points.items():
+                merged.setdefault(name, {}).setdefault(n, []).extend(ts)
+    if args.filter:
         try:
-            exclude = re.compile(args.exclude) if args.exclude else None
+            rx = re.compile(args.filter)
         except re.error as e:
-            raise PlotError("--exclude: invalid regular expression: %s" % e)
-        per_file = [(p, load(p, exclude)) for p in args.json]
-        merged = {}
-        for p, (curves, _) in per_file:
-            stem = os.path.splitext(os.path.basename(p))[0]
-            for label, points in curves.items():
-                name = label if len(args.json) == 1 else "%s (%s)" % (label, stem)
-                for n, ts in points.items():
-                    merged.setdefault(name, {}).setdefault(n, []).extend(ts)
-        if args.filter:
-            try:
-                rx = re.compile(args.filter)
-            except re.error as e:
-                raise PlotError("--filter: invalid regular expression: %s" % e)
-            merged = {k: v for k, v in merged.items() if rx.search(k)}
-        if not merged:
-            raise PlotError("nothing to plot: no benchmark with an N argument and a time%s in %s" %
-                            (" matching --filter" if args.filter else "", ", ".join(args.json)))
+            raise PlotError("--filter: invalid regular expression: %s" % e)
+        merged = {k: v for k, v in merged.items() if rx.search(k)}
+    if not merged:
+        raise PlotError("nothing to plot: no benchmark with an N argument and a time%s in %s" %
+                        (" matching --filter" if args.filter else "", ", ".join(args.json)))
 
-        _, plt = pyplot()
+    _, plt = pyplot()
 
-        fig, ax = plt.subplots(figsize=(10, 5.5))
-        markers = "os^vD<>phX*"
-        colors = plt.get_cmap("tab20").colors
-        for i, (label, points) in enumerate(sorted(merged.items())):
-            ns = sorted(points)
-            color = colors[(2 * i) % 20 + (i // 10) % 2]  # the 10 dark ones of tab20 first, then the light ones
-            ax.plot(ns, [median(points[n]) for n in ns], marker=markers[i % len(markers)], label=label, color=color,
-                    linestyle="--" if "from previous" in label else "-")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("nfourbar N (N + 1 cranks, 2N + 3 natural coordinates)")
-        ax.set_ylabel("time per drive step (s)")
-        ax.set_title(args.title, fontsize=10)
-        ax.grid(True, which="both", linewidth=0.3, alpha=0.6)
-        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-        fig.tight_layout()
-        for path, fmt in [(args.output, "svg")] + ([(args.png, "png")] if args.png else []):
-            try:
-                fig.savefig(path, format=fmt, metadata={"Date": None} if fmt == "svg" else None, dpi=120)
-            except OSError as e:
-                raise PlotError("%s: cannot write: %s" % (path, e.strerror or e))
-        skipped = {}
-        for _, (_, sk) in per_file:
-            for why, k in sk.items():
-                skipped[why] = skipped.get(why, 0) + k
-        print("%s: %d curves -> %s%s%s" % (
-            PROG, len(merged), args.output, " and " + args.png if args.png else "",
-            "; skipped: " + ", ".join("%d %s" % (k, why) for why, k in sorted(skipped.items())) if skipped else ""),
-            file=sys.stderr)
-        return 0
-    except PlotError as e:
-        print("%s: %s" % (PROG, e), file=sys.stderr)
-        return 1
+    fig, ax = plt.subplots(figsize=(10, 5.5))
+    markers = "os^vD<>phX*"
+    colors = plt.get_cmap("tab20").colors
+    for i, (label, points) in enumerate(sorted(merged.items())):
+        ns = sorted(points)
+        color = colors[(2 * i) % 20 + (i // 10) % 2]  # the 10 dark ones of tab20 first, then the light ones
+        ax.plot(ns, [median(points[n]) for n in ns], marker=markers[i % len(markers)], label=label, color=color,
+                linestyle="--" if "from previous" in label else "-")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("nfourbar N (N + 1 cranks, 2N + 3 natural coordinates)")
+    ax.set_ylabel("time per drive step (s)")
+    ax.set_title(args.title, fontsize=10)
+    ax.grid(True, which="both", linewidth=0.3, alpha=0.6)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    fig.tight_layout()
+    save(fig, args.output, args.png, svg_dpi=120, png_dpi=120)
+    skipped = {}
+    for _, (_, sk) in per_file:
+        for why, k in sk.items():
+            skipped[why] = skipped.get(why, 0) + k
+    print("%s: %d curves -> %s%s%s" % (
+        PROG, len(merged), args.output, " and " + args.png if args.png else "",
+        "; skipped: " + ", ".join("%d %s" % (k, why) for why, k in sorted(skipped.items())) if skipped else ""),
+        file=sys.stderr)
+    return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(run(main, PROG, sys.argv[1:]))
