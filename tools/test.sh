@@ -3,9 +3,10 @@
 #   tools/test.sh            1. Release build (build/) and its ctest suite, with the installed-package consumer,
 #                               the regression comparisons and the benchmark smoke run;
 #                            2. the same suite built with clang under AddressSanitizer + UndefinedBehaviorSanitizer
-#                               (build-asan/), preceded by a bounded libFuzzer run of the scene loader (60 s).
+#                               (build-asan/), preceded by bounded libFuzzer runs: the scene loader (60 s), then the
+#                               expression compiler (30 s).
 #   tools/test.sh --quick    step 1 only (the inner loop while developing)
-#   PHIQ_FUZZ_SECONDS=N      fuzzing time (default 60)
+#   PHIQ_FUZZ_SECONDS=N      scene fuzzing time (default 60; expressions get half)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 quick=0

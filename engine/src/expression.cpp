@@ -1,4 +1,4 @@
-// GiNaC front end (parse, differentiate) and the register tape back end of equation constraints.
+// Equation constraints: phiq's parser, GiNaC for exact differentiation, and the register tape back end.
 #include "phiq/expression.hpp"
 
 #include <ginac/ginac.h>
@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <tuple>
 #include <unordered_map>
@@ -198,8 +199,8 @@ class TapeBuilder {
   using Op = Tape::Op;
 
   std::uint32_t push(Op op, std::uint32_t a = 0, std::uint32_t b = 0, double imm = 0.0) {
-    // Constant folding: numbers reach GiNaC as symbols (see compile()), so their arithmetic happens here, in
-    // double precision, exactly as the tape would do it. A constant part that is not a finite real (sqrt(-1),
+    // Constant folding: numbers reach GiNaC as symbols (see ExpressionParser), so their arithmetic happens here,
+    // in double precision, exactly as the tape would do it. A constant part that is not a finite real (sqrt(-1),
     // 1/0, exp(1000)) is refused at compile time rather than left as a NaN in the residual.
     const bool loads = op == Op::kConst || op == Op::kLoadQ || op == Op::kLoadQd || op == Op::kLoadT;
     if (!loads && is_const(a) && (!is_binary(op) || is_const(b))) {
@@ -237,6 +238,32 @@ class TapeBuilder {
     return reg;
   }
 
+  // base^expo. Constant integer and half-integer exponents by multiplication and sqrt, as accurate as the
+  // operations they stand for (and finite where the derivative's closed form is: x^2 at 0).
+  std::uint32_t emit_power(const GiNaC::ex& base, std::uint32_t expo) {
+    if (is_const(expo)) {
+      const double x = tape_.code_[expo].imm;
+      auto small_int = [](double v) { return v == std::round(v) && std::fabs(v) <= 1024; };
+      if (small_int(x)) {
+        const long k = std::lround(x);
+        if (k == 0) return constant(1.0);
+        if (k == 1) return emit(base);
+        std::uint32_t b = emit(base);
+        if (k == 2) return push(Op::kMul, b, b);
+        if (k == -1) return push(Op::kDiv, constant(1.0), b);
+        return push(Op::kPowInt, b, 0, static_cast<double>(k));
+      }
+      if (small_int(2 * x)) {
+        std::uint32_t s = push(Op::kSqrt, emit(base));
+        const long k = std::lround(2 * x);
+        if (k == 1) return s;
+        if (k == -1) return push(Op::kDiv, constant(1.0), s);
+        return push(Op::kPowInt, s, 0, static_cast<double>(k));
+      }
+    }
+    return push(Op::kPow, emit(base), expo);
+  }
+
   std::uint32_t emit_node(const GiNaC::ex& e) {
     using namespace GiNaC;
     if (is_a<numeric>(e)) {
@@ -270,42 +297,33 @@ class TapeBuilder {
     if (is_a<mul>(e)) {
       const ex& last = e.op(e.nops() - 1);
       if (last.is_equal(-1)) return push(Op::kNeg, emit(-e));
-      std::uint32_t acc = emit(e.op(0));
-      for (std::size_t i = 1; i < e.nops(); ++i) {
+      // Factors with one base are multiplied as one power. Exponents written in the text are constants, which
+      // reach GiNaC as symbols (see ExpressionParser), so GiNaC differentiates x^k as x^k·k·x^(-1): 0·∞ at x = 0.
+      // As x^(k-1), with k - 1 folded, it is the closed form (for k = 2: 2x).
+      std::vector<std::pair<ex, std::vector<ex>>> groups;  // base, exponents
+      for (std::size_t i = 0; i < e.nops(); ++i) {
         const ex& f = e.op(i);
-        // x * y^(-1) is emitted as a division
-        if (is_a<power>(f) && f.op(1).is_equal(-1)) acc = push(Op::kDiv, acc, emit(f.op(0)));
-        else acc = push(Op::kMul, acc, emit(f));
+        const bool pw = is_a<power>(f);
+        const ex base = pw ? f.op(0) : f;
+        auto g = std::find_if(groups.begin(), groups.end(), [&](const auto& p) { return p.first.is_equal(base); });
+        if (g != groups.end()) g->second.push_back(pw ? f.op(1) : ex(1));
+        else groups.emplace_back(base, std::vector<ex>{pw ? f.op(1) : ex(1)});
       }
-      return acc;
-    }
-    if (is_a<power>(e)) {
-      const ex& base = e.op(0);
-      const std::uint32_t expo = emit(e.op(1));
-      if (is_const(expo)) {
-        // integer and half-integer exponents (exact in the text, or folded from literals) by multiplication
-        // and sqrt, as accurate as the operations they stand for
-        const double x = tape_.code_[expo].imm;
-        auto small_int = [](double v) { return v == std::round(v) && std::fabs(v) <= 1024; };
-        if (small_int(x)) {
-          const long k = std::lround(x);
-          if (k == 0) return constant(1.0);
-          if (k == 1) return emit(base);
-          std::uint32_t b = emit(base);
-          if (k == 2) return push(Op::kMul, b, b);
-          if (k == -1) return push(Op::kDiv, constant(1.0), b);
-          return push(Op::kPowInt, b, 0, static_cast<double>(k));
+      std::optional<std::uint32_t> acc;
+      for (const auto& [base, exponents] : groups) {
+        std::uint32_t x = emit(exponents[0]);
+        for (std::size_t k = 1; k < exponents.size(); ++k) x = push(Op::kAdd, x, emit(exponents[k]));
+        if (is_const(x) && tape_.code_[x].imm == 0.0) continue;
+        if (acc && is_const(x) && tape_.code_[x].imm == -1.0) {  // a * b^(-1) is emitted as a division
+          acc = push(Op::kDiv, *acc, emit(base));
+          continue;
         }
-        if (small_int(2 * x)) {
-          std::uint32_t s = push(Op::kSqrt, emit(base));
-          const long k = std::lround(2 * x);
-          if (k == 1) return s;
-          if (k == -1) return push(Op::kDiv, constant(1.0), s);
-          return push(Op::kPowInt, s, 0, static_cast<double>(k));
-        }
+        const std::uint32_t f = emit_power(base, x);
+        acc = acc ? push(Op::kMul, *acc, f) : f;
       }
-      return push(Op::kPow, emit(base), expo);
+      return acc ? *acc : constant(1.0);
     }
+    if (is_a<power>(e)) return emit_power(e.op(0), emit(e.op(1)));
     if (is_a<function>(e)) {
       const std::string name = ex_to<function>(e).get_name();
       static const std::map<std::string, Op> unary = {
@@ -341,98 +359,7 @@ class TapeBuilder {
 
 namespace {
 
-bool is_ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
-bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
-
-// The text as GiNaC is given it. GiNaC evaluates numbers exactly and eagerly as it builds an expression, and some
-// of that is unsafe on input a user (or a fuzzer) can write: complex intermediate values such as (-1)^(1/2) send
-// its atan2 and differentiation into unbounded recursion (a crash), and exact powers such as 9^9^9 never finish.
-// So every number literal is replaced by a real symbol whose value is folded back in double precision when the
-// tape is built (TapeBuilder::push); GiNaC only ever sees real symbols. Two kinds of literal stay exact because
-// they are safe and their exactness matters: 0 (so that 0*x does not make x a column) and a small integer
-// exponent written after '^' (so that d/dx x^2 is 2x and not x^2·2/x, which is NaN at x = 0).
-struct LexedText {
-  std::string text;                 // with literals replaced
-  std::vector<std::string> names;   // identifiers not directly followed by '(' (variables)
-  std::vector<double> literals;     // value of literal symbol kLiteralPrefix<i>
-};
-constexpr const char* kLiteralPrefix = "phiqK";
-
-LexedText lex_expression(const std::string& text) {
-  LexedText out;
-  const std::size_t n = text.size();
-  auto prev_non_space = [&](std::size_t i) -> std::ptrdiff_t {  // index of the previous non-space character, or -1
-    auto k = static_cast<std::ptrdiff_t>(i) - 1;
-    while (k >= 0 && std::isspace(static_cast<unsigned char>(text[static_cast<std::size_t>(k)]))) --k;
-    return k;
-  };
-  auto next_non_space = [&](std::size_t i) {
-    while (i < n && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
-    return i < n ? text[i] : '\0';
-  };
-  // a literal written directly as an exponent: x^2, x^(2), x^(-2)
-  auto is_exponent = [&](std::size_t start) {
-    std::ptrdiff_t k = prev_non_space(start);
-    if (k >= 0 && text[k] == '^') return true;
-    if (k >= 0 && (text[k] == '-' || text[k] == '+')) k = prev_non_space(static_cast<std::size_t>(k));
-    if (k < 0 || text[k] != '(') return false;
-    k = prev_non_space(static_cast<std::size_t>(k));
-    return k >= 0 && text[k] == '^';
-  };
-  std::size_t i = 0;
-  while (i < n) {
-    const char c = text[i];
-    if (std::isdigit(static_cast<unsigned char>(c)) ||
-        (c == '.' && i + 1 < n && std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
-      const std::size_t start = i;
-      while (i < n && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.')) ++i;
-      if (i < n && (text[i] == 'e' || text[i] == 'E')) {
-        std::size_t j = i + 1;
-        if (j < n && (text[j] == '+' || text[j] == '-')) ++j;
-        if (j < n && std::isdigit(static_cast<unsigned char>(text[j]))) {
-          i = j;
-          while (i < n && std::isdigit(static_cast<unsigned char>(text[i]))) ++i;
-        }
-      }
-      const std::string literal = text.substr(start, i - start);
-      char* end = nullptr;
-      const double v = std::strtod(literal.c_str(), &end);
-      if (end != literal.c_str() + literal.size())
-        throw expression_error(text, "'" + literal.substr(0, 40) + "' is not a number");
-      if (!std::isfinite(v))
-        throw expression_error(text, "number '" + literal.substr(0, 40) + "' is out of the range of a double");
-      const char after = next_non_space(i);
-      if (v == 0.0) {
-        out.text += "0";
-      } else if (v == std::round(v) && v <= 1024 && after != '^' && is_exponent(start)) {
-        out.text += std::to_string(static_cast<long>(v));
-      } else {
-        out.text += kLiteralPrefix + std::to_string(out.literals.size());
-        out.literals.push_back(v);
-      }
-    } else if (is_ident_start(c)) {
-      std::size_t j = i;
-      while (j < n && is_ident_char(text[j])) ++j;
-      const std::string name = text.substr(i, j - i);
-      if (name.rfind(kLiteralPrefix, 0) == 0)
-        throw expression_error(text, "names starting with '" + std::string(kLiteralPrefix) + "' are reserved");
-      if (next_non_space(j) != '(') out.names.push_back(name);
-      out.text += name;
-      i = j;
-    } else {
-      // GiNaC's parser takes everything after "^-" as the exponent: x^-1 + y is read as x^(-1 + y). Refuse the
-      // form rather than let it mean something else than it says.
-      if (c == '^' && (next_non_space(i + 1) == '-' || next_non_space(i + 1) == '+'))
-        throw expression_error(text, "write a signed exponent in parentheses, as x^(-2) (x^-2*y would be read "
-                                     "as x^(-2*y))");
-      out.text += c;
-      ++i;
-    }
-  }
-  return out;
-}
-
-// "expression "<first 40 characters>...": <what>" — built with a stream: GCC 12 warns falsely (-Wrestrict,
+// "expression "<first 60 characters>...": <what>" — built with a stream: GCC 12 warns falsely (-Wrestrict,
 // PR 105329) on "literal" + std::string temporaries.
 Error expression_error(const std::string& text, const std::string& what) {
   std::ostringstream s;
@@ -451,10 +378,271 @@ std::string clean_ginac_message(std::string m) {
   m = first_line(m);
   const std::string prefix = "GiNaC: ";
   if (m.rfind(prefix, 0) == 0) m = m.substr(prefix.size());
-  auto p = m.find("at line 0, column 0: ");
-  if (p != std::string::npos) m.erase(p, std::strlen("at line 0, column 0: "));
   return m;
 }
+
+bool is_ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// The functions an expression may call, with their tape instruction and number of arguments.
+struct FunctionSpec {
+  Tape::Op op;
+  int arity;
+};
+const std::map<std::string, FunctionSpec>& supported_functions() {
+  using Op = Tape::Op;
+  static const std::map<std::string, FunctionSpec> table = {
+      {"sin", {Op::kSin, 1}},   {"cos", {Op::kCos, 1}},   {"tan", {Op::kTan, 1}},   {"asin", {Op::kAsin, 1}},
+      {"acos", {Op::kAcos, 1}}, {"atan", {Op::kAtan, 1}}, {"atan2", {Op::kAtan2, 2}}, {"exp", {Op::kExp, 1}},
+      {"log", {Op::kLog, 1}},   {"sqrt", {Op::kSqrt, 1}}, {"sinh", {Op::kSinh, 1}}, {"cosh", {Op::kCosh, 1}},
+      {"tanh", {Op::kTanh, 1}}, {"abs", {Op::kAbs, 1}}};
+  return table;
+}
+std::string supported_function_list() {
+  std::string s;
+  for (const auto& [name, spec] : supported_functions()) s += (s.empty() ? "" : " ") + name;
+  return s;
+}
+
+// phiq's own recursive-descent parser, building the GiNaC expression operation by operation. GiNaC's text parser
+// is not used: it crashes on input as small as "sin()" (found by fuzzing), knows dozens of functions phiq cannot
+// evaluate, and reads x^-1 + y as x^(-1 + y). GiNaC is also kept away from numbers: it evaluates them exactly and
+// eagerly, and on text a user (or a fuzzer) can write that recurses without bound (atan2 of complex constants
+// such as (-1)^(1/2)) or never finishes (exact powers such as ((2*x)^1024)^1024 or 9^9^9). So every operation
+// whose operands are all constant is folded here in double precision, with the very operation the tape evaluates
+// (apply()), and its result reaches GiNaC as a fresh real symbol (its value kept for TapeBuilder); so do literals,
+// parameters and pi. The one exact number GiNaC sees is 0 (so that 0*x makes no column), and an operation that
+// cancels to a number (x - x, x/x) is folded at once. GiNaC is left with what it is for: exact differentiation.
+//
+// Grammar (usual precedence; ^ binds tighter than unary minus, -x^2 = -(x^2); a chained x^a^b is ambiguous and
+// refused; a signed exponent x^-2 is x^(-2)):
+//   sum      := product (('+' | '-') product)*
+//   product  := unary (('*' | '/') unary)*
+//   unary    := ('-' | '+') unary | power
+//   power    := primary ('^' exponent)?
+//   exponent := ('-' | '+') exponent | primary
+//   primary  := number | name | function '(' sum (',' sum)* ')' | '(' sum ')'
+class ExpressionParser {
+ public:
+  struct Node {
+    GiNaC::ex e;            // the expression GiNaC sees: 0, a real symbol, or a term in coordinates and t
+    bool constant = false;  // true when it depends on neither q nor t
+    double value = 0.0;     // its value when constant
+  };
+  using NameNode = std::function<Node(const std::string&)>;
+
+  ExpressionParser(const std::string& text, NameNode name, std::map<std::string, double>& value_of_constant)
+      : text_(text), name_(std::move(name)), value_of_constant_(value_of_constant) {}
+
+  Node parse() {
+    Node n = sum();
+    skip_space();
+    if (pos_ < text_.size()) {
+      if (text_[pos_] == ')') fail_at("')' without a matching '('");
+      fail_at("expected an operator before '" + token_text() + "'");
+    }
+    return n;
+  }
+
+  // A constant: 0 stays exact, anything else becomes a real symbol GiNaC cannot do arithmetic with.
+  Node constant(double v) {
+    if (!std::isfinite(v))
+      fail(std::string("a constant part of it is not a finite real number (") +
+           (std::isnan(v) ? "NaN" : v > 0 ? "+inf" : "-inf") + ")");
+    if (v == 0.0) return Node{0, true, 0.0};
+    const std::string symbol_name = "k:" + std::to_string(value_of_constant_.size());
+    value_of_constant_[symbol_name] = v;
+    return Node{GiNaC::realsymbol(symbol_name), true, v};
+  }
+
+ private:
+  using Op = Tape::Op;
+
+  [[noreturn]] void fail(const std::string& what) const { throw expression_error(text_, what); }
+  [[noreturn]] void fail_at(const std::string& what) const {
+    fail(what + " (column " + std::to_string(pos_ + 1) + ")");
+  }
+
+  void skip_space() {
+    while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+  }
+  char peek() {
+    skip_space();
+    return pos_ < text_.size() ? text_[pos_] : '\0';
+  }
+  bool accept(char c) {
+    if (peek() != c) return false;
+    ++pos_;
+    return true;
+  }
+  void expect(char c, const char* what) {
+    if (accept(c)) return;
+    if (pos_ >= text_.size()) fail(std::string("missing ") + what + " at the end");
+    fail_at(std::string("expected ") + what + " before '" + token_text() + "'");
+  }
+  std::string token_text() const {  // the token at pos_, for messages
+    std::size_t end = pos_ + 1;
+    if (is_ident_char(text_[pos_]))
+      while (end < text_.size() && is_ident_char(text_[end])) ++end;
+    return text_.substr(pos_, std::min<std::size_t>(end - pos_, 40));
+  }
+
+  // The result of a GiNaC operation on operands not all constant: a number (by cancellation) is folded at once.
+  Node settle(const GiNaC::ex& r) {
+    if (GiNaC::is_a<GiNaC::numeric>(r)) {
+      const GiNaC::numeric& n = GiNaC::ex_to<GiNaC::numeric>(r);
+      if (!n.is_real()) fail("a constant part of it is not a finite real number (complex)");
+      return constant(n.to_double());
+    }
+    return Node{r, false, 0.0};
+  }
+
+  Node unary_op(Op op, const Node& a) {
+    if (a.constant) return constant(apply(op, a.value, 0.0, 0.0));
+    switch (op) {
+      case Op::kNeg: return settle(-a.e);
+      case Op::kSqrt: return settle(GiNaC::sqrt(a.e));
+      case Op::kSin: return settle(GiNaC::sin(a.e));
+      case Op::kCos: return settle(GiNaC::cos(a.e));
+      case Op::kTan: return settle(GiNaC::tan(a.e));
+      case Op::kAsin: return settle(GiNaC::asin(a.e));
+      case Op::kAcos: return settle(GiNaC::acos(a.e));
+      case Op::kAtan: return settle(GiNaC::atan(a.e));
+      case Op::kExp: return settle(GiNaC::exp(a.e));
+      case Op::kLog: return settle(GiNaC::log(a.e));
+      case Op::kSinh: return settle(GiNaC::sinh(a.e));
+      case Op::kCosh: return settle(GiNaC::cosh(a.e));
+      case Op::kTanh: return settle(GiNaC::tanh(a.e));
+      case Op::kAbs: return settle(GiNaC::abs(a.e));
+      default: fail("internal: unary operation " + std::to_string(static_cast<int>(op)));
+    }
+  }
+
+  Node binary_op(Op op, const Node& a, const Node& b) {
+    if (op == Op::kDiv && b.constant && b.value == 0.0) fail("division by zero");
+    if (a.constant && b.constant) return constant(apply(op, a.value, b.value, 0.0));
+    switch (op) {
+      case Op::kAdd: return settle(a.e + b.e);
+      case Op::kSub: return settle(a.e - b.e);
+      case Op::kMul: return settle(a.e * b.e);
+      case Op::kDiv: return settle(a.e / b.e);
+      case Op::kPow: return settle(GiNaC::pow(a.e, b.e));
+      case Op::kAtan2: return settle(GiNaC::atan2(a.e, b.e));
+      default: fail("internal: binary operation " + std::to_string(static_cast<int>(op)));
+    }
+  }
+
+  Node sum() {
+    Node n = product();
+    for (;;) {
+      if (accept('+')) n = binary_op(Op::kAdd, n, product());
+      else if (accept('-')) n = binary_op(Op::kSub, n, product());
+      else return n;
+    }
+  }
+
+  Node product() {
+    Node n = unary();
+    for (;;) {
+      if (accept('*')) n = binary_op(Op::kMul, n, unary());
+      else if (accept('/')) n = binary_op(Op::kDiv, n, unary());
+      else return n;
+    }
+  }
+
+  Node unary() {
+    if (accept('-')) return unary_op(Op::kNeg, unary());
+    if (accept('+')) return unary();
+    return power();
+  }
+
+  Node power() {
+    Node base = primary();
+    if (!accept('^')) return base;
+    Node n = binary_op(Op::kPow, base, exponent());
+    if (peek() == '^') fail_at("x^a^b is ambiguous: write (x^a)^b or x^(a^b)");
+    return n;
+  }
+
+  Node exponent() {
+    if (accept('-')) return unary_op(Op::kNeg, exponent());
+    if (accept('+')) return exponent();
+    return primary();
+  }
+
+  Node primary() {
+    const char c = peek();
+    if (c == '\0') fail("an operand is missing at the end");
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return number();
+    if (is_ident_start(c)) {
+      const std::size_t start = pos_;
+      while (pos_ < text_.size() && is_ident_char(text_[pos_])) ++pos_;
+      const std::string name = text_.substr(start, pos_ - start);
+      if (peek() == '(') return call(name, start);
+      return name_(name);
+    }
+    if (accept('(')) {
+      if (++depth_ > CompiledExpression::kMaxNesting)
+        fail("nested more than " + std::to_string(CompiledExpression::kMaxNesting) + " parentheses deep");
+      Node n = sum();
+      expect(')', "')'");
+      --depth_;
+      return n;
+    }
+    fail_at("expected a number, a name or '(' before '" + token_text() + "'");
+  }
+
+  Node number() {
+    const std::size_t start = pos_;
+    const std::size_t n = text_.size();
+    while (pos_ < n && (std::isdigit(static_cast<unsigned char>(text_[pos_])) || text_[pos_] == '.')) ++pos_;
+    if (pos_ < n && (text_[pos_] == 'e' || text_[pos_] == 'E')) {
+      std::size_t j = pos_ + 1;
+      if (j < n && (text_[j] == '+' || text_[j] == '-')) ++j;
+      if (j < n && std::isdigit(static_cast<unsigned char>(text_[j]))) {
+        pos_ = j;
+        while (pos_ < n && std::isdigit(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+      }
+    }
+    while (pos_ < n && is_ident_char(text_[pos_])) ++pos_;  // "2x" is one malformed number, not 2 times x
+    const std::string literal = text_.substr(start, pos_ - start);
+    char* end = nullptr;
+    const double v = std::strtod(literal.c_str(), &end);
+    if (end != literal.c_str() + literal.size())
+      fail("'" + literal.substr(0, 40) + "' is not a number");
+    if (!std::isfinite(v)) fail("number '" + literal.substr(0, 40) + "' is out of the range of a double");
+    return constant(v);
+  }
+
+  Node call(const std::string& name, std::size_t start) {
+    auto it = supported_functions().find(name);
+    if (it == supported_functions().end())
+      fail("unknown function '" + name.substr(0, 40) + "' (supported: " + supported_function_list() + ")");
+    expect('(', "'('");
+    if (++depth_ > CompiledExpression::kMaxNesting)
+      fail("nested more than " + std::to_string(CompiledExpression::kMaxNesting) + " parentheses deep");
+    std::vector<Node> args;
+    if (peek() != ')') {
+      args.push_back(sum());
+      while (accept(',')) args.push_back(sum());
+    }
+    expect(')', "')'");
+    --depth_;
+    const FunctionSpec& f = it->second;
+    if (static_cast<int>(args.size()) != f.arity) {
+      pos_ = start;
+      fail_at("'" + name + "' takes " + std::to_string(f.arity) + " argument" + (f.arity == 1 ? "" : "s") +
+              ", not " + std::to_string(args.size()));
+    }
+    return f.arity == 1 ? unary_op(f.op, args[0]) : binary_op(f.op, args[0], args[1]);
+  }
+
+  const std::string& text_;
+  NameNode name_;
+  std::map<std::string, double>& value_of_constant_;
+  std::size_t pos_ = 0;
+  int depth_ = 0;
+};
 
 }  // namespace
 
@@ -466,75 +654,54 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   if (text.size() > kMaxTextLength)
     throw Error("expression of " + std::to_string(text.size()) + " characters; the limit is " +
                 std::to_string(kMaxTextLength));
-  {
-    // The parser recurses per nesting level: bound it before parsing.
-    int depth = 0, worst = 0;
-    for (char c : text) {
-      if (c == '(') worst = std::max(worst, ++depth);
-      if (c == ')') --depth;
-    }
-    if (worst > kMaxNesting)
-      throw expression_error(text, "nested more than " + std::to_string(kMaxNesting) + " parentheses deep");
-  }
   auto out = std::make_shared<CompiledExpression>();
   out->text_ = text;
 
-  const LexedText lexed = lex_expression(text);
-  symtab table;
-  std::map<std::string, Index> coord_of_symbol;  // symbol name -> coordinate index
+  std::map<std::string, Index> coord_of_symbol;     // symbol name -> coordinate index
   std::map<std::string, double> value_of_constant;  // symbol name -> value folded in by the tape builder
-  std::vector<std::pair<realsymbol, Index>> coord_symbols;
-  auto constant_symbol = [&](const std::string& symbol_name, double value) -> ex {
-    if (value == 0.0) return 0;
-    value_of_constant[symbol_name] = value;
-    return realsymbol(symbol_name);
-  };
-  for (std::size_t k = 0; k < lexed.literals.size(); ++k) {
-    const std::string name = kLiteralPrefix + std::to_string(k);
-    table[name] = constant_symbol(name, lexed.literals[k]);
-  }
+  std::map<Index, realsymbol> symbol_of_coord;      // one symbol per coordinate, however many names it has
+  std::map<std::string, ExpressionParser::Node> named;
   realsymbol tsym("t");
-  for (const std::string& name : lexed.names) {
-    if (table.count(name)) continue;
-    if (name == "pi") { table[name] = constant_symbol("k:pi", M_PI); continue; }
-    std::optional<NameBinding> b = resolve(name);
-    if (!b) {
+  ExpressionParser* parser_ptr = nullptr;
+  auto name_node = [&](const std::string& name) -> ExpressionParser::Node {
+    if (auto it = named.find(name); it != named.end()) return it->second;
+    ExpressionParser::Node n;
+    std::optional<NameBinding> b;
+    if (name != "pi") b = resolve(name);
+    if (name == "pi") {
+      n = parser_ptr->constant(M_PI);
+    } else if (!b) {
       if (name == "t" && !allow_time) throw expression_error(text, "time 't' is not allowed here");
-      throw expression_error(text, "unknown name '" + name + "'");
+      throw expression_error(text, "unknown name '" + name.substr(0, 40) + "'");
+    } else if (b->kind == NameBinding::Kind::kTime) {
+      if (!allow_time) throw expression_error(text, "time 't' is not allowed here");
+      n = ExpressionParser::Node{tsym, false, 0.0};
+    } else if (b->kind == NameBinding::Kind::kConstant) {
+      if (!std::isfinite(b->value)) throw expression_error(text, "'" + name + "' is not finite");
+      n = parser_ptr->constant(b->value);
+    } else {
+      auto [it, fresh] = symbol_of_coord.try_emplace(b->coordinate, "q:" + std::to_string(b->coordinate));
+      if (fresh) coord_of_symbol[it->second.get_name()] = b->coordinate;
+      n = ExpressionParser::Node{it->second, false, 0.0};
     }
-    switch (b->kind) {
-      case NameBinding::Kind::kTime:
-        if (!allow_time) throw expression_error(text, "time 't' is not allowed here");
-        table[name] = tsym;
-        break;
-      case NameBinding::Kind::kConstant:
-        if (!std::isfinite(b->value)) throw expression_error(text, "'" + name + "' is not finite");
-        table[name] = constant_symbol("k:" + name, b->value);
-        break;
-      case NameBinding::Kind::kCoordinate: {
-        // symbol names are made unique per coordinate so that two names for one index could never alias wrongly
-        realsymbol s("q:" + std::to_string(b->coordinate));
-        table[name] = s;
-        coord_of_symbol[s.get_name()] = b->coordinate;
-        coord_symbols.emplace_back(s, b->coordinate);
-        break;
-      }
-    }
-  }
+    named.emplace(name, n);
+    return n;
+  };
 
   ex g;
   try {
-    parser reader(table);
-    reader.strict = true;
-    g = reader(lexed.text);
-  } catch (const std::exception& e) {
+    ExpressionParser parser(text, name_node, value_of_constant);
+    parser_ptr = &parser;
+    g = parser.parse().e;
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {  // GiNaC's own refusals, e.g. division by an exact zero
     throw expression_error(text, clean_ginac_message(e.what()));
   }
 
   // Keep only the coordinates the expression really depends on, in ascending index order.
-  std::sort(coord_symbols.begin(), coord_symbols.end(), [](auto& a, auto& b) { return a.second < b.second; });
   std::vector<std::pair<realsymbol, Index>> used;
-  for (auto& [s, i] : coord_symbols)
+  for (auto& [i, s] : symbol_of_coord)
     if (g.has(s)) used.emplace_back(s, i);
   out->depends_on_time_ = g.has(tsym);
 

@@ -1,11 +1,12 @@
 /// @file
 /// Equation constraints written as text, exactly as the notes write Φ: "xA - L2*cos(theta2)".
 ///
-/// The text is parsed and differentiated exactly by GiNaC once, when the model is built; the value, the gradient
-/// and ∂/∂t are compiled into flat register tapes with common subexpressions shared, so that evaluation inside the
-/// Newton loop never touches the symbolic engine and never re-parses. γ needs second derivatives: it is computed
-/// exactly by second-order forward (Taylor-mode) automatic differentiation of the value tape along (q̇, 1), which
-/// costs a few passes over the tape, where symbolic second derivatives can grow with the cube of a product's length.
+/// The text is parsed by phiq (constant parts folded in double precision) and differentiated exactly by GiNaC
+/// once, when the model is built; the value, the gradient and ∂/∂t are compiled into flat register tapes with
+/// common subexpressions shared, so that evaluation inside the Newton loop never touches the symbolic engine and
+/// never re-parses. γ needs second derivatives: it is computed exactly by second-order forward (Taylor-mode)
+/// automatic differentiation of the value tape along (q̇, 1), which costs a few passes over the tape, where symbolic
+/// second derivatives can grow with the cube of a product's length.
 #pragma once
 
 #include <cstdint>
