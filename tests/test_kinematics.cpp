@@ -102,6 +102,52 @@ TEST(Kinematics, DenseAndSparsePathsAgree) {
   }
 }
 
+// The Newton loop evaluates Φ and Φq in one pass (Model::residual_and_jacobian); it must give exactly what the two
+// separate passes give, for every kind of constraint (these scenes cover the 2D and 3D kinds and equations), both
+// where each Jacobian entry has a slot of its own (stored) and where entries share one (added up: a pin whose
+// two points share a coordinate).
+TEST(Kinematics, FusedResidualAndJacobianEqualTheSeparatePasses) {
+  auto same = [](const Model& m, const Eigen::VectorXd& q, double t, const std::string& what) {
+    Eigen::VectorXd phi(m.num_equations()), phi2(m.num_equations());
+    // different garbage in the two buffers: a slot neither pass writes cannot compare equal
+    std::vector<double> jac(static_cast<std::size_t>(m.jacobian_pattern().nnz()), -7.0);
+    std::vector<double> jac2(jac.size(), 5.0);
+    m.residual(q.data(), t, phi.data());
+    m.jacobian(q.data(), t, jac.data());
+    m.residual_and_jacobian(q.data(), t, phi2.data(), jac2.data());
+    EXPECT_EQ(phi, phi2) << what;
+    EXPECT_EQ(jac, jac2) << what;
+  };
+  for (const char* rel : {"seed/fourbar_mixed.yaml", "seed/crank_slider_equations.yaml", "seed/fourbar_relative.yaml",
+                          "seed/fourbar_reference_point.yaml", "spatial/rssr.yaml", "spatial/rssr_natural.yaml",
+                          "benchmarks/bricard.yaml", "redundant/door_three_hinges.yaml"}) {
+    Scene s = load_scene(test::model_path(rel));
+    Eigen::VectorXd q = s.model->initial_positions();
+    for (Index j = 0; j < q.size(); ++j) q(j) += 0.01 * std::sin(1.3 * static_cast<double>(j) + 0.4);
+    same(*s.model, q, 0.37, rel);
+  }
+  // Shared slots: B = (x, x) makes the distance row's two entries on x fall on one slot.
+  ModelBuilder b;
+  const Index x = b.add_coordinate("x", 0.6), y = b.add_coordinate("y", 0.2);
+  b.add("d", DistanceSpec{{Slot::constant(0.0), Slot::constant(0.0)}, {Slot::coordinate(x), Slot::coordinate(x)}, 1.0});
+  b.add("e", DistanceSpec{{Slot::coordinate(y), Slot::constant(0.0)}, {Slot::coordinate(x), Slot::coordinate(y)}, 1.0});
+  Model m = std::move(b).build();
+  ASSERT_LT(m.jacobian_pattern().nnz(), 5);  // 5 entries on fewer slots
+  Eigen::VectorXd q(2);
+  q << 0.7, -0.3;
+  same(m, q, 0.0, "shared slots");
+  std::vector<double> jac(static_cast<std::size_t>(m.jacobian_pattern().nnz()));
+  m.jacobian(q.data(), 0.0, jac.data());
+  // d: (2x² − 1)/2 → ∂/∂x = 2x; e: ((x − y)² + y² − 1)/2 → ∂/∂x = x − y, ∂/∂y = 2y − x
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(2, 2);
+  const CscPattern& p = m.jacobian_pattern();
+  for (Index c = 0; c < 2; ++c)
+    for (Index k = p.col_ptr[c]; k < p.col_ptr[c + 1]; ++k) dense(p.row_idx[k], c) = jac[static_cast<std::size_t>(k)];
+  EXPECT_DOUBLE_EQ(dense(0, 0), 2 * 0.7);
+  EXPECT_DOUBLE_EQ(dense(1, 0), 0.7 + 0.3);
+  EXPECT_DOUBLE_EQ(dense(1, 1), 2 * -0.3 - 0.7);
+}
+
 TEST(Kinematics, AssemblyFromRoughPlacementIsTheNearbySolution) {
   Model m = crank_slider(2.0, 0.4);
   Workspace ws(m);

@@ -73,7 +73,22 @@ double max_scaled(const Model& model, const Eigen::VectorXd& phi) {
 }
 
 double merit(const Model& model, const Eigen::VectorXd& phi) {
-  return 0.5 * (phi.array() / model.tolerance_scales().row_scale.array()).square().sum();
+  return 0.5 * phi.cwiseProduct(model.tolerance_scales().inverse_row_scale).squaredNorm();
+}
+
+// The size of a step in the tolerance-scaled norm, max_j |Δq_j| / scale_j (step_ratio with tol = 1, whose floor
+// 64 ulps · |q_j| / scale_j is negligible there): the Newton loop's contraction estimate.
+double scaled_norm(const Model& model, const Eigen::VectorXd& dq) {
+  if (dq.size() == 0) return 0.0;
+  const double r = dq.cwiseAbs().cwiseProduct(model.tolerance_scales().inverse_coordinate_scale).maxCoeff();
+  return std::isnan(r) ? std::numeric_limits<double>::infinity() : r;
+}
+
+// factor · step_ratio(dq, q, tol) ≤ 1, without a division per coordinate (false on NaN).
+template <class Step>
+bool step_within(const Model& model, const Step& dq, const Eigen::VectorXd& q, double tol, double factor) {
+  const ToleranceScales& s = model.tolerance_scales();
+  return ((factor * dq.array().abs()) <= (tol * s.coordinate_scale.array() + kUlpFloor * q.array().abs())).all();
 }
 
 bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
@@ -104,8 +119,12 @@ SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, doubl
     return SolveStatus::kSuccess;
   }
   ws.has_factorization = false;
-  model.jacobian(ws.q.data(), t, ws.jacobian_values.data());
-  ++ws.counters.jacobian_evaluations;
+  // Φq may have been evaluated with Φ at this very point by the Newton loop (NewtonOptions::jacobian_with_residual)
+  if (!(ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q == ws.q)) {
+    model.jacobian(ws.q.data(), t, ws.jacobian_values.data());
+    ++ws.counters.jacobian_evaluations;
+  }
+  ws.has_jacobian = false;
   const double* values = ws.jacobian_values.data();
   if (!model.dropped_rows().empty()) {  // the kept rows only (Model::without_rows())
     const std::vector<Index>& from = model.solve_entries();
@@ -181,7 +200,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
       // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
       if (ws.has_factorization && ws.factorized_t == t &&
-          step_ratio(model, ws.q - ws.factorized_q, ws.q, opt.tolerance) <= 1.0)
+          step_within(model, ws.q - ws.factorized_q, ws.q, opt.tolerance, 1.0))
         ws.factorized_q = ws.q;
       return st;
     }
@@ -204,6 +223,11 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   model.residual(ws.q.data(), t, ws.phi.data());
   ++ws.counters.residual_evaluations;
   double f = merit(model, ws.phi);
+  // Φq with Φ at every trial point where Φq will be wanted at the accepted one: each iteration of full Newton, and
+  // the solution when the caller factorises there next (velocities follow). One pass over the constraints instead
+  // of two; the Jacobian of a rejected trial is wasted, which the line search makes rare.
+  const bool with_jacobian = opt.jacobian_update == JacobianUpdate::kEveryIteration || opt.jacobian_with_residual;
+  if (with_jacobian) ws.trial_jacobian_values.resize(ws.jacobian_values.size());
   bool step_ok = false;
   // Modified Newton reuses the workspace's factorisation until it contracts badly; then (and always for full
   // Newton) every iteration factorises at its iterate.
@@ -257,7 +281,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     }
     // Contraction θ = ‖Δq_k‖ / ‖Δq_k−1‖ in the tolerance-scaled norm. A reused matrix that contracts worse than
     // max_contraction is replaced by a fresh one at this iterate (the step just computed is discarded).
-    const double norm = step_ratio(model, ws.step, ws.q, 1.0);
+    const double norm = scaled_norm(model, ws.step);
     double theta = prev_norm > 0.0 ? norm / prev_norm : (reuse && carried_theta >= 0.0 ? 2.0 * carried_theta : -1.0);
     if (reuse && prev_norm > 0.0) {
       theta_seen = std::max(theta_seen, theta);
@@ -267,7 +291,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       ++reused_steps;
       const int left = std::min(opt.max_iterations - sum.iterations - 1, kMaxReusedSteps - reused_steps);
       if (theta > opt.max_contraction || left < 0 ||
-          std::pow(theta, left + 1) / (1.0 - theta) * step_ratio(model, ws.step, ws.q, opt.tolerance) > 1.0) {
+          !step_within(model, ws.step, ws.q, opt.tolerance, std::pow(theta, left + 1) / (1.0 - theta))) {
         reuse = false, prev_norm = -1.0;
         continue;
       }
@@ -279,7 +303,12 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     bool refresh = false;
     for (int bt = 0;; ++bt) {
       ws.trial = ws.q + alpha * ws.step;
-      model.residual(ws.trial.data(), t, ws.trial_phi.data());
+      if (with_jacobian) {
+        model.residual_and_jacobian(ws.trial.data(), t, ws.trial_phi.data(), ws.trial_jacobian_values.data());
+        ++ws.counters.jacobian_evaluations;
+      } else {
+        model.residual(ws.trial.data(), t, ws.trial_phi.data());
+      }
       ++ws.counters.residual_evaluations;
       ftrial = merit(model, ws.trial_phi);
       if (!opt.line_search || ftrial <= (1.0 - 1e-4 * alpha) * f ||
@@ -306,11 +335,17 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     ws.step *= alpha;
     // Error of the new iterate: θ/(1−θ)·|Δq| where a contraction is known, else the step itself.
     const double eta = (theta >= 0.0 && theta < 1.0) ? theta / (1.0 - theta) : 1.0;
-    step_ok = std::min(eta, 1.0) * step_ratio(model, ws.step, ws.trial, opt.tolerance) <= 1.0;
+    step_ok = step_within(model, ws.step, ws.trial, opt.tolerance, std::min(eta, 1.0));
     stagnant = (!reuse && alpha == 1.0 && prev_norm > 0.0 && theta >= 0.5) ? stagnant + 1 : 0;
     prev_norm = alpha == 1.0 ? norm : -1.0;  // a shortened step says nothing about the contraction
     ws.q.swap(ws.trial);
     ws.phi.swap(ws.trial_phi);
+    if (with_jacobian) {
+      ws.jacobian_values.swap(ws.trial_jacobian_values);
+      ws.jacobian_q = ws.q;
+      ws.jacobian_t = t;
+      ws.has_jacobian = true;
+    }
     f = ftrial;
   }
 }

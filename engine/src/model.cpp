@@ -83,9 +83,20 @@ void Model::residual(const double* q, double t, double* phi) const {
 }
 
 void Model::jacobian(const double* q, double t, double* csc_values) const {
-  std::fill(csc_values, csc_values + pattern_->nnz(), 0.0);
+  // Every slot of the pattern has at least one entry (the pattern is made of them); when none has two, storing
+  // each entry writes every slot exactly once and the zero fill is not needed.
+  const bool overwrite = static_cast<Index>(slot_of_entry_.size()) == pattern_->nnz();
+  if (!overwrite) std::fill(csc_values, csc_values + pattern_->nnz(), 0.0);
   for_each_range(blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) {
-    b.jacobian(i0, i1, q, t, slot_of_entry_.data(), csc_values);
+    b.jacobian(i0, i1, q, t, slot_of_entry_.data(), csc_values, overwrite);
+  });
+}
+
+void Model::residual_and_jacobian(const double* q, double t, double* phi, double* csc_values) const {
+  const bool overwrite = static_cast<Index>(slot_of_entry_.size()) == pattern_->nnz();  // as in jacobian()
+  if (!overwrite) std::fill(csc_values, csc_values + pattern_->nnz(), 0.0);
+  for_each_range(blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) {
+    b.residual_and_jacobian(i0, i1, q, t, phi, slot_of_entry_.data(), csc_values, overwrite);
   });
 }
 
@@ -383,6 +394,9 @@ void ModelBuilder::tolerance_scales(const CscPattern& pattern, const std::vector
       sc.coordinate_scale(j) = s != kUnset ? s : fallback;
     }
   }
+
+  sc.inverse_row_scale = sc.row_scale.cwiseInverse();
+  sc.inverse_coordinate_scale = sc.coordinate_scale.cwiseInverse();
 
   // Rounding floors: per row, the coordinates of its unit class (all of its coordinates when it reads none).
   sc.floor_begin.assign(static_cast<std::size_t>(rows) + 1, 0);

@@ -50,6 +50,9 @@ class Sweeper {
       : model_(m), opt_(o), ws_(ws), sum_(sum) {
     need_v_ = o.velocities || o.accelerations;  // q̈ needs q̇
     need_a_ = o.accelerations;
+    // With velocities every step factorises at its solution: Φq there comes with the residual that accepts it.
+    newton_ = o.newton;
+    newton_.jacobian_with_residual = o.newton.jacobian_with_residual || need_v_;
     predictor_ = o.predictor;
     if (predictor_ == Predictor::kAuto)
       predictor_ = need_a_ ? Predictor::kQuadratic : need_v_ ? Predictor::kLinear : Predictor::kSecant;
@@ -113,7 +116,7 @@ class Sweeper {
   bool start_from(double t, const Eigen::VectorXd& seed) {
     ws_.q = seed;
     PositionSummary ps;
-    SolveStatus st = solve_position(model_, t, opt_.newton, ws_, &ps);
+    SolveStatus st = solve_position(model_, t, newton_, ws_, &ps);
     if (st != SolveStatus::kSuccess) return fail(st, ps.message);
     return converged(t, ps);
   }
@@ -310,7 +313,7 @@ class Sweeper {
   bool advance(double t1, int depth) {
     predict(t1);
     PositionSummary ps;
-    SolveStatus st = solve_position(model_, t1, opt_.newton, ws_, &ps);
+    SolveStatus st = solve_position(model_, t1, newton_, ws_, &ps);
     if (st == SolveStatus::kSuccess && depth < opt_.max_subdivisions && jumped()) {
       // Newton went much farther than the step itself: it has left the branch (near a toggle or a bifurcation
       // a coarse step can land in the other branch's basin). Retried as half steps, as a failure is.
@@ -417,6 +420,7 @@ class Sweeper {
   Workspace& ws_;
   SweepSummary& sum_;
   bool need_v_ = false, need_a_ = false;
+  NewtonOptions newton_;  // opt_.newton, with jacobian_with_residual when velocities follow
   Predictor predictor_;
   State current_, prev_;
   bool has_current_ = false, has_prev_ = false;

@@ -41,10 +41,17 @@ class ConstraintBlock {
   /// Accumulates (adds) the Φq values of constraints [begin, end) into `csc_values`, the value array of the model's
   /// CSC Jacobian pattern: the k-th entry of the model's triplet list (as appended by build_pattern()) is added at
   /// `csc_values[slot_of_entry[k]]` (entries sharing a (row, column) share a slot). The caller zeroes
-  /// `csc_values` first; entries of other constraints are left untouched. Requires build_pattern() to have run.
+  /// `csc_values` first; entries of other constraints are left untouched. With `overwrite`, each entry is stored
+  /// (=) instead of added: the model asks for it when no two entries of the whole model share a slot, which spares
+  /// it the zero fill (a pass over all non-zeros per Newton iteration). Requires build_pattern() to have run.
   /// Thread-safe.
   virtual void jacobian(std::size_t begin, std::size_t end, const double* q, double t, const Index* slot_of_entry,
-                        double* csc_values) const = 0;
+                        double* csc_values, bool overwrite = false) const = 0;
+  /// residual() and jacobian() at the same (q, t) in one pass over the constraints: each constraint's data is read
+  /// once (the Newton loop needs both at every accepted iterate; on large models each pass streams the whole
+  /// constraint list from memory). Same contracts as the two calls. Thread-safe.
+  virtual void residual_and_jacobian(std::size_t begin, std::size_t end, const double* q, double t, double* phi,
+                                     const Index* slot_of_entry, double* csc_values, bool overwrite) const = 0;
   /// Writes Φt = ∂Φ/∂t of the time-dependent constraints in [begin, end) into `out` at their global row offsets;
   /// the rows of the others are left untouched (their Φt is zero: the caller zero-fills `out`). Thread-safe.
   virtual void phi_t(std::size_t begin, std::size_t end, const double* q, double t, double* out) const = 0;
@@ -86,12 +93,16 @@ struct PatternSink {
     if (s.is_coordinate()) rows->push_back(row0 + row), cols->push_back(s.coord);
   }
 };
-/// Value mode: same entries, same order, values accumulated into their CSC slots.
+/// Value mode: same entries, same order, values accumulated into their CSC slots (or stored, with kOverwrite:
+/// only where no two entries share a slot).
+template <bool kOverwrite>
 struct ValueSink {
   const Index* slot;
   double* values;
   void operator()(int, const Slot& s, double v) {
-    if (s.is_coordinate()) values[*slot++] += v;
+    if (!s.is_coordinate()) return;
+    if constexpr (kOverwrite) values[*slot++] = v;
+    else values[*slot++] += v;
   }
 };
 }  // namespace detail
@@ -135,11 +146,14 @@ class TypedBlock final : public ConstraintBlock {
     for (std::size_t i = begin; i < end; ++i) entries_[i].spec.residual(q, t, phi + entries_[i].row0);
   }
   void jacobian(std::size_t begin, std::size_t end, const double* q, double t, const Index* slot_of_entry,
-                double* csc_values) const override {
-    for (std::size_t i = begin; i < end; ++i) {
-      detail::ValueSink sink{slot_of_entry + entries_[i].nz0, csc_values};
-      entries_[i].spec.jacobian(q, t, sink);
-    }
+                double* csc_values, bool overwrite) const override {
+    if (overwrite) evaluate<false, true>(begin, end, q, t, nullptr, slot_of_entry, csc_values);
+    else evaluate<false, false>(begin, end, q, t, nullptr, slot_of_entry, csc_values);
+  }
+  void residual_and_jacobian(std::size_t begin, std::size_t end, const double* q, double t, double* phi,
+                             const Index* slot_of_entry, double* csc_values, bool overwrite) const override {
+    if (overwrite) evaluate<true, true>(begin, end, q, t, phi, slot_of_entry, csc_values);
+    else evaluate<true, false>(begin, end, q, t, phi, slot_of_entry, csc_values);
   }
   void phi_t(std::size_t begin, std::size_t end, const double* q, double t, double* out) const override {
     for (std::size_t i = begin; i < end; ++i)
@@ -184,6 +198,18 @@ class TypedBlock final : public ConstraintBlock {
   }
 
  private:
+  // Φq of constraints [begin, end) into their CSC slots (stored or added), and with kResidual their Φ too.
+  template <bool kResidual, bool kOverwrite>
+  void evaluate(std::size_t begin, std::size_t end, const double* q, double t, double* phi, const Index* slot_of_entry,
+                double* csc_values) const {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Entry& e = entries_[i];
+      if constexpr (kResidual) e.spec.residual(q, t, phi + e.row0);
+      detail::ValueSink<kOverwrite> sink{slot_of_entry + e.nz0, csc_values};
+      e.spec.jacobian(q, t, sink);
+    }
+  }
+
   std::vector<Entry> entries_;
 };
 

@@ -55,6 +55,9 @@ struct NewtonOptions {
   bool line_search = true;  ///< backtracking on ½‖Φ/scale‖² (always on for assembly from a rough placement)
   int max_backtracks = 12;  ///< halvings of the step before the line search gives up
   JacobianUpdate jacobian_update = JacobianUpdate::kEveryIteration;  ///< full or modified Newton
+  /// Modified Newton: evaluate Φq together with Φ at every trial point, for a caller that factorises at the solution
+  /// next (velocities): one pass over the constraints instead of two. Full Newton always does it.
+  bool jacobian_with_residual = false;
   /// Modified Newton: refactorise when the observed contraction exceeds this (0 < max_contraction < 1).
   double max_contraction = 0.25;
 };

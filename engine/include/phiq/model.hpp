@@ -184,6 +184,9 @@ struct ToleranceScales {
   Eigen::VectorXd row_is_length;          ///< 1 for length rows, 0 otherwise
   Eigen::VectorXd coordinate_scale;       ///< per coordinate, metres for length coordinates, 1 otherwise
   Eigen::VectorXd coordinate_is_length;   ///< 1 for length coordinates, 0 otherwise
+  /// 1 / row_scale: the Newton loop's per-iteration tests multiply instead of dividing.
+  Eigen::VectorXd inverse_row_scale;
+  Eigen::VectorXd inverse_coordinate_scale;  ///< 1 / coordinate_scale (see inverse_row_scale)
   /// Where each row's floor coordinates start in floor_coordinates (m + 1 entries).
   std::vector<Index> floor_begin;
   /// The coordinates each row's rounding floor is taken over (see above): those of row i are
@@ -285,6 +288,9 @@ class Model {
   void residual(const double* q, double t, double* phi) const;
   /// Φq(q, t) values into csc_values (jacobian_pattern().nnz() entries, in pattern order). Thread-safe.
   void jacobian(const double* q, double t, double* csc_values) const;
+  /// residual() and jacobian() together, in one pass over the constraints (cheaper than the two calls on large
+  /// models, where each pass streams the constraint data from memory). Thread-safe.
+  void residual_and_jacobian(const double* q, double t, double* phi, double* csc_values) const;
   /// ∂Φ/∂t into out (m entries; zero rows for constraints that do not depend on t). Thread-safe.
   void phi_t(const double* q, double t, double* out) const;
   /// γ = −(Φq q̇)q q̇ − 2Φqt q̇ − Φtt into out (m entries). Pre-condition: qd has n entries. Thread-safe.

@@ -49,6 +49,12 @@ class Workspace {
   Eigen::VectorXd trial;                 ///< line-search trial point
   Eigen::VectorXd trial_phi;             ///< Φ at the trial point
   std::vector<double> jacobian_values;   ///< Φq values in jacobian_pattern() order
+  /// Φq evaluated by the Newton loop together with Φ at its trial point (NewtonOptions::jacobian_with_residual);
+  /// when the trial is accepted it becomes jacobian_values, valid at (jacobian_q, jacobian_t) while has_jacobian.
+  std::vector<double> trial_jacobian_values;
+  Eigen::VectorXd jacobian_q;            ///< see trial_jacobian_values
+  double jacobian_t = 0.0;               ///< see jacobian_q
+  bool has_jacobian = false;             ///< jacobian_values hold Φq at (jacobian_q, jacobian_t), not yet factorised
   /// Models with dropped rows (Model::without_rows()): the values of the kept rows in solve_pattern() order, and
   /// the right-hand side of the kept rows; empty otherwise.
   std::vector<double> solve_values;
