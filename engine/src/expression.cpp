@@ -429,9 +429,14 @@ class ExpressionParser {
     bool constant = false;  // true when it depends on neither q nor t
     double value = 0.0;     // its value when constant
   };
-  using NameNode = std::function<Node(const std::string&)>;
+  // What a name stands for: a constant value, or a GiNaC symbol (a coordinate or t).
+  struct Name {
+    std::optional<double> value;
+    GiNaC::ex symbol;
+  };
+  using NameLookup = std::function<Name(const std::string&)>;
 
-  ExpressionParser(const std::string& text, NameNode name, std::map<std::string, double>& value_of_constant)
+  ExpressionParser(const std::string& text, NameLookup name, std::map<std::string, double>& value_of_constant)
       : text_(text), name_(std::move(name)), value_of_constant_(value_of_constant) {}
 
   Node parse() {
@@ -579,7 +584,8 @@ class ExpressionParser {
       while (pos_ < text_.size() && is_ident_char(text_[pos_])) ++pos_;
       const std::string name = text_.substr(start, pos_ - start);
       if (peek() == '(') return call(name, start);
-      return name_(name);
+      const Name n = name_(name);
+      return n.value ? constant(*n.value) : Node{n.symbol, false, 0.0};
     }
     if (accept('(')) {
       if (++depth_ > CompiledExpression::kMaxNesting)
@@ -638,7 +644,7 @@ class ExpressionParser {
   }
 
   const std::string& text_;
-  NameNode name_;
+  NameLookup name_;
   std::map<std::string, double>& value_of_constant_;
   std::size_t pos_ = 0;
   int depth_ = 0;
@@ -660,38 +666,32 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   std::map<std::string, Index> coord_of_symbol;     // symbol name -> coordinate index
   std::map<std::string, double> value_of_constant;  // symbol name -> value folded in by the tape builder
   std::map<Index, realsymbol> symbol_of_coord;      // one symbol per coordinate, however many names it has
-  std::map<std::string, ExpressionParser::Node> named;
   realsymbol tsym("t");
-  ExpressionParser* parser_ptr = nullptr;
-  auto name_node = [&](const std::string& name) -> ExpressionParser::Node {
-    if (auto it = named.find(name); it != named.end()) return it->second;
-    ExpressionParser::Node n;
-    std::optional<NameBinding> b;
-    if (name != "pi") b = resolve(name);
-    if (name == "pi") {
-      n = parser_ptr->constant(M_PI);
-    } else if (!b) {
+  auto lookup = [&](const std::string& name) -> ExpressionParser::Name {
+    if (name == "pi") return {M_PI, {}};
+    const std::optional<NameBinding> b = resolve(name);
+    if (!b) {
       if (name == "t" && !allow_time) throw expression_error(text, "time 't' is not allowed here");
       throw expression_error(text, "unknown name '" + name.substr(0, 40) + "'");
-    } else if (b->kind == NameBinding::Kind::kTime) {
-      if (!allow_time) throw expression_error(text, "time 't' is not allowed here");
-      n = ExpressionParser::Node{tsym, false, 0.0};
-    } else if (b->kind == NameBinding::Kind::kConstant) {
-      if (!std::isfinite(b->value)) throw expression_error(text, "'" + name + "' is not finite");
-      n = parser_ptr->constant(b->value);
-    } else {
-      auto [it, fresh] = symbol_of_coord.try_emplace(b->coordinate, "q:" + std::to_string(b->coordinate));
-      if (fresh) coord_of_symbol[it->second.get_name()] = b->coordinate;
-      n = ExpressionParser::Node{it->second, false, 0.0};
     }
-    named.emplace(name, n);
-    return n;
+    switch (b->kind) {
+      case NameBinding::Kind::kTime:
+        if (!allow_time) throw expression_error(text, "time 't' is not allowed here");
+        return {std::nullopt, tsym};
+      case NameBinding::Kind::kConstant:
+        if (!std::isfinite(b->value)) throw expression_error(text, "'" + name + "' is not finite");
+        return {b->value, {}};
+      case NameBinding::Kind::kCoordinate:
+        break;
+    }
+    auto [it, fresh] = symbol_of_coord.try_emplace(b->coordinate, "q:" + std::to_string(b->coordinate));
+    if (fresh) coord_of_symbol[it->second.get_name()] = b->coordinate;
+    return {std::nullopt, it->second};
   };
 
   ex g;
   try {
-    ExpressionParser parser(text, name_node, value_of_constant);
-    parser_ptr = &parser;
+    ExpressionParser parser(text, lookup, value_of_constant);
     g = parser.parse().e;
   } catch (const Error&) {
     throw;
