@@ -307,7 +307,7 @@ TEST(Generate, HeaderStatesTheCounts) {
 }
 
 TEST(Generate, OutputsAndStepsReachTheScene) {
-  for (const char* kind : {"scissor", "grid"}) {
+  for (const char* kind : {"scissor", "grid", "chain3d"}) {
     GenerateOptions o = generate_options(kind, 3, "reference-point", 0.4, 1.0, 7);
     o.v = false;
     o.a = false;
@@ -362,7 +362,7 @@ TEST(Generate, FamilyFormIsTheExplicitModel) {
 
 TEST(Generate, RefusesBadOptionsLikeNFourBar) {
   const auto message = test::generate_error;
-  for (const char* kind : {"nfourbar", "scissor", "grid"}) {
+  for (const char* kind : {"nfourbar", "scissor", "grid", "chain3d"}) {
     GenerateOptions o = generate_options(kind, 3, "natural", 0.5, 1.0);
     o.n = 0;
     EXPECT_EQ(message(o), "N must be at least 1") << kind;
@@ -377,7 +377,7 @@ TEST(Generate, RefusesBadOptionsLikeNFourBar) {
     EXPECT_EQ(message(o), "--outputs must include q (positions are always written)") << kind;
   }
   EXPECT_EQ(message(generate_options("gears", 3, "natural", 0.5, 1.0)),
-            "unknown kind 'gears' (available: nfourbar, scissor, grid)");
+            "unknown kind 'gears' (available: nfourbar, scissor, grid, chain3d)");
   // driven ranges that reach a singular position
   for (double bad : {0.0, -0.1, M_PI / 2, 2.0}) {
     EXPECT_NE(message(generate_options("scissor", 3, "natural", bad, 1.0)).find("strictly between 0 (flat) and pi/2"),
