@@ -29,12 +29,13 @@ using emit::SceneText;
 using gen::num;
 
 constexpr double kPi = 3.14159265358979323846;
-// The rough placement (so that the first solve is an assembly): the exact solution at crank angle from + δ, every
-// point shifted by kShift along u (off its hinge's plane). Both moves keep every coupler exact, so that the
-// assembly is a few Newton iterations at any N (a placement that lengthened every coupler a little would add up to
-// a large turn along a long chain). δ = kTurn, or a tenth of the distance to the nearest singular position of the
-// parallelogram row if that is less, away from it.
-constexpr double kTurn = 0.02, kShift = 0.01;
+// The rough placement (so that the first solve is an assembly): the exact solution at t = 0 with every point shifted
+// by kShift along u, off its hinge's plane; the assembly moves each crank back on its own. A placement off the
+// solution along the chain's motion (every crank turned a little), or one that lengthened every coupler a little
+// (adding up to a large turn along a long chain), takes a correction through the whole chain: Newton failed on the
+// second at N = 10^5, and the minimum-norm assembly of `phiq check`, which solves with Φq Φqᵀ, did not converge on
+// the first at N = 10^6 (100 iterations, residual 8e-9); the shift takes 3-4 iterations at any N.
+constexpr double kShift = 0.01;
 // The twisted row's conditioning grows like 1/|sin twist|.
 constexpr double kMinSinTwist = 0.01;
 
@@ -60,19 +61,16 @@ std::string vector_parameters(const std::string& name, const chain3d::Vec& v, co
 }
 
 // The parameters both styles read: the size, the drive's start, the twist, the coupler length, the pivot step, the
-// axes, and the rough placement.
+// axes, and the rough placement's shift.
 std::string parameters(const GenerateOptions& o, const chain3d::Geometry& g) {
   const bool twisted = o.twist != 0.0;
-  const double r = std::remainder(o.from, kPi);  // from − the nearest multiple of π
-  const double turn = twisted ? kTurn : std::copysign(std::min(kTurn, 0.1 * std::fabs(r)), r);
   return "parameters:\n  N: " + gen::str(o.n) + "\n  from: " + num(o.from) + "    # crank 0's angle at t = 0\n  tw: " +
          num(o.twist) + "    # crank i+1's phase ahead of crank i\n  L: " + num(chain3d::coupler_length(o.twist)) +
          "    # coupler length\n" +
          vector_parameters("o", twisted ? g.u : g.e1, "pivot step: O_i = i (ox, oy, oz)") +
          vector_parameters("u", g.u, "hinge axis") + vector_parameters("e1", g.e1, "crank direction at angle 0") +
-         vector_parameters("e2", g.e2, "u x e1: crank direction at angle pi/2") + "  a0: " + num(o.from + turn) +
-         "    # rough placement: the solution at crank angle a0 (not from), shifted by 'shift' along u\n  shift: " +
-         num(kShift) + "\n";
+         vector_parameters("e2", g.e2, "u x e1: crank direction at angle pi/2") + "  shift: " + num(kShift) +
+         "    # rough placement: the solution at t = 0 shifted along u, off the hinges' planes\n";
 }
 
 // The drive's description.
@@ -101,8 +99,8 @@ struct Style {
 };
 
 // The scene up to the body of the coordinates' family: the header, dimension 3, the parameters, and `for i in
-// 0..N:` with the three coordinates of crank i's point, placed roughly: the exact position at angle a0 shifted
-// along u. The caller continues the family's body.
+// 0..N:` with the three coordinates of crank i's point, placed roughly: the exact position at t = 0 shifted along
+// u. The caller continues the family's body.
 SceneText begin(const GenerateOptions& o, const chain3d::Geometry& g, const Style& s) {
   SceneText t(4096);
   gen::header(t, o, what(o), drive(o, s.driven), s.coordinates, s.kinematic, 1, s.names);
@@ -111,8 +109,8 @@ SceneText begin(const GenerateOptions& o, const chain3d::Geometry& g, const Styl
   t.section("coordinates");
   std::string c = "  for i in 0..N:\n";
   for (const char* k : {"x", "y", "z"})
-    c += std::string("    ") + k + s.suffix + "{i}: i*o" + k + " + " + s.radius + "*(cos(a0 + i*tw)*e1" + k +
-         " + sin(a0 + i*tw)*e2" + k + ") + shift*u" + k + "\n";
+    c += std::string("    ") + k + s.suffix + "{i}: i*o" + k + " + " + s.radius + "*(cos(from + i*tw)*e1" + k +
+         " + sin(from + i*tw)*e2" + k + ") + shift*u" + k + "\n";
   t.raw(c);
   return t;
 }
@@ -176,7 +174,7 @@ std::string chain3d_reference_point(const GenerateOptions& o) {
                        euler, "c", "0.5"});
   std::string c;
   for (char k : {'0', '1', '2', '3'})
-    c += std::string("    e") + k + "c{i}: qa" + k + "*cos((a0 + i*tw)/2) + qb" + k + "*sin((a0 + i*tw)/2)\n";
+    c += std::string("    e") + k + "c{i}: qa" + k + "*cos((from + i*tw)/2) + qb" + k + "*sin((from + i*tw)/2)\n";
   t.raw(c);
   t.section("bodies");
   t.raw("  for i in 0..N:\n    crank{i}: [\"xc{i}\", \"yc{i}\", \"zc{i}\", \"e0c{i}\", \"e1c{i}\", \"e2c{i}\", "
