@@ -634,7 +634,35 @@ TEST_F(Cli, GenerateScissorAndGridRefuseBadOptions) {
     EXPECT_NE(r.err.find("generate: --from and --to: "), std::string::npos) << r.err;
   }
   EXPECT_EQ(run("generate scissor 5 --to 1.6" + x).code, 2);  // beyond vertical
-  EXPECT_NE(run("generate gears 5" + x).err.find("available: nfourbar, scissor, grid"), std::string::npos);
+  EXPECT_NE(run("generate gears 5" + x).err.find("available: nfourbar, scissor, grid, chain3d"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
+}
+
+TEST_F(Cli, GeneratedChain3dRuns) {
+  // the command as written: N = 10 spatial loops, the default quarter turn in 1000 steps
+  const fs::path scene = dir_ / "c.yaml", out = dir_ / "c.csv";
+  ASSERT_EQ(run("generate chain3d 10 -o " + scene.string()).code, 0);
+  Result r = run("run -q " + scene.string() + " -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto c = columns_of(slurp(out));
+  ASSERT_EQ(c["t"].size(), 1001u);
+  ASSERT_EQ(c.size(), 1u + 3 * 34);  // t and x0, y0, z0, ..., z10, theta with their .v and .a
+  // the last row: every crank at 3π/4 about u = (1, 2, 2)/3 from e1 = d = (2, 1, -2)/3, P_10 = 10 d + c(3π/4)
+  const double th = 3 * M_PI / 4, e1[3] = {2. / 3, 1. / 3, -2. / 3}, e2[3] = {-2. / 3, 2. / 3, -1. / 3};
+  const char* axes[3] = {"x10", "y10", "z10"};
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(c[axes[k]].back(), 10 * e1[k] + std::cos(th) * e1[k] + std::sin(th) * e2[k], 1e-9) << axes[k];
+  // the twisted row in reference-point coordinates through a full turn, and the options it refuses
+  ASSERT_EQ(run("generate chain3d 4 --coords reference-point --twist 2 --from 0 --to 6.3 --steps 100 -o " +
+                scene.string()).code, 0);
+  EXPECT_NE(slurp(scene).find("--coords reference-point --twist 2:"), std::string::npos);
+  r = run("run -q " + scene.string() + " -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(columns_of(slurp(out))["t"].size(), 101u);
+  const std::string x = " -o " + (dir_ / "x.yaml").string();
+  EXPECT_EQ(run("generate chain3d 5 --from 0" + x).code, 2);            // the parallelogram row lies flat
+  EXPECT_EQ(run("generate chain3d 5 --twist 3.1415926" + x).code, 2);   // neighbours opposite: singular
+  EXPECT_EQ(run("generate nfourbar 5 --twist 1" + x).code, 2);          // chain3d only
   EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
 }
 

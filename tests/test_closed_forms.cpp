@@ -93,6 +93,11 @@ TEST(ClosedForms, VelocitiesAndAccelerationsAreTheDerivativesOfThePositions) {
   auto f = make_closed_form("nfourbar:from=0.3,to=2.5");
   f->bind({"x0", "y0", "x7", "y7", "theta", "xc3", "yc3", "psi3", "xk2", "yk2", "phi2"});
   expect_derivatives_of_positions(*f, 11, 0.0, 1.0);
+  for (const char* spec : {"chain3d:from=0.3,to=2.5", "chain3d:from=-1,to=2,twist=2"}) {
+    auto c = make_closed_form(spec);
+    c->bind({"x0", "y3", "z12", "theta", "xc3", "yc0", "zc7", "e0c0", "e1c3", "e2c5", "e3c11"});
+    expect_derivatives_of_positions(*c, 11, 0.0, 1.0);
+  }
 }
 
 TEST(ClosedForms, BadSpecificationsAreRefused) {
@@ -110,6 +115,11 @@ TEST(ClosedForms, BadSpecificationsAreRefused) {
   EXPECT_EQ(tools::closed_form_for_scene_name("nfourbar_1000_natural"), "nfourbar");
   EXPECT_EQ(tools::closed_form_for_scene_name("crank_slider_mixed"), "crank-slider");
   EXPECT_EQ(tools::closed_form_for_scene_name("scissor_10_natural"), "");
+  EXPECT_EQ(tools::closed_form_for_scene_name("chain3d_10_reference_point"), "chain3d");
+  auto c = make_closed_form("chain3d");
+  EXPECT_EQ(c->describe(), "chain3d:from=0.7853981633974483,to=2.356194490192345,twist=0");
+  for (const char* bad : {"x", "w1", "xk1", "e4c1", "e0c", "e0k1", "psi0"})
+    EXPECT_THROW(c->bind({"x0", bad}), std::invalid_argument) << bad;
 }
 
 // phiq at tolerance 1e-12 (full Newton) against the closed form at every time point: positions (angles modulo 2π),

@@ -22,17 +22,7 @@ namespace {
 
 using tools::GenerateOptions;
 
-GenerateOptions options(const std::string& kind, std::int64_t n, const std::string& coords, double from, double to,
-                        std::int64_t steps = 24) {
-  GenerateOptions o;
-  o.kind = kind;
-  o.n = n;
-  o.coords = coords;
-  o.from = from;
-  o.to = to;
-  o.steps = steps;
-  return o;
-}
+using test::generate_options;
 
 // A closed form: c + Σ (A cos θ_k + B sin θ_k + D θ_k) over driven angles θ_k(t) = θ_k(0) + r_k t.
 struct Term {
@@ -235,8 +225,8 @@ constexpr std::int64_t kSizes[] = {1, 2, 5, 7};
 
 TEST(GenerateScissor, BothCoordinateStylesFollowTheClosedFormAndAgree) {
   for (std::int64_t n : kSizes) {
-    const SweptScene nat = check_against_closed_form(options("scissor", n, "natural", 0.3, 1.2));
-    const SweptScene ref = check_against_closed_form(options("scissor", n, "reference-point", 0.3, 1.2));
+    const SweptScene nat = check_against_closed_form(generate_options("scissor", n, "natural", 0.3, 1.2));
+    const SweptScene ref = check_against_closed_form(generate_options("scissor", n, "reference-point", 0.3, 1.2));
     // shared quantities: the lift's height (top joint) and the crossing pins, with their velocities
     ASSERT_EQ(nat.trace.t.size(), ref.trace.t.size());
     double worst = 0.0;
@@ -266,8 +256,9 @@ TEST(GenerateScissor, BothCoordinateStylesFollowTheClosedFormAndAgree) {
 
 TEST(GenerateGrid, BothCoordinateStylesFollowTheClosedFormAndAgree) {
   for (std::int64_t n : kSizes) {
-    const SweptScene nat = check_against_closed_form(options("grid", n, "natural", M_PI / 4, 3 * M_PI / 4));
-    const SweptScene ref = check_against_closed_form(options("grid", n, "reference-point", M_PI / 4, 3 * M_PI / 4));
+    const SweptScene nat = check_against_closed_form(generate_options("grid", n, "natural", M_PI / 4, 3 * M_PI / 4));
+    const SweptScene ref =
+        check_against_closed_form(generate_options("grid", n, "reference-point", M_PI / 4, 3 * M_PI / 4));
     // shared quantities: every node above ground, natural (x, y) against the top of the vertical bar below it
     const Shape g = shape_of(n);
     ASSERT_EQ(nat.trace.t.size(), ref.trace.t.size());
@@ -298,26 +289,26 @@ TEST(GenerateGrid, ShapeHasExactlyNCells) {
     EXPECT_EQ(s.cols, c.cols) << c.n;
     EXPECT_EQ(s.rows, c.rows) << c.n;
     EXPECT_EQ(s.last, c.last) << c.n;
-    const std::string text = tools::generate_scene(options("grid", c.n, "natural", 1.0, 2.0, 1));
+    const std::string text = tools::generate_scene(generate_options("grid", c.n, "natural", 1.0, 2.0, 1));
     const std::string shape = std::to_string(c.rows) + " rows of " + std::to_string(c.cols) + " cells";
     EXPECT_NE(text.find(shape), std::string::npos) << text.substr(0, 400);
   }
 }
 
 TEST(Generate, HeaderStatesTheCounts) {
-  const std::string s = tools::generate_scene(options("scissor", 5, "natural", 0.3, 1.2));
+  const std::string s = tools::generate_scene(generate_options("scissor", 5, "natural", 0.3, 1.2));
   EXPECT_NE(s.find("# Counts: 32 coordinates, 31 kinematic equations + 1 driver = 32 equations; 1 dof\n"),
             std::string::npos)
       << s.substr(0, 800);
-  const std::string g = tools::generate_scene(options("grid", 5, "reference-point", 0.5, 2.5));
+  const std::string g = tools::generate_scene(generate_options("grid", 5, "reference-point", 0.5, 2.5));
   EXPECT_NE(g.find("# Counts: 36 coordinates, 34 kinematic equations + 2 drivers = 36 equations; 2 dof\n"),
             std::string::npos)
       << g.substr(0, 800);
 }
 
 TEST(Generate, OutputsAndStepsReachTheScene) {
-  for (const char* kind : {"scissor", "grid"}) {
-    GenerateOptions o = options(kind, 3, "reference-point", 0.4, 1.0, 7);
+  for (const char* kind : {"scissor", "grid", "chain3d"}) {
+    GenerateOptions o = generate_options(kind, 3, "reference-point", 0.4, 1.0, 7);
     o.v = false;
     o.a = false;
     Scene s = parse_scene(tools::generate_scene(o), "s.yaml");
@@ -337,7 +328,9 @@ TEST(Generate, SceneSizeDoesNotGrowWithN) {
   // has the shape of N = 10^5 (316 rows of 317, the last 145); any N stays under 8 KB.
   for (const char* kind : {"scissor", "grid"})
     for (const char* coords : {"natural", "reference-point"}) {
-      auto size = [&](std::int64_t n) { return tools::generate_scene(options(kind, n, coords, 0.5, 1.0, 10)).size(); };
+      auto size = [&](std::int64_t n) {
+        return tools::generate_scene(generate_options(kind, n, coords, 0.5, 1.0, 10)).size();
+      };
       const std::size_t small = size(std::string(kind) == "grid" ? 14 : 10), large = size(100000);
       EXPECT_LT(std::max(small, large) - std::min(small, large), 100u) << kind << " " << coords;
       for (std::int64_t n : {1, 2, 3, 7, 10, 1000000, 10000000}) EXPECT_LT(size(n), 8192u) << kind << " " << coords;
@@ -357,7 +350,7 @@ TEST(Generate, FamilyFormIsTheExplicitModel) {
     for (const char* coords : {"natural", "reference-point"})
       for (auto [from, to] : {std::pair{0.3, 1.2}, std::pair{1.1, 0.4}}) {
         SCOPED_TRACE(std::string(c.kind) + " " + std::to_string(c.n) + " " + coords + " " + std::to_string(from));
-        const GenerateOptions o = options(c.kind, c.n, coords, from, to, 5);
+        const GenerateOptions o = generate_options(c.kind, c.n, coords, from, to, 5);
         const std::string families = tools::generate_scene(o), listed = test::explicit_linkages::scene(o);
         EXPECT_NE(families.find("for k in"), std::string::npos);
         EXPECT_EQ(listed.find(" in 0.."), std::string::npos);
@@ -368,41 +361,36 @@ TEST(Generate, FamilyFormIsTheExplicitModel) {
 }
 
 TEST(Generate, RefusesBadOptionsLikeNFourBar) {
-  auto message = [](GenerateOptions o) -> std::string {
-    try {
-      tools::generate_scene(o);
-    } catch (const std::invalid_argument& e) {
-      return e.what();
-    }
-    return "(no error)";
-  };
-  for (const char* kind : {"nfourbar", "scissor", "grid"}) {
-    GenerateOptions o = options(kind, 3, "natural", 0.5, 1.0);
+  const auto message = test::generate_error;
+  for (const char* kind : {"nfourbar", "scissor", "grid", "chain3d"}) {
+    GenerateOptions o = generate_options(kind, 3, "natural", 0.5, 1.0);
     o.n = 0;
     EXPECT_EQ(message(o), "N must be at least 1") << kind;
-    o = options(kind, 3, "polar", 0.5, 1.0);
+    o = generate_options(kind, 3, "polar", 0.5, 1.0);
     EXPECT_EQ(message(o), "--coords is natural or reference-point") << kind;
-    o = options(kind, 3, "natural", 0.5, 1.0, -1);
+    o = generate_options(kind, 3, "natural", 0.5, 1.0, -1);
     EXPECT_EQ(message(o), "--steps must be >= 0") << kind;
-    o = options(kind, 3, "natural", 0.5, NAN);
+    o = generate_options(kind, 3, "natural", 0.5, NAN);
     EXPECT_EQ(message(o), "--from and --to must be finite") << kind;
-    o = options(kind, 3, "natural", 0.5, 1.0);
+    o = generate_options(kind, 3, "natural", 0.5, 1.0);
     o.q = false;
     EXPECT_EQ(message(o), "--outputs must include q (positions are always written)") << kind;
   }
-  EXPECT_EQ(message(options("gears", 3, "natural", 0.5, 1.0)),
-            "unknown kind 'gears' (available: nfourbar, scissor, grid)");
+  EXPECT_EQ(message(generate_options("gears", 3, "natural", 0.5, 1.0)),
+            "unknown kind 'gears' (available: nfourbar, scissor, grid, chain3d)");
   // driven ranges that reach a singular position
   for (double bad : {0.0, -0.1, M_PI / 2, 2.0}) {
-    EXPECT_NE(message(options("scissor", 3, "natural", bad, 1.0)).find("strictly between 0 (flat) and pi/2"),
+    EXPECT_NE(message(generate_options("scissor", 3, "natural", bad, 1.0)).find("strictly between 0 (flat) and pi/2"),
               std::string::npos);
-    EXPECT_NE(message(options("scissor", 3, "reference-point", 0.5, bad)).find("--from and --to"), std::string::npos);
+    EXPECT_NE(message(generate_options("scissor", 3, "reference-point", 0.5, bad)).find("--from and --to"),
+              std::string::npos);
   }
   for (double bad : {0.0, M_PI, 4.0}) {
-    EXPECT_NE(message(options("grid", 3, "natural", bad, 1.0)).find("strictly between 0 and pi"), std::string::npos);
-    EXPECT_NE(message(options("grid", 3, "natural", 1.0, bad)).find("--from and --to"), std::string::npos);
+    EXPECT_NE(message(generate_options("grid", 3, "natural", bad, 1.0)).find("strictly between 0 and pi"),
+              std::string::npos);
+    EXPECT_NE(message(generate_options("grid", 3, "natural", 1.0, bad)).find("--from and --to"), std::string::npos);
   }
-  EXPECT_EQ(message(options("grid", 3, "natural", 2.0, 3.0)), "(no error)");  // beyond π/2 is fine for the grid
+  EXPECT_EQ(message(generate_options("grid", 3, "natural", 2.0, 3.0)), "(no error)");  // beyond π/2: fine for the grid
 }
 
 }  // namespace

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -13,6 +15,7 @@
 #include "phiq/phiq.hpp"
 #include "../bench/nfourbar_model.hpp"
 #include "closed_forms.hpp"
+#include "generate.hpp"
 
 namespace phiq::test {
 
@@ -178,6 +181,29 @@ inline void expect_same_model(const Model& a, const Model& b) {
   EXPECT_EQ(ja, jb);
   EXPECT_EQ(ta, tb);
   EXPECT_EQ(ga, gb);
+}
+
+// Options of `phiq generate KIND N`: the coordinates, the driven range and the steps (the rest as defaults).
+inline tools::GenerateOptions generate_options(const std::string& kind, std::int64_t n, const std::string& coords,
+                                               double from, double to, std::int64_t steps = 24) {
+  tools::GenerateOptions o;
+  o.kind = kind;
+  o.n = n;
+  o.coords = coords;
+  o.from = from;
+  o.to = to;
+  o.steps = steps;
+  return o;
+}
+
+// The message tools::generate_scene() refuses `o` with, or "(no error)".
+inline std::string generate_error(const tools::GenerateOptions& o) {
+  try {
+    tools::generate_scene(o);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "(no error)";
 }
 
 // Difference of two angles, wrapped to (-pi, pi].

@@ -1,5 +1,7 @@
 #include "closed_forms.hpp"
 
+#include "chain3d_geometry.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -213,6 +215,55 @@ class NFourBar final : public ClosedForm {
   Params p_;
 };
 
+// `phiq generate chain3d` (generate_chain3d.cpp, geometry in chain3d_geometry.hpp): N + 1 unit cranks on hinges of
+// axis u, crank i pinned at O_i = i·o and at angle φ_i = θ + i·twist about u, θ = from + (to − from)·t, its tip
+// P_i = O_i + cos φ_i e1 + sin φ_i e2 (o = e1 for twist 0, the parallelogram row; o = u otherwise). Natural (tips
+// x<i>, y<i>, z<i> and theta) and reference-point (crank centres xc, yc, zc at half the radius; Euler parameters
+// e0c … e3c = cos(φ_i/2) qa + sin(φ_i/2) qb) coordinates. Each is written in the angles θ (0) and θ/2 (1):
+// cos(θ + β) = cos β cos θ − sin β sin θ.
+class Chain3d final : public ClosedForm {
+ public:
+  explicit Chain3d(Params p) : p_(std::move(p)), g_(chain3d::geometry()), twist_(p_["twist"]) {}
+  std::string describe() const override { return p_.describe(); }
+
+ protected:
+  bool terms_of(const std::string& n, Binding& b) const override {
+    using T = ClosedForm::Term;
+    if (n == "theta") return b = {{{T::kAngle, 0, 1.0}}, true}, true;
+    // c · (cos(angle + β) a + sin(angle + β) b), one component: terms in cos and sin of `angle`
+    auto rotating = [](int angle, double beta, double c, double a, double b) {
+      const double cb = std::cos(beta), sb = std::sin(beta);
+      return std::vector<T>{{T::kCos, angle, c * (cb * a + sb * b)}, {T::kSin, angle, c * (cb * b - sb * a)}};
+    };
+    if (n.size() > 3 && n[0] == 'e' && n[1] >= '0' && n[1] <= '3' && n[2] == 'c') {  // Euler parameter e<k>c<i>
+      const long i = split_index(n.substr(2)).second;
+      const auto k = static_cast<std::size_t>(n[1] - '0');
+      if (i < 0) return false;
+      b = {rotating(1, 0.5 * twist_ * static_cast<double>(i), 1.0, g_.qa[k], g_.qb[k]), false};
+      return true;
+    }
+    // tips x<i>, y<i>, z<i>; crank centres xc<i>, yc<i>, zc<i> (half the radius)
+    const auto [prefix, i] = split_index(n);
+    if (i < 0 || prefix.size() > 2 || prefix[0] < 'x' || prefix[0] > 'z' || (prefix.size() == 2 && prefix[1] != 'c'))
+      return false;
+    const auto k = static_cast<std::size_t>(prefix[0] - 'x');
+    const double x = static_cast<double>(i);
+    b = {rotating(0, twist_ * x, prefix.size() == 2 ? 0.5 : 1.0, g_.e1[k], g_.e2[k]), false};
+    b.terms.push_back({T::kConstant, -1, x * (twist_ == 0.0 ? g_.e1 : g_.u)[k]});
+    return true;
+  }
+  void angles(double t, std::vector<Motion>& out) const override {
+    const double from = p_["from"], rate = p_["to"] - from;
+    const Motion th{from + rate * t, rate, 0.0};
+    out = {th, {0.5 * th.q, 0.5 * th.v, 0.5 * th.a}};
+  }
+
+ private:
+  Params p_;
+  chain3d::Geometry g_;
+  double twist_;
+};
+
 }  // namespace
 
 void ClosedForm::bind(const std::vector<std::string>& coordinates) {
@@ -273,7 +324,10 @@ std::unique_ptr<ClosedForm> make_closed_form(const std::string& spec) {
                                            {"omega", 1.0}, {"branch", 1.0}});
   else if (kind == "nfourbar")
     p = std::make_unique<Params>(kind, std::vector<std::pair<std::string, double>>{{"from", kPi / 4}, {"to", 3 * kPi / 4}});
-  else throw std::invalid_argument("unknown closed form '" + kind + "' (crank-slider, fourbar, nfourbar)");
+  else if (kind == "chain3d")
+    p = std::make_unique<Params>(kind, std::vector<std::pair<std::string, double>>{
+                                           {"from", kPi / 4}, {"to", 3 * kPi / 4}, {"twist", 0.0}});
+  else throw std::invalid_argument("unknown closed form '" + kind + "' (crank-slider, fourbar, nfourbar, chain3d)");
   if (colon != std::string::npos) {
     const std::string rest = spec.substr(colon + 1);
     std::size_t start = 0;
@@ -293,6 +347,7 @@ std::unique_ptr<ClosedForm> make_closed_form(const std::string& spec) {
   }
   if (kind == "crank-slider") return std::make_unique<CrankSlider>(std::move(*p));
   if (kind == "fourbar") return std::make_unique<FourBar>(std::move(*p));
+  if (kind == "chain3d") return std::make_unique<Chain3d>(std::move(*p));
   return std::make_unique<NFourBar>(std::move(*p));
 }
 
@@ -300,6 +355,7 @@ std::string closed_form_for_scene_name(const std::string& n) {
   auto starts = [&](const char* s) { return n.rfind(s, 0) == 0; };
   if (starts("crank_slider")) return "crank-slider";
   if (starts("nfourbar_")) return "nfourbar";
+  if (starts("chain3d_")) return "chain3d";
   if (starts("fourbar_")) return "fourbar";
   return "";
 }

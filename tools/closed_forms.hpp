@@ -1,7 +1,7 @@
 // Closed-form kinematics of the mechanisms phiq's accuracy is measured on (`phiq sweep-accuracy`, tools/README.md):
-// the seed crank-slider, the seed four-bar (any of its four formulations) and the generated nfourbar. Derived from
-// the geometry alone (circle intersections and their time derivatives), never from phiq's solver, so that they are
-// an independent reference.
+// the seed crank-slider, the seed four-bar (any of its four formulations) and the generated nfourbar and chain3d.
+// Derived from the geometry alone (circle intersections and their time derivatives), never from phiq's solver, so
+// that they are an independent reference.
 #pragma once
 
 #include <memory>
@@ -22,7 +22,7 @@ struct Motion {
 class ClosedForm {
  public:
   virtual ~ClosedForm() = default;
-  // "crank-slider", "fourbar" or "nfourbar", with the parameters in use: "fourbar:L1=1,L2=0.4,...".
+  // "crank-slider", "fourbar", "nfourbar" or "chain3d", with the parameters in use: "fourbar:L1=1,L2=0.4,...".
   virtual std::string describe() const = 0;
   // Binds the coordinates of a model, in order; afterwards evaluate() fills one entry per bound name. Throws
   // std::invalid_argument naming the first coordinate this mechanism does not have.
@@ -74,12 +74,13 @@ class ClosedFormErrors {
   std::vector<double> rq_, rv_, ra_;  // the closed form at t
 };
 
-// Parses "KIND[:NAME=VALUE,...]" (KIND crank-slider, fourbar or nfourbar; parameters in describe() order, defaults
-// those of models/seed/ and of `phiq generate nfourbar`). Throws std::invalid_argument for an unknown kind or
+// Parses "KIND[:NAME=VALUE,...]" (KIND crank-slider, fourbar, nfourbar or chain3d; parameters in describe() order,
+// defaults those of models/seed/ and of `phiq generate nfourbar` and `chain3d`). Throws std::invalid_argument for an unknown kind or
 // parameter, a value that is not a finite number, or impossible geometry.
 std::unique_ptr<ClosedForm> make_closed_form(const std::string& spec);
 
-// The closed form a scene's `name` suggests ("crank_slider_*", "fourbar_*", "nfourbar_*"), or "" if none.
+// The closed form a scene's `name` suggests ("crank_slider_*", "fourbar_*", "nfourbar_*", "chain3d_*"), or "" if
+// none.
 std::string closed_form_for_scene_name(const std::string& scene_name);
 
 }  // namespace phiq::tools

@@ -101,6 +101,8 @@ std::string generate_scene(const GenerateOptions& o) {
   if (o.steps < 0) throw std::invalid_argument("--steps must be >= 0");
   if (!std::isfinite(o.from) || !std::isfinite(o.to)) throw std::invalid_argument("--from and --to must be finite");
   if (!o.q) throw std::invalid_argument("--outputs must include q (positions are always written)");
+  if (!std::isfinite(o.twist)) throw std::invalid_argument("--twist must be finite");
+  if (o.twist != 0.0 && o.kind != "chain3d") throw std::invalid_argument("--twist applies to chain3d only");
   if (o.kind == "nfourbar") {
     if (o.coords == "natural") return nfourbar_natural(o);
     if (o.coords == "reference-point") return nfourbar_reference_point(o);
@@ -108,7 +110,8 @@ std::string generate_scene(const GenerateOptions& o) {
   }
   if (o.kind == "scissor") return scissor_scene(o);
   if (o.kind == "grid") return grid_scene(o);
-  throw std::invalid_argument("unknown kind '" + o.kind + "' (available: nfourbar, scissor, grid)");
+  if (o.kind == "chain3d") return chain3d_scene(o);
+  throw std::invalid_argument("unknown kind '" + o.kind + "' (available: nfourbar, scissor, grid, chain3d)");
 }
 
 }  // namespace phiq::tools

@@ -482,15 +482,19 @@ int main(int argc, char** argv) {
 
   phiq::tools::GenerateOptions gen;
   std::string gen_out, gen_outputs = "q,v,a";
-  CLI::App* generate = app.add_subcommand("generate", "Write a scalable scene (nfourbar, scissor, grid)");
-  generate->add_option("kind", gen.kind, "nfourbar, scissor or grid")->required();
-  generate->add_option("N", gen.n, "Size: four-bars (nfourbar), stages (scissor), cells (grid)")->required();
+  CLI::App* generate = app.add_subcommand("generate", "Write a scalable scene (nfourbar, scissor, grid, chain3d)");
+  generate->add_option("kind", gen.kind, "nfourbar, scissor, grid or chain3d")->required();
+  generate->add_option("N", gen.n, "Size: four-bars (nfourbar), stages (scissor), cells (grid), spatial loops (chain3d)")
+      ->required();
   generate->add_option("-o,--output", gen_out, "Scene file to write")->required();
   generate->add_option("--steps", gen.steps, "Sweep intervals")->capture_default_str();
   CLI::Option* gen_from =
       generate->add_option("--from", gen.from, "Driven angle at t = 0 (rad; default pi/4, scissor 0.3)");
   CLI::Option* gen_to = generate->add_option("--to", gen.to, "Driven angle at t = 1 (rad; default 3pi/4, scissor 1.2)");
   generate->add_option("--coords", gen.coords, "natural or reference-point")->capture_default_str();
+  generate->add_option("--twist", gen.twist,
+                       "chain3d: phase between neighbouring cranks on one hinge line (rad; 0: the parallelogram row)")
+      ->capture_default_str();
   generate->add_option("--outputs", gen_outputs, "Which of q (positions), v, a the scene asks for")
       ->capture_default_str();
 

@@ -2,7 +2,8 @@
 // generator writes (a coordinate, a point, a body, one constraint of each kind, a driver, the footer) is written by
 // one member function here, so that a change of syntax, such as the compact "indexed family" form of the scale
 // issue, is a change of this file only. The indexed families (`for i in A..B`) the generators now write are built
-// by the generators themselves and written with raw(). Names are systematic: a family and up to two indices (Name).
+// by the generators themselves and written with raw() (tools/generate_linkages.cpp, tools/generate_chain3d.cpp).
+// Names are systematic: a family and up to two indices (Name).
 #pragma once
 
 #include <charconv>
@@ -93,9 +94,10 @@ class SceneText {
 
   // Under `drivers:`: coordinate = initial + rate · t.
   void linear_driver(Name n, Name coordinate, double initial, double rate) {
-    w("  - {name: ", n, ", coordinate: ", coordinate, ", law: {type: linear, initial: ", initial, ", rate: ", rate,
-      "}}\n");
+    driver(n, "coordinate", coordinate, initial, rate);
   }
+  // Under `drivers:` (dimension 3): the angle of the revolute joint `joint` = initial + rate · t.
+  void joint_driver(Name n, Name joint, double initial, double rate) { driver(n, "joint", joint, initial, rate); }
 
   // The footer: the sweep and the outputs.
   void time(double start, double end, std::int64_t steps) {
@@ -112,6 +114,11 @@ class SceneText {
   template <class... A>
   void w(const A&... a) {
     (put(a), ...);
+  }
+
+  // A driver of `what` (coordinate or joint) with a linear law.
+  void driver(Name n, std::string_view key, Name what, double initial, double rate) {
+    w("  - {name: ", n, ", ", key, ": ", what, ", law: {type: linear, initial: ", initial, ", rate: ", rate, "}}\n");
   }
 
   void put(char c) { s_.push_back(c); }
