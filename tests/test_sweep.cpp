@@ -165,7 +165,10 @@ TEST(Sweep, ReverseTimeAndSingleStepSweeps) {
   opt.steps = 0;
   test::Trace one;
   ASSERT_EQ(test::sweep(m, opt, &one), SolveStatus::kSuccess);
-  EXPECT_EQ(one.t.size(), 1u);
+  ASSERT_EQ(one.t.size(), 1u);
+  // no step: the one row is the position at t_begin (it was labelled and solved at t_end)
+  EXPECT_EQ(one.t[0], 1.0);
+  EXPECT_NEAR(one.q[0](3), tr.q.front()(3), 1e-12);
 }
 
 

@@ -464,7 +464,7 @@ struct Run {
 
   // t_k computed from k, not accumulated, so that the last point is t_end exactly
   double time_of(Index k) const {
-    return k == opt.steps ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
+    return k == opt.steps && k > 0 ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;  // steps = 0: one row, at t_begin
   }
   // Sign of det Φq at the last delivered regular row, and whether a singular row (bracketed, with its own
   // warning) was delivered since.
