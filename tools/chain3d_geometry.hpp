@@ -9,6 +9,8 @@
 // frame [e1, e2, u] (θ = 0) and qb = (0, u) ⊗ qa (a turn about u after it: (cos θ/2, u sin θ/2) ⊗ qa).
 #pragma once
 
+#include <Eigen/Geometry>
+
 #include <array>
 #include <cmath>
 
@@ -33,13 +35,12 @@ inline Geometry geometry() {
   g.u = {1.0 / 3, 2.0 / 3, 2.0 / 3};
   g.e1 = {2.0 / 3, 1.0 / 3, -2.0 / 3};
   g.e2 = cross(g.u, g.e1);
-  // The rotation matrix with columns e1, e2, u to Euler parameters (its trace is 2 > 0: the e0 branch is stable).
-  const double r[3][3] = {{g.e1[0], g.e2[0], g.u[0]}, {g.e1[1], g.e2[1], g.u[1]}, {g.e1[2], g.e2[2], g.u[2]}};
-  const double e0 = 0.5 * std::sqrt(1.0 + r[0][0] + r[1][1] + r[2][2]);
-  g.qa = {e0, (r[2][1] - r[1][2]) / (4 * e0), (r[0][2] - r[2][0]) / (4 * e0), (r[1][0] - r[0][1]) / (4 * e0)};
-  // (0, u) ⊗ (a0, a) = (−u · a, a0 u + u × a)
-  const Vec a{g.qa[1], g.qa[2], g.qa[3]}, uxa = cross(g.u, a);
-  g.qb = {-dot(g.u, a), g.qa[0] * g.u[0] + uxa[0], g.qa[0] * g.u[1] + uxa[1], g.qa[0] * g.u[2] + uxa[2]};
+  // The Euler parameters of the rotation with columns e1, e2, u (Eigen's conversion), then qb = (0, u) ⊗ qa.
+  Eigen::Matrix3d r;
+  r << g.e1[0], g.e2[0], g.u[0], g.e1[1], g.e2[1], g.u[1], g.e1[2], g.e2[2], g.u[2];
+  const Eigen::Quaterniond a(r), b = Eigen::Quaterniond(0.0, g.u[0], g.u[1], g.u[2]) * a;
+  g.qa = {a.w(), a.x(), a.y(), a.z()};
+  g.qb = {b.w(), b.x(), b.y(), b.z()};
   return g;
 }
 

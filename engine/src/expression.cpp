@@ -184,6 +184,41 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
 
 namespace {
 Error expression_error(const std::string& text, const std::string& what);  // defined with the parsing helpers
+
+// The functions an expression may call: the tape instruction, the number of arguments, and how GiNaC builds the
+// call (one of make1, make2). One table for the parser (names, arity, what to build) and the tape builder (what a
+// GiNaC function of that name computes).
+struct FunctionSpec {
+  Tape::Op op;
+  int arity;
+  GiNaC::ex (*make1)(const GiNaC::ex&) = nullptr;
+  GiNaC::ex (*make2)(const GiNaC::ex&, const GiNaC::ex&) = nullptr;
+};
+const std::map<std::string, FunctionSpec>& supported_functions() {
+  using Op = Tape::Op;
+  using GiNaC::ex;
+  static const std::map<std::string, FunctionSpec> table = {
+      {"sin", {Op::kSin, 1, [](const ex& a) -> ex { return GiNaC::sin(a); }}},
+      {"cos", {Op::kCos, 1, [](const ex& a) -> ex { return GiNaC::cos(a); }}},
+      {"tan", {Op::kTan, 1, [](const ex& a) -> ex { return GiNaC::tan(a); }}},
+      {"asin", {Op::kAsin, 1, [](const ex& a) -> ex { return GiNaC::asin(a); }}},
+      {"acos", {Op::kAcos, 1, [](const ex& a) -> ex { return GiNaC::acos(a); }}},
+      {"atan", {Op::kAtan, 1, [](const ex& a) -> ex { return GiNaC::atan(a); }}},
+      {"atan2", {Op::kAtan2, 2, nullptr, [](const ex& y, const ex& x) -> ex { return GiNaC::atan2(y, x); }}},
+      {"exp", {Op::kExp, 1, [](const ex& a) -> ex { return GiNaC::exp(a); }}},
+      {"log", {Op::kLog, 1, [](const ex& a) -> ex { return GiNaC::log(a); }}},
+      {"sqrt", {Op::kSqrt, 1, [](const ex& a) -> ex { return GiNaC::sqrt(a); }}},  // a power to GiNaC
+      {"sinh", {Op::kSinh, 1, [](const ex& a) -> ex { return GiNaC::sinh(a); }}},
+      {"cosh", {Op::kCosh, 1, [](const ex& a) -> ex { return GiNaC::cosh(a); }}},
+      {"tanh", {Op::kTanh, 1, [](const ex& a) -> ex { return GiNaC::tanh(a); }}},
+      {"abs", {Op::kAbs, 1, [](const ex& a) -> ex { return GiNaC::abs(a); }}}};
+  return table;
+}
+std::string supported_function_list() {
+  std::string s;
+  for (const auto& [name, spec] : supported_functions()) s += (s.empty() ? "" : " ") + name;
+  return s;
+}
 }  // namespace
 
 class TapeBuilder {
@@ -326,16 +361,12 @@ class TapeBuilder {
     if (is_a<power>(e)) return emit_power(e.op(0), emit(e.op(1)));
     if (is_a<function>(e)) {
       const std::string name = ex_to<function>(e).get_name();
-      static const std::map<std::string, Op> unary = {
-          {"sin", Op::kSin},   {"cos", Op::kCos},   {"tan", Op::kTan},   {"asin", Op::kAsin},
-          {"acos", Op::kAcos}, {"atan", Op::kAtan}, {"exp", Op::kExp},   {"log", Op::kLog},
-          {"sinh", Op::kSinh}, {"cosh", Op::kCosh}, {"tanh", Op::kTanh}, {"abs", Op::kAbs},
-          {"csgn", Op::kSign}};
-      if (name == "atan2" && e.nops() == 2) return push(Op::kAtan2, emit(e.op(0)), emit(e.op(1)));
-      auto it = unary.find(name);
-      if (it != unary.end() && e.nops() == 1) return push(it->second, emit(e.op(0)));
-      fail("function '" + name + "' is not supported (supported: sin cos tan asin acos atan atan2 exp log sqrt "
-           "sinh cosh tanh abs)");
+      if (name == "csgn" && e.nops() == 1) return push(Op::kSign, emit(e.op(0)));  // GiNaC's derivative of abs
+      auto it = supported_functions().find(name);
+      if (it != supported_functions().end() && static_cast<int>(e.nops()) == it->second.arity)
+        return it->second.arity == 1 ? push(it->second.op, emit(e.op(0)))
+                                     : push(it->second.op, emit(e.op(0)), emit(e.op(1)));
+      fail("function '" + name + "' is not supported (supported: " + supported_function_list() + ")");
     }
     fail("unsupported term " + to_text(e));
   }
@@ -384,25 +415,6 @@ std::string clean_ginac_message(std::string m) {
 bool is_ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
 bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
 
-// The functions an expression may call, with their tape instruction and number of arguments.
-struct FunctionSpec {
-  Tape::Op op;
-  int arity;
-};
-const std::map<std::string, FunctionSpec>& supported_functions() {
-  using Op = Tape::Op;
-  static const std::map<std::string, FunctionSpec> table = {
-      {"sin", {Op::kSin, 1}},   {"cos", {Op::kCos, 1}},   {"tan", {Op::kTan, 1}},   {"asin", {Op::kAsin, 1}},
-      {"acos", {Op::kAcos, 1}}, {"atan", {Op::kAtan, 1}}, {"atan2", {Op::kAtan2, 2}}, {"exp", {Op::kExp, 1}},
-      {"log", {Op::kLog, 1}},   {"sqrt", {Op::kSqrt, 1}}, {"sinh", {Op::kSinh, 1}}, {"cosh", {Op::kCosh, 1}},
-      {"tanh", {Op::kTanh, 1}}, {"abs", {Op::kAbs, 1}}};
-  return table;
-}
-std::string supported_function_list() {
-  std::string s;
-  for (const auto& [name, spec] : supported_functions()) s += (s.empty() ? "" : " ") + name;
-  return s;
-}
 
 // phiq's own recursive-descent parser, building the GiNaC expression operation by operation. GiNaC's text parser
 // is not used: it crashes on input as small as "sin()" (found by fuzzing), knows dozens of functions phiq cannot
@@ -468,6 +480,12 @@ class ExpressionParser {
     fail(what + " (column " + std::to_string(pos_ + 1) + ")");
   }
 
+  // The parser recurses once per parenthesis level: bounded.
+  void enter_parentheses() {
+    if (++depth_ > CompiledExpression::kMaxNesting)
+      fail("nested more than " + std::to_string(CompiledExpression::kMaxNesting) + " parentheses deep");
+  }
+
   void skip_space() {
     while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
   }
@@ -502,25 +520,13 @@ class ExpressionParser {
     return Node{r, false, 0.0};
   }
 
-  Node unary_op(Op op, const Node& a) {
-    if (a.constant) return constant(apply(op, a.value, 0.0, 0.0));
-    switch (op) {
-      case Op::kNeg: return settle(-a.e);
-      case Op::kSqrt: return settle(GiNaC::sqrt(a.e));
-      case Op::kSin: return settle(GiNaC::sin(a.e));
-      case Op::kCos: return settle(GiNaC::cos(a.e));
-      case Op::kTan: return settle(GiNaC::tan(a.e));
-      case Op::kAsin: return settle(GiNaC::asin(a.e));
-      case Op::kAcos: return settle(GiNaC::acos(a.e));
-      case Op::kAtan: return settle(GiNaC::atan(a.e));
-      case Op::kExp: return settle(GiNaC::exp(a.e));
-      case Op::kLog: return settle(GiNaC::log(a.e));
-      case Op::kSinh: return settle(GiNaC::sinh(a.e));
-      case Op::kCosh: return settle(GiNaC::cosh(a.e));
-      case Op::kTanh: return settle(GiNaC::tanh(a.e));
-      case Op::kAbs: return settle(GiNaC::abs(a.e));
-      default: fail("internal: unary operation " + std::to_string(static_cast<int>(op)));
-    }
+  Node negate(const Node& a) { return a.constant ? constant(-a.value) : settle(-a.e); }
+
+  // A supported function of its arguments: folded when they are all constant, else built by GiNaC.
+  Node call_function(const FunctionSpec& f, const std::vector<Node>& args) {
+    const bool constant_args = std::all_of(args.begin(), args.end(), [](const Node& n) { return n.constant; });
+    if (constant_args) return constant(apply(f.op, args[0].value, f.arity == 2 ? args[1].value : 0.0, 0.0));
+    return settle(f.arity == 1 ? f.make1(args[0].e) : f.make2(args[0].e, args[1].e));
   }
 
   Node binary_op(Op op, const Node& a, const Node& b) {
@@ -532,7 +538,6 @@ class ExpressionParser {
       case Op::kMul: return settle(a.e * b.e);
       case Op::kDiv: return settle(a.e / b.e);
       case Op::kPow: return settle(GiNaC::pow(a.e, b.e));
-      case Op::kAtan2: return settle(GiNaC::atan2(a.e, b.e));
       default: fail("internal: binary operation " + std::to_string(static_cast<int>(op)));
     }
   }
@@ -556,7 +561,7 @@ class ExpressionParser {
   }
 
   Node unary() {
-    if (accept('-')) return unary_op(Op::kNeg, unary());
+    if (accept('-')) return negate(unary());
     if (accept('+')) return unary();
     return power();
   }
@@ -570,7 +575,7 @@ class ExpressionParser {
   }
 
   Node exponent() {
-    if (accept('-')) return unary_op(Op::kNeg, exponent());
+    if (accept('-')) return negate(exponent());
     if (accept('+')) return exponent();
     return primary();
   }
@@ -588,8 +593,7 @@ class ExpressionParser {
       return n.value ? constant(*n.value) : Node{n.symbol, false, 0.0};
     }
     if (accept('(')) {
-      if (++depth_ > CompiledExpression::kMaxNesting)
-        fail("nested more than " + std::to_string(CompiledExpression::kMaxNesting) + " parentheses deep");
+      enter_parentheses();
       Node n = sum();
       expect(')', "')'");
       --depth_;
@@ -625,8 +629,7 @@ class ExpressionParser {
     if (it == supported_functions().end())
       fail("unknown function '" + name.substr(0, 40) + "' (supported: " + supported_function_list() + ")");
     expect('(', "'('");
-    if (++depth_ > CompiledExpression::kMaxNesting)
-      fail("nested more than " + std::to_string(CompiledExpression::kMaxNesting) + " parentheses deep");
+    enter_parentheses();
     std::vector<Node> args;
     if (peek() != ')') {
       args.push_back(sum());
@@ -640,7 +643,7 @@ class ExpressionParser {
       fail_at("'" + name + "' takes " + std::to_string(f.arity) + " argument" + (f.arity == 1 ? "" : "s") +
               ", not " + std::to_string(args.size()));
     }
-    return f.arity == 1 ? unary_op(f.op, args[0]) : binary_op(f.op, args[0], args[1]);
+    return call_function(f, args);
   }
 
   const std::string& text_;

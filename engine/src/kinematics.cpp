@@ -108,8 +108,10 @@ std::string not_square_message(const Model& model) {
   return s + "; the driven system must be square (assemble() and analyse_rank() handle other models)";
 }
 
-// Factorises Φq at (ws.q, t) unless the current factorisation was made exactly there.
-SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond, std::string* message) {
+// Factorises Φq at (ws.q, t) unless the current factorisation was made exactly there. `values_at_q`: the caller
+// knows ws.jacobian_values hold Φq at (ws.q, t) already (the Newton loop's fused evaluation).
+SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
+                              bool values_at_q = false) {
   if (!ws.lu) {
     *message = not_square_message(model);
     return SolveStatus::kNotSquare;
@@ -119,8 +121,9 @@ SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, doubl
     return SolveStatus::kSuccess;
   }
   ws.has_factorization = false;
-  // Φq may have been evaluated with Φ at this very point by the Newton loop (NewtonOptions::jacobian_with_residual)
-  if (!(ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q == ws.q)) {
+  // Φq may have been evaluated with Φ at this very point by the Newton loop (NewtonOptions::jacobian_with_residual):
+  // known to the loop itself, or left by the last solve_position for the velocity solve that follows it
+  if (!values_at_q && !(ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q == ws.q)) {
     model.jacobian(ws.q.data(), t, ws.jacobian_values.data());
     ++ws.counters.jacobian_evaluations;
   }
@@ -193,15 +196,26 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   const double carried_theta = ws.newton_contraction;
   ws.newton_contraction = -1.0;
 
+  // Whether ws.jacobian_values hold Φq at the current iterate (evaluated with Φ at the accepted trial point and
+  // not yet factorised): the loop knows it without comparing points; the point is recorded once, at the end.
+  ws.has_jacobian = false;
+  bool jacobian_at_q = false;
+
   auto finish = [&](SolveStatus st, std::string msg) {
     sum.status = st;
     if (st == SolveStatus::kSuccess) {
       sum.residual = max_scaled(model, ws.phi);  // O(m), no allocation: this runs once per drive step
       // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
       // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
+      // Otherwise they factorise at the solution, from the Jacobian evaluated there with Φ if there is one.
       if (ws.has_factorization && ws.factorized_t == t &&
-          step_within(model, ws.q - ws.factorized_q, ws.q, opt.tolerance, 1.0))
+          step_within(model, ws.q - ws.factorized_q, ws.q, opt.tolerance, 1.0)) {
         ws.factorized_q = ws.q;
+      } else if (jacobian_at_q) {
+        ws.jacobian_q = ws.q;
+        ws.jacobian_t = t;
+        ws.has_jacobian = true;
+      }
       return st;
     }
     sum.worst_rows = worst_rows(model, ws.phi, 3);
@@ -263,7 +277,8 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     std::string msg;
     if (!reuse) {
       const Index before = ws.counters.factorizations;
-      SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
+      SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg, jacobian_at_q);
+      jacobian_at_q = false;  // factorised (or failed): jacobian_values are no longer news
       if (st != SolveStatus::kSuccess) return finish(st, msg);
       sum.factorizations += static_cast<int>(ws.counters.factorizations - before);
     } else {
@@ -340,12 +355,8 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     prev_norm = alpha == 1.0 ? norm : -1.0;  // a shortened step says nothing about the contraction
     ws.q.swap(ws.trial);
     ws.phi.swap(ws.trial_phi);
-    if (with_jacobian) {
-      ws.jacobian_values.swap(ws.trial_jacobian_values);
-      ws.jacobian_q = ws.q;
-      ws.jacobian_t = t;
-      ws.has_jacobian = true;
-    }
+    if (with_jacobian) ws.jacobian_values.swap(ws.trial_jacobian_values);
+    jacobian_at_q = with_jacobian;
     f = ftrial;
   }
 }

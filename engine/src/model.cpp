@@ -82,19 +82,23 @@ void Model::residual(const double* q, double t, double* phi) const {
   for_each_range(blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) { b.residual(i0, i1, q, t, phi); });
 }
 
-void Model::jacobian(const double* q, double t, double* csc_values) const {
+bool Model::prepare_jacobian_values(double* csc_values) const {
   // Every slot of the pattern has at least one entry (the pattern is made of them); when none has two, storing
   // each entry writes every slot exactly once and the zero fill is not needed.
   const bool overwrite = static_cast<Index>(slot_of_entry_.size()) == pattern_->nnz();
   if (!overwrite) std::fill(csc_values, csc_values + pattern_->nnz(), 0.0);
+  return overwrite;
+}
+
+void Model::jacobian(const double* q, double t, double* csc_values) const {
+  const bool overwrite = prepare_jacobian_values(csc_values);
   for_each_range(blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) {
     b.jacobian(i0, i1, q, t, slot_of_entry_.data(), csc_values, overwrite);
   });
 }
 
 void Model::residual_and_jacobian(const double* q, double t, double* phi, double* csc_values) const {
-  const bool overwrite = static_cast<Index>(slot_of_entry_.size()) == pattern_->nnz();  // as in jacobian()
-  if (!overwrite) std::fill(csc_values, csc_values + pattern_->nnz(), 0.0);
+  const bool overwrite = prepare_jacobian_values(csc_values);
   for_each_range(blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) {
     b.residual_and_jacobian(i0, i1, q, t, phi, slot_of_entry_.data(), csc_values, overwrite);
   });

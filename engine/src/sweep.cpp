@@ -462,9 +462,9 @@ struct Run {
   SweepSummary& sum;
   double h = 0.0;
 
-  // t_k computed from k, not accumulated, so that the last point is t_end exactly
+  // t_k computed from k, not accumulated, so that the last point is t_end exactly (steps = 0: one row, at t_begin)
   double time_of(Index k) const {
-    return k == opt.steps && k > 0 ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;  // steps = 0: one row, at t_begin
+    return k == opt.steps && k > 0 ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
   }
   // Sign of det Φq at the last delivered regular row, and whether a singular row (bracketed, with its own
   // warning) was delivered since.

@@ -320,6 +320,9 @@ class Model {
   std::vector<Unit> row_units_;
   std::shared_ptr<const CscPattern> pattern_ = std::make_shared<CscPattern>();
   std::vector<Index> slot_of_entry_;
+  // Zero-fills csc_values unless no two entries share a slot; returns whether entries are stored (=) rather than
+  // added (jacobian(), residual_and_jacobian()).
+  bool prepare_jacobian_values(double* csc_values) const;
   double length_scale_ = 1.0;
   ToleranceScales scales_;
   double time_begin_ = -1e308, time_end_ = 1e308;

@@ -50,7 +50,8 @@ class Workspace {
   Eigen::VectorXd trial_phi;             ///< Φ at the trial point
   std::vector<double> jacobian_values;   ///< Φq values in jacobian_pattern() order
   /// Φq evaluated by the Newton loop together with Φ at its trial point (NewtonOptions::jacobian_with_residual);
-  /// when the trial is accepted it becomes jacobian_values, valid at (jacobian_q, jacobian_t) while has_jacobian.
+  /// when the trial is accepted it becomes jacobian_values. A solve that ends with such values not yet factorised
+  /// records their point (jacobian_q, jacobian_t) and sets has_jacobian, for the velocity solve that follows.
   std::vector<double> trial_jacobian_values;
   Eigen::VectorXd jacobian_q;            ///< see trial_jacobian_values
   double jacobian_t = 0.0;               ///< see jacobian_q
