@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <thread>
 
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
@@ -258,6 +259,57 @@ TEST(ParallelSweep, AFailureIsReportedAsInTheSequentialSweep) {
   EXPECT_GT(ps.parallel_chunks, 0);
   EXPECT_LT(test::max_difference(seq, par, 0), 1e-9);
   EXPECT_LT(test::max_difference(seq, par, 1), 1e-6);  // approaching the dead point, q̇ grows as 1/sin
+}
+
+// The rows reach on_step on the calling thread, in order, however many threads compute them (the caller of an
+// embedding simulator may keep thread-local state there); and a caller that stops the sweep gets exactly the rows
+// up to the one it stopped at.
+TEST(ParallelSweep, DeliversOnTheCallingThreadInOrderAndStopsWhereTheCallerSays) {
+  Model m = test::nfourbar_model(20, M_PI / 4, M_PI / 2);
+  SweepOptions opt;
+  opt.steps = 240;
+  opt.threads = 2;
+  opt.chunk_steps = 8;
+  const std::thread::id me = std::this_thread::get_id();
+  for (Index stop_at : {Index{-1}, Index{0}, Index{5}, Index{8}, Index{9}, Index{100}}) {
+    Workspace ws(m);
+    std::vector<Index> seen;
+    bool foreign_thread = false;
+    SweepSummary sum;
+    const SolveStatus st = run_sweep(
+        m, opt, ws,
+        [&](const StepView& v) {
+          seen.push_back(v.step);
+          foreign_thread = foreign_thread || std::this_thread::get_id() != me;
+          return v.step != stop_at;
+        },
+        &sum);
+    EXPECT_FALSE(foreign_thread) << "stop at " << stop_at;
+    const Index last = stop_at < 0 ? opt.steps : stop_at;
+    ASSERT_EQ(static_cast<Index>(seen.size()), last + 1) << "stop at " << stop_at;
+    for (Index k = 0; k <= last; ++k) EXPECT_EQ(seen[static_cast<std::size_t>(k)], k);
+    EXPECT_EQ(st, stop_at < 0 ? SolveStatus::kSuccess : SolveStatus::kCancelled) << sum.message;
+    EXPECT_EQ(sum.steps_completed, last + 1);
+  }
+}
+
+// A model large enough to be evaluated in parallel itself (more than 65536 constraints), swept in parallel chunks:
+// the evaluation's tasks run inside the chunks' threads without deadlock, and the rows are the sequential ones.
+TEST(ParallelSweep, LargeModelsEvaluatedInParallelInsideParallelChunks) {
+  Model m = test::nfourbar_model(33000, M_PI / 4, M_PI / 2);
+  ASSERT_GT(m.num_equations(), 65536);  // one row per constraint but the angle
+  SweepOptions opt;
+  opt.steps = 6;
+  opt.t_end = 0.01;
+  test::Trace seq, par;
+  SweepSummary ss, ps;
+  ASSERT_EQ(test::sweep(m, opt, &seq, &ss), SolveStatus::kSuccess) << ss.message;
+  opt.threads = 2;
+  opt.chunk_steps = 1;
+  ASSERT_EQ(test::sweep(m, opt, &par, &ps), SolveStatus::kSuccess) << ps.message;
+  EXPECT_EQ(ps.parallel_chunks, 6);
+  EXPECT_LT(test::max_difference(seq, par, 0), 1e-9 * 33000);  // lengths up to 3.3·10⁴ m
+  EXPECT_LT(test::max_difference(seq, par, 1), 1e-7);
 }
 
 }  // namespace

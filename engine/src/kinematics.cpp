@@ -72,18 +72,6 @@ double max_scaled(const Model& model, const Eigen::VectorXd& phi) {
   return m;
 }
 
-double merit(const Model& model, const Eigen::VectorXd& phi) {
-  return 0.5 * phi.cwiseProduct(model.tolerance_scales().inverse_row_scale).squaredNorm();
-}
-
-// The size of a step in the tolerance-scaled norm, max_j |Δq_j| / scale_j (step_ratio with tol = 1, whose floor
-// 64 ulps · |q_j| / scale_j is negligible there): the Newton loop's contraction estimate.
-double scaled_norm(const Model& model, const Eigen::VectorXd& dq) {
-  if (dq.size() == 0) return 0.0;
-  const double r = dq.cwiseAbs().cwiseProduct(model.tolerance_scales().inverse_coordinate_scale).maxCoeff();
-  return std::isnan(r) ? std::numeric_limits<double>::infinity() : r;
-}
-
 // factor · step_ratio(dq, q, tol) ≤ 1, without a division per coordinate (false on NaN).
 template <class Step>
 bool step_within(const Model& model, const Step& dq, const Eigen::VectorXd& q, double tol, double factor) {
@@ -92,6 +80,64 @@ bool step_within(const Model& model, const Step& dq, const Eigen::VectorXd& q, d
 }
 
 bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
+
+// What the Newton loop needs of Φ at each iterate, from one pass over it instead of three: the merit
+// ½ Σ (Φ_i / scale_i)², whether Φ is finite, and whether every row is within the tolerance (residual_within).
+struct ResidualCheck {
+  double merit = 0.0;
+  bool finite = true;
+  bool within = false;
+};
+ResidualCheck check_residual(const Model& model, const Eigen::VectorXd& phi, double tol, const Eigen::VectorXd& q) {
+  const double* p = phi.data();
+  const double* inv = model.tolerance_scales().inverse_row_scale.data();
+  double sum = 0.0, worst = 0.0;
+  for (Index i = 0, m = phi.size(); i < m; ++i) {
+    const double s = std::fabs(p[i]) * inv[i];
+    sum += s * s;
+    worst = worst < s ? s : worst;  // NaN rows are caught by `finite`
+  }
+  ResidualCheck c;
+  c.merit = 0.5 * sum;
+  c.finite = std::isfinite(sum) || phi.allFinite();  // a sum that overflowed is still a finite Φ
+  // rows above tol are held to tol · scale_i plus their rounding floor, looked at only then
+  c.within = c.finite && (worst <= tol || residual_within(model, phi, tol, q));
+  return c;
+}
+
+// The size of a step in the tolerance-scaled norm, max_j |Δq_j| / scale_j (step_ratio with tol = 1, whose floor
+// 64 ulps · |q_j| / scale_j is negligible there): the Newton loop's contraction estimate. With it, in the same
+// pass, whether the step is finite.
+double scaled_norm_if_finite(const Model& model, const Eigen::VectorXd& dq, bool* finite) {
+  const double* d = dq.data();
+  const double* inv = model.tolerance_scales().inverse_coordinate_scale.data();
+  double worst = 0.0, sum = 0.0;
+  for (Index j = 0, n = dq.size(); j < n; ++j) {
+    const double s = std::fabs(d[j]) * inv[j];
+    sum += s;
+    worst = worst < s ? s : worst;
+  }
+  *finite = std::isfinite(sum) || dq.allFinite();
+  return worst;
+}
+
+// trial = q − α·dx (dx = Φq⁻¹Φ, so that −α·dx is the Newton step), and whether the step passes
+// step_within(α·dx, trial, tol, factor): one pass for the trial point and the step test.
+bool take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& dx, double alpha, double tol,
+               double factor, Eigen::VectorXd& trial) {
+  const double* cs = model.tolerance_scales().coordinate_scale.data();
+  const double* x = q.data();
+  const double* d = dx.data();
+  double* out = trial.data();
+  bool ok = true;
+  for (Index j = 0, n = q.size(); j < n; ++j) {
+    const double step = alpha * d[j];
+    const double v = x[j] - step;
+    out[j] = v;
+    ok &= factor * std::fabs(step) <= tol * cs[j] + kUlpFloor * std::fabs(v);  // false on NaN
+  }
+  return ok;
+}
 
 void check_workspace(const Model& model, const Workspace& ws) {
   if (&ws.model() != &model) throw Error("workspace was made for another model");
@@ -151,13 +197,15 @@ SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, doubl
   return SolveStatus::kSuccess;
 }
 
-// The right-hand side the LU solves with: ws.rhs itself, or its kept rows for a model with dropped rows.
-const double* solve_rhs(const Model& model, Workspace& ws) {
-  if (model.dropped_rows().empty()) return ws.rhs.data();
+// The right-hand side the LU solves with: `b` (one entry per equation) itself, or its kept rows for a model with
+// dropped rows.
+const double* solve_rhs(const Model& model, Workspace& ws, const Eigen::VectorXd& b) {
+  if (model.dropped_rows().empty()) return b.data();
   const std::vector<Index>& rows = model.solve_rows();
-  for (std::size_t i = 0; i < rows.size(); ++i) ws.solve_rhs(static_cast<Index>(i)) = ws.rhs(rows[i]);
+  for (std::size_t i = 0; i < rows.size(); ++i) ws.solve_rhs(static_cast<Index>(i)) = b(rows[i]);
   return ws.solve_rhs.data();
 }
+const double* solve_rhs(const Model& model, Workspace& ws) { return solve_rhs(model, ws, ws.rhs); }
 
 std::string fmt(double v) {
   std::ostringstream s;
@@ -234,18 +282,26 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     return finish(SolveStatus::kNonFinite, "starting point has non-finite coordinates");
   }
 
-  model.residual(ws.q.data(), t, ws.phi.data());
-  ++ws.counters.residual_evaluations;
-  double f = merit(model, ws.phi);
-  // Φq with Φ at every trial point where Φq will be wanted at the accepted one: each iteration of full Newton, and
-  // the solution when the caller factorises there next (velocities follow). One pass over the constraints instead
-  // of two; the Jacobian of a rejected trial is wasted, which the line search makes rare.
-  const bool with_jacobian = opt.jacobian_update == JacobianUpdate::kEveryIteration || opt.jacobian_with_residual;
-  if (with_jacobian) ws.trial_jacobian_values.resize(ws.jacobian_values.size());
+  // Φq comes with Φ (one pass over the constraints instead of two) at every point where it will be factorised: the
+  // start and each trial when the next iteration factorises at its iterate (full Newton; modified Newton once it
+  // has refreshed), unless the trial's step already passes the tolerance (it is then expected to be the solution);
+  // and the expected solution when the caller factorises there next (NewtonOptions::jacobian_with_residual:
+  // velocities follow). A wrong guess costs one separate Jacobian evaluation, or one wasted.
+  ws.trial_jacobian_values.resize(ws.jacobian_values.size());
   bool step_ok = false;
   // Modified Newton reuses the workspace's factorisation until it contracts badly; then (and always for full
   // Newton) every iteration factorises at its iterate.
   bool reuse = opt.jacobian_update == JacobianUpdate::kWhenSlow && ws.has_factorization;
+  // The start point too: where its first iteration will factorise there anyway, Φq comes with Φ.
+  if (!reuse) {
+    model.residual_and_jacobian(ws.q.data(), t, ws.phi.data(), ws.jacobian_values.data());
+    ++ws.counters.jacobian_evaluations;
+    jacobian_at_q = true;
+  } else {
+    model.residual(ws.q.data(), t, ws.phi.data());
+  }
+  ++ws.counters.residual_evaluations;
+  ResidualCheck check = check_residual(model, ws.phi, opt.tolerance, ws.q);
   double prev_norm = -1.0;   // scaled size of the previous step taken with the same kind of matrix
   double theta_seen = -1.0;  // largest contraction observed with the reused matrix in this solve
   int reused_steps = 1;      // steps taken with the reused matrix once a contraction is known
@@ -254,8 +310,8 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   // The iteration limit counts steps taken; a step discarded to refresh a reused factorisation does not count.
   for (;;) {
     const int it = sum.iterations;
-    if (!all_finite(ws.phi)) return finish(SolveStatus::kNonFinite, "constraint residual is not finite");
-    const bool within = residual_within(model, ws.phi, opt.tolerance, ws.q);
+    if (!check.finite) return finish(SolveStatus::kNonFinite, "constraint residual is not finite");
+    const bool within = check.within;
     if (within && (it == 0 || step_ok)) {
       if (theta_seen >= 0.0) ws.newton_contraction = theta_seen;
       return finish(SolveStatus::kSuccess, "");
@@ -284,10 +340,12 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     } else {
       sum.rcond = ws.lu->rcond();
     }
-    ws.rhs = -ws.phi;
-    if (!ws.lu->solve(solve_rhs(model, ws), ws.step.data()))
+    // ws.step = Φq⁻¹Φ: the Newton step is −ws.step (no negated copy of Φ; the LU's rounding is sign-symmetric)
+    if (!ws.lu->solve(solve_rhs(model, ws, ws.phi), ws.step.data()))
       return finish(SolveStatus::kLinearSolverFailed, "sparse solve failed: " + ws.lu->last_message());
-    if (!all_finite(ws.step)) {
+    bool step_finite = true;
+    const double norm = scaled_norm_if_finite(model, ws.step, &step_finite);
+    if (!step_finite) {
       if (reuse) {  // an old factorisation may be singular where the current iterate is not
         reuse = false, prev_norm = -1.0;
         continue;
@@ -296,7 +354,6 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     }
     // Contraction θ = ‖Δq_k‖ / ‖Δq_k−1‖ in the tolerance-scaled norm. A reused matrix that contracts worse than
     // max_contraction is replaced by a fresh one at this iterate (the step just computed is discarded).
-    const double norm = scaled_norm(model, ws.step);
     double theta = prev_norm > 0.0 ? norm / prev_norm : (reuse && carried_theta >= 0.0 ? 2.0 * carried_theta : -1.0);
     if (reuse && prev_norm > 0.0) {
       theta_seen = std::max(theta_seen, theta);
@@ -312,12 +369,17 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       }
     }
 
+    // Error of the new iterate: θ/(1−θ)·|Δq| where a contraction is known, else the step itself.
+    const double eta = (theta >= 0.0 && theta < 1.0) ? theta / (1.0 - theta) : 1.0;
     // Backtracking on the scaled merit: a full step whenever it helps, a shorter one from a rough placement. A
     // reused matrix whose full step does not decrease the merit is refreshed rather than backtracked along.
-    double alpha = 1.0, ftrial = 0.0;
+    double alpha = 1.0;
+    ResidualCheck trial_check;
+    bool with_jacobian = false;  // Φq evaluated at the trial
     bool refresh = false;
     for (int bt = 0;; ++bt) {
-      ws.trial = ws.q + alpha * ws.step;
+      step_ok = take_step(model, ws.q, ws.step, alpha, opt.tolerance, std::min(eta, 1.0), ws.trial);
+      with_jacobian = step_ok ? opt.jacobian_with_residual : !reuse;
       if (with_jacobian) {
         model.residual_and_jacobian(ws.trial.data(), t, ws.trial_phi.data(), ws.trial_jacobian_values.data());
         ++ws.counters.jacobian_evaluations;
@@ -325,10 +387,8 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
         model.residual(ws.trial.data(), t, ws.trial_phi.data());
       }
       ++ws.counters.residual_evaluations;
-      ftrial = merit(model, ws.trial_phi);
-      if (!opt.line_search || ftrial <= (1.0 - 1e-4 * alpha) * f ||
-          residual_within(model, ws.trial_phi, opt.tolerance, ws.trial))
-        break;
+      trial_check = check_residual(model, ws.trial_phi, opt.tolerance, ws.trial);
+      if (!opt.line_search || trial_check.merit <= (1.0 - 1e-4 * alpha) * check.merit || trial_check.within) break;
       if (reuse) {
         refresh = true;
         break;
@@ -347,17 +407,13 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     }
     ++ws.counters.newton_iterations;
     ++sum.iterations;
-    ws.step *= alpha;
-    // Error of the new iterate: θ/(1−θ)·|Δq| where a contraction is known, else the step itself.
-    const double eta = (theta >= 0.0 && theta < 1.0) ? theta / (1.0 - theta) : 1.0;
-    step_ok = step_within(model, ws.step, ws.trial, opt.tolerance, std::min(eta, 1.0));
     stagnant = (!reuse && alpha == 1.0 && prev_norm > 0.0 && theta >= 0.5) ? stagnant + 1 : 0;
     prev_norm = alpha == 1.0 ? norm : -1.0;  // a shortened step says nothing about the contraction
     ws.q.swap(ws.trial);
     ws.phi.swap(ws.trial_phi);
     if (with_jacobian) ws.jacobian_values.swap(ws.trial_jacobian_values);
     jacobian_at_q = with_jacobian;
-    f = ftrial;
+    check = trial_check;
   }
 }
 

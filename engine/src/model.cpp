@@ -54,10 +54,14 @@ std::string Model::row_name(Index row) const {
 
 namespace {
 
-// Constraints per parallel task. Below twice this in a block, the block is evaluated in the calling thread: a
-// task of 8192 distance rows is about 30 µs of work, well above TBB's scheduling cost, and small models never
-// pay for a task at all.
+// Constraints per parallel task: a task of 8192 distance rows is about 30 µs of work, well above TBB's
+// scheduling cost.
 constexpr std::size_t kGrain = 8192;
+// Below this many constraints the model is evaluated in the calling thread. Not 2 · kGrain: between two
+// evaluations a Newton iteration spends a factorisation in one thread, TBB's idle workers go to sleep, and waking
+// them costs more than the split gains up to here (nfourbar N = 10⁴, 2·10⁴ constraints: the engine's iteration
+// 1.27–1.29 kernels evaluated in one thread against 1.34–1.37 in two, bench/README.md).
+constexpr std::size_t kParallelFrom = 65536;
 
 // Calls f(block, begin, end) over all constraints of `blocks`, split into tasks of about kGrain constraints run
 // by TBB when the model is large. Disjoint ranges write disjoint outputs (ConstraintBlock's contract), so no
@@ -66,7 +70,7 @@ template <class Blocks, class F>
 void for_each_range(const Blocks& blocks, F&& f) {
   std::size_t total = 0;
   for (const auto& b : blocks) total += b->size();
-  if (total < 2 * kGrain) {
+  if (total < kParallelFrom) {
     for (const auto& b : blocks) f(*b, std::size_t{0}, b->size());
     return;
   }

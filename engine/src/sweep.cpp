@@ -8,11 +8,12 @@
 #include <memory>
 #include <mutex>
 #include <sstream>
+#include <thread>
+#include <condition_variable>
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
 #include "phiq/assembly.hpp"
@@ -551,10 +552,9 @@ struct Chunk {
   Eigen::VectorXd seam_q;    // the position at t_{k1+1} reached by continuing in order
 };
 
-}  // namespace
-
-SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws,
-                      const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
+// run_sweep's body, run inside a task arena of the sweep's threads.
+SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspace& ws,
+                           const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
   if (&ws.model() != &model) throw Error("workspace was made for another model");
   if (opt.steps < 0) throw Error("SweepOptions: steps must be >= 0");
   if (!std::isfinite(opt.t_begin) || !std::isfinite(opt.t_end)) throw Error("SweepOptions: times must be finite");
@@ -652,7 +652,7 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   std::vector<PointMotion> last_points(opt.points.size());  // its point motions
   bool seam_known = false;
   Eigen::VectorXd seam_q;
-  std::vector<Eigen::VectorXd> seeds(1);  // chunk 0 starts from row 0 itself
+  std::vector<Eigen::VectorXd> seeds(static_cast<std::size_t>(n_chunks));  // seeds[c]: chunk c's first row (not 0)
 
   // Chunk c: its rows from its seed (chunk 0: in order from row 0), then the seam step.
   auto run_chunk = [&](Index c, Chunk& ch) {
@@ -736,15 +736,15 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
     return 0;
   };
 
-  // Chunks per wave: as many as the row buffer allows, at least one per thread so that TBB balances the chunks of
-  // a wave, and at most 16 per thread so that rows are delivered (and Ctrl-C seen) every few thousand steps
-  // however long the sweep.
+  // How far the work may run ahead of the delivery: chunks seeded beyond the next one to deliver. As many as the
+  // row buffer allows, at least one per thread, and at most 16 per thread so that rows are delivered (and Ctrl-C
+  // seen) every few thousand steps however long the sweep.
   const double chunk_bytes = 8.0 * static_cast<double>(std::max<Index>(width, 1)) * static_cast<double>(chunk);
-  const Index per_wave = std::max<Index>(
+  const Index ahead = std::max<Index>(
       threads, std::min<Index>(16 * threads, static_cast<Index>(kRowBufferBytes / chunk_bytes)));
 
   // Seeds: the position at each chunk's first row, found in order with the chunk's span as the step (positions
-  // only, the secant predictor, subdivision on failure), wave by wave, just ahead of the chunks that need them.
+  // only, the secant predictor, subdivision on failure), one at a time, just ahead of the chunks that need them.
   // A failure ends the seeding; the chunks after it run in order below, where the failure is reported as the
   // sequential sweep reports it.
   SweepOptions seed_options = opt;
@@ -756,55 +756,101 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   sws.q = last_q;
   Sweeper seeder(model, seed_options, sws, seed_summary);
   seeder.adopt(run.time_of(0));
-  bool seeding_ok = true;
-  auto seed_until = [&](Index c_end) {  // seeds for the chunks below c_end
-    const auto seed_start = std::chrono::steady_clock::now();
-    for (Index c = static_cast<Index>(seeds.size()); seeding_ok && c < std::min(c_end, n_chunks); ++c) {
-      seeding_ok = seeder.advance(run.time_of(first_row(c)), 0);
-      if (seeding_ok) seeds.push_back(sws.q);
-    }
-    sum.seed_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
-  };
 
-  // The first wave's seeds are found while chunk 0, which needs none, runs on another thread.
-  tbb::task_arena arena(threads);
-  Chunk first;
-  arena.execute([&] { tbb::parallel_invoke([&] { seed_until(1 + per_wave); }, [&] { run_chunk(0, first); }); });
+  // The schedule. `threads` loops run the work as it becomes ready: the seeding (in order, one thread at a time,
+  // first whenever fewer chunks are ready than threads, so that it stays ahead) and the seeded chunks (lowest
+  // first). A chunk starts as soon as its seed is known, not in waves, so no thread waits for a wave's slowest
+  // chunk. The calling thread alone delivers, in order, each chunk as soon as it and all before it are done: the
+  // caller's on_step runs on the caller's thread, as in a sequential sweep, overlapped with the other threads'
+  // chunks.
+  std::mutex mutex;
+  std::condition_variable wake;
+  std::vector<Chunk> chunks(static_cast<std::size_t>(n_chunks));
+  std::vector<char> chunk_done(static_cast<std::size_t>(n_chunks), 0);
+  Index seeded = 1;            // chunks 0 … seeded − 1 have their seed (chunk 0 starts from row 0)
+  Index claimed = 0;           // chunks 0 … claimed − 1 have been taken by a thread
+  Index delivered = 0;         // chunks 0 … delivered − 1 have been delivered
+  bool seeding_busy = false;   // a thread is finding a seed
+  bool seeding_over = n_chunks <= 1;  // every seed found, or the seeding failed
+  bool stop = false;           // a chunk was rejected (fallback) or the caller stopped the sweep
+  bool cancelled = false;
   bool fallback = false;
-  if (const int d = deliver_chunk(first); d == 2) {
+  const std::thread::id caller = std::this_thread::get_id();
+
+  auto seed_one = [&] {  // finds seed `seeded` (the lock is not held)
+    const auto seed_start = std::chrono::steady_clock::now();
+    const Index c = seeded;  // only the thread holding seeding_busy changes it
+    const bool ok = seeder.advance(run.time_of(first_row(c)), 0);
+    if (ok) seeds[static_cast<std::size_t>(c)] = sws.q;
+    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
+    std::lock_guard<std::mutex> lock(mutex);
+    sum.seed_seconds += took;
+    if (ok) ++seeded;
+    seeding_over = !ok || seeded == n_chunks;
+    seeding_busy = false;
+    wake.notify_all();
+  };
+  // The caller's deliveries: every chunk done in order (the lock is held on entry and on return).
+  auto deliver_ready = [&](std::unique_lock<std::mutex>& lock) {
+    while (!stop && delivered < claimed && chunk_done[static_cast<std::size_t>(delivered)]) {
+      Chunk& ch = chunks[static_cast<std::size_t>(delivered)];
+      lock.unlock();
+      const int d = deliver_chunk(ch);
+      ch.rows = std::vector<double>();  // delivered: free
+      seeds[static_cast<std::size_t>(delivered)] = Eigen::VectorXd();
+      lock.lock();
+      if (d != 0) {
+        stop = true, cancelled = d == 2, fallback = d == 1;
+      } else {
+        ++delivered;
+      }
+      wake.notify_all();
+    }
+  };
+  auto work = [&] {
+    const bool is_caller = std::this_thread::get_id() == caller;
+    std::unique_lock<std::mutex> lock(mutex);
+    for (;;) {
+      if (is_caller) deliver_ready(lock);
+      if (stop) return;
+      const Index ready = seeded - claimed;
+      const bool can_seed = !seeding_busy && !seeding_over && seeded < std::min(n_chunks, delivered + ahead + 1);
+      if (can_seed && ready < threads) {
+        seeding_busy = true;
+        lock.unlock();
+        tbb::this_task_arena::isolate(seed_one);  // nested evaluations wait only for their own tasks
+        lock.lock();
+      } else if (ready > 0) {
+        const Index c = claimed++;
+        lock.unlock();
+        tbb::this_task_arena::isolate([&] { run_chunk(c, chunks[static_cast<std::size_t>(c)]); });
+        lock.lock();
+        chunk_done[static_cast<std::size_t>(c)] = 1;
+        wake.notify_all();
+      } else if (can_seed) {
+        seeding_busy = true;
+        lock.unlock();
+        tbb::this_task_arena::isolate(seed_one);
+        lock.lock();
+      } else if (seeding_over && !seeding_busy && claimed == seeded && (!is_caller || delivered == claimed)) {
+        return;  // nothing more will become ready (the caller: and everything done is delivered)
+      } else {
+        wake.wait(lock);  // for a seed, a finished chunk (the caller) or a delivery (the window)
+      }
+    }
+  };
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, threads, 1),
+      [&](const tbb::blocked_range<int>& r) {
+        for (int k = r.begin(); k < r.end(); ++k) work();
+      },
+      tbb::simple_partitioner());
+  // chunks computed but not delivered (after a rejected one): their work was done all the same
+  for (Index c = delivered + (stop ? 1 : 0); c < claimed; ++c)
+    add_counters(others, chunks[static_cast<std::size_t>(c)].sum.counters, WorkCounters{});
+  if (cancelled) {
     add_counters(others, sws.counters, WorkCounters{});
     return done(sum.status);
-  } else {
-    fallback = d == 1;
-  }
-
-  for (Index c0 = 1; !fallback; c0 += per_wave) {
-    seed_until(c0 + per_wave);
-    const Index c1 = std::min<Index>(static_cast<Index>(seeds.size()), c0 + per_wave);
-    if (c0 >= c1) break;  // all chunks done, or the seeding stopped: the rest runs in order
-    std::vector<Chunk> chunks(static_cast<std::size_t>(c1 - c0));
-    arena.execute([&] {
-      // one task per chunk (chunks are large, uneven units of work; TBB's default partitioner may run
-      // neighbouring chunks as one task on one thread)
-      tbb::parallel_for(
-          tbb::blocked_range<Index>(c0, c1, 1),
-          [&](const tbb::blocked_range<Index>& r) {
-            for (Index c = r.begin(); c < r.end(); ++c) run_chunk(c, chunks[static_cast<std::size_t>(c - c0)]);
-          },
-          tbb::simple_partitioner());
-    });
-    for (Index c = c0; c < c1; ++c) seeds[static_cast<std::size_t>(c)] = Eigen::VectorXd();  // used: free
-    for (Chunk& ch : chunks) {
-      const int d = deliver_chunk(ch);
-      if (d == 2) {
-        add_counters(others, sws.counters, WorkCounters{});
-        return done(sum.status);
-      }
-      if (d == 1) {
-        fallback = true;
-        break;
-      }
-    }
   }
   add_counters(others, sws.counters, WorkCounters{});
   // The caller's workspace ends at the last delivered row, as after a sequential sweep.
@@ -824,6 +870,17 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
     run.sequential(rest, ws, resume);
   }
   return done(sum.status);
+}
+
+}  // namespace
+
+SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws,
+                      const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
+  if (opt.threads < 0) throw Error("SweepOptions: threads must be >= 0 (0: all cores)");
+  // Everything the sweep runs, the model's parallel evaluation of large models included, stays on its threads:
+  // threads = 1 is one thread.
+  tbb::task_arena arena(opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads);
+  return arena.execute([&] { return sweep_in_arena(model, opt, ws, on_step, summary); });
 }
 
 }  // namespace phiq

@@ -45,7 +45,7 @@ class Workspace {
   ///@{
   Eigen::VectorXd phi;                   ///< Φ at q
   Eigen::VectorXd rhs;                   ///< right-hand side of the last linear solve
-  Eigen::VectorXd step;                  ///< last Newton step
+  Eigen::VectorXd step;                  ///< Φq⁻¹Φ of the last Newton iteration (its step was −α times this)
   Eigen::VectorXd trial;                 ///< line-search trial point
   Eigen::VectorXd trial_phi;             ///< Φ at the trial point
   std::vector<double> jacobian_values;   ///< Φq values in jacobian_pattern() order
