@@ -401,7 +401,31 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       alpha *= 0.5;
       ++sum.backtracks;
     }
-    if (refresh) {
+    // At the rounding level: the residual already holds, and a full Newton step above the tolerance does not even
+    // halve the merit (a step that corrects a real error of q shrinks a residual within tolerance by orders of
+    // magnitude, stale matrix or not). The step is then the rounding of Φ amplified by Φq⁻¹ — on a long chain
+    // (10⁵ scissor stages) it exceeds the tolerance however often Newton repeats it — and it says how well q is
+    // known. Stop at the better point of the two, with a warning, instead of refactorising in search of a
+    // contraction that cannot come.
+    const bool rounding_level = within && !step_ok && alpha == 1.0 && !(trial_check.merit < 0.5 * check.merit);
+    auto stop_at_rounding_level = [&] {
+      const Eigen::VectorXd& cs = model.tolerance_scales().coordinate_scale;
+      Index worst = 0;
+      double worst_ratio = 0.0;
+      for (Index j = 0; j < ws.step.size(); ++j) {  // step_ratio's test, coordinate by coordinate
+        const double r = std::fabs(ws.step(j)) / (opt.tolerance * cs(j) + kUlpFloor * std::fabs(ws.q(j)));
+        if (r > worst_ratio) worst_ratio = r, worst = j;
+      }
+      sum.slow_convergence = true;
+      finish(SolveStatus::kSuccess, "");
+      sum.message = "the residual is at its rounding level and the Newton steps no longer reduce it: they are the "
+                    "rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
+                    fmt(worst_ratio) + " × the tolerance at '" + model.coordinate_names()[static_cast<std::size_t>(worst)] +
+                    "', which is how well q is known there";
+      return SolveStatus::kSuccess;
+    };
+    if (rounding_level && !(trial_check.within && trial_check.merit < check.merit)) return stop_at_rounding_level();
+    if (refresh && !rounding_level) {
       reuse = false, prev_norm = -1.0;
       continue;
     }
@@ -414,6 +438,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     if (with_jacobian) ws.jacobian_values.swap(ws.trial_jacobian_values);
     jacobian_at_q = with_jacobian;
     check = trial_check;
+    if (rounding_level) return stop_at_rounding_level();
   }
 }
 

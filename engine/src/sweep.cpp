@@ -552,6 +552,42 @@ struct Chunk {
   Eigen::VectorXd seam_q;    // the position at t_{k1+1} reached by continuing in order
 };
 
+// Keeps the first warning of `kind` of every stretch of consecutive rows (on the grid of the sweep) and says on it
+// how far the stretch went: a long chain at its rounding level warns at every row otherwise. Done on the merged
+// list, so that sequential and parallel sweeps report alike.
+void once_per_stretch(std::vector<SweepWarning>& warnings, const char* kind, const SweepOptions& opt) {
+  if (opt.steps <= 0) return;
+  const double h = (opt.t_end - opt.t_begin) / static_cast<double>(opt.steps);
+  auto row_of = [&](double t) { return (t - opt.t_begin) / h; };  // fractional on sub-steps
+  std::vector<SweepWarning> kept;
+  kept.reserve(warnings.size());
+  std::size_t first = 0;  // index in `kept` of the open stretch's warning
+  Index more = 0;         // rows of the open stretch after its first
+  double last_row = -2.0, last_t = 0.0;
+  auto close = [&] {
+    if (more > 0)
+      kept[first].message += "; the same at the next " + std::to_string(more) + " rows, to t = " + fmt_t(last_t);
+    more = 0;
+  };
+  for (SweepWarning& w : warnings) {
+    if (w.kind != kind) {
+      kept.push_back(std::move(w));
+      continue;
+    }
+    const double t = w.t, r = row_of(t);
+    if (std::fabs(r - (last_row + 1.0)) < 1e-6) {
+      ++more;
+    } else {
+      close();
+      first = kept.size();
+      kept.push_back(std::move(w));
+    }
+    last_row = r, last_t = t;
+  }
+  close();
+  warnings.swap(kept);
+}
+
 // run_sweep's body, run inside a task arena of the sweep's threads.
 SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspace& ws,
                            const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
@@ -570,6 +606,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   const WorkCounters before = ws.counters;
   WorkCounters others;  // work done in the seeding and chunk workspaces
   auto done = [&](SolveStatus st) {
+    once_per_stretch(sum.warnings, "slow_convergence", opt);
     sum.status = st;
     sum.counters = others;
     add_counters(sum.counters, ws.counters, before);
