@@ -43,10 +43,13 @@ struct SweepOptions {
   /// (positions only, every chunk_steps-th time point), and is accepted only if the sequential sweep, continued
   /// one step past the previous chunk, reaches the same position there to within 100 × the tolerance: otherwise
   /// the rest of the sweep runs in order (warning "parallel_fallback"). Rows are delivered in time order in any
-  /// case, and equal the sequential sweep's to the solver tolerance.
+  /// case, and equal the sequential sweep's to the solver tolerance; on_step is called on the calling thread.
+  /// Everything the sweep runs stays on these threads, the model's own parallel evaluation of large models
+  /// (ModelBuilder, 65536 constraints and more) included: 1 is one thread.
   int threads = 1;
-  /// Steps per parallel chunk; 0 picks 64, fewer when the rows a wave of chunks buffers (threads × chunk_steps
-  /// rows of q, q̇, q̈) would exceed 512 MiB.
+  /// Steps per parallel chunk; 0 picks 64, fewer (down to 16) so that there are at least 4 chunks per thread (the
+  /// seed of a chunk is one step over its span, expensive on large models when long), and fewer when the rows
+  /// held for delivery (threads × chunk_steps rows of q, q̇, q̈ and the outputs) would exceed 512 MiB.
   Index chunk_steps = 0;
 
   // Outputs beyond q, q̇, q̈: the sweep computes only what is listed (models/README.md, `output`).
