@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 #include <thread>
 
 #include "phiq/phiq.hpp"
@@ -310,6 +311,32 @@ TEST(ParallelSweep, LargeModelsEvaluatedInParallelInsideParallelChunks) {
   EXPECT_EQ(ps.parallel_chunks, 6);
   EXPECT_LT(test::max_difference(seq, par, 0), 1e-9 * 33000);  // lengths up to 3.3·10⁴ m
   EXPECT_LT(test::max_difference(seq, par, 1), 1e-7);
+}
+
+// A step callback that throws ends a parallel sweep with its exception, whatever the other threads were doing (none
+// is left waiting for the thrower), and the same model sweeps again afterwards.
+TEST(ParallelSweep, AnExceptionFromTheCallbackPropagates) {
+  Model m = test::nfourbar_model(20, M_PI / 4, M_PI / 2);
+  SweepOptions opt;
+  opt.steps = 400;
+  opt.threads = 2;
+  opt.chunk_steps = 5;
+  for (Index throw_at : {Index{0}, Index{3}, Index{57}, Index{400}}) {
+    Workspace ws(m);
+    Index seen = 0;
+    EXPECT_THROW(run_sweep(m, opt, ws,
+                           [&](const StepView& v) {
+                             if (v.step == throw_at) throw std::runtime_error("stop here");
+                             ++seen;
+                             return true;
+                           },
+                           nullptr),
+                 std::runtime_error);
+    EXPECT_EQ(seen, throw_at);
+  }
+  test::Trace tr;
+  EXPECT_EQ(test::sweep(m, opt, &tr), SolveStatus::kSuccess);
+  EXPECT_EQ(static_cast<Index>(tr.t.size()), opt.steps + 1);
 }
 
 }  // namespace

@@ -418,10 +418,10 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       }
       sum.slow_convergence = true;
       finish(SolveStatus::kSuccess, "");
+      const std::string& name = model.coordinate_names()[static_cast<std::size_t>(worst)];
       sum.message = "the residual is at its rounding level and the Newton steps no longer reduce it: they are the "
                     "rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
-                    fmt(worst_ratio) + " × the tolerance at '" + model.coordinate_names()[static_cast<std::size_t>(worst)] +
-                    "', which is how well q is known there";
+                    fmt(worst_ratio) + " × the tolerance at '" + name + "', which is how well q is known there";
       return SolveStatus::kSuccess;
     };
     if (rounding_level && !(trial_check.within && trial_check.merit < check.merit)) return stop_at_rounding_level();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstring>
+#include <exception>
 #include <iomanip>
 #include <memory>
 #include <mutex>
@@ -651,11 +652,12 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   Index chunk = opt.chunk_steps;
   if (chunk == 0) {
     // 64 steps (a chunk costs a seed, a start from it and a seam step), but at least 4 chunks per thread, down to
-    // 16 steps (so a sweep of 16 steps or fewer runs in order): the seed of a chunk is a step over the chunk's whole span, and on a large model long spans are
-    // expensive (Newton from far away, sub-steps). Measured, 100 steps on 2 threads against 1 thread: chain3d
-    // N = 10⁴ positions only 1.5× with 9 chunks of 12 steps, 0.9–1.0× with 2 of 50; nfourbar N = 10³ with q̇, q̈
-    // 1.45× either way. More chunks also balance more threads (tools/simulate_schedule.py). Fewer steps when the
-    // rows a window of chunks holds would exceed kRowBufferBytes.
+    // 16 steps (so a sweep of 16 steps or fewer runs in order): the seed of a chunk is one step over the chunk's
+    // whole span, and on a large model long spans are expensive (Newton from far away, sub-steps). Measured, 100
+    // steps on 2 threads against 1 thread: chain3d N = 10⁴ positions only 1.5× with 9 chunks of 12 steps,
+    // 0.9–1.0× with 2 of 50; nfourbar N = 10³ with q̇, q̈ 1.45× either way. More chunks also balance more threads
+    // (tools/simulate_schedule.py). Fewer steps when the rows a window of chunks holds would exceed
+    // kRowBufferBytes.
     const double fit = kRowBufferBytes / (8.0 * static_cast<double>(std::max<Index>(width, 1)) * threads);
     const Index balanced = std::max<Index>(16, opt.steps / (4 * static_cast<Index>(threads)));
     chunk = std::max<Index>(1, std::min<Index>({64, balanced, static_cast<Index>(fit)}));
@@ -851,7 +853,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
       wake.notify_all();
     }
   };
-  auto work = [&] {
+  auto work_loop = [&] {
     const bool is_caller = std::this_thread::get_id() == caller;
     std::unique_lock<std::mutex> lock(mutex);
     for (;;) {
@@ -883,12 +885,26 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
       }
     }
   };
+  // An exception (the caller's on_step may throw) stops every loop, so that none waits for the thrower, and is
+  // rethrown once they have all returned.
+  std::exception_ptr failure;
+  auto work = [&] {
+    try {
+      work_loop();
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex);
+      stop = true;
+      if (!failure) failure = std::current_exception();
+      wake.notify_all();
+    }
+  };
   tbb::parallel_for(
       tbb::blocked_range<int>(0, threads, 1),
       [&](const tbb::blocked_range<int>& r) {
         for (int k = r.begin(); k < r.end(); ++k) work();
       },
       tbb::simple_partitioner());
+  if (failure) std::rethrow_exception(failure);
   // chunks computed but not delivered (after a rejected one): their work was done all the same
   for (Index c = delivered + (stop ? 1 : 0); c < claimed; ++c)
     add_counters(others, chunks[static_cast<std::size_t>(c)].sum.counters, WorkCounters{});
