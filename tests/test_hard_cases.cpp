@@ -312,5 +312,15 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   EXPECT_LE(r.sum.counters.factorizations, usual.sum.counters.factorizations + 10);
   EXPECT_LE(deviation(usual), 2e-10);
   EXPECT_LE(deviation(r), 2.0 * deviation(usual));
+
+  // In parallel chunks: a chunk's first row (from its seed) and the previous chunk's seam differ by the rounding
+  // level, thousands of tolerances here, not by the 100 tolerances the seam check allows a regular solve; the check
+  // allows 10× the rounding level such stops report, so every chunk is accepted (before, the rest ran in order).
+  sc.sweep.chunk_steps = 5;
+  const Rows p = sweep_scene(sc, 2);
+  ASSERT_EQ(p.status, SolveStatus::kSuccess) << p.sum.message;
+  for (const SweepWarning& w : p.sum.warnings) EXPECT_NE(w.kind, "parallel_fallback") << w.message;
+  EXPECT_EQ(p.sum.parallel_chunks, 4);
+  EXPECT_LE(deviation(p), 2.0 * deviation(usual));
 }
 }  // namespace

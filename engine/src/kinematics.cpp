@@ -286,8 +286,9 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   // start and each trial when the next iteration factorises at its iterate (full Newton; modified Newton once it
   // has refreshed), unless the trial's step already passes the tolerance (it is then expected to be the solution);
   // and the expected solution when the caller factorises there next (NewtonOptions::jacobian_with_residual:
-  // velocities follow). A wrong guess costs one separate Jacobian evaluation, or one wasted.
-  ws.trial_jacobian_values.resize(ws.jacobian_values.size());
+  // velocities follow). A wrong guess costs one separate Jacobian evaluation, or one wasted. The trial's Φq goes
+  // straight into jacobian_values: once the iterate's own Φq is factorised nothing needs it, and where it is not
+  // (jacobian_at_q, a reused matrix) a rejected trial only costs its evaluation again — no second array of Φq.
   bool step_ok = false;
   // Modified Newton reuses the workspace's factorisation until it contracts badly; then (and always for full
   // Newton) every iteration factorises at its iterate.
@@ -381,7 +382,8 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       step_ok = take_step(model, ws.q, ws.step, alpha, opt.tolerance, std::min(eta, 1.0), ws.trial);
       with_jacobian = step_ok ? opt.jacobian_with_residual : !reuse;
       if (with_jacobian) {
-        model.residual_and_jacobian(ws.trial.data(), t, ws.trial_phi.data(), ws.trial_jacobian_values.data());
+        model.residual_and_jacobian(ws.trial.data(), t, ws.trial_phi.data(), ws.jacobian_values.data());
+        jacobian_at_q = false;  // the values are the trial's now
         ++ws.counters.jacobian_evaluations;
       } else {
         model.residual(ws.trial.data(), t, ws.trial_phi.data());
@@ -417,6 +419,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
         if (r > worst_ratio) worst_ratio = r, worst = j;
       }
       sum.slow_convergence = true;
+      sum.rounding_level = worst_ratio;
       finish(SolveStatus::kSuccess, "");
       const std::string& name = model.coordinate_names()[static_cast<std::size_t>(worst)];
       sum.message = "the residual is at its rounding level and the Newton steps no longer reduce it: they are the "
@@ -435,7 +438,6 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     prev_norm = alpha == 1.0 ? norm : -1.0;  // a shortened step says nothing about the contraction
     ws.q.swap(ws.trial);
     ws.phi.swap(ws.trial_phi);
-    if (with_jacobian) ws.jacobian_values.swap(ws.trial_jacobian_values);
     jacobian_at_q = with_jacobian;
     check = trial_check;
     if (rounding_level) return stop_at_rounding_level();

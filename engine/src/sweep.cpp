@@ -11,6 +11,7 @@
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
@@ -103,6 +104,9 @@ class Sweeper {
     det_sign_ = singular_row_ || !ws_.lu ? 0 : ws_.lu->determinant_sign();
   }
   int det_sign() const { return det_sign_; }
+  // The largest PositionSummary::rounding_level of the positions converged since the last call (0: none stopped
+  // at the rounding level): how far from the exact solution, in tolerances, they may be.
+  double take_rounding_level() { return std::exchange(rounding_level_, 0.0); }
   const PointMotion* point_motions() const { return points_.empty() ? nullptr : points_.data(); }
   double rcond() const { return rcond_; }
 
@@ -354,6 +358,7 @@ class Sweeper {
   // A position converged at t: its warning, the derivatives asked for, and it becomes the current state.
   bool converged(double t, const PositionSummary& ps) {
     singular_row_ = false;
+    rounding_level_ = std::max(rounding_level_, ps.rounding_level);
     if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
     if (!need_v_ && ps.rcond > 0.0 && ps.rcond < kSingularRcond) {
       // positions only: nothing is computed from Φq here, but the user is told where the motion branches
@@ -433,6 +438,7 @@ class Sweeper {
   bool bracketing_ = false;         // inside singular_point(): no nested bracketing
   bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
   int det_sign_ = 0;                // sign of det Φq at the last row (0: singular)
+  double rounding_level_ = 0.0;     // see take_rounding_level()
   bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)
   double default_step_ = (opt_.t_end - opt_.t_begin) / static_cast<double>(std::max<Index>(opt_.steps, 1));
 };
@@ -533,10 +539,11 @@ void add_counters(WorkCounters& into, const WorkCounters& now, const WorkCounter
   into.point_evaluations += now.point_evaluations - before.point_evaluations;
 }
 
-// Two solutions of the same position problem are the same one if they differ by less than 100 tolerances in
-// every coordinate (each is within about one of the exact root; another branch is a finite distance away).
-bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b, double tol) {
-  return scaled_step(model, a - Eigen::Map<const Eigen::VectorXd>(b, a.size()), a, tol) <= 100.0;
+// Two solutions of the same position problem are the same one if they differ by less than `limit` tolerances in
+// every coordinate (each is within about one of the exact root, or of its rounding level; another branch is a
+// finite distance away).
+bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b, double tol, double limit) {
+  return scaled_step(model, a - Eigen::Map<const Eigen::VectorXd>(b, a.size()), a, tol) <= limit;
 }
 
 // One parallel chunk: rows k0 … k1 computed from a seed at t_k0 (chunk 0: from row 0), then the sweep continued
@@ -551,6 +558,7 @@ struct Chunk {
   bool ok = false;
   bool has_seam = false;
   Eigen::VectorXd seam_q;    // the position at t_{k1+1} reached by continuing in order
+  double rounding = 0.0;  // largest rounding level (Sweeper::take_rounding_level) of its solves, seed included
 };
 
 // Keeps the first warning of `kind` of every stretch of consecutive rows (on the grid of the sweep) and says on it
@@ -698,7 +706,9 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   std::vector<PointMotion> last_points(opt.points.size());  // its point motions
   bool seam_known = false;
   Eigen::VectorXd seam_q;
+  double seam_rounding = 0.0;
   std::vector<Eigen::VectorXd> seeds(static_cast<std::size_t>(n_chunks));  // seeds[c]: chunk c's first row (not 0)
+  std::vector<double> seed_rounding(static_cast<std::size_t>(n_chunks), 0.0);  // the seeder's rounding level there
 
   // Chunk c: its rows from its seed (chunk 0: in order from row 0), then the seam step.
   auto run_chunk = [&](Index c, Chunk& ch) {
@@ -745,6 +755,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
       ch.sum.status = kept.status, ch.sum.message = kept.message;
       ch.sum.min_rcond = kept.min_rcond, ch.sum.min_rcond_time = kept.min_rcond_time;
     }
+    ch.rounding = std::max(s.take_rounding_level(), c > 0 ? seed_rounding[static_cast<std::size_t>(c)] : 0.0);
     add_counters(ch.sum.counters, w.counters, w0);
     release(std::move(held));
   };
@@ -754,8 +765,11 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // the last delivered row, arrives (chunk 0 is that continuation by construction).
   auto deliver_chunk = [&](Chunk& ch) {
     add_counters(others, ch.sum.counters, WorkCounters{});
-    const bool accept =
-        ch.ok && (ch.k0 == 1 || (seam_known && same_solution(model, seam_q, ch.rows.data(), opt.newton.tolerance)));
+    // Two solutions of the same problem agree to 100 tolerances, or, where Newton stopped at the rounding level
+    // (a long chain), to 10× how well that stop says q is known: another branch is a finite distance away.
+    const double limit = std::max(100.0, 10.0 * std::max(seam_rounding, ch.rounding));
+    const bool accept = ch.ok && (ch.k0 == 1 || (seam_known && same_solution(model, seam_q, ch.rows.data(),
+                                                                             opt.newton.tolerance, limit)));
     if (!accept) return 1;
     const double* r = ch.rows.data();
     for (Index k = ch.k0; k <= ch.k1; ++k, r += width) {
@@ -772,7 +786,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     }
     resume = ch.k1 + 1;
     seam_known = ch.has_seam;
-    if (seam_known) seam_q.swap(ch.seam_q);
+    if (seam_known) seam_q.swap(ch.seam_q), seam_rounding = ch.rounding;
     sum.subdivisions += ch.sum.subdivisions;
     sum.singular_positions += ch.sum.singular_positions;
     sum.warnings.insert(sum.warnings.end(), ch.sum.warnings.begin(), ch.sum.warnings.end());
@@ -827,7 +841,10 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     const auto seed_start = std::chrono::steady_clock::now();
     const Index c = seeded;  // only the thread holding seeding_busy changes it
     const bool ok = seeder.advance(run.time_of(first_row(c)), 0);
-    if (ok) seeds[static_cast<std::size_t>(c)] = sws.q;
+    if (ok) {
+      seeds[static_cast<std::size_t>(c)] = sws.q;
+      seed_rounding[static_cast<std::size_t>(c)] = seeder.take_rounding_level();
+    }
     const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
     std::lock_guard<std::mutex> lock(mutex);
     sum.seed_seconds += took;

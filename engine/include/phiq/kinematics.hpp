@@ -74,6 +74,10 @@ struct PositionSummary {
   /// convergence of Newton at a singular position (a dead point, a bifurcation). The constraints hold to tolerance;
   /// the position itself is less accurate (about √tol). message says so.
   bool slow_convergence = false;
+  /// At a stop at the rounding level (slow_convergence, message "…rounding level…"): the last Newton step in
+  /// units of the tolerance test (max_j |Δq_j| / (tol · scale_j + floor_j)), i.e. how well q is known relative to
+  /// the tolerance; 0 otherwise.
+  double rounding_level = 0.0;
   /// The worst rows at the end (row, |Φ_i| / scale_i), largest first, at most 3.
   std::vector<std::pair<Index, double>> worst_rows;
   std::string message;  ///< one line; empty on a clean success

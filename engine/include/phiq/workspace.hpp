@@ -48,12 +48,12 @@ class Workspace {
   Eigen::VectorXd step;                  ///< Φq⁻¹Φ of the last Newton iteration (its step was −α times this)
   Eigen::VectorXd trial;                 ///< line-search trial point
   Eigen::VectorXd trial_phi;             ///< Φ at the trial point
-  std::vector<double> jacobian_values;   ///< Φq values in jacobian_pattern() order
-  /// Φq evaluated by the Newton loop together with Φ at its trial point (NewtonOptions::jacobian_with_residual);
-  /// when the trial is accepted it becomes jacobian_values. A solve that ends with such values not yet factorised
-  /// records their point (jacobian_q, jacobian_t) and sets has_jacobian, for the velocity solve that follows.
-  std::vector<double> trial_jacobian_values;
-  Eigen::VectorXd jacobian_q;            ///< see trial_jacobian_values
+  /// Φq values in jacobian_pattern() order. The Newton loop evaluates Φq together with Φ at its trial points
+  /// where it will factorise (NewtonOptions::jacobian_with_residual); a solve that ends with such values at its
+  /// solution, not yet factorised, records their point (jacobian_q, jacobian_t) and sets has_jacobian, for the
+  /// velocity solve that follows.
+  std::vector<double> jacobian_values;
+  Eigen::VectorXd jacobian_q;            ///< see jacobian_values
   double jacobian_t = 0.0;               ///< see jacobian_q
   bool has_jacobian = false;             ///< jacobian_values hold Φq at (jacobian_q, jacobian_t), not yet factorised
   /// Models with dropped rows (Model::without_rows()): the values of the kept rows in solve_pattern() order, and
