@@ -453,8 +453,11 @@ std::string SweepSummary::BriefReport() const {
   if (counters.point_evaluations) s << ", " << counters.point_evaluations << " point evaluations";
   if (subdivisions) s << ", " << subdivisions << " step subdivisions";
   if (singular_positions) s << ", " << singular_positions << " singular positions passed";
-  if (threads > 1) s << ", " << threads << " threads (" << parallel_chunks << " parallel chunks)";
-  if (!warnings.empty()) s << ", " << warnings.size() << " warnings (first at t = " << warnings[0].t << ")";
+  if (threads > 1)
+    s << ", " << threads << " threads (" << parallel_chunks << " parallel chunk" << (parallel_chunks == 1 ? ")" : "s)");
+  if (!warnings.empty())
+    s << ", " << warnings.size() << (warnings.size() == 1 ? " warning" : " warnings") << " (first at t = "
+      << warnings[0].t << ")";
   s.precision(3);
   s << ", " << std::scientific << solve_seconds << " s";
   if (!message.empty()) s << " — " << message;
