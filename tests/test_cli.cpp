@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <thread>
 #include <tuple>
 
 #include "phiq/csv_compare.hpp"
@@ -410,6 +411,23 @@ TEST_F(Cli, SummaryJsonCountsWhatWasComputed) {
   const std::string j2 = slurp(sum);
   EXPECT_NE(j2.find("\"velocity_solves\": 11"), std::string::npos) << j2;
   EXPECT_NE(j2.find("\"acceleration_solves\": 11"), std::string::npos) << j2;
+}
+
+// --memory: with all cores (--threads 0, the default) and no room for a second thread's workspace, the run goes
+// in order and says why; the rows are the same.
+TEST_F(Cli, MemoryBudgetFitsTheThreads) {
+  if (std::thread::hardware_concurrency() < 2) GTEST_SKIP() << "one core: all cores is one thread anyway";
+  const fs::path scene = dir_ / "m.yaml", sum = dir_ / "m.json", a = dir_ / "a.csv", b = dir_ / "b.csv";
+  ASSERT_EQ(run("generate nfourbar 50 --steps 200 -o " + scene.string()).code, 0);
+  Result r = run("run " + scene.string() + " -o " + a.string() + " --memory 0.000001 --summary " + sum.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string j = slurp(sum);
+  EXPECT_NE(j.find("\"threads\": 1"), std::string::npos) << j;
+  EXPECT_NE(j.find("threads_reduced"), std::string::npos) << j;
+  EXPECT_NE(r.err.find("are allowed (memory_budget)"), std::string::npos) << r.err;
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + b.string() + " --threads 1").code, 0);
+  EXPECT_EQ(slurp(a), slurp(b));  // one thread either way: the same rows, digit for digit
+  EXPECT_NE(run("run -q " + scene.string() + " --memory -1").code, 0);
 }
 
 // The four-bar of models/seed/fourbar_mixed.yaml with every kind of output: two points (B, natural; P on the

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include <tbb/info.h>
+
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
 
@@ -337,6 +339,44 @@ TEST(ParallelSweep, AnExceptionFromTheCallbackPropagates) {
   test::Trace tr;
   EXPECT_EQ(test::sweep(m, opt, &tr), SolveStatus::kSuccess);
   EXPECT_EQ(static_cast<Index>(tr.t.size()), opt.steps + 1);
+}
+
+// threads = 0 runs on all cores, as many as the memory allows: below the room for two more workspaces the sweep runs
+// in order, with a warning that says why; with room, on every core; an explicit thread count is kept whatever the
+// budget. The rows are the same in every case.
+TEST(ParallelSweep, AllCoresAsManyAsTheMemoryAllows) {
+  Model m = test::nfourbar_model(200, M_PI / 4, M_PI / 2);
+  SweepOptions opt;
+  opt.steps = 200;
+  opt.threads = 0;
+  opt.memory_budget = 1;  // far too little for a second workspace
+  test::Trace tight, roomy, forced;
+  SweepSummary st, sr, sf;
+  ASSERT_EQ(test::sweep(m, opt, &tight, &st), SolveStatus::kSuccess) << st.message;
+  const int cores = tbb::info::default_concurrency();
+  auto reduced = [](const SweepSummary& s) {
+    for (const SweepWarning& w : s.warnings)
+      if (w.kind == "threads_reduced") return w.message;
+    return std::string();
+  };
+  if (cores > 1) {
+    EXPECT_EQ(st.threads, 1);
+    EXPECT_EQ(st.parallel_chunks, 0);
+    EXPECT_NE(reduced(st).find("instead of " + std::to_string(cores)), std::string::npos) << reduced(st);
+  }
+  opt.memory_budget = std::size_t{1} << 40;
+  ASSERT_EQ(test::sweep(m, opt, &roomy, &sr), SolveStatus::kSuccess) << sr.message;
+  EXPECT_EQ(reduced(sr), "");
+  if (cores > 1) {
+    EXPECT_EQ(sr.threads, cores);
+  }
+  opt.threads = 2;
+  opt.memory_budget = 1;
+  ASSERT_EQ(test::sweep(m, opt, &forced, &sf), SolveStatus::kSuccess) << sf.message;
+  EXPECT_EQ(sf.threads, 2);
+  EXPECT_EQ(reduced(sf), "");
+  EXPECT_LT(test::max_difference(tight, roomy, 0), 1e-9);
+  EXPECT_LT(test::max_difference(tight, forced, 0), 1e-9);
 }
 
 }  // namespace

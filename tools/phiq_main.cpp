@@ -106,7 +106,7 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
 }
 
 int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
-            int threads, phiq::tools::ProgressBar::Mode progress_mode) {
+            int threads, double memory_gb, phiq::tools::ProgressBar::Mode progress_mode) {
   const auto load_start = Clock::now();
   std::optional<phiq::Scene> loaded = load_or_report(scene_path);
   if (!loaded) return 2;
@@ -121,6 +121,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   const phiq::AssemblySummary& redundancy = square.assembly;
   const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;
+  scene.sweep.memory_budget = static_cast<std::size_t>(memory_gb * 1e9);
   phiq::Workspace ws(model);
   ws.q = square.start;
   // columns from the scene (its constraints and outputs); residuals of a model solved on its independent rows
@@ -475,6 +476,12 @@ int main(int argc, char** argv) {
   run->add_option("--threads", threads, "Threads for the drive steps (0: all cores; 1: in order)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  double memory_gb = 0.0;
+  run->add_option("--memory", memory_gb,
+                  "GB the drive steps may use with --threads 0: fewer threads when theirs would not fit (0: what the "
+                  "system reports available)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   std::string progress = "auto";
   run->add_option("--progress", progress, "Progress bar on standard error: auto (when it is a terminal), always, never")
       ->capture_default_str()
@@ -572,7 +579,7 @@ int main(int argc, char** argv) {
   try {
     if (*run) {
       using Mode = phiq::tools::ProgressBar::Mode;
-      return cmd_run(scene_path, out_path, quiet, summary_path, threads,
+      return cmd_run(scene_path, out_path, quiet, summary_path, threads, memory_gb,
                      progress == "always" ? Mode::kAlways : progress == "never" ? Mode::kNever : Mode::kAuto);
     }
     if (*generate) {

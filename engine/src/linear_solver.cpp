@@ -78,6 +78,11 @@ class UmfpackNumeric final : public SparseLuNumeric {
   }
   std::string last_message() const override { return message_; }
   std::int64_t pivoting_factorizations() const override { return factorizations_; }
+  std::size_t memory_bytes() const override {
+    SuiteSparse_long lnz = 0, unz = 0, nr = 0, nc = 0, nzud = 0;
+    if (!numeric_ || umfpack_dl_get_lunz(&lnz, &unz, &nr, &nc, &nzud, numeric_) != UMFPACK_OK) return 0;
+    return static_cast<std::size_t>(lnz + unz) * (sizeof(double) + sizeof(SuiteSparse_long));
+  }
 
  private:
   bool solve_system(int sys, const double* b, double* x);
@@ -200,6 +205,7 @@ class DenseNumeric final : public SparseLuNumeric {
   }
   std::string last_message() const override { return rcond_ == 0.0 ? "singular matrix" : ""; }
   std::int64_t pivoting_factorizations() const override { return factorizations_; }
+  std::size_t memory_bytes() const override { return static_cast<std::size_t>(a_.size()) * sizeof(double); }
 
  private:
   const CscPattern& p_;
@@ -225,6 +231,7 @@ class KluNumeric final : public SparseLuNumeric {
   int determinant_sign() const override;
   std::string last_message() const override { return message_; }
   std::int64_t pivoting_factorizations() const override { return pivoting_; }
+  std::size_t memory_bytes() const override { return numeric_ ? common_.mempeak : 0; }  // factorising included
 
   // A refactorisation keeps the pivot order of the last pivoting factorisation; when its reciprocal pivot ratio
   // falls below this fraction of the one measured right after pivoting, the pivots have degraded (the matrix moved

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <iomanip>
@@ -600,6 +601,27 @@ void once_per_stretch(std::vector<SweepWarning>& warnings, const char* kind, con
   warnings.swap(kept);
 }
 
+// What one more thread of a parallel sweep of `ws`'s model takes: the LU (measured, ws has factorised: KLU's peak),
+// Φq's values, and the vectors of a workspace and of a sweeper's predictor history, about 16 of n and 4 of m.
+// (10⁶ scissor stages: 2.2 GB measured per extra thread; this says 10 × its 0.22 GB at 10⁵.)
+double workspace_bytes(const Workspace& ws) {
+  const double n = static_cast<double>(ws.q.size()), m = static_cast<double>(ws.phi.size());
+  const double lu = ws.lu ? static_cast<double>(ws.lu->memory_bytes()) : 0.0;
+  return lu + 8.0 * (static_cast<double>(ws.jacobian_values.size() + ws.solve_values.size()) + 16.0 * n + 4.0 * m);
+}
+
+// The memory the system reports available (Linux: MemAvailable), 0 when it reports none.
+double available_memory() {
+  std::FILE* f = std::fopen("/proc/meminfo", "r");
+  if (!f) return 0.0;
+  char line[256];
+  double kb = 0.0;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "MemAvailable: %lf kB", &kb) == 1) break;
+  std::fclose(f);
+  return 1024.0 * kb;
+}
+
 // run_sweep's body, run inside a task arena of the sweep's threads.
 SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspace& ws,
                            const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
@@ -649,7 +671,26 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   if (!run.deliver(0, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign()))
     return done(sum.status);
 
-  const int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
+  int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
+  if (opt.threads == 0 && threads > 1 && ws.lu && opt.steps > 0) {
+    // All cores, as many as fit: each thread and the seeding pass need a workspace like the caller's (which has
+    // factorised at row 0), beside the rows held for delivery (kRowBufferBytes at most).
+    const double budget = opt.memory_budget > 0 ? static_cast<double>(opt.memory_budget) : available_memory();
+    const double per = workspace_bytes(ws);
+    if (budget > 0.0 && per > 0.0) {
+      const double room = std::floor((budget - kRowBufferBytes) / per) - 1.0;  // less the seeding pass's
+      if (room < threads) {
+        const int fit = std::max(1, static_cast<int>(std::max(room, 1.0)));
+        std::ostringstream m;
+        m.precision(3);
+        m << "the drive steps run on " << fit << (fit == 1 ? " thread" : " threads") << " instead of " << threads
+          << ": each needs a workspace of " << per / 1e9 << " GB (its LU of Φq and its vectors), and "
+          << budget / 1e9 << " GB " << (opt.memory_budget > 0 ? "are allowed (memory_budget)" : "are available");
+        sum.warnings.push_back({run.time_of(0), "threads_reduced", m.str()});
+        threads = fit;
+      }
+    }
+  }
   const Index n = model.num_coordinates();
   // Rows keep q̇ whenever it is solved (q̈ needs it, and so does an ordered continuation's predictor).
   const bool need_v = opt.velocities || opt.accelerations, need_a = opt.accelerations;

@@ -55,6 +55,9 @@ class SparseLuNumeric {
   /// Factorisations so far that searched for pivots (for KLU: not a refactorisation with the old pivot order).
   /// Equal to the number of factorize() calls for libraries that always pivot.
   virtual std::int64_t pivoting_factorizations() const = 0;
+  /// Bytes the factors take (KLU: its memory in use; UMFPACK: the entries of L and U; dense: n²), 0 before the
+  /// first factorisation. What a parallel sweep counts per thread when it fits its threads to the memory.
+  virtual std::size_t memory_bytes() const = 0;
 };
 
 /// Symbolic analysis of a pattern (orderings, once per model). Immutable and thread-safe: share it.

@@ -45,8 +45,13 @@ struct SweepOptions {
   /// the rest of the sweep runs in order (warning "parallel_fallback"). Rows are delivered in time order in any
   /// case, and equal the sequential sweep's to the solver tolerance; on_step is called on the calling thread.
   /// Everything the sweep runs stays on these threads, the model's own parallel evaluation of large models
-  /// (ModelBuilder, 65536 constraints and more) included: 1 is one thread.
+  /// (ModelBuilder, 65536 constraints and more) included: 1 is one thread. With 0, fewer than all cores when
+  /// their workspaces (one per thread and the seeding pass's, each with its own LU of Φq, measured on the first
+  /// factorisation) and the rows held for delivery would not fit in memory_budget: warning "threads_reduced".
   int threads = 1;
+  /// Bytes the parallel drive steps may use when threads = 0; 0: the memory the system reports available
+  /// (MemAvailable of /proc/meminfo), no limit where it reports none. An explicit thread count is never reduced.
+  std::size_t memory_budget = 0;
   /// Steps per parallel chunk; 0 picks 64, fewer (down to 16) so that there are at least 4 chunks per thread (the
   /// seed of a chunk is one step over its span, expensive on large models when long), and fewer when the rows
   /// held for delivery (threads × chunk_steps rows of q, q̇, q̈ and the outputs) would exceed 512 MiB.
