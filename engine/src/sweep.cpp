@@ -14,6 +14,8 @@
 #include <thread>
 #include <utility>
 
+#include <unistd.h>
+
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
@@ -622,6 +624,16 @@ double available_memory() {
   return 1024.0 * kb;
 }
 
+// The process's resident memory (Linux: /proc/self/statm), 0 when unknown.
+double resident_memory() {
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  if (!f) return 0.0;
+  double size = 0.0, resident = 0.0;
+  const bool ok = std::fscanf(f, "%lf %lf", &size, &resident) == 2;
+  std::fclose(f);
+  return ok ? resident * static_cast<double>(sysconf(_SC_PAGESIZE)) : 0.0;
+}
+
 // run_sweep's body, run inside a task arena of the sweep's threads.
 SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspace& ws,
                            const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
@@ -675,17 +687,23 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   if (opt.threads == 0 && threads > 1 && ws.lu && opt.steps > 0) {
     // All cores, as many as fit: each thread and the seeding pass need a workspace like the caller's (which has
     // factorised at row 0), beside the rows held for delivery (kRowBufferBytes at most).
-    const double budget = opt.memory_budget > 0 ? static_cast<double>(opt.memory_budget) : available_memory();
+    // memory_budget is the whole process's: what it holds already (the model, the caller's workspace) is spent
+    const double budget = opt.memory_budget > 0 ? static_cast<double>(opt.memory_budget) - resident_memory()
+                                                : available_memory();
     const double per = workspace_bytes(ws);
-    if (budget > 0.0 && per > 0.0) {
+    if ((budget > 0.0 || opt.memory_budget > 0) && per > 0.0) {
       const double room = std::floor((budget - kRowBufferBytes) / per) - 1.0;  // less the seeding pass's
       if (room < threads) {
         const int fit = std::max(1, static_cast<int>(std::max(room, 1.0)));
         std::ostringstream m;
         m.precision(3);
         m << "the drive steps run on " << fit << (fit == 1 ? " thread" : " threads") << " instead of " << threads
-          << ": each needs a workspace of " << per / 1e9 << " GB (its LU of Φq and its vectors), and "
-          << budget / 1e9 << " GB " << (opt.memory_budget > 0 ? "are allowed (memory_budget)" : "are available");
+          << ": each needs a workspace of " << per / 1e9 << " GB (its LU of Φq and its vectors), and ";
+        if (opt.memory_budget > 0)
+          m << "the budget of " << static_cast<double>(opt.memory_budget) / 1e9 << " GB (memory_budget) leaves "
+            << std::max(budget, 0.0) / 1e9 << " GB beside what the run holds";
+        else
+          m << budget / 1e9 << " GB are available";
         sum.warnings.push_back({run.time_of(0), "threads_reduced", m.str()});
         threads = fit;
       }

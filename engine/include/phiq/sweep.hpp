@@ -49,8 +49,10 @@ struct SweepOptions {
   /// their workspaces (one per thread and the seeding pass's, each with its own LU of Φq, measured on the first
   /// factorisation) and the rows held for delivery would not fit in memory_budget: warning "threads_reduced".
   int threads = 1;
-  /// Bytes the parallel drive steps may use when threads = 0; 0: the memory the system reports available
-  /// (MemAvailable of /proc/meminfo), no limit where it reports none. An explicit thread count is never reduced.
+  /// Bytes the whole process may reach when threads = 0 picks the threads (what it holds already, the model and
+  /// the caller's workspace among it, counts); 0: the threads' workspaces must fit in the memory the system
+  /// reports available (MemAvailable of /proc/meminfo), no limit where it reports none. An explicit thread count
+  /// is never reduced.
   std::size_t memory_budget = 0;
   /// Steps per parallel chunk; 0 picks 64, fewer (down to 16) so that there are at least 4 chunks per thread (the
   /// seed of a chunk is one step over its span, expensive on large models when long), and fewer when the rows
