@@ -178,6 +178,21 @@ TEST(Sweep, ReverseTimeAndSingleStepSweeps) {
 
 // ---- parallel drive steps -------------------------------------------------------------------------------------
 
+// The same sweep in order and on `threads` threads in chunks of `chunk` steps.
+struct InOrderAndParallel {
+  test::Trace seq, par;
+  SweepSummary ss, ps;
+  SolveStatus seq_status, par_status;
+};
+InOrderAndParallel sweep_both(const Model& m, SweepOptions opt, int threads, Index chunk) {
+  InOrderAndParallel r;
+  r.seq_status = test::sweep(m, opt, &r.seq, &r.ss);
+  opt.threads = threads;
+  opt.chunk_steps = chunk;
+  r.par_status = test::sweep(m, opt, &r.par, &r.ps);
+  return r;
+}
+
 // The parallel sweep delivers the same rows as the sequential one, to the solver tolerance, whatever the thread
 // count and chunk size; every chunk is accepted on this regular motion.
 TEST(ParallelSweep, EqualsTheSequentialSweepForAnyThreadCount) {
@@ -216,12 +231,11 @@ TEST(ParallelSweep, ThroughSingularPositionsMatchesTheSequentialSweep) {
   Model m = test::nfourbar_model(10, 0.1, 2 * M_PI);
   SweepOptions opt;
   opt.steps = 400;
-  test::Trace seq, par;
-  SweepSummary ss, ps;
-  ASSERT_EQ(test::sweep(m, opt, &seq, &ss), SolveStatus::kSuccess) << ss.message;
-  opt.threads = 2;
-  opt.chunk_steps = 25;
-  ASSERT_EQ(test::sweep(m, opt, &par, &ps), SolveStatus::kSuccess) << ps.message;
+  const InOrderAndParallel r = sweep_both(m, opt, 2, 25);
+  const test::Trace &seq = r.seq, &par = r.par;
+  const SweepSummary& ps = r.ps;
+  ASSERT_EQ(r.seq_status, SolveStatus::kSuccess) << r.ss.message;
+  ASSERT_EQ(r.par_status, SolveStatus::kSuccess) << ps.message;
   EXPECT_GT(ps.parallel_chunks, 0);
   EXPECT_LT(test::max_difference(seq, par, 0), 1e-8);
   // near the singular positions Φq is ill-conditioned (rcond ~1e-5 a step away), which amplifies the 1e-10
@@ -304,15 +318,12 @@ TEST(ParallelSweep, LargeModelsEvaluatedInParallelInsideParallelChunks) {
   SweepOptions opt;
   opt.steps = 6;
   opt.t_end = 0.01;
-  test::Trace seq, par;
-  SweepSummary ss, ps;
-  ASSERT_EQ(test::sweep(m, opt, &seq, &ss), SolveStatus::kSuccess) << ss.message;
-  opt.threads = 2;
-  opt.chunk_steps = 1;
-  ASSERT_EQ(test::sweep(m, opt, &par, &ps), SolveStatus::kSuccess) << ps.message;
-  EXPECT_EQ(ps.parallel_chunks, 6);
-  EXPECT_LT(test::max_difference(seq, par, 0), 1e-9 * 33000);  // lengths up to 3.3·10⁴ m
-  EXPECT_LT(test::max_difference(seq, par, 1), 1e-7);
+  const InOrderAndParallel r = sweep_both(m, opt, 2, 1);
+  ASSERT_EQ(r.seq_status, SolveStatus::kSuccess) << r.ss.message;
+  ASSERT_EQ(r.par_status, SolveStatus::kSuccess) << r.ps.message;
+  EXPECT_EQ(r.ps.parallel_chunks, 6);
+  EXPECT_LT(test::max_difference(r.seq, r.par, 0), 1e-9 * 33000);  // lengths up to 3.3·10⁴ m
+  EXPECT_LT(test::max_difference(r.seq, r.par, 1), 1e-7);
 }
 
 // A step callback that throws ends a parallel sweep with its exception, whatever the other threads were doing (none

@@ -54,13 +54,16 @@ using detail::residual_within;
 using detail::worst_rows;
 
 // max_j |Δq_j| / (tol · scale_j + floor_j): ≤ 1 when the step is within the tolerance (NaN propagates as > 1).
-// With tol = 1 it is the size of the step in the tolerance-scaled norm (the floor is then negligible).
+// With tol = 1 it is the size of the step in the tolerance-scaled norm (the floor is then negligible). `worst`,
+// when given, receives the j of the maximum.
 template <class Step>
-double step_ratio(const Model& model, const Step& dq, const Eigen::VectorXd& q, double tol) {
+double step_ratio(const Model& model, const Step& dq, const Eigen::VectorXd& q, double tol, Index* worst = nullptr) {
   if (q.size() == 0) return 0.0;
+  Index j = 0;
   const double r = (dq.array().abs() /
                     (tol * model.tolerance_scales().coordinate_scale.array() + kUlpFloor * q.array().abs()))
-                       .maxCoeff();
+                       .maxCoeff(&j);
+  if (worst) *worst = j;
   return std::isnan(r) ? std::numeric_limits<double>::infinity() : r;
 }
 
@@ -411,13 +414,8 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     // contraction that cannot come.
     const bool rounding_level = within && !step_ok && alpha == 1.0 && !(trial_check.merit < 0.5 * check.merit);
     auto stop_at_rounding_level = [&] {
-      const Eigen::VectorXd& cs = model.tolerance_scales().coordinate_scale;
       Index worst = 0;
-      double worst_ratio = 0.0;
-      for (Index j = 0; j < ws.step.size(); ++j) {  // step_ratio's test, coordinate by coordinate
-        const double r = std::fabs(ws.step(j)) / (opt.tolerance * cs(j) + kUlpFloor * std::fabs(ws.q(j)));
-        if (r > worst_ratio) worst_ratio = r, worst = j;
-      }
+      const double worst_ratio = step_ratio(model, ws.step, ws.q, opt.tolerance, &worst);
       sum.slow_convergence = true;
       sum.rounding_level = worst_ratio;
       finish(SolveStatus::kSuccess, "");

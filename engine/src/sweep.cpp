@@ -634,13 +634,39 @@ double resident_memory() {
   return ok ? resident * static_cast<double>(sysconf(_SC_PAGESIZE)) : 0.0;
 }
 
-// run_sweep's body, run inside a task arena of the sweep's threads.
+// All cores (threads = 0), as many as fit: each thread and the seeding pass need a workspace like the caller's
+// `ws` (which has factorised at row 0), beside the rows held for delivery (kRowBufferBytes at most). memory_budget
+// is the whole process's: what it holds already (the model, the caller's workspace) is spent. Fewer threads than
+// `threads` come with a "threads_reduced" warning at `t0`.
+int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, double t0,
+                     std::vector<SweepWarning>& warnings) {
+  const double budget =
+      opt.memory_budget > 0 ? static_cast<double>(opt.memory_budget) - resident_memory() : available_memory();
+  const double per = workspace_bytes(ws);
+  if (!(budget > 0.0 || opt.memory_budget > 0) || !(per > 0.0)) return threads;
+  const double room = std::floor((budget - kRowBufferBytes) / per) - 1.0;  // less the seeding pass's
+  if (room >= threads) return threads;
+  const int fit = std::max(1, static_cast<int>(std::max(room, 1.0)));
+  std::ostringstream m;
+  m.precision(3);
+  m << "the drive steps run on " << fit << (fit == 1 ? " thread" : " threads") << " instead of " << threads
+    << ": each needs a workspace of " << per / 1e9 << " GB (its LU of Φq and its vectors), and ";
+  if (opt.memory_budget > 0)
+    m << "the budget of " << static_cast<double>(opt.memory_budget) / 1e9 << " GB (memory_budget) leaves "
+      << std::max(budget, 0.0) / 1e9 << " GB beside what the run holds";
+  else
+    m << budget / 1e9 << " GB are available";
+  warnings.push_back({t0, "threads_reduced", m.str()});
+  return fit;
+}
+
+// run_sweep's body, run inside a task arena of `threads` (run_sweep's count: opt.threads, or all cores for 0).
 SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspace& ws,
-                           const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
+                           const std::function<bool(const StepView&)>& on_step, SweepSummary* summary,
+                           int threads) {
   if (&ws.model() != &model) throw Error("workspace was made for another model");
   if (opt.steps < 0) throw Error("SweepOptions: steps must be >= 0");
   if (!std::isfinite(opt.t_begin) || !std::isfinite(opt.t_end)) throw Error("SweepOptions: times must be finite");
-  if (opt.threads < 0) throw Error("SweepOptions: threads must be >= 0 (0: all cores)");
   if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
   for (const OutputPoint& p : opt.points)
     if (p.max_coordinate() >= model.num_coordinates())
@@ -683,32 +709,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   if (!run.deliver(0, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign()))
     return done(sum.status);
 
-  int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
-  if (opt.threads == 0 && threads > 1 && ws.lu && opt.steps > 0) {
-    // All cores, as many as fit: each thread and the seeding pass need a workspace like the caller's (which has
-    // factorised at row 0), beside the rows held for delivery (kRowBufferBytes at most).
-    // memory_budget is the whole process's: what it holds already (the model, the caller's workspace) is spent
-    const double budget = opt.memory_budget > 0 ? static_cast<double>(opt.memory_budget) - resident_memory()
-                                                : available_memory();
-    const double per = workspace_bytes(ws);
-    if ((budget > 0.0 || opt.memory_budget > 0) && per > 0.0) {
-      const double room = std::floor((budget - kRowBufferBytes) / per) - 1.0;  // less the seeding pass's
-      if (room < threads) {
-        const int fit = std::max(1, static_cast<int>(std::max(room, 1.0)));
-        std::ostringstream m;
-        m.precision(3);
-        m << "the drive steps run on " << fit << (fit == 1 ? " thread" : " threads") << " instead of " << threads
-          << ": each needs a workspace of " << per / 1e9 << " GB (its LU of Φq and its vectors), and ";
-        if (opt.memory_budget > 0)
-          m << "the budget of " << static_cast<double>(opt.memory_budget) / 1e9 << " GB (memory_budget) leaves "
-            << std::max(budget, 0.0) / 1e9 << " GB beside what the run holds";
-        else
-          m << budget / 1e9 << " GB are available";
-        sum.warnings.push_back({run.time_of(0), "threads_reduced", m.str()});
-        threads = fit;
-      }
-    }
-  }
+  if (opt.threads == 0 && threads > 1 && ws.lu && opt.steps > 0)
+    threads = threads_that_fit(opt, ws, threads, run.time_of(0), sum.warnings);
   const Index n = model.num_coordinates();
   // Rows keep q̇ whenever it is solved (q̈ needs it, and so does an ordered continuation's predictor).
   const bool need_v = opt.velocities || opt.accelerations, need_a = opt.accelerations;
@@ -940,7 +942,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
       if (stop) return;
       const Index ready = seeded - claimed;
       const bool can_seed = !seeding_busy && !seeding_over && seeded < std::min(n_chunks, delivered + ahead + 1);
-      if (can_seed && ready < threads) {
+      if (can_seed && ready < threads) {  // (with no chunk ready, always: threads ≥ 2 here)
         seeding_busy = true;
         lock.unlock();
         tbb::this_task_arena::isolate(seed_one);  // nested evaluations wait only for their own tasks
@@ -952,11 +954,6 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
         lock.lock();
         chunk_done[static_cast<std::size_t>(c)] = 1;
         wake.notify_all();
-      } else if (can_seed) {
-        seeding_busy = true;
-        lock.unlock();
-        tbb::this_task_arena::isolate(seed_one);
-        lock.lock();
       } else if (seeding_over && !seeding_busy && claimed == seeded && (!is_caller || delivered == claimed)) {
         return;  // nothing more will become ready (the caller: and everything done is delivered)
       } else {
@@ -1018,8 +1015,9 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   if (opt.threads < 0) throw Error("SweepOptions: threads must be >= 0 (0: all cores)");
   // Everything the sweep runs, the model's parallel evaluation of large models included, stays on its threads:
   // threads = 1 is one thread.
-  tbb::task_arena arena(opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads);
-  return arena.execute([&] { return sweep_in_arena(model, opt, ws, on_step, summary); });
+  const int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
+  tbb::task_arena arena(threads);
+  return arena.execute([&] { return sweep_in_arena(model, opt, ws, on_step, summary, threads); });
 }
 
 }  // namespace phiq

@@ -55,8 +55,10 @@ struct NewtonOptions {
   bool line_search = true;  ///< backtracking on ½‖Φ/scale‖² (always on for assembly from a rough placement)
   int max_backtracks = 12;  ///< halvings of the step before the line search gives up
   JacobianUpdate jacobian_update = JacobianUpdate::kEveryIteration;  ///< full or modified Newton
-  /// Modified Newton: evaluate Φq together with Φ at every trial point, for a caller that factorises at the solution
-  /// next (velocities): one pass over the constraints instead of two. Full Newton always does it.
+  /// Evaluate Φq together with Φ (one pass over the constraints instead of two) also at the trial expected to be
+  /// the solution (its step already passes the tolerance), for a caller that factorises there next (velocities).
+  /// Wherever the next iteration factorises at the trial (full Newton; modified Newton once it has refreshed) the
+  /// loop does it anyway.
   bool jacobian_with_residual = false;
   /// Modified Newton: refactorise when the observed contraction exceeds this (0 < max_contraction < 1).
   double max_contraction = 0.25;

@@ -44,7 +44,7 @@ class Workspace {
   /// @name Scratch of the algorithms (kinematics.cpp); callers need not touch it
   ///@{
   Eigen::VectorXd phi;                   ///< Φ at q
-  Eigen::VectorXd rhs;                   ///< right-hand side of the last linear solve
+  Eigen::VectorXd rhs;                   ///< right-hand side of the last velocity or acceleration solve
   Eigen::VectorXd step;                  ///< Φq⁻¹Φ of the last Newton iteration (its step was −α times this)
   Eigen::VectorXd trial;                 ///< line-search trial point
   Eigen::VectorXd trial_phi;             ///< Φ at the trial point
