@@ -6,7 +6,6 @@
 #include <string>
 #include <vector>
 
-#include "generate.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -268,9 +267,8 @@ TEST(HardCases, LongChainPositionsOnlyDoNotDrift) {
 // tolerance (1e-10, where no row warns), and its positions are as close to the closed form L_k = (0, k sin θ),
 // R_k = (cos θ, k sin θ) as the default's (measured: 1.2e-10 and 1.1e-10 m at the top, 600 m up).
 TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
-  tools::GenerateOptions o;
-  o.kind = "scissor", o.n = 2000, o.steps = 1000, o.from = 0.3, o.to = 1.2;
-  Scene sc = parse_scene(tools::generate_scene(o), "scissor.yaml");
+  Scene sc = parse_scene(tools::generate_scene(test::generate_options("scissor", 2000, "natural", 0.3, 1.2, 1000)),
+                         "scissor.yaml");
   sc.sweep.steps = 20;
   sc.sweep.t_end = 0.02;
   const Model& m = *sc.model;
