@@ -1,6 +1,7 @@
 #include "phiq/linear_solver.hpp"
 
-#include <klu.h>
+#include "klu_lu.hpp"
+
 #include <umfpack.h>
 
 #include <Eigen/Dense>
@@ -40,20 +41,6 @@ std::string umfpack_status_text(int status) {
     case UMFPACK_ERROR_invalid_Numeric_object: return "invalid numeric object";
     default: return "UMFPACK status " + std::to_string(status);
   }
-}
-
-// Parity of a permutation of 0 … n−1 (+1 even, −1 odd), by its cycles. Once per pivot order, not per solve.
-template <typename Int>
-int permutation_sign(const Int* p, Index n) {
-  std::vector<char> seen(static_cast<std::size_t>(n), 0);
-  int sign = 1;
-  for (Index i = 0; i < n; ++i) {
-    if (seen[static_cast<std::size_t>(i)]) continue;
-    Index len = 0;
-    for (Index j = i; !seen[static_cast<std::size_t>(j)]; j = static_cast<Index>(p[j])) seen[static_cast<std::size_t>(j)] = 1, ++len;
-    if (len % 2 == 0) sign = -sign;
-  }
-  return sign;
 }
 
 // ---- UMFPACK ------------------------------------------------------------------------------------------------
@@ -216,152 +203,6 @@ class DenseNumeric final : public SparseLuNumeric {
   std::int64_t factorizations_ = 0;
 };
 
-// ---- KLU ------------------------------------------------------------------------------------------------------
-
-class KluSymbolic;
-
-class KluNumeric final : public SparseLuNumeric {
- public:
-  explicit KluNumeric(std::shared_ptr<const KluSymbolic> sym);
-  ~KluNumeric() override;
-  FactorStatus factorize(const double* values) override;
-  bool solve(const double* b, double* x) override;
-  bool solve_transposed(const double* b, double* x) override;
-  double rcond() const override { return rcond_; }
-  int determinant_sign() const override;
-  std::string last_message() const override { return message_; }
-  std::int64_t pivoting_factorizations() const override { return pivoting_; }
-  std::size_t memory_bytes() const override { return numeric_ ? common_.mempeak : 0; }  // factorising included
-
-  // A refactorisation keeps the pivot order of the last pivoting factorisation; when its reciprocal pivot ratio
-  // falls below this fraction of the one measured right after pivoting, the pivots have degraded (the matrix moved
-  // far from the one they were chosen for) and the matrix is factorised again with a pivot search.
-  static constexpr double kDegradation = 1e-3;
-
- private:
-  FactorStatus factor_with_pivoting(const double* values);
-  bool solve_system(bool transposed, const double* b, double* x);
-  std::shared_ptr<const KluSymbolic> keep_;
-  const KluSymbolic& sym_;
-  mutable klu_l_common common_;
-  klu_l_numeric* numeric_ = nullptr;
-  double rcond_ = 0.0, rcond_at_pivoting_ = 0.0;
-  std::int64_t pivoting_ = 0;
-  std::string message_;
-  int p_sign_ = 1;  // parity of the row permutation Pnum of the last pivoting factorisation
-};
-
-class KluSymbolic final : public SparseLuSymbolic, public std::enable_shared_from_this<KluSymbolic> {
- public:
-  explicit KluSymbolic(std::shared_ptr<const CscPattern> pattern) : pattern_(std::move(pattern)) {
-    klu_l_common common;
-    klu_l_defaults(&common);
-    // BTF + AMD on the pattern only: the orderings are fixed per model.
-    symbolic_ = klu_l_analyze(pattern_->cols, const_cast<SuiteSparse_long*>(pattern_->col_ptr.data()),
-                              const_cast<SuiteSparse_long*>(pattern_->row_idx.data()), &common);
-    if (!symbolic_) throw Error("KLU symbolic analysis failed (status " + std::to_string(common.status) + ")");
-    q_sign_ = permutation_sign(symbolic_->Q, pattern_->cols);
-  }
-  ~KluSymbolic() override {
-    klu_l_common common;
-    klu_l_defaults(&common);
-    klu_l_free_symbolic(&symbolic_, &common);
-  }
-  LinearSolverKind kind() const override { return LinearSolverKind::kKlu; }
-  std::unique_ptr<SparseLuNumeric> make_numeric() const override {
-    return std::make_unique<KluNumeric>(shared_from_this());
-  }
-
-  std::shared_ptr<const CscPattern> pattern_;
-  klu_l_symbolic* symbolic_ = nullptr;  // read-only after construction: shared by all numeric objects
-  int q_sign_ = 1;                      // parity of the fixed column permutation Q
-};
-
-// P R⁻¹ A Q = L U with L unit lower triangular and R > 0 (KLU's row scaling): sign det A = sign P · sign Q ·
-// Π sign U_ii. The final row permutation Pnum changes only with a pivoting factorisation (p_sign_).
-int KluNumeric::determinant_sign() const {
-  if (!numeric_ || rcond_ == 0.0) return 0;
-  const Index n = sym_.pattern_->cols;
-  int sign = sym_.q_sign_ * p_sign_;
-  const double* u = static_cast<const double*>(numeric_->Udiag);
-  for (Index i = 0; i < n; ++i) {
-    if (u[i] == 0.0) return 0;
-    if (u[i] < 0.0) sign = -sign;
-  }
-  return sign;
-}
-
-KluNumeric::KluNumeric(std::shared_ptr<const KluSymbolic> sym) : keep_(std::move(sym)), sym_(*keep_) {
-  klu_l_defaults(&common_);
-}
-
-KluNumeric::~KluNumeric() {
-  if (numeric_) klu_l_free_numeric(&numeric_, &common_);
-}
-
-FactorStatus KluNumeric::factor_with_pivoting(const double* values) {
-  if (numeric_) klu_l_free_numeric(&numeric_, &common_);
-  const CscPattern& p = *sym_.pattern_;
-  ++pivoting_;
-  numeric_ = klu_l_factor(const_cast<SuiteSparse_long*>(p.col_ptr.data()), const_cast<SuiteSparse_long*>(p.row_idx.data()),
-                          const_cast<double*>(values), sym_.symbolic_, &common_);
-  if (!numeric_) {
-    rcond_ = 0.0;
-    // halt_if_singular (the default): a zero pivot frees the factors and reports KLU_SINGULAR
-    if (common_.status == KLU_SINGULAR) {
-      message_ = "singular matrix";
-      return FactorStatus::kSingular;
-    }
-    message_ = "KLU factorisation failed (status " + std::to_string(common_.status) + ")";
-    return FactorStatus::kFailed;
-  }
-  klu_l_rcond(sym_.symbolic_, numeric_, &common_);
-  rcond_ = rcond_at_pivoting_ = common_.rcond;
-  // the row permutation is fixed until the next pivot search: its parity once here, not per determinant_sign()
-  p_sign_ = permutation_sign(numeric_->Pnum, sym_.pattern_->cols);
-  message_.clear();
-  return FactorStatus::kOk;
-}
-
-FactorStatus KluNumeric::factorize(const double* values) {
-  if (numeric_) {
-    const CscPattern& p = *sym_.pattern_;
-    const bool ok = klu_l_refactor(const_cast<SuiteSparse_long*>(p.col_ptr.data()),
-                                   const_cast<SuiteSparse_long*>(p.row_idx.data()), const_cast<double*>(values),
-                                   sym_.symbolic_, numeric_, &common_) &&
-                    common_.status == KLU_OK;
-    if (ok) {
-      klu_l_rcond(sym_.symbolic_, numeric_, &common_);
-      if (common_.rcond >= kDegradation * rcond_at_pivoting_) {
-        rcond_ = common_.rcond;
-        message_.clear();
-        return FactorStatus::kOk;
-      }
-    }
-    // refactorisation failed, hit a zero pivot, or its pivots degraded: search for pivots again
-  }
-  return factor_with_pivoting(values);
-}
-
-bool KluNumeric::solve(const double* b, double* x) { return solve_system(false, b, x); }
-bool KluNumeric::solve_transposed(const double* b, double* x) { return solve_system(true, b, x); }
-
-bool KluNumeric::solve_system(bool transposed, const double* b, double* x) {
-  if (!numeric_) {
-    message_ = "solve before a successful factorisation";
-    return false;
-  }
-  const Index n = sym_.pattern_->cols;
-  std::copy(b, b + n, x);
-  const bool ok = transposed ? klu_l_tsolve(sym_.symbolic_, numeric_, n, 1, x, &common_)
-                             : klu_l_solve(sym_.symbolic_, numeric_, n, 1, x, &common_);
-  if (!ok) {
-    message_ = "KLU solve failed (status " + std::to_string(common_.status) + ")";
-    return false;
-  }
-  return true;
-}
-
 class DenseSymbolic final : public SparseLuSymbolic {
  public:
   explicit DenseSymbolic(std::shared_ptr<const CscPattern> p) : p_(std::move(p)) {}
@@ -381,7 +222,7 @@ std::shared_ptr<const SparseLuSymbolic> analyse(LinearSolverKind kind, std::shar
                 std::to_string(pattern->cols));
   switch (kind) {
     case LinearSolverKind::kUmfpack: return std::make_shared<UmfpackSymbolic>(pattern);
-    case LinearSolverKind::kKlu: return std::make_shared<KluSymbolic>(pattern);
+    case LinearSolverKind::kKlu: return detail::analyse_klu(std::move(pattern));
     case LinearSolverKind::kDense: return std::make_shared<DenseSymbolic>(pattern);
   }
   throw Error("unknown linear solver kind");

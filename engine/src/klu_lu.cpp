@@ -1,0 +1,389 @@
+// KLU (SuiteSparse) behind the sparse LU interface: analysis once per pattern, refactorisation with the old pivot
+// order while the pivots hold, a pivot search again when they degrade.
+//
+// Two choices on top of KLU's defaults, both measured on the generated models (bench/README.md, "Sparse LU at
+// scale"):
+// - 32-bit indices (klu_*) whenever the matrix and the estimated factors fit them, 64-bit (klu_l_*) otherwise:
+//   every entry of L and U carries its row index, so the factors take a quarter less memory, and refactorisations
+//   and solves, which stream them, a quarter less memory traffic.
+// - The blocks of the block triangular form in an order that follows the pattern's own where that is more local
+//   than the order KLU finds them in (resequence_blocks).
+#include "klu_lu.hpp"
+
+#include <klu.h>
+
+#include <algorithm>
+#include <climits>
+#include <cstdint>
+#include <cstdlib>
+#include <functional>
+#include <queue>
+#include <type_traits>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace phiq::detail {
+namespace {
+
+// KLU's two index widths under one set of names: klu_* (int) and klu_l_* (SuiteSparse_long).
+template <class Int>
+struct Klu;
+
+template <>
+struct Klu<int> {
+  using Common = klu_common;
+  using Symbolic = klu_symbolic;
+  using Numeric = klu_numeric;
+  static void defaults(Common* c) { klu_defaults(c); }
+  static Symbolic* analyze(int n, int* ap, int* ai, Common* c) { return klu_analyze(n, ap, ai, c); }
+  static void free_symbolic(Symbolic** s, Common* c) { klu_free_symbolic(s, c); }
+  static Numeric* factor(int* ap, int* ai, double* ax, Symbolic* s, Common* c) { return klu_factor(ap, ai, ax, s, c); }
+  static bool refactor(int* ap, int* ai, double* ax, Symbolic* s, Numeric* f, Common* c) {
+    return klu_refactor(ap, ai, ax, s, f, c) != 0;
+  }
+  static void rcond(Symbolic* s, Numeric* f, Common* c) { klu_rcond(s, f, c); }
+  static bool solve(Symbolic* s, Numeric* f, int n, double* b, Common* c) { return klu_solve(s, f, n, 1, b, c) != 0; }
+  static bool tsolve(Symbolic* s, Numeric* f, int n, double* b, Common* c) {
+    return klu_tsolve(s, f, n, 1, b, c) != 0;
+  }
+  static void free_numeric(Numeric** f, Common* c) { klu_free_numeric(f, c); }
+};
+
+template <>
+struct Klu<SuiteSparse_long> {
+  using Int = SuiteSparse_long;
+  using Common = klu_l_common;
+  using Symbolic = klu_l_symbolic;
+  using Numeric = klu_l_numeric;
+  static void defaults(Common* c) { klu_l_defaults(c); }
+  static Symbolic* analyze(Int n, Int* ap, Int* ai, Common* c) { return klu_l_analyze(n, ap, ai, c); }
+  static void free_symbolic(Symbolic** s, Common* c) { klu_l_free_symbolic(s, c); }
+  static Numeric* factor(Int* ap, Int* ai, double* ax, Symbolic* s, Common* c) {
+    return klu_l_factor(ap, ai, ax, s, c);
+  }
+  static bool refactor(Int* ap, Int* ai, double* ax, Symbolic* s, Numeric* f, Common* c) {
+    return klu_l_refactor(ap, ai, ax, s, f, c) != 0;
+  }
+  static void rcond(Symbolic* s, Numeric* f, Common* c) { klu_l_rcond(s, f, c); }
+  static bool solve(Symbolic* s, Numeric* f, Int n, double* b, Common* c) {
+    return klu_l_solve(s, f, n, 1, b, c) != 0;
+  }
+  static bool tsolve(Symbolic* s, Numeric* f, Int n, double* b, Common* c) {
+    return klu_l_tsolve(s, f, n, 1, b, c) != 0;
+  }
+  static void free_numeric(Numeric** f, Common* c) { klu_l_free_numeric(f, c); }
+};
+
+// Parity of a permutation of 0 … n−1 (+1 even, −1 odd), by its cycles. Once per pivot order, not per solve.
+template <typename Int>
+int permutation_sign(const Int* p, Index n) {
+  std::vector<char> seen(static_cast<std::size_t>(n), 0);
+  int sign = 1;
+  for (Index i = 0; i < n; ++i) {
+    if (seen[static_cast<std::size_t>(i)]) continue;
+    Index len = 0;
+    for (Index j = i; !seen[static_cast<std::size_t>(j)]; j = static_cast<Index>(p[j])) seen[static_cast<std::size_t>(j)] = 1, ++len;
+    if (len % 2 == 0) sign = -sign;
+  }
+  return sign;
+}
+
+// Mean |p[k] − p[k−1]|: 1 for the identity or its reverse, about n/3 for a random permutation. How far apart in
+// memory consecutive columns of the factorisation are.
+template <class Int>
+double mean_jump(const std::vector<Int>& p) {
+  if (p.size() < 2) return 0.0;
+  double sum = 0.0;
+  for (std::size_t k = 1; k < p.size(); ++k) sum += static_cast<double>(std::llabs(static_cast<long long>(p[k]) - p[k - 1]));
+  return sum / static_cast<double>(p.size() - 1);
+}
+
+// KLU finds the diagonal blocks of the block upper triangular form by Tarjan's depth-first search and keeps them in
+// the order the search closes them. On a lattice (phiq generate grid) that order scatters neighbouring blocks
+// across the matrix: each column of a refactorisation or a solve then reads A, X and the factors far from the last
+// one and, once the factors outgrow the cache, misses it nearly every time (grid, 2·10⁶ coordinates: 178 ms per
+// refactorisation in KLU's order, 71 ms in the lattice's). Any topological order of the blocks is the same block
+// triangular form — the same blocks, pivots, factors and fill; only the order of the off-diagonal updates differs —
+// so this takes the one that follows the pattern's own column order, which models number locally (a coordinate
+// next to those of its neighbours) far more often than not: Kahn's algorithm, taking among the blocks whose
+// predecessors are placed the one with the smallest first column (or, the other way round, the largest last
+// column). The more local of the two replaces KLU's order if it halves KLU's mean jump between consecutive
+// columns. O(nnz + blocks · log blocks), once per pattern.
+template <class Int>
+KluAnalysis resequence_blocks(const Int* ap, const Int* ai, typename Klu<Int>::Symbolic* s) {
+  const Int n = s->n, nb = s->nblocks;
+  KluAnalysis a;
+  a.index_bits = 8 * static_cast<int>(sizeof(Int));
+  a.blocks = nb;
+  a.klu_jump = a.jump = mean_jump(std::vector<Int>(s->Q, s->Q + n));
+  if (nb < 3) return a;
+  Int* const P = s->P;
+  Int* const Q = s->Q;
+  Int* const R = s->R;
+  std::vector<Int> block_of_row(static_cast<std::size_t>(n));
+  for (Int b = 0; b < nb; ++b)
+    for (Int k = R[b]; k < R[b + 1]; ++k) block_of_row[static_cast<std::size_t>(P[k])] = b;
+  // An entry of block b's columns in another block's row r ties r's block before b (upper triangular): the
+  // successors of each block, compressed by rows (duplicates kept: each is counted in the in-degree too).
+  std::vector<Int> first(static_cast<std::size_t>(nb) + 1, 0), indegree(static_cast<std::size_t>(nb), 0);
+  std::vector<Int> lo(static_cast<std::size_t>(nb), n), hi(static_cast<std::size_t>(nb), -1);
+  auto each_tie = [&](auto&& f) {
+    for (Int b = 0; b < nb; ++b)
+      for (Int k = R[b]; k < R[b + 1]; ++k)
+        for (Int p = ap[Q[k]]; p < ap[Q[k] + 1]; ++p)
+          if (const Int rb = block_of_row[static_cast<std::size_t>(ai[p])]; rb != b) f(rb, b);
+  };
+  each_tie([&](Int from, Int to) { ++first[static_cast<std::size_t>(from) + 1], ++indegree[static_cast<std::size_t>(to)]; });
+  for (Int b = 0; b < nb; ++b) {
+    first[static_cast<std::size_t>(b) + 1] += first[static_cast<std::size_t>(b)];
+    for (Int k = R[b]; k < R[b + 1]; ++k) {
+      lo[static_cast<std::size_t>(b)] = std::min(lo[static_cast<std::size_t>(b)], Q[k]);
+      hi[static_cast<std::size_t>(b)] = std::max(hi[static_cast<std::size_t>(b)], Q[k]);
+    }
+  }
+  std::vector<Int> successors(static_cast<std::size_t>(first[static_cast<std::size_t>(nb)]));
+  {
+    std::vector<Int> next(first.begin(), first.end() - 1);
+    each_tie([&](Int from, Int to) { successors[static_cast<std::size_t>(next[static_cast<std::size_t>(from)]++)] = to; });
+  }
+  // Kahn's algorithm by a priority: the blocks in the order taken.
+  auto order_by = [&](const std::vector<Int>& key, bool ascending) {
+    std::vector<Int> left = indegree, order;
+    order.reserve(static_cast<std::size_t>(nb));
+    using Item = std::pair<Int, Int>;  // (±key, block)
+    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> ready;
+    auto push = [&](Int b) { ready.push({ascending ? key[static_cast<std::size_t>(b)] : -key[static_cast<std::size_t>(b)], b}); };
+    for (Int b = 0; b < nb; ++b)
+      if (left[static_cast<std::size_t>(b)] == 0) push(b);
+    while (!ready.empty()) {
+      const Int b = ready.top().second;
+      ready.pop();
+      order.push_back(b);
+      for (Int e = first[static_cast<std::size_t>(b)]; e < first[static_cast<std::size_t>(b) + 1]; ++e)
+        if (--left[static_cast<std::size_t>(successors[static_cast<std::size_t>(e)])] == 0) push(successors[static_cast<std::size_t>(e)]);
+    }
+    return order;  // all nb blocks: the ties of a block triangular form have no cycle
+  };
+  auto columns_in = [&](const std::vector<Int>& order) {
+    std::vector<Int> q;
+    q.reserve(static_cast<std::size_t>(n));
+    for (Int b : order) q.insert(q.end(), Q + R[b], Q + R[b + 1]);
+    return q;
+  };
+  std::vector<Int> best;
+  double best_jump = 0.5 * a.klu_jump;
+  for (const bool ascending : {true, false}) {
+    std::vector<Int> order = order_by(ascending ? lo : hi, ascending);
+    if (static_cast<Int>(order.size()) != nb) return a;  // not a block triangular form: leave KLU's order
+    if (const double j = mean_jump(columns_in(order)); j < best_jump) best_jump = j, best.swap(order);
+  }
+  if (best.empty()) return a;
+  std::vector<Int> p2, q2, r2(static_cast<std::size_t>(nb) + 1);
+  std::vector<double> lnz2(static_cast<std::size_t>(nb));
+  p2.reserve(static_cast<std::size_t>(n)), q2.reserve(static_cast<std::size_t>(n));
+  for (std::size_t i = 0; i < best.size(); ++i) {
+    const Int b = best[i];
+    r2[i] = static_cast<Int>(p2.size());
+    lnz2[i] = s->Lnz[b];
+    p2.insert(p2.end(), P + R[b], P + R[b + 1]);
+    q2.insert(q2.end(), Q + R[b], Q + R[b + 1]);
+  }
+  r2[static_cast<std::size_t>(nb)] = n;
+  std::copy(p2.begin(), p2.end(), P);
+  std::copy(q2.begin(), q2.end(), Q);
+  std::copy(r2.begin(), r2.end(), R);
+  std::copy(lnz2.begin(), lnz2.end(), s->Lnz);
+  a.resequenced = true;
+  a.jump = best_jump;
+  return a;
+}
+
+template <class Int>
+class KluSymbolic;
+
+template <class Int>
+class KluNumeric final : public SparseLuNumeric {
+ public:
+  using Api = Klu<Int>;
+  explicit KluNumeric(std::shared_ptr<const KluSymbolic<Int>> sym) : keep_(std::move(sym)), sym_(*keep_) {
+    Api::defaults(&common_);
+  }
+  ~KluNumeric() override {
+    if (numeric_) Api::free_numeric(&numeric_, &common_);
+  }
+  FactorStatus factorize(const double* values) override;
+  bool solve(const double* b, double* x) override { return solve_system(false, b, x); }
+  bool solve_transposed(const double* b, double* x) override { return solve_system(true, b, x); }
+  double rcond() const override { return rcond_; }
+  int determinant_sign() const override;
+  std::string last_message() const override { return message_; }
+  std::int64_t pivoting_factorizations() const override { return pivoting_; }
+  std::size_t memory_bytes() const override { return numeric_ ? common_.mempeak : 0; }  // factorising included
+
+  // A refactorisation keeps the pivot order of the last pivoting factorisation; when its reciprocal pivot ratio
+  // falls below this fraction of the one measured right after pivoting, the pivots have degraded (the matrix moved
+  // far from the one they were chosen for) and the matrix is factorised again with a pivot search.
+  static constexpr double kDegradation = 1e-3;
+
+ private:
+  FactorStatus factor_with_pivoting(const double* values);
+  bool solve_system(bool transposed, const double* b, double* x);
+  std::shared_ptr<const KluSymbolic<Int>> keep_;
+  const KluSymbolic<Int>& sym_;
+  mutable typename Api::Common common_;
+  typename Api::Numeric* numeric_ = nullptr;
+  double rcond_ = 0.0, rcond_at_pivoting_ = 0.0;
+  std::int64_t pivoting_ = 0;
+  std::string message_;
+  int p_sign_ = 1;  // parity of the row permutation Pnum of the last pivoting factorisation
+};
+
+// The interface of both widths' analyses that describe_klu reads.
+class KluSymbolicBase : public SparseLuSymbolic {
+ public:
+  KluAnalysis analysis;
+};
+
+template <class Int>
+class KluSymbolic final : public KluSymbolicBase, public std::enable_shared_from_this<KluSymbolic<Int>> {
+ public:
+  using Api = Klu<Int>;
+  explicit KluSymbolic(std::shared_ptr<const CscPattern> pattern) : pattern_(std::move(pattern)) {
+    const CscPattern& p = *pattern_;
+    if constexpr (std::is_same_v<Int, SuiteSparse_long>) {
+      static_assert(sizeof(SuiteSparse_long) == sizeof(Index));
+      ap_ = const_cast<Int*>(reinterpret_cast<const Int*>(p.col_ptr.data()));
+      ai_ = const_cast<Int*>(reinterpret_cast<const Int*>(p.row_idx.data()));
+    } else {  // KLU reads the pattern at every factorisation: a copy in its own index type
+      ap32_.assign(p.col_ptr.begin(), p.col_ptr.end());
+      ai32_.assign(p.row_idx.begin(), p.row_idx.end());
+      ap_ = ap32_.data(), ai_ = ai32_.data();
+    }
+    typename Api::Common common;
+    Api::defaults(&common);
+    // BTF + AMD on the pattern only: the orderings are fixed per model.
+    symbolic_ = Api::analyze(static_cast<Int>(p.cols), ap_, ai_, &common);
+    if (!symbolic_) throw Error("KLU symbolic analysis failed (status " + std::to_string(common.status) + ")");
+    analysis = resequence_blocks<Int>(ap_, ai_, symbolic_);
+    q_sign_ = permutation_sign(symbolic_->Q, p.cols);
+  }
+  ~KluSymbolic() override {
+    typename Api::Common common;
+    Api::defaults(&common);
+    Api::free_symbolic(&symbolic_, &common);
+  }
+  LinearSolverKind kind() const override { return LinearSolverKind::kKlu; }
+  std::unique_ptr<SparseLuNumeric> make_numeric() const override {
+    return std::make_unique<KluNumeric<Int>>(this->shared_from_this());
+  }
+  // Entries of L and U that the analysis expects, and those of the off-diagonal blocks.
+  double estimated_entries() const { return symbolic_->lnz + symbolic_->unz + static_cast<double>(symbolic_->nzoff); }
+
+  std::shared_ptr<const CscPattern> pattern_;
+  std::vector<int> ap32_, ai32_;        // the pattern with 32-bit indices (Int = int only)
+  Int* ap_ = nullptr;                   // the pattern as KLU reads it
+  Int* ai_ = nullptr;
+  typename Api::Symbolic* symbolic_ = nullptr;  // read-only after construction: shared by all numeric objects
+  int q_sign_ = 1;                      // parity of the fixed column permutation Q
+};
+
+// P R⁻¹ A Q = L U with L unit lower triangular and R > 0 (KLU's row scaling): sign det A = sign P · sign Q ·
+// Π sign U_ii. The final row permutation Pnum changes only with a pivoting factorisation (p_sign_).
+template <class Int>
+int KluNumeric<Int>::determinant_sign() const {
+  if (!numeric_ || rcond_ == 0.0) return 0;
+  const Index n = sym_.pattern_->cols;
+  int sign = sym_.q_sign_ * p_sign_;
+  const double* u = static_cast<const double*>(numeric_->Udiag);
+  for (Index i = 0; i < n; ++i) {
+    if (u[i] == 0.0) return 0;
+    if (u[i] < 0.0) sign = -sign;
+  }
+  return sign;
+}
+
+template <class Int>
+FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
+  if (numeric_) Api::free_numeric(&numeric_, &common_);
+  ++pivoting_;
+  numeric_ = Api::factor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, &common_);
+  if (!numeric_) {
+    rcond_ = 0.0;
+    // halt_if_singular (the default): a zero pivot frees the factors and reports KLU_SINGULAR
+    if (common_.status == KLU_SINGULAR) {
+      message_ = "singular matrix";
+      return FactorStatus::kSingular;
+    }
+    message_ = common_.status == KLU_TOO_LARGE
+                   ? std::string("KLU factorisation failed: the factors outgrew its index type")
+                   : "KLU factorisation failed (status " + std::to_string(common_.status) + ")";
+    return FactorStatus::kFailed;
+  }
+  Api::rcond(sym_.symbolic_, numeric_, &common_);
+  rcond_ = rcond_at_pivoting_ = common_.rcond;
+  // the row permutation is fixed until the next pivot search: its parity once here, not per determinant_sign()
+  p_sign_ = permutation_sign(numeric_->Pnum, sym_.pattern_->cols);
+  message_.clear();
+  return FactorStatus::kOk;
+}
+
+template <class Int>
+FactorStatus KluNumeric<Int>::factorize(const double* values) {
+  if (numeric_) {
+    const bool ok = Api::refactor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, numeric_, &common_) &&
+                    common_.status == KLU_OK;
+    if (ok) {
+      Api::rcond(sym_.symbolic_, numeric_, &common_);
+      if (common_.rcond >= kDegradation * rcond_at_pivoting_) {
+        rcond_ = common_.rcond;
+        message_.clear();
+        return FactorStatus::kOk;
+      }
+    }
+    // refactorisation failed, hit a zero pivot, or its pivots degraded: search for pivots again
+  }
+  return factor_with_pivoting(values);
+}
+
+template <class Int>
+bool KluNumeric<Int>::solve_system(bool transposed, const double* b, double* x) {
+  if (!numeric_) {
+    message_ = "solve before a successful factorisation";
+    return false;
+  }
+  const Int n = static_cast<Int>(sym_.pattern_->cols);
+  std::copy(b, b + n, x);
+  const bool ok = transposed ? Api::tsolve(sym_.symbolic_, numeric_, n, x, &common_)
+                             : Api::solve(sym_.symbolic_, numeric_, n, x, &common_);
+  if (!ok) {
+    message_ = "KLU solve failed (status " + std::to_string(common_.status) + ")";
+    return false;
+  }
+  return true;
+}
+
+// 32-bit KLU up to this many expected entries of L, U and the off-diagonal blocks: each block's factors are
+// addressed by int offsets into its own array of 8-byte units (an entry takes 1.5 units), so 2^28 entries leave
+// room for four times the fill the analysis expects before the offsets could overflow.
+constexpr double kInt32Entries = 268435456.0;
+
+}  // namespace
+
+std::shared_ptr<const SparseLuSymbolic> analyse_klu(std::shared_ptr<const CscPattern> pattern, KluIndexWidth width) {
+  const bool fits = pattern->cols < INT_MAX / 2 && pattern->nnz() < INT_MAX / 2;
+  if (width == KluIndexWidth::k32 && !fits) throw Error("KLU: the pattern is too large for 32-bit indices");
+  if (width != KluIndexWidth::k64 && fits) {
+    auto narrow = std::make_shared<KluSymbolic<int>>(pattern);
+    if (width == KluIndexWidth::k32 || narrow->estimated_entries() < kInt32Entries) return narrow;
+  }
+  return std::make_shared<KluSymbolic<SuiteSparse_long>>(std::move(pattern));
+}
+
+KluAnalysis describe_klu(const SparseLuSymbolic& s) {
+  const auto* k = dynamic_cast<const KluSymbolicBase*>(&s);
+  if (!k) throw Error("describe_klu: not a KLU analysis");
+  return k->analysis;
+}
+
+}  // namespace phiq::detail
