@@ -236,16 +236,21 @@ void expect_no_drift(const ChainRun& r, const char* what) {
               r.sum.solve_seconds);
 }
 
-// Positions, velocities and accelerations (the quadratic predictor; Φq factorised at every solution): the Newton
-// solves end at the rounding level, so the residual of a step is the rounding of its far coordinates (about
-// 1e-12 m, proportional to |cos θ| ulp(10^4)), and the last step's must not exceed 10× the first's. Velocities and
+// Positions, velocities and accelerations (the cubic predictor; Φq factorised at every solution for q̇ and q̈): the
+// prediction errs by about 1e-12 m here, so most steps are accepted without a Newton step, each carrying the error
+// of the one before plus its own extrapolation's (the error budget, sweep.cpp predict()), and a Newton step comes
+// when that sum reaches the tolerance. So the residual of a step lies anywhere below the tolerance (single steps
+// say nothing; the windows of expect_no_drift do), every position stays within 2 tolerances of the parallelogram
+// (measured 9.2e-11 m), and there are a few Newton steps, not one per step (measured 16 in 1000). Velocities and
 // accelerations: the linear solves along the chain, within 1e-9 of the exact θ̇ = π/2 rad/s motion (measured
-// about 1e-12).
+// 1.4e-10 and 2.4e-10).
 TEST(HardCases, LongChainDoesNotDrift) {
   const ChainRun r = long_chain(true);
   expect_no_drift(r, "nfourbar 10^4, q v a");
   if (r.residual.size() != static_cast<std::size_t>(kChainSteps + 1)) return;
-  EXPECT_LE(r.residual[kChainSteps], 10.0 * r.residual[1]);
+  EXPECT_LE(max_of(r.deviation, 0, r.deviation.size()), 2 * kTol);
+  EXPECT_GE(r.sum.counters.newton_iterations, 5);
+  EXPECT_LE(r.sum.counters.newton_iterations, kChainSteps / 10);
   EXPECT_LE(r.deviation_v, 1e-9);
   EXPECT_LE(r.deviation_a, 1e-9);
 }

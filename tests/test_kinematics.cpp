@@ -235,6 +235,39 @@ TEST(Kinematics, ModifiedNewtonReusesTheFactorisationAcrossSolvesAndRefreshesWhe
   EXPECT_LT((ref2.q - ws.q).cwiseAbs().maxCoeff(), 1e-9);
 }
 
+// NewtonOptions::start_error: a start whose residual holds is accepted without a Newton step only when its estimated
+// error is within the tolerance too (or not given); otherwise one step at least, whose own estimate then reports.
+TEST(Kinematics, AStartIsAcceptedWithoutAStepOnlyWhenItsErrorEstimateHolds) {
+  Model m = crank_slider(2.0, 0.0, LinearSolverKind::kKlu);
+  const double t = 0.3, th = 2.0 * t;
+  Workspace ws(m);
+  ASSERT_EQ(solve_position(m, t, NewtonOptions{}, ws), SolveStatus::kSuccess);
+  const Eigen::VectorXd exact = ws.q;
+  // 3e-11 m off along x_B: the residual (the rod's row, ~3e-11 m) is within the tolerance of 1e-10 m
+  Eigen::VectorXd start = exact;
+  start(3) += 3e-11;
+  struct Case {
+    double start_error;
+    int iterations;
+  };
+  for (const Case c : {Case{-1.0, 0}, Case{0.5, 0}, Case{1.0, 0}, Case{1.5, 1}, Case{INFINITY, 1}}) {
+    NewtonOptions o;
+    o.start_error = c.start_error;
+    ws.q = start;
+    PositionSummary sum;
+    ASSERT_EQ(solve_position(m, t, o, ws, &sum), SolveStatus::kSuccess) << c.start_error;
+    EXPECT_EQ(sum.iterations, c.iterations) << c.start_error;
+    if (c.iterations == 0) {
+      EXPECT_EQ(ws.q, start);
+      EXPECT_EQ(sum.error_estimate, c.start_error);
+    } else {
+      EXPECT_NEAR(ws.q(3), slider(th).x, 1e-15);  // the step lands on the solution (to rounding)
+      EXPECT_GE(sum.error_estimate, 0.0);
+      EXPECT_LE(sum.error_estimate, 1.0);
+    }
+  }
+}
+
 TEST(Kinematics, SingularJacobianIsAStatusNotACrash) {
   // Drive the slider coordinate xB instead of the crank: at the dead centre θ = 0 the crank angle is not
   // determined to first order by xB and Φq is singular.

@@ -564,5 +564,32 @@ TEST(SceneSolver, NewtonModeIsASetting) {
   }
 }
 
+TEST(SceneSolver, PredictorIsASettingThatNeedsItsDerivativesInTheOutput) {
+  const std::string base =
+      "coordinates: {x: 0.1}\ndrivers: [{coordinate: x, law: {type: linear, initial: 0, rate: 1}}]\n"
+      "time: {start: 0, end: 1, steps: 2}\n";
+  EXPECT_EQ(parse_scene(base, "s.yaml").sweep.predictor, Predictor::kAuto);
+  EXPECT_EQ(parse_scene(base + "solver: {predictor: cubic}\noutput: {velocities: true, accelerations: true}\n",
+                        "s.yaml").sweep.predictor,
+            Predictor::kCubic);
+  EXPECT_EQ(parse_scene(base + "solver: {predictor: parabolic}\noutput: {velocities: false, accelerations: false}\n",
+                        "s.yaml").sweep.predictor,
+            Predictor::kParabolic);
+  for (const auto& [text, message] :
+       {std::pair<std::string, std::string>{"solver: {predictor: quartic}\n",
+                                            "s.yaml:4:21: solver.predictor: predictor is auto, previous, secant, "
+                                            "parabolic, linear, quadratic or cubic"},
+        {"solver: {predictor: cubic}\noutput: {accelerations: false}\n",
+         "s.yaml: solver.predictor: 'cubic' needs the derivatives it extrapolates with in the output (velocities / "
+         "accelerations)"}}) {
+    try {
+      parse_scene(base + text, "s.yaml");
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const SceneError& e) {
+      EXPECT_EQ(std::string(e.what()), message);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace phiq

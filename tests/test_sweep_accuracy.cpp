@@ -77,7 +77,7 @@ constexpr const char* kHeader =
 TEST_F(SweepAccuracy, CrankSliderGridAgainstItsClosedForm) {
   const fs::path csv = dir_ / "acc.csv";
   Result r = run(seed("crank_slider_mixed") +
-                 " --tolerances 1e-6,1e-10,1e-12 --steps-list 45,180 --predictors previous,quadratic --newton modified"
+                 " --tolerances 1e-6,1e-10,1e-12 --steps-list 45,180 --predictors previous,cubic --newton modified"
                  " --linear-solvers klu --repeat 1 -o " + csv.string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(slurp(csv).substr(0, slurp(csv).find('\n')), kHeader);
@@ -94,13 +94,13 @@ TEST_F(SweepAccuracy, CrankSliderGridAgainstItsClosedForm) {
     EXPECT_GT(std::stod(row.at("us_per_step")), 0.0);
     for (const char* e : {"err_q", "err_v", "err_a"}) EXPECT_GE(std::stod(row.at(e)), 0.0) << e;
     err_q[row.at("steps") + "/" + row.at("predictor") + "/" + row.at("tolerance")] = std::stod(row.at("err_q"));
-    // the scene's own settings: 180 steps, tolerance 1e-10, auto = quadratic (it outputs q̈), modified Newton, KLU
-    const bool is_default = row.at("steps") == "180" && row.at("tolerance") == "1e-10" && row.at("predictor") == "quadratic";
+    // the scene's own settings: 180 steps, tolerance 1e-10, auto = cubic (it outputs q̈), modified Newton, KLU
+    const bool is_default = row.at("steps") == "180" && row.at("tolerance") == "1e-10" && row.at("predictor") == "cubic";
     EXPECT_EQ(row.at("default"), is_default ? "1" : "0");
     defaults += is_default;
   }
   EXPECT_EQ(defaults, 1);
-  for (const char* k : {"45/previous/", "45/quadratic/", "180/previous/", "180/quadratic/"}) {
+  for (const char* k : {"45/previous/", "45/cubic/", "180/previous/", "180/cubic/"}) {
     const std::string key(k);
     EXPECT_LT(err_q.at(key + "1e-12"), err_q.at(key + "1e-06")) << key;
     EXPECT_LT(err_q.at(key + "1e-12"), 1e-9) << key;
@@ -118,7 +118,7 @@ TEST_F(SweepAccuracy, JsonHasTheSettingsTheDefaultAndTheReference) {
   EXPECT_EQ(j["format"], 1);
   EXPECT_EQ(j["reference"], "closed-form:fourbar:L1=1,L2=0.4,L3=1.2,L4=1,theta0=0,omega=1,branch=1");
   EXPECT_EQ(j["scene_default"]["tolerance"], 1e-10);
-  EXPECT_EQ(j["scene_default"]["predictor"], "quadratic");
+  EXPECT_EQ(j["scene_default"]["predictor"], "cubic");
   EXPECT_EQ(j["scene_default"]["newton"], "modified");
   EXPECT_EQ(j["scene_default"]["linear_solver"], "klu");
   ASSERT_EQ(j["rows"].size(), 8u);
@@ -238,7 +238,8 @@ TEST_F(SweepAccuracy, CtrlCWritesNothing) {
 }
 
 TEST(SweepAccuracyApi, DefaultGridSkipsPredictorsTheSceneCannotFeed) {
-  // Positions only: linear and quadratic need q̇ / q̈, which the scene does not compute; they are left out, said so.
+  // Positions only: linear, quadratic and cubic need q̇ / q̈, which the scene does not compute; they are left out,
+  // said so.
   std::string text = "phiq: 1\nname: crank_slider_positions\nparameters: {L2: 0.3, L3: 1.0}\n"
                      "coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}\n"
                      "points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}\n"
@@ -255,14 +256,15 @@ TEST(SweepAccuracyApi, DefaultGridSkipsPredictorsTheSceneCannotFeed) {
   o.repeat = 1;
   const tools::AccuracyReport rep = tools::measure_accuracy(s, o);
   EXPECT_EQ(rep.reference_kind, "closed-form:crank-slider");
-  ASSERT_EQ(rep.rows.size(), 12u);  // 3 step counts (10, 40, 160) × previous, secant × 2 tolerances
+  ASSERT_EQ(rep.rows.size(), 18u);  // 3 step counts (10, 40, 160) × previous, secant, parabolic × 2 tolerances
   for (const auto& row : rep.rows) {
-    EXPECT_TRUE(row.setting.predictor == Predictor::kPrevious || row.setting.predictor == Predictor::kSecant);
+    EXPECT_TRUE(row.setting.predictor == Predictor::kPrevious || row.setting.predictor == Predictor::kSecant ||
+                row.setting.predictor == Predictor::kParabolic);
     EXPECT_TRUE(std::isnan(row.err_v) && std::isnan(row.err_a));
     EXPECT_LT(row.err_q, row.setting.tolerance == 1e-12 ? 1e-10 : 1e-4);
   }
-  EXPECT_EQ(rep.notes.size(), 2u);
-  EXPECT_EQ(rep.scene_default.predictor, Predictor::kSecant);  // auto without derivatives
+  EXPECT_EQ(rep.notes.size(), 3u);
+  EXPECT_EQ(rep.scene_default.predictor, Predictor::kParabolic);  // auto without derivatives
 }
 
 }  // namespace

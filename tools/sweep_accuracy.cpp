@@ -62,10 +62,9 @@ std::vector<std::string> split(const std::string& list, const char* option) {
 
 const char* newton_name(JacobianUpdate u) { return u == JacobianUpdate::kWhenSlow ? "modified" : "full"; }
 
-// The sweep's own choice for Predictor::kAuto (sweep.cpp), so that the scene's default can be found in the grid.
+// The sweep's own choice for Predictor::kAuto, so that the scene's default can be found in the grid.
 Predictor resolved(Predictor p, const SweepOptions& o) {
-  if (p != Predictor::kAuto) return p;
-  return o.accelerations ? Predictor::kQuadratic : (o.velocities ? Predictor::kLinear : Predictor::kSecant);
+  return effective_predictor(p, o.velocities || o.accelerations, o.accelerations);
 }
 
 bool stopped(const std::atomic<bool>* stop) { return stop && stop->load(); }
@@ -222,18 +221,12 @@ std::vector<Index> parse_steps(const std::string& list) {
 }
 
 std::vector<Predictor> parse_predictors(const std::string& list) {
-  static const std::map<std::string, Predictor> m = {{"auto", Predictor::kAuto},
-                                                     {"previous", Predictor::kPrevious},
-                                                     {"secant", Predictor::kSecant},
-                                                     {"linear", Predictor::kLinear},
-                                                     {"quadratic", Predictor::kQuadratic}};
   std::vector<Predictor> out;
   for (const std::string& item : split(list, "--predictors")) {
-    auto it = m.find(item);
-    if (it == m.end())
-      throw std::invalid_argument("--predictors: unknown predictor '" + item +
-                                  "' (auto, previous, secant, linear, quadratic)");
-    out.push_back(it->second);
+    Predictor p{};
+    if (!predictor_from_string(item, &p))
+      throw std::invalid_argument("--predictors: unknown predictor '" + item + "' (" + predictor_names() + ")");
+    out.push_back(p);
   }
   return out;
 }
@@ -283,7 +276,9 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
       if (std::find(steps.begin(), steps.end(), s) == steps.end()) steps.push_back(s);
   }
   std::vector<Predictor> preds = opt.predictors;
-  if (preds.empty()) preds = {Predictor::kPrevious, Predictor::kSecant, Predictor::kLinear, Predictor::kQuadratic};
+  if (preds.empty())
+    preds = {Predictor::kPrevious, Predictor::kSecant, Predictor::kParabolic, Predictor::kLinear, Predictor::kQuadratic,
+             Predictor::kCubic};
   std::vector<JacobianUpdate> newtons = opt.newton;
   if (newtons.empty()) newtons = {JacobianUpdate::kWhenSlow, JacobianUpdate::kEveryIteration};
   std::vector<LinearSolverKind> lus = opt.linear_solvers;
@@ -377,8 +372,8 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
           for (double tol : tols) {
             ++done;
             const AccuracySetting set{tol, st, p, nu, lu};
-            if ((p == Predictor::kQuadratic && !so.accelerations) ||
-                (p == Predictor::kLinear && !(so.velocities || so.accelerations))) {
+            if ((predictor_needs_accelerations(p) && !so.accelerations) ||
+                (predictor_needs_velocities(p) && !(so.velocities || so.accelerations))) {
               const std::string note = std::string("predictor ") + to_string(p) +
                                        " skipped: the scene does not output the derivatives it extrapolates with";
               if (std::find(rep.notes.begin(), rep.notes.end(), note) == rep.notes.end()) rep.notes.push_back(note);

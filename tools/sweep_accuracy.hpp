@@ -41,7 +41,7 @@ struct AccuracyRow {
 struct AccuracyOptions {
   std::vector<double> tolerances;            // default 1e-4, 1e-5, ..., 1e-14
   std::vector<Index> steps;                  // default the scene's steps × {1/4, 1, 4}
-  std::vector<Predictor> predictors;         // default previous, secant, linear, quadratic
+  std::vector<Predictor> predictors;         // default previous, secant, parabolic, linear, quadratic, cubic
   std::vector<JacobianUpdate> newton;        // default modified, full
   std::vector<LinearSolverKind> linear_solvers;  // default klu, umfpack
   // "auto" (the closed form the scene's name suggests if it satisfies the scene's constraints, else numerical),

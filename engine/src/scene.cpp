@@ -2119,14 +2119,7 @@ class SceneReader {
       else v.fail("newton is modified or full");
     }
     if (auto v = c.field("predictor"); v.present()) {
-      static const std::map<std::string, Predictor> m = {{"auto", Predictor::kAuto},
-                                                         {"previous", Predictor::kPrevious},
-                                                         {"secant", Predictor::kSecant},
-                                                         {"linear", Predictor::kLinear},
-                                                         {"quadratic", Predictor::kQuadratic}};
-      auto it = m.find(v.text());
-      if (it == m.end()) v.fail("predictor is auto, previous, secant, linear or quadratic");
-      o.predictor = it->second;
+      if (!predictor_from_string(v.text(), &o.predictor)) v.fail(std::string("predictor is ") + predictor_names());
     }
     if (auto v = c.field("length_scale"); v.present()) builder_.set_length_scale(positive(v));
     if (auto v = c.field("linear_solver"); v.present()) {
@@ -2259,8 +2252,8 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
   // A predictor that needs derivatives the scene does not output would compute extra work silently: refuse.
   if (reader.predictor_given()) {
     const Predictor p = scene.sweep.predictor;
-    if ((p == Predictor::kQuadratic && !scene.sweep.accelerations) ||
-        (p == Predictor::kLinear && !(scene.sweep.velocities || scene.sweep.accelerations)))
+    if ((predictor_needs_accelerations(p) && !scene.sweep.accelerations) ||
+        (predictor_needs_velocities(p) && !(scene.sweep.velocities || scene.sweep.accelerations)))
       throw SceneError(path + ": solver.predictor: '" + to_string(p) +
                        "' needs the derivatives it extrapolates with in the output (velocities / accelerations)");
   }

@@ -32,9 +32,31 @@ const char* to_string(Predictor p) {
     case Predictor::kSecant: return "secant";
     case Predictor::kLinear: return "linear";
     case Predictor::kQuadratic: return "quadratic";
+    case Predictor::kCubic: return "cubic";
+    case Predictor::kParabolic: return "parabolic";
   }
   return "?";
 }
+
+bool predictor_from_string(const std::string& name, Predictor* p) {
+  for (Predictor k : {Predictor::kAuto, Predictor::kPrevious, Predictor::kSecant, Predictor::kLinear,
+                      Predictor::kQuadratic, Predictor::kCubic, Predictor::kParabolic})
+    if (name == to_string(k)) return *p = k, true;
+  return false;
+}
+
+const char* predictor_names() { return "auto, previous, secant, parabolic, linear, quadratic or cubic"; }
+
+Predictor effective_predictor(Predictor p, bool velocities, bool accelerations) {
+  if (p != Predictor::kAuto) return p;
+  return accelerations ? Predictor::kCubic : velocities ? Predictor::kLinear : Predictor::kParabolic;
+}
+
+bool predictor_needs_velocities(Predictor p) {
+  return p == Predictor::kLinear || predictor_needs_accelerations(p);
+}
+
+bool predictor_needs_accelerations(Predictor p) { return p == Predictor::kQuadratic || p == Predictor::kCubic; }
 
 namespace {
 
@@ -59,13 +81,25 @@ class Sweeper {
     // With velocities every step factorises at its solution: Φq there comes with the residual that accepts it.
     newton_ = o.newton;
     newton_.jacobian_with_residual = o.newton.jacobian_with_residual || need_v_;
-    predictor_ = o.predictor;
-    if (predictor_ == Predictor::kAuto)
-      predictor_ = need_a_ ? Predictor::kQuadratic : need_v_ ? Predictor::kLinear : Predictor::kSecant;
-    if (predictor_ == Predictor::kQuadratic && !need_a_)
-      throw Error("the quadratic predictor needs accelerations (SweepOptions::accelerations)");
-    if (predictor_ == Predictor::kLinear && !need_v_)
+    predictor_ = effective_predictor(o.predictor, need_v_, need_a_);
+    if (predictor_needs_accelerations(predictor_) && !need_a_)
+      throw Error(std::string("the ") + to_string(predictor_) +
+                  " predictor needs accelerations (SweepOptions::accelerations)");
+    if (predictor_needs_velocities(predictor_) && !need_v_)
       throw Error("the linear predictor needs velocities (SweepOptions::velocities)");
+    // The rows before the current one that the predictor extrapolates from, and one more for its error estimate.
+    switch (predictor_) {
+      case Predictor::kPrevious: depth_ = 1; break;
+      case Predictor::kSecant: depth_ = 2; break;
+      case Predictor::kParabolic: depth_ = 3; break;
+      case Predictor::kLinear: depth_ = 1; break;
+      case Predictor::kQuadratic: depth_ = 1; break;
+      case Predictor::kCubic: depth_ = 2; break;
+      case Predictor::kAuto: break;
+    }
+    history_.resize(static_cast<std::size_t>(depth_));
+    history_t_.resize(static_cast<std::size_t>(depth_));
+    history_error_.resize(static_cast<std::size_t>(depth_));
   }
 
   // Below this reciprocal condition estimate of Φq (KLU: min/max |U_ii|, UMFPACK alike) the position is taken
@@ -124,6 +158,7 @@ class Sweeper {
   // tolerance), then the derivatives, as any converged step.
   bool start_from(double t, const Eigen::VectorXd& seed) {
     ws_.q = seed;
+    newton_.start_error = INFINITY;  // found to the seeding pass's accuracy over a long step: Newton checks it
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t, newton_, ws_, &ps);
     if (st != SolveStatus::kSuccess) return fail(st, ps.message);
@@ -133,7 +168,9 @@ class Sweeper {
   // Continues from the converged state in ws (q, and q̇, q̈ where asked for) at t, as if this sweeper had reached
   // it (the secant predictor's history starts anew).
   void adopt(double t) {
-    has_current_ = has_prev_ = false;
+    has_current_ = false;
+    known_ = 0;
+    row_error_ = INFINITY;  // how well the adopted state is known is not said: the next step checks it
     remember(t);
   }
 
@@ -271,6 +308,9 @@ class Sweeper {
     sum_.warnings.push_back({t, "bifurcation", m.str()});
     note_min_rcond(t, rc);
     ill_conditioned_ = false;
+    // The factorisation left is of a side, next to the singular position: a poor Newton matrix for the next step,
+    // whose contraction the last solves (full Newton, to rounding level) did not measure. The next step factorises.
+    ws_.has_factorization = false;
     return true;
   }
 
@@ -333,6 +373,7 @@ class Sweeper {
     if (st == SolveStatus::kSingularJacobian && has_current_ && !bracketing_) {
       // a zero pivot exactly at a singular position: bracket it (position interpolated from both sides)
       if (singular_point(t1, 0.0, /*have_position=*/false)) {
+        row_error_ = INFINITY;  // interpolated: the next step checks it
         remember(t1);
         return true;
       }
@@ -361,6 +402,7 @@ class Sweeper {
   // A position converged at t: its warning, the derivatives asked for, and it becomes the current state.
   bool converged(double t, const PositionSummary& ps) {
     singular_row_ = false;
+    row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
     rounding_level_ = std::max(rounding_level_, ps.rounding_level);
     if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
     if (!need_v_ && ps.rcond > 0.0 && ps.rcond < kSingularRcond) {
@@ -378,43 +420,168 @@ class Sweeper {
     return true;
   }
   // Whether the converged ws.q is farther from the prediction than the prediction is from the last state (in
-  // tolerance units, beyond a floor of 1000 tolerances): a predictor from q̇ or a secant errs by O(h²) of an O(h)
-  // move, so a correction as large as the move means another solution was found.
-  // Runs every drive step: the differences go to a buffer sized once, and the move is only measured when the
-  // correction is large at all.
+  // tolerance units, beyond a floor of 1000 tolerances): a predictor errs by a higher order of h than the O(h)
+  // move, so a correction as large as the move means another solution was found. Runs every drive step: one pass
+  // for the correction, and one for the move only when the correction is large at all.
   bool jumped() {
-    if (predictor_ == Predictor::kPrevious || (predictor_ == Predictor::kSecant && !has_prev_)) return false;
-    difference_ = ws_.q - predicted_;
-    const double correction = scaled_step(model_, difference_, ws_.q, opt_.newton.tolerance);
+    if (!extrapolated_) return false;  // the previous position: nothing predicted
+    const double tol = opt_.newton.tolerance;
+    const double correction = scaled_distance(ws_.q, predicted_, ws_.q, tol);
     if (!(correction > 1000.0)) return false;
-    difference_ = predicted_ - current_.q;
-    return correction > 0.5 * scaled_step(model_, difference_, current_.q, opt_.newton.tolerance);
+    return correction > 0.5 * scaled_distance(predicted_, current_.q, current_.q, tol);
   }
-  // ws.q = the predictor's guess at t1 from the current state; kept in predicted_ for jumped().
-  void predict(double t1) {
-    const double h = t1 - current_.t;
-    switch (predictor_) {
-      case Predictor::kQuadratic: ws_.q = current_.q + h * current_.qd + (0.5 * h * h) * current_.qdd; break;
-      case Predictor::kLinear: ws_.q = current_.q + h * current_.qd; break;
-      case Predictor::kSecant:
-        if (has_prev_ && current_.t != prev_.t)
-          ws_.q = current_.q + (h / (current_.t - prev_.t)) * (current_.q - prev_.q);
-        else
-          ws_.q = current_.q;
-        break;
-      default: ws_.q = current_.q; break;
+  // scaled_step(a − b, at, tol) without a temporary for a − b.
+  double scaled_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const Eigen::VectorXd& at,
+                         double tol) const {
+    const double* cs = model_.tolerance_scales().coordinate_scale.data();
+    double worst = 0.0;
+    for (Index j = 0, n = a.size(); j < n; ++j) {
+      const double r = std::fabs(a[j] - b[j]) / (tol * cs[j] + ToleranceScales::kUlpFloor * std::fabs(at[j]));
+      if (!(r <= worst)) worst = std::isnan(r) ? INFINITY : r;
     }
-    predicted_ = ws_.q;
+    return worst;
+  }
+
+  // ws.q = the predictor's guess at t1 from the current state and the history (kept in predicted_ for jumped()),
+  // and newton_.start_error = the size of the next term of the extrapolation in units of the tolerance test — its
+  // error estimate, from one more row of history than the prediction needs (infinite until there is one, so that
+  // Newton then takes a step). One pass over the vectors.
+  void predict(double t1) {
+    const Index n = current_.q.size();
+    const double h = t1 - current_.t, tc = current_.t;
+    const double tol = opt_.newton.tolerance;
+    const double* cs = model_.tolerance_scales().coordinate_scale.data();
+    ws_.q.resize(n);
+    predicted_.resize(n);
+    double* out = ws_.q.data();
+    double* kept = predicted_.data();
+    const double* q = current_.q.data();
+    const int k = known_;
+    auto x = [&](int i) { return history_[static_cast<std::size_t>(i)].data(); };
+    auto th = [&](int i) { return history_t_[static_cast<std::size_t>(i)]; };
+    double worst = 0.0;
+    bool estimated = true;
+    double inherited = current_error_;  // the error of the rows extrapolated from, carried into the prediction
+    // f(j, &error) returns the prediction of coordinate j and sets its error estimate.
+    auto each = [&](auto&& f) {
+      for (Index j = 0; j < n; ++j) {
+        double e = 0.0;
+        const double p = f(j, e);
+        out[j] = kept[j] = p;
+        const double r = std::fabs(e) / (tol * cs[j] + ToleranceScales::kUlpFloor * std::fabs(p));
+        if (!(r <= worst)) worst = std::isnan(r) ? INFINITY : r;
+      }
+    };
+    switch (predictor_) {
+      case Predictor::kPrevious:
+      case Predictor::kSecant:
+      case Predictor::kParabolic: {
+        // Newton's divided differences of q over tc, t_0, t_1, t_2 (the current row, then the history): the
+        // polynomial of the predictor's order through the last rows, and its next term as the error
+        const int order = std::min(predictor_ == Predictor::kPrevious ? 0 : predictor_ == Predictor::kSecant ? 1 : 2, k);
+        estimated = k > order;
+        const int terms = order + (estimated ? 1 : 0);
+        inherited = 0.0;
+        const double T[4] = {tc, k > 0 ? th(0) : tc, k > 1 ? th(1) : tc, k > 2 ? th(2) : tc};
+        const double w1 = h, w2 = w1 * (t1 - T[1]), w3 = w2 * (t1 - T[2]);
+        const double* xs[3] = {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q};
+        // the rows' own errors carry over with the weights of Lagrange's polynomial through them at t1
+        for (int i = 0; i <= order; ++i) {
+          double w = 1.0;
+          for (int l = 0; l <= order; ++l)
+            if (l != i) w *= (t1 - T[l]) / (T[i] - T[l]);
+          inherited += std::fabs(w) * (i == 0 ? current_error_ : history_error_[static_cast<std::size_t>(i - 1)]);
+        }
+        each([&](Index j, double& e) {
+          const double v0 = q[j];
+          if (terms == 0) return v0;
+          const double d01 = (v0 - xs[0][j]) / (T[0] - T[1]);
+          double p = v0, next = w1 * d01;
+          if (terms >= 2) {
+            const double d12 = (xs[0][j] - xs[1][j]) / (T[1] - T[2]);
+            const double d012 = (d01 - d12) / (T[0] - T[2]);
+            p += w1 * d01, next = w2 * d012;
+            if (terms >= 3) {
+              const double d23 = (xs[1][j] - xs[2][j]) / (T[2] - T[3]);
+              const double d123 = (d12 - d23) / (T[1] - T[3]);
+              p += w2 * d012, next = w3 * (d012 - d123) / (T[0] - T[3]);
+            }
+          }
+          if (estimated) e = next;
+          else p += next;  // the highest term is the prediction's own, with no estimate beyond it
+          return p;
+        });
+        extrapolated_ = order > 0;
+        break;
+      }
+      case Predictor::kLinear: {
+        const double* v = current_.qd.data();
+        estimated = k > 0;
+        const double c = estimated ? 0.5 * h * h / (tc - th(0)) : 0.0;
+        const double* v0 = estimated ? x(0) : v;
+        each([&](Index j, double& e) {
+          e = c * (v[j] - v0[j]);  // h²/2 q̈, q̈ from the last two q̇
+          return q[j] + h * v[j];
+        });
+        extrapolated_ = true;
+        break;
+      }
+      case Predictor::kQuadratic:
+      case Predictor::kCubic: {
+        const double* v = current_.qd.data();
+        const double* a = current_.qdd.data();
+        const bool cubic = predictor_ == Predictor::kCubic && k > 0;
+        estimated = k > (cubic ? 1 : 0);
+        const double hh = 0.5 * h * h, h3 = h * h * h / 6.0;
+        const double dt0 = k > 0 ? tc - th(0) : 1.0, dt1 = k > 1 ? th(0) - th(1) : 1.0;
+        const double* a0 = k > 0 ? x(0) : a;
+        const double* a1 = k > 1 ? x(1) : a;
+        // cubic: q⃛ ≈ (q̈ − q̈_0) / (tc − t_0), which errs by (tc − t_0)/2 q⁗; with the Taylor remainder the
+        // prediction errs by h³ (h/24 + (tc − t_0)/12) q⁗, q⁗ ≈ 2 q̈[tc, t_0, t_1] (Newton's divided difference)
+        const double ce = h * h * h * (h / 24.0 + dt0 / 12.0) * 2.0 / (tc - (k > 1 ? th(1) : tc - 1.0));
+        each([&](Index j, double& e) {
+          double p = q[j] + h * v[j] + hh * a[j];
+          if (k > 0) {
+            const double jerk = (a[j] - a0[j]) / dt0;
+            if (cubic) {
+              p += h3 * jerk;
+              if (estimated) e = ce * (jerk - (a0[j] - a1[j]) / dt1);
+            } else {
+              e = h3 * jerk;
+            }
+          }
+          return p;
+        });
+        extrapolated_ = true;
+        break;
+      }
+      case Predictor::kAuto: break;
+    }
+    // The prediction is as far from the solution as the rows it extrapolates (how well each was solved) plus the
+    // extrapolation's own error; accepted without a Newton step, its error becomes the next row's to carry. So the
+    // error budget adds up over steps taken without Newton until it exceeds the tolerance, and a step resets it.
+    newton_.start_error = estimated ? inherited + worst : INFINITY;
   }
   void remember(double t) {
-    // Only a state that was really converged becomes the secant's previous point (the default-constructed one
-    // has no q: found by the fuzzer with a sweep starting away from t = 0).
-    if (predictor_ == Predictor::kSecant && has_current_) {
-      std::swap(prev_, current_);  // current_ now holds prev's buffers: assigned below without allocating
-      has_prev_ = true;
+    // The quantity the predictor extrapolates, at the current row, moves into the history (by buffer swaps: the
+    // oldest entry's buffer becomes current_'s, assigned below without allocating). Only a state that was really
+    // converged enters it (the default-constructed one has no q: found by the fuzzer with a sweep starting away
+    // from t = 0).
+    if (depth_ > 0 && has_current_) {
+      std::rotate(history_.rbegin(), history_.rbegin() + 1, history_.rend());
+      std::rotate(history_t_.rbegin(), history_t_.rbegin() + 1, history_t_.rend());
+      Eigen::VectorXd& x = predictor_ == Predictor::kLinear                                        ? current_.qd
+                           : predictor_ == Predictor::kQuadratic || predictor_ == Predictor::kCubic ? current_.qdd
+                                                                                                   : current_.q;
+      history_[0].swap(x);
+      history_t_[0] = current_.t;
+      std::rotate(history_error_.rbegin(), history_error_.rbegin() + 1, history_error_.rend());
+      history_error_[0] = current_error_;
+      known_ = std::min(known_ + 1, depth_);
     }
     has_current_ = true;
     current_.t = t;
+    current_error_ = row_error_;
     current_.q = ws_.q;
     if (need_v_) current_.qd = ws_.qd;
     if (need_a_) current_.qdd = ws_.qdd;
@@ -432,12 +599,20 @@ class Sweeper {
   bool need_v_ = false, need_a_ = false;
   NewtonOptions newton_;  // opt_.newton, with jacobian_with_residual when velocities follow
   Predictor predictor_;
-  State current_, prev_;
-  bool has_current_ = false, has_prev_ = false;
+  State current_;  // the last converged state
+  bool has_current_ = false;
+  // What the predictor extrapolates from (q for the position predictors, q̇ for linear, q̈ for quadratic and
+  // cubic) at the converged rows before current_, newest first, and their times: depth_ rows, known_ of them valid.
+  std::vector<Eigen::VectorXd> history_;
+  std::vector<double> history_t_;
+  std::vector<double> history_error_;  // the estimated error of q at those rows (units of the tolerance test)
+  int depth_ = 0, known_ = 0;
+  double current_error_ = INFINITY;  // the estimated error of current_.q (PositionSummary::error_estimate)
+  double row_error_ = INFINITY;      // that of the row being converged, until remember() makes it current
+  bool extrapolated_ = false;  // the last prediction moved from current_ (jumped() has something to compare)
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
   double rcond_ = 0.0;
   Eigen::VectorXd predicted_;       // the last prediction (for jumped())
-  Eigen::VectorXd difference_;      // jumped()'s buffer
   bool bracketing_ = false;         // inside singular_point(): no nested bracketing
   bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
   int det_sign_ = 0;                // sign of det Φq at the last row (0: singular)

@@ -62,6 +62,14 @@ struct NewtonOptions {
   bool jacobian_with_residual = false;
   /// Modified Newton: refactorise when the observed contraction exceeds this (0 < max_contraction < 1).
   double max_contraction = 0.25;
+  /// How far the start point ws.q is estimated to be from the solution, in units of the tolerance test on a step
+  /// (scaled_step(): ≤ 1 within the tolerance), from whoever chose it — a sweep's predictor gives the size of the
+  /// next term of its extrapolation. The start is accepted without a Newton step only when its residual holds and
+  /// this estimate is ≤ 1: a residual within tolerance alone does not bound the error of q where Φq is
+  /// ill-conditioned (near a singular position, along a long chain). Infinity: always take a step. Negative (the
+  /// default): unknown, and the start is accepted on its residual alone (the convergence test above, with no step
+  /// to estimate).
+  double start_error = -1.0;
 };
 
 /// What solve_position did (Ceres-style summary).
@@ -76,10 +84,16 @@ struct PositionSummary {
   /// convergence of Newton at a singular position (a dead point, a bifurcation). The constraints hold to tolerance;
   /// the position itself is less accurate (about √tol). message says so.
   bool slow_convergence = false;
-  /// At a stop at the rounding level (slow_convergence, message "…rounding level…"): the last Newton step in
-  /// units of the tolerance test (max_j |Δq_j| / (tol · scale_j + floor_j)), i.e. how well q is known relative to
-  /// the tolerance; 0 otherwise.
+  /// At a stop at the rounding level: the last Newton step in units of the tolerance test (max_j |Δq_j| / (tol ·
+  /// scale_j + floor_j)), i.e. how well q is known relative to the tolerance; 0 otherwise. Above 2 the stop is a
+  /// slow_convergence with the message "…rounding level…"; up to 2 it is a plain success (known as well as the
+  /// tolerance test's estimate promises).
   double rounding_level = 0.0;
+  /// On success, the estimated error of q in units of the tolerance test (scaled_step(): ≤ 1 within the tolerance):
+  /// θ/(1−θ)|Δq| of the last step (the step itself where no contraction was observed), the rounding level at a
+  /// stop there, or NewtonOptions::start_error when the start was accepted without a step; negative when unknown
+  /// (a start accepted on its residual alone).
+  double error_estimate = -1.0;
   /// The worst rows at the end (row, |Φ_i| / scale_i), largest first, at most 3.
   std::vector<std::pair<Index, double>> worst_rows;
   std::string message;  ///< one line; empty on a clean success

@@ -13,16 +13,39 @@
 
 namespace phiq {
 
-/// How successive positions are started.
+/// How successive positions are started: an extrapolation of the solutions already found, of the order the
+/// computed quantities allow. Its error is what Newton has to correct: O(h) from the previous position, O(h²)
+/// (secant, linear), O(h³) (parabolic, quadratic), O(h⁴) (cubic), so that a better predictor needs fewer Newton
+/// iterations per step, down to none once its error is within the tolerance (bench/README.md).
 enum class Predictor {
-  kAuto,       ///< the best the computed quantities allow: quadratic with q̇ and q̈, linear with q̇, else secant
+  /// The best the computed quantities allow: cubic with q̇ and q̈, linear with q̇ only, parabolic with positions
+  /// only.
+  kAuto,
   kPrevious,   ///< the previous solution, as in the notes
   kSecant,     ///< linear extrapolation from the two previous solutions (free: needs no velocity)
   kLinear,     ///< q + h q̇            (needs velocities)
   kQuadratic,  ///< q + h q̇ + h²/2 q̈   (needs accelerations)
+  /// q + h q̇ + h²/2 q̈ + h³/6 q⃛, with q⃛ the difference quotient of the last two q̈ (needs accelerations; free:
+  /// the previous q̈ is kept, not recomputed). The quadratic predictor until two rows are known.
+  kCubic,
+  /// The parabola through the last three solutions, evaluated at the new time (free: needs no velocity; any
+  /// spacing of the three times, sub-steps included). The secant until three rows are known.
+  kParabolic,
 };
-/// "auto", "previous", "secant", "linear" or "quadratic".
+/// "auto", "previous", "secant", "linear", "quadratic", "cubic" or "parabolic".
 const char* to_string(Predictor p);
+/// The predictor named `name` (to_string()'s words); false, leaving `*p` unchanged, for any other text.
+bool predictor_from_string(const std::string& name, Predictor* p);
+/// The names predictor_from_string() takes, for messages: "auto, previous, secant, parabolic, linear, quadratic or
+/// cubic".
+const char* predictor_names();
+/// The predictor a sweep runs with: `p` itself, or for Predictor::kAuto the best for what the sweep computes
+/// (velocities: q̇ is solved, also when only accelerations are asked for; accelerations: q̈ is solved).
+Predictor effective_predictor(Predictor p, bool velocities, bool accelerations);
+/// Whether `p` extrapolates with q̇ (linear) or q̈ (quadratic, cubic): a sweep must compute them to use it.
+bool predictor_needs_velocities(Predictor p);
+/// Whether `p` extrapolates with q̈ (quadratic, cubic).
+bool predictor_needs_accelerations(Predictor p);
 
 /// What run_sweep computes and how.
 struct SweepOptions {
