@@ -270,7 +270,9 @@ TEST(HardCases, LongChainPositionsOnlyDoNotDrift) {
 // instead of refactorising in search of a contraction that cannot come: the sweep succeeds, warns once per stretch
 // of such rows, naming the coordinate and how well it is known, costs no more factorisations than at the default
 // tolerance (1e-10, where no row warns), and its positions are as close to the closed form L_k = (0, k sin θ),
-// R_k = (cos θ, k sin θ) as the default's (measured: 1.2e-10 and 1.1e-10 m at the top, 600 m up).
+// R_k = (cos θ, k sin θ) as the default's (measured: 1.2e-10 and 1.1e-10 m at the top, 600 m up, with the quadratic
+// predictor; 2.1e-10 m at the default with the cubic one, whose rows take one Newton step each: the top joints are
+// at their rounding level, about 1.2 tolerances, which a step's error estimate does not see).
 TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   Scene sc = parse_scene(tools::generate_scene(test::generate_options("scissor", 2000, "natural", 0.3, 1.2, 1000)),
                          "scissor.yaml");
@@ -313,7 +315,7 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   EXPECT_GE(rounding, 1);
   EXPECT_LE(r.sum.warnings.size(), 10u) << "once per stretch of rows, not at every row";
   EXPECT_LE(r.sum.counters.factorizations, usual.sum.counters.factorizations + 10);
-  EXPECT_LE(deviation(usual), 2e-10);
+  EXPECT_LE(deviation(usual), 3e-10);  // measured 2.1e-10 at one row, 6e-11 or less at the others
   EXPECT_LE(deviation(r), 2.0 * deviation(usual));
 
   // In parallel chunks: a chunk's first row (from its seed) and the previous chunk's seam differ by the rounding

@@ -91,6 +91,7 @@ bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
 // ½ Σ (Φ_i / scale_i)², whether Φ is finite, and whether every row is within the tolerance (residual_within).
 struct ResidualCheck {
   double merit = 0.0;
+  double worst = 0.0;  // max_i |Φ_i| / scale_i
   bool finite = true;
   bool within = false;
 };
@@ -105,6 +106,7 @@ ResidualCheck check_residual(const Model& model, const Eigen::VectorXd& phi, dou
   }
   ResidualCheck c;
   c.merit = 0.5 * sum;
+  c.worst = worst;
   c.finite = std::isfinite(sum) || phi.allFinite();  // a sum that overflowed is still a finite Φ
   // rows above tol are held to tol · scale_i plus their rounding floor, looked at only then
   c.within = c.finite && (worst <= tol || residual_within(model, phi, tol, q));
@@ -127,10 +129,10 @@ double scaled_norm_if_finite(const Model& model, const Eigen::VectorXd& dq, bool
   return worst;
 }
 
-// trial = q − α·dx (dx = Φq⁻¹Φ, so that −α·dx is the Newton step), and the step test in one pass: returns
-// factor · step_ratio(α·dx, trial, tol), ≤ 1 when the step passes step_within (NaN when it is not finite).
+// trial = q − α·dx (dx = Φq⁻¹Φ, so that −α·dx is the Newton step), and the step's size in one pass: returns
+// step_ratio(α·dx, trial, tol), ≤ 1 when the step is within the tolerance (NaN when it is not finite).
 double take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& dx, double alpha, double tol,
-                 double factor, Eigen::VectorXd& trial) {
+                 Eigen::VectorXd& trial) {
   const double* cs = model.tolerance_scales().coordinate_scale.data();
   const double* x = q.data();
   const double* d = dx.data();
@@ -140,7 +142,7 @@ double take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::Vect
     const double step = alpha * d[j];
     const double v = x[j] - step;
     out[j] = v;
-    const double r = factor * std::fabs(step) / (tol * cs[j] + kUlpFloor * std::fabs(v));
+    const double r = std::fabs(step) / (tol * cs[j] + kUlpFloor * std::fabs(v));
     if (!(r <= worst)) worst = r;  // NaN sticks
   }
   return worst;
@@ -246,10 +248,10 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   PositionSummary local;
   PositionSummary& sum = summary ? *summary : local;
   sum = PositionSummary{};
-  // The contraction observed with the reused factorisation in the previous solve, if any: it estimates the error of
-  // the first step of this one (same age of the matrix in a sweep); it is consumed here, measured afresh below.
+  // The contraction last observed with a reused factorisation, if any: it estimates the error of the first step of
+  // this solve (same age of the matrix in a sweep). It is kept until a solve measures it again — a solve accepted
+  // without a step, or one that refactorised at once, says nothing new about it — and dropped on a failure.
   const double carried_theta = ws.newton_contraction;
-  ws.newton_contraction = -1.0;
 
   // Whether ws.jacobian_values hold Φq at the current iterate (evaluated with Φ at the accepted trial point and
   // not yet factorised): the loop knows it without comparing points; the point is recorded once, at the end.
@@ -258,6 +260,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
 
   auto finish = [&](SolveStatus st, std::string msg) {
     sum.status = st;
+    if (st != SolveStatus::kSuccess) ws.newton_contraction = -1.0;
     if (st == SolveStatus::kSuccess) {
       sum.residual = max_scaled(model, ws.phi);  // O(m), no allocation: this runs once per drive step
       // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
@@ -385,12 +388,14 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     // Backtracking on the scaled merit: a full step whenever it helps, a shorter one from a rough placement. A
     // reused matrix whose full step does not decrease the merit is refreshed rather than backtracked along.
     double alpha = 1.0;
-    double step_error = 0.0;  // the trial's estimated error in units of the tolerance test
+    double step_size = 0.0;   // the step in units of the tolerance test
+    double step_error = 0.0;  // the trial's estimated error, θ/(1−θ) times that
     ResidualCheck trial_check;
     bool with_jacobian = false;  // Φq evaluated at the trial
     bool refresh = false;
     for (int bt = 0;; ++bt) {
-      step_error = take_step(model, ws.q, ws.step, alpha, opt.tolerance, std::min(eta, 1.0), ws.trial);
+      step_size = take_step(model, ws.q, ws.step, alpha, opt.tolerance, ws.trial);
+      step_error = std::min(eta, 1.0) * step_size;
       step_ok = step_error <= 1.0;
       with_jacobian = step_ok ? opt.jacobian_with_residual : !reuse;
       if (with_jacobian) {
@@ -450,7 +455,11 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     prev_norm = alpha == 1.0 ? norm : -1.0;  // a shortened step says nothing about the contraction
     ws.q.swap(ws.trial);
     ws.phi.swap(ws.trial_phi);
-    accepted_error = step_error;
+    // The error reported (and carried by a sweep to the rows it extrapolates): the contraction estimate, or the
+    // step's size times the residual's reduction when that is the larger — the size of the next step, were it
+    // taken. Where the steps are the rounding of Φ amplified along a long chain, the residual no longer falls and
+    // θ measured on the previous solve's steps says nothing of it: the error is then about the step itself.
+    accepted_error = std::max(step_error, check.worst > 0.0 ? step_size * (trial_check.worst / check.worst) : 0.0);
     jacobian_at_q = with_jacobian;
     check = trial_check;
     if (rounding_level) return stop_at_rounding_level();

@@ -90,9 +90,10 @@ struct PositionSummary {
   /// tolerance test's estimate promises).
   double rounding_level = 0.0;
   /// On success, the estimated error of q in units of the tolerance test (scaled_step(): ≤ 1 within the tolerance):
-  /// θ/(1−θ)|Δq| of the last step (the step itself where no contraction was observed), the rounding level at a
-  /// stop there, or NewtonOptions::start_error when the start was accepted without a step; negative when unknown
-  /// (a start accepted on its residual alone).
+  /// the larger of θ/(1−θ)|Δq| of the last step (the step itself where no contraction was observed) and |Δq| times
+  /// the factor by which that step reduced the residual (the size of the next step, were it taken: about |Δq| itself
+  /// where the steps are rounding noise), the rounding level at a stop there, or NewtonOptions::start_error when
+  /// the start was accepted without a step; negative when unknown (a start accepted on its residual alone).
   double error_estimate = -1.0;
   /// The worst rows at the end (row, |Φ_i| / scale_i), largest first, at most 3.
   std::vector<std::pair<Index, double>> worst_rows;

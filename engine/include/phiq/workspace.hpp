@@ -66,8 +66,8 @@ class Workspace {
   Eigen::VectorXd factorized_q;
   double factorized_t = 0.0;             ///< see factorized_q
   bool has_factorization = false;        ///< lu holds valid factors at (factorized_q, factorized_t)
-  /// Contraction of modified Newton observed with a reused factorisation in the last solve_position(), −1 if none:
-  /// the error estimate of the next solve's first step.
+  /// Contraction of modified Newton last observed with a reused factorisation (kept by the solves that observe
+  /// none, −1 before any and after a failed solve): the error estimate of the next solve's first step.
   double newton_contraction = -1.0;
   ///@}
 
