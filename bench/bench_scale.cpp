@@ -6,11 +6,15 @@
 //
 // Generation, loading and the assembly of the initial position (chain3d starts from a rough placement; the others
 // on the solution) are outside the timed region (load_s reports the loading). Arguments: N (the generator's size)
-// and coords (0 natural, 1 reference-point).
+// and coords (0 natural, 1 reference-point). Counters kernel_ms (a step's bare kernel: one KLU refactorisation and
+// two solves) and stream_ms (one triad over vectors of the model's size), measured in the same loop, give the
+// machine's own slopes beside the step's (bench/README.md).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include "generate.hpp"
 #include "generate_linkages.hpp"
@@ -44,16 +48,37 @@ void run(benchmark::State& state, const char* kind) {
     return state.SkipWithError("no assembly at the first time");
   const Eigen::VectorXd start = ws.q;
   phiq::SweepSummary sum;
-  double solve_s = 0;
+  // In the same loop, for the slope of what a step is made of on this machine: the bare kernel of a step (one
+  // refactorisation and two solves of Φq at the first position, with a numeric object of its own on the model's
+  // symbolic analysis) and a pure stream over memory of the model's size (a triad over three vectors of n doubles:
+  // what any O(n) pass costs once the vectors no longer fit in the caches).
+  std::unique_ptr<phiq::SparseLuNumeric> lu = m.symbolic()->make_numeric();
+  std::vector<double> values(static_cast<std::size_t>(m.jacobian_pattern().nnz()));
+  m.jacobian(start.data(), opt.t_begin, values.data());
+  lu->factorize(values.data());
+  Eigen::VectorXd b = Eigen::VectorXd::Ones(m.num_coordinates()), x(m.num_coordinates()), y(m.num_coordinates());
+  double kernel_s = 0, stream_s = 0;
   for (auto _ : state) {
     ws.q = start;
     const auto t0 = Clock::now();
     phiq::run_sweep(m, opt, ws, nullptr, &sum);
     const double e = seconds_since(t0);
-    solve_s += e;
     state.SetIterationTime(e / static_cast<double>(opt.steps + 1));
     if (sum.status != phiq::SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
+    const auto k0 = Clock::now();
+    lu->factorize(values.data());
+    lu->solve(b.data(), x.data());
+    lu->solve(x.data(), y.data());
+    kernel_s += seconds_since(k0);
+    benchmark::DoNotOptimize(y.data());
+    const auto s0 = Clock::now();
+    x = b + 0.5 * y;
+    stream_s += seconds_since(s0);
+    benchmark::DoNotOptimize(x.data());
   }
+  const double it = static_cast<double>(state.iterations());
+  state.counters["kernel_ms"] = 1e3 * kernel_s / it;
+  state.counters["stream_ms"] = 1e3 * stream_s / it;
   state.counters["coordinates"] = static_cast<double>(m.num_coordinates());
   state.counters["load_s"] = load_s;
   state.counters["newton_per_step"] = static_cast<double>(sum.counters.newton_iterations) / (opt.steps + 1);

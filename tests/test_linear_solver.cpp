@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include <klu.h>
+
 #include "generate.hpp"
 #include "klu_lu.hpp"
 #include "phiq/kinematics.hpp"
@@ -175,6 +177,23 @@ TEST(LinearSolver, KluBlocksFollowTheModelsOrderWithEitherIndexWidth) {
   const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1, 2);
   const Eigen::PartialPivLU<Eigen::MatrixXd> ref(grid.dense);
   const int ref_sign = ref.determinant() > 0 ? 1 : -1;
+  // KLU itself, in its own order: the same blocks and pivots, so the same reciprocal pivot ratio (klu_lu.cpp
+  // computes it with the determinant's sign in one pass over U's diagonal instead of calling klu_rcond)
+  double klu_rcond_itself = 0.0;
+  {
+    std::vector<SuiteSparse_long> ap(grid.pattern->col_ptr.begin(), grid.pattern->col_ptr.end()),
+        ai(grid.pattern->row_idx.begin(), grid.pattern->row_idx.end());
+    std::vector<double> ax = grid.values;
+    klu_l_common c;
+    klu_l_defaults(&c);
+    klu_l_symbolic* sym = klu_l_analyze(n, ap.data(), ai.data(), &c);
+    klu_l_numeric* num = klu_l_factor(ap.data(), ai.data(), ax.data(), sym, &c);
+    ASSERT_NE(num, nullptr);
+    klu_l_rcond(sym, num, &c);
+    klu_rcond_itself = c.rcond;
+    klu_l_free_numeric(&num, &c);
+    klu_l_free_symbolic(&sym, &c);
+  }
   for (auto [width, bits] : {std::pair{detail::KluIndexWidth::k32, 32}, std::pair{detail::KluIndexWidth::k64, 64}}) {
     auto sym = detail::analyse_klu(grid.pattern, width);
     const detail::KluAnalysis a = detail::describe_klu(*sym);
@@ -191,6 +210,8 @@ TEST(LinearSolver, KluBlocksFollowTheModelsOrderWithEitherIndexWidth) {
     EXPECT_LT((grid.dense * x - rhs).cwiseAbs().maxCoeff(), 1e-12) << bits;
     EXPECT_LT((grid.dense.transpose() * y - rhs).cwiseAbs().maxCoeff(), 1e-12) << bits;
     EXPECT_EQ(lu->determinant_sign(), ref_sign) << bits;
+    EXPECT_NEAR(lu->rcond(), klu_rcond_itself, 1e-15 * klu_rcond_itself) << bits;
+    EXPECT_GT(lu->rcond(), 0.0);
     EXPECT_GT(lu->memory_bytes(), 0u);
   }
   // the default on a small model is 32-bit

@@ -1,5 +1,6 @@
 #include "phiq/kinematics.hpp"
 
+#include "kinematics_internal.hpp"
 #include "tolerance_tests.hpp"
 
 #include <algorithm>
@@ -163,22 +164,12 @@ std::string not_square_message(const Model& model) {
   return s + "; the driven system must be square (assemble() and analyse_rank() handle other models)";
 }
 
-// Factorises Φq at (ws.q, t) unless the current factorisation was made exactly there. `values_at_q`: the caller
-// knows ws.jacobian_values hold Φq at (ws.q, t) already (the Newton loop's fused evaluation).
-SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
-                              bool values_at_q = false) {
-  if (!ws.lu) {
-    *message = not_square_message(model);
-    return SolveStatus::kNotSquare;
-  }
-  if (ws.has_factorization && ws.factorized_t == t && ws.factorized_q == ws.q) {
-    *rcond = ws.lu->rcond();
-    return SolveStatus::kSuccess;
-  }
+// Factorises Φq at (ws.q, t) from ws.jacobian_values (evaluating them first unless `values_at_q`), and records
+// that the factors are at time t (ws.factorized_q is the caller's to record).
+SolveStatus factorize_at_q(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
+                           bool values_at_q) {
   ws.has_factorization = false;
-  // Φq may have been evaluated with Φ at this very point by the Newton loop (NewtonOptions::jacobian_with_residual):
-  // known to the loop itself, or left by the last solve_position for the velocity solve that follows it
-  if (!values_at_q && !(ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q == ws.q)) {
+  if (!values_at_q) {
     model.jacobian(ws.q.data(), t, ws.jacobian_values.data());
     ++ws.counters.jacobian_evaluations;
   }
@@ -200,10 +191,29 @@ SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, doubl
     *message = "Jacobian is singular (a zero pivot): singular position, or redundant or missing constraints";
     return SolveStatus::kSingularJacobian;
   }
-  ws.factorized_q = ws.q;
   ws.factorized_t = t;
   ws.has_factorization = true;
   return SolveStatus::kSuccess;
+}
+
+// Factorises Φq at (ws.q, t) unless the current factorisation was made exactly there. `values_at_q`: the caller
+// knows ws.jacobian_values hold Φq at (ws.q, t) already (the Newton loop's fused evaluation).
+SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
+                              bool values_at_q = false) {
+  if (!ws.lu) {
+    *message = not_square_message(model);
+    return SolveStatus::kNotSquare;
+  }
+  if (ws.has_factorization && ws.factorized_t == t && ws.factorized_q == ws.q) {
+    *rcond = ws.lu->rcond();
+    return SolveStatus::kSuccess;
+  }
+  // Φq may have been evaluated with Φ at this very point by the Newton loop (NewtonOptions::jacobian_with_residual):
+  // known to the loop itself, or left by the last solve_position for the velocity solve that follows it
+  values_at_q = values_at_q || (ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q == ws.q);
+  const SolveStatus st = factorize_at_q(model, t, ws, rcond, message, values_at_q);
+  if (st == SolveStatus::kSuccess) ws.factorized_q = ws.q;
+  return st;
 }
 
 // The right-hand side the LU solves with: `b` (one entry per equation) itself, or its kept rows for a model with
@@ -256,19 +266,22 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   // Whether ws.jacobian_values hold Φq at the current iterate (evaluated with Φ at the accepted trial point and
   // not yet factorised): the loop knows it without comparing points; the point is recorded once, at the end.
   ws.has_jacobian = false;
+  ws.factorized_at_solution = false;
   bool jacobian_at_q = false;
 
+  ResidualCheck check;  // of the current iterate (its worst row is the residual reported on success)
   auto finish = [&](SolveStatus st, std::string msg) {
     sum.status = st;
     if (st != SolveStatus::kSuccess) ws.newton_contraction = -1.0;
     if (st == SolveStatus::kSuccess) {
-      sum.residual = max_scaled(model, ws.phi);  // O(m), no allocation: this runs once per drive step
+      sum.residual = check.worst;  // max_i |Φ_i| / scale_i, from the pass that tested it
       // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
       // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
       // Otherwise they factorise at the solution, from the Jacobian evaluated there with Φ if there is one.
       if (ws.has_factorization && ws.factorized_t == t &&
           step_within(model, ws.q - ws.factorized_q, ws.q, opt.tolerance, 1.0)) {
         ws.factorized_q = ws.q;
+        ws.factorized_at_solution = true;
       } else if (jacobian_at_q) {
         ws.jacobian_q = ws.q;
         ws.jacobian_t = t;
@@ -303,8 +316,10 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   // Modified Newton reuses the workspace's factorisation until it contracts badly; then (and always for full
   // Newton) every iteration factorises at its iterate.
   bool reuse = opt.jacobian_update == JacobianUpdate::kWhenSlow && ws.has_factorization;
-  // The start point too: where its first iteration will factorise there anyway, Φq comes with Φ.
-  if (!reuse) {
+  // The start point too: where its first iteration will factorise there anyway, Φq comes with Φ; and where the
+  // caller factorises next (velocities follow) at a start its estimate expects to be accepted as it is.
+  const bool start_expected = opt.jacobian_with_residual && opt.start_error >= 0.0 && opt.start_error <= 1.0;
+  if (!reuse || start_expected) {
     model.residual_and_jacobian(ws.q.data(), t, ws.phi.data(), ws.jacobian_values.data());
     ++ws.counters.jacobian_evaluations;
     jacobian_at_q = true;
@@ -312,7 +327,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     model.residual(ws.q.data(), t, ws.phi.data());
   }
   ++ws.counters.residual_evaluations;
-  ResidualCheck check = check_residual(model, ws.phi, opt.tolerance, ws.q);
+  check = check_residual(model, ws.phi, opt.tolerance, ws.q);
   double prev_norm = -1.0;   // scaled size of the previous step taken with the same kind of matrix
   double theta_seen = -1.0;  // largest contraction observed with the reused matrix in this solve
   int reused_steps = 1;      // steps taken with the reused matrix once a contraction is known
@@ -504,5 +519,45 @@ SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, Line
     return sum.status = SolveStatus::kNonFinite, sum.message = "acceleration is not finite", sum.status;
   return SolveStatus::kSuccess;
 }
+
+namespace detail {
+
+SolveStatus derivatives_at_solution(const Model& model, double t, Workspace& ws, bool accelerations,
+                                    LinearSummary* summary) {
+  LinearSummary local;
+  LinearSummary& sum = summary ? *summary : local;
+  sum = LinearSummary{};
+  auto fail = [&](SolveStatus st, std::string msg) {
+    sum.status = st, sum.message = std::move(msg);
+    return st;
+  };
+  if (!ws.lu) return fail(SolveStatus::kNotSquare, not_square_message(model));
+  if (ws.has_factorization && ws.factorized_at_solution && ws.factorized_t == t) {
+    sum.rcond = ws.lu->rcond();
+  } else {
+    std::string msg;
+    const SolveStatus st =
+        factorize_at_q(model, t, ws, &sum.rcond, &msg, ws.has_jacobian && ws.jacobian_t == t);
+    if (st == SolveStatus::kSingularJacobian) return fail(st, "velocities are not unique here: " + msg);
+    if (st != SolveStatus::kSuccess) return fail(st, msg);
+    ws.factorized_at_solution = true;
+  }
+  model.phi_t(ws.q.data(), t, ws.rhs.data());
+  ++ws.counters.phi_t_evaluations;
+  ws.rhs = -ws.rhs;
+  if (!ws.lu->solve(solve_rhs(model, ws), ws.qd.data())) return fail(SolveStatus::kLinearSolverFailed, ws.lu->last_message());
+  ++ws.counters.velocity_solves;
+  if (!all_finite(ws.qd)) return fail(SolveStatus::kNonFinite, "velocity is not finite");
+  if (!accelerations) return SolveStatus::kSuccess;
+  model.gamma(ws.q.data(), ws.qd.data(), t, ws.rhs.data());
+  ++ws.counters.gamma_evaluations;
+  if (!ws.lu->solve(solve_rhs(model, ws), ws.qdd.data()))
+    return fail(SolveStatus::kLinearSolverFailed, ws.lu->last_message());
+  ++ws.counters.acceleration_solves;
+  if (!all_finite(ws.qdd)) return fail(SolveStatus::kNonFinite, "acceleration is not finite");
+  return SolveStatus::kSuccess;
+}
+
+}  // namespace detail
 
 }  // namespace phiq

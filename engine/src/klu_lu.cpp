@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <functional>
@@ -42,7 +43,6 @@ struct Klu<int> {
   static bool refactor(int* ap, int* ai, double* ax, Symbolic* s, Numeric* f, Common* c) {
     return klu_refactor(ap, ai, ax, s, f, c) != 0;
   }
-  static void rcond(Symbolic* s, Numeric* f, Common* c) { klu_rcond(s, f, c); }
   static bool solve(Symbolic* s, Numeric* f, int n, double* b, Common* c) { return klu_solve(s, f, n, 1, b, c) != 0; }
   static bool tsolve(Symbolic* s, Numeric* f, int n, double* b, Common* c) {
     return klu_tsolve(s, f, n, 1, b, c) != 0;
@@ -65,7 +65,6 @@ struct Klu<SuiteSparse_long> {
   static bool refactor(Int* ap, Int* ai, double* ax, Symbolic* s, Numeric* f, Common* c) {
     return klu_l_refactor(ap, ai, ax, s, f, c) != 0;
   }
-  static void rcond(Symbolic* s, Numeric* f, Common* c) { klu_l_rcond(s, f, c); }
   static bool solve(Symbolic* s, Numeric* f, Int n, double* b, Common* c) {
     return klu_l_solve(s, f, n, 1, b, c) != 0;
   }
@@ -228,6 +227,7 @@ class KluNumeric final : public SparseLuNumeric {
 
  private:
   FactorStatus factor_with_pivoting(const double* values);
+  double scan_diagonal();  // KLU's rcond of the factors, and u_sign_
   bool solve_system(bool transposed, const double* b, double* x);
   std::shared_ptr<const KluSymbolic<Int>> keep_;
   const KluSymbolic<Int>& sym_;
@@ -237,6 +237,7 @@ class KluNumeric final : public SparseLuNumeric {
   std::int64_t pivoting_ = 0;
   std::string message_;
   int p_sign_ = 1;  // parity of the row permutation Pnum of the last pivoting factorisation
+  int u_sign_ = 1;  // sign of the product of U's diagonal (0: a zero pivot)
 };
 
 // The interface of both widths' analyses that describe_klu reads.
@@ -293,14 +294,28 @@ class KluSymbolic final : public KluSymbolicBase, public std::enable_shared_from
 template <class Int>
 int KluNumeric<Int>::determinant_sign() const {
   if (!numeric_ || rcond_ == 0.0) return 0;
+  return sym_.q_sign_ * p_sign_ * u_sign_;
+}
+
+// One pass over U's diagonal for what klu_rcond computes (min |U_ii| / max |U_ii|, 0 for a zero or NaN pivot) and
+// the sign of Π U_ii, which determinant_sign() needs: a sweep asks for both at every row, and on large models each
+// pass over the diagonal is a pass over memory.
+template <class Int>
+double KluNumeric<Int>::scan_diagonal() {
   const Index n = sym_.pattern_->cols;
-  int sign = sym_.q_sign_ * p_sign_;
   const double* u = static_cast<const double*>(numeric_->Udiag);
+  double lo = INFINITY, hi = 0.0;
+  int negative = 0;
   for (Index i = 0; i < n; ++i) {
-    if (u[i] == 0.0) return 0;
-    if (u[i] < 0.0) sign = -sign;
+    const double a = std::fabs(u[i]);
+    lo = a < lo ? a : lo;
+    hi = a > hi ? a : hi;
+    negative ^= u[i] < 0.0;
+    if (!(a > 0.0)) return u_sign_ = 0, 0.0;  // zero or NaN
   }
-  return sign;
+  u_sign_ = negative ? -1 : 1;
+  const double r = n > 0 ? lo / hi : 0.0;
+  return std::isfinite(r) ? r : 0.0;
 }
 
 template <class Int>
@@ -320,8 +335,7 @@ FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
                    : "KLU factorisation failed (status " + std::to_string(common_.status) + ")";
     return FactorStatus::kFailed;
   }
-  Api::rcond(sym_.symbolic_, numeric_, &common_);
-  rcond_ = rcond_at_pivoting_ = common_.rcond;
+  rcond_ = rcond_at_pivoting_ = scan_diagonal();
   // the row permutation is fixed until the next pivot search: its parity once here, not per determinant_sign()
   p_sign_ = permutation_sign(numeric_->Pnum, sym_.pattern_->cols);
   message_.clear();
@@ -334,9 +348,9 @@ FactorStatus KluNumeric<Int>::factorize(const double* values) {
     const bool ok = Api::refactor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, numeric_, &common_) &&
                     common_.status == KLU_OK;
     if (ok) {
-      Api::rcond(sym_.symbolic_, numeric_, &common_);
-      if (common_.rcond >= kDegradation * rcond_at_pivoting_) {
-        rcond_ = common_.rcond;
+      const double rc = scan_diagonal();
+      if (rc >= kDegradation * rcond_at_pivoting_) {
+        rcond_ = rc;
         message_.clear();
         return FactorStatus::kOk;
       }

@@ -21,6 +21,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "kinematics_internal.hpp"
 #include "phiq/assembly.hpp"
 
 namespace phiq {
@@ -97,9 +98,15 @@ class Sweeper {
       case Predictor::kCubic: depth_ = 2; break;
       case Predictor::kAuto: break;
     }
-    history_.resize(static_cast<std::size_t>(depth_));
+    // Every buffer the states rotate through has the workspace's size from the start, so that a swap never hands
+    // the workspace an empty vector.
+    const Index n = model_.num_coordinates();
+    history_.assign(static_cast<std::size_t>(depth_), Eigen::VectorXd::Zero(n));
     history_t_.resize(static_cast<std::size_t>(depth_));
     history_error_.resize(static_cast<std::size_t>(depth_));
+    current_.q = Eigen::VectorXd::Zero(n);
+    if (need_v_) current_.qd = Eigen::VectorXd::Zero(n);
+    if (need_a_) current_.qdd = Eigen::VectorXd::Zero(n);
   }
 
   // Below this reciprocal condition estimate of Φq (KLU: min/max |U_ii|, UMFPACK alike) the position is taken
@@ -130,10 +137,10 @@ class Sweeper {
   // (counted) and the condition estimate (Φ is ws.phi already). Only delivered rows pay for them: sub-steps and
   // the seam steps of parallel chunks do not.
   void row_outputs() {
-    const double* qd = need_v_ ? ws_.qd.data() : nullptr;
-    const double* qdd = need_a_ ? ws_.qdd.data() : nullptr;
+    const double* qd = need_v_ ? current_.qd.data() : nullptr;
+    const double* qdd = need_a_ ? current_.qdd.data() : nullptr;
     for (std::size_t i = 0; i < opt_.points.size(); ++i)
-      points_[i] = evaluate_point(opt_.points[i], ws_.q.data(), qd, qdd);
+      points_[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
     ws_.counters.point_evaluations += static_cast<Index>(opt_.points.size());
     rcond_ = opt_.condition && ws_.lu ? ws_.lu->rcond() : 0.0;
     // With velocities the LU is the one at the converged position; positions only, Newton's last (at most a
@@ -141,6 +148,16 @@ class Sweeper {
     det_sign_ = singular_row_ || !ws_.lu ? 0 : ws_.lu->determinant_sign();
   }
   int det_sign() const { return det_sign_; }
+  // The last converged state (q, and q̇, q̈ as computed), which the rows deliver.
+  const State& state() const { return current_; }
+  // Leaves the last converged state in the workspace too, as a sweep ends (the caller's workspace ends at the
+  // last delivered row).
+  void leave_state_in_workspace() {
+    if (!has_current_) return;
+    ws_.q = current_.q;
+    if (need_v_) ws_.qd = current_.qd;
+    if (need_a_) ws_.qdd = current_.qdd;
+  }
   // The largest PositionSummary::rounding_level of the positions converged since the last call (0: none stopped
   // at the rounding level): how far from the exact solution, in tolerances, they may be.
   double take_rounding_level() { return std::exchange(rounding_level_, 0.0); }
@@ -174,8 +191,11 @@ class Sweeper {
     remember(t);
   }
 
-  // The LU's q̇ (and q̈) at ws.q.
-  SolveStatus lu_derivatives(double t, bool accelerations, LinearSummary* ls) {
+  // The LU's q̇ (and q̈) at ws.q: the position the last solve_position converged to (`just_solved`: its factorisation
+  // or Jacobian values are taken as they are, detail::derivatives_at_solution), or any other (the public solves,
+  // which compare points).
+  SolveStatus lu_derivatives(double t, bool accelerations, LinearSummary* ls, bool just_solved = true) {
+    if (just_solved) return detail::derivatives_at_solution(model_, t, ws_, accelerations, ls);
     SolveStatus st = solve_velocity(model_, t, ws_, ls);
     if (st == SolveStatus::kSuccess && accelerations) st = solve_acceleration(model_, t, ws_, ls);
     return st;
@@ -322,7 +342,7 @@ class Sweeper {
   std::string dead_point(double t1) {
     ws_.q = current_.q;
     LinearSummary ls;
-    if (lu_derivatives(current_.t, true, &ls) != SolveStatus::kSuccess) return "";
+    if (lu_derivatives(current_.t, true, &ls, /*just_solved=*/false) != SolveStatus::kSuccess) return "";
     const double vv = ws_.qd.squaredNorm(), va = ws_.qd.dot(ws_.qdd);
     const double tau = va != 0.0 ? vv / (2.0 * va) : 0.0;  // t* − t, signed like the drive direction
     if (!(std::isfinite(tau) && tau * (t1 - current_.t) > 0 && std::fabs(tau) <= 2.0 * std::fabs(t1 - current_.t)))
@@ -363,7 +383,8 @@ class Sweeper {
     predict(t1);
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t1, newton_, ws_, &ps);
-    if (st == SolveStatus::kSuccess && depth < opt_.max_subdivisions && jumped()) {
+    // (a start accepted without a Newton step is the prediction itself: nothing moved off it)
+    if (st == SolveStatus::kSuccess && depth < opt_.max_subdivisions && ps.iterations > 0 && jumped()) {
       // Newton went much farther than the step itself: it has left the branch (near a toggle or a bifurcation
       // a coarse step can land in the other branch's basin). Retried as half steps, as a failure is.
       st = SolveStatus::kNotConverged;
@@ -582,9 +603,11 @@ class Sweeper {
     has_current_ = true;
     current_.t = t;
     current_error_ = row_error_;
-    current_.q = ws_.q;
-    if (need_v_) current_.qd = ws_.qd;
-    if (need_a_) current_.qdd = ws_.qdd;
+    // The converged state moves into current_ by swaps too: ws keeps the buffers of the state before, which the
+    // next step overwrites (predict() writes q, the solves q̇ and q̈). Rows are delivered from state().
+    current_.q.swap(ws_.q);
+    if (need_v_) current_.qd.swap(ws_.qd);
+    if (need_a_) current_.qdd.swap(ws_.qdd);
   }
   void restore() {
     ws_.q = current_.q;
@@ -701,7 +724,8 @@ struct Run {
         return false;
       }
       sw.row_outputs();
-      if (!deliver(k, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign())) return false;
+      const State& s = sw.state();
+      if (!deliver(k, s.q, s.qd, s.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign())) return false;
     }
     return true;
   }
@@ -881,8 +905,11 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     return done(sum.status);
   }
   sw.row_outputs();
-  if (!run.deliver(0, ws.q, ws.qd, ws.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign()))
+  if (!run.deliver(0, sw.state().q, sw.state().qd, sw.state().qdd, sw.point_motions(), ws.phi, sw.rcond(),
+                   sw.det_sign())) {
+    sw.leave_state_in_workspace();
     return done(sum.status);
+  }
 
   if (opt.threads == 0 && threads > 1 && ws.lu && opt.steps > 0)
     threads = threads_that_fit(opt, ws, threads, run.time_of(0), sum.warnings);
@@ -912,6 +939,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
   if (threads <= 1 || n_chunks < 2 || !ws.lu) {
     run.sequential(sw, ws, 1);
+    sw.leave_state_in_workspace();
     return done(sum.status);
   }
 
@@ -940,7 +968,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // The last delivered row (the state an ordered continuation starts from) and the position the sweep reaches
   // one step after it when continued in order (the previous chunk's seam), if known.
   Index resume = 1;
-  Eigen::VectorXd last_q = ws.q, last_qd = ws.qd, last_qdd = ws.qdd;
+  Eigen::VectorXd last_q = sw.state().q, last_qd = need_v ? sw.state().qd : ws.qd,
+                  last_qdd = need_a ? sw.state().qdd : ws.qdd;
   Eigen::VectorXd last_phi = ws.phi;                        // Φ of the row being delivered, when asked
   std::vector<PointMotion> last_points(opt.points.size());  // its point motions
   bool seam_known = false;
@@ -959,9 +988,10 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     ch.rows.resize(static_cast<std::size_t>((ch.k1 - ch.k0 + 1) * width));
     double* out = ch.rows.data();
     auto keep = [&] {
-      out = std::copy(w.q.data(), w.q.data() + n, out);
-      if (need_v) out = std::copy(w.qd.data(), w.qd.data() + n, out);
-      if (need_a) out = std::copy(w.qdd.data(), w.qdd.data() + n, out);
+      const State& st = s.state();
+      out = std::copy(st.q.data(), st.q.data() + n, out);
+      if (need_v) out = std::copy(st.qd.data(), st.qd.data() + n, out);
+      if (need_a) out = std::copy(st.qdd.data(), st.qdd.data() + n, out);
       s.row_outputs();
       if (n_phi) out = std::copy(w.phi.data(), w.phi.data() + m, out);
       if (n_rcond) *out++ = s.rcond();
@@ -986,7 +1016,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
       const SweepSummary kept = ch.sum;
       if (s.advance(run.time_of(ch.k1 + 1), 0)) {
         ch.has_seam = true;
-        ch.seam_q = w.q;
+        ch.seam_q = s.state().q;
       }
       ch.sum.warnings = kept.warnings;
       ch.sum.subdivisions = kept.subdivisions;
@@ -1081,7 +1111,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     const Index c = seeded;  // only the thread holding seeding_busy changes it
     const bool ok = seeder.advance(run.time_of(first_row(c)), 0);
     if (ok) {
-      seeds[static_cast<std::size_t>(c)] = sws.q;
+      seeds[static_cast<std::size_t>(c)] = seeder.state().q;
       seed_rounding[static_cast<std::size_t>(c)] = seeder.take_rounding_level();
     }
     const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
@@ -1159,15 +1189,12 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // chunks computed but not delivered (after a rejected one): their work was done all the same
   for (Index c = delivered + (stop ? 1 : 0); c < claimed; ++c)
     add_counters(others, chunks[static_cast<std::size_t>(c)].sum.counters, WorkCounters{});
-  if (cancelled) {
-    add_counters(others, sws.counters, WorkCounters{});
-    return done(sum.status);
-  }
   add_counters(others, sws.counters, WorkCounters{});
   // The caller's workspace ends at the last delivered row, as after a sequential sweep.
   ws.q = last_q;
   if (need_v) ws.qd = last_qd;
   if (need_a) ws.qdd = last_qdd;
+  if (cancelled) return done(sum.status);
   if (resume <= opt.steps) {
     // In order from the last delivered row: the unseeded chunks, or everything after a chunk that did not
     // continue the sweep's branch or failed (the failure is then found, and reported, in order).
@@ -1179,6 +1206,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     Sweeper rest(model, opt, ws, sum);
     rest.adopt(run.time_of(resume - 1));
     run.sequential(rest, ws, resume);
+    rest.leave_state_in_workspace();
   }
   return done(sum.status);
 }

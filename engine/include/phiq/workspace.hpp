@@ -66,6 +66,10 @@ class Workspace {
   Eigen::VectorXd factorized_q;
   double factorized_t = 0.0;             ///< see factorized_q
   bool has_factorization = false;        ///< lu holds valid factors at (factorized_q, factorized_t)
+  /// The factors are of Φq at the solution the last solve_position converged to (set by that solve when its last
+  /// factorisation is within the tolerance of the solution, and by the sweep's derivative solves after they
+  /// factorise there); cleared by every solve_position at its start.
+  bool factorized_at_solution = false;
   /// Contraction of modified Newton last observed with a reused factorisation (kept by the solves that observe
   /// none, −1 before any and after a failed solve): the error estimate of the next solve's first step.
   double newton_contraction = -1.0;

@@ -1,0 +1,17 @@
+// Internal to the engine: what the sweep needs of kinematics.cpp beyond the public functions.
+#pragma once
+
+#include "phiq/kinematics.hpp"
+
+namespace phiq::detail {
+
+/// solve_velocity and, with `accelerations`, solve_acceleration at the position solve_position has just converged
+/// to at t. Pre-condition (the sweep's own sequence, not checked): ws.q has not changed since that solve returned
+/// kSuccess. The factorisation or the Jacobian values that solve reported valid at its solution are taken as they
+/// are, without the public functions' comparison of points (two O(n) passes, and a copy of q, per drive step);
+/// a factorisation made here does not record its point, so that a later public call factorises again. Same
+/// statuses and summary as the public functions (the summary of the last solve made).
+SolveStatus derivatives_at_solution(const Model& model, double t, Workspace& ws, bool accelerations,
+                                    LinearSummary* summary);
+
+}  // namespace phiq::detail
