@@ -204,13 +204,15 @@ SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, doubl
     *message = not_square_message(model);
     return SolveStatus::kNotSquare;
   }
-  if (ws.has_factorization && ws.factorized_t == t && ws.factorized_q == ws.q) {
+  if (ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
+      ws.factorized_q == ws.q) {
     *rcond = ws.lu->rcond();
     return SolveStatus::kSuccess;
   }
   // Φq may have been evaluated with Φ at this very point by the Newton loop (NewtonOptions::jacobian_with_residual):
   // known to the loop itself, or left by the last solve_position for the velocity solve that follows it
-  values_at_q = values_at_q || (ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q == ws.q);
+  values_at_q = values_at_q || (ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q.size() == ws.q.size() &&
+                                 ws.jacobian_q == ws.q);
   const SolveStatus st = factorize_at_q(model, t, ws, rcond, message, values_at_q);
   if (st == SolveStatus::kSuccess) ws.factorized_q = ws.q;
   return st;
@@ -278,7 +280,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
       // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
       // Otherwise they factorise at the solution, from the Jacobian evaluated there with Φ if there is one.
-      if (ws.has_factorization && ws.factorized_t == t &&
+      if (ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
           step_within(model, ws.q - ws.factorized_q, ws.q, opt.tolerance, 1.0)) {
         ws.factorized_q = ws.q;
         ws.factorized_at_solution = true;
@@ -540,7 +542,9 @@ SolveStatus derivatives_at_solution(const Model& model, double t, Workspace& ws,
         factorize_at_q(model, t, ws, &sum.rcond, &msg, ws.has_jacobian && ws.jacobian_t == t);
     if (st == SolveStatus::kSingularJacobian) return fail(st, "velocities are not unique here: " + msg);
     if (st != SolveStatus::kSuccess) return fail(st, msg);
-    ws.factorized_at_solution = true;
+    // the point is not recorded (factorized_q is another's): no (q, t) may match it, so that public solves and the
+    // next solve_position's end factorise again rather than trust it
+    ws.factorized_t = std::numeric_limits<double>::quiet_NaN();
   }
   model.phi_t(ws.q.data(), t, ws.rhs.data());
   ++ws.counters.phi_t_evaluations;

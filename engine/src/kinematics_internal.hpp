@@ -9,7 +9,8 @@ namespace phiq::detail {
 /// to at t. Pre-condition (the sweep's own sequence, not checked): ws.q has not changed since that solve returned
 /// kSuccess. The factorisation or the Jacobian values that solve reported valid at its solution are taken as they
 /// are, without the public functions' comparison of points (two O(n) passes, and a copy of q, per drive step);
-/// a factorisation made here does not record its point, so that a later public call factorises again. Same
+/// a factorisation made here does not record its point (factorized_t is NaN), so that a later public call, or the
+/// end of the next solve_position at this t, factorises again. Same
 /// statuses and summary as the public functions (the summary of the last solve made).
 SolveStatus derivatives_at_solution(const Model& model, double t, Workspace& ws, bool accelerations,
                                     LinearSummary* summary);

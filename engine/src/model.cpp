@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <tbb/blocked_range.h>
@@ -353,10 +354,8 @@ void ModelBuilder::tolerance_scales(const CscPattern& pattern, const std::vector
   const auto length_coordinate = [&](Index j) {
     return m.coordinate_units_[static_cast<std::size_t>(j)] == Unit::kLength;
   };
-  sc.row_is_length.resize(rows);
-  for (Index i = 0; i < rows; ++i) sc.row_is_length(i) = length_row(i) ? 1.0 : 0.0;
-  sc.coordinate_is_length.resize(n);
-  for (Index j = 0; j < n; ++j) sc.coordinate_is_length(j) = length_coordinate(j) ? 1.0 : 0.0;
+  if (n >= INT32_MAX)
+    throw Error("the model has " + std::to_string(n) + " coordinates; phiq handles fewer than 2^31");
 
   // The pattern by rows, as Φqᵀ's: the columns of row i are cols[begin[i] … begin[i + 1] − 1].
   const CscPattern by_rows = transpose_pattern(pattern, nullptr);
@@ -364,8 +363,10 @@ void ModelBuilder::tolerance_scales(const CscPattern& pattern, const std::vector
   const std::vector<Index>& cols = by_rows.row_idx;
 
   if (length_scale_override_ > 0.0) {  // one scale for every length, as set
-    sc.row_scale = 1.0 + (fallback - 1.0) * sc.row_is_length.array();
-    sc.coordinate_scale = 1.0 + (fallback - 1.0) * sc.coordinate_is_length.array();
+    sc.row_scale.resize(rows);
+    for (Index i = 0; i < rows; ++i) sc.row_scale(i) = length_row(i) ? fallback : 1.0;
+    sc.coordinate_scale.resize(n);
+    for (Index j = 0; j < n; ++j) sc.coordinate_scale(j) = length_coordinate(j) ? fallback : 1.0;
   } else {
     constexpr double kUnset = std::numeric_limits<double>::infinity();
     sc.row_scale = Eigen::VectorXd::Ones(rows);
@@ -414,11 +415,11 @@ void ModelBuilder::tolerance_scales(const CscPattern& pattern, const std::vector
     const std::size_t first = sc.floor_coordinates.size();
     for (Index k = begin[static_cast<std::size_t>(i)]; k < begin[static_cast<std::size_t>(i) + 1]; ++k) {
       const Index j = cols[static_cast<std::size_t>(k)];
-      if (length_coordinate(j) == length_row(i)) sc.floor_coordinates.push_back(j);
+      if (length_coordinate(j) == length_row(i)) sc.floor_coordinates.push_back(static_cast<std::int32_t>(j));
     }
     if (sc.floor_coordinates.size() == first)
-      sc.floor_coordinates.insert(sc.floor_coordinates.end(), cols.begin() + begin[static_cast<std::size_t>(i)],
-                                  cols.begin() + begin[static_cast<std::size_t>(i) + 1]);
+      for (Index k = begin[static_cast<std::size_t>(i)]; k < begin[static_cast<std::size_t>(i) + 1]; ++k)
+        sc.floor_coordinates.push_back(static_cast<std::int32_t>(cols[static_cast<std::size_t>(k)]));
     sc.floor_begin[static_cast<std::size_t>(i) + 1] = static_cast<Index>(sc.floor_coordinates.size());
   }
   sc.floor_coordinates.shrink_to_fit();

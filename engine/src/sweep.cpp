@@ -76,7 +76,7 @@ struct State {
 class Sweeper {
  public:
   Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum)
-      : model_(m), opt_(o), ws_(ws), sum_(sum) {
+      : model_(m), opt_(o), ws_(&ws), sum_(sum) {
     need_v_ = o.velocities || o.accelerations;  // q̈ needs q̇
     need_a_ = o.accelerations;
     // With velocities every step factorises at its solution: Φq there comes with the residual that accepts it.
@@ -125,7 +125,7 @@ class Sweeper {
     if (!need_v_) return true;
     LinearSummary ls;
     const SolveStatus st = lu_derivatives(t, need_a_, &ls);
-    if (!bracketing_ && ws_.lu && (st == SolveStatus::kSingularJacobian ||
+    if (!bracketing_ && ws_->lu && (st == SolveStatus::kSingularJacobian ||
                                   (st == SolveStatus::kSuccess && ls.rcond < kSingularRcond)))
       return singular_point(t, ls.rcond);
     if (st != SolveStatus::kSuccess) return fail(st, ls.message);
@@ -141,22 +141,32 @@ class Sweeper {
     const double* qdd = need_a_ ? current_.qdd.data() : nullptr;
     for (std::size_t i = 0; i < opt_.points.size(); ++i)
       points_[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
-    ws_.counters.point_evaluations += static_cast<Index>(opt_.points.size());
-    rcond_ = opt_.condition && ws_.lu ? ws_.lu->rcond() : 0.0;
+    ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
+    rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
     // With velocities the LU is the one at the converged position; positions only, Newton's last (at most a
     // few steps old with modified Newton, so a sign change may be noticed a row late).
-    det_sign_ = singular_row_ || !ws_.lu ? 0 : ws_.lu->determinant_sign();
+    det_sign_ = singular_row_ || !ws_->lu ? 0 : ws_->lu->determinant_sign();
   }
   int det_sign() const { return det_sign_; }
   // The last converged state (q, and q̇, q̈ as computed), which the rows deliver.
   const State& state() const { return current_; }
+  // Solves with `w` from now on: the state and the history are the sweeper's, a workspace holds only the solves'
+  // scratch and an LU (whichever factorisation it holds is a start for modified Newton, which refreshes it when it
+  // contracts badly). A parallel sweep's seeding pass takes whichever workspace is free for each seed.
+  void bind(Workspace& w) { ws_ = &w; }
+  // Moves the last converged state out and frees the history: the sweeper is not used after this.
+  State take_state() {
+    history_.clear(), history_.shrink_to_fit();
+    predicted_ = Eigen::VectorXd();
+    return std::move(current_);
+  }
   // Leaves the last converged state in the workspace too, as a sweep ends (the caller's workspace ends at the
   // last delivered row).
   void leave_state_in_workspace() {
     if (!has_current_) return;
-    ws_.q = current_.q;
-    if (need_v_) ws_.qd = current_.qd;
-    if (need_a_) ws_.qdd = current_.qdd;
+    ws_->q = current_.q;
+    if (need_v_) ws_->qd = current_.qd;
+    if (need_a_) ws_->qdd = current_.qdd;
   }
   // The largest PositionSummary::rounding_level of the positions converged since the last call (0: none stopped
   // at the rounding level): how far from the exact solution, in tolerances, they may be.
@@ -174,10 +184,10 @@ class Sweeper {
   // First row of a parallel chunk: the position at t from a seed that solves it (up to the seeding pass's
   // tolerance), then the derivatives, as any converged step.
   bool start_from(double t, const Eigen::VectorXd& seed) {
-    ws_.q = seed;
+    ws_->q = seed;
     newton_.start_error = INFINITY;  // found to the seeding pass's accuracy over a long step: Newton checks it
     PositionSummary ps;
-    SolveStatus st = solve_position(model_, t, newton_, ws_, &ps);
+    SolveStatus st = solve_position(model_, t, newton_, *ws_, &ps);
     if (st != SolveStatus::kSuccess) return fail(st, ps.message);
     return converged(t, ps);
   }
@@ -195,9 +205,9 @@ class Sweeper {
   // or Jacobian values are taken as they are, detail::derivatives_at_solution), or any other (the public solves,
   // which compare points).
   SolveStatus lu_derivatives(double t, bool accelerations, LinearSummary* ls, bool just_solved = true) {
-    if (just_solved) return detail::derivatives_at_solution(model_, t, ws_, accelerations, ls);
-    SolveStatus st = solve_velocity(model_, t, ws_, ls);
-    if (st == SolveStatus::kSuccess && accelerations) st = solve_acceleration(model_, t, ws_, ls);
+    if (just_solved) return detail::derivatives_at_solution(model_, t, *ws_, accelerations, ls);
+    SolveStatus st = solve_velocity(model_, t, *ws_, ls);
+    if (st == SolveStatus::kSuccess && accelerations) st = solve_acceleration(model_, t, *ws_, ls);
     return st;
   }
 
@@ -235,7 +245,7 @@ class Sweeper {
       bool& b;
       ~Guard() { b = false; }
     } guard{bracketing_ = true};
-    const Eigen::VectorXd qs = ws_.q;
+    const Eigen::VectorXd qs = ws_->q;
     double step = has_current_ ? t - current_.t : default_step_;
     if (step == 0.0) step = 1e-3;
     const double d = 0.05 * step;
@@ -260,7 +270,7 @@ class Sweeper {
           // The sweep starts at the singular position: no past motion tells the branch, and Newton cannot
           // start from a singular Φq. The assembly (least squares, then the solution nearest the placement)
           // finds the side's position nearest the start.
-          ws_.q = qs;
+          ws_->q = qs;
           AssemblyOptions ao;
           ao.tolerance = opt_.newton.tolerance;
           // Newton (regular at ts) finishes from wherever the assembly got, converged or not. Known limit: on
@@ -268,9 +278,9 @@ class Sweeper {
           // far cranks off the flat position one loop per iteration, so beyond N ≈ 90 the start is not resolved
           // and the sweep stops at t0 with the diagnosis.
           AssemblySummary as;
-          phiq::assemble(model_, ts, ao, ws_.q, &as);
-          if (!ws_.q.allFinite()) {
-            ws_.q = qs;
+          phiq::assemble(model_, ts, ao, ws_->q, &as);
+          if (!ws_->q.allFinite()) {
+            ws_->q = qs;
             return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " +
                                                             fmt_t(t) + "), and no position near it at t = " +
                                                             fmt_t(ts) + " was found: " + as.message);
@@ -278,12 +288,12 @@ class Sweeper {
         }
       } else {
         const double h = offset[k] - offset[k - 1];
-        ws_.q = side[k - 1].q + h * side[k - 1].qd + (0.5 * h * h) * side[k - 1].qdd;
+        ws_->q = side[k - 1].q + h * side[k - 1].qd + (0.5 * h * h) * side[k - 1].qdd;
       }
-      SolveStatus st = solve_position(model_, ts, tight, ws_, &ps);
+      SolveStatus st = solve_position(model_, ts, tight, *ws_, &ps);
       if (st == SolveStatus::kSuccess) st = lu_derivatives(ts, true, &ls);
       if (st != SolveStatus::kSuccess || ls.rcond < kSingularRcond) {
-        ws_.q = qs;
+        ws_->q = qs;
         std::ostringstream m;
         m << "singular position at t = " << fmt_t(t) << " (Φq rcond " << rc << "): ";
         if (k >= 2 && st != SolveStatus::kSuccess)
@@ -295,26 +305,26 @@ class Sweeper {
           m << "the branch cannot be followed to it: " << ps.message;
         return fail(SolveStatus::kSingularJacobian, m.str());
       }
-      side[k].t = ts, side[k].q = ws_.q, side[k].qd = ws_.qd, side[k].qdd = ws_.qdd;
+      side[k].t = ts, side[k].q = ws_->q, side[k].qd = ws_->qd, side[k].qdd = ws_->qdd;
     }
     // Symmetric means over ±δ and ±2δ, combined by Richardson extrapolation: the branch's value at t to O(δ⁴).
     auto at_t = [&](const Eigen::VectorXd State::*x) -> Eigen::VectorXd {
       return (2.0 / 3.0) * (side[1].*x + side[2].*x) - (1.0 / 6.0) * (side[0].*x + side[3].*x);
     };
-    ws_.q = have_position ? qs : at_t(&State::q);
+    ws_->q = have_position ? qs : at_t(&State::q);
     if (!have_position) {
-      model_.residual(ws_.q.data(), t, ws_.phi.data());
-      ++ws_.counters.residual_evaluations;
-      if (!(scaled_residual(model_, ws_.phi) <= opt_.newton.tolerance)) {
+      model_.residual(ws_->q.data(), t, ws_->phi.data());
+      ++ws_->counters.residual_evaluations;
+      if (!(scaled_residual(model_, ws_->phi) <= opt_.newton.tolerance)) {
         std::ostringstream m;
         m << "singular position at t = " << fmt_t(t) << ": Newton meets a zero pivot there, and the position "
-          << "interpolated from t ± " << d << " misses the tolerance (residual " << scaled_residual(model_, ws_.phi)
+          << "interpolated from t ± " << d << " misses the tolerance (residual " << scaled_residual(model_, ws_->phi)
           << ")";
         return fail(SolveStatus::kSingularJacobian, m.str());
       }
     }
-    ws_.qd = at_t(&State::qd);
-    if (need_a_) ws_.qdd = at_t(&State::qdd);
+    ws_->qd = at_t(&State::qd);
+    if (need_a_) ws_->qdd = at_t(&State::qdd);
     ++sum_.singular_positions;
     singular_row_ = true;
     std::ostringstream m;
@@ -330,7 +340,7 @@ class Sweeper {
     ill_conditioned_ = false;
     // The factorisation left is of a side, next to the singular position: a poor Newton matrix for the next step,
     // whose contraction the last solves (full Newton, to rounding level) did not measure. The next step factorises.
-    ws_.has_factorization = false;
+    ws_->has_factorization = false;
     return true;
   }
 
@@ -340,17 +350,17 @@ class Sweeper {
   // equations that line up are the support of Φq's left near-null vector, found by inverse iteration on Φqᵀ
   // with the LU. Returns "" when the last state does not look like one (then the cause is left open).
   std::string dead_point(double t1) {
-    ws_.q = current_.q;
+    ws_->q = current_.q;
     LinearSummary ls;
     if (lu_derivatives(current_.t, true, &ls, /*just_solved=*/false) != SolveStatus::kSuccess) return "";
-    const double vv = ws_.qd.squaredNorm(), va = ws_.qd.dot(ws_.qdd);
+    const double vv = ws_->qd.squaredNorm(), va = ws_->qd.dot(ws_->qdd);
     const double tau = va != 0.0 ? vv / (2.0 * va) : 0.0;  // t* − t, signed like the drive direction
     if (!(std::isfinite(tau) && tau * (t1 - current_.t) > 0 && std::fabs(tau) <= 2.0 * std::fabs(t1 - current_.t)))
       return "";
     const Index m = model_.num_solve_rows();
     Eigen::VectorXd y = Eigen::VectorXd::Ones(m), z(m);
     for (int it = 0; it < 4; ++it) {
-      if (!ws_.lu->solve_transposed(y.data(), z.data()) || !z.allFinite()) return "";
+      if (!ws_->lu->solve_transposed(y.data(), z.data()) || !z.allFinite()) return "";
       y = z / z.cwiseAbs().maxCoeff();
     }
     std::vector<std::string> names;
@@ -372,7 +382,7 @@ class Sweeper {
 
   // Initial position problem from the rough placement in ws.q.
   bool assemble(double t) {
-    SolveStatus st = solve_position(model_, t, opt_.assembly, ws_, &sum_.assembly);
+    SolveStatus st = solve_position(model_, t, opt_.assembly, *ws_, &sum_.assembly);
     if (st != SolveStatus::kSuccess) return fail(st, "initial assembly failed: " + sum_.assembly.message);
     return converged(t, sum_.assembly);
   }
@@ -382,7 +392,7 @@ class Sweeper {
   bool advance(double t1, int depth) {
     predict(t1);
     PositionSummary ps;
-    SolveStatus st = solve_position(model_, t1, newton_, ws_, &ps);
+    SolveStatus st = solve_position(model_, t1, newton_, *ws_, &ps);
     // (a start accepted without a Newton step is the prediction itself: nothing moved off it)
     if (st == SolveStatus::kSuccess && depth < opt_.max_subdivisions && ps.iterations > 0 && jumped()) {
       // Newton went much farther than the step itself: it has left the branch (near a toggle or a bifurcation
@@ -447,7 +457,7 @@ class Sweeper {
   bool jumped() {
     if (!extrapolated_) return false;  // the previous position: nothing predicted
     const double tol = opt_.newton.tolerance;
-    const double correction = scaled_distance(ws_.q, predicted_, ws_.q, tol);
+    const double correction = scaled_distance(ws_->q, predicted_, ws_->q, tol);
     if (!(correction > 1000.0)) return false;
     return correction > 0.5 * scaled_distance(predicted_, current_.q, current_.q, tol);
   }
@@ -472,9 +482,9 @@ class Sweeper {
     const double h = t1 - current_.t, tc = current_.t;
     const double tol = opt_.newton.tolerance;
     const double* cs = model_.tolerance_scales().coordinate_scale.data();
-    ws_.q.resize(n);
+    ws_->q.resize(n);
     predicted_.resize(n);
-    double* out = ws_.q.data();
+    double* out = ws_->q.data();
     double* kept = predicted_.data();
     const double* q = current_.q.data();
     const int k = known_;
@@ -605,19 +615,19 @@ class Sweeper {
     current_error_ = row_error_;
     // The converged state moves into current_ by swaps too: ws keeps the buffers of the state before, which the
     // next step overwrites (predict() writes q, the solves q̇ and q̈). Rows are delivered from state().
-    current_.q.swap(ws_.q);
-    if (need_v_) current_.qd.swap(ws_.qd);
-    if (need_a_) current_.qdd.swap(ws_.qdd);
+    current_.q.swap(ws_->q);
+    if (need_v_) current_.qd.swap(ws_->qd);
+    if (need_a_) current_.qdd.swap(ws_->qdd);
   }
   void restore() {
-    ws_.q = current_.q;
-    if (need_v_) ws_.qd = current_.qd;
-    if (need_a_) ws_.qdd = current_.qdd;
+    ws_->q = current_.q;
+    if (need_v_) ws_->qd = current_.qd;
+    if (need_a_) ws_->qdd = current_.qdd;
   }
 
   const Model& model_;
   const SweepOptions& opt_;
-  Workspace& ws_;
+  Workspace* ws_;  // the workspace the solves use (bind())
   SweepSummary& sum_;
   bool need_v_ = false, need_a_ = false;
   NewtonOptions newton_;  // opt_.newton, with jacobian_with_residual when velocities follow
@@ -833,17 +843,18 @@ double resident_memory() {
   return ok ? resident * static_cast<double>(sysconf(_SC_PAGESIZE)) : 0.0;
 }
 
-// All cores (threads = 0), as many as fit: each thread and the seeding pass need a workspace like the caller's
-// `ws` (which has factorised at row 0), beside the rows held for delivery (kRowBufferBytes at most). memory_budget
-// is the whole process's: what it holds already (the model, the caller's workspace) is spent. Fewer threads than
-// `threads` come with a "threads_reduced" warning at `t0`.
+// All cores (threads = 0), as many as fit: each thread beyond the first needs a workspace like the caller's `ws`
+// (which has factorised at row 0; the caller's own serves one thread, and the seeding pass shares them), beside the
+// rows held for delivery (kRowBufferBytes at most). memory_budget is the whole process's: what it holds already
+// (the model, the caller's workspace) is spent. Fewer threads than `threads` come with a "threads_reduced" warning
+// at `t0`.
 int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, double t0,
                      std::vector<SweepWarning>& warnings) {
   const double budget =
       opt.memory_budget > 0 ? static_cast<double>(opt.memory_budget) - resident_memory() : available_memory();
   const double per = workspace_bytes(ws);
   if (!(budget > 0.0 || opt.memory_budget > 0) || !(per > 0.0)) return threads;
-  const double room = std::floor((budget - kRowBufferBytes) / per) - 1.0;  // less the seeding pass's
+  const double room = std::floor((budget - kRowBufferBytes) / per) + 1.0;  // the caller's is one of them
   if (room >= threads) return threads;
   const int fit = std::max(1, static_cast<int>(std::max(room, 1.0)));
   std::ostringstream m;
@@ -876,11 +887,15 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   const auto start = std::chrono::steady_clock::now();
   const WorkCounters before = ws.counters;
   WorkCounters others;  // work done in the seeding and chunk workspaces
+  // Work done in the caller's workspace between these two counts is counted in `others` already (the parallel
+  // part's chunks and seeds): left out of the workspace's share.
+  WorkCounters counted_begin{}, counted_end{};
   auto done = [&](SolveStatus st) {
     once_per_stretch(sum.warnings, "slow_convergence", opt);
     sum.status = st;
     sum.counters = others;
     add_counters(sum.counters, ws.counters, before);
+    add_counters(sum.counters, counted_begin, counted_end);  // − (counted_end − counted_begin)
     sum.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return st;
   };
@@ -948,28 +963,40 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   auto first_row = [&](Index c) { return 1 + c * chunk; };
   auto last_row = [&](Index c) { return std::min(opt.steps, (c + 1) * chunk); };
 
-  // Workspaces for the chunks, taken from a pool for the time of one chunk. Not one per thread index: a thread
-  // waiting inside a nested parallel evaluation (large models) may start another chunk meanwhile, which then
-  // needs a workspace of its own.
-  std::vector<std::unique_ptr<Workspace>> pool;
+  // Workspaces, taken from a pool for the time of one chunk or one seed: the caller's own (idle otherwise) and as
+  // many more as are in use at once, one per thread, since the seeding pass takes one only while it finds a seed.
+  // On large models a workspace is mostly the LU of Φq (10⁶ scissor stages: 1.5 GB), so that is what the memory
+  // of a parallel sweep grows by per thread. Not one per thread index: a thread waiting inside a nested parallel
+  // evaluation (large models) may start other work meanwhile, which then needs a workspace of its own. The work
+  // done in each is counted with the chunk or seed that did it; the caller's workspace's share is taken out of its
+  // own count at the end (ws_in_parallel).
+  std::vector<std::unique_ptr<Workspace>> owned;
+  std::vector<Workspace*> pool{&ws};
   std::mutex pool_mutex;
   auto acquire = [&] {
     std::lock_guard<std::mutex> lock(pool_mutex);
-    if (pool.empty()) return std::make_unique<Workspace>(model);
-    auto w = std::move(pool.back());
+    if (pool.empty()) {
+      owned.push_back(std::make_unique<Workspace>(model));
+      return owned.back().get();
+    }
+    Workspace* w = pool.back();
     pool.pop_back();
+    w->newton_contraction = -1.0;  // measured by its last user, on other steps
     return w;
   };
-  auto release = [&](std::unique_ptr<Workspace> w) {
+  auto release = [&](Workspace* w) {
     std::lock_guard<std::mutex> lock(pool_mutex);
-    pool.push_back(std::move(w));
+    pool.push_back(w);
   };
+  counted_begin = ws.counters;
 
   // The last delivered row (the state an ordered continuation starts from) and the position the sweep reaches
-  // one step after it when continued in order (the previous chunk's seam), if known.
+  // one step after it when continued in order (the previous chunk's seam), if known. The caller's sweeper is not
+  // used again: its state moves here and its history is freed.
   Index resume = 1;
-  Eigen::VectorXd last_q = sw.state().q, last_qd = need_v ? sw.state().qd : ws.qd,
-                  last_qdd = need_a ? sw.state().qdd : ws.qdd;
+  State row0 = sw.take_state();
+  Eigen::VectorXd last_q = std::move(row0.q), last_qd = need_v ? std::move(row0.qd) : ws.qd,
+                  last_qdd = need_a ? std::move(row0.qdd) : ws.qdd;
   Eigen::VectorXd last_phi = ws.phi;                        // Φ of the row being delivered, when asked
   std::vector<PointMotion> last_points(opt.points.size());  // its point motions
   bool seam_known = false;
@@ -980,7 +1007,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
 
   // Chunk c: its rows from its seed (chunk 0: in order from row 0), then the seam step.
   auto run_chunk = [&](Index c, Chunk& ch) {
-    std::unique_ptr<Workspace> held = acquire();
+    Workspace* held = acquire();
     Workspace& w = *held;
     const WorkCounters w0 = w.counters;
     ch.k0 = first_row(c), ch.k1 = last_row(c);
@@ -1026,7 +1053,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     }
     ch.rounding = std::max(s.take_rounding_level(), c > 0 ? seed_rounding[static_cast<std::size_t>(c)] : 0.0);
     add_counters(ch.sum.counters, w.counters, w0);
-    release(std::move(held));
+    release(held);
   };
 
   // Accepts and delivers a computed chunk: 0 delivered, 1 rejected (the rest runs in order), 2 stopped by the
@@ -1081,10 +1108,12 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   seed_options.predictor = Predictor::kSecant;
   seed_options.points.clear(), seed_options.residuals = seed_options.condition = false;  // seeds deliver no rows
   SweepSummary seed_summary;
-  Workspace sws(model);
-  sws.q = last_q;
-  Sweeper seeder(model, seed_options, sws, seed_summary);
+  WorkCounters seed_work;  // done in pool workspaces by the seeding pass
+  Workspace* sws = acquire();
+  sws->q = last_q;
+  Sweeper seeder(model, seed_options, *sws, seed_summary);
   seeder.adopt(run.time_of(0));
+  release(sws);
 
   // The schedule. `threads` loops run the work as it becomes ready: the seeding (in order, one thread at a time,
   // first whenever fewer chunks are ready than threads, so that it stays ahead) and the seeded chunks (lowest
@@ -1109,7 +1138,12 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   auto seed_one = [&] {  // finds seed `seeded` (the lock is not held)
     const auto seed_start = std::chrono::steady_clock::now();
     const Index c = seeded;  // only the thread holding seeding_busy changes it
+    Workspace* w = acquire();
+    const WorkCounters w0 = w->counters;
+    seeder.bind(*w);
     const bool ok = seeder.advance(run.time_of(first_row(c)), 0);
+    add_counters(seed_work, w->counters, w0);
+    release(w);
     if (ok) {
       seeds[static_cast<std::size_t>(c)] = seeder.state().q;
       seed_rounding[static_cast<std::size_t>(c)] = seeder.take_rounding_level();
@@ -1189,7 +1223,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // chunks computed but not delivered (after a rejected one): their work was done all the same
   for (Index c = delivered + (stop ? 1 : 0); c < claimed; ++c)
     add_counters(others, chunks[static_cast<std::size_t>(c)].sum.counters, WorkCounters{});
-  add_counters(others, sws.counters, WorkCounters{});
+  add_counters(others, seed_work, WorkCounters{});
+  counted_end = ws.counters;  // the caller's workspace's work so far is the chunks' and seeds'
   // The caller's workspace ends at the last delivered row, as after a sequential sweep.
   ws.q = last_q;
   if (need_v) ws.qd = last_qd;

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <type_traits>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <typeindex>
@@ -155,7 +156,7 @@ struct HasSetup<T, std::void_t<decltype(std::declval<T&>().setup())>> : std::tru
 /// One constraint of a model, as diagnostics name it.
 struct ConstraintInfo {
   std::string name;              ///< as given by the user (or "<kind>#<k>")
-  std::string kind;              ///< DistanceSpec::kKind, ...
+  std::string_view kind;         ///< DistanceSpec::kKind, ... (a static string: no copy per constraint)
   Index first_row = 0;           ///< its first row in Φ
   int rows = 0;                  ///< how many rows it owns
   bool depends_on_time = false;  ///< rheonomic (a driver, or an equation in t)
@@ -181,17 +182,16 @@ struct ConstraintInfo {
 /// wherever the origin is. floor_j of a coordinate is kUlpFloor · |q_j|.
 struct ToleranceScales {
   Eigen::VectorXd row_scale;              ///< per row, metres for length rows, 1 for angle and unitless rows
-  Eigen::VectorXd row_is_length;          ///< 1 for length rows, 0 otherwise
   Eigen::VectorXd coordinate_scale;       ///< per coordinate, metres for length coordinates, 1 otherwise
-  Eigen::VectorXd coordinate_is_length;   ///< 1 for length coordinates, 0 otherwise
   /// 1 / row_scale: the Newton loop's per-iteration tests multiply instead of dividing.
   Eigen::VectorXd inverse_row_scale;
   Eigen::VectorXd inverse_coordinate_scale;  ///< 1 / coordinate_scale (see inverse_row_scale)
   /// Where each row's floor coordinates start in floor_coordinates (m + 1 entries).
   std::vector<Index> floor_begin;
   /// The coordinates each row's rounding floor is taken over (see above): those of row i are
-  /// floor_coordinates[floor_begin[i] … floor_begin[i + 1] − 1].
-  std::vector<Index> floor_coordinates;
+  /// floor_coordinates[floor_begin[i] … floor_begin[i + 1] − 1]. 32-bit: about one entry per non-zero of Φq, and a
+  /// model has fewer than 2³¹ coordinates (ModelBuilder::build() checks).
+  std::vector<std::int32_t> floor_coordinates;
   /// 64 ulps: the rounding floor per unit of |q| (see above).
   static constexpr double kUlpFloor = 64.0 * std::numeric_limits<double>::epsilon();
 };

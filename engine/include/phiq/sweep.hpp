@@ -68,9 +68,10 @@ struct SweepOptions {
   /// the rest of the sweep runs in order (warning "parallel_fallback"). Rows are delivered in time order in any
   /// case, and equal the sequential sweep's to the solver tolerance; on_step is called on the calling thread.
   /// Everything the sweep runs stays on these threads, the model's own parallel evaluation of large models
-  /// (ModelBuilder, 65536 constraints and more) included: 1 is one thread. With 0, fewer than all cores when
-  /// their workspaces (one per thread and the seeding pass's, each with its own LU of Φq, measured on the first
-  /// factorisation) and the rows held for delivery would not fit in memory_budget: warning "threads_reduced".
+  /// (ModelBuilder, 65536 constraints and more) included: 1 is one thread. The threads solve in the caller's
+  /// workspace and one more per extra thread (each with its own LU of Φq), which the seeding pass shares. With 0,
+  /// fewer than all cores when those extra workspaces (measured on the first factorisation) and the rows held for
+  /// delivery would not fit in memory_budget: warning "threads_reduced".
   int threads = 1;
   /// Bytes the whole process may reach when threads = 0 picks the threads (what it holds already, the model and
   /// the caller's workspace among it, counts); 0: the threads' workspaces must fit in the memory the system
