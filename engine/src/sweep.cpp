@@ -183,13 +183,27 @@ class Sweeper {
 
   // First row of a parallel chunk: the position at t from a seed that solves it (up to the seeding pass's
   // tolerance), then the derivatives, as any converged step.
-  bool start_from(double t, const Eigen::VectorXd& seed) {
+  // `seed_error`: the seed's own estimated error (the seeding pass's PositionSummary::error_estimate; infinite if
+  // unknown), so that a seed found to the tolerance is taken without a Newton step, as a predicted start is. The
+  // seam check (the previous chunk, continued in order, must arrive at this row) guards the chunk either way.
+  bool start_from(double t, const Eigen::VectorXd& seed, double seed_error) {
     ws_->q = seed;
-    newton_.start_error = INFINITY;  // found to the seeding pass's accuracy over a long step: Newton checks it
+    newton_.start_error = seed_error;
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t, newton_, *ws_, &ps);
     if (st != SolveStatus::kSuccess) return fail(st, ps.message);
     return converged(t, ps);
+  }
+
+  // The estimated error of state().q (units of the tolerance test; infinite when unknown).
+  double state_error() const { return current_error_; }
+  // One more step to t1 for its position only (a parallel chunk's seam, compared with the next chunk's first row):
+  // no derivatives, no outputs.
+  bool advance_position(double t1) {
+    position_only_ = true;
+    const bool ok = advance(t1, 0);
+    position_only_ = false;
+    return ok;
   }
 
   // Continues from the converged state in ws (q, and q̇, q̈ where asked for) at t, as if this sweeper had reached
@@ -446,7 +460,7 @@ class Sweeper {
       if (!has_current_) m << " (the sweep starts here: the branch is the one nearest the placement)";
       sum_.warnings.push_back({t, "bifurcation", m.str()});
     }
-    if (!derivatives(t)) return false;
+    if (!position_only_ && !derivatives(t)) return false;
     remember(t);
     return true;
   }
@@ -643,6 +657,7 @@ class Sweeper {
   double current_error_ = INFINITY;  // the estimated error of current_.q (PositionSummary::error_estimate)
   double row_error_ = INFINITY;      // that of the row being converged, until remember() makes it current
   bool extrapolated_ = false;  // the last prediction moved from current_ (jumped() has something to compare)
+  bool position_only_ = false;  // inside advance_position()
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
   double rcond_ = 0.0;
   Eigen::VectorXd predicted_;       // the last prediction (for jumped())
@@ -766,9 +781,19 @@ bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b
 // Rows a parallel sweep may hold at once before delivering them in order (all waves' chunks together).
 constexpr double kRowBufferBytes = 512.0 * 1024 * 1024;
 
+// A row computed by a parallel chunk, held until it is delivered in order. Its vectors are delivered as they are
+// (no copy into the caller's state per row: on a model whose steps are cheap, copying rows in and out cost a fifth
+// of a chunk's time).
+struct Row {
+  Eigen::VectorXd q, qd, qdd, phi;  // q̇, q̈ as solved, Φ when asked
+  double rcond = 0.0;
+  int det_sign = 0;
+  std::vector<PointMotion> points;
+};
+
 struct Chunk {
   Index k0 = 0, k1 = 0;
-  std::vector<double> rows;  // (k1 − k0 + 1) rows of [q | q̇ | q̈ | Φ | rcond | point motions], as asked for
+  std::vector<Row> rows;     // rows k0 … k1
   SweepSummary sum;          // status, message, warnings, subdivisions, rcond and work of this chunk
   bool ok = false;
   bool has_seam = false;
@@ -997,13 +1022,12 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   State row0 = sw.take_state();
   Eigen::VectorXd last_q = std::move(row0.q), last_qd = need_v ? std::move(row0.qd) : ws.qd,
                   last_qdd = need_a ? std::move(row0.qdd) : ws.qdd;
-  Eigen::VectorXd last_phi = ws.phi;                        // Φ of the row being delivered, when asked
-  std::vector<PointMotion> last_points(opt.points.size());  // its point motions
   bool seam_known = false;
   Eigen::VectorXd seam_q;
   double seam_rounding = 0.0;
   std::vector<Eigen::VectorXd> seeds(static_cast<std::size_t>(n_chunks));  // seeds[c]: chunk c's first row (not 0)
   std::vector<double> seed_rounding(static_cast<std::size_t>(n_chunks), 0.0);  // the seeder's rounding level there
+  std::vector<double> seed_error(static_cast<std::size_t>(n_chunks), INFINITY);  // and its error estimate
 
   // Chunk c: its rows from its seed (chunk 0: in order from row 0), then the seam step.
   auto run_chunk = [&](Index c, Chunk& ch) {
@@ -1012,28 +1036,27 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     const WorkCounters w0 = w.counters;
     ch.k0 = first_row(c), ch.k1 = last_row(c);
     Sweeper s(model, opt, w, ch.sum);
-    ch.rows.resize(static_cast<std::size_t>((ch.k1 - ch.k0 + 1) * width));
-    double* out = ch.rows.data();
+    ch.rows.resize(static_cast<std::size_t>(ch.k1 - ch.k0 + 1));
+    std::size_t kept = 0;
     auto keep = [&] {
       const State& st = s.state();
-      out = std::copy(st.q.data(), st.q.data() + n, out);
-      if (need_v) out = std::copy(st.qd.data(), st.qd.data() + n, out);
-      if (need_a) out = std::copy(st.qdd.data(), st.qdd.data() + n, out);
+      Row& r = ch.rows[kept++];
+      r.q = st.q;
+      if (need_v) r.qd = st.qd;
+      if (need_a) r.qdd = st.qdd;
       s.row_outputs();
-      if (n_phi) out = std::copy(w.phi.data(), w.phi.data() + m, out);
-      if (n_rcond) *out++ = s.rcond();
-      if (n_points) {
-        std::memcpy(out, s.point_motions(), sizeof(PointMotion) * opt.points.size());
-        out += n_points * kMotionDoubles;
-      }
-      *out++ = s.det_sign();
+      if (n_phi) r.phi = w.phi;
+      r.rcond = s.rcond();
+      if (n_points) r.points.assign(s.point_motions(), s.point_motions() + n_points);
+      r.det_sign = s.det_sign();
     };
     if (c == 0) {  // continues row 0 in order: the sequential sweep itself
       w.q = last_q, w.qd = last_qd, w.qdd = last_qdd;
       s.adopt(run.time_of(0));
       ch.ok = s.advance(run.time_of(ch.k0), 0);
     } else {
-      ch.ok = s.start_from(run.time_of(ch.k0), seeds[static_cast<std::size_t>(c)]);
+      ch.ok = s.start_from(run.time_of(ch.k0), seeds[static_cast<std::size_t>(c)],
+                           seed_error[static_cast<std::size_t>(c)]);
     }
     if (ch.ok) keep();
     for (Index k = ch.k0 + 1; ch.ok && k <= ch.k1; ++k)
@@ -1041,7 +1064,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     if (ch.ok && ch.k1 < opt.steps) {
       // the seam row belongs to the next chunk: its warnings and sub-steps are counted there
       const SweepSummary kept = ch.sum;
-      if (s.advance(run.time_of(ch.k1 + 1), 0)) {
+      if (s.advance_position(run.time_of(ch.k1 + 1))) {
         ch.has_seam = true;
         ch.seam_q = s.state().q;
       }
@@ -1064,22 +1087,21 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     // Two solutions of the same problem agree to 100 tolerances, or, where Newton stopped at the rounding level
     // (a long chain), to 10× how well that stop says q is known: another branch is a finite distance away.
     const double limit = std::max(100.0, 10.0 * std::max(seam_rounding, ch.rounding));
-    const bool accept = ch.ok && (ch.k0 == 1 || (seam_known && same_solution(model, seam_q, ch.rows.data(),
+    const bool accept = ch.ok && (ch.k0 == 1 || (seam_known && same_solution(model, seam_q, ch.rows[0].q.data(),
                                                                              opt.newton.tolerance, limit)));
     if (!accept) return 1;
-    const double* r = ch.rows.data();
-    for (Index k = ch.k0; k <= ch.k1; ++k, r += width) {
-      last_q = Eigen::Map<const Eigen::VectorXd>(r, n);
-      if (need_v) last_qd = Eigen::Map<const Eigen::VectorXd>(r + n, n);
-      if (need_a) last_qdd = Eigen::Map<const Eigen::VectorXd>(r + 2 * n, n);
-      const double* extra = r + n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0));
-      if (n_phi) last_phi = Eigen::Map<const Eigen::VectorXd>(extra, m);
-      const double rc = n_rcond ? extra[n_phi] : 0.0;
-      if (n_points) std::memcpy(static_cast<void*>(last_points.data()), extra + n_phi + n_rcond, sizeof(PointMotion) * opt.points.size());
-      const int sign = static_cast<int>(extra[n_phi + n_rcond + n_points * kMotionDoubles]);
-      if (!run.deliver(k, last_q, last_qd, last_qdd, n_points ? last_points.data() : nullptr, last_phi, rc, sign))
+    for (Index k = ch.k0; k <= ch.k1; ++k) {
+      const Row& r = ch.rows[static_cast<std::size_t>(k - ch.k0)];
+      if (!run.deliver(k, r.q, r.qd, r.qdd, n_points ? r.points.data() : nullptr, r.phi, r.rcond, r.det_sign)) {
+        last_q = r.q, last_qd = need_v ? r.qd : last_qd, last_qdd = need_a ? r.qdd : last_qdd;  // where it stopped
         return 2;
+      }
     }
+    // the state an ordered continuation starts from: the chunk's last row (it is freed once delivered)
+    Row& last = ch.rows.back();
+    last_q.swap(last.q);
+    if (need_v) last_qd.swap(last.qd);
+    if (need_a) last_qdd.swap(last.qdd);
     resume = ch.k1 + 1;
     seam_known = ch.has_seam;
     if (seam_known) seam_q.swap(ch.seam_q), seam_rounding = ch.rounding;
@@ -1100,12 +1122,13 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
       threads, std::min<Index>(16 * threads, static_cast<Index>(kRowBufferBytes / chunk_bytes)));
 
   // Seeds: the position at each chunk's first row, found in order with the chunk's span as the step (positions
-  // only, the secant predictor, subdivision on failure), one at a time, just ahead of the chunks that need them.
+  // only, the parabolic predictor over the seeds before, subdivision on failure), one at a time, just ahead of the
+  // chunks that need them.
   // A failure ends the seeding; the chunks after it run in order below, where the failure is reported as the
   // sequential sweep reports it.
   SweepOptions seed_options = opt;
   seed_options.velocities = seed_options.accelerations = false;
-  seed_options.predictor = Predictor::kSecant;
+  seed_options.predictor = Predictor::kParabolic;
   seed_options.points.clear(), seed_options.residuals = seed_options.condition = false;  // seeds deliver no rows
   SweepSummary seed_summary;
   WorkCounters seed_work;  // done in pool workspaces by the seeding pass
@@ -1146,6 +1169,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     release(w);
     if (ok) {
       seeds[static_cast<std::size_t>(c)] = seeder.state().q;
+      seed_error[static_cast<std::size_t>(c)] = seeder.state_error();
       seed_rounding[static_cast<std::size_t>(c)] = seeder.take_rounding_level();
     }
     const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
@@ -1162,7 +1186,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
       Chunk& ch = chunks[static_cast<std::size_t>(delivered)];
       lock.unlock();
       const int d = deliver_chunk(ch);
-      ch.rows = std::vector<double>();  // delivered: free
+      ch.rows = std::vector<Row>();  // delivered: free
       seeds[static_cast<std::size_t>(delivered)] = Eigen::VectorXd();
       lock.lock();
       if (d != 0) {

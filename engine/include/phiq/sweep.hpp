@@ -64,7 +64,8 @@ struct SweepOptions {
   /// Threads for the drive steps: 1 runs them in order; N > 1 runs chunks of chunk_steps steps in parallel on N
   /// threads; 0 uses all cores. Each chunk starts from a seed found by a sequential pass over the chunk starts
   /// (positions only, every chunk_steps-th time point), and is accepted only if the sequential sweep, continued
-  /// one step past the previous chunk, reaches the same position there to within 100 × the tolerance: otherwise
+  /// one step past the previous chunk (that seam step solves its position only), reaches the same position there
+  /// to within 100 × the tolerance: otherwise
   /// the rest of the sweep runs in order (warning "parallel_fallback"). Rows are delivered in time order in any
   /// case, and equal the sequential sweep's to the solver tolerance; on_step is called on the calling thread.
   /// Everything the sweep runs stays on these threads, the model's own parallel evaluation of large models
