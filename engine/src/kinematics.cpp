@@ -114,39 +114,39 @@ ResidualCheck check_residual(const Model& model, const Eigen::VectorXd& phi, dou
   return c;
 }
 
-// The size of a step in the tolerance-scaled norm, max_j |Δq_j| / scale_j (step_ratio with tol = 1, whose floor
-// 64 ulps · |q_j| / scale_j is negligible there): the Newton loop's contraction estimate. With it, in the same
-// pass, whether the step is finite.
-double scaled_norm_if_finite(const Model& model, const Eigen::VectorXd& dq, bool* finite) {
-  const double* d = dq.data();
-  const double* inv = model.tolerance_scales().inverse_coordinate_scale.data();
-  double worst = 0.0, sum = 0.0;
-  for (Index j = 0, n = dq.size(); j < n; ++j) {
-    const double s = std::fabs(d[j]) * inv[j];
-    sum += s;
-    worst = worst < s ? s : worst;
-  }
-  *finite = std::isfinite(sum) || dq.allFinite();
-  return worst;
-}
-
-// trial = q − α·dx (dx = Φq⁻¹Φ, so that −α·dx is the Newton step), and the step's size in one pass: returns
-// step_ratio(α·dx, trial, tol), ≤ 1 when the step is within the tolerance (NaN when it is not finite).
-double take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& dx, double alpha, double tol,
-                 Eigen::VectorXd& trial) {
+// trial = q − α·dx (dx = Φq⁻¹Φ, so that −α·dx is the Newton step), in one pass with what the loop needs of the
+// step: its size in the tolerance test, step_ratio(α·dx, trial, tol) (≤ 1 when within the tolerance; NaN sticks),
+// and for the full step its scaled norm max_j |dx_j| / scale_j (the contraction estimate's measure) and whether
+// it is finite.
+struct StepPass {
+  double size = 0.0;
+  double norm = 0.0;
+  bool finite = true;
+};
+StepPass take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& dx, double alpha, double tol,
+                   Eigen::VectorXd& trial) {
   const double* cs = model.tolerance_scales().coordinate_scale.data();
+  const double* inv = model.tolerance_scales().inverse_coordinate_scale.data();
   const double* x = q.data();
   const double* d = dx.data();
   double* out = trial.data();
-  double worst = 0.0;
+  double worst = 0.0, norm = 0.0, sum = 0.0;
   for (Index j = 0, n = q.size(); j < n; ++j) {
     const double step = alpha * d[j];
     const double v = x[j] - step;
     out[j] = v;
-    const double r = std::fabs(step) / (tol * cs[j] + kUlpFloor * std::fabs(v));
-    if (!(r <= worst)) worst = r;  // NaN sticks
+    // |step| / allowed, divided only where it exceeds the largest so far (NaN too, and it sticks)
+    const double a = std::fabs(step), allowed = tol * cs[j] + kUlpFloor * std::fabs(v);
+    if (!(a <= worst * allowed)) worst = std::isnan(worst) ? worst : a / allowed;
+    const double s = std::fabs(d[j]) * inv[j];
+    sum += s;
+    norm = norm < s ? s : norm;
   }
-  return worst;
+  StepPass p;
+  p.size = worst;
+  p.norm = norm;
+  p.finite = std::isfinite(sum) || dx.allFinite();
+  return p;
 }
 
 void check_workspace(const Model& model, const Workspace& ws) {
@@ -271,6 +271,8 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   ws.factorized_at_solution = false;
   bool jacobian_at_q = false;
 
+  bool factorized_here = false;  // this solve factorised (at an iterate whose point is not recorded)
+  double drift = 0.0;            // sum of the steps' sizes (tolerance units) since that factorisation
   ResidualCheck check;  // of the current iterate (its worst row is the residual reported on success)
   auto finish = [&](SolveStatus st, std::string msg) {
     sum.status = st;
@@ -280,9 +282,11 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
       // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
       // Otherwise they factorise at the solution, from the Jacobian evaluated there with Φ if there is one.
-      if (ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
-          step_within(model, ws.q - ws.factorized_q, ws.q, opt.tolerance, 1.0)) {
+      if (factorized_here ? ws.has_factorization && drift <= 1.0
+                          : ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
+                                step_within(model, ws.q - ws.factorized_q, ws.q, opt.tolerance, 1.0)) {
         ws.factorized_q = ws.q;
+        ws.factorized_t = t;
         ws.factorized_at_solution = true;
       } else if (jacobian_at_q) {
         ws.jacobian_q = ws.q;
@@ -363,20 +367,31 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
 
     std::string msg;
     if (!reuse) {
-      const Index before = ws.counters.factorizations;
-      SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg, jacobian_at_q);
+      // Φq at this iterate, unless the factors are there already. Its point is not copied per iteration: the loop
+      // counts how far it has moved since (drift), and records it once, at the end, if that is the solution.
+      SolveStatus st = SolveStatus::kSuccess;
+      if (!(ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
+            ws.factorized_q == ws.q)) {
+        st = factorize_at_q(model, t, ws, &sum.rcond, &msg, jacobian_at_q);
+        ws.factorized_t = std::numeric_limits<double>::quiet_NaN();  // point not recorded (yet)
+        if (st == SolveStatus::kSuccess) ++sum.factorizations;
+      } else {
+        sum.rcond = ws.lu->rcond();
+      }
       jacobian_at_q = false;  // factorised (or failed): jacobian_values are no longer news
       if (st != SolveStatus::kSuccess) return finish(st, msg);
-      sum.factorizations += static_cast<int>(ws.counters.factorizations - before);
+      factorized_here = true;
+      drift = 0.0;
     } else {
       sum.rcond = ws.lu->rcond();
     }
     // ws.step = Φq⁻¹Φ: the Newton step is −ws.step (no negated copy of Φ; the LU's rounding is sign-symmetric)
     if (!ws.lu->solve(solve_rhs(model, ws, ws.phi), ws.step.data()))
       return finish(SolveStatus::kLinearSolverFailed, "sparse solve failed: " + ws.lu->last_message());
-    bool step_finite = true;
-    const double norm = scaled_norm_if_finite(model, ws.step, &step_finite);
-    if (!step_finite) {
+    // the full step's trial point and measures in one pass (the trial is wasted when the matrix is refreshed)
+    const StepPass full_step = take_step(model, ws.q, ws.step, 1.0, opt.tolerance, ws.trial);
+    const double norm = full_step.norm;
+    if (!full_step.finite) {
       if (reuse) {  // an old factorisation may be singular where the current iterate is not
         reuse = false, prev_norm = -1.0;
         continue;
@@ -394,7 +409,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       ++reused_steps;
       const int left = std::min(opt.max_iterations - sum.iterations - 1, kMaxReusedSteps - reused_steps);
       if (theta > opt.max_contraction || left < 0 ||
-          !step_within(model, ws.step, ws.q, opt.tolerance, std::pow(theta, left + 1) / (1.0 - theta))) {
+          !(std::pow(theta, left + 1) / (1.0 - theta) * full_step.size <= 1.0)) {
         reuse = false, prev_norm = -1.0;
         continue;
       }
@@ -411,7 +426,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     bool with_jacobian = false;  // Φq evaluated at the trial
     bool refresh = false;
     for (int bt = 0;; ++bt) {
-      step_size = take_step(model, ws.q, ws.step, alpha, opt.tolerance, ws.trial);
+      step_size = bt == 0 ? full_step.size : take_step(model, ws.q, ws.step, alpha, opt.tolerance, ws.trial).size;
       step_error = std::min(eta, 1.0) * step_size;
       step_ok = step_error <= 1.0;
       with_jacobian = step_ok ? opt.jacobian_with_residual : !reuse;
@@ -472,6 +487,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     prev_norm = alpha == 1.0 ? norm : -1.0;  // a shortened step says nothing about the contraction
     ws.q.swap(ws.trial);
     ws.phi.swap(ws.trial_phi);
+    drift += step_size;  // max-norm distance from the factorisation's point, by the triangle inequality
     // The error reported (and carried by a sweep to the rows it extrapolates): the contraction estimate, or the
     // step's size times the residual's reduction when that is the larger — the size of the next step, were it
     // taken. Where the steps are the rounding of Φ amplified along a long chain, the residual no longer falls and

@@ -435,7 +435,11 @@ Model ModelBuilder::build() && {
   // Sparsity pattern, fixed for the life of the model.
   std::vector<Index> trip_rows, trip_cols;
   for (auto& b : m.blocks_) b->build_pattern(trip_rows, trip_cols);
-  auto pattern = std::make_shared<CscPattern>(build_csc_pattern(rows, n, trip_rows, trip_cols, &m.slot_of_entry_));
+  if (static_cast<Index>(trip_rows.size()) >= INT32_MAX)
+    throw Error("the model's Jacobian has " + std::to_string(trip_rows.size()) + " entries; phiq handles fewer than 2^31");
+  std::vector<Index> slots;
+  auto pattern = std::make_shared<CscPattern>(build_csc_pattern(rows, n, trip_rows, trip_cols, &slots));
+  m.slot_of_entry_.assign(slots.begin(), slots.end());
   m.pattern_ = pattern;
   m.solve_pattern_ = pattern;
 

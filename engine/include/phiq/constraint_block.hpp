@@ -4,12 +4,18 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
 #include "phiq/constraint_kinds.hpp"
 
 namespace phiq {
+
+/// Where a Jacobian entry goes in the CSC value array, and a constraint's first row and first entry: 32-bit, since
+/// the value passes read them for every entry (a model has fewer than 2³¹ rows and entries: ModelBuilder::build()
+/// checks).
+using EntryIndex = std::int32_t;
 
 /// The constraints of one kind, behind the one interface the Model and the solvers see. Constraint i of the block
 /// (0 ≤ i < size()) owns the rows_per_constraint() consecutive global rows that start at first_row(i).
@@ -45,13 +51,13 @@ class ConstraintBlock {
   /// (=) instead of added: the model asks for it when no two entries of the whole model share a slot, which spares
   /// it the zero fill (a pass over all non-zeros per Newton iteration). Requires build_pattern() to have run.
   /// Thread-safe.
-  virtual void jacobian(std::size_t begin, std::size_t end, const double* q, double t, const Index* slot_of_entry,
+  virtual void jacobian(std::size_t begin, std::size_t end, const double* q, double t, const EntryIndex* slot_of_entry,
                         double* csc_values, bool overwrite = false) const = 0;
   /// residual() and jacobian() at the same (q, t) in one pass over the constraints: each constraint's data is read
   /// once (the Newton loop needs both at every accepted iterate; on large models each pass streams the whole
   /// constraint list from memory). Same contracts as the two calls. Thread-safe.
   virtual void residual_and_jacobian(std::size_t begin, std::size_t end, const double* q, double t, double* phi,
-                                     const Index* slot_of_entry, double* csc_values, bool overwrite) const = 0;
+                                     const EntryIndex* slot_of_entry, double* csc_values, bool overwrite) const = 0;
   /// Writes Φt = ∂Φ/∂t of the time-dependent constraints in [begin, end) into `out` at their global row offsets;
   /// the rows of the others are left untouched (their Φt is zero: the caller zero-fills `out`). Thread-safe.
   virtual void phi_t(std::size_t begin, std::size_t end, const double* q, double t, double* out) const = 0;
@@ -97,7 +103,7 @@ struct PatternSink {
 /// only where no two entries share a slot).
 template <bool kOverwrite>
 struct ValueSink {
-  const Index* slot;
+  const EntryIndex* slot;
   double* values;
   void operator()(int, const Slot& s, double v) {
     if (!s.is_coordinate()) return;
@@ -128,8 +134,8 @@ class TypedBlock final : public ConstraintBlock {
   /// One constraint of the block: its data and where its rows and Jacobian entries are in the model.
   struct Entry {
     Spec spec;  ///< the constraint's data and equations
-    Index row0;  ///< first global row (the constraint owns rows row0 … row0 + Spec::kRows − 1)
-    Index nz0;   ///< index of its first Jacobian entry in the model's triplet list, set by build_pattern()
+    EntryIndex row0;  ///< first global row (the constraint owns rows row0 … row0 + Spec::kRows − 1)
+    EntryIndex nz0;   ///< index of its first Jacobian entry in the model's triplet list, set by build_pattern()
   };
 
   const char* kind() const override { return Spec::kKind; }
@@ -145,13 +151,13 @@ class TypedBlock final : public ConstraintBlock {
   void residual(std::size_t begin, std::size_t end, const double* q, double t, double* phi) const override {
     for (std::size_t i = begin; i < end; ++i) entries_[i].spec.residual(q, t, phi + entries_[i].row0);
   }
-  void jacobian(std::size_t begin, std::size_t end, const double* q, double t, const Index* slot_of_entry,
+  void jacobian(std::size_t begin, std::size_t end, const double* q, double t, const EntryIndex* slot_of_entry,
                 double* csc_values, bool overwrite) const override {
     if (overwrite) evaluate<false, true>(begin, end, q, t, nullptr, slot_of_entry, csc_values);
     else evaluate<false, false>(begin, end, q, t, nullptr, slot_of_entry, csc_values);
   }
   void residual_and_jacobian(std::size_t begin, std::size_t end, const double* q, double t, double* phi,
-                             const Index* slot_of_entry, double* csc_values, bool overwrite) const override {
+                             const EntryIndex* slot_of_entry, double* csc_values, bool overwrite) const override {
     if (overwrite) evaluate<true, true>(begin, end, q, t, phi, slot_of_entry, csc_values);
     else evaluate<true, false>(begin, end, q, t, phi, slot_of_entry, csc_values);
   }
@@ -172,7 +178,7 @@ class TypedBlock final : public ConstraintBlock {
     for (const Entry& e : entries_) top = std::max(top, max_coordinate(e.spec));
     const std::vector<double> zeros(static_cast<std::size_t>(top + 1), 0.0);
     for (Entry& e : entries_) {
-      e.nz0 = static_cast<Index>(rows.size());
+      e.nz0 = static_cast<EntryIndex>(rows.size());  // < 2³¹: ModelBuilder::build() checks the total
       detail::PatternSink sink{e.row0, &rows, &cols};
       e.spec.jacobian(zeros.data(), 0.0, sink);
     }
@@ -200,13 +206,17 @@ class TypedBlock final : public ConstraintBlock {
  private:
   // Φq of constraints [begin, end) into their CSC slots (stored or added), and with kResidual their Φ too.
   template <bool kResidual, bool kOverwrite>
-  void evaluate(std::size_t begin, std::size_t end, const double* q, double t, double* phi, const Index* slot_of_entry,
+  void evaluate(std::size_t begin, std::size_t end, const double* q, double t, double* phi, const EntryIndex* slot_of_entry,
                 double* csc_values) const {
     for (std::size_t i = begin; i < end; ++i) {
       const Entry& e = entries_[i];
-      if constexpr (kResidual) e.spec.residual(q, t, phi + e.row0);
       detail::ValueSink<kOverwrite> sink{slot_of_entry + e.nz0, csc_values};
-      e.spec.jacobian(q, t, sink);
+      if constexpr (kResidual && requires { e.spec.residual_and_jacobian(q, t, phi, sink); }) {
+        e.spec.residual_and_jacobian(q, t, phi + e.row0, sink);  // the kind's own fused evaluation
+      } else {
+        if constexpr (kResidual) e.spec.residual(q, t, phi + e.row0);
+        e.spec.jacobian(q, t, sink);
+      }
     }
   }
 

@@ -135,6 +135,16 @@ struct DistanceSpec {
     kin::V2 d = (1.0 / length) * (kin::pos(b, q) - kin::pos(a, q));
     s(0, a.x, -d.x), s(0, a.y, -d.y), s(0, b.x, d.x), s(0, b.y, d.y);
   }
+  /// residual() and jacobian() in one go, with the same operations (the same values to the last bit): the
+  /// difference of the end points is read from q once. Optional for a kind: ConstraintBlock's fused pass calls it
+  /// when a kind has it (the distance is most rows of the large generated models), and the two functions otherwise.
+  template <class Sink>
+  void residual_and_jacobian(const double* q, double, double* phi, Sink& s) const {
+    const kin::V2 d = kin::pos(b, q) - kin::pos(a, q);
+    phi[0] = (kin::dot(d, d) - length * length) / (2.0 * length);
+    const kin::V2 u = (1.0 / length) * d;
+    s(0, a.x, -u.x), s(0, a.y, -u.y), s(0, b.x, u.x), s(0, b.y, u.y);
+  }
   /// Writes Φt = ∂Φ/∂t, the explicit time derivative of the residual at (q, t): kRows values at `out`, in the
   /// row's unit per second. Only called when depends_on_time() is true (the time-independent kinds write zeros).
   /// @par Arguments

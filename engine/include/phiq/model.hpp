@@ -5,12 +5,12 @@
 /// Workspace (workspace.hpp).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <type_traits>
-#include <cstdint>
 #include <string>
 #include <string_view>
 #include <typeindex>
@@ -319,7 +319,7 @@ class Model {
   std::vector<Index> row_constraint_;
   std::vector<Unit> row_units_;
   std::shared_ptr<const CscPattern> pattern_ = std::make_shared<CscPattern>();
-  std::vector<Index> slot_of_entry_;
+  std::vector<EntryIndex> slot_of_entry_;
   // Zero-fills csc_values unless no two entries share a slot; returns whether entries are stored (=) rather than
   // added (jacobian(), residual_and_jacobian()).
   bool prepare_jacobian_values(double* csc_values) const;
@@ -461,7 +461,9 @@ Index ModelBuilder::add(const std::string& name, Spec spec) {
   const bool td = spec.depends_on_time();
   const Index id = add_info(label, Spec::kKind, Spec::kRows, td);
   count_joint(detail::joint_count(spec));
-  block_for<Spec>().entries().push_back({std::move(spec), model_.constraints_[static_cast<std::size_t>(id)].first_row, 0});
+  const Index row0 = model_.constraints_[static_cast<std::size_t>(id)].first_row;
+  if (row0 + Spec::kRows >= INT32_MAX) throw Error("the model has more equations than phiq handles (2^31)");
+  block_for<Spec>().entries().push_back({std::move(spec), static_cast<EntryIndex>(row0), 0});
   return id;
 }
 
