@@ -78,6 +78,37 @@ TEST(Batch, AFailedCaseDoesNotStopTheOthers) {
   EXPECT_EQ(delivered, 61 + 61 + sum.cases[1].steps_completed);
 }
 
+// Each case's own start (what prepare_scene() gives a redundant scene): the first row is the assembly nearest it —
+// here the crank-slider's two branches, the slider right of the crank (x_B > 0) or mirrored left of it — and a start
+// of the wrong size or count is a programming error.
+TEST(Batch, EachCaseStartsFromItsOwnPlacement) {
+  std::vector<Model> models;
+  models.reserve(2);
+  models.push_back(crank_slider(0.3, nullptr));
+  models.push_back(crank_slider(0.3, &models[0]));
+  SweepOptions opt;
+  opt.t_end = 1.0;
+  opt.steps = 10;
+  std::vector<Eigen::VectorXd> starts = {models[0].initial_positions(), models[1].initial_positions()};
+  starts[1](3) = -starts[1](3);  // the slider mirrored: the other assembly branch
+  std::vector<double> first_x(2, 0.0);
+  std::mutex mu;
+  BatchSummary sum = run_batch({&models[0], &models[1]}, std::vector<SweepOptions>(2, opt), 1,
+                               [&](std::size_t c, const StepView& s) {
+                                 std::lock_guard<std::mutex> lock(mu);
+                                 if (s.step == 0) first_x[c] = s.q(3);
+                                 return true;
+                               },
+                               &starts);
+  ASSERT_EQ(sum.failed, 0);
+  EXPECT_NEAR(first_x[0], 1.3, 1e-12);   // L2 cos 0 + sqrt(L3² − 0) with the slider to the right
+  EXPECT_NEAR(first_x[1], -0.7, 1e-12);  // L2 cos 0 − L3: the mirrored branch
+  starts[1].resize(2);
+  EXPECT_THROW(run_batch({&models[0], &models[1]}, std::vector<SweepOptions>(2, opt), 1, nullptr, &starts), Error);
+  starts.pop_back();
+  EXPECT_THROW(run_batch({&models[0], &models[1]}, std::vector<SweepOptions>(2, opt), 1, nullptr, &starts), Error);
+}
+
 TEST(Batch, ModelsOfAnotherStructureAreAnalysedOnTheirOwn) {
   Model a = crank_slider(0.3, nullptr);
   ModelBuilder b;

@@ -135,6 +135,34 @@ TEST_F(Cli, BatchSweepsEveryParameterSetInParallel) {
   EXPECT_FALSE(fs::exists(dir_ / "bad"));
 }
 
+// phiq batch on a redundant scene: each case is assembled and swept on its independent rows, as `phiq run` does
+// (the door on three hinges, the third hinge's ground point moved by a parameter): on the axis, or 1e-12 off it,
+// the door turns about z as driven; 1 cm off, the hinges cannot all hold and that case alone fails, naming hinge3.
+TEST_F(Cli, BatchSweepsRedundantScenesOnTheirIndependentRows) {
+  std::string text = slurp(phiq::test::model_path("redundant/door_three_hinges.yaml"));
+  text.replace(text.find("dimension: 3"), 12, "dimension: 3\nparameters: {off: 0}");
+  text.replace(text.find("at: [0, 0, 2]}, {body: door"), 13, "at: [off, 0, 2]");
+  const fs::path scene = write("door.yaml", text);
+  const fs::path cases = write("cases.csv", "off\n0\n1e-12\n0.01\n");
+  const fs::path out = dir_ / "out";
+  Result r = run("batch " + scene.string() + " " + cases.string() + " -o " + out.string() + " --threads 2");
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("case 2: t = "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("hinge3"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("2 of 3 cases"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "case2.csv"));
+  for (int k = 0; k < 2; ++k) {
+    const phiq::CsvTable t = phiq::read_csv_table((out / ("case" + std::to_string(k) + ".csv")).string());
+    ASSERT_EQ(t.rows.size(), 31u);
+    ASSERT_EQ(t.columns[4], "door_e0");
+    ASSERT_EQ(t.columns[7], "door_e3");
+    double worst = 0;
+    for (const auto& row : t.rows)  // a turn by t about z: e0 = cos(t/2), e3 = sin(t/2)
+      worst = std::max({worst, std::fabs(row[4] - std::cos(row[0] / 2)), std::fabs(row[7] - std::sin(row[0] / 2))});
+    EXPECT_LT(worst, 1e-9) << "case " << k;
+  }
+}
+
 TEST_F(Cli, RunWithoutOutputFileWritesToStandardOutput) {
   Result r = run("run -q " + phiq::test::model_path("seed/crank_slider_mixed.yaml"));
   ASSERT_EQ(r.code, 0) << r.err;

@@ -251,14 +251,29 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return fail(dir + ": cannot create the output directory: " + ec.message(), 3);
+  // A case whose model is not square (redundant constraints) is assembled by minimum norm and swept on its
+  // independent rows, as `phiq run` does; one that cannot be (inconsistent, under-driven) fails alone.
+  std::vector<phiq::SquareScene> squares(scenes.size());
+  std::vector<std::string> prepare_errors(scenes.size());
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    const phiq::Scene& sc = scenes[k];
+    if (phiq::prepare_scene(*sc.model, sc.sweep.t_begin, sc.sweep.assembly, &squares[k]) != phiq::SolveStatus::kSuccess)
+      prepare_errors[k] = "t = " + std::to_string(sc.sweep.t_begin) + ": " + squares[k].assembly.message;
+  }
   std::vector<const phiq::Model*> models;
+  std::vector<Eigen::VectorXd> starts;
+  std::vector<std::size_t> swept;  // the cases that run, in order
   std::vector<phiq::CsvFormat> formats;
   std::vector<std::string> buffers(scenes.size());
   std::vector<std::unique_ptr<phiq::AtomicOutputFile>> files(scenes.size());
   std::vector<std::string> write_errors(scenes.size());
   for (std::size_t k = 0; k < scenes.size(); ++k) {
     const phiq::Scene& sc = scenes[k];
-    models.push_back(sc.model.get());
+    if (prepare_errors[k].empty()) {
+      models.push_back(&squares[k].model(*sc.model));
+      starts.push_back(squares[k].start);
+      swept.push_back(k);
+    }
     formats.emplace_back(sc);
     buffers[k] = formats[k].header();
     try {
@@ -271,8 +286,9 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   // Each case touches only its own buffer and file: the callback is safe across cases without a lock.
   // each case's own sweep: its output points (and time range) may depend on its parameters
   std::vector<phiq::SweepOptions> sweeps;
-  for (const phiq::Scene& sc : scenes) sweeps.push_back(sc.sweep);
-  const phiq::BatchSummary sum = phiq::run_batch(models, sweeps, threads, [&](std::size_t k, const phiq::StepView& step) {
+  for (std::size_t k : swept) sweeps.push_back(scenes[k].sweep);
+  const phiq::BatchSummary sum = phiq::run_batch(models, sweeps, threads, [&](std::size_t c, const phiq::StepView& step) {
+    const std::size_t k = swept[c];
     formats[k].append_row(step, buffers[k]);
     if (buffers[k].size() > (1u << 20)) {
       try {
@@ -284,12 +300,18 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
       buffers[k].clear();
     }
     return !g_interrupted.load();
-  });
+  }, &starts);
   std::signal(SIGINT, SIG_DFL);
   if (g_interrupted) return fail(scene_path + ": interrupted; no output written", 130);
   int failed = 0;
+  std::size_t c = 0;  // index of case k among the swept ones
   for (std::size_t k = 0; k < scenes.size(); ++k) {
-    const phiq::SweepSummary& s = sum.cases[k];
+    if (!prepare_errors[k].empty()) {
+      ++failed;
+      std::cerr << "phiq: " << scene_path << ": case " << k << ": " << prepare_errors[k] << "; no output written\n";
+      continue;
+    }
+    const phiq::SweepSummary& s = sum.cases[c++];
     std::string why = !write_errors[k].empty() ? write_errors[k] : s.status != phiq::SolveStatus::kSuccess ? s.message : "";
     if (why.empty()) {
       try {

@@ -15,10 +15,17 @@ BatchSummary run_batch(const std::vector<const Model*>& models, const SweepOptio
 }
 
 BatchSummary run_batch(const std::vector<const Model*>& models, const std::vector<SweepOptions>& options,
-                       int threads, const std::function<bool(std::size_t, const StepView&)>& on_step) {
+                       int threads, const std::function<bool(std::size_t, const StepView&)>& on_step,
+                       const std::vector<Eigen::VectorXd>* starts) {
   if (options.size() != models.size()) throw Error("run_batch: one SweepOptions per model is needed");
   for (const Model* m : models)
     if (!m) throw Error("run_batch: null model");
+  if (starts) {
+    if (starts->size() != models.size()) throw Error("run_batch: one start per model is needed");
+    for (std::size_t c = 0; c < models.size(); ++c)
+      if ((*starts)[c].size() != models[c]->num_coordinates())
+        throw Error("run_batch: start " + std::to_string(c) + " has the wrong size");
+  }
   if (threads < 0) throw Error("run_batch: threads must be >= 0 (0: all cores)");
   BatchSummary out;
   out.cases.resize(models.size());
@@ -29,6 +36,7 @@ BatchSummary run_batch(const std::vector<const Model*>& models, const std::vecto
     // one case per task: cases are whole sweeps, far above any scheduling cost
     tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t c) {
       Workspace ws(*models[c]);
+      if (starts) ws.q = (*starts)[c];
       SweepOptions one = options[c];
       one.threads = 1;  // parallel over cases, not within one
       run_sweep(*models[c], one, ws, on_step ? [&](const StepView& s) { return on_step(c, s); }
