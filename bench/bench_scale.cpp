@@ -16,8 +16,11 @@
 #include <memory>
 #include <vector>
 
+#include <klu.h>
+
 #include "generate.hpp"
 #include "generate_linkages.hpp"
+#include "klu_lu.hpp"
 #include "phiq/phiq.hpp"
 
 namespace {
@@ -91,6 +94,81 @@ void sizes(benchmark::internal::Benchmark* b) {
   for (int64_t n = 100; n <= 1000000; n *= 10) b->Args({n, 0});
   for (int64_t n = 100; n <= 100000; n *= 10) b->Args({n, 1});
 }
+
+// KLU as phiq analyses it (32-bit indices where the factors fit, its blocks in the model's own order: klu_lu.cpp)
+// against KLU as it comes (klu_l_*, 64-bit, the blocks as its depth-first search orders them), on the same Jacobian
+// (the generated model's at its first position),
+// in one loop: one refactorisation and one solve each. Counters: phiq_refactor_ms, klu_refactor_ms, phiq_solve_ms,
+// klu_solve_ms, their ratios (klu ÷ phiq: the speed-up), the peak memory of factorising (KLU's mempeak) of each,
+// and the mean jump between consecutive columns of each order (klu_lu.hpp).
+void klu_at_scale(benchmark::State& state, const char* kind) {
+  phiq::tools::GenerateOptions g;
+  g.kind = kind;
+  g.n = state.range(0);
+  if (auto r = phiq::tools::kind_default_range(kind)) g.from = r->from, g.to = r->to;
+  phiq::Scene scene = phiq::parse_scene(phiq::tools::generate_scene(g), std::string(kind) + ".yaml");
+  const phiq::Model& m = *scene.model;
+  phiq::Workspace ws(m);
+  if (phiq::solve_position(m, scene.sweep.t_begin, scene.sweep.assembly, ws) != phiq::SolveStatus::kSuccess)
+    return state.SkipWithError("no assembly at the first time");
+  const phiq::CscPattern& p = m.jacobian_pattern();
+  std::vector<double> values(static_cast<std::size_t>(p.nnz()));
+  m.jacobian(ws.q.data(), scene.sweep.t_begin, values.data());
+  const SuiteSparse_long n = p.cols;
+  std::vector<SuiteSparse_long> ap(p.col_ptr.begin(), p.col_ptr.end()), ai(p.row_idx.begin(), p.row_idx.end());
+  klu_l_common c;
+  klu_l_defaults(&c);
+  klu_l_symbolic* sym = klu_l_analyze(n, ap.data(), ai.data(), &c);
+  klu_l_numeric* num = sym ? klu_l_factor(ap.data(), ai.data(), values.data(), sym, &c) : nullptr;
+  if (!num) return state.SkipWithError("KLU failed");
+  std::unique_ptr<phiq::SparseLuNumeric> lu = m.symbolic()->make_numeric();
+  lu->factorize(values.data());
+  Eigen::VectorXd b = Eigen::VectorXd::Ones(n), x(n);
+  double phiq_f = 0, klu_f = 0, phiq_s = 0, klu_s = 0;
+  for (auto _ : state) {
+    auto t0 = Clock::now();
+    lu->factorize(values.data());
+    phiq_f += seconds_since(t0);
+    t0 = Clock::now();
+    lu->solve(b.data(), x.data());
+    phiq_s += seconds_since(t0);
+    t0 = Clock::now();
+    klu_l_refactor(ap.data(), ai.data(), values.data(), sym, num, &c);
+    klu_f += seconds_since(t0);
+    x = b;
+    t0 = Clock::now();
+    klu_l_solve(sym, num, n, 1, x.data(), &c);
+    klu_s += seconds_since(t0);
+    benchmark::DoNotOptimize(x.data());
+    state.SetIterationTime(seconds_since(t0));
+  }
+  const double it = static_cast<double>(state.iterations());
+  state.counters["phiq_refactor_ms"] = 1e3 * phiq_f / it;
+  state.counters["klu_refactor_ms"] = 1e3 * klu_f / it;
+  state.counters["phiq_solve_ms"] = 1e3 * phiq_s / it;
+  state.counters["klu_solve_ms"] = 1e3 * klu_s / it;
+  state.counters["refactor_speedup"] = klu_f / phiq_f;
+  state.counters["solve_speedup"] = klu_s / phiq_s;
+  state.counters["phiq_peak_mb"] = static_cast<double>(lu->memory_bytes()) / 1e6;
+  state.counters["klu_peak_mb"] = static_cast<double>(c.mempeak) / 1e6;
+  const phiq::detail::KluAnalysis a = phiq::detail::describe_klu(*m.symbolic());
+  state.counters["index_bits"] = a.index_bits;
+  state.counters["klu_jump"] = a.klu_jump;
+  state.counters["phiq_jump"] = a.jump;
+  state.counters["coordinates"] = static_cast<double>(n);
+  klu_l_free_numeric(&num, &c);
+  klu_l_free_symbolic(&sym, &c);
+}
+void BM_KluAtScaleGrid(benchmark::State& s) { klu_at_scale(s, "grid"); }
+void BM_KluAtScaleNFourBar(benchmark::State& s) { klu_at_scale(s, "nfourbar"); }
+void BM_KluAtScaleScissor(benchmark::State& s) { klu_at_scale(s, "scissor"); }
+void klu_sizes(benchmark::internal::Benchmark* b) {
+  b->ArgName("N");
+  for (int64_t n = 100; n <= 1000000; n *= 10) b->Arg(n);
+}
+BENCHMARK(BM_KluAtScaleGrid)->Apply(klu_sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.5);
+BENCHMARK(BM_KluAtScaleNFourBar)->Apply(klu_sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.5);
+BENCHMARK(BM_KluAtScaleScissor)->Apply(klu_sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.5);
 
 void BM_NFourBarStep(benchmark::State& s) { run(s, "nfourbar"); }
 void BM_ScissorStep(benchmark::State& s) { run(s, "scissor"); }

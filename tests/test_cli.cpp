@@ -431,7 +431,8 @@ TEST_F(Cli, SummaryJsonCountsWhatWasComputed) {
   const std::string j = slurp(sum);
   for (const char* part : {"\"steps\": 11", "\"threads\": 1", "\"velocity_solves\": 0", "\"acceleration_solves\": 0",
                            "\"gamma_evaluations\": 0", "\"phi_t_evaluations\": 0", "\"load_seconds\": ",
-                           "\"solve_seconds\": ", "\"write_seconds\": ", "\"linear_solver\": \"klu\"", "\"warnings\": []"})
+                           "\"solve_seconds\": ", "\"write_seconds\": ", "\"linear_solver\": \"klu\"", "\"warnings\": []",
+                           "\"min_rcond\": null"})
     EXPECT_NE(j.find(part), std::string::npos) << part << "\n" << j;
   // with velocities and accelerations: one of each per row
   ASSERT_EQ(run("generate nfourbar 3 --steps 10 -o " + scene.string()).code, 0);
@@ -439,6 +440,7 @@ TEST_F(Cli, SummaryJsonCountsWhatWasComputed) {
   const std::string j2 = slurp(sum);
   EXPECT_NE(j2.find("\"velocity_solves\": 11"), std::string::npos) << j2;
   EXPECT_NE(j2.find("\"acceleration_solves\": 11"), std::string::npos) << j2;
+  EXPECT_EQ(j2.find("\"min_rcond\": null"), std::string::npos) << "measured at every row's solution\n" << j2;
 }
 
 // --memory: with all cores (--threads 0, the default) and no room for a second thread's workspace, the run goes

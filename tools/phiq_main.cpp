@@ -91,7 +91,12 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
   j["point_evaluations"] = s.counters.point_evaluations;
   j["subdivisions"] = s.subdivisions;
   j["singular_positions"] = s.singular_positions;
-  j["min_rcond"] = s.min_rcond;
+  // 0 in the summary means no row measured it (a positions-only sweep factorises at Newton iterates, not at the
+  // solutions): null, not a condition number of 0, which would read as a singular Jacobian
+  if (s.min_rcond > 0.0)
+    j["min_rcond"] = s.min_rcond;
+  else
+    j["min_rcond"] = nullptr;
   j["warnings"] = nlohmann::ordered_json::array();
   for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});
   try {

@@ -40,7 +40,8 @@ PROG = "plot_accuracy.py"
 COLUMNS = ["scene", "reference", "tolerance", "steps", "predictor", "newton", "linear_solver", "err_q", "err_v",
            "err_a", "iterations_per_step", "factorizations_per_step", "us_per_step", "status", "default"]
 ERRORS = [("err_q", "positions"), ("err_v", "velocities"), ("err_a", "accelerations")]
-SHAPES = {"previous": "o", "secant": "s", "linear": "^", "quadratic": "D", "auto": "*"}
+SHAPES = {"previous": "o", "secant": "s", "parabolic": "p", "linear": "^", "quadratic": "D", "cubic": "v",
+          "auto": "*"}
 ALPHA = {"klu": 0.95, "umfpack": 0.35, "dense": 0.2}
 FLOOR = 1e-17
 

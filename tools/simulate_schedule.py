@@ -4,7 +4,7 @@
 run_sweep (engine/src/sweep.cpp) runs `threads` loops that take, in this order of preference: the next seed when
 fewer chunks are ready than threads; else the lowest ready chunk; else the next seed; else wait. Seeds are found
 one at a time, in order. This script replays that policy with durations measured on this machine by
-`BM_NFourBarParallelSweep` (bench/results/engine_schedule.json):
+`BM_NFourBarParallelSweep` (bench/results/engine.json):
 
 - a chunk takes (1-thread sweep time / steps) · (its steps + 1 + start) — its steps (`chunk`, fewer in the last),
   its seam step (not the last) and the start from its seed (not chunk 0), which costs about `start` steps more (a
@@ -14,7 +14,7 @@ one at a time, in order. This script replays that policy with durations measured
 It assumes that the memory system keeps up with every core (measured here: two independent sweeps run 1.6–2.0×
 as fast as one, `pair_throughput`), so it is a bound on what the schedule loses, not a prediction of a machine.
 
-    tools/simulate_schedule.py bench/results/engine_schedule.json [--steps 1000] [--chunk 64] [--start 1]
+    tools/simulate_schedule.py bench/results/engine.json [--steps 1000] [--chunk 64] [--start 1]
 """
 import argparse
 import heapq
