@@ -578,7 +578,7 @@ TEST(SceneSolver, PredictorIsASettingThatNeedsItsDerivativesInTheOutput) {
   for (const auto& [text, message] :
        {std::pair<std::string, std::string>{"solver: {predictor: quartic}\n",
                                             "s.yaml:4:21: solver.predictor: predictor is auto, previous, secant, "
-                                            "parabolic, linear, quadratic or cubic"},
+                                            "parabolic, linear, hermite, quadratic or cubic"},
         {"solver: {predictor: cubic}\noutput: {accelerations: false}\n",
          "s.yaml: solver.predictor: 'cubic' needs the derivatives it extrapolates with in the output (velocities / "
          "accelerations)"}}) {

@@ -92,7 +92,7 @@ TEST(Sweep, FailedStepsAreSubdividedAndTheSweepContinues) {
 TEST(Sweep, PredictorsReachTheSameSolutions) {
   Model m = crank_slider();
   for (Predictor p : {Predictor::kPrevious, Predictor::kSecant, Predictor::kParabolic, Predictor::kLinear,
-                      Predictor::kQuadratic, Predictor::kCubic}) {
+                      Predictor::kHermite, Predictor::kQuadratic, Predictor::kCubic}) {
     SweepOptions opt;
     opt.t_begin = 0.5;  // not 0: the secant's first extrapolation once read an empty state here (fuzzer)
     opt.t_end = 2 * M_PI;
@@ -108,18 +108,19 @@ TEST(Sweep, PredictorsReachTheSameSolutions) {
 }
 
 // Each order of extrapolation saves Newton iterations, with positions only (the parabola against the previous
-// position and the secant) and with q̇, q̈ (linear → quadratic → cubic), and the solutions stay within the tolerance
-// of the closed form. On finer steps the cubic predictor errs by about 1e-11 m per step, so that most steps are
+// position and the secant), with q̇ only (linear → hermite) and with q̇, q̈ (linear → quadratic → cubic), and the
+// solutions stay within the tolerance of the closed form. On finer steps the cubic predictor errs by about 1e-11 m per step, so that most steps are
 // accepted without a Newton step (predict()'s error budget brings one when the carried errors add up to the
 // tolerance).
 TEST(Sweep, BetterPredictorsNeedFewerNewtonIterations) {
   Model m = crank_slider();
-  auto iterations = [&](Predictor p, bool derivatives, Index steps) {
+  auto iterations = [&](Predictor p, bool derivatives, Index steps, bool accelerations = true) {
     SweepOptions opt;
     opt.t_end = 2 * M_PI;
     opt.steps = steps;
     opt.predictor = p;
-    opt.velocities = opt.accelerations = derivatives;
+    opt.velocities = derivatives;
+    opt.accelerations = derivatives && accelerations;
     test::Trace tr;
     SweepSummary sum;
     EXPECT_EQ(test::sweep(m, opt, &tr, &sum), SolveStatus::kSuccess);
@@ -138,17 +139,67 @@ TEST(Sweep, BetterPredictorsNeedFewerNewtonIterations) {
               fine_cubic = iterations(Predictor::kCubic, true, 2880);
   EXPECT_LT(fine_cubic, 2880 / 2);  // most steps without a Newton step
   EXPECT_LT(fine_cubic, fine_quadratic / 2);
+  // velocities only: the cubic tangent to q̇ against q + h q̇ (O(h⁴) against O(h²))
+  const Index linear_v = iterations(Predictor::kLinear, true, 720, false),
+              hermite = iterations(Predictor::kHermite, true, 720, false),
+              fine_hermite = iterations(Predictor::kHermite, true, 2880, false);
+  EXPECT_LT(hermite, linear_v * 11 / 20);  // about half: like the cubic predictor at this step
+  EXPECT_LT(hermite, cubic * 21 / 20);
+  EXPECT_LT(hermite, parabolic / 2);  // q̇ makes the positions' extrapolation one order better
+  // On fine steps about every other step needs no Newton step (the cubic: nearly all): the hermite prediction
+  // weighs the errors of three rows, by |−3/2| + 3 + |−1/2| = 5 at equal steps, where the cubic's carries its
+  // current row's only, so the carried errors reach the tolerance sooner.
+  EXPECT_LT(fine_hermite, 2880 * 3 / 5);
   std::printf("Newton iterations over 720 steps: previous %ld, secant %ld, parabolic %ld; linear %ld, quadratic %ld, "
-              "cubic %ld; over 2880 steps: quadratic %ld, cubic %ld\n", static_cast<long>(previous),
-              static_cast<long>(secant), static_cast<long>(parabolic), static_cast<long>(linear),
-              static_cast<long>(quadratic), static_cast<long>(cubic), static_cast<long>(fine_quadratic),
-              static_cast<long>(fine_cubic));
+              "cubic %ld; q̇ only: linear %ld, hermite %ld; over 2880 steps: quadratic %ld, cubic %ld, hermite %ld\n",
+              static_cast<long>(previous), static_cast<long>(secant), static_cast<long>(parabolic),
+              static_cast<long>(linear), static_cast<long>(quadratic), static_cast<long>(cubic),
+              static_cast<long>(linear_v), static_cast<long>(hermite), static_cast<long>(fine_quadratic),
+              static_cast<long>(fine_cubic), static_cast<long>(fine_hermite));
+}
+
+// The hermite predictor is the cubic through the current row (position and velocity) and the two rows before: a
+// coordinate driven by a cubic law is predicted exactly once three rows are known, and its error estimate (the next, quartic term) is then zero, so those steps take no Newton iteration; a quartic law is
+// not (the estimate sees the quartic term).
+TEST(Sweep, HermitePredictorIsExactForCubicMotion) {
+  auto sweep = [](std::vector<double> coefficients) {
+    ModelBuilder b;
+    const Index x = b.add_coordinate("x", coefficients[0]);
+    b.add_driver("law", x, MotionLaw::polynomial(coefficients));
+    Model m = std::move(b).build();
+    SweepOptions opt;
+    opt.t_end = 2.0;
+    opt.steps = 13;
+    opt.velocities = true;
+    opt.accelerations = false;
+    opt.predictor = Predictor::kHermite;
+    opt.newton.jacobian_update = JacobianUpdate::kEveryIteration;
+    std::vector<Index> per_row;
+    Workspace ws(m);
+    SweepSummary sum;
+    Index before = 0;
+    run_sweep(m, opt, ws, [&](const StepView&) {
+      per_row.push_back(ws.counters.newton_iterations - before);
+      before = ws.counters.newton_iterations;
+      return true;
+    }, &sum);
+    EXPECT_EQ(sum.status, SolveStatus::kSuccess) << sum.message;
+    return per_row;
+  };
+  const std::vector<Index> cubic = sweep({0.3, -1.0, 0.5, 0.25});
+  ASSERT_EQ(cubic.size(), 14u);
+  // rows 0 … 3: the assembly, then too few rows for the cubic and its estimate; from row 4 on, none
+  for (std::size_t k = 4; k < cubic.size(); ++k) EXPECT_EQ(cubic[k], 0) << "row " << k;
+  const std::vector<Index> quartic = sweep({0.3, -1.0, 0.5, 0.25, 2.0});
+  Index quartic_steps = 0;
+  for (std::size_t k = 4; k < quartic.size(); ++k) quartic_steps += quartic[k];
+  EXPECT_GE(quartic_steps, 5) << "the quartic term is 2 h⁴-sized: seen by the estimate";
 }
 
 // The predictors' names, and what auto resolves to for what a sweep computes.
 TEST(Sweep, PredictorNamesAndTheAutomaticChoice) {
   for (Predictor p : {Predictor::kAuto, Predictor::kPrevious, Predictor::kSecant, Predictor::kParabolic,
-                      Predictor::kLinear, Predictor::kQuadratic, Predictor::kCubic}) {
+                      Predictor::kLinear, Predictor::kHermite, Predictor::kQuadratic, Predictor::kCubic}) {
     Predictor back = Predictor::kPrevious;
     EXPECT_TRUE(predictor_from_string(to_string(p), &back));
     EXPECT_EQ(back, p);
@@ -157,12 +208,14 @@ TEST(Sweep, PredictorNamesAndTheAutomaticChoice) {
   EXPECT_FALSE(predictor_from_string("quartic", &unchanged));
   EXPECT_EQ(unchanged, Predictor::kSecant);
   EXPECT_EQ(effective_predictor(Predictor::kAuto, true, true), Predictor::kCubic);
-  EXPECT_EQ(effective_predictor(Predictor::kAuto, true, false), Predictor::kLinear);
+  EXPECT_EQ(effective_predictor(Predictor::kAuto, true, false), Predictor::kHermite);
   EXPECT_EQ(effective_predictor(Predictor::kAuto, false, false), Predictor::kParabolic);
   EXPECT_EQ(effective_predictor(Predictor::kSecant, true, true), Predictor::kSecant);
   EXPECT_TRUE(predictor_needs_accelerations(Predictor::kCubic));
   EXPECT_TRUE(predictor_needs_velocities(Predictor::kCubic));
   EXPECT_FALSE(predictor_needs_velocities(Predictor::kParabolic));
+  EXPECT_TRUE(predictor_needs_velocities(Predictor::kHermite));
+  EXPECT_FALSE(predictor_needs_accelerations(Predictor::kHermite));
   // a sweep refuses a predictor whose derivatives it does not compute
   Model m = crank_slider();
   SweepOptions opt;

@@ -263,7 +263,7 @@ TEST(SweepAccuracyApi, DefaultGridSkipsPredictorsTheSceneCannotFeed) {
     EXPECT_TRUE(std::isnan(row.err_v) && std::isnan(row.err_a));
     EXPECT_LT(row.err_q, row.setting.tolerance == 1e-12 ? 1e-10 : 1e-4);
   }
-  EXPECT_EQ(rep.notes.size(), 3u);
+  EXPECT_EQ(rep.notes.size(), 4u);  // linear, hermite, quadratic and cubic skipped, each with a note
   EXPECT_EQ(rep.scene_default.predictor, Predictor::kParabolic);  // auto without derivatives
 }
 

@@ -277,8 +277,8 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
   }
   std::vector<Predictor> preds = opt.predictors;
   if (preds.empty())
-    preds = {Predictor::kPrevious, Predictor::kSecant, Predictor::kParabolic, Predictor::kLinear, Predictor::kQuadratic,
-             Predictor::kCubic};
+    preds = {Predictor::kPrevious, Predictor::kSecant, Predictor::kParabolic, Predictor::kLinear, Predictor::kHermite,
+             Predictor::kQuadratic, Predictor::kCubic};
   std::vector<JacobianUpdate> newtons = opt.newton;
   if (newtons.empty()) newtons = {JacobianUpdate::kWhenSlow, JacobianUpdate::kEveryIteration};
   std::vector<LinearSolverKind> lus = opt.linear_solvers;

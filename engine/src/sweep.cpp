@@ -35,26 +35,27 @@ const char* to_string(Predictor p) {
     case Predictor::kQuadratic: return "quadratic";
     case Predictor::kCubic: return "cubic";
     case Predictor::kParabolic: return "parabolic";
+    case Predictor::kHermite: return "hermite";
   }
   return "?";
 }
 
 bool predictor_from_string(const std::string& name, Predictor* p) {
   for (Predictor k : {Predictor::kAuto, Predictor::kPrevious, Predictor::kSecant, Predictor::kLinear,
-                      Predictor::kQuadratic, Predictor::kCubic, Predictor::kParabolic})
+                      Predictor::kQuadratic, Predictor::kCubic, Predictor::kParabolic, Predictor::kHermite})
     if (name == to_string(k)) return *p = k, true;
   return false;
 }
 
-const char* predictor_names() { return "auto, previous, secant, parabolic, linear, quadratic or cubic"; }
+const char* predictor_names() { return "auto, previous, secant, parabolic, linear, hermite, quadratic or cubic"; }
 
 Predictor effective_predictor(Predictor p, bool velocities, bool accelerations) {
   if (p != Predictor::kAuto) return p;
-  return accelerations ? Predictor::kCubic : velocities ? Predictor::kLinear : Predictor::kParabolic;
+  return accelerations ? Predictor::kCubic : velocities ? Predictor::kHermite : Predictor::kParabolic;
 }
 
 bool predictor_needs_velocities(Predictor p) {
-  return p == Predictor::kLinear || predictor_needs_accelerations(p);
+  return p == Predictor::kLinear || p == Predictor::kHermite || predictor_needs_accelerations(p);
 }
 
 bool predictor_needs_accelerations(Predictor p) { return p == Predictor::kQuadratic || p == Predictor::kCubic; }
@@ -87,12 +88,13 @@ class Sweeper {
       throw Error(std::string("the ") + to_string(predictor_) +
                   " predictor needs accelerations (SweepOptions::accelerations)");
     if (predictor_needs_velocities(predictor_) && !need_v_)
-      throw Error("the linear predictor needs velocities (SweepOptions::velocities)");
+      throw Error(std::string("the ") + to_string(predictor_) + " predictor needs velocities (SweepOptions::velocities)");
     // The rows before the current one that the predictor extrapolates from, and one more for its error estimate.
     switch (predictor_) {
       case Predictor::kPrevious: depth_ = 1; break;
       case Predictor::kSecant: depth_ = 2; break;
       case Predictor::kParabolic: depth_ = 3; break;
+      case Predictor::kHermite: depth_ = 3; break;
       case Predictor::kLinear: depth_ = 1; break;
       case Predictor::kQuadratic: depth_ = 1; break;
       case Predictor::kCubic: depth_ = 2; break;
@@ -557,6 +559,61 @@ class Sweeper {
           return p;
         });
         extrapolated_ = order > 0;
+        break;
+      }
+      case Predictor::kHermite: {
+        // Hermite divided differences over the nodes tc, tc, t_0, t_1, t_2 (f[tc] = q, f[tc, tc] = q̇): the cubic
+        // through the current row (position and velocity) and the two rows before, and its next term as the error
+        const double* v = current_.qd.data();
+        const int order = std::min(3, k + 1);  // Newton terms after q: (t − tc) q̇, then one per row of history
+        estimated = k > 2;
+        const int terms = order + (estimated ? 1 : 0);
+        const double T[4] = {tc, k > 0 ? th(0) : tc, k > 1 ? th(1) : tc, k > 2 ? th(2) : tc};
+        const double w1 = h, w2 = w1 * h, w3 = w2 * (t1 - T[1]), w4 = w3 * (t1 - T[2]);
+        const double* xs[3] = {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q};
+        // reciprocals of the node spacings the differences divide by (only those of known rows are used)
+        auto inv = [](double d) { return d != 0.0 ? 1.0 / d : 0.0; };
+        const double i01 = inv(T[0] - T[1]), i12 = inv(T[1] - T[2]), i23 = inv(T[2] - T[3]);
+        const double i02 = inv(T[0] - T[2]), i13 = inv(T[1] - T[3]), i03 = inv(T[0] - T[3]);
+        // Each term as a function of the positions q, q_0, q_1, q_2 (and q̇), so that the rows' own errors carry
+        // over with the weights the prediction gives them: found by evaluating it on unit values.
+        auto eval = [&](const double* f, double fd, double* next) {
+          double p = f[0] + w1 * fd, nx = 0.0;
+          if (terms >= 2) {
+            const double a1 = (f[0] - f[1]) * i01;  // f[tc, t_0]
+            const double b0 = (fd - a1) * i01;      // f[tc, tc, t_0]
+            double add = w2 * b0;
+            if (terms >= 3) {
+              const double a2 = (f[1] - f[2]) * i12;  // f[t_0, t_1]
+              const double b1 = (a1 - a2) * i02;      // f[tc, t_0, t_1]
+              const double c0 = (b0 - b1) * i02;      // f[tc, tc, t_0, t_1]
+              p += add, add = w3 * c0;
+              if (terms >= 4) {
+                const double a3 = (f[2] - f[3]) * i23;  // f[t_1, t_2]
+                const double b2 = (a2 - a3) * i13;      // f[t_0, t_1, t_2]
+                const double c1 = (b1 - b2) * i03;      // f[tc, t_0, t_1, t_2]
+                const double d0 = (c0 - c1) * i03;      // f[tc, tc, t_0, t_1, t_2]
+                p += add, add = w4 * d0;
+              }
+            }
+            if (estimated) nx = add;
+            else p += add;  // the highest term is the prediction's own, with no estimate beyond it
+          }
+          if (next) *next = nx;
+          return p;
+        };
+        inherited = 0.0;
+        for (int i = 0; i <= std::min(k, 2); ++i) {
+          double unit[4] = {0.0, 0.0, 0.0, 0.0};
+          unit[i] = 1.0;
+          inherited += std::fabs(eval(unit, 0.0, nullptr)) *
+                       (i == 0 ? current_error_ : history_error_[static_cast<std::size_t>(i - 1)]);
+        }
+        each([&](Index j, double& e) {
+          const double f[4] = {q[j], xs[0][j], xs[1][j], xs[2][j]};
+          return eval(f, v[j], &e);
+        });
+        extrapolated_ = true;
         break;
       }
       case Predictor::kLinear: {

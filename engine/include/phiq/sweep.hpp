@@ -15,10 +15,10 @@ namespace phiq {
 
 /// How successive positions are started: an extrapolation of the solutions already found, of the order the
 /// computed quantities allow. Its error is what Newton has to correct: O(h) from the previous position, O(h²)
-/// (secant, linear), O(h³) (parabolic, quadratic), O(h⁴) (cubic), so that a better predictor needs fewer Newton
+/// (secant, linear), O(h³) (parabolic, quadratic), O(h⁴) (cubic, hermite), so that a better predictor needs fewer Newton
 /// iterations per step, down to none once its error is within the tolerance (bench/README.md).
 enum class Predictor {
-  /// The best the computed quantities allow: cubic with q̇ and q̈, linear with q̇ only, parabolic with positions
+  /// The best the computed quantities allow: cubic with q̇ and q̈, hermite with q̇ only, parabolic with positions
   /// only.
   kAuto,
   kPrevious,   ///< the previous solution, as in the notes
@@ -31,8 +31,12 @@ enum class Predictor {
   /// The parabola through the last three solutions, evaluated at the new time (free: needs no velocity; any
   /// spacing of the three times, sub-steps included). The secant until three rows are known.
   kParabolic,
+  /// The cubic through the last three solutions and tangent to the current row's q̇ (Hermite interpolation:
+  /// q and q̇ at the current row, q at the two before), evaluated at the new time (needs velocities, not
+  /// accelerations; free: the previous positions are kept). Secant, then parabola, until three rows are known.
+  kHermite,
 };
-/// "auto", "previous", "secant", "linear", "quadratic", "cubic" or "parabolic".
+/// "auto", "previous", "secant", "linear", "quadratic", "cubic", "parabolic" or "hermite".
 const char* to_string(Predictor p);
 /// The predictor named `name` (to_string()'s words); false, leaving `*p` unchanged, for any other text.
 bool predictor_from_string(const std::string& name, Predictor* p);
