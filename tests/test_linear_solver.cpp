@@ -167,6 +167,62 @@ GeneratedJacobian generated_jacobian(const char* kind, std::int64_t n) {
   return j;
 }
 
+// KLU refactorisations work on the unscaled matrix with the pivot order chosen on the row-scaled one (klu_lu.cpp):
+// on a badly scaled matrix (rows multiplied by 10⁻⁶ … 10⁶, as a model mixing micrometres and kilometres would
+// give) the refactorised factors solve as accurately as the pivoting factorisation's, transposed too, with the
+// same determinant sign, and the reciprocal pivot ratio is still that of the scaled rows: the same as for the
+// unscaled matrix, whichever factorisation made it. Values that move (a sweep) are refactorised without a new
+// pivot search.
+TEST(LinearSolver, KluRefactorisationIsAsAccurateOnBadlyScaledRows) {
+  const GeneratedJacobian j = generated_jacobian("grid", 100);
+  const Index n = j.pattern->cols;
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n, -1, 2);
+  Eigen::VectorXd row_scale(n);
+  for (Index i = 0; i < n; ++i) row_scale(i) = std::pow(10.0, static_cast<double>((i * 7) % 13) - 6.0);
+  auto scaled = [&](const std::vector<double>& v) {
+    std::vector<double> out(v);
+    for (Index c = 0; c < n; ++c)
+      for (Index k = j.pattern->col_ptr[c]; k < j.pattern->col_ptr[c + 1]; ++k)
+        out[static_cast<std::size_t>(k)] *= row_scale(j.pattern->row_idx[k]);
+    return out;
+  };
+  auto dense_of = [&](const std::vector<double>& v) {
+    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(n, n);
+    for (Index c = 0; c < n; ++c)
+      for (Index k = j.pattern->col_ptr[c]; k < j.pattern->col_ptr[c + 1]; ++k)
+        d(j.pattern->row_idx[k], c) = v[static_cast<std::size_t>(k)];
+    return d;
+  };
+  // the matrix a sweep meets a few steps on: every value moved by up to 1e-3 of itself
+  std::vector<double> moved(j.values);
+  for (std::size_t k = 0; k < moved.size(); ++k) moved[k] *= 1.0 + 1e-3 * std::sin(0.37 * static_cast<double>(k));
+  for (const std::vector<double>& base : {j.values, moved}) {
+    auto plain_lu = analyse(LinearSolverKind::kKlu, j.pattern)->make_numeric();
+    ASSERT_EQ(plain_lu->factorize(base.data()), FactorStatus::kOk);
+    const double rcond_unscaled = plain_lu->rcond();
+    const int sign = plain_lu->determinant_sign();
+    const std::vector<double> values = scaled(base);
+    const Eigen::MatrixXd a = dense_of(values);
+    const Eigen::VectorXd b = row_scale.asDiagonal() * rhs;
+    const Eigen::VectorXd x_ref = a.partialPivLu().solve(b), y_ref = a.transpose().partialPivLu().solve(rhs);
+    auto lu = analyse(LinearSolverKind::kKlu, j.pattern)->make_numeric();
+    ASSERT_EQ(lu->factorize(values.data()), FactorStatus::kOk);  // pivots chosen on the scaled rows
+    EXPECT_NEAR(lu->rcond(), rcond_unscaled, 1e-12 * rcond_unscaled);
+    for (int refactorisation = 0; refactorisation < 2; ++refactorisation) {
+      Eigen::VectorXd x(n), y(n);
+      ASSERT_TRUE(lu->solve(b.data(), x.data()));
+      ASSERT_TRUE(lu->solve_transposed(rhs.data(), y.data()));
+      EXPECT_LT((x - x_ref).cwiseAbs().maxCoeff(), 1e-11 * x_ref.cwiseAbs().maxCoeff()) << refactorisation;
+      EXPECT_LT((y - y_ref).cwiseAbs().maxCoeff(), 1e-11 * y_ref.cwiseAbs().maxCoeff()) << refactorisation;
+      EXPECT_EQ(lu->determinant_sign(), sign);
+      const double before = lu->rcond();
+      ASSERT_EQ(lu->factorize(values.data()), FactorStatus::kOk);  // the same values again: a refactorisation
+      EXPECT_NEAR(lu->rcond(), before, 1e-12 * before) << "measured on the scaled rows either way";
+    }
+    EXPECT_EQ(lu->pivoting_factorizations(), 1) << "refactorised, not pivoted again";
+  }
+}
+
 // KLU's blocks put in the lattice's own order (klu_lu.cpp: resequence_blocks), with either index width: the same
 // solutions, transposed solutions and determinant sign as the dense LU. A 20 x 20 lattice of parallelograms
 // (phiq generate grid) is block triangular with two-coordinate blocks, which KLU's depth-first search leaves

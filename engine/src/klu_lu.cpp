@@ -227,7 +227,7 @@ class KluNumeric final : public SparseLuNumeric {
 
  private:
   FactorStatus factor_with_pivoting(const double* values);
-  double scan_diagonal();  // KLU's rcond of the factors, and u_sign_
+  double scan_diagonal();  // KLU's rcond of the factors (of the row-scaled matrix), and u_sign_
   bool solve_system(bool transposed, const double* b, double* x);
   std::shared_ptr<const KluSymbolic<Int>> keep_;
   const KluSymbolic<Int>& sym_;
@@ -238,6 +238,10 @@ class KluNumeric final : public SparseLuNumeric {
   std::string message_;
   int p_sign_ = 1;  // parity of the row permutation Pnum of the last pivoting factorisation
   int u_sign_ = 1;  // sign of the product of U's diagonal (0: a zero pivot)
+  // The row scale factors of the last pivoting factorisation, in pivot order (KLU's Rs, the largest |entry| of
+  // each row); empty while the factors are of the scaled matrix (right after pivoting), used by scan_diagonal()
+  // once refactorisations work on the unscaled one.
+  std::vector<double> row_scale_;
 };
 
 // The interface of both widths' analyses that describe_klu reads.
@@ -304,10 +308,11 @@ template <class Int>
 double KluNumeric<Int>::scan_diagonal() {
   const Index n = sym_.pattern_->cols;
   const double* u = static_cast<const double*>(numeric_->Udiag);
+  const double* rs = row_scale_.empty() ? nullptr : row_scale_.data();
   double lo = INFINITY, hi = 0.0;
   int negative = 0;
   for (Index i = 0; i < n; ++i) {
-    const double a = std::fabs(u[i]);
+    const double a = rs ? std::fabs(u[i]) / rs[i] : std::fabs(u[i]);
     lo = a < lo ? a : lo;
     hi = a > hi ? a : hi;
     negative ^= u[i] < 0.0;
@@ -322,6 +327,8 @@ template <class Int>
 FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
   if (numeric_) Api::free_numeric(&numeric_, &common_);
   ++pivoting_;
+  row_scale_.clear();
+  common_.scale = 2;  // pivots chosen on rows scaled by their largest entries (KLU's default)
   numeric_ = Api::factor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, &common_);
   if (!numeric_) {
     rcond_ = 0.0;
@@ -342,10 +349,22 @@ FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
   return FactorStatus::kOk;
 }
 
+// A refactorisation keeps the pivot order and works on the unscaled matrix (KLU's scale −1: no pass over the
+// values for their row maxima, no division of each entry, no scaling of each right-hand side). Row scaling only
+// matters for choosing pivots: with the order fixed, elimination on D⁻¹A and on A differ by the diagonal D alone
+// (P A Q = (D L D⁻¹)(D U), D > 0), so the factors are equally accurate. The reciprocal pivot ratio is still measured
+// on the scaled rows, with the scale factors of the pivoting factorisation (the values move little between the
+// two), so that its thresholds and the degradation test keep their meaning on badly scaled models.
 template <class Int>
 FactorStatus KluNumeric<Int>::factorize(const double* values) {
   if (numeric_) {
-    const bool ok = Api::refactor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, numeric_, &common_) &&
+    if (row_scale_.empty() && numeric_->Rs) {  // first refactorisation after a pivot search: keep KLU's scales
+      const double* rs = static_cast<const double*>(numeric_->Rs);
+      row_scale_.assign(rs, rs + sym_.pattern_->cols);
+    }
+    common_.scale = -1;  // KLU frees its Rs: the factors and the solves are of the unscaled matrix
+    const bool ok = !row_scale_.empty() &&
+                    Api::refactor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, numeric_, &common_) &&
                     common_.status == KLU_OK;
     if (ok) {
       const double rc = scan_diagonal();
