@@ -238,10 +238,10 @@ class KluNumeric final : public SparseLuNumeric {
   std::string message_;
   int p_sign_ = 1;  // parity of the row permutation Pnum of the last pivoting factorisation
   int u_sign_ = 1;  // sign of the product of U's diagonal (0: a zero pivot)
-  // The row scale factors of the last pivoting factorisation, in pivot order (KLU's Rs, the largest |entry| of
-  // each row); empty while the factors are of the scaled matrix (right after pivoting), used by scan_diagonal()
-  // once refactorisations work on the unscaled one.
-  std::vector<double> row_scale_;
+  // The reciprocals of the row scale factors of the last pivoting factorisation, in pivot order (KLU's Rs, the
+  // largest |entry| of each row); empty while the factors are of the scaled matrix (right after pivoting), used
+  // by scan_diagonal() once refactorisations work on the unscaled one.
+  std::vector<double> inverse_row_scale_;
 };
 
 // The interface of both widths' analyses that describe_klu reads.
@@ -308,11 +308,11 @@ template <class Int>
 double KluNumeric<Int>::scan_diagonal() {
   const Index n = sym_.pattern_->cols;
   const double* u = static_cast<const double*>(numeric_->Udiag);
-  const double* rs = row_scale_.empty() ? nullptr : row_scale_.data();
+  const double* rs = inverse_row_scale_.empty() ? nullptr : inverse_row_scale_.data();
   double lo = INFINITY, hi = 0.0;
   int negative = 0;
   for (Index i = 0; i < n; ++i) {
-    const double a = rs ? std::fabs(u[i]) / rs[i] : std::fabs(u[i]);
+    const double a = rs ? std::fabs(u[i]) * rs[i] : std::fabs(u[i]);
     lo = a < lo ? a : lo;
     hi = a > hi ? a : hi;
     negative ^= u[i] < 0.0;
@@ -327,7 +327,7 @@ template <class Int>
 FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
   if (numeric_) Api::free_numeric(&numeric_, &common_);
   ++pivoting_;
-  row_scale_.clear();
+  inverse_row_scale_.clear();
   common_.scale = 2;  // pivots chosen on rows scaled by their largest entries (KLU's default)
   numeric_ = Api::factor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, &common_);
   if (!numeric_) {
@@ -358,12 +358,13 @@ FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
 template <class Int>
 FactorStatus KluNumeric<Int>::factorize(const double* values) {
   if (numeric_) {
-    if (row_scale_.empty() && numeric_->Rs) {  // first refactorisation after a pivot search: keep KLU's scales
-      const double* rs = static_cast<const double*>(numeric_->Rs);
-      row_scale_.assign(rs, rs + sym_.pattern_->cols);
+    if (inverse_row_scale_.empty() && numeric_->Rs) {  // first refactorisation after a pivot search: keep KLU's
+      const double* rs = static_cast<const double*>(numeric_->Rs);  // scales (> 0: an empty row has scale 1)
+      inverse_row_scale_.resize(static_cast<std::size_t>(sym_.pattern_->cols));
+      for (std::size_t i = 0; i < inverse_row_scale_.size(); ++i) inverse_row_scale_[i] = 1.0 / rs[i];
     }
     common_.scale = -1;  // KLU frees its Rs: the factors and the solves are of the unscaled matrix
-    const bool ok = !row_scale_.empty() &&
+    const bool ok = !inverse_row_scale_.empty() &&
                     Api::refactor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, numeric_, &common_) &&
                     common_.status == KLU_OK;
     if (ok) {
