@@ -172,7 +172,7 @@ GeneratedJacobian generated_jacobian(const char* kind, std::int64_t n) {
 // give) the refactorised factors solve as accurately as the pivoting factorisation's, transposed too, with the
 // same determinant sign, and the reciprocal pivot ratio is still that of the scaled rows: the same as for the
 // unscaled matrix, whichever factorisation made it. Values that move (a sweep) are refactorised without a new
-// pivot search.
+// pivot search. Either index width.
 TEST(LinearSolver, KluRefactorisationIsAsAccurateOnBadlyScaledRows) {
   const GeneratedJacobian j = generated_jacobian("grid", 100);
   const Index n = j.pattern->cols;
@@ -205,21 +205,23 @@ TEST(LinearSolver, KluRefactorisationIsAsAccurateOnBadlyScaledRows) {
     const Eigen::MatrixXd a = dense_of(values);
     const Eigen::VectorXd b = row_scale.asDiagonal() * rhs;
     const Eigen::VectorXd x_ref = a.partialPivLu().solve(b), y_ref = a.transpose().partialPivLu().solve(rhs);
-    auto lu = analyse(LinearSolverKind::kKlu, j.pattern)->make_numeric();
-    ASSERT_EQ(lu->factorize(values.data()), FactorStatus::kOk);  // pivots chosen on the scaled rows
-    EXPECT_NEAR(lu->rcond(), rcond_unscaled, 1e-12 * rcond_unscaled);
-    for (int refactorisation = 0; refactorisation < 2; ++refactorisation) {
-      Eigen::VectorXd x(n), y(n);
-      ASSERT_TRUE(lu->solve(b.data(), x.data()));
-      ASSERT_TRUE(lu->solve_transposed(rhs.data(), y.data()));
-      EXPECT_LT((x - x_ref).cwiseAbs().maxCoeff(), 1e-11 * x_ref.cwiseAbs().maxCoeff()) << refactorisation;
-      EXPECT_LT((y - y_ref).cwiseAbs().maxCoeff(), 1e-11 * y_ref.cwiseAbs().maxCoeff()) << refactorisation;
-      EXPECT_EQ(lu->determinant_sign(), sign);
-      const double before = lu->rcond();
-      ASSERT_EQ(lu->factorize(values.data()), FactorStatus::kOk);  // the same values again: a refactorisation
-      EXPECT_NEAR(lu->rcond(), before, 1e-12 * before) << "measured on the scaled rows either way";
+    for (auto [width, bits] : {std::pair{detail::KluIndexWidth::k32, 32}, std::pair{detail::KluIndexWidth::k64, 64}}) {
+      auto lu = detail::analyse_klu(j.pattern, width)->make_numeric();
+      ASSERT_EQ(lu->factorize(values.data()), FactorStatus::kOk);  // pivots chosen on the scaled rows
+      EXPECT_NEAR(lu->rcond(), rcond_unscaled, 1e-12 * rcond_unscaled) << bits;
+      for (int refactorisation = 0; refactorisation < 2; ++refactorisation) {
+        Eigen::VectorXd x(n), y(n);
+        ASSERT_TRUE(lu->solve(b.data(), x.data()));
+        ASSERT_TRUE(lu->solve_transposed(rhs.data(), y.data()));
+        EXPECT_LT((x - x_ref).cwiseAbs().maxCoeff(), 1e-11 * x_ref.cwiseAbs().maxCoeff()) << bits << refactorisation;
+        EXPECT_LT((y - y_ref).cwiseAbs().maxCoeff(), 1e-11 * y_ref.cwiseAbs().maxCoeff()) << bits << refactorisation;
+        EXPECT_EQ(lu->determinant_sign(), sign) << bits;
+        const double before = lu->rcond();
+        ASSERT_EQ(lu->factorize(values.data()), FactorStatus::kOk);  // the same values again: a refactorisation
+        EXPECT_NEAR(lu->rcond(), before, 1e-12 * before) << bits << ": measured on the scaled rows either way";
+      }
+      EXPECT_EQ(lu->pivoting_factorizations(), 1) << bits << ": refactorised, not pivoted again";
     }
-    EXPECT_EQ(lu->pivoting_factorizations(), 1) << "refactorised, not pivoted again";
   }
 }
 
