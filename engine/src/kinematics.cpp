@@ -180,6 +180,15 @@ std::string not_square_message(const Model& model) {
   return s + "; the driven system must be square (assemble() and analyse_rank() handle other models)";
 }
 
+// The workspace's factors, or its Jacobian values, are Φq at exactly (ws.q, t) (the points they recorded).
+bool factors_at_q(const Workspace& ws, double t) {
+  return ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
+         ws.factorized_q == ws.q;
+}
+bool jacobian_values_at_q(const Workspace& ws, double t) {
+  return ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q.size() == ws.q.size() && ws.jacobian_q == ws.q;
+}
+
 // Factorises Φq at (ws.q, t) from ws.jacobian_values (evaluating them first unless `values_at_q`), and records
 // that the factors are at time t (ws.factorized_q is the caller's to record).
 SolveStatus factorize_at_q(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
@@ -220,15 +229,13 @@ SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, doubl
     *message = not_square_message(model);
     return SolveStatus::kNotSquare;
   }
-  if (ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
-      ws.factorized_q == ws.q) {
+  if (factors_at_q(ws, t)) {
     *rcond = ws.lu->rcond();
     return SolveStatus::kSuccess;
   }
   // Φq may have been evaluated with Φ at this very point by the Newton loop (NewtonOptions::jacobian_with_residual):
   // known to the loop itself, or left by the last solve_position for the velocity solve that follows it
-  values_at_q = values_at_q || (ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q.size() == ws.q.size() &&
-                                 ws.jacobian_q == ws.q);
+  values_at_q = values_at_q || jacobian_values_at_q(ws, t);
   const SolveStatus st = factorize_at_q(model, t, ws, rcond, message, values_at_q);
   if (st == SolveStatus::kSuccess) ws.factorized_q = ws.q;
   return st;
@@ -386,8 +393,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       // Φq at this iterate, unless the factors are there already. Its point is not copied per iteration: the loop
       // counts how far it has moved since (drift), and records it once, at the end, if that is the solution.
       SolveStatus st = SolveStatus::kSuccess;
-      if (!(ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
-            ws.factorized_q == ws.q)) {
+      if (!factors_at_q(ws, t)) {
         st = factorize_at_q(model, t, ws, &sum.rcond, &msg, jacobian_at_q);
         ws.factorized_t = std::numeric_limits<double>::quiet_NaN();  // point not recorded (yet)
         if (st == SolveStatus::kSuccess) ++sum.factorizations;
@@ -515,15 +521,10 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   }
 }
 
-SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
-  check_workspace(model, ws);
-  LinearSummary local;
-  LinearSummary& sum = summary ? *summary : local;
-  sum = LinearSummary{};
-  std::string msg;
-  SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
-  if (st == SolveStatus::kSingularJacobian) msg = "velocities are not unique here: " + msg;
-  if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
+// q̇ from Φq q̇ = −Φt, and q̈ from Φq q̈ = γ, with the factors ws.lu holds (Φq at ws.q, t; the caller saw to
+// it): the solves of solve_velocity / solve_acceleration and of the sweep's derivatives_at_solution.
+namespace {
+SolveStatus velocity_from_factors(const Model& model, double t, Workspace& ws, LinearSummary& sum) {
   model.phi_t(ws.q.data(), t, ws.rhs.data());
   ++ws.counters.phi_t_evaluations;
   ws.rhs = -ws.rhs;
@@ -533,6 +534,29 @@ SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSu
   if (!all_finite(ws.qd))
     return sum.status = SolveStatus::kNonFinite, sum.message = "velocity is not finite", sum.status;
   return SolveStatus::kSuccess;
+}
+SolveStatus acceleration_from_factors(const Model& model, double t, Workspace& ws, LinearSummary& sum) {
+  model.gamma(ws.q.data(), ws.qd.data(), t, ws.rhs.data());
+  ++ws.counters.gamma_evaluations;
+  if (!ws.lu->solve(solve_rhs(model, ws), ws.qdd.data()))
+    return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
+  ++ws.counters.acceleration_solves;
+  if (!all_finite(ws.qdd))
+    return sum.status = SolveStatus::kNonFinite, sum.message = "acceleration is not finite", sum.status;
+  return SolveStatus::kSuccess;
+}
+}  // namespace
+
+SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
+  check_workspace(model, ws);
+  LinearSummary local;
+  LinearSummary& sum = summary ? *summary : local;
+  sum = LinearSummary{};
+  std::string msg;
+  SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
+  if (st == SolveStatus::kSingularJacobian) msg = "velocities are not unique here: " + msg;
+  if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
+  return velocity_from_factors(model, t, ws, sum);
 }
 
 SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
@@ -544,14 +568,7 @@ SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, Line
   SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
   if (st == SolveStatus::kSingularJacobian) msg = "accelerations are not unique here: " + msg;
   if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
-  model.gamma(ws.q.data(), ws.qd.data(), t, ws.rhs.data());
-  ++ws.counters.gamma_evaluations;
-  if (!ws.lu->solve(solve_rhs(model, ws), ws.qdd.data()))
-    return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
-  ++ws.counters.acceleration_solves;
-  if (!all_finite(ws.qdd))
-    return sum.status = SolveStatus::kNonFinite, sum.message = "acceleration is not finite", sum.status;
-  return SolveStatus::kSuccess;
+  return acceleration_from_factors(model, t, ws, sum);
 }
 
 namespace detail {
@@ -578,20 +595,9 @@ SolveStatus derivatives_at_solution(const Model& model, double t, Workspace& ws,
     // next solve_position's end factorise again rather than trust it
     ws.factorized_t = std::numeric_limits<double>::quiet_NaN();
   }
-  model.phi_t(ws.q.data(), t, ws.rhs.data());
-  ++ws.counters.phi_t_evaluations;
-  ws.rhs = -ws.rhs;
-  if (!ws.lu->solve(solve_rhs(model, ws), ws.qd.data())) return fail(SolveStatus::kLinearSolverFailed, ws.lu->last_message());
-  ++ws.counters.velocity_solves;
-  if (!all_finite(ws.qd)) return fail(SolveStatus::kNonFinite, "velocity is not finite");
-  if (!accelerations) return SolveStatus::kSuccess;
-  model.gamma(ws.q.data(), ws.qd.data(), t, ws.rhs.data());
-  ++ws.counters.gamma_evaluations;
-  if (!ws.lu->solve(solve_rhs(model, ws), ws.qdd.data()))
-    return fail(SolveStatus::kLinearSolverFailed, ws.lu->last_message());
-  ++ws.counters.acceleration_solves;
-  if (!all_finite(ws.qdd)) return fail(SolveStatus::kNonFinite, "acceleration is not finite");
-  return SolveStatus::kSuccess;
+  const SolveStatus st = velocity_from_factors(model, t, ws, sum);
+  if (st != SolveStatus::kSuccess || !accelerations) return st;
+  return acceleration_from_factors(model, t, ws, sum);
 }
 
 }  // namespace detail

@@ -23,6 +23,7 @@
 
 #include "kinematics_internal.hpp"
 #include "phiq/assembly.hpp"
+#include "tolerance_tests.hpp"
 
 namespace phiq {
 
@@ -473,20 +474,10 @@ class Sweeper {
   bool jumped() {
     if (!extrapolated_) return false;  // the previous position: nothing predicted
     const double tol = opt_.newton.tolerance;
-    const double correction = scaled_distance(ws_->q, predicted_, ws_->q, tol);
+    const double correction = detail::scaled_distance(model_, ws_->q.data(), predicted_.data(), ws_->q.data(), tol);
     if (!(correction > 1000.0)) return false;
-    return correction > 0.5 * scaled_distance(predicted_, current_.q, current_.q, tol);
-  }
-  // scaled_step(a − b, at, tol) without a temporary for a − b.
-  double scaled_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const Eigen::VectorXd& at,
-                         double tol) const {
-    const double* cs = model_.tolerance_scales().coordinate_scale.data();
-    double worst = 0.0;
-    for (Index j = 0, n = a.size(); j < n; ++j) {
-      const double r = std::fabs(a[j] - b[j]) / (tol * cs[j] + ToleranceScales::kUlpFloor * std::fabs(at[j]));
-      if (!(r <= worst)) worst = std::isnan(r) ? INFINITY : r;
-    }
-    return worst;
+    return correction >
+           0.5 * detail::scaled_distance(model_, predicted_.data(), current_.q.data(), current_.q.data(), tol);
   }
 
   // ws.q = the predictor's guess at t1 from the current state and the history (kept in predicted_ for jumped()),
@@ -506,7 +497,7 @@ class Sweeper {
     const int k = known_;
     auto x = [&](int i) { return history_[static_cast<std::size_t>(i)].data(); };
     auto th = [&](int i) { return history_t_[static_cast<std::size_t>(i)]; };
-    double worst = 0.0;
+    detail::WorstRatio worst;
     bool estimated = true;
     double inherited = current_error_;  // the error of the rows extrapolated from, carried into the prediction
     // f(j, &error) returns the prediction of coordinate j and sets its error estimate.
@@ -515,10 +506,11 @@ class Sweeper {
         double e = 0.0;
         const double p = f(j, e);
         out[j] = kept[j] = p;
-        const double r = std::fabs(e) / (tol * cs[j] + ToleranceScales::kUlpFloor * std::fabs(p));
-        if (!(r <= worst)) worst = std::isnan(r) ? INFINITY : r;
+        worst.add(std::fabs(e), tol * cs[j] + ToleranceScales::kUlpFloor * std::fabs(p));
       }
     };
+    // Reciprocals of the node spacings, once per step: the passes below multiply (no division per coordinate).
+    auto inv = [](double d) { return d != 0.0 ? 1.0 / d : 0.0; };
     switch (predictor_) {
       case Predictor::kPrevious:
       case Predictor::kSecant:
@@ -532,6 +524,8 @@ class Sweeper {
         const double T[4] = {tc, k > 0 ? th(0) : tc, k > 1 ? th(1) : tc, k > 2 ? th(2) : tc};
         const double w1 = h, w2 = w1 * (t1 - T[1]), w3 = w2 * (t1 - T[2]);
         const double* xs[3] = {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q};
+        const double i01 = inv(T[0] - T[1]), i12 = inv(T[1] - T[2]), i23 = inv(T[2] - T[3]);
+        const double i02 = inv(T[0] - T[2]), i13 = inv(T[1] - T[3]), i03 = inv(T[0] - T[3]);
         // the rows' own errors carry over with the weights of Lagrange's polynomial through them at t1
         for (int i = 0; i <= order; ++i) {
           double w = 1.0;
@@ -542,16 +536,16 @@ class Sweeper {
         each([&](Index j, double& e) {
           const double v0 = q[j];
           if (terms == 0) return v0;
-          const double d01 = (v0 - xs[0][j]) / (T[0] - T[1]);
+          const double d01 = (v0 - xs[0][j]) * i01;
           double p = v0, next = w1 * d01;
           if (terms >= 2) {
-            const double d12 = (xs[0][j] - xs[1][j]) / (T[1] - T[2]);
-            const double d012 = (d01 - d12) / (T[0] - T[2]);
+            const double d12 = (xs[0][j] - xs[1][j]) * i12;
+            const double d012 = (d01 - d12) * i02;
             p += w1 * d01, next = w2 * d012;
             if (terms >= 3) {
-              const double d23 = (xs[1][j] - xs[2][j]) / (T[2] - T[3]);
-              const double d123 = (d12 - d23) / (T[1] - T[3]);
-              p += w2 * d012, next = w3 * (d012 - d123) / (T[0] - T[3]);
+              const double d23 = (xs[1][j] - xs[2][j]) * i23;
+              const double d123 = (d12 - d23) * i13;
+              p += w2 * d012, next = w3 * (d012 - d123) * i03;
             }
           }
           if (estimated) e = next;
@@ -571,8 +565,6 @@ class Sweeper {
         const double T[4] = {tc, k > 0 ? th(0) : tc, k > 1 ? th(1) : tc, k > 2 ? th(2) : tc};
         const double w1 = h, w2 = w1 * h, w3 = w2 * (t1 - T[1]), w4 = w3 * (t1 - T[2]);
         const double* xs[3] = {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q};
-        // reciprocals of the node spacings the differences divide by (only those of known rows are used)
-        auto inv = [](double d) { return d != 0.0 ? 1.0 / d : 0.0; };
         const double i01 = inv(T[0] - T[1]), i12 = inv(T[1] - T[2]), i23 = inv(T[2] - T[3]);
         const double i02 = inv(T[0] - T[2]), i13 = inv(T[1] - T[3]), i03 = inv(T[0] - T[3]);
         // Each term as a function of the positions q, q_0, q_1, q_2 (and q̇), so that the rows' own errors carry
@@ -635,7 +627,8 @@ class Sweeper {
         const bool cubic = predictor_ == Predictor::kCubic && k > 0;
         estimated = k > (cubic ? 1 : 0);
         const double hh = 0.5 * h * h, h3 = h * h * h / 6.0;
-        const double dt0 = k > 0 ? tc - th(0) : 1.0, dt1 = k > 1 ? th(0) - th(1) : 1.0;
+        const double dt0 = k > 0 ? tc - th(0) : 1.0, i_dt0 = 1.0 / dt0;
+        const double i_dt1 = k > 1 ? 1.0 / (th(0) - th(1)) : 1.0;
         const double* a0 = k > 0 ? x(0) : a;
         const double* a1 = k > 1 ? x(1) : a;
         // cubic: q⃛ ≈ (q̈ − q̈_0) / (tc − t_0), which errs by (tc − t_0)/2 q⁗; with the Taylor remainder the
@@ -644,10 +637,10 @@ class Sweeper {
         each([&](Index j, double& e) {
           double p = q[j] + h * v[j] + hh * a[j];
           if (k > 0) {
-            const double jerk = (a[j] - a0[j]) / dt0;
+            const double jerk = (a[j] - a0[j]) * i_dt0;
             if (cubic) {
               p += h3 * jerk;
-              if (estimated) e = ce * (jerk - (a0[j] - a1[j]) / dt1);
+              if (estimated) e = ce * (jerk - (a0[j] - a1[j]) * i_dt1);
             } else {
               e = h3 * jerk;
             }
@@ -662,7 +655,7 @@ class Sweeper {
     // The prediction is as far from the solution as the rows it extrapolates (how well each was solved) plus the
     // extrapolation's own error; accepted without a Newton step, its error becomes the next row's to carry. So the
     // error budget adds up over steps taken without Newton until it exceeds the tolerance, and a step resets it.
-    newton_.start_error = estimated ? inherited + worst : INFINITY;
+    newton_.start_error = estimated ? inherited + worst.worst : INFINITY;
   }
   void remember(double t) {
     // The quantity the predictor extrapolates, at the current row, moves into the history (by buffer swaps: the
@@ -830,7 +823,7 @@ void add_counters(WorkCounters& into, const WorkCounters& now, const WorkCounter
 // every coordinate (each is within about one of the exact root, or of its rounding level; another branch is a
 // finite distance away).
 bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b, double tol, double limit) {
-  return scaled_step(model, a - Eigen::Map<const Eigen::VectorXd>(b, a.size()), a, tol) <= limit;
+  return detail::scaled_distance(model, a.data(), b, a.data(), tol) <= limit;
 }
 
 // One parallel chunk: rows k0 … k1 computed from a seed at t_k0 (chunk 0: from row 0), then the sweep continued

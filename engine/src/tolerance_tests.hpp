@@ -75,6 +75,28 @@ inline std::vector<std::pair<Index, double>> worst_rows(const Model& model, cons
   return rows;
 }
 
+// The largest of ratios |e_j| / allowed_j fed one by one (a NaN ratio counts as +inf), dividing only where a ratio
+// may exceed the largest so far: the passes that run every drive step (a sweep's predictor and its branch check)
+// then divide a few times per pass, not once per coordinate.
+struct WorstRatio {
+  double worst = 0.0;
+  void add(double magnitude, double allowed) {
+    if (magnitude <= worst * allowed) return;
+    const double r = magnitude / allowed;
+    worst = std::isnan(r) ? std::numeric_limits<double>::infinity() : std::max(worst, r);
+  }
+};
+
+// max_j |a_j − b_j| / (tol · scale_j + floor_j at `at`), the size of a − b in units of the tolerance test
+// (scaled_step() of a − b), without forming a − b. NaN gives +inf.
+inline double scaled_distance(const Model& model, const double* a, const double* b, const double* at, double tol) {
+  const double* cs = model.tolerance_scales().coordinate_scale.data();
+  WorstRatio w;
+  for (Index j = 0, n = model.num_coordinates(); j < n; ++j)
+    w.add(std::fabs(a[j] - b[j]), tol * cs[j] + kUlpFloor * std::fabs(at[j]));
+  return w.worst;
+}
+
 // "'name' 1.234e-05, 'other[1]' …" for diagnostics.
 inline std::string describe_rows(const Model& model, const std::vector<std::pair<Index, double>>& rows) {
   std::ostringstream s;
