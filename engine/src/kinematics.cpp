@@ -547,28 +547,28 @@ SolveStatus acceleration_from_factors(const Model& model, double t, Workspace& w
 }
 }  // namespace
 
-SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
+// The public linear solves: Φq factorised at (ws.q, t) unless it is already, then `solve` (velocity_from_factors or
+// acceleration_from_factors); `what` names the derivatives when Φq is singular there.
+template <class Solve>
+SolveStatus factorize_and_solve(const Model& model, double t, Workspace& ws, LinearSummary* summary, const char* what,
+                                Solve solve) {
   check_workspace(model, ws);
   LinearSummary local;
   LinearSummary& sum = summary ? *summary : local;
   sum = LinearSummary{};
   std::string msg;
   SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
-  if (st == SolveStatus::kSingularJacobian) msg = "velocities are not unique here: " + msg;
+  if (st == SolveStatus::kSingularJacobian) msg = std::string(what) + " are not unique here: " + msg;
   if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
-  return velocity_from_factors(model, t, ws, sum);
+  return solve(model, t, ws, sum);
+}
+
+SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
+  return factorize_and_solve(model, t, ws, summary, "velocities", velocity_from_factors);
 }
 
 SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
-  check_workspace(model, ws);
-  LinearSummary local;
-  LinearSummary& sum = summary ? *summary : local;
-  sum = LinearSummary{};
-  std::string msg;
-  SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
-  if (st == SolveStatus::kSingularJacobian) msg = "accelerations are not unique here: " + msg;
-  if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
-  return acceleration_from_factors(model, t, ws, sum);
+  return factorize_and_solve(model, t, ws, summary, "accelerations", acceleration_from_factors);
 }
 
 namespace detail {
