@@ -100,7 +100,7 @@ template <class Spec>
 std::vector<Entry> Entries(const Spec& spec, const double* q, double t) {
   std::vector<Entry> out;
   auto sink = [&](int row, const Slot& s, double v) {
-    if (s.is_coordinate()) out.push_back({row, s.coord, v});
+    if (s.is_coordinate()) out.push_back({row, s.coord(), v});
   };
   spec.jacobian(q, t, sink);
   return out;

@@ -15,6 +15,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <random>
@@ -56,6 +58,72 @@ std::shared_ptr<const phiq::CompiledExpression> CompileCrank(const std::string& 
     if (name == "t") return phiq::NameBinding{K::kTime};
     return std::nullopt;
   });
+}
+
+// ---- Slot: one word that is a coordinate index or a constant --------------------------------------------------
+
+TEST(Slot, CoordinatesAndConstantsRoundTripThroughOneWord) {
+  static_assert(sizeof(Slot) == 8);
+  const double q[] = {10.0, 11.0, 12.0};
+  const double qd[] = {-1.0, -2.0, -3.0};
+  for (Index i : {Index{0}, Index{1}, Index{2}}) {
+    const Slot s = S(i);
+    EXPECT_TRUE(s.is_coordinate());
+    EXPECT_EQ(s.coord(), i);
+    EXPECT_EQ(s.value(), 0.0);
+    EXPECT_EQ(s.of(q), q[i]);
+    EXPECT_EQ(s.rate(qd), qd[i]);
+  }
+  const Index largest = (Index{1} << 50) - 1;
+  EXPECT_EQ(S(largest).coord(), largest);
+  EXPECT_THROW(S(-1), phiq::Error);
+  EXPECT_THROW(S(largest + 1), phiq::Error);
+  // every double is its own constant, bit for bit, including the signed zero, the extremes and infinities
+  for (double v : {0.0, -0.0, 1.5, -7.25e300, 4.9e-324, -std::numeric_limits<double>::max(),
+                   std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}) {
+    const Slot c = C(v);
+    EXPECT_FALSE(c.is_coordinate()) << v;
+    EXPECT_EQ(c.coord(), -1);
+    EXPECT_EQ(std::signbit(c.value()), std::signbit(v));
+    EXPECT_EQ(c.value(), v);
+    EXPECT_EQ(c.of(q), v);
+    EXPECT_EQ(c.rate(qd), 0.0);
+  }
+  EXPECT_FALSE(Slot().is_coordinate());
+  EXPECT_EQ(Slot().value(), 0.0);
+  EXPECT_FALSE(std::signbit(Slot().value()));
+  // any NaN, whatever its payload (one carrying the coordinate tag's bits included), stays a NaN constant
+  std::uint64_t tagged = 0xFFFC000000000005ULL;
+  double tagged_nan;
+  std::memcpy(&tagged_nan, &tagged, sizeof tagged_nan);
+  for (double v : {std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::quiet_NaN(), tagged_nan}) {
+    const Slot c = C(v);
+    EXPECT_FALSE(c.is_coordinate());
+    EXPECT_TRUE(std::isnan(c.value()));
+  }
+}
+
+TEST(Slot, ModelBuilderRejectsNonFiniteConstantsAndUnknownCoordinates) {
+  phiq::ModelBuilder b;
+  b.add_coordinate("x", 1.0);
+  b.add_coordinate("y", 0.0);
+  auto distance = [](Slot ax) { return phiq::DistanceSpec{{ax, C(0.0)}, {S(0), S(1)}, 1.0}; };
+  EXPECT_NO_THROW(b.add("ok", distance(C(0.0))));
+  for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    try {
+      b.add("bad", distance(C(bad)));
+      ADD_FAILURE() << "constant " << bad << " accepted";
+    } catch (const phiq::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("constraint 'bad': constant is not finite"), std::string::npos) << e.what();
+    }
+  }
+  try {
+    b.add("far", distance(S(2)));
+    ADD_FAILURE() << "coordinate 2 of 2 accepted";
+  } catch (const phiq::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("coordinate index 2 out of range (2 coordinates)"), std::string::npos)
+        << e.what();
+  }
 }
 
 // ---- DistanceSpec ---------------------------------------------------------------------------------------------

@@ -119,7 +119,7 @@ int plot_svg(const PlotOptions& o) {
     const Slot* slots[] = {&p.point.x, &p.point.y, &p.body.x, &p.body.y, &p.body.psi};
     const int first = p.kind == OutputPointKind::kPlanarPoint ? 0 : 2, last = first == 0 ? 2 : 5;
     for (int k = first; k < last; ++k)
-      if (slots[k]->is_coordinate()) needed.push_back(slots[k]->coord);
+      if (slots[k]->is_coordinate()) needed.push_back(slots[k]->coord());
   };
   for (const SketchSegment& s : segments) need(s.from), need(s.to);
   std::sort(needed.begin(), needed.end());

@@ -11,11 +11,11 @@ namespace {
 // A point's identity: kind, slots and local coordinates; two ends are the same point of the mechanism when they
 // read the same slots the same way.
 using PointKey = std::tuple<int, Index, double, Index, double, Index, double, double, double>;
-double constant_part(const Slot& s) { return s.is_coordinate() ? 0.0 : s.value; }
+double constant_part(const Slot& s) { return s.value(); }
 PointKey key_of(const OutputPoint& p) {
   if (p.kind == OutputPointKind::kPlanarPoint)
-    return {0, p.point.x.coord, constant_part(p.point.x), p.point.y.coord, constant_part(p.point.y), -1, 0.0, 0.0, 0.0};
-  return {1, p.body.x.coord, constant_part(p.body.x), p.body.y.coord, constant_part(p.body.y), p.body.psi.coord,
+    return {0, p.point.x.coord(), constant_part(p.point.x), p.point.y.coord(), constant_part(p.point.y), -1, 0.0, 0.0, 0.0};
+  return {1, p.body.x.coord(), constant_part(p.body.x), p.body.y.coord(), constant_part(p.body.y), p.body.psi.coord(),
           constant_part(p.body.psi), p.local_x, p.local_y};
 }
 

@@ -227,10 +227,10 @@ Index ModelBuilder::add_driver(const std::string& name, Index coordinate, Motion
 }
 
 void ModelBuilder::check_slot(const Slot& s, const std::string& name) const {
-  if (s.is_coordinate() && s.coord >= num_coordinates())
-    throw Error("constraint '" + name + "': coordinate index " + std::to_string(s.coord) + " out of range (" +
+  if (s.is_coordinate() && s.coord() >= num_coordinates())
+    throw Error("constraint '" + name + "': coordinate index " + std::to_string(s.coord()) + " out of range (" +
                 std::to_string(num_coordinates()) + " coordinates)");
-  if (!s.is_coordinate() && !std::isfinite(s.value))
+  if (!s.is_coordinate() && !std::isfinite(s.value()))
     throw Error("constraint '" + name + "': constant is not finite");
 }
 
@@ -313,9 +313,9 @@ void ModelBuilder::count_joint(const JointCount& c) {
 void ModelBuilder::check_body(const std::string& name, std::initializer_list<Slot> slots) {
   if (name.empty()) throw Error("body name is empty");
   for (const Slot& s : slots) {
-    if (s.is_coordinate() && s.coord >= num_coordinates())
+    if (s.is_coordinate() && s.coord() >= num_coordinates())
       throw Error("body '" + name + "': coordinate index out of range");
-    if (!s.is_coordinate() && !std::isfinite(s.value)) throw Error("body '" + name + "': constant is not finite");
+    if (!s.is_coordinate() && !std::isfinite(s.value())) throw Error("body '" + name + "': constant is not finite");
   }
   const auto name_of = [this](Index k) -> const std::string& { return model_.body_names_[static_cast<std::size_t>(k)]; };
   if (!body_names_.insert(name, static_cast<Index>(model_.body_names_.size()), name_of))

@@ -6,8 +6,8 @@
 namespace phiq {
 
 Index OutputPoint::max_coordinate() const {
-  if (kind == OutputPointKind::kPlanarPoint) return std::max(point.x.coord, point.y.coord);
-  return std::max({body.x.coord, body.y.coord, body.psi.coord});
+  if (kind == OutputPointKind::kPlanarPoint) return std::max(point.x.coord(), point.y.coord());
+  return std::max({body.x.coord(), body.y.coord(), body.psi.coord()});
 }
 
 OutputPoint planar_point(std::string name, Point2 p) {

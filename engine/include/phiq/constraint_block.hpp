@@ -96,7 +96,7 @@ struct PatternSink {
   std::vector<Index>* rows;
   std::vector<Index>* cols;
   void operator()(int row, const Slot& s, double) {
-    if (s.is_coordinate()) rows->push_back(row0 + row), cols->push_back(s.coord);
+    if (s.is_coordinate()) rows->push_back(row0 + row), cols->push_back(s.coord());
   }
 };
 /// Value mode: same entries, same order, values accumulated into their CSC slots (or stored, with kOverwrite:
@@ -119,7 +119,7 @@ struct ValueSink {
 template <class Spec>
 Index max_coordinate(const Spec& spec) {
   Index m = -1;
-  spec.for_each_slot([&](const Slot& s, Unit) { m = std::max(m, s.coord); });
+  spec.for_each_slot([&](const Slot& s, Unit) { m = std::max(m, s.coord()); });
   return m;
 }
 
@@ -187,7 +187,7 @@ class TypedBlock final : public ConstraintBlock {
     for (const Entry& e : entries_)
       e.spec.for_each_slot([&](const Slot& s, Unit u) {
         if (!s.is_coordinate() || u == Unit::kNone) return;
-        Unit& cu = units[static_cast<std::size_t>(s.coord)];
+        Unit& cu = units[static_cast<std::size_t>(s.coord())];
         if (cu == Unit::kNone) cu = u;
         else if (cu != u) cu = Unit::kNone;  // used as both: fall back to the plain tolerance
       });

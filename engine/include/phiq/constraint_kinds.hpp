@@ -603,7 +603,7 @@ struct LoopSpec {
   double characteristic_length() const {
     double l = std::hypot(closure.x, closure.y);
     for (const Link& k : links)
-      if (!k.length.is_coordinate()) l = std::max(l, std::fabs(k.length.value));
+      if (!k.length.is_coordinate()) l = std::max(l, std::fabs(k.length.value()));
     return l;
   }
   /// @copydoc DistanceSpec::for_each_slot
@@ -686,10 +686,10 @@ struct CoordinateDriverSpec {
   /// A driver always depends on time.
   bool depends_on_time() const { return true; }
   /// @copydoc DistanceSpec::row_unit
-  /// A driver's row has the unit of the driven coordinate, `coordinate_units[coordinate.coord]` (Unit::kNone if
+  /// A driver's row has the unit of the driven coordinate, `coordinate_units[coordinate.coord()]` (Unit::kNone if
   /// none was inferred).
   Unit row_unit(int, const std::vector<Unit>& coordinate_units) const {
-    return coordinate.is_coordinate() ? coordinate_units[coordinate.coord] : Unit::kNone;
+    return coordinate.is_coordinate() ? coordinate_units[coordinate.coord()] : Unit::kNone;
   }
   /// @copydoc DistanceSpec::characteristic_length
   /// A driver carries no length as data: 0.
