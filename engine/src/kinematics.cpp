@@ -141,7 +141,7 @@ StepPass take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::Ve
   const double* x = q.data();
   const double* d = dx.data();
   double* out = trial.data();
-  double worst = 0.0, norms[kLanes] = {}, sums[kLanes] = {};  // per lane, as in check_residual
+  double worst = 0.0, norms[kLanes] = {};  // per lane, as in check_residual
   auto coordinate = [&](int k, Index j) {
     const double step = alpha * d[j];
     const double v = x[j] - step;
@@ -150,8 +150,7 @@ StepPass take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::Ve
     const double a = std::fabs(step), allowed = tol * cs[j] + kUlpFloor * std::fabs(v);
     if (!(a <= worst * allowed)) worst = std::isnan(worst) ? worst : a / allowed;
     const double s = std::fabs(d[j]) * inv[j];
-    sums[k] += s;
-    norms[k] = norms[k] < s ? s : norms[k];
+    norms[k] = norms[k] < s ? s : norms[k];  // a NaN is lost here, not in `worst`; an infinity is kept
   };
   const Index n = q.size();
   Index j = 0;
@@ -161,7 +160,9 @@ StepPass take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::Ve
   StepPass p;
   p.size = worst;
   p.norm = std::max(std::max(norms[0], norms[1]), std::max(norms[2], norms[3]));
-  p.finite = std::isfinite((sums[0] + sums[1]) + (sums[2] + sums[3])) || dx.allFinite();
+  // A NaN in dx makes `worst` NaN (it sticks there), an infinity makes the norm infinite: only then (or on an
+  // overflow of |dx_j| / scale_j) is dx itself looked at.
+  p.finite = (std::isfinite(p.norm) && !std::isnan(worst)) || dx.allFinite();
   return p;
 }
 
