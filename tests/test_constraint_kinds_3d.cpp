@@ -101,6 +101,52 @@ TEST(ConstraintKinds3d, Rigid) { CheckJoint<phiq::RigidSpec>(370); }
 TEST(ConstraintKinds3d, PointOnLine) { CheckJoint<phiq::SpatialPointOnLineSpec>(380); }
 TEST(ConstraintKinds3d, PointOnPlane) { CheckJoint<phiq::PointOnPlaneSpec>(390); }
 
+// A fixed frame turned by 60° about (1, 2, 2)/3, away from the origin: its attachments are constants, which setup
+// folds into their values (Attachment3::fold_constant). Against Rodrigues' formula, bit for bit against the
+// unfolded evaluation, and through the derivative checks as one side of every joint.
+TEST(ConstraintKinds3d, ConstantAttachmentsFoldToTheirValue) {
+  const double half = M_PI / 6.0;
+  const V3 u{1.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0};
+  const Frame3 fixed{C(0.3), C(-1.2), C(2.0), C(std::cos(half)), C(std::sin(half) * u.x), C(std::sin(half) * u.y),
+                     C(std::sin(half) * u.z)};
+  const V3 at{0.4, -0.7, 1.1};
+  const phiq::Attachment3 point = phiq::Attachment3::body_point(fixed, at);
+  phiq::Attachment3 folded = point;
+  folded.fold_constant();
+  EXPECT_TRUE(point.rotates());
+  EXPECT_FALSE(folded.rotates());
+  const V3 x = point.value(nullptr), y = folded.value(nullptr);
+  EXPECT_EQ(x.x, y.x);  // the same arithmetic, once: equal to the last bit
+  EXPECT_EQ(x.y, y.y);
+  EXPECT_EQ(x.z, y.z);
+  // Rodrigues: R at = cos φ at + sin φ (u × at) + (1 − cos φ)(u · at) u, φ = 60°
+  const double c = std::cos(2 * half), n = std::sin(2 * half);
+  const V3 rodrigues = phiq::kin3::V3{0.3, -1.2, 2.0} + c * at + n * phiq::kin3::cross(u, at) +
+                       ((1.0 - c) * phiq::kin3::dot(u, at)) * u;
+  EXPECT_NEAR(y.x, rodrigues.x, 1e-15);
+  EXPECT_NEAR(y.y, rodrigues.y, 1e-15);
+  EXPECT_NEAR(y.z, rodrigues.z, 1e-15);
+  const double q[kN] = {}, qd[kN] = {};
+  const V3 v = folded.rate(q, qd), b = folded.bias(qd);
+  for (double e : {v.x, v.y, v.z, b.x, b.y, b.z}) EXPECT_EQ(e, 0.0);
+  // an attachment that reads coordinates is left as it is
+  std::mt19937 rng(400);
+  const phiq::Attachment3 moving = phiq::Attachment3::body_point(Body(0), at);
+  phiq::Attachment3 kept = moving;
+  kept.fold_constant();
+  std::vector<double> state(kN);
+  for (double& e : state) e = std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+  EXPECT_TRUE(kept.rotates());
+  EXPECT_EQ(kept.value(state.data()).x, moving.value(state.data()).x);
+  EXPECT_EQ(kept.r[0].coord(), 0);
+  EXPECT_EQ(kept.p[3].coord(), 6);
+  // every joint with the rotated fixed frame on one side: derivatives against finite differences
+  const JointSide3 side = JointSide3::body(fixed, at, RandomVector(rng), RandomVector(rng));
+  CheckSpec(Joint<phiq::SpatialRevoluteSpec>(side, BodySide(7, rng)), kN, Opts(401));
+  CheckSpec(Joint<phiq::PointOnPlaneSpec>(BodySide(0, rng), side), kN, Opts(402));
+  CheckSpec(Joint<phiq::UniversalSpec>(side, JointSide3::natural_point(Nat(14), Nat(17))), kN, Opts(403));
+}
+
 TEST(ConstraintKinds3d, JointsWithNaturalSides) {
   std::mt19937 rng(400);
   // a body point pinned to a natural point (mixed coordinates)

@@ -66,6 +66,7 @@ std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const Joi
     att[Y] = Attachment3::body_vector(s.frame, f.y);
     att[Z] = Attachment3::body_vector(s.frame, f.z);
   }
+  for (Attachment3& x : att) x.fold_constant();
   return att;
 }
 

@@ -290,8 +290,10 @@ void ModelBuilder::prepare(CoordinateDriverSpec& s) const {
 void ModelBuilder::prepare(EquationSpec& s) const { require(s.g != nullptr, "equation: no expression"); }
 void ModelBuilder::prepare(SpatialDistanceSpec& s) const {
   require(std::isfinite(s.length) && s.length > 0.0, "distance: length must be positive and finite");
-  for (const Attachment3& e : s.ends)
+  for (Attachment3& e : s.ends) {
     require(std::isfinite(e.s.x) && std::isfinite(e.s.y) && std::isfinite(e.s.z), "distance: point is not finite");
+    e.fold_constant();
+  }
 }
 void ModelBuilder::prepare(DotSpec& s) const {
   require(std::isfinite(s.value), "dot: value is not finite");
@@ -300,6 +302,7 @@ void ModelBuilder::prepare(DotSpec& s) const {
   const double l1 = kin3::norm(s.ends[0].value(q0) - s.ends[1].value(q0));
   const double l2 = kin3::norm(s.ends[2].value(q0) - s.ends[3].value(q0));
   s.ref = (l1 > 0.0 && l2 > 0.0 && std::isfinite(l1 * l2)) ? l1 * l2 : 1.0;
+  for (Attachment3& e : s.ends) e.fold_constant();
 }
 
 void ModelBuilder::count_joint(const JointCount& c) {

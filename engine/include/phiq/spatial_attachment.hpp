@@ -81,6 +81,20 @@ struct Attachment3 {
 
   /// Whether R(p) s varies: s ≠ 0 (decided by the data, so the Jacobian's entry set never depends on values).
   bool rotates() const { return !kin3::is_zero(s); }
+  /// When r and p are all constants (a ground or fixed-frame attachment), X is a constant: stores it in r and sets
+  /// s = 0, so that every evaluation reads three constants instead of rotating s (on a natural-coordinate chain
+  /// the ground's points and axes are most of the rotations). The value is the one value() computed, to the last
+  /// bit, and no Jacobian entry changes (constants have none). The setup of the spatial kinds calls it.
+  void fold_constant() {
+    if (!rotates()) return;
+    for (const Slot& k : r)
+      if (k.is_coordinate()) return;
+    for (const Slot& k : p)
+      if (k.is_coordinate()) return;
+    const kin3::V3 x = value(nullptr);  // constants only: q is not read
+    *this = Attachment3{};
+    r[0] = Slot::constant(x.x), r[1] = Slot::constant(x.y), r[2] = Slot::constant(x.z);
+  }
   /// X at q.
   kin3::V3 value(const double* q) const {
     kin3::V3 x{r[0].of(q), r[1].of(q), r[2].of(q)};
