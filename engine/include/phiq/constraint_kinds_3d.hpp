@@ -209,6 +209,36 @@ inline double row_gamma(const Attachment3* a, const RowDef& d, const double* q, 
                kin3::dot(x, bias(a, d.y, qd)));
 }
 
+/// The attachments a joint's rows read, in the order of their indices (`index[i]`: the Attach index of the i-th),
+/// and the rows with their terms renumbered into that list: a joint stores only those (a point on a plane reads 3
+/// of the 8), since every evaluation streams them.
+template <int kRows>
+struct CompactRows {
+  int count = 0;
+  std::int8_t index[kCount] = {};
+  RowDef rows[kRows] = {};
+};
+template <int kRows>
+constexpr CompactRows<kRows> compact_rows(const RowDef (&defs)[kRows]) {
+  bool used[kCount] = {};
+  for (const RowDef& d : defs)
+    for (const Term& t : {d.x, d.y}) {
+      if (t.plus >= 0) used[t.plus] = true;
+      if (t.minus >= 0) used[t.minus] = true;
+    }
+  CompactRows<kRows> c;
+  std::int8_t position[kCount] = {};
+  for (int k = 0; k < kCount; ++k)
+    if (used[k]) position[k] = static_cast<std::int8_t>(c.count), c.index[c.count++] = static_cast<std::int8_t>(k);
+  auto renumber = [&](Term t) {
+    if (t.plus >= 0) t.plus = position[t.plus];
+    if (t.minus >= 0) t.minus = position[t.minus];
+    return t;
+  };
+  for (int r = 0; r < kRows; ++r) c.rows[r] = RowDef{renumber(defs[r].x), renumber(defs[r].y), defs[r].unit};
+  return c;
+}
+
 /// The attachments of a joint between sides a and b, for the rows `defs` (which say what is needed). Normalises
 /// the axes, makes the reference directions perpendicular. Throws phiq::Error (naming `kind`) for a zero or
 /// non-finite axis, a reference along the axis, non-finite points, and rows that need the perpendicular
@@ -240,10 +270,16 @@ struct SpatialJointSpec {
   /// @var a
   /// @brief Side a: its joint frame carries the axis of one-sided rows (lines, planes).
   JointSide3 a, b;  ///< side b
-  std::array<Attachment3, detail3::kCount> att{};  ///< derived by setup()
+  /// The rows' attachments and the rows renumbered into them (detail3::compact_rows).
+  static constexpr auto kCompact = detail3::compact_rows(Traits::kRowDefs);
+  std::array<Attachment3, kCompact.count> att{};  ///< derived by setup(): the attachments the rows read
 
   /// Validates the sides and derives `att`. Throws phiq::Error.
-  void setup() { att = detail3::joint_attachments(a, b, Traits::kRowDefs, kRows, kKind); }
+  void setup() {
+    const auto all = detail3::joint_attachments(a, b, Traits::kRowDefs, kRows, kKind);
+    for (int i = 0; i < kCompact.count; ++i)
+      att[static_cast<std::size_t>(i)] = all[static_cast<std::size_t>(kCompact.index[i])];
+  }
   /// @copydoc DistanceSpec::depends_on_time
   bool depends_on_time() const { return false; }
   /// @copydoc DistanceSpec::row_unit
@@ -260,12 +296,12 @@ struct SpatialJointSpec {
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double, double* phi) const {
-    for (int r = 0; r < kRows; ++r) phi[r] = detail3::row_value(att.data(), Traits::kRowDefs[r], q, 1.0, 0.0);
+    for (int r = 0; r < kRows; ++r) phi[r] = detail3::row_value(att.data(), kCompact.rows[r], q, 1.0, 0.0);
   }
   /// @copydoc DistanceSpec::jacobian
   template <class Sink>
   void jacobian(const double* q, double, Sink& s) const {
-    for (int r = 0; r < kRows; ++r) detail3::row_jacobian(att.data(), Traits::kRowDefs[r], q, s, r, 1.0);
+    for (int r = 0; r < kRows; ++r) detail3::row_jacobian(att.data(), kCompact.rows[r], q, s, r, 1.0);
   }
   /// @copydoc DistanceSpec::phi_t
   void phi_t(const double*, double, double* out) const {
@@ -273,7 +309,7 @@ struct SpatialJointSpec {
   }
   /// @copydoc DistanceSpec::gamma
   void gamma(const double* q, const double* qd, double, double* out) const {
-    for (int r = 0; r < kRows; ++r) out[r] = detail3::row_gamma(att.data(), Traits::kRowDefs[r], q, qd, 1.0);
+    for (int r = 0; r < kRows; ++r) out[r] = detail3::row_gamma(att.data(), kCompact.rows[r], q, qd, 1.0);
   }
 };
 
