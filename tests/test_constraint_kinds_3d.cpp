@@ -6,9 +6,13 @@
 // pattern, and the Grübler–Kutzbach count of Model::grubler().
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "constraint_check.hpp"
@@ -145,6 +149,44 @@ TEST(ConstraintKinds3d, ConstantAttachmentsFoldToTheirValue) {
   CheckSpec(Joint<phiq::SpatialRevoluteSpec>(side, BodySide(7, rng)), kN, Opts(401));
   CheckSpec(Joint<phiq::PointOnPlaneSpec>(BodySide(0, rng), side), kN, Opts(402));
   CheckSpec(Joint<phiq::UniversalSpec>(side, JointSide3::natural_point(Nat(14), Nat(17))), kN, Opts(403));
+}
+
+// A joint stores only the attachments its rows read (SpatialJointSpec::kCompact): the distinct ones of its row
+// table, in index order, and every renumbered term names the attachment it named before.
+template <class Traits>
+void CheckCompactRows() {
+  using Spec = phiq::SpatialJointSpec<Traits>;
+  constexpr auto c = Spec::kCompact;
+  std::set<int> named;
+  for (const auto& d : Traits::kRowDefs)
+    for (const phiq::detail3::Term& t : {d.x, d.y}) {
+      if (t.plus >= 0) named.insert(t.plus);
+      if (t.minus >= 0) named.insert(t.minus);
+    }
+  ASSERT_EQ(c.count, static_cast<int>(named.size())) << Traits::kKind;
+  EXPECT_EQ(std::tuple_size<decltype(Spec::att)>::value, named.size()) << Traits::kKind;
+  EXPECT_TRUE(std::equal(named.begin(), named.end(), c.index, c.index + c.count)) << Traits::kKind;
+  auto back = [&](int compact) { return compact < 0 ? compact : static_cast<int>(c.index[compact]); };
+  for (int r = 0; r < Traits::kRows; ++r) {
+    const auto &full = Traits::kRowDefs[r], &mine = c.rows[r];
+    EXPECT_EQ(mine.unit, full.unit);
+    for (const auto& [f, m] : {std::pair{full.x, mine.x}, std::pair{full.y, mine.y}}) {
+      EXPECT_EQ(m.axis, f.axis) << Traits::kKind << " row " << r;
+      EXPECT_EQ(back(m.plus), f.plus) << Traits::kKind << " row " << r;
+      EXPECT_EQ(back(m.minus), f.minus) << Traits::kKind << " row " << r;
+    }
+  }
+}
+
+TEST(ConstraintKinds3d, JointsStoreOnlyTheAttachmentsTheirRowsRead) {
+  namespace j = phiq::joint3;
+  CheckCompactRows<j::Spherical>(), CheckCompactRows<j::Revolute>(), CheckCompactRows<j::Cylindrical>();
+  CheckCompactRows<j::Prismatic>(), CheckCompactRows<j::Universal>(), CheckCompactRows<j::Planar>();
+  CheckCompactRows<j::Rigid>(), CheckCompactRows<j::PointOnLine>(), CheckCompactRows<j::PointOnPlane>();
+  // the two of the large generated scenes, by hand: a ball joint reads P_a and P_b, a point on a plane also z_a
+  EXPECT_EQ(phiq::SphericalSpec::kCompact.count, 2);
+  EXPECT_EQ(phiq::PointOnPlaneSpec::kCompact.count, 3);
+  EXPECT_EQ(sizeof(phiq::PointOnPlaneSpec), 2 * sizeof(JointSide3) + 3 * sizeof(phiq::Attachment3));
 }
 
 TEST(ConstraintKinds3d, JointsWithNaturalSides) {
