@@ -98,17 +98,23 @@ struct Attachment3 {
   /// X at q.
   kin3::V3 value(const double* q) const {
     kin3::V3 x{r[0].of(q), r[1].of(q), r[2].of(q)};
-    if (!rotates()) return x;
-    const double e[4] = {p[0].of(q), p[1].of(q), p[2].of(q), p[3].of(q)};
-    return x + kin3::rotate(e, s);
+    return rotates() ? x + rotated(q) : x;  // natural points and folded constants: three reads, inlined
   }
   /// Ẋ = ṙ + 2 B(p, ṗ, s).
   kin3::V3 rate(const double* q, const double* qd) const {
     kin3::V3 v{r[0].rate(qd), r[1].rate(qd), r[2].rate(qd)};
-    if (!rotates()) return v;
+    return rotates() ? v + rotated_rate(q, qd) : v;
+  }
+  /// R(p) s at q (kept out of the callers: only moving frames need it).
+  [[gnu::noinline]] kin3::V3 rotated(const double* q) const {
+    const double e[4] = {p[0].of(q), p[1].of(q), p[2].of(q), p[3].of(q)};
+    return kin3::rotate(e, s);
+  }
+  /// 2 B(p, ṗ, s) at (q, q̇).
+  [[gnu::noinline]] kin3::V3 rotated_rate(const double* q, const double* qd) const {
     const double e[4] = {p[0].of(q), p[1].of(q), p[2].of(q), p[3].of(q)};
     const double ed[4] = {p[0].rate(qd), p[1].rate(qd), p[2].rate(qd), p[3].rate(qd)};
-    return v + 2.0 * kin3::bilinear(e, ed, s);
+    return 2.0 * kin3::bilinear(e, ed, s);
   }
   /// The part of Ẍ that does not contain q̈: 2 R(ṗ) s.
   kin3::V3 bias(const double* qd) const {
