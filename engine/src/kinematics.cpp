@@ -96,26 +96,30 @@ struct ResidualCheck {
   bool finite = true;
   bool within = false;
 };
-constexpr int kLanes = 4;  // independent accumulators in the passes' reductions
+// The passes' reductions run in kLanes independent accumulators: one chain would wait for each addition's latency
+// (a pass ran at a third of the speed of memory on models that fit in cache). in_lanes(n, f) calls f(lane, i) for
+// every i < n, lanes taking consecutive i in turn; lanes_max() joins the lanes' maxima.
+constexpr int kLanes = 4;
+template <class F>
+void in_lanes(Index n, F&& f) {
+  Index i = 0;
+  for (; i + kLanes <= n; i += kLanes)
+    for (int k = 0; k < kLanes; ++k) f(k, i + k);
+  for (int k = 0; i < n; ++i, ++k) f(k, i);
+}
+double lanes_max(const double (&v)[kLanes]) { return std::max(std::max(v[0], v[1]), std::max(v[2], v[3])); }
 
 ResidualCheck check_residual(const Model& model, const Eigen::VectorXd& phi, double tol, const Eigen::VectorXd& q) {
   const double* p = phi.data();
   const double* inv = model.tolerance_scales().inverse_row_scale.data();
-  // Four independent sums and maxima: one chain would wait for each addition's latency (the pass ran at a third of
-  // the speed of memory on models that fit in cache).
   double sums[kLanes] = {}, worsts[kLanes] = {};
-  const Index m = phi.size();
-  Index i = 0;
-  auto row = [&](int k, Index r) {
+  in_lanes(phi.size(), [&](int k, Index r) {
     const double s = std::fabs(p[r]) * inv[r];
     sums[k] += s * s;
     worsts[k] = worsts[k] < s ? s : worsts[k];  // NaN rows are caught by `finite`
-  };
-  for (; i + kLanes <= m; i += kLanes)
-    for (int k = 0; k < kLanes; ++k) row(k, i + k);
-  for (int k = 0; i < m; ++i, ++k) row(k, i);
+  });
   const double sum = (sums[0] + sums[1]) + (sums[2] + sums[3]);
-  const double worst = std::max(std::max(worsts[0], worsts[1]), std::max(worsts[2], worsts[3]));
+  const double worst = lanes_max(worsts);
   ResidualCheck c;
   c.merit = 0.5 * sum;
   c.worst = worst;
@@ -126,7 +130,7 @@ ResidualCheck check_residual(const Model& model, const Eigen::VectorXd& phi, dou
 }
 
 // trial = q − α·dx (dx = Φq⁻¹Φ, so that −α·dx is the Newton step), in one pass with what the loop needs of the
-// step: its size in the tolerance test, step_ratio(α·dx, trial, tol) (≤ 1 when within the tolerance; NaN sticks),
+// step: its size in the tolerance test, step_ratio(α·dx, trial, tol) (≤ 1 when within the tolerance; +∞ on NaN),
 // and for the full step its scaled norm max_j |dx_j| / scale_j (the contraction estimate's measure) and whether
 // it is finite.
 struct StepPass {
@@ -141,28 +145,22 @@ StepPass take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::Ve
   const double* x = q.data();
   const double* d = dx.data();
   double* out = trial.data();
-  double worst = 0.0, norms[kLanes] = {};  // per lane, as in check_residual
-  auto coordinate = [&](int k, Index j) {
+  detail::WorstRatio worst;  // |step| / allowed, divided only where it may exceed the largest so far
+  double norms[kLanes] = {};
+  in_lanes(q.size(), [&](int k, Index j) {
     const double step = alpha * d[j];
     const double v = x[j] - step;
     out[j] = v;
-    // |step| / allowed, divided only where it exceeds the largest so far (NaN too, and it sticks)
-    const double a = std::fabs(step), allowed = tol * cs[j] + kUlpFloor * std::fabs(v);
-    if (!(a <= worst * allowed)) worst = std::isnan(worst) ? worst : a / allowed;
+    worst.add(std::fabs(step), tol * cs[j] + kUlpFloor * std::fabs(v));
     const double s = std::fabs(d[j]) * inv[j];
     norms[k] = norms[k] < s ? s : norms[k];  // a NaN is lost here, not in `worst`; an infinity is kept
-  };
-  const Index n = q.size();
-  Index j = 0;
-  for (; j + kLanes <= n; j += kLanes)
-    for (int k = 0; k < kLanes; ++k) coordinate(k, j + k);
-  for (int k = 0; j < n; ++j, ++k) coordinate(k, j);
+  });
   StepPass p;
-  p.size = worst;
-  p.norm = std::max(std::max(norms[0], norms[1]), std::max(norms[2], norms[3]));
-  // A NaN in dx makes `worst` NaN (it sticks there), an infinity makes the norm infinite: only then (or on an
-  // overflow of |dx_j| / scale_j) is dx itself looked at.
-  p.finite = (std::isfinite(p.norm) && !std::isnan(worst)) || dx.allFinite();
+  p.size = worst.worst;
+  p.norm = lanes_max(norms);
+  // A NaN in dx makes the worst ratio infinite (WorstRatio), an infinity makes the norm infinite: only then (or on
+  // an overflow of either) is dx itself looked at.
+  p.finite = (std::isfinite(p.norm) && std::isfinite(p.size)) || dx.allFinite();
   return p;
 }
 
