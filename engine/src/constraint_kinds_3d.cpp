@@ -34,14 +34,10 @@ LocalFrame local_frame(const JointSide3& s, const std::string& who) {
 
 }  // namespace
 
-std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const JointSide3& b, const RowDef* defs,
-                                                  int rows, const char* kind) {
+std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const JointSide3& b, const std::int8_t* index,
+                                                  int count, const char* kind) {
   bool used[kCount] = {};
-  for (int r = 0; r < rows; ++r)
-    for (const Term& t : {defs[r].x, defs[r].y}) {
-      if (t.plus >= 0) used[t.plus] = true;
-      if (t.minus >= 0) used[t.minus] = true;
-    }
+  for (int i = 0; i < count; ++i) used[index[i]] = true;
   std::array<Attachment3, kCount> att{};
   const JointSide3* sides[2] = {&a, &b};
   for (int k = 0; k < 2; ++k) {
@@ -66,8 +62,13 @@ std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const Joi
     att[Y] = Attachment3::body_vector(s.frame, f.y);
     att[Z] = Attachment3::body_vector(s.frame, f.z);
   }
-  for (Attachment3& x : att) x.fold_constant();
-  return att;
+  // the named ones, in order, folded where they are constants
+  std::array<Attachment3, kCount> out{};
+  for (int i = 0; i < count; ++i) {
+    out[static_cast<std::size_t>(i)] = att[static_cast<std::size_t>(index[i])];
+    out[static_cast<std::size_t>(i)].fold_constant();
+  }
+  return out;
 }
 
 }  // namespace phiq::detail3

@@ -239,12 +239,22 @@ constexpr CompactRows<kRows> compact_rows(const RowDef (&defs)[kRows]) {
   return c;
 }
 
-/// The attachments of a joint between sides a and b, for the rows `defs` (which say what is needed). Normalises
-/// the axes, makes the reference directions perpendicular. Throws phiq::Error (naming `kind`) for a zero or
-/// non-finite axis, a reference along the axis, non-finite points, and rows that need the perpendicular
-/// directions of a natural side or the axis of a natural point without a vector.
-std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const JointSide3& b, const RowDef* defs,
-                                                  int rows, const char* kind);
+/// The attachments of a joint between sides a and b that `index[0 … count − 1]` name (Attach indices, ascending:
+/// CompactRows::index), in that order in the first `count` entries; an attachment of constants only is folded
+/// into its value (Attachment3::fold_constant). Normalises the axes, makes the reference directions perpendicular.
+/// Throws phiq::Error (naming `kind`) for a zero or non-finite axis, a reference along the axis, non-finite
+/// points, and rows that need the perpendicular directions of a natural side or the axis of a natural point without
+/// a vector.
+std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const JointSide3& b, const std::int8_t* index,
+                                                  int count, const char* kind);
+/// Validates the sides and fills `att` with the attachments the rows of `c` read: the setup() of every joint and
+/// joint driver (`att` has c.count entries).
+template <int kRows, std::size_t N>
+void set_up_attachments(const JointSide3& a, const JointSide3& b, const CompactRows<kRows>& c, const char* kind,
+                        std::array<Attachment3, N>& att) {
+  const std::array<Attachment3, kCount> all = joint_attachments(a, b, c.index, c.count, kind);
+  std::copy_n(all.begin(), N, att.begin());
+}
 /// The longer arm |at| of the sides whose body moves (the characteristic length of a joint; see PinSpec).
 inline double joint_arm(const JointSide3& a, const JointSide3& b) {
   const double la = a.frame.is_fixed() ? 0.0 : kin3::norm(a.at), lb = b.frame.is_fixed() ? 0.0 : kin3::norm(b.at);
@@ -275,11 +285,7 @@ struct SpatialJointSpec {
   std::array<Attachment3, kCompact.count> att{};  ///< derived by setup(): the attachments the rows read
 
   /// Validates the sides and derives `att`. Throws phiq::Error.
-  void setup() {
-    const auto all = detail3::joint_attachments(a, b, Traits::kRowDefs, kRows, kKind);
-    for (int i = 0; i < kCompact.count; ++i)
-      att[static_cast<std::size_t>(i)] = all[static_cast<std::size_t>(kCompact.index[i])];
-  }
+  void setup() { detail3::set_up_attachments(a, b, kCompact, kKind, att); }
   /// @copydoc DistanceSpec::depends_on_time
   bool depends_on_time() const { return false; }
   /// @copydoc DistanceSpec::row_unit
@@ -504,6 +510,11 @@ struct DotSpec {
 ///   Φ = z_a · (P_b − P_a) − f(t),   Φt = −f'(t)        (1 row, a length)
 /// Scene: a driver `{joint: NAME, measure: distance}`.
 struct JointDistanceDriverSpec {
+ private:
+  static constexpr detail3::RowDef kDefs[1] = {
+      {detail3::T(detail3::kZa), detail3::T(detail3::kPb, detail3::kPa), Unit::kLength}};
+
+ public:
   static constexpr int kRows = 1;  ///< one row, a length
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "joint_distance_driver";
@@ -511,10 +522,12 @@ struct JointDistanceDriverSpec {
   /// @brief Side a of the driven joint.
   JointSide3 a, b;  ///< side b of the driven joint
   MotionLaw law;    ///< f(t), metres
-  std::array<Attachment3, detail3::kCount> att{};  ///< derived by setup()
+  /// The row's attachments and the row renumbered into them (detail3::compact_rows).
+  static constexpr auto kCompact = detail3::compact_rows(kDefs);
+  std::array<Attachment3, kCompact.count> att{};  ///< derived by setup(): the attachments the row reads
 
   /// Validates the sides and derives `att`. Throws phiq::Error.
-  void setup() { att = detail3::joint_attachments(a, b, &kDef, 1, kKind); }
+  void setup() { detail3::set_up_attachments(a, b, kCompact, kKind, att); }
   /// @copydoc DistanceSpec::depends_on_time
   bool depends_on_time() const { return true; }
   /// @copydoc DistanceSpec::row_unit
@@ -528,23 +541,19 @@ struct JointDistanceDriverSpec {
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double t, double* phi) const {
-    phi[0] = detail3::row_value(att.data(), kDef, q, 1.0, law.evaluate(t).f);
+    phi[0] = detail3::row_value(att.data(), kCompact.rows[0], q, 1.0, law.evaluate(t).f);
   }
   /// @copydoc DistanceSpec::jacobian
   template <class Sink>
   void jacobian(const double* q, double, Sink& s) const {
-    detail3::row_jacobian(att.data(), kDef, q, s, 0, 1.0);
+    detail3::row_jacobian(att.data(), kCompact.rows[0], q, s, 0, 1.0);
   }
   /// @copydoc DistanceSpec::phi_t
   void phi_t(const double*, double t, double* out) const { out[0] = -law.evaluate(t).df; }
   /// @copydoc DistanceSpec::gamma
   void gamma(const double* q, const double* qd, double t, double* out) const {
-    out[0] = detail3::row_gamma(att.data(), kDef, q, qd, 1.0) + law.evaluate(t).ddf;
+    out[0] = detail3::row_gamma(att.data(), kCompact.rows[0], q, qd, 1.0) + law.evaluate(t).ddf;
   }
-
- private:
-  static constexpr detail3::RowDef kDef = {detail3::T(detail3::kZa), detail3::T(detail3::kPb, detail3::kPa),
-                                           Unit::kLength};
 };
 
 /// Driver on the rotation of a revolute or cylindrical joint: the angle θ of x_b about z_a measured from x_a,
@@ -554,6 +563,12 @@ struct JointDistanceDriverSpec {
 /// driver runs through any number of turns. Φq = (c ∂s − s ∂c) / (c² + s²), Φt = −f'(t).
 /// Both sides must be bodies or ground. Scene: a driver `{joint: NAME}` (`measure: angle`).
 struct JointAngleDriverSpec {
+ private:
+  // c = x_a · x_b and s = y_a · x_b
+  static constexpr detail3::RowDef kDefs[2] = {{detail3::T(detail3::kXa), detail3::T(detail3::kXb), Unit::kNone},
+                                               {detail3::T(detail3::kYa), detail3::T(detail3::kXb), Unit::kNone}};
+
+ public:
   static constexpr int kRows = 1;  ///< one row, an angle
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "joint_angle_driver";
@@ -561,10 +576,12 @@ struct JointAngleDriverSpec {
   /// @brief Side a of the driven joint.
   JointSide3 a, b;  ///< side b of the driven joint
   MotionLaw law;    ///< f(t), radians
-  std::array<Attachment3, detail3::kCount> att{};  ///< derived by setup()
+  /// The two products' attachments and the products renumbered into them (detail3::compact_rows).
+  static constexpr auto kCompact = detail3::compact_rows(kDefs);
+  std::array<Attachment3, kCompact.count> att{};  ///< derived by setup(): the attachments c and s read
 
   /// Validates the sides and derives `att`. Throws phiq::Error.
-  void setup() { att = detail3::joint_attachments(a, b, kDefs, 2, kKind); }
+  void setup() { detail3::set_up_attachments(a, b, kCompact, kKind, att); }
   /// @copydoc DistanceSpec::depends_on_time
   bool depends_on_time() const { return true; }
   /// @copydoc DistanceSpec::row_unit
@@ -578,8 +595,8 @@ struct JointAngleDriverSpec {
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double t, double* phi) const {
-    const double c = detail3::row_value(att.data(), kDefs[0], q, 1.0, 0.0);
-    const double s = detail3::row_value(att.data(), kDefs[1], q, 1.0, 0.0);
+    const double c = detail3::row_value(att.data(), kCompact.rows[0], q, 1.0, 0.0);
+    const double s = detail3::row_value(att.data(), kCompact.rows[1], q, 1.0, 0.0);
     const double f = law.evaluate(t).f, cf = std::cos(f), sf = std::sin(f);
     phi[0] = std::atan2(s * cf - c * sf, c * cf + s * sf);
   }
@@ -589,11 +606,11 @@ struct JointAngleDriverSpec {
   /// entries add up.
   template <class Sink>
   void jacobian(const double* q, double, Sink& sink) const {
-    const double c = detail3::row_value(att.data(), kDefs[0], q, 1.0, 0.0);
-    const double s = detail3::row_value(att.data(), kDefs[1], q, 1.0, 0.0);
+    const double c = detail3::row_value(att.data(), kCompact.rows[0], q, 1.0, 0.0);
+    const double s = detail3::row_value(att.data(), kCompact.rows[1], q, 1.0, 0.0);
     const double rho = c * c + s * s;
-    detail3::row_jacobian(att.data(), kDefs[0], q, sink, 0, -s / rho);
-    detail3::row_jacobian(att.data(), kDefs[1], q, sink, 0, c / rho);
+    detail3::row_jacobian(att.data(), kCompact.rows[0], q, sink, 0, -s / rho);
+    detail3::row_jacobian(att.data(), kCompact.rows[1], q, sink, 0, c / rho);
   }
   /// @copydoc DistanceSpec::phi_t
   void phi_t(const double*, double t, double* out) const { out[0] = -law.evaluate(t).df; }
@@ -602,17 +619,13 @@ struct JointAngleDriverSpec {
   /// θ̈ = (c s̈ − s c̈)/ρ − (c ṡ − s ċ) ρ̇/ρ², ρ̇ = 2 (c ċ + s ṡ); γ keeps the q̈-free parts of c̈, s̈, plus f''(t).
   void gamma(const double* q, const double* qd, double t, double* out) const {
     const Attachment3* a3 = att.data();
-    const double c = detail3::row_value(a3, kDefs[0], q, 1.0, 0.0), s = detail3::row_value(a3, kDefs[1], q, 1.0, 0.0);
-    const double cd = detail3::row_rate(a3, kDefs[0], q, qd, 1.0), sd = detail3::row_rate(a3, kDefs[1], q, qd, 1.0);
+    const double c = detail3::row_value(a3, kCompact.rows[0], q, 1.0, 0.0), s = detail3::row_value(a3, kCompact.rows[1], q, 1.0, 0.0);
+    const double cd = detail3::row_rate(a3, kCompact.rows[0], q, qd, 1.0), sd = detail3::row_rate(a3, kCompact.rows[1], q, qd, 1.0);
     // row_gamma is −(q̈-free part of the second derivative)
-    const double cb = -detail3::row_gamma(a3, kDefs[0], q, qd, 1.0), sb = -detail3::row_gamma(a3, kDefs[1], q, qd, 1.0);
+    const double cb = -detail3::row_gamma(a3, kCompact.rows[0], q, qd, 1.0), sb = -detail3::row_gamma(a3, kCompact.rows[1], q, qd, 1.0);
     const double rho = c * c + s * s, rhod = 2.0 * (c * cd + s * sd);
     out[0] = -(c * sb - s * cb) / rho + (c * sd - s * cd) * rhod / (rho * rho) + law.evaluate(t).ddf;
   }
-
- private:
-  static constexpr detail3::RowDef kDefs[2] = {{detail3::T(detail3::kXa), detail3::T(detail3::kXb), Unit::kNone},
-                                               {detail3::T(detail3::kYa), detail3::T(detail3::kXb), Unit::kNone}};
 };
 
 }  // namespace phiq

@@ -19,6 +19,7 @@
 /// special case at any orientation, and the same formulas for ground (constant p) and natural coordinates (s = 0).
 #pragma once
 
+#include <array>
 #include <cmath>
 
 #include "phiq/types.hpp"
@@ -107,20 +108,16 @@ struct Attachment3 {
   }
   /// R(p) s at q (kept out of the callers: only moving frames need it).
   [[gnu::noinline]] kin3::V3 rotated(const double* q) const {
-    const double e[4] = {p[0].of(q), p[1].of(q), p[2].of(q), p[3].of(q)};
-    return kin3::rotate(e, s);
+    return kin3::rotate(euler(q).data(), s);
   }
   /// 2 B(p, ṗ, s) at (q, q̇).
   [[gnu::noinline]] kin3::V3 rotated_rate(const double* q, const double* qd) const {
-    const double e[4] = {p[0].of(q), p[1].of(q), p[2].of(q), p[3].of(q)};
-    const double ed[4] = {p[0].rate(qd), p[1].rate(qd), p[2].rate(qd), p[3].rate(qd)};
-    return 2.0 * kin3::bilinear(e, ed, s);
+    return 2.0 * kin3::bilinear(euler(q).data(), euler_rates(qd).data(), s);
   }
   /// The part of Ẍ that does not contain q̈: 2 R(ṗ) s.
   kin3::V3 bias(const double* qd) const {
     if (!rotates()) return {};
-    const double ed[4] = {p[0].rate(qd), p[1].rate(qd), p[2].rate(qd), p[3].rate(qd)};
-    return 2.0 * kin3::rotate(ed, s);
+    return 2.0 * kin3::rotate(euler_rates(qd).data(), s);
   }
   /// Emits the entries of ∂(w · X)/∂q at q for row `row`, with w held fixed: w_k on r_k (only on r_only when
   /// `only` ≥ 0: the other components of w are structurally zero), then 2 w · B(p, e_k, s) on p_k when s ≠ 0.
@@ -133,7 +130,7 @@ struct Attachment3 {
       sink(row, r[0], w.x), sink(row, r[1], w.y), sink(row, r[2], w.z);
     }
     if (!rotates()) return;
-    const double e[4] = {p[0].of(q), p[1].of(q), p[2].of(q), p[3].of(q)};
+    const std::array<double, 4> e = euler(q);
     const kin3::V3 ep{e[1], e[2], e[3]};
     const double ws = kin3::dot(w, s), we = kin3::dot(w, ep), es = kin3::dot(ep, s);
     const kin3::V3 sw = kin3::cross(s, w);
@@ -142,6 +139,12 @@ struct Attachment3 {
     sink(row, p[1], 2.0 * (-e[1] * ws + s.x * we + es * w.x + e[0] * sw.x));
     sink(row, p[2], 2.0 * (-e[2] * ws + s.y * we + es * w.y + e[0] * sw.y));
     sink(row, p[3], 2.0 * (-e[3] * ws + s.z * we + es * w.z + e[0] * sw.z));
+  }
+  /// The Euler parameters p at q.
+  std::array<double, 4> euler(const double* q) const { return {p[0].of(q), p[1].of(q), p[2].of(q), p[3].of(q)}; }
+  /// Their rates ṗ at q̇.
+  std::array<double, 4> euler_rates(const double* qd) const {
+    return {p[0].rate(qd), p[1].rate(qd), p[2].rate(qd), p[3].rate(qd)};
   }
   /// Calls f(slot, unit) for the slots X reads: r as `r_unit` (a length for points, none for vectors), p as
   /// Unit::kNone (Euler parameters are unitless).
