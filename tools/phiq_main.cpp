@@ -110,6 +110,15 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
   return true;
 }
 
+// The scene made square for the sweep (prepare_scene(): a model with redundant constraints assembled by minimum
+// norm and solved on its independent rows), or, when it cannot be (inconsistent, under-driven), the reason with
+// the time it applies to.
+std::optional<std::string> make_square(const phiq::Scene& scene, phiq::SquareScene* square) {
+  const phiq::SolveStatus st = phiq::prepare_scene(*scene.model, scene.sweep.t_begin, scene.sweep.assembly, square);
+  if (st == phiq::SolveStatus::kSuccess) return std::nullopt;
+  return "t = " + std::to_string(scene.sweep.t_begin) + ": " + square->assembly.message;
+}
+
 int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
             int threads, double memory_gb, phiq::tools::ProgressBar::Mode progress_mode) {
   const auto load_start = Clock::now();
@@ -117,12 +126,10 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   if (!loaded) return 2;
   phiq::Scene& scene = *loaded;
   const double load_s = since(load_start);
-  // A model that is not square (redundant constraints) is assembled by minimum norm and solved on its independent
-  // rows; inconsistent or under-driven models stop here, naming the constraints.
+  // inconsistent or under-driven models stop here, naming the constraints
   phiq::SquareScene square;
-  if (phiq::prepare_scene(*scene.model, scene.sweep.t_begin, scene.sweep.assembly, &square) != phiq::SolveStatus::kSuccess)
-    return fail(scene_path + ": t = " + std::to_string(scene.sweep.t_begin) + ": " + square.assembly.message +
-                    (out_path.empty() ? "" : "; no output written"), 1);
+  if (const auto why = make_square(scene, &square))
+    return fail(scene_path + ": " + *why + (out_path.empty() ? "" : "; no output written"), 1);
   const phiq::AssemblySummary& redundancy = square.assembly;
   const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;
@@ -256,15 +263,11 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return fail(dir + ": cannot create the output directory: " + ec.message(), 3);
-  // A case whose model is not square (redundant constraints) is assembled by minimum norm and swept on its
-  // independent rows, as `phiq run` does; one that cannot be (inconsistent, under-driven) fails alone.
+  // Each case made square as `phiq run` does; one that cannot be fails alone.
   std::vector<phiq::SquareScene> squares(scenes.size());
   std::vector<std::string> prepare_errors(scenes.size());
-  for (std::size_t k = 0; k < scenes.size(); ++k) {
-    const phiq::Scene& sc = scenes[k];
-    if (phiq::prepare_scene(*sc.model, sc.sweep.t_begin, sc.sweep.assembly, &squares[k]) != phiq::SolveStatus::kSuccess)
-      prepare_errors[k] = "t = " + std::to_string(sc.sweep.t_begin) + ": " + squares[k].assembly.message;
-  }
+  for (std::size_t k = 0; k < scenes.size(); ++k)
+    if (const auto why = make_square(scenes[k], &squares[k])) prepare_errors[k] = *why;
   std::vector<const phiq::Model*> models;
   std::vector<Eigen::VectorXd> starts;
   std::vector<std::size_t> swept;  // the cases that run, in order

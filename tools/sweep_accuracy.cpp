@@ -276,9 +276,9 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
       if (std::find(steps.begin(), steps.end(), s) == steps.end()) steps.push_back(s);
   }
   std::vector<Predictor> preds = opt.predictors;
-  if (preds.empty())
-    preds = {Predictor::kPrevious, Predictor::kSecant, Predictor::kParabolic, Predictor::kLinear, Predictor::kHermite,
-             Predictor::kQuadratic, Predictor::kCubic};
+  if (preds.empty())  // every predictor but auto, which resolves to one of them
+    for (Predictor p : all_predictors())
+      if (p != Predictor::kAuto) preds.push_back(p);
   std::vector<JacobianUpdate> newtons = opt.newton;
   if (newtons.empty()) newtons = {JacobianUpdate::kWhenSlow, JacobianUpdate::kEveryIteration};
   std::vector<LinearSolverKind> lus = opt.linear_solvers;

@@ -41,14 +41,29 @@ const char* to_string(Predictor p) {
   return "?";
 }
 
+const std::vector<Predictor>& all_predictors() {
+  static const std::vector<Predictor> all = {Predictor::kAuto,     Predictor::kPrevious, Predictor::kSecant,
+                                             Predictor::kParabolic, Predictor::kLinear,   Predictor::kHermite,
+                                             Predictor::kQuadratic, Predictor::kCubic};
+  return all;
+}
+
 bool predictor_from_string(const std::string& name, Predictor* p) {
-  for (Predictor k : {Predictor::kAuto, Predictor::kPrevious, Predictor::kSecant, Predictor::kLinear,
-                      Predictor::kQuadratic, Predictor::kCubic, Predictor::kParabolic, Predictor::kHermite})
+  for (Predictor k : all_predictors())
     if (name == to_string(k)) return *p = k, true;
   return false;
 }
 
-const char* predictor_names() { return "auto, previous, secant, parabolic, linear, hermite, quadratic or cubic"; }
+const char* predictor_names() {
+  static const std::string names = [] {
+    const std::vector<Predictor>& all = all_predictors();
+    std::string s;
+    for (std::size_t i = 0; i < all.size(); ++i)
+      s += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + std::string(to_string(all[i]));
+    return s;
+  }();
+  return names.c_str();
+}
 
 Predictor effective_predictor(Predictor p, bool velocities, bool accelerations) {
   if (p != Predictor::kAuto) return p;

@@ -40,8 +40,10 @@ enum class Predictor {
 const char* to_string(Predictor p);
 /// The predictor named `name` (to_string()'s words); false, leaving `*p` unchanged, for any other text.
 bool predictor_from_string(const std::string& name, Predictor* p);
-/// The names predictor_from_string() takes, for messages: "auto, previous, secant, parabolic, linear, quadratic or
-/// cubic".
+/// Every predictor, Predictor::kAuto first, in the order predictor_names() lists them.
+const std::vector<Predictor>& all_predictors();
+/// The names predictor_from_string() takes, for messages: "auto, previous, secant, parabolic, linear, hermite,
+/// quadratic or cubic".
 const char* predictor_names();
 /// The predictor a sweep runs with: `p` itself, or for Predictor::kAuto the best for what the sweep computes
 /// (velocities: q̇ is solved, also when only accelerations are asked for; accelerations: q̈ is solved).
