@@ -524,8 +524,23 @@ class Sweeper {
         worst.add(std::fabs(e), tol * cs[j] + ToleranceScales::kUlpFloor * std::fabs(p));
       }
     };
-    // Reciprocals of the node spacings, once per step: the passes below multiply (no division per coordinate).
-    auto inv = [](double d) { return d != 0.0 ? 1.0 / d : 0.0; };
+    // The nodes of the divided-difference predictors: tc, t_0, t_1, t_2 (the current row, then the history; the
+    // current row again where the history is shorter), their rows, and the reciprocals of their spacings, once per
+    // step, so that the passes below multiply (no division per coordinate).
+    struct Nodes {
+      double T[4];
+      const double* xs[3];
+      double i01, i12, i23, i02, i13, i03;
+    };
+    auto nodes = [&] {
+      auto inv = [](double d) { return d != 0.0 ? 1.0 / d : 0.0; };
+      Nodes nd{{tc, k > 0 ? th(0) : tc, k > 1 ? th(1) : tc, k > 2 ? th(2) : tc},
+               {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q}, 0, 0, 0, 0, 0, 0};
+      const double* T = nd.T;
+      nd.i01 = inv(T[0] - T[1]), nd.i12 = inv(T[1] - T[2]), nd.i23 = inv(T[2] - T[3]);
+      nd.i02 = inv(T[0] - T[2]), nd.i13 = inv(T[1] - T[3]), nd.i03 = inv(T[0] - T[3]);
+      return nd;
+    };
     switch (predictor_) {
       case Predictor::kPrevious:
       case Predictor::kSecant:
@@ -536,11 +551,11 @@ class Sweeper {
         estimated = k > order;
         const int terms = order + (estimated ? 1 : 0);
         inherited = 0.0;
-        const double T[4] = {tc, k > 0 ? th(0) : tc, k > 1 ? th(1) : tc, k > 2 ? th(2) : tc};
+        const Nodes nd = nodes();
+        const double* T = nd.T;
+        const double* const* xs = nd.xs;
+        const double i01 = nd.i01, i12 = nd.i12, i23 = nd.i23, i02 = nd.i02, i13 = nd.i13, i03 = nd.i03;
         const double w1 = h, w2 = w1 * (t1 - T[1]), w3 = w2 * (t1 - T[2]);
-        const double* xs[3] = {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q};
-        const double i01 = inv(T[0] - T[1]), i12 = inv(T[1] - T[2]), i23 = inv(T[2] - T[3]);
-        const double i02 = inv(T[0] - T[2]), i13 = inv(T[1] - T[3]), i03 = inv(T[0] - T[3]);
         // the rows' own errors carry over with the weights of Lagrange's polynomial through them at t1
         for (int i = 0; i <= order; ++i) {
           double w = 1.0;
@@ -577,11 +592,11 @@ class Sweeper {
         const int order = std::min(3, k + 1);  // Newton terms after q: (t − tc) q̇, then one per row of history
         estimated = k > 2;
         const int terms = order + (estimated ? 1 : 0);
-        const double T[4] = {tc, k > 0 ? th(0) : tc, k > 1 ? th(1) : tc, k > 2 ? th(2) : tc};
+        const Nodes nd = nodes();
+        const double* T = nd.T;
+        const double* const* xs = nd.xs;
+        const double i01 = nd.i01, i12 = nd.i12, i23 = nd.i23, i02 = nd.i02, i13 = nd.i13, i03 = nd.i03;
         const double w1 = h, w2 = w1 * h, w3 = w2 * (t1 - T[1]), w4 = w3 * (t1 - T[2]);
-        const double* xs[3] = {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q};
-        const double i01 = inv(T[0] - T[1]), i12 = inv(T[1] - T[2]), i23 = inv(T[2] - T[3]);
-        const double i02 = inv(T[0] - T[2]), i13 = inv(T[1] - T[3]), i03 = inv(T[0] - T[3]);
         // Each term as a function of the positions q, q_0, q_1, q_2 (and q̇), so that the rows' own errors carry
         // over with the weights the prediction gives them: found by evaluating it on unit values.
         auto eval = [&](const double* f, double fd, double* next) {
