@@ -67,8 +67,9 @@ class Workspace {
   double factorized_t = 0.0;             ///< see factorized_q
   bool has_factorization = false;        ///< lu holds valid factors at (factorized_q, factorized_t)
   /// The factors are of Φq at the solution the last solve_position converged to (set by that solve when its last
-  /// factorisation is within the tolerance of the solution, and by the sweep's derivative solves after they
-  /// factorise there); cleared by every solve_position at its start.
+  /// factorisation is within the tolerance of the solution — or, at a stop at the rounding level, was made where
+  /// the last step, a rounding-level one, started: q is known no better than that step — and by the sweep's
+  /// derivative solves after they factorise there); cleared by every solve_position at its start.
   bool factorized_at_solution = false;
   /// Contraction of modified Newton last observed with a reused factorisation (kept by the solves that observe
   /// none, −1 before any and after a failed solve): the error estimate of the next solve's first step.
