@@ -330,6 +330,37 @@ TEST(ParallelSweep, EqualsTheSequentialSweepForAnyThreadCount) {
   }
 }
 
+// A parallel sweep writes its held rows into recycled buffers and leaves them in the workspace for the next one
+// (Workspace::spare_rows): a second sweep with the same workspace, reusing them, still delivers the sequential
+// sweep's rows; buffers of another size left there are dropped, not used.
+TEST(ParallelSweep, RowBuffersAreRecycledAndKeptInTheWorkspace) {
+  Model m = test::nfourbar_model(40, M_PI / 4, M_PI / 2);
+  const Index n = m.num_coordinates();
+  SweepOptions opt;
+  opt.steps = 200;
+  test::Trace seq;
+  ASSERT_EQ(test::sweep(m, opt, &seq), SolveStatus::kSuccess);
+  opt.threads = 2;
+  opt.chunk_steps = 16;
+  Workspace ws(m);
+  ws.spare_rows.emplace_back(Eigen::VectorXd::Constant(3, 7.0));  // not a row of this model
+  for (int run = 0; run < 2; ++run) {
+    ws.q = m.initial_positions();
+    test::Trace par;
+    SweepSummary ps;
+    ASSERT_EQ(test::sweep(m, opt, &par, &ps, &ws), SolveStatus::kSuccess) << ps.message;
+    EXPECT_EQ(ps.parallel_chunks, 13) << "run " << run;
+    EXPECT_LT(test::max_difference(seq, par, 0), 1e-9) << "run " << run;
+    EXPECT_LT(test::max_difference(seq, par, 1), 1e-8) << "run " << run;
+    EXPECT_LT(test::max_difference(seq, par, 2), 1e-8) << "run " << run;
+    // every delivered row's q, q̇, q̈ went back to the pool: at least one chunk's (16 rows × 3), never more
+    // than the bound, all of the model's size
+    EXPECT_GE(ws.spare_rows.size(), 48u) << "run " << run;
+    EXPECT_LE(static_cast<double>(ws.spare_rows.size()) * 8.0 * static_cast<double>(n), Workspace::kSpareRowBytes);
+    for (const Eigen::VectorXd& v : ws.spare_rows) ASSERT_EQ(v.size(), n) << "run " << run;
+  }
+}
+
 // Through singular positions (a full turn of the N four-bar: the cranks are horizontal twice, where the dof jumps),
 // the result must still be the sequential sweep's, however the seeds behave there.
 TEST(ParallelSweep, ThroughSingularPositionsMatchesTheSequentialSweep) {

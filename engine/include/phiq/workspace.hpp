@@ -71,6 +71,13 @@ class Workspace {
   /// the last step, a rounding-level one, started: q is known no better than that step — and by the sweep's
   /// derivative solves after they factorise there); cleared by every solve_position at its start.
   bool factorized_at_solution = false;
+  /// Buffers of num_coordinates() entries for the rows a parallel sweep holds until it delivers them in order (its
+  /// chunks' q, q̇, q̈), kept for the next parallel sweep with this workspace: writing rows into memory the process
+  /// already has, rather than into pages the system must map in and clear, made a repeated 2-thread sweep of
+  /// nfourbar N = 10³ 7 % faster (bench/README.md). At most kSpareRowBytes are kept after a sweep; clearing the
+  /// vector (with shrink_to_fit) gives the memory back.
+  std::vector<Eigen::VectorXd> spare_rows;
+  static constexpr double kSpareRowBytes = 64.0 * 1024 * 1024;  ///< see spare_rows
   /// Contraction of modified Newton last observed with a reused factorisation (kept by the solves that observe
   /// none, −1 before any and after a failed solve): the error estimate of the next solve's first step.
   double newton_contraction = -1.0;
