@@ -865,9 +865,6 @@ bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b
 // Rows a parallel sweep may hold at once before delivering them in order (all waves' chunks together).
 constexpr double kRowBufferBytes = 512.0 * 1024 * 1024;
 
-// A row computed by a parallel chunk, held until it is delivered in order. Its vectors are delivered as they are
-// (no copy into the caller's state per row: on a model whose steps are cheap, copying rows in and out cost a fifth
-// of a chunk's time).
 // to = from (to has from's size), with stores that bypass the caches where the processor has them (SSE2): a
 // parallel chunk's rows are read again only when they are delivered, long after, and writing them through the
 // caches evicted the chunk's own LU factors and constraints (nfourbar N = 10⁴, 2 threads: 2–3 % of the sweep).
@@ -886,6 +883,9 @@ void stream_copy(const Eigen::VectorXd& from, Eigen::VectorXd& to) {
 #endif
 }
 
+// A row computed by a parallel chunk, held until it is delivered in order. Its vectors are delivered as they are
+// (no copy into the caller's state per row: on a model whose steps are cheap, copying rows in and out cost a fifth
+// of a chunk's time).
 struct Row {
   Eigen::VectorXd q, qd, qdd, phi;  // q̇, q̈ as solved, Φ when asked
   double rcond = 0.0;
