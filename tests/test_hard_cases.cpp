@@ -269,8 +269,8 @@ TEST(HardCases, LongChainPositionsOnlyDoNotDrift) {
 // happens at the default tolerance from about 10^5 stages, bench/README.md). Newton stops at that rounding level
 // instead of refactorising in search of a contraction that cannot come: the sweep succeeds, warns once per stretch
 // of such rows, naming the coordinate and how well it is known, costs hardly more factorisations than at the
-// default tolerance (1e-10, where no row warns), and its positions, velocities and accelerations are as close to the closed form L_k = (0, k sin θ),
-// R_k = (cos θ, k sin θ) as the default's (measured: 1.2e-10 and 1.1e-10 m at the top, 600 m up, with the quadratic
+// default tolerance (1e-10, where no row warns), and its positions, velocities and accelerations are as close to
+// the closed form L_k = (0, k sin θ), R_k = (cos θ, k sin θ) as the default's (measured: 1.2e-10 and 1.1e-10 m at the top, 600 m up, with the quadratic
 // predictor; 2.1e-10 m at the default with the cubic one, whose rows take one Newton step each: the top joints are
 // at their rounding level, about 1.2 tolerances, which a step's error estimate does not see).
 TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {

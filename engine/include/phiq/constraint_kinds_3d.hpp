@@ -595,8 +595,7 @@ struct JointAngleDriverSpec {
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double t, double* phi) const {
-    const double c = detail3::row_value(att.data(), kCompact.rows[0], q, 1.0, 0.0);
-    const double s = detail3::row_value(att.data(), kCompact.rows[1], q, 1.0, 0.0);
+    const auto [c, s] = products(q);
     const double f = law.evaluate(t).f, cf = std::cos(f), sf = std::sin(f);
     phi[0] = std::atan2(s * cf - c * sf, c * cf + s * sf);
   }
@@ -606,8 +605,7 @@ struct JointAngleDriverSpec {
   /// entries add up.
   template <class Sink>
   void jacobian(const double* q, double, Sink& sink) const {
-    const double c = detail3::row_value(att.data(), kCompact.rows[0], q, 1.0, 0.0);
-    const double s = detail3::row_value(att.data(), kCompact.rows[1], q, 1.0, 0.0);
+    const auto [c, s] = products(q);
     const double rho = c * c + s * s;
     detail3::row_jacobian(att.data(), kCompact.rows[0], q, sink, 0, -s / rho);
     detail3::row_jacobian(att.data(), kCompact.rows[1], q, sink, 0, c / rho);
@@ -619,12 +617,21 @@ struct JointAngleDriverSpec {
   /// θ̈ = (c s̈ − s c̈)/ρ − (c ṡ − s ċ) ρ̇/ρ², ρ̇ = 2 (c ċ + s ṡ); γ keeps the q̈-free parts of c̈, s̈, plus f''(t).
   void gamma(const double* q, const double* qd, double t, double* out) const {
     const Attachment3* a3 = att.data();
-    const double c = detail3::row_value(a3, kCompact.rows[0], q, 1.0, 0.0), s = detail3::row_value(a3, kCompact.rows[1], q, 1.0, 0.0);
-    const double cd = detail3::row_rate(a3, kCompact.rows[0], q, qd, 1.0), sd = detail3::row_rate(a3, kCompact.rows[1], q, qd, 1.0);
+    const detail3::RowDef& cdef = kCompact.rows[0];
+    const detail3::RowDef& sdef = kCompact.rows[1];
+    const auto [c, s] = products(q);
+    const double cd = detail3::row_rate(a3, cdef, q, qd, 1.0), sd = detail3::row_rate(a3, sdef, q, qd, 1.0);
     // row_gamma is −(q̈-free part of the second derivative)
-    const double cb = -detail3::row_gamma(a3, kCompact.rows[0], q, qd, 1.0), sb = -detail3::row_gamma(a3, kCompact.rows[1], q, qd, 1.0);
+    const double cb = -detail3::row_gamma(a3, cdef, q, qd, 1.0), sb = -detail3::row_gamma(a3, sdef, q, qd, 1.0);
     const double rho = c * c + s * s, rhod = 2.0 * (c * cd + s * sd);
     out[0] = -(c * sb - s * cb) / rho + (c * sd - s * cd) * rhod / (rho * rho) + law.evaluate(t).ddf;
+  }
+
+ private:
+  // c = x_a · x_b and s = y_a · x_b at q: what Φ, Φq and γ all start from
+  std::array<double, 2> products(const double* q) const {
+    return {detail3::row_value(att.data(), kCompact.rows[0], q, 1.0, 0.0),
+            detail3::row_value(att.data(), kCompact.rows[1], q, 1.0, 0.0)};
   }
 };
 
