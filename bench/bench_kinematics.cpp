@@ -13,6 +13,8 @@
 #include <thread>
 #include <tuple>
 
+#include <tbb/task_arena.h>
+
 #include "nfourbar_model.hpp"
 #include "phiq/phiq.hpp"
 
@@ -619,6 +621,63 @@ void BM_NFourBarOutputCost(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_NFourBarOutputCost)->ArgName("N")->Arg(10)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(7);
+
+// Writing the result CSV (issue 4: a wide CSV must not dominate a large run): one row of q, q̇, q̈ of nfourbar formatted
+// by CsvFormat::append_row (shortest round-trip text), in a task arena of 1 thread and of 2, interleaved, against the
+// time of one drive step of the same model on one thread (a 200-step sweep, q, q̇, q̈). format_per_step_1t > 1 means
+// that one thread writing the rows would take longer than one thread solving them.
+void BM_CsvRowFormatting(benchmark::State& state) {
+  const Index n = state.range(0), steps = 200;
+  Model m = nfourbar(n, M_PI / 4, M_PI / 2);
+  Workspace ws(m);
+  SweepOptions o;
+  o.steps = steps;
+  o.threads = 1;
+  Eigen::VectorXd q, qd, qdd;  // the last row: values as a run writes them
+  const auto s0 = Clock::now();
+  run_sweep(m, o, ws, [&](const StepView& s) {
+    if (s.step == steps) q = s.q, qd = *s.qd, qdd = *s.qdd;
+    return true;
+  }, nullptr);
+  const double step_s = seconds_since(s0) / static_cast<double>(steps);
+  std::vector<Index> columns(static_cast<std::size_t>(m.num_coordinates()));
+  for (std::size_t j = 0; j < columns.size(); ++j) columns[j] = static_cast<Index>(j);
+  const CsvFormat csv(m, columns, true, true);
+  const StepView row{steps, 1.0, q, &qd, &qdd};
+  tbb::task_arena one(1), two(2);
+  const int rows = std::max<int>(1, static_cast<int>(1000000 / (3 * n)));  // about 10⁶ numbers per pass
+  std::string out;
+  double t1 = 0, t2 = 0;
+  std::size_t bytes = 0;
+  auto pass = [&](tbb::task_arena& arena) {
+    const auto t0 = Clock::now();
+    arena.execute([&] {
+      for (int r = 0; r < rows; ++r) {
+        out.clear();
+        csv.append_row(row, out);
+      }
+    });
+    bytes = out.size();
+    return seconds_since(t0);
+  };
+  for (auto _ : state) {
+    t1 += pass(one);
+    const double e = pass(two);
+    t2 += e;
+    state.SetIterationTime(e);
+  }
+  const double values = 3.0 * static_cast<double>(m.num_coordinates()) + 1.0;
+  const double per_row_1 = t1 / (static_cast<double>(state.iterations()) * rows);
+  const double per_row_2 = t2 / (static_cast<double>(state.iterations()) * rows);
+  state.counters["ns_per_value_1t"] = 1e9 * per_row_1 / values;
+  state.counters["ns_per_value_2t"] = 1e9 * per_row_2 / values;
+  state.counters["speedup"] = t1 / t2;
+  state.counters["bytes_per_value"] = static_cast<double>(bytes) / values;
+  state.counters["step_us"] = 1e6 * step_s;
+  state.counters["format_per_step_1t"] = per_row_1 / step_s;
+  state.counters["format_per_step_2t"] = per_row_2 / step_s;
+}
+BENCHMARK(BM_CsvRowFormatting)->ArgName("N")->Arg(10)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(5);
 
 }  // namespace
 

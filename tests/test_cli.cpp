@@ -7,6 +7,7 @@
 #include <charconv>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -434,6 +435,14 @@ TEST_F(Cli, SummaryJsonCountsWhatWasComputed) {
                            "\"solve_seconds\": ", "\"write_seconds\": ", "\"linear_solver\": \"klu\"", "\"warnings\": []",
                            "\"min_rcond\": null"})
     EXPECT_NE(j.find(part), std::string::npos) << part << "\n" << j;
+  // the sweep's wall time holds the solve and the writing done in the sweep (the final flush comes after it)
+  auto number = [&](const std::string& key) {
+    const std::size_t at = j.find("\"" + key + "\": ");
+    return at == std::string::npos ? -1.0 : std::strtod(j.c_str() + at + key.size() + 4, nullptr);
+  };
+  EXPECT_GT(number("sweep_seconds"), 0.0) << j;
+  EXPECT_GE(number("sweep_seconds"), number("solve_seconds")) << j;
+  EXPECT_GE(number("solve_seconds"), 0.0) << j;
   // with velocities and accelerations: one of each per row
   ASSERT_EQ(run("generate nfourbar 3 --steps 10 -o " + scene.string()).code, 0);
   ASSERT_EQ(run("run -q " + scene.string() + " -o " + (dir_ / "p.csv").string() + " --summary " + sum.string()).code, 0);

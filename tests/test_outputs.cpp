@@ -3,7 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <limits>
+
+#include <tbb/task_arena.h>
 
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
@@ -246,6 +250,72 @@ TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
   EXPECT_DOUBLE_EQ(v[13], rocker);
   EXPECT_GE(v[14], v[13]);  // the largest over all rows is at least the rocker's
   EXPECT_LE(v[14], 1e-10);
+}
+
+// The text a row's values should have: shortest round-trip (std::to_chars), −0 written as 0, one value at a time.
+std::string reference_row(double t, const std::vector<const Eigen::VectorXd*>& groups, const std::vector<Index>& cols) {
+  auto text = [](double v) {
+    char buf[64];
+    if (v == 0.0) v = 0.0;
+    return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
+  };
+  std::string r = text(t);
+  for (const Eigen::VectorXd* g : groups)
+    for (Index j : cols) r.append(",").append(text((*g)(j)));
+  return r + "\n";
+}
+
+TEST(CsvFormat, WideRowsFormattedInParallelReadAsTheSequentialText) {
+  // 4 003 coordinates: q, q̇, q̈ make 12 009 values, twelve blocks of the parallel formatting (the last one short)
+  const Model m = test::nfourbar_model(2000, M_PI / 4, 1.0);
+  const Index n = m.num_coordinates();
+  ASSERT_EQ(n, 4003);
+  // values of every shape: −0, signed, tiny, huge, subnormal, integers, 17 significant digits
+  Eigen::VectorXd q(n), qd(n), qdd(n);
+  const double special[] = {-0.0, 0.0, 1.0, -2.5, 1e-300, -1.7976931348623157e308, 4.9406564584124654e-324,
+                            0.1, 1.0 / 3.0, -123456789.0, 2.2250738585072014e-308};
+  for (Index j = 0; j < n; ++j) {
+    q(j) = j < 11 ? special[j] : std::sin(0.37 * static_cast<double>(j)) * std::pow(10.0, j % 40 - 20);
+    qd(j) = -std::cos(1.3 * static_cast<double>(j)) * (1 + j);
+    qdd(j) = j % 7 == 0 ? -0.0 : 1.0 / (1.0 + static_cast<double>(j));
+  }
+  // every column, then a subset in scrambled order (the blocks' boundaries fall inside a group, at other columns)
+  std::vector<Index> all(static_cast<std::size_t>(n)), some;
+  for (Index j = 0; j < n; ++j) all[static_cast<std::size_t>(j)] = j;
+  for (Index j = n - 1; j >= 0; j -= 3) some.push_back(j);
+  for (Index j = 1; j < n; j += 5) some.push_back(j);
+  const StepView step{3, 0.125, q, &qd, &qdd};
+  for (const std::vector<Index>* cols : {&all, &some}) {
+    for (const auto& [v, a] : {std::pair{true, true}, std::pair{false, true}, std::pair{false, false}}) {
+      const CsvFormat csv(m, *cols, v, a);
+      std::vector<const Eigen::VectorXd*> groups{&q};
+      if (v) groups.push_back(&qd);
+      if (a) groups.push_back(&qdd);
+      const std::string expected = reference_row(0.125, groups, *cols);
+      for (int threads : {1, 2, 4}) {
+        // after earlier text, as the CLI's buffer holds the rows before it
+        std::string out = "earlier row\n";
+        tbb::task_arena(threads).execute([&] {
+          csv.append_row(step, out);
+          csv.append_row(step, out);
+        });
+        EXPECT_EQ(out, "earlier row\n" + expected + expected)
+            << cols->size() << " columns, v " << v << ", a " << a << ", " << threads << " threads";
+      }
+    }
+  }
+  // a narrow row (one block) too, and the pre-conditions
+  const CsvFormat narrow(m, {0, 1, 4002}, true, true);
+  std::string out;
+  narrow.append_row(step, out);
+  EXPECT_EQ(out, reference_row(0.125, {&q, &qd, &qdd}, {0, 1, 4002}));
+  out.clear();
+  CsvFormat(m, {0, 2, 3, 4, 6, 8, 5}, false, false).append_row(step, out);
+  EXPECT_EQ(out, "0.125,0,1,-2.5,1e-300,5e-324,0.3333333333333333,-1.7976931348623157e+308\n");
+  const CsvFormat wide(m, all, true, true);
+  EXPECT_THROW(wide.append_row(StepView{0, 0.0, q, nullptr, &qdd}, out), Error);
+  const Eigen::VectorXd shorter = q.head(n - 1);
+  EXPECT_THROW(wide.append_row(StepView{0, 0.0, shorter, &qd, &qdd}, out), Error);
 }
 
 TEST(OutputPlan, BadOutputListsAreOneLineErrorsNamingTheField) {

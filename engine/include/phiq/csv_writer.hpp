@@ -28,7 +28,9 @@ class CsvFormat {
   std::vector<std::string> column_names() const;
   /// The header line, with '\\n'.
   std::string header() const;
-  /// Appends one line (with '\n') for this step. Pre-condition: the step carries qd / qdd when they are columns.
+  /// Appends one line (with '\n') for this step. Pre-condition: the step carries qd / qdd when they are columns
+  /// (throws phiq::Error otherwise, or when its vectors are not the model's size). A wide row (more than 1 024
+  /// coordinate values) is formatted in parallel by the current task arena's threads: `phiq run --threads 1` is one.
   void append_row(const StepView& step, std::string& out) const;
 
  private:
@@ -36,7 +38,8 @@ class CsvFormat {
   std::vector<Index> columns_;
   bool velocities_, accelerations_;
   const Scene* scene_ = nullptr;  // the other outputs, when made from a scene
-  void append_outputs(const StepView& step, std::string& out) const;  // the columns after the coordinates
+  void append_coordinates(const StepView& step, std::string& out) const;  // the q, q̇, q̈ columns
+  void append_outputs(const StepView& step, std::string& out) const;      // the columns after the coordinates
 };
 
 /// An output file that appears only when complete: written under a temporary name in the same directory and
