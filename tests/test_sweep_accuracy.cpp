@@ -157,6 +157,32 @@ TEST_F(SweepAccuracy, WithoutAClosedFormTheReferenceIsTheSceneAtTightTolerance) 
   }
 }
 
+TEST_F(SweepAccuracy, RedundantScenesAreSweptAsPhiqRunSweepsThem) {
+  // A door on three hinges (10 consistent redundant equations): swept on its independent rows, as `phiq run` does,
+  // against the numerical reference of that same square model; it was refused as "not square" before.
+  const fs::path csv = dir_ / "acc.csv";
+  Result r = run(test::model_path("redundant/door_three_hinges.yaml") +
+                 " --tolerances 1e-4,1e-11 --steps-list 30 --predictors previous --newton full --linear-solvers klu"
+                 " --repeat 1 -o " + csv.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto rs = rows(csv);
+  ASSERT_EQ(rs.size(), 2u);
+  for (const auto& row : rs) {
+    EXPECT_EQ(row.at("status"), "ok");
+    EXPECT_EQ(row.at("reference"), "numerical");
+  }
+  EXPECT_LT(std::stod(rs[1].at("err_q")), 1e-10);
+  EXPECT_LT(std::stod(rs[1].at("err_q")), std::stod(rs[0].at("err_q")));
+  // Its third hinge 5 mm off the axis: inconsistent, refused as `phiq run` refuses it (exit 1), naming the hinges.
+  const fs::path refused = dir_ / "refused.csv";
+  r = run(test::model_path("redundant/door_misaligned.yaml") + " --tolerances 1e-6 -o " + refused.string());
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("t = 0: inconsistent redundant constraints"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("conflicting constraints: hinge1, hinge3"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(refused));
+}
+
 TEST_F(SweepAccuracy, BadInputIsOneLineAndWritesNothing) {
   const std::string out = " -o " + (dir_ / "acc.csv").string();
   const std::string cs = seed("crank_slider_mixed");

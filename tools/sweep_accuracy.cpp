@@ -254,10 +254,15 @@ std::vector<LinearSolverKind> parse_linear_solvers(const std::string& list) {
 
 AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
                                 const std::function<void(const std::string&)>& progress) {
-  const Model& model = *scene.model;
-  if (!model.symbolic()) throw std::invalid_argument("the model is not square: nothing to sweep");
   if (opt.repeat < 1) throw std::invalid_argument("--repeat must be at least 1");
   const SweepOptions& so = scene.sweep;
+  // The model `phiq run` sweeps: a scene with consistent redundant constraints is assembled by minimum norm and
+  // solved on its independent rows (every row is still evaluated and checked); an inconsistent or under-driven one
+  // is refused with prepare_scene()'s reason.
+  SquareScene square;
+  if (prepare_scene(*scene.model, so.t_begin, so.assembly, &square) != SolveStatus::kSuccess)
+    throw std::runtime_error("t = " + short_num(so.t_begin, 17) + ": " + square.assembly.message);
+  const Model& model = square.model(*scene.model);
   AccuracyReport rep;
   rep.scene_path = scene.path;
   rep.scene_name = scene.name;
@@ -287,13 +292,14 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
   // Every run starts from the assembled position at t_begin (tight, full Newton), so that the time per step is the
   // drive steps' and not the assembly from the scene's rough placement.
   Workspace ws0(model);
+  ws0.q = square.start;
   {
     NewtonOptions a = so.assembly;
     a.tolerance = kReferenceTolerance;
     a.max_iterations = std::max(a.max_iterations, 100);
     PositionSummary ps;
     if (solve_position(model, so.t_begin, a, ws0, &ps) != SolveStatus::kSuccess) {
-      ws0.q = model.initial_positions();
+      ws0.q = square.start;
       if (solve_position(model, so.t_begin, so.assembly, ws0, &ps) != SolveStatus::kSuccess)
         throw std::runtime_error("assembly at t = " + short_num(so.t_begin, 17) + " failed: " + ps.message);
     }
