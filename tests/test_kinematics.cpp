@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <tuple>
 
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
@@ -321,6 +323,59 @@ TEST(Kinematics, ConvergenceDoesNotDependOnTheOrigin) {
     ASSERT_EQ(test::sweep(m, opt, &tr), SolveStatus::kSuccess) << "shift " << shift;
     for (std::size_t k = 0; k < tr.t.size(); ++k)
       EXPECT_NEAR(tr.q[k](3) - shift, slider(2.0 * tr.t[k]).x, 1e-8) << "shift " << shift;
+  }
+}
+
+TEST(Kinematics, RoundingFloorIsTheRowsSensitivityToItsCoordinates) {
+  // A bar 10^6 m from the origin: Φ = (|B − A|² − L²) / 2L, ∂Φ/∂x_B = −∂Φ/∂x_A = d_x / L (and y alike), so the floor
+  // is 64 ε (|d_x| (|x_A| + |x_B|) + |d_y| (|y_A| + |y_B|)) / L: the few ulps a residual computed there carries.
+  const double xa = 1e6 + 0.3, ya = -2e5 + 0.4, xb = 1e6 + 1.1, yb = -2e5 - 0.2, len = 1.25;
+  ModelBuilder b;
+  auto S = Slot::coordinate;
+  const Index ia = b.add_coordinate("xa", xa), ja = b.add_coordinate("ya", ya), ib = b.add_coordinate("xb", xb),
+              jb = b.add_coordinate("yb", yb);
+  b.add("bar", DistanceSpec{{S(ia), S(ja)}, {S(ib), S(jb)}, len});
+  Model m = std::move(b).build();
+  const Eigen::VectorXd q = m.initial_positions();
+  const double dx = xb - xa, dy = yb - ya;
+  const double expected = ToleranceScales::kUlpFloor *
+                          (std::fabs(dx) * (std::fabs(xa) + std::fabs(xb)) + std::fabs(dy) * (std::fabs(ya) + std::fabs(yb))) / len;
+  EXPECT_NEAR(m.row_rounding_floor(0, q.data(), 0.0), expected, 1e-14 * expected);
+
+  // A driver atan(x) = t at x = 10^26: the row hardly moves with x (∂/∂x = 1/(1 + x²)), so the floor is
+  // 64 ε · |x| / (1 + x²) ≈ 1e-38 and not 64 ε · |x| ≈ 4e14, which passed any residual for a drive beyond π/2.
+  const Scene sc = parse_scene(R"Y(
+coordinates: {x: 1e26}
+drivers:
+  - {name: d, expr: "atan(x)", unit: angle, law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 2, steps: 4}
+)Y", "atan.yaml");
+  const Eigen::VectorXd qx = sc.model->initial_positions();
+  EXPECT_NEAR(sc.model->row_rounding_floor(0, qx.data(), 2.0), ToleranceScales::kUlpFloor * 1e26 / (1.0 + 1e52), 1e-52);
+  EXPECT_THROW(sc.model->row_rounding_floor(1, qx.data(), 2.0), Error);
+}
+
+TEST(Kinematics, ADriveBeyondAnAsymptoteFailsWhereThePositionsStopExisting) {
+  // atan(x) = t has no solution from t = π/2 on (x runs off to infinity), nor 1/x = 1 − t from t = 1 for x > 0.
+  // A residual of 0.43 at x = 2e26 was accepted before as "within its rounding floor" (64 ulps of |x|): the sweep
+  // reported success with rows far off. Now it stops at the asymptote, and no row after it is delivered.
+  for (const auto& [expr, rate, t_star] : {std::tuple{"atan(x)", 1.0, M_PI / 2}, std::tuple{"1/x", -1.0, 1.0}}) {
+    const std::string start = rate > 0 ? "0" : "1";
+    const std::string text = "coordinates: {x: " + start + "}\ndrivers:\n  - {name: d, expr: \"" + expr +
+                             "\", unit: angle, law: {type: linear, initial: " + start + ", rate: " +
+                             std::to_string(rate) + "}}\ntime: {start: 0, end: 2, steps: 4}\n";
+    const Scene sc = parse_scene(text, "asymptote.yaml");
+    Workspace ws(*sc.model);
+    SweepSummary sum;
+    double last_t = -1.0;
+    const SolveStatus st = run_sweep(*sc.model, sc.sweep, ws, [&](const StepView& v) {
+      last_t = v.t;
+      return true;
+    }, &sum);
+    EXPECT_NE(st, SolveStatus::kSuccess) << expr;
+    EXPECT_LT(last_t, t_star) << expr;
+    EXPECT_GT(sum.failed_time, t_star - 0.5) << expr << ": " << sum.message;
+    EXPECT_LE(sum.failed_time, t_star + 0.5) << expr << ": " << sum.message;
   }
 }
 

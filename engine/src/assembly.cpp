@@ -81,7 +81,7 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
   double f = 0.5 * b.squaredNorm(), mu = 0.0;
   while (sum.iterations < opt.max_iterations) {
     if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
-    if (scaled_rows_within(model, b, nullptr, opt.tolerance, q)) return SolveStatus::kSuccess;
+    if (scaled_rows_within(model, b, nullptr, opt.tolerance, q, t)) return SolveStatus::kSuccess;
     jac.evaluate(q, t, jv);
     tv.resize(from.size());
     for (std::size_t k = 0; k < from.size(); ++k) tv[k] = jv[static_cast<std::size_t>(from[k])];
@@ -102,7 +102,7 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
       if (alpha == 1.0) mu *= 0.1;
       continue;
     }
-    if (scaled_rows_within(model, b, nullptr, opt.tolerance, q)) return SolveStatus::kSuccess;
+    if (scaled_rows_within(model, b, nullptr, opt.tolerance, q, t)) return SolveStatus::kSuccess;
     if (mu < 1e6) {  // regularise more, then give up: a least-squares minimum
       mu = mu == 0.0 ? std::max(b.cwiseAbs().maxCoeff(), 1e-8) : 10.0 * mu;
       continue;
@@ -140,7 +140,7 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
   std::vector<double> values;
   MinNormSolver solver_of_kept(jac.pattern());
   MinNormSolver* solver = &solver_of_kept;
-  auto kept_within = [&] { return scaled_rows_within(model, b, &kept, opt.tolerance, q); };
+  auto kept_within = [&] { return scaled_rows_within(model, b, &kept, opt.tolerance, q, t); };
 
   model.residual(q.data(), t, phi.data());
   kept_scaled(phi, b);
@@ -264,8 +264,8 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     sum.rank = analyse_rank(model, q, t, opt.rank);
     model.residual(q.data(), t, phi.data());
     const Eigen::VectorXd scaled = scaled_rows(model, phi);
-    auto within = [&](Index r) { return detail::row_within(model, r, scaled(r), opt.tolerance, q); };
-    const bool all_within = detail::residual_within(model, phi, opt.tolerance, q);
+    auto within = [&](Index r) { return detail::row_within(model, r, scaled(r), opt.tolerance, q, t); };
+    const bool all_within = detail::residual_within(model, phi, opt.tolerance, q, t);
     if (st == SolveStatus::kSuccess && all_within) return finish(SolveStatus::kSuccess, "");
     if (st == SolveStatus::kNonFinite || st == SolveStatus::kLinearSolverFailed) return finish(st, why);
     // The independent equations now hold (or stall) but others do not. If the rows found independent here differ

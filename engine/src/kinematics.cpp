@@ -109,7 +109,8 @@ void in_lanes(Index n, F&& f) {
 }
 double lanes_max(const double (&v)[kLanes]) { return std::max(std::max(v[0], v[1]), std::max(v[2], v[3])); }
 
-ResidualCheck check_residual(const Model& model, const Eigen::VectorXd& phi, double tol, const Eigen::VectorXd& q) {
+ResidualCheck check_residual(const Model& model, const Eigen::VectorXd& phi, double tol, const Eigen::VectorXd& q,
+                             double t) {
   const double* p = phi.data();
   const double* inv = model.tolerance_scales().inverse_row_scale.data();
   double sums[kLanes] = {}, worsts[kLanes] = {};
@@ -125,7 +126,7 @@ ResidualCheck check_residual(const Model& model, const Eigen::VectorXd& phi, dou
   c.worst = worst;
   c.finite = std::isfinite(sum) || phi.allFinite();  // a sum that overflowed is still a finite Φ
   // rows above tol are held to tol · scale_i plus their rounding floor, looked at only then
-  c.within = c.finite && (worst <= tol || residual_within(model, phi, tol, q));
+  c.within = c.finite && (worst <= tol || residual_within(model, phi, tol, q, t));
   return c;
 }
 
@@ -359,7 +360,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     model.residual(ws.q.data(), t, ws.phi.data());
   }
   ++ws.counters.residual_evaluations;
-  check = check_residual(model, ws.phi, opt.tolerance, ws.q);
+  check = check_residual(model, ws.phi, opt.tolerance, ws.q, t);
   double prev_norm = -1.0;   // scaled size of the previous step taken with the same kind of matrix
   double theta_seen = -1.0;  // largest contraction observed with the reused matrix in this solve
   int reused_steps = 1;      // steps taken with the reused matrix once a contraction is known
@@ -463,7 +464,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
         model.residual(ws.trial.data(), t, ws.trial_phi.data());
       }
       ++ws.counters.residual_evaluations;
-      trial_check = check_residual(model, ws.trial_phi, opt.tolerance, ws.trial);
+      trial_check = check_residual(model, ws.trial_phi, opt.tolerance, ws.trial, t);
       if (!opt.line_search || trial_check.merit <= (1.0 - 1e-4 * alpha) * check.merit || trial_check.within) break;
       if (reuse) {
         refresh = true;

@@ -118,6 +118,24 @@ void Model::gamma(const double* q, const double* qd, double t, double* out) cons
   for_each_range(blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) { b.gamma(i0, i1, q, qd, t, out); });
 }
 
+double Model::row_rounding_floor(Index row, const double* q, double t) const {
+  // Each block's constraints are in the order they were added, so their first rows ascend: the owner of `row` is
+  // the last constraint of some block that starts at or before it and still covers it.
+  for (const auto& b : blocks_) {
+    std::size_t lo = 0, hi = b->size();  // the first constraint starting after `row` is in [lo, hi]
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (b->first_row(mid) <= row) lo = mid + 1;
+      else hi = mid;
+    }
+    if (lo == 0) continue;
+    const Index first = b->first_row(lo - 1);
+    if (row < first + b->rows_per_constraint())
+      return ToleranceScales::kUlpFloor * b->coordinate_sensitivity(lo - 1, static_cast<int>(row - first), q, t);
+  }
+  throw Error("row_rounding_floor: row " + std::to_string(row) + " out of range");
+}
+
 Model Model::without_rows(std::vector<Index> rows) const {
   const Index m = num_equations(), n = num_coordinates();
   std::sort(rows.begin(), rows.end());
@@ -409,23 +427,6 @@ void ModelBuilder::tolerance_scales(const CscPattern& pattern, const std::vector
 
   sc.inverse_row_scale = sc.row_scale.cwiseInverse();
   sc.inverse_coordinate_scale = sc.coordinate_scale.cwiseInverse();
-
-  // Rounding floors: per row, the coordinates of its unit class (all of its coordinates when it reads none).
-  sc.floor_begin.assign(static_cast<std::size_t>(rows) + 1, 0);
-  sc.floor_coordinates.clear();
-  sc.floor_coordinates.reserve(cols.size());
-  for (Index i = 0; i < rows; ++i) {
-    const std::size_t first = sc.floor_coordinates.size();
-    for (Index k = begin[static_cast<std::size_t>(i)]; k < begin[static_cast<std::size_t>(i) + 1]; ++k) {
-      const Index j = cols[static_cast<std::size_t>(k)];
-      if (length_coordinate(j) == length_row(i)) sc.floor_coordinates.push_back(static_cast<std::int32_t>(j));
-    }
-    if (sc.floor_coordinates.size() == first)
-      for (Index k = begin[static_cast<std::size_t>(i)]; k < begin[static_cast<std::size_t>(i) + 1]; ++k)
-        sc.floor_coordinates.push_back(static_cast<std::int32_t>(cols[static_cast<std::size_t>(k)]));
-    sc.floor_begin[static_cast<std::size_t>(i) + 1] = static_cast<Index>(sc.floor_coordinates.size());
-  }
-  sc.floor_coordinates.shrink_to_fit();
 }
 
 Model ModelBuilder::build() && {

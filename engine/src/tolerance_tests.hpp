@@ -16,41 +16,32 @@ namespace phiq::detail {
 
 inline constexpr double kUlpFloor = ToleranceScales::kUlpFloor;
 
-// Rounding floor of row i at q (ToleranceScales): kUlpFloor times the largest |q_j| over the row's floor
-// coordinates. A residual or a step cannot be resolved below a few ulps of the coordinates it is computed from,
-// wherever the origin is.
-inline double row_floor(const Model& model, Index i, const Eigen::VectorXd& q) {
-  const ToleranceScales& s = model.tolerance_scales();
-  double m = 0.0;
-  for (Index k = s.floor_begin[static_cast<std::size_t>(i)]; k < s.floor_begin[static_cast<std::size_t>(i) + 1]; ++k)
-    m = std::max(m, std::fabs(q(s.floor_coordinates[static_cast<std::size_t>(k)])));
-  return kUlpFloor * m;
-}
+// The tests below run every Newton iteration: the floor of a row (Model::row_rounding_floor(), from that one
+// constraint's Jacobian at (q, t)) is looked at only when the row fails without it.
 
-// The tests below run every Newton iteration: the floor of a row is looked at only when the row fails without it.
-
-// Row i with |Φ_i| / scale_i = `scaled` is within tol · scale_i + floor_i at q (false on NaN).
-inline bool row_within(const Model& model, Index i, double scaled, double tol, const Eigen::VectorXd& q) {
+// Row i with |Φ_i| / scale_i = `scaled` is within tol · scale_i + floor_i at (q, t) (false on NaN).
+inline bool row_within(const Model& model, Index i, double scaled, double tol, const Eigen::VectorXd& q, double t) {
   if (scaled <= tol) return true;
-  return scaled <= tol + row_floor(model, i, q) / model.tolerance_scales().row_scale(i);
+  return scaled <= tol + model.row_rounding_floor(i, q.data(), t) / model.tolerance_scales().row_scale(i);
 }
 
-// Every row |Φ_i| ≤ tol · scale_i + floor_i at q (false on NaN).
-inline bool residual_within(const Model& model, const Eigen::VectorXd& phi, double tol, const Eigen::VectorXd& q) {
+// Every row |Φ_i| ≤ tol · scale_i + floor_i at (q, t) (false on NaN).
+inline bool residual_within(const Model& model, const Eigen::VectorXd& phi, double tol, const Eigen::VectorXd& q,
+                            double t) {
   const Eigen::VectorXd& rs = model.tolerance_scales().row_scale;
   for (Index i = 0; i < phi.size(); ++i) {
     const double a = std::fabs(phi(i));
     if (a <= tol * rs(i)) continue;
-    if (!(a <= tol * rs(i) + row_floor(model, i, q))) return false;
+    if (!(a <= tol * rs(i) + model.row_rounding_floor(i, q.data(), t))) return false;
   }
   return true;
 }
 
-// The rows `rows` (rows k = 0 … when null) of a scaled residual b, b_k = Φ_row / scale_row, pass the test at q.
+// The rows `rows` (rows k = 0 … when null) of a scaled residual b, b_k = Φ_row / scale_row, pass the test at (q, t).
 inline bool scaled_rows_within(const Model& model, const Eigen::VectorXd& b, const std::vector<Index>* rows, double tol,
-                               const Eigen::VectorXd& q) {
+                               const Eigen::VectorXd& q, double t) {
   for (Index k = 0; k < b.size(); ++k)
-    if (!row_within(model, rows ? (*rows)[static_cast<std::size_t>(k)] : k, std::fabs(b(k)), tol, q)) return false;
+    if (!row_within(model, rows ? (*rows)[static_cast<std::size_t>(k)] : k, std::fabs(b(k)), tol, q, t)) return false;
   return true;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -67,6 +68,11 @@ class ConstraintBlock {
                      double* out) const = 0;
   /// Whether constraint `i` (0 ≤ i < size()) depends explicitly on time (DistanceSpec::depends_on_time()).
   virtual bool depends_on_time(std::size_t i) const = 0;
+  /// Σ_j |∂Φ_r/∂q_j| · |q_j| over the coordinates that local row `row` (0 ≤ row < rows_per_constraint()) of
+  /// constraint `i` reads, at (q, t): how far the row moves when every coordinate moves by the same relative amount,
+  /// so that ε times it is the rounding of the row's value at q (ToleranceScales, Model::row_rounding_floor()).
+  /// Thread-safe.
+  virtual double coordinate_sensitivity(std::size_t i, int row, const double* q, double t) const = 0;
 
   /// Appends the (row, column) of every Jacobian entry of every constraint that falls on a coordinate to `rows` and
   /// `cols` (the model's triplet list, in evaluation order), and records where each constraint's entries start, so
@@ -170,6 +176,14 @@ class TypedBlock final : public ConstraintBlock {
     for (std::size_t i = begin; i < end; ++i) entries_[i].spec.gamma(q, qd, t, out + entries_[i].row0);
   }
   bool depends_on_time(std::size_t i) const override { return entries_[i].spec.depends_on_time(); }
+  double coordinate_sensitivity(std::size_t i, int row, const double* q, double t) const override {
+    double sum = 0.0;
+    auto sink = [&](int r, const Slot& s, double v) {
+      if (r == row && s.is_coordinate()) sum += std::fabs(v) * std::fabs(q[s.coord()]);
+    };
+    entries_[i].spec.jacobian(q, t, sink);
+    return sum;
+  }
 
   void build_pattern(std::vector<Index>& rows, std::vector<Index>& cols) override {
     // Values are ignored in pattern mode; evaluate at a harmless point (entries never depend on values). One

@@ -176,22 +176,17 @@ struct ConstraintInfo {
 /// ModelBuilder::set_length_scale() (scene `solver.length_scale`) every length row and coordinate uses that one
 /// scale instead. Angle and unitless rows and coordinates: 1.
 ///
-/// The rounding floor of a row is kUlpFloor (64 ulps) times the largest |q_j| among the coordinates it reads that
-/// have its unit class (length coordinates for length rows, the others for the others; all of them when it reads
-/// none of its class): a residual cannot be resolved below a few ulps of the coordinates it is computed from,
-/// wherever the origin is. floor_j of a coordinate is kUlpFloor · |q_j|.
+/// The rounding floor of a row is kUlpFloor (64 ulps) times Σ_j |∂Φ_i/∂q_j| · |q_j| at the point tested
+/// (Model::row_rounding_floor()): how much the row's value moves when every coordinate it reads moves by 64 ulps of
+/// itself. A residual cannot be resolved below that, wherever the origin is (a link 10⁶ m from it), and a row that
+/// hardly depends on large coordinates (atan(x) at x = 10²⁶, a driver 1/x) gets no floor from them: its residual
+/// is held to the tolerance. floor_j of a coordinate is kUlpFloor · |q_j|.
 struct ToleranceScales {
   Eigen::VectorXd row_scale;              ///< per row, metres for length rows, 1 for angle and unitless rows
   Eigen::VectorXd coordinate_scale;       ///< per coordinate, metres for length coordinates, 1 otherwise
   /// 1 / row_scale: the Newton loop's per-iteration tests multiply instead of dividing.
   Eigen::VectorXd inverse_row_scale;
   Eigen::VectorXd inverse_coordinate_scale;  ///< 1 / coordinate_scale (see inverse_row_scale)
-  /// Where each row's floor coordinates start in floor_coordinates (m + 1 entries).
-  std::vector<Index> floor_begin;
-  /// The coordinates each row's rounding floor is taken over (see above): those of row i are
-  /// floor_coordinates[floor_begin[i] … floor_begin[i + 1] − 1]. 32-bit: about one entry per non-zero of Φq, and a
-  /// model has fewer than 2³¹ coordinates (ModelBuilder::build() checks).
-  std::vector<std::int32_t> floor_coordinates;
   /// 64 ulps: the rounding floor per unit of |q| (see above).
   static constexpr double kUlpFloor = 64.0 * std::numeric_limits<double>::epsilon();
 };
@@ -295,6 +290,11 @@ class Model {
   void phi_t(const double* q, double t, double* out) const;
   /// γ = −(Φq q̇)q q̇ − 2Φqt q̇ − Φtt into out (m entries). Pre-condition: qd has n entries. Thread-safe.
   void gamma(const double* q, const double* qd, double t, double* out) const;
+  /// The rounding floor of `row` at (q, t) (ToleranceScales): kUlpFloor · Σ_j |∂Φ_row/∂q_j| · |q_j|, from the
+  /// Jacobian of the one constraint owning the row. Meant for the few rows a tolerance test finds above tol (a
+  /// search over the blocks and one constraint's Jacobian per call). Pre-condition: 0 ≤ row < m, q has n entries.
+  /// Thread-safe.
+  double row_rounding_floor(Index row, const double* q, double t) const;
 
  private:
   friend class ModelBuilder;
