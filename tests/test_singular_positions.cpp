@@ -100,12 +100,39 @@ TEST(SingularPositions, ACrossingBetweenStepsIsReportedByTheSignOfDetPhiQ) {
   // θ = π at t = (π − 0.3)/2π = 0.45225…, θ = 2π at t = 0.95225…: reported at the next grid rows
   EXPECT_DOUBLE_EQ(bif[0].t, 0.453);
   EXPECT_DOUBLE_EQ(bif[1].t, 0.953);
-  EXPECT_HAS(bif[0].message, "det Φq changed sign since t = 0.452");
+  EXPECT_HAS(bif[0].message, "det Φq changed sign between t = 0.452 and t = 0.453");
   EXPECT_EQ(sum.singular_positions, 0);
   const auto exact = test::nfourbar_exact(model, th0, w);
   tools::ClosedFormErrors err(*exact);
   for (std::size_t k = 0; k < tr.t.size(); ++k) err.add(tr.t[k], tr.q[k].data(), nullptr, nullptr);
   EXPECT_LT(err.q_error, 1e-8);
+}
+
+// Positions only, the sweep factorises only where Newton needs it (a few rows in a hundred): a crossing is reported
+// between the last two positions whose factorisations the sweep made itself, which bracket it, on one thread and
+// in parallel chunks alike (a chunk's workspace held another chunk's factorisation, of another place, and
+// reported a "crossing" at t = 0.49 where there was none).
+TEST(SingularPositions, PositionsOnlyACrossingIsBracketedByTheSweepsOwnFactorisations) {
+  const double w = 1.0, th0 = 2.5, crossing = M_PI - th0;  // N = 1: θ = π at t = 0.6416
+  const Model model = test::nfourbar_model(1, th0, w);
+  for (int threads : {1, 2}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    SweepOptions o;
+    o.t_begin = 0, o.t_end = 1, o.steps = 100;
+    o.threads = threads;
+    o.chunk_steps = 16;
+    SweepSummary sum;
+    test::Trace tr;
+    ASSERT_EQ(test::sweep(model, o, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+    const auto bif = of_kind(sum, "bifurcation");
+    ASSERT_EQ(bif.size(), 1u);
+    std::smatch m;
+    const std::regex between("between t = ([0-9.e-]+) and t = ([0-9.e-]+)");
+    ASSERT_TRUE(std::regex_search(bif[0].message, m, between)) << bif[0].message;
+    EXPECT_LT(std::stod(m[1]), crossing) << bif[0].message;
+    EXPECT_GT(std::stod(m[2]), crossing) << bif[0].message;
+    EXPECT_GE(bif[0].t, crossing);
+  }
 }
 
 // The change-point four-bar of models/hard: the parallelogram branch (ψ2 = ψ1, ψc = 0) is kept through both

@@ -203,6 +203,36 @@ TEST(SpatialScenes, RssrSweepsAndAgreesWithItsClosedForm) {
   }
 }
 
+TEST(SpatialScenes, CardanNearItsSingularAngleStaysOnItsBranch) {
+  // Shafts 89° apart: tan θ2 = tan θ1 / cos β, θ̇2 = ω cos β / D, D = cos²β cos²θ1 + sin²θ1 (θ1 = ω t). Near
+  // θ1 = π the output swings 78.7° in a 5° step, and the sweep landed on the other assembly mode (θ2 + π) from
+  // there on, with a warning that it had "kept its branch": now det Φq's change of sign between two regular
+  // positions makes it halve the step, which follows the branch.
+  const Scene s = load_scene(test::model_path("spatial/cardan_near_singular.yaml"));
+  const Model& m = *s.model;
+  SweepSummary sum;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+  ASSERT_EQ(tr.t.size(), 73u);
+  for (const SweepWarning& w : sum.warnings) ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
+  const double beta = 89.0 * M_PI / 180.0, cb = std::cos(beta), w = 1.5;
+  const Index i = m.coordinate_index("x2");
+  const Frame3 s2{Slot::coordinate(i),     Slot::coordinate(i + 1), Slot::coordinate(i + 2), Slot::coordinate(i + 3),
+                  Slot::coordinate(i + 4), Slot::coordinate(i + 5), Slot::coordinate(i + 6)};
+  // The output fork (s2's y axis) at θ2 is −sin θ2 b + cos θ2 ŷ, with b = (cos β, 0, −sin β) ⊥ the output axis.
+  const Attachment3 fork = Attachment3::body_vector(s2, kin3::V3{0, 1, 0});
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    SCOPED_TRACE("t = " + std::to_string(tr.t[k]));
+    const double th1 = w * tr.t[k], c1 = std::cos(th1), s1 = std::sin(th1);
+    const double th2 = std::atan2(s1, c1 * cb), D = cb * cb * c1 * c1 + s1 * s1, th2d = w * cb / D;
+    const kin3::V3 f = fork.value(tr.q[k].data()), fd = fork.rate(tr.q[k].data(), tr.qd[k].data());
+    const double b_f = f.x * cb - f.z * std::sin(beta);
+    EXPECT_NEAR(std::remainder(std::atan2(-b_f, f.y) - th2, 2 * M_PI), 0.0, 1e-8);
+    // d/dt of the fork: (−cos θ2 b − sin θ2 ŷ) θ̇2
+    EXPECT_NEAR(fd.y, -std::sin(th2) * th2d, 1e-7 * std::max(1.0, th2d));
+  }
+}
+
 TEST(SpatialScenes, RssrInReferencePointAndNaturalCoordinatesAgree) {
   const Scene rp = load_scene(test::model_path("spatial/rssr.yaml"));
   const Scene nat = load_scene(test::model_path("spatial/rssr_natural.yaml"));

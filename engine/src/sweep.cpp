@@ -94,6 +94,10 @@ struct State {
   Eigen::VectorXd q, qd, qdd;
 };
 
+// The sign of det Φq at a converged state when no factorisation was made there (positions only, a start accepted
+// from its prediction): ±1 is the sign at that very position, 0 a singular position.
+constexpr int kSignUnknown = 2;
+
 class Sweeper {
  public:
   Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum)
@@ -140,6 +144,9 @@ class Sweeper {
   // Below this (and above kSingularRcond) the position is near-singular (a toggle position nearby): the results
   // hold, but with fewer digits; a warning says so, once per stretch of such steps.
   static constexpr double kIllConditionedRcond = 1e-7;
+  // A step across which det Φq changes sign is halved, and halved again, to see whether the change stays (a
+  // singular position crossed) or goes (another branch reached): see advance().
+  static constexpr int kBranchCheckDepth = 2;
 
   // Derivatives at the converged ws.q, as asked for. Returns false (summary filled) on failure. At a singular
   // position they are not unique: see singular_point().
@@ -165,17 +172,23 @@ class Sweeper {
       points_[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
     ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
     rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
-    // With velocities the LU is the one at the converged position; positions only, Newton's last (at most a
-    // few steps old with modified Newton, so a sign change may be noticed a row late).
-    det_sign_ = singular_row_ || !ws_->lu ? 0 : ws_->lu->determinant_sign();
+    det_sign_ = current_row_sign_;
+    det_sign_t_ = current_row_sign_t_;
   }
+  // Sign of det Φq at the last delivered row (row_outputs()): ±1, 0 at a singular position, kSignUnknown where no
+  // factorisation of this sweeper's tells it; and the time it holds at (det_sign_time(): the row's, or with
+  // positions only that of the step whose Newton factorised last).
   int det_sign() const { return det_sign_; }
+  double det_sign_time() const { return det_sign_t_; }
   // The last converged state (q, and q̇, q̈ as computed), which the rows deliver.
   const State& state() const { return current_; }
   // Solves with `w` from now on: the state and the history are the sweeper's, a workspace holds only the solves'
   // scratch and an LU (whichever factorisation it holds is a start for modified Newton, which refreshes it when it
   // contracts badly). A parallel sweep's seeding pass takes whichever workspace is free for each seed.
-  void bind(Workspace& w) { ws_ = &w; }
+  void bind(Workspace& w) {
+    ws_ = &w;
+    factorizations_before_ = factorizations_seen_ = w.counters.factorizations;
+  }
   // Moves the last converged state out and frees the history: the sweeper is not used after this.
   State take_state() {
     history_.clear(), history_.shrink_to_fit();
@@ -233,6 +246,7 @@ class Sweeper {
   void adopt(double t) {
     has_current_ = false;
     known_ = 0;
+    current_sign_ = current_row_sign_ = kSignUnknown;
     row_error_ = INFINITY;  // how well the adopted state is known is not said: the next step checks it
     remember(t);
   }
@@ -436,7 +450,20 @@ class Sweeper {
       st = SolveStatus::kNotConverged;
       ps.message = "Newton moved off the predicted path (another branch?)";
     }
-    if (st == SolveStatus::kSuccess) return converged(t1, ps);
+    if (st == SolveStatus::kSuccess) {
+      bool left_branch = false;
+      if (converged(t1, ps, depth < std::min(kBranchCheckDepth, opt_.max_subdivisions) ? &left_branch : nullptr))
+        return true;
+      if (!left_branch) return false;
+      // det Φq changed sign between two regular positions: the step crossed a singular position, or Newton landed
+      // on another branch (a Cardan joint near its singular angle swings its output shaft so fast that the
+      // extrapolation lands nearer the mode turned by π). Half steps tell them apart: they follow the branch, and
+      // a crossing stays between two of them. It is accepted at the second level of halving, with a warning:
+      // bisecting on towards it would only feed the predictor positions next to a singular Φq, whose q̈ are
+      // rounding noise.
+      st = SolveStatus::kNotConverged;
+      ps.message = "det Φq changed sign with Φq regular at both ends (another branch?)";
+    }
     if (st == SolveStatus::kSingularJacobian && has_current_ && !bracketing_) {
       // a zero pivot exactly at a singular position: bracket it (position interpolated from both sides)
       if (singular_point(t1, 0.0, /*have_position=*/false)) {
@@ -466,8 +493,18 @@ class Sweeper {
   }
 
  private:
-  // A position converged at t: its warning, the derivatives asked for, and it becomes the current state.
-  bool converged(double t, const PositionSummary& ps) {
+  // A position converged at t: its warning, the derivatives asked for, and it becomes the current state. With
+  // `left_branch`, a position where det Φq has the other sign than at the current state (both regular, both
+  // factorised at their position) is refused instead, with *left_branch set and nothing of it kept: no warning,
+  // no count, no condition noted.
+  bool converged(double t, const PositionSummary& ps, bool* left_branch = nullptr) {
+    struct Noted {
+      std::size_t warnings;
+      Index singular_positions;
+      double min_rcond, min_rcond_time, rounding_level;
+      bool ill_conditioned;
+    } const noted{sum_.warnings.size(), sum_.singular_positions, sum_.min_rcond, sum_.min_rcond_time,
+                  rounding_level_, ill_conditioned_};
     singular_row_ = false;
     row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
     rounding_level_ = std::max(rounding_level_, ps.rounding_level);
@@ -483,9 +520,45 @@ class Sweeper {
       sum_.warnings.push_back({t, "bifurcation", m.str()});
     }
     if (!position_only_ && !derivatives(t)) return false;
+    const int sign = sign_at_solution();
+    if (left_branch && has_current_ && (sign == 1 || sign == -1) && (current_sign_ == 1 || current_sign_ == -1) &&
+        sign != current_sign_) {
+      sum_.warnings.resize(noted.warnings);
+      sum_.singular_positions = noted.singular_positions;
+      sum_.min_rcond = noted.min_rcond, sum_.min_rcond_time = noted.min_rcond_time;
+      rounding_level_ = noted.rounding_level, ill_conditioned_ = noted.ill_conditioned;
+      *left_branch = true;
+      return false;
+    }
+    if (ws_->counters.factorizations != factorizations_seen_)  // this step's solves factorised
+      factorizations_seen_ = ws_->counters.factorizations, factorized_step_t_ = t;
+    current_sign_ = sign;
+    current_row_sign_ = row_sign();
+    current_row_sign_t_ = row_sign_time(t);
     remember(t);
     return true;
   }
+  // Sign of det Φq at the position just converged (ws.q): from the LU when it was factorised there (velocities
+  // are solved at every row; positions only, when Newton's last factorisation is at the solution), 0 at a
+  // singular position, else kSignUnknown.
+  int sign_at_solution() const {
+    if (singular_row_) return 0;
+    if (!ws_->lu || !ws_->has_factorization) return kSignUnknown;
+    const bool at_solution = (need_v_ && !position_only_) || ws_->factorized_at_solution;
+    return at_solution ? ws_->lu->determinant_sign() : kSignUnknown;
+  }
+  // The sign a delivered row reports: sign_at_solution(), else (positions only) that of the last factorisation
+  // this sweeper made, at an iterate a few steps back on its own path, so that a change is seen a row or two late
+  // rather than not at all; never that of a factorisation the workspace held before (another chunk's, or another
+  // sweep's: the sign of another place).
+  int row_sign() const {
+    const int exact = sign_at_solution();
+    if (exact != kSignUnknown || ws_->counters.factorizations == factorizations_before_) return exact;
+    return ws_->lu->determinant_sign();
+  }
+  // Where row_sign() holds: t itself for a sign at the solution, else the time of the step whose solves made the
+  // last factorisation (tracked in converged()).
+  double row_sign_time(double t) const { return sign_at_solution() != kSignUnknown ? t : factorized_step_t_; }
   // Whether the converged ws.q is farther from the prediction than the prediction is from the last state (in
   // tolerance units, beyond a floor of 1000 tolerances): a predictor errs by a higher order of h than the O(h)
   // move, so a correction as large as the move means another solution was found. Runs every drive step: one pass
@@ -747,7 +820,14 @@ class Sweeper {
   Eigen::VectorXd predicted_;       // the last prediction (for jumped())
   bool bracketing_ = false;         // inside singular_point(): no nested bracketing
   bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
-  int det_sign_ = 0;                // sign of det Φq at the last row (0: singular)
+  int det_sign_ = 0;                // sign of det Φq at the last delivered row (det_sign())
+  int current_sign_ = kSignUnknown;  // and at current_ (sign_at_solution() when it converged)
+  int current_row_sign_ = kSignUnknown;  // what current_'s row reports (row_sign()), and at which time
+  double current_row_sign_t_ = 0.0, det_sign_t_ = 0.0;
+  // The workspace's factorisation count when this sweeper took it: the ones after it are its own (row_sign()).
+  Index factorizations_before_ = ws_->counters.factorizations;
+  Index factorizations_seen_ = factorizations_before_;  // the count at the last converged state
+  double factorized_step_t_ = 0.0;  // the time of the last step whose solves factorised (row_sign_time())
   double rounding_level_ = 0.0;     // see take_rounding_level()
   bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)
   double default_step_ = (opt_.t_end - opt_.t_begin) / static_cast<double>(std::max<Index>(opt_.steps, 1));
@@ -787,26 +867,31 @@ struct Run {
   double time_of(Index k) const {
     return k == opt.steps && k > 0 ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
   }
-  // Sign of det Φq at the last delivered regular row, and whether a singular row (bracketed, with its own
-  // warning) was delivered since.
+  // Sign of det Φq at the last delivered regular row whose sign is known, its time, and whether a singular row
+  // (bracketed, with its own warning) was delivered since.
   int last_sign = 0;
+  double last_sign_t = 0.0;
   bool singular_since = false;
 
   // Delivers row k; false when the caller stops the sweep (status and message set). A change of det Φq's sign
   // since the last regular row is a singular position passed between the two: warned here, in row order, so that
   // sequential and parallel sweeps report it alike.
   bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
-               const PointMotion* points, const Eigen::VectorXd& phi, double rcond, int det_sign) {
+               const PointMotion* points, const Eigen::VectorXd& phi, double rcond, int det_sign,
+               double det_sign_t) {
     if (det_sign == 0) {
       singular_since = true;
-    } else {
+    } else if (det_sign != kSignUnknown) {
+      // (a change between two steps of a sweep that solves velocities was found at the finest sub-step: no branch
+      // was left there)
       if (last_sign != 0 && det_sign != last_sign && !singular_since)
         sum.warnings.push_back(
             {time_of(k), "bifurcation",
-             "det Φq changed sign since t = " + fmt_t(time_of(k - 1)) +
-                 ": the motion passed a singular position between the two steps (a bifurcation, where branches "
-                 "cross); the sweep kept the branch it was on"});
+             "det Φq changed sign between t = " + fmt_t(last_sign_t) + " and t = " + fmt_t(det_sign_t) +
+                 ": the motion passed a singular position there (a bifurcation, where branches cross); the sweep "
+                 "kept the branch it was on"});
       last_sign = det_sign;
+      last_sign_t = det_sign_t;
       singular_since = false;
     }
     StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
@@ -834,7 +919,8 @@ struct Run {
       }
       sw.row_outputs();
       const State& s = sw.state();
-      if (!deliver(k, s.q, s.qd, s.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign())) return false;
+      if (!deliver(k, s.q, s.qd, s.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign(), sw.det_sign_time()))
+        return false;
     }
     return true;
   }
@@ -890,6 +976,7 @@ struct Row {
   Eigen::VectorXd q, qd, qdd, phi;  // q̇, q̈ as solved, Φ when asked
   double rcond = 0.0;
   int det_sign = 0;
+  double det_sign_t = 0.0;  // where det_sign holds (Sweeper::det_sign_time())
   std::vector<PointMotion> points;
 };
 
@@ -1048,7 +1135,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   }
   sw.row_outputs();
   if (!run.deliver(0, sw.state().q, sw.state().qd, sw.state().qdd, sw.point_motions(), ws.phi, sw.rcond(),
-                   sw.det_sign())) {
+                   sw.det_sign(), sw.det_sign_time())) {
     sw.leave_state_in_workspace();
     return done(sum.status);
   }
@@ -1177,7 +1264,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
       if (n_phi) r.phi = w.phi;
       r.rcond = s.rcond();
       if (n_points) r.points.assign(s.point_motions(), s.point_motions() + n_points);
-      r.det_sign = s.det_sign();
+      r.det_sign = s.det_sign(), r.det_sign_t = s.det_sign_time();
     };
     if (c == 0) {  // continues row 0 in order: the sequential sweep itself
       w.q = last_q, w.qd = last_qd, w.qdd = last_qdd;
@@ -1221,7 +1308,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     if (!accept) return 1;
     for (Index k = ch.k0; k <= ch.k1; ++k) {
       const Row& r = ch.rows[static_cast<std::size_t>(k - ch.k0)];
-      if (!run.deliver(k, r.q, r.qd, r.qdd, n_points ? r.points.data() : nullptr, r.phi, r.rcond, r.det_sign)) {
+      if (!run.deliver(k, r.q, r.qd, r.qdd, n_points ? r.points.data() : nullptr, r.phi, r.rcond, r.det_sign,
+                       r.det_sign_t)) {
         last_q = r.q, last_qd = need_v ? r.qd : last_qd, last_qdd = need_a ? r.qdd : last_qdd;  // where it stopped
         return 2;
       }
