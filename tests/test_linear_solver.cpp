@@ -127,6 +127,32 @@ TEST(LinearSolver, KluSearchesPivotsAgainWhenTheOldOnesDegrade) {
   EXPECT_NEAR(x[0] + x[1], 2.0, 1e-14);
 }
 
+TEST(LinearSolver, KluChecksALowPivotRatioWithAPivotSearchBeforeReportingIt) {
+  // Pivots chosen at [[0.002, 1], [1, 1]]: KLU keeps the diagonal 0.002 (above 1e-3 of its column), ratio
+  // 0.002 / 499 = 4e-6. At [[1e-4, 1], [1, 1]] (det −1: well conditioned) the old order gives 1e-4 / 1e4 = 1e-8,
+  // within the degradation allowed (1e-3 of 4e-6), which a sweep reported as a near-singular position (below 1e-7).
+  // Below 1e-6 a pivot search measures again: the ratio is that of the matrix's own pivots, about 1.
+  auto p = std::make_shared<CscPattern>();
+  std::vector<Index> slot;
+  *p = build_csc_pattern(2, 2, {0, 1, 0, 1}, {0, 0, 1, 1}, &slot);
+  auto n = analyse(LinearSolverKind::kKlu, p)->make_numeric();
+  std::vector<double> a = {0.002, 1, 1, 1}, b = {1e-4, 1, 1, 1};  // column-major
+  ASSERT_EQ(n->factorize(a.data()), FactorStatus::kOk);
+  EXPECT_NEAR(n->rcond(), 0.002 / 499.0, 1e-9);
+  ASSERT_EQ(n->factorize(b.data()), FactorStatus::kOk);
+  EXPECT_EQ(n->pivoting_factorizations(), 2);
+  EXPECT_GT(n->rcond(), 0.5);
+  EXPECT_EQ(n->determinant_sign(), -1);
+  // and where the matrix itself is that close to singular, the search's ratio is the new reference: refactorised
+  // at a matrix half as good, no further search (a pivot search only where the ratio falls tenfold below it)
+  std::vector<double> c = {1, 1, 1, 1 + 1e-8}, d = {1, 1, 1, 1 + 0.5e-8};  // rows nearly parallel: 1e-8, 5e-9
+  ASSERT_EQ(n->factorize(c.data()), FactorStatus::kOk);
+  const std::int64_t searches = n->pivoting_factorizations();
+  ASSERT_EQ(n->factorize(d.data()), FactorStatus::kOk);
+  EXPECT_EQ(n->pivoting_factorizations(), searches);
+  EXPECT_LT(n->rcond(), 1e-6);
+}
+
 TEST(LinearSolver, SingularIsAWarningNotAFailure) {
   // [[1, 2], [2, 4]]
   auto p = std::make_shared<CscPattern>();

@@ -224,6 +224,14 @@ class KluNumeric final : public SparseLuNumeric {
   // falls below this fraction of the one measured right after pivoting, the pivots have degraded (the matrix moved
   // far from the one they were chosen for) and the matrix is factorised again with a pivot search.
   static constexpr double kDegradation = 1e-3;
+  // Nor is a refactorisation whose ratio falls below this, and tenfold below the one right after pivoting (not at
+  // every small drift of a ratio that is low by nature: a chain of 10⁶ loops has 2.5e-7 at any angle), taken as it is:
+  // a pivot search may have been made where the matrix was poor (KLU prefers diagonal pivots down to 1e-3 of their
+  // column), and the old order then lets a pivot run to zero that the matrix does not need — a body's Euler
+  // parameter crossing zero gave 5e-9 where a pivot search gives 0.49 — and the sweep would report a
+  // near-singular position (its warning is at 1e-7) that is not there. Below it a pivot search measures again;
+  // where the matrix really is that close to singular, the search's own ratio becomes the new reference.
+  static constexpr double kCheckedBelow = 1e-6;
 
  private:
   FactorStatus factor_with_pivoting(const double* values);
@@ -369,7 +377,7 @@ FactorStatus KluNumeric<Int>::factorize(const double* values) {
                     common_.status == KLU_OK;
     if (ok) {
       const double rc = scan_diagonal();
-      if (rc >= kDegradation * rcond_at_pivoting_) {
+      if (rc >= kDegradation * rcond_at_pivoting_ && !(rc < kCheckedBelow && rc < 0.1 * rcond_at_pivoting_)) {
         rcond_ = rc;
         message_.clear();
         return FactorStatus::kOk;
