@@ -394,6 +394,49 @@ class Sweeper {
     return true;
   }
 
+  // Why the sweep cannot go on towards t1, when it is redundant equations that stop holding: the model is solved on
+  // its independent rows (Model::without_rows), chosen where it was assembled, and the rows left out, consistent
+  // there, are checked at every step. Two drivers of one coordinate at different rates, or two joint drivers of
+  // one door, agree at the start and part at once. Newton on the independent rows alone, from the last state (full
+  // steps with the square LU, a few iterations), tells: where they hold and some left-out row does not, those rows
+  // are named. "" otherwise. A diagnosis after the sub-steps failed: it leaves ws.q, ws.qd as scratch.
+  std::string conflicting_redundancy(double t1) {
+    const std::vector<Index>& dropped = model_.dropped_rows();
+    if (dropped.empty() || !ws_->lu) return "";
+    const double tol = opt_.newton.tolerance;
+    const Eigen::VectorXd& rs = model_.tolerance_scales().row_scale;
+    const std::vector<Index>& kept = model_.solve_rows();
+    auto holds = [&](Index i) { return detail::row_within(model_, i, std::fabs(ws_->phi(i)) / rs(i), tol, ws_->q, t1); };
+    ws_->q = current_.q;
+    Eigen::VectorXd rhs(static_cast<Index>(kept.size())), step(model_.num_coordinates());
+    bool kept_hold = false;
+    for (int it = 0; it < 10 && !kept_hold; ++it) {
+      model_.residual(ws_->q.data(), t1, ws_->phi.data());
+      if (!ws_->phi.allFinite()) return "";
+      kept_hold = std::all_of(kept.begin(), kept.end(), holds);
+      if (kept_hold) break;
+      LinearSummary ls;  // the factorisation at ws.q (the velocity it solves is not used)
+      if (solve_velocity(model_, t1, *ws_, &ls) != SolveStatus::kSuccess) return "";
+      for (std::size_t k = 0; k < kept.size(); ++k) rhs(static_cast<Index>(k)) = ws_->phi(kept[k]);
+      if (!ws_->lu->solve(rhs.data(), step.data()) || !step.allFinite()) return "";
+      ws_->q -= step;
+    }
+    if (!kept_hold) return "";
+    std::vector<std::string> names;
+    for (Index i : dropped)
+      if (!holds(i)) {
+        const std::string name = model_.row_name(i);
+        if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+      }
+    if (names.empty()) return "";
+    std::ostringstream m;
+    m << "redundant equations, consistent where the model was assembled, stop holding where the others hold (";
+    for (std::size_t k = 0; k < names.size() && k < 8; ++k) m << (k ? ", '" : "'") << names[k] << "'";
+    if (names.size() > 8) m << " and " << names.size() - 8 << " more";
+    m << "): the redundant constraints are inconsistent from here on";
+    return m.str();
+  }
+
   // Why the sweep cannot go on from the last converged state (current_) towards t1, when it is a dead point (a
   // turning point of the motion: the drive asks for positions that do not exist): Φq is near-singular there and
   // the speed grows like 1/√(t* − t). Then q̈ ≈ q̇ / (2 (t* − t)) along q̇, so t* − t ≈ |q̇|² / (2 q̇·q̈), and the
@@ -479,6 +522,9 @@ class Sweeper {
     // unless the sub-steps avoid it, so all statuses are retried.
     if (depth >= opt_.max_subdivisions) {
       const std::string why = ps.message;
+      if (const std::string conflict = conflicting_redundancy(t1); !conflict.empty())
+        return fail(SolveStatus::kInconsistent, "no assembly beyond t = " + fmt_t(current_.t) + " (sub-steps down to t = " +
+                                                    fmt_t(t1) + " tried): " + conflict);
       const std::string dead = dead_point(t1);
       return fail(st, "no assembly beyond t = " + fmt_t(current_.t) + " (sub-steps down to t = " + fmt_t(t1) +
                           " tried" + (dead.empty() ? ": the drive leaves the reachable range, or the mechanism "
