@@ -2,6 +2,10 @@
 // positions, the nearest-point property, consistent against inconsistent redundancy, and sweeps that stay exact.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+#include <string>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -168,6 +172,25 @@ time: {start: 0, end: 0, steps: 0}
   EXPECT_NE(st, SolveStatus::kSuccess);
   EXPECT_GT(as.residual, 0.01);  // 1.6 m are missing, spread over the three links (length scale 3 m)
   EXPECT_NE(as.message.find("coupler"), std::string::npos) << as.message;
+}
+
+TEST(Assembly, ALockedStructureWithoutAPositionIsNotCalledConsistent) {
+  // The fifth-bar parallelogram with its third crank 10 % long: the twelve revolute equations (Grübler 0, rank 12)
+  // have no common solution, and the driver is redundant with them. The assembly was reported "consistent" with
+  // the driver named as the worst constraint; now it says the independent equations have no solution, names the
+  // worst among them, and claims nothing about consistency.
+  std::ifstream in(test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text = test::replace_first(text, "{body: crank3, at: [r, 0]}", "{body: crank3, at: [1.1*r, 0]}");
+  Scene sc = parse_scene(text, "fifth_bar_long.yaml");
+  Eigen::VectorXd q = sc.model->initial_positions();
+  AssemblySummary as;
+  EXPECT_EQ(assemble(*sc.model, 0.0, {}, q, &as), SolveStatus::kNotConverged);
+  EXPECT_FALSE(as.consistent);
+  EXPECT_TRUE(as.conflicts.empty());
+  EXPECT_HAS(as.message, "the independent equations have no common solution near this placement");
+  ASSERT_FALSE(as.worst_rows.empty());
+  for (const auto& [row, residual] : as.worst_rows) EXPECT_NE(sc.model->row_name(row), "motor") << as.message;
 }
 
 }  // namespace

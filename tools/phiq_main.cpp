@@ -404,7 +404,9 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
       j["redundant_rows"].push_back({{"constraint", model.constraints()[model.constraint_of_row(r)].name},
                                      {"row", r},
                                      {"name", model.row_name(r)}});
-    j["consistent"] = as.consistent;
+    // null: not known (the independent equations themselves do not hold)
+    j["consistent"] = as.consistent || !as.conflicts.empty() ? nlohmann::ordered_json(as.consistent)
+                                                              : nlohmann::ordered_json();
     j["conflicts"] = as.conflicts;
     j["rank_tolerance"] = rk.tolerance;
     j["rank_uncertain"] = rk.uncertain;
@@ -434,7 +436,11 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
             << "dof           " << rk.dof << " (" << rk.driven_dof << " not driven)\n"
             << "grubler       " << (rk.grubler ? std::to_string(*rk.grubler) : std::string("not defined")) << "\n"
             << "redundant     " << (rk.redundant.empty() ? "none" : joined(rk.redundant)) << "\n"
-            << "consistent    " << (as.consistent ? "yes" : "no: conflicting " + joined(as.conflicts)) << "\n";
+            << "consistent    "
+            << (as.consistent ? "yes"
+                : as.conflicts.empty() ? "not known: the independent equations do not hold"
+                                       : "no: conflicting " + joined(as.conflicts))
+            << "\n";
   if (rk.uncertain) std::cout << "uncertain     " << rk.message << "\n";
   if (!ok) std::cout << "diagnosis     " << as.message << "\n";
   return ok ? 0 : 1;

@@ -227,14 +227,15 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
   const Eigen::VectorXd q0 = q;
   Eigen::VectorXd phi(m);
 
-  auto finish = [&](SolveStatus st, std::string msg) {
+  // `among`: the rows the worst are named from (all when null).
+  auto finish = [&](SolveStatus st, std::string msg, const std::vector<Index>* among = nullptr) {
     sum.status = st;
     model.residual(q.data(), t, phi.data());
     const Eigen::VectorXd scaled = scaled_rows(model, phi);
     sum.residual = m ? scaled.maxCoeff() : 0.0;
     sum.moved = n ? ((q - q0).cwiseAbs().cwiseQuotient(model.tolerance_scales().coordinate_scale)).maxCoeff() : 0.0;
     if (st != SolveStatus::kSuccess) {
-      sum.worst_rows = detail::worst_rows(model, phi, 3);
+      sum.worst_rows = detail::worst_rows(model, phi, 3, among);
       if (msg.empty()) msg = to_string(st);
       if (!sum.worst_rows.empty() && st != SolveStatus::kInconsistent)
         msg += "; worst constraints: " + detail::describe_rows(model, sum.worst_rows);
@@ -279,7 +280,16 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     for (Index r : ind) kept_within = kept_within && within(r);
     for (Index r : sum.rank.redundant_rows)
       if (!within(r)) sum.violated_rows.push_back(r);
-    if (!kept_within || sum.violated_rows.empty()) return finish(SolveStatus::kNotConverged, why);
+    // The independent equations themselves have no solution near here (a fifth bar of the wrong length locks a
+    // parallelogram where no position exists): whether the redundant ones conflict is not known, and the worst
+    // rows are named among the independent ones — a redundant driver's row, far off at a least-squares minimum
+    // of the others, says nothing about the cause.
+    if (!kept_within) {
+      sum.consistent = false;
+      return finish(SolveStatus::kNotConverged,
+                    "the independent equations have no common solution near this placement (" + why + ")", &kept);
+    }
+    if (sum.violated_rows.empty()) return finish(SolveStatus::kNotConverged, why);
 
     // Inconsistent: each violated redundant row is a combination of independent rows, which it contradicts.
     sum.consistent = false;

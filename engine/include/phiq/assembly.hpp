@@ -49,7 +49,9 @@ struct AssemblySummary {
   /// How far the placement moved: max_j |q_j − q₀_j| / coordinate scale_j.
   double moved = 0.0;
   RankReport rank;         ///< at the final configuration
-  /// False when redundant equations are not satisfied where the independent ones are: the model is inconsistent.
+  /// False when redundant equations are not satisfied where the independent ones are (the model is inconsistent:
+  /// status kInconsistent), or when the independent equations themselves could not be satisfied (kNotConverged:
+  /// nothing is known of the redundant ones).
   bool consistent = true;
   std::vector<Index> violated_rows;    ///< the redundant rows not satisfied (inconsistent models)
   std::vector<std::string> conflicts;  ///< constraints that cannot hold together: each violated redundant row and the rows it is a combination of (empty when consistent)
