@@ -2,6 +2,8 @@
 // solves and evaluations, point motions against closed forms and finite differences.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -135,6 +137,51 @@ TEST(OutputPoints, SweepPointsAreExactAndTheirDerivativesMatchFiniteDifferences)
                           std::fabs(par.points[k][i].a[d] - r.points[k][i].a[d])});
   EXPECT_LT(worst, 1e-8);
   EXPECT_EQ(par_sum.counters.point_evaluations, 2 * (steps + 1));
+}
+
+TEST(OutputPoints, SpatialPointsMoveAsRigidBodyKinematicsSays) {
+  // A disk on a hinge about u = (1, 2, 2)/3 through G = (0.3, −0.2, 0.5), turned by θ = −0.3 + 3t + 0.5t²; T is
+  // the disk's point (1, 0, 0), P a natural point held fixed. Every point of the disk moves on a circle about the
+  // axis: ṙ_T = θ̇ u × d and r̈_T = θ̈ u × d + θ̇² u × (u × d), d = r_T − G (the sense of θ about u, ±, from the
+  // first row); r_T itself is r + R(e) (1, 0, 0) with R(e) the rotation matrix of the Euler parameters.
+  Scene scene = parse_scene(R"Y(phiq: 1
+dimension: 3
+coordinates: {x: 0.068, y: -0.484, z: 0.843, e0: 1.317, e1: 0.017, e2: 0.068, e3: -0.239, px: 1, py: 2, pz: 3}
+points: {P: [px, py, pz]}
+bodies:
+  disk: [x, y, z, e0, e1, e2, e3]
+constraints:
+  - {name: hinge, type: revolute, between: [{body: ground, at: [0.3, -0.2, 0.5], axis: [1, 2, 2]}, {body: disk, at: [0.1, 0.4, -0.3], axis: [0, 1, 1]}]}
+  - {name: fixP, type: fixed_point, point: P, at: [1, 2, 3]}
+drivers:
+  - {name: motor, joint: hinge, measure: angle, law: {type: polynomial, coefficients: [-0.3, 3, 0.5]}}
+time: {start: 0, end: 1, steps: 40}
+output: {velocities: true, accelerations: true, points: [P, {name: T, body: disk, at: [1, 0, 0]}]}
+)Y", "disk.yaml");
+  ASSERT_EQ(scene.sweep.points.size(), 2u);
+  EXPECT_EQ(scene.sweep.points[1].dimension(), 3);
+  SweepSummary sum;
+  Rows r = sweep_scene(scene, &sum);
+  ASSERT_EQ(r.points.size(), 41u);
+  const Eigen::Vector3d u = Eigen::Vector3d(1, 2, 2) / 3.0, g(0.3, -0.2, 0.5);
+  double sense = 0.0;
+  for (std::size_t k = 0; k < r.t.size(); ++k) {
+    SCOPED_TRACE("t = " + std::to_string(r.t[k]));
+    const PointMotion &p = r.points[k][0], &m = r.points[k][1];
+    EXPECT_EQ(p.r[0], 1.0);
+    EXPECT_EQ(p.r[2], 3.0);
+    EXPECT_EQ(p.v[1], 0.0);
+    EXPECT_EQ(p.a[2], 0.0);
+    const Eigen::VectorXd& q = r.q[k];
+    const Eigen::Quaterniond e(q(3), q(4), q(5), q(6));
+    const Eigen::Vector3d rt(m.r[0], m.r[1], m.r[2]), vt(m.v[0], m.v[1], m.v[2]), at(m.a[0], m.a[1], m.a[2]);
+    EXPECT_LT((rt - (q.head<3>() + e.toRotationMatrix() * Eigen::Vector3d(1, 0, 0))).norm(), 1e-9);  // |e| = 1 to tol
+    const double t = r.t[k], w = 3 + t, al = 1;
+    const Eigen::Vector3d d = rt - g;
+    if (k == 0) sense = vt.dot(u.cross(d)) > 0 ? 1.0 : -1.0;
+    EXPECT_LT((vt - sense * w * u.cross(d)).norm(), 1e-9);
+    EXPECT_LT((at - (sense * al * u.cross(d) + w * w * u.cross(u.cross(d)))).norm(), 1e-8);
+  }
 }
 
 // Exact counts of the work each output list causes, sequential and parallel. Full Newton and a fixed predictor

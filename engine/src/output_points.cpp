@@ -6,8 +6,18 @@
 namespace phiq {
 
 Index OutputPoint::max_coordinate() const {
-  if (kind == OutputPointKind::kPlanarPoint) return std::max(point.x.coord(), point.y.coord());
-  return std::max({body.x.coord(), body.y.coord(), body.psi.coord()});
+  switch (kind) {
+    case OutputPointKind::kPlanarPoint: return std::max(point.x.coord(), point.y.coord());
+    case OutputPointKind::kPlanarBodyPoint: return std::max({body.x.coord(), body.y.coord(), body.psi.coord()});
+    case OutputPointKind::kSpatialPoint:
+    case OutputPointKind::kSpatialBodyPoint: {
+      Index m = -1;
+      for (const Slot& s : spatial.r) m = std::max(m, s.coord());
+      for (const Slot& s : spatial.p) m = std::max(m, s.coord());
+      return m;
+    }
+  }
+  return -1;
 }
 
 OutputPoint planar_point(std::string name, Point2 p) {
@@ -25,6 +35,24 @@ OutputPoint planar_body_point(std::string name, Frame2 body, double sx, double s
   o.kind = OutputPointKind::kPlanarBodyPoint;
   o.body = body;
   o.local_x = sx, o.local_y = sy;
+  return o;
+}
+
+OutputPoint spatial_point(std::string name, Point3 p) {
+  OutputPoint o;
+  o.name = std::move(name);
+  o.kind = OutputPointKind::kSpatialPoint;
+  o.spatial = Attachment3::natural(p);
+  return o;
+}
+
+OutputPoint spatial_body_point(std::string name, const Frame3& body, kin3::V3 at) {
+  if (!std::isfinite(at.x) || !std::isfinite(at.y) || !std::isfinite(at.z))
+    throw Error("output point '" + name + "': 'at' is not finite");
+  OutputPoint o;
+  o.name = std::move(name);
+  o.kind = OutputPointKind::kSpatialBodyPoint;
+  o.spatial = Attachment3::body_point(body, at);
   return o;
 }
 
@@ -47,6 +75,21 @@ PointMotion evaluate_point(const OutputPoint& p, const double* q, const double* 
         if (qdd) {
           const double al = p.body.psi.rate(qdd);
           m.a = {p.body.x.rate(qdd) - al * rsy - w * w * rsx, p.body.y.rate(qdd) + al * rsx - w * w * rsy, 0.0};
+        }
+      }
+      break;
+    }
+    case OutputPointKind::kSpatialPoint:
+    case OutputPointKind::kSpatialBodyPoint: {
+      const Attachment3& x = p.spatial;
+      const kin3::V3 r = x.value(q);
+      m.r = {r.x, r.y, r.z};
+      if (qd) {
+        const kin3::V3 v = x.rate(q, qd);
+        m.v = {v.x, v.y, v.z};
+        if (qdd) {
+          const kin3::V3 a = x.rate(q, qdd) + x.bias(qd);  // the q̈-linear part, and the rest (2 R(ė) s)
+          m.a = {a.x, a.y, a.z};
         }
       }
       break;

@@ -2071,8 +2071,24 @@ class SceneReader {
         c.fail("coordinate '" + n + "' and the column '" + n + "' would share a name: leave it out of coordinates");
     }
   }
-  // An output point: a point name, or {name: P, body: B, at: [x, y]} (a point fixed on body B, in B's frame).
+  // An output point: a point name, or {name: P, body: B, at: [x, y]} (a point fixed on body B, in B's frame;
+  // [x, y, z] in dimension 3).
   OutputPoint output_point(const Cursor& c) const {
+    if (spatial_) {
+      if (!c.is_map()) {
+        const std::string n = c.name();
+        const Index k = entry_at(c, n, points3_);
+        if (k < 0) c.fail("unknown point '" + n + "' (or write {name: P, body: B, at: [x, y, z]})");
+        return spatial_point(n, points3_[k]);
+      }
+      c.expect_map({"name", "body", "at"});
+      const std::string n = c.require("name").name();
+      if (!Cursor::valid_name(n)) c.require("name").fail("'" + n + "' is not a valid name");
+      const Frame3 f = body3(c.require("body"));
+      kin3::V3 at;
+      if (auto a = c.field("at"); a.present()) at = vec3(a);
+      return spatial_body_point(n, f, at);
+    }
     if (!c.is_map()) {
       const std::string n = c.name();
       const Index k = entry_at(c, n, points_);
