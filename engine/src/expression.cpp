@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <optional>
@@ -177,6 +178,33 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
   }
   const J& o = r[outputs_.at(0)];
   out[0] = o.v, out[1] = o.d, out[2] = o.h;
+}
+
+std::string Tape::listing() const {
+  static const char* const names[] = {"const", "loadq", "loadqd", "loadt", "add",  "sub",  "mul",  "div", "neg",
+                                      "powint", "pow", "sqrt",  "sin",   "cos",  "tan",  "asin", "acos", "atan",
+                                      "atan2", "exp",  "log",   "sinh",  "cosh", "tanh", "abs",  "sign"};
+  std::ostringstream s;
+  char imm[64];
+  for (std::size_t i = 0; i < code_.size(); ++i) {
+    const Instr& in = code_[i];
+    std::snprintf(imm, sizeof imm, "%a", in.imm);
+    s << 'r' << i << " = " << names[static_cast<int>(in.op)];
+    switch (in.op) {
+      case Op::kConst: s << ' ' << imm; break;
+      case Op::kLoadQ: case Op::kLoadQd: s << ' ' << in.a; break;
+      case Op::kLoadT: break;
+      default:
+        s << " r" << in.a;
+        if (is_binary(in.op)) s << " r" << in.b;
+        if (in.op == Op::kPowInt) s << ' ' << imm;
+    }
+    s << '\n';
+  }
+  s << "out";
+  for (std::uint32_t o : outputs_) s << " r" << o;
+  s << '\n';
+  return s.str();
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -730,6 +758,10 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   }
   for (auto& [s, i] : used) out->coords_.push_back(i);
   return out;
+}
+
+std::string CompiledExpression::listing() const {
+  return "value:\n" + value_.listing() + "gradient:\n" + gradient_.listing() + "partial_t:\n" + partial_t_.listing();
 }
 
 double CompiledExpression::value(const double* q, double t) const {

@@ -45,6 +45,9 @@ class Tape {
 
   std::size_t size() const { return code_.size(); }  ///< number of instructions
   std::size_t num_outputs() const { return outputs_.size(); }  ///< number of outputs
+  /// The program as text, one instruction per line ("r3 = mul r1 r2"; constants as hexadecimal floats, so that
+  /// equal listings are the same program bit for bit), then its outputs. For tests and debugging.
+  std::string listing() const;
 
  private:
   friend class TapeBuilder;
@@ -98,6 +101,9 @@ class CompiledExpression {
   double partial_t(const double* q, double t) const;
   /// γ contribution: −( Σ_jk g_qjqk q̇j q̇k + 2 Σ_j g_qjt q̇j + g_tt ).
   double gamma(const double* q, const double* qd, double t) const;
+
+  /// The value, gradient and ∂/∂t tapes as text (Tape::listing), for tests and debugging.
+  std::string listing() const;
 
   /// The same function with the coordinate indices it was compiled with reinterpreted, without symbolic work (the
   /// tapes are copied and patched): compiled index k reads q[target[k]] when target[k] ≥ 0 and is the constant
