@@ -186,6 +186,109 @@ TEST(Expression, LiteralsFoldToTheValuesTheTextMeans) {
   EXPECT_DOUBLE_EQ(gh[0], 3.0);
 }
 
+// The value, gradient, ∂/∂t and γ of e at (q, t) along (q̇, 1) against central differences (Richardson for γ):
+// the check of every order the tapes provide. `scale` is the size of the derivatives checked (tolerances relative
+// to it). All of them must be finite.
+void expect_derivatives_match_differences(const CompiledExpression& e, const double q[3], const double qd[3],
+                                          double t, double scale) {
+  const std::vector<Index>& cols = e.coordinates();
+  std::vector<double> grad(cols.size());
+  e.gradient(q, t, grad.data());
+  auto at = [&](double s, double dt) {
+    double x[3] = {q[0] + s * qd[0], q[1] + s * qd[1], q[2] + s * qd[2]};
+    return e.value(x, t + dt);
+  };
+  const double h = 1e-5;
+  for (std::size_t k = 0; k < cols.size(); ++k) {
+    double a[3] = {q[0], q[1], q[2]}, b[3] = {q[0], q[1], q[2]};
+    a[cols[k]] += h, b[cols[k]] -= h;
+    ASSERT_TRUE(std::isfinite(grad[k])) << e.text() << " column " << cols[k];
+    EXPECT_NEAR(grad[k], (e.value(a, t) - e.value(b, t)) / (2 * h), 1e-7 * scale) << e.text() << " column " << cols[k];
+  }
+  const double pt = e.partial_t(q, t);
+  ASSERT_TRUE(std::isfinite(pt)) << e.text();
+  EXPECT_NEAR(pt, (e.value(q, t + h) - e.value(q, t - h)) / (2 * h), 1e-7 * scale) << e.text();
+  // −γ = d²/ds² g(q + s q̇, t + s) at s = 0
+  auto d2 = [&](double step) { return (at(step, step) - 2 * at(0, 0) + at(-step, -step)) / (step * step); };
+  const double g = e.gamma(q, qd, t);
+  ASSERT_TRUE(std::isfinite(g)) << e.text();
+  EXPECT_NEAR(-g, (4 * d2(1e-3) - d2(2e-3)) / 3, 1e-6 * scale) << e.text();
+}
+
+TEST(Expression, IntegerPowersHaveExactDerivativesAtAZeroBase) {
+  // GiNaC differentiated u^k (k a constant of the text) as u^k·k·u'·u^(-1): 0·∞ where u = 0, unless the tape
+  // builder could merge u^k·u^(-1) — which failed whenever GiNaC rewrote u^(-1): (2x)^(-1) as ½·x^(-1) always,
+  // (x − y)^(-1) as −(y − x)^(-1) in about half of all processes. Compiled several times (GiNaC's term order
+  // changes with its symbols' serial numbers), so that an order-dependent failure shows here too.
+  const double q[3] = {0.0, 0.0, 0.0}, qd[3] = {0.7, -1.3, 0.4};
+  for (int round = 0; round < 6; ++round) {
+    // (2 xA)^2 at xA = 0: g = 0, ∂g/∂xA = 8 xA = 0, −γ = 8 ẋA²
+    auto sq = CompiledExpression::compile("(2*xA)^2", resolve);
+    double g1[1];
+    sq->gradient(q, 0.0, g1);
+    EXPECT_EQ(g1[0], 0.0);
+    EXPECT_DOUBLE_EQ(-sq->gamma(q, qd, 0.0), 8 * qd[1] * qd[1]);
+    // (xA − yA)^2 with xA = yA ≠ 0: 2 (xA − yA) (1, −1) = 0; −γ = 2 (ẋA − ẏA)²
+    auto diff = CompiledExpression::compile("(xA - yA)^2 + (yA - xA)^3", resolve);
+    const double qe[3] = {0.0, 0.35, 0.35};
+    double g2[2];
+    diff->gradient(qe, 0.0, g2);
+    EXPECT_EQ(g2[0], 0.0);
+    EXPECT_EQ(g2[1], 0.0);
+    EXPECT_DOUBLE_EQ(-diff->gamma(qe, qd, 0.0), 2 * (qd[1] - qd[2]) * (qd[1] - qd[2]));
+    // a cube and a time-dependent base: (t − 0.5)^3 xA + (2 t − 1)^2 at t = 0.5: ∂/∂t = 0 and −γ = 8 (no xA
+    // term survives: 3 (t − ½)² ẋA and 6 (t − ½) xA vanish)
+    auto tm = CompiledExpression::compile("(t - 0.5)^3*xA + (2*t - 1)^2", resolve);
+    const double qx[3] = {0.0, 1.7, 0.0};
+    EXPECT_EQ(tm->partial_t(qx, 0.5), 0.0);
+    EXPECT_DOUBLE_EQ(-tm->gamma(qx, qd, 0.5), 8.0);
+    for (const char* text : {"(2*xA)^2", "(xA - yA)^2 + (yA - xA)^3", "(2*xA - 3*yA)^3 - (xA*yA)^2",
+                             "(sin(theta2) - xA)^4 + (t - 0.5)^2*yA", "L2*(theta2 - 2*t)^3 + (xA + yA - t)^2"}) {
+      auto e = CompiledExpression::compile(text, resolve);
+      // every base above is 0 here: theta2 = sin(theta2) = xA = yA = 0, t = 0; and at θ2 = 1, t = ½
+      expect_derivatives_match_differences(*e, q, qd, 0.0, 1.0);
+      const double q1[3] = {1.0, std::sin(1.0), 0.0};
+      expect_derivatives_match_differences(*e, q1, qd, 0.5, 10.0);
+    }
+  }
+  // negative integer powers away from 0 keep their closed forms
+  for (const char* text : {"(2*xA - yA)^(-2)", "(xA - yA)^-3 + xA/(t - yA)^2", "1/(2*xA)^2"}) {
+    auto e = CompiledExpression::compile(text, resolve);
+    const double q2[3] = {0.0, 0.8, -0.3};
+    expect_derivatives_match_differences(*e, q2, qd, 0.25, 100.0);
+  }
+}
+
+TEST(Expression, RealPowersAtAZeroBaseAreFiniteWhereTheirDerivativesAre) {
+  // u^p at u = 0: ∂ = p u^(p−1) and the second derivative p (p − 1) u^(p−2) are 0 for p > 2, the second is
+  // infinite for 1 < p < 2, both are for p < 1. Finite ones must come out exactly 0, not NaN.
+  const double q[3] = {0.0, 0.0, 0.0}, qd[3] = {0.0, 0.9, 0.0};
+  for (const char* text : {"xA^2.5", "(2*xA)^2.5", "xA^2.7", "(3*xA)^3.5", "xA^7.25"}) {
+    auto e = CompiledExpression::compile(text, resolve);
+    double g[1];
+    e->gradient(q, 0.0, g);
+    EXPECT_EQ(g[0], 0.0) << text;
+    EXPECT_EQ(e->gamma(q, qd, 0.0), 0.0) << text;
+  }
+  for (const char* text : {"xA^1.5", "(2*xA)^1.7"}) {  // ∂ = 0, second derivative infinite
+    auto e = CompiledExpression::compile(text, resolve);
+    double g[1];
+    e->gradient(q, 0.0, g);
+    EXPECT_EQ(g[0], 0.0) << text;
+    EXPECT_FALSE(std::isfinite(e->gamma(q, qd, 0.0))) << text;
+  }
+  for (const char* text : {"sqrt(xA)", "xA^0.5", "(2*xA)^0.3"}) {  // ∂ itself infinite: not finite, never 0
+    auto e = CompiledExpression::compile(text, resolve);
+    double g[1];
+    e->gradient(q, 0.0, g);
+    EXPECT_FALSE(std::isfinite(g[0])) << text;
+  }
+  // and away from 0, against differences
+  const double q1[3] = {0.3, 0.6, 0.2};
+  for (const char* text : {"xA^2.5 + (xA - yA)^1.5", "(2*xA)^2.7*yA", "(xA + yA)^(-0.5)"})
+    expect_derivatives_match_differences(*CompiledExpression::compile(text, resolve), q1, qd, 0.0, 10.0);
+}
+
 TEST(Expression, ConstantExpressions) {
   auto c = [](const std::string& n) -> std::optional<double> {
     if (n == "L") return 2.0;

@@ -19,6 +19,19 @@ namespace phiq {
 // Tape evaluation
 
 namespace {
+// x^k by repeated squaring (as accurate as the multiplications x^2 or x^(-1) stand for). k = 0 gives 1, 0^k for
+// k < 0 gives +inf.
+double int_power(double x, long k) {
+  if (k < 0) x = 1.0 / x, k = -k;
+  double acc = 1.0;
+  while (k) {
+    if (k & 1) acc *= x;
+    x *= x;
+    k >>= 1;
+  }
+  return acc;
+}
+
 // One instruction on operand values a, b (loads excluded): shared by the evaluator and the builder's constant
 // folding, so that a folded constant is exactly what the tape would have computed.
 double apply(Tape::Op op, double a, double b, double imm) {
@@ -30,15 +43,8 @@ double apply(Tape::Op op, double a, double b, double imm) {
     case Op::kMul: return a * b;
     case Op::kDiv: return a / b;
     case Op::kNeg: return -a;
-    case Op::kPowInt: {
-      // exact repeated squaring for integer exponents (keeps x^2 and x^(-1) as accurate as a multiply)
-      long e = static_cast<long>(imm);
-      double base = a;
-      if (e < 0) { base = 1.0 / base; e = -e; }
-      double acc = 1.0;
-      while (e) { if (e & 1) acc *= base; base *= base; e >>= 1; }
-      return acc;
-    }
+    case Op::kPowInt: return int_power(a, static_cast<long>(imm));
+    case Op::kPowHalf: return int_power(std::sqrt(a), static_cast<long>(imm));
     case Op::kPow: return std::pow(a, b);
     case Op::kSqrt: return std::sqrt(a);
     case Op::kSin: return std::sin(a);
@@ -111,13 +117,27 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
         w = {w0, w1, (a.h - w0 * b.h - w1 * b.d) / b.v};
         break;
       }
+      // Powers with a constant exponent p by their closed forms p a^(p−1), p (p−1) a^(p−2), each power computed
+      // as such: at a = 0 they are 0 where p is large enough, where a product with a^p/a would be 0·∞.
       case Op::kPowInt: {
-        const double k = in.imm;
-        const double p2 = std::pow(a.v, k - 2.0);  // x^(k-2), then x^(k-1) and x^k from it
-        w = unary(a, p2 * a.v * a.v, k * p2 * a.v, k * (k - 1.0) * p2);
+        const long k = static_cast<long>(in.imm);
+        w = unary(a, int_power(a.v, k), in.imm * int_power(a.v, k - 1),
+                  in.imm * (in.imm - 1.0) * int_power(a.v, k - 2));
         break;
       }
-      case Op::kPow: {  // a^b = exp(b ln a)
+      case Op::kPowHalf: {  // √a^k: p = k/2
+        const long k = static_cast<long>(in.imm);
+        const double s = std::sqrt(a.v), p = 0.5 * in.imm;
+        w = unary(a, int_power(s, k), p * int_power(s, k - 2), p * (p - 1.0) * int_power(s, k - 4));
+        break;
+      }
+      case Op::kPow: {
+        if (b.d == 0.0 && b.h == 0.0) {  // a constant exponent (along the direction)
+          const double p = b.v;
+          w = unary(a, std::pow(a.v, p), p * std::pow(a.v, p - 1.0), p * (p - 1.0) * std::pow(a.v, p - 2.0));
+          break;
+        }
+        // a^b = exp(b ln a)
         const J l = unary(a, std::log(a.v), 1.0 / a.v, -1.0 / (a.v * a.v));
         const J m{b.v * l.v, b.v * l.d + b.d * l.v, b.v * l.h + b.d * l.d + b.h * l.v};
         const double e = std::exp(m.v);
@@ -181,9 +201,10 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
 }
 
 std::string Tape::listing() const {
-  static const char* const names[] = {"const", "loadq", "loadqd", "loadt", "add",  "sub",  "mul",  "div", "neg",
-                                      "powint", "pow", "sqrt",  "sin",   "cos",  "tan",  "asin", "acos", "atan",
-                                      "atan2", "exp",  "log",   "sinh",  "cosh", "tanh", "abs",  "sign"};
+  static const char* const names[] = {"const", "loadq", "loadqd", "loadt", "add",  "sub",  "mul",   "div",
+                                      "neg",   "powint", "powhalf", "pow", "sqrt", "sin",  "cos",   "tan",
+                                      "asin",  "acos",  "atan",   "atan2", "exp",  "log",  "sinh",  "cosh",
+                                      "tanh",  "abs",   "sign"};
   std::ostringstream s;
   char imm[64];
   for (std::size_t i = 0; i < code_.size(); ++i) {
@@ -197,7 +218,7 @@ std::string Tape::listing() const {
       default:
         s << " r" << in.a;
         if (is_binary(in.op)) s << " r" << in.b;
-        if (in.op == Op::kPowInt) s << ' ' << imm;
+        if (in.op == Op::kPowInt || in.op == Op::kPowHalf) s << ' ' << imm;
     }
     s << '\n';
   }
@@ -247,6 +268,34 @@ std::string supported_function_list() {
   for (const auto& [name, spec] : supported_functions()) s += (s.empty() ? "" : " ") + name;
   return s;
 }
+
+// u^p for an exponent p that is a constant of the text, as a GiNaC function of its own, phiq_pow(u, p), whose
+// derivative is the closed form p·phiq_pow(u, p − 1)·u'. Such a p reaches GiNaC as a symbol (see ExpressionParser),
+// and GiNaC's power differentiates a symbolic exponent by D(u^p) = u^p·(p'·ln u + p·u'/u): 0·∞ wherever u = 0,
+// even for u² (a parallelogram's coupler (xA − xB)² + (yA − yB)² − b², yA = yB, failed as "singular"). Merging
+// u^p·u^(−1) back into u^(p−1) on the tape worked only while GiNaC left u^(−1) alone, which it does not: (2x)^(−1)
+// becomes ½·x^(−1), and (x − y)^(−1) becomes −(y − x)^(−1) in about half of all processes (its term order follows
+// hash values). Here p − 1 is folded in double precision like any constant part, and the tape computes
+// u^(p−1) as a power (exact: 0 for u = 0 and p > 1).
+GiNaC::ex constant_power_derivative(const GiNaC::ex& u, const GiNaC::ex& p, unsigned wrt);
+unsigned constant_power_serial() {
+  static const unsigned serial = GiNaC::function::register_new(
+      GiNaC::function_options("phiq_pow", 2).derivative_func(constant_power_derivative));
+  return serial;
+}
+GiNaC::ex constant_power(const GiNaC::ex& u, const GiNaC::ex& p) {
+  return GiNaC::function(constant_power_serial(), u, p);
+}
+GiNaC::ex constant_power_derivative(const GiNaC::ex& u, const GiNaC::ex& p, unsigned wrt) {
+  // ∂/∂p is never asked for (p is a constant), but is the exact one: u^p ln u
+  return wrt == 0 ? p * constant_power(u, p - 1) : constant_power(u, p) * GiNaC::log(u);
+}
+bool is_constant_power(const GiNaC::ex& e) {
+  return GiNaC::is_a<GiNaC::function>(e) && GiNaC::ex_to<GiNaC::function>(e).get_serial() == constant_power_serial();
+}
+// A power of either kind: GiNaC's own (numeric exponents from its derivatives, sqrt; exponents that are not
+// constant) or phiq_pow; op(0) is the base and op(1) the exponent of both.
+bool is_power(const GiNaC::ex& e) { return GiNaC::is_a<GiNaC::power>(e) || is_constant_power(e); }
 }  // namespace
 
 class TapeBuilder {
@@ -317,11 +366,10 @@ class TapeBuilder {
         return push(Op::kPowInt, b, 0, static_cast<double>(k));
       }
       if (small_int(2 * x)) {
-        std::uint32_t s = push(Op::kSqrt, emit(base));
         const long k = std::lround(2 * x);
-        if (k == 1) return s;
-        if (k == -1) return push(Op::kDiv, constant(1.0), s);
-        return push(Op::kPowInt, s, 0, static_cast<double>(k));
+        if (k == 1) return push(Op::kSqrt, emit(base));
+        if (k == -1) return push(Op::kDiv, constant(1.0), push(Op::kSqrt, emit(base)));
+        return push(Op::kPowHalf, emit(base), 0, static_cast<double>(k));  // one instruction: γ's closed forms
       }
     }
     return push(Op::kPow, emit(base), expo);
@@ -360,13 +408,12 @@ class TapeBuilder {
     if (is_a<mul>(e)) {
       const ex& last = e.op(e.nops() - 1);
       if (last.is_equal(-1)) return push(Op::kNeg, emit(-e));
-      // Factors with one base are multiplied as one power. Exponents written in the text are constants, which
-      // reach GiNaC as symbols (see ExpressionParser), so GiNaC differentiates x^k as x^k·k·x^(-1): 0·∞ at x = 0.
-      // As x^(k-1), with k - 1 folded, it is the closed form (for k = 2: 2x).
+      // Factors with one base are multiplied as one power, its exponents added (x^3/x is x^2, with 3 - 1 folded:
+      // finite at x = 0, as the text means).
       std::vector<std::pair<ex, std::vector<ex>>> groups;  // base, exponents
       for (std::size_t i = 0; i < e.nops(); ++i) {
         const ex& f = e.op(i);
-        const bool pw = is_a<power>(f);
+        const bool pw = is_power(f);
         const ex base = pw ? f.op(0) : f;
         auto g = std::find_if(groups.begin(), groups.end(), [&](const auto& p) { return p.first.is_equal(base); });
         if (g != groups.end()) g->second.push_back(pw ? f.op(1) : ex(1));
@@ -386,7 +433,7 @@ class TapeBuilder {
       }
       return acc ? *acc : constant(1.0);
     }
-    if (is_a<power>(e)) return emit_power(e.op(0), emit(e.op(1)));
+    if (is_power(e)) return emit_power(e.op(0), emit(e.op(1)));
     if (is_a<function>(e)) {
       const std::string name = ex_to<function>(e).get_name();
       if (name == "csgn" && e.nops() == 1) return push(Op::kSign, emit(e.op(0)));  // GiNaC's derivative of abs
@@ -565,7 +612,10 @@ class ExpressionParser {
       case Op::kSub: return settle(a.e - b.e);
       case Op::kMul: return settle(a.e * b.e);
       case Op::kDiv: return settle(a.e / b.e);
-      case Op::kPow: return settle(GiNaC::pow(a.e, b.e));
+      case Op::kPow:
+        if (!b.constant) return settle(GiNaC::pow(a.e, b.e));
+        if (b.value == 0.0) return constant(1.0);  // x^0 = 1, also at x = 0 (as the tape's power computes it)
+        return settle(constant_power(a.e, b.e));
       default: fail("internal: binary operation " + std::to_string(static_cast<int>(op)));
     }
   }

@@ -6,7 +6,9 @@
 /// common subexpressions shared, so that evaluation inside the Newton loop never touches the symbolic engine and
 /// never re-parses. γ needs second derivatives: it is computed exactly by second-order forward (Taylor-mode)
 /// automatic differentiation of the value tape along (q̇, 1), which costs a few passes over the tape, where symbolic
-/// second derivatives can grow with the cube of a product's length.
+/// second derivatives can grow with the cube of a product's length. A power u^p with a constant exponent has the
+/// derivatives p u^(p−1) and p (p−1) u^(p−2), each evaluated as a power: at u = 0 they are exactly 0 where p is
+/// large enough ((2x)² has the derivative 8x), and infinite (not NaN) where they really are (√u).
 #pragma once
 
 #include <cstdint>
@@ -23,10 +25,11 @@ namespace phiq {
 /// One compiled straight-line program over doubles. Inputs are read from q (coordinates), qd (velocities) and t.
 class Tape {
  public:
-  /// Instruction codes: loads of inputs, arithmetic, and the supported functions (kSign is csgn).
+  /// Instruction codes: loads of inputs, arithmetic, and the supported functions (kSign is csgn). kPowInt is a^k and
+  /// kPowHalf is √a^k for an integer k in imm (exact repeated squaring); kPow is a^b.
   enum class Op : std::uint8_t {
     kConst, kLoadQ, kLoadQd, kLoadT,
-    kAdd, kSub, kMul, kDiv, kNeg, kPowInt, kPow, kSqrt,
+    kAdd, kSub, kMul, kDiv, kNeg, kPowInt, kPowHalf, kPow, kSqrt,
     kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2, kExp, kLog, kSinh, kCosh, kTanh, kAbs, kSign,
   };
   /// One instruction; its result is the register with its own index (static single assignment).
@@ -34,7 +37,7 @@ class Tape {
     Op op;                 ///< what it computes
     std::uint32_t a = 0;   ///< first operand register (or the input index for loads)
     std::uint32_t b = 0;   ///< second operand register
-    double imm = 0.0;      ///< constant value, or integer exponent for kPowInt
+    double imm = 0.0;      ///< constant value, or integer exponent for kPowInt and kPowHalf
   };
 
   /// Evaluates the program; out[k] receives register outputs()[k]. Thread-safe (scratch is thread-local).
