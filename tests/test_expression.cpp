@@ -2,6 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "phiq/expression.hpp"
 #include "test_support.hpp"
@@ -120,6 +124,7 @@ TEST(Expression, ComplexOrHugeConstantsAreRefusedNotHandedToGiNaC) {
   EXPECT_HAS(compile_message("xA/(1 - 1)"), "division by zero");
   EXPECT_HAS(compile_message("xA/0"), "division by zero");
   EXPECT_HAS(compile_message("xA/(xA - xA)"), "division by zero");  // GiNaC's own refusal, one line
+  EXPECT_HAS(compile_message("xA/((t - (3 + t)) + 3)"), "division by zero");  // two 3s, two symbols to GiNaC
   EXPECT_HAS(compile_message("xA - 1e400"), "number '1e400' is out of the range of a double");
 }
 
@@ -287,6 +292,59 @@ TEST(Expression, RealPowersAtAZeroBaseAreFiniteWhereTheirDerivativesAre) {
   const double q1[3] = {0.3, 0.6, 0.2};
   for (const char* text : {"xA^2.5 + (xA - yA)^1.5", "(2*xA)^2.7*yA", "(xA + yA)^(-0.5)"})
     expect_derivatives_match_differences(*CompiledExpression::compile(text, resolve), q1, qd, 0.0, 10.0);
+}
+
+// Texts whose terms GiNaC orders by hash values: numbers, differences, products of differences, powers, functions.
+const char* const kOrderSensitiveTexts[] = {
+    "(xA - xA*yA)^2 + (yA - theta2)^2 - L2^2",
+    "xA - L2*cos(theta2) + 0.1*sin(t)*yA - (yA - 2*xA)^3",
+    "atan2(yA - xA, xA + 2*yA) * abs(xA - yA) + sqrt(1 + (xA - t)^2)*exp(-theta2)",
+    "(xA*yA - theta2)/(1 + xA^2 + yA^2) - tanh(yA - xA)^2 + L2*t^2*(xA - yA)",
+    // constants of one value are different symbols to GiNaC: sums that are 0 only on the tape, with either sign
+    "(0.5*xA - 0.5*xA + yA)*(0.5 - (0.5 - yA))^3 + (xA - 2*t)*(2*t - xA + 3 - 3)*(3 + xA)/(xA + 3)",
+};
+
+std::string listings() {
+  std::string all;
+  for (const char* text : kOrderSensitiveTexts) all += CompiledExpression::compile(text, resolve)->listing();
+  return all;
+}
+
+TEST(Expression, CompilesToTheSameTapeWhateverWasCompiledBefore) {
+  // GiNaC orders a sum's terms by hash values, which come from its symbols' serial numbers (and from addresses,
+  // below): the same text compiled after others used to give another order of operations, other roundings.
+  const std::string first = listings();
+  for (int k = 1; k <= 5; ++k) {
+    for (int j = 0; j < k; ++j) CompiledExpression::compile("xA*yA + theta2", resolve);  // new symbols in between
+    EXPECT_EQ(listings(), first) << "after " << k << " more compilations";
+  }
+}
+
+TEST(Expression, CompilesToTheSameTapeInEveryProcess) {
+  // GiNaC's hash values start from the address of its classes' type names, which address-space randomisation
+  // moves from process to process: the same scene's CSV differed in its last bits from run to run. The test
+  // binary runs this test again in child processes (PHIQ_TAPE_LISTING names the file a child writes its listings
+  // to) and compares.
+  if (const char* out = std::getenv("PHIQ_TAPE_LISTING")) {
+    std::ofstream(out) << listings();
+    return;
+  }
+  const std::string mine = listings();
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "phiq_tape_listing";
+  std::filesystem::create_directories(dir);
+  for (int child = 0; child < 4; ++child) {
+    const std::filesystem::path file = dir / ("child" + std::to_string(child) + ".txt");
+    std::filesystem::remove(file);
+    const std::string cmd = "PHIQ_TAPE_LISTING=" + file.string() + " " +
+                            std::filesystem::read_symlink("/proc/self/exe").string() +
+                            " --gtest_filter=Expression.CompilesToTheSameTapeInEveryProcess >/dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    std::ifstream in(file);
+    std::stringstream text;
+    text << in.rdbuf();
+    EXPECT_EQ(text.str(), mine) << "child process " << child;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Expression, ConstantExpressions) {

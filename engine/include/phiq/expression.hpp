@@ -8,7 +8,9 @@
 /// automatic differentiation of the value tape along (q̇, 1), which costs a few passes over the tape, where symbolic
 /// second derivatives can grow with the cube of a product's length. A power u^p with a constant exponent has the
 /// derivatives p u^(p−1) and p (p−1) u^(p−2), each evaluated as a power: at u = 0 they are exactly 0 where p is
-/// large enough ((2x)² has the derivative 8x), and infinite (not NaN) where they really are (√u).
+/// large enough ((2x)² has the derivative 8x), and infinite (not NaN) where they really are (√u). The tapes do not
+/// follow GiNaC's order of terms (which follows hash values that change from process to process): the same text
+/// compiles to the same tapes, hence the same bits, in every process and whatever was compiled before.
 #pragma once
 
 #include <cstdint>
@@ -105,7 +107,8 @@ class CompiledExpression {
   /// γ contribution: −( Σ_jk g_qjqk q̇j q̇k + 2 Σ_j g_qjt q̇j + g_tt ).
   double gamma(const double* q, const double* qd, double t) const;
 
-  /// The value, gradient and ∂/∂t tapes as text (Tape::listing), for tests and debugging.
+  /// The value, gradient and ∂/∂t tapes as text (Tape::listing), for tests and debugging: the same text (and the
+  /// same names) give the same listing in every process.
   std::string listing() const;
 
   /// The same function with the coordinate indices it was compiled with reinterpreted, without symbolic work (the
