@@ -376,6 +376,53 @@ TEST(Kinematics, ADriveBeyondAnAsymptoteFailsWhereThePositionsStopExisting) {
     EXPECT_LT(last_t, t_star) << expr;
     EXPECT_GT(sum.failed_time, t_star - 0.5) << expr << ": " << sum.message;
     EXPECT_LE(sum.failed_time, t_star + 0.5) << expr << ": " << sum.message;
+// A derivative that does not exist where the value does (√x at x = 0: ∂ = −∞; x^1.5 there: γ infinite; the law
+// √t at t = 0: ḟ infinite) is a kNonFinite naming the constraint and the coordinate. It was a "singular position"
+// (the LU found the matrix with −∞ singular) or a bare "velocity is not finite".
+TEST(Kinematics, DerivativesThatDoNotExistAreNamedNotSingular) {
+  auto scene = [](const std::string& expr, const std::string& law) {
+    return parse_scene("phiq: 1\ncoordinates: {x: 0, y: 0}\nconstraints:\n  - {name: c, type: equation, expr: \"" +
+                           expr + "\", unit: length}\ndrivers:\n  - {name: m, coordinate: x, law: " + law +
+                           "}\ntime: {start: 0, end: 1, steps: 4}\noutput: {velocities: true, accelerations: true}\n",
+                       "nf.yaml");
+  };
+  const std::string linear = "{type: linear, initial: 0, rate: 1}";
+  {  // y = √x, x = t: ∂c/∂x = −1/(2√x) = −∞ at t = 0
+    Scene s = scene("y - sqrt(x)", linear);
+    Workspace ws(*s.model);
+    ASSERT_EQ(solve_position(*s.model, 0.0, NewtonOptions{}, ws), SolveStatus::kSuccess);  // x = y = 0 holds
+    LinearSummary ls;
+    EXPECT_EQ(solve_velocity(*s.model, 0.0, ws, &ls), SolveStatus::kNonFinite);
+    EXPECT_HAS(ls.message, "Φq is not finite: ∂'c'/∂'x' = -inf, a derivative that does not exist at this position");
+    SweepSummary sum;
+    test::Trace tr;
+    EXPECT_EQ(test::sweep(*s.model, s.sweep, &tr, &sum), SolveStatus::kNonFinite);
+    EXPECT_EQ(sum.failed_step, 0);
+    EXPECT_HAS(sum.message, "∂'c'/∂'x' = -inf");
+    EXPECT_EQ(sum.message.find("singular"), std::string::npos) << sum.message;
+    // positions only: Newton's matrix at x = 0 has the −∞; the sub-steps cannot avoid it
+    s.sweep.velocities = s.sweep.accelerations = false;
+    EXPECT_EQ(test::sweep(*s.model, s.sweep, &tr, &sum), SolveStatus::kNonFinite);
+    EXPECT_HAS(sum.message, "∂'c'/∂'x' = -inf");
+    EXPECT_EQ(sum.message.find("singular"), std::string::npos) << sum.message;
+  }
+  {  // y = x^1.5: ∂ = 1.5 √x is 0 at x = 0, but γ = −0.75 ẋ²/√x is infinite
+    Scene s = scene("y - x^1.5", linear);
+    Workspace ws(*s.model);
+    ASSERT_EQ(solve_position(*s.model, 0.0, NewtonOptions{}, ws), SolveStatus::kSuccess);
+    LinearSummary ls;
+    ASSERT_EQ(solve_velocity(*s.model, 0.0, ws, &ls), SolveStatus::kSuccess) << ls.message;
+    EXPECT_EQ(ws.qd(1), 0.0);
+    EXPECT_EQ(solve_acceleration(*s.model, 0.0, ws, &ls), SolveStatus::kNonFinite);
+    EXPECT_HAS(ls.message, "acceleration is not finite: γ of 'c' is not finite, second derivatives that do not exist");
+  }
+  {  // x = √t: ḟ = 1/(2√t) is infinite at t = 0
+    Scene s = scene("y - x", "{type: expression, f: \"sqrt(t)\"}");
+    Workspace ws(*s.model);
+    ASSERT_EQ(solve_position(*s.model, 0.0, NewtonOptions{}, ws), SolveStatus::kSuccess);
+    LinearSummary ls;
+    EXPECT_EQ(solve_velocity(*s.model, 0.0, ws, &ls), SolveStatus::kNonFinite);
+    EXPECT_HAS(ls.message, "velocity is not finite: Φt of 'm' is not finite, a derivative that does not exist");
   }
 }
 

@@ -189,6 +189,49 @@ bool jacobian_values_at_q(const Workspace& ws, double t) {
   return ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q.size() == ws.q.size() && ws.jacobian_q == ws.q;
 }
 
+// Derivatives that do not exist. An equation's or a law's derivative can be infinite or NaN where its value is
+// finite (√u or u^0.5 at u = 0; γ of u^1.5 there): the LU then finds Φq singular, or a solve gives NaN, and the
+// failure read as a singular position or as a bare "velocity is not finite". These name the first such entry —
+// looked for only once a factorisation or a solve has failed — so that the message says what it is.
+const char* const kNoDerivative =
+    ", a derivative that does not exist at this position (as that of sqrt(u) or u^p, p < 1, at u = 0)";
+std::string number_text(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+// The first non-finite entry of Φq's values (in the solve pattern: `values` as factorised), or "".
+std::string non_finite_jacobian(const Model& model, const double* values) {
+  const CscPattern& p = model.solve_pattern();
+  for (Index j = 0; j < p.cols; ++j)
+    for (Index k = p.col_ptr[static_cast<std::size_t>(j)]; k < p.col_ptr[static_cast<std::size_t>(j) + 1]; ++k)
+      if (!std::isfinite(values[k])) {
+        const Index r = p.row_idx[static_cast<std::size_t>(k)];
+        const Index row = model.dropped_rows().empty() ? r : model.solve_rows()[static_cast<std::size_t>(r)];
+        return std::string(detail::kNonFiniteJacobian) + "∂'" + model.row_name(row) + "'/∂'" +
+               model.coordinate_names()[static_cast<std::size_t>(j)] + "' = " + number_text(values[k]) + kNoDerivative;
+      }
+  return "";
+}
+// The same for Φq evaluated at (q, t), for a failure after the factorisation (whose values may be gone).
+std::string non_finite_jacobian_at(const Model& model, const double* q, double t) {
+  std::vector<double> values(static_cast<std::size_t>(model.jacobian_pattern().nnz()));
+  model.jacobian(q, t, values.data());
+  if (model.dropped_rows().empty()) return non_finite_jacobian(model, values.data());
+  std::vector<double> kept(model.solve_entries().size());
+  for (std::size_t k = 0; k < kept.size(); ++k) kept[k] = values[static_cast<std::size_t>(model.solve_entries()[k])];
+  return non_finite_jacobian(model, kept.data());
+}
+// The first non-finite row of a right-hand side (Φt or γ, one entry per equation), or "".
+std::string non_finite_row(const Model& model, const Eigen::VectorXd& rhs, const std::string& what,
+                           const char* why) {
+  for (Index i = 0; i < rhs.size(); ++i)
+    if (!std::isfinite(rhs(i)))
+      return what + " of '" + model.row_name(i) + "' is not finite" + why;
+  return "";
+}
+
 // Factorises Φq at (ws.q, t) from ws.jacobian_values (evaluating them first unless `values_at_q`), and records
 // that the factors are at time t (ws.factorized_q is the caller's to record).
 SolveStatus factorize_at_q(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
@@ -208,6 +251,13 @@ SolveStatus factorize_at_q(const Model& model, double t, Workspace& ws, double* 
   FactorStatus fs = ws.lu->factorize(values);
   ++ws.counters.factorizations;
   *rcond = ws.lu->rcond();
+  if (fs != FactorStatus::kOk || !(*rcond > 0.0)) {  // a non-finite entry makes the factors fail or rcond 0
+    std::string why = non_finite_jacobian(model, values);
+    if (!why.empty()) {
+      *message = std::move(why);
+      return SolveStatus::kNonFinite;
+    }
+  }
   if (fs == FactorStatus::kFailed) {
     *message = "sparse LU failed: " + ws.lu->last_message();
     return SolveStatus::kLinearSolverFailed;
@@ -422,6 +472,8 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
         reuse = false, prev_norm = -1.0;
         continue;
       }
+      std::string why = non_finite_jacobian_at(model, ws.q.data(), t);
+      if (!why.empty()) return finish(SolveStatus::kNonFinite, why);
       return finish(SolveStatus::kSingularJacobian, "Newton step is not finite (Jacobian numerically singular)");
     }
     // Contraction θ = ‖Δq_k‖ / ‖Δq_k−1‖ in the tolerance-scaled norm. A reused matrix that contracts worse than
@@ -543,8 +595,12 @@ SolveStatus velocity_from_factors(const Model& model, double t, Workspace& ws, L
   if (!ws.lu->solve(solve_rhs(model, ws), ws.qd.data()))
     return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
   ++ws.counters.velocity_solves;
-  if (!all_finite(ws.qd))
-    return sum.status = SolveStatus::kNonFinite, sum.message = "velocity is not finite", sum.status;
+  if (!all_finite(ws.qd)) {
+    std::string why = non_finite_row(model, ws.rhs, "Φt", kNoDerivative);
+    if (why.empty()) why = non_finite_jacobian_at(model, ws.q.data(), t);
+    sum.message = "velocity is not finite" + (why.empty() ? "" : ": " + why);
+    return sum.status = SolveStatus::kNonFinite;
+  }
   return SolveStatus::kSuccess;
 }
 SolveStatus acceleration_from_factors(const Model& model, double t, Workspace& ws, LinearSummary& sum) {
@@ -553,8 +609,14 @@ SolveStatus acceleration_from_factors(const Model& model, double t, Workspace& w
   if (!ws.lu->solve(solve_rhs(model, ws), ws.qdd.data()))
     return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
   ++ws.counters.acceleration_solves;
-  if (!all_finite(ws.qdd))
-    return sum.status = SolveStatus::kNonFinite, sum.message = "acceleration is not finite", sum.status;
+  if (!all_finite(ws.qdd)) {
+    std::string why = non_finite_row(model, ws.rhs, "γ",
+                                     ", second derivatives that do not exist at this position (as those of u^p, "
+                                     "p < 2, at u = 0)");
+    if (why.empty()) why = non_finite_jacobian_at(model, ws.q.data(), t);
+    sum.message = "acceleration is not finite" + (why.empty() ? "" : ": " + why);
+    return sum.status = SolveStatus::kNonFinite;
+  }
   return SolveStatus::kSuccess;
 }
 }  // namespace

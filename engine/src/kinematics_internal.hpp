@@ -5,6 +5,10 @@
 
 namespace phiq::detail {
 
+/// How the message of a kNonFinite from a derivative that does not exist at the position begins ("Φq is not
+/// finite: ∂'c'/∂'x' = -inf, …"): the sweep then names no other cause.
+inline constexpr const char* kNonFiniteJacobian = "Φq is not finite: ";
+
 /// solve_velocity and, with `accelerations`, solve_acceleration at the position solve_position has just converged
 /// to at t. Pre-condition (the sweep's own sequence, not checked): ws.q has not changed since that solve returned
 /// kSuccess. The factorisation or the Jacobian values that solve reported valid at its solution are taken as they

@@ -526,10 +526,14 @@ class Sweeper {
         return fail(SolveStatus::kInconsistent, "no assembly beyond t = " + fmt_t(current_.t) + " (sub-steps down to t = " +
                                                     fmt_t(t1) + " tried): " + conflict);
       const std::string dead = dead_point(t1);
+      // (a derivative that does not exist says so itself: no guess at another cause)
+      const bool no_derivative = st == SolveStatus::kNonFinite && why.rfind(detail::kNonFiniteJacobian, 0) == 0;
       return fail(st, "no assembly beyond t = " + fmt_t(current_.t) + " (sub-steps down to t = " + fmt_t(t1) +
-                          " tried" + (dead.empty() ? ": the drive leaves the reachable range, or the mechanism "
-                                                     "passes a singular position): "
-                                                   : "): " + dead + "; ") +
+                          " tried" +
+                          (no_derivative   ? "): "
+                           : dead.empty() ? ": the drive leaves the reachable range, or the mechanism "
+                                            "passes a singular position): "
+                                          : "): " + dead + "; ") +
                           why);
     }
     restore();

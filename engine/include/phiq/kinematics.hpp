@@ -20,7 +20,8 @@ enum class SolveStatus {
   kNotConverged,        ///< Newton reached its iteration limit, or could not decrease the residual
   kSingularJacobian,    ///< Φq is singular here (singular position, redundant or missing constraints)
   kLinearSolverFailed,  ///< the sparse library failed (out of memory, invalid data)
-  kNonFinite,           ///< NaN or Inf in Φ, Φq or a solution (e.g. a law outside its table, sqrt of a negative)
+  kNonFinite,           ///< NaN or Inf in Φ, Φq or a solution (e.g. a law outside its table, sqrt of a negative; a
+                        ///< derivative that does not exist, sqrt at 0, with the constraint and coordinate named)
   kNotSquare,           ///< equations ≠ coordinates: not solvable by the square driven-system path
   kOutsideTimeDomain,   ///< a driver's law is not defined at the requested time
   kCancelled,           ///< the caller's step callback asked to stop
