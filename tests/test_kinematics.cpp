@@ -376,6 +376,9 @@ TEST(Kinematics, ADriveBeyondAnAsymptoteFailsWhereThePositionsStopExisting) {
     EXPECT_LT(last_t, t_star) << expr;
     EXPECT_GT(sum.failed_time, t_star - 0.5) << expr << ": " << sum.message;
     EXPECT_LE(sum.failed_time, t_star + 0.5) << expr << ": " << sum.message;
+  }
+}
+
 // A derivative that does not exist where the value does (√x at x = 0: ∂ = −∞; x^1.5 there: γ infinite; the law
 // √t at t = 0: ḟ infinite) is a kNonFinite naming the constraint and the coordinate. It was a "singular position"
 // (the LU found the matrix with −∞ singular) or a bare "velocity is not finite".
