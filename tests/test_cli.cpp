@@ -941,4 +941,30 @@ output: {velocities: true, accelerations: true}
   }
 }
 
+// ---- the robustness audit: output paths, signals, standard output, the command line, messages ----------------
+
+// One line on stderr, "phiq: " first.
+::testing::AssertionResult one_phiq_line(const std::string& err) {
+  if (std::count(err.begin(), err.end(), '\n') == 1 && err.rfind("phiq: ", 0) == 0)
+    return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "not one 'phiq: ' line: " << err;
+}
+
+// Times in failures keep their digits: time.start 1e-7 is "t = 1e-07", not std::to_string's "t = 0.000000" (run's
+// refusal of an inconsistent model at the start, assemble's failure).
+TEST_F(Cli, FailureTimesKeepTheirDigits) {
+  std::string text = kPlanarDoorMisaligned;
+  text.replace(text.find("start: 0,"), 9, "start: 1e-7,");
+  const fs::path p = write("door.yaml", text);
+  for (const std::string cmd : {"run ", "assemble "}) {
+    Result r = run(cmd + p.string() + " -o " + (dir_ / "out.csv").string());
+    EXPECT_EQ(r.code, 1) << cmd << r.err;
+    EXPECT_TRUE(one_phiq_line(r.err)) << cmd;
+    EXPECT_NE(r.err.find("door.yaml: t = 1e-07: "), std::string::npos) << cmd << r.err;
+    EXPECT_EQ(r.err.find("0.000000"), std::string::npos) << cmd << r.err;
+  }
+  Result c = run("check " + p.string());
+  EXPECT_NE(c.out.find(" at t = 1e-07 in "), std::string::npos) << c.out;
+}
+
 }  // namespace

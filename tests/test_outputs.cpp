@@ -421,5 +421,13 @@ TEST(MechanismSketch, LinesFollowTheConstraintsEachOnce) {
   EXPECT_EQ(arms, 2);
 }
 
+TEST(FormatTime, TenSignificantDigitsWhateverTheScale) {
+  EXPECT_EQ(format_time(1e-7), "1e-07");
+  EXPECT_EQ(format_time(0.6000000000000001), "0.6");
+  EXPECT_EQ(format_time(0), "0");
+  EXPECT_EQ(format_time(-1.0471975511965976), "-1.047197551");
+  EXPECT_EQ(format_time(std::numeric_limits<double>::infinity()), "inf");
+}
+
 }  // namespace
 }  // namespace phiq

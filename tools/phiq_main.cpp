@@ -118,7 +118,7 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
 std::optional<std::string> make_square(const phiq::Scene& scene, phiq::SquareScene* square) {
   const phiq::SolveStatus st = phiq::prepare_scene(*scene.model, scene.sweep.t_begin, scene.sweep.assembly, square);
   if (st == phiq::SolveStatus::kSuccess) return std::nullopt;
-  return "t = " + std::to_string(scene.sweep.t_begin) + ": " + square->assembly.message;
+  return "t = " + phiq::format_time(scene.sweep.t_begin) + ": " + square->assembly.message;
 }
 
 int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
@@ -225,9 +225,11 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
       std::cerr << "phiq: " << scene_path << ": redundant equations left out of the solve (consistent): "
                 << joined(redundancy.rank.redundant) << "\n";
     for (const auto& w : summary.warnings)
-      std::cerr << "phiq: " << scene_path << ": warning: t = " << w.t << ": " << w.kind << ": " << w.message << "\n";
+      std::cerr << "phiq: " << scene_path << ": warning: t = " << phiq::format_time(w.t) << ": " << w.kind << ": "
+                << w.message << "\n";
     std::cerr << "phiq: " << scene_path << ": " << summary.BriefReport();
-    if (summary.min_rcond > 0) std::cerr << ", min rcond " << sci(summary.min_rcond) << " at t = " << summary.min_rcond_time;
+    if (summary.min_rcond > 0)
+      std::cerr << ", min rcond " << sci(summary.min_rcond) << " at t = " << phiq::format_time(summary.min_rcond_time);
     if (file) std::cerr << "; wrote " << out_path;
     std::cerr << "\n";
   }
@@ -428,8 +430,8 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
     std::cout << "assembly      not attempted: " << as.message << "\n";
     return 1;
   }
-  std::cout << "assembly      " << phiq::to_string(as.status) << " at t = " << t0 << " in " << as.iterations
-            << " iterations, scaled residual " << sci(as.residual) << " (tolerance "
+  std::cout << "assembly      " << phiq::to_string(as.status) << " at t = " << phiq::format_time(t0) << " in "
+            << as.iterations << " iterations, scaled residual " << sci(as.residual) << " (tolerance "
             << sci(scene.sweep.assembly.tolerance) << ")\n"
             << "rank          " << rk.rank << " of " << rk.kinematic_equations << " kinematic equations ("
             << rk.driven_rank << " of " << rk.equations << " with the drivers)\n"
@@ -457,7 +459,7 @@ int cmd_assemble(const std::string& scene_path, const std::string& out_path, boo
   phiq::AssemblySummary as;
   const double t0 = scene.sweep.t_begin;
   if (phiq::assemble(model, t0, assembly_options(scene), q, &as) != phiq::SolveStatus::kSuccess)
-    return fail(scene_path + ": t = " + std::to_string(t0) + ": " + as.message + "; no output written", 1);
+    return fail(scene_path + ": t = " + phiq::format_time(t0) + ": " + as.message + "; no output written", 1);
   std::vector<phiq::Index> all(static_cast<std::size_t>(model.num_coordinates()));
   for (std::size_t j = 0; j < all.size(); ++j) all[j] = static_cast<phiq::Index>(j);
   phiq::CsvFormat csv(model, all, false, false);

@@ -246,7 +246,7 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
 
   if (t < model.time_domain_begin() || t > model.time_domain_end())
     return finish(SolveStatus::kOutsideTimeDomain,
-                  "driver '" + model.time_domain_limiter() + "' is not defined at t = " + std::to_string(t));
+                  "driver '" + model.time_domain_limiter() + "' is not defined at t = " + format_time(t));
   if (!q.allFinite()) return finish(SolveStatus::kNonFinite, "starting point has non-finite coordinates");
 
   // 1. All rows in least squares from the placement (no choice of rows needed), 2. the rank analysis where that

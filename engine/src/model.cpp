@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <sstream>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -18,6 +19,13 @@ const char* to_string(Unit u) {
     case Unit::kAngle: return "angle";
   }
   return "?";
+}
+
+std::string format_time(double t) {
+  std::ostringstream s;
+  s.precision(10);
+  s << t;
+  return s.str();
 }
 
 std::string single_line(const std::string& text) {

@@ -82,13 +82,6 @@ bool predictor_needs_accelerations(Predictor p) { return p == Predictor::kQuadra
 
 namespace {
 
-std::string fmt_t(double t) {
-  std::ostringstream s;
-  s.precision(10);
-  s << t;
-  return s.str();
-}
-
 struct State {
   double t = 0.0;
   Eigen::VectorXd q, qd, qdd;
@@ -332,8 +325,8 @@ class Sweeper {
           if (!ws_->q.allFinite()) {
             ws_->q = qs;
             return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " +
-                                                            fmt_t(t) + "), and no position near it at t = " +
-                                                            fmt_t(ts) + " was found: " + as.message);
+                                                            format_time(t) + "), and no position near it at t = " +
+                                                            format_time(ts) + " was found: " + as.message);
           }
         }
       } else {
@@ -345,11 +338,11 @@ class Sweeper {
       if (st != SolveStatus::kSuccess || ls.rcond < kSingularRcond) {
         ws_->q = qs;
         std::ostringstream m;
-        m << "singular position at t = " << fmt_t(t) << " (Φq rcond " << rc << "): ";
+        m << "singular position at t = " << format_time(t) << " (Φq rcond " << rc << "): ";
         if (k >= 2 && st != SolveStatus::kSuccess)
           m << "no position beyond it on this branch (a dead point: the drive cannot go on)";
         else if (st == SolveStatus::kSuccess)
-          m << "Φq stays singular around it (rcond " << ls.rcond << " at t = " << fmt_t(ts)
+          m << "Φq stays singular around it (rcond " << ls.rcond << " at t = " << format_time(ts)
             << "): redundant or missing constraints";
         else
           m << "the branch cannot be followed to it: " << ps.message;
@@ -367,7 +360,7 @@ class Sweeper {
       ++ws_->counters.residual_evaluations;
       if (!(scaled_residual(model_, ws_->phi) <= opt_.newton.tolerance)) {
         std::ostringstream m;
-        m << "singular position at t = " << fmt_t(t) << ": Newton meets a zero pivot there, and the position "
+        m << "singular position at t = " << format_time(t) << ": Newton meets a zero pivot there, and the position "
           << "interpolated from t ± " << d << " misses the tolerance (residual " << scaled_residual(model_, ws_->phi)
           << ")";
         return fail(SolveStatus::kSingularJacobian, m.str());
@@ -523,12 +516,12 @@ class Sweeper {
     if (depth >= opt_.max_subdivisions) {
       const std::string why = ps.message;
       if (const std::string conflict = conflicting_redundancy(t1); !conflict.empty())
-        return fail(SolveStatus::kInconsistent, "no assembly beyond t = " + fmt_t(current_.t) + " (sub-steps down to t = " +
-                                                    fmt_t(t1) + " tried): " + conflict);
+        return fail(SolveStatus::kInconsistent, "no assembly beyond t = " + format_time(current_.t) + " (sub-steps down to t = " +
+                                                    format_time(t1) + " tried): " + conflict);
       const std::string dead = dead_point(t1);
       // (a derivative that does not exist says so itself: no guess at another cause)
       const bool no_derivative = st == SolveStatus::kNonFinite && why.rfind(detail::kNonFiniteJacobian, 0) == 0;
-      return fail(st, "no assembly beyond t = " + fmt_t(current_.t) + " (sub-steps down to t = " + fmt_t(t1) +
+      return fail(st, "no assembly beyond t = " + format_time(current_.t) + " (sub-steps down to t = " + format_time(t1) +
                           " tried" +
                           (no_derivative   ? "): "
                            : dead.empty() ? ": the drive leaves the reachable range, or the mechanism "
@@ -937,7 +930,7 @@ struct Run {
       if (last_sign != 0 && det_sign != last_sign && !singular_since)
         sum.warnings.push_back(
             {time_of(k), "bifurcation",
-             "det Φq changed sign between t = " + fmt_t(last_sign_t) + " and t = " + fmt_t(det_sign_t) +
+             "det Φq changed sign between t = " + format_time(last_sign_t) + " and t = " + format_time(det_sign_t) +
                  ": the motion passed a singular position there (a bifurcation, where branches cross); the sweep "
                  "kept the branch it was on"});
       last_sign = det_sign;
@@ -958,7 +951,7 @@ struct Run {
   void failed(Index k) {
     sum.failed_step = k;
     sum.failed_time = time_of(k);
-    sum.message = "step " + std::to_string(k) + ", t = " + fmt_t(time_of(k)) + ": " + sum.message;
+    sum.message = "step " + std::to_string(k) + ", t = " + format_time(time_of(k)) + ": " + sum.message;
   }
   // Steps k0 … steps in order with `sw`, whose state in ws is row k0 − 1. False on failure or cancellation.
   bool sequential(Sweeper& sw, Workspace& ws, Index k0) {
@@ -1054,7 +1047,7 @@ void once_per_stretch(std::vector<SweepWarning>& warnings, const char* kind, con
   double last_row = -2.0, last_t = 0.0;
   auto close = [&] {
     if (more > 0)
-      kept[first].message += "; the same at the next " + std::to_string(more) + " rows, to t = " + fmt_t(last_t);
+      kept[first].message += "; the same at the next " + std::to_string(more) + " rows, to t = " + format_time(last_t);
     more = 0;
   };
   for (SweepWarning& w : warnings) {
@@ -1170,9 +1163,9 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     sum.failed_step = lo < model.time_domain_begin() ? (opt.t_begin <= opt.t_end ? 0 : opt.steps)
                                                      : (opt.t_begin <= opt.t_end ? opt.steps : 0);
     sum.failed_time = bad;
-    sum.message = "t = " + fmt_t(bad) + ": driver '" + model.time_domain_limiter() + "' is defined on [" +
-                  fmt_t(model.time_domain_begin()) + ", " + fmt_t(model.time_domain_end()) +
-                  "] only; the sweep runs over [" + fmt_t(lo) + ", " + fmt_t(hi) + "]";
+    sum.message = "t = " + format_time(bad) + ": driver '" + model.time_domain_limiter() + "' is defined on [" +
+                  format_time(model.time_domain_begin()) + ", " + format_time(model.time_domain_end()) +
+                  "] only; the sweep runs over [" + format_time(lo) + ", " + format_time(hi) + "]";
     return done(SolveStatus::kOutsideTimeDomain);
   }
 
@@ -1531,7 +1524,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     // continue the sweep's branch or failed (the failure is then found, and reported, in order).
     if (fallback)
       sum.warnings.push_back({run.time_of(resume), "parallel_fallback",
-                              "the parallel chunk starting at t = " + fmt_t(run.time_of(resume)) +
+                              "the parallel chunk starting at t = " + format_time(run.time_of(resume)) +
                                   " did not continue the sweep in order (another branch, or a failure); the "
                                   "remaining steps ran in order"});
     Sweeper rest(model, opt, ws, sum);
