@@ -967,4 +967,36 @@ TEST_F(Cli, FailureTimesKeepTheirDigits) {
   EXPECT_NE(c.out.find(" at t = 1e-07 in "), std::string::npos) << c.out;
 }
 
+// compare's worst cell's line is the file's line (as its parse errors count them).
+TEST_F(Cli, CompareCountsFileLines) {
+  const fs::path a = write("a.csv", "t,x\n0,1\n0.5,2\n1,3\n"), b = write("b.csv", "t,x\n0,1\n0.5,2.5\n1,3\n");
+  Result r = run("compare " + a.string() + " " + b.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("worst x at line 3 (t = 0.5): 2 vs 2.5"), std::string::npos) << r.err;
+  const fs::path bad = write("bad.csv", "t,x\n0,1\n0.5,abc\n");
+  r = run("compare " + a.string() + " " + bad.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("bad.csv:3: "), std::string::npos) << r.err;
+}
+
+// batch names the case only when the error comes from the case's parameters, not for an error of the scene itself.
+TEST_F(Cli, BatchNamesTheCaseOnlyForItsOwnErrors) {
+  const fs::path broken = write("broken.yaml", "parameters: {L2: 0.3}\ncoordinates: {x: [0\n");
+  const fs::path cases = write("cases.csv", "L2\n0.2\n");
+  Result r = run("batch " + broken.string() + " " + cases.string() + " -o " + (dir_ / "out").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(one_phiq_line(r.err));
+  EXPECT_NE(r.err.find("broken.yaml:"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("case 0"), std::string::npos) << r.err;
+  // a value of the case that makes the scene invalid: named with the case
+  std::string text = slurp(phiq::test::model_path("seed/crank_slider_mixed.yaml"));
+  const fs::path scene = write("cs.yaml", text);
+  const fs::path neg = write("neg.csv", "L2,L3\n0.2,1\n0.3,-1\n");
+  r = run("batch " + scene.string() + " " + neg.string() + " -o " + (dir_ / "out").string());
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_TRUE(one_phiq_line(r.err));
+  EXPECT_NE(r.err.find("(case 1 of " + neg.string() + ", line 3)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
 }  // namespace

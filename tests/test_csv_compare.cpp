@@ -263,14 +263,14 @@ TEST(CsvCompare, WorstCellIsReportedWithColumnRowTimeAndValues) {
   EXPECT_EQ(r.max_abs_diff, 1.2500001 - 1.25);
   EXPECT_EQ(r.max_abs_diff_column, "xB.a");
   EXPECT_EQ(r.summary(),
-            "differ: 2 cells beyond tolerance; worst xB.a at row 2 (t = 0.30000000000000004): 1.25 vs 1.2500001 "
+            "differ: 2 cells beyond tolerance; worst xB.a at line 4 (t = 0.30000000000000004): 1.25 vs 1.2500001 "
             "(|diff| 1e-07 > tol 1.25e-09)");
 
   // Without a "t" column there is no time to report.
   CsvTable a2 = parse("xB.a\n1.25\n"), b2 = parse("xB.a\n1.2500001\n");
   CompareResult r2 = compare_csv(a2, b2, {});
   EXPECT_TRUE(std::isnan(r2.worst_t));
-  EXPECT_EQ(r2.summary(), "differ: 1 cell beyond tolerance; worst xB.a at row 0: 1.25 vs 1.2500001 "
+  EXPECT_EQ(r2.summary(), "differ: 1 cell beyond tolerance; worst xB.a at line 2: 1.25 vs 1.2500001 "
                           "(|diff| 1e-07 > tol 1.25e-09)");
 }
 
@@ -287,7 +287,7 @@ TEST(CsvCompare, NanEqualsNanButNotANumber) {
   EXPECT_EQ(r.worst_ratio, kInf);
   EXPECT_EQ(r.worst_a, 2.0);
   EXPECT_TRUE(std::isnan(r.worst_b));
-  EXPECT_TRUE(contains(r.summary(), "worst x at row 1 (t = 0.1): 2 vs nan (NaN against a number)")) << r.summary();
+  EXPECT_TRUE(contains(r.summary(), "worst x at line 3 (t = 0.1): 2 vs nan (NaN against a number)")) << r.summary();
 
   EXPECT_FALSE(compare_csv(tx({nan}), tx({0.0}), {}).equal);  // in either order
 }

@@ -258,8 +258,20 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     try {
       scenes.push_back(phiq::load_scene(scene_path, phiq::SceneLimits{}, o));
     } catch (const phiq::SceneError& e) {
-      return fail(std::string(e.what()) + " (case " + std::to_string(k) + " of " + cases_path + ", line " +
-                      std::to_string(k + 2) + ")",
+      // The case is named only when its parameters cause the error: an error of the scene itself (its YAML, a
+      // field) is the same without them. Cases after the first loaded the same scene, so theirs are theirs.
+      bool from_case = k > 0;
+      if (!from_case) {
+        try {
+          (void)phiq::load_scene(scene_path);
+          from_case = true;
+        } catch (const phiq::SceneError& plain) {
+          from_case = std::string(plain.what()) != e.what();
+        }
+      }
+      return fail(std::string(e.what()) + (from_case ? " (case " + std::to_string(k) + " of " + cases_path +
+                                                           ", line " + std::to_string(k + 2) + ")"
+                                                     : ""),
                   2);
     }
   }

@@ -304,8 +304,9 @@ std::string CompareResult::summary() const {
 
   std::string s = "differ: ";
   if (mismatches > 0) {
-    s += plural(mismatches, "cell") + " beyond tolerance; worst " + worst_column + " at row " +
-         std::to_string(worst_row);
+    // the line of both files (the header is line 1), as the parse errors count
+    s += plural(mismatches, "cell") + " beyond tolerance; worst " + worst_column + " at line " +
+         std::to_string(worst_row + 2);
     if (!std::isnan(worst_t)) s += " (t = " + fmt_exact(worst_t) + ")";
     s += ": " + fmt_exact(worst_a) + " vs " + fmt_exact(worst_b);
     if (std::isnan(worst_a) || std::isnan(worst_b)) {

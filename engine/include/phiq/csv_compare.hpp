@@ -87,10 +87,11 @@ struct CompareResult {
   std::size_t mismatches = 0;       ///< Number of compared cells beyond tolerance.
 
   /// One line for logs and test failures, e.g.
-  /// "differ: 3 cells beyond tolerance; worst xB.a at row 17 (t = 0.29670597283903605): 1.25 vs 1.2500001
+  /// "differ: 3 cells beyond tolerance; worst xB.a at line 19 (t = 0.29670597283903605): 1.25 vs 1.2500001
   /// (|diff| 1e-07 > tol 1.25e-09); row counts differ: A has 181 rows, B has 180; columns only in A: xB.a; only in
-  /// B: (none)" or "agree: 181 rows x 13 columns (max |diff| 2.2e-16 in xA)". Values a, b and t are printed
-  /// exactly (shortest round-trip), so they can be searched for in the files.
+  /// B: (none)" or "agree: 181 rows x 13 columns (max |diff| 2.2e-16 in xA)". The worst cell's line is the line of
+  /// both files (worst_row + 2: the header is line 1), as parse_csv_table()'s errors count them. Values a, b and t
+  /// are printed exactly (shortest round-trip), so they can be searched for in the files.
   std::string summary() const;
 };
 
