@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <Eigen/Dense>
 
@@ -191,6 +192,20 @@ TEST(Assembly, ALockedStructureWithoutAPositionIsNotCalledConsistent) {
   EXPECT_HAS(as.message, "the independent equations have no common solution near this placement");
   ASSERT_FALSE(as.worst_rows.empty());
   for (const auto& [row, residual] : as.worst_rows) EXPECT_NE(sc.model->row_name(row), "motor") << as.message;
+}
+
+// A time that is not finite is outside every time domain, said so without a driver's name (there is none to blame)
+// and without worst constraints (Φ means nothing there).
+TEST(Assembly, NonFiniteTimesAreOutsideTheTimeDomain) {
+  const Scene scene = load_scene(test::model_path("seed/fourbar_natural.yaml"));
+  for (double t : {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    Eigen::VectorXd q = scene.model->initial_positions();
+    AssemblySummary as;
+    EXPECT_EQ(assemble(*scene.model, t, assembly_options(scene.sweep.assembly), q, &as),
+              SolveStatus::kOutsideTimeDomain);
+    EXPECT_EQ(as.message, "t = " + format_time(t) + " is not a finite time");
+    EXPECT_TRUE(as.worst_rows.empty());
+  }
 }
 
 }  // namespace

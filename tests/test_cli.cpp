@@ -967,8 +967,65 @@ TEST_F(Cli, FailureTimesKeepTheirDigits) {
   EXPECT_NE(c.out.find(" at t = 1e-07 in "), std::string::npos) << c.out;
 }
 
-// compare's worst cell's line is the file's line (as its parse errors count them).
-TEST_F(Cli, CompareCountsFileLines) {
+// Command-line errors are one line, "phiq: <command>: <what>", exit 2, with readable ranges.
+TEST_F(Cli, CommandLineErrorsAreOneLineNamingTheCommand) {
+  const std::string scene = phiq::test::model_path("seed/fourbar_natural.yaml");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"run " + scene + " --threads -1",
+       "phiq: run: --threads: expected a whole number from 0 (all cores) to 1000000, got '-1'"},
+      {"run " + scene + " --threads abc", "phiq: run: --threads: expected a whole number"},
+      {"run " + scene + " --memory -1", "phiq: run: --memory: expected a number of GB from 0"},
+      {"run " + scene + " --memory nan", "phiq: run: --memory: expected a number of GB from 0"},
+      {"run " + scene + " --frobnicate", "phiq: run: unknown option --frobnicate"},
+      {"run " + scene + " " + scene, "phiq: run: unexpected argument"},
+      {"run " + scene + " -o", "phiq: run: --output: a value is required"},
+      {"run " + scene + " --progress sometimes",
+       "phiq: run: --progress: expected auto, always or never, got 'sometimes'"},
+      {"run", "phiq: run: scene is required"},
+      {"frobnicate " + scene, "phiq: unknown command 'frobnicate' (commands: run, "},
+      {"", "phiq: a command is required (run, "},
+      {"--frobnicate", "phiq: unknown option --frobnicate"},
+      {"plot " + scene + " x.csv -o x.svg --positions 0",
+       "phiq: plot: --positions: expected a whole number from 1 to 50, got '0'"},
+      {"batch " + scene + " x.csv -o out --threads -2", "phiq: batch: --threads: "},
+      {"compare a.csv b.csv --rtol nan", "phiq: compare: --rtol: expected a number >= 0"},
+      {"compare a.csv b.csv --atol -1", "phiq: compare: --atol: "},
+      {"check " + scene + " --time inf", "phiq: check: --time: expected a finite number, got 'inf'"},
+      {"check " + scene + " --time nan", "phiq: check: --time: expected a finite number, got 'nan'"},
+      {"generate nfourbar many -o x.yaml", "phiq: generate: N: expected a whole number, got 'many'"},
+      {"sweep-accuracy " + scene + " --repeat x",
+       "phiq: sweep-accuracy: --repeat: expected a whole number from 1 to 1000"},
+  };
+  for (const auto& [args, says] : cases) {
+    Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+    EXPECT_TRUE(one_phiq_line(r.err)) << args;
+    EXPECT_EQ(r.err.rfind(says, 0), 0u) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.find("1797693134862315"), std::string::npos) << r.err;  // no 309-digit bound
+    EXPECT_TRUE(r.out.empty()) << args;
+  }
+  EXPECT_FALSE(fs::exists("x.yaml"));
+}
+
+// More threads than the machine runs at once are capped to them, with a note, and the summary says how many ran
+// (TBB would keep its limit, warn on several lines, and the summary claim the number asked for).
+TEST_F(Cli, ThreadsBeyondTheCoresAreCapped) {
+  const fs::path sum = dir_ / "s.json";
+  Result r = run("run " + phiq::test::model_path("seed/crank_slider_mixed.yaml") + " -o " + (dir_ / "a.csv").string() +
+                 " --threads 100000 --summary " + sum.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("TBB"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("phiq: run: --threads 100000: "), std::string::npos) << r.err;
+  const std::string j = slurp(sum);
+  const std::size_t at = j.find("\"threads\": ");
+  ASSERT_NE(at, std::string::npos);
+  const int threads = std::atoi(j.c_str() + at + 11);
+  EXPECT_GE(threads, 1);
+  EXPECT_LE(threads, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+}
+
+// compare names its options, and its worst cell's line is the file's line (as its parse errors count them).
+TEST_F(Cli, CompareCountsFileLinesAndNamesItsOptions) {
   const fs::path a = write("a.csv", "t,x\n0,1\n0.5,2\n1,3\n"), b = write("b.csv", "t,x\n0,1\n0.5,2.5\n1,3\n");
   Result r = run("compare " + a.string() + " " + b.string());
   EXPECT_EQ(r.code, 1);
@@ -977,6 +1034,10 @@ TEST_F(Cli, CompareCountsFileLines) {
   r = run("compare " + a.string() + " " + bad.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("bad.csv:3: "), std::string::npos) << r.err;
+  r = run("compare " + a.string() + " " + b.string() + " --rtol nan");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.find("compare_csv"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--rtol"), std::string::npos) << r.err;
 }
 
 // batch names the case only when the error comes from the case's parameters, not for an error of the scene itself.

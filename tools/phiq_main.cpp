@@ -6,8 +6,11 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +18,8 @@
 #include <iostream>
 #include <optional>
 #include <sstream>
+
+#include <tbb/info.h>
 
 #include "generate.hpp"
 #include "generate_linkages.hpp"
@@ -507,6 +512,115 @@ int cmd_compare(const std::string& a_path, const std::string& b_path, const phiq
   return fail("compare " + a_path + " " + b_path + ": " + r.summary(), 1);
 }
 
+// ---- the command line: validators with readable one-line messages, and CLI11's errors made one line ----------
+
+// A whole number from lo to hi; `lo_means` explains the lowest value ("0: all cores").
+CLI::Validator whole_number(long long lo, long long hi, const std::string& lo_means = "") {
+  const std::string range = "a whole number from " + std::to_string(lo) +
+                            (lo_means.empty() ? "" : " (" + lo_means + ")") + " to " + std::to_string(hi);
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        long long v = 0;
+        const char* end = text.data() + text.size();
+        const auto [p, ec] = std::from_chars(text.data(), end, v);
+        if (ec != std::errc() || p != end || v < lo || v > hi) return "expected " + range + ", got '" + text + "'";
+        return "";
+      },
+      "INT");
+}
+
+// A whole number of any size the option's type holds (its range is checked by the command).
+CLI::Validator any_whole_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        long long v = 0;
+        const char* end = text.data() + text.size();
+        const auto [p, ec] = std::from_chars(text.data(), end, v);
+        if (ec != std::errc() || p != end) return "expected a whole number, got '" + text + "'";
+        return "";
+      },
+      "INT");
+}
+
+// A number (decimal or exponent form, an optional '+'); finite unless `allow_inf`, ≥ lo, ≤ hi.
+CLI::Validator number(double lo, double hi, bool allow_inf, const std::string& what) {
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        const char* first = text.data() + (!text.empty() && text.front() == '+');
+        const char* end = text.data() + text.size();
+        double v = 0.0;
+        const auto [p, ec] = std::from_chars(first, end, v);
+        const bool ok = ec == std::errc() && p == end && first != end && !std::isnan(v) &&
+                        (std::isfinite(v) || (allow_inf && v > 0)) && v >= lo && v <= hi;
+        return ok ? "" : "expected " + what + ", got '" + text + "'";
+      },
+      "NUMBER");
+}
+
+// One of the listed words.
+CLI::Validator one_of(const std::vector<std::string>& words) {
+  std::string list;
+  for (std::size_t k = 0; k < words.size(); ++k)
+    list += (k == 0 ? "" : k + 1 == words.size() ? " or " : ", ") + words[k];
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        if (std::find(words.begin(), words.end(), text) != words.end()) return "";
+        return "expected " + list + ", got '" + text + "'";
+      },
+      "WORD");
+}
+
+// More threads than the cores TBB runs (tbb::info::default_concurrency(), which honours the process's affinity
+// mask) would not run at once: TBB warns (several lines) and keeps its limit while the summary would claim the
+// number asked for. Capped, with a note.
+int cap_threads(const std::string& command, int threads, bool quiet) {
+  const int cores = tbb::info::default_concurrency();
+  if (threads <= cores) return threads;
+  if (!quiet)
+    std::cerr << "phiq: " << command << ": --threads " << threads << ": " << cores << " cores here; running on "
+              << cores << " threads\n";
+  return cores;
+}
+
+// CLI11's error made one line: "phiq: <command>: <what>" (command-line errors exit 2).
+int usage_error(CLI::App& app, int argc, char** argv, const CLI::ParseError& e) {
+  std::vector<std::string> commands;
+  for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) commands.push_back(sub->get_name());
+  std::string command_list;
+  for (const auto& c : commands) command_list += (command_list.empty() ? "" : ", ") + c;
+  std::string command;  // the first word that is not an option: the command
+  for (int i = 1; i < argc && command.empty(); ++i)
+    if (argv[i][0] != '-' || std::string(argv[i]) == "-") command = argv[i];
+  if (!command.empty() && std::find(commands.begin(), commands.end(), command) == commands.end())
+    return fail("unknown command '" + phiq::single_line(command) + "' (commands: " + command_list + ")", 2);
+  std::string what = e.what();
+  std::replace(what.begin(), what.end(), '\n', ' ');
+  while (!what.empty() && what.back() == ' ') what.pop_back();
+  auto after = [&](const std::string& head) {
+    const std::size_t at = what.find(head);
+    return at == std::string::npos ? std::string() : what.substr(at + head.size());
+  };
+  // (by type: an error's get_name() is sometimes the subcommand's name)
+  if (command.empty() && dynamic_cast<const CLI::RequiredError*>(&e)) {
+    std::string option;  // `phiq --bogus`: CLI11 says only that a command is required
+    for (int i = 1; i < argc && option.empty(); ++i) option = argv[i];
+    what = option.empty() ? "a command is required (" + command_list + "); phiq --help says more"
+                          : "unknown option " + phiq::single_line(option) + " (commands: " + command_list + ")";
+  } else if (dynamic_cast<const CLI::ExtrasError*>(&e)) {
+    const std::string extras = after("not expected: ");
+    what = (extras.empty() || extras[0] == '-' ? "unknown option " : "unexpected argument ") + extras;
+  } else if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) && what.find(" required ") != std::string::npos &&
+             what.find("missing") != std::string::npos) {
+    what = what.substr(0, what.find(':')) + ": a value is required";
+  } else if (dynamic_cast<const CLI::ConversionError*>(&e) && what.rfind("Could not convert: ", 0) == 0) {
+    const std::string rest = after("Could not convert: ");
+    const std::size_t eq = rest.find(" = ");
+    what = eq == std::string::npos ? "cannot read " + rest
+                                   : rest.substr(0, eq) + ": cannot read '" + rest.substr(eq + 3) + "'";
+  }
+  return fail((command.empty() ? "" : command + ": ") + phiq::single_line(what), 2);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -516,6 +630,7 @@ int main(int argc, char** argv) {
                                         std::to_string(phiq::kCsvFormat) + ", check --json format " +
                                         std::to_string(phiq::kCheckJsonFormat) + ")");
   app.require_subcommand(1);
+  const CLI::Validator threads_range = whole_number(0, 1000000, "all cores");
 
   std::string scene_path, out_path, summary_path;
   bool quiet = false;
@@ -527,33 +642,38 @@ int main(int argc, char** argv) {
   int threads = 0;
   run->add_option("--threads", threads, "Threads for the drive steps (0: all cores; 1: in order)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(threads_range);
   double memory_gb = 0.0;
   run->add_option("--memory", memory_gb,
                   "GB the drive steps may use with --threads 0: fewer threads when theirs would not fit (0: what the "
                   "system reports available)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(number(0.0, 1e6, false, "a number of GB from 0 (what the system reports available) to 1000000"));
   std::string progress = "auto";
   run->add_option("--progress", progress, "Progress bar on standard error: auto (when it is a terminal), always, never")
       ->capture_default_str()
-      ->check(CLI::IsMember({"auto", "always", "never"}));
+      ->check(one_of({"auto", "always", "never"}));
 
   phiq::tools::GenerateOptions gen;
   std::string gen_out, gen_outputs = "q,v,a";
   CLI::App* generate = app.add_subcommand("generate", "Write a scalable scene (nfourbar, scissor, grid, chain3d)");
   generate->add_option("kind", gen.kind, "nfourbar, scissor, grid or chain3d")->required();
   generate->add_option("N", gen.n, "Size: four-bars (nfourbar), stages (scissor), cells (grid), spatial loops (chain3d)")
-      ->required();
+      ->required()
+      ->check(any_whole_number());
   generate->add_option("-o,--output", gen_out, "Scene file to write")->required();
-  generate->add_option("--steps", gen.steps, "Sweep intervals")->capture_default_str();
+  generate->add_option("--steps", gen.steps, "Sweep intervals")->capture_default_str()->check(any_whole_number());
+  const CLI::Validator any_number = number(-HUGE_VAL, HUGE_VAL, false, "a finite number");
   CLI::Option* gen_from =
       generate->add_option("--from", gen.from, "Driven angle at t = 0 (rad; default pi/4, scissor 0.3)");
+  gen_from->check(any_number);
   CLI::Option* gen_to = generate->add_option("--to", gen.to, "Driven angle at t = 1 (rad; default 3pi/4, scissor 1.2)");
+  gen_to->check(any_number);
   generate->add_option("--coords", gen.coords, "natural or reference-point")->capture_default_str();
   generate->add_option("--twist", gen.twist,
                        "chain3d: phase between neighbouring cranks on one hinge line (rad; 0: the parallelogram row)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(any_number);
   generate->add_option("--outputs", gen_outputs, "Which of q (positions), v, a the scene asks for")
       ->capture_default_str();
 
@@ -569,7 +689,7 @@ int main(int argc, char** argv) {
   batch->add_flag("-q,--quiet", batch_quiet, "Print only failures on standard error");
   batch->add_option("--threads", batch_threads, "Threads for the cases (0: all cores)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(threads_range);
   std::string asm_path, asm_out;
   bool asm_quiet = false;
   CLI::App* assemble_cmd =
@@ -582,7 +702,8 @@ int main(int argc, char** argv) {
   check->add_flag("--json", check_json, "Print one JSON object (format: tools/README.md)");
   double check_time = 0.0;
   CLI::Option* check_at =
-      check->add_option("--time", check_time, "Assemble and analyse at this time instead of time.start");
+      check->add_option("--time", check_time, "Assemble and analyse at this time instead of time.start")
+          ->check(any_number);
 
   phiq::tools::PlotOptions plot_options;
   CLI::App* plot = app.add_subcommand("plot", "Draw the mechanism at a few positions with its traced points, and "
@@ -594,17 +715,18 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   plot->add_option("--positions", plot_options.positions, "Rows at which the mechanism is drawn, evenly spread")
       ->capture_default_str()
-      ->check(CLI::Range(1, 50));
+      ->check(whole_number(1, 50));
 
   std::string cmp_a, cmp_b;
   phiq::CompareOptions cmp;
   CLI::App* compare = app.add_subcommand("compare", "Compare two result CSVs column by column within tolerances");
   compare->add_option("a", cmp_a, "First CSV (e.g. the reference)")->required();
   compare->add_option("b", cmp_b, "Second CSV")->required();
+  const CLI::Validator tolerance = number(0.0, HUGE_VAL, true, "a number >= 0 (inf: any difference)");
   compare->add_option("--rtol", cmp.rtol, "Relative tolerance: |a-b| <= atol + rtol*max(|a|,|b|)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
-  compare->add_option("--atol", cmp.atol, "Absolute tolerance")->capture_default_str()->check(CLI::NonNegativeNumber);
+      ->check(tolerance);
+  compare->add_option("--atol", cmp.atol, "Absolute tolerance")->capture_default_str()->check(tolerance);
   compare->add_option("--columns", cmp.columns, "Compare only these columns (default: all; headers must match)")
       ->delimiter(',');
 
@@ -619,19 +741,22 @@ int main(int argc, char** argv) {
   accuracy->add_option("--newton", acc.newton, "Of modified,full (default: both)");
   accuracy->add_option("--linear-solvers", acc.linear_solvers, "Of klu,umfpack,dense (default: klu,umfpack)");
   accuracy->add_option("--reference", acc.reference, "auto, numerical or closed-form:KIND[:NAME=VALUE,...]")->capture_default_str();
-  accuracy->add_option("--repeat", acc.repeat, "Timed runs per setting (best of)")->capture_default_str();
+  accuracy->add_option("--repeat", acc.repeat, "Timed runs per setting (best of)")
+      ->capture_default_str()
+      ->check(whole_number(1, 1000));
   accuracy->add_flag("-q,--quiet", acc.quiet, "Print only errors on standard error");
   accuracy->add_flag("-v,--verbose", acc.verbose, "One line per setting on standard error");
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), 2);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    return usage_error(app, argc, argv, e);
   }
   try {
     if (*run) {
       using Mode = phiq::tools::ProgressBar::Mode;
-      return cmd_run(scene_path, out_path, quiet, summary_path, threads, memory_gb,
+      return cmd_run(scene_path, out_path, quiet, summary_path, cap_threads("run", threads, quiet), memory_gb,
                      progress == "always" ? Mode::kAlways : progress == "never" ? Mode::kNever : Mode::kAuto);
     }
     if (*generate) {
@@ -665,7 +790,10 @@ int main(int argc, char** argv) {
     if (*check)
       return cmd_check(check_path, check_json, check_at->count() ? std::optional<double>(check_time) : std::nullopt);
     if (*assemble_cmd) return cmd_assemble(asm_path, asm_out, asm_quiet);
-    if (*batch) return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, batch_threads);
+    if (*batch) {
+      const int cases_threads = cap_threads("batch", batch_threads, batch_quiet);
+      return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, cases_threads);
+    }
     if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
     if (*plot) return phiq::tools::plot_svg(plot_options);
     if (*accuracy) return phiq::tools::run_sweep_accuracy_command(acc);

@@ -235,7 +235,8 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     sum.residual = m ? scaled.maxCoeff() : 0.0;
     sum.moved = n ? ((q - q0).cwiseAbs().cwiseQuotient(model.tolerance_scales().coordinate_scale)).maxCoeff() : 0.0;
     if (st != SolveStatus::kSuccess) {
-      sum.worst_rows = detail::worst_rows(model, phi, 3, among);
+      // outside the time domain the drivers' values, and so the residuals, mean nothing: no worst rows
+      if (st != SolveStatus::kOutsideTimeDomain) sum.worst_rows = detail::worst_rows(model, phi, 3, among);
       if (msg.empty()) msg = to_string(st);
       if (!sum.worst_rows.empty() && st != SolveStatus::kInconsistent)
         msg += "; worst constraints: " + detail::describe_rows(model, sum.worst_rows);
@@ -244,6 +245,9 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     return st;
   };
 
+  // A time that is not a number, or infinite, is outside every domain (tabulated laws or not); no driver to name.
+  if (!std::isfinite(t))
+    return finish(SolveStatus::kOutsideTimeDomain, "t = " + format_time(t) + " is not a finite time");
   if (t < model.time_domain_begin() || t > model.time_domain_end())
     return finish(SolveStatus::kOutsideTimeDomain,
                   "driver '" + model.time_domain_limiter() + "' is not defined at t = " + format_time(t));

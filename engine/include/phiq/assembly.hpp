@@ -55,7 +55,9 @@ struct AssemblySummary {
   bool consistent = true;
   std::vector<Index> violated_rows;    ///< the redundant rows not satisfied (inconsistent models)
   std::vector<std::string> conflicts;  ///< constraints that cannot hold together: each violated redundant row and the rows it is a combination of (empty when consistent)
-  std::vector<std::pair<Index, double>> worst_rows;  ///< (row, |Φ_i| / scale_i), largest first, at most 3
+  /// (row, |Φ_i| / scale_i), largest first, at most 3; empty on success and for kOutsideTimeDomain (t outside the
+  /// drivers' domain, or not finite: Φ means nothing there)
+  std::vector<std::pair<Index, double>> worst_rows;
   std::string message;     ///< one line; empty on a clean success
   /// One line: status, iterations, residual, rank, redundant and conflicting constraints.
   std::string BriefReport() const;
