@@ -1,6 +1,8 @@
 // The phiq command: exit status, CSV header and rows, no output file on failure, one-line errors.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -244,7 +246,7 @@ TEST_F(Cli, InterruptStopsCleanlyWithoutOutput) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(r.code, 130) << r.err;
   EXPECT_LT(seconds, 5.0);
-  EXPECT_NE(r.err.find("interrupted; no output written"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("interrupted (SIGINT); no output written"), std::string::npos) << r.err;
   EXPECT_EQ(files(), (std::vector<std::string>{"long.yaml", "stderr.txt", "stdout.txt"}));
 }
 
@@ -950,21 +952,189 @@ output: {velocities: true, accelerations: true}
   return ::testing::AssertionFailure() << "not one 'phiq: ' line: " << err;
 }
 
-// Times in failures keep their digits: time.start 1e-7 is "t = 1e-07", not std::to_string's "t = 0.000000" (run's
-// refusal of an inconsistent model at the start, assemble's failure).
-TEST_F(Cli, FailureTimesKeepTheirDigits) {
-  std::string text = kPlanarDoorMisaligned;
-  text.replace(text.find("start: 0,"), 9, "start: 1e-7,");
-  const fs::path p = write("door.yaml", text);
-  for (const std::string cmd : {"run ", "assemble "}) {
-    Result r = run(cmd + p.string() + " -o " + (dir_ / "out.csv").string());
-    EXPECT_EQ(r.code, 1) << cmd << r.err;
-    EXPECT_TRUE(one_phiq_line(r.err)) << cmd;
-    EXPECT_NE(r.err.find("door.yaml: t = 1e-07: "), std::string::npos) << cmd << r.err;
-    EXPECT_EQ(r.err.find("0.000000"), std::string::npos) << cmd << r.err;
+// A device node (as /dev/null: character device 1, 3) given to -o is written in place and stays a device, as does
+// a FIFO (its reader gets the whole CSV); several outputs may share a device. Creating the node needs root (mknod):
+// skipped otherwise. The real /dev/null is never used: the node lives in the test's directory.
+TEST_F(Cli, DeviceAndFifoOutputsAreWrittenInPlace) {
+  const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
+  const fs::path fifo = dir_ / "fifo", copy = dir_ / "copy.csv";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+  const std::string cmd = "cat " + fifo.string() + " > " + copy.string() + " & " + std::string(PHIQ_CLI) + " run -q " +
+                          scene + " -o " + fifo.string() + " >" + out.string() + " 2>" + err.string() +
+                          "; s=$?; wait; exit $s";
+  const int st = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << slurp(err);
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  EXPECT_EQ(std::count_if(std::istreambuf_iterator<char>(*std::make_unique<std::ifstream>(copy)),
+                          std::istreambuf_iterator<char>(), [](char c) { return c == '\n'; }),
+            182);  // the header and 181 rows
+  EXPECT_EQ(files(), (std::vector<std::string>{"copy.csv", "fifo", "stderr.txt", "stdout.txt"}));  // no temporary
+
+  const fs::path null = dir_ / "null";
+  if (::mknod(null.c_str(), S_IFCHR | 0666, ::makedev(1, 3)) != 0) GTEST_SKIP() << "mknod needs root";
+  Result r = run("run -q " + scene + " -o " + null.string() + " --summary " + null.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  struct stat sb;
+  ASSERT_EQ(::stat(null.c_str(), &sb), 0);
+  EXPECT_TRUE(S_ISCHR(sb.st_mode));
+  EXPECT_EQ(::major(sb.st_rdev), 1u);
+  EXPECT_EQ(::minor(sb.st_rdev), 3u);
+  r = run("assemble -q " + scene + " -o " + null.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  r = run("generate nfourbar 3 -o " + null.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  ASSERT_EQ(::stat(null.c_str(), &sb), 0);
+  EXPECT_TRUE(S_ISCHR(sb.st_mode));
+  EXPECT_EQ(files(), (std::vector<std::string>{"copy.csv", "fifo", "null", "stderr.txt", "stdout.txt"}));
+}
+
+// -o through a symbolic link (relative, into another directory) replaces the link's target and leaves the link;
+// the temporary lives beside the target. /dev/stdout (one of the process's own descriptors) is written through the
+// descriptor: appended to what the shell opened with >>, not replacing it.
+TEST_F(Cli, SymlinkOutputsReplaceTheirTargetAndKeepTheLink) {
+  const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
+  fs::create_directories(dir_ / "results");
+  write("results/cs.csv", "old result\n");
+  fs::create_symlink("results/cs.csv", dir_ / "latest.csv");
+  Result r = run("run -q " + scene + " -o " + (dir_ / "latest.csv").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(dir_ / "latest.csv"));
+  EXPECT_EQ(fs::read_symlink(dir_ / "latest.csv"), "results/cs.csv");
+  EXPECT_EQ(slurp(dir_ / "results/cs.csv").rfind("t,theta2,", 0), 0u);
+  std::vector<std::string> in_results;
+  for (auto& e : fs::directory_iterator(dir_ / "results")) in_results.push_back(e.path().filename().string());
+  EXPECT_EQ(in_results, std::vector<std::string>{"cs.csv"});
+  // a dangling link: its target is created
+  fs::create_symlink("results/new.csv", dir_ / "next.csv");
+  ASSERT_EQ(run("assemble -q " + scene + " -o " + (dir_ / "next.csv").string()).code, 0);
+  EXPECT_TRUE(fs::is_symlink(dir_ / "next.csv"));
+  EXPECT_EQ(slurp(dir_ / "results/new.csv").rfind("t,theta2,", 0), 0u);
+
+  write("log.txt", "before\n");
+  const std::string cmd = std::string(PHIQ_CLI) + " assemble -q " + scene + " -o /dev/stdout >>" + (dir_ / "log.txt").string();
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_EQ(slurp(dir_ / "log.txt").rfind("before\nt,theta2,", 0), 0u) << slurp(dir_ / "log.txt");
+  EXPECT_FALSE(fs::is_symlink(dir_ / "log.txt"));
+}
+
+// An output that is an input (the scene, through a link or a hard link too), or two outputs that are one file, are
+// refused in one line before anything is solved; the files are untouched.
+TEST_F(Cli, OutputsThatAreInputsOrEachOtherAreRefused) {
+  const std::string original = slurp(phiq::test::model_path("seed/crank_slider_mixed.yaml"));
+  const fs::path scene = write("s.yaml", original);
+  fs::create_symlink("s.yaml", dir_ / "link.yaml");
+  fs::create_hard_link(scene, dir_ / "hard.yaml");
+  const fs::path csv = write("r.csv", "t,theta2\n0,0\n");
+  const std::string s = scene.string(), d = dir_.string();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"run " + s + " -o " + s, "run: -o " + s + ": the same file as the scene " + s},
+      {"run " + s + " -o " + d + "/link.yaml", "the same file as the scene"},
+      {"run " + s + " -o " + d + "/hard.yaml", "the same file as the scene"},
+      {"run " + s + " -o " + d + "/./s.yaml", "the same file as the scene"},
+      {"run " + s + " --summary " + s, "run: --summary " + s + ": the same file as the scene"},
+      {"run " + s + " -o " + d + "/a.csv --summary " + d + "/a.csv", "-o " + d + "/a.csv and --summary " + d + "/a.csv are the same file"},
+      {"assemble " + s + " -o " + d + "/link.yaml", "assemble: -o "},
+      {"sweep-accuracy " + s + " -o " + d + "/x.csv --json " + d + "/x.csv", "are the same file"},
+      {"sweep-accuracy " + s + " --json " + s, "the same file as the scene"},
+      {"plot " + s + " " + csv.string() + " -o " + csv.string(), "plot: -o " + csv.string() + ": the same file as the result"},
+      {"plot " + s + " " + csv.string() + " -o " + s, "the same file as the scene"},
+  };
+  for (const auto& [args, says] : cases) {
+    Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.err;
+    EXPECT_TRUE(one_phiq_line(r.err)) << args;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << "\n" << r.err;
   }
-  Result c = run("check " + p.string());
-  EXPECT_NE(c.out.find(" at t = 1e-07 in "), std::string::npos) << c.out;
+  EXPECT_EQ(slurp(scene), original);
+  EXPECT_EQ(slurp(csv), "t,theta2\n0,0\n");
+  // batch: a case file that is the cases file
+  fs::create_directories(dir_ / "out");
+  const fs::path cases_csv = write("out/case0.csv", "L2\n0.2\n");
+  Result r = run("batch " + s + " " + cases_csv.string() + " -o " + d + "/out");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("the same file as the cases"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(cases_csv), "L2\n0.2\n");
+  EXPECT_EQ(files(), (std::vector<std::string>{"hard.yaml", "link.yaml", "out", "r.csv", "s.yaml", "stderr.txt", "stdout.txt"}));
+}
+
+// An empty output path is refused (it used to mean standard output); nothing goes to standard output.
+TEST_F(Cli, EmptyOutputPathsAreRefused) {
+  const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
+  for (const std::string& args : std::vector<std::string>{
+           "run " + scene + " -o ''", "run " + scene + " --summary ''", "assemble " + scene + " -o ''",
+           "generate nfourbar 3 -o ''", "sweep-accuracy " + scene + " --json ''", "batch " + scene + " x.csv -o ''",
+           "plot " + scene + " x.csv -o ''"}) {
+    Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_TRUE(one_phiq_line(r.err)) << args;
+    EXPECT_NE(r.err.find("the path is empty"), std::string::npos) << args << "\n" << r.err;
+    EXPECT_TRUE(r.out.empty()) << args;
+  }
+}
+
+// A scene that sweeps for minutes (10^7 steps of the crank-slider).
+std::string long_scene() {
+  std::string scene = slurp(phiq::test::model_path("seed/crank_slider_mixed.yaml"));
+  scene.replace(scene.find("steps: 180"), 10, "steps: 10000000");
+  return scene;
+}
+
+// SIGTERM and SIGHUP stop a run as SIGINT does: exit 128 + the signal, one line naming it, no output and no
+// temporary left (the CSV and the summary).
+TEST_F(Cli, TermAndHangupStopARunLikeInterrupt) {
+  const fs::path p = write("long.yaml", long_scene());
+  for (const auto& [sig, status] : {std::pair<std::string, int>{"TERM", 143}, {"HUP", 129}, {"INT", 130}}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    Result r = run_prefixed("timeout --preserve-status -s " + sig + " 0.5 ",
+                            "run " + p.string() + " -o " + (dir_ / "out.csv").string() + " --summary " +
+                                (dir_ / "s.json").string());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(r.code, status) << sig << ": " << r.err;
+    EXPECT_LT(seconds, 5.0) << sig;
+    EXPECT_TRUE(one_phiq_line(r.err)) << sig;
+    EXPECT_NE(r.err.find("long.yaml: interrupted (SIG" + sig + "); no output written"), std::string::npos) << r.err;
+    EXPECT_EQ(files(), (std::vector<std::string>{"long.yaml", "stderr.txt", "stdout.txt"})) << sig;
+  }
+}
+
+// A signal while no sweep runs (here: waiting for a FIFO's reader, with another output's temporary already
+// created) ends the command at once, removing the temporaries.
+TEST_F(Cli, SignalOutsideTheSweepRemovesTheTemporaries) {
+  const fs::path fifo = dir_ / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  Result r = run_prefixed("timeout --preserve-status -s TERM 0.5 ",
+                          "sweep-accuracy " + phiq::test::model_path("seed/crank_slider_mixed.yaml") + " -o " +
+                              (dir_ / "acc.csv").string() + " --json " + fifo.string());
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  EXPECT_EQ(r.code, 143) << r.err;
+  EXPECT_TRUE(one_phiq_line(r.err));
+  EXPECT_NE(r.err.find("interrupted (SIGTERM); no output written"), std::string::npos) << r.err;
+  EXPECT_EQ(files(), (std::vector<std::string>{"fifo", "stderr.txt", "stdout.txt"}));
+}
+
+// Every output is created before the sweep: an unusable --summary fails at once (exit 3, the sweep of minutes not
+// run) and no file appears, nor is an existing one replaced; the same for sweep-accuracy's two outputs.
+TEST_F(Cli, UnwritableOutputsFailBeforeTheSweepAndNoneAppears) {
+  const fs::path p = write("long.yaml", long_scene());
+  write("a.csv", "previous\n");
+  const auto t0 = std::chrono::steady_clock::now();
+  Result r = run("run " + p.string() + " -o " + (dir_ / "a.csv").string() + " --summary " +
+                 (dir_ / "nodir" / "s.json").string());
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_TRUE(one_phiq_line(r.err));
+  EXPECT_NE(r.err.find("nodir/s.json: cannot write: No such file or directory"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(dir_ / "a.csv"), "previous\n");
+  r = run("run " + p.string() + " -o " + dir_.string());  // a directory
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_NE(r.err.find(": cannot write: is a directory"), std::string::npos) << r.err;
+  r = run("sweep-accuracy " + phiq::test::model_path("seed/crank_slider_mixed.yaml") + " --repeat 1 -o " +
+          (dir_ / "acc.csv").string() + " --json " + (dir_ / "nodir" / "acc.json").string());
+  EXPECT_EQ(r.code, 3) << r.err;
+  EXPECT_TRUE(one_phiq_line(r.err));
+  EXPECT_EQ(files(), (std::vector<std::string>{"a.csv", "long.yaml", "stderr.txt", "stdout.txt"}));
 }
 
 // Command-line errors are one line, "phiq: <command>: <what>", exit 2, with readable ranges.
@@ -1022,6 +1192,23 @@ TEST_F(Cli, ThreadsBeyondTheCoresAreCapped) {
   const int threads = std::atoi(j.c_str() + at + 11);
   EXPECT_GE(threads, 1);
   EXPECT_LE(threads, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+}
+
+// Times in failures keep their digits: time.start 1e-7 is "t = 1e-07", not std::to_string's "t = 0.000000" (run's
+// refusal of an inconsistent model at the start, assemble's failure).
+TEST_F(Cli, FailureTimesKeepTheirDigits) {
+  std::string text = kPlanarDoorMisaligned;
+  text.replace(text.find("start: 0,"), 9, "start: 1e-7,");
+  const fs::path p = write("door.yaml", text);
+  for (const std::string cmd : {"run ", "assemble "}) {
+    Result r = run(cmd + p.string() + " -o " + (dir_ / "out.csv").string());
+    EXPECT_EQ(r.code, 1) << cmd << r.err;
+    EXPECT_TRUE(one_phiq_line(r.err)) << cmd;
+    EXPECT_NE(r.err.find("door.yaml: t = 1e-07: "), std::string::npos) << cmd << r.err;
+    EXPECT_EQ(r.err.find("0.000000"), std::string::npos) << cmd << r.err;
+  }
+  Result c = run("check " + p.string());
+  EXPECT_NE(c.out.find(" at t = 1e-07 in "), std::string::npos) << c.out;
 }
 
 // compare names its options, and its worst cell's line is the file's line (as its parse errors count them).

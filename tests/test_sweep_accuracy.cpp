@@ -248,19 +248,24 @@ TEST(SweepAccuracyApi, AStopRequestEndsTheMeasurement) {
 }
 
 TEST_F(SweepAccuracy, CtrlCWritesNothing) {
-  // nfourbar 200 over a long grid, interrupted after a moment: exit 130, no file, no temporary left
-  const fs::path scene = dir_ / "nf.yaml", csv = dir_ / "acc.csv";
+  // nfourbar 200 over a long grid, interrupted after a moment (SIGINT, or SIGTERM as from a job scheduler): exit
+  // 128 + the signal, no file, no temporary left
+  const fs::path scene = dir_ / "nf.yaml", csv = dir_ / "acc.csv", json = dir_ / "acc.json";
   ASSERT_EQ(std::system((std::string(PHIQ_CLI) + " generate nfourbar 200 --steps 400 -o " + scene.string()).c_str()), 0);
-  const std::string cmd = "sh -c '" + std::string(PHIQ_CLI) + " sweep-accuracy " + scene.string() + " -o " +
-                          csv.string() + " 2>" + (dir_ / "err.txt").string() + " & pid=$!; sleep 1; kill -INT $pid;" +
-                          " wait $pid; echo $? >" + (dir_ / "status.txt").string() + "'";
-  ASSERT_EQ(std::system(cmd.c_str()), 0);
-  EXPECT_EQ(slurp(dir_ / "status.txt"), "130\n") << slurp(dir_ / "err.txt");
-  EXPECT_NE(slurp(dir_ / "err.txt").find("interrupted; no output written"), std::string::npos);
-  std::vector<std::string> left;
-  for (auto& e : fs::directory_iterator(dir_)) left.push_back(e.path().filename().string());
-  std::sort(left.begin(), left.end());
-  EXPECT_EQ(left, (std::vector<std::string>{"err.txt", "nf.yaml", "status.txt"}));
+  for (const auto& [sig, status] : {std::pair<std::string, std::string>{"INT", "130\n"}, {"TERM", "143\n"}}) {
+    const std::string cmd = "sh -c '" + std::string(PHIQ_CLI) + " sweep-accuracy " + scene.string() + " -o " +
+                            csv.string() + " --json " + json.string() + " 2>" + (dir_ / "err.txt").string() +
+                            " & pid=$!; sleep 1; kill -" + sig + " $pid; wait $pid; echo $? >" +
+                            (dir_ / "status.txt").string() + "'";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    EXPECT_EQ(slurp(dir_ / "status.txt"), status) << slurp(dir_ / "err.txt");
+    EXPECT_NE(slurp(dir_ / "err.txt").find("interrupted (SIG" + sig + "); no output written"), std::string::npos)
+        << slurp(dir_ / "err.txt");
+    std::vector<std::string> left;
+    for (auto& e : fs::directory_iterator(dir_)) left.push_back(e.path().filename().string());
+    std::sort(left.begin(), left.end());
+    EXPECT_EQ(left, (std::vector<std::string>{"err.txt", "nf.yaml", "status.txt"}));
+  }
 }
 
 TEST(SweepAccuracyApi, DefaultGridSkipsPredictorsTheSceneCannotFeed) {

@@ -1,8 +1,8 @@
 // phiq — command line front end. See tools/README.md.
 //
 // Exit status: 0 success; 1 the mechanism could not be solved (the message names step, time and constraints), or
-// `compare` found a difference; 2 bad input (scene, CSV or command line); 3 an output file could not be written;
-// 130 interrupted.
+// `compare` found a difference; 2 bad input (scene, CSV or command line); 3 an output (a file, standard output)
+// could not be written; 128 + the signal when interrupted (130 SIGINT, 143 SIGTERM, 129 SIGHUP).
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
@@ -11,16 +11,15 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
-#include <csignal>
-#include <filesystem>
-#include <fstream>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <sstream>
 
 #include <tbb/info.h>
 
+#include "cli_support.hpp"
 #include "generate.hpp"
 #include "generate_linkages.hpp"
 #include "plot_svg.hpp"
@@ -31,8 +30,8 @@
 
 namespace {
 
-std::atomic<bool> g_interrupted{false};
-extern "C" void on_sigint(int) { g_interrupted = true; }
+using phiq::tools::NamedPath;
+using phiq::tools::OutputSet;
 
 int fail(const std::string& msg, int code) {
   std::cerr << "phiq: " << msg << "\n";
@@ -70,8 +69,8 @@ std::string joined(const std::vector<std::string>& names) {
 
 
 // `phiq run --summary FILE.json`: the run summary, format version 1 (tools/README.md).
-bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq::Workspace& ws,
-                   const phiq::SweepSummary& s, double load_s, double solve_s, double write_s) {
+std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& ws, const phiq::SweepSummary& s,
+                         double load_s, double solve_s, double write_s) {
   nlohmann::ordered_json j;
   j["format"] = 1;
   j["scene"] = scene.path;
@@ -106,15 +105,7 @@ bool write_summary(const std::string& path, const phiq::Scene& scene, const phiq
     j["min_rcond"] = nullptr;
   j["warnings"] = nlohmann::ordered_json::array();
   for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});
-  try {
-    phiq::AtomicOutputFile f(path);
-    f.write(j.dump(2) + "\n");
-    f.commit();
-  } catch (const phiq::Error& e) {
-    std::cerr << "phiq: " << e.what() << "\n";
-    return false;
-  }
-  return true;
+  return j.dump(2) + "\n";
 }
 
 // The scene made square for the sweep (prepare_scene(): a model with redundant constraints assembled by minimum
@@ -128,15 +119,34 @@ std::optional<std::string> make_square(const phiq::Scene& scene, phiq::SquareSce
 
 int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
             int threads, double memory_gb, phiq::tools::ProgressBar::Mode progress_mode) {
+  // Outputs that would replace the scene or each other are refused before anything is read or solved.
+  std::vector<NamedPath> outs;
+  if (!out_path.empty()) outs.push_back({"-o", out_path});
+  if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
+  if (const auto clash = phiq::tools::output_clash(outs, {{"the scene", scene_path}})) return fail("run: " + *clash, 2);
+  phiq::tools::set_interrupt_subject(scene_path, "; no output written");
   const auto load_start = Clock::now();
   std::optional<phiq::Scene> loaded = load_or_report(scene_path);
   if (!loaded) return 2;
   phiq::Scene& scene = *loaded;
   const double load_s = since(load_start);
+
+  // Every output exists (as a temporary, or a device opened) before the solve: an unwritable path fails now, not
+  // after the sweep; they are committed together at the end, or none of them appears.
+  OutputSet outputs;
+  phiq::AtomicOutputFile* file = nullptr;
+  phiq::AtomicOutputFile* summary_file = nullptr;
+  try {
+    if (!out_path.empty()) file = &outputs.add(out_path);
+    if (!summary_path.empty()) summary_file = &outputs.add(summary_path);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+
   // inconsistent or under-driven models stop here, naming the constraints
   phiq::SquareScene square;
   if (const auto why = make_square(scene, &square))
-    return fail(scene_path + ": " + *why + (out_path.empty() ? "" : "; no output written"), 1);
+    return fail(scene_path + ": " + *why + (outs.empty() ? "" : "; no output written"), 1);
   const phiq::AssemblySummary& redundancy = square.assembly;
   const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;
@@ -147,17 +157,11 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   // are evaluated on the whole scene model (CsvFormat)
   phiq::CsvFormat csv(scene);
 
-  // Where the CSV goes: a file that appears only when complete, or standard output after success, spooled through
-  // an anonymous temporary file so that memory stays bounded however long the sweep is.
-  std::unique_ptr<phiq::AtomicOutputFile> file;
+  // Where the CSV goes: the output file, or standard output after success, spooled through an anonymous temporary
+  // file so that memory stays bounded however long the sweep is.
   std::FILE* spool = nullptr;
   std::string buffer = csv.header();
-  try {
-    if (!out_path.empty()) file = std::make_unique<phiq::AtomicOutputFile>(out_path);
-    else if (!(spool = std::tmpfile())) throw phiq::Error("cannot create a temporary file for standard output");
-  } catch (const phiq::Error& e) {
-    return fail(e.what(), 3);
-  }
+  if (!file && !(spool = std::tmpfile())) return fail("cannot create a temporary file for standard output", 3);
   struct CloseSpool {
     std::FILE* f;
     ~CloseSpool() {
@@ -171,28 +175,31 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
     buffer.clear();
   };
 
-  std::signal(SIGINT, on_sigint);
   phiq::SweepSummary summary;
   double write_s = 0.0;  // formatting and writing rows, timed inside the step callback
   phiq::tools::ProgressBar progress(scene.sweep.steps + 1,
                                     quiet ? phiq::tools::ProgressBar::Mode::kNever : progress_mode);
   try {
+    phiq::tools::StopOnSignal stop_on_signal;  // a signal stops the sweep at its next row
+    const std::atomic<bool>& stop = phiq::tools::stop_flag();
     phiq::run_sweep(model, scene.sweep, ws, [&](const phiq::StepView& step) {
       const auto w0 = Clock::now();
       csv.append_row(step, buffer);
       if (buffer.size() > (1u << 20)) flush();
       progress.update(step.step + 1);
       write_s += since(w0);
-      return !g_interrupted.load();
+      return !stop.load();
     }, &summary);
   } catch (const phiq::Error& e) {
     progress.finish();
     return fail(scene_path + ": " + e.what(), 3);
   }
   progress.finish();
-  std::signal(SIGINT, SIG_DFL);
 
-  if (summary.status == phiq::SolveStatus::kCancelled) return fail(scene_path + ": interrupted; no output written", 130);
+  // (also a signal that came after the last row: the command stops before committing, as it said it would)
+  if (summary.status == phiq::SolveStatus::kCancelled || phiq::tools::stop_flag().load())
+    return fail(scene_path + ": " + phiq::tools::interrupt_message() + "; no output written",
+                phiq::tools::interrupt_exit_status());
   if (summary.status != phiq::SolveStatus::kSuccess) {
     std::string why = summary.message;
     // A square model singular at its first position: redundant constraints and missing drivers in equal numbers,
@@ -205,26 +212,29 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
           phiq::SolveStatus::kSuccess)
         why += "; rank analysis: " + as.message;
     }
-    return fail(scene_path + ": " + why + (out_path.empty() ? "" : "; no output written"), 1);
+    return fail(scene_path + ": " + why + (outs.empty() ? "" : "; no output written"), 1);
   }
   const double solve_s = summary.solve_seconds - write_s;
   const auto final_write = Clock::now();
   try {
     flush();
     if (file) {
-      file->commit();
+      file->finish();
     } else {
+      // what reaches standard output cannot be taken back: a signal from here on says so
+      phiq::tools::set_interrupt_subject(scene_path, "; standard output incomplete");
       std::rewind(spool);
       char chunk[1 << 16];
       for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, spool)) > 0;)
         if (std::fwrite(chunk, 1, n, stdout) != n) throw phiq::Error("cannot write to standard output");
       if (std::fflush(stdout) != 0) throw phiq::Error("cannot write to standard output");
     }
+    write_s += since(final_write);
+    if (summary_file) summary_file->write(summary_json(scene, ws, summary, load_s, solve_s, write_s));
+    outputs.commit();
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
   }
-  write_s += since(final_write);
-  if (!summary_path.empty() && !write_summary(summary_path, scene, ws, summary, load_s, solve_s, write_s)) return 3;
   if (!quiet) {
     if (!redundancy.rank.redundant.empty())
       std::cerr << "phiq: " << scene_path << ": redundant equations left out of the solve (consistent): "
@@ -252,6 +262,14 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     return fail(e.what(), 2);
   }
   if (cases.rows.empty()) return fail(cases_path + ": no cases (one row per parameter set)", 2);
+  auto case_file = [&](std::size_t k) { return dir + "/case" + std::to_string(k) + ".csv"; };
+  {  // no case file may replace the scene or the cases
+    std::vector<NamedPath> outs;
+    for (std::size_t k = 0; k < cases.rows.size(); ++k) outs.push_back({"-o", case_file(k)});
+    if (const auto clash = phiq::tools::output_clash(outs, {{"the scene", scene_path}, {"the cases", cases_path}}))
+      return fail("batch: " + *clash, 2);
+  }
+  phiq::tools::set_interrupt_subject(scene_path, "; no output written");
   // Build every case's model (in order: each shares the first one's analysis), then sweep them in parallel.
   std::vector<phiq::Scene> scenes;
   scenes.reserve(cases.rows.size());
@@ -287,14 +305,22 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   // Each case made square as `phiq run` does; one that cannot be fails alone.
   std::vector<phiq::SquareScene> squares(scenes.size());
   std::vector<std::string> prepare_errors(scenes.size());
-  for (std::size_t k = 0; k < scenes.size(); ++k)
-    if (const auto why = make_square(scenes[k], &squares[k])) prepare_errors[k] = *why;
   std::vector<const phiq::Model*> models;
   std::vector<Eigen::VectorXd> starts;
   std::vector<std::size_t> swept;  // the cases that run, in order
   std::vector<phiq::CsvFormat> formats;
   std::vector<std::string> buffers(scenes.size());
-  std::vector<std::unique_ptr<phiq::AtomicOutputFile>> files(scenes.size());
+  // every case's file exists (as a temporary) before the work; those of the cases that succeed are renamed at the
+  // end, the others removed
+  OutputSet outputs;
+  std::vector<phiq::AtomicOutputFile*> files(scenes.size());
+  try {
+    for (std::size_t k = 0; k < scenes.size(); ++k) files[k] = &outputs.add(case_file(k));
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  for (std::size_t k = 0; k < scenes.size(); ++k)
+    if (const auto why = make_square(scenes[k], &squares[k])) prepare_errors[k] = *why;
   std::vector<std::string> write_errors(scenes.size());
   for (std::size_t k = 0; k < scenes.size(); ++k) {
     const phiq::Scene& sc = scenes[k];
@@ -305,39 +331,41 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     }
     formats.emplace_back(sc);
     buffers[k] = formats[k].header();
-    try {
-      files[k] = std::make_unique<phiq::AtomicOutputFile>(dir + "/case" + std::to_string(k) + ".csv");
-    } catch (const phiq::Error& e) {
-      return fail(e.what(), 3);
-    }
   }
-  std::signal(SIGINT, on_sigint);
   // Each case touches only its own buffer and file: the callback is safe across cases without a lock.
   // each case's own sweep: its output points (and time range) may depend on its parameters
   std::vector<phiq::SweepOptions> sweeps;
   for (std::size_t k : swept) sweeps.push_back(scenes[k].sweep);
-  const phiq::BatchSummary sum = phiq::run_batch(models, sweeps, threads, [&](std::size_t c, const phiq::StepView& step) {
-    const std::size_t k = swept[c];
-    formats[k].append_row(step, buffers[k]);
-    if (buffers[k].size() > (1u << 20)) {
-      try {
-        files[k]->write(buffers[k]);
-      } catch (const phiq::Error& e) {
-        write_errors[k] = e.what();
-        return false;
+  const std::atomic<bool>& stop = phiq::tools::stop_flag();
+  phiq::BatchSummary sum;
+  {
+    phiq::tools::StopOnSignal stop_on_signal;  // a signal stops every case at its next row
+    sum = phiq::run_batch(models, sweeps, threads, [&](std::size_t c, const phiq::StepView& step) {
+      const std::size_t k = swept[c];
+      formats[k].append_row(step, buffers[k]);
+      if (buffers[k].size() > (1u << 20)) {
+        try {
+          files[k]->write(buffers[k]);
+        } catch (const phiq::Error& e) {
+          write_errors[k] = e.what();
+          return false;
+        }
+        buffers[k].clear();
       }
-      buffers[k].clear();
-    }
-    return !g_interrupted.load();
-  }, &starts);
-  std::signal(SIGINT, SIG_DFL);
-  if (g_interrupted) return fail(scene_path + ": interrupted; no output written", 130);
+      return !stop.load();
+    }, &starts);
+  }
+  if (stop.load())
+    return fail(scene_path + ": " + phiq::tools::interrupt_message() + "; no output written",
+                phiq::tools::interrupt_exit_status());
   int failed = 0;
   std::size_t c = 0;  // index of case k among the swept ones
+  std::vector<std::string> reports(scenes.size());
   for (std::size_t k = 0; k < scenes.size(); ++k) {
     if (!prepare_errors[k].empty()) {
       ++failed;
-      std::cerr << "phiq: " << scene_path << ": case " << k << ": " << prepare_errors[k] << "; no output written\n";
+      reports[k] = "phiq: " + scene_path + ": case " + std::to_string(k) + ": " + prepare_errors[k] +
+                   "; no output written\n";
       continue;
     }
     const phiq::SweepSummary& s = sum.cases[c++];
@@ -345,18 +373,24 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     if (why.empty()) {
       try {
         files[k]->write(buffers[k]);
-        files[k]->commit();
+        files[k]->finish();
       } catch (const phiq::Error& e) {
         why = e.what();
       }
     }
     if (!why.empty()) {
       ++failed;
-      std::cerr << "phiq: " << scene_path << ": case " << k << ": " << why << "; no output written\n";
+      reports[k] = "phiq: " + scene_path + ": case " + std::to_string(k) + ": " + why + "; no output written\n";
     } else if (!quiet) {
-      std::cerr << "phiq: " << scene_path << ": case " << k << ": " << s.BriefReport() << "\n";
+      reports[k] = "phiq: " + scene_path + ": case " + std::to_string(k) + ": " + s.BriefReport() + "\n";
     }
   }
+  try {
+    outputs.publish_finished();
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  for (const std::string& r : reports) std::cerr << r;
   if (!quiet)
     std::cerr << "phiq: " << scene_path << ": " << scenes.size() - failed << " of " << scenes.size() << " cases in "
               << dir << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
@@ -468,10 +502,21 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
 // `phiq assemble SCENE [-o OUT.csv]`: the assembled position at time.start as a one-row CSV (the columns of
 // `phiq run`'s positions). Nothing is written when the assembly fails.
 int cmd_assemble(const std::string& scene_path, const std::string& out_path, bool quiet) {
+  if (!out_path.empty())
+    if (const auto clash = phiq::tools::output_clash({{"-o", out_path}}, {{"the scene", scene_path}}))
+      return fail("assemble: " + *clash, 2);
+  phiq::tools::set_interrupt_subject(scene_path, "; no output written");
   std::optional<phiq::Scene> loaded = load_or_report(scene_path);
   if (!loaded) return 2;
   const phiq::Scene& scene = *loaded;
   const phiq::Model& model = *scene.model;
+  OutputSet outputs;  // created before the assembly, committed after it
+  phiq::AtomicOutputFile* file = nullptr;
+  try {
+    if (!out_path.empty()) file = &outputs.add(out_path);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
   Eigen::VectorXd q = model.initial_positions();
   phiq::AssemblySummary as;
   const double t0 = scene.sweep.t_begin;
@@ -483,12 +528,11 @@ int cmd_assemble(const std::string& scene_path, const std::string& out_path, boo
   std::string text = csv.header();
   csv.append_row(phiq::StepView{0, t0, q, nullptr, nullptr}, text);
   try {
-    if (out_path.empty()) {
-      std::cout << text << std::flush;
+    if (file) {
+      file->write(text);
+      outputs.commit();
     } else {
-      phiq::AtomicOutputFile f(out_path);
-      f.write(text);
-      f.commit();
+      std::cout << text << std::flush;
     }
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
@@ -570,6 +614,12 @@ CLI::Validator one_of(const std::vector<std::string>& words) {
       "WORD");
 }
 
+// An output path that is not empty (an empty one used to mean standard output, silently).
+CLI::Validator non_empty_path(const std::string& instead) {
+  return CLI::Validator(
+      [=](std::string& text) -> std::string { return text.empty() ? "the path is empty" + instead : ""; }, "PATH");
+}
+
 // More threads than the cores TBB runs (tbb::info::default_concurrency(), which honours the process's affinity
 // mask) would not run at once: TBB warns (several lines) and keeps its limit while the summary would claim the
 // number asked for. Capped, with a note.
@@ -624,6 +674,9 @@ int usage_error(CLI::App& app, int argc, char** argv, const CLI::ParseError& e) 
 }  // namespace
 
 int main(int argc, char** argv) {
+  // before anything starts a thread
+  phiq::tools::start_interrupts();
+
   CLI::App app{"phiq: sparse, large-scale multibody kinematics"};
   app.set_version_flag("--version", std::string("phiq ") + phiq::kVersion + " (scene format " +
                                         std::to_string(phiq::kSceneFormat) + ", CSV format " +
@@ -631,14 +684,17 @@ int main(int argc, char** argv) {
                                         std::to_string(phiq::kCheckJsonFormat) + ")");
   app.require_subcommand(1);
   const CLI::Validator threads_range = whole_number(0, 1000000, "all cores");
+  const CLI::Validator path_given = non_empty_path("");
+  const CLI::Validator path_or_stdout = non_empty_path(" (without the option: standard output)");
 
   std::string scene_path, out_path, summary_path;
   bool quiet = false;
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
   run->add_option("scene", scene_path, "Scene file (YAML)")->required();
-  run->add_option("-o,--output", out_path, "CSV file to write (default: standard output)");
+  run->add_option("-o,--output", out_path, "CSV file to write (default: standard output)")->check(path_or_stdout);
   run->add_flag("-q,--quiet", quiet, "Do not print the run summary on standard error");
-  run->add_option("--summary", summary_path, "Write the run summary as JSON (counts and timings) to this file");
+  run->add_option("--summary", summary_path, "Write the run summary as JSON (counts and timings) to this file")
+      ->check(path_given);
   int threads = 0;
   run->add_option("--threads", threads, "Threads for the drive steps (0: all cores; 1: in order)")
       ->capture_default_str()
@@ -661,7 +717,7 @@ int main(int argc, char** argv) {
   generate->add_option("N", gen.n, "Size: four-bars (nfourbar), stages (scissor), cells (grid), spatial loops (chain3d)")
       ->required()
       ->check(any_whole_number());
-  generate->add_option("-o,--output", gen_out, "Scene file to write")->required();
+  generate->add_option("-o,--output", gen_out, "Scene file to write")->required()->check(path_given);
   generate->add_option("--steps", gen.steps, "Sweep intervals")->capture_default_str()->check(any_whole_number());
   const CLI::Validator any_number = number(-HUGE_VAL, HUGE_VAL, false, "a finite number");
   CLI::Option* gen_from =
@@ -685,7 +741,7 @@ int main(int argc, char** argv) {
   int batch_threads = 0;
   batch->add_option("scene", batch_scene, "Scene file (YAML)")->required();
   batch->add_option("cases", batch_cases, "CSV: a header of parameter names, one row of values per case")->required();
-  batch->add_option("-o,--output", batch_dir, "Directory for case<k>.csv (k = row, from 0)")->required();
+  batch->add_option("-o,--output", batch_dir, "Directory for case<k>.csv (k = row, from 0)")->required()->check(path_given);
   batch->add_flag("-q,--quiet", batch_quiet, "Print only failures on standard error");
   batch->add_option("--threads", batch_threads, "Threads for the cases (0: all cores)")
       ->capture_default_str()
@@ -695,7 +751,7 @@ int main(int argc, char** argv) {
   CLI::App* assemble_cmd =
       app.add_subcommand("assemble", "Assemble the rough placement (minimum-norm) and write the coordinates as CSV");
   assemble_cmd->add_option("scene", asm_path, "Scene file (YAML)")->required();
-  assemble_cmd->add_option("-o,--output", asm_out, "CSV file to write (default: standard output)");
+  assemble_cmd->add_option("-o,--output", asm_out, "CSV file to write (default: standard output)")->check(path_or_stdout);
   assemble_cmd->add_flag("-q,--quiet", asm_quiet, "Do not print the summary on standard error");
   CLI::App* check = app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
   check->add_option("scene", check_path, "Scene file (YAML)")->required();
@@ -710,7 +766,7 @@ int main(int argc, char** argv) {
                                               "columns against time, as SVG");
   plot->add_option("scene", plot_options.scene, "Scene file (YAML)")->required();
   plot->add_option("result", plot_options.csv, "CSV written by `phiq run` for this scene")->required();
-  plot->add_option("-o,--output", plot_options.out, "SVG file to write")->required();
+  plot->add_option("-o,--output", plot_options.out, "SVG file to write")->required()->check(path_given);
   plot->add_option("--columns", plot_options.columns, "Columns to plot against t (default: the coordinates, at most 6)")
       ->delimiter(',');
   plot->add_option("--positions", plot_options.positions, "Rows at which the mechanism is drawn, evenly spread")
@@ -733,8 +789,9 @@ int main(int argc, char** argv) {
   phiq::tools::SweepAccuracyArgs acc;  // `phiq sweep-accuracy`: tools/sweep_accuracy.hpp
   CLI::App* accuracy = app.add_subcommand("sweep-accuracy", "Error against a reference and time per step, per solver setting");
   accuracy->add_option("scene", acc.scene, "Scene file (YAML)")->required();
-  accuracy->add_option("-o,--output", acc.csv_path, "CSV to write (default: standard output unless --json)");
-  accuracy->add_option("--json", acc.json_path, "JSON to write");
+  accuracy->add_option("-o,--output", acc.csv_path, "CSV to write (default: standard output unless --json)")
+      ->check(path_or_stdout);
+  accuracy->add_option("--json", acc.json_path, "JSON to write")->check(path_given);
   accuracy->add_option("--tolerances", acc.tolerances, "Newton tolerances (default 1e-4,1e-5,...,1e-14)");
   accuracy->add_option("--steps-list", acc.steps, "Step counts (default: the scene's x 1/4, 1, 4)");
   accuracy->add_option("--predictors", acc.predictors, "Of previous,secant,parabolic,linear,quadratic,cubic,auto (default: all but auto)");
@@ -778,10 +835,11 @@ int main(int argc, char** argv) {
       } catch (const std::invalid_argument& e) {
         return fail(std::string("generate: ") + e.what(), 2);
       }
+      phiq::tools::set_interrupt_subject("generate: " + gen_out, "; no output written");
       try {
-        phiq::AtomicOutputFile f(gen_out);
-        f.write(text);
-        f.commit();
+        OutputSet outputs;
+        outputs.add(gen_out).write(text);
+        outputs.commit();
       } catch (const phiq::Error& e) {
         return fail(e.what(), 3);
       }
@@ -795,7 +853,12 @@ int main(int argc, char** argv) {
       return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, cases_threads);
     }
     if (*compare) return cmd_compare(cmp_a, cmp_b, cmp);
-    if (*plot) return phiq::tools::plot_svg(plot_options);
+    if (*plot) {
+      if (const auto clash = phiq::tools::output_clash(
+              {{"-o", plot_options.out}}, {{"the scene", plot_options.scene}, {"the result", plot_options.csv}}))
+        return fail("plot: " + *clash, 2);
+      return phiq::tools::plot_svg(plot_options);
+    }
     if (*accuracy) return phiq::tools::run_sweep_accuracy_command(acc);
   } catch (const std::exception& e) {
     return fail(std::string("internal error: ") + e.what(), 4);

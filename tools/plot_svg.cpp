@@ -8,6 +8,7 @@
 #include <memory>
 #include <sstream>
 
+#include "cli_support.hpp"
 #include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 
@@ -85,6 +86,15 @@ int plot_svg(const PlotOptions& o) {
     table = read_csv_table(o.csv);
   } catch (const Error& e) {
     return fail(e.what(), 2);
+  }
+  // the SVG exists (as a temporary) before the drawing, which may sweep the scene again
+  set_interrupt_subject("plot: " + o.out, "; no output written");
+  OutputSet outputs;
+  AtomicOutputFile* out = nullptr;
+  try {
+    out = &outputs.add(o.out);
+  } catch (const Error& e) {
+    return fail(e.what(), 3);
   }
   // The CSV must be the scene's result: the columns its output lists, in order.
   const std::vector<std::string> expected = CsvFormat(scene).column_names();
@@ -295,9 +305,8 @@ int plot_svg(const PlotOptions& o) {
   }
   svg << "</svg>\n";
   try {
-    AtomicOutputFile f(o.out);
-    f.write(svg.str());
-    f.commit();
+    out->write(svg.str());
+    outputs.commit();
   } catch (const Error& e) {
     return fail(e.what(), 3);
   }

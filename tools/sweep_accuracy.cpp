@@ -6,7 +6,6 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -16,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "cli_support.hpp"
 #include "closed_forms.hpp"
 
 namespace phiq::tools {
@@ -189,10 +189,6 @@ std::string csv_field(const std::string& s) {
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
   return q + "\"";
 }
-
-std::atomic<bool> g_interrupted{false};
-// extern "C" names ignore namespaces: this one must differ from phiq_main.cpp's on_sigint
-extern "C" void sweep_accuracy_on_sigint(int) { g_interrupted = true; }
 
 }  // namespace
 
@@ -540,50 +536,57 @@ int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
   }
   o.reference = a.reference;
   o.repeat = a.repeat;
-  // Ctrl-C stops the running sweep; the temporary output files are then removed (nothing is written). Installed
-  // before the files are created, so that no moment leaves a temporary behind.
-  o.stop = &g_interrupted;
-  std::signal(SIGINT, sweep_accuracy_on_sigint);
-  struct RestoreSignal {
-    ~RestoreSignal() { std::signal(SIGINT, SIG_DFL); }
-  } restore;
+  // Outputs that would replace the scene or each other are refused before anything is read or run.
+  std::vector<NamedPath> outs;
+  if (!a.csv_path.empty()) outs.push_back({"-o", a.csv_path});
+  if (!a.json_path.empty()) outs.push_back({"--json", a.json_path});
+  if (const auto clash = output_clash(outs, {{"the scene", a.scene}})) return fail(*clash, 2);
+  set_interrupt_subject("sweep-accuracy: " + a.scene, "; no output written");
   Scene scene;
   try {
     scene = load_scene(a.scene);
   } catch (const SceneError& e) {
     return fail(e.what(), 2);
   }
-  // Files are created (as temporaries) before the long run, so that an unwritable path fails at once.
-  std::unique_ptr<AtomicOutputFile> csv_file, json_file;
+  // Files are created (as temporaries) before the long run, so that an unwritable path fails at once; a signal
+  // (SIGINT, SIGTERM, SIGHUP) stops the running sweep, and the temporaries are then removed (nothing is written).
+  OutputSet outputs;
+  AtomicOutputFile* csv_file = nullptr;
+  AtomicOutputFile* json_file = nullptr;
   try {
-    if (!a.csv_path.empty()) csv_file = std::make_unique<AtomicOutputFile>(a.csv_path);
-    if (!a.json_path.empty()) json_file = std::make_unique<AtomicOutputFile>(a.json_path);
+    if (!a.csv_path.empty()) csv_file = &outputs.add(a.csv_path);
+    if (!a.json_path.empty()) json_file = &outputs.add(a.json_path);
   } catch (const Error& e) {
     return fail(e.what(), 3);
   }
+  o.stop = &stop_flag();
   AccuracyReport rep;
   const auto t0 = Clock::now();
   try {
+    StopOnSignal stop_on_signal;
     rep = measure_accuracy(scene, o, a.verbose ? std::function<void(const std::string&)>([](const std::string& l) {
                                       std::cerr << "phiq: sweep-accuracy: " << l << "\n";
                                     })
                                                : std::function<void(const std::string&)>());
   } catch (const AccuracyCancelled&) {
-    return fail(a.scene + ": interrupted; no output written", 130);
+    return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
   } catch (const std::invalid_argument& e) {
     return fail(a.scene + ": " + e.what(), 2);
   } catch (const std::runtime_error& e) {
     return fail(a.scene + ": " + e.what(), 1);
   }
+  if (stop_flag().load())  // a signal after the last sweep: stopped all the same
+    return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   try {
     const std::string csv = accuracy_csv(rep);
-    if (csv_file) csv_file->write(csv), csv_file->commit();
-    if (json_file) json_file->write(accuracy_json(rep)), json_file->commit();
+    if (csv_file) csv_file->write(csv);
+    if (json_file) json_file->write(accuracy_json(rep));
     if (!csv_file && !json_file) {
       if (std::fwrite(csv.data(), 1, csv.size(), stdout) != csv.size() || std::fflush(stdout) != 0)
         throw Error("cannot write to standard output");
     }
+    outputs.commit();  // both files, or neither
   } catch (const Error& e) {
     return fail(e.what(), 3);
   }

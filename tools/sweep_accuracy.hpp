@@ -103,8 +103,10 @@ struct SweepAccuracyArgs {
 };
 
 // Runs the command: exit status 0, 1 (the reference could not be computed), 2 (bad input: scene, option, a
-// reference that does not fit), 3 (an output could not be written), 130 (interrupted by Ctrl-C: nothing written). Errors are one line on stderr ("phiq: ...").
-// Without -o and --json the CSV goes to standard output; files are written whole or not at all.
+// reference that does not fit, an output that is the scene or the other output), 3 (an output could not be
+// written), 128 + the signal (SIGINT, SIGTERM, SIGHUP: the running sweep stops, nothing is written; signals as
+// cli_support.hpp). Errors are one line on stderr ("phiq: ..."). Without -o and --json the CSV goes to standard
+// output; the files are written whole or not at all, both or neither.
 int run_sweep_accuracy_command(const SweepAccuracyArgs& args);
 
 }  // namespace phiq::tools

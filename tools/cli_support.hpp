@@ -1,0 +1,76 @@
+// What the phiq commands share about their effects on the outside (tools/README.md, "Exit status and errors"):
+// the signals that stop them, their output files (created before the work, committed together at the end), and the
+// checks of output paths against the inputs and against each other.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "phiq/csv_writer.hpp"
+
+namespace phiq::tools {
+
+// SIGINT, SIGTERM and SIGHUP. start_interrupts(), first thing in main() (before any thread exists), blocks them in
+// every thread and waits for them in a thread of its own, which acts on the current mode:
+//  - by default, it removes the temporaries of every live OutputSet, prints "phiq: SUBJECT: interrupted (SIGTERM)
+//    SUFFIX" and exits with 128 + the signal (130 for SIGINT, 143 for SIGTERM, 129 for SIGHUP);
+//  - while a StopOnSignal lives (a sweep that polls stop_flag()), the first signal only sets the flag: the sweep
+//    stops at its next row and the command cleans up and reports (interrupt_message(), interrupt_exit_status()); a
+//    second signal exits at once, as by default;
+//  - once an OutputSet is committed, a signal exits with 128 + the signal without a word (the outputs are complete).
+// Without start_interrupts() (the library's users, the tests) nothing is installed and stop_flag() stays false.
+void start_interrupts();
+// What the message names ("SCENE", "sweep-accuracy: SCENE") and what it adds ("; no output written").
+void set_interrupt_subject(const std::string& subject, const std::string& suffix = "");
+// Whether a signal came (or, in a StopOnSignal, asked the sweep to stop), and which one.
+const std::atomic<bool>& stop_flag();
+int interrupt_signal();            // 0 when none
+int interrupt_exit_status();       // 128 + interrupt_signal()
+std::string interrupt_message();   // "interrupted (SIGTERM)"
+
+// The mode in which a signal asks the running sweep to stop (stop_flag()) instead of exiting at once.
+class StopOnSignal {
+ public:
+  StopOnSignal();
+  ~StopOnSignal();
+  StopOnSignal(const StopOnSignal&) = delete;
+  StopOnSignal& operator=(const StopOnSignal&) = delete;
+};
+
+// The output files of one command: all created before the work (so that an unwritable path fails at once, and a
+// signal removes them), all committed together at the end, or none.
+class OutputSet {
+ public:
+  OutputSet() = default;
+  ~OutputSet();  // removes the temporaries of files not committed
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
+
+  // Creates the output at `path` now (AtomicOutputFile: a temporary in its target's directory, or a device / FIFO
+  // opened in place). Throws phiq::Error "PATH: cannot write: REASON".
+  AtomicOutputFile& add(const std::string& path);
+  // Finishes every file (flush, fsync), then renames them all onto their targets; no file is renamed unless every
+  // one was written. Afterwards signals exit quietly. Throws phiq::Error (the set's temporaries are then removed).
+  void commit();
+  // Renames the files already finished (AtomicOutputFile::finish()) onto their targets; the others are removed
+  // with the set (phiq batch: the files of the cases that succeeded). Afterwards signals exit quietly.
+  void publish_finished();
+
+ private:
+  std::vector<std::unique_ptr<AtomicOutputFile>> files_;
+  bool committed_ = false;
+};
+
+// An output path of the command line with what it is ("-o", "--summary", "the scene").
+struct NamedPath {
+  std::string what, path;
+};
+// The one-line reason when an output would overwrite an input (`phiq run S.yaml -o S.yaml`) or two outputs are the
+// same file (`-o X --summary X`); several outputs may go to one device or FIFO (`/dev/null`). Empty paths are
+// refused too. Nothing when the paths are fine.
+std::optional<std::string> output_clash(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
+
+}  // namespace phiq::tools
