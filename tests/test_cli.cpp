@@ -1137,6 +1137,31 @@ TEST_F(Cli, UnwritableOutputsFailBeforeTheSweepAndNoneAppears) {
   EXPECT_EQ(files(), (std::vector<std::string>{"a.csv", "long.yaml", "stderr.txt", "stdout.txt"}));
 }
 
+// What goes to standard output and is lost (a full device, a closed descriptor) is an error, exit 3 in one line:
+// check, check --json, assemble, run.
+TEST_F(Cli, LostStandardOutputIsAnError) {
+  const std::string scene = phiq::test::model_path("seed/fourbar_natural.yaml");
+  const fs::path err = dir_ / "err.txt";
+  // the command with standard output redirected as given: its exit status, its stderr in err.txt
+  auto status = [&](const std::string& args, const std::string& redirect) {
+    const int st = std::system((std::string(PHIQ_CLI) + " " + args + " " + redirect + " 2>" + err.string()).c_str());
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  };
+  if (fs::exists("/dev/full")) {
+    for (const std::string& args :
+         std::vector<std::string>{"check " + scene, "check --json " + scene, "assemble -q " + scene, "run -q " + scene}) {
+      EXPECT_EQ(status(args, ">/dev/full"), 3) << args << ": " << slurp(err);
+      EXPECT_TRUE(one_phiq_line(slurp(err))) << args;
+      EXPECT_NE(slurp(err).find("standard output: cannot write: No space left on device"), std::string::npos) << slurp(err);
+    }
+  }
+  for (const std::string& args : std::vector<std::string>{"run -q " + scene, "check " + scene, "assemble -q " + scene}) {
+    EXPECT_EQ(status(args, ">&-"), 3) << args << ": " << slurp(err);
+    EXPECT_TRUE(one_phiq_line(slurp(err))) << args;
+    EXPECT_NE(slurp(err).find("standard output: cannot write: it is closed"), std::string::npos) << slurp(err);
+  }
+}
+
 // Command-line errors are one line, "phiq: <command>: <what>", exit 2, with readable ranges.
 TEST_F(Cli, CommandLineErrorsAreOneLineNamingTheCommand) {
   const std::string scene = phiq::test::model_path("seed/fourbar_natural.yaml");

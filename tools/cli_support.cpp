@@ -1,10 +1,15 @@
 #include "cli_support.hpp"
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
 #include <mutex>
 #include <thread>
 
@@ -21,6 +26,7 @@ bool g_quiet = false;                   // outputs committed: exit without a wor
 std::string g_subject = "phiq", g_suffix;
 std::atomic<bool> g_stop{false};
 std::atomic<int> g_signal{0};
+bool g_stdout_closed = false;
 
 const char* signal_name(int sig) {
   switch (sig) {
@@ -150,6 +156,29 @@ std::optional<std::string> output_clash(const std::vector<NamedPath>& outputs, c
         return outputs[j].what + " " + outputs[j].path + " and " + o.what + " " + o.path + " are the same file";
   }
   return std::nullopt;
+}
+
+void ensure_standard_descriptors() {
+  for (int fd = 0; fd <= 2; ++fd) {
+    if (::fcntl(fd, F_GETFD) != -1 || errno != EBADF) continue;
+    if (fd == STDOUT_FILENO) g_stdout_closed = true;
+    // the lowest free descriptor: fd itself; read-only, so that writes to it fail instead of vanishing
+    const int got = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+    if (got >= 0 && got != fd) ::close(got);
+  }
+}
+
+bool stdout_was_closed() { return g_stdout_closed; }
+
+std::optional<std::string> stdout_error() {
+  errno = 0;
+  std::cout.flush();  // with the streams synchronised (the default), this is stdout's fflush: its errno counts
+  int err = errno;
+  const bool flushed = std::fflush(stdout) == 0;
+  if (err == 0) err = errno;
+  if (flushed && !std::ferror(stdout) && !std::cout.bad() && !std::cout.fail()) return std::nullopt;
+  std::string why = g_stdout_closed ? "it is closed" : err ? std::strerror(err) : "a write failed";
+  return "standard output: cannot write: " + why;
 }
 
 }  // namespace phiq::tools

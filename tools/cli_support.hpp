@@ -1,6 +1,6 @@
 // What the phiq commands share about their effects on the outside (tools/README.md, "Exit status and errors"):
-// the signals that stop them, their output files (created before the work, committed together at the end), and the
-// checks of output paths against the inputs and against each other.
+// the signals that stop them, their output files (created before the work, committed together at the end), the
+// checks of output paths against the inputs and against each other, and standard output's errors.
 #pragma once
 
 #include <atomic>
@@ -72,5 +72,15 @@ struct NamedPath {
 // same file (`-o X --summary X`); several outputs may go to one device or FIFO (`/dev/null`). Empty paths are
 // refused too. Nothing when the paths are fine.
 std::optional<std::string> output_clash(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
+
+// Makes sure descriptors 0, 1 and 2 are open, so that no file the command opens takes their place (with standard
+// output closed, a temporary file would become "standard output"). A closed one is replaced by /dev/null opened
+// read-only: writing to it fails, and the failure is reported. Call first in main().
+void ensure_standard_descriptors();
+// Standard output was closed when the command started.
+bool stdout_was_closed();
+// Flushes std::cout and stdout; the one-line reason when anything written to standard output was lost
+// ("standard output: cannot write: No space left on device"), else nothing.
+std::optional<std::string> stdout_error();
 
 }  // namespace phiq::tools

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -124,6 +125,8 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   if (!out_path.empty()) outs.push_back({"-o", out_path});
   if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
   if (const auto clash = phiq::tools::output_clash(outs, {{"the scene", scene_path}})) return fail("run: " + *clash, 2);
+  if (out_path.empty() && phiq::tools::stdout_was_closed())
+    return fail("run: standard output: cannot write: it is closed", 3);
   phiq::tools::set_interrupt_subject(scene_path, "; no output written");
   const auto load_start = Clock::now();
   std::optional<phiq::Scene> loaded = load_or_report(scene_path);
@@ -226,8 +229,9 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
       std::rewind(spool);
       char chunk[1 << 16];
       for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, spool)) > 0;)
-        if (std::fwrite(chunk, 1, n, stdout) != n) throw phiq::Error("cannot write to standard output");
-      if (std::fflush(stdout) != 0) throw phiq::Error("cannot write to standard output");
+        if (std::fwrite(chunk, 1, n, stdout) != n)
+          throw phiq::Error(std::string("standard output: cannot write: ") + std::strerror(errno));
+      if (const auto bad = phiq::tools::stdout_error()) throw phiq::Error(*bad);
     }
     write_s += since(final_write);
     if (summary_file) summary_file->write(summary_json(scene, ws, summary, load_s, solve_s, write_s));
@@ -502,9 +506,12 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
 // `phiq assemble SCENE [-o OUT.csv]`: the assembled position at time.start as a one-row CSV (the columns of
 // `phiq run`'s positions). Nothing is written when the assembly fails.
 int cmd_assemble(const std::string& scene_path, const std::string& out_path, bool quiet) {
-  if (!out_path.empty())
+  if (!out_path.empty()) {
     if (const auto clash = phiq::tools::output_clash({{"-o", out_path}}, {{"the scene", scene_path}}))
       return fail("assemble: " + *clash, 2);
+  } else if (phiq::tools::stdout_was_closed()) {
+    return fail("assemble: standard output: cannot write: it is closed", 3);
+  }
   phiq::tools::set_interrupt_subject(scene_path, "; no output written");
   std::optional<phiq::Scene> loaded = load_or_report(scene_path);
   if (!loaded) return 2;
@@ -532,7 +539,8 @@ int cmd_assemble(const std::string& scene_path, const std::string& out_path, boo
       file->write(text);
       outputs.commit();
     } else {
-      std::cout << text << std::flush;
+      std::cout << text;
+      if (const auto bad = phiq::tools::stdout_error()) throw phiq::Error(*bad);
     }
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
@@ -674,7 +682,8 @@ int usage_error(CLI::App& app, int argc, char** argv, const CLI::ParseError& e) 
 }  // namespace
 
 int main(int argc, char** argv) {
-  // before anything starts a thread
+  // before anything opens a file or starts a thread
+  phiq::tools::ensure_standard_descriptors();
   phiq::tools::start_interrupts();
 
   CLI::App app{"phiq: sparse, large-scale multibody kinematics"};
@@ -804,17 +813,24 @@ int main(int argc, char** argv) {
   accuracy->add_flag("-q,--quiet", acc.quiet, "Print only errors on standard error");
   accuracy->add_flag("-v,--verbose", acc.verbose, "One line per setting on standard error");
 
+  // The command's exit status, made 3 when what it wrote to standard output was lost (a full disk, a closed
+  // descriptor): a report that never arrived is not a success.
+  auto finished = [](int status) {
+    if (status == 0 || status == 1)
+      if (const auto bad = phiq::tools::stdout_error()) return fail(*bad, 3);
+    return status;
+  };
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    if (e.get_exit_code() == 0) return finished(app.exit(e));  // --help, --version
     return usage_error(app, argc, argv, e);
   }
   try {
     if (*run) {
       using Mode = phiq::tools::ProgressBar::Mode;
-      return cmd_run(scene_path, out_path, quiet, summary_path, cap_threads("run", threads, quiet), memory_gb,
-                     progress == "always" ? Mode::kAlways : progress == "never" ? Mode::kNever : Mode::kAuto);
+      return finished(cmd_run(scene_path, out_path, quiet, summary_path, cap_threads("run", threads, quiet), memory_gb,
+                              progress == "always" ? Mode::kAlways : progress == "never" ? Mode::kNever : Mode::kAuto));
     }
     if (*generate) {
       if (auto range = phiq::tools::kind_default_range(gen.kind)) {  // kinds whose default range differs
@@ -846,8 +862,9 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*check)
-      return cmd_check(check_path, check_json, check_at->count() ? std::optional<double>(check_time) : std::nullopt);
-    if (*assemble_cmd) return cmd_assemble(asm_path, asm_out, asm_quiet);
+      return finished(
+          cmd_check(check_path, check_json, check_at->count() ? std::optional<double>(check_time) : std::nullopt));
+    if (*assemble_cmd) return finished(cmd_assemble(asm_path, asm_out, asm_quiet));
     if (*batch) {
       const int cases_threads = cap_threads("batch", batch_threads, batch_quiet);
       return cmd_batch(batch_scene, batch_cases, batch_dir, batch_quiet, cases_threads);
@@ -859,7 +876,7 @@ int main(int argc, char** argv) {
         return fail("plot: " + *clash, 2);
       return phiq::tools::plot_svg(plot_options);
     }
-    if (*accuracy) return phiq::tools::run_sweep_accuracy_command(acc);
+    if (*accuracy) return finished(phiq::tools::run_sweep_accuracy_command(acc));
   } catch (const std::exception& e) {
     return fail(std::string("internal error: ") + e.what(), 4);
   }

@@ -541,6 +541,7 @@ int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
   if (!a.csv_path.empty()) outs.push_back({"-o", a.csv_path});
   if (!a.json_path.empty()) outs.push_back({"--json", a.json_path});
   if (const auto clash = output_clash(outs, {{"the scene", a.scene}})) return fail(*clash, 2);
+  if (outs.empty() && stdout_was_closed()) return fail("standard output: cannot write: it is closed", 3);
   set_interrupt_subject("sweep-accuracy: " + a.scene, "; no output written");
   Scene scene;
   try {
@@ -583,8 +584,8 @@ int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
     if (csv_file) csv_file->write(csv);
     if (json_file) json_file->write(accuracy_json(rep));
     if (!csv_file && !json_file) {
-      if (std::fwrite(csv.data(), 1, csv.size(), stdout) != csv.size() || std::fflush(stdout) != 0)
-        throw Error("cannot write to standard output");
+      std::fwrite(csv.data(), 1, csv.size(), stdout);
+      if (const auto bad = stdout_error()) throw Error(*bad);
     }
     outputs.commit();  // both files, or neither
   } catch (const Error& e) {
