@@ -1272,4 +1272,48 @@ TEST_F(Cli, BatchNamesTheCaseOnlyForItsOwnErrors) {
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
+// A square scene whose first position Newton cannot reach from the placement for want of a descent direction, not
+// for a zero pivot: a Cardan joint at 90° placed at its singular angle, where the output shaft is free and the motor
+// fixes nothing. The failure gets the minimum-norm assembly's rank analysis, as a singular Jacobian did, and so says
+// what is wrong; before it ended on "no decrease of the residual along the Newton direction".
+TEST_F(Cli, AFirstPositionNotReachedGetsTheRankAnalysis) {
+  const fs::path p = write("cardan90.yaml", R"Y(phiq: 1
+name: cardan_b90_refpoint
+dimension: 3
+parameters: {W: 1.5}
+coordinates:
+  x1: 0.2100
+  y1: 0.0900
+  z1: -0.3000
+  p0: 0.9694
+  p1: 0.1700
+  p2: -0.1100
+  p3: 0.3100
+  x2: 0.2000
+  y2: 0.1100
+  z2: -0.3000
+  q0: 0.7332
+  q1: -0.1290
+  q2: 0.5353
+  q3: 0.2670
+bodies:
+  s1: [x1, y1, z1, p0, p1, p2, p3]
+  s2: [x2, y2, z2, q0, q1, q2, q3]
+constraints:
+  - {name: hinge1, type: revolute, between: [{body: ground, at: [0.20000000000000001, 0.10000000000000001, -0.29999999999999999], axis: [-0.18461483192953382, -0.34138670707320812, 0.92161406242816279], ref: [0.8040351560704071, 0.48680857021682333, 0.34138670707320812]}, {body: s1, axis: [0, 0, 1], ref: [1, 0, 0]}]}
+  - {name: cross, type: universal, between: [{body: s1, axis: [1, 0, 0]}, {body: s2, axis: [0, 1, 0]}]}
+  - {name: axis2, type: point_on_line, between: [{body: ground, at: [0.20000000000000001, 0.10000000000000001, -0.29999999999999999], axis: [0.8040351560704071, 0.48680857021682333, 0.34138670707320817]}, {body: s2, at: [0, 0, 1]}]}
+drivers:
+  - {name: motor, joint: hinge1, measure: angle, law: {type: linear, initial: 0, rate: W}}
+time: {start: 0.0, end: 4.1887902047863905, steps: 72}
+output: {velocities: true, accelerations: true}
+)Y");
+  Result r = run("run " + p.string() + " -o " + (dir_ / "out.csv").string());
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("step 0, t = 0: initial assembly failed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; rank analysis: 1 degree(s) of freedom not driven"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
+}
+
 }  // namespace

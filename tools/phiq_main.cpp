@@ -205,9 +205,11 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
                 phiq::tools::interrupt_exit_status());
   if (summary.status != phiq::SolveStatus::kSuccess) {
     std::string why = summary.message;
-    // A square model singular at its first position: redundant constraints and missing drivers in equal numbers,
-    // or a singular placement. The rank analysis says which.
-    if (summary.failed_step == 0 && summary.status == phiq::SolveStatus::kSingularJacobian && !square.reduced) {
+    // A square model not assembled at its first position: singular there (redundant constraints and missing
+    // drivers in equal numbers, or a singular placement), or Newton found no descent from the placement (the
+    // Jacobian of a Cardan joint at 90° drops rank there). The minimum-norm assembly and its rank analysis say which.
+    if (summary.failed_step == 0 && summary.status != phiq::SolveStatus::kOutsideTimeDomain &&
+        summary.status != phiq::SolveStatus::kNonFinite && !square.reduced) {
       Eigen::VectorXd q = scene.model->initial_positions();
       phiq::AssemblySummary as;
       std::unique_ptr<phiq::Model> unused;
