@@ -110,13 +110,18 @@ TEST(LinearSolver, KluRefactorisesWithTheOldPivotsWhileTheyHold) {
   EXPECT_EQ(n->pivoting_factorizations(), 1);  // five refactorisations, no new pivot search
 }
 
-TEST(LinearSolver, KluSearchesPivotsAgainWhenTheOldOnesDegrade) {
-  // full 2 x 2: first diagonally dominant (diagonal pivots), then with a tiny (1,1) entry, where the old pivot
-  // order would divide by 1e-14
+// A KLU numeric object for the full 2 × 2 pattern (values column-major).
+std::unique_ptr<SparseLuNumeric> full_2x2_klu() {
   auto p = std::make_shared<CscPattern>();
   std::vector<Index> slot;
   *p = build_csc_pattern(2, 2, {0, 1, 0, 1}, {0, 0, 1, 1}, &slot);
-  auto n = analyse(LinearSolverKind::kKlu, p)->make_numeric();
+  return analyse(LinearSolverKind::kKlu, p)->make_numeric();
+}
+
+TEST(LinearSolver, KluSearchesPivotsAgainWhenTheOldOnesDegrade) {
+  // full 2 x 2: first diagonally dominant (diagonal pivots), then with a tiny (1,1) entry, where the old pivot
+  // order would divide by 1e-14
+  auto n = full_2x2_klu();
   std::vector<double> a = {2, 1, 1, 2}, b = {1e-14, 1, 1, 1};  // column-major
   ASSERT_EQ(n->factorize(a.data()), FactorStatus::kOk);
   ASSERT_EQ(n->factorize(b.data()), FactorStatus::kOk);
@@ -132,10 +137,7 @@ TEST(LinearSolver, KluChecksALowPivotRatioWithAPivotSearchBeforeReportingIt) {
   // 0.002 / 499 = 4e-6. At [[1e-4, 1], [1, 1]] (det −1: well conditioned) the old order gives 1e-4 / 1e4 = 1e-8,
   // within the degradation allowed (1e-3 of 4e-6), which a sweep reported as a near-singular position (below 1e-7).
   // Below 1e-6 a pivot search measures again: the ratio is that of the matrix's own pivots, about 1.
-  auto p = std::make_shared<CscPattern>();
-  std::vector<Index> slot;
-  *p = build_csc_pattern(2, 2, {0, 1, 0, 1}, {0, 0, 1, 1}, &slot);
-  auto n = analyse(LinearSolverKind::kKlu, p)->make_numeric();
+  auto n = full_2x2_klu();
   std::vector<double> a = {0.002, 1, 1, 1}, b = {1e-4, 1, 1, 1};  // column-major
   ASSERT_EQ(n->factorize(a.data()), FactorStatus::kOk);
   EXPECT_NEAR(n->rcond(), 0.002 / 499.0, 1e-9);
