@@ -87,8 +87,8 @@ struct State {
   Eigen::VectorXd q, qd, qdd;
 };
 
-// The sign of det Φq at a converged state when no factorisation was made there (positions only, a start accepted
-// from its prediction): ±1 is the sign at that very position, 0 a singular position.
+// A sign of det Φq is ±1 at a regular position and 0 at a singular one; kSignUnknown where no factorisation tells
+// it (positions only, a start accepted from its prediction).
 constexpr int kSignUnknown = 2;
 
 class Sweeper {
@@ -399,7 +399,9 @@ class Sweeper {
     const double tol = opt_.newton.tolerance;
     const Eigen::VectorXd& rs = model_.tolerance_scales().row_scale;
     const std::vector<Index>& kept = model_.solve_rows();
-    auto holds = [&](Index i) { return detail::row_within(model_, i, std::fabs(ws_->phi(i)) / rs(i), tol, ws_->q, t1); };
+    auto holds = [&](Index i) {
+      return detail::row_within(model_, i, std::fabs(ws_->phi(i)) / rs(i), tol, ws_->q, t1);
+    };
     ws_->q = current_.q;
     Eigen::VectorXd rhs(static_cast<Index>(kept.size())), step(model_.num_coordinates());
     bool kept_hold = false;
@@ -515,14 +517,14 @@ class Sweeper {
     // unless the sub-steps avoid it, so all statuses are retried.
     if (depth >= opt_.max_subdivisions) {
       const std::string why = ps.message;
+      const std::string beyond = "no assembly beyond t = " + format_time(current_.t) + " (sub-steps down to t = " +
+                                 format_time(t1) + " tried";
       if (const std::string conflict = conflicting_redundancy(t1); !conflict.empty())
-        return fail(SolveStatus::kInconsistent, "no assembly beyond t = " + format_time(current_.t) + " (sub-steps down to t = " +
-                                                    format_time(t1) + " tried): " + conflict);
+        return fail(SolveStatus::kInconsistent, beyond + "): " + conflict);
       const std::string dead = dead_point(t1);
       // (a derivative that does not exist says so itself: no guess at another cause)
       const bool no_derivative = st == SolveStatus::kNonFinite && why.rfind(detail::kNonFiniteJacobian, 0) == 0;
-      return fail(st, "no assembly beyond t = " + format_time(current_.t) + " (sub-steps down to t = " + format_time(t1) +
-                          " tried" +
+      return fail(st, beyond +
                           (no_derivative   ? "): "
                            : dead.empty() ? ": the drive leaves the reachable range, or the mechanism "
                                             "passes a singular position): "
