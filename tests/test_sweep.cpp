@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <thread>
+#include <tuple>
 
 #include <tbb/info.h>
 
@@ -51,6 +52,25 @@ TEST(Sweep, DriveBeyondTheReachableRangeStopsWithADiagnosis) {
   EXPECT_NE(sum.message.find("t = "), std::string::npos) << sum.message;
   // the diagnosis names constraints
   EXPECT_NE(sum.message.find("'"), std::string::npos) << sum.message;
+}
+
+TEST(Sweep, ALawNotDefinedAheadStopsNamingTheDriver) {
+  // A slider driven by x = √(1 − t) (undefined beyond t = 1) and by x = exp(t) (beyond the largest double past
+  // t = 709.78): the sweep stops at the last time it can reach, naming the driver whose law is not defined, not
+  // "a dead point" or "the drive leaves the reachable range" (what the failure was reported as).
+  for (const auto& [law, t_end, t_star] : {std::tuple{"sqrt(1 - t)", 2.0, 1.0}, std::tuple{"exp(t)", 720.0, 709.78}}) {
+    const Scene sc = parse_scene(std::string("coordinates: {x: 1}\ndrivers:\n  - {name: push, coordinate: x, law: "
+                                             "{type: expression, f: \"") + law + "\"}}\ntime: {start: 0, end: " +
+                                     std::to_string(t_end) + ", steps: 4}\n",
+                                 "law.yaml");
+    Workspace ws(*sc.model);
+    SweepSummary sum;
+    EXPECT_EQ(run_sweep(*sc.model, sc.sweep, ws, nullptr, &sum), SolveStatus::kNonFinite) << law;
+    EXPECT_HAS(sum.message, "'push' is not finite at t = ");
+    EXPECT_HAS(sum.message, "(its law or equation is not defined there, or overflows)");
+    EXPECT_EQ(sum.message.find("dead point"), std::string::npos) << sum.message;
+    EXPECT_GT(sum.failed_time, t_star) << sum.message;
+  }
 }
 
 TEST(Sweep, TableOutsideItsRangeIsRefusedBeforeSolving) {

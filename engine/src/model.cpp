@@ -278,6 +278,12 @@ double initial_length(const Point2& a, const Point2& b, const Eigen::VectorXd& q
 void require(bool ok, const std::string& what) {
   if (!ok) throw Error(what);
 }
+// Two points made of constants only that are the same point: a segment or line between them has no direction
+// anywhere, so a constraint on it holds for no position or for all (points that move may meet at a placement).
+bool same_fixed_point(const Point2& a, const Point2& b) {
+  return !a.x.is_coordinate() && !a.y.is_coordinate() && !b.x.is_coordinate() && !b.y.is_coordinate() &&
+         a.x.value() == b.x.value() && a.y.value() == b.y.value();
+}
 }  // namespace
 
 // Kind-specific checks and set-up done once at add time (scales from the initial placement, normalised axes).
@@ -292,11 +298,14 @@ void ModelBuilder::prepare(PinSpec& s) const {
           "pin: attachment point is not finite");
 }
 void ModelBuilder::prepare(PointOnLineSpec& s) const {
+  require(!same_fixed_point(s.a, s.b), "point_on_line: the line's two points are the same fixed point");
   double l = initial_length(s.a, s.b, model_.initial_);
   s.ref = (std::isfinite(l) && l > 0.0) ? l : 1.0;
 }
 void ModelBuilder::prepare(ConstantAngleSpec& s) const {
   require(std::isfinite(s.angle), "constant_angle: angle is not finite");
+  require(!same_fixed_point(s.a, s.b) && !same_fixed_point(s.c, s.d),
+          "constant_angle: a segment's two ends are the same fixed point");
   double lu = initial_length(s.a, s.b, model_.initial_), lv = initial_length(s.c, s.d, model_.initial_);
   s.ref = (lu > 0.0 && lv > 0.0 && std::isfinite(lu * lv)) ? lu * lv : 1.0;
 }

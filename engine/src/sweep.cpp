@@ -387,6 +387,19 @@ class Sweeper {
     return true;
   }
 
+  // Why the sweep cannot go on towards t1, when a driver's law or a rheonomic equation is not defined there
+  // (√(1 − t) beyond t = 1, exp(t) past the largest double): at the last converged position, whose rows were all
+  // finite, only rows that depend on t can turn non-finite at t1; the first is named. "" otherwise (ws.phi is
+  // scratch).
+  std::string undefined_at(double t1) {
+    model_.residual(current_.q.data(), t1, ws_->phi.data());
+    for (Index i = 0; i < ws_->phi.size(); ++i)
+      if (!std::isfinite(ws_->phi(i)))
+        return "'" + model_.row_name(i) + "' is not finite at t = " + format_time(t1) +
+               " (its law or equation is not defined there, or overflows)";
+    return "";
+  }
+
   // Why the sweep cannot go on towards t1, when it is redundant equations that stop holding: the model is solved on
   // its independent rows (Model::without_rows), chosen where it was assembled, and the rows left out, consistent
   // there, are checked at every step. Two drivers of one coordinate at different rates, or two joint drivers of
@@ -519,6 +532,8 @@ class Sweeper {
       const std::string why = ps.message;
       const std::string beyond = "no assembly beyond t = " + format_time(current_.t) + " (sub-steps down to t = " +
                                  format_time(t1) + " tried";
+      if (const std::string undefined = undefined_at(t1); !undefined.empty())
+        return fail(SolveStatus::kNonFinite, beyond + "): " + undefined);
       if (const std::string conflict = conflicting_redundancy(t1); !conflict.empty())
         return fail(SolveStatus::kInconsistent, beyond + "): " + conflict);
       const std::string dead = dead_point(t1);
