@@ -198,6 +198,9 @@ output: {velocities: true, accelerations: true}
 TEST(Scene3d, BadInputIsOneLineNamingTheField) {
   EXPECT_HAS(error_of(variant("axis: [0, 0, 1]}", "axis: [0, 0, 0]}")), "between[0].axis: must not be the zero vector");
   EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: dor, at: [0, 0, h]}")), "unknown body 'dor'");
+  // all-zero Euler parameters are no orientation: refused at the body, not "Gauss-Newton step is not finite"
+  EXPECT_HAS(error_of(variant("e0: 1,", "e0: 0,")),
+             "bad.yaml:6:9: bodies.door: body 'door': its Euler parameters are all 0 in the placement");
   EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: door, at: [0, h]}")),
              "between[1].at: expected a list of 3 numbers");
   EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: door, ref: [0, 0, 3]}")),

@@ -369,6 +369,16 @@ Index ModelBuilder::add_body(const std::string& name, const Frame2& f) {
 
 Index ModelBuilder::add_body(const std::string& name, const Frame3& f) {
   check_body(name, {f.x, f.y, f.z, f.e0, f.e1, f.e2, f.e3});
+  // Euler parameters all 0 at the placement are no orientation: the normalisation's gradient 2e vanishes there,
+  // and the assembly could only fail ("Gauss-Newton step is not finite").
+  double norm2 = 0.0;
+  for (const Slot& e : {f.e0, f.e1, f.e2, f.e3}) {
+    const double v = e.is_coordinate() ? model_.initial_(e.coord()) : e.value();
+    norm2 += v * v;
+  }
+  if (!(norm2 > 0.0))
+    throw Error("body '" + name + "': its Euler parameters are all 0 in the placement, which is no orientation "
+                "(1, 0, 0, 0 is the body unturned)");
   if (f.e0.is_coordinate() || f.e1.is_coordinate() || f.e2.is_coordinate() || f.e3.is_coordinate())
     add(name + ".euler", EulerParametersSpec{{f.e0, f.e1, f.e2, f.e3}});
   model_.body_names_.push_back(name);

@@ -381,7 +381,9 @@ class ModelBuilder {
   Index add_body(const std::string& name, const Frame2& frame);
   /// Records a spatial rigid body (position and Euler parameters) for the Grübler–Kutzbach count and adds its
   /// normalisation constraint (EulerParametersSpec) named `name.euler` when any Euler parameter is a coordinate.
-  /// Returns its index among the bodies. Throws phiq::Error as the planar overload.
+  /// Returns its index among the bodies. Throws phiq::Error as the planar overload, and when the Euler parameters'
+  /// values (initial guesses as they are now, and constants) are all 0: no orientation. Pre-condition: their
+  /// initial guesses are set (add_coordinate, set_initial) before the body is added.
   Index add_body(const std::string& name, const Frame3& frame);
   /// Adds the unit-norm constraint of a natural unit vector (UnitVectorSpec), named `name.unit`. Returns the
   /// constraint's index.
