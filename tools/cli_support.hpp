@@ -61,7 +61,6 @@ class OutputSet {
 
  private:
   std::vector<std::unique_ptr<AtomicOutputFile>> files_;
-  bool committed_ = false;
 };
 
 // An output path of the command line with what it is ("-o", "--summary", "the scene").

@@ -422,6 +422,9 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
   const bool ok = as.status == phiq::SolveStatus::kSuccess;
   const bool analysed = as.rank.coordinates == model.num_coordinates() && as.status != phiq::SolveStatus::kOutsideTimeDomain;
   const phiq::RankReport& rk = as.rank;
+  // inconsistent names its conflicts; not consistent without any is "not known" (the independent equations
+  // themselves do not hold: AssemblySummary::consistent)
+  const bool consistency_known = as.consistent || !as.conflicts.empty();
 
   if (json) {
     // `phiq check --json`, format version 1 (tools/README.md): one object on standard output.
@@ -463,9 +466,7 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
       j["redundant_rows"].push_back({{"constraint", model.constraints()[model.constraint_of_row(r)].name},
                                      {"row", r},
                                      {"name", model.row_name(r)}});
-    // null: not known (the independent equations themselves do not hold)
-    j["consistent"] = as.consistent || !as.conflicts.empty() ? nlohmann::ordered_json(as.consistent)
-                                                              : nlohmann::ordered_json();
+    j["consistent"] = consistency_known ? nlohmann::ordered_json(as.consistent) : nlohmann::ordered_json();
     j["conflicts"] = as.conflicts;
     j["rank_tolerance"] = rk.tolerance;
     j["rank_uncertain"] = rk.uncertain;
@@ -496,9 +497,9 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
             << "grubler       " << (rk.grubler ? std::to_string(*rk.grubler) : std::string("not defined")) << "\n"
             << "redundant     " << (rk.redundant.empty() ? "none" : joined(rk.redundant)) << "\n"
             << "consistent    "
-            << (as.consistent ? "yes"
-                : as.conflicts.empty() ? "not known: the independent equations do not hold"
-                                       : "no: conflicting " + joined(as.conflicts))
+            << (!consistency_known ? "not known: the independent equations do not hold"
+                : as.consistent     ? "yes"
+                                    : "no: conflicting " + joined(as.conflicts))
             << "\n";
   if (rk.uncertain) std::cout << "uncertain     " << rk.message << "\n";
   if (!ok) std::cout << "diagnosis     " << as.message << "\n";

@@ -257,7 +257,7 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
   // is refused with prepare_scene()'s reason.
   SquareScene square;
   if (prepare_scene(*scene.model, so.t_begin, so.assembly, &square) != SolveStatus::kSuccess)
-    throw std::runtime_error("t = " + short_num(so.t_begin, 17) + ": " + square.assembly.message);
+    throw std::runtime_error("t = " + format_time(so.t_begin) + ": " + square.assembly.message);
   const Model& model = square.model(*scene.model);
   AccuracyReport rep;
   rep.scene_path = scene.path;
@@ -297,7 +297,7 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
     if (solve_position(model, so.t_begin, a, ws0, &ps) != SolveStatus::kSuccess) {
       ws0.q = square.start;
       if (solve_position(model, so.t_begin, so.assembly, ws0, &ps) != SolveStatus::kSuccess)
-        throw std::runtime_error("assembly at t = " + short_num(so.t_begin, 17) + " failed: " + ps.message);
+        throw std::runtime_error("assembly at t = " + format_time(so.t_begin) + " failed: " + ps.message);
     }
   }
   const Eigen::VectorXd start = ws0.q;

@@ -224,12 +224,11 @@ class KluNumeric final : public SparseLuNumeric {
   // falls below this fraction of the one measured right after pivoting, the pivots have degraded (the matrix moved
   // far from the one they were chosen for) and the matrix is factorised again with a pivot search.
   static constexpr double kDegradation = 1e-3;
-  // Nor is a refactorisation whose ratio falls below this, and tenfold below the one right after pivoting (not at
-  // every small drift of a ratio that is low by nature: a chain of 10⁶ loops has 2.5e-7 at any angle), taken as
-  // it is:
-  // a pivot search may have been made where the matrix was poor (KLU prefers diagonal pivots down to 1e-3 of their
-  // column), and the old order then lets a pivot run to zero that the matrix does not need — a body's Euler
-  // parameter crossing zero gave 5e-9 where a pivot search gives 0.49 — and the sweep would report a
+  // Nor is a refactorisation taken as it is when its ratio falls below this and tenfold below the one right after
+  // pivoting (tenfold: not at every small drift of a ratio that is low by nature, 2.5e-7 at any angle for a chain of
+  // 10⁶ loops). A pivot search may have been made where the matrix was poor (KLU keeps diagonal pivots down to 1e-3
+  // of their column), and the old order then lets a pivot run to zero that the matrix does not need — a body's
+  // Euler parameter crossing zero gave 5e-9 where a pivot search gives 0.49 — and the sweep would report a
   // near-singular position (its warning is at 1e-7) that is not there. Below it a pivot search measures again;
   // where the matrix really is that close to singular, the search's own ratio becomes the new reference.
   static constexpr double kCheckedBelow = 1e-6;

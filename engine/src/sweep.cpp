@@ -593,8 +593,13 @@ class Sweeper {
     if (ws_->counters.factorizations != factorizations_seen_)  // this step's solves factorised
       factorizations_seen_ = ws_->counters.factorizations, factorized_step_t_ = t;
     current_sign_ = sign;
-    current_row_sign_ = row_sign();
-    current_row_sign_t_ = row_sign_time(t);
+    // the row's sign: the one at the solution, else (positions only) that of the last factorisation this sweeper
+    // made, at an iterate a few steps back on its own path, so that a change is seen a row or two late rather than
+    // not at all, with the time of the step that made it; never that of a factorisation the workspace held before
+    // (another chunk's, or another sweep's: the sign of another place)
+    const bool own = ws_->counters.factorizations != factorizations_before_;
+    current_row_sign_ = sign != kSignUnknown || !own ? sign : ws_->lu->determinant_sign();
+    current_row_sign_t_ = sign != kSignUnknown ? t : factorized_step_t_;
     remember(t);
     return true;
   }
@@ -607,18 +612,6 @@ class Sweeper {
     const bool at_solution = (need_v_ && !position_only_) || ws_->factorized_at_solution;
     return at_solution ? ws_->lu->determinant_sign() : kSignUnknown;
   }
-  // The sign a delivered row reports: sign_at_solution(), else (positions only) that of the last factorisation
-  // this sweeper made, at an iterate a few steps back on its own path, so that a change is seen a row or two late
-  // rather than not at all; never that of a factorisation the workspace held before (another chunk's, or another
-  // sweep's: the sign of another place).
-  int row_sign() const {
-    const int exact = sign_at_solution();
-    if (exact != kSignUnknown || ws_->counters.factorizations == factorizations_before_) return exact;
-    return ws_->lu->determinant_sign();
-  }
-  // Where row_sign() holds: t itself for a sign at the solution, else the time of the step whose solves made the
-  // last factorisation (tracked in converged()).
-  double row_sign_time(double t) const { return sign_at_solution() != kSignUnknown ? t : factorized_step_t_; }
   // Whether the converged ws.q is farther from the prediction than the prediction is from the last state (in
   // tolerance units, beyond a floor of 1000 tolerances): a predictor errs by a higher order of h than the O(h)
   // move, so a correction as large as the move means another solution was found. Runs every drive step: one pass
@@ -882,12 +875,12 @@ class Sweeper {
   bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
   int det_sign_ = 0;                // sign of det Φq at the last delivered row (det_sign())
   int current_sign_ = kSignUnknown;  // and at current_ (sign_at_solution() when it converged)
-  int current_row_sign_ = kSignUnknown;  // what current_'s row reports (row_sign()), and at which time
+  int current_row_sign_ = kSignUnknown;  // what current_'s row reports (converged()), and at which time
   double current_row_sign_t_ = 0.0, det_sign_t_ = 0.0;
-  // The workspace's factorisation count when this sweeper took it: the ones after it are its own (row_sign()).
+  // The workspace's factorisation count when this sweeper took it: the ones after it are its own (converged()).
   Index factorizations_before_ = ws_->counters.factorizations;
   Index factorizations_seen_ = factorizations_before_;  // the count at the last converged state
-  double factorized_step_t_ = 0.0;  // the time of the last step whose solves factorised (row_sign_time())
+  double factorized_step_t_ = 0.0;  // the time of the last step whose solves factorised (converged())
   double rounding_level_ = 0.0;     // see take_rounding_level()
   bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)
   double default_step_ = (opt_.t_end - opt_.t_begin) / static_cast<double>(std::max<Index>(opt_.steps, 1));
