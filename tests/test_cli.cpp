@@ -138,6 +138,28 @@ TEST_F(Cli, BatchSweepsEveryParameterSetInParallel) {
   EXPECT_FALSE(fs::exists(dir_ / "bad"));
 }
 
+// phiq batch holds no descriptor per case between writes: 150 cases under a limit of 64 open files all run, each
+// ending at its own closed form (θ2 = 2π: x_B = L2 + L3).
+TEST_F(Cli, BatchRunsMoreCasesThanTheOpenFileLimit) {
+  std::string text = "L2\n";
+  const int cases = 150;
+  for (int k = 0; k < cases; ++k) text += std::to_string(0.2 + 0.001 * k) + "\n";
+  const fs::path list = write("cases.csv", text);
+  const fs::path out = dir_ / "out";
+  Result r = run_prefixed("ulimit -n 64; ", "batch -q " + phiq::test::model_path("seed/crank_slider_mixed.yaml") + " " +
+                                                list.string() + " -o " + out.string() + " --threads 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  int files = 0;
+  for (auto& e : fs::directory_iterator(out)) files += e.path().extension() == ".csv";
+  EXPECT_EQ(files, cases) << "no temporaries left beside the case files";
+  for (int k = 0; k < cases; ++k) {
+    const phiq::CsvTable t = phiq::read_csv_table((out / ("case" + std::to_string(k) + ".csv")).string());
+    ASSERT_EQ(t.rows.size(), 181u) << k;
+    EXPECT_NEAR(t.rows.back()[4], 0.2 + 0.001 * k + 1.0, 1e-9) << k;
+  }
+}
+
 // phiq batch on a redundant scene: each case is assembled and swept on its independent rows, as `phiq run` does
 // (the door on three hinges, the third hinge's ground point moved by a parameter): on the axis, or 1e-12 off it,
 // the door turns about z as driven; 1 cm off, the hinges cannot all hold and that case alone fails, naming hinge3.

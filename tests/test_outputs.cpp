@@ -474,6 +474,31 @@ TEST_F(OutputFile, AppearsWhenCommittedAndNotOtherwise) {
   EXPECT_EQ(names(dir_), std::vector<std::string>{"a.csv"});
 }
 
+// Hold::kClosedBetweenWrites: the temporary exists from the start, each write appends to it, and it is committed or
+// removed as a held-open one is; a direct target (here /dev/null) is held open as ever.
+TEST_F(OutputFile, AFileClosedBetweenWritesAppendsAndCommitsAsAnOpenOne) {
+  using Hold = AtomicOutputFile::Hold;
+  const auto p = dir_ / "a.csv";
+  {
+    AtomicOutputFile f(p.string(), Hold::kClosedBetweenWrites);
+    EXPECT_EQ(names(dir_).size(), 1u);  // created at once
+    f.write("dropped");
+  }
+  EXPECT_TRUE(names(dir_).empty());
+  AtomicOutputFile f(p.string(), Hold::kClosedBetweenWrites);
+  f.write("t,x\n");
+  f.write("");
+  f.write("0,1\n");
+  EXPECT_EQ(read(f.temporary_path()), "t,x\n0,1\n");  // on disk between writes
+  f.commit();
+  EXPECT_EQ(read(p), "t,x\n0,1\n");
+  EXPECT_THROW(f.write("late"), Error);
+  AtomicOutputFile null("/dev/null", Hold::kClosedBetweenWrites);
+  EXPECT_TRUE(null.direct());
+  null.write("x");
+  null.commit();
+}
+
 // A chain of relative links into another directory: the last target is replaced, the temporary made beside it, the
 // links stay.
 TEST_F(OutputFile, SymbolicLinksAreFollowedToTheirTarget) {

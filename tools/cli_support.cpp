@@ -111,14 +111,14 @@ OutputSet::~OutputSet() {
   files_.clear();  // removes the temporaries not published
 }
 
-AtomicOutputFile& OutputSet::add(const std::string& path) {
+AtomicOutputFile& OutputSet::add(const std::string& path, AtomicOutputFile::Hold hold) {
   if (resolve_output_path(path).direct) {
     // no temporary to remove on a signal; a FIFO may wait here for its reader, which a signal must interrupt
     files_.push_back(std::make_unique<AtomicOutputFile>(path));
     return *files_.back();
   }
   std::lock_guard<std::mutex> lock(g_mutex);
-  files_.push_back(std::make_unique<AtomicOutputFile>(path));
+  files_.push_back(std::make_unique<AtomicOutputFile>(path, hold));
   g_live.push_back(files_.back().get());
   return *files_.back();
 }

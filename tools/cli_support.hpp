@@ -51,7 +51,7 @@ class OutputSet {
 
   // Creates the output at `path` now (AtomicOutputFile: a temporary in its target's directory, or a device / FIFO
   // opened in place). Throws phiq::Error "PATH: cannot write: REASON".
-  AtomicOutputFile& add(const std::string& path);
+  AtomicOutputFile& add(const std::string& path, AtomicOutputFile::Hold hold = AtomicOutputFile::Hold::kOpen);
   // Finishes every file (flush, fsync), then renames them all onto their targets; no file is renamed unless every
   // one was written. Afterwards signals exit quietly. Throws phiq::Error (the set's temporaries are then removed).
   void commit();

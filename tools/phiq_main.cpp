@@ -317,11 +317,12 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   std::vector<phiq::CsvFormat> formats;
   std::vector<std::string> buffers(scenes.size());
   // every case's file exists (as a temporary) before the work; those of the cases that succeed are renamed at the
-  // end, the others removed
+  // end, the others removed. They are closed between writes: a batch of 10 000 cases holds no 10 000 descriptors.
   OutputSet outputs;
   std::vector<phiq::AtomicOutputFile*> files(scenes.size());
   try {
-    for (std::size_t k = 0; k < scenes.size(); ++k) files[k] = &outputs.add(case_file(k));
+    for (std::size_t k = 0; k < scenes.size(); ++k)
+      files[k] = &outputs.add(case_file(k), phiq::AtomicOutputFile::Hold::kClosedBetweenWrites);
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
   }

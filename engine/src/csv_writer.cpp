@@ -264,7 +264,7 @@ bool same_file(const std::string& a, const std::string& b) {
   }
 }
 
-AtomicOutputFile::AtomicOutputFile(std::string path) : path_(std::move(path)) {
+AtomicOutputFile::AtomicOutputFile(std::string path, Hold hold) : path_(std::move(path)) {
   const OutputPath where = resolve_output_path(path_);
   target_ = where.target;
   direct_ = where.direct;
@@ -291,6 +291,22 @@ AtomicOutputFile::AtomicOutputFile(std::string path) : path_(std::move(path)) {
     tmp_.clear();
     throw Error(cannot_write(shown, std::strerror(err)));
   }
+  if (hold == Hold::kClosedBetweenWrites && !direct_) {
+    closed_between_writes_ = true;
+    std::fclose(f_);  // nothing written yet: nothing to lose
+    f_ = nullptr;
+  }
+}
+
+void AtomicOutputFile::reopen() {
+  const int fd = ::open(tmp_.c_str(), O_WRONLY | O_APPEND | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) throw Error(cannot_write(path_, std::strerror(errno)));
+  f_ = ::fdopen(fd, "ab");
+  if (!f_) {
+    const int err = errno;
+    ::close(fd);
+    throw Error(cannot_write(path_, std::strerror(err)));
+  }
 }
 
 AtomicOutputFile::~AtomicOutputFile() {
@@ -299,13 +315,23 @@ AtomicOutputFile::~AtomicOutputFile() {
 }
 
 void AtomicOutputFile::write(const std::string& data) {
-  if (!f_) throw Error(path_ + ": cannot write: already closed");
+  if (finished_ || (!f_ && !closed_between_writes_)) throw Error(path_ + ": cannot write: already closed");
+  if (closed_between_writes_) {
+    reopen();
+    bool ok = std::fwrite(data.data(), 1, data.size(), f_) == data.size() && std::fflush(f_) == 0;
+    int err = ok ? 0 : errno;
+    if (std::fclose(f_) != 0 && ok) ok = false, err = errno;
+    f_ = nullptr;
+    if (!ok) throw Error(cannot_write(path_, std::strerror(err)));
+    return;
+  }
   if (std::fwrite(data.data(), 1, data.size(), f_) != data.size())
     throw Error(cannot_write(path_, std::strerror(errno)));
 }
 
 void AtomicOutputFile::finish() {
-  if (!f_) throw Error(path_ + ": cannot write: already closed");
+  if (finished_ || (!f_ && !closed_between_writes_)) throw Error(path_ + ": cannot write: already closed");
+  if (!f_) reopen();  // closed between writes: open once more to sync it
   bool ok = std::fflush(f_) == 0 && !std::ferror(f_);
   int err = errno;
   // a temporary goes to disk before it is renamed; a device or FIFO has nothing to sync (fsync: EINVAL)

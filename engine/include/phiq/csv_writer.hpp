@@ -72,9 +72,13 @@ bool same_file(const std::string& a, const std::string& b);
 /// opened at once and written in place instead: no temporary, no rename (`-o /dev/null` stays a device).
 class AtomicOutputFile {
  public:
+  /// How a temporary is held between writes. kClosedBetweenWrites closes it once created and opens it again (to
+  /// append) for each write() and for finish(): a command with thousands of outputs (`phiq batch`, one per case)
+  /// then holds no descriptor per output, and cannot run out of them. A direct target is always held open.
+  enum class Hold { kOpen, kClosedBetweenWrites };
   /// Creates the temporary (or opens the direct target; a FIFO waits here for its reader). Throws phiq::Error
   /// "PATH: cannot write: REASON" if it cannot (resolve_output_path's errors included).
-  explicit AtomicOutputFile(std::string path);
+  explicit AtomicOutputFile(std::string path, Hold hold = Hold::kOpen);
   ~AtomicOutputFile();
   AtomicOutputFile(const AtomicOutputFile&) = delete;
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
@@ -95,8 +99,11 @@ class AtomicOutputFile {
 
  private:
   std::string path_, target_, tmp_;
+  // Opens the closed temporary again to append to it (Hold::kClosedBetweenWrites); throws phiq::Error.
+  void reopen();
   std::FILE* f_ = nullptr;
   bool direct_ = false, finished_ = false, committed_ = false;
+  bool closed_between_writes_ = false;
 };
 
 }  // namespace phiq
