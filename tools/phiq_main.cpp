@@ -350,14 +350,19 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     sum = phiq::run_batch(models, sweeps, threads, [&](std::size_t c, const phiq::StepView& step) {
       const std::size_t k = swept[c];
       formats[k].append_row(step, buffers[k]);
-      if (buffers[k].size() > (1u << 20)) {
+      // written every 1 MB and at the case's last row: a finished case holds no rows in memory while others run
+      const bool last = step.step == sweeps[c].steps;
+      if (buffers[k].size() > (1u << 20) || last) {
         try {
           files[k]->write(buffers[k]);
         } catch (const phiq::Error& e) {
           write_errors[k] = e.what();
           return false;
         }
-        buffers[k].clear();
+        if (last)
+          std::string().swap(buffers[k]);
+        else
+          buffers[k].clear();
       }
       return !stop.load();
     }, &starts);
