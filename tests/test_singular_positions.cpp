@@ -200,5 +200,65 @@ TEST(SingularPositions, ARockerDrivenBeyondItsRangeStopsAtTheDeadPointAndNamesIt
   EXPECT_EQ(sum.message.find('\n'), std::string::npos);
 }
 
+// A crank driven exactly onto its dead point (a = 2, b = 1, c = 1.5, d = 2: coupler and rocker align when
+// |A C| = b + c, cos θ* = 7/32). Newton reaches that row only linearly, to within √tol of it, where rcond is 4e-7
+// (far above the singular threshold) and the LU's q̇ is its position error amplified (|ẋ_B| = 5e6 was reported as a
+// success). Now the row is examined as a singular position: no position beyond it, so the sweep stops there naming
+// the dead point. Ending the range 1e-4 before it, the last row's speed (large, finite) matches the closed form.
+std::string dead_point_scene(const std::string& end) {
+  return "phiq: 1\n"
+         "parameters: {a: 2.0, b: 1.0, c: 1.5, d: 2.0}\n"
+         "coordinates: {theta: 0.5, xA: 1.75, yA: 0.96, xB: 2.5, yB: 1.4}\n"
+         "points: {O: [0, 0], C: [d, 0], A: [xA, yA], B: [xB, yB]}\n"
+         "constraints:\n"
+         "  - {name: crank, type: polar, point: A, origin: O, length: a, angle: theta}\n"
+         "  - {name: coupler, type: distance, points: [A, B], length: b}\n"
+         "  - {name: rocker, type: distance, points: [C, B], length: c}\n"
+         "drivers:\n"
+         "  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.5, rate: 1}}\n"
+         "time: {start: 0, end: " + end + ", steps: 20}\n"
+         "output: {velocities: true, accelerations: true}\n";
+}
+
+// B of the four-bar above at crank angle θ (the branch with B left of the line A → C).
+Eigen::Vector2d dead_point_b(double th) {
+  const Eigen::Vector2d a(2 * std::cos(th), 2 * std::sin(th)), u = Eigen::Vector2d(2, 0) - a;
+  const double l = u.norm(), x = (1.0 - 2.25 + l * l) / (2 * l), h = std::sqrt(std::max(0.0, 1.0 - x * x));
+  return a + (x / l) * u + (h / l) * Eigen::Vector2d(-u.y(), u.x());
+}
+
+TEST(SingularPositions, ARowLandingOnADeadPointStopsThereInsteadOfReportingASpeed) {
+  const double t_star = std::acos(7.0 / 32.0) - 0.5;
+  for (const bool exact_end : {true, false}) {
+    const Scene scene = parse_scene(dead_point_scene(exact_end ? "acos(7/32) - 0.5" : "acos(7/32) - 0.5 - 1e-4"),
+                                    "dead.yaml");
+    test::Trace tr;
+    SweepSummary sum;
+    const SolveStatus st = test::sweep(*scene.model, scene.sweep, &tr, &sum);
+    const Index xb = scene.model->coordinate_index("xB"), yb = scene.model->coordinate_index("yB");
+    for (std::size_t k = 0; k < tr.t.size(); ++k) {  // every delivered row on the closed form
+      const double th = 0.5 + tr.t[k], h = 1e-8;  // truncation ~h²/(t* − t)² of the speed
+      const Eigen::Vector2d b = dead_point_b(th), v = (dead_point_b(th + h) - dead_point_b(th - h)) / (2 * h);
+      EXPECT_NEAR(tr.q[k](xb), b.x(), 1e-9) << "row " << k;
+      EXPECT_NEAR(tr.q[k](yb), b.y(), 1e-9) << "row " << k;
+      EXPECT_NEAR(tr.qd[k](xb), v.x(), 1e-6 * v.norm()) << "row " << k;
+      EXPECT_NEAR(tr.qd[k](yb), v.y(), 1e-6 * v.norm()) << "row " << k;
+    }
+    if (exact_end) {
+      ASSERT_EQ(st, SolveStatus::kSingularJacobian) << sum.message;
+      EXPECT_EQ(tr.t.size(), 20u);  // rows 0 … 19 delivered, the dead point's row refused
+      EXPECT_NEAR(sum.failed_time, t_star, 1e-15);
+      EXPECT_HAS(sum.message, "a dead point: the drive cannot go on, and the speed it asks for there is unbounded");
+      EXPECT_HAS(sum.message, "'rocker'");
+      EXPECT_HAS(sum.message, "'coupler'");
+      EXPECT_EQ(sum.message.find('\n'), std::string::npos);
+    } else {
+      ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
+      ASSERT_EQ(tr.t.size(), 21u);
+      EXPECT_GT(tr.qd.back().norm(), 50.0);  // 1e-4 from the dead point: fast, and still exact
+    }
+  }
+}
+
 }  // namespace
 }  // namespace phiq

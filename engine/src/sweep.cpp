@@ -141,14 +141,23 @@ class Sweeper {
   // singular position crossed) or goes (another branch reached): see advance().
   static constexpr int kBranchCheckDepth = 2;
 
+  // Below this rcond, a position Newton reached only linearly (`linear` in derivatives()) is taken as singular.
+  static constexpr double kLinearSingularRcond = 1e-4;
+
   // Derivatives at the converged ws.q, as asked for. Returns false (summary filled) on failure. At a singular
-  // position they are not unique: see singular_point().
-  bool derivatives(double t) {
+  // position they are not unique: see singular_point(). `linear`: Newton converged only linearly to ws.q (its full
+  // steps contracting by ½ or worse), the mark of a singular Φq at the solution. It then stopped within the
+  // tolerance of Φ but only about √tol from the singular position itself (Φ is quadratic along the direction Φq
+  // loses), so rcond stays near √tol, far above kSingularRcond, while q̇ from that Φq is dominated by the position's
+  // error: a row landing on a dead point (a drive range ending where coupler and rocker align) gave |q̇| = 5e6 with
+  // the exact speed unbounded. Such a row, when Φq is also ill-conditioned, is examined as a singular one.
+  bool derivatives(double t, bool linear = false) {
     if (!need_v_) return true;
     LinearSummary ls;
     const SolveStatus st = lu_derivatives(t, need_a_, &ls);
-    if (!bracketing_ && ws_->lu && (st == SolveStatus::kSingularJacobian ||
-                                  (st == SolveStatus::kSuccess && ls.rcond < kSingularRcond)))
+    if (!bracketing_ && ws_->lu &&
+        (st == SolveStatus::kSingularJacobian ||
+         (st == SolveStatus::kSuccess && (ls.rcond < kSingularRcond || (linear && ls.rcond < kLinearSingularRcond)))))
       return singular_point(t, ls.rcond);
     if (st != SolveStatus::kSuccess) return fail(st, ls.message);
     note_condition(t, ls.rcond);
@@ -289,6 +298,8 @@ class Sweeper {
       ~Guard() { b = false; }
     } guard{bracketing_ = true};
     const Eigen::VectorXd qs = ws_->q;
+    // named now, from Φq factorised at the singular position itself, in case it is a dead point
+    const std::string lined_up = ws_->has_factorization ? lined_up_equations() : "";
     double step = has_current_ ? t - current_.t : default_step_;
     if (step == 0.0) step = 1e-3;
     const double d = 0.05 * step;
@@ -340,7 +351,9 @@ class Sweeper {
         std::ostringstream m;
         m << "singular position at t = " << format_time(t) << " (Φq rcond " << rc << "): ";
         if (k >= 2 && st != SolveStatus::kSuccess)
-          m << "no position beyond it on this branch (a dead point: the drive cannot go on)";
+          m << "no position beyond it on this branch (a dead point: the drive cannot go on, and the speed it asks "
+               "for there is unbounded)"
+            << (lined_up.empty() ? "" : ", where these equations line up:" + lined_up);
         else if (st == SolveStatus::kSuccess)
           m << "Φq stays singular around it (rcond " << ls.rcond << " at t = " << format_time(ts)
             << "): redundant or missing constraints";
@@ -458,6 +471,19 @@ class Sweeper {
     const double tau = va != 0.0 ? vv / (2.0 * va) : 0.0;  // t* − t, signed like the drive direction
     if (!(std::isfinite(tau) && tau * (t1 - current_.t) > 0 && std::fabs(tau) <= 2.0 * std::fabs(t1 - current_.t)))
       return "";
+    const std::string lined_up = lined_up_equations();
+    if (lined_up.empty()) return "";
+    std::ostringstream s;
+    s.precision(6);
+    s << "a dead point near t = " << current_.t + tau << " (the drive asks for positions that do not exist; Φq rcond "
+      << std::setprecision(2) << ls.rcond << " at t = " << std::setprecision(10) << current_.t
+      << ", speed growing as 1/√(t* − t)), where these equations line up:" << lined_up;
+    return s.str();
+  }
+
+  // " 'crank', 'coupler'": the equations in the support of the left near-null vector of the near-singular Φq
+  // factorised in ws.lu (inverse iteration on Φqᵀ, 4 solves), up to 8 named; "" when a solve fails.
+  std::string lined_up_equations() {
     const Index m = model_.num_solve_rows();
     Eigen::VectorXd y = Eigen::VectorXd::Ones(m), z(m);
     for (int it = 0; it < 4; ++it) {
@@ -472,10 +498,6 @@ class Sweeper {
       if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
     }
     std::ostringstream s;
-    s.precision(6);
-    s << "a dead point near t = " << current_.t + tau << " (the drive asks for positions that do not exist; Φq rcond "
-      << std::setprecision(2) << ls.rcond << " at t = " << std::setprecision(10) << current_.t
-      << ", speed growing as 1/√(t* − t)), where these equations line up:";
     for (std::size_t k = 0; k < names.size() && k < 8; ++k) s << (k ? ", '" : " '") << names[k] << "'";
     if (names.size() > 8) s << " and " << names.size() - 8 << " more";
     return s.str();
@@ -579,7 +601,7 @@ class Sweeper {
       if (!has_current_) m << " (the sweep starts here: the branch is the one nearest the placement)";
       sum_.warnings.push_back({t, "bifurcation", m.str()});
     }
-    if (!position_only_ && !derivatives(t)) return false;
+    if (!position_only_ && !derivatives(t, ps.slow_convergence && ps.rounding_level == 0.0)) return false;
     const int sign = sign_at_solution();
     if (left_branch && has_current_ && (sign == 1 || sign == -1) && (current_sign_ == 1 || current_sign_ == -1) &&
         sign != current_sign_) {
