@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -153,6 +154,62 @@ TEST(LinearSolver, KluChecksALowPivotRatioWithAPivotSearchBeforeReportingIt) {
   ASSERT_EQ(n->factorize(d.data()), FactorStatus::kOk);
   EXPECT_EQ(n->pivoting_factorizations(), searches);
   EXPECT_LT(n->rcond(), 1e-6);
+}
+
+// KLU factorises a block triangular form block by block; block_signs() tells the signs of the blocks'
+// determinants apart where det A's sign cannot: two blocks turning negative at once leave det A's sign as it was.
+// Three 2 × 2 blocks [[a, 1], [1, d]] coupled above the diagonal, rows and columns scrambled. The fingerprint must
+// depend on the blocks' signs only, not on the pivots chosen (a = d = 1e4 makes KLU pivot on other rows of a
+// block whose sign is the same) nor on the path (a fresh pivot search and a refactorisation
+// of the same values agree).
+TEST(LinearSolver, KluBlockSignsSeeBlocksThatTurnNegativeTogether) {
+  const Index row_of[6] = {3, 0, 5, 1, 4, 2}, col_of[6] = {1, 4, 0, 5, 2, 3};
+  std::vector<Index> r, c;
+  for (Index b = 0; b < 3; ++b)
+    for (Index i = 0; i < 2; ++i)
+      for (Index j = 0; j < 2; ++j) r.push_back(row_of[2 * b + i]), c.push_back(col_of[2 * b + j]);
+  r.push_back(row_of[0]), c.push_back(col_of[2]);  // couplings above the diagonal blocks
+  r.push_back(row_of[2]), c.push_back(col_of[4]);
+  auto p = std::make_shared<CscPattern>();
+  std::vector<Index> slot;
+  *p = build_csc_pattern(6, 6, r, c, &slot);
+  auto sym = analyse(LinearSolverKind::kKlu, p);
+  ASSERT_EQ(detail::describe_klu(*sym).blocks, 3);
+  auto running = sym->make_numeric();
+  // (det sign, block signs), the same from the running object (refactorisation) and a fresh one (pivot search)
+  auto signs = [&](std::array<double, 3> a, std::array<double, 3> d) {
+    std::vector<double> v(static_cast<std::size_t>(p->nnz()), 0.0);
+    std::size_t k = 0;
+    for (int b = 0; b < 3; ++b)
+      for (const double x : {a[b], 1.0, 1.0, d[b]}) v[static_cast<std::size_t>(slot[k++])] += x;
+    v[static_cast<std::size_t>(slot[k++])] += 0.5;
+    v[static_cast<std::size_t>(slot[k++])] += 0.5;
+    auto fresh = sym->make_numeric();
+    EXPECT_EQ(fresh->factorize(v.data()), FactorStatus::kOk);
+    EXPECT_EQ(running->factorize(v.data()), FactorStatus::kOk);
+    EXPECT_EQ(running->determinant_sign(), fresh->determinant_sign());
+    EXPECT_EQ(running->block_signs(), fresh->block_signs());
+    return std::make_pair(fresh->determinant_sign(), fresh->block_signs());
+  };
+  const auto all_positive = signs({2, 2, 2}, {3, 3, 3});             // det 5 each
+  // pivots on the blocks' 1s, except where a = d = 1e4 (the 1s then below 1e-3 of their columns): the same
+  // signs, other pivot rows
+  const auto two_swapped = signs({1e4, 1e4, 2}, {1e4, 1e4, 3});
+  const auto two_negative = signs({1e-4, 1e-4, 2}, {1e-4, 1e-4, 3});  // det −1 in blocks 0 and 1
+  const auto third_negative = signs({2, 2, 0.01}, {3, 3, 0.01});
+  EXPECT_EQ(two_negative.first, all_positive.first);  // det A keeps its sign ...
+  EXPECT_NE(two_negative.second, all_positive.second);  // ... the blocks do not
+  EXPECT_EQ(two_swapped, all_positive);
+  EXPECT_EQ(third_negative.first, -all_positive.first);
+  EXPECT_NE(third_negative.second, two_negative.second);
+  EXPECT_NE(third_negative.second, all_positive.second);
+  EXPECT_EQ(signs({2, 2, 2}, {3, 3, 3}), all_positive);  // back again
+  // a library that factorises A whole has no blocks to tell
+  auto dense = analyse(LinearSolverKind::kUmfpack, p)->make_numeric();
+  std::vector<double> v(static_cast<std::size_t>(p->nnz()), 1.0);
+  for (Index i = 0; i < 6; ++i) v[static_cast<std::size_t>(slot[static_cast<std::size_t>(4 * (i / 2) + 3 * (i % 2))])] = 3.0;
+  ASSERT_EQ(dense->factorize(v.data()), FactorStatus::kOk);
+  EXPECT_EQ(dense->block_signs(), 0u);
 }
 
 TEST(LinearSolver, SingularIsAWarningNotAFailure) {

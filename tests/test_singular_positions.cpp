@@ -84,28 +84,39 @@ TEST(SingularPositions, ParallelSweepsPassThemAsTheSequentialOneDoes) {
   full_turn_in_whole_degrees(10, 2);
 }
 
-// Steps that miss the singular positions: a single loop (N = 1) changes the sign of det Φq at each crossing,
-// which the sweep reports at the first row after it.
+// Steps that miss the singular positions: at each flat position all N loops of nfourbar are singular at once. A
+// single loop (N = 1) changes the sign of det Φq there, which the sweep reports at the first row after it; an even
+// number of loops leaves det Φq's sign as it was, and the crossing is seen in the signs of Φq's diagonal blocks
+// (one per loop in KLU's block triangular form): it used to pass unreported. On 1 and 2 threads alike.
 TEST(SingularPositions, ACrossingBetweenStepsIsReportedByTheSignOfDetPhiQ) {
   const double w = 2 * M_PI, th0 = 0.3;
-  const Model model = test::nfourbar_model(1, th0, w);
-  SweepOptions o;
-  o.t_begin = 0, o.t_end = 1, o.steps = 1000;
-  o.velocities = o.accelerations = true;
-  test::Trace tr;
-  SweepSummary sum;
-  ASSERT_EQ(test::sweep(model, o, &tr, &sum), SolveStatus::kSuccess) << sum.message;
-  const auto bif = of_kind(sum, "bifurcation");
-  ASSERT_EQ(bif.size(), 2u);
-  // θ = π at t = (π − 0.3)/2π = 0.45225…, θ = 2π at t = 0.95225…: reported at the next grid rows
-  EXPECT_DOUBLE_EQ(bif[0].t, 0.453);
-  EXPECT_DOUBLE_EQ(bif[1].t, 0.953);
-  EXPECT_HAS(bif[0].message, "det Φq changed sign between t = 0.452 and t = 0.453");
-  EXPECT_EQ(sum.singular_positions, 0);
-  const auto exact = test::nfourbar_exact(model, th0, w);
-  tools::ClosedFormErrors err(*exact);
-  for (std::size_t k = 0; k < tr.t.size(); ++k) err.add(tr.t[k], tr.q[k].data(), nullptr, nullptr);
-  EXPECT_LT(err.q_error, 1e-8);
+  for (const Index n : {1, 2, 10}) {
+    for (const int threads : {1, 2}) {
+      SCOPED_TRACE("N = " + std::to_string(n) + ", " + std::to_string(threads) + " threads");
+      const Model model = test::nfourbar_model(n, th0, w);
+      SweepOptions o;
+      o.t_begin = 0, o.t_end = 1, o.steps = 1000;
+      o.velocities = o.accelerations = true;
+      o.threads = threads;
+      o.chunk_steps = 64;
+      test::Trace tr;
+      SweepSummary sum;
+      ASSERT_EQ(test::sweep(model, o, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+      const auto bif = of_kind(sum, "bifurcation");
+      ASSERT_EQ(bif.size(), 2u);
+      // θ = π at t = (π − 0.3)/2π = 0.45225…, θ = 2π at t = 0.95225…: reported at the next grid rows
+      EXPECT_DOUBLE_EQ(bif[0].t, 0.453);
+      EXPECT_DOUBLE_EQ(bif[1].t, 0.953);
+      EXPECT_HAS(bif[0].message, n % 2 ? "det Φq changed sign between t = 0.452 and t = 0.453"
+                                       : "det Φq changed sign on an even number of its independent blocks (loops "
+                                         "that Φq factorises one by one) between t = 0.452 and t = 0.453");
+      EXPECT_EQ(sum.singular_positions, 0);
+      const auto exact = test::nfourbar_exact(model, th0, w);
+      tools::ClosedFormErrors err(*exact);
+      for (std::size_t k = 0; k < tr.t.size(); ++k) err.add(tr.t[k], tr.q[k].data(), nullptr, nullptr);
+      EXPECT_LT(err.q_error, 1e-8);
+    }
+  }
 }
 
 // Positions only, the sweep factorises only where Newton needs it (a few rows in a hundred): a crossing is reported

@@ -88,6 +88,47 @@ int permutation_sign(const Int* p, Index n) {
   return sign;
 }
 
+// For each block b of a block triangular form (rows or columns R[b] … R[b+1] − 1), whether the segment
+// p[R[b]] … p[R[b+1] − 1] of a permutation is an odd rearrangement of its entries in increasing order (1) or an
+// even one (0): what turns the determinant of a diagonal block as KLU factorises it into that of the same rows and
+// columns of A in their own order, which does not depend on the pivots chosen. Once per pivot order.
+template <typename Int>
+std::vector<unsigned char> block_parities(const Int* p, const Int* R, Int nb) {
+  std::vector<unsigned char> odd(static_cast<std::size_t>(nb), 0);
+  std::vector<std::pair<Int, Int>> seg;  // (entry, position in the segment)
+  std::vector<char> seen;
+  for (Int b = 0; b < nb; ++b) {
+    const Int lo = R[b], len = R[b + 1] - R[b];
+    if (len < 2) continue;
+    if (len == 2) {
+      odd[static_cast<std::size_t>(b)] = p[lo] > p[lo + 1];
+      continue;
+    }
+    seg.clear();
+    for (Int k = 0; k < len; ++k) seg.emplace_back(p[lo + k], k);
+    std::sort(seg.begin(), seg.end());  // seg[j].second: where the j-th smallest entry sits
+    seen.assign(static_cast<std::size_t>(len), 0);
+    unsigned char parity = 0;
+    for (Int i = 0; i < len; ++i) {
+      if (seen[static_cast<std::size_t>(i)]) continue;
+      Int cycle = 0;
+      for (Int j = i; !seen[static_cast<std::size_t>(j)]; j = seg[static_cast<std::size_t>(j)].second)
+        seen[static_cast<std::size_t>(j)] = 1, ++cycle;
+      parity ^= (cycle % 2 == 0);
+    }
+    odd[static_cast<std::size_t>(b)] = parity;
+  }
+  return odd;
+}
+
+// A 64-bit key per block (two multiplications by odd constants with a xor-shift between: distinct blocks get
+// unrelated keys); block_signs() is the xor of the keys of the blocks whose determinant is negative.
+inline std::uint64_t block_key(std::uint64_t b) {
+  std::uint64_t x = (b + 1) * 0x9E3779B97F4A7C15ull;
+  x ^= x >> 31;
+  return x * 0xBF58476D1CE4E5B9ull;
+}
+
 // Mean |p[k] − p[k−1]|: 1 for the identity or its reverse, about n/3 for a random permutation. How far apart in
 // memory consecutive columns of the factorisation are.
 template <class Int>
@@ -216,6 +257,7 @@ class KluNumeric final : public SparseLuNumeric {
   bool solve_transposed(const double* b, double* x) override { return solve_system(true, b, x); }
   double rcond() const override { return rcond_; }
   int determinant_sign() const override;
+  std::uint64_t block_signs() const override { return block_signs_; }
   std::string last_message() const override { return message_; }
   std::int64_t pivoting_factorizations() const override { return pivoting_; }
   std::size_t memory_bytes() const override { return numeric_ ? common_.mempeak : 0; }  // factorising included
@@ -246,6 +288,11 @@ class KluNumeric final : public SparseLuNumeric {
   std::string message_;
   int p_sign_ = 1;  // parity of the row permutation Pnum of the last pivoting factorisation
   int u_sign_ = 1;  // sign of the product of U's diagonal (0: a zero pivot)
+  // Per block: the parity of the pivot order's rows and the fixed columns (block_parities of Pnum and Q, xor-ed),
+  // of the last pivoting factorisation; empty for a single block (block_signs() is then 0).
+  std::vector<unsigned char> block_parity_;
+  std::uint64_t block_signs_ = 0;  // block_signs() of the last factorisation (scan_diagonal)
+  int negative_parity_offset_ = 0;  // xor of block_parity_: taken out of the blocks' product again for u_sign_
   // The reciprocals of the row scale factors of the last pivoting factorisation, in pivot order (KLU's Rs, the
   // largest |entry| of each row); empty while the factors are of the scaled matrix (right after pivoting), used
   // by scan_diagonal() once refactorisations work on the unscaled one.
@@ -280,6 +327,7 @@ class KluSymbolic final : public KluSymbolicBase, public std::enable_shared_from
     if (!symbolic_) throw Error("KLU symbolic analysis failed (status " + std::to_string(common.status) + ")");
     analysis = resequence_blocks<Int>(ap_, ai_, symbolic_);
     q_sign_ = permutation_sign(symbolic_->Q, p.cols);
+    if (symbolic_->nblocks > 1) q_block_parity_ = block_parities(symbolic_->Q, symbolic_->R, symbolic_->nblocks);
   }
   ~KluSymbolic() override {
     typename Api::Common common;
@@ -299,6 +347,7 @@ class KluSymbolic final : public KluSymbolicBase, public std::enable_shared_from
   Int* ai_ = nullptr;
   typename Api::Symbolic* symbolic_ = nullptr;  // read-only after construction: shared by all numeric objects
   int q_sign_ = 1;                      // parity of the fixed column permutation Q
+  std::vector<unsigned char> q_block_parity_;  // block_parities of Q (empty for a single block)
 };
 
 // P R⁻¹ A Q = L U with L unit lower triangular and R > 0 (KLU's row scaling): sign det A = sign P · sign Q ·
@@ -319,12 +368,31 @@ double KluNumeric<Int>::scan_diagonal() {
   const double* rs = inverse_row_scale_.empty() ? nullptr : inverse_row_scale_.data();
   double lo = INFINITY, hi = 0.0;
   int negative = 0;
-  for (Index i = 0; i < n; ++i) {
-    const double a = rs ? std::fabs(u[i]) * rs[i] : std::fabs(u[i]);
-    lo = a < lo ? a : lo;
-    hi = a > hi ? a : hi;
-    negative ^= u[i] < 0.0;
-    if (!(a > 0.0)) return u_sign_ = 0, 0.0;  // zero or NaN
+  if (block_parity_.empty()) {
+    for (Index i = 0; i < n; ++i) {
+      const double a = rs ? std::fabs(u[i]) * rs[i] : std::fabs(u[i]);
+      lo = a < lo ? a : lo;
+      hi = a > hi ? a : hi;
+      negative ^= u[i] < 0.0;
+      if (!(a > 0.0)) return u_sign_ = 0, 0.0;  // zero or NaN
+    }
+  } else {  // the same, block by block: a block's sign is its pivots' times its rows' and columns' parity
+    const Int* R = sym_.symbolic_->R;
+    std::uint64_t signs = 0;
+    for (Index b = 0, nb = static_cast<Index>(block_parity_.size()); b < nb; ++b) {
+      int block_negative = block_parity_[static_cast<std::size_t>(b)];
+      for (Index i = R[b], end = R[b + 1]; i < end; ++i) {
+        const double a = rs ? std::fabs(u[i]) * rs[i] : std::fabs(u[i]);
+        lo = a < lo ? a : lo;
+        hi = a > hi ? a : hi;
+        block_negative ^= u[i] < 0.0;
+        if (!(a > 0.0)) return u_sign_ = 0, 0.0;  // zero or NaN
+      }
+      signs ^= block_key(static_cast<std::uint64_t>(b)) & (0 - static_cast<std::uint64_t>(block_negative));
+      negative ^= block_negative;
+    }
+    negative ^= negative_parity_offset_;  // undo the blocks' parities: u_sign_ is Π sign U_ii alone
+    block_signs_ = signs;
   }
   u_sign_ = negative ? -1 : 1;
   const double r = n > 0 ? lo / hi : 0.0;
@@ -350,9 +418,15 @@ FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
                    : "KLU factorisation failed (status " + std::to_string(common_.status) + ")";
     return FactorStatus::kFailed;
   }
-  rcond_ = rcond_at_pivoting_ = scan_diagonal();
   // the row permutation is fixed until the next pivot search: its parity once here, not per determinant_sign()
   p_sign_ = permutation_sign(numeric_->Pnum, sym_.pattern_->cols);
+  if (!sym_.q_block_parity_.empty()) {
+    block_parity_ = block_parities(numeric_->Pnum, sym_.symbolic_->R, sym_.symbolic_->nblocks);
+    negative_parity_offset_ = 0;
+    for (std::size_t b = 0; b < block_parity_.size(); ++b)
+      negative_parity_offset_ ^= block_parity_[b] ^= sym_.q_block_parity_[b];
+  }
+  rcond_ = rcond_at_pivoting_ = scan_diagonal();
   message_.clear();
   return FactorStatus::kOk;
 }

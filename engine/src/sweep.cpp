@@ -91,6 +91,22 @@ struct State {
 // it (positions only, a start accepted from its prediction).
 constexpr int kSignUnknown = 2;
 
+// Which way Φq is oriented at a factorisation: det Φq's sign, and at a regular position the fingerprint of the
+// signs of its diagonal blocks' determinants (SparseLuNumeric::block_signs(): KLU factorises a chain loop by
+// loop). Along a branch it changes exactly where the motion passes a singular position: det Φq's sign alone misses
+// an even number of loops crossing at once (nfourbar of even N through its flat position), the blocks do not.
+struct Orientation {
+  int sign = kSignUnknown;
+  std::uint64_t blocks = 0;
+  bool regular() const { return sign == 1 || sign == -1; }
+  bool operator==(const Orientation& o) const { return sign == o.sign && blocks == o.blocks; }
+  bool operator!=(const Orientation& o) const { return !(*this == o); }
+};
+Orientation orientation_of(const SparseLuNumeric& lu) {
+  const int sign = lu.determinant_sign();
+  return {sign, sign == 1 || sign == -1 ? lu.block_signs() : 0};
+}
+
 class Sweeper {
  public:
   Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum)
@@ -177,10 +193,10 @@ class Sweeper {
     det_sign_ = current_row_sign_;
     det_sign_t_ = current_row_sign_t_;
   }
-  // Sign of det Φq at the last delivered row (row_outputs()): ±1, 0 at a singular position, kSignUnknown where no
-  // factorisation of this sweeper's tells it; and the time it holds at (det_sign_time(): the row's, or with
-  // positions only that of the step whose Newton factorised last).
-  int det_sign() const { return det_sign_; }
+  // Orientation of Φq at the last delivered row (row_outputs()): sign ±1, 0 at a singular position, kSignUnknown
+  // where no factorisation of this sweeper's tells it; and the time it holds at (det_sign_time(): the row's, or
+  // with positions only that of the step whose Newton factorised last).
+  Orientation det_sign() const { return det_sign_; }
   double det_sign_time() const { return det_sign_t_; }
   // The last converged state (q, and q̇, q̈ as computed), which the rows deliver.
   const State& state() const { return current_; }
@@ -248,7 +264,7 @@ class Sweeper {
   void adopt(double t) {
     has_current_ = false;
     known_ = 0;
-    current_sign_ = current_row_sign_ = kSignUnknown;
+    current_sign_ = current_row_sign_ = Orientation{};
     row_error_ = INFINITY;  // how well the adopted state is known is not said: the next step checks it
     remember(t);
   }
@@ -602,9 +618,8 @@ class Sweeper {
       sum_.warnings.push_back({t, "bifurcation", m.str()});
     }
     if (!position_only_ && !derivatives(t, ps.slow_convergence && ps.rounding_level == 0.0)) return false;
-    const int sign = sign_at_solution();
-    if (left_branch && has_current_ && (sign == 1 || sign == -1) && (current_sign_ == 1 || current_sign_ == -1) &&
-        sign != current_sign_) {
+    const Orientation sign = sign_at_solution();
+    if (left_branch && has_current_ && sign.regular() && current_sign_.regular() && sign != current_sign_) {
       sum_.warnings.resize(noted.warnings);
       sum_.singular_positions = noted.singular_positions;
       sum_.min_rcond = noted.min_rcond, sum_.min_rcond_time = noted.min_rcond_time;
@@ -620,19 +635,19 @@ class Sweeper {
     // not at all, with the time of the step that made it; never that of a factorisation the workspace held before
     // (another chunk's, or another sweep's: the sign of another place)
     const bool own = ws_->counters.factorizations != factorizations_before_;
-    current_row_sign_ = sign != kSignUnknown || !own ? sign : ws_->lu->determinant_sign();
-    current_row_sign_t_ = sign != kSignUnknown ? t : factorized_step_t_;
+    current_row_sign_ = sign.sign != kSignUnknown || !own ? sign : orientation_of(*ws_->lu);
+    current_row_sign_t_ = sign.sign != kSignUnknown ? t : factorized_step_t_;
     remember(t);
     return true;
   }
-  // Sign of det Φq at the position just converged (ws.q): from the LU when it was factorised there (velocities
-  // are solved at every row; positions only, when Newton's last factorisation is at the solution), 0 at a
+  // Orientation of Φq at the position just converged (ws.q): from the LU when it was factorised there (velocities
+  // are solved at every row; positions only, when Newton's last factorisation is at the solution), sign 0 at a
   // singular position, else kSignUnknown.
-  int sign_at_solution() const {
-    if (singular_row_) return 0;
-    if (!ws_->lu || !ws_->has_factorization) return kSignUnknown;
+  Orientation sign_at_solution() const {
+    if (singular_row_) return {0, 0};
+    if (!ws_->lu || !ws_->has_factorization) return {};
     const bool at_solution = (need_v_ && !position_only_) || ws_->factorized_at_solution;
-    return at_solution ? ws_->lu->determinant_sign() : kSignUnknown;
+    return at_solution ? orientation_of(*ws_->lu) : Orientation{};
   }
   // Whether the converged ws.q is farther from the prediction than the prediction is from the last state (in
   // tolerance units, beyond a floor of 1000 tolerances): a predictor errs by a higher order of h than the O(h)
@@ -895,9 +910,9 @@ class Sweeper {
   Eigen::VectorXd predicted_;       // the last prediction (for jumped())
   bool bracketing_ = false;         // inside singular_point(): no nested bracketing
   bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
-  int det_sign_ = 0;                // sign of det Φq at the last delivered row (det_sign())
-  int current_sign_ = kSignUnknown;  // and at current_ (sign_at_solution() when it converged)
-  int current_row_sign_ = kSignUnknown;  // what current_'s row reports (converged()), and at which time
+  Orientation det_sign_{0, 0};      // of Φq at the last delivered row (det_sign())
+  Orientation current_sign_;         // and at current_ (sign_at_solution() when it converged)
+  Orientation current_row_sign_;     // what current_'s row reports (converged()), and at which time
   double current_row_sign_t_ = 0.0, det_sign_t_ = 0.0;
   // The workspace's factorisation count when this sweeper took it: the ones after it are its own (converged()).
   Index factorizations_before_ = ws_->counters.factorizations;
@@ -944,7 +959,7 @@ struct Run {
   }
   // Sign of det Φq at the last delivered regular row whose sign is known, its time, and whether a singular row
   // (bracketed, with its own warning) was delivered since.
-  int last_sign = 0;
+  Orientation last_sign{0, 0};
   double last_sign_t = 0.0;
   bool singular_since = false;
 
@@ -952,17 +967,20 @@ struct Run {
   // since the last regular row is a singular position passed between the two: warned here, in row order, so that
   // sequential and parallel sweeps report it alike.
   bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
-               const PointMotion* points, const Eigen::VectorXd& phi, double rcond, int det_sign,
+               const PointMotion* points, const Eigen::VectorXd& phi, double rcond, Orientation det_sign,
                double det_sign_t) {
-    if (det_sign == 0) {
+    if (det_sign.sign == 0) {
       singular_since = true;
-    } else if (det_sign != kSignUnknown) {
+    } else if (det_sign.sign != kSignUnknown) {
       // (a change between two steps of a sweep that solves velocities was found at the finest sub-step: no branch
       // was left there)
-      if (last_sign != 0 && det_sign != last_sign && !singular_since)
+      if (last_sign.sign != 0 && det_sign != last_sign && !singular_since)
         sum.warnings.push_back(
             {time_of(k), "bifurcation",
-             "det Φq changed sign between t = " + format_time(last_sign_t) + " and t = " + format_time(det_sign_t) +
+             std::string(det_sign.sign != last_sign.sign ? "det Φq changed sign"
+                                                         : "det Φq changed sign on an even number of its independent "
+                                                           "blocks (loops that Φq factorises one by one)") +
+                 " between t = " + format_time(last_sign_t) + " and t = " + format_time(det_sign_t) +
                  ": the motion passed a singular position there (a bifurcation, where branches cross); the sweep "
                  "kept the branch it was on"});
       last_sign = det_sign;
@@ -1050,7 +1068,7 @@ void stream_copy(const Eigen::VectorXd& from, Eigen::VectorXd& to) {
 struct Row {
   Eigen::VectorXd q, qd, qdd, phi;  // q̇, q̈ as solved, Φ when asked
   double rcond = 0.0;
-  int det_sign = 0;
+  Orientation det_sign{0, 0};
   double det_sign_t = 0.0;  // where det_sign holds (Sweeper::det_sign_time())
   std::vector<PointMotion> points;
 };

@@ -50,6 +50,13 @@ class SparseLuNumeric {
   /// zero pivot. Along a branch of a driven motion det Φq changes sign exactly where the branch passes a singular
   /// position (a bifurcation or a dead point), which is how a sweep notices one between two steps. O(n).
   virtual int determinant_sign() const = 0;
+  /// A fingerprint of the signs of the determinants of A's diagonal blocks, for a library that factorises A's
+  /// block triangular form (KLU: a chain of loops has one block per loop); 0 for one that factorises A whole. Two
+  /// factorisations of matrices of this pattern give the same value when every block's determinant has the same
+  /// sign, and different values (but for a 2⁻⁶⁴ coincidence) when any differs. det A keeps its sign when an even
+  /// number of blocks change theirs at once (nfourbar of even N through its flat position, all loops singular
+  /// together); a sweep compares both to notice such a crossing. Valid when determinant_sign() is ±1.
+  virtual std::uint64_t block_signs() const { return 0; }
   /// Detail of the last failure, for diagnostics.
   virtual std::string last_message() const = 0;
   /// Factorisations so far that searched for pivots (for KLU: not a refactorisation with the old pivot order).
