@@ -657,6 +657,16 @@ TEST_F(Cli, GenerateRefusesBadOptions) {
   EXPECT_EQ(run("generate nfourbar 0 -o " + (dir_ / "x.yaml").string()).code, 2);
   EXPECT_EQ(run("generate nfourbar 5 --coords polar -o " + (dir_ / "x.yaml").string()).code, 2);
   EXPECT_EQ(run("generate nfourbar 5 --outputs q,w -o " + (dir_ / "x.yaml").string()).code, 2);
+  // a scene the loader would refuse: more family entries than SceneLimits::max_family_instances, or more steps
+  // than time.steps takes (it was written, a kilobyte, and refused by `phiq check` only after minutes)
+  Result r = run("generate nfourbar 1000000000000 -o " + (dir_ / "x.yaml").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "phiq: generate: N = 1000000000000: nfourbar in natural coordinates is at most N = 9999999 (its "
+                   "families would make more entries than a scene may, SceneLimits::max_family_instances)\n");
+  EXPECT_EQ(run("generate scissor 3333334 -o " + (dir_ / "x.yaml").string()).code, 2);
+  r = run("generate grid 3 --steps 1000000001 -o " + (dir_ / "x.yaml").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "phiq: generate: --steps must be at most 1000000000 (a scene's time.steps), got 1000000001\n");
   EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
 }
 

@@ -333,7 +333,10 @@ TEST(Generate, SceneSizeDoesNotGrowWithN) {
       };
       const std::size_t small = size(std::string(kind) == "grid" ? 14 : 10), large = size(100000);
       EXPECT_LT(std::max(small, large) - std::min(small, large), 100u) << kind << " " << coords;
-      for (std::int64_t n : {1, 2, 3, 7, 10, 1000000, 10000000}) EXPECT_LT(size(n), 8192u) << kind << " " << coords;
+      const std::int64_t most = tools::max_n(generate_options(kind, 1, coords, 0.5, 1.0));
+      for (std::int64_t n : {std::int64_t{1}, std::int64_t{2}, std::int64_t{3}, std::int64_t{7}, std::int64_t{10},
+                             std::int64_t{1000000}, most})
+        EXPECT_LT(size(n), 8192u) << kind << " " << coords;
     }
 }
 
@@ -391,6 +394,70 @@ TEST(Generate, RefusesBadOptionsLikeNFourBar) {
     EXPECT_NE(message(generate_options("grid", 3, "natural", 1.0, bad)).find("--from and --to"), std::string::npos);
   }
   EXPECT_EQ(message(generate_options("grid", 3, "natural", 2.0, 3.0)), "(no error)");  // beyond π/2: fine for the grid
+}
+
+// The loader refuses a scene whose families make more than SceneLimits::max_family_instances entries (after
+// expanding the families before the one that exceeds it: nfourbar N = 10^7 took 160 s and 4.7 GB to be refused).
+// family_entries() counts them as the loader does: a scene loads with exactly that limit and not with one less.
+TEST(Generate, FamilyEntriesAreWhatTheLoaderCounts) {
+  std::vector<std::int64_t> sizes;
+  for (std::int64_t n = 1; n <= 30; ++n) sizes.push_back(n);  // grids of 1, 2 and 3+ rows, short and full last rows
+  for (std::int64_t n : {35, 36, 37, 42, 49, 56, 99, 100, 101, 111, 1000}) sizes.push_back(n);
+  for (const char* kind : {"nfourbar", "scissor", "grid", "chain3d"})
+    for (const char* coords : {"natural", "reference-point"})
+      for (std::int64_t n : sizes) {
+        const GenerateOptions o = generate_options(kind, n, coords, 0.5, 1.0, 4);
+        const std::string text = tools::generate_scene(o);
+        const std::uint64_t entries = tools::family_entries(o);
+        SceneLimits exact, less;
+        exact.max_family_instances = entries;
+        less.max_family_instances = entries - 1;
+        EXPECT_NO_THROW(parse_scene(text, "exact.yaml", exact)) << kind << " " << coords << " N = " << n;
+        try {
+          parse_scene(text, "less.yaml", less);
+          ADD_FAILURE() << kind << " " << coords << " N = " << n << ": loads with " << entries - 1 << " entries";
+        } catch (const SceneError& e) {
+          EXPECT_NE(std::string(e.what()).find("max_family_instances"), std::string::npos) << e.what();
+        }
+      }
+}
+
+// An N or a step count the loader would refuse is refused by generate (it wrote such scenes, a kilobyte each, and
+// `phiq check` said so only after expanding gigabytes). The largest N of each kind, counted by hand from the
+// families each writes (per N: nfourbar 5 natural, 11 reference-point; scissor 15, 11; chain3d 7, 10; grid about
+// 5 and 11, its rows adding a few), within 5·10^7.
+TEST(Generate, RefusesWhatTheLoaderWouldRefuse) {
+  const auto message = test::generate_error;
+  struct Case {
+    const char* kind;
+    const char* coords;
+    std::int64_t most;
+  };
+  for (const Case& c : {Case{"nfourbar", "natural", 9999999}, Case{"nfourbar", "reference-point", 4545454},
+                        Case{"scissor", "natural", 3333333}, Case{"scissor", "reference-point", 4545454},
+                        Case{"grid", "natural", 9993046}, Case{"grid", "reference-point", 4542936},
+                        Case{"chain3d", "natural", 7142856}, Case{"chain3d", "reference-point", 4999999}}) {
+    GenerateOptions o = generate_options(c.kind, c.most, c.coords, 0.5, 1.0);
+    EXPECT_EQ(tools::max_n(o), c.most) << c.kind << " " << c.coords;
+    EXPECT_LE(tools::family_entries(o), SceneLimits{}.max_family_instances) << c.kind << " " << c.coords;
+    EXPECT_EQ(message(o), "(no error)") << c.kind << " " << c.coords;
+    for (std::int64_t n : {c.most + 1, std::int64_t{10000000}, std::int64_t{1000000000000}}) {
+      o.n = n;
+      if (n <= 10000000) EXPECT_GT(tools::family_entries(o), SceneLimits{}.max_family_instances);
+      EXPECT_EQ(message(o), "N = " + std::to_string(n) + ": " + c.kind + " in " + c.coords +
+                                " coordinates is at most N = " + std::to_string(c.most) +
+                                " (its families would make more entries than a scene may, "
+                                "SceneLimits::max_family_instances)");
+    }
+  }
+  // time.steps is at most 10^9
+  for (const char* kind : {"nfourbar", "scissor", "grid", "chain3d"}) {
+    GenerateOptions o = generate_options(kind, 2, "natural", 0.5, 1.0, tools::kMaxSteps);
+    Scene s = parse_scene(tools::generate_scene(o), "s.yaml");
+    EXPECT_EQ(s.sweep.steps, tools::kMaxSteps);
+    o.steps = tools::kMaxSteps + 1;
+    EXPECT_EQ(message(o), "--steps must be at most 1000000000 (a scene's time.steps), got 1000000001") << kind;
+  }
 }
 
 }  // namespace

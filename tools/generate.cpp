@@ -1,9 +1,12 @@
 #include "generate.hpp"
+#include "generate_common.hpp"
 #include "generate_linkages.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <stdexcept>
+
+#include "phiq/scene.hpp"
 
 namespace phiq::tools {
 
@@ -94,7 +97,43 @@ std::string nfourbar_reference_point(const GenerateOptions& o) {
   return s;
 }
 
+// The entries of nfourbar's families (family_entries()): natural, the tips' coordinates (2 per crank), the points,
+// the cranks and the couplers; reference-point, the cranks' and couplers' coordinates (3 each), their bodies, the
+// pivots and the couplers' two pairs.
+std::uint64_t nfourbar_family_entries(const GenerateOptions& o) {
+  const auto cranks = static_cast<std::uint64_t>(o.n) + 1, couplers = static_cast<std::uint64_t>(o.n);
+  if (o.coords == "natural") return 2 * cranks + cranks + cranks + couplers;
+  return 3 * cranks + 3 * couplers + cranks + couplers + cranks + 2 * couplers;
+}
+
 }  // namespace
+
+std::uint64_t family_entries(const GenerateOptions& o) {
+  if (o.kind == "nfourbar") return nfourbar_family_entries(o);
+  if (o.kind == "scissor") return scissor_family_entries(o);
+  if (o.kind == "grid") return grid_family_entries(o);
+  if (o.kind == "chain3d") return chain3d_family_entries(o);
+  throw std::invalid_argument("unknown kind '" + o.kind + "' (available: nfourbar, scissor, grid, chain3d)");
+}
+
+std::int64_t max_n(const GenerateOptions& o) {
+  // The counts grow with N (each family's members do, and the grid's shape only adds rows or columns), so the
+  // largest N within the limit is found by bisection, in about 24 counts.
+  const std::uint64_t limit = SceneLimits{}.max_family_instances;
+  GenerateOptions at = o;
+  auto fits = [&](std::int64_t n) {
+    at.n = n;
+    return family_entries(at) <= limit;
+  };
+  std::int64_t lo = 1, hi = gen::kMaxN;  // fits(lo); the answer is in [lo, hi]
+  if (fits(hi)) return hi;
+  while (lo < hi) {
+    const std::int64_t mid = lo + (hi - lo + 1) / 2;
+    if (fits(mid)) lo = mid;
+    else hi = mid - 1;
+  }
+  return lo;
+}
 
 std::string generate_scene(const GenerateOptions& o) {
   if (o.n < 1) throw std::invalid_argument("N must be at least 1");
@@ -104,9 +143,8 @@ std::string generate_scene(const GenerateOptions& o) {
   if (!std::isfinite(o.twist)) throw std::invalid_argument("--twist must be finite");
   if (o.twist != 0.0 && o.kind != "chain3d") throw std::invalid_argument("--twist applies to chain3d only");
   if (o.kind == "nfourbar") {
-    if (o.coords == "natural") return nfourbar_natural(o);
-    if (o.coords == "reference-point") return nfourbar_reference_point(o);
-    throw std::invalid_argument("--coords is natural or reference-point");
+    gen::check_size_and_coords(o);
+    return o.coords == "natural" ? nfourbar_natural(o) : nfourbar_reference_point(o);
   }
   if (o.kind == "scissor") return scissor_scene(o);
   if (o.kind == "grid") return grid_scene(o);
