@@ -420,8 +420,9 @@ TEST_F(Cli, GeneratedSceneSizeDoesNotDependOnN) {
     const fs::path small = dir_ / "small.yaml", large = dir_ / "large.yaml";
     ASSERT_EQ(run(std::string("generate nfourbar 10 --coords ") + coords + " -o " + small.string()).code, 0);
     ASSERT_EQ(run(std::string("generate nfourbar 1000000 --coords ") + coords + " -o " + large.string()).code, 0);
-    // N is written three times (comment, name, parameter): 5 more digits each
-    EXPECT_EQ(fs::file_size(large), fs::file_size(small) + 15) << coords;
+    // N is written three times (comment, name, parameter), and the counts of coordinates, kinematic equations and
+    // equations once each: 5 more digits each
+    EXPECT_EQ(fs::file_size(large), fs::file_size(small) + 30) << coords;
     EXPECT_LT(fs::file_size(large), 4096u) << coords;
   }
 }
@@ -664,6 +665,10 @@ TEST_F(Cli, GenerateRefusesBadOptions) {
   EXPECT_EQ(r.err, "phiq: generate: N = 1000000000000: nfourbar in natural coordinates is at most N = 9999999 (its "
                    "families would make more entries than a scene may, SceneLimits::max_family_instances)\n");
   EXPECT_EQ(run("generate scissor 3333334 -o " + (dir_ / "x.yaml").string()).code, 2);
+  // an item twice is most likely another one mistyped
+  r = run("generate nfourbar 3 --outputs q,v,v -o " + (dir_ / "x.yaml").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "phiq: generate: --outputs: 'v' given twice in 'q,v,v'\n");
   r = run("generate grid 3 --steps 1000000001 -o " + (dir_ / "x.yaml").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, "phiq: generate: --steps must be at most 1000000000 (a scene's time.steps), got 1000000001\n");

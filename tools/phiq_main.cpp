@@ -843,10 +843,11 @@ int main(int argc, char** argv) {
       gen.q = gen.v = gen.a = false;
       std::stringstream ss(gen_outputs);
       for (std::string item; std::getline(ss, item, ',');) {
-        if (item == "q") gen.q = true;
-        else if (item == "v") gen.v = true;
-        else if (item == "a") gen.a = true;
-        else return fail("generate: --outputs: unknown output '" + item + "' (q, v, a)", 2);
+        bool* wanted = item == "q" ? &gen.q : item == "v" ? &gen.v : item == "a" ? &gen.a : nullptr;
+        if (!wanted) return fail("generate: --outputs: unknown output '" + item + "' (q, v, a)", 2);
+        // a repeat is most likely another item mistyped (q,v,v for q,v,a): said, not merged
+        if (*wanted) return fail("generate: --outputs: '" + item + "' given twice in '" + gen_outputs + "'", 2);
+        *wanted = true;
       }
       std::string text;
       try {
