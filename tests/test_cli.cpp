@@ -273,7 +273,10 @@ TEST_F(Cli, CompareExitStatusAndWorstCell) {
   EXPECT_NE(diff.err.find("0.5061454830783556"), std::string::npos) << diff.err;  // the time of the worst row
   EXPECT_EQ(run("compare --rtol 1e-5 " + ref + " " + bad.string()).code, 0);
   EXPECT_EQ(run("compare " + ref + " /nonexistent.csv").code, 2);
-  EXPECT_EQ(run("compare --columns t,nope " + ref + " " + out.string()).code, 2);
+  Result missing = run("compare --columns t,nope " + ref + " " + out.string());
+  EXPECT_EQ(missing.code, 2);
+  // one line naming the command and the option, as every command-line error does
+  EXPECT_EQ(missing.err, "phiq: compare: --columns: column 'nope' is not in " + ref + "\n");
 }
 
 // Reads a CSV written by phiq into columns by name.

@@ -556,8 +556,12 @@ int cmd_compare(const std::string& a_path, const std::string& b_path, const phiq
   phiq::CompareResult r;
   try {
     const phiq::CsvTable a = phiq::read_csv_table(a_path), b = phiq::read_csv_table(b_path);
-    r = phiq::compare_csv(a, b, options);
-  } catch (const phiq::Error& e) {
+    try {
+      r = phiq::compare_csv(a, b, options);
+    } catch (const phiq::Error& e) {  // a --columns name not in a file: a command-line error names its option
+      return fail("compare: --columns: " + std::string(e.what()), 2);
+    }
+  } catch (const phiq::Error& e) {  // the file and line are named
     return fail(e.what(), 2);
   }
   if (r.equal) {
