@@ -620,6 +620,27 @@ TEST_F(Cli, PlotDrawsTheMechanismTracesAndColumns) {
   for (const auto& row : rt.rows) EXPECT_LE(row.back(), 1e-10);
 }
 
+// A scene whose mechanism draws nothing (dimension 3: `phiq generate chain3d`) got an empty panel without a word.
+TEST_F(Cli, PlotSaysWhenThereIsNothingOfTheMechanismToDraw) {
+  const fs::path scene = dir_ / "c.yaml", csv = dir_ / "c.csv", svg = dir_ / "c.svg";
+  ASSERT_EQ(run("generate chain3d 3 --steps 10 -o " + scene.string()).code, 0);
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
+  Result r = run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.rfind("phiq: plot: " + scene.string() + ": nothing of the mechanism to draw (", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const std::string drawn = slurp(svg);
+  EXPECT_EQ(drawn.find("class=\"mechanism\""), std::string::npos);
+  EXPECT_NE(drawn.find("class=\"series\""), std::string::npos);
+  // a planar generated scene draws its bars, silently
+  ASSERT_EQ(run("generate nfourbar 3 --steps 10 -o " + scene.string()).code, 0);
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
+  r = run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_NE(slurp(svg).find("class=\"mechanism\""), std::string::npos);
+}
+
 TEST_F(Cli, PlotRefusesBadInputWithOneLineAndNoFile) {
   const fs::path scene = write("f.yaml", kFourbarOutputs), csv = dir_ / "f.csv", svg = dir_ / "f.svg";
   ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
