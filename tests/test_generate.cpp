@@ -412,6 +412,17 @@ TEST(Generate, RefusesBadOptionsLikeNFourBar) {
     o.q = false;
     EXPECT_EQ(message(o), "--outputs must include q (positions are always written)") << kind;
   }
+  // finite options whose scene would not be: the driver's rate overflows, or chain3d's phases (the loader refused
+  // '-inf' and 'inf' where generate wrote them)
+  for (const char* kind : {"nfourbar", "scissor", "grid", "chain3d"})
+    EXPECT_EQ(message(generate_options(kind, 3, "natural", 1.7e308, -1.7e308)),
+              "--from and --to: the driven range to - from = -inf is not finite")
+        << kind;
+  GenerateOptions twisted = generate_options("chain3d", 3, "reference-point", 0.5, 1.0);
+  twisted.twist = 1e308;
+  EXPECT_EQ(message(twisted), "--twist: crank N's phase from + N*twist is not finite");
+  twisted.twist = 1e307;  // 3e307: every phase finite, the scene loads
+  EXPECT_NO_THROW(parse_scene(tools::generate_scene(twisted), "t.yaml"));
   EXPECT_EQ(message(generate_options("gears", 3, "natural", 0.5, 1.0)),
             "unknown kind 'gears' (available: nfourbar, scissor, grid, chain3d)");
   // driven ranges that reach a singular position

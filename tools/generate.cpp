@@ -153,6 +153,13 @@ std::string generate_scene(const GenerateOptions& o) {
   if (!std::isfinite(o.from) || !std::isfinite(o.to)) throw std::invalid_argument("--from and --to must be finite");
   if (!o.q) throw std::invalid_argument("--outputs must include q (positions are always written)");
   if (!std::isfinite(o.twist)) throw std::invalid_argument("--twist must be finite");
+  // Finite options can still make numbers of the scene that are not: the driver's rate, and chain3d's phases
+  // from + i·twist up to i = N; the loader would refuse the scene ('-inf' is not a finite number).
+  if (!std::isfinite(o.to - o.from))
+    throw std::invalid_argument("--from and --to: the driven range to - from = " + num(o.to - o.from) +
+                                " is not finite");
+  if (!std::isfinite(std::fabs(o.from) + static_cast<double>(o.n) * std::fabs(o.twist)))
+    throw std::invalid_argument("--twist: crank N's phase from + N*twist is not finite");
   if (o.twist != 0.0 && o.kind != "chain3d") throw std::invalid_argument("--twist applies to chain3d only");
   if (o.kind == "nfourbar") {
     gen::check_size_and_coords(o);
