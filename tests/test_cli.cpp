@@ -295,7 +295,10 @@ TEST_F(Cli, CompareExitStatusAndWorstCell) {
   EXPECT_NE(diff.err.find("0.5061454830783556"), std::string::npos) << diff.err;  // the time of the worst row
   EXPECT_EQ(run("compare --rtol 1e-5 " + ref + " " + bad.string()).code, 0);
   EXPECT_EQ(run("compare " + ref + " /nonexistent.csv").code, 2);
-  EXPECT_EQ(run("compare --columns t,nope " + ref + " " + out.string()).code, 2);
+  Result missing = run("compare --columns t,nope " + ref + " " + out.string());
+  EXPECT_EQ(missing.code, 2);
+  // one line naming the command and the option, as every command-line error does
+  EXPECT_EQ(missing.err, "phiq: compare: --columns: column 'nope' is not in " + ref + "\n");
 }
 
 // Reads a CSV written by phiq into columns by name.
@@ -442,8 +445,9 @@ TEST_F(Cli, GeneratedSceneSizeDoesNotDependOnN) {
     const fs::path small = dir_ / "small.yaml", large = dir_ / "large.yaml";
     ASSERT_EQ(run(std::string("generate nfourbar 10 --coords ") + coords + " -o " + small.string()).code, 0);
     ASSERT_EQ(run(std::string("generate nfourbar 1000000 --coords ") + coords + " -o " + large.string()).code, 0);
-    // N is written three times (comment, name, parameter): 5 more digits each
-    EXPECT_EQ(fs::file_size(large), fs::file_size(small) + 15) << coords;
+    // N is written three times (comment, name, parameter), and the counts of coordinates, kinematic equations and
+    // equations once each: 5 more digits each
+    EXPECT_EQ(fs::file_size(large), fs::file_size(small) + 30) << coords;
     EXPECT_LT(fs::file_size(large), 4096u) << coords;
   }
 }
@@ -638,6 +642,27 @@ TEST_F(Cli, PlotDrawsTheMechanismTracesAndColumns) {
   for (const auto& row : rt.rows) EXPECT_LE(row.back(), 1e-10);
 }
 
+// A scene whose mechanism draws nothing (dimension 3: `phiq generate chain3d`) got an empty panel without a word.
+TEST_F(Cli, PlotSaysWhenThereIsNothingOfTheMechanismToDraw) {
+  const fs::path scene = dir_ / "c.yaml", csv = dir_ / "c.csv", svg = dir_ / "c.svg";
+  ASSERT_EQ(run("generate chain3d 3 --steps 10 -o " + scene.string()).code, 0);
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
+  Result r = run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.rfind("phiq: plot: " + scene.string() + ": nothing of the mechanism to draw (", 0), 0u) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const std::string drawn = slurp(svg);
+  EXPECT_EQ(drawn.find("class=\"mechanism\""), std::string::npos);
+  EXPECT_NE(drawn.find("class=\"series\""), std::string::npos);
+  // a planar generated scene draws its bars, silently
+  ASSERT_EQ(run("generate nfourbar 3 --steps 10 -o " + scene.string()).code, 0);
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
+  r = run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string());
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_NE(slurp(svg).find("class=\"mechanism\""), std::string::npos);
+}
+
 TEST_F(Cli, PlotRefusesBadInputWithOneLineAndNoFile) {
   const fs::path scene = write("f.yaml", kFourbarOutputs), csv = dir_ / "f.csv", svg = dir_ / "f.svg";
   ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
@@ -679,6 +704,20 @@ TEST_F(Cli, GenerateRefusesBadOptions) {
   EXPECT_EQ(run("generate nfourbar 0 -o " + (dir_ / "x.yaml").string()).code, 2);
   EXPECT_EQ(run("generate nfourbar 5 --coords polar -o " + (dir_ / "x.yaml").string()).code, 2);
   EXPECT_EQ(run("generate nfourbar 5 --outputs q,w -o " + (dir_ / "x.yaml").string()).code, 2);
+  // a scene the loader would refuse: more family entries than SceneLimits::max_family_instances, or more steps
+  // than time.steps takes (it was written, a kilobyte, and refused by `phiq check` only after minutes)
+  Result r = run("generate nfourbar 1000000000000 -o " + (dir_ / "x.yaml").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "phiq: generate: N = 1000000000000: nfourbar in natural coordinates is at most N = 9999999 (its "
+                   "families would make more entries than a scene may, SceneLimits::max_family_instances)\n");
+  EXPECT_EQ(run("generate scissor 3333334 -o " + (dir_ / "x.yaml").string()).code, 2);
+  // an item twice is most likely another one mistyped
+  r = run("generate nfourbar 3 --outputs q,v,v -o " + (dir_ / "x.yaml").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "phiq: generate: --outputs: 'v' given twice in 'q,v,v'\n");
+  r = run("generate grid 3 --steps 1000000001 -o " + (dir_ / "x.yaml").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "phiq: generate: --steps must be at most 1000000000 (a scene's time.steps), got 1000000001\n");
   EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
 }
 

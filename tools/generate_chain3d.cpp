@@ -191,6 +191,15 @@ std::string chain3d_reference_point(const GenerateOptions& o) {
 
 }  // namespace
 
+// The entries of chain3d's families, as the loader counts them (family_entries(), generate.hpp): the points' or
+// crank bodies' coordinates (3 or 7 per crank), the points or bodies, the hinges (crank and plane per crank, or
+// pivot) and the couplers.
+std::uint64_t chain3d_family_entries(const GenerateOptions& o) {
+  const auto cranks = static_cast<std::uint64_t>(o.n) + 1, couplers = static_cast<std::uint64_t>(o.n);
+  if (o.coords == "natural") return 3 * cranks + cranks + 2 * cranks + couplers;
+  return 7 * cranks + cranks + cranks + couplers;
+}
+
 std::string chain3d_scene(const GenerateOptions& o) {
   check(o);
   return o.coords == "natural" ? chain3d_natural(o) : chain3d_reference_point(o);

@@ -12,8 +12,8 @@
 
 namespace phiq::tools::gen {
 
-// Ten times the largest benchmark (10^6) and far beyond a loadable scene (128 MiB): a larger N would be gigabytes
-// of text, refused here rather than by a failed allocation.
+// Beyond every kind's max_n() (each makes at least 5 family entries per N, and the loader takes 5·10^7): the
+// counts of family_entries() are computed only up to here, where they cannot overflow.
 constexpr std::int64_t kMaxN = 10'000'000;
 
 inline std::string str(std::int64_t v) { return std::to_string(v); }
@@ -24,11 +24,19 @@ inline std::string num(double v) {
   return std::string(buf, r.ptr);
 }
 
-// N at most kMaxN, and a known --coords.
+// A known --coords, then an N and a step count whose scene the loader accepts: a larger one would be written in a
+// few kilobytes and refused only when loaded, after the families before the one that exceeds the limit were
+// expanded (nfourbar N = 10^7: 160 s and 4.7 GB to say so).
 inline void check_size_and_coords(const GenerateOptions& o) {
-  if (o.n > kMaxN) throw std::invalid_argument("N must be at most " + str(kMaxN));
   if (o.coords != "natural" && o.coords != "reference-point")
     throw std::invalid_argument("--coords is natural or reference-point");
+  if (const std::int64_t most = max_n(o); o.n > most)
+    throw std::invalid_argument("N = " + str(o.n) + ": " + o.kind + " in " + o.coords + " coordinates is at most N = " +
+                                str(most) + " (its families would make more entries than a scene may, SceneLimits::"
+                                "max_family_instances)");
+  if (o.steps > kMaxSteps)
+    throw std::invalid_argument("--steps must be at most " + str(kMaxSteps) + " (a scene's time.steps), got " +
+                                str(o.steps));
 }
 
 // The first lines: what was generated, the drive, the counts and the names; then the format version and the name.

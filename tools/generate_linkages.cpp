@@ -268,6 +268,18 @@ std::string grid_natural(const GenerateOptions& o) {
   return t.take();
 }
 
+// The pairs at node (i, j + 1) on top of the vertical bar of a row of width w below a node row whose vertical bars
+// go up from i <= wn (wn < 0: none): u (up, i <= wn), l (left, i > 0), r (right, i < w), in this order.
+std::string pairs_at(std::int64_t i, std::int64_t w, std::int64_t wn) {
+  return std::string(i <= wn ? "u" : "") + (i > 0 ? "l" : "") + (i < w ? "r" : "");
+}
+// The last node of the run from a whose nodes have the same pairs: one family of the pairs.
+std::int64_t pair_run_end(std::int64_t a, std::int64_t w, std::int64_t wn) {
+  std::int64_t b = a;
+  while (b < w && pairs_at(b + 1, w, wn) == pairs_at(a, w, wn)) ++b;
+  return b;
+}
+
 // Reference-point coordinates: every bar a body with its reference point at its middle and its x axis from its first
 // node to its second (ends at x = ∓1/2): vertical bars v<i>_<j> (node (i, j) to (i, j+1), angle θ_j), horizontal
 // bars h<i>_<j> (node (i, j) to (i+1, j), angle 0). Each node above ground pins the top of the vertical bar below it
@@ -319,15 +331,11 @@ std::string grid_reference_point(const GenerateOptions& o) {
   auto crow = [](const std::string& ind, const std::string& jt, const std::string& j1t, std::int64_t w,
                  std::int64_t wn) {
     const std::string top = "{body: \"v{i}_" + jt + "\", at: [0.5, 0]}";
-    auto pairs_at = [&](std::int64_t i) {
-      return std::string(i <= wn ? "u" : "") + (i > 0 ? "l" : "") + (i < w ? "r" : "");
-    };
     std::string s;
     for (std::int64_t a = 0; a <= w;) {
-      std::int64_t b = a;
-      while (b < w && pairs_at(b + 1) == pairs_at(a)) ++b;
+      const std::int64_t b = pair_run_end(a, w, wn);
       s += ind + "- for i in " + range(a, b) + ":\n";
-      for (char c : pairs_at(a)) {
+      for (char c : pairs_at(a, w, wn)) {
         if (c == 'u')
           s += ind + "    - {name: \"up{i}_" + j1t + "\", type: revolute, between: [" + top + ", {body: \"v{i}_" +
                j1t + "\", at: [-0.5, 0]}]}\n";
@@ -362,6 +370,58 @@ std::string scissor_scene(const GenerateOptions& o) {
 std::string grid_scene(const GenerateOptions& o) {
   check(o, kPi, "the grid's row angles must lie strictly between 0 and pi, where the cells are flat (singular)");
   return o.coords == "natural" ? grid_natural(o) : grid_reference_point(o);
+}
+
+// The entries of the families written above, counted as the loader counts them: a family of M members whose body
+// has E entries makes M·E (none when empty), a nested family being one entry of its parent's body per member plus
+// what it makes. Each term follows the text written by scissor_natural() ... grid_reference_point(), in order;
+// tests/test_generate.cpp checks the count against the loader's limit at many N.
+namespace {
+std::uint64_t fam(std::int64_t members, std::int64_t entries) {
+  return members > 0 ? static_cast<std::uint64_t>(members) * static_cast<std::uint64_t>(entries) : 0;
+}
+// The constraints at node row j + 1 of reference-point grid (crow in grid_reference_point()): one family per run
+// of nodes with the same pairs, each making (nodes) x (pairs) entries.
+std::uint64_t grid_pair_entries(std::int64_t w, std::int64_t wn) {
+  std::uint64_t e = 0;
+  for (std::int64_t a = 0; a <= w;) {
+    const std::int64_t b = pair_run_end(a, w, wn);
+    e += 1 + fam(b - a + 1, static_cast<std::int64_t>(pairs_at(a, w, wn).size()));
+    a = b + 1;
+  }
+  return e;
+}
+}  // namespace
+
+std::uint64_t scissor_family_entries(const GenerateOptions& o) {
+  const std::int64_t n = o.n;
+  if (o.coords == "natural") return fam(n, 6) + fam(n, 3) + fam(n, 6);  // coordinates, points, constraints
+  return fam(n, 6) + fam(n, 2) + fam(n - 1, 3);  // coordinates, bodies, the pairs of stages 0 ... N-2
+}
+
+std::uint64_t grid_family_entries(const GenerateOptions& o) {
+  const GridShape g = grid_shape(o.n);
+  const std::int64_t c = g.cols, r = g.rows, l = g.last, w0 = r > 1 ? c : l;
+  const RowPairs p = row_pairs(g);
+  const std::uint64_t drivers = fam(p.pairs, 2) + (p.odd_tail ? 2 : 1);
+  if (o.coords == "natural") {
+    // coordinates: per pair of rows 4 entries (theta, the nodes' family, twice), each node 2; then the tail
+    const std::uint64_t coordinates =
+        fam(p.pairs, 4) + 2 * fam(p.pairs, 2 * (c + 1)) + (p.odd_tail ? 4 + 2 * (c + 1) + 2 * (l + 1) : 2 + 2 * (l + 1));
+    const std::uint64_t points = fam(r - 1, 1) + fam(r - 1, c + 1) + fam(l + 1, 1);
+    // row 0 (its vertical and horizontal bars' families), rows 1 ... R-2 (3 items each), row R-1
+    const std::uint64_t constraints = fam(w0 + 1, 1) + fam(w0, 1) + fam(r - 2, 3) + fam(r - 2, 2 * c + 1) +
+                                      (r > 1 ? 3 + fam(l + 1, 1) + fam(l, 1) : 0);
+    return coordinates + points + constraints + drivers;
+  }
+  // coordinates: per row 2 entries (the vertical and the horizontal bars' families), 3 per bar
+  const std::uint64_t coordinates = fam(p.pairs, 4) + 2 * fam(p.pairs, 3 * (c + 1) + 3 * c) +
+                                    (p.odd_tail ? 4 + 3 * (c + 1) + 3 * c + 3 * (l + 1) + 3 * l
+                                                : 2 + 3 * (l + 1) + 3 * l);
+  const std::uint64_t bodies = fam(r - 1, 2) + fam(r - 1, 2 * c + 1) + 2 + fam(l + 1, 1) + fam(l, 1);
+  const std::uint64_t constraints = fam(w0 + 1, 1) + (r > 2 ? (r - 2) * grid_pair_entries(c, c) : 0) +
+                                    (r > 1 ? grid_pair_entries(c, l) : 0) + grid_pair_entries(l, -1);
+  return coordinates + bodies + constraints + drivers;
 }
 
 std::optional<DrivenRange> kind_default_range(const std::string& kind) {

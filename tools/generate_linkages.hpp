@@ -2,6 +2,7 @@
 // (tools/generate_chain3d.cpp); formats in tools/README.md.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -22,6 +23,11 @@ std::string grid_scene(const GenerateOptions& o);
 // std::invalid_argument for a bad --coords, a parallelogram row driven through a singular position (a multiple of
 // π) or a twist with |sin twist| < 0.01.
 std::string chain3d_scene(const GenerateOptions& o);
+
+// The entries the families of these scenes make, as the loader counts them (family_entries(), generate.hpp).
+std::uint64_t scissor_family_entries(const GenerateOptions& o);
+std::uint64_t grid_family_entries(const GenerateOptions& o);
+std::uint64_t chain3d_family_entries(const GenerateOptions& o);
 
 // The driven range used when --from / --to are not given, for the kinds whose default differs from
 // GenerateOptions' (π/4 → 3π/4): scissor 0.3 → 1.2 rad. Empty for the other kinds.

@@ -562,8 +562,12 @@ int cmd_compare(const std::string& a_path, const std::string& b_path, const phiq
   phiq::CompareResult r;
   try {
     const phiq::CsvTable a = phiq::read_csv_table(a_path), b = phiq::read_csv_table(b_path);
-    r = phiq::compare_csv(a, b, options);
-  } catch (const phiq::Error& e) {
+    try {
+      r = phiq::compare_csv(a, b, options);
+    } catch (const phiq::Error& e) {  // a --columns name not in a file: a command-line error names its option
+      return fail("compare: --columns: " + std::string(e.what()), 2);
+    }
+  } catch (const phiq::Error& e) {  // the file and line are named
     return fail(e.what(), 2);
   }
   if (r.equal) {
@@ -849,10 +853,11 @@ int main(int argc, char** argv) {
       gen.q = gen.v = gen.a = false;
       std::stringstream ss(gen_outputs);
       for (std::string item; std::getline(ss, item, ',');) {
-        if (item == "q") gen.q = true;
-        else if (item == "v") gen.v = true;
-        else if (item == "a") gen.a = true;
-        else return fail("generate: --outputs: unknown output '" + item + "' (q, v, a)", 2);
+        bool* wanted = item == "q" ? &gen.q : item == "v" ? &gen.v : item == "a" ? &gen.a : nullptr;
+        if (!wanted) return fail("generate: --outputs: unknown output '" + item + "' (q, v, a)", 2);
+        // a repeat is most likely another item mistyped (q,v,v for q,v,a): said, not merged
+        if (*wanted) return fail("generate: --outputs: '" + item + "' given twice in '" + gen_outputs + "'", 2);
+        *wanted = true;
       }
       std::string text;
       try {

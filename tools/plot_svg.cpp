@@ -226,6 +226,12 @@ int plot_svg(const PlotOptions& o) {
     traces.push_back(std::move(l));
     trace_names.push_back(p.name);
   }
+  // An empty panel without a word reads as a broken drawing (every dimension 3 scene, e.g. `phiq generate chain3d`):
+  // say why.
+  if (segments.empty() && traces.empty())
+    std::cerr << "phiq: plot: " << o.scene << ": nothing of the mechanism to draw (its constraints make no lines: "
+              << "spatial ones, loops and equations draw none; output.points lists no point to trace): the SVG has "
+              << "the columns against t only\n";
 
   // ---- the SVG: mechanism on the left (equal scales), columns against t on the right
   constexpr double W = 1000, H = 460, M = 40;
