@@ -487,7 +487,9 @@ TEST(Generate, RefusesWhatTheLoaderWouldRefuse) {
     EXPECT_EQ(message(o), "(no error)") << c.kind << " " << c.coords;
     for (std::int64_t n : {c.most + 1, std::int64_t{10000000}, std::int64_t{1000000000000}}) {
       o.n = n;
-      if (n <= 10000000) EXPECT_GT(tools::family_entries(o), SceneLimits{}.max_family_instances);
+      if (n <= 10000000) {
+        EXPECT_GT(tools::family_entries(o), SceneLimits{}.max_family_instances);
+      }
       EXPECT_EQ(message(o), "N = " + std::to_string(n) + ": " + c.kind + " in " + c.coords +
                                 " coordinates is at most N = " + std::to_string(c.most) +
                                 " (its families would make more entries than a scene may, "
