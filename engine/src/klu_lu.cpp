@@ -121,12 +121,11 @@ std::vector<unsigned char> block_parities(const Int* p, const Int* R, Int nb) {
   return odd;
 }
 
-// A 64-bit key per block (two multiplications by odd constants with a xor-shift between: distinct blocks get
-// unrelated keys); block_signs() is the xor of the keys of the blocks whose determinant is negative.
+// A 64-bit key per block (a multiplication by an odd constant, its high bits folded into the low: distinct blocks
+// get unrelated keys); block_signs() is the xor of the keys of the blocks whose determinant is negative.
 inline std::uint64_t block_key(std::uint64_t b) {
-  std::uint64_t x = (b + 1) * 0x9E3779B97F4A7C15ull;
-  x ^= x >> 31;
-  return x * 0xBF58476D1CE4E5B9ull;
+  const std::uint64_t x = (b + 1) * 0x9E3779B97F4A7C15ull;
+  return x ^ (x >> 29);
 }
 
 // Mean |p[k] − p[k−1]|: 1 for the identity or its reverse, about n/3 for a random permutation. How far apart in
@@ -378,19 +377,29 @@ double KluNumeric<Int>::scan_diagonal() {
     }
   } else {  // the same, block by block: a block's sign is its pivots' times its rows' and columns' parity
     const Int* R = sym_.symbolic_->R;
+    const unsigned char* parity = block_parity_.data();
+    const Index nb = static_cast<Index>(block_parity_.size());
     std::uint64_t signs = 0;
-    for (Index b = 0, nb = static_cast<Index>(block_parity_.size()); b < nb; ++b) {
-      int block_negative = block_parity_[static_cast<std::size_t>(b)];
-      for (Index i = R[b], end = R[b + 1]; i < end; ++i) {
-        const double a = rs ? std::fabs(u[i]) * rs[i] : std::fabs(u[i]);
-        lo = a < lo ? a : lo;
-        hi = a > hi ? a : hi;
-        block_negative ^= u[i] < 0.0;
-        if (!(a > 0.0)) return u_sign_ = 0, 0.0;  // zero or NaN
+    bool zero = false;
+    auto blocks = [&](auto scaled) {  // the loop twice, with and without scale factors (no test per entry)
+      for (Index b = 0; b < nb; ++b) {
+        unsigned block_negative = parity[b];
+        for (Index i = R[b], end = R[b + 1]; i < end; ++i) {
+          const double a = scaled ? std::fabs(u[i]) * rs[i] : std::fabs(u[i]);
+          lo = a < lo ? a : lo;
+          hi = a > hi ? a : hi;
+          block_negative ^= u[i] < 0.0;
+          zero |= !(a > 0.0);  // zero or NaN
+        }
+        signs ^= block_key(static_cast<std::uint64_t>(b)) & (0 - static_cast<std::uint64_t>(block_negative));
+        negative ^= static_cast<int>(block_negative);
       }
-      signs ^= block_key(static_cast<std::uint64_t>(b)) & (0 - static_cast<std::uint64_t>(block_negative));
-      negative ^= block_negative;
-    }
+    };
+    if (rs)
+      blocks(std::true_type{});
+    else
+      blocks(std::false_type{});
+    if (zero) return u_sign_ = 0, 0.0;
     negative ^= negative_parity_offset_;  // undo the blocks' parities: u_sign_ is Π sign U_ii alone
     block_signs_ = signs;
   }
