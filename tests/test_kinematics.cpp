@@ -291,6 +291,40 @@ TEST(Kinematics, SingularJacobianIsAStatusNotACrash) {
   EXPECT_NE(ls.message.find("not unique"), std::string::npos) << ls.message;
 }
 
+// Settings no solve can honour are refused at the call, naming the field: an infinite tolerance used to accept the
+// start as the solution, a NaN start_error to accept it unchecked with a NaN error estimate, a negative
+// max_iterations to be refused as a bad tolerance; an unknown jacobian_update and negative max_backtracks passed.
+TEST(Kinematics, NewtonOptionsNoSolveCanHonourAreRefusedNamingTheField) {
+  Model m = crank_slider(2.0, 0.0);
+  auto refusal = [&](auto&& edit) -> std::string {
+    NewtonOptions o;
+    edit(o);
+    Workspace ws(m);
+    try {
+      solve_position(m, 0.5, o, ws);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.tolerance = INFINITY; }),
+            "NewtonOptions: tolerance must be > 0 and finite");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.tolerance = 0.0; }), "NewtonOptions: tolerance must be > 0 and finite");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.tolerance = NAN; }), "NewtonOptions: tolerance must be > 0 and finite");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_iterations = -1; }), "NewtonOptions: max_iterations must be >= 0");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_backtracks = -1; }), "NewtonOptions: max_backtracks must be >= 0");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_contraction = 1.0; }),
+            "NewtonOptions: max_contraction must be in (0, 1)");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.start_error = NAN; }),
+            "NewtonOptions: start_error must not be NaN (negative: unknown)");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.jacobian_update = static_cast<JacobianUpdate>(7); }),
+            "NewtonOptions: jacobian_update is not a JacobianUpdate");
+  // the limits themselves are settings: no step at all, no backtrack, an infinite start error (always a step)
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_iterations = 0; }), "accepted");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_backtracks = 0; }), "accepted");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.start_error = INFINITY; }), "accepted");
+}
+
 TEST(Kinematics, NonSquareModelIsReportedWithCounts) {
   ModelBuilder b;
   Index x = b.add_coordinate("x", 0.0);

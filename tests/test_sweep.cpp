@@ -245,6 +245,41 @@ TEST(Sweep, PredictorNamesAndTheAutomaticChoice) {
   EXPECT_THROW(run_sweep(m, opt, ws, nullptr, nullptr), Error);
 }
 
+// Bad settings are refused before the sweep starts, naming the field: an infinite drive tolerance used to pass as
+// a successful sweep of the unmoved start, bad drive settings were found only after the assembly had delivered row
+// 0 (on 2 threads, by a worker), a negative max_subdivisions and an unknown predictor passed unnoticed.
+TEST(Sweep, SettingsNoSweepCanHonourAreRefusedBeforeTheFirstRow) {
+  Model m = crank_slider();
+  for (int threads : {1, 2}) {
+    auto refusal = [&](auto&& edit) -> std::string {
+      SweepOptions opt;
+      opt.threads = threads;
+      opt.chunk_steps = 10;
+      edit(opt);
+      Workspace ws(m);
+      Index rows = 0;
+      try {
+        run_sweep(m, opt, ws, [&](const StepView&) { return ++rows, true; }, nullptr);
+      } catch (const Error& e) {
+        EXPECT_EQ(rows, 0) << e.what();
+        return e.what();
+      }
+      return "accepted";
+    };
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.newton.tolerance = INFINITY; }),
+              "SweepOptions::newton: tolerance must be > 0 and finite");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.newton.max_contraction = 2.0; }),
+              "SweepOptions::newton: max_contraction must be in (0, 1)");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.assembly.max_iterations = -1; }),
+              "SweepOptions::assembly: max_iterations must be >= 0");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.max_subdivisions = -1; }),
+              "SweepOptions: max_subdivisions must be >= 0");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.predictor = static_cast<Predictor>(99); }),
+              "SweepOptions: predictor is not a Predictor");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.max_subdivisions = 0; }), "accepted");
+  }
+}
+
 TEST(Sweep, PositionOnlySweepDoesNoVelocityOrAccelerationWork) {
   Model m = crank_slider();
   SweepOptions opt;

@@ -172,6 +172,23 @@ void check_workspace(const Model& model, const Workspace& ws) {
     throw Error("workspace state has the wrong size (q, qd, qdd must have " + std::to_string(n) + " entries)");
 }
 
+}  // namespace
+
+void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
+  // An infinite tolerance accepts any point as the solution, a NaN start_error accepts the start unchecked (and
+  // reports NaN as its error): settings no solve can honour, each named by its field.
+  auto fail = [&](const std::string& why) { throw Error(std::string(what) + ": " + why); };
+  if (!(opt.tolerance > 0.0 && std::isfinite(opt.tolerance))) fail("tolerance must be > 0 and finite");
+  if (opt.max_iterations < 0) fail("max_iterations must be >= 0");
+  if (opt.max_backtracks < 0) fail("max_backtracks must be >= 0");
+  if (!(opt.max_contraction > 0.0 && opt.max_contraction < 1.0)) fail("max_contraction must be in (0, 1)");
+  if (std::isnan(opt.start_error)) fail("start_error must not be NaN (negative: unknown)");
+  if (opt.jacobian_update != JacobianUpdate::kEveryIteration && opt.jacobian_update != JacobianUpdate::kWhenSlow)
+    fail("jacobian_update is not a JacobianUpdate");
+}
+
+namespace {
+
 std::string not_square_message(const Model& model) {
   std::string s = "the model has " + std::to_string(model.num_solve_rows()) + " equations for " +
                   std::to_string(model.num_coordinates()) + " coordinates";
@@ -327,9 +344,7 @@ std::string PositionSummary::BriefReport() const {
 SolveStatus solve_position(const Model& model, double t, const NewtonOptions& opt, Workspace& ws,
                            PositionSummary* summary) {
   check_workspace(model, ws);
-  if (!(opt.tolerance > 0.0) || opt.max_iterations < 0) throw Error("NewtonOptions: tolerance must be > 0");
-  if (!(opt.max_contraction > 0.0 && opt.max_contraction < 1.0))
-    throw Error("NewtonOptions: max_contraction must be in (0, 1)");
+  detail::check_newton_options(opt);
   PositionSummary local;
   PositionSummary& sum = summary ? *summary : local;
   sum = PositionSummary{};

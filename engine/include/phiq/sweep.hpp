@@ -158,7 +158,9 @@ struct SweepSummary {
 
 /// Runs the sweep from ws.q (the rough placement; the model's initial positions for a fresh workspace), calling
 /// on_step once per time point, in order; on_step returns false to stop (status kCancelled). On failure nothing
-/// more is delivered and the summary says where and why. Pre-condition: ws made for model.
+/// more is delivered and the summary says where and why. Pre-condition: ws made for model. Throws phiq::Error,
+/// before anything is solved, for settings no sweep can honour (negative counts, non-finite times, `newton` or
+/// `assembly` settings solve_position refuses, a predictor whose derivatives are not computed).
 SolveStatus run_sweep(const Model& model, const SweepOptions& options, Workspace& ws,
                       const std::function<bool(const StepView&)>& on_step, SweepSummary* summary);
 
