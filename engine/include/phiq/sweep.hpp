@@ -56,7 +56,9 @@ bool predictor_needs_accelerations(Predictor p);
 /// What run_sweep computes and how.
 struct SweepOptions {
   double t_begin = 0.0;   ///< first time point (s)
-  double t_end = 1.0;     ///< last time point (s); may be below t_begin
+  /// last time point (s); may be below t_begin. With steps > 0 every step must move time: t_end ≠ t_begin and
+  /// |t_end − t_begin| / steps above 8 ulps of the larger of |t_begin|, |t_end| (else run_sweep throws phiq::Error)
+  double t_end = 1.0;
   Index steps = 100;      ///< intervals: steps + 1 time points, t_k = t_begin + k (t_end − t_begin) / steps
   bool velocities = true;     ///< solve and deliver q̇ at every time point
   bool accelerations = true;  ///< solve and deliver q̈ (q̇ is then solved too, but delivered only if asked)
