@@ -20,6 +20,7 @@
 #include "phiq/constraint_kinds_3d.hpp"
 #include "phiq/model.hpp"
 #include "phiq/motion_law.hpp"
+#include "phiq/sweep.hpp"
 
 namespace {
 
@@ -366,6 +367,40 @@ TEST(ConstraintKinds3d, ModelOfSpatialKindsThroughItsPattern) {
   EXPECT_EQ(*m.grubler(), 1);
   EXPECT_EQ(m.body_names(), (std::vector<std::string>{"crank", "rocker"}));
   CheckModel(m, 450);
+}
+
+// A spatial joint driver's law bounds the model's time domain as a coordinate driver's does: a table on a joint
+// angle or distance driver was left out of it, so that a sweep past the table's end was not refused before solving
+// (models/README.md, `table`) but ran up to it and failed there ("'motor' is not finite at t = 2.000390625").
+TEST(ConstraintKinds3d, JointDriversLawsBoundTheTimeDomain) {
+  for (bool angle : {true, false}) {
+    phiq::ModelBuilder b;
+    const Frame3 crank = AddBody(b, "crank");
+    const JointSide3 a = JointSide3::body(Frame3::ground(), V3{}), c = JointSide3::body(crank, V3{});
+    const phiq::MotionLaw table = phiq::MotionLaw::table({0.5, 1.0, 2.0}, {0.0, 0.1, 0.2});
+    if (angle) {
+      phiq::JointAngleDriverSpec motor;
+      motor.a = a, motor.b = c, motor.law = table;
+      b.add("motor", motor);
+    } else {
+      phiq::JointDistanceDriverSpec motor;
+      motor.a = a, motor.b = c, motor.law = table;
+      b.add("motor", motor);
+    }
+    const phiq::Model m = std::move(b).build();
+    EXPECT_EQ(m.time_domain_begin(), 0.5);
+    EXPECT_EQ(m.time_domain_end(), 2.0);
+    EXPECT_EQ(m.time_domain_limiter(), "motor");
+    phiq::Workspace ws(m);
+    phiq::SweepOptions opt;
+    opt.t_begin = 0.5, opt.t_end = 3.0, opt.steps = 10;
+    phiq::SweepSummary sum;
+    Index rows = 0;
+    EXPECT_EQ(phiq::run_sweep(m, opt, ws, [&](const phiq::StepView&) { return ++rows, true; }, &sum),
+              phiq::SolveStatus::kOutsideTimeDomain);
+    EXPECT_EQ(rows, 0);
+    EXPECT_NE(sum.message.find("driver 'motor' is defined on [0.5, 2] only"), std::string::npos) << sum.message;
+  }
 }
 
 TEST(Grubler, PlanarReferencePointFourBarIsOne) {
