@@ -146,6 +146,10 @@ inline JointCount joint_count(const JointDistanceDriverSpec&) { return {JointCou
 inline JointCount joint_count(const EquationSpec& s) {
   return s.law ? JointCount{JointCount::Role::kDriver, 0, 0} : JointCount{};
 }
+/// Whether a driver's law has a function: a default-constructed MotionLaw has none (its evaluation throws, and its
+/// domain reads [0, 0]); an equation's absent law is f ≡ 0.
+inline bool law_has_value(const MotionLaw& law) { return law.has_value(); }
+inline bool law_has_value(const std::optional<MotionLaw>& law) { return !law || law->has_value(); }
 /// Whether a kind derives data from its inputs with a setup() member (the spatial joints and joint drivers).
 template <class T, class = void>
 struct HasSetup : std::false_type {};
@@ -459,6 +463,11 @@ Index ModelBuilder::add(const std::string& name, Spec spec) {
   const std::string label = name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(model_.constraints_.size())
                                          : name;
   spec.for_each_slot([&](const Slot& s, Unit) { check_slot(s, label); });
+  // (here, not at the first solve: a law without a function would otherwise read as the time domain [0, 0] and
+  // throw from inside Φ, on a worker thread when the model is evaluated in parallel)
+  if constexpr (requires { spec.law; })
+    if (!detail::law_has_value(spec.law))
+      throw Error("constraint '" + label + "': its motion law has no function (a default-constructed MotionLaw)");
   prepare(spec);
   const bool td = spec.depends_on_time();
   const Index id = add_info(label, Spec::kKind, Spec::kRows, td);
