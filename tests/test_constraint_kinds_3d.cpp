@@ -403,6 +403,34 @@ TEST(ConstraintKinds3d, JointDriversLawsBoundTheTimeDomain) {
   }
 }
 
+// The accessors that take a row or coordinate index check it: they read out of bounds before (a crash, or a name
+// made of whatever memory followed), where an embedding program's stale index deserves a phiq::Error.
+TEST(ConstraintKinds3d, ModelAccessorsRefuseIndicesOutOfRange) {
+  phiq::ModelBuilder b;
+  const Frame3 crank = AddBody(b, "crank");
+  b.add("hinge",
+        phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{}), JointSide3::body(crank, V3{}), {}});
+  EXPECT_EQ(b.coordinate_name(6), "crank_e3");
+  auto refusal = [](auto&& call) -> std::string {
+    try {
+      call();
+    } catch (const phiq::Error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(refusal([&] { b.coordinate_name(7); }), "coordinate index 7 out of range (the model has 7 coordinates)");
+  EXPECT_EQ(refusal([&] { b.coordinate_name(-1); }), "coordinate index -1 out of range (the model has 7 coordinates)");
+  const phiq::Model m = std::move(b).build();
+  ASSERT_EQ(m.num_equations(), 6);  // crank.euler and the hinge's 5 rows
+  EXPECT_EQ(m.row_name(5), "hinge[4]");
+  EXPECT_EQ(m.constraint_of_row(5), 1);
+  EXPECT_EQ(refusal([&] { m.row_name(6); }), "row index 6 out of range (the model has 6 rows)");
+  EXPECT_EQ(refusal([&] { m.constraint_of_row(1000000); }), "row index 1000000 out of range (the model has 6 rows)");
+  EXPECT_EQ(refusal([&] { m.row_unit(-1); }), "row index -1 out of range (the model has 6 rows)");
+  EXPECT_EQ(refusal([&] { m.coordinate_unit(7); }), "coordinate index 7 out of range (the model has 7 coordinates)");
+}
+
 TEST(Grubler, PlanarReferencePointFourBarIsOne) {
   phiq::ModelBuilder b;
   std::vector<phiq::Frame2> f;

@@ -55,6 +55,11 @@ Index Model::coordinate_index(const std::string& name) const {
   return j;
 }
 
+void detail::throw_index_out_of_range(Index i, Index size, const char* what) {
+  throw Error(std::string(what) + " index " + std::to_string(i) + " out of range (the model has " +
+              std::to_string(size) + " " + what + "s)");
+}
+
 std::string Model::row_name(Index row) const {
   const ConstraintInfo& c = constraints_[static_cast<std::size_t>(constraint_of_row(row))];
   if (c.rows == 1) return c.name;
