@@ -325,6 +325,35 @@ TEST(Kinematics, NewtonOptionsNoSolveCanHonourAreRefusedNamingTheField) {
   EXPECT_EQ(refusal([](NewtonOptions& o) { o.start_error = INFINITY; }), "accepted");
 }
 
+// The workspace's scratch vectors are public; one a caller had resized made the solves write past its end (an
+// abort in free()). It is refused at the call, like a wrong-sized state.
+TEST(Kinematics, AWorkspaceWhoseScratchWasResizedIsRefused) {
+  Model m = crank_slider(2.0, 0.0);
+  auto refusal = [&](auto&& edit) -> std::string {
+    Workspace ws(m);
+    edit(ws);
+    try {
+      solve_position(m, 0.5, NewtonOptions{}, ws);
+      solve_velocity(m, 0.5, ws);
+      solve_acceleration(m, 0.5, ws);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  const std::string refused =
+      "workspace scratch has the wrong size (phi, rhs, step, trial, trial_phi, jacobian_values, solve_values, "
+      "solve_rhs keep the sizes the Workspace was made with)";
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.phi.resize(1); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.rhs.resize(0); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.step.resize(2); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.trial.resize(1); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.trial_phi.resize(1); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.jacobian_values.resize(1); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.solve_rhs.resize(3); }), refused);
+  EXPECT_EQ(refusal([](Workspace&) {}), "accepted");
+}
+
 TEST(Kinematics, NonSquareModelIsReportedWithCounts) {
   ModelBuilder b;
   Index x = b.add_coordinate("x", 0.0);

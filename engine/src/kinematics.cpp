@@ -170,6 +170,14 @@ void check_workspace(const Model& model, const Workspace& ws) {
   const Index n = model.num_coordinates();
   if (ws.q.size() != n || ws.qd.size() != n || ws.qdd.size() != n)
     throw Error("workspace state has the wrong size (q, qd, qdd must have " + std::to_string(n) + " entries)");
+  // The scratch is public (the sweep and tests read it) and sized by the constructor: resized by a caller, the solves
+  // wrote past its end (heap corruption, an abort in free()). Checked with the state, in O(1).
+  const Index m = model.num_equations(), solve_rows = model.dropped_rows().empty() ? 0 : model.num_solve_rows();
+  if (ws.phi.size() != m || ws.rhs.size() != m || ws.trial_phi.size() != m || ws.step.size() != n ||
+      ws.trial.size() != n || static_cast<Index>(ws.jacobian_values.size()) != model.jacobian_pattern().nnz() ||
+      ws.solve_values.size() != model.solve_entries().size() || ws.solve_rhs.size() != solve_rows)
+    throw Error("workspace scratch has the wrong size (phi, rhs, step, trial, trial_phi, jacobian_values, "
+                "solve_values, solve_rhs keep the sizes the Workspace was made with)");
 }
 
 }  // namespace
