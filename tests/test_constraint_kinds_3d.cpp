@@ -20,6 +20,7 @@
 #include "phiq/constraint_kinds_3d.hpp"
 #include "phiq/model.hpp"
 #include "phiq/motion_law.hpp"
+#include "phiq/sweep.hpp"
 
 namespace {
 
@@ -366,6 +367,68 @@ TEST(ConstraintKinds3d, ModelOfSpatialKindsThroughItsPattern) {
   EXPECT_EQ(*m.grubler(), 1);
   EXPECT_EQ(m.body_names(), (std::vector<std::string>{"crank", "rocker"}));
   CheckModel(m, 450);
+}
+
+// A spatial joint driver's law bounds the model's time domain as a coordinate driver's does: a table on a joint
+// angle or distance driver was left out of it, so that a sweep past the table's end was not refused before solving
+// (models/README.md, `table`) but ran up to it and failed there ("'motor' is not finite at t = 2.000390625").
+TEST(ConstraintKinds3d, JointDriversLawsBoundTheTimeDomain) {
+  for (bool angle : {true, false}) {
+    phiq::ModelBuilder b;
+    const Frame3 crank = AddBody(b, "crank");
+    const JointSide3 a = JointSide3::body(Frame3::ground(), V3{}), c = JointSide3::body(crank, V3{});
+    const phiq::MotionLaw table = phiq::MotionLaw::table({0.5, 1.0, 2.0}, {0.0, 0.1, 0.2});
+    if (angle) {
+      phiq::JointAngleDriverSpec motor;
+      motor.a = a, motor.b = c, motor.law = table;
+      b.add("motor", motor);
+    } else {
+      phiq::JointDistanceDriverSpec motor;
+      motor.a = a, motor.b = c, motor.law = table;
+      b.add("motor", motor);
+    }
+    const phiq::Model m = std::move(b).build();
+    EXPECT_EQ(m.time_domain_begin(), 0.5);
+    EXPECT_EQ(m.time_domain_end(), 2.0);
+    EXPECT_EQ(m.time_domain_limiter(), "motor");
+    phiq::Workspace ws(m);
+    phiq::SweepOptions opt;
+    opt.t_begin = 0.5, opt.t_end = 3.0, opt.steps = 10;
+    phiq::SweepSummary sum;
+    Index rows = 0;
+    EXPECT_EQ(phiq::run_sweep(m, opt, ws, [&](const phiq::StepView&) { return ++rows, true; }, &sum),
+              phiq::SolveStatus::kOutsideTimeDomain);
+    EXPECT_EQ(rows, 0);
+    EXPECT_NE(sum.message.find("driver 'motor' is defined on [0.5, 2] only"), std::string::npos) << sum.message;
+  }
+}
+
+// The accessors that take a row or coordinate index check it: they read out of bounds before (a crash, or a name
+// made of whatever memory followed), where an embedding program's stale index deserves a phiq::Error.
+TEST(ConstraintKinds3d, ModelAccessorsRefuseIndicesOutOfRange) {
+  phiq::ModelBuilder b;
+  const Frame3 crank = AddBody(b, "crank");
+  b.add("hinge",
+        phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{}), JointSide3::body(crank, V3{}), {}});
+  EXPECT_EQ(b.coordinate_name(6), "crank_e3");
+  auto refusal = [](auto&& call) -> std::string {
+    try {
+      call();
+    } catch (const phiq::Error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(refusal([&] { b.coordinate_name(7); }), "coordinate index 7 out of range (the model has 7 coordinates)");
+  EXPECT_EQ(refusal([&] { b.coordinate_name(-1); }), "coordinate index -1 out of range (the model has 7 coordinates)");
+  const phiq::Model m = std::move(b).build();
+  ASSERT_EQ(m.num_equations(), 6);  // crank.euler and the hinge's 5 rows
+  EXPECT_EQ(m.row_name(5), "hinge[4]");
+  EXPECT_EQ(m.constraint_of_row(5), 1);
+  EXPECT_EQ(refusal([&] { m.row_name(6); }), "row index 6 out of range (the model has 6 rows)");
+  EXPECT_EQ(refusal([&] { m.constraint_of_row(1000000); }), "row index 1000000 out of range (the model has 6 rows)");
+  EXPECT_EQ(refusal([&] { m.row_unit(-1); }), "row index -1 out of range (the model has 6 rows)");
+  EXPECT_EQ(refusal([&] { m.coordinate_unit(7); }), "coordinate index 7 out of range (the model has 7 coordinates)");
 }
 
 TEST(Grubler, PlanarReferencePointFourBarIsOne) {

@@ -291,6 +291,69 @@ TEST(Kinematics, SingularJacobianIsAStatusNotACrash) {
   EXPECT_NE(ls.message.find("not unique"), std::string::npos) << ls.message;
 }
 
+// Settings no solve can honour are refused at the call, naming the field: an infinite tolerance used to accept the
+// start as the solution, a NaN start_error to accept it unchecked with a NaN error estimate, a negative
+// max_iterations to be refused as a bad tolerance; an unknown jacobian_update and negative max_backtracks passed.
+TEST(Kinematics, NewtonOptionsNoSolveCanHonourAreRefusedNamingTheField) {
+  Model m = crank_slider(2.0, 0.0);
+  auto refusal = [&](auto&& edit) -> std::string {
+    NewtonOptions o;
+    edit(o);
+    Workspace ws(m);
+    try {
+      solve_position(m, 0.5, o, ws);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.tolerance = INFINITY; }),
+            "NewtonOptions: tolerance must be > 0 and finite");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.tolerance = 0.0; }), "NewtonOptions: tolerance must be > 0 and finite");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.tolerance = NAN; }), "NewtonOptions: tolerance must be > 0 and finite");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_iterations = -1; }), "NewtonOptions: max_iterations must be >= 0");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_backtracks = -1; }), "NewtonOptions: max_backtracks must be >= 0");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_contraction = 1.0; }),
+            "NewtonOptions: max_contraction must be in (0, 1)");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.start_error = NAN; }),
+            "NewtonOptions: start_error must not be NaN (negative: unknown)");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.jacobian_update = static_cast<JacobianUpdate>(7); }),
+            "NewtonOptions: jacobian_update is not a JacobianUpdate");
+  // the limits themselves are settings: no step at all, no backtrack, an infinite start error (always a step)
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_iterations = 0; }), "accepted");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.max_backtracks = 0; }), "accepted");
+  EXPECT_EQ(refusal([](NewtonOptions& o) { o.start_error = INFINITY; }), "accepted");
+}
+
+// The workspace's scratch vectors are public; one a caller had resized made the solves write past its end (an
+// abort in free()). It is refused at the call, like a wrong-sized state.
+TEST(Kinematics, AWorkspaceWhoseScratchWasResizedIsRefused) {
+  Model m = crank_slider(2.0, 0.0);
+  auto refusal = [&](auto&& edit) -> std::string {
+    Workspace ws(m);
+    edit(ws);
+    try {
+      solve_position(m, 0.5, NewtonOptions{}, ws);
+      solve_velocity(m, 0.5, ws);
+      solve_acceleration(m, 0.5, ws);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  const std::string refused =
+      "workspace scratch has the wrong size (phi, rhs, step, trial, trial_phi, jacobian_values, solve_values, "
+      "solve_rhs keep the sizes the Workspace was made with)";
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.phi.resize(1); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.rhs.resize(0); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.step.resize(2); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.trial.resize(1); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.trial_phi.resize(1); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.jacobian_values.resize(1); }), refused);
+  EXPECT_EQ(refusal([](Workspace& ws) { ws.solve_rhs.resize(3); }), refused);
+  EXPECT_EQ(refusal([](Workspace&) {}), "accepted");
+}
+
 TEST(Kinematics, NonSquareModelIsReportedWithCounts) {
   ModelBuilder b;
   Index x = b.add_coordinate("x", 0.0);

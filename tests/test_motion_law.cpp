@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "phiq/expression.hpp"
+#include "phiq/model.hpp"
 #include "phiq/motion_law.hpp"
 
 namespace phiq {
@@ -107,6 +109,47 @@ TEST(MotionLaw, InvalidData) {
   EXPECT_THROW(MotionLaw::table({0.0, 1.0}, {0}), Error);
   EXPECT_THROW(MotionLaw::linear(NAN, 1.0), Error);
   EXPECT_THROW(MotionLaw::polynomial({}), Error);
+}
+
+// A default-constructed law has no function, and every kind that holds a law refuses it where the constraint is
+// added, naming it: it used to be accepted, made the model's time domain [0, 0] (limited by that driver) and threw
+// only from inside Φ at the first solve.
+TEST(MotionLaw, ADefaultConstructedLawHasNoFunctionAndNoDriverTakesIt) {
+  EXPECT_FALSE(MotionLaw{}.has_value());
+  EXPECT_TRUE(MotionLaw::linear(0.0, 1.0).has_value());
+  EXPECT_THROW(MotionLaw{}.evaluate(0.0), Error);
+  auto refusal = [](auto&& add) -> std::string {
+    ModelBuilder b;
+    for (const char* c : {"x", "y", "z", "e0", "e1", "e2", "e3"}) b.add_coordinate(c, c[0] == 'e' ? 0.5 : 0.0);
+    try {
+      add(b);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "accepted";
+  };
+  const std::string refused = "': its motion law has no function (a default-constructed MotionLaw)";
+  EXPECT_EQ(refusal([](ModelBuilder& b) { b.add_driver("motor", 0, MotionLaw{}); }),
+            "constraint 'motor" + refused);
+  EXPECT_EQ(refusal([](ModelBuilder& b) { b.add_driver("motor", 0, MotionLaw::linear(0.0, 1.0)); }), "accepted");
+  const Frame3 body{Slot::coordinate(0), Slot::coordinate(1), Slot::coordinate(2), Slot::coordinate(3),
+                    Slot::coordinate(4), Slot::coordinate(5), Slot::coordinate(6)};
+  EXPECT_EQ(refusal([&](ModelBuilder& b) {
+              b.add("turn", JointAngleDriverSpec{JointSide3::body(Frame3::ground(), {}), JointSide3::body(body, {}),
+                                                 MotionLaw{}});
+            }),
+            "constraint 'turn" + refused);
+  EXPECT_EQ(refusal([&](ModelBuilder& b) {
+              b.add("lift", JointDistanceDriverSpec{JointSide3::body(Frame3::ground(), {}),
+                                                    JointSide3::body(body, {}), MotionLaw{}});
+            }),
+            "constraint 'lift" + refused);
+  const auto g = CompiledExpression::compile("x", [](const std::string& name) -> std::optional<NameBinding> {
+    if (name == "x") return NameBinding{NameBinding::Kind::kCoordinate, 0};
+    return std::nullopt;
+  });
+  EXPECT_EQ(refusal([&](ModelBuilder& b) { b.add("eq", EquationSpec{g, MotionLaw{}}); }), "constraint 'eq" + refused);
+  EXPECT_EQ(refusal([&](ModelBuilder& b) { b.add("eq", EquationSpec{g, std::nullopt}); }), "accepted");
 }
 
 }  // namespace

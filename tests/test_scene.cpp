@@ -130,6 +130,12 @@ TEST(Scene, ImpossibleValuesAreRefused) {
   EXPECT_HAS(error_of(variant("steps: 4", "steps: -4")), "time.steps");
   EXPECT_HAS(error_of(variant("steps: 4", "steps: 2.5")), "expected a whole number");
   EXPECT_HAS(error_of(variant("end: pi/2", "end: 0")), "end equals start");
+  // steps that would not move time (run_sweep refuses them): below the rounding of the times, or an overflowing span
+  const std::string time = "time: {start: 0, end: pi/2, steps: 4}";
+  EXPECT_HAS(error_of(variant(time, "time: {start: 1, end: 1.000000000000001, steps: 4}")),
+             "time.end: 4 steps from t = 1 to 1 are 2.78e-16 s each, below the rounding of the times");
+  EXPECT_HAS(error_of(variant(time, "time: {start: -1e308, end: 1e308, steps: 4}")),
+             "time.end: the span from t = -1e+308 to 1e+308 is not a finite number");
 }
 
 TEST(Scene, WrongTypes) {

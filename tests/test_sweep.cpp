@@ -245,6 +245,80 @@ TEST(Sweep, PredictorNamesAndTheAutomaticChoice) {
   EXPECT_THROW(run_sweep(m, opt, ws, nullptr, nullptr), Error);
 }
 
+// Bad settings are refused before the sweep starts, naming the field: an infinite drive tolerance used to pass as
+// a successful sweep of the unmoved start, bad drive settings were found only after the assembly had delivered row
+// 0 (on 2 threads, by a worker), a negative max_subdivisions and an unknown predictor passed unnoticed.
+TEST(Sweep, SettingsNoSweepCanHonourAreRefusedBeforeTheFirstRow) {
+  Model m = crank_slider();
+  for (int threads : {1, 2}) {
+    auto refusal = [&](auto&& edit) -> std::string {
+      SweepOptions opt;
+      opt.threads = threads;
+      opt.chunk_steps = 10;
+      edit(opt);
+      Workspace ws(m);
+      Index rows = 0;
+      try {
+        run_sweep(m, opt, ws, [&](const StepView&) { return ++rows, true; }, nullptr);
+      } catch (const Error& e) {
+        EXPECT_EQ(rows, 0) << e.what();
+        return e.what();
+      }
+      return "accepted";
+    };
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.newton.tolerance = INFINITY; }),
+              "SweepOptions::newton: tolerance must be > 0 and finite");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.newton.max_contraction = 2.0; }),
+              "SweepOptions::newton: max_contraction must be in (0, 1)");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.assembly.max_iterations = -1; }),
+              "SweepOptions::assembly: max_iterations must be >= 0");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.max_subdivisions = -1; }),
+              "SweepOptions: max_subdivisions must be >= 0");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.predictor = static_cast<Predictor>(99); }),
+              "SweepOptions: predictor is not a Predictor");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.max_subdivisions = 0; }), "accepted");
+  }
+}
+
+// A time grid whose steps do not move time is refused before anything is solved (the scene loader refuses it at
+// `time.end`): t_begin = t_end with steps > 0 and steps below the rounding of the times made the predictors divide
+// by a zero spacing, and failed as "starting point has non-finite coordinates"; a span that overflows
+// (−1e308 to 1e308) failed at "t = -nan". A short span well above the rounding, and steps = 0, are swept.
+TEST(Sweep, ATimeGridWhoseStepsDoNotMoveTimeIsRefused) {
+  Model m = crank_slider();
+  for (int threads : {1, 2}) {
+    auto refusal = [&](double t_begin, double t_end, Index steps, Index* rows_out = nullptr) -> std::string {
+      SweepOptions opt;
+      opt.threads = threads;
+      opt.chunk_steps = 2;
+      opt.t_begin = t_begin, opt.t_end = t_end, opt.steps = steps;
+      Workspace ws(m);
+      Index rows = 0;
+      SweepSummary sum;
+      try {
+        run_sweep(m, opt, ws, [&](const StepView&) { return ++rows, true; }, &sum);
+      } catch (const Error& e) {
+        EXPECT_EQ(rows, 0) << e.what();
+        return e.what();
+      }
+      if (rows_out) *rows_out = rows;
+      return sum.status == SolveStatus::kSuccess ? "swept" : sum.message;
+    };
+    EXPECT_EQ(refusal(0.5, 0.5, 10), "SweepOptions: t_end equals t_begin but steps > 0");
+    EXPECT_EQ(refusal(1.0, 1.0 + 4e-16, 10),
+              "SweepOptions: 10 steps from t = 1 to 1 are 4.44e-17 s each, below the rounding of the times (8 ulps: "
+              "1.78e-15 s): they would not move time");
+    EXPECT_EQ(refusal(-1e308, 1e308, 4), "SweepOptions: the span from t = -1e+308 to 1e+308 is not a finite number");
+    Index rows = 0;
+    EXPECT_EQ(refusal(0.5, 0.5, 0, &rows), "swept");
+    EXPECT_EQ(rows, 1);
+    EXPECT_EQ(refusal(1.0, 1.0 + 1e-9, 10, &rows), "swept");
+    EXPECT_EQ(rows, 11);
+    EXPECT_EQ(refusal(1.0 + 1e-9, 1.0, 10, &rows), "swept");
+    EXPECT_EQ(rows, 11);
+  }
+}
+
 TEST(Sweep, PositionOnlySweepDoesNoVelocityOrAccelerationWork) {
   Model m = crank_slider();
   SweepOptions opt;

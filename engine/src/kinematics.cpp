@@ -170,7 +170,32 @@ void check_workspace(const Model& model, const Workspace& ws) {
   const Index n = model.num_coordinates();
   if (ws.q.size() != n || ws.qd.size() != n || ws.qdd.size() != n)
     throw Error("workspace state has the wrong size (q, qd, qdd must have " + std::to_string(n) + " entries)");
+  // The scratch is public (the sweep and tests read it) and sized by the constructor: resized by a caller, the solves
+  // wrote past its end (heap corruption, an abort in free()). Checked with the state, in O(1).
+  const Index m = model.num_equations(), solve_rows = model.dropped_rows().empty() ? 0 : model.num_solve_rows();
+  if (ws.phi.size() != m || ws.rhs.size() != m || ws.trial_phi.size() != m || ws.step.size() != n ||
+      ws.trial.size() != n || static_cast<Index>(ws.jacobian_values.size()) != model.jacobian_pattern().nnz() ||
+      ws.solve_values.size() != model.solve_entries().size() || ws.solve_rhs.size() != solve_rows)
+    throw Error("workspace scratch has the wrong size (phi, rhs, step, trial, trial_phi, jacobian_values, "
+                "solve_values, solve_rhs keep the sizes the Workspace was made with)");
 }
+
+}  // namespace
+
+void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
+  // An infinite tolerance accepts any point as the solution, a NaN start_error accepts the start unchecked (and
+  // reports NaN as its error): settings no solve can honour, each named by its field.
+  auto fail = [&](const std::string& why) { throw Error(std::string(what) + ": " + why); };
+  if (!(opt.tolerance > 0.0 && std::isfinite(opt.tolerance))) fail("tolerance must be > 0 and finite");
+  if (opt.max_iterations < 0) fail("max_iterations must be >= 0");
+  if (opt.max_backtracks < 0) fail("max_backtracks must be >= 0");
+  if (!(opt.max_contraction > 0.0 && opt.max_contraction < 1.0)) fail("max_contraction must be in (0, 1)");
+  if (std::isnan(opt.start_error)) fail("start_error must not be NaN (negative: unknown)");
+  if (opt.jacobian_update != JacobianUpdate::kEveryIteration && opt.jacobian_update != JacobianUpdate::kWhenSlow)
+    fail("jacobian_update is not a JacobianUpdate");
+}
+
+namespace {
 
 std::string not_square_message(const Model& model) {
   std::string s = "the model has " + std::to_string(model.num_solve_rows()) + " equations for " +
@@ -327,9 +352,7 @@ std::string PositionSummary::BriefReport() const {
 SolveStatus solve_position(const Model& model, double t, const NewtonOptions& opt, Workspace& ws,
                            PositionSummary* summary) {
   check_workspace(model, ws);
-  if (!(opt.tolerance > 0.0) || opt.max_iterations < 0) throw Error("NewtonOptions: tolerance must be > 0");
-  if (!(opt.max_contraction > 0.0 && opt.max_contraction < 1.0))
-    throw Error("NewtonOptions: max_contraction must be in (0, 1)");
+  detail::check_newton_options(opt);
   PositionSummary local;
   PositionSummary& sum = summary ? *summary : local;
   sum = PositionSummary{};

@@ -9,6 +9,11 @@ namespace phiq::detail {
 /// finite: ∂'c'/∂'x' = -inf, …"): the sweep then names no other cause.
 inline constexpr const char* kNonFiniteJacobian = "Φq is not finite: ";
 
+/// Throws phiq::Error naming the first field of `opt` no solve can honour, after `what` (solve_position's check,
+/// also made by a sweep before it starts, so that bad drive settings are refused before the assembly, not on a
+/// worker thread).
+void check_newton_options(const NewtonOptions& opt, const char* what = "NewtonOptions");
+
 /// solve_velocity and, with `accelerations`, solve_acceleration at the position solve_position has just converged
 /// to at t. Pre-condition (the sweep's own sequence, not checked): ws.q has not changed since that solve returned
 /// kSuccess. The factorisation or the Jacobian values that solve reported valid at its solution are taken as they

@@ -55,6 +55,11 @@ Index Model::coordinate_index(const std::string& name) const {
   return j;
 }
 
+void detail::throw_index_out_of_range(Index i, Index size, const char* what) {
+  throw Error(std::string(what) + " index " + std::to_string(i) + " out of range (the model has " +
+              std::to_string(size) + " " + what + "s)");
+}
+
 std::string Model::row_name(Index row) const {
   const ConstraintInfo& c = constraints_[static_cast<std::size_t>(constraint_of_row(row))];
   if (c.rows == 1) return c.name;
@@ -509,10 +514,18 @@ Model ModelBuilder::build() && {
     if (law.domain_begin() > m.time_begin_) m.time_begin_ = law.domain_begin(), m.time_limiter_ = name;
     if (law.domain_end() < m.time_end_) m.time_end_ = law.domain_end(), m.time_limiter_ = name;
   };
-  if (auto it = block_of_type_.find(std::type_index(typeid(CoordinateDriverSpec))); it != block_of_type_.end()) {
-    auto& blk = static_cast<TypedBlock<CoordinateDriverSpec>&>(*m.blocks_[it->second]);
-    for (std::size_t i = 0; i < blk.size(); ++i) limit_time(blk.spec(i).law, blk.first_row(i));
-  }
+  // (every kind that holds a law: the spatial joint drivers too, or a table on a joint's angle was only found
+  // undefined where the sweep reached its end)
+  auto limit_by_drivers = [&](auto kind) {
+    using Spec = decltype(kind);
+    if (auto it = block_of_type_.find(std::type_index(typeid(Spec))); it != block_of_type_.end()) {
+      auto& blk = static_cast<TypedBlock<Spec>&>(*m.blocks_[it->second]);
+      for (std::size_t i = 0; i < blk.size(); ++i) limit_time(blk.spec(i).law, blk.first_row(i));
+    }
+  };
+  limit_by_drivers(CoordinateDriverSpec{});
+  limit_by_drivers(JointAngleDriverSpec{});
+  limit_by_drivers(JointDistanceDriverSpec{});
   if (auto it = block_of_type_.find(std::type_index(typeid(EquationSpec))); it != block_of_type_.end()) {
     auto& blk = static_cast<TypedBlock<EquationSpec>&>(*m.blocks_[it->second]);
     for (std::size_t i = 0; i < blk.size(); ++i)

@@ -18,6 +18,8 @@
 #include <type_traits>
 #include <unordered_map>
 
+#include "time_grid.hpp"
+
 namespace phiq {
 
 namespace {
@@ -2010,6 +2012,8 @@ class SceneReader {
     o.t_end = number(c.require("end"));
     o.steps = c.require("steps").integer(0, 1000000000);
     if (o.steps > 0 && o.t_end == o.t_begin) c.require("end").fail("end equals start but steps > 0");
+    if (const std::string why = detail::time_grid_problem(o.t_begin, o.t_end, o.steps); !why.empty())
+      c.require("end").fail(why);  // steps that would not move time: run_sweep refuses them
   }
 
   // The output list, and from it the sweep's plan: derivatives, points, residuals and the condition estimate are

@@ -27,6 +27,7 @@
 
 #include "kinematics_internal.hpp"
 #include "phiq/assembly.hpp"
+#include "time_grid.hpp"
 #include "tolerance_tests.hpp"
 
 namespace phiq {
@@ -1184,7 +1185,15 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   if (&ws.model() != &model) throw Error("workspace was made for another model");
   if (opt.steps < 0) throw Error("SweepOptions: steps must be >= 0");
   if (!std::isfinite(opt.t_begin) || !std::isfinite(opt.t_end)) throw Error("SweepOptions: times must be finite");
+  if (const std::string why = detail::time_grid_problem(opt.t_begin, opt.t_end, opt.steps); !why.empty())
+    throw Error("SweepOptions: " + why);
   if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
+  if (opt.max_subdivisions < 0) throw Error("SweepOptions: max_subdivisions must be >= 0");
+  const std::vector<Predictor>& predictors = all_predictors();
+  if (std::find(predictors.begin(), predictors.end(), opt.predictor) == predictors.end())
+    throw Error("SweepOptions: predictor is not a Predictor");
+  detail::check_newton_options(opt.assembly, "SweepOptions::assembly");
+  detail::check_newton_options(opt.newton, "SweepOptions::newton");
   for (const OutputPoint& p : opt.points)
     if (p.max_coordinate() >= model.num_coordinates())
       throw Error("SweepOptions: output point '" + p.name + "' reads a coordinate the model does not have");

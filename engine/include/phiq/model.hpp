@@ -92,6 +92,17 @@ class NameIndex {
 };
 }  // namespace detail
 
+namespace detail {
+/// Throws phiq::Error for an index `i` outside [0, size) of a `what` ("row", "coordinate").
+[[noreturn]] void throw_index_out_of_range(Index i, Index size, const char* what);
+/// `i` as a vector index, checked: the accessors that take a row or coordinate index read out of bounds otherwise
+/// (an embedding program's stale index is its error, said as one, not a crash). One comparison, on cold paths.
+inline std::size_t index_in(Index i, Index size, const char* what) {
+  if (i < 0 || i >= size) throw_index_out_of_range(i, size, what);
+  return static_cast<std::size_t>(i);
+}
+}  // namespace detail
+
 /// What a constraint counts for in the Grübler–Kutzbach formula (Model::grubler()).
 struct JointCount {
   /// The role of the constraint in the count.
@@ -146,6 +157,10 @@ inline JointCount joint_count(const JointDistanceDriverSpec&) { return {JointCou
 inline JointCount joint_count(const EquationSpec& s) {
   return s.law ? JointCount{JointCount::Role::kDriver, 0, 0} : JointCount{};
 }
+/// Whether a driver's law has a function: a default-constructed MotionLaw has none (its evaluation throws, and its
+/// domain reads [0, 0]); an equation's absent law is f ≡ 0.
+inline bool law_has_value(const MotionLaw& law) { return law.has_value(); }
+inline bool law_has_value(const std::optional<MotionLaw>& law) { return !law || law->has_value(); }
 /// Whether a kind derives data from its inputs with a setup() member (the spatial joints and joint drivers).
 template <class T, class = void>
 struct HasSetup : std::false_type {};
@@ -210,18 +225,20 @@ class Model {
   Index coordinate_index(const std::string& name) const;
   /// The initial guesses (rough placement) of q.
   const Eigen::VectorXd& initial_positions() const { return initial_; }
-  /// Unit of coordinate j, inferred from the constraints that read it. Pre-condition: 0 ≤ j < n.
-  Unit coordinate_unit(Index j) const { return coordinate_units_[static_cast<std::size_t>(j)]; }
+  /// Unit of coordinate j, inferred from the constraints that read it. Throws phiq::Error unless 0 ≤ j < n.
+  Unit coordinate_unit(Index j) const {
+    return coordinate_units_[detail::index_in(j, num_coordinates(), "coordinate")];
+  }
 
   /// The constraints, in the order they were added (rows follow that order).
   const std::vector<ConstraintInfo>& constraints() const { return constraints_; }
   /// The constraint blocks, one per kind, for tools that read the constraints' data (mechanism_sketch.hpp).
   const std::vector<std::shared_ptr<ConstraintBlock>>& blocks() const { return blocks_; }
-  /// Index into constraints() of the constraint owning `row`. Pre-condition: 0 ≤ row < m.
-  Index constraint_of_row(Index row) const { return row_constraint_[static_cast<std::size_t>(row)]; }
-  /// Unit of a row of Φ (for its tolerance). Pre-condition: 0 ≤ row < m.
-  Unit row_unit(Index row) const { return row_units_[static_cast<std::size_t>(row)]; }
-  /// "name" for one-row constraints, "name[k]" for row k of a multi-row one.
+  /// Index into constraints() of the constraint owning `row`. Throws phiq::Error unless 0 ≤ row < m.
+  Index constraint_of_row(Index row) const { return row_constraint_[detail::index_in(row, num_equations(), "row")]; }
+  /// Unit of a row of Φ (for its tolerance). Throws phiq::Error unless 0 ≤ row < m.
+  Unit row_unit(Index row) const { return row_units_[detail::index_in(row, num_equations(), "row")]; }
+  /// "name" for one-row constraints, "name[k]" for row k of a multi-row one. Throws phiq::Error unless 0 ≤ row < m.
   std::string row_name(Index row) const;
   /// The Grübler–Kutzbach count of the model's joints: 3 (nb − 1) − Σ c_i for planar bodies, 6 (nb − 1) − Σ c_i for
   /// spatial bodies, nb counting ground and c_i the freedoms joint i removes (drivers and the bodies' Euler
@@ -360,8 +377,10 @@ class ModelBuilder {
   Index num_coordinates() const { return static_cast<Index>(model_.names_.size()); }
   /// Index of a coordinate by name, or -1.
   Index find_coordinate(const std::string& name) const;
-  /// Name of coordinate j. Pre-condition: 0 ≤ j < num_coordinates().
-  const std::string& coordinate_name(Index j) const { return model_.names_[static_cast<std::size_t>(j)]; }
+  /// Name of coordinate j. Throws phiq::Error unless 0 ≤ j < num_coordinates().
+  const std::string& coordinate_name(Index j) const {
+    return model_.names_[detail::index_in(j, num_coordinates(), "coordinate")];
+  }
   /// True when a constraint of that name has been added.
   bool has_constraint(const std::string& name) const {
     return constraint_names_.find(name, model_.constraint_name_of()) >= 0;
@@ -459,6 +478,11 @@ Index ModelBuilder::add(const std::string& name, Spec spec) {
   const std::string label = name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(model_.constraints_.size())
                                          : name;
   spec.for_each_slot([&](const Slot& s, Unit) { check_slot(s, label); });
+  // (here, not at the first solve: a law without a function would otherwise read as the time domain [0, 0] and
+  // throw from inside Φ, on a worker thread when the model is evaluated in parallel)
+  if constexpr (requires { spec.law; })
+    if (!detail::law_has_value(spec.law))
+      throw Error("constraint '" + label + "': its motion law has no function (a default-constructed MotionLaw)");
   prepare(spec);
   const bool td = spec.depends_on_time();
   const Index id = add_info(label, Spec::kKind, Spec::kRows, td);

@@ -35,6 +35,9 @@ class MotionLaw {
 
   /// f, f', f'' at t; NaN outside [domain_begin(), domain_end()]. Throws phiq::Error on a default-constructed law.
   LawValue evaluate(double t) const;
+  /// False for a default-constructed law (no function: evaluate() throws), true for every law the factory
+  /// functions make. ModelBuilder refuses a driver whose law has none.
+  bool has_value() const { return impl_ != nullptr; }
   /// Interval on which the law is defined: infinite for analytic laws, the table's range for tables.
   double domain_begin() const;
   double domain_end() const;  ///< see domain_begin()

@@ -56,7 +56,9 @@ bool predictor_needs_accelerations(Predictor p);
 /// What run_sweep computes and how.
 struct SweepOptions {
   double t_begin = 0.0;   ///< first time point (s)
-  double t_end = 1.0;     ///< last time point (s); may be below t_begin
+  /// last time point (s); may be below t_begin. With steps > 0 every step must move time: t_end ≠ t_begin and
+  /// |t_end − t_begin| / steps above 8 ulps of the larger of |t_begin|, |t_end| (else run_sweep throws phiq::Error)
+  double t_end = 1.0;
   Index steps = 100;      ///< intervals: steps + 1 time points, t_k = t_begin + k (t_end − t_begin) / steps
   bool velocities = true;     ///< solve and deliver q̇ at every time point
   bool accelerations = true;  ///< solve and deliver q̈ (q̇ is then solved too, but delivered only if asked)
@@ -158,7 +160,9 @@ struct SweepSummary {
 
 /// Runs the sweep from ws.q (the rough placement; the model's initial positions for a fresh workspace), calling
 /// on_step once per time point, in order; on_step returns false to stop (status kCancelled). On failure nothing
-/// more is delivered and the summary says where and why. Pre-condition: ws made for model.
+/// more is delivered and the summary says where and why. Pre-condition: ws made for model. Throws phiq::Error,
+/// before anything is solved, for settings no sweep can honour (negative counts, non-finite times, `newton` or
+/// `assembly` settings solve_position refuses, a predictor whose derivatives are not computed).
 SolveStatus run_sweep(const Model& model, const SweepOptions& options, Workspace& ws,
                       const std::function<bool(const StepView&)>& on_step, SweepSummary* summary);
 
