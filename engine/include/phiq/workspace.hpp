@@ -42,6 +42,7 @@ class Workspace {
   WorkCounters counters;   ///< work done with this workspace so far (never reset by the algorithms)
 
   /// @name Scratch of the algorithms (kinematics.cpp); callers need not touch it
+  /// Its values may be read; a vector resized by the caller makes every solve refuse the workspace (phiq::Error).
   ///@{
   Eigen::VectorXd phi;                   ///< Φ at q
   Eigen::VectorXd rhs;                   ///< right-hand side of the last velocity or acceleration solve
