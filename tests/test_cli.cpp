@@ -1016,6 +1016,38 @@ output: {velocities: true, accelerations: true}
 // A device node (as /dev/null: character device 1, 3) given to -o is written in place and stays a device, as does
 // a FIFO (its reader gets the whole CSV); several outputs may share a device. Creating the node needs root (mknod):
 // skipped otherwise. The real /dev/null is never used: the node lives in the test's directory.
+// "-" is standard output, as in most tools: run -o - gives the bytes run gives without -o (one thread: the same
+// bytes in every run), generate -o - a scene that loads, plot -o - an SVG, --summary - the JSON; no file named "-"
+// appears; batch refuses it for its directory.
+TEST_F(Cli, ADashIsStandardOutput) {
+  const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
+  struct Cwd {  // in dir_ (a file named "-" would land there), back however the test ends
+    fs::path was = fs::current_path();
+    explicit Cwd(const fs::path& to) { fs::current_path(to); }
+    ~Cwd() { fs::current_path(was); }
+  } in_dir(dir_);
+  Result plain = run("run -q --threads 1 " + scene);
+  Result dash = run("run -q --threads 1 " + scene + " -o -");
+  ASSERT_EQ(dash.code, 0) << dash.err;
+  EXPECT_EQ(dash.out, plain.out);
+  EXPECT_EQ(dash.out.rfind("t,theta2,", 0), 0u);
+  Result gen = run("generate nfourbar 3 --steps 4 -o -");
+  ASSERT_EQ(gen.code, 0) << gen.err;
+  EXPECT_EQ(phiq::parse_scene(gen.out, "generated.yaml").model->num_coordinates(), 9);  // θ and 4 tips
+  const fs::path csv = dir_ / "cs.csv";
+  Result sum = run("run -q --threads 1 " + scene + " -o " + csv.string() + " --summary -");
+  ASSERT_EQ(sum.code, 0) << sum.err;
+  EXPECT_EQ(sum.out.rfind("{", 0), 0u) << sum.out;
+  EXPECT_NE(sum.out.find("\"steps\": 181"), std::string::npos) << sum.out;
+  Result svg = run("plot " + scene + " " + csv.string() + " -o -");
+  ASSERT_EQ(svg.code, 0) << svg.err;
+  EXPECT_NE(svg.out.find("<svg"), std::string::npos);
+  Result batch = run("batch " + scene + " " + write("c.csv", "L2\n0.2\n").string() + " -o -");
+  EXPECT_EQ(batch.code, 2);
+  EXPECT_NE(batch.err.find("'-' (standard output) cannot hold the case files"), std::string::npos) << batch.err;
+  EXPECT_FALSE(fs::exists(dir_ / "-"));
+}
+
 TEST_F(Cli, DeviceAndFifoOutputsAreWrittenInPlace) {
   const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
   const fs::path fifo = dir_ / "fifo", copy = dir_ / "copy.csv";

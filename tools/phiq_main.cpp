@@ -636,9 +636,17 @@ CLI::Validator one_of(const std::vector<std::string>& words) {
 }
 
 // An output path that is not empty (an empty one used to mean standard output, silently).
-CLI::Validator non_empty_path(const std::string& instead) {
+// An output path where "-" is standard output, as in most tools (a file named "-" is still `./-`). `spooled`: as if
+// the option were absent (run, assemble: the CSV is spooled and written whole once the solve succeeded); otherwise
+// /dev/stdout, the descriptor itself (written in place, as a pipe or a terminal is).
+CLI::Validator output_path(const std::string& instead, bool spooled) {
   return CLI::Validator(
-      [=](std::string& text) -> std::string { return text.empty() ? "the path is empty" + instead : ""; }, "PATH");
+      [=](std::string& text) -> std::string {
+        if (text.empty()) return "the path is empty" + instead;
+        if (text == "-") text = spooled ? "" : "/dev/stdout";
+        return "";
+      },
+      "PATH");
 }
 
 // More threads than the cores TBB runs (tbb::info::default_concurrency(), which honours the process's affinity
@@ -706,17 +714,26 @@ int main(int argc, char** argv) {
                                         std::to_string(phiq::kCheckJsonFormat) + ")");
   app.require_subcommand(1);
   const CLI::Validator threads_range = whole_number(0, 1000000, "all cores");
-  const CLI::Validator path_given = non_empty_path("");
-  const CLI::Validator path_or_stdout = non_empty_path(" (without the option: standard output)");
+  const CLI::Validator path_given = output_path("", false);
+  const CLI::Validator path_or_stdout = output_path(" (without the option, or '-': standard output)", false);
+  const CLI::Validator spooled_or_stdout = output_path(" (without the option, or '-': standard output)", true);
+  const CLI::Validator directory_given = CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (text.empty()) return "the path is empty";
+        return text == "-" ? "'-' (standard output) cannot hold the case files: give a directory" : "";
+      },
+      "DIR");
 
   std::string scene_path, out_path, summary_path;
   bool quiet = false;
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
   run->add_option("scene", scene_path, "Scene file (YAML)")->required();
-  run->add_option("-o,--output", out_path, "CSV file to write (default: standard output)")->check(path_or_stdout);
+  run->add_option("-o,--output", out_path, "CSV file to write (default or '-': standard output)")
+      ->transform(spooled_or_stdout);
   run->add_flag("-q,--quiet", quiet, "Do not print the run summary on standard error");
-  run->add_option("--summary", summary_path, "Write the run summary as JSON (counts and timings) to this file")
-      ->check(path_given);
+  run->add_option("--summary", summary_path,
+                  "Write the run summary as JSON (counts and timings) to this file ('-': standard output)")
+      ->transform(path_given);
   int threads = 0;
   run->add_option("--threads", threads, "Threads for the drive steps (0: all cores; 1: in order)")
       ->capture_default_str()
@@ -739,7 +756,9 @@ int main(int argc, char** argv) {
   generate->add_option("N", gen.n, "Size: four-bars (nfourbar), stages (scissor), cells (grid), spatial loops (chain3d)")
       ->required()
       ->check(any_whole_number());
-  generate->add_option("-o,--output", gen_out, "Scene file to write")->required()->check(path_given);
+  generate->add_option("-o,--output", gen_out, "Scene file to write ('-': standard output)")
+      ->required()
+      ->transform(path_given);
   generate->add_option("--steps", gen.steps, "Sweep intervals")->capture_default_str()->check(any_whole_number());
   const CLI::Validator any_number = number(-HUGE_VAL, HUGE_VAL, false, "a finite number");
   CLI::Option* gen_from =
@@ -763,7 +782,9 @@ int main(int argc, char** argv) {
   int batch_threads = 0;
   batch->add_option("scene", batch_scene, "Scene file (YAML)")->required();
   batch->add_option("cases", batch_cases, "CSV: a header of parameter names, one row of values per case")->required();
-  batch->add_option("-o,--output", batch_dir, "Directory for case<k>.csv (k = row, from 0)")->required()->check(path_given);
+  batch->add_option("-o,--output", batch_dir, "Directory for case<k>.csv (k = row, from 0)")
+      ->required()
+      ->check(directory_given);
   batch->add_flag("-q,--quiet", batch_quiet, "Print only failures on standard error");
   batch->add_option("--threads", batch_threads, "Threads for the cases (0: all cores)")
       ->capture_default_str()
@@ -773,7 +794,8 @@ int main(int argc, char** argv) {
   CLI::App* assemble_cmd =
       app.add_subcommand("assemble", "Assemble the rough placement (minimum-norm) and write the coordinates as CSV");
   assemble_cmd->add_option("scene", asm_path, "Scene file (YAML)")->required();
-  assemble_cmd->add_option("-o,--output", asm_out, "CSV file to write (default: standard output)")->check(path_or_stdout);
+  assemble_cmd->add_option("-o,--output", asm_out, "CSV file to write (default or '-': standard output)")
+      ->transform(spooled_or_stdout);
   assemble_cmd->add_flag("-q,--quiet", asm_quiet, "Do not print the summary on standard error");
   CLI::App* check = app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
   check->add_option("scene", check_path, "Scene file (YAML)")->required();
@@ -788,7 +810,9 @@ int main(int argc, char** argv) {
                                               "columns against time, as SVG");
   plot->add_option("scene", plot_options.scene, "Scene file (YAML)")->required();
   plot->add_option("result", plot_options.csv, "CSV written by `phiq run` for this scene")->required();
-  plot->add_option("-o,--output", plot_options.out, "SVG file to write")->required()->check(path_given);
+  plot->add_option("-o,--output", plot_options.out, "SVG file to write ('-': standard output)")
+      ->required()
+      ->transform(path_given);
   plot->add_option("--columns", plot_options.columns, "Columns to plot against t (default: the coordinates, at most 6)")
       ->delimiter(',');
   plot->add_option("--positions", plot_options.positions, "Rows at which the mechanism is drawn, evenly spread")
@@ -812,8 +836,8 @@ int main(int argc, char** argv) {
   CLI::App* accuracy = app.add_subcommand("sweep-accuracy", "Error against a reference and time per step, per solver setting");
   accuracy->add_option("scene", acc.scene, "Scene file (YAML)")->required();
   accuracy->add_option("-o,--output", acc.csv_path, "CSV to write (default: standard output unless --json)")
-      ->check(path_or_stdout);
-  accuracy->add_option("--json", acc.json_path, "JSON to write")->check(path_given);
+      ->transform(path_or_stdout);
+  accuracy->add_option("--json", acc.json_path, "JSON to write ('-': standard output)")->transform(path_given);
   accuracy->add_option("--tolerances", acc.tolerances, "Newton tolerances (default 1e-4,1e-5,...,1e-14)");
   accuracy->add_option("--steps-list", acc.steps, "Step counts (default: the scene's x 1/4, 1, 4)");
   accuracy->add_option("--predictors", acc.predictors, "Of previous,secant,parabolic,linear,quadratic,cubic,auto (default: all but auto)");
