@@ -108,8 +108,9 @@ TEST(SingularPositions, ACrossingBetweenStepsIsReportedByTheSignOfDetPhiQ) {
       EXPECT_DOUBLE_EQ(bif[0].t, 0.453);
       EXPECT_DOUBLE_EQ(bif[1].t, 0.953);
       EXPECT_HAS(bif[0].message, n % 2 ? "det Φq changed sign between t = 0.452 and t = 0.453"
-                                       : "det Φq changed sign on an even number of its independent blocks (loops "
-                                         "that Φq factorises one by one) between t = 0.452 and t = 0.453");
+                                       : "the determinants of an even number of Φq's diagonal blocks (loops that Φq "
+                                         "factorises one by one) changed sign, det Φq's not, between t = 0.452 and "
+                                         "t = 0.453");
       EXPECT_EQ(sum.singular_positions, 0);
       const auto exact = test::nfourbar_exact(model, th0, w);
       tools::ClosedFormErrors err(*exact);

@@ -978,9 +978,10 @@ struct Run {
       if (last_sign.sign != 0 && det_sign != last_sign && !singular_since)
         sum.warnings.push_back(
             {time_of(k), "bifurcation",
-             std::string(det_sign.sign != last_sign.sign ? "det Φq changed sign"
-                                                         : "det Φq changed sign on an even number of its independent "
-                                                           "blocks (loops that Φq factorises one by one)") +
+             std::string(det_sign.sign != last_sign.sign
+                             ? "det Φq changed sign"
+                             : "the determinants of an even number of Φq's diagonal blocks (loops that Φq factorises "
+                               "one by one) changed sign, det Φq's not,") +
                  " between t = " + format_time(last_sign_t) + " and t = " + format_time(det_sign_t) +
                  ": the motion passed a singular position there (a bifurcation, where branches cross); the sweep "
                  "kept the branch it was on"});
