@@ -117,6 +117,13 @@ TEST(Slot, ModelBuilderRejectsNonFiniteConstantsAndUnknownCoordinates) {
       EXPECT_NE(std::string(e.what()).find("constraint 'bad': constant is not finite"), std::string::npos) << e.what();
     }
   }
+  // a kind's own check names the constraint too (a large programmatic model has thousands of distances)
+  try {
+    b.add("rod", phiq::DistanceSpec{{C(0.0), C(0.0)}, {S(0), S(1)}, -1.0});
+    ADD_FAILURE() << "negative length accepted";
+  } catch (const phiq::Error& e) {
+    EXPECT_EQ(std::string(e.what()), "constraint 'rod': distance: length must be positive and finite");
+  }
   try {
     b.add("far", distance(S(2)));
     ADD_FAILURE() << "coordinate 2 of 2 accepted";

@@ -548,13 +548,14 @@ points: {P: [x, y], A: [1, 1], B: [1, 1]}
 constraints:
   - {name: online, type: point_on_line, point: P, line: [A, B]}
 time: {start: 0, end: 1, steps: 10}
-)"), "bad.yaml:4:5: constraints[0]: point_on_line: the line's two points are the same fixed point");
+)"), "bad.yaml:4:5: constraints[0]: constraint 'online': point_on_line: the line's two points are the same "
+       "fixed point");
   EXPECT_HAS(test::scene_error(R"(coordinates: {x: 0.5, y: 0.1}
 points: {P: [x, y], O: [0, 0]}
 constraints:
   - {name: ang, type: constant_angle, segments: [[O, P], [O, O]], angle: 0.5}
 time: {start: 0, end: 1, steps: 10}
-)"), "constant_angle: a segment's two ends are the same fixed point");
+)"), "constraint 'ang': constant_angle: a segment's two ends are the same fixed point");
 }
 
 TEST(Scene, EverySeedSceneLoads) {

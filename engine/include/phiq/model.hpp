@@ -392,6 +392,8 @@ class ModelBuilder {
   void set_initial(Index j, double value);
 
   /// Adds a constraint of any kind in constraint_kinds.hpp; its rows follow those added before. Returns its index.
+  /// Throws phiq::Error "constraint 'NAME': ..." for a slot that is not a coordinate of the model or a constant
+  /// that is not finite, a law without a function, or data its kind refuses ("distance: length must be positive").
   template <class Spec>
   Index add(const std::string& name, Spec spec);
   /// Records a planar rigid body in reference-point coordinates, for the Grübler–Kutzbach count (Model::grubler());
@@ -483,7 +485,11 @@ Index ModelBuilder::add(const std::string& name, Spec spec) {
   if constexpr (requires { spec.law; })
     if (!detail::law_has_value(spec.law))
       throw Error("constraint '" + label + "': its motion law has no function (a default-constructed MotionLaw)");
-  prepare(spec);
+  try {  // the kind's own checks name the kind; the constraint is named here, as check_slot names it
+    prepare(spec);
+  } catch (const Error& e) {
+    throw Error("constraint '" + label + "': " + e.what());
+  }
   const bool td = spec.depends_on_time();
   const Index id = add_info(label, Spec::kKind, Spec::kRows, td);
   count_joint(detail::joint_count(spec));
