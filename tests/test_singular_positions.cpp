@@ -21,6 +21,17 @@ std::vector<SweepWarning> of_kind(const SweepSummary& s, const std::string& kind
   return out;
 }
 
+// nfourbar's crank through a full turn as t runs from 0 to 1 (θ = θ0 + 2π t), q, q̇ and q̈ kept, in `steps` steps
+// on `threads` threads (chunks of `chunk` steps).
+SolveStatus full_turn(const Model& model, Index steps, int threads, Index chunk, test::Trace* tr, SweepSummary* sum) {
+  SweepOptions o;
+  o.t_begin = 0, o.t_end = 1, o.steps = steps;
+  o.velocities = o.accelerations = true;
+  o.threads = threads;
+  o.chunk_steps = chunk;
+  return test::sweep(model, o, tr, sum);
+}
+
 // nfourbar through a full turn of its crank in whole degrees: rows 0, 180 and 360 are the horizontal positions,
 // where all N+1 cranks, couplers and the ground line are collinear and the mechanism has N+1 degrees of freedom.
 // Every row must be the parallelogram (x_i = i + cos θ, y_i = sin θ) with its exact velocity and acceleration,
@@ -29,14 +40,9 @@ std::vector<SweepWarning> of_kind(const SweepSummary& s, const std::string& kind
 void full_turn_in_whole_degrees(Index n, int threads, double th0 = 0.0) {
   const double w = 2 * M_PI;
   const Model model = test::nfourbar_model(n, th0, w);
-  SweepOptions o;
-  o.t_begin = 0, o.t_end = 1, o.steps = 360;
-  o.velocities = o.accelerations = true;
-  o.threads = threads;
-  o.chunk_steps = 40;
   test::Trace tr;
   SweepSummary sum;
-  ASSERT_EQ(test::sweep(model, o, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+  ASSERT_EQ(full_turn(model, 360, threads, 40, &tr, &sum), SolveStatus::kSuccess) << sum.message;
   ASSERT_EQ(tr.t.size(), 361u);
   Eigen::VectorXd phi(model.num_equations());
   const auto exact = test::nfourbar_exact(model, th0, w);
@@ -94,14 +100,9 @@ TEST(SingularPositions, ACrossingBetweenStepsIsReportedByTheSignOfDetPhiQ) {
     for (const int threads : {1, 2}) {
       SCOPED_TRACE("N = " + std::to_string(n) + ", " + std::to_string(threads) + " threads");
       const Model model = test::nfourbar_model(n, th0, w);
-      SweepOptions o;
-      o.t_begin = 0, o.t_end = 1, o.steps = 1000;
-      o.velocities = o.accelerations = true;
-      o.threads = threads;
-      o.chunk_steps = 64;
       test::Trace tr;
       SweepSummary sum;
-      ASSERT_EQ(test::sweep(model, o, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+      ASSERT_EQ(full_turn(model, 1000, threads, 64, &tr, &sum), SolveStatus::kSuccess) << sum.message;
       const auto bif = of_kind(sum, "bifurcation");
       ASSERT_EQ(bif.size(), 2u);
       // θ = π at t = (π − 0.3)/2π = 0.45225…, θ = 2π at t = 0.95225…: reported at the next grid rows

@@ -96,7 +96,7 @@ template <typename Int>
 std::vector<unsigned char> block_parities(const Int* p, const Int* R, Int nb) {
   std::vector<unsigned char> odd(static_cast<std::size_t>(nb), 0);
   std::vector<std::pair<Int, Int>> seg;  // (entry, position in the segment)
-  std::vector<char> seen;
+  std::vector<Int> where;                // a permutation of 0 … len − 1 with the segment's parity
   for (Int b = 0; b < nb; ++b) {
     const Int lo = R[b], len = R[b + 1] - R[b];
     if (len < 2) continue;
@@ -107,16 +107,9 @@ std::vector<unsigned char> block_parities(const Int* p, const Int* R, Int nb) {
     seg.clear();
     for (Int k = 0; k < len; ++k) seg.emplace_back(p[lo + k], k);
     std::sort(seg.begin(), seg.end());  // seg[j].second: where the j-th smallest entry sits
-    seen.assign(static_cast<std::size_t>(len), 0);
-    unsigned char parity = 0;
-    for (Int i = 0; i < len; ++i) {
-      if (seen[static_cast<std::size_t>(i)]) continue;
-      Int cycle = 0;
-      for (Int j = i; !seen[static_cast<std::size_t>(j)]; j = seg[static_cast<std::size_t>(j)].second)
-        seen[static_cast<std::size_t>(j)] = 1, ++cycle;
-      parity ^= (cycle % 2 == 0);
-    }
-    odd[static_cast<std::size_t>(b)] = parity;
+    where.resize(static_cast<std::size_t>(len));
+    for (Int j = 0; j < len; ++j) where[static_cast<std::size_t>(j)] = seg[static_cast<std::size_t>(j)].second;
+    odd[static_cast<std::size_t>(b)] = permutation_sign(where.data(), len) < 0;
   }
   return odd;
 }
@@ -291,7 +284,7 @@ class KluNumeric final : public SparseLuNumeric {
   // of the last pivoting factorisation; empty for a single block (block_signs() is then 0).
   std::vector<unsigned char> block_parity_;
   std::uint64_t block_signs_ = 0;  // block_signs() of the last factorisation (scan_diagonal)
-  int negative_parity_offset_ = 0;  // xor of block_parity_: taken out of the blocks' product again for u_sign_
+  unsigned negative_parity_offset_ = 0;  // xor of block_parity_: taken out of the blocks' product again for u_sign_
   // The reciprocals of the row scale factors of the last pivoting factorisation, in pivot order (KLU's Rs, the
   // largest |entry| of each row); empty while the factors are of the scaled matrix (right after pivoting), used
   // by scan_diagonal() once refactorisations work on the unscaled one.
@@ -366,40 +359,37 @@ double KluNumeric<Int>::scan_diagonal() {
   const double* u = static_cast<const double*>(numeric_->Udiag);
   const double* rs = inverse_row_scale_.empty() ? nullptr : inverse_row_scale_.data();
   double lo = INFINITY, hi = 0.0;
-  int negative = 0;
-  if (block_parity_.empty()) {
-    for (Index i = 0; i < n; ++i) {
-      const double a = rs ? std::fabs(u[i]) * rs[i] : std::fabs(u[i]);
-      lo = a < lo ? a : lo;
-      hi = a > hi ? a : hi;
-      negative ^= u[i] < 0.0;
-      if (!(a > 0.0)) return u_sign_ = 0, 0.0;  // zero or NaN
-    }
-  } else {  // the same, block by block: a block's sign is its pivots' times its rows' and columns' parity
-    const Int* R = sym_.symbolic_->R;
-    const unsigned char* parity = block_parity_.data();
-    const Index nb = static_cast<Index>(block_parity_.size());
-    std::uint64_t signs = 0;
-    bool zero = false;
-    auto blocks = [&](auto scaled) {  // the loop twice, with and without scale factors (no test per entry)
-      for (Index b = 0; b < nb; ++b) {
-        unsigned block_negative = parity[b];
-        for (Index i = R[b], end = R[b + 1]; i < end; ++i) {
-          const double a = scaled ? std::fabs(u[i]) * rs[i] : std::fabs(u[i]);
-          lo = a < lo ? a : lo;
-          hi = a > hi ? a : hi;
-          block_negative ^= u[i] < 0.0;
-          zero |= !(a > 0.0);  // zero or NaN
-        }
-        signs ^= block_key(static_cast<std::uint64_t>(b)) & (0 - static_cast<std::uint64_t>(block_negative));
-        negative ^= static_cast<int>(block_negative);
+  // Block by block (a block's sign is its pivots' times its rows' and columns' parity); a matrix factorised whole
+  // is one block of parity 0, with no fingerprint.
+  const bool blocked = !block_parity_.empty();
+  const Int whole[2] = {0, static_cast<Int>(n)};
+  static constexpr unsigned char kEven = 0;
+  const Int* R = blocked ? sym_.symbolic_->R : whole;
+  const unsigned char* parity = blocked ? block_parity_.data() : &kEven;
+  const Index nb = blocked ? static_cast<Index>(block_parity_.size()) : 1;
+  std::uint64_t signs = 0;
+  unsigned negative = 0;
+  bool zero = false;
+  auto blocks = [&](auto scaled) {  // the loop twice, with and without scale factors (no test per entry)
+    for (Index b = 0; b < nb; ++b) {
+      unsigned block_negative = parity[b];
+      for (Index i = R[b], end = R[b + 1]; i < end; ++i) {
+        const double a = scaled ? std::fabs(u[i]) * rs[i] : std::fabs(u[i]);
+        lo = a < lo ? a : lo;
+        hi = a > hi ? a : hi;
+        block_negative ^= u[i] < 0.0;
+        zero |= !(a > 0.0);  // zero or NaN
       }
-    };
-    if (rs)
-      blocks(std::true_type{});
-    else
-      blocks(std::false_type{});
-    if (zero) return u_sign_ = 0, 0.0;
+      signs ^= block_key(static_cast<std::uint64_t>(b)) & (0 - static_cast<std::uint64_t>(block_negative));
+      negative ^= block_negative;
+    }
+  };
+  if (rs)
+    blocks(std::true_type{});
+  else
+    blocks(std::false_type{});
+  if (zero) return u_sign_ = 0, 0.0;
+  if (blocked) {
     negative ^= negative_parity_offset_;  // undo the blocks' parities: u_sign_ is Π sign U_ii alone
     block_signs_ = signs;
   }
