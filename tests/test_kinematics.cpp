@@ -272,6 +272,62 @@ TEST(Kinematics, AStartIsAcceptedWithoutAStepOnlyWhenItsErrorEstimateHolds) {
   }
 }
 
+// NewtonOptions::known_to (a sweep's rows at their rounding level): a full step whose estimated error is within it
+// ends the solve, reported as the rounding level with its warning; a step beyond it, or none given, goes on to the
+// tolerance; and not where Φq is ill-conditioned (rcond < 1e-4), where linear convergence marks a singular position.
+TEST(Kinematics, AStepWithinTheLevelQIsKnownToEndsTheSolve) {
+  Model m = crank_slider(2.0, 0.0, LinearSolverKind::kKlu);
+  const double t = 0.3;
+  Workspace ws(m);
+  ASSERT_EQ(solve_position(m, t, NewtonOptions{}, ws), SolveStatus::kSuccess);
+  const Eigen::VectorXd exact = ws.q;
+  Eigen::VectorXd start = exact;
+  start(3) += 1e-7;  // 1000 tolerances off along x_B: its residual (the rod's row) is not within the tolerance
+  auto solve = [&](double known_to) {
+    NewtonOptions o;
+    o.known_to = known_to;
+    ws.q = start;
+    PositionSummary sum;
+    EXPECT_EQ(solve_position(m, t, o, ws, &sum), SolveStatus::kSuccess) << known_to;
+    return sum;
+  };
+  const PositionSummary plain = solve(0.0);
+  EXPECT_GE(plain.iterations, 2);
+  EXPECT_EQ(plain.rounding_level, 0.0);
+  EXPECT_FALSE(plain.slow_convergence);
+  EXPECT_EQ(solve(100.0).iterations, plain.iterations) << "a first step of about 1000 tolerances is beyond 100";
+  const PositionSummary known = solve(1e4);
+  EXPECT_EQ(known.iterations, 1);
+  EXPECT_GT(known.rounding_level, 500.0);  // the step's size: about 1e-7 m over the tolerance test's 1e-10 m
+  EXPECT_LT(known.rounding_level, 2000.0);
+  EXPECT_EQ(known.error_estimate, known.rounding_level);
+  EXPECT_TRUE(known.slow_convergence);
+  EXPECT_NE(known.message.find("within the rounding level the previous positions stopped at"), std::string::npos)
+      << known.message;
+  EXPECT_NEAR(ws.q(3), exact(3), 1e-12);  // Newton's step itself is as good as ever
+
+  // The slider driven next to its dead centre (θ = 2e-5 rad): Φq's pivot ratio is about 1e-5
+  ModelBuilder b;
+  const double th0 = 2e-5, xb0 = kL2 * std::cos(th0) + std::sqrt(kL3 * kL3 - std::pow(kL2 * std::sin(th0), 2));
+  Index th = b.add_coordinate("theta2", th0), xa = b.add_coordinate("xA", kL2 * std::cos(th0)),
+        ya = b.add_coordinate("yA", kL2 * std::sin(th0)), xb = b.add_coordinate("xB", xb0);
+  auto S = Slot::coordinate;
+  auto C = Slot::constant;
+  b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, kL2, S(th)});
+  b.add("rod", DistanceSpec{{S(xa), S(ya)}, {S(xb), C(0)}, kL3});
+  b.add_driver("slide", xb, MotionLaw::linear(xb0, 0.0));
+  Model dead = std::move(b).build();
+  Workspace wd(dead);
+  wd.q(th) += 1e-7;
+  NewtonOptions o;
+  o.known_to = 1e4;
+  PositionSummary near;
+  ASSERT_EQ(solve_position(dead, 0.0, o, wd, &near), SolveStatus::kSuccess) << near.message;
+  EXPECT_LT(near.rcond, 1e-4);
+  EXPECT_EQ(near.rounding_level, 0.0) << near.message;
+  EXPECT_GE(near.iterations, 2);
+}
+
 TEST(Kinematics, SingularJacobianIsAStatusNotACrash) {
   // Drive the slider coordinate xB instead of the crank: at the dead centre θ = 0 the crank angle is not
   // determined to first order by xB and Φq is singular.
@@ -317,6 +373,8 @@ TEST(Kinematics, NewtonOptionsNoSolveCanHonourAreRefusedNamingTheField) {
             "NewtonOptions: max_contraction must be in (0, 1)");
   EXPECT_EQ(refusal([](NewtonOptions& o) { o.start_error = NAN; }),
             "NewtonOptions: start_error must not be NaN (negative: unknown)");
+  for (double bad : {-1.0, double{NAN}, double{INFINITY}})
+    EXPECT_EQ(refusal([&](NewtonOptions& o) { o.known_to = bad; }), "NewtonOptions: known_to must be >= 0 and finite");
   EXPECT_EQ(refusal([](NewtonOptions& o) { o.jacobian_update = static_cast<JacobianUpdate>(7); }),
             "NewtonOptions: jacobian_update is not a JacobianUpdate");
   // the limits themselves are settings: no step at all, no backtrack, an infinite start error (always a step)

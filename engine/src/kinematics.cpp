@@ -191,6 +191,7 @@ void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
   if (opt.max_backtracks < 0) fail("max_backtracks must be >= 0");
   if (!(opt.max_contraction > 0.0 && opt.max_contraction < 1.0)) fail("max_contraction must be in (0, 1)");
   if (std::isnan(opt.start_error)) fail("start_error must not be NaN (negative: unknown)");
+  if (!(opt.known_to >= 0.0 && std::isfinite(opt.known_to))) fail("known_to must be >= 0 and finite");
   if (opt.jacobian_update != JacobianUpdate::kEveryIteration && opt.jacobian_update != JacobianUpdate::kWhenSlow)
     fail("jacobian_update is not a JacobianUpdate");
 }
@@ -525,12 +526,14 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     double step_error = 0.0;  // the trial's estimated error, θ/(1−θ) times that
     ResidualCheck trial_check;
     bool with_jacobian = false;  // Φq evaluated at the trial
+    bool known_ok = false;       // a full step whose error is within NewtonOptions::known_to
     bool refresh = false;
     for (int bt = 0;; ++bt) {
       step_size = bt == 0 ? full_step.size : take_step(model, ws.q, ws.step, alpha, opt.tolerance, ws.trial).size;
       step_error = std::min(eta, 1.0) * step_size;
       step_ok = step_error <= 1.0;
-      with_jacobian = step_ok ? opt.jacobian_with_residual : !reuse;
+      known_ok = bt == 0 && step_error <= opt.known_to;
+      with_jacobian = step_ok || known_ok ? opt.jacobian_with_residual : !reuse;
       if (with_jacobian) {
         model.residual_and_jacobian(ws.trial.data(), t, ws.trial_phi.data(), ws.jacobian_values.data());
         jacobian_at_q = false;  // the values are the trial's now
@@ -560,9 +563,12 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     // known. Stop at the better point of the two, with a warning, instead of refactorising in search of a
     // contraction that cannot come.
     const bool rounding_level = within && !step_ok && alpha == 1.0 && !(trial_check.merit < 0.5 * check.merit);
-    auto stop_at_rounding_level = [&] {
+    // `known_before`: the step ended the solve within NewtonOptions::known_to, its error estimated as
+    // min(η, 1) × its size (η from a contraction observed), not as its size.
+    auto stop_at_rounding_level = [&](bool known_before) {
       Index worst = 0;
-      const double worst_ratio = step_ratio(model, ws.step, ws.q, opt.tolerance, &worst);
+      const double worst_ratio =
+          step_ratio(model, ws.step, ws.q, opt.tolerance, &worst) * (known_before ? std::min(eta, 1.0) : 1.0);
       sum.rounding_level = worst_ratio;
       sum.error_estimate = worst_ratio;
       finish(SolveStatus::kSuccess, "");
@@ -572,13 +578,23 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       if (worst_ratio <= kQuietRoundingLevel) return SolveStatus::kSuccess;
       sum.slow_convergence = true;
       const std::string& name = model.coordinate_names()[static_cast<std::size_t>(worst)];
-      sum.message = "the residual is at its rounding level and the Newton steps no longer reduce it: they are the "
-                    "rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
-                    fmt(worst_ratio) + " × the tolerance at '" + name + "', which is how well q is known there";
+      sum.message = known_before
+                        ? "the Newton step is within the rounding level the previous positions stopped at (the "
+                          "rounding of Φ amplified by Φq⁻¹: a long chain, or Φq ill-conditioned): up to " +
+                              fmt(worst_ratio) + " × the tolerance at '" + name + "', which is how well q is known there"
+                        : "the residual is at its rounding level and the Newton steps no longer reduce it: they are "
+                          "the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
+                              fmt(worst_ratio) + " × the tolerance at '" + name + "', which is how well q is known there";
       return SolveStatus::kSuccess;
     };
-    if (rounding_level && !(trial_check.within && trial_check.merit < check.merit)) return stop_at_rounding_level();
-    if (refresh && !rounding_level) {
+    if (rounding_level && !(trial_check.within && trial_check.merit < check.merit)) return stop_at_rounding_level(false);
+    // Within the level the previous positions are known to: the step is taken and ends the solve, as at a stop at
+    // the rounding level (below), without the iterations that would only measure the rounding again.
+    // Not where Φq is ill-conditioned: linear convergence there marks a singular position (a dead point), which
+    // the sweep must still see.
+    const bool within_known = known_ok && !step_ok && alpha == 1.0 && trial_check.within && !rounding_level &&
+                              sum.rcond >= detail::kLinearSingularRcond;
+    if (refresh && !rounding_level && !within_known) {
       reuse = false, prev_norm = -1.0;
       continue;
     }
@@ -597,13 +613,13 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     accepted_error = std::max(step_error, check.worst > 0.0 ? step_size * (trial_check.worst / check.worst) : 0.0);
     jacobian_at_q = with_jacobian;
     check = trial_check;
-    if (rounding_level) {
+    if (rounding_level || within_known) {
       // The step just taken is the rounding of Φ amplified by Φq⁻¹: it moved q by about as much as q is known, so
       // the factorisation made where it started is Φq at the solution to the accuracy q has. Velocities and
       // accelerations reuse it rather than refactorise (on a 10⁵-stage scissor lift a quarter of the rows stop
       // here, and each paid a second factorisation).
       factorized_at_rounding_level = step_from_factorization;
-      return stop_at_rounding_level();
+      return stop_at_rounding_level(within_known);
     }
   }
 }

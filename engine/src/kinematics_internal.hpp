@@ -9,6 +9,11 @@ namespace phiq::detail {
 /// finite: ∂'c'/∂'x' = -inf, …"): the sweep then names no other cause.
 inline constexpr const char* kNonFiniteJacobian = "Φq is not finite: ";
 
+/// Below this reciprocal condition estimate of Φq, a position Newton reached only linearly is examined as a
+/// singular one by the sweep (a dead point: Sweeper::derivatives()); solve_position ends no solve within
+/// NewtonOptions::known_to there, so that such a position keeps its mark of linear convergence.
+inline constexpr double kLinearSingularRcond = 1e-4;
+
 /// Throws phiq::Error naming the first field of `opt` no solve can honour, after `what` (solve_position's check,
 /// also made by a sweep before it starts, so that bad drive settings are refused before the assembly, not on a
 /// worker thread).

@@ -159,7 +159,7 @@ class Sweeper {
   static constexpr int kBranchCheckDepth = 2;
 
   // Below this rcond, a position Newton reached only linearly (`linear` in derivatives()) is taken as singular.
-  static constexpr double kLinearSingularRcond = 1e-4;
+  static constexpr double kLinearSingularRcond = detail::kLinearSingularRcond;
 
   // Derivatives at the converged ws.q, as asked for. Returns false (summary filled) on failure. At a singular
   // position they are not unique: see singular_point(). `linear`: Newton converged only linearly to ws.q (its full
@@ -531,6 +531,7 @@ class Sweeper {
   // success, so a failed attempt restores from them without copying any state on the way.
   bool advance(double t1, int depth) {
     predict(t1);
+    newton_.known_to = known_to_;
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t1, newton_, *ws_, &ps);
     // (a start accepted without a Newton step is the prediction itself: nothing moved off it)
@@ -600,13 +601,19 @@ class Sweeper {
     struct Noted {
       std::size_t warnings;
       Index singular_positions;
-      double min_rcond, min_rcond_time, rounding_level;
+      double min_rcond, min_rcond_time, rounding_level, known_to;
       bool ill_conditioned;
     } const noted{sum_.warnings.size(), sum_.singular_positions, sum_.min_rcond, sum_.min_rcond_time,
-                  rounding_level_, ill_conditioned_};
+                  rounding_level_, known_to_, ill_conditioned_};
     singular_row_ = false;
     row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
     rounding_level_ = std::max(rounding_level_, ps.rounding_level);
+    // How well the positions can be known here (NewtonOptions::known_to): the largest rounding level the rows
+    // stopped at since the last one that converged to the tolerance. (A row ending within it reports its own
+    // step, no larger.) Dropped again as soon as a row converges to the tolerance.
+    known_to_ = ps.rounding_level > 0.0 ? std::max(known_to_, ps.rounding_level)
+                : ps.error_estimate <= 1.0 ? 0.0
+                                            : known_to_;
     if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
     if (!need_v_ && ps.rcond > 0.0 && ps.rcond < kSingularRcond) {
       // positions only: nothing is computed from Φq here, but the user is told where the motion branches
@@ -624,7 +631,7 @@ class Sweeper {
       sum_.warnings.resize(noted.warnings);
       sum_.singular_positions = noted.singular_positions;
       sum_.min_rcond = noted.min_rcond, sum_.min_rcond_time = noted.min_rcond_time;
-      rounding_level_ = noted.rounding_level, ill_conditioned_ = noted.ill_conditioned;
+      rounding_level_ = noted.rounding_level, known_to_ = noted.known_to, ill_conditioned_ = noted.ill_conditioned;
       *left_branch = true;
       return false;
     }
@@ -920,6 +927,7 @@ class Sweeper {
   Index factorizations_seen_ = factorizations_before_;  // the count at the last converged state
   double factorized_step_t_ = 0.0;  // the time of the last step whose solves factorised (converged())
   double rounding_level_ = 0.0;     // see take_rounding_level()
+  double known_to_ = 0.0;           // the rounding level carried to the next solves (converged())
   bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)
   double default_step_ = (opt_.t_end - opt_.t_begin) / static_cast<double>(std::max<Index>(opt_.steps, 1));
 };
