@@ -301,6 +301,7 @@ TEST(Kinematics, AStepWithinTheLevelQIsKnownToEndsTheSolve) {
   EXPECT_GT(known.rounding_level, 500.0);  // the step's size: about 1e-7 m over the tolerance test's 1e-10 m
   EXPECT_LT(known.rounding_level, 2000.0);
   EXPECT_EQ(known.error_estimate, known.rounding_level);
+  EXPECT_FALSE(known.rounding_measured) << "an end within the level measures nothing a sweep should carry";
   EXPECT_TRUE(known.slow_convergence);
   EXPECT_NE(known.message.find("within the rounding level the previous positions stopped at"), std::string::npos)
       << known.message;

@@ -507,11 +507,11 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       theta_seen = std::max(theta_seen, theta);
       // Refresh on a slow contraction, or when the steps left (the iteration limit, or kMaxReusedSteps: a
       // factorisation costs about two solves) cannot reach the tolerance at this rate: after j more steps the
-      // error is about θ^(j+1)/(1−θ)·|Δq| (Hairer & Wanner IV.8).
+      // error is about θ^(j+1)/(1−θ)·|Δq| (Hairer & Wanner IV.8), or the level q is known to (known_to).
       ++reused_steps;
       const int left = std::min(opt.max_iterations - sum.iterations - 1, kMaxReusedSteps - reused_steps);
       if (theta > opt.max_contraction || left < 0 ||
-          !(std::pow(theta, left + 1) / (1.0 - theta) * full_step.size <= 1.0)) {
+          !(std::pow(theta, left + 1) / (1.0 - theta) * full_step.size <= std::max(1.0, opt.known_to))) {
         reuse = false, prev_norm = -1.0;
         continue;
       }
@@ -570,7 +570,11 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       const double worst_ratio =
           step_ratio(model, ws.step, ws.q, opt.tolerance, &worst) * (known_before ? std::min(eta, 1.0) : 1.0);
       sum.rounding_level = worst_ratio;
+      sum.rounding_measured = !known_before && it > 0;
       sum.error_estimate = worst_ratio;
+      // The contraction seen with a reused matrix: the rounding in its last step makes it an overestimate, which
+      // the next solve's first step may use as such (kept, as a success's).
+      if (theta_seen >= 0.0) ws.newton_contraction = theta_seen;
       finish(SolveStatus::kSuccess, "");
       // Known to within twice the tolerance: as good as the tolerance test's own estimate promises (it is an
       // estimate, not a bound), nothing to warn about. A 2000-stage scissor lift sits there at the default

@@ -609,11 +609,12 @@ class Sweeper {
     row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
     rounding_level_ = std::max(rounding_level_, ps.rounding_level);
     // How well the positions can be known here (NewtonOptions::known_to): the largest rounding level the rows
-    // stopped at since the last one that converged to the tolerance. (A row ending within it reports its own
-    // step, no larger.) Dropped again as soon as a row converges to the tolerance.
-    known_to_ = ps.rounding_level > 0.0 ? std::max(known_to_, ps.rounding_level)
-                : ps.error_estimate <= 1.0 ? 0.0
-                                            : known_to_;
+    // measured since the last one that converged to the tolerance (a step from a point Newton reached, not the
+    // first step from a prediction, which corrects the prediction's own error too; nor a row that ended within
+    // it). Dropped again as soon as a row converges to the tolerance.
+    known_to_ = ps.rounding_measured                              ? std::max(known_to_, ps.rounding_level)
+                : ps.rounding_level == 0.0 && ps.error_estimate <= 1.0 ? 0.0
+                                                                     : known_to_;
     if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
     if (!need_v_ && ps.rcond > 0.0 && ps.rcond < kSingularRcond) {
       // positions only: nothing is computed from Φq here, but the user is told where the motion branches

@@ -101,6 +101,10 @@ struct PositionSummary {
   /// slow_convergence with the message "…rounding level…"; up to 2 it is a plain success (known as well as the
   /// tolerance test's estimate promises).
   double rounding_level = 0.0;
+  /// rounding_level was measured by a step from an iterate an earlier step of this solve had reached, so that it
+  /// is the rounding alone, not also the start's own error (which a first step corrects): what a sweep carries to
+  /// its next solves in NewtonOptions::known_to.
+  bool rounding_measured = false;
   /// On success, the estimated error of q in units of the tolerance test (scaled_step(): ≤ 1 within the tolerance):
   /// the larger of θ/(1−θ)|Δq| of the last step (the step itself where no contraction was observed) and |Δq| times
   /// the factor by which that step reduced the residual (the size of the next step, were it taken: about |Δq| itself
