@@ -290,7 +290,8 @@ TEST(GenerateGrid, ShapeHasExactlyNCells) {
     EXPECT_EQ(s.rows, c.rows) << c.n;
     EXPECT_EQ(s.last, c.last) << c.n;
     const std::string text = tools::generate_scene(generate_options("grid", c.n, "natural", 1.0, 2.0, 1));
-    const std::string shape = std::to_string(c.rows) + " rows of " + std::to_string(c.cols) + " cells";
+    const std::string shape = std::to_string(c.rows) + (c.rows == 1 ? " row of " : " rows of ") +
+                              std::to_string(c.cols) + (c.cols == 1 ? " cell" : " cells");
     EXPECT_NE(text.find(shape), std::string::npos) << text.substr(0, 400);
   }
 }

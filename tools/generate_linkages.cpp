@@ -175,7 +175,8 @@ std::string grid_drive(const GenerateOptions& o, const std::string& coordinate) 
 }
 
 std::string grid_shape_text(const GridShape& g) {
-  return str(g.rows) + " rows of " + str(g.cols) + " cells" +
+  auto count = [](std::int64_t n, const char* one, const char* many) { return str(n) + " " + (n == 1 ? one : many); };
+  return count(g.rows, "row", "rows") + " of " + count(g.cols, "cell", "cells") +
          (g.last == g.cols ? std::string() : " (the top row " + str(g.last) + ")");
 }
 
