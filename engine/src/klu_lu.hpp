@@ -23,6 +23,10 @@ struct KluAnalysis {
   bool resequenced = false;   ///< the blocks follow the pattern's order instead of KLU's
   double klu_jump = 0.0;      ///< mean distance between consecutive columns in KLU's own order
   double jump = 0.0;          ///< the same in the order used
+  /// The column order BTF's maximum transversal searched (klu_lu.cpp, KluSymbolic::analyze_bounded): 0 the
+  /// pattern's, within its bound; 1 reversed, the pattern's having exceeded it; 2 the pattern's without a bound,
+  /// both having exceeded it.
+  int transversal = 0;
 };
 /// Throws phiq::Error when `s` is not a KLU analysis.
 KluAnalysis describe_klu(const SparseLuSymbolic& s);

@@ -59,8 +59,10 @@ class UmfpackNumeric final : public SparseLuNumeric {
   double rcond() const override { return rcond_; }
   int determinant_sign() const override {
     if (!numeric_ || rcond_ == 0.0) return 0;
-    double mx = 0.0;
-    if (umfpack_dl_get_determinant(&mx, nullptr, numeric_, nullptr) != UMFPACK_OK) return 0;
+    // mantissa and exponent apart: the determinant itself under- or overflows a double on large models (a
+    // 24 270-coordinate lattice gave 0, which read as singular)
+    double mx = 0.0, ex = 0.0;
+    if (umfpack_dl_get_determinant(&mx, &ex, numeric_, nullptr) != UMFPACK_OK) return 0;
     return (mx > 0) - (mx < 0);
   }
   std::string last_message() const override { return message_; }
