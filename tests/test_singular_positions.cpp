@@ -72,6 +72,30 @@ void full_turn_in_whole_degrees(Index n, int threads, double th0 = 0.0) {
   EXPECT_HAS(bif[1].message, "kept the branch it was on");
 }
 
+// nfourbar started on its folded position (θ = π: every tip P_i on the pivot of crank i − 1, each coupler lying on
+// its neighbour's crank) stays singular on the branch the drive follows from there, where the far loops stay
+// folded, though the model is regular off it: the sweep and the rank analysis say the position is singular, not
+// that the model is short of drivers or constraints, as they used to. A model short of a driver stays so off it.
+TEST(SingularPositions, AStartWithEveryLoopFoldedIsASingularPositionNotAModelShortOfConstraints) {
+  const Model model = test::nfourbar_model(3, M_PI, -1.0);
+  SweepOptions o;
+  o.t_begin = 0, o.t_end = 1, o.steps = 10;
+  test::Trace tr;
+  SweepSummary sum;
+  EXPECT_EQ(test::sweep(model, o, &tr, &sum), SolveStatus::kSingularJacobian);
+  EXPECT_EQ(sum.failed_step, 0);
+  EXPECT_HAS(sum.message, "Φq stays singular around it");
+  EXPECT_HAS(sum.message, "the position is singular, several loops folded or aligned at once");
+  EXPECT_EQ(sum.message.find("redundant or missing constraints"), std::string::npos) << sum.message;
+  Eigen::VectorXd q = model.initial_positions();
+  std::unique_ptr<Model> solved;
+  AssemblySummary as;
+  EXPECT_EQ(prepare_square(model, 0.0, {}, q, &solved, &as), SolveStatus::kNotSquare);
+  EXPECT_EQ(as.rank.driven_dof, 3);
+  EXPECT_HAS(as.message, "3 degree(s) of freedom not driven");
+  EXPECT_HAS(as.message, "at this position only (a placement off it leaves 0: a singular position");
+}
+
 TEST(SingularPositions, NFourBarFullTurnInWholeDegreesStaysOnTheParallelogram) {
   for (Index n : {1, 2, 10, 50}) {
     SCOPED_TRACE("N = " + std::to_string(n));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -325,6 +326,13 @@ SolveStatus prepare_square(const Model& model, double t, const AssemblyOptions& 
     sum.message = std::to_string(sum.rank.driven_dof) + " degree(s) of freedom not driven: the mechanism has " +
                   std::to_string(sum.rank.dof) + " and the drivers fix " +
                   std::to_string(sum.rank.driven_rank - sum.rank.rank);
+    // Of the model, or of this position only? Φq off it (detail::nearby_placement) has the model's
+    // generic rank: a position where several loops are folded or aligned at once (nfourbar started flat, every
+    // coupler on its neighbour's crank) loses rank there only; a model short of drivers or constraints, everywhere.
+    const RankReport generic = analyse_rank(model, detail::nearby_placement(model, q), t, options.rank);
+    if (generic.driven_dof < sum.rank.driven_dof)
+      sum.message += " at this position only (a placement off it leaves " + std::to_string(generic.driven_dof) +
+                     ": a singular position, not a model short of drivers or constraints)";
     return sum.status;
   }
   *solved = std::make_unique<Model>(model.without_rows(sum.rank.redundant_rows));

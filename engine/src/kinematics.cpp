@@ -182,6 +182,13 @@ void check_workspace(const Model& model, const Workspace& ws) {
 
 }  // namespace
 
+const double* detail::solve_values(const Model& model, Workspace& ws) {
+  if (model.dropped_rows().empty()) return ws.jacobian_values.data();
+  const std::vector<Index>& from = model.solve_entries();  // the kept rows only (Model::without_rows())
+  for (std::size_t k = 0; k < from.size(); ++k) ws.solve_values[k] = ws.jacobian_values[static_cast<std::size_t>(from[k])];
+  return ws.solve_values.data();
+}
+
 void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
   // An infinite tolerance accepts any point as the solution, a NaN start_error accepts the start unchecked (and
   // reports NaN as its error): settings no solve can honour, each named by its field.
@@ -268,12 +275,7 @@ SolveStatus factorize_at_q(const Model& model, double t, Workspace& ws, double* 
     ++ws.counters.jacobian_evaluations;
   }
   ws.has_jacobian = false;
-  const double* values = ws.jacobian_values.data();
-  if (!model.dropped_rows().empty()) {  // the kept rows only (Model::without_rows())
-    const std::vector<Index>& from = model.solve_entries();
-    for (std::size_t k = 0; k < from.size(); ++k) ws.solve_values[k] = ws.jacobian_values[static_cast<std::size_t>(from[k])];
-    values = ws.solve_values.data();
-  }
+  const double* values = detail::solve_values(model, ws);
   FactorStatus fs = ws.lu->factorize(values);
   ++ws.counters.factorizations;
   *rcond = ws.lu->rcond();

@@ -14,6 +14,10 @@ inline constexpr const char* kNonFiniteJacobian = "Φq is not finite: ";
 /// NewtonOptions::known_to there, so that such a position keeps its mark of linear convergence.
 inline constexpr double kLinearSingularRcond = 1e-4;
 
+/// The values of ws.jacobian_values that the LU factorises: all of them, or the kept rows' (in ws.solve_values)
+/// for a model with dropped rows (Model::without_rows()).
+const double* solve_values(const Model& model, Workspace& ws);
+
 /// Throws phiq::Error naming the first field of `opt` no solve can honour, after `what` (solve_position's check,
 /// also made by a sweep before it starts, so that bad drive settings are refused before the assembly, not on a
 /// worker thread).

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <exception>
 #include <iomanip>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -297,6 +298,31 @@ class Sweeper {
     ill_conditioned_ = ill;
   }
 
+  // Why Φq stays singular on both sides of the singular position qs at t: the model's Φq is singular everywhere
+  // (": redundant or missing constraints"), or only along the branch followed from there, Φq off it
+  // (detail::nearby_placement) being regular: several loops folded or aligned at once, which the drive keeps them
+  // (nfourbar started flat: every coupler on its neighbour's crank, the folded loops staying so as the crank
+  // turns). Factorises in the workspace's LU, which the failing sweep no longer needs.
+  std::string singular_throughout(const Eigen::VectorXd& qs, double t) {
+    const Eigen::VectorXd nearby = detail::nearby_placement(model_, qs);
+    model_.jacobian(nearby.data(), t, ws_->jacobian_values.data());
+    ++ws_->counters.jacobian_evaluations;
+    ws_->has_factorization = ws_->has_jacobian = ws_->factorized_at_solution = false;
+    double rc = 0.0;
+    if (ws_->lu && ws_->lu->factorize(detail::solve_values(model_, *ws_)) == FactorStatus::kOk) rc = ws_->lu->rcond();
+    ws_->has_factorization = false;
+    // A pivot ratio above a thousand ε is not rounding: Φq there has full rank, however ill-conditioned a
+    // random placement of a long chain leaves it (nfourbar of 10⁵ folded loops: 6.9e-11); a model short of
+    // constraints gives a zero pivot or one at ε.
+    if (!(rc >= 1e3 * std::numeric_limits<double>::epsilon())) return ": redundant or missing constraints";
+    std::ostringstream m;
+    m.precision(3);
+    m << " on the branch the drive follows from there, though not off it (rcond " << rc
+      << " with q moved by a tenth of its scale): the position is singular, several loops folded or aligned at "
+         "once, rather than the model short of drivers or constraints; start the drive off it";
+    return m.str();
+  }
+
   // Φq is singular at the converged position ws.q at t (rcond below kSingularRcond, or a zero pivot): a
   // bifurcation, where branches of the motion cross and the mechanism momentarily gains degrees of freedom
   // (nfourbar at its horizontal positions, a change-point four-bar). The velocity there is not unique, and the
@@ -372,8 +398,8 @@ class Sweeper {
                "for there is unbounded)"
             << (lined_up.empty() ? "" : ", where these equations line up:" + lined_up);
         else if (st == SolveStatus::kSuccess)
-          m << "Φq stays singular around it (rcond " << ls.rcond << " at t = " << format_time(ts)
-            << "): redundant or missing constraints";
+          m << "Φq stays singular around it (rcond " << ls.rcond << " at t = " << format_time(ts) << ")"
+            << singular_throughout(qs, t);
         else
           m << "the branch cannot be followed to it: " << ps.message;
         return fail(SolveStatus::kSingularJacobian, m.str());

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -86,6 +87,21 @@ inline double scaled_distance(const Model& model, const double* a, const double*
   for (Index j = 0, n = model.num_coordinates(); j < n; ++j)
     w.add(std::fabs(a[j] - b[j]), tol * cs[j] + kUlpFloor * std::fabs(at[j]));
   return w.worst;
+}
+
+// q moved by up to a tenth of each coordinate's tolerance scale (the length scale, or a radian), in a fixed
+// pseudo-random direction (the same in every run): no longer a solution, but Φq there has the model's generic
+// rank, so that a position singular by itself (several loops folded or aligned at once) is told apart from a model
+// short of drivers or constraints. (10⁻³ left nfourbar of 10³ folded loops at a pivot ratio of 1.6e-9.)
+inline Eigen::VectorXd nearby_placement(const Model& model, const Eigen::VectorXd& q) {
+  Eigen::VectorXd out = q;
+  const Eigen::VectorXd& scale = model.tolerance_scales().coordinate_scale;
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;
+  for (Index j = 0; j < out.size(); ++j) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;  // Knuth's MMIX generator
+    out(j) += 0.1 * scale(j) * (static_cast<double>(state >> 11) * 0x1.0p-53 * 2.0 - 1.0);
+  }
+  return out;
 }
 
 // "'name' 1.234e-05, 'other[1]' …" for diagnostics.
