@@ -83,6 +83,12 @@ TEST_P(SparseLu, TransposedSolveAndDeterminantSignMatchDenseLu) {
     ASSERT_EQ(lu->factorize(s.values.data()), FactorStatus::kOk);
     const double det = s.dense.partialPivLu().determinant();
     EXPECT_EQ(lu->determinant_sign(), det > 0 ? 1 : -1) << "seed " << seed;
+    // entries scaled by 10⁻⁹: the determinant (10⁻⁵⁴⁰ times det) underflows a double, its sign must not
+    std::vector<double> tiny = s.values;
+    for (double& v : tiny) v *= 1e-9;
+    auto small = analyse(GetParam(), s.p)->make_numeric();
+    ASSERT_EQ(small->factorize(tiny.data()), FactorStatus::kOk);
+    EXPECT_EQ(small->determinant_sign(), det > 0 ? 1 : -1) << "seed " << seed << ", entries scaled by 1e-9";
     Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(60, -1, 2), x(60);
     ASSERT_TRUE(lu->solve_transposed(rhs.data(), x.data()));
     EXPECT_LT((s.dense.transpose() * x - rhs).cwiseAbs().maxCoeff(), 1e-12) << "seed " << seed;
