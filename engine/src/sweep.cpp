@@ -300,9 +300,9 @@ class Sweeper {
 
   // Why Φq stays singular on both sides of the singular position qs at t: the model's Φq is singular everywhere
   // (": redundant or missing constraints"), or only along the branch followed from there, Φq off it
-  // (detail::nearby_placement) being regular: several loops folded or aligned at once, which the drive keeps them
-  // (nfourbar started flat: every coupler on its neighbour's crank, the folded loops staying so as the crank
-  // turns). Factorises in the workspace's LU, which the failing sweep no longer needs.
+  // (detail::nearby_placement) being regular: several loops folded or aligned at once, and kept so by the drive
+  // (nfourbar started folded: every coupler on its neighbour's crank, the far loops staying so as crank 0 turns).
+  // Factorises in the workspace's LU, which the failing sweep no longer needs.
   std::string singular_throughout(const Eigen::VectorXd& qs, double t) {
     const Eigen::VectorXd nearby = detail::nearby_placement(model_, qs);
     model_.jacobian(nearby.data(), t, ws_->jacobian_values.data());
@@ -557,7 +557,7 @@ class Sweeper {
   // success, so a failed attempt restores from them without copying any state on the way.
   bool advance(double t1, int depth) {
     predict(t1);
-    newton_.known_to = known_to_;
+    newton_.known_to = std::max(opt_.newton.known_to, known_to_);  // the caller's as a floor
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t1, newton_, *ws_, &ps);
     // (a start accepted without a Newton step is the prediction itself: nothing moved off it)

@@ -79,7 +79,7 @@ struct NewtonOptions {
   /// measure the rounding again. On a 10⁵-stage scissor lift the top joints are known to some 10³ tolerances, and
   /// half the rows took a second Newton step, with a fresh factorisation, to find that out. The step's estimated
   /// error is reported as the rounding level, with the warning of such a stop above 2. Up to 1 (the default, 0):
-  /// none.
+  /// none. In SweepOptions::newton it is a floor under the level the sweep carries.
   double known_to = 0.0;
 };
 
