@@ -109,6 +109,35 @@ TEST(Sweep, FailedStepsAreSubdividedAndTheSweepContinues) {
   for (std::size_t k = 0; k < tr.t.size(); ++k) EXPECT_NEAR(tr.q[k](3), slider_x(tr.t[k]), 1e-9);
 }
 
+// SweepOptions::newton.known_to is a floor under the rounding level a sweep carries (NewtonOptions::known_to): with
+// the quadratic predictor on 0.5° rows and full Newton, a row's first step (about 10³ tolerances) lands within the
+// residual's tolerance but needs a second to show it; with a floor above those steps, each row ends after its
+// first, reported as its rounding level (and warned of).
+TEST(Sweep, TheCallersKnownToIsAFloorUnderTheLevelTheSweepCarries) {
+  Model m = crank_slider();
+  auto run = [&](double known_to) {
+    SweepOptions opt;
+    opt.t_end = M_PI;
+    opt.steps = 360;
+    opt.predictor = Predictor::kQuadratic;
+    opt.newton.jacobian_update = JacobianUpdate::kEveryIteration;
+    opt.newton.known_to = known_to;
+    test::Trace tr;
+    SweepSummary sum;
+    EXPECT_EQ(test::sweep(m, opt, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+    return sum;
+  };
+  const SweepSummary plain = run(0.0), floored = run(1e12);
+  std::printf("Newton iterations over 360 rows: %ld, with the floor %ld\n",
+              static_cast<long>(plain.counters.newton_iterations), static_cast<long>(floored.counters.newton_iterations));
+  EXPECT_GE(plain.counters.newton_iterations, 2 * 360 - 10);
+  EXPECT_TRUE(plain.warnings.empty());
+  EXPECT_LE(floored.counters.newton_iterations, 360 + 10);
+  ASSERT_FALSE(floored.warnings.empty());
+  EXPECT_EQ(floored.warnings[0].kind, "slow_convergence");
+  EXPECT_HAS(floored.warnings[0].message, "within the rounding level the previous positions stopped at");
+}
+
 TEST(Sweep, PredictorsReachTheSameSolutions) {
   Model m = crank_slider();
   for (Predictor p : {Predictor::kPrevious, Predictor::kSecant, Predictor::kParabolic, Predictor::kLinear,
