@@ -344,6 +344,28 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   EXPECT_LE(derivative_deviation(usual), 1.5e-9);
   EXPECT_LE(derivative_deviation(r), 1.5e-9);
 
+  // A rounding level is taken as measured (PositionSummary::rounding_measured, what a sweep carries to its next
+  // rows in NewtonOptions::known_to) only from a step that started where a step of the same solve had arrived: a
+  // first step is the start's own error as well (from a converged row here, the rounding alone, but a solve
+  // cannot tell), and from a start 10⁻⁶ m off, the second step is the rounding.
+  {
+    Workspace ws(m);
+    NewtonOptions o = sc.sweep.newton;
+    o.start_error = INFINITY;  // a step from the start, as from a prediction
+    ws.q = r.tr.q.back();
+    PositionSummary first;
+    ASSERT_EQ(solve_position(m, r.tr.t.back(), o, ws, &first), SolveStatus::kSuccess) << first.message;
+    EXPECT_GT(first.rounding_level, 0.0);
+    EXPECT_FALSE(first.rounding_measured);
+    ws.q = r.tr.q.back();
+    ws.q.array() += 1e-6;
+    PositionSummary off;
+    ASSERT_EQ(solve_position(m, r.tr.t.back(), o, ws, &off), SolveStatus::kSuccess) << off.message;
+    EXPECT_GE(off.iterations, 1);
+    EXPECT_GT(off.rounding_level, 0.0);
+    EXPECT_TRUE(off.rounding_measured);
+  }
+
   // In parallel chunks: a chunk's first row (from its seed) and the previous chunk's seam differ by the rounding
   // level, thousands of tolerances here, not by the 100 tolerances the seam check allows a regular solve; the check
   // allows 10× the rounding level such stops report, so every chunk is accepted (before, the rest ran in order).

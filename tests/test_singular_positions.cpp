@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <regex>
 
+#include "kinematics_internal.hpp"
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
 
@@ -93,7 +96,25 @@ TEST(SingularPositions, AStartWithEveryLoopFoldedIsASingularPositionNotAModelSho
   EXPECT_EQ(prepare_square(model, 0.0, {}, q, &solved, &as), SolveStatus::kNotSquare);
   EXPECT_EQ(as.rank.driven_dof, 3);
   EXPECT_HAS(as.message, "3 degree(s) of freedom not driven");
-  EXPECT_HAS(as.message, "at this position only (a placement off it leaves 0: a singular position");
+  EXPECT_HAS(as.message, "at this position only (at a solution near it 0: a singular position");
+
+  // Bricard's overconstrained loop, its driver taken away: one freedom undriven at every position. Off its
+  // solutions its Φq has full rank (its redundancy is on the motion only), so the diagnosis is made at a solution.
+  std::ifstream in(model_path("benchmarks/bricard.yaml"));
+  std::stringstream file;
+  file << in.rdbuf();
+  std::string text = file.str();
+  const std::string driver = "  - {name: motor, joint: J1, law: {type: linear, initial: 0, rate: 1}}\n";
+  ASSERT_NE(text.find(driver), std::string::npos);
+  text.replace(text.find("drivers:\n" + driver), std::string("drivers:\n").size() + driver.size(), "");
+  const Scene bricard = parse_scene(text, "bricard_undriven.yaml");
+  Eigen::VectorXd qb = bricard.model->initial_positions();
+  AssemblySummary bs;
+  EXPECT_EQ(prepare_square(*bricard.model, 0.0, {}, qb, &solved, &bs), SolveStatus::kNotSquare);
+  EXPECT_EQ(bs.rank.driven_dof, 1);
+  EXPECT_HAS(bs.message, "1 degree(s) of freedom not driven");
+  EXPECT_EQ(bs.message.find("at this position only"), std::string::npos) << bs.message;
+  EXPECT_EQ(detail::driven_dof_nearby(*bricard.model, qb, 0.0, {}), 1);
 }
 
 TEST(SingularPositions, NFourBarFullTurnInWholeDegreesStaysOnTheParallelogram) {

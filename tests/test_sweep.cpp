@@ -135,7 +135,7 @@ TEST(Sweep, TheCallersKnownToIsAFloorUnderTheLevelTheSweepCarries) {
   EXPECT_LE(floored.counters.newton_iterations, 360 + 10);
   ASSERT_FALSE(floored.warnings.empty());
   EXPECT_EQ(floored.warnings[0].kind, "slow_convergence");
-  EXPECT_HAS(floored.warnings[0].message, "within the rounding level the previous positions stopped at");
+  EXPECT_HAS(floored.warnings[0].message, "within the level q can be known to here");
 }
 
 TEST(Sweep, PredictorsReachTheSameSolutions) {

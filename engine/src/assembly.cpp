@@ -7,6 +7,7 @@
 #include <memory>
 #include <sstream>
 
+#include "kinematics_internal.hpp"
 #include "phiq/min_norm_solver.hpp"
 #include "tolerance_tests.hpp"
 
@@ -314,6 +315,23 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
   }
 }
 
+// Of the model, or of this position only? A position where several loops are folded or aligned at once (nfourbar
+// started folded, every coupler on its neighbour's crank) loses rank there only; a model short of drivers or
+// constraints, all along its motion. The rank is taken at a solution assembled from q moved off it
+// (detail::nearby_placement), not at the moved placement itself, where an overconstrained linkage (Bricard's,
+// a braced parallelogram) has full rank though it loses it on every solution.
+Index detail::driven_dof_nearby(const Model& model, const Eigen::VectorXd& q, double t,
+                                const AssemblyOptions& options) {
+  Eigen::VectorXd nearby = detail::nearby_placement(model, q);
+  AssemblySummary as;
+  try {
+    if (assemble(model, t, options, nearby, &as) != SolveStatus::kSuccess) return -1;
+  } catch (const Error&) {  // a placement outside an expression's domain can upset the rank analysis
+    return -1;
+  }
+  return as.rank.driven_dof;
+}
+
 SolveStatus prepare_square(const Model& model, double t, const AssemblyOptions& options, Eigen::VectorXd& q,
                            std::unique_ptr<Model>* solved, AssemblySummary* summary) {
   if (!solved) throw Error("prepare_square: solved must not be null");
@@ -326,12 +344,9 @@ SolveStatus prepare_square(const Model& model, double t, const AssemblyOptions& 
     sum.message = std::to_string(sum.rank.driven_dof) + " degree(s) of freedom not driven: the mechanism has " +
                   std::to_string(sum.rank.dof) + " and the drivers fix " +
                   std::to_string(sum.rank.driven_rank - sum.rank.rank);
-    // Of the model, or of this position only? Φq off it (detail::nearby_placement) has the model's
-    // generic rank: a position where several loops are folded or aligned at once (nfourbar started flat, every
-    // coupler on its neighbour's crank) loses rank there only; a model short of drivers or constraints, everywhere.
-    const RankReport generic = analyse_rank(model, detail::nearby_placement(model, q), t, options.rank);
-    if (generic.driven_dof < sum.rank.driven_dof)
-      sum.message += " at this position only (a placement off it leaves " + std::to_string(generic.driven_dof) +
+    const Index nearby = detail::driven_dof_nearby(model, q, t, options);
+    if (nearby >= 0 && nearby < sum.rank.driven_dof)
+      sum.message += " at this position only (at a solution near it " + std::to_string(nearby) +
                      ": a singular position, not a model short of drivers or constraints)";
     return sum.status;
   }

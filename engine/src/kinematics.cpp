@@ -565,12 +565,14 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     // known. Stop at the better point of the two, with a warning, instead of refactorising in search of a
     // contraction that cannot come.
     const bool rounding_level = within && !step_ok && alpha == 1.0 && !(trial_check.merit < 0.5 * check.merit);
-    // `known_before`: the step ended the solve within NewtonOptions::known_to, its error estimated as
-    // min(η, 1) × its size (η from a contraction observed), not as its size.
+    // `known_before`: the step ended the solve within NewtonOptions::known_to. Its error is then the larger of
+    // min(η, 1) × its size (η from a contraction observed) and of its size up to known_to: a step that is mostly
+    // rounding does not contract, however well the steps before it did, and q is known no better than that level.
     auto stop_at_rounding_level = [&](bool known_before) {
       Index worst = 0;
+      const double size = step_ratio(model, ws.step, ws.q, opt.tolerance, &worst);
       const double worst_ratio =
-          step_ratio(model, ws.step, ws.q, opt.tolerance, &worst) * (known_before ? std::min(eta, 1.0) : 1.0);
+          known_before ? std::max(std::min(eta, 1.0) * size, std::min(size, opt.known_to)) : size;
       sum.rounding_level = worst_ratio;
       sum.rounding_measured = !known_before && it > 0;
       sum.error_estimate = worst_ratio;
@@ -585,8 +587,9 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       sum.slow_convergence = true;
       const std::string& name = model.coordinate_names()[static_cast<std::size_t>(worst)];
       sum.message = known_before
-                        ? "the Newton step is within the rounding level the previous positions stopped at (the "
-                          "rounding of Φ amplified by Φq⁻¹: a long chain, or Φq ill-conditioned): up to " +
+                        ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
+                          "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a long "
+                          "chain or Φq ill-conditioned): up to " +
                               fmt(worst_ratio) + " × the tolerance at '" + name + "', which is how well q is known there"
                         : "the residual is at its rounding level and the Newton steps no longer reduce it: they are "
                           "the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
@@ -620,10 +623,11 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     jacobian_at_q = with_jacobian;
     check = trial_check;
     if (rounding_level || within_known) {
-      // The step just taken is the rounding of Φ amplified by Φq⁻¹: it moved q by about as much as q is known, so
-      // the factorisation made where it started is Φq at the solution to the accuracy q has. Velocities and
-      // accelerations reuse it rather than refactorise (on a 10⁵-stage scissor lift a quarter of the rows stop
-      // here, and each paid a second factorisation).
+      // The step just taken is the rounding of Φ amplified by Φq⁻¹ (within known_to: that, and the start's own
+      // error up to that level): it moved q by about as much as q is known, so the factorisation made where it
+      // started is Φq at the solution to the accuracy q has. Velocities and accelerations reuse it rather than
+      // refactorise (on a 10⁵-stage scissor lift a quarter of the rows stop here, and each paid a second
+      // factorisation).
       factorized_at_rounding_level = step_from_factorization;
       return stop_at_rounding_level(within_known);
     }

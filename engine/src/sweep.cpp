@@ -298,29 +298,21 @@ class Sweeper {
     ill_conditioned_ = ill;
   }
 
-  // Why Φq stays singular on both sides of the singular position qs at t: the model's Φq is singular everywhere
-  // (": redundant or missing constraints"), or only along the branch followed from there, Φq off it
-  // (detail::nearby_placement) being regular: several loops folded or aligned at once, and kept so by the drive
-  // (nfourbar started folded: every coupler on its neighbour's crank, the far loops staying so as crank 0 turns).
-  // Factorises in the workspace's LU, which the failing sweep no longer needs.
+  // Why Φq stays singular on both sides of the singular position qs at t: the model is short of drivers or
+  // constraints all along its motion (": redundant or missing constraints"), or the position is singular by itself,
+  // several loops folded or aligned at once and kept so by the drive (nfourbar started folded: every coupler on
+  // its neighbour's crank, the far loops staying so as crank 0 turns), which a solution assembled near it, fully
+  // driven, tells (detail::driven_dof_nearby).
   std::string singular_throughout(const Eigen::VectorXd& qs, double t) {
-    const Eigen::VectorXd nearby = detail::nearby_placement(model_, qs);
-    model_.jacobian(nearby.data(), t, ws_->jacobian_values.data());
-    ++ws_->counters.jacobian_evaluations;
-    ws_->has_factorization = ws_->has_jacobian = ws_->factorized_at_solution = false;
-    double rc = 0.0;
-    if (ws_->lu && ws_->lu->factorize(detail::solve_values(model_, *ws_)) == FactorStatus::kOk) rc = ws_->lu->rcond();
-    ws_->has_factorization = false;
-    // A pivot ratio above a thousand ε is not rounding: Φq there has full rank, however ill-conditioned a
-    // random placement of a long chain leaves it (nfourbar of 10⁵ folded loops: 6.9e-11); a model short of
-    // constraints gives a zero pivot or one at ε.
-    if (!(rc >= 1e3 * std::numeric_limits<double>::epsilon())) return ": redundant or missing constraints";
-    std::ostringstream m;
-    m.precision(3);
-    m << " on the branch the drive follows from there, though not off it (rcond " << rc
-      << " with q moved by a tenth of its scale): the position is singular, several loops folded or aligned at "
-         "once, rather than the model short of drivers or constraints; start the drive off it";
-    return m.str();
+    const Index nearby = detail::driven_dof_nearby(model_, qs, t, assembly_options(opt_.newton));
+    if (nearby > 0) return ": redundant or missing constraints";
+    if (nearby < 0)
+      return ": redundant or missing constraints, or several loops folded or aligned at once (no solution near it "
+             "was assembled to tell which)";
+    return std::string(" on the branch the drive follows from there, though a solution near it is regular: the "
+                       "position is singular, several loops folded or aligned at once, rather than the model short "
+                       "of drivers or constraints") +
+           (has_current_ ? "" : "; start the drive off it");
   }
 
   // Φq is singular at the converged position ws.q at t (rcond below kSingularRcond, or a zero pivot): a
@@ -356,6 +348,7 @@ class Sweeper {
     // singular value, O(δ), so a position error ε_q becomes a velocity error ε_q/δ (and worse in q̈).
     NewtonOptions tight = opt_.newton;
     tight.tolerance = std::max(1e-4 * opt_.newton.tolerance, 1e-15);
+    tight.known_to = 0.0;  // a level in units of the sweep's tolerance: not this one's, and these reach rounding
     tight.jacobian_update = JacobianUpdate::kEveryIteration;
     tight.max_iterations = std::max(tight.max_iterations, 30);
     for (int k = 0; k < 4; ++k) {

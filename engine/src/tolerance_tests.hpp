@@ -90,9 +90,8 @@ inline double scaled_distance(const Model& model, const double* a, const double*
 }
 
 // q moved by up to a tenth of each coordinate's tolerance scale (the length scale, or a radian), in a fixed
-// pseudo-random direction (the same in every run): no longer a solution, but Φq there has the model's generic
-// rank, so that a position singular by itself (several loops folded or aligned at once) is told apart from a model
-// short of drivers or constraints. (10⁻³ left nfourbar of 10³ folded loops at a pivot ratio of 1.6e-9.)
+// pseudo-random direction (the same in every run): a placement off a singular position, from which to assemble a
+// solution near it (detail::driven_dof_nearby).
 inline Eigen::VectorXd nearby_placement(const Model& model, const Eigen::VectorXd& q) {
   Eigen::VectorXd out = q;
   const Eigen::VectorXd& scale = model.tolerance_scales().coordinate_scale;
