@@ -441,9 +441,10 @@ TEST(Generate, RefusesBadOptionsLikeNFourBar) {
   EXPECT_EQ(message(generate_options("grid", 3, "natural", 2.0, 3.0)), "(no error)");  // beyond π/2: fine for the grid
 }
 
-// The loader refuses a scene whose families make more than SceneLimits::max_family_instances entries (after
-// expanding the families before the one that exceeds it: nfourbar N = 10^7 took 160 s and 4.7 GB to be refused).
-// family_entries() counts them as the loader does: a scene loads with exactly that limit and not with one less.
+// The loader refuses a scene whose families make more than SceneLimits::max_family_instances entries (counted
+// before any is expanded; once only after expanding those before the one that exceeds it: nfourbar N = 10^7 took
+// 160 s and 4.7 GB to be refused). family_entries() counts them as the loader does: a scene loads with exactly
+// that limit and not with one less.
 TEST(Generate, FamilyEntriesAreWhatTheLoaderCounts) {
   std::vector<std::int64_t> sizes;
   for (std::int64_t n = 1; n <= 30; ++n) sizes.push_back(n);  // grids of 1, 2 and 3+ rows, short and full last rows

@@ -494,24 +494,37 @@ TEST(SceneFamilies, MalformedFamiliesAndLimits) {
             "bad.yaml:15:5: constraints[1].for i 0..N-1: a family is 'for NAME in A..B' (A and B whole numbers, B "
             "included)");
   EXPECT_EQ(error_of(family_variant("for i in 0..N-1:", "for i in 0..100000000:")),
-            "bad.yaml:15:5: constraints[1].for i in 0..100000000: the family would make 100000001 x 1 entries; "
-            "families may make 50000000 entries in all and 49999984 are left (SceneLimits::max_family_instances)");
+            "bad.yaml:15:5: constraints[1].for i in 0..100000000: the families would make 100000017 entries in all "
+            "(coordinates 8, points 4, constraints 100000005), more than the 50000000 they may make "
+            "(SceneLimits::max_family_instances)");
   EXPECT_EQ(error_of(family_variant("  for i in 0..N:\n    P{i}", "  for i in 0..N:\n    - P{i}")),
             "bad.yaml:10:3: points.for i in 0..N: the body of a family in a map is a map of entries: {for i in 0..N: "
             "{NAME: VALUE, ...}}");
   EXPECT_EQ(error_of(family_variant("  - for i in 0..N-1:\n", "  - for i in 0..N-1:\n    name: x\n    body:\n")),
             "bad.yaml:15:5: constraints[1]: a family item is a map with the one key 'for NAME in A..B' and nothing "
             "beside it");
-  // the budget counts every entry made, nested families included
+  // the families of all sections together, counted before any is expanded
   SceneLimits few;
   few.max_family_instances = 12;
   try {
     parse_scene(kFamilies, "few.yaml", few);
     ADD_FAILURE();
   } catch (const SceneError& e) {
-    // coordinates 4 x 2, points 4 x 1: nothing left for the cranks
-    EXPECT_EQ(std::string(e.what()), "few.yaml:13:5: constraints[0].for i in 0..N: the family would make 4 x 1 "
-                                     "entries; families may make 12 entries in all and 0 are left "
+    // coordinates 4 x 2, points 4 x 1: the cranks take the count beyond 12
+    EXPECT_EQ(std::string(e.what()), "few.yaml:13:5: constraints[0].for i in 0..N: the families would make 19 "
+                                     "entries in all (coordinates 8, points 4, constraints 7), more than the 12 "
+                                     "they may make (SceneLimits::max_family_instances)");
+  }
+  // the budget counts every entry made, nested families included: those whose range uses an enclosing index are
+  // checked as they are expanded (here 2 x 1 counted beforehand, then 10 x 1 for i = 0 and 11 x 1 for i = 1)
+  const std::string nested = "phiq: 1\nparameters: {N: 9}\ncoordinates:\n  for i in 0..1:\n    for j in 0..N+i:\n"
+                             "      x{i}_{j}: 0\ntime: {start: 0, end: 1, steps: 1}\n";
+  try {
+    parse_scene(nested, "few.yaml", few);
+    ADD_FAILURE();
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), "few.yaml:5:5: coordinates.for i in 0..1[i=1].for j in 0..N+i: the family would "
+                                     "make 11 x 1 entries; families may make 12 entries in all and 0 are left "
                                      "(SceneLimits::max_family_instances)");
   }
   // nesting deeper than the limit
@@ -522,6 +535,63 @@ TEST(SceneFamilies, MalformedFamiliesAndLimits) {
   EXPECT_EQ(error_of(deep), "bad.yaml:10:19: coordinates.for i0 in 0..0.for i1 in 0..0.for i2 in 0..0.for i3 in "
                             "0..0.for i4 in 0..0.for i5 in 0..0.for i6 in 0..0.for i7 in 0..0.for i8 in 0..0: "
                             "families nested more than 8 deep");
+}
+
+// A scene whose families fit one by one but not together is refused before any is expanded: the limit was consumed
+// section by section, so that nfourbar with N = 10^7 was refused at its couplers after its coordinates, points and
+// cranks were made (4.7 GB). Here the coordinates' body fails at the first member (an unknown name), which
+// expanding them would report first.
+TEST(SceneFamilies, FamiliesOverTheLimitTogetherAreRefusedBeforeAnyIsExpanded) {
+  auto scene = [](std::int64_t n, const std::string& value) {
+    return "phiq: 1\nparameters: {N: " + std::to_string(n) + "}\ncoordinates:\n  for k in 0..N-1:\n    q{k}: " +
+           value + "\nconstraints:\n  - for k in 0..N-1:\n"
+           "      - {name: \"fix{k}\", type: equation, expr: \"q{k} - 0.5*k\", unit: length}\n"
+           "time: {start: 0, end: 1, steps: 1}\n";
+  };
+  auto error = [](const std::string& text, const SceneLimits& limits) -> std::string {
+    try {
+      parse_scene(text, "many.yaml", limits);
+    } catch (const SceneError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  };
+  SceneLimits limits;
+  limits.max_family_instances = 1000;
+  ASSERT_EQ(error(scene(600, "0.5*k + missing"), limits),
+            "many.yaml:7:5: constraints[0].for k in 0..N-1: the families would make 1200 entries in all "
+            "(coordinates 600, constraints 600), more than the 1000 they may make "
+            "(SceneLimits::max_family_instances)");
+  // within the limit, the coordinates are expanded (and say what is wrong with them); a scene within it loads
+  EXPECT_EQ(error(scene(500, "0.5*k + missing"), limits),
+            "many.yaml:5:11: coordinates.for k in 0..N-1[k=0].q{k}: expression \"0.5*k + missing\": unknown name "
+            "'missing'");
+  const Scene ok = parse_scene(scene(500, "0.5*k"), "many.yaml", limits);
+  EXPECT_EQ(ok.model->num_coordinates(), 500);
+  EXPECT_EQ(ok.model->constraints().size(), 500u);
+  EXPECT_EQ(ok.model->constraints().back().name, "fix499");
+  // a parameter given for the run counts as the file's would
+  SceneOverrides bigger;
+  bigger.parameters = {{"N", 501.0}};
+  try {
+    parse_scene(scene(500, "0.5*k"), "many.yaml", limits, bigger);
+    ADD_FAILURE();
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("the families would make 1002 entries in all"), std::string::npos)
+        << e.what();
+  }
+  // nested families count one entry per member beforehand: they make at least that many
+  const std::string nested = "phiq: 1\nparameters: {N: 1000}\ncoordinates:\n  for i in 0..N:\n"
+                             "    for j in 0..1:\n      x{i}_{j}: 0\ntime: {start: 0, end: 1, steps: 1}\n";
+  EXPECT_EQ(error(nested, limits),
+            "many.yaml:4:3: coordinates.for i in 0..N: the families would make at least 1001 entries in all "
+            "(coordinates 1001), more than the 1000 they may make (SceneLimits::max_family_instances)");
+  // at the default limit: 3·10^7 coordinates fit, with their 3·10^7 equations not; expanding the coordinates
+  // first would have made them (gigabytes) before the equations were refused
+  EXPECT_EQ(error(scene(30000000, "0.5*k"), SceneLimits{}),
+            "many.yaml:7:5: constraints[0].for k in 0..N-1: the families would make 60000000 entries in all "
+            "(coordinates 30000000, constraints 30000000), more than the 50000000 they may make "
+            "(SceneLimits::max_family_instances)");
 }
 
 // Inputs the fuzzer once found a defect with (tests/fuzz/regressions/): each must load or fail with one line.

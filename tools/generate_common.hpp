@@ -25,8 +25,8 @@ inline std::string num(double v) {
 }
 
 // A known --coords, then an N and a step count whose scene the loader accepts: a larger one would be written in a
-// few kilobytes and refused only when loaded, after the families before the one that exceeds the limit were
-// expanded (nfourbar N = 10^7: 160 s and 4.7 GB to say so).
+// few kilobytes and refused only when loaded (until the loader counted the families before expanding any, after
+// those before the one that exceeds the limit were expanded: nfourbar N = 10^7, 160 s and 4.7 GB to say so).
 inline void check_size_and_coords(const GenerateOptions& o) {
   if (o.coords != "natural" && o.coords != "reference-point")
     throw std::invalid_argument("--coords is natural or reference-point");

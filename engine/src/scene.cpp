@@ -661,12 +661,17 @@ struct TNode {
   mutable std::shared_ptr<ScalarPlan> plan;
 };
 
-// One `for NAME in A..B` with its body (a map in map sections, a list in list sections).
-struct Family {
-  std::string key;    // as written
+// The key `for NAME in A..B` of a family: its index and its range, whose bounds are whole-number expressions of
+// the parameters and the indices of the enclosing families.
+struct FamilyRange {
   std::string index;  // NAME
   std::string lo_text, hi_text;
   std::shared_ptr<const IndexExpr> lo, hi;
+};
+
+// One `for NAME in A..B` with its body (a map in map sections, a list in list sections).
+struct Family : FamilyRange {
+  std::string key;    // as written
   std::string path;   // of the key, with the marks of the enclosing families
   YAML::Mark mark;    // of the key
   int depth = 0;      // 0 for a family in a section, 1 inside it, ...
@@ -884,6 +889,7 @@ class SceneReader {
     if (overrides_ && overrides_->share_analysis_with) builder_.share_analysis_with(*overrides_->share_analysis_with);
     if (auto d = top.field("dimension"); d.present()) spatial_ = d.integer(2, 3) == 3;
     read_parameters(top.field("parameters"));
+    check_family_total(top);  // the parameters give the ranges of the families in the sections
     read_coordinates(top.require("coordinates"));
     if (auto p = top.field("points"); p.present()) read_points(p);
     if (auto b = top.field("bodies"); b.present()) read_bodies(b);
@@ -1102,40 +1108,28 @@ class SceneReader {
   }
 
   // ---- families -----------------------------------------------------------------------------------------------
-  // Reads "for NAME in A..B" and copies the body out of the YAML tree. `path` is the key's field path, `enclosing`
-  // the indices of the families around it (outermost first), `list` whether the body is a list of items.
-  std::shared_ptr<Family> parse_family(const std::string& key, const YAML::Mark& key_mark, const YAML::Node& body,
-                                       const std::string& path, const std::vector<std::string>& enclosing,
-                                       bool list) {
-    auto f = std::make_shared<Family>();
-    f->key = key, f->path = path, f->mark = key_mark, f->depth = static_cast<int>(enclosing.size());
+  // Reads the key "for NAME in A..B" of a family: its index and its range, compiled. `path` is the key's field
+  // path, `enclosing` the indices of the families around it (outermost first), which the bounds may use.
+  FamilyRange parse_range(const std::string& key, const YAML::Mark& key_mark, const std::string& path,
+                          const std::vector<std::string>& enclosing) const {
     auto fail = [&](const std::string& what) { fail_at(file_, key_mark, families_.render(path), what); };
-    // for NAME in A..B
+    FamilyRange r;
     std::istringstream words(key);
     std::string w_for, w_in;
-    words >> w_for >> f->index >> w_in;
+    words >> w_for >> r.index >> w_in;
     std::string range;
     std::getline(words, range);
     const std::size_t dots = range.find("..");
     if (w_for != "for" || w_in != "in" || dots == std::string::npos)
       fail("a family is 'for NAME in A..B' (A and B whole numbers, B included)");
-    f->lo_text = range.substr(0, dots), f->hi_text = range.substr(dots + 2);
+    r.lo_text = range.substr(0, dots), r.hi_text = range.substr(dots + 2);
     auto trim = [](std::string& s) {
       s.erase(0, s.find_first_not_of(" \t"));
       s.erase(s.find_last_not_of(" \t") + 1);
     };
-    trim(f->lo_text), trim(f->hi_text);
-    if (f->lo_text.empty() || f->hi_text.empty())
+    trim(r.lo_text), trim(r.hi_text);
+    if (r.lo_text.empty() || r.hi_text.empty())
       fail("a family is 'for NAME in A..B' (A and B whole numbers, B included)");
-    const std::string& n = f->index;
-    if (!valid_name(n)) fail("'" + n + "' is not a valid index name");
-    if (n == "t" || n == "pi") fail("index '" + n + "' is reserved");
-    if (parameters_.count(n)) fail("index '" + n + "' shadows the parameter '" + n + "'");
-    for (const std::string& e : enclosing)
-      if (e == n) fail("index '" + n + "' shadows the index of an enclosing family");
-    if (builder_.find_coordinate(n) >= 0) fail("index '" + n + "' shadows the coordinate '" + n + "'");
-    if (f->depth >= limits_.max_family_depth)
-      fail("families nested more than " + std::to_string(limits_.max_family_depth) + " deep");
     // the range: whole-number expressions of the parameters and the enclosing indices
     Meanings meaning = [&](const std::string& name) {
       Meaning m;
@@ -1146,11 +1140,51 @@ class SceneReader {
       return m;
     };
     try {
-      f->lo = std::make_shared<IndexExpr>(f->lo_text, "range bound '" + clip(f->lo_text) + "'", meaning, false);
-      f->hi = std::make_shared<IndexExpr>(f->hi_text, "range bound '" + clip(f->hi_text) + "'", meaning, false);
+      r.lo = std::make_shared<IndexExpr>(r.lo_text, "range bound '" + clip(r.lo_text) + "'", meaning, false);
+      r.hi = std::make_shared<IndexExpr>(r.hi_text, "range bound '" + clip(r.hi_text) + "'", meaning, false);
     } catch (const Error& e) {
       fail(e.what());
     }
+    return r;
+  }
+
+  // The first and last member of a range, for the members of the enclosing families being read (families_);
+  // messages point at the family's key (`mark`, `path`). B < A: no member.
+  std::pair<std::int64_t, std::int64_t> range_bounds(const FamilyRange& r, const YAML::Mark& mark,
+                                                     const std::string& path) const {
+    auto fail = [&](const std::string& what) { fail_at(file_, mark, families_.render(path), what); };
+    auto bound = [&](const IndexExpr& e, const std::string& text) -> std::int64_t {
+      double v = 0.0;
+      try {
+        v = e.eval(families_.env());
+      } catch (const Error& x) {
+        fail(x.what());
+      }
+      if (!(std::floor(v) == v && std::fabs(v) <= 4503599627370496.0))
+        fail("range bound '" + clip(text) + "' is " + shortest(v) + ", not a whole number");
+      return static_cast<std::int64_t>(v);
+    };
+    return {bound(*r.lo, r.lo_text), bound(*r.hi, r.hi_text)};
+  }
+
+  // Reads "for NAME in A..B" and copies the body out of the YAML tree. `path` is the key's field path, `enclosing`
+  // the indices of the families around it (outermost first), `list` whether the body is a list of items.
+  std::shared_ptr<Family> parse_family(const std::string& key, const YAML::Mark& key_mark, const YAML::Node& body,
+                                       const std::string& path, const std::vector<std::string>& enclosing,
+                                       bool list) {
+    auto f = std::make_shared<Family>();
+    static_cast<FamilyRange&>(*f) = parse_range(key, key_mark, path, enclosing);
+    f->key = key, f->path = path, f->mark = key_mark, f->depth = static_cast<int>(enclosing.size());
+    auto fail = [&](const std::string& what) { fail_at(file_, key_mark, families_.render(path), what); };
+    const std::string& n = f->index;
+    if (!valid_name(n)) fail("'" + n + "' is not a valid index name");
+    if (n == "t" || n == "pi") fail("index '" + n + "' is reserved");
+    if (parameters_.count(n)) fail("index '" + n + "' shadows the parameter '" + n + "'");
+    for (const std::string& e : enclosing)
+      if (e == n) fail("index '" + n + "' shadows the index of an enclosing family");
+    if (builder_.find_coordinate(n) >= 0) fail("index '" + n + "' shadows the coordinate '" + n + "'");
+    if (f->depth >= limits_.max_family_depth)
+      fail("families nested more than " + std::to_string(limits_.max_family_depth) + " deep");
     // the body
     std::vector<std::string> inner = enclosing;
     inner.push_back(n);
@@ -1242,18 +1276,7 @@ class SceneReader {
   template <class Each>
   void for_each_member(const Family& f, Each&& each) {
     auto fail = [&](const std::string& what) { fail_at(file_, f.mark, families_.render(f.path), what); };
-    auto bound = [&](const IndexExpr& e, const std::string& text) -> std::int64_t {
-      double v = 0.0;
-      try {
-        v = e.eval(families_.env());
-      } catch (const Error& x) {
-        fail(x.what());
-      }
-      if (!(std::floor(v) == v && std::fabs(v) <= 4503599627370496.0))
-        fail("range bound '" + clip(text) + "' is " + shortest(v) + ", not a whole number");
-      return static_cast<std::int64_t>(v);
-    };
-    const std::int64_t lo = bound(*f.lo, f.lo_text), hi = bound(*f.hi, f.hi_text);
+    const auto [lo, hi] = range_bounds(f, f.mark, f.path);
     const std::size_t entries = f.body.kind == TNode::Kind::kSeq ? f.body.seq.size() : f.body.map.size();
     if (hi < lo || entries == 0) return;
     const auto members = static_cast<std::uint64_t>(hi - lo) + 1;
@@ -1334,6 +1357,73 @@ class SceneReader {
         else each(TCursor(&item, &families_));
       }
     });
+  }
+
+  // Refuses at once a scene whose families would make more entries than SceneLimits::max_family_instances, before
+  // any is expanded (the budget of for_each_member is consumed section by section, so that a scene over the limit
+  // was refused only when a later section's family ran out of it: an nfourbar scene with N = 10^7 after its first
+  // 4·10^7 entries, 4.7 GB). Counts the families in the sections, M members x E entries of each body, a nested
+  // family counting as one entry per member as in for_each_member; the ranges of those nested in them may use the
+  // enclosing indices and stay checked as they are expanded. Reads only the keys and the sizes of the bodies: no
+  // body is copied or checked (parse_family does that as each is expanded).
+  void check_family_total(const Cursor& top) {
+    constexpr std::uint64_t kAll = std::numeric_limits<std::uint64_t>::max();  // at least this many (saturated)
+    auto add = [](std::uint64_t a, std::uint64_t b) { return b > kAll - a ? kAll : a + b; };
+    std::uint64_t total = 0;
+    bool nested = false;  // bodies hold families: they make more than counted
+    std::vector<std::pair<std::string, std::uint64_t>> sections;  // entries by section, in order
+    std::optional<std::pair<YAML::Mark, std::string>> over;         // the family that takes the total beyond
+    auto count = [&](const std::string& section, const std::string& key, const YAML::Mark& mark,
+                     const std::string& path, std::size_t entries, bool holds_families) {
+      const auto [lo, hi] = range_bounds(parse_range(key, mark, path, {}), mark, path);
+      if (hi < lo || entries == 0) return;
+      const auto members = static_cast<std::uint64_t>(hi - lo) + 1;
+      const std::uint64_t made = members > kAll / entries ? kAll : members * entries;
+      total = add(total, made);
+      nested = nested || holds_families;
+      if (sections.empty() || sections.back().first != section) sections.emplace_back(section, 0);
+      sections.back().second = add(sections.back().second, made);
+      if (!over && total > limits_.max_family_instances) over.emplace(mark, path);
+    };
+    auto family_key = [](const YAML::Node& key) { return key.IsScalar() && is_family_key(key.Scalar()); };
+    for (const char* section : {"coordinates", "points", "bodies", "vectors"}) {
+      const Cursor c = top.field(section);
+      if (!c.present() || !c.is_map() || (!spatial_ && std::string(section) == "vectors")) continue;
+      for (auto it = c.node().begin(); it != c.node().end(); ++it) {
+        if (!family_key(it->first)) continue;
+        const YAML::Node& body = it->second;
+        if (!body.IsMap()) continue;  // parse_family says what is wrong
+        bool holds = false;
+        for (auto b = body.begin(); b != body.end() && !holds; ++b) holds = family_key(b->first);
+        count(section, it->first.Scalar(), it->first.Mark(), c.join(it->first.Scalar()), body.size(), holds);
+      }
+    }
+    for (const char* section : {"constraints", "drivers"}) {
+      const Cursor c = top.field(section);
+      if (!c.present() || !c.is_sequence()) continue;
+      std::size_t i = 0;
+      for (auto it = c.node().begin(); it != c.node().end(); ++it, ++i) {
+        const YAML::Node& item = *it;
+        if (!item.IsMap() || item.size() != 1 || !family_key(item.begin()->first)) continue;
+        const YAML::Node& body = item.begin()->second;
+        if (!body.IsSequence()) continue;  // parse_family says what is wrong
+        bool holds = false;
+        for (auto b = body.begin(); b != body.end() && !holds; ++b)
+          if (b->IsMap())
+            for (auto e = b->begin(); e != b->end() && !holds; ++e) holds = family_key(e->first);
+        const std::string key = item.begin()->first.Scalar();
+        count(section, key, item.begin()->first.Mark(), c.path() + "[" + std::to_string(i) + "]." + key,
+              body.size(), holds);
+      }
+    }
+    if (!over) return;
+    std::string by_section;
+    for (const auto& [section, n] : sections)
+      by_section += (by_section.empty() ? "" : ", ") + section + " " + std::to_string(n);
+    fail_at(file_, over->first, over->second,
+            "the families would make " + std::string(nested || total == kAll ? "at least " : "") +
+                std::to_string(total) + " entries in all (" + by_section + "), more than the " +
+                std::to_string(limits_.max_family_instances) + " they may make (SceneLimits::max_family_instances)");
   }
 
   // ---- top-level sections -------------------------------------------------------------------------------------
