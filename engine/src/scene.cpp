@@ -1391,7 +1391,7 @@ class SceneReader {
       if (!c.present() || !c.is_map() || (!spatial_ && std::string(section) == "vectors")) continue;
       for (auto it = c.node().begin(); it != c.node().end(); ++it) {
         if (!family_key(it->first)) continue;
-        const YAML::Node& body = it->second;
+        const YAML::Node body = it->second;  // a handle, by value: yaml-cpp's iterators give temporaries
         if (!body.IsMap()) continue;  // parse_family says what is wrong
         bool holds = false;
         for (auto b = body.begin(); b != body.end() && !holds; ++b) holds = family_key(b->first);
@@ -1403,9 +1403,9 @@ class SceneReader {
       if (!c.present() || !c.is_sequence()) continue;
       std::size_t i = 0;
       for (auto it = c.node().begin(); it != c.node().end(); ++it, ++i) {
-        const YAML::Node& item = *it;
+        const YAML::Node item = *it;
         if (!item.IsMap() || item.size() != 1 || !family_key(item.begin()->first)) continue;
-        const YAML::Node& body = item.begin()->second;
+        const YAML::Node body = item.begin()->second;
         if (!body.IsSequence()) continue;  // parse_family says what is wrong
         bool holds = false;
         for (auto b = body.begin(); b != body.end() && !holds; ++b)
