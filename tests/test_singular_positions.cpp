@@ -115,6 +115,13 @@ TEST(SingularPositions, AStartWithEveryLoopFoldedIsASingularPositionNotAModelSho
   EXPECT_HAS(bs.message, "1 degree(s) of freedom not driven");
   EXPECT_EQ(bs.message.find("at this position only"), std::string::npos) << bs.message;
   EXPECT_EQ(detail::driven_dof_nearby(*bricard.model, qb, 0.0, {}), 1);
+  // its sweep stops at once: Φq singular at the start and at its sides (the velocity solve there meets a zero
+  // pivot; the message used to end in "the branch cannot be followed to it: " and nothing), and at a solution near
+  // it as well
+  SweepSummary bsum;
+  EXPECT_EQ(test::sweep(*bricard.model, bricard.sweep, &tr, &bsum), SolveStatus::kSingularJacobian);
+  EXPECT_HAS(bsum.message, "Φq stays singular around it");
+  EXPECT_HAS(bsum.message, "): redundant or missing constraints");
 }
 
 TEST(SingularPositions, NFourBarFullTurnInWholeDegreesStaysOnTheParallelogram) {

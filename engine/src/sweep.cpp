@@ -381,20 +381,24 @@ class Sweeper {
         ws_->q = side[k - 1].q + h * side[k - 1].qd + (0.5 * h * h) * side[k - 1].qdd;
       }
       SolveStatus st = solve_position(model_, ts, tight, *ws_, &ps);
-      if (st == SolveStatus::kSuccess) st = lu_derivatives(ts, true, &ls);
+      const bool position_found = st == SolveStatus::kSuccess;
+      if (position_found) st = lu_derivatives(ts, true, &ls);
       if (st != SolveStatus::kSuccess || ls.rcond < kSingularRcond) {
         ws_->q = qs;
         std::ostringstream m;
         m << "singular position at t = " << format_time(t) << " (Φq rcond " << rc << "): ";
-        if (k >= 2 && st != SolveStatus::kSuccess)
+        // (a side whose position was found but whose velocity solve met a zero pivot is singular too)
+        const bool side_singular =
+            position_found && (st == SolveStatus::kSuccess || st == SolveStatus::kSingularJacobian);
+        if (k >= 2 && !position_found)
           m << "no position beyond it on this branch (a dead point: the drive cannot go on, and the speed it asks "
                "for there is unbounded)"
             << (lined_up.empty() ? "" : ", where these equations line up:" + lined_up);
-        else if (st == SolveStatus::kSuccess)
+        else if (side_singular)
           m << "Φq stays singular around it (rcond " << ls.rcond << " at t = " << format_time(ts) << ")"
             << singular_throughout(qs, t);
         else
-          m << "the branch cannot be followed to it: " << ps.message;
+          m << "the branch cannot be followed to it: " << (position_found ? ls.message : ps.message);
         return fail(SolveStatus::kSingularJacobian, m.str());
       }
       side[k].t = ts, side[k].q = ws_->q, side[k].qd = ws_->qd, side[k].qdd = ws_->qdd;
