@@ -364,6 +364,16 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
     EXPECT_GE(off.iterations, 1);
     EXPECT_GT(off.rounding_level, 0.0);
     EXPECT_TRUE(off.rounding_measured);
+    // with the factorisation reused (modified Newton), a stop at the rounding level keeps the contraction it saw
+    // with that matrix, for the next solve's first step (an overestimate: its last step is the rounding)
+    o.jacobian_update = JacobianUpdate::kWhenSlow;
+    ws.newton_contraction = -1.0;
+    ws.q = r.tr.q.back();
+    ws.q.array() += 1e-6;
+    PositionSummary reused;
+    ASSERT_EQ(solve_position(m, r.tr.t.back(), o, ws, &reused), SolveStatus::kSuccess) << reused.message;
+    EXPECT_GT(reused.rounding_level, 0.0);
+    EXPECT_GE(ws.newton_contraction, 0.0);
   }
 
   // In parallel chunks: a chunk's first row (from its seed) and the previous chunk's seam differ by the rounding
