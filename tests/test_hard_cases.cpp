@@ -352,27 +352,24 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
     Workspace ws(m);
     NewtonOptions o = sc.sweep.newton;
     o.start_error = INFINITY;  // a step from the start, as from a prediction
-    ws.q = r.tr.q.back();
-    PositionSummary first;
-    ASSERT_EQ(solve_position(m, r.tr.t.back(), o, ws, &first), SolveStatus::kSuccess) << first.message;
-    EXPECT_GT(first.rounding_level, 0.0);
-    EXPECT_FALSE(first.rounding_measured);
-    ws.q = r.tr.q.back();
-    ws.q.array() += 1e-6;
-    PositionSummary off;
-    ASSERT_EQ(solve_position(m, r.tr.t.back(), o, ws, &off), SolveStatus::kSuccess) << off.message;
+    // solves the last row of the sweep again from its position moved by `off` m in every coordinate
+    auto solve_from = [&](double off) {
+      ws.q = r.tr.q.back();
+      ws.q.array() += off;
+      PositionSummary ps;
+      EXPECT_EQ(solve_position(m, r.tr.t.back(), o, ws, &ps), SolveStatus::kSuccess) << ps.message;
+      EXPECT_GT(ps.rounding_level, 0.0);
+      return ps;
+    };
+    EXPECT_FALSE(solve_from(0.0).rounding_measured);
+    const PositionSummary off = solve_from(1e-6);
     EXPECT_GE(off.iterations, 1);
-    EXPECT_GT(off.rounding_level, 0.0);
     EXPECT_TRUE(off.rounding_measured);
     // with the factorisation reused (modified Newton), a stop at the rounding level keeps the contraction it saw
     // with that matrix, for the next solve's first step (an overestimate: its last step is the rounding)
     o.jacobian_update = JacobianUpdate::kWhenSlow;
     ws.newton_contraction = -1.0;
-    ws.q = r.tr.q.back();
-    ws.q.array() += 1e-6;
-    PositionSummary reused;
-    ASSERT_EQ(solve_position(m, r.tr.t.back(), o, ws, &reused), SolveStatus::kSuccess) << reused.message;
-    EXPECT_GT(reused.rounding_level, 0.0);
+    solve_from(1e-6);
     EXPECT_GE(ws.newton_contraction, 0.0);
   }
 

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
+#include <random>
 #include <sstream>
 
 #include "kinematics_internal.hpp"
@@ -314,14 +316,31 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
   }
 }
 
+namespace {
+
+// q moved by up to a tenth of each coordinate's tolerance scale (the length scale, or a radian), in a fixed
+// pseudo-random direction (Knuth's MMIX generator with a fixed seed: the same in every run): a placement off a
+// singular position, from which to assemble a solution near it (driven_dof_nearby).
+Eigen::VectorXd nearby_placement(const Model& model, const Eigen::VectorXd& q) {
+  std::linear_congruential_engine<std::uint64_t, 6364136223846793005ull, 1442695040888963407ull, 0> mmix(
+      0x9E3779B97F4A7C15ull);
+  Eigen::VectorXd out = q;
+  const Eigen::VectorXd& scale = model.tolerance_scales().coordinate_scale;
+  for (Index j = 0; j < out.size(); ++j)
+    out(j) += 0.1 * scale(j) * (static_cast<double>(mmix() >> 11) * 0x1.0p-53 * 2.0 - 1.0);
+  return out;
+}
+
+}  // namespace
+
 // Of the model, or of this position only? A position where several loops are folded or aligned at once (nfourbar
 // started folded, every coupler on its neighbour's crank) loses rank there only; a model short of drivers or
 // constraints, all along its motion. The rank is taken at a solution assembled from q moved off it
-// (detail::nearby_placement), not at the moved placement itself, where an overconstrained linkage (Bricard's,
+// (nearby_placement), not at the moved placement itself, where an overconstrained linkage (Bricard's,
 // a braced parallelogram) has full rank though it loses it on every solution.
 Index detail::driven_dof_nearby(const Model& model, const Eigen::VectorXd& q, double t,
                                 const AssemblyOptions& options) {
-  Eigen::VectorXd nearby = detail::nearby_placement(model, q);
+  Eigen::VectorXd nearby = nearby_placement(model, q);
   AssemblySummary as;
   try {
     if (assemble(model, t, options, nearby, &as) != SolveStatus::kSuccess) return -1;

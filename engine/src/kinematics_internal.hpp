@@ -19,7 +19,8 @@ inline constexpr double kLinearSingularRcond = 1e-4;
 /// for a model with dropped rows (Model::without_rows()).
 const double* solve_values(const Model& model, Workspace& ws);
 
-/// The freedoms the drivers leave at a solution assembled near q at t (from q moved off it by nearby_placement),
+/// The freedoms the drivers leave at a solution assembled near q at t (from q moved off it by up to a tenth of each
+/// coordinate's scale),
 /// or −1 when none was found: fewer than at q means q is a singular position of a model regular elsewhere
 /// (assembly.cpp).
 Index driven_dof_nearby(const Model& model, const Eigen::VectorXd& q, double t, const AssemblyOptions& options);

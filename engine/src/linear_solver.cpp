@@ -169,10 +169,15 @@ class DenseNumeric final : public SparseLuNumeric {
     for (Index c = 0; c < p_.cols; ++c)
       for (Index k = p_.col_ptr[c]; k < p_.col_ptr[c + 1]; ++k) a_(p_.row_idx[k], c) = values[k];
     lu_.compute(a_);
-    // PartialPivLU does not report singularity; judge it from U's diagonal like UMFPACK does.
-    auto d = lu_.matrixLU().diagonal().cwiseAbs();
+    // PartialPivLU does not report singularity; judge it from U's diagonal like UMFPACK does. The determinant's
+    // sign from the signs of that diagonal and of the row permutation: the determinant itself, their product,
+    // underflows a double (60 rows scaled by 10⁻⁹ scale it by 10⁻⁵⁴⁰) and its sign then reads 0, singular.
+    const auto diag = lu_.matrixLU().diagonal();
+    auto d = diag.cwiseAbs();
     double mx = d.size() ? d.maxCoeff() : 0.0, mn = d.size() ? d.minCoeff() : 0.0;
     rcond_ = mx > 0 ? mn / mx : 0.0;
+    sign_ = static_cast<int>(lu_.permutationP().determinant());
+    for (Index i = 0; i < diag.size(); ++i) sign_ = diag(i) < 0 ? -sign_ : sign_;
     if (!std::isfinite(mx)) return FactorStatus::kFailed;
     return mn == 0.0 ? FactorStatus::kSingular : FactorStatus::kOk;
   }
@@ -187,14 +192,7 @@ class DenseNumeric final : public SparseLuNumeric {
     return true;
   }
   double rcond() const override { return rcond_; }
-  int determinant_sign() const override {
-    if (rcond_ == 0.0) return 0;
-    // from the signs of U's diagonal and of the row permutation: the determinant itself, their product,
-    // underflows a double (60 rows scaled by 10⁻⁹ scale it by 10⁻⁵⁴⁰) and its sign then reads 0, singular
-    int sign = static_cast<int>(lu_.permutationP().determinant());
-    for (Index i = 0; i < lu_.matrixLU().rows(); ++i) sign = lu_.matrixLU()(i, i) < 0 ? -sign : sign;
-    return sign;
-  }
+  int determinant_sign() const override { return rcond_ == 0.0 ? 0 : sign_; }
   std::string last_message() const override { return rcond_ == 0.0 ? "singular matrix" : ""; }
   std::int64_t pivoting_factorizations() const override { return factorizations_; }
   std::size_t memory_bytes() const override { return static_cast<std::size_t>(a_.size()) * sizeof(double); }
@@ -205,6 +203,7 @@ class DenseNumeric final : public SparseLuNumeric {
   Eigen::MatrixXd a_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   double rcond_ = 0.0;
+  int sign_ = 0;  // of det A, from the last factorisation (determinant_sign())
   std::int64_t factorizations_ = 0;
 };
 

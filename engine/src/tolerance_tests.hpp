@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -87,20 +86,6 @@ inline double scaled_distance(const Model& model, const double* a, const double*
   for (Index j = 0, n = model.num_coordinates(); j < n; ++j)
     w.add(std::fabs(a[j] - b[j]), tol * cs[j] + kUlpFloor * std::fabs(at[j]));
   return w.worst;
-}
-
-// q moved by up to a tenth of each coordinate's tolerance scale (the length scale, or a radian), in a fixed
-// pseudo-random direction (the same in every run): a placement off a singular position, from which to assemble a
-// solution near it (detail::driven_dof_nearby).
-inline Eigen::VectorXd nearby_placement(const Model& model, const Eigen::VectorXd& q) {
-  Eigen::VectorXd out = q;
-  const Eigen::VectorXd& scale = model.tolerance_scales().coordinate_scale;
-  std::uint64_t state = 0x9E3779B97F4A7C15ull;
-  for (Index j = 0; j < out.size(); ++j) {
-    state = state * 6364136223846793005ull + 1442695040888963407ull;  // Knuth's MMIX generator
-    out(j) += 0.1 * scale(j) * (static_cast<double>(state >> 11) * 0x1.0p-53 * 2.0 - 1.0);
-  }
-  return out;
 }
 
 // "'name' 1.234e-05, 'other[1]' …" for diagnostics.
