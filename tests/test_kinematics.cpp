@@ -295,6 +295,7 @@ TEST(Kinematics, AStepWithinTheLevelQIsKnownToEndsTheSolve) {
   EXPECT_GE(plain.iterations, 2);
   EXPECT_EQ(plain.rounding_level, 0.0);
   EXPECT_FALSE(plain.slow_convergence);
+  EXPECT_FALSE(plain.linear_convergence);
   EXPECT_EQ(solve(100.0).iterations, plain.iterations) << "a first step of about 1000 tolerances is beyond 100";
   const PositionSummary known = solve(1e4);
   EXPECT_EQ(known.iterations, 1);
@@ -303,6 +304,7 @@ TEST(Kinematics, AStepWithinTheLevelQIsKnownToEndsTheSolve) {
   EXPECT_EQ(known.error_estimate, known.rounding_level);
   EXPECT_FALSE(known.rounding_measured) << "an end within the level measures nothing a sweep should carry";
   EXPECT_TRUE(known.slow_convergence);
+  EXPECT_FALSE(known.linear_convergence) << "a stop at the level q is known to, not a singular position";
   EXPECT_NE(known.message.find("within the level q can be known to here"), std::string::npos)
       << known.message;
   EXPECT_NEAR(ws.q(3), exact(3), 1e-12);  // Newton's step itself is as good as ever
@@ -327,6 +329,27 @@ TEST(Kinematics, AStepWithinTheLevelQIsKnownToEndsTheSolve) {
   EXPECT_LT(near.rcond, 1e-4);
   EXPECT_EQ(near.rounding_level, 0.0) << near.message;
   EXPECT_GE(near.iterations, 2);
+
+  // On the dead centre itself (the slider at L2 + L3, θ = 0), from θ = 1e-3: Φ is quadratic in θ there, so the
+  // steps only halve (linear convergence) and Newton stops with the residual within tolerance and θ about √tol
+  // off: a slow convergence that is linear_convergence, not a rounding level.
+  {
+    ModelBuilder bd;
+    Index t2 = bd.add_coordinate("theta2", 1e-3), xa2 = bd.add_coordinate("xA", kL2),
+          ya2 = bd.add_coordinate("yA", 0.0), xb2 = bd.add_coordinate("xB", kL2 + kL3);
+    bd.add("crank", PolarSpec{{S(xa2), S(ya2)}, {C(0), C(0)}, kL2, S(t2)});
+    bd.add("rod", DistanceSpec{{S(xa2), S(ya2)}, {S(xb2), C(0)}, kL3});
+    bd.add_driver("slide", xb2, MotionLaw::linear(kL2 + kL3, 0.0));
+    Model on = std::move(bd).build();
+    Workspace wo(on);
+    PositionSummary at;
+    ASSERT_EQ(solve_position(on, 0.0, NewtonOptions{}, wo, &at), SolveStatus::kSuccess) << at.message;
+    EXPECT_TRUE(at.slow_convergence) << at.BriefReport();
+    EXPECT_TRUE(at.linear_convergence) << at.BriefReport();
+    EXPECT_EQ(at.rounding_level, 0.0);
+    EXPECT_NE(at.message.find("stopped converging quadratically"), std::string::npos) << at.message;
+    EXPECT_LT(std::fabs(wo.q(t2)), 1e-3);
+  }
 }
 
 TEST(Kinematics, SingularJacobianIsAStatusNotACrash) {

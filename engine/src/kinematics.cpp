@@ -457,7 +457,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     // twice in a row (linear convergence at a singular position, or steps at the rounding level of an
     // ill-conditioned Φq), or the iteration limit reached. More iterations would not make q more accurate.
     if (it > 0 && (it >= opt.max_iterations || stagnant >= 2) && within) {
-      sum.slow_convergence = true;
+      sum.slow_convergence = sum.linear_convergence = true;
       sum.error_estimate = accepted_error;
       finish(SolveStatus::kSuccess, "");
       sum.message = "residual within tolerance but the Newton steps stopped converging quadratically (a singular "

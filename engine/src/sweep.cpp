@@ -649,7 +649,7 @@ class Sweeper {
       if (!has_current_) m << " (the sweep starts here: the branch is the one nearest the placement)";
       sum_.warnings.push_back({t, "bifurcation", m.str()});
     }
-    if (!position_only_ && !derivatives(t, ps.slow_convergence && ps.rounding_level == 0.0)) return false;
+    if (!position_only_ && !derivatives(t, ps.linear_convergence)) return false;
     const Orientation sign = sign_at_solution();
     if (left_branch && has_current_ && sign.regular() && current_sign_.regular() && sign != current_sign_) {
       sum_.warnings.resize(noted.warnings);

@@ -95,6 +95,10 @@ struct PositionSummary {
   /// convergence of Newton at a singular position (a dead point, a bifurcation). The constraints hold to tolerance;
   /// the position itself is less accurate (about √tol). message says so.
   bool slow_convergence = false;
+  /// Of slow_convergence: the steps converged only linearly with the residual within tolerance (at a singular
+  /// position, q known to about √tol), not a stop at the rounding level (rounding_level > 0). A sweep takes such a
+  /// row as singular below a stricter condition (rcond < 1e-4 instead of 1e-10).
+  bool linear_convergence = false;
   /// At a stop at the rounding level: the last Newton step in units of the tolerance test (max_j |Δq_j| / (tol ·
   /// scale_j + floor_j)), i.e. how well q is known relative to the tolerance (at an end within
   /// NewtonOptions::known_to, the step's estimated error); 0 otherwise. Above 2 the stop is a
