@@ -23,20 +23,4 @@ for threads, chunks, seed, expected in cases:
     if abs(got - expected) > 1e-12:
         print(f"simulate({threads}, {chunks}, {seed}) = {got}, expected {expected}")
         failed += 1
-# the engine's split (run_sweep): chunks rounded up to a multiple of the threads, the steps spread evenly
-sizes = [
-    # (steps, chunk, threads, fixed, chunk sizes)
-    (1000, 64, 2, False, [63] * 8 + [62] * 8),
-    (950, 64, 2, False, [60] * 6 + [59] * 10),
-    (950, 59, 4, False, [48] * 10 + [47] * 10),
-    (1000, 64, 2, True, [64] * 15 + [40]),
-    (1000, 64, 1, False, [64] * 15 + [40]),
-    (10, 64, 2, False, [10]),
-    (3, 1, 2, False, [1, 1, 1]),  # never more chunks than steps
-]
-for steps, chunk, threads, fixed, expected in sizes:
-    got = sim.chunk_sizes(steps, chunk, threads, fixed)
-    if got != expected:
-        print(f"chunk_sizes({steps}, {chunk}, {threads}, {fixed}) = {got}, expected {expected}")
-        failed += 1
 sys.exit(1 if failed else 0)

@@ -453,32 +453,6 @@ TEST(ParallelSweep, EqualsTheSequentialSweepForAnyThreadCount) {
   }
 }
 
-// With chunk_steps = 0 the sweep picks the chunks' size (64 steps here, 59 on 4 threads: at least 4 chunks per
-// thread), then rounds their number up to a multiple of the threads and spreads the steps evenly over them, so that
-// no thread finishes a short last chunk alone: 950 steps make 16 chunks of 59–60 steps on 2 threads (not 14 of 64
-// and one of 54) and 20 of 47–48 on 4 (not 17). The rows are still the sequential sweep's, every one delivered.
-TEST(ParallelSweep, AutomaticChunksComeInMultiplesOfTheThreadsWithTheStepsSpreadEvenly) {
-  Model m = test::nfourbar_model(40, M_PI / 4, M_PI / 2);
-  SweepOptions opt;
-  opt.steps = 950;
-  test::Trace seq;
-  ASSERT_EQ(test::sweep(m, opt, &seq), SolveStatus::kSuccess);
-  for (const auto& [threads, chunks] : {std::pair{2, Index{16}}, std::pair{4, Index{20}}}) {
-    opt.threads = threads;
-    test::Trace par;
-    SweepSummary ps;
-    ASSERT_EQ(test::sweep(m, opt, &par, &ps), SolveStatus::kSuccess) << ps.message;
-    EXPECT_EQ(ps.parallel_chunks, chunks) << threads << " threads";
-    EXPECT_EQ(ps.steps_completed, opt.steps + 1) << threads << " threads";
-    ASSERT_EQ(par.t.size(), seq.t.size());
-    for (std::size_t k = 0; k < seq.t.size(); ++k) ASSERT_EQ(par.t[k], seq.t[k]) << "row " << k;
-    EXPECT_LT(test::max_difference(seq, par, 0), 1e-9) << threads << " threads";
-    EXPECT_LT(test::max_difference(seq, par, 1), 1e-8) << threads << " threads";
-    EXPECT_LT(test::max_difference(seq, par, 2), 1e-8) << threads << " threads";
-    EXPECT_TRUE(ps.warnings.empty()) << threads << " threads";
-  }
-}
-
 // A parallel sweep writes its held rows into recycled buffers and leaves them in the workspace for the next one
 // (Workspace::spare_rows): a second sweep with the same workspace, reusing them, still delivers the sequential
 // sweep's rows; buffers of another size left there are dropped, not used.

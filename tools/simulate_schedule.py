@@ -6,33 +6,21 @@ fewer chunks are ready than threads; else the lowest ready chunk; else the next 
 one at a time, in order. This script replays that policy with durations measured on this machine by
 `BM_NFourBarParallelSweep` (bench/results/engine.json):
 
-- the chunks are the engine's: ⌈steps / chunk⌉ of them, rounded up to a multiple of the threads, the steps spread
-  evenly (chunk_sizes(); with --fixed, chunks of exactly `chunk` steps and a shorter last one, as an explicit
-  SweepOptions::chunk_steps gives);
-- a chunk takes (1-thread sweep time / steps) · (its steps + 1 + start) — its steps, its seam step (not the last)
-  and the start from its seed (not chunk 0), which costs about `start` steps more (a fresh factorisation and no
-  predictor history);
+- a chunk takes (1-thread sweep time / steps) · (its steps + 1 + start) — its steps (`chunk`, fewer in the last),
+  its seam step (not the last) and the start from its seed (not chunk 0), which costs about `start` steps more (a
+  fresh factorisation and no predictor history);
 - a seed takes (seed_share · 2-thread time) / (number of seeds).
 
 It assumes that the memory system keeps up with every core (measured here: two independent sweeps run 1.6–2.0×
 as fast as one, `pair_throughput`), so it is a bound on what the schedule loses, not a prediction of a machine.
 
-    tools/simulate_schedule.py bench/results/engine.json [--steps 1000] [--chunk 64] [--start 1] [--fixed]
+    tools/simulate_schedule.py bench/results/engine.json [--steps 1000] [--chunk 64] [--start 1]
 """
 import argparse
 import heapq
 import json
 import math
 import sys
-
-
-def chunk_sizes(steps, chunk, threads, fixed=False):
-    """Steps of each chunk, as run_sweep (engine/src/sweep.cpp) splits a sweep for `threads` threads."""
-    n = math.ceil(steps / chunk)
-    if fixed or n < 2 or threads < 2:
-        return [min(chunk, steps - c * chunk) for c in range(n)]
-    n = min(steps, math.ceil(n / threads) * threads)
-    return [steps // n + (1 if c < steps % n else 0) for c in range(n)]
 
 
 def simulate(threads, chunk_times, seed_time):
@@ -79,28 +67,24 @@ def main():
     ap.add_argument("--chunk", type=int, default=64, help="steps per chunk (the engine's default: 64)")
     ap.add_argument("--start", type=float, default=1.0, help="extra cost of a chunk's start, in steps")
     ap.add_argument("--threads", default="1,2,4,8,16,32", help="thread counts to simulate")
-    ap.add_argument("--fixed", action="store_true", help="chunks of exactly --chunk steps (an explicit chunk_steps)")
     a = ap.parse_args()
     rows = [b for b in json.load(open(a.json))["benchmarks"] if b["name"].startswith("BM_NFourBarParallelSweep")]
     if not rows:
         sys.exit(f"{a.json}: no BM_NFourBarParallelSweep rows")
     counts = [int(x) for x in a.threads.split(",")]
+    n_chunks = math.ceil(a.steps / a.chunk)
     print("| nfourbar N | measured 2-thread speed-up | " + " | ".join(f"{p} threads" for p in counts) + " |")
     print("| ---: | ---: | " + " | ".join("---:" for _ in counts) + " |")
     for b in rows:
         n = b["name"].split("N:")[1].split("/")[0]
         t1 = b["one_thread_ms"]
         step = t1 / a.steps
-        # the seeding time measured on 2 threads, per seed
-        seed_time = b["seed_share"] * b["two_threads_ms"] / max(1, len(chunk_sizes(a.steps, a.chunk, 2, a.fixed)) - 1)
-
-        def makespan(p):
-            sizes = chunk_sizes(a.steps, a.chunk, p, a.fixed)
-            n = len(sizes)
-            times = [step * (k + (1 if c + 1 < n else 0) + (a.start if c > 0 else 0)) for c, k in enumerate(sizes)]
-            return simulate(p, times, seed_time)
-
-        speedups = [t1 / makespan(p) if p > 1 else 1.0 for p in counts]
+        chunk_times = []
+        for c in range(n_chunks):
+            steps = min(a.chunk, a.steps - c * a.chunk)
+            chunk_times.append(step * (steps + (1 if c + 1 < n_chunks else 0) + (a.start if c > 0 else 0)))
+        seed_time = b["seed_share"] * b["two_threads_ms"] / max(1, n_chunks - 1)
+        speedups = [t1 / simulate(p, chunk_times, seed_time) if p > 1 else 1.0 for p in counts]
         print(f"| {n} | {b['speedup']:.2f} | " + " | ".join(f"{s:.2f}" for s in speedups) + " |")
 
 

@@ -1300,16 +1300,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     const Index balanced = std::max<Index>(16, opt.steps / (4 * static_cast<Index>(threads)));
     chunk = std::max<Index>(1, std::min<Index>({64, balanced, static_cast<Index>(fit)}));
   }
-  Index n_chunks = (opt.steps + chunk - 1) / chunk;
-  // The automatic chunks: as many as the size above asks for, rounded up to a multiple of the threads, and the
-  // steps spread evenly over them (the first steps % n_chunks chunks one step longer), so that the threads run out
-  // of chunks together rather than one of them finishing a short last chunk alone while the other idles
-  // (tools/simulate_schedule.py: 1000 steps on 2 threads, 16 chunks of 62–63 steps 1.88×, 15 of 64 and one of 40
-  // 1.85×; 15 or 17 chunks 1.79×). chunk_steps, when set, is taken as it is: chunk c is rows 1 + c·chunk …
-  // min(steps, (c+1)·chunk).
-  const bool spread = opt.chunk_steps == 0 && n_chunks >= 2 && threads > 1;
-  if (spread) n_chunks = std::min(opt.steps, (n_chunks + threads - 1) / threads * threads);
-  const Index base = spread ? opt.steps / n_chunks : chunk, longer = spread ? opt.steps % n_chunks : 0;
+  const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
   if (threads <= 1 || n_chunks < 2 || !ws.lu) {
     run.sequential(sw, ws, 1);
     sw.leave_state_in_workspace();
@@ -1318,8 +1309,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
 
   // ---- parallel drive steps ------------------------------------------------------------------------------
   sum.threads = threads;
-  auto first_row = [&](Index c) { return 1 + c * base + std::min(c, longer); };
-  auto last_row = [&](Index c) { return std::min(opt.steps, first_row(c + 1) - 1); };
+  auto first_row = [&](Index c) { return 1 + c * chunk; };
+  auto last_row = [&](Index c) { return std::min(opt.steps, (c + 1) * chunk); };
 
   // Workspaces, taken from a pool for the time of one chunk or one seed: the caller's own (idle otherwise) and as
   // many more as are in use at once, one per thread, since the seeding pass takes one only while it finds a seed.

@@ -89,9 +89,7 @@ struct SweepOptions {
   std::size_t memory_budget = 0;
   /// Steps per parallel chunk; 0 picks 64, fewer (down to 16) so that there are at least 4 chunks per thread (the
   /// seed of a chunk is one step over its span, expensive on large models when long), and fewer when the rows
-  /// held for delivery (threads × chunk_steps rows of q, q̇, q̈ and the outputs) would exceed 512 MiB; it then
-  /// rounds the number of chunks up to a multiple of the threads and spreads the steps evenly over them (chunks
-  /// differ by one step at most), so that the threads finish together. A value set here is used as it is.
+  /// held for delivery (threads × chunk_steps rows of q, q̇, q̈ and the outputs) would exceed 512 MiB.
   Index chunk_steps = 0;
 
   // Outputs beyond q, q̇, q̈: the sweep computes only what is listed (models/README.md, `output`).
