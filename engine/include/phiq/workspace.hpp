@@ -26,6 +26,9 @@ struct WorkCounters {
 };
 
 /// Per-thread data of the algorithms in kinematics.hpp and sweep.hpp. Not thread-safe: one thread at a time.
+/// What it keeps between calls (the LU's pivot order, newton_contraction, a factorisation still valid at its point)
+/// changes the next call's work and the last bits of its results, within the tolerance: for results identical to
+/// the bit between runs, start each from a fresh Workspace, on one thread (engine/README.md, Thread safety).
 class Workspace {
  public:
   /// Sized for `model`, with q at its initial positions and its own numeric LU object (sharing the model's
