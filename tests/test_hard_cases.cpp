@@ -403,4 +403,28 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
               deviation(p), derivative_deviation(usual), derivative_deviation(r), derivative_deviation(p),
               static_cast<long>(usual.sum.counters.factorizations), static_cast<long>(r.sum.counters.factorizations));
 }
+
+// What a workspace carries between sweeps (the LU's pivot order, the Newton contraction) may move the last bits of
+// rows at their rounding level (engine/README.md, Thread safety: Reproducibility); a fresh workspace on one thread
+// repeats the sweep to the bit. The 2000-stage lift at a tolerance below its rounding, where every row ends at the
+// level its last bits set: q, q̇ and q̈ of every row identical in two sweeps, each from a fresh workspace.
+TEST(HardCases, AFreshWorkspaceOnOneThreadRepeatsASweepToTheBit) {
+  Scene sc = parse_scene(tools::generate_scene(test::generate_options("scissor", 2000, "natural", 0.3, 1.2, 1000)),
+                         "scissor.yaml");
+  sc.sweep.steps = 20;
+  sc.sweep.t_end = 0.02;
+  sc.sweep.newton.tolerance = 1e-16;
+  const Rows a = sweep_scene(sc, 1), b = sweep_scene(sc, 1);
+  ASSERT_EQ(a.status, SolveStatus::kSuccess) << a.sum.message;
+  ASSERT_EQ(b.status, SolveStatus::kSuccess) << b.sum.message;
+  EXPECT_FALSE(a.sum.warnings.empty()) << "rows at their rounding level";
+  ASSERT_EQ(a.tr.q.size(), b.tr.q.size());
+  for (std::size_t k = 0; k < a.tr.q.size(); ++k) {
+    ASSERT_TRUE(a.tr.q[k] == b.tr.q[k]) << "row " << k;
+    ASSERT_TRUE(a.tr.qd[k] == b.tr.qd[k]) << "row " << k;
+    ASSERT_TRUE(a.tr.qdd[k] == b.tr.qdd[k]) << "row " << k;
+  }
+  EXPECT_EQ(a.sum.counters.newton_iterations, b.sum.counters.newton_iterations);
+  EXPECT_EQ(a.sum.counters.factorizations, b.sum.counters.factorizations);
+}
 }  // namespace
