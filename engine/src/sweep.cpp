@@ -159,9 +159,6 @@ class Sweeper {
   // singular position crossed) or goes (another branch reached): see advance().
   static constexpr int kBranchCheckDepth = 2;
 
-  // Below this rcond, a position Newton reached only linearly (`linear` in derivatives()) is taken as singular.
-  static constexpr double kLinearSingularRcond = detail::kLinearSingularRcond;
-
   // Derivatives at the converged ws.q, as asked for. Returns false (summary filled) on failure. At a singular
   // position they are not unique: see singular_point(). `linear`: Newton converged only linearly to ws.q (its full
   // steps contracting by ½ or worse), the mark of a singular Φq at the solution. It then stopped within the
@@ -175,7 +172,8 @@ class Sweeper {
     const SolveStatus st = lu_derivatives(t, need_a_, &ls);
     if (!bracketing_ && ws_->lu &&
         (st == SolveStatus::kSingularJacobian ||
-         (st == SolveStatus::kSuccess && (ls.rcond < kSingularRcond || (linear && ls.rcond < kLinearSingularRcond)))))
+         (st == SolveStatus::kSuccess &&
+          (ls.rcond < kSingularRcond || (linear && ls.rcond < detail::kLinearSingularRcond)))))
       return singular_point(t, ls.rcond);
     if (st != SolveStatus::kSuccess) return fail(st, ls.message);
     note_condition(t, ls.rcond);
