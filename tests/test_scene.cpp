@@ -506,27 +506,17 @@ TEST(SceneFamilies, MalformedFamiliesAndLimits) {
   // the families of all sections together, counted before any is expanded
   SceneLimits few;
   few.max_family_instances = 12;
-  try {
-    parse_scene(kFamilies, "few.yaml", few);
-    ADD_FAILURE();
-  } catch (const SceneError& e) {
-    // coordinates 4 x 2, points 4 x 1: the cranks take the count beyond 12
-    EXPECT_EQ(std::string(e.what()), "few.yaml:13:5: constraints[0].for i in 0..N: the families would make 19 "
-                                     "entries in all (coordinates 8, points 4, constraints 7), more than the 12 "
-                                     "they may make (SceneLimits::max_family_instances)");
-  }
+  // coordinates 4 x 2, points 4 x 1: the cranks take the count beyond 12
+  EXPECT_EQ(test::scene_error(kFamilies, "few.yaml", few),
+            "few.yaml:13:5: constraints[0].for i in 0..N: the families would make 19 entries in all (coordinates 8, "
+            "points 4, constraints 7), more than the 12 they may make (SceneLimits::max_family_instances)");
   // the budget counts every entry made, nested families included: those whose range uses an enclosing index are
   // checked as they are expanded (here 2 x 1 counted beforehand, then 10 x 1 for i = 0 and 11 x 1 for i = 1)
   const std::string nested = "phiq: 1\nparameters: {N: 9}\ncoordinates:\n  for i in 0..1:\n    for j in 0..N+i:\n"
                              "      x{i}_{j}: 0\ntime: {start: 0, end: 1, steps: 1}\n";
-  try {
-    parse_scene(nested, "few.yaml", few);
-    ADD_FAILURE();
-  } catch (const SceneError& e) {
-    EXPECT_EQ(std::string(e.what()), "few.yaml:5:5: coordinates.for i in 0..1[i=1].for j in 0..N+i: the family would "
-                                     "make 11 x 1 entries; families may make 12 entries in all and 0 are left "
-                                     "(SceneLimits::max_family_instances)");
-  }
+  EXPECT_EQ(test::scene_error(nested, "few.yaml", few),
+            "few.yaml:5:5: coordinates.for i in 0..1[i=1].for j in 0..N+i: the family would make 11 x 1 entries; "
+            "families may make 12 entries in all and 0 are left (SceneLimits::max_family_instances)");
   // nesting deeper than the limit
   std::string deep = "coordinates:\n";
   std::string indent = "  ";

@@ -29,13 +29,14 @@ inline std::string replace_first(std::string text, const std::string& from, cons
 }
 
 // The SceneError of a scene read as "bad.yaml": one line, starting with the file name (a failure if it loads).
-inline std::string scene_error(const std::string& text) {
+inline std::string scene_error(const std::string& text, const std::string& file = "bad.yaml",
+                               const SceneLimits& limits = {}) {
   try {
-    parse_scene(text, "bad.yaml");
+    parse_scene(text, file, limits);
   } catch (const SceneError& e) {
     std::string m = e.what();
     EXPECT_EQ(m.find('\n'), std::string::npos) << "one line: " << m;
-    EXPECT_EQ(m.rfind("bad.yaml:", 0), 0u) << m;
+    EXPECT_EQ(m.rfind(file + ":", 0), 0u) << m;
     return m;
   }
   ADD_FAILURE() << "no error for:\n" << text;

@@ -20,9 +20,8 @@ inline constexpr double kLinearSingularRcond = 1e-4;
 const double* solve_values(const Model& model, Workspace& ws);
 
 /// The freedoms the drivers leave at a solution assembled near q at t (from q moved off it by up to a tenth of each
-/// coordinate's scale),
-/// or −1 when none was found: fewer than at q means q is a singular position of a model regular elsewhere
-/// (assembly.cpp).
+/// coordinate's scale), or −1 when none was found: fewer than at q means q is a singular position of a model
+/// regular elsewhere (assembly.cpp). Called on failure paths only (an assembly and a rank analysis).
 Index driven_dof_nearby(const Model& model, const Eigen::VectorXd& q, double t, const AssemblyOptions& options);
 
 /// Throws phiq::Error naming the first field of `opt` no solve can honour, after `what` (solve_position's check,
