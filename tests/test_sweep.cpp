@@ -508,6 +508,41 @@ TEST(ParallelSweep, ThroughSingularPositionsMatchesTheSequentialSweep) {
   }
 }
 
+// A parallel sweep that nobody reads row by row (no callback: a sweep for its summary and its last state) keeps
+// only the rows it reads again itself, each chunk's first and last, and still reports what a read sweep reports:
+// the same warnings at the same times (they come from every row's sign of det Φq, through singular positions
+// here), the same solves, and the sequential sweep's last state in the workspace.
+TEST(ParallelSweep, WithoutACallbackOnlyEachChunksFirstAndLastRowsAreKept) {
+  Model m = test::nfourbar_model(10, 0.1, 2 * M_PI);
+  SweepOptions opt;
+  opt.steps = 400;
+  const InOrderAndParallel r = sweep_both(m, opt, 2, 50);
+  ASSERT_EQ(r.par_status, SolveStatus::kSuccess) << r.ps.message;
+  ASSERT_FALSE(r.ps.warnings.empty()) << "the full turn passes singular positions";
+  opt.threads = 2;
+  opt.chunk_steps = 50;
+  Workspace ws(m);
+  SweepSummary sum;
+  ASSERT_EQ(run_sweep(m, opt, ws, nullptr, &sum), SolveStatus::kSuccess) << sum.message;
+  EXPECT_EQ(sum.parallel_chunks, 8);
+  EXPECT_EQ(sum.steps_completed, opt.steps + 1);
+  ASSERT_EQ(sum.warnings.size(), r.ps.warnings.size());
+  for (std::size_t i = 0; i < sum.warnings.size(); ++i) {
+    EXPECT_EQ(sum.warnings[i].kind, r.ps.warnings[i].kind) << i;
+    EXPECT_EQ(sum.warnings[i].t, r.ps.warnings[i].t) << i;
+  }
+  EXPECT_EQ(sum.counters.velocity_solves, r.ps.counters.velocity_solves);
+  EXPECT_LT((ws.q - r.seq.q.back()).lpNorm<Eigen::Infinity>(), 1e-8);
+  EXPECT_LT((ws.qd - r.seq.qd.back()).lpNorm<Eigen::Infinity>(), 1e-5);
+  EXPECT_LT((ws.qdd - r.seq.qdd.back()).lpNorm<Eigen::Infinity>(), 1e-3);
+  // q, q̇, q̈ of two rows per chunk went through the pool; a read sweep returns all 3 × 50 of a chunk's at least
+  EXPECT_LE(ws.spare_rows.size(), 2u * 3u * 8u);
+  Workspace read(m);
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, opt, &tr, nullptr, &read), SolveStatus::kSuccess);
+  EXPECT_GE(read.spare_rows.size(), 3u * 50u);
+}
+
 // A drive that leaves the reachable range: the parallel sweep reports the same failure, at the same step, as the
 // sequential one, after delivering the same rows.
 TEST(ParallelSweep, AFailureIsReportedAsInTheSequentialSweep) {
