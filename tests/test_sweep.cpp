@@ -128,8 +128,6 @@ TEST(Sweep, TheCallersKnownToIsAFloorUnderTheLevelTheSweepCarries) {
     return sum;
   };
   const SweepSummary plain = run(0.0), floored = run(1e12);
-  std::printf("Newton iterations over 360 rows: %ld, with the floor %ld\n",
-              static_cast<long>(plain.counters.newton_iterations), static_cast<long>(floored.counters.newton_iterations));
   EXPECT_GE(plain.counters.newton_iterations, 2 * 360 - 10);
   EXPECT_TRUE(plain.warnings.empty());
   EXPECT_LE(floored.counters.newton_iterations, 360 + 10);
