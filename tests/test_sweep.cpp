@@ -541,6 +541,52 @@ TEST(ParallelSweep, WithoutACallbackOnlyEachChunksFirstAndLastRowsAreKept) {
   EXPECT_GE(read.spare_rows.size(), 3u * 50u);
 }
 
+// Rows too wide for chunks worth their seeds: where the rows held for delivery leave room for fewer than 8 steps
+// per chunk and thread, the sweep runs in order and says why (10⁶ scissor stages with q, q̇, q̈ ran 100 chunks of
+// one row and held 12 GB); with room for 8, in chunks of 8; a sweep without a callback holds two rows per chunk and
+// keeps its usual chunks.
+TEST(ParallelSweep, RowsTooWideForChunksOfEightStepsRunInOrder) {
+  Model m = test::nfourbar_model(100, M_PI / 4, M_PI / 2);
+  const double row_bytes = 8.0 * static_cast<double>(3 * m.num_coordinates() + 1);  // q, q̇, q̈ and the time
+  SweepOptions opt;
+  opt.steps = 300;
+  test::Trace seq;
+  ASSERT_EQ(test::sweep(m, opt, &seq), SolveStatus::kSuccess);
+  opt.threads = 2;
+  opt.row_buffer_bytes = static_cast<std::size_t>(7.5 * 2 * row_bytes);  // 7 rows per chunk and thread
+  test::Trace in_order;
+  SweepSummary s7;
+  ASSERT_EQ(test::sweep(m, opt, &in_order, &s7), SolveStatus::kSuccess) << s7.message;
+  EXPECT_EQ(s7.threads, 1);
+  EXPECT_EQ(s7.parallel_chunks, 0);
+  ASSERT_EQ(s7.warnings.size(), 1u);
+  EXPECT_EQ(s7.warnings[0].kind, "threads_reduced");
+  EXPECT_EQ(s7.warnings[0].t, 0.0);
+  EXPECT_HAS(s7.warnings[0].message, "chunks of 7 steps per thread, fewer than the 8");
+  EXPECT_HAS(s7.warnings[0].message, "row_buffer_bytes");
+  EXPECT_EQ(test::max_difference(seq, in_order, 0), 0.0);  // the sequential sweep itself
+  EXPECT_EQ(test::max_difference(seq, in_order, 2), 0.0);
+
+  opt.row_buffer_bytes = static_cast<std::size_t>(8.5 * 2 * row_bytes);  // 8 rows per chunk and thread
+  test::Trace par;
+  SweepSummary s8;
+  ASSERT_EQ(test::sweep(m, opt, &par, &s8), SolveStatus::kSuccess) << s8.message;
+  EXPECT_EQ(s8.threads, 2);
+  EXPECT_EQ(s8.parallel_chunks, 38);  // ⌈300 / 8⌉
+  EXPECT_TRUE(s8.warnings.empty());
+  EXPECT_LT(test::max_difference(seq, par, 0), 1e-9);
+
+  opt.row_buffer_bytes = static_cast<std::size_t>(7.5 * 2 * row_bytes);
+  Workspace ws(m);
+  SweepSummary unread;
+  ASSERT_EQ(run_sweep(m, opt, ws, nullptr, &unread), SolveStatus::kSuccess) << unread.message;
+  EXPECT_EQ(unread.parallel_chunks, 9);  // chunks of max(16, 300 / (4 × 2)) = 37 steps
+  EXPECT_TRUE(unread.warnings.empty());
+
+  opt.row_buffer_bytes = 0;
+  EXPECT_THROW(run_sweep(m, opt, ws, nullptr, nullptr), Error);
+}
+
 // A drive that leaves the reachable range: the parallel sweep reports the same failure, at the same step, as the
 // sequential one, after delivering the same rows.
 TEST(ParallelSweep, AFailureIsReportedAsInTheSequentialSweep) {

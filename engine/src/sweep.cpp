@@ -1073,8 +1073,12 @@ bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b
 
 // One parallel chunk: rows k0 … k1 computed from a seed at t_k0 (chunk 0: from row 0), then the sweep continued
 // in order one step further (the seam), which the next chunk's first row must match.
-// Rows a parallel sweep may hold at once before delivering them in order (all waves' chunks together).
-constexpr double kRowBufferBytes = 512.0 * 1024 * 1024;
+// The shortest chunk the automatic choice makes. A chunk costs about three steps besides its own (its seed, the
+// start from it, the seam step), so shorter chunks cost more than a second thread gains: 10⁶ scissor stages, 100
+// steps on 2 threads, ran slower in chunks of 5 rows (solve 82 s) than in order, and took 12 GB in chunks of 1
+// (q, q̇, q̈: rows of 144 MB); chunks of 12 steps still gave 1.5× (chain3d N = 10⁴). Where the rows held for
+// delivery leave room for fewer steps per chunk than this, the sweep runs in order.
+constexpr Index kMinChunkSteps = 8;
 
 // to = from (to has from's size), with stores that bypass the caches where the processor has them (SSE2): a
 // parallel chunk's rows are read again only when they are delivered, long after, and writing them through the
@@ -1192,7 +1196,7 @@ double resident_memory() {
 
 // All cores (threads = 0), as many as fit: each thread beyond the first needs a workspace like the caller's `ws`
 // (which has factorised at row 0; the caller's own serves one thread, and the seeding pass shares them), beside the
-// rows held for delivery (kRowBufferBytes at most). memory_budget is the whole process's: what it holds already
+// rows held for delivery (SweepOptions::row_buffer_bytes at most). memory_budget is the whole process's: what it holds already
 // (the model, the caller's workspace) is spent. Fewer threads than `threads` come with a "threads_reduced" warning
 // at `t0`.
 int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, double t0,
@@ -1201,7 +1205,8 @@ int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, 
       opt.memory_budget > 0 ? static_cast<double>(opt.memory_budget) - resident_memory() : available_memory();
   const double per = workspace_bytes(ws);
   if (!(budget > 0.0 || opt.memory_budget > 0) || !(per > 0.0)) return threads;
-  const double room = std::floor((budget - kRowBufferBytes) / per) + 1.0;  // the caller's is one of them
+  const double room =
+      std::floor((budget - static_cast<double>(opt.row_buffer_bytes)) / per) + 1.0;  // the caller's is one of them
   if (room >= threads) return threads;
   const int fit = std::max(1, static_cast<int>(std::max(room, 1.0)));
   std::ostringstream m;
@@ -1227,6 +1232,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   if (const std::string why = detail::time_grid_problem(opt.t_begin, opt.t_end, opt.steps); !why.empty())
     throw Error("SweepOptions: " + why);
   if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
+  if (opt.row_buffer_bytes == 0) throw Error("SweepOptions: row_buffer_bytes must be > 0");
   if (opt.max_subdivisions < 0) throw Error("SweepOptions: max_subdivisions must be >= 0");
   const std::vector<Predictor>& predictors = all_predictors();
   if (std::find(predictors.begin(), predictors.end(), opt.predictor) == predictors.end())
@@ -1293,6 +1299,15 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   constexpr Index kMotionDoubles = static_cast<Index>(sizeof(PointMotion) / sizeof(double));
   static_assert(sizeof(PointMotion) == 9 * sizeof(double), "PointMotion is stored as 9 doubles in chunk rows");
   const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles + 1;
+  // Which of a chunk's rows keep their vectors: all of them for a caller that reads the rows. Without one (a sweep
+  // for its summary and last state), only what the parallel sweep reads again itself: the first row's q (the seam
+  // check) and the last row (the state an ordered continuation starts from). Copying the rows in between was 3 % of
+  // a 2-thread sweep of nfourbar N = 10³ that nobody read.
+  const bool caller_reads_rows = static_cast<bool>(on_step);
+  const double row_bytes = 8.0 * static_cast<double>(std::max<Index>(width, 1));
+  auto held_bytes = [&](Index rows) {  // what a chunk of `rows` rows holds until it is delivered
+    return row_bytes * static_cast<double>(caller_reads_rows ? rows : std::min<Index>(rows, 2));
+  };
   Index chunk = opt.chunk_steps;
   if (chunk == 0) {
     // 64 steps (a chunk costs a seed, a start from it and a seam step), but at least 4 chunks per thread, down to
@@ -1300,11 +1315,27 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     // whole span, and on a large model long spans are expensive (Newton from far away, sub-steps). Measured, 100
     // steps on 2 threads against 1 thread: chain3d N = 10⁴ positions only 1.5× with 9 chunks of 12 steps,
     // 0.9–1.0× with 2 of 50; nfourbar N = 10³ with q̇, q̈ 1.45× either way. More chunks also balance more threads
-    // (tools/simulate_schedule.py). Fewer steps when the rows a window of chunks holds would exceed
-    // kRowBufferBytes.
-    const double fit = kRowBufferBytes / (8.0 * static_cast<double>(std::max<Index>(width, 1)) * threads);
+    // (tools/simulate_schedule.py). Fewer steps when the rows a chunk per thread holds would exceed
+    // row_buffer_bytes, and none below kMinChunkSteps: the sweep then runs in order.
     const Index balanced = std::max<Index>(16, opt.steps / (4 * static_cast<Index>(threads)));
-    chunk = std::max<Index>(1, std::min<Index>({64, balanced, static_cast<Index>(fit)}));
+    const double fit = static_cast<double>(opt.row_buffer_bytes) / (row_bytes * threads);
+    chunk = std::min<Index>(64, balanced);
+    if (caller_reads_rows && fit < static_cast<double>(chunk)) {
+      chunk = static_cast<Index>(fit);
+      if (chunk < kMinChunkSteps && threads > 1 && opt.steps > kMinChunkSteps && ws.lu) {
+        std::ostringstream msg;
+        msg.precision(3);
+        msg << "the drive steps run in order, not in parallel chunks on " << threads
+            << " threads: a row of the outputs is " << row_bytes / 1e6 << " MB, and the rows held for delivery in "
+            << "order (SweepOptions::row_buffer_bytes, " << static_cast<double>(opt.row_buffer_bytes) / 1e6
+            << " MB) leave room for chunks of " << chunk << (chunk == 1 ? " step" : " steps")
+            << " per thread, fewer than the " << kMinChunkSteps
+            << " that pay for a chunk's seed; the threads still serve the model's parallel evaluation";
+        sum.warnings.push_back({run.time_of(0), "threads_reduced", msg.str()});
+        threads = 1;
+      }
+      chunk = std::max<Index>(chunk, 1);
+    }
   }
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
   if (threads <= 1 || n_chunks < 2 || !ws.lu) {
@@ -1366,11 +1397,6 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   spare.swap(ws.spare_rows);
   const Index n_coords = model.num_coordinates();
   std::erase_if(spare, [&](const Eigen::VectorXd& v) { return v.size() != n_coords; });
-  // Which of a chunk's rows keep their vectors: all of them for a caller that reads the rows. Without one (a sweep
-  // for its summary and last state), only what the parallel sweep reads again itself: the first row's q (the seam
-  // check) and the last row (the state an ordered continuation starts from). Copying the rows in between was 3 % of
-  // a 2-thread sweep of nfourbar N = 10³ that nobody read.
-  const bool caller_reads_rows = static_cast<bool>(on_step);
   auto keeps_vectors = [&](const std::vector<Row>& rows, std::size_t i) {
     return caller_reads_rows || i == 0 || i + 1 == rows.size();
   };
@@ -1485,9 +1511,9 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // How far the work may run ahead of the delivery: chunks seeded beyond the next one to deliver. As many as the
   // row buffer allows, at least one per thread, and at most 16 per thread so that rows are delivered (and Ctrl-C
   // seen) every few thousand steps however long the sweep.
-  const double chunk_bytes = 8.0 * static_cast<double>(std::max<Index>(width, 1)) * static_cast<double>(chunk);
   const Index ahead = std::max<Index>(
-      threads, std::min<Index>(16 * threads, static_cast<Index>(kRowBufferBytes / chunk_bytes)));
+      threads,
+      std::min<Index>(16 * threads, static_cast<Index>(static_cast<double>(opt.row_buffer_bytes) / held_bytes(chunk))));
 
   // Seeds: the position at each chunk's first row, found in order with the chunk's span as the step (positions
   // only, the parabolic predictor over the seeds before, subdivision on failure), one at a time, just ahead of the
