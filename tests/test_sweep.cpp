@@ -10,6 +10,7 @@
 
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
+#include "warning_stretches.hpp"
 
 namespace phiq {
 namespace {
@@ -400,6 +401,32 @@ TEST(Sweep, ReverseTimeAndSingleStepSweeps) {
   EXPECT_NEAR(one.q[0](3), tr.q.front()(3), 1e-12);
 }
 
+
+// A warning that recurs is said once per stretch of rows (detail::once_per_stretch, run_sweep's slow_convergence):
+// consecutive rows and rows up to two quiet rows apart join one stretch, whose first warning says how far it went
+// and, with quiet rows in it, how many of its rows warned; a sub-step's warning stands alone; other kinds keep their
+// place.
+TEST(Sweep, ARecurringWarningIsSaidOncePerStretchOfRows) {
+  SweepOptions opt;
+  opt.t_begin = 1.0, opt.t_end = 2.0, opt.steps = 100;  // rows 0.01 apart
+  auto at = [&](double row, const char* kind = "slow_convergence") {
+    return SweepWarning{1.0 + row / 100.0, kind, std::string("w") + std::to_string(static_cast<int>(row * 10))};
+  };
+  std::vector<SweepWarning> w = {at(3), at(4), at(5),             // consecutive: one stretch
+                                 at(9), at(11), at(12), at(15),   // 1 and 2 quiet rows between: one stretch
+                                 at(19, "ill_conditioned"),       // another kind, in its place
+                                 at(19), at(22.5), at(23), at(40)};  // a sub-step alone, 3 quiet rows: new stretches
+  detail::once_per_stretch(w, "slow_convergence", opt);
+  ASSERT_EQ(w.size(), 7u);
+  EXPECT_EQ(w[0].message, "w30; the same at the next 2 rows, to t = 1.05");
+  EXPECT_EQ(w[1].message, "w90; the same at 3 of the next 6 rows, to t = 1.15");
+  EXPECT_EQ(w[2].kind, "ill_conditioned");
+  EXPECT_EQ(w[3].message, "w190");
+  EXPECT_EQ(w[4].message, "w225");
+  EXPECT_EQ(w[5].message, "w230");
+  EXPECT_EQ(w[6].message, "w400");
+  EXPECT_DOUBLE_EQ(w[4].t, 1.225);
+}
 
 // ---- parallel drive steps -------------------------------------------------------------------------------------
 

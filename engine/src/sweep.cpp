@@ -29,6 +29,7 @@
 #include "kinematics_internal.hpp"
 #include "phiq/assembly.hpp"
 #include "time_grid.hpp"
+#include "warning_stretches.hpp"
 #include "tolerance_tests.hpp"
 
 namespace phiq {
@@ -1127,42 +1128,6 @@ struct Chunk {
   double rounding = 0.0;  // largest rounding level (Sweeper::take_rounding_level) of its solves, seed included
 };
 
-// Keeps the first warning of `kind` of every stretch of consecutive rows (on the grid of the sweep) and says on it
-// how far the stretch went: a long chain at its rounding level warns at every row otherwise. Done on the merged
-// list, so that sequential and parallel sweeps report alike.
-void once_per_stretch(std::vector<SweepWarning>& warnings, const char* kind, const SweepOptions& opt) {
-  if (opt.steps <= 0) return;
-  const double h = (opt.t_end - opt.t_begin) / static_cast<double>(opt.steps);
-  auto row_of = [&](double t) { return (t - opt.t_begin) / h; };  // fractional on sub-steps
-  std::vector<SweepWarning> kept;
-  kept.reserve(warnings.size());
-  std::size_t first = 0;  // index in `kept` of the open stretch's warning
-  Index more = 0;         // rows of the open stretch after its first
-  double last_row = -2.0, last_t = 0.0;
-  auto close = [&] {
-    if (more > 0)
-      kept[first].message += "; the same at the next " + std::to_string(more) + " rows, to t = " + format_time(last_t);
-    more = 0;
-  };
-  for (SweepWarning& w : warnings) {
-    if (w.kind != kind) {
-      kept.push_back(std::move(w));
-      continue;
-    }
-    const double t = w.t, r = row_of(t);
-    if (std::fabs(r - (last_row + 1.0)) < 1e-6) {
-      ++more;
-    } else {
-      close();
-      first = kept.size();
-      kept.push_back(std::move(w));
-    }
-    last_row = r, last_t = t;
-  }
-  close();
-  warnings.swap(kept);
-}
-
 // What one more thread of a parallel sweep of `ws`'s model takes: the LU (measured, ws has factorised: KLU's peak),
 // Φq's values, and the vectors of a workspace and of a sweeper's predictor history, about 16 of n and 4 of m.
 // (10⁶ scissor stages: 2.2 GB measured per extra thread; this says 10 × its 0.22 GB at 10⁵.)
@@ -1252,7 +1217,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // part's chunks and seeds): left out of the workspace's share.
   WorkCounters counted_begin{}, counted_end{};
   auto done = [&](SolveStatus st) {
-    once_per_stretch(sum.warnings, "slow_convergence", opt);
+    detail::once_per_stretch(sum.warnings, "slow_convergence", opt);
     sum.status = st;
     sum.counters = others;
     add_counters(sum.counters, ws.counters, before);
