@@ -130,7 +130,7 @@ struct SweepWarning {
   double t;             ///< time of the row concerned
   /// "slow_convergence": Newton converged only linearly (singular position nearby), or stopped at the rounding
   /// level of Φ above the tolerance (a long chain; the message says how well q is known; once per stretch of
-  /// consecutive rows, the message says how long); "ill_conditioned": Φq is
+  /// rows, up to two rows without it apart, the message says how long and how many); "ill_conditioned": Φq is
   /// near-singular (rcond below 1e-7; once per stretch of such rows); "bifurcation": Φq is singular at this row,
   /// the velocity is not unique and the branch's own is reported; "parallel_fallback": the parallel sweep
   /// continued in order
