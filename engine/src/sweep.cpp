@@ -1161,8 +1161,8 @@ double resident_memory() {
 
 // All cores (threads = 0), as many as fit: each thread beyond the first needs a workspace like the caller's `ws`
 // (which has factorised at row 0; the caller's own serves one thread, and the seeding pass shares them), beside the
-// rows held for delivery (SweepOptions::row_buffer_bytes at most). memory_budget is the whole process's: what it holds already
-// (the model, the caller's workspace) is spent. Fewer threads than `threads` come with a "threads_reduced" warning
+// rows held for delivery (SweepOptions::row_buffer_bytes at most). memory_budget is the whole process's: what it
+// holds already (the model, the caller's workspace) is spent. Fewer threads than `threads` come with a "threads_reduced" warning
 // at `t0`.
 int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, double t0,
                      std::vector<SweepWarning>& warnings) {
