@@ -1080,6 +1080,8 @@ bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b
 // (q, q̇, q̈: rows of 144 MB); chunks of 12 steps still gave 1.5× (chain3d N = 10⁴). Where the rows held for
 // delivery leave room for fewer steps per chunk than this, the sweep runs in order.
 constexpr Index kMinChunkSteps = 8;
+// Sub-steps of a positions-only sweep's first seed (see seed_one).
+constexpr int kFirstSeedParts = 4;
 
 // to = from (to has from's size), with stores that bypass the caches where the processor has them (SSE2): a
 // parallel chunk's rows are read again only when they are delivered, long after, and writing them through the
@@ -1523,7 +1525,15 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     Workspace* w = acquire();
     const WorkCounters w0 = w->counters;
     seeder.bind(*w);
-    const bool ok = seeder.advance(run.time_of(first_row(c)), 0);
+    // Without derivatives at row 0 (positions only), the first seed is the one extrapolated from a single position
+    // over a whole chunk's span: from that constant prediction its Newton failed on nfourbar N = 10⁵ and took 0.57 s
+    // of a 1.66 s sweep. In sub-steps it gives the parabola through the seeds its first rows: 1.35 s.
+    const int parts = c == 1 && !need_v ? kFirstSeedParts : 1;
+    bool ok = true;
+    for (int i = 1; ok && i <= parts; ++i) {
+      const double t0 = run.time_of(0), t1 = run.time_of(first_row(c));
+      ok = seeder.advance(i == parts ? t1 : t0 + (t1 - t0) * static_cast<double>(i) / parts, 0);
+    }
     add_counters(seed_work, w->counters, w0);
     release(w);
     if (ok) {
