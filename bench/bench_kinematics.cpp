@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <thread>
 #include <tuple>
 #include <vector>
@@ -38,6 +39,15 @@ Model crank_slider() {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// One sweep of `m` from its initial positions, timed: its wall time in seconds (the summary in *sum).
+double timed_sweep(const Model& m, const SweepOptions& opt, Workspace& ws,
+                   const std::function<bool(const StepView&)>& on_step, SweepSummary* sum) {
+  ws.q = m.initial_positions();
+  const auto t0 = Clock::now();
+  run_sweep(m, opt, ws, on_step, sum);
+  return seconds_since(t0);
+}
 
 // The bare kernel: one numeric factorisation + solve of the Jacobian at ws.q with a separate numeric object (same
 // symbolic analysis). Timed by the caller right next to the engine work, so that their ratio is measured in one
@@ -532,21 +542,15 @@ void BM_NFourBarParallelSweep(benchmark::State& state) {
   };
   for (auto _ : state) {
     SweepSummary sum;
-    ws.q = m.initial_positions();
-    auto t0 = Clock::now();
-    run_sweep(m, one, ws, nullptr, &sum);
-    const double e1 = seconds_since(t0);
+    const double e1 = timed_sweep(m, one, ws, nullptr, &sum);
     t1 += e1;
-    ws.q = m.initial_positions();
-    t0 = Clock::now();
-    run_sweep(m, two, ws, nullptr, &sum);
-    const double e = seconds_since(t0);
+    const double e = timed_sweep(m, two, ws, nullptr, &sum);
     t2 += e, seed += sum.seed_seconds;
     if (sum.parallel_chunks == 0) state.SkipWithError("no parallel chunks");
     state.SetIterationTime(e);
     ws.q = m.initial_positions();
     ws_copy.q = m_copy.initial_positions();
-    t0 = Clock::now();
+    const auto t0 = Clock::now();
     std::thread other([&] {
       SweepSummary s2;
       run_sweep(m_copy, one, ws_copy, nullptr, &s2);
@@ -557,14 +561,8 @@ void BM_NFourBarParallelSweep(benchmark::State& state) {
     const double ep = seconds_since(t0);
     pair += ep;
     speedups.push_back(e1 / e), pairs.push_back(2.0 * e1 / ep), efficiencies.push_back((e1 / e) / (2.0 * e1 / ep));
-    ws.q = m.initial_positions();
-    t0 = Clock::now();
-    run_sweep(m, one, ws, read, &sum);
-    const double r1 = seconds_since(t0);
-    ws.q = m.initial_positions();
-    t0 = Clock::now();
-    run_sweep(m, two, ws, read, &sum);
-    read_speedups.push_back(r1 / seconds_since(t0));
+    const double r1 = timed_sweep(m, one, ws, read, &sum);
+    read_speedups.push_back(r1 / timed_sweep(m, two, ws, read, &sum));
   }
   benchmark::DoNotOptimize(checksum);
   auto median = [](std::vector<double> v) {
@@ -598,14 +596,8 @@ void BM_NFourBarParallelPositions(benchmark::State& state) {
   std::vector<double> speedups;
   for (auto _ : state) {
     SweepSummary sum;
-    ws.q = m.initial_positions();
-    auto t0 = Clock::now();
-    run_sweep(m, one, ws, nullptr, &sum);
-    const double e1 = seconds_since(t0);
-    ws.q = m.initial_positions();
-    t0 = Clock::now();
-    run_sweep(m, two, ws, nullptr, &sum);
-    const double e2 = seconds_since(t0);
+    const double e1 = timed_sweep(m, one, ws, nullptr, &sum);
+    const double e2 = timed_sweep(m, two, ws, nullptr, &sum);
     if (sum.parallel_chunks == 0) state.SkipWithError("no parallel chunks");
     state.SetIterationTime(e2);
     t1 += e1, t2 += e2, seed += sum.seed_seconds;
