@@ -569,10 +569,10 @@ TEST(ParallelSweep, WithoutACallbackOnlyEachChunksFirstAndLastRowsAreKept) {
 }
 
 // Rows too wide for chunks worth their seeds: where the rows held for delivery leave room for fewer than 8 steps
-// per chunk and thread, the sweep runs in order and says why (10⁶ scissor stages with q, q̇, q̈ ran 100 chunks of
-// one row and held 12 GB); with room for 8, in chunks of 8; a sweep without a callback holds two rows per chunk and
-// keeps its usual chunks.
-TEST(ParallelSweep, RowsTooWideForChunksOfEightStepsRunInOrder) {
+// per chunk and thread, the sweep runs on as many threads as have room for 8, or in order, and says why (10⁶
+// scissor stages with q, q̇, q̈ ran 100 chunks of one row and held 12 GB); with room for 8, in chunks of 8; a sweep
+// without a callback holds two rows per chunk and keeps its usual chunks.
+TEST(ParallelSweep, RowsTooWideForChunksOfEightStepsRunOnFewerThreadsOrInOrder) {
   Model m = test::nfourbar_model(100, M_PI / 4, M_PI / 2);
   const double row_bytes = 8.0 * static_cast<double>(3 * m.num_coordinates() + 1);  // q, q̇, q̈ and the time
   SweepOptions opt;
@@ -589,7 +589,9 @@ TEST(ParallelSweep, RowsTooWideForChunksOfEightStepsRunInOrder) {
   ASSERT_EQ(s7.warnings.size(), 1u);
   EXPECT_EQ(s7.warnings[0].kind, "threads_reduced");
   EXPECT_EQ(s7.warnings[0].t, 0.0);
-  EXPECT_HAS(s7.warnings[0].message, "chunks of 7 steps per thread, fewer than the 8");
+  EXPECT_HAS(s7.warnings[0].message, "run in order, not in parallel chunks on 2 threads");
+  EXPECT_HAS(s7.warnings[0].message, "hold 15 rows: chunks of 8 steps, the fewest that pay for a chunk's seed, for no "
+                                     "more than one thread");
   EXPECT_HAS(s7.warnings[0].message, "row_buffer_bytes");
   EXPECT_EQ(test::max_difference(seq, in_order, 0), 0.0);  // the sequential sweep itself
   EXPECT_EQ(test::max_difference(seq, in_order, 2), 0.0);
@@ -603,6 +605,21 @@ TEST(ParallelSweep, RowsTooWideForChunksOfEightStepsRunInOrder) {
   EXPECT_TRUE(s8.warnings.empty());
   EXPECT_LT(test::max_difference(seq, par, 0), 1e-9);
 
+  // on 4 threads, room for 17 rows: chunks of 8 on 2 of them
+  opt.threads = 4;
+  opt.row_buffer_bytes = static_cast<std::size_t>(17.5 * row_bytes);
+  test::Trace fewer;
+  SweepSummary s4;
+  ASSERT_EQ(test::sweep(m, opt, &fewer, &s4), SolveStatus::kSuccess) << s4.message;
+  EXPECT_EQ(s4.threads, 2);
+  EXPECT_EQ(s4.parallel_chunks, 38);
+  ASSERT_EQ(s4.warnings.size(), 1u);
+  EXPECT_HAS(s4.warnings[0].message, "run in parallel chunks on 2 threads instead of 4 threads");
+  EXPECT_HAS(s4.warnings[0].message, "hold 17 rows: chunks of 8 steps, the fewest that pay for a chunk's seed, for "
+                                     "only 2 threads");
+  EXPECT_LT(test::max_difference(seq, fewer, 0), 1e-9);
+
+  opt.threads = 2;
   opt.row_buffer_bytes = static_cast<std::size_t>(7.5 * 2 * row_bytes);
   Workspace ws(m);
   SweepSummary unread;

@@ -1078,7 +1078,7 @@ bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b
 // start from it, the seam step), so shorter chunks cost more than a second thread gains: 10⁶ scissor stages, 100
 // steps on 2 threads, ran slower in chunks of 5 rows (solve 82 s) than in order, and took 12 GB in chunks of 1
 // (q, q̇, q̈: rows of 144 MB); chunks of 12 steps still gave 1.5× (chain3d N = 10⁴). Where the rows held for
-// delivery leave room for fewer steps per chunk than this, the sweep runs in order.
+// delivery leave room for fewer steps per chunk than this, the sweep runs on fewer threads, or in order.
 constexpr Index kMinChunkSteps = 8;
 // Sub-steps of a positions-only sweep's first seed (see seed_one).
 constexpr int kFirstSeedParts = 4;
@@ -1283,25 +1283,30 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     // steps on 2 threads against 1 thread: chain3d N = 10⁴ positions only 1.5× with 9 chunks of 12 steps,
     // 0.9–1.0× with 2 of 50; nfourbar N = 10³ with q̇, q̈ 1.45× either way. More chunks also balance more threads
     // (tools/simulate_schedule.py). Fewer steps when the rows a chunk per thread holds would exceed
-    // row_buffer_bytes, and none below kMinChunkSteps: the sweep then runs in order.
+    // row_buffer_bytes, and none below kMinChunkSteps: fewer threads then, or the sweep in order.
     const Index balanced = std::max<Index>(16, opt.steps / (4 * static_cast<Index>(threads)));
-    const double fit = static_cast<double>(opt.row_buffer_bytes) / (row_bytes * threads);
     chunk = std::min<Index>(64, balanced);
-    if (caller_reads_rows && fit < static_cast<double>(chunk)) {
-      chunk = static_cast<Index>(fit);
-      if (chunk < kMinChunkSteps && threads > 1 && opt.steps > kMinChunkSteps && ws.lu) {
+    const double rows_fit = static_cast<double>(opt.row_buffer_bytes) / row_bytes;  // rows the buffer holds
+    if (caller_reads_rows && rows_fit < static_cast<double>(chunk * threads)) {
+      // as many threads as can each hold a chunk of kMinChunkSteps, the rest of the cores left to the model's
+      // parallel evaluation; none but the caller's: in order
+      const int room = static_cast<int>(std::min<double>(threads, std::floor(rows_fit / kMinChunkSteps)));
+      if (room < threads && opt.steps > kMinChunkSteps && ws.lu) {
         std::ostringstream msg;
         msg.precision(3);
-        msg << "the drive steps run in order, not in parallel chunks on " << threads
-            << " threads: a row of the outputs is " << row_bytes / 1e6 << " MB, and the rows held for delivery in "
-            << "order (SweepOptions::row_buffer_bytes, " << static_cast<double>(opt.row_buffer_bytes) / 1e6
-            << " MB) leave room for chunks of " << chunk << (chunk == 1 ? " step" : " steps")
-            << " per thread, fewer than the " << kMinChunkSteps
-            << " that pay for a chunk's seed; the threads still serve the model's parallel evaluation";
+        msg << "the drive steps run "
+            << (room >= 2 ? "in parallel chunks on " + std::to_string(room) + " threads instead of "
+                          : std::string("in order, not in parallel chunks on "))
+            << threads << " threads: a row of the outputs is " << row_bytes / 1e6
+            << " MB, and the rows held for delivery in order (SweepOptions::row_buffer_bytes, "
+            << static_cast<double>(opt.row_buffer_bytes) / 1e6 << " MB) hold " << static_cast<long long>(rows_fit)
+            << " rows: chunks of " << kMinChunkSteps << " steps, the fewest that pay for a chunk's seed, for "
+            << (room >= 2 ? "only " + std::to_string(room) + " threads" : std::string("no more than one thread"))
+            << "; the other threads still serve the model's parallel evaluation";
         sum.warnings.push_back({run.time_of(0), "threads_reduced", msg.str()});
-        threads = 1;
+        threads = std::max(room, 1);
       }
-      chunk = std::max<Index>(chunk, 1);
+      chunk = std::max<Index>(1, std::min<Index>(chunk, static_cast<Index>(rows_fit / threads)));
     }
   }
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)

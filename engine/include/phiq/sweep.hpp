@@ -90,8 +90,9 @@ struct SweepOptions {
   /// Steps per parallel chunk; 0 picks 64, fewer (down to 16) so that there are at least 4 chunks per thread (the
   /// seed of a chunk is one step over its span, expensive on large models when long), and fewer when the rows
   /// held for delivery (threads × chunk_steps rows of q, q̇, q̈ and the outputs) would exceed row_buffer_bytes;
-  /// where that leaves fewer than 8 steps per chunk, which cost more in seeds than a thread gains, the steps run
-  /// in order (warning "threads_reduced"). A sweep with no on_step holds two rows per chunk, whatever their width.
+  /// where that leaves fewer than 8 steps per chunk, which cost more in seeds than a thread gains, they run on as
+  /// many threads as have room for 8, or in order (warning "threads_reduced"). A sweep with no on_step holds two
+  /// rows per chunk, whatever their width.
   Index chunk_steps = 0;
   /// Bytes of rows a parallel sweep may hold before it delivers them in order (> 0; see chunk_steps).
   std::size_t row_buffer_bytes = std::size_t{512} * 1024 * 1024;
