@@ -579,45 +579,39 @@ TEST(ParallelSweep, RowsTooWideForChunksOfEightStepsRunOnFewerThreadsOrInOrder) 
   opt.steps = 300;
   test::Trace seq;
   ASSERT_EQ(test::sweep(m, opt, &seq), SolveStatus::kSuccess);
-  opt.threads = 2;
-  opt.row_buffer_bytes = static_cast<std::size_t>(7.5 * 2 * row_bytes);  // 7 rows per chunk and thread
-  test::Trace in_order;
-  SweepSummary s7;
-  ASSERT_EQ(test::sweep(m, opt, &in_order, &s7), SolveStatus::kSuccess) << s7.message;
-  EXPECT_EQ(s7.threads, 1);
-  EXPECT_EQ(s7.parallel_chunks, 0);
-  ASSERT_EQ(s7.warnings.size(), 1u);
-  EXPECT_EQ(s7.warnings[0].kind, "threads_reduced");
-  EXPECT_EQ(s7.warnings[0].t, 0.0);
-  EXPECT_HAS(s7.warnings[0].message, "run in order, not in parallel chunks on 2 threads");
-  EXPECT_HAS(s7.warnings[0].message, "hold 15 rows: chunks of 8 steps, the fewest that pay for a chunk's seed, for no "
-                                     "more than one thread");
-  EXPECT_HAS(s7.warnings[0].message, "row_buffer_bytes");
-  EXPECT_EQ(test::max_difference(seq, in_order, 0), 0.0);  // the sequential sweep itself
-  EXPECT_EQ(test::max_difference(seq, in_order, 2), 0.0);
+  struct Run {
+    test::Trace tr;
+    SweepSummary sum;
+  };
+  // on `threads` threads with room for `rows` rows, expecting it to run on `ran` threads in `chunks` chunks
+  auto run = [&](int threads, double rows, int ran, Index chunks) {
+    Run r;
+    opt.threads = threads;
+    opt.row_buffer_bytes = static_cast<std::size_t>(rows * row_bytes);
+    EXPECT_EQ(test::sweep(m, opt, &r.tr, &r.sum), SolveStatus::kSuccess) << r.sum.message;
+    EXPECT_EQ(r.sum.threads, ran) << threads << " threads, " << rows << " rows";
+    EXPECT_EQ(r.sum.parallel_chunks, chunks) << threads << " threads, " << rows << " rows";
+    EXPECT_LT(test::max_difference(seq, r.tr, 0), 1e-9) << threads << " threads, " << rows << " rows";
+    return r;
+  };
+  const Run s7 = run(2, 15.5, 1, 0);  // 7 rows per chunk and thread: in order
+  ASSERT_EQ(s7.sum.warnings.size(), 1u);
+  EXPECT_EQ(s7.sum.warnings[0].kind, "threads_reduced");
+  EXPECT_EQ(s7.sum.warnings[0].t, 0.0);
+  EXPECT_HAS(s7.sum.warnings[0].message, "run in order, not in parallel chunks on 2 threads");
+  EXPECT_HAS(s7.sum.warnings[0].message,
+             "hold 15 rows: chunks of 8 steps, the fewest that pay for a chunk's seed, for no more than one thread");
+  EXPECT_HAS(s7.sum.warnings[0].message, "row_buffer_bytes");
+  EXPECT_EQ(test::max_difference(seq, s7.tr, 0), 0.0);  // the sequential sweep itself
+  EXPECT_EQ(test::max_difference(seq, s7.tr, 2), 0.0);
 
-  opt.row_buffer_bytes = static_cast<std::size_t>(8.5 * 2 * row_bytes);  // 8 rows per chunk and thread
-  test::Trace par;
-  SweepSummary s8;
-  ASSERT_EQ(test::sweep(m, opt, &par, &s8), SolveStatus::kSuccess) << s8.message;
-  EXPECT_EQ(s8.threads, 2);
-  EXPECT_EQ(s8.parallel_chunks, 38);  // ⌈300 / 8⌉
-  EXPECT_TRUE(s8.warnings.empty());
-  EXPECT_LT(test::max_difference(seq, par, 0), 1e-9);
+  EXPECT_TRUE(run(2, 17.5, 2, 38).sum.warnings.empty());  // 8 rows per chunk and thread: ⌈300 / 8⌉ chunks
 
-  // on 4 threads, room for 17 rows: chunks of 8 on 2 of them
-  opt.threads = 4;
-  opt.row_buffer_bytes = static_cast<std::size_t>(17.5 * row_bytes);
-  test::Trace fewer;
-  SweepSummary s4;
-  ASSERT_EQ(test::sweep(m, opt, &fewer, &s4), SolveStatus::kSuccess) << s4.message;
-  EXPECT_EQ(s4.threads, 2);
-  EXPECT_EQ(s4.parallel_chunks, 38);
-  ASSERT_EQ(s4.warnings.size(), 1u);
-  EXPECT_HAS(s4.warnings[0].message, "run in parallel chunks on 2 threads instead of 4 threads");
-  EXPECT_HAS(s4.warnings[0].message, "hold 17 rows: chunks of 8 steps, the fewest that pay for a chunk's seed, for "
-                                     "only 2 threads");
-  EXPECT_LT(test::max_difference(seq, fewer, 0), 1e-9);
+  const Run s4 = run(4, 17.5, 2, 38);  // on 4 threads, room for 17 rows: chunks of 8 on 2 of them
+  ASSERT_EQ(s4.sum.warnings.size(), 1u);
+  EXPECT_HAS(s4.sum.warnings[0].message, "run in parallel chunks on 2 threads instead of 4 threads");
+  EXPECT_HAS(s4.sum.warnings[0].message,
+             "hold 17 rows: chunks of 8 steps, the fewest that pay for a chunk's seed, for only 2 threads");
 
   opt.threads = 2;
   opt.row_buffer_bytes = static_cast<std::size_t>(7.5 * 2 * row_bytes);
