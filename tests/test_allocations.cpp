@@ -4,8 +4,9 @@
 // other suites do not need and which the sanitizer builds, whose runtime replaces malloc itself, cannot have.
 //
 // What a workspace does allocate, and is allowed to: its first factorisation (KLU's pivot search allocates per
-// block) and its first refactorisation (the row scales it keeps), a sweep's own buffers (the predictor's history, once per sweep), a full KLU factorisation where the
-// refactorisation's pivots degraded, the text of a warning. None of these grows with the number of steps.
+// block) and its first refactorisation (the row scales it keeps), a sweep's own buffers (the predictor's history,
+// once per sweep), a full KLU factorisation where the refactorisation's pivots degraded, the text of a warning.
+// None of these grows with the number of steps.
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -100,22 +101,30 @@ TEST(Allocations, TheCounterSeesEigenAndTheStandardLibrary) {
 struct Sweep {
   long allocations;
   WorkCounters work;
+  SolveStatus status, warm_status;  // of the counted sweep and of the one before it
 };
 
-// A sweep of nfourbar over a quarter turn in `steps` steps, on one thread, from a workspace that has swept the
-// same model before (its first factorisation and KLU's pivot search behind it).
-Sweep counted_sweep(const Model& m, SweepOptions opt, Index steps) {
+// A sweep of `steps` steps on one thread from `start`, counted, on a workspace that has swept the same from there
+// before (its first factorisation and KLU's pivot search behind it).
+Sweep counted_sweep_from(const Model& m, SweepOptions opt, Index steps, const Eigen::VectorXd& start) {
   Workspace ws(m);
   opt.steps = steps;
   opt.threads = 1;
-  SweepSummary warm;
-  EXPECT_EQ(run_sweep(m, opt, ws, nullptr, &warm), SolveStatus::kSuccess) << warm.message;
-  ws.q = m.initial_positions();
-  SweepSummary sum;
+  ws.q = start;
+  SweepSummary warm, sum;
+  const SolveStatus warm_status = run_sweep(m, opt, ws, nullptr, &warm);
+  ws.q = start;
   SolveStatus st = SolveStatus::kSuccess;
   const long a = allocations_of([&] { st = run_sweep(m, opt, ws, nullptr, &sum); });
-  EXPECT_EQ(st, SolveStatus::kSuccess) << sum.message;
-  return {a, sum.counters};
+  return {a, sum.counters, st, warm_status};
+}
+
+// The same from the model's initial positions (nfourbar over a quarter turn), both sweeps succeeding.
+Sweep counted_sweep(const Model& m, const SweepOptions& opt, Index steps) {
+  const Sweep s = counted_sweep_from(m, opt, steps, m.initial_positions());
+  EXPECT_EQ(s.warm_status, SolveStatus::kSuccess);
+  EXPECT_EQ(s.status, SolveStatus::kSuccess);
+  return s;
 }
 
 // With KLU (the default) a step allocates nothing: sweeps of 100, 200 and 400 steps make the same allocations
@@ -213,16 +222,10 @@ TEST(Allocations, EveryModelsSceneAllocatesLessThanOncePerStep) {
     long a[2] = {0, 0};
     bool ok = true;
     for (int k = 0; k < 2 && ok; ++k) {
-      SweepOptions opt = sc.sweep;
-      opt.steps = sc.sweep.steps * (k == 0 ? 1 : 4);
-      opt.threads = 1;
-      Workspace ws(*solved);
-      ws.q = q;
-      SweepSummary warm, sum;
-      ok = run_sweep(*solved, opt, ws, nullptr, &warm) == SolveStatus::kSuccess;
-      ws.q = q;
-      a[k] = allocations_of([&] { run_sweep(*solved, opt, ws, nullptr, &sum); });
-      EXPECT_EQ(sum.status, warm.status) << rel;
+      const Sweep r = counted_sweep_from(*solved, sc.sweep, sc.sweep.steps * (k == 0 ? 1 : 4), q);
+      ok = r.warm_status == SolveStatus::kSuccess;
+      a[k] = r.allocations;
+      EXPECT_EQ(r.status, r.warm_status) << rel;
     }
     EXPECT_EQ(ok, !error_by_design) << rel;
     if (!ok) continue;

@@ -1164,8 +1164,8 @@ double resident_memory() {
 // All cores (threads = 0), as many as fit: each thread beyond the first needs a workspace like the caller's `ws`
 // (which has factorised at row 0; the caller's own serves one thread, and the seeding pass shares them), beside the
 // rows held for delivery (SweepOptions::row_buffer_bytes at most). memory_budget is the whole process's: what it
-// holds already (the model, the caller's workspace) is spent. Fewer threads than `threads` come with a "threads_reduced" warning
-// at `t0`.
+// holds already (the model, the caller's workspace) is spent. Fewer threads than `threads` come with a
+// "threads_reduced" warning at `t0`.
 int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, double t0,
                      std::vector<SweepWarning>& warnings) {
   const double budget =
@@ -1187,6 +1187,41 @@ int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, 
     m << budget / 1e9 << " GB are available";
   warnings.push_back({t0, "threads_reduced", m.str()});
   return fit;
+}
+
+// SweepOptions::chunk_steps = 0: the chunk of a parallel sweep on `threads` threads whose rows take `row_bytes`
+// each (held until delivered when `caller_reads_rows`). 64 steps (a chunk costs a seed, a start from it and a seam
+// step), but at least 4 chunks per thread, down to 16 steps (so a sweep of 16 steps or fewer runs in order): the
+// seed of a chunk is one step over the chunk's whole span, and on a large model long spans are expensive (Newton
+// from far away, sub-steps). Measured, 100 steps on 2 threads against 1 thread: chain3d N = 10⁴ positions only 1.5×
+// with 9 chunks of 12 steps, 0.9–1.0× with 2 of 50; nfourbar N = 10³ with q̇, q̈ 1.45× either way. More chunks also
+// balance more threads (tools/simulate_schedule.py). Fewer steps when the rows a chunk per thread holds would
+// exceed row_buffer_bytes, and none below kMinChunkSteps: `threads` is then lowered to as many as have room for
+// such chunks, the rest of the cores left to the model's parallel evaluation (1: in order), with a
+// "threads_reduced" warning at `t0` (only where the sweep could run in parallel chunks: `parallel`).
+Index automatic_chunk_steps(const SweepOptions& opt, double row_bytes, bool caller_reads_rows, bool parallel,
+                            double t0, int& threads, std::vector<SweepWarning>& warnings) {
+  const Index balanced = std::max<Index>(16, opt.steps / (4 * static_cast<Index>(threads)));
+  Index chunk = std::min<Index>(64, balanced);
+  const double rows_fit = static_cast<double>(opt.row_buffer_bytes) / row_bytes;  // rows the buffer holds
+  if (!caller_reads_rows || rows_fit >= static_cast<double>(chunk * threads)) return chunk;
+  const int room = static_cast<int>(std::min<double>(threads, std::floor(rows_fit / kMinChunkSteps)));
+  if (room < threads && opt.steps > kMinChunkSteps && parallel) {
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << "the drive steps run "
+        << (room >= 2 ? "in parallel chunks on " + std::to_string(room) + " threads instead of "
+                      : std::string("in order, not in parallel chunks on "))
+        << threads << " threads: a row of the outputs is " << row_bytes / 1e6
+        << " MB, and the rows held for delivery in order (SweepOptions::row_buffer_bytes, "
+        << static_cast<double>(opt.row_buffer_bytes) / 1e6 << " MB) hold " << static_cast<long long>(rows_fit)
+        << " rows: chunks of " << kMinChunkSteps << " steps, the fewest that pay for a chunk's seed, for "
+        << (room >= 2 ? "only " + std::to_string(room) + " threads" : std::string("no more than one thread"))
+        << "; the other threads still serve the model's parallel evaluation";
+    warnings.push_back({t0, "threads_reduced", msg.str()});
+    threads = std::max(room, 1);
+  }
+  return std::max<Index>(1, std::min<Index>(chunk, static_cast<Index>(rows_fit / threads)));
 }
 
 // run_sweep's body, run inside a task arena of `threads` (run_sweep's count: opt.threads, or all cores for 0).
@@ -1271,44 +1306,17 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // check) and the last row (the state an ordered continuation starts from). Copying the rows in between was 3 % of
   // a 2-thread sweep of nfourbar N = 10³ that nobody read.
   const bool caller_reads_rows = static_cast<bool>(on_step);
+  auto keeps_vectors = [&](const std::vector<Row>& rows, std::size_t i) {
+    return caller_reads_rows || i == 0 || i + 1 == rows.size();
+  };
   const double row_bytes = 8.0 * static_cast<double>(std::max<Index>(width, 1));
-  auto held_bytes = [&](Index rows) {  // what a chunk of `rows` rows holds until it is delivered
+  auto held_bytes = [&](Index rows) {  // what a chunk of `rows` rows holds until it is delivered (keeps_vectors)
     return row_bytes * static_cast<double>(caller_reads_rows ? rows : std::min<Index>(rows, 2));
   };
   Index chunk = opt.chunk_steps;
-  if (chunk == 0) {
-    // 64 steps (a chunk costs a seed, a start from it and a seam step), but at least 4 chunks per thread, down to
-    // 16 steps (so a sweep of 16 steps or fewer runs in order): the seed of a chunk is one step over the chunk's
-    // whole span, and on a large model long spans are expensive (Newton from far away, sub-steps). Measured, 100
-    // steps on 2 threads against 1 thread: chain3d N = 10⁴ positions only 1.5× with 9 chunks of 12 steps,
-    // 0.9–1.0× with 2 of 50; nfourbar N = 10³ with q̇, q̈ 1.45× either way. More chunks also balance more threads
-    // (tools/simulate_schedule.py). Fewer steps when the rows a chunk per thread holds would exceed
-    // row_buffer_bytes, and none below kMinChunkSteps: fewer threads then, or the sweep in order.
-    const Index balanced = std::max<Index>(16, opt.steps / (4 * static_cast<Index>(threads)));
-    chunk = std::min<Index>(64, balanced);
-    const double rows_fit = static_cast<double>(opt.row_buffer_bytes) / row_bytes;  // rows the buffer holds
-    if (caller_reads_rows && rows_fit < static_cast<double>(chunk * threads)) {
-      // as many threads as can each hold a chunk of kMinChunkSteps, the rest of the cores left to the model's
-      // parallel evaluation; none but the caller's: in order
-      const int room = static_cast<int>(std::min<double>(threads, std::floor(rows_fit / kMinChunkSteps)));
-      if (room < threads && opt.steps > kMinChunkSteps && ws.lu) {
-        std::ostringstream msg;
-        msg.precision(3);
-        msg << "the drive steps run "
-            << (room >= 2 ? "in parallel chunks on " + std::to_string(room) + " threads instead of "
-                          : std::string("in order, not in parallel chunks on "))
-            << threads << " threads: a row of the outputs is " << row_bytes / 1e6
-            << " MB, and the rows held for delivery in order (SweepOptions::row_buffer_bytes, "
-            << static_cast<double>(opt.row_buffer_bytes) / 1e6 << " MB) hold " << static_cast<long long>(rows_fit)
-            << " rows: chunks of " << kMinChunkSteps << " steps, the fewest that pay for a chunk's seed, for "
-            << (room >= 2 ? "only " + std::to_string(room) + " threads" : std::string("no more than one thread"))
-            << "; the other threads still serve the model's parallel evaluation";
-        sum.warnings.push_back({run.time_of(0), "threads_reduced", msg.str()});
-        threads = std::max(room, 1);
-      }
-      chunk = std::max<Index>(1, std::min<Index>(chunk, static_cast<Index>(rows_fit / threads)));
-    }
-  }
+  if (chunk == 0)
+    chunk = automatic_chunk_steps(opt, row_bytes, caller_reads_rows, ws.lu != nullptr, run.time_of(0), threads,
+                                  sum.warnings);
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
   if (threads <= 1 || n_chunks < 2 || !ws.lu) {
     run.sequential(sw, ws, 1);
@@ -1369,9 +1377,6 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   spare.swap(ws.spare_rows);
   const Index n_coords = model.num_coordinates();
   std::erase_if(spare, [&](const Eigen::VectorXd& v) { return v.size() != n_coords; });
-  auto keeps_vectors = [&](const std::vector<Row>& rows, std::size_t i) {
-    return caller_reads_rows || i == 0 || i + 1 == rows.size();
-  };
   auto take_buffers = [&](std::vector<Row>& rows) {
     std::lock_guard<std::mutex> lock(spare_mutex);
     for (std::size_t i = 0; i < rows.size(); ++i)
@@ -1534,11 +1539,10 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     // over a whole chunk's span: from that constant prediction its Newton failed on nfourbar N = 10⁵ and took 0.57 s
     // of a 1.66 s sweep. In sub-steps it gives the parabola through the seeds its first rows: 1.35 s.
     const int parts = c == 1 && !need_v ? kFirstSeedParts : 1;
+    const double t0 = seeder.state().t, t1 = run.time_of(first_row(c));
     bool ok = true;
-    for (int i = 1; ok && i <= parts; ++i) {
-      const double t0 = run.time_of(0), t1 = run.time_of(first_row(c));
+    for (int i = 1; ok && i <= parts; ++i)
       ok = seeder.advance(i == parts ? t1 : t0 + (t1 - t0) * static_cast<double>(i) / parts, 0);
-    }
     add_counters(seed_work, w->counters, w0);
     release(w);
     if (ok) {
