@@ -21,7 +21,7 @@
 
 #include "generate.hpp"
 #include "generate_linkages.hpp"
-#include "klu_lu.hpp"
+#include "linear/klu_lu.hpp"
 #include "phiq/phiq.hpp"
 
 namespace {

@@ -9,7 +9,7 @@
 #include <klu.h>
 
 #include "generate.hpp"
-#include "klu_lu.hpp"
+#include "linear/klu_lu.hpp"
 #include "phiq/kinematics.hpp"
 #include "phiq/linear_solver.hpp"
 #include "phiq/scene.hpp"

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <regex>
 
-#include "kinematics_internal.hpp"
+#include "solve/kinematics_internal.hpp"
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
 

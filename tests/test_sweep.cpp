@@ -10,7 +10,7 @@
 
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
-#include "warning_stretches.hpp"
+#include "sweep/warning_stretches.hpp"
 
 namespace phiq {
 namespace {

@@ -18,5 +18,6 @@
 #include "phiq/rank_analysis.hpp"
 #include "phiq/scene.hpp"
 #include "phiq/sweep.hpp"
+#include "phiq/text.hpp"
 #include "phiq/version.hpp"
 #include "phiq/workspace.hpp"

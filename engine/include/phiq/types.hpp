@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "phiq/text.hpp"  // single_line, format_time: every message is built with them
+
 namespace phiq {
 
 /// Indices are 64-bit: SuiteSparse's "l" interfaces (UMFPACK dl, KLU l, CHOLMOD long) take SuiteSparse_long, and
@@ -21,15 +23,6 @@ class Error : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
 };
-
-/// `text` made fit for a one-line message: control characters escaped as `\\n`, `\\t`, `\\xNN`. User text quoted in
-/// errors (expressions, names from a scene) may contain them. Thread-safe.
-std::string single_line(const std::string& text);
-
-/// A time as phiq's messages write it (`t = …`: sweep and assembly failures, warnings): ten significant digits, so
-/// that a time the sweep computes (t_begin + k h) reads as the grid point it is ("0.6", not "0.6000000000000001")
-/// and a small start time keeps its digits ("1e-07", where std::to_string would say "0.000000"). Thread-safe.
-std::string format_time(double t);
 
 /// What a coordinate or a constraint row measures. Tolerances are dimensional: a length is compared with
 /// tol * its own tolerance scale (ToleranceScales: its link), an angle with tol (radians), a quantity of unknown unit

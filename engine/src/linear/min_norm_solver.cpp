@@ -1,6 +1,6 @@
 #include "phiq/min_norm_solver.hpp"
 
-#include "cholmod_view.hpp"
+#include "linear/cholmod_view.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -18,7 +18,7 @@
 #include <type_traits>
 #include <unordered_map>
 
-#include "time_grid.hpp"
+#include "sweep/time_grid.hpp"
 
 namespace phiq {
 

@@ -1,7 +1,7 @@
 #include "phiq/kinematics.hpp"
 
-#include "kinematics_internal.hpp"
-#include "tolerance_tests.hpp"
+#include "solve/kinematics_internal.hpp"
+#include "solve/tolerance_tests.hpp"
 
 #include <algorithm>
 #include <cmath>

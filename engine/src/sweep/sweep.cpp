@@ -26,11 +26,11 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include "kinematics_internal.hpp"
+#include "solve/kinematics_internal.hpp"
 #include "phiq/assembly.hpp"
-#include "time_grid.hpp"
-#include "warning_stretches.hpp"
-#include "tolerance_tests.hpp"
+#include "sweep/time_grid.hpp"
+#include "sweep/warning_stretches.hpp"
+#include "solve/tolerance_tests.hpp"
 
 namespace phiq {
 

@@ -1,6 +1,6 @@
 #include "phiq/linear_solver.hpp"
 
-#include "klu_lu.hpp"
+#include "linear/klu_lu.hpp"
 
 #include <umfpack.h>
 

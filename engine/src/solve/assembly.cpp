@@ -8,9 +8,9 @@
 #include <random>
 #include <sstream>
 
-#include "kinematics_internal.hpp"
+#include "solve/kinematics_internal.hpp"
 #include "phiq/min_norm_solver.hpp"
-#include "tolerance_tests.hpp"
+#include "solve/tolerance_tests.hpp"
 
 namespace phiq {
 

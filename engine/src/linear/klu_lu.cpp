@@ -8,7 +8,7 @@
 //   and solves, which stream them, a quarter less memory traffic.
 // - The blocks of the block triangular form in an order that follows the pattern's own where that is more local
 //   than the order KLU finds them in (resequence_blocks).
-#include "klu_lu.hpp"
+#include "linear/klu_lu.hpp"
 
 #include <klu.h>
 

@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "phiq/min_norm_solver.hpp"
-#include "cholmod_view.hpp"
+#include "linear/cholmod_view.hpp"
 
 namespace phiq {
 

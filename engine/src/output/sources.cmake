@@ -1,0 +1,7 @@
+# engine/src/output/: the sources of this stage (engine/CMakeLists.txt includes this file).
+target_sources(phiq_engine PRIVATE
+  ${CMAKE_CURRENT_LIST_DIR}/csv_compare.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/csv_writer.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mechanism_sketch.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/output_points.cpp
+)
