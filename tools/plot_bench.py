@@ -3,7 +3,8 @@
 
 One curve per benchmark family: the benchmark name without its N argument, with its other arguments (lu, pred)
 spelled out, e.g. "phiq KLU", "phiq UMFPACK", "dense Eigen LU, from previous", "Simbody, quadratic predictor".
-With several files, each label ends with its file's name: "phiq KLU (klu_vs_umfpack)".
+With several files, each label ends with its file's name: "phiq KLU (klu_vs_umfpack)", or with the label given
+as FILE=LABEL: "phiq KLU (50 steps per quarter turn)".
 
 Time per step: the benchmark's per-step counter when it has one (us_per_step, ms_per_step, ns_per_step,
 step_seconds or seconds_per_step), else its real_time in its time_unit (one iteration taken as one step) -- but
@@ -47,7 +48,7 @@ SETTINGS = re.compile(r"^(manual_time|real_time|process_time|(iterations|repeats
 
 # Known families: label, and default values of arguments missing from older runs.
 KNOWN = {
-    # phiq_bench; its runs from before the `lu` argument existed (results/baseline_umfpack.json) are UMFPACK's
+    # phiq_bench; its runs from before the `lu` argument existed are UMFPACK's
     "BM_NFourBarSweepStep": ("phiq", {"lu": "0"}),
     # phiq_bench_peers
     "BM_NFourBarStepPhiqKlu": ("phiq KLU", {}),
@@ -173,7 +174,7 @@ def median(xs):
 def main(argv):
     ap = argparse.ArgumentParser(prog=PROG, description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("json", nargs="+", metavar="JSON", help="Google Benchmark output (--benchmark_out_format=json)")
+    ap.add_argument("json", nargs="+", metavar="JSON", help="Google Benchmark output (--benchmark_out_format=json), or FILE=LABEL to name its curves")
     ap.add_argument("-o", "--output", default="time_per_step.svg", metavar="OUT.svg",
                     help="SVG to write (default: time_per_step.svg)")
     ap.add_argument("--png", metavar="OUT.png", help="also write a PNG")
@@ -186,10 +187,12 @@ def main(argv):
         exclude = re.compile(args.exclude) if args.exclude else None
     except re.error as e:
         raise PlotError("--exclude: invalid regular expression: %s" % e)
-    per_file = [(p, load(p, exclude)) for p in args.json]
+    # FILE=LABEL names the file's curves in the legend; a path that exists is taken whole.
+    named = [(a, None) if os.path.exists(a) or "=" not in a else tuple(a.rsplit("=", 1)) for a in args.json]
+    per_file = [(p, tag, load(p, exclude)) for p, tag in named]
     merged = {}
-    for p, (curves, _) in per_file:
-        stem = os.path.splitext(os.path.basename(p))[0]
+    for p, tag, (curves, _) in per_file:
+        stem = tag or os.path.splitext(os.path.basename(p))[0]
         for label, points in curves.items():
             name = label if len(args.json) == 1 else "%s (%s)" % (label, stem)
             for n, ts in points.items():
@@ -224,7 +227,7 @@ def main(argv):
     fig.tight_layout()
     save(fig, args.output, args.png, svg_dpi=120, png_dpi=120)
     skipped = {}
-    for _, (_, sk) in per_file:
+    for _, _, (_, sk) in per_file:
         for why, k in sk.items():
             skipped[why] = skipped.get(why, 0) + k
     print("%s: %d curves -> %s%s%s" % (
