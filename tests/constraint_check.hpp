@@ -19,6 +19,7 @@
 #include "phiq/constraint_block.hpp"
 #include "phiq/model.hpp"
 #include "phiq/types.hpp"
+#include "kind_checks.hpp"
 
 namespace {
 
@@ -153,6 +154,7 @@ CheckOptions Opts(std::uint32_t seed, bool time_dependent = false, int samples =
 
 template <class Spec>
 void CheckSpec(const Spec& spec, int n_coords, const CheckOptions& opt) {
+  (void)phiq::test::FdCheckOf<Spec>::registered;  // tests/test_kind_registry.cpp: this kind has a check
   constexpr int m = Spec::kRows;
   const std::size_t n = static_cast<std::size_t>(n_coords);
   SCOPED_TRACE(std::string("kind '") + Spec::kKind + "'");

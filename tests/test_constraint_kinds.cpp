@@ -331,6 +331,16 @@ TEST(ConstraintKinds, EquationWithLaw) {
   CheckSpec(f, 4, Opts(1004, true));
 }
 
+// ---- CouplerSpec ----------------------------------------------------------------------------------------------
+
+TEST(ConstraintKinds, CouplerOfTwoCoordinates) {
+  // a q_i + b q_j = c with the first coefficient negative (the row is divided by |a|), one coordinate unused
+  phiq::CouplerSpec c{S(2), S(0), -0.3, 1.7, 0.25};
+  CheckSpec(c, 3, Opts(1101));
+  phiq::CouplerSpec gear{S(0), S(1), 0.1, 0.05, 0.0};  // an external gear pair, pitch radii 0.1 and 0.05
+  CheckSpec(gear, 2, Opts(1102));
+}
+
 TEST(ModelPlumbing, CrankSliderJacobianPhiTAndGamma) {
   phiq::ModelBuilder b;
   const Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3),

@@ -103,69 +103,11 @@ inline std::size_t index_in(Index i, Index size, const char* what) {
 }
 }  // namespace detail
 
-/// What a constraint counts for in the Grübler–Kutzbach formula (Model::grubler()).
-struct JointCount {
-  /// The role of the constraint in the count.
-  enum class Role {
-    kOther,    ///< not a joint between bodies (natural coordinates, equations, …): the count is not defined
-    kJoint,    ///< a joint between bodies or ground: removes `freedoms`
-    kDriver,   ///< a driver: not counted
-    kBodyOwn,  ///< a body's own constraint (Euler-parameter normalisation): not counted
-  };
-  Role role = Role::kOther;  ///< its role
-  int dimension = 0;         ///< 2 (planar joint) or 3 (spatial joint), for kJoint
-  int freedoms = 0;          ///< freedoms the joint removes, for kJoint
-};
-
 namespace detail {
-/// JointCount of a constraint (the role of its kind, and for joints whether both sides are bodies or ground).
-template <class Spec>
-JointCount joint_count(const Spec&) {
-  return {};
-}
-/// A planar frame is a body's (ψ a coordinate) or ground (all constants); else a natural point.
-inline bool body_or_ground(const Frame2& f) {
-  return f.psi.is_coordinate() || (!f.x.is_coordinate() && !f.y.is_coordinate());
-}
-inline JointCount joint_count(const PinSpec& s) {
-  if (!body_or_ground(s.a) || !body_or_ground(s.b)) return {};
-  return {JointCount::Role::kJoint, 2, 2};
-}
-inline JointCount joint_count(const PrismaticSpec& s) {
-  if (!body_or_ground(s.a) || !body_or_ground(s.b)) return {};
-  return {JointCount::Role::kJoint, 2, 2};
-}
-template <class Traits>
-JointCount joint_count(const SpatialJointSpec<Traits>& s) {
-  if (s.a.natural || s.b.natural) return {};
-  return {JointCount::Role::kJoint, 3, Traits::kRows};
-}
-/// A spatial distance between two body (or ground) points: a bar with two ball joints, removing one freedom.
-inline JointCount joint_count(const SpatialDistanceSpec& s) {
-  for (const Attachment3& e : s.ends) {
-    bool body = false, fixed = true;
-    for (const Slot& v : e.p) body = body || v.is_coordinate();
-    for (const Slot& v : e.r) fixed = fixed && !v.is_coordinate();
-    if (!body && !fixed) return {};
-  }
-  return {JointCount::Role::kJoint, 3, 1};
-}
-inline JointCount joint_count(const EulerParametersSpec&) { return {JointCount::Role::kBodyOwn, 0, 0}; }
-inline JointCount joint_count(const CoordinateDriverSpec&) { return {JointCount::Role::kDriver, 0, 0}; }
-inline JointCount joint_count(const JointAngleDriverSpec&) { return {JointCount::Role::kDriver, 0, 0}; }
-inline JointCount joint_count(const JointDistanceDriverSpec&) { return {JointCount::Role::kDriver, 0, 0}; }
-inline JointCount joint_count(const EquationSpec& s) {
-  return s.law ? JointCount{JointCount::Role::kDriver, 0, 0} : JointCount{};
-}
 /// Whether a driver's law has a function: a default-constructed MotionLaw has none (its evaluation throws, and its
 /// domain reads [0, 0]); an equation's absent law is f ≡ 0.
 inline bool law_has_value(const MotionLaw& law) { return law.has_value(); }
 inline bool law_has_value(const std::optional<MotionLaw>& law) { return !law || law->has_value(); }
-/// Whether a kind derives data from its inputs with a setup() member (the spatial joints and joint drivers).
-template <class T, class = void>
-struct HasSetup : std::false_type {};
-template <class T>
-struct HasSetup<T, std::void_t<decltype(std::declval<T&>().setup())>> : std::true_type {};
 }  // namespace detail
 
 /// One constraint of a model, as diagnostics name it.
@@ -391,10 +333,10 @@ class ModelBuilder {
   /// Sets a coordinate's initial guess (rough placement for assembly).
   void set_initial(Index j, double value);
 
-  /// Adds a constraint of any kind in constraint_kinds.hpp; its rows follow those added before. Returns its index.
+  /// Adds a constraint of any kind of kinds/registry.hpp; its rows follow those added before. Returns its index.
   /// Throws phiq::Error "constraint 'NAME': ..." for a slot that is not a coordinate of the model or a constant
   /// that is not finite, a law without a function, or data its kind refuses ("distance: length must be positive").
-  template <class Spec>
+  template <ConstraintKind Spec>
   Index add(const std::string& name, Spec spec);
   /// Records a planar rigid body in reference-point coordinates, for the Grübler–Kutzbach count (Model::grubler());
   /// adds no coordinate and no constraint. Returns its index among the bodies. Throws phiq::Error for an empty or
@@ -432,24 +374,8 @@ class ModelBuilder {
   template <class Spec>
   TypedBlock<Spec>& block_for();
   /// @cond internal
-  /// Kind-specific validation and set-up at add time; kinds with nothing to check use the template.
-  template <class Spec>
-  void prepare(Spec& s) const {
-    if constexpr (detail::HasSetup<Spec>::value) s.setup();
-  }
-  void prepare(SpatialDistanceSpec& s) const;
-  void prepare(DotSpec& s) const;
   void count_joint(const JointCount& c);
   void check_body(const std::string& name, std::initializer_list<Slot> slots);
-  void prepare(PointOnLineSpec& s) const;
-  void prepare(ConstantAngleSpec& s) const;
-  void prepare(PrismaticSpec& s) const;
-  void prepare(DistanceSpec& s) const;
-  void prepare(PolarSpec& s) const;
-  void prepare(CoordinateDriverSpec& s) const;
-  void prepare(EquationSpec& s) const;
-  void prepare(PinSpec& s) const;
-  void prepare(LoopSpec& s) const;
   void tolerance_scales(const CscPattern& pattern, const std::vector<double>& own);  // model_.scales_, in build()
   /// @endcond
 
@@ -475,7 +401,7 @@ TypedBlock<Spec>& ModelBuilder::block_for() {
   return static_cast<TypedBlock<Spec>&>(*model_.blocks_[it->second]);
 }
 
-template <class Spec>
+template <ConstraintKind Spec>
 Index ModelBuilder::add(const std::string& name, Spec spec) {
   const std::string label = name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(model_.constraints_.size())
                                          : name;
@@ -486,13 +412,13 @@ Index ModelBuilder::add(const std::string& name, Spec spec) {
     if (!detail::law_has_value(spec.law))
       throw Error("constraint '" + label + "': its motion law has no function (a default-constructed MotionLaw)");
   try {  // the kind's own checks name the kind; the constraint is named here, as check_slot names it
-    prepare(spec);
+    spec.prepare(model_.initial_.data());
   } catch (const Error& e) {
     throw Error("constraint '" + label + "': " + e.what());
   }
   const bool td = spec.depends_on_time();
   const Index id = add_info(label, Spec::kKind, Spec::kRows, td);
-  count_joint(detail::joint_count(spec));
+  count_joint(spec.joint_count());
   const Index row0 = model_.constraints_[static_cast<std::size_t>(id)].first_row;
   if (row0 + Spec::kRows >= INT32_MAX) throw Error("the model has more equations than phiq handles (2^31)");
   block_for<Spec>().entries().push_back({std::move(spec), static_cast<EntryIndex>(row0), 0});

@@ -54,25 +54,9 @@ void each(const ConstraintBlock& b, F&& f) {
 
 std::vector<SketchSegment> sketch_segments(const Model& model) {
   Sketcher sk;
-  // per kind, the kinds in the order the model first used them
-  for (const auto& block : model.blocks()) {
-    each<DistanceSpec>(*block, [&](const DistanceSpec& s) { sk.bar(s.a, s.b); });
-    each<PolarSpec>(*block, [&](const PolarSpec& s) { sk.bar(s.o, s.p); });
-    each<SegmentAngleSpec>(*block, [&](const SegmentAngleSpec& s) { sk.bar(s.a, s.b); });
-    each<PointOnLineSpec>(*block, [&](const PointOnLineSpec& s) { sk.bar(s.a, s.b); });
-    each<ConstantAngleSpec>(*block, [&](const ConstantAngleSpec& s) {
-      sk.bar(s.a, s.b);
-      sk.bar(s.c, s.d);
-    });
-    each<PinSpec>(*block, [&](const PinSpec& s) {
-      sk.arm(s.a, s.sa);
-      sk.arm(s.b, s.sb);
-    });
-    each<PrismaticSpec>(*block, [&](const PrismaticSpec& s) {
-      sk.arm(s.a, s.sa);
-      sk.arm(s.b, s.sb);
-    });
-  }
+  // per block (one kind each, in the order the model first used them), each constraint's own sketch()
+  for (const auto& block : model.blocks())
+    ConstraintKinds::for_each([&]<class K>() { each<K>(*block, [&](const K& s) { s.sketch(sk); }); });
   return sk.take();
 }
 

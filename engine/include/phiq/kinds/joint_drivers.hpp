@@ -1,0 +1,170 @@
+/// @file
+/// Drivers on a spatial joint: its translation (prismatic, cylindrical) or its rotation (revolute, cylindrical). One constraint kind (or one family of
+/// kinds sharing a row table): equation, derivatives, validation, joint count, sketch and scene form; the contract
+/// is documented on DistanceSpec, and kinds/registry.hpp lists every kind.
+#pragma once
+
+#include <cmath>
+
+#include "phiq/motion_law.hpp"
+#include "phiq/kinds/spatial_joints.hpp"
+#include "phiq/kinds/kind_support.hpp"
+
+namespace phiq {
+
+/// Driver on the translation of a prismatic or cylindrical joint: the distance of P_b from P_a along z_a.
+///   Φ = z_a · (P_b − P_a) − f(t),   Φt = −f'(t)        (1 row, a length)
+/// Scene: a driver `{joint: NAME, measure: distance}`.
+struct JointDistanceDriverSpec {
+
+  /// @copydoc DistanceSpec::joint_count
+  /// A driver is not counted.
+  JointCount joint_count() const { return JointCount::driver(); }
+  /// @copydoc DistanceSpec::prepare
+  /// For a joint driver: setup().
+  void prepare(const double* /*q0*/) { setup(); }
+  /// @copydoc DistanceSpec::sketch
+  /// A driver draws nothing: its joint's bodies are drawn by their constraints.
+  template <class Sketch>
+  void sketch(Sketch&) const {}
+  /// @copydoc DistanceSpec::kScene
+  static constexpr SceneForm kScene[] = {{"drivers", "joint", 3, "- {name: push, joint: slider, measure: distance, law: {type: linear, initial: 0, rate: 0.1}}"}};
+ private:
+  static constexpr detail3::RowDef kDefs[1] = {
+      {detail3::T(detail3::kZa), detail3::T(detail3::kPb, detail3::kPa), Unit::kLength}};
+
+ public:
+  static constexpr int kRows = 1;  ///< one row, a length
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "joint_distance_driver";
+  /// @var a
+  /// @brief Side a of the driven joint.
+  JointSide3 a, b;  ///< side b of the driven joint
+  MotionLaw law;    ///< f(t), metres
+  /// The row's attachments and the row renumbered into them (detail3::compact_rows).
+  static constexpr auto kCompact = detail3::compact_rows(kDefs);
+  std::array<Attachment3, kCompact.count> att{};  ///< derived by setup(): the attachments the row reads
+
+  /// Validates the sides and derives `att`. Throws phiq::Error.
+  void setup() { detail3::set_up_attachments(a, b, kCompact, kKind, att); }
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return true; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kLength; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return 0.0; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    detail3::side_slots(a, f), detail3::side_slots(b, f);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double t, double* phi) const {
+    phi[0] = detail3::row_value(att.data(), kCompact.rows[0], q, 1.0, law.evaluate(t).f);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& s) const {
+    detail3::row_jacobian(att.data(), kCompact.rows[0], q, s, 0, 1.0);
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double t, double* out) const { out[0] = -law.evaluate(t).df; }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double* q, const double* qd, double t, double* out) const {
+    out[0] = detail3::row_gamma(att.data(), kCompact.rows[0], q, qd, 1.0) + law.evaluate(t).ddf;
+  }
+};
+
+/// Driver on the rotation of a revolute or cylindrical joint: the angle θ of x_b about z_a measured from x_a,
+/// with c = x_a · x_b and s = y_a · x_b (so x_b = cos θ x_a + sin θ y_a when the axes are aligned):
+///   Φ = atan2(s cos f − c sin f,  c cos f + s sin f)     = θ − f(t) wrapped to (−π, π]
+/// The difference is taken as the angle of (c, s) turned back by f, not as atan2(s, c) − f: smooth at any θ, so a
+/// driver runs through any number of turns. Φq = (c ∂s − s ∂c) / (c² + s²), Φt = −f'(t).
+/// Both sides must be bodies or ground. Scene: a driver `{joint: NAME}` (`measure: angle`).
+struct JointAngleDriverSpec {
+ private:
+  // c = x_a · x_b and s = y_a · x_b
+  static constexpr detail3::RowDef kDefs[2] = {{detail3::T(detail3::kXa), detail3::T(detail3::kXb), Unit::kNone},
+                                               {detail3::T(detail3::kYa), detail3::T(detail3::kXb), Unit::kNone}};
+
+ public:
+  static constexpr int kRows = 1;  ///< one row, an angle
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "joint_angle_driver";
+  /// @var a
+  /// @brief Side a of the driven joint.
+  JointSide3 a, b;  ///< side b of the driven joint
+  MotionLaw law;    ///< f(t), radians
+  /// The two products' attachments and the products renumbered into them (detail3::compact_rows).
+  static constexpr auto kCompact = detail3::compact_rows(kDefs);
+  std::array<Attachment3, kCompact.count> att{};  ///< derived by setup(): the attachments c and s read
+
+  /// Validates the sides and derives `att`. Throws phiq::Error.
+  void setup() { detail3::set_up_attachments(a, b, kCompact, kKind, att); }
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return true; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kAngle; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return 0.0; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    detail3::side_slots(a, f), detail3::side_slots(b, f);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double t, double* phi) const {
+    const auto [c, s] = products(q);
+    const double f = law.evaluate(t).f, cf = std::cos(f), sf = std::sin(f);
+    phi[0] = std::atan2(s * cf - c * sf, c * cf + s * sf);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  /// @par Joint angle driver
+  /// The entries of ∂c (scaled by −s/ρ) and then of ∂s (scaled by c/ρ), ρ = c² + s²; x_b appears in both and its
+  /// entries add up.
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& sink) const {
+    const auto [c, s] = products(q);
+    const double rho = c * c + s * s;
+    detail3::row_jacobian(att.data(), kCompact.rows[0], q, sink, 0, -s / rho);
+    detail3::row_jacobian(att.data(), kCompact.rows[1], q, sink, 0, c / rho);
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double t, double* out) const { out[0] = -law.evaluate(t).df; }
+  /// @copydoc DistanceSpec::gamma
+  /// @par Joint angle driver
+  /// θ̈ = (c s̈ − s c̈)/ρ − (c ṡ − s ċ) ρ̇/ρ², ρ̇ = 2 (c ċ + s ṡ); γ keeps the q̈-free parts of c̈, s̈, plus f''(t).
+  void gamma(const double* q, const double* qd, double t, double* out) const {
+    const Attachment3* a3 = att.data();
+    const detail3::RowDef& cdef = kCompact.rows[0];
+    const detail3::RowDef& sdef = kCompact.rows[1];
+    const auto [c, s] = products(q);
+    const double cd = detail3::row_rate(a3, cdef, q, qd, 1.0), sd = detail3::row_rate(a3, sdef, q, qd, 1.0);
+    // row_gamma is −(q̈-free part of the second derivative)
+    const double cb = -detail3::row_gamma(a3, cdef, q, qd, 1.0), sb = -detail3::row_gamma(a3, sdef, q, qd, 1.0);
+    const double rho = c * c + s * s, rhod = 2.0 * (c * cd + s * sd);
+    out[0] = -(c * sb - s * cb) / rho + (c * sd - s * cd) * rhod / (rho * rho) + law.evaluate(t).ddf;
+  }
+
+
+  /// @copydoc DistanceSpec::joint_count
+  /// A driver is not counted.
+  JointCount joint_count() const { return JointCount::driver(); }
+  /// @copydoc DistanceSpec::prepare
+  /// For a joint driver: setup().
+  void prepare(const double* /*q0*/) { setup(); }
+  /// @copydoc DistanceSpec::sketch
+  /// A driver draws nothing: its joint's bodies are drawn by their constraints.
+  template <class Sketch>
+  void sketch(Sketch&) const {}
+  /// @copydoc DistanceSpec::kScene
+  static constexpr SceneForm kScene[] = {{"drivers", "joint", 3, "- {name: crank_motor, joint: crank_hinge, law: {type: linear, initial: 0, rate: 1}}"}};
+ private:
+  // c = x_a · x_b and s = y_a · x_b at q: what Φ, Φq and γ all start from
+  std::array<double, 2> products(const double* q) const {
+    return {detail3::row_value(att.data(), kCompact.rows[0], q, 1.0, 0.0),
+            detail3::row_value(att.data(), kCompact.rows[1], q, 1.0, 0.0)};
+  }
+};
+
+}  // namespace phiq

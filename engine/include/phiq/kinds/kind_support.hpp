@@ -1,0 +1,105 @@
+/// @file
+/// What every constraint kind header needs besides the basic types: planar vector helpers (kin::V2), the
+/// Grübler–Kutzbach role of a constraint (JointCount), the description of a kind's scene form (SceneForm), and the
+/// checks kinds share when a constraint is added.
+#pragma once
+
+#include <cmath>
+#include <algorithm>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "phiq/types.hpp"
+
+namespace phiq {
+
+namespace kin {
+struct V2 {
+  double x, y;
+};
+inline V2 operator+(V2 a, V2 b) { return {a.x + b.x, a.y + b.y}; }
+inline V2 operator-(V2 a, V2 b) { return {a.x - b.x, a.y - b.y}; }
+inline V2 operator*(double s, V2 a) { return {s * a.x, s * a.y}; }
+inline double dot(V2 a, V2 b) { return a.x * b.x + a.y * b.y; }
+inline double cross(V2 a, V2 b) { return a.x * b.y - a.y * b.x; }
+inline V2 perp(V2 a) { return {-a.y, a.x}; }  // rotation by +90°
+inline V2 rotate(double psi, V2 s) {
+  double c = std::cos(psi), n = std::sin(psi);
+  return {c * s.x - n * s.y, n * s.x + c * s.y};
+}
+inline V2 pos(const Point2& p, const double* q) { return {p.x.of(q), p.y.of(q)}; }
+inline V2 vel(const Point2& p, const double* qd) { return {p.x.rate(qd), p.y.rate(qd)}; }
+/// |s| when the frame moves (any of x, y, ψ is a coordinate), 0 for a fixed frame (see PinSpec).
+inline double moving_arm(const Frame2& f, V2 s) {
+  const bool fixed = !f.x.is_coordinate() && !f.y.is_coordinate() && !f.psi.is_coordinate();
+  return fixed ? 0.0 : std::hypot(s.x, s.y);
+}
+// |b − a| at the placement q0 (the initial guesses), for the reference scales of rows set when a constraint is added.
+inline double initial_length(const Point2& a, const Point2& b, const double* q0) {
+  V2 d = pos(b, q0) - pos(a, q0);
+  return std::hypot(d.x, d.y);
+}
+// Two points made of constants only that are the same point: a segment or line between them has no direction
+// anywhere, so a constraint on it holds for no position or for all (points that move may meet at a placement).
+inline bool same_fixed_point(const Point2& a, const Point2& b) {
+  return !a.x.is_coordinate() && !a.y.is_coordinate() && !b.x.is_coordinate() && !b.y.is_coordinate() &&
+         a.x.value() == b.x.value() && a.y.value() == b.y.value();
+}
+/// A planar frame is a body's (ψ a coordinate) or ground (all constants); else a natural point.
+inline bool body_or_ground(const Frame2& f) {
+  return f.psi.is_coordinate() || (!f.x.is_coordinate() && !f.y.is_coordinate());
+}
+}  // namespace kin
+
+namespace detail {
+/// Throws phiq::Error(what) unless `ok`: the kinds' checks of their data when a constraint is added (the model
+/// prefixes the constraint's name).
+inline void require(bool ok, const char* what) {
+  if (!ok) throw Error(what);
+}
+}  // namespace detail
+
+/// What a constraint counts for in the Grübler–Kutzbach formula (Model::grubler()). Every kind says it
+/// (`joint_count()`): kinds/registry.hpp refuses a kind without it at compile time.
+struct JointCount {
+  /// The role of the constraint in the count.
+  enum class Role {
+    kOther,    ///< not a joint between bodies (natural coordinates, equations, …): the count is not defined
+    kJoint,    ///< a joint between bodies or ground: removes `freedoms`
+    kDriver,   ///< a driver: not counted
+    kBodyOwn,  ///< a body's own constraint (Euler-parameter normalisation): not counted
+  };
+  Role role = Role::kOther;  ///< its role
+  int dimension = 0;         ///< 2 (planar joint) or 3 (spatial joint), for kJoint
+  int freedoms = 0;          ///< freedoms the joint removes, for kJoint
+
+  /// Not a joint: the count is not defined for a model that has one.
+  static JointCount other() { return {}; }
+  /// A driver: not counted.
+  static JointCount driver() { return {Role::kDriver, 0, 0}; }
+  /// A joint of `dimension` (2 or 3) removing `freedoms`.
+  static JointCount joint(int dimension, int freedoms) { return {Role::kJoint, dimension, freedoms}; }
+};
+
+/// @page scene_fields The scene vocabulary of the kinds
+/// A kind read from the `constraints` section of a scene has `template <class Fields> static Spec read(const
+/// Fields& f)`. `f` is one entry of the list (scene/kind_fields.hpp implements it over the YAML cursor and over
+/// family members alike); each call names the field it reads and fails with the file, line and field path:
+/// `type()`; `expect({fields})` (the fields allowed); `present(field)`; `fail(field, message)` (`""`: the entry);
+/// `number`, `positive`, `slot` (a coordinate or a constant), `coordinate` (an index), `vec2`, `point`, `segment`,
+/// `two_segments`, `attachments` (two planar attachments {frame, at, body}), `items` (a list of entries, each with
+/// the same vocabulary), `signed_coordinates`, `coordinate_pair`, `number_pair`, `expression`, `unit`; in space
+/// `point3`, `point3_pair`, `vec3`, `sides3` (two JointSide3), `two_directions` ({head, tail, unit} each).
+
+/// Where and how a scene writes a constraint of some kind: the section, the `type` (or the automatic entry), the
+/// dimension, and a one-line YAML example as models/README.md documents it (tests check that the README shows
+/// every example and that each loads in a scene).
+struct SceneForm {
+  const char* section;  ///< "constraints", "drivers", "bodies" or "vectors"
+  const char* type;     ///< the `type` field (constraints), or what selects the kind in its section
+  int dimension;        ///< 2 or 3
+  const char* example;  ///< the documented YAML entry, one line
+};
+
+}  // namespace phiq

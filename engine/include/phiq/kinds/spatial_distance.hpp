@@ -1,0 +1,105 @@
+/// @file
+/// The distance between two spatial points. One constraint kind (or one family of
+/// kinds sharing a row table): equation, derivatives, validation, joint count, sketch and scene form; the contract
+/// is documented on DistanceSpec, and kinds/registry.hpp lists every kind.
+#pragma once
+
+#include <cmath>
+
+#include "phiq/kinds/spatial_joints.hpp"  // detail3: the row formulas
+#include "phiq/spatial_attachment.hpp"
+#include "phiq/kinds/kind_support.hpp"
+
+namespace phiq {
+
+/// Distance between two spatial points (natural points, or points of bodies: a massless bar with a ball joint at
+/// each end):
+///   Φ = (|B − A|² − L²) / (2L)        (1 row, a length ≈ |B − A| − L)
+/// Scene type `distance` (dimension 3).
+struct SpatialDistanceSpec {
+  static constexpr int kRows = 1;  ///< one row, a length
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "distance";
+  Attachment3 ends[2];  ///< A, B
+  double length = 1.0;  ///< L > 0 (checked when added)
+
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return false; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kLength; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return length; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    ends[0].for_each_slot(f, Unit::kLength), ends[1].for_each_slot(f, Unit::kLength);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double, double* phi) const {
+    phi[0] = detail3::row_value(ends, kDef, q, 0.5 / length, length * length);
+  }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& s) const {
+    detail3::row_jacobian(ends, kDef, q, s, 0, 0.5 / length);
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double* q, const double* qd, double, double* out) const {
+    out[0] = detail3::row_gamma(ends, kDef, q, qd, 0.5 / length);
+  }
+
+
+  /// @copydoc DistanceSpec::joint_count
+  /// A distance between body (or ground) points is a bar with two ball joints, removing one freedom; between
+  /// natural points it is no joint.
+  JointCount joint_count() const {
+    for (const Attachment3& e : ends) {
+      bool body = false, fixed = true;
+      for (const Slot& v : e.p) body = body || v.is_coordinate();
+      for (const Slot& v : e.r) fixed = fixed && !v.is_coordinate();
+      if (!body && !fixed) return JointCount::other();
+    }
+    return JointCount::joint(3, 1);
+  }
+  /// @copydoc DistanceSpec::prepare
+  /// Constant ends are folded into their values here.
+  void prepare(const double* /*q0*/) {
+    detail::require(std::isfinite(length) && length > 0.0, "distance: length must be positive and finite");
+    for (Attachment3& e : ends) {
+      detail::require(std::isfinite(e.s.x) && std::isfinite(e.s.y) && std::isfinite(e.s.z), "distance: point is not finite");
+      e.fold_constant();
+    }
+  }
+  /// @copydoc DistanceSpec::sketch
+  /// A spatial distance draws nothing yet: the sketch is planar (mechanism_sketch.hpp).
+  template <class Sketch>
+  void sketch(Sketch&) const {}
+  /// @copydoc DistanceSpec::kScene
+  static constexpr SceneForm kScene[] = {
+      {"constraints", "distance", 3, "- {name: coupler, type: distance, points: [P0, P1], length: 1}"}};
+  /// @copydoc DistanceSpec::read
+  template <class Fields>
+  static SpatialDistanceSpec read(const Fields& f) {
+    f.expect({"type", "name", "points", "between", "length"});
+    SpatialDistanceSpec spec;
+    if (f.present("points") == f.present("between"))
+      f.fail("", "a distance has either 'points' (natural points) or 'between' (attachments)");
+    if (f.present("points")) {
+      const auto [pa, pb] = f.point3_pair("points", "a distance joins two points [A, B]");
+      spec.ends[0] = Attachment3::natural(pa);
+      spec.ends[1] = Attachment3::natural(pb);
+    } else {
+      const auto [sa, sb] = f.sides3("between");
+      spec.ends[0] = Attachment3::body_point(sa.frame, sa.at);
+      spec.ends[1] = Attachment3::body_point(sb.frame, sb.at);
+    }
+    spec.length = f.positive("length");
+    return spec;
+  }
+ private:
+  static constexpr detail3::RowDef kDef = {detail3::T(1, 0), detail3::T(1, 0), Unit::kLength};
+};
+
+}  // namespace phiq
