@@ -1,0 +1,28 @@
+// phiq's expression parser: text → GiNaC expression, with every constant part folded in double precision so that
+// GiNaC never does exact arithmetic on numbers (parser.cpp says why). Internal to engine/src/expression/.
+#pragma once
+
+#include <ginac/ginac.h>
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+
+namespace phiq::detail {
+
+// What a name stands for: a constant value, or a GiNaC symbol (a coordinate or t).
+struct ParsedName {
+  std::optional<double> value;
+  GiNaC::ex symbol;
+};
+// Resolves a name, or throws phiq::Error when it is unknown or not allowed.
+using NameLookup = std::function<ParsedName(const std::string&)>;
+
+// The GiNaC expression of `text`. Each folded constant reaches it as a real symbol whose value is entered in
+// value_of_constant (for the tape builder). Throws phiq::Error with a one-line message (column, offending token)
+// when the text is malformed; GiNaC's own refusals escape as its exceptions.
+GiNaC::ex parse_expression(const std::string& text, NameLookup name,
+                           std::map<std::string, double>& value_of_constant);
+
+}  // namespace phiq::detail
