@@ -1,4 +1,5 @@
 #include "phiq/kinematics.hpp"
+#include "phiq/text.hpp"
 
 #include "solve/kinematics_internal.hpp"
 #include "solve/tolerance_tests.hpp"
@@ -228,12 +229,6 @@ bool jacobian_values_at_q(const Workspace& ws, double t) {
 // looked for only once a factorisation or a solve has failed — so that the message says what it is.
 const char* const kNoDerivative =
     ", a derivative that does not exist at this position (as that of sqrt(u) or u^p, p < 1, at u = 0)";
-std::string number_text(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << v;
-  return s.str();
-}
 // The first non-finite entry of Φq's values (in the solve pattern: `values` as factorised), or "".
 std::string non_finite_jacobian(const Model& model, const double* values) {
   const CscPattern& p = model.solve_pattern();
@@ -243,7 +238,7 @@ std::string non_finite_jacobian(const Model& model, const double* values) {
         const Index r = p.row_idx[static_cast<std::size_t>(k)];
         const Index row = model.dropped_rows().empty() ? r : model.solve_rows()[static_cast<std::size_t>(r)];
         return std::string(detail::kNonFiniteJacobian) + "∂'" + model.row_name(row) + "'/∂'" +
-               model.coordinate_names()[static_cast<std::size_t>(j)] + "' = " + number_text(values[k]) + kNoDerivative;
+               model.coordinate_names()[static_cast<std::size_t>(j)] + "' = " + significant(values[k], 3) + kNoDerivative;
       }
   return "";
 }
@@ -329,13 +324,6 @@ const double* solve_rhs(const Model& model, Workspace& ws, const Eigen::VectorXd
 }
 const double* solve_rhs(const Model& model, Workspace& ws) { return solve_rhs(model, ws, ws.rhs); }
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << std::scientific << v;
-  return s.str();
-}
-
 }  // namespace
 
 double scaled_residual(const Model& model, const Eigen::VectorXd& phi) { return max_scaled(model, phi); }
@@ -347,7 +335,7 @@ double scaled_step(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& 
 
 std::string PositionSummary::BriefReport() const {
   std::ostringstream s;
-  s << "position: " << to_string(status) << ", " << iterations << " iterations, scaled residual " << fmt(residual);
+  s << "position: " << to_string(status) << ", " << iterations << " iterations, scaled residual " << scientific(residual, 3);
   if (!message.empty()) s << " (" << message << ")";
   return s.str();
 }
@@ -590,10 +578,10 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
                         ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
                           "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a long "
                           "chain or Φq ill-conditioned): up to " +
-                              fmt(worst_ratio) + " × the tolerance at '" + name + "', which is how well q is known there"
+                              scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there"
                         : "the residual is at its rounding level and the Newton steps no longer reduce it: they are "
                           "the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
-                              fmt(worst_ratio) + " × the tolerance at '" + name + "', which is how well q is known there";
+                              scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there";
       return SolveStatus::kSuccess;
     };
     if (rounding_level && !(trial_check.within && trial_check.merit < check.merit)) return stop_at_rounding_level(false);

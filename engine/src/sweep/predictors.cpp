@@ -1,0 +1,270 @@
+// The predictors: their names and the choice among them (the public functions of phiq/sweep.hpp), the history each
+// needs, and their formulas (Sweeper::predict(), run before every drive step): one place to read, or add, a way of
+// guessing the next position.
+#include "sweep/predictors.hpp"
+
+#include "sweep/sweeper.hpp"
+
+namespace phiq {
+
+const char* to_string(Predictor p) {
+  switch (p) {
+    case Predictor::kAuto: return "auto";
+    case Predictor::kPrevious: return "previous";
+    case Predictor::kSecant: return "secant";
+    case Predictor::kLinear: return "linear";
+    case Predictor::kQuadratic: return "quadratic";
+    case Predictor::kCubic: return "cubic";
+    case Predictor::kParabolic: return "parabolic";
+    case Predictor::kHermite: return "hermite";
+  }
+  return "?";
+}
+
+const std::vector<Predictor>& all_predictors() {
+  static const std::vector<Predictor> all = {Predictor::kAuto,     Predictor::kPrevious, Predictor::kSecant,
+                                             Predictor::kParabolic, Predictor::kLinear,   Predictor::kHermite,
+                                             Predictor::kQuadratic, Predictor::kCubic};
+  return all;
+}
+
+bool predictor_from_string(const std::string& name, Predictor* p) {
+  for (Predictor k : all_predictors())
+    if (name == to_string(k)) return *p = k, true;
+  return false;
+}
+
+const char* predictor_names() {
+  static const std::string names = [] {
+    const std::vector<Predictor>& all = all_predictors();
+    std::string s;
+    for (std::size_t i = 0; i < all.size(); ++i)
+      s += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + std::string(to_string(all[i]));
+    return s;
+  }();
+  return names.c_str();
+}
+
+Predictor effective_predictor(Predictor p, bool velocities, bool accelerations) {
+  if (p != Predictor::kAuto) return p;
+  return accelerations ? Predictor::kCubic : velocities ? Predictor::kHermite : Predictor::kParabolic;
+}
+
+bool predictor_needs_velocities(Predictor p) {
+  return p == Predictor::kLinear || p == Predictor::kHermite || predictor_needs_accelerations(p);
+}
+
+bool predictor_needs_accelerations(Predictor p) { return p == Predictor::kQuadratic || p == Predictor::kCubic; }
+
+namespace detail {
+
+int predictor_history_depth(Predictor p) {
+  switch (p) {
+    case Predictor::kPrevious: return 1;
+    case Predictor::kSecant: return 2;
+    case Predictor::kParabolic: return 3;
+    case Predictor::kHermite: return 3;
+    case Predictor::kLinear: return 1;
+    case Predictor::kQuadratic: return 1;
+    case Predictor::kCubic: return 2;
+    case Predictor::kAuto: break;
+  }
+  return 0;
+}
+
+// ws.q = the predictor's guess at t1 from the current state and the history (kept in predicted_ for jumped()),
+// and newton_.start_error = the size of the next term of the extrapolation in units of the tolerance test — its
+// error estimate, from one more row of history than the prediction needs (infinite until there is one, so that
+// Newton then takes a step). One pass over the vectors.
+void Sweeper::predict(double t1) {
+  const Index n = current_.q.size();
+  const double h = t1 - current_.t, tc = current_.t;
+  const double tol = opt_.newton.tolerance;
+  const double* cs = model_.tolerance_scales().coordinate_scale.data();
+  ws_->q.resize(n);
+  predicted_.resize(n);
+  double* out = ws_->q.data();
+  double* kept = predicted_.data();
+  const double* q = current_.q.data();
+  const int k = known_;
+  auto x = [&](int i) { return history_[static_cast<std::size_t>(i)].data(); };
+  auto th = [&](int i) { return history_t_[static_cast<std::size_t>(i)]; };
+  detail::WorstRatio worst;
+  bool estimated = true;
+  double inherited = current_error_;  // the error of the rows extrapolated from, carried into the prediction
+  // f(j, &error) returns the prediction of coordinate j and sets its error estimate.
+  auto each = [&](auto&& f) {
+    for (Index j = 0; j < n; ++j) {
+      double e = 0.0;
+      const double p = f(j, e);
+      out[j] = kept[j] = p;
+      worst.add(std::fabs(e), tol * cs[j] + ToleranceScales::kUlpFloor * std::fabs(p));
+    }
+  };
+  // The nodes of the divided-difference predictors: tc, t_0, t_1, t_2 (the current row, then the history; the
+  // current row again where the history is shorter), their rows, and the reciprocals of their spacings, once per
+  // step, so that the passes below multiply (no division per coordinate).
+  struct Nodes {
+    double T[4];
+    const double* xs[3];
+    double i01, i12, i23, i02, i13, i03;
+  };
+  auto nodes = [&] {
+    auto inv = [](double d) { return d != 0.0 ? 1.0 / d : 0.0; };
+    Nodes nd{{tc, k > 0 ? th(0) : tc, k > 1 ? th(1) : tc, k > 2 ? th(2) : tc},
+             {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q}, 0, 0, 0, 0, 0, 0};
+    const double* T = nd.T;
+    nd.i01 = inv(T[0] - T[1]), nd.i12 = inv(T[1] - T[2]), nd.i23 = inv(T[2] - T[3]);
+    nd.i02 = inv(T[0] - T[2]), nd.i13 = inv(T[1] - T[3]), nd.i03 = inv(T[0] - T[3]);
+    return nd;
+  };
+  switch (predictor_) {
+    case Predictor::kPrevious:
+    case Predictor::kSecant:
+    case Predictor::kParabolic: {
+      // Newton's divided differences of q over tc, t_0, t_1, t_2 (the current row, then the history): the
+      // polynomial of the predictor's order through the last rows, and its next term as the error
+      const int order = std::min(predictor_ == Predictor::kPrevious ? 0 : predictor_ == Predictor::kSecant ? 1 : 2, k);
+      estimated = k > order;
+      const int terms = order + (estimated ? 1 : 0);
+      inherited = 0.0;
+      const Nodes nd = nodes();
+      const double* T = nd.T;
+      const double* const* xs = nd.xs;
+      const double i01 = nd.i01, i12 = nd.i12, i23 = nd.i23, i02 = nd.i02, i13 = nd.i13, i03 = nd.i03;
+      const double w1 = h, w2 = w1 * (t1 - T[1]), w3 = w2 * (t1 - T[2]);
+      // the rows' own errors carry over with the weights of Lagrange's polynomial through them at t1
+      for (int i = 0; i <= order; ++i) {
+        double w = 1.0;
+        for (int l = 0; l <= order; ++l)
+          if (l != i) w *= (t1 - T[l]) / (T[i] - T[l]);
+        inherited += std::fabs(w) * (i == 0 ? current_error_ : history_error_[static_cast<std::size_t>(i - 1)]);
+      }
+      each([&](Index j, double& e) {
+        const double v0 = q[j];
+        if (terms == 0) return v0;
+        const double d01 = (v0 - xs[0][j]) * i01;
+        double p = v0, next = w1 * d01;
+        if (terms >= 2) {
+          const double d12 = (xs[0][j] - xs[1][j]) * i12;
+          const double d012 = (d01 - d12) * i02;
+          p += w1 * d01, next = w2 * d012;
+          if (terms >= 3) {
+            const double d23 = (xs[1][j] - xs[2][j]) * i23;
+            const double d123 = (d12 - d23) * i13;
+            p += w2 * d012, next = w3 * (d012 - d123) * i03;
+          }
+        }
+        if (estimated) e = next;
+        else p += next;  // the highest term is the prediction's own, with no estimate beyond it
+        return p;
+      });
+      extrapolated_ = order > 0;
+      break;
+    }
+    case Predictor::kHermite: {
+      // Hermite divided differences over the nodes tc, tc, t_0, t_1, t_2 (f[tc] = q, f[tc, tc] = q̇): the cubic
+      // through the current row (position and velocity) and the two rows before, and its next term as the error
+      const double* v = current_.qd.data();
+      const int order = std::min(3, k + 1);  // Newton terms after q: (t − tc) q̇, then one per row of history
+      estimated = k > 2;
+      const int terms = order + (estimated ? 1 : 0);
+      const Nodes nd = nodes();
+      const double* T = nd.T;
+      const double* const* xs = nd.xs;
+      const double i01 = nd.i01, i12 = nd.i12, i23 = nd.i23, i02 = nd.i02, i13 = nd.i13, i03 = nd.i03;
+      const double w1 = h, w2 = w1 * h, w3 = w2 * (t1 - T[1]), w4 = w3 * (t1 - T[2]);
+      // Each term as a function of the positions q, q_0, q_1, q_2 (and q̇), so that the rows' own errors carry
+      // over with the weights the prediction gives them: found by evaluating it on unit values.
+      auto eval = [&](const double* f, double fd, double* next) {
+        double p = f[0] + w1 * fd, nx = 0.0;
+        if (terms >= 2) {
+          const double a1 = (f[0] - f[1]) * i01;  // f[tc, t_0]
+          const double b0 = (fd - a1) * i01;      // f[tc, tc, t_0]
+          double add = w2 * b0;
+          if (terms >= 3) {
+            const double a2 = (f[1] - f[2]) * i12;  // f[t_0, t_1]
+            const double b1 = (a1 - a2) * i02;      // f[tc, t_0, t_1]
+            const double c0 = (b0 - b1) * i02;      // f[tc, tc, t_0, t_1]
+            p += add, add = w3 * c0;
+            if (terms >= 4) {
+              const double a3 = (f[2] - f[3]) * i23;  // f[t_1, t_2]
+              const double b2 = (a2 - a3) * i13;      // f[t_0, t_1, t_2]
+              const double c1 = (b1 - b2) * i03;      // f[tc, t_0, t_1, t_2]
+              const double d0 = (c0 - c1) * i03;      // f[tc, tc, t_0, t_1, t_2]
+              p += add, add = w4 * d0;
+            }
+          }
+          if (estimated) nx = add;
+          else p += add;  // the highest term is the prediction's own, with no estimate beyond it
+        }
+        if (next) *next = nx;
+        return p;
+      };
+      inherited = 0.0;
+      for (int i = 0; i <= std::min(k, 2); ++i) {
+        double unit[4] = {0.0, 0.0, 0.0, 0.0};
+        unit[i] = 1.0;
+        inherited += std::fabs(eval(unit, 0.0, nullptr)) *
+                     (i == 0 ? current_error_ : history_error_[static_cast<std::size_t>(i - 1)]);
+      }
+      each([&](Index j, double& e) {
+        const double f[4] = {q[j], xs[0][j], xs[1][j], xs[2][j]};
+        return eval(f, v[j], &e);
+      });
+      extrapolated_ = true;
+      break;
+    }
+    case Predictor::kLinear: {
+      const double* v = current_.qd.data();
+      estimated = k > 0;
+      const double c = estimated ? 0.5 * h * h / (tc - th(0)) : 0.0;
+      const double* v0 = estimated ? x(0) : v;
+      each([&](Index j, double& e) {
+        e = c * (v[j] - v0[j]);  // h²/2 q̈, q̈ from the last two q̇
+        return q[j] + h * v[j];
+      });
+      extrapolated_ = true;
+      break;
+    }
+    case Predictor::kQuadratic:
+    case Predictor::kCubic: {
+      const double* v = current_.qd.data();
+      const double* a = current_.qdd.data();
+      const bool cubic = predictor_ == Predictor::kCubic && k > 0;
+      estimated = k > (cubic ? 1 : 0);
+      const double hh = 0.5 * h * h, h3 = h * h * h / 6.0;
+      const double dt0 = k > 0 ? tc - th(0) : 1.0, i_dt0 = 1.0 / dt0;
+      const double i_dt1 = k > 1 ? 1.0 / (th(0) - th(1)) : 1.0;
+      const double* a0 = k > 0 ? x(0) : a;
+      const double* a1 = k > 1 ? x(1) : a;
+      // cubic: q⃛ ≈ (q̈ − q̈_0) / (tc − t_0), which errs by (tc − t_0)/2 q⁗; with the Taylor remainder the
+      // prediction errs by h³ (h/24 + (tc − t_0)/12) q⁗, q⁗ ≈ 2 q̈[tc, t_0, t_1] (Newton's divided difference)
+      const double ce = h * h * h * (h / 24.0 + dt0 / 12.0) * 2.0 / (tc - (k > 1 ? th(1) : tc - 1.0));
+      each([&](Index j, double& e) {
+        double p = q[j] + h * v[j] + hh * a[j];
+        if (k > 0) {
+          const double jerk = (a[j] - a0[j]) * i_dt0;
+          if (cubic) {
+            p += h3 * jerk;
+            if (estimated) e = ce * (jerk - (a0[j] - a1[j]) * i_dt1);
+          } else {
+            e = h3 * jerk;
+          }
+        }
+        return p;
+      });
+      extrapolated_ = true;
+      break;
+    }
+    case Predictor::kAuto: break;
+  }
+  // The prediction is as far from the solution as the rows it extrapolates (how well each was solved) plus the
+  // extrapolation's own error; accepted without a Newton step, its error becomes the next row's to carry. So the
+  // error budget adds up over steps taken without Newton until it exceeds the tolerance, and a step resets it.
+  newton_.start_error = estimated ? inherited + worst.worst : INFINITY;
+}
+
+}  // namespace detail
+
+}  // namespace phiq

@@ -1,0 +1,127 @@
+// run_sweep(): a sweep's checks of its options and time domain, the assembly and row 0, the choice between the
+// drive steps in order (Run::sequential) and in parallel chunks (parallel_sweep.cpp) with the threads and chunk size
+// that fit (resources.hpp), and the summary's work counters and time. The task arena that keeps the sweep on
+// its threads is made here.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <tbb/info.h>
+#include <tbb/task_arena.h>
+
+#include "phiq/sweep.hpp"
+#include "phiq/text.hpp"
+#include "sweep/parallel_sweep.hpp"
+#include "sweep/resources.hpp"
+#include "sweep/sweep_run.hpp"
+#include "sweep/sweeper.hpp"
+#include "sweep/time_grid.hpp"
+#include "sweep/warning_stretches.hpp"
+
+namespace phiq {
+
+namespace {
+
+using detail::add_counters;
+using detail::Run;
+using detail::Sweeper;
+
+// run_sweep's body, run inside a task arena of `threads` (run_sweep's count: opt.threads, or all cores for 0).
+SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspace& ws,
+                           const std::function<bool(const StepView&)>& on_step, SweepSummary* summary,
+                           int threads) {
+  if (&ws.model() != &model) throw Error("workspace was made for another model");
+  if (opt.steps < 0) throw Error("SweepOptions: steps must be >= 0");
+  if (!std::isfinite(opt.t_begin) || !std::isfinite(opt.t_end)) throw Error("SweepOptions: times must be finite");
+  if (const std::string why = detail::time_grid_problem(opt.t_begin, opt.t_end, opt.steps); !why.empty())
+    throw Error("SweepOptions: " + why);
+  if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
+  if (opt.row_buffer_bytes == 0) throw Error("SweepOptions: row_buffer_bytes must be > 0");
+  if (opt.max_subdivisions < 0) throw Error("SweepOptions: max_subdivisions must be >= 0");
+  const std::vector<Predictor>& predictors = all_predictors();
+  if (std::find(predictors.begin(), predictors.end(), opt.predictor) == predictors.end())
+    throw Error("SweepOptions: predictor is not a Predictor");
+  detail::check_newton_options(opt.assembly, "SweepOptions::assembly");
+  detail::check_newton_options(opt.newton, "SweepOptions::newton");
+  for (const OutputPoint& p : opt.points)
+    if (p.max_coordinate() >= model.num_coordinates())
+      throw Error("SweepOptions: output point '" + p.name + "' reads a coordinate the model does not have");
+  SweepSummary local;
+  SweepSummary& sum = summary ? *summary : local;
+  sum = SweepSummary{};
+  const auto start = std::chrono::steady_clock::now();
+  const WorkCounters before = ws.counters;
+  WorkCounters others;  // work done in the seeding and chunk workspaces
+  // Work done in the caller's workspace between these two counts is counted in `others` already (the parallel
+  // part's chunks and seeds): left out of the workspace's share.
+  WorkCounters counted_begin{}, counted_end{};
+  auto done = [&](SolveStatus st) {
+    detail::once_per_stretch(sum.warnings, "slow_convergence", opt);
+    sum.status = st;
+    sum.counters = others;
+    add_counters(sum.counters, ws.counters, before);
+    add_counters(sum.counters, counted_begin, counted_end);  // − (counted_end − counted_begin)
+    sum.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return st;
+  };
+
+  const double lo = std::min(opt.t_begin, opt.t_end), hi = std::max(opt.t_begin, opt.t_end);
+  if (lo < model.time_domain_begin() || hi > model.time_domain_end()) {
+    const double bad = lo < model.time_domain_begin() ? lo : hi;
+    sum.failed_step = lo < model.time_domain_begin() ? (opt.t_begin <= opt.t_end ? 0 : opt.steps)
+                                                     : (opt.t_begin <= opt.t_end ? opt.steps : 0);
+    sum.failed_time = bad;
+    sum.message = "t = " + format_time(bad) + ": driver '" + model.time_domain_limiter() + "' is defined on [" +
+                  format_time(model.time_domain_begin()) + ", " + format_time(model.time_domain_end()) +
+                  "] only; the sweep runs over [" + format_time(lo) + ", " + format_time(hi) + "]";
+    return done(SolveStatus::kOutsideTimeDomain);
+  }
+
+  Run run{opt, on_step, sum};
+  run.h = opt.steps > 0 ? (opt.t_end - opt.t_begin) / static_cast<double>(opt.steps) : 0.0;
+  Sweeper sw(model, opt, ws, sum);
+  if (!sw.assemble(run.time_of(0))) {
+    run.failed(0);
+    return done(sum.status);
+  }
+  sw.row_outputs();
+  if (!run.deliver(0, sw.state().q, sw.state().qd, sw.state().qdd, sw.point_motions(), ws.phi, sw.rcond(),
+                   sw.det_sign(), sw.det_sign_time())) {
+    sw.leave_state_in_workspace();
+    return done(sum.status);
+  }
+
+  if (opt.threads == 0 && threads > 1 && ws.lu && opt.steps > 0)
+    threads = detail::threads_that_fit(opt, ws, threads, run.time_of(0), sum.warnings);
+  const detail::HeldRows rows = detail::held_rows(model, opt, static_cast<bool>(on_step));
+  Index chunk = opt.chunk_steps;
+  if (chunk == 0)
+    chunk = detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows, ws.lu != nullptr,
+                                          run.time_of(0), threads, sum.warnings);
+  const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
+  if (threads <= 1 || n_chunks < 2 || !ws.lu) {
+    run.sequential(sw, ws, 1);
+    sw.leave_state_in_workspace();
+    return done(sum.status);
+  }
+
+  detail::parallel_sweep(model, opt, ws, run, sw, rows, chunk, n_chunks, threads, others, counted_begin,
+                         counted_end);
+  return done(sum.status);
+}
+
+}  // namespace
+
+SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws,
+                      const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
+  if (opt.threads < 0) throw Error("SweepOptions: threads must be >= 0 (0: all cores)");
+  // Everything the sweep runs, the model's parallel evaluation of large models included, stays on its threads:
+  // threads = 1 is one thread.
+  const int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
+  tbb::task_arena arena(threads);
+  return arena.execute([&] { return sweep_in_arena(model, opt, ws, on_step, summary, threads); });
+}
+
+}  // namespace phiq

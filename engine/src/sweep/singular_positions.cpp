@@ -1,0 +1,202 @@
+// Singular positions, where Φq loses rank: a bifurcation the sweep passes (Sweeper::singular_point() reports the
+// branch's own velocity, extrapolated from both sides, with a warning), a model singular all along its motion
+// (singular_throughout()), and a dead point, where the drive cannot go on (dead_point(), lined_up_equations():
+// which equations line up there). Apart from the step loop (sweeper.cpp) because they run only where Φq is
+// singular or a step has failed.
+#include "sweep/sweeper.hpp"
+
+#include <iomanip>
+
+#include "phiq/assembly.hpp"
+#include "phiq/text.hpp"
+
+namespace phiq::detail {
+
+// Why Φq stays singular on both sides of the singular position qs at t: the model is short of drivers or
+// constraints all along its motion (": redundant or missing constraints"), or the position is singular by itself,
+// several loops folded or aligned at once and kept so by the drive (nfourbar started folded: every coupler on
+// its neighbour's crank, the far loops staying so as crank 0 turns), which a solution assembled near it, fully
+// driven, tells (detail::driven_dof_nearby).
+std::string Sweeper::singular_throughout(const Eigen::VectorXd& qs, double t) {
+  const Index nearby = detail::driven_dof_nearby(model_, qs, t, assembly_options(opt_.newton));
+  if (nearby > 0) return ": redundant or missing constraints";
+  if (nearby < 0)
+    return ": redundant or missing constraints, or several loops folded or aligned at once (no solution near it "
+           "was assembled to tell which)";
+  return std::string(" on the branch the drive follows from there, though a solution near it is regular: the "
+                     "position is singular, several loops folded or aligned at once, rather than the model short "
+                     "of drivers or constraints") +
+         (has_current_ ? "" : "; start the drive off it");
+}
+
+// Φq is singular at the converged position ws.q at t (rcond below kSingularRcond, or a zero pivot): a
+// bifurcation, where branches of the motion cross and the mechanism momentarily gains degrees of freedom
+// (nfourbar at its horizontal positions, a change-point four-bar). The velocity there is not unique, and the
+// LU's answer is rounding noise in the directions Φq no longer constrains. The branch the sweep follows has its
+// own velocity, the limit from both sides: reported is the Richardson extrapolation of the symmetric means of
+// the derivatives at t ± δ and t ± 2δ (δ = 5 % of the step, all four regular), which differs from that limit
+// by O(δ⁴), with a warning. The plus side is reached straight through from the minus side, so the sweep keeps
+// its branch. When there is no
+// position beyond (a dead point: the drive cannot go on) or the sides are singular too (the model is singular
+// on an interval: redundant or missing constraints), the step fails with that diagnosis.
+// `have_position`: false when Newton could not converge at t itself (a zero pivot exactly at the singular
+// point); the position is then extrapolated the same way, to O(δ⁴), and checked against the tolerance.
+bool Sweeper::singular_point(double t, double rc, bool have_position) {
+  struct Guard {
+    bool& b;
+    ~Guard() { b = false; }
+  } guard{bracketing_ = true};
+  const Eigen::VectorXd qs = ws_->q;
+  // named now, from Φq factorised at the singular position itself, in case it is a dead point
+  const std::string lined_up = ws_->has_factorization ? lined_up_equations() : "";
+  double step = has_current_ ? t - current_.t : default_step_;
+  if (step == 0.0) step = 1e-3;
+  const double d = 0.05 * step;
+  // Four regular points t − 2δ, t − δ, t + δ, t + 2δ, each predicted from the one before (the first from the
+  // last state of the sweep), so the plus side is reached straight through the singular point.
+  const double offset[4] = {-2 * d, -d, d, 2 * d};
+  State side[4];
+  LinearSummary ls;
+  PositionSummary ps;
+  // The sides are solved to rounding level: their derivatives divide O(δ) quantities by Φq's smallest
+  // singular value, O(δ), so a position error ε_q becomes a velocity error ε_q/δ (and worse in q̈).
+  NewtonOptions tight = opt_.newton;
+  tight.tolerance = std::max(1e-4 * opt_.newton.tolerance, 1e-15);
+  tight.known_to = 0.0;  // a level in units of the sweep's tolerance: not this one's, and these reach rounding
+  tight.jacobian_update = JacobianUpdate::kEveryIteration;
+  tight.max_iterations = std::max(tight.max_iterations, 30);
+  for (int k = 0; k < 4; ++k) {
+    const double ts = t + offset[k];
+    if (k == 0) {
+      if (has_current_) {
+        predict(ts);
+      } else {
+        // The sweep starts at the singular position: no past motion tells the branch, and Newton cannot
+        // start from a singular Φq. The assembly (least squares, then the solution nearest the placement)
+        // finds the side's position nearest the start.
+        ws_->q = qs;
+        AssemblyOptions ao;
+        ao.tolerance = opt_.newton.tolerance;
+        // Newton (regular at ts) finishes from wherever the assembly got, converged or not. Known limit: on
+        // a chain of N loops all flat at once (nfourbar starting at θ = 0), the least-squares steps move the
+        // far cranks off the flat position one loop per iteration, so beyond N ≈ 90 the start is not resolved
+        // and the sweep stops at t0 with the diagnosis.
+        AssemblySummary as;
+        phiq::assemble(model_, ts, ao, ws_->q, &as);
+        if (!ws_->q.allFinite()) {
+          ws_->q = qs;
+          return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " +
+                                                          format_time(t) + "), and no position near it at t = " +
+                                                          format_time(ts) + " was found: " + as.message);
+        }
+      }
+    } else {
+      const double h = offset[k] - offset[k - 1];
+      ws_->q = side[k - 1].q + h * side[k - 1].qd + (0.5 * h * h) * side[k - 1].qdd;
+    }
+    SolveStatus st = solve_position(model_, ts, tight, *ws_, &ps);
+    const bool position_found = st == SolveStatus::kSuccess;
+    if (position_found) st = lu_derivatives(ts, true, &ls);
+    if (st != SolveStatus::kSuccess || ls.rcond < kSingularRcond) {
+      ws_->q = qs;
+      std::ostringstream m;
+      m << "singular position at t = " << format_time(t) << " (Φq rcond " << rc << "): ";
+      // (a side whose position was found but whose velocity solve met a zero pivot is singular too)
+      const bool side_singular =
+          position_found && (st == SolveStatus::kSuccess || st == SolveStatus::kSingularJacobian);
+      if (k >= 2 && !position_found)
+        m << "no position beyond it on this branch (a dead point: the drive cannot go on, and the speed it asks "
+             "for there is unbounded)"
+          << (lined_up.empty() ? "" : ", where these equations line up:" + lined_up);
+      else if (side_singular)
+        m << "Φq stays singular around it (rcond " << ls.rcond << " at t = " << format_time(ts) << ")"
+          << singular_throughout(qs, t);
+      else
+        m << "the branch cannot be followed to it: " << (position_found ? ls.message : ps.message);
+      return fail(SolveStatus::kSingularJacobian, m.str());
+    }
+    side[k].t = ts, side[k].q = ws_->q, side[k].qd = ws_->qd, side[k].qdd = ws_->qdd;
+  }
+  // Symmetric means over ±δ and ±2δ, combined by Richardson extrapolation: the branch's value at t to O(δ⁴).
+  auto at_t = [&](const Eigen::VectorXd State::*x) -> Eigen::VectorXd {
+    return (2.0 / 3.0) * (side[1].*x + side[2].*x) - (1.0 / 6.0) * (side[0].*x + side[3].*x);
+  };
+  ws_->q = have_position ? qs : at_t(&State::q);
+  if (!have_position) {
+    model_.residual(ws_->q.data(), t, ws_->phi.data());
+    ++ws_->counters.residual_evaluations;
+    if (!(scaled_residual(model_, ws_->phi) <= opt_.newton.tolerance)) {
+      std::ostringstream m;
+      m << "singular position at t = " << format_time(t) << ": Newton meets a zero pivot there, and the position "
+        << "interpolated from t ± " << d << " misses the tolerance (residual " << scaled_residual(model_, ws_->phi)
+        << ")";
+      return fail(SolveStatus::kSingularJacobian, m.str());
+    }
+  }
+  ws_->qd = at_t(&State::qd);
+  if (need_a_) ws_->qdd = at_t(&State::qdd);
+  ++sum_.singular_positions;
+  singular_row_ = true;
+  std::ostringstream m;
+  m.precision(3);
+  m << (has_current_ ? "bifurcation passed" : "the sweep starts at a bifurcation")
+    << ": Φq is singular here (rcond " << rc
+    << "), so the velocity is not unique; reported is the branch's own (extrapolated from t ± " << d
+    << " and t ± " << 2 * d << ")"
+    << (has_current_ ? ", and the sweep kept the branch it was on"
+                     : "; the branch followed is the one nearest the placement");
+  sum_.warnings.push_back({t, "bifurcation", m.str()});
+  note_min_rcond(t, rc);
+  ill_conditioned_ = false;
+  // The factorisation left is of a side, next to the singular position: a poor Newton matrix for the next step,
+  // whose contraction the last solves (full Newton, to rounding level) did not measure. The next step factorises.
+  ws_->has_factorization = false;
+  return true;
+}
+
+// Why the sweep cannot go on from the last converged state (current_) towards t1, when it is a dead point (a
+// turning point of the motion: the drive asks for positions that do not exist): Φq is near-singular there and
+// the speed grows like 1/√(t* − t). Then q̈ ≈ q̇ / (2 (t* − t)) along q̇, so t* − t ≈ |q̇|² / (2 q̇·q̈), and the
+// equations that line up are the support of Φq's left near-null vector, found by inverse iteration on Φqᵀ
+// with the LU. Returns "" when the last state does not look like one (then the cause is left open).
+std::string Sweeper::dead_point(double t1) {
+  ws_->q = current_.q;
+  LinearSummary ls;
+  if (lu_derivatives(current_.t, true, &ls, /*just_solved=*/false) != SolveStatus::kSuccess) return "";
+  const double vv = ws_->qd.squaredNorm(), va = ws_->qd.dot(ws_->qdd);
+  const double tau = va != 0.0 ? vv / (2.0 * va) : 0.0;  // t* − t, signed like the drive direction
+  if (!(std::isfinite(tau) && tau * (t1 - current_.t) > 0 && std::fabs(tau) <= 2.0 * std::fabs(t1 - current_.t)))
+    return "";
+  const std::string lined_up = lined_up_equations();
+  if (lined_up.empty()) return "";
+  std::ostringstream s;
+  s.precision(6);
+  s << "a dead point near t = " << current_.t + tau << " (the drive asks for positions that do not exist; Φq rcond "
+    << std::setprecision(2) << ls.rcond << " at t = " << std::setprecision(10) << current_.t
+    << ", speed growing as 1/√(t* − t)), where these equations line up:" << lined_up;
+  return s.str();
+}
+
+// " 'crank', 'coupler'": the equations in the support of the left near-null vector of the near-singular Φq
+// factorised in ws.lu (inverse iteration on Φqᵀ, 4 solves), up to 8 named; "" when a solve fails.
+std::string Sweeper::lined_up_equations() {
+  const Index m = model_.num_solve_rows();
+  Eigen::VectorXd y = Eigen::VectorXd::Ones(m), z(m);
+  for (int it = 0; it < 4; ++it) {
+    if (!ws_->lu->solve_transposed(y.data(), z.data()) || !z.allFinite()) return "";
+    y = z / z.cwiseAbs().maxCoeff();
+  }
+  std::vector<std::string> names;
+  for (Index i = 0; i < m; ++i) {
+    if (std::fabs(y[i]) < 0.05) continue;
+    const Index row = model_.dropped_rows().empty() ? i : model_.solve_rows()[static_cast<std::size_t>(i)];
+    const std::string name = model_.row_name(row);
+    if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  }
+  std::ostringstream s;
+  for (std::size_t k = 0; k < names.size() && k < 8; ++k) s << (k ? ", '" : " '") << names[k] << "'";
+  if (names.size() > 8) s << " and " << names.size() - 8 << " more";
+  return s.str();
+}
+
+}  // namespace phiq::detail

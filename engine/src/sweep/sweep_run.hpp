@@ -1,0 +1,103 @@
+// The bookkeeping of one run of a sweep that the sequential path (run_sweep.cpp) and the parallel one
+// (parallel_sweep.cpp) share: the time grid, the delivery of rows in order (with the bifurcation check between
+// them), a failed step's message, the drive steps in order, and the sum of work counters. Defined in the header,
+// so that both paths may inline deliver() and sequential(), which run on every row.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "phiq/sweep.hpp"
+#include "phiq/text.hpp"
+#include "sweep/sweeper.hpp"
+
+namespace phiq::detail {
+
+// The per-run bookkeeping shared by the sequential and parallel paths.
+struct Run {
+  const SweepOptions& opt;
+  const std::function<bool(const StepView&)>& on_step;
+  SweepSummary& sum;
+  double h = 0.0;
+
+  // t_k computed from k, not accumulated, so that the last point is t_end exactly (steps = 0: one row, at t_begin)
+  double time_of(Index k) const {
+    return k == opt.steps && k > 0 ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
+  }
+  // Sign of det Φq at the last delivered regular row whose sign is known, its time, and whether a singular row
+  // (bracketed, with its own warning) was delivered since.
+  Orientation last_sign{0, 0};
+  double last_sign_t = 0.0;
+  bool singular_since = false;
+
+  // Delivers row k; false when the caller stops the sweep (status and message set). A change of det Φq's sign
+  // since the last regular row is a singular position passed between the two: warned here, in row order, so that
+  // sequential and parallel sweeps report it alike.
+  bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
+               const PointMotion* points, const Eigen::VectorXd& phi, double rcond, Orientation det_sign,
+               double det_sign_t) {
+    if (det_sign.sign == 0) {
+      singular_since = true;
+    } else if (det_sign.sign != kSignUnknown) {
+      // (a change between two steps of a sweep that solves velocities was found at the finest sub-step: no branch
+      // was left there)
+      if (last_sign.sign != 0 && det_sign != last_sign && !singular_since)
+        sum.warnings.push_back(
+            {time_of(k), "bifurcation",
+             std::string(det_sign.sign != last_sign.sign
+                             ? "det Φq changed sign"
+                             : "the determinants of an even number of Φq's diagonal blocks (loops that Φq factorises "
+                               "one by one) changed sign, det Φq's not,") +
+                 " between t = " + format_time(last_sign_t) + " and t = " + format_time(det_sign_t) +
+                 ": the motion passed a singular position there (a bifurcation, where branches cross); the sweep "
+                 "kept the branch it was on"});
+      last_sign = det_sign;
+      last_sign_t = det_sign_t;
+      singular_since = false;
+    }
+    StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
+                  points, opt.residuals ? &phi : nullptr, opt.condition ? rcond : 0.0};
+    ++sum.steps_completed;
+    if (on_step && !on_step(view)) {
+      sum.status = SolveStatus::kCancelled;
+      sum.message = "stopped by the caller after step " + std::to_string(k);
+      return false;
+    }
+    return true;
+  }
+  // A failed step: the summary names the step, its grid time and the cause (already in sum.message).
+  void failed(Index k) {
+    sum.failed_step = k;
+    sum.failed_time = time_of(k);
+    sum.message = "step " + std::to_string(k) + ", t = " + format_time(time_of(k)) + ": " + sum.message;
+  }
+  // Steps k0 … steps in order with `sw`, whose state in ws is row k0 − 1. False on failure or cancellation.
+  bool sequential(Sweeper& sw, Workspace& ws, Index k0) {
+    for (Index k = k0; k <= opt.steps; ++k) {
+      if (!sw.advance(time_of(k), 0)) {
+        failed(k);
+        return false;
+      }
+      sw.row_outputs();
+      const State& s = sw.state();
+      if (!deliver(k, s.q, s.qd, s.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign(), sw.det_sign_time()))
+        return false;
+    }
+    return true;
+  }
+};
+
+// Adds the work counted in `now` since `before` to `into`.
+inline void add_counters(WorkCounters& into, const WorkCounters& now, const WorkCounters& before) {
+  into.newton_iterations += now.newton_iterations - before.newton_iterations;
+  into.residual_evaluations += now.residual_evaluations - before.residual_evaluations;
+  into.jacobian_evaluations += now.jacobian_evaluations - before.jacobian_evaluations;
+  into.factorizations += now.factorizations - before.factorizations;
+  into.velocity_solves += now.velocity_solves - before.velocity_solves;
+  into.acceleration_solves += now.acceleration_solves - before.acceleration_solves;
+  into.phi_t_evaluations += now.phi_t_evaluations - before.phi_t_evaluations;
+  into.gamma_evaluations += now.gamma_evaluations - before.gamma_evaluations;
+  into.point_evaluations += now.point_evaluations - before.point_evaluations;
+}
+
+}  // namespace phiq::detail

@@ -1,0 +1,192 @@
+// The sequential sweep's step loop: a Sweeper's construction, one drive step (advance(): predict, solve, check the
+// branch, subdivide on failure) and the bookkeeping of a converged row (converged(), remember()). The predictor
+// formulas it calls are in predictors.cpp, the singular-position checks in singular_positions.cpp.
+#include "sweep/sweeper.hpp"
+
+#include "phiq/text.hpp"
+#include "sweep/predictors.hpp"
+
+namespace phiq::detail {
+
+Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum)
+    : model_(m), opt_(o), ws_(&ws), sum_(sum) {
+  need_v_ = o.velocities || o.accelerations;  // q̈ needs q̇
+  need_a_ = o.accelerations;
+  // With velocities every step factorises at its solution: Φq there comes with the residual that accepts it.
+  newton_ = o.newton;
+  newton_.jacobian_with_residual = o.newton.jacobian_with_residual || need_v_;
+  predictor_ = effective_predictor(o.predictor, need_v_, need_a_);
+  if (predictor_needs_accelerations(predictor_) && !need_a_)
+    throw Error(std::string("the ") + to_string(predictor_) +
+                " predictor needs accelerations (SweepOptions::accelerations)");
+  if (predictor_needs_velocities(predictor_) && !need_v_)
+    throw Error(std::string("the ") + to_string(predictor_) + " predictor needs velocities (SweepOptions::velocities)");
+  // The rows before the current one that the predictor extrapolates from, and one more for its error estimate.
+  depth_ = predictor_history_depth(predictor_);
+  // Every buffer the states rotate through has the workspace's size from the start, so that a swap never hands
+  // the workspace an empty vector.
+  const Index n = model_.num_coordinates();
+  history_.assign(static_cast<std::size_t>(depth_), Eigen::VectorXd::Zero(n));
+  history_t_.resize(static_cast<std::size_t>(depth_));
+  history_error_.resize(static_cast<std::size_t>(depth_));
+  current_.q = Eigen::VectorXd::Zero(n);
+  if (need_v_) current_.qd = Eigen::VectorXd::Zero(n);
+  if (need_a_) current_.qdd = Eigen::VectorXd::Zero(n);
+}
+
+// From the converged state at current_.t to t1, subdividing on failure. current_ (and the history) change only
+// on success, so a failed attempt restores from them without copying any state on the way.
+bool Sweeper::advance(double t1, int depth) {
+  predict(t1);
+  newton_.known_to = std::max(opt_.newton.known_to, known_to_);  // the caller's as a floor
+  PositionSummary ps;
+  SolveStatus st = solve_position(model_, t1, newton_, *ws_, &ps);
+  // (a start accepted without a Newton step is the prediction itself: nothing moved off it)
+  if (st == SolveStatus::kSuccess && depth < opt_.max_subdivisions && ps.iterations > 0 && jumped()) {
+    // Newton went much farther than the step itself: it has left the branch (near a toggle or a bifurcation
+    // a coarse step can land in the other branch's basin). Retried as half steps, as a failure is.
+    st = SolveStatus::kNotConverged;
+    ps.message = "Newton moved off the predicted path (another branch?)";
+  }
+  if (st == SolveStatus::kSuccess) {
+    bool left_branch = false;
+    if (converged(t1, ps, depth < std::min(kBranchCheckDepth, opt_.max_subdivisions) ? &left_branch : nullptr))
+      return true;
+    if (!left_branch) return false;
+    // det Φq changed sign between two regular positions: the step crossed a singular position, or Newton landed
+    // on another branch (a Cardan joint near its singular angle swings its output shaft so fast that the
+    // extrapolation lands nearer the mode turned by π). Half steps tell them apart: they follow the branch, and
+    // a crossing stays between two of them. It is accepted at the second level of halving, with a warning:
+    // bisecting on towards it would only feed the predictor positions next to a singular Φq, whose q̈ are
+    // rounding noise.
+    st = SolveStatus::kNotConverged;
+    ps.message = "det Φq changed sign with Φq regular at both ends (another branch?)";
+  }
+  if (st == SolveStatus::kSingularJacobian && has_current_ && !bracketing_) {
+    // a zero pivot exactly at a singular position: bracket it (position interpolated from both sides)
+    if (singular_point(t1, 0.0, /*have_position=*/false)) {
+      row_error_ = INFINITY;  // interpolated: the next step checks it
+      remember(t1);
+      return true;
+    }
+    ps.message = sum_.message;  // the diagnosis, should the sub-steps fail too
+    sum_.status = SolveStatus::kSuccess, sum_.message.clear();
+    restore();
+  }
+  // Retry as two half steps from the last good state; a singular or non-finite point is not cured by that
+  // unless the sub-steps avoid it, so all statuses are retried.
+  if (depth >= opt_.max_subdivisions) {
+    const std::string why = ps.message;
+    const std::string beyond = "no assembly beyond t = " + format_time(current_.t) + " (sub-steps down to t = " +
+                               format_time(t1) + " tried";
+    if (const std::string undefined = undefined_at(t1); !undefined.empty())
+      return fail(SolveStatus::kNonFinite, beyond + "): " + undefined);
+    if (const std::string conflict = conflicting_redundancy(t1); !conflict.empty())
+      return fail(SolveStatus::kInconsistent, beyond + "): " + conflict);
+    const std::string dead = dead_point(t1);
+    // (a derivative that does not exist says so itself: no guess at another cause)
+    const bool no_derivative = st == SolveStatus::kNonFinite && why.rfind(detail::kNonFiniteJacobian, 0) == 0;
+    return fail(st, beyond +
+                        (no_derivative   ? "): "
+                         : dead.empty() ? ": the drive leaves the reachable range, or the mechanism "
+                                          "passes a singular position): "
+                                        : "): " + dead + "; ") +
+                        why);
+  }
+  restore();
+  ++sum_.subdivisions;
+  const double tm = 0.5 * (current_.t + t1);
+  return advance(tm, depth + 1) && advance(t1, depth + 1);
+}
+
+// A position converged at t: its warning, the derivatives asked for, and it becomes the current state. With
+// `left_branch`, a position where det Φq has the other sign than at the current state (both regular, both
+// factorised at their position) is refused instead, with *left_branch set and nothing of it kept: no warning,
+// no count, no condition noted.
+bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) {
+  struct Noted {
+    std::size_t warnings;
+    Index singular_positions;
+    double min_rcond, min_rcond_time, rounding_level, known_to;
+    bool ill_conditioned;
+  } const noted{sum_.warnings.size(), sum_.singular_positions, sum_.min_rcond, sum_.min_rcond_time,
+                rounding_level_, known_to_, ill_conditioned_};
+  singular_row_ = false;
+  row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
+  rounding_level_ = std::max(rounding_level_, ps.rounding_level);
+  // How well the positions can be known here (NewtonOptions::known_to): the largest rounding level the rows
+  // measured since the last one that converged to the tolerance (a step from a point Newton reached, not the
+  // first step from a prediction, which corrects the prediction's own error too; nor a row that ended within
+  // it). Dropped again as soon as a row converges to the tolerance.
+  known_to_ = ps.rounding_measured                              ? std::max(known_to_, ps.rounding_level)
+              : ps.rounding_level == 0.0 && ps.error_estimate <= 1.0 ? 0.0
+                                                                   : known_to_;
+  if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
+  if (!need_v_ && ps.rcond > 0.0 && ps.rcond < kSingularRcond) {
+    // positions only: nothing is computed from Φq here, but the user is told where the motion branches
+    ++sum_.singular_positions;
+    singular_row_ = true;
+    std::ostringstream m;
+    m.precision(3);
+    m << "singular position (Φq rcond " << ps.rcond << "): a bifurcation, velocities would not be unique here";
+    if (!has_current_) m << " (the sweep starts here: the branch is the one nearest the placement)";
+    sum_.warnings.push_back({t, "bifurcation", m.str()});
+  }
+  if (!position_only_ && !derivatives(t, ps.linear_convergence)) return false;
+  const Orientation sign = sign_at_solution();
+  if (left_branch && has_current_ && sign.regular() && current_sign_.regular() && sign != current_sign_) {
+    sum_.warnings.resize(noted.warnings);
+    sum_.singular_positions = noted.singular_positions;
+    sum_.min_rcond = noted.min_rcond, sum_.min_rcond_time = noted.min_rcond_time;
+    rounding_level_ = noted.rounding_level, known_to_ = noted.known_to, ill_conditioned_ = noted.ill_conditioned;
+    *left_branch = true;
+    return false;
+  }
+  if (ws_->counters.factorizations != factorizations_seen_)  // this step's solves factorised
+    factorizations_seen_ = ws_->counters.factorizations, factorized_step_t_ = t;
+  current_sign_ = sign;
+  // the row's sign: the one at the solution, else (positions only) that of the last factorisation this sweeper
+  // made, at an iterate a few steps back on its own path, so that a change is seen a row or two late rather than
+  // not at all, with the time of the step that made it; never that of a factorisation the workspace held before
+  // (another chunk's, or another sweep's: the sign of another place)
+  const bool own = ws_->counters.factorizations != factorizations_before_;
+  current_row_sign_ = sign.sign != kSignUnknown || !own ? sign : orientation_of(*ws_->lu);
+  current_row_sign_t_ = sign.sign != kSignUnknown ? t : factorized_step_t_;
+  remember(t);
+  return true;
+}
+
+void Sweeper::remember(double t) {
+  // The quantity the predictor extrapolates, at the current row, moves into the history (by buffer swaps: the
+  // oldest entry's buffer becomes current_'s, assigned below without allocating). Only a state that was really
+  // converged enters it (the default-constructed one has no q: found by the fuzzer with a sweep starting away
+  // from t = 0).
+  if (depth_ > 0 && has_current_) {
+    std::rotate(history_.rbegin(), history_.rbegin() + 1, history_.rend());
+    std::rotate(history_t_.rbegin(), history_t_.rbegin() + 1, history_t_.rend());
+    Eigen::VectorXd& x = predictor_ == Predictor::kLinear                                        ? current_.qd
+                         : predictor_ == Predictor::kQuadratic || predictor_ == Predictor::kCubic ? current_.qdd
+                                                                                                 : current_.q;
+    history_[0].swap(x);
+    history_t_[0] = current_.t;
+    std::rotate(history_error_.rbegin(), history_error_.rbegin() + 1, history_error_.rend());
+    history_error_[0] = current_error_;
+    known_ = std::min(known_ + 1, depth_);
+  }
+  has_current_ = true;
+  current_.t = t;
+  current_error_ = row_error_;
+  // The converged state moves into current_ by swaps too: ws keeps the buffers of the state before, which the
+  // next step overwrites (predict() writes q, the solves q̇ and q̈). Rows are delivered from state().
+  current_.q.swap(ws_->q);
+  if (need_v_) current_.qd.swap(ws_->qd);
+  if (need_a_) current_.qdd.swap(ws_->qdd);
+}
+
+void Sweeper::restore() {
+  ws_->q = current_.q;
+  if (need_v_) ws_->qd = current_.qd;
+  if (need_a_) ws_->qdd = current_.qdd;
+}
+
+}  // namespace phiq::detail

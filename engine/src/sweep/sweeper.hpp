@@ -1,0 +1,298 @@
+// Sweeper: the sequential sweep's stepper, which follows one branch of the motion from row to row (its state, the
+// predictor's history, the step subdivision and the singular-position checks), and the state and orientation of Φq
+// it carries. A sweep runs one; a parallel sweep runs one per chunk and one for the seeds (parallel_sweep.cpp).
+// Its members are defined by concept: the step loop in sweeper.cpp, the predictor formulas in predictors.cpp,
+// singular positions and dead points in singular_positions.cpp, the other causes of a failed step in
+// step_failures.cpp. The small members that run on every step are defined here, in the class, so that the step
+// loop inlines them.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "phiq/sweep.hpp"
+#include "solve/kinematics_internal.hpp"
+#include "solve/tolerance_tests.hpp"
+
+namespace phiq::detail {
+
+// A converged row: its time, q, and q̇, q̈ where the sweep solves them.
+struct State {
+  double t = 0.0;
+  Eigen::VectorXd q, qd, qdd;
+};
+
+// A sign of det Φq is ±1 at a regular position and 0 at a singular one; kSignUnknown where no factorisation tells
+// it (positions only, a start accepted from its prediction).
+constexpr int kSignUnknown = 2;
+
+// Which way Φq is oriented at a factorisation: det Φq's sign, and at a regular position the fingerprint of the
+// signs of its diagonal blocks' determinants (SparseLuNumeric::block_signs(): KLU factorises a chain loop by
+// loop). Along a branch it changes exactly where the motion passes a singular position: det Φq's sign alone misses
+// an even number of loops crossing at once (nfourbar of even N through its flat position), the blocks do not.
+struct Orientation {
+  int sign = kSignUnknown;
+  std::uint64_t blocks = 0;
+  bool regular() const { return sign == 1 || sign == -1; }
+  bool operator==(const Orientation& o) const { return sign == o.sign && blocks == o.blocks; }
+  bool operator!=(const Orientation& o) const { return !(*this == o); }
+};
+inline Orientation orientation_of(const SparseLuNumeric& lu) {
+  const int sign = lu.determinant_sign();
+  return {sign, sign == 1 || sign == -1 ? lu.block_signs() : 0};
+}
+
+// Follows one branch of the motion step by step from an assembled or adopted state (see the file comment).
+class Sweeper {
+ public:
+  // Resolves the predictor (effective_predictor) and refuses one whose derivatives the options do not ask for;
+  // sizes every buffer the states rotate through (sweeper.cpp).
+  Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum);
+
+  // Below this reciprocal condition estimate of Φq (KLU: min/max |U_ii|, UMFPACK alike) the position is taken
+  // as singular: a linear solve there loses more than ten digits, so the velocity the LU gives is rounding noise
+  // in the directions Φq no longer constrains. Regular positions of the models in models/ stay above 1e-6 at any
+  // size (nfourbar: 2.5e-4 … 2.5e-6 from N = 10 to 10^5, size-independent); the exactly singular ones of nfourbar
+  // fall to 1e-13.
+  static constexpr double kSingularRcond = 1e-10;
+  // Below this (and above kSingularRcond) the position is near-singular (a toggle position nearby): the results
+  // hold, but with fewer digits; a warning says so, once per stretch of such steps.
+  static constexpr double kIllConditionedRcond = 1e-7;
+  // A step across which det Φq changes sign is halved, and halved again, to see whether the change stays (a
+  // singular position crossed) or goes (another branch reached): see advance().
+  static constexpr int kBranchCheckDepth = 2;
+
+  // Derivatives at the converged ws.q, as asked for. Returns false (summary filled) on failure. At a singular
+  // position they are not unique: see singular_point(). `linear`: Newton converged only linearly to ws.q (its full
+  // steps contracting by ½ or worse), the mark of a singular Φq at the solution. It then stopped within the
+  // tolerance of Φ but only about √tol from the singular position itself (Φ is quadratic along the direction Φq
+  // loses), so rcond stays near √tol, far above kSingularRcond, while q̇ from that Φq is dominated by the position's
+  // error: a row landing on a dead point (a drive range ending where coupler and rocker align) gave |q̇| = 5e6 with
+  // the exact speed unbounded. Such a row, when Φq is also ill-conditioned, is examined as a singular one.
+  bool derivatives(double t, bool linear = false) {
+    if (!need_v_) return true;
+    LinearSummary ls;
+    const SolveStatus st = lu_derivatives(t, need_a_, &ls);
+    if (!bracketing_ && ws_->lu &&
+        (st == SolveStatus::kSingularJacobian ||
+         (st == SolveStatus::kSuccess &&
+          (ls.rcond < kSingularRcond || (linear && ls.rcond < detail::kLinearSingularRcond)))))
+      return singular_point(t, ls.rcond);
+    if (st != SolveStatus::kSuccess) return fail(st, ls.message);
+    note_condition(t, ls.rcond);
+    return true;
+  }
+
+  // The outputs of a delivered row beyond q, q̇, q̈, from the converged state in ws: the listed points' motions
+  // (counted) and the condition estimate (Φ is ws.phi already). Only delivered rows pay for them: sub-steps and
+  // the seam steps of parallel chunks do not.
+  void row_outputs() {
+    const double* qd = need_v_ ? current_.qd.data() : nullptr;
+    const double* qdd = need_a_ ? current_.qdd.data() : nullptr;
+    for (std::size_t i = 0; i < opt_.points.size(); ++i)
+      points_[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
+    ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
+    rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
+    det_sign_ = current_row_sign_;
+    det_sign_t_ = current_row_sign_t_;
+  }
+  // Orientation of Φq at the last delivered row (row_outputs()): sign ±1, 0 at a singular position, kSignUnknown
+  // where no factorisation of this sweeper's tells it; and the time it holds at (det_sign_time(): the row's, or
+  // with positions only that of the step whose Newton factorised last).
+  Orientation det_sign() const { return det_sign_; }
+  double det_sign_time() const { return det_sign_t_; }
+  // The last converged state (q, and q̇, q̈ as computed), which the rows deliver.
+  const State& state() const { return current_; }
+  // Solves with `w` from now on: the state and the history are the sweeper's, a workspace holds only the solves'
+  // scratch and an LU (whichever factorisation it holds is a start for modified Newton, which refreshes it when it
+  // contracts badly). A parallel sweep's seeding pass takes whichever workspace is free for each seed.
+  void bind(Workspace& w) {
+    ws_ = &w;
+    factorizations_before_ = factorizations_seen_ = w.counters.factorizations;
+  }
+  // Moves the last converged state out and frees the history: the sweeper is not used after this.
+  State take_state() {
+    history_.clear(), history_.shrink_to_fit();
+    predicted_ = Eigen::VectorXd();
+    return std::move(current_);
+  }
+  // Leaves the last converged state in the workspace too, as a sweep ends (the caller's workspace ends at the
+  // last delivered row).
+  void leave_state_in_workspace() {
+    if (!has_current_) return;
+    ws_->q = current_.q;
+    if (need_v_) ws_->qd = current_.qd;
+    if (need_a_) ws_->qdd = current_.qdd;
+  }
+  // The largest PositionSummary::rounding_level of the positions converged since the last call (0: none stopped
+  // at the rounding level): how far from the exact solution, in tolerances, they may be.
+  double take_rounding_level() { return std::exchange(rounding_level_, 0.0); }
+  const PointMotion* point_motions() const { return points_.empty() ? nullptr : points_.data(); }
+  double rcond() const { return rcond_; }
+
+  // Records the cause; run_sweep prefixes the step and its grid time (the sub-step time, if any, is in `why`).
+  bool fail(SolveStatus st, const std::string& why) {
+    sum_.status = st;
+    sum_.message = why;
+    return false;
+  }
+
+  // First row of a parallel chunk: the position at t from a seed that solves it (up to the seeding pass's
+  // tolerance), then the derivatives, as any converged step.
+  // `seed_error`: the seed's own estimated error (the seeding pass's PositionSummary::error_estimate; infinite if
+  // unknown), so that a seed found to the tolerance is taken without a Newton step, as a predicted start is. The
+  // seam check (the previous chunk, continued in order, must arrive at this row) guards the chunk either way.
+  bool start_from(double t, const Eigen::VectorXd& seed, double seed_error) {
+    ws_->q = seed;
+    newton_.start_error = seed_error;
+    PositionSummary ps;
+    SolveStatus st = solve_position(model_, t, newton_, *ws_, &ps);
+    if (st != SolveStatus::kSuccess) return fail(st, ps.message);
+    return converged(t, ps);
+  }
+
+  // The estimated error of state().q (units of the tolerance test; infinite when unknown).
+  double state_error() const { return current_error_; }
+  // One more step to t1 for its position only (a parallel chunk's seam, compared with the next chunk's first row):
+  // no derivatives, no outputs.
+  bool advance_position(double t1) {
+    position_only_ = true;
+    const bool ok = advance(t1, 0);
+    position_only_ = false;
+    return ok;
+  }
+
+  // Continues from the converged state in ws (q, and q̇, q̈ where asked for) at t, as if this sweeper had reached
+  // it (the secant predictor's history starts anew).
+  void adopt(double t) {
+    has_current_ = false;
+    known_ = 0;
+    current_sign_ = current_row_sign_ = Orientation{};
+    row_error_ = INFINITY;  // how well the adopted state is known is not said: the next step checks it
+    remember(t);
+  }
+
+  // The LU's q̇ (and q̈) at ws.q: the position the last solve_position converged to (`just_solved`: its factorisation
+  // or Jacobian values are taken as they are, detail::derivatives_at_solution), or any other (the public solves,
+  // which compare points).
+  SolveStatus lu_derivatives(double t, bool accelerations, LinearSummary* ls, bool just_solved = true) {
+    if (just_solved) return detail::derivatives_at_solution(model_, t, *ws_, accelerations, ls);
+    SolveStatus st = solve_velocity(model_, t, *ws_, ls);
+    if (st == SolveStatus::kSuccess && accelerations) st = solve_acceleration(model_, t, *ws_, ls);
+    return st;
+  }
+
+  void note_min_rcond(double t, double rc) {
+    if (sum_.min_rcond == 0.0 || rc < sum_.min_rcond) sum_.min_rcond = rc, sum_.min_rcond_time = t;
+  }
+  void note_condition(double t, double rc) {
+    note_min_rcond(t, rc);
+    const bool ill = rc < kIllConditionedRcond;
+    if (ill && !ill_conditioned_) {
+      std::ostringstream m;
+      m.precision(2);
+      m << "Φq is near-singular (rcond " << rc << " < " << kIllConditionedRcond
+        << "): a toggle or singular position is near; velocities and accelerations keep about "
+        << static_cast<int>(std::floor(std::log10(rc / 2.2e-16))) << " digits";
+      sum_.warnings.push_back({t, "ill_conditioned", m.str()});
+    }
+    ill_conditioned_ = ill;
+  }
+
+  // Initial position problem from the rough placement in ws.q.
+  bool assemble(double t) {
+    SolveStatus st = solve_position(model_, t, opt_.assembly, *ws_, &sum_.assembly);
+    if (st != SolveStatus::kSuccess) return fail(st, "initial assembly failed: " + sum_.assembly.message);
+    return converged(t, sum_.assembly);
+  }
+
+  // One drive step from the current state to t1 (`depth`: how many times it has been halved), subdividing on
+  // failure, with the branch and singular-position checks (sweeper.cpp).
+  bool advance(double t1, int depth);
+
+ private:
+  // A position converged at t becomes the current state (sweeper.cpp).
+  bool converged(double t, const PositionSummary& ps, bool* left_branch = nullptr);
+  // Orientation of Φq at the position just converged (ws.q): from the LU when it was factorised there (velocities
+  // are solved at every row; positions only, when Newton's last factorisation is at the solution), sign 0 at a
+  // singular position, else kSignUnknown.
+  Orientation sign_at_solution() const {
+    if (singular_row_) return {0, 0};
+    if (!ws_->lu || !ws_->has_factorization) return {};
+    const bool at_solution = (need_v_ && !position_only_) || ws_->factorized_at_solution;
+    return at_solution ? orientation_of(*ws_->lu) : Orientation{};
+  }
+  // Whether the converged ws.q is farther from the prediction than the prediction is from the last state (in
+  // tolerance units, beyond a floor of 1000 tolerances): a predictor errs by a higher order of h than the O(h)
+  // move, so a correction as large as the move means another solution was found. Runs every drive step: one pass
+  // for the correction, and one for the move only when the correction is large at all.
+  bool jumped() {
+    if (!extrapolated_) return false;  // the previous position: nothing predicted
+    const double tol = opt_.newton.tolerance;
+    const double correction = detail::scaled_distance(model_, ws_->q.data(), predicted_.data(), ws_->q.data(), tol);
+    if (!(correction > 1000.0)) return false;
+    return correction >
+           0.5 * detail::scaled_distance(model_, predicted_.data(), current_.q.data(), current_.q.data(), tol);
+  }
+
+  // ws.q = the predictor's guess at t1, newton_.start_error = its error estimate (predictors.cpp).
+  void predict(double t1);
+  // The converged state in ws becomes current_, the one before enters the history (sweeper.cpp).
+  void remember(double t);
+  // ws = the current state again, after a failed attempt (sweeper.cpp).
+  void restore();
+
+  // Singular positions (singular_positions.cpp): the branch's own derivatives at one, and why Φq stays singular
+  // around one or no position lies beyond it (a dead point).
+  std::string singular_throughout(const Eigen::VectorXd& qs, double t);
+  bool singular_point(double t, double rc, bool have_position = true);
+  std::string dead_point(double t1);
+  std::string lined_up_equations();
+  // The other causes of a step that failed at every subdivision (step_failures.cpp).
+  std::string undefined_at(double t1);
+  std::string conflicting_redundancy(double t1);
+
+  const Model& model_;
+  const SweepOptions& opt_;
+  Workspace* ws_;  // the workspace the solves use (bind())
+  SweepSummary& sum_;
+  bool need_v_ = false, need_a_ = false;
+  NewtonOptions newton_;  // opt_.newton, with jacobian_with_residual when velocities follow
+  Predictor predictor_;
+  State current_;  // the last converged state
+  bool has_current_ = false;
+  // What the predictor extrapolates from (q for the position predictors, q̇ for linear, q̈ for quadratic and
+  // cubic) at the converged rows before current_, newest first, and their times: depth_ rows, known_ of them valid.
+  std::vector<Eigen::VectorXd> history_;
+  std::vector<double> history_t_;
+  std::vector<double> history_error_;  // the estimated error of q at those rows (units of the tolerance test)
+  int depth_ = 0, known_ = 0;
+  double current_error_ = INFINITY;  // the estimated error of current_.q (PositionSummary::error_estimate)
+  double row_error_ = INFINITY;      // that of the row being converged, until remember() makes it current
+  bool extrapolated_ = false;  // the last prediction moved from current_ (jumped() has something to compare)
+  bool position_only_ = false;  // inside advance_position()
+  std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
+  double rcond_ = 0.0;
+  Eigen::VectorXd predicted_;       // the last prediction (for jumped())
+  bool bracketing_ = false;         // inside singular_point(): no nested bracketing
+  bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
+  Orientation det_sign_{0, 0};      // of Φq at the last delivered row (det_sign())
+  Orientation current_sign_;         // and at current_ (sign_at_solution() when it converged)
+  Orientation current_row_sign_;     // what current_'s row reports (converged()), and at which time
+  double current_row_sign_t_ = 0.0, det_sign_t_ = 0.0;
+  // The workspace's factorisation count when this sweeper took it: the ones after it are its own (converged()).
+  Index factorizations_before_ = ws_->counters.factorizations;
+  Index factorizations_seen_ = factorizations_before_;  // the count at the last converged state
+  double factorized_step_t_ = 0.0;  // the time of the last step whose solves factorised (converged())
+  double rounding_level_ = 0.0;     // see take_rounding_level()
+  double known_to_ = 0.0;           // the rounding level carried to the next solves (converged())
+  bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)
+  double default_step_ = (opt_.t_end - opt_.t_begin) / static_cast<double>(std::max<Index>(opt_.steps, 1));
+};
+
+}  // namespace phiq::detail
