@@ -33,7 +33,7 @@ NameResolver SceneReader::resolver(bool coordinates) const {
 
 // An equation (or law) expression of a family member: compiled once per body, rebound per member. Throws Error.
 std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const TCursor& c, bool allow_time,
-                                                            bool allow_coordinates) const {
+                                                                         bool allow_coordinates) const {
   const std::string& text = c.raw();
   ScalarPlan& plan = c.plan();
   if (!plan.equation) {

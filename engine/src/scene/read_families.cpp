@@ -14,7 +14,7 @@ namespace phiq::detail::scene {
 // Reads the key "for NAME in A..B" of a family: its index and its range, compiled. `path` is the key's field
 // path, `enclosing` the indices of the families around it (outermost first), which the bounds may use.
 FamilyRange SceneReader::parse_range(const std::string& key, const YAML::Mark& key_mark, const std::string& path,
-                        const std::vector<std::string>& enclosing) const {
+                                     const std::vector<std::string>& enclosing) const {
   auto fail = [&](const std::string& what) { fail_at(file_, key_mark, families_.render(path), what); };
   FamilyRange r;
   std::istringstream words(key);
@@ -54,7 +54,7 @@ FamilyRange SceneReader::parse_range(const std::string& key, const YAML::Mark& k
 // The first and last member of a range, for the members of the enclosing families being read (families_);
 // messages point at the family's key (`mark`, `path`). B < A: no member.
 std::pair<std::int64_t, std::int64_t> SceneReader::range_bounds(const FamilyRange& r, const YAML::Mark& mark,
-                                                   const std::string& path) const {
+                                                                const std::string& path) const {
   auto fail = [&](const std::string& what) { fail_at(file_, mark, families_.render(path), what); };
   auto bound = [&](const IndexExpr& e, const std::string& text) -> std::int64_t {
     double v = 0.0;
@@ -72,9 +72,9 @@ std::pair<std::int64_t, std::int64_t> SceneReader::range_bounds(const FamilyRang
 
 // Reads "for NAME in A..B" and copies the body out of the YAML tree. `path` is the key's field path, `enclosing`
 // the indices of the families around it (outermost first), `list` whether the body is a list of items.
-std::shared_ptr<Family> SceneReader::parse_family(const std::string& key, const YAML::Mark& key_mark, const YAML::Node& body,
-                                     const std::string& path, const std::vector<std::string>& enclosing,
-                                     bool list) {
+std::shared_ptr<Family> SceneReader::parse_family(const std::string& key, const YAML::Mark& key_mark,
+                                                  const YAML::Node& body, const std::string& path,
+                                                  const std::vector<std::string>& enclosing, bool list) {
   auto f = std::make_shared<Family>();
   static_cast<FamilyRange&>(*f) = parse_range(key, key_mark, path, enclosing);
   f->key = key, f->path = path, f->mark = key_mark, f->depth = static_cast<int>(enclosing.size());

@@ -154,7 +154,8 @@ Index SceneReader::coordinate(const C& c) const {
 // found) after the last one found, verified by name: families mostly walk their tables in order, and a hash
 // lookup in a table of millions of names costs cache misses.
 template <class C, class Find, class NameAt>
-Index SceneReader::lookup(const C& c, const std::string& name, Index size, const Find& find, const NameAt& name_at) const {
+Index SceneReader::lookup(const C& c, const std::string& name, Index size, const Find& find,
+                          const NameAt& name_at) const {
   if constexpr (kInFamily<C>) {
     ScalarPlan& p = c.plan();
     if (!c.node()->templated) {
