@@ -212,6 +212,7 @@ class TCursor {
   Families* fx_;
 };
 
+// True for a reader instantiated on a family member (the readers are templates over Cursor and TCursor).
 template <class C>
 inline constexpr bool kInFamily = std::is_same_v<C, TCursor>;
 
