@@ -1,0 +1,134 @@
+// The public entry points of the scene loader (phiq/scene.hpp): parse_scene and load_scene. Before the YAML tree
+// is built, ShapeGuard walks the parser's events and refuses what could exhaust memory or stack; then SceneReader
+// (scene_reader.hpp) reads the tree. YAML syntax errors become SceneErrors located in the file.
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "phiq/scene.hpp"
+#include "scene/scene_reader.hpp"
+
+namespace phiq {
+
+namespace {
+
+// First pass over the YAML events, before any node tree is built: refuses what a scene never needs and what
+// could exhaust memory or stack (deep nesting, aliases, several documents, too many nodes, huge values).
+class ShapeGuard final : public YAML::EventHandler {
+ public:
+  ShapeGuard(const std::string& path, const SceneLimits& limits) : path_(path), limits_(limits) {}
+  void OnDocumentStart(const YAML::Mark& m) override {
+    if (++documents_ > 1) fail(m, "a scene is one YAML document (found a second '---')");
+  }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& m, YAML::anchor_t) override { count(m); }
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override {
+    fail(m, "YAML aliases (*name) are not supported in scenes");
+  }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string& value) override {
+    count(m);
+    if (value.size() > limits_.max_scalar_bytes)
+      fail(m, "a value of " + std::to_string(value.size()) + " bytes; the limit is " +
+                  std::to_string(limits_.max_scalar_bytes));
+  }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    enter(m);
+  }
+  void OnSequenceEnd() override { --depth_; }
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    enter(m);
+  }
+  void OnMapEnd() override { --depth_; }
+
+ private:
+  void count(const YAML::Mark& m) {
+    if (++nodes_ > limits_.max_nodes)
+      fail(m, "more than " + std::to_string(limits_.max_nodes) + " values; the scene is too large");
+  }
+  void enter(const YAML::Mark& m) {
+    count(m);
+    if (++depth_ > limits_.max_depth)
+      fail(m, "nested more than " + std::to_string(limits_.max_depth) + " levels deep");
+  }
+  [[noreturn]] void fail(const YAML::Mark& m, const std::string& what) const {
+    throw SceneError(path_ + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1) + ": " + what);
+  }
+  const std::string& path_;
+  const SceneLimits& limits_;
+  int documents_ = 0, depth_ = 0;
+  std::size_t nodes_ = 0;
+};
+
+std::string yaml_error(const std::string& path, const YAML::Exception& e) {
+  std::ostringstream s;
+  s << path;
+  if (e.mark.line >= 0) s << ":" << e.mark.line + 1 << ":" << e.mark.column + 1;
+  s << ": YAML syntax error: " << e.msg;
+  return s.str();
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits) {
+  return parse_scene(text, path, limits, SceneOverrides{});
+}
+
+Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits,
+                  const SceneOverrides& overrides) {
+  if (text.size() > limits.max_file_bytes)
+    throw SceneError(path + ": the scene is " + std::to_string(text.size() >> 20) + " MiB; the limit is " +
+                     std::to_string(limits.max_file_bytes >> 20) + " MiB");
+  if (text.find('\0') != std::string::npos) throw SceneError(path + ": the scene is not text (contains a NUL byte)");
+  try {
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    ShapeGuard guard(path, limits);
+    while (parser.HandleNextDocument(guard)) {
+    }
+  } catch (const YAML::Exception& e) {
+    throw SceneError(yaml_error(path, e));
+  }
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw SceneError(yaml_error(path, e));
+  }
+  detail::scene::SceneReader reader(path, limits);
+  reader.overrides_ = &overrides;
+  Scene scene = reader.read(root);
+  // A predictor that needs derivatives the scene does not output would compute extra work silently: refuse.
+  if (reader.predictor_given()) {
+    const Predictor p = scene.sweep.predictor;
+    if ((predictor_needs_accelerations(p) && !scene.sweep.accelerations) ||
+        (predictor_needs_velocities(p) && !(scene.sweep.velocities || scene.sweep.accelerations)))
+      throw SceneError(path + ": solver.predictor: '" + to_string(p) +
+                       "' needs the derivatives it extrapolates with in the output (velocities / accelerations)");
+  }
+  return scene;
+}
+
+Scene load_scene(const std::string& path, const SceneLimits& limits) {
+  return load_scene(path, limits, SceneOverrides{});
+}
+
+Scene load_scene(const std::string& path, const SceneLimits& limits, const SceneOverrides& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path + ": cannot open the scene file");
+  // size first: a huge file is refused before it is read into memory
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw SceneError(path + ": cannot read the scene file (not a regular file?)");
+  if (static_cast<std::uint64_t>(size) > limits.max_file_bytes)
+    throw SceneError(path + ": the scene is " + std::to_string(size >> 20) + " MiB; the limit is " +
+                     std::to_string(limits.max_file_bytes >> 20) + " MiB");
+  in.seekg(0, std::ios::beg);
+  std::string text(static_cast<std::size_t>(size), '\0');
+  in.read(text.data(), size);
+  if (in.gcount() != size) throw SceneError(path + ": cannot read the scene file");
+  return parse_scene(text, path, limits, overrides);
+}
+
+}  // namespace phiq

@@ -1,0 +1,127 @@
+// The drivers section (scene_reader.hpp): drivers of a coordinate, of an expression, or of a named spatial joint
+// (its angle or its distance), each with its motion law.
+#include "scene/scene_reader.hpp"
+
+namespace phiq::detail::scene {
+
+// {joint: NAME, measure: angle | distance, law}: the rotation of a revolute or cylindrical joint, the
+// translation of a prismatic or cylindrical one.
+template <class C>
+void SceneReader::read_joint_driver(const C& c, const std::string& name, MotionLaw law) {
+  auto j = c.field("joint");
+  if (!spatial_) j.fail("joint drivers need 'dimension: 3' (in the plane, drive a coordinate)");
+  const std::string joint = j.name();
+  auto it = joints3_.find(joint);
+  if (it == joints3_.end()) j.fail("unknown joint '" + joint + "' (a named spatial joint of 'constraints')");
+  const Joint3& J = it->second;
+  std::string measure;
+  if (auto m = c.field("measure"); m.present()) {
+    measure = m.text();
+    if (measure != "angle" && measure != "distance") m.fail("measure is angle or distance");
+  } else if (J.type == "revolute") {
+    measure = "angle";
+  } else if (J.type == "prismatic") {
+    measure = "distance";
+  } else if (J.type == "cylindrical") {
+    c.fail("a cylindrical joint's driver needs 'measure: angle' or 'measure: distance'");
+  }
+  const bool angle_ok = J.type == "revolute" || J.type == "cylindrical";
+  const bool distance_ok = J.type == "prismatic" || J.type == "cylindrical";
+  if ((measure == "angle" && !angle_ok) || (measure == "distance" && !distance_ok) || measure.empty())
+    j.fail("joint '" + joint + "' is a " + J.type + " joint: drivers measure the angle of a revolute or " +
+           "cylindrical joint, or the distance of a prismatic or cylindrical one");
+  if (measure == "angle") {
+    JointAngleDriverSpec d;
+    d.a = J.a, d.b = J.b, d.law = std::move(law);
+    add(c, name, std::move(d));
+  } else {
+    JointDistanceDriverSpec d;
+    d.a = J.a, d.b = J.b, d.law = std::move(law);
+    add(c, name, std::move(d));
+  }
+}
+
+template <class C>
+void SceneReader::read_driver(const C& c) {
+  if (!c.is_map()) c.fail("a driver is a mapping with 'coordinate', 'expr' or 'joint', and a 'law'");
+  c.expect_map({"name", "coordinate", "expr", "unit", "joint", "measure", "law"});
+  std::string name;
+  if (auto n = c.field("name"); n.present()) name = n.name();
+  MotionLaw law = motion_law(c.require("law"));
+  if (!name.empty()) driver_laws_.emplace(name, law);  // for `output: drivers` (shared data: a cheap copy)
+  const bool by_coordinate = c.field("coordinate").present(), by_expr = c.field("expr").present(),
+             by_joint = c.field("joint").present();
+  if (int(by_coordinate) + int(by_expr) + int(by_joint) != 1)
+    c.fail("a driver has one of 'coordinate', 'expr' or 'joint'");
+  if (c.field("measure").present() && !by_joint) c.field("measure").fail("'measure' goes with 'joint'");
+  try {
+    if (by_joint) {
+      if (c.field("unit").present()) c.field("unit").fail("'unit' goes with 'expr' (a joint driver has its own)");
+      read_joint_driver(c, name, std::move(law));
+    } else if (by_coordinate) {
+      if (c.field("unit").present()) c.field("unit").fail("'unit' goes with 'expr' (a coordinate has its own)");
+      add(c, name, CoordinateDriverSpec{Slot::coordinate(coordinate(c.field("coordinate"))), std::move(law)});
+    } else {
+      add(c, name, EquationSpec{compile(c.field("expr"), false), std::move(law), unit(c.field("unit"))});
+    }
+  } catch (const Error& e) {
+    c.fail(e.what());
+  }
+}
+
+template <class C>
+MotionLaw SceneReader::motion_law(const C& c) const {
+  if (!c.is_map()) c.fail("a law is a mapping with a 'type'");
+  const std::string type = c.require("type").text();
+  try {
+    if (type == "linear") {
+      c.expect_map({"type", "initial", "rate"});
+      return MotionLaw::linear(number(c.require("initial")), number(c.require("rate")));
+    }
+    if (type == "polynomial") {
+      c.expect_map({"type", "coefficients"});
+      auto v = numbers(c.require("coefficients"), 0);
+      if (v.empty()) c.require("coefficients").fail("needs at least one coefficient");
+      return MotionLaw::polynomial(v);
+    }
+    if (type == "harmonic") {
+      c.expect_map({"type", "offset", "amplitude", "frequency", "phase"});
+      double off = c.field("offset").present() ? number(c.field("offset")) : 0.0;
+      double ph = c.field("phase").present() ? number(c.field("phase")) : 0.0;
+      return MotionLaw::harmonic(off, number(c.require("amplitude")), number(c.require("frequency")), ph);
+    }
+    if (type == "table") {
+      c.expect_map({"type", "t", "values"});
+      auto t = numbers(c.require("t"), 0), v = numbers(c.require("values"), 0);
+      if (t.size() != v.size()) c.require("values").fail("needs as many values as times");
+      if (t.size() < 2) c.require("t").fail("a table needs at least 2 points");
+      for (std::size_t k = 1; k < t.size(); ++k)
+        if (!(t[k] > t[k - 1])) c.require("t").at(k).fail("times must increase strictly");
+      return MotionLaw::table(t, v);
+    }
+    if (type == "expression") {
+      c.expect_map({"type", "f"});
+      auto f = c.require("f");
+      std::shared_ptr<const CompiledExpression> expr;
+      if constexpr (kInFamily<C>) {
+        expr = family_expression(f, true, false);
+      } else {
+        expr = CompiledExpression::compile(f.text(), [&](const std::string& n) -> std::optional<NameBinding> {
+          if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+          if (auto p = parameter(n)) return NameBinding{NameBinding::Kind::kConstant, -1, *p};
+          return std::nullopt;
+        });
+      }
+      return MotionLaw::expression(expr);
+    }
+  } catch (const Error& e) {
+    c.fail(e.what());
+  }
+  c.require("type").fail("unknown law type '" + type + "' (linear, polynomial, harmonic, table, expression)");
+}
+
+// Used by read() for plain entries and family members.
+template void SceneReader::read_driver(const Cursor&);
+template void SceneReader::read_driver(const TCursor&);
+
+}  // namespace phiq::detail::scene

@@ -1,0 +1,159 @@
+// The sections that set how the scene is swept and what it writes (scene_reader.hpp): time, output (and the output
+// points and residuals it names), solver. They are never in families: they read plain Cursors only.
+#include <set>
+#include <unordered_map>
+
+#include "scene/scene_reader.hpp"
+#include "sweep/time_grid.hpp"
+
+namespace phiq::detail::scene {
+
+void SceneReader::read_time(const Cursor& c, SweepOptions& o) const {
+  c.expect_map({"start", "end", "steps"});
+  o.t_begin = number(c.require("start"));
+  o.t_end = number(c.require("end"));
+  o.steps = c.require("steps").integer(0, 1000000000);
+  if (o.steps > 0 && o.t_end == o.t_begin) c.require("end").fail("end equals start but steps > 0");
+  if (const std::string why = detail::time_grid_problem(o.t_begin, o.t_end, o.steps); !why.empty())
+    c.require("end").fail(why);  // steps that would not move time: run_sweep refuses them
+}
+
+// The output list, and from it the sweep's plan: derivatives, points, residuals and the condition estimate are
+// computed only when listed here (models/README.md, `output`).
+void SceneReader::read_output(const Cursor& c, Scene& scene) {
+  scene.sweep.velocities = scene.sweep.accelerations = false;
+  bool coordinates_listed = false;
+  if (c.present()) {
+    c.expect_map({"velocities", "accelerations", "coordinates", "points", "drivers", "residuals", "max_residual",
+                  "rcond"});
+    if (auto v = c.field("velocities"); v.present()) scene.sweep.velocities = v.boolean();
+    if (auto a = c.field("accelerations"); a.present()) scene.sweep.accelerations = a.boolean();
+    if (auto cs = c.field("coordinates"); cs.present()) {
+      coordinates_listed = true;
+      std::set<Index> seen;
+      for (const Cursor& i : cs.items()) {
+        Index j = coordinate(i);
+        if (!seen.insert(j).second) i.fail("coordinate listed twice");
+        scene.output_coordinates.push_back(j);
+      }
+    }
+    if (auto ps = c.field("points"); ps.present()) {
+      std::set<std::string> seen;
+      for (const Cursor& i : ps.items()) {
+        OutputPoint p = output_point(i);
+        if (!seen.insert(p.name).second) i.fail("output point '" + p.name + "' listed twice");
+        scene.sweep.points.push_back(std::move(p));
+      }
+    }
+    if (auto ds = c.field("drivers"); ds.present()) {
+      std::set<std::string> seen;
+      for (const Cursor& i : ds.items()) {
+        const std::string n = i.name();
+        auto it = driver_laws_.find(n);
+        if (it == driver_laws_.end()) i.fail("unknown driver '" + n + "' (a named entry of `drivers`)");
+        if (!seen.insert(n).second) i.fail("driver listed twice");
+        scene.output_drivers.push_back({n, it->second});
+      }
+    }
+    if (auto rs = c.field("residuals"); rs.present()) {
+      std::set<std::string> seen;
+      for (const Cursor& i : rs.items()) {
+        const std::string n = i.name();
+        if (!builder_.has_constraint(n)) i.fail("unknown constraint or driver '" + n + "'");
+        if (!seen.insert(n).second) i.fail("constraint listed twice");
+        residual_names_.push_back(n);
+      }
+    }
+    if (auto v = c.field("max_residual"); v.present()) scene.output_max_residual = v.boolean();
+    if (auto v = c.field("rcond"); v.present()) scene.sweep.condition = v.boolean();
+    scene.sweep.residuals = scene.output_max_residual || !residual_names_.empty();
+  }
+  if (!coordinates_listed)
+    for (Index j = 0; j < builder_.num_coordinates(); ++j) scene.output_coordinates.push_back(j);
+  // the columns `residual` and `rcond` must not collide with a coordinate's
+  for (Index j : scene.output_coordinates) {
+    const std::string& n = builder_.coordinate_name(j);
+    if ((n == "residual" && scene.output_max_residual) || (n == "rcond" && scene.sweep.condition))
+      c.fail("coordinate '" + n + "' and the column '" + n + "' would share a name: leave it out of coordinates");
+  }
+}
+
+// An output point: a point name, or {name: P, body: B, at: [x, y]} (a point fixed on body B, in B's frame;
+// [x, y, z] in dimension 3).
+OutputPoint SceneReader::output_point(const Cursor& c) const {
+  if (spatial_) {
+    if (!c.is_map()) {
+      const std::string n = c.name();
+      const Index k = entry_at(c, n, points3_);
+      if (k < 0) c.fail("unknown point '" + n + "' (or write {name: P, body: B, at: [x, y, z]})");
+      return spatial_point(n, points3_[k]);
+    }
+    c.expect_map({"name", "body", "at"});
+    const std::string n = c.require("name").name();
+    if (!valid_name(n)) c.require("name").fail("'" + n + "' is not a valid name");
+    const Frame3 f = body3(c.require("body"));
+    kin3::V3 at;
+    if (auto a = c.field("at"); a.present()) at = vec3(a);
+    return spatial_body_point(n, f, at);
+  }
+  if (!c.is_map()) {
+    const std::string n = c.name();
+    const Index k = entry_at(c, n, points_);
+    if (k < 0) c.fail("unknown point '" + n + "' (or write {name: P, body: B, at: [x, y]})");
+    return planar_point(n, points_[k]);
+  }
+  c.expect_map({"name", "body", "at"});
+  const std::string n = c.require("name").name();
+  if (!valid_name(n)) c.require("name").fail("'" + n + "' is not a valid name");
+  const Frame2 f = body(c.require("body"));
+  kin::V2 at{0, 0};
+  if (auto a = c.field("at"); a.present()) at = vec2(a);
+  return planar_body_point(n, f, at.x, at.y);
+}
+
+// Constraint names of `output: residuals` to indices, once the model is built (one pass over the constraints).
+void SceneReader::resolve_output_residuals(Scene& scene) const {
+  if (residual_names_.empty()) return;
+  std::unordered_map<std::string, Index> wanted;
+  for (const std::string& n : residual_names_) wanted.emplace(n, -1);
+  const auto& cs = scene.model->constraints();
+  for (std::size_t k = 0; k < cs.size(); ++k)
+    if (auto it = wanted.find(cs[k].name); it != wanted.end()) it->second = static_cast<Index>(k);
+  for (const std::string& n : residual_names_) scene.output_residuals.push_back(wanted.at(n));
+}
+
+void SceneReader::read_solver(const Cursor& c, SweepOptions& o) {
+  if (!c.present()) return;
+  c.expect_map({"tolerance", "max_iterations", "assembly_max_iterations", "line_search", "predictor",
+                "max_subdivisions", "length_scale", "linear_solver", "newton"});
+  if (auto v = c.field("tolerance"); v.present()) {
+    double tol = positive(v);
+    if (tol >= 1.0) v.fail("tolerance must be below 1");
+    o.newton.tolerance = o.assembly.tolerance = tol;
+  }
+  if (auto v = c.field("max_iterations"); v.present()) o.newton.max_iterations = static_cast<int>(v.integer(1, 1000));
+  if (auto v = c.field("assembly_max_iterations"); v.present())
+    o.assembly.max_iterations = static_cast<int>(v.integer(1, 10000));
+  if (auto v = c.field("line_search"); v.present()) o.newton.line_search = v.boolean();
+  if (auto v = c.field("max_subdivisions"); v.present()) o.max_subdivisions = static_cast<int>(v.integer(0, 30));
+  if (auto v = c.field("newton"); v.present()) {
+    const std::string s = v.text();
+    if (s == "modified") o.newton.jacobian_update = JacobianUpdate::kWhenSlow;
+    else if (s == "full") o.newton.jacobian_update = JacobianUpdate::kEveryIteration;
+    else v.fail("newton is modified or full");
+  }
+  if (auto v = c.field("predictor"); v.present()) {
+    if (!predictor_from_string(v.text(), &o.predictor)) v.fail(std::string("predictor is ") + predictor_names());
+  }
+  if (auto v = c.field("length_scale"); v.present()) builder_.set_length_scale(positive(v));
+  if (auto v = c.field("linear_solver"); v.present()) {
+    const std::string s = v.text();
+    if (s == "umfpack") builder_.set_linear_solver(LinearSolverKind::kUmfpack);
+    else if (s == "klu") builder_.set_linear_solver(LinearSolverKind::kKlu);
+    else if (s == "dense") builder_.set_linear_solver(LinearSolverKind::kDense);
+    else v.fail("linear_solver is umfpack, klu or dense");
+  }
+  predictor_field_ = c.field("predictor").present();
+}
+
+}  // namespace phiq::detail::scene

@@ -1,0 +1,58 @@
+// SceneReader::read (scene_reader.hpp): the sections of a scene in the order they are read — parameters first
+// (family ranges and numbers use them), the solver before the constraints (length scale, linear solver), time and
+// output last — then the model built from them.
+#include <memory>
+
+#include "scene/family_expansion.hpp"
+#include "scene/scene_reader.hpp"
+
+namespace phiq::detail::scene {
+
+Scene SceneReader::read(const YAML::Node& root) {
+  Cursor top(root, "", &file_, YAML::Mark());
+  if (!root.IsDefined() || root.IsNull()) top.fail("the scene is empty");
+  top.expect_map({"phiq", "name", "description", "dimension", "parameters", "coordinates", "points", "bodies",
+                  "vectors", "constraints", "drivers", "time", "output", "solver"});
+  if (auto v = top.field("phiq"); v.present() && v.integer(1, 1) != 1) v.fail("unsupported format version");
+
+  Scene scene;
+  scene.path = file_;
+  if (auto n = top.field("name"); n.present()) scene.name = n.text();
+  if (auto d = top.field("description"); d.present()) (void)d.text();
+
+  if (overrides_ && overrides_->share_analysis_with) builder_.share_analysis_with(*overrides_->share_analysis_with);
+  if (auto d = top.field("dimension"); d.present()) spatial_ = d.integer(2, 3) == 3;
+  read_parameters(top.field("parameters"));
+  check_family_total(top);  // the parameters give the ranges of the families in the sections
+  read_coordinates(top.require("coordinates"));
+  if (auto p = top.field("points"); p.present()) read_points(p);
+  if (auto b = top.field("bodies"); b.present()) read_bodies(b);
+  if (auto v = top.field("vectors"); v.present()) {
+    if (!spatial_) v.fail("natural unit vectors need 'dimension: 3'");
+    read_vectors(v);
+  }
+  read_solver(top.field("solver"), scene.sweep);  // before constraints: length scale, linear solver
+
+  reserve_ = [&](std::size_t more) { builder_.reserve(0, static_cast<Index>(more)); };
+  if (auto c = top.field("constraints"); c.present())
+    read_list(c, [&](const auto& item) { read_constraint(item); });
+  if (auto d = top.field("drivers"); d.present()) read_list(d, [&](const auto& item) { read_driver(item); });
+
+  read_time(top.require("time"), scene.sweep);
+  read_output(top.field("output"), scene);
+  points_ = {}, bodies_ = {};  // not needed any more: their memory is free for the model
+  driver_laws_ = {};
+  points3_ = {}, bodies3_ = {}, vectors_ = {}, joints3_.clear();
+
+  try {
+    scene.model = std::make_unique<Model>(std::move(builder_).build());
+  } catch (const Error& e) {
+    top.fail(e.what());
+  }
+  // Models that are not square (redundant constraints, missing drivers) load: the rank analysis and the
+  // minimum-norm assembly (assembly.hpp) tell what they are, and `phiq run` solves the redundant ones.
+  resolve_output_residuals(scene);
+  return scene;
+}
+
+}  // namespace phiq::detail::scene

@@ -1,0 +1,214 @@
+// SceneReader: reads the sections of a scene's YAML tree into a ModelBuilder and SweepOptions. This header
+// declares the class; its members are defined by subject, one file each:
+//   scene_reader.cpp     read(): the sections in their order, then the model
+//   read_values.cpp      numbers, constant expressions, slots, coordinates and names looked up in the tables
+//   read_equations.cpp   equation and law expressions (compiled once per family body, rebound per member)
+//   read_families.cpp    family keys and bodies copied out of the YAML tree, the total of family entries
+//   family_expansion.hpp the walk over the members of families (templates over the callers' lambdas)
+//   read_entities.cpp    parameters, coordinates, points, bodies, vectors
+//   read_constraints.cpp constraints, planar and spatial, and the attachments, sides and segments they refer to
+//   read_drivers.cpp     drivers, joint drivers and motion laws
+//   read_settings.cpp    time, output, solver
+// The readers are templates over the cursor type C: Cursor (a plain entry of the YAML tree) or TCursor (a member
+// of a family, families.hpp). The .cpp that defines a member template used elsewhere instantiates it explicitly
+// for both cursors.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "phiq/scene.hpp"
+#include "scene/families.hpp"
+#include "scene/name_table.hpp"
+#include "scene/yaml_cursor.hpp"
+
+namespace phiq::detail::scene {
+
+// The fixed frame, predefined in every scene.
+const char* const kGround = "ground";
+
+class SceneReader {
+ public:
+  SceneReader(const std::string& file, const SceneLimits& limits) : file_(file), limits_(limits) {
+    families_.file = &file_;
+    families_.parameters = &parameters_;
+    families_.budget = limits.max_family_instances;
+  }
+
+  Scene read(const YAML::Node& root);
+
+ private:
+  // ---- names and numbers (read_values.cpp) --------------------------------------------------------------------
+  std::optional<double> parameter(const std::string& name) const;
+  template <class C>
+  double constant_expression(const C& c, const std::string& s) const;
+  template <class C>
+  double number(const C& c) const;
+  bool uses_member(const TCursor& c, const std::string& s) const;
+  Meanings member_meanings(const TCursor& c) const;
+  template <class C>
+  double positive(const C& c) const;
+  template <class C>
+  std::vector<double> numbers(const C& c, std::size_t n) const;
+  template <class C>
+  kin::V2 vec2(const C& c) const;
+  template <class C>
+  kin3::V3 vec3(const C& c) const;
+  template <class C>
+  Index coordinate(const C& c) const;
+  template <class C, class Find, class NameAt>
+  Index lookup(const C& c, const std::string& name, Index size, const Find& find, const NameAt& name_at) const;
+  template <class C>
+  Index coordinate_at(const C& c, const std::string& name) const;
+  template <class C, class T>
+  Index entry_at(const C& c, const std::string& name, const NameTable<T>& table) const;
+  template <class C>
+  Slot slot(const C& c) const;
+  template <class C>
+  Unit unit(const C& c) const;
+
+  // ---- expressions (read_equations.cpp) -----------------------------------------------------------------------
+  template <class C>
+  std::shared_ptr<const CompiledExpression> compile(const C& c, bool allow_time) const;
+  NameResolver resolver(bool coordinates) const;
+  std::shared_ptr<const CompiledExpression> family_expression(const TCursor& c, bool allow_time,
+                                                              bool allow_coordinates) const;
+
+  // ---- families (read_families.cpp, family_expansion.hpp) -----------------------------------------------------
+  FamilyRange parse_range(const std::string& key, const YAML::Mark& key_mark, const std::string& path,
+                          const std::vector<std::string>& enclosing) const;
+  std::pair<std::int64_t, std::int64_t> range_bounds(const FamilyRange& r, const YAML::Mark& mark,
+                                                     const std::string& path) const;
+  std::shared_ptr<Family> parse_family(const std::string& key, const YAML::Mark& key_mark, const YAML::Node& body,
+                                       const std::string& path, const std::vector<std::string>& enclosing,
+                                       bool list);
+  std::optional<std::string> family_item_key(const YAML::Node& item, const std::string& path) const;
+  TNode copy(const YAML::Node& n, const std::string& path, const YAML::Mark& parent_mark) const;
+  void check_family_total(const Cursor& top);
+  template <class Each>
+  void for_each_member(const Family& f, Each&& each);
+  template <class Each>
+  void expand_map(const Family& f, Each& each);
+  template <class Each>
+  void read_map(const std::vector<Cursor::Entry>& entries, Each each);
+  template <class Each>
+  void read_list(const Cursor& c, Each each);
+  template <class Each>
+  void expand_list(const Family& f, Each& each);
+
+  // ---- parameters, coordinates, points, bodies, vectors (read_entities.cpp) ----------------------------------
+  void read_parameters(const Cursor& c);
+  void read_coordinates(const Cursor& c);
+  template <class C, class T, class U>
+  Index new_entity(const C& where, const std::string& name, NameTable<T>& table, const NameTable<U>& other);
+  template <class C, class T>
+  Index new_entity3(const C& where, const std::string& name, NameTable<T>& table);
+  void read_points(const Cursor& c);
+  void read_bodies(const Cursor& c);
+  void read_vectors(const Cursor& c);
+
+  // ---- constraints (read_constraints.cpp) ---------------------------------------------------------------------
+  template <class C>
+  Point2 point(const C& c) const;
+  template <class C>
+  std::pair<Point2, Point2> segment(const C& c) const;
+  template <class C>
+  Frame2 body(const C& c) const;
+  template <class C>
+  std::pair<Frame2, kin::V2> attachment(const C& c) const;
+  template <class C>
+  void read_constraint(const C& c);
+  template <class C>
+  Point3 point3(const C& c) const;
+  template <class C>
+  Point3 vector3(const C& c) const;
+  template <class C>
+  Frame3 body3(const C& c) const;
+  template <class C>
+  kin3::V3 direction3(const C& c) const;
+  template <class C>
+  JointSide3 side3(const C& c) const;
+  template <class C>
+  std::pair<JointSide3, JointSide3> sides3(const C& c, const std::string& type) const;
+  template <class C>
+  std::pair<Attachment3, Attachment3> dot_direction(const C& c, Unit& unit) const;
+  template <class Spec, class C>
+  void add_joint3(const C& c, const std::string& name, const std::string& type);
+  template <class C>
+  void read_constraint_3d(const C& c, const std::string& type, const std::string& name);
+  // Adds a constraint or driver to the model, named `name` or KIND#N (below).
+  template <class C, class Spec>
+  void add(const C& c, const std::string& name, Spec spec);
+
+  // ---- drivers (read_drivers.cpp) -----------------------------------------------------------------------------
+  template <class C>
+  void read_joint_driver(const C& c, const std::string& name, MotionLaw law);
+  template <class C>
+  void read_driver(const C& c);
+  template <class C>
+  MotionLaw motion_law(const C& c) const;
+
+  // ---- time, output, solver (read_settings.cpp) ---------------------------------------------------------------
+  void read_time(const Cursor& c, SweepOptions& o) const;
+  void read_output(const Cursor& c, Scene& scene);
+  OutputPoint output_point(const Cursor& c) const;
+  void resolve_output_residuals(Scene& scene) const;
+  void read_solver(const Cursor& c, SweepOptions& o);
+
+  const std::string& file_;
+  const SceneLimits& limits_;
+  ModelBuilder builder_;
+
+ public:
+  const SceneOverrides* overrides_ = nullptr;  ///< the caller's changes, if any
+
+ private:
+  std::unordered_map<std::string, double> parameters_;
+  NameTable<Point2> points_;
+  NameTable<Frame2> bodies_;
+  bool spatial_ = false;  // dimension: 3
+  NameTable<Point3> points3_;
+  NameTable<Frame3> bodies3_;
+  NameTable<Point3> vectors_;
+  // Named spatial joints, for the drivers that measure them.
+  struct Joint3 {
+    std::string type;
+    JointSide3 a, b;
+  };
+  std::unordered_map<std::string, Joint3> joints3_;
+  Families families_;
+  std::function<void(std::size_t)> reserve_;  // room for that many more entries of the section being read
+  int unnamed_ = 0;
+  bool predictor_field_ = false;
+  std::unordered_map<std::string, MotionLaw> driver_laws_;  // named drivers, for `output: drivers`
+  std::vector<std::string> residual_names_;                 // `output: residuals`, resolved after the build
+
+ public:
+  bool predictor_given() const { return predictor_field_; }
+};
+
+// Defined here, not in a .cpp: it is instantiated for every Spec of every constraint and driver kind.
+template <class C, class Spec>
+void SceneReader::add(const C& c, const std::string& name, Spec spec) {
+  const std::string label = name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(++unnamed_) : name;
+  try {
+    builder_.add(label, std::move(spec));
+  } catch (const Error&) {
+    // the builder registers the name only when it adds the constraint: a name it has is a duplicate (reported
+    // before anything else wrong with the constraint, as a check before adding would)
+    if (builder_.has_constraint(label))
+      c.field("name").fail("duplicate constraint or driver name '" + label + "'");
+    throw;
+  }
+}
+
+}  // namespace phiq::detail::scene
