@@ -20,6 +20,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "atomic_file.hpp"
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
 

@@ -2,8 +2,9 @@
 
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <unsupported/Eigen/Splines>
+
+#include "phiq/text.hpp"
 
 namespace phiq {
 
@@ -69,18 +70,11 @@ struct Expression final : MotionLaw::Impl {
   }
 };
 
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(12);
-  s << v;
-  return s.str();
-}
-
 }  // namespace
 
 MotionLaw MotionLaw::linear(double initial, double rate) {
   MotionLaw law = polynomial({initial, rate});
-  law.description_ = "linear " + fmt(initial) + " + " + fmt(rate) + "*t";
+  law.description_ = "linear " + significant(initial, 12) + " + " + significant(rate, 12) + "*t";
   return law;
 }
 
@@ -121,8 +115,8 @@ MotionLaw MotionLaw::table(std::vector<double> t, std::vector<double> values) {
     require_finite(t[k], "table time");
     require_finite(values[k], "table value");
     if (k > 0 && !(t[k] > t[k - 1]))
-      throw Error("motion law: table times must increase strictly (t[" + std::to_string(k) + "] = " + fmt(t[k]) +
-                  " after " + fmt(t[k - 1]) + ")");
+      throw Error("motion law: table times must increase strictly (t[" + std::to_string(k) +
+                  "] = " + significant(t[k], 12) + " after " + significant(t[k - 1], 12) + ")");
   }
   auto impl = std::make_shared<Table>();
   impl->t0 = t.front();
@@ -137,7 +131,8 @@ MotionLaw MotionLaw::table(std::vector<double> t, std::vector<double> values) {
   impl->spline = Eigen::SplineFitting<Table::Spline>::Interpolate(y, degree, u);
   MotionLaw law;
   law.impl_ = impl;
-  law.description_ = "table of " + std::to_string(n) + " points on [" + fmt(impl->t0) + ", " + fmt(impl->t1) + "]";
+  law.description_ = "table of " + std::to_string(n) + " points on [" + significant(impl->t0, 12) + ", " +
+                     significant(impl->t1, 12) + "]";
   return law;
 }
 

@@ -11,6 +11,8 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "phiq/text.hpp"
+
 namespace phiq {
 
 namespace {
@@ -89,18 +91,6 @@ class LineReader {
   std::size_t pos_ = 0, number_ = 0;
 };
 
-std::string fmt_exact(double v) {
-  char buf[32];
-  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, p);
-}
-
-std::string fmt_short(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
-
 std::string fmt_list(const std::vector<std::string>& names) {
   if (names.empty()) return "(none)";
   // A header can have thousands of columns; the line stays readable and the full lists are in the result.
@@ -116,7 +106,7 @@ std::string plural(std::size_t n, const char* word) {
 }
 
 void check_tolerance(const char* name, double v) {
-  if (!(v >= 0.0)) throw Error(std::string("compare_csv: ") + name + " must be >= 0, got " + fmt_exact(v));
+  if (!(v >= 0.0)) throw Error(std::string("compare_csv: ") + name + " must be >= 0, got " + shortest(v));
 }
 
 std::string table_name(const CsvTable& t, const char* fallback) { return t.path.empty() ? fallback : t.path; }
@@ -294,7 +284,7 @@ std::string CompareResult::summary() const {
   std::string detail;
   if (nrows > 0 && !compared.empty())
     detail = max_abs_diff == 0.0 ? " (identical)"
-                                 : " (max |diff| " + fmt_short(max_abs_diff) + " in " + max_abs_diff_column + ")";
+                                 : " (max |diff| " + significant(max_abs_diff, 3) + " in " + max_abs_diff_column + ")";
 
   if (equal) {
     std::string s = "agree: " + cells + detail;
@@ -307,16 +297,16 @@ std::string CompareResult::summary() const {
     // the line of both files (the header is line 1), as the parse errors count
     s += plural(mismatches, "cell") + " beyond tolerance; worst " + worst_column + " at line " +
          std::to_string(worst_row + 2);
-    if (!std::isnan(worst_t)) s += " (t = " + fmt_exact(worst_t) + ")";
-    s += ": " + fmt_exact(worst_a) + " vs " + fmt_exact(worst_b);
+    if (!std::isnan(worst_t)) s += " (t = " + shortest(worst_t) + ")";
+    s += ": " + shortest(worst_a) + " vs " + shortest(worst_b);
     if (std::isnan(worst_a) || std::isnan(worst_b)) {
       s += " (NaN against a number)";
     } else if (std::isinf(worst_a) || std::isinf(worst_b)) {
       s += " (infinity against a different value)";
     } else {
       const double diff = std::fabs(worst_a - worst_b);
-      std::string d = fmt_short(diff), t = fmt_short(worst_tol);
-      if (d == t) d = fmt_exact(diff), t = fmt_exact(worst_tol);  // 3 digits hid the difference
+      std::string d = significant(diff, 3), t = significant(worst_tol, 3);
+      if (d == t) d = shortest(diff), t = shortest(worst_tol);  // 3 digits hid the difference
       s += " (|diff| " + d + " > tol " + t + ")";
     }
   } else if (compared.empty()) {

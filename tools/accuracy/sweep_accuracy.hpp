@@ -91,22 +91,3 @@ std::string accuracy_csv(const AccuracyReport& report);
 std::string accuracy_json(const AccuracyReport& report);
 
 }  // namespace phiq::tools
-
-namespace phiq::tools {
-
-// The command line of `phiq sweep-accuracy`, as given (lists unparsed: they are checked with one-line errors).
-struct SweepAccuracyArgs {
-  std::string scene, csv_path, json_path;
-  std::string tolerances, steps, predictors, newton, linear_solvers, reference = "auto";
-  int repeat = 3;
-  bool quiet = false, verbose = false;
-};
-
-// Runs the command: exit status 0, 1 (the reference could not be computed), 2 (bad input: scene, option, a
-// reference that does not fit, an output that is the scene or the other output), 3 (an output could not be
-// written), 128 + the signal (SIGINT, SIGTERM, SIGHUP: the running sweep stops, nothing is written; signals as
-// cli_support.hpp). Errors are one line on stderr ("phiq: ..."). Without -o and --json the CSV goes to standard
-// output; the files are written whole or not at all, both or neither.
-int run_sweep_accuracy_command(const SweepAccuracyArgs& args);
-
-}  // namespace phiq::tools

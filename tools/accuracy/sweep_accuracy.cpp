@@ -1,6 +1,6 @@
+// measure_accuracy(): the grid of `phiq sweep-accuracy` run against its reference (a closed form that fits the
+// scene, or the scene itself solved tightly), the errors and Newton counts measured, then the settings timed.
 #include "sweep_accuracy.hpp"
-
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <charconv>
@@ -15,7 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "cli_support.hpp"
+#include "accuracy_text.hpp"
 #include "closed_forms.hpp"
 
 namespace phiq::tools {
@@ -33,34 +33,8 @@ constexpr double kFitResidual = 1e-8;
 constexpr double kFitBranch = 1e-6;
 
 using Clock = std::chrono::steady_clock;
-
-std::string num(double v) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-std::string short_num(double v, int digits = 4) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
-
-std::vector<std::string> split(const std::string& list, const char* option) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= list.size()) {
-    const std::size_t end = std::min(list.find(',', start), list.size());
-    std::string item = list.substr(start, end - start);
-    if (item.empty()) throw std::invalid_argument(std::string(option) + ": empty item in '" + list + "'");
-    out.push_back(item);
-    start = end + 1;
-  }
-  return out;
-}
-
-const char* newton_name(JacobianUpdate u) { return u == JacobianUpdate::kWhenSlow ? "modified" : "full"; }
+using detail::newton_name;
+using detail::significant_or_empty;
 
 // The sweep's own choice for Predictor::kAuto, so that the scene's default can be found in the grid.
 Predictor resolved(Predictor p, const SweepOptions& o) {
@@ -179,74 +153,11 @@ double branch_distance(const Model& m, const ClosedForm& f, double t, const Eige
 }
 
 std::string setting_text(const AccuracySetting& s) {
-  return "tolerance " + short_num(s.tolerance, 3) + ", " + std::to_string(s.steps) + " steps, " +
+  return "tolerance " + significant_or_empty(s.tolerance, 3) + ", " + std::to_string(s.steps) + " steps, " +
          to_string(s.predictor) + ", " + newton_name(s.newton) + " Newton, " + to_string(s.linear_solver);
 }
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
 }  // namespace
-
-std::vector<double> parse_tolerances(const std::string& list) {
-  std::vector<double> out;
-  for (const std::string& item : split(list, "--tolerances")) {
-    double v = 0;
-    auto r = std::from_chars(item.data(), item.data() + item.size(), v);
-    if (r.ec != std::errc() || r.ptr != item.data() + item.size() || !(v > 0 && v < 1))
-      throw std::invalid_argument("--tolerances: '" + item + "' is not a number between 0 and 1");
-    out.push_back(v);
-  }
-  return out;
-}
-
-std::vector<Index> parse_steps(const std::string& list) {
-  std::vector<Index> out;
-  for (const std::string& item : split(list, "--steps-list")) {
-    long long v = 0;
-    auto r = std::from_chars(item.data(), item.data() + item.size(), v);
-    if (r.ec != std::errc() || r.ptr != item.data() + item.size() || v < 1 || v > 100'000'000)
-      throw std::invalid_argument("--steps-list: '" + item + "' is not a step count (1 to 10^8)");
-    out.push_back(static_cast<Index>(v));
-  }
-  return out;
-}
-
-std::vector<Predictor> parse_predictors(const std::string& list) {
-  std::vector<Predictor> out;
-  for (const std::string& item : split(list, "--predictors")) {
-    Predictor p{};
-    if (!predictor_from_string(item, &p))
-      throw std::invalid_argument("--predictors: unknown predictor '" + item + "' (" + predictor_names() + ")");
-    out.push_back(p);
-  }
-  return out;
-}
-
-std::vector<JacobianUpdate> parse_newton(const std::string& list) {
-  std::vector<JacobianUpdate> out;
-  for (const std::string& item : split(list, "--newton")) {
-    if (item == "modified") out.push_back(JacobianUpdate::kWhenSlow);
-    else if (item == "full") out.push_back(JacobianUpdate::kEveryIteration);
-    else throw std::invalid_argument("--newton: '" + item + "' is modified or full");
-  }
-  return out;
-}
-
-std::vector<LinearSolverKind> parse_linear_solvers(const std::string& list) {
-  std::vector<LinearSolverKind> out;
-  for (const std::string& item : split(list, "--linear-solvers")) {
-    if (item == "klu") out.push_back(LinearSolverKind::kKlu);
-    else if (item == "umfpack") out.push_back(LinearSolverKind::kUmfpack);
-    else if (item == "dense") out.push_back(LinearSolverKind::kDense);
-    else throw std::invalid_argument("--linear-solvers: '" + item + "' is klu, umfpack or dense");
-  }
-  return out;
-}
 
 AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
                                 const std::function<void(const std::string&)>& progress) {
@@ -317,12 +228,12 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
       f->bind(model.coordinate_names());
       const double r = fit_residual(model, *f, so);
       if (!(r <= kFitResidual))
-        misfit = f->describe() + " does not satisfy the scene's constraints (scaled residual " + short_num(r, 3) +
+        misfit = f->describe() + " does not satisfy the scene's constraints (scaled residual " + significant_or_empty(r, 3) +
                  "): another mechanism or drive; give its parameters, e.g. closed-form:crank-slider:omega=1";
       // Both assembly branches satisfy the constraints: the scene's is the one it assembles into at t_begin.
       else if (const double d = branch_distance(model, *f, so.t_begin, start); !(d <= kFitBranch))
-        misfit = f->describe() + " is another assembly branch than the scene's (scaled distance " + short_num(d, 3) +
-                 " at t = " + short_num(so.t_begin, 6) + "), e.g. closed-form:fourbar:branch=-1";
+        misfit = f->describe() + " is another assembly branch than the scene's (scaled distance " + significant_or_empty(d, 3) +
+                 " at t = " + significant_or_empty(so.t_begin, 6) + "), e.g. closed-form:fourbar:branch=-1";
     } catch (const std::invalid_argument& e) {
       misfit = e.what();
     }
@@ -432,8 +343,8 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
             if (progress) {
               // a stream: GCC 12 warns (-Wrestrict, a false positive) on "/" + std::to_string(...)
               std::ostringstream line;
-              line << done << "/" << total << " " << setting_text(set) << ": err_q " << short_num(row.err_q, 2)
-                   << ", " << short_num(row.iterations_per_step, 3) << " iterations per step";
+              line << done << "/" << total << " " << setting_text(set) << ": err_q " << significant_or_empty(row.err_q, 2)
+                   << ", " << significant_or_empty(row.iterations_per_step, 3) << " iterations per step";
               progress(line.str());
             }
             timed.push_back({rep.rows.size(), o});
@@ -466,142 +377,6 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
     }
   }
   return rep;
-}
-
-std::string accuracy_csv(const AccuracyReport& r) {
-  std::string s =
-      "scene,reference,tolerance,steps,predictor,newton,linear_solver,err_q,err_v,err_a,iterations_per_step,"
-      "factorizations_per_step,us_per_step,status,default\n";
-  const std::string scene = csv_field(r.scene_name.empty() ? r.scene_path : r.scene_name);
-  for (const AccuracyRow& row : r.rows) {
-    const AccuracySetting& st = row.setting;
-    s += scene + "," + csv_field(r.reference_kind) + "," + num(st.tolerance) + "," + std::to_string(st.steps) + "," +
-         to_string(st.predictor) + "," + newton_name(st.newton) + "," + to_string(st.linear_solver) + "," +
-         short_num(row.err_q, 6) + "," + short_num(row.err_v, 6) + "," + short_num(row.err_a, 6) + "," +
-         short_num(row.iterations_per_step, 6) + "," + short_num(row.factorizations_per_step, 6) + "," +
-         short_num(row.us_per_step, 4) + "," + csv_field(row.status) + "," + (row.is_default ? "1" : "0") + "\n";
-  }
-  return s;
-}
-
-std::string accuracy_json(const AccuracyReport& r) {
-  auto number = [](double v) { return std::isnan(v) ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(v); };
-  auto setting = [](const AccuracySetting& s) {
-    return nlohmann::ordered_json{{"tolerance", s.tolerance},
-                                  {"steps", s.steps},
-                                  {"predictor", to_string(s.predictor)},
-                                  {"newton", newton_name(s.newton)},
-                                  {"linear_solver", to_string(s.linear_solver)}};
-  };
-  nlohmann::ordered_json j;
-  j["format"] = 1;
-  j["scene"] = r.scene_path;
-  j["name"] = r.scene_name;
-  j["reference"] = r.reference;
-  j["coordinates"] = r.coordinates;
-  j["length_scale"] = r.length_scale;
-  j["scene_default"] = setting(r.scene_default);
-  j["notes"] = r.notes;
-  j["rows"] = nlohmann::ordered_json::array();
-  for (const AccuracyRow& row : r.rows) {
-    nlohmann::ordered_json o = setting(row.setting);
-    o["err_q"] = number(row.err_q);
-    o["err_v"] = number(row.err_v);
-    o["err_a"] = number(row.err_a);
-    o["iterations_per_step"] = number(row.iterations_per_step);
-    o["factorizations_per_step"] = number(row.factorizations_per_step);
-    o["us_per_step"] = number(row.us_per_step);
-    o["status"] = row.status;
-    o["default"] = row.is_default;
-    j["rows"].push_back(o);
-  }
-  return j.dump(2) + "\n";
-}
-
-int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
-  auto fail = [](const std::string& msg, int code) {
-    std::cerr << "phiq: sweep-accuracy: " << single_line(msg) << "\n";
-    return code;
-  };
-  AccuracyOptions o;
-  try {
-    if (!a.tolerances.empty()) o.tolerances = parse_tolerances(a.tolerances);
-    if (!a.steps.empty()) o.steps = parse_steps(a.steps);
-    if (!a.predictors.empty()) o.predictors = parse_predictors(a.predictors);
-    if (!a.newton.empty()) o.newton = parse_newton(a.newton);
-    if (!a.linear_solvers.empty()) o.linear_solvers = parse_linear_solvers(a.linear_solvers);
-    if (a.repeat < 1 || a.repeat > 1000) throw std::invalid_argument("--repeat must be 1 to 1000");
-  } catch (const std::invalid_argument& e) {
-    return fail(e.what(), 2);
-  }
-  o.reference = a.reference;
-  o.repeat = a.repeat;
-  // Outputs that would replace the scene or each other are refused before anything is read or run.
-  std::vector<NamedPath> outs;
-  if (!a.csv_path.empty()) outs.push_back({"-o", a.csv_path});
-  if (!a.json_path.empty()) outs.push_back({"--json", a.json_path});
-  if (const auto clash = output_clash(outs, {{"the scene", a.scene}})) return fail(*clash, 2);
-  if (outs.empty() && stdout_was_closed()) return fail("standard output: cannot write: it is closed", 3);
-  set_interrupt_subject("sweep-accuracy: " + a.scene, "; no output written");
-  Scene scene;
-  try {
-    scene = load_scene(a.scene);
-  } catch (const SceneError& e) {
-    return fail(e.what(), 2);
-  }
-  // Files are created (as temporaries) before the long run, so that an unwritable path fails at once; a signal
-  // (SIGINT, SIGTERM, SIGHUP) stops the running sweep, and the temporaries are then removed (nothing is written).
-  OutputSet outputs;
-  AtomicOutputFile* csv_file = nullptr;
-  AtomicOutputFile* json_file = nullptr;
-  try {
-    if (!a.csv_path.empty()) csv_file = &outputs.add(a.csv_path);
-    if (!a.json_path.empty()) json_file = &outputs.add(a.json_path);
-  } catch (const Error& e) {
-    return fail(e.what(), 3);
-  }
-  o.stop = &stop_flag();
-  AccuracyReport rep;
-  const auto t0 = Clock::now();
-  try {
-    StopOnSignal stop_on_signal;
-    rep = measure_accuracy(scene, o, a.verbose ? std::function<void(const std::string&)>([](const std::string& l) {
-                                      std::cerr << "phiq: sweep-accuracy: " << l << "\n";
-                                    })
-                                               : std::function<void(const std::string&)>());
-  } catch (const AccuracyCancelled&) {
-    return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
-  } catch (const std::invalid_argument& e) {
-    return fail(a.scene + ": " + e.what(), 2);
-  } catch (const std::runtime_error& e) {
-    return fail(a.scene + ": " + e.what(), 1);
-  }
-  if (stop_flag().load())  // a signal after the last sweep: stopped all the same
-    return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
-  const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  try {
-    const std::string csv = accuracy_csv(rep);
-    if (csv_file) csv_file->write(csv);
-    if (json_file) json_file->write(accuracy_json(rep));
-    if (!csv_file && !json_file) {
-      std::fwrite(csv.data(), 1, csv.size(), stdout);
-      if (const auto bad = stdout_error()) throw Error(*bad);
-    }
-    outputs.commit();  // both files, or neither
-  } catch (const Error& e) {
-    return fail(e.what(), 3);
-  }
-  if (!a.quiet) {
-    for (const std::string& note : rep.notes) std::cerr << "phiq: sweep-accuracy: note: " << note << "\n";
-    std::size_t failed = 0;
-    for (const AccuracyRow& r : rep.rows) failed += r.status != "ok";
-    std::cerr << "phiq: sweep-accuracy: " << a.scene << ": " << rep.rows.size() << " settings (" << failed
-              << " failed) against " << rep.reference << " in " << short_num(seconds, 3) << " s";
-    if (csv_file) std::cerr << "; wrote " << a.csv_path;
-    if (json_file) std::cerr << (csv_file ? " and " : "; wrote ") << a.json_path;
-    std::cerr << "\n";
-  }
-  return 0;
 }
 
 }  // namespace phiq::tools

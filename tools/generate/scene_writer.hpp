@@ -2,7 +2,7 @@
 // generator writes (a coordinate, a point, a body, one constraint of each kind, a driver, the footer) is written by
 // one member function here, so that a change of syntax, such as the compact "indexed family" form of the scale
 // issue, is a change of this file only. The indexed families (`for i in A..B`) the generators now write are built
-// by the generators themselves and written with raw() (tools/generate_linkages.cpp, tools/generate_chain3d.cpp).
+// by the generators themselves and written with raw() (generate_linkages.cpp, generate_chain3d.cpp).
 // Names are systematic: a family and up to two indices (Name).
 #pragma once
 
@@ -64,7 +64,7 @@ class SceneText {
   void comment(std::string_view line) { w("# ", line, '\n'); }
   void field(std::string_view key, std::string_view value) { w(key, ": ", value, '\n'); }
   void section(std::string_view key) { w(key, ":\n"); }
-  // Text written as given (indexed families, built by the generator: tools/generate_linkages.cpp).
+  // Text written as given (indexed families, built by the generator: generate_linkages.cpp).
   void raw(std::string_view text) { put(text); }
 
   // Under `coordinates:`.

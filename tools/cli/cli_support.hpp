@@ -9,7 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "phiq/csv_writer.hpp"
+#include "atomic_file.hpp"
+#include "phiq/types.hpp"  // Error, which OutputSet throws
 
 namespace phiq::tools {
 

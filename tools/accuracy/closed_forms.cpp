@@ -8,17 +8,13 @@
 #include <stdexcept>
 #include <utility>
 
+#include "phiq/text.hpp"
+
 namespace phiq::tools {
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-std::string num(double v) {
-  char buf[32];
-  auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
 
 // Named parameters with defaults, in a fixed order (describe() lists them so, and the user overrides them by name).
 class Params {
@@ -42,7 +38,7 @@ class Params {
   }
   std::string describe() const {
     std::string s = kind_ + ":";
-    for (std::size_t k = 0; k < values_.size(); ++k) s += (k ? "," : "") + values_[k].first + "=" + num(values_[k].second);
+    for (std::size_t k = 0; k < values_.size(); ++k) s += (k ? "," : "") + values_[k].first + "=" + shortest(values_[k].second);
     return s;
   }
 

@@ -2,23 +2,15 @@
 #include "generate_common.hpp"
 #include "generate_linkages.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <stdexcept>
 
 #include "phiq/scene.hpp"
+#include "phiq/text.hpp"
 
 namespace phiq::tools {
 
 namespace {
-
-// Shortest round-trip decimal of a double.
-std::string num(double v) {
-  if (v == 0.0) v = 0.0;
-  char buf[32];
-  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, p);
-}
 
 // The first lines, as every kind writes them (gen::header: what was generated, the drive, the counts, the names),
 // then the format version and the name.
@@ -26,15 +18,15 @@ void header(std::string& s, const GenerateOptions& o, const std::string& what, c
             std::int64_t coordinates, std::int64_t kinematic, const std::string& names) {
   emit::SceneText t(1024);
   gen::header(t, o, what,
-              driven + " = crank 0's angle (rad), linear from " + num(o.from) + " at t = 0 to " + num(o.to) +
+              driven + " = crank 0's angle (rad), linear from " + shortest_unsigned_zero(o.from) + " at t = 0 to " + shortest_unsigned_zero(o.to) +
                   " at t = 1; every crank at that angle (the parallelogram solution)",
               coordinates, kinematic, 1, names);
   s += t.take();
 }
 
 void footer(std::string& s, const GenerateOptions& o, const std::string& driven) {
-  s += "drivers:\n  - {name: motor, coordinate: " + driven + ", law: {type: linear, initial: " + num(o.from) +
-       ", rate: " + num(o.to - o.from) + "}}\n";
+  s += "drivers:\n  - {name: motor, coordinate: " + driven + ", law: {type: linear, initial: " + shortest_unsigned_zero(o.from) +
+       ", rate: " + shortest_unsigned_zero(o.to - o.from) + "}}\n";
   s += "time: {start: 0, end: 1, steps: " + std::to_string(o.steps) + "}\n";
   s += std::string("output: {velocities: ") + (o.v ? "true" : "false") + ", accelerations: " +
        (o.a ? "true" : "false") + "}\n";
@@ -57,11 +49,11 @@ std::string nfourbar_natural(const GenerateOptions& o) {
          "from (i, 0)), coupler<i> (P<i> to P<i+1>, distance 1), crank0_angle (the angle of O->P0 = theta)");
   s += "parameters:\n";
   s += "  N: " + std::to_string(o.n) + "\n";
-  s += "  c: " + num(c) + "    # cos(from): crank tip i starts at (i + c, s)\n";
-  s += "  s: " + num(sn) + "    # sin(from)\n";
+  s += "  c: " + shortest_unsigned_zero(c) + "    # cos(from): crank tip i starts at (i + c, s)\n";
+  s += "  s: " + shortest_unsigned_zero(sn) + "    # sin(from)\n";
   s += "coordinates:\n";
   s += "  for i in 0..N:\n    x{i}: i + c\n    y{i}: s\n";
-  s += "  theta: " + num(o.from) + "\n";
+  s += "  theta: " + shortest_unsigned_zero(o.from) + "\n";
   s += "points:\n  O: [0, 0]\n";
   s += "  for i in 0..N:\n    P{i}: [\"x{i}\", \"y{i}\"]\n";
   s += "constraints:\n";
@@ -85,11 +77,11 @@ std::string nfourbar_reference_point(const GenerateOptions& o) {
          "coupler i), right<i> (crank i+1's tip to coupler i)");
   s += "parameters:\n";
   s += "  N: " + std::to_string(o.n) + "\n";
-  s += "  c: " + num(c) + "    # cos(from): coupler i starts at (i + 0.5 + c, s)\n";
-  s += "  s: " + num(sn) + "    # sin(from)\n";
-  s += "  hc: " + num(0.5 * c) + "    # crank i starts at (i + hc, hs), angle from\n";
-  s += "  hs: " + num(0.5 * sn) + "\n";
-  s += "  from: " + num(o.from) + "\n";
+  s += "  c: " + shortest_unsigned_zero(c) + "    # cos(from): coupler i starts at (i + 0.5 + c, s)\n";
+  s += "  s: " + shortest_unsigned_zero(sn) + "    # sin(from)\n";
+  s += "  hc: " + shortest_unsigned_zero(0.5 * c) + "    # crank i starts at (i + hc, hs), angle from\n";
+  s += "  hs: " + shortest_unsigned_zero(0.5 * sn) + "\n";
+  s += "  from: " + shortest_unsigned_zero(o.from) + "\n";
   s += "coordinates:\n";
   s += "  for i in 0..N:\n    xc{i}: i + hc\n    yc{i}: hs\n    psi{i}: from\n";
   s += "  for i in 0..N-1:\n    xk{i}: i + 0.5 + c\n    yk{i}: s\n    phi{i}: 0\n";
@@ -156,7 +148,7 @@ std::string generate_scene(const GenerateOptions& o) {
   // Finite options can still make numbers of the scene that are not: the driver's rate, and chain3d's phases
   // from + i·twist up to i = N; the loader would refuse the scene ('-inf' is not a finite number).
   if (!std::isfinite(o.to - o.from))
-    throw std::invalid_argument("--from and --to: the driven range to - from = " + num(o.to - o.from) +
+    throw std::invalid_argument("--from and --to: the driven range to - from = " + shortest_unsigned_zero(o.to - o.from) +
                                 " is not finite");
   if (!std::isfinite(std::fabs(o.from) + static_cast<double>(o.n) * std::fabs(o.twist)))
     throw std::invalid_argument("--twist: crank N's phase from + N*twist is not finite");

@@ -23,7 +23,7 @@ std::string generate_scene(const GenerateOptions& o);
 
 // The entries (coordinates, points, bodies, constraints, drivers, and nested families) that the indexed families of
 // the scene of o.kind, o.coords and o.n make, counted as the loader counts them against
-// SceneLimits::max_family_instances; o.n from 1 to gen::kMaxN (tools/generate_common.hpp).
+// SceneLimits::max_family_instances; o.n from 1 to gen::kMaxN (generate_common.hpp).
 std::uint64_t family_entries(const GenerateOptions& o);
 
 // The largest N whose scene of o.kind in o.coords the loader accepts: its families within

@@ -26,7 +26,6 @@ namespace {
 
 using emit::Name;
 using emit::SceneText;
-using gen::num;
 
 constexpr double kPi = 3.14159265358979323846;
 // The rough placement (so that the first solve is an assembly): the exact solution at t = 0 with every point shifted
@@ -56,27 +55,27 @@ void check(const GenerateOptions& o) {
 
 // `name`x, `name`y, `name`z: the components of a vector as parameters.
 std::string vector_parameters(const std::string& name, const chain3d::Vec& v, const std::string& comment) {
-  return "  " + name + "x: " + num(v[0]) + "    # " + comment + "\n  " + name + "y: " + num(v[1]) + "\n  " + name +
-         "z: " + num(v[2]) + "\n";
+  return "  " + name + "x: " + shortest(v[0]) + "    # " + comment + "\n  " + name + "y: " + shortest(v[1]) + "\n  " + name +
+         "z: " + shortest(v[2]) + "\n";
 }
 
 // The parameters both styles read: the size, the drive's start, the twist, the coupler length, the pivot step, the
 // axes, and the rough placement's shift.
 std::string parameters(const GenerateOptions& o, const chain3d::Geometry& g) {
   const bool twisted = o.twist != 0.0;
-  return "parameters:\n  N: " + gen::str(o.n) + "\n  from: " + num(o.from) + "    # crank 0's angle at t = 0\n  tw: " +
-         num(o.twist) + "    # crank i+1's phase ahead of crank i\n  L: " + num(chain3d::coupler_length(o.twist)) +
+  return "parameters:\n  N: " + gen::str(o.n) + "\n  from: " + shortest(o.from) + "    # crank 0's angle at t = 0\n  tw: " +
+         shortest(o.twist) + "    # crank i+1's phase ahead of crank i\n  L: " + shortest(chain3d::coupler_length(o.twist)) +
          "    # coupler length\n" +
          vector_parameters("o", twisted ? g.u : g.e1, "pivot step: O_i = i (ox, oy, oz)") +
          vector_parameters("u", g.u, "hinge axis") + vector_parameters("e1", g.e1, "crank direction at angle 0") +
-         vector_parameters("e2", g.e2, "u x e1: crank direction at angle pi/2") + "  shift: " + num(kShift) +
+         vector_parameters("e2", g.e2, "u x e1: crank direction at angle pi/2") + "  shift: " + shortest(kShift) +
          "    # rough placement: the solution at t = 0 shifted along u, off the hinges' planes\n";
 }
 
 // The drive's description.
 std::string drive(const GenerateOptions& o, const std::string& what) {
-  return what + " = crank 0's angle about u from e1 towards e2 (rad), linear from " + num(o.from) + " at t = 0 to " +
-         num(o.to) + " at t = 1; crank i at that angle + i*tw";
+  return what + " = crank 0's angle about u from e1 towards e2 (rad), linear from " + shortest(o.from) + " at t = 0 to " +
+         shortest(o.to) + " at t = 1; crank i at that angle + i*tw";
 }
 
 std::string what(const GenerateOptions& o) {
@@ -84,7 +83,7 @@ std::string what(const GenerateOptions& o) {
     return "row of N spatial loops: N + 1 unit cranks on parallel hinges (axis u = (1, 2, 2)/3) pinned along "
            "d = (2, 1, -2)/3, their tips joined by N unit couplers with ball joints (the parallelogram row), 1 dof";
   return "twisted row of N spatial loops: N + 1 unit cranks on one hinge axis u = (1, 2, 2)/3, pinned one unit "
-         "apart along it, neighbours " + num(o.twist) + " rad apart in phase, tips joined by couplers of length "
+         "apart along it, neighbours " + shortest(o.twist) + " rad apart in phase, tips joined by couplers of length "
          "sqrt(3 - 2 cos twist) with ball joints, 1 dof";
 }
 
@@ -163,7 +162,7 @@ std::string chain3d_reference_point(const GenerateOptions& o) {
   std::string euler;
   for (const auto& [name, q] : {std::pair{"qa", g.qa}, std::pair{"qb", g.qb}})
     for (std::size_t k = 0; k < 4; ++k)
-      euler += "  " + std::string(name) + std::to_string(k) + ": " + num(q[k]) +
+      euler += "  " + std::string(name) + std::to_string(k) + ": " + shortest(q[k]) +
                (k == 0 && name[1] == 'a' ? "    # a crank's Euler parameters at angle a: cos(a/2) qa + sin(a/2) qb\n"
                                          : "\n");
   SceneText t = begin(o, g,

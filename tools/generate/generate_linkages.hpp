@@ -1,5 +1,5 @@
-// `phiq generate scissor` and `phiq generate grid` (tools/generate_linkages.cpp) and `phiq generate chain3d`
-// (tools/generate_chain3d.cpp); formats in tools/README.md.
+// `phiq generate scissor` and `phiq generate grid` (generate_linkages.cpp) and `phiq generate chain3d`
+// (generate_chain3d.cpp); formats in tools/README.md.
 #pragma once
 
 #include <cstdint>

@@ -25,7 +25,6 @@ constexpr double kPi = 3.14159265358979323846;
 
 using gen::footer;
 using gen::header;
-using gen::num;
 using gen::str;
 
 void check(const GenerateOptions& o, double singular_at, const std::string& what) {
@@ -43,8 +42,8 @@ void check(const GenerateOptions& o, double singular_at, const std::string& what
 const char* const kScissorWhat = "scissor lift of N stages (unit bars crossing at their midpoints), 1 dof";
 
 std::string scissor_drive(const GenerateOptions& o, const std::string& coordinate) {
-  return coordinate + " = the bars' angle to the horizontal (rad), linear from " + num(o.from) +
-         " at t = 0 to " + num(o.to) + " at t = 1";
+  return coordinate + " = the bars' angle to the horizontal (rad), linear from " + shortest(o.from) +
+         " at t = 0 to " + shortest(o.to) + " at t = 1";
 }
 
 // The scenes are written with indexed families (`for k in 0..N-1`, models/README.md), so that their size does not
@@ -63,8 +62,8 @@ std::string scissor_natural(const GenerateOptions& o) {
          "points L<k> = (xl<k>, yl<k>) and R<k> = (xr<k>, yr<k>) are the left and right joints at level k "
          "(L0 = origin, R0 = (xr0, 0) the slider), M<k> = (xm<k>, ym<k>) the crossing pin of stage k; "
          "bar a<k> joins L<k> to R<k+1>, bar b<k> joins R<k> to L<k+1>");
-  t.raw("parameters:\n  N: " + str(n) + "\n  c: " + num(c) + "    # cos(from)\n  s: " + num(s) +
-        "    # sin(from)\n  hc: " + num(0.5 * c) + "    # c/2\n");
+  t.raw("parameters:\n  N: " + str(n) + "\n  c: " + shortest(c) + "    # cos(from)\n  s: " + shortest(s) +
+        "    # sin(from)\n  hc: " + shortest(0.5 * c) + "    # c/2\n");
   t.section("coordinates");
   t.coordinate(Name{"xr", 0}, c);
   t.raw("  for k in 0..N-1:\n"
@@ -106,8 +105,8 @@ std::string scissor_reference_point(const GenerateOptions& o) {
          "bodies a<k> = (xa<k>, ya<k>, psia<k>) and b<k> = (xb<k>, yb<k>, psib<k>) are the bars of stage k "
          "(a rises to the right from the left joint, b to the left from the right joint; reference point at the "
          "middle = the crossing pin), s = (xs, ys, psis) the slider");
-  t.raw("parameters:\n  N: " + str(n) + "\n  s: " + num(s) + "    # sin(from)\n  hc: " + num(0.5 * c) +
-        "    # cos(from)/2\n  from: " + num(o.from) + "\n  pmf: " + num(kPi - o.from) + "    # pi - from\n");
+  t.raw("parameters:\n  N: " + str(n) + "\n  s: " + shortest(s) + "    # sin(from)\n  hc: " + shortest(0.5 * c) +
+        "    # cos(from)/2\n  from: " + shortest(o.from) + "\n  pmf: " + shortest(kPi - o.from) + "    # pi - from\n");
   t.section("coordinates");
   t.coordinate(Name{"xs"}, c);
   t.coordinate(Name{"ys"}, 0.0);
@@ -170,8 +169,8 @@ const char* const kGridWhat = "lattice of N parallelogram cells of unit bars, on
 
 std::string grid_drive(const GenerateOptions& o, const std::string& coordinate) {
   return coordinate + " = the angle of row j's vertical bars to the horizontal (rad), linear from " +
-         num(o.from) + " to " + num(o.to) + " in even rows j and from " +
-         num(o.to) + " to " + num(o.from) + " in odd rows";
+         shortest(o.from) + " to " + shortest(o.to) + " in even rows j and from " +
+         shortest(o.to) + " to " + shortest(o.from) + " in odd rows";
 }
 
 std::string grid_shape_text(const GridShape& g) {
@@ -203,11 +202,11 @@ std::string range(std::int64_t a, std::int64_t b) { return str(a) + ".." + str(b
 // Parameters of both grid styles: the shape and the row angles at t = 0.
 void grid_parameters(SceneText& t, const GenerateOptions& o, const GridShape& g) {
   t.raw("parameters:\n  N: " + str(o.n) + "\n  C: " + str(g.cols) + "    # cells per row\n  L: " + str(g.last) +
-        "    # cells of the last row\n  R: " + str(g.rows) + "    # rows\n  from: " + num(o.from) + "\n  to: " +
-        num(o.to) + "\n  ca: " + num(std::cos(o.from)) + "\n  sa: " + num(std::sin(o.from)) + "\n  cb: " +
-        num(std::cos(o.to)) + "\n  sb: " + num(std::sin(o.to)) + "\n  hca: " + num(0.5 * std::cos(o.from)) +
-        "\n  hsa: " + num(0.5 * std::sin(o.from)) + "\n  hcb: " + num(0.5 * std::cos(o.to)) + "\n  hsb: " +
-        num(0.5 * std::sin(o.to)) + "\n");
+        "    # cells of the last row\n  R: " + str(g.rows) + "    # rows\n  from: " + shortest(o.from) + "\n  to: " +
+        shortest(o.to) + "\n  ca: " + shortest(std::cos(o.from)) + "\n  sa: " + shortest(std::sin(o.from)) + "\n  cb: " +
+        shortest(std::cos(o.to)) + "\n  sb: " + shortest(std::sin(o.to)) + "\n  hca: " + shortest(0.5 * std::cos(o.from)) +
+        "\n  hsa: " + shortest(0.5 * std::sin(o.from)) + "\n  hcb: " + shortest(0.5 * std::cos(o.to)) + "\n  hsb: " +
+        shortest(0.5 * std::sin(o.to)) + "\n");
 }
 
 // The drivers: motor<j> drives row j's angle from `from` (even j) or `to` (odd j) at the rate of row_rate.
@@ -215,7 +214,7 @@ void grid_drivers(SceneText& t, const GenerateOptions& o, const GridShape& g, co
   const RowPairs p = row_pairs(g);
   auto law = [&](const std::string& jt, std::int64_t parity) {
     return "      - {name: \"motor" + jt + "\", coordinate: \"" + coordinate + jt + "\", law: {type: linear, "
-           "initial: " + num(row_initial(o, parity)) + ", rate: " + num(row_rate(o, parity)) + "}}\n";
+           "initial: " + shortest(row_initial(o, parity)) + ", rate: " + shortest(row_rate(o, parity)) + "}}\n";
   };
   t.section("drivers");
   t.raw("  - for k in " + range(0, p.pairs - 1) + ":\n" + law("{2*k}", 0) + law("{2*k+1}", 1));

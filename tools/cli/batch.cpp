@@ -1,0 +1,208 @@
+// `phiq batch SCENE CASES.csv -o DIR`: the scene swept once per parameter set, the cases in parallel on one
+// symbolic analysis, each case's CSV published only when it succeeded.
+#include <atomic>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "cli_support.hpp"
+#include "command_line.hpp"
+#include "command_support.hpp"
+#include "commands.hpp"
+#include "phiq/csv_compare.hpp"  // read_csv_table: the cases
+#include "phiq/phiq.hpp"
+
+namespace phiq::tools {
+
+namespace {
+
+// `phiq batch SCENE CASES.csv -o DIR`: the scene swept once per row of CASES.csv (columns: parameter names), the
+// cases in parallel, sharing one symbolic analysis; DIR/case<k>.csv per successful case (k from 0, the row order).
+int cmd_batch(const std::string& scene_path, const std::string& cases_path, const std::string& dir, bool quiet,
+              int threads) {
+  phiq::CsvTable cases;
+  try {
+    cases = phiq::read_csv_table(cases_path);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 2);
+  }
+  if (cases.rows.empty()) return fail(cases_path + ": no cases (one row per parameter set)", 2);
+  auto case_file = [&](std::size_t k) { return dir + "/case" + std::to_string(k) + ".csv"; };
+  {  // no case file may replace the scene or the cases
+    std::vector<NamedPath> outs;
+    for (std::size_t k = 0; k < cases.rows.size(); ++k) outs.push_back({"-o", case_file(k)});
+    if (const auto clash = output_clash(outs, {{"the scene", scene_path}, {"the cases", cases_path}}))
+      return fail("batch: " + *clash, 2);
+  }
+  set_interrupt_subject(scene_path, "; no output written");
+  // Build every case's model (in order: each shares the first one's analysis), then sweep them in parallel.
+  std::vector<phiq::Scene> scenes;
+  scenes.reserve(cases.rows.size());
+  const auto load_start = Clock::now();
+  for (std::size_t k = 0; k < cases.rows.size(); ++k) {
+    phiq::SceneOverrides o;
+    for (std::size_t c = 0; c < cases.columns.size(); ++c) o.parameters.emplace_back(cases.columns[c], cases.rows[k][c]);
+    if (!scenes.empty()) o.share_analysis_with = scenes.front().model.get();
+    try {
+      scenes.push_back(phiq::load_scene(scene_path, phiq::SceneLimits{}, o));
+    } catch (const phiq::SceneError& e) {
+      // The case is named only when its parameters cause the error: an error of the scene itself (its YAML, a
+      // field) is the same without them. Cases after the first loaded the same scene, so theirs are theirs.
+      bool from_case = k > 0;
+      if (!from_case) {
+        try {
+          (void)phiq::load_scene(scene_path);
+          from_case = true;
+        } catch (const phiq::SceneError& plain) {
+          from_case = std::string(plain.what()) != e.what();
+        }
+      }
+      return fail(std::string(e.what()) + (from_case ? " (case " + std::to_string(k) + " of " + cases_path +
+                                                           ", line " + std::to_string(k + 2) + ")"
+                                                     : ""),
+                  2);
+    }
+  }
+  const double load_s = since(load_start);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) return fail(dir + ": cannot create the output directory: " + ec.message(), 3);
+  // Each case made square as `phiq run` does; one that cannot be fails alone.
+  std::vector<phiq::SquareScene> squares(scenes.size());
+  std::vector<std::string> prepare_errors(scenes.size());
+  std::vector<const phiq::Model*> models;
+  std::vector<Eigen::VectorXd> starts;
+  std::vector<std::size_t> swept;  // the cases that run, in order
+  std::vector<phiq::CsvFormat> formats;
+  std::vector<std::string> buffers(scenes.size());
+  // every case's file exists (as a temporary) before the work; those of the cases that succeed are renamed at the
+  // end, the others removed. They are closed between writes: a batch of 10 000 cases holds no 10 000 descriptors.
+  OutputSet outputs;
+  std::vector<phiq::AtomicOutputFile*> files(scenes.size());
+  try {
+    for (std::size_t k = 0; k < scenes.size(); ++k)
+      files[k] = &outputs.add(case_file(k), phiq::AtomicOutputFile::Hold::kClosedBetweenWrites);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  for (std::size_t k = 0; k < scenes.size(); ++k)
+    if (const auto why = make_square(scenes[k], &squares[k])) prepare_errors[k] = *why;
+  std::vector<std::string> write_errors(scenes.size());
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    const phiq::Scene& sc = scenes[k];
+    if (prepare_errors[k].empty()) {
+      models.push_back(&squares[k].model(*sc.model));
+      starts.push_back(squares[k].start);
+      swept.push_back(k);
+    }
+    formats.emplace_back(sc);
+    buffers[k] = formats[k].header();
+  }
+  // Each case touches only its own buffer and file: the callback is safe across cases without a lock.
+  // each case's own sweep: its output points (and time range) may depend on its parameters
+  std::vector<phiq::SweepOptions> sweeps;
+  for (std::size_t k : swept) sweeps.push_back(scenes[k].sweep);
+  const std::atomic<bool>& stop = stop_flag();
+  phiq::BatchSummary sum;
+  {
+    StopOnSignal stop_on_signal;  // a signal stops every case at its next row
+    sum = phiq::run_batch(models, sweeps, threads, [&](std::size_t c, const phiq::StepView& step) {
+      const std::size_t k = swept[c];
+      formats[k].append_row(step, buffers[k]);
+      // written every 1 MB and at the case's last row: a finished case holds no rows in memory while others run
+      const bool last = step.step == sweeps[c].steps;
+      if (buffers[k].size() > (1u << 20) || last) {
+        try {
+          files[k]->write(buffers[k]);
+        } catch (const phiq::Error& e) {
+          write_errors[k] = e.what();
+          return false;
+        }
+        if (last)
+          std::string().swap(buffers[k]);
+        else
+          buffers[k].clear();
+      }
+      return !stop.load();
+    }, &starts);
+  }
+  if (stop.load())
+    return fail(scene_path + ": " + interrupt_message() + "; no output written",
+                interrupt_exit_status());
+  int failed = 0;
+  std::size_t c = 0;  // index of case k among the swept ones
+  std::vector<std::string> reports(scenes.size());
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    if (!prepare_errors[k].empty()) {
+      ++failed;
+      reports[k] = "phiq: " + scene_path + ": case " + std::to_string(k) + ": " + prepare_errors[k] +
+                   "; no output written\n";
+      continue;
+    }
+    const phiq::SweepSummary& s = sum.cases[c++];
+    std::string why = !write_errors[k].empty() ? write_errors[k] : s.status != phiq::SolveStatus::kSuccess ? s.message : "";
+    if (why.empty()) {
+      try {
+        files[k]->write(buffers[k]);
+        files[k]->finish();
+      } catch (const phiq::Error& e) {
+        why = e.what();
+      }
+    }
+    if (!why.empty()) {
+      ++failed;
+      reports[k] = "phiq: " + scene_path + ": case " + std::to_string(k) + ": " + why + "; no output written\n";
+    } else if (!quiet) {
+      reports[k] = "phiq: " + scene_path + ": case " + std::to_string(k) + ": " + s.BriefReport() + "\n";
+    }
+  }
+  try {
+    outputs.publish_finished();
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  for (const std::string& r : reports) std::cerr << r;
+  if (!quiet)
+    std::cerr << "phiq: " << scene_path << ": " << scenes.size() - failed << " of " << scenes.size() << " cases in "
+              << dir << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
+              << " cases on one symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
+              << scientific(sum.solve_seconds, 3) << " s\n";
+  return failed ? 1 : 0;
+}
+
+// An output directory: not empty, not standard output.
+CLI::Validator directory_given() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (text.empty()) return "the path is empty";
+        return text == "-" ? "'-' (standard output) cannot hold the case files: give a directory" : "";
+      },
+      "DIR");
+}
+
+}  // namespace
+
+Command register_batch(CLI::App& app) {
+  struct Args {
+    std::string scene, cases, dir;
+    bool quiet = false;
+    int threads = 0;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* batch = app.add_subcommand("batch", "Sweep the scene once per parameter set of a CSV, the cases in parallel");
+  batch->add_option("scene", a->scene, "Scene file (YAML)")->required();
+  batch->add_option("cases", a->cases, "CSV: a header of parameter names, one row of values per case")->required();
+  batch->add_option("-o,--output", a->dir, "Directory for case<k>.csv (k = row, from 0)")
+      ->required()
+      ->check(directory_given());
+  batch->add_flag("-q,--quiet", a->quiet, "Print only failures on standard error");
+  batch->add_option("--threads", a->threads, "Threads for the cases (0: all cores)")
+      ->capture_default_str()
+      ->check(thread_count());
+  return {batch, [a] {
+            const int cases_threads = cap_threads("batch", a->threads, a->quiet);
+            return cmd_batch(a->scene, a->cases, a->dir, a->quiet, cases_threads);
+          }};
+}
+
+}  // namespace phiq::tools

@@ -1,0 +1,140 @@
+// `phiq check SCENE [--json] [--time T]`: the scene's counts (coordinates, equations, non-zeros), the assembly from
+// its rough placement and the rank analysis there (dof, redundant and conflicting constraints), as text or JSON.
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "command_line.hpp"
+#include "command_support.hpp"
+#include "commands.hpp"
+#include "phiq/phiq.hpp"
+
+namespace phiq::tools {
+
+namespace {
+
+int cmd_check(const std::string& scene_path, bool json, std::optional<double> at) {
+  std::optional<phiq::Scene> loaded = load_or_report(scene_path);
+  if (!loaded) return 2;
+  const phiq::Scene& scene = *loaded;
+  const phiq::Model& model = *scene.model;
+  int drivers = 0;
+  for (const auto& c : model.constraints()) drivers += c.depends_on_time ? c.rows : 0;
+
+  // Minimum-norm assembly from the rough placement, with the rank analysis at the assembled position (or where it
+  // stopped): works for square, redundant and under-driven models alike.
+  Eigen::VectorXd q = model.initial_positions();
+  phiq::AssemblySummary as;
+  const double t0 = at ? *at : scene.sweep.t_begin;  // rank belongs to a configuration: `--time` picks another
+  phiq::assemble(model, t0, assembly_options(scene), q, &as);
+  const bool ok = as.status == phiq::SolveStatus::kSuccess;
+  const bool analysed = as.rank.coordinates == model.num_coordinates() && as.status != phiq::SolveStatus::kOutsideTimeDomain;
+  const phiq::RankReport& rk = as.rank;
+  // inconsistent names its conflicts; not consistent without any is "not known" (the independent equations
+  // themselves do not hold: AssemblySummary::consistent)
+  const bool consistency_known = as.consistent || !as.conflicts.empty();
+
+  if (json) {
+    // `phiq check --json`, format version 1 (tools/README.md): one object on standard output.
+    nlohmann::ordered_json j;
+    j["format"] = phiq::kCheckJsonFormat;
+    j["phiq"] = phiq::kVersion;
+    j["scene"] = scene_path;
+    j["name"] = scene.name;
+    j["coordinates"] = model.num_coordinates();
+    j["equations"] = model.num_equations();
+    j["kinematic_equations"] = model.num_equations() - drivers;
+    j["driver_equations"] = drivers;
+    j["constraints"] = model.constraints().size();
+    j["nonzeros"] = model.jacobian_pattern().nnz();
+    j["length_scale"] = model.length_scale();
+    j["linear_solver"] = phiq::to_string(model.linear_solver());
+    nlohmann::ordered_json a;
+    a["time"] = t0;
+    a["status"] = phiq::to_string(as.status);
+    a["iterations"] = as.iterations;
+    a["residual"] = as.residual;
+    a["tolerance"] = scene.sweep.assembly.tolerance;
+    a["message"] = as.message;
+    a["worst"] = nlohmann::ordered_json::array();
+    for (const auto& [row, value] : as.worst_rows)
+      a["worst"].push_back({{"constraint", model.constraints()[model.constraint_of_row(row)].name},
+                            {"row", row},
+                            {"residual", value}});
+    j["assembly"] = a;
+    // The redundancy analysis at the assembled position (or where the assembly stopped); null when not run.
+    auto or_null = [&](auto v) { return analysed ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+    j["rank"] = or_null(rk.rank);
+    j["dof"] = or_null(rk.dof);
+    j["driven_dof"] = or_null(rk.driven_dof);
+    j["grubler"] = rk.grubler ? nlohmann::ordered_json(*rk.grubler) : nlohmann::ordered_json();
+    j["redundant"] = rk.redundant;
+    j["redundant_rows"] = nlohmann::ordered_json::array();
+    for (phiq::Index r : rk.redundant_rows)
+      j["redundant_rows"].push_back({{"constraint", model.constraints()[model.constraint_of_row(r)].name},
+                                     {"row", r},
+                                     {"name", model.row_name(r)}});
+    j["consistent"] = consistency_known ? nlohmann::ordered_json(as.consistent) : nlohmann::ordered_json();
+    j["conflicts"] = as.conflicts;
+    j["rank_tolerance"] = rk.tolerance;
+    j["rank_uncertain"] = rk.uncertain;
+    j["rank_message"] = rk.message;
+    std::cout << j.dump(2) << "\n";
+    return ok ? 0 : 1;
+  }
+
+  std::cout << "scene         " << scene_path << (scene.name.empty() ? "" : " (" + scene.name + ")") << "\n"
+            << "coordinates   " << model.num_coordinates() << "\n"
+            << "equations     " << model.num_equations() << " (" << model.num_equations() - drivers
+            << " kinematic, " << drivers << " rheonomic)\n"
+            << "constraints   " << model.constraints().size() << "\n"
+            << "jacobian      " << model.num_equations() << " x " << model.num_coordinates() << ", "
+            << model.jacobian_pattern().nnz() << " non-zeros\n"
+            << "length scale  " << model.length_scale() << " m\n"
+            << "linear solver " << phiq::to_string(model.linear_solver()) << "\n";
+  if (!analysed) {
+    std::cout << "assembly      not attempted: " << as.message << "\n";
+    return 1;
+  }
+  std::cout << "assembly      " << phiq::to_string(as.status) << " at t = " << phiq::format_time(t0) << " in "
+            << as.iterations << " iterations, scaled residual " << scientific(as.residual, 3) << " (tolerance "
+            << scientific(scene.sweep.assembly.tolerance, 3) << ")\n"
+            << "rank          " << rk.rank << " of " << rk.kinematic_equations << " kinematic equations ("
+            << rk.driven_rank << " of " << rk.equations << " with the drivers)\n"
+            << "dof           " << rk.dof << " (" << rk.driven_dof << " not driven)\n"
+            << "grubler       " << (rk.grubler ? std::to_string(*rk.grubler) : std::string("not defined")) << "\n"
+            << "redundant     " << (rk.redundant.empty() ? "none" : joined(rk.redundant)) << "\n"
+            << "consistent    "
+            << (!consistency_known ? "not known: the independent equations do not hold"
+                : as.consistent     ? "yes"
+                                    : "no: conflicting " + joined(as.conflicts))
+            << "\n";
+  if (rk.uncertain) std::cout << "uncertain     " << rk.message << "\n";
+  if (!ok) std::cout << "diagnosis     " << as.message << "\n";
+  return ok ? 0 : 1;
+}
+
+}  // namespace
+
+Command register_check(CLI::App& app) {
+  struct Args {
+    std::string path;
+    bool json = false;
+    double time = 0.0;
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* check = app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
+  check->add_option("scene", a->path, "Scene file (YAML)")->required();
+  check->add_flag("--json", a->json, "Print one JSON object (format: tools/README.md)");
+  CLI::Option* at =
+      check->add_option("--time", a->time, "Assemble and analyse at this time instead of time.start")
+          ->check(any_number());
+  return {check, [a, at] {
+            return with_stdout_checked(
+                cmd_check(a->path, a->json, at->count() ? std::optional<double>(a->time) : std::nullopt));
+          }};
+}
+
+}  // namespace phiq::tools

@@ -1,0 +1,39 @@
+// What the phiq commands share beyond their outputs and signals (cli_support.hpp): the one-line error, the scene
+// loaded or its error reported, the wall clock of their timings, and the scene made square for a sweep (run and
+// batch both solve on it).
+#pragma once
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "phiq/phiq.hpp"
+
+namespace phiq::tools {
+
+// Prints "phiq: MSG" on standard error and returns `code`, the command's exit status.
+int fail(const std::string& msg, int code);
+
+// The scene at `path`; on a scene error its one line is printed and the result is empty (the command exits 2).
+std::optional<Scene> load_or_report(const std::string& path);
+
+using Clock = std::chrono::steady_clock;
+inline double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// The scene's assembly settings (tolerance, iteration budget) for the minimum-norm assembly.
+AssemblyOptions assembly_options(const Scene& scene);
+
+// "a, b, c".
+std::string joined(const std::vector<std::string>& names);
+
+// The scene made square for the sweep (prepare_scene(): a model with redundant constraints assembled by minimum
+// norm and solved on its independent rows), or, when it cannot be (inconsistent, under-driven), the reason with
+// the time it applies to.
+std::optional<std::string> make_square(const Scene& scene, SquareScene* square);
+
+// The command's exit status, made 3 when what it wrote to standard output was lost (a full disk, a closed
+// descriptor): a report that never arrived is not a success.
+int with_stdout_checked(int status);
+
+}  // namespace phiq::tools

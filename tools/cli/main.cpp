@@ -1,0 +1,47 @@
+// phiq — command line front end: the subcommands wired to CLI11 (each declared with its options in its own file,
+// commands.hpp), and CLI11's errors made one line. See tools/README.md.
+//
+// Exit status: 0 success; 1 the mechanism could not be solved (the message names step, time and constraints), or
+// `compare` found a difference; 2 bad input (scene, CSV or command line); 3 an output (a file, standard output)
+// could not be written; 128 + the signal when interrupted (130 SIGINT, 143 SIGTERM, 129 SIGHUP).
+#include <CLI/CLI.hpp>
+
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "cli_support.hpp"
+#include "command_line.hpp"
+#include "command_support.hpp"
+#include "commands.hpp"
+#include "phiq/phiq.hpp"
+
+int main(int argc, char** argv) {
+  using namespace phiq::tools;
+  // before anything opens a file or starts a thread
+  ensure_standard_descriptors();
+  start_interrupts();
+
+  CLI::App app{"phiq: sparse, large-scale multibody kinematics"};
+  app.set_version_flag("--version", std::string("phiq ") + phiq::kVersion + " (scene format " +
+                                        std::to_string(phiq::kSceneFormat) + ", CSV format " +
+                                        std::to_string(phiq::kCsvFormat) + ", check --json format " +
+                                        std::to_string(phiq::kCheckJsonFormat) + ")");
+  app.require_subcommand(1);
+  const std::vector<Command> commands{register_run(app),    register_generate(app), register_batch(app),
+                                      register_assemble(app), register_check(app),  register_plot(app),
+                                      register_compare(app),  register_sweep_accuracy(app)};
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return with_stdout_checked(app.exit(e));  // --help, --version
+    return usage_error(app, argc, argv, e);
+  }
+  try {
+    for (const Command& c : commands)
+      if (*c.subcommand) return c.run();
+  } catch (const std::exception& e) {
+    return fail(std::string("internal error: ") + e.what(), 4);
+  }
+  return 2;
+}

@@ -1,0 +1,242 @@
+// `phiq run SCENE [-o OUT.csv]`: the scene's sweep of positions, velocities and accelerations as CSV, with its
+// summary (stderr, --summary JSON). The CSV goes to its file, or to standard output once the sweep succeeded.
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_support.hpp"
+#include "command_line.hpp"
+#include "command_support.hpp"
+#include "commands.hpp"
+#include "progress_bar.hpp"
+#include "phiq/phiq.hpp"
+
+namespace phiq::tools {
+
+namespace {
+
+// `phiq run --summary FILE.json`: the run summary, format version 1 (tools/README.md).
+std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& ws, const phiq::SweepSummary& s,
+                         double load_s, double solve_s, double write_s) {
+  nlohmann::ordered_json j;
+  j["format"] = 1;
+  j["scene"] = scene.path;
+  j["status"] = phiq::to_string(s.status);
+  j["message"] = s.message;
+  j["steps"] = s.steps_completed;
+  j["threads"] = s.threads;
+  j["parallel_chunks"] = s.parallel_chunks;
+  j["coordinates"] = scene.model->num_coordinates();
+  j["linear_solver"] = phiq::to_string(scene.model->linear_solver());
+  j["load_seconds"] = load_s;
+  j["solve_seconds"] = solve_s;
+  // the sweep's wall time: the solve and the writing done in its callback, which other threads' solving overlaps
+  j["sweep_seconds"] = s.solve_seconds;
+  j["write_seconds"] = write_s;
+  j["newton_iterations"] = s.counters.newton_iterations;
+  j["factorizations"] = s.counters.factorizations;
+  j["pivoting_factorizations"] = ws.lu ? ws.lu->pivoting_factorizations() : 0;
+  j["velocity_solves"] = s.counters.velocity_solves;
+  j["acceleration_solves"] = s.counters.acceleration_solves;
+  j["phi_t_evaluations"] = s.counters.phi_t_evaluations;
+  j["gamma_evaluations"] = s.counters.gamma_evaluations;
+  j["residual_evaluations"] = s.counters.residual_evaluations;
+  j["point_evaluations"] = s.counters.point_evaluations;
+  j["subdivisions"] = s.subdivisions;
+  j["singular_positions"] = s.singular_positions;
+  // 0 in the summary means no row measured it (a positions-only sweep factorises at Newton iterates, not at the
+  // solutions): null, not a condition number of 0, which would read as a singular Jacobian
+  if (s.min_rcond > 0.0)
+    j["min_rcond"] = s.min_rcond;
+  else
+    j["min_rcond"] = nullptr;
+  j["warnings"] = nlohmann::ordered_json::array();
+  for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});
+  return j.dump(2) + "\n";
+}
+
+int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
+            int threads, double memory_gb, ProgressBar::Mode progress_mode) {
+  // Outputs that would replace the scene or each other are refused before anything is read or solved.
+  std::vector<NamedPath> outs;
+  if (!out_path.empty()) outs.push_back({"-o", out_path});
+  if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
+  if (const auto clash = output_clash(outs, {{"the scene", scene_path}})) return fail("run: " + *clash, 2);
+  if (out_path.empty() && stdout_was_closed())
+    return fail("run: standard output: cannot write: it is closed", 3);
+  set_interrupt_subject(scene_path, "; no output written");
+  const auto load_start = Clock::now();
+  std::optional<phiq::Scene> loaded = load_or_report(scene_path);
+  if (!loaded) return 2;
+  phiq::Scene& scene = *loaded;
+  const double load_s = since(load_start);
+
+  // Every output exists (as a temporary, or a device opened) before the solve: an unwritable path fails now, not
+  // after the sweep; they are committed together at the end, or none of them appears.
+  OutputSet outputs;
+  phiq::AtomicOutputFile* file = nullptr;
+  phiq::AtomicOutputFile* summary_file = nullptr;
+  try {
+    if (!out_path.empty()) file = &outputs.add(out_path);
+    if (!summary_path.empty()) summary_file = &outputs.add(summary_path);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+
+  // inconsistent or under-driven models stop here, naming the constraints
+  phiq::SquareScene square;
+  if (const auto why = make_square(scene, &square))
+    return fail(scene_path + ": " + *why + (outs.empty() ? "" : "; no output written"), 1);
+  const phiq::AssemblySummary& redundancy = square.assembly;
+  const phiq::Model& model = square.model(*scene.model);
+  scene.sweep.threads = threads;
+  scene.sweep.memory_budget = static_cast<std::size_t>(memory_gb * 1e9);
+  phiq::Workspace ws(model);
+  ws.q = square.start;
+  // columns from the scene (its constraints and outputs); residuals of a model solved on its independent rows
+  // are evaluated on the whole scene model (CsvFormat)
+  phiq::CsvFormat csv(scene);
+
+  // Where the CSV goes: the output file, or standard output after success, spooled through an anonymous temporary
+  // file so that memory stays bounded however long the sweep is.
+  std::FILE* spool = nullptr;
+  std::string buffer = csv.header();
+  if (!file && !(spool = std::tmpfile())) return fail("cannot create a temporary file for standard output", 3);
+  struct CloseSpool {
+    std::FILE* f;
+    ~CloseSpool() {
+      if (f) std::fclose(f);
+    }
+  } close_spool{spool};
+  auto flush = [&] {
+    if (file) file->write(buffer);
+    else if (std::fwrite(buffer.data(), 1, buffer.size(), spool) != buffer.size())
+      throw phiq::Error("cannot write the temporary file for standard output");
+    buffer.clear();
+  };
+
+  phiq::SweepSummary summary;
+  double write_s = 0.0;  // formatting and writing rows, timed inside the step callback
+  ProgressBar progress(scene.sweep.steps + 1,
+                                    quiet ? ProgressBar::Mode::kNever : progress_mode);
+  try {
+    StopOnSignal stop_on_signal;  // a signal stops the sweep at its next row
+    const std::atomic<bool>& stop = stop_flag();
+    phiq::run_sweep(model, scene.sweep, ws, [&](const phiq::StepView& step) {
+      const auto w0 = Clock::now();
+      csv.append_row(step, buffer);
+      if (buffer.size() > (1u << 20)) flush();
+      progress.update(step.step + 1);
+      write_s += since(w0);
+      return !stop.load();
+    }, &summary);
+  } catch (const phiq::Error& e) {
+    progress.finish();
+    return fail(scene_path + ": " + e.what(), 3);
+  }
+  progress.finish();
+
+  // (also a signal that came after the last row: the command stops before committing, as it said it would)
+  if (summary.status == phiq::SolveStatus::kCancelled || stop_flag().load())
+    return fail(scene_path + ": " + interrupt_message() + "; no output written",
+                interrupt_exit_status());
+  if (summary.status != phiq::SolveStatus::kSuccess) {
+    std::string why = summary.message;
+    // A square model not assembled at its first position: singular there (redundant constraints and missing
+    // drivers in equal numbers, or a singular placement), or Newton found no descent from the placement (the
+    // Jacobian of a Cardan joint at 90° drops rank there). The minimum-norm assembly and its rank analysis say which.
+    if (summary.failed_step == 0 && summary.status != phiq::SolveStatus::kOutsideTimeDomain &&
+        summary.status != phiq::SolveStatus::kNonFinite && !square.reduced) {
+      Eigen::VectorXd q = scene.model->initial_positions();
+      phiq::AssemblySummary as;
+      std::unique_ptr<phiq::Model> unused;
+      if (phiq::prepare_square(*scene.model, scene.sweep.t_begin, assembly_options(scene), q, &unused, &as) !=
+          phiq::SolveStatus::kSuccess)
+        why += "; rank analysis: " + as.message;
+    }
+    return fail(scene_path + ": " + why + (outs.empty() ? "" : "; no output written"), 1);
+  }
+  const double solve_s = summary.solve_seconds - write_s;
+  const auto final_write = Clock::now();
+  try {
+    flush();
+    if (file) {
+      file->finish();
+    } else {
+      // what reaches standard output cannot be taken back: a signal from here on says so
+      set_interrupt_subject(scene_path, "; standard output incomplete");
+      std::rewind(spool);
+      char chunk[1 << 16];
+      for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, spool)) > 0;)
+        if (std::fwrite(chunk, 1, n, stdout) != n)
+          throw phiq::Error(std::string("standard output: cannot write: ") + std::strerror(errno));
+      if (const auto bad = stdout_error()) throw phiq::Error(*bad);
+    }
+    write_s += since(final_write);
+    if (summary_file) summary_file->write(summary_json(scene, ws, summary, load_s, solve_s, write_s));
+    outputs.commit();
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  if (!quiet) {
+    if (!redundancy.rank.redundant.empty())
+      std::cerr << "phiq: " << scene_path << ": redundant equations left out of the solve (consistent): "
+                << joined(redundancy.rank.redundant) << "\n";
+    for (const auto& w : summary.warnings)
+      std::cerr << "phiq: " << scene_path << ": warning: t = " << phiq::format_time(w.t) << ": " << w.kind << ": "
+                << w.message << "\n";
+    std::cerr << "phiq: " << scene_path << ": " << summary.BriefReport();
+    if (summary.min_rcond > 0)
+      std::cerr << ", min rcond " << scientific(summary.min_rcond, 3) << " at t = "
+                << phiq::format_time(summary.min_rcond_time);
+    if (file) std::cerr << "; wrote " << out_path;
+    std::cerr << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command register_run(CLI::App& app) {
+  struct Args {
+    std::string scene_path, out_path, summary_path;
+    bool quiet = false;
+    int threads = 0;
+    double memory_gb = 0.0;
+    std::string progress = "auto";
+  };
+  auto a = std::make_shared<Args>();
+  CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
+  run->add_option("scene", a->scene_path, "Scene file (YAML)")->required();
+  run->add_option("-o,--output", a->out_path, "CSV file to write (default or '-': standard output)")
+      ->transform(output_path(" (without the option, or '-': standard output)", true));
+  run->add_flag("-q,--quiet", a->quiet, "Do not print the run summary on standard error");
+  run->add_option("--summary", a->summary_path,
+                  "Write the run summary as JSON (counts and timings) to this file ('-': standard output)")
+      ->transform(output_path("", false));
+  run->add_option("--threads", a->threads, "Threads for the drive steps (0: all cores; 1: in order)")
+      ->capture_default_str()
+      ->check(thread_count());
+  run->add_option("--memory", a->memory_gb,
+                  "GB the drive steps may use with --threads 0: fewer threads when theirs would not fit (0: what the "
+                  "system reports available)")
+      ->capture_default_str()
+      ->check(number(0.0, 1e6, false, "a number of GB from 0 (what the system reports available) to 1000000"));
+  run->add_option("--progress", a->progress,
+                  "Progress bar on standard error: auto (when it is a terminal), always, never")
+      ->capture_default_str()
+      ->check(one_of({"auto", "always", "never"}));
+  return {run, [a] {
+            using Mode = ProgressBar::Mode;
+            const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
+            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->quiet, a->summary_path,
+                                               cap_threads("run", a->threads, a->quiet), a->memory_gb, mode));
+          }};
+}
+
+}  // namespace phiq::tools
