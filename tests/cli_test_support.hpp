@@ -1,0 +1,98 @@
+// What the tests of the `phiq` command (test_cli_*.cpp) share: the Cli fixture, which runs the binary in a
+// directory of its own and captures its exit status and output, and the scenes and checks several of them use.
+// Not in an anonymous namespace: every file's TEST_F(Cli, ...) must derive from this one fixture class.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace phiq::test {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int code;
+  std::string out, err;
+};
+
+inline std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("phiq_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result run(const std::string& args) { return run_prefixed("", args); }
+  Result run_prefixed(const std::string& prefix, const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = prefix + std::string(PHIQ_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const int st = std::system(cmd.c_str());
+    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(out), slurp(err)};
+  }
+  fs::path write(const std::string& name, const std::string& text) {
+    fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+  // The directory holds nothing but the named files (no partial or temporary output).
+  std::vector<std::string> files() const {
+    std::vector<std::string> v;
+    for (auto& e : fs::directory_iterator(dir_)) v.push_back(e.path().filename().string());
+    std::sort(v.begin(), v.end());
+    return v;
+  }
+  fs::path dir_;
+};
+
+// One line on stderr, "phiq: " first.
+inline ::testing::AssertionResult one_phiq_line(const std::string& err) {
+  if (std::count(err.begin(), err.end(), '\n') == 1 && err.rfind("phiq: ", 0) == 0)
+    return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "not one 'phiq: ' line: " << err;
+}
+
+// The four-bar of models/seed/fourbar_mixed.yaml with every kind of output: two points (B, natural; P on the
+// coupler body), the driver, residuals and rcond.
+inline constexpr const char* kFourbarOutputs = R"(phiq: 1
+name: fourbar_outputs
+parameters: {L1: 1.0, L2: 0.4, L3: 1.2, L4: 1.0}
+coordinates: {theta2: 0.0, xA: 0.4, yA: 0.0, x3: 0.7, y3: 0.5, psi3: 1.0, xB: 1.1, yB: 1.0}
+points: {O: [0, 0], A: [xA, yA], B: [xB, yB], C: [L1, 0]}
+bodies: {coupler: [x3, y3, psi3]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: A, type: revolute, between: [{body: coupler, at: [-L3/2, 0]}, {point: A}]}
+  - {name: B, type: revolute, between: [{body: coupler, at: [L3/2, 0]}, {point: B}]}
+  - {name: rocker, type: distance, points: [C, B], length: L4}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 2*pi, steps: 72}
+output:
+  velocities: true
+  points: [B, {name: P, body: coupler, at: [0, 0.3]}]
+  drivers: [motor]
+  residuals: [rocker]
+  max_residual: true
+  rcond: true
+)";
+
+}  // namespace phiq::test

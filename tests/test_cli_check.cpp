@@ -1,0 +1,150 @@
+// `phiq check` and `phiq assemble`: counts and assembly in text and JSON, the rank analysis of redundant
+// constraints (rank, dof, conflicts) at the time asked, `run` refusing inconsistent redundancy in one line, and
+// failure times written with their digits.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_test_support.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using phiq::test::Cli;
+using phiq::test::Result;
+using phiq::test::slurp;
+using phiq::test::one_phiq_line;
+namespace fs = std::filesystem;
+
+TEST_F(Cli, CheckReportsCountsAndAssembly) {
+  Result r = run("check " + phiq::test::model_path("seed/fourbar_reference_point.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("coordinates   9"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("equations     9 (8 kinematic, 1 rheonomic)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("assembly      success"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, CheckJsonIsOneVersionedObject) {
+  Result r = run("check --json " + phiq::test::model_path("seed/fourbar_natural.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  // key order and values, without a JSON library in the test: the format is documented line by line
+  for (const char* part : {"\"format\": 1", "\"coordinates\": 5", "\"equations\": 5", "\"kinematic_equations\": 4",
+                           "\"driver_equations\": 1", "\"status\": \"success\"", "\"worst\": []"})
+    EXPECT_NE(r.out.find(part), std::string::npos) << part << "\n" << r.out;
+  EXPECT_EQ(r.out.front(), '{');
+  EXPECT_EQ(r.out.substr(r.out.size() - 2), "}\n");
+}
+
+TEST_F(Cli, CheckJsonNamesTheWorstConstraintsWhenAssemblyFails) {
+  // a coupler too short to close the loop: no assembly exists
+  std::string scene = slurp(phiq::test::model_path("seed/fourbar_natural.yaml"));
+  scene.replace(scene.find("L3: 1.2"), 7, "L3: 0.1");
+  fs::path p = write("open.yaml", scene);
+  Result r = run("check --json " + p.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.out.find("\"status\": \"not converged\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"constraint\": \""), std::string::npos) << r.out;
+}
+
+const char* kPlanarDoorMisaligned = R"(phiq: 1
+coordinates: {x: 0.01, y: -0.02, psi: 0.1}
+bodies: {door: [x, y, psi]}
+constraints:
+  - {name: pin1, type: revolute, between: [{body: door, at: [0, 0]}, {body: ground, at: [0, 0]}]}
+  - {name: pin2, type: revolute, between: [{body: door, at: [0, 0]}, {body: ground, at: [0.001, 0]}]}
+drivers:
+  - {name: motor, coordinate: psi, law: {type: linear, initial: 0.2, rate: 1}}
+time: {start: 0, end: 1, steps: 10}
+)";
+
+TEST_F(Cli, CheckJsonReportsRankDofAndRedundantConstraints) {
+  Result r = run("check --json " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  for (const char* part : {"\"coordinates\": 12", "\"equations\": 13", "\"rank\": 11", "\"dof\": 1",
+                           "\"driven_dof\": 0", "\"grubler\": ", "\"redundant\": [\n    \"A3\"\n  ]",
+                           "\"name\": \"A3[1]\"", "\"consistent\": true", "\"conflicts\": []",
+                           "\"rank_uncertain\": false"})
+    EXPECT_NE(r.out.find(part), std::string::npos) << part << "\n" << r.out;
+  Result text = run("check " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  EXPECT_NE(text.out.find("redundant     A3\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("dof           1 (0 not driven)\n"), std::string::npos) << text.out;
+}
+
+TEST_F(Cli, CheckNamesTheConflictsOfInconsistentRedundancy) {
+  fs::path p = write("door.yaml", kPlanarDoorMisaligned);
+  Result r = run("check --json " + p.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.out.find("\"consistent\": false"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"conflicts\": [\n    \"pin1\",\n    \"pin2\"\n  ]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"status\": \"inconsistent redundant constraints\""), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, RunRefusesInconsistentRedundancyInOneLineAndWritesNothing) {
+  fs::path p = write("door.yaml", kPlanarDoorMisaligned);
+  Result r = run("run " + p.string() + " -o " + (dir_ / "out.csv").string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("t = 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("conflicting constraints: pin1, pin2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("no output written"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.csv"));
+}
+
+TEST_F(Cli, AssembleWritesTheAssembledCoordinatesAsOneCsvRow) {
+  const fs::path out = dir_ / "q.csv";
+  Result r = run("assemble " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml") + " -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string text = slurp(out);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2) << text;
+  EXPECT_EQ(text.substr(0, text.find('\n')), "t,x1,y1,psi1,x2,y2,psi2,x3,y3,psi3,xc,yc,psic");
+  // the row: every crank at pi/3 (the motor at t = 0), the coupler's left end at (cos, sin) of it
+  std::vector<double> v;
+  std::stringstream row(text.substr(text.find('\n') + 1));
+  for (std::string cell; std::getline(row, cell, ',');) v.push_back(std::stod(cell));
+  ASSERT_EQ(v.size(), 13u);
+  for (int k : {3, 6, 9}) EXPECT_NEAR(v[k], M_PI / 3, 1e-10);
+  EXPECT_NEAR(v[10], 0.5, 1e-10);
+  EXPECT_NEAR(v[11], std::sqrt(3.0) / 2, 1e-10);
+  // an inconsistent model: exit 1, nothing written
+  fs::path p = write("door.yaml", kPlanarDoorMisaligned);
+  EXPECT_EQ(run("assemble " + p.string() + " -o " + (dir_ / "door.csv").string()).code, 1);
+  EXPECT_FALSE(fs::exists(dir_ / "door.csv"));
+}
+
+
+TEST_F(Cli, CheckAnalysesTheConfigurationAtTheTimeAsked) {
+  const std::string scene = phiq::test::model_path("redundant/parallelogram_change_point.yaml");
+  Result normal = run("check --json " + scene);
+  ASSERT_EQ(normal.code, 0) << normal.err;
+  EXPECT_NE(normal.out.find("\"rank\": 8"), std::string::npos) << normal.out;
+  EXPECT_NE(normal.out.find("\"rank_uncertain\": false"), std::string::npos) << normal.out;
+  // the crank driven to 0: flat, a change point; assembled only to about 1e-6 there, which the analysis reports
+  Result flat = run("check --json --time -1.0471975511965976 " + scene);
+  EXPECT_NE(flat.out.find("\"time\": -1.0471975511965976"), std::string::npos) << flat.out;
+  EXPECT_NE(flat.out.find("\"rank_uncertain\": true"), std::string::npos) << flat.out;
+  EXPECT_NE(flat.out.find("singular value"), std::string::npos) << flat.out;
+}
+
+// Times in failures keep their digits: time.start 1e-7 is "t = 1e-07", not std::to_string's "t = 0.000000" (run's
+// refusal of an inconsistent model at the start, assemble's failure).
+TEST_F(Cli, FailureTimesKeepTheirDigits) {
+  std::string text = kPlanarDoorMisaligned;
+  text.replace(text.find("start: 0,"), 9, "start: 1e-7,");
+  const fs::path p = write("door.yaml", text);
+  for (const std::string cmd : {"run ", "assemble "}) {
+    Result r = run(cmd + p.string() + " -o " + (dir_ / "out.csv").string());
+    EXPECT_EQ(r.code, 1) << cmd << r.err;
+    EXPECT_TRUE(one_phiq_line(r.err)) << cmd;
+    EXPECT_NE(r.err.find("door.yaml: t = 1e-07: "), std::string::npos) << cmd << r.err;
+    EXPECT_EQ(r.err.find("0.000000"), std::string::npos) << cmd << r.err;
+  }
+  Result c = run("check " + p.string());
+  EXPECT_NE(c.out.find(" at t = 1e-07 in "), std::string::npos) << c.out;
+}
+
+}  // namespace
