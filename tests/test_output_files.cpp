@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "phiq/csv_writer.hpp"
+#include "atomic_file.hpp"
 
 namespace phiq {
 namespace {

@@ -1,10 +1,15 @@
-// The constraints section (scene_reader.hpp): the planar readers (read_constraint) and the spatial ones
-// (read_constraint_3d, add_joint3), with the references a constraint is made of — points, segments, bodies,
-// attachments of a pair, sides of a spatial joint, directions of a dot product. One file, so that the reading of
-// constraint kinds can be replaced as a whole.
-#include <set>
+// The constraints section (scene_reader.hpp): read_constraint hands each entry to the kind of the registry that
+// claims its type (kinds/registry.hpp), and the references a constraint is made of — points, segments, bodies,
+// attachments of a pair, sides of a spatial joint, directions of a dot product — which the kinds read through
+// KindFields (kind_fields.hpp).
+#include <algorithm>
+#include <concepts>
+#include <string_view>
 #include <tuple>
+#include <vector>
 
+#include "phiq/constraint_kinds.hpp"
+#include "scene/kind_fields.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace phiq::detail::scene {
@@ -53,99 +58,83 @@ std::pair<Frame2, kin::V2> SceneReader::attachment(const C& c) const {
   return {f, at};
 }
 
+namespace {
+
+// Whether a kind is written in the `constraints` section (some are drivers, or added with bodies and vectors).
+template <class K>
+constexpr bool read_as_constraint() {
+  for (const SceneForm& f : K::kScene)
+    if (std::string_view(f.section) == "constraints") return true;
+  return false;
+}
+// A spatial joint's sides, kept by name for the joint drivers that measure it.
+template <class K>
+constexpr bool is_spatial_joint() {
+  return requires(const K& k) {
+    { k.a } -> std::convertible_to<JointSide3>;
+    { k.b } -> std::convertible_to<JointSide3>;
+  };
+}
+bool in_dimension(const SceneForm& f, int dimension) { return f.dimension == 0 || f.dimension == dimension; }
+
+// The constraint types of one dimension, in registry order, for the message about an unknown one.
+std::string constraint_types(int dimension) {
+  std::vector<std::string_view> types;
+  ConstraintKinds::for_each([&]<class K>() {
+    for (const SceneForm& f : K::kScene)
+      if (std::string_view(f.section) == "constraints" && in_dimension(f, dimension) &&
+          std::find(types.begin(), types.end(), f.type) == types.end())
+        types.push_back(f.type);
+  });
+  std::string list;
+  for (std::string_view t : types) list += (list.empty() ? "" : ", ") + std::string(t);
+  return list;
+}
+// Whether `type` is a constraint type of some dimension.
+bool constraint_type_of(const std::string& type, int dimension) {
+  bool found = false;
+  ConstraintKinds::for_each([&]<class K>() {
+    for (const SceneForm& f : K::kScene)
+      found = found || (std::string_view(f.section) == "constraints" && in_dimension(f, dimension) && type == f.type);
+  });
+  return found;
+}
+
+}  // namespace
+
+// A constraint is read by the kind that claims its type in the scene's dimension (kinds/registry.hpp): the kind's
+// own read() in the scene vocabulary (kind_fields.hpp).
 template <class C>
 void SceneReader::read_constraint(const C& c) {
   if (!c.is_map()) c.fail("a constraint is a mapping with a 'type'");
   const std::string type = c.require("type").text();
   std::string name;
   if (auto n = c.field("name"); n.present()) name = n.name();
-  if (spatial_) return read_constraint_3d(c, type, name);
-  static const std::set<std::string> spatial_only = {"spherical", "cylindrical", "universal", "planar",
-                                                     "rigid",     "point_on_plane", "dot"};
-  if (spatial_only.count(type))
-    c.require("type").fail("'" + type + "' is a spatial constraint: it needs 'dimension: 3'");
+  const int dimension = spatial_ ? 3 : 2;
+  if (!constraint_type_of(type, dimension)) {
+    if (!spatial_ && constraint_type_of(type, 3))
+      c.require("type").fail("'" + type + "' is a spatial constraint: it needs 'dimension: 3'");
+    if (spatial_ && constraint_type_of(type, 2))
+      c.require("type").fail("'" + type + "' is a planar constraint; this scene has 'dimension: 3'");
+    c.require("type").fail("unknown constraint type '" + type + "' (" + (spatial_ ? "dimension 3: " : "") +
+                           constraint_types(dimension) + ")");
+  }
   try {
-    if (type == "distance") {
-      c.expect_map({"type", "name", "points", "length"});
-      auto [a, b] = segment(c.require("points"));
-      add(c, name, DistanceSpec{a, b, positive(c.require("length"))});
-    } else if (type == "fixed_point") {
-      c.expect_map({"type", "name", "point", "at"});
-      Point2 p = point(c.require("point"));
-      kin::V2 at = vec2(c.require("at"));
-      add(c, name, PinSpec{Frame2{p.x, p.y, Slot::constant(0)},
-                           Frame2{Slot::constant(at.x), Slot::constant(at.y), Slot::constant(0)}, {0, 0}, {0, 0}});
-    } else if (type == "point_on_line") {
-      c.expect_map({"type", "name", "point", "line"});
-      auto [a, b] = segment(c.require("line"));
-      add(c, name, PointOnLineSpec{point(c.require("point")), a, b, 1.0});
-    } else if (type == "constant_angle") {
-      c.expect_map({"type", "name", "segments", "angle"});
-      auto segs = c.require("segments");
-      if (!segs.is_sequence() || segs.size() != 2) segs.fail("expected two segments [[A, B], [C, D]]");
-      auto [a, b] = segment(segs.at(0));
-      auto [cc, d] = segment(segs.at(1));
-      add(c, name, ConstantAngleSpec{a, b, cc, d, number(c.require("angle")), 1.0});
-    } else if (type == "segment_angle") {
-      c.expect_map({"type", "name", "segment", "angle"});
-      auto [a, b] = segment(c.require("segment"));
-      add(c, name, SegmentAngleSpec{a, b, Slot::coordinate(coordinate(c.require("angle")))});
-    } else if (type == "polar") {
-      c.expect_map({"type", "name", "point", "origin", "length", "angle"});
-      add(c, name, PolarSpec{point(c.require("point")), point(c.require("origin")), number(c.require("length")),
-                             slot(c.require("angle"))});
-    } else if (type == "revolute") {
-      c.expect_map({"type", "name", "between"});
-      auto between = c.require("between");
-      if (!between.is_sequence() || between.size() != 2) between.fail("a revolute joins two attachments");
-      auto [fa, sa] = attachment(between.at(0));
-      auto [fb, sb] = attachment(between.at(1));
-      add(c, name, PinSpec{fa, fb, sa, sb});
-    } else if (type == "prismatic") {
-      c.expect_map({"type", "name", "between", "axis", "angle"});
-      auto between = c.require("between");
-      if (!between.is_sequence() || between.size() != 2) between.fail("a prismatic pair joins two attachments");
-      auto [fa, sa] = attachment(between.at(0));
-      auto [fb, sb] = attachment(between.at(1));
-      if (!fa.psi.is_coordinate() && !fb.psi.is_coordinate() && !between.at(0).field("body").present())
-        between.fail("a prismatic pair needs bodies");
-      PrismaticSpec spec{fa, fb, sa, sb, {1, 0}, 0.0};
-      if (auto ax = c.field("axis"); ax.present()) spec.axis = vec2(ax);
-      if (auto an = c.field("angle"); an.present()) spec.angle = number(an);
-      if (spec.axis.x == 0.0 && spec.axis.y == 0.0) c.field("axis").fail("the axis must not be zero");
-      add(c, name, spec);
-    } else if (type == "loop") {
-      c.expect_map({"type", "name", "links", "closure"});
-      LoopSpec spec;
-      for (const auto& l : c.require("links").items()) {
-        l.expect_map({"length", "angles", "offset"});
-        LoopSpec::Link link;
-        link.length = slot(l.require("length"));
-        if (auto o = l.field("offset"); o.present()) link.offset = number(o);
-        if (auto as = l.field("angles"); as.present()) {
-          for (const auto& a : as.items()) {
-            std::string s = a.text();
-            double sign = 1.0;
-            if (!s.empty() && (s[0] == '-' || s[0] == '+')) sign = s[0] == '-' ? -1.0 : 1.0, s = s.substr(1);
-            Index j = builder_.find_coordinate(s);
-            if (j < 0) a.fail("unknown coordinate '" + s + "'");
-            link.terms.push_back({Slot::coordinate(j), sign});
-          }
+    bool read = false;
+    ConstraintKinds::for_each([&]<class K>() {
+      if constexpr (read_as_constraint<K>()) {
+        if (read) return;
+        for (const SceneForm& f : K::kScene) {
+          if (std::string_view(f.section) != "constraints" || !in_dimension(f, dimension) || type != f.type) continue;
+          K spec = K::read(KindFields<C>(*this, c, type));
+          if constexpr (is_spatial_joint<K>())
+            if (!name.empty()) joints3_[name] = Joint3{type, spec.a, spec.b};
+          add(c, name, std::move(spec));
+          read = true;
+          return;
         }
-        spec.links.push_back(std::move(link));
       }
-      if (spec.links.empty()) c.require("links").fail("a loop needs at least one link");
-      if (auto cl = c.field("closure"); cl.present()) spec.closure = vec2(cl);
-      add(c, name, std::move(spec));
-    } else if (type == "equation") {
-      c.expect_map({"type", "name", "expr", "unit"});
-      EquationSpec spec{compile(c.require("expr"), true), std::nullopt, unit(c.field("unit"))};
-      add(c, name, std::move(spec));
-    } else {
-      c.require("type").fail("unknown constraint type '" + type +
-                             "' (distance, fixed_point, point_on_line, constant_angle, segment_angle, polar, "
-                             "revolute, prismatic, loop, equation)");
-    }
+    });
   } catch (const Error& e) {
     c.fail(e.what());
   }
@@ -224,82 +213,6 @@ std::pair<Attachment3, Attachment3> SceneReader::dot_direction(const C& c, Unit&
   }
   unit = Unit::kNone;
   return {Attachment3::natural(vector3(c)), Attachment3::zero()};
-}
-
-template <class Spec, class C>
-void SceneReader::add_joint3(const C& c, const std::string& name, const std::string& type) {
-  c.expect_map({"type", "name", "between"});
-  Spec spec;
-  std::tie(spec.a, spec.b) = sides3(c, type);
-  if (!name.empty()) joints3_[name] = Joint3{type, spec.a, spec.b};
-  add(c, name, std::move(spec));
-}
-
-template <class C>
-void SceneReader::read_constraint_3d(const C& c, const std::string& type, const std::string& name) {
-  try {
-    if (type == "distance") {
-      c.expect_map({"type", "name", "points", "between", "length"});
-      SpatialDistanceSpec spec;
-      if (c.field("points").present() == c.field("between").present())
-        c.fail("a distance has either 'points' (natural points) or 'between' (attachments)");
-      if (auto pts = c.field("points"); pts.present()) {
-        if (!pts.is_sequence() || pts.size() != 2) pts.fail("a distance joins two points [A, B]");
-        spec.ends[0] = Attachment3::natural(point3(pts.at(0)));
-        spec.ends[1] = Attachment3::natural(point3(pts.at(1)));
-      } else {
-        auto [a, b] = sides3(c, "distance");
-        spec.ends[0] = Attachment3::body_point(a.frame, a.at);
-        spec.ends[1] = Attachment3::body_point(b.frame, b.at);
-      }
-      spec.length = positive(c.require("length"));
-      add(c, name, spec);
-    } else if (type == "fixed_point") {
-      c.expect_map({"type", "name", "point", "at"});
-      SphericalSpec spec;
-      spec.a = JointSide3::natural_point(point3(c.require("point")));
-      spec.b = JointSide3::body(Frame3::ground(), vec3(c.require("at")));
-      add(c, name, std::move(spec));
-    } else if (type == "dot") {
-      c.expect_map({"type", "name", "directions", "value"});
-      auto dirs = c.require("directions");
-      if (!dirs.is_sequence() || dirs.size() != 2) dirs.fail("a dot product has two directions [D1, D2]");
-      DotSpec spec;
-      std::tie(spec.ends[0], spec.ends[1]) = dot_direction(dirs.at(0), spec.end_units[0]);
-      std::tie(spec.ends[2], spec.ends[3]) = dot_direction(dirs.at(1), spec.end_units[1]);
-      spec.value = number(c.require("value"));
-      add(c, name, spec);
-    } else if (type == "spherical") {
-      add_joint3<SphericalSpec>(c, name, type);
-    } else if (type == "revolute") {
-      add_joint3<SpatialRevoluteSpec>(c, name, type);
-    } else if (type == "prismatic") {
-      add_joint3<SpatialPrismaticSpec>(c, name, type);
-    } else if (type == "cylindrical") {
-      add_joint3<CylindricalSpec>(c, name, type);
-    } else if (type == "universal") {
-      add_joint3<UniversalSpec>(c, name, type);
-    } else if (type == "planar") {
-      add_joint3<PlanarSpec>(c, name, type);
-    } else if (type == "rigid") {
-      add_joint3<RigidSpec>(c, name, type);
-    } else if (type == "point_on_line") {
-      add_joint3<SpatialPointOnLineSpec>(c, name, type);
-    } else if (type == "point_on_plane") {
-      add_joint3<PointOnPlaneSpec>(c, name, type);
-    } else if (type == "equation") {
-      c.expect_map({"type", "name", "expr", "unit"});
-      add(c, name, EquationSpec{compile(c.require("expr"), true), std::nullopt, unit(c.field("unit"))});
-    } else if (type == "polar" || type == "segment_angle" || type == "constant_angle" || type == "loop") {
-      c.require("type").fail("'" + type + "' is a planar constraint; this scene has 'dimension: 3'");
-    } else {
-      c.require("type").fail("unknown constraint type '" + type +
-                             "' (dimension 3: distance, fixed_point, dot, spherical, revolute, prismatic, "
-                             "cylindrical, universal, planar, rigid, point_on_line, point_on_plane, equation)");
-    }
-  } catch (const Error& e) {
-    c.fail(e.what());
-  }
 }
 
 // The constraint readers, and the references they read (points, bodies, attachments, sides), for plain entries

@@ -6,7 +6,8 @@
 //   read_families.cpp    family keys and bodies copied out of the YAML tree, the total of family entries
 //   family_expansion.hpp the walk over the members of families (templates over the callers' lambdas)
 //   read_entities.cpp    parameters, coordinates, points, bodies, vectors
-//   read_constraints.cpp constraints, planar and spatial, and the attachments, sides and segments they refer to
+//   read_constraints.cpp constraints, each read by its kind (kinds/registry.hpp, through kind_fields.hpp), and the
+//                        attachments, sides and segments they refer to
 //   read_drivers.cpp     drivers, joint drivers and motion laws
 //   read_settings.cpp    time, output, solver
 // The readers are templates over the cursor type C: Cursor (a plain entry of the YAML tree) or TCursor (a member
@@ -36,7 +37,13 @@ namespace phiq::detail::scene {
 // The fixed frame, predefined in every scene.
 const char* const kGround = "ground";
 
+template <class C>
+class KindFields;
+
 class SceneReader {
+  template <class C>
+  friend class KindFields;  // the scene vocabulary the constraint kinds read themselves with
+
  public:
   SceneReader(const std::string& file, const SceneLimits& limits) : file_(file), limits_(limits) {
     families_.file = &file_;
@@ -141,10 +148,6 @@ class SceneReader {
   std::pair<JointSide3, JointSide3> sides3(const C& c, const std::string& type) const;
   template <class C>
   std::pair<Attachment3, Attachment3> dot_direction(const C& c, Unit& unit) const;
-  template <class Spec, class C>
-  void add_joint3(const C& c, const std::string& name, const std::string& type);
-  template <class C>
-  void read_constraint_3d(const C& c, const std::string& type, const std::string& name);
   // Adds a constraint or driver to the model, named `name` or KIND#N (below).
   template <class C, class Spec>
   void add(const C& c, const std::string& name, Spec spec);

@@ -1,0 +1,129 @@
+// The scene vocabulary a constraint kind reads itself with (kinds/kind_support.hpp, "The scene vocabulary of the
+// kinds"): one entry of the `constraints` list, plain (Cursor) or a family member (TCursor), seen through the
+// reader's tables of points, bodies and coordinates. Every read names its field, so that an error carries the
+// file, line and field path; the wording of each message is the one the scene format documents.
+#pragma once
+
+#include <initializer_list>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "scene/scene_reader.hpp"
+
+namespace phiq::detail::scene {
+
+template <class C>
+class KindFields {
+ public:
+  KindFields(const SceneReader& reader, C entry, const std::string& type)
+      : r_(reader), c_(std::move(entry)), type_(type) {}
+
+  const std::string& type() const { return type_; }
+  void expect(std::initializer_list<const char*> allowed) const { c_.expect_map(allowed); }
+  bool present(const char* field) const { return c_.field(field).present(); }
+  // `field` empty: the entry itself.
+  [[noreturn]] void fail(const char* field, const std::string& what) const {
+    if (*field == '\0') c_.fail(what);
+    c_.field(field).fail(what);
+  }
+
+  double number(const char* field) const { return r_.number(c_.require(field)); }
+  double positive(const char* field) const { return r_.positive(c_.require(field)); }
+  Slot slot(const char* field) const { return r_.slot(c_.require(field)); }
+  Index coordinate(const char* field) const { return r_.coordinate(c_.require(field)); }
+  kin::V2 vec2(const char* field) const { return r_.vec2(c_.require(field)); }
+  Point2 point(const char* field) const { return r_.point(c_.require(field)); }
+  std::pair<Point2, Point2> segment(const char* field) const { return r_.segment(c_.require(field)); }
+  std::pair<std::pair<Point2, Point2>, std::pair<Point2, Point2>> two_segments(const char* field) const {
+    auto segs = c_.require(field);
+    if (!segs.is_sequence() || segs.size() != 2) segs.fail("expected two segments [[A, B], [C, D]]");
+    auto u = r_.segment(segs.at(0));
+    return {u, r_.segment(segs.at(1))};
+  }
+
+  // An attachment of a planar pair, and whether it was written {body: …} (not {point: …}).
+  struct Attachment {
+    Frame2 frame;
+    kin::V2 at;
+    bool body;
+  };
+  std::pair<Attachment, Attachment> attachments(const char* field, const char* arity_message) const {
+    auto between = c_.require(field);
+    if (!between.is_sequence() || between.size() != 2) between.fail(arity_message);
+    auto [fa, sa] = r_.attachment(between.at(0));
+    auto [fb, sb] = r_.attachment(between.at(1));
+    return {Attachment{fa, sa, between.at(0).field("body").present()},
+            Attachment{fb, sb, between.at(1).field("body").present()}};
+  }
+
+  // The entries of a list field, each read with this same vocabulary.
+  std::vector<KindFields> items(const char* field) const {
+    std::vector<KindFields> out;
+    for (const auto& item : c_.require(field).items()) out.emplace_back(r_, item, type_);
+    return out;
+  }
+  // A list of coordinate names, each with an optional sign ("-psi3"): (index, ±1).
+  std::vector<std::pair<Index, double>> signed_coordinates(const char* field) const {
+    std::vector<std::pair<Index, double>> out;
+    for (const auto& a : c_.field(field).items()) {
+      std::string s = a.text();
+      double sign = 1.0;
+      if (!s.empty() && (s[0] == '-' || s[0] == '+')) sign = s[0] == '-' ? -1.0 : 1.0, s = s.substr(1);
+      const Index j = r_.builder_.find_coordinate(s);
+      if (j < 0) a.fail("unknown coordinate '" + s + "'");
+      out.emplace_back(j, sign);
+    }
+    return out;
+  }
+  std::pair<Index, Index> coordinate_pair(const char* field) const {
+    auto v = c_.require(field);
+    if (!v.is_sequence() || v.size() != 2) v.fail("expected two coordinates [q_i, q_j]");
+    const Index i = r_.coordinate(v.at(0));
+    return {i, r_.coordinate(v.at(1))};
+  }
+  std::pair<double, double> number_pair(const char* field) const {
+    auto v = c_.require(field);
+    if (!v.is_sequence() || v.size() != 2) v.fail("expected two numbers [a, b]");
+    const double a = r_.number(v.at(0));
+    return {a, r_.number(v.at(1))};
+  }
+  std::shared_ptr<const CompiledExpression> expression(const char* field) const {
+    return r_.compile(c_.require(field), true);
+  }
+  Unit unit(const char* field) const { return r_.unit(c_.field(field)); }
+
+  // ---- dimension 3
+  Point3 point3(const char* field) const { return r_.point3(c_.require(field)); }
+  std::pair<Point3, Point3> point3_pair(const char* field, const char* arity_message) const {
+    auto pts = c_.field(field);
+    if (!pts.is_sequence() || pts.size() != 2) pts.fail(arity_message);
+    const Point3 a = r_.point3(pts.at(0));
+    return {a, r_.point3(pts.at(1))};
+  }
+  kin3::V3 vec3(const char* field) const { return r_.vec3(c_.require(field)); }
+  // The two sides of a joint, `between` (the message names the entry's type).
+  std::pair<JointSide3, JointSide3> sides3(const char* /*between*/) const { return r_.sides3(c_, type_); }
+  // A direction of a dot product: head − tail, and its unit (a segment's is a length, a vector's none).
+  struct Direction {
+    Attachment3 head, tail;
+    Unit unit = Unit::kNone;
+  };
+  std::pair<Direction, Direction> two_directions(const char* field) const {
+    auto dirs = c_.require(field);
+    if (!dirs.is_sequence() || dirs.size() != 2) dirs.fail("a dot product has two directions [D1, D2]");
+    Direction d1, d2;
+    std::tie(d1.head, d1.tail) = r_.dot_direction(dirs.at(0), d1.unit);
+    std::tie(d2.head, d2.tail) = r_.dot_direction(dirs.at(1), d2.unit);
+    return {d1, d2};
+  }
+
+ private:
+  const SceneReader& r_;
+  C c_;
+  const std::string& type_;
+};
+
+}  // namespace phiq::detail::scene
