@@ -42,7 +42,7 @@ void BM_LongChainNoDrift(benchmark::State& state) {
   opt.velocities = opt.accelerations = derivs;
   opt.residuals = true;
   opt.threads = 1;
-  // the exact motion: the parallelogram (tools/closed_forms.hpp), θ = π/4 + w t
+  // the exact motion: the parallelogram (tools/accuracy/closed_forms.hpp), θ = π/4 + w t
   auto exact = phiq::tools::make_closed_form("nfourbar");  // defaults: from π/4 to 3π/4 over t in [0, 1]
   exact->bind(m.coordinate_names());
   std::vector<double> residual, deviation;

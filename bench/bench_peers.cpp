@@ -16,7 +16,7 @@
 //
 //   build/bench/phiq_bench_peers --benchmark_out=bench/results/peers.json --benchmark_out_format=json
 //
-// Counters: us_per_step (CPU µs per drive step; the figure bench/README.md and tools/plot_bench.py use),
+// Counters: us_per_step (CPU µs per drive step; the figure bench/README.md and tools/plot/plot_bench.py use),
 // wall_us_per_step, steps (timed per iteration), newton_per_step (Newton iterations; Simbody: projectQ iterations),
 // max_position_error, max_velocity_error, max_acceleration_error (against P_i = (i + cos θ, sin θ); a peer above
 // 1e-8 fails the benchmark), phiq_us_per_step and per_phiq (phiq on the same steps in the same loop, and the peer's

@@ -1,5 +1,5 @@
 #!/bin/sh
-# ctest plot_accuracy: tools/plot_accuracy.py on the hand-written fixture tests/data/accuracy_fixture.csv, whose
+# ctest plot_accuracy: tools/plot/plot_accuracy.py on the hand-written fixture tests/data/accuracy_fixture.csv, whose
 # Pareto fronts are known: fixture_slider's default is on its front, fixture_fourbar's is dominated (by a setting
 # at its own step count, 5 % faster, and over all step counts by one at 90 steps), fixture_positions has no
 # velocities or accelerations, and one failed row is left out.

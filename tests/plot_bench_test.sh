@@ -1,5 +1,5 @@
 #!/bin/sh
-# ctest plot_bench: tools/plot_bench.py on the hand-written fixture tests/data/bench_fixture.json.
+# ctest plot_bench: tools/plot/plot_bench.py on the hand-written fixture tests/data/bench_fixture.json.
 # Usage: plot_bench_test.sh SCRIPT FIXTURE SCRATCH_DIR. Exit 77 (skipped) without python3 or matplotlib.
 set -u
 script=$1 fixture=$2 dir=$3

@@ -1,4 +1,4 @@
-// The closed forms of `phiq sweep-accuracy` (tools/closed_forms.hpp): their positions satisfy the mechanism's
+// The closed forms of `phiq sweep-accuracy` (tools/accuracy/closed_forms.hpp): their positions satisfy the mechanism's
 // geometry, their velocities and accelerations are the time derivatives of their positions (central differences),
 // and phiq at tolerance 1e-12 agrees with them on every seed scene and on both nfourbar formulations.
 #include <gtest/gtest.h>

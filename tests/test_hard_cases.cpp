@@ -238,7 +238,7 @@ void expect_no_drift(const ChainRun& r, const char* what) {
 
 // Positions, velocities and accelerations (the cubic predictor; Φq factorised at every solution for q̇ and q̈): the
 // prediction errs by about 1e-12 m here, so most steps are accepted without a Newton step, each carrying the error
-// of the one before plus its own extrapolation's (the error budget, sweep.cpp predict()), and a Newton step comes
+// of the one before plus its own extrapolation's (the error budget, Sweeper::predict() in engine/src/sweep/predictors.cpp), and a Newton step comes
 // when that sum reaches the tolerance. So the residual of a step lies anywhere below the tolerance (single steps
 // say nothing; the windows of expect_no_drift do), every position stays within 2 tolerances of the parallelogram
 // (measured 9.2e-11 m), and there are a few Newton steps, not one per step (measured 16 in 1000). Velocities and

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <regex>
 
+#include "solve/assembly_internal.hpp"
 #include "solve/kinematics_internal.hpp"
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"

@@ -132,7 +132,7 @@ inline Model nfourbar_model(Index n, double theta0, double rate, LinearSolverKin
   return phiq_bench::nfourbar(n, theta0, rate, lu);
 }
 
-// Its exact motion (the parallelogram, tools/closed_forms.hpp) bound to the model's coordinates, for t in [0, 1]
+// Its exact motion (the parallelogram, tools/accuracy/closed_forms.hpp) bound to the model's coordinates, for t in [0, 1]
 // (θ = theta0 + rate·t).
 inline std::unique_ptr<tools::ClosedForm> nfourbar_exact(const Model& m, double theta0, double rate) {
   char spec[96];

@@ -1,4 +1,4 @@
-// `phiq sweep-accuracy` (tools/sweep_accuracy.hpp): the grid's rows, errors that fall with the tolerance, the
+// `phiq sweep-accuracy` (tools/accuracy/sweep_accuracy.hpp): the grid's rows, errors that fall with the tolerance, the
 // reference chosen (closed form, or the numerical run when no closed form fits), the scene's default marked, and
 // bad input refused with one line and no file. Timings are measured but never asserted (bench/README.md).
 #include <gtest/gtest.h>

@@ -17,7 +17,7 @@ packages=(
   libgtest-dev         # GoogleTest
   libbenchmark-dev     # Google Benchmark
   libsimbody-dev       # optional peer for the benchmark (bench/bench_peers.cpp); skipped with a message if absent
-  python3-matplotlib   # tools/plot_bench.py (the figure of bench/README.md); its ctest is skipped if absent
+  python3-matplotlib   # tools/plot/plot_bench.py (the figure of bench/README.md); its ctest is skipped if absent
 )
 
 missing=()

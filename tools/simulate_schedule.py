@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Speed-up of a parallel sweep on more cores than this machine has, by simulating phiq's schedule.
 
-run_sweep (engine/src/sweep.cpp) runs `threads` loops that take, in this order of preference: the next seed when
+run_sweep (engine/src/sweep/parallel_sweep.cpp) runs `threads` loops that take, in this order of preference: the next seed when
 fewer chunks are ready than threads; else the lowest ready chunk; else the next seed; else wait. Seeds are found
 one at a time, in order. This script replays that policy with durations measured on this machine by
 `BM_NFourBarParallelSweep` (bench/results/engine.json):

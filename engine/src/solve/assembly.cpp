@@ -8,6 +8,7 @@
 #include <random>
 #include <sstream>
 
+#include "solve/assembly_internal.hpp"
 #include "solve/kinematics_internal.hpp"
 #include "phiq/min_norm_solver.hpp"
 #include "solve/tolerance_tests.hpp"

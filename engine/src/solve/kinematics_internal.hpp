@@ -1,7 +1,6 @@
 // Internal to the engine: what the sweep needs of kinematics.cpp beyond the public functions.
 #pragma once
 
-#include "phiq/assembly.hpp"
 #include "phiq/kinematics.hpp"
 
 namespace phiq::detail {
@@ -18,11 +17,6 @@ inline constexpr double kLinearSingularRcond = 1e-4;
 /// The values of ws.jacobian_values that the LU factorises: all of them, or the kept rows' (in ws.solve_values)
 /// for a model with dropped rows (Model::without_rows()).
 const double* solve_values(const Model& model, Workspace& ws);
-
-/// The freedoms the drivers leave at a solution assembled near q at t (from q moved off it by up to a tenth of each
-/// coordinate's scale), or −1 when none was found: fewer than at q means q is a singular position of a model
-/// regular elsewhere (assembly.cpp). Called on failure paths only (an assembly and a rank analysis).
-Index driven_dof_nearby(const Model& model, const Eigen::VectorXd& q, double t, const AssemblyOptions& options);
 
 /// Throws phiq::Error naming the first field of `opt` no solve can honour, after `what` (solve_position's check,
 /// also made by a sweep before it starts, so that bad drive settings are refused before the assembly, not on a

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "phiq/sweep.hpp"
+#include "solve/assembly_internal.hpp"
 #include "solve/kinematics_internal.hpp"
 #include "solve/tolerance_tests.hpp"
 

@@ -1,4 +1,4 @@
-"""What tools/plot_bench.py and tools/plot_accuracy.py share: the one-line user error and a reproducible
+"""What tools/plot/plot_bench.py and tools/plot/plot_accuracy.py share: the one-line user error and a reproducible
 matplotlib (SVG labels kept as text, stable ids so that the same input writes the same file)."""
 
 

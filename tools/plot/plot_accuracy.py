@@ -25,7 +25,7 @@ Errors (unreadable file, not a sweep-accuracy CSV, nothing to plot, unwritable o
 exit status 1.
 
 Example (the figure of bench/README.md):
-  tools/plot_accuracy.py bench/results/accuracy_*.csv -o bench/results/accuracy_pareto.svg
+  tools/plot/plot_accuracy.py bench/results/accuracy_*.csv -o bench/results/accuracy_pareto.svg
 Needs matplotlib (Debian: python3-matplotlib, installed by tools/install_deps.sh).
 """
 

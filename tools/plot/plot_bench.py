@@ -17,7 +17,7 @@ Writes an SVG (text kept as text, no timestamp: the same input gives the same fi
 Errors (unreadable file, invalid JSON, nothing to plot, unwritable output) are one line on stderr, exit status 1.
 
 Example (the figure of bench/README.md):
-  tools/plot_bench.py bench/results/*.json -o bench/results/time_per_step.svg
+  tools/plot/plot_bench.py bench/results/*.json -o bench/results/time_per_step.svg
 Needs matplotlib (Debian: python3-matplotlib, installed by tools/install_deps.sh).
 """
 
