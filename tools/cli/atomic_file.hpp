@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <string>
 
+#include "phiq/types.hpp"  // phiq::Error, which these functions throw
+
 namespace phiq {
 
 // Where an output path leads: what AtomicOutputFile writes, found before anything is created.
