@@ -3,9 +3,11 @@
 // attachments of a pair, sides of a spatial joint, directions of a dot product — which the kinds read through
 // KindFields (kind_fields.hpp).
 #include <algorithm>
+#include <array>
 #include <concepts>
 #include <string_view>
 #include <tuple>
+#include <unordered_map>
 #include <vector>
 
 #include "phiq/constraint_kinds.hpp"
@@ -90,51 +92,54 @@ std::string constraint_types(int dimension) {
   for (std::string_view t : types) list += (list.empty() ? "" : ", ") + std::string(t);
   return list;
 }
-// Whether `type` is a constraint type of some dimension.
-bool constraint_type_of(const std::string& type, int dimension) {
-  bool found = false;
-  ConstraintKinds::for_each([&]<class K>() {
-    for (const SceneForm& f : K::kScene)
-      found = found || (std::string_view(f.section) == "constraints" && in_dimension(f, dimension) && type == f.type);
-  });
-  return found;
-}
-
 }  // namespace
 
-// A constraint is read by the kind that claims its type in the scene's dimension (kinds/registry.hpp): the kind's
-// own read() in the scene vocabulary (kind_fields.hpp).
+// The kinds that read constraint entries, by type, one table per dimension (built once, from the registry).
+template <class C>
+const std::unordered_map<std::string, SceneReader::KindReader<C>>& SceneReader::kind_readers(bool spatial) {
+  static const auto tables = [] {
+    std::array<std::unordered_map<std::string, KindReader<C>>, 2> t;
+    ConstraintKinds::for_each([&]<class K>() {
+      if constexpr (read_as_constraint<K>()) {
+        for (const SceneForm& f : K::kScene) {
+          if (std::string_view(f.section) != "constraints") continue;
+          for (int d : {2, 3})
+            if (in_dimension(f, d)) t[d == 3].try_emplace(f.type, &SceneReader::read_kind<K, C>);
+        }
+      }
+    });
+    return t;
+  }();
+  return tables[spatial];
+}
+
+// One entry read by kind K (its own read(), in the scene vocabulary of kind_fields.hpp) and added to the model.
+template <class K, class C>
+void SceneReader::read_kind(const C& c, const std::string& type, const std::string& name) {
+  K spec = K::read(KindFields<C>(*this, c, type));
+  if constexpr (is_spatial_joint<K>())
+    if (!name.empty()) joints3_[name] = Joint3{type, spec.a, spec.b};
+  add(c, name, std::move(spec));
+}
+
+// A constraint is read by the kind that claims its type in the scene's dimension (kinds/registry.hpp).
 template <class C>
 void SceneReader::read_constraint(const C& c) {
   if (!c.is_map()) c.fail("a constraint is a mapping with a 'type'");
   const std::string type = c.require("type").text();
   std::string name;
   if (auto n = c.field("name"); n.present()) name = n.name();
-  const int dimension = spatial_ ? 3 : 2;
-  if (!constraint_type_of(type, dimension)) {
-    if (!spatial_ && constraint_type_of(type, 3))
-      c.require("type").fail("'" + type + "' is a spatial constraint: it needs 'dimension: 3'");
-    if (spatial_ && constraint_type_of(type, 2))
-      c.require("type").fail("'" + type + "' is a planar constraint; this scene has 'dimension: 3'");
+  const auto& readers = kind_readers<C>(spatial_);
+  const auto it = readers.find(type);
+  if (it == readers.end()) {
+    if (kind_readers<C>(!spatial_).count(type))
+      c.require("type").fail("'" + type + (spatial_ ? "' is a planar constraint; this scene has 'dimension: 3'"
+                                                    : "' is a spatial constraint: it needs 'dimension: 3'"));
     c.require("type").fail("unknown constraint type '" + type + "' (" + (spatial_ ? "dimension 3: " : "") +
-                           constraint_types(dimension) + ")");
+                           constraint_types(spatial_ ? 3 : 2) + ")");
   }
   try {
-    bool read = false;
-    ConstraintKinds::for_each([&]<class K>() {
-      if constexpr (read_as_constraint<K>()) {
-        if (read) return;
-        for (const SceneForm& f : K::kScene) {
-          if (std::string_view(f.section) != "constraints" || !in_dimension(f, dimension) || type != f.type) continue;
-          K spec = K::read(KindFields<C>(*this, c, type));
-          if constexpr (is_spatial_joint<K>())
-            if (!name.empty()) joints3_[name] = Joint3{type, spec.a, spec.b};
-          add(c, name, std::move(spec));
-          read = true;
-          return;
-        }
-      }
-    });
+    (this->*(it->second))(c, type, name);
   } catch (const Error& e) {
     c.fail(e.what());
   }

@@ -134,6 +134,13 @@ class SceneReader {
   std::pair<Frame2, kin::V2> attachment(const C& c) const;
   template <class C>
   void read_constraint(const C& c);
+  // Reads one entry as a constraint of kind K (read_constraints.cpp); kind_readers() finds K by type.
+  template <class K, class C>
+  void read_kind(const C& c, const std::string& type, const std::string& name);
+  template <class C>
+  using KindReader = void (SceneReader::*)(const C&, const std::string&, const std::string&);
+  template <class C>
+  static const std::unordered_map<std::string, KindReader<C>>& kind_readers(bool spatial);
   template <class C>
   Point3 point3(const C& c) const;
   template <class C>

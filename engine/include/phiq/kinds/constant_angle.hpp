@@ -90,7 +90,8 @@ struct ConstantAngleSpec {
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "constant_angle", 2, "- {name: bend, type: constant_angle, segments: [[A, B], [B, C]], angle: pi/3}"}};
+      {"constraints", "constant_angle", 2, "- {name: bend, type: constant_angle, segments: [[A, B], [B, C]], "
+                                           "angle: pi/3}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static ConstantAngleSpec read(const Fields& f) {

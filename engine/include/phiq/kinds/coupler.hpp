@@ -81,7 +81,8 @@ struct CouplerSpec {
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "coupler", 0, "- {name: gears, type: coupler, coordinates: [theta2, theta5], coefficients: [0.1, 0.05], constant: 0}"}};
+      {"constraints", "coupler", 0, "- {name: gears, type: coupler, coordinates: [theta2, theta5], "
+                                    "coefficients: [0.1, 0.05], constant: 0}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static CouplerSpec read(const Fields& f) {

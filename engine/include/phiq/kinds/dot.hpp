@@ -71,7 +71,8 @@ struct DotSpec {
   template <class Sketch>
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {{"constraints", "dot", 3, "- {name: w_across_crank, type: dot, directions: [w, [O, A]], value: 0}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "dot", 3, "- {name: w_across_crank, type: dot, "
+        "directions: [w, [O, A]], value: 0}"}};
   /// @copydoc DistanceSpec::read
   /// A direction is a vector name or a segment [A, B] of points (B − A).
   template <class Fields>

@@ -88,7 +88,8 @@ struct EquationSpec {
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
       {"constraints", "equation", 0, "- {name: crank_x, type: equation, expr: \"xA - L2*cos(theta2)\", unit: length}"},
-      {"drivers", "expr", 0, "- {name: lift, expr: yA, unit: length, law: {type: harmonic, amplitude: 0.1, frequency: 1}}"}};
+      {"drivers", "expr", 0, "- {name: lift, expr: yA, unit: length, law: {type: harmonic, amplitude: 0.1, "
+                             "frequency: 1}}"}};
   /// @copydoc DistanceSpec::read
   /// (The driver form, `expr` under `drivers`, is read with the other drivers.)
   template <class Fields>

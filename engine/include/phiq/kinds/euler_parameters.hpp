@@ -64,7 +64,8 @@ struct EulerParametersSpec {
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"bodies", "(every spatial body: BODY.euler)", 3, "crank: [crank_x, crank_y, crank_z, crank_e0, crank_e1, crank_e2, crank_e3]"}};
+      {"bodies", "(every spatial body: BODY.euler)", 3, "crank: [crank_x, crank_y, crank_z, crank_e0, crank_e1, "
+                                                        "crank_e2, crank_e3]"}};
 };
 
 }  // namespace phiq

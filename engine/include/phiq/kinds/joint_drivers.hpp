@@ -28,7 +28,8 @@ struct JointDistanceDriverSpec {
   template <class Sketch>
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {{"drivers", "joint", 3, "- {name: push, joint: slider, measure: distance, law: {type: linear, initial: 0, rate: 0.1}}"}};
+  static constexpr SceneForm kScene[] = {{"drivers", "joint (measure: distance)", 3, "- {name: push, joint: slider, "
+        "measure: distance, law: {type: linear, initial: 0, rate: 0.1}}"}};
  private:
   static constexpr detail3::RowDef kDefs[1] = {
       {detail3::T(detail3::kZa), detail3::T(detail3::kPb, detail3::kPa), Unit::kLength}};
@@ -158,7 +159,8 @@ struct JointAngleDriverSpec {
   template <class Sketch>
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {{"drivers", "joint", 3, "- {name: crank_motor, joint: crank_hinge, law: {type: linear, initial: 0, rate: 1}}"}};
+  static constexpr SceneForm kScene[] = {{"drivers", "joint (measure: angle)", 3, "- {name: crank_motor, "
+        "joint: crank_hinge, law: {type: linear, initial: 0, rate: 1}}"}};
  private:
   // c = x_a · x_b and s = y_a · x_b at q: what Φ, Φq and γ all start from
   std::array<double, 2> products(const double* q) const {

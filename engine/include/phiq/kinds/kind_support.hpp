@@ -92,6 +92,17 @@ struct JointCount {
 /// the same vocabulary), `signed_coordinates`, `coordinate_pair`, `number_pair`, `expression`, `unit`; in space
 /// `point3`, `point3_pair`, `vec3`, `sides3` (two JointSide3), `two_directions` ({head, tail, unit} each).
 
+/// @cond internal
+namespace detail {
+// A planar pair (pin, prismatic) between bodies or ground removes 2 freedoms; with a natural point on either side
+// it is no joint of the count.
+inline JointCount planar_pair_joint_count(const Frame2& a, const Frame2& b) {
+  if (!kin::body_or_ground(a) || !kin::body_or_ground(b)) return JointCount::other();
+  return JointCount::joint(2, 2);
+}
+}  // namespace detail
+/// @endcond
+
 /// Where and how a scene writes a constraint of some kind: the section, the `type` (or the automatic entry), the
 /// dimension, and a one-line YAML example as models/README.md documents it (tests check that the README shows
 /// every example and that each loads in a scene).

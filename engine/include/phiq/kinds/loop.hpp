@@ -126,7 +126,9 @@ struct LoopSpec {
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "loop", 2, "- {name: closure, type: loop, links: [{length: L2, angles: [psi2]}, {length: L3, angles: [psi2, psi3]}, {length: L4, angles: [psi2, psi3, psi4]}], closure: [L1, 0]}"}};
+      {"constraints", "loop", 2, "- {name: closure, type: loop, links: [{length: L2, angles: [psi2]}, {length: L3, "
+                                 "angles: [psi2, psi3]}, {length: L4, angles: [psi2, psi3, psi4]}], closure: [L1, "
+                                 "0]}"}};
   /// @copydoc DistanceSpec::read
   /// A loop's `links` are maps {length, angles, offset}, the angles coordinate names with an optional sign.
   template <class Fields>

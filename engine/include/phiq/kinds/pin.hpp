@@ -80,10 +80,7 @@ struct PinSpec {
 
   /// @copydoc DistanceSpec::joint_count
   /// A pin between bodies or ground is a revolute pair (2 freedoms); with a natural point the count is undefined.
-  JointCount joint_count() const {
-    if (!kin::body_or_ground(a) || !kin::body_or_ground(b)) return JointCount::other();
-    return JointCount::joint(2, 2);
-  }
+  JointCount joint_count() const { return detail::planar_pair_joint_count(a, b); }
   /// @copydoc DistanceSpec::prepare
   void prepare(const double* /*q0*/) const {
     detail::require(std::isfinite(sa.x) && std::isfinite(sa.y) && std::isfinite(sb.x) && std::isfinite(sb.y),
@@ -98,7 +95,8 @@ struct PinSpec {
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "revolute", 2, "- {name: A, type: revolute, between: [{body: crank, at: [0.2, 0]}, {body: coupler, at: [-0.6, 0]}]}"},
+      {"constraints", "revolute", 2, "- {name: A, type: revolute, between: [{body: crank, at: [0.2, 0]}, "
+                                     "{body: coupler, at: [-0.6, 0]}]}"},
       {"constraints", "fixed_point", 2, "- {name: pin, type: fixed_point, point: P, at: [0.5, 0]}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>

@@ -80,10 +80,7 @@ struct PrismaticSpec {
 
   /// @copydoc DistanceSpec::joint_count
   /// A prismatic pair between bodies or ground removes 2 freedoms.
-  JointCount joint_count() const {
-    if (!kin::body_or_ground(a) || !kin::body_or_ground(b)) return JointCount::other();
-    return JointCount::joint(2, 2);
-  }
+  JointCount joint_count() const { return detail::planar_pair_joint_count(a, b); }
   /// @copydoc DistanceSpec::prepare
   /// The axis is normalised here.
   void prepare(const double* /*q0*/) {
@@ -101,7 +98,8 @@ struct PrismaticSpec {
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "prismatic", 2, "- {name: slide, type: prismatic, between: [{body: ground}, {body: slider}], axis: [1, 0]}"}};
+      {"constraints", "prismatic", 2, "- {name: slide, type: prismatic, between: [{body: ground}, {body: slider}], "
+                                      "axis: [1, 0]}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static PrismaticSpec read(const Fields& f) {

@@ -75,7 +75,8 @@ struct SegmentAngleSpec {
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "segment_angle", 2, "- {name: crank_angle, type: segment_angle, segment: [O, A], angle: theta2}"}};
+      {"constraints", "segment_angle", 2, "- {name: crank_angle, type: segment_angle, segment: [O, A], "
+                                          "angle: theta2}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static SegmentAngleSpec read(const Fields& f) {

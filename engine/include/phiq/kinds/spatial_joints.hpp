@@ -290,7 +290,8 @@ struct Revolute {
   static constexpr const char* kKind = "revolute";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
-      {"constraints", "revolute", 3, "- {name: hinge, type: revolute, between: [{body: ground, at: [0, 0, 1], axis: [0, 0, 1]}, {body: door, at: [0, 0, 1]}]}"}};
+      {"constraints", "revolute", 3, "- {name: hinge, type: revolute, between: [{body: ground, at: [0, 0, 1], "
+                                     "axis: [0, 0, 1]}, {body: door, at: [0, 0, 1]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
   static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL},
                                              {Axis(2), T(kPa, kPb), kL}, {T(kXa), T(kZb), kA},
@@ -303,7 +304,8 @@ struct Cylindrical {
   static constexpr const char* kKind = "cylindrical";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
-      {"constraints", "cylindrical", 3, "- {name: cyl, type: cylindrical, between: [{body: ground, axis: [1, 0, 0]}, {body: screw, axis: [1, 0, 0]}]}"}};
+      {"constraints", "cylindrical", 3, "- {name: cyl, type: cylindrical, between: [{body: ground, axis: [1, 0, "
+                                        "0]}, {body: screw, axis: [1, 0, 0]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
   static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kZb), kA}, {T(kYa), T(kZb), kA},
                                              {T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL}};
@@ -315,7 +317,8 @@ struct Prismatic {
   static constexpr const char* kKind = "prismatic";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
-      {"constraints", "prismatic", 3, "- {name: slide, type: prismatic, between: [{body: ground, axis: [1, 0, 0]}, {body: slider, axis: [1, 0, 0]}]}"}};
+      {"constraints", "prismatic", 3, "- {name: slide, type: prismatic, between: [{body: ground, axis: [1, 0, 0]}, "
+                                      "{body: slider, axis: [1, 0, 0]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
   static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kZb), kA}, {T(kYa), T(kZb), kA},
                                              {T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL},
@@ -328,7 +331,8 @@ struct Universal {
   static constexpr const char* kKind = "universal";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
-      {"constraints", "universal", 3, "- {name: cross, type: universal, between: [{body: s1, axis: [1, 0, 0]}, {body: s2, axis: [0, 1, 0]}]}"}};
+      {"constraints", "universal", 3, "- {name: cross, type: universal, between: [{body: s1, axis: [1, 0, 0]}, "
+                                      "{body: s2, axis: [0, 1, 0]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
   static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL},
                                              {Axis(2), T(kPa, kPb), kL}, {T(kZa), T(kZb), kA}};
@@ -364,7 +368,8 @@ struct PointOnLine {
   static constexpr const char* kKind = "point_on_line";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
-      {"constraints", "point_on_line", 3, "- {name: axis2, type: point_on_line, between: [{body: ground, axis: [1, 0, 0]}, {body: s2, at: [0, 0, 1]}]}"}};
+      {"constraints", "point_on_line", 3, "- {name: axis2, type: point_on_line, between: [{body: ground, axis: [1, "
+                                          "0, 0]}, {body: s2, at: [0, 0, 1]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
   static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL}};
 };
@@ -375,7 +380,8 @@ struct PointOnPlane {
   static constexpr const char* kKind = "point_on_plane";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
-      {"constraints", "point_on_plane", 3, "- {name: plane0, type: point_on_plane, between: [{body: ground, axis: [1, 2, 2]}, {point: P0}]}"}};
+      {"constraints", "point_on_plane", 3, "- {name: plane0, type: point_on_plane, between: [{body: ground, "
+                                           "axis: [1, 2, 2]}, {point: P0}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
   static constexpr RowDef kRowDefs[kRows] = {{T(kZa), T(kPb, kPa), kL}};
 };
