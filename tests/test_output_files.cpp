@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "atomic_file.hpp"
+#include "phiq/types.hpp"
 
 namespace phiq {
 namespace {
