@@ -238,8 +238,8 @@ TEST(OutputPlan, ResidualsAndConditionAreDeliveredWithoutExtraEvaluations) {
                                           "rcond: true}", steps), "fourbar.yaml");
   EXPECT_TRUE(asked.sweep.residuals);
   EXPECT_TRUE(asked.sweep.condition);
-  ASSERT_EQ(asked.output_residuals.size(), 2u);
-  EXPECT_EQ(asked.model->constraints()[asked.output_residuals[0]].name, "rocker");
+  ASSERT_EQ(asked.sweep.residual_columns.size(), 2u);
+  EXPECT_EQ(asked.model->constraints()[asked.sweep.residual_columns[0]].name, "rocker");
   for (int threads : {1, 2}) {
     SweepSummary s0, s1;
     Rows r0 = sweep_scene(plain, &s0, threads, 4), r1 = sweep_scene(asked, &s1, threads, 4);
@@ -271,7 +271,7 @@ TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
   Scene scene = parse_scene(fourbar_scene("{velocities: true, coordinates: [theta2], points: [B, {name: P, body: "
                                           "coupler, at: [0, 0.3]}], drivers: [motor], residuals: [rocker], "
                                           "max_residual: true, rcond: true}", 4), "fourbar.yaml");
-  CsvFormat csv(scene);
+  CsvFormat csv(*scene.model, scene.sweep);
   EXPECT_EQ(csv.header(),
             "t,theta2,theta2.v,B.x,B.y,B.vx,B.vy,P.x,P.y,P.vx,P.vy,motor.f,motor.df,rocker.residual,residual,rcond\n");
   // the driver's columns are its law f(t) = 0.5 + 2 sin(1.5 t) and f'(t)
@@ -283,7 +283,7 @@ TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
     if (s.step == 1) {
       csv.append_row(s, row);
       // the rocker's one row (a length), scaled by the model's length scale
-      const ConstraintInfo& c = scene.model->constraints()[scene.output_residuals[0]];
+      const ConstraintInfo& c = scene.model->constraints()[scene.sweep.residual_columns[0]];
       rocker = std::fabs((*s.phi)(c.first_row)) / scene.model->length_scale();
     }
     return true;
@@ -388,7 +388,7 @@ TEST(OutputPlan, BadOutputListsAreOneLineErrorsNamingTheField) {
   Scene s = parse_scene(fourbar_scene("{velocities: true, accelerations: true}"), "fourbar.yaml");
   EXPECT_TRUE(s.sweep.points.empty());
   EXPECT_FALSE(s.sweep.residuals || s.sweep.condition);
-  EXPECT_EQ(s.output_coordinates.size(), 8u);
+  EXPECT_EQ(s.sweep.coordinate_columns.size(), 8u);
 }
 
 // The drawing's lines come from the constraints: each bar once, body arms to their pair attachments.

@@ -51,7 +51,7 @@ TEST(Scene, GoodSceneBuildsTheModelItDescribes) {
   EXPECT_EQ(s.sweep.steps, 4);
   EXPECT_TRUE(s.sweep.velocities);
   EXPECT_FALSE(s.sweep.accelerations);
-  EXPECT_EQ(s.output_coordinates.size(), 4u);
+  EXPECT_EQ(s.sweep.coordinate_columns.size(), 4u);
   // the polar row is a length, the driver row has the unit of its coordinate
   EXPECT_EQ(m.row_unit(0), Unit::kLength);
   EXPECT_EQ(m.row_unit(3), Unit::kAngle);

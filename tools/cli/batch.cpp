@@ -95,7 +95,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
       starts.push_back(squares[k].start);
       swept.push_back(k);
     }
-    formats.emplace_back(sc);
+    formats.emplace_back(*sc.model, sc.sweep);
     buffers[k] = formats[k].header();
   }
   // Each case touches only its own buffer and file: the callback is safe across cases without a lock.

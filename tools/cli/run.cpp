@@ -98,9 +98,9 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   scene.sweep.memory_budget = static_cast<std::size_t>(memory_gb * 1e9);
   phiq::Workspace ws(model);
   ws.q = square.start;
-  // columns from the scene (its constraints and outputs); residuals of a model solved on its independent rows
-  // are evaluated on the whole scene model (CsvFormat)
-  phiq::CsvFormat csv(scene);
+  // columns from the scene's output plan and model (its constraints); residuals of a model solved on its
+  // independent rows are evaluated on the whole scene model (CsvFormat)
+  phiq::CsvFormat csv(*scene.model, scene.sweep);
 
   // Where the CSV goes: the output file, or standard output after success, spooled through an anonymous temporary
   // file so that memory stays bounded however long the sweep is.

@@ -97,7 +97,7 @@ int plot_svg(const PlotOptions& o) {
     return fail(e.what(), 3);
   }
   // The CSV must be the scene's result: the columns its output lists, in order.
-  const std::vector<std::string> expected = CsvFormat(scene).column_names();
+  const std::vector<std::string> expected = CsvFormat(*scene.model, scene.sweep).column_names();
   if (table.columns != expected) {
     std::string want;
     for (const auto& c : expected) {
@@ -115,8 +115,8 @@ int plot_svg(const PlotOptions& o) {
   // Columns against time: as asked, else the coordinate columns (at most 6).
   std::vector<std::string> series = o.columns;
   if (series.empty())
-    for (std::size_t k = 0; k < scene.output_coordinates.size() && k < 6; ++k)
-      series.push_back(model.coordinate_names()[scene.output_coordinates[k]]);
+    for (std::size_t k = 0; k < scene.sweep.coordinate_columns.size() && k < 6; ++k)
+      series.push_back(model.coordinate_names()[scene.sweep.coordinate_columns[k]]);
   if (series.empty())  // no coordinate written (e.g. a coupler curve alone): the first columns after t
     for (std::size_t c = 1; c < table.columns.size() && c <= 6; ++c) series.push_back(table.columns[c]);
   for (const std::string& c : series)

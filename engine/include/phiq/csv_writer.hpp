@@ -1,6 +1,6 @@
 /// @file
-/// Results as CSV: header `t, <coordinate>..., <coordinate>.v..., <coordinate>.a...`, then the other outputs a scene
-/// lists (points, drivers, residuals, rcond; tools/README.md), one row per time point.
+/// Results as CSV: header `t, <coordinate>..., <coordinate>.v..., <coordinate>.a...`, then the other outputs an output
+/// plan lists (points, drivers, residuals, rcond; tools/README.md), one row per time point.
 /// Numbers are written in the shortest form that reads back to the same double (std::to_chars), so a CSV compares
 /// exactly with the run that wrote it.
 #pragma once
@@ -8,7 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "phiq/scene.hpp"
+#include "phiq/model.hpp"
+#include "phiq/output_plan.hpp"
 #include "phiq/sweep.hpp"
 
 namespace phiq {
@@ -19,10 +20,11 @@ class CsvFormat {
   /// `columns`: coordinate indices to write, in order; `velocities` / `accelerations`: add the `.v` / `.a` groups.
   /// Throws phiq::Error for an index out of range. The model must outlive the CsvFormat.
   CsvFormat(const Model& model, std::vector<Index> columns, bool velocities, bool accelerations);
-  /// Every column the scene's output lists, in the order of tools/README.md: t; coordinates, `.v`, `.a`; per point
+  /// Every column the output plan lists, in the order of tools/README.md: t; coordinates, `.v`, `.a`; per point
   /// `P.x, P.y` (`P.vx, P.vy`, `P.ax, P.ay`); per driver `D.f` (`D.df`, `D.ddf`); per constraint `C.residual`;
-  /// `residual`; `rcond`. The scene must outlive the CsvFormat.
-  explicit CsvFormat(const Scene& scene);
+  /// `residual`; `rcond`. Throws phiq::Error for an index out of range. The model and the plan must outlive the
+  /// CsvFormat.
+  CsvFormat(const Model& model, const OutputPlan& plan);
   /// The column names, "t" first.
   std::vector<std::string> column_names() const;
   /// The header line, with '\\n'.
@@ -36,7 +38,7 @@ class CsvFormat {
   const Model& model_;
   std::vector<Index> columns_;
   bool velocities_, accelerations_;
-  const Scene* scene_ = nullptr;  // the other outputs, when made from a scene
+  const OutputPlan* plan_ = nullptr;  // the other outputs, when made from an output plan
   void append_coordinates(const StepView& step, std::string& out) const;  // the q, q̇, q̈ columns
   void append_outputs(const StepView& step, std::string& out) const;      // the columns after the coordinates
 };

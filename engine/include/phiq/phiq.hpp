@@ -14,6 +14,7 @@
 #include "phiq/model.hpp"
 #include "phiq/min_norm_solver.hpp"
 #include "phiq/motion_law.hpp"
+#include "phiq/output_plan.hpp"
 #include "phiq/output_points.hpp"
 #include "phiq/rank_analysis.hpp"
 #include "phiq/scene.hpp"

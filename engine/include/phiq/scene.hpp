@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "phiq/model.hpp"
-#include "phiq/motion_law.hpp"
 #include "phiq/sweep.hpp"
 
 namespace phiq {
@@ -33,25 +32,14 @@ struct SceneLimits {
   int max_family_depth = 8;                              ///< families nested in families
 };
 
-/// A driver whose law a scene outputs: columns `NAME.f` = f(t), and `NAME.df`, `NAME.ddf` with velocities /
-/// accelerations.
-struct OutputDriver {
-  std::string name;  ///< the driver's name
-  MotionLaw law;     ///< its law (shared, cheap to copy)
-};
-
 /// A loaded scene: the model, the sweep and what to output.
 struct Scene {
   std::string path;              ///< the file it was read from (or the name given to parse_scene)
   std::string name;              ///< the scene's `name` field (may be empty)
   std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: workspaces keep its address)
-  SweepOptions sweep;            ///< time sweep, outputs asked for, and solver settings
-  std::vector<Index> output_coordinates;  ///< columns written, in scene order (default: all coordinates)
-  // Output points are sweep.points, the residual and condition flags sweep.residuals / sweep.condition: the sweep
-  // computes them. What follows is derived from the delivered rows when they are written.
-  std::vector<OutputDriver> output_drivers;  ///< drivers whose f(t) (and derivatives) are written
-  std::vector<Index> output_residuals;       ///< constraints (indices into model->constraints()) whose residual is written
-  bool output_max_residual = false;          ///< write the largest scaled residual of all rows (`residual`)
+  /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns
+  /// written, coordinates defaulting to all).
+  SweepOptions sweep;
 };
 
 /// Changes to a scene made by the caller rather than the file (batch mode, `phiq batch`).

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "phiq/kinematics.hpp"
-#include "phiq/output_points.hpp"
+#include "phiq/output_plan.hpp"
 
 namespace phiq {
 
@@ -53,15 +53,17 @@ bool predictor_needs_velocities(Predictor p);
 /// Whether `p` extrapolates with q̈ (quadratic, cubic).
 bool predictor_needs_accelerations(Predictor p);
 
-/// What run_sweep computes and how.
-struct SweepOptions {
+/// The time points of a sweep.
+struct TimeGrid {
   double t_begin = 0.0;   ///< first time point (s)
   /// last time point (s); may be below t_begin. With steps > 0 every step must move time: t_end ≠ t_begin and
   /// |t_end − t_begin| / steps above 8 ulps of the larger of |t_begin|, |t_end| (else run_sweep throws phiq::Error)
   double t_end = 1.0;
   Index steps = 100;      ///< intervals: steps + 1 time points, t_k = t_begin + k (t_end − t_begin) / steps
-  bool velocities = true;     ///< solve and deliver q̇ at every time point
-  bool accelerations = true;  ///< solve and deliver q̈ (q̇ is then solved too, but delivered only if asked)
+};
+
+/// How each position of a sweep is solved.
+struct SolverSettings {
   Predictor predictor = Predictor::kAuto;  ///< start of each successive position
   /// Successive positions: modified Newton, reusing the factorisation made for the previous step's velocity and
   /// acceleration (or the previous position) while it contracts well — one factorisation per drive step instead
@@ -69,6 +71,10 @@ struct SweepOptions {
   NewtonOptions newton{1e-10, 20, true, 12, JacobianUpdate::kWhenSlow};
   NewtonOptions assembly{1e-10, 100, true, 30};              ///< initial position from the rough placement
   int max_subdivisions = 8;  ///< a failed step is retried as 2, 4, … sub-steps, down to h / 2^max_subdivisions
+};
+
+/// How the drive steps of a sweep are spread over threads, and the memory they may take.
+struct ParallelSettings {
   /// Threads for the drive steps: 1 runs them in order; N > 1 runs chunks of chunk_steps steps in parallel on N
   /// threads; 0 uses all cores. Each chunk starts from a seed found by a sequential pass over the chunk starts
   /// (positions only, every chunk_steps-th time point), and is accepted only if the sequential sweep, continued
@@ -96,21 +102,10 @@ struct SweepOptions {
   Index chunk_steps = 0;
   /// Bytes of rows a parallel sweep may hold before it delivers them in order (> 0; see chunk_steps).
   std::size_t row_buffer_bytes = std::size_t{512} * 1024 * 1024;
-
-  // Outputs beyond q, q̇, q̈: the sweep computes only what is listed (models/README.md, `output`).
-
-  /// Points whose motion is evaluated at every delivered row (StepView::points): position always, velocity when
-  /// q̇ is solved, acceleration when q̈ is. Nothing is evaluated for points not listed.
-  std::vector<OutputPoint> points;
-  /// Deliver Φ(q, t) at every row (StepView::phi). Free: Newton's convergence test has just evaluated it.
-  bool residuals = false;
-  /// Deliver the reciprocal condition estimate of the last factorisation of Φq (StepView::rcond). Free with KLU
-  /// and UMFPACK (the pivot ratio is computed with every factorisation). It is of Φq at the delivered q when
-  /// velocities or accelerations are solved; in a positions-only sweep it is of the factorisation modified Newton
-  /// last made (at this step or a few before; at the first rows of a parallel chunk possibly one its pooled
-  /// workspace made for another chunk), which is what the positions were solved with.
-  bool condition = false;
 };
+
+/// What run_sweep computes and how: its parts can be set and passed on their own.
+struct SweepOptions : TimeGrid, OutputPlan, SolverSettings, ParallelSettings {};
 
 /// What the step callback sees. qd / qdd are null when not computed.
 struct StepView {
@@ -119,11 +114,11 @@ struct StepView {
   const Eigen::VectorXd& q;    ///< positions (valid during the callback only)
   const Eigen::VectorXd* qd;   ///< velocities, or null when not asked for
   const Eigen::VectorXd* qdd;  ///< accelerations, or null when not asked for
-  /// Motions of SweepOptions::points, in that order (null when none are listed); velocity / acceleration
+  /// Motions of OutputPlan::points, in that order (null when none are listed); velocity / acceleration
   /// components are filled when q̇ / q̈ are solved.
   const PointMotion* points = nullptr;
-  const Eigen::VectorXd* phi = nullptr;  ///< Φ(q, t) when SweepOptions::residuals, else null
-  double rcond = 0.0;                    ///< when SweepOptions::condition (see there), else 0
+  const Eigen::VectorXd* phi = nullptr;  ///< Φ(q, t) when OutputPlan::residuals, else null
+  double rcond = 0.0;                    ///< when OutputPlan::condition (see there), else 0
 };
 
 /// Something the caller should know about a delivered row (the row itself is within tolerance).

@@ -19,10 +19,10 @@ CsvFormat::CsvFormat(const Model& model, std::vector<Index> columns, bool veloci
     if (j < 0 || j >= model.num_coordinates()) throw Error("CsvFormat: column index out of range");
 }
 
-CsvFormat::CsvFormat(const Scene& scene)
-    : CsvFormat(*scene.model, scene.output_coordinates, scene.sweep.velocities, scene.sweep.accelerations) {
-  scene_ = &scene;
-  for (Index c : scene.output_residuals)
+CsvFormat::CsvFormat(const Model& model, const OutputPlan& plan)
+    : CsvFormat(model, plan.coordinate_columns, plan.velocities, plan.accelerations) {
+  plan_ = &plan;
+  for (Index c : plan.residual_columns)
     if (c < 0 || c >= static_cast<Index>(model_.constraints().size()))
       throw Error("CsvFormat: residual constraint index out of range");
 }
@@ -35,23 +35,23 @@ std::vector<std::string> CsvFormat::column_names() const {
     for (Index j : columns_) h.push_back(names[j] + ".v");
   if (accelerations_)
     for (Index j : columns_) h.push_back(names[j] + ".a");
-  if (!scene_) return h;
+  if (!plan_) return h;
   static const char* const axis[] = {"x", "y", "z"};
-  for (const OutputPoint& p : scene_->sweep.points) {
+  for (const OutputPoint& p : plan_->points) {
     for (int d = 0; d < p.dimension(); ++d) h.push_back(p.name + "." + axis[d]);
     if (velocities_)
       for (int d = 0; d < p.dimension(); ++d) h.push_back(p.name + ".v" + axis[d]);
     if (accelerations_)
       for (int d = 0; d < p.dimension(); ++d) h.push_back(p.name + ".a" + axis[d]);
   }
-  for (const OutputDriver& d : scene_->output_drivers) {
+  for (const OutputDriver& d : plan_->driver_columns) {
     h.push_back(d.name + ".f");
     if (velocities_) h.push_back(d.name + ".df");
     if (accelerations_) h.push_back(d.name + ".ddf");
   }
-  for (Index c : scene_->output_residuals) h.push_back(model_.constraints()[c].name + ".residual");
-  if (scene_->output_max_residual) h.push_back("residual");
-  if (scene_->sweep.condition) h.push_back("rcond");
+  for (Index c : plan_->residual_columns) h.push_back(model_.constraints()[c].name + ".residual");
+  if (plan_->max_residual_column) h.push_back("residual");
+  if (plan_->condition) h.push_back("rcond");
   return h;
 }
 
@@ -82,7 +82,7 @@ constexpr std::size_t kValuesPerTask = 1024;
 }  // namespace
 
 void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
-  const auto& points = scene_->sweep.points;
+  const auto& points = plan_->points;
   if (!points.empty() && !s.points) throw Error("CsvFormat: step has no point motions");
   for (std::size_t i = 0; i < points.size(); ++i) {
     const PointMotion& m = s.points[i];
@@ -93,34 +93,34 @@ void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
     if (accelerations_)
       for (int d = 0; d < dim; ++d) out += ',', put(m.a[d], out);
   }
-  for (const OutputDriver& d : scene_->output_drivers) {
+  for (const OutputDriver& d : plan_->driver_columns) {
     const LawValue v = d.law.evaluate(s.t);
     out += ',', put(v.f, out);
     if (velocities_) out += ',', put(v.df, out);
     if (accelerations_) out += ',', put(v.ddf, out);
   }
-  if (!scene_->output_residuals.empty() || scene_->output_max_residual) {
+  if (!plan_->residual_columns.empty() || plan_->max_residual_column) {
     if (!s.phi) throw Error("CsvFormat: step has no residuals");
     // Φ of every row: a model solved on its independent rows (Model::without_rows) still evaluates all of them.
     const Eigen::VectorXd* phi = s.phi;
     if (phi->size() != model_.num_equations()) throw Error("CsvFormat: step's Φ is not the scene model's");
     const Eigen::VectorXd& rs = model_.tolerance_scales().row_scale;
-    for (Index c : scene_->output_residuals) {
+    for (Index c : plan_->residual_columns) {
       // the measure of the convergence test: |Φ_i| / scale_i, the largest over the constraint's rows
       const ConstraintInfo& ci = model_.constraints()[c];
       double r = 0.0;
       for (Index i = ci.first_row; i < ci.first_row + ci.rows; ++i) r = std::max(r, std::fabs((*phi)(i)) / rs(i));
       out += ',', put(r, out);
     }
-    if (scene_->output_max_residual) out += ',', put(scaled_residual(model_, *phi), out);
+    if (plan_->max_residual_column) out += ',', put(scaled_residual(model_, *phi), out);
   }
-  if (scene_->sweep.condition) out += ',', put(s.rcond, out);
+  if (plan_->condition) out += ',', put(s.rcond, out);
 }
 
 void CsvFormat::append_row(const StepView& s, std::string& out) const {
   put(s.t, out);
   append_coordinates(s, out);
-  if (scene_) append_outputs(s, out);
+  if (plan_) append_outputs(s, out);
   out += '\n';
 }
 

@@ -8,7 +8,7 @@
 
 namespace phiq::detail::scene {
 
-void SceneReader::read_time(const Cursor& c, SweepOptions& o) const {
+void SceneReader::read_time(const Cursor& c, TimeGrid& o) const {
   c.expect_map({"start", "end", "steps"});
   o.t_begin = number(c.require("start"));
   o.t_end = number(c.require("end"));
@@ -20,21 +20,21 @@ void SceneReader::read_time(const Cursor& c, SweepOptions& o) const {
 
 // The output list, and from it the sweep's plan: derivatives, points, residuals and the condition estimate are
 // computed only when listed here (models/README.md, `output`).
-void SceneReader::read_output(const Cursor& c, Scene& scene) {
-  scene.sweep.velocities = scene.sweep.accelerations = false;
+void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
+  plan.velocities = plan.accelerations = false;
   bool coordinates_listed = false;
   if (c.present()) {
     c.expect_map({"velocities", "accelerations", "coordinates", "points", "drivers", "residuals", "max_residual",
                   "rcond"});
-    if (auto v = c.field("velocities"); v.present()) scene.sweep.velocities = v.boolean();
-    if (auto a = c.field("accelerations"); a.present()) scene.sweep.accelerations = a.boolean();
+    if (auto v = c.field("velocities"); v.present()) plan.velocities = v.boolean();
+    if (auto a = c.field("accelerations"); a.present()) plan.accelerations = a.boolean();
     if (auto cs = c.field("coordinates"); cs.present()) {
       coordinates_listed = true;
       std::set<Index> seen;
       for (const Cursor& i : cs.items()) {
         Index j = coordinate(i);
         if (!seen.insert(j).second) i.fail("coordinate listed twice");
-        scene.output_coordinates.push_back(j);
+        plan.coordinate_columns.push_back(j);
       }
     }
     if (auto ps = c.field("points"); ps.present()) {
@@ -42,7 +42,7 @@ void SceneReader::read_output(const Cursor& c, Scene& scene) {
       for (const Cursor& i : ps.items()) {
         OutputPoint p = output_point(i);
         if (!seen.insert(p.name).second) i.fail("output point '" + p.name + "' listed twice");
-        scene.sweep.points.push_back(std::move(p));
+        plan.points.push_back(std::move(p));
       }
     }
     if (auto ds = c.field("drivers"); ds.present()) {
@@ -52,7 +52,7 @@ void SceneReader::read_output(const Cursor& c, Scene& scene) {
         auto it = driver_laws_.find(n);
         if (it == driver_laws_.end()) i.fail("unknown driver '" + n + "' (a named entry of `drivers`)");
         if (!seen.insert(n).second) i.fail("driver listed twice");
-        scene.output_drivers.push_back({n, it->second});
+        plan.driver_columns.push_back({n, it->second});
       }
     }
     if (auto rs = c.field("residuals"); rs.present()) {
@@ -64,16 +64,16 @@ void SceneReader::read_output(const Cursor& c, Scene& scene) {
         residual_names_.push_back(n);
       }
     }
-    if (auto v = c.field("max_residual"); v.present()) scene.output_max_residual = v.boolean();
-    if (auto v = c.field("rcond"); v.present()) scene.sweep.condition = v.boolean();
-    scene.sweep.residuals = scene.output_max_residual || !residual_names_.empty();
+    if (auto v = c.field("max_residual"); v.present()) plan.max_residual_column = v.boolean();
+    if (auto v = c.field("rcond"); v.present()) plan.condition = v.boolean();
+    plan.residuals = plan.max_residual_column || !residual_names_.empty();
   }
   if (!coordinates_listed)
-    for (Index j = 0; j < builder_.num_coordinates(); ++j) scene.output_coordinates.push_back(j);
+    for (Index j = 0; j < builder_.num_coordinates(); ++j) plan.coordinate_columns.push_back(j);
   // the columns `residual` and `rcond` must not collide with a coordinate's
-  for (Index j : scene.output_coordinates) {
+  for (Index j : plan.coordinate_columns) {
     const std::string& n = builder_.coordinate_name(j);
-    if ((n == "residual" && scene.output_max_residual) || (n == "rcond" && scene.sweep.condition))
+    if ((n == "residual" && plan.max_residual_column) || (n == "rcond" && plan.condition))
       c.fail("coordinate '" + n + "' and the column '" + n + "' would share a name: leave it out of coordinates");
   }
 }
@@ -119,10 +119,10 @@ void SceneReader::resolve_output_residuals(Scene& scene) const {
   const auto& cs = scene.model->constraints();
   for (std::size_t k = 0; k < cs.size(); ++k)
     if (auto it = wanted.find(cs[k].name); it != wanted.end()) it->second = static_cast<Index>(k);
-  for (const std::string& n : residual_names_) scene.output_residuals.push_back(wanted.at(n));
+  for (const std::string& n : residual_names_) scene.sweep.residual_columns.push_back(wanted.at(n));
 }
 
-void SceneReader::read_solver(const Cursor& c, SweepOptions& o) {
+void SceneReader::read_solver(const Cursor& c, SolverSettings& o) {
   if (!c.present()) return;
   c.expect_map({"tolerance", "max_iterations", "assembly_max_iterations", "line_search", "predictor",
                 "max_subdivisions", "length_scale", "linear_solver", "newton"});

@@ -39,7 +39,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   if (auto d = top.field("drivers"); d.present()) read_list(d, [&](const auto& item) { read_driver(item); });
 
   read_time(top.require("time"), scene.sweep);
-  read_output(top.field("output"), scene);
+  read_output(top.field("output"), scene.sweep);
   points_ = {}, bodies_ = {};  // not needed any more: their memory is free for the model
   driver_laws_ = {};
   points3_ = {}, bodies3_ = {}, vectors_ = {}, joints3_.clear();

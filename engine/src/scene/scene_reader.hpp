@@ -168,11 +168,11 @@ class SceneReader {
   MotionLaw motion_law(const C& c) const;
 
   // ---- time, output, solver (read_settings.cpp) ---------------------------------------------------------------
-  void read_time(const Cursor& c, SweepOptions& o) const;
-  void read_output(const Cursor& c, Scene& scene);
+  void read_time(const Cursor& c, TimeGrid& o) const;
+  void read_output(const Cursor& c, OutputPlan& plan);
   OutputPoint output_point(const Cursor& c) const;
   void resolve_output_residuals(Scene& scene) const;
-  void read_solver(const Cursor& c, SweepOptions& o);
+  void read_solver(const Cursor& c, SolverSettings& o);
 
   const std::string& file_;
   const SceneLimits& limits_;

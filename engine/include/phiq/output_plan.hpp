@@ -1,0 +1,55 @@
+/// @file
+/// What a sweep outputs, described once: the output plan that run_sweep reads to know what to compute at every row
+/// and that the writers (CsvFormat, the plots) read to lay out their columns. A scene's `output` section is read
+/// into one (Scene::sweep); it is separate from the time grid and the solver settings so that a writer needs the
+/// plan and the model only, never the scene or the sweep's other settings.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "phiq/motion_law.hpp"
+#include "phiq/output_points.hpp"
+#include "phiq/types.hpp"
+
+namespace phiq {
+
+/// A driver whose law is output: columns `NAME.f` = f(t), and `NAME.df`, `NAME.ddf` with velocities /
+/// accelerations.
+struct OutputDriver {
+  std::string name;  ///< the driver's name
+  MotionLaw law;     ///< its law (shared, cheap to copy)
+};
+
+/// The outputs of a sweep beyond q (models/README.md, `output`). The sweep computes only what the plan lists; the
+/// writers lay out their columns from the same plan, so that what is computed and what is written cannot disagree.
+struct OutputPlan {
+  // What the sweep computes and delivers in each StepView.
+
+  bool velocities = true;     ///< solve and deliver q̇ at every time point
+  bool accelerations = true;  ///< solve and deliver q̈ (q̇ is then solved too, but delivered only if asked)
+  /// Points whose motion is evaluated at every delivered row (StepView::points): position always, velocity when
+  /// q̇ is solved, acceleration when q̈ is. Nothing is evaluated for points not listed.
+  std::vector<OutputPoint> points;
+  /// Deliver Φ(q, t) at every row (StepView::phi). Free: Newton's convergence test has just evaluated it.
+  bool residuals = false;
+  /// Deliver the reciprocal condition estimate of the last factorisation of Φq (StepView::rcond). Free with KLU
+  /// and UMFPACK (the pivot ratio is computed with every factorisation). It is of Φq at the delivered q when
+  /// velocities or accelerations are solved; in a positions-only sweep it is of the factorisation modified Newton
+  /// last made (at this step or a few before; at the first rows of a parallel chunk possibly one its pooled
+  /// workspace made for another chunk), which is what the positions were solved with.
+  bool condition = false;
+
+  // What the writers write from the delivered rows (derived from them, nothing more is computed).
+
+  /// Coordinate indices whose columns are written, in order (a scene's default: all coordinates).
+  std::vector<Index> coordinate_columns;
+  /// Drivers whose f(t) (and derivatives, with velocities / accelerations) are written.
+  std::vector<OutputDriver> driver_columns;
+  /// Constraints (indices into Model::constraints()) whose residual is written; needs `residuals`.
+  std::vector<Index> residual_columns;
+  /// Write the largest scaled residual of all rows (column `residual`); needs `residuals`.
+  bool max_residual_column = false;
+};
+
+}  // namespace phiq
