@@ -1,6 +1,11 @@
+// The position solve: Newton's method on Φ(q, t) = 0 with its step and residual tests, backtracking, the reuse
+// of a factorisation while it contracts, and the stop at the rounding level; with the statuses' names, the
+// Workspace's constructor and the check of NewtonOptions. Φq's factorisation, shared with the velocity and
+// acceleration solves (derivatives.cpp), is in factorisation.cpp.
 #include "phiq/kinematics.hpp"
 #include "phiq/text.hpp"
 
+#include "solve/factorisation.hpp"
 #include "solve/kinematics_internal.hpp"
 #include "solve/tolerance_tests.hpp"
 
@@ -50,9 +55,15 @@ Workspace::Workspace(const Model& model) : model_(&model) {
 
 namespace {
 
+using detail::check_workspace;
 using detail::describe_rows;
+using detail::factorize_at_q;
+using detail::factors_at_q;
 using detail::kUlpFloor;
+using detail::non_finite_jacobian_at;
+using detail::not_square_message;
 using detail::residual_within;
+using detail::solve_rhs;
 using detail::worst_rows;
 
 // A stop at the rounding level with q known to within this many tolerances is no slow convergence (no warning).
@@ -166,29 +177,7 @@ StepPass take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::Ve
   return p;
 }
 
-void check_workspace(const Model& model, const Workspace& ws) {
-  if (&ws.model() != &model) throw Error("workspace was made for another model");
-  const Index n = model.num_coordinates();
-  if (ws.q.size() != n || ws.qd.size() != n || ws.qdd.size() != n)
-    throw Error("workspace state has the wrong size (q, qd, qdd must have " + std::to_string(n) + " entries)");
-  // The scratch is public (the sweep and tests read it) and sized by the constructor: resized by a caller, the solves
-  // wrote past its end (heap corruption, an abort in free()). Checked with the state, in O(1).
-  const Index m = model.num_equations(), solve_rows = model.dropped_rows().empty() ? 0 : model.num_solve_rows();
-  if (ws.phi.size() != m || ws.rhs.size() != m || ws.trial_phi.size() != m || ws.step.size() != n ||
-      ws.trial.size() != n || static_cast<Index>(ws.jacobian_values.size()) != model.jacobian_pattern().nnz() ||
-      ws.solve_values.size() != model.solve_entries().size() || ws.solve_rhs.size() != solve_rows)
-    throw Error("workspace scratch has the wrong size (phi, rhs, step, trial, trial_phi, jacobian_values, "
-                "solve_values, solve_rhs keep the sizes the Workspace was made with)");
-}
-
 }  // namespace
-
-const double* detail::solve_values(const Model& model, Workspace& ws) {
-  if (model.dropped_rows().empty()) return ws.jacobian_values.data();
-  const std::vector<Index>& from = model.solve_entries();  // the kept rows only (Model::without_rows())
-  for (std::size_t k = 0; k < from.size(); ++k) ws.solve_values[k] = ws.jacobian_values[static_cast<std::size_t>(from[k])];
-  return ws.solve_values.data();
-}
 
 void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
   // An infinite tolerance accepts any point as the solution, a NaN start_error accepts the start unchecked (and
@@ -203,128 +192,6 @@ void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
   if (opt.jacobian_update != JacobianUpdate::kEveryIteration && opt.jacobian_update != JacobianUpdate::kWhenSlow)
     fail("jacobian_update is not a JacobianUpdate");
 }
-
-namespace {
-
-std::string not_square_message(const Model& model) {
-  std::string s = "the model has " + std::to_string(model.num_solve_rows()) + " equations for " +
-                  std::to_string(model.num_coordinates()) + " coordinates";
-  if (!model.dropped_rows().empty())
-    s += " (after leaving out " + std::to_string(model.dropped_rows().size()) + " redundant rows)";
-  return s + "; the driven system must be square (assemble() and analyse_rank() handle other models)";
-}
-
-// The workspace's factors, or its Jacobian values, are Φq at exactly (ws.q, t) (the points they recorded).
-bool factors_at_q(const Workspace& ws, double t) {
-  return ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
-         ws.factorized_q == ws.q;
-}
-bool jacobian_values_at_q(const Workspace& ws, double t) {
-  return ws.has_jacobian && ws.jacobian_t == t && ws.jacobian_q.size() == ws.q.size() && ws.jacobian_q == ws.q;
-}
-
-// Derivatives that do not exist. An equation's or a law's derivative can be infinite or NaN where its value is
-// finite (√u or u^0.5 at u = 0; γ of u^1.5 there): the LU then finds Φq singular, or a solve gives NaN, and the
-// failure read as a singular position or as a bare "velocity is not finite". These name the first such entry —
-// looked for only once a factorisation or a solve has failed — so that the message says what it is.
-const char* const kNoDerivative =
-    ", a derivative that does not exist at this position (as that of sqrt(u) or u^p, p < 1, at u = 0)";
-// The first non-finite entry of Φq's values (in the solve pattern: `values` as factorised), or "".
-std::string non_finite_jacobian(const Model& model, const double* values) {
-  const CscPattern& p = model.solve_pattern();
-  for (Index j = 0; j < p.cols; ++j)
-    for (Index k = p.col_ptr[static_cast<std::size_t>(j)]; k < p.col_ptr[static_cast<std::size_t>(j) + 1]; ++k)
-      if (!std::isfinite(values[k])) {
-        const Index r = p.row_idx[static_cast<std::size_t>(k)];
-        const Index row = model.dropped_rows().empty() ? r : model.solve_rows()[static_cast<std::size_t>(r)];
-        return std::string(detail::kNonFiniteJacobian) + "∂'" + model.row_name(row) + "'/∂'" +
-               model.coordinate_names()[static_cast<std::size_t>(j)] + "' = " + significant(values[k], 3) + kNoDerivative;
-      }
-  return "";
-}
-// The same for Φq evaluated at (q, t), for a failure after the factorisation (whose values may be gone).
-std::string non_finite_jacobian_at(const Model& model, const double* q, double t) {
-  std::vector<double> values(static_cast<std::size_t>(model.jacobian_pattern().nnz()));
-  model.jacobian(q, t, values.data());
-  if (model.dropped_rows().empty()) return non_finite_jacobian(model, values.data());
-  std::vector<double> kept(model.solve_entries().size());
-  for (std::size_t k = 0; k < kept.size(); ++k) kept[k] = values[static_cast<std::size_t>(model.solve_entries()[k])];
-  return non_finite_jacobian(model, kept.data());
-}
-// The first non-finite row of a right-hand side (Φt or γ, one entry per equation), or "".
-std::string non_finite_row(const Model& model, const Eigen::VectorXd& rhs, const std::string& what,
-                           const char* why) {
-  for (Index i = 0; i < rhs.size(); ++i)
-    if (!std::isfinite(rhs(i)))
-      return what + " of '" + model.row_name(i) + "' is not finite" + why;
-  return "";
-}
-
-// Factorises Φq at (ws.q, t) from ws.jacobian_values (evaluating them first unless `values_at_q`), and records
-// that the factors are at time t (ws.factorized_q is the caller's to record).
-SolveStatus factorize_at_q(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
-                           bool values_at_q) {
-  ws.has_factorization = false;
-  if (!values_at_q) {
-    model.jacobian(ws.q.data(), t, ws.jacobian_values.data());
-    ++ws.counters.jacobian_evaluations;
-  }
-  ws.has_jacobian = false;
-  const double* values = detail::solve_values(model, ws);
-  FactorStatus fs = ws.lu->factorize(values);
-  ++ws.counters.factorizations;
-  *rcond = ws.lu->rcond();
-  if (fs != FactorStatus::kOk || !(*rcond > 0.0)) {  // a non-finite entry makes the factors fail or rcond 0
-    std::string why = non_finite_jacobian(model, values);
-    if (!why.empty()) {
-      *message = std::move(why);
-      return SolveStatus::kNonFinite;
-    }
-  }
-  if (fs == FactorStatus::kFailed) {
-    *message = "sparse LU failed: " + ws.lu->last_message();
-    return SolveStatus::kLinearSolverFailed;
-  }
-  if (fs == FactorStatus::kSingular) {
-    *message = "Jacobian is singular (a zero pivot): singular position, or redundant or missing constraints";
-    return SolveStatus::kSingularJacobian;
-  }
-  ws.factorized_t = t;
-  ws.has_factorization = true;
-  return SolveStatus::kSuccess;
-}
-
-// Factorises Φq at (ws.q, t) unless the current factorisation was made exactly there. `values_at_q`: the caller
-// knows ws.jacobian_values hold Φq at (ws.q, t) already (the Newton loop's fused evaluation).
-SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
-                              bool values_at_q = false) {
-  if (!ws.lu) {
-    *message = not_square_message(model);
-    return SolveStatus::kNotSquare;
-  }
-  if (factors_at_q(ws, t)) {
-    *rcond = ws.lu->rcond();
-    return SolveStatus::kSuccess;
-  }
-  // Φq may have been evaluated with Φ at this very point by the Newton loop (NewtonOptions::jacobian_with_residual):
-  // known to the loop itself, or left by the last solve_position for the velocity solve that follows it
-  values_at_q = values_at_q || jacobian_values_at_q(ws, t);
-  const SolveStatus st = factorize_at_q(model, t, ws, rcond, message, values_at_q);
-  if (st == SolveStatus::kSuccess) ws.factorized_q = ws.q;
-  return st;
-}
-
-// The right-hand side the LU solves with: `b` (one entry per equation) itself, or its kept rows for a model with
-// dropped rows.
-const double* solve_rhs(const Model& model, Workspace& ws, const Eigen::VectorXd& b) {
-  if (model.dropped_rows().empty()) return b.data();
-  const std::vector<Index>& rows = model.solve_rows();
-  for (std::size_t i = 0; i < rows.size(); ++i) ws.solve_rhs(static_cast<Index>(i)) = b(rows[i]);
-  return ws.solve_rhs.data();
-}
-const double* solve_rhs(const Model& model, Workspace& ws) { return solve_rhs(model, ws, ws.rhs); }
-
-}  // namespace
 
 double scaled_residual(const Model& model, const Eigen::VectorXd& phi) { return max_scaled(model, phi); }
 
@@ -621,96 +488,5 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     }
   }
 }
-
-// q̇ from Φq q̇ = −Φt, and q̈ from Φq q̈ = γ, with the factors ws.lu holds (Φq at ws.q, t; the caller saw to
-// it): the solves of solve_velocity / solve_acceleration and of the sweep's derivatives_at_solution.
-namespace {
-SolveStatus velocity_from_factors(const Model& model, double t, Workspace& ws, LinearSummary& sum) {
-  model.phi_t(ws.q.data(), t, ws.rhs.data());
-  ++ws.counters.phi_t_evaluations;
-  ws.rhs = -ws.rhs;
-  if (!ws.lu->solve(solve_rhs(model, ws), ws.qd.data()))
-    return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
-  ++ws.counters.velocity_solves;
-  if (!all_finite(ws.qd)) {
-    std::string why = non_finite_row(model, ws.rhs, "Φt", kNoDerivative);
-    if (why.empty()) why = non_finite_jacobian_at(model, ws.q.data(), t);
-    sum.message = "velocity is not finite" + (why.empty() ? "" : ": " + why);
-    return sum.status = SolveStatus::kNonFinite;
-  }
-  return SolveStatus::kSuccess;
-}
-SolveStatus acceleration_from_factors(const Model& model, double t, Workspace& ws, LinearSummary& sum) {
-  model.gamma(ws.q.data(), ws.qd.data(), t, ws.rhs.data());
-  ++ws.counters.gamma_evaluations;
-  if (!ws.lu->solve(solve_rhs(model, ws), ws.qdd.data()))
-    return sum.status = SolveStatus::kLinearSolverFailed, sum.message = ws.lu->last_message(), sum.status;
-  ++ws.counters.acceleration_solves;
-  if (!all_finite(ws.qdd)) {
-    std::string why = non_finite_row(model, ws.rhs, "γ",
-                                     ", second derivatives that do not exist at this position (as those of u^p, "
-                                     "p < 2, at u = 0)");
-    if (why.empty()) why = non_finite_jacobian_at(model, ws.q.data(), t);
-    sum.message = "acceleration is not finite" + (why.empty() ? "" : ": " + why);
-    return sum.status = SolveStatus::kNonFinite;
-  }
-  return SolveStatus::kSuccess;
-}
-}  // namespace
-
-// The public linear solves: Φq factorised at (ws.q, t) unless it is already, then `solve` (velocity_from_factors or
-// acceleration_from_factors); `what` names the derivatives when Φq is singular there.
-template <class Solve>
-SolveStatus factorize_and_solve(const Model& model, double t, Workspace& ws, LinearSummary* summary, const char* what,
-                                Solve solve) {
-  check_workspace(model, ws);
-  LinearSummary local;
-  LinearSummary& sum = summary ? *summary : local;
-  sum = LinearSummary{};
-  std::string msg;
-  SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
-  if (st == SolveStatus::kSingularJacobian) msg = std::string(what) + " are not unique here: " + msg;
-  if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
-  return solve(model, t, ws, sum);
-}
-
-SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
-  return factorize_and_solve(model, t, ws, summary, "velocities", velocity_from_factors);
-}
-
-SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
-  return factorize_and_solve(model, t, ws, summary, "accelerations", acceleration_from_factors);
-}
-
-namespace detail {
-
-SolveStatus derivatives_at_solution(const Model& model, double t, Workspace& ws, bool accelerations,
-                                    LinearSummary* summary) {
-  LinearSummary local;
-  LinearSummary& sum = summary ? *summary : local;
-  sum = LinearSummary{};
-  auto fail = [&](SolveStatus st, std::string msg) {
-    sum.status = st, sum.message = std::move(msg);
-    return st;
-  };
-  if (!ws.lu) return fail(SolveStatus::kNotSquare, not_square_message(model));
-  if (ws.has_factorization && ws.factorized_at_solution && ws.factorized_t == t) {
-    sum.rcond = ws.lu->rcond();
-  } else {
-    std::string msg;
-    const SolveStatus st =
-        factorize_at_q(model, t, ws, &sum.rcond, &msg, ws.has_jacobian && ws.jacobian_t == t);
-    if (st == SolveStatus::kSingularJacobian) return fail(st, "velocities are not unique here: " + msg);
-    if (st != SolveStatus::kSuccess) return fail(st, msg);
-    // the point is not recorded (factorized_q is another's): no (q, t) may match it, so that public solves and the
-    // next solve_position's end factorise again rather than trust it
-    ws.factorized_t = std::numeric_limits<double>::quiet_NaN();
-  }
-  const SolveStatus st = velocity_from_factors(model, t, ws, sum);
-  if (st != SolveStatus::kSuccess || !accelerations) return st;
-  return acceleration_from_factors(model, t, ws, sum);
-}
-
-}  // namespace detail
 
 }  // namespace phiq

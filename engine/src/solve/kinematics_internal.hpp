@@ -1,4 +1,5 @@
-// Internal to the engine: what the sweep needs of kinematics.cpp beyond the public functions.
+// Internal to the engine: what the sweep needs of the kinematic solves (kinematics.cpp, factorisation.cpp,
+// derivatives.cpp) beyond the public functions.
 #pragma once
 
 #include "phiq/kinematics.hpp"

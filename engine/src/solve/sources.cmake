@@ -1,6 +1,8 @@
 # engine/src/solve/: the sources of this stage (engine/CMakeLists.txt includes this file).
 target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/assembly.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/derivatives.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/factorisation.cpp
   ${CMAKE_CURRENT_LIST_DIR}/kinematics.cpp
   ${CMAKE_CURRENT_LIST_DIR}/rank_analysis.cpp
 )
