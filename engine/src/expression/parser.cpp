@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "base/names.hpp"  // identifiers follow the scene's rule for names
 #include "expression/messages.hpp"
 #include "expression/symbolic.hpp"
 #include "expression/tape_ops.hpp"
@@ -17,9 +18,6 @@
 namespace phiq::detail {
 
 namespace {
-
-bool is_ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
-bool is_ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
 
 // phiq's own recursive-descent parser, building the GiNaC expression operation by operation. GiNaC's text parser
 // is not used: it crashes on input as small as "sin()" (found by fuzzing), knows dozens of functions phiq cannot
@@ -105,8 +103,8 @@ class ExpressionParser {
   }
   std::string token_text() const {  // the token at pos_, for messages
     std::size_t end = pos_ + 1;
-    if (is_ident_char(text_[pos_]))
-      while (end < text_.size() && is_ident_char(text_[end])) ++end;
+    if (is_name_char(text_[pos_]))
+      while (end < text_.size() && is_name_char(text_[end])) ++end;
     return text_.substr(pos_, std::min<std::size_t>(end - pos_, 40));
   }
 
@@ -188,9 +186,9 @@ class ExpressionParser {
     const char c = peek();
     if (c == '\0') fail("an operand is missing at the end");
     if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return number();
-    if (is_ident_start(c)) {
+    if (is_name_start(c)) {
       const std::size_t start = pos_;
-      while (pos_ < text_.size() && is_ident_char(text_[pos_])) ++pos_;
+      while (pos_ < text_.size() && is_name_char(text_[pos_])) ++pos_;
       const std::string name = text_.substr(start, pos_ - start);
       if (peek() == '(') return call(name, start);
       const Name n = name_(name);
@@ -218,7 +216,7 @@ class ExpressionParser {
         while (pos_ < n && std::isdigit(static_cast<unsigned char>(text_[pos_]))) ++pos_;
       }
     }
-    while (pos_ < n && is_ident_char(text_[pos_])) ++pos_;  // "2x" is one malformed number, not 2 times x
+    while (pos_ < n && is_name_char(text_[pos_])) ++pos_;  // "2x" is one malformed number, not 2 times x
     const std::string literal = text_.substr(start, pos_ - start);
     char* end = nullptr;
     const double v = std::strtod(literal.c_str(), &end);

@@ -11,7 +11,7 @@
 
 #include "phiq/expression.hpp"
 #include "phiq/text.hpp"
-#include "scene/names.hpp"
+#include "base/names.hpp"
 
 namespace phiq::detail::scene {
 

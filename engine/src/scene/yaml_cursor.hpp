@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "phiq/scene.hpp"
-#include "scene/names.hpp"
+#include "base/names.hpp"
 
 namespace phiq::detail::scene {
 

@@ -1,11 +1,12 @@
-// The one rule for names in scenes: letters, digits and '_', not starting with a digit. Parameters, coordinates,
-// points, bodies, vectors, family indices and the names inside family texts all follow it; it has a file of its own
-// so that the YAML cursor and the family index language read names by the same rule.
+// The one rule for names: letters, digits and '_', not starting with a digit. Parameters, coordinates, points,
+// bodies, vectors, family indices, the names inside family texts and the identifiers of equation texts all follow
+// it; it has a file of its own so that the scene's YAML cursor, its family index language and the expression parser
+// read names by the same rule.
 #pragma once
 
 #include <string>
 
-namespace phiq::detail::scene {
+namespace phiq::detail {
 
 // ASCII, as the "C" locale's isalpha/isalnum say, without a library call per character: families check millions
 // of names.
@@ -20,4 +21,4 @@ inline bool valid_name(const std::string& s) {
   return true;
 }
 
-}  // namespace phiq::detail::scene
+}  // namespace phiq::detail
