@@ -44,7 +44,7 @@ class Workspace {
   Eigen::VectorXd qdd;     ///< accelerations q̈ (written by solve_acceleration; starts at zero)
   WorkCounters counters;   ///< work done with this workspace so far (never reset by the algorithms)
 
-  /// @name Scratch of the algorithms (kinematics.cpp); callers need not touch it
+  /// @name Scratch of the algorithms (src/solve/); callers need not touch it
   /// Its values may be read; a vector resized by the caller makes every solve refuse the workspace (phiq::Error).
   ///@{
   Eigen::VectorXd phi;                   ///< Φ at q
