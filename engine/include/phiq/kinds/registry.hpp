@@ -4,7 +4,8 @@
 /// equation in a comment, residual, Jacobian entries, Φt, γ, the validation of its data, its joint count, its
 /// sketch and its scene forms), one line below, and one finite-difference test; the ConstraintKind concept refuses
 /// at compile time a registered kind that lacks any of these members, and tests/test_kind_registry.cpp fails for
-/// one without a finite-difference check, a documented scene example or a scene that uses it.
+/// one without a finite-difference check, without its scene examples in models/README.md, or with a constraint type
+/// missing from the fuzzing dictionary or claimed by another kind.
 #pragma once
 
 #include <string_view>
