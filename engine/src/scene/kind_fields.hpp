@@ -38,10 +38,7 @@ class KindFields {
   Point2 point(const char* field) const { return r_.point(c_.require(field)); }
   std::pair<Point2, Point2> segment(const char* field) const { return r_.segment(c_.require(field)); }
   std::pair<std::pair<Point2, Point2>, std::pair<Point2, Point2>> two_segments(const char* field) const {
-    auto segs = c_.require(field);
-    if (!segs.is_sequence() || segs.size() != 2) segs.fail("expected two segments [[A, B], [C, D]]");
-    auto u = r_.segment(segs.at(0));
-    return {u, r_.segment(segs.at(1))};
+    return pair_of(field, "expected two segments [[A, B], [C, D]]", [&](const C& n) { return r_.segment(n); });
   }
 
   // An attachment of a planar pair, and whether it was written {body: …} (not {point: …}).
@@ -51,12 +48,10 @@ class KindFields {
     bool body;
   };
   std::pair<Attachment, Attachment> attachments(const char* field, const char* arity_message) const {
-    auto between = c_.require(field);
-    if (!between.is_sequence() || between.size() != 2) between.fail(arity_message);
-    auto [fa, sa] = r_.attachment(between.at(0));
-    auto [fb, sb] = r_.attachment(between.at(1));
-    return {Attachment{fa, sa, between.at(0).field("body").present()},
-            Attachment{fb, sb, between.at(1).field("body").present()}};
+    return pair_of(field, arity_message, [&](const C& n) {
+      auto [frame, at] = r_.attachment(n);
+      return Attachment{frame, at, n.field("body").present()};
+    });
   }
 
   // The entries of a list field, each read with this same vocabulary.
@@ -79,16 +74,10 @@ class KindFields {
     return out;
   }
   std::pair<Index, Index> coordinate_pair(const char* field) const {
-    auto v = c_.require(field);
-    if (!v.is_sequence() || v.size() != 2) v.fail("expected two coordinates [q_i, q_j]");
-    const Index i = r_.coordinate(v.at(0));
-    return {i, r_.coordinate(v.at(1))};
+    return pair_of(field, "expected two coordinates [q_i, q_j]", [&](const C& n) { return r_.coordinate(n); });
   }
   std::pair<double, double> number_pair(const char* field) const {
-    auto v = c_.require(field);
-    if (!v.is_sequence() || v.size() != 2) v.fail("expected two numbers [a, b]");
-    const double a = r_.number(v.at(0));
-    return {a, r_.number(v.at(1))};
+    return pair_of(field, "expected two numbers [a, b]", [&](const C& n) { return r_.number(n); });
   }
   std::shared_ptr<const CompiledExpression> expression(const char* field) const {
     return r_.compile(c_.require(field), true);
@@ -98,10 +87,7 @@ class KindFields {
   // ---- dimension 3
   Point3 point3(const char* field) const { return r_.point3(c_.require(field)); }
   std::pair<Point3, Point3> point3_pair(const char* field, const char* arity_message) const {
-    auto pts = c_.field(field);
-    if (!pts.is_sequence() || pts.size() != 2) pts.fail(arity_message);
-    const Point3 a = r_.point3(pts.at(0));
-    return {a, r_.point3(pts.at(1))};
+    return pair_of(field, arity_message, [&](const C& n) { return r_.point3(n); });
   }
   kin3::V3 vec3(const char* field) const { return r_.vec3(c_.require(field)); }
   // The two sides of a joint, `between` (the message names the entry's type).
@@ -112,15 +98,23 @@ class KindFields {
     Unit unit = Unit::kNone;
   };
   std::pair<Direction, Direction> two_directions(const char* field) const {
-    auto dirs = c_.require(field);
-    if (!dirs.is_sequence() || dirs.size() != 2) dirs.fail("a dot product has two directions [D1, D2]");
-    Direction d1, d2;
-    std::tie(d1.head, d1.tail) = r_.dot_direction(dirs.at(0), d1.unit);
-    std::tie(d2.head, d2.tail) = r_.dot_direction(dirs.at(1), d2.unit);
-    return {d1, d2};
+    return pair_of(field, "a dot product has two directions [D1, D2]", [&](const C& n) {
+      Direction d;
+      std::tie(d.head, d.tail) = r_.dot_direction(n, d.unit);
+      return d;
+    });
   }
 
  private:
+  // A field that is a list of exactly two entries, each read by `read` (the first, then the second).
+  template <class Read>
+  auto pair_of(const char* field, const char* arity_message, Read read) const {
+    auto v = c_.require(field);
+    if (!v.is_sequence() || v.size() != 2) v.fail(arity_message);
+    auto first = read(v.at(0));
+    return std::pair{first, read(v.at(1))};
+  }
+
   const SceneReader& r_;
   C c_;
   const std::string& type_;
