@@ -26,6 +26,7 @@ struct Rows {
 Rows sweep_scene(const Scene& sc, int threads) {
   SweepOptions opt = sc.sweep;
   opt.threads = threads;
+  if (opt.chunk_steps == 0) opt.chunk_steps = opt.steps;  // one chunk, in order: the rows' own work is counted
   opt.residuals = true;
   Rows r;
   Workspace ws(*sc.model);
@@ -191,6 +192,7 @@ ChainRun long_chain(bool derivatives) {
   opt.t_begin = 0.0;
   opt.t_end = 1.0;
   opt.steps = kChainSteps;
+  opt.chunk_steps = kChainSteps;  // one chunk, in order: the rows' own Newton steps are counted, not chunk seeds
   opt.velocities = opt.accelerations = derivatives;
   opt.residuals = true;
   ChainRun r;

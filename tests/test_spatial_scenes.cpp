@@ -214,7 +214,10 @@ TEST(SpatialScenes, CardanNearItsSingularAngleStaysOnItsBranch) {
   test::Trace tr;
   ASSERT_EQ(test::sweep(m, s.sweep, &tr, &sum), SolveStatus::kSuccess) << sum.message;
   ASSERT_EQ(tr.t.size(), 73u);
-  for (const SweepWarning& w : sum.warnings) ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
+  // The chunks' seeds, found over a chunk's whole span (16 steps, 80°), land on the other mode beyond the swing; the
+  // seam check refuses that chunk and the rest runs in order, on every thread count alike: its one warning.
+  for (const SweepWarning& w : sum.warnings)
+    if (w.kind != "parallel_fallback") ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
   const double beta = 89.0 * M_PI / 180.0, cb = std::cos(beta), w = 1.5;
   const Index i = m.coordinate_index("x2");
   const Frame3 s2{Slot::coordinate(i),     Slot::coordinate(i + 1), Slot::coordinate(i + 2), Slot::coordinate(i + 3),

@@ -120,6 +120,7 @@ TEST(Sweep, TheCallersKnownToIsAFloorUnderTheLevelTheSweepCarries) {
     opt.predictor = Predictor::kQuadratic;
     opt.newton.jacobian_update = JacobianUpdate::kEveryIteration;
     opt.newton.known_to = known_to;
+    opt.chunk_steps = opt.steps;  // one chunk, in order: the rows' own Newton steps are counted, not chunk seeds
     test::Trace tr;
     SweepSummary sum;
     EXPECT_EQ(test::sweep(m, opt, &tr, &sum), SolveStatus::kSuccess) << sum.message;

@@ -21,7 +21,7 @@ namespace phiq::tools {
 namespace {
 
 // `phiq run --summary FILE.json`: the run summary, format version 1 (tools/README.md).
-std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& ws, const phiq::SweepSummary& s,
+std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& /*ws*/, const phiq::SweepSummary& s,
                          double load_s, double solve_s, double write_s) {
   nlohmann::ordered_json j;
   j["format"] = 1;
@@ -40,7 +40,7 @@ std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& ws, co
   j["write_seconds"] = write_s;
   j["newton_iterations"] = s.counters.newton_iterations;
   j["factorizations"] = s.counters.factorizations;
-  j["pivoting_factorizations"] = ws.lu ? ws.lu->pivoting_factorizations() : 0;
+  j["pivoting_factorizations"] = s.counters.pivoting_factorizations;
   j["velocity_solves"] = s.counters.velocity_solves;
   j["acceleration_solves"] = s.counters.acceleration_solves;
   j["phi_t_evaluations"] = s.counters.phi_t_evaluations;

@@ -59,6 +59,10 @@ class SparseLuNumeric {
   virtual std::uint64_t block_signs() const { return 0; }
   /// Detail of the last failure, for diagnostics.
   virtual std::string last_message() const = 0;
+  /// The next factorize() searches for pivots as the first one does, instead of keeping the pivot order of an
+  /// earlier factorisation (KLU): its factors then depend on the matrix alone, not on which matrices this object
+  /// factorised before (Workspace::start_afresh). No-op for libraries that always pivot.
+  virtual void forget_pivot_order() {}
   /// Factorisations so far that searched for pivots (for KLU: not a refactorisation with the old pivot order).
   /// Equal to the number of factorize() calls for libraries that always pivot.
   virtual std::int64_t pivoting_factorizations() const = 0;

@@ -75,13 +75,15 @@ struct SolverSettings {
 
 /// How the drive steps of a sweep are spread over threads, and the memory they may take.
 struct ParallelSettings {
-  /// Threads for the drive steps: 1 runs them in order; N > 1 runs chunks of chunk_steps steps in parallel on N
-  /// threads; 0 uses all cores. Each chunk starts from a seed found by a sequential pass over the chunk starts
-  /// (positions only, every chunk_steps-th time point), and is accepted only if the sequential sweep, continued
-  /// one step past the previous chunk (that seam step solves its position only), reaches the same position there
-  /// to within 100 × the tolerance: otherwise
-  /// the rest of the sweep runs in order (warning "parallel_fallback"). Rows are delivered in time order in any
-  /// case, and equal the sequential sweep's to the solver tolerance; on_step is called on the calling thread.
+  /// Threads for the drive steps; 0 uses all cores. The steps run in chunks of chunk_steps steps, cut alike for
+  /// every thread count, and the rows, the summary's counts and its warnings are the same bits on every thread
+  /// count and every run: N threads run N chunks at once, one thread runs the same chunks one after the other.
+  /// Each chunk starts from a seed found by a sequential pass over the chunk starts (positions only, every
+  /// chunk_steps-th time point, a row later where the seed is at or next to a singular position), and is accepted
+  /// only if the sweep, continued one step past the previous chunk (that seam step solves its position only),
+  /// reaches the same position there to within 100 × the tolerance: otherwise the rest of the sweep runs in order
+  /// (warning "parallel_fallback"). Rows are delivered in time order, and equal the sweep in order's (chunk_steps ≥
+  /// steps) to the solver tolerance; on_step is called on the calling thread.
   /// Everything the sweep runs stays on these threads, the model's own parallel evaluation of large models
   /// (ModelBuilder, 65536 constraints and more) included: 1 is one thread. The threads solve in the caller's
   /// workspace and one more per extra thread (each with its own LU of Φq), which the seeding pass shares. With 0,
@@ -93,14 +95,14 @@ struct ParallelSettings {
   /// reports available (MemAvailable of /proc/meminfo), no limit where it reports none. An explicit thread count
   /// is never reduced.
   std::size_t memory_budget = 0;
-  /// Steps per parallel chunk; 0 picks 64, fewer (down to 16) so that there are at least 4 chunks per thread (the
-  /// seed of a chunk is one step over its span, expensive on large models when long), and fewer when the rows
-  /// held for delivery (threads × chunk_steps rows of q, q̇, q̈ and the outputs) would exceed row_buffer_bytes;
-  /// where that leaves fewer than 8 steps per chunk, which cost more in seeds than a thread gains, they run on as
-  /// many threads as have room for 8, or in order (warning "threads_reduced"). A sweep with no on_step holds two
-  /// rows per chunk, whatever their width.
+  /// Steps per chunk; ≥ steps runs the sweep in order, as one chunk. 0 picks 64, fewer (down to 16) so that there
+  /// are 16 chunks (the seed of a chunk is one step over its span, expensive on large models when long), and no
+  /// more than the rows row_buffer_bytes holds (q, q̇, q̈ and the outputs of a row), none below 8, which cost more in
+  /// seeds than a thread gains: one chunk then. It depends on the scene and these options only, never on the
+  /// threads or the machine. Threads beyond those with room for a chunk's rows each are not used (warning
+  /// "threads_reduced"). A sweep with no on_step holds two rows per chunk, whatever their width.
   Index chunk_steps = 0;
-  /// Bytes of rows a parallel sweep may hold before it delivers them in order (> 0; see chunk_steps).
+  /// Bytes of rows a sweep in chunks may hold before it delivers them in order (> 0; see chunk_steps).
   std::size_t row_buffer_bytes = std::size_t{512} * 1024 * 1024;
 };
 
@@ -151,8 +153,8 @@ struct SweepSummary {
   std::vector<SweepWarning> warnings;  ///< in time order
   double solve_seconds = 0.0;          ///< wall time of the sweep, the callback's own work included
   int threads = 1;                     ///< threads the drive steps ran on
-  Index parallel_chunks = 0;           ///< chunks run in parallel and accepted (0 for a sequential sweep)
-  double seed_seconds = 0.0;           ///< wall time of the sequential seeding pass of a parallel sweep
+  Index parallel_chunks = 0;           ///< chunks run from their seeds and accepted (0 for a sweep in order)
+  double seed_seconds = 0.0;           ///< wall time of the sequential seeding pass of a sweep in chunks
   /// One line: status, steps, iterations, factorisations, solves, point evaluations, subdivisions, warnings, time,
   /// message.
   std::string BriefReport() const;

@@ -18,6 +18,8 @@ struct WorkCounters {
   Index residual_evaluations = 0;  ///< evaluations of Φ (including line-search trials)
   Index jacobian_evaluations = 0;  ///< evaluations of Φq values
   Index factorizations = 0;        ///< numeric LU factorisations
+  /// Those of them that searched for pivots (KLU: not a refactorisation with the pivot order of an earlier one)
+  Index pivoting_factorizations = 0;
   Index velocity_solves = 0;       ///< solves of Φq q̇ = −Φt
   Index acceleration_solves = 0;   ///< solves of Φq q̈ = γ
   Index phi_t_evaluations = 0;     ///< evaluations of Φt (velocity right-hand sides)
@@ -27,8 +29,8 @@ struct WorkCounters {
 
 /// Per-thread data of the algorithms in kinematics.hpp and sweep.hpp. Not thread-safe: one thread at a time.
 /// What it keeps between calls (the LU's pivot order, newton_contraction, a factorisation still valid at its point)
-/// changes the next call's work and the last bits of its results, within the tolerance: for results identical to
-/// the bit between runs, start each from a fresh Workspace, on one thread (engine/README.md, Thread safety).
+/// changes the next call's work and the last bits of its results, within the tolerance; start_afresh() forgets it
+/// (run_sweep does, so a sweep's results depend on its model, options and starting q only).
 class Workspace {
  public:
   /// Sized for `model`, with q at its initial positions and its own numeric LU object (sharing the model's
@@ -36,6 +38,10 @@ class Workspace {
   explicit Workspace(const Model& model);
   /// The model it was made for.
   const Model& model() const { return *model_; }
+  /// Forgets what the last calls left for the next (the factorisation, its pivot order, Φq values not yet
+  /// factorised, newton_contraction): the next call computes, to the bit, what it would in a fresh workspace
+  /// with the same q (q̇, q̈ and the counters are kept; the memory of the factors too).
+  void start_afresh();
 
   /// Generalized coordinates. Starts at the model's initial positions; algorithms read and write it, and so may
   /// the caller (e.g. to give a better starting guess). Keep its size.

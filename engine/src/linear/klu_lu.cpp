@@ -252,6 +252,7 @@ class KluNumeric final : public SparseLuNumeric {
   std::uint64_t block_signs() const override { return block_signs_; }
   std::string last_message() const override { return message_; }
   std::int64_t pivoting_factorizations() const override { return pivoting_; }
+  void forget_pivot_order() override { forget_pivots_ = true; }
   std::size_t memory_bytes() const override { return numeric_ ? common_.mempeak : 0; }  // factorising included
 
   // A refactorisation keeps the pivot order of the last pivoting factorisation; when its reciprocal pivot ratio
@@ -277,6 +278,7 @@ class KluNumeric final : public SparseLuNumeric {
   typename Api::Numeric* numeric_ = nullptr;
   double rcond_ = 0.0, rcond_at_pivoting_ = 0.0;
   std::int64_t pivoting_ = 0;
+  bool forget_pivots_ = false;  // forget_pivot_order(): the next factorize() searches for pivots
   std::string message_;
   int p_sign_ = 1;  // parity of the row permutation Pnum of the last pivoting factorisation
   int u_sign_ = 1;  // sign of the product of U's diagonal (0: a zero pivot)
@@ -438,6 +440,7 @@ double KluNumeric<Int>::scan_diagonal() {
 template <class Int>
 FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
   if (numeric_) Api::free_numeric(&numeric_, &common_);
+  forget_pivots_ = false;
   ++pivoting_;
   inverse_row_scale_.clear();
   common_.scale = 2;  // pivots chosen on rows scaled by their largest entries (KLU's default)
@@ -475,7 +478,7 @@ FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
 // two), so that its thresholds and the degradation test keep their meaning on badly scaled models.
 template <class Int>
 FactorStatus KluNumeric<Int>::factorize(const double* values) {
-  if (numeric_) {
+  if (numeric_ && !forget_pivots_) {
     if (inverse_row_scale_.empty() && numeric_->Rs) {  // first refactorisation after a pivot search: keep KLU's
       const double* rs = static_cast<const double*>(numeric_->Rs);  // scales (> 0: an empty row has scale 1)
       inverse_row_scale_.resize(static_cast<std::size_t>(sym_.pattern_->cols));

@@ -79,8 +79,10 @@ SolveStatus detail::factorize_at_q(const Model& model, double t, Workspace& ws, 
   }
   ws.has_jacobian = false;
   const double* values = detail::solve_values(model, ws);
+  const std::int64_t pivoting_before = ws.lu->pivoting_factorizations();
   FactorStatus fs = ws.lu->factorize(values);
   ++ws.counters.factorizations;
+  if (ws.lu->pivoting_factorizations() != pivoting_before) ++ws.counters.pivoting_factorizations;
   *rcond = ws.lu->rcond();
   if (fs != FactorStatus::kOk || !(*rcond > 0.0)) {  // a non-finite entry makes the factors fail or rcond 0
     std::string why = non_finite_jacobian(model, values);

@@ -53,6 +53,14 @@ Workspace::Workspace(const Model& model) : model_(&model) {
   if (model.symbolic()) lu = model.symbolic()->make_numeric();
 }
 
+void Workspace::start_afresh() {
+  has_factorization = false;
+  factorized_at_solution = false;
+  has_jacobian = false;
+  newton_contraction = -1.0;
+  if (lu) lu->forget_pivot_order();
+}
+
 namespace {
 
 using detail::check_workspace;

@@ -57,6 +57,9 @@ struct Chunk {
   bool has_seam = false;
   Eigen::VectorXd seam_q;    // the position at t_{k1+1} reached by continuing in order
   double rounding = 0.0;  // largest rounding level (Sweeper::take_rounding_level) of its solves, seed included
+  double first_rounding = 0.0;  // that of its seed and first row (what the seam check allows for)
+  Index good = 0;         // rows k0 … k0 + good − 1 converged (all of them when ok)
+  State end;              // the last good row's state (streamed chunks, and held ones that failed after some)
 };
 
 }  // namespace
@@ -84,8 +87,18 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   const Index n_phi = opt.residuals ? model.num_equations() : 0;
   const Index n_points = static_cast<Index>(opt.points.size());
   sum.threads = threads;
-  auto first_row = [&](Index c) { return 1 + c * chunk; };
-  auto last_row = [&](Index c) { return std::min(opt.steps, (c + 1) * chunk); };
+  // Chunk c's rows: first[c] … first[c + 1] − 1. A chunk starts at row 1 + c·chunk, or a few rows later where its
+  // seed there is at or next to a singular position (seed_one): a chunk started there would start as a sweep
+  // starting on a singular position does, from an assembly, with the branch and the derivatives less well known
+  // (nfourbar through its flat positions: the row's q̇ extrapolated from one side, and the chunk rejected at its
+  // seam), while the chunk before passes it in order, as a sequential sweep does. The seeds decide it, in order,
+  // so the layout is the same on every thread count; a chunk is run once its end (the next seed) is known.
+  std::vector<Index> first(static_cast<std::size_t>(n_chunks) + 1);
+  for (Index c = 0; c < n_chunks; ++c) first[static_cast<std::size_t>(c)] = 1 + c * chunk;
+  first[static_cast<std::size_t>(n_chunks)] = opt.steps + 1;
+  auto first_row = [&](Index c) { return first[static_cast<std::size_t>(c)]; };
+  auto last_row = [&](Index c) { return first[static_cast<std::size_t>(c) + 1] - 1; };
+  const Index max_shift = chunk / 2;  // how far a chunk's start moves at most (its chunk then holds 1.5 chunks)
 
   // Workspaces, taken from a pool for the time of one chunk or one seed: the caller's own (idle otherwise) and as
   // many more as are in use at once, one per thread, since the seeding pass takes one only while it finds a seed.
@@ -105,7 +118,9 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     }
     Workspace* w = pool.back();
     pool.pop_back();
-    w->newton_contraction = -1.0;  // measured by its last user, on other steps
+    // A chunk or a seed computes the same bits whichever workspace it gets: nothing its last user left (a
+    // factorisation, its pivot order, a measured contraction) is carried into it.
+    w->start_afresh();
     return w;
   };
   auto release = [&](Workspace* w) {
@@ -154,29 +169,82 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
       for (Eigen::VectorXd* v : {&r.q, &r.qd, &r.qdd})
         if (v->size() == n_coords) spare.push_back(std::move(*v));
   };
-  // Chunk c: its rows from its seed (chunk 0: in order from row 0), then the seam step.
-  auto run_chunk = [&](Index c, Chunk& ch) {
+  // Whether a chunk whose first row is at q0 continues the sweep in order: chunk 0 does by construction; another
+  // must start where the sweep, continued in order from the last delivered row, arrives (the previous chunk's
+  // seam). Two solutions of the same problem agree to 100 tolerances, or, where Newton stopped at the rounding level
+  // (a long chain), to 10× how well that stop says q is known: another branch is a finite distance away.
+  auto continues = [&](const Chunk& ch, const double* q0) {
+    const double limit = std::max(100.0, 10.0 * std::max(seam_rounding, ch.first_rounding));
+    return ch.k0 == 1 || (seam_known && same_solution(model, seam_q, q0, opt.newton.tolerance, limit));
+  };
+  // A chunk delivered (its first `good` rows): the state an ordered continuation starts from, its seam, and its
+  // summary, up to its last good row. Returns 0 when every row was good, 3 when it failed after them (the rest
+  // then runs in order from its last good row, where the failure is found and reported as a sequential sweep's).
+  auto finish = [&](Chunk& ch, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd) {
+    last_q.swap(q);
+    if (need_v) last_qd.swap(qd);
+    if (need_a) last_qdd.swap(qdd);
+    resume = ch.k0 + ch.good;
+    seam_known = ch.ok && ch.has_seam;
+    if (seam_known) seam_q.swap(ch.seam_q), seam_rounding = ch.rounding;
+    sum.subdivisions += ch.sum.subdivisions;
+    sum.singular_positions += ch.sum.singular_positions;
+    sum.warnings.insert(sum.warnings.end(), ch.sum.warnings.begin(), ch.sum.warnings.end());
+    if (ch.sum.min_rcond > 0.0 && (sum.min_rcond == 0.0 || ch.sum.min_rcond < sum.min_rcond))
+      sum.min_rcond = ch.sum.min_rcond, sum.min_rcond_time = ch.sum.min_rcond_time;
+    ++sum.parallel_chunks;
+    return ch.ok ? 0 : 3;
+  };
+
+  // Chunk c: its rows from its seed (chunk 0: in order from row 0), then the seam step. `stream`: the caller's
+  // thread runs the chunk next to be delivered, and delivers each row as it is computed instead of holding it
+  // (one thread always does): the same rows, the same checks, no buffers. Returns, when streaming, what
+  // deliver_chunk returns.
+  auto run_chunk = [&](Index c, Chunk& ch, bool stream) {
     Workspace* held = acquire();
     Workspace& w = *held;
     const WorkCounters w0 = w.counters;
     ch.k0 = first_row(c), ch.k1 = last_row(c);
     Sweeper s(model, opt, w, ch.sum);
-    ch.rows.resize(static_cast<std::size_t>(ch.k1 - ch.k0 + 1));
-    take_buffers(ch.rows);
-    std::size_t kept = 0;
-    auto keep = [&] {
+    if (!stream) {
+      ch.rows.resize(static_cast<std::size_t>(ch.k1 - ch.k0 + 1));
+      take_buffers(ch.rows);
+    }
+    int outcome = 0;
+    // The summary up to the last good row: what is delivered of it (sub-steps, warnings and the condition of a
+    // failed step or of the seam step belong to the sweep that runs them next).
+    SweepSummary good_sum;
+    auto keep = [&] {  // false: stop the chunk (streaming: rejected or stopped by the caller)
       const State& st = s.state();
-      Row& r = ch.rows[kept];
       s.row_outputs();
+      if (ch.good == 0) ch.first_rounding = std::max(s.take_rounding_level(), ch.first_rounding);
+      good_sum.warnings = ch.sum.warnings, good_sum.subdivisions = ch.sum.subdivisions;
+      good_sum.singular_positions = ch.sum.singular_positions;
+      good_sum.min_rcond = ch.sum.min_rcond, good_sum.min_rcond_time = ch.sum.min_rcond_time;
+      const Index k = ch.k0 + ch.good;
+      if (stream) {
+        if (ch.good == 0 && !continues(ch, st.q.data())) return outcome = 1, false;
+        ++ch.good;
+        if (!run.deliver(k, st.q, st.qd, st.qdd, s.point_motions(), w.phi, s.rcond(), s.det_sign(),
+                         s.det_sign_time())) {
+          last_q = st.q, last_qd = need_v ? st.qd : last_qd, last_qdd = need_a ? st.qdd : last_qdd;
+          return outcome = 2, false;
+        }
+        return true;
+      }
+      Row& r = ch.rows[static_cast<std::size_t>(ch.good)];
       r.det_sign = s.det_sign(), r.det_sign_t = s.det_sign_time();  // (the bifurcation check reads every row's)
-      if (!layout.keeps_vectors(ch.rows.size(), kept++)) return;
-      stream_copy(st.q, r.q);
-      if (need_v) stream_copy(st.qd, r.qd);
-      if (need_a) stream_copy(st.qdd, r.qdd);
-      if (n_phi) r.phi = w.phi;
-      r.rcond = s.rcond();
-      if (n_points) r.points.assign(s.point_motions(), s.point_motions() + n_points);
+      if (layout.keeps_vectors(ch.rows.size(), static_cast<std::size_t>(ch.good++))) {
+        stream_copy(st.q, r.q);
+        if (need_v) stream_copy(st.qd, r.qd);
+        if (need_a) stream_copy(st.qdd, r.qdd);
+        if (n_phi) r.phi = w.phi;
+        r.rcond = s.rcond();
+        if (n_points) r.points.assign(s.point_motions(), s.point_motions() + n_points);
+      }
+      return true;
     };
+    if (c > 0) ch.first_rounding = seed_rounding[static_cast<std::size_t>(c)];
     if (c == 0) {  // continues row 0 in order: the sequential sweep itself
       w.q = last_q, w.qd = last_qd, w.qdd = last_qdd;
       s.adopt(run.time_of(0));
@@ -185,40 +253,41 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
       ch.ok = s.start_from(run.time_of(ch.k0), seeds[static_cast<std::size_t>(c)],
                            seed_error[static_cast<std::size_t>(c)]);
     }
-    if (ch.ok) keep();
-    for (Index k = ch.k0 + 1; ch.ok && k <= ch.k1; ++k)
-      if ((ch.ok = s.advance(run.time_of(k), 0))) keep();
-    if (ch.ok && ch.k1 < opt.steps) {
-      // the seam row belongs to the next chunk: its warnings and sub-steps are counted there
-      const SweepSummary kept = ch.sum;
-      if (s.advance_position(run.time_of(ch.k1 + 1))) {
-        ch.has_seam = true;
-        ch.seam_q = s.state().q;
-      }
-      ch.sum.warnings = kept.warnings;
-      ch.sum.subdivisions = kept.subdivisions;
-      ch.sum.singular_positions = kept.singular_positions;
-      ch.sum.status = kept.status, ch.sum.message = kept.message;
-      ch.sum.min_rcond = kept.min_rcond, ch.sum.min_rcond_time = kept.min_rcond_time;
+    bool going = ch.ok && keep();
+    for (Index k = ch.k0 + 1; going && k <= ch.k1; ++k) going = (ch.ok = s.advance(run.time_of(k), 0)) && keep();
+    // The last good row's state, where an ordered continuation starts (before the seam step moves the stepper on):
+    // a streamed chunk holds no rows, and a held one that failed kept only its ends' vectors.
+    if ((stream || !ch.ok) && ch.good > 0) ch.end = s.state();
+    if (going && ch.k1 < opt.steps && s.advance_position(run.time_of(ch.k1 + 1))) {
+      ch.has_seam = true;  // the seam row belongs to the next chunk
+      ch.seam_q = s.state().q;
     }
-    ch.rounding = std::max(s.take_rounding_level(), c > 0 ? seed_rounding[static_cast<std::size_t>(c)] : 0.0);
+    ch.rounding = std::max(s.take_rounding_level(), ch.first_rounding);
+    ch.sum.warnings.swap(good_sum.warnings);
+    ch.sum.subdivisions = good_sum.subdivisions, ch.sum.singular_positions = good_sum.singular_positions;
+    ch.sum.min_rcond = good_sum.min_rcond, ch.sum.min_rcond_time = good_sum.min_rcond_time;
     add_counters(ch.sum.counters, w.counters, w0);
+    if (stream) {
+      add_counters(others, ch.sum.counters, WorkCounters{});
+      if (outcome == 0) {
+        if (ch.good == 0) {
+          outcome = 1;  // no first row: rejected, the rest runs in order
+        } else {
+          outcome = finish(ch, ch.end.q, ch.end.qd, ch.end.qdd);
+        }
+      }
+    }
     release(held);
-    stream_fence();  // the chunk's streamed rows are complete before it is marked done for the delivering thread
+    if (!stream) stream_fence();  // the chunk's streamed rows are complete before it is marked done for the caller
+    return outcome;
   };
 
-  // Accepts and delivers a computed chunk: 0 delivered, 1 rejected (the rest runs in order), 2 stopped by the
-  // caller. A chunk is the sequential sweep's continuation if it starts where the sweep, continued in order from
-  // the last delivered row, arrives (chunk 0 is that continuation by construction).
+  // Accepts and delivers a chunk computed ahead: 0 delivered, 1 rejected (the rest runs in order), 2 stopped by the
+  // caller, 3 failed after its first rows, which are delivered (the rest runs in order from there).
   auto deliver_chunk = [&](Chunk& ch) {
     add_counters(others, ch.sum.counters, WorkCounters{});
-    // Two solutions of the same problem agree to 100 tolerances, or, where Newton stopped at the rounding level
-    // (a long chain), to 10× how well that stop says q is known: another branch is a finite distance away.
-    const double limit = std::max(100.0, 10.0 * std::max(seam_rounding, ch.rounding));
-    const bool accept = ch.ok && (ch.k0 == 1 || (seam_known && same_solution(model, seam_q, ch.rows[0].q.data(),
-                                                                             opt.newton.tolerance, limit)));
-    if (!accept) return 1;
-    for (Index k = ch.k0; k <= ch.k1; ++k) {
+    if (ch.good == 0 || !continues(ch, ch.rows[0].q.data())) return 1;
+    for (Index k = ch.k0; k < ch.k0 + ch.good; ++k) {
       const Row& r = ch.rows[static_cast<std::size_t>(k - ch.k0)];
       if (!run.deliver(k, r.q, r.qd, r.qdd, n_points ? r.points.data() : nullptr, r.phi, r.rcond, r.det_sign,
                        r.det_sign_t)) {
@@ -226,21 +295,10 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
         return 2;
       }
     }
-    // the state an ordered continuation starts from: the chunk's last row (it is freed once delivered)
+    // the state an ordered continuation starts from: the chunk's last good row (freed once delivered)
+    if (!ch.ok) return finish(ch, ch.end.q, ch.end.qd, ch.end.qdd);
     Row& last = ch.rows.back();
-    last_q.swap(last.q);
-    if (need_v) last_qd.swap(last.qd);
-    if (need_a) last_qdd.swap(last.qdd);
-    resume = ch.k1 + 1;
-    seam_known = ch.has_seam;
-    if (seam_known) seam_q.swap(ch.seam_q), seam_rounding = ch.rounding;
-    sum.subdivisions += ch.sum.subdivisions;
-    sum.singular_positions += ch.sum.singular_positions;
-    sum.warnings.insert(sum.warnings.end(), ch.sum.warnings.begin(), ch.sum.warnings.end());
-    if (ch.sum.min_rcond > 0.0 && (sum.min_rcond == 0.0 || ch.sum.min_rcond < sum.min_rcond))
-      sum.min_rcond = ch.sum.min_rcond, sum.min_rcond_time = ch.sum.min_rcond_time;
-    ++sum.parallel_chunks;
-    return 0;
+    return finish(ch, last.q, last.qd, last.qdd);
   };
 
   // How far the work may run ahead of the delivery: chunks seeded beyond the next one to deliver. As many as the
@@ -249,7 +307,8 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   const Index ahead = std::max<Index>(
       threads,
       std::min<Index>(16 * threads,
-                      static_cast<Index>(static_cast<double>(opt.row_buffer_bytes) / layout.held_bytes(chunk))));
+                      static_cast<Index>(static_cast<double>(opt.row_buffer_bytes) /
+                                         layout.held_bytes(chunk + max_shift))));
 
   // Seeds: the position at each chunk's first row, found in order with the chunk's span as the step (positions
   // only, the parabolic predictor over the seeds before, subdivision on failure), one at a time, just ahead of the
@@ -261,7 +320,9 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   seed_options.predictor = Predictor::kParabolic;
   seed_options.points.clear(), seed_options.residuals = seed_options.condition = false;  // seeds deliver no rows
   SweepSummary seed_summary;
-  WorkCounters seed_work;  // done in pool workspaces by the seeding pass
+  // Done in pool workspaces by the seeding pass, per seed: the summary counts the seeds the result needed, not the
+  // ones found ahead of a rejected chunk (how far ahead depends on the threads: the counts must not).
+  std::vector<WorkCounters> seed_work(static_cast<std::size_t>(n_chunks));
   Workspace* sws = acquire();
   sws->q = last_q;
   Sweeper seeder(model, seed_options, *sws, seed_summary);
@@ -298,13 +359,18 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     // over a whole chunk's span: from that constant prediction its Newton failed on nfourbar N = 10⁵ and took 0.57 s
     // of a 1.66 s sweep. In sub-steps it gives the parabola through the seeds its first rows: 1.35 s.
     const int parts = c == 1 && !need_v ? kFirstSeedParts : 1;
-    const double t0 = seeder.state().t, t1 = run.time_of(first_row(c));
+    Index row = first_row(c);
+    const double t0 = seeder.state().t, t1 = run.time_of(row);
     bool ok = true;
     for (int i = 1; ok && i <= parts; ++i)
       ok = seeder.advance(i == parts ? t1 : t0 + (t1 - t0) * static_cast<double>(i) / parts, 0);
-    add_counters(seed_work, w->counters, w0);
+    // at or next to a singular position (Φq near-singular at the seed): the chunk starts a row later
+    for (const Index last = std::min(row + max_shift, opt.steps); ok && row < last && seeder.near_singular();)
+      ok = seeder.advance(run.time_of(++row), 0);
+    add_counters(seed_work[static_cast<std::size_t>(c)], w->counters, w0);
     release(w);
     if (ok) {
+      first[static_cast<std::size_t>(c)] = row;  // (chunk c − 1, which ends here, is not claimed before: ready)
       seeds[static_cast<std::size_t>(c)] = seeder.state().q;
       seed_error[static_cast<std::size_t>(c)] = seeder.state_error();
       seed_rounding[static_cast<std::size_t>(c)] = seeder.take_rounding_level();
@@ -317,6 +383,15 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     seeding_busy = false;
     wake.notify_all();
   };
+  // What a chunk's delivery says for the schedule (the lock is held): delivered, or the parallel part stops.
+  auto settle = [&](int d) {
+    if (d != 0) {
+      stop = true, cancelled = d == 2, fallback = d == 1;
+    } else {
+      ++delivered;
+    }
+    wake.notify_all();
+  };
   // The caller's deliveries: every chunk done in order (the lock is held on entry and on return).
   auto deliver_ready = [&](std::unique_lock<std::mutex>& lock) {
     while (!stop && delivered < claimed && chunk_done[static_cast<std::size_t>(delivered)]) {
@@ -327,12 +402,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
       ch.rows = std::vector<Row>();  // delivered: free
       seeds[static_cast<std::size_t>(delivered)] = Eigen::VectorXd();
       lock.lock();
-      if (d != 0) {
-        stop = true, cancelled = d == 2, fallback = d == 1;
-      } else {
-        ++delivered;
-      }
-      wake.notify_all();
+      settle(d);
     }
   };
   auto work_loop = [&] {
@@ -341,19 +411,27 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     for (;;) {
       if (is_caller) deliver_ready(lock);
       if (stop) return;
-      const Index ready = seeded - claimed;
+      // chunks whose seed and end (the next seed, or the end of the seeding) are known, and not taken yet
+      const Index ready = (seeding_over ? seeded : seeded - 1) - claimed;
       const bool can_seed = !seeding_busy && !seeding_over && seeded < std::min(n_chunks, delivered + ahead + 1);
-      if (can_seed && ready < threads) {  // (with no chunk ready, always: threads ≥ 2 here)
+      if (can_seed && ready < threads) {  // (with no chunk ready, always)
         seeding_busy = true;
         lock.unlock();
         tbb::this_task_arena::isolate(seed_one);  // nested evaluations wait only for their own tasks
         lock.lock();
       } else if (ready > 0) {
         const Index c = claimed++;
+        // the caller, with every chunk before this one delivered, delivers its rows as it computes them
+        const bool stream = is_caller && c == delivered;
         lock.unlock();
-        tbb::this_task_arena::isolate([&] { run_chunk(c, chunks[static_cast<std::size_t>(c)]); });
+        int d = 0;
+        tbb::this_task_arena::isolate([&] { d = run_chunk(c, chunks[static_cast<std::size_t>(c)], stream); });
         lock.lock();
         chunk_done[static_cast<std::size_t>(c)] = 1;
+        if (stream) {
+          seeds[static_cast<std::size_t>(c)] = Eigen::VectorXd();
+          settle(d);
+        }
         wake.notify_all();
       } else if (seeding_over && !seeding_busy && claimed == seeded && (!is_caller || delivered == claimed)) {
         return;  // nothing more will become ready (the caller: and everything done is delivered)
@@ -386,10 +464,11 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   if (spare.size() > keep) spare.resize(keep);
   ws.spare_rows.swap(spare);
   if (failure) std::rethrow_exception(failure);
-  // chunks computed but not delivered (after a rejected one): their work was done all the same
-  for (Index c = delivered + (stop ? 1 : 0); c < claimed; ++c)
-    add_counters(others, chunks[static_cast<std::size_t>(c)].sum.counters, WorkCounters{});
-  add_counters(others, seed_work, WorkCounters{});
+  // The work counted is that of the chunks delivered or rejected (deliver_chunk) and of their seeds, and of a seed
+  // that failed next: the same for every thread count. Chunks and seeds computed ahead of a rejected chunk are
+  // left out, as they would not have been computed on fewer threads.
+  const Index seeds_counted = std::min(delivered, n_chunks - 1);
+  for (Index c = 1; c <= seeds_counted; ++c) add_counters(others, seed_work[static_cast<std::size_t>(c)], WorkCounters{});
   counted_end = ws.counters;  // the caller's workspace's work so far is the chunks' and seeds'
   // The caller's workspace ends at the last delivered row, as after a sequential sweep.
   ws.q = last_q;
@@ -404,6 +483,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
                               "the parallel chunk starting at t = " + format_time(run.time_of(resume)) +
                                   " did not continue the sweep in order (another branch, or a failure); the "
                                   "remaining steps ran in order"});
+    ws.start_afresh();  // as a chunk starts: from the row alone, whatever the workspace solved last
     Sweeper rest(model, opt, ws, sum);
     rest.adopt(run.time_of(resume - 1));
     run.sequential(rest, ws, resume);

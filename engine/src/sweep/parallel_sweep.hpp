@@ -1,4 +1,4 @@
-// The parallel sweep: the drive steps in chunks on several threads, each chunk started from a seed that a
+// The chunked sweep: the drive steps in chunks on one or more threads, each chunk started from a seed that a
 // positions-only pass finds ahead of it, accepted where the chunk before, continued one step (its seam), arrives at
 // its first row, and delivered in order on the caller's thread (parallel_sweep.cpp). run_sweep.cpp chooses it, and
 // the chunk size, from what a row takes to hold (HeldRows) and the resources (resources.hpp).
@@ -30,8 +30,8 @@ struct HeldRows {
 HeldRows held_rows(const Model& model, const SweepOptions& opt, bool caller_reads_rows);
 
 // The drive steps 1 … opt.steps of the sweep `run`, whose row 0 the caller's sweeper `sw` has delivered (its state is
-// moved out: `sw` is not used after this), in `n_chunks` chunks of `chunk` steps on `threads` threads (≥ 2), with
-// the rows held as `layout` says; what the chunks do not deliver runs in order at the end. Work done in other
+// moved out: `sw` is not used after this), in `n_chunks` chunks of `chunk` steps on `threads` threads (1: one after
+// the other, with the same seeds, so the same rows, as on any other count), with the rows held as `layout` says; what the chunks do not deliver runs in order at the end. Work done in other
 // workspaces is added to `others`; the caller's workspace's counters at the start and the end of the parallel part
 // are left in `counted_begin` and `counted_end` (the work between them is the chunks' and seeds', in `others`
 // already). Status, message and warnings go to run.sum; the caller's workspace ends at the last delivered row.

@@ -77,29 +77,39 @@ int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, 
   return fit;
 }
 
-Index automatic_chunk_steps(const SweepOptions& opt, double row_bytes, bool caller_reads_rows, bool parallel,
-                            double t0, int& threads, std::vector<SweepWarning>& warnings) {
-  const Index balanced = std::max<Index>(16, opt.steps / (4 * static_cast<Index>(threads)));
-  Index chunk = std::min<Index>(64, balanced);
+Index automatic_chunk_steps(const SweepOptions& opt, double row_bytes, bool caller_reads_rows) {
+  Index chunk = std::min<Index>(64, std::max<Index>(16, opt.steps / 16));
+  if (!caller_reads_rows) return chunk;
   const double rows_fit = static_cast<double>(opt.row_buffer_bytes) / row_bytes;  // rows the buffer holds
-  if (!caller_reads_rows || rows_fit >= static_cast<double>(chunk * threads)) return chunk;
-  const int room = static_cast<int>(std::min<double>(threads, std::floor(rows_fit / kMinChunkSteps)));
-  if (room < threads && opt.steps > kMinChunkSteps && parallel) {
-    std::ostringstream msg;
-    msg.precision(3);
-    msg << "the drive steps run "
-        << (room >= 2 ? "in parallel chunks on " + std::to_string(room) + " threads instead of "
-                      : std::string("in order, not in parallel chunks on "))
-        << threads << " threads: a row of the outputs is " << row_bytes / 1e6
-        << " MB, and the rows held for delivery in order (SweepOptions::row_buffer_bytes, "
-        << static_cast<double>(opt.row_buffer_bytes) / 1e6 << " MB) hold " << static_cast<long long>(rows_fit)
-        << " rows: chunks of " << kMinChunkSteps << " steps, the fewest that pay for a chunk's seed, for "
-        << (room >= 2 ? "only " + std::to_string(room) + " threads" : std::string("no more than one thread"))
-        << "; the other threads still serve the model's parallel evaluation";
-    warnings.push_back({t0, "threads_reduced", msg.str()});
-    threads = std::max(room, 1);
-  }
-  return std::max<Index>(1, std::min<Index>(chunk, static_cast<Index>(rows_fit / threads)));
+  if (rows_fit >= static_cast<double>(chunk)) return chunk;
+  return rows_fit >= kMinChunkSteps ? static_cast<Index>(rows_fit) : std::max<Index>(opt.steps, 1);
+}
+
+int threads_with_room_for_rows(const SweepOptions& opt, double row_bytes, bool caller_reads_rows, Index chunk,
+                               int threads, double t0, std::vector<SweepWarning>& warnings) {
+  if (!caller_reads_rows || threads <= 1) return threads;
+  const double rows_fit = static_cast<double>(opt.row_buffer_bytes) / row_bytes;
+  const bool one_chunk = chunk >= opt.steps;
+  // (one chunk by choice — a short sweep, or chunk_steps — runs in order without a word)
+  if (one_chunk && (rows_fit >= kMinChunkSteps || opt.steps <= kMinChunkSteps)) return threads;
+  const int room =
+      one_chunk ? 1 : static_cast<int>(std::min<double>(threads, std::floor(rows_fit / static_cast<double>(chunk))));
+  if (room >= threads) return threads;
+  std::ostringstream msg;
+  msg.precision(3);
+  msg << "the drive steps run "
+      << (one_chunk ? std::string("in order, not in chunks,")
+                    : "on " + std::to_string(std::max(room, 1)) + (room > 1 ? " threads" : " thread"))
+      << " instead of on " << threads << " threads: a row of the outputs is " << row_bytes / 1e6
+      << " MB, and the rows held for delivery in order (SweepOptions::row_buffer_bytes, "
+      << static_cast<double>(opt.row_buffer_bytes) / 1e6 << " MB) hold " << static_cast<long long>(rows_fit)
+      << " rows: "
+      << (one_chunk ? "fewer than the " + std::to_string(kMinChunkSteps) + " steps that pay for a chunk's seed"
+                    : "chunks of " + std::to_string(chunk) + " steps for " + std::to_string(std::max(room, 1)) +
+                          (room > 1 ? " threads" : " thread"))
+      << "; the other threads still serve the model's parallel evaluation";
+  warnings.push_back({t0, "threads_reduced", msg.str()});
+  return std::max(room, 1);
 }
 
 }  // namespace phiq::detail

@@ -17,17 +17,20 @@ namespace phiq::detail {
 int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, double t0,
                      std::vector<SweepWarning>& warnings);
 
-// SweepOptions::chunk_steps = 0: the chunk of a parallel sweep on `threads` threads whose rows take `row_bytes`
-// each (held until delivered when `caller_reads_rows`). 64 steps (a chunk costs a seed, a start from it and a seam
-// step), but at least 4 chunks per thread, down to 16 steps (so a sweep of 16 steps or fewer runs in order): the
-// seed of a chunk is one step over the chunk's whole span, and on a large model long spans are expensive (Newton
-// from far away, sub-steps). Measured, 100 steps on 2 threads against 1 thread: chain3d N = 10⁴ positions only 1.5×
-// with 9 chunks of 12 steps, 0.9–1.0× with 2 of 50; nfourbar N = 10³ with q̇, q̈ 1.45× either way. More chunks also
-// balance more threads (tools/simulate_schedule.py). Fewer steps when the rows a chunk per thread holds would
-// exceed row_buffer_bytes, and none below kMinChunkSteps: `threads` is then lowered to as many as have room for
-// such chunks, the rest of the cores left to the model's parallel evaluation (1: in order), with a
-// "threads_reduced" warning at `t0` (only where the sweep could run in parallel chunks: `parallel`).
-Index automatic_chunk_steps(const SweepOptions& opt, double row_bytes, bool caller_reads_rows, bool parallel,
-                            double t0, int& threads, std::vector<SweepWarning>& warnings);
+// SweepOptions::chunk_steps = 0: the steps per chunk, from the scene and the options only — never from the thread
+// count, the machine or the time — so that every thread count cuts the sweep alike and computes the same rows, to the
+// bit. 64 steps (a chunk costs a seed, a start from it and a seam step: about 3 steps of 64), fewer for short
+// sweeps so that there are 16 chunks to share among threads, down to 16 steps (a sweep of 16 steps or fewer is one
+// chunk: in order). Measured, 100 steps on 2 threads against 1 thread: chain3d N = 10⁴ positions only 1.5× with 9
+// chunks of 12 steps, 0.9–1.0× with 2 of 50 (tools/simulate_schedule.py for more threads). When the caller reads
+// the rows (`caller_reads_rows`), a chunk holds no more rows than row_buffer_bytes has room for, and none below
+// kMinChunkSteps: a sweep whose rows are wider runs as one chunk, in order.
+Index automatic_chunk_steps(const SweepOptions& opt, double row_bytes, bool caller_reads_rows);
+
+// The threads among `threads` that have room for a chunk's rows each in row_buffer_bytes (all of them when the
+// caller reads no rows: two are held per chunk); fewer come with a "threads_reduced" warning at `t0`. Only the
+// schedule changes with it, never the rows.
+int threads_with_room_for_rows(const SweepOptions& opt, double row_bytes, bool caller_reads_rows, Index chunk,
+                               int threads, double t0, std::vector<SweepWarning>& warnings);
 
 }  // namespace phiq::detail

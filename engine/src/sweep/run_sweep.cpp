@@ -79,6 +79,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     return done(SolveStatus::kOutsideTimeDomain);
   }
 
+  ws.start_afresh();  // the sweep's results depend on the model, the options and ws.q only
   Run run{opt, on_step, sum};
   run.h = opt.steps > 0 ? (opt.t_end - opt.t_begin) / static_cast<double>(opt.steps) : 0.0;
   Sweeper sw(model, opt, ws, sum);
@@ -95,13 +96,17 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
 
   if (opt.threads == 0 && threads > 1 && ws.lu && opt.steps > 0)
     threads = detail::threads_that_fit(opt, ws, threads, run.time_of(0), sum.warnings);
+  // The chunks are cut alike for every thread count (automatic_chunk_steps), and a chunk computes the same rows
+  // whichever thread runs it (each starts from a workspace started afresh): one thread runs them in order, with
+  // their seeds, so that its rows are, to the bit, those of any other thread count.
   const detail::HeldRows rows = detail::held_rows(model, opt, static_cast<bool>(on_step));
-  Index chunk = opt.chunk_steps;
-  if (chunk == 0)
-    chunk = detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows, ws.lu != nullptr,
-                                          run.time_of(0), threads, sum.warnings);
+  const Index chunk =
+      opt.chunk_steps > 0 ? opt.chunk_steps : detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows);
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
-  if (threads <= 1 || n_chunks < 2 || !ws.lu) {
+  if (ws.lu)
+    threads = detail::threads_with_room_for_rows(opt, rows.row_bytes, rows.caller_reads_rows, chunk, threads,
+                                                 run.time_of(0), sum.warnings);
+  if (n_chunks < 2 || !ws.lu) {
     run.sequential(sw, ws, 1);
     sw.leave_state_in_workspace();
     return done(sum.status);

@@ -93,6 +93,7 @@ inline void add_counters(WorkCounters& into, const WorkCounters& now, const Work
   into.residual_evaluations += now.residual_evaluations - before.residual_evaluations;
   into.jacobian_evaluations += now.jacobian_evaluations - before.jacobian_evaluations;
   into.factorizations += now.factorizations - before.factorizations;
+  into.pivoting_factorizations += now.pivoting_factorizations - before.pivoting_factorizations;
   into.velocity_solves += now.velocity_solves - before.velocity_solves;
   into.acceleration_solves += now.acceleration_solves - before.acceleration_solves;
   into.phi_t_evaluations += now.phi_t_evaluations - before.phi_t_evaluations;

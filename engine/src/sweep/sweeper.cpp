@@ -112,6 +112,7 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   } const noted{sum_.warnings.size(), sum_.singular_positions, sum_.min_rcond, sum_.min_rcond_time,
                 rounding_level_, known_to_, ill_conditioned_};
   singular_row_ = false;
+  last_rcond_ = ps.rcond;
   row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
   rounding_level_ = std::max(rounding_level_, ps.rounding_level);
   // How well the positions can be known here (NewtonOptions::known_to): the largest rounding level the rows

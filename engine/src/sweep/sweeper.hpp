@@ -157,6 +157,10 @@ class Sweeper {
     return converged(t, ps);
   }
 
+  // Whether Φq was near-singular (rcond below kIllConditionedRcond) where the last position converged, as far as
+  // the last Newton factorisation of it tells (false when it made none).
+  bool near_singular() const { return last_rcond_ > 0.0 && last_rcond_ < kIllConditionedRcond; }
+
   // The estimated error of state().q (units of the tolerance test; infinite when unknown).
   double state_error() const { return current_error_; }
   // One more step to t1 for its position only (a parallel chunk's seam, compared with the next chunk's first row):
@@ -279,6 +283,7 @@ class Sweeper {
   bool position_only_ = false;  // inside advance_position()
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
   double rcond_ = 0.0;
+  double last_rcond_ = 0.0;         // PositionSummary::rcond of the last converged position (near_singular())
   Eigen::VectorXd predicted_;       // the last prediction (for jumped())
   bool bracketing_ = false;         // inside singular_point(): no nested bracketing
   bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
