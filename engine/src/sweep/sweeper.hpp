@@ -290,6 +290,10 @@ class Sweeper {
   Index factorizations_before_ = ws_->counters.factorizations;
   Index factorizations_seen_ = factorizations_before_;  // the count at the last converged state
   double factorized_step_t_ = 0.0;  // the time of the last step whose solves factorised (converged())
+  // Positions only, at a singular start: the branch's q̇ and q̈ there (singular_point()) and its time; the first
+  // prediction from that row extrapolates along them (predict()), NaN once used.
+  Eigen::VectorXd branch_qd_, branch_qdd_;
+  double branch_t_ = NAN;
   double rounding_level_ = 0.0;     // see take_rounding_level()
   double known_to_ = 0.0;           // the rounding level carried to the next solves (converged())
   bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)
