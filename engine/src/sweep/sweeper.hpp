@@ -206,8 +206,21 @@ class Sweeper {
   }
 
   // Initial position problem from the rough placement in ws.q.
+  // The placement is taken only after a Newton step from it is within the tolerance (start_error unknown becomes
+  // infinite): a residual within tolerance alone does not bound the error of q where the scales of the rows differ
+  // by orders of magnitude (a 10⁶ m coupler's row holds to 10⁻⁴ m, more than a 10⁻⁶ m crank it carries). Where
+  // no step can be taken (a placement exactly on a singular position: a zero pivot) the placement is judged on its
+  // residual, as given, and the singular start is examined as such (converged()).
   bool assemble(double t) {
-    SolveStatus st = solve_position(model_, t, opt_.assembly, *ws_, &sum_.assembly);
+    NewtonOptions o = opt_.assembly;
+    SolveStatus st = SolveStatus::kSingularJacobian;
+    if (o.start_error < 0.0) {
+      const Eigen::VectorXd placement = ws_->q;
+      o.start_error = INFINITY;
+      st = solve_position(model_, t, o, *ws_, &sum_.assembly);
+      if (st == SolveStatus::kSingularJacobian) ws_->q = placement, o.start_error = opt_.assembly.start_error;
+    }
+    if (st == SolveStatus::kSingularJacobian) st = solve_position(model_, t, o, *ws_, &sum_.assembly);
     if (st != SolveStatus::kSuccess) return fail(st, "initial assembly failed: " + sum_.assembly.message);
     return converged(t, sum_.assembly);
   }
