@@ -8,7 +8,8 @@
 //   3. γ: along q(s) = q + s q̇, time t + s (so q̈ = 0), d²/ds² Φ at s = 0 equals −γ; checked by a Richardson-
 //      extrapolated central second difference.
 // The last tests build Models through ModelBuilder and check Model::jacobian (CSC values through the pattern),
-// Model::phi_t and Model::gamma the same way.
+// Model::phi_t and Model::gamma the same way; and an equation whose expression is an angle (atan2) is swept through
+// ±π (its residual wrapped).
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -30,6 +31,8 @@
 #include "phiq/expression.hpp"
 #include "phiq/model.hpp"
 #include "phiq/motion_law.hpp"
+#include "phiq/scene.hpp"
+#include "phiq/sweep.hpp"
 #include "phiq/types.hpp"
 #include "constraint_check.hpp"
 
@@ -390,6 +393,34 @@ TEST(ModelPlumbing, RelativeFourBarAccumulatesDuplicateEntries) {
   // loop: 2 rows × {ψ2, ψ3, ψ4}; motor: ψ2; output: s, ψ2, ψ3 — duplicates merged
   EXPECT_EQ(model.jacobian_pattern().nnz(), 10);
   CheckModel(model, 1201);
+}
+
+// A driver written as an expression whose top-level form is an angle (atan2) passes ±π as a joint-angle driver
+// does: its residual is the angle difference wrapped to (−π, π] (EquationSpec), not atan2 − f, which jumps by 2π
+// there and stopped the sweep at t = π. Both forms: a driver with a law and an equation in t.
+TEST(EquationKind, AtanDriverPassesPlusMinusPi) {
+  using namespace phiq;
+  for (const char* driver : {"drivers:\n  - {expr: \"atan2(yA - y0, xA - x0)\", unit: angle, law: {type: linear, "
+                             "initial: 0, rate: 1}}\n",
+                             "  - {type: equation, expr: \"atan2(yA - y0, xA - x0) - t\", unit: angle}\n"}) {
+    const std::string text = std::string("phiq: 1\nparameters: {x0: 0.5, y0: 0.25}\ncoordinates: {xA: 1.5, yA: 0.25}\n"
+                                         "points: {O: [x0, y0], A: [xA, yA]}\n") +
+                             "constraints:\n  - {name: crank, type: distance, points: [O, A], length: 1}\n" + driver +
+                             "time: {start: 0, end: 7, steps: 70}\noutput: {velocities: true}\n";
+    const Scene sc = parse_scene(text, "atan_driver.yaml");
+    Workspace ws(*sc.model);
+    SweepSummary sum;
+    int rows = 0;
+    const SolveStatus st = run_sweep(*sc.model, sc.sweep, ws, [&](const StepView& v) {
+      EXPECT_NEAR(v.q(0), 0.5 + std::cos(v.t), 1e-9) << "t = " << v.t;
+      EXPECT_NEAR(v.q(1), 0.25 + std::sin(v.t), 1e-9) << "t = " << v.t;
+      EXPECT_NEAR((*v.qd)(0), -std::sin(v.t), 1e-8) << "t = " << v.t;
+      ++rows;
+      return true;
+    }, &sum);
+    ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
+    EXPECT_EQ(rows, 71);
+  }
 }
 
 }  // namespace

@@ -347,6 +347,24 @@ TEST(Expression, CompilesToTheSameTapeInEveryProcess) {
   std::filesystem::remove_all(dir);
 }
 
+// An angle by its top-level form: a sum of ±atan2 terms and other terms without atan2 (EquationSpec wraps its
+// residual); anything else is not, whatever atan2 it holds deeper.
+TEST(Expression, AngleDifferenceIsRecognisedFromTheTopLevelForm) {
+  auto angle = [](const std::string& text) { return CompiledExpression::compile(text, resolve)->angle_difference(); };
+  EXPECT_TRUE(angle("atan2(yA, xA)"));
+  EXPECT_TRUE(angle("atan2(yA - 0.25, xA - 0.5) - t"));
+  EXPECT_TRUE(angle("-atan2(yA, xA) + theta2"));
+  EXPECT_TRUE(angle("atan2(yA, xA) - atan2(xA, yA) - 0.3*t^2"));
+  EXPECT_FALSE(angle("2*atan2(yA, xA) - t"));       // jumps by 4π
+  EXPECT_FALSE(angle("sin(atan2(yA, xA)) - t"));    // no jump at all
+  EXPECT_FALSE(angle("atan2(yA, xA)*xA - t"));
+  EXPECT_FALSE(angle("theta2 - t"));
+  EXPECT_FALSE(angle("atan(yA/xA) - t"));
+  // kept when a family instantiates the expression for its members
+  auto e = CompiledExpression::compile("atan2(yA, xA) - theta2", resolve);
+  EXPECT_TRUE(e->rebind({5, 6, 7}, {0.0, 0.0, 0.0}, "atan2(y1, x1) - a1")->angle_difference());
+}
+
 TEST(Expression, ConstantExpressions) {
   auto c = [](const std::string& n) -> std::optional<double> {
     if (n == "L") return 2.0;

@@ -246,6 +246,45 @@ void expect_no_drift(const ChainRun& r, const char* what) {
 // (measured 9.2e-11 m), and there are a few Newton steps, not one per step (measured 16 in 1000). Velocities and
 // accelerations: the linear solves along the chain, within 1e-9 of the exact θ̇ = π/2 rad/s motion (measured
 // 1.4e-10 and 2.4e-10).
+// A four-bar of a 10⁶ m ground and coupler on a 10⁻⁶ m crank and a 1.5·10⁻⁶ m rocker, natural coordinates, placed
+// with B 0.4 rad of rocker off: the coupler's row, held to tol · 10⁶ m = 10⁻⁴ m, passes at the placement, which was
+// taken as the first row (the rocker 0.73 rad off the closed form, exit 0). The placement is now taken only after
+// a Newton step from it is within the tolerance: every row is as close to the closed form as double precision
+// allows (B's x near 10⁶ m is known to an ulp, 1.2·10⁻¹⁰ m, 8·10⁻⁵ rad of the rocker).
+TEST(HardCases, BadlyScaledFourBarIsSolvedToWhatDoublesAllowFromItsFirstRow) {
+  const Scene sc = parse_scene(R"Y(phiq: 1
+parameters: {L1: 1e6, L2: 1e-6, L3: 1e6, L4: 1.5e-6}
+coordinates: {xA: 1e-6, yA: 0.0, xB: 1e6, yB: 1.5e-6, theta2: 0.0}
+points: {O: [0, 0], A: [xA, yA], B: [xB, yB], C: [L1, 0]}
+constraints:
+  - {name: crank, type: distance, points: [O, A], length: L2}
+  - {name: coupler, type: distance, points: [A, B], length: L3}
+  - {name: rocker, type: distance, points: [C, B], length: L4}
+  - {name: crank_angle, type: segment_angle, segment: [O, A], angle: theta2}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 2*pi, steps: 72}
+)Y", "badly_scaled.yaml");
+  const double L1 = 1e6, L2 = 1e-6, L3 = 1e6, L4 = 1.5e-6;
+  const Index xB = sc.model->coordinate_index("xB"), yB = sc.model->coordinate_index("yB");
+  Workspace ws(*sc.model);
+  SweepSummary sum;
+  double worst = 0.0;
+  const SolveStatus st = run_sweep(*sc.model, sc.sweep, ws, [&](const StepView& v) {
+    // the closed form about C, free of cancellation: B·A' = (L4² + |A'|² − L3²)/2 with A' = A − C, L1 = L3
+    const double th = v.t, ax = L2 * std::cos(th), ay = L2 * std::sin(th);
+    const double k = 0.5 * (L4 * L4 + (-2 * L1 * ax + ax * ax + ay * ay));
+    const double px = ax - L1, py = ay, r = std::hypot(px, py), a0 = std::atan2(py, px);
+    const double c = std::acos(std::clamp(k / (L4 * r), -1.0, 1.0));
+    const double phi = std::atan2(v.q[yB], v.q[xB] - L1);
+    worst = std::max(worst, std::min(std::fabs(std::remainder(phi - a0 - c, 2 * M_PI)),
+                                     std::fabs(std::remainder(phi - a0 + c, 2 * M_PI))));
+    return true;
+  }, &sum);
+  ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
+  EXPECT_LT(worst, 1e-4);
+}
+
 TEST(HardCases, LongChainDoesNotDrift) {
   const ChainRun r = long_chain(true);
   expect_no_drift(r, "nfourbar 10^4, q v a");

@@ -201,6 +201,63 @@ TEST(SingularPositions, PositionsOnlyACrossingIsBracketedByTheSweepsOwnFactorisa
   }
 }
 
+// Positions only, as with velocities: a sweep started exactly on the flat position (θ0 = 0) follows the branch's
+// own tangent there (it used to stop at its first sub-step, Newton meeting a zero pivot at the singular start), and
+// a crossing inside the last step is reported (the rows before it reused a factorisation made before it).
+TEST(SingularPositions, PositionsOnlyAFlatStartAndACrossingInTheLastStepAreHandled) {
+  {
+    const Model model = test::nfourbar_model(1, 0.0, 0.5);
+    SweepOptions o;
+    o.t_begin = 0, o.t_end = 1, o.steps = 1000;
+    o.velocities = o.accelerations = false;
+    o.threads = 1;
+    SweepSummary sum;
+    test::Trace tr;
+    ASSERT_EQ(test::sweep(model, o, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+    ASSERT_EQ(tr.t.size(), 1001u);
+    const auto exact = test::nfourbar_exact(model, 0.0, 0.5);
+    tools::ClosedFormErrors err(*exact);
+    for (std::size_t k = 0; k < tr.t.size(); ++k) err.add(tr.t[k], tr.q[k].data(), nullptr, nullptr);
+    // near the singular start Φq's smallest singular value is O(θ): a residual at tolerance allows more (3e-8)
+    EXPECT_LT(err.q_error, 1e-7);
+    const auto bif = of_kind(sum, "bifurcation");
+    ASSERT_EQ(bif.size(), 1u);
+    EXPECT_EQ(bif[0].t, 0.0);
+    EXPECT_HAS(bif[0].message, "the sweep starts at a bifurcation");
+  }
+  {
+    const double w = 1.0, crossing = 0.995, th0 = M_PI - crossing;  // θ = π inside the last of 100 steps
+    const Model model = test::nfourbar_model(1, th0, w);
+    SweepOptions o;
+    o.t_begin = 0, o.t_end = 1, o.steps = 100;
+    o.velocities = o.accelerations = false;
+    o.threads = 1;
+    SweepSummary sum;
+    test::Trace tr;
+    ASSERT_EQ(test::sweep(model, o, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+    const auto bif = of_kind(sum, "bifurcation");
+    ASSERT_EQ(bif.size(), 1u);
+    EXPECT_EQ(bif[0].t, 1.0);
+    EXPECT_HAS(bif[0].message, "det Φq changed sign");
+  }
+}
+
+// nfourbar of N = 101 loops started flat: the least squares from the singular start moves one loop off it per
+// iteration, so 100 assembly iterations do not reach the branch beyond it. The failure says so — a singular start,
+// not a model short of drivers (the rank at the singular position counts the flat loops as freedoms).
+TEST(SingularPositions, AFlatStartNotResolvedSaysThePositionIsSingular) {
+  const Model model = test::nfourbar_model(101, 0.0, 1.0);
+  SweepOptions o;
+  o.t_begin = 0, o.t_end = 0.01, o.steps = 2;
+  o.threads = 1;
+  SweepSummary sum;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(model, o, &tr, &sum), SolveStatus::kSingularJacobian);
+  EXPECT_HAS(sum.message, "the sweep starts at a singular position");
+  EXPECT_HAS(sum.message, "not the model short of drivers or constraints");
+  EXPECT_EQ(sum.message.find("zero pivot"), std::string::npos) << sum.message;
+}
+
 // The change-point four-bar of models/hard: the parallelogram branch (ψ2 = ψ1, ψc = 0) is kept through both
 // crossings, whether the steps land on them or not.
 void expect_parallelogram_branch(const std::string& scene, const std::vector<double>& crossings, bool exact) {

@@ -150,7 +150,10 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
     // A square model not assembled at its first position: singular there (redundant constraints and missing
     // drivers in equal numbers, or a singular placement), or Newton found no descent from the placement (the
     // Jacobian of a Cardan joint at 90° drops rank there). The minimum-norm assembly and its rank analysis say which.
-    if (summary.failed_step == 0 && summary.status != phiq::SolveStatus::kOutsideTimeDomain &&
+    // (Not when the first position was assembled and the sweep stopped at its singular start: the rank there
+    // counts the loops lying flat at once as freedoms not driven.)
+    if (summary.failed_step == 0 && summary.assembly.status != phiq::SolveStatus::kSuccess &&
+        summary.status != phiq::SolveStatus::kOutsideTimeDomain &&
         summary.status != phiq::SolveStatus::kNonFinite && !square.reduced) {
       Eigen::VectorXd q = scene.model->initial_positions();
       phiq::AssemblySummary as;

@@ -97,6 +97,11 @@ class CompiledExpression {
   const std::vector<Index>& coordinates() const { return coords_; }
   /// True when g depends on t explicitly.
   bool depends_on_time() const { return depends_on_time_; }
+  /// True when g is an angle defined modulo 2π by its top-level form: a sum whose terms include atan2(…), each
+  /// such term with coefficient +1 or −1 and no atan2 nested deeper (`atan2(yA - y0, xA - x0) - t`,
+  /// `atan2(yB, xB) - atan2(yA, xA)`). atan2 jumps by 2π as its angle passes ±π, so an equation g − f = 0 of such a
+  /// g is solved with its residual wrapped to (−π, π] (EquationSpec), as the joint-angle drivers are.
+  bool angle_difference() const { return angle_difference_; }
 
   /// g(q, t). Pre-condition: q has an entry for every index in coordinates(). Thread-safe (as all below).
   double value(const double* q, double t) const;
@@ -124,6 +129,7 @@ class CompiledExpression {
   std::string text_;
   std::vector<Index> coords_;
   bool depends_on_time_ = false;
+  bool angle_difference_ = false;
   Tape value_, gradient_, partial_t_;
 };
 

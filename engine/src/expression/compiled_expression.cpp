@@ -19,6 +19,34 @@ namespace phiq {
 using detail::clean_ginac_message;
 using detail::expression_error;
 
+namespace {
+// CompiledExpression::angle_difference(): every top-level term of g that holds an atan2 is ±atan2(…) itself, and
+// there is at least one. (GiNaC keeps −atan2(…) as a product of the function and the number −1.)
+bool is_angle_difference(const GiNaC::ex& g) {
+  using namespace GiNaC;
+  auto is_atan2 = [](const ex& e) { return is_the_function<atan2_SERIAL>(e); };
+  auto signed_atan2 = [&](const ex& e) {
+    if (is_atan2(e)) return true;
+    if (!is_a<mul>(e) || e.nops() != 2) return false;
+    for (std::size_t k = 0; k < 2; ++k)
+      if (is_atan2(e.op(k)) && is_a<numeric>(e.op(1 - k)) && abs(ex_to<numeric>(e.op(1 - k))).is_equal(numeric(1)))
+        return true;
+    return false;
+  };
+  bool any = false;
+  auto term = [&](const ex& e) {
+    if (signed_atan2(e)) return any = true;
+    return !e.has(atan2(wild(0), wild(1)));
+  };
+  if (is_a<add>(g)) {
+    for (std::size_t k = 0; k < g.nops(); ++k)
+      if (!term(g.op(k))) return false;
+    return any;
+  }
+  return signed_atan2(g);
+}
+}  // namespace
+
 std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std::string& text,
                                                                       const NameResolver& resolve,
                                                                       bool allow_time) {
@@ -70,6 +98,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   for (auto& [i, s] : symbol_of_coord)
     if (g.has(s)) used.emplace_back(s, i);
   out->depends_on_time_ = g.has(tsym);
+  out->angle_difference_ = is_angle_difference(g);
 
   try {
     std::vector<ex> grad;
@@ -127,6 +156,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::rebind(const std::
   auto out = std::make_shared<CompiledExpression>();
   out->text_ = std::move(text);
   out->depends_on_time_ = depends_on_time_;
+  out->angle_difference_ = angle_difference_;
   auto patch = [&](const Tape& in) {
     Tape tape = in;
     for (Tape::Instr& ins : tape.code_) {

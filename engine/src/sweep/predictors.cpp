@@ -87,6 +87,16 @@ void Sweeper::predict(double t1) {
   double* kept = predicted_.data();
   const double* q = current_.q.data();
   const int k = known_;
+  if (current_.t == branch_t_ && branch_qd_.size() == n) {
+    // positions only, from a singular start: along the branch's own q̇ and q̈ there (singular_point()), which no
+    // history of positions tells; Newton then takes its steps (no error estimate).
+    const double hh = 0.5 * h * h;
+    for (Index j = 0; j < n; ++j)
+      ws_->q[j] = predicted_[j] = current_.q[j] + h * branch_qd_[j] + hh * branch_qdd_[j];
+    extrapolated_ = true;
+    newton_.start_error = INFINITY;
+    return;
+  }
   auto x = [&](int i) { return history_[static_cast<std::size_t>(i)].data(); };
   auto th = [&](int i) { return history_t_[static_cast<std::size_t>(i)]; };
   detail::WorstRatio worst;

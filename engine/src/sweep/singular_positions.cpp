@@ -91,7 +91,21 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
         // far cranks off the flat position one loop per iteration, so beyond N ≈ 90 the start is not resolved
         // and the sweep stops at t0 with the diagnosis.
         AssemblySummary as;
-        phiq::assemble(model_, ts, ao, ws_->q, &as);
+        const SolveStatus assembled = phiq::assemble(model_, ts, ao, ws_->q, &as);
+        if (assembled != SolveStatus::kSuccess && ws_->q.allFinite() &&
+            solve_position(model_, ts, tight, *ws_, &ps) != SolveStatus::kSuccess) {
+          // Not a model short of constraints (the placement assembled and is square): the start is singular and
+          // the least squares from it did not reach the branch beyond it. Said as such, with the assembly's
+          // account, rather than as a zero pivot that the rank analysis of the singular position would blame on
+          // missing drivers.
+          ws_->q = qs;
+          return fail(SolveStatus::kSingularJacobian,
+                      "the sweep starts at a singular position (t = " + format_time(t) + ", Φq rcond " +
+                          scientific(rc, 2) + "), and no regular position of the branch near it was reached at t = " +
+                          format_time(ts) + " from it (" + as.BriefReport() +
+                          "): the position is singular, not the model short of drivers or constraints; start the "
+                          "drive off it");
+        }
         if (!ws_->q.allFinite()) {
           ws_->q = qs;
           return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " +
@@ -155,17 +169,24 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
   const double qd_spread = relative_spread(ws_->qd, inner(&State::qd));
   double qdd_spread = 0.0;
   if (need_a_) ws_->qdd = at_t(&State::qdd), qdd_spread = relative_spread(ws_->qdd, inner(&State::qdd));
+  if (!need_v_) {  // positions only: the branch's tangent for the next prediction (predict())
+    branch_qd_ = ws_->qd, branch_qdd_ = at_t(&State::qdd);
+    branch_t_ = t;
+  }
   ++sum_.singular_positions;
   singular_row_ = true;
   std::ostringstream m;
   m.precision(3);
   m << (has_current_ ? "bifurcation passed" : "the sweep starts at a bifurcation")
     << ": Φq is singular here (rcond " << rc
-    << "), so the velocity is not unique; reported is the branch's own (extrapolated from t ± " << d << ", ± "
-    << 2 * d << " and ± " << 3 * d << "; it differs from the extrapolation from ± " << d << " and ± " << 2 * d
-    << " by " << qd_spread << (need_a_ ? " in q̇ and " : " in q̇") ;
-  if (need_a_) m << qdd_spread << " in q̈";
-  m << ", relative)"
+    << "), so the velocity is not unique; " << (need_v_ ? "reported is" : "the next step follows")
+    << " the branch's own (extrapolated from t ± " << d << ", ± " << 2 * d << " and ± " << 3 * d;
+  if (need_v_) {
+    m << "; it differs from the extrapolation from ± " << d << " and ± " << 2 * d << " by " << qd_spread << " in q̇";
+    if (need_a_) m << " and " << qdd_spread << " in q̈";
+    m << ", relative";
+  }
+  m << ")"
     << (has_current_ ? ", and the sweep kept the branch it was on"
                      : "; the branch followed is the one nearest the placement");
   sum_.warnings.push_back({t, "bifurcation", m.str()});

@@ -4,6 +4,7 @@
 #include "sweep/sweeper.hpp"
 
 #include "phiq/text.hpp"
+#include "solve/factorisation.hpp"
 #include "sweep/predictors.hpp"
 
 namespace phiq::detail {
@@ -123,13 +124,35 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
               : ps.rounding_level == 0.0 && ps.error_estimate <= 1.0 ? 0.0
                                                                    : known_to_;
   if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
-  if (!need_v_ && ps.rcond > 0.0 && ps.rcond < kSingularRcond) {
+  // Positions only: Φq is factorised at the solution where nothing else would tell the row's state, the first row
+  // (a sweep that starts on a singular position; an assembly accepted as placed factorises nowhere) and the last
+  // (a crossing in the last step: the rows before it reuse a factorisation made before it).
+  double rcond = ps.rcond;
+  const bool first = !has_current_;
+  if (!need_v_ && !bracketing_ && !position_only_ && ws_->lu && (first || t == opt_.t_end)) {
+    if (!factors_at_q(*ws_, t)) {
+      std::string why;
+      const SolveStatus st = ensure_factorized(model_, t, *ws_, &rcond, &why);
+      if (st != SolveStatus::kSuccess && st != SolveStatus::kSingularJacobian) return fail(st, why);
+      if (st == SolveStatus::kSingularJacobian) rcond = 0.0;
+      ws_->factorized_q = ws_->q;
+    } else {
+      rcond = ws_->lu->rcond();
+    }
+    ws_->factorized_at_solution = true;
+  }
+  if (!need_v_ && first && !bracketing_ && ws_->lu && rcond < kSingularRcond) {
+    // positions only, starting on a singular position: no past rows tell the next step where the branch goes, and
+    // Newton from the singular position itself meets a zero pivot. The branch's q̇ and q̈ there are found as with
+    // velocities (singular_point(), with its warning) and kept for the first prediction only.
+    if (!singular_point(t, rcond)) return false;
+  } else if (!need_v_ && rcond > 0.0 && rcond < kSingularRcond) {
     // positions only: nothing is computed from Φq here, but the user is told where the motion branches
     ++sum_.singular_positions;
     singular_row_ = true;
     std::ostringstream m;
     m.precision(3);
-    m << "singular position (Φq rcond " << ps.rcond << "): a bifurcation, velocities would not be unique here";
+    m << "singular position (Φq rcond " << rcond << "): a bifurcation, velocities would not be unique here";
     if (!has_current_) m << " (the sweep starts here: the branch is the one nearest the placement)";
     sum_.warnings.push_back({t, "bifurcation", m.str()});
   }

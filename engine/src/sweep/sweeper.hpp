@@ -210,8 +210,21 @@ class Sweeper {
   }
 
   // Initial position problem from the rough placement in ws.q.
+  // The placement is taken only after a Newton step from it is within the tolerance (start_error unknown becomes
+  // infinite): a residual within tolerance alone does not bound the error of q where the scales of the rows differ
+  // by orders of magnitude (a 10⁶ m coupler's row holds to 10⁻⁴ m, more than a 10⁻⁶ m crank it carries). Where
+  // no step can be taken (a placement exactly on a singular position: a zero pivot) the placement is judged on its
+  // residual, as given, and the singular start is examined as such (converged()).
   bool assemble(double t) {
-    SolveStatus st = solve_position(model_, t, opt_.assembly, *ws_, &sum_.assembly);
+    NewtonOptions o = opt_.assembly;
+    SolveStatus st = SolveStatus::kSingularJacobian;
+    if (o.start_error < 0.0) {
+      const Eigen::VectorXd placement = ws_->q;
+      o.start_error = INFINITY;
+      st = solve_position(model_, t, o, *ws_, &sum_.assembly);
+      if (st == SolveStatus::kSingularJacobian) ws_->q = placement, o.start_error = opt_.assembly.start_error;
+    }
+    if (st == SolveStatus::kSingularJacobian) st = solve_position(model_, t, o, *ws_, &sum_.assembly);
     if (st != SolveStatus::kSuccess) return fail(st, "initial assembly failed: " + sum_.assembly.message);
     return converged(t, sum_.assembly);
   }
@@ -295,6 +308,10 @@ class Sweeper {
   Index factorizations_before_ = ws_->counters.factorizations;
   Index factorizations_seen_ = factorizations_before_;  // the count at the last converged state
   double factorized_step_t_ = 0.0;  // the time of the last step whose solves factorised (converged())
+  // Positions only, at a singular start: the branch's q̇ and q̈ there (singular_point()) and its time; the first
+  // prediction from that row extrapolates along them (predict()), NaN once used.
+  Eigen::VectorXd branch_qd_, branch_qdd_;
+  double branch_t_ = NAN;
   double rounding_level_ = 0.0;     // see take_rounding_level()
   double known_to_ = 0.0;           // the rounding level carried to the next solves (converged())
   bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)

@@ -16,6 +16,10 @@ namespace phiq {
 /// General equation written as text, optionally driven by a motion law:
 ///   Φ = g(q, t) − f(t)            (f ≡ 0 without a law)
 /// with Φq, Φt and γ derived exactly from g (expression.hpp). `unit` says what g measures (for tolerances).
+/// When g is an angle by its top-level form (CompiledExpression::angle_difference(): ±atan2 terms), Φ is g − f
+/// wrapped to (−π, π]: atan2 jumps by 2π where its angle passes ±π, the wrapped difference does not, so such a
+/// driver runs through any number of turns as the joint-angle drivers do. The wrap changes nothing within π of a
+/// solution (the same Φq, Φt and γ), only the 2π jumps.
 struct EquationSpec {
   static constexpr int kRows = 1;  ///< one row, in `unit`
   /// @copydoc DistanceSpec::kKind
@@ -46,9 +50,16 @@ struct EquationSpec {
   }
   /// @copydoc DistanceSpec::residual
   /// @par Equation
-  /// For an equation: Φ = g(q, t) − f(t). g is evaluated with thread-local scratch (see CompiledExpression).
+  /// For an equation: Φ = g(q, t) − f(t) (wrapped to (−π, π] when g is an angle, above). g is evaluated with thread-local scratch (see CompiledExpression).
   void residual(const double* q, double t, double* phi) const {
-    phi[0] = g->value(q, t) - (law ? law->evaluate(t).f : 0.0);
+    const double d = g->value(q, t) - (law ? law->evaluate(t).f : 0.0);
+    phi[0] = g->angle_difference() ? wrapped_angle(d) : d;
+  }
+  /// d wrapped to (−π, π] (d itself when |d| < π: std::remainder is exact).
+  static double wrapped_angle(double d) {
+    constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
+    const double r = std::remainder(d, kTwoPi);
+    return r <= -0.5 * kTwoPi ? r + kTwoPi : r;
   }
   /// @copydoc DistanceSpec::jacobian
   /// @par Equation
