@@ -163,8 +163,8 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   }
   for (const std::string& r : reports) std::cerr << r;
   if (!quiet)
-    std::cerr << "phiq: " << scene_path << ": " << scenes.size() - failed << " of " << scenes.size() << " cases in "
-              << dir << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
+    std::cerr << "phiq: " << printable(scene_path) << ": " << scenes.size() - failed << " of " << scenes.size() << " cases in "
+              << printable(dir) << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
               << " cases on one symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
               << scientific(sum.solve_seconds, 3) << " s\n";
   return failed ? 1 : 0;
