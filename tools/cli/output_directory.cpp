@@ -27,13 +27,14 @@ std::string temporary_name(const std::string& target, long pid) { return target 
 
 void remove_stale_temporaries(const std::string& target) {
   static std::mutex mutex;
-  static std::set<std::pair<dev_t, ino_t>> cleaned;  // directories already looked at by this process
+  // directories already looked at by this process (the path too: an inode is reused once a directory is removed)
+  static std::set<std::tuple<dev_t, ino_t, std::string>> cleaned;
   const std::string dir = directory_of(target);
   struct stat ds;
   if (::stat(dir.c_str(), &ds) != 0) return;
   {
     std::lock_guard<std::mutex> lock(mutex);
-    if (!cleaned.insert({ds.st_dev, ds.st_ino}).second) return;
+    if (!cleaned.insert({ds.st_dev, ds.st_ino, dir}).second) return;
   }
   DIR* d = ::opendir(dir.c_str());
   if (!d) return;
