@@ -29,7 +29,8 @@ struct Case {
   std::map<std::string, std::string> files, copies;
   std::string setup, prefix, run;
   int exit = 0;
-  std::string stderr_regex;
+  std::string stderr_regex, stdout_regex;
+  std::map<std::string, std::string> match;  // file -> regex searched in its bytes afterwards
   int lines = 1;
   std::vector<std::string> keep, absent, created;
   bool any_files = false;           // `created: any`: the command may leave other files (checked by `absent`)
@@ -86,6 +87,9 @@ std::vector<Case> load_catalogue() {
       c.run = unescape(n["run"].as<std::string>());
       c.exit = n["exit"].as<int>();
       if (n["stderr"]) c.stderr_regex = unescape(n["stderr"].as<std::string>());
+      if (n["stdout"]) c.stdout_regex = unescape(n["stdout"].as<std::string>());
+      if (n["match"])
+        for (const auto& kv : n["match"]) c.match[unescape(kv.first.as<std::string>())] = unescape(kv.second.as<std::string>());
       if (n["lines"]) c.lines = n["lines"].as<int>();
       if (n["timeout"]) c.timeout = n["timeout"].as<double>();
       c.keep = strings(n["keep"]);
@@ -129,14 +133,25 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-// Every file under `dir` (relative paths; directories end in '/'), not following links.
+// Every file under `dir` (relative paths; directories end in '/'), not following links (a link that loops or
+// dangles is listed as the link it is).
+void list_into(const fs::path& root, const fs::path& dir, std::set<std::string>& v) {
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, fs::directory_options::skip_permission_denied, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    const std::string rel = it->path().lexically_relative(root).string();
+    if (it->symlink_status(ec).type() == fs::file_type::directory) {
+      v.insert(rel + "/");
+      list_into(root, it->path(), v);
+    } else {
+      v.insert(rel);
+    }
+  }
+}
+
 std::set<std::string> listing(const fs::path& dir) {
   std::set<std::string> v;
-  for (auto it = fs::recursive_directory_iterator(dir, fs::directory_options::skip_permission_denied);
-       it != fs::recursive_directory_iterator(); ++it) {
-    const std::string rel = fs::relative(it->path(), dir).string();
-    v.insert(it->is_directory() && !it->is_symlink() ? rel + "/" : rel);
-  }
+  list_into(dir, dir, v);
   return v;
 }
 
@@ -179,7 +194,7 @@ TEST_P(Hostile, Case) {
       << shell_quote(err.string()) << "; }";
   const int st = std::system(cmd.str().c_str());
   const int code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  const std::string stderr_text = slurp(err);
+  const std::string stderr_text = slurp(err), stdout_text = slurp(out);
   fs::remove(out, ec), fs::remove(err, ec);
 
   EXPECT_EQ(code, c.exit) << "phiq " << c.run << "\nstderr: " << stderr_text;
@@ -200,6 +215,11 @@ TEST_P(Hostile, Case) {
     EXPECT_EQ(stderr_text.find('\0'), std::string::npos);
     EXPECT_TRUE(valid_utf8(stderr_text)) << "stderr is not UTF-8: " << stderr_text;
   }
+  if (!c.stdout_regex.empty())
+    EXPECT_TRUE(std::regex_search(stdout_text, std::regex(c.stdout_regex)))
+        << "stdout: " << stdout_text << "\ndoes not match: " << c.stdout_regex;
+  for (const auto& [path, regex] : c.match)
+    EXPECT_TRUE(std::regex_search(slurp(dir / path), std::regex(regex))) << path << " does not match: " << regex;
   for (const auto& [path, bytes] : kept) EXPECT_EQ(slurp(dir / path), bytes) << path << " was changed";
   for (const std::string& a : c.absent) EXPECT_FALSE(fs::exists(fs::symlink_status(dir / a))) << a << " exists";
   for (const std::string& k : c.created) EXPECT_TRUE(fs::exists(dir / k)) << k << " was not written";

@@ -53,7 +53,8 @@ TEST_F(OutputFile, AppearsWhenCommittedAndNotOtherwise) {
     AtomicOutputFile f(p.string());
     f.write("half");
     EXPECT_FALSE(std::filesystem::exists(p));
-    EXPECT_EQ(names(dir_).size(), 1u);  // the temporary
+    EXPECT_TRUE(names(dir_).empty());  // the temporary has no name (O_TMPFILE): nothing a kill -9 could leave
+    EXPECT_TRUE(f.temporary_path().empty());
   }
   EXPECT_TRUE(names(dir_).empty());
   AtomicOutputFile f(p.string());
@@ -65,6 +66,19 @@ TEST_F(OutputFile, AppearsWhenCommittedAndNotOtherwise) {
   EXPECT_EQ(read(p), "whole\n");
   EXPECT_TRUE(f.temporary_path().empty());
   EXPECT_EQ(names(dir_), std::vector<std::string>{"a.csv"});
+}
+
+// Temporaries ("TARGET.tmp-PID") that processes no longer running left in a directory are removed when a file is
+// next written there; a running process's (PID 1) and other users' names stay. PID 4194304 is above every pid_max.
+TEST_F(OutputFile, StaleTemporariesOfDeadProcessesAreRemoved) {
+  const auto d = dir_ / "with_stale_temporaries";  // a path no other test wrote in (each directory is looked at once)
+  std::filesystem::create_directories(d);
+  for (const char* n : {"a.csv.tmp-4194304", "b.csv.tmp-4194304", "a.csv.tmp-1", "notes.tmp-x", "a.csv.tmp-"})
+    std::ofstream(d / n) << "half";
+  AtomicOutputFile f((d / "a.csv").string());
+  f.write("whole\n");
+  f.commit();
+  EXPECT_EQ(names(d), (std::vector<std::string>{"a.csv", "a.csv.tmp-", "a.csv.tmp-1", "notes.tmp-x"}));
 }
 
 // Hold::kClosedBetweenWrites: the temporary exists from the start, each write appends to it, and it is committed or
@@ -103,7 +117,8 @@ TEST_F(OutputFile, SymbolicLinksAreFollowedToTheirTarget) {
   EXPECT_EQ(where.target, (dir_ / "data" / "t.csv").string());
   EXPECT_TRUE(where.exists);
   EXPECT_FALSE(where.direct);
-  AtomicOutputFile f((dir_ / "link.csv").string());
+  // (a named temporary shows where it is made: beside the target)
+  AtomicOutputFile f((dir_ / "link.csv").string(), AtomicOutputFile::Hold::kClosedBetweenWrites);
   EXPECT_EQ(std::filesystem::path(f.temporary_path()).parent_path(), dir_ / "data");
   f.write("new\n");
   f.commit();

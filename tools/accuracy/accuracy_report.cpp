@@ -70,7 +70,8 @@ std::string accuracy_json(const AccuracyReport& r) {
     o["default"] = row.is_default;
     j["rows"].push_back(o);
   }
-  return j.dump(2) + "\n";
+  // a scene path or name that is not UTF-8 gets U+FFFD for its invalid bytes: the measurements are never lost to it
+  return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace phiq::tools

@@ -56,7 +56,7 @@ int cmd_assemble(const std::string& scene_path, const std::string& out_path, boo
     return fail(e.what(), 3);
   }
   if (!quiet)
-    std::cerr << "phiq: " << scene_path << ": " << as.BriefReport() << ", moved " << scientific(as.moved, 3) << "\n";
+    std::cerr << "phiq: " << printable(scene_path) << ": " << as.BriefReport() << ", moved " << scientific(as.moved, 3) << "\n";
   return 0;
 }
 

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "output_directory.hpp"
 #include "phiq/types.hpp"
 
 namespace phiq {
@@ -97,14 +98,27 @@ AtomicOutputFile::AtomicOutputFile(std::string path, Hold hold) : path_(std::mov
   target_ = where.target;
   direct_ = where.direct;
   const std::string shown = target_ == path_ ? path_ : path_ + " (a link to " + target_ + ")";
-  int fd;
+  int fd = -1;
   if (where.descriptor >= 0) {
     fd = ::fcntl(where.descriptor, F_DUPFD_CLOEXEC, 0);
   } else if (direct_) {
     fd = ::open(target_.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);  // a FIFO waits for its reader here
   } else {
-    tmp_ = target_ + ".tmp-" + std::to_string(::getpid());
-    fd = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
+    remove_stale_temporaries(target_);
+    if (hold == Hold::kOpen) {
+      // no name until it is complete: a process killed by SIGKILL leaves nothing behind
+      fd = ::open(directory_of(target_).c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+      if (fd >= 0) {
+        unnamed_ = true;
+      } else if (errno != EOPNOTSUPP && errno != EISDIR && errno != EINVAL) {
+        const int err = errno;
+        throw Error(cannot_write(shown, std::strerror(err)));
+      }
+    }
+    if (fd < 0) {  // held closed between writes, or a file system without unnamed files: a named temporary
+      tmp_ = temporary_name(target_, ::getpid());
+      fd = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
+    }
   }
   if (fd < 0) {
     const int err = errno;
@@ -138,7 +152,7 @@ void AtomicOutputFile::reopen() {
 }
 
 AtomicOutputFile::~AtomicOutputFile() {
-  if (f_) std::fclose(f_);
+  if (f_) std::fclose(f_);  // an unnamed temporary not published vanishes here
   if (!committed_ && !tmp_.empty()) ::unlink(tmp_.c_str());
 }
 
@@ -164,8 +178,11 @@ void AtomicOutputFile::finish() {
   int err = errno;
   // a temporary goes to disk before it is renamed; a device or FIFO has nothing to sync (fsync: EINVAL)
   if (ok && !direct_ && ::fsync(::fileno(f_)) != 0) ok = false, err = errno;
-  if (std::fclose(f_) != 0 && ok) ok = false, err = errno;
-  f_ = nullptr;
+  // an unnamed temporary stays open: its descriptor is all there is of it until publish() links it
+  if (!unnamed_ || !ok) {
+    if (std::fclose(f_) != 0 && ok) ok = false, err = errno;
+    f_ = nullptr;
+  }
   if (!ok) throw Error(cannot_write(path_, std::strerror(err)));
   finished_ = true;
 }
@@ -173,6 +190,21 @@ void AtomicOutputFile::finish() {
 void AtomicOutputFile::publish() {
   if (!finished_) throw Error(path_ + ": cannot write: not finished");
   if (committed_) return;
+  if (unnamed_) {
+    // linkat cannot replace a file: the unnamed temporary gets its temporary's name, which rename() moves onto
+    // the target in one step, as a named temporary is
+    tmp_ = temporary_name(target_, ::getpid());
+    ::unlink(tmp_.c_str());  // (a leftover of this process, if any)
+    const std::string self = "/proc/self/fd/" + std::to_string(::fileno(f_));
+    if (::linkat(::fileno(f_), "", AT_FDCWD, tmp_.c_str(), AT_EMPTY_PATH) != 0 &&
+        ::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, tmp_.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+      const int err = errno;
+      tmp_.clear();
+      throw Error(cannot_write(path_, std::string("link: ") + std::strerror(err)));
+    }
+    std::fclose(f_);
+    f_ = nullptr;
+  }
   if (!direct_ && std::rename(tmp_.c_str(), target_.c_str()) != 0)
     throw Error(cannot_write(path_, std::string("rename: ") + std::strerror(errno)));
   committed_ = true;
@@ -181,6 +213,7 @@ void AtomicOutputFile::publish() {
 
 void AtomicOutputFile::commit() {
   finish();
+  const DirectoryLock lock({target_});
   publish();
 }
 

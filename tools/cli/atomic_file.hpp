@@ -33,10 +33,14 @@ OutputPath resolve_output_path(const std::string& path);
 // links included), or, for files that do not exist yet, the same resolved target. Never throws.
 bool same_file(const std::string& a, const std::string& b);
 
-// An output file that appears only when complete: written under a temporary name in its target's directory
+// An output file that appears only when complete: written to a temporary in its target's directory
 // (resolve_output_path: a symbolic link is followed, and its target replaced) and renamed onto the target by
-// commit(). If it is destroyed without commit() (failure, exception), the temporary is removed and an existing file
-// at the target is left untouched. A device, a FIFO or an open descriptor of the process (OutputPath::direct) is
+// commit(). The temporary has no name (O_TMPFILE) where the file system allows it, so that a process killed by
+// SIGKILL leaves nothing; at publish() it is linked as "TARGET.tmp-PID" and renamed at once. Elsewhere, and for
+// Hold::kClosedBetweenWrites, it is the named file "TARGET.tmp-PID" from the start; such files left by processes
+// that no longer run are removed when a file is next written beside them (remove_stale_temporaries). If it is
+// destroyed without commit() (failure, exception), the temporary is removed and an existing file at the target is
+// left untouched. A device, a FIFO or an open descriptor of the process (OutputPath::direct) is
 // opened at once and written in place instead: no temporary, no rename (`-o /dev/null` stays a device).
 class AtomicOutputFile {
  public:
@@ -52,15 +56,18 @@ class AtomicOutputFile {
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
   void write(const std::string& data);  // throws phiq::Error on an I/O error
-  // finish() then publish(). Throws phiq::Error on an I/O error (the temporary is then removed by the destructor).
+  // finish() then publish(), under the lock of the target's directory (DirectoryLock). Throws phiq::Error on an I/O error (the temporary is then removed by the destructor).
   void commit();
   // Flushes and closes: to disk (fsync) for a temporary. After it only publish() remains; throws phiq::Error.
   void finish();
-  // Renames the finished temporary onto the target (nothing to do for a direct file); throws phiq::Error.
+  // Renames the finished temporary onto the target (nothing to do for a direct file); throws phiq::Error. The
+  // caller holds the DirectoryLock of the target (OutputSet does) when outputs must change together.
   void publish();
 
   const std::string& path() const { return path_; }  // as given
-  // The temporary file while it exists (until publish() or destruction); empty for a direct file.
+  const std::string& target() const { return target_; }  // the file replaced (resolve_output_path)
+  // The named temporary file while it exists (until publish() or destruction); empty for a direct file and for an
+  // unnamed temporary (nothing to remove on a signal).
   const std::string& temporary_path() const { return tmp_; }
   bool direct() const { return direct_; }      // written in place (OutputPath::direct)
   bool finished() const { return finished_; }  // finish() succeeded
@@ -71,6 +78,7 @@ class AtomicOutputFile {
   void reopen();
   std::FILE* f_ = nullptr;
   bool direct_ = false, finished_ = false, committed_ = false;
+  bool unnamed_ = false;  // an O_TMPFILE temporary, held open until publish()
   bool closed_between_writes_ = false;
 };
 

@@ -75,13 +75,15 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   std::vector<std::size_t> swept;  // the cases that run, in order
   std::vector<phiq::CsvFormat> formats;
   std::vector<std::string> buffers(scenes.size());
-  // every case's file exists (as a temporary) before the work; those of the cases that succeed are renamed at the
-  // end, the others removed. They are closed between writes: a batch of 10 000 cases holds no 10 000 descriptors.
+  // An unwritable directory fails now, not after the sweeps: a first case file is created and dropped (an unnamed
+  // temporary leaves nothing). Each case's file is then created at its first write (its first 1 MB of rows, or
+  // its last row) and committed as soon as the case completes, so that an interrupted or failing batch keeps the
+  // cases it finished, and no more descriptors are open than cases are running.
   OutputSet outputs;
-  std::vector<phiq::AtomicOutputFile*> files(scenes.size());
+  std::vector<phiq::AtomicOutputFile*> files(scenes.size(), nullptr);
+  std::vector<char> written(scenes.size(), 0);
   try {
-    for (std::size_t k = 0; k < scenes.size(); ++k)
-      files[k] = &outputs.add(case_file(k), phiq::AtomicOutputFile::Hold::kClosedBetweenWrites);
+    if (!phiq::resolve_output_path(case_file(0)).direct) outputs.drop(outputs.add(case_file(0)));
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
   }
@@ -98,8 +100,9 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     formats.emplace_back(*sc.model, sc.sweep);
     buffers[k] = formats[k].header();
   }
-  // Each case touches only its own buffer and file: the callback is safe across cases without a lock.
-  // each case's own sweep: its output points (and time range) may depend on its parameters
+  // Each case touches only its own buffer and file: the callback is safe across cases without a lock (OutputSet
+  // locks what the cases share). Each case's own sweep: its output points (and time range) may depend on its
+  // parameters.
   std::vector<phiq::SweepOptions> sweeps;
   for (std::size_t k : swept) sweeps.push_back(scenes[k].sweep);
   const std::atomic<bool>& stop = stop_flag();
@@ -113,9 +116,18 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
       const bool last = step.step == sweeps[c].steps;
       if (buffers[k].size() > (1u << 20) || last) {
         try {
+          if (!files[k])  // held open (unnamed) when written at once, else closed between writes
+            files[k] = &outputs.add(case_file(k), last ? phiq::AtomicOutputFile::Hold::kOpen
+                                                       : phiq::AtomicOutputFile::Hold::kClosedBetweenWrites);
           files[k]->write(buffers[k]);
+          if (last) {
+            outputs.commit_one(*files[k]);
+            written[k] = 1;
+          }
         } catch (const phiq::Error& e) {
           write_errors[k] = e.what();
+          if (files[k]) outputs.drop(*files[k]);
+          files[k] = nullptr;
           return false;
         }
         if (last)
@@ -126,48 +138,42 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
       return !stop.load();
     }, &starts);
   }
+  std::size_t cases_written = 0;
+  for (char w : written) cases_written += w != 0;
   if (stop.load())
-    return fail(scene_path + ": " + interrupt_message() + "; no output written",
+    return fail(scene_path + ": " + interrupt_message() + "; " + std::to_string(cases_written) + " of " +
+                    std::to_string(scenes.size()) + " cases written (the others not)",
                 interrupt_exit_status());
   int failed = 0;
+  bool output_error = false;
   std::size_t c = 0;  // index of case k among the swept ones
-  std::vector<std::string> reports(scenes.size());
   for (std::size_t k = 0; k < scenes.size(); ++k) {
     if (!prepare_errors[k].empty()) {
       ++failed;
-      reports[k] = "phiq: " + scene_path + ": case " + std::to_string(k) + ": " + prepare_errors[k] +
-                   "; no output written\n";
+      std::cerr << "phiq: " << printable(scene_path + ": case " + std::to_string(k) + ": " + prepare_errors[k]) +
+                       "; no output written\n";
       continue;
     }
     const phiq::SweepSummary& s = sum.cases[c++];
-    std::string why = !write_errors[k].empty() ? write_errors[k] : s.status != phiq::SolveStatus::kSuccess ? s.message : "";
-    if (why.empty()) {
-      try {
-        files[k]->write(buffers[k]);
-        files[k]->finish();
-      } catch (const phiq::Error& e) {
-        why = e.what();
-      }
-    }
+    // (a case whose last row was written is complete, even if a signal or a later case asked it to stop)
+    const std::string why = !write_errors[k].empty()                                  ? write_errors[k]
+                            : written[k]                                              ? ""
+                            : s.status != phiq::SolveStatus::kSuccess ? s.message : "not written";
+    output_error |= !write_errors[k].empty();
     if (!why.empty()) {
       ++failed;
-      reports[k] = "phiq: " + scene_path + ": case " + std::to_string(k) + ": " + why + "; no output written\n";
+      std::cerr << "phiq: " << printable(scene_path + ": case " + std::to_string(k) + ": " + why) +
+                       "; no output written\n";
     } else if (!quiet) {
-      reports[k] = "phiq: " + scene_path + ": case " + std::to_string(k) + ": " + s.BriefReport() + "\n";
+      std::cerr << "phiq: " << printable(scene_path + ": case " + std::to_string(k) + ": " + s.BriefReport()) << "\n";
     }
   }
-  try {
-    outputs.publish_finished();
-  } catch (const phiq::Error& e) {
-    return fail(e.what(), 3);
-  }
-  for (const std::string& r : reports) std::cerr << r;
   if (!quiet)
-    std::cerr << "phiq: " << scene_path << ": " << scenes.size() - failed << " of " << scenes.size() << " cases in "
-              << dir << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
+    std::cerr << "phiq: " << printable(scene_path) << ": " << scenes.size() - failed << " of " << scenes.size() << " cases in "
+              << printable(dir) << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
               << " cases on one symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
               << scientific(sum.solve_seconds, 3) << " s\n";
-  return failed ? 1 : 0;
+  return output_error ? 3 : failed ? 1 : 0;
 }
 
 // An output directory: not empty, not standard output.

@@ -81,7 +81,7 @@ int cmd_check(const std::string& scene_path, bool json, std::optional<double> at
     j["rank_tolerance"] = rk.tolerance;
     j["rank_uncertain"] = rk.uncertain;
     j["rank_message"] = rk.message;
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j, 2) << "\n";
     return ok ? 0 : 1;
   }
 

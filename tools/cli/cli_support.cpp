@@ -13,6 +13,8 @@
 #include <mutex>
 #include <thread>
 
+#include "output_directory.hpp"
+
 namespace phiq::tools {
 
 namespace {
@@ -114,7 +116,9 @@ OutputSet::~OutputSet() {
 AtomicOutputFile& OutputSet::add(const std::string& path, AtomicOutputFile::Hold hold) {
   if (resolve_output_path(path).direct) {
     // no temporary to remove on a signal; a FIFO may wait here for its reader, which a signal must interrupt
-    files_.push_back(std::make_unique<AtomicOutputFile>(path));
+    auto file = std::make_unique<AtomicOutputFile>(path);
+    std::lock_guard<std::mutex> lock(g_mutex);
+    files_.push_back(std::move(file));
     return *files_.back();
   }
   std::lock_guard<std::mutex> lock(g_mutex);
@@ -126,14 +130,33 @@ AtomicOutputFile& OutputSet::add(const std::string& path, AtomicOutputFile::Hold
 void OutputSet::commit() {
   for (const auto& f : files_)
     if (!f->finished()) f->finish();
-  publish_finished();
+  std::vector<std::string> targets;
+  for (const auto& f : files_)
+    if (!f->direct()) targets.push_back(f->target());
+  // another phiq renaming files in these directories waits, so that a pair (CSV and summary) is one command's
+  const DirectoryLock directories(targets);
+  std::lock_guard<std::mutex> lock(g_mutex);
+  for (const auto& f : files_) f->publish();
+  g_quiet = true;
 }
 
-void OutputSet::publish_finished() {
+void OutputSet::commit_one(AtomicOutputFile& file) {
+  if (!file.finished()) file.finish();
+  std::vector<std::string> targets;
+  if (!file.direct()) targets.push_back(file.target());
+  const DirectoryLock directories(targets);
   std::lock_guard<std::mutex> lock(g_mutex);
-  for (const auto& f : files_)
-    if (f->finished()) f->publish();
-  g_quiet = true;
+  file.publish();
+}
+
+void OutputSet::drop(AtomicOutputFile& file) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  g_live.erase(std::remove(g_live.begin(), g_live.end(), &file), g_live.end());
+  for (auto it = files_.begin(); it != files_.end(); ++it)
+    if (it->get() == &file) {
+      files_.erase(it);  // removes its temporary
+      return;
+    }
 }
 
 std::optional<std::string> output_clash(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {

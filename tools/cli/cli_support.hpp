@@ -42,7 +42,9 @@ class StopOnSignal {
 };
 
 // The output files of one command: all created before the work (so that an unwritable path fails at once, and a
-// signal removes them), all committed together at the end, or none.
+// signal removes them), all committed together at the end, or none. `phiq batch` instead commits each case's file
+// as the case completes (commit_one), so that an interrupted batch keeps the cases it finished. Thread-safe for
+// add, commit_one and drop of different files (the cases of a batch run concurrently).
 class OutputSet {
  public:
   OutputSet() = default;
@@ -53,12 +55,16 @@ class OutputSet {
   // Creates the output at `path` now (AtomicOutputFile: a temporary in its target's directory, or a device / FIFO
   // opened in place). Throws phiq::Error "PATH: cannot write: REASON".
   AtomicOutputFile& add(const std::string& path, AtomicOutputFile::Hold hold = AtomicOutputFile::Hold::kOpen);
-  // Finishes every file (flush, fsync), then renames them all onto their targets; no file is renamed unless every
-  // one was written. Afterwards signals exit quietly. Throws phiq::Error (the set's temporaries are then removed).
+  // Finishes every file (flush, fsync), then renames them all onto their targets under the lock of their
+  // directories (DirectoryLock: two commands writing the same pair commit one after the other, so the pair is
+  // one command's); no file is renamed unless every one was written. Afterwards signals exit quietly. Throws
+  // phiq::Error (the set's temporaries are then removed).
   void commit();
-  // Renames the files already finished (AtomicOutputFile::finish()) onto their targets; the others are removed
-  // with the set (phiq batch: the files of the cases that succeeded). Afterwards signals exit quietly.
-  void publish_finished();
+  // Finishes and renames one file of the set onto its target now, under its directory's lock (a batch's case).
+  // Throws phiq::Error (the file's temporary is then removed with the set, or by drop()).
+  void commit_one(AtomicOutputFile& file);
+  // Removes one file of the set (and its temporary, if not committed) now.
+  void drop(AtomicOutputFile& file);
 
  private:
   std::vector<std::unique_ptr<AtomicOutputFile>> files_;

@@ -3,13 +3,51 @@
 
 #include <iostream>
 
+#include "phiq/text.hpp"
+
 #include "cli_support.hpp"
 
 namespace phiq::tools {
 
 int fail(const std::string& msg, int code) {
-  std::cerr << "phiq: " << msg << "\n";
+  std::cerr << "phiq: " << printable(msg) << "\n";
   return code;
+}
+
+std::string printable(const std::string& text) {
+  const std::string line = phiq::single_line(text);
+  std::string out;
+  out.reserve(line.size());
+  for (std::size_t i = 0; i < line.size();) {
+    const auto b = static_cast<unsigned char>(line[i]);
+    const int len = b < 0x80 ? 1 : (b >> 5) == 0x6 ? 2 : (b >> 4) == 0xE ? 3 : (b >> 3) == 0x1E ? 4 : 0;
+    bool valid = len > 0 && i + len <= line.size();
+    unsigned cp = len == 1 ? b : b & (0x7Fu >> len);
+    for (int k = 1; valid && k < len; ++k) {
+      const auto c = static_cast<unsigned char>(line[i + k]);
+      valid = (c >> 6) == 0x2;
+      cp = (cp << 6) | (c & 0x3Fu);
+    }
+    // overlong forms, surrogates and code points past U+10FFFF are not UTF-8 either
+    if (valid && ((len == 2 && cp < 0x80) || (len == 3 && cp < 0x800) || (len == 4 && (cp < 0x10000 || cp > 0x10FFFF)) ||
+                  (cp >= 0xD800 && cp <= 0xDFFF)))
+      valid = false;
+    if (valid) {
+      out.append(line, i, static_cast<std::size_t>(len));
+      i += static_cast<std::size_t>(len);
+    } else {
+      const char* hex = "0123456789abcdef";
+      out += "\\x";
+      out += hex[b >> 4];
+      out += hex[b & 15];
+      ++i;
+    }
+  }
+  return out;
+}
+
+std::string json_text(const nlohmann::ordered_json& value, int indent) {
+  return value.dump(indent, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
 std::optional<Scene> load_or_report(const std::string& path) {

@@ -8,12 +8,23 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
 
-// Prints "phiq: MSG" on standard error and returns `code`, the command's exit status.
+// Prints "phiq: MSG" on standard error, as printable() makes it, and returns `code`, the command's exit status.
 int fail(const std::string& msg, int code);
+
+// `text` made one line of valid UTF-8 for standard error: control characters escaped as single_line() does, and
+// every byte that is not part of a well-formed UTF-8 sequence (a path or scene name in Latin-1) written `\xNN`, so
+// that a terminal or a log shows the bytes rather than mojibake, and a reader of the message can recover them.
+std::string printable(const std::string& text);
+
+// JSON text for `value`, with every string that is not valid UTF-8 (a path or a name with Latin-1 bytes) given
+// U+FFFD for each invalid byte instead of throwing: a report is never lost to the bytes of a name.
+std::string json_text(const nlohmann::ordered_json& value, int indent);
 
 // The scene at `path`; on a scene error its one line is printed and the result is empty (the command exits 2).
 std::optional<Scene> load_or_report(const std::string& path);

@@ -27,7 +27,7 @@ int cmd_compare(const std::string& a_path, const std::string& b_path, const phiq
     return fail(e.what(), 2);
   }
   if (r.equal) {
-    std::cerr << "phiq: compare " << a_path << " " << b_path << ": " << r.summary() << "\n";
+    std::cerr << "phiq: compare " << printable(a_path) << " " << printable(b_path) << ": " << r.summary() << "\n";
     return 0;
   }
   return fail("compare " + a_path + " " + b_path + ": " + r.summary(), 1);

@@ -3,10 +3,14 @@
 //
 // Exit status: 0 success; 1 the mechanism could not be solved (the message names step, time and constraints), or
 // `compare` found a difference; 2 bad input (scene, CSV or command line); 3 an output (a file, standard output)
-// could not be written; 128 + the signal when interrupted (130 SIGINT, 143 SIGTERM, 129 SIGHUP).
+// could not be written; 128 + the signal when interrupted (130 SIGINT, 143 SIGTERM, 129 SIGHUP). An exception no
+// command caught is one of these too (out of memory, an error of the file system, an internal error): exit 1, or 3
+// for the file system's, never a status the table of tools/README.md does not list.
 #include <CLI/CLI.hpp>
 
 #include <exception>
+#include <filesystem>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -40,8 +44,12 @@ int main(int argc, char** argv) {
   try {
     for (const Command& c : commands)
       if (*c.subcommand) return c.run();
+  } catch (const std::bad_alloc&) {
+    return fail("out of memory", 1);
+  } catch (const std::filesystem::filesystem_error& e) {
+    return fail(e.what(), 3);
   } catch (const std::exception& e) {
-    return fail(std::string("internal error: ") + e.what(), 4);
+    return fail(std::string("internal error: ") + e.what(), 1);
   }
   return 2;
 }

@@ -57,7 +57,7 @@ std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& /*ws*/
     j["min_rcond"] = nullptr;
   j["warnings"] = nlohmann::ordered_json::array();
   for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});
-  return j.dump(2) + "\n";
+  return json_text(j, 2) + "\n";
 }
 
 int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
@@ -188,16 +188,16 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   }
   if (!quiet) {
     if (!redundancy.rank.redundant.empty())
-      std::cerr << "phiq: " << scene_path << ": redundant equations left out of the solve (consistent): "
+      std::cerr << "phiq: " << printable(scene_path) << ": redundant equations left out of the solve (consistent): "
                 << joined(redundancy.rank.redundant) << "\n";
     for (const auto& w : summary.warnings)
-      std::cerr << "phiq: " << scene_path << ": warning: t = " << phiq::format_time(w.t) << ": " << w.kind << ": "
+      std::cerr << "phiq: " << printable(scene_path) << ": warning: t = " << phiq::format_time(w.t) << ": " << w.kind << ": "
                 << w.message << "\n";
-    std::cerr << "phiq: " << scene_path << ": " << summary.BriefReport();
+    std::cerr << "phiq: " << printable(scene_path) << ": " << summary.BriefReport();
     if (summary.min_rcond > 0)
       std::cerr << ", min rcond " << scientific(summary.min_rcond, 3) << " at t = "
                 << phiq::format_time(summary.min_rcond_time);
-    if (file) std::cerr << "; wrote " << out_path;
+    if (file) std::cerr << "; wrote " << printable(out_path);
     std::cerr << "\n";
   }
   return 0;

@@ -33,7 +33,7 @@ struct SweepAccuracyArgs {
 // output; the files are written whole or not at all, both or neither.
 int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
   auto fail = [](const std::string& msg, int code) {
-    std::cerr << "phiq: sweep-accuracy: " << single_line(msg) << "\n";
+    std::cerr << "phiq: sweep-accuracy: " << printable(msg) << "\n";
     return code;
   };
   AccuracyOptions o;
@@ -108,10 +108,10 @@ int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
     for (const std::string& note : rep.notes) std::cerr << "phiq: sweep-accuracy: note: " << note << "\n";
     std::size_t failed = 0;
     for (const AccuracyRow& r : rep.rows) failed += r.status != "ok";
-    std::cerr << "phiq: sweep-accuracy: " << a.scene << ": " << rep.rows.size() << " settings (" << failed
+    std::cerr << "phiq: sweep-accuracy: " << printable(a.scene) << ": " << rep.rows.size() << " settings (" << failed
               << " failed) against " << rep.reference << " in " << significant(seconds, 3) << " s";
-    if (csv_file) std::cerr << "; wrote " << a.csv_path;
-    if (json_file) std::cerr << (csv_file ? " and " : "; wrote ") << a.json_path;
+    if (csv_file) std::cerr << "; wrote " << printable(a.csv_path);
+    if (json_file) std::cerr << (csv_file ? " and " : "; wrote ") << printable(a.json_path);
     std::cerr << "\n";
   }
   return 0;

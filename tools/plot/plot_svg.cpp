@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli_support.hpp"
+#include "command_support.hpp"  // printable()
 #include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 
@@ -16,8 +17,8 @@ namespace phiq::tools {
 
 namespace {
 
-int fail(const std::string& msg, int code) {
-  std::cerr << "phiq: plot: " << msg << "\n";
+int plot_fail(const std::string& msg, int code) {
+  std::cerr << "phiq: plot: " << printable(msg) << "\n";
   return code;
 }
 
@@ -80,12 +81,12 @@ int plot_svg(const PlotOptions& o) {
   try {
     scene = load_scene(o.scene);
   } catch (const SceneError& e) {
-    return fail(e.what(), 2);
+    return plot_fail(e.what(), 2);
   }
   try {
     table = read_csv_table(o.csv);
   } catch (const Error& e) {
-    return fail(e.what(), 2);
+    return plot_fail(e.what(), 2);
   }
   // the SVG exists (as a temporary) before the drawing, which may sweep the scene again
   set_interrupt_subject("plot: " + o.out, "; no output written");
@@ -94,7 +95,7 @@ int plot_svg(const PlotOptions& o) {
   try {
     out = &outputs.add(o.out);
   } catch (const Error& e) {
-    return fail(e.what(), 3);
+    return plot_fail(e.what(), 3);
   }
   // The CSV must be the scene's result: the columns its output lists, in order.
   const std::vector<std::string> expected = CsvFormat(*scene.model, scene.sweep).column_names();
@@ -105,9 +106,9 @@ int plot_svg(const PlotOptions& o) {
       want += c;
     }
     if (want.size() > 120) want = want.substr(0, 117) + "...";
-    return fail(o.csv + ": its columns are not the output of " + o.scene + " (expected " + want + ")", 2);
+    return plot_fail(o.csv + ": its columns are not the output of " + o.scene + " (expected " + want + ")", 2);
   }
-  if (table.rows.empty()) return fail(o.csv + ": no rows", 2);
+  if (table.rows.empty()) return plot_fail(o.csv + ": no rows", 2);
   std::map<std::string, std::size_t> col;
   for (std::size_t c = 0; c < table.columns.size(); ++c) col[table.columns[c]] = c;
   const Model& model = *scene.model;
@@ -120,7 +121,7 @@ int plot_svg(const PlotOptions& o) {
   if (series.empty())  // no coordinate written (e.g. a coupler curve alone): the first columns after t
     for (std::size_t c = 1; c < table.columns.size() && c <= 6; ++c) series.push_back(table.columns[c]);
   for (const std::string& c : series)
-    if (!col.count(c) || c == "t") return fail("--columns: no column '" + c + "' in " + o.csv, 2);
+    if (!col.count(c) || c == "t") return plot_fail("--columns: no column '" + c + "' in " + o.csv, 2);
 
   // The mechanism: every coordinate its lines read must be in the CSV.
   const std::vector<SketchSegment> segments = sketch_segments(model);
@@ -154,7 +155,7 @@ int plot_svg(const PlotOptions& o) {
   std::map<std::size_t, Eigen::VectorXd> solved;
   if (!all_in_csv) {
     if (static_cast<Index>(n_rows) != scene.sweep.steps + 1)
-      return fail(o.csv + ": " + std::to_string(n_rows) + " rows, but " + o.scene + " sweeps " +
+      return plot_fail(o.csv + ": " + std::to_string(n_rows) + " rows, but " + o.scene + " sweeps " +
                       std::to_string(scene.sweep.steps + 1) + " time points",
                   2);
     SweepOptions opt = scene.sweep;  // the same outputs, so the same predictor and path as the run
@@ -163,7 +164,7 @@ int plot_svg(const PlotOptions& o) {
     // a redundant model is solved as `phiq run` solves it: assembled by minimum norm, swept on its independent rows
     SquareScene square;
     if (prepare_scene(model, scene.sweep.t_begin, scene.sweep.assembly, &square) != SolveStatus::kSuccess)
-      return fail(o.scene + ": " + square.assembly.message, 1);
+      return plot_fail(o.scene + ": " + square.assembly.message, 1);
     const Model& swept = square.model(model);
     Workspace ws(swept);
     ws.q = square.start;
@@ -187,8 +188,8 @@ int plot_svg(const PlotOptions& o) {
       if (std::binary_search(drawn.begin(), drawn.end(), row)) solved[row] = v.q;
       return mismatch.empty();
     }, &sum);
-    if (!mismatch.empty()) return fail(o.csv + " is not the result of " + o.scene + ": " + mismatch, 2);
-    if (sum.status != SolveStatus::kSuccess) return fail(o.scene + ": " + sum.message, 1);
+    if (!mismatch.empty()) return plot_fail(o.csv + " is not the result of " + o.scene + ": " + mismatch, 2);
+    if (sum.status != SolveStatus::kSuccess) return plot_fail(o.scene + ": " + sum.message, 1);
   }
   Eigen::VectorXd q = model.initial_positions();
   auto load_row = [&](std::size_t r) {
@@ -314,7 +315,7 @@ int plot_svg(const PlotOptions& o) {
     out->write(svg.str());
     outputs.commit();
   } catch (const Error& e) {
-    return fail(e.what(), 3);
+    return plot_fail(e.what(), 3);
   }
   return 0;
 }

@@ -4,10 +4,10 @@
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
-#include <fstream>
 #include <sstream>
 
 #include "phiq/scene.hpp"
+#include "scene/read_scene_file.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace phiq {
@@ -115,20 +115,7 @@ Scene load_scene(const std::string& path, const SceneLimits& limits) {
 }
 
 Scene load_scene(const std::string& path, const SceneLimits& limits, const SceneOverrides& overrides) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path + ": cannot open the scene file");
-  // size first: a huge file is refused before it is read into memory
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw SceneError(path + ": cannot read the scene file (not a regular file?)");
-  if (static_cast<std::uint64_t>(size) > limits.max_file_bytes)
-    throw SceneError(path + ": the scene is " + std::to_string(size >> 20) + " MiB; the limit is " +
-                     std::to_string(limits.max_file_bytes >> 20) + " MiB");
-  in.seekg(0, std::ios::beg);
-  std::string text(static_cast<std::size_t>(size), '\0');
-  in.read(text.data(), size);
-  if (in.gcount() != size) throw SceneError(path + ": cannot read the scene file");
-  return parse_scene(text, path, limits, overrides);
+  return parse_scene(detail::scene::read_scene_file(path, limits), path, limits, overrides);
 }
 
 }  // namespace phiq
