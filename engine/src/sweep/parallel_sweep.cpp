@@ -133,6 +133,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   // one step after it when continued in order (the previous chunk's seam), if known. The caller's sweeper is not
   // used again: its state moves here and its history is freed.
   Index resume = 1;
+  Sweeper& row0_sweeper = sw;  // (chunk 0 takes its branch tangent, if row 0 is a singular start)
   State row0 = sw.take_state();
   Eigen::VectorXd last_q = std::move(row0.q), last_qd = need_v ? std::move(row0.qd) : ws.qd,
                   last_qdd = need_a ? std::move(row0.qdd) : ws.qdd;
@@ -248,6 +249,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     if (c == 0) {  // continues row 0 in order: the sequential sweep itself
       w.q = last_q, w.qd = last_qd, w.qdd = last_qdd;
       s.adopt(run.time_of(0));
+      s.take_branch_tangent(row0_sweeper);
       ch.ok = s.advance(run.time_of(ch.k0), 0);
     } else {
       ch.ok = s.start_from(run.time_of(ch.k0), seeds[static_cast<std::size_t>(c)],

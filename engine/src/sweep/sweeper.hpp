@@ -116,6 +116,12 @@ class Sweeper {
     ws_ = &w;
     factorizations_before_ = factorizations_seen_ = w.counters.factorizations;
   }
+  // Takes the branch tangent `from` found at a singular position where its state is (positions only: what the next
+  // step predicts along, singular_point()), for a sweeper that adopts that state: a chunk that continues row 0.
+  void take_branch_tangent(Sweeper& from) {
+    branch_qd_.swap(from.branch_qd_), branch_qdd_.swap(from.branch_qdd_);
+    branch_t_ = from.branch_t_;
+  }
   // Moves the last converged state out and frees the history: the sweeper is not used after this.
   State take_state() {
     history_.clear(), history_.shrink_to_fit();
