@@ -16,7 +16,8 @@ namespace phiq::detail {
 // PR 105329) on "literal" + std::string temporaries.
 inline Error expression_error(const std::string& text, const std::string& what) {
   std::size_t cut = std::min<std::size_t>(text.size(), 60);
-  while (cut > 0 && cut < text.size() && (static_cast<unsigned char>(text[cut]) & 0xc0) == 0x80) --cut;  // whole code points
+  // whole code points: never cut inside a UTF-8 sequence
+  while (cut > 0 && cut < text.size() && (static_cast<unsigned char>(text[cut]) & 0xc0) == 0x80) --cut;
   std::ostringstream s;
   s << "expression \"" << single_line(text.substr(0, cut)) << (cut < text.size() ? "..." : "") << "\": "
     << single_line(what);

@@ -69,8 +69,8 @@ bool MinNormSolver::solve(const double* b, double* y) {
   B.dtype = CHOLMOD_DOUBLE;
   Impl& im = *impl_;
   if (!cholmod_l_solve2(CHOLMOD_A, im.L, &B, nullptr, &im.X, nullptr, &im.Y, &im.E, &im.cc)) {
-    message_ = im.cc.status == CHOLMOD_OUT_OF_MEMORY ? "minimum-norm solver (CHOLMOD): out of memory in the solve"
-                                                     : "minimum-norm solver (CHOLMOD): the solve with the factors failed";
+    message_ = std::string("minimum-norm solver (CHOLMOD): ") +
+               (im.cc.status == CHOLMOD_OUT_OF_MEMORY ? "out of memory in the solve" : "the solve with the factors failed");
     return false;
   }
   std::copy_n(static_cast<const double*>(im.X->x), r, y);

@@ -31,7 +31,8 @@ inline std::string unusable_pattern(const CscPattern& p, const std::string& what
   if (empty_cols)
     why += (why.empty() ? "" : " and ") + std::to_string(empty_cols) + " coordinate" + (empty_cols == 1 ? "" : "s") +
            " that no equation involves (empty columns)";
-  if (why.empty()) return size + " " + what + ": it is structurally singular (no pivot order makes its diagonal non-zero)";
+  if (why.empty())
+    return size + " " + what + ": it is structurally singular (no pivot order makes its diagonal non-zero)";
   return size + " " + what + ": it has " + why;
 }
 

@@ -89,7 +89,8 @@ void refuse_non_utf8_encoding(const std::string& text, const std::string& path) 
   const std::size_t nul = text.find('\0');
   if (nul == std::string::npos) return;
   const std::size_t line_start = text.rfind('\n', nul);
-  const std::size_t line = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(nul), '\n'));
+  const std::size_t line =
+      1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(nul), '\n'));
   const std::size_t column = nul - (line_start == std::string::npos ? 0 : line_start + 1) + 1;
   throw SceneError(path + ":" + std::to_string(line) + ":" + std::to_string(column) +
                    ": the scene is not text (a NUL byte)");

@@ -35,7 +35,9 @@ std::pair<Point2, Point2> SceneReader::segment(const C& c) const {
   const Point2 from = point(c.at(0)), to = point(c.at(1));
   // a segment from a point to itself has no length and no direction, whatever its coordinates become: every kind
   // that reads one (distance, point_on_line, segment_angle, constant_angle) would be degenerate
-  const auto same = [](Slot u, Slot v) { return u.is_coordinate() ? u.coord() == v.coord() : !v.is_coordinate() && u.value() == v.value(); };
+  const auto same = [](Slot u, Slot v) {
+    return u.is_coordinate() ? u.coord() == v.coord() : !v.is_coordinate() && u.value() == v.value();
+  };
   if (same(from.x, to.x) && same(from.y, to.y))
     c.fail("the segment's two ends are the same point" +
            (c.at(0).is_scalar() ? " '" + c.at(0).text() + "'" : std::string()) + ": it has no length nor direction");

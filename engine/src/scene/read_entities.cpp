@@ -13,7 +13,8 @@ namespace phiq::detail::scene {
 // An override that names no parameter: located where the names were given (a batch header) when the caller says
 // where, else in the scene.
 void SceneReader::unknown_override(const Cursor& c, const std::string& name) const {
-  if (overrides_->parameters_source.empty()) c.fail("'" + name + "' (given for this run) is not a parameter of the scene");
+  if (overrides_->parameters_source.empty())
+    c.fail("'" + name + "' (given for this run) is not a parameter of the scene");
   std::vector<std::string> names;
   for (const auto& [n, v] : parameters_) names.push_back(n);
   std::sort(names.begin(), names.end());
