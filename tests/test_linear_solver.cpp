@@ -478,7 +478,7 @@ TEST(LinearSolver, AnUnusablePatternIsDescribedNotGivenAsAStatus) {
   }
   MinNormSolver min_norm(empty);
   const double none[1] = {0.0};
-  EXPECT_EQ(min_norm.factorize(none, 0.0), FactorStatus::kFailed);
+  EXPECT_NE(min_norm.factorize(none, 0.0), FactorStatus::kOk);
   EXPECT_EQ(min_norm.last_message().find("status"), std::string::npos) << min_norm.last_message();
 }
 

@@ -387,7 +387,7 @@ Model ModelBuilder::build() && {
      // library refuses the empty row of the Jacobian in its own words
     std::vector<char> used(static_cast<std::size_t>(rows), 0);
     for (Index r : pattern->row_idx) used[static_cast<std::size_t>(r)] = 1;
-    for (Index r = 0; r < rows; ++r)
+    for (Index r = 0; r < rows && rows == n; ++r)  // square: for the LU (a redundant model's rank analysis copes)
       if (!used[static_cast<std::size_t>(r)])
         throw Error("constraint '" + m.row_name(r) + "' involves no coordinate (an empty row of the Jacobian): " +
                     "it holds at every position or at none");

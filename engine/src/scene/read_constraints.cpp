@@ -38,7 +38,10 @@ std::pair<Point2, Point2> SceneReader::segment(const C& c) const {
   const auto same = [](Slot u, Slot v) {
     return u.is_coordinate() ? u.coord() == v.coord() : !v.is_coordinate() && u.value() == v.value();
   };
-  if (same(from.x, to.x) && same(from.y, to.y))
+  // (two fixed ends are left to the kinds, which say "the same fixed point")
+  const bool fixed =
+      !from.x.is_coordinate() && !from.y.is_coordinate() && !to.x.is_coordinate() && !to.y.is_coordinate();
+  if (!fixed && same(from.x, to.x) && same(from.y, to.y))
     c.fail("the segment's two ends are the same point" +
            (c.at(0).is_scalar() ? " '" + c.at(0).text() + "'" : std::string()) + ": it has no length nor direction");
   return {from, to};

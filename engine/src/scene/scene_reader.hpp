@@ -220,6 +220,16 @@ void SceneReader::add(const C& c, const std::string& name, Spec spec) {
   const std::string label = name.empty() ? c.path() + " (line " + std::to_string(c.mark().line + 1) + ")" : name;
   bool any_coordinate = false;
   spec.for_each_slot([&](const Slot& s, Unit) { any_coordinate = any_coordinate || s.is_coordinate(); });
+  // one that involves no coordinate nor t and is 0 (`0*x`, a joint between two coincident fixed points) holds
+  // everywhere: a redundant row the rank analysis reports, not an error
+  bool holds_everywhere = false;
+  if (!any_coordinate && !spec.depends_on_time()) {
+    double phi[Spec::kRows > 0 ? Spec::kRows : 1] = {};
+    const double no_coordinates[1] = {0.0};
+    spec.residual(no_coordinates, 0.0, phi);
+    holds_everywhere = true;
+    for (int r = 0; r < Spec::kRows; ++r) holds_everywhere = holds_everywhere && phi[r] == 0.0;
+  }
   try {
     builder_.add(label, std::move(spec));
   } catch (const Error&) {
@@ -229,13 +239,13 @@ void SceneReader::add(const C& c, const std::string& name, Spec spec) {
       c.field("name").fail("duplicate constraint or driver name '" + label + "'");
     throw;
   }
-  // An equation of constants and t holds at every position or at none: said here, where its line is known, not
-  // by a factorisation library refusing the empty row of the Jacobian.
-  if (!any_coordinate) {
+  // Any other equation of constants and t holds at no position (or at isolated times): said here, where its line
+  // is known, not by a factorisation library refusing the empty row of the Jacobian.
+  if (!any_coordinate && !holds_everywhere) {
     const C expr = c.field("expr");
     if (expr.present() && expr.is_scalar())
-      expr.fail("expression \"" + expr.text() + "\" involves no coordinate: it holds at every position or at none");
-    c.fail("involves no coordinate: it holds at every position or at none");
+      expr.fail("expression \"" + expr.text() + "\" involves no coordinate and is not zero: no position satisfies it");
+    c.fail("involves no coordinate and is not zero: no position satisfies it");
   }
 }
 
