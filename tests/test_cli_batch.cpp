@@ -47,12 +47,15 @@ TEST_F(Cli, BatchSweepsEveryParameterSetInParallel) {
     }
     EXPECT_LT(worst, 1e-9) << "case " << k;
   }
-  // a column that is not a parameter of the scene: one line naming it and the case, nothing written
+  // a column that is not a parameter of the scene: one line naming it at the header (line 1: no case's fault) and
+  // the scene's parameters, nothing written
   const fs::path bad = write("bad.csv", "L2,L9\n0.2,1\n");
   r = run("batch " + phiq::test::model_path("seed/crank_slider_mixed.yaml") + " " + bad.string() + " -o " +
           (dir_ / "bad").string());
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("'L9' (given for this run) is not a parameter of the scene (case 0 of"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("phiq: " + bad.string() + ":1: 'L9' is not a parameter of "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(its parameters: L2, L3)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("case 0"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "bad"));
 }

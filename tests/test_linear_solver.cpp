@@ -1,4 +1,5 @@
-// Sparse LU (UMFPACK) against the dense reference; singular kept apart from failure; symbolic shared.
+// Sparse LU (UMFPACK) against the dense reference; singular kept apart from failure; symbolic shared; unusable
+// patterns reported in the model's terms.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -12,6 +13,7 @@
 #include "linear/klu_lu.hpp"
 #include "phiq/kinematics.hpp"
 #include "phiq/linear_solver.hpp"
+#include "phiq/min_norm_solver.hpp"
 #include "phiq/scene.hpp"
 
 namespace phiq {
@@ -446,6 +448,38 @@ TEST(LinearSolver, NonSquarePatternIsRefused) {
   std::vector<Index> slot;
   *p = build_csc_pattern(2, 3, {0, 1}, {0, 2}, &slot);
   EXPECT_THROW(analyse(LinearSolverKind::kUmfpack, p), Error);
+}
+
+}  // namespace
+}  // namespace phiq
+
+namespace phiq {
+namespace {
+
+// A pattern a factorisation library cannot use is reported in the model's terms — what the Jacobian lacks — and
+// never by the library's status number (KLU -3, UMFPACK -5 and CHOLMOD -4 for the same empty matrix).
+TEST(LinearSolver, AnUnusablePatternIsDescribedNotGivenAsAStatus) {
+  auto empty = std::make_shared<CscPattern>();
+  empty->rows = empty->cols = 1;
+  empty->col_ptr = {0, 0};
+  for (LinearSolverKind kind : {LinearSolverKind::kKlu, LinearSolverKind::kUmfpack}) {
+    SCOPED_TRACE(to_string(kind));
+    try {
+      (void)analyse(kind, empty);
+      ADD_FAILURE() << "an empty 1 x 1 pattern was analysed";
+    } catch (const Error& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.find("status"), std::string::npos) << m;
+      EXPECT_NE(m.find("1 equation that involves no coordinate (empty rows) and 1 coordinate that no equation "
+                       "involves (empty columns)"),
+                std::string::npos)
+          << m;
+    }
+  }
+  MinNormSolver min_norm(empty);
+  const double none[1] = {0.0};
+  EXPECT_NE(min_norm.factorize(none, 0.0), FactorStatus::kOk);
+  EXPECT_EQ(min_norm.last_message().find("status"), std::string::npos) << min_norm.last_message();
 }
 
 }  // namespace

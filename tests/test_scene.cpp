@@ -217,7 +217,8 @@ TEST(Scene, HostileShapesAreRefusedBeforeTheTreeIsBuilt) {
   EXPECT_HAS(error_of(std::string(kGood) + "---\nname: two\n"), "a scene is one YAML document");
   EXPECT_HAS(error_of(std::string(kGood) + "description: \"" + std::string(20000, 'x') + "\"\n"),
              "a value of 20000 bytes; the limit is 16384");
-  EXPECT_HAS(error_of(std::string("name: a\0b\n", 11)), "contains a NUL byte");
+  EXPECT_HAS(error_of(std::string("name: a\0b\n", 11)), ":1:8: the scene is not text (a NUL byte)");
+  EXPECT_HAS(error_of(std::string("\xff\xfen\0a\0", 6)), "the scene is UTF-16 (little-endian, with a byte order mark)");
   SceneLimits tiny;
   tiny.max_file_bytes = 100;
   try {

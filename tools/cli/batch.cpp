@@ -42,6 +42,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   for (std::size_t k = 0; k < cases.rows.size(); ++k) {
     phiq::SceneOverrides o;
     for (std::size_t c = 0; c < cases.columns.size(); ++c) o.parameters.emplace_back(cases.columns[c], cases.rows[k][c]);
+    o.parameters_source = cases_path + ":1";  // the header names them: its errors are no case's
     if (!scenes.empty()) o.share_analysis_with = scenes.front().model.get();
     try {
       scenes.push_back(phiq::load_scene(scene_path, phiq::SceneLimits{}, o));
@@ -49,6 +50,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
       // The case is named only when its parameters cause the error: an error of the scene itself (its YAML, a
       // field) is the same without them. Cases after the first loaded the same scene, so theirs are theirs.
       bool from_case = k > 0;
+      if (std::string(e.what()).rfind(o.parameters_source + ": ", 0) == 0) return fail(e.what(), 2);
       if (!from_case) {
         try {
           (void)phiq::load_scene(scene_path);

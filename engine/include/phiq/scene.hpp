@@ -24,7 +24,9 @@ class SceneError : public std::runtime_error {
 struct SceneLimits {
   std::size_t max_file_bytes = std::size_t{128} << 20;  ///< 128 MiB
   int max_depth = 32;                                    ///< nesting of maps and lists
-  std::size_t max_nodes = 20'000'000;                    ///< scalars + maps + lists
+  /// Scalars + maps + lists. yaml-cpp's tree costs about 470 bytes a value, so this bounds the loader's memory
+  /// (10^6 values: 0.48 GB); larger models are written with families (`for i in A..B`), which cost no values.
+  std::size_t max_nodes = 1'000'000;
   std::size_t max_scalar_bytes = 16384;                  ///< one value (expressions are shorter still, see expression.hpp)
   /// Entries (coordinates, points, bodies, constraints, drivers) that indexed families (`for i in A..B`) may make
   /// in all; a nested family counts as one entry of its parent per member, plus what it makes.
@@ -47,6 +49,10 @@ struct SceneOverrides {
   /// Parameter values replacing the file's, by name; each must be a parameter of the scene (else SceneError). A
   /// replaced parameter is seen by every parameter, number and family after it, as if the file had said so.
   std::vector<std::pair<std::string, double>> parameters;
+  /// Where the names of `parameters` were given, for the message about one that names no parameter ("cases.csv:1",
+  /// the header of `phiq batch`): "cases.csv:1: 'foo' is not a parameter of scene.yaml (its parameters: ...)".
+  /// Empty: the message points into the scene and says "(given for this run)".
+  std::string parameters_source;
   /// If set, the model shares this model's pattern and symbolic analysis when its structure is the same
   /// (ModelBuilder::share_analysis_with()); it must outlive the call.
   const Model* share_analysis_with = nullptr;

@@ -3,6 +3,7 @@
 /// generated scene writes its numbers through these functions, so that the same double reads the same everywhere.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace phiq {
@@ -20,9 +21,13 @@ std::string significant(double v, int digits);
 /// residuals in messages, which are compared by their exponent. Thread-safe.
 std::string scientific(double v, int digits);
 
-/// `text` made fit for a one-line message: control characters escaped as `\\n`, `\\t`, `\\xNN`. User text quoted in
+/// `text` made fit for a one-line message in UTF-8: control characters escaped as `\\n`, `\\t`, `\\xNN`, and so is
+/// each byte that is not part of a well-formed UTF-8 sequence (whole code points are kept). User text quoted in
 /// errors (expressions, names from a scene) may contain them. Thread-safe.
 std::string single_line(const std::string& text);
+/// The length in bytes of the well-formed UTF-8 sequence that starts at `text[i]` (1 for ASCII), or 0 when the
+/// bytes there are not one (a lone continuation byte, a truncated or overlong sequence, a surrogate). Thread-safe.
+std::size_t utf8_sequence_length(const std::string& text, std::size_t i);
 
 /// A time as phiq's messages write it (`t = …`: sweep and assembly failures, warnings): ten significant digits, so
 /// that a time the sweep computes (t_begin + k h) reads as the grid point it is ("0.6", not "0.6000000000000001")

@@ -54,7 +54,7 @@ class ExpressionParser {
     skip_space();
     if (pos_ < text_.size()) {
       if (text_[pos_] == ')') fail_at("')' without a matching '('");
-      fail_at("expected an operator before '" + token_text() + "'");
+      fail_before("expected an operator");
     }
     return n;
   }
@@ -99,13 +99,18 @@ class ExpressionParser {
   void expect(char c, const char* what) {
     if (accept(c)) return;
     if (pos_ >= text_.size()) fail(std::string("missing ") + what + " at the end");
-    fail_at(std::string("expected ") + what + " before '" + token_text() + "'");
+    fail_before(std::string("expected ") + what);
   }
-  std::string token_text() const {  // the token at pos_, for messages
-    std::size_t end = pos_ + 1;
+  std::string token_text() const {  // the token at pos_, for messages: a name, or one whole code point
+    std::size_t end = pos_ + std::max<std::size_t>(1, utf8_sequence_length(text_, pos_));
     if (is_name_char(text_[pos_]))
       while (end < text_.size() && is_name_char(text_[end])) ++end;
-    return text_.substr(pos_, std::min<std::size_t>(end - pos_, 40));
+    return single_line(text_.substr(pos_, std::min<std::size_t>(end - pos_, 40)));
+  }
+  // "expected ... before 'X' (column N)", and for a character that only looks like an operator, what to write.
+  [[noreturn]] void fail_before(const std::string& expected) const {
+    const std::string token = token_text();
+    fail(expected + " before '" + token + "' (column " + std::to_string(pos_ + 1) + ")" + lookalike_hint(token));
   }
 
   // The result of a GiNaC operation on operands not all constant: a number (by cancellation) is folded at once.
@@ -201,7 +206,7 @@ class ExpressionParser {
       --depth_;
       return n;
     }
-    fail_at("expected a number, a name or '(' before '" + token_text() + "'");
+    fail_before("expected a number, a name or '('");
   }
 
   Node number() {

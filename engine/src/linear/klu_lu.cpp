@@ -9,6 +9,7 @@
 // - The blocks of the block triangular form in an order that follows the pattern's own where that is more local
 //   than the order KLU finds them in (resequence_blocks).
 #include "linear/klu_lu.hpp"
+#include "linear/pattern_messages.hpp"
 
 #include <klu.h>
 
@@ -316,7 +317,8 @@ class KluSymbolic final : public KluSymbolicBase, public std::enable_shared_from
     }
     // BTF + AMD on the pattern only: the orderings are fixed per model.
     symbolic_ = analyze_bounded(static_cast<Int>(p.cols));
-    if (!symbolic_) throw Error("KLU symbolic analysis failed (status " + std::to_string(last_status_) + ")");
+    if (!symbolic_)
+      throw Error("sparse LU (KLU): " + unusable_pattern(p, "cannot be analysed", last_status_ == KLU_OUT_OF_MEMORY));
     analysis = resequence_blocks<Int>(ap_, ai_, symbolic_);
     analysis.transversal = transversal_;
     q_sign_ = permutation_sign(symbolic_->Q, p.cols);
@@ -454,7 +456,7 @@ FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
     }
     message_ = common_.status == KLU_TOO_LARGE
                    ? std::string("KLU factorisation failed: the factors outgrew its index type")
-                   : "KLU factorisation failed (status " + std::to_string(common_.status) + ")";
+                   : unusable_pattern(*sym_.pattern_, "cannot be factorised", common_.status == KLU_OUT_OF_MEMORY);
     return FactorStatus::kFailed;
   }
   // the row permutation is fixed until the next pivot search: its parity once here, not per determinant_sign()
@@ -512,7 +514,8 @@ bool KluNumeric<Int>::solve_system(bool transposed, const double* b, double* x) 
   const bool ok = transposed ? Api::tsolve(sym_.symbolic_, numeric_, n, x, &common_)
                              : Api::solve(sym_.symbolic_, numeric_, n, x, &common_);
   if (!ok) {
-    message_ = "KLU solve failed (status " + std::to_string(common_.status) + ")";
+    message_ = common_.status == KLU_OUT_OF_MEMORY ? "sparse LU (KLU): out of memory in the solve with the Jacobian"
+                                                   : "sparse LU (KLU): the solve with the Jacobian's factors failed";
     return false;
   }
   return true;

@@ -1,6 +1,7 @@
 #include "phiq/linear_solver.hpp"
 
 #include "linear/klu_lu.hpp"
+#include "linear/pattern_messages.hpp"
 
 #include <umfpack.h>
 
@@ -39,7 +40,7 @@ std::string umfpack_status_text(int status) {
     case UMFPACK_ERROR_different_pattern: return "pattern changed since the symbolic analysis";
     case UMFPACK_ERROR_invalid_Symbolic_object: return "invalid symbolic object";
     case UMFPACK_ERROR_invalid_Numeric_object: return "invalid numeric object";
-    default: return "UMFPACK status " + std::to_string(status);
+    default: return "sparse LU (UMFPACK) failed (an error it does not name)";
   }
 }
 
@@ -102,7 +103,9 @@ class UmfpackSymbolic final : public SparseLuSymbolic, public std::enable_shared
     // the numeric factorisation still pivots on the values of every iteration.
     int status = umfpack_dl_symbolic(p.rows, p.cols, p.col_ptr.data(), p.row_idx.data(), nullptr, &symbolic_,
                                      control_, info);
-    if (status != UMFPACK_OK) throw Error("UMFPACK symbolic analysis failed: " + umfpack_status_text(status));
+    if (status != UMFPACK_OK)
+      throw Error("sparse LU (UMFPACK): " +
+                  detail::unusable_pattern(p, "cannot be analysed", status == UMFPACK_ERROR_out_of_memory));
   }
   ~UmfpackSymbolic() override {
     if (symbolic_) umfpack_dl_free_symbolic(&symbolic_);

@@ -1,6 +1,7 @@
 #include "phiq/min_norm_solver.hpp"
 
 #include "linear/cholmod_view.hpp"
+#include "linear/pattern_messages.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -28,7 +29,9 @@ MinNormSolver::MinNormSolver(std::shared_ptr<const CscPattern> pattern)
     : pattern_(std::move(pattern)), impl_(std::make_unique<Impl>()) {
   impl_->A = detail::csc_view(*pattern_, nullptr);
   impl_->L = cholmod_l_analyze(&impl_->A, &impl_->cc);
-  if (!impl_->L) throw Error("CHOLMOD could not analyse the pattern (status " + std::to_string(impl_->cc.status) + ")");
+  if (!impl_->L)
+    throw Error("minimum-norm solver (CHOLMOD): " +
+                detail::unusable_pattern(*pattern_, "cannot be analysed", impl_->cc.status == CHOLMOD_OUT_OF_MEMORY));
 }
 
 MinNormSolver::~MinNormSolver() = default;
@@ -40,7 +43,8 @@ FactorStatus MinNormSolver::factorize(const double* values, double beta) {
   double b[2] = {beta, 0.0};
   const int ok = cholmod_l_factorize_p(&impl_->A, b, nullptr, 0, impl_->L, &impl_->cc);
   if (!ok || impl_->cc.status < CHOLMOD_OK) {
-    message_ = "CHOLMOD factorisation failed (status " + std::to_string(impl_->cc.status) + ")";
+    message_ = "minimum-norm solver (CHOLMOD): " +
+               detail::unusable_pattern(*pattern_, "cannot be factorised", impl_->cc.status == CHOLMOD_OUT_OF_MEMORY);
     return FactorStatus::kFailed;
   }
   if (impl_->cc.status == CHOLMOD_NOT_POSDEF || impl_->L->minor < impl_->L->n) {
@@ -65,7 +69,8 @@ bool MinNormSolver::solve(const double* b, double* y) {
   B.dtype = CHOLMOD_DOUBLE;
   Impl& im = *impl_;
   if (!cholmod_l_solve2(CHOLMOD_A, im.L, &B, nullptr, &im.X, nullptr, &im.Y, &im.E, &im.cc)) {
-    message_ = "CHOLMOD solve failed (status " + std::to_string(im.cc.status) + ")";
+    message_ = std::string("minimum-norm solver (CHOLMOD): ") +
+               (im.cc.status == CHOLMOD_OUT_OF_MEMORY ? "out of memory in the solve" : "the solve with the factors failed");
     return false;
   }
   std::copy_n(static_cast<const double*>(im.X->x), r, y);

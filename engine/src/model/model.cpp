@@ -383,6 +383,15 @@ Model ModelBuilder::build() && {
   m.slot_of_entry_.assign(slots.begin(), slots.end());
   m.pattern_ = pattern;
   m.solve_pattern_ = pattern;
+  {  // a row that involves no coordinate holds at every position or at none: named here, before a factorisation
+     // library refuses the empty row of the Jacobian in its own words
+    std::vector<char> used(static_cast<std::size_t>(rows), 0);
+    for (Index r : pattern->row_idx) used[static_cast<std::size_t>(r)] = 1;
+    for (Index r = 0; r < rows && rows == n; ++r)  // square: for the LU (a redundant model's rank analysis copes)
+      if (!used[static_cast<std::size_t>(r)])
+        throw Error("constraint '" + m.row_name(r) + "' involves no coordinate (an empty row of the Jacobian): " +
+                    "it holds at every position or at none");
+  }
 
   // Units and scales.
   m.coordinate_units_.assign(static_cast<std::size_t>(n), Unit::kNone);

@@ -126,6 +126,9 @@ class TCursor {
       : node_(node), parent_(parent), key_(key), fx_(fx) {}
 
   const TNode* node() const { return node_; }
+  // The field path of the member being read ("constraints[0][i=17]"), and where it is written.
+  std::string path() const { return fx_->render(node_ ? node_->path : parent_->path + "." + key_); }
+  YAML::Mark mark() const { return node_ ? node_->mark : parent_->mark; }
   Families& families() const { return *fx_; }
   bool present() const { return node_ && node_->kind != TNode::Kind::kNull; }
   bool is_map() const { return node_ && node_->kind == TNode::Kind::kMap; }

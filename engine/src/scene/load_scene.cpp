@@ -4,6 +4,7 @@
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <sstream>
 
 #include "phiq/scene.hpp"
@@ -45,7 +46,8 @@ class ShapeGuard final : public YAML::EventHandler {
  private:
   void count(const YAML::Mark& m) {
     if (++nodes_ > limits_.max_nodes)
-      fail(m, "more than " + std::to_string(limits_.max_nodes) + " values; the scene is too large");
+      fail(m, "more than " + std::to_string(limits_.max_nodes) +
+                  " values; the scene is too large (write repeated entries as families, `for i in A..B`)");
   }
   void enter(const YAML::Mark& m) {
     count(m);
@@ -69,6 +71,31 @@ std::string yaml_error(const std::string& path, const YAML::Exception& e) {
   return s.str();
 }
 
+// A scene is UTF-8 (or ASCII). UTF-16 and UTF-32 — what some editors save as "Unicode" — are recognised by their
+// byte order mark or by the NUL bytes of their ASCII characters and named, with the conversion; any other NUL byte
+// is located. (A UTF-8 byte order mark is accepted: YAML allows it.)
+void refuse_non_utf8_encoding(const std::string& text, const std::string& path) {
+  const auto starts = [&](const char* bom, std::size_t n) { return text.compare(0, n, bom, n) == 0; };
+  const char* encoding = nullptr;
+  if (starts("\xff\xfe\0\0", 4)) encoding = "UTF-32 (little-endian, with a byte order mark)";
+  else if (starts("\0\0\xfe\xff", 4)) encoding = "UTF-32 (big-endian, with a byte order mark)";
+  else if (starts("\xff\xfe", 2)) encoding = "UTF-16 (little-endian, with a byte order mark)";
+  else if (starts("\xfe\xff", 2)) encoding = "UTF-16 (big-endian, with a byte order mark)";
+  else if (text.size() >= 2 && text[0] != '\0' && text[1] == '\0') encoding = "UTF-16 (little-endian)";
+  else if (text.size() >= 2 && text[0] == '\0' && text[1] != '\0') encoding = "UTF-16 (big-endian)";
+  if (encoding)
+    throw SceneError(path + ": the scene is " + encoding + "; phiq reads UTF-8: convert it (iconv -f " +
+                     (std::string(encoding).rfind("UTF-32", 0) == 0 ? "UTF-32" : "UTF-16") + " -t UTF-8)");
+  const std::size_t nul = text.find('\0');
+  if (nul == std::string::npos) return;
+  const std::size_t line_start = text.rfind('\n', nul);
+  const std::size_t line =
+      1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(nul), '\n'));
+  const std::size_t column = nul - (line_start == std::string::npos ? 0 : line_start + 1) + 1;
+  throw SceneError(path + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                   ": the scene is not text (a NUL byte)");
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits) {
@@ -80,7 +107,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
   if (text.size() > limits.max_file_bytes)
     throw SceneError(path + ": the scene is " + std::to_string(text.size() >> 20) + " MiB; the limit is " +
                      std::to_string(limits.max_file_bytes >> 20) + " MiB");
-  if (text.find('\0') != std::string::npos) throw SceneError(path + ": the scene is not text (contains a NUL byte)");
+  refuse_non_utf8_encoding(text, path);
   try {
     std::istringstream in(text);
     YAML::Parser parser(in);

@@ -32,7 +32,19 @@ Point2 SceneReader::point(const C& c) const {
 template <class C>
 std::pair<Point2, Point2> SceneReader::segment(const C& c) const {
   if (!c.is_sequence() || c.size() != 2) c.fail("a segment is [from, to]");
-  return {point(c.at(0)), point(c.at(1))};
+  const Point2 from = point(c.at(0)), to = point(c.at(1));
+  // a segment from a point to itself has no length and no direction, whatever its coordinates become: every kind
+  // that reads one (distance, point_on_line, segment_angle, constant_angle) would be degenerate
+  const auto same = [](Slot u, Slot v) {
+    return u.is_coordinate() ? u.coord() == v.coord() : !v.is_coordinate() && u.value() == v.value();
+  };
+  // (two fixed ends are left to the kinds, which say "the same fixed point")
+  const bool fixed =
+      !from.x.is_coordinate() && !from.y.is_coordinate() && !to.x.is_coordinate() && !to.y.is_coordinate();
+  if (!fixed && same(from.x, to.x) && same(from.y, to.y))
+    c.fail("the segment's two ends are the same point" +
+           (c.at(0).is_scalar() ? " '" + c.at(0).text() + "'" : std::string()) + ": it has no length nor direction");
+  return {from, to};
 }
 
 template <class C>

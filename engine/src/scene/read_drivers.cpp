@@ -103,14 +103,15 @@ MotionLaw SceneReader::motion_law(const C& c) const {
       c.expect_map({"type", "f"});
       auto f = c.require("f");
       std::shared_ptr<const CompiledExpression> expr;
-      if constexpr (kInFamily<C>) {
-        expr = family_expression(f, true, false);
-      } else {
-        expr = CompiledExpression::compile(f.text(), [&](const std::string& n) -> std::optional<NameBinding> {
-          if (n == "t") return NameBinding{NameBinding::Kind::kTime};
-          if (auto p = parameter(n)) return NameBinding{NameBinding::Kind::kConstant, -1, *p};
-          return std::nullopt;
-        });
+      try {  // the message names the field, `law.f`
+        if constexpr (kInFamily<C>) {
+          expr = family_expression(f, true, false);
+        } else {
+          const std::string text = f.text();
+          expr = CompiledExpression::compile(text, resolver(false, text));
+        }
+      } catch (const Error& e) {
+        f.fail(e.what());
       }
       return MotionLaw::expression(expr);
     }

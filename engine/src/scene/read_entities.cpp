@@ -1,14 +1,32 @@
 // The sections that define names (scene_reader.hpp): parameters, coordinates, points, bodies and natural unit
 // vectors, plain entries and family members, each checked for a valid and unused name.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "phiq/text.hpp"
 #include "scene/family_expansion.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace phiq::detail::scene {
 
+// An override that names no parameter: located where the names were given (a batch header) when the caller says
+// where, else in the scene.
+void SceneReader::unknown_override(const Cursor& c, const std::string& name) const {
+  if (overrides_->parameters_source.empty())
+    c.fail("'" + name + "' (given for this run) is not a parameter of the scene");
+  std::vector<std::string> names;
+  for (const auto& [n, v] : parameters_) names.push_back(n);
+  std::sort(names.begin(), names.end());
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  throw SceneError(single_line(overrides_->parameters_source + ": '" + name + "' is not a parameter of " + file_ +
+                               (list.empty() ? " (it has none)" : " (its parameters: " + list + ")")));
+}
+
 void SceneReader::read_parameters(const Cursor& c) {
   if (!c.present()) {
-    if (overrides_ && !overrides_->parameters.empty())
-      c.fail("'" + overrides_->parameters[0].first + "' (given for this run) is not a parameter of the scene");
+    if (overrides_ && !overrides_->parameters.empty()) unknown_override(c, overrides_->parameters[0].first);
     return;
   }
   for (auto& [name, key_mark, value] : c.entries()) {
@@ -21,7 +39,7 @@ void SceneReader::read_parameters(const Cursor& c) {
   }
   if (overrides_)
     for (const auto& [n, v] : overrides_->parameters)
-      if (!parameters_.count(n)) c.fail("'" + n + "' (given for this run) is not a parameter of the scene");
+      if (!parameters_.count(n)) unknown_override(c, n);
 }
 
 void SceneReader::read_coordinates(const Cursor& c) {
@@ -79,6 +97,26 @@ void SceneReader::read_points(const Cursor& c) {
   });
 }
 
+// A fixed frame's Euler parameters are data, not coordinates the assembly normalises: within kEulerNormSlack of
+// unit norm (constants rounded to a few digits, cos(pi/8) written 0.9239) they are normalised, which keeps the
+// rotation they mean; beyond, they would scale every attachment by |e|^2, so they are refused.
+template <class C>
+void SceneReader::fixed_euler_parameters(const C& value, Frame3& f) const {
+  Slot* e[4] = {&f.e0, &f.e1, &f.e2, &f.e3};
+  double norm2 = 0.0;
+  for (Slot* s : e) norm2 += s->value() * s->value();
+  const double norm = std::sqrt(norm2);
+  if (std::abs(norm - 1.0) <= kEulerNormSlack) {
+    if (std::abs(norm - 1.0) > 8 * std::numeric_limits<double>::epsilon())  // unit to rounding: kept as written
+      for (Slot* s : e) *s = Slot::constant(s->value() / norm);
+    return;
+  }
+  value.fail("the Euler parameters of a fixed frame [" + shortest(e[0]->value()) + ", " + shortest(e[1]->value()) +
+             ", " + shortest(e[2]->value()) + ", " + shortest(e[3]->value()) + "] have norm " + significant(norm, 6) +
+             "; they must have norm 1 (within " + significant(kEulerNormSlack, 1) +
+             "): a rotation by angle a about the unit axis u is [cos(a/2), u sin(a/2)]");
+}
+
 // Bodies that move are recorded for the Grübler–Kutzbach count (a body of constants is a fixed frame, as ground);
 // a spatial body's Euler normalisation `NAME.euler` is added with it.
 void SceneReader::read_bodies(const Cursor& c) {
@@ -90,7 +128,8 @@ void SceneReader::read_bodies(const Cursor& c) {
       if (value.size() != 7 || !value.is_sequence()) value.fail("a body is [x, y, z, e0, e1, e2, e3] (dimension: 3)");
       Slot v[7];
       for (int i = 0; i < 7; ++i) v[i] = slot(value.at(static_cast<std::size_t>(i)));
-      const Frame3 f{v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+      Frame3 f{v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
+      if (f.is_fixed()) fixed_euler_parameters(value, f);
       bodies3_[k] = f;
       if (!f.is_fixed()) {
         try {

@@ -13,22 +13,30 @@ std::shared_ptr<const CompiledExpression> SceneReader::compile(const C& c, bool 
     if constexpr (kInFamily<C>) {
       return family_expression(c, allow_time, true);
     } else {
-      return CompiledExpression::compile(c.text(), resolver(true), allow_time);
+      const std::string text = c.text();
+      return CompiledExpression::compile(text, resolver(true, text), allow_time);
     }
   } catch (const Error& e) {
     c.fail(e.what());
   }
 }
 
-// Names of equation expressions: t, coordinates (when allowed), parameters.
-NameResolver SceneReader::resolver(bool coordinates) const {
-  return [this, coordinates](const std::string& n) -> std::optional<NameBinding> {
+// Names of equation expressions: t, coordinates (when allowed), parameters. `text` is the expression, for the
+// message that refuses a coordinate where none is allowed (a law: a function of t alone).
+NameResolver SceneReader::resolver(bool coordinates, const std::string& text) const {
+  return [this, coordinates, &text](const std::string& n) -> std::optional<NameBinding> {
     if (n == "t") return NameBinding{NameBinding::Kind::kTime};
-    if (coordinates)
-      if (Index j = builder_.find_coordinate(n); j >= 0) return NameBinding{NameBinding::Kind::kCoordinate, j};
+    if (Index j = builder_.find_coordinate(n); j >= 0) {
+      if (!coordinates) throw labelled(expression_label(text), coordinate_in_law(n));
+      return NameBinding{NameBinding::Kind::kCoordinate, j};
+    }
     if (auto p = parameter(n)) return NameBinding{NameBinding::Kind::kConstant, -1, *p};
     return std::nullopt;
   };
+}
+
+std::string coordinate_in_law(const std::string& name) {
+  return "'" + name + "' is a coordinate: a law is a function of t alone (parameters, pi and t), not of coordinates";
 }
 
 // An equation (or law) expression of a family member: compiled once per body, rebound per member. Throws Error.
@@ -40,7 +48,7 @@ std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const T
     auto eq = std::make_shared<ScalarPlan::Equation>();
     eq->allow_coordinates = allow_coordinates;
     if (!uses_member(c, text)) {
-      eq->shared = CompiledExpression::compile(text, resolver(allow_coordinates), allow_time);
+      eq->shared = CompiledExpression::compile(text, resolver(allow_coordinates, text), allow_time);
     } else {
       // each templated name becomes a placeholder identifier that the text cannot already contain
       const std::vector<NameToken> tokens = name_tokens(text, expression_label(text));
@@ -81,9 +89,10 @@ std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const T
             return NameBinding{NameBinding::Kind::kCoordinate,
                                add(n, P{P::Kind::kIndex, -1, static_cast<int>(k), 0})};
         if (n == "t") return NameBinding{NameBinding::Kind::kTime};
-        if (allow_coordinates)
-          if (Index j = builder_.find_coordinate(n); j >= 0)
-            return NameBinding{NameBinding::Kind::kCoordinate, add(n, P{P::Kind::kCoordinate, j, 0, 0})};
+        if (Index j = builder_.find_coordinate(n); j >= 0) {
+          if (!allow_coordinates) throw labelled(expression_label(text), coordinate_in_law(n));
+          return NameBinding{NameBinding::Kind::kCoordinate, add(n, P{P::Kind::kCoordinate, j, 0, 0})};
+        }
         if (auto p = parameter(n)) return NameBinding{NameBinding::Kind::kConstant, -1, *p};
         return std::nullopt;
       };
@@ -117,6 +126,7 @@ std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const T
       eq.names[p.name]->render(fx.env(), name);
       if (Index j = eq.allow_coordinates ? builder_.find_coordinate(name) : -1; j >= 0) target[k] = j;
       else if (auto v = parameter(name)) value[k] = *v;
+      else if (builder_.find_coordinate(name) >= 0) throw labelled(expression_label(text), coordinate_in_law(name));
       else throw labelled(expression_label(text), "unknown name '" + name + "'");
     }
   }

@@ -112,9 +112,14 @@ template <class C>
 double SceneReader::positive(const C& c) const {
   double v = number(c);
   if (!(v > 0.0)) {
+    // a name or an expression is shown with its value ("got L2 = -0.4"), a number as written
+    std::string written;
     if constexpr (kInFamily<C>)
-      if (!plain_number(c.raw())) c.fail("must be positive, got " + c.raw() + " = " + shortest(v));
-    c.fail("must be positive, got " + c.text());
+      written = c.raw();
+    else
+      written = c.text();
+    if (!plain_number(written)) c.fail("must be positive, got " + written + " = " + shortest(v));
+    c.fail("must be positive, got " + written);
   }
   return v;
 }

@@ -3,6 +3,7 @@
 // output last — then the model built from them.
 #include <memory>
 
+#include "phiq/text.hpp"
 #include "scene/family_expansion.hpp"
 #include "scene/scene_reader.hpp"
 
@@ -47,7 +48,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   try {
     scene.model = std::make_unique<Model>(std::move(builder_).build());
   } catch (const Error& e) {
-    top.fail(e.what());
+    throw SceneError(single_line(file_ + ": " + e.what()));  // about the model as a whole: no one place in the file
   }
   // Models that are not square (redundant constraints, missing drivers) load: the rank analysis and the
   // minimum-norm assembly (assembly.hpp) tell what they are, and `phiq run` solves the redundant ones.

@@ -40,6 +40,9 @@ const char* const kGround = "ground";
 template <class C>
 class KindFields;
 
+// "'x' is a coordinate: a law is a function of t alone ...": the message for a coordinate in a law expression.
+std::string coordinate_in_law(const std::string& name);
+
 class SceneReader {
   template <class C>
   friend class KindFields;  // the scene vocabulary the constraint kinds read themselves with
@@ -86,7 +89,7 @@ class SceneReader {
   // ---- expressions (read_equations.cpp) -----------------------------------------------------------------------
   template <class C>
   std::shared_ptr<const CompiledExpression> compile(const C& c, bool allow_time) const;
-  NameResolver resolver(bool coordinates) const;
+  NameResolver resolver(bool coordinates, const std::string& text) const;
   std::shared_ptr<const CompiledExpression> family_expression(const TCursor& c, bool allow_time,
                                                               bool allow_coordinates) const;
 
@@ -114,6 +117,7 @@ class SceneReader {
 
   // ---- parameters, coordinates, points, bodies, vectors (read_entities.cpp) ----------------------------------
   void read_parameters(const Cursor& c);
+  [[noreturn]] void unknown_override(const Cursor& c, const std::string& name) const;
   void read_coordinates(const Cursor& c);
   template <class C, class T, class U>
   Index new_entity(const C& where, const std::string& name, NameTable<T>& table, const NameTable<U>& other);
@@ -122,6 +126,10 @@ class SceneReader {
   void read_points(const Cursor& c);
   void read_bodies(const Cursor& c);
   void read_vectors(const Cursor& c);
+  // How far from 1 a fixed frame's |e| may be and still be normalised (read_entities.cpp).
+  static constexpr double kEulerNormSlack = 1e-3;
+  template <class C>
+  void fixed_euler_parameters(const C& value, Frame3& f) const;
 
   // ---- constraints (read_constraints.cpp) ---------------------------------------------------------------------
   template <class C>
@@ -155,7 +163,7 @@ class SceneReader {
   std::pair<JointSide3, JointSide3> sides3(const C& c, const std::string& type) const;
   template <class C>
   std::pair<Attachment3, Attachment3> dot_direction(const C& c, Unit& unit) const;
-  // Adds a constraint or driver to the model, named `name` or KIND#N (below).
+  // Adds a constraint or driver to the model, named `name` or, unnamed, by its place: "drivers[2] (line 31)".
   template <class C, class Spec>
   void add(const C& c, const std::string& name, Spec spec);
 
@@ -197,7 +205,6 @@ class SceneReader {
   std::unordered_map<std::string, Joint3> joints3_;
   Families families_;
   std::function<void(std::size_t)> reserve_;  // room for that many more entries of the section being read
-  int unnamed_ = 0;
   bool predictor_field_ = false;
   std::unordered_map<std::string, MotionLaw> driver_laws_;  // named drivers, for `output: drivers`
   std::vector<std::string> residual_names_;                 // `output: residuals`, resolved after the build
@@ -209,7 +216,20 @@ class SceneReader {
 // Defined here, not in a .cpp: it is instantiated for every Spec of every constraint and driver kind.
 template <class C, class Spec>
 void SceneReader::add(const C& c, const std::string& name, Spec spec) {
-  const std::string label = name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(++unnamed_) : name;
+  // an unnamed entry is called by its place and line, which every message about it then shows
+  const std::string label = name.empty() ? c.path() + " (line " + std::to_string(c.mark().line + 1) + ")" : name;
+  bool any_coordinate = false;
+  spec.for_each_slot([&](const Slot& s, Unit) { any_coordinate = any_coordinate || s.is_coordinate(); });
+  // one that involves no coordinate nor t and is 0 (`0*x`, a joint between two coincident fixed points) holds
+  // everywhere: a redundant row the rank analysis reports, not an error
+  bool holds_everywhere = false;
+  if (!any_coordinate && !spec.depends_on_time()) {
+    double phi[Spec::kRows > 0 ? Spec::kRows : 1] = {};
+    const double no_coordinates[1] = {0.0};
+    spec.residual(no_coordinates, 0.0, phi);
+    holds_everywhere = true;
+    for (int r = 0; r < Spec::kRows; ++r) holds_everywhere = holds_everywhere && phi[r] == 0.0;
+  }
   try {
     builder_.add(label, std::move(spec));
   } catch (const Error&) {
@@ -218,6 +238,14 @@ void SceneReader::add(const C& c, const std::string& name, Spec spec) {
     if (builder_.has_constraint(label))
       c.field("name").fail("duplicate constraint or driver name '" + label + "'");
     throw;
+  }
+  // Any other equation of constants and t holds at no position (or at isolated times): said here, where its line
+  // is known, not by a factorisation library refusing the empty row of the Jacobian.
+  if (!any_coordinate && !holds_everywhere) {
+    const C expr = c.field("expr");
+    if (expr.present() && expr.is_scalar())
+      expr.fail("expression \"" + expr.text() + "\" involves no coordinate and is not zero: no position satisfies it");
+    c.fail("involves no coordinate and is not zero: no position satisfies it");
   }
 }
 

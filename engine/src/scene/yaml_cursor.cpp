@@ -6,6 +6,8 @@
 #include <set>
 #include <sstream>
 
+#include "phiq/text.hpp"
+
 namespace phiq::detail::scene {
 
 [[noreturn]] void fail_at(const std::string& file, YAML::Mark m, const std::string& path, const std::string& what) {
@@ -13,7 +15,7 @@ namespace phiq::detail::scene {
   s << file;
   if (m.line >= 0) s << ":" << m.line + 1 << ":" << m.column + 1;
   s << ": " << (path.empty() ? "(top level)" : path) << ": " << what;
-  throw SceneError(s.str());
+  throw SceneError(single_line(s.str()));  // keys and values quoted in it may hold any bytes: one line of UTF-8
 }
 
 std::string allowed_list(std::initializer_list<const char*> allowed) {

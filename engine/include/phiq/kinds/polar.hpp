@@ -65,7 +65,11 @@ struct PolarSpec {
   /// @copydoc DistanceSpec::joint_count
   JointCount joint_count() const { return JointCount::other(); }
   /// @copydoc DistanceSpec::prepare
-  void prepare(const double* /*q0*/) const { detail::require(std::isfinite(length), "polar: length is not finite"); }
+  /// A zero length is refused: the point would sit on the origin whatever θ, leaving θ undetermined.
+  void prepare(const double* /*q0*/) const {
+    detail::require(std::isfinite(length), "polar: length is not finite");
+    detail::require(length != 0.0, "polar: the length is zero (the angle would be undetermined)");
+  }
   /// @copydoc DistanceSpec::sketch
   /// A polar constraint draws its arm, o to p.
   template <class Sketch>

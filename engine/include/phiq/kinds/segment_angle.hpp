@@ -65,8 +65,10 @@ struct SegmentAngleSpec {
   /// @copydoc DistanceSpec::joint_count
   JointCount joint_count() const { return JointCount::other(); }
   /// @copydoc DistanceSpec::prepare
-  /// A segment angle has nothing to check beyond its slots.
-  void prepare(const double* /*q0*/) const {}
+  /// A segment whose ends are the same fixed point has no direction: refused.
+  void prepare(const double* /*q0*/) const {
+    detail::require(!kin::same_fixed_point(a, b), "segment_angle: the segment's two ends are the same fixed point");
+  }
   /// @copydoc DistanceSpec::sketch
   /// A segment angle draws its segment.
   template <class Sketch>
