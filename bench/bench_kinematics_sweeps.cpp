@@ -44,16 +44,20 @@ double timed_sweep(const Model& m, const SweepOptions& opt, Workspace& ws,
 // These sweeps have no callback, so the parallel one holds only the rows it reads again itself. A caller that reads
 // every row (a writer) makes it hold them all until their turn: speedup_rows_read is the same ratio with a callback
 // that reads every value of q, q̇ and q̈ on both sides (median too).
+// The 1-thread sweep runs the very chunks of the 2-thread one (the same bits on every thread count): what that costs
+// on one thread against the sweep in order (one chunk: no seeds, no seam steps, no fresh factorisation per chunk)
+// is chunking_cost_one_thread = t1 / t_in_order (median).
 void BM_NFourBarParallelSweep(benchmark::State& state) {
   const Index n = state.range(0);
   Model m = nfourbar(n, M_PI / 4, M_PI / 2);
   Model m_copy = nfourbar(n, M_PI / 4, M_PI / 2);
   Workspace ws(m), ws_copy(m_copy);
-  SweepOptions one, two;
-  one.steps = two.steps = 1000;
+  SweepOptions one, two, in_order;
+  one.steps = two.steps = in_order.steps = 1000;
   two.threads = 2;
+  in_order.chunk_steps = in_order.steps;
   double t1 = 0, t2 = 0, pair = 0, seed = 0;
-  std::vector<double> speedups, pairs, efficiencies, read_speedups;  // per iteration
+  std::vector<double> speedups, pairs, efficiencies, read_speedups, chunking_costs;  // per iteration
   double checksum = 0;
   auto read = [&](const StepView& s) {  // every value of the row, as a writer reads them
     checksum += s.q.sum() + s.qd->sum() + s.qdd->sum();
@@ -82,6 +86,7 @@ void BM_NFourBarParallelSweep(benchmark::State& state) {
     speedups.push_back(e1 / e), pairs.push_back(2.0 * e1 / ep), efficiencies.push_back((e1 / e) / (2.0 * e1 / ep));
     const double r1 = timed_sweep(m, one, ws, read, &sum);
     read_speedups.push_back(r1 / timed_sweep(m, two, ws, read, &sum));
+    chunking_costs.push_back(e1 / timed_sweep(m, in_order, ws, nullptr, &sum));
   }
   benchmark::DoNotOptimize(checksum);
   auto median = [](std::vector<double> v) {
@@ -96,6 +101,7 @@ void BM_NFourBarParallelSweep(benchmark::State& state) {
   state.counters["pair_throughput"] = median(pairs);
   state.counters["schedule_efficiency"] = median(efficiencies);
   state.counters["speedup_rows_read"] = median(read_speedups);
+  state.counters["chunking_cost_one_thread"] = median(chunking_costs);
 }
 BENCHMARK(BM_NFourBarParallelSweep)->ArgName("N")->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(9);
 

@@ -269,14 +269,12 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     ch.sum.subdivisions = good_sum.subdivisions, ch.sum.singular_positions = good_sum.singular_positions;
     ch.sum.min_rcond = good_sum.min_rcond, ch.sum.min_rcond_time = good_sum.min_rcond_time;
     add_counters(ch.sum.counters, w.counters, w0);
-    if (stream) {
-      add_counters(others, ch.sum.counters, WorkCounters{});
-      if (outcome == 0) {
-        if (ch.good == 0) {
-          outcome = 1;  // no first row: rejected, the rest runs in order
-        } else {
-          outcome = finish(ch, ch.end.q, ch.end.qd, ch.end.qdd);
-        }
+    if (stream && outcome == 0) {
+      if (ch.good == 0) {
+        outcome = 1;  // no first row: rejected, the rest runs in order
+      } else {
+        add_counters(others, ch.sum.counters, WorkCounters{});
+        outcome = finish(ch, ch.end.q, ch.end.qd, ch.end.qdd);
       }
     }
     release(held);
@@ -287,7 +285,6 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   // Accepts and delivers a chunk computed ahead: 0 delivered, 1 rejected (the rest runs in order), 2 stopped by the
   // caller, 3 failed after its first rows, which are delivered (the rest runs in order from there).
   auto deliver_chunk = [&](Chunk& ch) {
-    add_counters(others, ch.sum.counters, WorkCounters{});
     if (ch.good == 0 || !continues(ch, ch.rows[0].q.data())) return 1;
     for (Index k = ch.k0; k < ch.k0 + ch.good; ++k) {
       const Row& r = ch.rows[static_cast<std::size_t>(k - ch.k0)];
@@ -297,6 +294,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
         return 2;
       }
     }
+    add_counters(others, ch.sum.counters, WorkCounters{});
     // the state an ordered continuation starts from: the chunk's last good row (freed once delivered)
     if (!ch.ok) return finish(ch, ch.end.q, ch.end.qd, ch.end.qdd);
     Row& last = ch.rows.back();
@@ -466,10 +464,11 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   if (spare.size() > keep) spare.resize(keep);
   ws.spare_rows.swap(spare);
   if (failure) std::rethrow_exception(failure);
-  // The work counted is that of the chunks delivered or rejected (deliver_chunk) and of their seeds, and of a seed
-  // that failed next: the same for every thread count. Chunks and seeds computed ahead of a rejected chunk are
-  // left out, as they would not have been computed on fewer threads.
-  const Index seeds_counted = std::min(delivered, n_chunks - 1);
+  // The work counted is the same for every thread count: that of the chunks whose rows were delivered (a rejected
+  // chunk, or one the caller stopped, ran further when held than when streamed: not counted), and of the seeds
+  // needed to run every chunk examined (its own and the next, which ends it; a seed that failed included). Chunks
+  // and seeds computed further ahead are left out, as they would not have been computed on fewer threads.
+  const Index seeds_counted = std::min(stop ? delivered + 1 : delivered, n_chunks - 1);
   for (Index c = 1; c <= seeds_counted; ++c) add_counters(others, seed_work[static_cast<std::size_t>(c)], WorkCounters{});
   counted_end = ws.counters;  // the caller's workspace's work so far is the chunks' and seeds'
   // The caller's workspace ends at the last delivered row, as after a sequential sweep.
