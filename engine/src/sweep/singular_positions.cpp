@@ -15,6 +15,10 @@ namespace phiq::detail {
 namespace {
 constexpr int kSides = 6;              // the regular points a singular row's derivatives are extrapolated from
 constexpr double kSideOffset = 0.45;    // δ, as a fraction of the step: the sides are t ± δ, ± 2δ, ± 3δ
+// δ where the sweep starts at the singular position: its first side is reached by a least-squares assembly from the
+// singular position itself, with nothing of the motion to predict from, so it is kept as close as before the
+// sides moved out (4 sides at 5 % of the step; the start's derivatives are known the less well for it)
+constexpr double kStartSideOffset = 0.05;
 }  // namespace
 
 // Why Φq stays singular on both sides of the singular position qs at t: the model is short of drivers or
@@ -60,7 +64,7 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
   const std::string lined_up = ws_->has_factorization ? lined_up_equations() : "";
   double step = has_current_ ? t - current_.t : default_step_;
   if (step == 0.0) step = 1e-3;
-  const double d = kSideOffset * step;
+  const double d = (has_current_ ? kSideOffset : kStartSideOffset) * step;
   // Six regular points t ± δ, t ± 2δ, t ± 3δ, each predicted from the one before (the first from the last state of
   // the sweep), so the plus side is reached straight through the singular point.
   const double offset[kSides] = {-3 * d, -2 * d, -d, d, 2 * d, 3 * d};
