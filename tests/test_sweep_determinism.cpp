@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 // Everything a sweep delivers and reports but its timings and thread count, as bytes.
 struct Record {
   std::string rows;     // every delivered row's numbers, as their bytes
-  std::string summary;  // status, message, counts, warnings
+  std::string summary;  // status, message, counts, accuracy, warnings
 };
 
 void append(std::string& out, const double* v, std::size_t n) {
@@ -59,6 +59,8 @@ Record record(const Model& model, SweepOptions opt, int threads, Workspace* reus
     << c.jacobian_evaluations << ' ' << c.factorizations << ' ' << c.pivoting_factorizations << ' '
     << c.velocity_solves << ' ' << c.acceleration_solves << ' ' << c.phi_t_evaluations << ' '
     << c.gamma_evaluations << ' ' << c.point_evaluations;
+  for (const RowClassAccuracy* a : {&sum.accuracy.converged, &sum.accuracy.rounding_level, &sum.accuracy.singular})
+    o << '|' << a->rows << ' ' << a->worst_error << '@' << a->worst_time << ' ' << a->unestimated;
   for (const SweepWarning& w : sum.warnings) o << '\n' << w.t << ' ' << w.kind << ' ' << w.message;
   r.summary = o.str();
   return r;

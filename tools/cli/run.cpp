@@ -55,6 +55,19 @@ std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& /*ws*/
     j["min_rcond"] = s.min_rcond;
   else
     j["min_rcond"] = nullptr;
+  // how well q is known per class of row (SweepAccuracy): the estimated error in units of the tolerance test
+  auto row_class = [](const phiq::RowClassAccuracy& c) {
+    nlohmann::ordered_json r;
+    r["rows"] = c.rows;
+    r["worst_error"] = c.worst_error;
+    r["worst_time"] = c.worst_time;
+    r["unestimated"] = c.unestimated;
+    return r;
+  };
+  j["accuracy"] = {{"tolerance", scene.sweep.newton.tolerance},
+                   {"converged", row_class(s.accuracy.converged)},
+                   {"rounding_level", row_class(s.accuracy.rounding_level)},
+                   {"singular", row_class(s.accuracy.singular)}};
   j["warnings"] = nlohmann::ordered_json::array();
   for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});
   return json_text(j, 2) + "\n";
@@ -197,6 +210,9 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
     if (summary.min_rcond > 0)
       std::cerr << ", min rcond " << scientific(summary.min_rcond, 3) << " at t = "
                 << phiq::format_time(summary.min_rcond_time);
+    if (const phiq::RowClassAccuracy& r = summary.accuracy.rounding_level; r.rows > 0)
+      std::cerr << "; " << r.rows << " row(s) known only to " << phiq::significant(r.worst_error, 3)
+                << " tolerances (the rounding level; worst at t = " << phiq::format_time(r.worst_time) << ")";
     if (file) std::cerr << "; wrote " << printable(out_path);
     std::cerr << "\n";
   }

@@ -137,6 +137,37 @@ struct SweepWarning {
   std::string message;  ///< one line
 };
 
+/// How well the positions of one class of delivered rows are known (SweepAccuracy).
+struct RowClassAccuracy {
+  Index rows = 0;  ///< delivered rows of this class
+  /// The largest estimated error of q over those rows whose error a solve estimated, in units of the tolerance
+  /// test: max_j |δq_j| / (tol · scale_j + floor_j), so that ≤ 1 is within the tolerance
+  /// (PositionSummary::error_estimate: Newton's last step and its contraction, the rounding level at a stop there,
+  /// the predictor's error budget for a prediction taken without a step); 0 when no row has one.
+  double worst_error = 0.0;
+  double worst_time = 0.0;  ///< the first row where worst_error is reached
+  /// Rows whose error no solve estimated: a position taken on its residual alone, or interpolated between the two
+  /// sides of a singular position.
+  Index unestimated = 0;
+};
+
+/// How well q is known on the delivered rows, per class of row: each row is in exactly one class, so the three
+/// counts add up to SweepSummary::steps_completed. The same on every thread count (rows and summary alike).
+struct SweepAccuracy {
+  /// Rows whose Newton ended within the tolerance test (or whose prediction was taken within it), or stopped at a
+  /// rounding level within 2 tolerances (PositionSummary::rounding_level): q within the tolerance, worst_error ≤ 2.
+  RowClassAccuracy converged;
+  /// Rows known to more than 2 tolerances because Φ's rounding, amplified by Φq⁻¹, is larger than the tolerance
+  /// (a long chain, a badly scaled model): Newton stopped at that level (each stretch of such rows has its
+  /// slow_convergence warning), or was accepted within the level the rows before it measured
+  /// (NewtonOptions::known_to). q is known to worst_error tolerances, not to the tolerance.
+  RowClassAccuracy rounding_level;
+  /// Rows at or next to a singular position: Newton converged only linearly there (q known to about √tol, its
+  /// estimate from the contraction), or the row lies on the singular position itself (a bifurcation; q̇ and q̈ are
+  /// the branch's extrapolated limits, with their warning).
+  RowClassAccuracy singular;
+};
+
 /// What run_sweep did (Ceres-style summary).
 struct SweepSummary {
   SolveStatus status = SolveStatus::kSuccess;  ///< the outcome; kSuccess when every time point was delivered
@@ -155,6 +186,7 @@ struct SweepSummary {
   int threads = 1;                     ///< threads the drive steps ran on
   Index parallel_chunks = 0;           ///< chunks run from their seeds and accepted (0 for a sweep in order)
   double seed_seconds = 0.0;           ///< wall time of the sequential seeding pass of a sweep in chunks
+  SweepAccuracy accuracy;              ///< how well q is known on the delivered rows, per class of row
   /// One line: status, steps, iterations, factorisations, solves, point evaluations, subdivisions, warnings, time,
   /// message.
   std::string BriefReport() const;

@@ -67,15 +67,13 @@ using detail::check_workspace;
 using detail::describe_rows;
 using detail::factorize_at_q;
 using detail::factors_at_q;
+using detail::kQuietRoundingLevel;
 using detail::kUlpFloor;
 using detail::non_finite_jacobian_at;
 using detail::not_square_message;
 using detail::residual_within;
 using detail::solve_rhs;
 using detail::worst_rows;
-
-// A stop at the rounding level with q known to within this many tolerances is no slow convergence (no warning).
-constexpr double kQuietRoundingLevel = 2.0;
 
 // max_j |Δq_j| / (tol · scale_j + floor_j): ≤ 1 when the step is within the tolerance (NaN propagates as > 1).
 // With tol = 1 it is the size of the step in the tolerance-scaled norm (the floor is then negligible). `worst`,

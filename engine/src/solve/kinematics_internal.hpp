@@ -6,6 +6,10 @@
 
 namespace phiq::detail {
 
+// A stop at the rounding level with q known to within this many tolerances is no slow convergence (no warning);
+// a sweep's row known to more is counted at the rounding level (SweepAccuracy).
+constexpr double kQuietRoundingLevel = 2.0;
+
 /// How the message of a kNonFinite from a derivative that does not exist at the position begins ("Φq is not
 /// finite: ∂'c'/∂'x' = -inf, …"): the sweep then names no other cause.
 inline constexpr const char* kNonFiniteJacobian = "Φq is not finite: ";

@@ -44,6 +44,7 @@ struct Row {
   double rcond = 0.0;
   Orientation det_sign{0, 0};
   double det_sign_t = 0.0;  // where det_sign holds (Sweeper::det_sign_time())
+  RowQuality quality;       // its class and estimated error (SweepSummary::accuracy)
   std::vector<PointMotion> points;
 };
 
@@ -227,7 +228,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
         if (ch.good == 0 && !continues(ch, st.q.data())) return outcome = 1, false;
         ++ch.good;
         if (!run.deliver(k, st.q, st.qd, st.qdd, s.point_motions(), w.phi, s.rcond(), s.det_sign(),
-                         s.det_sign_time())) {
+                         s.det_sign_time(), s.row_quality())) {
           last_q = st.q, last_qd = need_v ? st.qd : last_qd, last_qdd = need_a ? st.qdd : last_qdd;
           return outcome = 2, false;
         }
@@ -235,6 +236,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
       }
       Row& r = ch.rows[static_cast<std::size_t>(ch.good)];
       r.det_sign = s.det_sign(), r.det_sign_t = s.det_sign_time();  // (the bifurcation check reads every row's)
+      r.quality = s.row_quality();  // (and the summary's accuracy)
       if (layout.keeps_vectors(ch.rows.size(), static_cast<std::size_t>(ch.good++))) {
         stream_copy(st.q, r.q);
         if (need_v) stream_copy(st.qd, r.qd);
@@ -289,7 +291,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     for (Index k = ch.k0; k < ch.k0 + ch.good; ++k) {
       const Row& r = ch.rows[static_cast<std::size_t>(k - ch.k0)];
       if (!run.deliver(k, r.q, r.qd, r.qdd, n_points ? r.points.data() : nullptr, r.phi, r.rcond, r.det_sign,
-                       r.det_sign_t)) {
+                       r.det_sign_t, r.quality)) {
         last_q = r.q, last_qd = need_v ? r.qd : last_qd, last_qdd = need_a ? r.qdd : last_qdd;  // where it stopped
         return 2;
       }

@@ -35,7 +35,7 @@ struct Run {
   // sequential and parallel sweeps report it alike.
   bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
                const PointMotion* points, const Eigen::VectorXd& phi, double rcond, Orientation det_sign,
-               double det_sign_t) {
+               double det_sign_t, const RowQuality& quality) {
     if (det_sign.sign == 0) {
       singular_since = true;
     } else if (det_sign.sign != kSignUnknown) {
@@ -58,6 +58,7 @@ struct Run {
     StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
                   points, opt.residuals ? &phi : nullptr, opt.condition ? rcond : 0.0};
     ++sum.steps_completed;
+    add_row_quality(sum.accuracy, view.t, quality);
     if (on_step && !on_step(view)) {
       sum.status = SolveStatus::kCancelled;
       sum.message = "stopped by the caller after step " + std::to_string(k);
@@ -80,7 +81,8 @@ struct Run {
       }
       sw.row_outputs();
       const State& s = sw.state();
-      if (!deliver(k, s.q, s.qd, s.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign(), sw.det_sign_time()))
+      if (!deliver(k, s.q, s.qd, s.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign(), sw.det_sign_time(),
+                   sw.row_quality()))
         return false;
     }
     return true;

@@ -115,6 +115,11 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   singular_row_ = false;
   last_rcond_ = ps.rcond;
   row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
+  // (a row accepted within NewtonOptions::known_to, the rounding level rows before it measured, is at that
+  // level too, though its own Newton did not stop there: known to its estimate, not to the tolerance)
+  row_class_ = ps.linear_convergence                                   ? RowClass::kSingular
+               : ps.slow_convergence || row_error_ > kQuietRoundingLevel ? RowClass::kRoundingLevel
+                                                                         : RowClass::kConverged;
   rounding_level_ = std::max(rounding_level_, ps.rounding_level);
   // How well the positions can be known here (NewtonOptions::known_to): the largest rounding level the rows
   // measured since the last one that converged to the tolerance (a step from a point Newton reached, not the
@@ -200,6 +205,7 @@ void Sweeper::remember(double t) {
   has_current_ = true;
   current_.t = t;
   current_error_ = row_error_;
+  current_class_ = singular_row_ ? RowClass::kSingular : row_class_;
   // The converged state moves into current_ by swaps too: ws keeps the buffers of the state before, which the
   // next step overwrites (predict() writes q, the solves q̇ and q̈). Rows are delivered from state().
   current_.q.swap(ws_->q);

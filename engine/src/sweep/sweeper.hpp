@@ -28,6 +28,23 @@ struct State {
   Eigen::VectorXd q, qd, qdd;
 };
 
+// The class of a delivered row in SweepAccuracy, and its estimated error (units of the tolerance test; infinite
+// when no solve estimated it).
+enum class RowClass { kConverged, kRoundingLevel, kSingular };
+struct RowQuality {
+  RowClass row_class = RowClass::kConverged;
+  double error = INFINITY;
+};
+// Adds a delivered row at t to the summary's accuracy.
+inline void add_row_quality(SweepAccuracy& a, double t, const RowQuality& r) {
+  RowClassAccuracy& c = r.row_class == RowClass::kConverged       ? a.converged
+                        : r.row_class == RowClass::kRoundingLevel ? a.rounding_level
+                                                                  : a.singular;
+  ++c.rows;
+  if (!std::isfinite(r.error)) ++c.unestimated;
+  else if (r.error > c.worst_error) c.worst_error = r.error, c.worst_time = t;
+}
+
 // A sign of det Φq is ±1 at a regular position and 0 at a singular one; kSignUnknown where no factorisation tells
 // it (positions only, a start accepted from its prediction).
 constexpr int kSignUnknown = 2;
@@ -169,6 +186,8 @@ class Sweeper {
 
   // The estimated error of state().q (units of the tolerance test; infinite when unknown).
   double state_error() const { return current_error_; }
+  // What the delivered row of state() says of its accuracy (SweepAccuracy): its class and estimated error.
+  RowQuality row_quality() const { return {current_class_, current_error_}; }
   // One more step to t1 for its position only (a parallel chunk's seam, compared with the next chunk's first row):
   // no derivatives, no outputs.
   bool advance_position(double t1) {
@@ -298,6 +317,8 @@ class Sweeper {
   int depth_ = 0, known_ = 0;
   double current_error_ = INFINITY;  // the estimated error of current_.q (PositionSummary::error_estimate)
   double row_error_ = INFINITY;      // that of the row being converged, until remember() makes it current
+  RowClass row_class_ = RowClass::kConverged;  // how the row being converged ended (converged())
+  RowClass current_class_ = RowClass::kConverged;  // and current_'s (remember(): singular_row_ overrides it)
   bool extrapolated_ = false;  // the last prediction moved from current_ (jumped() has something to compare)
   bool position_only_ = false;  // inside advance_position()
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
