@@ -36,8 +36,8 @@ class CsvFormat {
 
  private:
   const Model& model_;
-  std::vector<Index> columns_;
-  bool velocities_, accelerations_;
+  std::vector<Index> columns_, v_columns_, a_columns_;  // the q, q̇ and q̈ columns
+  bool velocities_, accelerations_;  // q̇ / q̈ are delivered: the points' and drivers' derivative columns too
   const OutputPlan* plan_ = nullptr;  // the other outputs, when made from an output plan
   void append_coordinates(const StepView& step, std::string& out) const;  // the q, q̇, q̈ columns
   void append_outputs(const StepView& step, std::string& out) const;      // the columns after the coordinates

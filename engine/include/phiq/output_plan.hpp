@@ -5,6 +5,8 @@
 /// plan and the model only, never the scene or the sweep's other settings.
 #pragma once
 
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +46,33 @@ struct OutputPlan {
 
   /// Coordinate indices whose columns are written, in order (a scene's default: all coordinates).
   std::vector<Index> coordinate_columns;
+  /// Coordinate indices whose q̇ (`.v`) / q̈ (`.a`) columns are written, in order, when `velocities` /
+  /// `accelerations`; unset: coordinate_columns. (q̇ and q̈ are solved whole whatever is written: one linear solve.)
+  std::optional<std::vector<Index>> velocity_columns;
+  std::optional<std::vector<Index>> acceleration_columns;  ///< see velocity_columns
+  /// The rows delivered (StepView) and written: time points k = 0, every, 2·every, … (every ≥ 1) with
+  /// window_begin ≤ t_k ≤ window_end. Every time point is still solved (the predictor extrapolates from each), so
+  /// a written row is the same bits as in a sweep that writes all; the rows not written evaluate no points, no
+  /// rcond and reach no callback.
+  Index every = 1;
+  double window_begin = -std::numeric_limits<double>::infinity();  ///< (s) see `every`
+  double window_end = std::numeric_limits<double>::infinity();     ///< (s) see `every`
+  /// Whether time point k at t is a row delivered and written (see `every`).
+  bool writes_row(Index k, double t) const { return k % every == 0 && t >= window_begin && t <= window_end; }
+  /// The q̇ / q̈ columns written: velocity_columns / acceleration_columns, else coordinate_columns; empty when
+  /// velocities / accelerations are not asked for.
+  const std::vector<Index>& written_velocities() const {
+    return !velocities ? no_columns() : velocity_columns ? *velocity_columns : coordinate_columns;
+  }
+  /// See written_velocities().
+  const std::vector<Index>& written_accelerations() const {
+    return !accelerations ? no_columns() : acceleration_columns ? *acceleration_columns : coordinate_columns;
+  }
+  /// An empty list of columns.
+  static const std::vector<Index>& no_columns() {
+    static const std::vector<Index> none;
+    return none;
+  }
   /// Drivers whose f(t) (and derivatives, with velocities / accelerations) are written.
   std::vector<OutputDriver> driver_columns;
   /// Constraints (indices into Model::constraints()) whose residual is written; needs `residuals`.

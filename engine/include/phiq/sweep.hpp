@@ -172,7 +172,9 @@ struct SweepAccuracy {
 struct SweepSummary {
   SolveStatus status = SolveStatus::kSuccess;  ///< the outcome; kSuccess when every time point was delivered
   std::string message;       ///< one line naming the step, time, cause and constraints; empty on success
-  Index steps_completed = 0; ///< rows delivered to the callback
+  /// Time points solved, in order from the first: all of them delivered to the callback, save those the output
+  /// plan does not write (OutputPlan::writes_row: `every`, the time window)
+  Index steps_completed = 0;
   Index failed_step = -1;    ///< k of the step that failed, or -1
   double failed_time = 0.0;  ///< t_k of the step that failed
   PositionSummary assembly;  ///< the initial position problem

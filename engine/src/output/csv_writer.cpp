@@ -15,6 +15,8 @@ namespace phiq {
 
 CsvFormat::CsvFormat(const Model& model, std::vector<Index> columns, bool velocities, bool accelerations)
     : model_(model), columns_(std::move(columns)), velocities_(velocities), accelerations_(accelerations) {
+  if (velocities_) v_columns_ = columns_;
+  if (accelerations_) a_columns_ = columns_;
   for (Index j : columns_)
     if (j < 0 || j >= model.num_coordinates()) throw Error("CsvFormat: column index out of range");
 }
@@ -22,6 +24,11 @@ CsvFormat::CsvFormat(const Model& model, std::vector<Index> columns, bool veloci
 CsvFormat::CsvFormat(const Model& model, const OutputPlan& plan)
     : CsvFormat(model, plan.coordinate_columns, plan.velocities, plan.accelerations) {
   plan_ = &plan;
+  v_columns_ = plan.written_velocities();
+  a_columns_ = plan.written_accelerations();
+  for (const std::vector<Index>* cs : {&v_columns_, &a_columns_})
+    for (Index j : *cs)
+      if (j < 0 || j >= model.num_coordinates()) throw Error("CsvFormat: column index out of range");
   for (Index c : plan.residual_columns)
     if (c < 0 || c >= static_cast<Index>(model_.constraints().size()))
       throw Error("CsvFormat: residual constraint index out of range");
@@ -31,10 +38,8 @@ std::vector<std::string> CsvFormat::column_names() const {
   std::vector<std::string> h{"t"};
   const auto& names = model_.coordinate_names();
   for (Index j : columns_) h.push_back(names[j]);
-  if (velocities_)
-    for (Index j : columns_) h.push_back(names[j] + ".v");
-  if (accelerations_)
-    for (Index j : columns_) h.push_back(names[j] + ".a");
+  for (Index j : v_columns_) h.push_back(names[j] + ".v");
+  for (Index j : a_columns_) h.push_back(names[j] + ".a");
   if (!plan_) return h;
   static const char* const axis[] = {"x", "y", "z"};
   for (const OutputPoint& p : plan_->points) {
@@ -130,19 +135,22 @@ void CsvFormat::append_coordinates(const StepView& s, std::string& out) const {
   if (s.q.size() != model_.num_coordinates() || (velocities_ && s.qd->size() != s.q.size()) ||
       (accelerations_ && s.qdd->size() != s.q.size()))
     throw Error("CsvFormat: step's vectors are not the model's size");
-  const double* groups[3];
-  std::size_t n_groups = 0;
-  groups[n_groups++] = s.q.data();
-  if (velocities_) groups[n_groups++] = s.qd->data();
-  if (accelerations_) groups[n_groups++] = s.qdd->data();
-  const std::size_t per = columns_.size(), total = per * n_groups;
+  // q's columns, then q̇'s, then q̈'s: group g's values are [first[g], first[g + 1]) of the row's coordinate part
+  const double* groups[3] = {s.q.data(), velocities_ ? s.qd->data() : nullptr,
+                             accelerations_ ? s.qdd->data() : nullptr};
+  const std::vector<Index>* cols[3] = {&columns_, &v_columns_, &a_columns_};
+  std::size_t first[4] = {0};
+  for (int g = 0; g < 3; ++g) first[g + 1] = first[g] + cols[g]->size();
+  const std::size_t total = first[3];
   if (total == 0) return;
-  // ",v" for values [begin, end) of the row's coordinate part (q's columns, then q̇'s, then q̈'s) from w on
+  // ",v" for values [begin, end) of the row's coordinate part from w on
   auto format = [&](std::size_t begin, std::size_t end, char* w) {
-    for (std::size_t g = begin / per, k = begin; k < end; ++g) {
+    std::size_t g = 0;
+    while (first[g + 1] <= begin) ++g;
+    for (std::size_t k = begin; k < end; ++g) {
       const double* v = groups[g];
-      const std::size_t stop = std::min(end, (g + 1) * per);
-      for (std::size_t c = k - g * per; k < stop; ++k, ++c) *w++ = ',', w = put(v[columns_[c]], w);
+      const Index* c = cols[g]->data() + (k - first[g]);
+      for (const std::size_t stop = std::min(end, first[g + 1]); k < stop; ++k) *w++ = ',', w = put(v[*c++], w);
     }
     return w;
   };

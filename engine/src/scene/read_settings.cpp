@@ -1,5 +1,8 @@
 // The sections that set how the scene is swept and what it writes (scene_reader.hpp): time, output (and the output
 // points and residuals it names), solver. They are never in families: they read plain Cursors only.
+#include <fnmatch.h>
+
+#include <cmath>
 #include <set>
 #include <unordered_map>
 
@@ -18,6 +21,35 @@ void SceneReader::read_time(const Cursor& c, TimeGrid& o) const {
     c.require("end").fail(why);  // steps that would not move time: run_sweep refuses them
 }
 
+namespace {
+bool is_pattern(const std::string& s) { return s.find_first_of("*?[") != std::string::npos; }
+}  // namespace
+
+// A list of coordinates to write: names, and shell patterns (`x1*`, `theta?`, `y[0-9]`) that select every
+// coordinate whose name matches, in scene order. A name listed twice is refused; a coordinate a pattern selects
+// again is not repeated; a pattern that selects nothing is refused (a misspelt pattern would write nothing).
+std::vector<Index> SceneReader::coordinate_selection(const Cursor& list) const {
+  std::vector<Index> out;
+  std::set<Index> seen;
+  for (const Cursor& i : list.items()) {
+    const std::string text = i.text();
+    if (!is_pattern(text)) {
+      const Index j = coordinate(i);
+      if (!seen.insert(j).second) i.fail("coordinate listed twice");
+      out.push_back(j);
+      continue;
+    }
+    bool any = false;
+    for (Index j = 0; j < builder_.num_coordinates(); ++j) {
+      if (fnmatch(text.c_str(), builder_.coordinate_name(j).c_str(), 0) != 0) continue;
+      any = true;
+      if (seen.insert(j).second) out.push_back(j);
+    }
+    if (!any) i.fail("pattern '" + text + "' selects no coordinate");
+  }
+  return out;
+}
+
 // The output list, and from it the sweep's plan: derivatives, points, residuals and the condition estimate are
 // computed only when listed here (models/README.md, `output`).
 void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
@@ -25,17 +57,30 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
   bool coordinates_listed = false;
   if (c.present()) {
     c.expect_map({"velocities", "accelerations", "coordinates", "points", "drivers", "residuals", "max_residual",
-                  "rcond"});
-    if (auto v = c.field("velocities"); v.present()) plan.velocities = v.boolean();
-    if (auto a = c.field("accelerations"); a.present()) plan.accelerations = a.boolean();
+                  "rcond", "every", "window"});
+    // true / false, or the coordinates whose derivative is written (q̇ or q̈ is solved whole either way)
+    auto derivative = [&](const char* key, bool& asked, std::optional<std::vector<Index>>& columns) {
+      const Cursor d = c.field(key);
+      if (!d.present()) return;
+      if (d.is_sequence()) {
+        columns = coordinate_selection(d);
+        asked = true;
+      } else {
+        asked = d.boolean();
+      }
+    };
+    derivative("velocities", plan.velocities, plan.velocity_columns);
+    derivative("accelerations", plan.accelerations, plan.acceleration_columns);
     if (auto cs = c.field("coordinates"); cs.present()) {
       coordinates_listed = true;
-      std::set<Index> seen;
-      for (const Cursor& i : cs.items()) {
-        Index j = coordinate(i);
-        if (!seen.insert(j).second) i.fail("coordinate listed twice");
-        plan.coordinate_columns.push_back(j);
-      }
+      plan.coordinate_columns = coordinate_selection(cs);
+    }
+    if (auto e = c.field("every"); e.present()) plan.every = static_cast<Index>(e.integer(1, 1000000000));
+    if (auto w = c.field("window"); w.present()) {
+      if (!w.is_sequence() || w.size() != 2) w.fail("must be [begin, end] (s)");
+      plan.window_begin = number(w.at(0));
+      plan.window_end = number(w.at(1));
+      if (!(plan.window_begin <= plan.window_end)) w.fail("begin must not be above end");
     }
     if (auto ps = c.field("points"); ps.present()) {
       std::set<std::string> seen;

@@ -178,6 +178,7 @@ class SceneReader {
   // ---- time, output, solver (read_settings.cpp) ---------------------------------------------------------------
   void read_time(const Cursor& c, TimeGrid& o) const;
   void read_output(const Cursor& c, OutputPlan& plan);
+  std::vector<Index> coordinate_selection(const Cursor& list) const;
   OutputPoint output_point(const Cursor& c) const;
   void resolve_output_residuals(Scene& scene) const;
   void read_solver(const Cursor& c, SolverSettings& o);

@@ -218,12 +218,12 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     SweepSummary good_sum;
     auto keep = [&] {  // false: stop the chunk (streaming: rejected or stopped by the caller)
       const State& st = s.state();
-      s.row_outputs();
+      const Index k = ch.k0 + ch.good;
+      s.row_outputs(k);
       if (ch.good == 0) ch.first_rounding = std::max(s.take_rounding_level(), ch.first_rounding);
       good_sum.warnings = ch.sum.warnings, good_sum.subdivisions = ch.sum.subdivisions;
       good_sum.singular_positions = ch.sum.singular_positions;
       good_sum.min_rcond = ch.sum.min_rcond, good_sum.min_rcond_time = ch.sum.min_rcond_time;
-      const Index k = ch.k0 + ch.good;
       if (stream) {
         if (ch.good == 0 && !continues(ch, st.q.data())) return outcome = 1, false;
         ++ch.good;

@@ -87,7 +87,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     run.failed(0);
     return done(sum.status);
   }
-  sw.row_outputs();
+  sw.row_outputs(0);
   if (!run.deliver(0, sw.state().q, sw.state().qd, sw.state().qdd, sw.point_motions(), ws.phi, sw.rcond(),
                    sw.det_sign(), sw.det_sign_time(), sw.row_quality())) {
     sw.leave_state_in_workspace();

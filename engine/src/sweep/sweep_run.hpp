@@ -55,6 +55,11 @@ struct Run {
       last_sign_t = det_sign_t;
       singular_since = false;
     }
+    if (!opt.writes_row(k, time_of(k))) {  // solved, not written (OutputPlan::every, window)
+      ++sum.steps_completed;
+      add_row_quality(sum.accuracy, time_of(k), quality);
+      return true;
+    }
     StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
                   points, opt.residuals ? &phi : nullptr, opt.condition ? rcond : 0.0};
     ++sum.steps_completed;
@@ -79,7 +84,7 @@ struct Run {
         failed(k);
         return false;
       }
-      sw.row_outputs();
+      sw.row_outputs(k);
       const State& s = sw.state();
       if (!deliver(k, s.q, s.qd, s.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign(), sw.det_sign_time(),
                    sw.row_quality()))

@@ -106,16 +106,20 @@ class Sweeper {
     return true;
   }
 
-  // The outputs of a delivered row beyond q, q̇, q̈, from the converged state in ws: the listed points' motions
-  // (counted) and the condition estimate (Φ is ws.phi already). Only delivered rows pay for them: sub-steps and
-  // the seam steps of parallel chunks do not.
-  void row_outputs() {
-    const double* qd = need_v_ ? current_.qd.data() : nullptr;
-    const double* qdd = need_a_ ? current_.qdd.data() : nullptr;
-    for (std::size_t i = 0; i < opt_.points.size(); ++i)
-      points_[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
-    ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
-    rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
+  // The outputs of time point k beyond q, q̇, q̈, from the converged state in ws: the listed points' motions
+  // (counted) and the condition estimate (Φ is ws.phi already), for a row the output plan writes
+  // (OutputPlan::writes_row); the orientation of Φq for every time point (the bifurcation check between rows).
+  // Only written rows pay for the outputs: sub-steps, the seam steps of parallel chunks and the rows between
+  // written ones do not.
+  void row_outputs(Index k) {
+    if (opt_.writes_row(k, current_.t)) {
+      const double* qd = need_v_ ? current_.qd.data() : nullptr;
+      const double* qdd = need_a_ ? current_.qdd.data() : nullptr;
+      for (std::size_t i = 0; i < opt_.points.size(); ++i)
+        points_[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
+      ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
+      rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
+    }
     det_sign_ = current_row_sign_;
     det_sign_t_ = current_row_sign_t_;
   }
