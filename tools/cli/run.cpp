@@ -1,5 +1,6 @@
-// `phiq run SCENE [-o OUT.csv]`: the scene's sweep of positions, velocities and accelerations as CSV, with its
-// summary (stderr, --summary JSON). The CSV goes to its file, or to standard output once the sweep succeeded.
+// `phiq run SCENE [-o OUT.csv|OUT.h5]`: the scene's sweep of positions, velocities and accelerations as CSV or HDF5
+// (result_file.hpp), with its summary (stderr, --summary JSON). The CSV goes to its file, or to standard output
+// once the sweep succeeded; HDF5 goes to a file only.
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "command_support.hpp"
 #include "commands.hpp"
 #include "progress_bar.hpp"
+#include "result_file.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -60,13 +62,15 @@ std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& /*ws*/
   return json_text(j, 2) + "\n";
 }
 
-int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
-            int threads, double memory_gb, ProgressBar::Mode progress_mode) {
+int cmd_run(const std::string& scene_path, const std::string& out_path, const std::string& format, bool quiet,
+            const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode) {
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
   if (!out_path.empty()) outs.push_back({"-o", out_path});
   if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
   if (const auto clash = output_clash(outs, {{"the scene", scene_path}})) return fail("run: " + *clash, 2);
+  const bool hdf5 = result_format(format, out_path) == ResultFormat::kHdf5;
+  if (hdf5 && out_path.empty()) return fail("run: --format hdf5 needs -o FILE: HDF5 is not written to standard output", 2);
   if (out_path.empty() && stdout_was_closed())
     return fail("run: standard output: cannot write: it is closed", 3);
   set_interrupt_subject(scene_path, "; no output written");
@@ -82,7 +86,11 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   phiq::AtomicOutputFile* file = nullptr;
   phiq::AtomicOutputFile* summary_file = nullptr;
   try {
-    if (!out_path.empty()) file = &outputs.add(out_path);
+    if (hdf5) check_hdf5_target(out_path);
+    // HDF5 opens its file by name, and its name must be a real path (not /proc/self/fd/N): a named temporary
+    if (!out_path.empty())
+      file = &outputs.add(out_path, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
+                                         : phiq::AtomicOutputFile::Hold::kOpen);
     if (!summary_path.empty()) summary_file = &outputs.add(summary_path);
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
@@ -101,11 +109,17 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   // columns from the scene's output plan and model (its constraints); residuals of a model solved on its
   // independent rows are evaluated on the whole scene model (CsvFormat)
   phiq::CsvFormat csv(*scene.model, scene.sweep);
+  std::unique_ptr<phiq::Hdf5Writer> h5;  // after `outputs`: closed before its temporary is removed
+  try {
+    if (hdf5) h5 = open_hdf5_results(*file, scene);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
 
   // Where the CSV goes: the output file, or standard output after success, spooled through an anonymous temporary
   // file so that memory stays bounded however long the sweep is.
   std::FILE* spool = nullptr;
-  std::string buffer = csv.header();
+  std::string buffer = h5 ? "" : csv.header();
   if (!file && !(spool = std::tmpfile())) return fail("cannot create a temporary file for standard output", 3);
   struct CloseSpool {
     std::FILE* f;
@@ -129,8 +143,12 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
     const std::atomic<bool>& stop = stop_flag();
     phiq::run_sweep(model, scene.sweep, ws, [&](const phiq::StepView& step) {
       const auto w0 = Clock::now();
-      csv.append_row(step, buffer);
-      if (buffer.size() > (1u << 20)) flush();
+      if (h5) {
+        h5->append_row(step);
+      } else {
+        csv.append_row(step, buffer);
+        if (buffer.size() > (1u << 20)) flush();
+      }
       progress.update(step.step + 1);
       write_s += since(w0);
       return !stop.load();
@@ -167,6 +185,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   const double solve_s = summary.solve_seconds - write_s;
   const auto final_write = Clock::now();
   try {
+    if (h5) h5->close();
     flush();
     if (file) {
       file->finish();
@@ -207,7 +226,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
 
 Command register_run(CLI::App& app) {
   struct Args {
-    std::string scene_path, out_path, summary_path;
+    std::string scene_path, out_path, summary_path, format;
     bool quiet = false;
     int threads = 0;
     double memory_gb = 0.0;
@@ -216,8 +235,12 @@ Command register_run(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
   run->add_option("scene", a->scene_path, "Scene file (YAML)")->required();
-  run->add_option("-o,--output", a->out_path, "CSV file to write (default or '-': standard output)")
+  run->add_option("-o,--output", a->out_path,
+                  "Results file to write, CSV or HDF5 (--format; default or '-': CSV on standard output)")
       ->transform(output_path(" (without the option, or '-': standard output)", true));
+  run->add_option("--format", a->format,
+                  "Results format: csv or hdf5 (default: hdf5 for an output ending in .h5 or .hdf5, else csv)")
+      ->check(one_of({"csv", "hdf5"}));
   run->add_flag("-q,--quiet", a->quiet, "Do not print the run summary on standard error");
   run->add_option("--summary", a->summary_path,
                   "Write the run summary as JSON (counts and timings) to this file ('-': standard output)")
@@ -237,7 +260,7 @@ Command register_run(CLI::App& app) {
   return {run, [a] {
             using Mode = ProgressBar::Mode;
             const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
-            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->quiet, a->summary_path,
+            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->quiet, a->summary_path,
                                                cap_threads("run", a->threads, a->quiet), a->memory_gb, mode));
           }};
 }
