@@ -38,6 +38,13 @@ TEST_F(Cli, Hdf5ResultsEqualTheCsvOfTheSameRun) {
     EXPECT_EQ(c.code, 0) << c.err;
     EXPECT_NE(c.err.find("agree: 73 rows x 30 columns (identical)"), std::string::npos) << c.err;
   }
+  // compressed: the same doubles
+  ASSERT_EQ(run("run -q --deflate 6 " + scene.string() + " -o " + (dir_ / "z.h5").string()).code, 0);
+  EXPECT_EQ(run("compare --rtol 0 --atol 0 " + (dir_ / "z.h5").string() + " " + csv.string()).code, 0);
+  Result z = run("run -q --deflate 6 " + scene.string() + " -o " + (dir_ / "z.csv").string());
+  EXPECT_EQ(z.code, 2);
+  EXPECT_TRUE(one_phiq_line(z.err)) << z.err;
+  EXPECT_NE(z.err.find("--deflate compresses HDF5 results only"), std::string::npos) << z.err;
   ASSERT_EQ(run("run -q --format hdf5 " + scene.string() + " -o " + other.string()).code, 0);
   EXPECT_TRUE(phiq::is_hdf5_file(other.string()));
   ASSERT_EQ(run("run -q --format csv " + scene.string() + " -o " + text.string()).code, 0);
@@ -50,7 +57,7 @@ TEST_F(Cli, Hdf5ResultsEqualTheCsvOfTheSameRun) {
   EXPECT_EQ(d.code, 1) << d.err;
   EXPECT_NE(d.err.find("row counts differ: A has 73 rows, B has 72"), std::string::npos) << d.err;
   EXPECT_EQ(files(), (Names{"fb.yaml", "r.csv", "r.data", "r.h5", "s.h5", "s.json", "short.yaml", "stderr.txt",
-                            "stdout.txt", "t.h5"}));
+                            "stdout.txt", "t.h5", "z.h5"}));
 }
 
 // HDF5 needs a file: without -o, or to a FIFO, it is refused before the solve with one line, and nothing appears.
@@ -116,7 +123,7 @@ time: {start: 0, end: 1, steps: 10}
   EXPECT_NE(r.err.find("no output written"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(keep), before);
 
-  // interrupted in the middle of a sweep of minutes, with blocks of rows already written to the temporary
+  // interrupted in the middle of a sweep of minutes
   std::string long_scene = slurp(phiq::test::model_path("seed/crank_slider_mixed.yaml"));
   long_scene.replace(long_scene.find("steps: 180"), 10, "steps: 10000000");
   const fs::path slow = write("long.yaml", long_scene);

@@ -27,7 +27,8 @@ void check_hdf5_target(const std::string& path) {
                       "wrote (write to a file, or use --format csv)");
 }
 
-std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile& file, const phiq::Scene& scene) {
+std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile& file, const phiq::Scene& scene,
+                                                    int deflate) {
   if (file.direct() || file.temporary_path().empty())
     throw phiq::Error(file.path() + ": cannot write: HDF5 needs a named temporary file (phiq bug)");
   phiq::Hdf5Options o;
@@ -35,6 +36,8 @@ std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile
   o.scene_text = scene.text;
   o.expected_rows = static_cast<std::size_t>(scene.sweep.steps) + 1;
   o.shown_path = file.path();
+  o.deflate = deflate;
+  o.shuffle = deflate > 0;  // the doubles' exponent bytes together: bench/README.md, "Writing HDF5"
   return std::make_unique<phiq::Hdf5Writer>(file.temporary_path(), *scene.model, scene.sweep, o);
 }
 

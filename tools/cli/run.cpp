@@ -62,7 +62,7 @@ std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& /*ws*/
   return json_text(j, 2) + "\n";
 }
 
-int cmd_run(const std::string& scene_path, const std::string& out_path, const std::string& format, bool quiet,
+int cmd_run(const std::string& scene_path, const std::string& out_path, const std::string& format, int deflate, bool quiet,
             const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode) {
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
@@ -70,6 +70,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, const st
   if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
   if (const auto clash = output_clash(outs, {{"the scene", scene_path}})) return fail("run: " + *clash, 2);
   const bool hdf5 = result_format(format, out_path) == ResultFormat::kHdf5;
+  if (deflate > 0 && !hdf5) return fail("run: --deflate compresses HDF5 results only (-o FILE.h5 or --format hdf5)", 2);
   if (hdf5 && out_path.empty()) return fail("run: --format hdf5 needs -o FILE: HDF5 is not written to standard output", 2);
   if (out_path.empty() && stdout_was_closed())
     return fail("run: standard output: cannot write: it is closed", 3);
@@ -111,7 +112,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, const st
   phiq::CsvFormat csv(*scene.model, scene.sweep);
   std::unique_ptr<phiq::Hdf5Writer> h5;  // after `outputs`: closed before its temporary is removed
   try {
-    if (hdf5) h5 = open_hdf5_results(*file, scene);
+    if (hdf5) h5 = open_hdf5_results(*file, scene, deflate);
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
   }
@@ -231,6 +232,7 @@ Command register_run(CLI::App& app) {
     int threads = 0;
     double memory_gb = 0.0;
     std::string progress = "auto";
+    int deflate = 0;
   };
   auto a = std::make_shared<Args>();
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
@@ -241,6 +243,11 @@ Command register_run(CLI::App& app) {
   run->add_option("--format", a->format,
                   "Results format: csv or hdf5 (default: hdf5 for an output ending in .h5 or .hdf5, else csv)")
       ->check(one_of({"csv", "hdf5"}));
+  run->add_option("--deflate", a->deflate,
+                  "HDF5: shuffle and deflate (gzip) every dataset at this level, 1-9 (0: uncompressed; bench/README.md: "
+                  "it costs more time than it saves on a fast disk)")
+      ->capture_default_str()
+      ->check(whole_number(0, 9, "uncompressed"));
   run->add_flag("-q,--quiet", a->quiet, "Do not print the run summary on standard error");
   run->add_option("--summary", a->summary_path,
                   "Write the run summary as JSON (counts and timings) to this file ('-': standard output)")
@@ -260,7 +267,7 @@ Command register_run(CLI::App& app) {
   return {run, [a] {
             using Mode = ProgressBar::Mode;
             const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
-            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->quiet, a->summary_path,
+            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet, a->summary_path,
                                                cap_threads("run", a->threads, a->quiet), a->memory_gb, mode));
           }};
 }
