@@ -42,7 +42,8 @@ Command register_compare(CLI::App& app) {
     CompareOptions options;
   };
   auto a = std::make_shared<Args>();
-  CLI::App* compare = app.add_subcommand("compare", "Compare two result files (CSV or HDF5) column by column within tolerances");
+  CLI::App* compare =
+      app.add_subcommand("compare", "Compare two result files (CSV or HDF5) column by column within tolerances");
   compare->add_option("a", a->a, "First results file, CSV or HDF5 (e.g. the reference)")->required();
   compare->add_option("b", a->b, "Second results file, CSV or HDF5")->required();
   const CLI::Validator tolerance = number(0.0, HUGE_VAL, true, "a number >= 0 (inf: any difference)");

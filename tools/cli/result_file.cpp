@@ -1,23 +1,13 @@
 #include "result_file.hpp"
 
-#include <cctype>
+#include "phiq/hdf5_reader.hpp"
 
 namespace phiq::tools {
-
-namespace {
-bool ends_with_nocase(const std::string& s, const std::string& suffix) {
-  if (s.size() < suffix.size()) return false;
-  for (std::size_t i = 0; i < suffix.size(); ++i)
-    if (std::tolower(static_cast<unsigned char>(s[s.size() - suffix.size() + i])) != suffix[i]) return false;
-  return true;
-}
-}  // namespace
 
 ResultFormat result_format(const std::string& option, const std::string& out_path) {
   if (option == "hdf5") return ResultFormat::kHdf5;
   if (option == "csv") return ResultFormat::kCsv;
-  return ends_with_nocase(out_path, ".h5") || ends_with_nocase(out_path, ".hdf5") ? ResultFormat::kHdf5
-                                                                                    : ResultFormat::kCsv;
+  return phiq::has_hdf5_extension(out_path) ? ResultFormat::kHdf5 : ResultFormat::kCsv;
 }
 
 void check_hdf5_target(const std::string& path) {

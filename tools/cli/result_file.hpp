@@ -24,8 +24,9 @@ ResultFormat result_format(const std::string& option, const std::string& out_pat
 // (resolve_output_path: direct): HDF5 seeks and reads back what it wrote. Also resolve_output_path's errors.
 void check_hdf5_target(const std::string& path);
 
-// An Hdf5Writer on the named temporary of `file` (added with Hold::kClosedBetweenWrites, not direct), with the scene's path and text as attributes and chunks
-// sized for its steps + 1 rows; `deflate` > 0: shuffle and deflate at that level. Its errors name file.path().
+// An Hdf5Writer on the named temporary of `file` (added with Hold::kClosedBetweenWrites, not direct), with the
+// scene's path and text as attributes and chunks sized for its steps + 1 rows; `deflate` > 0: shuffle and deflate at
+// that level. Its errors name file.path().
 // Throws phiq::Error "PATH: cannot write: REASON".
 std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile& file, const phiq::Scene& scene,
                                                     int deflate = 0);

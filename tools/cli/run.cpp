@@ -62,16 +62,19 @@ std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& /*ws*/
   return json_text(j, 2) + "\n";
 }
 
-int cmd_run(const std::string& scene_path, const std::string& out_path, const std::string& format, int deflate, bool quiet,
-            const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode) {
+int cmd_run(const std::string& scene_path, const std::string& out_path, const std::string& format, int deflate,
+            bool quiet, const std::string& summary_path, int threads, double memory_gb,
+            ProgressBar::Mode progress_mode) {
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
   if (!out_path.empty()) outs.push_back({"-o", out_path});
   if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
   if (const auto clash = output_clash(outs, {{"the scene", scene_path}})) return fail("run: " + *clash, 2);
   const bool hdf5 = result_format(format, out_path) == ResultFormat::kHdf5;
-  if (deflate > 0 && !hdf5) return fail("run: --deflate compresses HDF5 results only (-o FILE.h5 or --format hdf5)", 2);
-  if (hdf5 && out_path.empty()) return fail("run: --format hdf5 needs -o FILE: HDF5 is not written to standard output", 2);
+  if (deflate > 0 && !hdf5)
+    return fail("run: --deflate compresses HDF5 results only (-o FILE.h5 or --format hdf5)", 2);
+  if (hdf5 && out_path.empty())
+    return fail("run: --format hdf5 needs -o FILE: HDF5 is not written to standard output", 2);
   if (out_path.empty() && stdout_was_closed())
     return fail("run: standard output: cannot write: it is closed", 3);
   set_interrupt_subject(scene_path, "; no output written");

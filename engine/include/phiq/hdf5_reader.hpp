@@ -9,6 +9,9 @@
 
 namespace phiq {
 
+/// True when `path` ends in `.h5` or `.hdf5`, in any case: the names phiq reads and writes as HDF5.
+bool has_hdf5_extension(const std::string& path);
+
 /// True when the file at `path` begins with the HDF5 signature (\\x89 H D F \\r \\n \\x1a \\n). False for a file that
 /// cannot be read or is shorter.
 bool is_hdf5_file(const std::string& path);

@@ -1,5 +1,6 @@
 #include "phiq/hdf5_reader.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -55,6 +56,8 @@ Block read_block(hid_t file, const char* name, const std::string& path) {
 
 }  // namespace
 
+bool has_hdf5_extension(const std::string& path) { return ends_with(path, ".h5") || ends_with(path, ".hdf5"); }
+
 bool is_hdf5_file(const std::string& path) {
   static const unsigned char kSignature[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
@@ -101,7 +104,8 @@ CsvTable read_hdf5_table(const std::string& path) {
   std::unordered_map<std::string, std::size_t> seen;
   for (const Block& b : blocks)
     for (const std::string& c : b.columns) {
-      if (c.empty()) throw Error(path + ": empty column name (column " + std::to_string(table.columns.size() + 1) + ")");
+      if (c.empty())
+        throw Error(path + ": empty column name (column " + std::to_string(table.columns.size() + 1) + ")");
       if (!seen.emplace(c, table.columns.size() + 1).second)
         throw Error(path + ": duplicate column name '" + c + "'");
       table.columns.push_back(c);
@@ -121,7 +125,7 @@ CsvTable read_hdf5_table(const std::string& path) {
 }
 
 CsvTable read_result_table(const std::string& path) {
-  if (is_hdf5_file(path) || ends_with(path, ".h5") || ends_with(path, ".hdf5")) return read_hdf5_table(path);
+  if (is_hdf5_file(path) || has_hdf5_extension(path)) return read_hdf5_table(path);
   return read_csv_table(path);
 }
 

@@ -121,7 +121,8 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   output_row.resize(format.num_output_values());
 
   block_rows = choose_block_rows(names.size() * sizeof(double), o);
-  if (o.deflate < 0 || o.deflate > 9) throw Error(cannot("deflate level " + std::to_string(o.deflate) + " is not 0–9"));
+  if (o.deflate < 0 || o.deflate > 9)
+    throw Error(cannot("deflate level " + std::to_string(o.deflate) + " is not 0–9"));
   if (o.deflate > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0) throw Error(cannot("HDF5 has no deflate filter"));
 
   const Hid fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, cannot("file access list"));
@@ -131,7 +132,8 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   // No advisory lock: the file is the caller's own (the CLI writes a temporary nobody else knows), and file
   // systems without flock (some NFS mounts) would refuse it.
   check(H5Pset_file_locking(fapl.get(), false, true), cannot("file locking"));
-  file = checked(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose, path + ": cannot write");
+  file = checked(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
+                 path + ": cannot write");
   const std::string attrs = cannot("attributes");
   try {
     write_attribute(file.get(), "format", std::string("phiq results"));
