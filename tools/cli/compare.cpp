@@ -1,5 +1,5 @@
-// `phiq compare A.csv B.csv`: two result CSVs compared column by column within tolerances (phiq/csv_compare.hpp);
-// exit 1 when they differ.
+// `phiq compare A B`: two result files, CSV or HDF5 on either side (phiq/hdf5_reader.hpp), compared column by column
+// within tolerances (phiq/csv_compare.hpp); exit 1 when they differ.
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -8,6 +8,7 @@
 #include "command_support.hpp"
 #include "commands.hpp"
 #include "phiq/csv_compare.hpp"
+#include "phiq/hdf5_reader.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -17,7 +18,7 @@ namespace {
 int cmd_compare(const std::string& a_path, const std::string& b_path, const phiq::CompareOptions& options) {
   phiq::CompareResult r;
   try {
-    const phiq::CsvTable a = phiq::read_csv_table(a_path), b = phiq::read_csv_table(b_path);
+    const phiq::CsvTable a = phiq::read_result_table(a_path), b = phiq::read_result_table(b_path);
     try {
       r = phiq::compare_csv(a, b, options);
     } catch (const phiq::Error& e) {  // a --columns name not in a file: a command-line error names its option
@@ -41,9 +42,10 @@ Command register_compare(CLI::App& app) {
     CompareOptions options;
   };
   auto a = std::make_shared<Args>();
-  CLI::App* compare = app.add_subcommand("compare", "Compare two result CSVs column by column within tolerances");
-  compare->add_option("a", a->a, "First CSV (e.g. the reference)")->required();
-  compare->add_option("b", a->b, "Second CSV")->required();
+  CLI::App* compare =
+      app.add_subcommand("compare", "Compare two result files (CSV or HDF5) column by column within tolerances");
+  compare->add_option("a", a->a, "First results file, CSV or HDF5 (e.g. the reference)")->required();
+  compare->add_option("b", a->b, "Second results file, CSV or HDF5")->required();
   const CLI::Validator tolerance = number(0.0, HUGE_VAL, true, "a number >= 0 (inf: any difference)");
   compare->add_option("--rtol", a->options.rtol, "Relative tolerance: |a-b| <= atol + rtol*max(|a|,|b|)")
       ->capture_default_str()

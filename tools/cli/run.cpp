@@ -1,5 +1,6 @@
-// `phiq run SCENE [-o OUT.csv]`: the scene's sweep of positions, velocities and accelerations as CSV, with its
-// summary (stderr, --summary JSON). The CSV goes to its file, or to standard output once the sweep succeeded.
+// `phiq run SCENE [-o OUT.csv|OUT.h5]`: the scene's sweep of positions, velocities and accelerations as CSV or HDF5
+// (result_file.hpp), with its summary (stderr, --summary JSON). The CSV goes to its file, or to standard output
+// once the sweep succeeded; HDF5 goes to a file only.
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -14,6 +15,7 @@
 #include "command_support.hpp"
 #include "commands.hpp"
 #include "progress_bar.hpp"
+#include "result_file.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -73,13 +75,19 @@ std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& /*ws*/
   return json_text(j, 2) + "\n";
 }
 
-int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
-            int threads, double memory_gb, ProgressBar::Mode progress_mode) {
+int cmd_run(const std::string& scene_path, const std::string& out_path, const std::string& format, int deflate,
+            bool quiet, const std::string& summary_path, int threads, double memory_gb,
+            ProgressBar::Mode progress_mode) {
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
   if (!out_path.empty()) outs.push_back({"-o", out_path});
   if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
   if (const auto clash = output_clash(outs, {{"the scene", scene_path}})) return fail("run: " + *clash, 2);
+  const bool hdf5 = result_format(format, out_path) == ResultFormat::kHdf5;
+  if (deflate > 0 && !hdf5)
+    return fail("run: --deflate compresses HDF5 results only (-o FILE.h5 or --format hdf5)", 2);
+  if (hdf5 && out_path.empty())
+    return fail("run: --format hdf5 needs -o FILE: HDF5 is not written to standard output", 2);
   if (out_path.empty() && stdout_was_closed())
     return fail("run: standard output: cannot write: it is closed", 3);
   set_interrupt_subject(scene_path, "; no output written");
@@ -95,7 +103,11 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   phiq::AtomicOutputFile* file = nullptr;
   phiq::AtomicOutputFile* summary_file = nullptr;
   try {
-    if (!out_path.empty()) file = &outputs.add(out_path);
+    if (hdf5) check_hdf5_target(out_path);
+    // HDF5 opens its file by name, and its name must be a real path (not /proc/self/fd/N): a named temporary
+    if (!out_path.empty())
+      file = &outputs.add(out_path, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
+                                         : phiq::AtomicOutputFile::Hold::kOpen);
     if (!summary_path.empty()) summary_file = &outputs.add(summary_path);
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
@@ -114,11 +126,17 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   // columns from the scene's output plan and model (its constraints); residuals of a model solved on its
   // independent rows are evaluated on the whole scene model (CsvFormat)
   phiq::CsvFormat csv(*scene.model, scene.sweep);
+  std::unique_ptr<phiq::Hdf5Writer> h5;  // after `outputs`: closed before its temporary is removed
+  try {
+    if (hdf5) h5 = open_hdf5_results(*file, scene, deflate);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
 
   // Where the CSV goes: the output file, or standard output after success, spooled through an anonymous temporary
   // file so that memory stays bounded however long the sweep is.
   std::FILE* spool = nullptr;
-  std::string buffer = csv.header();
+  std::string buffer = h5 ? "" : csv.header();
   if (!file && !(spool = std::tmpfile())) return fail("cannot create a temporary file for standard output", 3);
   struct CloseSpool {
     std::FILE* f;
@@ -142,8 +160,12 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
     const std::atomic<bool>& stop = stop_flag();
     phiq::run_sweep(model, scene.sweep, ws, [&](const phiq::StepView& step) {
       const auto w0 = Clock::now();
-      csv.append_row(step, buffer);
-      if (buffer.size() > (1u << 20)) flush();
+      if (h5) {
+        h5->append_row(step);
+      } else {
+        csv.append_row(step, buffer);
+        if (buffer.size() > (1u << 20)) flush();
+      }
       progress.update(step.step + 1);
       write_s += since(w0);
       return !stop.load();
@@ -180,6 +202,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   const double solve_s = summary.solve_seconds - write_s;
   const auto final_write = Clock::now();
   try {
+    if (h5) h5->close();
     flush();
     if (file) {
       file->finish();
@@ -223,17 +246,27 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
 
 Command register_run(CLI::App& app) {
   struct Args {
-    std::string scene_path, out_path, summary_path;
+    std::string scene_path, out_path, summary_path, format;
     bool quiet = false;
     int threads = 0;
     double memory_gb = 0.0;
     std::string progress = "auto";
+    int deflate = 0;
   };
   auto a = std::make_shared<Args>();
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
   run->add_option("scene", a->scene_path, "Scene file (YAML)")->required();
-  run->add_option("-o,--output", a->out_path, "CSV file to write (default or '-': standard output)")
+  run->add_option("-o,--output", a->out_path,
+                  "Results file to write, CSV or HDF5 (--format; default or '-': CSV on standard output)")
       ->transform(output_path(" (without the option, or '-': standard output)", true));
+  run->add_option("--format", a->format,
+                  "Results format: csv or hdf5 (default: hdf5 for an output ending in .h5 or .hdf5, else csv)")
+      ->check(one_of({"csv", "hdf5"}));
+  run->add_option("--deflate", a->deflate,
+                  "HDF5: shuffle and deflate (gzip) every dataset at this level, 1-9 (0: uncompressed; bench/README.md: "
+                  "it costs more time than it saves on a fast disk)")
+      ->capture_default_str()
+      ->check(whole_number(0, 9, "uncompressed"));
   run->add_flag("-q,--quiet", a->quiet, "Do not print the run summary on standard error");
   run->add_option("--summary", a->summary_path,
                   "Write the run summary as JSON (counts and timings) to this file ('-': standard output)")
@@ -253,7 +286,7 @@ Command register_run(CLI::App& app) {
   return {run, [a] {
             using Mode = ProgressBar::Mode;
             const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
-            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->quiet, a->summary_path,
+            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet, a->summary_path,
                                                cap_threads("run", a->threads, a->quiet), a->memory_gb, mode));
           }};
 }

@@ -33,6 +33,11 @@ class CsvFormat {
   /// (throws phiq::Error otherwise, or when its vectors are not the model's size). A wide row (more than 1 024
   /// coordinate values) is formatted in parallel by the current task arena's threads: `phiq run --threads 1` is one.
   void append_row(const StepView& step, std::string& out) const;
+  /// The number of columns after the coordinates' (points, drivers, residuals, rcond): 0 without an output plan.
+  std::size_t num_output_values() const;
+  /// Writes those columns' values for this step to out[0 .. num_output_values()), as append_row() formats them
+  /// (the HDF5 writer's row: the same doubles as the CSV's). Throws phiq::Error as append_row() does.
+  void append_output_values(const StepView& step, double* out) const;
 
  private:
   const Model& model_;
@@ -41,6 +46,8 @@ class CsvFormat {
   const OutputPlan* plan_ = nullptr;  // the other outputs, when made from an output plan
   void append_coordinates(const StepView& step, std::string& out) const;  // the q, q̇, q̈ columns
   void append_outputs(const StepView& step, std::string& out) const;      // the columns after the coordinates
+  template <class Emit>
+  void for_each_output(const StepView& step, Emit&& emit) const;  // their values, in column order
 };
 
 }  // namespace phiq

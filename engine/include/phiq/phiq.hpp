@@ -8,6 +8,8 @@
 #include "phiq/constraint_kinds_3d.hpp"
 #include "phiq/csv_writer.hpp"
 #include "phiq/expression.hpp"
+#include "phiq/hdf5_reader.hpp"
+#include "phiq/hdf5_writer.hpp"
 #include "phiq/kinematics.hpp"
 #include "phiq/linear_solver.hpp"
 #include "phiq/mechanism_sketch.hpp"

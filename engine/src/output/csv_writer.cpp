@@ -86,23 +86,26 @@ inline void put(double v, std::string& out) {
 constexpr std::size_t kValuesPerTask = 1024;
 }  // namespace
 
-void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
+// Calls emit(v) for each value after the coordinate columns, in column order: the one computation of those values
+// for the CSV text and for append_output_values() (the HDF5 writer), so that the two files cannot disagree.
+template <class Emit>
+void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
   const auto& points = plan_->points;
   if (!points.empty() && !s.points) throw Error("CsvFormat: step has no point motions");
   for (std::size_t i = 0; i < points.size(); ++i) {
     const PointMotion& m = s.points[i];
     const int dim = points[i].dimension();
-    for (int d = 0; d < dim; ++d) out += ',', put(m.r[d], out);
+    for (int d = 0; d < dim; ++d) emit(m.r[d]);
     if (velocities_)
-      for (int d = 0; d < dim; ++d) out += ',', put(m.v[d], out);
+      for (int d = 0; d < dim; ++d) emit(m.v[d]);
     if (accelerations_)
-      for (int d = 0; d < dim; ++d) out += ',', put(m.a[d], out);
+      for (int d = 0; d < dim; ++d) emit(m.a[d]);
   }
   for (const OutputDriver& d : plan_->driver_columns) {
     const LawValue v = d.law.evaluate(s.t);
-    out += ',', put(v.f, out);
-    if (velocities_) out += ',', put(v.df, out);
-    if (accelerations_) out += ',', put(v.ddf, out);
+    emit(v.f);
+    if (velocities_) emit(v.df);
+    if (accelerations_) emit(v.ddf);
   }
   if (!plan_->residual_columns.empty() || plan_->max_residual_column) {
     if (!s.phi) throw Error("CsvFormat: step has no residuals");
@@ -115,11 +118,29 @@ void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
       const ConstraintInfo& ci = model_.constraints()[c];
       double r = 0.0;
       for (Index i = ci.first_row; i < ci.first_row + ci.rows; ++i) r = std::max(r, std::fabs((*phi)(i)) / rs(i));
-      out += ',', put(r, out);
+      emit(r);
     }
-    if (plan_->max_residual_column) out += ',', put(scaled_residual(model_, *phi), out);
+    if (plan_->max_residual_column) emit(scaled_residual(model_, *phi));
   }
-  if (plan_->condition) out += ',', put(s.rcond, out);
+  if (plan_->condition) emit(s.rcond);
+}
+
+void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
+  for_each_output(s, [&](double v) { out += ',', put(v, out); });
+}
+
+void CsvFormat::append_output_values(const StepView& s, double* out) const {
+  if (!plan_) return;
+  for_each_output(s, [&](double v) { *out++ = v; });
+}
+
+std::size_t CsvFormat::num_output_values() const {
+  if (!plan_) return 0;
+  const std::size_t per = 1 + velocities_ + accelerations_;
+  std::size_t n = plan_->driver_columns.size() * per + plan_->residual_columns.size() + plan_->max_residual_column +
+                  plan_->condition;
+  for (const OutputPoint& p : plan_->points) n += static_cast<std::size_t>(p.dimension()) * per;
+  return n;
 }
 
 void CsvFormat::append_row(const StepView& s, std::string& out) const {

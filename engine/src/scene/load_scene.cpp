@@ -126,6 +126,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
   detail::scene::SceneReader reader(path, limits);
   reader.overrides_ = &overrides;
   Scene scene = reader.read(root);
+  scene.text = text;
   // A predictor that needs derivatives the scene does not output would compute extra work silently: refuse.
   if (reader.predictor_given()) {
     const Predictor p = scene.sweep.predictor;

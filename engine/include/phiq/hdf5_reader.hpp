@@ -1,0 +1,32 @@
+/// @file
+/// Reading HDF5 results (hdf5_writer.hpp) back as the table their CSV would parse to, so that `phiq compare`
+/// and compare_csv() take either format on either side.
+#pragma once
+
+#include <string>
+
+#include "phiq/csv_compare.hpp"
+
+namespace phiq {
+
+/// True when `path` ends in `.h5` or `.hdf5`, in any case: the names phiq reads and writes as HDF5.
+bool has_hdf5_extension(const std::string& path);
+
+/// True when the file at `path` begins with the HDF5 signature (\\x89 H D F \\r \\n \\x1a \\n). False for a file that
+/// cannot be read or is shorter.
+bool is_hdf5_file(const std::string& path);
+
+/// Reads HDF5 results of format version kHdf5Format: the datasets /t, /q, /qd, /qdd, /points, /drivers, /residuals,
+/// /rcond that are present, in that order, their columns named by each dataset's `columns` attribute.
+/// @return The table, columns and rows in the order of the CSV of the same run, with CsvTable::path = `path`.
+/// @throws phiq::Error with one line "PATH: what is wrong" for a file that is not HDF5 or cannot be opened
+///         ("PATH: not a readable HDF5 file: REASON"), another format or version, a missing or malformed `columns`
+///         attribute, a dataset that is not floating point, of rank above 2, or whose row count differs from /t's,
+///         or a duplicate column name.
+CsvTable read_hdf5_table(const std::string& path);
+
+/// read_hdf5_table() for a file with the HDF5 signature or a name ending in .h5 / .hdf5, read_csv_table()
+/// otherwise; throws what they throw.
+CsvTable read_result_table(const std::string& path);
+
+}  // namespace phiq

@@ -1,0 +1,69 @@
+/// @file
+/// Results as HDF5 (format version kHdf5Format; layout in tools/README.md, "HDF5 results"): the columns a CSV of
+/// the same output plan has (CsvFormat), as one chunked, extendible dataset per group — /t, /q, /qd, /qdd,
+/// /points, /drivers, /residuals, /rcond — holding the very doubles the CSV's text reads back to. Rows are
+/// buffered and written a block at a time as the sweep delivers them, so that memory stays bounded at any length.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+
+#include "phiq/model.hpp"
+#include "phiq/output_plan.hpp"
+#include "phiq/sweep.hpp"
+
+namespace phiq {
+
+/// HDF5 results format version: the root attribute `format_version` (tools/README.md, "HDF5 results").
+inline constexpr int kHdf5Format = 1;
+
+/// What an Hdf5Writer writes besides the rows, and how.
+struct Hdf5Options {
+  std::string scene_path;  ///< root attribute `scene_path` (where the scene was read from)
+  std::string scene_text;  ///< root attribute `scene`: the scene's text, so that the file says how it was made
+  /// The path errors name, when the file is written under another (the CLI's temporary); empty: the path.
+  std::string shown_path;
+  /// gzip (deflate) level 1–9 applied to every dataset, 0 for none. Off by default: on kinematic doubles it saves
+  /// little and costs more time than the sweep (bench/README.md, "HDF5 results").
+  int deflate = 0;
+  bool shuffle = false;  ///< byte-shuffle before deflating (only with deflate > 0)
+  /// Rows the writer will be given (a sweep's steps + 1), or 0 if unknown: chunks are then sized so that the
+  /// last one is not mostly empty (an uncompressed chunk takes its whole size on disk).
+  std::size_t expected_rows = 0;
+  /// Memory for the rows held between writes (at least one row is always held): the writer's memory, which
+  /// does not grow with the number of rows.
+  std::size_t buffer_bytes = std::size_t{16} << 20;
+};
+
+/// Writes a sweep's rows to an HDF5 file as they are delivered. Not thread-safe: call append_row() from one
+/// thread at a time (run_sweep's callback is). HDF5 errors are reported as phiq::Error; HDF5's own printing of
+/// its error stack is silenced while the writer works.
+class Hdf5Writer {
+ public:
+  /// Creates (or truncates) the file at `path` with the datasets of `plan` (CsvFormat's columns), the root
+  /// attributes and each dataset's `columns` and `units`. The model and the plan must outlive the writer.
+  /// Throws phiq::Error "PATH: cannot write: REASON" (an index out of range as CsvFormat does).
+  Hdf5Writer(const std::string& path, const Model& model, const OutputPlan& plan, const Hdf5Options& options = {});
+  /// Closes the file if close() was not called; what was not written is lost and errors are ignored (a caller that
+  /// failed removes the file).
+  ~Hdf5Writer();
+  Hdf5Writer(const Hdf5Writer&) = delete;
+  Hdf5Writer& operator=(const Hdf5Writer&) = delete;
+
+  /// Adds one row (pre-conditions as CsvFormat::append_row()). −0 is stored as 0, as the CSV writes it.
+  /// Throws phiq::Error on a write error or after close().
+  void append_row(const StepView& step);
+  /// Writes the rows still held and closes the file. Throws phiq::Error "PATH: cannot write: REASON".
+  void close();
+  /// Rows given so far.
+  std::size_t rows() const;
+  /// Rows written per block (the chunks' row count): what the writer holds in memory between writes.
+  std::size_t block_rows() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace phiq

@@ -1,0 +1,258 @@
+#include "phiq/hdf5_writer.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <vector>
+
+#include "output/hdf5_handle.hpp"
+#include "phiq/csv_writer.hpp"
+#include "phiq/version.hpp"
+
+namespace phiq {
+
+using detail::h5::check;
+using detail::h5::checked;
+using detail::h5::Hid;
+using detail::h5::QuietErrors;
+using detail::h5::write_attribute;
+
+namespace {
+
+// Chunks of at most 1 MiB: HDF5's default chunk cache holds one, and h5py's guidance is 10 KiB – 1 MiB. A chunk is
+// written once, whole (a block of rows is a chunk's rows), so the cache never evicts a half-written one.
+constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
+
+// The unit of a coordinate and of its derivatives ("" where the model does not know it).
+std::string unit_of(Unit u, const char* per_time) {
+  const char* base = u == Unit::kLength ? "m" : u == Unit::kAngle ? "rad" : "";
+  return *base ? std::string(base) + per_time : std::string();
+}
+
+// Rows per block (= per chunk): as many as the buffer holds, at most a chunk of one column, and — when the number
+// of rows is known — the count in [max/4, max] whose last block is fullest: the last chunk of an uncompressed
+// dataset takes its whole size on disk, so 1 001 rows in blocks of 34 would store 1 020.
+std::size_t choose_block_rows(std::size_t row_bytes, const Hdf5Options& o) {
+  std::size_t most = std::max<std::size_t>(1, o.buffer_bytes / std::max<std::size_t>(row_bytes, 1));
+  most = std::min(most, kChunkBytes / sizeof(double));
+  if (o.expected_rows > 0) most = std::min(most, o.expected_rows);
+  if (o.expected_rows == 0) return most;
+  std::size_t best = most, best_waste = o.expected_rows;
+  for (std::size_t r = most; r >= std::max<std::size_t>(1, most / 4); --r) {
+    const std::size_t waste = (o.expected_rows + r - 1) / r * r - o.expected_rows;
+    if (waste < best_waste) best = r, best_waste = waste;
+    if (r == 1) break;
+  }
+  return best;
+}
+
+}  // namespace
+
+// One dataset: its columns' names and units, the rows held for the next write, and where they go.
+struct Group {
+  const char* name;
+  std::vector<std::string> columns, units;
+  bool one_dimensional = false;  // /t and /rcond: one value per row
+  Hid dataset;
+  std::vector<double> held;  // block_rows × columns, row-major
+};
+
+struct Hdf5Writer::Impl {
+  std::string path;
+  const Model& model;
+  const OutputPlan& plan;
+  CsvFormat format;
+  Hid file;
+  std::vector<Group> groups;  // in CSV column order
+  Group *t = nullptr, *q = nullptr, *qd = nullptr, *qdd = nullptr;
+  std::vector<Group*> outputs;  // points, drivers, residuals, rcond: the CsvFormat::append_output_values() slices
+  std::vector<double> output_row;
+  std::size_t block_rows = 1, held_rows = 0, written_rows = 0;
+  bool closed = false;
+
+  Impl(const std::string& p, const Model& m, const OutputPlan& pl) : path(p), model(m), plan(pl), format(m, pl) {}
+  std::string file_path;  // what H5Fcreate opens (`path` names it in messages)
+
+  std::string cannot(const std::string& why) const { return path + ": cannot write: " + why; }
+  void create(const Hdf5Options& o);
+  void create_dataset(Group& g, const Hdf5Options& o);
+  void flush();
+};
+
+void Hdf5Writer::Impl::create(const Hdf5Options& o) {
+  // The groups, their columns named as CsvFormat names them, in its order.
+  const std::vector<std::string> names = format.column_names();
+  std::size_t at = 0;
+  auto take = [&](const char* name, std::size_t n, auto unit) -> Group* {
+    if (n == 0) return nullptr;
+    Group g{name, {names.begin() + at, names.begin() + at + n}, {}, false, {}, {}};
+    for (std::size_t k = 0; k < n; ++k) g.units.push_back(unit(k));
+    at += n;
+    groups.push_back(std::move(g));
+    return &groups.back();
+  };
+  groups.reserve(8);  // pointers into it are kept
+  const auto& cols = plan.coordinate_columns;
+  auto coordinate_unit = [&](const char* per_time) {
+    return [&, per_time](std::size_t k) { return unit_of(model.coordinate_unit(cols[k]), per_time); };
+  };
+  t = take("t", 1, [](std::size_t) { return std::string("s"); });
+  t->one_dimensional = true;
+  q = take("q", cols.size(), coordinate_unit(""));
+  if (plan.velocities) qd = take("qd", cols.size(), coordinate_unit("/s"));
+  if (plan.accelerations) qdd = take("qdd", cols.size(), coordinate_unit("/s^2"));
+  std::vector<std::string> point_units;
+  for (const OutputPoint& p : plan.points) {
+    point_units.insert(point_units.end(), static_cast<std::size_t>(p.dimension()), "m");
+    if (plan.velocities) point_units.insert(point_units.end(), static_cast<std::size_t>(p.dimension()), "m/s");
+    if (plan.accelerations) point_units.insert(point_units.end(), static_cast<std::size_t>(p.dimension()), "m/s^2");
+  }
+  const std::size_t per_driver = 1 + plan.velocities + plan.accelerations;
+  const std::size_t residuals = plan.residual_columns.size() + plan.max_residual_column;
+  auto none = [](std::size_t) { return std::string(); };
+  for (Group* g : {take("points", point_units.size(), [&](std::size_t k) { return point_units[k]; }),
+                   take("drivers", plan.driver_columns.size() * per_driver, none),
+                   take("residuals", residuals, none)})
+    if (g) outputs.push_back(g);
+  if (plan.condition) {
+    outputs.push_back(take("rcond", 1, none));
+    outputs.back()->one_dimensional = true;
+  }
+  if (at != names.size()) throw Error(cannot("the columns do not match the CSV's (phiq bug)"));
+  output_row.resize(format.num_output_values());
+
+  block_rows = choose_block_rows(names.size() * sizeof(double), o);
+  if (o.deflate < 0 || o.deflate > 9)
+    throw Error(cannot("deflate level " + std::to_string(o.deflate) + " is not 0–9"));
+  if (o.deflate > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0) throw Error(cannot("HDF5 has no deflate filter"));
+
+  const Hid fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, cannot("file access list"));
+  // The 1.8 file format: attributes larger than 64 KiB (the names of 10⁴ coordinates) go to dense storage, and
+  // readers from HDF5 1.8 on (MATLAB, older h5py) can open the file.
+  check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18), cannot("file format"));
+  // No advisory lock: the file is the caller's own (the CLI writes a temporary nobody else knows), and file
+  // systems without flock (some NFS mounts) would refuse it.
+  check(H5Pset_file_locking(fapl.get(), false, true), cannot("file locking"));
+  file = checked(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
+                 path + ": cannot write");
+  const std::string attrs = cannot("attributes");
+  try {
+    write_attribute(file.get(), "format", std::string("phiq results"));
+    write_attribute(file.get(), "format_version", static_cast<long long>(kHdf5Format));
+    write_attribute(file.get(), "phiq_version", std::string(kVersion));
+    write_attribute(file.get(), "scene_path", o.scene_path);
+    write_attribute(file.get(), "scene", o.scene_text);
+    for (Group& g : groups) create_dataset(g, o);
+  } catch (const Error& e) {
+    throw Error(path + ": cannot write: " + e.what());
+  }
+}
+
+void Hdf5Writer::Impl::create_dataset(Group& g, const Hdf5Options& o) {
+  const std::string what = std::string("dataset /") + g.name;
+  const hsize_t n = g.columns.size();
+  const int rank = g.one_dimensional ? 1 : 2;
+  const hsize_t dims[2] = {0, n}, maxdims[2] = {H5S_UNLIMITED, n};
+  // columns per chunk: a chunk of block_rows rows within kChunkBytes, the columns split evenly so that the last
+  // chunk of a row is not mostly empty
+  const hsize_t most = std::max<hsize_t>(1, kChunkBytes / (sizeof(double) * block_rows));
+  const hsize_t pieces = (n + most - 1) / most;
+  const hsize_t chunk[2] = {block_rows, (n + pieces - 1) / pieces};
+  const Hid space = checked(H5Screate_simple(rank, dims, maxdims), H5Sclose, what);
+  const Hid dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, what);
+  check(H5Pset_chunk(dcpl.get(), rank, chunk), what);
+  check(H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER), what);  // every element is written: no fill to write first
+  if (o.deflate > 0) {
+    if (o.shuffle) check(H5Pset_shuffle(dcpl.get()), what);
+    check(H5Pset_deflate(dcpl.get(), static_cast<unsigned>(o.deflate)), what);
+  }
+  g.dataset = checked(H5Dcreate2(file.get(), g.name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
+                      H5Dclose, what);
+  write_attribute(g.dataset.get(), "columns", g.columns);
+  write_attribute(g.dataset.get(), "units", g.units);
+  g.held.resize(block_rows * n);
+}
+
+void Hdf5Writer::Impl::flush() {
+  if (held_rows == 0) return;
+  for (Group& g : groups) {
+    const std::string what = cannot(std::string("dataset /") + g.name);
+    const int rank = g.one_dimensional ? 1 : 2;
+    const hsize_t n = g.columns.size();
+    const hsize_t extent[2] = {written_rows + held_rows, n}, start[2] = {written_rows, 0}, count[2] = {held_rows, n};
+    check(H5Dset_extent(g.dataset.get(), extent), what);
+    const Hid file_space = checked(H5Dget_space(g.dataset.get()), H5Sclose, what);
+    check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr), what);
+    const Hid memory = checked(H5Screate_simple(rank, count, nullptr), H5Sclose, what);
+    check(H5Dwrite(g.dataset.get(), H5T_NATIVE_DOUBLE, memory.get(), file_space.get(), H5P_DEFAULT, g.held.data()),
+          what);
+  }
+  written_rows += held_rows;
+  held_rows = 0;
+}
+
+Hdf5Writer::Hdf5Writer(const std::string& path, const Model& model, const OutputPlan& plan,
+                       const Hdf5Options& options)
+    : impl_(std::make_unique<Impl>(options.shown_path.empty() ? path : options.shown_path, model, plan)) {
+  const QuietErrors quiet;
+  impl_->file_path = path;
+  impl_->create(options);
+}
+
+Hdf5Writer::~Hdf5Writer() {
+  const QuietErrors quiet;
+  impl_.reset();  // the datasets, then the file (members in reverse order): HDF5 closes what was written
+}
+
+void Hdf5Writer::append_row(const StepView& s) {
+  Impl& w = *impl_;
+  if (w.closed) throw Error(w.cannot("already closed"));
+  if (w.held_rows == w.block_rows) {  // a block whose write failed: tried again, never overrun
+    const QuietErrors quiet;
+    w.flush();
+  }
+  const std::size_t k = w.held_rows;
+  // −0 → 0, as the CSV writes it: the two files of a run hold the same doubles
+  auto store = [](double v) { return v == 0.0 ? 0.0 : v; };
+  w.t->held[k] = store(s.t);
+  const auto& cols = w.plan.coordinate_columns;
+  const std::size_t n = cols.size();
+  auto gather = [&](Group* g, const Eigen::VectorXd* v, const char* what) {
+    if (!g) return;
+    if (!v) throw Error(std::string("Hdf5Writer: step has no ") + what);
+    if (v->size() != w.model.num_coordinates()) throw Error("Hdf5Writer: step's vectors are not the model's size");
+    double* out = g->held.data() + k * n;
+    for (std::size_t c = 0; c < n; ++c) out[c] = store((*v)(cols[c]));
+  };
+  gather(w.q, &s.q, "positions");
+  gather(w.qd, s.qd, "velocities");
+  gather(w.qdd, s.qdd, "accelerations");
+  if (!w.outputs.empty()) {
+    w.format.append_output_values(s, w.output_row.data());
+    const double* v = w.output_row.data();
+    for (Group* g : w.outputs) {
+      const std::size_t m = g->columns.size();
+      std::transform(v, v + m, g->held.data() + k * m, store);
+      v += m;
+    }
+  }
+  if (++w.held_rows == w.block_rows) {
+    const QuietErrors quiet;
+    w.flush();
+  }
+}
+
+void Hdf5Writer::close() {
+  Impl& w = *impl_;
+  if (w.closed) throw Error(w.cannot("already closed"));
+  const QuietErrors quiet;
+  w.closed = true;
+  w.flush();
+  for (Group& g : w.groups)
+    if (!g.dataset.close()) throw Error(w.cannot(detail::h5::last_error()));
+  if (!w.file.close()) throw Error(w.cannot(detail::h5::last_error()));  // H5Fclose writes the metadata
+}
+
+std::size_t Hdf5Writer::rows() const { return impl_->written_rows + impl_->held_rows; }
+std::size_t Hdf5Writer::block_rows() const { return impl_->block_rows; }
+
+}  // namespace phiq
