@@ -91,15 +91,18 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     return &groups.back();
   };
   groups.reserve(8);  // pointers into it are kept
-  const auto& cols = plan.coordinate_columns;
-  auto coordinate_unit = [&](const char* per_time) {
+  // (the q̇ and q̈ columns may be other coordinates than q's: OutputPlan::velocity_columns)
+  auto coordinate_unit = [&](const std::vector<Index>& cols, const char* per_time) {
     return [&, per_time](std::size_t k) { return unit_of(model.coordinate_unit(cols[k]), per_time); };
   };
+  const std::vector<Index>& q_cols = plan.coordinate_columns;
+  const std::vector<Index>& qd_cols = plan.written_velocities();
+  const std::vector<Index>& qdd_cols = plan.written_accelerations();
   t = take("t", 1, [](std::size_t) { return std::string("s"); });
   t->one_dimensional = true;
-  q = take("q", cols.size(), coordinate_unit(""));
-  if (plan.velocities) qd = take("qd", cols.size(), coordinate_unit("/s"));
-  if (plan.accelerations) qdd = take("qdd", cols.size(), coordinate_unit("/s^2"));
+  q = take("q", q_cols.size(), coordinate_unit(q_cols, ""));
+  qd = take("qd", qd_cols.size(), coordinate_unit(qd_cols, "/s"));
+  qdd = take("qdd", qdd_cols.size(), coordinate_unit(qdd_cols, "/s^2"));
   std::vector<std::string> point_units;
   for (const OutputPoint& p : plan.points) {
     point_units.insert(point_units.end(), static_cast<std::size_t>(p.dimension()), "m");
@@ -214,18 +217,17 @@ void Hdf5Writer::append_row(const StepView& s) {
   // −0 → 0, as the CSV writes it: the two files of a run hold the same doubles
   auto store = [](double v) { return v == 0.0 ? 0.0 : v; };
   w.t->held[k] = store(s.t);
-  const auto& cols = w.plan.coordinate_columns;
-  const std::size_t n = cols.size();
-  auto gather = [&](Group* g, const Eigen::VectorXd* v, const char* what) {
+  auto gather = [&](Group* g, const Eigen::VectorXd* v, const std::vector<Index>& cols, const char* what) {
     if (!g) return;
     if (!v) throw Error(std::string("Hdf5Writer: step has no ") + what);
     if (v->size() != w.model.num_coordinates()) throw Error("Hdf5Writer: step's vectors are not the model's size");
+    const std::size_t n = cols.size();
     double* out = g->held.data() + k * n;
     for (std::size_t c = 0; c < n; ++c) out[c] = store((*v)(cols[c]));
   };
-  gather(w.q, &s.q, "positions");
-  gather(w.qd, s.qd, "velocities");
-  gather(w.qdd, s.qdd, "accelerations");
+  gather(w.q, &s.q, w.plan.coordinate_columns, "positions");
+  gather(w.qd, s.qd, w.plan.written_velocities(), "velocities");
+  gather(w.qdd, s.qdd, w.plan.written_accelerations(), "accelerations");
   if (!w.outputs.empty()) {
     w.format.append_output_values(s, w.output_row.data());
     const double* v = w.output_row.data();
