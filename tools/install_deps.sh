@@ -18,6 +18,8 @@ packages=(
   libbenchmark-dev     # Google Benchmark
   libsimbody-dev       # optional peer for the benchmark (bench/bench_peers.cpp); skipped with a message if absent
   python3-matplotlib   # tools/plot/plot_bench.py (the figure of bench/README.md); its ctest is skipped if absent
+  help2man             # the man page phiq.1, generated from `phiq --help` at install (skipped with a note if absent)
+  python3-numpy        # ctest csv_names_numpy: numpy.genfromtxt(names=True) keeps the --names identifiers columns
 )
 
 missing=()

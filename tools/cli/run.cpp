@@ -7,71 +7,32 @@
 #include <iostream>
 #include <memory>
 
-#include <nlohmann/json.hpp>
-
 #include "cli_support.hpp"
 #include "command_line.hpp"
 #include "command_support.hpp"
 #include "commands.hpp"
 #include "progress_bar.hpp"
+#include "run_summary.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
 
 namespace {
 
-// `phiq run --summary FILE.json`: the run summary, format version 1 (tools/README.md).
-std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& /*ws*/, const phiq::SweepSummary& s,
-                         double load_s, double solve_s, double write_s) {
-  nlohmann::ordered_json j;
-  j["format"] = 1;
-  j["scene"] = scene.path;
-  j["status"] = phiq::to_string(s.status);
-  j["message"] = s.message;
-  j["steps"] = s.steps_completed;
-  j["threads"] = s.threads;
-  j["parallel_chunks"] = s.parallel_chunks;
-  j["coordinates"] = scene.model->num_coordinates();
-  j["linear_solver"] = phiq::to_string(scene.model->linear_solver());
-  j["load_seconds"] = load_s;
-  j["solve_seconds"] = solve_s;
-  // the sweep's wall time: the solve and the writing done in its callback, which other threads' solving overlaps
-  j["sweep_seconds"] = s.solve_seconds;
-  j["write_seconds"] = write_s;
-  j["newton_iterations"] = s.counters.newton_iterations;
-  j["factorizations"] = s.counters.factorizations;
-  j["pivoting_factorizations"] = s.counters.pivoting_factorizations;
-  j["velocity_solves"] = s.counters.velocity_solves;
-  j["acceleration_solves"] = s.counters.acceleration_solves;
-  j["phi_t_evaluations"] = s.counters.phi_t_evaluations;
-  j["gamma_evaluations"] = s.counters.gamma_evaluations;
-  j["residual_evaluations"] = s.counters.residual_evaluations;
-  j["point_evaluations"] = s.counters.point_evaluations;
-  j["subdivisions"] = s.subdivisions;
-  j["singular_positions"] = s.singular_positions;
-  // 0 in the summary means no row measured it (a positions-only sweep factorises at Newton iterates, not at the
-  // solutions): null, not a condition number of 0, which would read as a singular Jacobian
-  if (s.min_rcond > 0.0)
-    j["min_rcond"] = s.min_rcond;
-  else
-    j["min_rcond"] = nullptr;
-  j["warnings"] = nlohmann::ordered_json::array();
-  for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});
-  return json_text(j, 2) + "\n";
-}
-
-int cmd_run(const std::string& scene_path, const std::string& out_path, bool quiet, const std::string& summary_path,
-            int threads, double memory_gb, ProgressBar::Mode progress_mode) {
+int cmd_run(const std::string& scene_arg, const std::string& out_path, bool quiet, const std::string& summary_path,
+            int threads, double memory_gb, ProgressBar::Mode progress_mode, bool identifier_names) {
+  const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
   if (!out_path.empty()) outs.push_back({"-o", out_path});
   if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
-  if (const auto clash = output_clash(outs, {{"the scene", scene_path}})) return fail("run: " + *clash, 2);
+  if (const auto clash = output_clash(outs, {{"the scene", scene_arg == "-" ? "" : scene_arg}}))
+    return fail("run: " + *clash, 2);
   if (out_path.empty() && stdout_was_closed())
     return fail("run: standard output: cannot write: it is closed", 3);
   set_interrupt_subject(scene_path, "; no output written");
   const auto load_start = Clock::now();
-  std::optional<phiq::Scene> loaded = load_or_report(scene_path);
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg);
   if (!loaded) return 2;
   phiq::Scene& scene = *loaded;
   const double load_s = since(load_start);
@@ -88,10 +49,31 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
     return fail(e.what(), 3);
   }
 
+  // A run that cannot be solved still commits its summary (status, where, why: for harnesses), never the CSV. Its
+  // message is the line stderr gets.
+  auto failed = [&](const phiq::Model& swept, phiq::SweepSummary s, const RunTimes& times, const std::string& why) {
+    s.message = why;
+    if (summary_file) try {
+        summary_file->write(run_summary_json(scene, swept, s, times));
+        outputs.commit_one(*summary_file);
+      } catch (const phiq::Error& e) {
+        return fail(e.what(), 3);
+      }
+    return fail(scene_path + ": " + why +
+                    (summary_file ? "; wrote the summary only" : outs.empty() ? "" : "; no output written"),
+                1);
+  };
   // inconsistent or under-driven models stop here, naming the constraints
   phiq::SquareScene square;
-  if (const auto why = make_square(scene, &square))
-    return fail(scene_path + ": " + *why + (outs.empty() ? "" : "; no output written"), 1);
+  if (const auto why = make_square(scene, &square)) {
+    phiq::SweepSummary at_start;  // the first position, before any sweep
+    at_start.status = square.assembly.status;
+    at_start.message = *why;
+    at_start.failed_step = 0;
+    at_start.failed_time = scene.sweep.t_begin;
+    at_start.worst_rows = square.assembly.worst_rows;
+    return failed(*scene.model, at_start, {load_s, 0.0, 0.0}, *why);
+  }
   const phiq::AssemblySummary& redundancy = square.assembly;
   const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;
@@ -101,6 +83,11 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
   // columns from the scene's output plan and model (its constraints); residuals of a model solved on its
   // independent rows are evaluated on the whole scene model (CsvFormat)
   phiq::CsvFormat csv(*scene.model, scene.sweep);
+  try {
+    csv.set_naming(identifier_names ? phiq::ColumnNaming::kIdentifiers : phiq::ColumnNaming::kDotted);
+  } catch (const phiq::Error& e) {  // names that would collide: the scene's to change
+    return fail(scene_path + ": --names identifiers: " + e.what(), 2);
+  }
 
   // Where the CSV goes: the output file, or standard output after success, spooled through an anonymous temporary
   // file so that memory stays bounded however long the sweep is.
@@ -162,7 +149,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
           phiq::SolveStatus::kSuccess)
         why += "; rank analysis: " + as.message;
     }
-    return fail(scene_path + ": " + why + (outs.empty() ? "" : "; no output written"), 1);
+    return failed(model, summary, {load_s, summary.solve_seconds - write_s, write_s}, why);
   }
   const double solve_s = summary.solve_seconds - write_s;
   const auto final_write = Clock::now();
@@ -181,7 +168,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, bool qui
       if (const auto bad = stdout_error()) throw phiq::Error(*bad);
     }
     write_s += since(final_write);
-    if (summary_file) summary_file->write(summary_json(scene, ws, summary, load_s, solve_s, write_s));
+    if (summary_file) summary_file->write(run_summary_json(scene, model, summary, {load_s, solve_s, write_s}));
     outputs.commit();
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
@@ -212,10 +199,11 @@ Command register_run(CLI::App& app) {
     int threads = 0;
     double memory_gb = 0.0;
     std::string progress = "auto";
+    std::string names = "dotted";
   };
   auto a = std::make_shared<Args>();
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
-  run->add_option("scene", a->scene_path, "Scene file (YAML)")->required();
+  run->add_option("scene", a->scene_path, "Scene file (YAML; '-': standard input)")->required();
   run->add_option("-o,--output", a->out_path, "CSV file to write (default or '-': standard output)")
       ->transform(output_path(" (without the option, or '-': standard output)", true));
   run->add_flag("-q,--quiet", a->quiet, "Do not print the run summary on standard error");
@@ -234,11 +222,16 @@ Command register_run(CLI::App& app) {
                   "Progress bar on standard error: auto (when it is a terminal), always, never")
       ->capture_default_str()
       ->check(one_of({"auto", "always", "never"}));
+  run->add_option("--names", a->names,
+                  "Column names: dotted (theta2.v) or identifiers (theta2__v: kept by numpy and pandas)")
+      ->capture_default_str()
+      ->check(one_of({"dotted", "identifiers"}));
   return {run, [a] {
             using Mode = ProgressBar::Mode;
             const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
             return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->quiet, a->summary_path,
-                                               cap_threads("run", a->threads, a->quiet), a->memory_gb, mode));
+                                               cap_threads("run", a->threads, a->quiet), a->memory_gb, mode,
+                                               a->names == "identifiers"));
           }};
 }
 
