@@ -1,6 +1,7 @@
 // `phiq run --summary`: the run summary (format 2) on success and on a failure to solve (status, failed step and
 // time, message, worst constraints; the summary committed, no CSV), with phiq's version, the scene's name and
-// path and the host; `phiq run -` reading the scene from standard input; `sweep-accuracy --json` on a failure.
+// path and the host; `phiq run -` reading the scene from standard input; `sweep-accuracy --json` on a failure;
+// `batch --summary`, each case's outcome.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -38,6 +39,9 @@ drivers:
   - {name: slide, coordinate: xB, law: {type: linear, initial: 1.2, rate: 0.2}}
 time: {start: 0, end: 1, steps: 10}
 )";
+
+// 'name', as messages quote constraints (appended, not `"'" + name`: GCC 12 warns falsely on that, -Wrestrict).
+std::string quoted(const std::string& name) { return std::string(1, '\'').append(name).append(1, '\''); }
 
 // What every summary carries, whatever the outcome: the version, the scene, the host.
 void expect_provenance(const Json& j, const std::string& scene_path) {
@@ -86,7 +90,7 @@ TEST_F(Cli, RunSummaryTellsWhyARunFailed) {
     const std::string name = w["name"];
     const double residual = w["residual"];
     EXPECT_TRUE(name.rfind("crank", 0) == 0 || name.rfind("rod", 0) == 0 || name.rfind("slide", 0) == 0) << name;
-    EXPECT_NE(message.find("'" + name + "'"), std::string::npos) << name << " not in: " << message;
+    EXPECT_NE(message.find(quoted(name)), std::string::npos) << name << " not in: " << message;
     EXPECT_GT(residual, 1e-10) << "a worst row is beyond the tolerance";
     EXPECT_LE(residual, previous) << "largest first";
     previous = residual;
@@ -175,6 +179,54 @@ TEST_F(Cli, SweepAccuracyJsonTellsWhyItFailed) {
   EXPECT_EQ(r.err, "phiq: sweep-accuracy: " + j["message"].get<std::string>() + "; wrote the JSON only\n");
   EXPECT_EQ(j["rows"], Json::array());
   EXPECT_FALSE(j.contains("reference"));
+}
+
+// batch --summary: every case's outcome, the failing one (the crank longer than the rod: stuck at θ2 where
+// L2 sin θ2 = L3) with its step, time and worst constraints, the others with their files.
+TEST_F(Cli, BatchSummaryHasEveryCasesOutcome) {
+  const fs::path cases = write("cases.csv", "L2,L3\n0.2,1.0\n1.5,1.0\n0.4,1.2\n"), out = dir_ / "out",
+                 sum = dir_ / "b.json";
+  const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
+  Result r = run("batch -q " + scene + " " + cases.string() + " -o " + out.string() + " --threads 2 --summary " +
+                 sum.string());
+  EXPECT_EQ(r.code, 1) << r.err;
+  const Json j = Json::parse(slurp(sum));
+  EXPECT_EQ(j["format"], 1);
+  EXPECT_EQ(j["phiq"], phiq::kVersion);
+  EXPECT_EQ(j["scene"], scene);
+  EXPECT_EQ(j["name"], "crank_slider_mixed");
+  EXPECT_FALSE(j["host"]["cpu"].get<std::string>().empty());
+  EXPECT_EQ(j["cases_file"], cases.string());
+  EXPECT_EQ(j["cases"], 3);
+  EXPECT_EQ(j["failed"], 1);
+  EXPECT_EQ(j["written"], 2);
+  ASSERT_EQ(j["results"].size(), 3u);
+  for (int k : {0, 2}) {
+    const Json& c = j["results"][k];
+    const fs::path file = out / ("case" + std::to_string(k) + ".csv");
+    EXPECT_EQ(c["case"], k);
+    EXPECT_EQ(c["line"], k + 2);
+    EXPECT_EQ(c["status"], "success");
+    EXPECT_EQ(c["file"], file.string());
+    EXPECT_TRUE(fs::exists(file));
+    EXPECT_EQ(c["steps"], 181);
+    EXPECT_TRUE(c["failed_step"].is_null());
+  }
+  const Json& bad = j["results"][1];
+  EXPECT_EQ(bad["case"], 1);
+  EXPECT_EQ(bad["line"], 3);
+  EXPECT_TRUE(bad["file"].is_null());
+  EXPECT_FALSE(fs::exists(out / "case1.csv"));
+  EXPECT_NE(bad["status"], "success");
+  const std::string message = bad["message"];
+  // stderr's line for the case, less its prefix and the note on the output
+  EXPECT_NE(r.err.find("case 1: " + message + "; no output written\n"), std::string::npos) << r.err;
+  const std::string step = "step " + bad["failed_step"].dump() + ", t = ";
+  EXPECT_EQ(message.rfind(step, 0), 0u) << message;
+  EXPECT_GT(bad["failed_step"].get<int>(), 0);
+  EXPECT_EQ(bad["steps"], bad["failed_step"]) << "the rows before the failed step";
+  for (const Json& w : bad["worst_constraints"])
+    EXPECT_NE(message.find(quoted(w["name"].get<std::string>())), std::string::npos) << message;
 }
 
 }  // namespace

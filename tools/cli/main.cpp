@@ -32,7 +32,8 @@ int main(int argc, char** argv) {
                                         std::to_string(phiq::kSceneFormat) + ", CSV format " +
                                         std::to_string(phiq::kCsvFormat) + ", check --json format " +
                                         std::to_string(phiq::kCheckJsonFormat) + ", run --summary format " +
-                                        std::to_string(phiq::kRunSummaryFormat) + ", sweep-accuracy --json format " +
+                                        std::to_string(phiq::kRunSummaryFormat) + ", batch --summary format " +
+                                        std::to_string(phiq::kBatchSummaryFormat) + ", sweep-accuracy --json format " +
                                         std::to_string(phiq::kSweepAccuracyJsonFormat) + ", compare --json format " +
                                         std::to_string(phiq::kCompareJsonFormat) + ")");
   app.require_subcommand(1);

@@ -208,7 +208,8 @@ Command register_run(CLI::App& app) {
       ->transform(output_path(" (without the option, or '-': standard output)", true));
   run->add_flag("-q,--quiet", a->quiet, "Do not print the run summary on standard error");
   run->add_option("--summary", a->summary_path,
-                  "Write the run summary as JSON (counts and timings) to this file ('-': standard output)")
+                  "Write the run summary as JSON (counts, timings; on a failure to solve, why) to this file ('-': "
+                  "standard output)")
       ->transform(output_path("", false));
   run->add_option("--threads", a->threads, "Threads for the drive steps (0: all cores; 1: in order)")
       ->capture_default_str()

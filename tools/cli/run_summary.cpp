@@ -8,17 +8,7 @@
 
 namespace phiq::tools {
 
-std::string run_summary_json(const Scene& scene, const Model& swept, const SweepSummary& s, const RunTimes& times) {
-  nlohmann::ordered_json j;
-  j["format"] = kRunSummaryFormat;
-  // where and with what it ran: a summary kept by a harness says so without the command line
-  j["phiq"] = version();
-  j["scene"] = scene.path;
-  if (scene.name.empty())
-    j["name"] = nullptr;
-  else
-    j["name"] = scene.name;
-  j["host"] = {{"name", host_name()}, {"cpu", cpu_model()}};
+void add_outcome(nlohmann::ordered_json& j, const Model& swept, const SweepSummary& s) {
   j["status"] = to_string(s.status);
   j["message"] = s.message;
   // where it failed: null on success
@@ -32,6 +22,22 @@ std::string run_summary_json(const Scene& scene, const Model& swept, const Sweep
   j["worst_constraints"] = nlohmann::ordered_json::array();
   for (const auto& [row, residual] : s.worst_rows)
     j["worst_constraints"].push_back({{"name", swept.row_name(row)}, {"residual", residual}});
+}
+
+nlohmann::ordered_json host_json() { return {{"name", host_name()}, {"cpu", cpu_model()}}; }
+
+std::string run_summary_json(const Scene& scene, const Model& swept, const SweepSummary& s, const RunTimes& times) {
+  nlohmann::ordered_json j;
+  j["format"] = kRunSummaryFormat;
+  // where and with what it ran: a summary kept by a harness says so without the command line
+  j["phiq"] = version();
+  j["scene"] = scene.path;
+  if (scene.name.empty())
+    j["name"] = nullptr;
+  else
+    j["name"] = scene.name;
+  j["host"] = host_json();
+  add_outcome(j, swept, s);
   j["steps"] = s.steps_completed;
   j["threads"] = s.threads;
   j["parallel_chunks"] = s.parallel_chunks;

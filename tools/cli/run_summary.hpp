@@ -4,6 +4,8 @@
 
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -12,6 +14,14 @@ namespace phiq::tools {
 struct RunTimes {
   double load = 0.0, solve = 0.0, write = 0.0;
 };
+
+// The outcome of one sweep as the summaries write it (`run --summary`, `batch --summary`'s cases): status,
+// message, failed_step and failed_time (null on success), worst_constraints (the rows of s.worst_rows, named by
+// `swept`), appended to `j`.
+void add_outcome(nlohmann::ordered_json& j, const Model& swept, const SweepSummary& s);
+
+// Where a report was made: {name, cpu} of the host (host_info.hpp).
+nlohmann::ordered_json host_json();
 
 // The summary's JSON text. `swept`: the model the sweep ran on, which names the rows of s.worst_rows (the scene's
 // model, or the square model solved on its independent rows).
