@@ -5,8 +5,10 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -79,7 +81,10 @@ TEST_F(Cli, NumpyKeepsTheIdentifierNames) {
                                 "import sys, numpy\n"
                                 "a = numpy.genfromtxt(sys.argv[1], delimiter=',', names=True)\n"
                                 "print('\\n'.join(a.dtype.names))\n"
-                                "print(repr(float(a[-1]['theta2__v' if sys.argv[2] == 'i' else 'theta2v'])))\n");
+                                "print(repr(float(a[-1]['theta2__v' if sys.argv[2] == 'i' else 'theta2v'])))\n"
+                                "if sys.argv[2] == 'i':\n"
+                                "  r = a.view(numpy.recarray)\n"  // attribute access, as pandas' df.theta2__v
+                                "  print(repr(float(r.theta2__v[-1])), repr(float(r.B__vx[0])))\n");
   auto numpy_names = [&](const fs::path& csv, const char* kind) {
     const fs::path out = dir_ / "py.out", err = dir_ / "py.err";
     const int st = std::system(("/usr/bin/python3 " + script.string() + " " + csv.string() + " " + kind + " >" +
@@ -92,7 +97,16 @@ TEST_F(Cli, NumpyKeepsTheIdentifierNames) {
   const std::string header = first_line(slurp(ident));
   for (char c : header) expected += c == ',' ? '\n' : c;
   EXPECT_EQ(i.out.substr(0, expected.size() + 1), expected + "\n") << "numpy renamed some: " << i.out;
-  EXPECT_EQ(i.out.substr(expected.size() + 1), "1.0\n") << "theta2' = 1 (the motor's rate)";
+  // theta2' = 1 (the motor's rate), read by name and as an attribute; B's x-velocity at the first row by attribute
+  const phiq::CsvTable t = phiq::read_csv_table(ident.string());
+  const auto col = std::find(t.columns.begin(), t.columns.end(), "B__vx") - t.columns.begin();
+  ASSERT_LT(static_cast<std::size_t>(col), t.columns.size());
+  std::istringstream values(i.out.substr(expected.size() + 1));
+  double by_name = 0, by_attribute = 0, vx = 0;
+  values >> by_name >> by_attribute >> vx;
+  EXPECT_EQ(by_name, 1.0) << i.out;
+  EXPECT_EQ(by_attribute, 1.0) << i.out;
+  EXPECT_EQ(vx, t.rows[0][col]) << i.out;  // repr() is the shortest round trip: the same double
   Result d = numpy_names(dotted, "d");
   ASSERT_EQ(d.code, 0) << d.err;
   EXPECT_NE(d.out.find("\ntheta2v_1\n"), std::string::npos) << "format 1's collision, as the issue says: " << d.out;
