@@ -131,4 +131,15 @@ TEST_F(Cli, CompareReadsBothNamings) {
   EXPECT_EQ(run("compare " + dotted.string() + " " + bad.string()).code, 1);
 }
 
+// batch --names identifiers: every case file has the header run writes with the option, the same rows.
+TEST_F(Cli, BatchWritesIdentifierNamesToo) {
+  const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
+  const fs::path cases = write("cases.csv", "L2\n0.3\n"), out = dir_ / "out";
+  ASSERT_EQ(run("batch -q --names identifiers " + scene + " " + cases.string() + " -o " + out.string()).code, 0);
+  Result single = run("run -q --names identifiers " + scene);
+  ASSERT_EQ(single.code, 0) << single.err;
+  EXPECT_EQ(first_line(single.out), "t,theta2,xA,yA,xB,theta2__v,xA__v,yA__v,xB__v,theta2__a,xA__a,yA__a,xB__a");
+  EXPECT_EQ(slurp(out / "case0.csv"), single.out) << "L2 = 0.3 is the scene's own";
+}
+
 }  // namespace

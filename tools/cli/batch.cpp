@@ -20,7 +20,7 @@ namespace {
 // `phiq batch SCENE CASES.csv -o DIR`: the scene swept once per row of CASES.csv (columns: parameter names), the
 // cases in parallel, sharing one symbolic analysis; DIR/case<k>.csv per successful case (k from 0, the row order).
 int cmd_batch(const std::string& scene_path, const std::string& cases_path, const std::string& dir, bool quiet,
-              int threads, const std::string& summary_path) {
+              int threads, const std::string& summary_path, bool identifier_names) {
   phiq::CsvTable cases;
   try {
     cases = phiq::read_csv_table(cases_path);
@@ -104,6 +104,11 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
       swept.push_back(k);
     }
     formats.emplace_back(*sc.model, sc.sweep);
+    try {  // (names that collide are the scene's, whichever case: the first says so)
+      if (identifier_names) formats[k].set_naming(phiq::ColumnNaming::kIdentifiers);
+    } catch (const phiq::Error& e) {
+      return fail(scene_path + ": --names identifiers: " + e.what(), 2);
+    }
     buffers[k] = formats[k].header();
   }
   // Each case touches only its own buffer and file: the callback is safe across cases without a lock (OutputSet
@@ -243,6 +248,7 @@ Command register_batch(CLI::App& app) {
     bool quiet = false;
     int threads = 0;
     std::string summary;
+    std::string names = "dotted";
   };
   auto a = std::make_shared<Args>();
   CLI::App* batch = app.add_subcommand("batch", "Sweep the scene once per parameter set of a CSV, the cases in parallel");
@@ -259,9 +265,12 @@ Command register_batch(CLI::App& app) {
                      "Write the batch summary as JSON (each case's outcome, why it failed) to this file ('-': standard "
                      "output)")
       ->transform(output_path("", false));
+  batch->add_option("--names", a->names, "Column names: dotted (theta2.v) or identifiers (theta2__v), as run's")
+      ->capture_default_str()
+      ->check(one_of({"dotted", "identifiers"}));
   return {batch, [a] {
             const int cases_threads = cap_threads("batch", a->threads, a->quiet);
-            return cmd_batch(a->scene, a->cases, a->dir, a->quiet, cases_threads, a->summary);
+            return cmd_batch(a->scene, a->cases, a->dir, a->quiet, cases_threads, a->summary, a->names == "identifiers");
           }};
 }
 

@@ -26,7 +26,7 @@ _phiq() {
     run) opts="--help --output --quiet --summary --threads --memory --progress --names" ;;
     check) opts="--help --json --time" ;;
     assemble) opts="--help --output --quiet" ;;
-    batch) opts="--help --output --quiet --threads --summary" ;;
+    batch) opts="--help --output --quiet --threads --summary --names" ;;
     compare) opts="--help --rtol --atol --columns --json --junit" ;;
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
     plot) opts="--help --output --columns --positions" ;;
