@@ -389,5 +389,49 @@ TEST(CsvCompare, EmptyTablesAgreeWhenHeadersMatch) {
   EXPECT_EQ(r.summary(), "agree: 0 rows x 2 columns");
 }
 
+// Each column's own worst cell, beside the overall one: row, t, both values, tolerance and ratio, counted apart.
+TEST(CsvCompare, EachColumnHasItsOwnWorstCell) {
+  const CsvTable a = parse("t,x,y\n0,1,5\n0.5,2,6\n1,3,7\n"), b = parse("t,x,y\n0,1,5\n0.5,2.5,6\n1,3.25,7.5\n", "b.csv");
+  const CompareResult r = compare_csv(a, b);
+  ASSERT_EQ(r.per_column.size(), 3u);
+  EXPECT_EQ(r.per_column[0].column, "t");
+  EXPECT_EQ(r.per_column[0].mismatches, 0u);
+  EXPECT_EQ(r.per_column[0].max_abs_diff, 0.0);
+  const ColumnComparison& x = r.per_column[1];
+  EXPECT_EQ(x.column, "x");
+  EXPECT_EQ(x.mismatches, 2u);
+  EXPECT_EQ(x.worst_row, 1u);  // 0.5 / (1e-12 + 2.5e-9) beats 0.25 / (1e-12 + 3.25e-9)
+  EXPECT_EQ(x.worst_t, 0.5);
+  EXPECT_EQ(x.worst_a, 2.0);
+  EXPECT_EQ(x.worst_b, 2.5);
+  EXPECT_EQ(x.worst_tol, 1e-12 + 1e-9 * 2.5);
+  EXPECT_EQ(x.worst_ratio, 0.5 / (1e-12 + 1e-9 * 2.5));
+  EXPECT_EQ(x.max_abs_diff, 0.5);
+  const ColumnComparison& y = r.per_column[2];
+  EXPECT_EQ(y.mismatches, 1u);
+  EXPECT_EQ(y.worst_row, 2u);
+  EXPECT_EQ(y.worst_t, 1.0);
+  EXPECT_EQ(r.mismatches, x.mismatches + y.mismatches);
+  EXPECT_EQ(r.worst_column, "x");
+}
+
+// `theta2.v` in one table, `theta2__v` in the other: the same column (the two namings of `phiq run --names`).
+TEST(CsvCompare, DottedAndIdentifierNamesAreOneColumn) {
+  const CsvTable a = parse("t,x,x.v,P.vx\n0,1,2,3\n"), b = parse("t,x,x__v,P__vx\n0,1,2,3.5\n", "b.csv");
+  const CompareResult r = compare_csv(a, b);
+  EXPECT_EQ(r.compared, (Strings{"t", "x", "x.v", "P.vx"}));
+  EXPECT_TRUE(r.only_in_a.empty());
+  EXPECT_TRUE(r.only_in_b.empty());
+  EXPECT_FALSE(r.equal);
+  EXPECT_EQ(r.worst_column, "P.vx");
+  const CompareResult restricted = compare_csv(a, b, CompareOptions{1e-9, 1e-12, {"x.v"}});
+  EXPECT_TRUE(restricted.equal);
+  // a column matched by its own name is not matched again by its form; `x_v` is not the form of `x.v`
+  const CompareResult exact = compare_csv(parse("t,x.v\n0,1\n"), parse("t,x__v,x.v\n0,2,1\n", "b.csv"));
+  EXPECT_EQ(exact.compared, (Strings{"t", "x.v"}));
+  EXPECT_EQ(exact.only_in_b, (Strings{"x__v"}));
+  EXPECT_EQ(compare_csv(parse("t,x_v\n0,1\n"), parse("t,x.v\n0,1\n", "b.csv")).only_in_a, (Strings{"x_v"}));
+}
+
 }  // namespace
 }  // namespace phiq

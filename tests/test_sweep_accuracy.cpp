@@ -115,7 +115,12 @@ TEST_F(SweepAccuracy, JsonHasTheSettingsTheDefaultAndTheReference) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(r.out.empty());  // with --json and no -o, nothing on standard output
   const auto j = nlohmann::json::parse(slurp(json));
-  EXPECT_EQ(j["format"], 1);
+  EXPECT_EQ(j["format"], 2);
+  EXPECT_EQ(j["phiq"], phiq::kVersion);
+  EXPECT_EQ(j["status"], "success");
+  EXPECT_EQ(j["message"], "");
+  EXPECT_FALSE(j["host"]["name"].get<std::string>().empty());
+  EXPECT_FALSE(j["host"]["cpu"].get<std::string>().empty());
   EXPECT_EQ(j["reference"], "closed-form:fourbar:L1=1,L2=0.4,L3=1.2,L4=1,theta0=0,omega=1,branch=1");
   EXPECT_EQ(j["scene_default"]["tolerance"], 1e-10);
   EXPECT_EQ(j["scene_default"]["predictor"], "cubic");

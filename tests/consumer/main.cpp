@@ -1,11 +1,21 @@
 // An embedding simulator in miniature, built against the installed phiq package: it builds a four-bar in code
 // (natural coordinates + a driven crank angle), advances its own clock, calls the position, velocity and
 // acceleration solves each tick, and checks the results against Freudenstein's closed form and finite
-// differences of its own positions. Exit 0 when every check holds.
+// differences of its own positions, and that the version macros, constant and function of its headers and library
+// agree. Exit 0 when every check holds.
 #include <phiq/phiq.hpp>
+
+#if !defined(PHIQ_VERSION_MAJOR) || !defined(PHIQ_VERSION_MINOR) || !defined(PHIQ_VERSION_PATCH)
+#error "phiq/version.hpp defines PHIQ_VERSION_MAJOR, _MINOR and _PATCH"
+#endif
+#if PHIQ_VERSION_MAJOR == 0 && PHIQ_VERSION_MINOR < 1
+#error "this consumer needs phiq 0.1 or later"
+#endif
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <string>
 
 int main() {
   using namespace phiq;
@@ -49,7 +59,14 @@ int main() {
     vb_1 = ws.qd(xb);
     ++ticks;
   }
+  // the library's own version (version()) is the headers' (kVersion), and the macros spell it
+  const std::string macros = std::to_string(PHIQ_VERSION_MAJOR) + "." + std::to_string(PHIQ_VERSION_MINOR) + "." +
+                             std::to_string(PHIQ_VERSION_PATCH);
+  if (std::strcmp(version(), kVersion) != 0 || macros != kVersion) {
+    std::fprintf(stderr, "consumer: version() %s, kVersion %s, macros %s\n", version(), kVersion, macros.c_str());
+    return 1;
+  }
   std::printf("consumer: phiq %s, %d ticks, worst rocker angle error %.2e rad, velocity vs difference %.2e\n",
-              kVersion, ticks, worst_angle, worst_vel);
+              version(), ticks, worst_angle, worst_vel);
   return (ticks == 401 && worst_angle < 1e-10 && worst_vel < 1e-3) ? 0 : 1;
 }

@@ -1,4 +1,4 @@
-// The report of `phiq sweep-accuracy` written out: one CSV row per setting, or the JSON document (format 1) with
+// The report of `phiq sweep-accuracy` written out: one CSV row per setting, or the JSON document (format 2) with
 // the scene, the reference and the notes (sweep_accuracy.hpp).
 #include <nlohmann/json.hpp>
 
@@ -49,9 +49,18 @@ std::string accuracy_json(const AccuracyReport& r) {
                                   {"linear_solver", to_string(s.linear_solver)}};
   };
   nlohmann::ordered_json j;
-  j["format"] = 1;
+  j["format"] = kSweepAccuracyJsonFormat;
+  j["phiq"] = version();
+  j["host"] = {{"name", r.host}, {"cpu", r.cpu}};
   j["scene"] = r.scene_path;
   j["name"] = r.scene_name;
+  j["status"] = r.status;
+  j["message"] = r.message;
+  if (r.status != "success") {  // nothing was measured: no reference, no settings to report
+    j["notes"] = r.notes;
+    j["rows"] = nlohmann::ordered_json::array();
+    return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+  }
   j["reference"] = r.reference;
   j["coordinates"] = r.coordinates;
   j["length_scale"] = r.length_scale;

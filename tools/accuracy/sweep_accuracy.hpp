@@ -70,6 +70,10 @@ struct AccuracyReport {
   AccuracySetting scene_default;
   std::vector<AccuracyRow> rows;
   std::vector<std::string> notes;  // settings skipped and why, reference fallbacks
+  // Set by the command: where it ran (the times mean little without the machine), and, when the measurement could
+  // not be made (the numerical reference failed), why: status "failed" and the message, with no rows.
+  std::string host = "unknown", cpu = "unknown";
+  std::string status = "success", message;
 };
 
 // Parses the command line's lists ("1e-4,1e-8", "previous,quadratic", "modified,full", "klu,umfpack", "45,180").
@@ -86,7 +90,9 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& optio
                                 const std::function<void(const std::string&)>& progress = {});
 
 // The report as CSV (columns: scene, reference, tolerance, steps, predictor, newton, linear_solver, err_q, err_v,
-// err_a, iterations_per_step, factorizations_per_step, us_per_step, status, default) and as JSON (format 1).
+// err_a, iterations_per_step, factorizations_per_step, us_per_step, status, default) and as JSON (format
+// kSweepAccuracyJsonFormat; a failed report has only the format, phiq, host, scene, name, status, message, notes and
+// an empty rows list).
 std::string accuracy_csv(const AccuracyReport& report);
 std::string accuracy_json(const AccuracyReport& report);
 

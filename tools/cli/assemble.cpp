@@ -15,15 +15,16 @@ namespace {
 
 // `phiq assemble SCENE [-o OUT.csv]`: the assembled position at time.start as a one-row CSV (the columns of
 // `phiq run`'s positions). Nothing is written when the assembly fails.
-int cmd_assemble(const std::string& scene_path, const std::string& out_path, bool quiet) {
+int cmd_assemble(const std::string& scene_arg, const std::string& out_path, bool quiet) {
+  const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   if (!out_path.empty()) {
-    if (const auto clash = output_clash({{"-o", out_path}}, {{"the scene", scene_path}}))
+    if (const auto clash = output_clash({{"-o", out_path}}, {{"the scene", scene_arg == "-" ? "" : scene_arg}}))
       return fail("assemble: " + *clash, 2);
   } else if (stdout_was_closed()) {
     return fail("assemble: standard output: cannot write: it is closed", 3);
   }
   set_interrupt_subject(scene_path, "; no output written");
-  std::optional<phiq::Scene> loaded = load_or_report(scene_path);
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg);
   if (!loaded) return 2;
   const phiq::Scene& scene = *loaded;
   const phiq::Model& model = *scene.model;
@@ -70,7 +71,7 @@ Command register_assemble(CLI::App& app) {
   auto a = std::make_shared<Args>();
   CLI::App* assemble_cmd =
       app.add_subcommand("assemble", "Assemble the rough placement (minimum-norm) and write the coordinates as CSV");
-  assemble_cmd->add_option("scene", a->path, "Scene file (YAML)")->required();
+  assemble_cmd->add_option("scene", a->path, "Scene file (YAML; '-': standard input)")->required();
   assemble_cmd->add_option("-o,--output", a->out, "CSV file to write (default or '-': standard output)")
       ->transform(output_path(" (without the option, or '-': standard output)", true));
   assemble_cmd->add_flag("-q,--quiet", a->quiet, "Do not print the summary on standard error");

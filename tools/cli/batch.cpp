@@ -9,6 +9,7 @@
 #include "command_line.hpp"
 #include "command_support.hpp"
 #include "commands.hpp"
+#include "run_summary.hpp"  // a case's outcome as run --summary writes it
 #include "phiq/csv_compare.hpp"  // read_csv_table: the cases
 #include "phiq/phiq.hpp"
 
@@ -19,7 +20,7 @@ namespace {
 // `phiq batch SCENE CASES.csv -o DIR`: the scene swept once per row of CASES.csv (columns: parameter names), the
 // cases in parallel, sharing one symbolic analysis; DIR/case<k>.csv per successful case (k from 0, the row order).
 int cmd_batch(const std::string& scene_path, const std::string& cases_path, const std::string& dir, bool quiet,
-              int threads) {
+              int threads, const std::string& summary_path, bool identifier_names) {
   phiq::CsvTable cases;
   try {
     cases = phiq::read_csv_table(cases_path);
@@ -31,6 +32,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   {  // no case file may replace the scene or the cases
     std::vector<NamedPath> outs;
     for (std::size_t k = 0; k < cases.rows.size(); ++k) outs.push_back({"-o", case_file(k)});
+    if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
     if (const auto clash = output_clash(outs, {{"the scene", scene_path}, {"the cases", cases_path}}))
       return fail("batch: " + *clash, 2);
   }
@@ -84,8 +86,10 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   OutputSet outputs;
   std::vector<phiq::AtomicOutputFile*> files(scenes.size(), nullptr);
   std::vector<char> written(scenes.size(), 0);
+  phiq::AtomicOutputFile* summary_file = nullptr;
   try {
     if (!phiq::resolve_output_path(case_file(0)).direct) outputs.drop(outputs.add(case_file(0)));
+    if (!summary_path.empty()) summary_file = &outputs.add(summary_path);
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
   }
@@ -100,6 +104,11 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
       swept.push_back(k);
     }
     formats.emplace_back(*sc.model, sc.sweep);
+    try {  // (names that collide are the scene's, whichever case: the first says so)
+      if (identifier_names) formats[k].set_naming(phiq::ColumnNaming::kIdentifiers);
+    } catch (const phiq::Error& e) {
+      return fail(scene_path + ": --names identifiers: " + e.what(), 2);
+    }
     buffers[k] = formats[k].header();
   }
   // Each case touches only its own buffer and file: the callback is safe across cases without a lock (OutputSet
@@ -148,12 +157,29 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
                 interrupt_exit_status());
   int failed = 0;
   bool output_error = false;
+  nlohmann::ordered_json results = nlohmann::ordered_json::array();  // each case's outcome, for --summary
+  auto result = [&](std::size_t k, const phiq::Model& swept, const phiq::SweepSummary& s, const std::string& error) {
+    nlohmann::ordered_json r{{"case", k}, {"line", k + 2}};
+    r["file"] = written[k] ? nlohmann::ordered_json(case_file(k)) : nlohmann::ordered_json(nullptr);
+    add_outcome(r, swept, s);
+    if (!error.empty()) r["status"] = "output error", r["message"] = error;
+    r["steps"] = s.steps_completed;
+    r["newton_iterations"] = s.counters.newton_iterations;
+    results.push_back(r);
+  };
   std::size_t c = 0;  // index of case k among the swept ones
   for (std::size_t k = 0; k < scenes.size(); ++k) {
     if (!prepare_errors[k].empty()) {
       ++failed;
       std::cerr << "phiq: " << printable(scene_path + ": case " + std::to_string(k) + ": " + prepare_errors[k]) +
                        "; no output written\n";
+      phiq::SweepSummary at_start;  // the first position, before any sweep
+      at_start.status = squares[k].assembly.status;
+      at_start.message = prepare_errors[k];
+      at_start.failed_step = 0;
+      at_start.failed_time = scenes[k].sweep.t_begin;
+      at_start.worst_rows = squares[k].assembly.worst_rows;
+      result(k, *scenes[k].model, at_start, "");
       continue;
     }
     const phiq::SweepSummary& s = sum.cases[c++];
@@ -162,6 +188,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
                             : written[k]                                              ? ""
                             : s.status != phiq::SolveStatus::kSuccess ? s.message : "not written";
     output_error |= !write_errors[k].empty();
+    result(k, *models[c - 1], s, write_errors[k]);
     if (!why.empty()) {
       ++failed;
       std::cerr << "phiq: " << printable(scene_path + ": case " + std::to_string(k) + ": " + why) +
@@ -175,6 +202,31 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
               << printable(dir) << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
               << " cases on one symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
               << scientific(sum.solve_seconds, 3) << " s\n";
+  if (summary_file) {
+    nlohmann::ordered_json j;
+    j["format"] = phiq::kBatchSummaryFormat;
+    j["phiq"] = phiq::version();
+    j["scene"] = scene_path;
+    const std::string& name = scenes.front().name;
+    j["name"] = name.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(name);
+    j["host"] = host_json();
+    j["cases_file"] = cases_path;
+    j["directory"] = dir;
+    j["cases"] = scenes.size();
+    j["failed"] = failed;
+    j["written"] = cases_written;
+    j["threads"] = sum.threads;
+    j["shared_analyses"] = sum.shared_analyses;
+    j["load_seconds"] = load_s;
+    j["solve_seconds"] = sum.solve_seconds;
+    j["results"] = std::move(results);
+    try {
+      summary_file->write(json_text(j, 2) + "\n");
+      outputs.commit_one(*summary_file);
+    } catch (const phiq::Error& e) {
+      return fail(e.what(), 3);
+    }
+  }
   return output_error ? 3 : failed ? 1 : 0;
 }
 
@@ -195,6 +247,8 @@ Command register_batch(CLI::App& app) {
     std::string scene, cases, dir;
     bool quiet = false;
     int threads = 0;
+    std::string summary;
+    std::string names = "dotted";
   };
   auto a = std::make_shared<Args>();
   CLI::App* batch = app.add_subcommand("batch", "Sweep the scene once per parameter set of a CSV, the cases in parallel");
@@ -207,9 +261,16 @@ Command register_batch(CLI::App& app) {
   batch->add_option("--threads", a->threads, "Threads for the cases (0: all cores)")
       ->capture_default_str()
       ->check(thread_count());
+  batch->add_option("--summary", a->summary,
+                     "Write the batch summary as JSON (each case's outcome, why it failed) to this file ('-': standard "
+                     "output)")
+      ->transform(output_path("", false));
+  batch->add_option("--names", a->names, "Column names: dotted (theta2.v) or identifiers (theta2__v), as run's")
+      ->capture_default_str()
+      ->check(one_of({"dotted", "identifiers"}));
   return {batch, [a] {
             const int cases_threads = cap_threads("batch", a->threads, a->quiet);
-            return cmd_batch(a->scene, a->cases, a->dir, a->quiet, cases_threads);
+            return cmd_batch(a->scene, a->cases, a->dir, a->quiet, cases_threads, a->summary, a->names == "identifiers");
           }};
 }
 

@@ -15,8 +15,9 @@ namespace phiq::tools {
 
 namespace {
 
-int cmd_check(const std::string& scene_path, bool json, std::optional<double> at) {
-  std::optional<phiq::Scene> loaded = load_or_report(scene_path);
+int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at) {
+  const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg);
   if (!loaded) return 2;
   const phiq::Scene& scene = *loaded;
   const phiq::Model& model = *scene.model;
@@ -126,7 +127,7 @@ Command register_check(CLI::App& app) {
   };
   auto a = std::make_shared<Args>();
   CLI::App* check = app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
-  check->add_option("scene", a->path, "Scene file (YAML)")->required();
+  check->add_option("scene", a->path, "Scene file (YAML; '-': standard input)")->required();
   check->add_flag("--json", a->json, "Print one JSON object (format: tools/README.md)");
   CLI::Option* at =
       check->add_option("--time", a->time, "Assemble and analyse at this time instead of time.start")

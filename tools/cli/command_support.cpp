@@ -1,6 +1,11 @@
 // The helpers every phiq command shares (command_support.hpp).
 #include "command_support.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 
 #include "phiq/text.hpp"
@@ -50,9 +55,24 @@ std::string json_text(const nlohmann::ordered_json& value, int indent) {
   return value.dump(indent, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
+namespace {
+// The scene piped to standard input, named kStdinScene in its errors. Read up to one byte past the size limit, so
+// that parse_scene() refuses an oversized one as load_scene() does, without reading it all. A terminal is refused
+// as load_scene() refuses one given as /dev/stdin: nobody types a scene.
+Scene load_stdin_scene() {
+  if (::isatty(STDIN_FILENO)) throw SceneError(std::string(kStdinScene) + ": is a terminal, not a scene (pipe one in)");
+  const std::size_t limit = SceneLimits{}.max_file_bytes;
+  std::string text;
+  char buf[1 << 16];
+  for (std::size_t n; text.size() <= limit && (n = std::fread(buf, 1, sizeof buf, stdin)) > 0;) text.append(buf, n);
+  if (std::ferror(stdin)) throw SceneError(std::string(kStdinScene) + ": cannot read: " + std::strerror(errno));
+  return phiq::parse_scene(text, kStdinScene);
+}
+}  // namespace
+
 std::optional<Scene> load_or_report(const std::string& path) {
   try {
-    return phiq::load_scene(path);
+    return path == "-" ? load_stdin_scene() : phiq::load_scene(path);
   } catch (const phiq::SceneError& e) {
     fail(e.what(), 2);
     return std::nullopt;

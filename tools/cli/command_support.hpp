@@ -26,8 +26,15 @@ std::string printable(const std::string& text);
 // U+FFFD for each invalid byte instead of throwing: a report is never lost to the bytes of a name.
 std::string json_text(const nlohmann::ordered_json& value, int indent);
 
-// The scene at `path`; on a scene error its one line is printed and the result is empty (the command exits 2).
+// What the scene read from standard input (`phiq run -`) is called in messages and reports.
+inline constexpr const char* kStdinScene = "<stdin>";
+
+// The scene at `path` ("-": standard input, named kStdinScene); on a scene error its one line is printed and the
+// result is empty (the command exits 2).
 std::optional<Scene> load_or_report(const std::string& path);
+
+// How the scene given as `path` is named in messages: kStdinScene for "-", else the path.
+inline std::string scene_label(const std::string& path) { return path == "-" ? kStdinScene : path; }
 
 using Clock = std::chrono::steady_clock;
 inline double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }

@@ -6,7 +6,9 @@
 
 #include "command_line.hpp"
 #include "command_support.hpp"
+#include "cli_support.hpp"
 #include "commands.hpp"
+#include "compare_reports.hpp"
 #include "phiq/csv_compare.hpp"
 #include "phiq/hdf5_reader.hpp"
 #include "phiq/phiq.hpp"
@@ -15,17 +17,33 @@ namespace phiq::tools {
 
 namespace {
 
-int cmd_compare(const std::string& a_path, const std::string& b_path, const phiq::CompareOptions& options) {
+// The reports asked for (--json, --junit) are written on both verdicts, equal or not, and committed together;
+// unreadable input (exit 2) writes none.
+int cmd_compare(const CompareSubject& subject, const std::string& json_path, const std::string& junit_path) {
+  const std::string &a_path = subject.a, &b_path = subject.b;
+  std::vector<NamedPath> outs;
+  if (!json_path.empty()) outs.push_back({"--json", json_path});
+  if (!junit_path.empty()) outs.push_back({"--junit", junit_path});
+  if (const auto clash = output_clash(outs, {{"the first results file", a_path}, {"the second results file", b_path}}))
+    return fail("compare: " + *clash, 2);
   phiq::CompareResult r;
   try {
     const phiq::CsvTable a = phiq::read_result_table(a_path), b = phiq::read_result_table(b_path);
     try {
-      r = phiq::compare_csv(a, b, options);
+      r = phiq::compare_csv(a, b, subject.options);
     } catch (const phiq::Error& e) {  // a --columns name not in a file: a command-line error names its option
       return fail("compare: --columns: " + std::string(e.what()), 2);
     }
   } catch (const phiq::Error& e) {  // the file and line are named
     return fail(e.what(), 2);
+  }
+  try {
+    OutputSet outputs;
+    if (!json_path.empty()) outputs.add(json_path).write(compare_json(subject, r));
+    if (!junit_path.empty()) outputs.add(junit_path).write(compare_junit(subject, r));
+    outputs.commit();
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
   }
   if (r.equal) {
     std::cerr << "phiq: compare " << printable(a_path) << " " << printable(b_path) << ": " << r.summary() << "\n";
@@ -38,22 +56,27 @@ int cmd_compare(const std::string& a_path, const std::string& b_path, const phiq
 
 Command register_compare(CLI::App& app) {
   struct Args {
-    std::string a, b;
-    CompareOptions options;
+    CompareSubject subject;
+    std::string json, junit;
   };
   auto a = std::make_shared<Args>();
   CLI::App* compare =
       app.add_subcommand("compare", "Compare two result files (CSV or HDF5) column by column within tolerances");
-  compare->add_option("a", a->a, "First results file, CSV or HDF5 (e.g. the reference)")->required();
-  compare->add_option("b", a->b, "Second results file, CSV or HDF5")->required();
+  compare->add_option("a", a->subject.a, "First results file, CSV or HDF5 (e.g. the reference)")->required();
+  compare->add_option("b", a->subject.b, "Second results file, CSV or HDF5")->required();
   const CLI::Validator tolerance = number(0.0, HUGE_VAL, true, "a number >= 0 (inf: any difference)");
-  compare->add_option("--rtol", a->options.rtol, "Relative tolerance: |a-b| <= atol + rtol*max(|a|,|b|)")
+  compare->add_option("--rtol", a->subject.options.rtol, "Relative tolerance: |a-b| <= atol + rtol*max(|a|,|b|)")
       ->capture_default_str()
       ->check(tolerance);
-  compare->add_option("--atol", a->options.atol, "Absolute tolerance")->capture_default_str()->check(tolerance);
-  compare->add_option("--columns", a->options.columns, "Compare only these columns (default: all; headers must match)")
+  compare->add_option("--atol", a->subject.options.atol, "Absolute tolerance")->capture_default_str()->check(tolerance);
+  compare->add_option("--columns", a->subject.options.columns, "Compare only these columns (default: all; headers must match)")
       ->delimiter(',');
-  return {compare, [a] { return cmd_compare(a->a, a->b, a->options); }};
+  // a flag, not an option: `--json` alone (standard output) never takes the next argument, a CSV, for its file
+  compare->add_flag("--json{-}", a->json, "Write the comparison as JSON to standard output, or --json=FILE")
+      ->transform(output_path("", false));
+  compare->add_option("--junit", a->junit, "Write the comparison as JUnit XML to this file (one test case per column)")
+      ->transform(output_path("", false));
+  return {compare, [a] { return with_stdout_checked(cmd_compare(a->subject, a->json, a->junit)); }};
 }
 
 }  // namespace phiq::tools

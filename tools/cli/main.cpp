@@ -27,10 +27,16 @@ int main(int argc, char** argv) {
   start_interrupts();
 
   CLI::App app{"phiq: sparse, large-scale multibody kinematics"};
-  app.set_version_flag("--version", std::string("phiq ") + phiq::kVersion + " (scene format " +
+  // every format another program parses, with its version: a harness checks the ones it reads
+  app.set_version_flag("--version", std::string("phiq ") + phiq::version() + " (scene format " +
                                         std::to_string(phiq::kSceneFormat) + ", CSV format " +
-                                        std::to_string(phiq::kCsvFormat) + ", check --json format " +
-                                        std::to_string(phiq::kCheckJsonFormat) + ")");
+                                        std::to_string(phiq::kCsvFormat) + ", HDF5 results format " +
+                                        std::to_string(phiq::kHdf5Format) + ", check --json format " +
+                                        std::to_string(phiq::kCheckJsonFormat) + ", run --summary format " +
+                                        std::to_string(phiq::kRunSummaryFormat) + ", batch --summary format " +
+                                        std::to_string(phiq::kBatchSummaryFormat) + ", sweep-accuracy --json format " +
+                                        std::to_string(phiq::kSweepAccuracyJsonFormat) + ", compare --json format " +
+                                        std::to_string(phiq::kCompareJsonFormat) + ")");
   app.require_subcommand(1);
   const std::vector<Command> commands{register_run(app),    register_generate(app), register_batch(app),
                                       register_assemble(app), register_check(app),  register_plot(app),

@@ -8,81 +8,29 @@
 #include <iostream>
 #include <memory>
 
-#include <nlohmann/json.hpp>
-
 #include "cli_support.hpp"
 #include "command_line.hpp"
 #include "command_support.hpp"
 #include "commands.hpp"
 #include "progress_bar.hpp"
 #include "result_file.hpp"
+#include "run_summary.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
 
 namespace {
 
-// `phiq run --summary FILE.json`: the run summary, format version 1 (tools/README.md).
-std::string summary_json(const phiq::Scene& scene, const phiq::Workspace& /*ws*/, const phiq::SweepSummary& s,
-                         double load_s, double solve_s, double write_s) {
-  nlohmann::ordered_json j;
-  j["format"] = 1;
-  j["scene"] = scene.path;
-  j["status"] = phiq::to_string(s.status);
-  j["message"] = s.message;
-  j["steps"] = s.steps_completed;
-  j["threads"] = s.threads;
-  j["parallel_chunks"] = s.parallel_chunks;
-  j["coordinates"] = scene.model->num_coordinates();
-  j["linear_solver"] = phiq::to_string(scene.model->linear_solver());
-  j["load_seconds"] = load_s;
-  j["solve_seconds"] = solve_s;
-  // the sweep's wall time: the solve and the writing done in its callback, which other threads' solving overlaps
-  j["sweep_seconds"] = s.solve_seconds;
-  j["write_seconds"] = write_s;
-  j["newton_iterations"] = s.counters.newton_iterations;
-  j["factorizations"] = s.counters.factorizations;
-  j["pivoting_factorizations"] = s.counters.pivoting_factorizations;
-  j["velocity_solves"] = s.counters.velocity_solves;
-  j["acceleration_solves"] = s.counters.acceleration_solves;
-  j["phi_t_evaluations"] = s.counters.phi_t_evaluations;
-  j["gamma_evaluations"] = s.counters.gamma_evaluations;
-  j["residual_evaluations"] = s.counters.residual_evaluations;
-  j["point_evaluations"] = s.counters.point_evaluations;
-  j["subdivisions"] = s.subdivisions;
-  j["singular_positions"] = s.singular_positions;
-  // 0 in the summary means no row measured it (a positions-only sweep factorises at Newton iterates, not at the
-  // solutions): null, not a condition number of 0, which would read as a singular Jacobian
-  if (s.min_rcond > 0.0)
-    j["min_rcond"] = s.min_rcond;
-  else
-    j["min_rcond"] = nullptr;
-  // how well q is known per class of row (SweepAccuracy): the estimated error in units of the tolerance test
-  auto row_class = [](const phiq::RowClassAccuracy& c) {
-    nlohmann::ordered_json r;
-    r["rows"] = c.rows;
-    r["worst_error"] = c.worst_error;
-    r["worst_time"] = c.worst_time;
-    r["unestimated"] = c.unestimated;
-    return r;
-  };
-  j["accuracy"] = {{"tolerance", scene.sweep.newton.tolerance},
-                   {"converged", row_class(s.accuracy.converged)},
-                   {"rounding_level", row_class(s.accuracy.rounding_level)},
-                   {"singular", row_class(s.accuracy.singular)}};
-  j["warnings"] = nlohmann::ordered_json::array();
-  for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});
-  return json_text(j, 2) + "\n";
-}
-
-int cmd_run(const std::string& scene_path, const std::string& out_path, const std::string& format, int deflate,
+int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb,
-            ProgressBar::Mode progress_mode) {
+            ProgressBar::Mode progress_mode, bool identifier_names) {
+  const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
   if (!out_path.empty()) outs.push_back({"-o", out_path});
   if (!summary_path.empty()) outs.push_back({"--summary", summary_path});
-  if (const auto clash = output_clash(outs, {{"the scene", scene_path}})) return fail("run: " + *clash, 2);
+  if (const auto clash = output_clash(outs, {{"the scene", scene_arg == "-" ? "" : scene_arg}}))
+    return fail("run: " + *clash, 2);
   const bool hdf5 = result_format(format, out_path) == ResultFormat::kHdf5;
   if (deflate > 0 && !hdf5)
     return fail("run: --deflate compresses HDF5 results only (-o FILE.h5 or --format hdf5)", 2);
@@ -92,7 +40,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, const st
     return fail("run: standard output: cannot write: it is closed", 3);
   set_interrupt_subject(scene_path, "; no output written");
   const auto load_start = Clock::now();
-  std::optional<phiq::Scene> loaded = load_or_report(scene_path);
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg);
   if (!loaded) return 2;
   phiq::Scene& scene = *loaded;
   const double load_s = since(load_start);
@@ -113,10 +61,31 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, const st
     return fail(e.what(), 3);
   }
 
+  // A run that cannot be solved still commits its summary (status, where, why: for harnesses), never the CSV. Its
+  // message is the line stderr gets.
+  auto failed = [&](const phiq::Model& swept, phiq::SweepSummary s, const RunTimes& times, const std::string& why) {
+    s.message = why;
+    if (summary_file) try {
+        summary_file->write(run_summary_json(scene, swept, s, times));
+        outputs.commit_one(*summary_file);
+      } catch (const phiq::Error& e) {
+        return fail(e.what(), 3);
+      }
+    return fail(scene_path + ": " + why +
+                    (summary_file ? "; wrote the summary only" : outs.empty() ? "" : "; no output written"),
+                1);
+  };
   // inconsistent or under-driven models stop here, naming the constraints
   phiq::SquareScene square;
-  if (const auto why = make_square(scene, &square))
-    return fail(scene_path + ": " + *why + (outs.empty() ? "" : "; no output written"), 1);
+  if (const auto why = make_square(scene, &square)) {
+    phiq::SweepSummary at_start;  // the first position, before any sweep
+    at_start.status = square.assembly.status;
+    at_start.message = *why;
+    at_start.failed_step = 0;
+    at_start.failed_time = scene.sweep.t_begin;
+    at_start.worst_rows = square.assembly.worst_rows;
+    return failed(*scene.model, at_start, {load_s, 0.0, 0.0}, *why);
+  }
   const phiq::AssemblySummary& redundancy = square.assembly;
   const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;
@@ -126,6 +95,11 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, const st
   // columns from the scene's output plan and model (its constraints); residuals of a model solved on its
   // independent rows are evaluated on the whole scene model (CsvFormat)
   phiq::CsvFormat csv(*scene.model, scene.sweep);
+  try {
+    csv.set_naming(identifier_names ? phiq::ColumnNaming::kIdentifiers : phiq::ColumnNaming::kDotted);
+  } catch (const phiq::Error& e) {  // names that would collide: the scene's to change
+    return fail(scene_path + ": --names identifiers: " + e.what(), 2);
+  }
   std::unique_ptr<phiq::Hdf5Writer> h5;  // after `outputs`: closed before its temporary is removed
   try {
     if (hdf5) h5 = open_hdf5_results(*file, scene, deflate);
@@ -197,7 +171,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, const st
           phiq::SolveStatus::kSuccess)
         why += "; rank analysis: " + as.message;
     }
-    return fail(scene_path + ": " + why + (outs.empty() ? "" : "; no output written"), 1);
+    return failed(model, summary, {load_s, summary.solve_seconds - write_s, write_s}, why);
   }
   const double solve_s = summary.solve_seconds - write_s;
   const auto final_write = Clock::now();
@@ -217,7 +191,7 @@ int cmd_run(const std::string& scene_path, const std::string& out_path, const st
       if (const auto bad = stdout_error()) throw phiq::Error(*bad);
     }
     write_s += since(final_write);
-    if (summary_file) summary_file->write(summary_json(scene, ws, summary, load_s, solve_s, write_s));
+    if (summary_file) summary_file->write(run_summary_json(scene, model, summary, {load_s, solve_s, write_s}));
     outputs.commit();
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
@@ -252,10 +226,11 @@ Command register_run(CLI::App& app) {
     double memory_gb = 0.0;
     std::string progress = "auto";
     int deflate = 0;
+    std::string names = "dotted";
   };
   auto a = std::make_shared<Args>();
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
-  run->add_option("scene", a->scene_path, "Scene file (YAML)")->required();
+  run->add_option("scene", a->scene_path, "Scene file (YAML; '-': standard input)")->required();
   run->add_option("-o,--output", a->out_path,
                   "Results file to write, CSV or HDF5 (--format; default or '-': CSV on standard output)")
       ->transform(output_path(" (without the option, or '-': standard output)", true));
@@ -269,7 +244,8 @@ Command register_run(CLI::App& app) {
       ->check(whole_number(0, 9, "uncompressed"));
   run->add_flag("-q,--quiet", a->quiet, "Do not print the run summary on standard error");
   run->add_option("--summary", a->summary_path,
-                  "Write the run summary as JSON (counts and timings) to this file ('-': standard output)")
+                  "Write the run summary as JSON (counts, timings; on a failure to solve, why) to this file ('-': "
+                  "standard output)")
       ->transform(output_path("", false));
   run->add_option("--threads", a->threads, "Threads for the drive steps (0: all cores; 1: in order)")
       ->capture_default_str()
@@ -283,11 +259,16 @@ Command register_run(CLI::App& app) {
                   "Progress bar on standard error: auto (when it is a terminal), always, never")
       ->capture_default_str()
       ->check(one_of({"auto", "always", "never"}));
+  run->add_option("--names", a->names,
+                  "Column names: dotted (theta2.v) or identifiers (theta2__v: kept by numpy and pandas)")
+      ->capture_default_str()
+      ->check(one_of({"dotted", "identifiers"}));
   return {run, [a] {
             using Mode = ProgressBar::Mode;
             const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
-            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet, a->summary_path,
-                                               cap_threads("run", a->threads, a->quiet), a->memory_gb, mode));
+            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet,
+                                               a->summary_path, cap_threads("run", a->threads, a->quiet), a->memory_gb,
+                                               mode, a->names == "identifiers"));
           }};
 }
 

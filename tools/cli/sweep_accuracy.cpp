@@ -11,6 +11,7 @@
 #include "command_line.hpp"
 #include "command_support.hpp"
 #include "commands.hpp"
+#include "host_info.hpp"
 #include "sweep_accuracy.hpp"
 #include "phiq/text.hpp"
 
@@ -87,11 +88,23 @@ int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
   } catch (const std::invalid_argument& e) {
     return fail(a.scene + ": " + e.what(), 2);
   } catch (const std::runtime_error& e) {
-    return fail(a.scene + ": " + e.what(), 1);
+    // the JSON is a report for programs: it says why, as stderr does (the CSV, a table of settings, is not written)
+    if (json_file) try {
+        AccuracyReport failed;
+        failed.scene_path = scene.path, failed.scene_name = scene.name;
+        failed.host = host_name(), failed.cpu = cpu_model();
+        failed.status = "failed", failed.message = a.scene + ": " + e.what();
+        json_file->write(accuracy_json(failed));
+        outputs.commit_one(*json_file);
+      } catch (const Error& w) {
+        return fail(w.what(), 3);
+      }
+    return fail(a.scene + ": " + e.what() + (json_file ? "; wrote the JSON only" : ""), 1);
   }
   if (stop_flag().load())  // a signal after the last sweep: stopped all the same
     return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  rep.host = host_name(), rep.cpu = cpu_model();
   try {
     const std::string csv = accuracy_csv(rep);
     if (csv_file) csv_file->write(csv);

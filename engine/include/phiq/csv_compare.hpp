@@ -58,6 +58,22 @@ struct CompareOptions {
   std::vector<std::string> columns;
 };
 
+/// One compared column's comparison (CompareResult::per_column): its own worst cell, for reports that judge
+/// column by column (JUnit test cases, `phiq compare --json`).
+struct ColumnComparison {
+  std::string column;          ///< Its name.
+  std::size_t mismatches = 0;  ///< Its cells beyond tolerance.
+  /// Its cell with the largest ratio |a-b| / tol (the first such row on ties); the fields below are valid when
+  /// both tables have rows.
+  std::size_t worst_row = 0;
+  double worst_t = std::numeric_limits<double>::quiet_NaN();  ///< Column "t" of A at worst_row, NaN without one.
+  double worst_a = 0;      ///< Value in A at its worst cell.
+  double worst_b = 0;      ///< Value in B at its worst cell.
+  double worst_tol = 0;    ///< Tolerance there, atol + rtol*max(|a|,|b|) (0 for NaN or inf against another value).
+  double worst_ratio = 0;  ///< |a-b| / worst_tol there (inf for NaN or inf against another value).
+  double max_abs_diff = 0; ///< Largest |a-b| over its cells, counted as CompareResult::max_abs_diff.
+};
+
 /// What compare_csv() found. The "worst" fields describe the cell with the largest ratio
 /// |a-b| / (atol + rtol*max(|a|,|b|)); they are valid when `compared` is non-empty and both tables have rows
 /// (otherwise worst_column is empty). Ties go to the first such cell, rows first, then columns in A's order.
@@ -85,6 +101,8 @@ struct CompareResult {
   double max_abs_diff = 0;
   std::string max_abs_diff_column;  ///< Column where max_abs_diff occurs (empty if max_abs_diff is 0).
   std::size_t mismatches = 0;       ///< Number of compared cells beyond tolerance.
+  /// Each compared column's own comparison, in the order of `compared`.
+  std::vector<ColumnComparison> per_column;
 
   /// One line for logs and test failures, e.g.
   /// "differ: 3 cells beyond tolerance; worst xB.a at line 19 (t = 0.29670597283903605): 1.25 vs 1.2500001
@@ -96,6 +114,10 @@ struct CompareResult {
 };
 
 /// Compares the shared columns of two tables row by row, over min(rows_a, rows_b) rows.
+///
+/// Columns are matched by name; a name found in one table only is matched with the other's column of the same
+/// identifier_column_name() when each table has exactly one such unmatched column, so that a CSV with dotted names
+/// (`theta2.v`) compares with one of `phiq run --names identifiers` (`theta2__v`). Results name A's columns.
 ///
 /// A cell agrees when |a-b| <= atol + rtol*max(|a|,|b|). NaN agrees with NaN; NaN against a number is a mismatch
 /// with an infinite ratio; an infinity agrees only with the same infinity.

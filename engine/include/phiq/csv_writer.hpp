@@ -14,6 +14,20 @@
 
 namespace phiq {
 
+/// How the columns of a result CSV are named (tools/README.md, `phiq run --names`).
+enum class ColumnNaming {
+  /// `theta2.v`, `B.x`, `motor.f`: the scene's names with the quantity after a dot (CSV format 1's default).
+  kDotted,
+  /// Python identifiers that numpy.genfromtxt(names=True) and pandas attribute access keep as they are:
+  /// identifier_column_name() of the dotted name (`theta2__v`, `B__x`, `motor__f`).
+  kIdentifiers,
+};
+
+/// The identifier form of a dotted column name: each '.' written "__", any other character that is not an ASCII
+/// letter, digit or '_' written '_', and a leading digit preceded by '_' (`theta2.v` → `theta2__v`). Not
+/// one-to-one by itself: CsvFormat::set_naming() refuses the columns whose forms collide.
+std::string identifier_column_name(const std::string& dotted);
+
 /// The columns of a result CSV (format version kCsvFormat) and the formatting of its rows. Thread-safe (const).
 class CsvFormat {
  public:
@@ -25,6 +39,11 @@ class CsvFormat {
   /// `residual`; `rcond`. Throws phiq::Error for an index out of range. The model and the plan must outlive the
   /// CsvFormat.
   CsvFormat(const Model& model, const OutputPlan& plan);
+  /// Names the columns so (ColumnNaming::kDotted unless set). Throws phiq::Error, leaving the naming unchanged,
+  /// for kIdentifiers when two columns would get the same name (a coordinate `theta2__v` beside the velocity of
+  /// `theta2`), or a column's would be a Python keyword or one genfromtxt renames (`return`, `file`, `print`): the
+  /// message names the columns.
+  void set_naming(ColumnNaming naming);
   /// The column names, "t" first.
   std::vector<std::string> column_names() const;
   /// The header line, with '\\n'.
@@ -44,6 +63,8 @@ class CsvFormat {
   std::vector<Index> columns_, v_columns_, a_columns_;  // the q, q̇ and q̈ columns
   bool velocities_, accelerations_;  // q̇ / q̈ are delivered: the points' and drivers' derivative columns too
   const OutputPlan* plan_ = nullptr;  // the other outputs, when made from an output plan
+  ColumnNaming naming_ = ColumnNaming::kDotted;
+  std::vector<std::string> dotted_names() const;  // the names of format 1
   void append_coordinates(const StepView& step, std::string& out) const;  // the q, q̇, q̈ columns
   void append_outputs(const StepView& step, std::string& out) const;      // the columns after the coordinates
   template <class Emit>

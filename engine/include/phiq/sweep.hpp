@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "phiq/kinematics.hpp"
@@ -177,6 +178,10 @@ struct SweepSummary {
   Index steps_completed = 0;
   Index failed_step = -1;    ///< k of the step that failed, or -1
   double failed_time = 0.0;  ///< t_k of the step that failed
+  /// At a failed position (initial assembly, drive step): the worst rows of the last position tried, (row of the
+  /// model swept, |Φ_i| / scale_i), largest first, at most 3, as `message` names them (Model::row_name()); empty
+  /// on success, or when the failure is not a position's (a derivative, the time domain, a redundancy conflict).
+  std::vector<std::pair<Index, double>> worst_rows;
   PositionSummary assembly;  ///< the initial position problem
   WorkCounters counters;     ///< work done by this sweep
   Index subdivisions = 0;    ///< sub-steps inserted after Newton failures

@@ -1,10 +1,12 @@
 #include "phiq/csv_compare.hpp"
+#include "phiq/csv_writer.hpp"  // identifier_column_name
 
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -199,6 +201,27 @@ CompareResult compare_csv(const CsvTable& a, const CsvTable& b, const CompareOpt
   std::unordered_map<std::string_view, std::size_t> index_a, index_b;
   for (std::size_t j = 0; j < a.columns.size(); ++j) index_a.emplace(a.columns[j], j);
   for (std::size_t j = 0; j < b.columns.size(); ++j) index_b.emplace(b.columns[j], j);
+  // A column whose name is in one file only is matched with one of the other file that has the same identifier
+  // form (`theta2.v` against `theta2__v`: the two namings of `phiq run --names`), when exactly one has it.
+  {
+    std::unordered_map<std::string, std::size_t> ident_b;  // identifier form -> B's column (SIZE_MAX: several)
+    for (std::size_t j = 0; j < b.columns.size(); ++j)
+      if (!index_a.count(b.columns[j])) {
+        auto [it, fresh] = ident_b.emplace(identifier_column_name(b.columns[j]), j);
+        if (!fresh) it->second = SIZE_MAX;
+      }
+    std::vector<std::pair<std::size_t, std::size_t>> aliases;
+    std::unordered_map<std::string, std::size_t> ident_a;
+    for (std::size_t j = 0; j < a.columns.size(); ++j)
+      if (!index_b.count(a.columns[j])) ++ident_a[identifier_column_name(a.columns[j])];
+    for (std::size_t j = 0; j < a.columns.size(); ++j) {
+      if (index_b.count(a.columns[j])) continue;
+      const std::string id = identifier_column_name(a.columns[j]);
+      const auto it = ident_b.find(id);
+      if (it != ident_b.end() && it->second != SIZE_MAX && ident_a[id] == 1) aliases.emplace_back(j, it->second);
+    }
+    for (const auto& [ja, jb] : aliases) index_b.emplace(a.columns[ja], jb), index_a.emplace(b.columns[jb], ja);
+  }
 
   CompareResult r;
   r.rows_a = a.rows.size();
@@ -227,6 +250,9 @@ CompareResult compare_csv(const CsvTable& a, const CsvTable& b, const CompareOpt
     }
   }
   for (const auto& [ja, jb] : cols) r.compared.push_back(a.columns[ja]);
+  r.per_column.resize(cols.size());
+  std::vector<double> column_worst(cols.size(), -1.0);
+  for (std::size_t c = 0; c < cols.size(); ++c) r.per_column[c].column = r.compared[c];
 
   const auto t_it = index_a.find("t");
   const std::size_t nrows = std::min(r.rows_a, r.rows_b);
@@ -237,7 +263,8 @@ CompareResult compare_csv(const CsvTable& a, const CsvTable& b, const CompareOpt
   for (std::size_t i = 0; i < nrows; ++i) {
     const std::vector<double>& ra = a.rows[i];
     const std::vector<double>& rb = b.rows[i];
-    for (const auto& [ja, jb] : cols) {
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      const auto [ja, jb] = cols[c];
       const double x = ra[ja], y = rb[jb];
       double diff, ratio, tol = 0.0;
       bool bad;
@@ -254,6 +281,14 @@ CompareResult compare_csv(const CsvTable& a, const CsvTable& b, const CompareOpt
       }
       if (bad) ++r.mismatches;
       if (diff > r.max_abs_diff) r.max_abs_diff = diff, max_diff_col = ja;
+      ColumnComparison& col = r.per_column[c];
+      col.mismatches += bad;
+      col.max_abs_diff = std::max(col.max_abs_diff, diff);
+      if (ratio > column_worst[c]) {
+        column_worst[c] = col.worst_ratio = ratio;
+        col.worst_row = i, col.worst_a = x, col.worst_b = y, col.worst_tol = tol;
+        if (t_it != index_a.end()) col.worst_t = ra[t_it->second];
+      }
       if (ratio > worst) {
         worst = ratio;
         r.worst_tol = tol;

@@ -4,12 +4,16 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <map>
+#include <set>
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
+
+#include "base/names.hpp"
 
 namespace phiq {
 
@@ -34,7 +38,49 @@ CsvFormat::CsvFormat(const Model& model, const OutputPlan& plan)
       throw Error("CsvFormat: residual constraint index out of range");
 }
 
+std::string identifier_column_name(const std::string& dotted) {
+  std::string id;
+  if (!dotted.empty() && dotted[0] >= '0' && dotted[0] <= '9') id += '_';
+  for (char c : dotted) {
+    if (c == '.')
+      id += "__";
+    else
+      id += detail::is_name_char(c) ? c : '_';
+  }
+  return id;
+}
+
+void CsvFormat::set_naming(ColumnNaming naming) {
+  if (naming == ColumnNaming::kIdentifiers) {
+    // Python's keywords (attribute access cannot spell them) and the names numpy.genfromtxt renames
+    static const std::set<std::string> reserved = {
+        "False", "None",   "True",  "and",      "as",     "assert", "async", "await",  "break",  "class",
+        "continue", "def", "del",   "elif",     "else",   "except", "finally", "for",  "from",   "global",
+        "if",    "import", "in",    "is",       "lambda", "nonlocal", "not", "or",     "pass",   "raise",
+        "return", "try",   "while", "with",     "yield",  "file",   "print"};
+    std::map<std::string, std::string> first;  // identifier form -> the dotted name that has it
+    for (const std::string& d : dotted_names()) {
+      const std::string id = identifier_column_name(d);
+      if (reserved.count(id))
+        throw Error("column '" + d + "' would be named '" + id +
+                    "', which Python reserves or numpy.genfromtxt renames: rename it in the scene");
+      auto [it, fresh] = first.emplace(id, d);
+      if (!fresh)
+        throw Error("columns '" + it->second + "' and '" + d + "' would both be named '" + id +
+                    "': rename one in the scene");
+    }
+  }
+  naming_ = naming;
+}
+
 std::vector<std::string> CsvFormat::column_names() const {
+  std::vector<std::string> h = dotted_names();
+  if (naming_ == ColumnNaming::kIdentifiers)
+    for (std::string& n : h) n = identifier_column_name(n);
+  return h;
+}
+
+std::vector<std::string> CsvFormat::dotted_names() const {
   std::vector<std::string> h{"t"};
   const auto& names = model_.coordinate_names();
   for (Index j : columns_) h.push_back(names[j]);

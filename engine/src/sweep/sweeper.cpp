@@ -87,6 +87,7 @@ bool Sweeper::advance(double t1, int depth) {
     const std::string dead = dead_point(t1);
     // (a derivative that does not exist says so itself: no guess at another cause)
     const bool no_derivative = st == SolveStatus::kNonFinite && why.rfind(detail::kNonFiniteJacobian, 0) == 0;
+    sum_.worst_rows = ps.worst_rows;  // the last sub-step's position, the one `why` describes
     return fail(st, beyond +
                         (no_derivative   ? "): "
                          : dead.empty() ? ": the drive leaves the reachable range, or the mechanism "

@@ -180,7 +180,10 @@ class Sweeper {
     newton_.start_error = seed_error;
     PositionSummary ps;
     SolveStatus st = solve_position(model_, t, newton_, *ws_, &ps);
-    if (st != SolveStatus::kSuccess) return fail(st, ps.message);
+    if (st != SolveStatus::kSuccess) {
+      sum_.worst_rows = ps.worst_rows;
+      return fail(st, ps.message);
+    }
     return converged(t, ps);
   }
 
@@ -254,7 +257,10 @@ class Sweeper {
       if (st == SolveStatus::kSingularJacobian) ws_->q = placement, o.start_error = opt_.assembly.start_error;
     }
     if (st == SolveStatus::kSingularJacobian) st = solve_position(model_, t, o, *ws_, &sum_.assembly);
-    if (st != SolveStatus::kSuccess) return fail(st, "initial assembly failed: " + sum_.assembly.message);
+    if (st != SolveStatus::kSuccess) {
+      sum_.worst_rows = sum_.assembly.worst_rows;
+      return fail(st, "initial assembly failed: " + sum_.assembly.message);
+    }
     return converged(t, sum_.assembly);
   }
 
