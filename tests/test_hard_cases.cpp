@@ -265,7 +265,7 @@ drivers:
   - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 1}}
 time: {start: 0, end: 2*pi, steps: 72}
 )Y", "badly_scaled.yaml");
-  const double L1 = 1e6, L2 = 1e-6, L3 = 1e6, L4 = 1.5e-6;
+  const double L1 = 1e6, L2 = 1e-6, L4 = 1.5e-6;  // L3 = L1 (the closed form below uses it so)
   const Index xB = sc.model->coordinate_index("xB"), yB = sc.model->coordinate_index("yB");
   Workspace ws(*sc.model);
   SweepSummary sum;
