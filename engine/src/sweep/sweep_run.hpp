@@ -55,15 +55,11 @@ struct Run {
       last_sign_t = det_sign_t;
       singular_since = false;
     }
-    if (!opt.writes_row(k, time_of(k))) {  // solved, not written (OutputPlan::every, window)
-      ++sum.steps_completed;
-      add_row_quality(sum.accuracy, time_of(k), quality);
-      return true;
-    }
+    ++sum.steps_completed;
+    add_row_quality(sum.accuracy, time_of(k), quality);
+    if (!opt.writes_row(k, time_of(k))) return true;  // solved, not written (OutputPlan::every, window)
     StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
                   points, opt.residuals ? &phi : nullptr, opt.condition ? rcond : 0.0};
-    ++sum.steps_completed;
-    add_row_quality(sum.accuracy, view.t, quality);
     if (on_step && !on_step(view)) {
       sum.status = SolveStatus::kCancelled;
       sum.message = "stopped by the caller after step " + std::to_string(k);
