@@ -1,7 +1,5 @@
 #include "result_file.hpp"
 
-#include <cmath>
-
 #include "phiq/hdf5_reader.hpp"
 
 namespace phiq::tools {
@@ -26,15 +24,7 @@ std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile
   phiq::Hdf5Options o;
   o.scene_path = scene.path;
   o.scene_text = scene.text;
-  // the rows the output plan writes (OutputPlan::every, window), counted on the grid the sweep runs
-  const phiq::SweepOptions& so = scene.sweep;
-  const double h = so.steps > 0 ? (so.t_end - so.t_begin) / static_cast<double>(so.steps) : 0.0;
-  if (std::isinf(so.window_begin) && std::isinf(so.window_end))
-    o.expected_rows = static_cast<std::size_t>(so.steps / so.every) + 1;
-  else
-    for (phiq::Index k = 0; k <= so.steps; k += so.every)
-      if (so.writes_row(k, k == so.steps && k > 0 ? so.t_end : so.t_begin + static_cast<double>(k) * h))
-        ++o.expected_rows;
+  o.expected_rows = static_cast<std::size_t>(phiq::rows_written(scene.sweep));
   o.shown_path = file.path();
   o.deflate = deflate;
   o.shuffle = deflate > 0;  // the doubles' exponent bytes together: bench/README.md, "Writing HDF5"

@@ -61,6 +61,12 @@ struct TimeGrid {
   /// |t_end − t_begin| / steps above 8 ulps of the larger of |t_begin|, |t_end| (else run_sweep throws phiq::Error)
   double t_end = 1.0;
   Index steps = 100;      ///< intervals: steps + 1 time points, t_k = t_begin + k (t_end − t_begin) / steps
+  /// t_k, computed from k, not accumulated, so that the last point is t_end exactly (steps = 0: t_begin).
+  double time_of(Index k) const {
+    if (steps == 0) return t_begin;
+    if (k == steps) return t_end;
+    return t_begin + static_cast<double>(k) * ((t_end - t_begin) / static_cast<double>(steps));
+  }
 };
 
 /// How each position of a sweep is solved.
@@ -109,6 +115,9 @@ struct ParallelSettings {
 
 /// What run_sweep computes and how: its parts can be set and passed on their own.
 struct SweepOptions : TimeGrid, OutputPlan, SolverSettings, ParallelSettings {};
+
+/// The rows a sweep with these options delivers when it succeeds: the time points OutputPlan::writes_row selects.
+Index rows_written(const SweepOptions& o);
 
 /// What the step callback sees. qd / qdd are null when not computed.
 struct StepView {

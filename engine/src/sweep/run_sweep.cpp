@@ -81,7 +81,6 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
 
   ws.start_afresh();  // the sweep's results depend on the model, the options and ws.q only
   Run run{opt, on_step, sum};
-  run.h = opt.steps > 0 ? (opt.t_end - opt.t_begin) / static_cast<double>(opt.steps) : 0.0;
   Sweeper sw(model, opt, ws, sum);
   if (!sw.assemble(run.time_of(0))) {
     run.failed(0);
@@ -127,6 +126,13 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   const int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
   tbb::task_arena arena(threads);
   return arena.execute([&] { return sweep_in_arena(model, opt, ws, on_step, summary, threads); });
+}
+
+Index rows_written(const SweepOptions& o) {
+  if (std::isinf(o.window_begin) && std::isinf(o.window_end)) return o.steps / o.every + 1;
+  Index n = 0;
+  for (Index k = 0; k <= o.steps; k += o.every) n += o.writes_row(k, o.time_of(k)) ? 1 : 0;
+  return n;
 }
 
 }  // namespace phiq

@@ -18,12 +18,8 @@ struct Run {
   const SweepOptions& opt;
   const std::function<bool(const StepView&)>& on_step;
   SweepSummary& sum;
-  double h = 0.0;
 
-  // t_k computed from k, not accumulated, so that the last point is t_end exactly (steps = 0: one row, at t_begin)
-  double time_of(Index k) const {
-    return k == opt.steps && k > 0 ? opt.t_end : opt.t_begin + static_cast<double>(k) * h;
-  }
+  double time_of(Index k) const { return opt.time_of(k); }  // TimeGrid::time_of
   // Sign of det Φq at the last delivered regular row whose sign is known, its time, and whether a singular row
   // (bracketed, with its own warning) was delivered since.
   Orientation last_sign{0, 0};
