@@ -20,6 +20,10 @@ packages=(
   python3-matplotlib   # tools/plot/plot_bench.py (the figure of bench/README.md); its ctest is skipped if absent
   libhdf5-dev          # HDF5 1.10 (serial flavour, C interface): `phiq run -o OUT.h5`, `phiq compare` of HDF5
   python3-h5py python3-numpy python3-pytest  # tests/python/test_hdf5_output.py; its ctest is skipped if absent
+  python3-dev python3-pybind11 pybind11-dev  # the Python package phiq (engine/python/), for /usr/bin/python3
+  python3-scipy        # phiq's Jacobian in Python is a scipy.sparse.csc_matrix
+  python3-pandas       # SweepResult.to_pandas() (optional for users; its test needs it)
+  mypy                 # stubgen: the package's type stubs (_phiq.pyi); the type-checking test of tests/python
   help2man             # the man page phiq.1, generated from `phiq --help` at install (skipped with a note if absent)
 )
 

@@ -1,0 +1,115 @@
+"""phiq: sparse, large-scale multibody kinematics, from Python.
+
+A five-minute tour is in engine/python/README.md. In short::
+
+    import phiq
+    scene = phiq.load_scene("models/seed/crank_slider_mixed.yaml")
+    result = phiq.run_sweep(scene, threads=2)      # t, q, qd, qdd: numpy arrays (rows × coordinates)
+    xB = result["xB"]                              # a column by name
+    report = phiq.check(scene)                     # rank, dof, Grübler, redundant and conflicting constraints
+
+Numerical outcomes are statuses (``SolveStatus``) in the returned summaries and results, never exceptions:
+a sweep that fails returns the rows it delivered, with ``ok`` False and phiq's one-line ``message``;
+``result.raise_for_status()`` turns that into ``SolveError`` when an exception is wanted. Programming errors
+(wrong sizes, unknown names, settings no solve can honour) raise ValueError, and wrong types TypeError, with the
+messages of phiq's C++ checks; a bad scene raises ``SceneError`` (a ValueError) naming file, line and field.
+phiq releases the GIL while it works; Ctrl-C stops a sweep at its next delivered row (KeyboardInterrupt).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, List, Optional
+
+from . import _phiq
+from ._phiq import (AssemblySummary, ConstraintInfo, JacobianUpdate, LinearSummary, Model, NewtonOptions,
+                    PositionSummary, Predictor, RankReport, Scene, SceneError, SolveStatus, SweepOptions,
+                    SweepSummary, SweepWarning, Unit, WorkCounters, Workspace, analyse_rank, assemble,
+                    constraint_kinds, load_scene, parse_scene, solve_acceleration, solve_position, solve_velocity)
+from ._builder import SceneBuilder
+from ._results import SolveError, SweepResult
+
+__version__: str = _phiq.__version__
+
+__all__ = [
+    "AssemblySummary", "CheckReport", "ConstraintInfo", "JacobianUpdate", "LinearSummary", "Model", "NewtonOptions",
+    "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError", "SolveError", "SolveStatus",
+    "SweepOptions", "SweepResult", "SweepSummary", "SweepWarning", "Unit", "WorkCounters", "Workspace",
+    "analyse_rank", "assemble", "check", "constraint_kinds", "load_scene", "parse_scene", "run_sweep",
+    "solve_acceleration", "solve_position", "solve_velocity",
+]
+
+
+def run_sweep(scene: Scene, options: Optional[SweepOptions] = None, *, identifier_names: bool = False,
+              **overrides: Any) -> SweepResult:
+    """Sweep a scene as ``phiq run`` does: the assembly from its rough placement (redundant constraints of a
+    consistent model left out of the square solves), then every time point of the grid.
+
+    ``options``: the SweepOptions to use (default: ``scene.options``); keyword arguments then set its fields, e.g.
+    ``run_sweep(scene, threads=2, steps=1000, accelerations=False)`` (TypeError for a name SweepOptions lacks).
+    ``identifier_names``: name the columns as Python identifiers (``theta2__v`` for ``theta2.v``).
+    Every thread count gives the same bits. Returns a SweepResult (check ``ok``, or call ``raise_for_status()``).
+    """
+    opts = scene.options if options is None else options
+    if overrides:
+        if options is not None:
+            opts = _copy_options(options)
+        for name, value in overrides.items():
+            if not hasattr(opts, name) or name.startswith("_"):
+                fields = sorted(n for n in dir(opts) if not n.startswith("_") and not callable(getattr(opts, n)))
+                raise TypeError(f"run_sweep() got an unexpected keyword argument '{name}' (SweepOptions fields: "
+                                f"{', '.join(fields)})")
+            setattr(opts, name, value)
+    return SweepResult(_phiq._sweep_scene(scene, opts, identifier_names))
+
+
+def _copy_options(options: SweepOptions) -> SweepOptions:
+    import copy
+    return copy.copy(options)
+
+
+@dataclasses.dataclass(frozen=True)
+class CheckReport:
+    """What ``phiq check`` reports: the counts, the assembly from the rough placement at ``time``, and the rank
+    analysis there (rank is a property of a configuration)."""
+    coordinates: int
+    equations: int
+    kinematic_equations: int
+    driver_equations: int
+    constraints: int
+    nonzeros: int
+    time: float
+    status: SolveStatus
+    message: str
+    rank: int
+    dof: int
+    driven_dof: int
+    grubler: Optional[int]
+    redundant: List[str]
+    consistent: bool
+    conflicts: List[str]
+    uncertain: bool
+    q: Any  # numpy array: the assembled position (or where the assembly stopped)
+
+    @property
+    def ok(self) -> bool:
+        """The scene assembles and its constraints are consistent."""
+        return self.status == SolveStatus.SUCCESS
+
+
+def check(scene: Scene, time: Optional[float] = None) -> CheckReport:
+    """Count, assemble and analyse a scene as ``phiq check`` does: minimum-norm assembly from the rough placement
+    at ``time`` (default: the sweep's start), then the rank there — degrees of freedom, Grübler count, redundant
+    constraints (consistent) or conflicting ones (inconsistent)."""
+    model = scene.model
+    opts = scene.options
+    t = opts.t_begin if time is None else time
+    q, a = assemble(model, t, model.initial_positions, opts.assembly)
+    drivers = sum(c.rows for c in model.constraints if c.depends_on_time)
+    r = a.rank
+    return CheckReport(coordinates=model.num_coordinates, equations=model.num_equations,
+                       kinematic_equations=model.num_equations - drivers, driver_equations=drivers,
+                       constraints=len(model.constraints), nonzeros=model.nonzeros, time=t, status=a.status,
+                       message=a.message, rank=r.rank, dof=r.dof, driven_dof=r.driven_dof, grubler=model.grubler,
+                       redundant=list(r.redundant), consistent=a.consistent, conflicts=list(a.conflicts),
+                       uncertain=r.uncertain, q=q)

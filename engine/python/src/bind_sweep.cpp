@@ -1,0 +1,132 @@
+// The sweep's options (one flat SweepOptions: time grid, solver, threads, outputs), its summary (with warnings as
+// objects and to_dict() for JSON), and the predictors.
+
+#include "bindings.hpp"
+
+namespace phiq::python {
+
+namespace {
+
+py::dict counters_dict(const WorkCounters& c) {
+  return py::dict(py::arg("newton_iterations") = c.newton_iterations,
+                  py::arg("residual_evaluations") = c.residual_evaluations,
+                  py::arg("jacobian_evaluations") = c.jacobian_evaluations,
+                  py::arg("factorizations") = c.factorizations,
+                  py::arg("pivoting_factorizations") = c.pivoting_factorizations,
+                  py::arg("velocity_solves") = c.velocity_solves,
+                  py::arg("acceleration_solves") = c.acceleration_solves,
+                  py::arg("phi_t_evaluations") = c.phi_t_evaluations,
+                  py::arg("gamma_evaluations") = c.gamma_evaluations,
+                  py::arg("point_evaluations") = c.point_evaluations);
+}
+
+py::dict accuracy_dict(const RowClassAccuracy& a) {
+  return py::dict(py::arg("rows") = a.rows, py::arg("worst_error") = a.worst_error,
+                  py::arg("worst_time") = a.worst_time, py::arg("unestimated") = a.unestimated);
+}
+
+}  // namespace
+
+py::dict summary_dict(const SweepSummary& s) {
+  py::list warnings;
+  for (const SweepWarning& w : s.warnings)
+    warnings.append(py::dict(py::arg("t") = w.t, py::arg("kind") = w.kind, py::arg("message") = w.message));
+  return py::dict(
+      py::arg("status") = to_string(s.status), py::arg("message") = s.message,
+      py::arg("steps_completed") = s.steps_completed, py::arg("failed_step") = s.failed_step,
+      py::arg("failed_time") = s.failed_time,
+      py::arg("assembly") = py::dict(py::arg("status") = to_string(s.assembly.status),
+                                     py::arg("iterations") = s.assembly.iterations,
+                                     py::arg("residual") = s.assembly.residual),
+      py::arg("counters") = counters_dict(s.counters), py::arg("subdivisions") = s.subdivisions,
+      py::arg("singular_positions") = s.singular_positions, py::arg("min_rcond") = s.min_rcond,
+      py::arg("min_rcond_time") = s.min_rcond_time, py::arg("warnings") = warnings,
+      py::arg("solve_seconds") = s.solve_seconds, py::arg("threads") = s.threads,
+      py::arg("parallel_chunks") = s.parallel_chunks, py::arg("seed_seconds") = s.seed_seconds,
+      py::arg("accuracy") = py::dict(py::arg("converged") = accuracy_dict(s.accuracy.converged),
+                                     py::arg("rounding_level") = accuracy_dict(s.accuracy.rounding_level),
+                                     py::arg("singular") = accuracy_dict(s.accuracy.singular)));
+}
+
+void bind_sweep(py::module_& m) {
+  py::enum_<Predictor> pred(m, "Predictor", "How successive positions are started (sweep.hpp).");
+  for (Predictor p : all_predictors()) {
+    std::string upper = to_string(p);
+    for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    pred.value(upper.c_str(), p);
+  }
+  pred.def("__str__", [](Predictor p) { return to_string(p); });
+
+  py::class_<SweepOptions>(m, "SweepOptions",
+                           "What run_sweep computes and how: the time grid, the solver settings, the threads and "
+                           "the outputs. Get the scene's with Scene.options, change fields, pass it to run_sweep.")
+      .def(py::init<>())
+      .def("__copy__", [](const SweepOptions& o) { return o; })
+      .def("__deepcopy__", [](const SweepOptions& o, py::dict) { return o; }, py::arg("memo"))
+      .def_readwrite("t_begin", &SweepOptions::t_begin, "first time point (s)")
+      .def_readwrite("t_end", &SweepOptions::t_end, "last time point (s)")
+      .def_readwrite("steps", &SweepOptions::steps, "intervals: steps + 1 time points")
+      .def("time_of", &SweepOptions::time_of, py::arg("k"), "t_k, the time of grid point k")
+      .def_readwrite("predictor", &SweepOptions::predictor)
+      .def_readwrite("newton", &SweepOptions::newton, "NewtonOptions of the successive positions")
+      .def_readwrite("assembly", &SweepOptions::assembly, "NewtonOptions of the initial position")
+      .def_readwrite("max_subdivisions", &SweepOptions::max_subdivisions)
+      .def_readwrite("threads", &SweepOptions::threads,
+                     "threads for the drive steps (0: all cores); every count gives the same bits")
+      .def_readwrite("memory_budget", &SweepOptions::memory_budget)
+      .def_readwrite("chunk_steps", &SweepOptions::chunk_steps)
+      .def_readwrite("row_buffer_bytes", &SweepOptions::row_buffer_bytes)
+      .def_readwrite("velocities", &SweepOptions::velocities, "solve and deliver q̇")
+      .def_readwrite("accelerations", &SweepOptions::accelerations, "solve and deliver q̈")
+      .def_readwrite("residuals", &SweepOptions::residuals, "deliver Φ at every row (residual columns)")
+      .def_readwrite("condition", &SweepOptions::condition, "deliver the rcond column")
+      .def_readwrite("coordinate_columns", &SweepOptions::coordinate_columns, "indices of the q columns written")
+      .def_readwrite("velocity_columns", &SweepOptions::velocity_columns,
+                     "indices of the q̇ columns (None: coordinate_columns)")
+      .def_readwrite("acceleration_columns", &SweepOptions::acceleration_columns,
+                     "indices of the q̈ columns (None: coordinate_columns)")
+      .def_readwrite("every", &SweepOptions::every, "write every k-th time point")
+      .def_readwrite("window_begin", &SweepOptions::window_begin, "write rows with t ≥ this")
+      .def_readwrite("window_end", &SweepOptions::window_end, "write rows with t ≤ this")
+      .def_readwrite("max_residual_column", &SweepOptions::max_residual_column)
+      .def_readwrite("residual_columns", &SweepOptions::residual_columns, "constraint indices whose residual is written")
+      .def_property_readonly("point_names",
+                             [](const SweepOptions& o) {
+                               std::vector<std::string> n;
+                               for (const OutputPoint& p : o.points) n.push_back(p.name);
+                               return n;
+                             },
+                             "output points of the scene (their columns NAME.x, NAME.y, …)")
+      .def_property_readonly("driver_names",
+                             [](const SweepOptions& o) {
+                               std::vector<std::string> n;
+                               for (const OutputDriver& d : o.driver_columns) n.push_back(d.name);
+                               return n;
+                             },
+                             "drivers whose law is written (NAME.f, NAME.df, NAME.ddf)")
+      .def("rows_written", [](const SweepOptions& o) { return rows_written(o); },
+           "rows a successful sweep with these options delivers");
+
+  py::class_<SweepWarning>(m, "SweepWarning", "Something to know about a delivered row (it is within tolerance).")
+      .def_readonly("t", &SweepWarning::t, "time of the row concerned")
+      .def_readonly("kind", &SweepWarning::kind,
+                    "'slow_convergence', 'ill_conditioned', 'bifurcation', 'parallel_fallback' or 'threads_reduced'")
+      .def_readonly("message", &SweepWarning::message, "one line")
+      .def("__repr__", [](const SweepWarning& w) {
+        return "SweepWarning(t=" + shortest(w.t) + ", kind='" + w.kind + "', message='" + w.message + "')";
+      });
+
+  py::class_<SweepSummary>(m, "SweepSummary", "What run_sweep did.")
+      .def_readonly("status", &SweepSummary::status)
+      .def_readonly("message", &SweepSummary::message, "one line naming the step, time, cause and constraints")
+      .def_readonly("steps_completed", &SweepSummary::steps_completed)
+      .def_readonly("failed_step", &SweepSummary::failed_step)
+      .def_readonly("failed_time", &SweepSummary::failed_time)
+      .def_readonly("warnings", &SweepSummary::warnings)
+      .def_readonly("counters", &SweepSummary::counters)
+      .def_readonly("threads", &SweepSummary::threads)
+      .def("brief_report", &SweepSummary::BriefReport)
+      .def("to_dict", &summary_dict, "Every field as plain Python values (JSON-ready).");
+}
+
+}  // namespace phiq::python

@@ -1,0 +1,41 @@
+// The pieces of the extension module phiq._phiq, one file per pipeline stage (model, scene, solve, sweep), and
+// what they share: the conversions of coordinate vectors, with their size checked against the model.
+#pragma once
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+
+#include <phiq/phiq.hpp>
+
+namespace phiq::python {
+
+namespace py = pybind11;
+
+void bind_model(py::module_& m);
+void bind_scene(py::module_& m);
+void bind_solve(py::module_& m);
+void bind_sweep(py::module_& m);
+void bind_sweep_result(py::module_& m);
+
+/// A vector the caller passed as `what`, checked to have the model's n entries: phiq::Error (ValueError in Python)
+/// otherwise, with the sizes in the message, as the C++ pre-condition checks word it.
+inline Eigen::VectorXd coordinate_vector(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& v,
+                                         const char* what) {
+  if (v.size() != model.num_coordinates())
+    throw Error(std::string(what) + " has " + std::to_string(v.size()) + " entries; the model has " +
+                std::to_string(model.num_coordinates()) + " coordinates");
+  return v;
+}
+
+/// A copy of an Eigen vector as a new numpy array (the caller owns it).
+inline py::array_t<double> to_numpy(const Eigen::VectorXd& v) {
+  py::array_t<double> a(v.size());
+  std::copy(v.data(), v.data() + v.size(), a.mutable_data());
+  return a;
+}
+
+}  // namespace phiq::python

@@ -1,0 +1,109 @@
+// run_sweep from Python: a scene swept as `phiq run` sweeps it (prepare_scene: the redundant rows of a consistent
+// model left out), its rows written straight into one rows × columns table of doubles — the CSV's columns and
+// doubles, bit for bit — that numpy views without a copy. The GIL is released during the sweep; the row callback
+// takes it back every 50 ms only, to let Python's signal handlers run, so that Ctrl-C stops a long sweep at its
+// next delivered row (KeyboardInterrupt).
+
+#include "bindings.hpp"
+
+#include <chrono>
+#include <memory>
+
+namespace phiq::python {
+
+py::dict summary_dict(const SweepSummary& s);  // bind_sweep.cpp
+
+namespace {
+
+/// The delivered rows of a sweep and its summary. Columns: t, the q columns, the q̇ columns, the q̈ columns, then
+/// the outputs (points, drivers, residuals, rcond), named as the CSV's.
+struct SweepTable {
+  std::unique_ptr<double[]> data;  // rows × columns, row-major; room for the rows a successful sweep delivers
+  Index rows = 0;
+  std::vector<std::string> columns;
+  Index q_columns = 0, v_columns = 0, a_columns = 0, output_columns = 0;
+  SweepSummary summary;
+  Index width() const { return static_cast<Index>(columns.size()); }
+};
+
+std::shared_ptr<SweepTable> sweep_scene(const Scene& scene, const SweepOptions& opt, bool identifier_names) {
+  auto table = std::make_shared<SweepTable>();
+  // The columns from the scene's model and these options, as `phiq run` names them.
+  CsvFormat format(*scene.model, opt);
+  format.set_naming(identifier_names ? ColumnNaming::kIdentifiers : ColumnNaming::kDotted);
+  table->columns = format.column_names();
+  table->q_columns = static_cast<Index>(opt.coordinate_columns.size());
+  table->v_columns = static_cast<Index>(opt.written_velocities().size());
+  table->a_columns = static_cast<Index>(opt.written_accelerations().size());
+  table->output_columns = static_cast<Index>(format.num_output_values());
+  const Index width = table->width();
+  const Index capacity = rows_written(opt);
+  table->data.reset(new double[static_cast<std::size_t>(std::max<Index>(capacity, 1) * width)]);
+
+  SquareScene square;
+  SolveStatus prepared;
+  {
+    py::gil_scoped_release free;
+    prepared = prepare_scene(*scene.model, opt.t_begin, opt.assembly, &square);
+  }
+  if (prepared != SolveStatus::kSuccess) {  // inconsistent or under-driven: nothing is swept
+    table->summary.status = square.assembly.status;
+    table->summary.message = "t = " + format_time(opt.t_begin) + ": " + square.assembly.message;
+    table->summary.failed_step = 0;
+    table->summary.failed_time = opt.t_begin;
+    table->summary.worst_rows = square.assembly.worst_rows;
+    return table;
+  }
+  const Model& model = square.model(*scene.model);
+  Workspace ws(model);
+  ws.q = square.start;
+
+  const Index nq = table->q_columns, nv = table->v_columns, na = table->a_columns;
+  const std::vector<Index>&qc = opt.coordinate_columns, &vc = opt.written_velocities(),
+  &ac = opt.written_accelerations();
+  bool interrupted = false;
+  auto next_check = std::chrono::steady_clock::now() + std::chrono::milliseconds(50);
+  {
+    py::gil_scoped_release free;
+    (void)run_sweep(model, opt, ws, [&](const StepView& step) {  // the status is in the summary
+      if (table->rows >= capacity) throw Error("run_sweep delivered more rows than rows_written() counts");
+      double* row = table->data.get() + table->rows * width;
+      *row++ = step.t;
+      for (Index j = 0; j < nq; ++j) *row++ = step.q[qc[static_cast<std::size_t>(j)]];
+      for (Index j = 0; j < nv; ++j) *row++ = (*step.qd)[vc[static_cast<std::size_t>(j)]];
+      for (Index j = 0; j < na; ++j) *row++ = (*step.qdd)[ac[static_cast<std::size_t>(j)]];
+      if (table->output_columns > 0) format.append_output_values(step, row);
+      ++table->rows;
+      if (const auto now = std::chrono::steady_clock::now(); now >= next_check) {
+        next_check = now + std::chrono::milliseconds(50);
+        py::gil_scoped_acquire hold;
+        if (PyErr_CheckSignals() != 0) return !(interrupted = true);  // the exception stays set for below
+      }
+      return true;
+    }, &table->summary);
+  }
+  if (interrupted) throw py::error_already_set();
+  return table;
+}
+
+}  // namespace
+
+void bind_sweep_result(py::module_& m) {
+  py::class_<SweepTable, std::shared_ptr<SweepTable>>(m, "_SweepTable", py::buffer_protocol(),
+                                                      "The rows of a sweep (numpy.asarray views them).")
+      .def_buffer([](SweepTable& t) {
+        return py::buffer_info(t.data.get(), sizeof(double), py::format_descriptor<double>::format(), 2,
+                               {t.rows, t.width()},
+                               {static_cast<Index>(sizeof(double)) * t.width(), static_cast<Index>(sizeof(double))});
+      })
+      .def_readonly("columns", &SweepTable::columns)
+      .def_readonly("q_columns", &SweepTable::q_columns)
+      .def_readonly("v_columns", &SweepTable::v_columns)
+      .def_readonly("a_columns", &SweepTable::a_columns)
+      .def_readonly("output_columns", &SweepTable::output_columns)
+      .def_readonly("summary", &SweepTable::summary);
+  m.def("_sweep_scene", &sweep_scene, py::arg("scene"), py::arg("options"), py::arg("identifier_names") = false,
+        "The table of a scene's sweep with these options (phiq.run_sweep wraps it).");
+}
+
+}  // namespace phiq::python

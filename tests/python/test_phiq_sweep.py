@@ -1,0 +1,178 @@
+"""run_sweep from Python (engine/python/src/sweep_result.cpp, phiq/_results.py): the CLI's CSV bit for bit, every
+thread count the same bits, output selection, failures as statuses, redundant and inconsistent scenes, pandas, the
+arrays as views of one table, and Ctrl-C."""
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+
+import phiq
+
+from conftest import MODELS, PHIQ, package_env
+
+EVERY_OUTPUT = """phiq: 1
+name: fourbar_outputs
+parameters: {L1: 1.0, L2: 0.4, L3: 1.2, L4: 1.0}
+coordinates: {theta2: 0.0, xA: 0.4, yA: 0.0, x3: 0.7, y3: 0.5, psi3: 1.0, xB: 1.1, yB: 1.0}
+points: {O: [0, 0], A: [xA, yA], B: [xB, yB], C: [L1, 0]}
+bodies: {coupler: [x3, y3, psi3]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: A, type: revolute, between: [{body: coupler, at: [-L3/2, 0]}, {point: A}]}
+  - {name: B, type: revolute, between: [{body: coupler, at: [L3/2, 0]}, {point: B}]}
+  - {name: rocker, type: distance, points: [C, B], length: L4}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 2*pi, steps: 72}
+output:
+  velocities: true
+  accelerations: [xB, yB]
+  coordinates: ['x*', psi3]
+  points: [B, {name: P, body: coupler, at: [0, 0.3]}]
+  drivers: [motor]
+  residuals: [rocker]
+  max_residual: true
+  rcond: true
+"""
+
+
+def cli_csv(scene_path, tmp_path, *args):
+    out = tmp_path / "cli.csv"
+    subprocess.run([PHIQ, "run", scene_path, "-o", str(out), "--quiet", *args], check=True)
+    with open(out) as f:
+        header = f.readline().strip().split(",")
+    return header, np.loadtxt(out, delimiter=",", skiprows=1, ndmin=2)
+
+
+@pytest.mark.parametrize("scene_file", ["seed/crank_slider_mixed.yaml", "seed/fourbar_natural.yaml",
+                                        "spatial/rssr.yaml", "redundant/parallelogram_fifth_bar.yaml",
+                                        "hard/change_point_exact.yaml"])
+def test_sweep_equals_the_cli_csv_bit_for_bit(scene_file, tmp_path):
+    path = os.path.join(MODELS, scene_file)
+    header, table = cli_csv(path, tmp_path)
+    result = phiq.run_sweep(phiq.load_scene(path), threads=2)
+    assert result.ok, result.message
+    assert result.columns == header
+    assert np.array_equal(result.table, table)  # every double, bit for bit (the CSV is shortest round-trip)
+    assert [w.kind for w in result.warnings] == [w["kind"] for w in result.summary["warnings"]]
+
+
+def test_output_selection_and_identifier_names(tmp_path):
+    path = tmp_path / "outputs.yaml"
+    path.write_text(EVERY_OUTPUT)
+    header, table = cli_csv(str(path), tmp_path, "--names", "identifiers")
+    result = phiq.run_sweep(phiq.load_scene(str(path)), identifier_names=True)
+    assert result.columns == header
+    assert np.array_equal(result.table, table)
+    assert result.coordinate_names == ["xA", "x3", "xB", "psi3"]
+    assert result.velocity_names == ["xA__v", "x3__v", "xB__v", "psi3__v"]
+    assert result.acceleration_names == ["xB__a", "yB__a"]
+    assert result.point("P").shape == (73, 2)
+    assert result.output_names[-1] == "rcond"
+    # only the rows and outputs asked for are computed: two points per delivered row
+    assert result.summary["counters"]["point_evaluations"] == 2 * 73
+
+
+def test_parallel_sweep_equals_the_sequential():
+    scene = phiq.load_scene(os.path.join(MODELS, "hard", "change_point_full_turn.yaml"))
+    runs = [phiq.run_sweep(scene, threads=n, steps=720) for n in (1, 2, 3)]
+    for r in runs[1:]:
+        assert np.array_equal(r.table, runs[0].table)
+        assert r.summary["counters"] == runs[0].summary["counters"]
+        assert [(w.t, w.kind, w.message) for w in r.warnings] == [(w.t, w.kind, w.message) for w in runs[0].warnings]
+    assert runs[1].summary["threads"] == 2
+    assert any(w.kind == "bifurcation" for w in runs[0].warnings)
+
+
+def test_arrays_are_views_of_one_table():
+    result = phiq.run_sweep(phiq.load_scene(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml")))
+    for a in (result.t, result.q, result.qd, result.qdd):
+        assert np.shares_memory(a, result.table)
+    assert result.outputs.shape == (181, 0)
+    assert result.table.base is not None and not result.table.flags.owndata
+    assert result.q.shape == (181, 4) and result.table.shape == (181, 13)
+    np.testing.assert_array_equal(result["xB.v"], result.qd[:, 3])
+    with pytest.raises(KeyError, match="no column 'xC'"):
+        result["xC"]
+
+
+def test_a_failed_sweep_is_a_status_with_the_cli_message(tmp_path):
+    path = os.path.join(MODELS, "hard", "crank_rocker_rocker_driven.yaml")
+    result = phiq.run_sweep(phiq.load_scene(path))
+    assert not result.ok
+    assert result.status == phiq.SolveStatus.NOT_CONVERGED
+    assert "no assembly beyond" in result.message
+    t_star = np.arccos(-7 / 8) - 2.2
+    assert 0 < len(result) < 101 and result.t[-1] <= t_star
+    cli = subprocess.run([PHIQ, "run", path, "-o", str(tmp_path / "x.csv"), "--quiet"], capture_output=True, text=True)
+    assert cli.returncode == 1
+    assert result.message in cli.stderr
+    with pytest.raises(phiq.SolveError) as e:
+        result.raise_for_status()
+    assert str(e.value) == result.message and e.value.status == result.status
+
+
+def test_redundant_and_inconsistent_scenes():
+    door = phiq.run_sweep(phiq.load_scene(os.path.join(MODELS, "redundant", "door_three_hinges.yaml")))
+    assert door.ok and len(door) == door.summary["steps_completed"]
+    bad = phiq.run_sweep(phiq.load_scene(os.path.join(MODELS, "redundant", "door_misaligned.yaml")))
+    assert bad.status == phiq.SolveStatus.INCONSISTENT and len(bad) == 0
+    assert "hinge3" in bad.message and bad.message.startswith("t = 0: ")
+
+
+def test_options_and_errors():
+    scene = phiq.load_scene(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"))
+    opts = scene.options
+    opts.steps, opts.accelerations, opts.every = 10, False, 5
+    result = phiq.run_sweep(scene, opts)
+    assert len(result) == 3 and result.qdd is None and result.qd is not None
+    assert result.summary["counters"]["acceleration_solves"] == 0
+    assert scene.options.steps == 180  # the scene's own options are unchanged
+    with pytest.raises(TypeError, match="unexpected keyword argument 'thread'"):
+        phiq.run_sweep(scene, thread=2)
+    with pytest.raises(ValueError, match="SweepOptions: steps must be >= 0"):
+        phiq.run_sweep(scene, steps=-1)
+    with pytest.raises(ValueError, match="threads must be >= 0"):
+        phiq.run_sweep(scene, threads=-2)
+
+
+def test_to_pandas():
+    pandas = pytest.importorskip("pandas")
+    result = phiq.run_sweep(phiq.load_scene(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml")))
+    frame = result.to_pandas()
+    assert isinstance(frame, pandas.DataFrame)
+    assert list(frame.columns) == result.columns[1:]
+    assert frame.index.name == "t"
+    np.testing.assert_array_equal(frame["xB"].to_numpy(), result["xB"])
+
+
+def test_ctrl_c_stops_a_long_sweep_promptly(tmp_path):
+    """A sweep of some minutes, interrupted half a second after it starts, raises KeyboardInterrupt within a few
+    seconds (it stops at its next delivered row)."""
+    scene = tmp_path / "long.yaml"
+    subprocess.run([PHIQ, "generate", "nfourbar", "1000", "--steps", "1000000", "--outputs", "q", "-o", str(scene)],
+                   check=True)
+    script = textwrap.dedent(f"""
+        import sys, time, phiq
+        scene = phiq.load_scene({str(scene)!r})
+        print("sweeping", flush=True)
+        start = time.monotonic()
+        try:
+            phiq.run_sweep(scene, threads=1, every=1000)
+            print("finished", flush=True)
+        except KeyboardInterrupt:
+            print(f"interrupted after {{time.monotonic() - start:.2f}} s", flush=True)
+    """)
+    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True,
+                             env=package_env())
+    assert child.stdout.readline().strip() == "sweeping"
+    time.sleep(0.5)
+    child.send_signal(signal.SIGINT)
+    out, _ = child.communicate(timeout=60)
+    assert out.startswith("interrupted after"), out
+    assert float(out.split()[2]) < 10.0
