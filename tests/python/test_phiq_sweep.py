@@ -176,3 +176,36 @@ def test_ctrl_c_stops_a_long_sweep_promptly(tmp_path):
     out, _ = child.communicate(timeout=60)
     assert out.startswith("interrupted after"), out
     assert float(out.split()[2]) < 10.0
+
+
+def test_the_gil_is_released_while_sweeping(tmp_path):
+    """Python code runs in another thread while a sweep works: with the GIL held through the sweep, the loop below
+    could not run until the sweep returned."""
+    import threading
+    path = tmp_path / "chain.yaml"
+    subprocess.run([PHIQ, "generate", "nfourbar", "1000", "--steps", "400", "--outputs", "q", "-o", str(path)],
+                   check=True)
+    scene = phiq.load_scene(str(path))
+    started, results = threading.Event(), []
+    worker = threading.Thread(target=lambda: (started.set(), results.append(phiq.run_sweep(scene, threads=1))))
+    worker.start()
+    started.wait()
+    spins = 0
+    while worker.is_alive():
+        spins += 1
+    worker.join()
+    assert results[0].ok and len(results[0]) == 401
+    assert spins > 100_000, spins
+
+
+def test_objects_keep_what_they_need_alive():
+    import gc
+    scene = phiq.load_scene(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"))
+    model = scene.model
+    ws = phiq.Workspace(model)
+    result = phiq.run_sweep(scene)
+    q = result.q
+    del scene, model, result
+    gc.collect()
+    assert phiq.solve_position(ws.model, 0.2, ws).ok  # the workspace keeps its model and scene
+    assert q.shape == (181, 4) and q[0, 0] == 0.0    # the view keeps its table

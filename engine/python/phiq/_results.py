@@ -3,6 +3,8 @@ summary as a dict and the warnings as objects."""
 
 from __future__ import annotations
 
+import functools
+
 from typing import Any, Dict, List, Optional
 
 import numpy as np
@@ -35,23 +37,49 @@ class SweepResult:
         self._table = table
         self.table: np.ndarray = np.asarray(table)
         self.table.flags.writeable = False
-        self.columns: List[str] = list(table.columns)
         nq, nv, na = table.q_columns, table.v_columns, table.a_columns
+        self._bounds = (1, 1 + nq, 1 + nq + nv, 1 + nq + nv + na)
         self.t: np.ndarray = self.table[:, 0]
         self.q: np.ndarray = self.table[:, 1:1 + nq]
         self.qd: Optional[np.ndarray] = self.table[:, 1 + nq:1 + nq + nv] if nv else None
         self.qdd: Optional[np.ndarray] = self.table[:, 1 + nq + nv:1 + nq + nv + na] if na else None
         self.outputs: np.ndarray = self.table[:, 1 + nq + nv + na:]
-        self.coordinate_names: List[str] = self.columns[1:1 + nq]
-        self.velocity_names: List[str] = self.columns[1 + nq:1 + nq + nv]
-        self.acceleration_names: List[str] = self.columns[1 + nq + nv:1 + nq + nv + na]
-        self.output_names: List[str] = self.columns[1 + nq + nv + na:]
         s = table.summary
         self.status: _phiq.SolveStatus = s.status
         self.message: str = s.message
         self.warnings: List[_phiq.SweepWarning] = list(s.warnings)
         self.summary: Dict[str, Any] = s.to_dict()
-        self._index = {name: k for k, name in enumerate(self.columns)}
+
+    # The names are made on first use: a 10⁴-loop chain has 6·10⁴ columns, whose Python strings cost more than
+    # returning the arrays does.
+    @functools.cached_property
+    def columns(self) -> List[str]:
+        """Every column's name, "t" first, as the CSV's header names them."""
+        return list(self._table.columns)
+
+    @property
+    def coordinate_names(self) -> List[str]:
+        """Names of the columns of ``q``."""
+        return self.columns[self._bounds[0]:self._bounds[1]]
+
+    @property
+    def velocity_names(self) -> List[str]:
+        """Names of the columns of ``qd`` (``theta2.v``)."""
+        return self.columns[self._bounds[1]:self._bounds[2]]
+
+    @property
+    def acceleration_names(self) -> List[str]:
+        """Names of the columns of ``qdd`` (``theta2.a``)."""
+        return self.columns[self._bounds[2]:self._bounds[3]]
+
+    @property
+    def output_names(self) -> List[str]:
+        """Names of the columns of ``outputs`` (points, drivers, residuals, rcond)."""
+        return self.columns[self._bounds[3]:]
+
+    @functools.cached_property
+    def _index(self) -> Dict[str, int]:
+        return {name: k for k, name in enumerate(self.columns)}
 
     @property
     def ok(self) -> bool:
