@@ -145,3 +145,19 @@ def test_the_registry_is_visible_from_python():
     assert all(k["example"] for k in kinds)
     # one entry per scene form: as many as the kinds' forms, each type once per dimension and section
     assert len(types) == len({(k["type"], k["dimension"], k["section"]) for k in kinds})
+
+
+def test_everything_public_has_a_docstring():
+    import inspect
+    missing = []
+    for name in phiq.__all__:
+        obj = getattr(phiq, name)
+        if not (obj.__doc__ or "").strip():
+            missing.append(name)
+        if inspect.isclass(obj) and obj is not phiq.CheckReport:
+            for attr, value in vars(obj).items():
+                if attr.startswith("_") or attr in ("value", "name") or not (callable(value) or isinstance(value, property)):
+                    continue
+                if not (getattr(value, "__doc__", None) or "").strip():
+                    missing.append(f"{name}.{attr}")
+    assert missing == []

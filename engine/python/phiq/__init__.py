@@ -30,6 +30,8 @@ from ._builder import SceneBuilder
 from ._results import SolveError, SweepResult
 
 __version__: str = _phiq.__version__
+SceneError.__doc__ = ("A scene that cannot be used (a ValueError): one line 'FILE:LINE:COL: field.path: message', or "
+                      "for a SceneBuilder the Python line of the entry at fault.")
 
 __all__ = [
     "AssemblySummary", "CheckReport", "ConstraintInfo", "JacobianUpdate", "LinearSummary", "Model", "NewtonOptions",

@@ -152,16 +152,16 @@ void bind_model(py::module_& m) {
       });
 
   py::class_<WorkCounters>(m, "WorkCounters", "Work done, counted where it happens.")
-      .def_readonly("newton_iterations", &WorkCounters::newton_iterations)
-      .def_readonly("residual_evaluations", &WorkCounters::residual_evaluations)
-      .def_readonly("jacobian_evaluations", &WorkCounters::jacobian_evaluations)
-      .def_readonly("factorizations", &WorkCounters::factorizations)
-      .def_readonly("pivoting_factorizations", &WorkCounters::pivoting_factorizations)
-      .def_readonly("velocity_solves", &WorkCounters::velocity_solves)
-      .def_readonly("acceleration_solves", &WorkCounters::acceleration_solves)
-      .def_readonly("phi_t_evaluations", &WorkCounters::phi_t_evaluations)
-      .def_readonly("gamma_evaluations", &WorkCounters::gamma_evaluations)
-      .def_readonly("point_evaluations", &WorkCounters::point_evaluations);
+      .def_readonly("newton_iterations", &WorkCounters::newton_iterations, "Newton steps")
+      .def_readonly("residual_evaluations", &WorkCounters::residual_evaluations, "evaluations of Φ (line-search trials included)")
+      .def_readonly("jacobian_evaluations", &WorkCounters::jacobian_evaluations, "evaluations of Φq values")
+      .def_readonly("factorizations", &WorkCounters::factorizations, "numeric LU factorisations")
+      .def_readonly("pivoting_factorizations", &WorkCounters::pivoting_factorizations, "of them, those that searched for pivots")
+      .def_readonly("velocity_solves", &WorkCounters::velocity_solves, "solves of Φq q̇ = −Φt")
+      .def_readonly("acceleration_solves", &WorkCounters::acceleration_solves, "solves of Φq q̈ = γ")
+      .def_readonly("phi_t_evaluations", &WorkCounters::phi_t_evaluations, "evaluations of Φt")
+      .def_readonly("gamma_evaluations", &WorkCounters::gamma_evaluations, "evaluations of γ")
+      .def_readonly("point_evaluations", &WorkCounters::point_evaluations, "output point motions evaluated");
 
   py::class_<Workspace> ws(m, "Workspace",
                            "One thread's state for the solves: q, qd, qdd (numpy views, writable in place), the "

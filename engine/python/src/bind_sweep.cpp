@@ -67,15 +67,15 @@ void bind_sweep(py::module_& m) {
       .def_readwrite("t_end", &SweepOptions::t_end, "last time point (s)")
       .def_readwrite("steps", &SweepOptions::steps, "intervals: steps + 1 time points")
       .def("time_of", &SweepOptions::time_of, py::arg("k"), "t_k, the time of grid point k")
-      .def_readwrite("predictor", &SweepOptions::predictor)
+      .def_readwrite("predictor", &SweepOptions::predictor, "how each successive position is started (Predictor)")
       .def_readwrite("newton", &SweepOptions::newton, "NewtonOptions of the successive positions")
       .def_readwrite("assembly", &SweepOptions::assembly, "NewtonOptions of the initial position")
-      .def_readwrite("max_subdivisions", &SweepOptions::max_subdivisions)
+      .def_readwrite("max_subdivisions", &SweepOptions::max_subdivisions, "a failed step is retried as 2, 4, … sub-steps, down to h / 2^this")
       .def_readwrite("threads", &SweepOptions::threads,
                      "threads for the drive steps (0: all cores); every count gives the same bits")
-      .def_readwrite("memory_budget", &SweepOptions::memory_budget)
-      .def_readwrite("chunk_steps", &SweepOptions::chunk_steps)
-      .def_readwrite("row_buffer_bytes", &SweepOptions::row_buffer_bytes)
+      .def_readwrite("memory_budget", &SweepOptions::memory_budget, "bytes the process may reach when threads = 0 picks the threads (0: what the system has)")
+      .def_readwrite("chunk_steps", &SweepOptions::chunk_steps, "steps per parallel chunk (0: automatic; the same on every thread count)")
+      .def_readwrite("row_buffer_bytes", &SweepOptions::row_buffer_bytes, "bytes of rows a sweep in chunks may hold before delivering them in order")
       .def_readwrite("velocities", &SweepOptions::velocities, "solve and deliver q̇")
       .def_readwrite("accelerations", &SweepOptions::accelerations, "solve and deliver q̈")
       .def_readwrite("residuals", &SweepOptions::residuals, "deliver Φ at every row (residual columns)")
@@ -88,7 +88,7 @@ void bind_sweep(py::module_& m) {
       .def_readwrite("every", &SweepOptions::every, "write every k-th time point")
       .def_readwrite("window_begin", &SweepOptions::window_begin, "write rows with t ≥ this")
       .def_readwrite("window_end", &SweepOptions::window_end, "write rows with t ≤ this")
-      .def_readwrite("max_residual_column", &SweepOptions::max_residual_column)
+      .def_readwrite("max_residual_column", &SweepOptions::max_residual_column, "write the largest scaled residual of all rows (column residual)")
       .def_readwrite("residual_columns", &SweepOptions::residual_columns, "constraint indices whose residual is written")
       .def_property_readonly("point_names",
                              [](const SweepOptions& o) {
@@ -117,14 +117,14 @@ void bind_sweep(py::module_& m) {
       });
 
   py::class_<SweepSummary>(m, "SweepSummary", "What run_sweep did.")
-      .def_readonly("status", &SweepSummary::status)
+      .def_readonly("status", &SweepSummary::status, "the outcome (SolveStatus); SUCCESS when every time point was delivered")
       .def_readonly("message", &SweepSummary::message, "one line naming the step, time, cause and constraints")
-      .def_readonly("steps_completed", &SweepSummary::steps_completed)
-      .def_readonly("failed_step", &SweepSummary::failed_step)
-      .def_readonly("failed_time", &SweepSummary::failed_time)
-      .def_readonly("warnings", &SweepSummary::warnings)
-      .def_readonly("counters", &SweepSummary::counters)
-      .def_readonly("threads", &SweepSummary::threads)
+      .def_readonly("steps_completed", &SweepSummary::steps_completed, "time points solved, in order from the first")
+      .def_readonly("failed_step", &SweepSummary::failed_step, "k of the step that failed, or -1")
+      .def_readonly("failed_time", &SweepSummary::failed_time, "t_k of the step that failed")
+      .def_readonly("warnings", &SweepSummary::warnings, "SweepWarning objects, in time order")
+      .def_readonly("counters", &SweepSummary::counters, "work done by this sweep (WorkCounters)")
+      .def_readonly("threads", &SweepSummary::threads, "threads the drive steps ran on")
       .def("brief_report", &SweepSummary::BriefReport)
       .def("to_dict", &summary_dict, "Every field as plain Python values (JSON-ready).");
 }
