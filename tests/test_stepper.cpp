@@ -59,8 +59,8 @@ std::vector<SweepWarning> of_kind(const std::vector<SweepWarning>& all, const st
 
 // (1) Over run_sweep's grid the stepper is run_sweep in order: the same Sweeper, started afresh from the same
 // placement, asked the same times. Rows, work and summary are the same, to the bit and the count; the hand loop the
-// README showed before over the same times (solve_position, solve_velocity, solve_acceleration) does three times the
-// Newton iterations and four times the factorisations.
+// README showed before over the same times (solve_position, solve_velocity, solve_acceleration) does nearly three
+// times the Newton iterations and four times the factorisations.
 TEST(Stepper, OnASweepsGridGivesItsRowsBitForBitWithItsWork) {
   const Model model = readme_crank_slider();
   SweepOptions o;
