@@ -26,14 +26,17 @@ TEST(ApiExample, ReadmeTourRunsAndMatchesTheClosedForm) {
   b.add("rod", DistanceSpec{{Slot::coordinate(xa), Slot::coordinate(ya)}, {Slot::coordinate(xb), {}}, 1.0});
   b.add_driver("motor", th, MotionLaw::linear(0.0, 2.0));
   Model model = std::move(b).build();                   // pattern + symbolic factorisation, once
-  Workspace ws(model);                                  // one per thread
+  Stepper stepper(model);                               // keeps predictors and diagnostics across steps
   for (int k = 0; k <= 100; ++k)                       // the simulator's clock: t = k / 100
-    if (const double t = 0.01 * k; solve_position(model, t, NewtonOptions{}, ws) == SolveStatus::kSuccess &&
-        solve_velocity(model, t, ws) == SolveStatus::kSuccess && solve_acceleration(model, t, ws) == SolveStatus::kSuccess)
-      use(t, ws.q, ws.qd, ws.qdd);                      // positions, velocities, accelerations
+    if (const double t = 0.01 * k; stepper.step(t) == SolveStatus::kSuccess)
+      use(t, stepper.q(), stepper.qd(), stepper.qdd()); // positions, velocities, accelerations
   // ---- end README ----
   EXPECT_EQ(rows, 101);
   EXPECT_LT(worst, 1e-10);
+  // the sweep's work: the assembly, then one modified-Newton iteration and one factorisation per step (the loop of
+  // solve_position / solve_velocity / solve_acceleration over these times took 300 and 401: tests/test_stepper.cpp)
+  EXPECT_EQ(stepper.summary().counters.newton_iterations, 102);
+  EXPECT_EQ(stepper.summary().counters.factorizations, 101);
 }
 
 }  // namespace

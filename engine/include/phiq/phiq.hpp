@@ -20,6 +20,7 @@
 #include "phiq/output_points.hpp"
 #include "phiq/rank_analysis.hpp"
 #include "phiq/scene.hpp"
+#include "phiq/stepper.hpp"
 #include "phiq/sweep.hpp"
 #include "phiq/text.hpp"
 #include "phiq/version.hpp"

@@ -39,15 +39,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     throw Error("SweepOptions: " + why);
   if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
   if (opt.row_buffer_bytes == 0) throw Error("SweepOptions: row_buffer_bytes must be > 0");
-  if (opt.max_subdivisions < 0) throw Error("SweepOptions: max_subdivisions must be >= 0");
-  const std::vector<Predictor>& predictors = all_predictors();
-  if (std::find(predictors.begin(), predictors.end(), opt.predictor) == predictors.end())
-    throw Error("SweepOptions: predictor is not a Predictor");
-  detail::check_newton_options(opt.assembly, "SweepOptions::assembly");
-  detail::check_newton_options(opt.newton, "SweepOptions::newton");
-  for (const OutputPoint& p : opt.points)
-    if (p.max_coordinate() >= model.num_coordinates())
-      throw Error("SweepOptions: output point '" + p.name + "' reads a coordinate the model does not have");
+  detail::check_solver_settings(model, opt, opt.points, "SweepOptions");
   SweepSummary local;
   SweepSummary& sum = summary ? *summary : local;
   sum = SweepSummary{};
@@ -117,6 +109,19 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
 }
 
 }  // namespace
+
+void detail::check_solver_settings(const Model& model, const SolverSettings& s, const std::vector<OutputPoint>& points,
+                                   const std::string& who) {
+  if (s.max_subdivisions < 0) throw Error(who + ": max_subdivisions must be >= 0");
+  const std::vector<Predictor>& predictors = all_predictors();
+  if (std::find(predictors.begin(), predictors.end(), s.predictor) == predictors.end())
+    throw Error(who + ": predictor is not a Predictor");
+  detail::check_newton_options(s.assembly, (who + "::assembly").c_str());
+  detail::check_newton_options(s.newton, (who + "::newton").c_str());
+  for (const OutputPoint& p : points)
+    if (p.max_coordinate() >= model.num_coordinates())
+      throw Error(who + ": output point '" + p.name + "' reads a coordinate the model does not have");
+}
 
 SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws,
                       const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {

@@ -7,6 +7,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/run_sweep.cpp
   ${CMAKE_CURRENT_LIST_DIR}/singular_positions.cpp
   ${CMAKE_CURRENT_LIST_DIR}/step_failures.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/stepper.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sweep_summary.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sweeper.cpp
 )

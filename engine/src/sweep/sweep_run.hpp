@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "phiq/sweep.hpp"
 #include "phiq/text.hpp"
@@ -32,6 +33,20 @@ struct Run {
   bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
                const PointMotion* points, const Eigen::VectorXd& phi, double rcond, Orientation det_sign,
                double det_sign_t, const RowQuality& quality) {
+    count_row(time_of(k), det_sign, det_sign_t, quality);
+    if (!opt.writes_row(k, time_of(k))) return true;  // solved, not written (OutputPlan::every, window)
+    StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
+                  points, opt.residuals ? &phi : nullptr, opt.condition ? rcond : 0.0};
+    if (on_step && !on_step(view)) {
+      sum.status = SolveStatus::kCancelled;
+      sum.message = "stopped by the caller after step " + std::to_string(k);
+      return false;
+    }
+    return true;
+  }
+  // A row delivered at t (deliver(); a Stepper's step): the bifurcation check against the last regular row, and
+  // the row counted in the summary with its accuracy.
+  void count_row(double t, Orientation det_sign, double det_sign_t, const RowQuality& quality) {
     if (det_sign.sign == 0) {
       singular_since = true;
     } else if (det_sign.sign != kSignUnknown) {
@@ -39,7 +54,7 @@ struct Run {
       // was left there)
       if (last_sign.sign != 0 && det_sign != last_sign && !singular_since)
         sum.warnings.push_back(
-            {time_of(k), "bifurcation",
+            {t, "bifurcation",
              std::string(det_sign.sign != last_sign.sign
                              ? "det Φq changed sign"
                              : "the determinants of an even number of Φq's diagonal blocks (loops that Φq factorises "
@@ -52,16 +67,7 @@ struct Run {
       singular_since = false;
     }
     ++sum.steps_completed;
-    add_row_quality(sum.accuracy, time_of(k), quality);
-    if (!opt.writes_row(k, time_of(k))) return true;  // solved, not written (OutputPlan::every, window)
-    StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
-                  points, opt.residuals ? &phi : nullptr, opt.condition ? rcond : 0.0};
-    if (on_step && !on_step(view)) {
-      sum.status = SolveStatus::kCancelled;
-      sum.message = "stopped by the caller after step " + std::to_string(k);
-      return false;
-    }
-    return true;
+    add_row_quality(sum.accuracy, t, quality);
   }
   // A failed step: the summary names the step, its grid time and the cause (already in sum.message).
   void failed(Index k) {
@@ -85,6 +91,11 @@ struct Run {
     return true;
   }
 };
+
+// Throws phiq::Error for solver settings no step can honour, and for output points that read a coordinate `model`
+// does not have, naming `who` (the options' type) in the message: run_sweep's checks, and a Stepper's.
+void check_solver_settings(const Model& model, const SolverSettings& s, const std::vector<OutputPoint>& points,
+                           const std::string& who);
 
 // Adds the work counted in `now` since `before` to `into`.
 inline void add_counters(WorkCounters& into, const WorkCounters& now, const WorkCounters& before) {

@@ -96,6 +96,7 @@ bool Sweeper::advance(double t1, int depth) {
                         why);
   }
   restore();
+  if (depth == 0 && before_subdividing) before_subdividing(*this);
   ++sum_.subdivisions;
   const double tm = 0.5 * (current_.t + t1);
   return advance(tm, depth + 1) && advance(t1, depth + 1);

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -267,6 +268,10 @@ class Sweeper {
   // One drive step from the current state to t1 (`depth`: how many times it has been halved), subdividing on
   // failure, with the branch and singular-position checks (sweeper.cpp).
   bool advance(double t1, int depth);
+  // Called in advance() once per drive step, before its first subdivision, with the sweeper as it stands then (at
+  // the last good state, the failed attempt's diagnosis noted): a Stepper keeps a copy to return to should the
+  // sub-steps fail too, after some of them converged (stepper.cpp). Empty in sweeps, which stop at a failure.
+  std::function<void(const Sweeper&)> before_subdividing;
 
  private:
   // A position converged at t becomes the current state (sweeper.cpp).
