@@ -18,4 +18,5 @@ PYBIND11_MODULE(_phiq, m) {
   phiq::python::bind_solve(m);
   phiq::python::bind_sweep(m);
   phiq::python::bind_sweep_result(m);
+  phiq::python::bind_stepper(m);
 }
