@@ -194,19 +194,22 @@ void BM_NFourBarStepVsBareLoop(benchmark::State& state) {
     SweepSummary sum;
     ws.q = m.initial_positions();
     auto t0 = Clock::now();
-    run_sweep(m, modified, ws, keep, &sum);
+    (void)run_sweep(m, modified, ws, keep, &sum);
     const double e = seconds_since(t0);
+    if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
     check(phiq_err);
     phiq_s += e, phiq_fact += sum.counters.factorizations, phiq_newton += sum.counters.newton_iterations;
     ws.q = m.initial_positions();
     t0 = Clock::now();
-    run_sweep(m, full, ws, keep, &sum);
+    (void)run_sweep(m, full, ws, keep, &sum);
     full_s += seconds_since(t0), full_fact += sum.counters.factorizations;
+    if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
     check(full_err);
     ws.q = m.initial_positions();
     t0 = Clock::now();
-    run_sweep(m, tight, ws, keep, &sum);
+    (void)run_sweep(m, tight, ws, keep, &sum);
     tight_s += seconds_since(t0);
+    if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
     check(tight_err);
     bare.reset();
     for (Index k = 0; k <= steps; ++k) {

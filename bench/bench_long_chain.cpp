@@ -53,7 +53,7 @@ void BM_LongChainNoDrift(benchmark::State& state) {
     residual.clear(), deviation.clear(), finite = true;
     phiq::tools::ClosedFormErrors err(*exact);
     Workspace ws(m);
-    run_sweep(m, opt, ws, [&](const StepView& s) {
+    (void)run_sweep(m, opt, ws, [&](const StepView& s) {  // its status is sum.status, checked below
       finite = finite && s.q.allFinite() && s.phi && s.phi->allFinite() && (!s.qd || s.qd->allFinite()) &&
                (!s.qdd || s.qdd->allFinite());
       residual.push_back(s.phi ? scaled_residual(m, *s.phi) : INFINITY);

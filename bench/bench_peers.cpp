@@ -197,7 +197,7 @@ class PhiqNFourBar {
     Elapsed timed;
     Stamp mark{};
     phiq::SweepSummary sum;
-    phiq::run_sweep(model_, opt, ws_, [&](const phiq::StepView& s) {
+    (void)phiq::run_sweep(model_, opt, ws_, [&](const phiq::StepView& s) {  // its status is sum.status, checked below
       if (s.step > 0) timed.add(mark, now());
       Deviation d;
       for (int i = 0; i <= n_; ++i) {

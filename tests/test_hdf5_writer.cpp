@@ -44,7 +44,7 @@ Written write_both(const Scene& scene, const std::string& h5_path, Hdf5Options o
   w.csv = csv.header();
   Hdf5Writer h5w(h5_path, *scene.model, scene.sweep, options);
   SweepSummary sum;
-  run_sweep(model, scene.sweep, ws, [&](const StepView& s) {
+  (void)run_sweep(model, scene.sweep, ws, [&](const StepView& s) {  // its status is sum.status, checked below
     csv.append_row(s, w.csv);
     h5w.append_row(s);
     return true;

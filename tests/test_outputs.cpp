@@ -279,7 +279,7 @@ TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
   SweepSummary sum;
   Workspace ws(*scene.model);
   double rocker = -1;
-  run_sweep(*scene.model, scene.sweep, ws, [&](const StepView& s) {
+  const SolveStatus st = run_sweep(*scene.model, scene.sweep, ws, [&](const StepView& s) {
     if (s.step == 1) {
       csv.append_row(s, row);
       // the rocker's one row (a length), scaled by the model's length scale
@@ -288,6 +288,7 @@ TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
     }
     return true;
   }, &sum);
+  ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
   EXPECT_EQ(scene.model->length_scale(), 1.0);  // the largest length in the constraints' data: the rocker's
   std::vector<double> v;
   std::stringstream in(row);

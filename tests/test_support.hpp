@@ -62,7 +62,8 @@ inline Prepared prepare(const std::string& rel) {
   Prepared p;
   p.scene = load_scene(model_path(rel));
   p.q = p.scene.model->initial_positions();
-  prepare_square(*p.scene.model, p.scene.sweep.t_begin, {}, p.q, &p.solved, &p.assembly);
+  // its status is p.assembly's; `solved` stays null on failure
+  (void)prepare_square(*p.scene.model, p.scene.sweep.t_begin, {}, p.q, &p.solved, &p.assembly);
   return p;
 }
 

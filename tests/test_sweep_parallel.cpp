@@ -223,7 +223,7 @@ TEST(ParallelSweep, RowsTooWideForChunksOfEightStepsRunOnFewerThreadsOrInOrder) 
   EXPECT_TRUE(unread.warnings.empty());
 
   opt.row_buffer_bytes = 0;
-  EXPECT_THROW(run_sweep(m, opt, ws, nullptr, nullptr), Error);
+  EXPECT_THROW((void)run_sweep(m, opt, ws, nullptr, nullptr), Error);
 }
 
 // A drive that leaves the reachable range: the parallel sweep reports the same failure, at the same step, as the
@@ -314,7 +314,7 @@ TEST(ParallelSweep, AnExceptionFromTheCallbackPropagates) {
   for (Index throw_at : {Index{0}, Index{3}, Index{57}, Index{400}}) {
     Workspace ws(m);
     Index seen = 0;
-    EXPECT_THROW(run_sweep(m, opt, ws,
+    EXPECT_THROW((void)run_sweep(m, opt, ws,
                            [&](const StepView& v) {
                              if (v.step == throw_at) throw std::runtime_error("stop here");
                              ++seen;

@@ -99,7 +99,8 @@ class NumericalReference final : public Reference {
     ws.q = start_;
     Rows r;
     SweepSummary sum;
-    run_sweep(model_, o, ws, [&](const StepView& s) {
+    (void)run_sweep(  // its status is sum.status, read below
+        model_, o, ws, [&](const StepView& s) {
       if (stopped(stop_)) return false;
       if (s.step % substeps_ != 0) return true;
       r.q.insert(r.q.end(), s.q.data(), s.q.data() + s.q.size());
@@ -310,7 +311,8 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
               Workspace ws(model);
               ws.lu = numeric(lu);
               ws.q = start;
-              run_sweep(model, o, ws, [&](const StepView& s) {
+              (void)run_sweep(  // its status is sum.status, read below
+                  model, o, ws, [&](const StepView& s) {
                 ref->at(st, s.step, s.t, rq.data(), rv.data(), ra.data());
                 for (std::size_t j = 0; j < n; ++j) {
                   const auto jj = static_cast<Index>(j);
@@ -368,7 +370,8 @@ AccuracyReport measure_accuracy(const Scene& scene, const AccuracyOptions& opt,
         ws.q = start;
         SweepSummary s2;
         const auto t0 = Clock::now();
-        run_sweep(model, t.options, ws, [&](const StepView&) { return !stopped(opt.stop); }, &s2);
+        (void)run_sweep(  // its status is s2.status, read below
+            model, t.options, ws, [&](const StepView&) { return !stopped(opt.stop); }, &s2);
         if (s2.status == SolveStatus::kCancelled) throw AccuracyCancelled();
         const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
         spent += dt;

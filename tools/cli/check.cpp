@@ -29,7 +29,8 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at)
   Eigen::VectorXd q = model.initial_positions();
   phiq::AssemblySummary as;
   const double t0 = at ? *at : scene.sweep.t_begin;  // rank belongs to a configuration: `--time` picks another
-  phiq::assemble(model, t0, assembly_options(scene), q, &as);
+  (void)phiq::assemble(  // its status is as.status, read below
+      model, t0, assembly_options(scene), q, &as);
   const bool ok = as.status == phiq::SolveStatus::kSuccess;
   const bool analysed = as.rank.coordinates == model.num_coordinates() && as.status != phiq::SolveStatus::kOutsideTimeDomain;
   const phiq::RankReport& rk = as.rank;

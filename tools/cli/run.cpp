@@ -132,7 +132,8 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   try {
     StopOnSignal stop_on_signal;  // a signal stops the sweep at its next row
     const std::atomic<bool>& stop = stop_flag();
-    phiq::run_sweep(model, scene.sweep, ws, [&](const phiq::StepView& step) {
+    (void)phiq::run_sweep(  // its status is summary.status, read below
+        model, scene.sweep, ws, [&](const phiq::StepView& step) {
       const auto w0 = Clock::now();
       if (h5) {
         h5->append_row(step);

@@ -174,7 +174,8 @@ int plot_svg(const PlotOptions& o) {
       if (auto c = col.find(model.coordinate_names()[j]); c != col.end()) checked.emplace_back(j, c->second);
     SweepSummary sum;
     std::string mismatch;
-    run_sweep(swept, opt, ws, [&](const StepView& v) {
+    (void)run_sweep(  // its status is sum.status, read below
+        swept, opt, ws, [&](const StepView& v) {
       const auto row = static_cast<std::size_t>(v.step);
       for (const auto& [j, c] : checked) {
         const double mine = v.q(j);

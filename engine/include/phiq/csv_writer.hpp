@@ -32,7 +32,8 @@ std::string identifier_column_name(const std::string& dotted);
 class CsvFormat {
  public:
   /// `columns`: coordinate indices to write, in order; `velocities` / `accelerations`: add the `.v` / `.a` groups.
-  /// Throws phiq::Error for an index out of range. The model must outlive the CsvFormat.
+  /// Throws phiq::Error for an index out of range. The model must outlive the CsvFormat and not move (it keeps the
+  /// model's address, unlike a Workspace).
   CsvFormat(const Model& model, std::vector<Index> columns, bool velocities, bool accelerations);
   /// Every column the output plan lists, in the order of tools/README.md: t; coordinates, `.v`, `.a`; per point
   /// `P.x, P.y` (`P.vx, P.vy`, `P.ax, P.ay`); per driver `D.f` (`D.df`, `D.ddf`); per constraint `C.residual`;

@@ -15,7 +15,7 @@
 namespace phiq {
 
 /// Outcome of a solve: what the caller can act on. Only kSuccess leaves a valid solution in the workspace.
-enum class SolveStatus {
+enum class [[nodiscard]] SolveStatus {
   kSuccess,             ///< solved to tolerance
   kNotConverged,        ///< Newton reached its iteration limit, or could not decrease the residual
   kSingularJacobian,    ///< Φq is singular here (singular position, redundant or missing constraints)
@@ -26,6 +26,9 @@ enum class SolveStatus {
   kOutsideTimeDomain,   ///< a driver's law is not defined at the requested time
   kCancelled,           ///< the caller's step callback asked to stop
   kInconsistent,        ///< redundant constraints that cannot hold together (assembly.hpp names them)
+  /// solve_velocity / solve_acceleration at a q that does not solve the position problem Φ(q, t) = 0 (to
+  /// DerivativeOptions::tolerance): its q̇ or q̈ would mean nothing. The message names the worst constraint.
+  kPositionNotSolved,
 };
 /// Lower-case words, e.g. "singular Jacobian".
 const char* to_string(SolveStatus s);
@@ -136,14 +139,37 @@ struct LinearSummary {
 SolveStatus solve_position(const Model& model, double t, const NewtonOptions& options, Workspace& ws,
                            PositionSummary* summary = nullptr);
 
-/// Solves Φq q̇ = −Φt at ws.q into ws.qd. Pre-condition: ws.q solves the position problem at t. Reuses the
+/// Settings of solve_velocity() and solve_acceleration().
+struct DerivativeOptions {
+  /// ws.q must solve the position problem at t to this tolerance, by the residual test of solve_position (every
+  /// row |Φ_i| ≤ tolerance · scale_i + floor_i: NewtonOptions::tolerance, whose default it shares); otherwise the
+  /// solve returns kPositionNotSolved and leaves q̇ / q̈ as they were. Pass the tolerance q was solved with when
+  /// that was looser. The test costs one evaluation of Φ (cheap beside the factorisation of Φq), and none where the
+  /// workspace knows q is the solution solve_position reached at t (its factorisation or Jacobian values are at
+  /// ws.q), or passed this test with the factors it holds (solve_acceleration after solve_velocity). Infinity: no
+  /// test (the caller vouches for q). Must be > 0 (else phiq::Error).
+  double tolerance = 1e-10;
+};
+
+/// Solves Φq q̇ = −Φt at ws.q into ws.qd. Pre-condition: ws.q solves the position problem at t, checked
+/// (DerivativeOptions::tolerance): kPositionNotSolved, with the worst constraint named, when it does not. Reuses the
 /// factorisation when it was made at time t at a point within the position tolerance of ws.q (the last Newton
 /// step was below the tolerance; the difference is below the accuracy of q itself), and otherwise factorises Φq at
 /// (ws.q, t). kSingularJacobian: the velocity is not unique there.
-/// Throws phiq::Error only for violated pre-conditions (workspace of another model, wrong sizes).
+/// Throws phiq::Error only for violated pre-conditions (workspace of another model, wrong sizes, bad options).
+SolveStatus solve_velocity(const Model& model, double t, const DerivativeOptions& options, Workspace& ws,
+                           LinearSummary* summary = nullptr);
+/// solve_velocity() with the default DerivativeOptions (q solved to 1e-10).
 SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary = nullptr);
 
-/// Solves Φq q̈ = γ(q, q̇, t) into ws.qdd. Pre-condition: ws.q and ws.qd solve position and velocity at t.
+/// Solves Φq q̈ = γ(q, q̇, t) into ws.qdd. Pre-condition: ws.q and ws.qd solve position and velocity at t; the
+/// position is checked as by solve_velocity() (kPositionNotSolved), the velocity is not: q̈ is the acceleration of
+/// the motion through q with the velocity ws.qd, whichever it is (γ is defined for any q̇), and checking
+/// Φq q̇ = −Φt would cost an evaluation of Φt and a product with Φq on every call, for a velocity that
+/// solve_velocity has just computed in the usual sequence.
+SolveStatus solve_acceleration(const Model& model, double t, const DerivativeOptions& options, Workspace& ws,
+                               LinearSummary* summary = nullptr);
+/// solve_acceleration() with the default DerivativeOptions (q solved to 1e-10).
 SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, LinearSummary* summary = nullptr);
 
 /// max_i |Φ_i| / scale_i, the measure the convergence test uses (0 for an empty model).

@@ -148,14 +148,70 @@ struct ToleranceScales {
   static constexpr double kUlpFloor = 64.0 * std::numeric_limits<double>::epsilon();
 };
 
+class Model;
+
+namespace detail {
+/// Where a Model is now: what its Workspaces (and ScaledJacobianRows) hold instead of its address, so that a Model
+/// that moves (in a growing std::vector) takes its workspaces along, and one that is destroyed leaves them refusing
+/// to work (Workspace::model() throws) instead of reading freed memory. Shared by the model and its workspaces.
+struct ModelAnchor {
+  const Model* model = nullptr;  ///< the model's current address; null once it is destroyed
+};
+/// Throws phiq::Error "the Model this <what> was made for no longer exists" (`anchor` not null: the model was
+/// destroyed), or "this <what> was moved from" (null).
+[[noreturn]] void throw_model_gone(const ModelAnchor* anchor, const char* what);
+/// The model `anchor` points at now; throws phiq::Error (throw_model_gone) when there is none.
+inline const Model& model_of(const ModelAnchor* anchor, const char* what) {
+  if (!anchor || !anchor->model) throw_model_gone(anchor, what);
+  return *anchor->model;
+}
+
+/// Model's data, a base of its own so that Model's moves, which re-point the anchor, need not list every member
+/// (a member added later and forgotten in a hand-written move would silently be left behind).
+struct ModelData {
+  std::vector<std::string> names_;
+  detail::NameIndex index_of_;  ///< coordinate names → indices (names in names_)
+  detail::NameIndex constraint_index_;  ///< constraint names → indices (names in constraints_[k].name)
+  Eigen::VectorXd initial_;
+  std::vector<Unit> coordinate_units_;
+  std::vector<std::shared_ptr<ConstraintBlock>> blocks_;  ///< read-only once built (shared by without_rows())
+  std::vector<const ConstraintBlock*> time_blocks_;
+  std::vector<ConstraintInfo> constraints_;
+  std::vector<Index> row_constraint_;
+  std::vector<Unit> row_units_;
+  std::shared_ptr<const CscPattern> pattern_ = std::make_shared<CscPattern>();
+  std::vector<EntryIndex> slot_of_entry_;
+  double length_scale_ = 1.0;
+  ToleranceScales scales_;
+  double time_begin_ = -1e308, time_end_ = 1e308;
+  std::string time_limiter_;
+  // KLU by default: its refactorisation is 10-12x cheaper per drive step than UMFPACK on nfourbar from 10^3 to
+  // 10^5 four-bars (bench/README.md).
+  LinearSolverKind lu_kind_ = LinearSolverKind::kKlu;
+  std::shared_ptr<const SparseLuSymbolic> symbolic_;
+  std::vector<Index> dropped_rows_, solve_rows_;  ///< both empty unless rows are dropped (without_rows())
+  std::shared_ptr<const CscPattern> solve_pattern_ = pattern_;
+  std::vector<Index> solve_entries_;
+  std::optional<Index> grubler_;
+  std::vector<std::string> body_names_;
+};
+}  // namespace detail
+
 /// An immutable mechanism: coordinates, constraints, the fixed CSC pattern of Φq and its symbolic analysis.
-/// Built by ModelBuilder or load_scene(). Every const member function is thread-safe. Movable, not copyable;
-/// Workspaces keep its address, so it must not move while they exist.
-class Model {
+/// Built by ModelBuilder or load_scene(). Every const member function is thread-safe. Movable, not copyable.
+/// Its Workspaces follow it when it moves (a std::vector<Model> may grow while they exist) and refuse to work
+/// (phiq::Error) once it is destroyed; moving it while another thread solves with it is a data race.
+class Model : private detail::ModelData {
  public:
-  Model(Model&&) noexcept = default;             ///< only before any Workspace refers to it
-  Model& operator=(Model&&) noexcept = default;  ///< only before any Workspace refers to it
+  /// Takes `other`'s data and its workspaces: they refer to this model from now on. `other` is left without
+  /// workspaces (making one of it throws phiq::Error) until it is assigned a model again.
+  Model(Model&& other) noexcept;
+  /// Takes `other`'s data and workspaces (as the move constructor); the workspaces made for this model before
+  /// refuse to work from now on, as if it had been destroyed.
+  Model& operator=(Model&& other) noexcept;
   Model& operator=(const Model&) = delete;
+  /// Workspaces made for the model refuse to work from now on (phiq::Error, not a read of freed memory).
+  ~Model();
 
   /// n, the size of q.
   Index num_coordinates() const { return static_cast<Index>(names_.size()); }
@@ -165,6 +221,8 @@ class Model {
   const std::vector<std::string>& coordinate_names() const { return names_; }
   /// Index of a coordinate by name; throws phiq::Error for an unknown name.
   Index coordinate_index(const std::string& name) const;
+  /// Index of a coordinate by name, or -1 for an unknown name.
+  Index find_coordinate(std::string_view name) const;
   /// The initial guesses (rough placement) of q.
   const Eigen::VectorXd& initial_positions() const { return initial_; }
   /// Unit of coordinate j, inferred from the constraints that read it. Throws phiq::Error unless 0 ≤ j < n.
@@ -176,6 +234,20 @@ class Model {
   const std::vector<ConstraintInfo>& constraints() const { return constraints_; }
   /// The constraint blocks, one per kind, for tools that read the constraints' data (mechanism_sketch.hpp).
   const std::vector<std::shared_ptr<ConstraintBlock>>& blocks() const { return blocks_; }
+  /// Index into constraints() of the constraint named `name` (as given to ModelBuilder::add or in the scene);
+  /// throws phiq::Error for an unknown name. O(1): a hash index over the names, kept from the build.
+  Index constraint_index(std::string_view name) const;
+  /// Index into constraints() of the constraint named `name`, or -1 for an unknown name.
+  Index find_constraint(std::string_view name) const;
+  /// The constraint named `name`: its kind and its rows [first_row, first_row + rows) in Φ. Throws phiq::Error
+  /// for an unknown name.
+  const ConstraintInfo& constraint(std::string_view name) const {
+    return constraints_[static_cast<std::size_t>(constraint_index(name))];
+  }
+  /// The row of Φ named `row_name` as row_name() names it: "name" for a one-row constraint, "name[k]" for row k of
+  /// a multi-row one (a constraint whose own name is the whole string comes first). Throws phiq::Error for a name
+  /// that names no row (an unknown constraint, k out of range, or a bare multi-row name).
+  Index row_index(std::string_view row_name) const;
   /// Index into constraints() of the constraint owning `row`. Throws phiq::Error unless 0 ≤ row < m.
   Index constraint_of_row(Index row) const { return row_constraint_[detail::index_in(row, num_equations(), "row")]; }
   /// Unit of a row of Φ (for its tolerance). Throws phiq::Error unless 0 ≤ row < m.
@@ -257,8 +329,8 @@ class Model {
 
  private:
   friend class ModelBuilder;
-  Model() = default;
-  Model(const Model&) = default;  // without_rows() only: the constraint blocks are shared, not copied
+  Model();
+  Model(const Model& other);  // without_rows() only: the constraint blocks are shared, not copied; its own anchor
   /// The name of coordinate k, as index_of_ reads it.
   auto coordinate_name_of() const {
     return [this](Index k) -> const std::string& { return names_[static_cast<std::size_t>(k)]; };
@@ -268,33 +340,14 @@ class Model {
     return [this](Index k) -> const std::string& { return constraints_[static_cast<std::size_t>(k)].name; };
   }
 
-  std::vector<std::string> names_;
-  detail::NameIndex index_of_;  ///< coordinate names → indices (names in names_)
-  Eigen::VectorXd initial_;
-  std::vector<Unit> coordinate_units_;
-  std::vector<std::shared_ptr<ConstraintBlock>> blocks_;  ///< read-only once built (shared by without_rows())
-  std::vector<const ConstraintBlock*> time_blocks_;
-  std::vector<ConstraintInfo> constraints_;
-  std::vector<Index> row_constraint_;
-  std::vector<Unit> row_units_;
-  std::shared_ptr<const CscPattern> pattern_ = std::make_shared<CscPattern>();
-  std::vector<EntryIndex> slot_of_entry_;
   // Zero-fills csc_values unless no two entries share a slot; returns whether entries are stored (=) rather than
   // added (jacobian(), residual_and_jacobian()).
   bool prepare_jacobian_values(double* csc_values) const;
-  double length_scale_ = 1.0;
-  ToleranceScales scales_;
-  double time_begin_ = -1e308, time_end_ = 1e308;
-  std::string time_limiter_;
-  // KLU by default: its refactorisation is 10-12x cheaper per drive step than UMFPACK on nfourbar from 10^3 to
-  // 10^5 four-bars (bench/README.md).
-  LinearSolverKind lu_kind_ = LinearSolverKind::kKlu;
-  std::shared_ptr<const SparseLuSymbolic> symbolic_;
-  std::vector<Index> dropped_rows_, solve_rows_;  ///< both empty unless rows are dropped (without_rows())
-  std::shared_ptr<const CscPattern> solve_pattern_ = pattern_;
-  std::vector<Index> solve_entries_;
-  std::optional<Index> grubler_;
-  std::vector<std::string> body_names_;
+  // Workspaces and ScaledJacobianRows hold this anchor, not the model's address: the moves re-point it, the
+  // destructor nulls it (null here once moved from).
+  std::shared_ptr<detail::ModelAnchor> anchor_;
+  friend class Workspace;
+  friend class ScaledJacobianRows;
 };
 
 /// Builds a Model in code. Coordinates first (they are referenced by index), then constraints:

@@ -7,6 +7,7 @@
 #include "phiq/constraint_kinds.hpp"
 #include "phiq/constraint_kinds_3d.hpp"
 #include "phiq/csv_writer.hpp"
+#include "phiq/evaluation.hpp"
 #include "phiq/expression.hpp"
 #include "phiq/hdf5_reader.hpp"
 #include "phiq/hdf5_writer.hpp"

@@ -104,7 +104,8 @@ std::vector<RowCombination> combinations_of(const Model& model, const Eigen::Vec
 class ScaledJacobianRows {
  public:
   /// The rows `rows` of `model` (in that order: row k of the result is model row rows[k]). Throws phiq::Error for a
-  /// row out of range. The model must outlive the object.
+  /// row out of range. The object follows the model where it moves; evaluate() throws phiq::Error once the model
+  /// is destroyed (as Workspace does).
   ScaledJacobianRows(const Model& model, std::vector<Index> rows);
   /// The rows, in the order of the pattern's rows.
   const std::vector<Index>& rows() const { return rows_; }
@@ -116,7 +117,7 @@ class ScaledJacobianRows {
   void gather(const double* jacobian_values, std::vector<double>& values) const;
 
  private:
-  const Model* model_;
+  std::shared_ptr<const detail::ModelAnchor> model_;  // where the model is now (Model::anchor_)
   std::vector<Index> rows_;
   std::shared_ptr<const CscPattern> pattern_;
   std::vector<Index> source_;    // entry k is Φq's value source_[k] · coordinate_scale(column) / row_scale(row)

@@ -39,7 +39,7 @@ struct Scene {
   std::string path;              ///< the file it was read from (or the name given to parse_scene)
   std::string name;              ///< the scene's `name` field (may be empty)
   std::string text;              ///< the text it was parsed from (written into HDF5 results: how they were made)
-  std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: workspaces keep its address)
+  std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: a CsvFormat keeps its address)
   /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns
   /// written, coordinates defaulting to all).
   SweepOptions sweep;

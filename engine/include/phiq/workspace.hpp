@@ -1,10 +1,11 @@
 /// @file
 /// Per-thread data for the algorithms of kinematics.hpp: the state (q, q̇, q̈), the Jacobian values, the numeric LU
 /// factorisation and scratch vectors. A Workspace belongs to one thread at a time; the Model it was made for is
-/// shared and must outlive it (and must not be moved while it exists).
+/// shared: the workspace follows it when it moves, and refuses to work (phiq::Error) once it is destroyed.
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -34,10 +35,13 @@ struct WorkCounters {
 class Workspace {
  public:
   /// Sized for `model`, with q at its initial positions and its own numeric LU object (sharing the model's
-  /// symbolic analysis). The model must outlive the workspace and not move.
+  /// symbolic analysis). The workspace follows the model where it moves (Model's move constructor and assignment),
+  /// so that a std::vector<Model> may grow while workspaces of its models exist. Throws phiq::Error for a model
+  /// that was moved from.
   explicit Workspace(const Model& model);
-  /// The model it was made for.
-  const Model& model() const { return *model_; }
+  /// The model it was made for, where it is now. Throws phiq::Error "the Model this Workspace was made for no
+  /// longer exists" once that model is destroyed (or assigned another), as every solve with the workspace does.
+  const Model& model() const { return detail::model_of(anchor_.get(), "Workspace"); }
   /// Forgets what the last calls left for the next (the factorisation, its pivot order, Φq values not yet
   /// factorised, newton_contraction): the next call computes, to the bit, what it would in a fresh workspace
   /// with the same q (q̇, q̈ and the counters are kept; the memory of the factors too).
@@ -81,6 +85,10 @@ class Workspace {
   /// the last step, a rounding-level one, started: q is known no better than that step — and by the sweep's
   /// derivative solves after they factorise there); cleared by every solve_position at its start.
   bool factorized_at_solution = false;
+  /// The factors' point (factorized_q, factorized_t) passed the position test of solve_velocity() at this
+  /// tolerance (DerivativeOptions::tolerance; NaN when not tested), so that solve_acceleration() there does not
+  /// evaluate Φ again. Cleared with each new factorisation and by every solve_position at its start.
+  double factorized_solves_to = std::numeric_limits<double>::quiet_NaN();
   /// Buffers of num_coordinates() entries for the rows a parallel sweep holds until it delivers them in order (its
   /// chunks' q, q̇, q̈), kept for the next parallel sweep with this workspace: writing rows into memory the process
   /// already has, rather than into pages the system must map in and clear, made a repeated 2-thread sweep of
@@ -94,7 +102,7 @@ class Workspace {
   ///@}
 
  private:
-  const Model* model_;
+  std::shared_ptr<const detail::ModelAnchor> anchor_;  // where the model is now (null once this was moved from)
 };
 
 }  // namespace phiq

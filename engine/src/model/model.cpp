@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <limits>
 #include <sstream>
+#include <string_view>
+#include <type_traits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -23,10 +25,77 @@ const char* to_string(Unit u) {
 
 // ---- Model ---------------------------------------------------------------------------------------------------
 
+static_assert(std::is_nothrow_move_constructible_v<detail::ModelData> &&
+                  std::is_nothrow_move_assignable_v<detail::ModelData>,
+              "Model's moves are noexcept (a std::vector<Model> grows by moving)");
+
+void detail::throw_model_gone(const ModelAnchor* anchor, const char* what) {
+  if (anchor)
+    throw Error(std::string("the Model this ") + what +
+                " was made for no longer exists (it was destroyed, or assigned another model)");
+  throw Error(std::string("this ") + what + " was moved from: it has no model");
+}
+
+Model::Model() : anchor_(std::make_shared<detail::ModelAnchor>(detail::ModelAnchor{this})) {}
+
+Model::Model(const Model& other)
+    : detail::ModelData(other), anchor_(std::make_shared<detail::ModelAnchor>(detail::ModelAnchor{this})) {}
+
+Model::Model(Model&& other) noexcept : detail::ModelData(std::move(other)), anchor_(std::move(other.anchor_)) {
+  if (anchor_) anchor_->model = this;
+}
+
+Model& Model::operator=(Model&& other) noexcept {
+  if (this == &other) return *this;
+  detail::ModelData::operator=(std::move(other));
+  if (anchor_) anchor_->model = nullptr;  // the workspaces of the model overwritten: it no longer exists
+  anchor_ = std::move(other.anchor_);
+  if (anchor_) anchor_->model = this;
+  return *this;
+}
+
+Model::~Model() {
+  if (anchor_) anchor_->model = nullptr;
+}
+
 Index Model::coordinate_index(const std::string& name) const {
   const Index j = index_of_.find(name, coordinate_name_of());
   if (j < 0) throw Error("unknown coordinate '" + name + "'");
   return j;
+}
+
+Index Model::find_coordinate(std::string_view name) const { return index_of_.find(name, coordinate_name_of()); }
+
+Index Model::find_constraint(std::string_view name) const {
+  return constraint_index_.find(name, constraint_name_of());
+}
+
+Index Model::constraint_index(std::string_view name) const {
+  const Index k = find_constraint(name);
+  if (k < 0) throw Error("unknown constraint '" + std::string(name) + "'");
+  return k;
+}
+
+Index Model::row_index(std::string_view row_name) const {
+  const Index whole = find_constraint(row_name);
+  if (whole >= 0 && constraints_[static_cast<std::size_t>(whole)].rows == 1)
+    return constraints_[static_cast<std::size_t>(whole)].first_row;
+  // "name[k]": row k of the multi-row constraint `name`
+  const std::size_t open = row_name.rfind('[');
+  if (open != std::string_view::npos && open > 0 && row_name.size() > open + 2 && row_name.back() == ']') {
+    const std::string_view digits = row_name.substr(open + 1, row_name.size() - open - 2);
+    const Index c = find_constraint(row_name.substr(0, open));
+    if (c >= 0 && digits.find_first_not_of("0123456789") == std::string_view::npos && digits.size() < 10) {
+      const ConstraintInfo& info = constraints_[static_cast<std::size_t>(c)];
+      const Index k = std::stoll(std::string(digits));
+      if (info.rows > 1 && k < info.rows) return info.first_row + k;
+    }
+  }
+  if (whole >= 0)
+    throw Error("constraint '" + std::string(row_name) + "' has " +
+                std::to_string(constraints_[static_cast<std::size_t>(whole)].rows) + " rows: name one as '" +
+                std::string(row_name) + "[k]'");
+  throw Error("no row of Φ is named '" + std::string(row_name) + "'");
 }
 
 void detail::throw_index_out_of_range(Index i, Index size, const char* what) {
@@ -370,7 +439,7 @@ Model ModelBuilder::build() && {
   Model& m = model_;
   const Index n = m.num_coordinates(), rows = m.num_equations();
   m.initial_.conservativeResize(n);  // add_coordinate() and reserve() leave room beyond n
-  constraint_names_.clear();  // only needed while adding: free it now
+  m.constraint_index_ = std::move(constraint_names_);  // kept for Model::constraint_index()
   body_names_.clear();
 
   // Sparsity pattern, fixed for the life of the model.

@@ -4,7 +4,9 @@
 #include "phiq/kinematics.hpp"
 
 #include "solve/factorisation.hpp"
+#include "phiq/text.hpp"
 #include "solve/kinematics_internal.hpp"
+#include "solve/tolerance_tests.hpp"
 
 #include <cmath>
 #include <limits>
@@ -64,30 +66,81 @@ SolveStatus acceleration_from_factors(const Model& model, double t, Workspace& w
   }
   return SolveStatus::kSuccess;
 }
-}  // namespace
 
-// The public linear solves: Φq factorised at (ws.q, t) unless it is already, then `solve` (velocity_from_factors or
-// acceleration_from_factors); `what` names the derivatives when Φq is singular there.
+// Whether ws.q is known to solve the position problem at t without evaluating Φ: the factors or the Jacobian
+// values solve_position left at its solution are at (ws.q, t), or the factors' point passed this test at `tol`.
+bool known_solved(const Workspace& ws, double t, double tol) {
+  if (detail::factors_at_q(ws, t)) return ws.factorized_at_solution || ws.factorized_solves_to <= tol;
+  return detail::jacobian_values_at_q(ws, t);
+}
+
+// "" when ws.q solves Φ(q, t) = 0 to `tol` (solve_position's residual test), else why not, naming the worst row
+// among those that fail. One evaluation of Φ into ws.phi.
+std::string position_not_solved(const Model& model, double t, double tol, Workspace& ws) {
+  model.residual(ws.q.data(), t, ws.phi.data());
+  ++ws.counters.residual_evaluations;
+  const Eigen::VectorXd& rs = model.tolerance_scales().row_scale;
+  Index worst = -1;
+  double worst_scaled = 0.0;
+  for (Index i = 0; i < ws.phi.size(); ++i) {
+    double scaled = std::fabs(ws.phi(i)) / rs(i);
+    if (std::isnan(scaled)) scaled = std::numeric_limits<double>::infinity();
+    if (scaled <= tol || (worst >= 0 && scaled <= worst_scaled)) continue;  // the floor only where it matters
+    if (detail::row_within(model, i, scaled, tol, ws.q, t)) continue;
+    worst = i, worst_scaled = scaled;
+  }
+  if (worst < 0) return "";
+  return "q does not solve the position problem at t = " + format_time(t) + ": constraint '" +
+         model.row_name(worst) + "' residual " + significant(worst_scaled, 3) + " > tolerance " +
+         significant(tol, 3) + " (|Φ| / scale; solve_position first, or pass the tolerance q was solved to in " +
+         "DerivativeOptions)";
+}
+
+// The public linear solves: q checked (DerivativeOptions::tolerance), Φq factorised at (ws.q, t) unless it is
+// already, then `solve` (velocity_from_factors or acceleration_from_factors); `what` names the derivatives when
+// Φq is singular there.
 template <class Solve>
-SolveStatus factorize_and_solve(const Model& model, double t, Workspace& ws, LinearSummary* summary, const char* what,
-                                Solve solve) {
+SolveStatus factorize_and_solve(const Model& model, double t, const DerivativeOptions& opt, Workspace& ws,
+                                LinearSummary* summary, const char* what, Solve solve) {
   check_workspace(model, ws);
+  if (!(opt.tolerance > 0.0))
+    throw Error("DerivativeOptions.tolerance must be > 0 (infinity: no test of the position), not " +
+                significant(opt.tolerance, 3));
   LinearSummary local;
   LinearSummary& sum = summary ? *summary : local;
   sum = LinearSummary{};
+  const bool test = opt.tolerance != std::numeric_limits<double>::infinity() && !known_solved(ws, t, opt.tolerance);
+  if (test) {
+    std::string why = position_not_solved(model, t, opt.tolerance, ws);
+    if (!why.empty()) return sum.status = SolveStatus::kPositionNotSolved, sum.message = std::move(why), sum.status;
+  }
   std::string msg;
   SolveStatus st = ensure_factorized(model, t, ws, &sum.rcond, &msg);
   if (st == SolveStatus::kSingularJacobian) msg = std::string(what) + " are not unique here: " + msg;
   if (st != SolveStatus::kSuccess) return sum.status = st, sum.message = msg, st;
+  // the factors' point passed the test, or is known to (Jacobian values left at solve_position's solution, now
+  // factorised): the acceleration that follows need not test it again
+  const bool tested = opt.tolerance != std::numeric_limits<double>::infinity();
+  if (tested && !(ws.factorized_solves_to <= opt.tolerance)) ws.factorized_solves_to = opt.tolerance;
   return solve(model, t, ws, sum);
 }
 
+}  // namespace
+
+SolveStatus solve_velocity(const Model& model, double t, const DerivativeOptions& options, Workspace& ws,
+                           LinearSummary* summary) {
+  return factorize_and_solve(model, t, options, ws, summary, "velocities", velocity_from_factors);
+}
 SolveStatus solve_velocity(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
-  return factorize_and_solve(model, t, ws, summary, "velocities", velocity_from_factors);
+  return solve_velocity(model, t, DerivativeOptions{}, ws, summary);
 }
 
+SolveStatus solve_acceleration(const Model& model, double t, const DerivativeOptions& options, Workspace& ws,
+                               LinearSummary* summary) {
+  return factorize_and_solve(model, t, options, ws, summary, "accelerations", acceleration_from_factors);
+}
 SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, LinearSummary* summary) {
-  return factorize_and_solve(model, t, ws, summary, "accelerations", acceleration_from_factors);
+  return solve_acceleration(model, t, DerivativeOptions{}, ws, summary);
 }
 
 namespace detail {

@@ -7,6 +7,7 @@
 #include "solve/kinematics_internal.hpp"
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -73,6 +74,7 @@ std::string detail::non_finite_jacobian_at(const Model& model, const double* q, 
 SolveStatus detail::factorize_at_q(const Model& model, double t, Workspace& ws, double* rcond,
                                    std::string* message, bool values_at_q) {
   ws.has_factorization = false;
+  ws.factorized_solves_to = std::numeric_limits<double>::quiet_NaN();
   if (!values_at_q) {
     model.jacobian(ws.q.data(), t, ws.jacobian_values.data());
     ++ws.counters.jacobian_evaluations;

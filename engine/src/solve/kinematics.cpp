@@ -31,11 +31,13 @@ const char* to_string(SolveStatus s) {
     case SolveStatus::kOutsideTimeDomain: return "outside time domain";
     case SolveStatus::kCancelled: return "cancelled";
     case SolveStatus::kInconsistent: return "inconsistent redundant constraints";
+    case SolveStatus::kPositionNotSolved: return "position not solved";
   }
   return "?";
 }
 
-Workspace::Workspace(const Model& model) : model_(&model) {
+Workspace::Workspace(const Model& model) : anchor_(model.anchor_) {
+  if (!anchor_) throw Error("a Workspace of a Model that was moved from (it has no data)");
   const Index n = model.num_coordinates(), m = model.num_equations();
   q = model.initial_positions();
   qd = Eigen::VectorXd::Zero(n);
@@ -56,6 +58,7 @@ Workspace::Workspace(const Model& model) : model_(&model) {
 void Workspace::start_afresh() {
   has_factorization = false;
   factorized_at_solution = false;
+  factorized_solves_to = std::numeric_limits<double>::quiet_NaN();
   has_jacobian = false;
   newton_contraction = -1.0;
   if (lu) lu->forget_pivot_order();
@@ -229,6 +232,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   // not yet factorised): the loop knows it without comparing points; the point is recorded once, at the end.
   ws.has_jacobian = false;
   ws.factorized_at_solution = false;
+  ws.factorized_solves_to = std::numeric_limits<double>::quiet_NaN();
   bool jacobian_at_q = false;
 
   bool factorized_here = false;  // this solve factorised (at an iterate whose point is not recorded)
@@ -320,7 +324,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
     if (it > 0 && (it >= opt.max_iterations || stagnant >= 2) && within) {
       sum.slow_convergence = sum.linear_convergence = true;
       sum.error_estimate = accepted_error;
-      finish(SolveStatus::kSuccess, "");
+      (void)finish(SolveStatus::kSuccess, "");  // (returned below, after its message)
       sum.message = "residual within tolerance but the Newton steps stopped converging quadratically (a singular "
                     "position, or Φq too ill-conditioned for this tolerance)";
       return SolveStatus::kSuccess;
@@ -440,7 +444,7 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
       // The contraction seen with a reused matrix: the rounding in its last step makes it an overestimate, which
       // the next solve's first step may use as such (kept, as a success's).
       if (theta_seen >= 0.0) ws.newton_contraction = theta_seen;
-      finish(SolveStatus::kSuccess, "");
+      (void)finish(SolveStatus::kSuccess, "");  // (its status is returned below, with the message set)
       // Known to within twice the tolerance: as good as the tolerance test's own estimate promises (it is an
       // estimate, not a bound), nothing to warn about. A 2000-stage scissor lift sits there at the default
       // tolerance (its top joints, 600 m up, are known to 1.2 tolerances).

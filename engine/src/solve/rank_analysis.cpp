@@ -29,7 +29,7 @@ std::string RankReport::BriefReport() const {
 }
 
 ScaledJacobianRows::ScaledJacobianRows(const Model& model, std::vector<Index> rows)
-    : model_(&model), rows_(std::move(rows)) {
+    : model_(model.anchor_), rows_(std::move(rows)) {
   const Index n = model.num_coordinates(), m = model.num_equations();
   const CscPattern& full = model.jacobian_pattern();
   std::vector<Index> pos(static_cast<std::size_t>(m), -1);
@@ -58,17 +58,19 @@ ScaledJacobianRows::ScaledJacobianRows(const Model& model, std::vector<Index> ro
 }
 
 void ScaledJacobianRows::evaluate(const Eigen::VectorXd& q, double t, std::vector<double>& values) {
-  if (q.size() != model_->num_coordinates())
-    throw Error("ScaledJacobianRows: q must have " + std::to_string(model_->num_coordinates()) + " entries");
-  full_.resize(static_cast<std::size_t>(model_->jacobian_pattern().nnz()));
-  model_->jacobian(q.data(), t, full_.data());
+  const Model& model = detail::model_of(model_.get(), "ScaledJacobianRows");
+  if (q.size() != model.num_coordinates())
+    throw Error("ScaledJacobianRows: q must have " + std::to_string(model.num_coordinates()) + " entries");
+  full_.resize(static_cast<std::size_t>(model.jacobian_pattern().nnz()));
+  model.jacobian(q.data(), t, full_.data());
   gather(full_.data(), values);
 }
 
 void ScaledJacobianRows::gather(const double* jacobian_values, std::vector<double>& values) const {
   values.resize(source_.size());
-  const ToleranceScales& s = model_->tolerance_scales();
-  const std::vector<Index>& full_rows = model_->jacobian_pattern().row_idx;
+  const Model& model = detail::model_of(model_.get(), "ScaledJacobianRows");
+  const ToleranceScales& s = model.tolerance_scales();
+  const std::vector<Index>& full_rows = model.jacobian_pattern().row_idx;
   const CscPattern& p = *pattern_;
   for (Index j = 0; j < p.cols; ++j)
     for (Index k = p.col_ptr[j]; k < p.col_ptr[j + 1]; ++k) {

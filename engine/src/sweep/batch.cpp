@@ -39,7 +39,8 @@ BatchSummary run_batch(const std::vector<const Model*>& models, const std::vecto
       if (starts) ws.q = (*starts)[c];
       SweepOptions one = options[c];
       one.threads = 1;  // parallel over cases, not within one
-      run_sweep(*models[c], one, ws, on_step ? [&](const StepView& s) { return on_step(c, s); }
+      (void)run_sweep(  // the status is the case summary's (out.cases[c].status)
+          *models[c], one, ws, on_step ? [&](const StepView& s) { return on_step(c, s); }
                                              : std::function<bool(const StepView&)>{},
                 &out.cases[c]);
     });

@@ -210,7 +210,11 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
 std::string Sweeper::dead_point(double t1) {
   ws_->q = current_.q;
   LinearSummary ls;
-  if (lu_derivatives(current_.t, true, &ls, /*just_solved=*/false) != SolveStatus::kSuccess) return "";
+  DerivativeOptions converged;  // current_.q is a row the sweep converged to (at its own tolerance): not tested again
+  converged.tolerance = INFINITY;
+  if (solve_velocity(model_, current_.t, converged, *ws_, &ls) != SolveStatus::kSuccess ||
+      solve_acceleration(model_, current_.t, converged, *ws_, &ls) != SolveStatus::kSuccess)
+    return "";
   const double vv = ws_->qd.squaredNorm(), va = ws_->qd.dot(ws_->qdd);
   const double tau = va != 0.0 ? vv / (2.0 * va) : 0.0;  // t* − t, signed like the drive direction
   if (!(std::isfinite(tau) && tau * (t1 - current_.t) > 0 && std::fabs(tau) <= 2.0 * std::fabs(t1 - current_.t)))

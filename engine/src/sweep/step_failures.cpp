@@ -5,6 +5,7 @@
 #include "sweep/sweeper.hpp"
 
 #include "phiq/text.hpp"
+#include "solve/factorisation.hpp"
 
 namespace phiq::detail {
 
@@ -49,8 +50,9 @@ std::string Sweeper::conflicting_redundancy(double t1) {
     if (!ws_->phi.allFinite()) return "";
     kept_hold = std::all_of(kept.begin(), kept.end(), holds);
     if (kept_hold) break;
-    LinearSummary ls;  // the factorisation at ws.q (the velocity it solves is not used)
-    if (solve_velocity(model_, t1, *ws_, &ls) != SolveStatus::kSuccess) return "";
+    double rcond = 0.0;  // the factorisation at ws.q (not a solved position: no velocity there)
+    std::string why;
+    if (detail::ensure_factorized(model_, t1, *ws_, &rcond, &why) != SolveStatus::kSuccess) return "";
     for (std::size_t k = 0; k < kept.size(); ++k) rhs(static_cast<Index>(k)) = ws_->phi(kept[k]);
     if (!ws_->lu->solve(rhs.data(), step.data()) || !step.allFinite()) return "";
     ws_->q -= step;
