@@ -161,3 +161,26 @@ def test_everything_public_has_a_docstring():
                 if not (getattr(value, "__doc__", None) or "").strip():
                     missing.append(f"{name}.{attr}")
     assert missing == []
+
+
+def test_derivatives_at_an_unsolved_q_are_refused():
+    model = phiq.load_scene(CRANK_SLIDER).model
+    ws = phiq.Workspace(model)  # q is the rough placement: not a solution
+    qd = ws.qd.copy()
+    v = phiq.solve_velocity(model, 0.0, ws)
+    assert v.status == phiq.SolveStatus.POSITION_NOT_SOLVED and not v.ok
+    assert v.message.startswith("q does not solve the position problem at t = 0: constraint '")
+    assert np.array_equal(ws.qd, qd)
+    assert phiq.solve_velocity(model, 0.0, ws, tolerance=math.inf).ok  # the caller vouches for q
+    assert phiq.solve_position(model, 0.0, ws).ok and phiq.solve_velocity(model, 0.0, ws).ok
+
+
+def test_names_to_constraints_and_rows():
+    model = phiq.load_scene(CRANK_SLIDER).model
+    crank = model.constraint("crank")
+    assert (crank.name, crank.kind, crank.rows) == ("crank", "polar", 2)
+    assert model.constraints[model.constraint_index("rod")].name == "rod"
+    assert model.row_index("crank[1]") == crank.first_row + 1
+    assert model.row_name(model.row_index("rod")) == "rod"
+    with pytest.raises(ValueError, match="hinge"):
+        model.constraint("hinge")

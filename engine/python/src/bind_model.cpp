@@ -58,6 +58,8 @@ void bind_model(py::module_& m) {
       .value("OUTSIDE_TIME_DOMAIN", SolveStatus::kOutsideTimeDomain, "a driver's law is not defined at t")
       .value("CANCELLED", SolveStatus::kCancelled, "stopped by the caller (Ctrl-C in Python)")
       .value("INCONSISTENT", SolveStatus::kInconsistent, "redundant constraints that cannot hold together")
+      .value("POSITION_NOT_SOLVED", SolveStatus::kPositionNotSolved,
+             "a velocity or acceleration asked at a q that does not solve the position problem")
       .def("__str__", [](SolveStatus s) { return to_string(s); });
 
   py::class_<ConstraintInfo>(m, "ConstraintInfo", "One constraint of a model, as diagnostics name it.")
@@ -81,6 +83,12 @@ void bind_model(py::module_& m) {
       .def_property_readonly("coordinate_names", &Model::coordinate_names, "names of q's entries, in order")
       .def("coordinate_index", &Model::coordinate_index, py::arg("name"),
            "Index in q of the coordinate `name`; ValueError for an unknown name.")
+      .def("constraint_index", [](const Model& md, const std::string& name) { return md.constraint_index(name); },
+           py::arg("name"), "Index in constraints of the constraint `name`; ValueError for an unknown name.")
+      .def("constraint", [](const Model& md, const std::string& name) { return md.constraint(name); },
+           py::arg("name"), "The ConstraintInfo of constraint `name` (its first_row and rows); ValueError if unknown.")
+      .def("row_index", [](const Model& md, const std::string& name) { return md.row_index(name); },
+           py::arg("row_name"), "The row of Φ named 'name' or 'name[k]' (row_name's inverse); ValueError if unknown.")
       .def_property_readonly(
           "coordinate_units",
           [](const Model& md) {

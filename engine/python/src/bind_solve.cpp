@@ -88,26 +88,28 @@ void bind_solve(py::module_& m) {
       "PositionSummary (its status says whether it succeeded).");
   m.def(
       "solve_velocity",
-      [](const Model& model, double t, Workspace& ws) {
+      [](const Model& model, double t, Workspace& ws, double tolerance) {
         check_workspace(model, ws);
         LinearSummary s;
         py::gil_scoped_release free;
-        (void)solve_velocity(model, t, ws, &s);
+        (void)solve_velocity(model, t, DerivativeOptions{tolerance}, ws, &s);  // the status is in the summary
         return s;
       },
-      py::arg("model"), py::arg("t"), py::arg("workspace"),
-      "Solve Φq q̇ = −Φt at workspace.q into workspace.qd (q must solve the position problem at t).");
+      py::arg("model"), py::arg("t"), py::arg("workspace"), py::arg("tolerance") = DerivativeOptions{}.tolerance,
+      "Solve Φq q̇ = −Φt at workspace.q into workspace.qd. workspace.q must solve the position problem at t to "
+      "`tolerance` (solve_position's residual test; math.inf: no test), else the status is POSITION_NOT_SOLVED "
+      "with the worst constraint named and qd is left as it was.");
   m.def(
       "solve_acceleration",
-      [](const Model& model, double t, Workspace& ws) {
+      [](const Model& model, double t, Workspace& ws, double tolerance) {
         check_workspace(model, ws);
         LinearSummary s;
         py::gil_scoped_release free;
-        (void)solve_acceleration(model, t, ws, &s);
+        (void)solve_acceleration(model, t, DerivativeOptions{tolerance}, ws, &s);  // the status is in the summary
         return s;
       },
-      py::arg("model"), py::arg("t"), py::arg("workspace"),
-      "Solve Φq q̈ = γ at workspace.q, workspace.qd into workspace.qdd.");
+      py::arg("model"), py::arg("t"), py::arg("workspace"), py::arg("tolerance") = DerivativeOptions{}.tolerance,
+      "Solve Φq q̈ = γ at workspace.q, workspace.qd into workspace.qdd (q checked as in solve_velocity).");
 
   py::class_<RankReport>(m, "RankReport", "Rank and redundancy of the constraint equations at one configuration.")
       .def_readonly("coordinates", &RankReport::coordinates, "n")
