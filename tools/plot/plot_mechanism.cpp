@@ -65,8 +65,14 @@ std::string mechanism_panel(const MechanismFrames& m, double x0, double y0, doub
   }
   for (const auto& tr : m.traces)
     for (const P3& p : tr.second) extend(p);
-  if (m.spatial) extend({0, 0, 0});  // the axes' origin
   if (!(xmax >= xmin)) xmin = -1, xmax = 1, ymin = -1, ymax = 1;  // nothing to draw
+  // in space, the axes from the origin: a round length, at most 0.3 of the drawing, inside the panel with their names
+  double len = 0.0;
+  if (m.spatial) {
+    const double most = 0.3 * std::max(xmax - xmin, ymax - ymin), mag = std::pow(10.0, std::floor(std::log10(most)));
+    len = most >= 5 * mag ? 5 * mag : (most >= 2 * mag ? 2 * mag : mag);
+    extend({0, 0, 0}), extend({1.3 * len, 0, 0}), extend({0, 1.3 * len, 0}), extend({0, 0, 1.3 * len});
+  }
   widen(xmin, xmax), widen(ymin, ymax);
   const double span = std::max(xmax - xmin, ymax - ymin), cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
   // room below for the ground symbols: 10 % more span, the centre lifted
@@ -82,9 +88,6 @@ std::string mechanism_panel(const MechanismFrames& m, double x0, double y0, doub
   if (m.spatial) {  // projected axes carry no scale: a frame, the three axes from the origin, and a scale bar
     s += "<rect class=\"frame\" x=\"" + px(x0) + "\" y=\"" + px(y0) + "\" width=\"" + px(side) + "\" height=\"" +
          px(side) + "\" fill=\"none\" stroke=\"#888\"/>\n";
-    // the axes' length: 1, 2 or 5 × 10^k, at most 0.3 of the drawing
-    const double most = 0.3 * span, mag = std::pow(10.0, std::floor(std::log10(most)));
-    const double len = most >= 5 * mag ? 5 * mag : (most >= 2 * mag ? 2 * mag : mag);
     const auto o = screen({0, 0, 0});
     const char* names[3] = {"x", "y", "z"};
     for (int a = 0; a < 3; ++a) {
