@@ -63,6 +63,16 @@ class Cli : public ::testing::Test {
   fs::path dir_;
 };
 
+// The result CSV `csv` with xA, the second field of its second data row, made NaN (the natural four-bar's results,
+// whose columns start t, xA).
+inline std::string with_nan_xA(std::string csv) {
+  const std::size_t line = csv.find('\n', csv.find('\n') + 1) + 1;  // the second data row
+  const std::size_t comma = csv.find(',', line);                    // its second field
+  EXPECT_EQ(csv.substr(0, 5), "t,xA,");
+  csv.replace(comma + 1, csv.find(',', comma + 1) - comma - 1, "nan");
+  return csv;
+}
+
 // One line on stderr, "phiq: " first.
 inline ::testing::AssertionResult one_phiq_line(const std::string& err) {
   if (std::count(err.begin(), err.end(), '\n') == 1 && err.rfind("phiq: ", 0) == 0)

@@ -23,6 +23,18 @@ done
 "$py" "$script" "$fixture" "$fixture_rt" -o "$dir/again.svg" 2>/dev/null || fail "second run"
 cmp -s "$dir/fixture.svg" "$dir/again.svg" || fail "the SVG differs between two runs on the same input"
 
+# the x axis says whose N it is: nfourbar alone, or the generators of the scenes plotted (never "nfourbar N" for
+# chain3d and grid curves)
+"$py" "$script" "$fixture" --filter 'phiq KLU' -o "$dir/nfourbar.svg" 2>/dev/null || fail "exit status $? on --filter"
+grep -q 'nfourbar N (N + 1 cranks, 2N + 3 natural coordinates)' "$dir/nfourbar.svg" || fail "nfourbar x label missing"
+printf '{"benchmarks": [{"name": "BM_Chain3dStep/N:10/manual_time", "us_per_step": 5},
+  {"name": "BM_Chain3dStep/N:100/manual_time", "us_per_step": 50}, {"name": "BM_GridStep/N:10", "us_per_step": 7},
+  {"name": "BM_GridStep/N:100", "us_per_step": 70}]}' >"$dir/scenes.json"
+"$py" "$script" "$dir/scenes.json" -o "$dir/scenes.svg" 2>/dev/null || fail "exit status $? on chain3d and grid"
+grep -q "size argument of each scene's generator (phiq generate chain3d|grid N)" "$dir/scenes.svg" ||
+  fail "chain3d/grid x label missing"
+grep -q 'nfourbar' "$dir/scenes.svg" && fail "chain3d and grid curves labelled nfourbar"
+
 # errors: one line on stderr, exit status 1
 expect_error "missing file" "$dir/no_such.json"
 printf '{"benchmarks": [' >"$dir/truncated.json"

@@ -70,10 +70,14 @@ TEST_F(Cli, PlotDrawsTheMechanismTracesAndColumns) {
   for (const auto& row : rt.rows) EXPECT_LE(row.back(), 1e-10);
 }
 
-// A scene whose mechanism draws nothing (dimension 3: `phiq generate chain3d`) got an empty panel without a word.
+// A scene whose mechanism draws nothing (coordinates tied by an equation alone) got an empty panel without a word.
 TEST_F(Cli, PlotSaysWhenThereIsNothingOfTheMechanismToDraw) {
-  const fs::path scene = dir_ / "c.yaml", csv = dir_ / "c.csv", svg = dir_ / "c.svg";
-  ASSERT_EQ(run("generate chain3d 3 --steps 10 -o " + scene.string()).code, 0);
+  const fs::path scene = write("c.yaml", R"(phiq: 1
+coordinates: {a: 0, b: 0}
+constraints: [{name: tie, type: equation, expr: "b - 2*a", unit: length}]
+drivers: [{name: m, coordinate: a, law: {type: linear, initial: 0, rate: 1}}]
+time: {start: 0, end: 1, steps: 10}
+)"), csv = dir_ / "c.csv", svg = dir_ / "c.svg";
   ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
   Result r = run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string());
   EXPECT_EQ(r.code, 0) << r.err;

@@ -424,6 +424,58 @@ TEST(MechanismSketch, LinesFollowTheConstraintsEachOnce) {
   EXPECT_EQ(arms, 2);
 }
 
+// The joints: a pivot per revolute pair, on ground where a side is ground (still), each with its constraint; the
+// spatial kinds draw their bars, arms and joints too.
+TEST(MechanismSketch, JointsAndSpatialLinks) {
+  Scene ref = load_scene(test::model_path("seed/fourbar_reference_point.yaml"));
+  const MechanismSketch r = sketch_mechanism(*ref.model);
+  ASSERT_EQ(r.joints.size(), 4u);
+  std::vector<std::string> names;
+  for (const SketchJoint& j : r.joints) {
+    names.push_back(ref.model->constraints()[static_cast<std::size_t>(j.constraint)].name);
+    EXPECT_EQ(j.mark, JointMark::kRevolute);
+    EXPECT_EQ(j.fixed, names.back() == "O" || names.back() == "C") << names.back();
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"O", "A", "B", "C"}));
+  // ground pivots at their places: O (0, 0), C (L1, 0)
+  const PointMotion c = evaluate_point(r.joints[3].at, ref.model->initial_positions().data(), nullptr, nullptr);
+  EXPECT_EQ(c.r[0], 1.0);
+  EXPECT_EQ(c.r[1], 0.0);
+  // rssr: the coupler's bar and the arms to its ends; two ground hinges; the bar's two ends
+  Scene rssr = load_scene(test::model_path("spatial/rssr.yaml"));
+  const MechanismSketch s = sketch_mechanism(*rssr.model);
+  ASSERT_EQ(s.segments.size(), 3u);
+  EXPECT_EQ(s.segments[0].line, SketchLine::kBar);
+  EXPECT_EQ(rssr.model->constraints()[static_cast<std::size_t>(s.segments[0].constraint)].name, "coupler");
+  Workspace ws(*rssr.model);
+  ASSERT_EQ(solve_position(*rssr.model, 0.0, rssr.sweep.assembly, ws), SolveStatus::kSuccess);
+  const PointMotion a = evaluate_point(s.segments[0].from, ws.q.data(), nullptr, nullptr),
+                    b = evaluate_point(s.segments[0].to, ws.q.data(), nullptr, nullptr);
+  EXPECT_NEAR(std::hypot(b.r[0] - a.r[0], b.r[1] - a.r[1], b.r[2] - a.r[2]), 0.92, 1e-9);
+  ASSERT_EQ(s.joints.size(), 4u);
+  int hinges = 0, ends = 0;
+  for (const SketchJoint& j : s.joints) {
+    if (j.mark == JointMark::kRevolute) {
+      ++hinges;
+      EXPECT_TRUE(j.fixed);
+    }
+    if (j.mark == JointMark::kPoint) {
+      ++ends;
+      EXPECT_FALSE(j.fixed);
+    }
+  }
+  EXPECT_EQ(hinges, 2);
+  EXPECT_EQ(ends, 2);
+  // the scene keeps its moving bodies' frames, in the order of the model's body names
+  ASSERT_EQ(rssr.spatial_bodies.size(), 2u);
+  EXPECT_EQ(rssr.model->body_names(), (std::vector<std::string>{"crank", "rocker"}));
+  EXPECT_EQ(rssr.spatial_bodies[1].e0.coord(), rssr.model->coordinate_index("rocker_e0"));
+  EXPECT_EQ(ref.planar_bodies.size(), 3u);
+  EXPECT_EQ(ref.planar_bodies[2].psi.coord(), ref.model->coordinate_index("psi4"));
+  EXPECT_EQ(rssr.dimension, 3);
+  EXPECT_EQ(ref.dimension, 2);
+}
+
 TEST(FormatTime, TenSignificantDigitsWhateverTheScale) {
   EXPECT_EQ(format_time(1e-7), "1e-07");
   EXPECT_EQ(format_time(0.6000000000000001), "0.6");

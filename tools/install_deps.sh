@@ -25,21 +25,31 @@ packages=(
   python3-pandas       # SweepResult.to_pandas() (optional for users; its test needs it)
   mypy                 # stubgen: the package's type stubs (_phiq.pyi); the type-checking test of tests/python
   help2man             # the man page phiq.1, generated from `phiq --help` at install (skipped with a note if absent)
+  nodejs               # runs the Khronos glTF-Validator on `phiq animate`'s .glb files (ctest gltf_validator)
 )
+# npm (Debian's package, unless a node install already brings its own) installs the validator below
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || { echo "install_deps.sh: run as root (missing: ${missing[*]})" >&2; exit 1; }
+    SUDO=sudo
+  fi
+  echo "install_deps.sh: installing ${missing[*]}" >&2
+  $SUDO apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then
-  command -v sudo >/dev/null || { echo "install_deps.sh: run as root (missing: ${missing[*]})" >&2; exit 1; }
-  SUDO=sudo
+# The Khronos glTF-Validator (npm package gltf-validator, a fixed version) into tools/gltf_validator/, beside the
+# sources and ignored by git: the tests run it from there and download nothing themselves.
+validator_dir="$(cd "$(dirname "$0")" && pwd)/gltf_validator"
+if [ ! -f "$validator_dir/node_modules/gltf-validator/package.json" ]; then
+  echo "install_deps.sh: installing gltf-validator into $validator_dir" >&2
+  mkdir -p "$validator_dir"
+  npm install --silent --no-audit --no-fund --prefix "$validator_dir" gltf-validator@2.0.0-dev.3.10
 fi
-echo "install_deps.sh: installing ${missing[*]}" >&2
-$SUDO apt-get update -q
-DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -22,6 +22,7 @@ Command register_batch(CLI::App& app);
 Command register_assemble(CLI::App& app);
 Command register_check(CLI::App& app);
 Command register_plot(CLI::App& app);
+Command register_animate(CLI::App& app);
 Command register_compare(CLI::App& app);
 Command register_sweep_accuracy(CLI::App& app);
 

@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   const std::vector<Command> commands{register_run(app),    register_generate(app), register_batch(app),
                                       register_assemble(app), register_check(app),  register_plot(app),
+                                      register_animate(app),
                                       register_compare(app),  register_sweep_accuracy(app)};
   try {
     app.parse(argc, argv);

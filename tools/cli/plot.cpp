@@ -19,7 +19,7 @@ Command register_plot(CLI::App& app) {
   plot->add_option("-o,--output", options->out, "SVG file to write ('-': standard output)")
       ->required()
       ->transform(output_path("", false));
-  plot->add_option("--columns", options->columns, "Columns to plot against t (default: the coordinates, at most 6)")
+  plot->add_option("--columns", options->columns, "Columns to plot against t (default: the driven and the moving coordinates, at most 6)")
       ->delimiter(',');
   plot->add_option("--positions", options->positions, "Rows at which the mechanism is drawn, evenly spread")
       ->capture_default_str()

@@ -11,7 +11,7 @@ _phiq() {
     words=("${COMP_WORDS[@]}")
     cword=$COMP_CWORD
   }
-  local commands="run check assemble batch compare generate plot sweep-accuracy"
+  local commands="run check assemble batch compare generate plot animate sweep-accuracy"
   local cmd="" i
   for ((i = 1; i < cword; i++)); do
     case " $commands " in *" ${words[i]} "*) cmd="${words[i]}"; break ;; esac
@@ -30,6 +30,7 @@ _phiq() {
     compare) opts="--help --rtol --atol --columns --json --junit" ;;
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
     plot) opts="--help --output --columns --positions" ;;
+    animate) opts="--help --output" ;;
     sweep-accuracy) opts="--help --output --json --tolerances --steps-list --predictors --newton --linear-solvers
                           --reference --repeat --quiet --verbose" ;;
   esac

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Plot time per drive step against nfourbar N (log-log) from Google Benchmark JSON files.
+"""Plot time per drive step against the scene's size N (log-log) from Google Benchmark JSON files.
 
 One curve per benchmark family: the benchmark name without its N argument, with its other arguments (lu, pred)
 spelled out, e.g. "phiq KLU", "phiq UMFPACK", "dense Eigen LU, from previous", "Simbody, quadratic predictor".
@@ -99,6 +99,29 @@ def family_label(base, args):
     return ", ".join([label] + words)
 
 
+# The generated scene each family steps, from its name ("BM_NFourBarStepSimbody", "BM_GridStep", ...), for the
+# axis label: the x axis says whose N it is.
+SCENES = (("nfourbar", re.compile(r"nfourbar", re.I)), ("grid", re.compile(r"grid", re.I)),
+          ("scissor", re.compile(r"scissor", re.I)), ("chain3d", re.compile(r"chain3d", re.I)))
+
+
+def scene_of(base):
+    for scene, rx in SCENES:
+        if rx.search(base):
+            return scene
+    return None
+
+
+def x_label(scenes):
+    """The x axis's label for the scenes plotted (names, None for a family of no known scene)."""
+    known = sorted(set(s for s in scenes if s))
+    if known == ["nfourbar"] and None not in scenes:
+        return "nfourbar N (N + 1 cranks, 2N + 3 natural coordinates)"
+    if len(known) == 1 and None not in scenes:
+        return "%s N (the size argument of phiq generate %s)" % (known[0], known[0])
+    return "N, the size argument of each scene's generator (phiq generate %s N)" % "|".join(known or ["KIND"])
+
+
 def step_counter(b):
     """Time per step (s) from a per-step counter, or None."""
     for key, scale in STEP_COUNTERS.items():
@@ -115,7 +138,7 @@ def real_time(b):
 
 
 def load(path, exclude=None):
-    """Returns ({label: {N: [seconds, ...]}}, skipped) for one file."""
+    """Returns ({label: {N: [seconds, ...]}}, skipped, {label: scene or None}) for one file."""
     try:
         with open(path, encoding="utf-8") as f:
             text = f.read()
@@ -132,7 +155,7 @@ def load(path, exclude=None):
         if not isinstance(b, dict) or not isinstance(b.get("name"), str):
             raise PlotError("%s: a benchmark entry without a name" % path)
     counters_here = any(any(k in b for k in STEP_COUNTERS) for b in entries)
-    curves, skipped = {}, {}
+    curves, skipped, scenes = {}, {}, {}
 
     def skip(why):
         skipped[why] = skipped.get(why, 0) + 1
@@ -162,7 +185,8 @@ def load(path, exclude=None):
             skip("not per step")
             continue
         curves.setdefault(family_label(base, args), {}).setdefault(n, []).append(t)
-    return curves, skipped
+        scenes[family_label(base, args)] = scene_of(base)
+    return curves, skipped, scenes
 
 
 def median(xs):
@@ -180,7 +204,7 @@ def main(argv):
     ap.add_argument("--png", metavar="OUT.png", help="also write a PNG")
     ap.add_argument("--filter", metavar="REGEX", help="only curves whose label matches REGEX (re.search)")
     ap.add_argument("--exclude", metavar="REGEX", help="leave out benchmarks whose name matches REGEX")
-    ap.add_argument("--title", help="title of the figure", default="nfourbar: time per drive step (position, velocity, acceleration)")
+    ap.add_argument("--title", help="title of the figure (default: the scenes plotted, and what is timed)")
     args = ap.parse_args(argv)
 
     try:
@@ -190,11 +214,12 @@ def main(argv):
     # FILE=LABEL names the file's curves in the legend; a path that exists is taken whole.
     named = [(a, None) if os.path.exists(a) or "=" not in a else tuple(a.rsplit("=", 1)) for a in args.json]
     per_file = [(p, tag, load(p, exclude)) for p, tag in named]
-    merged = {}
-    for p, tag, (curves, _) in per_file:
+    merged, scene_of_curve = {}, {}
+    for p, tag, (curves, _, scenes) in per_file:
         stem = tag or os.path.splitext(os.path.basename(p))[0]
         for label, points in curves.items():
             name = label if len(args.json) == 1 else "%s (%s)" % (label, stem)
+            scene_of_curve[name] = scenes[label]
             for n, ts in points.items():
                 merged.setdefault(name, {}).setdefault(n, []).extend(ts)
     if args.filter:
@@ -219,15 +244,18 @@ def main(argv):
                 linestyle="--" if "from previous" in label else "-")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel("nfourbar N (N + 1 cranks, 2N + 3 natural coordinates)")
+    plotted = [scene_of_curve[label] for label in merged]
+    ax.set_xlabel(x_label(plotted))
     ax.set_ylabel("time per drive step (s)")
-    ax.set_title(args.title, fontsize=10)
+    known = sorted(set(s for s in plotted if s))
+    ax.set_title(args.title or "%s: time per drive step (position, velocity, acceleration)" %
+                 (", ".join(known) if known else "benchmarks"), fontsize=10)
     ax.grid(True, which="both", linewidth=0.3, alpha=0.6)
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     fig.tight_layout()
     save(fig, args.output, args.png, svg_dpi=120, png_dpi=120)
     skipped = {}
-    for _, _, (_, sk) in per_file:
+    for _, _, (_, sk, _) in per_file:
         for why, k in sk.items():
             skipped[why] = skipped.get(why, 0) + k
     print("%s: %d curves -> %s%s%s" % (

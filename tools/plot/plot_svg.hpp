@@ -1,6 +1,6 @@
 // `phiq plot SCENE RESULT.csv -o OUT.svg`: what a user looks at first. The mechanism drawn at a few rows of the
-// result with the traced output points (a coupler curve), beside chosen columns against time, as one SVG written
-// by hand (no plotting dependency).
+// result with the traced output points (a coupler curve; plot_mechanism.*), beside chosen columns against time, one
+// panel per quantity (plot_series.*), as one SVG written by hand (no plotting dependency; plot_draw.*).
 #pragma once
 
 #include <string>
@@ -12,12 +12,13 @@ struct PlotOptions {
   std::string scene;                 // the scene the result was computed from
   std::string csv;                   // `phiq run` output for that scene
   std::string out;                   // the SVG to write
-  std::vector<std::string> columns;  // plotted against t; empty: the coordinate columns (else the first), at most 6
+  std::vector<std::string> columns;  // plotted against t; empty: the driven and moving coordinates, at most 6
   int positions = 5;                 // rows at which the mechanism is drawn, evenly spread, first and last included
 };
 
 // Writes the SVG (under a temporary name, renamed when complete). Returns the exit status of `phiq plot`: 0, 2 for
-// bad input (scene, CSV that does not match it, unknown column), 3 when the file cannot be written; errors are one
+// bad input (scene, CSV that does not match it, unknown column, a value to plot or draw that is not a number), 3
+// when the file cannot be written; errors are one
 // line on stderr.
 int plot_svg(const PlotOptions& options);
 

@@ -39,6 +39,11 @@ struct Scene {
   std::string path;              ///< the file it was read from (or the name given to parse_scene)
   std::string name;              ///< the scene's `name` field (may be empty)
   std::string text;              ///< the text it was parsed from (written into HDF5 results: how they were made)
+  int dimension = 2;             ///< the scene's `dimension` (2: planar, 3: spatial)
+  /// The frame of each moving body, in the order of Model::body_names() (planar scenes fill planar_bodies,
+  /// spatial ones spatial_bodies): where `phiq animate` reads a body's pose from q.
+  std::vector<Frame2> planar_bodies;
+  std::vector<Frame3> spatial_bodies;  ///< see planar_bodies
   std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: a CsvFormat keeps its address)
   /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns
   /// written, coordinates defaulting to all).

@@ -134,6 +134,7 @@ void SceneReader::read_bodies(const Cursor& c) {
       if (!f.is_fixed()) {
         try {
           builder_.add_body(name, f);
+          spatial_bodies_.push_back(f);
         } catch (const Error& e) {
           value.fail(e.what());
         }
@@ -148,7 +149,10 @@ void SceneReader::read_bodies(const Cursor& c) {
     if (value.size() != 3 || !value.is_sequence()) value.fail("a body is [x, y, psi]");
     const Frame2 f{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
     bodies_[k] = f;
-    if (f.x.is_coordinate() || f.y.is_coordinate() || f.psi.is_coordinate()) builder_.add_body(name, f);
+    if (f.x.is_coordinate() || f.y.is_coordinate() || f.psi.is_coordinate()) {
+      builder_.add_body(name, f);
+      planar_bodies_.push_back(f);
+    }
   });
 }
 

@@ -41,6 +41,8 @@ Scene SceneReader::read(const YAML::Node& root) {
 
   read_time(top.require("time"), scene.sweep);
   read_output(top.field("output"), scene.sweep);
+  scene.dimension = spatial_ ? 3 : 2;
+  scene.planar_bodies = std::move(planar_bodies_), scene.spatial_bodies = std::move(spatial_bodies_);
   points_ = {}, bodies_ = {};  // not needed any more: their memory is free for the model
   driver_laws_ = {};
   points3_ = {}, bodies3_ = {}, vectors_ = {}, joints3_.clear();

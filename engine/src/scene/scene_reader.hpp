@@ -197,6 +197,9 @@ class SceneReader {
   bool spatial_ = false;  // dimension: 3
   NameTable<Point3> points3_;
   NameTable<Frame3> bodies3_;
+  // the frames of the moving bodies, in the order of ModelBuilder::add_body() (Scene::planar_bodies)
+  std::vector<Frame2> planar_bodies_;
+  std::vector<Frame3> spatial_bodies_;
   NameTable<Point3> vectors_;
   // Named spatial joints, for the drivers that measure them.
   struct Joint3 {

@@ -14,6 +14,15 @@
 
 namespace phiq {
 
+/// What a joint is drawn as in the mechanism's sketch (mechanism_sketch.hpp), as a kind's sketch() says.
+enum class JointMark {
+  kRevolute,   ///< a pin: a circle (planar), a hinge (spatial)
+  kPrismatic,  ///< a slider: a block at `at` on its guide along `axis`
+  kSpherical,  ///< a ball joint (and the other spatial joints, drawn as a ball)
+  kPoint,      ///< the end of a natural-coordinate link (a natural point, moving or fixed)
+};
+
+
 namespace kin {
 struct V2 {
   double x, y;

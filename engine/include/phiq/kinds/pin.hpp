@@ -87,11 +87,12 @@ struct PinSpec {
                     "pin: attachment point is not finite");
   }
   /// @copydoc DistanceSpec::sketch
-  /// A pin draws the arms of the bodies it joins.
+  /// A pin draws the arms of the bodies it joins, and a pivot where they meet (on ground when a side is ground).
   template <class Sketch>
   void sketch(Sketch& sk) const {
     sk.arm(a, sa);
     sk.arm(b, sb);
+    sk.pivot(a, sa, b, sb);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {

@@ -90,11 +90,12 @@ struct PrismaticSpec {
     detail::require(std::isfinite(angle), "prismatic: angle is not finite");
   }
   /// @copydoc DistanceSpec::sketch
-  /// A prismatic pair draws the arms of the bodies it joins.
+  /// A prismatic pair draws the arms of the bodies it joins, and b's block on a's guide.
   template <class Sketch>
   void sketch(Sketch& sk) const {
     sk.arm(a, sa);
     sk.arm(b, sb);
+    sk.slider(a, axis, b, sb);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {

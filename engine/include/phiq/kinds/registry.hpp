@@ -32,10 +32,15 @@ namespace phiq {
 
 /// @cond internal
 namespace detail {
-// What a kind's sketch() is called with: the two drawing primitives (mechanism_sketch.cpp implements them).
+// What a kind's sketch() is called with: the drawing primitives (mechanism_sketch.cpp implements them).
 struct SketchProbe {
   void bar(const Point2&, const Point2&) {}
   void arm(const Frame2&, const kin::V2&) {}
+  void pivot(const Frame2&, const kin::V2&, const Frame2&, const kin::V2&) {}
+  void slider(const Frame2&, const kin::V2&, const Frame2&, const kin::V2&) {}
+  void bar3(const Attachment3&, const Attachment3&) {}
+  void arm3(const Attachment3&) {}
+  void joint3(const Attachment3&, const Attachment3&, JointMark) {}
 };
 // What a kind's jacobian() is called with: (local row, slot, value).
 struct SinkProbe {

@@ -73,9 +73,13 @@ struct SpatialDistanceSpec {
     }
   }
   /// @copydoc DistanceSpec::sketch
-  /// A spatial distance draws nothing yet: the sketch is planar (mechanism_sketch.hpp).
+  /// A spatial distance draws its bar, and the arms of the bodies it joins.
   template <class Sketch>
-  void sketch(Sketch&) const {}
+  void sketch(Sketch& sk) const {
+    sk.bar3(ends[0], ends[1]);
+    sk.arm3(ends[0]);
+    sk.arm3(ends[1]);
+  }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
       {"constraints", "distance", 3, "- {name: coupler, type: distance, points: [P0, P1], length: 1}"}};

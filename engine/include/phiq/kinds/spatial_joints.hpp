@@ -24,6 +24,7 @@
 #include <tuple>
 #include <cstdint>
 #include <optional>
+#include <string_view>
 
 #include "phiq/spatial_attachment.hpp"
 #include "phiq/kinds/kind_support.hpp"
@@ -241,9 +242,17 @@ struct SpatialJointSpec {
   /// For a joint: setup().
   void prepare(const double* /*q0*/) { setup(); }
   /// @copydoc DistanceSpec::sketch
-  /// A spatial joint draws nothing yet: the sketch is planar (mechanism_sketch.hpp).
+  /// A spatial joint draws the arms of the bodies it joins, and a mark at its point (a hinge for a revolute, a
+  /// block for a prismatic pair, a ball for the others), on ground when a side is ground.
   template <class Sketch>
-  void sketch(Sketch&) const {}
+  void sketch(Sketch& sk) const {
+    const Attachment3 pa = Attachment3::body_point(a.frame, a.at), pb = Attachment3::body_point(b.frame, b.at);
+    sk.arm3(pa);
+    sk.arm3(pb);
+    const std::string_view kind = Traits::kKind;
+    sk.joint3(pa, pb, kind == "revolute" ? JointMark::kRevolute
+                                         : (kind == "prismatic" ? JointMark::kPrismatic : JointMark::kSpherical));
+  }
   /// @copydoc DistanceSpec::kScene
   static constexpr const auto& kScene = Traits::kScene;
   /// @copydoc DistanceSpec::read

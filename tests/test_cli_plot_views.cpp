@@ -1,0 +1,151 @@
+// `phiq plot`'s views: axes with ticks and units, one panel per quantity, default columns that move, the ground,
+// joints and guides drawn, spatial scenes in an isometric view with their axes, and a NaN refused in one line.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <regex>
+#include <string>
+
+#include "phiq/csv_compare.hpp"
+
+#include "cli_test_support.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using phiq::test::Cli;
+using phiq::test::Result;
+using phiq::test::slurp;
+namespace fs = std::filesystem;
+
+std::size_t count(const std::string& s, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+  return n;
+}
+// Every match of group 1 of `re` in `s`.
+std::vector<std::string> all(const std::string& s, const std::string& re) {
+  std::vector<std::string> v;
+  const std::regex r(re);
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), r); it != std::sregex_iterator(); ++it)
+    v.push_back((*it)[1]);
+  return v;
+}
+
+class Plot : public Cli {
+ protected:
+  std::string plot(const std::string& model, const std::string& extra = "") {
+    const fs::path csv = dir_ / "r.csv", svg = dir_ / "p.svg";
+    EXPECT_EQ(run("run -q " + phiq::test::model_path(model) + " -o " + csv.string()).code, 0);
+    table = phiq::read_csv_table(csv.string());
+    const Result r = run("plot " + phiq::test::model_path(model) + " " + csv.string() + " -o " + svg.string() + extra);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    return slurp(svg);
+  }
+  // min and max of a column of the result
+  std::pair<double, double> range(const std::string& column) {
+    const std::size_t c = static_cast<std::size_t>(
+        std::find(table.columns.begin(), table.columns.end(), column) - table.columns.begin());
+    double lo = 1e300, hi = -1e300;
+    for (const auto& row : table.rows) lo = std::min(lo, row[c]), hi = std::max(hi, row[c]);
+    return {lo, hi};
+  }
+  phiq::CsvTable table;
+};
+
+TEST_F(Plot, SpatialMechanismIsDrawnInIsometricViewWithItsAxesAndMovingColumns) {
+  const std::string s = plot("spatial/rssr.yaml");
+  // the mechanism: 5 rows × (the coupler bar and the two arms to its ends), the two ground hinges hatched, the
+  // coupler's ends as dots at every row, and the three axes
+  EXPECT_EQ(count(s, "<polyline class=\"mechanism\""), 15u);
+  EXPECT_EQ(count(s, "<g class=\"ground\">"), 2u);
+  EXPECT_EQ(count(s, "class=\"joint revolute\""), 2u);  // still: drawn once
+  EXPECT_EQ(count(s, "class=\"joint point\""), 10u);
+  for (const char* a : {"x", "y", "z"}) EXPECT_EQ(count(s, std::string("class=\"axis3d\" data-axis=\"") + a), 1u);
+  EXPECT_NE(s.find("isometric view"), std::string::npos);
+  // no constant column: the default columns are those that change (the Euler parameters that turn)
+  const std::vector<std::string> cols = all(s, "data-column=\"([^\"]+)\"");
+  EXPECT_EQ(cols, (std::vector<std::string>{"crank_e0", "crank_e3", "rocker_e0", "rocker_e1"}));
+  for (const std::string& c : cols) {
+    const auto [lo, hi] = range(c);
+    EXPECT_GT(hi - lo, 0.1) << c;
+  }
+  // one panel, the Euler parameters' (unitless), with ticks and its unit
+  EXPECT_EQ(all(s, "data-quantity=\"([^\"]+)\""), (std::vector<std::string>{"unitless"}));
+  EXPECT_NE(s.find(">unitless (1)</text>"), std::string::npos);
+  EXPECT_NE(s.find(">t (s)</text>"), std::string::npos);
+}
+
+TEST_F(Plot, PanelsPerQuantityWithTicksAndUnits) {
+  const std::string s =
+      plot("seed/fourbar_reference_point.yaml", " --columns psi2,x3,psi3.v,x3.v,x3.a,psi2.a --positions 4");
+  // one panel per quantity, in order of first use, each labelled with its unit
+  EXPECT_EQ(all(s, "data-quantity=\"([^\"]+)\""),
+            (std::vector<std::string>{"angle", "length", "angular velocity", "velocity", "acceleration",
+                                      "angular acceleration"}));
+  EXPECT_EQ(all(s, "data-unit=\"([^\"]+)\""), (std::vector<std::string>{"rad", "m", "rad/s", "m/s", "m/s²", "rad/s²"}));
+  for (const char* label : {">angle (rad)<", ">length (m)<", ">angular velocity (rad/s)<", ">velocity (m/s)<",
+                            ">acceleration (m/s²)<", ">angular acceleration (rad/s²)<", ">x (m)<", ">y (m)<"})
+    EXPECT_NE(s.find(label), std::string::npos) << label;
+  // the ticks of the angle panel: psi2 runs 0 … 2π: 0, 2, 4, 6 rad (4 asked for); t: 0, 1, …, 6 s (8 asked for)
+  const std::size_t angle = s.find("data-quantity=\"angle\""), next = s.find("</g>", angle);
+  const std::string panel = s.substr(angle, next - angle);
+  std::vector<std::string> labels = all(panel, "class=\"tick-label\"[^>]*>([^<]+)<");
+  EXPECT_EQ(labels, (std::vector<std::string>{"0", "1", "2", "3", "4", "5", "6", "0", "2", "4", "6"}));
+  EXPECT_EQ(count(panel, "class=\"tick\""), count(panel, "class=\"tick-label\""));
+  // the ground pivots O and C hatched; the two moving pivots as circles at each of the 4 rows (a full turn: the
+  // last row, the first again, is not drawn on top of it)
+  EXPECT_EQ(count(s, "<g class=\"ground\">"), 2u);
+  EXPECT_EQ(count(s, "class=\"joint revolute\""), 2u + 2u * 4u);
+  const std::vector<std::string> t = all(s, "class=\"position\" data-t=\"([^\"]+)\"");
+  EXPECT_EQ(t, (std::vector<std::string>{"0", "1.571", "3.142", "4.712"}));
+  // the default columns: the driven coordinate psi2 first, then the first 5 moving ones in column order (x2, y2, x3,
+  // y3, psi3; not x4 …), drawn by quantity: the angles' panel, then the lengths'
+  const std::string d = plot("seed/fourbar_reference_point.yaml");
+  EXPECT_EQ(all(d, "data-column=\"([^\"]+)\""), (std::vector<std::string>{"psi2", "psi3", "x2", "y2", "x3", "y3"}));
+}
+
+// A crank-slider of three bodies in reference-point coordinates, the slider on a guide along ground's x axis.
+constexpr const char* kSlider = R"(phiq: 1
+name: slider
+parameters: {L2: 0.4, L3: 1.2}
+coordinates: {x2: 0.2, y2: 0, psi2: 0, x3: 1.0, y3: 0, psi3: 0, x4: 1.6, y4: 0, psi4: 0}
+bodies: {crank: [x2, y2, psi2], rod: [x3, y3, psi3], slider: [x4, y4, psi4]}
+constraints:
+  - {name: O, type: revolute, between: [{body: crank, at: [-L2/2, 0]}, {body: ground, at: [0, 0]}]}
+  - {name: A, type: revolute, between: [{body: crank, at: [L2/2, 0]}, {body: rod, at: [-L3/2, 0]}]}
+  - {name: B, type: revolute, between: [{body: rod, at: [L3/2, 0]}, {body: slider, at: [0, 0]}]}
+  - {name: slide, type: prismatic, between: [{body: ground}, {body: slider}], axis: [1, 0]}
+drivers: [{name: motor, coordinate: psi2, law: {type: linear, initial: 0, rate: 1}}]
+time: {start: 0, end: 2*pi, steps: 72}
+)";
+
+TEST_F(Plot, PrismaticPairsAreBlocksOnTheirGuides) {
+  const fs::path scene = write("slider.yaml", kSlider), csv = dir_ / "r.csv", svg = dir_ / "p.svg";
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
+  const Result r = run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string() + " --positions 3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string s = slurp(svg);
+  EXPECT_EQ(count(s, "class=\"joint prismatic\""), 3u);
+  EXPECT_EQ(count(s, "class=\"guide\""), 3u);
+  EXPECT_EQ(count(s, "class=\"hatch\""), 3u * 5u + 6u);  // the guide on ground at each row, the ground pivot O
+  EXPECT_EQ(count(s, "<g class=\"ground\">"), 1u);
+  // the block lies along the guide: ground's x axis, no rotation
+  EXPECT_EQ(all(s, "class=\"joint prismatic\"[^>]*rotate\\((-?[0-9.]+) "), (std::vector<std::string>{"0.0", "0.0", "0.0"}));
+}
+
+TEST_F(Cli, PlotRefusesAColumnWithNaNInOneLine) {
+  const std::string scene = phiq::test::model_path("seed/fourbar_natural.yaml");
+  const fs::path csv = dir_ / "r.csv", svg = dir_ / "p.svg";
+  ASSERT_EQ(run("run -q " + scene + " -o " + csv.string()).code, 0);
+  const fs::path bad = write("bad.csv", phiq::test::with_nan_xA(slurp(csv)));
+  const Result r = run("plot " + scene + " " + bad.string() + " -o " + svg.string() + " --columns xA");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(phiq::test::one_phiq_line(r.err));
+  EXPECT_NE(r.err.find("column 'xA', data row 2: nan"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(svg));
+}
+
+}  // namespace

@@ -1,0 +1,20 @@
+// `phiq animate SCENE RESULT -o OUT.glb`: the motion of a scene's result as a glTF 2.0 binary. A node per moving
+// body (its reference point and orientation: planar bodies in the z = 0 plane rotated about z by ψ, spatial ones
+// by their Euler parameters as the quaternion (e1, e2, e3, e0)), per link of the sketch (natural coordinates, a
+// spatial distance: origin at its first point, x axis along it) and per joint (a ball at its point), keyframed at
+// the result's rows; simple shapes sized from the sketch (mechanism_sketch.hpp).
+#pragma once
+
+#include <string>
+
+#include "phiq/csv_compare.hpp"
+#include "phiq/scene.hpp"
+
+namespace phiq::tools {
+
+// The .glb of `table`, the result of `scene` read from `result` (named in messages). Throws phiq::Error with one
+// line for a result that is not the scene's (a coordinate the drawing reads has no column, no column t, a value
+// that is not finite, times not increasing as 32-bit floats) or a scene with nothing to animate.
+std::string motion_glb(const Scene& scene, const CsvTable& table, const std::string& result);
+
+}  // namespace phiq::tools

@@ -1,0 +1,153 @@
+#include "plot_series.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <set>
+
+#include "phiq/phiq.hpp"
+#include "plot_draw.hpp"
+
+namespace phiq::tools {
+
+namespace {
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() > tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+// order 0: the value, 1: its rate, 2: its second rate.
+Quantity of_unit(Unit u, int order) {
+  static const char* const names[3][3] = {{"unitless", "unitless rate", "unitless second rate"},
+                                          {"length", "velocity", "acceleration"},
+                                          {"angle", "angular velocity", "angular acceleration"}};
+  static const char* const base[3] = {"1", "m", "rad"};
+  const int k = u == Unit::kLength ? 1 : (u == Unit::kAngle ? 2 : 0);
+  std::string unit = base[k];
+  if (order == 1) unit = k == 0 ? "1/s" : unit + "/s";
+  if (order == 2) unit = k == 0 ? "1/s²" : unit + "/s²";
+  return {names[k][order], unit};
+}
+
+}  // namespace
+
+Quantity column_quantity(const Scene& scene, const std::string& column) {
+  const Model& model = *scene.model;
+  if (column == "t") return {"time", "s"};
+  // the unit of coordinate `name`, if it is one (the model's index of names: O(1) on large models)
+  auto coordinate = [&](const std::string& name) -> std::optional<Unit> {
+    try {
+      return model.coordinate_unit(model.coordinate_index(name));
+    } catch (const Error&) {
+      return std::nullopt;
+    }
+  };
+  if (const auto u = coordinate(column)) return of_unit(*u, 0);
+  for (int order : {1, 2}) {
+    const std::string tail = order == 1 ? ".v" : ".a";
+    if (ends_with(column, tail))
+      if (const auto u = coordinate(column.substr(0, column.size() - 2))) return of_unit(*u, order);
+  }
+  for (const OutputPoint& p : scene.sweep.points)
+    for (const char* axis : {"x", "y", "z"})
+      for (int order : {0, 1, 2}) {
+        const std::string tail = std::string(".") + (order == 1 ? "v" : (order == 2 ? "a" : "")) + axis;
+        if (column == p.name + tail) return of_unit(Unit::kLength, order);
+      }
+  if (ends_with(column, ".residual")) return {"residual", ""};
+  if (ends_with(column, ".ddf")) return {"driver law, second rate", ""};
+  if (ends_with(column, ".df")) return {"driver law, rate", ""};
+  if (ends_with(column, ".f")) return {"driver law", ""};
+  return {column, ""};
+}
+
+std::vector<std::string> default_columns(const Scene& scene, const CsvTable& table, std::size_t most) {
+  const Model& model = *scene.model;
+  auto changes = [&](std::size_t c) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (const auto& row : table.rows)
+      if (std::isfinite(row[c])) lo = std::min(lo, row[c]), hi = std::max(hi, row[c]);
+    return hi - lo > 1e-9 * (1.0 + std::max(std::fabs(lo), std::fabs(hi)));
+  };
+  std::set<Index> driven;
+  for (const auto& block : model.blocks())
+    if (auto* t = dynamic_cast<const TypedBlock<CoordinateDriverSpec>*>(block.get()))
+      for (std::size_t i = 0; i < t->size(); ++i) driven.insert(t->spec(i).coordinate.coord());
+  std::vector<std::string> out;
+  std::vector<std::size_t> moving;
+  std::set<std::string> written;  // the coordinate columns
+  for (Index k : scene.sweep.coordinate_columns) written.insert(model.coordinate_names()[static_cast<std::size_t>(k)]);
+  for (std::size_t c = 1; c < table.columns.size(); ++c) {
+    if (!written.count(table.columns[c]) || !changes(c)) continue;
+    const Index j = model.coordinate_index(table.columns[c]);
+    if (driven.count(j)) out.push_back(table.columns[c]);
+    else moving.push_back(c);
+  }
+  for (std::size_t c : moving) out.push_back(table.columns[c]);
+  if (out.empty())
+    for (std::size_t c = 1; c < table.columns.size(); ++c)
+      if (changes(c)) out.push_back(table.columns[c]);
+  if (out.empty())
+    for (std::size_t c = 1; c < table.columns.size(); ++c) out.push_back(table.columns[c]);
+  if (out.size() > most) out.resize(most);
+  return out;
+}
+
+namespace {
+
+// The quantities of `series`, in order of first use, with their columns.
+std::vector<std::pair<Quantity, std::vector<std::size_t>>> group(const Scene& scene,
+                                                                 const std::vector<std::string>& series) {
+  std::vector<std::pair<Quantity, std::vector<std::size_t>>> groups;
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    const Quantity q = column_quantity(scene, series[k]);
+    auto g = std::find_if(groups.begin(), groups.end(),
+                          [&](const auto& e) { return e.first.name == q.name && e.first.unit == q.unit; });
+    if (g == groups.end()) groups.push_back({q, {k}});
+    else g->second.push_back(k);
+  }
+  return groups;
+}
+
+}  // namespace
+
+std::size_t panel_count(const Scene& scene, const std::vector<std::string>& series) {
+  return group(scene, series).size();
+}
+
+std::string series_panels(const Scene& scene, const CsvTable& table, const std::map<std::string, std::size_t>& col,
+                          const std::vector<std::string>& series, double x0, double y0, double w, double h) {
+  using namespace svg;
+  const auto groups = group(scene, series);
+  if (groups.empty()) return "<g id=\"series\"/>\n";  // a result of t alone
+  double tmin = table.rows.front()[0], tmax = table.rows.back()[0];
+  if (tmin > tmax) std::swap(tmin, tmax);
+  if (!(tmax > tmin)) tmin -= 0.5, tmax += 0.5;
+  const double gap = 50, ph = (h - gap * static_cast<double>(groups.size() - 1)) / static_cast<double>(groups.size());
+  std::string s = "<g id=\"series\">\n";
+  for (std::size_t p = 0; p < groups.size(); ++p) {
+    const auto& [quantity, members] = groups[p];
+    double vmin = INFINITY, vmax = -INFINITY;
+    for (std::size_t k : members) {
+      const std::size_t c = col.at(series[k]);
+      for (const auto& row : table.rows) vmin = std::min(vmin, row[c]), vmax = std::max(vmax, row[c]);
+    }
+    widen(vmin, vmax);
+    const Box b{x0, y0 + static_cast<double>(p) * (ph + gap), w, ph, tmin, tmax, vmin, vmax};
+    s += "<g class=\"panel\" data-quantity=\"" + escape(quantity.name) + "\" data-unit=\"" + escape(quantity.unit) +
+         "\">\n";
+    s += axes(b, "t (s)", quantity.label(), 8, 4);
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      const std::size_t k = members[i], c = col.at(series[k]);
+      Line pts;
+      for (const auto& row : table.rows) pts.push_back({b.sx(row[0]), b.sy(row[c])});
+      s += polyline("series", kPalette[k % 8], 1.5, pts, " data-column=\"" + escape(series[k]) + "\"");
+      s += "<text class=\"legend\" x=\"" + px(b.x0 + b.w - 6) + "\" y=\"" + px(b.y0 + 14 + 13 * static_cast<double>(i)) +
+           "\" text-anchor=\"end\" fill=\"" + kPalette[k % 8] + "\">" + escape(series[k]) + "</text>\n";
+    }
+    s += "</g>\n";
+  }
+  return s + "</g>\n";
+}
+
+}  // namespace phiq::tools

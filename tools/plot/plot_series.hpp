@@ -1,0 +1,40 @@
+// `phiq plot`'s columns against time: each column's physical quantity and unit (from the model's coordinate units
+// and the output plan), the default columns (the driven and the moving coordinates, never constants), and the
+// panels, one per quantity (lengths, angles, velocities, ...), each with its axes, ticks and unit.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "phiq/csv_compare.hpp"
+#include "phiq/scene.hpp"
+
+namespace phiq::tools {
+
+// What a column measures: "length" in "m", "angular velocity" in "rad/s", "unitless" in "1", ... ; a column phiq
+// cannot tell (a driver's law, a residual, rcond) has its own quantity and an empty unit.
+struct Quantity {
+  std::string name;
+  std::string unit;
+  std::string label() const { return unit.empty() ? name : name + " (" + unit + ")"; }
+  bool operator<(const Quantity& o) const { return name != o.name ? name < o.name : unit < o.unit; }
+};
+
+// The quantity of `column` of `scene`'s results (dotted names, CsvFormat's default).
+Quantity column_quantity(const Scene& scene, const std::string& column);
+
+// The columns drawn when none is asked for: the coordinates a coordinate driver drives, then those whose value
+// changes over the rows, in column order, at most `most`; never a constant. Without either: the first columns after
+// t that change, else the first columns after t.
+std::vector<std::string> default_columns(const Scene& scene, const CsvTable& table, std::size_t most);
+
+// The panels of `series` against t, stacked in the box (x0, y0, w, h), one per quantity in order of first use.
+// Every value of the columns is finite (plot_svg() checks).
+std::string series_panels(const Scene& scene, const CsvTable& table, const std::map<std::string, std::size_t>& col,
+                          const std::vector<std::string>& series, double x0, double y0, double w, double h);
+
+// How many panels series_panels() draws for `series`.
+std::size_t panel_count(const Scene& scene, const std::vector<std::string>& series);
+
+}  // namespace phiq::tools
