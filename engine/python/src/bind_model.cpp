@@ -25,6 +25,15 @@ py::object jacobian_matrix(const Model& model, const Eigen::VectorXd& q, double 
   return csc(py::make_tuple(data, indices, indptr), py::arg("shape") = py::make_tuple(p.rows, p.cols));
 }
 
+// A vector of the model's m rows that `evaluate` fills (Φ, Φt or γ), the GIL released meanwhile.
+template <class Evaluate>
+Eigen::VectorXd rows_of(const Model& model, Evaluate&& evaluate) {
+  Eigen::VectorXd out(model.num_equations());
+  py::gil_scoped_release free;
+  evaluate(out.data());
+  return out;
+}
+
 // One of the workspace's state vectors, writable in place (a numpy view whose base keeps the workspace alive), or
 // replaced by a copy of the same size.
 template <Eigen::VectorXd Workspace::*member>
@@ -119,10 +128,7 @@ void bind_model(py::module_& m) {
           "residual",
           [](const Model& md, const Eigen::Ref<const Eigen::VectorXd>& q, double t) {
             const Eigen::VectorXd x = coordinate_vector(md, q, "q");
-            Eigen::VectorXd phi(md.num_equations());
-            py::gil_scoped_release free;
-            md.residual(x.data(), t, phi.data());
-            return phi;
+            return rows_of(md, [&](double* out) { md.residual(x.data(), t, out); });
           },
           py::arg("q"), py::arg("t"), "Φ(q, t), an array of m entries")
       .def(
@@ -135,10 +141,7 @@ void bind_model(py::module_& m) {
           "phi_t",
           [](const Model& md, const Eigen::Ref<const Eigen::VectorXd>& q, double t) {
             const Eigen::VectorXd x = coordinate_vector(md, q, "q");
-            Eigen::VectorXd out(md.num_equations());
-            py::gil_scoped_release free;
-            md.phi_t(x.data(), t, out.data());
-            return out;
+            return rows_of(md, [&](double* out) { md.phi_t(x.data(), t, out); });
           },
           py::arg("q"), py::arg("t"), "Φt = ∂Φ/∂t at (q, t): the velocity equation is Φq q̇ = −Φt")
       .def(
@@ -146,10 +149,7 @@ void bind_model(py::module_& m) {
           [](const Model& md, const Eigen::Ref<const Eigen::VectorXd>& q, const Eigen::Ref<const Eigen::VectorXd>& qd,
              double t) {
             const Eigen::VectorXd x = coordinate_vector(md, q, "q"), v = coordinate_vector(md, qd, "qd");
-            Eigen::VectorXd out(md.num_equations());
-            py::gil_scoped_release free;
-            md.gamma(x.data(), v.data(), t, out.data());
-            return out;
+            return rows_of(md, [&](double* out) { md.gamma(x.data(), v.data(), t, out); });
           },
           py::arg("q"), py::arg("qd"), py::arg("t"),
           "γ = −(Φq q̇)q q̇ − 2Φqt q̇ − Φtt: the acceleration equation is Φq q̈ = γ")

@@ -24,13 +24,8 @@ std::unique_ptr<PyStepper> stepper_for_scene(std::shared_ptr<const Scene> scene,
   auto s = std::make_unique<PyStepper>();
   s->scene = std::move(scene);
   const Scene& sc = *s->scene;
-  SolveStatus st;
-  {
-    py::gil_scoped_release free;
-    st = prepare_scene(*sc.model, sc.sweep.t_begin, sc.sweep.assembly, &s->square);
-  }
-  if (st != SolveStatus::kSuccess)
-    throw Error(sc.path + ": t = " + format_time(sc.sweep.t_begin) + ": " + s->square.assembly.message);
+  if (const std::string why = prepare_for_sweep(sc, sc.sweep.t_begin, sc.sweep.assembly, &s->square); !why.empty())
+    throw Error(sc.path + ": " + why);
   StepperOptions o;
   static_cast<SolverSettings&>(o) = sc.sweep;
   o.velocities = velocities.value_or(sc.sweep.velocities);

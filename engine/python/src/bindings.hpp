@@ -32,6 +32,19 @@ inline Eigen::VectorXd coordinate_vector(const Model& model, const Eigen::Ref<co
   return v;
 }
 
+/// Prepares a scene's model for the square sweep as `phiq run` does (prepare_scene, the GIL released): "" on
+/// success, else the one line the CLI prints for an inconsistent or under-driven scene ("t = T: …"), with the
+/// assembly's summary in square->assembly.
+inline std::string prepare_for_sweep(const Scene& scene, double t_begin, const NewtonOptions& assembly,
+                                     SquareScene* square) {
+  SolveStatus st;
+  {
+    py::gil_scoped_release free;
+    st = prepare_scene(*scene.model, t_begin, assembly, square);
+  }
+  return st == SolveStatus::kSuccess ? "" : "t = " + format_time(t_begin) + ": " + square->assembly.message;
+}
+
 /// A copy of an Eigen vector as a new numpy array (the caller owns it).
 inline py::array_t<double> to_numpy(const Eigen::VectorXd& v) {
   py::array_t<double> a(v.size());

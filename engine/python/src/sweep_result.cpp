@@ -41,14 +41,10 @@ std::shared_ptr<SweepTable> sweep_scene(const Scene& scene, const SweepOptions& 
   table->data.reset(new double[static_cast<std::size_t>(std::max<Index>(capacity, 1) * width)]);
 
   SquareScene square;
-  SolveStatus prepared;
-  {
-    py::gil_scoped_release free;
-    prepared = prepare_scene(*scene.model, opt.t_begin, opt.assembly, &square);
-  }
-  if (prepared != SolveStatus::kSuccess) {  // inconsistent or under-driven: nothing is swept
+  if (std::string why = prepare_for_sweep(scene, opt.t_begin, opt.assembly, &square); !why.empty()) {
+    // inconsistent or under-driven: nothing is swept
     table->summary.status = square.assembly.status;
-    table->summary.message = "t = " + format_time(opt.t_begin) + ": " + square.assembly.message;
+    table->summary.message = std::move(why);
     table->summary.failed_step = 0;
     table->summary.failed_time = opt.t_begin;
     table->summary.worst_rows = square.assembly.worst_rows;
