@@ -159,6 +159,37 @@ TEST(Scene, MissingSectionsAndFields) {
   EXPECT_HAS(error_of(variant(", length: L3}", "}")), "missing field 'length'");
 }
 
+// A planar body written as a map brings NAME_x, NAME_y, NAME_psi: a crank pinned to ground, driven by its angle.
+TEST(Scene, PlanarBodiesWrittenAsMapsBringTheirCoordinates) {
+  const std::string text = R"(phiq: 1
+bodies:
+  crank: {at: [0.01, 0], angle: 0.2}
+  base: {at: [1, 2], angle: pi/2, fixed: true}
+constraints:
+  - {name: pin, type: revolute, between: [{body: base, at: [-2, 1]}, {body: crank}]}
+drivers:
+  - {name: motor, coordinate: crank_psi, law: {type: linear, initial: 0.25, rate: 1}}
+time: {start: 0, end: 1, steps: 2}
+)";
+  const Scene s = parse_scene(text, "map.yaml");
+  const Model& m = *s.model;
+  EXPECT_EQ(m.coordinate_names(), (std::vector<std::string>{"crank_x", "crank_y", "crank_psi"}));
+  EXPECT_EQ(m.initial_positions()[0], 0.01);
+  EXPECT_EQ(m.initial_positions()[2], 0.2);
+  EXPECT_EQ(*m.grubler(), 1);
+  Workspace ws(m);
+  SweepSummary sum;
+  ASSERT_EQ(run_sweep(m, s.sweep, ws, nullptr, &sum), SolveStatus::kSuccess) << sum.message;
+  // the base's local (−2, 1) turned by 90° from (1, 2): (1 − 1, 2 − 2) = the origin; ψ = 1.25 at t = 1
+  EXPECT_NEAR(ws.q[0], 0.0, 1e-12);
+  EXPECT_NEAR(ws.q[1], 0.0, 1e-12);
+  EXPECT_NEAR(ws.q[2], 1.25, 1e-12);
+  EXPECT_HAS(test::scene_error(test::replace_first(text, "angle: 0.2", "orientation: {angle: 1}")),
+             "bodies.crank.orientation: unknown field 'orientation' (allowed: at, angle, fixed)");
+  EXPECT_HAS(test::scene_error(test::replace_first(text, "{at: [0.01, 0], angle: 0.2}", "[0.01, 0]")),
+             "bodies.crank: a body is [x, y, psi], or {at: [x, y], angle: psi}");
+}
+
 TEST(Scene, EquationErrorsNameTheExpression) {
   std::string base = variant("  - {name: rod, type: distance, points: [A, B], length: L3}",
                              "  - {name: rod, type: equation, expr: \"(xA - xB)^2 + yA^2 - L3^2\"}");

@@ -206,7 +206,7 @@ TEST(Scene3d, BadInputIsOneLineNamingTheField) {
   EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: door, ref: [0, 0, 3]}")),
              "ref must not be zero or along the axis");
   EXPECT_HAS(error_of(variant("door: [x, y, z, e0, e1, e2, e3]", "door: [x, y, z]")),
-             "a body is [x, y, z, e0, e1, e2, e3] (dimension: 3)");
+             "a body is [x, y, z, e0, e1, e2, e3], or {at: [x, y, z], orientation: {...}} (dimension: 3)");
   EXPECT_HAS(error_of(variant("type: revolute", "type: polar")), "'polar' is a planar constraint");
   EXPECT_HAS(error_of(variant("type: revolute", "type: hinge")), "unknown constraint type 'hinge'");
   EXPECT_HAS(error_of(variant("joint: hinge", "joint: hing")), "drivers[0].joint: unknown joint 'hing'");
@@ -224,6 +224,63 @@ TEST(Scene3d, BadInputIsOneLineNamingTheField) {
   EXPECT_HAS(error_of(variant("bodies:", "vectors: {u: [1, 2]}\nbodies:")), "a vector is [ux, uy, uz]");
   EXPECT_HAS(error_of(variant("bodies:", "points: {door: [1, 2, 3]}\nbodies:")), "duplicate point, body or vector name");
   EXPECT_HAS(error_of(variant("dimension: 3", "dimension: 4")), "dimension");
+}
+
+// The door of kGood written as a map: phiq adds door_x … door_e3 with the placement and orientation as initial
+// guesses; every form of orientation gives the Euler parameters of the same rotation.
+TEST(Scene3d, BodiesWrittenAsMapsBringTheirCoordinates) {
+  auto door = [](const std::string& body) {
+    std::string s = test::replace_first(kGood, "coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\n", "");
+    return test::replace_first(s, "door: [x, y, z, e0, e1, e2, e3]", "door: " + body);
+  };
+  const double c = std::cos(0.15), sn = std::sin(0.15);  // a turn of 0.3 about z
+  for (const std::string& body : {std::string("{at: [0, 0, h], orientation: {axis: [0, 0, 2], angle: 0.3}}"),
+                                  std::string("{at: [0, 0, h], orientation: {euler: zyx, angles: [0.3, 0, 0]}}"),
+                                  std::string("{at: [0, 0, h], orientation: {euler: zxz, angles: [0.1, 0, 0.2]}}"),
+                                  std::string("{at: [0, 0, h], orientation: {x: [cos(0.3), sin(0.3), 0]}}"),
+                                  std::string("{at: [0, 0, h], orientation: {z: [0, 0, 1], x: [cos(0.3), sin(0.3), 5]}}"),
+                                  std::string("{at: [0, 0, h], orientation: {euler_parameters: [2*cos(0.15), 0, 0, "
+                                              "2*sin(0.15)]}}")}) {
+    SCOPED_TRACE(body);
+    const Scene s = parse_scene(door(body), "map.yaml");
+    const Model& m = *s.model;
+    ASSERT_EQ(m.num_coordinates(), 7);
+    EXPECT_EQ(m.coordinate_names(),
+              (std::vector<std::string>{"door_x", "door_y", "door_z", "door_e0", "door_e1", "door_e2", "door_e3"}));
+    const std::vector<double> want{0, 0, 2, c, 0, 0, sn};
+    for (Index i = 0; i < 7; ++i) EXPECT_NEAR(m.initial_positions()[i], want[static_cast<std::size_t>(i)], 1e-15) << i;
+    EXPECT_EQ(m.constraints()[0].name, "door.euler");
+    EXPECT_EQ(*m.grubler(), 1);
+  }
+  // a fixed body adds no coordinate: a frame of constants, here a hinge's ground side turned by 90° about x
+  const std::string fixed = test::replace_first(
+      door("{at: [0, 0, h]}"), "bodies:\n",
+      "bodies:\n  wall: {at: [0, 0, h], orientation: {axis: [1, 0, 0], angle: pi/2}, fixed: true}\n");
+  const Scene f = parse_scene(test::replace_first(fixed, "{body: ground, at: [0, 0, h], axis: [0, 0, 1]}",
+                                                  "{body: wall, axis: [0, -1, 0]}"),
+                              "fixed.yaml");
+  EXPECT_EQ(f.model->num_coordinates(), 7);
+  Workspace ws(*f.model);
+  SweepSummary sum;
+  ASSERT_EQ(run_sweep(*f.model, f.sweep, ws, nullptr, &sum), SolveStatus::kSuccess) << sum.message;
+  EXPECT_NEAR(ws.q[5], 0.0, 1e-12);  // the wall's −y is the world's z: the door still turns about z
+  // bad maps: one line naming the field
+  EXPECT_HAS(error_of(door("{at: [0, 0, h], orientation: {axis: [0, 0, 1], angle: 1, z: [0, 0, 1]}}")),
+             "bodies.door.orientation: an orientation is one of {axis: [ux, uy, uz], angle: a}");
+  EXPECT_HAS(error_of(door("{orientation: {euler: zzx, angles: [1, 2, 3]}}")),
+             "bodies.door.orientation.euler: 'zzx' is not an Euler sequence");
+  EXPECT_HAS(error_of(door("{orientation: {x: [1, 0, 0], y: [2, 0, 0]}}")),
+             "bodies.door.orientation: the second direction lies along the first");
+  EXPECT_HAS(error_of(door("{orientation: {axis: [0, 0, 0], angle: 1}}")),
+             "bodies.door.orientation: the rotation axis must be a non-zero finite vector");
+  EXPECT_HAS(error_of(door("{at: [0, 0]}")), "bodies.door.at: expected a list of 3 numbers");
+  EXPECT_HAS(error_of(door("{at: [0, 0, 0], angle: 1}")), "bodies.door.angle: unknown field 'angle' (allowed: at, orientation, fixed)");
+  EXPECT_HAS(error_of(test::replace_first(door("{}"), "parameters: {h: 2}", "parameters: {h: 2, door_z: 1}")),
+             "bodies.door: its coordinate 'door_z' is already a parameter");
+  EXPECT_HAS(error_of(test::replace_first(door("{}"), "bodies:", "coordinates: {door_e1: 0}\nbodies:")),
+             "bodies.door: its coordinate 'door_e1' is already a coordinate");
+  EXPECT_HAS(error_of(test::replace_first(door("{fixed: true}"), "  - {name: open", "  - {name: x")),
+             "at least one coordinate is needed: a `coordinates` section, or bodies written as maps");
 }
 
 TEST(Scene3d, SpatialInputInAPlanarSceneIsAnError) {

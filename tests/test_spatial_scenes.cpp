@@ -203,23 +203,11 @@ TEST(SpatialScenes, RssrSweepsAndAgreesWithItsClosedForm) {
   }
 }
 
-TEST(SpatialScenes, CardanNearItsSingularAngleStaysOnItsBranch) {
-  // Shafts 89° apart: tan θ2 = tan θ1 / cos β, θ̇2 = ω cos β / D, D = cos²β cos²θ1 + sin²θ1 (θ1 = ω t). Near
-  // θ1 = π the output swings 78.7° in a 5° step, and the sweep landed on the other assembly mode (θ2 + π) from
-  // there on, with a warning that it had "kept its branch": now det Φq's change of sign between two regular
-  // positions makes it halve the step, which follows the branch.
-  const Scene s = load_scene(test::model_path("spatial/cardan_near_singular.yaml"));
-  const Model& m = *s.model;
-  SweepSummary sum;
-  test::Trace tr;
-  ASSERT_EQ(test::sweep(m, s.sweep, &tr, &sum), SolveStatus::kSuccess) << sum.message;
-  ASSERT_EQ(tr.t.size(), 73u);
-  // The chunks' seeds, found over a chunk's whole span (16 steps, 80°), land on the other mode beyond the swing; the
-  // seam check refuses that chunk and the rest runs in order, on every thread count alike: its one warning.
-  for (const SweepWarning& w : sum.warnings)
-    if (w.kind != "parallel_fallback") ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
-  const double beta = 89.0 * M_PI / 180.0, cb = std::cos(beta), w = 1.5;
-  const Index i = m.coordinate_index("x2");
+// A Cardan joint's output fork against the closed form over a sweep: shafts β apart, input at rate w, the output
+// shaft's frame first at coordinate `x2`. tan θ2 = tan θ1 / cos β, θ̇2 = ω cos β / D, D = cos²β cos²θ1 + sin²θ1.
+void ExpectCardanClosedForm(const Model& m, const test::Trace& tr, double beta, double w, const std::string& x2) {
+  const double cb = std::cos(beta);
+  const Index i = m.coordinate_index(x2);
   const Frame3 s2{Slot::coordinate(i),     Slot::coordinate(i + 1), Slot::coordinate(i + 2), Slot::coordinate(i + 3),
                   Slot::coordinate(i + 4), Slot::coordinate(i + 5), Slot::coordinate(i + 6)};
   // The output fork (s2's y axis) at θ2 is −sin θ2 b + cos θ2 ŷ, with b = (cos β, 0, −sin β) ⊥ the output axis.
@@ -234,6 +222,41 @@ TEST(SpatialScenes, CardanNearItsSingularAngleStaysOnItsBranch) {
     // d/dt of the fork: (−cos θ2 b − sin θ2 ŷ) θ̇2
     EXPECT_NEAR(fd.y, -std::sin(th2) * th2d, 1e-7 * std::max(1.0, th2d));
   }
+}
+
+TEST(SpatialScenes, CardanNearItsSingularAngleStaysOnItsBranch) {
+  // Shafts 89° apart: near θ1 = π the output swings 78.7° in a 5° step, and the sweep landed on the other assembly
+  // mode (θ2 + π) from there on, with a warning that it had "kept its branch": now det Φq's change of sign between
+  // two regular positions makes it halve the step, which follows the branch.
+  const Scene s = load_scene(test::model_path("spatial/cardan_near_singular.yaml"));
+  const Model& m = *s.model;
+  SweepSummary sum;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+  ASSERT_EQ(tr.t.size(), 73u);
+  // The chunks' seeds, found over a chunk's whole span (16 steps, 80°), land on the other mode beyond the swing; the
+  // seam check refuses that chunk and the rest runs in order, on every thread count alike: its one warning.
+  for (const SweepWarning& w : sum.warnings)
+    if (w.kind != "parallel_fallback") ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
+  ExpectCardanClosedForm(m, tr, 89.0 * M_PI / 180.0, 1.5, "x2");
+}
+
+TEST(SpatialScenes, CardanWrittenWithOrientationsIsTheClosedForm) {
+  // The same joint 30° apart, its bodies written as maps with their orientations (no Euler parameters, no
+  // coordinates section): the placement is exact, so the first row needs no Newton correction of s2.
+  const Scene s = load_scene(test::model_path("spatial/cardan.yaml"));
+  const Model& m = *s.model;
+  EXPECT_EQ(m.num_coordinates(), 14);
+  EXPECT_EQ(m.coordinate_names()[7], "s2_x");
+  EXPECT_EQ(*m.grubler(), 1);  // 2 · 6 − 5 − 4 − 2
+  SweepSummary sum;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+  ASSERT_EQ(tr.t.size(), 73u);
+  const double beta = M_PI / 6;
+  EXPECT_NEAR(tr.q[0][m.coordinate_index("s2_e0")], std::cos(beta / 2), 1e-15);  // a turn of β about y
+  EXPECT_NEAR(tr.q[0][m.coordinate_index("s2_e2")], std::sin(beta / 2), 1e-15);
+  ExpectCardanClosedForm(m, tr, beta, 1.0, "s2_x");
 }
 
 TEST(SpatialScenes, RssrInReferencePointAndNaturalCoordinatesAgree) {

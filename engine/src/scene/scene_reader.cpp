@@ -25,13 +25,15 @@ Scene SceneReader::read(const YAML::Node& root) {
   if (auto d = top.field("dimension"); d.present()) spatial_ = d.integer(2, 3) == 3;
   read_parameters(top.field("parameters"));
   check_family_total(top);  // the parameters give the ranges of the families in the sections
-  read_coordinates(top.require("coordinates"));
+  read_coordinates(top.field("coordinates"));
   if (auto p = top.field("points"); p.present()) read_points(p);
   if (auto b = top.field("bodies"); b.present()) read_bodies(b);
   if (auto v = top.field("vectors"); v.present()) {
     if (!spatial_) v.fail("natural unit vectors need 'dimension: 3'");
     read_vectors(v);
   }
+  if (builder_.num_coordinates() == 0)
+    top.fail("at least one coordinate is needed: a `coordinates` section, or bodies written as maps");
   read_solver(top.field("solver"), scene.sweep);  // before constraints: length scale, linear solver
 
   reserve_ = [&](std::size_t more) { builder_.reserve(0, static_cast<Index>(more)); };

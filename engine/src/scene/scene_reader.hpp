@@ -27,6 +27,7 @@
 #include <utility>
 #include <vector>
 
+#include "phiq/orientation.hpp"
 #include "phiq/scene.hpp"
 #include "scene/families.hpp"
 #include "scene/name_table.hpp"
@@ -130,6 +131,10 @@ class SceneReader {
   static constexpr double kEulerNormSlack = 1e-3;
   template <class C>
   void fixed_euler_parameters(const C& value, Frame3& f) const;
+  template <class C>
+  EulerParameters orientation(const C& o) const;
+  template <class C>
+  void body_from_map(const C& value, const std::string& name, Slot* v, int dimension);
 
   // ---- constraints (read_constraints.cpp) ---------------------------------------------------------------------
   template <class C>
