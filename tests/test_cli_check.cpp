@@ -29,6 +29,23 @@ TEST_F(Cli, CheckReportsCountsAndAssembly) {
   EXPECT_NE(r.out.find("assembly      success"), std::string::npos) << r.out;
 }
 
+// The zero of a driven joint angle is never chosen silently: check names the reference directions it uses.
+TEST_F(Cli, CheckNamesWhereJointAnglesAreMeasuredFrom) {
+  Result r = run("check " + phiq::test::model_path("spatial/rssr.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("joint angle   motor: joint crank_hinge from x_a = [1, 0, 0] (default: state `ref` to choose) "
+                       "to x_b = [1, 0, 0] (default: state `ref` to choose), in the sides' body frames"),
+            std::string::npos)
+      << r.out;
+  r = run("check --json " + phiq::test::model_path("spatial/cardan.yaml"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"joint_angles\": [\n    {\n      \"driver\": \"motor\",\n      \"joint\": \"hinge1\",\n"
+                       "      \"ref_a\": [\n        1.0,\n        0.0,\n        0.0\n      ],"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("\"stated_a\": true,\n      \"stated_b\": true"), std::string::npos) << r.out;
+}
+
 TEST_F(Cli, CheckJsonIsOneVersionedObject) {
   Result r = run("check --json " + phiq::test::model_path("seed/fourbar_natural.yaml"));
   ASSERT_EQ(r.code, 0) << r.err;

@@ -186,6 +186,9 @@ time: {start: 0, end: 1, steps: 2}
   EXPECT_NEAR(ws.q[2], 1.25, 1e-12);
   EXPECT_HAS(test::scene_error(test::replace_first(text, "angle: 0.2", "orientation: {angle: 1}")),
              "bodies.crank.orientation: unknown field 'orientation' (allowed: at, angle, fixed)");
+  EXPECT_HAS(test::scene_error(test::replace_first(text, "{body: crank}", "{body: crank, axis: [0, 0, 1]}")),
+             "between[1].axis: in dimension 2 a side has no axis: a revolute turns about z, and a prismatic's sliding "
+             "axis is its own field");
   EXPECT_HAS(test::scene_error(test::replace_first(text, "{at: [0.01, 0], angle: 0.2}", "[0.01, 0]")),
              "bodies.crank: a body is [x, y, psi], or {at: [x, y], angle: psi}");
 }

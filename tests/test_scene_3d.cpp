@@ -283,6 +283,27 @@ TEST(Scene3d, BodiesWrittenAsMapsBringTheirCoordinates) {
              "at least one coordinate is needed: a `coordinates` section, or bodies written as maps");
 }
 
+// A hinge about x measures its angle from y on both sides unless the scene says otherwise; the scene records it.
+TEST(Scene3d, JointAngleReferencesAreRecorded) {
+  const Scene s = parse_scene(kGood, "good.yaml");
+  ASSERT_EQ(s.joint_angles.size(), 1u);
+  EXPECT_EQ(s.joint_angles[0].driver, "open");
+  EXPECT_EQ(s.joint_angles[0].joint, "hinge");
+  EXPECT_EQ(s.joint_angles[0].ref_a, (std::array<double, 3>{1, 0, 0}));
+  EXPECT_FALSE(s.joint_angles[0].stated_a);
+  std::string about_x = variant("axis: [0, 0, 1]}", "axis: [1, 0, 0]}");
+  about_x = test::replace_first(about_x, "{body: door, at: [0, 0, h]}", "{body: door, at: [0, 0, h], axis: [0.95, 0.1, 0], ref: [0, 0, 1]}");
+  const Scene x = parse_scene(about_x, "x.yaml");
+  ASSERT_EQ(x.joint_angles.size(), 1u);
+  EXPECT_EQ(x.joint_angles[0].ref_a, (std::array<double, 3>{0, 1, 0}));  // within 25° of x: y
+  EXPECT_EQ(x.joint_angles[0].ref_b, (std::array<double, 3>{0, 0, 1}));
+  EXPECT_FALSE(x.joint_angles[0].stated_a);
+  EXPECT_TRUE(x.joint_angles[0].stated_b);
+  // the axis of a spatial joint is on its sides: a prismatic's planar `axis` field says where it goes
+  EXPECT_HAS(error_of(variant("type: revolute, between:", "type: prismatic, axis: [0, 0, 1], between:")),
+             "constraints[0].axis: in dimension 3 a joint's axis is given on each side");
+}
+
 TEST(Scene3d, SpatialInputInAPlanarSceneIsAnError) {
   const std::string planar = R"(phiq: 1
 coordinates: {x: 0, y: 0, psi: 0}

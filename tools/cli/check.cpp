@@ -15,6 +15,17 @@ namespace phiq::tools {
 
 namespace {
 
+// "motor: joint crank_hinge from x_a = [1, 0, 0] (default) to x_b = [0, 1, 0] (stated)": where a driven joint
+// angle is measured from, in the sides' body frames.
+std::string joint_angle_line(const phiq::JointAngleReference& r) {
+  auto vec = [](const std::array<double, 3>& v) {
+    return "[" + phiq::shortest(v[0]) + ", " + phiq::shortest(v[1]) + ", " + phiq::shortest(v[2]) + "]";
+  };
+  auto how = [](bool stated) { return stated ? " (stated)" : " (default: state `ref` to choose)"; };
+  return r.driver + ": joint " + r.joint + " from x_a = " + vec(r.ref_a) + how(r.stated_a) + " to x_b = " +
+         vec(r.ref_b) + how(r.stated_b) + ", in the sides' body frames";
+}
+
 int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at) {
   const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   std::optional<phiq::Scene> loaded = load_or_report(scene_arg);
@@ -83,6 +94,14 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at)
     j["rank_tolerance"] = rk.tolerance;
     j["rank_uncertain"] = rk.uncertain;
     j["rank_message"] = rk.message;
+    j["joint_angles"] = nlohmann::ordered_json::array();
+    for (const phiq::JointAngleReference& r : scene.joint_angles)
+      j["joint_angles"].push_back({{"driver", r.driver},
+                                   {"joint", r.joint},
+                                   {"ref_a", r.ref_a},
+                                   {"ref_b", r.ref_b},
+                                   {"stated_a", r.stated_a},
+                                   {"stated_b", r.stated_b}});
     std::cout << json_text(j, 2) << "\n";
     return ok ? 0 : 1;
   }
@@ -113,6 +132,8 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at)
                 : as.consistent     ? "yes"
                                     : "no: conflicting " + joined(as.conflicts))
             << "\n";
+  for (const phiq::JointAngleReference& r : scene.joint_angles)
+    std::cout << "joint angle   " << joint_angle_line(r) << "\n";
   if (rk.uncertain) std::cout << "uncertain     " << rk.message << "\n";
   if (!ok) std::cout << "diagnosis     " << as.message << "\n";
   return ok ? 0 : 1;

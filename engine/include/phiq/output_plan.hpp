@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "phiq/motion_law.hpp"
+#include "phiq/output_joints.hpp"
 #include "phiq/output_points.hpp"
 #include "phiq/types.hpp"
 
@@ -33,6 +34,13 @@ struct OutputPlan {
   /// Points whose motion is evaluated at every delivered row (StepView::points): position always, velocity when
   /// q̇ is solved, acceleration when q̈ is. Nothing is evaluated for points not listed.
   std::vector<OutputPoint> points;
+  /// Spatial joints whose angle or distance is output (StepView::joints): evaluated at every time point, written
+  /// or not, so that angles are unwrapped over turns from row to row (a few dot products a joint).
+  std::vector<OutputJoint> joints;
+  /// Bodies whose orientation is output (StepView::orientations), written as `orientation_form`, with ω and α when
+  /// q̇ and q̈ are solved; evaluated at written rows only.
+  std::vector<OutputOrientation> orientations;
+  OrientationForm orientation_form;  ///< how `orientations` are written
   /// Deliver Φ(q, t) at every row (StepView::phi). Free: Newton's convergence test has just evaluated it.
   bool residuals = false;
   /// Deliver the reciprocal condition estimate of the last factorisation of Φq (StepView::rcond). Free with KLU

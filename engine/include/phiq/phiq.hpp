@@ -18,6 +18,8 @@
 #include "phiq/min_norm_solver.hpp"
 #include "phiq/motion_law.hpp"
 #include "phiq/output_plan.hpp"
+#include "phiq/orientation.hpp"
+#include "phiq/output_joints.hpp"
 #include "phiq/output_points.hpp"
 #include "phiq/rank_analysis.hpp"
 #include "phiq/scene.hpp"

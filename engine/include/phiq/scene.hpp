@@ -2,6 +2,7 @@
 /// Scene files: a mechanism, its drivers, the time sweep and the outputs, in YAML (format: models/README.md).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -34,6 +35,18 @@ struct SceneLimits {
   int max_family_depth = 8;                              ///< families nested in families
 };
 
+/// Where a joint angle driver measures its joint's angle from: the reference directions x_a, x_b of the joint's
+/// two sides, in their bodies' frames, as the scene states them or as phiq chose them (a default: x, or y for an
+/// axis within 25° of x). phiq check lists them, so that the zero of a driven angle is never chosen silently.
+struct JointAngleReference {
+  std::string driver;            ///< the driver's name
+  std::string joint;             ///< the joint it drives
+  std::array<double, 3> ref_a{};  ///< x_a in side a's body frame (its part perpendicular to the axis is used)
+  std::array<double, 3> ref_b{};  ///< x_b in side b's body frame
+  bool stated_a = false;         ///< x_a is the scene's `ref` (else the default)
+  bool stated_b = false;         ///< x_b is the scene's `ref` (else the default)
+};
+
 /// A loaded scene: the model, the sweep and what to output.
 struct Scene {
   std::string path;              ///< the file it was read from (or the name given to parse_scene)
@@ -44,6 +57,7 @@ struct Scene {
   /// spatial ones spatial_bodies): where `phiq animate` reads a body's pose from q.
   std::vector<Frame2> planar_bodies;
   std::vector<Frame3> spatial_bodies;  ///< see planar_bodies
+  std::vector<JointAngleReference> joint_angles;  ///< the reference directions of the joint angle drivers
   std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: a CsvFormat keeps its address)
   /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns
   /// written, coordinates defaulting to all).

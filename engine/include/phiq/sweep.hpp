@@ -131,6 +131,10 @@ struct StepView {
   const PointMotion* points = nullptr;
   const Eigen::VectorXd* phi = nullptr;  ///< Φ(q, t) when OutputPlan::residuals, else null
   double rcond = 0.0;                    ///< when OutputPlan::condition (see there), else 0
+  /// Measures of OutputPlan::joints, in that order (null when none): angles unwrapped over the sweep's turns.
+  const JointMotion* joints = nullptr;
+  /// Orientations of OutputPlan::orientations, in that order (null when none).
+  const OrientationMotion* orientations = nullptr;
 };
 
 /// Something the caller should know about a delivered row (the row itself is within tolerance).

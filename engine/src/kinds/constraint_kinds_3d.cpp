@@ -20,9 +20,7 @@ LocalFrame local_frame(const JointSide3& s, const std::string& who) {
   if (!(n > 0.0)) throw Error(who + ": axis must not be zero");
   LocalFrame f;
   f.z = (1.0 / n) * s.axis;
-  // default reference: x, or y when the axis is within 25° of x (so that the perpendicular part is well defined)
-  kin3::V3 ref = s.ref ? *s.ref : (std::fabs(f.z.x) < std::cos(25.0 * M_PI / 180.0) ? kin3::V3{1, 0, 0}
-                                                                                       : kin3::V3{0, 1, 0});
+  const kin3::V3 ref = reference_direction(s);
   if (!finite(ref)) throw Error(who + ": ref is not finite");
   const kin3::V3 perp = ref - kin3::dot(ref, f.z) * f.z;
   const double m = kin3::norm(perp), r = kin3::norm(ref);
@@ -33,6 +31,13 @@ LocalFrame local_frame(const JointSide3& s, const std::string& who) {
 }
 
 }  // namespace
+
+kin3::V3 reference_direction(const JointSide3& s) {
+  if (s.ref) return *s.ref;
+  const double n = kin3::norm(s.axis);
+  // x, unless the axis is within 25° of it; then y (|z_x| ≥ cos 25°, so y's part perpendicular to z is ≥ sin 25°)
+  return n > 0.0 && std::fabs(s.axis.x / n) >= std::cos(25.0 * M_PI / 180.0) ? kin3::V3{0, 1, 0} : kin3::V3{1, 0, 0};
+}
 
 std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const JointSide3& b, const std::int8_t* index,
                                                   int count, const char* kind) {

@@ -95,6 +95,20 @@ std::vector<std::string> CsvFormat::dotted_names() const {
     if (accelerations_)
       for (int d = 0; d < p.dimension(); ++d) h.push_back(p.name + ".a" + axis[d]);
   }
+  for (const OutputJoint& j : plan_->joints) {
+    const std::string m = j.name + (j.measure == JointMeasure::kAngle ? ".angle" : ".distance");
+    h.push_back(m);
+    if (velocities_) h.push_back(m + ".v");
+    if (accelerations_) h.push_back(m + ".a");
+  }
+  const std::vector<std::string> suffixes = plan_->orientation_form.suffixes();
+  for (const OutputOrientation& o : plan_->orientations) {
+    for (const std::string& s : suffixes) h.push_back(o.name + "." + s);
+    if (velocities_)
+      for (int d = 0; d < 3; ++d) h.push_back(o.name + ".omega_" + axis[d]);
+    if (accelerations_)
+      for (int d = 0; d < 3; ++d) h.push_back(o.name + ".alpha_" + axis[d]);
+  }
   for (const OutputDriver& d : plan_->driver_columns) {
     h.push_back(d.name + ".f");
     if (velocities_) h.push_back(d.name + ".df");
@@ -147,6 +161,22 @@ void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
     if (accelerations_)
       for (int d = 0; d < dim; ++d) emit(m.a[d]);
   }
+  if (!plan_->joints.empty() && !s.joints) throw Error("CsvFormat: step has no joint measures");
+  for (std::size_t i = 0; i < plan_->joints.size(); ++i) {
+    emit(s.joints[i].value);
+    if (velocities_) emit(s.joints[i].rate);
+    if (accelerations_) emit(s.joints[i].acceleration);
+  }
+  if (!plan_->orientations.empty() && !s.orientations) throw Error("CsvFormat: step has no orientations");
+  const int form_size = plan_->orientation_form.size();
+  for (std::size_t i = 0; i < plan_->orientations.size(); ++i) {
+    const OrientationMotion& o = s.orientations[i];
+    for (int d = 0; d < form_size; ++d) emit(o.values[static_cast<std::size_t>(d)]);
+    if (velocities_)
+      for (int d = 0; d < 3; ++d) emit(o.omega[static_cast<std::size_t>(d)]);
+    if (accelerations_)
+      for (int d = 0; d < 3; ++d) emit(o.alpha[static_cast<std::size_t>(d)]);
+  }
   for (const OutputDriver& d : plan_->driver_columns) {
     const LawValue v = d.law.evaluate(s.t);
     emit(v.f);
@@ -186,6 +216,9 @@ std::size_t CsvFormat::num_output_values() const {
   std::size_t n = plan_->driver_columns.size() * per + plan_->residual_columns.size() + plan_->max_residual_column +
                   plan_->condition;
   for (const OutputPoint& p : plan_->points) n += static_cast<std::size_t>(p.dimension()) * per;
+  n += plan_->joints.size() * per;
+  n += plan_->orientations.size() *
+       (static_cast<std::size_t>(plan_->orientation_form.size()) + 3 * (velocities_ + accelerations_));
   return n;
 }
 

@@ -90,7 +90,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     groups.push_back(std::move(g));
     return &groups.back();
   };
-  groups.reserve(8);  // pointers into it are kept
+  groups.reserve(10);  // pointers into it are kept
   // (the q̇ and q̈ columns may be other coordinates than q's: OutputPlan::velocity_columns)
   auto coordinate_unit = [&](const std::vector<Index>& cols, const char* per_time) {
     return [&, per_time](std::size_t k) { return unit_of(model.coordinate_unit(cols[k]), per_time); };
@@ -109,10 +109,28 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     if (plan.velocities) point_units.insert(point_units.end(), static_cast<std::size_t>(p.dimension()), "m/s");
     if (plan.accelerations) point_units.insert(point_units.end(), static_cast<std::size_t>(p.dimension()), "m/s^2");
   }
+  std::vector<std::string> joint_units;
+  for (const OutputJoint& j : plan.joints) {
+    const std::string u = j.measure == JointMeasure::kAngle ? "rad" : "m";
+    joint_units.push_back(u);
+    if (plan.velocities) joint_units.push_back(u + "/s");
+    if (plan.accelerations) joint_units.push_back(u + "/s^2");
+  }
+  std::vector<std::string> orientation_units;
+  for (std::size_t i = 0; i < plan.orientations.size(); ++i) {
+    const std::string& form = plan.orientation_form.form;
+    for (int d = 0; d < plan.orientation_form.size(); ++d)
+      orientation_units.push_back(form == "matrix" ? "" : form == "axis_angle" ? (d == 3 ? "rad" : "") : "rad");
+    if (plan.velocities) orientation_units.insert(orientation_units.end(), 3, "rad/s");
+    if (plan.accelerations) orientation_units.insert(orientation_units.end(), 3, "rad/s^2");
+  }
   const std::size_t per_driver = 1 + plan.velocities + plan.accelerations;
   const std::size_t residuals = plan.residual_columns.size() + plan.max_residual_column;
   auto none = [](std::size_t) { return std::string(); };
   for (Group* g : {take("points", point_units.size(), [&](std::size_t k) { return point_units[k]; }),
+                   take("joints", joint_units.size(), [&](std::size_t k) { return joint_units[k]; }),
+                   take("orientations", orientation_units.size(),
+                        [&](std::size_t k) { return orientation_units[k]; }),
                    take("drivers", plan.driver_columns.size() * per_driver, none),
                    take("residuals", residuals, none)})
     if (g) outputs.push_back(g);

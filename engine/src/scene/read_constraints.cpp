@@ -65,6 +65,9 @@ std::pair<Frame2, kin::V2> SceneReader::attachment(const C& c) const {
     Point2 p = point(c.field("point"));
     return {Frame2{p.x, p.y, Slot::constant(0.0)}, kin::V2{0, 0}};
   }
+  if (auto axis = c.field("axis"); axis.present())  // where a spatial joint writes it
+    axis.fail("in dimension 2 a side has no axis: a revolute turns about z, and a prismatic's sliding axis is its "
+              "own field (axis: [x, y], in the first body's frame) beside `between`");
   c.expect_map({"body", "at"});
   Frame2 f = body(c.require("body"));
   kin::V2 at{0, 0};

@@ -56,8 +56,8 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
   plan.velocities = plan.accelerations = false;
   bool coordinates_listed = false;
   if (c.present()) {
-    c.expect_map({"velocities", "accelerations", "coordinates", "points", "drivers", "residuals", "max_residual",
-                  "rcond", "every", "window"});
+    c.expect_map({"velocities", "accelerations", "coordinates", "points", "joints", "orientations", "drivers",
+                  "residuals", "max_residual", "rcond", "every", "window"});
     // true / false, or the coordinates whose derivative is written (q̇ or q̈ is solved whole either way)
     auto derivative = [&](const char* key, bool& asked, std::optional<std::vector<Index>>& columns) {
       const Cursor d = c.field(key);
@@ -90,6 +90,8 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
         plan.points.push_back(std::move(p));
       }
     }
+    if (auto js = c.field("joints"); js.present()) output_joints(js, plan);
+    if (auto os = c.field("orientations"); os.present()) output_orientations(os, plan);
     if (auto ds = c.field("drivers"); ds.present()) {
       std::set<std::string> seen;
       for (const Cursor& i : ds.items()) {
@@ -120,6 +122,59 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
     const std::string& n = builder_.coordinate_name(j);
     if ((n == "residual" && plan.max_residual_column) || (n == "rcond" && plan.condition))
       c.fail("coordinate '" + n + "' and the column '" + n + "' would share a name: leave it out of coordinates");
+  }
+}
+
+// `joints: [NAME, ...]`: named spatial joints; a revolute's angle, a prismatic's distance, a cylindrical's both.
+void SceneReader::output_joints(const Cursor& js, OutputPlan& plan) const {
+  if (!spatial_) js.fail("joint outputs are of spatial joints (dimension: 3); in the plane, output the angle coordinate");
+  std::set<std::string> seen;
+  for (const Cursor& i : js.items()) {
+    const std::string n = i.name();
+    auto it = joints3_.find(n);
+    if (it == joints3_.end()) i.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
+    if (!seen.insert(n).second) i.fail("joint listed twice");
+    const Joint3& J = it->second;
+    const bool angle = J.type == "revolute" || J.type == "cylindrical";
+    const bool distance = J.type == "prismatic" || J.type == "cylindrical";
+    if (!angle && !distance)
+      i.fail("joint '" + n + "' is a " + J.type + " joint: outputs measure the angle of a revolute or cylindrical " +
+             "joint, or the distance of a prismatic or cylindrical one (output its bodies' orientations instead)");
+    try {
+      if (angle) plan.joints.push_back(output_joint(n, JointMeasure::kAngle, J.a, J.b));
+      if (distance) plan.joints.push_back(output_joint(n, JointMeasure::kDistance, J.a, J.b));
+    } catch (const Error& e) {
+      i.fail(e.what());
+    }
+  }
+}
+
+// `orientations: [BODY, ...]` (as rotation matrices) or `{bodies: [BODY, ...], as: matrix | axis_angle | zyx …}`.
+void SceneReader::output_orientations(const Cursor& os, OutputPlan& plan) const {
+  if (!spatial_) os.fail("orientations are of spatial bodies (dimension: 3); a planar body's is its angle coordinate");
+  // (no Cursor assignment: a YAML::Node assigned to rewrites the node it refers to)
+  if (os.is_map()) {
+    os.expect_map({"bodies", "as"});
+    if (auto as = os.field("as"); as.present()) {
+      const std::string f = as.text();
+      if (f != "matrix" && f != "axis_angle" && !is_euler_sequence(f))
+        as.fail("'" + f + "' is not an orientation form: matrix, axis_angle, or an Euler sequence (zyx, xyz, zxz, ...)");
+      plan.orientation_form.form = f;
+    }
+  }
+  std::set<std::string> seen;
+  for (const Cursor& i : (os.is_map() ? os.require("bodies") : os).items()) {
+    const std::string n = i.name();
+    const Index k = entry_at(i, n, bodies3_);
+    if (k < 0) i.fail("unknown body '" + n + "'");
+    if (!seen.insert(n).second) i.fail("body listed twice");
+    if (plan.orientation_form.form == "axis_angle")
+      for (const OutputJoint& j : plan.joints)
+        if (j.name == n && j.measure == JointMeasure::kAngle)
+          i.fail("the columns '" + n + ".angle' of joint '" + n + "' and of this body's axis and angle would share a "
+                 "name: write the orientation in another form, or rename one");
+    const Frame3& f = bodies3_[k];
+    plan.orientations.push_back(OutputOrientation{n, {f.e0, f.e1, f.e2, f.e3}});
   }
 }
 

@@ -45,6 +45,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   read_output(top.field("output"), scene.sweep);
   scene.dimension = spatial_ ? 3 : 2;
   scene.planar_bodies = std::move(planar_bodies_), scene.spatial_bodies = std::move(spatial_bodies_);
+  scene.joint_angles = std::move(joint_angles_);
   points_ = {}, bodies_ = {};  // not needed any more: their memory is free for the model
   driver_laws_ = {};
   points3_ = {}, bodies3_ = {}, vectors_ = {}, joints3_.clear();

@@ -185,6 +185,8 @@ class SceneReader {
   void read_output(const Cursor& c, OutputPlan& plan);
   std::vector<Index> coordinate_selection(const Cursor& list) const;
   OutputPoint output_point(const Cursor& c) const;
+  void output_joints(const Cursor& js, OutputPlan& plan) const;
+  void output_orientations(const Cursor& os, OutputPlan& plan) const;
   void resolve_output_residuals(Scene& scene) const;
   void read_solver(const Cursor& c, SolverSettings& o);
 
@@ -212,6 +214,7 @@ class SceneReader {
     JointSide3 a, b;
   };
   std::unordered_map<std::string, Joint3> joints3_;
+  std::vector<JointAngleReference> joint_angles_;  // Scene::joint_angles
   Families families_;
   std::function<void(std::size_t)> reserve_;  // room for that many more entries of the section being read
   bool predictor_field_ = false;

@@ -46,6 +46,12 @@ struct Row {
   double det_sign_t = 0.0;  // where det_sign holds (Sweeper::det_sign_time())
   RowQuality quality;       // its class and estimated error (SweepSummary::accuracy)
   std::vector<PointMotion> points;
+  std::vector<JointMotion> joints;              // every row's (the delivery unwraps the angles row by row)
+  std::vector<OrientationMotion> orientations;  // with the vectors
+  RowMotions motions() const {
+    return {points.empty() ? nullptr : points.data(), joints.empty() ? nullptr : joints.data(),
+            orientations.empty() ? nullptr : orientations.data()};
+  }
 };
 
 // One parallel chunk: rows k0 … k1 computed from a seed at t_k0 (chunk 0: from row 0), then the sweep continued
@@ -227,7 +233,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
       if (stream) {
         if (ch.good == 0 && !continues(ch, st.q.data())) return outcome = 1, false;
         ++ch.good;
-        if (!run.deliver(k, st.q, st.qd, st.qdd, s.point_motions(), w.phi, s.rcond(), s.det_sign(),
+        if (!run.deliver(k, st.q, st.qd, st.qdd, s.motions(), w.phi, s.rcond(), s.det_sign(),
                          s.det_sign_time(), s.row_quality())) {
           last_q = st.q, last_qd = need_v ? st.qd : last_qd, last_qdd = need_a ? st.qdd : last_qdd;
           return outcome = 2, false;
@@ -237,6 +243,8 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
       Row& r = ch.rows[static_cast<std::size_t>(ch.good)];
       r.det_sign = s.det_sign(), r.det_sign_t = s.det_sign_time();  // (the bifurcation check reads every row's)
       r.quality = s.row_quality();  // (and the summary's accuracy)
+      const RowMotions rm = s.motions();
+      if (rm.joints) r.joints.assign(rm.joints, rm.joints + opt.joints.size());
       if (layout.keeps_vectors(ch.rows.size(), static_cast<std::size_t>(ch.good++))) {
         stream_copy(st.q, r.q);
         if (need_v) stream_copy(st.qd, r.qd);
@@ -244,6 +252,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
         if (n_phi) r.phi = w.phi;
         r.rcond = s.rcond();
         if (n_points) r.points.assign(s.point_motions(), s.point_motions() + n_points);
+        if (rm.orientations) r.orientations.assign(rm.orientations, rm.orientations + opt.orientations.size());
       }
       return true;
     };
@@ -290,7 +299,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     if (ch.good == 0 || !continues(ch, ch.rows[0].q.data())) return 1;
     for (Index k = ch.k0; k < ch.k0 + ch.good; ++k) {
       const Row& r = ch.rows[static_cast<std::size_t>(k - ch.k0)];
-      if (!run.deliver(k, r.q, r.qd, r.qdd, n_points ? r.points.data() : nullptr, r.phi, r.rcond, r.det_sign,
+      if (!run.deliver(k, r.q, r.qd, r.qdd, r.motions(), r.phi, r.rcond, r.det_sign,
                        r.det_sign_t, r.quality)) {
         last_q = r.q, last_qd = need_v ? r.qd : last_qd, last_qdd = need_a ? r.qdd : last_qdd;  // where it stopped
         return 2;

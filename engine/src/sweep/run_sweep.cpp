@@ -40,6 +40,17 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
   if (opt.row_buffer_bytes == 0) throw Error("SweepOptions: row_buffer_bytes must be > 0");
   detail::check_solver_settings(model, opt, opt.points, "SweepOptions");
+  for (const OutputJoint& j : opt.joints)
+    if (j.max_coordinate() >= model.num_coordinates())
+      throw Error("SweepOptions: output joint '" + j.name + "' reads a coordinate the model does not have");
+  for (const OutputOrientation& o : opt.orientations)
+    for (const Slot& e : o.e)
+      if (e.is_coordinate() && e.coord() >= model.num_coordinates())
+        throw Error("SweepOptions: output orientation '" + o.name + "' reads a coordinate the model does not have");
+  if (opt.orientation_form.form != "matrix" && opt.orientation_form.form != "axis_angle" &&
+      !is_euler_sequence(opt.orientation_form.form))
+    throw Error("SweepOptions: orientation_form '" + opt.orientation_form.form + "' is not matrix, axis_angle or an "
+                "Euler sequence");
   SweepSummary local;
   SweepSummary& sum = summary ? *summary : local;
   sum = SweepSummary{};
@@ -79,7 +90,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     return done(sum.status);
   }
   sw.row_outputs(0);
-  if (!run.deliver(0, sw.state().q, sw.state().qd, sw.state().qdd, sw.point_motions(), ws.phi, sw.rcond(),
+  if (!run.deliver(0, sw.state().q, sw.state().qd, sw.state().qdd, sw.motions(), ws.phi, sw.rcond(),
                    sw.det_sign(), sw.det_sign_time(), sw.row_quality())) {
     sw.leave_state_in_workspace();
     return done(sum.status);

@@ -31,18 +31,43 @@ struct Run {
   // since the last regular row is a singular position passed between the two: warned here, in row order, so that
   // sequential and parallel sweeps report it alike.
   bool deliver(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
-               const PointMotion* points, const Eigen::VectorXd& phi, double rcond, Orientation det_sign,
+               const RowMotions& motions, const Eigen::VectorXd& phi, double rcond, Orientation det_sign,
                double det_sign_t, const RowQuality& quality) {
     count_row(time_of(k), det_sign, det_sign_t, quality);
+    unwrap_joints(k, motions.joints);
     if (!opt.writes_row(k, time_of(k))) return true;  // solved, not written (OutputPlan::every, window)
-    StepView view{k, time_of(k), q, opt.velocities ? &qd : nullptr, opt.accelerations ? &qdd : nullptr,
-                  points, opt.residuals ? &phi : nullptr, opt.condition ? rcond : 0.0};
+    StepView view{k,
+                  time_of(k),
+                  q,
+                  opt.velocities ? &qd : nullptr,
+                  opt.accelerations ? &qdd : nullptr,
+                  motions.points,
+                  opt.residuals ? &phi : nullptr,
+                  opt.condition ? rcond : 0.0,
+                  joints.empty() ? nullptr : joints.data(),
+                  motions.orientations};
     if (on_step && !on_step(view)) {
       sum.status = SolveStatus::kCancelled;
       sum.message = "stopped by the caller after step " + std::to_string(k);
       return false;
     }
     return true;
+  }
+  // The joint measures of the rows delivered so far, angles unwrapped: each row's angle is the 2π-multiple of its
+  // wrapped value nearest to the last row's plus the rates' trapezoid over the step (every time point is
+  // delivered here, written or not, so a joint is followed turn by turn).
+  std::vector<JointMotion> joints;
+  void unwrap_joints(Index k, const JointMotion* now) {
+    if (!now) return;
+    const bool first = joints.empty();
+    if (first) joints.resize(opt.joints.size());
+    const double dt = first ? 0.0 : time_of(k) - time_of(k - 1);
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      JointMotion m = now[i];
+      if (opt.joints[i].measure == JointMeasure::kAngle && !first)
+        m.value = unwrap_angle(m.value, joints[i].value, 0.5 * (joints[i].rate + m.rate) * dt);
+      joints[i] = m;
+    }
   }
   // A row delivered at t (deliver(); a Stepper's step): the bifurcation check against the last regular row, and
   // the row counted in the summary with its accuracy.
@@ -84,7 +109,7 @@ struct Run {
       }
       sw.row_outputs(k);
       const State& s = sw.state();
-      if (!deliver(k, s.q, s.qd, s.qdd, sw.point_motions(), ws.phi, sw.rcond(), sw.det_sign(), sw.det_sign_time(),
+      if (!deliver(k, s.q, s.qd, s.qdd, sw.motions(), ws.phi, sw.rcond(), sw.det_sign(), sw.det_sign_time(),
                    sw.row_quality()))
         return false;
     }

@@ -29,6 +29,14 @@ struct State {
   Eigen::VectorXd q, qd, qdd;
 };
 
+// The motions of a row's outputs beyond q, q̇, q̈ (each null when none are asked for): the points', the joints'
+// (angles wrapped; the delivery unwraps them) and the orientations'.
+struct RowMotions {
+  const PointMotion* points = nullptr;
+  const JointMotion* joints = nullptr;
+  const OrientationMotion* orientations = nullptr;
+};
+
 // The class of a delivered row in SweepAccuracy, and its estimated error (units of the tolerance test; infinite
 // when no solve estimated it).
 enum class RowClass { kConverged, kRoundingLevel, kSingular };
@@ -112,12 +120,17 @@ class Sweeper {
   // (OutputPlan::writes_row); the orientation of Φq for every time point (the bifurcation check between rows).
   // Only written rows pay for the outputs: sub-steps, the seam steps of parallel chunks and the rows between
   // written ones do not.
+  // Joint measures are evaluated at every time point, written or not: the delivery unwraps angles row to row.
   void row_outputs(Index k) {
+    const double* qd = need_v_ ? current_.qd.data() : nullptr;
+    const double* qdd = need_a_ ? current_.qdd.data() : nullptr;
+    for (std::size_t i = 0; i < opt_.joints.size(); ++i)
+      joints_[i] = evaluate_joint(opt_.joints[i], current_.q.data(), qd, qdd);
     if (opt_.writes_row(k, current_.t)) {
-      const double* qd = need_v_ ? current_.qd.data() : nullptr;
-      const double* qdd = need_a_ ? current_.qdd.data() : nullptr;
       for (std::size_t i = 0; i < opt_.points.size(); ++i)
         points_[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
+      for (std::size_t i = 0; i < opt_.orientations.size(); ++i)
+        orientations_[i] = evaluate_orientation(opt_.orientations[i], opt_.orientation_form, current_.q.data(), qd, qdd);
       ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
       rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
     }
@@ -162,6 +175,11 @@ class Sweeper {
   // at the rounding level): how far from the exact solution, in tolerances, they may be.
   double take_rounding_level() { return std::exchange(rounding_level_, 0.0); }
   const PointMotion* point_motions() const { return points_.empty() ? nullptr : points_.data(); }
+  // The motions row_outputs() evaluated, for the delivery.
+  RowMotions motions() const {
+    return {point_motions(), joints_.empty() ? nullptr : joints_.data(),
+            orientations_.empty() ? nullptr : orientations_.data()};
+  }
   double rcond() const { return rcond_; }
 
   // Records the cause; run_sweep prefixes the step and its grid time (the sub-step time, if any, is in `why`).
@@ -337,6 +355,8 @@ class Sweeper {
   bool extrapolated_ = false;  // the last prediction moved from current_ (jumped() has something to compare)
   bool position_only_ = false;  // inside advance_position()
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
+  std::vector<JointMotion> joints_ = std::vector<JointMotion>(opt_.joints.size());
+  std::vector<OrientationMotion> orientations_ = std::vector<OrientationMotion>(opt_.orientations.size());
   double rcond_ = 0.0;
   double last_rcond_ = 0.0;         // PositionSummary::rcond of the last converged position (near_singular())
   Eigen::VectorXd predicted_;       // the last prediction (for jumped())

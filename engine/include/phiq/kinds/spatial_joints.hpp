@@ -153,6 +153,11 @@ constexpr CompactRows<kRows> compact_rows(const RowDef (&defs)[kRows]) {
   return c;
 }
 
+/// The reference direction of a body side, in its body's frame, from which a joint angle is measured: `s.ref` when
+/// the scene states it, else x, or y when the axis lies within 25° of x (so that its part perpendicular to the axis
+/// is well defined). phiq check reports which one each joint angle driver uses (Scene::joint_angles).
+kin3::V3 reference_direction(const JointSide3& s);
+
 /// The attachments of a joint between sides a and b that `index[0 … count − 1]` name (Attach indices, ascending:
 /// CompactRows::index), in that order in the first `count` entries; an attachment of constants only is folded
 /// into its value (Attachment3::fold_constant). Normalises the axes, makes the reference directions perpendicular.
@@ -266,6 +271,9 @@ struct SpatialJointSpec {
       spec.b = JointSide3::body(Frame3::ground(), f.vec3("at"));
       return spec;
     }
+    if (f.present("axis"))  // where a planar prismatic writes it
+      f.fail("axis", "in dimension 3 a joint's axis is given on each side, in that body's frame: between: "
+                     "[{body: A, axis: [x, y, z]}, {body: B, axis: [x, y, z]}]");
     f.expect({"type", "name", "between"});
     std::tie(spec.a, spec.b) = f.sides3("between");
     return spec;
