@@ -41,7 +41,9 @@ OutputJoint output_joint(std::string name, JointMeasure measure, const JointSide
 /// A joint measure at a row: value (an angle wrapped to (−π, π] by evaluate_joint(); unwrapped by the sweep), rate
 /// and acceleration (0 where not evaluated).
 struct JointMotion {
-  double value = 0.0, rate = 0.0, acceleration = 0.0;  ///< θ or d, and its first two time derivatives
+  double value = 0.0;         ///< θ (rad) or d (m)
+  double rate = 0.0;          ///< its time derivative
+  double acceleration = 0.0;  ///< its second time derivative
 };
 
 /// The measure at (q, q̇, q̈): the value always, the rate when qd is given, the acceleration when qd and qdd are.
