@@ -63,6 +63,13 @@ class Cli : public ::testing::Test {
   fs::path dir_;
 };
 
+// How many times `what` occurs in `s` (an SVG's or a page's elements, counted by their text).
+inline std::size_t count(const std::string& s, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+  return n;
+}
+
 // The result CSV `csv` with xA, the second field of its second data row, made NaN (the natural four-bar's results,
 // whose columns start t, xA).
 inline std::string with_nan_xA(std::string csv) {

@@ -179,11 +179,11 @@ TEST_F(Cli, AnimateRefusesAResultOfAnotherSceneInOneLine) {
   EXPECT_TRUE(phiq::test::one_phiq_line(r.err));
   EXPECT_NE(r.err.find("data row 2, column 'xA'"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "b.glb"));
-  // an output that is not a .glb
-  r = run("animate " + nat + " " + csv.string() + " -o " + (dir_ / "m.html").string());
+  // an output that is neither a .glb nor an .html page
+  r = run("animate " + nat + " " + csv.string() + " -o " + (dir_ / "m.gltf").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(phiq::test::one_phiq_line(r.err));
-  EXPECT_FALSE(fs::exists(dir_ / "m.html"));
+  EXPECT_FALSE(fs::exists(dir_ / "m.gltf"));
 }
 
 }  // namespace

@@ -15,15 +15,11 @@
 namespace {
 
 using phiq::test::Cli;
+using phiq::test::count;
 using phiq::test::Result;
 using phiq::test::slurp;
 namespace fs = std::filesystem;
 
-std::size_t count(const std::string& s, const std::string& what) {
-  std::size_t n = 0;
-  for (std::size_t p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
-  return n;
-}
 // Every match of group 1 of `re` in `s`.
 std::vector<std::string> all(const std::string& s, const std::string& re) {
   std::vector<std::string> v;

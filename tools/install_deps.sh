@@ -25,7 +25,10 @@ packages=(
   python3-pandas       # SweepResult.to_pandas() (optional for users; its test needs it)
   mypy                 # stubgen: the package's type stubs (_phiq.pyi); the type-checking test of tests/python
   help2man             # the man page phiq.1, generated from `phiq --help` at install (skipped with a note if absent)
-  nodejs               # runs the Khronos glTF-Validator on `phiq animate`'s .glb files (ctest gltf_validator)
+  nodejs               # runs the Khronos glTF-Validator on `phiq animate`'s .glb files (ctest gltf_validator), and
+                       # drives Chromium over its DevTools pipe in ctest browser_viewer
+  libjs-three          # three.js r111 and its OrbitControls, embedded at build time into `phiq animate -o OUT.html`
+  chromium             # headless browser of ctest browser_viewer (the HTML viewer's pages; skipped if absent)
 )
 # npm (Debian's package, unless a node install already brings its own) installs the validator below
 command -v npm >/dev/null 2>&1 || packages+=(npm)

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "glb.hpp"
+#include "motion_columns.hpp"
 #include "phiq/mechanism_sketch.hpp"
 #include "phiq/phiq.hpp"
 #include "phiq/version.hpp"
@@ -19,18 +20,6 @@ using Quat = std::array<double, 4>;  // glTF order: x, y, z, w
 using Vec3 = std::array<double, 3>;
 
 bool same(const Slot& a, const Slot& b) { return std::memcmp(&a, &b, sizeof(Slot)) == 0; }
-
-// The slots an output point reads.
-std::vector<Slot> slots_of(const OutputPoint& p) {
-  switch (p.kind) {
-    case OutputPointKind::kPlanarPoint: return {p.point.x, p.point.y};
-    case OutputPointKind::kPlanarBodyPoint: return {p.body.x, p.body.y, p.body.psi};
-    default: {
-      const Attachment3& a = p.spatial;
-      return {a.r[0], a.r[1], a.r[2], a.p[0], a.p[1], a.p[2], a.p[3]};
-    }
-  }
-}
 
 Vec3 position(const OutputPoint& p, const double* q) {
   const PointMotion m = evaluate_point(p, q, nullptr, nullptr);
@@ -120,9 +109,6 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
       scene.name.empty() ? std::filesystem::path(scene.path).stem().string() : scene.name;
 
   // ---- the columns the motion reads: t and every coordinate of the bodies, links and joints
-  std::map<std::string, std::size_t> col;
-  for (std::size_t c = 0; c < table.columns.size(); ++c) col[table.columns[c]] = c;
-  if (!col.count("t")) throw Error(result + ": no column 't': not a result of `phiq run`");
   std::vector<Slot> read;
   for (const Frame2& f : scene.planar_bodies) read.insert(read.end(), {f.x, f.y, f.psi});
   for (const Frame3& f : scene.spatial_bodies) read.insert(read.end(), {f.x, f.y, f.z, f.e0, f.e1, f.e2, f.e3});
@@ -135,23 +121,7 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
     }
   for (const SketchJoint& j : sketch.joints)
     for (const Slot& x : slots_of(j.at)) read.push_back(x);
-  std::vector<std::pair<Index, std::size_t>> columns;  // (coordinate, column)
-  {
-    std::vector<Index> coords;
-    for (const Slot& s : read)
-      if (s.is_coordinate()) coords.push_back(s.coord());
-    std::sort(coords.begin(), coords.end());
-    coords.erase(std::unique(coords.begin(), coords.end()), coords.end());
-    for (Index j : coords) {
-      const std::string& name = model.coordinate_names()[static_cast<std::size_t>(j)];
-      const auto c = col.find(name);
-      if (c == col.end())
-        throw Error(result + ": no column '" + name + "', a coordinate of " + scene.path +
-                    " that its motion reads: not a result of this scene (or its output leaves the coordinate out)");
-      columns.emplace_back(j, c->second);
-    }
-  }
-  if (table.rows.empty()) throw Error(result + ": no rows");
+  const MotionColumns columns(scene, read, table, result);
   const std::size_t nodes = scene.planar_bodies.size() + scene.spatial_bodies.size() + links.size() +
                             sketch.joints.size();
   if (nodes == 0) throw Error(scene.path + ": nothing to animate (no moving body, link or joint)");
@@ -173,17 +143,11 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
   std::vector<Quat> last(links.size());
   std::vector<float> times;
   Eigen::VectorXd q = model.initial_positions();
-  const std::size_t t_col = col["t"];
   for (std::size_t row = 0; row < table.rows.size(); ++row) {
-    const std::vector<double>& values = table.rows[row];
-    const std::string at_row = result + ": data row " + std::to_string(row + 1);
-    for (const auto& [j, c] : columns) {
-      if (!std::isfinite(values[c]))
-        throw Error(at_row + ", column '" + table.columns[c] + "': not a finite number");
-      q(j) = values[c];
-    }
-    const auto t = static_cast<float>(values[t_col]);
-    if (!std::isfinite(values[t_col]) || (!times.empty() && !(t > times.back())))
+    columns.positions(row, q);
+    const std::string at_row = columns.at_row(row);
+    const auto t = static_cast<float>(table.rows[row][columns.t_column()]);
+    if (!times.empty() && !(t > times.back()))
       throw Error(at_row + ": t does not increase (as 32-bit floats, which glTF keyframe times are)");
     times.push_back(t);
     std::size_t n = 0;

@@ -1,5 +1,6 @@
-// `phiq animate SCENE RESULT -o OUT.glb`: the motion of a result as a glTF 2.0 binary (tools/animate/gltf_motion.*);
-// its options, the checks of its input and the atomic write.
+// `phiq animate SCENE RESULT -o OUT.glb|OUT.html`: the motion of a result as a glTF 2.0 binary
+// (tools/animate/gltf_motion.*) or a self-contained HTML viewer (tools/animate/html_page.*), chosen by the output's
+// extension; its options, the checks of its input and the atomic write.
 #include <memory>
 #include <string>
 
@@ -8,6 +9,7 @@
 #include "command_support.hpp"
 #include "commands.hpp"
 #include "gltf_motion.hpp"
+#include "html_page.hpp"
 #include "phiq/hdf5_reader.hpp"
 #include "phiq/phiq.hpp"
 
@@ -17,6 +19,7 @@ namespace {
 
 struct AnimateOptions {
   std::string scene, result, out;
+  std::vector<std::string> columns;  // the HTML's plots (as phiq plot --columns)
 };
 
 bool ends_with(const std::string& s, const std::string& suffix) {
@@ -24,16 +27,18 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 }
 
 int cmd_animate(const AnimateOptions& o) {
-  if (!ends_with(o.out, ".glb"))
-    return fail("animate: -o " + o.out + ": the output is a glTF binary, named *.glb (the HTML viewer is not built "
-                "yet)", 2);
+  const bool html = ends_with(o.out, ".html") || ends_with(o.out, ".htm");
+  if (!html && !ends_with(o.out, ".glb"))
+    return fail("animate: -o " + o.out + ": the output is a glTF binary (*.glb) or an HTML viewer (*.html)", 2);
+  if (!html && !o.columns.empty())
+    return fail("animate: --columns: the plots are the HTML viewer's; a .glb has none", 2);
   if (const auto clash = output_clash({{"-o", o.out}}, {{"the scene", o.scene}, {"the result", o.result}}))
     return fail("animate: " + *clash, 2);
-  std::string glb;
+  std::string text;
   try {
     const Scene scene = load_scene(o.scene);
     const CsvTable table = read_result_table(o.result);
-    glb = motion_glb(scene, table, o.result);
+    text = html ? motion_html(scene, table, o.result, o.columns) : motion_glb(scene, table, o.result);
   } catch (const SceneError& e) {
     return fail("animate: " + std::string(e.what()), 2);
   } catch (const Error& e) {
@@ -41,7 +46,7 @@ int cmd_animate(const AnimateOptions& o) {
   }
   try {
     OutputSet outputs;
-    outputs.add(o.out).write(glb);
+    outputs.add(o.out).write(text);
     outputs.commit();
   } catch (const Error& e) {
     return fail("animate: " + std::string(e.what()), 3);
@@ -53,11 +58,15 @@ int cmd_animate(const AnimateOptions& o) {
 
 Command register_animate(CLI::App& app) {
   auto options = std::make_shared<AnimateOptions>();
-  CLI::App* animate = app.add_subcommand("animate", "Write the motion of a result as a glTF 2.0 binary (.glb): a "
-                                                    "node per body, link and joint, keyframed at the result's rows");
+  CLI::App* animate = app.add_subcommand(
+      "animate", "Write the motion of a result as a glTF 2.0 binary (.glb: a node per body, link and joint, "
+                 "keyframed at the result's rows) or as one self-contained HTML page that plays it (.html)");
   animate->add_option("scene", options->scene, "Scene file (YAML)")->required();
   animate->add_option("result", options->result, "Result of `phiq run` for this scene (CSV or HDF5)")->required();
-  animate->add_option("-o,--output", options->out, "glTF binary to write (*.glb)")->required();
+  animate->add_option("-o,--output", options->out, "File to write: *.glb (glTF binary) or *.html (viewer)")->required();
+  animate->add_option("--columns", options->columns, "HTML: columns plotted against t (default: as phiq plot, the "
+                                                     "driven and the moving coordinates, at most 6)")
+      ->delimiter(',');
   return {animate, [options] { return cmd_animate(*options); }};
 }
 

@@ -30,7 +30,7 @@ _phiq() {
     compare) opts="--help --rtol --atol --columns --json --junit" ;;
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
     plot) opts="--help --output --columns --positions" ;;
-    animate) opts="--help --output" ;;
+    animate) opts="--help --output --columns" ;;
     sweep-accuracy) opts="--help --output --json --tolerances --steps-list --predictors --newton --linear-solvers
                           --reference --repeat --quiet --verbose" ;;
   esac

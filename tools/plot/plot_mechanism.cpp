@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <set>
 
 #include "phiq/phiq.hpp"
 #include "plot_draw.hpp"
@@ -13,14 +14,6 @@ namespace {
 
 using namespace svg;
 using P3 = std::array<double, 3>;
-
-// Screen coordinates (x right, y up) of a point: the plane as it is; space in the isometric view, z up, x towards
-// the lower right and y towards the lower left.
-std::pair<double, double> project(const P3& p, bool spatial) {
-  if (!spatial) return {p[0], p[1]};
-  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
-  return {c * (p[0] - p[1]), p[2] - s * (p[0] + p[1])};
-}
 
 P3 at(const OutputPoint& p, const Eigen::VectorXd& q) {
   const PointMotion m = evaluate_point(p, q.data(), nullptr, nullptr);
@@ -34,9 +27,10 @@ std::string grey(std::size_t f, std::size_t n) {
   return c;
 }
 
-// Ground under a fixed pivot at pixel (x, y): a triangle down to a base line, hatched beneath.
-std::string ground_pivot(double x, double y) {
-  std::string s = "<g class=\"ground\">\n<polygon points=\"" + px(x) + "," + px(y) + " " + px(x - 8) + "," +
+// Ground under a fixed pivot at pixel (x, y): a triangle down to a base line, hatched beneath (a group with an id:
+// a drawing that others use).
+std::string ground_pivot(double x, double y, const std::string& id = "") {
+  std::string s = "<g class=\"ground\"" + (id.empty() ? "" : " id=\"" + id + "\"") + ">\n<polygon points=\"" + px(x) + "," + px(y) + " " + px(x - 8) + "," +
                   px(y + 12) + " " + px(x + 8) + "," + px(y + 12) + "\" fill=\"white\" stroke=\"black\"/>\n";
   s += "<line x1=\"" + px(x - 13) + "\" x2=\"" + px(x + 13) + "\" y1=\"" + px(y + 12) + "\" y2=\"" + px(y + 12) +
        "\" stroke=\"black\"/>\n";
@@ -50,7 +44,13 @@ std::string ground_pivot(double x, double y) {
 
 }  // namespace
 
-std::string mechanism_panel(const MechanismFrames& m, double x0, double y0, double side) {
+std::pair<double, double> project(const P3& p, bool spatial) {
+  if (!spatial) return {p[0], p[1]};
+  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
+  return {c * (p[0] - p[1]), p[2] - s * (p[0] + p[1])};
+}
+
+MechanismView mechanism_view(const MechanismFrames& m, double x0, double y0, double side) {
   const MechanismSketch& sk = *m.sketch;
   // the extent of everything drawn, on screen axes
   double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
@@ -76,15 +76,18 @@ std::string mechanism_panel(const MechanismFrames& m, double x0, double y0, doub
   widen(xmin, xmax), widen(ymin, ymax);
   const double span = std::max(xmax - xmin, ymax - ymin), cx = 0.5 * (xmin + xmax), cy = 0.5 * (ymin + ymax);
   // room below for the ground symbols: 10 % more span, the centre lifted
-  const Box b{x0, y0, side, side, cx - 0.55 * span, cx + 0.55 * span, cy - 0.6 * span, cy + 0.5 * span};
+  return {{x0, y0, side, side, cx - 0.55 * span, cx + 0.55 * span, cy - 0.6 * span, cy + 0.5 * span}, len};
+}
+
+std::string mechanism_background(const MechanismFrames& m, const MechanismView& view, GroundPivots pivots) {
+  const MechanismSketch& sk = *m.sketch;
+  const Box& b = view.box;
+  const double x0 = b.x0, y0 = b.y0, side = b.w, len = view.axis_length;
   auto screen = [&](const P3& p) {
     const auto [u, v] = project(p, m.spatial);
     return std::pair<double, double>{b.sx(u), b.sy(v)};
   };
-
-  std::string s = "<g id=\"mechanism\">\n<text x=\"" + px(x0) + "\" y=\"" + px(y0 - 12) + "\">mechanism at " +
-                  std::to_string(m.q.size()) + " rows (light: first, dark: last)" +
-                  (m.traces.empty() ? "" : ", traced points") + (m.spatial ? ", isometric view" : "") + "</text>\n";
+  std::string s;
   if (m.spatial) {  // projected axes carry no scale: a frame, the three axes from the origin, and a scale bar
     s += "<rect class=\"frame\" x=\"" + px(x0) + "\" y=\"" + px(y0) + "\" width=\"" + px(side) + "\" height=\"" +
          px(side) + "\" fill=\"none\" stroke=\"#888\"/>\n";
@@ -107,13 +110,34 @@ std::string mechanism_panel(const MechanismFrames& m, double x0, double y0, doub
   } else {
     s += axes(b, "x (m)", "y (m)", 6, 6);
   }
-  // ground: fixed pivots and fixed link ends, once
+  // ground: fixed pivots and fixed link ends, once (as uses of one drawing: a line of 10⁴ pivots stays small)
   const Eigen::VectorXd& q0 = m.q.front();
+  if (pivots == GroundPivots::kUses) s += "<defs>" + ground_pivot(0, 0, "ground-pivot") + "</defs>\n";
+  std::set<std::pair<long, long>> used;  // kUses: the 2-pixel cells holding a pivot already
   for (const SketchJoint& j : sk.joints)
     if (j.fixed && j.mark != JointMark::kPrismatic) {
       const auto [x, y] = screen(at(j.at, q0));
-      s += ground_pivot(x, y);
+      if (pivots == GroundPivots::kUses && !used.emplace(std::lround(x / 2), std::lround(y / 2)).second) continue;
+      s += pivots == GroundPivots::kUses
+               ? "<use class=\"ground\" href=\"#ground-pivot\" x=\"" + px(x) + "\" y=\"" + px(y) + "\"/>\n"
+               : ground_pivot(x, y);
     }
+  return s;
+}
+
+std::string mechanism_panel(const MechanismFrames& m, double x0, double y0, double side) {
+  const MechanismSketch& sk = *m.sketch;
+  const MechanismView view = mechanism_view(m, x0, y0, side);
+  const Box& b = view.box;
+  auto screen = [&](const P3& p) {
+    const auto [u, v] = project(p, m.spatial);
+    return std::pair<double, double>{b.sx(u), b.sy(v)};
+  };
+
+  std::string s = "<g id=\"mechanism\">\n<text x=\"" + px(x0) + "\" y=\"" + px(y0 - 12) + "\">mechanism at " +
+                  std::to_string(m.q.size()) + " rows (light: first, dark: last)" +
+                  (m.traces.empty() ? "" : ", traced points") + (m.spatial ? ", isometric view" : "") + "</text>\n";
+  s += mechanism_background(m, view);
   for (std::size_t f = 0; f < m.q.size(); ++f) {
     const Eigen::VectorXd& q = m.q[f];
     const std::string colour = grey(f, m.q.size());

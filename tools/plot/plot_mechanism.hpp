@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "phiq/mechanism_sketch.hpp"
+#include "plot_draw.hpp"
 
 namespace phiq::tools {
 
@@ -26,5 +27,26 @@ struct MechanismFrames {
 
 // The panel, in the square at (x0, y0) of side `side` pixels.
 std::string mechanism_panel(const MechanismFrames& m, double x0, double y0, double side);
+
+// What the panel's parts share (and `phiq animate`'s HTML viewer draws its moving mechanism on): screen axes of a
+// point before scaling (x right, y up: the plane as it is, space in the isometric view, z up, x towards the lower
+// right and y towards the lower left).
+std::pair<double, double> project(const std::array<double, 3>& p, bool spatial);
+
+// The panel's pixel box around everything drawn at m's rows and its traces (equal scales, room for the ground
+// symbols), and in space the length of the three axes drawn from the origin (0 in the plane).
+struct MechanismView {
+  svg::Box box;
+  double axis_length = 0.0;
+};
+MechanismView mechanism_view(const MechanismFrames& m, double x0, double y0, double side);
+
+// The still part of the panel: axes with ticks and units (plane) or the frame, the three axes and a scale bar
+// (space), and the hatched ground under every fixed pivot, where it is at the first row: each drawn in full, or
+// drawn once and used at each pivot, one per 2-pixel cell (the HTML viewer, where 10⁴ pivots in a row would
+// otherwise weigh 7 MB and cost every frame's repaint).
+enum class GroundPivots { kInline, kUses };
+std::string mechanism_background(const MechanismFrames& m, const MechanismView& view,
+                                 GroundPivots pivots = GroundPivots::kInline);
 
 }  // namespace phiq::tools

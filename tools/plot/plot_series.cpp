@@ -93,6 +93,24 @@ std::vector<std::string> default_columns(const Scene& scene, const CsvTable& tab
   return out;
 }
 
+std::vector<std::string> plotted_columns(const Scene& scene, const CsvTable& table,
+                                         const std::vector<std::string>& asked, const std::string& result) {
+  std::map<std::string, std::size_t> col;
+  for (std::size_t c = 0; c < table.columns.size(); ++c) col[table.columns[c]] = c;
+  const std::vector<std::string> series = asked.empty() ? default_columns(scene, table, 6) : asked;
+  for (const std::string& c : series)
+    if (!col.count(c) || c == "t") throw Error("--columns: no column '" + c + "' in " + result);
+  // a value that is not a number has no place on an axis: say where it is rather than draw a gap
+  for (const std::string& c : series) {
+    const std::size_t k = col[c];
+    for (std::size_t r = 0; r < table.rows.size(); ++r)
+      if (!std::isfinite(table.rows[r][k]))
+        throw Error(result + ": column '" + c + "', data row " + std::to_string(r + 1) + ": " +
+                    svg::label(table.rows[r][k]) + " cannot be plotted");
+  }
+  return series;
+}
+
 namespace {
 
 // The quantities of `series`, in order of first use, with their columns.

@@ -29,6 +29,11 @@ Quantity column_quantity(const Scene& scene, const std::string& column);
 // t that change, else the first columns after t.
 std::vector<std::string> default_columns(const Scene& scene, const CsvTable& table, std::size_t most);
 
+// The columns to plot: `asked` (--columns), else default_columns(…, 6). Throws phiq::Error with one line for a
+// column the table lacks (or t), or a value of one that is not finite (`result` names the table in messages).
+std::vector<std::string> plotted_columns(const Scene& scene, const CsvTable& table,
+                                         const std::vector<std::string>& asked, const std::string& result);
+
 // The panels of `series` against t, stacked in the box (x0, y0, w, h), one per quantity in order of first use.
 // Every value of the columns is finite (plot_svg() checks).
 std::string series_panels(const Scene& scene, const CsvTable& table, const std::map<std::string, std::size_t>& col,

@@ -69,16 +69,11 @@ int plot_svg(const PlotOptions& o) {
   const Model& model = *scene.model;
 
   // Columns against time: as asked, else the driven and the moving coordinates (at most 6), never a constant.
-  const std::vector<std::string> series = o.columns.empty() ? default_columns(scene, table, 6) : o.columns;
-  for (const std::string& c : series)
-    if (!col.count(c) || c == "t") return plot_fail("--columns: no column '" + c + "' in " + o.csv, 2);
-  // a value that is not a number has no place on an axis: say where it is rather than draw a gap
-  for (const std::string& c : series) {
-    const std::size_t k = col[c];
-    for (std::size_t r = 0; r < table.rows.size(); ++r)
-      if (!std::isfinite(table.rows[r][k]))
-        return plot_fail(o.csv + ": column '" + c + "', data row " + std::to_string(r + 1) + ": " +
-                         label(table.rows[r][k]) + " cannot be plotted", 2);
+  std::vector<std::string> series;
+  try {
+    series = plotted_columns(scene, table, o.columns, o.csv);
+  } catch (const Error& e) {
+    return plot_fail(e.what(), 2);
   }
   // The mechanism: every coordinate its lines read must be in the CSV.
   const MechanismSketch sketch = sketch_mechanism(model);

@@ -1,0 +1,19 @@
+// `phiq animate SCENE RESULT -o OUT.html`: one self-contained page that plays the motion (html_motion.*) in the
+// planar view (SVG over `phiq plot`'s axes and ground) or the spatial one (WebGL, three.js), beside `phiq plot`'s
+// panels of chosen columns against t with a cursor at the time shown; every script, style and datum inlined.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "phiq/csv_compare.hpp"
+#include "phiq/scene.hpp"
+
+namespace phiq::tools {
+
+// The page for `table`, the result of `scene` read from `result`; `columns` as `phiq plot --columns` (empty: its
+// defaults). Throws phiq::Error with one line for bad input (see viewer_motion(), plotted_columns()).
+std::string motion_html(const Scene& scene, const CsvTable& table, const std::string& result,
+                        const std::vector<std::string>& columns);
+
+}  // namespace phiq::tools

@@ -1,0 +1,154 @@
+// phiq animate's planar view: the mechanism in SVG over the still background phiq drew (axes with units, the
+// hatched ground under fixed pivots: tools/plot/plot_mechanism.cpp, as `phiq plot` draws them). Each pose redraws a
+// few <path> elements, one per kind of mark (links, revolute pins, prismatic blocks, ...), whatever the number of
+// loops, and only what the pixels can show (pairs(), Sparse below): a 10^4-loop chain is a handful of elements of
+// a few hundred strokes, not 10^5 elements. The marks are phiq plot's: pins white circles, sliders blocks on their
+// guides, link ends dots.
+'use strict';
+
+(function () {
+  const d = phiq.data, b = d.box, P = d.points;
+  const NS = 'http://www.w3.org/2000/svg';
+  const svg = document.getElementById('mechanism-svg'), layer = document.getElementById('moving');
+  const kx = b.w / (b.xmax - b.xmin), ky = b.h / (b.ymax - b.ymin);
+  function path(cls, attrs) {
+    const e = document.createElementNS(NS, 'path');
+    e.setAttribute('class', cls);
+    for (const k in attrs) e.setAttribute(k, attrs[k]);
+    layer.appendChild(e);
+    return e;
+  }
+  // drawn bottom to top: trails, guides, lines, marks, vectors
+  const trails = phiq.traces.map((tr) => path('trail', {fill: 'none', stroke: tr.colour, 'stroke-width': 1.5,
+                                                        'data-point': tr.name}));
+  const guides = path('guide', {fill: 'none', stroke: '#222', 'stroke-width': 1});
+  const hatches = path('hatch', {fill: 'none', stroke: '#222', 'stroke-width': 1});
+  const arms = path('arm', {fill: 'none', stroke: '#222', 'stroke-width': 2, 'stroke-linecap': 'round'});
+  const links = path('link', {fill: 'none', stroke: '#222', 'stroke-width': 2, 'stroke-linecap': 'round'});
+  const blocks = path('joint prismatic', {fill: 'white', stroke: '#222', 'stroke-width': 1.5});
+  const pins = path('joint revolute', {fill: 'white', stroke: '#222', 'stroke-width': 1.5});
+  const balls = path('joint spherical', {fill: '#222', stroke: '#222', 'stroke-width': 1.5});
+  const dots = path('joint point', {fill: '#222', stroke: 'none'});
+  const vectors = path('velocity', {fill: 'none', stroke: '#cc00cc', 'stroke-width': 1.5});
+  const heads = path('velocity-head', {fill: '#cc00cc', stroke: 'none'});
+  const legend = document.createElementNS(NS, 'g');
+  phiq.traces.forEach((tr, k) => {
+    const text = document.createElementNS(NS, 'text');
+    text.setAttribute('x', b.x0 + 6), text.setAttribute('y', b.y0 + 16 + 14 * k), text.setAttribute('fill', tr.colour);
+    text.setAttribute('class', 'legend');
+    text.textContent = tr.name;
+    legend.appendChild(text);
+  });
+  layer.appendChild(legend);
+
+  const X = new Float32Array(P), Y = new Float32Array(P), J = d.joints.p.length;
+  const prismatic = {};
+  for (const j of d.prismatic) prismatic[j.joint] = j;
+  const r1 = (v) => Math.round(v * 10) / 10;
+  function circle(x, y, r) { return 'M' + r1(x - r) + ' ' + r1(y) + 'a' + r + ' ' + r + ' 0 1 0 ' + 2 * r + ' 0a' + r + ' ' + r + ' 0 1 0 ' + -2 * r + ' 0'; }
+  // Level of detail: what the panel's pixels can show, whatever the number of loops. A line is drawn once per
+  // pair of end pixels (10^4 cranks 0.05 px apart are one stroke), and a mark or an arrow only where no other
+  // lies within `cell` pixels; lines and marks outside the panel are left out. Small mechanisms lose nothing.
+  const left = b.x0, right = b.x0 + b.w, top = b.y0, bottom = b.y0 + b.h;
+  const drawn = new Set();
+  function pairs(list) {
+    const s = [];
+    drawn.clear();
+    for (let k = 0; k < list.length; k += 2) {
+      const i = list[k], j = list[k + 1];
+      const x1 = X[i], y1 = Y[i], x2 = X[j], y2 = Y[j];
+      if ((x1 < left && x2 < left) || (x1 > right && x2 > right) || (y1 < top && y2 < top) || (y1 > bottom && y2 > bottom)) continue;
+      const a = Math.round(x1) + 4096 * Math.round(y1), c = Math.round(x2) + 4096 * Math.round(y2);
+      const key = a < c ? a * 16777216 + c : c * 16777216 + a;
+      if (drawn.has(key)) continue;
+      drawn.add(key);
+      s.push('M' + r1(x1) + ' ' + r1(y1) + 'L' + r1(x2) + ' ' + r1(y2));
+    }
+    return s.join('');
+  }
+  function Sparse(cell) {
+    const nx = Math.ceil(b.w / cell) + 1, ny = Math.ceil(b.h / cell) + 1, used = new Uint8Array(nx * ny);
+    return {
+      clear() { used.fill(0); },
+      // true the first time a cell is asked for; false outside the panel
+      take(x, y) {
+        const i = Math.floor((x - left) / cell), j = Math.floor((y - top) / cell);
+        if (i < 0 || j < 0 || i >= nx || j >= ny || used[i + nx * j]) return false;
+        used[i + nx * j] = 1;
+        return true;
+      },
+    };
+  }
+  const marksGrid = Sparse(3), arrowsGrid = Sparse(12);
+  // the largest speed drawn 60 pixels long
+  const vscale = d.vmax > 0 ? 60 / (d.vmax * kx) : 0;
+
+  phiq.start({
+    draw(p, show) {
+      const pos = p.pos;
+      for (let i = 0; i < P; ++i) {
+        X[i] = b.x0 + (pos[2 * i] - b.xmin) * kx;
+        Y[i] = b.y0 + b.h - (pos[2 * i + 1] - b.ymin) * ky;
+      }
+      links.setAttribute('d', pairs(d.links));
+      arms.setAttribute('d', pairs(d.arms));
+      const pin = [], ball = [], dot = [], block = [], guide = [], hatch = [];
+      marksGrid.clear();
+      for (let k = 0; k < J; ++k) {
+        const x = X[d.joints.p[k]], y = Y[d.joints.p[k]], mark = d.joints.marks[k];
+        if (!marksGrid.take(x, y)) continue;
+        if (mark === 'p') {
+          const j = prismatic[k] || {};
+          // the block along its guide, 18 x 10 px, the guide through it; hatched below a guide on the ground
+          const a = j.angles ? j.angles[p.frame] : (j.angle || 0), ux = Math.cos(a), uy = -Math.sin(a);
+          guide.push('M' + r1(x - 26 * ux) + ' ' + r1(y - 26 * uy) + 'L' + r1(x + 26 * ux) + ' ' + r1(y + 26 * uy));
+          const c = [[-9, -5], [9, -5], [9, 5], [-9, 5]].map(([u, v]) => r1(x + u * ux - v * uy) + ' ' + r1(y + u * uy + v * ux));
+          block.push('M' + c.join('L') + 'Z');
+          if (j.ground_guide)
+            for (let k = -2; k <= 2; ++k) {
+              const hx = x + 10 * k * ux, hy = y + 10 * k * uy;
+              hatch.push('M' + r1(hx + 7 * uy) + ' ' + r1(hy - 7 * ux) + 'l' + r1(-5 * ux) + ' ' + r1(-5 * uy));
+            }
+        } else if (mark === 'o') {
+          dot.push(circle(x, y, 2.5));
+        } else {
+          (mark === 's' ? ball : pin).push(circle(x, y, 4));
+        }
+      }
+      pins.setAttribute('d', pin.join('')), balls.setAttribute('d', ball.join('')), dots.setAttribute('d', dot.join(''));
+      blocks.setAttribute('d', block.join('')), guides.setAttribute('d', guide.join(''));
+      hatches.setAttribute('d', hatch.join(''));
+      phiq.traces.forEach((tr, k) => {
+        const s = [];
+        if (show.trails)
+          for (let i = 0; i < p.samples; ++i)
+            s.push((i ? 'L' : 'M') + r1(b.x0 + (tr.pos[2 * i] - b.xmin) * kx) + ' ' +
+                   r1(b.y0 + b.h - (tr.pos[2 * i + 1] - b.ymin) * ky));
+        trails[k].setAttribute('d', s.join(''));
+      });
+      const v = [], h = [];
+      arrowsGrid.clear();
+      if (show.vectors && p.vel)
+        for (let i = 0; i < P; ++i) {
+          if (d.moving[i] !== '1' || !arrowsGrid.take(X[i], Y[i])) continue;
+          const vx = p.vel[2 * i] * kx * vscale, vy = -p.vel[2 * i + 1] * ky * vscale, n = Math.hypot(vx, vy);
+          if (n < 2) continue;
+          const ex = X[i] + vx, ey = Y[i] + vy, ux = vx / n, uy = vy / n;
+          v.push('M' + r1(X[i]) + ' ' + r1(Y[i]) + 'L' + r1(ex) + ' ' + r1(ey));
+          h.push('M' + r1(ex) + ' ' + r1(ey) + 'L' + r1(ex - 7 * ux + 3 * uy) + ' ' + r1(ey - 7 * uy - 3 * ux) + 'L' +
+                 r1(ex - 7 * ux - 3 * uy) + ' ' + r1(ey - 7 * uy + 3 * ux) + 'Z');
+        }
+      vectors.setAttribute('d', v.join('')), heads.setAttribute('d', h.join(''));
+    },
+    // where each point is on the page (CSS pixels), and whether it moves: for scripts checking screenshots
+    screenPoints(pos) {
+      const m = svg.getScreenCTM(), q = svg.createSVGPoint(), out = [];
+      for (let i = 0; i < P; ++i) {
+        q.x = b.x0 + (pos[2 * i] - b.xmin) * kx, q.y = b.y0 + b.h - (pos[2 * i + 1] - b.ymin) * ky;
+        const s = q.matrixTransform(m);
+        out.push({x: s.x, y: s.y, moving: d.moving[i] === '1'});
+      }
+      return out;
+    },
+  });
+})();
