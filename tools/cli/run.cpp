@@ -163,7 +163,7 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     // (Not when the first position was assembled and the sweep stopped at its singular start: the rank there
     // counts the loops lying flat at once as freedoms not driven.)
     if (summary.failed_step == 0 && summary.assembly.status != phiq::SolveStatus::kSuccess &&
-        summary.status != phiq::SolveStatus::kOutsideTimeDomain &&
+        summary.status != phiq::SolveStatus::kOutsideTimeDomain && summary.status != phiq::SolveStatus::kOutsideDomain &&
         summary.status != phiq::SolveStatus::kNonFinite && !square.reduced) {
       Eigen::VectorXd q = scene.model->initial_positions();
       phiq::AssemblySummary as;

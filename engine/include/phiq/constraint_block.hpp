@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "phiq/constraint_kinds.hpp"
@@ -93,6 +95,10 @@ class ConstraintBlock {
   /// indexed by global row. Used once, while the model is built, for the rows' tolerance scales (ToleranceScales)
   /// and, their largest, the model's length scale (Model::length_scale()).
   virtual void row_lengths(std::vector<double>& lengths) const = 0;
+  /// The first constraint of the block whose equations are not defined at q (a curve parameter past the end of
+  /// an open curve: PointOnCurveSpec::outside_domain()), and what happened; {size(), ""} when there is none.
+  /// Kinds without a domain are always inside. Thread-safe.
+  virtual std::pair<std::size_t, std::string> outside_domain(const double* /*q*/) const { return {size(), ""}; }
 };
 
 namespace detail {
@@ -210,6 +216,13 @@ class TypedBlock final : public ConstraintBlock {
     for (const Entry& e : entries_)
       for (int r = 0; r < Spec::kRows; ++r)
         units[static_cast<std::size_t>(e.row0 + r)] = e.spec.row_unit(r, coordinate_units);
+  }
+  std::pair<std::size_t, std::string> outside_domain(const double* q) const override {
+    if constexpr (requires(const Spec& k, const double* at) { k.outside_domain(at); }) {
+      for (std::size_t i = 0; i < entries_.size(); ++i)
+        if (std::string why = entries_[i].spec.outside_domain(q); !why.empty()) return {i, std::move(why)};
+    }
+    return {entries_.size(), ""};
   }
   void row_lengths(std::vector<double>& lengths) const override {
     for (const Entry& e : entries_)

@@ -29,6 +29,9 @@ enum class [[nodiscard]] SolveStatus {
   /// solve_velocity / solve_acceleration at a q that does not solve the position problem Φ(q, t) = 0 (to
   /// DerivativeOptions::tolerance): its q̇ or q̈ would mean nothing. The message names the worst constraint.
   kPositionNotSolved,
+  /// a coordinate left the range where a constraint's equations are defined (a curve parameter past the end of an
+  /// open curve, Model::outside_domain()): the message names the constraint, and the sweep's the time
+  kOutsideDomain,
 };
 /// Lower-case words, e.g. "singular Jacobian".
 const char* to_string(SolveStatus s);

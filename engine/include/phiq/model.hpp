@@ -5,8 +5,10 @@
 /// Workspace (workspace.hpp).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -254,6 +256,10 @@ class Model : private detail::ModelData {
   Unit row_unit(Index row) const { return row_units_[detail::index_in(row, num_equations(), "row")]; }
   /// "name" for one-row constraints, "name[k]" for row k of a multi-row one. Throws phiq::Error unless 0 ≤ row < m.
   std::string row_name(Index row) const;
+  /// "" when every constraint's equations are defined at q; else "constraint 'NAME': what happened" for the first
+  /// that is not (a curve parameter past the end of an open curve: PointOnCurveSpec::outside_domain()). The sweeps
+  /// check every converged position (SolveStatus::kOutsideDomain). Thread-safe.
+  std::string outside_domain(const double* q) const;
   /// The Grübler–Kutzbach count of the model's joints: 3 (nb − 1) − Σ c_i for planar bodies, 6 (nb − 1) − Σ c_i for
   /// spatial bodies, nb counting ground and c_i the freedoms joint i removes (drivers and the bodies' Euler
   /// normalisations are not counted). std::nullopt where it is not defined: no bodies (ModelBuilder::add_body), a
@@ -387,6 +393,9 @@ class ModelBuilder {
   void set_initial(Index j, double value);
 
   /// Adds a constraint of any kind of kinds/registry.hpp; its rows follow those added before. Returns its index.
+  /// A kind with kAddedCoordinates (PointOnCurveSpec: the curve parameter) gets those coordinates added after
+  /// the model's others so far, named "NAME.<suffix>", with the kind's initial guess from the placement
+  /// (`added_initial`); the spec's own slots for them are ignored and bound here (`added`).
   /// Throws phiq::Error "constraint 'NAME': ..." for a slot that is not a coordinate of the model or a constant
   /// that is not finite, a law without a function, or data its kind refuses ("distance: length must be positive").
   template <ConstraintKind Spec>
@@ -468,6 +477,17 @@ Index ModelBuilder::add(const std::string& name, Spec spec) {
     spec.prepare(model_.initial_.data());
   } catch (const Error& e) {
     throw Error("constraint '" + label + "': " + e.what());
+  }
+  // A kind with coordinates of its own (a curve's parameter) has them added here, after its checks, as
+  // "NAME.<suffix>" (nothing is added for a constraint refused), each with the kind's guess from the placement.
+  if constexpr (requires { Spec::kAddedCoordinates; }) {
+    if (has_constraint(label)) throw Error("duplicate constraint name '" + label + "'");
+    for (int i = 0; i < static_cast<int>(std::size(Spec::kAddedCoordinates)); ++i) {
+      const Index j = add_coordinate(label + "." + Spec::kAddedCoordinates[i], 0.0);
+      spec.added(i) = Slot::coordinate(j);
+      const double guess = spec.added_initial(i, model_.initial_.data());
+      model_.initial_(j) = std::isfinite(guess) ? guess : 0.0;
+    }
   }
   const bool td = spec.depends_on_time();
   const Index id = add_info(label, Spec::kKind, Spec::kRows, td);

@@ -69,6 +69,7 @@ void bind_model(py::module_& m) {
       .value("INCONSISTENT", SolveStatus::kInconsistent, "redundant constraints that cannot hold together")
       .value("POSITION_NOT_SOLVED", SolveStatus::kPositionNotSolved,
              "a velocity or acceleration asked at a q that does not solve the position problem")
+      .value("OUTSIDE_DOMAIN", SolveStatus::kOutsideDomain, "a curve parameter left its open curve")
       .def("__str__", [](SolveStatus s) { return to_string(s); });
 
   py::class_<ConstraintInfo>(m, "ConstraintInfo", "One constraint of a model, as diagnostics name it.")

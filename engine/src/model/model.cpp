@@ -109,6 +109,16 @@ std::string Model::row_name(Index row) const {
   return c.name + "[" + std::to_string(row - c.first_row) + "]";
 }
 
+std::string Model::outside_domain(const double* q) const {
+  for (const auto& b : blocks_) {
+    auto [i, why] = b->outside_domain(q);
+    if (i < b->size())
+      return "constraint '" + constraints_[static_cast<std::size_t>(constraint_of_row(b->first_row(i)))].name +
+             "': " + why;
+  }
+  return "";
+}
+
 namespace {
 
 // Constraints per parallel task: a task of 8192 distance rows is about 30 µs of work, well above TBB's

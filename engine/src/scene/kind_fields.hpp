@@ -60,6 +60,34 @@ class KindFields {
     for (const auto& item : c_.require(field).items()) out.emplace_back(r_, item, type_);
     return out;
   }
+  // A mapping field (a curve: {body: …, spline: …}), read with this same vocabulary.
+  KindFields sub(const char* field) const {
+    auto v = c_.require(field);
+    if (!v.is_map()) v.fail("expected a mapping (key: value)");
+    return KindFields(r_, v, type_);
+  }
+  // A list of [x, y] (a spline's points), at least one.
+  std::vector<kin::V2> vec2_list(const char* field) const {
+    std::vector<kin::V2> out;
+    for (const auto& item : c_.require(field).items()) out.push_back(r_.vec2(item));
+    if (out.empty()) c_.field(field).fail("expected a list of [x, y]");
+    return out;
+  }
+  bool flag(const char* field) const { return c_.require(field).boolean(); }
+  // A body (or `ground`) by name.
+  Frame2 body(const char* field) const { return r_.body(c_.require(field)); }
+  // One attachment {body: B, at: [x, y]} or {point: P}.
+  Attachment attachment(const char* field) const {
+    const auto n = c_.require(field);
+    auto [frame, at] = r_.attachment(n);
+    return Attachment{frame, at, n.field("body").present()};
+  }
+  // The entry's name, for messages ("" when unnamed).
+  std::string name() const {
+    const auto n = c_.field("name");
+    return n.present() ? n.text() : std::string();
+  }
+
   // A list of coordinate names, each with an optional sign ("-psi3"): (index, ±1).
   std::vector<std::pair<Index, double>> signed_coordinates(const char* field) const {
     std::vector<std::pair<Index, double>> out;

@@ -232,6 +232,13 @@ void SceneReader::add(const C& c, const std::string& name, Spec spec) {
   const std::string label = name.empty() ? c.path() + " (line " + std::to_string(c.mark().line + 1) + ")" : name;
   bool any_coordinate = false;
   spec.for_each_slot([&](const Slot& s, Unit) { any_coordinate = any_coordinate || s.is_coordinate(); });
+  if constexpr (requires { Spec::kAddedCoordinates; }) {
+    // its own coordinates (a curve parameter) are named after it, and added with it
+    if (name.empty())
+      c.fail(std::string("a constraint with a coordinate of its own needs a name (its coordinate is NAME.") +
+             Spec::kAddedCoordinates[0] + ")");
+    any_coordinate = true;
+  }
   // one that involves no coordinate nor t and is 0 (`0*x`, a joint between two coincident fixed points) holds
   // everywhere: a redundant row the rank analysis reports, not an error
   bool holds_everywhere = false;

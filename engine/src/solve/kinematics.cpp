@@ -32,6 +32,7 @@ const char* to_string(SolveStatus s) {
     case SolveStatus::kCancelled: return "cancelled";
     case SolveStatus::kInconsistent: return "inconsistent redundant constraints";
     case SolveStatus::kPositionNotSolved: return "position not solved";
+    case SolveStatus::kOutsideDomain: return "outside a constraint's domain";
   }
   return "?";
 }

@@ -114,6 +114,10 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
     bool ill_conditioned;
   } const noted{sum_.warnings.size(), sum_.singular_positions, sum_.min_rcond, sum_.min_rcond_time,
                 rounding_level_, known_to_, ill_conditioned_};
+  // A position beyond the end of an open curve solves its equations (the end piece continues), but is no
+  // position of the mechanism: the slot or profile ends there. (The sweep names the step and its time.)
+  if (std::string off = model_.outside_domain(ws_->q.data()); !off.empty())
+    return fail(SolveStatus::kOutsideDomain, off);
   singular_row_ = false;
   last_rcond_ = ps.rcond;
   row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;

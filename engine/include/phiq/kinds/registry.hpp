@@ -27,6 +27,9 @@
 #include "phiq/kinds/spatial_distance.hpp"
 #include "phiq/kinds/spatial_joints.hpp"
 #include "phiq/kinds/unit_vector.hpp"
+// higher pairs on curves (issue 27 part B)
+#include "phiq/kinds/flat_follower.hpp"
+#include "phiq/kinds/point_on_curve.hpp"
 
 namespace phiq {
 
@@ -84,6 +87,7 @@ struct KindList {
 using ConstraintKinds =
     KindList<DistanceSpec, PinSpec, PointOnLineSpec, ConstantAngleSpec, SegmentAngleSpec, PolarSpec, PrismaticSpec,
              LoopSpec, EquationSpec, CouplerSpec, CoordinateDriverSpec,
+             PointOnCurveSpec, FlatFollowerSpec,  // higher pairs on curves (issue 27 part B)
              EulerParametersSpec, UnitVectorSpec, SpatialDistanceSpec, DotSpec, SphericalSpec, SpatialRevoluteSpec,
              SpatialPrismaticSpec, CylindricalSpec, UniversalSpec, PlanarSpec, RigidSpec, SpatialPointOnLineSpec,
              PointOnPlaneSpec, JointDistanceDriverSpec, JointAngleDriverSpec>;
