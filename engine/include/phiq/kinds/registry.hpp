@@ -27,6 +27,11 @@
 #include "phiq/kinds/spatial_distance.hpp"
 #include "phiq/kinds/spatial_joints.hpp"
 #include "phiq/kinds/unit_vector.hpp"
+// transmissions, the screw joint and spatial mixed coordinates (issue 27, part A)
+#include "phiq/kinds/screw.hpp"
+#include "phiq/kinds/spatial_gear.hpp"
+#include "phiq/kinds/spatial_mixed.hpp"
+#include "phiq/kinds/transmissions.hpp"
 
 namespace phiq {
 
@@ -86,7 +91,9 @@ using ConstraintKinds =
              LoopSpec, EquationSpec, CouplerSpec, CoordinateDriverSpec,
              EulerParametersSpec, UnitVectorSpec, SpatialDistanceSpec, DotSpec, SphericalSpec, SpatialRevoluteSpec,
              SpatialPrismaticSpec, CylindricalSpec, UniversalSpec, PlanarSpec, RigidSpec, SpatialPointOnLineSpec,
-             PointOnPlaneSpec, JointDistanceDriverSpec, JointAngleDriverSpec>;
+             PointOnPlaneSpec, JointDistanceDriverSpec, JointAngleDriverSpec,
+             // transmissions, the screw joint and spatial mixed coordinates (issue 27, part A)
+             GearSpec, RackPinionSpec, BeltSpec, ScrewSpec, SpatialGearSpec, SpatialPolarSpec, SpatialAngleSpec>;
 
 /// @cond internal
 namespace detail {
