@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "constraint_check.hpp"
@@ -18,19 +19,19 @@ namespace {
 Slot S(Index i) { return Slot::coordinate(i); }
 
 TEST(Transmissions, GearDerivatives) {
-  GearSpec external{S(0), S(1), Slot::constant(0.0), 0.03, 0.09, false, 0.2, 2};
+  GearSpec external{{}, S(0), S(1), Slot::constant(0.0), 0.03, 0.09, false, 0.2, 2};
   CheckSpec(external, 2, Opts(2701));
-  GearSpec planet_ring{S(2), S(0), S(1), 18.0, 60.0, true, -0.1, 2};  // with a moving carrier
+  GearSpec planet_ring{{}, S(2), S(0), S(1), 18.0, 60.0, true, -0.1, 2};  // with a moving carrier
   CheckSpec(planet_ring, 3, Opts(2702));
-  GearSpec fixed_sun{Slot::constant(0.4), S(0), S(1), 24.0, 18.0, false, 0.0, 2};  // the sun held
+  GearSpec fixed_sun{{}, Slot::constant(0.4), S(0), S(1), 24.0, 18.0, false, 0.0, 2};  // the sun held
   CheckSpec(fixed_sun, 2, Opts(2703));
 }
 
 TEST(Transmissions, RackAndBeltDerivatives) {
-  CheckSpec(RackPinionSpec{S(1), S(0), 0.04, 0.01, false, 2}, 2, Opts(2711));
-  CheckSpec(RackPinionSpec{S(0), S(1), 0.5, 0.0, true, 3}, 2, Opts(2712));
-  CheckSpec(BeltSpec{S(0), S(1), 0.08, 0.05, false, 0.0, 2}, 2, Opts(2713));
-  CheckSpec(BeltSpec{S(1), S(0), 0.08, 0.12, true, 0.3, 2}, 2, Opts(2714));
+  CheckSpec(RackPinionSpec{{}, S(1), S(0), 0.04, 0.01, false, 2}, 2, Opts(2711));
+  CheckSpec(RackPinionSpec{{}, S(0), S(1), 0.5, 0.0, true, 3}, 2, Opts(2712));
+  CheckSpec(BeltSpec{{}, S(0), S(1), 0.08, 0.05, false, 0.0, 2}, 2, Opts(2713));
+  CheckSpec(BeltSpec{{}, S(1), S(0), 0.08, 0.12, true, 0.3, 2}, 2, Opts(2714));
 }
 
 // The values of one row of a kind at q (the relation it states, whatever its scaling).
@@ -43,24 +44,22 @@ double Row(const Spec& s, std::initializer_list<double> q) {
 
 TEST(Transmissions, RowsStateTheRelationsOfTheirHeaders) {
   // external: r1 (θ1 − θc) + r2 (θ2 − θc) = r1 φ; internal: r1 (θ1 − θc) − r2 (θ2 − θc) = r1 φ, per radian of gear 1
-  const GearSpec ext{S(0), S(1), S(2), 2.0, 3.0, false, 0.5, 2}, inl{S(0), S(1), S(2), 2.0, 3.0, true, 0.5, 2};
+  const GearSpec ext{{}, S(0), S(1), S(2), 2.0, 3.0, false, 0.5, 2}, inl{{}, S(0), S(1), S(2), 2.0, 3.0, true, 0.5, 2};
   EXPECT_DOUBLE_EQ(Row(ext, {1.0, 2.0, 0.25}), (2.0 * 0.75 + 3.0 * 1.75) / 2.0 - 0.5);
   EXPECT_DOUBLE_EQ(Row(inl, {1.0, 2.0, 0.25}), (2.0 * 0.75 - 3.0 * 1.75) / 2.0 - 0.5);
-  EXPECT_DOUBLE_EQ(Row(RackPinionSpec{S(0), S(1), 0.04, 0.01, false, 2}, {0.3, 2.0}), 0.3 - 0.08 - 0.01);
-  EXPECT_DOUBLE_EQ(Row(RackPinionSpec{S(0), S(1), 0.04, 0.01, true, 2}, {0.3, 2.0}), 0.3 + 0.08 - 0.01);
-  EXPECT_DOUBLE_EQ(Row(BeltSpec{S(0), S(1), 0.08, 0.05, false, 0.0, 2}, {1.0, 1.6}), 1.0 - 0.05 / 0.08 * 1.6);
-  EXPECT_DOUBLE_EQ(Row(BeltSpec{S(0), S(1), 0.08, 0.05, true, 0.0, 2}, {1.0, 1.6}), 1.0 + 0.05 / 0.08 * 1.6);
+  EXPECT_DOUBLE_EQ(Row(RackPinionSpec{{}, S(0), S(1), 0.04, 0.01, false, 2}, {0.3, 2.0}), 0.3 - 0.08 - 0.01);
+  EXPECT_DOUBLE_EQ(Row(RackPinionSpec{{}, S(0), S(1), 0.04, 0.01, true, 2}, {0.3, 2.0}), 0.3 + 0.08 - 0.01);
+  EXPECT_DOUBLE_EQ(Row(BeltSpec{{}, S(0), S(1), 0.08, 0.05, false, 0.0, 2}, {1.0, 1.6}), 1.0 - 0.05 / 0.08 * 1.6);
+  EXPECT_DOUBLE_EQ(Row(BeltSpec{{}, S(0), S(1), 0.08, 0.05, true, 0.0, 2}, {1.0, 1.6}), 1.0 + 0.05 / 0.08 * 1.6);
 }
 
 TEST(Transmissions, TwoStageTrainTurnsItsOutputAtOneNinth) {
-  Scene scene = load_scene(test::model_path("transmissions/gear_train.yaml"));
-  const Model& m = *scene.model;
-  ASSERT_TRUE(m.grubler().has_value());
-  EXPECT_EQ(*m.grubler(), 1);
+  const test::SweptScene run = test::sweep_scene("transmissions/gear_train.yaml");
+  const Model& m = *run.scene.model;
+  ASSERT_EQ(run.status, SolveStatus::kSuccess) << run.summary.message;
+  const test::Trace& tr = run.trace;
+  EXPECT_EQ(m.grubler(), std::optional<Index>(1));
   const Index p1 = m.coordinate_index("psi1"), p2 = m.coordinate_index("psi2"), p3 = m.coordinate_index("psi3");
-  test::Trace tr;
-  SweepSummary sum;
-  ASSERT_EQ(test::sweep(m, scene.sweep, &tr, &sum), SolveStatus::kSuccess) << sum.message;
   ASSERT_EQ(tr.t.size(), 121u);
   for (std::size_t k = 0; k < tr.t.size(); ++k) {
     const double t = tr.t[k], a = 6.0 * M_PI;  // psi1 = a sin t: three turns each way
@@ -73,15 +72,13 @@ TEST(Transmissions, TwoStageTrainTurnsItsOutputAtOneNinth) {
 }
 
 TEST(Transmissions, PlanetaryTrainWithAMovingCarrierObeysWillis) {
-  Scene scene = load_scene(test::model_path("transmissions/planetary.yaml"));
-  const Model& m = *scene.model;
-  ASSERT_TRUE(m.grubler().has_value());
-  EXPECT_EQ(*m.grubler(), 2);
+  const test::SweptScene run = test::sweep_scene("transmissions/planetary.yaml");
+  const Model& m = *run.scene.model;
+  ASSERT_EQ(run.status, SolveStatus::kSuccess) << run.summary.message;
+  const test::Trace& tr = run.trace;
+  EXPECT_EQ(m.grubler(), std::optional<Index>(2));
   const Index ps = m.coordinate_index("psis"), pc = m.coordinate_index("psic"), pp = m.coordinate_index("psip"),
               pr = m.coordinate_index("psir"), xp = m.coordinate_index("xp"), yp = m.coordinate_index("yp");
-  test::Trace tr;
-  SweepSummary sum;
-  ASSERT_EQ(test::sweep(m, scene.sweep, &tr, &sum), SolveStatus::kSuccess) << sum.message;
   ASSERT_EQ(tr.t.size(), 141u);
   const double zs = 24, zp = 18, zr = 60, ws = 1.0, wr = -0.2, arm = 0.004 * (zs + zp) / 2.0;
   const double wc = (zs * ws + zr * wr) / (zs + zr);  // Willis: (ws − wc)/(wr − wc) = −zr/zs
@@ -104,15 +101,13 @@ TEST(Transmissions, PlanetaryTrainWithAMovingCarrierObeysWillis) {
 }
 
 TEST(Transmissions, RackTravelsTheRadiusTimesThePinionsTurn) {
-  Scene scene = load_scene(test::model_path("transmissions/rack_pinion.yaml"));
-  const Model& m = *scene.model;
-  ASSERT_TRUE(m.grubler().has_value());
-  EXPECT_EQ(*m.grubler(), 1);
+  const test::SweptScene run = test::sweep_scene("transmissions/rack_pinion.yaml");
+  const Model& m = *run.scene.model;
+  ASSERT_EQ(run.status, SolveStatus::kSuccess) << run.summary.message;
+  const test::Trace& tr = run.trace;
+  EXPECT_EQ(m.grubler(), std::optional<Index>(1));
   const Index x = m.coordinate_index("x_rack");
   EXPECT_EQ(m.row_unit(m.constraints()[2].first_row), Unit::kLength);
-  test::Trace tr;
-  SweepSummary sum;
-  ASSERT_EQ(test::sweep(m, scene.sweep, &tr, &sum), SolveStatus::kSuccess) << sum.message;
   ASSERT_EQ(tr.t.size(), 61u);
   const double r = 0.04;
   for (std::size_t k = 0; k < tr.t.size(); ++k) {
@@ -124,11 +119,10 @@ TEST(Transmissions, RackTravelsTheRadiusTimesThePinionsTurn) {
 }
 
 TEST(Transmissions, OpenAndCrossedBeltsAndAChain) {
-  Scene scene = load_scene(test::model_path("transmissions/belts.yaml"));
-  const Model& m = *scene.model;
-  test::Trace tr;
-  SweepSummary sum;
-  ASSERT_EQ(test::sweep(m, scene.sweep, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+  const test::SweptScene run = test::sweep_scene("transmissions/belts.yaml");
+  const Model& m = *run.scene.model;
+  ASSERT_EQ(run.status, SolveStatus::kSuccess) << run.summary.message;
+  const test::Trace& tr = run.trace;
   ASSERT_EQ(tr.t.size(), 41u);
   for (std::size_t k = 0; k < tr.t.size(); ++k) {
     const double t = tr.t[k], th = t + 0.5 * t * t, w = 1 + t, a = 1.0;
@@ -155,22 +149,22 @@ std::string Refused(const Spec& spec) {
 }
 
 TEST(Transmissions, RefusesBadData) {
-  EXPECT_EQ(Refused(GearSpec{S(0), S(1), Slot::constant(0), 0.0, 1.0, false, 0.0, 2}),
+  EXPECT_EQ(Refused(GearSpec{{}, S(0), S(1), Slot::constant(0), 0.0, 1.0, false, 0.0, 2}),
             "constraint 't1': gear: the radii (or tooth counts) must be positive");
-  EXPECT_EQ(Refused(GearSpec{S(0), S(1), Slot::constant(0), 1.0, -2.0, false, 0.0, 2}),
+  EXPECT_EQ(Refused(GearSpec{{}, S(0), S(1), Slot::constant(0), 1.0, -2.0, false, 0.0, 2}),
             "constraint 't1': gear: the radii (or tooth counts) must be positive");
-  EXPECT_EQ(Refused(GearSpec{S(0), S(1), Slot::constant(0), 3.0, 2.0, true, 0.0, 2}),
+  EXPECT_EQ(Refused(GearSpec{{}, S(0), S(1), Slot::constant(0), 3.0, 2.0, true, 0.0, 2}),
             "constraint 't1': gear: an internal pair's second gear is the ring: its radius must exceed the first's");
-  EXPECT_EQ(Refused(GearSpec{S(0), S(0), Slot::constant(0), 1.0, 2.0, false, 0.0, 2}),
+  EXPECT_EQ(Refused(GearSpec{{}, S(0), S(0), Slot::constant(0), 1.0, 2.0, false, 0.0, 2}),
             "constraint 't1': gear: the two gears must be different angles");
-  EXPECT_EQ(Refused(GearSpec{S(0), S(1), S(1), 1.0, 2.0, false, 0.0, 2}),
+  EXPECT_EQ(Refused(GearSpec{{}, S(0), S(1), S(1), 1.0, 2.0, false, 0.0, 2}),
             "constraint 't1': gear: the carrier must not be one of the gears");
-  EXPECT_EQ(Refused(GearSpec{S(0), S(1), S(2), 1.0, 2.0, true, 0.0, 2}), "");
-  EXPECT_EQ(Refused(RackPinionSpec{S(0), S(1), 0.0, 0.0, false, 2}),
+  EXPECT_EQ(Refused(GearSpec{{}, S(0), S(1), S(2), 1.0, 2.0, true, 0.0, 2}), "");
+  EXPECT_EQ(Refused(RackPinionSpec{{}, S(0), S(1), 0.0, 0.0, false, 2}),
             "constraint 't1': rack_pinion: the radius must be positive");
-  EXPECT_EQ(Refused(RackPinionSpec{S(0), S(0), 0.1, 0.0, false, 2}),
+  EXPECT_EQ(Refused(RackPinionSpec{{}, S(0), S(0), 0.1, 0.0, false, 2}),
             "constraint 't1': rack_pinion: the rack's travel and the pinion's angle must be different coordinates");
-  EXPECT_EQ(Refused(BeltSpec{S(0), S(1), 0.1, NAN, false, 0.0, 2}),
+  EXPECT_EQ(Refused(BeltSpec{{}, S(0), S(1), 0.1, NAN, false, 0.0, 2}),
             "constraint 't1': belt: the radii (or tooth counts) must be positive");
 }
 

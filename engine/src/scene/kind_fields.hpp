@@ -124,8 +124,11 @@ class KindFields {
   // One side of a spatial joint (the axis of a mixed coordinate).
   JointSide3 side3(const char* field) const { return r_.side3(c_.require(field)); }
   // The sides of a named joint that turns about its axis (revolute, cylindrical, screw), declared above.
-  std::pair<JointSide3, JointSide3> turning_joint(const char* field) const { return turning_joint_of(c_.require(field)); }
-  std::pair<std::pair<JointSide3, JointSide3>, std::pair<JointSide3, JointSide3>> turning_joints(const char* field) const {
+  std::pair<JointSide3, JointSide3> turning_joint(const char* field) const {
+    return turning_joint_of(c_.require(field));
+  }
+  using Sides = std::pair<JointSide3, JointSide3>;
+  std::pair<Sides, Sides> turning_joints(const char* field) const {
     const auto v = c_.require(field);
     if (!v.is_sequence() || v.size() != 2) v.fail("expected two joints [J1, J2]");
     if (v.at(0).name() == v.at(1).name()) v.fail("the two shafts must be different joints");

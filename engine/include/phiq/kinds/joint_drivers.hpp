@@ -1,5 +1,5 @@
 /// @file
-/// Drivers on a spatial joint: its translation (prismatic, cylindrical) or its rotation (revolute, cylindrical). One constraint kind (or one family of
+/// Drivers on a spatial joint: its translation (prismatic, cylindrical, screw) or its rotation (revolute, cylindrical, screw). One constraint kind (or one family of
 /// kinds sharing a row table): equation, derivatives, validation, joint count, sketch and scene form; the contract
 /// is documented on DistanceSpec, and kinds/registry.hpp lists every kind.
 #pragma once

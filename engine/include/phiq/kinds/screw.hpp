@@ -96,10 +96,7 @@ struct ScrewSpec {
   /// A screw draws the arms of its bodies and a hinge at its point.
   template <class Sketch>
   void sketch(Sketch& sk) const {
-    const Attachment3 pa = Attachment3::body_point(a.frame, a.at), pb = Attachment3::body_point(b.frame, b.at);
-    sk.arm3(pa);
-    sk.arm3(pb);
-    sk.joint3(pa, pb, JointMark::kRevolute);
+    detail3::sketch_joint(a, b, JointMark::kRevolute, sk);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {

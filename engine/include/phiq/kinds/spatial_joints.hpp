@@ -209,6 +209,14 @@ struct AngleRows {
     return (cv * sb - sv * cb) / rho - (cv * sd - sv * cd) * rhod / (rho * rho);
   }
 };
+/// Draws a joint: the arms of the bodies it joins, and `mark` at its point (on ground when a side is ground).
+template <class Sketch>
+void sketch_joint(const JointSide3& a, const JointSide3& b, JointMark mark, Sketch& sk) {
+  const Attachment3 pa = Attachment3::body_point(a.frame, a.at), pb = Attachment3::body_point(b.frame, b.at);
+  sk.arm3(pa);
+  sk.arm3(pb);
+  sk.joint3(pa, pb, mark);
+}
 /// Reports the slots of a side: its position (lengths), Euler parameters and vector (unitless).
 template <class F>
 void side_slots(const JointSide3& s, F& f) {
@@ -281,12 +289,11 @@ struct SpatialJointSpec {
   /// block for a prismatic pair, a ball for the others), on ground when a side is ground.
   template <class Sketch>
   void sketch(Sketch& sk) const {
-    const Attachment3 pa = Attachment3::body_point(a.frame, a.at), pb = Attachment3::body_point(b.frame, b.at);
-    sk.arm3(pa);
-    sk.arm3(pb);
     const std::string_view kind = Traits::kKind;
-    sk.joint3(pa, pb, kind == "revolute" ? JointMark::kRevolute
-                                         : (kind == "prismatic" ? JointMark::kPrismatic : JointMark::kSpherical));
+    const JointMark mark = kind == "revolute"    ? JointMark::kRevolute
+                           : kind == "prismatic" ? JointMark::kPrismatic
+                                                 : JointMark::kSpherical;
+    detail3::sketch_joint(a, b, mark, sk);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr const auto& kScene = Traits::kScene;

@@ -38,10 +38,37 @@ struct LinearRow {
 inline void require_positive_pair(double r1, double r2, const char* message) {
   require(std::isfinite(r1) && std::isfinite(r2) && r1 > 0.0 && r2 > 0.0, message);
 }
-// A transmission between two bodies removes one freedom (a higher pair) in its scene's dimension.
-inline JointCount transmission_joint_count(int dimension) { return JointCount::joint(dimension == 3 ? 3 : 2, 1); }
 }  // namespace detail
 /// @endcond
+
+/// What the transmissions share: one time-independent row, linear in q (`Derived::row()`, a detail::LinearRow), so
+/// Φt = 0 and γ = 0; a higher pair removing one freedom in the scene's dimension (`Derived::dimension`); nothing to
+/// draw (the bodies are drawn by their joints).
+template <class Derived>
+struct LinearTransmission {
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return false; }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double, double* phi) const { phi[0] = self().row().value(q); }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double*, double, Sink& s) const {
+    self().row().emit(s);
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double*, const double*, double, double* out) const { out[0] = 0.0; }
+  /// @copydoc DistanceSpec::joint_count
+  /// A transmission between two bodies is a higher pair: one freedom.
+  JointCount joint_count() const { return JointCount::joint(self().dimension == 3 ? 3 : 2, 1); }
+  /// @copydoc DistanceSpec::sketch
+  template <class Sketch>
+  void sketch(Sketch&) const {}
+
+ private:
+  const Derived& self() const { return static_cast<const Derived&>(*this); }
+};
 
 /// Gear pair: the angles θ1, θ2 of two gears of pitch radii r1, r2 (or tooth counts z1, z2: the ratio is the same),
 /// both measured relative to the carrier's angle θc (0, the ground, without a carrier):
@@ -55,7 +82,7 @@ inline JointCount transmission_joint_count(int dimension) { return JointCount::j
 /// Scene type `gear` (any dimension): `between: [G1, G2]` (each a body — its ψ, dimension 2 — or an angle
 /// coordinate), `radii: [r1, r2]` or `teeth: [z1, z2]`, `mesh: external | internal` (external), `carrier: C` (a
 /// body or an angle coordinate; none), `phase: φ` (0).
-struct GearSpec {
+struct GearSpec : LinearTransmission<GearSpec> {
   static constexpr int kRows = 1;  ///< one row, an angle
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "gear";
@@ -68,8 +95,6 @@ struct GearSpec {
   double phase = 0.0;                  ///< φ (rad)
   int dimension = 2;                   ///< the scene's dimension (for the Grübler count)
 
-  /// @copydoc DistanceSpec::depends_on_time
-  bool depends_on_time() const { return false; }
   /// @copydoc DistanceSpec::row_unit
   Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kAngle; }
   /// @copydoc DistanceSpec::characteristic_length
@@ -80,35 +105,18 @@ struct GearSpec {
   void for_each_slot(F&& f) const {
     f(first, Unit::kAngle), f(second, Unit::kAngle), f(carrier, Unit::kAngle);
   }
-  /// @copydoc DistanceSpec::residual
-  void residual(const double* q, double, double* phi) const { phi[0] = row().value(q); }
-  /// @copydoc DistanceSpec::jacobian
-  template <class Sink>
-  void jacobian(const double*, double, Sink& s) const {
-    row().emit(s);
-  }
-  /// @copydoc DistanceSpec::phi_t
-  void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
-  /// @copydoc DistanceSpec::gamma
-  void gamma(const double*, const double*, double, double* out) const { out[0] = 0.0; }
-  /// @copydoc DistanceSpec::joint_count
-  /// A gear pair is a higher pair: one freedom.
-  JointCount joint_count() const { return detail::transmission_joint_count(dimension); }
   /// @copydoc DistanceSpec::prepare
   void prepare(const double* /*q0*/) const {
     detail::require_positive_pair(r1, r2, "gear: the radii (or tooth counts) must be positive");
     detail::require(std::isfinite(phase), "gear: phase is not finite");
-    detail::require(!internal || r2 > r1, "gear: an internal pair's second gear is the ring: its radius must exceed the first's");
+    detail::require(!internal || r2 > r1,
+                    "gear: an internal pair's second gear is the ring: its radius must exceed the first's");
     detail::require(!(first.is_coordinate() && second.is_coordinate() && first.coord() == second.coord()),
                     "gear: the two gears must be different angles");
     detail::require(!(carrier.is_coordinate() && ((first.is_coordinate() && first.coord() == carrier.coord()) ||
                                                   (second.is_coordinate() && second.coord() == carrier.coord()))),
                     "gear: the carrier must not be one of the gears");
   }
-  /// @copydoc DistanceSpec::sketch
-  /// A gear pair draws nothing: the gears' bodies are drawn by their joints.
-  template <class Sketch>
-  void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
       {"constraints", "gear", 0, "- {name: mesh, type: gear, between: [pinion, wheel], teeth: [12, 36]}"}};
@@ -126,7 +134,7 @@ struct GearSpec {
     return g;
   }
 
- private:
+  /// The row as a linear form (LinearTransmission evaluates it).
   detail::LinearRow row() const {
     const double k = (internal ? -r2 : r2) / r1;
     return detail::LinearRow{{first, second, carrier}, {1.0, k, -(1.0 + k)}, phase};
@@ -140,7 +148,7 @@ struct GearSpec {
 ///
 /// Scene type `rack_pinion` (any dimension): `rack: x` (a travel coordinate), `pinion: P` (a body — its ψ,
 /// dimension 2 — or an angle coordinate), `radius: r` (> 0), `offset: c` (0), `reversed: true | false` (false).
-struct RackPinionSpec {
+struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
   static constexpr int kRows = 1;  ///< one row, a length
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "rack_pinion";
@@ -151,8 +159,6 @@ struct RackPinionSpec {
   bool reversed = false;  ///< x = −r θ + c
   int dimension = 2;      ///< the scene's dimension (for the Grübler count)
 
-  /// @copydoc DistanceSpec::depends_on_time
-  bool depends_on_time() const { return false; }
   /// @copydoc DistanceSpec::row_unit
   Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kLength; }
   /// @copydoc DistanceSpec::characteristic_length
@@ -163,20 +169,6 @@ struct RackPinionSpec {
   void for_each_slot(F&& f) const {
     f(rack, Unit::kLength), f(pinion, Unit::kAngle);
   }
-  /// @copydoc DistanceSpec::residual
-  void residual(const double* q, double, double* phi) const { phi[0] = row().value(q); }
-  /// @copydoc DistanceSpec::jacobian
-  template <class Sink>
-  void jacobian(const double*, double, Sink& s) const {
-    row().emit(s);
-  }
-  /// @copydoc DistanceSpec::phi_t
-  void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
-  /// @copydoc DistanceSpec::gamma
-  void gamma(const double*, const double*, double, double* out) const { out[0] = 0.0; }
-  /// @copydoc DistanceSpec::joint_count
-  /// A rack and pinion is a higher pair: one freedom.
-  JointCount joint_count() const { return detail::transmission_joint_count(dimension); }
   /// @copydoc DistanceSpec::prepare
   void prepare(const double* /*q0*/) const {
     detail::require(std::isfinite(radius) && radius > 0.0, "rack_pinion: the radius must be positive");
@@ -184,10 +176,6 @@ struct RackPinionSpec {
     detail::require(!(rack.is_coordinate() && pinion.is_coordinate() && rack.coord() == pinion.coord()),
                     "rack_pinion: the rack's travel and the pinion's angle must be different coordinates");
   }
-  /// @copydoc DistanceSpec::sketch
-  /// A rack and pinion draws nothing: its bodies are drawn by their joints.
-  template <class Sketch>
-  void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
       {"constraints", "rack_pinion", 0, "- {name: steering, type: rack_pinion, rack: x_rack, pinion: pinion, "
@@ -206,7 +194,7 @@ struct RackPinionSpec {
     return s;
   }
 
- private:
+  /// The row as a linear form (LinearTransmission evaluates it).
   detail::LinearRow row() const {
     return detail::LinearRow{{rack, pinion, Slot::constant(0)}, {1.0, reversed ? radius : -radius, 0.0}, offset};
   }
@@ -219,7 +207,7 @@ struct RackPinionSpec {
 ///
 /// Scene types `belt` and `chain` (any dimension): `between: [P1, P2]` (bodies — ψ, dimension 2 — or angle
 /// coordinates), `radii: [r1, r2]` or `teeth: [z1, z2]`, `crossed: true | false` (false), `phase: φ` (0).
-struct BeltSpec {
+struct BeltSpec : LinearTransmission<BeltSpec> {
   static constexpr int kRows = 1;  ///< one row, an angle
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "belt";
@@ -231,8 +219,6 @@ struct BeltSpec {
   double phase = 0.0;    ///< φ (rad)
   int dimension = 2;     ///< the scene's dimension (for the Grübler count)
 
-  /// @copydoc DistanceSpec::depends_on_time
-  bool depends_on_time() const { return false; }
   /// @copydoc DistanceSpec::row_unit
   Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kAngle; }
   /// @copydoc DistanceSpec::characteristic_length
@@ -242,20 +228,6 @@ struct BeltSpec {
   void for_each_slot(F&& f) const {
     f(first, Unit::kAngle), f(second, Unit::kAngle);
   }
-  /// @copydoc DistanceSpec::residual
-  void residual(const double* q, double, double* phi) const { phi[0] = row().value(q); }
-  /// @copydoc DistanceSpec::jacobian
-  template <class Sink>
-  void jacobian(const double*, double, Sink& s) const {
-    row().emit(s);
-  }
-  /// @copydoc DistanceSpec::phi_t
-  void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
-  /// @copydoc DistanceSpec::gamma
-  void gamma(const double*, const double*, double, double* out) const { out[0] = 0.0; }
-  /// @copydoc DistanceSpec::joint_count
-  /// A belt couples two bodies' rotations: one freedom.
-  JointCount joint_count() const { return detail::transmission_joint_count(dimension); }
   /// @copydoc DistanceSpec::prepare
   void prepare(const double* /*q0*/) const {
     detail::require_positive_pair(r1, r2, "belt: the radii (or tooth counts) must be positive");
@@ -263,10 +235,6 @@ struct BeltSpec {
     detail::require(!(first.is_coordinate() && second.is_coordinate() && first.coord() == second.coord()),
                     "belt: the two pulleys must be different angles");
   }
-  /// @copydoc DistanceSpec::sketch
-  /// A belt draws nothing: the pulleys' bodies are drawn by their joints.
-  template <class Sketch>
-  void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
       {"constraints", "belt", 0, "- {name: fan_belt, type: belt, between: [crank_pulley, fan_pulley], "
@@ -285,7 +253,7 @@ struct BeltSpec {
     return b;
   }
 
- private:
+  /// The row as a linear form (LinearTransmission evaluates it).
   detail::LinearRow row() const {
     return detail::LinearRow{{first, second, Slot::constant(0)}, {1.0, (crossed ? r2 : -r2) / r1, 0.0}, phase};
   }
