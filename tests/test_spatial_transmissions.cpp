@@ -35,8 +35,10 @@ JointSide3 Side(const Frame3& f, std::mt19937& rng) {
 
 TEST(SpatialTransmissions, ScrewDerivatives) {
   std::mt19937 rng(2721);
-  // 2π/p small enough that these seeds' difference stencils stay clear of the helical row's wrap at ±π
-  for (double pitch : {0.7, -1.3}) {
+  // Long pitches: at random states (unnormalised Euler parameters) the helical row moves fast, and with 2π/p large
+  // the difference stencils of γ straddle its wrap at ±π (a jump of 2π). The k·d terms are still checked well above
+  // the tolerance; screw_jack's closed form checks γ at a 4 mm pitch through its accelerations.
+  for (double pitch : {50.0, -80.0}) {
     ScrewSpec s;
     s.a = Side(Body(0), rng), s.b = Side(Body(7), rng), s.pitch = pitch;
     s.setup();
@@ -106,6 +108,7 @@ TEST(SpatialTransmissions, BevelPairTurnsItsOutputAtHalfSpeedTheOtherWay) {
   ASSERT_EQ(run.status, SolveStatus::kSuccess) << run.summary.message;
   const test::Trace& tr = run.trace;
   EXPECT_EQ(m.grubler(), std::optional<Index>(1));
+  CheckModel(m, 2734);  // the whole model's Jacobian, Φt and γ through its CSC pattern
   const Index th2 = m.coordinate_index("theta2"), e0 = m.coordinate_index("s2_e0"), e2 = m.coordinate_index("s2_e2");
   const Index f0 = m.coordinate_index("s1_e0"), f1 = m.coordinate_index("s1_e1");
   ASSERT_EQ(tr.t.size(), 61u);
@@ -158,10 +161,10 @@ TEST(SpatialTransmissions, SpatialCrankSliderInMixedCoordinates) {
   }
 }
 
-std::string SceneError(const std::string& text) {
+std::string LoadError(const std::string& text) {
   try {
     (void)parse_scene(text, "bad.yaml");
-  } catch (const Error& e) {
+  } catch (const SceneError& e) {
     return e.what();
   }
   return "";
@@ -175,29 +178,29 @@ TEST(SpatialTransmissions, RefusesBadDataNamingTheConstraint) {
       "  - {name: h1, type: revolute, between: [{body: ground, axis: [1, 0, 0]}, {body: s, axis: [1, 0, 0]}]}\n"
       "  - {name: h2, type: revolute, between: [{body: ground, axis: [2, 0, 0]}, {body: s, axis: [1, 0, 0]}]}\n"
       "  - {name: sl, type: prismatic, between: [{body: ground}, {body: s}]}\n";
-  EXPECT_EQ(SceneError(head + "  - {name: sc, type: screw, between: [{body: ground}, {body: s}], pitch: 0}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: sc, type: screw, between: [{body: ground}, {body: s}], pitch: 0}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'sc': screw: the pitch must not be zero (a screw of no "
             "pitch is a revolute joint)");
-  EXPECT_EQ(SceneError(head + "  - {name: g, type: spatial_gear, shafts: [h1, h2], angles: [a, b], teeth: [9, 9]}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: g, type: spatial_gear, shafts: [h1, h2], angles: [a, b], teeth: [9, 9]}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'g': spatial_gear: the shafts are parallel at the placement "
             "(parallel shafts mesh by a 'gear' between their rotation angles)");
-  EXPECT_EQ(SceneError(head + "  - {name: g, type: spatial_gear, shafts: [h1, h1], angles: [a, b], teeth: [9, 9]}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: g, type: spatial_gear, shafts: [h1, h1], angles: [a, b], teeth: [9, 9]}\n"),
             "bad.yaml:11:43: constraints[3].shafts: the two shafts must be different joints");
-  EXPECT_EQ(SceneError(head + "  - {name: g, type: spatial_gear, shafts: [h1, sl], angles: [a, b], teeth: [9, 9]}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: g, type: spatial_gear, shafts: [h1, sl], angles: [a, b], teeth: [9, 9]}\n"),
             "bad.yaml:11:48: constraints[3].shafts[1]: joint 'sl' is a prismatic joint: a shaft turns in a revolute, "
             "cylindrical or screw joint");
-  EXPECT_EQ(SceneError(head + "  - {name: c, type: polar, point: P, radius: 0, angle: a}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: c, type: polar, point: P, radius: 0, angle: a}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'c': polar: the radius is zero (the angle would be "
             "undetermined)");
-  EXPECT_EQ(SceneError(head + "  - {name: c, type: segment_angle, segment: [P, P], angle: a}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: c, type: segment_angle, segment: [P, P], angle: a}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'c': segment_angle: the segment's two ends are the same point");
-  EXPECT_EQ(SceneError(head + "  - {name: c, type: gear, between: [s, a], teeth: [9, 9]}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: c, type: gear, between: [s, a], teeth: [9, 9]}\n"),
             "bad.yaml:11:37: constraints[3].between[0]: 's' is a body: in dimension 3 a transmission relates angle "
             "coordinates (define the body's rotation about its axis with a rotation_angle constraint)");
-  EXPECT_EQ(SceneError(head + "  - {name: c, type: rotation_angle, joint: sl, angle: a}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: c, type: rotation_angle, joint: sl, angle: a}\n"),
             "bad.yaml:11:44: constraints[3].joint: joint 'sl' is a prismatic joint: a shaft turns in a revolute, "
             "cylindrical or screw joint");
-  EXPECT_EQ(SceneError(head + "  - {name: c, type: rotation_angle, angle: a}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: c, type: rotation_angle, angle: a}\n"),
             "bad.yaml:11:5: constraints[3]: give either 'between: [S1, S2]' or 'joint: NAME' (a revolute, "
             "cylindrical or screw joint)");
 }

@@ -77,6 +77,7 @@ TEST(Transmissions, PlanetaryTrainWithAMovingCarrierObeysWillis) {
   ASSERT_EQ(run.status, SolveStatus::kSuccess) << run.summary.message;
   const test::Trace& tr = run.trace;
   EXPECT_EQ(m.grubler(), std::optional<Index>(2));
+  CheckModel(m, 2704);  // the whole model's Jacobian, Φt and γ through its CSC pattern
   const Index ps = m.coordinate_index("psis"), pc = m.coordinate_index("psic"), pp = m.coordinate_index("psip"),
               pr = m.coordinate_index("psir"), xp = m.coordinate_index("xp"), yp = m.coordinate_index("yp");
   ASSERT_EQ(tr.t.size(), 141u);
@@ -123,6 +124,7 @@ TEST(Transmissions, OpenAndCrossedBeltsAndAChain) {
   const Model& m = *run.scene.model;
   ASSERT_EQ(run.status, SolveStatus::kSuccess) << run.summary.message;
   const test::Trace& tr = run.trace;
+  EXPECT_FALSE(m.grubler().has_value());  // angles without bodies: no count
   ASSERT_EQ(tr.t.size(), 41u);
   for (std::size_t k = 0; k < tr.t.size(); ++k) {
     const double t = tr.t[k], th = t + 0.5 * t * t, w = 1 + t, a = 1.0;
@@ -169,10 +171,10 @@ TEST(Transmissions, RefusesBadData) {
 }
 
 // In a scene: one line naming the file, the constraint's field and what is wrong.
-std::string SceneError(const std::string& text) {
+std::string LoadError(const std::string& text) {
   try {
     (void)parse_scene(text, "bad.yaml");
-  } catch (const Error& e) {
+  } catch (const SceneError& e) {
     return e.what();
   }
   return "";
@@ -181,15 +183,15 @@ std::string SceneError(const std::string& text) {
 TEST(Transmissions, SceneErrorsNameTheField) {
   const std::string head = "phiq: 1\ncoordinates: {x: 0, y: 0, psi: 0}\nbodies: {g: [x, y, psi]}\n"
                            "time: {start: 0, end: 1, steps: 1}\nconstraints:\n";
-  EXPECT_EQ(SceneError(head + "  - {name: m, type: gear, between: [g, psi], radii: [1, 2], teeth: [1, 2]}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: m, type: gear, between: [g, psi], radii: [1, 2], teeth: [1, 2]}\n"),
             "bad.yaml:6:5: constraints[0]: give either 'radii: [r1, r2]' or 'teeth: [z1, z2]'");
-  EXPECT_EQ(SceneError(head + "  - {name: m, type: gear, between: [g, nope], teeth: [12, 30]}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: m, type: gear, between: [g, nope], teeth: [12, 30]}\n"),
             "bad.yaml:6:40: constraints[0].between[1]: unknown body or angle coordinate 'nope'");
-  EXPECT_EQ(SceneError(head + "  - {name: m, type: gear, between: [g, x], teeth: [12.5, 30]}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: m, type: gear, between: [g, x], teeth: [12.5, 30]}\n"),
             "bad.yaml:6:52: constraints[0].teeth[0]: expected a whole number, got '12.5'");
-  EXPECT_EQ(SceneError(head + "  - {name: m, type: gear, between: [g, x], teeth: [12, 30], mesh: inner}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: m, type: gear, between: [g, x], teeth: [12, 30], mesh: inner}\n"),
             "bad.yaml:6:67: constraints[0].mesh: expected one of external, internal, got 'inner'");
-  EXPECT_EQ(SceneError(head + "  - {name: m, type: belt, between: [g, x], radii: [0, 1]}\n"),
+  EXPECT_EQ(LoadError(head + "  - {name: m, type: belt, between: [g, x], radii: [0, 1]}\n"),
             "bad.yaml:6:5: constraints[0]: constraint 'm': belt: the radii (or tooth counts) must be positive");
 }
 
