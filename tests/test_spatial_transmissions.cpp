@@ -161,15 +161,6 @@ TEST(SpatialTransmissions, SpatialCrankSliderInMixedCoordinates) {
   }
 }
 
-std::string LoadError(const std::string& text) {
-  try {
-    (void)parse_scene(text, "bad.yaml");
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(SpatialTransmissions, RefusesBadDataNamingTheConstraint) {
   const std::string head =
       "phiq: 1\ndimension: 3\ncoordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0, u: 0, v: 0, w: 0, "
@@ -178,29 +169,29 @@ TEST(SpatialTransmissions, RefusesBadDataNamingTheConstraint) {
       "  - {name: h1, type: revolute, between: [{body: ground, axis: [1, 0, 0]}, {body: s, axis: [1, 0, 0]}]}\n"
       "  - {name: h2, type: revolute, between: [{body: ground, axis: [2, 0, 0]}, {body: s, axis: [1, 0, 0]}]}\n"
       "  - {name: sl, type: prismatic, between: [{body: ground}, {body: s}]}\n";
-  EXPECT_EQ(LoadError(head + "  - {name: sc, type: screw, between: [{body: ground}, {body: s}], pitch: 0}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: sc, type: screw, between: [{body: ground}, {body: s}], pitch: 0}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'sc': screw: the pitch must not be zero (a screw of no "
             "pitch is a revolute joint)");
-  EXPECT_EQ(LoadError(head + "  - {name: g, type: spatial_gear, shafts: [h1, h2], angles: [a, b], teeth: [9, 9]}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, h2], angles: [a, b], teeth: [9, 9]}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'g': spatial_gear: the shafts are parallel at the placement "
             "(parallel shafts mesh by a 'gear' between their rotation angles)");
-  EXPECT_EQ(LoadError(head + "  - {name: g, type: spatial_gear, shafts: [h1, h1], angles: [a, b], teeth: [9, 9]}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, h1], angles: [a, b], teeth: [9, 9]}\n"),
             "bad.yaml:11:43: constraints[3].shafts: the two shafts must be different joints");
-  EXPECT_EQ(LoadError(head + "  - {name: g, type: spatial_gear, shafts: [h1, sl], angles: [a, b], teeth: [9, 9]}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, sl], angles: [a, b], teeth: [9, 9]}\n"),
             "bad.yaml:11:48: constraints[3].shafts[1]: joint 'sl' is a prismatic joint: a shaft turns in a revolute, "
             "cylindrical or screw joint");
-  EXPECT_EQ(LoadError(head + "  - {name: c, type: polar, point: P, radius: 0, angle: a}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: c, type: polar, point: P, radius: 0, angle: a}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'c': polar: the radius is zero (the angle would be "
             "undetermined)");
-  EXPECT_EQ(LoadError(head + "  - {name: c, type: segment_angle, segment: [P, P], angle: a}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: c, type: segment_angle, segment: [P, P], angle: a}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'c': segment_angle: the segment's two ends are the same point");
-  EXPECT_EQ(LoadError(head + "  - {name: c, type: gear, between: [s, a], teeth: [9, 9]}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: c, type: gear, between: [s, a], teeth: [9, 9]}\n"),
             "bad.yaml:11:37: constraints[3].between[0]: 's' is a body: in dimension 3 a transmission relates angle "
             "coordinates (define the body's rotation about its axis with a rotation_angle constraint)");
-  EXPECT_EQ(LoadError(head + "  - {name: c, type: rotation_angle, joint: sl, angle: a}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: c, type: rotation_angle, joint: sl, angle: a}\n"),
             "bad.yaml:11:44: constraints[3].joint: joint 'sl' is a prismatic joint: a shaft turns in a revolute, "
             "cylindrical or screw joint");
-  EXPECT_EQ(LoadError(head + "  - {name: c, type: rotation_angle, angle: a}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: c, type: rotation_angle, angle: a}\n"),
             "bad.yaml:11:5: constraints[3]: give either 'between: [S1, S2]' or 'joint: NAME' (a revolute, "
             "cylindrical or screw joint)");
 }

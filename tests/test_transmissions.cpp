@@ -170,28 +170,18 @@ TEST(Transmissions, RefusesBadData) {
             "constraint 't1': belt: the radii (or tooth counts) must be positive");
 }
 
-// In a scene: one line naming the file, the constraint's field and what is wrong.
-std::string LoadError(const std::string& text) {
-  try {
-    (void)parse_scene(text, "bad.yaml");
-  } catch (const SceneError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 TEST(Transmissions, SceneErrorsNameTheField) {
   const std::string head = "phiq: 1\ncoordinates: {x: 0, y: 0, psi: 0}\nbodies: {g: [x, y, psi]}\n"
                            "time: {start: 0, end: 1, steps: 1}\nconstraints:\n";
-  EXPECT_EQ(LoadError(head + "  - {name: m, type: gear, between: [g, psi], radii: [1, 2], teeth: [1, 2]}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: m, type: gear, between: [g, psi], radii: [1, 2], teeth: [1, 2]}\n"),
             "bad.yaml:6:5: constraints[0]: give either 'radii: [r1, r2]' or 'teeth: [z1, z2]'");
-  EXPECT_EQ(LoadError(head + "  - {name: m, type: gear, between: [g, nope], teeth: [12, 30]}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: m, type: gear, between: [g, nope], teeth: [12, 30]}\n"),
             "bad.yaml:6:40: constraints[0].between[1]: unknown body or angle coordinate 'nope'");
-  EXPECT_EQ(LoadError(head + "  - {name: m, type: gear, between: [g, x], teeth: [12.5, 30]}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: m, type: gear, between: [g, x], teeth: [12.5, 30]}\n"),
             "bad.yaml:6:52: constraints[0].teeth[0]: expected a whole number, got '12.5'");
-  EXPECT_EQ(LoadError(head + "  - {name: m, type: gear, between: [g, x], teeth: [12, 30], mesh: inner}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: m, type: gear, between: [g, x], teeth: [12, 30], mesh: inner}\n"),
             "bad.yaml:6:67: constraints[0].mesh: expected one of external, internal, got 'inner'");
-  EXPECT_EQ(LoadError(head + "  - {name: m, type: belt, between: [g, x], radii: [0, 1]}\n"),
+  EXPECT_EQ(test::scene_error(head + "  - {name: m, type: belt, between: [g, x], radii: [0, 1]}\n"),
             "bad.yaml:6:5: constraints[0]: constraint 'm': belt: the radii (or tooth counts) must be positive");
 }
 
