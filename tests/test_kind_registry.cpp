@@ -48,7 +48,7 @@ TEST(KindRegistry, EveryKindHasAFiniteDifferenceCheck) {
     if (!checked.count(std::type_index(typeid(K)))) missing.push_back(K::kKind);
   });
   EXPECT_TRUE(missing.empty()) << "kinds without a CheckSpec test: " << ::testing::PrintToString(missing);
-  EXPECT_EQ(phiq::ConstraintKinds::size, 28u);
+  EXPECT_EQ(phiq::ConstraintKinds::size, 35u);
 }
 
 TEST(KindRegistry, EverySceneExampleIsDocumentedInTheModelsReadme) {

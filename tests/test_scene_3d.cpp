@@ -207,7 +207,7 @@ TEST(Scene3d, BadInputIsOneLineNamingTheField) {
              "ref must not be zero or along the axis");
   EXPECT_HAS(error_of(variant("door: [x, y, z, e0, e1, e2, e3]", "door: [x, y, z]")),
              "a body is [x, y, z, e0, e1, e2, e3], or {at: [x, y, z], orientation: {...}} (dimension: 3)");
-  EXPECT_HAS(error_of(variant("type: revolute", "type: polar")), "'polar' is a planar constraint");
+  EXPECT_HAS(error_of(variant("type: revolute", "type: loop")), "'loop' is a planar constraint");
   EXPECT_HAS(error_of(variant("type: revolute", "type: hinge")), "unknown constraint type 'hinge'");
   EXPECT_HAS(error_of(variant("joint: hinge", "joint: hing")), "drivers[0].joint: unknown joint 'hing'");
   EXPECT_HAS(error_of(variant("joint: hinge,", "joint: hinge, measure: distance,")),

@@ -111,6 +111,20 @@ inline SolveStatus sweep(const Model& model, const SweepOptions& opt, Trace* tra
       summary);
 }
 
+// A scene of models/ swept with every row kept: what the closed-form tests of a scene start from.
+struct SweptScene {
+  Scene scene;
+  Trace trace;
+  SweepSummary summary;
+  SolveStatus status = SolveStatus::kSuccess;
+};
+inline SweptScene sweep_scene(const std::string& rel) {
+  SweptScene s;
+  s.scene = load_scene(model_path(rel));
+  s.status = sweep(*s.scene.model, s.scene.sweep, &s.trace, &s.summary);
+  return s;
+}
+
 // The notes' crank-slider built in code: q = [theta2, xA, yA, xB], L2 = 0.3, L3 = 1.0, theta2 = theta0 + omega t,
 // from a rough placement.
 inline Model crank_slider_model(double omega = 1.0, double theta0 = 0.0,

@@ -111,6 +111,35 @@ class KindFields {
     return r_.compile(c_.require(field), true);
   }
   Unit unit(const char* field) const { return r_.unit(c_.field(field)); }
+  // The scene's dimension, 2 or 3.
+  int dimension() const { return r_.spatial_ ? 3 : 2; }
+  bool boolean(const char* field) const { return c_.require(field).boolean(); }
+  // The index of `field`'s text among `choices` (e.g. {"external", "internal"}).
+  int choice(const char* field, std::initializer_list<const char*> choices) const {
+    const auto v = c_.require(field);
+    const std::string s = v.text();
+    std::string list;
+    int k = 0;
+    for (const char* ch : choices) {
+      if (s == ch) return k;
+      list += (k++ ? ", " : "") + std::string(ch);
+    }
+    v.fail("expected one of " + list + ", got '" + s + "'");
+  }
+  // An angle (the transmissions): an angle coordinate, or in the plane a body's name for its ψ (ground: 0).
+  Slot angle(const char* field) const { return angle_of(c_.require(field)); }
+  std::pair<Slot, Slot> angle_pair(const char* field) const {
+    return pair_of(field, "expected two bodies or angle coordinates [A, B]", [&](const C& n) { return angle_of(n); });
+  }
+  // `radii: [r1, r2]` or `teeth: [z1, z2]` (whole numbers), exactly one of them.
+  std::pair<double, double> radii_or_teeth() const {
+    const bool radii = present("radii"), teeth = present("teeth");
+    if (radii == teeth) fail("", "give either 'radii: [r1, r2]' or 'teeth: [z1, z2]'");
+    if (radii) return number_pair("radii");
+    return pair_of("teeth", "expected two tooth counts [z1, z2]", [&](const C& n) {
+      return static_cast<double>(n.integer(1, 1000000));
+    });
+  }
 
   // ---- dimension 3
   Point3 point3(const char* field) const { return r_.point3(c_.require(field)); }
@@ -120,6 +149,19 @@ class KindFields {
   kin3::V3 vec3(const char* field) const { return r_.vec3(c_.require(field)); }
   // The two sides of a joint, `between` (the message names the entry's type).
   std::pair<JointSide3, JointSide3> sides3(const char* /*between*/) const { return r_.sides3(c_, type_); }
+  // One side of a spatial joint (the axis of a mixed coordinate).
+  JointSide3 side3(const char* field) const { return r_.side3(c_.require(field)); }
+  // The sides of a named joint that turns about its axis (revolute, cylindrical, screw), declared above.
+  std::pair<JointSide3, JointSide3> turning_joint(const char* field) const {
+    return turning_joint_of(c_.require(field));
+  }
+  using Sides = std::pair<JointSide3, JointSide3>;
+  std::pair<Sides, Sides> turning_joints(const char* field) const {
+    const auto v = c_.require(field);
+    if (!v.is_sequence() || v.size() != 2) v.fail("expected two joints [J1, J2]");
+    if (v.at(0).name() == v.at(1).name()) v.fail("the two shafts must be different joints");
+    return {turning_joint_of(v.at(0)), turning_joint_of(v.at(1))};
+  }
   // A direction of a dot product: head − tail, and its unit (a segment's is a length, a vector's none).
   struct Direction {
     Attachment3 head, tail;
@@ -134,6 +176,28 @@ class KindFields {
   }
 
  private:
+  std::pair<JointSide3, JointSide3> turning_joint_of(const C& n) const {
+    const std::string name = n.name();
+    const auto it = r_.joints3_.find(name);
+    if (it == r_.joints3_.end()) n.fail("unknown joint '" + name + "' (a named spatial joint of 'constraints', above)");
+    const std::string& t = it->second.type;
+    if (t != "revolute" && t != "cylindrical" && t != "screw")
+      n.fail("joint '" + name + "' is a " + t + " joint: a shaft turns in a revolute, cylindrical or screw joint");
+    return {it->second.a, it->second.b};
+  }
+  Slot angle_of(const C& n) const {
+    const std::string s = n.name();
+    if (!r_.spatial_) {
+      if (s == kGround) return Slot::constant(0.0);
+      if (const Index k = r_.entry_at(n, s, r_.bodies_); k >= 0) return r_.bodies_[k].psi;
+    } else if (s == kGround || r_.entry_at(n, s, r_.bodies3_) >= 0) {
+      n.fail("'" + s + "' is a body: in dimension 3 a transmission relates angle coordinates (define the body's "
+             "rotation about its axis with a rotation_angle constraint)");
+    }
+    const Index j = r_.builder_.find_coordinate(s);
+    if (j < 0) n.fail("unknown body or angle coordinate '" + s + "'");
+    return Slot::coordinate(j);
+  }
   // A field that is a list of exactly two entries, each read by `read` (the first, then the second).
   template <class Read>
   auto pair_of(const char* field, const char* arity_message, Read read) const {

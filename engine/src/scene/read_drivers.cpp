@@ -4,8 +4,8 @@
 
 namespace phiq::detail::scene {
 
-// {joint: NAME, measure: angle | distance, law}: the rotation of a revolute or cylindrical joint, the
-// translation of a prismatic or cylindrical one.
+// {joint: NAME, measure: angle | distance, law}: the rotation of a revolute, cylindrical or screw joint, the
+// translation of a prismatic, cylindrical or screw one.
 template <class C>
 void SceneReader::read_joint_driver(const C& c, const std::string& name, MotionLaw law) {
   auto j = c.field("joint");
@@ -22,14 +22,15 @@ void SceneReader::read_joint_driver(const C& c, const std::string& name, MotionL
     measure = "angle";
   } else if (J.type == "prismatic") {
     measure = "distance";
-  } else if (J.type == "cylindrical") {
-    c.fail("a cylindrical joint's driver needs 'measure: angle' or 'measure: distance'");
+  } else if (J.type == "cylindrical" || J.type == "screw") {
+    c.fail("a " + J.type + " joint's driver needs 'measure: angle' or 'measure: distance'");
   }
-  const bool angle_ok = J.type == "revolute" || J.type == "cylindrical";
-  const bool distance_ok = J.type == "prismatic" || J.type == "cylindrical";
+  const bool both = J.type == "cylindrical" || J.type == "screw";
+  const bool angle_ok = J.type == "revolute" || both;
+  const bool distance_ok = J.type == "prismatic" || both;
   if ((measure == "angle" && !angle_ok) || (measure == "distance" && !distance_ok) || measure.empty())
-    j.fail("joint '" + joint + "' is a " + J.type + " joint: drivers measure the angle of a revolute or " +
-           "cylindrical joint, or the distance of a prismatic or cylindrical one");
+    j.fail("joint '" + joint + "' is a " + J.type + " joint: drivers measure the angle of a revolute, " +
+           "cylindrical or screw joint, or the distance of a prismatic, cylindrical or screw one");
   if (measure == "angle") {
     const kin3::V3 ra = detail3::reference_direction(J.a), rb = detail3::reference_direction(J.b);
     joint_angles_.push_back(JointAngleReference{name.empty() ? c.path() : name, joint, {ra.x, ra.y, ra.z},

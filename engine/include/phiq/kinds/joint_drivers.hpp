@@ -1,5 +1,5 @@
 /// @file
-/// Drivers on a spatial joint: its translation (prismatic, cylindrical) or its rotation (revolute, cylindrical). One constraint kind (or one family of
+/// Drivers on a spatial joint: its translation (prismatic, cylindrical, screw) or its rotation (revolute, cylindrical, screw). One constraint kind (or one family of
 /// kinds sharing a row table): equation, derivatives, validation, joint count, sketch and scene form; the contract
 /// is documented on DistanceSpec, and kinds/registry.hpp lists every kind.
 #pragma once
@@ -115,20 +115,15 @@ struct JointAngleDriverSpec {
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double t, double* phi) const {
-    const auto [c, s] = products(q);
-    const double f = law.evaluate(t).f, cf = std::cos(f), sf = std::sin(f);
-    phi[0] = std::atan2(s * cf - c * sf, c * cf + s * sf);
+    phi[0] = angle().minus(att.data(), q, law.evaluate(t).f);
   }
   /// @copydoc DistanceSpec::jacobian
   /// @par Joint angle driver
   /// The entries of ∂c (scaled by −s/ρ) and then of ∂s (scaled by c/ρ), ρ = c² + s²; x_b appears in both and its
-  /// entries add up.
+  /// entries add up (detail3::AngleRows).
   template <class Sink>
   void jacobian(const double* q, double, Sink& sink) const {
-    const auto [c, s] = products(q);
-    const double rho = c * c + s * s;
-    detail3::row_jacobian(att.data(), kCompact.rows[0], q, sink, 0, -s / rho);
-    detail3::row_jacobian(att.data(), kCompact.rows[1], q, sink, 0, c / rho);
+    angle().emit(att.data(), q, sink, 0);
   }
   /// @copydoc DistanceSpec::phi_t
   void phi_t(const double*, double t, double* out) const { out[0] = -law.evaluate(t).df; }
@@ -136,15 +131,7 @@ struct JointAngleDriverSpec {
   /// @par Joint angle driver
   /// θ̈ = (c s̈ − s c̈)/ρ − (c ṡ − s ċ) ρ̇/ρ², ρ̇ = 2 (c ċ + s ṡ); γ keeps the q̈-free parts of c̈, s̈, plus f''(t).
   void gamma(const double* q, const double* qd, double t, double* out) const {
-    const Attachment3* a3 = att.data();
-    const detail3::RowDef& cdef = kCompact.rows[0];
-    const detail3::RowDef& sdef = kCompact.rows[1];
-    const auto [c, s] = products(q);
-    const double cd = detail3::row_rate(a3, cdef, q, qd, 1.0), sd = detail3::row_rate(a3, sdef, q, qd, 1.0);
-    // row_gamma is −(q̈-free part of the second derivative)
-    const double cb = -detail3::row_gamma(a3, cdef, q, qd, 1.0), sb = -detail3::row_gamma(a3, sdef, q, qd, 1.0);
-    const double rho = c * c + s * s, rhod = 2.0 * (c * cd + s * sd);
-    out[0] = -(c * sb - s * cb) / rho + (c * sd - s * cd) * rhod / (rho * rho) + law.evaluate(t).ddf;
+    out[0] = -angle().bias(att.data(), q, qd) + law.evaluate(t).ddf;
   }
 
 
@@ -162,11 +149,8 @@ struct JointAngleDriverSpec {
   static constexpr SceneForm kScene[] = {{"drivers", "joint (measure: angle)", 3, "- {name: crank_motor, "
         "joint: crank_hinge, law: {type: linear, initial: 0, rate: 1}}"}};
  private:
-  // c = x_a · x_b and s = y_a · x_b at q: what Φ, Φq and γ all start from
-  std::array<double, 2> products(const double* q) const {
-    return {detail3::row_value(att.data(), kCompact.rows[0], q, 1.0, 0.0),
-            detail3::row_value(att.data(), kCompact.rows[1], q, 1.0, 0.0)};
-  }
+  // c = x_a · x_b and s = y_a · x_b
+  static detail3::AngleRows angle() { return {kCompact.rows[0], kCompact.rows[1]}; }
 };
 
 }  // namespace phiq

@@ -27,9 +27,14 @@
 #include "phiq/kinds/spatial_distance.hpp"
 #include "phiq/kinds/spatial_joints.hpp"
 #include "phiq/kinds/unit_vector.hpp"
-// higher pairs on curves (issue 27 part B)
+// higher pairs on curves
 #include "phiq/kinds/flat_follower.hpp"
 #include "phiq/kinds/point_on_curve.hpp"
+// transmissions, the screw joint and spatial mixed coordinates
+#include "phiq/kinds/screw.hpp"
+#include "phiq/kinds/spatial_gear.hpp"
+#include "phiq/kinds/spatial_mixed.hpp"
+#include "phiq/kinds/transmissions.hpp"
 
 namespace phiq {
 
@@ -87,10 +92,12 @@ struct KindList {
 using ConstraintKinds =
     KindList<DistanceSpec, PinSpec, PointOnLineSpec, ConstantAngleSpec, SegmentAngleSpec, PolarSpec, PrismaticSpec,
              LoopSpec, EquationSpec, CouplerSpec, CoordinateDriverSpec,
-             PointOnCurveSpec, FlatFollowerSpec,  // higher pairs on curves (issue 27 part B)
+             PointOnCurveSpec, FlatFollowerSpec,  // higher pairs on curves
              EulerParametersSpec, UnitVectorSpec, SpatialDistanceSpec, DotSpec, SphericalSpec, SpatialRevoluteSpec,
              SpatialPrismaticSpec, CylindricalSpec, UniversalSpec, PlanarSpec, RigidSpec, SpatialPointOnLineSpec,
-             PointOnPlaneSpec, JointDistanceDriverSpec, JointAngleDriverSpec>;
+             PointOnPlaneSpec, JointDistanceDriverSpec, JointAngleDriverSpec,
+             // transmissions, the screw joint and spatial mixed coordinates
+             GearSpec, RackPinionSpec, BeltSpec, ScrewSpec, SpatialGearSpec, SpatialPolarSpec, SpatialAngleSpec>;
 
 /// @cond internal
 namespace detail {

@@ -179,6 +179,49 @@ inline double joint_arm(const JointSide3& a, const JointSide3& b) {
   const double la = a.frame.is_fixed() ? 0.0 : kin3::norm(a.at), lb = b.frame.is_fixed() ? 0.0 : kin3::norm(b.at);
   return std::max(la, lb);
 }
+/// The angle θ of a direction about an axis, from its two products c (with the reference direction x) and s (with
+/// y = z × x): θ = atan2(s, c) wherever ρ = c² + s² > 0. What the joint angle driver, the screw joint and the spatial
+/// mixed angles share. dθ = (c ds − s dc)/ρ, and θ̈ = (c s̈ − s c̈)/ρ − (c ṡ − s ċ) ρ̇/ρ², ρ̇ = 2 (c ċ + s ṡ).
+struct AngleRows {
+  RowDef c, s;  ///< the rows of c and s (w = 1)
+
+  /// (c, s) at q.
+  std::array<double, 2> products(const Attachment3* a, const double* q) const {
+    return {row_value(a, c, q, 1.0, 0.0), row_value(a, s, q, 1.0, 0.0)};
+  }
+  /// θ − f wrapped to (−π, π]: the angle of (c, s) turned back by f, atan2(s cos f − c sin f, c cos f + s sin f),
+  /// smooth at any θ (a row through any number of turns, where atan2(s, c) − f would jump by 2π).
+  double minus(const Attachment3* a, const double* q, double f) const {
+    const auto [cv, sv] = products(a, q);
+    const double cf = std::cos(f), sf = std::sin(f);
+    return std::atan2(sv * cf - cv * sf, cv * cf + sv * sf);
+  }
+  /// Emits the entries of k · ∂θ/∂q in `row`: ∂c scaled by −k s/ρ, then ∂s by k c/ρ (a slot in both adds up).
+  template <class Sink>
+  void emit(const Attachment3* a, const double* q, Sink& sink, int row, double k = 1.0) const {
+    const auto [cv, sv] = products(a, q);
+    const double rho = cv * cv + sv * sv;
+    row_jacobian(a, c, q, sink, row, -k * sv / rho);
+    row_jacobian(a, s, q, sink, row, k * cv / rho);
+  }
+  /// The part of θ̈ without q̈ (γ of a row θ − f is f̈'s part minus this).
+  double bias(const Attachment3* a, const double* q, const double* qd) const {
+    const auto [cv, sv] = products(a, q);
+    const double cd = row_rate(a, c, q, qd, 1.0), sd = row_rate(a, s, q, qd, 1.0);
+    // row_gamma is −(the q̈-free part of the second derivative)
+    const double cb = -row_gamma(a, c, q, qd, 1.0), sb = -row_gamma(a, s, q, qd, 1.0);
+    const double rho = cv * cv + sv * sv, rhod = 2.0 * (cv * cd + sv * sd);
+    return (cv * sb - sv * cb) / rho - (cv * sd - sv * cd) * rhod / (rho * rho);
+  }
+};
+/// Draws a joint: the arms of the bodies it joins, and `mark` at its point (on ground when a side is ground).
+template <class Sketch>
+void sketch_joint(const JointSide3& a, const JointSide3& b, JointMark mark, Sketch& sk) {
+  const Attachment3 pa = Attachment3::body_point(a.frame, a.at), pb = Attachment3::body_point(b.frame, b.at);
+  sk.arm3(pa);
+  sk.arm3(pb);
+  sk.joint3(pa, pb, mark);
+}
 /// Reports the slots of a side: its position (lengths), Euler parameters and vector (unitless).
 template <class F>
 void side_slots(const JointSide3& s, F& f) {
@@ -251,12 +294,11 @@ struct SpatialJointSpec {
   /// block for a prismatic pair, a ball for the others), on ground when a side is ground.
   template <class Sketch>
   void sketch(Sketch& sk) const {
-    const Attachment3 pa = Attachment3::body_point(a.frame, a.at), pb = Attachment3::body_point(b.frame, b.at);
-    sk.arm3(pa);
-    sk.arm3(pb);
     const std::string_view kind = Traits::kKind;
-    sk.joint3(pa, pb, kind == "revolute" ? JointMark::kRevolute
-                                         : (kind == "prismatic" ? JointMark::kPrismatic : JointMark::kSpherical));
+    const JointMark mark = kind == "revolute"    ? JointMark::kRevolute
+                           : kind == "prismatic" ? JointMark::kPrismatic
+                                                 : JointMark::kSpherical;
+    detail3::sketch_joint(a, b, mark, sk);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr const auto& kScene = Traits::kScene;

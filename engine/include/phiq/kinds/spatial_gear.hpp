@@ -1,0 +1,138 @@
+/// @file
+/// Gears between two shafts at an angle in space (bevel, crossed helical, worm): the shafts' rotations in their
+/// bearings, tied by the tooth ratio. One constraint kind: its equation, derivatives, validation, joint count,
+/// sketch and scene form; the contract is documented on DistanceSpec, and kinds/registry.hpp lists every kind.
+#pragma once
+
+#include <array>
+#include <cmath>
+
+#include "phiq/kinds/spatial_joints.hpp"
+#include "phiq/kinds/kind_support.hpp"
+
+namespace phiq {
+
+/// Spatial gear pair. Each shaft turns in a joint (revolute, cylindrical or screw) whose side a is the housing —
+/// ground, or a carrier that moves — and side b the shaft; θ_i, an angle coordinate, is the shaft's turn in it (x_b
+/// about z_a from x_a, as `rotation_angle` measures it). The gears roll on each other: in the housing the relative
+/// rotations obey the ratio of the tooth counts z_i (or pitch radii, for bevel gears):
+///   Φ = [θ(J1) − θ1;  θ(J2) − θ2  (each wrapped to (−π, π], kinds/spatial_mixed.hpp);   (2 rows, angles)
+///        θ1 ± (z2/z1) θ2 − φ]                                                            (1 row, an angle)
+/// Why +: for a bevel pair with each joint's axis z_a pointing from the apex (where the axes cross) toward its gear,
+/// a pitch point P on the line of contact between the axes moves on gear 1 by θ̇1 z1 × P = r1 θ̇1 n and on gear 2 by
+/// θ̇2 z2 × P = −r2 θ̇2 n (n = z1 × z2 / |z1 × z2|, r_i the distance of P from axis i), so rolling is
+/// r1 θ̇1 + r2 θ̇2 = 0 at any shaft angle, with r1/r2 = z1/z2. `reversed` takes − (the relation z1 θ1 − z2 θ2 = z1 φ):
+/// an axis given the other way, or a crossed helical pair whose hands turn it the other way (for crossed helical
+/// gears and worms give the tooth counts — a worm's is its number of starts —, not the pitch radii, which do not
+/// make the ratio there). The angles must be coordinates
+/// because a ratio holds between turns, not orientations: 2.5 turns of one gear and half a turn of the other leave
+/// the same orientations. Parallel shafts are refused (their gears are a `gear` between two rotation angles), and
+/// so is one joint for both. Scene type `spatial_gear`: `shafts: [J1, J2]` (named joints above it),
+/// `angles: [θ1, θ2]` (coordinates), `teeth: [z1, z2]` or `radii: [r1, r2]`, `reversed` (false), `phase: φ` (0).
+struct SpatialGearSpec {
+  static constexpr int kRows = 3;  ///< the two shafts' angles and the ratio
+  /// @copydoc DistanceSpec::kKind
+  static constexpr const char* kKind = "spatial_gear";
+  /// @var a1
+  /// @brief Shaft 1's joint: side a1 the housing (its z is the axis), b1 the shaft.
+  JointSide3 a1, b1, a2, b2;  ///< shaft 2's joint, likewise
+  Slot theta1, theta2;        ///< θ1, θ2 (rad): coordinates
+  double z1 = 1.0;            ///< gear 1's tooth count (or pitch radius), > 0
+  double z2 = 1.0;            ///< gear 2's tooth count (or pitch radius), > 0
+  bool reversed = false;      ///< the relation z1 θ1 − z2 θ2 = z1 φ
+  double phase = 0.0;         ///< φ (rad)
+  /// derived by setup(): x_a, y_a, z_a, x_b of each joint
+  std::array<Attachment3, 4> att1{}, att2{};
+
+  /// Validates the joints and derives the attachments. Throws phiq::Error.
+  void setup() {
+    static constexpr std::int8_t kIndex[4] = {detail3::kXa, detail3::kYa, detail3::kZa, detail3::kXb};
+    detail::require(std::isfinite(z1) && std::isfinite(z2) && z1 > 0.0 && z2 > 0.0,
+                    "spatial_gear: the tooth counts (or radii) must be positive");
+    detail::require(std::isfinite(phase), "spatial_gear: phase is not finite");
+    detail::require(theta1.is_coordinate() && theta2.is_coordinate() && theta1.coord() != theta2.coord(),
+                    "spatial_gear: the angles must be two different coordinates");
+    const auto j1 = detail3::joint_attachments(a1, b1, kIndex, 4, kKind);
+    const auto j2 = detail3::joint_attachments(a2, b2, kIndex, 4, kKind);
+    std::copy_n(j1.begin(), 4, att1.begin());
+    std::copy_n(j2.begin(), 4, att2.begin());
+  }
+  /// @copydoc DistanceSpec::depends_on_time
+  bool depends_on_time() const { return false; }
+  /// @copydoc DistanceSpec::row_unit
+  Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kAngle; }
+  /// @copydoc DistanceSpec::characteristic_length
+  double characteristic_length() const { return 0.0; }
+  /// @copydoc DistanceSpec::for_each_slot
+  template <class F>
+  void for_each_slot(F&& f) const {
+    detail3::side_slots(a1, f), detail3::side_slots(b1, f), detail3::side_slots(a2, f), detail3::side_slots(b2, f);
+    f(theta1, Unit::kAngle), f(theta2, Unit::kAngle);
+  }
+  /// @copydoc DistanceSpec::residual
+  void residual(const double* q, double, double* phi) const {
+    phi[0] = kAngle.minus(att1.data(), q, theta1.of(q));
+    phi[1] = kAngle.minus(att2.data(), q, theta2.of(q));
+    phi[2] = theta1.of(q) + ratio() * theta2.of(q) - phase;
+  }
+  /// @copydoc DistanceSpec::jacobian
+  template <class Sink>
+  void jacobian(const double* q, double, Sink& s) const {
+    kAngle.emit(att1.data(), q, s, 0);
+    s(0, theta1, -1.0);
+    kAngle.emit(att2.data(), q, s, 1);
+    s(1, theta2, -1.0);
+    s(2, theta1, 1.0), s(2, theta2, ratio());
+  }
+  /// @copydoc DistanceSpec::phi_t
+  void phi_t(const double*, double, double* out) const { out[0] = out[1] = out[2] = 0.0; }
+  /// @copydoc DistanceSpec::gamma
+  void gamma(const double* q, const double* qd, double, double* out) const {
+    out[0] = -kAngle.bias(att1.data(), q, qd);
+    out[1] = -kAngle.bias(att2.data(), q, qd);
+    out[2] = 0.0;
+  }
+  /// @copydoc DistanceSpec::joint_count
+  /// Two angle coordinates and their rows count for nothing; the mesh removes one freedom.
+  JointCount joint_count() const { return JointCount::joint(3, 1); }
+  /// @copydoc DistanceSpec::prepare
+  /// setup(), then the shafts' axes at the placement: parallel ones are refused.
+  void prepare(const double* q0) {
+    setup();
+    const kin3::V3 u = att1[2].value(q0), v = att2[2].value(q0);
+    detail::require(kin3::norm(kin3::cross(u, v)) > 1e-6 * kin3::norm(u) * kin3::norm(v),
+                    "spatial_gear: the shafts are parallel at the placement (parallel shafts mesh by a 'gear' "
+                    "between their rotation angles)");
+  }
+  /// @copydoc DistanceSpec::sketch
+  /// A spatial gear draws nothing: its shafts are drawn by their joints.
+  template <class Sketch>
+  void sketch(Sketch&) const {}
+  /// @copydoc DistanceSpec::kScene
+  static constexpr SceneForm kScene[] = {
+      {"constraints", "spatial_gear", 3, "- {name: bevel, type: spatial_gear, shafts: [input_bearing, "
+                                         "output_bearing], angles: [theta1, theta2], teeth: [15, 30]}"}};
+  /// @copydoc DistanceSpec::read
+  template <class Fields>
+  static SpatialGearSpec read(const Fields& f) {
+    f.expect({"type", "name", "shafts", "angles", "teeth", "radii", "reversed", "phase"});
+    SpatialGearSpec g;
+    const auto [j1, j2] = f.turning_joints("shafts");
+    std::tie(g.a1, g.b1) = j1;
+    std::tie(g.a2, g.b2) = j2;
+    const auto [i, j] = f.coordinate_pair("angles");
+    g.theta1 = Slot::coordinate(i), g.theta2 = Slot::coordinate(j);
+    std::tie(g.z1, g.z2) = f.radii_or_teeth();
+    if (f.present("reversed")) g.reversed = f.boolean("reversed");
+    if (f.present("phase")) g.phase = f.number("phase");
+    return g;
+  }
+
+ private:
+  // c = x_b · x_a, s = x_b · y_a in each shaft's attachments (x_a, y_a, z_a, x_b)
+  static constexpr detail3::AngleRows kAngle{{detail3::T(3), detail3::T(0), Unit::kNone},
+                                             {detail3::T(3), detail3::T(1), Unit::kNone}};
+  double ratio() const { return (reversed ? -z2 : z2) / z1; }
+};
+
+}  // namespace phiq
