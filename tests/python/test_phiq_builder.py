@@ -67,7 +67,7 @@ def test_a_bad_entry_names_the_python_line():
 
 def test_unknown_type_lists_the_registry():
     b = crank_slider_builder()
-    b.constraint("g", type="gear", bodies=["A", "B"])
+    b.constraint("g", type="sprocket", bodies=["A", "B"])
     with pytest.raises(phiq.SceneError, match="gear"):
         b.build()
 

@@ -33,16 +33,18 @@ struct SpatialGearSpec {
   static constexpr int kRows = 3;  ///< the two shafts' angles and the ratio
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "spatial_gear";
-  /// @var a1
-  /// @brief Shaft 1's joint: side a1 the housing (its z is the axis), b1 the shaft.
-  JointSide3 a1, b1, a2, b2;  ///< shaft 2's joint, likewise
-  Slot theta1, theta2;        ///< θ1, θ2 (rad): coordinates
+  JointSide3 a1;              ///< shaft 1's joint, side a: the housing (its z is the axis)
+  JointSide3 b1;              ///< shaft 1's joint, side b: the shaft
+  JointSide3 a2;              ///< shaft 2's joint, side a
+  JointSide3 b2;              ///< shaft 2's joint, side b
+  Slot theta1;                ///< θ1 (rad): a coordinate
+  Slot theta2;                ///< θ2 (rad): a coordinate
   double z1 = 1.0;            ///< gear 1's tooth count (or pitch radius), > 0
   double z2 = 1.0;            ///< gear 2's tooth count (or pitch radius), > 0
   bool reversed = false;      ///< the relation z1 θ1 − z2 θ2 = z1 φ
   double phase = 0.0;         ///< φ (rad)
-  /// derived by setup(): x_a, y_a, z_a, x_b of each joint
-  std::array<Attachment3, 4> att1{}, att2{};
+  std::array<Attachment3, 4> att1{};  ///< derived by setup(): x_a, y_a, z_a, x_b of shaft 1's joint
+  std::array<Attachment3, 4> att2{};  ///< the same of shaft 2's joint
 
   /// Validates the joints and derives the attachments. Throws phiq::Error.
   void setup() {

@@ -150,7 +150,8 @@ struct SpatialAngleSpec {
   JointSide3 a;               ///< the axis z_a and the reference x_a (a body or ground)
   JointSide3 b;               ///< `rotation_angle`: the turning body (its reference direction x_b is D)
   bool segment = false;       ///< D = B − A (natural points) instead of x_b
-  Point3 from, to;            ///< A and B, for a segment
+  Point3 from;                ///< A, for a segment
+  Point3 to;                  ///< B, for a segment
   Slot theta;                 ///< θ (rad), a coordinate
   std::array<Attachment3, 4> att{};  ///< derived by setup(): x_a, y_a, then D's head and tail
 

@@ -46,23 +46,23 @@ inline void require_positive_pair(double r1, double r2, const char* message) {
 /// draw (the bodies are drawn by their joints).
 template <class Derived>
 struct LinearTransmission {
-  /// @copydoc DistanceSpec::depends_on_time
+  /// @copydoc phiq::DistanceSpec::depends_on_time
   bool depends_on_time() const { return false; }
-  /// @copydoc DistanceSpec::residual
+  /// @copydoc phiq::DistanceSpec::residual
   void residual(const double* q, double, double* phi) const { phi[0] = self().row().value(q); }
-  /// @copydoc DistanceSpec::jacobian
+  /// @copydoc phiq::DistanceSpec::jacobian
   template <class Sink>
   void jacobian(const double*, double, Sink& s) const {
     self().row().emit(s);
   }
-  /// @copydoc DistanceSpec::phi_t
+  /// @copydoc phiq::DistanceSpec::phi_t
   void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
-  /// @copydoc DistanceSpec::gamma
+  /// @copydoc phiq::DistanceSpec::gamma
   void gamma(const double*, const double*, double, double* out) const { out[0] = 0.0; }
-  /// @copydoc DistanceSpec::joint_count
+  /// @copydoc phiq::DistanceSpec::joint_count
   /// A transmission between two bodies is a higher pair: one freedom.
   JointCount joint_count() const { return JointCount::joint(self().dimension == 3 ? 3 : 2, 1); }
-  /// @copydoc DistanceSpec::sketch
+  /// @copydoc phiq::DistanceSpec::sketch
   template <class Sketch>
   void sketch(Sketch&) const {}
 
