@@ -188,3 +188,26 @@ def test_objects_keep_what_they_need_alive():
     gc.collect()
     assert phiq.solve_position(ws.model, 0.2, ws).ok  # the workspace keeps its model and scene
     assert q.shape == (181, 4) and q[0, 0] == 0.0    # the view keeps its table
+
+
+def test_sensitivities_reach_python_as_the_clis_columns(tmp_path):
+    # output.sensitivities: the same columns and bits as the CLI's, and ∂x_B/∂L2, ∂x_B/∂L3 of the notes'
+    # crank-slider against x_B = L2 cos θ + √(L3² − L2² sin² θ), θ = 2t.
+    with open(os.path.join(MODELS, "seed/crank_slider_mixed.yaml")) as f:
+        text = f.read()
+    plain = "output: {velocities: true, accelerations: true}"
+    assert plain in text
+    path = tmp_path / "sensitivities.yaml"
+    path.write_text(text.replace(plain, "output: {velocities: true, accelerations: true, sensitivities: [L2, L3]}"))
+    header, table = cli_csv(str(path), tmp_path)
+    result = phiq.run_sweep(phiq.load_scene(str(path)))
+    assert result.ok, result.message
+    assert result.columns == header
+    assert np.array_equal(result.table, table)
+    theta = 2 * table[:, 0]
+    l2, l3 = 0.3, 1.0
+    w = np.sqrt(l3**2 - (l2 * np.sin(theta)) ** 2)
+    assert np.max(np.abs(table[:, header.index("xB.d_L2")] - (np.cos(theta) - l2 * np.sin(theta) ** 2 / w))) < 1e-9
+    assert np.max(np.abs(table[:, header.index("xB.d_L3")] - l3 / w)) < 1e-9
+    assert header[-1] == "xB.a.d_L3"
+    assert result.summary["counters"]["sensitivity_solves"] == 181 * 2 * 3

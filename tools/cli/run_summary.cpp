@@ -57,6 +57,7 @@ std::string run_summary_json(const Scene& scene, const Model& swept, const Sweep
   j["gamma_evaluations"] = s.counters.gamma_evaluations;
   j["residual_evaluations"] = s.counters.residual_evaluations;
   j["point_evaluations"] = s.counters.point_evaluations;
+  j["sensitivity_solves"] = s.counters.sensitivity_solves;
   j["subdivisions"] = s.subdivisions;
   j["singular_positions"] = s.singular_positions;
   // 0 in the summary means no row measured it (a positions-only sweep factorises at Newton iterates, not at the

@@ -13,6 +13,7 @@
 #include "phiq/motion_law.hpp"
 #include "phiq/output_joints.hpp"
 #include "phiq/output_points.hpp"
+#include "phiq/sensitivity.hpp"
 #include "phiq/types.hpp"
 
 namespace phiq {
@@ -41,6 +42,10 @@ struct OutputPlan {
   /// q̇ and q̈ are solved; evaluated at written rows only.
   std::vector<OutputOrientation> orientations;
   OrientationForm orientation_form;  ///< how `orientations` are written
+  /// Design parameters whose sensitivities ∂q/∂p (and ∂q̇/∂p, ∂q̈/∂p with velocities, accelerations) are delivered
+  /// at every written row (StepView::sensitivities), solved with the row's own factorisation of Φq
+  /// (sensitivity.hpp); written for the coordinate columns, as `x.d_P`, `x.v.d_P`, `x.a.d_P`.
+  std::vector<OutputSensitivity> sensitivities;
   /// Deliver Φ(q, t) at every row (StepView::phi). Free: Newton's convergence test has just evaluated it.
   bool residuals = false;
   /// Deliver the reciprocal condition estimate of the last factorisation of Φq (StepView::rcond). Free with KLU

@@ -76,6 +76,10 @@ struct SceneOverrides {
   /// If set, the model shares this model's pattern and symbolic analysis when its structure is the same
   /// (ModelBuilder::share_analysis_with()); it must outlive the call.
   const Model* share_analysis_with = nullptr;
+  /// Build the models along each parameter of `output.sensitivities` (OutputSensitivity::models: the scene again
+  /// with the parameter moved by −2h, −h, h, 2h). False lists the sensitivities without models: the scenes built
+  /// along a parameter are read so, and so is a scene only checked, not swept.
+  bool sensitivity_models = true;
 };
 
 /// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,

@@ -135,6 +135,9 @@ struct StepView {
   const JointMotion* joints = nullptr;
   /// Orientations of OutputPlan::orientations, in that order (null when none).
   const OrientationMotion* orientations = nullptr;
+  /// Sensitivities to OutputPlan::sensitivities laid out as SensitivityLayout says (null when none are listed):
+  /// ∂q/∂p always, ∂q̇/∂p and ∂q̈/∂p when velocities / accelerations are delivered; NaN at a singular position.
+  const double* sensitivities = nullptr;
 };
 
 /// Something the caller should know about a delivered row (the row itself is within tolerance).

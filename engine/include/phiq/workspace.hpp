@@ -26,6 +26,9 @@ struct WorkCounters {
   Index phi_t_evaluations = 0;     ///< evaluations of Φt (velocity right-hand sides)
   Index gamma_evaluations = 0;     ///< evaluations of γ (acceleration right-hand sides)
   Index point_evaluations = 0;     ///< output point motions evaluated (one per point and delivered row)
+  /// Solves for sensitivities to design parameters (sensitivity.hpp): one per parameter, derivative order and
+  /// delivered row, each with the row's factorisation
+  Index sensitivity_solves = 0;
 };
 
 /// Per-thread data of the algorithms in kinematics.hpp and sweep.hpp. Not thread-safe: one thread at a time.

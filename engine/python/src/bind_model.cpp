@@ -170,7 +170,9 @@ void bind_model(py::module_& m) {
       .def_readonly("acceleration_solves", &WorkCounters::acceleration_solves, "solves of Φq q̈ = γ")
       .def_readonly("phi_t_evaluations", &WorkCounters::phi_t_evaluations, "evaluations of Φt")
       .def_readonly("gamma_evaluations", &WorkCounters::gamma_evaluations, "evaluations of γ")
-      .def_readonly("point_evaluations", &WorkCounters::point_evaluations, "output point motions evaluated");
+      .def_readonly("point_evaluations", &WorkCounters::point_evaluations, "output point motions evaluated")
+      .def_readonly("sensitivity_solves", &WorkCounters::sensitivity_solves,
+                    "solves for sensitivities to design parameters");
 
   py::class_<Workspace> ws(m, "Workspace",
                            "One thread's state for the solves: q, qd, qdd (numpy views, writable in place), the "

@@ -117,6 +117,12 @@ std::vector<std::string> CsvFormat::dotted_names() const {
   for (Index c : plan_->residual_columns) h.push_back(model_.constraints()[c].name + ".residual");
   if (plan_->max_residual_column) h.push_back("residual");
   if (plan_->condition) h.push_back("rcond");
+  for (const OutputSensitivity& p : plan_->sensitivities) {
+    const std::string d = ".d_" + p.name;
+    for (Index j : columns_) h.push_back(names[j] + d);
+    for (Index j : v_columns_) h.push_back(names[j] + ".v" + d);
+    for (Index j : a_columns_) h.push_back(names[j] + ".a" + d);
+  }
   return h;
 }
 
@@ -199,6 +205,16 @@ void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
     if (plan_->max_residual_column) emit(scaled_residual(model_, *phi));
   }
   if (plan_->condition) emit(s.rcond);
+  if (!plan_->sensitivities.empty()) {
+    if (!s.sensitivities) throw Error("CsvFormat: step has no sensitivities");
+    const SensitivityLayout layout{model_.num_coordinates()};
+    for (std::size_t i = 0; i < plan_->sensitivities.size(); ++i) {
+      const double* base = s.sensitivities;
+      for (Index j : columns_) emit(base[layout.offset(i, 0) + j]);
+      for (Index j : v_columns_) emit(base[layout.offset(i, 1) + j]);
+      for (Index j : a_columns_) emit(base[layout.offset(i, 2) + j]);
+    }
+  }
 }
 
 void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
@@ -219,6 +235,7 @@ std::size_t CsvFormat::num_output_values() const {
   n += plan_->joints.size() * per;
   n += plan_->orientations.size() *
        (static_cast<std::size_t>(plan_->orientation_form.size()) + 3 * (velocities_ + accelerations_));
+  n += plan_->sensitivities.size() * (columns_.size() + v_columns_.size() + a_columns_.size());
   return n;
 }
 

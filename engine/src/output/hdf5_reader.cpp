@@ -89,7 +89,8 @@ CsvTable read_hdf5_table(const std::string& path) {
   CsvTable table;
   table.path = path;
   std::vector<Block> blocks;
-  for (const char* name : {"t", "q", "qd", "qdd", "points", "joints", "orientations", "drivers", "residuals", "rcond"}) {
+  for (const char* name : {"t", "q", "qd", "qdd", "points", "joints", "orientations", "drivers", "residuals", "rcond",
+                           "sensitivities"}) {
     const htri_t exists = H5Lexists(file.get(), name, H5P_DEFAULT);
     if (exists < 0) throw Error(path + ": " + detail::h5::last_error());
     if (exists == 0) {

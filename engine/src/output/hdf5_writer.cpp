@@ -90,7 +90,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     groups.push_back(std::move(g));
     return &groups.back();
   };
-  groups.reserve(10);  // pointers into it are kept
+  groups.reserve(11);  // pointers into it are kept
   // (the q̇ and q̈ columns may be other coordinates than q's: OutputPlan::velocity_columns)
   auto coordinate_unit = [&](const std::vector<Index>& cols, const char* per_time) {
     return [&, per_time](std::size_t k) { return unit_of(model.coordinate_unit(cols[k]), per_time); };
@@ -138,6 +138,16 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     outputs.push_back(take("rcond", 1, none));
     outputs.back()->one_dimensional = true;
   }
+  // The sensitivities' unit: the coordinate's per the parameter's, which the scene does not state ("/P").
+  std::vector<std::string> sensitivity_units;
+  for (const OutputSensitivity& p : plan.sensitivities) {
+    const std::string per = "/" + p.name;
+    for (Index j : q_cols) sensitivity_units.push_back(unit_of(model.coordinate_unit(j), "") + per);
+    for (Index j : qd_cols) sensitivity_units.push_back(unit_of(model.coordinate_unit(j), "/s") + per);
+    for (Index j : qdd_cols) sensitivity_units.push_back(unit_of(model.coordinate_unit(j), "/s^2") + per);
+  }
+  if (Group* g = take("sensitivities", sensitivity_units.size(), [&](std::size_t k) { return sensitivity_units[k]; }))
+    outputs.push_back(g);
   if (at != names.size()) throw Error(cannot("the columns do not match the CSV's (phiq bug)"));
   output_row.resize(format.num_output_values());
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "phiq/scene.hpp"
+#include "phiq/text.hpp"
 #include "scene/read_scene_file.hpp"
 #include "scene/scene_reader.hpp"
 
@@ -96,6 +97,37 @@ void refuse_non_utf8_encoding(const std::string& text, const std::string& path) 
                    ": the scene is not text (a NUL byte)");
 }
 
+// The models along each parameter of the scene's `output.sensitivities` (OutputSensitivity::models): the same text
+// read with the parameter moved (and the caller's other overrides), sharing the scene model's symbolic analysis.
+// A parameter that changes the model's structure, or makes the scene unreadable, is refused naming it.
+void build_sensitivity_models(Scene& scene, const std::string& text, const std::string& path,
+                              const SceneLimits& limits, const SceneOverrides& overrides) {
+  if (!overrides.sensitivity_models) return;
+  for (OutputSensitivity& s : scene.sweep.sensitivities) {
+    const double shifts[4] = {-2.0, -1.0, 1.0, 2.0};
+    for (std::size_t k = 0; k < 4; ++k) {
+      SceneOverrides moved = overrides;
+      moved.sensitivity_models = false;
+      moved.share_analysis_with = scene.model.get();
+      moved.parameters_source.clear();
+      const double value = s.value + shifts[k] * s.step;
+      bool replaced = false;
+      for (auto& [name, v] : moved.parameters)
+        if (name == s.name) v = value, replaced = true;
+      if (!replaced) moved.parameters.emplace_back(s.name, value);
+      try {
+        s.models[k] = std::shared_ptr<const Model>(std::move(parse_scene(text, path, limits, moved).model));
+      } catch (const SceneError& e) {
+        throw SceneError(path + ": output.sensitivities: with " + s.name + " = " + shortest(value) +
+                         " (the difference step " + shortest(s.step) + " from " + shortest(s.value) +
+                         ") the scene cannot be read: " + e.what());
+      }
+    }
+    if (const std::string why = check_sensitivity_models(*scene.model, s); !why.empty())
+      throw SceneError(path + ": output.sensitivities: " + why);
+  }
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits) {
@@ -135,6 +167,7 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
       throw SceneError(path + ": solver.predictor: '" + to_string(p) +
                        "' needs the derivatives it extrapolates with in the output (velocities / accelerations)");
   }
+  build_sensitivity_models(scene, text, path, limits, overrides);
   return scene;
 }
 

@@ -1,6 +1,7 @@
 // The sections that set how the scene is swept and what it writes (scene_reader.hpp): time, output (and the output
 // points and residuals it names), solver. They are never in families: they read plain Cursors only.
 #include <fnmatch.h>
+#include <algorithm>
 
 #include <cmath>
 #include <set>
@@ -57,7 +58,7 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
   bool coordinates_listed = false;
   if (c.present()) {
     c.expect_map({"velocities", "accelerations", "coordinates", "points", "joints", "orientations", "drivers",
-                  "residuals", "max_residual", "rcond", "every", "window"});
+                  "residuals", "max_residual", "rcond", "every", "window", "sensitivities"});
     // true / false, or the coordinates whose derivative is written (q̇ or q̈ is solved whole either way)
     auto derivative = [&](const char* key, bool& asked, std::optional<std::vector<Index>>& columns) {
       const Cursor d = c.field(key);
@@ -111,6 +112,7 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
         residual_names_.push_back(n);
       }
     }
+    if (auto ss = c.field("sensitivities"); ss.present()) output_sensitivities(ss, plan);
     if (auto v = c.field("max_residual"); v.present()) plan.max_residual_column = v.boolean();
     if (auto v = c.field("rcond"); v.present()) plan.condition = v.boolean();
     plan.residuals = plan.max_residual_column || !residual_names_.empty();
@@ -254,6 +256,39 @@ void SceneReader::read_solver(const Cursor& c, SolverSettings& o) {
     else v.fail("linear_solver is umfpack, klu or dense");
   }
   predictor_field_ = c.field("predictor").present();
+}
+
+}  // namespace phiq::detail::scene
+
+namespace phiq::detail::scene {
+
+// `output.sensitivities`: parameters by name, or {parameter: NAME, step: H}. Their models along the parameter are
+// built once the scene is read (parse_scene), from the same text with the parameter moved.
+void SceneReader::output_sensitivities(const Cursor& c, OutputPlan& plan) {
+  std::set<std::string> seen;
+  for (const Cursor& i : c.items()) {
+    // (a Cursor is never assigned: assigning a YAML::Node rewrites the node it refers to)
+    if (i.is_map()) i.expect_map({"parameter", "step"});
+    const Cursor name = i.is_map() ? i.require("parameter") : i;
+    const Cursor step = i.is_map() ? i.field("step") : Cursor(YAML::Node(), i.join("step"), i.file(), i.mark());
+    OutputSensitivity s;
+    s.name = name.name();
+    const auto it = parameters_.find(s.name);
+    if (it == parameters_.end()) {
+      std::vector<std::string> names;
+      for (const auto& [n, v] : parameters_) names.push_back(n);
+      std::sort(names.begin(), names.end());
+      std::string list;
+      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+      name.fail("'" + s.name + "' is not a parameter of the scene" +
+                (list.empty() ? " (it has none)" : " (its parameters: " + list + ")"));
+    }
+    if (!seen.insert(s.name).second) name.fail("parameter '" + s.name + "' listed twice");
+    s.value = it->second;
+    s.step = step.present() ? number(step) : default_sensitivity_step(s.value);
+    if (!(s.step > 0.0)) step.fail("the difference step must be positive");
+    plan.sensitivities.push_back(std::move(s));
+  }
 }
 
 }  // namespace phiq::detail::scene

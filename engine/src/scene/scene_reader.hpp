@@ -183,6 +183,7 @@ class SceneReader {
   // ---- time, output, solver (read_settings.cpp) ---------------------------------------------------------------
   void read_time(const Cursor& c, TimeGrid& o) const;
   void read_output(const Cursor& c, OutputPlan& plan);
+  void output_sensitivities(const Cursor& c, OutputPlan& plan);
   std::vector<Index> coordinate_selection(const Cursor& list) const;
   OutputPoint output_point(const Cursor& c) const;
   void output_joints(const Cursor& js, OutputPlan& plan) const;

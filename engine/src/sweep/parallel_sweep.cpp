@@ -48,9 +48,11 @@ struct Row {
   std::vector<PointMotion> points;
   std::vector<JointMotion> joints;              // every row's (the delivery unwraps the angles row by row)
   std::vector<OrientationMotion> orientations;  // with the vectors
+  std::vector<double> sensitivities;            // with the vectors (SensitivityLayout)
   RowMotions motions() const {
     return {points.empty() ? nullptr : points.data(), joints.empty() ? nullptr : joints.data(),
-            orientations.empty() ? nullptr : orientations.data()};
+            orientations.empty() ? nullptr : orientations.data(),
+            sensitivities.empty() ? nullptr : sensitivities.data()};
   }
 };
 
@@ -75,13 +77,16 @@ HeldRows held_rows(const Model& model, const SweepOptions& opt, bool caller_read
   const Index n = model.num_coordinates();
   // Rows keep q̇ whenever it is solved (q̈ needs it, and so does an ordered continuation's predictor).
   const bool need_v = opt.velocities || opt.accelerations, need_a = opt.accelerations;
-  // a row's layout in the chunk buffers: q, q̇, q̈ as solved, then Φ, rcond and the point motions as asked
+  // a row's layout in the chunk buffers: q, q̇, q̈ as solved, then Φ, rcond, the point motions and the
+  // sensitivities as asked
   const Index m = model.num_equations();
   const Index n_phi = opt.residuals ? m : 0, n_rcond = opt.condition ? 1 : 0;
   const Index n_points = static_cast<Index>(opt.points.size());
   constexpr Index kMotionDoubles = static_cast<Index>(sizeof(PointMotion) / sizeof(double));
   static_assert(sizeof(PointMotion) == 9 * sizeof(double), "PointMotion is stored as 9 doubles in chunk rows");
-  const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles + 1;
+  const Index n_sensitivities = SensitivityLayout{n}.size(opt.sensitivities.size());
+  const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles +
+                      n_sensitivities + 1;
   return {caller_reads_rows, 8.0 * static_cast<double>(std::max<Index>(width, 1))};
 }
 
@@ -253,6 +258,9 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
         r.rcond = s.rcond();
         if (n_points) r.points.assign(s.point_motions(), s.point_motions() + n_points);
         if (rm.orientations) r.orientations.assign(rm.orientations, rm.orientations + opt.orientations.size());
+        if (rm.sensitivities)
+          r.sensitivities.assign(rm.sensitivities,
+                                 rm.sensitivities + SensitivityLayout{model.num_coordinates()}.size(opt.sensitivities.size()));
       }
       return true;
     };

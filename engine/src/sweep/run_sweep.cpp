@@ -47,6 +47,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     for (const Slot& e : o.e)
       if (e.is_coordinate() && e.coord() >= model.num_coordinates())
         throw Error("SweepOptions: output orientation '" + o.name + "' reads a coordinate the model does not have");
+  for (const OutputSensitivity& p : opt.sensitivities)
+    if (const std::string why = check_sensitivity_models(model, p); !why.empty()) throw Error("SweepOptions: " + why);
   if (opt.orientation_form.form != "matrix" && opt.orientation_form.form != "axis_angle" &&
       !is_euler_sequence(opt.orientation_form.form))
     throw Error("SweepOptions: orientation_form '" + opt.orientation_form.form + "' is not matrix, axis_angle or an "

@@ -45,7 +45,8 @@ struct Run {
                   opt.residuals ? &phi : nullptr,
                   opt.condition ? rcond : 0.0,
                   joints.empty() ? nullptr : joints.data(),
-                  motions.orientations};
+                  motions.orientations,
+                  motions.sensitivities};
     if (on_step && !on_step(view)) {
       sum.status = SolveStatus::kCancelled;
       sum.message = "stopped by the caller after step " + std::to_string(k);
@@ -134,6 +135,7 @@ inline void add_counters(WorkCounters& into, const WorkCounters& now, const Work
   into.phi_t_evaluations += now.phi_t_evaluations - before.phi_t_evaluations;
   into.gamma_evaluations += now.gamma_evaluations - before.gamma_evaluations;
   into.point_evaluations += now.point_evaluations - before.point_evaluations;
+  into.sensitivity_solves += now.sensitivity_solves - before.sensitivity_solves;
 }
 
 }  // namespace phiq::detail

@@ -226,3 +226,41 @@ void Sweeper::restore() {
 }
 
 }  // namespace phiq::detail
+
+namespace phiq::detail {
+
+void Sweeper::row_sensitivities() {
+  std::fill(sensitivities_.begin(), sensitivities_.end(), std::numeric_limits<double>::quiet_NaN());
+  // At a singular position Φq has no inverse: the sensitivities are not defined (NaN; the row's bifurcation
+  // warning says where).
+  if (singular_row_) return;
+  const double t = current_.t;
+  Workspace* w = ws_;
+  // With velocities the row's velocity solve has just used the workspace's factors (of Φq at this row's solution,
+  // or at Newton's last iterate within the tolerance of it): the sensitivities are solved with the same ones.
+  if (!(ws_->lu && derivative_factors_.ws == ws_ && derivative_factors_.t == t &&
+        derivative_factors_.factorizations == ws_->counters.factorizations)) {
+    if (!sensitivity_ws_) sensitivity_ws_ = std::make_shared<Workspace>(model_);
+    w = sensitivity_ws_.get();
+    if (!w->lu) return;
+    w->q = current_.q;
+    const WorkCounters before = w->counters;
+    double rc = 0.0;
+    std::string why;
+    const SolveStatus st = ensure_factorized(model_, t, *w, &rc, &why);
+    ws_->counters.jacobian_evaluations += w->counters.jacobian_evaluations - before.jacobian_evaluations;
+    ws_->counters.factorizations += w->counters.factorizations - before.factorizations;
+    if (st != SolveStatus::kSuccess) return;
+  }
+  if (!(w->lu->rcond() >= kSingularRcond)) return;
+  const int order = need_a_ ? 2 : need_v_ ? 1 : 0;
+  const Index solves_before = w->counters.sensitivity_solves;
+  const bool ok = sensitivities_with_factors(model_, opt_.sensitivities, t, current_.q.data(),
+                                             order >= 1 ? current_.qd.data() : nullptr,
+                                             order >= 2 ? current_.qdd.data() : nullptr, order, *w->lu, *w,
+                                             sensitivity_scratch_, sensitivities_.data());
+  if (w != ws_) ws_->counters.sensitivity_solves += w->counters.sensitivity_solves - solves_before;
+  if (!ok) std::fill(sensitivities_.begin(), sensitivities_.end(), std::numeric_limits<double>::quiet_NaN());
+}
+
+}  // namespace phiq::detail

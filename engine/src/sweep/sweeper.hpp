@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -19,6 +20,7 @@
 #include "phiq/sweep.hpp"
 #include "solve/assembly_internal.hpp"
 #include "solve/kinematics_internal.hpp"
+#include "solve/sensitivity_internal.hpp"
 #include "solve/tolerance_tests.hpp"
 
 namespace phiq::detail {
@@ -30,11 +32,12 @@ struct State {
 };
 
 // The motions of a row's outputs beyond q, q̇, q̈ (each null when none are asked for): the points', the joints'
-// (angles wrapped; the delivery unwraps them) and the orientations'.
+// (angles wrapped; the delivery unwraps them), the orientations' and the sensitivities (SensitivityLayout).
 struct RowMotions {
   const PointMotion* points = nullptr;
   const JointMotion* joints = nullptr;
   const OrientationMotion* orientations = nullptr;
+  const double* sensitivities = nullptr;
 };
 
 // The class of a delivered row in SweepAccuracy, and its estimated error (units of the tolerance test; infinite
@@ -112,6 +115,7 @@ class Sweeper {
       return singular_point(t, ls.rcond);
     if (st != SolveStatus::kSuccess) return fail(st, ls.message);
     note_condition(t, ls.rcond);
+    derivative_factors_ = {ws_, ws_->counters.factorizations, t};
     return true;
   }
 
@@ -133,6 +137,7 @@ class Sweeper {
         orientations_[i] = evaluate_orientation(opt_.orientations[i], opt_.orientation_form, current_.q.data(), qd, qdd);
       ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
       rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
+      if (!opt_.sensitivities.empty()) row_sensitivities();
     }
     det_sign_ = current_row_sign_;
     det_sign_t_ = current_row_sign_t_;
@@ -178,7 +183,8 @@ class Sweeper {
   // The motions row_outputs() evaluated, for the delivery.
   RowMotions motions() const {
     return {point_motions(), joints_.empty() ? nullptr : joints_.data(),
-            orientations_.empty() ? nullptr : orientations_.data()};
+            orientations_.empty() ? nullptr : orientations_.data(),
+            sensitivities_.empty() ? nullptr : sensitivities_.data()};
   }
   double rcond() const { return rcond_; }
 
@@ -323,6 +329,10 @@ class Sweeper {
   // ws = the current state again, after a failed attempt (sweeper.cpp).
   void restore();
 
+  // The sensitivities of the current state to the plan's parameters (sensitivities_), solved with the factors of
+  // Φq at its position: the workspace's when the row's velocity solve used them, else a factorisation of its own
+  // (positions only), which leaves the workspace's, and so the next steps' bits, as they are (sweeper.cpp).
+  void row_sensitivities();
   // Singular positions (singular_positions.cpp): the branch's own derivatives at one, and why Φq stays singular
   // around one or no position lies beyond it (a dead point).
   std::string singular_throughout(const Eigen::VectorXd& qs, double t);
@@ -358,6 +368,20 @@ class Sweeper {
   std::vector<JointMotion> joints_ = std::vector<JointMotion>(opt_.joints.size());
   std::vector<OrientationMotion> orientations_ = std::vector<OrientationMotion>(opt_.orientations.size());
   double rcond_ = 0.0;
+  std::vector<double> sensitivities_ =
+      std::vector<double>(static_cast<std::size_t>(SensitivityLayout{model_.num_coordinates()}.size(opt_.sensitivities.size())));
+  SensitivityScratch sensitivity_scratch_;
+  // Factors at the row where the workspace's are elsewhere; shared by a copy (a Stepper's way back), which never
+  // solves at the same time.
+  std::shared_ptr<Workspace> sensitivity_ws_;
+  // The factors the last derivatives() solved with: its workspace, that workspace's factorisation count then, and
+  // the row's time. row_sensitivities() solves with them while they are still the workspace's (no factorisation
+  // since) and of the same row.
+  struct {
+    const Workspace* ws = nullptr;
+    Index factorizations = -1;
+    double t = NAN;
+  } derivative_factors_;
   double last_rcond_ = 0.0;         // PositionSummary::rcond of the last converged position (near_singular())
   Eigen::VectorXd predicted_;       // the last prediction (for jumped())
   bool bracketing_ = false;         // inside singular_point(): no nested bracketing

@@ -1,0 +1,68 @@
+// What sensitivities to design parameters cost: nfourbar (natural coordinates, the scene phiq generate writes) with
+// its cranks' and couplers' lengths as parameters, swept a quarter turn in 100 steps with q, q̇, q̈ on one thread,
+// with 0, 1 and 2 parameters' ∂q/∂p, ∂q̇/∂p and ∂q̈/∂p. Counters: seconds per row, and per_parameter: the extra
+// time of each parameter as a fraction of the sweep without sensitivities. Part of phiq_bench (BENCHMARK_MAIN is in
+// bench_kinematics.cpp).
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <string>
+
+#include "phiq/phiq.hpp"
+
+namespace {
+
+using namespace phiq;
+
+// `phiq generate nfourbar N` with the lengths as parameters R (cranks) and L (couplers).
+std::string nfourbar_scene(Index n, int parameters) {
+  const char* list = parameters == 0 ? "[]" : parameters == 1 ? "[L]" : "[L, R]";
+  return "phiq: 1\nparameters: {N: " + std::to_string(n) +
+         ", c: 0.7071067811865476, s: 0.7071067811865475, R: 1, L: 1}\n"
+         "coordinates:\n  for i in 0..N:\n    x{i}: i + c\n    y{i}: s\n  theta: 0.7853981633974483\n"
+         "points:\n  O: [0, 0]\n  for i in 0..N:\n    P{i}: [\"x{i}\", \"y{i}\"]\n"
+         "constraints:\n  - for i in 0..N:\n      - {name: \"crank{i}\", type: distance, points: [[i, 0], \"P{i}\"], "
+         "length: R}\n  - for i in 0..N-1:\n      - {name: \"coupler{i}\", type: distance, points: [\"P{i}\", "
+         "\"P{i+1}\"], length: L}\n  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}\n"
+         "drivers:\n  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: "
+         "1.5707963267948966}}\ntime: {start: 0, end: 1, steps: 100}\n"
+         "output: {velocities: true, accelerations: true, sensitivities: " +
+         std::string(list) + "}\n";
+}
+
+double sweep_seconds(const Scene& s, SweepOptions o) {
+  Workspace ws(*s.model);
+  SweepSummary sum;
+  const auto t0 = std::chrono::steady_clock::now();
+  const SolveStatus st = run_sweep(*s.model, o, ws, nullptr, &sum);
+  if (st != SolveStatus::kSuccess) throw Error(sum.message);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// range(0) = N, range(1) = parameters. Manual time: the sweep with sensitivities; each iteration also sweeps
+// without them (per_parameter compares the two, iteration by iteration, summed).
+void BM_SensitivitySweep(benchmark::State& state) {
+  const Index n = state.range(0);
+  const int parameters = static_cast<int>(state.range(1));
+  const Scene s = parse_scene(nfourbar_scene(n, parameters), "nfourbar.yaml");
+  SweepOptions o = s.sweep;
+  o.threads = 1;
+  SweepOptions plain = o;
+  plain.sensitivities.clear();
+  double with = 0, without = 0;
+  for (auto _ : state) {
+    const double a = sweep_seconds(s, o), b = sweep_seconds(s, plain);
+    with += a, without += b;
+    state.SetIterationTime(a);
+  }
+  const double rows = static_cast<double>(o.steps + 1) * static_cast<double>(state.iterations());
+  state.counters["s_per_row"] = with / rows;
+  state.counters["per_parameter"] = parameters ? (with / without - 1.0) / parameters : 0.0;
+}
+BENCHMARK(BM_SensitivitySweep)
+    ->ArgsProduct({{10, 1000, 10000}, {0, 1, 2}})
+    ->ArgNames({"N", "params"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,79 @@
+/// @file
+/// Sensitivities of the motion to design parameters: ∂q/∂p, ∂q̇/∂p and ∂q̈/∂p at a converged position, from the
+/// position, velocity and acceleration equations differentiated with respect to p:
+///
+///   Φq s  = −Φp                                         s  = ∂q/∂p
+///   Φq ṡ  = −(∂/∂p [Φq q̇ + Φt])  along (q, p) ← (s, 1)    ṡ  = ∂q̇/∂p
+///   Φq s̈  = −(∂/∂p [Φq q̈ − γ])   along (q, q̇, p) ← (s, ṡ, 1), q̈ held    s̈ = ∂q̈/∂p
+///
+/// Each right-hand side is the total derivative, with respect to p, of the equation's residual while q (and q̇)
+/// move along the sensitivities already known; each is solved with the factorisation of Φq the row was solved
+/// with (one triangular solve a parameter and derivative order, no new factorisation).
+///
+/// How the parameter enters: through the model itself. A parameter of a scene can reach any number of a
+/// constraint's data (a length, an offset, a local point, an axis, a law coefficient, an equation's constant),
+/// through the scene's arithmetic, and another parameter defined from it moves with it. So the derivative along p
+/// is taken of the models built at p − 2h, p − h, p + h and p + 2h (same structure: only values differ), by the
+/// fourth-order central difference
+///
+///   D f = [f(−2h) − 8 f(−h) + 8 f(h) − f(2h)] / (12 h),
+///
+/// of functions evaluated exactly by each model (Φ, Φq, Φt, γ at the shifted q, q̇). D is exact, up to rounding,
+/// for every dependence of degree ≤ 4 in p: lengths (Φ quadratic in them), local coordinates and offsets (linear),
+/// the law coefficients of polynomial drivers. For a parameter inside a sine or cosine (an angle), its error is
+/// h⁴/30 of the fifth derivative: 3·10⁻¹⁴ relative at the default h = 10⁻³ |p|. Rounding adds about
+/// ε |Φ's terms| / h. The tests compare with closed forms to 1e-9 and with re-solved sweeps (models/README.md).
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "phiq/kinematics.hpp"
+
+namespace phiq {
+
+/// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the
+/// model built at p − 2h, p − h, p + h, p + 2h (in that order), each with the same coordinates, rows and Φq pattern
+/// as the model swept (check_sensitivity_models()). A scene's `output: {sensitivities: [...]}` builds them
+/// (models/README.md); the C++ API builds them with the scene's overrides (SceneOverrides) or by hand.
+struct OutputSensitivity {
+  std::string name;  ///< the parameter's name, the columns' suffix (`x.d_NAME`)
+  double value = 0.0;  ///< p
+  double step = 0.0;   ///< h > 0
+  std::array<std::shared_ptr<const Model>, 4> models;  ///< at p − 2h, p − h, p + h, p + 2h
+};
+
+/// The default difference step for a parameter of value p: 10⁻³ |p|, or 10⁻³ for p = 0.
+double default_sensitivity_step(double p);
+
+/// "" when the four models of `s` can stand for `model` moved along the parameter (same number of coordinates and
+/// of rows, the same Φq pattern, a finite positive step); else one line naming the parameter and what differs
+/// (a parameter that sets a family's size or a count changes the structure: it has no derivative).
+std::string check_sensitivity_models(const Model& model, const OutputSensitivity& s);
+
+/// Where the sensitivities of one row are: for parameter j (0 ≤ j < parameters), the n values of ∂q/∂p_j from
+/// `data + j·3n`, then ∂q̇/∂p_j, then ∂q̈/∂p_j (n each; NaN where not computed: q̇'s without velocities, q̈'s
+/// without accelerations, all at a singular position, where Φq has no inverse).
+struct SensitivityLayout {
+  Index coordinates = 0;  ///< n
+  /// Offset of parameter j's block of `order` (0: q, 1: q̇, 2: q̈) in a row's values.
+  Index offset(std::size_t j, int order) const { return (3 * static_cast<Index>(j) + order) * coordinates; }
+  /// Values a row holds for `parameters` parameters.
+  Index size(std::size_t parameters) const { return 3 * static_cast<Index>(parameters) * coordinates; }
+};
+
+/// The sensitivities of the state in `ws` to each parameter of `parameters`, into `out` (SensitivityLayout): ∂q/∂p
+/// always, ∂q̇/∂p for order ≥ 1 and ∂q̈/∂p for order 2 (NaN otherwise). Pre-conditions: ws.q solves the position
+/// problem at t, ws.qd the velocity (order ≥ 1) and ws.qdd the acceleration (order 2), as after solve_position,
+/// solve_velocity and solve_acceleration; each parameter passes check_sensitivity_models(); `out` holds
+/// SensitivityLayout{n}.size(parameters.size()) values. Factorises Φq at ws.q unless the workspace's factors are
+/// there already. Returns kSuccess, or kSingularJacobian at a singular position (Φq has no inverse there: the
+/// sensitivities are not defined, `out` is NaN) and the failures of a factorisation. Throws phiq::Error for
+/// violated pre-conditions (sizes, order outside 0 … 2, a parameter whose models do not match). Thread-safe for
+/// distinct workspaces.
+SolveStatus solve_sensitivities(const Model& model, const std::vector<OutputSensitivity>& parameters, double t,
+                                int order, Workspace& ws, double* out, LinearSummary* summary = nullptr);
+
+}  // namespace phiq

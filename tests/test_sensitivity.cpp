@@ -1,0 +1,346 @@
+// Sensitivities to design parameters (phiq/sensitivity.hpp): ∂q/∂p, ∂q̇/∂p, ∂q̈/∂p against closed forms (the
+// crank-slider's slider, differentiated exactly by nested dual numbers; the redundant parallelogram), against
+// central differences of two re-solved sweeps (planar, spatial, redundant scenes), over thread counts, in
+// positions-only sweeps (same bits of q as without them), and the scene's refusals.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "cli_test_support.hpp"
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+using test::model_path;
+using test::sweep;
+using test::Trace;
+
+// Forward-mode dual numbers, nested for mixed higher derivatives: Dual<Dual<double>> carries ∂/∂a, ∂/∂b and
+// ∂²/∂a∂b exactly. Only what the closed forms below use.
+template <class T>
+struct Dual {
+  T v{}, d{};
+};
+template <class T> Dual<T> operator+(Dual<T> a, Dual<T> b) { return {a.v + b.v, a.d + b.d}; }
+template <class T> Dual<T> operator-(Dual<T> a, Dual<T> b) { return {a.v - b.v, a.d - b.d}; }
+template <class T> Dual<T> operator*(Dual<T> a, Dual<T> b) { return {a.v * b.v, a.d * b.v + a.v * b.d}; }
+template <class T> Dual<T> operator/(Dual<T> a, Dual<T> b) { return {a.v / b.v, (a.d * b.v - a.v * b.d) / (b.v * b.v)}; }
+inline double sqrt_(double x) { return std::sqrt(x); }
+inline double sin_(double x) { return std::sin(x); }
+inline double cos_(double x) { return std::cos(x); }
+template <class T> Dual<T> sqrt_(Dual<T> a) {
+  const T r = sqrt_(a.v);
+  return {r, a.d / (r + r)};
+}
+template <class T> Dual<T> sin_(Dual<T> a) { return {sin_(a.v), a.d * cos_(a.v)}; }
+template <class T> Dual<T> cos_(Dual<T> a) { return {cos_(a.v), T{} - a.d * sin_(a.v)}; }
+
+// The slider of the notes' crank-slider: x_B = L2 cos θ + √(L3² − L2² sin² θ).
+template <class T>
+T slider(T theta, T l2, T l3) {
+  const T s = sin_(theta);
+  return l2 * cos_(theta) + sqrt_(l3 * l3 - l2 * l2 * s * s);
+}
+
+using D1 = Dual<double>;
+using D2 = Dual<D1>;
+using D3 = Dual<D2>;
+
+// ∂x_B/∂L, ∂²x_B/∂θ∂L and ∂³x_B/∂θ²∂L at (θ, L2, L3), `which` = 2 for L2, 3 for L3: θ carries the two inner
+// directions, L the outer one.
+std::array<double, 3> slider_derivatives(double theta, double l2, double l3, int which) {
+  auto constant = [](double x) { return D3{D2{D1{x, 0}, D1{0, 0}}, D2{D1{0, 0}, D1{0, 0}}}; };
+  const D3 th{D2{D1{theta, 1}, D1{1, 0}}, D2{D1{0, 0}, D1{0, 0}}};
+  D3 a = constant(l2), b = constant(l3);
+  (which == 2 ? a : b).d = D2{D1{1, 0}, D1{0, 0}};
+  const D3 x = slider(th, a, b);
+  return {x.d.v.v, x.d.v.d, x.d.d.d};
+}
+
+const char* kCrankSlider = R"(phiq: 1
+name: crank_slider
+parameters: {L2: 0.3, L3: 1.0}
+coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}
+points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: rod, type: distance, points: [A, B], length: L3}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
+time: {start: 0, end: pi, steps: 90}
+output: {velocities: true, accelerations: true, sensitivities: [L2, {parameter: L3, step: 1e-3}]}
+)";
+
+// Every delivered row's sensitivities, with the row's time and state.
+struct SensitivityTrace {
+  Trace rows;
+  std::vector<std::vector<double>> s;
+  SweepSummary summary;
+};
+
+SensitivityTrace sweep_sensitivities(const Model& model, const SweepOptions& o, const Eigen::VectorXd* start = nullptr) {
+  SensitivityTrace r;
+  Workspace ws(model);
+  if (start) ws.q = *start;
+  const Index size = SensitivityLayout{model.num_coordinates()}.size(o.sensitivities.size());
+  const SolveStatus st = run_sweep(model, o, ws, [&](const StepView& v) {
+    r.rows.t.push_back(v.t);
+    r.rows.q.push_back(v.q);
+    if (v.qd) r.rows.qd.push_back(*v.qd);
+    if (v.qdd) r.rows.qdd.push_back(*v.qdd);
+    EXPECT_NE(v.sensitivities, nullptr);
+    if (v.sensitivities) r.s.emplace_back(v.sensitivities, v.sensitivities + size);
+    return true;
+  }, &r.summary);
+  EXPECT_EQ(st, SolveStatus::kSuccess) << r.summary.message;
+  return r;
+}
+
+TEST(Sensitivity, CrankSliderAgainstTheClosedFormAndItsTimeDerivatives) {
+  const Scene s = parse_scene(kCrankSlider, "crank_slider.yaml");
+  ASSERT_EQ(s.sweep.sensitivities.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.sweep.sensitivities[0].step, 3e-4);  // 10⁻³ |p|
+  EXPECT_DOUBLE_EQ(s.sweep.sensitivities[1].step, 1e-3);  // as given
+  const SensitivityTrace r = sweep_sensitivities(*s.model, s.sweep);
+  ASSERT_EQ(r.s.size(), 91u);
+  const Index n = s.model->num_coordinates(), xb = s.model->coordinate_index("xB");
+  const Index th = s.model->coordinate_index("theta2");
+  const SensitivityLayout layout{n};
+  double worst = 0.0;
+  for (std::size_t k = 0; k < r.s.size(); ++k) {
+    const double theta = 2.0 * r.rows.t[k];
+    for (int which : {2, 3}) {
+      const std::size_t j = which == 2 ? 0 : 1;
+      const auto exact = slider_derivatives(theta, 0.3, 1.0, which);
+      // θ = 2t: ∂ẋ_B/∂L = 2 ∂²x_B/∂θ∂L, ∂ẍ_B/∂L = 4 ∂³x_B/∂θ²∂L (θ̈ = 0)
+      const double got[3] = {r.s[k][layout.offset(j, 0) + xb], r.s[k][layout.offset(j, 1) + xb],
+                             r.s[k][layout.offset(j, 2) + xb]};
+      const double want[3] = {exact[0], 2.0 * exact[1], 4.0 * exact[2]};
+      for (int o = 0; o < 3; ++o) {
+        EXPECT_NEAR(got[o], want[o], 1e-9) << "t = " << r.rows.t[k] << ", L" << which << ", order " << o;
+        worst = std::max(worst, std::fabs(got[o] - want[o]));
+      }
+      // the driven crank angle does not move with a length
+      for (int o = 0; o < 3; ++o) EXPECT_NEAR(r.s[k][layout.offset(j, o) + th], 0.0, 1e-12);
+    }
+  }
+  EXPECT_GT(worst, 0.0);  // (compared for real: the sweep's rows are not the closed form's bits)
+  // One solve per parameter, order and row, each with the row's own factorisation: no more factorisations than
+  // the same sweep without sensitivities.
+  EXPECT_EQ(r.summary.counters.sensitivity_solves, 91 * 2 * 3);
+  SweepOptions plain = s.sweep;
+  plain.sensitivities.clear();
+  const SensitivityTrace p = [&] {
+    SensitivityTrace t;
+    Workspace ws(*s.model);
+    (void)run_sweep(*s.model, plain, ws, [](const StepView&) { return true; }, &t.summary);
+    return t;
+  }();
+  EXPECT_EQ(r.summary.counters.factorizations, p.summary.counters.factorizations);
+  EXPECT_EQ(p.summary.counters.sensitivity_solves, 0);
+}
+
+// The models along `parameter` of the scene `text`, built through the C++ API (SceneOverrides), as the scene's
+// `output.sensitivities` builds them.
+OutputSensitivity along(const std::string& text, const Scene& scene, const std::string& parameter, double value) {
+  OutputSensitivity s;
+  s.name = parameter, s.value = value, s.step = default_sensitivity_step(value);
+  const double shifts[4] = {-2, -1, 1, 2};
+  for (int k = 0; k < 4; ++k) {
+    SceneOverrides o;
+    o.parameters = {{parameter, value + shifts[k] * s.step}};
+    o.share_analysis_with = scene.model.get();
+    o.sensitivity_models = false;
+    s.models[static_cast<std::size_t>(k)] = std::shared_ptr<const Model>(parse_scene(text, "scene.yaml", {}, o).model);
+  }
+  EXPECT_EQ(check_sensitivity_models(*scene.model, s), "");
+  return s;
+}
+
+// The scene at parameter = value swept as `phiq run` sweeps it (prepare_scene: redundant rows left out).
+SensitivityTrace sweep_at(const std::string& text, const std::string& parameter, double value,
+                          const std::string& with_sensitivity = "", double tolerance = 1e-13) {
+  SceneOverrides o;
+  o.parameters = {{parameter, value}};
+  Scene s = parse_scene(text, "scene.yaml", {}, o);
+  s.sweep.newton.tolerance = tolerance;
+  if (!with_sensitivity.empty()) s.sweep.sensitivities = {along(text, s, with_sensitivity, value)};
+  SquareScene sq;
+  EXPECT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &sq), SolveStatus::kSuccess);
+  SensitivityTrace r;
+  if (!s.sweep.sensitivities.empty()) return sweep_sensitivities(sq.model(*s.model), s.sweep, &sq.start);
+  Workspace ws(sq.model(*s.model));
+  ws.q = sq.start;
+  EXPECT_EQ(sweep(sq.model(*s.model), s.sweep, &r.rows, &r.summary, &ws), SolveStatus::kSuccess);
+  return r;
+}
+
+// Whole-sweep sensitivities against central differences of two sweeps re-solved at p ± δ: relative 1e-6 of the
+// largest sensitivity of each order (of ∂q/∂p's where an order's are all zero: a translation has no ∂q̇/∂p).
+void expect_matches_resolved_sweeps(const std::string& rel, const std::string& parameter, double value) {
+  const std::string text = test::slurp(model_path(rel));
+  const SensitivityTrace r = sweep_at(text, parameter, value, parameter);
+  const double delta = 1e-4 * std::max(1.0, std::fabs(value));
+  const SensitivityTrace up = sweep_at(text, parameter, value + delta);
+  const SensitivityTrace down = sweep_at(text, parameter, value - delta);
+  ASSERT_EQ(up.rows.q.size(), r.s.size());
+  ASSERT_EQ(down.rows.q.size(), r.s.size());
+  const Index n = static_cast<Index>(r.rows.q[0].size());
+  const SensitivityLayout layout{n};
+  double position_scale = 0.0;
+  for (int order = 0; order < 3; ++order) {
+    const auto& u = order == 0 ? up.rows.q : order == 1 ? up.rows.qd : up.rows.qdd;
+    const auto& d = order == 0 ? down.rows.q : order == 1 ? down.rows.qd : down.rows.qdd;
+    double scale = 0.0, worst = 0.0;
+    for (std::size_t k = 0; k < r.s.size(); ++k)
+      for (Index j = 0; j < n; ++j) {
+        const double exact = r.s[k][layout.offset(0, order) + j];
+        ASSERT_TRUE(std::isfinite(exact)) << rel << " t = " << r.rows.t[k];
+        scale = std::max(scale, std::fabs(exact));
+        worst = std::max(worst, std::fabs(exact - (u[k](j) - d[k](j)) / (2 * delta)));
+      }
+    if (order == 0) {
+      position_scale = scale;
+      EXPECT_GT(scale, 1e-3) << rel << ": the parameter moves the motion";
+    }
+    EXPECT_LE(worst, 1e-6 * std::max(scale, position_scale)) << rel << ", ∂/∂" << parameter << " of order " << order;
+  }
+}
+
+TEST(Sensitivity, PlanarFourBarMatchesResolvedSweeps) {
+  expect_matches_resolved_sweeps("seed/fourbar_natural.yaml", "L3", 1.2);
+  expect_matches_resolved_sweeps("seed/fourbar_reference_point.yaml", "L2", 0.4);
+}
+
+TEST(Sensitivity, SpatialScenesMatchResolvedSweeps) {
+  expect_matches_resolved_sweeps("spatial/rssr.yaml", "L", 0.92);
+  expect_matches_resolved_sweeps("spatial/crank_slider_natural.yaml", "h", 0.1);
+}
+
+TEST(Sensitivity, RedundantParallelogramMatchesItsClosedForm) {
+  // Every crank at ψ = π/3 + t, the coupler's left end at r (cos ψ, sin ψ): ∂xc/∂r = cos ψ, ∂yc/∂r = sin ψ and
+  // their time derivatives; the redundant fifth bar's row is left out of the solves, not of Φp.
+  const std::string text = test::slurp(model_path("redundant/parallelogram_fifth_bar.yaml"));
+  const SensitivityTrace r = sweep_at(text, "r", 1.0, "r", 1e-10);
+  const Scene s = parse_scene(text, "p.yaml");
+  const Index xc = s.model->coordinate_index("xc"), yc = s.model->coordinate_index("yc");
+  const SensitivityLayout layout{s.model->num_coordinates()};
+  ASSERT_EQ(r.s.size(), 101u);
+  for (std::size_t k = 0; k < r.s.size(); ++k) {
+    const double psi = M_PI / 3 + r.rows.t[k], c = std::cos(psi), sn = std::sin(psi);
+    const double want_x[3] = {c, -sn, -c}, want_y[3] = {sn, c, -sn};
+    for (int o = 0; o < 3; ++o) {
+      EXPECT_NEAR(r.s[k][layout.offset(0, o) + xc], want_x[o], 1e-9) << "t = " << r.rows.t[k] << " order " << o;
+      EXPECT_NEAR(r.s[k][layout.offset(0, o) + yc], want_y[o], 1e-9) << "t = " << r.rows.t[k] << " order " << o;
+    }
+  }
+  expect_matches_resolved_sweeps("redundant/parallelogram_fifth_bar.yaml", "d", 1.0);
+}
+
+TEST(Sensitivity, SameBitsOnEveryThreadCount) {
+  const std::string text = test::slurp(model_path("seed/fourbar_natural.yaml"));
+  Scene s = parse_scene(text, "f.yaml");
+  s.sweep.sensitivities = {along(text, s, "L2", 0.4), along(text, s, "L4", 1.0)};
+  std::vector<std::vector<double>> first;
+  for (int threads : {1, 2, 3}) {
+    SweepOptions o = s.sweep;
+    o.threads = threads;
+    o.chunk_steps = 40;
+    const SensitivityTrace r = sweep_sensitivities(*s.model, o);
+    if (threads == 1) first = r.s;
+    ASSERT_EQ(r.s.size(), first.size());
+    for (std::size_t k = 0; k < first.size(); ++k)
+      for (std::size_t i = 0; i < first[k].size(); ++i)
+        ASSERT_EQ(std::memcmp(&r.s[k][i], &first[k][i], sizeof(double)), 0)
+            << threads << " threads, row " << k << " value " << i;
+  }
+}
+
+TEST(Sensitivity, PositionsOnlyFactoriseApartAndLeaveTheSweepsBits) {
+  // Without velocities the workspace's factors are not at the rows: the sensitivities factorise Φq there on
+  // their own, and the positions stay the bits of the same sweep without sensitivities.
+  Scene s = parse_scene(kCrankSlider, "crank_slider.yaml");
+  const SensitivityTrace full = sweep_sensitivities(*s.model, s.sweep);
+  s.sweep.velocities = s.sweep.accelerations = false;
+  const SensitivityTrace r = sweep_sensitivities(*s.model, s.sweep);
+  SweepOptions plain = s.sweep;
+  plain.sensitivities.clear();
+  Trace p;
+  ASSERT_EQ(sweep(*s.model, plain, &p), SolveStatus::kSuccess);
+  ASSERT_EQ(r.rows.q.size(), p.q.size());
+  const SensitivityLayout layout{s.model->num_coordinates()};
+  for (std::size_t k = 0; k < p.q.size(); ++k) {
+    EXPECT_EQ(r.rows.q[k], p.q[k]) << "row " << k;
+    for (Index j = 0; j < s.model->num_coordinates(); ++j)
+      for (std::size_t i = 0; i < 2; ++i) {
+        EXPECT_NEAR(r.s[k][layout.offset(i, 0) + j], full.s[k][layout.offset(i, 0) + j], 1e-10);
+        EXPECT_TRUE(std::isnan(r.s[k][layout.offset(i, 1) + j]));  // q̇'s: not asked for
+      }
+  }
+  EXPECT_EQ(r.summary.counters.sensitivity_solves, 91 * 2);
+}
+
+TEST(Sensitivity, SolveSensitivitiesOnAWorkspaceEqualsTheSweeps) {
+  const Scene s = parse_scene(kCrankSlider, "crank_slider.yaml");
+  const SensitivityTrace r = sweep_sensitivities(*s.model, s.sweep);
+  Workspace ws(*s.model);
+  const std::size_t k = 37;
+  ws.q = r.rows.q[k], ws.qd = r.rows.qd[k], ws.qdd = r.rows.qdd[k];
+  std::vector<double> out(r.s[k].size());
+  LinearSummary ls;
+  ASSERT_EQ(solve_sensitivities(*s.model, s.sweep.sensitivities, r.rows.t[k], 2, ws, out.data(), &ls),
+            SolveStatus::kSuccess)
+      << ls.message;
+  for (std::size_t i = 0; i < out.size(); ++i) EXPECT_NEAR(out[i], r.s[k][i], 1e-12) << i;
+  EXPECT_THROW((void)solve_sensitivities(*s.model, s.sweep.sensitivities, 0.0, 3, ws, out.data()), Error);
+}
+
+TEST(Sensitivity, AParameterTheMotionDoesNotDependOnGivesZeros) {
+  // `unused` reaches no constraint: its column is zero (reported by its values, not an error).
+  const std::string text = test::replace_first(
+      test::replace_first(kCrankSlider, "{L2: 0.3, L3: 1.0}", "{L2: 0.3, L3: 1.0, unused: 5}"),
+      "sensitivities: [L2, {parameter: L3, step: 1e-3}]", "sensitivities: [unused]");
+  const Scene s = parse_scene(text, "c.yaml");
+  const SensitivityTrace r = sweep_sensitivities(*s.model, s.sweep);
+  for (const auto& row : r.s)
+    for (double v : row) EXPECT_EQ(v, 0.0);
+}
+
+TEST(Sensitivity, SceneRefusals) {
+  auto with = [](const std::string& list) {
+    return test::replace_first(kCrankSlider, "sensitivities: [L2, {parameter: L3, step: 1e-3}]",
+                               "sensitivities: " + list);
+  };
+  EXPECT_EQ(test::scene_error(with("[L9]")),
+            "bad.yaml:12:65: output.sensitivities[0]: 'L9' is not a parameter of the scene (its parameters: L2, L3)");
+  EXPECT_EQ(test::scene_error(with("[L2, L2]")), "bad.yaml:12:69: output.sensitivities[1]: parameter 'L2' listed twice");
+  EXPECT_EQ(test::scene_error(with("[{parameter: L2, step: 0}]")),
+            "bad.yaml:12:87: output.sensitivities[0].step: the difference step must be positive");
+  EXPECT_EQ(test::scene_error(with("[{parameter: L2, by: 1}]")).substr(0, 43),
+            "bad.yaml:12:81: output.sensitivities[0].by:");
+  // A parameter that sets a family's range changes the model's structure: no derivative.
+  const char* family = R"(phiq: 1
+parameters: {N: 3}
+coordinates:
+  for i in 1..N:
+    x{i}: 0
+drivers:
+  - for i in 1..N:
+      - {name: "d{i}", coordinate: "x{i}", law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 1, steps: 2}
+output: {sensitivities: [N]}
+)";
+  const std::string e = test::scene_error(family);
+  EXPECT_NE(e.find("output.sensitivities"), std::string::npos) << e;
+  EXPECT_NE(e.find("'N'"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace phiq
