@@ -244,6 +244,21 @@ TEST(Sensitivity, RedundantParallelogramMatchesItsClosedForm) {
   expect_matches_resolved_sweeps("redundant/parallelogram_fifth_bar.yaml", "d", 1.0);
 }
 
+TEST(Sensitivity, RowsOnASingularPositionAreNaNTheOthersFinite) {
+  // The parallelogram's change points (crank at π and 2π): Φq has no inverse there, the rows say NaN; every other
+  // row has finite sensitivities.
+  const std::string text = test::slurp(model_path("hard/change_point_exact.yaml"));
+  const SensitivityTrace r = sweep_at(text, "r", 1.0, "r", 1e-10);
+  ASSERT_GT(r.summary.singular_positions, 0);
+  Index nan_rows = 0;
+  for (const auto& row : r.s) {
+    const bool nan = std::isnan(row[0]);
+    nan_rows += nan;
+    for (double v : row) EXPECT_EQ(std::isnan(v), nan);
+  }
+  EXPECT_EQ(nan_rows, r.summary.singular_positions);
+}
+
 TEST(Sensitivity, SameBitsOnEveryThreadCount) {
   const std::string text = test::slurp(model_path("seed/fourbar_natural.yaml"));
   Scene s = parse_scene(text, "f.yaml");

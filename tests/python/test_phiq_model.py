@@ -121,6 +121,9 @@ def test_error_paths_name_what_is_wrong(tmp_path):
         phiq.load_scene(str(tmp_path / "missing.yaml"))
     with pytest.raises(phiq.SceneError, match=r"'L9' \(given for this run\) is not a parameter of the scene"):
         phiq.load_scene(CRANK_SLIDER, parameters={"L9": 1.0})
+    # the parameters, in file order, with the overrides applied
+    assert list(phiq.load_scene(CRANK_SLIDER).parameters.items()) == [("L2", 0.3), ("L3", 1.0)]
+    assert phiq.load_scene(CRANK_SLIDER, parameters={"L3": 1.5}).parameters == {"L2": 0.3, "L3": 1.5}
     with pytest.raises(ValueError, match="tolerance"):
         phiq.solve_position(scene.model, 0.0, phiq.Workspace(scene.model), phiq.NewtonOptions(tolerance=-1))
 

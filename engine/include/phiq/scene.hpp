@@ -6,6 +6,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "phiq/model.hpp"
@@ -52,6 +53,9 @@ struct Scene {
   std::string path;              ///< the file it was read from (or the name given to parse_scene)
   std::string name;              ///< the scene's `name` field (may be empty)
   std::string text;              ///< the text it was parsed from (written into HDF5 results: how they were made)
+  /// The scene's `parameters` in file order, with their values (the caller's overrides applied): what
+  /// SceneOverrides, `phiq batch` and `output.sensitivities` may name.
+  std::vector<std::pair<std::string, double>> parameters;
   int dimension = 2;             ///< the scene's `dimension` (2: planar, 3: spatial)
   /// The frame of each moving body, in the order of Model::body_names() (planar scenes fill planar_bodies,
   /// spatial ones spatial_bodies): where `phiq animate` reads a body's pose from q.

@@ -27,6 +27,14 @@ void bind_scene(py::module_& m) {
       .def_readonly("path", &Scene::path, "the file it was read from (or the name given to parse_scene)")
       .def_readonly("name", &Scene::name, "the scene's `name` field")
       .def_readonly("text", &Scene::text, "the text it was parsed from")
+      .def_property_readonly(
+          "parameters",
+          [](const Scene& s) {
+            py::dict d;  // (insertion-ordered: the file's order)
+            for (const auto& [name, value] : s.parameters) d[py::str(name)] = value;
+            return d;
+          },
+          "the scene's parameters and their values (overrides applied), in file order")
       .def_property_readonly("model", [](const Scene& s) -> const Model& { return *s.model; },
                              py::return_value_policy::reference_internal, "the mechanism (a Model)")
       .def_property_readonly("options", [](const Scene& s) { return s.sweep; },
