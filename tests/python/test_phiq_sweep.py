@@ -210,4 +210,12 @@ def test_sensitivities_reach_python_as_the_clis_columns(tmp_path):
     assert np.max(np.abs(table[:, header.index("xB.d_L2")] - (np.cos(theta) - l2 * np.sin(theta) ** 2 / w))) < 1e-9
     assert np.max(np.abs(table[:, header.index("xB.d_L3")] - l3 / w)) < 1e-9
     assert header[-1] == "xB.a.d_L3"
+    xb = result.coordinate_names.index("xB")
+    assert np.array_equal(result.sensitivity("L2")[:, xb], table[:, header.index("xB.d_L2")])
+    assert np.array_equal(result.sensitivity("L3", 2)[:, xb], table[:, header.index("xB.a.d_L3")])
+    assert result.sensitivity("L3", 1).shape == (181, 4)
+    with pytest.raises(KeyError, match="no sensitivities of order 0 to 'L9'"):
+        result.sensitivity("L9")
+    with pytest.raises(ValueError, match="order must be 0, 1 or 2"):
+        result.sensitivity("L2", 3)
     assert result.summary["counters"]["sensitivity_solves"] == 181 * 2 * 3

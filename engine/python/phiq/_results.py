@@ -74,7 +74,7 @@ class SweepResult:
 
     @property
     def output_names(self) -> List[str]:
-        """Names of the columns of ``outputs`` (points, drivers, residuals, rcond)."""
+        """Names of the columns of ``outputs`` (points, drivers, residuals, rcond, sensitivities)."""
         return self.columns[self._bounds[3]:]
 
     @functools.cached_property
@@ -108,6 +108,19 @@ class SweepResult:
             if axes:
                 return np.stack([self.column(a) for a in axes], axis=1)
         raise KeyError(f"no output point '{name}' in this result (its columns: {', '.join(self.columns)})")
+
+    def sensitivity(self, parameter: str, order: int = 0) -> np.ndarray:
+        """Sensitivities to a parameter of the scene's ``output.sensitivities``: ∂q/∂p (order 0), ∂q̇/∂p (1) or
+        ∂q̈/∂p (2), rows × the columns of ``q`` (``qd``, ``qdd``) in their order; NaN on a singular position."""
+        if order not in (0, 1, 2):
+            raise ValueError(f"order must be 0, 1 or 2, not {order}")
+        base = (self.coordinate_names, self.velocity_names, self.acceleration_names)[order]
+        for suffix in (f".d_{parameter}", f"__d_{parameter}"):  # dotted or identifier column names
+            names = [n + suffix for n in base]
+            if names and all(n in self._index for n in names):
+                return self.table[:, [self._index[n] for n in names]]
+        raise KeyError(f"no sensitivities of order {order} to '{parameter}' in this result (list the parameter in "
+                       f"the scene's output.sensitivities; its columns: {', '.join(self.columns)})")
 
     def __len__(self) -> int:
         return self.table.shape[0]
