@@ -326,6 +326,13 @@ TEST(Sensitivity, AParameterTheMotionDoesNotDependOnGivesZeros) {
   const SensitivityTrace r = sweep_sensitivities(*s.model, s.sweep);
   for (const auto& row : r.s)
     for (double v : row) EXPECT_EQ(v, 0.0);
+  ASSERT_EQ(r.summary.warnings.size(), 1u);
+  EXPECT_EQ(r.summary.warnings[0].kind, "no_dependence");
+  EXPECT_EQ(r.summary.warnings[0].message, "no constraint or driver reads the parameter 'unused': its sensitivities are zero");
+  // a parameter that is read is not reported
+  const Scene both = parse_scene(kCrankSlider, "c.yaml");
+  const SensitivityTrace read = sweep_sensitivities(*both.model, both.sweep);
+  for (const SweepWarning& w : read.summary.warnings) EXPECT_NE(w.kind, "no_dependence");
 }
 
 TEST(Sensitivity, SceneRefusals) {
