@@ -215,32 +215,19 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
               << printable(dir) << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
               << " cases on one symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
               << scientific(sum.solve_seconds, 3) << " s\n";
+  const int status = output_error ? 3 : failed ? 1 : 0;
   if (summary_file) {
-    nlohmann::ordered_json j;
-    j["format"] = phiq::kBatchSummaryFormat;
-    j["phiq"] = phiq::version();
-    j["scene"] = scene_path;
-    const std::string& name = scenes.front().name;
-    j["name"] = name.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(name);
-    j["host"] = host_json();
-    j["cases_file"] = cases_path;
-    j["directory"] = dir;
-    j["cases"] = scenes.size();
-    j["failed"] = failed;
-    j["written"] = cases_written;
-    j["threads"] = sum.threads;
-    j["shared_analyses"] = sum.shared_analyses;
-    j["load_seconds"] = load_s;
-    j["solve_seconds"] = sum.solve_seconds;
-    j["results"] = std::move(results);
-    try {
-      summary_file->write(json_text(j, 2) + "\n");
-      outputs.commit_one(*summary_file);
-    } catch (const phiq::Error& e) {
-      return fail(e.what(), 3);
-    }
+    BatchTotals t;
+    t.scene_name = scenes.front().name;
+    t.directory = dir;
+    t.cases = scenes.size(), t.failed = static_cast<std::size_t>(failed), t.written = cases_written;
+    t.shared_analyses = static_cast<std::size_t>(sum.shared_analyses);
+    t.threads = sum.threads;
+    t.load_seconds = load_s, t.solve_seconds = sum.solve_seconds;
+    return commit_batch_summary(outputs, *summary_file, {scene_path, cases_path, dir, summary_path}, t,
+                                std::move(results), status);
   }
-  return output_error ? 3 : failed ? 1 : 0;
+  return status;
 }
 
 // An output directory: not empty, not standard output.

@@ -4,6 +4,7 @@
 // case waits only for those before it), so that an interrupted or failing batch publishes whole cases, in order.
 #include "batch_file.hpp"
 
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -41,6 +42,37 @@ SceneOverrides case_overrides(const CsvTable& cases, std::size_t k, const std::s
   for (std::size_t c = 0; c < cases.columns.size(); ++c) o.parameters.emplace_back(cases.columns[c], cases.rows[k][c]);
   o.parameters_source = cases_path + ":1";  // the header names them: its errors are no case's
   return o;
+}
+
+int commit_batch_summary(OutputSet& outputs, AtomicOutputFile& file, const BatchArgs& args, const BatchTotals& t,
+                         nlohmann::ordered_json results, int status) {
+  const auto or_null = [](const std::string& s) {
+    return s.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s);
+  };
+  nlohmann::ordered_json j;
+  j["format"] = phiq::kBatchSummaryFormat;
+  j["phiq"] = phiq::version();
+  j["scene"] = args.scene;
+  j["name"] = or_null(t.scene_name);
+  j["host"] = host_json();
+  j["cases_file"] = args.cases;
+  j["directory"] = or_null(t.directory);
+  j["output"] = or_null(t.output);
+  j["cases"] = t.cases;
+  j["failed"] = t.failed;
+  j["written"] = t.written;
+  j["threads"] = t.threads;
+  j["shared_analyses"] = t.shared_analyses;
+  j["load_seconds"] = t.load_seconds;
+  j["solve_seconds"] = t.solve_seconds;
+  j["results"] = std::move(results);
+  try {
+    file.write(json_text(j, 2) + "\n");
+    outputs.commit_one(file);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  return status;
 }
 
 namespace {
@@ -102,7 +134,9 @@ class InOrder {
 
 }  // namespace
 
-int batch_to_one_file(const BatchArgs& a, const CsvTable& cases) {
+int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
+  BatchArgs a = args;
+  if (a.threads <= 0) a.threads = tbb::info::default_concurrency();  // 0: all cores
   const bool hdf5 = phiq::has_hdf5_extension(a.out);
   const std::size_t n = cases.rows.size();
   {
@@ -200,6 +234,8 @@ int batch_to_one_file(const BatchArgs& a, const CsvTable& cases) {
   });
 
   std::vector<CaseReport> reports(n);
+  for (std::size_t k = 0; k < n; ++k)
+    reports[k].outcome = nlohmann::ordered_json{{"case", k}, {"line", k + 2}, {"file", nullptr}};
   std::atomic<std::size_t> next_case{0};
   std::atomic<std::size_t> shared{0};  // cases swept on the reference's symbolic analysis
   const std::atomic<bool>& stop = stop_flag();
@@ -207,7 +243,6 @@ int batch_to_one_file(const BatchArgs& a, const CsvTable& cases) {
   // One case, on the thread's own tree: built, made square, swept, its rows formatted, handed to in_order.
   auto run_case = [&](std::size_t k, phiq::ParsedScene& tree) {
     CaseReport& report = reports[k];
-    report.outcome = nlohmann::ordered_json{{"case", k}, {"line", k + 2}, {"file", nullptr}};
     auto fails = [&](const std::string& why) {
       report.complete = report.failed = true;
       report.line = a.scene + ": case " + std::to_string(k) + ": " + why + left_out;
@@ -332,16 +367,18 @@ int batch_to_one_file(const BatchArgs& a, const CsvTable& cases) {
     CaseReport& r = reports[k];
     failed += r.failed;
     if (written[k] && published) r.outcome["file"] = a.out;
+    if (!r.outcome.contains("status")) r.outcome["status"] = "not run";  // the batch stopped before its turn
     if (r.failed)
       std::cerr << "phiq: " << printable(r.line) << "\n";
     else if (!a.quiet && r.complete)
       std::cerr << "phiq: " << printable(r.line) << "\n";
   }
-  if (!write_error.empty() || !publish_error.empty())
-    return fail((write_error.empty() ? publish_error : write_error) + "; " + written_text +
-                    (published ? " (whole cases, in order)" : ""),
-                3);
-  if (!a.quiet)
+  const bool output_error = !write_error.empty() || !publish_error.empty();
+  if (output_error)  // (the summary, as for -o DIR, is still written: it says which cases are in the file)
+    (void)fail((write_error.empty() ? publish_error : write_error) + "; " + written_text +
+                   (published ? " (whole cases, in order)" : ""),
+               3);
+  else if (!a.quiet)
     std::cerr << "phiq: " << printable(a.scene) << ": " << n - failed << " of " << n << " cases in "
               << printable(a.out) << ", " << a.threads << " threads, " << shared.load()
               << " cases on the scene's symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
@@ -349,33 +386,17 @@ int batch_to_one_file(const BatchArgs& a, const CsvTable& cases) {
               << ", sweep " << scientific(seconds(sweep_ns), 3) << ", rows " << scientific(seconds(format_ns), 3)
               << ", write " << scientific(seconds(write_ns), 3) << ")\n";
   if (summary_file) {
-    nlohmann::ordered_json j;
-    j["format"] = phiq::kBatchSummaryFormat;
-    j["phiq"] = phiq::version();
-    j["scene"] = a.scene;
-    j["name"] = reference->name.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(reference->name);
-    j["host"] = host_json();
-    j["cases_file"] = a.cases;
-    j["directory"] = nullptr;
-    j["output"] = a.out;
-    j["cases"] = n;
-    j["failed"] = failed;
-    j["written"] = cases_written;
-    j["threads"] = a.threads;
-    j["shared_analyses"] = shared.load();
-    j["load_seconds"] = load_s;
-    j["solve_seconds"] = solve_s;
+    BatchTotals t;
+    t.scene_name = reference->name;
+    t.output = a.out;
+    t.cases = n, t.failed = failed, t.written = published ? cases_written : 0, t.shared_analyses = shared.load();
+    t.threads = a.threads;
+    t.load_seconds = load_s, t.solve_seconds = solve_s;
     nlohmann::ordered_json results = nlohmann::ordered_json::array();
     for (CaseReport& r : reports) results.push_back(std::move(r.outcome));
-    j["results"] = std::move(results);
-    try {
-      summary_file->write(json_text(j, 2) + "\n");
-      outputs.commit_one(*summary_file);
-    } catch (const phiq::Error& e) {
-      return fail(e.what(), 3);
-    }
+    return commit_batch_summary(outputs, *summary_file, a, t, std::move(results), output_error ? 3 : failed ? 1 : 0);
   }
-  return failed ? 1 : 0;
+  return output_error ? 3 : failed ? 1 : 0;
 }
 
 }  // namespace phiq::tools
