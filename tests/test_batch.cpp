@@ -3,6 +3,7 @@
 
 #include <mutex>
 
+#include "phiq/parsed_scene.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq {
@@ -21,6 +22,58 @@ Model crank_slider(double l2, const Model* share) {
   b.set_length_scale(1.0);
   if (share) b.share_analysis_with(*share);
   return std::move(b).build();
+}
+
+// The rows of a scene's sweep as CSV text (the bytes `phiq run` writes).
+std::string sweep_text(const Scene& scene) {
+  Workspace ws(*scene.model);
+  const CsvFormat format(*scene.model, scene.sweep);
+  std::string text = format.header();
+  SweepSummary sum;
+  (void)run_sweep(*scene.model, scene.sweep, ws, [&](const StepView& s) {
+    format.append_row(s, text);
+    return true;
+  }, &sum);
+  EXPECT_EQ(sum.status, SolveStatus::kSuccess) << sum.message;
+  return text;
+}
+
+// A ParsedScene read again and again, with other parameters each time, gives what parse_scene gives for the text
+// with those parameters written in (the same rows, byte for byte), also after a read its parameters made fail
+// (a negative rod) and after a copy (its own tree); and the cases share the first one's symbolic analysis.
+TEST(Batch, ParsedSceneReadsEachCaseAsParseSceneDoes) {
+  const std::string text = "parameters: {L2: 0.3, L3: 1.0}\n"
+                           "coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}\n"
+                           "points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}\n"
+                           "constraints:\n"
+                           "  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}\n"
+                           "  - {name: rod, type: distance, points: [A, B], length: L3}\n"
+                           "drivers:\n"
+                           "  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}\n"
+                           "time: {start: 0, end: pi, steps: 36}\n";
+  ParsedScene parsed(text, "cs.yaml");
+  const Scene first = parsed.read();
+  EXPECT_EQ(sweep_text(first), sweep_text(parse_scene(text, "cs.yaml")));
+  const std::vector<std::pair<double, double>> cases{{0.2, 1.0}, {0.3, -1.0}, {0.4, 1.2}, {0.25, 0.9}};
+  for (int copy = 0; copy < 2; ++copy) {
+    ParsedScene own = copy ? ParsedScene(parsed) : ParsedScene(text, "cs.yaml");
+    for (const auto& [l2, l3] : cases) {
+      SceneOverrides o;
+      o.parameters = {{"L2", l2}, {"L3", l3}};
+      o.share_analysis_with = first.model.get();
+      if (l3 < 0) {
+        EXPECT_THROW((void)own.read(o), SceneError);
+        continue;
+      }
+      const Scene scene = own.read(o);
+      EXPECT_EQ(scene.model->symbolic(), first.model->symbolic());
+      std::string written = text;
+      written.replace(0, written.find('\n'), "parameters: {L2: " + std::to_string(l2) + ", L3: " + std::to_string(l3) + "}");
+      ASSERT_EQ(std::stod(std::to_string(l2)), l2);  // the text holds the very doubles
+      EXPECT_EQ(sweep_text(scene), sweep_text(parse_scene(written, "cs.yaml"))) << l2 << " " << l3;
+    }
+  }
+  EXPECT_THROW(ParsedScene("time: {start: 0, end: 1, steps: [\n", "bad.yaml"), SceneError);  // YAML syntax
 }
 
 TEST(Batch, EveryCaseMatchesItsClosedFormAndSharesTheAnalysis) {

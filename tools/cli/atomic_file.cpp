@@ -3,6 +3,7 @@
 #include "atomic_file.hpp"
 
 #include <fcntl.h>
+#include <stdio_ext.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -168,6 +169,21 @@ void AtomicOutputFile::write(const std::string& data) {
     return;
   }
   if (std::fwrite(data.data(), 1, data.size(), f_) != data.size())
+    throw Error(cannot_write(path_, std::strerror(errno)));
+}
+
+void AtomicOutputFile::truncate(std::uint64_t size) {
+  if (direct_) throw Error(cannot_write(path_, "a device, FIFO or descriptor cannot be cut back"));
+  if (finished_ || (!f_ && !closed_between_writes_)) throw Error(path_ + ": cannot write: already closed");
+  const auto at = static_cast<off_t>(size);
+  if (!f_) {  // closed between writes: by its name
+    if (::truncate(tmp_.c_str(), at) != 0) throw Error(cannot_write(path_, std::strerror(errno)));
+    return;
+  }
+  // what stdio still holds would be written at the next flush, after the cut: drop it (a failed fflush keeps it)
+  ::__fpurge(f_);
+  std::clearerr(f_);
+  if (::ftruncate(::fileno(f_), at) != 0 || ::fseeko(f_, at, SEEK_SET) != 0)
     throw Error(cannot_write(path_, std::strerror(errno)));
 }
 

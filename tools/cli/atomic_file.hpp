@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdio>
+#include <cstdint>
 #include <string>
 
 #include "phiq/types.hpp"  // phiq::Error, which these functions throw
@@ -56,6 +57,10 @@ class AtomicOutputFile {
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
   void write(const std::string& data);  // throws phiq::Error on an I/O error
+  // Takes the temporary back to its first `size` bytes, dropping what is buffered and not yet written: after a
+  // failed write, a batch's file is cut back to the cases it holds whole. Throws phiq::Error for a direct file
+  // (nothing written there can be taken back), after finish(), or on an I/O error.
+  void truncate(std::uint64_t size);
   // finish() then publish(), under the lock of the target's directory (DirectoryLock). Throws phiq::Error on an I/O error (the temporary is then removed by the destructor).
   void commit();
   // Flushes and closes: to disk (fsync) for a temporary. After it only publish() remains; throws phiq::Error.

@@ -34,7 +34,14 @@ struct Hdf5Options {
   /// Memory for the rows held between writes (at least one row is always held): the writer's memory, which
   /// does not grow with the number of rows.
   std::size_t buffer_bytes = std::size_t{16} << 20;
+  /// A batch's file (`phiq batch -o OUT.h5`, layout version kHdf5BatchFormat): a first dataset /case (float64, one
+  /// value per row: the row's case), and the root attribute `batch_format_version`. Rows are then given by
+  /// append_values(), whose first value is the case.
+  bool case_column = false;
 };
+
+/// Version of the batch layout (Hdf5Options::case_column): the run layout with a /case dataset first.
+inline constexpr int kHdf5BatchFormat = 1;
 
 /// Writes a sweep's rows to an HDF5 file as they are delivered. Not thread-safe: call append_row() from one
 /// thread at a time (run_sweep's callback is). HDF5 errors are reported as phiq::Error; HDF5's own printing of
@@ -52,8 +59,15 @@ class Hdf5Writer {
   Hdf5Writer& operator=(const Hdf5Writer&) = delete;
 
   /// Adds one row (pre-conditions as CsvFormat::append_row()). −0 is stored as 0, as the CSV writes it.
-  /// Throws phiq::Error on a write error or after close().
+  /// Throws phiq::Error on a write error, after close(), or for a batch's file (Hdf5Options::case_column).
   void append_row(const StepView& step);
+  /// Adds one row given as its values in column order: the case (with Hdf5Options::case_column), then what
+  /// CsvFormat::append_row() writes (t, q, q̇, q̈, then CsvFormat::append_output_values()). For rows buffered
+  /// before they are written (a batch's cases, written in case order). −0 is stored as 0. Throws phiq::Error as
+  /// append_row() does.
+  void append_values(const double* row);
+  /// Values per row that append_values() takes.
+  std::size_t row_values() const;
   /// Writes the rows still held and closes the file. Throws phiq::Error "PATH: cannot write: REASON".
   void close();
   /// Rows given so far.

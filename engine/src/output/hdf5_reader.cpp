@@ -89,12 +89,14 @@ CsvTable read_hdf5_table(const std::string& path) {
   CsvTable table;
   table.path = path;
   std::vector<Block> blocks;
-  for (const char* name : {"t", "q", "qd", "qdd", "points", "joints", "orientations", "drivers", "residuals", "rcond",
-                           "sensitivities"}) {
+  // a batch's file (hdf5_writer.hpp, Hdf5Options::case_column) has /case first: the column `case` of its CSV
+  for (const char* name : {"case", "t", "q", "qd", "qdd", "points", "joints", "orientations", "drivers", "residuals",
+                           "rcond", "sensitivities"}) {
     const htri_t exists = H5Lexists(file.get(), name, H5P_DEFAULT);
     if (exists < 0) throw Error(path + ": " + detail::h5::last_error());
     if (exists == 0) {
-      if (blocks.empty()) throw Error(path + ": no dataset /t");
+      if (std::string(name) == "case") continue;
+      if (blocks.size() < 2 && std::string(name) == "t") throw Error(path + ": no dataset /t");
       continue;
     }
     blocks.push_back(read_block(file.get(), name, path));

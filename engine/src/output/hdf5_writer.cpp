@@ -63,6 +63,7 @@ struct Hdf5Writer::Impl {
   CsvFormat format;
   Hid file;
   std::vector<Group> groups;  // in CSV column order
+  Group *batch_case = nullptr;  // /case (Hdf5Options::case_column)
   Group *t = nullptr, *q = nullptr, *qd = nullptr, *qdd = nullptr;
   std::vector<Group*> outputs;  // points, drivers, residuals, rcond: the CsvFormat::append_output_values() slices
   std::vector<double> output_row;
@@ -90,7 +91,11 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     groups.push_back(std::move(g));
     return &groups.back();
   };
-  groups.reserve(11);  // pointers into it are kept
+  groups.reserve(12);  // pointers into it are kept
+  if (o.case_column) {  // first, as the batch CSV's `case` column
+    groups.push_back(Group{"case", {"case"}, {""}, true, {}, {}});
+    batch_case = &groups.back();
+  }
   // (the q̇ and q̈ columns may be other coordinates than q's: OutputPlan::velocity_columns)
   auto coordinate_unit = [&](const std::vector<Index>& cols, const char* per_time) {
     return [&, per_time](std::size_t k) { return unit_of(model.coordinate_unit(cols[k]), per_time); };
@@ -148,10 +153,10 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   }
   if (Group* g = take("sensitivities", sensitivity_units.size(), [&](std::size_t k) { return sensitivity_units[k]; }))
     outputs.push_back(g);
-  if (at != names.size()) throw Error(cannot("the columns do not match the CSV's (phiq bug)"));
+  if (at != names.size() || groups.size() > 12) throw Error(cannot("the columns do not match the CSV's (phiq bug)"));
   output_row.resize(format.num_output_values());
 
-  block_rows = choose_block_rows(names.size() * sizeof(double), o);
+  block_rows = choose_block_rows((names.size() + o.case_column) * sizeof(double), o);
   if (o.deflate < 0 || o.deflate > 9)
     throw Error(cannot("deflate level " + std::to_string(o.deflate) + " is not 0–9"));
   if (o.deflate > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0) throw Error(cannot("HDF5 has no deflate filter"));
@@ -172,6 +177,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     write_attribute(file.get(), "phiq_version", std::string(kVersion));
     write_attribute(file.get(), "scene_path", o.scene_path);
     write_attribute(file.get(), "scene", o.scene_text);
+    if (o.case_column) write_attribute(file.get(), "batch_format_version", static_cast<long long>(kHdf5BatchFormat));
     for (Group& g : groups) create_dataset(g, o);
   } catch (const Error& e) {
     throw Error(path + ": cannot write: " + e.what());
@@ -241,6 +247,7 @@ void Hdf5Writer::append_row(const StepView& s) {
     const QuietErrors quiet;
     w.flush();
   }
+  if (w.batch_case) throw Error(w.cannot("a batch's rows are given with their case (append_values)"));
   const std::size_t k = w.held_rows;
   // −0 → 0, as the CSV writes it: the two files of a run hold the same doubles
   auto store = [](double v) { return v == 0.0 ? 0.0 : v; };
@@ -269,6 +276,31 @@ void Hdf5Writer::append_row(const StepView& s) {
     const QuietErrors quiet;
     w.flush();
   }
+}
+
+void Hdf5Writer::append_values(const double* row) {
+  Impl& w = *impl_;
+  if (w.closed) throw Error(w.cannot("already closed"));
+  if (w.held_rows == w.block_rows) {  // as append_row()
+    const QuietErrors quiet;
+    w.flush();
+  }
+  const std::size_t k = w.held_rows;
+  for (Group& g : w.groups) {  // in column order: each group takes its slice of the row
+    const std::size_t m = g.columns.size();
+    std::transform(row, row + m, g.held.data() + k * m, [](double v) { return v == 0.0 ? 0.0 : v; });
+    row += m;
+  }
+  if (++w.held_rows == w.block_rows) {
+    const QuietErrors quiet;
+    w.flush();
+  }
+}
+
+std::size_t Hdf5Writer::row_values() const {
+  std::size_t n = 0;
+  for (const Group& g : impl_->groups) n += g.columns.size();
+  return n;
 }
 
 void Hdf5Writer::close() {

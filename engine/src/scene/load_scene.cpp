@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <sstream>
 
+#include "phiq/parsed_scene.hpp"
 #include "phiq/scene.hpp"
 #include "phiq/text.hpp"
 #include "scene/read_scene_file.hpp"
@@ -128,14 +129,8 @@ void build_sensitivity_models(Scene& scene, const std::string& text, const std::
   }
 }
 
-}  // namespace
-
-Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits) {
-  return parse_scene(text, path, limits, SceneOverrides{});
-}
-
-Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits,
-                  const SceneOverrides& overrides) {
+// The checks and the parse of parse_scene(), before the tree is read: what a ParsedScene does once.
+YAML::Node parse_tree(const std::string& text, const std::string& path, const SceneLimits& limits) {
   if (text.size() > limits.max_file_bytes)
     throw SceneError(path + ": the scene is " + std::to_string(text.size() >> 20) + " MiB; the limit is " +
                      std::to_string(limits.max_file_bytes >> 20) + " MiB");
@@ -149,12 +144,16 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
   } catch (const YAML::Exception& e) {
     throw SceneError(yaml_error(path, e));
   }
-  YAML::Node root;
   try {
-    root = YAML::Load(text);
+    return YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw SceneError(yaml_error(path, e));
   }
+}
+
+// The Scene of a parsed tree (parse_scene() after parse_tree()).
+Scene read_tree(const YAML::Node& root, const std::string& text, const std::string& path, const SceneLimits& limits,
+                const SceneOverrides& overrides) {
   detail::scene::SceneReader reader(path, limits);
   reader.overrides_ = &overrides;
   Scene scene = reader.read(root);
@@ -169,6 +168,43 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
   }
   build_sensitivity_models(scene, text, path, limits, overrides);
   return scene;
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits,
+                  const SceneOverrides& overrides) {
+  return read_tree(parse_tree(text, path, limits), text, path, limits, overrides);
+}
+
+struct ParsedScene::Tree {
+  std::string text, path;
+  SceneLimits limits;
+  YAML::Node root;
+};
+
+ParsedScene ParsedScene::load(const std::string& path, const SceneLimits& limits) {
+  return ParsedScene(detail::scene::read_scene_file(path, limits), path, limits);
+}
+
+ParsedScene::ParsedScene(std::string text, std::string path, const SceneLimits& limits)
+    : tree_(std::make_unique<Tree>()) {
+  tree_->root = parse_tree(text, path, limits);
+  tree_->text = std::move(text), tree_->path = std::move(path), tree_->limits = limits;
+}
+
+ParsedScene::ParsedScene(const ParsedScene& other) : ParsedScene(other.text(), other.path(), other.tree_->limits) {}
+ParsedScene::ParsedScene(ParsedScene&&) noexcept = default;
+ParsedScene::~ParsedScene() = default;
+
+Scene ParsedScene::read(const SceneOverrides& overrides) {
+  return read_tree(tree_->root, tree_->text, tree_->path, tree_->limits, overrides);
+}
+const std::string& ParsedScene::text() const { return tree_->text; }
+const std::string& ParsedScene::path() const { return tree_->path; }
+
+Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits) {
+  return parse_scene(text, path, limits, SceneOverrides{});
 }
 
 Scene load_scene(const std::string& path, const SceneLimits& limits) {

@@ -1,0 +1,402 @@
+// `phiq batch SCENE CASES.csv -o OUT.csv|OUT.h5`: every case in one file. The scene is parsed once (a ParsedScene
+// per thread); each case is built from the parsed tree in the thread that sweeps it, when it is its turn, so that
+// no more cases are held than threads run; the cases go to the file in case order as they complete (a finished
+// case waits only for those before it), so that an interrupted or failing batch publishes whole cases, in order.
+#include "batch_file.hpp"
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "cli_support.hpp"
+#include "command_support.hpp"
+#include "result_file.hpp"
+#include "run_summary.hpp"  // a case's outcome as run --summary writes it
+#include "phiq/hdf5_reader.hpp"
+#include "phiq/parsed_scene.hpp"
+#include "phiq/phiq.hpp"
+
+namespace phiq::tools {
+
+bool is_one_file_output(const std::string& path) {
+  if (path.empty() || path.back() == '/') return false;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return false;
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".csv" || phiq::has_hdf5_extension(path);
+}
+
+SceneOverrides case_overrides(const CsvTable& cases, std::size_t k, const std::string& cases_path) {
+  SceneOverrides o;
+  for (std::size_t c = 0; c < cases.columns.size(); ++c) o.parameters.emplace_back(cases.columns[c], cases.rows[k][c]);
+  o.parameters_source = cases_path + ":1";  // the header names them: its errors are no case's
+  return o;
+}
+
+int commit_batch_summary(OutputSet& outputs, AtomicOutputFile& file, const BatchArgs& args, const BatchTotals& t,
+                         nlohmann::ordered_json results, int status) {
+  const auto or_null = [](const std::string& s) {
+    return s.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s);
+  };
+  nlohmann::ordered_json j;
+  j["format"] = phiq::kBatchSummaryFormat;
+  j["phiq"] = phiq::version();
+  j["scene"] = args.scene;
+  j["name"] = or_null(t.scene_name);
+  j["host"] = host_json();
+  j["cases_file"] = args.cases;
+  j["directory"] = or_null(t.directory);
+  j["output"] = or_null(t.output);
+  j["cases"] = t.cases;
+  j["failed"] = t.failed;
+  j["written"] = t.written;
+  j["threads"] = t.threads;
+  j["shared_analyses"] = t.shared_analyses;
+  j["load_seconds"] = t.load_seconds;
+  j["solve_seconds"] = t.solve_seconds;
+  j["results"] = std::move(results);
+  try {
+    file.write(json_text(j, 2) + "\n");
+    outputs.commit_one(file);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  return status;
+}
+
+namespace {
+
+using Nanos = std::atomic<long long>;
+void add_time(Nanos& total, Clock::time_point since_t) {
+  total += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - since_t).count();
+}
+double seconds(const Nanos& n) { return static_cast<double>(n.load()) * 1e-9; }
+
+// A finished case's rows, formatted in the thread that swept it: CSV text (the case column first), or the HDF5
+// row values (Hdf5Writer::append_values: the case first).
+struct CaseRows {
+  bool any = false;  // false: a failed case, left out
+  std::string text;
+  std::vector<double> values;
+};
+
+// What is said about a case once the batch ends: its line on standard error and its --summary entry.
+struct CaseReport {
+  bool complete = false;  // swept to its end (written or failed); not: a case the batch stopped before it ended
+  bool failed = false;
+  std::string line;
+  nlohmann::ordered_json outcome;
+};
+
+// Writes finished cases in case order: a case is written once every case before it has completed; those that
+// complete early wait here (about one per thread when cases take alike). `write` runs under the lock: one case
+// at a time, in order.
+class InOrder {
+ public:
+  explicit InOrder(std::function<void(std::size_t, CaseRows&)> write) : write_(std::move(write)) {}
+  void complete(std::size_t k, CaseRows rows) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    waiting_.emplace(k, std::move(rows));
+    for (auto it = waiting_.begin(); it != waiting_.end() && it->first == next_; it = waiting_.erase(it), ++next_) {
+      write_(it->first, it->second);
+      it->second.any = false, it->second.text.clear(), it->second.values.clear();
+      spare_.push_back(std::move(it->second));
+    }
+  }
+  // The buffers of a written case, emptied, for the next case: a case's 100 KB of rows freed and allocated again
+  // made malloc return memory to the system and take it back each time (brk, TLB flushes: 10 % of a batch).
+  CaseRows spare() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (spare_.empty()) return {};
+    CaseRows rows = std::move(spare_.back());
+    spare_.pop_back();
+    return rows;
+  }
+
+ private:
+  std::function<void(std::size_t, CaseRows&)> write_;
+  std::mutex mutex_;
+  std::map<std::size_t, CaseRows> waiting_;
+  std::vector<CaseRows> spare_;
+  std::size_t next_ = 0;
+};
+
+}  // namespace
+
+int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
+  BatchArgs a = args;
+  if (a.threads <= 0) a.threads = tbb::info::default_concurrency();  // 0: all cores
+  const bool hdf5 = phiq::has_hdf5_extension(a.out);
+  const std::size_t n = cases.rows.size();
+  {
+    std::vector<NamedPath> outs{{"-o", a.out}};
+    if (!a.summary.empty()) outs.push_back({"--summary", a.summary});
+    if (const auto clash = output_clash(outs, {{"the scene", a.scene}, {"the cases", a.cases}}))
+      return fail("batch: " + *clash, 2);
+  }
+  set_interrupt_subject(a.scene, "; no output written");
+  // The scene parsed once; its own parameters' scene is the model every case shares its analysis with, and the
+  // columns' names.
+  const auto load_start = Clock::now();
+  std::vector<phiq::ParsedScene> trees;
+  std::optional<phiq::Scene> reference;
+  try {
+    trees.push_back(phiq::ParsedScene::load(a.scene));
+    reference = trees.front().read();
+  } catch (const phiq::SceneError& e) {
+    return fail(e.what(), 2);
+  }
+  try {  // a header naming no parameter is no case's error: refused before anything runs
+    phiq::SceneOverrides o = case_overrides(cases, 0, a.cases);
+    o.share_analysis_with = reference->model.get();
+    (void)trees.front().read(o);
+  } catch (const phiq::SceneError& e) {
+    if (std::string(e.what()).rfind(a.cases + ":1: ", 0) == 0) return fail(e.what(), 2);
+  }  // (case 0's own error is its own: reported as its failure below)
+  phiq::CsvFormat format(*reference->model, reference->sweep);
+  try {
+    if (a.identifier_names) format.set_naming(phiq::ColumnNaming::kIdentifiers);
+  } catch (const phiq::Error& e) {
+    return fail(a.scene + ": --names identifiers: " + e.what(), 2);
+  }
+  {
+    const std::vector<std::string> names = format.column_names();
+    if (std::find(names.begin(), names.end(), "case") != names.end())
+      return fail(a.scene + ": a column is named 'case', the batch's case column: rename it", 2);
+  }
+  for (int w = 1; w < a.threads; ++w) trees.push_back(trees.front());  // a tree per thread (ParsedScene)
+  const double load_s = since(load_start);
+
+  // The output now: an unwritable path fails before any case runs, and leaves nothing.
+  OutputSet outputs;
+  phiq::AtomicOutputFile* file = nullptr;
+  phiq::AtomicOutputFile* summary_file = nullptr;
+  std::unique_ptr<phiq::Hdf5Writer> h5;  // after `outputs`: closed before its temporary is removed
+  std::uint64_t committed_bytes = 0;
+  try {
+    if (hdf5) check_hdf5_target(a.out);
+    file = &outputs.add(a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
+                                    : phiq::AtomicOutputFile::Hold::kOpen);
+    if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
+    if (hdf5) {
+      phiq::Hdf5Options o;
+      o.scene_path = reference->path;
+      o.scene_text = reference->text;
+      o.expected_rows = static_cast<std::size_t>(phiq::rows_written(reference->sweep)) * n;
+      o.shown_path = file->path();
+      o.case_column = true;
+      h5 = std::make_unique<phiq::Hdf5Writer>(file->temporary_path(), *reference->model, reference->sweep, o);
+    } else {
+      const std::string header = "case," + format.header();
+      file->write(header);
+      committed_bytes = header.size();
+    }
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+
+  // Cases commit in order as they complete. A write error stops the batch: the CSV is cut back to the cases it
+  // holds whole and published; an HDF5 file is not (a failed write may have left its structure half-written).
+  std::atomic<bool> abort{false};
+  std::string write_error;
+  std::vector<char> written(n, 0);
+  std::size_t cases_written = 0;
+  Nanos setup_ns{0}, sweep_ns{0}, format_ns{0}, write_ns{0};
+  InOrder in_order([&](std::size_t k, CaseRows& rows) {
+    if (!rows.any || !write_error.empty()) return;
+    const auto w0 = Clock::now();
+    try {
+      if (h5) {
+        const std::size_t m = h5->row_values();
+        for (std::size_t at = 0; at < rows.values.size(); at += m) h5->append_values(rows.values.data() + at);
+      } else {
+        file->write(rows.text);
+        committed_bytes += rows.text.size();
+      }
+      written[k] = 1;
+      ++cases_written;
+    } catch (const phiq::Error& e) {
+      write_error = e.what();
+      abort = true;
+    }
+    add_time(write_ns, w0);
+  });
+
+  std::vector<CaseReport> reports(n);
+  for (std::size_t k = 0; k < n; ++k)
+    reports[k].outcome = nlohmann::ordered_json{{"case", k}, {"line", k + 2}, {"file", nullptr}};
+  std::atomic<std::size_t> next_case{0};
+  std::atomic<std::size_t> shared{0};  // cases swept on the reference's symbolic analysis
+  const std::atomic<bool>& stop = stop_flag();
+  const std::string left_out = "; left out of " + a.out;
+  // One case, on the thread's own tree: built, made square, swept, its rows formatted, handed to in_order.
+  auto run_case = [&](std::size_t k, phiq::ParsedScene& tree) {
+    CaseReport& report = reports[k];
+    auto fails = [&](const std::string& why) {
+      report.complete = report.failed = true;
+      report.line = a.scene + ": case " + std::to_string(k) + ": " + why + left_out;
+      in_order.complete(k, CaseRows{});
+    };
+    const auto t0 = Clock::now();
+    phiq::SceneOverrides o = case_overrides(cases, k, a.cases);
+    o.share_analysis_with = reference->model.get();
+    std::optional<phiq::Scene> scene;
+    try {
+      scene = tree.read(o);
+    } catch (const phiq::SceneError& e) {  // its parameters make the scene impossible (a negative length)
+      report.outcome["status"] = "scene error";
+      report.outcome["message"] = e.what();
+      add_time(setup_ns, t0);
+      return fails(std::string(e.what()) + " (line " + std::to_string(k + 2) + " of " + a.cases + ")");
+    }
+    phiq::SquareScene square;
+    if (const auto why = make_square(*scene, &square)) {  // as `phiq run`: one that cannot be fails alone
+      phiq::SweepSummary at_start;  // the first position, before any sweep
+      at_start.status = square.assembly.status;
+      at_start.message = *why;
+      at_start.failed_step = 0;
+      at_start.failed_time = scene->sweep.t_begin;
+      at_start.worst_rows = square.assembly.worst_rows;
+      add_outcome(report.outcome, *scene->model, at_start);
+      add_time(setup_ns, t0);
+      return fails(*why);
+    }
+    const phiq::Model& model = square.model(*scene->model);
+    if (model.symbolic() && model.symbolic() == reference->model->symbolic()) ++shared;
+    phiq::Workspace ws(model);
+    ws.q = square.start;
+    phiq::SweepOptions one = scene->sweep;
+    one.threads = 1;  // parallel over cases, not within one
+    const phiq::CsvFormat rows_format(*scene->model, scene->sweep);  // the case's own output points
+    const std::string prefix = std::to_string(k) + ",";
+    CaseRows rows = in_order.spare();
+    bool last = false;
+    std::vector<double> row(h5 ? h5->row_values() : 0);
+    const std::vector<Index>& qd_cols = one.written_velocities();
+    const std::vector<Index>& qdd_cols = one.written_accelerations();
+    add_time(setup_ns, t0);
+    long long format_case_ns = 0;
+    phiq::SweepSummary s;
+    (void)phiq::run_sweep(model, one, ws, [&](const phiq::StepView& step) {
+      const auto f0 = Clock::now();
+      if (h5) {  // the values Hdf5Writer::append_row() would store, the case first
+        double* v = row.data();
+        *v++ = static_cast<double>(k);
+        *v++ = step.t;
+        for (Index c : one.coordinate_columns) *v++ = step.q(c);
+        for (Index c : qd_cols) *v++ = (*step.qd)(c);
+        for (Index c : qdd_cols) *v++ = (*step.qdd)(c);
+        rows_format.append_output_values(step, v);
+        rows.values.insert(rows.values.end(), row.begin(), row.end());
+      } else {
+        rows.text += prefix;
+        rows_format.append_row(step, rows.text);
+      }
+      last = step.step == one.steps;
+      format_case_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - f0).count();
+      return !stop.load() && !abort.load();
+    }, &s);
+    format_ns += format_case_ns;
+    sweep_ns += static_cast<long long>(s.solve_seconds * 1e9) - format_case_ns;
+    add_outcome(report.outcome, model, s);
+    report.outcome["steps"] = s.steps_completed;
+    report.outcome["newton_iterations"] = s.counters.newton_iterations;
+    // (a case whose last row was delivered is complete, even if a signal asked it to stop there)
+    if (s.status == phiq::SolveStatus::kSuccess || (s.status == phiq::SolveStatus::kCancelled && last)) {
+      report.complete = true;
+      report.line = a.scene + ": case " + std::to_string(k) + ": " + s.BriefReport();
+      rows.any = true;
+      in_order.complete(k, std::move(rows));
+    } else if (s.status != phiq::SolveStatus::kCancelled) {
+      fails(s.message);
+    }  // else stopped before its end: it never completes, and no case after it is written
+  };
+
+  const auto solve_start = Clock::now();
+  {
+    StopOnSignal stop_on_signal;  // a signal stops every case at its next row
+    tbb::task_arena arena(a.threads);
+    arena.execute([&] {
+      // a worker per thread taking the next case in order: cases complete about in order, so few wait
+      tbb::parallel_for(
+          0, a.threads,
+          [&](int w) {
+            for (std::size_t k; !stop.load() && !abort.load() && (k = next_case++) < n;) run_case(k, trees[w]);
+          },
+          tbb::simple_partitioner());
+    });
+  }
+  const double solve_s = since(solve_start);
+  const bool interrupted = stop.load();
+
+  // Publish what was committed: every case in order, or (interrupted, write error) the cases before the first
+  // that did not complete.
+  std::string publish_error;
+  bool published = false;
+  try {
+    if (!write_error.empty() && h5) {
+      outputs.drop(*file);
+    } else {
+      if (!write_error.empty()) file->truncate(committed_bytes);
+      if (h5) h5->close();
+      outputs.commit_one(*file);
+      published = true;
+    }
+  } catch (const phiq::Error& e) {
+    publish_error = e.what();
+  }
+  const std::string written_text = std::to_string(published ? cases_written : 0) + " of " + std::to_string(n) +
+                                   " cases written to " + a.out;
+  if (interrupted && write_error.empty() && publish_error.empty())
+    return fail(a.scene + ": " + interrupt_message() + "; " + written_text + " (the cases before the first " +
+                    "unfinished one)",
+                interrupt_exit_status());
+  std::size_t failed = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    CaseReport& r = reports[k];
+    failed += r.failed;
+    if (written[k] && published) r.outcome["file"] = a.out;
+    if (!r.outcome.contains("status")) r.outcome["status"] = "not run";  // the batch stopped before its turn
+    if (r.failed)
+      std::cerr << "phiq: " << printable(r.line) << "\n";
+    else if (!a.quiet && r.complete)
+      std::cerr << "phiq: " << printable(r.line) << "\n";
+  }
+  const bool output_error = !write_error.empty() || !publish_error.empty();
+  if (output_error)  // (the summary, as for -o DIR, is still written: it says which cases are in the file)
+    (void)fail((write_error.empty() ? publish_error : write_error) + "; " + written_text +
+                   (published ? " (whole cases, in order)" : ""),
+               3);
+  else if (!a.quiet)
+    std::cerr << "phiq: " << printable(a.scene) << ": " << n - failed << " of " << n << " cases in "
+              << printable(a.out) << ", " << a.threads << " threads, " << shared.load()
+              << " cases on the scene's symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
+              << scientific(solve_s, 3) << " s (thread-seconds: set-up " << scientific(seconds(setup_ns), 3)
+              << ", sweep " << scientific(seconds(sweep_ns), 3) << ", rows " << scientific(seconds(format_ns), 3)
+              << ", write " << scientific(seconds(write_ns), 3) << ")\n";
+  if (summary_file) {
+    BatchTotals t;
+    t.scene_name = reference->name;
+    t.output = a.out;
+    t.cases = n, t.failed = failed, t.written = published ? cases_written : 0, t.shared_analyses = shared.load();
+    t.threads = a.threads;
+    t.load_seconds = load_s, t.solve_seconds = solve_s;
+    nlohmann::ordered_json results = nlohmann::ordered_json::array();
+    for (CaseReport& r : reports) results.push_back(std::move(r.outcome));
+    return commit_batch_summary(outputs, *summary_file, a, t, std::move(results), output_error ? 3 : failed ? 1 : 0);
+  }
+  return output_error ? 3 : failed ? 1 : 0;
+}
+
+}  // namespace phiq::tools
