@@ -6,6 +6,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "phiq/model.hpp"
@@ -58,6 +59,9 @@ struct Scene {
   std::vector<Frame2> planar_bodies;
   std::vector<Frame3> spatial_bodies;  ///< see planar_bodies
   std::vector<JointAngleReference> joint_angles;  ///< the reference directions of the joint angle drivers
+  /// The scene's `parameters` in file order, with the values the model was built with (the caller's overrides
+  /// applied): what a tool that moves them (`phiq tolerance`) starts from.
+  std::vector<std::pair<std::string, double>> parameters;
   std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: a CsvFormat keeps its address)
   /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns
   /// written, coordinates defaulting to all).

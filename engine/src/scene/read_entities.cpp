@@ -34,6 +34,7 @@ void SceneReader::read_parameters(const Cursor& c) {
     if (!valid_name(name)) value.fail("'" + name + "' is not a valid parameter name");
     if (name == "t" || name == "pi") value.fail("'" + name + "' is reserved");
     parameters_[name] = number(value);  // may use the parameters above it
+    parameter_order_.push_back(name);
     if (overrides_)
       for (const auto& [n, v] : overrides_->parameters)
         if (n == name) parameters_[name] = v;

@@ -24,6 +24,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   if (overrides_ && overrides_->share_analysis_with) builder_.share_analysis_with(*overrides_->share_analysis_with);
   if (auto d = top.field("dimension"); d.present()) spatial_ = d.integer(2, 3) == 3;
   read_parameters(top.field("parameters"));
+  for (const std::string& p : parameter_order_) scene.parameters.emplace_back(p, parameters_.at(p));
   check_family_total(top);  // the parameters give the ranges of the families in the sections
   read_coordinates(top.field("coordinates"));
   if (auto p = top.field("points"); p.present()) read_points(p);

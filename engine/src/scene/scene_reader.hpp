@@ -200,6 +200,7 @@ class SceneReader {
 
  private:
   std::unordered_map<std::string, double> parameters_;
+  std::vector<std::string> parameter_order_;  // the names of parameters_ in file order (Scene::parameters)
   NameTable<Point2> points_;
   NameTable<Frame2> bodies_;
   bool spatial_ = false;  // dimension: 3
