@@ -1,6 +1,7 @@
 // `phiq tolerance`: the first-order spread of the crank-slider's slider against its closed form (normal, ± limit and
 // correlated parameters), the Monte Carlo spread within its standard error of it, reproducible samples, a four-bar
-// whose tolerance makes cases fail to assemble (counted, named, disagreeing), and bad input refused.
+// whose tolerance makes cases fail to assemble (counted, named, disagreeing), a parameter nothing reads (reported),
+// and bad input refused.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -145,15 +146,19 @@ TEST_F(Cli, ToleranceSamplesAreReproducible) {
   EXPECT_FALSE(a.empty());
   EXPECT_EQ(a, b);
   EXPECT_NE(a, c);
-  // the samples are those of the library's stream: its first case is the mean of the samples when there is one
+  // the library's samples: the same for the same seed, the uniform parameter within its limit, the normal one
+  // beyond 1.96 σ in 5 % of the cases (Box–Muller's tails: 50 of 1000 expected, binomial sd 7; within 4 of them)
   phiq::tolerance::Tolerance l2, l3;
   l2.name = "L2", l2.spread = 0.001;
   l3.name = "L3", l3.spread = 0.002, l3.distribution = phiq::tolerance::Distribution::kUniform;
   const auto spread = phiq::tolerance::parameter_spread({l2, l3}, nullptr);
-  const Eigen::MatrixXd d = phiq::tolerance::sample_offsets(spread, 2, 7);
-  EXPECT_NE(d(0, 0), d(1, 0));
-  EXPECT_LE(std::fabs(d(0, 1)), 0.002);  // the uniform one within its limit
-  EXPECT_LE(std::fabs(d(1, 1)), 0.002);
+  const Eigen::MatrixXd d = phiq::tolerance::sample_offsets(spread, 1000, 7);
+  EXPECT_EQ(d, phiq::tolerance::sample_offsets(spread, 1000, 7));
+  EXPECT_NE(d, phiq::tolerance::sample_offsets(spread, 1000, 8));
+  EXPECT_LE(d.col(1).cwiseAbs().maxCoeff(), 0.002);
+  const long tails = (d.col(0).array().abs() > 1.96 * 0.001).count();
+  EXPECT_GE(tails, 50 - 4 * 7);
+  EXPECT_LE(tails, 50 + 4 * 7);
 }
 
 // A four-bar whose ground length L1 below 0.6 lets the crank (0.4) not turn: those sampled cases fail to assemble
@@ -190,6 +195,30 @@ TEST_F(Cli, ToleranceNamesFailedCasesAndReportsDisagreementNearSingularPositions
   EXPECT_GE(j["disagreeing"].get<int>(), 1);
   EXPECT_NE(r.err.find("disagree"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("singular position"), std::string::npos) << r.err;
+}
+
+// A parameter nothing reads: its sensitivities are zero at every row, which is reported (stderr, summary), not an
+// error; the spread is the other parameter's alone.
+TEST_F(Cli, ToleranceReportsAParameterNoOutputDependsOn) {
+  std::string text = slurp(kCrankSlider);
+  const std::string l3 = "  L3: 1.0     # m\n";
+  ASSERT_NE(text.find(l3), std::string::npos);
+  text.replace(text.find(l3), l3.size(), l3 + "  spare: 2.0\n");
+  const fs::path scene = write("spare.yaml", text), out = dir_ / "tol.csv", summary = dir_ / "tol.json";
+  const Result r = run("tolerance " + scene.string() + " --sd spare=0.1 --sd L3=0.002 --columns xB --samples 100 -o " +
+                       out.string() + " --summary " + summary.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("note: no output depends on spare (its sensitivities are zero at every row)"),
+            std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(slurp(summary));
+  EXPECT_EQ(j["parameters"][0]["name"], "spare");
+  EXPECT_EQ(j["parameters"][0]["independent"], true);
+  EXPECT_EQ(j["parameters"][1]["independent"], false);
+  const phiq::CsvTable table = phiq::read_csv_table(out.string());
+  for (std::size_t row = 0; row < table.rows.size(); ++row) {
+    const double closed = std::fabs(slider_gradient(table.rows[row][0]).l3) * 0.002;
+    EXPECT_NEAR(column(table, row, "xB.sd_linear"), closed, 1e-9 * closed);
+  }
 }
 
 // Bad input: one line, exit 2, no output file.
