@@ -25,5 +25,6 @@ Command register_plot(CLI::App& app);
 Command register_animate(CLI::App& app);
 Command register_compare(CLI::App& app);
 Command register_sweep_accuracy(CLI::App& app);
+Command register_tolerance(CLI::App& app);
 
 }  // namespace phiq::tools

@@ -36,12 +36,15 @@ int main(int argc, char** argv) {
                                         std::to_string(phiq::kRunSummaryFormat) + ", batch --summary format " +
                                         std::to_string(phiq::kBatchSummaryFormat) + ", sweep-accuracy --json format " +
                                         std::to_string(phiq::kSweepAccuracyJsonFormat) + ", compare --json format " +
-                                        std::to_string(phiq::kCompareJsonFormat) + ")");
+                                        std::to_string(phiq::kCompareJsonFormat) + ", tolerance CSV format " +
+                                        std::to_string(phiq::kToleranceCsvFormat) + ", tolerance --summary format " +
+                                        std::to_string(phiq::kToleranceSummaryFormat) + ")");
   app.require_subcommand(1);
   const std::vector<Command> commands{register_run(app),    register_generate(app), register_batch(app),
                                       register_assemble(app), register_check(app),  register_plot(app),
                                       register_animate(app),
-                                      register_compare(app),  register_sweep_accuracy(app)};
+                                      register_compare(app),  register_sweep_accuracy(app),
+                                      register_tolerance(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

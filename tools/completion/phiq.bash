@@ -11,7 +11,7 @@ _phiq() {
     words=("${COMP_WORDS[@]}")
     cword=$COMP_CWORD
   }
-  local commands="run check assemble batch compare generate plot animate sweep-accuracy"
+  local commands="run check assemble batch compare generate plot animate sweep-accuracy tolerance"
   local cmd="" i
   for ((i = 1; i < cword; i++)); do
     case " $commands " in *" ${words[i]} "*) cmd="${words[i]}"; break ;; esac
@@ -33,6 +33,8 @@ _phiq() {
     animate) opts="--help --output --columns" ;;
     sweep-accuracy) opts="--help --output --json --tolerances --steps-list --predictors --newton --linear-solvers
                           --reference --repeat --quiet --verbose" ;;
+    tolerance) opts="--help --output --sd --limit --covariance --samples --seed --columns --threshold --summary --plot
+                     --plot-column --threads --names --quiet" ;;
   esac
 
   # values of the options that take a fixed set of words, or files
@@ -46,9 +48,9 @@ _phiq() {
     --predictors) COMPREPLY=($(compgen -W "auto previous secant parabolic linear hermite quadratic cubic" -- "$cur")); return ;;
     --reference) COMPREPLY=($(compgen -W "auto numerical closed-form:crank-slider closed-form:fourbar
                                           closed-form:nfourbar closed-form:chain3d" -- "$cur")); return ;;
-    --summary|--junit|-o|--output) COMPREPLY=($(compgen -f -- "$cur")); return ;;
+    --summary|--junit|-o|--output|--covariance|--plot) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     --threads|--memory|--steps|--from|--to|--twist|--time|--rtol|--atol|--columns|--positions|--tolerances|\
-    --steps-list|--repeat|--outputs|--deflate) return ;;  # a value of the user's
+    --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column) return ;;  # a value of the user's
   esac
   if [[ "$cur" == -* ]]; then
     COMPREPLY=($(compgen -W "$opts" -- "$cur"))

@@ -1,0 +1,434 @@
+// `phiq tolerance SCENE --sd P=σ ... -o OUT.csv`: the spread of the scene's outputs over toleranced parameters,
+// first order from the exact sensitivities of one nominal sweep, and Monte Carlo from sampled parameter sets swept in
+// parallel on the nominal model's symbolic analysis (run_batch), with their agreement. The numbers are
+// tools/tolerance/; what is written, tolerance_report.*; the format, tools/README.md.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <set>
+
+#include "cli_support.hpp"
+#include "command_line.hpp"
+#include "command_support.hpp"
+#include "commands.hpp"
+#include "tolerance_input.hpp"
+#include "tolerance_report.hpp"
+#include "tolerance_spread.hpp"
+#include "phiq/phiq.hpp"
+
+namespace phiq::tools {
+
+namespace {
+
+using tolerance::OutputSpread;
+using tolerance::ParameterSpread;
+
+struct ToleranceArgs {
+  std::string scene, out, summary, plot, plot_column, covariance;
+  std::vector<std::string> sd, limit, columns;
+  long samples = 1000;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  double threshold = 4.0;
+  std::string names = "dotted";
+  bool quiet = false;
+};
+
+// An output: coordinate `coordinate`'s value (order 0), velocity (1) or acceleration (2).
+struct OutputColumn {
+  std::string name;  // dotted
+  Index coordinate = 0;
+  int order = 0;
+};
+
+// The coordinate columns the scene writes (with `.v` / `.a` when it writes them), the outputs by default.
+std::vector<OutputColumn> written_columns(const Scene& scene) {
+  std::vector<OutputColumn> cols;
+  const auto& names = scene.model->coordinate_names();
+  for (Index j : scene.sweep.coordinate_columns) cols.push_back({names[static_cast<std::size_t>(j)], j, 0});
+  for (Index j : scene.sweep.written_velocities()) cols.push_back({names[static_cast<std::size_t>(j)] + ".v", j, 1});
+  for (Index j : scene.sweep.written_accelerations()) cols.push_back({names[static_cast<std::size_t>(j)] + ".a", j, 2});
+  return cols;
+}
+
+// The outputs asked for by --columns (dotted or identifier names): a coordinate, with `.v` / `.a` when the scene
+// solves velocities / accelerations. Throws phiq::Error naming the first that is none.
+std::vector<OutputColumn> asked_columns(const Scene& scene, const std::vector<std::string>& asked) {
+  std::vector<OutputColumn> all;
+  const auto& names = scene.model->coordinate_names();
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    const Index i = static_cast<Index>(j);
+    all.push_back({names[j], i, 0});
+    if (scene.sweep.velocities) all.push_back({names[j] + ".v", i, 1});
+    if (scene.sweep.accelerations) all.push_back({names[j] + ".a", i, 2});
+  }
+  std::vector<OutputColumn> cols;
+  for (const std::string& a : asked) {
+    const OutputColumn* found = nullptr;
+    for (const OutputColumn& c : all)
+      if (c.name == a || identifier_column_name(c.name) == a) found = &c;
+    if (!found) {
+      std::vector<std::string> listed;
+      for (const OutputColumn& c : written_columns(scene)) listed.push_back(c.name);
+      throw Error("--columns: '" + a + "' is not an output of " + scene.path +
+                  " (a coordinate, with .v / .a when the scene solves velocities / accelerations; its columns: " +
+                  joined(listed) + ")");
+    }
+    for (const OutputColumn& c : cols)
+      if (c.name == found->name) throw Error("--columns: '" + a + "' is listed twice");
+    cols.push_back(*found);
+  }
+  return cols;
+}
+
+// The sweep of a sampled case computes the outputs' coordinates and derivatives only: no points, joints,
+// orientations, residuals, rcond or sensitivities (they cost time and nothing here reads them).
+SweepOptions case_sweep(SweepOptions o) {
+  o.sensitivities.clear();
+  o.points.clear(), o.joints.clear(), o.orientations.clear();
+  o.residuals = false, o.condition = false;
+  o.residual_columns.clear(), o.max_residual_column = false, o.driver_columns.clear();
+  return o;
+}
+
+int cmd_tolerance(const ToleranceArgs& a) {
+  std::vector<NamedPath> outs{{"-o", a.out}};
+  if (!a.summary.empty()) outs.push_back({"--summary", a.summary});
+  if (!a.plot.empty()) outs.push_back({"--plot", a.plot});
+  if (const auto clash = output_clash(outs, {{"the scene", a.scene}, {"the covariance", a.covariance}}))
+    return fail("tolerance: " + *clash, 2);
+
+  // ---- the parameters, their covariance and the scene
+  std::vector<tolerance::Tolerance> given;
+  std::optional<tolerance::Covariance> covariance;
+  ParameterSpread spread;
+  try {
+    for (const std::string& s : a.sd) given.push_back(tolerance::parse_tolerance("--sd", s));
+    for (const std::string& s : a.limit) given.push_back(tolerance::parse_tolerance("--limit", s));
+    if (!a.covariance.empty()) covariance = tolerance::read_covariance(a.covariance);
+    if (given.empty() && !covariance)
+      throw Error("no toleranced parameter: give --sd NAME=SD, --limit NAME=L or --covariance FILE");
+    spread = tolerance::parameter_spread(given, covariance ? &*covariance : nullptr);
+  } catch (const Error& e) {
+    return fail("tolerance: " + std::string(e.what()), 2);
+  }
+  set_interrupt_subject(a.scene, "; no output written");
+  Scene scene;
+  try {
+    SceneOverrides o;
+    o.sensitivity_models = false;  // the scene's own output.sensitivities are not swept here
+    scene = load_scene(a.scene, SceneLimits{}, o);
+  } catch (const SceneError& e) {
+    return fail(e.what(), 2);
+  }
+  std::vector<double> nominal;
+  for (const tolerance::Tolerance& t : spread.parameters) {
+    const auto it = std::find_if(scene.parameters.begin(), scene.parameters.end(),
+                                 [&](const auto& p) { return p.first == t.name; });
+    if (it == scene.parameters.end()) {
+      std::vector<std::string> names;
+      for (const auto& p : scene.parameters) names.push_back(p.first);
+      const std::string where = t.from_covariance ? a.covariance
+                                : t.distribution == tolerance::Distribution::kUniform ? "tolerance: --limit"
+                                                                                      : "tolerance: --sd";
+      return fail(where + ": '" + t.name + "' is not a parameter of " + a.scene +
+                      (names.empty() ? " (it has none)" : " (its parameters: " + joined(names) + ")"),
+                  2);
+    }
+    nominal.push_back(it->second);
+  }
+  std::vector<OutputColumn> columns;
+  try {
+    columns = a.columns.empty() ? written_columns(scene) : asked_columns(scene, a.columns);
+  } catch (const Error& e) {
+    return fail("tolerance: " + std::string(e.what()), 2);
+  }
+  if (columns.empty()) return fail("tolerance: " + a.scene + " writes no coordinate column: give --columns", 2);
+  std::size_t plotted = 0;
+  if (!a.plot_column.empty()) {
+    auto it = std::find_if(columns.begin(), columns.end(), [&](const OutputColumn& c) {
+      return c.name == a.plot_column || identifier_column_name(c.name) == a.plot_column;
+    });
+    if (it == columns.end())
+      return fail("tolerance: --plot-column: '" + a.plot_column + "' is not one of the outputs (--columns)", 2);
+    plotted = static_cast<std::size_t>(it - columns.begin());
+  }
+  const bool identifiers = a.names == "identifiers";
+  if (identifiers) {  // names that would collide as identifiers: the scene's to change
+    std::set<std::string> seen{"t"};
+    for (const OutputColumn& c : columns)
+      for (const char* suffix : {"", ".sd_linear", ".sd_mc", ".mean_mc"})
+        if (!seen.insert(identifier_column_name(c.name + suffix)).second)
+          return fail("tolerance: --names identifiers: two columns would be named " +
+                          identifier_column_name(c.name + suffix),
+                      2);
+  }
+
+  // ---- the models along each parameter (sensitivities), sharing the nominal model's analysis
+  scene.sweep.sensitivities.clear();  // the scene's own (read without their models)
+  for (std::size_t j = 0; j < spread.parameters.size(); ++j) {
+    OutputSensitivity s;
+    s.name = spread.parameters[j].name, s.value = nominal[j], s.step = default_sensitivity_step(nominal[j]);
+    const double shifts[4] = {-2.0, -1.0, 1.0, 2.0};
+    for (std::size_t k = 0; k < 4; ++k) {
+      SceneOverrides o;
+      o.parameters = {{s.name, s.value + shifts[k] * s.step}};
+      o.share_analysis_with = scene.model.get();
+      o.sensitivity_models = false;
+      try {
+        s.models[k] = std::shared_ptr<const Model>(parse_scene(scene.text, scene.path, {}, o).model);
+      } catch (const SceneError& e) {
+        return fail(a.scene + ": with " + s.name + " = " + shortest(s.value + shifts[k] * s.step) +
+                        " (its difference step) the scene cannot be read: " + e.what(),
+                    2);
+      }
+    }
+    if (const std::string why = check_sensitivity_models(*scene.model, s); !why.empty())
+      return fail(a.scene + ": " + why, 2);
+    scene.sweep.sensitivities.push_back(std::move(s));
+  }
+
+  // Every output exists before the sweeps: an unwritable path fails now; all are committed together at the end.
+  OutputSet outputs;
+  AtomicOutputFile *csv_file = nullptr, *summary_file = nullptr, *plot_file = nullptr;
+  try {
+    csv_file = &outputs.add(a.out);
+    if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
+    if (!a.plot.empty()) plot_file = &outputs.add(a.plot);
+  } catch (const Error& e) {
+    return fail(e.what(), 3);
+  }
+  const auto start = Clock::now();
+  StopOnSignal stop_on_signal;
+  const std::atomic<bool>& stop = stop_flag();
+
+  // ---- the nominal sweep: values and first-order spreads
+  SquareScene square;
+  if (const auto why = make_square(scene, &square)) return fail(a.scene + ": the nominal scene: " + *why, 1);
+  const Model& model = square.model(*scene.model);
+  const std::size_t np = spread.parameters.size();
+  const SensitivityLayout layout{model.num_coordinates()};
+  std::vector<double> t;
+  std::vector<OutputSpread> spreads(columns.size());
+  for (std::size_t o = 0; o < columns.size(); ++o) spreads[o].name = columns[o].name;
+  std::vector<double> largest_sensitivity(np, 0.0);
+  SweepSummary nominal_summary;
+  {
+    Workspace ws(model);
+    ws.q = square.start;
+    Eigen::VectorXd g(static_cast<Eigen::Index>(np));
+    (void)run_sweep(model, scene.sweep, ws, [&](const StepView& step) {
+      t.push_back(step.t);
+      for (std::size_t o = 0; o < columns.size(); ++o) {
+        const OutputColumn& c = columns[o];
+        const Eigen::VectorXd& v = c.order == 0 ? step.q : c.order == 1 ? *step.qd : *step.qdd;
+        spreads[o].nominal.push_back(v(c.coordinate));
+        for (std::size_t j = 0; j < np; ++j) {
+          g(static_cast<Eigen::Index>(j)) = step.sensitivities[layout.offset(j, c.order) + c.coordinate];
+          if (std::isfinite(g(static_cast<Eigen::Index>(j))))
+            largest_sensitivity[j] = std::max(largest_sensitivity[j], std::fabs(g(static_cast<Eigen::Index>(j))));
+        }
+        spreads[o].sd_linear.push_back(tolerance::linear_sd(g, spread.sigma));
+      }
+      return !stop.load();
+    }, &nominal_summary);
+  }
+  if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
+  if (nominal_summary.status != SolveStatus::kSuccess)
+    return fail(a.scene + ": the nominal scene: " + nominal_summary.message + "; no output written", 1);
+
+  // ---- the sampled cases: built in order (each shares the nominal model's analysis), swept in parallel
+  const Eigen::MatrixXd offsets = tolerance::sample_offsets(spread, a.samples, a.seed);
+  const auto n_cases = static_cast<std::size_t>(a.samples);
+  std::vector<Scene> scenes(n_cases);
+  std::vector<SquareScene> squares(n_cases);
+  std::vector<std::string> why_failed(n_cases);
+  std::vector<const Model*> models;
+  std::vector<SweepOptions> sweeps;
+  std::vector<Eigen::VectorXd> starts;
+  std::vector<std::size_t> swept;
+  auto values_of = [&](std::size_t k) {
+    std::vector<double> v(np);
+    for (std::size_t j = 0; j < np; ++j) v[j] = nominal[j] + offsets(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
+    return v;
+  };
+  for (std::size_t k = 0; k < n_cases; ++k) {
+    SceneOverrides o;
+    const std::vector<double> v = values_of(k);
+    for (std::size_t j = 0; j < np; ++j) o.parameters.emplace_back(spread.parameters[j].name, v[j]);
+    o.share_analysis_with = scene.model.get();
+    o.sensitivity_models = false;
+    try {
+      scenes[k] = parse_scene(scene.text, scene.path, {}, o);
+    } catch (const SceneError& e) {  // a value the scene refuses (a negative length): this case's failure
+      why_failed[k] = e.what();
+      continue;
+    }
+    if (const auto why = make_square(scenes[k], &squares[k])) {
+      why_failed[k] = *why;
+      continue;
+    }
+    models.push_back(&squares[k].model(*scenes[k].model));
+    sweeps.push_back(case_sweep(scenes[k].sweep));
+    starts.push_back(squares[k].start);
+    swept.push_back(k);
+    if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
+  }
+  tolerance::CaseValues cases;
+  cases.rows = t.size(), cases.outputs = columns.size();
+  cases.values.resize(n_cases);
+  std::vector<std::size_t> rows_seen(n_cases, 0);
+  // Each case writes only its own vector: safe across cases without a lock.
+  const BatchSummary batch = run_batch(models, sweeps, a.threads, [&](std::size_t c, const StepView& step) {
+    const std::size_t k = swept[c];
+    std::vector<double>& v = cases.values[k];
+    const std::size_t r = rows_seen[k]++;
+    if (r >= t.size() || std::fabs(step.t - t[r]) > 1e-12 * (1.0 + std::fabs(t[r]))) {
+      why_failed[k] = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
+      v.clear();
+      return false;
+    }
+    if (v.empty()) v.reserve(t.size() * columns.size());
+    for (const OutputColumn& col : columns)
+      v.push_back((col.order == 0 ? step.q : col.order == 1 ? *step.qd : *step.qdd)(col.coordinate));
+    return !stop.load();
+  }, &starts);
+  if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
+  std::vector<FailedCase> failed;
+  for (std::size_t c = 0; c < swept.size(); ++c) {
+    const std::size_t k = swept[c];
+    const SweepSummary& s = batch.cases[c];
+    if (why_failed[k].empty() && s.status != SolveStatus::kSuccess) why_failed[k] = s.message;
+    if (why_failed[k].empty() && rows_seen[k] != t.size())
+      why_failed[k] = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
+  }
+  for (std::size_t k = 0; k < n_cases; ++k)
+    if (!why_failed[k].empty()) {
+      cases.values[k].clear();
+      failed.push_back({k, values_of(k), why_failed[k]});
+    }
+  const std::size_t succeeded = cases.succeeded();
+
+  // ---- the Monte Carlo moments and the agreement
+  tolerance::monte_carlo_moments(cases, spreads);
+  // a spread at the solver's tolerance is its noise, not the tolerances' (tolerance_spread.hpp)
+  ToleranceRun run;
+  run.floor = 10.0 * scene.sweep.newton.tolerance * std::max(model.length_scale(), 1.0);
+  for (OutputSpread& s : spreads) {
+    double scale = 1.0;
+    for (double y : s.nominal) scale = std::max(scale, std::fabs(y));
+    s.agreement = tolerance::agreement(s, t, succeeded, run.floor * scale, a.threshold);
+  }
+  run.scene_path = a.scene, run.scene_name = scene.name, run.spread = &spread, run.nominal = nominal;
+  run.covariance_file = a.covariance, run.samples = a.samples, run.seed = a.seed, run.threshold = a.threshold;
+  run.failed = failed, run.threads = batch.threads, run.solve_seconds = since(start);
+  for (std::size_t j = 0; j < np; ++j)
+    if (largest_sensitivity[j] == 0.0) run.independent.push_back(spread.parameters[j].name);
+  if (succeeded < 2)
+    return fail(a.scene + ": " + std::to_string(succeeded) + " of " + std::to_string(n_cases) +
+                    " sampled cases succeeded: no Monte Carlo spread (first failure: " +
+                    (failed.empty() ? std::string("none") : case_label(failed.front(), spread) + ": " + failed.front().message) +
+                    "); no output written",
+                1);
+
+  // ---- the outputs, committed together
+  try {
+    csv_file->write(tolerance_csv(t, spreads, identifiers));
+    if (summary_file) summary_file->write(json_text(tolerance_summary(run, spreads), 2) + "\n");
+    if (plot_file) plot_file->write(tolerance_svg(scene, t, spreads[plotted], succeeded));
+    outputs.commit();
+  } catch (const Error& e) {
+    return fail(e.what(), 3);
+  }
+
+  // ---- the report on standard error: failures always, the rest unless --quiet
+  const std::size_t shown = std::min<std::size_t>(failed.size(), 20);
+  for (std::size_t i = 0; i < shown; ++i)
+    std::cerr << "phiq: " << printable(a.scene + ": " + case_label(failed[i], spread) + ": " + failed[i].message) << "\n";
+  if (failed.size() > shown)
+    std::cerr << "phiq: " << printable(a.scene) << ": and " << failed.size() - shown << " more failed cases"
+              << (summary_file ? " (all named in the summary)" : " (--summary names them all)") << "\n";
+  if (!failed.empty())
+    std::cerr << "phiq: " << printable(a.scene) << ": " << failed.size() << " of " << n_cases
+              << " sampled cases failed (left out of the Monte Carlo spread)\n";
+  for (const std::string& p : run.independent)
+    std::cerr << "phiq: " << printable(a.scene) << ": note: no output depends on " << p
+              << " (its sensitivities are zero at every row)\n";
+  std::size_t disagreeing = 0;
+  for (const OutputSpread& s : spreads) {
+    if (!s.agreement.disagrees) continue;
+    ++disagreeing;
+    std::cerr << "phiq: " << printable(a.scene + ": " + s.name) << ": linear and Monte Carlo spreads disagree: "
+              << significant(s.agreement.worst, 3) << " standard errors at t = " << format_time(s.agreement.worst_t)
+              << " (sd_linear " << significant(s.agreement.sd_linear_at_worst, 4) << ", sd_mc "
+              << significant(s.agreement.sd_mc_at_worst, 4)
+              << "; expected near a singular position, where the first-order model fails)\n";
+  }
+  if (!a.quiet) {
+    double worst = 0.0;
+    std::string where;
+    for (const OutputSpread& s : spreads)
+      if (s.agreement.worst >= worst) worst = s.agreement.worst, where = s.name;
+    std::cerr << "phiq: " << printable(a.scene) << ": " << succeeded << " of " << n_cases << " cases on "
+              << batch.threads << " threads, " << columns.size() << " outputs, " << disagreeing
+              << " disagreeing (worst " << significant(worst, 3) << " standard errors, " << printable(where)
+              << "; threshold " << significant(a.threshold, 3) << "), " << scientific(run.solve_seconds, 3)
+              << " s; wrote " << printable(a.out) << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command register_tolerance(CLI::App& app) {
+  auto a = std::make_shared<ToleranceArgs>();
+  CLI::App* tol = app.add_subcommand(
+      "tolerance", "Spread of the outputs over toleranced parameters: first order (sensitivities) and Monte Carlo");
+  tol->add_option("scene", a->scene, "Scene file (YAML)")->required();
+  tol->add_option("-o,--output", a->out, "CSV to write: t, then per output y, y.sd_linear, y.sd_mc, y.mean_mc "
+                                         "('-': standard output)")
+      ->required()
+      ->transform(output_path("", false));
+  tol->add_option("--sd", a->sd, "NAME=SD: the parameter is normal with this standard deviation (repeat per parameter)")
+      ->allow_extra_args(false);  // one NAME=SD an occurrence: the scene after it stays the scene
+  tol->add_option("--limit", a->limit, "NAME=L: the parameter is uniform on [p - L, p + L] (standard deviation L/sqrt(3))")
+      ->allow_extra_args(false);
+  tol->add_option("--covariance", a->covariance,
+                  "CSV: a header of parameter names and their covariance matrix (symmetric positive definite), one "
+                  "row per parameter; normal, correlated");
+  tol->add_option("--samples", a->samples, "Monte Carlo parameter sets")
+      ->capture_default_str()
+      ->check(whole_number(2, 10'000'000));
+  tol->add_option("--seed", a->seed, "Seed of the samples (std::mt19937_64, Box-Muller): the same seed, the same bytes")
+      ->capture_default_str()
+      ->check(any_whole_number());
+  tol->add_option("--columns", a->columns,
+                  "Outputs: coordinates, with .v/.a (default: every coordinate column the scene writes)")
+      ->delimiter(',');
+  tol->add_option("--threshold", a->threshold,
+                  "Standard errors beyond which the linear and Monte Carlo spreads of an output disagree")
+      ->capture_default_str()
+      ->check(number(0.0, 1e6, false, "a positive number of standard errors"));
+  tol->add_option("--summary", a->summary, "Write the JSON summary (parameters, covariance, failed cases, agreement) "
+                                            "to this file ('-': standard output)")
+      ->transform(output_path("", false));
+  tol->add_option("--plot", a->plot, "Write an SVG of one output with its nominal curve and both ±2σ bands")
+      ->transform(output_path("", false));
+  tol->add_option("--plot-column", a->plot_column, "The output --plot draws (default: the first)");
+  tol->add_option("--threads", a->threads, "Threads for the cases (0: all cores)")
+      ->capture_default_str()
+      ->check(thread_count());
+  tol->add_option("--names", a->names, "Column names: dotted (xB.sd_mc) or identifiers (xB__sd_mc), as run's")
+      ->capture_default_str()
+      ->check(one_of({"dotted", "identifiers"}));
+  tol->add_flag("-q,--quiet", a->quiet, "Print only failed cases and disagreements on standard error");
+  return {tol, [a] {
+            a->threads = cap_threads("tolerance", a->threads, a->quiet);
+            return with_stdout_checked(cmd_tolerance(*a));
+          }};
+}
+
+}  // namespace phiq::tools
