@@ -17,6 +17,7 @@
 #include "tolerance_input.hpp"
 #include "tolerance_report.hpp"
 #include "tolerance_spread.hpp"
+#include "phiq/parsed_scene.hpp"  // the cases, read from one parse
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -255,6 +256,8 @@ int cmd_tolerance(const ToleranceArgs& a) {
     for (std::size_t j = 0; j < np; ++j) v[j] = nominal[j] + offsets(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
     return v;
   };
+  // The cases are read from the scene parsed once (ParsedScene: no YAML parse per case).
+  ParsedScene parsed(scene.text, scene.path);
   for (std::size_t k = 0; k < n_cases; ++k) {
     SceneOverrides o;
     const std::vector<double> v = values_of(k);
@@ -262,7 +265,7 @@ int cmd_tolerance(const ToleranceArgs& a) {
     o.share_analysis_with = scene.model.get();
     o.sensitivity_models = false;
     try {
-      scenes[k] = parse_scene(scene.text, scene.path, {}, o);
+      scenes[k] = parsed.read(o);
     } catch (const SceneError& e) {  // a value the scene refuses (a negative length): this case's failure
       why_failed[k] = e.what();
       continue;
