@@ -225,10 +225,6 @@ void Sweeper::restore() {
   if (need_a_) ws_->qdd = current_.qdd;
 }
 
-}  // namespace phiq::detail
-
-namespace phiq::detail {
-
 void Sweeper::row_sensitivities() {
   std::fill(sensitivities_.begin(), sensitivities_.end(), std::numeric_limits<double>::quiet_NaN());
   // At a singular position Φq has no inverse: the sensitivities are not defined (NaN; the row's bifurcation
