@@ -6,6 +6,7 @@
 #include <limits>
 #include <string>
 
+#include "phiq/evaluation.hpp"  // JacobianView: Φq over values held here
 #include "phiq/text.hpp"
 #include "solve/factorisation.hpp"
 #include "solve/sensitivity_internal.hpp"
@@ -17,16 +18,6 @@ namespace {
 // The shifts of the four models, in units of h, and the weights of D f = Σ w_k f(k h) / (12 h).
 constexpr std::array<double, 4> kShift = {-2.0, -1.0, 1.0, 2.0};
 constexpr std::array<double, 4> kWeight = {1.0, -8.0, 8.0, -1.0};
-
-// y = A x for A = values in `pattern` (m × n).
-void multiply(const CscPattern& pattern, const std::vector<double>& values, const double* x, Eigen::VectorXd& y) {
-  y.setZero();
-  for (Index j = 0; j < pattern.cols; ++j) {
-    const double xj = x[j];
-    if (xj == 0.0) continue;
-    for (Index e = pattern.col_ptr[j]; e < pattern.col_ptr[j + 1]; ++e) y(pattern.row_idx[e]) += values[e] * xj;
-  }
-}
 
 }  // namespace
 
@@ -57,7 +48,13 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   const SensitivityLayout layout{n};
   for (auto& f : sc.f) f.resize(m);
   sc.d.resize(m), sc.qk.resize(n), sc.vk.resize(n);
-  sc.jacobian.resize(static_cast<std::size_t>(model.jacobian_pattern().nnz()));
+  const CscPattern& pattern = model.jacobian_pattern();  // (every model along a parameter has it: checked)
+  if (order >= 1)
+    for (auto& values : sc.jacobian) values.resize(static_cast<std::size_t>(pattern.nnz()));
+  auto jacobian = [&](std::size_t k) {
+    return JacobianView(pattern.rows, pattern.cols, pattern.nnz(), pattern.col_ptr.data(), pattern.row_idx.data(),
+                        sc.jacobian[k].data());
+  };
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::fill(out, out + layout.size(parameters.size()), nan);
   const Eigen::Map<const Eigen::VectorXd> qv(q, n);
@@ -79,26 +76,26 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     for (std::size_t k = 0; k < 4; ++k) p.models[k]->residual(q, t, sc.f[k].data());
     if (!solve_difference(s)) return false;
     if (order < 1) continue;
-    // Velocity: Φq q̇ + Φt along (q, p) ← (s, 1).
+    // Velocity: Φq q̇ + Φt along (q, p) ← (s, 1). Each model's Φq at its shifted q is kept for the acceleration,
+    // which reads it at the same point.
     const Eigen::Map<const Eigen::VectorXd> sv(s, n), qdv(qd, n);
     for (std::size_t k = 0; k < 4; ++k) {
       const Model& mk = *p.models[k];
       sc.qk = qv + (kShift[k] * h) * sv;
-      mk.jacobian(sc.qk.data(), t, sc.jacobian.data());
-      multiply(mk.jacobian_pattern(), sc.jacobian, qd, sc.f[k]);
+      mk.jacobian(sc.qk.data(), t, sc.jacobian[k].data());
+      sc.f[k].noalias() = jacobian(k) * qdv;
       mk.phi_t(sc.qk.data(), t, sc.d.data());
       sc.f[k] += sc.d;
     }
     if (!solve_difference(sd)) return false;
     if (order < 2) continue;
     // Acceleration: Φq q̈ − γ along (q, q̇, p) ← (s, ṡ, 1), q̈ held.
-    const Eigen::Map<const Eigen::VectorXd> sdv(sd, n);
+    const Eigen::Map<const Eigen::VectorXd> sdv(sd, n), qddv(qdd, n);
     for (std::size_t k = 0; k < 4; ++k) {
       const Model& mk = *p.models[k];
       sc.qk = qv + (kShift[k] * h) * sv;
       sc.vk = qdv + (kShift[k] * h) * sdv;
-      mk.jacobian(sc.qk.data(), t, sc.jacobian.data());
-      multiply(mk.jacobian_pattern(), sc.jacobian, qdd, sc.f[k]);
+      sc.f[k].noalias() = jacobian(k) * qddv;
       mk.gamma(sc.qk.data(), sc.vk.data(), t, sc.d.data());
       sc.f[k] -= sc.d;
     }

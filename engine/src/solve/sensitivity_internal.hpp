@@ -15,7 +15,8 @@ struct SensitivityScratch {
   std::array<Eigen::VectorXd, 4> f;  // the function at the four shifted points (one entry per row of Φ)
   Eigen::VectorXd d;                 // its difference quotient: the right-hand side, negated
   Eigen::VectorXd qk, vk;            // the shifted q and q̇
-  std::vector<double> jacobian;      // Φq values of a shifted model
+  // Φq of each model at its shifted q: made for the velocity, read again for the acceleration (the same point)
+  std::array<std::vector<double>, 4> jacobian;
 };
 
 // Writes the sensitivities of (q, q̇, q̈) at t to every parameter into `out` (SensitivityLayout; derivatives above

@@ -226,10 +226,12 @@ void Sweeper::restore() {
 }
 
 void Sweeper::row_sensitivities() {
-  std::fill(sensitivities_.begin(), sensitivities_.end(), std::numeric_limits<double>::quiet_NaN());
-  // At a singular position Φq has no inverse: the sensitivities are not defined (NaN; the row's bifurcation
-  // warning says where).
-  if (singular_row_) return;
+  // NaN where they are not defined (sensitivities_with_factors() writes every value itself otherwise).
+  auto not_defined = [&] {
+    std::fill(sensitivities_.begin(), sensitivities_.end(), std::numeric_limits<double>::quiet_NaN());
+  };
+  // At a singular position Φq has no inverse (the row's bifurcation warning says where).
+  if (singular_row_) return not_defined();
   const double t = current_.t;
   Workspace* w = ws_;
   // With velocities the row's velocity solve has just used the workspace's factors (of Φq at this row's solution,
@@ -238,7 +240,7 @@ void Sweeper::row_sensitivities() {
         derivative_factors_.factorizations == ws_->counters.factorizations)) {
     if (!sensitivity_ws_) sensitivity_ws_ = std::make_shared<Workspace>(model_);
     w = sensitivity_ws_.get();
-    if (!w->lu) return;
+    if (!w->lu) return not_defined();
     w->q = current_.q;
     const WorkCounters before = w->counters;
     double rc = 0.0;
@@ -246,9 +248,9 @@ void Sweeper::row_sensitivities() {
     const SolveStatus st = ensure_factorized(model_, t, *w, &rc, &why);
     ws_->counters.jacobian_evaluations += w->counters.jacobian_evaluations - before.jacobian_evaluations;
     ws_->counters.factorizations += w->counters.factorizations - before.factorizations;
-    if (st != SolveStatus::kSuccess) return;
+    if (st != SolveStatus::kSuccess) return not_defined();
   }
-  if (!(w->lu->rcond() >= kSingularRcond)) return;
+  if (!(w->lu->rcond() >= kSingularRcond)) return not_defined();
   const int order = need_a_ ? 2 : need_v_ ? 1 : 0;
   const Index solves_before = w->counters.sensitivity_solves;
   const bool ok = sensitivities_with_factors(model_, opt_.sensitivities, t, current_.q.data(),
@@ -256,7 +258,7 @@ void Sweeper::row_sensitivities() {
                                              order >= 2 ? current_.qdd.data() : nullptr, order, *w->lu, *w,
                                              sensitivity_scratch_, sensitivities_.data());
   if (w != ws_) ws_->counters.sensitivity_solves += w->counters.sensitivity_solves - solves_before;
-  if (!ok) std::fill(sensitivities_.begin(), sensitivities_.end(), std::numeric_limits<double>::quiet_NaN());
+  if (!ok) not_defined();
 }
 
 }  // namespace phiq::detail
