@@ -25,7 +25,8 @@ std::mutex g_mutex;
 std::vector<AtomicOutputFile*> g_live;  // files of live OutputSets whose temporaries a signal removes
 int g_stop_depth = 0;                   // live StopOnSignal objects
 bool g_quiet = false;                   // outputs committed: exit without a word
-std::string g_subject = "phiq", g_suffix;
+// (before a command names its subject, it has created no output yet)
+std::string g_subject, g_suffix = "; no output written";
 std::atomic<bool> g_stop{false};
 std::atomic<int> g_signal{0};
 bool g_stdout_closed = false;
@@ -52,7 +53,8 @@ sigset_t handled_signals() {
   if (!g_quiet) {
     for (AtomicOutputFile* f : g_live)
       if (!f->temporary_path().empty()) ::unlink(f->temporary_path().c_str());
-    const std::string line = "phiq: " + g_subject + ": interrupted (" + signal_name(sig) + ")" + g_suffix + "\n";
+    const std::string line = "phiq: " + (g_subject.empty() ? "" : g_subject + ": ") + "interrupted (" +
+                             signal_name(sig) + ")" + g_suffix + "\n";
     if (::write(STDERR_FILENO, line.data(), line.size()) < 0) {
       // nothing more to do about it: the exit status still says what happened
     }
