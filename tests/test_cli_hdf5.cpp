@@ -23,6 +23,19 @@ using phiq::test::slurp;
 namespace fs = std::filesystem;
 using Names = std::vector<std::string>;
 
+// The same run writes the same bytes, whenever and on however many threads: HDF5 stores no object times (it
+// does by default, to the second, so the runs are more than a second apart).
+TEST_F(Cli, Hdf5ResultsAreTheSameBytesOnEveryRun) {
+  const fs::path scene = write("fb.yaml", phiq::test::kFourbarOutputs);
+  const fs::path a = dir_ / "a.h5", b = dir_ / "b.h5";
+  ASSERT_EQ(run("run -q --threads 2 " + scene.string() + " -o " + a.string()).code, 0);
+  ::usleep(1'100'000);
+  ASSERT_EQ(run("run -q --threads 1 " + scene.string() + " -o " + b.string()).code, 0);
+  const std::string bytes = slurp(a);
+  EXPECT_GT(bytes.size(), 1000u);
+  EXPECT_TRUE(bytes == slurp(b));
+}
+
 // The HDF5 of a run holds the CSV's doubles: compare agrees with tolerances 0, either side; the extension chooses
 // the format, --format overrides it; the summary counts the HDF5 writing.
 TEST_F(Cli, Hdf5ResultsEqualTheCsvOfTheSameRun) {

@@ -168,7 +168,11 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   // No advisory lock: the file is the caller's own (the CLI writes a temporary nobody else knows), and file
   // systems without flock (some NFS mounts) would refuse it.
   check(H5Pset_file_locking(fapl.get(), false, true), cannot("file locking"));
-  file = checked(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), H5Fclose,
+  // No creation or modification times in the object headers (HDF5 stores them by default): the same run writes
+  // the same bytes, which regression suites compare.
+  const Hid fcpl = checked(H5Pcreate(H5P_FILE_CREATE), H5Pclose, cannot("file creation list"));
+  check(H5Pset_obj_track_times(fcpl.get(), false), cannot("file creation list"));
+  file = checked(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), H5Fclose,
                  path + ": cannot write");
   const std::string attrs = cannot("attributes");
   try {
@@ -197,6 +201,7 @@ void Hdf5Writer::Impl::create_dataset(Group& g, const Hdf5Options& o) {
   const Hid space = checked(H5Screate_simple(rank, dims, maxdims), H5Sclose, what);
   const Hid dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, what);
   check(H5Pset_chunk(dcpl.get(), rank, chunk), what);
+  check(H5Pset_obj_track_times(dcpl.get(), false), what);  // the same bytes on every run (above)
   check(H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER), what);  // every element is written: no fill to write first
   if (o.deflate > 0) {
     if (o.shuffle) check(H5Pset_shuffle(dcpl.get()), what);
