@@ -29,6 +29,7 @@ packages=(
                        # drives Chromium over its DevTools pipe in ctest browser_viewer
   libjs-three          # three.js r111 and its OrbitControls, embedded at build time into `phiq animate -o OUT.html`
   chromium             # headless browser of ctest browser_viewer (the HTML viewer's pages; skipped if absent)
+  openmpi-bin libopenmpi-dev  # `mpirun -np K phiq batch` (tools/cli/batch_ranks.hpp) and its ctest mpi_batch
 )
 # npm (Debian's package, unless a node install already brings its own) installs the validator below
 command -v npm >/dev/null 2>&1 || packages+=(npm)

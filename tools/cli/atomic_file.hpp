@@ -85,6 +85,9 @@ class AtomicOutputFile {
   bool direct_ = false, finished_ = false, committed_ = false;
   bool unnamed_ = false;  // an O_TMPFILE temporary, held open until publish()
   bool closed_between_writes_ = false;
+  // Write-behind (write()): bytes written through the open temporary, and those handed to the disk so far.
+  static constexpr std::uint64_t kWriteBehindBytes = std::uint64_t{8} << 20;
+  std::uint64_t written_ = 0, flushed_ = 0;
 };
 
 }  // namespace phiq

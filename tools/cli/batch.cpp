@@ -24,16 +24,34 @@ namespace {
 // `phiq batch SCENE CASES.csv -o DIR`: the scene swept once per row of CASES.csv (columns: parameter names), the
 // cases in parallel, sharing one symbolic analysis; DIR/case<k>.csv per successful case (k from 0, the row order).
 int cmd_batch(const std::string& scene_path, const std::string& cases_path, const std::string& dir, bool quiet,
-              int threads, const std::string& summary_path, bool identifier_names) {
+              int threads, const std::string& summary_path, bool identifier_names, bool resume) {
+  if (BatchRanks::launched_without_support())
+    return fail("batch: started by mpirun with several processes, but this phiq was built without MPI "
+                "(PHIQ_MPI=OFF): each would run the whole batch; run it without mpirun",
+                2);
+  std::unique_ptr<BatchRanks> ranks;
+  try {
+    ranks = BatchRanks::join();
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 1);
+  }
+  if (ranks->rank() > 0) {  // rank 0 says everything (a worker rank's errors are its too)
+    std::cerr.rdbuf(nullptr);
+    quiet_interrupts();
+  }
   phiq::CsvTable cases;
   try {
     cases = phiq::read_csv_table(cases_path);
   } catch (const phiq::Error& e) {
-    return fail(e.what(), 2);
+    return ranks->finish(fail(e.what(), 2));
   }
-  if (cases.rows.empty()) return fail(cases_path + ": no cases (one row per parameter set)", 2);
+  if (cases.rows.empty()) return ranks->finish(fail(cases_path + ": no cases (one row per parameter set)", 2));
   if (is_one_file_output(dir))  // OUT.csv / OUT.h5: every case in one file (batch_file.cpp)
-    return batch_to_one_file({scene_path, cases_path, dir, summary_path, quiet, threads, identifier_names}, cases);
+    return ranks->finish(batch_to_one_file(
+        {scene_path, cases_path, dir, summary_path, quiet, threads, identifier_names, resume}, cases, *ranks));
+  if (ranks->size() > 1)
+    return ranks->finish(fail("batch: -o " + dir + ": under mpirun a batch writes one file (-o OUT.csv or OUT.h5)", 2));
+  if (resume) return fail("batch: --resume continues a one-file output (-o OUT.csv), not a directory of cases", 2);
   auto case_file = [&](std::size_t k) { return dir + "/case" + std::to_string(k) + ".csv"; };
   // No case file may replace the scene, the cases or the summary. Each case file is checked against those alone:
   // the case files are distinct names in one directory, and checking them pairwise (output_clash of all of them)
@@ -249,6 +267,7 @@ Command register_batch(CLI::App& app) {
     int threads = 0;
     std::string summary;
     std::string names = "dotted";
+    bool resume = false;
   };
   auto a = std::make_shared<Args>();
   CLI::App* batch = app.add_subcommand("batch", "Sweep the scene once per parameter set of a CSV, the cases in parallel");
@@ -270,9 +289,13 @@ Command register_batch(CLI::App& app) {
   batch->add_option("--names", a->names, "Column names: dotted (theta2.v) or identifiers (theta2__v), as run's")
       ->capture_default_str()
       ->check(one_of({"dotted", "identifiers"}));
+  batch->add_flag("--resume", a->resume,
+                  "Keep the cases an interrupted run of this batch wrote to OUT.csv and run only the others (a "
+                  "missing OUT.csv: the whole batch)");
   return {batch, [a] {
             const int cases_threads = cap_threads("batch", a->threads, a->quiet);
-            return cmd_batch(a->scene, a->cases, a->dir, a->quiet, cases_threads, a->summary, a->names == "identifiers");
+            return cmd_batch(a->scene, a->cases, a->dir, a->quiet, cases_threads, a->summary, a->names == "identifiers",
+                             a->resume);
           }};
 }
 

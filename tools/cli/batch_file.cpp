@@ -11,13 +11,16 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <thread>
 
+#include "batch_resume.hpp"
 #include "cli_support.hpp"
 #include "command_support.hpp"
 #include "result_file.hpp"
@@ -61,6 +64,7 @@ int commit_batch_summary(OutputSet& outputs, AtomicOutputFile& file, const Batch
   j["cases"] = t.cases;
   j["failed"] = t.failed;
   j["written"] = t.written;
+  j["ranks"] = t.ranks;
   j["threads"] = t.threads;
   j["shared_analyses"] = t.shared_analyses;
   j["load_seconds"] = t.load_seconds;
@@ -104,7 +108,14 @@ struct CaseReport {
 // at a time, in order.
 class InOrder {
  public:
-  explicit InOrder(std::function<void(std::size_t, CaseRows&)> write) : write_(std::move(write)) {}
+  // `first`: the first case to write (cases before it are in the file already: --resume)
+  InOrder(std::size_t first, std::function<void(std::size_t, CaseRows&)> write)
+      : write_(std::move(write)), next_(first) {}
+  // The first case not written yet.
+  std::size_t next() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return next_;
+  }
   void complete(std::size_t k, CaseRows rows) {
     const std::lock_guard<std::mutex> lock(mutex_);
     waiting_.emplace(k, std::move(rows));
@@ -132,12 +143,76 @@ class InOrder {
   std::size_t next_ = 0;
 };
 
-}  // namespace
+// A case as its worker leaves it, on any rank: what rank 0 reports and writes of it.
+struct CaseResult {
+  CaseReport report;
+  CaseRows rows;
+  bool on_shared_analysis = false;
+  long long setup_ns = 0, sweep_ns = 0, format_ns = 0;
+};
 
-int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
+// A case's --summary entry before it runs.
+nlohmann::ordered_json initial_outcome(std::size_t k) {
+  return nlohmann::ordered_json{{"case", k}, {"line", k + 2}, {"file", nullptr}};
+}
+
+// A worker rank's case, for rank 0 (`signal`: the signal that stopped it, if one did).
+CaseMessage to_message(std::size_t k, const CaseResult& r, int signal) {
+  CaseMessage m;
+  m.kind = r.report.complete ? CaseMessage::Kind::kDone : CaseMessage::Kind::kStopped;
+  m.k = static_cast<std::int64_t>(k);
+  m.complete = r.report.complete, m.failed = r.report.failed, m.on_shared_analysis = r.on_shared_analysis;
+  m.line = r.report.line;
+  m.outcome_json = r.report.outcome.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+  m.text = r.rows.text;
+  m.values.assign(reinterpret_cast<const char*>(r.rows.values.data()), r.rows.values.size() * sizeof(double));
+  m.setup_ns = r.setup_ns, m.sweep_ns = r.sweep_ns, m.format_ns = r.format_ns;
+  m.signal = signal;
+  return m;
+}
+
+// ... and back, on rank 0: the same report and rows as had the case run there (doubles travel as their bytes).
+CaseResult from_message(CaseMessage m) {
+  CaseResult r;
+  r.report.complete = m.complete, r.report.failed = m.failed;
+  r.report.line = std::move(m.line);
+  r.report.outcome = nlohmann::ordered_json::parse(m.outcome_json);
+  r.rows.any = m.complete && !m.failed;
+  r.rows.text = std::move(m.text);
+  r.rows.values.resize(m.values.size() / sizeof(double));
+  std::memcpy(r.rows.values.data(), m.values.data(), r.rows.values.size() * sizeof(double));
+  r.on_shared_analysis = m.on_shared_analysis;
+  r.setup_ns = m.setup_ns, r.sweep_ns = m.sweep_ns, r.format_ns = m.format_ns;
+  return r;
+}
+
+// Rank 0's side of the protocol (batch_ranks.hpp): each message of another rank's worker handled (`handle`
+// returns the case to answer with, −1 for none) until every worker has been told there is none. A batch that
+// halts (a signal: mpirun sends SIGTERM when a rank dies, and SIGKILL a second later) waits for no one: its
+// committed cases are published at once, and the workers left unanswered (BatchRanks::abandon).
+void serve_remote_workers(BatchRanks& ranks, int workers, const std::function<bool()>& halted,
+                          const std::function<std::int64_t(CaseMessage)>& handle) {
+  int finished = 0;
+  while (finished < workers) {
+    if (halted()) return ranks.abandon();
+    int from = 0, tag = 0;
+    std::optional<CaseMessage> m = ranks.poll(&from, &tag, halted);
+    if (!m) {
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+      continue;
+    }
+    const std::int64_t k = handle(std::move(*m));
+    ranks.answer(from, tag, k, halted);
+    if (k < 0) ++finished;
+  }
+}
+
+}  // namespace
+int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& ranks) {
   BatchArgs a = args;
-  if (a.threads <= 0) a.threads = tbb::info::default_concurrency();  // 0: all cores
+  if (a.threads <= 0) a.threads = tbb::info::default_concurrency();  // 0: all cores (of this rank)
   const bool hdf5 = phiq::has_hdf5_extension(a.out);
+  const bool writer = ranks.rank() == 0;  // the other ranks sweep cases and print nothing
   const std::size_t n = cases.rows.size();
   {
     std::vector<NamedPath> outs{{"-o", a.out}};
@@ -145,6 +220,8 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
     if (const auto clash = output_clash(outs, {{"the scene", a.scene}, {"the cases", a.cases}}))
       return fail("batch: " + *clash, 2);
   }
+  if (a.resume && hdf5)
+    return fail(a.out + ": --resume continues a CSV output (an HDF5 one is written again: drop --resume)", 2);
   set_interrupt_subject(a.scene, "; no output written");
   // The scene parsed once; its own parameters' scene is the model every case shares its analysis with, and the
   // columns' names.
@@ -178,42 +255,55 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
   for (int w = 1; w < a.threads; ++w) trees.push_back(trees.front());  // a tree per thread (ParsedScene)
   const double load_s = since(load_start);
 
-  // The output now: an unwritable path fails before any case runs, and leaves nothing.
+  // The output now (rank 0's alone): an unwritable path fails before any case runs, and leaves nothing. With
+  // --resume, the cases already in the file are copied first and the batch goes on after the last of them.
   OutputSet outputs;
   phiq::AtomicOutputFile* file = nullptr;
   phiq::AtomicOutputFile* summary_file = nullptr;
   std::unique_ptr<phiq::Hdf5Writer> h5;  // after `outputs`: closed before its temporary is removed
   std::uint64_t committed_bytes = 0;
-  try {
-    if (hdf5) check_hdf5_target(a.out);
-    file = &outputs.add(a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
-                                    : phiq::AtomicOutputFile::Hold::kOpen);
-    if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
-    if (hdf5) {
-      phiq::Hdf5Options o;
-      o.scene_path = reference->path;
-      o.scene_text = reference->text;
-      o.expected_rows = static_cast<std::size_t>(phiq::rows_written(reference->sweep)) * n;
-      o.shown_path = file->path();
-      o.case_column = true;
-      h5 = std::make_unique<phiq::Hdf5Writer>(file->temporary_path(), *reference->model, reference->sweep, o);
-    } else {
-      const std::string header = "case," + format.header();
-      file->write(header);
-      committed_bytes = header.size();
+  ResumePoint resumed;  // nothing earlier: the batch from case 0
+  int status = 0;
+  if (writer) {
+    const std::string header = "case," + format.header();
+    try {
+      if (a.resume) resumed = read_resume_point(a.out, header, n);
+      if (hdf5) check_hdf5_target(a.out);
+      file = &outputs.add(a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
+                                      : phiq::AtomicOutputFile::Hold::kOpen);
+      if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
+      if (hdf5) {
+        phiq::Hdf5Options o;
+        o.scene_path = reference->path;
+        o.scene_text = reference->text;
+        o.expected_rows = static_cast<std::size_t>(phiq::rows_written(reference->sweep)) * n;
+        o.shown_path = file->path();
+        o.case_column = true;
+        h5 = std::make_unique<phiq::Hdf5Writer>(file->temporary_path(), *reference->model, reference->sweep, o);
+      } else if (resumed.first > 0) {
+        committed_bytes = copy_resumed_cases(a.out, resumed, *file);
+      } else {
+        file->write(header);
+        committed_bytes = header.size();
+      }
+    } catch (const ResumeError& e) {
+      status = fail(e.what(), 2);
+    } catch (const phiq::Error& e) {
+      status = fail(e.what(), 3);
     }
-  } catch (const phiq::Error& e) {
-    return fail(e.what(), 3);
   }
+  if ((status = ranks.agree(status)) != 0) return status;  // every rank stops where rank 0 could not go on
+  const int remote_workers = ranks.total_remote_workers(a.threads);
 
   // Cases commit in order as they complete. A write error stops the batch: the CSV is cut back to the cases it
   // holds whole and published; an HDF5 file is not (a failed write may have left its structure half-written).
   std::atomic<bool> abort{false};
+  std::atomic<int> remote_signal{0};  // a signal that stopped a case on another rank
   std::string write_error;
   std::vector<char> written(n, 0);
-  std::size_t cases_written = 0;
+  std::size_t cases_written = resumed.cases_in_file;
   Nanos setup_ns{0}, sweep_ns{0}, format_ns{0}, write_ns{0};
-  InOrder in_order([&](std::size_t k, CaseRows& rows) {
+  InOrder in_order(resumed.first, [&](std::size_t k, CaseRows& rows) {
     if (!rows.any || !write_error.empty()) return;
     const auto w0 = Clock::now();
     try {
@@ -234,21 +324,38 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
   });
 
   std::vector<CaseReport> reports(n);
-  for (std::size_t k = 0; k < n; ++k)
-    reports[k].outcome = nlohmann::ordered_json{{"case", k}, {"line", k + 2}, {"file", nullptr}};
-  std::atomic<std::size_t> next_case{0};
+  for (std::size_t k = 0; k < n; ++k) reports[k].outcome = initial_outcome(k);
+  for (std::size_t k = 0; k < resumed.first; ++k) {  // --resume: the cases before the first it runs
+    CaseReport& r = reports[k];
+    written[k] = resumed.in_file[k];
+    if (written[k]) {
+      r.outcome["status"] = "written earlier";  // by the run resumed (its summary has the rest)
+    } else {  // it failed in the run resumed (or that run's file had already left it out)
+      r.complete = r.failed = true;
+      r.outcome["status"] = "failed earlier";
+      r.line = a.scene + ": case " + std::to_string(k) + ": not in " + a.out + " (left out by the run resumed)";
+    }
+  }
+  std::atomic<std::size_t> next_case{resumed.first};
   std::atomic<std::size_t> shared{0};  // cases swept on the reference's symbolic analysis
   const std::atomic<bool>& stop = stop_flag();
+  auto halted = [&] { return stop.load() || abort.load() || remote_signal.load() != 0; };
   const std::string left_out = "; left out of " + a.out;
-  // One case, on the thread's own tree: built, made square, swept, its rows formatted, handed to in_order.
-  auto run_case = [&](std::size_t k, phiq::ParsedScene& tree) {
-    CaseReport& report = reports[k];
+  // One case, on the thread's own tree: built, made square, swept, its rows formatted into `rows` (a written
+  // case's buffers, reused).
+  auto run_case = [&](std::size_t k, phiq::ParsedScene& tree, CaseRows rows) {
+    CaseResult result;
+    result.report.outcome = initial_outcome(k);
+    CaseReport& report = result.report;
     auto fails = [&](const std::string& why) {
       report.complete = report.failed = true;
       report.line = a.scene + ": case " + std::to_string(k) + ": " + why + left_out;
-      in_order.complete(k, CaseRows{});
+      return std::move(result);
     };
     const auto t0 = Clock::now();
+    auto setup_done = [&] {
+      result.setup_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
+    };
     phiq::SceneOverrides o = case_overrides(cases, k, a.cases);
     o.share_analysis_with = reference->model.get();
     std::optional<phiq::Scene> scene;
@@ -257,7 +364,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
     } catch (const phiq::SceneError& e) {  // its parameters make the scene impossible (a negative length)
       report.outcome["status"] = "scene error";
       report.outcome["message"] = e.what();
-      add_time(setup_ns, t0);
+      setup_done();
       return fails(std::string(e.what()) + " (line " + std::to_string(k + 2) + " of " + a.cases + ")");
     }
     phiq::SquareScene square;
@@ -269,28 +376,29 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
       at_start.failed_time = scene->sweep.t_begin;
       at_start.worst_rows = square.assembly.worst_rows;
       add_outcome(report.outcome, *scene->model, at_start);
-      add_time(setup_ns, t0);
+      setup_done();
       return fails(*why);
     }
     const phiq::Model& model = square.model(*scene->model);
-    if (model.symbolic() && model.symbolic() == reference->model->symbolic()) ++shared;
+    result.on_shared_analysis = model.symbolic() && model.symbolic() == reference->model->symbolic();
     phiq::Workspace ws(model);
     ws.q = square.start;
     phiq::SweepOptions one = scene->sweep;
-    one.threads = 1;  // parallel over cases, not within one
+    one.threads = 1;  // parallel over cases, not within one: each case computed alike on any thread or rank
     const phiq::CsvFormat rows_format(*scene->model, scene->sweep);  // the case's own output points
     const std::string prefix = std::to_string(k) + ",";
-    CaseRows rows = in_order.spare();
     bool last = false;
-    std::vector<double> row(h5 ? h5->row_values() : 0);
     const std::vector<Index>& qd_cols = one.written_velocities();
     const std::vector<Index>& qdd_cols = one.written_accelerations();
-    add_time(setup_ns, t0);
+    std::vector<double> row(hdf5 ? 2 + one.coordinate_columns.size() + qd_cols.size() + qdd_cols.size() +
+                                       rows_format.num_output_values()
+                                 : 0);
+    setup_done();
     long long format_case_ns = 0;
     phiq::SweepSummary s;
     (void)phiq::run_sweep(model, one, ws, [&](const phiq::StepView& step) {
       const auto f0 = Clock::now();
-      if (h5) {  // the values Hdf5Writer::append_row() would store, the case first
+      if (hdf5) {  // the values Hdf5Writer::append_row() would store, the case first
         double* v = row.data();
         *v++ = static_cast<double>(k);
         *v++ = step.t;
@@ -305,10 +413,10 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
       }
       last = step.step == one.steps;
       format_case_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - f0).count();
-      return !stop.load() && !abort.load();
+      return !halted();
     }, &s);
-    format_ns += format_case_ns;
-    sweep_ns += static_cast<long long>(s.solve_seconds * 1e9) - format_case_ns;
+    result.format_ns = format_case_ns;
+    result.sweep_ns = static_cast<long long>(s.solve_seconds * 1e9) - format_case_ns;
     add_outcome(report.outcome, model, s);
     report.outcome["steps"] = s.steps_completed;
     report.outcome["newton_iterations"] = s.counters.newton_iterations;
@@ -317,28 +425,67 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
       report.complete = true;
       report.line = a.scene + ": case " + std::to_string(k) + ": " + s.BriefReport();
       rows.any = true;
-      in_order.complete(k, std::move(rows));
-    } else if (s.status != phiq::SolveStatus::kCancelled) {
-      fails(s.message);
-    }  // else stopped before its end: it never completes, and no case after it is written
+      result.rows = std::move(rows);
+      return result;
+    }
+    if (s.status != phiq::SolveStatus::kCancelled) return fails(s.message);
+    return result;  // stopped before its end: it never completes, and no case after it is written
+  };
+  // A case's result, wherever it ran, reaches rank 0's report and file here.
+  auto deliver = [&](std::size_t k, CaseResult r) {
+    setup_ns += r.setup_ns, sweep_ns += r.sweep_ns, format_ns += r.format_ns;
+    shared += r.on_shared_analysis ? 1 : 0;
+    const bool complete = r.report.complete;
+    // the case's time on its thread (set-up, sweep, rows): the costs tools/simulate_batch_ranks.py schedules
+    r.report.outcome["seconds"] = static_cast<double>(r.setup_ns + r.sweep_ns + r.format_ns) * 1e-9;
+    reports[k] = std::move(r.report);
+    if (complete) in_order.complete(k, std::move(r.rows));
+  };
+  auto next = [&]() -> std::optional<std::size_t> {
+    if (halted()) return std::nullopt;
+    const std::size_t k = next_case++;
+    return k < n ? std::optional<std::size_t>(k) : std::nullopt;
   };
 
   const auto solve_start = Clock::now();
   {
     StopOnSignal stop_on_signal;  // a signal stops every case at its next row
     tbb::task_arena arena(a.threads);
-    arena.execute([&] {
-      // a worker per thread taking the next case in order: cases complete about in order, so few wait
-      tbb::parallel_for(
-          0, a.threads,
-          [&](int w) {
-            for (std::size_t k; !stop.load() && !abort.load() && (k = next_case++) < n;) run_case(k, trees[w]);
-          },
-          tbb::simple_partitioner());
+    if (!writer) {  // a worker rank: its threads ask rank 0 for cases and send it their results
+      arena.execute([&] {
+        tbb::parallel_for(0, a.threads, [&](int w) {
+          CaseMessage m;  // the first: an ask
+          CaseRows rows;
+          for (std::optional<std::int64_t> k; (k = ranks.exchange(w, m));) {
+            CaseResult r = run_case(static_cast<std::size_t>(*k), trees[w], std::move(rows));
+            m = to_message(static_cast<std::size_t>(*k), r, stop.load() ? interrupt_signal() : 0);
+            rows = std::move(r.rows);
+            rows.any = false, rows.text.clear(), rows.values.clear();
+          }
+        }, tbb::simple_partitioner());
+      });
+      return 0;  // (rank 0 says how the batch went)
+    }
+    // Rank 0: a worker per thread taking the next case in order (cases complete about in order, so few wait),
+    // while this thread answers the other ranks' workers, if any
+    std::thread local([&] {
+      arena.execute([&] {
+        tbb::parallel_for(0, a.threads, [&](int w) {
+          for (std::optional<std::size_t> k; (k = next());) deliver(*k, run_case(*k, trees[w], in_order.spare()));
+        }, tbb::simple_partitioner());
+      });
     });
+    serve_remote_workers(ranks, remote_workers, halted, [&](CaseMessage m) {
+      if (m.kind == CaseMessage::Kind::kStopped) remote_signal = m.signal > 0 ? m.signal : 15;
+      if (m.kind == CaseMessage::Kind::kDone) deliver(static_cast<std::size_t>(m.k), from_message(std::move(m)));
+      const std::optional<std::size_t> k = next();
+      return k ? static_cast<std::int64_t>(*k) : std::int64_t{-1};
+    });
+    local.join();
   }
   const double solve_s = since(solve_start);
-  const bool interrupted = stop.load();
+  const int signal = stop.load() ? interrupt_signal() : remote_signal.load();
+  const bool interrupted = signal != 0;
 
   // Publish what was committed: every case in order, or (interrupted, write error) the cases before the first
   // that did not complete.
@@ -358,10 +505,16 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
   }
   const std::string written_text = std::to_string(published ? cases_written : 0) + " of " + std::to_string(n) +
                                    " cases written to " + a.out;
-  if (interrupted && write_error.empty() && publish_error.empty())
-    return fail(a.scene + ": " + interrupt_message() + "; " + written_text + " (the cases before the first " +
-                    "unfinished one)",
-                interrupt_exit_status());
+  if (interrupted && write_error.empty() && publish_error.empty()) {
+    const std::size_t first_missing = in_order.next();
+    std::string missing;
+    if (first_missing < n)
+      missing = "; cases " + std::to_string(first_missing) + " to " + std::to_string(n - 1) + " missing" +
+                (hdf5 ? "" : ": the same command with --resume runs only those");
+    return fail(a.scene + ": interrupted (" + signal_name(signal) + "); " + written_text +
+                    " (the cases before the first unfinished one)" + missing,
+                128 + signal);
+  }
   std::size_t failed = 0;
   for (std::size_t k = 0; k < n; ++k) {
     CaseReport& r = reports[k];
@@ -380,7 +533,8 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
                3);
   else if (!a.quiet)
     std::cerr << "phiq: " << printable(a.scene) << ": " << n - failed << " of " << n << " cases in "
-              << printable(a.out) << ", " << a.threads << " threads, " << shared.load()
+              << printable(a.out) << ", " << (ranks.size() > 1 ? ranks.describe() + ", " : "")
+              << a.threads + remote_workers << " threads, " << shared.load()
               << " cases on the scene's symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
               << scientific(solve_s, 3) << " s (thread-seconds: set-up " << scientific(seconds(setup_ns), 3)
               << ", sweep " << scientific(seconds(sweep_ns), 3) << ", rows " << scientific(seconds(format_ns), 3)
@@ -390,7 +544,8 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases) {
     t.scene_name = reference->name;
     t.output = a.out;
     t.cases = n, t.failed = failed, t.written = published ? cases_written : 0, t.shared_analyses = shared.load();
-    t.threads = a.threads;
+    t.threads = a.threads + remote_workers;
+    t.ranks = ranks.size();
     t.load_seconds = load_s, t.solve_seconds = solve_s;
     nlohmann::ordered_json results = nlohmann::ordered_json::array();
     for (CaseReport& r : reports) results.push_back(std::move(r.outcome));

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "batch_ranks.hpp"
 #include "cli_support.hpp"       // OutputSet
 #include "phiq/csv_compare.hpp"  // CsvTable: the cases
 #include "phiq/scene.hpp"
@@ -18,6 +19,7 @@ struct BatchArgs {
   bool quiet = false;
   int threads = 0;  // 0: all cores
   bool identifier_names = false;
+  bool resume = false;  // go on after the cases an earlier run committed to `out` (batch_resume.hpp)
 };
 
 // True when `-o PATH` names one output file rather than a directory of case files: PATH ends in .csv, .h5 or
@@ -34,7 +36,8 @@ struct BatchTotals {
   std::string directory;   // -o DIR (empty for one file)
   std::string output;      // -o OUT.csv|OUT.h5 (empty for a directory)
   std::size_t cases = 0, failed = 0, written = 0, shared_analyses = 0;
-  int threads = 1;
+  int threads = 1;  // on every rank
+  int ranks = 1;    // MPI ranks (batch_ranks.hpp)
   double load_seconds = 0.0, solve_seconds = 0.0;
 };
 
@@ -43,9 +46,10 @@ struct BatchTotals {
 int commit_batch_summary(OutputSet& outputs, AtomicOutputFile& file, const BatchArgs& args, const BatchTotals& totals,
                          nlohmann::ordered_json results, int status);
 
-// The batch into one file (CSV, or HDF5 for .h5 / .hdf5). Exit status: 0 all cases written, 1 some failed (left
-// out, named), 2 bad scene or cases, 3 output error, 128 + signal when interrupted (the cases committed by then
-// published).
-int batch_to_one_file(const BatchArgs& args, const CsvTable& cases);
+// The batch into one file (CSV, or HDF5 for .h5 / .hdf5), on the ranks of `ranks` (rank 0 writes; on one rank,
+// the same file). Exit status (rank 0's; the others return 0 once their part is done, or rank 0's set-up error):
+// 0 all cases written, 1 some failed (left out, named), 2 bad scene or cases, 3 output error, 128 + signal when
+// interrupted (the cases committed by then published, the missing ones named).
+int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& ranks);
 
 }  // namespace phiq::tools

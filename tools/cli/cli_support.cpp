@@ -31,15 +31,6 @@ std::atomic<bool> g_stop{false};
 std::atomic<int> g_signal{0};
 bool g_stdout_closed = false;
 
-const char* signal_name(int sig) {
-  switch (sig) {
-    case SIGINT: return "SIGINT";
-    case SIGTERM: return "SIGTERM";
-    case SIGHUP: return "SIGHUP";
-  }
-  return "a signal";
-}
-
 sigset_t handled_signals() {
   sigset_t set;
   sigemptyset(&set);
@@ -79,6 +70,20 @@ void wait_for_signals() {
 }
 
 }  // namespace
+
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+  }
+  return "a signal";
+}
+
+void quiet_interrupts() {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  g_quiet = true;
+}
 
 void start_interrupts() {
   const sigset_t set = handled_signals();

@@ -26,6 +26,11 @@ namespace phiq::tools {
 void start_interrupts();
 // What the message names ("SCENE", "sweep-accuracy: SCENE") and what it adds ("; no output written").
 void set_interrupt_subject(const std::string& subject, const std::string& suffix = "");
+// "SIGINT", "SIGTERM", "SIGHUP" (what messages call a signal).
+const char* signal_name(int sig);
+// A second signal (or one outside a StopOnSignal) exits without a word: a worker rank of an MPI batch, which
+// writes no file and leaves the talking to rank 0.
+void quiet_interrupts();
 // Whether a signal came (or, in a StopOnSignal, asked the sweep to stop), and which one.
 const std::atomic<bool>& stop_flag();
 int interrupt_signal();            // 0 when none

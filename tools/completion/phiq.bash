@@ -26,7 +26,7 @@ _phiq() {
     run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names" ;;
     check) opts="--help --json --time" ;;
     assemble) opts="--help --output --quiet" ;;
-    batch) opts="--help --output --quiet --threads --summary --names" ;;
+    batch) opts="--help --output --quiet --threads --summary --names --resume" ;;
     compare) opts="--help --rtol --atol --columns --json --junit" ;;
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
     plot) opts="--help --output --columns --positions" ;;

@@ -1,0 +1,216 @@
+// MPI for `phiq batch` (batch_ranks.hpp), or one process when phiq is built without MPI or not run by mpirun.
+#include "batch_ranks.hpp"
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <thread>
+#include <vector>
+
+#include "phiq/types.hpp"  // phiq::Error
+
+#if PHIQ_WITH_MPI
+#include <mpi.h>
+#endif
+
+namespace phiq::tools {
+
+namespace {
+
+// Started by a launcher with more than one process (Open MPI, or any PMI / PMIx launcher)?
+int launched_size() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"})
+    if (const char* s = std::getenv(v)) return std::atoi(s);
+  return std::getenv("PMIX_RANK") ? 2 : 1;  // PMIx without a size: a launcher all the same
+}
+
+#if PHIQ_WITH_MPI
+// A message, flat: the fixed fields, then each string as its length and bytes.
+std::string pack(const CaseMessage& m) {
+  std::string b;
+  auto put = [&b](const void* p, std::size_t n) { b.append(static_cast<const char*>(p), n); };
+  auto put_string = [&](const std::string& s) {
+    const std::uint64_t n = s.size();
+    put(&n, sizeof n);
+    put(s.data(), s.size());
+  };
+  const std::int32_t kind = static_cast<std::int32_t>(m.kind);
+  const std::int32_t flags = (m.complete ? 1 : 0) | (m.failed ? 2 : 0) | (m.on_shared_analysis ? 4 : 0);
+  const std::int32_t sig = m.signal;
+  put(&kind, sizeof kind);
+  put(&flags, sizeof flags);
+  put(&sig, sizeof sig);
+  put(&m.k, sizeof m.k);
+  put(&m.setup_ns, sizeof m.setup_ns);
+  put(&m.sweep_ns, sizeof m.sweep_ns);
+  put(&m.format_ns, sizeof m.format_ns);
+  for (const std::string* s : {&m.line, &m.outcome_json, &m.text, &m.values}) put_string(*s);
+  return b;
+}
+
+CaseMessage unpack(const std::string& b) {
+  CaseMessage m;
+  std::size_t at = 0;
+  auto get = [&](void* p, std::size_t n) {
+    if (at + n > b.size()) throw Error("batch: a truncated message between MPI ranks (phiq bug)");
+    std::memcpy(p, b.data() + at, n);
+    at += n;
+  };
+  auto get_string = [&](std::string& s) {
+    std::uint64_t n = 0;
+    get(&n, sizeof n);
+    if (n > b.size() - at) throw Error("batch: a truncated message between MPI ranks (phiq bug)");
+    s.assign(b.data() + at, n);
+    at += n;
+  };
+  std::int32_t kind = 0, flags = 0, sig = 0;
+  get(&kind, sizeof kind);
+  get(&flags, sizeof flags);
+  get(&sig, sizeof sig);
+  m.kind = static_cast<CaseMessage::Kind>(kind);
+  m.complete = flags & 1, m.failed = flags & 2, m.on_shared_analysis = flags & 4;
+  m.signal = sig;
+  get(&m.k, sizeof m.k);
+  get(&m.setup_ns, sizeof m.setup_ns);
+  get(&m.sweep_ns, sizeof m.sweep_ns);
+  get(&m.format_ns, sizeof m.format_ns);
+  for (std::string* s : {&m.line, &m.outcome_json, &m.text, &m.values}) get_string(*s);
+  return m;
+}
+
+// Waits for `r` by polling (Open MPI's blocking calls spin a core, which the cases on this machine need) until it
+// completes (true) or `give_up` says to stop waiting (false: a peer that died mid-message never completes it).
+bool wait_politely(MPI_Request* r, const std::function<bool()>& give_up = {}) {
+  for (int done = 0;;) {
+    MPI_Test(r, &done, MPI_STATUS_IGNORE);
+    if (done) return true;
+    if (give_up && give_up()) return false;
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
+  }
+}
+#endif
+
+}  // namespace
+
+bool BatchRanks::launched_without_support() {
+#if PHIQ_WITH_MPI
+  return false;
+#else
+  return launched_size() > 1;
+#endif
+}
+
+std::unique_ptr<BatchRanks> BatchRanks::join() {
+  std::unique_ptr<BatchRanks> r(new BatchRanks());
+#if PHIQ_WITH_MPI
+  if (launched_size() > 1) {
+    int provided = 0;
+    MPI_Init_thread(nullptr, nullptr, MPI_THREAD_MULTIPLE, &provided);
+    r->mpi_ = true;
+    if (provided < MPI_THREAD_MULTIPLE) {
+      MPI_Finalize();
+      throw Error("batch: this MPI library cannot serve several threads per rank (MPI_THREAD_MULTIPLE)");
+    }
+    MPI_Comm_rank(MPI_COMM_WORLD, &r->rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &r->size_);
+  }
+#endif
+  return r;
+}
+
+BatchRanks::~BatchRanks() { (void)finish(0); }
+
+int BatchRanks::finish(int status) {
+  if (finished_) return status;
+  finished_ = true;
+#if PHIQ_WITH_MPI
+  if (mpi_) {
+    if (abandoned_) MPI_Abort(MPI_COMM_WORLD, status == 0 ? 1 : status);
+    MPI_Finalize();
+  }
+#endif
+  return status;
+}
+
+std::string BatchRanks::describe() const {
+  return size_ == 1 ? std::string("one process") : std::to_string(size_) + " MPI ranks";
+}
+
+int BatchRanks::total_remote_workers(int my_threads) {
+#if PHIQ_WITH_MPI
+  if (mpi_) {
+    const int mine = rank_ == 0 ? 0 : my_threads;
+    int total = 0;
+    MPI_Reduce(&mine, &total, 1, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);
+    return rank_ == 0 ? total : my_threads;
+  }
+#endif
+  (void)my_threads;
+  return 0;
+}
+
+int BatchRanks::agree(int status) {
+#if PHIQ_WITH_MPI
+  if (mpi_) {
+    int all = 0;
+    MPI_Allreduce(&status, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    return all;
+  }
+#endif
+  return status;
+}
+
+std::optional<std::int64_t> BatchRanks::exchange(int worker, const CaseMessage& m) {
+#if PHIQ_WITH_MPI
+  const std::string bytes = pack(m);
+  if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw Error("batch: a case of more than 2 GiB of rows cannot be sent between MPI ranks: fewer steps per case");
+  MPI_Request send, recv;
+  std::int64_t next = -1;
+  MPI_Irecv(&next, 1, MPI_INT64_T, 0, worker, MPI_COMM_WORLD, &recv);
+  MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, 0, worker, MPI_COMM_WORLD, &send);
+  wait_politely(&send);
+  wait_politely(&recv);
+  if (next < 0) return std::nullopt;
+  return next;
+#else
+  (void)worker, (void)m;
+  return std::nullopt;
+#endif
+}
+
+std::optional<CaseMessage> BatchRanks::poll(int* from, int* tag, const std::function<bool()>& give_up) {
+#if PHIQ_WITH_MPI
+  int arrived = 0;
+  MPI_Status st;
+  MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, &st);
+  if (!arrived) return std::nullopt;
+  int count = 0;
+  MPI_Get_count(&st, MPI_BYTE, &count);
+  std::string bytes(static_cast<std::size_t>(count), '\0');
+  // (a rank killed while sending its rows leaves the message half-arrived: `give_up` ends the wait)
+  MPI_Request r;
+  MPI_Irecv(bytes.data(), count, MPI_BYTE, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, &r);
+  if (!wait_politely(&r, give_up)) return std::nullopt;
+  *from = st.MPI_SOURCE;
+  *tag = st.MPI_TAG;
+  return unpack(bytes);
+#else
+  (void)from, (void)tag, (void)give_up;
+  return std::nullopt;
+#endif
+}
+
+void BatchRanks::answer(int from, int tag, std::int64_t k, const std::function<bool()>& give_up) {
+#if PHIQ_WITH_MPI
+  MPI_Request r;
+  MPI_Isend(&k, 1, MPI_INT64_T, from, tag, MPI_COMM_WORLD, &r);
+  (void)wait_politely(&r, give_up);
+#else
+  (void)from, (void)tag, (void)k, (void)give_up;
+#endif
+}
+
+}  // namespace phiq::tools

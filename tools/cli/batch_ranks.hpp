@@ -1,0 +1,77 @@
+// The processes of one `phiq batch`: MPI ranks when phiq was started by mpirun (and built with MPI), else one
+// process. Rank 0 hands out the cases one at a time, to its own threads and to every other rank's, as each asks
+// (cases near a singular position cost ten times the others: a static split would wait for the slowest rank), and
+// writes every case's rows itself, in case order, so that the file is the one a single process writes.
+//
+// The protocol, one message each way per case: a worker thread of rank r > 0 sends rank 0 its last case's result
+// (or, the first time, nothing) with its thread number as the tag, and rank 0 answers on that tag with the next
+// case, or −1 when there is none (or the batch stops). Only rank 0 writes files and prints.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace phiq::tools {
+
+// What a worker sends rank 0 after a case: everything rank 0 needs to write and report it as if it had run it.
+struct CaseMessage {
+  enum class Kind : std::int32_t { kAsk = 0, kDone = 1, kStopped = 2 };  // stopped: a signal ended it early
+  Kind kind = Kind::kAsk;
+  std::int64_t k = -1;  // the case
+  bool complete = false, failed = false, on_shared_analysis = false;
+  std::string line, outcome_json, text;  // report line, its --summary entry (JSON), its CSV rows
+  std::string values;                    // its HDF5 row values (doubles, as bytes)
+  std::int64_t setup_ns = 0, sweep_ns = 0, format_ns = 0;
+  int signal = 0;  // kStopped: the signal that stopped it
+};
+
+// The job: size() ranks (1 without mpirun). Rank 0 is the writer.
+class BatchRanks {
+ public:
+  // Joins the MPI job when phiq runs under mpirun (Open MPI's OMPI_COMM_WORLD_SIZE, or PMI_SIZE / PMIX_RANK, in
+  // the environment) and was built with MPI; else one process, and nothing of MPI is started (MPI_Init alone
+  // costs 0.4 s). Throws phiq::Error when the MPI library cannot give a thread-safe job.
+  static std::unique_ptr<BatchRanks> join();
+  ~BatchRanks();  // finish(0), if not called
+  // Leaves the job with the command's exit status: MPI_Finalize, or (abandon()) MPI_Abort with `status`, which
+  // mpirun then returns. Returns `status`.
+  int finish(int status);
+  BatchRanks(const BatchRanks&) = delete;
+  BatchRanks& operator=(const BatchRanks&) = delete;
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  // A description for messages and the summary: "3 MPI ranks" or "one process".
+  std::string describe() const;
+  // Whether phiq was started by mpirun with more than one rank but built without MPI (the ranks would each run
+  // the whole batch and write the same file): the command refuses that.
+  static bool launched_without_support();
+
+  // Every rank's worker-thread count, summed on rank 0 (others: their own). Collective.
+  int total_remote_workers(int my_threads);
+  // All ranks agree on a status (the largest), so that a set-up error is every rank's. Collective.
+  int agree(int status);
+
+  // Worker side (rank > 0): sends `m` to rank 0 on tag `worker` and waits for the next case; nullopt: none.
+  // While waiting it polls, sleeping 50 µs between polls, rather than spinning a core the cases need.
+  std::optional<std::int64_t> exchange(int worker, const CaseMessage& m);
+
+  // Rank 0: the next worker message, if one has arrived (source rank and tag in *from, *tag); nullopt also when
+  // `give_up` turned true while it was arriving (its sender may have died halfway).
+  std::optional<CaseMessage> poll(int* from, int* tag, const std::function<bool()>& give_up);
+  // Rank 0: the answer to (from, tag): the next case, or −1 (no more); not waited for once `give_up` is true.
+  void answer(int from, int tag, std::int64_t k, const std::function<bool()>& give_up);
+  // Rank 0: some remote worker never got its last answer (the batch stopped, or a rank died): MPI_Finalize would
+  // wait for it, so the job is left by MPI_Abort (after the output is published).
+  void abandon() { abandoned_ = true; }
+
+ private:
+  BatchRanks() = default;
+  int rank_ = 0, size_ = 1;
+  bool mpi_ = false, abandoned_ = false, finished_ = false;
+};
+
+}  // namespace phiq::tools

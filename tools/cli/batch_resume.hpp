@@ -1,0 +1,37 @@
+// `phiq batch SCENE CASES -o OUT.csv --resume`: an interrupted batch completed. The cases an earlier run of the
+// same batch committed to OUT.csv (whole cases, in case order: batch_file.cpp) are kept, and the batch runs on
+// from the case after the last of them, into a new file published as OUT.csv when it ends, so that OUT.csv is the
+// file one uninterrupted run writes, byte for byte, and the earlier one stays whole until then.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "atomic_file.hpp"
+#include "phiq/types.hpp"  // phiq::Error
+
+namespace phiq::tools {
+
+// OUT is not the earlier output of this batch (exit 2).
+struct ResumeError : Error {
+  using Error::Error;
+};
+
+struct ResumePoint {
+  std::size_t first = 0;          // the first case to run (0: the whole batch)
+  std::size_t cases_in_file = 0;  // the cases OUT holds
+  std::vector<char> in_file;      // per case before `first`: 1 in OUT, 0 left out (it failed earlier)
+  std::uint64_t bytes = 0;        // OUT's size
+};
+
+// Where the batch of `cases` cases whose CSV begins with `header` (its newline included) goes on after OUT: a
+// missing OUT is the whole batch. Throws ResumeError "OUT: --resume: …" for a file that is not such a batch's:
+// another header, a row that does not begin with a case of the batch or goes back in case order, a last row
+// without its newline.
+ResumePoint read_resume_point(const std::string& out, const std::string& header, std::size_t cases);
+
+// Copies OUT's bytes (the cases kept) into `file`, the batch's new output; returns how many. Throws phiq::Error.
+std::uint64_t copy_resumed_cases(const std::string& out, const ResumePoint& p, AtomicOutputFile& file);
+
+}  // namespace phiq::tools
