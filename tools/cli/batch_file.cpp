@@ -187,23 +187,29 @@ CaseResult from_message(CaseMessage m) {
 }
 
 // Rank 0's side of the protocol (batch_ranks.hpp): each message of another rank's worker handled (`handle`
-// returns the case to answer with, −1 for none) until every worker has been told there is none. A batch that
+// returns the case to answer a request with, −1 for none) until every worker has sent its last message. A batch that
 // halts (a signal: mpirun sends SIGTERM when a rank dies, and SIGKILL a second later) waits for no one: its
 // committed cases are published at once, and the workers left unanswered (BatchRanks::abandon).
 void serve_remote_workers(BatchRanks& ranks, int workers, const std::function<bool()>& halted,
                           const std::function<std::int64_t(CaseMessage)>& handle) {
   int finished = 0;
+  int pause_us = 20;  // between polls while nothing arrives: growing to 1 ms (wake-ups cost; see batch_ranks.cpp)
   while (finished < workers) {
     if (halted()) return ranks.abandon();
     int from = 0, tag = 0;
     std::optional<CaseMessage> m = ranks.poll(&from, &tag, halted);
     if (!m) {
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
+      std::this_thread::sleep_for(std::chrono::microseconds(pause_us));
+      pause_us = std::min(2 * pause_us, 1000);
       continue;
     }
+    pause_us = 20;
+    const bool asks = m->asks;
     const std::int64_t k = handle(std::move(*m));
-    ranks.answer(from, tag, k, halted);
-    if (k < 0) ++finished;
+    if (asks)
+      ranks.answer(from, tag, k, halted);
+    else
+      ++finished;  // its last message: that worker is done
   }
 }
 
@@ -454,14 +460,20 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     if (!writer) {  // a worker rank: its threads ask rank 0 for cases and send it their results
       arena.execute([&] {
         tbb::parallel_for(0, a.threads, [&](int w) {
-          CaseMessage m;  // the first: an ask
+          CaseMessage last;  // the result of the case before: none yet (a request alone)
+          std::optional<std::int64_t> k = ranks.send(w, last)->answer();
           CaseRows rows;
-          for (std::optional<std::int64_t> k; (k = ranks.exchange(w, m));) {
+          while (k && !stop.load()) {
+            // the next case asked for now, with the last result: its answer travels while this case runs
+            const std::unique_ptr<BatchRanks::Sent> next = ranks.send(w, last);
             CaseResult r = run_case(static_cast<std::size_t>(*k), trees[w], std::move(rows));
-            m = to_message(static_cast<std::size_t>(*k), r, stop.load() ? interrupt_signal() : 0);
+            last = to_message(static_cast<std::size_t>(*k), r, stop.load() ? interrupt_signal() : 0);
             rows = std::move(r.rows);
             rows.any = false, rows.text.clear(), rows.values.clear();
+            k = next->answer();
           }
+          last.asks = false;  // the last result, and no request: this worker is done
+          (void)ranks.send(w, last);
         }, tbb::simple_partitioner());
       });
       return 0;  // (rank 0 says how the batch went)
@@ -476,8 +488,10 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       });
     });
     serve_remote_workers(ranks, remote_workers, halted, [&](CaseMessage m) {
+      const bool asks = m.asks;
       if (m.kind == CaseMessage::Kind::kStopped) remote_signal = m.signal > 0 ? m.signal : 15;
       if (m.kind == CaseMessage::Kind::kDone) deliver(static_cast<std::size_t>(m.k), from_message(std::move(m)));
+      if (!asks) return std::int64_t{-1};
       const std::optional<std::size_t> k = next();
       return k ? static_cast<std::int64_t>(*k) : std::int64_t{-1};
     });

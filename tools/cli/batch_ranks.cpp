@@ -37,7 +37,8 @@ std::string pack(const CaseMessage& m) {
     put(s.data(), s.size());
   };
   const std::int32_t kind = static_cast<std::int32_t>(m.kind);
-  const std::int32_t flags = (m.complete ? 1 : 0) | (m.failed ? 2 : 0) | (m.on_shared_analysis ? 4 : 0);
+  const std::int32_t flags =
+      (m.complete ? 1 : 0) | (m.failed ? 2 : 0) | (m.on_shared_analysis ? 4 : 0) | (m.asks ? 8 : 0);
   const std::int32_t sig = m.signal;
   put(&kind, sizeof kind);
   put(&flags, sizeof flags);
@@ -50,19 +51,19 @@ std::string pack(const CaseMessage& m) {
   return b;
 }
 
-CaseMessage unpack(const std::string& b) {
+CaseMessage unpack(const char* b, std::size_t size) {
   CaseMessage m;
   std::size_t at = 0;
   auto get = [&](void* p, std::size_t n) {
-    if (at + n > b.size()) throw Error("batch: a truncated message between MPI ranks (phiq bug)");
-    std::memcpy(p, b.data() + at, n);
+    if (at + n > size) throw Error("batch: a truncated message between MPI ranks (phiq bug)");
+    std::memcpy(p, b + at, n);
     at += n;
   };
   auto get_string = [&](std::string& s) {
     std::uint64_t n = 0;
     get(&n, sizeof n);
-    if (n > b.size() - at) throw Error("batch: a truncated message between MPI ranks (phiq bug)");
-    s.assign(b.data() + at, n);
+    if (n > size - at) throw Error("batch: a truncated message between MPI ranks (phiq bug)");
+    s.assign(b + at, n);
     at += n;
   };
   std::int32_t kind = 0, flags = 0, sig = 0;
@@ -70,7 +71,7 @@ CaseMessage unpack(const std::string& b) {
   get(&flags, sizeof flags);
   get(&sig, sizeof sig);
   m.kind = static_cast<CaseMessage::Kind>(kind);
-  m.complete = flags & 1, m.failed = flags & 2, m.on_shared_analysis = flags & 4;
+  m.complete = flags & 1, m.failed = flags & 2, m.on_shared_analysis = flags & 4, m.asks = flags & 8;
   m.signal = sig;
   get(&m.k, sizeof m.k);
   get(&m.setup_ns, sizeof m.setup_ns);
@@ -82,12 +83,14 @@ CaseMessage unpack(const std::string& b) {
 
 // Waits for `r` by polling (Open MPI's blocking calls spin a core, which the cases on this machine need) until it
 // completes (true) or `give_up` says to stop waiting (false: a peer that died mid-message never completes it).
+// The sleep between polls grows from 20 µs to 1 ms: each wake-up costs (in a virtual machine, most of rank 0's
+// time went to them at a fixed 50 µs), and an answer usually arrives while the worker still runs its case.
 bool wait_politely(MPI_Request* r, const std::function<bool()>& give_up = {}) {
-  for (int done = 0;;) {
+  for (int done = 0, pause_us = 20;; pause_us = std::min(2 * pause_us, 1000)) {
     MPI_Test(r, &done, MPI_STATUS_IGNORE);
     if (done) return true;
     if (give_up && give_up()) return false;
-    std::this_thread::sleep_for(std::chrono::microseconds(50));
+    std::this_thread::sleep_for(std::chrono::microseconds(pause_us));
   }
 }
 #endif
@@ -162,23 +165,46 @@ int BatchRanks::agree(int status) {
   return status;
 }
 
-std::optional<std::int64_t> BatchRanks::exchange(int worker, const CaseMessage& m) {
+BatchRanks::Sent::~Sent() {
 #if PHIQ_WITH_MPI
-  const std::string bytes = pack(m);
-  if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
-    throw Error("batch: a case of more than 2 GiB of rows cannot be sent between MPI ranks: fewer steps per case");
-  MPI_Request send, recv;
-  std::int64_t next = -1;
-  MPI_Irecv(&next, 1, MPI_INT64_T, 0, worker, MPI_COMM_WORLD, &recv);
-  MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, 0, worker, MPI_COMM_WORLD, &send);
-  wait_politely(&send);
-  wait_politely(&recv);
-  if (next < 0) return std::nullopt;
-  return next;
+  for (void* r : {send_, recv_})
+    if (r) {
+      auto* request = static_cast<MPI_Request*>(r);
+      if (*request != MPI_REQUEST_NULL) wait_politely(request);
+      delete request;
+    }
+#endif
+}
+
+std::optional<std::int64_t> BatchRanks::Sent::answer() {
+#if PHIQ_WITH_MPI
+  if (!recv_) return std::nullopt;
+  wait_politely(static_cast<MPI_Request*>(recv_));
+  if (next_ < 0) return std::nullopt;
+  return next_;
 #else
-  (void)worker, (void)m;
   return std::nullopt;
 #endif
+}
+
+std::unique_ptr<BatchRanks::Sent> BatchRanks::send(int worker, const CaseMessage& m) {
+  std::unique_ptr<Sent> s(new Sent());
+#if PHIQ_WITH_MPI
+  s->bytes_ = pack(m);
+  if (s->bytes_.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw Error("batch: a case of more than 2 GiB of rows cannot be sent between MPI ranks: fewer steps per case");
+  if (m.asks) {
+    auto* recv = new MPI_Request;
+    s->recv_ = recv;
+    MPI_Irecv(&s->next_, 1, MPI_INT64_T, 0, worker, MPI_COMM_WORLD, recv);
+  }
+  auto* send = new MPI_Request;
+  s->send_ = send;
+  MPI_Isend(s->bytes_.data(), static_cast<int>(s->bytes_.size()), MPI_BYTE, 0, worker, MPI_COMM_WORLD, send);
+#else
+  (void)worker, (void)m;
+#endif
+  return s;
 }
 
 std::optional<CaseMessage> BatchRanks::poll(int* from, int* tag, const std::function<bool()>& give_up) {
@@ -189,14 +215,16 @@ std::optional<CaseMessage> BatchRanks::poll(int* from, int* tag, const std::func
   if (!arrived) return std::nullopt;
   int count = 0;
   MPI_Get_count(&st, MPI_BYTE, &count);
-  std::string bytes(static_cast<std::size_t>(count), '\0');
-  // (a rank killed while sending its rows leaves the message half-arrived: `give_up` ends the wait)
+  // (not zeroed: received into; a rank killed while sending its rows leaves the message half-arrived, and
+  // `give_up` ends the wait, the buffer then left to MPI_Abort)
+  auto* bytes = new char[static_cast<std::size_t>(count)];
   MPI_Request r;
-  MPI_Irecv(bytes.data(), count, MPI_BYTE, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, &r);
+  MPI_Irecv(bytes, count, MPI_BYTE, st.MPI_SOURCE, st.MPI_TAG, MPI_COMM_WORLD, &r);
   if (!wait_politely(&r, give_up)) return std::nullopt;
+  const std::unique_ptr<char[]> owned(bytes);
   *from = st.MPI_SOURCE;
   *tag = st.MPI_TAG;
-  return unpack(bytes);
+  return unpack(bytes, static_cast<std::size_t>(count));
 #else
   (void)from, (void)tag, (void)give_up;
   return std::nullopt;

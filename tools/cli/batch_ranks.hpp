@@ -3,9 +3,12 @@
 // (cases near a singular position cost ten times the others: a static split would wait for the slowest rank), and
 // writes every case's rows itself, in case order, so that the file is the one a single process writes.
 //
-// The protocol, one message each way per case: a worker thread of rank r > 0 sends rank 0 its last case's result
-// (or, the first time, nothing) with its thread number as the tag, and rank 0 answers on that tag with the next
-// case, or −1 when there is none (or the batch stops). Only rank 0 writes files and prints.
+// The protocol, one message each way per case: a worker thread of rank r > 0 sends rank 0, with its thread number
+// as the tag, a case's result and a request for its next case, and rank 0 answers on that tag with a case, or −1
+// when there is none (or the batch stops). The request goes out when the worker starts a case, carrying the
+// result of the case before, so that the answer travels while the case runs and the worker never waits for it
+// (one case in reserve per worker); a last message without a request (a "bye") carries the last result. Only
+// rank 0 writes files and prints.
 #pragma once
 
 #include <cstdint>
@@ -18,8 +21,9 @@ namespace phiq::tools {
 
 // What a worker sends rank 0 after a case: everything rank 0 needs to write and report it as if it had run it.
 struct CaseMessage {
-  enum class Kind : std::int32_t { kAsk = 0, kDone = 1, kStopped = 2 };  // stopped: a signal ended it early
-  Kind kind = Kind::kAsk;
+  enum class Kind : std::int32_t { kNone = 0, kDone = 1, kStopped = 2 };  // stopped: a signal ended it early
+  Kind kind = Kind::kNone;  // the result carried: none (the first request), a case done, or stopped
+  bool asks = true;         // a request for the next case (false: the worker's last message)
   std::int64_t k = -1;  // the case
   bool complete = false, failed = false, on_shared_analysis = false;
   std::string line, outcome_json, text;  // report line, its --summary entry (JSON), its CSV rows
@@ -55,9 +59,26 @@ class BatchRanks {
   // All ranks agree on a status (the largest), so that a set-up error is every rank's. Collective.
   int agree(int status);
 
-  // Worker side (rank > 0): sends `m` to rank 0 on tag `worker` and waits for the next case; nullopt: none.
-  // While waiting it polls, sleeping 50 µs between polls, rather than spinning a core the cases need.
-  std::optional<std::int64_t> exchange(int worker, const CaseMessage& m);
+  // Worker side (rank > 0): a message to rank 0 in flight, and (m.asks) the answer on its way back.
+  class Sent {
+   public:
+    ~Sent();  // waits for the send
+    Sent(const Sent&) = delete;
+    Sent& operator=(const Sent&) = delete;
+    // The next case; nullopt: none. Waits by polling, the sleep between polls growing from 20 µs to 1 ms, rather
+    // than in MPI's calls that spin a core the cases need.
+    std::optional<std::int64_t> answer();
+
+   private:
+    friend class BatchRanks;
+    Sent() = default;
+    std::string bytes_;
+    std::int64_t next_ = -1;
+    void* send_ = nullptr;  // MPI_Request (mpi.h stays out of this header)
+    void* recv_ = nullptr;
+  };
+  // Sends `m` to rank 0 on tag `worker`.
+  std::unique_ptr<Sent> send(int worker, const CaseMessage& m);
 
   // Rank 0: the next worker message, if one has arrived (source rank and tag in *from, *tag); nullopt also when
   // `give_up` turned true while it was arriving (its sender may have died halfway).
