@@ -30,6 +30,7 @@ packages=(
   libjs-three          # three.js r111 and its OrbitControls, embedded at build time into `phiq animate -o OUT.html`
   chromium             # headless browser of ctest browser_viewer (the HTML viewer's pages; skipped if absent)
   openmpi-bin libopenmpi-dev  # `mpirun -np K phiq batch` (tools/cli/batch_ranks.hpp) and its ctest mpi_batch
+  libmumps-dev         # MUMPS, distributed sparse LU: bench/bench_mumps.cpp against KLU (engine/README.md)
 )
 # npm (Debian's package, unless a node install already brings its own) installs the validator below
 command -v npm >/dev/null 2>&1 || packages+=(npm)

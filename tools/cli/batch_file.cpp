@@ -165,7 +165,8 @@ CaseMessage to_message(std::size_t k, const CaseResult& r, int signal) {
   m.line = r.report.line;
   m.outcome_json = r.report.outcome.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
   m.text = r.rows.text;
-  m.values.assign(reinterpret_cast<const char*>(r.rows.values.data()), r.rows.values.size() * sizeof(double));
+  if (!r.rows.values.empty())
+    m.values.assign(reinterpret_cast<const char*>(r.rows.values.data()), r.rows.values.size() * sizeof(double));
   m.setup_ns = r.setup_ns, m.sweep_ns = r.sweep_ns, m.format_ns = r.format_ns;
   m.signal = signal;
   return m;
@@ -180,7 +181,8 @@ CaseResult from_message(CaseMessage m) {
   r.rows.any = m.complete && !m.failed;
   r.rows.text = std::move(m.text);
   r.rows.values.resize(m.values.size() / sizeof(double));
-  std::memcpy(r.rows.values.data(), m.values.data(), r.rows.values.size() * sizeof(double));
+  if (!r.rows.values.empty())  // (a CSV batch's cases carry none: memcpy to an empty vector's null is undefined)
+    std::memcpy(r.rows.values.data(), m.values.data(), r.rows.values.size() * sizeof(double));
   r.on_shared_analysis = m.on_shared_analysis;
   r.setup_ns = m.setup_ns, r.sweep_ns = m.sweep_ns, r.format_ns = m.format_ns;
   return r;
