@@ -5,8 +5,6 @@
 #include "batch_file.hpp"
 
 #include <tbb/info.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -18,7 +16,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <thread>
 
 #include "batch_resume.hpp"
 #include "cli_support.hpp"
@@ -188,33 +185,6 @@ CaseResult from_message(CaseMessage m) {
   return r;
 }
 
-// Rank 0's side of the protocol (batch_ranks.hpp): each message of another rank's worker handled (`handle`
-// returns the case to answer a request with, −1 for none) until every worker has sent its last message. A batch that
-// halts (a signal: mpirun sends SIGTERM when a rank dies, and SIGKILL a second later) waits for no one: its
-// committed cases are published at once, and the workers left unanswered (BatchRanks::abandon).
-void serve_remote_workers(BatchRanks& ranks, int workers, const std::function<bool()>& halted,
-                          const std::function<std::int64_t(CaseMessage)>& handle) {
-  int finished = 0;
-  int pause_us = 20;  // between polls while nothing arrives: growing to 1 ms (wake-ups cost; see batch_ranks.cpp)
-  while (finished < workers) {
-    if (halted()) return ranks.abandon();
-    int from = 0, tag = 0;
-    std::optional<CaseMessage> m = ranks.poll(&from, &tag, halted);
-    if (!m) {
-      std::this_thread::sleep_for(std::chrono::microseconds(pause_us));
-      pause_us = std::min(2 * pause_us, 1000);
-      continue;
-    }
-    pause_us = 20;
-    const bool asks = m->asks;
-    const std::int64_t k = handle(std::move(*m));
-    if (asks)
-      ranks.answer(from, tag, k, halted);
-    else
-      ++finished;  // its last message: that worker is done
-  }
-}
-
 }  // namespace
 int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& ranks) {
   BatchArgs a = args;
@@ -344,7 +314,6 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       r.line = a.scene + ": case " + std::to_string(k) + ": not in " + a.out + " (left out by the run resumed)";
     }
   }
-  std::atomic<std::size_t> next_case{resumed.first};
   std::atomic<std::size_t> shared{0};  // cases swept on the reference's symbolic analysis
   const std::atomic<bool>& stop = stop_flag();
   auto halted = [&] { return stop.load() || abort.load() || remote_signal.load() != 0; };
@@ -449,55 +418,28 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     reports[k] = std::move(r.report);
     if (complete) in_order.complete(k, std::move(r.rows));
   };
-  auto next = [&]() -> std::optional<std::size_t> {
-    if (halted()) return std::nullopt;
-    const std::size_t k = next_case++;
-    return k < n ? std::optional<std::size_t>(k) : std::nullopt;
-  };
 
   const auto solve_start = Clock::now();
   {
     StopOnSignal stop_on_signal;  // a signal stops every case at its next row
-    tbb::task_arena arena(a.threads);
-    if (!writer) {  // a worker rank: its threads ask rank 0 for cases and send it their results
-      arena.execute([&] {
-        tbb::parallel_for(0, a.threads, [&](int w) {
-          CaseMessage last;  // the result of the case before: none yet (a request alone)
-          std::optional<std::int64_t> k = ranks.send(w, last)->answer();
-          CaseRows rows;
-          while (k && !stop.load()) {
-            // the next case asked for now, with the last result: its answer travels while this case runs
-            const std::unique_ptr<BatchRanks::Sent> next = ranks.send(w, last);
-            CaseResult r = run_case(static_cast<std::size_t>(*k), trees[w], std::move(rows));
-            last = to_message(static_cast<std::size_t>(*k), r, stop.load() ? interrupt_signal() : 0);
-            rows = std::move(r.rows);
-            rows.any = false, rows.text.clear(), rows.values.clear();
-            k = next->answer();
-          }
-          last.asks = false;  // the last result, and no request: this worker is done
-          (void)ranks.send(w, last);
-        }, tbb::simple_partitioner());
-      });
-      return 0;  // (rank 0 says how the batch went)
-    }
-    // Rank 0: a worker per thread taking the next case in order (cases complete about in order, so few wait),
-    // while this thread answers the other ranks' workers, if any
-    std::thread local([&] {
-      arena.execute([&] {
-        tbb::parallel_for(0, a.threads, [&](int w) {
-          for (std::optional<std::size_t> k; (k = next());) deliver(*k, run_case(*k, trees[w], in_order.spare()));
-        }, tbb::simple_partitioner());
-      });
-    });
-    serve_remote_workers(ranks, remote_workers, halted, [&](CaseMessage m) {
-      const bool asks = m.asks;
+    std::vector<CaseRows> worker_rows(static_cast<std::size_t>(a.threads));  // a worker rank's buffers, reused
+    CaseHandlers h;
+    h.run_here = [&](std::size_t k, int w) { deliver(k, run_case(k, trees[w], in_order.spare())); };
+    h.run_for_0 = [&](std::size_t k, int w) {
+      CaseRows& rows = worker_rows[static_cast<std::size_t>(w)];
+      CaseResult r = run_case(k, trees[w], std::move(rows));
+      CaseMessage m = to_message(k, r, stop.load() ? interrupt_signal() : 0);
+      rows = std::move(r.rows);
+      rows.any = false, rows.text.clear(), rows.values.clear();
+      return m;
+    };
+    h.deliver = [&](CaseMessage m) {
       if (m.kind == CaseMessage::Kind::kStopped) remote_signal = m.signal > 0 ? m.signal : 15;
       if (m.kind == CaseMessage::Kind::kDone) deliver(static_cast<std::size_t>(m.k), from_message(std::move(m)));
-      if (!asks) return std::int64_t{-1};
-      const std::optional<std::size_t> k = next();
-      return k ? static_cast<std::int64_t>(*k) : std::int64_t{-1};
-    });
-    local.join();
+    };
+    h.halted = halted;
+    run_cases(ranks, resumed.first, n, a.threads, h);
+    if (!writer) return 0;  // (rank 0 says how the batch went)
   }
   const double solve_s = since(solve_start);
   const int signal = stop.load() ? interrupt_signal() : remote_signal.load();

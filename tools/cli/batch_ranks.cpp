@@ -1,6 +1,11 @@
 // MPI for `phiq batch` (batch_ranks.hpp), or one process when phiq is built without MPI or not run by mpirun.
 #include "batch_ranks.hpp"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <atomic>
+
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -239,6 +244,82 @@ void BatchRanks::answer(int from, int tag, std::int64_t k, const std::function<b
 #else
   (void)from, (void)tag, (void)k, (void)give_up;
 #endif
+}
+
+namespace {
+
+// Rank 0's side: each message of another rank's worker handled (`handle` returns the case to answer a request
+// with, −1 for none) until every worker has sent its last message. A batch that halts (a signal: mpirun sends
+// SIGTERM when a rank dies, and SIGKILL a second later) waits for no one: its committed cases are published at
+// once, and the workers left unanswered (BatchRanks::abandon).
+void serve_remote_workers(BatchRanks& ranks, int workers, const std::function<bool()>& halted,
+                          const std::function<std::int64_t(CaseMessage)>& handle) {
+  int finished = 0;
+  int pause_us = 20;  // between polls while nothing arrives: growing to 1 ms (wake-ups cost: wait_politely)
+  while (finished < workers) {
+    if (halted()) return ranks.abandon();
+    int from = 0, tag = 0;
+    std::optional<CaseMessage> m = ranks.poll(&from, &tag, halted);
+    if (!m) {
+      std::this_thread::sleep_for(std::chrono::microseconds(pause_us));
+      pause_us = std::min(2 * pause_us, 1000);
+      continue;
+    }
+    pause_us = 20;
+    const bool asks = m->asks;
+    const std::int64_t k = handle(std::move(*m));
+    if (asks)
+      ranks.answer(from, tag, k, halted);
+    else
+      ++finished;  // its last message: that worker is done
+  }
+}
+
+}  // namespace
+
+void run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h) {
+  const int remote_workers = ranks.total_remote_workers(threads);
+  tbb::task_arena arena(threads);
+  if (ranks.rank() > 0) {  // a worker rank: its threads ask rank 0 for cases and send it their results
+    arena.execute([&] {
+      tbb::parallel_for(0, threads, [&](int w) {
+        CaseMessage last;  // the result of the case before: none yet (a request alone)
+        std::optional<std::int64_t> k = ranks.send(w, last)->answer();
+        while (k && !h.halted()) {
+          // the next case asked for now, with the last result: its answer travels while this case runs
+          const std::unique_ptr<BatchRanks::Sent> next = ranks.send(w, last);
+          last = h.run_for_0(static_cast<std::size_t>(*k), w);
+          k = next->answer();
+        }
+        last.asks = false;  // the last result, and no request: this worker is done
+        (void)ranks.send(w, last);
+      }, tbb::simple_partitioner());
+    });
+    return;
+  }
+  std::atomic<std::size_t> next_case{first};
+  auto next = [&]() -> std::optional<std::size_t> {
+    if (h.halted()) return std::nullopt;
+    const std::size_t k = next_case++;
+    return k < n ? std::optional<std::size_t>(k) : std::nullopt;
+  };
+  // rank 0's workers, each taking the next case in order (cases complete about in order, so few wait), while this
+  // thread answers the other ranks' workers, if any
+  std::thread local([&] {
+    arena.execute([&] {
+      tbb::parallel_for(0, threads, [&](int w) {
+        for (std::optional<std::size_t> k; (k = next());) h.run_here(*k, w);
+      }, tbb::simple_partitioner());
+    });
+  });
+  serve_remote_workers(ranks, remote_workers, h.halted, [&](CaseMessage m) {
+    const bool asks = m.asks;
+    if (m.kind != CaseMessage::Kind::kNone) h.deliver(std::move(m));
+    if (!asks) return std::int64_t{-1};
+    const std::optional<std::size_t> k = next();
+    return k ? static_cast<std::int64_t>(*k) : std::int64_t{-1};
+  });
+  local.join();
 }
 
 }  // namespace phiq::tools

@@ -95,4 +95,20 @@ class BatchRanks {
   bool mpi_ = false, abandoned_ = false, finished_ = false;
 };
 
+// What run_cases() does with a case.
+struct CaseHandlers {
+  std::function<void(std::size_t k, int worker)> run_here;           // rank 0: run case k and take its result
+  std::function<CaseMessage(std::size_t k, int worker)> run_for_0;   // other ranks: run case k, for rank 0
+  std::function<void(CaseMessage)> deliver;  // rank 0: another rank's message with a result (kDone, kStopped)
+  std::function<bool()> halted;              // hand out no more cases (on rank 0; elsewhere: stop asking)
+};
+
+// Cases first … n − 1 on every rank's `threads` workers, handed out one at a time by rank 0 (the protocol above):
+// on rank 0, its workers take the next case themselves (run_here) while the calling thread answers the other
+// ranks' workers and delivers their results, one at a time; on another rank, its workers ask rank 0 and send it
+// run_for_0's message. Returns when this rank's part is done: on rank 0, every case handed out and every worker's
+// last message received, or at once when halted() (the workers still out then abandoned: BatchRanks::abandon).
+// run_here and deliver may run at the same time (rank 0's workers and its answering thread).
+void run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h);
+
 }  // namespace phiq::tools
