@@ -52,6 +52,23 @@ awk -F, 'NR > 1 { seen[$1] = 1 } END { n = 0; for (c in seen) ++n; exit !(n == 1
   fail "a failing case: fail3.csv does not hold the other 119 cases"
 grep -q '"ranks": 3,' fail3.json && grep -q '"failed": 1,' fail3.json || fail "fail3.json: not 3 ranks and 1 failure"
 
+# 4. (before the long run) phiq tolerance: the Monte Carlo samples over the ranks, the same CSV and summary but
+#    for its timings and thread count; samples that fail (a wide tolerance reaches dead points) named once
+m="$models/seed/crank_slider_mixed.yaml"
+"$phiq" tolerance "$m" --sd L2=0.05 --sd L3=0.3 --samples 200 -q -o tol1.csv --summary tol1.json --threads 2 2>tol1.err ||
+  fail "tolerance, one process: exit $?"
+for np in 2 3; do
+  mpirun -np $np "$phiq" tolerance "$m" --sd L2=0.05 --sd L3=0.3 --samples 200 -q -o "tol$np.csv" \
+    --summary "tol$np.json" --threads 1 2>"tol$np.err" || fail "tolerance, $np ranks: exit $?"
+  cmp -s tol1.csv "tol$np.csv" || fail "tolerance, $np ranks: tol$np.csv differs from one process's tol1.csv"
+  diff <(grep -v -e '"seconds"' -e '"threads"' tol1.json) <(grep -v -e '"seconds"' -e '"threads"' "tol$np.json") >/dev/null ||
+    fail "tolerance, $np ranks: the summary differs from one process's beyond its timings and threads"
+  [ "$(grep -c '^phiq' "tol$np.err")" -eq "$(grep -c '^phiq' tol1.err)" ] ||
+    fail "tolerance, $np ranks: $(grep -c '^phiq' "tol$np.err") lines, one process $(grep -c '^phiq' tol1.err)"
+done
+grep -q '"failed": \[$' tol1.json && [ "$(grep -c '^phiq: .*: case [0-9]* (L2 = ' tol1.err)" -ge 1 ] ||
+  fail "tolerance: no sample failed (the test needs some)"
+
 # 3. rank 1 killed: the committed cases published, the missing named; --resume completes the same file
 sed 's/steps: 180/steps: 2000/' "$models/seed/crank_slider_mixed.yaml" > long.yaml
 awk 'BEGIN { print "L2"; for (k = 0; k < 1500; ++k) printf "%.6f\n", 0.2 + 1e-5 * k }' > long.csv

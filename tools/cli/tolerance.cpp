@@ -1,15 +1,20 @@
 // `phiq tolerance SCENE --sd P=σ ... -o OUT.csv`: the spread of the scene's outputs over toleranced parameters,
 // first order from the exact sensitivities of one nominal sweep, and Monte Carlo from sampled parameter sets swept in
-// parallel on the nominal model's symbolic analysis (run_batch), with their agreement. The numbers are
-// tools/tolerance/; what is written, tolerance_report.*; the format, tools/README.md.
+// parallel on the nominal model's symbolic analysis (run_batch; under mpirun, over the ranks: run_cases), with their
+// agreement. The numbers are tools/tolerance/; what is written, tolerance_report.*; the format, tools/README.md.
+#include <signal.h>
+#include <tbb/info.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <set>
 
+#include "batch_ranks.hpp"  // the samples on MPI ranks
 #include "cli_support.hpp"
 #include "command_line.hpp"
 #include "command_support.hpp"
@@ -95,7 +100,55 @@ SweepOptions case_sweep(SweepOptions o) {
   return o;
 }
 
-int cmd_tolerance(const ToleranceArgs& a) {
+// One sampled case on a rank of an MPI job: built from the worker's own parsed tree, made square and swept on one
+// thread, as run_batch sweeps it in one process (so the same values, bit for bit); `values` its outputs row after
+// row, or `why` it failed.
+struct SampledCase {
+  std::vector<double> values;
+  std::string why;
+};
+SampledCase sample_case(ParsedScene& tree, const SceneOverrides& o, const std::vector<double>& t,
+                        const std::vector<OutputColumn>& columns, const std::atomic<bool>& stop) {
+  SampledCase c;
+  Scene scene;
+  try {
+    scene = tree.read(o);
+  } catch (const SceneError& e) {
+    c.why = e.what();
+    return c;
+  }
+  SquareScene square;
+  if (const auto why = make_square(scene, &square)) {
+    c.why = *why;
+    return c;
+  }
+  const Model& model = square.model(*scene.model);
+  Workspace ws(model);
+  ws.q = square.start;
+  SweepOptions one = case_sweep(scene.sweep);
+  one.threads = 1;
+  std::size_t rows = 0;
+  const char* grid = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
+  SweepSummary s;
+  (void)run_sweep(model, one, ws, [&](const StepView& step) {
+    const std::size_t r = rows++;
+    if (r >= t.size() || std::fabs(step.t - t[r]) > 1e-12 * (1.0 + std::fabs(t[r]))) {
+      c.why = grid;
+      c.values.clear();
+      return false;
+    }
+    for (const OutputColumn& col : columns)
+      c.values.push_back((col.order == 0 ? step.q : col.order == 1 ? *step.qd : *step.qdd)(col.coordinate));
+    return !stop.load();
+  }, &s);
+  if (c.why.empty() && s.status != SolveStatus::kSuccess) c.why = s.message;
+  if (c.why.empty() && rows != t.size()) c.why = grid;
+  if (!c.why.empty()) c.values.clear();
+  return c;
+}
+
+int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
+  const bool writer = ranks.rank() == 0;  // under mpirun, rank 0 alone writes and prints
   std::vector<NamedPath> outs{{"-o", a.out}};
   if (!a.summary.empty()) outs.push_back({"--summary", a.summary});
   if (!a.plot.empty()) outs.push_back({"--plot", a.plot});
@@ -195,13 +248,17 @@ int cmd_tolerance(const ToleranceArgs& a) {
   // Every output exists before the sweeps: an unwritable path fails now; all are committed together at the end.
   OutputSet outputs;
   AtomicOutputFile *csv_file = nullptr, *summary_file = nullptr, *plot_file = nullptr;
-  try {
-    csv_file = &outputs.add(a.out);
-    if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
-    if (!a.plot.empty()) plot_file = &outputs.add(a.plot);
-  } catch (const Error& e) {
-    return fail(e.what(), 3);
+  int status = 0;
+  if (writer) {
+    try {
+      csv_file = &outputs.add(a.out);
+      if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
+      if (!a.plot.empty()) plot_file = &outputs.add(a.plot);
+    } catch (const Error& e) {
+      status = fail(e.what(), 3);
+    }
   }
+  if ((status = ranks.agree(status)) != 0) return status;  // every rank stops where rank 0 could not go on
   const auto start = Clock::now();
   StopOnSignal stop_on_signal;
   const std::atomic<bool>& stop = stop_flag();
@@ -256,58 +313,104 @@ int cmd_tolerance(const ToleranceArgs& a) {
     for (std::size_t j = 0; j < np; ++j) v[j] = nominal[j] + offsets(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
     return v;
   };
-  // The cases are read from the scene parsed once (ParsedScene: no YAML parse per case).
-  ParsedScene parsed(scene.text, scene.path);
-  for (std::size_t k = 0; k < n_cases; ++k) {
+  tolerance::CaseValues cases;
+  cases.rows = t.size(), cases.outputs = columns.size();
+  cases.values.resize(n_cases);
+  int threads_used = a.threads;
+  auto overrides_of = [&](std::size_t k) {
     SceneOverrides o;
     const std::vector<double> v = values_of(k);
     for (std::size_t j = 0; j < np; ++j) o.parameters.emplace_back(spread.parameters[j].name, v[j]);
     o.share_analysis_with = scene.model.get();
     o.sensitivity_models = false;
-    try {
-      scenes[k] = parsed.read(o);
-    } catch (const SceneError& e) {  // a value the scene refuses (a negative length): this case's failure
-      why_failed[k] = e.what();
-      continue;
+    return o;
+  };
+  if (ranks.size() == 1) {
+    // The cases are read from the scene parsed once (ParsedScene: no YAML parse per case).
+    ParsedScene parsed(scene.text, scene.path);
+    for (std::size_t k = 0; k < n_cases; ++k) {
+      const SceneOverrides o = overrides_of(k);
+      try {
+        scenes[k] = parsed.read(o);
+      } catch (const SceneError& e) {  // a value the scene refuses (a negative length): this case's failure
+        why_failed[k] = e.what();
+        continue;
+      }
+      if (const auto why = make_square(scenes[k], &squares[k])) {
+        why_failed[k] = *why;
+        continue;
+      }
+      models.push_back(&squares[k].model(*scenes[k].model));
+      sweeps.push_back(case_sweep(scenes[k].sweep));
+      starts.push_back(squares[k].start);
+      swept.push_back(k);
+      if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
     }
-    if (const auto why = make_square(scenes[k], &squares[k])) {
-      why_failed[k] = *why;
-      continue;
-    }
-    models.push_back(&squares[k].model(*scenes[k].model));
-    sweeps.push_back(case_sweep(scenes[k].sweep));
-    starts.push_back(squares[k].start);
-    swept.push_back(k);
+    std::vector<std::size_t> rows_seen(n_cases, 0);
+    // Each case writes only its own vector: safe across cases without a lock.
+    const BatchSummary batch = run_batch(models, sweeps, a.threads, [&](std::size_t c, const StepView& step) {
+      const std::size_t k = swept[c];
+      std::vector<double>& v = cases.values[k];
+      const std::size_t r = rows_seen[k]++;
+      if (r >= t.size() || std::fabs(step.t - t[r]) > 1e-12 * (1.0 + std::fabs(t[r]))) {
+        why_failed[k] = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
+        v.clear();
+        return false;
+      }
+      if (v.empty()) v.reserve(t.size() * columns.size());
+      for (const OutputColumn& col : columns)
+        v.push_back((col.order == 0 ? step.q : col.order == 1 ? *step.qd : *step.qdd)(col.coordinate));
+      return !stop.load();
+    }, &starts);
     if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
-  }
-  tolerance::CaseValues cases;
-  cases.rows = t.size(), cases.outputs = columns.size();
-  cases.values.resize(n_cases);
-  std::vector<std::size_t> rows_seen(n_cases, 0);
-  // Each case writes only its own vector: safe across cases without a lock.
-  const BatchSummary batch = run_batch(models, sweeps, a.threads, [&](std::size_t c, const StepView& step) {
-    const std::size_t k = swept[c];
-    std::vector<double>& v = cases.values[k];
-    const std::size_t r = rows_seen[k]++;
-    if (r >= t.size() || std::fabs(step.t - t[r]) > 1e-12 * (1.0 + std::fabs(t[r]))) {
-      why_failed[k] = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
-      v.clear();
-      return false;
+    for (std::size_t c = 0; c < swept.size(); ++c) {
+      const std::size_t k = swept[c];
+      const SweepSummary& s = batch.cases[c];
+      if (why_failed[k].empty() && s.status != SolveStatus::kSuccess) why_failed[k] = s.message;
+      if (why_failed[k].empty() && rows_seen[k] != t.size())
+        why_failed[k] = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
     }
-    if (v.empty()) v.reserve(t.size() * columns.size());
-    for (const OutputColumn& col : columns)
-      v.push_back((col.order == 0 ? step.q : col.order == 1 ? *step.qd : *step.qdd)(col.coordinate));
-    return !stop.load();
-  }, &starts);
-  if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
-  std::vector<FailedCase> failed;
-  for (std::size_t c = 0; c < swept.size(); ++c) {
-    const std::size_t k = swept[c];
-    const SweepSummary& s = batch.cases[c];
-    if (why_failed[k].empty() && s.status != SolveStatus::kSuccess) why_failed[k] = s.message;
-    if (why_failed[k].empty() && rows_seen[k] != t.size())
-      why_failed[k] = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
+    threads_used = batch.threads;
+  } else {  // the samples over the MPI ranks: each rank a parsed tree per thread; rank 0 collects their values
+    if (threads_used <= 0) threads_used = tbb::info::default_concurrency();
+    std::vector<ParsedScene> trees(static_cast<std::size_t>(threads_used), ParsedScene(scene.text, scene.path));
+    CaseHandlers h;
+    h.run_here = [&](std::size_t k, int w) {
+      SampledCase c = sample_case(trees[static_cast<std::size_t>(w)], overrides_of(k), t, columns, stop);
+      cases.values[k] = std::move(c.values), why_failed[k] = std::move(c.why);
+    };
+    h.run_for_0 = [&](std::size_t k, int w) {
+      const SampledCase c = sample_case(trees[static_cast<std::size_t>(w)], overrides_of(k), t, columns, stop);
+      CaseMessage m;
+      m.kind = stop.load() ? CaseMessage::Kind::kStopped : CaseMessage::Kind::kDone;
+      m.k = static_cast<std::int64_t>(k);
+      m.complete = true, m.failed = !c.why.empty();
+      m.line = c.why;
+      if (!c.values.empty())
+        m.values.assign(reinterpret_cast<const char*>(c.values.data()), c.values.size() * sizeof(double));
+      return m;
+    };
+    std::atomic<bool> remote_stop{false};
+    h.deliver = [&](CaseMessage m) {
+      if (m.kind == CaseMessage::Kind::kStopped) remote_stop = true;
+      if (m.kind != CaseMessage::Kind::kDone) return;
+      const auto k = static_cast<std::size_t>(m.k);
+      why_failed[k] = std::move(m.line);
+      std::vector<double>& v = cases.values[k];
+      v.resize(m.values.size() / sizeof(double));
+      if (!v.empty()) std::memcpy(v.data(), m.values.data(), v.size() * sizeof(double));
+    };
+    h.halted = [&] { return stop.load() || remote_stop.load(); };
+    const int remote_threads = ranks.total_remote_workers(threads_used);  // (collective: on every rank)
+    run_cases(ranks, 0, n_cases, threads_used, h);
+    if (!writer) return 0;  // (rank 0 reports)
+    threads_used += remote_threads;
+    if (stop.load() || remote_stop.load())
+      return fail(a.scene + ": interrupted (" + signal_name(stop.load() ? interrupt_signal() : SIGTERM) +
+                      "); no output written",
+                  128 + (stop.load() ? interrupt_signal() : SIGTERM));
   }
+  std::vector<FailedCase> failed;
   for (std::size_t k = 0; k < n_cases; ++k)
     if (!why_failed[k].empty()) {
       cases.values[k].clear();
@@ -327,7 +430,7 @@ int cmd_tolerance(const ToleranceArgs& a) {
   }
   run.scene_path = a.scene, run.scene_name = scene.name, run.spread = &spread, run.nominal = nominal;
   run.covariance_file = a.covariance, run.samples = a.samples, run.seed = a.seed, run.threshold = a.threshold;
-  run.failed = failed, run.threads = batch.threads, run.solve_seconds = since(start);
+  run.failed = failed, run.threads = threads_used, run.solve_seconds = since(start);
   for (std::size_t j = 0; j < np; ++j)
     if (largest_sensitivity[j] == 0.0) run.independent.push_back(spread.parameters[j].name);
   if (succeeded < 2)
@@ -376,7 +479,7 @@ int cmd_tolerance(const ToleranceArgs& a) {
     for (const OutputSpread& s : spreads)
       if (s.agreement.worst >= worst) worst = s.agreement.worst, where = s.name;
     std::cerr << "phiq: " << printable(a.scene) << ": " << succeeded << " of " << n_cases << " cases on "
-              << batch.threads << " threads, " << columns.size() << " outputs, " << disagreeing
+              << (ranks.size() > 1 ? ranks.describe() + ", " : "") << threads_used << " threads, " << columns.size() << " outputs, " << disagreeing
               << " disagreeing (worst " << significant(worst, 3) << " standard errors, " << printable(where)
               << "; threshold " << significant(a.threshold, 3) << "), " << scientific(run.solve_seconds, 3)
               << " s; wrote " << printable(a.out) << "\n";
@@ -430,7 +533,21 @@ Command register_tolerance(CLI::App& app) {
   tol->add_flag("-q,--quiet", a->quiet, "Print only failed cases and disagreements on standard error");
   return {tol, [a] {
             a->threads = cap_threads("tolerance", a->threads, a->quiet);
-            return with_stdout_checked(cmd_tolerance(*a));
+            if (BatchRanks::launched_without_support())
+              return fail("tolerance: started by mpirun with several processes, but this phiq was built without MPI "
+                          "(PHIQ_MPI=OFF): each would run the whole study; run it without mpirun",
+                          2);
+            std::unique_ptr<BatchRanks> ranks;
+            try {
+              ranks = BatchRanks::join();
+            } catch (const Error& e) {
+              return fail(e.what(), 1);
+            }
+            if (ranks->rank() > 0) {  // rank 0 says everything
+              std::cerr.rdbuf(nullptr);
+              quiet_interrupts();
+            }
+            return ranks->finish(with_stdout_checked(cmd_tolerance(*a, *ranks)));
           }};
 }
 
