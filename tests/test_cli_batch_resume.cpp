@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "phiq/hdf5_reader.hpp"
+
 #include "cli_test_support.hpp"
 #include "test_support.hpp"
 
@@ -66,6 +68,26 @@ TEST_F(BatchResume, RunsOnlyTheCasesAfterThoseWrittenAndEndsAsOneRun) {
   }
 }
 
+// HDF5: the earlier file (the first 5 cases, as a 5-case batch of the same scene writes them) copied and appended
+// to; the values those of one uninterrupted run, exactly (the bytes depend on how HDF5 laid the file out).
+TEST_F(BatchResume, AnHdf5OutputIsCompletedToTheValuesOfOneRun) {
+  const std::string first5 = write("first5.csv", slurp(cases_).substr(0, slurp(cases_).find("0.250000"))).string();
+  ASSERT_EQ(run("batch -q " + scene_ + " " + first5 + " -o " + (dir_ / "part.h5").string()).code, 1);  // case 3
+  ASSERT_EQ(run("batch -q " + scene_ + " " + cases_ + " -o " + (dir_ / "full.h5").string()).code, 1);
+  const std::string earlier = slurp(dir_ / "part.h5");
+  const Result r = resume("part.h5", " --summary " + (dir_ / "s.json").string());
+  EXPECT_EQ(r.code, 1) << r.err;  // case 3, left out earlier
+  const phiq::CsvTable part = phiq::read_result_table((dir_ / "part.h5").string());
+  const phiq::CsvTable full = phiq::read_result_table((dir_ / "full.h5").string());
+  EXPECT_EQ(part.columns, full.columns);
+  EXPECT_EQ(part.rows, full.rows);  // every double, exactly
+  EXPECT_EQ(part.rows.size(), 11u * 21u);
+  const std::string summary = slurp(dir_ / "s.json");
+  EXPECT_EQ(phiq::test::count(summary, "\"status\": \"written earlier\""), 4u);  // cases 0, 1, 2, 4
+  EXPECT_EQ(phiq::test::count(summary, "\"status\": \"failed earlier\""), 1u);   // case 3
+  EXPECT_NE(slurp(dir_ / "part.h5"), earlier);
+}
+
 TEST_F(BatchResume, AMissingOutputIsTheWholeBatch) {
   const Result r = resume("new.csv");
   EXPECT_EQ(r.code, 1) << r.err;  // case 3
@@ -91,15 +113,28 @@ TEST_F(BatchResume, WhatIsNotAnEarlierOutputOfThisBatchIsRefusedAndKept) {
     EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
     EXPECT_EQ(slurp(dir_ / "bad.csv"), text);
   }
-  const Result h5 = resume("out.h5");
+  write("text.h5", "t,x\n0,1\n");  // not HDF5 at all
+  const Result h5 = resume("text.h5");
   EXPECT_EQ(h5.code, 2);
   EXPECT_TRUE(one_phiq_line(h5.err)) << h5.err;
-  EXPECT_NE(h5.err.find("--resume continues a CSV output"), std::string::npos) << h5.err;
+  EXPECT_NE(h5.err.find("text.h5: not a readable HDF5 file"), std::string::npos) << h5.err;
+  EXPECT_EQ(slurp(dir_ / "text.h5"), "t,x\n0,1\n");
+  // HDF5 results of another scene: other columns
+  ASSERT_EQ(run("run -q " + phiq::test::model_path("seed/fourbar_natural.yaml") + " -o " + (dir_ / "other.h5").string())
+                .code,
+            0);
+  const std::string other = slurp(dir_ / "other.h5");
+  const Result o = resume("other.h5");
+  EXPECT_EQ(o.code, 2);
+  EXPECT_TRUE(one_phiq_line(o.err)) << o.err;
+  EXPECT_NE(o.err.find("not an output of this batch: its columns are not the scene's with the case first"),
+            std::string::npos)
+      << o.err;
+  EXPECT_EQ(slurp(dir_ / "other.h5"), other);
   const Result dir = run("batch -q " + scene_ + " " + cases_ + " -o " + (dir_ / "cases").string() + "/ --resume");
   EXPECT_EQ(dir.code, 2);
   EXPECT_TRUE(one_phiq_line(dir.err)) << dir.err;
   EXPECT_NE(dir.err.find("--resume continues a one-file output"), std::string::npos) << dir.err;
-  EXPECT_FALSE(fs::exists(dir_ / "out.h5"));
   EXPECT_FALSE(fs::exists(dir_ / "cases"));
 }
 

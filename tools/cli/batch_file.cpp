@@ -198,8 +198,6 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     if (const auto clash = output_clash(outs, {{"the scene", a.scene}, {"the cases", a.cases}}))
       return fail("batch: " + *clash, 2);
   }
-  if (a.resume && hdf5)
-    return fail(a.out + ": --resume continues a CSV output (an HDF5 one is written again: drop --resume)", 2);
   set_interrupt_subject(a.scene, "; no output written");
   // The scene parsed once; its own parameters' scene is the model every case shares its analysis with, and the
   // columns' names.
@@ -245,7 +243,13 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
   if (writer) {
     const std::string header = "case," + format.header();
     try {
-      if (a.resume) resumed = read_resume_point(a.out, header, n);
+      if (a.resume && hdf5) {
+        std::vector<std::string> columns{"case"};
+        for (const std::string& c : format.column_names()) columns.push_back(c);
+        resumed = read_resume_point_hdf5(a.out, columns, n);
+      } else if (a.resume) {
+        resumed = read_resume_point(a.out, header, n);
+      }
       if (hdf5) check_hdf5_target(a.out);
       file = &outputs.add(a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
                                       : phiq::AtomicOutputFile::Hold::kOpen);
@@ -257,6 +261,10 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
         o.expected_rows = static_cast<std::size_t>(phiq::rows_written(reference->sweep)) * n;
         o.shown_path = file->path();
         o.case_column = true;
+        if (resumed.first > 0) {  // the earlier file, copied to be appended to (its own stays whole meanwhile)
+          std::filesystem::copy_file(a.out, file->temporary_path(), std::filesystem::copy_options::overwrite_existing);
+          o.append = true;
+        }
         h5 = std::make_unique<phiq::Hdf5Writer>(file->temporary_path(), *reference->model, reference->sweep, o);
       } else if (resumed.first > 0) {
         committed_bytes = copy_resumed_cases(a.out, resumed, *file);
@@ -268,6 +276,8 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       status = fail(e.what(), 2);
     } catch (const phiq::Error& e) {
       status = fail(e.what(), 3);
+    } catch (const std::filesystem::filesystem_error& e) {  // copying an HDF5 output to resume it
+      status = fail(a.out + ": cannot write: " + e.code().message(), 3);
     }
   }
   if ((status = ranks.agree(status)) != 0) return status;  // every rank stops where rank 0 could not go on
@@ -467,8 +477,8 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     const std::size_t first_missing = in_order.next();
     std::string missing;
     if (first_missing < n)
-      missing = "; cases " + std::to_string(first_missing) + " to " + std::to_string(n - 1) + " missing" +
-                (hdf5 ? "" : ": the same command with --resume runs only those");
+      missing = "; cases " + std::to_string(first_missing) + " to " + std::to_string(n - 1) +
+                " missing: the same command with --resume runs only those";
     return fail(a.scene + ": interrupted (" + signal_name(signal) + "); " + written_text +
                     " (the cases before the first unfinished one)" + missing,
                 128 + signal);

@@ -3,7 +3,11 @@
 
 #include <cerrno>
 #include <cstring>
+#include <cmath>
+#include <filesystem>
 #include <fstream>
+
+#include "phiq/hdf5_reader.hpp"
 
 namespace phiq::tools {
 
@@ -43,6 +47,38 @@ ResumePoint read_resume_point(const std::string& out, const std::string& header,
     }
   }
   if (in.bad()) throw ResumeError(out + ": --resume: cannot read: " + std::strerror(errno));
+  p.first = static_cast<std::size_t>(last + 1);
+  return p;
+}
+
+ResumePoint read_resume_point_hdf5(const std::string& out, const std::vector<std::string>& columns, std::size_t cases) {
+  ResumePoint p;
+  std::error_code ec;
+  if (!std::filesystem::exists(out, ec)) return p;  // nothing earlier: the whole batch
+  CsvTable table;
+  try {
+    table = read_hdf5_table(out);
+  } catch (const Error& e) {
+    throw ResumeError(std::string(e.what()) + " (--resume)");
+  }
+  const std::string bad = out + ": --resume: not an output of this batch: ";
+  if (table.columns != columns) throw ResumeError(bad + "its columns are not the scene's with the case first");
+  double last = -1;
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const double k = table.rows[r][0];
+    if (!(k >= 0) || k >= static_cast<double>(cases) || k != std::floor(k))
+      throw ResumeError(bad + "row " + std::to_string(r) + " is not one of its " + std::to_string(cases) + " cases");
+    if (k < last)
+      throw ResumeError(bad + "row " + std::to_string(r) + ": case " + std::to_string(static_cast<long long>(k)) +
+                        " after case " + std::to_string(static_cast<long long>(last)));
+    if (k != last) {
+      const auto c = static_cast<std::size_t>(k);
+      p.in_file.resize(c + 1, 0);
+      p.in_file[c] = 1;
+      ++p.cases_in_file;
+      last = k;
+    }
+  }
   p.first = static_cast<std::size_t>(last + 1);
   return p;
 }

@@ -1,7 +1,8 @@
-// `phiq batch SCENE CASES -o OUT.csv --resume`: an interrupted batch completed. The cases an earlier run of the
-// same batch committed to OUT.csv (whole cases, in case order: batch_file.cpp) are kept, and the batch runs on
-// from the case after the last of them, into a new file published as OUT.csv when it ends, so that OUT.csv is the
-// file one uninterrupted run writes, byte for byte, and the earlier one stays whole until then.
+// `phiq batch SCENE CASES -o OUT.csv|OUT.h5 --resume`: an interrupted batch completed. The cases an earlier run of
+// the same batch committed to OUT (whole cases, in case order: batch_file.cpp) are kept, and the batch runs on from
+// the case after the last of them, into a new file published as OUT when it ends, so that OUT.csv is the file one
+// uninterrupted run writes, byte for byte (an HDF5 file: the same values), and the earlier one stays whole until
+// then.
 #pragma once
 
 #include <cstdint>
@@ -30,6 +31,11 @@ struct ResumePoint {
 // another header, a row that does not begin with a case of the batch or goes back in case order, a last row
 // without its newline.
 ResumePoint read_resume_point(const std::string& out, const std::string& header, std::size_t cases);
+
+// The same for an HDF5 batch output (`columns`: the batch's, `case` first): read back as its table (the CSV's
+// columns and doubles); its cases must be whole numbers of the batch, in order. Throws ResumeError as above, and
+// for a file that is not phiq's HDF5 results.
+ResumePoint read_resume_point_hdf5(const std::string& out, const std::vector<std::string>& columns, std::size_t cases);
 
 // Copies OUT's bytes (the cases kept) into `file`, the batch's new output; returns how many. Throws phiq::Error.
 std::uint64_t copy_resumed_cases(const std::string& out, const ResumePoint& p, AtomicOutputFile& file);

@@ -38,6 +38,11 @@ struct Hdf5Options {
   /// value per row: the row's case), and the root attribute `batch_format_version`. Rows are then given by
   /// append_values(), whose first value is the case.
   bool case_column = false;
+  /// Opens the file at `path`, results of this layout written earlier (an interrupted batch's, copied: `phiq batch
+  /// --resume`), and appends rows after its own, instead of creating it; its root attributes are kept. Each of
+  /// the plan's datasets must be there with its columns and all with as many rows, else phiq::Error "PATH: cannot
+  /// write: not results of this layout: …". The file's bytes then depend on how it was written, not its values.
+  bool append = false;
 };
 
 /// Version of the batch layout (Hdf5Options::case_column): the run layout with a /case dataset first.

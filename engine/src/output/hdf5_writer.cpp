@@ -76,6 +76,7 @@ struct Hdf5Writer::Impl {
   std::string cannot(const std::string& why) const { return path + ": cannot write: " + why; }
   void create(const Hdf5Options& o);
   void create_dataset(Group& g, const Hdf5Options& o);
+  void open_to_append(const Hid& fapl);  // Hdf5Options::append
   void flush();
 };
 
@@ -162,6 +163,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   if (o.deflate > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0) throw Error(cannot("HDF5 has no deflate filter"));
 
   const Hid fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, cannot("file access list"));
+  if (o.append) return open_to_append(fapl);
   // The 1.8 file format: attributes larger than 64 KiB (the names of 10⁴ coordinates) go to dense storage, and
   // readers from HDF5 1.8 on (MATLAB, older h5py) can open the file.
   check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18), cannot("file format"));
@@ -185,6 +187,27 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     for (Group& g : groups) create_dataset(g, o);
   } catch (const Error& e) {
     throw Error(path + ": cannot write: " + e.what());
+  }
+}
+
+void Hdf5Writer::Impl::open_to_append(const Hid& fapl) {
+  check(H5Pset_file_locking(fapl.get(), false, true), cannot("file locking"));
+  file = checked(H5Fopen(file_path.c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, path + ": cannot write");
+  // each group's dataset as this plan makes it: its columns, and as many rows as every other
+  bool first = true;
+  for (Group& g : groups) {
+    const std::string what = cannot("not results of this layout: dataset /" + std::string(g.name));
+    if (H5Lexists(file.get(), g.name, H5P_DEFAULT) <= 0) throw Error(what + " missing");
+    g.dataset = checked(H5Dopen2(file.get(), g.name, H5P_DEFAULT), H5Dclose, what);
+    const Hid space = checked(H5Dget_space(g.dataset.get()), H5Sclose, what);
+    const int rank = H5Sget_simple_extent_ndims(space.get());
+    hsize_t dims[2] = {0, 0};
+    if (rank != (g.one_dimensional ? 1 : 2) || H5Sget_simple_extent_dims(space.get(), dims, nullptr) != rank ||
+        (rank == 2 && dims[1] != g.columns.size()))
+      throw Error(what + " has another shape");
+    if (first) written_rows = dims[0], first = false;
+    if (dims[0] != written_rows) throw Error(what + " has another number of rows");
+    g.held.resize(block_rows * g.columns.size());
   }
 }
 
