@@ -25,20 +25,9 @@ namespace {
 // cases in parallel, sharing one symbolic analysis; DIR/case<k>.csv per successful case (k from 0, the row order).
 int cmd_batch(const std::string& scene_path, const std::string& cases_path, const std::string& dir, bool quiet,
               int threads, const std::string& summary_path, bool identifier_names, bool resume) {
-  if (BatchRanks::launched_without_support())
-    return fail("batch: started by mpirun with several processes, but this phiq was built without MPI "
-                "(PHIQ_MPI=OFF): each would run the whole batch; run it without mpirun",
-                2);
-  std::unique_ptr<BatchRanks> ranks;
-  try {
-    ranks = BatchRanks::join();
-  } catch (const phiq::Error& e) {
-    return fail(e.what(), 1);
-  }
-  if (ranks->rank() > 0) {  // rank 0 says everything (a worker rank's errors are its too)
-    std::cerr.rdbuf(nullptr);
-    quiet_interrupts();
-  }
+  int join_status = 0;
+  const std::unique_ptr<BatchRanks> ranks = BatchRanks::join_command("batch", "batch", &join_status);
+  if (!ranks) return join_status;
   phiq::CsvTable cases;
   try {
     cases = phiq::read_csv_table(cases_path);

@@ -10,11 +10,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <iostream>
 #include <limits>
 #include <thread>
 #include <vector>
 
-#include "phiq/types.hpp"  // phiq::Error
+#include "cli_support.hpp"      // quiet_interrupts
+#include "command_support.hpp"  // fail
+#include "phiq/types.hpp"       // phiq::Error
 
 #if PHIQ_WITH_MPI
 #include <mpi.h>
@@ -126,6 +129,28 @@ std::unique_ptr<BatchRanks> BatchRanks::join() {
   }
 #endif
   return r;
+}
+
+std::unique_ptr<BatchRanks> BatchRanks::join_command(const std::string& command, const std::string& work,
+                                                     int* status) {
+  if (launched_without_support()) {
+    *status = fail(command + ": started by mpirun with several processes, but this phiq was built without MPI " +
+                       "(PHIQ_MPI=OFF): each would run the whole " + work + "; run it without mpirun",
+                   2);
+    return nullptr;
+  }
+  std::unique_ptr<BatchRanks> ranks;
+  try {
+    ranks = join();
+  } catch (const Error& e) {
+    *status = fail(e.what(), 1);
+    return nullptr;
+  }
+  if (ranks->rank() > 0) {  // rank 0 says everything (a worker rank's errors are its too)
+    std::cerr.rdbuf(nullptr);
+    quiet_interrupts();
+  }
+  return ranks;
 }
 
 BatchRanks::~BatchRanks() { (void)finish(0); }

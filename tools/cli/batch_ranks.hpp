@@ -39,6 +39,10 @@ class BatchRanks {
   // the environment) and was built with MPI; else one process, and nothing of MPI is started (MPI_Init alone
   // costs 0.4 s). Throws phiq::Error when the MPI library cannot give a thread-safe job.
   static std::unique_ptr<BatchRanks> join();
+  // join() for a command (`batch`, `tolerance`): refuses several mpirun processes of a phiq built without MPI
+  // (each would do the whole `work`: exit 2) and silences every rank but 0 (its standard error and signal
+  // messages: rank 0 says everything). nullptr after printing the one-line error, with the exit status in *status.
+  static std::unique_ptr<BatchRanks> join_command(const std::string& command, const std::string& work, int* status);
   ~BatchRanks();  // finish(0), if not called
   // Leaves the job with the command's exit status: MPI_Finalize, or (abandon()) MPI_Abort with `status`, which
   // mpirun then returns. Returns `status`.

@@ -533,20 +533,9 @@ Command register_tolerance(CLI::App& app) {
   tol->add_flag("-q,--quiet", a->quiet, "Print only failed cases and disagreements on standard error");
   return {tol, [a] {
             a->threads = cap_threads("tolerance", a->threads, a->quiet);
-            if (BatchRanks::launched_without_support())
-              return fail("tolerance: started by mpirun with several processes, but this phiq was built without MPI "
-                          "(PHIQ_MPI=OFF): each would run the whole study; run it without mpirun",
-                          2);
-            std::unique_ptr<BatchRanks> ranks;
-            try {
-              ranks = BatchRanks::join();
-            } catch (const Error& e) {
-              return fail(e.what(), 1);
-            }
-            if (ranks->rank() > 0) {  // rank 0 says everything
-              std::cerr.rdbuf(nullptr);
-              quiet_interrupts();
-            }
+            int status = 0;
+            const std::unique_ptr<BatchRanks> ranks = BatchRanks::join_command("tolerance", "study", &status);
+            if (!ranks) return status;
             return ranks->finish(with_stdout_checked(cmd_tolerance(*a, *ranks)));
           }};
 }
