@@ -7,12 +7,7 @@
 //   fuzzer, tests/fuzz/regressions/ginac_throws_while_differentiating.yaml). phiq catches that exception and reports
 //   a one-line error; the bytes are lost inside libginac. phiq holds GiNaC objects only as reference-counted values
 //   on the stack while compiling, so a phiq leak would not hide behind this.
-// - Open MPI (libmpi, libopen-pal, libopen-rte, PMIx) keeps what MPI_Init allocates past MPI_Finalize; only
-//   `phiq batch` under mpirun starts it (ctest mpi_batch).
-extern "C" const char* __lsan_default_suppressions() {
-  return "leak:libcln.so\nleak:libginac.so\nleak:libmpi.so\nleak:libopen-pal.so\nleak:libopen-rte.so\n"
-         "leak:libpmix.so\n";
-}
+extern "C" const char* __lsan_default_suppressions() { return "leak:libcln.so\nleak:libginac.so\n"; }
 // UndefinedBehaviorSanitizer: print where.
 extern "C" const char* __ubsan_default_options() { return "print_stacktrace=1"; }
 // Do not list the suppression on stderr at exit: the CLI tests check that an error is exactly one line.
