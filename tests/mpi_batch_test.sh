@@ -72,7 +72,7 @@ grep -q '"failed": \[$' tol1.json && [ "$(grep -c '^phiq: .*: case [0-9]* (L2 = 
 # 3. rank 1 killed: the committed cases published, the missing named; --resume completes the same file
 sed 's/steps: 180/steps: 2000/' "$models/seed/crank_slider_mixed.yaml" > long.yaml
 awk 'BEGIN { print "L2"; for (k = 0; k < 1500; ++k) printf "%.6f\n", 0.2 + 1e-5 * k }' > long.csv
-mpirun -np 2 "$phiq" batch -q long.yaml long.csv -o big.csv --threads 1 2>kill.err &
+mpirun -np 2 "$phiq" batch -q long.yaml long.csv -o big.csv --threads 1 --summary kill.json 2>kill.err &
 runner=$!
 rank1=""
 for _ in $(seq 100); do  # rank 1's process, by the rank Open MPI gives it in its environment
@@ -95,6 +95,8 @@ if [ -f big.csv ]; then
   # whole cases, in order: case k is rows 2001 k + 2 … 2001 (k + 1) + 1
   awk -F, -v k="${kept:-x}" 'NR > 1 { c = int((NR - 2) / 2001); if ($1 != c) { print "row " NR ": case " $1 ", not " c; exit 1 } }
        END { if (NR != 2001 * k + 1) { print NR " lines for " k " cases"; exit 1 } }' big.csv || fail "big.csv: not whole cases in order"
+  grep -q '"interrupted": "SIGTERM",' kill.json && [ "$(grep -c '"status": "missing"' kill.json)" -eq $((1500 - kept)) ] ||
+    fail "kill.json: not interrupted by SIGTERM with $((1500 - kept)) cases missing"
 else
   printf '%s\n' "$line" | grep -q 'interrupted (SIGTERM); no output written$' || fail "a killed rank, no file: $line"
 fi

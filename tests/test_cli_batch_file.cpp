@@ -169,7 +169,8 @@ TEST_F(Cli, BatchOneFileInterruptedKeepsWholeCasesInOrder) {
   Result r;
   for (const char* delay : {"0.5", "1", "2", "4", "8", "16"}) {
     r = run_prefixed(std::string("timeout --preserve-status -s INT ") + delay + " ",
-                     "batch -q " + scene.string() + " " + list.string() + " -o " + out.string() + " --threads 2");
+                     "batch -q " + scene.string() + " " + list.string() + " -o " + out.string() + " --threads 2" +
+                         " --summary " + (dir_ / "s.json").string());
     ASSERT_EQ(r.code, 130) << r.err;
     if (fs::exists(out)) break;
     EXPECT_TRUE(r.err.empty() || (one_phiq_line(r.err) && r.err.find("; no output written") != std::string::npos))
@@ -191,7 +192,14 @@ TEST_F(Cli, BatchOneFileInterruptedKeepsWholeCasesInOrder) {
       ASSERT_NEAR(t.rows[i][1], M_PI, 1e-12) << i;  // … to its end, t = π
     }
   }
-  EXPECT_EQ(files(), (std::vector<std::string>{"all.csv", "cases.csv", "cs.yaml", "stderr.txt", "stdout.txt"}));
+  // the summary too: the signal, and every case not in the file "missing" (what --resume runs)
+  const std::string summary = slurp(dir_ / "s.json");
+  EXPECT_NE(summary.find("\"interrupted\": \"SIGINT\""), std::string::npos) << summary.substr(0, 600);
+  EXPECT_NE(summary.find("\"written\": " + std::to_string(k_written) + ","), std::string::npos);
+  EXPECT_EQ(phiq::test::count(summary, "\"status\": \"missing\""), 20000 - k_written);
+  EXPECT_EQ(phiq::test::count(summary, "\"file\": \"" + out.string() + "\""), k_written);
+  EXPECT_EQ(files(),
+            (std::vector<std::string>{"all.csv", "cases.csv", "cs.yaml", "s.json", "stderr.txt", "stdout.txt"}));
 }
 
 }  // namespace

@@ -61,6 +61,7 @@ int commit_batch_summary(OutputSet& outputs, AtomicOutputFile& file, const Batch
   j["cases"] = t.cases;
   j["failed"] = t.failed;
   j["written"] = t.written;
+  j["interrupted"] = or_null(t.interrupted);
   j["ranks"] = t.ranks;
   j["threads"] = t.threads;
   j["shared_analyses"] = t.shared_analyses;
@@ -473,26 +474,50 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
   }
   const std::string written_text = std::to_string(published ? cases_written : 0) + " of " + std::to_string(n) +
                                    " cases written to " + a.out;
-  if (interrupted && write_error.empty() && publish_error.empty()) {
-    const std::size_t first_missing = in_order.next();
-    std::string missing;
-    if (first_missing < n)
-      missing = "; cases " + std::to_string(first_missing) + " to " + std::to_string(n - 1) +
-                " missing: the same command with --resume runs only those";
-    return fail(a.scene + ": interrupted (" + signal_name(signal) + "); " + written_text +
-                    " (the cases before the first unfinished one)" + missing,
-                128 + signal);
-  }
+  // Interrupted (not by an output error): the cases from the first unfinished one on are missing from the file.
+  const bool stopped = interrupted && write_error.empty() && publish_error.empty();
+  const std::size_t first_missing = in_order.next();
   std::size_t failed = 0;
   for (std::size_t k = 0; k < n; ++k) {
     CaseReport& r = reports[k];
     failed += r.failed;
     if (written[k] && published) r.outcome["file"] = a.out;
-    if (!r.outcome.contains("status")) r.outcome["status"] = "not run";  // the batch stopped before its turn
+    if (stopped && k >= first_missing && !r.failed)
+      r.outcome["status"] = "missing";  // what --resume runs
+    else if (!r.outcome.contains("status"))
+      r.outcome["status"] = "not run";  // the batch stopped before its turn
+    if (stopped) continue;  // (the one line below says it all)
     if (r.failed)
       std::cerr << "phiq: " << printable(r.line) << "\n";
     else if (!a.quiet && r.complete)
       std::cerr << "phiq: " << printable(r.line) << "\n";
+  }
+  auto totals = [&] {
+    BatchTotals t;
+    t.scene_name = reference->name;
+    t.output = a.out;
+    t.cases = n, t.failed = failed, t.written = published ? cases_written : 0, t.shared_analyses = shared.load();
+    t.threads = a.threads + remote_workers;
+    t.ranks = ranks.size();
+    t.load_seconds = load_s, t.solve_seconds = solve_s;
+    if (stopped) t.interrupted = signal_name(signal);
+    return t;
+  };
+  auto results = [&] {
+    nlohmann::ordered_json all = nlohmann::ordered_json::array();
+    for (CaseReport& r : reports) all.push_back(std::move(r.outcome));
+    return all;
+  };
+  if (stopped) {
+    std::string missing;
+    if (first_missing < n)
+      missing = "; cases " + std::to_string(first_missing) + " to " + std::to_string(n - 1) +
+                " missing: the same command with --resume runs only those";
+    const int code = fail(a.scene + ": interrupted (" + signal_name(signal) + "); " + written_text +
+                              " (the cases before the first unfinished one)" + missing,
+                          128 + signal);
+    if (summary_file) (void)commit_batch_summary(outputs, *summary_file, a, totals(), results(), code);
+    return code;
   }
   const bool output_error = !write_error.empty() || !publish_error.empty();
   if (output_error)  // (the summary, as for -o DIR, is still written: it says which cases are in the file)
@@ -507,18 +532,8 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
               << scientific(solve_s, 3) << " s (thread-seconds: set-up " << scientific(seconds(setup_ns), 3)
               << ", sweep " << scientific(seconds(sweep_ns), 3) << ", rows " << scientific(seconds(format_ns), 3)
               << ", write " << scientific(seconds(write_ns), 3) << ")\n";
-  if (summary_file) {
-    BatchTotals t;
-    t.scene_name = reference->name;
-    t.output = a.out;
-    t.cases = n, t.failed = failed, t.written = published ? cases_written : 0, t.shared_analyses = shared.load();
-    t.threads = a.threads + remote_workers;
-    t.ranks = ranks.size();
-    t.load_seconds = load_s, t.solve_seconds = solve_s;
-    nlohmann::ordered_json results = nlohmann::ordered_json::array();
-    for (CaseReport& r : reports) results.push_back(std::move(r.outcome));
-    return commit_batch_summary(outputs, *summary_file, a, t, std::move(results), output_error ? 3 : failed ? 1 : 0);
-  }
+  if (summary_file)
+    return commit_batch_summary(outputs, *summary_file, a, totals(), results(), output_error ? 3 : failed ? 1 : 0);
   return output_error ? 3 : failed ? 1 : 0;
 }
 

@@ -38,6 +38,7 @@ struct BatchTotals {
   std::size_t cases = 0, failed = 0, written = 0, shared_analyses = 0;
   int threads = 1;  // on every rank
   int ranks = 1;    // MPI ranks (batch_ranks.hpp)
+  std::string interrupted;  // the signal that stopped a one-file batch ("SIGTERM"), else empty
   double load_seconds = 0.0, solve_seconds = 0.0;
 };
 
