@@ -182,6 +182,19 @@ void AtomicOutputFile::write(const std::string& data) {
   }
 }
 
+void AtomicOutputFile::start_writeback() {
+  if (direct_ || finished_) return;
+  if (f_) {
+    if (std::fflush(f_) == 0) (void)::sync_file_range(::fileno(f_), 0, 0, SYNC_FILE_RANGE_WRITE);
+    return;
+  }
+  if (tmp_.empty()) return;
+  const int fd = ::open(tmp_.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return;
+  (void)::sync_file_range(fd, 0, 0, SYNC_FILE_RANGE_WRITE);  // 0, 0: the whole file
+  ::close(fd);
+}
+
 void AtomicOutputFile::truncate(std::uint64_t size) {
   if (direct_) throw Error(cannot_write(path_, "a device, FIFO or descriptor cannot be cut back"));
   if (finished_ || (!f_ && !closed_between_writes_)) throw Error(path_ + ": cannot write: already closed");

@@ -57,6 +57,10 @@ class AtomicOutputFile {
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
   void write(const std::string& data);  // throws phiq::Error on an I/O error
+  // Hands what has reached the temporary so far to the disk, without waiting (a hint: errors ignored), for files
+  // another writer fills by their name (HDF5), so that finish()'s fsync does not wait for all of it at the end.
+  // write() does the same by itself every 8 MiB.
+  void start_writeback();
   // Takes the temporary back to its first `size` bytes, dropping what is buffered and not yet written: after a
   // failed write, a batch's file is cut back to the cases it holds whole. Throws phiq::Error for a direct file
   // (nothing written there can be taken back), after finish(), or on an I/O error.
