@@ -21,6 +21,12 @@ export OMPI_MCA_btl_vader_single_copy_mechanism=none   # containers forbid the c
 # plugins it cannot name (so no suppression matches them): leaks are not looked for in these runs. phiq's own batch
 # code is leak-checked in one process by test_cli_batch_file.cpp and test_cli_batch_resume.cpp.
 export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0"
+# a machine where mpirun cannot start two processes at all (no shared memory, a container without its launcher's
+# needs) is no test of phiq: skipped, with mpirun's reason
+if ! out=$(mpirun -np 2 true 2>&1); then
+  echo "mpi_batch: mpirun cannot start 2 processes here: $(printf '%s' "$out" | grep -v '^-*$' | head -3 | tr '\n' ' ')"
+  exit 77
+fi
 rm -rf "$dir" && mkdir -p "$dir" && cd "$dir" || exit 1
 status=0
 fail() { echo "mpi_batch: $*" >&2; status=1; }
