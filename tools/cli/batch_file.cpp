@@ -282,7 +282,6 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     }
   }
   if ((status = ranks.agree(status)) != 0) return status;  // every rank stops where rank 0 could not go on
-  const int remote_workers = ranks.total_remote_workers(a.threads);
 
   // Cases commit in order as they complete. A write error stops the batch: the CSV is cut back to the cases it
   // holds whole and published; an HDF5 file is not (a failed write may have left its structure half-written).
@@ -431,6 +430,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
   };
 
   const auto solve_start = Clock::now();
+  int all_threads = a.threads;  // on every rank
   {
     StopOnSignal stop_on_signal;  // a signal stops every case at its next row
     std::vector<CaseRows> worker_rows(static_cast<std::size_t>(a.threads));  // a worker rank's buffers, reused
@@ -449,7 +449,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       if (m.kind == CaseMessage::Kind::kDone) deliver(static_cast<std::size_t>(m.k), from_message(std::move(m)));
     };
     h.halted = halted;
-    run_cases(ranks, resumed.first, n, a.threads, h);
+    all_threads = run_cases(ranks, resumed.first, n, a.threads, h);
     if (!writer) return 0;  // (rank 0 says how the batch went)
   }
   const double solve_s = since(solve_start);
@@ -497,7 +497,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     t.scene_name = reference->name;
     t.output = a.out;
     t.cases = n, t.failed = failed, t.written = published ? cases_written : 0, t.shared_analyses = shared.load();
-    t.threads = a.threads + remote_workers;
+    t.threads = all_threads;
     t.ranks = ranks.size();
     t.load_seconds = load_s, t.solve_seconds = solve_s;
     if (stopped) t.interrupted = signal_name(signal);
@@ -527,7 +527,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
   else if (!a.quiet)
     std::cerr << "phiq: " << printable(a.scene) << ": " << n - failed << " of " << n << " cases in "
               << printable(a.out) << ", " << (ranks.size() > 1 ? ranks.describe() + ", " : "")
-              << a.threads + remote_workers << " threads, " << shared.load()
+              << all_threads << " threads, " << shared.load()
               << " cases on the scene's symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
               << scientific(solve_s, 3) << " s (thread-seconds: set-up " << scientific(seconds(setup_ns), 3)
               << ", sweep " << scientific(seconds(sweep_ns), 3) << ", rows " << scientific(seconds(format_ns), 3)

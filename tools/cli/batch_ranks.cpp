@@ -302,7 +302,7 @@ void serve_remote_workers(BatchRanks& ranks, int workers, const std::function<bo
 
 }  // namespace
 
-void run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h) {
+int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h) {
   const int remote_workers = ranks.total_remote_workers(threads);
   tbb::task_arena arena(threads);
   if (ranks.rank() > 0) {  // a worker rank: its threads ask rank 0 for cases and send it their results
@@ -320,7 +320,7 @@ void run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads,
         (void)ranks.send(w, last);
       }, tbb::simple_partitioner());
     });
-    return;
+    return threads;
   }
   std::atomic<std::size_t> next_case{first};
   auto next = [&]() -> std::optional<std::size_t> {
@@ -345,6 +345,7 @@ void run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads,
     return k ? static_cast<std::int64_t>(*k) : std::int64_t{-1};
   });
   local.join();
+  return threads + remote_workers;
 }
 
 }  // namespace phiq::tools

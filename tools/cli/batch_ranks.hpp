@@ -112,7 +112,8 @@ struct CaseHandlers {
 // ranks' workers and delivers their results, one at a time; on another rank, its workers ask rank 0 and send it
 // run_for_0's message. Returns when this rank's part is done: on rank 0, every case handed out and every worker's
 // last message received, or at once when halted() (the workers still out then abandoned: BatchRanks::abandon).
-// run_here and deliver may run at the same time (rank 0's workers and its answering thread).
-void run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h);
+// run_here and deliver may run at the same time (rank 0's workers and its answering thread). Returns the worker
+// threads of the whole job on rank 0 (every rank's `threads` summed), this rank's own elsewhere.
+int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h);
 
 }  // namespace phiq::tools

@@ -1,7 +1,7 @@
 // `phiq tolerance SCENE --sd P=σ ... -o OUT.csv`: the spread of the scene's outputs over toleranced parameters,
 // first order from the exact sensitivities of one nominal sweep, and Monte Carlo from sampled parameter sets swept in
-// parallel on the nominal model's symbolic analysis (run_batch; under mpirun, over the ranks: run_cases), with their
-// agreement. The numbers are tools/tolerance/; what is written, tolerance_report.*; the format, tools/README.md.
+// parallel on the nominal model's symbolic analysis (run_cases: over this process's threads and, under mpirun, the
+// ranks), with their agreement. The numbers are tools/tolerance/; what is written, tolerance_report.*; the format, tools/README.md.
 #include <signal.h>
 #include <tbb/info.h>
 
@@ -14,7 +14,7 @@
 #include <optional>
 #include <set>
 
-#include "batch_ranks.hpp"  // the samples on MPI ranks
+#include "batch_ranks.hpp"  // run_cases: the samples on the threads (and MPI ranks)
 #include "cli_support.hpp"
 #include "command_line.hpp"
 #include "command_support.hpp"
@@ -22,7 +22,7 @@
 #include "tolerance_input.hpp"
 #include "tolerance_report.hpp"
 #include "tolerance_spread.hpp"
-#include "phiq/parsed_scene.hpp"  // the cases, read from one parse
+#include "phiq/parsed_scene.hpp"  // the cases, read from one parse per thread
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -100,9 +100,8 @@ SweepOptions case_sweep(SweepOptions o) {
   return o;
 }
 
-// One sampled case on a rank of an MPI job: built from the worker's own parsed tree, made square and swept on one
-// thread, as run_batch sweeps it in one process (so the same values, bit for bit); `values` its outputs row after
-// row, or `why` it failed.
+// One sampled case: built from its worker's own parsed tree, made square and swept on one thread (so the same
+// values, bit for bit, on whichever thread or rank it runs); `values` its outputs row after row, or `why` it failed.
 struct SampledCase {
   std::vector<double> values;
   std::string why;
@@ -301,13 +300,7 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   // ---- the sampled cases: built in order (each shares the nominal model's analysis), swept in parallel
   const Eigen::MatrixXd offsets = tolerance::sample_offsets(spread, a.samples, a.seed);
   const auto n_cases = static_cast<std::size_t>(a.samples);
-  std::vector<Scene> scenes(n_cases);
-  std::vector<SquareScene> squares(n_cases);
   std::vector<std::string> why_failed(n_cases);
-  std::vector<const Model*> models;
-  std::vector<SweepOptions> sweeps;
-  std::vector<Eigen::VectorXd> starts;
-  std::vector<std::size_t> swept;
   auto values_of = [&](std::size_t k) {
     std::vector<double> v(np);
     for (std::size_t j = 0; j < np; ++j) v[j] = nominal[j] + offsets(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
@@ -325,53 +318,10 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
     o.sensitivity_models = false;
     return o;
   };
-  if (ranks.size() == 1) {
-    // The cases are read from the scene parsed once (ParsedScene: no YAML parse per case).
-    ParsedScene parsed(scene.text, scene.path);
-    for (std::size_t k = 0; k < n_cases; ++k) {
-      const SceneOverrides o = overrides_of(k);
-      try {
-        scenes[k] = parsed.read(o);
-      } catch (const SceneError& e) {  // a value the scene refuses (a negative length): this case's failure
-        why_failed[k] = e.what();
-        continue;
-      }
-      if (const auto why = make_square(scenes[k], &squares[k])) {
-        why_failed[k] = *why;
-        continue;
-      }
-      models.push_back(&squares[k].model(*scenes[k].model));
-      sweeps.push_back(case_sweep(scenes[k].sweep));
-      starts.push_back(squares[k].start);
-      swept.push_back(k);
-      if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
-    }
-    std::vector<std::size_t> rows_seen(n_cases, 0);
-    // Each case writes only its own vector: safe across cases without a lock.
-    const BatchSummary batch = run_batch(models, sweeps, a.threads, [&](std::size_t c, const StepView& step) {
-      const std::size_t k = swept[c];
-      std::vector<double>& v = cases.values[k];
-      const std::size_t r = rows_seen[k]++;
-      if (r >= t.size() || std::fabs(step.t - t[r]) > 1e-12 * (1.0 + std::fabs(t[r]))) {
-        why_failed[k] = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
-        v.clear();
-        return false;
-      }
-      if (v.empty()) v.reserve(t.size() * columns.size());
-      for (const OutputColumn& col : columns)
-        v.push_back((col.order == 0 ? step.q : col.order == 1 ? *step.qd : *step.qdd)(col.coordinate));
-      return !stop.load();
-    }, &starts);
-    if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
-    for (std::size_t c = 0; c < swept.size(); ++c) {
-      const std::size_t k = swept[c];
-      const SweepSummary& s = batch.cases[c];
-      if (why_failed[k].empty() && s.status != SolveStatus::kSuccess) why_failed[k] = s.message;
-      if (why_failed[k].empty() && rows_seen[k] != t.size())
-        why_failed[k] = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
-    }
-    threads_used = batch.threads;
-  } else {  // the samples over the MPI ranks: each rank a parsed tree per thread; rank 0 collects their values
+  // The samples, handed out one at a time to this process's threads (and, under mpirun, to every rank's: rank 0
+  // gathers their values), each read from a parsed tree of its thread's own (no YAML parse per case) and swept on
+  // one thread: the same values wherever it runs.
+  {
     if (threads_used <= 0) threads_used = tbb::info::default_concurrency();
     std::vector<ParsedScene> trees(static_cast<std::size_t>(threads_used), ParsedScene(scene.text, scene.path));
     CaseHandlers h;
@@ -401,10 +351,8 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
       if (!v.empty()) std::memcpy(v.data(), m.values.data(), v.size() * sizeof(double));
     };
     h.halted = [&] { return stop.load() || remote_stop.load(); };
-    const int remote_threads = ranks.total_remote_workers(threads_used);  // (collective: on every rank)
-    run_cases(ranks, 0, n_cases, threads_used, h);
+    threads_used = run_cases(ranks, 0, n_cases, threads_used, h);
     if (!writer) return 0;  // (rank 0 reports)
-    threads_used += remote_threads;
     if (stop.load() || remote_stop.load())
       return fail(a.scene + ": interrupted (" + signal_name(stop.load() ? interrupt_signal() : SIGTERM) +
                       "); no output written",
