@@ -40,7 +40,8 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
         {scene_path, cases_path, dir, summary_path, quiet, threads, identifier_names, resume}, cases, *ranks));
   if (ranks->size() > 1)
     return ranks->finish(fail("batch: -o " + dir + ": under mpirun a batch writes one file (-o OUT.csv or OUT.h5)", 2));
-  if (resume) return fail("batch: --resume continues a one-file output (-o OUT.csv), not a directory of cases", 2);
+  if (resume)
+    return fail("batch: --resume continues a one-file output (-o OUT.csv or OUT.h5), not a directory of cases", 2);
   auto case_file = [&](std::size_t k) { return dir + "/case" + std::to_string(k) + ".csv"; };
   // No case file may replace the scene, the cases or the summary. Each case file is checked against those alone:
   // the case files are distinct names in one directory, and checking them pairwise (output_clash of all of them)
@@ -279,8 +280,8 @@ Command register_batch(CLI::App& app) {
       ->capture_default_str()
       ->check(one_of({"dotted", "identifiers"}));
   batch->add_flag("--resume", a->resume,
-                  "Keep the cases an interrupted run of this batch wrote to OUT.csv and run only the others (a "
-                  "missing OUT.csv: the whole batch)");
+                  "Keep the cases an interrupted run of this batch wrote to OUT.csv or OUT.h5 and run only the "
+                  "others (a missing OUT: the whole batch)");
   return {batch, [a] {
             const int cases_threads = cap_threads("batch", a->threads, a->quiet);
             return cmd_batch(a->scene, a->cases, a->dir, a->quiet, cases_threads, a->summary, a->names == "identifiers",

@@ -296,8 +296,9 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     const auto w0 = Clock::now();
     try {
       if (h5) {
-        const std::size_t m = h5->row_values();
+        const std::size_t m = h5->row_values(), rows_before = h5->rows();
         for (std::size_t at = 0; at < rows.values.size(); at += m) h5->append_values(rows.values.data() + at);
+        hand_blocks_to_disk(*h5, rows_before, *file);
       } else {
         file->write(rows.text);
         committed_bytes += rows.text.size();

@@ -31,4 +31,8 @@ std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile
   return std::make_unique<phiq::Hdf5Writer>(file.temporary_path(), *scene.model, scene.sweep, o);
 }
 
+void hand_blocks_to_disk(const phiq::Hdf5Writer& h5, std::size_t rows_before, phiq::AtomicOutputFile& file) {
+  if (h5.rows() / h5.block_rows() != rows_before / h5.block_rows()) file.start_writeback();
+}
+
 }  // namespace phiq::tools

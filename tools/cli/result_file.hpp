@@ -31,4 +31,10 @@ void check_hdf5_target(const std::string& path);
 std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile& file, const phiq::Scene& scene,
                                                     int deflate = 0);
 
+// After rows were appended to `h5` (it held `rows_before` rows): when it has written a block to its file since, that
+// block goes on to the disk while the work runs (AtomicOutputFile::start_writeback(), as write() does for a CSV
+// every 8 MiB), so that the fsync before the commit waits for the last block, not for the whole file: an
+// interrupted batch publishes within the second mpirun gives it.
+void hand_blocks_to_disk(const phiq::Hdf5Writer& h5, std::size_t rows_before, phiq::AtomicOutputFile& file);
+
 }  // namespace phiq::tools

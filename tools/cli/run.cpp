@@ -136,10 +136,9 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
         model, scene.sweep, ws, [&](const phiq::StepView& step) {
       const auto w0 = Clock::now();
       if (h5) {
+        const std::size_t rows_before = h5->rows();
         h5->append_row(step);
-        // each block HDF5 has written goes on to the disk while the sweep runs (AtomicOutputFile::write() does
-        // this for a CSV): the fsync at the end then waits for the last block, not for the whole file
-        if (file && h5->rows() % h5->block_rows() == 0) file->start_writeback();
+        if (file) hand_blocks_to_disk(*h5, rows_before, *file);
       } else {
         csv.append_row(step, buffer);
         if (buffer.size() > (1u << 20)) flush();
