@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "closed_forms.hpp"
@@ -88,6 +89,60 @@ void BM_LongChainNoDrift(benchmark::State& state) {
 BENCHMARK(BM_LongChainNoDrift)
     ->ArgNames({"N", "derivs"})
     ->ArgsProduct({{100, 100000}, {0, 1}})
+    ->Unit(benchmark::kSecond)
+    ->UseManualTime()
+    ->Iterations(1);
+
+// A sweep that starts exactly on the flat position (θ = 0: every crank, coupler and the ground collinear, Φq singular
+// in every loop at once; issue "Trust" §2), 10 steps of 0.01 at rate π/2, against the same sweep started at π/4
+// (regular): flat_start_cost = the flat sweep's time ÷ the regular one's (the six sides of the singular start, the
+// first assembled block by block). Counters: the start row's q̇ and q̈ against the exact branch (relative to |q̇| = w
+// and |q̈| = w²), and the largest position error over the rows. Fails (SkipWithError) when the sweep fails or the
+// start row's derivatives are off by more than 1e-8 relative (tests/test_singular_positions.cpp checks N = 10^4).
+//
+//   ./build/bench/phiq_bench_long_chain --benchmark_filter=FlatStart --benchmark_counters_tabular=true
+void BM_LongChainFlatStart(benchmark::State& state) {
+  const Index n = state.range(0);
+  const bool derivs = state.range(1) != 0;
+  const double w = M_PI / 2;
+  const Model flat = phiq_bench::nfourbar(n, 0.0, w), regular = phiq_bench::nfourbar(n, M_PI / 4, w);
+  SweepOptions opt;
+  opt.t_begin = 0.0, opt.t_end = 0.1, opt.steps = 10;
+  opt.velocities = opt.accelerations = derivs;
+  opt.threads = 1;
+  char spec[96];
+  std::snprintf(spec, sizeof spec, "nfourbar:from=0,to=%.17g", w);
+  auto exact = phiq::tools::make_closed_form(spec);
+  exact->bind(flat.coordinate_names());
+  double flat_seconds = 0.0, regular_seconds = 0.0, q_error = 0.0, v_start = 0.0, a_start = 0.0;
+  SweepSummary sum, reg;
+  for (auto _ : state) {
+    Workspace ws(flat), ws_regular(regular);
+    phiq::tools::ClosedFormErrors err(*exact), start(*exact);
+    (void)run_sweep(flat, opt, ws, [&](const StepView& s) {  // its status is sum.status, checked below
+      err.add(s.t, s.q.data(), nullptr, nullptr);
+      if (s.t == 0.0 && derivs) start.add(s.t, s.q.data(), s.qd->data(), s.qdd->data());
+      return true;
+    }, &sum);
+    (void)run_sweep(regular, opt, ws_regular, nullptr, &reg);
+    flat_seconds += sum.solve_seconds, regular_seconds += reg.solve_seconds;
+    q_error = err.q_error, v_start = start.v_error / w, a_start = start.a_error / (w * w);
+    state.SetIterationTime(sum.solve_seconds);
+  }
+  if (sum.status != SolveStatus::kSuccess || reg.status != SolveStatus::kSuccess) {
+    state.SkipWithError((sum.message + reg.message).c_str());
+    return;
+  }
+  state.counters["coordinates"] = static_cast<double>(flat.num_coordinates());
+  state.counters["flat_start_cost"] = flat_seconds / regular_seconds;
+  state.counters["q_error"] = q_error;
+  if (derivs) state.counters["start_v_error_rel"] = v_start, state.counters["start_a_error_rel"] = a_start;
+  if (q_error > 1e-7 || v_start > 1e-8 || a_start > 1e-8) state.SkipWithError("off the exact branch");
+}
+
+BENCHMARK(BM_LongChainFlatStart)
+    ->ArgNames({"N", "derivs"})
+    ->ArgsProduct({{100, 10000, 100000}, {0, 1}})
     ->Unit(benchmark::kSecond)
     ->UseManualTime()
     ->Iterations(1);

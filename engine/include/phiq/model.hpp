@@ -279,6 +279,10 @@ class Model : private detail::ModelData {
   const ToleranceScales& tolerance_scales() const { return scales_; }
   /// The fixed pattern of Φq (m × n); Jacobian values are stored in its order.
   const CscPattern& jacobian_pattern() const { return *pattern_; }
+  /// For each entry of the constraint blocks' triplet lists, in the order build_pattern() appended them, its slot
+  /// in jacobian_pattern()'s value array: ConstraintBlock::jacobian()'s `slot_of_entry`, for solvers that evaluate
+  /// a few constraints at a time through blocks() (the block-triangular assembly of a singular start).
+  const std::vector<EntryIndex>& slot_of_entry() const { return slot_of_entry_; }
   /// The sparse LU the model was analysed for.
   LinearSolverKind linear_solver() const { return lu_kind_; }
   /// Symbolic analysis of the square system the solvers factorise (solve_pattern()); nullptr when it is not square
