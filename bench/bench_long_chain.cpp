@@ -98,7 +98,9 @@ BENCHMARK(BM_LongChainNoDrift)
 // (regular): flat_start_cost = the flat sweep's time ÷ the regular one's (the six sides of the singular start, the
 // first assembled block by block). Counters: the start row's q̇ and q̈ against the exact branch (relative to |q̇| = w
 // and |q̈| = w²), and the largest position error over the rows. Fails (SkipWithError) when the sweep fails or the
-// start row's derivatives are off by more than 1e-8 relative (tests/test_singular_positions.cpp checks N = 10^4).
+// start row's derivatives are off by more than 1e-6 relative. The sides' rounding, divided by Φq's smallest singular
+// value O(δ) (twice for q̈), adds up along the chain: q̈ is within 1e-8 up to N ≈ 10^4 at this rate
+// (tests/test_singular_positions.cpp checks N = 10^4 at rate 3π/4), and the start's warning states the spread.
 //
 //   ./build/bench/phiq_bench_long_chain --benchmark_filter=FlatStart --benchmark_counters_tabular=true
 void BM_LongChainFlatStart(benchmark::State& state) {
@@ -137,7 +139,12 @@ void BM_LongChainFlatStart(benchmark::State& state) {
   state.counters["flat_start_cost"] = flat_seconds / regular_seconds;
   state.counters["q_error"] = q_error;
   if (derivs) state.counters["start_v_error_rel"] = v_start, state.counters["start_a_error_rel"] = a_start;
-  if (q_error > 1e-7 || v_start > 1e-8 || a_start > 1e-8) state.SkipWithError("off the exact branch");
+  if (q_error > 1e-7 || v_start > 1e-6 || a_start > 1e-6) {
+    char why[160];
+    std::snprintf(why, sizeof why, "off the exact branch: q %.3g, start q̇ %.3g and q̈ %.3g relative", q_error, v_start,
+                  a_start);
+    state.SkipWithError(why);
+  }
 }
 
 BENCHMARK(BM_LongChainFlatStart)
