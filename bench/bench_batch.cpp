@@ -10,11 +10,14 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <string>
 #include <vector>
 
+#include "nfourbar_model.hpp"
 #include "phiq/parsed_scene.hpp"
 #include "phiq/phiq.hpp"
 
@@ -104,5 +107,56 @@ BENCHMARK(BM_BatchCases)
     ->Args({20, 2, 1})  // the smoke size (ctest bench_smoke)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// A batch of large cases (issue 25: "nfourbar N = 10³ batches at ≥ 80 % of a single sweep's steps per second per
+// core"): 16 cases of nfourbar N = 10³ (2 003 coordinates), each its own start angle and rate, 500 steps with q, q̇,
+// q̈, run_batch on `threads` threads (one case per thread at a time), against one sweep of the first case on one
+// thread, interleaved. per_core_vs_single = (the batch's steps per second ÷ threads) ÷ the single sweep's (median
+// of the iterations' ratios). The cases' models are built before the clock starts (setup_ms_per_case).
+//
+//   build/bench/phiq_bench --benchmark_filter=BatchNFourBar
+void BM_BatchNFourBar(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  constexpr int kCases = 16;
+  constexpr Index kLoops = 1000, kSteps = 500;
+  const auto b0 = std::chrono::steady_clock::now();
+  std::vector<Model> models;
+  models.reserve(kCases);
+  for (int k = 0; k < kCases; ++k) models.push_back(phiq_bench::nfourbar(kLoops, M_PI / 4 + 0.01 * k, M_PI / 2 * (1 + 0.01 * k)));
+  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - b0).count();
+  std::vector<const Model*> pointers;
+  for (const Model& m : models) pointers.push_back(&m);
+  SweepOptions o;
+  o.steps = kSteps;
+  o.velocities = o.accelerations = true;
+  std::vector<double> ratios;
+  double batch_rate = 0.0;
+  for (auto _ : state) {
+    BatchSummary bs = run_batch(pointers, o, threads, [](std::size_t, const StepView&) { return true; });
+    if (bs.failed > 0) {
+      state.SkipWithError("a case failed");
+      return;
+    }
+    SweepOptions one = o;
+    one.threads = 1;
+    Workspace ws(models.front());
+    SweepSummary s;
+    const auto t0 = std::chrono::steady_clock::now();
+    (void)run_sweep(models.front(), one, ws, nullptr, &s);
+    const double single = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (s.status != SolveStatus::kSuccess) {
+      state.SkipWithError(s.message.c_str());
+      return;
+    }
+    batch_rate = static_cast<double>(kCases * (kSteps + 1)) / bs.solve_seconds;
+    ratios.push_back(batch_rate / bs.threads / (static_cast<double>(kSteps + 1) / single));
+    state.SetIterationTime(bs.solve_seconds);
+  }
+  std::sort(ratios.begin(), ratios.end());
+  state.counters["steps_per_s"] = batch_rate;
+  state.counters["per_core_vs_single"] = ratios[ratios.size() / 2];
+  state.counters["setup_ms_per_case"] = 1e3 * setup / kCases;
+}
+BENCHMARK(BM_BatchNFourBar)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(5);
 
 }  // namespace
