@@ -65,4 +65,62 @@ BENCHMARK(BM_SensitivitySweep)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 
+// The adjoint form against the direct one where the parameters outnumber the outputs: nfourbar N with the first P
+// cranks' lengths as parameters R0 … R(P−1), one output coordinate (the far tip's y), q, q̇, q̈, 100 steps, one
+// thread. adjoint_vs_direct = the adjoint sweep's time ÷ the direct one's (interleaved, summed over iterations);
+// both also compute each parameter's right-hand sides along p (four models each), which the adjoint form does not
+// save: what it saves is the solves, 3 per parameter against 4 per output.
+//
+//   build/bench/phiq_bench --benchmark_filter=SensitivityForms --benchmark_counters_tabular=true
+std::string nfourbar_parameters_scene(Index n, int parameters) {
+  std::string s = "phiq: 1\nparameters: {N: " + std::to_string(n) + ", c: 0.7071067811865476, s: 0.7071067811865475";
+  std::string list;
+  for (int p = 0; p < parameters; ++p) {
+    s += ", R" + std::to_string(p) + ": 1";
+    list += (p ? ", R" : "R") + std::to_string(p);
+  }
+  s += "}\ncoordinates:\n  for i in 0..N:\n    x{i}: i + c\n    y{i}: s\n  theta: 0.7853981633974483\n"
+       "points:\n  O: [0, 0]\n  for i in 0..N:\n    P{i}: [\"x{i}\", \"y{i}\"]\nconstraints:\n";
+  for (int p = 0; p < parameters; ++p)
+    s += "  - {name: crank" + std::to_string(p) + ", type: distance, points: [[" + std::to_string(p) + ", 0], P" +
+         std::to_string(p) + "], length: R" + std::to_string(p) + "}\n";
+  s += "  - for i in " + std::to_string(parameters) +
+       "..N:\n      - {name: \"crank{i}\", type: distance, points: [[i, 0], \"P{i}\"], length: 1}\n"
+       "  - for i in 0..N-1:\n      - {name: \"coupler{i}\", type: distance, points: [\"P{i}\", \"P{i+1}\"], "
+       "length: 1}\n  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}\n"
+       "drivers:\n  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: "
+       "1.5707963267948966}}\ntime: {start: 0, end: 1, steps: 100}\n"
+       "output: {coordinates: [y" + std::to_string(n) + "], velocities: true, accelerations: true, sensitivities: [" +
+       list + "]}\n";
+  return s;
+}
+
+// range(0) = N, range(1) = P.
+void BM_SensitivityForms(benchmark::State& state) {
+  const Index n = state.range(0);
+  const int parameters = static_cast<int>(state.range(1));
+  const Scene s = parse_scene(nfourbar_parameters_scene(n, parameters), "nfourbar.yaml");
+  SweepOptions adjoint = s.sweep, direct = s.sweep;
+  adjoint.threads = direct.threads = 1;
+  adjoint.sensitivity_form = SensitivityForm::kAdjoint;
+  direct.sensitivity_form = SensitivityForm::kDirect;
+  double a = 0, d = 0;
+  for (auto _ : state) {
+    const double ta = sweep_seconds(s, adjoint), td = sweep_seconds(s, direct);
+    a += ta, d += td;
+    state.SetIterationTime(ta);
+  }
+  state.counters["adjoint_vs_direct"] = a / d;
+}
+BENCHMARK(BM_SensitivityForms)
+    ->ArgNames({"N", "P"})
+    ->Args({1000, 2})
+    ->Args({1000, 4})
+    ->Args({1000, 8})
+    ->Args({1000, 32})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(3);
+
+
 }  // namespace

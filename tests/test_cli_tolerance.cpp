@@ -80,6 +80,7 @@ TEST_F(Cli, ToleranceLinearSpreadIsTheClosedFormAndMonteCarloAgrees) {
   EXPECT_EQ(j["succeeded"], 1000);
   EXPECT_EQ(j["failed"].size(), 0u);
   EXPECT_EQ(j["disagreeing"], 0);
+  EXPECT_EQ(j["sensitivity_form"], "direct");  // two parameters with q̈: the adjoint's evaluations cost more
   EXPECT_EQ(j["parameters"][0]["name"], "L2");
   EXPECT_DOUBLE_EQ(j["parameters"][0]["nominal"].get<double>(), 0.3);
   EXPECT_DOUBLE_EQ(j["covariance"][1][1].get<double>(), 4e-6);
@@ -218,6 +219,27 @@ TEST_F(Cli, ToleranceReportsAParameterNoOutputDependsOn) {
   for (std::size_t row = 0; row < table.rows.size(); ++row) {
     const double closed = std::fabs(slider_gradient(table.rows[row][0]).l3) * 0.002;
     EXPECT_NEAR(column(table, row, "xB.sd_linear"), closed, 1e-9 * closed);
+  }
+}
+
+// Positions only, two parameters and one output (`--columns xB`, whatever the scene writes): the nominal sweep
+// solves the sensitivities in the adjoint form (one solve a row), and the linear spread is the closed form's.
+TEST_F(Cli, ToleranceTakesTheAdjointFormForFewOutputs) {
+  std::string text = slurp(kCrankSlider);
+  const std::string outputs = "output: {velocities: true, accelerations: true}";
+  ASSERT_NE(text.find(outputs), std::string::npos);
+  text.replace(text.find(outputs), outputs.size(), "output: {velocities: false, accelerations: false}");
+  const fs::path scene = write("positions.yaml", text), out = dir_ / "tol.csv", summary = dir_ / "tol.json";
+  const Result r = run("tolerance " + scene.string() + " --sd L2=0.001 --sd L3=0.002 --columns xB --samples 50 -q -o " +
+                       out.string() + " --summary " + summary.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(summary))["sensitivity_form"], "adjoint");
+  const phiq::CsvTable table = phiq::read_csv_table(out.string());
+  ASSERT_EQ(table.rows.size(), 181u);
+  for (std::size_t row = 0; row < table.rows.size(); ++row) {
+    const Gradient g = slider_gradient(table.rows[row][0]);
+    const double closed = std::hypot(g.l2 * 0.001, g.l3 * 0.002);
+    EXPECT_NEAR(column(table, row, "xB.sd_linear"), closed, 1e-9 * closed) << "t = " << table.rows[row][0];
   }
 }
 

@@ -80,7 +80,9 @@ TEST(OutputJoints, AnglesAndDistancesFollowTheDriversThroughTurns) {
       const OrientationMotion& o = r.orientations[k][0];
       const double turned = std::fabs(std::remainder(2 * t, 2 * M_PI));
       EXPECT_NEAR(o.values[3], turned, 1e-9) << t;
-      if (turned > 1e-3) EXPECT_NEAR(std::fabs(o.values[0]), std::sqrt(0.5), 1e-9) << t;
+      if (turned > 1e-3) {
+        EXPECT_NEAR(std::fabs(o.values[0]), std::sqrt(0.5), 1e-9) << t;
+      }
       EXPECT_NEAR(o.omega[0], std::sqrt(2.0), 1e-9) << t;
       EXPECT_NEAR(o.omega[2], 0.0, 1e-9) << t;
       EXPECT_NEAR(o.alpha[1], 0.0, 1e-9) << t;

@@ -4,11 +4,13 @@
 // positions-only sweeps (same bits of q as without them), and the scene's refusals.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli_test_support.hpp"
@@ -362,6 +364,153 @@ output: {sensitivities: [N]}
   const std::string e = test::scene_error(family);
   EXPECT_NE(e.find("output.sensitivities"), std::string::npos) << e;
   EXPECT_NE(e.find("'N'"), std::string::npos) << e;
+}
+
+// The adjoint form (SensitivityForm::kAdjoint) against the direct one on the same sweep, every coordinate an
+// output: relative 1e-10 of each order's largest value, on planar, spatial and redundant scenes (the transposed
+// second-derivative terms are differences along the motion: exact for lengths, h⁴ inside sines).
+void expect_adjoint_equals_direct(const std::string& rel, const std::vector<std::pair<std::string, double>>& params) {
+  const std::string text = test::slurp(model_path(rel));
+  Scene s = parse_scene(text, "scene.yaml");
+  s.sweep.sensitivities.clear();
+  for (const auto& [name, value] : params) s.sweep.sensitivities.push_back(along(text, s, name, value));
+  SquareScene sq;
+  ASSERT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &sq), SolveStatus::kSuccess);
+  const Model& model = sq.model(*s.model);
+  SweepOptions direct = s.sweep, adjoint = s.sweep;
+  direct.sensitivity_form = SensitivityForm::kDirect;
+  adjoint.sensitivity_form = SensitivityForm::kAdjoint;
+  const SensitivityTrace d = sweep_sensitivities(model, direct, &sq.start);
+  const SensitivityTrace a = sweep_sensitivities(model, adjoint, &sq.start);
+  EXPECT_EQ(d.summary.sensitivity_form, SensitivityForm::kDirect);
+  EXPECT_EQ(a.summary.sensitivity_form, SensitivityForm::kAdjoint);
+  ASSERT_EQ(a.s.size(), d.s.size());
+  const Index n = model.num_coordinates();
+  const SensitivityLayout layout{n};
+  const int orders = s.sweep.accelerations ? 3 : s.sweep.velocities ? 2 : 1;
+  for (int o = 0; o < orders; ++o) {
+    double scale = 0.0, worst = 0.0;
+    for (std::size_t k = 0; k < d.s.size(); ++k) {
+      EXPECT_EQ(a.rows.q[k], d.rows.q[k]) << rel << " row " << k;  // the sweep itself is the same bits
+      for (std::size_t j = 0; j < params.size(); ++j)
+        for (Index i = 0; i < n; ++i) {
+          const double want = d.s[k][layout.offset(j, o) + i], got = a.s[k][layout.offset(j, o) + i];
+          if (std::isnan(want)) {
+            EXPECT_TRUE(std::isnan(got)) << rel << " row " << k;  // a singular row's
+            continue;
+          }
+          scale = std::max(scale, std::fabs(want));
+          worst = std::max(worst, std::fabs(got - want));
+        }
+    }
+    EXPECT_GT(scale, 0.0) << rel << " order " << o;
+    EXPECT_LE(worst, 1e-10 * scale) << rel << ", order " << o << ": " << worst << " of " << scale;
+  }
+}
+
+TEST(Sensitivity, TheAdjointFormEqualsTheDirectOne) {
+  expect_adjoint_equals_direct("seed/fourbar_natural.yaml", {{"L2", 0.4}, {"L3", 1.2}});
+  expect_adjoint_equals_direct("seed/fourbar_reference_point.yaml", {{"L2", 0.4}});
+  expect_adjoint_equals_direct("spatial/rssr.yaml", {{"L", 0.92}});
+  expect_adjoint_equals_direct("spatial/crank_slider_natural.yaml", {{"h", 0.1}});
+  expect_adjoint_equals_direct("redundant/parallelogram_fifth_bar.yaml", {{"r", 1.0}, {"d", 1.0}});
+}
+
+// The form is chosen by cost (effective_sensitivity_form): positions only, the crank-slider's slider xB alone to
+// L2 and L3 is solved in the adjoint form by itself (one solve a row where the direct form takes two) and is the
+// closed form's to 1e-9; with q̇ and q̈ two parameters do not pay for the adjoint's 15 evaluations of Φq a row, so
+// the sweep stays direct, and asked for the adjoint it gives the same values in 4 solves a row (λ, μ, τ, ν) where the
+// direct form takes 6. The coordinates not written are NaN in the adjoint form.
+TEST(Sensitivity, TheFormIsChosenByItsCost) {
+  const std::string one = test::replace_first(kCrankSlider, "output: {", "output: {coordinates: [xB], ");
+  const std::string positions =
+      test::replace_first(one, "velocities: true, accelerations: true", "velocities: false, accelerations: false");
+  const Scene sp = parse_scene(positions, "crank_slider.yaml");
+  const SensitivityTrace rp = sweep_sensitivities(*sp.model, sp.sweep);
+  EXPECT_EQ(rp.summary.sensitivity_form, SensitivityForm::kAdjoint);
+  EXPECT_EQ(rp.summary.counters.sensitivity_solves, 91);
+  EXPECT_HAS(rp.summary.BriefReport(), "91 sensitivity solves (adjoint)");
+  const Index n = sp.model->num_coordinates(), xb = sp.model->coordinate_index("xB");
+  const SensitivityLayout layout{n};
+  ASSERT_EQ(rp.s.size(), 91u);
+  for (std::size_t k = 0; k < rp.s.size(); ++k)
+    for (int which : {2, 3}) {
+      const std::size_t j = which == 2 ? 0 : 1;
+      EXPECT_NEAR(rp.s[k][layout.offset(j, 0) + xb], slider_derivatives(2.0 * rp.rows.t[k], 0.3, 1.0, which)[0], 1e-9);
+      for (Index i = 0; i < n; ++i) {
+        if (i != xb) {
+          EXPECT_TRUE(std::isnan(rp.s[k][layout.offset(j, 0) + i]));
+        }
+      }
+    }
+
+  const Scene s = parse_scene(one, "crank_slider.yaml");
+  const SensitivityTrace direct = sweep_sensitivities(*s.model, s.sweep);
+  EXPECT_EQ(direct.summary.sensitivity_form, SensitivityForm::kDirect);
+  EXPECT_EQ(direct.summary.counters.sensitivity_solves, 91 * 2 * 3);
+  const Scene forced = parse_scene(
+      test::replace_first(one, "output: {", "output: {sensitivity_form: adjoint, "), "crank_slider.yaml");
+  EXPECT_EQ(forced.sweep.sensitivity_form, SensitivityForm::kAdjoint);
+  const SensitivityTrace r = sweep_sensitivities(*forced.model, forced.sweep);
+  EXPECT_EQ(r.summary.sensitivity_form, SensitivityForm::kAdjoint);
+  EXPECT_EQ(r.summary.counters.sensitivity_solves, 91 * 4);
+  EXPECT_HAS(r.summary.BriefReport(), "364 sensitivity solves (adjoint)");
+  ASSERT_EQ(r.s.size(), 91u);
+  for (std::size_t k = 0; k < r.s.size(); ++k)
+    for (int which : {2, 3}) {
+      const std::size_t j = which == 2 ? 0 : 1;
+      const auto exact = slider_derivatives(2.0 * r.rows.t[k], 0.3, 1.0, which);
+      const double want[3] = {exact[0], 2.0 * exact[1], 4.0 * exact[2]};
+      for (int o = 0; o < 3; ++o) {
+        const double got = r.s[k][layout.offset(j, o) + xb], d = direct.s[k][layout.offset(j, o) + xb];
+        EXPECT_NEAR(got, want[o], 1e-9) << "t = " << r.rows.t[k] << ", L" << which << ", order " << o;
+        EXPECT_NEAR(got, d, 1e-10 * std::max(1.0, std::fabs(d))) << "t = " << r.rows.t[k];
+        for (Index i = 0; i < n; ++i) {
+          if (i != xb) {
+            EXPECT_TRUE(std::isnan(r.s[k][layout.offset(j, o) + i]));
+          }
+        }
+      }
+    }
+  EXPECT_EQ(test::scene_error(test::replace_first(one, "output: {", "output: {sensitivity_form: sideways, ")),
+            "bad.yaml:12:28: output.sensitivity_form: sensitivity_form is auto, direct or adjoint");
+  // the rule: P (order + 1) solves against O·(1, 2, 4) solves and (0, 4, 15) evaluations at half a solve each
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 2, 0), SensitivityForm::kDirect);
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 3, 2, 0), SensitivityForm::kAdjoint);
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 1, 1), SensitivityForm::kDirect);
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 3, 1, 1), SensitivityForm::kAdjoint);
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 3, 1, 2), SensitivityForm::kDirect);
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 4, 1, 2), SensitivityForm::kAdjoint);
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAdjoint, 1, 9, 2), SensitivityForm::kAdjoint);
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kDirect, 9, 1, 0), SensitivityForm::kDirect);
+}
+
+TEST(Sensitivity, SolveSensitivitiesAdjointOnAWorkspace) {
+  const Scene s = parse_scene(kCrankSlider, "crank_slider.yaml");
+  const SensitivityTrace r = sweep_sensitivities(*s.model, s.sweep);
+  Workspace ws(*s.model);
+  const std::size_t k = 37;
+  ws.q = r.rows.q[k], ws.qd = r.rows.qd[k], ws.qdd = r.rows.qdd[k];
+  const Index xa = s.model->coordinate_index("xA"), xb = s.model->coordinate_index("xB");
+  std::vector<double> out(r.s[k].size());
+  LinearSummary ls;
+  ASSERT_EQ(solve_sensitivities_adjoint(*s.model, s.sweep.sensitivities, {xb, xa}, r.rows.t[k], 2, ws, out.data(), &ls),
+            SolveStatus::kSuccess)
+      << ls.message;
+  const SensitivityLayout layout{s.model->num_coordinates()};
+  for (std::size_t j = 0; j < 2; ++j)
+    for (int o = 0; o < 3; ++o)
+      for (Index i = 0; i < s.model->num_coordinates(); ++i) {
+        const double got = out[static_cast<std::size_t>(layout.offset(j, o) + i)];
+        if (i == xa || i == xb) {
+          EXPECT_NEAR(got, r.s[k][layout.offset(j, o) + i], 1e-10) << j << " " << o << " " << i;
+        } else {
+          EXPECT_TRUE(std::isnan(got));
+        }
+      }
+  EXPECT_THROW((void)solve_sensitivities_adjoint(*s.model, s.sweep.sensitivities, {xb, xb}, 0.0, 2, ws, out.data()),
+               Error);
+  EXPECT_THROW((void)solve_sensitivities_adjoint(*s.model, s.sweep.sensitivities, {4}, 0.0, 2, ws, out.data()), Error);
 }
 
 }  // namespace

@@ -243,6 +243,16 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
       return fail(a.scene + ": " + why, 2);
     scene.sweep.sensitivities.push_back(std::move(s));
   }
+  // The nominal sweep's written coordinates are the outputs' (--columns may name coordinates the scene does not
+  // write): the adjoint form, which the sweep takes when the parameters outnumber them, solves for exactly those.
+  {
+    std::vector<Index> outs;
+    for (const OutputColumn& c : columns) outs.push_back(c.coordinate);
+    std::sort(outs.begin(), outs.end());
+    outs.erase(std::unique(outs.begin(), outs.end()), outs.end());
+    scene.sweep.coordinate_columns = outs;
+    scene.sweep.velocity_columns = scene.sweep.acceleration_columns = outs;
+  }
 
   // Every output exists before the sweeps: an unwritable path fails now; all are committed together at the end.
   OutputSet outputs;
@@ -379,6 +389,7 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   run.scene_path = a.scene, run.scene_name = scene.name, run.spread = &spread, run.nominal = nominal;
   run.covariance_file = a.covariance, run.samples = a.samples, run.seed = a.seed, run.threshold = a.threshold;
   run.failed = failed, run.threads = threads_used, run.solve_seconds = since(start);
+  run.sensitivity_form = to_string(nominal_summary.sensitivity_form);
   for (std::size_t j = 0; j < np; ++j)
     if (largest_sensitivity[j] == 0.0) run.independent.push_back(spread.parameters[j].name);
   if (succeeded < 2)

@@ -94,6 +94,7 @@ nlohmann::ordered_json tolerance_summary(const ToleranceRun& run, const std::vec
   j["failed"] = failed;
   j["threshold"] = run.threshold;
   j["noise_floor"] = run.floor;
+  j["sensitivity_form"] = run.sensitivity_form;
   json outs = json::array();
   std::size_t disagreeing = 0;
   for (const tolerance::OutputSpread& o : outputs) {

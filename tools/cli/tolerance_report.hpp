@@ -42,6 +42,7 @@ struct ToleranceRun {
   double floor = 0.0;
   std::vector<FailedCase> failed;
   std::vector<std::string> independent;  // parameters whose sensitivities are zero at every row
+  std::string sensitivity_form;          // how the nominal sweep solved them: "direct" or "adjoint"
   int threads = 1;
   double solve_seconds = 0.0;
 };

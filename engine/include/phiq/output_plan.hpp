@@ -46,6 +46,11 @@ struct OutputPlan {
   /// at every written row (StepView::sensitivities), solved with the row's own factorisation of Φq
   /// (sensitivity.hpp); written for the coordinate columns, as `x.d_P`, `x.v.d_P`, `x.a.d_P`.
   std::vector<OutputSensitivity> sensitivities;
+  /// How the sensitivities are solved: kAuto takes the adjoint form where it costs less than the direct one for
+  /// the coordinates whose columns are written (effective_sensitivity_form()); SweepSummary says which.
+  SensitivityForm sensitivity_form = SensitivityForm::kAuto;
+  /// The coordinates the adjoint form solves for: those whose q, q̇ or q̈ columns are written, ascending.
+  std::vector<Index> sensitivity_outputs() const;
   /// Deliver Φ(q, t) at every row (StepView::phi). Free: Newton's convergence test has just evaluated it.
   bool residuals = false;
   /// Deliver the reciprocal condition estimate of the last factorisation of Φq (StepView::rcond). Free with KLU

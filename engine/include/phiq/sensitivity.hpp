@@ -48,6 +48,37 @@ struct OutputSensitivity {
 /// The default difference step for a parameter of value p: 10⁻³ |p|, or 10⁻³ for p = 0.
 double default_sensitivity_step(double p);
 
+/// How a row's sensitivities are solved.
+///
+/// Direct: one solve with Φq per parameter and derivative order, giving every coordinate's sensitivity (above).
+///
+/// Adjoint: per output coordinate i, Φqᵀ λ = e_i, and then ∂q_i/∂p_j = −λᵀ Φp_j for every parameter at once;
+/// likewise for q̇ and q̈, whose right-hand sides are linear in the lower sensitivities: with a_j = ∂Φ/∂p_j,
+/// b_j = ∂(Φq q̇ + Φt)/∂p_j and c_j = ∂(Φq q̈ − γ)/∂p_j at fixed (q, q̇), and B = ∂(Φq q̇ + Φt)/∂q,
+///
+///   ∂q_i/∂p_j = −λᵀ a_j,   ∂q̇_i/∂p_j = μᵀ a_j − λᵀ b_j,   ∂q̈_i/∂p_j = (ν − 2τ)ᵀ a_j + 2 μᵀ b_j − λᵀ c_j,
+///
+///   Φqᵀ μ = Bᵀ λ,   Φqᵀ τ = Bᵀ μ,   Φqᵀ ν = ∂(Φq q̈ − γ)/∂qᵀ λ     (∂γ/∂q̇ = −2B).
+///
+/// The transposed products are directional derivatives of Φqᵀv: Bᵀv = d/dε Φq(q + εq̇, t + ε)ᵀv and
+/// ∂(Φq q̈ − γ)/∂qᵀ v = d/dε Φq(q + εq̈, t)ᵀv + d²/dε² Φq(q + εq̇, t + ε)ᵀv (−γ is the second derivative of Φ along
+/// the motion), by central differences of fourth order (sixth for the second derivative; exact up to rounding
+/// where Φq is polynomial of low degree in q, as for lengths). So an output costs 1, 2 or 4 solves with Φqᵀ (for
+/// q, q̇, q̈) whatever the number of parameters, and a row 15 more evaluations of Φq; the direct form costs 1, 2
+/// or 3 solves per parameter.
+enum class SensitivityForm { kAuto, kDirect, kAdjoint };
+
+/// "auto", "direct", "adjoint".
+const char* to_string(SensitivityForm form);
+
+/// The form kAuto stands for at derivative order `order` (0: q, 1: and q̇, 2: and q̈): kAdjoint when it costs
+/// less, counting solves with Φq and evaluations of Φq as half a solve (measured on nfourbar 10³: 0.4–0.6), else
+/// kDirect: direct P (order + 1) solves against adjoint O·(1, 2, 4) solves and (0, 4, 15) evaluations for P
+/// parameters and O output coordinates. At order 0 that is the adjoint when the parameters outnumber the outputs;
+/// with q̈ and one output, from 4 parameters (bench/README.md, "Sensitivities"). Any other form as given.
+SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t parameters, std::size_t outputs,
+                                           int order);
+
 /// "" when the four models of `s` can stand for `model` moved along the parameter (same number of coordinates and
 /// of rows, the same Φq pattern, a finite positive step); else one line naming the parameter and what differs
 /// (a parameter that sets a family's size or a count changes the structure: it has no derivative).
@@ -75,5 +106,12 @@ struct SensitivityLayout {
 /// distinct workspaces.
 SolveStatus solve_sensitivities(const Model& model, const std::vector<OutputSensitivity>& parameters, double t,
                                 int order, Workspace& ws, double* out, LinearSummary* summary = nullptr);
+
+/// solve_sensitivities() in the adjoint form (SensitivityForm) for the coordinates `outputs` only (indices, each
+/// 0 ≤ i < n, without repeats): their entries of `out` are written, every other entry is NaN. Same pre-conditions,
+/// statuses and throws as solve_sensitivities(); `outputs` out of range or repeated throws phiq::Error.
+SolveStatus solve_sensitivities_adjoint(const Model& model, const std::vector<OutputSensitivity>& parameters,
+                                        const std::vector<Index>& outputs, double t, int order, Workspace& ws,
+                                        double* out, LinearSummary* summary = nullptr);
 
 }  // namespace phiq

@@ -211,6 +211,9 @@ struct SweepSummary {
   Index parallel_chunks = 0;           ///< chunks run from their seeds and accepted (0 for a sweep in order)
   double seed_seconds = 0.0;           ///< wall time of the sequential seeding pass of a sweep in chunks
   SweepAccuracy accuracy;              ///< how well q is known on the delivered rows, per class of row
+  /// How the sensitivities were solved (kDirect or kAdjoint: OutputPlan::sensitivity_form resolved by
+  /// effective_sensitivity_form()); kAuto when none were asked for.
+  SensitivityForm sensitivity_form = SensitivityForm::kAuto;
   /// One line: status, steps, iterations, factorisations, solves, point evaluations, subdivisions, warnings, time,
   /// message.
   std::string BriefReport() const;

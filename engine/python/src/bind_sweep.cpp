@@ -44,6 +44,7 @@ py::dict summary_dict(const SweepSummary& s) {
       py::arg("min_rcond_time") = s.min_rcond_time, py::arg("warnings") = warnings,
       py::arg("solve_seconds") = s.solve_seconds, py::arg("threads") = s.threads,
       py::arg("parallel_chunks") = s.parallel_chunks, py::arg("seed_seconds") = s.seed_seconds,
+      py::arg("sensitivity_form") = to_string(s.sensitivity_form),
       py::arg("accuracy") = py::dict(py::arg("converged") = accuracy_dict(s.accuracy.converged),
                                      py::arg("rounding_level") = accuracy_dict(s.accuracy.rounding_level),
                                      py::arg("singular") = accuracy_dict(s.accuracy.singular)));

@@ -58,7 +58,7 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
   bool coordinates_listed = false;
   if (c.present()) {
     c.expect_map({"velocities", "accelerations", "coordinates", "points", "joints", "orientations", "drivers",
-                  "residuals", "max_residual", "rcond", "every", "window", "sensitivities"});
+                  "residuals", "max_residual", "rcond", "every", "window", "sensitivities", "sensitivity_form"});
     // true / false, or the coordinates whose derivative is written (q̇ or q̈ is solved whole either way)
     auto derivative = [&](const char* key, bool& asked, std::optional<std::vector<Index>>& columns) {
       const Cursor d = c.field(key);
@@ -113,6 +113,13 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
       }
     }
     if (auto ss = c.field("sensitivities"); ss.present()) output_sensitivities(ss, plan);
+    if (auto f = c.field("sensitivity_form"); f.present()) {
+      const std::string form = f.text();
+      if (form == "auto") plan.sensitivity_form = SensitivityForm::kAuto;
+      else if (form == "direct") plan.sensitivity_form = SensitivityForm::kDirect;
+      else if (form == "adjoint") plan.sensitivity_form = SensitivityForm::kAdjoint;
+      else f.fail("sensitivity_form is auto, direct or adjoint");
+    }
     if (auto v = c.field("max_residual"); v.present()) plan.max_residual_column = v.boolean();
     if (auto v = c.field("rcond"); v.present()) plan.condition = v.boolean();
     plan.residuals = plan.max_residual_column || !residual_names_.empty();

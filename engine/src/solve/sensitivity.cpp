@@ -2,10 +2,12 @@
 // central difference along the parameter, each solved with the row's own factorisation of Φq.
 #include "phiq/sensitivity.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
+#include "phiq/output_plan.hpp"
 #include "phiq/evaluation.hpp"  // JacobianView: Φq over values held here
 #include "phiq/text.hpp"
 #include "solve/factorisation.hpp"
@@ -104,13 +106,200 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   return true;
 }
 
-SolveStatus solve_sensitivities(const Model& model, const std::vector<OutputSensitivity>& parameters, double t,
-                                int order, Workspace& ws, double* out, LinearSummary* summary) {
+const char* to_string(SensitivityForm form) {
+  switch (form) {
+    case SensitivityForm::kAuto: return "auto";
+    case SensitivityForm::kDirect: return "direct";
+    case SensitivityForm::kAdjoint: return "adjoint";
+  }
+  return "?";
+}
+
+SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t parameters, std::size_t outputs,
+                                           int order) {
+  if (form != SensitivityForm::kAuto) return form;
+  const int o = std::clamp(order, 0, 2);
+  constexpr double kSolvesPerOutput[3] = {1.0, 2.0, 4.0};  // λ; μ; τ and ν
+  constexpr double kEvaluations[3] = {0.0, 4.0, 15.0};     // Φq along the motion (and along q̈)
+  const double direct = static_cast<double>(parameters) * (o + 1);
+  const double adjoint = static_cast<double>(outputs) * kSolvesPerOutput[o] + 0.5 * kEvaluations[o];
+  return adjoint < direct ? SensitivityForm::kAdjoint : SensitivityForm::kDirect;
+}
+
+std::vector<Index> OutputPlan::sensitivity_outputs() const {
+  std::vector<Index> out(coordinate_columns);
+  for (const std::vector<Index>* more : {&written_velocities(), &written_accelerations()})
+    out.insert(out.end(), more->begin(), more->end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::vector<OutputSensitivity>& parameters,
+                                                const std::vector<Index>& outputs, double t, const double* q,
+                                                const double* qd, const double* qdd, int order, SparseLuNumeric& lu,
+                                                Workspace& ws, SensitivityScratch& sc, double* out) {
+  const Index n = model.num_coordinates(), m = model.num_equations();
+  const SensitivityLayout layout{n};
+  const std::size_t np = parameters.size();
+  std::fill(out, out + layout.size(np), std::numeric_limits<double>::quiet_NaN());
+  if (outputs.empty() || np == 0) return true;
+  const CscPattern& pattern = model.jacobian_pattern();
+  const std::size_t nnz = static_cast<std::size_t>(pattern.nnz());
+  auto view = [&](std::vector<double>& values) {
+    return JacobianView(pattern.rows, pattern.cols, pattern.nnz(), pattern.col_ptr.data(), pattern.row_idx.data(),
+                        values.data());
+  };
+  const Eigen::Map<const Eigen::VectorXd> qv(q, n);
+  // Per parameter, its derivatives at fixed (q, q̇): a_j = ∂Φ/∂p, b_j = ∂(Φq q̇ + Φt)/∂p, c_j = ∂(Φq q̈ − γ)/∂p,
+  // by the same difference along p as the direct form.
+  sc.a.resize(np), sc.b.resize(np), sc.c.resize(np);
+  for (auto& f : sc.f) f.resize(m);
+  sc.d.resize(m);
+  sc.jacobian[0].resize(nnz);
+  for (std::size_t j = 0; j < np; ++j) {
+    const OutputSensitivity& p = parameters[j];
+    // D f as differences of the pairs: exactly zero where the four models agree (a parameter nothing reads), not
+    // the rounding of f − 8f + 8f − f
+    auto difference = [&](Eigen::VectorXd& into) {
+      into = ((sc.f[0] - sc.f[3]) + 8.0 * (sc.f[2] - sc.f[1])) / (12.0 * p.step);
+    };
+    for (std::size_t k = 0; k < 4; ++k) p.models[k]->residual(q, t, sc.f[k].data());
+    difference(sc.a[j]);
+    if (order < 1) continue;
+    const Eigen::Map<const Eigen::VectorXd> qdv(qd, n);
+    std::array<Eigen::VectorXd, 4> acc;  // Φq_k q̈ − γ_k, made from the same Jacobians
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Model& mk = *p.models[k];
+      mk.jacobian(q, t, sc.jacobian[0].data());
+      sc.f[k].noalias() = view(sc.jacobian[0]) * qdv;
+      mk.phi_t(q, t, sc.d.data());
+      sc.f[k] += sc.d;
+      if (order >= 2) {
+        const Eigen::Map<const Eigen::VectorXd> qddv(qdd, n);
+        acc[k].noalias() = view(sc.jacobian[0]) * qddv;
+        mk.gamma(q, qd, t, sc.d.data());
+        acc[k] -= sc.d;
+      }
+    }
+    difference(sc.b[j]);
+    if (order >= 2) {
+      for (std::size_t k = 0; k < 4; ++k) sc.f[k].swap(acc[k]);
+      difference(sc.c[j]);
+    }
+  }
+  // Φq of the swept model along the motion, q + kεq̇ at t + kε, and along q̈: the transposed second-derivative
+  // terms are their differences applied to a vector. ε moves the fastest coordinate by 10⁻³ of its scale for the
+  // fourth-order first differences; the second difference, whose rounding grows as 1/ε², is of sixth order at
+  // 2·10⁻² (rounding and truncation both near 10⁻¹² of the terms: at 5·10⁻³ and fourth order the crank-slider's
+  // ∂ẍ_B/∂L3 was 10× less accurate than the direct form's). t moves by at most ε's cap (a body at rest moves in t only).
+  const double* cs = model.tolerance_scales().coordinate_scale.data();
+  auto fastest = [&](const double* v) {
+    double f = 0.0;
+    for (Index j = 0; j < n; ++j) f = std::max(f, std::fabs(v[j]) / cs[j]);
+    return f;
+  };
+  const double v_rate = order >= 1 ? fastest(qd) : 0.0, a_rate = order >= 2 ? fastest(qdd) : 0.0;
+  const double e1 = 1e-3 / std::max(v_rate, 1e-3), e2 = 2e-2 / std::max(v_rate, 2e-2);
+  const double e3 = 1e-3 / std::max(a_rate, 1e-3);
+  constexpr double kSecond[7] = {2.0, -27.0, 270.0, -490.0, 270.0, -27.0, 2.0};  // f'' · 180 h², offsets −3 … 3
+  if (order >= 1) {
+    for (auto& v : sc.first_along_motion) v.resize(nnz);
+    Eigen::VectorXd qk(n);
+    const Eigen::Map<const Eigen::VectorXd> qdv(qd, n);
+    for (std::size_t k = 0; k < 4; ++k) {
+      qk = qv + (kShift[k] * e1) * qdv;
+      model.jacobian(qk.data(), t + kShift[k] * e1, sc.first_along_motion[k].data());
+    }
+    if (order >= 2) {
+      for (auto& v : sc.along_motion) v.resize(nnz);
+      for (auto& v : sc.along_acceleration) v.resize(nnz);
+      for (std::size_t k = 0; k < 7; ++k) {
+        const double shift = static_cast<double>(k) - 3.0;
+        qk = qv + (shift * e2) * qdv;
+        model.jacobian(qk.data(), t + shift * e2, sc.along_motion[k].data());
+      }
+      const Eigen::Map<const Eigen::VectorXd> qddv(qdd, n);
+      for (std::size_t k = 0; k < 4; ++k) {
+        qk = qv + (kShift[k] * e3) * qddv;
+        model.jacobian(qk.data(), t, sc.along_acceleration[k].data());
+      }
+    }
+    ws.counters.jacobian_evaluations += order >= 2 ? 15 : 4;
+  }
+  // Bᵀv, and ∂(Φq q̈ − γ)/∂qᵀ v, into sc.rhs (over the coordinates).
+  auto b_transposed = [&](const Eigen::VectorXd& v) {
+    sc.rhs.setZero(n);
+    for (std::size_t k = 0; k < 4; ++k)
+      sc.rhs.noalias() += (kWeight[k] / (12.0 * e1)) * (view(sc.first_along_motion[k]).transpose() * v);
+  };
+  auto c1_transposed = [&](const Eigen::VectorXd& v) {
+    sc.rhs.setZero(n);
+    for (std::size_t k = 0; k < 4; ++k)
+      sc.rhs.noalias() += (kWeight[k] / (12.0 * e3)) * (view(sc.along_acceleration[k]).transpose() * v);
+    for (std::size_t k = 0; k < 7; ++k)
+      sc.rhs.noalias() += (kSecond[k] / (180.0 * e2 * e2)) * (view(sc.along_motion[k]).transpose() * v);
+  };
+  // Φqᵀ x = sc.rhs with the row's factors, x over Φ's rows (zero at the rows the square solves leave out).
+  const std::vector<Index>& kept = model.solve_rows();
+  auto solve_transposed = [&](Eigen::VectorXd& x) {
+    sc.solved.resize(n);
+    ++ws.counters.sensitivity_solves;
+    if (!lu.solve_transposed(sc.rhs.data(), sc.solved.data())) return false;
+    if (kept.empty()) {
+      x = sc.solved;
+    } else {
+      x.setZero(m);
+      for (std::size_t i = 0; i < kept.size(); ++i) x[kept[i]] = sc.solved[static_cast<Index>(i)];
+    }
+    return true;
+  };
+  for (const Index i : outputs) {
+    sc.rhs.setZero(n);
+    sc.rhs[i] = 1.0;
+    if (!solve_transposed(sc.lambda)) return false;
+    if (order >= 1) {
+      b_transposed(sc.lambda);
+      if (!solve_transposed(sc.mu)) return false;
+    }
+    if (order >= 2) {
+      b_transposed(sc.mu);
+      if (!solve_transposed(sc.tau)) return false;
+      c1_transposed(sc.lambda);
+      if (!solve_transposed(sc.nu)) return false;
+    }
+    for (std::size_t j = 0; j < np; ++j) {
+      out[layout.offset(j, 0) + i] = -sc.lambda.dot(sc.a[j]);
+      if (order >= 1) out[layout.offset(j, 1) + i] = sc.mu.dot(sc.a[j]) - sc.lambda.dot(sc.b[j]);
+      if (order >= 2)
+        out[layout.offset(j, 2) + i] = (sc.nu - 2.0 * sc.tau).dot(sc.a[j]) + 2.0 * sc.mu.dot(sc.b[j]) -
+                                       sc.lambda.dot(sc.c[j]);
+    }
+  }
+  return true;
+}
+
+namespace {
+
+// solve_sensitivities() and solve_sensitivities_adjoint(): checks, the factorisation at ws.q, then the form's solves
+// (`outputs` null: the direct form).
+SolveStatus solve_sensitivities_in(const Model& model, const std::vector<OutputSensitivity>& parameters,
+                                   const std::vector<Index>* outputs, double t, int order, Workspace& ws, double* out,
+                                   LinearSummary* summary, const char* who) {
   detail::check_workspace(model, ws);
-  if (order < 0 || order > 2) throw Error("solve_sensitivities: order must be 0, 1 or 2");
-  if (!out && !parameters.empty()) throw Error("solve_sensitivities: out must not be null");
+  const std::string name(who);
+  if (order < 0 || order > 2) throw Error(name + ": order must be 0, 1 or 2");
+  if (!out && !parameters.empty()) throw Error(name + ": out must not be null");
   for (const OutputSensitivity& p : parameters)
     if (const std::string why = check_sensitivity_models(model, p); !why.empty()) throw Error(why);
+  if (outputs) {
+    std::vector<char> seen(static_cast<std::size_t>(model.num_coordinates()), 0);
+    for (Index i : *outputs) {
+      if (i < 0 || i >= model.num_coordinates())
+        throw Error(name + ": output coordinate " + std::to_string(i) + " out of range");
+      if (seen[static_cast<std::size_t>(i)]++) throw Error(name + ": output coordinate " + std::to_string(i) + " repeated");
+    }
+  }
   LinearSummary local;
   LinearSummary& sum = summary ? *summary : local;
   sum = LinearSummary{};
@@ -129,12 +318,33 @@ SolveStatus solve_sensitivities(const Model& model, const std::vector<OutputSens
     return sum.status = SolveStatus::kSingularJacobian;
   }
   detail::SensitivityScratch scratch;
-  if (!detail::sensitivities_with_factors(model, parameters, t, ws.q.data(), order >= 1 ? ws.qd.data() : nullptr,
-                                          order >= 2 ? ws.qdd.data() : nullptr, order, *ws.lu, ws, scratch, out)) {
+  const double* qd = order >= 1 ? ws.qd.data() : nullptr;
+  const double* qdd = order >= 2 ? ws.qdd.data() : nullptr;
+  const bool ok =
+      outputs ? detail::adjoint_sensitivities_with_factors(model, parameters, *outputs, t, ws.q.data(), qd, qdd, order,
+                                                           *ws.lu, ws, scratch, out)
+              : detail::sensitivities_with_factors(model, parameters, t, ws.q.data(), qd, qdd, order, *ws.lu, ws,
+                                                   scratch, out);
+  if (!ok) {
+    std::fill(out, out + layout.size(parameters.size()), std::numeric_limits<double>::quiet_NaN());
     sum.message = "sparse LU solve failed: " + ws.lu->last_message();
     return sum.status = SolveStatus::kLinearSolverFailed;
   }
   return SolveStatus::kSuccess;
+}
+
+}  // namespace
+
+SolveStatus solve_sensitivities(const Model& model, const std::vector<OutputSensitivity>& parameters, double t,
+                                int order, Workspace& ws, double* out, LinearSummary* summary) {
+  return solve_sensitivities_in(model, parameters, nullptr, t, order, ws, out, summary, "solve_sensitivities");
+}
+
+SolveStatus solve_sensitivities_adjoint(const Model& model, const std::vector<OutputSensitivity>& parameters,
+                                        const std::vector<Index>& outputs, double t, int order, Workspace& ws,
+                                        double* out, LinearSummary* summary) {
+  return solve_sensitivities_in(model, parameters, &outputs, t, order, ws, out, summary,
+                                "solve_sensitivities_adjoint");
 }
 
 }  // namespace phiq

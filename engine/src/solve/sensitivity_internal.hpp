@@ -17,6 +17,15 @@ struct SensitivityScratch {
   Eigen::VectorXd qk, vk;            // the shifted q and q̇
   // Φq of each model at its shifted q: made for the velocity, read again for the acceleration (the same point)
   std::array<std::vector<double>, 4> jacobian;
+  // The adjoint form: per parameter, a_j, b_j, c_j at fixed (q, q̇) (sensitivity.hpp); Φq at the points along the
+  // motion (q + kεq̇, t + kε: k = −2, −1, 1, 2 for the first difference, −3 … 3 at a larger ε for the second) and
+  // along q̈ (q + kεq̈); the adjoint vectors (over Φ's rows: zero at rows the square solves leave out) and the
+  // solves' right-hand sides and results.
+  std::vector<Eigen::VectorXd> a, b, c;
+  std::array<std::vector<double>, 4> first_along_motion;
+  std::array<std::vector<double>, 7> along_motion;
+  std::array<std::vector<double>, 4> along_acceleration;
+  Eigen::VectorXd lambda, mu, tau, nu, rhs, solved, kept;
 };
 
 // Writes the sensitivities of (q, q̇, q̈) at t to every parameter into `out` (SensitivityLayout; derivatives above
@@ -26,5 +35,12 @@ struct SensitivityScratch {
 bool sensitivities_with_factors(const Model& model, const std::vector<OutputSensitivity>& parameters, double t,
                                 const double* q, const double* qd, const double* qdd, int order,
                                 SparseLuNumeric& lu, Workspace& ws, SensitivityScratch& scratch, double* out);
+
+// The same in the adjoint form (SensitivityForm::kAdjoint), for the coordinates `outputs` only; every other entry
+// of `out` is NaN.
+bool adjoint_sensitivities_with_factors(const Model& model, const std::vector<OutputSensitivity>& parameters,
+                                        const std::vector<Index>& outputs, double t, const double* q,
+                                        const double* qd, const double* qdd, int order, SparseLuNumeric& lu,
+                                        Workspace& ws, SensitivityScratch& scratch, double* out);
 
 }  // namespace phiq::detail

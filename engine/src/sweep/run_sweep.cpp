@@ -81,9 +81,16 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
       !is_euler_sequence(opt.orientation_form.form))
     throw Error("SweepOptions: orientation_form '" + opt.orientation_form.form + "' is not matrix, axis_angle or an "
                 "Euler sequence");
+  if (opt.sensitivity_form != SensitivityForm::kAuto && opt.sensitivity_form != SensitivityForm::kDirect &&
+      opt.sensitivity_form != SensitivityForm::kAdjoint)
+    throw Error("SweepOptions: sensitivity_form is not a SensitivityForm");
   SweepSummary local;
   SweepSummary& sum = summary ? *summary : local;
   sum = SweepSummary{};
+  if (!opt.sensitivities.empty())
+    sum.sensitivity_form = effective_sensitivity_form(opt.sensitivity_form, opt.sensitivities.size(),
+                                                      opt.sensitivity_outputs().size(),
+                                                      opt.accelerations ? 2 : opt.velocities ? 1 : 0);
   const auto start = std::chrono::steady_clock::now();
   const WorkCounters before = ws.counters;
   WorkCounters others;  // work done in the seeding and chunk workspaces

@@ -12,7 +12,8 @@ std::string SweepSummary::BriefReport() const {
     << " Newton iterations, " << counters.factorizations << " factorizations, " << counters.velocity_solves
     << " velocity and " << counters.acceleration_solves << " acceleration solves";
   if (counters.point_evaluations) s << ", " << counters.point_evaluations << " point evaluations";
-  if (counters.sensitivity_solves) s << ", " << counters.sensitivity_solves << " sensitivity solves";
+  if (counters.sensitivity_solves)
+    s << ", " << counters.sensitivity_solves << " sensitivity solves (" << to_string(sensitivity_form) << ")";
   if (subdivisions) s << ", " << subdivisions << " step subdivisions";
   if (singular_positions) s << ", " << singular_positions << " singular positions passed";
   if (threads > 1)
