@@ -219,3 +219,13 @@ def test_sensitivities_reach_python_as_the_clis_columns(tmp_path):
     with pytest.raises(ValueError, match="order must be 0, 1 or 2"):
         result.sensitivity("L2", 3)
     assert result.summary["counters"]["sensitivity_solves"] == 181 * 2 * 3
+    assert result.summary["sensitivity_form"] == "direct"
+    # the adjoint form asked for: the same values to 1e-10 (every coordinate written, so every column)
+    options = phiq.load_scene(str(path)).options
+    options.sensitivity_form = phiq.SensitivityForm.ADJOINT
+    adjoint = phiq.run_sweep(phiq.load_scene(str(path)), options)
+    assert adjoint.ok, adjoint.message
+    assert adjoint.summary["sensitivity_form"] == "adjoint"
+    assert adjoint.summary["counters"]["sensitivity_solves"] == 181 * 4 * 4
+    first = header.index("xB.d_L2")
+    assert np.max(np.abs(adjoint.table[:, first:] - table[:, first:])) < 1e-10 * np.max(np.abs(table[:, first:]))

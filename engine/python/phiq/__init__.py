@@ -23,9 +23,10 @@ from typing import Any, List, Optional
 
 from . import _phiq
 from ._phiq import (AssemblySummary, ConstraintInfo, JacobianUpdate, LinearSummary, Model, NewtonOptions,
-                    PositionSummary, Predictor, RankReport, Scene, SceneError, SolveStatus, StepSummary, Stepper,
-                    SweepOptions, SweepSummary, SweepWarning, Unit, WorkCounters, Workspace, analyse_rank, assemble,
-                    constraint_kinds, load_scene, parse_scene, solve_acceleration, solve_position, solve_velocity)
+                    PositionSummary, Predictor, RankReport, Scene, SceneError, SensitivityForm, SolveStatus,
+                    StepSummary, Stepper, SweepOptions, SweepSummary, SweepWarning, Unit, WorkCounters, Workspace,
+                    analyse_rank, assemble, constraint_kinds, load_scene, parse_scene, solve_acceleration,
+                    solve_position, solve_velocity)
 from ._builder import SceneBuilder
 from ._results import SolveError, SweepResult
 
@@ -35,7 +36,8 @@ SceneError.__doc__ = ("A scene that cannot be used (a ValueError): one line 'FIL
 
 __all__ = [
     "AssemblySummary", "CheckReport", "ConstraintInfo", "JacobianUpdate", "LinearSummary", "Model", "NewtonOptions",
-    "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError", "SolveError", "SolveStatus",
+    "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError", "SensitivityForm", "SolveError",
+    "SolveStatus",
     "StepSummary", "Stepper", "SweepOptions", "SweepResult", "SweepSummary", "SweepWarning", "Unit", "WorkCounters",
     "Workspace",
     "analyse_rank", "assemble", "check", "constraint_kinds", "load_scene", "parse_scene", "run_sweep",

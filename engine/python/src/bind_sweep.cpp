@@ -59,6 +59,14 @@ void bind_sweep(py::module_& m) {
   }
   pred.def("__str__", [](Predictor p) { return to_string(p); });
 
+  py::enum_<SensitivityForm>(m, "SensitivityForm",
+                             "How sensitivities are solved (sensitivity.hpp): AUTO picks the cheaper, DIRECT solves "
+                             "per parameter, ADJOINT per written coordinate.")
+      .value("AUTO", SensitivityForm::kAuto)
+      .value("DIRECT", SensitivityForm::kDirect)
+      .value("ADJOINT", SensitivityForm::kAdjoint)
+      .def("__str__", [](SensitivityForm f) { return to_string(f); });
+
   py::class_<SweepOptions>(m, "SweepOptions",
                            "What run_sweep computes and how: the time grid, the solver settings, the threads and "
                            "the outputs. Get the scene's with Scene.options, change fields, pass it to run_sweep.")
@@ -80,6 +88,8 @@ void bind_sweep(py::module_& m) {
       .def_readwrite("row_buffer_bytes", &SweepOptions::row_buffer_bytes, "bytes of rows a sweep in chunks may hold before delivering them in order")
       .def_readwrite("velocities", &SweepOptions::velocities, "solve and deliver q̇")
       .def_readwrite("accelerations", &SweepOptions::accelerations, "solve and deliver q̈")
+      .def_readwrite("sensitivity_form", &SweepOptions::sensitivity_form,
+                     "how the sensitivities of output.sensitivities are solved (SensitivityForm)")
       .def_readwrite("residuals", &SweepOptions::residuals, "deliver Φ at every row (residual columns)")
       .def_readwrite("condition", &SweepOptions::condition, "deliver the rcond column")
       .def_readwrite("coordinate_columns", &SweepOptions::coordinate_columns, "indices of the q columns written")
