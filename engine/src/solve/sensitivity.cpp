@@ -168,7 +168,6 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
     difference(sc.a[j]);
     if (order < 1) continue;
     const Eigen::Map<const Eigen::VectorXd> qdv(qd, n);
-    std::array<Eigen::VectorXd, 4> acc;  // Φq_k q̈ − γ_k, made from the same Jacobians
     for (std::size_t k = 0; k < 4; ++k) {
       const Model& mk = *p.models[k];
       mk.jacobian(q, t, sc.jacobian[0].data());
@@ -177,14 +176,14 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
       sc.f[k] += sc.d;
       if (order >= 2) {
         const Eigen::Map<const Eigen::VectorXd> qddv(qdd, n);
-        acc[k].noalias() = view(sc.jacobian[0]) * qddv;
+        sc.g[k].noalias() = view(sc.jacobian[0]) * qddv;
         mk.gamma(q, qd, t, sc.d.data());
-        acc[k] -= sc.d;
+        sc.g[k] -= sc.d;
       }
     }
     difference(sc.b[j]);
     if (order >= 2) {
-      for (std::size_t k = 0; k < 4; ++k) sc.f[k].swap(acc[k]);
+      for (std::size_t k = 0; k < 4; ++k) sc.f[k].swap(sc.g[k]);
       difference(sc.c[j]);
     }
   }
