@@ -116,15 +116,14 @@ SolveStatus assemble_by_blocks(const Model& model, double t, double tolerance, i
     bool within = true;
     for (Index k = 0; k < m; ++k) {
       const Index r = tb.rows[static_cast<std::size_t>(b0 + k)];
-      double floor = 0.0;
-      for (Index e = by_rows.col_ptr[r]; e < by_rows.col_ptr[r + 1]; ++e) {
-        const Index j = by_rows.row_idx[static_cast<std::size_t>(e)];
-        const double v = values[static_cast<std::size_t>(value_of[static_cast<std::size_t>(e)])];
-        floor += std::fabs(v) * std::fabs(q[j]);
-        if (const Index l = local_col[static_cast<std::size_t>(j)]; l >= 0) jb(k, l) = v;
-      }
+      for (Index e = by_rows.col_ptr[r]; e < by_rows.col_ptr[r + 1]; ++e)
+        if (const Index l = local_col[static_cast<std::size_t>(by_rows.row_idx[static_cast<std::size_t>(e)])]; l >= 0)
+          jb(k, l) = values[static_cast<std::size_t>(value_of[static_cast<std::size_t>(e)])];
       rb[k] = phi[r];
-      within = within && std::fabs(phi[r]) <= tolerance * scales.row_scale[r] + ToleranceScales::kUlpFloor * floor;
+      // the tolerance test of every solve: tol · scale, and above it the row's rounding floor (residual_within)
+      const double allowed = tolerance * scales.row_scale[r];
+      within = within && (std::fabs(phi[r]) <= allowed ||
+                          std::fabs(phi[r]) <= allowed + model.row_rounding_floor(r, q.data(), t));
     }
     return within;
   };

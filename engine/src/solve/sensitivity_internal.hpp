@@ -6,9 +6,18 @@
 #include <array>
 #include <vector>
 
+#include "phiq/output_plan.hpp"
 #include "phiq/sensitivity.hpp"
 
 namespace phiq::detail {
+
+// The form a sweep with `plan` solves its sensitivities in, for `outputs` written coordinates
+// (OutputPlan::sensitivity_outputs()): effective_sensitivity_form() at the plan's derivative order. run_sweep reports
+// it, each Sweeper solves in it.
+inline SensitivityForm sweep_sensitivity_form(const OutputPlan& plan, std::size_t outputs) {
+  return effective_sensitivity_form(plan.sensitivity_form, plan.sensitivities.size(), outputs,
+                                    plan.accelerations ? 2 : plan.velocities ? 1 : 0);
+}
 
 // The vectors one row's sensitivities are computed in, kept between rows (no allocation per row).
 struct SensitivityScratch {

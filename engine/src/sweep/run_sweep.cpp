@@ -88,9 +88,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   SweepSummary& sum = summary ? *summary : local;
   sum = SweepSummary{};
   if (!opt.sensitivities.empty())
-    sum.sensitivity_form = effective_sensitivity_form(opt.sensitivity_form, opt.sensitivities.size(),
-                                                      opt.sensitivity_outputs().size(),
-                                                      opt.accelerations ? 2 : opt.velocities ? 1 : 0);
+    sum.sensitivity_form = detail::sweep_sensitivity_form(opt, opt.sensitivity_outputs().size());
   const auto start = std::chrono::steady_clock::now();
   const WorkCounters before = ws.counters;
   WorkCounters others;  // work done in the seeding and chunk workspaces

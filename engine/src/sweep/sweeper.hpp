@@ -373,9 +373,7 @@ class Sweeper {
   SensitivityScratch sensitivity_scratch_;
   // The coordinates whose columns are written, and the form the sensitivities are solved in (effective_sensitivity_form)
   std::vector<Index> sensitivity_outputs_ = opt_.sensitivities.empty() ? std::vector<Index>{} : opt_.sensitivity_outputs();
-  SensitivityForm sensitivity_form_ = effective_sensitivity_form(
-      opt_.sensitivity_form, opt_.sensitivities.size(), sensitivity_outputs_.size(),
-      opt_.accelerations ? 2 : opt_.velocities ? 1 : 0);
+  SensitivityForm sensitivity_form_ = sweep_sensitivity_form(opt_, sensitivity_outputs_.size());
   // Factors at the row where the workspace's are elsewhere; shared by a copy (a Stepper's way back), which never
   // solves at the same time.
   std::shared_ptr<Workspace> sensitivity_ws_;
