@@ -164,6 +164,65 @@ TEST(LinearSolver, KluChecksALowPivotRatioWithAPivotSearchBeforeReportingIt) {
   EXPECT_LT(n->rcond(), 1e-6);
 }
 
+// A pinned pivot order (what each workspace of a parallel sweep holds, pinned at row 0):
+// restore_pinned_pivot_order() returns to it, even after a search replaced it, so that the factors of a matrix depend on
+// that matrix and the pinned order only, bit for bit, whatever was factorised in between. A pin needs factors.
+TEST(LinearSolver, KluReturnsToAPinnedPivotOrderWhateverWasFactorisedSince) {
+  Sys s = random_system(300, 7);
+  auto sym = analyse(LinearSolverKind::kKlu, s.p);
+  auto scaled = [&](double k) {
+    std::vector<double> v = s.values;
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] *= 1.0 + k * std::sin(static_cast<double>(i));
+    return v;
+  };
+  const std::vector<double> at_pin = scaled(0.0), target = scaled(0.05), other = scaled(0.02);
+  Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(300, 1, 2), fresh_x(300), x(300);
+  // reference: pinned, then straight to the target
+  auto fresh = sym->make_numeric();
+  EXPECT_FALSE(fresh->pin_pivot_order());  // nothing factorised: nothing to pin
+  ASSERT_EQ(fresh->factorize(at_pin.data()), FactorStatus::kOk);
+  ASSERT_TRUE(fresh->pin_pivot_order());
+  ASSERT_TRUE(fresh->restore_pinned_pivot_order());
+  ASSERT_EQ(fresh->factorize(target.data()), FactorStatus::kOk);
+  ASSERT_TRUE(fresh->solve(rhs.data(), fresh_x.data()));
+  EXPECT_EQ(fresh->pivoting_factorizations(), 1);  // the target refactorised with the pinned order
+
+  // pinned, then refactorised elsewhere, then a pivot search on a matrix whose diagonal (the pinned pivots) is
+  // nearly gone, then back: the target's factors are the reference's, to the bit
+  auto used = sym->make_numeric();
+  ASSERT_EQ(used->factorize(at_pin.data()), FactorStatus::kOk);
+  ASSERT_TRUE(used->pin_pivot_order());
+  ASSERT_EQ(used->factorize(other.data()), FactorStatus::kOk);
+  std::vector<double> no_diagonal = at_pin;
+  for (Index c = 0; c < 300; ++c)
+    for (Index k = s.p->col_ptr[c]; k < s.p->col_ptr[c + 1]; ++k)
+      if (s.p->row_idx[static_cast<std::size_t>(k)] == c) no_diagonal[static_cast<std::size_t>(k)] *= 1e-12;
+  ASSERT_EQ(used->factorize(no_diagonal.data()), FactorStatus::kOk);
+  ASSERT_EQ(used->pivoting_factorizations(), 2);  // the pinned order degraded there: searched again
+  const std::int64_t before = used->pivoting_factorizations();
+  ASSERT_TRUE(used->restore_pinned_pivot_order());
+  ASSERT_EQ(used->factorize(target.data()), FactorStatus::kOk);
+  EXPECT_EQ(used->pivoting_factorizations(), before);
+  ASSERT_TRUE(used->solve(rhs.data(), x.data()));
+  for (Index i = 0; i < 300; ++i) ASSERT_EQ(x(i), fresh_x(i)) << "entry " << i;
+  EXPECT_EQ(used->rcond(), fresh->rcond());
+  EXPECT_EQ(used->determinant_sign(), fresh->determinant_sign());
+  EXPECT_EQ(used->block_signs(), fresh->block_signs());
+  // forget_pivot_order() still searches (pinned or not); unpinned, there is nothing to restore
+  used->forget_pivot_order();
+  ASSERT_EQ(used->factorize(target.data()), FactorStatus::kOk);
+  EXPECT_EQ(used->pivoting_factorizations(), before + 1);
+  ASSERT_TRUE(used->restore_pinned_pivot_order());
+  ASSERT_EQ(used->factorize(target.data()), FactorStatus::kOk);
+  EXPECT_EQ(used->pivoting_factorizations(), before + 1);
+  used->unpin_pivot_order();
+  EXPECT_FALSE(used->restore_pinned_pivot_order());
+  // libraries that always pivot pin nothing
+  auto umfpack = analyse(LinearSolverKind::kUmfpack, s.p)->make_numeric();
+  ASSERT_EQ(umfpack->factorize(at_pin.data()), FactorStatus::kOk);
+  EXPECT_FALSE(umfpack->pin_pivot_order());
+}
+
 // KLU factorises a block triangular form block by block; block_signs() tells the signs of the blocks'
 // determinants apart where det A's sign cannot: two blocks turning negative at once leave det A's sign as it was.
 // Three 2 × 2 blocks [[a, 1], [1, d]] coupled above the diagonal, rows and columns scrambled. The fingerprint must

@@ -63,6 +63,17 @@ class SparseLuNumeric {
   /// earlier factorisation (KLU): its factors then depend on the matrix alone, not on which matrices this object
   /// factorised before (Workspace::start_afresh). No-op for libraries that always pivot.
   virtual void forget_pivot_order() {}
+  /// Keeps the pivot order of the last factorisation (true), for restore_pinned_pivot_order(). Returns false,
+  /// pinning nothing, when the last factorisation failed, and for libraries that always pivot. The pinned factors
+  /// are kept (memory_bytes() counts them) until unpin_pivot_order() or destruction.
+  virtual bool pin_pivot_order() { return false; }
+  /// The next factorize() refactorises with the pinned pivot order (and searches only where it has degraded, as
+  /// always), whatever was factorised since it was pinned: its factors then depend on the matrix and the pinned
+  /// order alone (a parallel sweep's chunks: the same bits on any thread, without a pivot search per chunk).
+  /// Returns false, changing nothing, when no order is pinned.
+  virtual bool restore_pinned_pivot_order() { return false; }
+  /// Forgets a pinned pivot order; the current factors stay usable.
+  virtual void unpin_pivot_order() {}
   /// Factorisations so far that searched for pivots (for KLU: not a refactorisation with the old pivot order).
   /// Equal to the number of factorize() calls for libraries that always pivot.
   virtual std::int64_t pivoting_factorizations() const = 0;

@@ -243,7 +243,8 @@ class KluNumeric final : public SparseLuNumeric {
     Api::defaults(&common_);
   }
   ~KluNumeric() override {
-    if (numeric_) Api::free_numeric(&numeric_, &common_);
+    if (numeric_ && numeric_ != pinned_.numeric) Api::free_numeric(&numeric_, &common_);
+    if (pinned_.numeric) Api::free_numeric(&pinned_.numeric, &common_);
   }
   FactorStatus factorize(const double* values) override;
   bool solve(const double* b, double* x) override { return solve_system(false, b, x); }
@@ -254,6 +255,9 @@ class KluNumeric final : public SparseLuNumeric {
   std::string last_message() const override { return message_; }
   std::int64_t pivoting_factorizations() const override { return pivoting_; }
   void forget_pivot_order() override { forget_pivots_ = true; }
+  bool pin_pivot_order() override;
+  bool restore_pinned_pivot_order() override;
+  void unpin_pivot_order() override;
   std::size_t memory_bytes() const override { return numeric_ ? common_.mempeak : 0; }  // factorising included
 
   // A refactorisation keeps the pivot order of the last pivoting factorisation; when its reciprocal pivot ratio
@@ -272,6 +276,7 @@ class KluNumeric final : public SparseLuNumeric {
  private:
   FactorStatus factor_with_pivoting(const double* values);
   double scan_diagonal();  // KLU's rcond of the factors (of the row-scaled matrix), and u_sign_
+  void keep_row_scale();   // inverse_row_scale_ from KLU's Rs, once after a pivot search
   bool solve_system(bool transposed, const double* b, double* x);
   std::shared_ptr<const KluSymbolic<Int>> keep_;
   const KluSymbolic<Int>& sym_;
@@ -292,6 +297,16 @@ class KluNumeric final : public SparseLuNumeric {
   // largest |entry| of each row); empty while the factors are of the scaled matrix (right after pivoting), used
   // by scan_diagonal() once refactorisations work on the unscaled one.
   std::vector<double> inverse_row_scale_;
+  // A pinned pivot order (pin_pivot_order()): its factors object, refactorised in place while it is the current
+  // one (numeric_), kept aside while a pivot search has replaced it, and what describes its order.
+  struct Pinned {
+    typename Api::Numeric* numeric = nullptr;
+    double rcond_at_pivoting = 0.0;
+    int p_sign = 1;
+    std::vector<unsigned char> block_parity;
+    unsigned negative_parity_offset = 0;
+    std::vector<double> inverse_row_scale;
+  } pinned_;
 };
 
 // The interface of both widths' analyses that describe_klu reads.
@@ -440,8 +455,51 @@ double KluNumeric<Int>::scan_diagonal() {
 }
 
 template <class Int>
+void KluNumeric<Int>::keep_row_scale() {
+  if (!inverse_row_scale_.empty() || !numeric_ || !numeric_->Rs) return;
+  const double* rs = static_cast<const double*>(numeric_->Rs);  // (> 0: an empty row has scale 1)
+  inverse_row_scale_.resize(static_cast<std::size_t>(sym_.pattern_->cols));
+  for (std::size_t i = 0; i < inverse_row_scale_.size(); ++i) inverse_row_scale_[i] = 1.0 / rs[i];
+}
+
+template <class Int>
+bool KluNumeric<Int>::pin_pivot_order() {
+  unpin_pivot_order();
+  if (!numeric_) return false;
+  keep_row_scale();
+  if (inverse_row_scale_.empty()) return false;
+  pinned_ = {numeric_, rcond_at_pivoting_, p_sign_, block_parity_, negative_parity_offset_, inverse_row_scale_};
+  return true;
+}
+
+template <class Int>
+void KluNumeric<Int>::unpin_pivot_order() {
+  if (pinned_.numeric && pinned_.numeric != numeric_) Api::free_numeric(&pinned_.numeric, &common_);
+  pinned_ = Pinned{};
+}
+
+// Back to the pinned order's factors object and what describes its order, so that the next factorize()
+// refactorises with it exactly as it would right after pinning (its values are overwritten; only the order and the
+// reference ratio matter).
+template <class Int>
+bool KluNumeric<Int>::restore_pinned_pivot_order() {
+  if (!pinned_.numeric) return false;
+  if (numeric_ && numeric_ != pinned_.numeric) Api::free_numeric(&numeric_, &common_);
+  numeric_ = pinned_.numeric;
+  forget_pivots_ = false;
+  rcond_at_pivoting_ = pinned_.rcond_at_pivoting;
+  p_sign_ = pinned_.p_sign;
+  block_parity_ = pinned_.block_parity;
+  negative_parity_offset_ = pinned_.negative_parity_offset;
+  inverse_row_scale_ = pinned_.inverse_row_scale;
+  return true;
+}
+
+template <class Int>
 FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
-  if (numeric_) Api::free_numeric(&numeric_, &common_);
+  // (the pinned factors are kept for restore_pinned_pivot_order(); a search builds a new object beside them)
+  if (numeric_ && numeric_ != pinned_.numeric) Api::free_numeric(&numeric_, &common_);
+  numeric_ = nullptr;
   forget_pivots_ = false;
   ++pivoting_;
   inverse_row_scale_.clear();
@@ -481,11 +539,7 @@ FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
 template <class Int>
 FactorStatus KluNumeric<Int>::factorize(const double* values) {
   if (numeric_ && !forget_pivots_) {
-    if (inverse_row_scale_.empty() && numeric_->Rs) {  // first refactorisation after a pivot search: keep KLU's
-      const double* rs = static_cast<const double*>(numeric_->Rs);  // scales (> 0: an empty row has scale 1)
-      inverse_row_scale_.resize(static_cast<std::size_t>(sym_.pattern_->cols));
-      for (std::size_t i = 0; i < inverse_row_scale_.size(); ++i) inverse_row_scale_[i] = 1.0 / rs[i];
-    }
+    keep_row_scale();  // first refactorisation after a pivot search: keep KLU's scales
     common_.scale = -1;  // KLU frees its Rs: the factors and the solves are of the unscaled matrix
     const bool ok = !inverse_row_scale_.empty() &&
                     Api::refactor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, numeric_, &common_) &&

@@ -106,6 +106,24 @@ SolveStatus detail::factorize_at_q(const Model& model, double t, Workspace& ws, 
   return SolveStatus::kSuccess;
 }
 
+bool detail::pin_pivot_order_at(const Model& model, Workspace& ws, const Eigen::VectorXd& q, double t) {
+  check_workspace(model, ws);
+  if (!ws.lu) return false;
+  const WorkCounters kept = ws.counters;
+  Eigen::VectorXd held = q;
+  ws.q.swap(held);
+  ws.lu->unpin_pivot_order();
+  ws.start_afresh();
+  double rcond = 0.0;
+  std::string message;
+  const bool pinned = factorize_at_q(model, t, ws, &rcond, &message, false) == SolveStatus::kSuccess &&
+                      ws.lu->memory_bytes() <= kMaxPinnedBytes && ws.lu->pin_pivot_order();
+  ws.q.swap(held);
+  ws.counters = kept;
+  ws.start_afresh();
+  return pinned;
+}
+
 SolveStatus detail::ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond,
                                       std::string* message, bool values_at_q) {
   if (!ws.lu) {

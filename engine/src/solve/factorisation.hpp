@@ -7,6 +7,7 @@
 
 #include "phiq/kinematics.hpp"
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,15 @@ SolveStatus factorize_at_q(const Model& model, double t, Workspace& ws, double* 
 // knows ws.jacobian_values hold Φq at (ws.q, t) already (the Newton loop's fused evaluation).
 SolveStatus ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
                               bool values_at_q = false);
+
+// Pins ws.lu's pivot order (SparseLuNumeric::pin_pivot_order) at Φq(q, t): a pivot search there, whatever ws
+// factorised before, so that workspaces pinned at the same (q, t) refactorise alike from then on. Set-up, not
+// counted (ws.counters are kept); ws.q is kept and ws starts afresh (start_afresh() then returns to the pinned
+// order). Pins nothing, returning false, where Φq(q, t) is singular, for a library that always pivots, and for
+// factors over kMaxPinnedBytes (the pinned factors are kept beside those of a later pivot search: at most twice
+// the factors' memory, which a large model's threads are fitted to).
+inline constexpr std::size_t kMaxPinnedBytes = std::size_t{256} << 20;
+bool pin_pivot_order_at(const Model& model, Workspace& ws, const Eigen::VectorXd& q, double t);
 
 // The right-hand side the LU solves with: `b` (one entry per equation) itself, or its kept rows for a model with
 // dropped rows.

@@ -62,7 +62,7 @@ void Workspace::start_afresh() {
   factorized_solves_to = std::numeric_limits<double>::quiet_NaN();
   has_jacobian = false;
   newton_contraction = -1.0;
-  if (lu) lu->forget_pivot_order();
+  if (lu && !lu->restore_pinned_pivot_order()) lu->forget_pivot_order();  // (a parallel sweep's pinned order)
 }
 
 namespace {

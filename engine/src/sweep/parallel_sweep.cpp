@@ -20,6 +20,7 @@
 #include <tbb/task_arena.h>
 
 #include "phiq/text.hpp"
+#include "solve/factorisation.hpp"
 #include "sweep/streamed_rows.hpp"
 
 namespace phiq::detail {
@@ -119,19 +120,41 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   // evaluation (large models) may start other work meanwhile, which then needs a workspace of its own. The work
   // done in each is counted with the chunk or seed that did it; the caller's workspace's share is taken out of its
   // own count at the end (ws_in_parallel).
+  //
+  // A chunk or a seed computes the same bits whichever workspace it gets: nothing its last user left (a
+  // factorisation, a measured contraction) is carried into it, and every workspace refactorises with one pivot
+  // order, that of Φq at row 0, pinned in each the first time it is taken (pin_pivot_order_at). A pivot search per
+  // chunk and per seed instead cost 7–17 % of a 2-thread sweep of nfourbar N = 10³ (bench/README.md, "What the
+  // same bits on every thread count cost"). Where nothing can be pinned (Φq singular at row 0, factors over
+  // kMaxPinnedBytes) each searches afresh — in every workspace alike, since that depends on row 0 alone.
   std::vector<std::unique_ptr<Workspace>> owned;
   std::vector<Workspace*> pool{&ws};
+  std::vector<const Workspace*> pinned;  // workspaces that had their order pinned (or tried to)
   std::mutex pool_mutex;
-  auto acquire = [&] {
-    std::lock_guard<std::mutex> lock(pool_mutex);
-    if (pool.empty()) {
-      owned.push_back(std::make_unique<Workspace>(model));
-      return owned.back().get();
+  const Eigen::VectorXd pin_q = sw.state().q;
+  const double pin_t = run.time_of(0);
+  struct Unpin {  // the caller's workspace does not keep the sweep's pinned order (its next calls start afresh)
+    Workspace& w;
+    ~Unpin() {
+      if (w.lu) w.lu->unpin_pivot_order();
     }
-    Workspace* w = pool.back();
-    pool.pop_back();
-    // A chunk or a seed computes the same bits whichever workspace it gets: nothing its last user left (a
-    // factorisation, its pivot order, a measured contraction) is carried into it.
+  } unpin{ws};
+  auto acquire = [&] {
+    Workspace* w = nullptr;
+    bool pin = false;
+    {
+      std::lock_guard<std::mutex> lock(pool_mutex);
+      if (pool.empty()) {
+        owned.push_back(std::make_unique<Workspace>(model));
+        w = owned.back().get();
+      } else {
+        w = pool.back();
+        pool.pop_back();
+      }
+      pin = std::find(pinned.begin(), pinned.end(), w) == pinned.end();
+      if (pin) pinned.push_back(w);
+    }
+    if (pin) pin_pivot_order_at(model, *w, pin_q, pin_t);  // (a factorisation: outside the lock)
     w->start_afresh();
     return w;
   };

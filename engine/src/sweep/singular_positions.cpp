@@ -15,14 +15,17 @@ namespace phiq::detail {
 
 namespace {
 constexpr int kSides = 6;              // the regular points a singular row's derivatives are extrapolated from
-constexpr double kSideOffset = 0.45;    // δ, as a fraction of the step: the sides are t ± δ, ± 2δ, ± 3δ
+constexpr double kSideOffset = 0.6;     // δ, as a fraction of the step: the sides are t ± δ, ± 2δ, ± 3δ
 // δ where the sweep starts at the singular position and its first side is reached by the least-squares assembly from
 // the singular position itself (a single loop: no block-triangular form to solve it by), with nothing of the motion
 // to predict from: kept as close as before the sides moved out, and the start's derivatives are known the less well
-// for it. A start reached block by block (assemble_by_blocks) takes kSideOffset: nfourbar N = 10⁴ started flat at
-// rate 3π/4, steps of 0.01: q̈ at the start within 7e-9 relative of the exact with it, 0.39 with 0.05 (the chain
-// adds up the sides' rounding, divided by Φq's smallest singular value, O(δ), twice).
+// for it. A start reached block by block (assemble_by_blocks) takes kBlockStartSideOffset: nfourbar N = 10⁴
+// started flat at rate 3π/4, steps of 0.01: q̈ at the start within 7e-9 relative of the exact with 0.45, 0.39 with
+// 0.05 (the chain adds up the sides' rounding, divided by Φq's smallest singular value, O(δ), twice).
 constexpr double kStartSideOffset = 0.05;
+// δ at a start reached block by block. Not kSideOffset: from a flat start the sides' errors add up along the chain
+// (above), and nfourbar N = 10⁴ had q̈ at its start 1.2e-7 off with 0.6, 7e-9 with 0.45.
+constexpr double kBlockStartSideOffset = 0.45;
 }  // namespace
 
 // Why Φq stays singular on both sides of the singular position qs at t: the model is short of drivers or
@@ -51,9 +54,14 @@ std::string Sweeper::singular_throughout(const Eigen::VectorXd& qs, double t) {
 // that limit by O(δ⁶), with a warning. The sides' own errors ε (their positions are solved to rounding level) grow
 // to ε/δ in q̇ and ε/δ² in q̈ (Φq's smallest singular value is O(δ) there), so δ is not small: nfourbar N = 100
 // through its flat positions (1440 steps over two turns), relative to the exact q̈: 2e-6 with four sides at 5 % of
-// the step, 1e-8 at 30 %; six sides at 45 %: 5e-9, and q̇ 1e-11. The warning states how far the O(δ⁴)
-// extrapolation from the inner four sides differs from the reported one: the truncation left, at most. The plus side is reached straight through from the minus side, so the sweep keeps
-// its branch. When there is no
+// the step, 1e-8 at 30 %. Six sides, on its four flat rows of 1712 steps: 2.0–2.4e-8 at 30 %, 0.6–1.2e-8 at 45 %,
+// 1.1–2.7e-9 at 60 %, 0.5–1.2e-9 at 80 % (q̇ 2–7e-12 from 60 %); the estimate of the truncation below grows from
+// 9e-10 at 45 % to 2–3e-10 and 2e-10 on that fine grid, and on the change-point four-bar's one-degree steps
+// (models/hard/change_point_exact.yaml) from 6e-10 to 2e-9 at 60 %, where ψ2's q̈ (exactly 0) went from
+// −6.5e-9 to −3.6e-9. 60 % keeps the sides within 1.8 steps. The truncation grows as the step's sixth power, so a
+// coarse grid's singular rows are known less well, and their warning says how well. The warning states how far the
+// O(δ⁴) extrapolation from the inner four sides differs from the reported one: the truncation left, at most. The
+// plus side is reached straight through from the minus side, so the sweep keeps its branch. When there is no
 // position beyond (a dead point: the drive cannot go on) or the sides are singular too (the model is singular
 // on an interval: redundant or missing constraints), the step fails with that diagnosis.
 // `have_position`: false when Newton could not converge at t itself (a zero pivot exactly at the singular
@@ -85,11 +93,11 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
   if (!has_current_) {
     ws_->q = qs;
     detail::BlockAssemblySummary bs;
-    by_blocks = detail::assemble_by_blocks(model_, t - 3 * kSideOffset * step, tight.tolerance, tight.max_iterations,
-                                           ws_->q, &bs) == SolveStatus::kSuccess;
+    by_blocks = detail::assemble_by_blocks(model_, t - 3 * kBlockStartSideOffset * step, tight.tolerance,
+                                           tight.max_iterations, ws_->q, &bs) == SolveStatus::kSuccess;
     if (!by_blocks) ws_->q = qs;
   }
-  const double d = (has_current_ || by_blocks ? kSideOffset : kStartSideOffset) * step;
+  const double d = (has_current_ ? kSideOffset : by_blocks ? kBlockStartSideOffset : kStartSideOffset) * step;
   // Six regular points t ± δ, t ± 2δ, t ± 3δ, each predicted from the one before (the first from the last state of
   // the sweep), so the plus side is reached straight through the singular point.
   const double offset[kSides] = {-3 * d, -2 * d, -d, d, 2 * d, 3 * d};
