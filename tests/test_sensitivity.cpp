@@ -149,21 +149,37 @@ TEST(Sensitivity, CrankSliderAgainstTheClosedFormAndItsTimeDerivatives) {
   EXPECT_EQ(p.summary.counters.sensitivity_solves, 0);
 }
 
-// The models along `parameter` of the scene `text`, built through the C++ API (SceneOverrides), as the scene's
-// `output.sensitivities` builds them.
-OutputSensitivity along(const std::string& text, const Scene& scene, const std::string& parameter, double value) {
-  OutputSensitivity s;
-  s.name = parameter, s.value = value, s.step = default_sensitivity_step(value);
-  const double shifts[4] = {-2, -1, 1, 2};
-  for (int k = 0; k < 4; ++k) {
-    SceneOverrides o;
-    o.parameters = {{parameter, value + shifts[k] * s.step}};
-    o.share_analysis_with = scene.model.get();
-    o.sensitivity_models = false;
-    s.models[static_cast<std::size_t>(k)] = std::shared_ptr<const Model>(parse_scene(text, "scene.yaml", {}, o).model);
-  }
+// The models along `parameter` at `value` of `scene` (read with `read_with`), built through the C++ API as the
+// scene's `output.sensitivities` builds them.
+OutputSensitivity along(const Scene& scene, const std::string& parameter, double value,
+                        SceneOverrides read_with = {}) {
+  read_with.sensitivity_models = false;
+  const OutputSensitivity s = sensitivity_along(scene, parameter, value, 0.0, {}, read_with);
+  EXPECT_EQ(s.step, default_sensitivity_step(value));
   EXPECT_EQ(check_sensitivity_models(*scene.model, s), "");
   return s;
+}
+
+// sensitivity_along() is what the scene's own `output.sensitivities` builds: the same models (the sweeps agree to
+// the bit), and one line naming the value where the moved scene cannot be read.
+TEST(Sensitivity, AlongAParameterAsTheScenesOwnOutput) {
+  const Scene own = parse_scene(kCrankSlider, "c.yaml");
+  ASSERT_EQ(own.sweep.sensitivities.size(), 2u);
+  Scene api = parse_scene(kCrankSlider, "c.yaml");
+  api.sweep.sensitivities = {sensitivity_along(api, "L2", 0.3), sensitivity_along(api, "L3", 1.0, 1e-3)};
+  EXPECT_EQ(api.sweep.sensitivities[1].step, 1e-3);
+  const SensitivityTrace a = sweep_sensitivities(*own.model, own.sweep), b = sweep_sensitivities(*api.model, api.sweep);
+  ASSERT_EQ(a.s.size(), 91u);
+  ASSERT_EQ(b.s.size(), a.s.size());
+  for (std::size_t k = 0; k < a.s.size(); ++k) ASSERT_TRUE(a.s[k] == b.s[k]) << "row " << k;
+  try {
+    (void)sensitivity_along(api, "L3", 1.0, 0.6);
+    FAIL() << "L3 = -0.2 was read";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), "with L3 = -0.19999999999999996 (the difference step 0.6 from 1) the scene "
+                                     "cannot be read: c.yaml:8:57: constraints[1].length: must be positive, got L3 "
+                                     "= -0.19999999999999996");
+  }
 }
 
 // The scene at parameter = value swept as `phiq run` sweeps it (prepare_scene: redundant rows left out).
@@ -173,7 +189,7 @@ SensitivityTrace sweep_at(const std::string& text, const std::string& parameter,
   o.parameters = {{parameter, value}};
   Scene s = parse_scene(text, "scene.yaml", {}, o);
   s.sweep.newton.tolerance = tolerance;
-  if (!with_sensitivity.empty()) s.sweep.sensitivities = {along(text, s, with_sensitivity, value)};
+  if (!with_sensitivity.empty()) s.sweep.sensitivities = {along(s, with_sensitivity, value, o)};
   SquareScene sq;
   EXPECT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &sq), SolveStatus::kSuccess);
   SensitivityTrace r;
@@ -264,7 +280,7 @@ TEST(Sensitivity, RowsOnASingularPositionAreNaNTheOthersFinite) {
 TEST(Sensitivity, SameBitsOnEveryThreadCount) {
   const std::string text = test::slurp(model_path("seed/fourbar_natural.yaml"));
   Scene s = parse_scene(text, "f.yaml");
-  s.sweep.sensitivities = {along(text, s, "L2", 0.4), along(text, s, "L4", 1.0)};
+  s.sweep.sensitivities = {along(s, "L2", 0.4), along(s, "L4", 1.0)};
   std::vector<std::vector<double>> first;
   for (int threads : {1, 2, 3}) {
     SweepOptions o = s.sweep;
@@ -373,7 +389,7 @@ void expect_adjoint_equals_direct(const std::string& rel, const std::vector<std:
   const std::string text = test::slurp(model_path(rel));
   Scene s = parse_scene(text, "scene.yaml");
   s.sweep.sensitivities.clear();
-  for (const auto& [name, value] : params) s.sweep.sensitivities.push_back(along(text, s, name, value));
+  for (const auto& [name, value] : params) s.sweep.sensitivities.push_back(along(s, name, value));
   SquareScene sq;
   ASSERT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &sq), SolveStatus::kSuccess);
   const Model& model = sq.model(*s.model);

@@ -86,6 +86,15 @@ struct SceneOverrides {
   bool sensitivity_models = true;
 };
 
+/// The sensitivity along the scene parameter `name` at `value`: its models at value − 2h, − h, + h, + 2h
+/// (OutputSensitivity::models), the scene's text read again with the parameter moved (and `overrides`' others),
+/// sharing scene.model's symbolic analysis; h = `step`, or default_sensitivity_step(value) for step ≤ 0. What a
+/// scene's `output.sensitivities` (parse_scene()) and `phiq tolerance` build. `scene` must have been read with
+/// `overrides` (its model is the nominal one). Throws SceneError "with NAME = V (the difference step H from P)
+/// the scene cannot be read: WHY", or check_sensitivity_models()' line when a moved model has another structure.
+OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name, double value, double step = 0.0,
+                                    const SceneLimits& limits = {}, const SceneOverrides& overrides = {});
+
 /// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,
 /// unknown or duplicate fields and names, wrong types, NaN or infinite numbers and impossible values.
 Scene load_scene(const std::string& path, const SceneLimits& limits = {});

@@ -37,7 +37,7 @@ namespace phiq {
 /// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the
 /// model built at p − 2h, p − h, p + h, p + 2h (in that order), each with the same coordinates, rows and Φq pattern
 /// as the model swept (check_sensitivity_models()). A scene's `output: {sensitivities: [...]}` builds them
-/// (models/README.md); the C++ API builds them with the scene's overrides (SceneOverrides) or by hand.
+/// (models/README.md); the C++ API with sensitivity_along() (scene.hpp), or by hand.
 struct OutputSensitivity {
   std::string name;  ///< the parameter's name, the columns' suffix (`x.d_NAME`)
   double value = 0.0;  ///< p

@@ -98,34 +98,16 @@ void refuse_non_utf8_encoding(const std::string& text, const std::string& path) 
                    ": the scene is not text (a NUL byte)");
 }
 
-// The models along each parameter of the scene's `output.sensitivities` (OutputSensitivity::models): the same text
-// read with the parameter moved (and the caller's other overrides), sharing the scene model's symbolic analysis.
-// A parameter that changes the model's structure, or makes the scene unreadable, is refused naming it.
-void build_sensitivity_models(Scene& scene, const std::string& text, const std::string& path,
-                              const SceneLimits& limits, const SceneOverrides& overrides) {
+// The models along each parameter of the scene's `output.sensitivities` (sensitivity_along()), refused naming the
+// scene's entry.
+void build_sensitivity_models(Scene& scene, const SceneLimits& limits, const SceneOverrides& overrides) {
   if (!overrides.sensitivity_models) return;
   for (OutputSensitivity& s : scene.sweep.sensitivities) {
-    const double shifts[4] = {-2.0, -1.0, 1.0, 2.0};
-    for (std::size_t k = 0; k < 4; ++k) {
-      SceneOverrides moved = overrides;
-      moved.sensitivity_models = false;
-      moved.share_analysis_with = scene.model.get();
-      moved.parameters_source.clear();
-      const double value = s.value + shifts[k] * s.step;
-      bool replaced = false;
-      for (auto& [name, v] : moved.parameters)
-        if (name == s.name) v = value, replaced = true;
-      if (!replaced) moved.parameters.emplace_back(s.name, value);
-      try {
-        s.models[k] = std::shared_ptr<const Model>(std::move(parse_scene(text, path, limits, moved).model));
-      } catch (const SceneError& e) {
-        throw SceneError(path + ": output.sensitivities: with " + s.name + " = " + shortest(value) +
-                         " (the difference step " + shortest(s.step) + " from " + shortest(s.value) +
-                         ") the scene cannot be read: " + e.what());
-      }
+    try {
+      s = sensitivity_along(scene, s.name, s.value, s.step, limits, overrides);
+    } catch (const SceneError& e) {
+      throw SceneError(scene.path + ": output.sensitivities: " + e.what());
     }
-    if (const std::string why = check_sensitivity_models(*scene.model, s); !why.empty())
-      throw SceneError(path + ": output.sensitivities: " + why);
   }
 }
 
@@ -166,7 +148,7 @@ Scene read_tree(const YAML::Node& root, const std::string& text, const std::stri
       throw SceneError(path + ": solver.predictor: '" + to_string(p) +
                        "' needs the derivatives it extrapolates with in the output (velocities / accelerations)");
   }
-  build_sensitivity_models(scene, text, path, limits, overrides);
+  build_sensitivity_models(scene, limits, overrides);
   return scene;
 }
 
@@ -205,6 +187,32 @@ const std::string& ParsedScene::path() const { return tree_->path; }
 
 Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits) {
   return parse_scene(text, path, limits, SceneOverrides{});
+}
+
+OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name, double value, double step,
+                                    const SceneLimits& limits, const SceneOverrides& overrides) {
+  OutputSensitivity s;
+  s.name = name, s.value = value, s.step = step > 0.0 ? step : default_sensitivity_step(value);
+  const double shifts[4] = {-2.0, -1.0, 1.0, 2.0};
+  for (std::size_t k = 0; k < 4; ++k) {
+    SceneOverrides moved = overrides;
+    moved.sensitivity_models = false;
+    moved.share_analysis_with = scene.model.get();
+    moved.parameters_source.clear();
+    const double at = value + shifts[k] * s.step;
+    bool replaced = false;
+    for (auto& [n, v] : moved.parameters)
+      if (n == name) v = at, replaced = true;
+    if (!replaced) moved.parameters.emplace_back(name, at);
+    try {
+      s.models[k] = std::shared_ptr<const Model>(std::move(parse_scene(scene.text, scene.path, limits, moved).model));
+    } catch (const SceneError& e) {
+      throw SceneError("with " + name + " = " + shortest(at) + " (the difference step " + shortest(s.step) +
+                       " from " + shortest(value) + ") the scene cannot be read: " + e.what());
+    }
+  }
+  if (const std::string why = check_sensitivity_models(*scene.model, s); !why.empty()) throw SceneError(why);
+  return s;
 }
 
 Scene load_scene(const std::string& path, const SceneLimits& limits) {
