@@ -1,6 +1,7 @@
 """`phiq run -o OUT.h5` read with h5py: every dataset holds the doubles of the CSV of the same run, bit for bit,
 in the layout tools/README.md documents (format version 1). Run by ctest (tests/CMakeLists.txt) with PHIQ_CLI and
 PHIQ_MODELS_DIR set; skipped there (exit 77) when h5py, numpy or pytest is missing."""
+import json
 import os
 import subprocess
 
@@ -81,3 +82,42 @@ def test_every_output_kind_and_its_units(tmp_path, tmp_path_factory):
         assert f["q"].chunks is not None and f["q"].maxshape == (None, 8)  # extendible, chunked
         # the driver's law, exactly: theta2 = t
         assert np.array_equal(f["drivers"][:, 0], f["t"][()])
+
+
+def test_identifier_names_are_the_files_column_names_too(tmp_path, tmp_path_factory):
+    """`--names identifiers` names each dataset's columns as the CSV of the same option, and `phiq compare` of the
+    two agrees column by column (none only in one file)."""
+    scene = scenes(tmp_path_factory)[0]
+    csv, h5 = tmp_path / "i.csv", tmp_path / "i.h5"
+    for out in (csv, h5):
+        subprocess.run([PHIQ, "run", "-q", "--threads", "1", "--names", "identifiers", str(scene), "-o", str(out)],
+                       check=True)
+    header, values = read_csv(csv)
+    assert "B__vx" in header and "motor__ddf" in header
+    with h5py.File(h5, "r") as f:
+        names = []
+        for name in [n for n in ORDER if n in f]:
+            names += list(f[name].attrs["columns"])
+        assert list(f["points"].attrs["columns"])[:3] == ["B__x", "B__y", "B__vx"]
+    assert names == header
+    r = subprocess.run([PHIQ, "compare", "--json", str(csv), str(h5)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    report = json.loads(r.stdout)
+    assert report["only_in_a"] == [] and report["only_in_b"] == []
+
+
+def test_a_batch_file_names_its_columns_as_its_csv(tmp_path):
+    """`phiq batch --names identifiers -o OUT.h5`: the same names as the batch's CSV (`case` first)."""
+    scene = os.path.join(MODELS, "seed/crank_slider_mixed.yaml")
+    cases = tmp_path / "cases.csv"
+    cases.write_text("L2\n0.3\n0.31\n")
+    csv, h5 = tmp_path / "b.csv", tmp_path / "b.h5"
+    for out in (csv, h5):
+        subprocess.run([PHIQ, "batch", "-q", "--names", "identifiers", scene, str(cases), "-o", str(out)],
+                       check=True)
+    header, values = read_csv(csv)
+    with h5py.File(h5, "r") as f:
+        names = ["case"] + [c for n in ORDER if n in f for c in f[n].attrs["columns"]]
+        assert list(f["qd"].attrs["columns"]) == ["theta2__v", "xA__v", "yA__v", "xB__v"]
+        assert f["q"].shape[0] == values.shape[0]
+    assert names == header

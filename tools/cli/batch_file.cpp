@@ -262,6 +262,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
         o.expected_rows = static_cast<std::size_t>(phiq::rows_written(reference->sweep)) * n;
         o.shown_path = file->path();
         o.case_column = true;
+        if (a.identifier_names) o.naming = phiq::ColumnNaming::kIdentifiers;
         if (resumed.first > 0) {  // the earlier file, copied to be appended to (its own stays whole meanwhile)
           std::filesystem::copy_file(a.out, file->temporary_path(), std::filesystem::copy_options::overwrite_existing);
           o.append = true;

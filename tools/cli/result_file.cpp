@@ -18,7 +18,7 @@ void check_hdf5_target(const std::string& path) {
 }
 
 std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile& file, const phiq::Scene& scene,
-                                                    int deflate) {
+                                                    int deflate, phiq::ColumnNaming naming) {
   if (file.direct() || file.temporary_path().empty())
     throw phiq::Error(file.path() + ": cannot write: HDF5 needs a named temporary file (phiq bug)");
   phiq::Hdf5Options o;
@@ -28,6 +28,7 @@ std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile
   o.shown_path = file.path();
   o.deflate = deflate;
   o.shuffle = deflate > 0;  // the doubles' exponent bytes together: bench/README.md, "Writing HDF5"
+  o.naming = naming;
   return std::make_unique<phiq::Hdf5Writer>(file.temporary_path(), *scene.model, scene.sweep, o);
 }
 

@@ -26,10 +26,11 @@ void check_hdf5_target(const std::string& path);
 
 // An Hdf5Writer on the named temporary of `file` (added with Hold::kClosedBetweenWrites, not direct), with the
 // scene's path and text as attributes and chunks sized for its steps + 1 rows; `deflate` > 0: shuffle and deflate at
-// that level. Its errors name file.path().
+// that level; columns named as `naming` names the CSV's. Its errors name file.path().
 // Throws phiq::Error "PATH: cannot write: REASON".
 std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile& file, const phiq::Scene& scene,
-                                                    int deflate = 0);
+                                                    int deflate = 0,
+                                                    phiq::ColumnNaming naming = phiq::ColumnNaming::kDotted);
 
 // After rows were appended to `h5` (it held `rows_before` rows): when it has written a block to its file since, that
 // block goes on to the disk while the work runs (AtomicOutputFile::start_writeback(), as write() does for a CSV

@@ -102,7 +102,9 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   }
   std::unique_ptr<phiq::Hdf5Writer> h5;  // after `outputs`: closed before its temporary is removed
   try {
-    if (hdf5) h5 = open_hdf5_results(*file, scene, deflate);
+    if (hdf5)
+      h5 = open_hdf5_results(*file, scene, deflate,
+                             identifier_names ? phiq::ColumnNaming::kIdentifiers : phiq::ColumnNaming::kDotted);
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
   }

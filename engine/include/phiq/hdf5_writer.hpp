@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "phiq/csv_writer.hpp"
 #include "phiq/model.hpp"
 #include "phiq/output_plan.hpp"
 #include "phiq/sweep.hpp"
@@ -28,6 +29,10 @@ struct Hdf5Options {
   /// little and costs more time than the sweep (bench/README.md, "HDF5 results").
   int deflate = 0;
   bool shuffle = false;  ///< byte-shuffle before deflating (only with deflate > 0)
+  /// The names in each dataset's `columns` attribute, as a CSV of this naming has them (`phiq run --names`):
+  /// kIdentifiers so that the names h5py and pandas code reads are those of the CSV it was compared with.
+  /// Throws what CsvFormat::set_naming() throws.
+  ColumnNaming naming = ColumnNaming::kDotted;
   /// Rows the writer will be given (a sweep's steps + 1), or 0 if unknown: chunks are then sized so that the
   /// last one is not mostly empty (an uncompressed chunk takes its whole size on disk).
   std::size_t expected_rows = 0;

@@ -260,6 +260,7 @@ Hdf5Writer::Hdf5Writer(const std::string& path, const Model& model, const Output
     : impl_(std::make_unique<Impl>(options.shown_path.empty() ? path : options.shown_path, model, plan)) {
   const QuietErrors quiet;
   impl_->file_path = path;
+  impl_->format.set_naming(options.naming);
   impl_->create(options);
 }
 
