@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <string>
 
@@ -61,6 +63,21 @@ TEST_F(Plot, SpatialMechanismIsDrawnInIsometricViewWithItsAxesAndMovingColumns) 
   EXPECT_EQ(count(s, "class=\"joint point\""), 10u);
   for (const char* a : {"x", "y", "z"}) EXPECT_EQ(count(s, std::string("class=\"axis3d\" data-axis=\"") + a), 1u);
   EXPECT_NE(s.find("isometric view"), std::string::npos);
+  // the view from (1, 1, 1), right-handed as space is: x towards the lower left, y towards the lower right, z up
+  // (screen coordinates: y down), so that x turns to y counterclockwise seen from the viewer, as about z
+  std::map<std::string, std::array<double, 2>> axis;
+  const std::regex line("data-axis=\"([xyz])\" x1=\"([-0-9.]+)\" y1=\"([-0-9.]+)\" x2=\"([-0-9.]+)\" "
+                        "y2=\"([-0-9.]+)\"");
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), line); it != std::sregex_iterator(); ++it)
+    axis[(*it)[1]] = {std::stod((*it)[4]) - std::stod((*it)[2]), -(std::stod((*it)[5]) - std::stod((*it)[3]))};
+  ASSERT_EQ(axis.size(), 3u);
+  EXPECT_LT(axis["x"][0], 0.0);
+  EXPECT_LT(axis["x"][1], 0.0);
+  EXPECT_GT(axis["y"][0], 0.0);
+  EXPECT_LT(axis["y"][1], 0.0);
+  EXPECT_NEAR(axis["z"][0], 0.0, 0.01);
+  EXPECT_GT(axis["z"][1], 0.0);
+  EXPECT_GT(axis["x"][0] * axis["y"][1] - axis["x"][1] * axis["y"][0], 0.0) << "a mirrored view";
   // no constant column: the default columns are those that change (the Euler parameters that turn)
   const std::vector<std::string> cols = all(s, "data-column=\"([^\"]+)\"");
   EXPECT_EQ(cols, (std::vector<std::string>{"crank_e0", "crank_e3", "rocker_e0", "rocker_e1"}));

@@ -46,8 +46,9 @@ std::string ground_pivot(double x, double y, const std::string& id = "") {
 
 std::pair<double, double> project(const P3& p, bool spatial) {
   if (!spatial) return {p[0], p[1]};
+  // seen from (1, 1, 1): screen right is (y − x)/√2 and up the rest of z; x − y instead mirrors the picture
   const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
-  return {c * (p[0] - p[1]), p[2] - s * (p[0] + p[1])};
+  return {c * (p[1] - p[0]), p[2] - s * (p[0] + p[1])};
 }
 
 MechanismView mechanism_view(const MechanismFrames& m, double x0, double y0, double side) {

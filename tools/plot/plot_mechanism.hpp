@@ -29,8 +29,8 @@ struct MechanismFrames {
 std::string mechanism_panel(const MechanismFrames& m, double x0, double y0, double side);
 
 // What the panel's parts share (and `phiq animate`'s HTML viewer draws its moving mechanism on): screen axes of a
-// point before scaling (x right, y up: the plane as it is, space in the isometric view, z up, x towards the lower
-// right and y towards the lower left).
+// point before scaling (x right, y up: the plane as it is, space in the isometric view from (1, 1, 1), z up, x towards
+// the lower left and y towards the lower right, right-handed as space is).
 std::pair<double, double> project(const std::array<double, 3>& p, bool spatial);
 
 // The panel's pixel box around everything drawn at m's rows and its traces (equal scales, room for the ground
