@@ -258,7 +258,8 @@ class KluNumeric final : public SparseLuNumeric {
   bool pin_pivot_order() override;
   bool restore_pinned_pivot_order() override;
   void unpin_pivot_order() override;
-  std::size_t memory_bytes() const override { return numeric_ ? common_.mempeak : 0; }  // factorising included
+  // the last pivot search's peak, factorising and what was kept aside included (factor_with_pivoting)
+  std::size_t memory_bytes() const override { return numeric_ ? common_.mempeak : 0; }
 
   // A refactorisation keeps the pivot order of the last pivoting factorisation; when its reciprocal pivot ratio
   // falls below this fraction of the one measured right after pivoting, the pivots have degraded (the matrix moved
@@ -504,6 +505,10 @@ FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
   ++pivoting_;
   inverse_row_scale_.clear();
   common_.scale = 2;  // pivots chosen on rows scaled by their largest entries (KLU's default)
+  // memory_bytes() from here: what is live (a pinned order's factors kept aside) and this factorisation's peak, the
+  // same in every workspace that factorises the same matrix (not the peak of whatever it factorised before, which
+  // a parallel sweep's decision to pin must not depend on)
+  common_.mempeak = common_.memusage;
   numeric_ = Api::factor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, &common_);
   if (!numeric_) {
     rcond_ = 0.0;
