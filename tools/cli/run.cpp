@@ -95,16 +95,16 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   // columns from the scene's output plan and model (its constraints); residuals of a model solved on its
   // independent rows are evaluated on the whole scene model (CsvFormat)
   phiq::CsvFormat csv(*scene.model, scene.sweep);
+  const phiq::ColumnNaming naming =  // the CSV's and the HDF5 file's column names alike
+      identifier_names ? phiq::ColumnNaming::kIdentifiers : phiq::ColumnNaming::kDotted;
   try {
-    csv.set_naming(identifier_names ? phiq::ColumnNaming::kIdentifiers : phiq::ColumnNaming::kDotted);
+    csv.set_naming(naming);
   } catch (const phiq::Error& e) {  // names that would collide: the scene's to change
     return fail(scene_path + ": --names identifiers: " + e.what(), 2);
   }
   std::unique_ptr<phiq::Hdf5Writer> h5;  // after `outputs`: closed before its temporary is removed
   try {
-    if (hdf5)
-      h5 = open_hdf5_results(*file, scene, deflate,
-                             identifier_names ? phiq::ColumnNaming::kIdentifiers : phiq::ColumnNaming::kDotted);
+    if (hdf5) h5 = open_hdf5_results(*file, scene, deflate, naming);
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
   }

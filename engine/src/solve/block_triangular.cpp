@@ -13,6 +13,7 @@
 
 #include "phiq/constraint_block.hpp"
 #include "phiq/text.hpp"
+#include "solve/tolerance_tests.hpp"
 
 namespace phiq::detail {
 
@@ -120,10 +121,8 @@ SolveStatus assemble_by_blocks(const Model& model, double t, double tolerance, i
         if (const Index l = local_col[static_cast<std::size_t>(by_rows.row_idx[static_cast<std::size_t>(e)])]; l >= 0)
           jb(k, l) = values[static_cast<std::size_t>(value_of[static_cast<std::size_t>(e)])];
       rb[k] = phi[r];
-      // the tolerance test of every solve: tol · scale, and above it the row's rounding floor (residual_within)
-      const double allowed = tolerance * scales.row_scale[r];
-      within = within && (std::fabs(phi[r]) <= allowed ||
-                          std::fabs(phi[r]) <= allowed + model.row_rounding_floor(r, q.data(), t));
+      // the tolerance test of every solve (tol · scale, and above it the row's rounding floor)
+      within = within && row_within(model, r, std::fabs(phi[r]) / scales.row_scale[r], tolerance, q, t);
     }
     return within;
   };

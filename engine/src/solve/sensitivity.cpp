@@ -21,6 +21,12 @@ namespace {
 constexpr std::array<double, 4> kShift = {-2.0, -1.0, 1.0, 2.0};
 constexpr std::array<double, 4> kWeight = {1.0, -8.0, 8.0, -1.0};
 
+// Φq over values held here, in the model's pattern (every model along a parameter has it: checked).
+JacobianView jacobian_view(const CscPattern& pattern, std::vector<double>& values) {
+  return JacobianView(pattern.rows, pattern.cols, pattern.nnz(), pattern.col_ptr.data(), pattern.row_idx.data(),
+                      values.data());
+}
+
 }  // namespace
 
 double default_sensitivity_step(double p) { return p == 0.0 ? 1e-3 : 1e-3 * std::fabs(p); }
@@ -53,10 +59,7 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   const CscPattern& pattern = model.jacobian_pattern();  // (every model along a parameter has it: checked)
   if (order >= 1)
     for (auto& values : sc.jacobian) values.resize(static_cast<std::size_t>(pattern.nnz()));
-  auto jacobian = [&](std::size_t k) {
-    return JacobianView(pattern.rows, pattern.cols, pattern.nnz(), pattern.col_ptr.data(), pattern.row_idx.data(),
-                        sc.jacobian[k].data());
-  };
+  auto jacobian = [&](std::size_t k) { return jacobian_view(pattern, sc.jacobian[k]); };
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::fill(out, out + layout.size(parameters.size()), nan);
   const Eigen::Map<const Eigen::VectorXd> qv(q, n);
@@ -146,10 +149,7 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
   if (outputs.empty() || np == 0) return true;
   const CscPattern& pattern = model.jacobian_pattern();
   const std::size_t nnz = static_cast<std::size_t>(pattern.nnz());
-  auto view = [&](std::vector<double>& values) {
-    return JacobianView(pattern.rows, pattern.cols, pattern.nnz(), pattern.col_ptr.data(), pattern.row_idx.data(),
-                        values.data());
-  };
+  auto view = [&](std::vector<double>& values) { return jacobian_view(pattern, values); };
   const Eigen::Map<const Eigen::VectorXd> qv(q, n);
   // Per parameter, its derivatives at fixed (q, q̇): a_j = ∂Φ/∂p, b_j = ∂(Φq q̇ + Φt)/∂p, c_j = ∂(Φq q̈ − γ)/∂p,
   // by the same difference along p as the direct form.
@@ -204,7 +204,8 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
   constexpr double kSecond[7] = {2.0, -27.0, 270.0, -490.0, 270.0, -27.0, 2.0};  // f'' · 180 h², offsets −3 … 3
   if (order >= 1) {
     for (auto& v : sc.first_along_motion) v.resize(nnz);
-    Eigen::VectorXd qk(n);
+    Eigen::VectorXd& qk = sc.qk;  // (kept between rows: no allocation per row)
+    qk.resize(n);
     const Eigen::Map<const Eigen::VectorXd> qdv(qd, n);
     for (std::size_t k = 0; k < 4; ++k) {
       qk = qv + (kShift[k] * e1) * qdv;

@@ -23,7 +23,7 @@ inline SensitivityForm sweep_sensitivity_form(const OutputPlan& plan, std::size_
 struct SensitivityScratch {
   std::array<Eigen::VectorXd, 4> f;  // the function at the four shifted points (one entry per row of Φ)
   Eigen::VectorXd d;                 // its difference quotient: the right-hand side, negated
-  Eigen::VectorXd qk, vk;            // the shifted q and q̇
+  Eigen::VectorXd qk, vk;            // the shifted q and q̇ (the adjoint form: q along the motion)
   // Φq of each model at its shifted q: made for the velocity, read again for the acceleration (the same point)
   std::array<std::vector<double>, 4> jacobian;
   // The adjoint form: per parameter, a_j, b_j, c_j at fixed (q, q̇) (sensitivity.hpp); Φq at the points along the
@@ -35,7 +35,7 @@ struct SensitivityScratch {
   std::array<std::vector<double>, 4> first_along_motion;
   std::array<std::vector<double>, 7> along_motion;
   std::array<std::vector<double>, 4> along_acceleration;
-  Eigen::VectorXd lambda, mu, tau, nu, rhs, solved, kept;
+  Eigen::VectorXd lambda, mu, tau, nu, rhs, solved;
 };
 
 // Writes the sensitivities of (q, q̇, q̈) at t to every parameter into `out` (SensitivityLayout; derivatives above

@@ -19,12 +19,11 @@ constexpr double kSideOffset = 0.6;     // δ, as a fraction of the step: the si
 // δ where the sweep starts at the singular position and its first side is reached by the least-squares assembly from
 // the singular position itself (a single loop: no block-triangular form to solve it by), with nothing of the motion
 // to predict from: kept as close as before the sides moved out, and the start's derivatives are known the less well
-// for it. A start reached block by block (assemble_by_blocks) takes kBlockStartSideOffset: nfourbar N = 10⁴
-// started flat at rate 3π/4, steps of 0.01: q̈ at the start within 7e-9 relative of the exact with 0.45, 0.39 with
-// 0.05 (the chain adds up the sides' rounding, divided by Φq's smallest singular value, O(δ), twice).
+// for it.
 constexpr double kStartSideOffset = 0.05;
-// δ at a start reached block by block. Not kSideOffset: from a flat start the sides' errors add up along the chain
-// (above), and nfourbar N = 10⁴ had q̈ at its start 1.2e-7 off with 0.6, 7e-9 with 0.45.
+// δ at a start reached block by block (assemble_by_blocks). Not kSideOffset: from a flat start the chain adds up the
+// sides' rounding, divided by Φq's smallest singular value, O(δ), twice. nfourbar N = 10⁴ started flat at rate 3π/4,
+// steps of 0.01: q̈ at the start 7e-9 relative off the exact with 0.45, 1.2e-7 with 0.6, 0.39 with 0.05.
 constexpr double kBlockStartSideOffset = 0.45;
 }  // namespace
 
