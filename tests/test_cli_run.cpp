@@ -258,3 +258,41 @@ output: {velocities: true, accelerations: true}
 }
 
 }  // namespace
+
+namespace {
+
+// `--set NAME=VALUE`: the run takes the parameters' values from the command line. The crank-slider's slider then
+// follows the closed form of those lengths, x_B = L2 cos θ + √(L3² − L2² sin² θ) and its rate; `phiq plot` recognises
+// the result as the scene's only with the same --set (it sweeps the scene again to check).
+TEST_F(Cli, SetGivesTheScenesParametersTheirValuesForTheRun) {
+  const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
+  const fs::path csv = dir_ / "set.csv";
+  Result r = run("run -q " + scene + " --set L2=0.25 --set L3=1.1 -o " + csv.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const phiq::CsvTable t = phiq::read_csv_table(csv.string());
+  auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(t.columns.begin(), t.columns.end(), name) - t.columns.begin());
+  };
+  const std::size_t th = col("theta2"), thd = col("theta2.v"), xb = col("xB"), xbd = col("xB.v");
+  ASSERT_EQ(t.rows.size(), 181u);
+  const double l2 = 0.25, l3 = 1.1;
+  for (const auto& row : t.rows) {
+    const double s = std::sin(row[th]), c = std::cos(row[th]), root = std::sqrt(l3 * l3 - l2 * l2 * s * s);
+    EXPECT_NEAR(row[xb], l2 * c + root, 1e-9) << "t = " << row[0];
+    EXPECT_NEAR(row[xbd], (-l2 * s - l2 * l2 * s * c / root) * row[thd], 1e-8) << "t = " << row[0];
+  }
+  // a result that writes the slider alone: the plot sweeps the scene again for the crank's position, and checks
+  // the slider's column against its own sweep
+  const fs::path slider = dir_ / "slider.yaml", slider_csv = dir_ / "slider.csv", svg = dir_ / "set.svg";
+  std::ofstream(slider) << phiq::test::replace_first(slurp(scene), "output: {velocities: true, accelerations: true}",
+                                                     "output: {coordinates: [xB]}");
+  ASSERT_EQ(run("run -q " + slider.string() + " --set L2=0.25 --set L3=1.1 -o " + slider_csv.string()).code, 0);
+  Result without = run("plot " + slider.string() + " " + slider_csv.string() + " -o " + svg.string());
+  EXPECT_EQ(without.code, 2) << "the file's lengths do not give these rows";
+  EXPECT_NE(without.err.find("is not the result of"), std::string::npos) << without.err;
+  Result with = run("plot " + slider.string() + " " + slider_csv.string() + " -o " + svg.string() +
+                    " --set L3=1.1 --set L2=0.25");
+  EXPECT_EQ(with.code, 0) << with.err;
+}
+
+}  // namespace

@@ -121,3 +121,31 @@ def test_a_batch_file_names_its_columns_as_its_csv(tmp_path):
         assert list(f["qd"].attrs["columns"]) == ["theta2__v", "xA__v", "yA__v", "xB__v"]
         assert f["q"].shape[0] == values.shape[0]
     assert names == header
+
+
+def test_the_parameters_a_run_used_are_in_the_file_and_the_summary(tmp_path):
+    """`phiq run --set`: the file's root attributes parameter_names / parameter_values and the summary's
+    `parameters` hold the values the run used (the scene's text alone says the file's), and the rows are those of
+    the scene edited to say them."""
+    scene = os.path.join(MODELS, "seed/crank_slider_mixed.yaml")
+    h5, summary = tmp_path / "set.h5", tmp_path / "set.json"
+    subprocess.run([PHIQ, "run", "-q", scene, "--set", "L3=1.1", "--set", "L2=0.25", "-o", str(h5),
+                    "--summary", str(summary)], check=True)
+    with open(scene) as s:
+        edited = s.read().replace("L2: 0.3 ", "L2: 0.25").replace("L3: 1.0 ", "L3: 1.1 ")
+    (tmp_path / "edited.yaml").write_text(edited)
+    csv = tmp_path / "edited.csv"
+    subprocess.run([PHIQ, "run", "-q", str(tmp_path / "edited.yaml"), "-o", str(csv)], check=True)
+    header, rows = read_csv(csv)
+    with h5py.File(h5, "r") as f:
+        assert list(f.attrs["parameter_names"]) == ["L2", "L3"]  # in the scene's order
+        assert f.attrs["parameter_values"].dtype == np.float64
+        assert list(f.attrs["parameter_values"]) == [0.25, 1.1]
+        q = f["q"][:]
+        assert np.array_equal(q, rows[:, 1:1 + q.shape[1]])
+    assert json.loads(summary.read_text())["parameters"] == {"L2": 0.25, "L3": 1.1}
+    # without --set: the file's own values
+    plain = tmp_path / "plain.h5"
+    subprocess.run([PHIQ, "run", "-q", scene, "-o", str(plain)], check=True)
+    with h5py.File(plain, "r") as f:
+        assert list(f.attrs["parameter_values"]) == [0.3, 1.0]

@@ -20,6 +20,7 @@ namespace {
 struct AnimateOptions {
   std::string scene, result, out;
   std::vector<std::string> columns;  // the HTML's plots (as phiq plot --columns)
+  std::vector<std::string> sets;     // --set NAME=VALUE: the scene's parameters as the run had them
 };
 
 bool ends_with(const std::string& s, const std::string& suffix) {
@@ -36,7 +37,7 @@ int cmd_animate(const AnimateOptions& o) {
     return fail("animate: " + *clash, 2);
   std::string text;
   try {
-    const Scene scene = load_scene(o.scene);
+    const Scene scene = load_scene(o.scene, SceneLimits{}, parameter_settings(o.sets));
     const CsvTable table = read_result_table(o.result);
     text = html ? motion_html(scene, table, o.result, o.columns) : motion_glb(scene, table, o.result);
   } catch (const SceneError& e) {
@@ -67,6 +68,7 @@ Command register_animate(CLI::App& app) {
   animate->add_option("--columns", options->columns, "HTML: columns plotted against t (default: as phiq plot, the "
                                                      "driven and the moving coordinates, at most 6)")
       ->delimiter(',');
+  add_set_option(animate, &options->sets);
   return {animate, [options] { return cmd_animate(*options); }};
 }
 

@@ -15,7 +15,8 @@ namespace {
 
 // `phiq assemble SCENE [-o OUT.csv]`: the assembled position at time.start as a one-row CSV (the columns of
 // `phiq run`'s positions). Nothing is written when the assembly fails.
-int cmd_assemble(const std::string& scene_arg, const std::string& out_path, bool quiet) {
+int cmd_assemble(const std::string& scene_arg, const std::string& out_path, bool quiet,
+                 const std::vector<std::string>& sets) {
   const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   if (!out_path.empty()) {
     if (const auto clash = output_clash({{"-o", out_path}}, {{"the scene", scene_arg == "-" ? "" : scene_arg}}))
@@ -24,7 +25,7 @@ int cmd_assemble(const std::string& scene_arg, const std::string& out_path, bool
     return fail("assemble: standard output: cannot write: it is closed", 3);
   }
   set_interrupt_subject(scene_path, "; no output written");
-  std::optional<phiq::Scene> loaded = load_or_report(scene_arg);
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets);
   if (!loaded) return 2;
   const phiq::Scene& scene = *loaded;
   const phiq::Model& model = *scene.model;
@@ -67,6 +68,7 @@ Command register_assemble(CLI::App& app) {
   struct Args {
     std::string path, out;
     bool quiet = false;
+    std::vector<std::string> sets;
   };
   auto a = std::make_shared<Args>();
   CLI::App* assemble_cmd =
@@ -75,7 +77,8 @@ Command register_assemble(CLI::App& app) {
   assemble_cmd->add_option("-o,--output", a->out, "CSV file to write (default or '-': standard output)")
       ->transform(output_path(" (without the option, or '-': standard output)", true));
   assemble_cmd->add_flag("-q,--quiet", a->quiet, "Do not print the summary on standard error");
-  return {assemble_cmd, [a] { return with_stdout_checked(cmd_assemble(a->path, a->out, a->quiet)); }};
+  add_set_option(assemble_cmd, &a->sets);
+  return {assemble_cmd, [a] { return with_stdout_checked(cmd_assemble(a->path, a->out, a->quiet, a->sets)); }};
 }
 
 }  // namespace phiq::tools

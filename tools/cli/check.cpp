@@ -26,9 +26,9 @@ std::string joint_angle_line(const phiq::JointAngleReference& r) {
          vec(r.ref_b) + how(r.stated_b) + ", in the sides' body frames";
 }
 
-int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at) {
+int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at, const std::vector<std::string>& sets) {
   const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
-  std::optional<phiq::Scene> loaded = load_or_report(scene_arg);
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets);
   if (!loaded) return 2;
   const phiq::Scene& scene = *loaded;
   const phiq::Model& model = *scene.model;
@@ -146,6 +146,7 @@ Command register_check(CLI::App& app) {
     std::string path;
     bool json = false;
     double time = 0.0;
+    std::vector<std::string> sets;
   };
   auto a = std::make_shared<Args>();
   CLI::App* check = app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
@@ -154,9 +155,10 @@ Command register_check(CLI::App& app) {
   CLI::Option* at =
       check->add_option("--time", a->time, "Assemble and analyse at this time instead of time.start")
           ->check(any_number());
+  add_set_option(check, &a->sets);
   return {check, [a, at] {
             return with_stdout_checked(
-                cmd_check(a->path, a->json, at->count() ? std::optional<double>(a->time) : std::nullopt));
+                cmd_check(a->path, a->json, at->count() ? std::optional<double>(a->time) : std::nullopt, a->sets));
           }};
 }
 

@@ -11,6 +11,7 @@
 #include "phiq/text.hpp"
 
 #include "cli_support.hpp"
+#include "tolerance_input.hpp"  // parse_named_value: NAME=VALUE as --sd reads it
 
 namespace phiq::tools {
 
@@ -56,27 +57,48 @@ std::string json_text(const nlohmann::ordered_json& value, int indent) {
 }
 
 namespace {
-// The scene piped to standard input, named kStdinScene in its errors. Read up to one byte past the size limit, so
+// The text of the scene piped to standard input, named kStdinScene in its errors. Read up to one byte past the size limit, so
 // that parse_scene() refuses an oversized one as load_scene() does, without reading it all. A terminal is refused
 // as load_scene() refuses one given as /dev/stdin: nobody types a scene.
-Scene load_stdin_scene() {
+std::string load_stdin_text() {
   if (::isatty(STDIN_FILENO)) throw SceneError(std::string(kStdinScene) + ": is a terminal, not a scene (pipe one in)");
   const std::size_t limit = SceneLimits{}.max_file_bytes;
   std::string text;
   char buf[1 << 16];
   for (std::size_t n; text.size() <= limit && (n = std::fread(buf, 1, sizeof buf, stdin)) > 0;) text.append(buf, n);
   if (std::ferror(stdin)) throw SceneError(std::string(kStdinScene) + ": cannot read: " + std::strerror(errno));
-  return phiq::parse_scene(text, kStdinScene);
+  return text;
 }
 }  // namespace
 
-std::optional<Scene> load_or_report(const std::string& path) {
+SceneOverrides parameter_settings(const std::vector<std::string>& sets) {
+  SceneOverrides o;
+  o.parameters_source = "--set";
+  for (const std::string& text : sets) {
+    auto setting = tolerance::parse_named_value("--set", text);
+    for (const auto& [name, value] : o.parameters)
+      if (name == setting.first) throw Error("--set " + text + ": '" + name + "' is already set");
+    o.parameters.push_back(std::move(setting));
+  }
+  return o;
+}
+
+void add_set_option(CLI::App* command, std::vector<std::string>* sets) {
+  command->add_option("--set", *sets, "NAME=VALUE: the scene parameter NAME takes this value (repeat per parameter)")
+      ->allow_extra_args(false);  // one NAME=VALUE an occurrence: the scene after it stays the scene
+}
+
+std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets) {
   try {
-    return path == "-" ? load_stdin_scene() : phiq::load_scene(path);
+    const SceneOverrides o = parameter_settings(sets);
+    if (path == "-") return phiq::parse_scene(load_stdin_text(), kStdinScene, SceneLimits{}, o);
+    return phiq::load_scene(path, SceneLimits{}, o);
   } catch (const phiq::SceneError& e) {
     fail(e.what(), 2);
-    return std::nullopt;
+  } catch (const phiq::Error& e) {  // a --set that is not NAME=VALUE
+    fail(e.what(), 2);
   }
+  return std::nullopt;
 }
 
 AssemblyOptions assembly_options(const phiq::Scene& scene) { return phiq::assembly_options(scene.sweep.assembly); }

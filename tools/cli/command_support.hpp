@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "phiq/phiq.hpp"
@@ -29,9 +30,18 @@ std::string json_text(const nlohmann::ordered_json& value, int indent);
 // What the scene read from standard input (`phiq run -`) is called in messages and reports.
 inline constexpr const char* kStdinScene = "<stdin>";
 
-// The scene at `path` ("-": standard input, named kStdinScene); on a scene error its one line is printed and the
-// result is empty (the command exits 2).
-std::optional<Scene> load_or_report(const std::string& path);
+// The scene parameters `--set NAME=VALUE` gives (one an occurrence), as overrides whose message about a name
+// that is no parameter of the scene starts "--set". Throws phiq::Error "--set TEXT: WHY" for one that is not
+// NAME=VALUE with a finite number, or that sets a parameter already set.
+SceneOverrides parameter_settings(const std::vector<std::string>& sets);
+
+// Registers `--set NAME=VALUE` (repeatable) on `command`, into `sets`.
+void add_set_option(CLI::App* command, std::vector<std::string>* sets);
+
+// The scene at `path` ("-": standard input, named kStdinScene), with the parameters `sets` gives
+// (parameter_settings()); on a scene or --set error its one line is printed and the result is empty (the command
+// exits 2).
+std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets = {});
 
 // How the scene given as `path` is named in messages: kStdinScene for "-", else the path.
 inline std::string scene_label(const std::string& path) { return path == "-" ? kStdinScene : path; }

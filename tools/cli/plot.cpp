@@ -24,6 +24,7 @@ Command register_plot(CLI::App& app) {
   plot->add_option("--positions", options->positions, "Rows at which the mechanism is drawn, evenly spread")
       ->capture_default_str()
       ->check(whole_number(1, 50));
+  add_set_option(plot, &options->sets);
   return {plot, [options] {
             if (const auto clash = output_clash({{"-o", options->out}},
                                                 {{"the scene", options->scene}, {"the result", options->csv}}))

@@ -24,6 +24,7 @@ std::unique_ptr<phiq::Hdf5Writer> open_hdf5_results(const phiq::AtomicOutputFile
   phiq::Hdf5Options o;
   o.scene_path = scene.path;
   o.scene_text = scene.text;
+  o.parameters = scene.parameters;
   o.expected_rows = static_cast<std::size_t>(phiq::rows_written(scene.sweep));
   o.shown_path = file.path();
   o.deflate = deflate;

@@ -23,7 +23,7 @@ namespace {
 
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb,
-            ProgressBar::Mode progress_mode, bool identifier_names) {
+            ProgressBar::Mode progress_mode, bool identifier_names, const std::vector<std::string>& sets) {
   const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
@@ -40,7 +40,7 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     return fail("run: standard output: cannot write: it is closed", 3);
   set_interrupt_subject(scene_path, "; no output written");
   const auto load_start = Clock::now();
-  std::optional<phiq::Scene> loaded = load_or_report(scene_arg);
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets);
   if (!loaded) return 2;
   phiq::Scene& scene = *loaded;
   const double load_s = since(load_start);
@@ -232,6 +232,7 @@ Command register_run(CLI::App& app) {
     std::string progress = "auto";
     int deflate = 0;
     std::string names = "dotted";
+    std::vector<std::string> sets;
   };
   auto a = std::make_shared<Args>();
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
@@ -268,12 +269,13 @@ Command register_run(CLI::App& app) {
                   "Column names: dotted (theta2.v) or identifiers (theta2__v: kept by numpy and pandas)")
       ->capture_default_str()
       ->check(one_of({"dotted", "identifiers"}));
+  add_set_option(run, &a->sets);
   return {run, [a] {
             using Mode = ProgressBar::Mode;
             const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
             return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet,
                                                a->summary_path, cap_threads("run", a->threads, a->quiet), a->memory_gb,
-                                               mode, a->names == "identifiers"));
+                                               mode, a->names == "identifiers", a->sets));
           }};
 }
 

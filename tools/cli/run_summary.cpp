@@ -36,6 +36,10 @@ std::string run_summary_json(const Scene& scene, const Model& swept, const Sweep
     j["name"] = nullptr;
   else
     j["name"] = scene.name;
+  // the parameters' values the run used (with `--set`): the scene's text alone does not say them
+  nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
+  for (const auto& [n, v] : scene.parameters) parameters[n] = v;
+  j["parameters"] = parameters;
   j["host"] = host_json();
   add_outcome(j, swept, s);
   j["steps"] = s.steps_completed;

@@ -34,7 +34,7 @@ using tolerance::ParameterSpread;
 
 struct ToleranceArgs {
   std::string scene, out, summary, plot, plot_column, covariance;
-  std::vector<std::string> sd, limit, columns;
+  std::vector<std::string> sd, limit, columns, sets;
   long samples = 1000;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -158,7 +158,9 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   std::vector<tolerance::Tolerance> given;
   std::optional<tolerance::Covariance> covariance;
   ParameterSpread spread;
+  SceneOverrides settings;  // --set: the nominal point's other parameters (a toleranced one's nominal value too)
   try {
+    settings = parameter_settings(a.sets);
     for (const std::string& s : a.sd) given.push_back(tolerance::parse_tolerance("--sd", s));
     for (const std::string& s : a.limit) given.push_back(tolerance::parse_tolerance("--limit", s));
     if (!a.covariance.empty()) covariance = tolerance::read_covariance(a.covariance);
@@ -171,7 +173,7 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   set_interrupt_subject(a.scene, "; no output written");
   Scene scene;
   try {
-    SceneOverrides o;
+    SceneOverrides o = settings;
     o.sensitivity_models = false;  // the scene's own output.sensitivities are not swept here
     scene = load_scene(a.scene, SceneLimits{}, o);
   } catch (const SceneError& e) {
@@ -223,7 +225,7 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   // ---- the models along each parameter (sensitivities), sharing the nominal model's analysis
   scene.sweep.sensitivities.clear();  // the scene's own (read without their models)
   for (std::size_t j = 0; j < spread.parameters.size(); ++j) {
-    SceneOverrides o;
+    SceneOverrides o = settings;
     o.sensitivity_models = false;  // (as the nominal scene was read)
     try {
       scene.sweep.sensitivities.push_back(sensitivity_along(scene, spread.parameters[j].name, nominal[j], 0.0, {}, o));
@@ -312,6 +314,9 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
     SceneOverrides o;
     const std::vector<double> v = values_of(k);
     for (std::size_t j = 0; j < np; ++j) o.parameters.emplace_back(spread.parameters[j].name, v[j]);
+    for (const auto& [name, value] : settings.parameters)  // the sampled values replace a toleranced one's
+      if (std::none_of(o.parameters.begin(), o.parameters.end(), [&](const auto& p) { return p.first == name; }))
+        o.parameters.emplace_back(name, value);
     o.share_analysis_with = scene.model.get();
     o.sensitivity_models = false;
     return o;
@@ -478,6 +483,7 @@ Command register_tolerance(CLI::App& app) {
       ->capture_default_str()
       ->check(one_of({"dotted", "identifiers"}));
   tol->add_flag("-q,--quiet", a->quiet, "Print only failed cases and disagreements on standard error");
+  add_set_option(tol, &a->sets);
   return {tol, [a] {
             a->threads = cap_threads("tolerance", a->threads, a->quiet);
             int status = 0;

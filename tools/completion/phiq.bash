@@ -23,18 +23,18 @@ _phiq() {
 
   local opts=""
   case "$cmd" in
-    run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names" ;;
-    check) opts="--help --json --time" ;;
-    assemble) opts="--help --output --quiet" ;;
+    run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names --set" ;;
+    check) opts="--help --json --time --set" ;;
+    assemble) opts="--help --output --quiet --set" ;;
     batch) opts="--help --output --quiet --threads --summary --names --resume" ;;
     compare) opts="--help --rtol --atol --columns --json --junit" ;;
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
-    plot) opts="--help --output --columns --positions" ;;
-    animate) opts="--help --output --columns" ;;
+    plot) opts="--help --output --columns --positions --set" ;;
+    animate) opts="--help --output --columns --set" ;;
     sweep-accuracy) opts="--help --output --json --tolerances --steps-list --predictors --newton --linear-solvers
                           --reference --repeat --quiet --verbose" ;;
     tolerance) opts="--help --output --sd --limit --covariance --samples --seed --columns --threshold --summary --plot
-                     --plot-column --threads --names --quiet" ;;
+                     --plot-column --threads --names --quiet --set" ;;
   esac
 
   # values of the options that take a fixed set of words, or files
@@ -50,7 +50,7 @@ _phiq() {
                                           closed-form:nfourbar closed-form:chain3d" -- "$cur")); return ;;
     --summary|--junit|-o|--output|--covariance|--plot) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     --threads|--memory|--steps|--from|--to|--twist|--time|--rtol|--atol|--columns|--positions|--tolerances|\
-    --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column) return ;;  # a value of the user's
+    --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column|--set) return ;;  # a value of the user's
   esac
   if [[ "$cur" == -* ]]; then
     COMPREPLY=($(compgen -W "$opts" -- "$cur"))

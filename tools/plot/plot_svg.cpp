@@ -8,7 +8,7 @@
 #include <memory>
 
 #include "cli_support.hpp"
-#include "command_support.hpp"  // printable()
+#include "command_support.hpp"  // printable(), parameter_settings()
 #include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 #include "plot_draw.hpp"
@@ -34,8 +34,10 @@ int plot_svg(const PlotOptions& o) {
   Scene scene;
   CsvTable table;
   try {
-    scene = load_scene(o.scene);
+    scene = load_scene(o.scene, SceneLimits{}, parameter_settings(o.sets));
   } catch (const SceneError& e) {
+    return plot_fail(e.what(), 2);
+  } catch (const Error& e) {  // a --set that is not NAME=VALUE
     return plot_fail(e.what(), 2);
   }
   try {

@@ -14,6 +14,7 @@ struct PlotOptions {
   std::string out;                   // the SVG to write
   std::vector<std::string> columns;  // plotted against t; empty: the driven and moving coordinates, at most 6
   int positions = 5;                 // rows at which the mechanism is drawn, evenly spread, first and last included
+  std::vector<std::string> sets;     // --set NAME=VALUE: the scene's parameters as the run had them
 };
 
 // Writes the SVG (under a temporary name, renamed when complete). Returns the exit status of `phiq plot`: 0, 2 for

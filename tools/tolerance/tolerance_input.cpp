@@ -11,21 +11,27 @@
 
 namespace phiq::tolerance {
 
-Tolerance parse_tolerance(const std::string& option, const std::string& text) {
+std::pair<std::string, double> parse_named_value(const std::string& option, const std::string& text) {
   const std::size_t eq = text.find('=');
   auto fail = [&](const std::string& why) { throw Error(option + " " + text + ": " + why); };
   if (eq == std::string::npos || eq == 0) fail("expected NAME=VALUE (a parameter of the scene and a number)");
-  Tolerance t;
-  t.name = text.substr(0, eq);
   const std::string value = text.substr(eq + 1);
   double v = 0.0;
   const char* first = value.data() + (!value.empty() && value[0] == '+');
   const auto [end, ec] = std::from_chars(first, value.data() + value.size(), v);
   if (value.empty() || ec != std::errc() || end != value.data() + value.size()) fail("'" + value + "' is not a number");
   if (!std::isfinite(v)) fail("the value is not finite");
+  return {text.substr(0, eq), v};
+}
+
+Tolerance parse_tolerance(const std::string& option, const std::string& text) {
+  const auto [name, v] = parse_named_value(option, text);
   if (!(v > 0.0))
-    fail(option == "--limit" ? "the limit must be positive (uniform on [p - l, p + l])"
-                             : "the standard deviation must be positive");
+    throw Error(option + " " + text + ": " +
+                (option == "--limit" ? "the limit must be positive (uniform on [p - l, p + l])"
+                                     : "the standard deviation must be positive"));
+  Tolerance t;
+  t.name = name;
   t.distribution = option == "--limit" ? Distribution::kUniform : Distribution::kNormal;
   t.spread = v;
   return t;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace phiq::tolerance {
@@ -31,6 +32,10 @@ struct Covariance {
   std::vector<std::string> names;
   Eigen::MatrixXd matrix;
 };
+
+// "NAME=VALUE" with VALUE a finite number (decimal or exponent form, an optional '+'), as --set, --sd and --limit
+// take it. Throws phiq::Error "OPTION NAME=VALUE: WHY".
+std::pair<std::string, double> parse_named_value(const std::string& option, const std::string& text);
 
 // "NAME=VALUE" of --sd / --limit: the value finite and > 0. Throws phiq::Error "OPTION NAME=VALUE: WHY".
 Tolerance parse_tolerance(const std::string& option, const std::string& text);

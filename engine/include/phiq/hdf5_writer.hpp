@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "phiq/csv_writer.hpp"
 #include "phiq/model.hpp"
@@ -23,6 +25,10 @@ inline constexpr int kHdf5Format = 1;
 struct Hdf5Options {
   std::string scene_path;  ///< root attribute `scene_path` (where the scene was read from)
   std::string scene_text;  ///< root attribute `scene`: the scene's text, so that the file says how it was made
+  /// Root attributes `parameter_names` and `parameter_values`: the scene's parameters with the values the run used
+  /// (Scene::parameters: the caller's overrides, `phiq run --set`, applied), which the text alone does not say.
+  /// None are written when it is empty.
+  std::vector<std::pair<std::string, double>> parameters;
   /// The path errors name, when the file is written under another (the CLI's temporary); empty: the path.
   std::string shown_path;
   /// gzip (deflate) level 1–9 applied to every dataset, 0 for none. Off by default: on kinematic doubles it saves

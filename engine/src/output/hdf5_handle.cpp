@@ -83,6 +83,15 @@ void write_attribute(hid_t object, const char* name, long long value) {
   check(H5Awrite(a.get(), H5T_NATIVE_LLONG, &value), what);
 }
 
+void write_attribute(hid_t object, const char* name, const std::vector<double>& values) {
+  const std::string what = std::string("attribute '") + name + "'";
+  const hsize_t n = values.size();
+  const Hid space = checked(H5Screate_simple(1, &n, nullptr), H5Sclose, what);
+  const Hid a =
+      checked(H5Acreate2(object, name, H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
+  if (n > 0) check(H5Awrite(a.get(), H5T_NATIVE_DOUBLE, values.data()), what);
+}
+
 namespace {
 
 // The attribute's strings (variable-length, as phiq writes them), with the number of elements of its space.

@@ -77,6 +77,8 @@ Hid string_type();
 void write_attribute(hid_t object, const char* name, const std::string& value);
 void write_attribute(hid_t object, const char* name, const std::vector<std::string>& values);
 void write_attribute(hid_t object, const char* name, long long value);
+/// A list of little-endian float64 (a one-dimensional attribute; an empty list has an empty extent).
+void write_attribute(hid_t object, const char* name, const std::vector<double>& values);
 // Reads them back; throws phiq::Error "WHAT: ..." for a missing attribute or one of another type or shape.
 std::string read_string_attribute(hid_t object, const char* name, const std::string& what);
 std::vector<std::string> read_strings_attribute(hid_t object, const char* name, const std::string& what);

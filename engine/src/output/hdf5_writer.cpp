@@ -183,6 +183,13 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     write_attribute(file.get(), "phiq_version", std::string(kVersion));
     write_attribute(file.get(), "scene_path", o.scene_path);
     write_attribute(file.get(), "scene", o.scene_text);
+    if (!o.parameters.empty()) {
+      std::vector<std::string> names;
+      std::vector<double> values;
+      for (const auto& [n, v] : o.parameters) names.push_back(n), values.push_back(v);
+      write_attribute(file.get(), "parameter_names", names);
+      write_attribute(file.get(), "parameter_values", values);
+    }
     if (o.case_column) write_attribute(file.get(), "batch_format_version", static_cast<long long>(kHdf5BatchFormat));
     for (Group& g : groups) create_dataset(g, o);
   } catch (const Error& e) {
