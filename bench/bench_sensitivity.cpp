@@ -123,4 +123,47 @@ BENCHMARK(BM_SensitivityForms)
     ->Iterations(3);
 
 
+
+// What evaluating only a parameter's reach saves (ParameterReach): the scene of BM_SensitivityForms (P cranks'
+// lengths, each read by its one bar), swept with each parameter's reach as parameter_reach() finds it against the
+// same sweep with every constraint evaluated along every parameter (the reach set to everything, as the sweeps
+// evaluated before reaches were found). range(2): 1 the adjoint form, 0 the direct one. reach_vs_everything = the
+// first's time ÷ the second's (interleaved, summed over iterations).
+//
+//   build/bench/phiq_bench --benchmark_filter=SensitivityReach --benchmark_counters_tabular=true
+ParameterReach every_constraint(const Model& m) {
+  ParameterReach r;
+  r.everything = true;
+  for (std::size_t b = 0; b < m.blocks().size(); ++b) r.spans.push_back({b, 0, m.blocks()[b]->size()});
+  for (Index i = 0; i < m.num_equations(); ++i) r.rows.push_back(i);
+  return r;
+}
+
+// range(0) = N, range(1) = P, range(2) = adjoint.
+void BM_SensitivityReach(benchmark::State& state) {
+  const Index n = state.range(0);
+  const int parameters = static_cast<int>(state.range(1));
+  const Scene s = parse_scene(nfourbar_parameters_scene(n, parameters), "nfourbar.yaml");
+  SweepOptions reach = s.sweep;
+  reach.threads = 1;
+  reach.sensitivity_form = state.range(2) ? SensitivityForm::kAdjoint : SensitivityForm::kDirect;
+  SweepOptions everything = reach;
+  const auto all = std::make_shared<const ParameterReach>(every_constraint(*s.model));
+  for (OutputSensitivity& p : everything.sensitivities) p.reach = all;
+  double a = 0, e = 0;
+  for (auto _ : state) {
+    const double ta = sweep_seconds(s, reach), te = sweep_seconds(s, everything);
+    a += ta, e += te;
+    state.SetIterationTime(ta);
+  }
+  state.counters["reach_vs_everything"] = a / e;
+  state.counters["everything_ms"] = 1e3 * e / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_SensitivityReach)
+    ->ArgNames({"N", "P", "adjoint"})
+    ->ArgsProduct({{1000}, {2, 8, 32}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(3);
+
 }  // namespace

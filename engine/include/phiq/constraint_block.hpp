@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -68,6 +70,17 @@ class ConstraintBlock {
   /// the right-hand side of Φq q̈ = γ (DistanceSpec::gamma()). `qd` is q̇, indexed like `q`. Thread-safe.
   virtual void gamma(std::size_t begin, std::size_t end, const double* q, const double* qd, double t,
                      double* out) const = 0;
+  /// Adds Φq v of constraints [begin, end) at (q, t) to `out` at their global row offsets (other rows untouched):
+  /// each Jacobian entry (DistanceSpec::jacobian()) on a coordinate j adds its value × v[j] to its row. `v` spans
+  /// all coordinates, `out` all rows. A product over a few constraints without the model's CSC values (the
+  /// sensitivities' derivatives along a parameter that reaches a few constraints: sensitivity.hpp). Thread-safe.
+  virtual void add_jacobian_product(std::size_t begin, std::size_t end, const double* q, double t, const double* v,
+                                    double* out) const = 0;
+  /// Whether constraint `i`'s data are, bit for bit, those of constraint `i` of `other` (a block of the same kind
+  /// with more than `i` constraints: else false). False too where the kind's data are not plain values (laws,
+  /// curves, expressions hold pointers): "not known to be the same", so that a caller treats the constraint as
+  /// changed (ParameterReach evaluates it). Thread-safe.
+  virtual bool same_data(std::size_t i, const ConstraintBlock& other) const = 0;
   /// Whether constraint `i` (0 ≤ i < size()) depends explicitly on time (DistanceSpec::depends_on_time()).
   virtual bool depends_on_time(std::size_t i) const = 0;
   /// Σ_j |∂Φ_r/∂q_j| · |q_j| over the coordinates that local row `row` (0 ≤ row < rows_per_constraint()) of
@@ -180,6 +193,26 @@ class TypedBlock final : public ConstraintBlock {
   void gamma(std::size_t begin, std::size_t end, const double* q, const double* qd, double t,
              double* out) const override {
     for (std::size_t i = begin; i < end; ++i) entries_[i].spec.gamma(q, qd, t, out + entries_[i].row0);
+  }
+  void add_jacobian_product(std::size_t begin, std::size_t end, const double* q, double t, const double* v,
+                            double* out) const override {
+    for (std::size_t i = begin; i < end; ++i) {
+      double* row = out + entries_[i].row0;
+      auto sink = [&](int r, const Slot& s, double value) {
+        if (s.is_coordinate()) row[r] += value * v[s.coord()];
+      };
+      entries_[i].spec.jacobian(q, t, sink);
+    }
+  }
+  bool same_data(std::size_t i, const ConstraintBlock& other) const override {
+    if constexpr (std::is_trivially_copyable_v<Spec>) {
+      const auto* o = dynamic_cast<const TypedBlock*>(&other);
+      // byte for byte: padding that differs only makes a constraint "changed", which costs an evaluation
+      return o && i < o->entries_.size() && i < entries_.size() &&
+             std::memcmp(&entries_[i].spec, &o->entries_[i].spec, sizeof(Spec)) == 0;
+    } else {
+      return false;
+    }
   }
   bool depends_on_time(std::size_t i) const override { return entries_[i].spec.depends_on_time(); }
   double coordinate_sensitivity(std::size_t i, int row, const double* q, double t) const override {

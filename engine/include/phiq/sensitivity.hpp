@@ -34,6 +34,26 @@
 
 namespace phiq {
 
+/// The constraints a parameter reaches: those whose data differ between the swept model and a model along the
+/// parameter (ConstraintBlock::same_data(); kinds whose data are not plain values count as reached). Only their rows
+/// of ∂Φ/∂p, ∂(Φq q̇ + Φt)/∂p and ∂(Φq q̈ − γ)/∂p can be non-zero, so only they are evaluated along p: a link's
+/// length costs its one constraint, not the four models' every row, and the other rows' derivatives are exactly 0.
+struct ParameterReach {
+  /// Constraints [begin, end) of block `block` (Model::blocks()), for each run of consecutive reached ones.
+  struct Span {
+    std::size_t block = 0;  ///< index into Model::blocks()
+    std::size_t begin = 0;  ///< first reached constraint of the run
+    std::size_t end = 0;    ///< one past its last
+  };
+  std::vector<Span> spans;  ///< in block order
+  std::vector<Index> rows;  ///< the rows of Φ the spans own, ascending
+  /// True when the models' blocks could not be matched one to one (another order or size): then every constraint
+  /// of the model is in `spans`.
+  bool everything = false;
+  /// Whether nothing is reached: no constraint reads the parameter (its sensitivities are zero).
+  bool empty() const { return spans.empty(); }
+};
+
 /// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the
 /// model built at p − 2h, p − h, p + h, p + 2h (in that order), each with the same coordinates, rows and Φq pattern
 /// as the model swept (check_sensitivity_models()). A scene's `output: {sensitivities: [...]}` builds them
@@ -43,7 +63,15 @@ struct OutputSensitivity {
   double value = 0.0;  ///< p
   double step = 0.0;   ///< h > 0
   std::array<std::shared_ptr<const Model>, 4> models;  ///< at p − 2h, p − h, p + h, p + 2h
+  /// What the parameter reaches (parameter_reach(): sensitivity_along() sets it; run_sweep() finds it when it is
+  /// null). Null: solve_sensitivities() evaluates every constraint along the parameter, as for a reach of
+  /// everything; the values agree up to rounding (outside the reach they are then the rounding of f − f, not 0).
+  std::shared_ptr<const ParameterReach> reach;
 };
+
+/// The constraints `s`'s models change against `model` (ParameterReach). Pre-condition: check_sensitivity_models()
+/// passed. O(constraints): a comparison of each constraint's data in the five models. Thread-safe.
+ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s);
 
 /// The default difference step for a parameter of value p: 10⁻³ |p|, or 10⁻³ for p = 0.
 double default_sensitivity_step(double p);

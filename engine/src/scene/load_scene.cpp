@@ -212,6 +212,7 @@ OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name,
     }
   }
   if (const std::string why = check_sensitivity_models(*scene.model, s); !why.empty()) throw SceneError(why);
+  s.reach = std::make_shared<const ParameterReach>(parameter_reach(*scene.model, s));
   return s;
 }
 

@@ -21,6 +21,20 @@ namespace {
 constexpr std::array<double, 4> kShift = {-2.0, -1.0, 1.0, 2.0};
 constexpr std::array<double, 4> kWeight = {1.0, -8.0, 8.0, -1.0};
 
+// D f over the rows of `reach` into `d` (its other rows untouched), as differences of the pairs: exactly zero where
+// the four models agree.
+void difference_on(const ParameterReach& reach, const std::array<Eigen::VectorXd, 4>& f, double h, Eigen::VectorXd& d) {
+  for (const Index r : reach.rows) d[r] = ((f[0][r] - f[3][r]) + 8.0 * (f[2][r] - f[1][r])) / (12.0 * h);
+}
+
+// v·w over the rows of `reach`, or over all rows when it is null.
+double dot_on(const ParameterReach* reach, const Eigen::VectorXd& v, const Eigen::VectorXd& w) {
+  if (!reach) return v.dot(w);
+  double sum = 0.0;
+  for (const Index r : reach->rows) sum += v[r] * w[r];
+  return sum;
+}
+
 // Φq over values held here, in the model's pattern (every model along a parameter has it: checked).
 JacobianView jacobian_view(const CscPattern& pattern, std::vector<double>& values) {
   return JacobianView(pattern.rows, pattern.cols, pattern.nnz(), pattern.col_ptr.data(), pattern.row_idx.data(),
@@ -55,7 +69,7 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   const Index n = model.num_coordinates(), m = model.num_equations();
   const SensitivityLayout layout{n};
   for (auto& f : sc.f) f.resize(m);
-  sc.d.resize(m), sc.qk.resize(n), sc.vk.resize(n);
+  sc.d.resize(m), sc.along.resize(m), sc.qk.resize(n), sc.vk.resize(n);
   const CscPattern& pattern = model.jacobian_pattern();  // (every model along a parameter has it: checked)
   if (order >= 1)
     for (auto& values : sc.jacobian) values.resize(static_cast<std::size_t>(pattern.nnz()));
@@ -77,9 +91,21 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
       ++ws.counters.sensitivity_solves;
       return lu.solve(solve_rhs(model, ws, sc.d), x);
     };
-    // Position: Φp from the residuals of the four models at q.
-    for (std::size_t k = 0; k < 4; ++k) p.models[k]->residual(q, t, sc.f[k].data());
-    if (!solve_difference(s)) return false;
+    // Position: Φp from the residuals of the four models at q, over the constraints p reaches when they are known
+    // (the other rows of Φp are exactly 0).
+    if (p.reach) {
+      for (std::size_t k = 0; k < 4; ++k)
+        detail::evaluate_over_reach(*p.reach, *p.models[k], detail::AlongParameter::kResidual, q, nullptr, nullptr, t,
+                                    sc.f[k].data(), sc.along.data());
+      sc.d.setZero();
+      difference_on(*p.reach, sc.f, h, sc.d);
+      sc.d = -sc.d;
+      ++ws.counters.sensitivity_solves;
+      if (!lu.solve(solve_rhs(model, ws, sc.d), s)) return false;
+    } else {
+      for (std::size_t k = 0; k < 4; ++k) p.models[k]->residual(q, t, sc.f[k].data());
+      if (!solve_difference(s)) return false;
+    }
     if (order < 1) continue;
     // Velocity: Φq q̇ + Φt along (q, p) ← (s, 1). Each model's Φq at its shifted q is kept for the acceleration,
     // which reads it at the same point.
@@ -155,10 +181,24 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
   // by the same difference along p as the direct form.
   sc.a.resize(np), sc.b.resize(np), sc.c.resize(np);
   for (auto& f : sc.f) f.resize(m);
-  sc.d.resize(m);
+  sc.d.resize(m), sc.along.resize(m);
   sc.jacobian[0].resize(nnz);
   for (std::size_t j = 0; j < np; ++j) {
     const OutputSensitivity& p = parameters[j];
+    if (p.reach) {  // over the constraints p reaches: a_j, b_j and c_j are read on their rows only (dot_on)
+      using detail::AlongParameter;
+      const AlongParameter terms[3] = {AlongParameter::kResidual, AlongParameter::kVelocityTerm,
+                                       AlongParameter::kAccelerationTerm};
+      Eigen::VectorXd* into[3] = {&sc.a[j], &sc.b[j], &sc.c[j]};
+      for (int o = 0; o <= order; ++o) {
+        for (std::size_t k = 0; k < 4; ++k)
+          detail::evaluate_over_reach(*p.reach, *p.models[k], terms[o], q, qd, qdd, t, sc.f[k].data(),
+                                      sc.along.data());
+        into[o]->resize(m);
+        difference_on(*p.reach, sc.f, p.step, *into[o]);
+      }
+      continue;
+    }
     // D f as differences of the pairs: exactly zero where the four models agree (a parameter nothing reads), not
     // the rounding of f − 8f + 8f − f
     auto difference = [&](Eigen::VectorXd& into) {
@@ -268,12 +308,14 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
       c1_transposed(sc.lambda);
       if (!solve_transposed(sc.nu)) return false;
     }
+    if (order >= 2) sc.nu -= 2.0 * sc.tau;  // ν − 2τ
     for (std::size_t j = 0; j < np; ++j) {
-      out[layout.offset(j, 0) + i] = -sc.lambda.dot(sc.a[j]);
-      if (order >= 1) out[layout.offset(j, 1) + i] = sc.mu.dot(sc.a[j]) - sc.lambda.dot(sc.b[j]);
+      const ParameterReach* reach = parameters[j].reach.get();
+      out[layout.offset(j, 0) + i] = -dot_on(reach, sc.lambda, sc.a[j]);
+      if (order >= 1) out[layout.offset(j, 1) + i] = dot_on(reach, sc.mu, sc.a[j]) - dot_on(reach, sc.lambda, sc.b[j]);
       if (order >= 2)
-        out[layout.offset(j, 2) + i] = (sc.nu - 2.0 * sc.tau).dot(sc.a[j]) + 2.0 * sc.mu.dot(sc.b[j]) -
-                                       sc.lambda.dot(sc.c[j]);
+        out[layout.offset(j, 2) + i] = dot_on(reach, sc.nu, sc.a[j]) + 2.0 * dot_on(reach, sc.mu, sc.b[j]) -
+                                       dot_on(reach, sc.lambda, sc.c[j]);
     }
   }
   return true;

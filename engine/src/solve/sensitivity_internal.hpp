@@ -23,6 +23,7 @@ inline SensitivityForm sweep_sensitivity_form(const OutputPlan& plan, std::size_
 struct SensitivityScratch {
   std::array<Eigen::VectorXd, 4> f;  // the function at the four shifted points (one entry per row of Φ)
   Eigen::VectorXd d;                 // its difference quotient: the right-hand side, negated
+  Eigen::VectorXd along;             // Φt or γ on the way (evaluate_over_reach)
   Eigen::VectorXd qk, vk;            // the shifted q and q̇ (the adjoint form: q along the motion)
   // Φq of each model at its shifted q: made for the velocity, read again for the acceleration (the same point)
   std::array<std::vector<double>, 4> jacobian;
@@ -37,6 +38,19 @@ struct SensitivityScratch {
   std::array<std::vector<double>, 4> along_acceleration;
   Eigen::VectorXd lambda, mu, tau, nu, rhs, solved;
 };
+
+// The functions differentiated along a parameter, at fixed (q, q̇, q̈) (sensitivity.hpp: a, b and c).
+enum class AlongParameter {
+  kResidual,         // Φ(q, t)
+  kVelocityTerm,     // Φq(q, t) q̇ + Φt(q, t)
+  kAccelerationTerm  // Φq(q, t) q̈ − γ(q, q̇, t)
+};
+
+// `which` of model `m` (one along the parameter, or the swept model) over the constraints of `reach` only: their
+// rows of `f` are written, every other row is left as it is. `scratch` (one entry per row of Φ, like `f`) holds Φt
+// or γ on the way. `qd` is read by kVelocityTerm and kAccelerationTerm, `qdd` by kAccelerationTerm (else null).
+void evaluate_over_reach(const ParameterReach& reach, const Model& m, AlongParameter which, const double* q,
+                         const double* qd, const double* qdd, double t, double* f, double* scratch);
 
 // Writes the sensitivities of (q, q̇, q̈) at t to every parameter into `out` (SensitivityLayout; derivatives above
 // `order` are NaN), solving with `lu`, the factors of the swept model's Φq at q. `ws` lends the right-hand side

@@ -177,6 +177,14 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
   // threads = 1 is one thread.
   const int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;
   tbb::task_arena arena(threads);
+  // Each parameter's reach, found once here when the caller did not give it: every row then evaluates along p only
+  // the constraints p reaches.
+  if (std::any_of(opt.sensitivities.begin(), opt.sensitivities.end(), [](const auto& p) { return !p.reach; })) {
+    SweepOptions with_reach = opt;
+    for (OutputSensitivity& p : with_reach.sensitivities)
+      if (!p.reach) p.reach = std::make_shared<const ParameterReach>(parameter_reach(model, p));
+    return arena.execute([&] { return sweep_in_arena(model, with_reach, ws, on_step, summary, threads); });
+  }
   return arena.execute([&] { return sweep_in_arena(model, opt, ws, on_step, summary, threads); });
 }
 

@@ -1,0 +1,249 @@
+// What a design parameter reaches (engine/src/solve/parameter_reach.cpp, ParameterReach in sensitivity.hpp): the
+// constraints whose data its models change, exactly; the product Φq v of ConstraintBlock::add_jacobian_product()
+// against the model's CSC Jacobian on every scene of models/; and sensitivities evaluated over the reach against
+// those evaluated over every constraint, in both forms.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "cli_test_support.hpp"
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* kCrankSlider = R"(phiq: 1
+parameters: {L2: 0.3, L3: 1.0, unused: 5}
+coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}
+points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: rod, type: distance, points: [A, B], length: L3}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
+time: {start: 0, end: pi, steps: 90}
+output: {velocities: true, accelerations: true}
+)";
+
+// The names of the constraints owning the reach's rows, in row order, each once.
+std::vector<std::string> reached(const Model& m, const ParameterReach& r) {
+  std::vector<std::string> names;
+  for (const Index row : r.rows) {
+    const std::string& name = m.constraints()[static_cast<std::size_t>(m.constraint_of_row(row))].name;
+    if (names.empty() || names.back() != name) names.push_back(name);
+  }
+  return names;
+}
+
+// A length reaches its one constraint; drivers, whose laws are not plain data, are always counted as reached (an
+// evaluation too many, never one too few).
+TEST(ParameterReach, ALengthReachesItsConstraintAndTheDriversLawsAreAlwaysCounted) {
+  const Scene s = parse_scene(kCrankSlider, "c.yaml");
+  const OutputSensitivity l2 = sensitivity_along(s, "L2", 0.3), l3 = sensitivity_along(s, "L3", 1.0);
+  ASSERT_TRUE(l2.reach && l3.reach);  // sensitivity_along() finds it
+  EXPECT_EQ(reached(*s.model, *l2.reach), (std::vector<std::string>{"crank", "motor"}));
+  EXPECT_EQ(reached(*s.model, *l3.reach), (std::vector<std::string>{"rod", "motor"}));
+  const Index crank = s.model->constraint("crank").first_row, rod = s.model->constraint("rod").first_row;
+  const Index motor = s.model->constraint("motor").first_row;
+  EXPECT_EQ(l2.reach->rows, (std::vector<Index>{crank, crank + 1, motor}));
+  EXPECT_EQ(l3.reach->rows, (std::vector<Index>{rod, motor}));
+  EXPECT_FALSE(l2.reach->everything);
+  // the same as parameter_reach() finds afresh; one span a reached constraint here (each of its own kind)
+  const ParameterReach again = parameter_reach(*s.model, l2);
+  EXPECT_EQ(again.rows, l2.reach->rows);
+  ASSERT_EQ(again.spans.size(), 2u);
+  for (const auto& span : again.spans) EXPECT_EQ(span.end - span.begin, 1u);
+  // a parameter nothing reads reaches the driver alone
+  const OutputSensitivity unused = sensitivity_along(s, "unused", 5.0);
+  EXPECT_EQ(reached(*s.model, *unused.reach), (std::vector<std::string>{"motor"}));
+}
+
+// A family of 40 bars of which one reads the parameter: one span of one constraint in the distance block.
+TEST(ParameterReach, OneBarOfAFamilyIsOneSpan) {
+  const std::string text = R"(phiq: 1
+parameters: {N: 40, R7: 1}
+coordinates:
+  for i in 0..N:
+    x{i}: i + 0.7071067811865476
+    y{i}: 0.7071067811865475
+  theta: 0.7853981633974483
+points:
+  O: [0, 0]
+  for i in 0..N:
+    P{i}: ["x{i}", "y{i}"]
+constraints:
+  - for i in 0..6:
+      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
+  - {name: crank7, type: distance, points: [[7, 0], P7], length: R7}
+  - for i in 8..N:
+      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
+  - for i in 0..N-1:
+      - {name: "coupler{i}", type: distance, points: ["P{i}", "P{i+1}"], length: 1}
+  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}
+drivers:
+  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: 1.5707963267948966}}
+time: {start: 0, end: 1, steps: 10}
+)";
+  const Scene s = parse_scene(text, "bars.yaml");
+  const OutputSensitivity r7 = sensitivity_along(s, "R7", 1.0);
+  EXPECT_EQ(reached(*s.model, *r7.reach), (std::vector<std::string>{"crank7", "motor"}));
+  std::size_t in_distances = 0;
+  for (const auto& span : r7.reach->spans)
+    if (std::string(s.model->blocks()[span.block]->kind()) == "distance") {
+      ++in_distances;
+      EXPECT_EQ(span.begin, 7u);
+      EXPECT_EQ(span.end, 8u);
+    }
+  EXPECT_EQ(in_distances, 1u);
+}
+
+// Models whose blocks cannot be matched to the swept model's (here another scene's) reach everything.
+TEST(ParameterReach, ModelsWhoseBlocksDoNotMatchReachEverything) {
+  const Scene s = parse_scene(kCrankSlider, "c.yaml");
+  const Scene other = load_scene(test::model_path("seed/fourbar_natural.yaml"));
+  OutputSensitivity p = sensitivity_along(s, "L2", 0.3);
+  p.models[2] = std::shared_ptr<const Model>(other.model.get(), [](const Model*) {});
+  const ParameterReach r = parameter_reach(*s.model, p);
+  EXPECT_TRUE(r.everything);
+  ASSERT_EQ(r.rows.size(), static_cast<std::size_t>(s.model->num_equations()));
+  for (std::size_t i = 0; i < r.rows.size(); ++i) EXPECT_EQ(r.rows[i], static_cast<Index>(i));
+  std::size_t constraints = 0;
+  for (const auto& span : r.spans) constraints += span.end - span.begin;
+  EXPECT_EQ(constraints, s.model->constraints().size());
+}
+
+// Φq v constraint by constraint (add_jacobian_product over every block) is the CSC Jacobian's product, to rounding,
+// at a random point near the placement, for every scene of models/ (every kind the scenes use).
+TEST(ParameterReach, AddJacobianProductIsTheJacobiansProductOnEveryScene) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int scenes = 0;
+  for (const auto& e : fs::recursive_directory_iterator(PHIQ_MODELS_DIR)) {
+    if (e.path().extension() != ".yaml" || e.path().parent_path().filename() == "reference") continue;
+    if (fs::file_size(e.path()) > 20000) continue;  // the generated large ones add no kind
+    const Scene s = load_scene(e.path().string());
+    const Model& m = *s.model;
+    const Index n = m.num_coordinates(), rows = m.num_equations();
+    Eigen::VectorXd q = m.initial_positions(), v(n);
+    for (Index j = 0; j < n; ++j) q[j] += 0.01 * u(rng), v[j] = u(rng);
+    const double t = s.sweep.t_begin;
+    std::vector<double> values(static_cast<std::size_t>(m.jacobian_pattern().nnz()));
+    m.jacobian(q.data(), t, values.data());
+    const CscPattern& p = m.jacobian_pattern();
+    Eigen::VectorXd expected = Eigen::VectorXd::Zero(rows), got = Eigen::VectorXd::Zero(rows);
+    double scale = 0.0;
+    for (Index c = 0; c < p.cols; ++c)
+      for (Index k = p.col_ptr[c]; k < p.col_ptr[c + 1]; ++k) {
+        const double term = values[static_cast<std::size_t>(k)] * v[c];
+        expected[p.row_idx[k]] += term, scale = std::max(scale, std::fabs(term));
+      }
+    for (const auto& b : m.blocks()) b->add_jacobian_product(0, b->size(), q.data(), t, v.data(), got.data());
+    EXPECT_LE((got - expected).lpNorm<Eigen::Infinity>(), 1e-13 * std::max(1.0, scale)) << e.path();
+    ++scenes;
+  }
+  EXPECT_GT(scenes, 30);
+}
+
+// same_data(): a constraint is the same as itself in another build of the scene, and differs exactly where the
+// parameter moved its data.
+TEST(ParameterReach, SameDataComparesTheConstraintsData) {
+  const Scene a = parse_scene(kCrankSlider, "c.yaml");
+  const Scene b = parse_scene(kCrankSlider, "c.yaml");
+  SceneOverrides o;
+  o.parameters = {{"L3", 1.25}};
+  const Scene c = parse_scene(kCrankSlider, "c.yaml", {}, o);
+  for (std::size_t k = 0; k < a.model->blocks().size(); ++k) {
+    const ConstraintBlock& x = *a.model->blocks()[k];
+    const std::string kind = x.kind();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const bool plain = kind != "driver";  // a law is not plain data
+      EXPECT_EQ(x.same_data(i, *b.model->blocks()[k]), plain) << kind;
+      EXPECT_EQ(x.same_data(i, *c.model->blocks()[k]), plain && kind != "distance") << kind;
+      EXPECT_FALSE(x.same_data(i + 1, *b.model->blocks()[k])) << "past the other block's end";
+    }
+    if (k > 0) EXPECT_FALSE(x.same_data(0, *a.model->blocks()[0])) << "another kind's block";
+  }
+}
+
+// The sensitivities evaluated over the reach are those evaluated over every constraint (reach null), in the direct
+// and the adjoint forms, at a row of a sweep: localised parameters (one crank's length among 40 bars, the
+// crank-slider's lengths) and one that reaches every bar.
+void expect_reach_changes_nothing(const Scene& s, const std::vector<std::string>& names) {
+  std::vector<OutputSensitivity> with, without;
+  for (const auto& name : names) {
+    double value = 0.0;
+    for (const auto& [n, v] : s.parameters)
+      if (n == name) value = v;
+    with.push_back(sensitivity_along(s, name, value));
+    without.push_back(with.back());
+    without.back().reach = nullptr;
+  }
+  SweepOptions o = s.sweep;
+  o.steps = 10;
+  o.velocities = o.accelerations = true;
+  Workspace ws(*s.model);
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(*s.model, o, &tr, nullptr, &ws), SolveStatus::kSuccess);
+  const std::size_t k = 6;
+  ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
+  const SensitivityLayout layout{s.model->num_coordinates()};
+  const std::size_t size = static_cast<std::size_t>(layout.size(names.size()));
+  std::vector<Index> all(static_cast<std::size_t>(s.model->num_coordinates()));
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<Index>(i);
+  for (const bool adjoint : {false, true}) {
+    std::vector<double> a(size), b(size);
+    if (adjoint) {
+      ASSERT_EQ(solve_sensitivities_adjoint(*s.model, with, all, tr.t[k], 2, ws, a.data()), SolveStatus::kSuccess);
+      ASSERT_EQ(solve_sensitivities_adjoint(*s.model, without, all, tr.t[k], 2, ws, b.data()), SolveStatus::kSuccess);
+    } else {
+      ASSERT_EQ(solve_sensitivities(*s.model, with, tr.t[k], 2, ws, a.data()), SolveStatus::kSuccess);
+      ASSERT_EQ(solve_sensitivities(*s.model, without, tr.t[k], 2, ws, b.data()), SolveStatus::kSuccess);
+    }
+    double scale = 0.0;
+    for (double v : b) scale = std::max(scale, std::fabs(v));
+    ASSERT_GT(scale, 1e-3);
+    for (std::size_t i = 0; i < size; ++i)
+      EXPECT_NEAR(a[i], b[i], 1e-11 * scale) << (adjoint ? "adjoint " : "direct ") << i;
+  }
+}
+
+TEST(ParameterReach, SensitivitiesOverTheReachAreThoseOverEveryConstraint) {
+  expect_reach_changes_nothing(parse_scene(kCrankSlider, "c.yaml"), {"L2", "L3"});
+  std::string bars = R"(phiq: 1
+parameters: {N: 40, R7: 1, L: 1}
+coordinates:
+  for i in 0..N:
+    x{i}: i + 0.7071067811865476
+    y{i}: 0.7071067811865475
+  theta: 0.7853981633974483
+points:
+  O: [0, 0]
+  for i in 0..N:
+    P{i}: ["x{i}", "y{i}"]
+constraints:
+  - for i in 0..6:
+      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
+  - {name: crank7, type: distance, points: [[7, 0], P7], length: R7}
+  - for i in 8..N:
+      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
+  - for i in 0..N-1:
+      - {name: "coupler{i}", type: distance, points: ["P{i}", "P{i+1}"], length: L}
+  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}
+drivers:
+  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: 1.5707963267948966}}
+time: {start: 0, end: 1, steps: 10}
+)";
+  expect_reach_changes_nothing(parse_scene(bars, "bars.yaml"), {"R7", "L"});
+  expect_reach_changes_nothing(load_scene(test::model_path("spatial/rssr.yaml")), {"L"});
+}
+
+}  // namespace
+}  // namespace phiq
