@@ -33,6 +33,32 @@ time: {start: 0, end: pi, steps: 90}
 output: {velocities: true, accelerations: true}
 )";
 
+// 41 cranks and 40 couplers: crank7's length is R7, every coupler's L.
+const char* kBars = R"(phiq: 1
+parameters: {N: 40, R7: 1, L: 1}
+coordinates:
+  for i in 0..N:
+    x{i}: i + 0.7071067811865476
+    y{i}: 0.7071067811865475
+  theta: 0.7853981633974483
+points:
+  O: [0, 0]
+  for i in 0..N:
+    P{i}: ["x{i}", "y{i}"]
+constraints:
+  - for i in 0..6:
+      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
+  - {name: crank7, type: distance, points: [[7, 0], P7], length: R7}
+  - for i in 8..N:
+      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
+  - for i in 0..N-1:
+      - {name: "coupler{i}", type: distance, points: ["P{i}", "P{i+1}"], length: L}
+  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}
+drivers:
+  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: 1.5707963267948966}}
+time: {start: 0, end: 1, steps: 10}
+)";
+
 // The names of the constraints owning the reach's rows, in row order, each once.
 std::vector<std::string> reached(const Model& m, const ParameterReach& r) {
   std::vector<std::string> names;
@@ -66,33 +92,9 @@ TEST(ParameterReach, ALengthReachesItsConstraintAndTheDriversLawsAreAlwaysCounte
   EXPECT_EQ(reached(*s.model, *unused.reach), (std::vector<std::string>{"motor"}));
 }
 
-// A family of 40 bars of which one reads the parameter: one span of one constraint in the distance block.
+// A family of 41 bars of which one reads the parameter: one span of one constraint in the distance block.
 TEST(ParameterReach, OneBarOfAFamilyIsOneSpan) {
-  const std::string text = R"(phiq: 1
-parameters: {N: 40, R7: 1}
-coordinates:
-  for i in 0..N:
-    x{i}: i + 0.7071067811865476
-    y{i}: 0.7071067811865475
-  theta: 0.7853981633974483
-points:
-  O: [0, 0]
-  for i in 0..N:
-    P{i}: ["x{i}", "y{i}"]
-constraints:
-  - for i in 0..6:
-      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
-  - {name: crank7, type: distance, points: [[7, 0], P7], length: R7}
-  - for i in 8..N:
-      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
-  - for i in 0..N-1:
-      - {name: "coupler{i}", type: distance, points: ["P{i}", "P{i+1}"], length: 1}
-  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}
-drivers:
-  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: 1.5707963267948966}}
-time: {start: 0, end: 1, steps: 10}
-)";
-  const Scene s = parse_scene(text, "bars.yaml");
+  const Scene s = parse_scene(kBars, "bars.yaml");
   const OutputSensitivity r7 = sensitivity_along(s, "R7", 1.0);
   EXPECT_EQ(reached(*s.model, *r7.reach), (std::vector<std::string>{"crank7", "motor"}));
   std::size_t in_distances = 0;
@@ -103,6 +105,14 @@ time: {start: 0, end: 1, steps: 10}
       EXPECT_EQ(span.end, 8u);
     }
   EXPECT_EQ(in_distances, 1u);
+  // L, every coupler's length: one span over the 40 couplers, after the 41 cranks in the distance block
+  const OutputSensitivity l = sensitivity_along(s, "L", 1.0);
+  EXPECT_EQ(l.reach->rows.size(), 41u);  // 40 couplers and the driver
+  bool couplers = false;
+  for (const auto& span : l.reach->spans)
+    if (std::string(s.model->blocks()[span.block]->kind()) == "distance")
+      couplers = span.begin == 41 && span.end == 81;
+  EXPECT_TRUE(couplers);
 }
 
 // Models whose blocks cannot be matched to the swept model's (here another scene's) reach everything.
@@ -217,31 +227,7 @@ void expect_reach_changes_nothing(const Scene& s, const std::vector<std::string>
 
 TEST(ParameterReach, SensitivitiesOverTheReachAreThoseOverEveryConstraint) {
   expect_reach_changes_nothing(parse_scene(kCrankSlider, "c.yaml"), {"L2", "L3"});
-  std::string bars = R"(phiq: 1
-parameters: {N: 40, R7: 1, L: 1}
-coordinates:
-  for i in 0..N:
-    x{i}: i + 0.7071067811865476
-    y{i}: 0.7071067811865475
-  theta: 0.7853981633974483
-points:
-  O: [0, 0]
-  for i in 0..N:
-    P{i}: ["x{i}", "y{i}"]
-constraints:
-  - for i in 0..6:
-      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
-  - {name: crank7, type: distance, points: [[7, 0], P7], length: R7}
-  - for i in 8..N:
-      - {name: "crank{i}", type: distance, points: [[i, 0], "P{i}"], length: 1}
-  - for i in 0..N-1:
-      - {name: "coupler{i}", type: distance, points: ["P{i}", "P{i+1}"], length: L}
-  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}
-drivers:
-  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: 1.5707963267948966}}
-time: {start: 0, end: 1, steps: 10}
-)";
-  expect_reach_changes_nothing(parse_scene(bars, "bars.yaml"), {"R7", "L"});
+  expect_reach_changes_nothing(parse_scene(kBars, "bars.yaml"), {"R7", "L"});
   expect_reach_changes_nothing(load_scene(test::model_path("spatial/rssr.yaml")), {"L"});
 }
 
