@@ -92,6 +92,28 @@ TEST_F(Cli, ToleranceLinearSpreadIsTheClosedFormAndMonteCarloAgrees) {
   EXPECT_EQ(phiq::test::count(picture, "data-column=\"xB\""), 1u);
 }
 
+// --set moves the nominal point: with L3 = 1.1 the nominal slider and its first-order spread to L2 are the closed
+// form's at those lengths, and the samples (L2 drawn, L3 kept at 1.1) agree with it; --set of the toleranced L2
+// is its nominal value, about which it is sampled.
+TEST_F(Cli, ToleranceSetMovesTheNominalPoint) {
+  const fs::path out = dir_ / "tol.csv", summary = dir_ / "tol.json";
+  const Result r = run("tolerance " + kCrankSlider + " --sd L2=0.001 --set L3=1.1 --set L2=0.25 --columns xB -o " +
+                       out.string() + " --summary " + summary.string() + " --samples 400 -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const phiq::CsvTable table = phiq::read_csv_table(out.string());
+  ASSERT_EQ(table.rows.size(), 181u);
+  const double L2 = 0.25, L3 = 1.1;
+  for (std::size_t row = 0; row < table.rows.size(); ++row) {
+    const double t = table.rows[row][0], s = std::sin(2 * t), w = std::sqrt(L3 * L3 - L2 * L2 * s * s);
+    EXPECT_NEAR(column(table, row, "xB"), L2 * std::cos(2 * t) + w, 1e-9) << "t = " << t;
+    const double dl2 = std::fabs(std::cos(2 * t) - L2 * s * s / w) * 0.001;
+    EXPECT_NEAR(column(table, row, "xB.sd_linear"), dl2, 1e-12) << "t = " << t;  // 1e-9 of 0.001 × O(1)
+  }
+  expect_agreement(table, "xB", 400, 4.0);
+  const auto j = nlohmann::json::parse(slurp(summary));
+  EXPECT_DOUBLE_EQ(j["parameters"][0]["nominal"].get<double>(), 0.25);
+}
+
 // A ± limit is uniform on [p − l, p + l]: its standard deviation l/√3 is what the linear spread uses.
 TEST_F(Cli, ToleranceLimitIsUniformWithSdLimitOverRootThree) {
   const fs::path out = dir_ / "tol.csv";

@@ -57,9 +57,9 @@ std::string json_text(const nlohmann::ordered_json& value, int indent) {
 }
 
 namespace {
-// The text of the scene piped to standard input, named kStdinScene in its errors. Read up to one byte past the size limit, so
-// that parse_scene() refuses an oversized one as load_scene() does, without reading it all. A terminal is refused
-// as load_scene() refuses one given as /dev/stdin: nobody types a scene.
+// The text of the scene piped to standard input, named kStdinScene in its errors. Read up to one byte past the size
+// limit, so that parse_scene() refuses an oversized one as load_scene() does, without reading it all. A terminal is
+// refused as load_scene() refuses one given as /dev/stdin: nobody types a scene.
 std::string load_stdin_text() {
   if (::isatty(STDIN_FILENO)) throw SceneError(std::string(kStdinScene) + ": is a terminal, not a scene (pipe one in)");
   const std::size_t limit = SceneLimits{}.max_file_bytes;
