@@ -314,9 +314,9 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
     SceneOverrides o;
     const std::vector<double> v = values_of(k);
     for (std::size_t j = 0; j < np; ++j) o.parameters.emplace_back(spread.parameters[j].name, v[j]);
-    for (const auto& [name, value] : settings.parameters)  // the sampled values replace a toleranced one's
-      if (std::none_of(o.parameters.begin(), o.parameters.end(), [&](const auto& p) { return p.first == name; }))
-        o.parameters.emplace_back(name, value);
+    for (const auto& set : settings.parameters)  // the sampled values replace a toleranced one's
+      if (std::none_of(o.parameters.begin(), o.parameters.end(), [&](const auto& p) { return p.first == set.first; }))
+        o.parameters.push_back(set);
     o.share_analysis_with = scene.model.get();
     o.sensitivity_models = false;
     return o;
