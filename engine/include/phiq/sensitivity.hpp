@@ -50,8 +50,6 @@ struct ParameterReach {
   /// True when the models' blocks could not be matched one to one (another order or size): then every constraint
   /// of the model is in `spans`.
   bool everything = false;
-  /// Whether nothing is reached: no constraint reads the parameter (its sensitivities are zero).
-  bool empty() const { return spans.empty(); }
 };
 
 /// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the

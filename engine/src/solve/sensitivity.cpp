@@ -83,13 +83,17 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     double* s = out + layout.offset(j, 0);
     double* sd = out + layout.offset(j, 1);
     double* sdd = out + layout.offset(j, 2);
-    // −D f solved with Φq into x: the sensitivity of one order.
+    // sc.d, which holds −D f, solved with Φq into x: the sensitivity of one order.
+    auto solve_negated_difference = [&](double* x) {
+      ++ws.counters.sensitivity_solves;
+      return lu.solve(solve_rhs(model, ws, sc.d), x);
+    };
+    // −D f over every row, solved: the orders whose functions are taken at q moved along s (every row changes).
     auto solve_difference = [&](double* x) {
       sc.d.setZero();
       for (std::size_t k = 0; k < 4; ++k) sc.d += kWeight[k] * sc.f[k];
       sc.d *= -1.0 / (12.0 * h);
-      ++ws.counters.sensitivity_solves;
-      return lu.solve(solve_rhs(model, ws, sc.d), x);
+      return solve_negated_difference(x);
     };
     // Position: Φp from the residuals of the four models at q, over the constraints p reaches when they are known
     // (the other rows of Φp are exactly 0).
@@ -100,8 +104,7 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
       sc.d.setZero();
       difference_on(*p.reach, sc.f, h, sc.d);
       sc.d = -sc.d;
-      ++ws.counters.sensitivity_solves;
-      if (!lu.solve(solve_rhs(model, ws, sc.d), s)) return false;
+      if (!solve_negated_difference(s)) return false;
     } else {
       for (std::size_t k = 0; k < 4; ++k) p.models[k]->residual(q, t, sc.f[k].data());
       if (!solve_difference(s)) return false;
