@@ -262,8 +262,9 @@ output: {velocities: true, accelerations: true}
 namespace {
 
 // `--set NAME=VALUE`: the run takes the parameters' values from the command line. The crank-slider's slider then
-// follows the closed form of those lengths, x_B = L2 cos θ + √(L3² − L2² sin² θ) and its rate; `phiq plot` recognises
-// the result as the scene's only with the same --set (it sweeps the scene again to check).
+// follows the closed form of those lengths, x_B = L2 cos θ + √(L3² − L2² sin² θ) and its rate; `phiq plot` of a
+// result that lacks coordinates (it sweeps the scene again for them) recognises it as the scene's only with the same
+// --set.
 TEST_F(Cli, SetGivesTheScenesParametersTheirValuesForTheRun) {
   const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
   const fs::path csv = dir_ / "set.csv";
