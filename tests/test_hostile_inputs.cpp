@@ -221,9 +221,10 @@ TEST_P(Hostile, Case) {
     EXPECT_EQ(stderr_text.find('\0'), std::string::npos);
     EXPECT_TRUE(valid_utf8(stderr_text)) << "stderr is not UTF-8: " << stderr_text;
   }
-  if (!c.stdout_regex.empty())
+  if (!c.stdout_regex.empty()) {
     EXPECT_TRUE(std::regex_search(stdout_text, std::regex(c.stdout_regex)))
         << "stdout: " << stdout_text << "\ndoes not match: " << c.stdout_regex;
+  }
   for (const auto& [path, regex] : c.match)
     EXPECT_TRUE(std::regex_search(slurp(dir / path), std::regex(regex))) << path << " does not match: " << regex;
   for (const auto& [path, bytes] : kept) EXPECT_EQ(slurp(dir / path), bytes) << path << " was changed";

@@ -16,6 +16,9 @@ namespace phiq::detail {
 
 // The per-run bookkeeping shared by the sequential and parallel paths.
 struct Run {
+  // A constructor, not aggregate initialisation: the members below start as their initialisers say.
+  Run(const SweepOptions& o, const std::function<bool(const StepView&)>& f, SweepSummary& s)
+      : opt(o), on_step(f), sum(s) {}
   const SweepOptions& opt;
   const std::function<bool(const StepView&)>& on_step;
   SweepSummary& sum;
