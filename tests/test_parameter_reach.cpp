@@ -69,34 +69,103 @@ std::vector<std::string> reached(const Model& m, const ParameterReach& r) {
   return names;
 }
 
-// A length reaches its one constraint; drivers, whose laws are not plain data, are always counted as reached (an
-// evaluation too many, never one too few).
-TEST(ParameterReach, ALengthReachesItsConstraintAndTheDriversLawsAreAlwaysCounted) {
+// A length reaches its one constraint, and nothing else: the driver's law is the same law in every model.
+TEST(ParameterReach, ALengthReachesItsConstraintOnly) {
   const Scene s = parse_scene(kCrankSlider, "c.yaml");
   const OutputSensitivity l2 = sensitivity_along(s, "L2", 0.3), l3 = sensitivity_along(s, "L3", 1.0);
   ASSERT_TRUE(l2.reach && l3.reach);  // sensitivity_along() finds it
-  EXPECT_EQ(reached(*s.model, *l2.reach), (std::vector<std::string>{"crank", "motor"}));
-  EXPECT_EQ(reached(*s.model, *l3.reach), (std::vector<std::string>{"rod", "motor"}));
+  EXPECT_EQ(reached(*s.model, *l2.reach), (std::vector<std::string>{"crank"}));
+  EXPECT_EQ(reached(*s.model, *l3.reach), (std::vector<std::string>{"rod"}));
   const Index crank = s.model->constraint("crank").first_row, rod = s.model->constraint("rod").first_row;
-  const Index motor = s.model->constraint("motor").first_row;
-  EXPECT_EQ(l2.reach->rows, (std::vector<Index>{crank, crank + 1, motor}));
-  EXPECT_EQ(l3.reach->rows, (std::vector<Index>{rod, motor}));
+  EXPECT_EQ(l2.reach->rows, (std::vector<Index>{crank, crank + 1}));
+  EXPECT_EQ(l3.reach->rows, (std::vector<Index>{rod}));
   EXPECT_FALSE(l2.reach->everything);
-  // the same as parameter_reach() finds afresh; one span a reached constraint here (each of its own kind)
+  // the same as parameter_reach() finds afresh: one span of one constraint
   const ParameterReach again = parameter_reach(*s.model, l2);
   EXPECT_EQ(again.rows, l2.reach->rows);
-  ASSERT_EQ(again.spans.size(), 2u);
-  for (const auto& span : again.spans) EXPECT_EQ(span.end - span.begin, 1u);
-  // a parameter nothing reads reaches the driver alone
+  ASSERT_EQ(again.spans.size(), 1u);
+  EXPECT_EQ(again.spans[0].end - again.spans[0].begin, 1u);
+  // a parameter nothing reads reaches nothing
   const OutputSensitivity unused = sensitivity_along(s, "unused", 5.0);
-  EXPECT_EQ(reached(*s.model, *unused.reach), (std::vector<std::string>{"motor"}));
+  EXPECT_TRUE(unused.reach->spans.empty());
+  EXPECT_TRUE(unused.reach->rows.empty());
+}
+
+// A parameter of the driver's law reaches the driver alone, and its sensitivities are the law's: θ2 = w t, so
+// ∂θ2/∂w = t, ∂θ̇2/∂w = 1, ∂θ̈2/∂w = 0, with the crank-slider following (x_B moves as ∂x_B/∂θ2 · t). Not reported
+// as a parameter nothing reads.
+TEST(ParameterReach, ALawsCoefficientReachesItsDriver) {
+  const std::string text = test::replace_first(
+      test::replace_first(kCrankSlider, "unused: 5}", "unused: 5, w: 2}"), "rate: 2}", "rate: w}");
+  const Scene s = parse_scene(text, "c.yaml");
+  OutputSensitivity w = sensitivity_along(s, "w", 2.0);
+  EXPECT_EQ(reached(*s.model, *w.reach), (std::vector<std::string>{"motor"}));
+  SweepOptions o = s.sweep;
+  o.sensitivities = {w};
+  const Index n = s.model->num_coordinates(), theta = s.model->coordinate_index("theta2");
+  const Index xb = s.model->coordinate_index("xB");
+  const SensitivityLayout layout{n};
+  int rows = 0;
+  SweepSummary sum;
+  Workspace ws(*s.model);
+  ASSERT_EQ(run_sweep(*s.model, o, ws, [&](const StepView& v) {
+              const double t = v.t, th = v.q[theta];
+              EXPECT_NEAR(v.sensitivities[layout.offset(0, 0) + theta], t, 1e-12) << t;
+              EXPECT_NEAR(v.sensitivities[layout.offset(0, 1) + theta], 1.0, 1e-12) << t;
+              EXPECT_NEAR(v.sensitivities[layout.offset(0, 2) + theta], 0.0, 1e-11) << t;
+              // x_B = L2 cos θ + √(L3² − L2² sin² θ): ∂x_B/∂w = ∂x_B/∂θ · t
+              const double r = std::sqrt(1.0 - 0.09 * std::sin(th) * std::sin(th));
+              const double dx = -0.3 * std::sin(th) - 0.09 * std::sin(th) * std::cos(th) / r;
+              EXPECT_NEAR(v.sensitivities[layout.offset(0, 0) + xb], dx * t, 1e-10) << t;
+              ++rows;
+              return true;
+            }, &sum),
+            SolveStatus::kSuccess);
+  EXPECT_EQ(rows, 91);
+  for (const SweepWarning& warning : sum.warnings) EXPECT_NE(warning.kind, "no_dependence") << warning.message;
+}
+
+// Laws, curves and expressions are compared by what they hold, not by address: each build of a scene makes its own.
+TEST(ParameterReach, LawsCurvesAndExpressionsCompareByValue) {
+  EXPECT_EQ(MotionLaw::linear(0, 2), MotionLaw::linear(0, 2));
+  EXPECT_NE(MotionLaw::linear(0, 2), MotionLaw::linear(0, 2.000000001));
+  EXPECT_NE(MotionLaw::linear(0, 2), MotionLaw::polynomial({0, 2, 0}));  // another polynomial's coefficients
+  EXPECT_EQ(MotionLaw::harmonic(0, 1, 2, 0.5), MotionLaw::harmonic(0, 1, 2, 0.5));
+  EXPECT_NE(MotionLaw::harmonic(0, 1, 2, 0.5), MotionLaw::harmonic(0, 1, 2, 0.25));
+  EXPECT_EQ(MotionLaw::table({0, 1, 2, 3}, {0, 1, 4, 9}), MotionLaw::table({0, 1, 2, 3}, {0, 1, 4, 9}));
+  EXPECT_NE(MotionLaw::table({0, 1, 2, 3}, {0, 1, 4, 9}), MotionLaw::table({0, 1, 2, 3}, {0, 1, 4, 9.5}));
+  EXPECT_NE(MotionLaw::linear(0, 2), MotionLaw{});
+  EXPECT_EQ(MotionLaw{}, MotionLaw{});
+  const NameResolver names = [](const std::string& name) -> std::optional<NameBinding> {
+    if (name == "x") return NameBinding{NameBinding::Kind::kCoordinate, 0};
+    if (name == "t") return NameBinding{NameBinding::Kind::kTime};
+    return std::nullopt;
+  };
+  const auto g1 = CompiledExpression::compile("x^2 + 0.5*t", names), g2 = CompiledExpression::compile("x^2 + 0.5*t", names);
+  const auto g3 = CompiledExpression::compile("x^2 + 0.25*t", names);
+  EXPECT_EQ(*g1, *g2);
+  EXPECT_FALSE(*g1 == *g3);
+  const auto f1 = CompiledExpression::compile("0.5*t^2", names), f2 = CompiledExpression::compile("0.5*t^2", names);
+  EXPECT_EQ(MotionLaw::expression(f1), MotionLaw::expression(f2));
+  EXPECT_NE(MotionLaw::expression(f1), MotionLaw::expression(CompiledExpression::compile("0.25*t^2", names)));
+  EquationSpec e1{g1, std::nullopt, Unit::kNone}, e2{g2, std::nullopt, Unit::kNone}, e3{g3, std::nullopt, Unit::kNone};
+  EXPECT_TRUE(e1 == e2);
+  EXPECT_FALSE(e1 == e3);
+  e2.law = MotionLaw::linear(0, 1);
+  EXPECT_FALSE(e1 == e2);
+  const CurveOn c1{Frame2{}, Curve::circle({0, 0}, 0.5)}, c2{Frame2{}, Curve::circle({0, 0}, 0.5)};
+  const CurveOn c3{Frame2{}, Curve::circle({0, 0}, 0.5000001)};
+  EXPECT_TRUE(c1 == c2);
+  EXPECT_FALSE(c1 == c3);
+  EXPECT_TRUE(*Curve::spline({{0, 0}, {1, 0}, {2, 1}, {3, 3}}, false) == *Curve::spline({{0, 0}, {1, 0}, {2, 1}, {3, 3}}, false));
+  EXPECT_FALSE(*Curve::spline({{0, 0}, {1, 0}, {2, 1}, {3, 3}}, false) == *Curve::spline({{0, 0}, {1, 0}, {2, 1}, {3, 3.5}}, false));
 }
 
 // A family of 41 bars of which one reads the parameter: one span of one constraint in the distance block.
 TEST(ParameterReach, OneBarOfAFamilyIsOneSpan) {
   const Scene s = parse_scene(kBars, "bars.yaml");
   const OutputSensitivity r7 = sensitivity_along(s, "R7", 1.0);
-  EXPECT_EQ(reached(*s.model, *r7.reach), (std::vector<std::string>{"crank7", "motor"}));
+  EXPECT_EQ(reached(*s.model, *r7.reach), (std::vector<std::string>{"crank7"}));
   std::size_t in_distances = 0;
   for (const auto& span : r7.reach->spans)
     if (std::string(s.model->blocks()[span.block]->kind()) == "distance") {
@@ -107,7 +176,7 @@ TEST(ParameterReach, OneBarOfAFamilyIsOneSpan) {
   EXPECT_EQ(in_distances, 1u);
   // L, every coupler's length: one span over the 40 couplers, after the 41 cranks in the distance block
   const OutputSensitivity l = sensitivity_along(s, "L", 1.0);
-  EXPECT_EQ(l.reach->rows.size(), 41u);  // 40 couplers and the driver
+  EXPECT_EQ(l.reach->rows.size(), 40u);  // the 40 couplers
   bool couplers = false;
   for (const auto& span : l.reach->spans)
     if (std::string(s.model->blocks()[span.block]->kind()) == "distance")
@@ -162,8 +231,8 @@ TEST(ParameterReach, AddJacobianProductIsTheJacobiansProductOnEveryScene) {
   EXPECT_GT(scenes, 30);
 }
 
-// same_data(): a constraint is the same as itself in another build of the scene, and differs exactly where the
-// parameter moved its data.
+// same_data(): a constraint is the same as itself in another build of the scene (its driver's law too), and differs
+// exactly where the parameter moved its data.
 TEST(ParameterReach, SameDataComparesTheConstraintsData) {
   const Scene a = parse_scene(kCrankSlider, "c.yaml");
   const Scene b = parse_scene(kCrankSlider, "c.yaml");
@@ -174,12 +243,13 @@ TEST(ParameterReach, SameDataComparesTheConstraintsData) {
     const ConstraintBlock& x = *a.model->blocks()[k];
     const std::string kind = x.kind();
     for (std::size_t i = 0; i < x.size(); ++i) {
-      const bool plain = kind != "driver";  // a law is not plain data
-      EXPECT_EQ(x.same_data(i, *b.model->blocks()[k]), plain) << kind;
-      EXPECT_EQ(x.same_data(i, *c.model->blocks()[k]), plain && kind != "distance") << kind;
+      EXPECT_TRUE(x.same_data(i, *b.model->blocks()[k])) << kind;
+      EXPECT_EQ(x.same_data(i, *c.model->blocks()[k]), kind != "distance") << kind;
       EXPECT_FALSE(x.same_data(i + 1, *b.model->blocks()[k])) << "past the other block's end";
     }
-    if (k > 0) EXPECT_FALSE(x.same_data(0, *a.model->blocks()[0])) << "another kind's block";
+    if (k > 0) {
+      EXPECT_FALSE(x.same_data(0, *a.model->blocks()[0])) << "another kind's block";
+    }
   }
 }
 

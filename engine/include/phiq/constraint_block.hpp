@@ -6,10 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <memory>
 #include <string>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -76,10 +74,10 @@ class ConstraintBlock {
   /// sensitivities' derivatives along a parameter that reaches a few constraints: sensitivity.hpp). Thread-safe.
   virtual void add_jacobian_product(std::size_t begin, std::size_t end, const double* q, double t, const double* v,
                                     double* out) const = 0;
-  /// Whether constraint `i`'s data are, bit for bit, those of constraint `i` of `other` (a block of the same kind
-  /// with more than `i` constraints: else false). False too where the kind's data are not plain values (laws,
-  /// curves, expressions hold pointers): "not known to be the same", so that a caller treats the constraint as
-  /// changed (ParameterReach evaluates it). Thread-safe.
+  /// Whether constraint `i` is the same constraint as constraint `i` of `other`: a block of the same kind with more
+  /// than `i` constraints (else false) whose spec there is equal to this one (the kind's operator==, datum by
+  /// datum: laws, curves and expressions by what they hold, not by address). What ParameterReach compares to find
+  /// the constraints a parameter changes. Thread-safe.
   virtual bool same_data(std::size_t i, const ConstraintBlock& other) const = 0;
   /// Whether constraint `i` (0 ≤ i < size()) depends explicitly on time (DistanceSpec::depends_on_time()).
   virtual bool depends_on_time(std::size_t i) const = 0;
@@ -205,14 +203,8 @@ class TypedBlock final : public ConstraintBlock {
     }
   }
   bool same_data(std::size_t i, const ConstraintBlock& other) const override {
-    if constexpr (std::is_trivially_copyable_v<Spec>) {
-      const auto* o = dynamic_cast<const TypedBlock*>(&other);
-      // byte for byte: padding that differs only makes a constraint "changed", which costs an evaluation
-      return o && i < o->entries_.size() && i < entries_.size() &&
-             std::memcmp(&entries_[i].spec, &o->entries_[i].spec, sizeof(Spec)) == 0;
-    } else {
-      return false;
-    }
+    const auto* o = dynamic_cast<const TypedBlock*>(&other);
+    return o && i < o->entries_.size() && i < entries_.size() && entries_[i].spec == o->entries_[i].spec;
   }
   bool depends_on_time(std::size_t i) const override { return entries_[i].spec.depends_on_time(); }
   double coordinate_sensitivity(std::size_t i, int row, const double* q, double t) const override {

@@ -40,6 +40,7 @@ class Tape {
     std::uint32_t a = 0;   ///< first operand register (or the input index for loads)
     std::uint32_t b = 0;   ///< second operand register
     double imm = 0.0;      ///< constant value, or integer exponent for kPowInt and kPowHalf
+    bool operator==(const Instr&) const = default;  ///< field by field
   };
 
   /// Evaluates the program; out[k] receives register outputs()[k]. Thread-safe (scratch is thread-local).
@@ -48,6 +49,8 @@ class Tape {
   /// Exact (no truncation). Thread-safe.
   void taylor2(const double* q, const double* qd, double t, double out[3]) const;
 
+  /// The same program: instruction for instruction (constants by value), and the same outputs.
+  bool operator==(const Tape&) const = default;
   std::size_t size() const { return code_.size(); }  ///< number of instructions
   std::size_t num_outputs() const { return outputs_.size(); }  ///< number of outputs
   /// The program as text, one instruction per line ("r3 = mul r1 r2"; constants as hexadecimal floats, so that
@@ -91,6 +94,9 @@ class CompiledExpression {
   static std::shared_ptr<const CompiledExpression> compile(const std::string& text, const NameResolver& resolve,
                                                            bool allow_time = true);
 
+  /// The same function: the same text, coordinates and programs (a scene's parameter is a constant of the tapes,
+  /// so a scene read at two values of a parameter its expression reads gives two different functions).
+  bool operator==(const CompiledExpression&) const = default;
   /// The text it was compiled from.
   const std::string& text() const { return text_; }
   /// Coordinates g depends on, ascending; gradient() writes ∂g/∂q for these, in this order.

@@ -41,6 +41,9 @@ class MotionLaw {
   /// Interval on which the law is defined: infinite for analytic laws, the table's range for tables.
   double domain_begin() const;
   double domain_end() const;  ///< see domain_begin()
+  /// The same law: the same kind with the same data (coefficients, table, program), or both default-constructed.
+  /// Laws read from one scene at two values of a parameter they use differ (DistanceSpec::operator==).
+  bool operator==(const MotionLaw& other) const;
   /// Short human-readable form, e.g. "linear 0 + 2*t".
   const std::string& description() const { return description_; }
 

@@ -35,7 +35,7 @@
 namespace phiq {
 
 /// The constraints a parameter reaches: those whose data differ between the swept model and a model along the
-/// parameter (ConstraintBlock::same_data(); kinds whose data are not plain values count as reached). Only their rows
+/// parameter (ConstraintBlock::same_data(): the kind's value equality, laws and expressions included). Only their rows
 /// of ∂Φ/∂p, ∂(Φq q̇ + Φt)/∂p and ∂(Φq q̈ − γ)/∂p can be non-zero, so only they are evaluated along p: a link's
 /// length costs its one constraint, not the four models' every row, and the other rows' derivatives are exactly 0.
 struct ParameterReach {

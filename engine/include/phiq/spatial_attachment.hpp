@@ -30,6 +30,7 @@ namespace kin3 {
 /// A plain 3-vector (metres for points, unitless for directions).
 struct V3 {
   double x = 0.0, y = 0.0, z = 0.0;
+  bool operator==(const V3&) const = default;  ///< component by component
 };
 inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
@@ -57,6 +58,7 @@ inline V3 rotate(const double p[4], V3 s) { return bilinear(p, p, s); }
 /// A point or a vector that moves with the coordinates: X = r + R(p) s (file comment). Built by the factories
 /// below; ground and fixed points are attachments of constants.
 struct Attachment3 {
+  bool operator==(const Attachment3&) const = default;  ///< slot by slot, and the local vector
   Slot r[3] = {Slot::constant(0), Slot::constant(0), Slot::constant(0)};  ///< translation part (m, or a vector)
   Slot p[4] = {Slot::constant(1), Slot::constant(0), Slot::constant(0), Slot::constant(0)};  ///< Euler parameters
   kin3::V3 s;  ///< the local vector rotated by R(p): a point or an axis fixed in the body

@@ -148,8 +148,8 @@ struct SweepWarning {
   /// rows, up to two rows without it apart, the message says how long and how many); "ill_conditioned": Φq is
   /// near-singular (rcond below 1e-7; once per stretch of such rows); "bifurcation": Φq is singular at this row,
   /// the velocity is not unique and the branch's own is reported; "parallel_fallback": the parallel sweep
-  /// continued in order; "no_dependence": no constraint or driver reads a parameter of
-  /// OutputPlan::sensitivities (its sensitivities are zero; at the first row)
+  /// continued in order; "no_dependence": a parameter of OutputPlan::sensitivities changes no constraint or
+  /// driver (its ParameterReach is empty: its sensitivities are exactly zero; at the first row)
   std::string kind;
 
   std::string message;  ///< one line

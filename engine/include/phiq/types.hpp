@@ -67,6 +67,9 @@ class Slot {
   Index coord() const { return is_coordinate() ? static_cast<Index>(bits_ & kIndexMask) : -1; }
   /// The constant (0 for a coordinate).
   double value() const { return is_coordinate() ? 0.0 : as_double(); }
+  /// Bit for bit: the same coordinate, or the same constant (+0 and −0 differ: two constants that print alike may
+  /// still be two data).
+  bool operator==(const Slot&) const = default;
   /// Its value at q (q must have more than coord() entries).
   double of(const double* q) const { return is_coordinate() ? q[bits_ & kIndexMask] : as_double(); }
   /// Time derivative: constants do not move.
@@ -90,6 +93,7 @@ static_assert(sizeof(Slot) == 8, "a slot is one word");
 
 /// A planar point given by two slots (natural coordinates, or a fixed point, or a mix such as (xB, 0)).
 struct Point2 {
+  bool operator==(const Point2&) const = default;  ///< slot by slot
   Slot x;  ///< x coordinate (m)
   Slot y;  ///< y coordinate (m)
 };
@@ -97,6 +101,7 @@ struct Point2 {
 /// A planar body frame in reference-point coordinates: position of its reference point and orientation angle.
 /// Ground is a frame of constants.
 struct Frame2 {
+  bool operator==(const Frame2&) const = default;  ///< slot by slot
   Slot x;    ///< x of the reference point (m)
   Slot y;    ///< y of the reference point (m)
   Slot psi;  ///< orientation (rad)
@@ -105,6 +110,7 @@ struct Frame2 {
 /// A spatial point given by three slots (natural coordinates, or a fixed point): also a natural unit vector's
 /// components (ux, uy, uz).
 struct Point3 {
+  bool operator==(const Point3&) const = default;  ///< slot by slot
   Slot x;  ///< x coordinate (m; unitless for a vector)
   Slot y;  ///< y coordinate
   Slot z;  ///< z coordinate
@@ -113,6 +119,7 @@ struct Point3 {
 /// A spatial body frame in reference-point coordinates: position of its reference point and its orientation as
 /// Euler parameters (a unit quaternion, e0 the scalar part). Ground is a frame of constants with e = (1, 0, 0, 0).
 struct Frame3 {
+  bool operator==(const Frame3&) const = default;  ///< slot by slot
   Slot x;   ///< x of the reference point (m)
   Slot y;   ///< y of the reference point (m)
   Slot z;   ///< z of the reference point (m)

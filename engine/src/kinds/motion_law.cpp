@@ -13,6 +13,8 @@ struct MotionLaw::Impl {
   virtual LawValue evaluate(double t) const = 0;
   virtual double begin() const { return -std::numeric_limits<double>::infinity(); }
   virtual double end() const { return std::numeric_limits<double>::infinity(); }
+  // The same law as `other` (of any kind: another kind is another law).
+  virtual bool same(const Impl& other) const = 0;
 };
 
 namespace {
@@ -33,6 +35,10 @@ struct Polynomial final : MotionLaw::Impl {
     }
     return v;
   }
+  bool same(const MotionLaw::Impl& other) const override {
+    const auto* o = dynamic_cast<const Polynomial*>(&other);
+    return o && c == o->c;
+  }
 };
 
 struct Harmonic final : MotionLaw::Impl {
@@ -40,6 +46,10 @@ struct Harmonic final : MotionLaw::Impl {
   LawValue evaluate(double t) const override {
     double s = std::sin(omega * t + phase), c = std::cos(omega * t + phase);
     return {offset + amplitude * s, amplitude * omega * c, -amplitude * omega * omega * s};
+  }
+  bool same(const MotionLaw::Impl& other) const override {
+    const auto* o = dynamic_cast<const Harmonic*>(&other);
+    return o && offset == o->offset && amplitude == o->amplitude && omega == o->omega && phase == o->phase;
   }
 };
 
@@ -60,6 +70,14 @@ struct Table final : MotionLaw::Impl {
   }
   double begin() const override { return t0; }
   double end() const override { return t1; }
+  bool same(const MotionLaw::Impl& other) const override {
+    const auto* o = dynamic_cast<const Table*>(&other);
+    const auto equal = [](const auto& a, const auto& b) {
+      return a.rows() == b.rows() && a.cols() == b.cols() && (a.array() == b.array()).all();
+    };
+    return o && t0 == o->t0 && t1 == o->t1 && equal(spline.knots(), o->spline.knots()) &&
+           equal(spline.ctrls(), o->spline.ctrls());
+  }
 };
 
 struct Expression final : MotionLaw::Impl {
@@ -68,9 +86,18 @@ struct Expression final : MotionLaw::Impl {
     // f depends on t only: ḟ = ∂f/∂t, and γ of f (no coordinates) is −f_tt.
     return {f->value(nullptr, t), f->partial_t(nullptr, t), -f->gamma(nullptr, nullptr, t)};
   }
+  bool same(const MotionLaw::Impl& other) const override {
+    const auto* o = dynamic_cast<const Expression*>(&other);
+    return o && (f == o->f || *f == *o->f);
+  }
 };
 
 }  // namespace
+
+bool MotionLaw::operator==(const MotionLaw& other) const {
+  if (impl_ == other.impl_) return true;
+  return impl_ && other.impl_ && impl_->same(*other.impl_);
+}
 
 MotionLaw MotionLaw::linear(double initial, double rate) {
   MotionLaw law = polynomial({initial, rate});

@@ -14,6 +14,8 @@ namespace phiq {
 /// ref is |u||v| at the initial placement, so the row is (close to) the angle error in radians. Well conditioned for
 /// every α (unlike a pure dot or cross form); it is also met at α + π, a branch Newton does not reach from nearby.
 struct ConstantAngleSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const ConstantAngleSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row: (close to) the angle error
   /// @copydoc DistanceSpec::kKind
   /// Scene type `constant_angle`.

@@ -13,6 +13,8 @@ namespace phiq {
 /// Rheonomic driver on one coordinate (a motor):
 ///   Φ = q_j − f(t),   Φt = −f'(t),   γ = f''(t)       (0 for a linear law: the notes' erratum)
 struct CoordinateDriverSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const CoordinateDriverSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, in the unit of the driven coordinate
   /// @copydoc DistanceSpec::kKind
   /// Added with ModelBuilder::add_driver() or, in a scene, as a driver given by `coordinate`.

@@ -22,6 +22,8 @@ namespace phiq {
 /// Scene type `coupler`: `coordinates: [q_i, q_j]`, `coefficients: [a, b]`, `constant: c` (default 0). Any
 /// dimension. Time-independent; its row has q_i's unit.
 struct CouplerSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const CouplerSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "coupler";

@@ -32,6 +32,9 @@ class Curve {
   /// profile): angles strictly increasing over less than one turn, radii positive.
   static std::shared_ptr<const Curve> radius_table(const std::vector<double>& angles, const std::vector<double>& radii);
 
+  /// The same curve, datum by datum (shape, ends, knots and every piece's coefficients): what makes two curves read
+  /// from one scene at different parameter values the same (DistanceSpec::operator==).
+  bool operator==(const Curve&) const = default;
   /// Whether the curve is closed (periodic in s with period length()).
   bool closed() const { return closed_; }
   /// The parameter's range is [0, length()]: the period of a closed curve, the end of an open one.
@@ -75,6 +78,10 @@ class Curve {
 struct CurveOn {
   Frame2 frame;                        ///< the body that carries the curve: x, y (m), ψ (rad); constants for ground
   std::shared_ptr<const Curve> curve;  ///< the curve in that frame's local coordinates (m)
+  /// The same frame and the same curve (by what it holds, not by address: each model reads its own).
+  bool operator==(const CurveOn& o) const {
+    return frame == o.frame && (curve == o.curve || (curve && o.curve && *curve == *o.curve));
+  }
 };
 
 /// @cond internal

@@ -19,6 +19,11 @@ namespace phiq {
 /// Its member functions are the interface that every constraint kind supplies (TypedBlock calls them, in one loop
 /// per kind); the other kinds copy their documentation from here.
 struct DistanceSpec {
+  /// Value equality, datum by datum (slots bit for bit, numbers by value, laws and curves by what they hold):
+  /// whether two constraints are the same constraint. ParameterReach compares each constraint of the swept
+  /// model with its counterpart in the models along a parameter, to evaluate only those the parameter changes.
+  /// Every kind has it (kinds/registry.hpp); a defaulted one serves wherever the data are plain values.
+  bool operator==(const DistanceSpec&) const = default;
   /// Number of rows of Φ a constraint of this kind owns: its residual, Φt and γ have kRows values and its Jacobian
   /// entries have rows 0 … kRows − 1 (local rows; the model places them at the constraint's first global row).
   static constexpr int kRows = 1;

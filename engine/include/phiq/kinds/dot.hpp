@@ -18,6 +18,8 @@ namespace phiq {
 ///   Φ = (D1 · D2 − c) / ref,   ref = |D1|₀ |D2|₀ at the initial placement (1 when that is 0)
 /// Unitless (≈ a change of cos of the angle between them). Scene type `dot`.
 struct DotSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const DotSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, unitless
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "dot";

@@ -30,6 +30,11 @@ struct EquationSpec {
   std::shared_ptr<const CompiledExpression> g;
   std::optional<MotionLaw> law;  ///< f(t), in g's unit; none means f ≡ 0
   Unit unit = Unit::kNone;  ///< what g measures: the row's unit, for its tolerance (Unit::kNone: plain tol)
+  /// @copydoc DistanceSpec::operator==
+  /// Equations compare g by its program (CompiledExpression::operator==: a parameter is a constant of the tape).
+  bool operator==(const EquationSpec& o) const {
+    return unit == o.unit && law == o.law && (g == o.g || (g && o.g && *g == *o.g));
+  }
 
   /// @copydoc DistanceSpec::depends_on_time
   /// An equation depends on time if it has a law or if g contains t.

@@ -16,6 +16,8 @@ namespace phiq {
 /// Unitless and ≈ |p| − 1 near the solution (so a rough initial guess of p is enough). Scene: automatic, named
 /// `BODY.euler`.
 struct EulerParametersSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const EulerParametersSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, unitless
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "euler_parameters";

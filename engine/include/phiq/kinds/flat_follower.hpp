@@ -22,6 +22,8 @@ namespace phiq {
 /// constraint is added): a flat face touches a concave stretch at no single point. A translating follower is a
 /// body on a prismatic pair, an oscillating one a body on a revolute; the face is the same.
 struct FlatFollowerSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const FlatFollowerSpec&) const = default;
   static constexpr int kRows = 2;  ///< Φ0, the contact point's distance from the face; Φ1, the tangency
   /// @copydoc DistanceSpec::kKind
   /// Scene type `flat_cam`.

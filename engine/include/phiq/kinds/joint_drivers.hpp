@@ -16,6 +16,8 @@ namespace phiq {
 ///   Φ = z_a · (P_b − P_a) − f(t),   Φt = −f'(t)        (1 row, a length)
 /// Scene: a driver `{joint: NAME, measure: distance}`.
 struct JointDistanceDriverSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const JointDistanceDriverSpec&) const = default;
 
   /// @copydoc DistanceSpec::joint_count
   /// A driver is not counted.
@@ -83,6 +85,8 @@ struct JointDistanceDriverSpec {
 /// driver runs through any number of turns. Φq = (c ∂s − s ∂c) / (c² + s²), Φt = −f'(t).
 /// Both sides must be bodies or ground. Scene: a driver `{joint: NAME}` (`measure: angle`).
 struct JointAngleDriverSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const JointAngleDriverSpec&) const = default;
  private:
   // c = x_a · x_b and s = y_a · x_b
   static constexpr detail3::RowDef kDefs[2] = {{detail3::T(detail3::kXa), detail3::T(detail3::kXb), Unit::kNone},

@@ -26,6 +26,7 @@ enum class JointMark {
 namespace kin {
 struct V2 {
   double x, y;
+  bool operator==(const V2&) const = default;
 };
 inline V2 operator+(V2 a, V2 b) { return {a.x + b.x, a.y + b.y}; }
 inline V2 operator-(V2 a, V2 b) { return {a.x - b.x, a.y - b.y}; }

@@ -15,17 +15,21 @@ namespace phiq {
 /// sums of relative joint angles as in the notes: ψ2, ψ2 + ψ3, ψ2 + ψ3 + ψ4), add up to the constant closure vector c:
 ///   Φ = Σ_k ℓ_k (cos θ_k, sin θ_k) − c                  (2 rows, lengths)
 struct LoopSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const LoopSpec&) const = default;
   static constexpr int kRows = 2;  ///< two rows: x and y of the closure error, lengths
   /// @copydoc DistanceSpec::kKind
   /// Scene type `loop`.
   static constexpr const char* kKind = "loop";
   /// One term sign · q_j of the angle θ_k of a link.
   struct Term {
+    bool operator==(const Term&) const = default;  ///< the slot and its factor
     Slot angle;  ///< q_j, an angle (rad): usually a coordinate (absolute or relative joint angle)
     double sign = 1.0;  ///< its factor in θ_k: +1 or −1 (any finite factor is accepted)
   };
   /// One link of the loop: the vector ℓ_k (cos θ_k, sin θ_k), with θ_k = offset + Σ_terms sign · q_j.
   struct Link {
+    bool operator==(const Link&) const = default;  ///< datum by datum
     Slot length;  ///< ℓ_k (m): a constant link length, or a coordinate (e.g. a slider travel)
     double offset = 0.0;  ///< constant part of θ_k (rad), finite
     std::vector<Term> terms;  ///< the variable part of θ_k; empty for a link of constant direction

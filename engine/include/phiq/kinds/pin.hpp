@@ -15,6 +15,8 @@ namespace phiq {
 ///   Φ = r_a + R(ψ_a) s_a − r_b − R(ψ_b) s_b            (2 rows, lengths)
 /// A natural point is a frame with ψ constant and s = 0.
 struct PinSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const PinSpec&) const = default;
   static constexpr int kRows = 2;  ///< two rows: x and y of the gap between the attachment points
   /// @copydoc DistanceSpec::kKind
   /// Scenes write a pin as `revolute` (between attachments) or `fixed_point` (a point at constant coordinates).

@@ -20,6 +20,8 @@ namespace phiq {
 /// c: the outside of a counter-clockwise closed profile, as circles and radius tables are). With u = c′/|c′| and
 /// κ = c′ × c″ / |c′|² (the turn of the tangent per unit s), n′ = κ u and n″ = κ′ u − κ² n: p″ needs c‴.
 struct PointOnCurveSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const PointOnCurveSpec&) const = default;
   static constexpr int kRows = 2;  ///< two rows: x and y of the gap between the point and the curve's point
   /// @copydoc DistanceSpec::kKind
   /// Scenes write it `point_on_curve` (a point or a pin in a slot) or `cam` (a knife-edge or roller follower).

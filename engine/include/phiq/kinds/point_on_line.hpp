@@ -14,6 +14,8 @@ namespace phiq {
 /// ref is |b − a| at the initial placement (set when the model is built), so that the row is the distance of p from
 /// the line, a length. It scales the row; it does not change the solution.
 struct PointOnLineSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const PointOnLineSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row: the distance of p from the line
   /// @copydoc DistanceSpec::kKind
   /// Scene type `point_on_line`.

@@ -13,6 +13,8 @@ namespace phiq {
 /// y_A − L2 sin θ2 = 0 with o the origin):
 ///   Φ = p − o − L (cos θ, sin θ)                         (2 rows, lengths)
 struct PolarSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const PolarSpec&) const = default;
   static constexpr int kRows = 2;  ///< two rows: x and y, lengths
   /// @copydoc DistanceSpec::kKind
   /// Scene type `polar`.

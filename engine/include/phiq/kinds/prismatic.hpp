@@ -14,6 +14,8 @@ namespace phiq {
 ///   Φ0 = ψ_b − ψ_a − θ0                 (no relative rotation; angle)
 ///   Φ1 = e × (P_b − P_a)                (P_b stays on the line of a; length since |e| = 1)
 struct PrismaticSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const PrismaticSpec&) const = default;
   static constexpr int kRows = 2;  ///< two rows: Φ0 (relative rotation) and Φ1 (distance of P_b from the line)
   /// @copydoc DistanceSpec::kKind
   /// Scene type `prismatic`.

@@ -2,7 +2,7 @@
 /// The registry of constraint kinds: the one list that the model builder, the scene reader, the mechanism sketch,
 /// the Grübler count, the documentation and the tests iterate over. A new kind is one header in kinds/ (its
 /// equation in a comment, residual, Jacobian entries, Φt, γ, the validation of its data, its joint count, its
-/// sketch and its scene forms), one line below, and one finite-difference test; the ConstraintKind concept refuses
+/// sketch, its scene forms and its value equality), one line below, and one finite-difference test; the ConstraintKind concept refuses
 /// at compile time a registered kind that lacks any of these members, and tests/test_kind_registry.cpp fails for
 /// one without a finite-difference check, without its scene examples in models/README.md, or with a constraint type
 /// missing from the fuzzing dictionary or claimed by another kind.
@@ -71,6 +71,7 @@ concept ConstraintKind = requires(K k, const K ck, const double* q, double* out,
   ck.phi_t(q, 0.0, out);
   ck.gamma(q, q, 0.0, out);
   { ck.joint_count() } -> std::same_as<JointCount>;
+  { ck == ck } -> std::same_as<bool>;
   k.prepare(q);
   ck.sketch(sketch);
   { K::kScene[0] } -> std::convertible_to<SceneForm>;

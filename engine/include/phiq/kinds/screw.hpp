@@ -23,6 +23,8 @@ namespace phiq {
 /// those of d. p > 0 is a right-handed thread, p < 0 a left-handed one; p = 0 (a revolute joint) is refused.
 /// Both sides must be bodies or ground. Scene type `screw`: `between: [S1, S2]`, `pitch: p` (m per turn).
 struct ScrewSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const ScrewSpec&) const = default;
  private:
   // the cylindrical rows, then c, s and d
   static constexpr detail3::RowDef kDefs[7] = {

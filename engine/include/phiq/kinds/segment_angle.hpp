@@ -14,6 +14,8 @@ namespace phiq {
 ///   Φ = (x_b − x_a) sin θ − (y_b − y_a) cos θ       = |b − a| sin(θ_ab − θ), a length
 /// Its gradient never vanishes for a segment of non-zero length, unlike a cos/sin pair chosen by quadrant.
 struct SegmentAngleSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const SegmentAngleSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, a length
   /// @copydoc DistanceSpec::kKind
   /// Scene type `segment_angle`.

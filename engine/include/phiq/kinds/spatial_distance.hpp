@@ -17,6 +17,8 @@ namespace phiq {
 ///   Φ = (|B − A|² − L²) / (2L)        (1 row, a length ≈ |B − A| − L)
 /// Scene type `distance` (dimension 3).
 struct SpatialDistanceSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const SpatialDistanceSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, a length
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "distance";

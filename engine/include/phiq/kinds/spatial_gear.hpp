@@ -30,6 +30,8 @@ namespace phiq {
 /// so is one joint for both. Scene type `spatial_gear`: `shafts: [J1, J2]` (named joints above it),
 /// `angles: [θ1, θ2]` (coordinates), `teeth: [z1, z2]` or `radii: [r1, r2]`, `reversed` (false), `phase: φ` (0).
 struct SpatialGearSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const SpatialGearSpec&) const = default;
   static constexpr int kRows = 3;  ///< the two shafts' angles and the ratio
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "spatial_gear";

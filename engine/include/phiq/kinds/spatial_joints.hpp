@@ -34,6 +34,7 @@ namespace phiq {
 /// One side of a spatial joint, as given: a body (or ground) with a local point and a local axis and reference
 /// direction, or a natural point with an optional natural unit vector. Build it with the factories.
 struct JointSide3 {
+  bool operator==(const JointSide3&) const = default;  ///< datum by datum
   Frame3 frame = Frame3::ground();  ///< the body; for a natural point, x, y, z are the point and p is constant
   kin3::V3 at;                      ///< the joint point in the body's frame (m); 0 for a natural point
   kin3::V3 axis{0, 0, 1};           ///< the joint axis z in the body's frame (normalised by setup)
@@ -236,6 +237,8 @@ void side_slots(const JointSide3& s, F& f) {
 /// them and derives the attachments the rows read.
 template <class Traits>
 struct SpatialJointSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const SpatialJointSpec&) const = default;
   static constexpr int kRows = Traits::kRows;  ///< the freedoms the joint removes
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = Traits::kKind;

@@ -27,6 +27,8 @@ namespace phiq {
 /// Scene type `polar` (dimension 3): `point: P`, `center: {body: B, at, axis, ref}` (ground by default),
 /// `radius: r` (≠ 0), `angle: θ` (a coordinate or a constant).
 struct SpatialPolarSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const SpatialPolarSpec&) const = default;
  private:
   // rows k: (P_b − P_a)_k, (x_a)_k, (y_a)_k
   static constexpr detail3::RowDef kDefs[9] = {
@@ -144,6 +146,8 @@ struct SpatialPolarSpec {
 /// `joint: J` (the sides of a named revolute, cylindrical or screw joint), `angle: θ`; `segment_angle` with
 /// `segment: [A, B]`, `axis: {body: B, axis, ref}` (ground by default), `angle: θ` (a coordinate).
 struct SpatialAngleSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const SpatialAngleSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, an angle
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "angle3";

@@ -24,6 +24,7 @@ namespace detail {
 // A row Σ w_k q_k − c over three slots (a constant slot adds w_k times its value and emits no entry): what every
 // transmission evaluates. Φ is linear in q: Φt = 0, γ = 0.
 struct LinearRow {
+  bool operator==(const LinearRow&) const = default;
   std::array<Slot, 3> slot{Slot::constant(0), Slot::constant(0), Slot::constant(0)};
   std::array<double, 3> w{0.0, 0.0, 0.0};
   double c = 0.0;
@@ -46,6 +47,8 @@ inline void require_positive_pair(double r1, double r2, const char* message) {
 /// draw (the bodies are drawn by their joints).
 template <class Derived>
 struct LinearTransmission {
+  /// No data of its own: the derived kind's operator== compares its own.
+  bool operator==(const LinearTransmission&) const = default;
   /// @copydoc phiq::DistanceSpec::depends_on_time
   bool depends_on_time() const { return false; }
   /// @copydoc phiq::DistanceSpec::residual
@@ -83,6 +86,8 @@ struct LinearTransmission {
 /// coordinate), `radii: [r1, r2]` or `teeth: [z1, z2]`, `mesh: external | internal` (external), `carrier: C` (a
 /// body or an angle coordinate; none), `phase: φ` (0).
 struct GearSpec : LinearTransmission<GearSpec> {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const GearSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, an angle
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "gear";
@@ -149,6 +154,8 @@ struct GearSpec : LinearTransmission<GearSpec> {
 /// Scene type `rack_pinion` (any dimension): `rack: x` (a travel coordinate), `pinion: P` (a body — its ψ,
 /// dimension 2 — or an angle coordinate), `radius: r` (> 0), `offset: c` (0), `reversed: true | false` (false).
 struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const RackPinionSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, a length
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "rack_pinion";
@@ -208,6 +215,8 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
 /// Scene types `belt` and `chain` (any dimension): `between: [P1, P2]` (bodies — ψ, dimension 2 — or angle
 /// coordinates), `radii: [r1, r2]` or `teeth: [z1, z2]`, `crossed: true | false` (false), `phase: φ` (0).
 struct BeltSpec : LinearTransmission<BeltSpec> {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const BeltSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, an angle
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "belt";

@@ -16,6 +16,8 @@ namespace phiq {
 ///   Φ = (u · u − 1) / 2
 /// Unitless. Scene: automatic, named `VECTOR.unit`.
 struct UnitVectorSpec {
+  /// @copydoc DistanceSpec::operator==
+  bool operator==(const UnitVectorSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, unitless
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "unit_vector";
