@@ -18,11 +18,12 @@
 ///
 ///   D f = [f(−2h) − 8 f(−h) + 8 f(h) − f(2h)] / (12 h),
 ///
-/// of functions evaluated exactly by each model (Φ, Φq, Φt, γ at the shifted q, q̇). D is exact, up to rounding,
-/// for every dependence of degree ≤ 4 in p: lengths (Φ quadratic in them), local coordinates and offsets (linear),
-/// the law coefficients of polynomial drivers. For a parameter inside a sine or cosine (an angle), its error is
-/// h⁴/30 of the fifth derivative: 3·10⁻¹⁴ relative at the default h = 10⁻³ |p|. Rounding adds about
-/// ε |Φ's terms| / h. The tests compare with closed forms to 1e-9 and with re-solved sweeps (models/README.md).
+/// of functions evaluated exactly by each model (Φ, Φq, Φt, γ at the shifted q, q̇), over the constraints whose data
+/// the models change (ParameterReach) where q is not moved along s. D is exact, up to rounding, for every
+/// dependence of degree ≤ 4 in p: local coordinates and offsets (linear), the law coefficients of polynomial
+/// drivers. For a bar's length L, Φ = (|d|² − L²)/(2L) is rational in L: the error is 2(h/L)⁴ of ∂Φ/∂L, 2·10⁻¹² at
+/// the default h = 10⁻³ |p|; for a parameter inside a sine or cosine (an angle), h⁴/30 of the fifth derivative:
+/// 3·10⁻¹⁴ relative. Rounding adds about ε |Φ's terms| / h. The tests compare with closed forms to 1e-9 and with re-solved sweeps (models/README.md).
 #pragma once
 
 #include <array>
@@ -61,9 +62,9 @@ struct OutputSensitivity {
   double value = 0.0;  ///< p
   double step = 0.0;   ///< h > 0
   std::array<std::shared_ptr<const Model>, 4> models;  ///< at p − 2h, p − h, p + h, p + 2h
-  /// What the parameter reaches (parameter_reach(): sensitivity_along() sets it; run_sweep() finds it when it is
-  /// null). Null: solve_sensitivities() evaluates every constraint along the parameter, as for a reach of
-  /// everything; the values agree up to rounding (outside the reach they are then the rounding of f − f, not 0).
+  /// What the parameter reaches (parameter_reach(): sensitivity_along() sets it, run_sweep() finds it once for the
+  /// sweep when it is null). Null: solve_sensitivities() finds it at each call (O(constraints) comparisons, fewer
+  /// operations than the evaluations of unreached constraints it spares).
   std::shared_ptr<const ParameterReach> reach;
 };
 

@@ -27,11 +27,10 @@ void difference_on(const ParameterReach& reach, const std::array<Eigen::VectorXd
   for (const Index r : reach.rows) d[r] = ((f[0][r] - f[3][r]) + 8.0 * (f[2][r] - f[1][r])) / (12.0 * h);
 }
 
-// v·w over the rows of `reach`, or over all rows when it is null.
-double dot_on(const ParameterReach* reach, const Eigen::VectorXd& v, const Eigen::VectorXd& w) {
-  if (!reach) return v.dot(w);
+// v·w over the rows of `reach`.
+double dot_on(const ParameterReach& reach, const Eigen::VectorXd& v, const Eigen::VectorXd& w) {
   double sum = 0.0;
-  for (const Index r : reach->rows) sum += v[r] * w[r];
+  for (const Index r : reach.rows) sum += v[r] * w[r];
   return sum;
 }
 
@@ -77,6 +76,9 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::fill(out, out + layout.size(parameters.size()), nan);
   const Eigen::Map<const Eigen::VectorXd> qv(q, n);
+  // A parameter's reach when it comes without one: found here (parameter_reach(), O(constraints) comparisons, fewer
+  // operations than evaluating every constraint in the four models).
+  ParameterReach found;
   for (std::size_t j = 0; j < parameters.size(); ++j) {
     const OutputSensitivity& p = parameters[j];
     const double h = p.step;
@@ -95,20 +97,16 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
       sc.d *= -1.0 / (12.0 * h);
       return solve_negated_difference(x);
     };
-    // Position: Φp from the residuals of the four models at q, over the constraints p reaches when they are known
-    // (the other rows of Φp are exactly 0).
-    if (p.reach) {
-      for (std::size_t k = 0; k < 4; ++k)
-        detail::evaluate_over_reach(*p.reach, *p.models[k], detail::AlongParameter::kResidual, q, nullptr, nullptr, t,
-                                    sc.f[k].data(), sc.along.data());
-      sc.d.setZero();
-      difference_on(*p.reach, sc.f, h, sc.d);
-      sc.d = -sc.d;
-      if (!solve_negated_difference(s)) return false;
-    } else {
-      for (std::size_t k = 0; k < 4; ++k) p.models[k]->residual(q, t, sc.f[k].data());
-      if (!solve_difference(s)) return false;
-    }
+    // Position: Φp from the residuals of the four models at q, over the constraints p reaches (the other rows of Φp
+    // are exactly 0).
+    const ParameterReach& reach = p.reach ? *p.reach : (found = parameter_reach(model, p));
+    for (std::size_t k = 0; k < 4; ++k)
+      detail::evaluate_over_reach(reach, *p.models[k], detail::AlongParameter::kResidual, q, nullptr, nullptr, t,
+                                  sc.f[k].data(), sc.along.data());
+    sc.d.setZero();
+    difference_on(reach, sc.f, h, sc.d);
+    sc.d = -sc.d;
+    if (!solve_negated_difference(s)) return false;
     if (order < 1) continue;
     // Velocity: Φq q̇ + Φt along (q, p) ← (s, 1). Each model's Φq at its shifted q is kept for the acceleration,
     // which reads it at the same point.
@@ -185,49 +183,25 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
   sc.a.resize(np), sc.b.resize(np), sc.c.resize(np);
   for (auto& f : sc.f) f.resize(m);
   sc.d.resize(m), sc.along.resize(m);
-  sc.jacobian[0].resize(nnz);
+  // The reaches of parameters that come without one, found here (none allocated when every parameter has one).
+  const bool missing = std::any_of(parameters.begin(), parameters.end(), [](const auto& p) { return !p.reach; });
+  std::vector<ParameterReach> found(missing ? np : 0);
+  std::vector<const ParameterReach*>& reaches = sc.reaches;
+  reaches.resize(np);
   for (std::size_t j = 0; j < np; ++j) {
     const OutputSensitivity& p = parameters[j];
-    if (p.reach) {  // over the constraints p reaches: a_j, b_j and c_j are read on their rows only (dot_on)
-      using detail::AlongParameter;
-      const AlongParameter terms[3] = {AlongParameter::kResidual, AlongParameter::kVelocityTerm,
-                                       AlongParameter::kAccelerationTerm};
-      Eigen::VectorXd* into[3] = {&sc.a[j], &sc.b[j], &sc.c[j]};
-      for (int o = 0; o <= order; ++o) {
-        for (std::size_t k = 0; k < 4; ++k)
-          detail::evaluate_over_reach(*p.reach, *p.models[k], terms[o], q, qd, qdd, t, sc.f[k].data(),
-                                      sc.along.data());
-        into[o]->resize(m);
-        difference_on(*p.reach, sc.f, p.step, *into[o]);
-      }
-      continue;
-    }
-    // D f as differences of the pairs: exactly zero where the four models agree (a parameter nothing reads), not
-    // the rounding of f − 8f + 8f − f
-    auto difference = [&](Eigen::VectorXd& into) {
-      into = ((sc.f[0] - sc.f[3]) + 8.0 * (sc.f[2] - sc.f[1])) / (12.0 * p.step);
-    };
-    for (std::size_t k = 0; k < 4; ++k) p.models[k]->residual(q, t, sc.f[k].data());
-    difference(sc.a[j]);
-    if (order < 1) continue;
-    const Eigen::Map<const Eigen::VectorXd> qdv(qd, n);
-    for (std::size_t k = 0; k < 4; ++k) {
-      const Model& mk = *p.models[k];
-      mk.jacobian(q, t, sc.jacobian[0].data());
-      sc.f[k].noalias() = view(sc.jacobian[0]) * qdv;
-      mk.phi_t(q, t, sc.d.data());
-      sc.f[k] += sc.d;
-      if (order >= 2) {
-        const Eigen::Map<const Eigen::VectorXd> qddv(qdd, n);
-        sc.g[k].noalias() = view(sc.jacobian[0]) * qddv;
-        mk.gamma(q, qd, t, sc.d.data());
-        sc.g[k] -= sc.d;
-      }
-    }
-    difference(sc.b[j]);
-    if (order >= 2) {
-      for (std::size_t k = 0; k < 4; ++k) sc.f[k].swap(sc.g[k]);
-      difference(sc.c[j]);
+    // over the constraints p reaches: a_j, b_j and c_j are read on their rows only (dot_on)
+    reaches[j] = p.reach ? p.reach.get() : &(found[j] = parameter_reach(model, p));
+    using detail::AlongParameter;
+    const AlongParameter terms[3] = {AlongParameter::kResidual, AlongParameter::kVelocityTerm,
+                                     AlongParameter::kAccelerationTerm};
+    Eigen::VectorXd* into[3] = {&sc.a[j], &sc.b[j], &sc.c[j]};
+    for (int o = 0; o <= order; ++o) {
+      for (std::size_t k = 0; k < 4; ++k)
+        detail::evaluate_over_reach(*reaches[j], *p.models[k], terms[o], q, qd, qdd, t, sc.f[k].data(),
+                                    sc.along.data());
+      into[o]->resize(m);
+      difference_on(*reaches[j], sc.f, p.step, *into[o]);
     }
   }
   // Φq of the swept model along the motion, q + kεq̇ at t + kε, and along q̈: the transposed second-derivative
@@ -313,7 +287,7 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
     }
     if (order >= 2) sc.nu -= 2.0 * sc.tau;  // ν − 2τ
     for (std::size_t j = 0; j < np; ++j) {
-      const ParameterReach* reach = parameters[j].reach.get();
+      const ParameterReach& reach = *reaches[j];
       out[layout.offset(j, 0) + i] = -dot_on(reach, sc.lambda, sc.a[j]);
       if (order >= 1) out[layout.offset(j, 1) + i] = dot_on(reach, sc.mu, sc.a[j]) - dot_on(reach, sc.lambda, sc.b[j]);
       if (order >= 2)

@@ -32,7 +32,7 @@ struct SensitivityScratch {
   // along q̈ (q + kεq̈); the adjoint vectors (over Φ's rows: zero at rows the square solves leave out) and the
   // solves' right-hand sides and results.
   std::vector<Eigen::VectorXd> a, b, c;
-  std::array<Eigen::VectorXd, 4> g;  // Φq q̈ − γ of each model along p (its Φq is the one f's velocity terms used)
+  std::vector<const ParameterReach*> reaches;  // each parameter's (the adjoint form's dot products)
   std::array<std::vector<double>, 4> first_along_motion;
   std::array<std::vector<double>, 7> along_motion;
   std::array<std::vector<double>, 4> along_acceleration;
