@@ -92,7 +92,11 @@ double default_sensitivity_step(double p);
 /// the motion), by central differences of fourth order (sixth for the second derivative; exact up to rounding
 /// where Φq is polynomial of low degree in q, as for lengths). So an output costs 1, 2 or 4 solves with Φqᵀ (for
 /// q, q̇, q̈) whatever the number of parameters, and a row 15 more evaluations of Φq; the direct form costs 1, 2
-/// or 3 solves per parameter.
+/// or 3 solves per parameter. The second derivative along the motion is that of a smooth Φq: where the seven
+/// points straddle a place where Φq is not smooth (a spline's knot, where its third derivative jumps, as a pin in a
+/// curved slot passes one), it would be off by percents, so a row whose sixth- and fourth-order second differences
+/// disagree (by more than 10⁻⁴ of the largest entry) is solved in the direct form instead, whose differences along
+/// p span only h |s|: WorkCounters::sensitivity_direct_rows counts them.
 enum class SensitivityForm { kAuto, kDirect, kAdjoint };
 
 /// "auto", "direct", "adjoint".

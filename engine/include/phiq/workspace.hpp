@@ -29,6 +29,9 @@ struct WorkCounters {
   /// Solves for sensitivities to design parameters (sensitivity.hpp): one per parameter, derivative order and
   /// delivered row, each with the row's factorisation
   Index sensitivity_solves = 0;
+  /// Rows of an adjoint-form sweep solved in the direct form instead, because Φq is not smooth along the motion
+  /// within the adjoint's difference (a spline's knot: SensitivityForm)
+  Index sensitivity_direct_rows = 0;
 };
 
 /// Per-thread data of the algorithms in kinematics.hpp and sweep.hpp. Not thread-safe: one thread at a time.

@@ -172,7 +172,9 @@ void bind_model(py::module_& m) {
       .def_readonly("gamma_evaluations", &WorkCounters::gamma_evaluations, "evaluations of γ")
       .def_readonly("point_evaluations", &WorkCounters::point_evaluations, "output point motions evaluated")
       .def_readonly("sensitivity_solves", &WorkCounters::sensitivity_solves,
-                    "solves for sensitivities to design parameters");
+                    "solves for sensitivities to design parameters")
+      .def_readonly("sensitivity_direct_rows", &WorkCounters::sensitivity_direct_rows,
+                    "rows of an adjoint-form sweep solved in the direct form (Φq not smooth along the motion)");
 
   py::class_<Workspace> ws(m, "Workspace",
                            "One thread's state for the solves: q, qd, qdd (numpy views, writable in place), the "

@@ -139,6 +139,7 @@ inline void add_counters(WorkCounters& into, const WorkCounters& now, const Work
   into.gamma_evaluations += now.gamma_evaluations - before.gamma_evaluations;
   into.point_evaluations += now.point_evaluations - before.point_evaluations;
   into.sensitivity_solves += now.sensitivity_solves - before.sensitivity_solves;
+  into.sensitivity_direct_rows += now.sensitivity_direct_rows - before.sensitivity_direct_rows;
 }
 
 }  // namespace phiq::detail

@@ -13,7 +13,9 @@ std::string SweepSummary::BriefReport() const {
     << " velocity and " << counters.acceleration_solves << " acceleration solves";
   if (counters.point_evaluations) s << ", " << counters.point_evaluations << " point evaluations";
   if (counters.sensitivity_solves)
-    s << ", " << counters.sensitivity_solves << " sensitivity solves (" << to_string(sensitivity_form) << ")";
+    s << ", " << counters.sensitivity_solves << " sensitivity solves (" << to_string(sensitivity_form)
+      << (counters.sensitivity_direct_rows ? ", " + std::to_string(counters.sensitivity_direct_rows) + " rows direct"
+                                           : std::string()) << ")";
   if (subdivisions) s << ", " << subdivisions << " step subdivisions";
   if (singular_positions) s << ", " << singular_positions << " singular positions passed";
   if (threads > 1)

@@ -252,7 +252,7 @@ void Sweeper::row_sensitivities() {
   }
   if (!(w->lu->rcond() >= kSingularRcond)) return not_defined();
   const int order = need_a_ ? 2 : need_v_ ? 1 : 0;
-  const Index solves_before = w->counters.sensitivity_solves;
+  const Index solves_before = w->counters.sensitivity_solves, direct_before = w->counters.sensitivity_direct_rows;
   const double* qd = order >= 1 ? current_.qd.data() : nullptr;
   const double* qdd = order >= 2 ? current_.qdd.data() : nullptr;
   const bool ok = sensitivity_form_ == SensitivityForm::kAdjoint
@@ -261,7 +261,10 @@ void Sweeper::row_sensitivities() {
                                                            sensitivity_scratch_, sensitivities_.data())
                       : sensitivities_with_factors(model_, opt_.sensitivities, t, current_.q.data(), qd, qdd, order,
                                                    *w->lu, *w, sensitivity_scratch_, sensitivities_.data());
-  if (w != ws_) ws_->counters.sensitivity_solves += w->counters.sensitivity_solves - solves_before;
+  if (w != ws_) {
+    ws_->counters.sensitivity_solves += w->counters.sensitivity_solves - solves_before;
+    ws_->counters.sensitivity_direct_rows += w->counters.sensitivity_direct_rows - direct_before;
+  }
   if (!ok) not_defined();
 }
 
