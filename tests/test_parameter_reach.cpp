@@ -142,14 +142,16 @@ TEST(ParameterReach, LawsCurvesAndExpressionsCompareByValue) {
     if (name == "t") return NameBinding{NameBinding::Kind::kTime};
     return std::nullopt;
   };
-  const auto g1 = CompiledExpression::compile("x^2 + 0.5*t", names), g2 = CompiledExpression::compile("x^2 + 0.5*t", names);
+  const auto g1 = CompiledExpression::compile("x^2 + 0.5*t", names);
+  const auto g2 = CompiledExpression::compile("x^2 + 0.5*t", names);
   const auto g3 = CompiledExpression::compile("x^2 + 0.25*t", names);
   EXPECT_EQ(*g1, *g2);
   EXPECT_FALSE(*g1 == *g3);
   const auto f1 = CompiledExpression::compile("0.5*t^2", names), f2 = CompiledExpression::compile("0.5*t^2", names);
   EXPECT_EQ(MotionLaw::expression(f1), MotionLaw::expression(f2));
   EXPECT_NE(MotionLaw::expression(f1), MotionLaw::expression(CompiledExpression::compile("0.25*t^2", names)));
-  EquationSpec e1{g1, std::nullopt, Unit::kNone}, e2{g2, std::nullopt, Unit::kNone}, e3{g3, std::nullopt, Unit::kNone};
+  EquationSpec e1{g1, std::nullopt, Unit::kNone}, e2{g2, std::nullopt, Unit::kNone};
+  const EquationSpec e3{g3, std::nullopt, Unit::kNone};
   EXPECT_TRUE(e1 == e2);
   EXPECT_FALSE(e1 == e3);
   e2.law = MotionLaw::linear(0, 1);
@@ -158,8 +160,9 @@ TEST(ParameterReach, LawsCurvesAndExpressionsCompareByValue) {
   const CurveOn c3{Frame2{}, Curve::circle({0, 0}, 0.5000001)};
   EXPECT_TRUE(c1 == c2);
   EXPECT_FALSE(c1 == c3);
-  EXPECT_TRUE(*Curve::spline({{0, 0}, {1, 0}, {2, 1}, {3, 3}}, false) == *Curve::spline({{0, 0}, {1, 0}, {2, 1}, {3, 3}}, false));
-  EXPECT_FALSE(*Curve::spline({{0, 0}, {1, 0}, {2, 1}, {3, 3}}, false) == *Curve::spline({{0, 0}, {1, 0}, {2, 1}, {3, 3.5}}, false));
+  const auto spline = [](double last) { return Curve::spline({{0, 0}, {1, 0}, {2, 1}, {3, last}}, false); };
+  EXPECT_TRUE(*spline(3) == *spline(3));
+  EXPECT_FALSE(*spline(3) == *spline(3.5));
 }
 
 // A family of 41 bars of which one reads the parameter: one span of one constraint in the distance block.

@@ -439,6 +439,39 @@ TEST(Sensitivity, TheAdjointFormEqualsTheDirectOne) {
   expect_adjoint_equals_direct("slots/curved_slot_crank.yaml", {{"L2", 0.2}, {"L3", 0.6}}, 5);
 }
 
+// Bars between natural points and a linear driver: Φq is linear in q, so its second difference along the motion is
+// rounding alone, which the smoothness check does not take for a knot: no row leaves the adjoint form, and its
+// values are the direct form's.
+TEST(Sensitivity, ALinearJacobianKeepsEveryRowAdjoint) {
+  const char* bars = R"(phiq: 1
+parameters: {L2: 0.3, L3: 1.0}
+coordinates: {xA: 0.0, yA: 0.3, xB: 0.96}
+points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
+constraints:
+  - {name: crank, type: distance, points: [O, A], length: L2}
+  - {name: rod, type: distance, points: [A, B], length: L3}
+drivers:
+  - {name: push, coordinate: xA, law: {type: linear, initial: 0, rate: 0.2}}
+time: {start: 0, end: 1, steps: 50}
+output: {coordinates: [xB], velocities: true, accelerations: true, sensitivities: [L2, L3]}
+)";
+  const Scene s = parse_scene(bars, "bars.yaml");
+  SweepOptions direct = s.sweep, adjoint = s.sweep;
+  direct.sensitivity_form = SensitivityForm::kDirect;
+  adjoint.sensitivity_form = SensitivityForm::kAdjoint;
+  const SensitivityTrace d = sweep_sensitivities(*s.model, direct), a = sweep_sensitivities(*s.model, adjoint);
+  EXPECT_EQ(a.summary.counters.sensitivity_direct_rows, 0);
+  const Index xb = s.model->coordinate_index("xB");
+  const SensitivityLayout layout{s.model->num_coordinates()};
+  ASSERT_EQ(a.s.size(), 51u);
+  for (std::size_t k = 0; k < a.s.size(); ++k)
+    for (std::size_t j = 0; j < 2; ++j)
+      for (int o = 0; o < 3; ++o) {
+        const Index at = layout.offset(j, o) + xb;
+        EXPECT_NEAR(a.s[k][at], d.s[k][at], 1e-10 * std::max(1.0, std::fabs(d.s[k][at]))) << k << " " << j << " " << o;
+      }
+}
+
 // The form is chosen by cost (effective_sensitivity_form): positions only, the crank-slider's slider xB alone to
 // L2 and L3 is solved in the adjoint form by itself (one solve a row where the direct form takes two) and is the
 // closed form's to 1e-9; with q̇ and q̈ two parameters do not pay for the adjoint's 15 evaluations of Φq a row, so

@@ -2,8 +2,8 @@
 /// The registry of constraint kinds: the one list that the model builder, the scene reader, the mechanism sketch,
 /// the Grübler count, the documentation and the tests iterate over. A new kind is one header in kinds/ (its
 /// equation in a comment, residual, Jacobian entries, Φt, γ, the validation of its data, its joint count, its
-/// sketch, its scene forms and its value equality), one line below, and one finite-difference test; the ConstraintKind concept refuses
-/// at compile time a registered kind that lacks any of these members, and tests/test_kind_registry.cpp fails for
+/// sketch, its scene forms and its value equality), one line below, and one finite-difference test; the
+/// ConstraintKind concept refuses at compile time a registered kind that lacks any of these members, and tests/test_kind_registry.cpp fails for
 /// one without a finite-difference check, without its scene examples in models/README.md, or with a constraint type
 /// missing from the fuzzing dictionary or claimed by another kind.
 #pragma once
