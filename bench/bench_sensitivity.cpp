@@ -131,13 +131,6 @@ BENCHMARK(BM_SensitivityForms)
 // first's time ÷ the second's (interleaved, summed over iterations).
 //
 //   build/bench/phiq_bench --benchmark_filter=SensitivityReach --benchmark_counters_tabular=true
-ParameterReach every_constraint(const Model& m) {
-  ParameterReach r;
-  r.everything = true;
-  for (std::size_t b = 0; b < m.blocks().size(); ++b) r.spans.push_back({b, 0, m.blocks()[b]->size()});
-  for (Index i = 0; i < m.num_equations(); ++i) r.rows.push_back(i);
-  return r;
-}
 
 // range(0) = N, range(1) = P, range(2) = adjoint.
 void BM_SensitivityReach(benchmark::State& state) {
@@ -148,7 +141,7 @@ void BM_SensitivityReach(benchmark::State& state) {
   reach.threads = 1;
   reach.sensitivity_form = state.range(2) ? SensitivityForm::kAdjoint : SensitivityForm::kDirect;
   SweepOptions everything = reach;
-  const auto all = std::make_shared<const ParameterReach>(every_constraint(*s.model));
+  const auto all = std::make_shared<const ParameterReach>(whole_model_reach(*s.model));
   for (OutputSensitivity& p : everything.sensitivities) p.reach = all;
   double a = 0, e = 0;
   for (auto _ : state) {

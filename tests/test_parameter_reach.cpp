@@ -257,16 +257,6 @@ TEST(ParameterReach, SameDataComparesTheConstraintsData) {
   }
 }
 
-// A reach of every constraint of `m`, as for models whose blocks do not match.
-std::shared_ptr<const ParameterReach> everything(const Model& m) {
-  auto r = std::make_shared<ParameterReach>();
-  r->everything = true;
-  for (std::size_t b = 0; b < m.blocks().size(); ++b)
-    if (m.blocks()[b]->size() > 0) r->spans.push_back({b, 0, m.blocks()[b]->size()});
-  for (Index row = 0; row < m.num_equations(); ++row) r->rows.push_back(row);
-  return r;
-}
-
 // The sensitivities evaluated over the reach are those evaluated over every constraint, in the direct and the
 // adjoint forms, at a row of a sweep: localised parameters (one crank's length among 40 bars, the crank-slider's
 // lengths) and one that reaches every bar. A parameter given without its reach gets it found: the same values, bit
@@ -279,7 +269,7 @@ void expect_reach_changes_nothing(const Scene& s, const std::vector<std::string>
       if (n == name) value = v;
     with.push_back(sensitivity_along(s, name, value));
     without.push_back(with.back());
-    without.back().reach = everything(*s.model);
+    without.back().reach = std::make_shared<const ParameterReach>(whole_model_reach(*s.model));
     unfound.push_back(with.back());
     unfound.back().reach = nullptr;
   }

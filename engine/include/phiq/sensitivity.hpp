@@ -72,6 +72,10 @@ struct OutputSensitivity {
 /// passed. O(constraints): a comparison of each constraint's data in the five models. Thread-safe.
 ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s);
 
+/// The reach of every constraint of `model` (ParameterReach::everything set): what parameter_reach() gives for models
+/// whose blocks do not match, and the whole-model evaluation along a parameter, for comparisons. Thread-safe.
+ParameterReach whole_model_reach(const Model& model);
+
 /// The default difference step for a parameter of value p: 10⁻³ |p|, or 10⁻³ for p = 0.
 double default_sensitivity_step(double p);
 

@@ -9,18 +9,6 @@ namespace phiq {
 
 namespace {
 
-// Every constraint of `model`, one span a block: the reach when the models' blocks cannot be matched.
-ParameterReach everything(const Model& model) {
-  ParameterReach r;
-  r.everything = true;
-  const auto& blocks = model.blocks();
-  for (std::size_t b = 0; b < blocks.size(); ++b)
-    if (blocks[b]->size() > 0) r.spans.push_back({b, 0, blocks[b]->size()});
-  r.rows.resize(static_cast<std::size_t>(model.num_equations()));
-  for (std::size_t i = 0; i < r.rows.size(); ++i) r.rows[i] = static_cast<Index>(i);
-  return r;
-}
-
 // Whether `a` and `b` hold the same kinds of blocks with the same constraints on the same rows: then constraint i
 // of block k is the same constraint in both, and its data can be compared.
 bool blocks_match(const Model& a, const Model& b) {
@@ -37,9 +25,20 @@ bool blocks_match(const Model& a, const Model& b) {
 
 }  // namespace
 
+ParameterReach whole_model_reach(const Model& model) {
+  ParameterReach r;
+  r.everything = true;
+  const auto& blocks = model.blocks();
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    if (blocks[b]->size() > 0) r.spans.push_back({b, 0, blocks[b]->size()});
+  r.rows.resize(static_cast<std::size_t>(model.num_equations()));
+  for (std::size_t i = 0; i < r.rows.size(); ++i) r.rows[i] = static_cast<Index>(i);
+  return r;
+}
+
 ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
   for (const auto& m : s.models)
-    if (!m || !blocks_match(model, *m)) return everything(model);
+    if (!m || !blocks_match(model, *m)) return whole_model_reach(model);
   ParameterReach r;
   const auto& blocks = model.blocks();
   for (std::size_t b = 0; b < blocks.size(); ++b) {

@@ -199,32 +199,6 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
   const std::size_t nnz = static_cast<std::size_t>(pattern.nnz());
   auto view = [&](std::vector<double>& values) { return jacobian_view(pattern, values); };
   const Eigen::Map<const Eigen::VectorXd> qv(q, n);
-  // Per parameter, its derivatives at fixed (q, q̇): a_j = ∂Φ/∂p, b_j = ∂(Φq q̇ + Φt)/∂p, c_j = ∂(Φq q̈ − γ)/∂p,
-  // by the same difference along p as the direct form.
-  sc.a.resize(np), sc.b.resize(np), sc.c.resize(np);
-  for (auto& f : sc.f) f.resize(m);
-  sc.d.resize(m), sc.along.resize(m);
-  // The reaches of parameters that come without one, found here (none allocated when every parameter has one).
-  const bool missing = std::any_of(parameters.begin(), parameters.end(), [](const auto& p) { return !p.reach; });
-  std::vector<ParameterReach> found(missing ? np : 0);
-  std::vector<const ParameterReach*>& reaches = sc.reaches;
-  reaches.resize(np);
-  for (std::size_t j = 0; j < np; ++j) {
-    const OutputSensitivity& p = parameters[j];
-    // over the constraints p reaches: a_j, b_j and c_j are read on their rows only (dot_on)
-    reaches[j] = p.reach ? p.reach.get() : &(found[j] = parameter_reach(model, p));
-    using detail::AlongParameter;
-    const AlongParameter terms[3] = {AlongParameter::kResidual, AlongParameter::kVelocityTerm,
-                                     AlongParameter::kAccelerationTerm};
-    Eigen::VectorXd* into[3] = {&sc.a[j], &sc.b[j], &sc.c[j]};
-    for (int o = 0; o <= order; ++o) {
-      for (std::size_t k = 0; k < 4; ++k)
-        detail::evaluate_over_reach(*reaches[j], *p.models[k], terms[o], q, qd, qdd, t, sc.f[k].data(),
-                                    sc.along.data());
-      into[o]->resize(m);
-      difference_on(*reaches[j], sc.f, p.step, *into[o]);
-    }
-  }
   // Φq of the swept model along the motion, q + kεq̇ at t + kε, and along q̈: the transposed second-derivative
   // terms are their differences applied to a vector. ε moves the fastest coordinate by 10⁻³ of its scale for the
   // fourth-order first differences; the second difference, whose rounding grows as 1/ε², is of sixth order at
@@ -279,6 +253,33 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
         for (Index i = 0; i < n; ++i)
           if (!written[static_cast<std::size_t>(i)]) out[layout.offset(j, o) + i] = nan;
     return true;
+  }
+  // (After the check above: a row solved in the direct form evaluates its own.) Per parameter, its derivatives at
+  // fixed (q, q̇): a_j = ∂Φ/∂p, b_j = ∂(Φq q̇ + Φt)/∂p, c_j = ∂(Φq q̈ − γ)/∂p,
+  // by the same difference along p as the direct form.
+  sc.a.resize(np), sc.b.resize(np), sc.c.resize(np);
+  for (auto& f : sc.f) f.resize(m);
+  sc.d.resize(m), sc.along.resize(m);
+  // The reaches of parameters that come without one, found here (none allocated when every parameter has one).
+  const bool missing = std::any_of(parameters.begin(), parameters.end(), [](const auto& p) { return !p.reach; });
+  std::vector<ParameterReach> found(missing ? np : 0);
+  std::vector<const ParameterReach*>& reaches = sc.reaches;
+  reaches.resize(np);
+  for (std::size_t j = 0; j < np; ++j) {
+    const OutputSensitivity& p = parameters[j];
+    // over the constraints p reaches: a_j, b_j and c_j are read on their rows only (dot_on)
+    reaches[j] = p.reach ? p.reach.get() : &(found[j] = parameter_reach(model, p));
+    using detail::AlongParameter;
+    const AlongParameter terms[3] = {AlongParameter::kResidual, AlongParameter::kVelocityTerm,
+                                     AlongParameter::kAccelerationTerm};
+    Eigen::VectorXd* into[3] = {&sc.a[j], &sc.b[j], &sc.c[j]};
+    for (int o = 0; o <= order; ++o) {
+      for (std::size_t k = 0; k < 4; ++k)
+        detail::evaluate_over_reach(*reaches[j], *p.models[k], terms[o], q, qd, qdd, t, sc.f[k].data(),
+                                    sc.along.data());
+      into[o]->resize(m);
+      difference_on(*reaches[j], sc.f, p.step, *into[o]);
+    }
   }
   // Bᵀv, and ∂(Φq q̈ − γ)/∂qᵀ v, into sc.rhs (over the coordinates).
   auto b_transposed = [&](const Eigen::VectorXd& v) {
