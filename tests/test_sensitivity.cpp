@@ -437,6 +437,57 @@ TEST(Sensitivity, TheAdjointFormEqualsTheDirectOne) {
   // A pin in a slot along a spline: the rows whose adjoint differences along the motion straddle one of its knots
   // (their sixth-order second difference was off by 0.4 to 2 % of ∂q̈/∂p) are solved in the direct form.
   expect_adjoint_equals_direct("slots/curved_slot_crank.yaml", {{"L2", 0.2}, {"L3", 0.6}}, 5);
+  // A flat follower on a circle whose radius is a parameter: the contact co-moves (ParameterReach::comotion)
+  expect_adjoint_equals_direct("cams/eccentric_flat.yaml", {{"R", 0.05}, {"e", 0.015}});
+}
+
+// An eccentric circular cam (radius R, eccentricity e, turning at ω) under a flat-faced follower: the face's height
+// is y = R + e sin ωt, so ∂y/∂R = 1, ∂y/∂e = sin ωt, ∂y/∂ω = e t cos ωt and their time derivatives, exactly. Over
+// ten turns the contact's curve parameter reaches s = 20πR: differenced at fixed s, a radius step h turns the circle
+// under the contact by s h / R², and ∂y/∂R was off by 7·10⁻⁶; the contact moves with the radius
+// (ParameterReach::comotion) instead. ∂θ/∂ω = t grows likewise, and the direct form's step along the motion is
+// scaled to it (a step h|s| put ∂ẏ/∂ω off by 4·10⁻⁷). Both forms, to 10⁻⁹.
+TEST(Sensitivity, ACamsRadiusOverTenTurnsAgainstTheClosedForm) {
+  std::string text = test::slurp(model_path("cams/eccentric_flat.yaml"));
+  text = test::replace_first(text, "time: {start: 0, end: 2*pi/omega, steps: 72}",
+                             "time: {start: 0, end: 20*pi/omega, steps: 720}");
+  text = test::replace_first(text, "output: {velocities: true, accelerations: true}",
+                             "output: {velocities: true, accelerations: true, sensitivities: [R, e, omega]}");
+  const Scene s = parse_scene(text, "cam.yaml");
+  ASSERT_EQ(s.sweep.sensitivities.size(), 3u);
+  const Model& model = *s.model;
+  // R moves the circle's length 2πR: the contact's parameter co-moves at (∂ℓ/∂R) / ℓ = 1/R; e and ω move no
+  // curve's length.
+  const Index cam_s = model.coordinate_index("cam.s");
+  const ParameterReach by_r = parameter_reach(model, s.sweep.sensitivities[0]);
+  ASSERT_EQ(by_r.comotion.size(), 1u);
+  EXPECT_EQ(by_r.comotion[0].coordinate, cam_s);
+  EXPECT_NEAR(by_r.comotion[0].rate, 1.0 / 0.05, 1e-9);
+  EXPECT_TRUE(parameter_reach(model, s.sweep.sensitivities[1]).comotion.empty());
+  EXPECT_TRUE(parameter_reach(model, s.sweep.sensitivities[2]).comotion.empty());
+  const double e = 0.015, w = 2.0;
+  const Index y = model.coordinate_index("yf");
+  const SensitivityLayout layout{model.num_coordinates()};
+  for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
+    SweepOptions o = s.sweep;
+    o.sensitivity_form = form;
+    const SensitivityTrace r = sweep_sensitivities(model, o);
+    ASSERT_EQ(r.s.size(), 721u);
+    double worst[3][3] = {};
+    for (std::size_t k = 0; k < r.s.size(); ++k) {
+      const double t = r.rows.t[k], c = std::cos(w * t), sn = std::sin(w * t);
+      const double exact[3][3] = {{1.0, 0.0, 0.0},                                             // R
+                                  {sn, w * c, -w * w * sn},                                     // e
+                                  {e * t * c, e * (c - w * t * sn), -e * w * (2 * sn + w * t * c)}};  // ω
+      for (std::size_t j = 0; j < 3; ++j)
+        for (int order = 0; order < 3; ++order)
+          worst[j][order] = std::max(worst[j][order],
+                                     std::fabs(r.s[k][layout.offset(j, order) + y] - exact[j][order]));
+    }
+    for (std::size_t j = 0; j < 3; ++j)
+      for (int order = 0; order < 3; ++order)
+        EXPECT_LE(worst[j][order], 1e-9) << to_string(form) << ", parameter " << j << ", order " << order;
+  }
 }
 
 // Bars between natural points and a linear driver: Φq is linear in q, so its second difference along the motion is

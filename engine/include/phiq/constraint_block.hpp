@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <memory>
 #include <string>
 #include <utility>
@@ -110,6 +111,13 @@ class ConstraintBlock {
   /// an open curve: PointOnCurveSpec::outside_domain()), and what happened; {size(), ""} when there is none.
   /// Kinds without a domain are always inside. Thread-safe.
   virtual std::pair<std::size_t, std::string> outside_domain(const double* /*q*/) const { return {size(), ""}; }
+  /// The coordinates constraint i adds (a kind with kAddedCoordinates: a curve's parameter) and the length each is
+  /// measured in proportion to (PointOnCurveSpec::added_scale()): at most `capacity` of them into `coordinate` and
+  /// `scale`, returning how many it adds (0 for the kinds that add none). For the sensitivities' co-motion
+  /// (ParameterReach::comotion). Thread-safe.
+  virtual int added_coordinates(std::size_t /*i*/, Index* /*coordinate*/, double* /*scale*/, int /*capacity*/) const {
+    return 0;
+  }
 };
 
 namespace detail {
@@ -248,6 +256,23 @@ class TypedBlock final : public ConstraintBlock {
         if (std::string why = entries_[i].spec.outside_domain(q); !why.empty()) return {i, std::move(why)};
     }
     return {entries_.size(), ""};
+  }
+  int added_coordinates(std::size_t i, Index* coordinate, double* scale, int capacity) const override {
+    if constexpr (requires { Spec::kAddedCoordinates; }) {
+      constexpr int kAdded = static_cast<int>(std::size(Spec::kAddedCoordinates));
+      static_assert(requires(const Spec& k) { k.added_scale(0); },
+                    "a kind with added coordinates states what each is measured in proportion to (added_scale)");
+      const Spec& spec = entries_[i].spec;
+      const int count = std::min(kAdded, capacity);
+      for (int k = 0; k < count; ++k) {
+        const Slot& slot = spec.added(k);
+        coordinate[k] = slot.is_coordinate() ? slot.coord() : -1;
+        scale[k] = spec.added_scale(k);
+      }
+      return count;
+    } else {
+      return 0;
+    }
   }
   void row_lengths(std::vector<double>& lengths) const override {
     for (const Entry& e : entries_)

@@ -18,12 +18,27 @@
 ///
 ///   D f = [f(−2h) − 8 f(−h) + 8 f(h) − f(2h)] / (12 h),
 ///
-/// of functions evaluated exactly by each model (Φ, Φq, Φt, γ at the shifted q, q̇), over the constraints whose data
-/// the models change (ParameterReach) where q is not moved along s. D is exact, up to rounding, for every
-/// dependence of degree ≤ 4 in p: local coordinates and offsets (linear), the law coefficients of polynomial
-/// drivers. For a bar's length L, Φ = (|d|² − L²)/(2L) is rational in L: the error is 2(h/L)⁴ of ∂Φ/∂L, 2·10⁻¹² at
-/// the default h = 10⁻³ |p|; for a parameter inside a sine or cosine (an angle), h⁴/30 of the fifth derivative:
-/// 3·10⁻¹⁴ relative. Rounding adds about ε |Φ's terms| / h. The tests compare with closed forms to 1e-9 and with re-solved sweeps (models/README.md).
+/// of functions evaluated exactly by each model (Φ, Φq q̇ + Φt, Φq q̈ − γ), at fixed (q, q̇, q̈) and over the
+/// constraints whose data the models change (ParameterReach). D is exact, up to rounding, for every dependence of
+/// degree ≤ 4 in p: local coordinates and offsets (linear), the law coefficients of polynomial drivers. For a bar's
+/// length L, Φ = (|d|² − L²)/(2L) is rational in L: the error is 2(h/L)⁴ of ∂Φ/∂L, 2·10⁻¹² at the default
+/// h = 10⁻³ |p|; for a parameter inside a sine or cosine (an angle), h⁴/30 of the fifth derivative: 3·10⁻¹⁴
+/// relative. Rounding adds about ε |Φ's terms| / h.
+///
+/// The higher orders' derivatives along the motion's own sensitivities, (q, q̇) ← (s, ṡ), are taken apart from p,
+/// with the swept model, by a fourth-order difference whose step moves the coordinate s moves most by 10⁻³ of its
+/// scale: s grows along a sweep (∂θ/∂ω = t for a crank at θ = ωt) and a step tied to h would grow with it.
+///
+/// A coordinate that a constraint adds and measures along its data (a curve's parameter s, PointOnCurveSpec) means
+/// another point when p changes the curve: at fixed s, a cam's circle of radius R turns under the contact by
+/// s h / R² for a step h, so that ten turns of a cam put ∂y/∂R off by 7·10⁻⁶. Such a coordinate co-moves with p
+/// (ParameterReach::comotion: q̂ = s (∂ℓ/∂p)/ℓ, ℓ the curve's length): the differences along p are taken along
+/// (q, p) ← (q̂, 1), where the models see one contact, and solve for s − q̂:
+///
+///   Φq (s − q̂) = −(Φp + Φq q̂),   and ṡ, s̈ with (s − q̂) in the part along the motion,
+///
+/// the same equations rearranged. The tests compare with closed forms to 1e-9 (that cam over ten turns among
+/// them) and with re-solved sweeps (models/README.md).
 #pragma once
 
 #include <array>
@@ -51,6 +66,18 @@ struct ParameterReach {
   /// True when the models' blocks could not be matched one to one (another order or size): then every constraint
   /// of the model is in `spans`.
   bool everything = false;
+  /// A coordinate that a reached constraint adds (a curve's parameter s) and how it moves along the parameter at the
+  /// same contact: q_c · rate per unit of p, with rate = (∂ℓ/∂p) / ℓ and ℓ its scale (PointOnCurveSpec::added_scale():
+  /// the curve's length). Differenced at fixed s, a curve whose radius is the parameter turns under the contact by
+  /// s / ℓ times the relative step (10 turns of a cam: ∂y/∂R off by 7·10⁻⁶); moved so, the four models see one
+  /// contact, and the part of the move along q at fixed p is taken away with the swept model (sensitivity.hpp).
+  struct Comotion {
+    Index coordinate = 0;  ///< the added coordinate's index
+    double rate = 0.0;     ///< (∂ℓ/∂p) / ℓ, 1/(the parameter's unit)
+  };
+  /// The added coordinates of reached constraints whose scale the parameter changes; every constraint that reads
+  /// one of them is in `spans`. Empty when `everything` is set.
+  std::vector<Comotion> comotion;
 };
 
 /// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the

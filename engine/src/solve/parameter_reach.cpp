@@ -1,6 +1,7 @@
 // What a design parameter reaches (sensitivity.hpp, ParameterReach): the constraints whose data its models change,
 // found once per sweep, and the derivatives along the parameter evaluated over those constraints only.
 #include <algorithm>
+#include <cmath>
 
 #include "phiq/sensitivity.hpp"
 #include "solve/sensitivity_internal.hpp"
@@ -41,13 +42,49 @@ ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
     if (!m || !blocks_match(model, *m)) return whole_model_reach(model);
   ParameterReach r;
   const auto& blocks = model.blocks();
+  // Which constraints of each block the parameter reaches: those whose data differ in some model along it.
+  std::vector<std::vector<char>> reached(blocks.size());
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const ConstraintBlock& block = *blocks[b];
+    reached[b].assign(block.size(), 0);
+    for (std::size_t i = 0; i < block.size(); ++i)
+      for (const auto& m : s.models)
+        if (!block.same_data(i, *m->blocks()[b])) reached[b][i] = 1;
+  }
+  // The coordinates they add whose scale moves with the parameter (a curve's length), with the relative rate of
+  // that scale by the same fourth-order difference as the derivatives.
+  constexpr int kCapacity = 4;
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    for (std::size_t i = 0; i < blocks[b]->size(); ++i) {
+      if (!reached[b][i]) continue;
+      Index coordinate[kCapacity];
+      double scale[kCapacity], along[4][kCapacity];
+      const int added = blocks[b]->added_coordinates(i, coordinate, scale, kCapacity);
+      for (std::size_t k = 0; k < 4 && added > 0; ++k)
+        s.models[k]->blocks()[b]->added_coordinates(i, coordinate, along[k], kCapacity);
+      for (int a = 0; a < added; ++a) {
+        const double rate =
+            ((along[0][a] - along[3][a]) + 8.0 * (along[2][a] - along[1][a])) / (12.0 * s.step) / scale[a];
+        if (coordinate[a] >= 0 && rate != 0.0 && std::isfinite(rate)) r.comotion.push_back({coordinate[a], rate});
+      }
+    }
+  // Every constraint that reads a co-moving coordinate is evaluated along p too (its rows move with the coordinate).
+  if (!r.comotion.empty()) {
+    std::vector<char> moved_row(static_cast<std::size_t>(model.num_equations()), 0);
+    const CscPattern& pattern = model.jacobian_pattern();
+    for (const ParameterReach::Comotion& c : r.comotion)
+      for (Index k = pattern.col_ptr[c.coordinate]; k < pattern.col_ptr[c.coordinate + 1]; ++k)
+        moved_row[static_cast<std::size_t>(pattern.row_idx[k])] = 1;
+    for (std::size_t b = 0; b < blocks.size(); ++b)
+      for (std::size_t i = 0; i < blocks[b]->size(); ++i)
+        for (int k = 0; k < blocks[b]->rows_per_constraint(); ++k)
+          if (moved_row[static_cast<std::size_t>(blocks[b]->first_row(i) + k)]) reached[b][i] = 1;
+  }
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     const ConstraintBlock& block = *blocks[b];
     const std::size_t rows_each = static_cast<std::size_t>(block.rows_per_constraint());
     for (std::size_t i = 0; i < block.size(); ++i) {
-      bool same = true;
-      for (const auto& m : s.models) same = same && block.same_data(i, *m->blocks()[b]);
-      if (same) continue;
+      if (!reached[b][i]) continue;
       if (!r.spans.empty() && r.spans.back().block == b && r.spans.back().end == i) ++r.spans.back().end;
       else r.spans.push_back({b, i, i + 1});
       for (std::size_t k = 0; k < rows_each; ++k) r.rows.push_back(block.first_row(i) + static_cast<Index>(k));

@@ -27,6 +27,32 @@ void difference_on(const ParameterReach& reach, const std::array<Eigen::VectorXd
   for (const Index r : reach.rows) d[r] = ((f[0][r] - f[3][r]) + 8.0 * (f[2][r] - f[1][r])) / (12.0 * h);
 }
 
+// The derivative of f = `which` along the parameter over the rows of `reach`, into `d` (its other rows untouched):
+// at fixed (q, q̇, q̈), or, where the parameter moves the scale of coordinates that reached constraints add
+// (ParameterReach::comotion: a curve's parameter), along (q, p) ← (q̂, 1), q̂ that move: the models then see one
+// contact (at fixed s, a curve whose radius is the parameter turns under it s / ℓ times faster than p moves).
+// Callers solve for s − q̂ (sensitivity.hpp): Φq (s − q̂) = −(Φp + Φq q̂), the higher orders alike.
+void along_parameter(const OutputSensitivity& p, const ParameterReach& reach, detail::AlongParameter which,
+                     const double* q, const double* qd, const double* qdd, double t, detail::SensitivityScratch& sc,
+                     Eigen::VectorXd& d) {
+  const double h = p.step;
+  const double* at = q;
+  if (!reach.comotion.empty())
+    sc.moved = Eigen::Map<const Eigen::VectorXd>(q, p.models[0]->num_coordinates()), at = sc.moved.data();
+  for (std::size_t k = 0; k < 4; ++k) {
+    for (const ParameterReach::Comotion& c : reach.comotion)
+      sc.moved[c.coordinate] = q[c.coordinate] * (1.0 + kShift[k] * h * c.rate);
+    detail::evaluate_over_reach(reach, *p.models[k], which, at, qd, qdd, t, sc.f[k].data(), sc.along.data());
+  }
+  difference_on(reach, sc.f, h, d);
+}
+
+// q̂ of `reach` at q into x (ParameterReach::comotion): zero but for the co-moving coordinates.
+void comotion(const ParameterReach& reach, const double* q, double* x, Index n) {
+  std::fill(x, x + n, 0.0);
+  for (const ParameterReach::Comotion& c : reach.comotion) x[c.coordinate] = q[c.coordinate] * c.rate;
+}
+
 // v·w over the rows of `reach`.
 double dot_on(const ParameterReach& reach, const Eigen::VectorXd& v, const Eigen::VectorXd& w) {
   double sum = 0.0;
@@ -97,62 +123,79 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::fill(out, out + layout.size(parameters.size()), nan);
   const Eigen::Map<const Eigen::VectorXd> qv(q, n);
+  const double* cs = model.tolerance_scales().coordinate_scale.data();
   // A parameter's reach when it comes without one: found here (parameter_reach(), O(constraints) comparisons, fewer
   // operations than evaluating every constraint in the four models).
   ParameterReach found;
   for (std::size_t j = 0; j < parameters.size(); ++j) {
     const OutputSensitivity& p = parameters[j];
-    const double h = p.step;
     double* s = out + layout.offset(j, 0);
     double* sd = out + layout.offset(j, 1);
     double* sdd = out + layout.offset(j, 2);
-    // sc.d, which holds −D f, solved with Φq into x: the sensitivity of one order.
+    // sc.d, which holds −(D f), solved with Φq into x: the sensitivity of one order.
     auto solve_negated_difference = [&](double* x) {
       ++ws.counters.sensitivity_solves;
       return lu.solve(solve_rhs(model, ws, sc.d), x);
     };
-    // −D f over every row, solved: the orders whose functions are taken at q moved along s (every row changes).
-    auto solve_difference = [&](double* x) {
-      sc.d.setZero();
-      for (std::size_t k = 0; k < 4; ++k) sc.d += kWeight[k] * sc.f[k];
-      sc.d *= -1.0 / (12.0 * h);
+    // sc.d (the part along p) plus the difference of sc.f along the motion's sensitivities with step e, negated
+    // and solved.
+    auto solve_difference = [&](double e, double* x) {
+      // in pairs, as difference_on: exactly zero where s is (the four points are one)
+      sc.d += ((sc.f[0] - sc.f[3]) + 8.0 * (sc.f[2] - sc.f[1])) / (12.0 * e);
+      sc.d = -sc.d;
       return solve_negated_difference(x);
     };
-    // Position: Φp from the residuals of the four models at q, over the constraints p reaches (the other rows of Φp
-    // are exactly 0).
+    // The part along p at fixed (q, q̇, q̈) of `which`, over the constraints p reaches, into sc.d (zero elsewhere).
     const ParameterReach& reach = p.reach ? *p.reach : (found = parameter_reach(model, p));
-    for (std::size_t k = 0; k < 4; ++k)
-      detail::evaluate_over_reach(reach, *p.models[k], detail::AlongParameter::kResidual, q, nullptr, nullptr, t,
-                                  sc.f[k].data(), sc.along.data());
-    sc.d.setZero();
-    difference_on(reach, sc.f, h, sc.d);
+    auto along_p = [&](detail::AlongParameter which) {
+      sc.d.setZero();
+      along_parameter(p, reach, which, q, qd, qdd, t, sc, sc.d);
+    };
+    // Position: Φp (the other rows of Φp are exactly 0).
+    along_p(detail::AlongParameter::kResidual);
     sc.d = -sc.d;
-    if (!solve_negated_difference(s)) return false;
+    if (!solve_negated_difference(s)) return false;  // s − q̂
+    if (!reach.comotion.empty()) {
+      sc.comoving.resize(n);
+      comotion(reach, q, sc.comoving.data(), n);
+      for (Index i = 0; i < n; ++i) s[i] += sc.comoving[i];
+    }
     if (order < 1) continue;
-    // Velocity: Φq q̇ + Φt along (q, p) ← (s, 1). Each model's Φq at its shifted q is kept for the acceleration,
-    // which reads it at the same point.
-    const Eigen::Map<const Eigen::VectorXd> sv(s, n), qdv(qd, n);
+    // The higher orders' right-hand sides are derivatives along (q, q̇, p) ← (s, ṡ, 1), taken in two parts, as
+    // the adjoint form takes them: along (q, p) ← (q̂, 1) at fixed q̇, with the models over the reach, and along
+    // (s − q̂, ṡ) at fixed p, with the swept model at q + kε(s − q̂), ε moving the coordinate that s − q̂ moves most
+    // by 10⁻³ of its scale. In one, with the models at q + khs, the step would move q by h|s|, and s grows along a
+    // sweep (∂θ/∂ω = t for a crank at θ = ωt: ten turns of a cam put ∂ẏ/∂ω off by 4·10⁻⁷, against 10⁻¹⁰ so).
+    const Eigen::Map<const Eigen::VectorXd> qdv(qd, n);
+    Eigen::VectorXd& sv = sc.sprime;
+    sv = Eigen::Map<const Eigen::VectorXd>(s, n);
+    if (!reach.comotion.empty()) sv -= sc.comoving;
+    double rate = 0.0;
+    for (Index i = 0; i < n; ++i) rate = std::max(rate, std::fabs(sv[i]) / cs[i]);
+    const double step = 1e-3 / std::max(rate, 1e-3);
+    // Velocity: Φq q̇ + Φt. The swept model's Φq at each q + kε(s − q̂) is kept for the acceleration (the same
+    // points).
+    along_p(detail::AlongParameter::kVelocityTerm);
     for (std::size_t k = 0; k < 4; ++k) {
-      const Model& mk = *p.models[k];
-      sc.qk = qv + (kShift[k] * h) * sv;
-      mk.jacobian(sc.qk.data(), t, sc.jacobian[k].data());
+      sc.qk = qv + (kShift[k] * step) * sv;
+      model.jacobian(sc.qk.data(), t, sc.jacobian[k].data());
       sc.f[k].noalias() = jacobian(k) * qdv;
-      mk.phi_t(sc.qk.data(), t, sc.d.data());
-      sc.f[k] += sc.d;
+      model.phi_t(sc.qk.data(), t, sc.along.data());
+      sc.f[k] += sc.along;
     }
-    if (!solve_difference(sd)) return false;
+    if (!solve_difference(step, sd)) return false;
     if (order < 2) continue;
-    // Acceleration: Φq q̈ − γ along (q, q̇, p) ← (s, ṡ, 1), q̈ held.
+    // Acceleration: Φq q̈ − γ, q̈ held.
     const Eigen::Map<const Eigen::VectorXd> sdv(sd, n), qddv(qdd, n);
+    along_p(detail::AlongParameter::kAccelerationTerm);
     for (std::size_t k = 0; k < 4; ++k) {
-      const Model& mk = *p.models[k];
-      sc.qk = qv + (kShift[k] * h) * sv;
-      sc.vk = qdv + (kShift[k] * h) * sdv;
+      sc.qk = qv + (kShift[k] * step) * sv;
+      sc.vk = qdv + (kShift[k] * step) * sdv;
       sc.f[k].noalias() = jacobian(k) * qddv;
-      mk.gamma(sc.qk.data(), sc.vk.data(), t, sc.d.data());
-      sc.f[k] -= sc.d;
+      model.gamma(sc.qk.data(), sc.vk.data(), t, sc.along.data());
+      sc.f[k] -= sc.along;
     }
-    if (!solve_difference(sdd)) return false;
+    if (!solve_difference(step, sdd)) return false;
   }
   return true;
 }
@@ -255,8 +298,9 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
     return true;
   }
   // (After the check above: a row solved in the direct form evaluates its own.) Per parameter, its derivatives at
-  // fixed (q, q̇): a_j = ∂Φ/∂p, b_j = ∂(Φq q̇ + Φt)/∂p, c_j = ∂(Φq q̈ − γ)/∂p,
-  // by the same difference along p as the direct form.
+  // fixed (q, q̇): a_j = ∂Φ/∂p, b_j = ∂(Φq q̇ + Φt)/∂p, c_j = ∂(Φq q̈ − γ)/∂p, by the same difference along p as
+  // the direct form; with co-moving coordinates, along (q̂, 1): the formulas then give s − q̂ (the position's q̂ is
+  // added back), ṡ and s̈ unchanged (sensitivity.hpp).
   sc.a.resize(np), sc.b.resize(np), sc.c.resize(np);
   for (auto& f : sc.f) f.resize(m);
   sc.d.resize(m), sc.along.resize(m);
@@ -274,11 +318,8 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
                                      AlongParameter::kAccelerationTerm};
     Eigen::VectorXd* into[3] = {&sc.a[j], &sc.b[j], &sc.c[j]};
     for (int o = 0; o <= order; ++o) {
-      for (std::size_t k = 0; k < 4; ++k)
-        detail::evaluate_over_reach(*reaches[j], *p.models[k], terms[o], q, qd, qdd, t, sc.f[k].data(),
-                                    sc.along.data());
       into[o]->resize(m);
-      difference_on(*reaches[j], sc.f, p.step, *into[o]);
+      along_parameter(p, *reaches[j], terms[o], q, qd, qdd, t, sc, *into[o]);
     }
   }
   // Bᵀv, and ∂(Φq q̈ − γ)/∂qᵀ v, into sc.rhs (over the coordinates).
@@ -325,7 +366,9 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
     if (order >= 2) sc.nu -= 2.0 * sc.tau;  // ν − 2τ
     for (std::size_t j = 0; j < np; ++j) {
       const ParameterReach& reach = *reaches[j];
-      out[layout.offset(j, 0) + i] = -dot_on(reach, sc.lambda, sc.a[j]);
+      out[layout.offset(j, 0) + i] = -dot_on(reach, sc.lambda, sc.a[j]);  // s − q̂, and q̂:
+      for (const ParameterReach::Comotion& c : reach.comotion)
+        if (c.coordinate == i) out[layout.offset(j, 0) + i] += q[i] * c.rate;
       if (order >= 1) out[layout.offset(j, 1) + i] = dot_on(reach, sc.mu, sc.a[j]) - dot_on(reach, sc.lambda, sc.b[j]);
       if (order >= 2)
         out[layout.offset(j, 2) + i] = dot_on(reach, sc.nu, sc.a[j]) + 2.0 * dot_on(reach, sc.mu, sc.b[j]) -

@@ -123,6 +123,10 @@ struct FlatFollowerSpec {
   }
   /// @copydoc PointOnCurveSpec::added
   Slot& added(int) { return s; }
+  /// @copydoc PointOnCurveSpec::added
+  const Slot& added(int) const { return s; }
+  /// @copydoc PointOnCurveSpec::added_scale
+  double added_scale(int) const { return on.curve->length(); }
   /// @copydoc PointOnCurveSpec::outside_domain
   std::string outside_domain(const double* q) const { return detail::outside_curve(*on.curve, s.of(q)); }
   /// @copydoc DistanceSpec::sketch

@@ -108,6 +108,13 @@ struct PointOnCurveSpec {
   }
   /// Added coordinate i's slot (ModelBuilder::add binds it).
   Slot& added(int) { return s; }
+  /// @copydoc added
+  const Slot& added(int) const { return s; }
+  /// The length added coordinate i is measured in proportion to: the curve's length (its period when closed). When
+  /// a design parameter changes the curve (a radius, a profile's points), the same contact point keeps s / length,
+  /// not s: the sensitivities move s so as they difference along the parameter (ParameterReach::comotion), where
+  /// s itself would sweep through the curve s / length times faster than the parameter changes it.
+  double added_scale(int) const { return on.curve->length(); }
   /// "" while s is on the curve; on an open curve past an end, what happened (Model::outside_domain).
   std::string outside_domain(const double* q) const { return detail::outside_curve(*on.curve, s.of(q)); }
   /// @copydoc DistanceSpec::sketch
