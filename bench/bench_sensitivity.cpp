@@ -114,6 +114,7 @@ void BM_SensitivityForms(benchmark::State& state) {
 }
 BENCHMARK(BM_SensitivityForms)
     ->ArgNames({"N", "P"})
+    ->Args({1000, 1})
     ->Args({1000, 2})
     ->Args({1000, 4})
     ->Args({1000, 8})

@@ -525,9 +525,9 @@ output: {coordinates: [xB], velocities: true, accelerations: true, sensitivities
 
 // The form is chosen by cost (effective_sensitivity_form): positions only, the crank-slider's slider xB alone to
 // L2 and L3 is solved in the adjoint form by itself (one solve a row where the direct form takes two) and is the
-// closed form's to 1e-9; with q̇ and q̈ two parameters do not pay for the adjoint's 15 evaluations of Φq a row, so
-// the sweep stays direct, and asked for the adjoint it gives the same values in 4 solves a row (λ, μ, τ, ν) where the
-// direct form takes 6. The coordinates not written are NaN in the adjoint form.
+// closed form's to 1e-9; with q̇ and q̈ one parameter does not pay for the adjoint's 15 evaluations of Φq a row
+// (the direct form's 3 solves and 8 evaluations), two do: the adjoint gives the direct form's values in 4 solves a
+// row (λ, μ, τ, ν) where the direct form takes 6. The coordinates not written are NaN in the adjoint form.
 TEST(Sensitivity, TheFormIsChosenByItsCost) {
   const std::string one = test::replace_first(kCrankSlider, "output: {", "output: {coordinates: [xB], ");
   const std::string positions =
@@ -551,14 +551,22 @@ TEST(Sensitivity, TheFormIsChosenByItsCost) {
       }
     }
 
-  const Scene s = parse_scene(one, "crank_slider.yaml");
-  const SensitivityTrace direct = sweep_sensitivities(*s.model, s.sweep);
+  // With q̇ and q̈ and one output: the direct form for one parameter, the adjoint from two.
+  const Scene single = parse_scene(
+      test::replace_first(one, "sensitivities: [L2, {parameter: L3, step: 1e-3}]", "sensitivities: [L2]"),
+      "crank_slider.yaml");
+  const SensitivityTrace rs = sweep_sensitivities(*single.model, single.sweep);
+  EXPECT_EQ(rs.summary.sensitivity_form, SensitivityForm::kDirect);
+  EXPECT_EQ(rs.summary.counters.sensitivity_solves, 91 * 3);
+  const Scene forced = parse_scene(
+      test::replace_first(one, "output: {", "output: {sensitivity_form: direct, "), "crank_slider.yaml");
+  EXPECT_EQ(forced.sweep.sensitivity_form, SensitivityForm::kDirect);
+  const SensitivityTrace direct = sweep_sensitivities(*forced.model, forced.sweep);
   EXPECT_EQ(direct.summary.sensitivity_form, SensitivityForm::kDirect);
   EXPECT_EQ(direct.summary.counters.sensitivity_solves, 91 * 2 * 3);
-  const Scene forced = parse_scene(
-      test::replace_first(one, "output: {", "output: {sensitivity_form: adjoint, "), "crank_slider.yaml");
-  EXPECT_EQ(forced.sweep.sensitivity_form, SensitivityForm::kAdjoint);
-  const SensitivityTrace r = sweep_sensitivities(*forced.model, forced.sweep);
+  const Scene s = parse_scene(one, "crank_slider.yaml");
+  EXPECT_EQ(s.sweep.sensitivity_form, SensitivityForm::kAuto);
+  const SensitivityTrace r = sweep_sensitivities(*s.model, s.sweep);
   EXPECT_EQ(r.summary.sensitivity_form, SensitivityForm::kAdjoint);
   EXPECT_EQ(r.summary.counters.sensitivity_solves, 91 * 4);
   EXPECT_HAS(r.summary.BriefReport(), "364 sensitivity solves (adjoint)");
@@ -581,13 +589,16 @@ TEST(Sensitivity, TheFormIsChosenByItsCost) {
     }
   EXPECT_EQ(test::scene_error(test::replace_first(one, "output: {", "output: {sensitivity_form: sideways, ")),
             "bad.yaml:12:28: output.sensitivity_form: sensitivity_form is auto, direct or adjoint");
-  // the rule: P (order + 1) solves against O·(1, 2, 4) solves and (0, 4, 15) evaluations at half a solve each
+  // the rule: P ((order + 1) solves and (0, 4, 8) evaluations) against O·(1, 2, 4) solves and (0, 4, 15)
+  // evaluations, an evaluation at half a solve
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 2, 0), SensitivityForm::kDirect);
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 3, 2, 0), SensitivityForm::kAdjoint);
-  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 1, 1), SensitivityForm::kDirect);
-  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 3, 1, 1), SensitivityForm::kAdjoint);
-  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 3, 1, 2), SensitivityForm::kDirect);
-  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 4, 1, 2), SensitivityForm::kAdjoint);
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 1, 1, 1), SensitivityForm::kDirect);  // 4 = 4
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 1, 1), SensitivityForm::kAdjoint);
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 1, 1, 2), SensitivityForm::kDirect);  // 7, 11.5
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 1, 2), SensitivityForm::kAdjoint);  // 14, 11.5
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 2, 2), SensitivityForm::kDirect);  // 14, 15.5
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 3, 2, 2), SensitivityForm::kAdjoint);
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAdjoint, 1, 9, 2), SensitivityForm::kAdjoint);
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kDirect, 9, 1, 0), SensitivityForm::kDirect);
 }

@@ -123,21 +123,24 @@ double default_sensitivity_step(double p);
 /// the motion), by central differences of fourth order (sixth for the second derivative; exact up to rounding
 /// where Φq is polynomial of low degree in q, as for lengths). So an output costs 1, 2 or 4 solves with Φqᵀ (for
 /// q, q̇, q̈) whatever the number of parameters, and a row 15 more evaluations of Φq; the direct form costs 1, 2
-/// or 3 solves per parameter. The second derivative along the motion is that of a smooth Φq: where the seven
+/// or 3 solves per parameter and, with q̇, 4 evaluations of Φq (with q̈, and 4 of γ) along its sensitivities. Both
+/// evaluate each parameter's reach alike. The second derivative along the motion is that of a smooth Φq: where the seven
 /// points straddle a place where Φq is not smooth (a spline's knot, where its third derivative jumps, as a pin in a
 /// curved slot passes one), it would be off by percents, so a row whose sixth- and fourth-order second differences
 /// disagree (by more than 10⁻⁴ of the largest entry) is solved in the direct form instead, whose differences along
-/// p span only h |s|: WorkCounters::sensitivity_direct_rows counts them.
+/// the motion are first differences only: WorkCounters::sensitivity_direct_rows counts them.
 enum class SensitivityForm { kAuto, kDirect, kAdjoint };
 
 /// "auto", "direct", "adjoint".
 const char* to_string(SensitivityForm form);
 
 /// The form kAuto stands for at derivative order `order` (0: q, 1: and q̇, 2: and q̈): kAdjoint when it costs
-/// less, counting solves with Φq and evaluations of Φq as half a solve (measured on nfourbar 10³: 0.4–0.6), else
-/// kDirect: direct P (order + 1) solves against adjoint O·(1, 2, 4) solves and (0, 4, 15) evaluations for P
-/// parameters and O output coordinates. At order 0 that is the adjoint when the parameters outnumber the outputs;
-/// with q̈ and one output, from 4 parameters (bench/README.md, "Sensitivities"). Any other form as given.
+/// less, counting solves with Φq and evaluations of Φq or γ as half a solve (measured on nfourbar 10³: 0.4–0.6),
+/// else kDirect: direct P·((order + 1) solves and (0, 4, 8) evaluations) against adjoint O·(1, 2, 4) solves and
+/// (0, 4, 15) evaluations, for P parameters and O output coordinates (their reaches cost both forms alike). At
+/// order 0 that is the adjoint when the parameters outnumber the outputs; with q̇ or q̈ and one output, from 2
+/// parameters (bench/README.md, "Sensitivities": 1.4 of the direct form's time at 1, 0.91 at 2). Any other form
+/// as given.
 SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t parameters, std::size_t outputs,
                                            int order);
 

@@ -215,7 +215,8 @@ SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t par
   const int o = std::clamp(order, 0, 2);
   constexpr double kSolvesPerOutput[3] = {1.0, 2.0, 4.0};  // λ; μ; τ and ν
   constexpr double kEvaluations[3] = {0.0, 4.0, 15.0};     // Φq along the motion (and along q̈)
-  const double direct = static_cast<double>(parameters) * (o + 1);
+  constexpr double kDirectEvaluations[3] = {0.0, 4.0, 8.0};  // Φq, then γ, along the sensitivities, a parameter
+  const double direct = static_cast<double>(parameters) * ((o + 1) + 0.5 * kDirectEvaluations[o]);
   const double adjoint = static_cast<double>(outputs) * kSolvesPerOutput[o] + 0.5 * kEvaluations[o];
   return adjoint < direct ? SensitivityForm::kAdjoint : SensitivityForm::kDirect;
 }
