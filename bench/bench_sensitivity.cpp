@@ -137,7 +137,9 @@ BENCHMARK(BM_SensitivityForms)
 void BM_SensitivityReach(benchmark::State& state) {
   const Index n = state.range(0);
   const int parameters = static_cast<int>(state.range(1));
-  const Scene s = parse_scene(nfourbar_parameters_scene(n, parameters), "nfourbar.yaml");
+  SceneOverrides keep;  // the models along each parameter, for the sweep that reads every constraint of them
+  keep.keep_sensitivity_models = true;
+  const Scene s = parse_scene(nfourbar_parameters_scene(n, parameters), "nfourbar.yaml", {}, keep);
   SweepOptions reach = s.sweep;
   reach.threads = 1;
   reach.sensitivity_form = state.range(2) ? SensitivityForm::kAdjoint : SensitivityForm::kDirect;

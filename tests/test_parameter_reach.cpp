@@ -192,7 +192,9 @@ TEST(ParameterReach, OneBarOfAFamilyIsOneSpan) {
 TEST(ParameterReach, ModelsWhoseBlocksDoNotMatchReachEverything) {
   const Scene s = parse_scene(kCrankSlider, "c.yaml");
   const Scene other = load_scene(test::model_path("seed/fourbar_natural.yaml"));
-  OutputSensitivity p = sensitivity_along(s, "L2", 0.3);
+  SceneOverrides keep;
+  keep.keep_sensitivity_models = true;
+  OutputSensitivity p = sensitivity_along(s, "L2", 0.3, 0.0, {}, keep);
   p.models[2] = std::shared_ptr<const Model>(other.model.get(), [](const Model*) {});
   const ParameterReach r = parameter_reach(*s.model, p);
   EXPECT_TRUE(r.everything);
@@ -267,7 +269,9 @@ void expect_reach_changes_nothing(const Scene& s, const std::vector<std::string>
     double value = 0.0;
     for (const auto& [n, v] : s.parameters)
       if (n == name) value = v;
-    with.push_back(sensitivity_along(s, name, value));
+    SceneOverrides keep;  // (whole_model_reach() reads every constraint of the models)
+    keep.keep_sensitivity_models = true;
+    with.push_back(sensitivity_along(s, name, value, 0.0, {}, keep));
     without.push_back(with.back());
     without.back().reach = std::make_shared<const ParameterReach>(whole_model_reach(*s.model));
     unfound.push_back(with.back());

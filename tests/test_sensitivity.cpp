@@ -490,6 +490,54 @@ TEST(Sensitivity, ACamsRadiusOverTenTurnsAgainstTheClosedForm) {
   }
 }
 
+// sensitivity_along() keeps of the four models along a parameter only the constraints it reaches
+// (keep_reached_only()): the sweeps give the same bits as with the models kept, in both forms, a curve's co-moving
+// parameter included.
+TEST(Sensitivity, ModelsAlongAParameterAreReleasedButForItsReach) {
+  const std::string text = test::slurp(model_path("cams/eccentric_flat.yaml"));
+  const Scene s = parse_scene(text, "cam.yaml");
+  SceneOverrides keep;
+  keep.keep_sensitivity_models = true;
+  for (const char* name : {"R", "e", "omega"}) {
+    const double value = name[0] == 'R' ? 0.05 : name[0] == 'e' ? 0.015 : 2.0;
+    const OutputSensitivity slim = sensitivity_along(s, name, value);
+    const OutputSensitivity kept = sensitivity_along(s, name, value, 0.0, {}, keep);
+    for (std::size_t k = 0; k < 4; ++k) {
+      EXPECT_EQ(slim.models[k], nullptr) << name;
+      ASSERT_NE(kept.models[k], nullptr) << name;
+      ASSERT_EQ(slim.reached->along[k].size(), slim.reach->spans.size()) << name;
+    }
+    EXPECT_EQ(slim.reached->reach, slim.reach);
+    EXPECT_EQ(kept.reached, nullptr);
+    EXPECT_EQ(check_sensitivity_models(*s.model, slim), "");
+    // the reach, found before the models went, is what they give
+    EXPECT_EQ(parameter_reach(*s.model, slim).rows, parameter_reach(*s.model, kept).rows) << name;
+    std::size_t constraints = 0;
+    for (const auto& span : slim.reach->spans) constraints += span.end - span.begin;
+    std::size_t copied = 0;
+    for (const auto& block : slim.reached->along[0]) copied += block->size();
+    EXPECT_EQ(copied, constraints) << name;
+    EXPECT_LT(constraints, s.model->constraints().size()) << name;
+    for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
+      SweepOptions a = s.sweep, b = s.sweep;
+      a.sensitivities = {slim}, b.sensitivities = {kept};
+      a.sensitivity_form = b.sensitivity_form = form;
+      a.velocities = b.velocities = a.accelerations = b.accelerations = true;
+      const SensitivityTrace ra = sweep_sensitivities(*s.model, a), rb = sweep_sensitivities(*s.model, b);
+      ASSERT_EQ(ra.s.size(), rb.s.size());
+      for (std::size_t k = 0; k < ra.s.size(); ++k)
+        for (std::size_t i = 0; i < ra.s[k].size(); ++i) {
+          if (std::isnan(ra.s[k][i]) && std::isnan(rb.s[k][i])) continue;  // the adjoint's unwritten entries
+          ASSERT_EQ(ra.s[k][i], rb.s[k][i]) << name << " " << to_string(form) << " row " << k << " entry " << i;
+        }
+    }
+  }
+  // a reach other than the one the constraints were kept for is refused, not read from released models
+  OutputSensitivity other = sensitivity_along(s, "R", 0.05);
+  other.reach = std::make_shared<const ParameterReach>(whole_model_reach(*s.model));
+  EXPECT_HAS(check_sensitivity_models(*s.model, other), "its reach is not the one their constraints were kept for");
+}
+
 // Bars between natural points and a linear driver: Φq is linear in q, so its second difference along the motion is
 // rounding alone, which the smoothness check does not take for a knot: no row leaves the adjoint form, and its
 // values are the direct form's.

@@ -118,6 +118,12 @@ class ConstraintBlock {
   virtual int added_coordinates(std::size_t /*i*/, Index* /*coordinate*/, double* /*scale*/, int /*capacity*/) const {
     return 0;
   }
+  /// A new block of the same kind without constraints, to append_copy() to: the constraints a design parameter
+  /// reaches, kept apart from the models along it (OutputSensitivity::reached).
+  virtual std::unique_ptr<ConstraintBlock> empty_copy() const = 0;
+  /// Appends a copy of constraint `i` of `from` (a block of the same kind: else phiq::Error), its rows included. Such
+  /// a block evaluates Φ, Φt, γ and Φq v (add_jacobian_product()); it has no Jacobian pattern. Not thread-safe.
+  virtual void append_copy(const ConstraintBlock& from, std::size_t i) = 0;
 };
 
 namespace detail {
@@ -256,6 +262,12 @@ class TypedBlock final : public ConstraintBlock {
         if (std::string why = entries_[i].spec.outside_domain(q); !why.empty()) return {i, std::move(why)};
     }
     return {entries_.size(), ""};
+  }
+  std::unique_ptr<ConstraintBlock> empty_copy() const override { return std::make_unique<TypedBlock>(); }
+  void append_copy(const ConstraintBlock& from, std::size_t i) override {
+    const auto* o = dynamic_cast<const TypedBlock*>(&from);
+    if (!o || i >= o->entries_.size()) throw Error("append_copy: not a constraint of a block of this kind");
+    entries_.push_back(o->entries_[i]);
   }
   int added_coordinates(std::size_t i, Index* coordinate, double* scale, int capacity) const override {
     if constexpr (requires { Spec::kAddedCoordinates; }) {

@@ -84,11 +84,16 @@ struct SceneOverrides {
   /// with the parameter moved by −2h, −h, h, 2h). False lists the sensitivities without models: the scenes built
   /// along a parameter are read so, and so is a scene only checked, not swept.
   bool sensitivity_models = true;
+  /// Keep the four models along each parameter (OutputSensitivity::models). False, the default, keeps only the
+  /// constraints each parameter reaches in them (keep_reached_only()): the same results, a fraction of the memory.
+  /// True serves a comparison with another reach (every constraint's, whole_model_reach()).
+  bool keep_sensitivity_models = false;
 };
 
 /// The sensitivity along the scene parameter `name` at `value`: its models at value − 2h, − h, + h, + 2h
 /// (OutputSensitivity::models), the scene's text read again with the parameter moved (and `overrides`' others),
-/// sharing scene.model's symbolic analysis; h = `step`, or default_sensitivity_step(value) for step ≤ 0. What a
+/// sharing scene.model's symbolic analysis (then released but for the constraints p reaches, unless
+/// `overrides.keep_sensitivity_models`); h = `step`, or default_sensitivity_step(value) for step ≤ 0. What a
 /// scene's `output.sensitivities` (parse_scene()) and `phiq tolerance` build. `scene` must have been read with
 /// `overrides` (its model is the nominal one). Throws SceneError "with NAME = V (the difference step H from P)
 /// the scene cannot be read: WHY", or check_sensitivity_models()' line when a moved model has another structure.

@@ -80,6 +80,14 @@ struct ParameterReach {
   std::vector<Comotion> comotion;
 };
 
+/// The constraints of a ParameterReach as each model along the parameter holds them: for model k (at p − 2h, p − h,
+/// p + h, p + 2h), one block per span of the reach, holding copies of the span's constraints with their rows. All
+/// that the derivatives along p read once the reach is known (keep_reached_only()).
+struct ReachedConstraints {
+  std::shared_ptr<const ParameterReach> reach;  ///< the reach they were kept for
+  std::array<std::vector<std::unique_ptr<ConstraintBlock>>, 4> along;  ///< per model, per span of the reach
+};
+
 /// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the
 /// model built at p − 2h, p − h, p + h, p + 2h (in that order), each with the same coordinates, rows and Φq pattern
 /// as the model swept (check_sensitivity_models()). A scene's `output: {sensitivities: [...]}` builds them
@@ -93,7 +101,16 @@ struct OutputSensitivity {
   /// sweep when it is null). Null: solve_sensitivities() finds it at each call (O(constraints) comparisons, fewer
   /// operations than the evaluations of unreached constraints it spares).
   std::shared_ptr<const ParameterReach> reach;
+  /// The constraints of `reach` in the four models (keep_reached_only()): when set, the derivatives along p read
+  /// these, and `models` may be null. sensitivity_along() keeps these and not the models: a model along p is the
+  /// whole model again (nfourbar 10⁵: 80 MB), what p reaches a fraction of it.
+  std::shared_ptr<const ReachedConstraints> reached;
 };
+
+/// Keeps of `s`'s models only the constraints its reach holds (ReachedConstraints), finding the reach first when
+/// `s.reach` is null, and releases the models: the sweep's results are the same bits. A reach of everything
+/// (models whose blocks do not match the model's) keeps the models. Pre-condition: check_sensitivity_models() passed.
+void keep_reached_only(const Model& model, OutputSensitivity& s);
 
 /// The constraints `s`'s models change against `model` (ParameterReach). Pre-condition: check_sensitivity_models()
 /// passed. O(constraints): a comparison of each constraint's data in the five models. Thread-safe.
@@ -145,8 +162,9 @@ SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t par
                                            int order);
 
 /// "" when the four models of `s` can stand for `model` moved along the parameter (same number of coordinates and
-/// of rows, the same Φq pattern, a finite positive step); else one line naming the parameter and what differs
-/// (a parameter that sets a family's size or a count changes the structure: it has no derivative).
+/// of rows, the same Φq pattern, a finite positive step), or, with the models released, when `s.reached` was kept
+/// for `s.reach`; else one line naming the parameter and what differs (a parameter that
+/// sets a family's size or a count changes the structure: it has no derivative).
 std::string check_sensitivity_models(const Model& model, const OutputSensitivity& s);
 
 /// Where the sensitivities of one row are: for parameter j (0 ≤ j < parameters), the n values of ∂q/∂p_j from

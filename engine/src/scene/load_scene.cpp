@@ -213,6 +213,8 @@ OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name,
   }
   if (const std::string why = check_sensitivity_models(*scene.model, s); !why.empty()) throw SceneError(why);
   s.reach = std::make_shared<const ParameterReach>(parameter_reach(*scene.model, s));
+  // the models along p are the whole model again: only the reach is read of them
+  if (!overrides.keep_sensitivity_models) keep_reached_only(*scene.model, s);
   return s;
 }
 

@@ -38,6 +38,10 @@ ParameterReach whole_model_reach(const Model& model) {
 }
 
 ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
+  // released models (keep_reached_only()): their reach was found before
+  if (s.reached && s.reach &&
+      std::none_of(s.models.begin(), s.models.end(), [](const auto& m) { return m != nullptr; }))
+    return *s.reach;
   for (const auto& m : s.models)
     if (!m || !blocks_match(model, *m)) return whole_model_reach(model);
   ParameterReach r;
@@ -94,22 +98,44 @@ ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
   return r;
 }
 
-void detail::evaluate_over_reach(const ParameterReach& reach, const Model& m, AlongParameter which, const double* q,
-                                 const double* qd, const double* qdd, double t, double* f, double* scratch) {
-  const auto& blocks = m.blocks();
+void keep_reached_only(const Model& model, OutputSensitivity& s) {
+  if (s.reached) return;
+  if (!s.reach) s.reach = std::make_shared<const ParameterReach>(parameter_reach(model, s));
+  if (s.reach->everything) return;
+  auto reached = std::make_shared<ReachedConstraints>();
+  reached->reach = s.reach;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const auto& blocks = s.models[k]->blocks();
+    for (const ParameterReach::Span& span : s.reach->spans) {
+      std::unique_ptr<ConstraintBlock> copy = blocks[span.block]->empty_copy();
+      for (std::size_t i = span.begin; i < span.end; ++i) copy->append_copy(*blocks[span.block], i);
+      reached->along[k].push_back(std::move(copy));
+    }
+  }
+  s.reached = std::move(reached);
+  for (auto& m : s.models) m.reset();
+}
+
+void detail::evaluate_over_reach(const ParameterReach& reach, const Model* m, const ReachedConstraints* reached,
+                                 std::size_t k, AlongParameter which, const double* q, const double* qd,
+                                 const double* qdd, double t, double* f, double* scratch) {
   if (which != AlongParameter::kResidual)
     for (const Index r : reach.rows) f[r] = 0.0, scratch[r] = 0.0;
-  for (const ParameterReach::Span& s : reach.spans) {
-    const ConstraintBlock& block = *blocks[s.block];
+  for (std::size_t j = 0; j < reach.spans.size(); ++j) {
+    const ParameterReach::Span& s = reach.spans[j];
+    // the span in the model, or its copy (the whole block) in the constraints kept of it
+    if (!reached && !m) throw Error("a parameter's models along it were released (keep_reached_only())");
+    const ConstraintBlock& block = reached ? *reached->along[k][j] : *m->blocks()[s.block];
+    const std::size_t begin = reached ? 0 : s.begin, end = reached ? block.size() : s.end;
     switch (which) {
-      case AlongParameter::kResidual: block.residual(s.begin, s.end, q, t, f); break;
+      case AlongParameter::kResidual: block.residual(begin, end, q, t, f); break;
       case AlongParameter::kVelocityTerm:  // Φq q̇ into f, Φt into the scratch (it writes time-dependent rows only)
-        block.add_jacobian_product(s.begin, s.end, q, t, qd, f);
-        block.phi_t(s.begin, s.end, q, t, scratch);
+        block.add_jacobian_product(begin, end, q, t, qd, f);
+        block.phi_t(begin, end, q, t, scratch);
         break;
       case AlongParameter::kAccelerationTerm:  // Φq q̈ into f, γ into the scratch
-        block.add_jacobian_product(s.begin, s.end, q, t, qdd, f);
-        block.gamma(s.begin, s.end, q, qd, t, scratch);
+        block.add_jacobian_product(begin, end, q, t, qdd, f);
+        block.gamma(begin, end, q, qd, t, scratch);
         break;
     }
   }

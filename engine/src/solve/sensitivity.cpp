@@ -33,16 +33,18 @@ void difference_on(const ParameterReach& reach, const std::array<Eigen::VectorXd
 // contact (at fixed s, a curve whose radius is the parameter turns under it s / ℓ times faster than p moves).
 // Callers solve for s − q̂ (sensitivity.hpp): Φq (s − q̂) = −(Φp + Φq q̂), the higher orders alike.
 void along_parameter(const OutputSensitivity& p, const ParameterReach& reach, detail::AlongParameter which,
-                     const double* q, const double* qd, const double* qdd, double t, detail::SensitivityScratch& sc,
-                     Eigen::VectorXd& d) {
+                     const double* q, const double* qd, const double* qdd, double t, Index n,
+                     detail::SensitivityScratch& sc, Eigen::VectorXd& d) {
   const double h = p.step;
   const double* at = q;
-  if (!reach.comotion.empty())
-    sc.moved = Eigen::Map<const Eigen::VectorXd>(q, p.models[0]->num_coordinates()), at = sc.moved.data();
+  if (!reach.comotion.empty()) sc.moved = Eigen::Map<const Eigen::VectorXd>(q, n), at = sc.moved.data();
+  // the constraints kept of the models (keep_reached_only()) when they hold this reach, else the models
+  const ReachedConstraints* reached = p.reached && p.reached->reach.get() == &reach ? p.reached.get() : nullptr;
   for (std::size_t k = 0; k < 4; ++k) {
     for (const ParameterReach::Comotion& c : reach.comotion)
       sc.moved[c.coordinate] = q[c.coordinate] * (1.0 + kShift[k] * h * c.rate);
-    detail::evaluate_over_reach(reach, *p.models[k], which, at, qd, qdd, t, sc.f[k].data(), sc.along.data());
+    detail::evaluate_over_reach(reach, p.models[k].get(), reached, k, which, at, qd, qdd, t, sc.f[k].data(),
+                                sc.along.data());
   }
   difference_on(reach, sc.f, h, d);
 }
@@ -94,6 +96,12 @@ double default_sensitivity_step(double p) { return p == 0.0 ? 1e-3 : 1e-3 * std:
 std::string check_sensitivity_models(const Model& model, const OutputSensitivity& s) {
   const std::string who = "sensitivity to '" + s.name + "': ";
   if (!(s.step > 0.0) || !std::isfinite(s.step)) return who + "the difference step must be positive and finite";
+  // released models (keep_reached_only()): the constraints kept of them stand for them, checked when kept
+  if (s.reached && std::all_of(s.models.begin(), s.models.end(), [](const auto& m) { return !m; })) {
+    if (!s.reach || s.reach != s.reached->reach)
+      return who + "its models were released, and its reach is not the one their constraints were kept for";
+    return "";
+  }
   for (std::size_t k = 0; k < s.models.size(); ++k) {
     const Model* m = s.models[k].get();
     if (!m) return who + "a model along the parameter is missing";
@@ -149,7 +157,7 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     const ParameterReach& reach = p.reach ? *p.reach : (found = parameter_reach(model, p));
     auto along_p = [&](detail::AlongParameter which) {
       sc.d.setZero();
-      along_parameter(p, reach, which, q, qd, qdd, t, sc, sc.d);
+      along_parameter(p, reach, which, q, qd, qdd, t, n, sc, sc.d);
     };
     // Position: Φp (the other rows of Φp are exactly 0).
     along_p(detail::AlongParameter::kResidual);
@@ -320,7 +328,7 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
     Eigen::VectorXd* into[3] = {&sc.a[j], &sc.b[j], &sc.c[j]};
     for (int o = 0; o <= order; ++o) {
       into[o]->resize(m);
-      along_parameter(p, *reaches[j], terms[o], q, qd, qdd, t, sc, *into[o]);
+      along_parameter(p, *reaches[j], terms[o], q, qd, qdd, t, n, sc, *into[o]);
     }
   }
   // Bᵀv, and ∂(Φq q̈ − γ)/∂qᵀ v, into sc.rhs (over the coordinates).
