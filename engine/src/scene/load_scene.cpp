@@ -11,6 +11,7 @@
 #include "phiq/scene.hpp"
 #include "phiq/text.hpp"
 #include "scene/read_scene_file.hpp"
+#include "solve/models_along.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace phiq {
@@ -194,7 +195,7 @@ OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name,
   OutputSensitivity s;
   s.name = name, s.value = value, s.step = step > 0.0 ? step : default_sensitivity_step(value);
   const double shifts[4] = {-2.0, -1.0, 1.0, 2.0};
-  for (std::size_t k = 0; k < 4; ++k) {
+  auto read_at = [&](std::size_t k) {
     SceneOverrides moved = overrides;
     moved.sensitivity_models = false;
     moved.share_analysis_with = scene.model.get();
@@ -205,16 +206,36 @@ OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name,
       if (n == name) v = at, replaced = true;
     if (!replaced) moved.parameters.emplace_back(name, at);
     try {
-      s.models[k] = std::shared_ptr<const Model>(std::move(parse_scene(scene.text, scene.path, limits, moved).model));
+      return std::shared_ptr<const Model>(std::move(parse_scene(scene.text, scene.path, limits, moved).model));
     } catch (const SceneError& e) {
       throw SceneError("with " + name + " = " + shortest(at) + " (the difference step " + shortest(s.step) +
                        " from " + shortest(value) + ") the scene cannot be read: " + e.what());
     }
+  };
+  // The models along p are the whole model again, and only what p reaches is read of them: each is read, checked
+  // and compared with the scene's model in turn, and only the constraints that differ are kept of it, so that one
+  // is in memory at a time (ReachedConstraints). Kept whole when asked, or when their blocks do not match the
+  // model's (then p reaches everything).
+  const Model& model = *scene.model;
+  std::array<detail::AlongModel, 4> along;
+  std::array<std::vector<std::unique_ptr<ConstraintBlock>>, 4> copies;
+  bool whole = overrides.keep_sensitivity_models;
+  for (std::size_t k = 0; k < 4; ++k) {
+    std::shared_ptr<const Model> m = read_at(k);
+    if (std::string why = detail::check_model_along(model, s, k, *m); !why.empty()) throw SceneError(why);
+    whole = whole || !detail::blocks_match(model, *m);
+    if (whole) s.models[k] = std::move(m);
+    else along[k] = detail::along_model_copied(model, *m, copies[k]);
   }
-  if (const std::string why = check_sensitivity_models(*scene.model, s); !why.empty()) throw SceneError(why);
-  s.reach = std::make_shared<const ParameterReach>(parameter_reach(*scene.model, s));
-  // the models along p are the whole model again: only the reach is read of them
-  if (!overrides.keep_sensitivity_models) keep_reached_only(*scene.model, s);
+  if (whole) {
+    for (std::size_t k = 0; k < 4; ++k)
+      if (!s.models[k]) s.models[k] = read_at(k);  // (read before their blocks were found not to match)
+    if (const std::string why = check_sensitivity_models(model, s); !why.empty()) throw SceneError(why);
+    s.reach = std::make_shared<const ParameterReach>(parameter_reach(model, s));
+    return s;
+  }
+  s.reach = std::make_shared<const ParameterReach>(detail::reach_of(model, along, s.step));
+  s.reached = detail::reached_of(model, along, s.reach);
   return s;
 }
 

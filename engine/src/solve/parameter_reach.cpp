@@ -4,15 +4,14 @@
 #include <cmath>
 
 #include "phiq/sensitivity.hpp"
+#include "solve/models_along.hpp"
 #include "solve/sensitivity_internal.hpp"
 
 namespace phiq {
 
-namespace {
-
 // Whether `a` and `b` hold the same kinds of blocks with the same constraints on the same rows: then constraint i
 // of block k is the same constraint in both, and its data can be compared.
-bool blocks_match(const Model& a, const Model& b) {
+bool detail::blocks_match(const Model& a, const Model& b) {
   const auto& x = a.blocks();
   const auto& y = b.blocks();
   if (x.size() != y.size()) return false;
@@ -24,7 +23,6 @@ bool blocks_match(const Model& a, const Model& b) {
   return true;
 }
 
-}  // namespace
 
 ParameterReach whole_model_reach(const Model& model) {
   ParameterReach r;
@@ -37,23 +35,55 @@ ParameterReach whole_model_reach(const Model& model) {
   return r;
 }
 
-ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
-  // released models (keep_reached_only()): their reach was found before
-  if (s.reached && s.reach &&
-      std::none_of(s.models.begin(), s.models.end(), [](const auto& m) { return m != nullptr; }))
-    return *s.reach;
-  for (const auto& m : s.models)
-    if (!m || !blocks_match(model, *m)) return whole_model_reach(model);
+detail::AlongModel detail::along_model(const Model& model, const Model& m) {
+  AlongModel a;
+  const auto& blocks = model.blocks();
+  a.differs.resize(blocks.size()), a.source.resize(blocks.size());
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    a.source[b] = m.blocks()[b].get();
+    a.differs[b].assign(blocks[b]->size(), 0);
+    for (std::size_t i = 0; i < blocks[b]->size(); ++i) a.differs[b][i] = !blocks[b]->same_data(i, *a.source[b]);
+  }
+  return a;  // (`at` empty: constraint i of m is at i)
+}
+
+detail::AlongModel detail::along_model_copied(const Model& model, const Model& m,
+                                              std::vector<std::unique_ptr<ConstraintBlock>>& copies) {
+  AlongModel a = along_model(model, m);
+  const auto& blocks = m.blocks();
+  copies.clear();
+  a.at.resize(blocks.size());
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    copies.push_back(blocks[b]->empty_copy());
+    a.at[b].assign(a.differs[b].size(), 0);
+    for (std::size_t i = 0; i < a.differs[b].size(); ++i)
+      if (a.differs[b][i]) a.at[b][i] = copies[b]->size(), copies[b]->append_copy(*blocks[b], i);
+    a.source[b] = copies[b].get();
+  }
+  return a;
+}
+
+namespace {
+
+// Where constraint i of block b is in the model along p that `a` describes, as (block, index): its own copy where
+// it differs from the swept model's, the swept model's where it does not (then they are equal, datum by datum).
+std::pair<const ConstraintBlock*, std::size_t> constraint_along(const Model& model, const detail::AlongModel& a,
+                                                                std::size_t b, std::size_t i) {
+  if (!a.differs[b][i]) return {model.blocks()[b].get(), i};
+  return {a.source[b], a.at.empty() ? i : a.at[b][i]};
+}
+
+}  // namespace
+
+ParameterReach detail::reach_of(const Model& model, const std::array<AlongModel, 4>& along, double step) {
   ParameterReach r;
   const auto& blocks = model.blocks();
   // Which constraints of each block the parameter reaches: those whose data differ in some model along it.
   std::vector<std::vector<char>> reached(blocks.size());
   for (std::size_t b = 0; b < blocks.size(); ++b) {
-    const ConstraintBlock& block = *blocks[b];
-    reached[b].assign(block.size(), 0);
-    for (std::size_t i = 0; i < block.size(); ++i)
-      for (const auto& m : s.models)
-        if (!block.same_data(i, *m->blocks()[b])) reached[b][i] = 1;
+    reached[b].assign(blocks[b]->size(), 0);
+    for (const AlongModel& a : along)
+      for (std::size_t i = 0; i < blocks[b]->size(); ++i) reached[b][i] |= a.differs[b][i];
   }
   // The coordinates they add whose scale moves with the parameter (a curve's length), with the relative rate of
   // that scale by the same fourth-order difference as the derivatives.
@@ -62,13 +92,14 @@ ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
     for (std::size_t i = 0; i < blocks[b]->size(); ++i) {
       if (!reached[b][i]) continue;
       Index coordinate[kCapacity];
-      double scale[kCapacity], along[4][kCapacity];
+      double scale[kCapacity], at[4][kCapacity];
       const int added = blocks[b]->added_coordinates(i, coordinate, scale, kCapacity);
-      for (std::size_t k = 0; k < 4 && added > 0; ++k)
-        s.models[k]->blocks()[b]->added_coordinates(i, coordinate, along[k], kCapacity);
+      for (std::size_t k = 0; k < 4 && added > 0; ++k) {
+        const auto [block, index] = constraint_along(model, along[k], b, i);
+        block->added_coordinates(index, coordinate, at[k], kCapacity);
+      }
       for (int a = 0; a < added; ++a) {
-        const double rate =
-            ((along[0][a] - along[3][a]) + 8.0 * (along[2][a] - along[1][a])) / (12.0 * s.step) / scale[a];
+        const double rate = ((at[0][a] - at[3][a]) + 8.0 * (at[2][a] - at[1][a])) / (12.0 * step) / scale[a];
         if (coordinate[a] >= 0 && rate != 0.0 && std::isfinite(rate)) r.comotion.push_back({coordinate[a], rate});
       }
     }
@@ -98,21 +129,42 @@ ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
   return r;
 }
 
+std::shared_ptr<const ReachedConstraints> detail::reached_of(const Model& model,
+                                                             const std::array<AlongModel, 4>& along,
+                                                             const std::shared_ptr<const ParameterReach>& reach) {
+  auto reached = std::make_shared<ReachedConstraints>();
+  reached->reach = reach;
+  for (std::size_t k = 0; k < 4; ++k)
+    for (const ParameterReach::Span& span : reach->spans) {
+      std::unique_ptr<ConstraintBlock> copy = model.blocks()[span.block]->empty_copy();
+      for (std::size_t i = span.begin; i < span.end; ++i) {
+        const auto [block, index] = constraint_along(model, along[k], span.block, i);
+        copy->append_copy(*block, index);
+      }
+      reached->along[k].push_back(std::move(copy));
+    }
+  return reached;
+}
+
+ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
+  // released models (keep_reached_only()): their reach was found before
+  if (s.reached && s.reach &&
+      std::none_of(s.models.begin(), s.models.end(), [](const auto& m) { return m != nullptr; }))
+    return *s.reach;
+  for (const auto& m : s.models)
+    if (!m || !detail::blocks_match(model, *m)) return whole_model_reach(model);
+  std::array<detail::AlongModel, 4> along;
+  for (std::size_t k = 0; k < 4; ++k) along[k] = detail::along_model(model, *s.models[k]);
+  return detail::reach_of(model, along, s.step);
+}
+
 void keep_reached_only(const Model& model, OutputSensitivity& s) {
   if (s.reached) return;
   if (!s.reach) s.reach = std::make_shared<const ParameterReach>(parameter_reach(model, s));
   if (s.reach->everything) return;
-  auto reached = std::make_shared<ReachedConstraints>();
-  reached->reach = s.reach;
-  for (std::size_t k = 0; k < 4; ++k) {
-    const auto& blocks = s.models[k]->blocks();
-    for (const ParameterReach::Span& span : s.reach->spans) {
-      std::unique_ptr<ConstraintBlock> copy = blocks[span.block]->empty_copy();
-      for (std::size_t i = span.begin; i < span.end; ++i) copy->append_copy(*blocks[span.block], i);
-      reached->along[k].push_back(std::move(copy));
-    }
-  }
-  s.reached = std::move(reached);
+  std::array<detail::AlongModel, 4> along;
+  for (std::size_t k = 0; k < 4; ++k) along[k] = detail::along_model(model, *s.models[k]);
+  s.reached = detail::reached_of(model, along, s.reach);
   for (auto& m : s.models) m.reset();
 }
 

@@ -11,6 +11,7 @@
 #include "phiq/evaluation.hpp"  // JacobianView: Φq over values held here
 #include "phiq/text.hpp"
 #include "solve/factorisation.hpp"
+#include "solve/models_along.hpp"
 #include "solve/sensitivity_internal.hpp"
 
 namespace phiq {
@@ -93,6 +94,19 @@ JacobianView jacobian_view(const CscPattern& pattern, std::vector<double>& value
 
 double default_sensitivity_step(double p) { return p == 0.0 ? 1e-3 : 1e-3 * std::fabs(p); }
 
+std::string detail::check_model_along(const Model& model, const OutputSensitivity& s, std::size_t k,
+                                      const Model& m) {
+  const CscPattern& a = m.jacobian_pattern();
+  const CscPattern& b = model.jacobian_pattern();
+  if (m.num_coordinates() != model.num_coordinates() || m.num_equations() != model.num_equations() ||
+      a.col_ptr != b.col_ptr || a.row_idx != b.row_idx)
+    return "sensitivity to '" + s.name + "': the model at " + s.name + " = " + shortest(s.value + kShift[k] * s.step) +
+           " has other coordinates, constraints or Jacobian entries than at " + shortest(s.value) +
+           ": a parameter that changes the model's structure (a count, a family's range, a switch) has no "
+           "derivative";
+  return "";
+}
+
 std::string check_sensitivity_models(const Model& model, const OutputSensitivity& s) {
   const std::string who = "sensitivity to '" + s.name + "': ";
   if (!(s.step > 0.0) || !std::isfinite(s.step)) return who + "the difference step must be positive and finite";
@@ -103,16 +117,8 @@ std::string check_sensitivity_models(const Model& model, const OutputSensitivity
     return "";
   }
   for (std::size_t k = 0; k < s.models.size(); ++k) {
-    const Model* m = s.models[k].get();
-    if (!m) return who + "a model along the parameter is missing";
-    const CscPattern& a = m->jacobian_pattern();
-    const CscPattern& b = model.jacobian_pattern();
-    if (m->num_coordinates() != model.num_coordinates() || m->num_equations() != model.num_equations() ||
-        a.col_ptr != b.col_ptr || a.row_idx != b.row_idx)
-      return who + "the model at " + s.name + " = " + shortest(s.value + kShift[k] * s.step) +
-             " has other coordinates, constraints or Jacobian entries than at " + shortest(s.value) +
-             ": a parameter that changes the model's structure (a count, a family's range, a switch) has no "
-             "derivative";
+    if (!s.models[k]) return who + "a model along the parameter is missing";
+    if (std::string why = detail::check_model_along(model, s, k, *s.models[k]); !why.empty()) return why;
   }
   return "";
 }
