@@ -70,7 +70,8 @@ struct ParameterReach {
   /// same contact: q_c · rate per unit of p, with rate = (∂ℓ/∂p) / ℓ and ℓ its scale (PointOnCurveSpec::added_scale():
   /// the curve's length). Differenced at fixed s, a curve whose radius is the parameter turns under the contact by
   /// s / ℓ times the relative step (10 turns of a cam: ∂y/∂R off by 7·10⁻⁶); moved so, the four models see one
-  /// contact, and the part of the move along q at fixed p is taken away with the swept model (sensitivity.hpp).
+  /// contact: the derivatives along p are taken along (q, p) ← (q̂, 1) and the sensitivities solved for s − q̂
+  /// (the file's description).
   struct Comotion {
     Index coordinate = 0;  ///< the added coordinate's index
     double rate = 0.0;     ///< (∂ℓ/∂p) / ℓ, 1/(the parameter's unit)
@@ -90,8 +91,10 @@ struct ReachedConstraints {
 
 /// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the
 /// model built at p − 2h, p − h, p + h, p + 2h (in that order), each with the same coordinates, rows and Φq pattern
-/// as the model swept (check_sensitivity_models()). A scene's `output: {sensitivities: [...]}` builds them
-/// (models/README.md); the C++ API with sensitivity_along() (scene.hpp), or by hand.
+/// as the model swept (check_sensitivity_models()), or, once its reach is known, only the constraints the reach
+/// holds of them (`reached`). A scene's `output: {sensitivities: [...]}` builds it (models/README.md); the C++ API
+/// with sensitivity_along() (scene.hpp: it keeps the reached constraints, reading the models one at a time), or by
+/// hand (the models; keep_reached_only() then releases them).
 struct OutputSensitivity {
   std::string name;  ///< the parameter's name, the columns' suffix (`x.d_NAME`)
   double value = 0.0;  ///< p
@@ -112,8 +115,9 @@ struct OutputSensitivity {
 /// (models whose blocks do not match the model's) keeps the models. Pre-condition: check_sensitivity_models() passed.
 void keep_reached_only(const Model& model, OutputSensitivity& s);
 
-/// The constraints `s`'s models change against `model` (ParameterReach). Pre-condition: check_sensitivity_models()
-/// passed. O(constraints): a comparison of each constraint's data in the five models. Thread-safe.
+/// The constraints `s`'s models change against `model` (ParameterReach); with the models released
+/// (keep_reached_only()), `s.reach`. Pre-condition: check_sensitivity_models() passed. O(constraints): a comparison
+/// of each constraint's data in the five models. Thread-safe.
 ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s);
 
 /// The reach of every constraint of `model` (ParameterReach::everything set): what parameter_reach() gives for models

@@ -11,8 +11,8 @@
 #include "phiq/scene.hpp"
 #include "phiq/text.hpp"
 #include "scene/read_scene_file.hpp"
-#include "solve/models_along.hpp"
 #include "scene/scene_reader.hpp"
+#include "solve/models_along.hpp"
 
 namespace phiq {
 
