@@ -491,6 +491,66 @@ TEST(Sensitivity, ACamsRadiusOverTenTurnsAgainstTheClosedForm) {
   }
 }
 
+// A pin in a circular slot of radius r driven along the slot by its arc length s (a driver on the coordinate the
+// slot adds, as the C++ API allows): s = 0.3 + w t is fixed, so ∂s/∂r = 0, and P = c + r (cos φ, sin φ) with
+// φ = s/r gives ∂x/∂r = cos φ + φ sin φ, ∂y/∂r = sin φ − φ cos φ, ∂ẋ/∂r = (wφ/r) cos φ, ∂ẏ/∂r = (wφ/r) sin φ,
+// ∂ẍ/∂r = (w/r)² (cos φ − φ sin φ), ∂ÿ/∂r = (w/r)² (sin φ + φ cos φ). r moves the contact's s with the circle
+// (ParameterReach::comotion), so the driver, which reads s and not r, is in r's reach: left out, its row of the
+// derivative along (q̂, 1) would be 0 instead of q̂_s, and ∂s/∂r would be −q̂_s. Over 2.3 turns, both forms, 1e-9.
+Model slot_by_arc(double r, const Model* share = nullptr) {
+  ModelBuilder b;
+  const double s0 = 0.3;
+  const Index x = b.add_coordinate("x", 0.2 + r * std::cos(s0 / r)), y = b.add_coordinate("y", 0.1 + r * std::sin(s0 / r));
+  PointOnCurveSpec slot;
+  slot.a = Frame2{Slot::coordinate(x), Slot::coordinate(y), Slot{}};
+  slot.on = CurveOn{Frame2{}, Curve::circle({0.2, 0.1}, r)};
+  b.add("slot", slot);
+  b.add_driver("push", b.num_coordinates() - 1, MotionLaw::linear(s0, 0.35));  // on slot.s
+  if (share) b.share_analysis_with(*share);
+  return std::move(b).build();
+}
+
+TEST(Sensitivity, AConstraintReadingACoMovingCoordinateIsInTheReach) {
+  const double r = 0.5, w = 0.35, h = default_sensitivity_step(r);
+  const Model model = slot_by_arc(r);
+  OutputSensitivity p;
+  p.name = "r", p.value = r, p.step = h;
+  const double shifts[4] = {-2, -1, 1, 2};
+  for (std::size_t k = 0; k < 4; ++k)
+    p.models[k] = std::make_shared<const Model>(slot_by_arc(r + shifts[k] * h, &model));
+  ASSERT_EQ(check_sensitivity_models(model, p), "");
+  const Index s_index = model.coordinate_index("slot.s"), xi = model.coordinate_index("x"),
+              yi = model.coordinate_index("y");
+  const ParameterReach reach = parameter_reach(model, p);
+  ASSERT_EQ(reach.comotion.size(), 1u);
+  EXPECT_EQ(reach.comotion[0].coordinate, s_index);
+  EXPECT_NEAR(reach.comotion[0].rate, 1.0 / r, 1e-9);
+  EXPECT_EQ(reach.rows, (std::vector<Index>{0, 1, 2}));  // the slot's two rows and the driver's, which reads s
+  SweepOptions o;
+  o.t_begin = 0.0, o.t_end = 20.0, o.steps = 200;
+  o.velocities = o.accelerations = true;
+  o.sensitivities = {p};
+  const SensitivityLayout layout{model.num_coordinates()};
+  for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
+    o.sensitivity_form = form;
+    const SensitivityTrace tr = sweep_sensitivities(model, o);
+    ASSERT_EQ(tr.s.size(), 201u);
+    double worst = 0.0;
+    for (std::size_t k = 0; k < tr.s.size(); ++k) {
+      const double phi = (0.3 + w * tr.rows.t[k]) / r, c = std::cos(phi), sn = std::sin(phi), g = w / r;
+      const double want[3][2] = {{c + phi * sn, sn - phi * c},
+                                 {g * phi * c, g * phi * sn},
+                                 {g * g * (c - phi * sn), g * g * (sn + phi * c)}};
+      for (int order = 0; order < 3; ++order) {
+        worst = std::max(worst, std::fabs(tr.s[k][layout.offset(0, order) + xi] - want[order][0]));
+        worst = std::max(worst, std::fabs(tr.s[k][layout.offset(0, order) + yi] - want[order][1]));
+        worst = std::max(worst, std::fabs(tr.s[k][layout.offset(0, order) + s_index]));  // s is driven
+      }
+    }
+    EXPECT_LE(worst, 1e-9) << to_string(form);
+  }
+}
+
 // sensitivity_along() keeps of the four models along a parameter only the constraints it reaches
 // (keep_reached_only()): the sweeps give the same bits as with the models kept, in both forms, a curve's co-moving
 // parameter included.
