@@ -4,6 +4,7 @@
 // or one at a time and released (sensitivity_along(): one model along p in memory at once, not four).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <string>
@@ -25,6 +26,11 @@ struct AlongModel {
 // Whether `a` and `b` hold the same kinds of blocks with the same constraints on the same rows: then constraint i
 // of block k is the same constraint in both, and its data can be compared.
 bool blocks_match(const Model& a, const Model& b);
+
+// Whether `s` holds only the constraints its reach keeps of its models (keep_reached_only()): its models released.
+inline bool models_released(const OutputSensitivity& s) {
+  return s.reached && std::none_of(s.models.begin(), s.models.end(), [](const auto& m) { return m != nullptr; });
+}
 
 // check_sensitivity_models() for model k (at p + kShift[k] h) alone, `m` standing for s.models[k].
 std::string check_model_along(const Model& model, const OutputSensitivity& s, std::size_t k, const Model& m);

@@ -147,10 +147,7 @@ std::shared_ptr<const ReachedConstraints> detail::reached_of(const Model& model,
 }
 
 ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
-  // released models (keep_reached_only()): their reach was found before
-  if (s.reached && s.reach &&
-      std::none_of(s.models.begin(), s.models.end(), [](const auto& m) { return m != nullptr; }))
-    return *s.reach;
+  if (detail::models_released(s) && s.reach) return *s.reach;  // found before the models went
   for (const auto& m : s.models)
     if (!m || !detail::blocks_match(model, *m)) return whole_model_reach(model);
   std::array<detail::AlongModel, 4> along;
@@ -160,10 +157,16 @@ ParameterReach parameter_reach(const Model& model, const OutputSensitivity& s) {
 
 void keep_reached_only(const Model& model, OutputSensitivity& s) {
   if (s.reached) return;
-  if (!s.reach) s.reach = std::make_shared<const ParameterReach>(parameter_reach(model, s));
-  if (s.reach->everything) return;
+  for (const auto& m : s.models)
+    if (!m || !detail::blocks_match(model, *m)) {  // a reach of everything: the models are kept
+      if (!s.reach) s.reach = std::make_shared<const ParameterReach>(whole_model_reach(model));
+      return;
+    }
+  // each model compared once: for the reach when it is not given, and for the constraints kept
   std::array<detail::AlongModel, 4> along;
   for (std::size_t k = 0; k < 4; ++k) along[k] = detail::along_model(model, *s.models[k]);
+  if (!s.reach) s.reach = std::make_shared<const ParameterReach>(detail::reach_of(model, along, s.step));
+  if (s.reach->everything) return;
   s.reached = detail::reached_of(model, along, s.reach);
   for (auto& m : s.models) m.reset();
 }
@@ -173,10 +176,10 @@ void detail::evaluate_over_reach(const ParameterReach& reach, const Model* m, co
                                  const double* qdd, double t, double* f, double* scratch) {
   if (which != AlongParameter::kResidual)
     for (const Index r : reach.rows) f[r] = 0.0, scratch[r] = 0.0;
+  if (!reached && !m) throw Error("a parameter's models along it were released (keep_reached_only())");
   for (std::size_t j = 0; j < reach.spans.size(); ++j) {
     const ParameterReach::Span& s = reach.spans[j];
     // the span in the model, or its copy (the whole block) in the constraints kept of it
-    if (!reached && !m) throw Error("a parameter's models along it were released (keep_reached_only())");
     const ConstraintBlock& block = reached ? *reached->along[k][j] : *m->blocks()[s.block];
     const std::size_t begin = reached ? 0 : s.begin, end = reached ? block.size() : s.end;
     switch (which) {

@@ -50,12 +50,6 @@ void along_parameter(const OutputSensitivity& p, const ParameterReach& reach, de
   difference_on(reach, sc.f, h, d);
 }
 
-// q̂ of `reach` at q into x (ParameterReach::comotion): zero but for the co-moving coordinates.
-void comotion(const ParameterReach& reach, const double* q, double* x, Index n) {
-  std::fill(x, x + n, 0.0);
-  for (const ParameterReach::Comotion& c : reach.comotion) x[c.coordinate] = q[c.coordinate] * c.rate;
-}
-
 // v·w over the rows of `reach`.
 double dot_on(const ParameterReach& reach, const Eigen::VectorXd& v, const Eigen::VectorXd& w) {
   double sum = 0.0;
@@ -111,7 +105,7 @@ std::string check_sensitivity_models(const Model& model, const OutputSensitivity
   const std::string who = "sensitivity to '" + s.name + "': ";
   if (!(s.step > 0.0) || !std::isfinite(s.step)) return who + "the difference step must be positive and finite";
   // released models (keep_reached_only()): the constraints kept of them stand for them, checked when kept
-  if (s.reached && std::all_of(s.models.begin(), s.models.end(), [](const auto& m) { return !m; })) {
+  if (detail::models_released(s)) {
     if (!s.reach || s.reach != s.reached->reach)
       return who + "its models were released, and its reach is not the one their constraints were kept for";
     return "";
@@ -168,12 +162,10 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     // Position: Φp (the other rows of Φp are exactly 0).
     along_p(detail::AlongParameter::kResidual);
     sc.d = -sc.d;
-    if (!solve_negated_difference(s)) return false;  // s − q̂
-    if (!reach.comotion.empty()) {
-      sc.comoving.resize(n);
-      comotion(reach, q, sc.comoving.data(), n);
-      for (Index i = 0; i < n; ++i) s[i] += sc.comoving[i];
-    }
+    if (!solve_negated_difference(s)) return false;  // s − q̂, the move along q the higher orders difference
+    Eigen::VectorXd& sv = sc.sprime;
+    if (order >= 1) sv = Eigen::Map<const Eigen::VectorXd>(s, n);
+    for (const ParameterReach::Comotion& c : reach.comotion) s[c.coordinate] += q[c.coordinate] * c.rate;  // + q̂
     if (order < 1) continue;
     // The higher orders' right-hand sides are derivatives along (q, q̇, p) ← (s, ṡ, 1), taken in two parts, as
     // the adjoint form takes them: along (q, p) ← (q̂, 1) at fixed q̇, with the models over the reach, and along
@@ -181,9 +173,6 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     // by 10⁻³ of its scale. In one, with the models at q + khs, the step would move q by h|s|, and s grows along a
     // sweep (∂θ/∂ω = t for a crank at θ = ωt: ten turns of a cam put ∂ẏ/∂ω off by 4·10⁻⁷, against 10⁻¹⁰ so).
     const Eigen::Map<const Eigen::VectorXd> qdv(qd, n);
-    Eigen::VectorXd& sv = sc.sprime;
-    sv = Eigen::Map<const Eigen::VectorXd>(s, n);
-    if (!reach.comotion.empty()) sv -= sc.comoving;
     double rate = 0.0;
     for (Index i = 0; i < n; ++i) rate = std::max(rate, std::fabs(sv[i]) / cs[i]);
     const double step = 1e-3 / std::max(rate, 1e-3);

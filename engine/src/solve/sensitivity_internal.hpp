@@ -37,8 +37,8 @@ struct SensitivityScratch {
   std::array<std::vector<double>, 7> along_motion;
   std::array<std::vector<double>, 4> along_acceleration;
   Eigen::VectorXd lambda, mu, tau, nu, rhs, solved;
-  // q with the co-moving coordinates moved along p (ParameterReach::comotion); q̂ and s − q̂ (the direct form)
-  Eigen::VectorXd moved, comoving, sprime;
+  // q with the co-moving coordinates moved along p (ParameterReach::comotion); s − q̂ (the direct form)
+  Eigen::VectorXd moved, sprime;
 };
 
 // The functions differentiated along a parameter, at fixed (q, q̇, q̈) (sensitivity.hpp: a, b and c).
