@@ -166,7 +166,7 @@ void CheckSpec(const Spec& spec, int n_coords, const CheckOptions& opt) {
   const std::vector<Entry> pattern = Entries(spec, zeros.data(), 0.0);
   ASSERT_FALSE(pattern.empty());
 
-  StateGenerator gen(opt.seed);
+  StateGenerator gen(opt.seed), directions(opt.seed ^ 0x5bd1e995u);  // (apart: the states stay those of the seed)
   for (int k = 0; k < opt.samples; ++k) {
     const State st = gen.Next(n_coords, opt.kinks);
     SCOPED_TRACE("sample " + std::to_string(k) + ", " + Describe(st));
@@ -234,6 +234,31 @@ void CheckSpec(const Spec& spec, int n_coords, const CheckOptions& opt) {
     const std::vector<double> dd =
         SecondDerivative([&](double s) { return ResidualAlongPath(spec, st, s); }, GammaStep(st.qd));
     for (int r = 0; r < m; ++r) EXPECT_NEAR(gam[r], -dd[r], Tol(kGammaTol, gam[r])) << "gamma row " << r;
+
+    // 4. γ is a quadratic in q̇ whose derivative along v is −2 B v, B = ∂(Φq q̇ + Φt)/∂q: the direct sensitivities
+    // read B v as [γ(q̇ − v) − γ(q̇ + v)] / 4 (sensitivity.hpp). Against the difference of Φq q̇ + Φt along v.
+    const State dir = directions.Next(n_coords);
+    std::vector<double> minus(st.qd), plus(st.qd), gm(m), gp(m);
+    for (std::size_t j = 0; j < n; ++j) minus[j] -= dir.qd[j], plus[j] += dir.qd[j];
+    spec.gamma(q, minus.data(), st.t, gm.data());
+    spec.gamma(q, plus.data(), st.t, gp.data());
+    auto velocity_term = [&](double e) {  // Φq(q + e v) q̇ + Φt(q + e v, t)
+      std::vector<double> at(st.q), out(m, 0.0);
+      for (std::size_t j = 0; j < n; ++j) at[j] += e * dir.qd[j];
+      spec.phi_t(at.data(), st.t, out.data());
+      auto sink = [&](int row, const Slot& slot, double value) {
+        if (slot.is_coordinate()) out[row] += value * st.qd[slot.coord()];
+      };
+      spec.jacobian(at.data(), st.t, sink);
+      return out;
+    };
+    const double e = 1e-4;
+    const std::vector<double> f2 = velocity_term(-2 * e), f1 = velocity_term(-e), g1 = velocity_term(e),
+                              g2 = velocity_term(2 * e);
+    for (int r = 0; r < m; ++r) {
+      const double fd = ((f2[r] - g2[r]) + 8.0 * (g1[r] - f1[r])) / (12.0 * e);
+      EXPECT_NEAR((gm[r] - gp[r]) / 4.0, fd, Tol(kJacTol, fd)) << "B v from gamma, row " << r;
+    }
   }
 }
 

@@ -26,8 +26,14 @@
 /// relative. Rounding adds about ε |Φ's terms| / h.
 ///
 /// The higher orders' derivatives along the motion's own sensitivities, (q, q̇) ← (s, ṡ), are taken apart from p,
-/// with the swept model, by a fourth-order difference whose step moves the coordinate s moves most by 10⁻³ of its
-/// scale: s grows along a sweep (∂θ/∂ω = t for a crank at θ = ωt) and a step tied to h would grow with it.
+/// with the swept model. The velocity's is exact: with B = ∂(Φq q̇ + Φt)/∂q, γ = −(Φq q̇)q q̇ − 2 Φqt q̇ − Φtt is a
+/// quadratic in q̇ whose derivative along s is −2 B s, so that
+///
+///   B s = [γ(q, q̇ − αs) − γ(q, q̇ + αs)] / (4α)   for every α,
+///
+/// two evaluations of γ at q itself (α makes αs as fast as q̇). The acceleration's, ∂(Φq q̈ − γ)/∂q s − ∂γ/∂q̇ ṡ,
+/// holds Φ's third derivatives: a fourth-order difference whose step moves the coordinate s moves most by 10⁻³ of
+/// its scale (s grows along a sweep, ∂θ/∂ω = t for a crank at θ = ωt, and a step tied to h would grow with it).
 ///
 /// A coordinate that a constraint adds and measures along its data (a curve's parameter s, PointOnCurveSpec) means
 /// another point when p changes the curve: at fixed s, a cam's circle of radius R turns under the contact by
@@ -144,7 +150,8 @@ double default_sensitivity_step(double p);
 /// the motion), by central differences of fourth order (sixth for the second derivative; exact up to rounding
 /// where Φq is polynomial of low degree in q, as for lengths). So an output costs 1, 2 or 4 solves with Φqᵀ (for
 /// q, q̇, q̈) whatever the number of parameters, and a row 15 more evaluations of Φq; the direct form costs 1, 2
-/// or 3 solves per parameter and, with q̇, 4 evaluations of Φq (with q̈, and 4 of γ) along its sensitivities. Both
+/// or 3 solves per parameter and, with q̇, 2 evaluations of γ (with q̈, and 4 of Φq and 4 of γ) along its
+/// sensitivities. Both
 /// evaluate each parameter's reach alike. The second derivative along the motion is that of a smooth Φq: where the seven
 /// points straddle a place where Φq is not smooth (a spline's knot, where its third derivative jumps, as a pin in a
 /// curved slot passes one), it would be off by percents, so a row whose sixth- and fourth-order second differences
@@ -157,7 +164,7 @@ const char* to_string(SensitivityForm form);
 
 /// The form kAuto stands for at derivative order `order` (0: q, 1: and q̇, 2: and q̈): kAdjoint when it costs
 /// less, counting solves with Φq and evaluations of Φq or γ as half a solve (measured on nfourbar 10³: 0.4–0.6),
-/// else kDirect: direct P·((order + 1) solves and (0, 4, 8) evaluations) against adjoint O·(1, 2, 4) solves and
+/// else kDirect: direct P·((order + 1) solves and (0, 2, 8) evaluations) against adjoint O·(1, 2, 4) solves and
 /// (0, 4, 15) evaluations, for P parameters and O output coordinates (their reaches cost both forms alike). At
 /// order 0 that is the adjoint when the parameters outnumber the outputs; with q̇ or q̈ and one output, from 2
 /// parameters (bench/README.md, "Sensitivities": 1.4 of the direct form's time at 1, 0.91 at 2). Any other form

@@ -125,7 +125,7 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   for (auto& f : sc.f) f.resize(m);
   sc.d.resize(m), sc.along.resize(m), sc.qk.resize(n), sc.vk.resize(n);
   const CscPattern& pattern = model.jacobian_pattern();  // (every model along a parameter has it: checked)
-  if (order >= 1)
+  if (order >= 2)
     for (auto& values : sc.jacobian) values.resize(static_cast<std::size_t>(pattern.nnz()));
   auto jacobian = [&](std::size_t k) { return jacobian_view(pattern, sc.jacobian[k]); };
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -169,31 +169,41 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     if (order < 1) continue;
     // The higher orders' right-hand sides are derivatives along (q, q̇, p) ← (s, ṡ, 1), taken in two parts, as
     // the adjoint form takes them: along (q, p) ← (q̂, 1) at fixed q̇, with the models over the reach, and along
-    // (s − q̂, ṡ) at fixed p, with the swept model at q + kε(s − q̂), ε moving the coordinate that s − q̂ moves most
-    // by 10⁻³ of its scale. In one, with the models at q + khs, the step would move q by h|s|, and s grows along a
-    // sweep (∂θ/∂ω = t for a crank at θ = ωt: ten turns of a cam put ∂ẏ/∂ω off by 4·10⁻⁷, against 10⁻¹⁰ so).
+    // (s − q̂, ṡ) at fixed p, with the swept model: the velocity's exactly (below), the acceleration's at q + kε(s − q̂),
+    // ε moving the coordinate that s − q̂ moves most by 10⁻³ of its scale. In one, with the models at q + khs, the
+    // step would move q by h|s|, and s grows along a sweep (∂θ/∂ω = t for a crank at θ = ωt: ten turns of a cam
+    // put ∂ẏ/∂ω off by 4·10⁻⁷, against 10⁻¹⁰ so).
     const Eigen::Map<const Eigen::VectorXd> qdv(qd, n);
     double rate = 0.0;
     for (Index i = 0; i < n; ++i) rate = std::max(rate, std::fabs(sv[i]) / cs[i]);
     const double step = 1e-3 / std::max(rate, 1e-3);
-    // Velocity: Φq q̇ + Φt. The swept model's Φq at each q + kε(s − q̂) is kept for the acceleration (the same
-    // points).
+    // Velocity: Φq q̇ + Φt. Along v = s − q̂ its derivative is B v = (Φq q̇)_q v + Φqt v, and γ = −(Φq q̇)_q q̇ −
+    // 2 Φqt q̇ − Φtt is a quadratic in q̇ whose derivative along v is −2 B v: so B v = [γ(q̇ − αv) − γ(q̇ + αv)] / (4α)
+    // exactly, for every α (no step to choose, and q stays where it is: no spline knot or curve end within reach).
+    // α makes αv as fast as q̇ (their fastest coordinates, in their scales; at least 1/s of its scale), which
+    // keeps the two γ's rounding near that of γ itself.
     along_p(detail::AlongParameter::kVelocityTerm);
-    for (std::size_t k = 0; k < 4; ++k) {
-      sc.qk = qv + (kShift[k] * step) * sv;
-      model.jacobian(sc.qk.data(), t, sc.jacobian[k].data());
-      sc.f[k].noalias() = jacobian(k) * qdv;
-      model.phi_t(sc.qk.data(), t, sc.along.data());
-      sc.f[k] += sc.along;
+    if (rate > 0.0) {
+      double qd_rate = 0.0;
+      for (Index i = 0; i < n; ++i) qd_rate = std::max(qd_rate, std::fabs(qd[i]) / cs[i]);
+      const double alpha = std::max(qd_rate, 1.0) / rate;
+      sc.vk = qdv - alpha * sv;
+      model.gamma(q, sc.vk.data(), t, sc.f[0].data());
+      sc.vk = qdv + alpha * sv;
+      model.gamma(q, sc.vk.data(), t, sc.f[1].data());
+      sc.d += (sc.f[0] - sc.f[1]) / (4.0 * alpha);
     }
-    if (!solve_difference(step, sd)) return false;
+    sc.d = -sc.d;
+    if (!solve_negated_difference(sd)) return false;
     if (order < 2) continue;
-    // Acceleration: Φq q̈ − γ, q̈ held.
+    // Acceleration: Φq q̈ − γ, q̈ held, along (v, ṡ), by the fourth-order difference at q + kεv (γ's derivative
+    // along q has Φ's third derivatives in it: no quadratic to read it from).
     const Eigen::Map<const Eigen::VectorXd> sdv(sd, n), qddv(qdd, n);
     along_p(detail::AlongParameter::kAccelerationTerm);
     for (std::size_t k = 0; k < 4; ++k) {
       sc.qk = qv + (kShift[k] * step) * sv;
       sc.vk = qdv + (kShift[k] * step) * sdv;
+      model.jacobian(sc.qk.data(), t, sc.jacobian[k].data());
       sc.f[k].noalias() = jacobian(k) * qddv;
       model.gamma(sc.qk.data(), sc.vk.data(), t, sc.along.data());
       sc.f[k] -= sc.along;
@@ -218,7 +228,9 @@ SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t par
   const int o = std::clamp(order, 0, 2);
   constexpr double kSolvesPerOutput[3] = {1.0, 2.0, 4.0};  // λ; μ; τ and ν
   constexpr double kEvaluations[3] = {0.0, 4.0, 15.0};     // Φq along the motion (and along q̈)
-  constexpr double kDirectEvaluations[3] = {0.0, 4.0, 8.0};  // Φq, then γ, along the sensitivities, a parameter
+  // along the sensitivities, a parameter: 2 γ; with q̈, 4 Φq and 4 γ more, which cost what the 8 before them did
+  // (4 Φq products with q̇ and 4 Φt gone: bench/README.md, "What sensitivities cost")
+  constexpr double kDirectEvaluations[3] = {0.0, 2.0, 8.0};
   const double direct = static_cast<double>(parameters) * ((o + 1) + 0.5 * kDirectEvaluations[o]);
   const double adjoint = static_cast<double>(outputs) * kSolvesPerOutput[o] + 0.5 * kEvaluations[o];
   return adjoint < direct ? SensitivityForm::kAdjoint : SensitivityForm::kDirect;
