@@ -13,6 +13,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -258,6 +259,71 @@ void CheckSpec(const Spec& spec, int n_coords, const CheckOptions& opt) {
     for (int r = 0; r < m; ++r) {
       const double fd = ((f2[r] - g2[r]) + 8.0 * (g1[r] - f1[r])) / (12.0 * e);
       EXPECT_NEAR((gm[r] - gp[r]) / 4.0, fd, Tol(kJacTol, fd)) << "B v from gamma, row " << r;
+    }
+  }
+}
+
+// ---- derivatives along a kind's own data (DataDifferentiable) ----------------------------------------------------
+
+// A datum moved by e times its rate: numbers and constant slots move, coordinate slots are no data.
+inline void MoveDatum(double& x, double r, double e) { x += e * r; }
+inline void MoveDatum(Slot& x, const Slot& r, double e) {
+  if (!x.is_coordinate()) x = Slot::constant(x.value() + e * r.value());
+}
+inline void MoveDatum(phiq::Point2& x, const phiq::Point2& r, double e) {
+  MoveDatum(x.x, r.x, e), MoveDatum(x.y, r.y, e);
+}
+template <class Spec>
+Spec MovedAlongData(const Spec& spec, const Spec& rate, double e) {
+  Spec moved = spec;
+  std::apply([&](auto... m) { (MoveDatum(moved.*m, rate.*m, e), ...); }, Spec::data_members());
+  return moved;
+}
+
+// data_derivative() of every order against the fourth-order central difference of Φ, Φq q̇ + Φt and Φq q̈ − γ
+// along spec + e·rate, at random states (q, q̇, q̈, t).
+template <class Spec>
+void CheckDataDerivative(const Spec& spec, const Spec& rate, int n_coords, std::uint32_t seed, int samples = 6) {
+  static_assert(phiq::DataDifferentiable<Spec>);
+  (void)phiq::test::DataCheckOf<Spec>::registered;  // tests/test_kind_registry.cpp: this kind's check exists
+  constexpr int m = Spec::kRows;
+  SCOPED_TRACE(std::string("kind '") + Spec::kKind + "', derivatives along its data");
+  StateGenerator gen(seed);
+  for (int k = 0; k < samples; ++k) {
+    const State st = gen.Next(n_coords), acc = gen.Next(n_coords);
+    SCOPED_TRACE("sample " + std::to_string(k) + ", " + Describe(st));
+    const double* q = st.q.data();
+    auto term = [&](const Spec& s, int order) {  // Φ, Φq q̇ + Φt, Φq q̈ − γ
+      std::vector<double> out(m, 0.0), g(m, 0.0);
+      if (order == 0) {
+        s.residual(q, st.t, out.data());
+        return out;
+      }
+      const double* v = order == 1 ? st.qd.data() : acc.qd.data();
+      auto sink = [&](int row, const Slot& slot, double value) {
+        if (slot.is_coordinate()) out[row] += value * v[slot.coord()];
+      };
+      s.jacobian(q, st.t, sink);
+      if (order == 1) {
+        s.phi_t(q, st.t, g.data());
+        for (int r = 0; r < m; ++r) out[r] += g[r];
+      } else {
+        s.gamma(q, st.qd.data(), st.t, g.data());
+        for (int r = 0; r < m; ++r) out[r] -= g[r];
+      }
+      return out;
+    };
+    for (int order = 0; order < 3; ++order) {
+      std::vector<double> exact(m + 1, kSentinel);
+      spec.data_derivative(rate, order, q, st.qd.data(), acc.qd.data(), st.t, exact.data());
+      EXPECT_EQ(exact[m], kSentinel) << "data_derivative writes past its rows";
+      const double e = 1e-4;
+      const auto f2 = term(MovedAlongData(spec, rate, -2 * e), order), f1 = term(MovedAlongData(spec, rate, -e), order),
+                 g1 = term(MovedAlongData(spec, rate, e), order), g2 = term(MovedAlongData(spec, rate, 2 * e), order);
+      for (int r = 0; r < m; ++r) {
+        const double fd = ((f2[r] - g2[r]) + 8.0 * (g1[r] - f1[r])) / (12.0 * e);
+        EXPECT_NEAR(exact[r], fd, Tol(kJacTol, fd)) << "order " << order << ", row " << r;
+      }
     }
   }
 }

@@ -20,4 +20,14 @@ struct FdCheckOf {
   static inline const bool registered = (kinds_with_fd_check().insert(std::type_index(typeid(Spec))), true);
 };
 
+// The kinds that differentiate their own data (DataDifferentiable) some CheckDataDerivative<Spec> is compiled for.
+inline std::set<std::type_index>& kinds_with_data_check() {
+  static std::set<std::type_index> kinds;
+  return kinds;
+}
+template <class Spec>
+struct DataCheckOf {
+  static inline const bool registered = (kinds_with_data_check().insert(std::type_index(typeid(Spec))), true);
+};
+
 }  // namespace phiq::test

@@ -143,6 +143,17 @@ TEST(ConstraintKinds, DistanceWithConstantComponent) {
   CheckSpec(d, 3, Opts(101));
 }
 
+TEST(ConstraintKinds, DistanceAlongItsData) {
+  // a ground point and the length move; a moving point's slots are no data
+  const phiq::DistanceSpec d{phiq::Point2{C(0.3), C(-0.2)}, phiq::Point2{S(0), S(1)}, 1.7};
+  const phiq::DistanceSpec rate{phiq::Point2{C(0.5), C(1.5)}, phiq::Point2{C(0.0), C(0.0)}, -0.8};
+  CheckDataDerivative(d, rate, 2, 111);
+  // two moving points, the length only
+  const phiq::DistanceSpec m{phiq::Point2{S(3), S(1)}, phiq::Point2{S(0), S(4)}, 0.35};
+  const phiq::DistanceSpec length_only{phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)}, 1.0};
+  CheckDataDerivative(m, length_only, 5, 112);
+}
+
 TEST(ConstraintKinds, DistanceBetweenMovingPoints) {
   // indices out of order, one coordinate (2) unused
   phiq::DistanceSpec d{phiq::Point2{S(3), S(1)}, phiq::Point2{S(0), S(4)}, 0.35};
@@ -242,6 +253,17 @@ TEST(ConstraintKinds, Polar) {
   // moving origin, negative length
   phiq::PolarSpec m{phiq::Point2{S(3), S(1)}, phiq::Point2{S(0), S(4)}, -0.8, S(2)};
   CheckSpec(m, 5, Opts(702));
+}
+
+TEST(ConstraintKinds, PolarAlongItsData) {
+  // the length and the fixed origin move, the angle a coordinate
+  const phiq::PolarSpec p{phiq::Point2{S(0), S(1)}, phiq::Point2{C(0.1), C(-0.3)}, 0.3, S(2)};
+  const phiq::PolarSpec rate{phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.7), C(-1.1)}, 2.0, C(0.0)};
+  CheckDataDerivative(p, rate, 3, 711);
+  // a constant angle that moves with the parameter, a negative length
+  const phiq::PolarSpec c{phiq::Point2{S(0), S(1)}, phiq::Point2{S(2), S(3)}, -0.8, C(0.4)};
+  const phiq::PolarSpec turns{phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)}, 0.5, C(1.3)};
+  CheckDataDerivative(c, turns, 4, 712);
 }
 
 // ---- LoopSpec -------------------------------------------------------------------------------------------------

@@ -51,6 +51,19 @@ TEST(KindRegistry, EveryKindHasAFiniteDifferenceCheck) {
   EXPECT_EQ(phiq::ConstraintKinds::size, 35u);
 }
 
+TEST(KindRegistry, EveryKindThatDifferentiatesItsDataHasACheckOfIt) {
+  const auto& checked = phiq::test::kinds_with_data_check();
+  std::vector<std::string> differentiating, missing;
+  phiq::ConstraintKinds::for_each([&]<class K>() {
+    if constexpr (phiq::DataDifferentiable<K>) {
+      differentiating.push_back(K::kKind);
+      if (!checked.count(std::type_index(typeid(K)))) missing.push_back(K::kKind);
+    }
+  });
+  EXPECT_TRUE(missing.empty()) << "kinds without a CheckDataDerivative test: " << ::testing::PrintToString(missing);
+  EXPECT_EQ(differentiating, (std::vector<std::string>{"distance", "polar"}));
+}
+
 TEST(KindRegistry, EverySceneExampleIsDocumentedInTheModelsReadme) {
   const std::string readme = read_file(PHIQ_SOURCE_DIR "/models/README.md");
   ASSERT_FALSE(readme.empty());

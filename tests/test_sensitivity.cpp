@@ -599,6 +599,56 @@ TEST(Sensitivity, ModelsAlongAParameterAreReleasedButForItsReach) {
   EXPECT_HAS(check_sensitivity_models(*s.model, other), "its reach is not the one their constraints were kept for");
 }
 
+// The crank-slider's crank (polar) and rod (distance) differentiate their own data (DataDifferentiable): the
+// constraints kept along L2 and L3 hold their data's rates, and the sensitivities are the kinds' derivatives, exact
+// whatever the step. With a step of 5 % the rod's differences are off by 2(h/L)⁴ ≈ 10⁻⁵ (the models kept, which
+// difference), while the kinds' stay at the closed form to 1e-9; at the default step the two agree to 1e-10.
+TEST(Sensitivity, KindsThatDifferentiateTheirDataAreExactAtAnyStep) {
+  const std::string coarse = test::replace_first(kCrankSlider, "sensitivities: [L2, {parameter: L3, step: 1e-3}]",
+                                                 "sensitivities: [{parameter: L2, step: 0.015}, {parameter: L3, step: 0.05}]");
+  for (const std::string& text : {std::string(kCrankSlider), coarse}) {
+    const bool large = text == coarse;
+    const Scene s = parse_scene(text, "crank_slider.yaml");
+    SceneOverrides keep;
+    keep.keep_sensitivity_models = true;
+    const Scene kept = parse_scene(text, "crank_slider.yaml", {}, keep);
+    for (const OutputSensitivity& p : s.sweep.sensitivities) {
+      ASSERT_TRUE(p.reached) << p.name;
+      ASSERT_EQ(p.reached->rates.size(), 1u) << p.name;  // one constraint each: the crank, the rod
+      EXPECT_NE(p.reached->rates[0], nullptr) << p.name;
+    }
+    for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
+      SweepOptions a = s.sweep, b = kept.sweep;
+      a.sensitivity_form = b.sensitivity_form = form;
+      const SensitivityTrace exact = sweep_sensitivities(*s.model, a), differenced = sweep_sensitivities(*kept.model, b);
+      ASSERT_EQ(exact.s.size(), 91u);
+      ASSERT_EQ(differenced.s.size(), 91u);
+      const Index n = s.model->num_coordinates(), xb = s.model->coordinate_index("xB");
+      const SensitivityLayout layout{n};
+      double worst_exact = 0.0, worst_differenced = 0.0;
+      for (std::size_t k = 0; k < exact.s.size(); ++k)
+        for (int which : {2, 3}) {
+          const std::size_t j = which == 2 ? 0 : 1;
+          const auto closed = slider_derivatives(2.0 * exact.rows.t[k], 0.3, 1.0, which);
+          const double want[3] = {closed[0], 2.0 * closed[1], 4.0 * closed[2]};
+          for (int o = 0; o < 3; ++o) {
+            const double e = exact.s[k][layout.offset(j, o) + xb], d = differenced.s[k][layout.offset(j, o) + xb];
+            EXPECT_NEAR(e, want[o], 1e-9) << to_string(form) << " t = " << exact.rows.t[k] << ", L" << which;
+            if (!large) {
+              EXPECT_NEAR(e, d, 1e-10 * std::max(1.0, std::fabs(d))) << to_string(form);
+            }
+            worst_exact = std::max(worst_exact, std::fabs(e - want[o]));
+            worst_differenced = std::max(worst_differenced, std::fabs(d - want[o]));
+          }
+        }
+      if (large) {
+        EXPECT_GT(worst_differenced, 1e-6) << to_string(form) << ": the differences at a 5 % step";
+      }
+      EXPECT_LT(worst_exact, 1e-9) << to_string(form);
+    }
+  }
+}
+
 // Bars between natural points and a linear driver: Φq is linear in q, so its second difference along the motion is
 // rounding alone, which the smoothness check does not take for a knot: no row leaves the adjoint form, and its
 // values are the direct form's.

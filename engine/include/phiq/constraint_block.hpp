@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <iterator>
@@ -124,7 +125,25 @@ class ConstraintBlock {
   /// Appends a copy of constraint `i` of `from` (a block of the same kind: else phiq::Error), its rows included. Such
   /// a block evaluates Φ, Φt, γ and Φq v (add_jacobian_product()); it has no Jacobian pattern. Not thread-safe.
   virtual void append_copy(const ConstraintBlock& from, std::size_t i) = 0;
+  /// The rates of the data of constraints [begin, end) along a design parameter, from their copies in the four
+  /// models at p − 2h, p − h, p + h, p + 2h: `along[k]` holds them as constraints 0 … end − begin − 1 (the
+  /// constraints a parameter reaches, ReachedConstraints). A block of this kind, one constraint for each, whose data
+  /// are the data's rates (DistanceSpec::data_derivative()), for data_derivative(); null when the kind does not
+  /// differentiate its data, or when data it does not list move (their derivatives are then differenced).
+  virtual std::unique_ptr<ConstraintBlock> data_rates(std::size_t /*begin*/, std::size_t /*end*/,
+                                                      const std::array<const ConstraintBlock*, 4>& /*along*/,
+                                                      double /*h*/) const {
+    return nullptr;
+  }
+  /// Writes the derivative along a design parameter, at fixed (q, q̇, q̈, t), of Φ (`order` 0), Φq q̇ + Φt (1) or
+  /// Φq q̈ − γ (2) of constraints [begin, end) into `out` at their global rows, `rates` being what data_rates() made
+  /// for that range: exact, one evaluation (DistanceSpec::data_derivative()). `qd` is read for order ≥ 1, `qdd`
+  /// for order 2. Thread-safe.
+  virtual void data_derivative(std::size_t /*begin*/, std::size_t /*end*/, const ConstraintBlock& /*rates*/,
+                               int /*order*/, const double* /*q*/, const double* /*qd*/, const double* /*qdd*/,
+                               double /*t*/, double* /*out*/) const {}
 };
+
 
 namespace detail {
 /// Pattern mode: records the column of every entry that falls on a coordinate.
@@ -284,6 +303,40 @@ class TypedBlock final : public ConstraintBlock {
       return count;
     } else {
       return 0;
+    }
+  }
+  std::unique_ptr<ConstraintBlock> data_rates(std::size_t begin, std::size_t end,
+                                              const std::array<const ConstraintBlock*, 4>& along,
+                                              double h) const override {
+    if constexpr (DataDifferentiable<Spec>) {
+      std::array<const TypedBlock*, 4> a{};
+      for (std::size_t k = 0; k < 4; ++k) {
+        a[k] = dynamic_cast<const TypedBlock*>(along[k]);
+        if (!a[k] || a[k]->entries_.size() != end - begin) return nullptr;
+      }
+      auto rates = std::make_unique<TypedBlock>();
+      rates->entries_.reserve(end - begin);
+      for (std::size_t i = begin; i < end; ++i) {
+        Entry e = entries_[i];  // its rows: the swept model's
+        const std::size_t j = i - begin;
+        if (!detail::spec_data_rate(entries_[i].spec,
+                                    {&a[0]->entries_[j].spec, &a[1]->entries_[j].spec, &a[2]->entries_[j].spec,
+                                     &a[3]->entries_[j].spec},
+                                    h, e.spec))
+          return nullptr;
+        rates->entries_.push_back(e);
+      }
+      return rates;
+    } else {
+      return nullptr;
+    }
+  }
+  void data_derivative(std::size_t begin, std::size_t end, const ConstraintBlock& rates, int order, const double* q,
+                       const double* qd, const double* qdd, double t, double* out) const override {
+    if constexpr (DataDifferentiable<Spec>) {
+      const auto& r = static_cast<const TypedBlock&>(rates);  // data_rates() made it, of this kind
+      for (std::size_t i = begin; i < end; ++i)
+        entries_[i].spec.data_derivative(r.entries_[i - begin].spec, order, q, qd, qdd, t, out + entries_[i].row0);
     }
   }
   void row_lengths(std::vector<double>& lengths) const override {

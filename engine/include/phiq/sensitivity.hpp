@@ -25,6 +25,11 @@
 /// h = 10⁻³ |p|; for a parameter inside a sine or cosine (an angle), h⁴/30 of the fifth derivative: 3·10⁻¹⁴
 /// relative. Rounding adds about ε |Φ's terms| / h.
 ///
+/// A kind that differentiates its own data (DataDifferentiable: the distance and the polar vector, most rows of
+/// the large linkages) gives its equations' derivatives itself, exactly and in one evaluation: D is then applied
+/// to its data alone (a datum's rate: exact for the scene's arithmetic of degree ≤ 4 in p, a length L itself
+/// among it) and the kind's data_derivative() chains it (DistanceSpec::data_derivative(); ReachedConstraints::rates).
+///
 /// The higher orders' derivatives along the motion's own sensitivities, (q, q̇) ← (s, ṡ), are taken apart from p,
 /// with the swept model. The velocity's is exact: with B = ∂(Φq q̇ + Φt)/∂q, γ = −(Φq q̇)q q̇ − 2 Φqt q̇ − Φtt is a
 /// quadratic in q̇ whose derivative along s is −2 B s, so that
@@ -90,9 +95,16 @@ struct ParameterReach {
 /// The constraints of a ParameterReach as each model along the parameter holds them: for model k (at p − 2h, p − h,
 /// p + h, p + 2h), one block per span of the reach, holding copies of the span's constraints with their rows. All
 /// that the derivatives along p read once the reach is known (keep_reached_only()).
+///
+/// Where the span's kind differentiates its own data (DataDifferentiable: the distance, the polar vector), `rates`
+/// holds its data's rates along p (ConstraintBlock::data_rates()), and the derivatives there are the kind's, exact
+/// and in one evaluation instead of four (a bar's length: the differences' 2(h/L)⁴ gone). Not with co-moving
+/// coordinates (ParameterReach::comotion: the models move q there), where every span is differenced.
 struct ReachedConstraints {
   std::shared_ptr<const ParameterReach> reach;  ///< the reach they were kept for
-  std::array<std::vector<std::unique_ptr<ConstraintBlock>>, 4> along;  ///< per model, per span of the reach
+  /// per model, per span of the reach (empty where `rates` holds the span's: what is read of it then)
+  std::array<std::vector<std::unique_ptr<ConstraintBlock>>, 4> along;
+  std::vector<std::unique_ptr<ConstraintBlock>> rates;  ///< per span of the reach: its data's rates, or null
 };
 
 /// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the

@@ -235,7 +235,7 @@ OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name,
     return s;
   }
   s.reach = std::make_shared<const ParameterReach>(detail::reach_of(model, along, s.step));
-  s.reached = detail::reached_of(model, along, s.reach);
+  s.reached = detail::reached_of(model, along, s.reach, s.step);
   return s;
 }
 

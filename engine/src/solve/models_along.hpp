@@ -46,6 +46,6 @@ ParameterReach reach_of(const Model& model, const std::array<AlongModel, 4>& alo
 
 // The constraints of `reach` as the four models hold them (keep_reached_only()).
 std::shared_ptr<const ReachedConstraints> reached_of(const Model& model, const std::array<AlongModel, 4>& along,
-                                                     const std::shared_ptr<const ParameterReach>& reach);
+                                                     const std::shared_ptr<const ParameterReach>& reach, double step);
 
 }  // namespace phiq::detail

@@ -131,7 +131,8 @@ ParameterReach detail::reach_of(const Model& model, const std::array<AlongModel,
 
 std::shared_ptr<const ReachedConstraints> detail::reached_of(const Model& model,
                                                              const std::array<AlongModel, 4>& along,
-                                                             const std::shared_ptr<const ParameterReach>& reach) {
+                                                             const std::shared_ptr<const ParameterReach>& reach,
+                                                             double step) {
   auto reached = std::make_shared<ReachedConstraints>();
   reached->reach = reach;
   for (std::size_t k = 0; k < 4; ++k)
@@ -142,6 +143,20 @@ std::shared_ptr<const ReachedConstraints> detail::reached_of(const Model& model,
         copy->append_copy(*block, index);
       }
       reached->along[k].push_back(std::move(copy));
+    }
+  // the rates of the data of the spans whose kind differentiates its own (the models move no coordinate): then
+  // they are all that is read of the span, and its four copies go (one copy kept of the span, not four)
+  reached->rates.resize(reach->spans.size());
+  if (reach->comotion.empty())
+    for (std::size_t j = 0; j < reach->spans.size(); ++j) {
+      const ParameterReach::Span& span = reach->spans[j];
+      reached->rates[j] = model.blocks()[span.block]->data_rates(
+          span.begin, span.end,
+          {reached->along[0][j].get(), reached->along[1][j].get(), reached->along[2][j].get(),
+           reached->along[3][j].get()},
+          step);
+      if (reached->rates[j])
+        for (auto& copies : reached->along) copies[j] = copies[j]->empty_copy();
     }
   return reached;
 }
@@ -167,18 +182,19 @@ void keep_reached_only(const Model& model, OutputSensitivity& s) {
   for (std::size_t k = 0; k < 4; ++k) along[k] = detail::along_model(model, *s.models[k]);
   if (!s.reach) s.reach = std::make_shared<const ParameterReach>(detail::reach_of(model, along, s.step));
   if (s.reach->everything) return;
-  s.reached = detail::reached_of(model, along, s.reach);
+  s.reached = detail::reached_of(model, along, s.reach, s.step);
   for (auto& m : s.models) m.reset();
 }
 
 void detail::evaluate_over_reach(const ParameterReach& reach, const Model* m, const ReachedConstraints* reached,
                                  std::size_t k, AlongParameter which, const double* q, const double* qd,
-                                 const double* qdd, double t, double* f, double* scratch) {
+                                 const double* qdd, double t, double* f, double* scratch, bool skip_rated) {
   if (which != AlongParameter::kResidual)
     for (const Index r : reach.rows) f[r] = 0.0, scratch[r] = 0.0;
   if (!reached && !m) throw Error("a parameter's models along it were released (keep_reached_only())");
   for (std::size_t j = 0; j < reach.spans.size(); ++j) {
     const ParameterReach::Span& s = reach.spans[j];
+    if (skip_rated && reached && reached->rates[j]) continue;
     // the span in the model, or its copy (the whole block) in the constraints kept of it
     const ConstraintBlock& block = reached ? *reached->along[k][j] : *m->blocks()[s.block];
     const std::size_t begin = reached ? 0 : s.begin, end = reached ? block.size() : s.end;

@@ -33,21 +33,45 @@ void difference_on(const ParameterReach& reach, const std::array<Eigen::VectorXd
 // (ParameterReach::comotion: a curve's parameter), along (q, p) ← (q̂, 1), q̂ that move: the models then see one
 // contact (at fixed s, a curve whose radius is the parameter turns under it s / ℓ times faster than p moves).
 // Callers solve for s − q̂ (sensitivity.hpp): Φq (s − q̂) = −(Φp + Φq q̂), the higher orders alike.
-void along_parameter(const OutputSensitivity& p, const ParameterReach& reach, detail::AlongParameter which,
-                     const double* q, const double* qd, const double* qdd, double t, Index n,
-                     detail::SensitivityScratch& sc, Eigen::VectorXd& d) {
+//
+// Where the kept constraints hold their data's rates (ReachedConstraints::rates: kinds that differentiate their own
+// data), those spans are the swept model's own derivatives along the data instead, one evaluation, exact.
+void along_parameter(const Model& model, const OutputSensitivity& p, const ParameterReach& reach,
+                     detail::AlongParameter which, const double* q, const double* qd, const double* qdd, double t,
+                     Index n, detail::SensitivityScratch& sc, Eigen::VectorXd& d) {
   const double h = p.step;
   const double* at = q;
   if (!reach.comotion.empty()) sc.moved = Eigen::Map<const Eigen::VectorXd>(q, n), at = sc.moved.data();
   // the constraints kept of the models (keep_reached_only()) when they hold this reach, else the models
   const ReachedConstraints* reached = p.reached && p.reached->reach.get() == &reach ? p.reached.get() : nullptr;
-  for (std::size_t k = 0; k < 4; ++k) {
-    for (const ParameterReach::Comotion& c : reach.comotion)
-      sc.moved[c.coordinate] = q[c.coordinate] * (1.0 + kShift[k] * h * c.rate);
-    detail::evaluate_over_reach(reach, p.models[k].get(), reached, k, which, at, qd, qdd, t, sc.f[k].data(),
-                                sc.along.data());
+  const bool rated = reached && std::any_of(reached->rates.begin(), reached->rates.end(),
+                                            [](const auto& r) { return r != nullptr; });
+  const bool differenced =
+      !rated || std::any_of(reached->rates.begin(), reached->rates.end(), [](const auto& r) { return !r; });
+  if (differenced) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      for (const ParameterReach::Comotion& c : reach.comotion)
+        sc.moved[c.coordinate] = q[c.coordinate] * (1.0 + kShift[k] * h * c.rate);
+      detail::evaluate_over_reach(reach, p.models[k].get(), reached, k, which, at, qd, qdd, t, sc.f[k].data(),
+                                  sc.along.data(), rated);
+    }
+    if (!rated) return difference_on(reach, sc.f, h, d);
   }
-  difference_on(reach, sc.f, h, d);
+  const int order = which == detail::AlongParameter::kResidual       ? 0
+                    : which == detail::AlongParameter::kVelocityTerm ? 1
+                                                                     : 2;
+  for (std::size_t j = 0; j < reach.spans.size(); ++j) {
+    const ParameterReach::Span& s = reach.spans[j];
+    const ConstraintBlock& block = *model.blocks()[s.block];
+    if (reached->rates[j]) {
+      block.data_derivative(s.begin, s.end, *reached->rates[j], order, q, qd, qdd, t, d.data());
+      continue;
+    }
+    const Index rows = block.rows_per_constraint();  // the span's rows, differenced as difference_on()
+    for (std::size_t i = s.begin; i < s.end; ++i)
+      for (Index r = block.first_row(i); r < block.first_row(i) + rows; ++r)
+        d[r] = ((sc.f[0][r] - sc.f[3][r]) + 8.0 * (sc.f[2][r] - sc.f[1][r])) / (12.0 * h);
+  }
 }
 
 // v·w over the rows of `reach`.
@@ -157,7 +181,7 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     const ParameterReach& reach = p.reach ? *p.reach : (found = parameter_reach(model, p));
     auto along_p = [&](detail::AlongParameter which) {
       sc.d.setZero();
-      along_parameter(p, reach, which, q, qd, qdd, t, n, sc, sc.d);
+      along_parameter(model, p, reach, which, q, qd, qdd, t, n, sc, sc.d);
     };
     // Position: Φp (the other rows of Φp are exactly 0).
     along_p(detail::AlongParameter::kResidual);
@@ -335,7 +359,7 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
     Eigen::VectorXd* into[3] = {&sc.a[j], &sc.b[j], &sc.c[j]};
     for (int o = 0; o <= order; ++o) {
       into[o]->resize(m);
-      along_parameter(p, *reaches[j], terms[o], q, qd, qdd, t, n, sc, *into[o]);
+      along_parameter(model, p, *reaches[j], terms[o], q, qd, qdd, t, n, sc, *into[o]);
     }
   }
   // Bᵀv, and ∂(Φq q̈ − γ)/∂qᵀ v, into sc.rhs (over the coordinates).

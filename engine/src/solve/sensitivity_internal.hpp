@@ -51,10 +51,11 @@ enum class AlongParameter {
 // `which` of model `m` (one along the parameter, or the swept model) over the constraints of `reach` only, or, with
 // `reached` set, of model k's copies of them (ReachedConstraints; `m` unread): their rows of `f` are written, every
 // other row is left as it is. `scratch` (one entry per row of Φ, like `f`) holds Φt or γ on the way. `qd` is read
-// by kVelocityTerm and kAccelerationTerm, `qdd` by kAccelerationTerm (else null).
+// by kVelocityTerm and kAccelerationTerm, `qdd` by kAccelerationTerm (else null). With `skip_rated`, the spans whose
+// data's rates `reached` holds are not evaluated (their kind gives their derivatives: the rows may hold anything).
 void evaluate_over_reach(const ParameterReach& reach, const Model* m, const ReachedConstraints* reached,
                          std::size_t k, AlongParameter which, const double* q, const double* qd, const double* qdd,
-                         double t, double* f, double* scratch);
+                         double t, double* f, double* scratch, bool skip_rated = false);
 
 // Writes the sensitivities of (q, q̇, q̈) at t to every parameter into `out` (SensitivityLayout; derivatives above
 // `order` are NaN), solving with `lu`, the factors of the swept model's Φq at q. `ws` lends the right-hand side

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <tuple>
 
 #include "phiq/kinds/kind_support.hpp"
 
@@ -136,6 +137,39 @@ struct DistanceSpec {
   void gamma(const double*, const double* qd, double, double* out) const {
     kin::V2 dd = kin::vel(b, qd) - kin::vel(a, qd);
     out[0] = -kin::dot(dd, dd) / length;
+  }
+
+  /// The data a design parameter may move, for data_derivative(): member pointers to numbers, Slots and Point2s
+  /// (a coordinate slot is no datum: its rate is 0). Optional, with data_derivative(): a kind without them has its
+  /// derivatives along a parameter differenced from the four models along it (sensitivity.hpp).
+  static constexpr auto data_members() {
+    return std::tuple{&DistanceSpec::a, &DistanceSpec::b, &DistanceSpec::length};
+  }
+  /// The derivative of the constraint's equations along its data at fixed (q, q̇, q̈, t), `rate` holding each
+  /// datum's rate along the parameter (data_members(): numbers their rate, constant slots a constant holding
+  /// theirs, coordinate slots 0): ∂Φ/∂p (`order` 0), ∂(Φq q̇ + Φt)/∂p (1), ∂(Φq q̈ − γ)/∂p (2), kRows values at
+  /// `out`. What the sensitivities to a parameter read where it reaches the constraint (sensitivity.hpp): exact,
+  /// where the differences of four models are exact only up to 2(h/L)⁴ for a length. With d = b − a, ḋ its
+  /// data's rate, v, w the velocities and accelerations of d, and L̇:
+  ///
+  ///   ∂Φ/∂p = d·ḋ / L − L̇ (|d|² + L²) / (2L²),   ∂(Φq q̇)/∂p = ḋ·v / L − L̇ d·v / L²,
+  ///   ∂(Φq q̈ − γ)/∂p = ḋ·w / L − L̇ (d·w + |v|²) / L².
+  /// @pre `qd` (order ≥ 1) and `qdd` (order 2) as q.
+  void data_derivative(const DistanceSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
+    const kin::V2 d = kin::pos(b, q) - kin::pos(a, q), dd = kin::pos(rate.b, q) - kin::pos(rate.a, q);
+    const double L = length, Ld = rate.length;
+    if (order == 0) {
+      out[0] = kin::dot(d, dd) / L - Ld * (kin::dot(d, d) + L * L) / (2.0 * L * L);
+      return;
+    }
+    const kin::V2 v = kin::vel(b, qd) - kin::vel(a, qd);
+    if (order == 1) {
+      out[0] = kin::dot(dd, v) / L - Ld * kin::dot(d, v) / (L * L);
+      return;
+    }
+    const kin::V2 w = kin::vel(b, qdd) - kin::vel(a, qdd);
+    out[0] = kin::dot(dd, w) / L - Ld * (kin::dot(d, w) + kin::dot(v, v)) / (L * L);
   }
 
   /// What the constraint counts for in the Grübler–Kutzbach formula (Model::grubler()). Called once, when the

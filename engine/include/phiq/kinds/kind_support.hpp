@@ -6,7 +6,9 @@
 
 #include <cmath>
 #include <algorithm>
+#include <array>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -102,8 +104,66 @@ struct JointCount {
 /// the same vocabulary), `signed_coordinates`, `coordinate_pair`, `number_pair`, `expression`, `unit`; in space
 /// `point3`, `point3_pair`, `vec3`, `sides3` (two JointSide3), `two_directions` ({head, tail, unit} each).
 
+/// Whether a kind differentiates its equations along its own data (DistanceSpec::data_derivative()): it lists the
+/// data in data_members() and supplies data_derivative(). The sensitivities to a parameter that reaches such a
+/// constraint read its derivatives there in one evaluation instead of differencing four models.
+template <class K>
+concept DataDifferentiable = requires(const K k, const double* q, double* out) {
+  K::data_members();
+  k.data_derivative(k, 0, q, q, q, 0.0, out);
+};
+
 /// @cond internal
 namespace detail {
+// The rates of a kind's data along a design parameter (DistanceSpec::data_derivative()), from its values in the
+// four models at p − 2h, p − h, p + h, p + 2h by the fourth-order central difference (sensitivity.hpp): one datum
+// of each type a kind lists in data_members(). False where the datum is not data that moves: a coordinate in one
+// model and another slot in the next.
+inline bool datum_rate(double& rate, const std::array<const double*, 4>& v, double h) {
+  rate = ((*v[0] - *v[3]) + 8.0 * (*v[2] - *v[1])) / (12.0 * h);
+  return std::isfinite(rate);
+}
+// A constant's rate, as a constant slot; a coordinate's (the same in the four), the constant 0: it is no datum.
+inline bool datum_rate(Slot& rate, const std::array<const Slot*, 4>& v, double h) {
+  if (v[0]->is_coordinate()) {
+    for (const Slot* s : v)
+      if (!(*s == *v[0])) return false;
+    rate = Slot::constant(0.0);
+    return true;
+  }
+  double x[4];
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (v[k]->is_coordinate()) return false;
+    x[k] = v[k]->value();
+  }
+  double r = 0.0;
+  const bool ok = datum_rate(r, {&x[0], &x[1], &x[2], &x[3]}, h);
+  rate = Slot::constant(r);
+  return ok;
+}
+inline bool datum_rate(Point2& rate, const std::array<const Point2*, 4>& v, double h) {
+  return datum_rate(rate.x, {&v[0]->x, &v[1]->x, &v[2]->x, &v[3]->x}, h) &&
+         datum_rate(rate.y, {&v[0]->y, &v[1]->y, &v[2]->y, &v[3]->y}, h);
+}
+
+// `rate` made of `at` with each datum of Spec::data_members() replaced by its rate along the parameter over the
+// four specs `along` (ConstraintBlock::data_rates()). False when it has none: a datum is no data that moves, or a
+// member the kind does not list differs between the specs (its equations' derivative along it is not the kind's).
+template <class Spec>
+bool spec_data_rate(const Spec& at, const std::array<const Spec*, 4>& along, double h, Spec& rate) {
+  rate = at;
+  bool ok = true;
+  std::apply([&](auto... m) { ((ok = ok && datum_rate(rate.*m, {&(along[0]->*m), &(along[1]->*m), &(along[2]->*m),
+                                                                 &(along[3]->*m)}, h)), ...); },
+             Spec::data_members());
+  for (const Spec* s : along) {
+    Spec other = *s;
+    std::apply([&](auto... m) { ((other.*m = at.*m), ...); }, Spec::data_members());
+    ok = ok && other == at;
+  }
+  return ok;
+}
+
 // A planar pair (pin, prismatic) between bodies or ground removes 2 freedoms; with a natural point on either side
 // it is no joint of the count.
 inline JointCount planar_pair_joint_count(const Frame2& a, const Frame2& b) {

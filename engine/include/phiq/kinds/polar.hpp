@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <tuple>
 
 #include "phiq/kinds/kind_support.hpp"
 
@@ -62,6 +63,34 @@ struct PolarSpec {
     double th = theta.of(q), w = theta.rate(qd);
     out[0] = -length * w * w * std::cos(th);
     out[1] = -length * w * w * std::sin(th);
+  }
+
+  /// The data a parameter may move (DistanceSpec::data_members()).
+  static constexpr auto data_members() {
+    return std::tuple{&PolarSpec::p, &PolarSpec::o, &PolarSpec::length, &PolarSpec::theta};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). With u = (cos θ, sin θ), u⊥ = (−sin θ, cos θ),
+  /// ω = θ̇, α = θ̈ and θ̂ the rate of a constant θ:
+  ///
+  ///   ∂Φ/∂p = ṗ − ȯ − L̇ u − L θ̂ u⊥,   ∂(Φq q̇)/∂p = −L̇ ω u⊥ + L θ̂ ω u,
+  ///   ∂(Φq q̈ − γ)/∂p = L̇ (ω² u − α u⊥) + L θ̂ (α u + ω² u⊥).
+  void data_derivative(const PolarSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
+    const double th = theta.of(q), c = std::cos(th), s = std::sin(th), Ld = rate.length, thd = rate.theta.of(q);
+    if (order == 0) {
+      out[0] = rate.p.x.of(q) - rate.o.x.of(q) - Ld * c + length * s * thd;
+      out[1] = rate.p.y.of(q) - rate.o.y.of(q) - Ld * s - length * c * thd;
+      return;
+    }
+    const double w = theta.rate(qd);
+    if (order == 1) {
+      out[0] = Ld * w * s + length * thd * w * c;
+      out[1] = -Ld * w * c + length * thd * w * s;
+      return;
+    }
+    const double al = theta.rate(qdd);
+    out[0] = Ld * (w * w * c + al * s) + length * thd * (al * c - w * w * s);
+    out[1] = Ld * (w * w * s - al * c) + length * thd * (al * s + w * w * c);
   }
 
   /// @copydoc DistanceSpec::joint_count
