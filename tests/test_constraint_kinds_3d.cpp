@@ -220,6 +220,11 @@ TEST(ConstraintKinds3d, Distance) {
       {phiq::Attachment3::body_point(Body(0), V3{0.3, -0.2, 0.5}), phiq::Attachment3::body_point(Body(7), V3{-1, 0.4, 0})},
       0.45};
   CheckSpec(between_bodies, kN, Opts(411));
+  // derivatives along the length (the one datum it differentiates)
+  phiq::SpatialDistanceSpec rate = between_points, body_rate = between_bodies;
+  rate.length = -0.6, body_rate.length = 1.3;
+  CheckDataDerivative(between_points, rate, kN, 412);
+  CheckDataDerivative(between_bodies, body_rate, kN, 413);
 }
 
 TEST(ConstraintKinds3d, DotOfVectorsAndSegments) {

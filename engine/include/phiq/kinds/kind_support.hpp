@@ -117,17 +117,18 @@ concept DataDifferentiable = requires(const K k, const double* q, double* out) {
 namespace detail {
 // The rates of a kind's data along a design parameter (DistanceSpec::data_derivative()), from its values in the
 // four models at p − 2h, p − h, p + h, p + 2h by the fourth-order central difference (sensitivity.hpp): one datum
-// of each type a kind lists in data_members(). False where the datum is not data that moves: a coordinate in one
-// model and another slot in the next.
+// of each type a kind lists in data_members(), `rate` holding the swept model's datum on entry. False where the
+// datum is not data that moves: a coordinate in one model and another slot in the next.
 inline bool datum_rate(double& rate, const std::array<const double*, 4>& v, double h) {
   rate = ((*v[0] - *v[3]) + 8.0 * (*v[2] - *v[1])) / (12.0 * h);
   return std::isfinite(rate);
 }
-// A constant's rate, as a constant slot; a coordinate's (the same in the four), the constant 0: it is no datum.
+// A constant's rate, as a constant slot; a coordinate's (the swept model's in the four), the constant 0: it is no
+// datum.
 inline bool datum_rate(Slot& rate, const std::array<const Slot*, 4>& v, double h) {
-  if (v[0]->is_coordinate()) {
+  if (rate.is_coordinate()) {
     for (const Slot* s : v)
-      if (!(*s == *v[0])) return false;
+      if (!(*s == rate)) return false;
     rate = Slot::constant(0.0);
     return true;
   }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <tuple>
 
 #include "phiq/kinds/spatial_joints.hpp"  // detail3: the row formulas
 #include "phiq/spatial_attachment.hpp"
@@ -50,6 +51,32 @@ struct SpatialDistanceSpec {
   /// @copydoc DistanceSpec::gamma
   void gamma(const double* q, const double* qd, double, double* out) const {
     out[0] = detail3::row_gamma(ends, kDef, q, qd, 0.5 / length);
+  }
+  /// The data a parameter may move (DistanceSpec::data_members()): the length. A parameter that moves an end's
+  /// local point is differenced from the models along it, as for the kinds without derivatives of their own.
+  static constexpr auto data_members() { return std::tuple{&SpatialDistanceSpec::length}; }
+  /// Derivatives along the length (DistanceSpec::data_derivative()). Φ = (|d|² − L²)/(2L), d = B − A, whose Φq and
+  /// γ are 1/(2L) times what does not hold L:
+  ///
+  ///   ∂Φ/∂p = −L̇ (Φ + L) / L,   ∂(Φq q̇)/∂p = −(L̇/L) Φq q̇,   ∂(Φq q̈ − γ)/∂p = −(L̇/L) (Φq q̈ − γ).
+  void data_derivative(const SpatialDistanceSpec& rate, int order, const double* q, const double* qd,
+                       const double* qdd, double t, double* out) const {
+    const double k = rate.length / length;
+    double value = 0.0;
+    if (order == 0) {
+      residual(q, t, &value);
+      out[0] = -k * (value + length);
+      return;
+    }
+    const double* v = order == 1 ? qd : qdd;
+    auto product = [&](int, const Slot& s, double entry) { value += entry * s.rate(v); };  // Φq v
+    jacobian(q, t, product);
+    if (order == 2) {
+      double g = 0.0;
+      gamma(q, qd, t, &g);
+      value -= g;
+    }
+    out[0] = -k * value;
   }
 
 
