@@ -273,6 +273,12 @@ inline void MoveDatum(Slot& x, const Slot& r, double e) {
 inline void MoveDatum(phiq::Point2& x, const phiq::Point2& r, double e) {
   MoveDatum(x.x, r.x, e), MoveDatum(x.y, r.y, e);
 }
+inline void MoveDatum(phiq::Frame2& x, const phiq::Frame2& r, double e) {
+  MoveDatum(x.x, r.x, e), MoveDatum(x.y, r.y, e), MoveDatum(x.psi, r.psi, e);
+}
+inline void MoveDatum(phiq::kin::V2& x, const phiq::kin::V2& r, double e) {
+  MoveDatum(x.x, r.x, e), MoveDatum(x.y, r.y, e);
+}
 template <class Spec>
 Spec MovedAlongData(const Spec& spec, const Spec& rate, double e) {
   Spec moved = spec;

@@ -176,6 +176,18 @@ TEST(ConstraintKinds, PinBodyGround) {
   CheckSpec(q, 3, Opts(203));
 }
 
+TEST(ConstraintKinds, PinAlongItsData) {
+  // a body pinned to ground: the ground frame's position and angle and both local points move
+  const phiq::PinSpec p{phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{C(1.0), C(-0.5), C(0.3)}, {0.45, 0.25}, {0.2, 0.4}};
+  const phiq::PinSpec rate{phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{C(0.6), C(-1.2), C(0.9)}, {1.1, -0.3},
+                           {0.5, 0.7}};
+  CheckDataDerivative(p, rate, 3, 231);
+  // two bodies, their arms move
+  const phiq::PinSpec q{phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{S(3), S(4), S(5)}, {0.3, -0.2}, {-0.5, 0.1}};
+  const phiq::PinSpec arms{phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{C(0), C(0), C(0)}, {1.0, 0.0}, {-0.4, 0.8}};
+  CheckDataDerivative(q, arms, 6, 232);
+}
+
 TEST(ConstraintKinds, PinBodyNaturalPoint) {
   // body a (with arm) pinned to natural point (x3, x4): ψ constant, s = 0
   phiq::PinSpec p{phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{S(3), S(4), C(0.0)}, {-0.4, 0.35}, {0.0, 0.0}};

@@ -61,7 +61,7 @@ TEST(KindRegistry, EveryKindThatDifferentiatesItsDataHasACheckOfIt) {
     }
   });
   EXPECT_TRUE(missing.empty()) << "kinds without a CheckDataDerivative test: " << ::testing::PrintToString(missing);
-  EXPECT_EQ(differentiating, (std::vector<std::string>{"distance", "polar", "distance"}));  // planar, spatial
+  EXPECT_EQ(differentiating, (std::vector<std::string>{"distance", "pin", "polar", "distance"}));  // planar, spatial
 }
 
 TEST(KindRegistry, EverySceneExampleIsDocumentedInTheModelsReadme) {

@@ -604,6 +604,14 @@ TEST(Sensitivity, ModelsAlongAParameterAreReleasedButForItsReach) {
   OutputSensitivity other = sensitivity_along(s, "R", 0.05);
   other.reach = std::make_shared<const ParameterReach>(whole_model_reach(*s.model));
   EXPECT_HAS(check_sensitivity_models(*s.model, other), "its reach is not the one their constraints were kept for");
+  // kept constraints whose data's rates do not match their reach's spans are refused, not read out of range
+  OutputSensitivity odd = sensitivity_along(s, "R", 0.05);
+  auto rates = std::make_shared<ReachedConstraints>();
+  rates->reach = odd.reach;
+  rates->rates.resize(odd.reach->spans.size() + 1);
+  odd.reached = rates;
+  EXPECT_EQ(check_sensitivity_models(*s.model, odd),
+            "sensitivity to 'R': the rates of its kept constraints' data are not one for each span of their reach");
 }
 
 // The crank-slider's crank (polar) and rod (distance) differentiate their own data (DataDifferentiable): the

@@ -129,6 +129,9 @@ std::string check_sensitivity_models(const Model& model, const OutputSensitivity
   const std::string who = "sensitivity to '" + s.name + "': ";
   if (!(s.step > 0.0) || !std::isfinite(s.step)) return who + "the difference step must be positive and finite";
   // released models (keep_reached_only()): the constraints kept of them stand for them, checked when kept
+  if (s.reached && s.reached->reach && !s.reached->rates.empty() &&
+      s.reached->rates.size() != s.reached->reach->spans.size())
+    return who + "the rates of its kept constraints' data are not one for each span of their reach";
   if (detail::models_released(s)) {
     if (!s.reach || s.reach != s.reached->reach)
       return who + "its models were released, and its reach is not the one their constraints were kept for";

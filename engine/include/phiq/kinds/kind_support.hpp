@@ -146,6 +146,15 @@ inline bool datum_rate(Point2& rate, const std::array<const Point2*, 4>& v, doub
   return datum_rate(rate.x, {&v[0]->x, &v[1]->x, &v[2]->x, &v[3]->x}, h) &&
          datum_rate(rate.y, {&v[0]->y, &v[1]->y, &v[2]->y, &v[3]->y}, h);
 }
+inline bool datum_rate(Frame2& rate, const std::array<const Frame2*, 4>& v, double h) {
+  return datum_rate(rate.x, {&v[0]->x, &v[1]->x, &v[2]->x, &v[3]->x}, h) &&
+         datum_rate(rate.y, {&v[0]->y, &v[1]->y, &v[2]->y, &v[3]->y}, h) &&
+         datum_rate(rate.psi, {&v[0]->psi, &v[1]->psi, &v[2]->psi, &v[3]->psi}, h);
+}
+inline bool datum_rate(kin::V2& rate, const std::array<const kin::V2*, 4>& v, double h) {
+  return datum_rate(rate.x, {&v[0]->x, &v[1]->x, &v[2]->x, &v[3]->x}, h) &&
+         datum_rate(rate.y, {&v[0]->y, &v[1]->y, &v[2]->y, &v[3]->y}, h);
+}
 
 // `rate` made of `at` with each datum of Spec::data_members() replaced by its rate along the parameter over the
 // four specs `along` (ConstraintBlock::data_rates()). False when it has none: a datum is no data that moves, or a
