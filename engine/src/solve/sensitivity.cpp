@@ -151,10 +151,6 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   const SensitivityLayout layout{n};
   for (auto& f : sc.f) f.resize(m);
   sc.d.resize(m), sc.along.resize(m), sc.qk.resize(n), sc.vk.resize(n);
-  const CscPattern& pattern = model.jacobian_pattern();  // (every model along a parameter has it: checked)
-  if (order >= 2)
-    for (auto& values : sc.jacobian) values.resize(static_cast<std::size_t>(pattern.nnz()));
-  auto jacobian = [&](std::size_t k) { return jacobian_view(pattern, sc.jacobian[k]); };
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::fill(out, out + layout.size(parameters.size()), nan);
   const Eigen::Map<const Eigen::VectorXd> qv(q, n);
@@ -225,15 +221,16 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     if (order < 2) continue;
     // Acceleration: Φq q̈ − γ, q̈ held, along (v, ṡ), by the fourth-order difference at q + kεv (γ's derivative
     // along q has Φ's third derivatives in it: no quadratic to read it from).
-    const Eigen::Map<const Eigen::VectorXd> sdv(sd, n), qddv(qdd, n);
+    const Eigen::Map<const Eigen::VectorXd> sdv(sd, n);
     along_p(detail::AlongParameter::kAccelerationTerm);
     for (std::size_t k = 0; k < 4; ++k) {
       sc.qk = qv + (kShift[k] * step) * sv;
       sc.vk = qdv + (kShift[k] * step) * sdv;
-      model.jacobian(sc.qk.data(), t, sc.jacobian[k].data());
-      sc.f[k].noalias() = jacobian(k) * qddv;
       model.gamma(sc.qk.data(), sc.vk.data(), t, sc.along.data());
-      sc.f[k] -= sc.along;
+      sc.f[k] = -sc.along;
+      // + Φq q̈, constraint by constraint: no CSC values to fill and read back
+      for (const auto& block : model.blocks())
+        block->add_jacobian_product(0, block->size(), sc.qk.data(), t, qdd, sc.f[k].data());
     }
     if (!solve_difference(step, sdd)) return false;
   }

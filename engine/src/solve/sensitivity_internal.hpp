@@ -25,8 +25,6 @@ struct SensitivityScratch {
   Eigen::VectorXd d;                 // its difference quotient: the right-hand side, negated
   Eigen::VectorXd along;             // Φt or γ on the way (evaluate_over_reach)
   Eigen::VectorXd qk, vk;            // the shifted q and q̇ (the adjoint form: q along the motion)
-  // the swept model's Φq at q + kε(s − q̂), for the direct form's acceleration term
-  std::array<std::vector<double>, 4> jacobian;
   // The adjoint form: per parameter, a_j, b_j, c_j at fixed (q, q̇) (sensitivity.hpp); Φq at the points along the
   // motion (q + kεq̇, t + kε: k = −2, −1, 1, 2 for the first difference, −3 … 3 at a larger ε for the second) and
   // along q̈ (q + kεq̈); the adjoint vectors (over Φ's rows: zero at rows the square solves leave out) and the
