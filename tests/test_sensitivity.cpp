@@ -663,6 +663,56 @@ TEST(Sensitivity, KindsThatDifferentiateTheirDataAreExactAtAnyStep) {
   }
 }
 
+// The notes' four-bar in bars (natural coordinates: distances) and in pins (reference-point coordinates: L3 in the
+// coupler's and rocker's local points, L1 in the rocker's ground pivot) is one mechanism: the sensitivities of its
+// point B to L1 and L3, and their time derivatives, are the same in both, each kind giving its own derivatives. At a
+// 6 % step, where the bars' differences would be off by 2(h/L)⁴ ≈ 3·10⁻⁵.
+TEST(Sensitivity, TheFourBarInBarsAndInPinsHasOneSensitivity) {
+  const std::string output = "output: {velocities: true, accelerations: true, sensitivities: "
+                             "[{parameter: L1, step: 0.06}, {parameter: L3, step: 0.072}]}";
+  auto read = [&](const char* rel) {
+    const std::string text = test::slurp(model_path(rel));
+    return parse_scene(test::replace_first(text, "output: {velocities: true, accelerations: true}", output), rel);
+  };
+  const Scene bars = read("seed/fourbar_natural.yaml"), pins = read("seed/fourbar_reference_point.yaml");
+  for (const Scene* s : {&bars, &pins})
+    for (const OutputSensitivity& p : s->sweep.sensitivities)
+      for (const auto& r : p.reached->rates) EXPECT_NE(r, nullptr) << p.name;  // every reached span its own
+  const SensitivityTrace a = sweep_sensitivities(*bars.model, bars.sweep), b = sweep_sensitivities(*pins.model, pins.sweep);
+  ASSERT_EQ(a.s.size(), 361u);
+  ASSERT_EQ(b.s.size(), 361u);
+  const Model& mb = *bars.model;
+  const Model& mp = *pins.model;
+  const Index xb = mb.coordinate_index("xB"), yb = mb.coordinate_index("yB");
+  const Index x4 = mp.coordinate_index("x4"), y4 = mp.coordinate_index("y4"), p4 = mp.coordinate_index("psi4");
+  const SensitivityLayout la{mb.num_coordinates()}, lp{mp.num_coordinates()};
+  const double half = 0.5;  // B = r4 + R(ψ4) (L4/2, 0), L4 = 1
+  double worst = 0.0;
+  for (std::size_t k = 0; k < a.s.size(); ++k) {
+    const double psi = b.rows.q[k][p4], w = b.rows.qd[k][p4], al = b.rows.qdd[k][p4];
+    const double ux = half * std::cos(psi), uy = half * std::sin(psi);  // R s, and its perp (−uy, ux)
+    for (std::size_t j = 0; j < 2; ++j) {
+      auto at = [&](int o, Index i) { return b.s[k][lp.offset(j, o) + i]; };
+      const double s0 = at(0, p4), s1 = at(1, p4), s2 = at(2, p4);
+      // ∂B/∂p, ∂Ḃ/∂p, ∂B̈/∂p from the rocker's ∂r4/∂p, ∂ψ4/∂p and their time derivatives
+      const double want[3][2] = {
+          {at(0, x4) - uy * s0, at(0, y4) + ux * s0},
+          {at(1, x4) - uy * s1 - ux * w * s0, at(1, y4) + ux * s1 - uy * w * s0},
+          {at(2, x4) - uy * s2 - ux * (al * s0 + 2 * w * s1) + uy * w * w * s0,
+           at(2, y4) + ux * s2 - uy * (al * s0 + 2 * w * s1) - ux * w * w * s0}};
+      for (int o = 0; o < 3; ++o) {
+        const double got[2] = {a.s[k][la.offset(j, o) + xb], a.s[k][la.offset(j, o) + yb]};
+        for (int c = 0; c < 2; ++c) {
+          EXPECT_NEAR(got[c], want[o][c], 1e-8 * std::max(1.0, std::fabs(want[o][c])))
+              << "t = " << a.rows.t[k] << (j ? ", L3" : ", L1") << ", order " << o << (c ? ", y" : ", x");
+          worst = std::max(worst, std::fabs(got[c] - want[o][c]));
+        }
+      }
+    }
+  }
+  EXPECT_LT(worst, 1e-8);
+}
+
 // Bars between natural points and a linear driver: Φq is linear in q, so its second difference along the motion is
 // rounding alone, which the smoothness check does not take for a knot: no row leaves the adjoint form, and its
 // values are the direct form's.
