@@ -228,6 +228,21 @@ TEST(ConstraintKinds, PointOnLine) {
   CheckSpec(f, 4, Opts(402));
 }
 
+TEST(ConstraintKinds, PointOnLineAlongItsData) {
+  // a slider's guide through two fixed points that move with the parameter (an offset), its reference length too
+  phiq::PointOnLineSpec g{phiq::Point2{S(0), S(1)}, phiq::Point2{C(0.1), C(0.2)}, phiq::Point2{C(1.3), C(0.5)}};
+  g.ref = 1.24;
+  phiq::PointOnLineSpec rate{phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(1.0)}, phiq::Point2{C(0.0), C(1.0)}};
+  rate.ref = 0.3;
+  CheckDataDerivative(g, rate, 2, 411);
+  // a fixed point on a moving line
+  phiq::PointOnLineSpec f{phiq::Point2{C(0.4), C(-0.2)}, phiq::Point2{S(0), S(1)}, phiq::Point2{S(2), S(3)}};
+  f.ref = 0.8;
+  phiq::PointOnLineSpec moves{phiq::Point2{C(-0.7), C(1.1)}, phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)}};
+  moves.ref = 0.0;
+  CheckDataDerivative(f, moves, 4, 412);
+}
+
 // ---- ConstantAngleSpec ----------------------------------------------------------------------------------------
 
 TEST(ConstraintKinds, ConstantAngle) {

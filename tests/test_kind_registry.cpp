@@ -61,7 +61,8 @@ TEST(KindRegistry, EveryKindThatDifferentiatesItsDataHasACheckOfIt) {
     }
   });
   EXPECT_TRUE(missing.empty()) << "kinds without a CheckDataDerivative test: " << ::testing::PrintToString(missing);
-  EXPECT_EQ(differentiating, (std::vector<std::string>{"distance", "pin", "polar", "distance"}));  // planar, spatial
+  EXPECT_EQ(differentiating,
+            (std::vector<std::string>{"distance", "pin", "point_on_line", "polar", "distance"}));  // planar, spatial
 }
 
 TEST(KindRegistry, EverySceneExampleIsDocumentedInTheModelsReadme) {

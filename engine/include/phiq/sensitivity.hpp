@@ -25,8 +25,8 @@
 /// h = 10⁻³ |p|; for a parameter inside a sine or cosine (an angle), h⁴/30 of the fifth derivative: 3·10⁻¹⁴
 /// relative. Rounding adds about ε |Φ's terms| / h.
 ///
-/// A kind that differentiates its own data (DataDifferentiable: the planar distance, pin and polar vector, most rows
-/// of the large linkages, and the spatial distance's length) gives its equations' derivatives itself, exactly and in one evaluation: D is then applied
+/// A kind that differentiates its own data (DataDifferentiable: the planar distance, pin, point on a line and polar
+/// vector, most rows of the large linkages, and the spatial distance's length) gives its equations' derivatives itself, exactly and in one evaluation: D is then applied
 /// to its data alone (a datum's rate: exact for the scene's arithmetic of degree ≤ 4 in p, a length L itself
 /// among it) and the kind's data_derivative() chains it (DistanceSpec::data_derivative(); ReachedConstraints::rates).
 ///
@@ -96,7 +96,7 @@ struct ParameterReach {
 /// p + h, p + 2h), one block per span of the reach, holding copies of the span's constraints with their rows. All
 /// that the derivatives along p read once the reach is known (keep_reached_only()).
 ///
-/// Where the span's kind differentiates its own data (DataDifferentiable: the distances, the pin, the polar vector), `rates`
+/// Where the span's kind differentiates its own data (DataDifferentiable: the distances, pin, point on a line, polar vector), `rates`
 /// holds its data's rates along p (ConstraintBlock::data_rates()), and the derivatives there are the kind's, exact
 /// and in one evaluation instead of four (a bar's length: the differences' 2(h/L)⁴ gone). Not with co-moving
 /// coordinates (ParameterReach::comotion: the models move q there), where every span is differenced.

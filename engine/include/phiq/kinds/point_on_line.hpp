@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <tuple>
 
 #include "phiq/kinds/kind_support.hpp"
 
@@ -67,6 +68,33 @@ struct PointOnLineSpec {
   void gamma(const double*, const double* qd, double, double* out) const {
     kin::V2 ud = kin::vel(b, qd) - kin::vel(a, qd), wd = kin::vel(p, qd) - kin::vel(a, qd);
     out[0] = -2.0 * kin::cross(ud, wd) / ref;
+  }
+  /// The data a parameter may move (DistanceSpec::data_members()): the points' constants and the reference length.
+  static constexpr auto data_members() {
+    return std::tuple{&PointOnLineSpec::p, &PointOnLineSpec::a, &PointOnLineSpec::b, &PointOnLineSpec::ref};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). With u = B − A, w = P − A, their data's rates
+  /// u̇, ẇ (constants' rates), velocities u′, w′ and accelerations u″, w″, and the reference length's rate ṙ:
+  ///
+  ///   ∂Φ/∂p = (u̇ × w + u × ẇ)/ref − (ṙ/ref) Φ,   ∂(Φq q̇)/∂p = (u̇ × w′ + u′ × ẇ)/ref − (ṙ/ref) Φq q̇,
+  ///   ∂(Φq q̈ − γ)/∂p = (u̇ × w″ + u″ × ẇ)/ref − (ṙ/ref) (Φq q̈ − γ),   Φq q̈ − γ = (u × w″ + u″ × w + 2 u′ × w′)/ref.
+  void data_derivative(const PointOnLineSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
+    const kin::V2 u = kin::pos(b, q) - kin::pos(a, q), w = kin::pos(p, q) - kin::pos(a, q);
+    const kin::V2 ud = kin::pos(rate.b, q) - kin::pos(rate.a, q), wd = kin::pos(rate.p, q) - kin::pos(rate.a, q);
+    const double k = rate.ref / ref;
+    if (order == 0) {
+      out[0] = (kin::cross(ud, w) + kin::cross(u, wd)) / ref - k * kin::cross(u, w) / ref;
+      return;
+    }
+    const kin::V2 uv = kin::vel(b, qd) - kin::vel(a, qd), wv = kin::vel(p, qd) - kin::vel(a, qd);
+    if (order == 1) {
+      out[0] = (kin::cross(ud, wv) + kin::cross(uv, wd)) / ref - k * (kin::cross(u, wv) + kin::cross(uv, w)) / ref;
+      return;
+    }
+    const kin::V2 ua = kin::vel(b, qdd) - kin::vel(a, qdd), wa = kin::vel(p, qdd) - kin::vel(a, qdd);
+    out[0] = (kin::cross(ud, wa) + kin::cross(ua, wd)) / ref -
+             k * (kin::cross(u, wa) + kin::cross(ua, w) + 2.0 * kin::cross(uv, wv)) / ref;
   }
 
   /// @copydoc DistanceSpec::joint_count
