@@ -24,8 +24,18 @@ constexpr std::array<double, 4> kWeight = {1.0, -8.0, 8.0, -1.0};
 
 // D f over the rows of `reach` into `d` (its other rows untouched), as differences of the pairs: exactly zero where
 // the four models agree.
+double difference_at(const std::array<Eigen::VectorXd, 4>& f, Index r, double h) {
+  return ((f[0][r] - f[3][r]) + 8.0 * (f[2][r] - f[1][r])) / (12.0 * h);
+}
 void difference_on(const ParameterReach& reach, const std::array<Eigen::VectorXd, 4>& f, double h, Eigen::VectorXd& d) {
-  for (const Index r : reach.rows) d[r] = ((f[0][r] - f[3][r]) + 8.0 * (f[2][r] - f[1][r])) / (12.0 * h);
+  for (const Index r : reach.rows) d[r] = difference_at(f, r, h);
+}
+
+// The largest |v_j| / scale_j over the n coordinates: how fast v moves its fastest coordinate, in their scales.
+double fastest(const double* v, const double* scale, Index n) {
+  double f = 0.0;
+  for (Index j = 0; j < n; ++j) f = std::max(f, std::fabs(v[j]) / scale[j]);
+  return f;
 }
 
 // The derivative of f = `which` along the parameter over the rows of `reach`, into `d` (its other rows untouched):
@@ -70,7 +80,7 @@ void along_parameter(const Model& model, const OutputSensitivity& p, const Param
     const Index rows = block.rows_per_constraint();  // the span's rows, differenced as difference_on()
     for (std::size_t i = s.begin; i < s.end; ++i)
       for (Index r = block.first_row(i); r < block.first_row(i) + rows; ++r)
-        d[r] = ((sc.f[0][r] - sc.f[3][r]) + 8.0 * (sc.f[2][r] - sc.f[1][r])) / (12.0 * h);
+        d[r] = difference_at(sc.f, r, h);
   }
 }
 
@@ -155,6 +165,7 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   std::fill(out, out + layout.size(parameters.size()), nan);
   const Eigen::Map<const Eigen::VectorXd> qv(q, n);
   const double* cs = model.tolerance_scales().coordinate_scale.data();
+  const double qd_rate = order >= 1 ? fastest(qd, cs, n) : 0.0;  // the row's, for every parameter's α below
   // A parameter's reach when it comes without one: found here (parameter_reach(), O(constraints) comparisons, fewer
   // operations than evaluating every constraint in the four models).
   ParameterReach found;
@@ -197,8 +208,7 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     // step would move q by h|s|, and s grows along a sweep (∂θ/∂ω = t for a crank at θ = ωt: ten turns of a cam
     // put ∂ẏ/∂ω off by 4·10⁻⁷, against 10⁻¹⁰ so).
     const Eigen::Map<const Eigen::VectorXd> qdv(qd, n);
-    double rate = 0.0;
-    for (Index i = 0; i < n; ++i) rate = std::max(rate, std::fabs(sv[i]) / cs[i]);
+    const double rate = fastest(sv.data(), cs, n);
     const double step = 1e-3 / std::max(rate, 1e-3);
     // Velocity: Φq q̇ + Φt. Along v = s − q̂ its derivative is B v = (Φq q̇)_q v + Φqt v, and γ = −(Φq q̇)_q q̇ −
     // 2 Φqt q̇ − Φtt is a quadratic in q̇ whose derivative along v is −2 B v: so B v = [γ(q̇ − αv) − γ(q̇ + αv)] / (4α)
@@ -207,8 +217,6 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
     // keeps the two γ's rounding near that of γ itself.
     along_p(detail::AlongParameter::kVelocityTerm);
     if (rate > 0.0) {
-      double qd_rate = 0.0;
-      for (Index i = 0; i < n; ++i) qd_rate = std::max(qd_rate, std::fabs(qd[i]) / cs[i]);
       const double alpha = std::max(qd_rate, 1.0) / rate;
       sc.vk = qdv - alpha * sv;
       model.gamma(q, sc.vk.data(), t, sc.f[0].data());
@@ -288,12 +296,7 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
   // 2·10⁻² (rounding and truncation both near 10⁻¹² of the terms: at 5·10⁻³ and fourth order the crank-slider's
   // ∂ẍ_B/∂L3 was 10× less accurate than the direct form's). t moves by at most ε's cap (a body at rest moves in t only).
   const double* cs = model.tolerance_scales().coordinate_scale.data();
-  auto fastest = [&](const double* v) {
-    double f = 0.0;
-    for (Index j = 0; j < n; ++j) f = std::max(f, std::fabs(v[j]) / cs[j]);
-    return f;
-  };
-  const double v_rate = order >= 1 ? fastest(qd) : 0.0, a_rate = order >= 2 ? fastest(qdd) : 0.0;
+  const double v_rate = order >= 1 ? fastest(qd, cs, n) : 0.0, a_rate = order >= 2 ? fastest(qdd, cs, n) : 0.0;
   const double e1 = 1e-3 / std::max(v_rate, 1e-3), e2 = 2e-2 / std::max(v_rate, 2e-2);
   const double e3 = 1e-3 / std::max(a_rate, 1e-3);
   constexpr double kSecond[7] = {2.0, -27.0, 270.0, -490.0, 270.0, -27.0, 2.0};  // f'' · 180 h², offsets −3 … 3
