@@ -152,5 +152,88 @@ TEST(MotionLaw, ADefaultConstructedLawHasNoFunctionAndNoDriverTakesIt) {
   EXPECT_EQ(refusal([&](ModelBuilder& b) { b.add("eq", EquationSpec{g, std::nullopt}); }), "accepted");
 }
 
+
+// ---- a law's rate along a design parameter ------------------------------------------------------------------------
+
+// A family of laws law(p) and the rate MotionLaw::rate_along gives at p, against the sixth-order central difference
+// of f, f′, f″ over p with steps other than the rate's own (independent of its formulas), at times across [0, 3].
+template <class Family>
+void check_rate(const Family& law, double p, double h, double tol) {
+  const MotionLaw at = law(p), m2 = law(p - 2 * h), m1 = law(p - h), p1 = law(p + h), p2 = law(p + 2 * h);
+  const MotionLaw rate = MotionLaw::rate_along(at, {&m2, &m1, &p1, &p2}, h);
+  ASSERT_TRUE(rate.has_value());
+  const double e = 2e-3;
+  for (double t = 0.0; t <= 3.0; t += 0.25) {
+    LawValue d[6];
+    const double off[6] = {-3, -2, -1, 1, 2, 3};
+    for (int k = 0; k < 6; ++k) d[k] = law(p + off[k] * e).evaluate(t);
+    auto fd = [&](double LawValue::*m) {
+      return (-(d[0].*m) + 9 * (d[1].*m) - 45 * (d[2].*m) + 45 * (d[3].*m) - 9 * (d[4].*m) + (d[5].*m)) / (60 * e);
+    };
+    const LawValue r = rate.evaluate(t);
+    EXPECT_NEAR(r.f, fd(&LawValue::f), tol) << at.description() << ", t = " << t;
+    EXPECT_NEAR(r.df, fd(&LawValue::df), tol) << at.description() << ", t = " << t;
+    EXPECT_NEAR(r.ddf, fd(&LawValue::ddf), tol) << at.description() << ", t = " << t;
+  }
+  check_derivatives(rate, 1.3, 1e-6);  // the rate law's own f′, f″ are its derivatives in t
+}
+
+TEST(MotionLaw, RateAlongItsDataIsExact) {
+  // data of degree ≤ 4 in p: their differences are exact, and f is differentiated along them exactly; a large
+  // step (10 % of p) shows that nothing of f itself is differenced
+  check_rate([](double p) { return MotionLaw::linear(0.3 * p * p, 2.0 - p); }, 0.7, 0.07, 1e-9);
+  check_rate([](double p) { return MotionLaw::polynomial({p, -p * p, 0.5, 0.2 * p * p * p}); }, 0.7, 0.07, 1e-9);
+  check_rate([](double p) { return MotionLaw::harmonic(0.1 + p * p, 0.5 + 0.3 * p, 2.0 + p - 0.2 * p * p, 0.2 * p); },
+             0.7, 0.07, 1e-8);
+  // a table's values that move (its times fixed): the spline is linear in the values
+  check_rate([](double p) {
+    return MotionLaw::table({-0.5, 0.4, 1.1, 2.0, 3.5}, {p, 0.2 * p * p, -0.3, 1.0 - p, 0.5 * p});
+  }, 0.7, 0.07, 1e-9);
+}
+
+TEST(MotionLaw, RateOfLawsWhoseDataDoNotMatchIsTheirDifference) {
+  // an expression's parameters are constants of its tapes: the four laws are differenced, fourth order in h
+  auto expression = [](double p) {
+    return MotionLaw::expression(CompiledExpression::compile(
+        "a*sin(a*t) + t^2", [p](const std::string& n) -> std::optional<NameBinding> {
+          if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+          if (n == "a") return NameBinding{NameBinding::Kind::kConstant, -1, p};
+          return std::nullopt;
+        }));
+  };
+  check_rate(expression, 1.2, 1e-3, 1e-8);
+  // a table whose times move has other knots: differenced too, defined where all four are
+  auto moving = [](double p) { return MotionLaw::table({0.0, 1.0 + 0.1 * p, 3.0}, {0.0, 1.0, p}); };
+  check_rate(moving, 0.5, 1e-3, 1e-7);
+  const MotionLaw at = moving(0.5), m2 = moving(0.3), m1 = moving(0.4), p1 = moving(0.6), p2 = moving(0.7);
+  const MotionLaw rate = MotionLaw::rate_along(at, {&m2, &m1, &p1, &p2}, 0.1);
+  EXPECT_EQ(rate.domain_begin(), 0.0);
+  EXPECT_EQ(rate.domain_end(), 3.0);
+  // laws of another kind along the parameter
+  const MotionLaw lin = MotionLaw::linear(0.0, 1.0), harm = MotionLaw::harmonic(0.0, 1.0, 1.0, 0.0);
+  const MotionLaw mixed = MotionLaw::rate_along(lin, {&lin, &lin, &harm, &harm}, 0.5);
+  const double t = 0.8;
+  EXPECT_NEAR(mixed.evaluate(t).f, (1.0 / 12 - 8.0 / 12) * t / 0.5 + (8.0 / 12 - 1.0 / 12) * std::sin(t) / 0.5, 1e-15);
+}
+
+TEST(MotionLaw, SumOfLaws) {
+  const MotionLaw a = MotionLaw::linear(1.0, 2.0), b = MotionLaw::table({0.0, 1.0, 2.0}, {0.0, 1.0, 0.0});
+  const MotionLaw s = MotionLaw::sum({{0.5, a}, {-2.0, b}});
+  for (double t : {0.0, 0.3, 1.7}) {
+    const LawValue x = a.evaluate(t), y = b.evaluate(t), v = s.evaluate(t);
+    EXPECT_DOUBLE_EQ(v.f, 0.5 * x.f - 2.0 * y.f);
+    EXPECT_DOUBLE_EQ(v.df, 0.5 * x.df - 2.0 * y.df);
+    EXPECT_DOUBLE_EQ(v.ddf, 0.5 * x.ddf - 2.0 * y.ddf);
+  }
+  EXPECT_EQ(s.domain_begin(), 0.0);
+  EXPECT_EQ(s.domain_end(), 2.0);
+  EXPECT_TRUE(std::isnan(s.evaluate(2.5).f));
+  EXPECT_TRUE(s == MotionLaw::sum({{0.5, a}, {-2.0, b}}));
+  EXPECT_FALSE(s == MotionLaw::sum({{0.5, a}, {-2.5, b}}));
+  EXPECT_THROW(MotionLaw::sum({}), Error);
+  EXPECT_THROW(MotionLaw::sum({{std::nan(""), a}}), Error);
+  EXPECT_THROW(MotionLaw::sum({{1.0, MotionLaw{}}}), Error);
+}
+
 }  // namespace
 }  // namespace phiq

@@ -2,8 +2,10 @@
 /// Motion laws f(t) of rheonomic driving constraints, with exact first and second derivatives.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "phiq/expression.hpp"
@@ -32,6 +34,17 @@ class MotionLaw {
   static MotionLaw table(std::vector<double> t, std::vector<double> values);
   /// Any function of t written as text, e.g. "0.1*t^2 + sin(t)"; derivatives are exact (see expression.hpp).
   static MotionLaw expression(std::shared_ptr<const CompiledExpression> f_of_t);
+  /// f = Σ_k w_k f_k(t), terms (w_k, f_k): a superposition of laws, defined where every term is. Throws
+  /// phiq::Error for no terms, a non-finite weight or a default-constructed law.
+  static MotionLaw sum(const std::vector<std::pair<double, MotionLaw>>& terms);
+  /// The law's rate along a design parameter p: the law ∂f/∂p (its f′ and f″ are ∂f′/∂p and ∂f″/∂p), from the law
+  /// `at` p and its copies `along` at p − 2h, p − h, p + h, p + 2h (the scene read there). The data's rates are the
+  /// fourth-order central difference of the copies' data (exact for data of degree ≤ 4 in p), and f is
+  /// differentiated along them exactly: a polynomial's coefficients and a table's values enter f linearly, a
+  /// harmonic's frequency and phase through the chain rule. Laws whose data cannot be matched (an expression, whose
+  /// parameters are constants of its tapes; a table whose times move; laws of other kinds) get the fourth-order
+  /// difference of the four laws themselves, a sum(). Pre-condition: the five laws have values, h > 0.
+  static MotionLaw rate_along(const MotionLaw& at, const std::array<const MotionLaw*, 4>& along, double h);
 
   /// f, f', f'' at t; NaN outside [domain_begin(), domain_end()]. Throws phiq::Error on a default-constructed law.
   LawValue evaluate(double t) const;

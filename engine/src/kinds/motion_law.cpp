@@ -1,5 +1,6 @@
 #include "phiq/motion_law.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <unsupported/Eigen/Splines>
@@ -15,12 +16,35 @@ struct MotionLaw::Impl {
   virtual double end() const { return std::numeric_limits<double>::infinity(); }
   // The same law as `other` (of any kind: another kind is another law).
   virtual bool same(const Impl& other) const = 0;
+  // The law's rate along a parameter (MotionLaw::rate_along), from its copies at p − 2h, p − h, p + h, p + 2h;
+  // null where their data do not match this law's (other kinds, other structure): the caller differences the laws.
+  virtual std::shared_ptr<const Impl> rate(const std::array<const Impl*, 4>& /*along*/, double /*h*/) const {
+    return nullptr;
+  }
 };
 
 namespace {
 
 void require_finite(double v, const char* what) {
   if (!std::isfinite(v)) throw Error(std::string("motion law: ") + what + " is not finite");
+}
+
+// The fourth-order central difference of a datum over its values at p − 2h, p − h, p + h, p + 2h (the weights of
+// MotionLaw::rate_along's fallback, and detail::datum_rate's).
+constexpr std::array<double, 4> kDifference{1.0 / 12.0, -8.0 / 12.0, 8.0 / 12.0, -1.0 / 12.0};
+double difference(double m2, double m1, double p1, double p2, double h) {
+  return ((m2 - p2) + 8.0 * (p1 - m1)) / (12.0 * h);
+}
+// The four copies as the type T, or nulls where one is another kind.
+template <class T>
+std::array<const T*, 4> copies_as(const std::array<const MotionLaw::Impl*, 4>& along) {
+  std::array<const T*, 4> out{};
+  for (std::size_t k = 0; k < 4; ++k) out[k] = dynamic_cast<const T*>(along[k]);
+  return out;
+}
+template <class T>
+bool all_of_kind(const std::array<const T*, 4>& c) {
+  return c[0] && c[1] && c[2] && c[3];
 }
 
 struct Polynomial final : MotionLaw::Impl {
@@ -39,6 +63,17 @@ struct Polynomial final : MotionLaw::Impl {
     const auto* o = dynamic_cast<const Polynomial*>(&other);
     return o && c == o->c;
   }
+  // f is linear in the coefficients: the rate is the polynomial of their rates.
+  std::shared_ptr<const Impl> rate(const std::array<const Impl*, 4>& along, double h) const override {
+    const auto o = copies_as<Polynomial>(along);
+    if (!all_of_kind(o)) return nullptr;
+    for (const Polynomial* p : o)
+      if (p->c.size() != c.size()) return nullptr;
+    auto r = std::make_shared<Polynomial>();
+    r->c.resize(c.size());
+    for (std::size_t k = 0; k < c.size(); ++k) r->c[k] = difference(o[0]->c[k], o[1]->c[k], o[2]->c[k], o[3]->c[k], h);
+    return r;
+  }
 };
 
 struct Harmonic final : MotionLaw::Impl {
@@ -51,7 +86,38 @@ struct Harmonic final : MotionLaw::Impl {
     const auto* o = dynamic_cast<const Harmonic*>(&other);
     return o && offset == o->offset && amplitude == o->amplitude && omega == o->omega && phase == o->phase;
   }
+  std::shared_ptr<const Impl> rate(const std::array<const Impl*, 4>& along, double h) const override;
 };
+
+// The rate of a harmonic law along its data's rates (ô, Â, ω̂, φ̂): with ϑ = ωt + φ, ϑ̂ = ω̂t + φ̂, s = sin ϑ, c = cos ϑ,
+//   ∂f/∂p = ô + Â s + A c ϑ̂,   ∂f′/∂p = (Âω + Aω̂) c − Aω s ϑ̂,   ∂f″/∂p = −(Âω² + 2Aωω̂) s − Aω² c ϑ̂.
+struct HarmonicRate final : MotionLaw::Impl {
+  Harmonic at, rate;
+  LawValue evaluate(double t) const override {
+    const double th = at.omega * t + at.phase, thd = rate.omega * t + rate.phase;
+    const double s = std::sin(th), c = std::cos(th), A = at.amplitude, w = at.omega;
+    const double Ad = rate.amplitude, wd = rate.omega;
+    return {rate.offset + Ad * s + A * c * thd, (Ad * w + A * wd) * c - A * w * s * thd,
+            -(Ad * w * w + 2.0 * A * w * wd) * s - A * w * w * c * thd};
+  }
+  bool same(const MotionLaw::Impl& other) const override {
+    const auto* o = dynamic_cast<const HarmonicRate*>(&other);
+    return o && at.same(o->at) && rate.same(o->rate);
+  }
+};
+
+std::shared_ptr<const MotionLaw::Impl> Harmonic::rate(const std::array<const Impl*, 4>& along, double h) const {
+  const auto o = copies_as<Harmonic>(along);
+  if (!all_of_kind(o)) return nullptr;
+  auto r = std::make_shared<HarmonicRate>();
+  r->at = *this;
+  const auto d = [&](double Harmonic::*m) { return difference(o[0]->*m, o[1]->*m, o[2]->*m, o[3]->*m, h); };
+  r->rate.offset = d(&Harmonic::offset);
+  r->rate.amplitude = d(&Harmonic::amplitude);
+  r->rate.omega = d(&Harmonic::omega);
+  r->rate.phase = d(&Harmonic::phase);
+  return r;
+}
 
 struct Table final : MotionLaw::Impl {
   using Spline = Eigen::Spline<double, 1>;
@@ -77,6 +143,57 @@ struct Table final : MotionLaw::Impl {
     };
     return o && t0 == o->t0 && t1 == o->t1 && equal(spline.knots(), o->spline.knots()) &&
            equal(spline.ctrls(), o->spline.ctrls());
+  }
+  // With the same times, the interpolating spline's control points are linear in the values, and f in them: the
+  // rate is the spline of the control points' rates. Times that move change the knots: null.
+  std::shared_ptr<const Impl> rate(const std::array<const Impl*, 4>& along, double h) const override {
+    const auto o = copies_as<Table>(along);
+    if (!all_of_kind(o)) return nullptr;
+    const auto knots = spline.knots();
+    const auto ctrls = spline.ctrls();
+    for (const Table* x : o)
+      if (x->t0 != t0 || x->t1 != t1 || x->spline.knots().size() != knots.size() ||
+          !(x->spline.knots().array() == knots.array()).all() || x->spline.ctrls().cols() != ctrls.cols())
+        return nullptr;
+    Spline::ControlPointVectorType rc(ctrls.rows(), ctrls.cols());
+    for (Eigen::Index k = 0; k < ctrls.cols(); ++k)
+      rc(0, k) = difference(o[0]->spline.ctrls()(0, k), o[1]->spline.ctrls()(0, k), o[2]->spline.ctrls()(0, k),
+                            o[3]->spline.ctrls()(0, k), h);
+    auto r = std::make_shared<Table>();
+    r->t0 = t0;
+    r->t1 = t1;
+    r->spline = Spline(knots, rc);
+    return r;
+  }
+};
+
+// f = Σ w_k f_k (MotionLaw::sum): defined where every term is.
+struct Sum final : MotionLaw::Impl {
+  std::vector<std::pair<double, std::shared_ptr<const MotionLaw::Impl>>> terms;
+  LawValue evaluate(double t) const override {
+    LawValue v;
+    for (const auto& [w, f] : terms) {
+      const LawValue x = f->evaluate(t);
+      v.f += w * x.f, v.df += w * x.df, v.ddf += w * x.ddf;
+    }
+    return v;
+  }
+  double begin() const override {
+    double b = -std::numeric_limits<double>::infinity();
+    for (const auto& term : terms) b = std::max(b, term.second->begin());
+    return b;
+  }
+  double end() const override {
+    double e = std::numeric_limits<double>::infinity();
+    for (const auto& term : terms) e = std::min(e, term.second->end());
+    return e;
+  }
+  bool same(const MotionLaw::Impl& other) const override {
+    const auto* o = dynamic_cast<const Sum*>(&other);
+    if (!o || o->terms.size() != terms.size()) return false;
+    for (std::size_t k = 0; k < terms.size(); ++k)
+      if (terms[k].first != o->terms[k].first || !terms[k].second->same(*o->terms[k].second)) return false;
+    return true;
   }
 };
 
@@ -173,6 +290,37 @@ MotionLaw MotionLaw::expression(std::shared_ptr<const CompiledExpression> f_of_t
   law.description_ = "f(t) = " + impl->f->text();
   law.impl_ = impl;
   return law;
+}
+
+MotionLaw MotionLaw::sum(const std::vector<std::pair<double, MotionLaw>>& terms) {
+  if (terms.empty()) throw Error("motion law: a sum needs at least one term");
+  auto impl = std::make_shared<Sum>();
+  std::string description;
+  for (const auto& [w, law] : terms) {
+    require_finite(w, "sum weight");
+    if (!law.impl_) throw Error("motion law: a term of a sum has no law");
+    impl->terms.emplace_back(w, law.impl_);
+    description += (description.empty() ? "" : " + ") + significant(w, 12) + "*(" + law.description_ + ")";
+  }
+  MotionLaw law;
+  law.impl_ = impl;
+  law.description_ = description;
+  return law;
+}
+
+MotionLaw MotionLaw::rate_along(const MotionLaw& at, const std::array<const MotionLaw*, 4>& along, double h) {
+  if (!at.impl_ || !along[0]->impl_ || !along[1]->impl_ || !along[2]->impl_ || !along[3]->impl_)
+    throw Error("motion law: the rate of a default-constructed law");
+  MotionLaw law;
+  law.impl_ = at.impl_->rate({along[0]->impl_.get(), along[1]->impl_.get(), along[2]->impl_.get(),
+                              along[3]->impl_.get()}, h);
+  if (law.impl_) {
+    law.description_ = "rate of " + at.description_;
+    return law;
+  }
+  std::vector<std::pair<double, MotionLaw>> terms;
+  for (std::size_t k = 0; k < 4; ++k) terms.emplace_back(kDifference[k] / h, *along[k]);
+  return sum(terms);
 }
 
 LawValue MotionLaw::evaluate(double t) const {
