@@ -8,8 +8,10 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -19,6 +21,8 @@
 
 #include "phiq/constraint_block.hpp"
 #include "phiq/model.hpp"
+#include "phiq/spatial_attachment.hpp"
+#include "phiq/kinds/spatial_joints.hpp"
 #include "phiq/types.hpp"
 #include "kind_checks.hpp"
 
@@ -278,6 +282,25 @@ inline void MoveDatum(phiq::Frame2& x, const phiq::Frame2& r, double e) {
 }
 inline void MoveDatum(phiq::kin::V2& x, const phiq::kin::V2& r, double e) {
   MoveDatum(x.x, r.x, e), MoveDatum(x.y, r.y, e);
+}
+// A spatial attachment: its constants and its local vector (coordinates are no data).
+inline void MoveDatum(phiq::Attachment3& x, const phiq::Attachment3& r, double e) {
+  for (int k = 0; k < 3; ++k) MoveDatum(x.r[k], r.r[k], e);
+  for (int k = 0; k < 4; ++k) MoveDatum(x.p[k], r.p[k], e);
+  MoveDatum(x.s.x, r.s.x, e), MoveDatum(x.s.y, r.s.y, e), MoveDatum(x.s.z, r.s.z, e);
+}
+template <std::size_t N>
+void MoveDatum(std::array<phiq::Attachment3, N>& x, const std::array<phiq::Attachment3, N>& r, double e) {
+  for (std::size_t i = 0; i < N; ++i) MoveDatum(x[i], r[i], e);
+}
+// A joint's side as given is not read by its rows (its attachments are): it does not move.
+inline void MoveDatum(phiq::JointSide3&, const phiq::JointSide3&, double) {}
+// A law moved along its rate (MotionLaw::rate_along: a law too): f + e ∂f/∂p.
+inline void MoveDatum(phiq::MotionLaw& x, const phiq::MotionLaw& r, double e) {
+  x = phiq::MotionLaw::sum({{1.0, x}, {e, r}});
+}
+inline void MoveDatum(std::optional<phiq::MotionLaw>& x, const std::optional<phiq::MotionLaw>& r, double e) {
+  if (x && r) MoveDatum(*x, *r, e);
 }
 template <class Spec>
 Spec MovedAlongData(const Spec& spec, const Spec& rate, double e) {

@@ -216,6 +216,27 @@ TEST(ConstraintKinds, PrismaticWithGroundSide) {
   CheckSpec(h, 3, Opts(303));
 }
 
+TEST(ConstraintKinds, PrismaticAlongItsData) {
+  // a slider on a ground guide: the guide's frame (position and angle), both local points, the axis and the angle
+  const phiq::PrismaticSpec g{phiq::Frame2{C(0.5), C(-0.2), C(0.3)}, phiq::Frame2{S(0), S(1), S(2)}, {0.2, -0.1},
+                              {0.25, 0.15}, {0.8, -0.6}, -0.3};
+  const phiq::PrismaticSpec everything{phiq::Frame2{C(0.7), C(-0.4), C(1.1)}, phiq::Frame2{C(0), C(0), C(0)},
+                                       {0.6, 0.9}, {-0.3, 1.2}, {0.5, 0.4}, 0.8};
+  CheckDataDerivative(g, everything, 3, 311);
+  // two moving bodies (the axis turns with a): the arms and the axis move
+  const phiq::PrismaticSpec p{phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{S(3), S(4), S(5)}, {0.3, 0.1},
+                              {-0.2, 0.5}, {0.6, 0.8}, 0.4};
+  const phiq::PrismaticSpec arms{phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{C(0), C(0), C(0)}, {-0.9, 0.4},
+                                 {0.7, 0.2}, {-0.8, 0.6}, 0.0};
+  CheckDataDerivative(p, arms, 6, 312);
+  // b on a ground frame that moves, a's guide turning
+  const phiq::PrismaticSpec h{phiq::Frame2{S(1), S(2), S(0)}, phiq::Frame2{C(-1.0), C(0.4), C(0.9)}, {-0.35, 0.2},
+                              {0.1, 0.3}, {0.0, 1.0}, 0.9};
+  const phiq::PrismaticSpec ground{phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{C(0.3), C(-0.8), C(-0.6)},
+                                   {0.0, 0.0}, {0.5, -0.5}, {0.0, 0.0}, -0.2};
+  CheckDataDerivative(h, ground, 3, 313);
+}
+
 // ---- PointOnLineSpec ------------------------------------------------------------------------------------------
 
 TEST(ConstraintKinds, PointOnLine) {
@@ -262,6 +283,25 @@ TEST(ConstraintKinds, ConstantAngleSharedPointAccumulatesDuplicates) {
   CheckSpec(c, 6, Opts(502));
 }
 
+TEST(ConstraintKinds, ConstantAngleAlongItsData) {
+  // a moving segment at a fixed angle to a ground segment whose ends move; the angle and the row's scale too
+  phiq::ConstantAngleSpec c{phiq::Point2{C(0.1), C(0.2)}, phiq::Point2{C(1.1), C(-0.3)}, phiq::Point2{S(0), S(1)},
+                            phiq::Point2{S(2), S(3)}};
+  c.angle = 0.7, c.ref = 1.3;
+  phiq::ConstantAngleSpec rate{phiq::Point2{C(0.4), C(-0.6)}, phiq::Point2{C(-0.2), C(0.9)},
+                               phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)}};
+  rate.angle = 1.1, rate.ref = -0.5;
+  CheckDataDerivative(c, rate, 4, 511);
+  // two moving segments sharing a point: the angle only
+  phiq::ConstantAngleSpec m{phiq::Point2{S(0), S(1)}, phiq::Point2{S(2), S(3)}, phiq::Point2{S(0), S(1)},
+                            phiq::Point2{S(4), S(5)}};
+  m.angle = 2.1, m.ref = 0.8;
+  phiq::ConstantAngleSpec turn{phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)},
+                               phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)}};
+  turn.angle = 1.0, turn.ref = 0.0;
+  CheckDataDerivative(m, turn, 6, 512);
+}
+
 // ---- SegmentAngleSpec -----------------------------------------------------------------------------------------
 
 TEST(ConstraintKinds, SegmentAngle) {
@@ -270,6 +310,17 @@ TEST(ConstraintKinds, SegmentAngle) {
   // from a fixed point
   phiq::SegmentAngleSpec f{phiq::Point2{C(0.2), C(-0.1)}, phiq::Point2{S(1), S(2)}, S(0)};
   CheckSpec(f, 3, Opts(602));
+}
+
+TEST(ConstraintKinds, SegmentAngleAlongItsData) {
+  // from a fixed point that moves, θ a coordinate
+  const phiq::SegmentAngleSpec f{phiq::Point2{C(0.2), C(-0.1)}, phiq::Point2{S(1), S(2)}, S(0)};
+  const phiq::SegmentAngleSpec pivot{phiq::Point2{C(0.8), C(-1.3)}, phiq::Point2{C(0.0), C(0.0)}, C(0.0)};
+  CheckDataDerivative(f, pivot, 3, 611);
+  // a constant θ that turns with the parameter, both ends moving
+  const phiq::SegmentAngleSpec c{phiq::Point2{S(0), S(1)}, phiq::Point2{S(2), S(3)}, C(0.6)};
+  const phiq::SegmentAngleSpec turns{phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)}, C(-0.9)};
+  CheckDataDerivative(c, turns, 4, 612);
 }
 
 // ---- PolarSpec ------------------------------------------------------------------------------------------------
@@ -357,6 +408,16 @@ TEST(ConstraintKinds, DriverExpression) {
   CheckSpec(d, 2, Opts(905, true));
 }
 
+TEST(ConstraintKinds, DriverAlongItsData) {
+  // the law moves along its rate (any law: MotionLaw::rate_along's are polynomials, harmonics' rates, tables, sums)
+  const phiq::CoordinateDriverSpec d{S(1), phiq::MotionLaw::harmonic(0.3, 0.8, 2.5, 0.4)};
+  const phiq::CoordinateDriverSpec rate{C(0.0), phiq::MotionLaw::polynomial({0.2, -0.7, 0.3, 0.1})};
+  CheckDataDerivative(d, rate, 3, 911);
+  const phiq::CoordinateDriverSpec e{S(0), phiq::MotionLaw::polynomial({0.1, 2.0})};
+  const phiq::CoordinateDriverSpec faster{C(0.0), phiq::MotionLaw::harmonic(0.1, 0.5, 1.5, -0.2)};
+  CheckDataDerivative(e, faster, 2, 912);
+}
+
 // ---- EquationSpec ---------------------------------------------------------------------------------------------
 
 TEST(ConstraintKinds, EquationInCoordinatesAndTime) {
@@ -381,6 +442,17 @@ TEST(ConstraintKinds, EquationWithLaw) {
   phiq::EquationSpec f{CompileCrank("xA - L2*cos(theta2) + 0.1*t^2*yA + atan2(yA, xA + 3)"),
                        phiq::MotionLaw::polynomial({0.2, -0.3, 0.15, 0.04}), phiq::Unit::kLength};
   CheckSpec(f, 4, Opts(1004, true));
+}
+
+TEST(ConstraintKinds, EquationAlongItsData) {
+  // a driven equation: its law moves; the expression is no datum
+  const auto g = CompileCrank("xA*yA - sin(theta2)");
+  const phiq::EquationSpec e{g, phiq::MotionLaw::harmonic(0.1, 0.6, 1.7, -0.3), phiq::Unit::kNone};
+  const phiq::EquationSpec rate{g, phiq::MotionLaw::polynomial({-0.4, 0.9, 0.25}), phiq::Unit::kNone};
+  CheckDataDerivative(e, rate, 4, 1011);
+  // without a law, nothing moves
+  const phiq::EquationSpec still{g, std::nullopt, phiq::Unit::kNone};
+  CheckDataDerivative(still, still, 4, 1012, 2);
 }
 
 // ---- CouplerSpec ----------------------------------------------------------------------------------------------

@@ -60,21 +60,45 @@ Spec Joint(const JointSide3& a, const JointSide3& b) {
   return s;
 }
 
-// Every joint type between two moving bodies, and with ground on either side.
+// The rates of an attachment's data along a parameter: r̂ and p̂ (read where its slots are constants: a ground
+// frame that moves and turns) and ŝ, random.
+phiq::Attachment3 RandomAttachmentRate(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  phiq::Attachment3 r;
+  for (Slot& k : r.r) k = C(u(rng));
+  for (Slot& k : r.p) k = C(u(rng));
+  r.s = RandomVector(rng);
+  return r;
+}
+// A joint's derivatives along its data (CheckDataDerivative), every attachment moving at random rates.
+template <class Spec>
+void CheckJointAlongItsData(const Spec& joint, std::mt19937& rng, std::uint32_t seed) {
+  Spec rate = joint;
+  for (phiq::Attachment3& a : rate.att) a = RandomAttachmentRate(rng);
+  CheckDataDerivative(joint, rate, kN, seed, 3);
+}
+
+// Every joint type between two moving bodies, and with ground on either side; with its derivatives along its data.
 template <class Spec>
 void CheckJoint(std::uint32_t seed) {
   std::mt19937 rng(seed);
   {
     SCOPED_TRACE("body - body");
-    CheckSpec(Joint<Spec>(BodySide(0, rng), BodySide(7, rng)), kN, Opts(seed));
+    const Spec j = Joint<Spec>(BodySide(0, rng), BodySide(7, rng));
+    CheckSpec(j, kN, Opts(seed));
+    CheckJointAlongItsData(j, rng, seed + 5);
   }
   {
     SCOPED_TRACE("ground - body");
-    CheckSpec(Joint<Spec>(GroundSide(rng), BodySide(7, rng)), kN, Opts(seed + 1));
+    const Spec j = Joint<Spec>(GroundSide(rng), BodySide(7, rng));
+    CheckSpec(j, kN, Opts(seed + 1));
+    CheckJointAlongItsData(j, rng, seed + 6);
   }
   {
     SCOPED_TRACE("body - ground");
-    CheckSpec(Joint<Spec>(BodySide(0, rng), GroundSide(rng)), kN, Opts(seed + 2));
+    const Spec j = Joint<Spec>(BodySide(0, rng), GroundSide(rng));
+    CheckSpec(j, kN, Opts(seed + 2));
+    CheckJointAlongItsData(j, rng, seed + 7);
   }
 }
 
@@ -220,11 +244,24 @@ TEST(ConstraintKinds3d, Distance) {
       {phiq::Attachment3::body_point(Body(0), V3{0.3, -0.2, 0.5}), phiq::Attachment3::body_point(Body(7), V3{-1, 0.4, 0})},
       0.45};
   CheckSpec(between_bodies, kN, Opts(411));
-  // derivatives along the length (the one datum it differentiates)
+  // derivatives along the length and the ends: the natural point's constant y, the bodies' local points
+  std::mt19937 rng(414);
   phiq::SpatialDistanceSpec rate = between_points, body_rate = between_bodies;
   rate.length = -0.6, body_rate.length = 1.3;
+  for (phiq::Attachment3& e : rate.ends) e = RandomAttachmentRate(rng);
+  for (phiq::Attachment3& e : body_rate.ends) e = RandomAttachmentRate(rng);
   CheckDataDerivative(between_points, rate, kN, 412);
   CheckDataDerivative(between_bodies, body_rate, kN, 413);
+  // a bar from a ground point that moves (folded into constants) to a body
+  phiq::SpatialDistanceSpec grounded{
+      {phiq::Attachment3::body_point(Frame3::ground(), V3{0.5, 0.2, -0.3}),
+       phiq::Attachment3::body_point(Body(7), V3{-1, 0.4, 0})},
+      1.1};
+  grounded.prepare(nullptr);
+  phiq::SpatialDistanceSpec ground_rate = grounded;
+  for (phiq::Attachment3& e : ground_rate.ends) e = RandomAttachmentRate(rng);
+  ground_rate.length = 0.0;
+  CheckDataDerivative(grounded, ground_rate, kN, 415);
 }
 
 TEST(ConstraintKinds3d, DotOfVectorsAndSegments) {
@@ -265,6 +302,34 @@ TEST(ConstraintKinds3d, JointDistanceDriver) {
   d.law = phiq::MotionLaw::harmonic(0.1, 0.5, 2.0, 0.0);
   d.setup();
   CheckSpec(d, kN, Opts(441, true));
+}
+
+TEST(ConstraintKinds3d, JointDriversAlongTheirLaws) {
+  std::mt19937 rng(450);
+  phiq::JointAngleDriverSpec a;
+  a.a = BodySide(0, rng), a.b = BodySide(7, rng);
+  a.law = phiq::MotionLaw::harmonic(0.4, 2.5, 1.3, 0.2);
+  a.setup();
+  phiq::JointAngleDriverSpec a_rate = a;
+  a_rate.law = phiq::MotionLaw::polynomial({0.3, -1.2, 0.5});
+  CheckDataDerivative(a, a_rate, kN, 451);
+  for (phiq::Attachment3& e : a_rate.att) e = RandomAttachmentRate(rng);  // the reference directions too
+  CheckDataDerivative(a, a_rate, kN, 454);
+  phiq::JointAngleDriverSpec g = a;  // from ground
+  g.a = GroundSide(rng);
+  g.setup();
+  phiq::JointAngleDriverSpec g_rate = g;
+  for (phiq::Attachment3& e : g_rate.att) e = RandomAttachmentRate(rng);
+  CheckDataDerivative(g, g_rate, kN, 455);
+  phiq::JointDistanceDriverSpec d;
+  d.a = BodySide(0, rng), d.b = GroundSide(rng);
+  d.law = phiq::MotionLaw::polynomial({0.1, 0.4});
+  d.setup();
+  phiq::JointDistanceDriverSpec d_rate = d;
+  d_rate.law = phiq::MotionLaw::harmonic(0.0, 0.2, 2.0, 0.5);
+  CheckDataDerivative(d, d_rate, kN, 452);
+  for (phiq::Attachment3& e : d_rate.att) e = RandomAttachmentRate(rng);  // its sides' data too
+  CheckDataDerivative(d, d_rate, kN, 453);
 }
 
 // ---- what the rows mean -------------------------------------------------------------------------------------------

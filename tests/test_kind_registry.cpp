@@ -62,7 +62,12 @@ TEST(KindRegistry, EveryKindThatDifferentiatesItsDataHasACheckOfIt) {
   });
   EXPECT_TRUE(missing.empty()) << "kinds without a CheckDataDerivative test: " << ::testing::PrintToString(missing);
   EXPECT_EQ(differentiating,
-            (std::vector<std::string>{"distance", "pin", "point_on_line", "polar", "distance"}));  // planar, spatial
+            (std::vector<std::string>{
+                "distance", "pin", "point_on_line", "constant_angle", "angle", "polar", "prismatic", "equation",
+                "driver",  // planar
+                "distance", "spherical", "revolute", "prismatic", "cylindrical", "universal", "planar", "rigid",
+                "point_on_line", "point_on_plane", "joint_distance_driver", "joint_angle_driver",  // spatial
+                "gear", "rack_pinion", "belt", "screw"}));  // transmissions
 }
 
 TEST(KindRegistry, EverySceneExampleIsDocumentedInTheModelsReadme) {

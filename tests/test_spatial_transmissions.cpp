@@ -49,6 +49,31 @@ TEST(SpatialTransmissions, ScrewDerivatives) {
   }
 }
 
+TEST(SpatialTransmissions, ScrewAlongItsData) {
+  // the sides' attachments (points, axes, reference directions, a ground's place) and the pitch move
+  std::mt19937 rng(2725);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto rate_of = [&](const ScrewSpec& s) {
+    ScrewSpec r = s;
+    for (Attachment3& a : r.att) {
+      for (Slot& k : a.r) k = Slot::constant(u(rng));
+      for (Slot& k : a.p) k = Slot::constant(u(rng));
+      a.s = Random(rng);
+    }
+    r.pitch = 7.0 * u(rng);
+    return r;
+  };
+  for (double pitch : {50.0, -80.0}) {
+    ScrewSpec s;
+    s.a = Side(Body(0), rng), s.b = Side(Body(7), rng), s.pitch = pitch;
+    s.setup();
+    CheckDataDerivative(s, rate_of(s), kN, 2726, 3);
+    s.a = Side(Frame3::ground(), rng);
+    s.setup();
+    CheckDataDerivative(s, rate_of(s), kN, 2727, 3);
+  }
+}
+
 TEST(SpatialTransmissions, SpatialGearDerivatives) {
   std::mt19937 rng(2731);
   SpatialGearSpec g;  // shaft 1 in ground, shaft 2 in a housing on body 0 that moves (a carrier)

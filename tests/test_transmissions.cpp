@@ -34,6 +34,25 @@ TEST(Transmissions, RackAndBeltDerivatives) {
   CheckSpec(BeltSpec{{}, S(1), S(0), 0.08, 0.12, true, 0.3, 2}, 2, Opts(2714));
 }
 
+TEST(Transmissions, AlongTheirData) {
+  const Slot Z = Slot::constant(0.0);
+  // the radii and the phase move; then a held sun that turns with the parameter
+  CheckDataDerivative(GearSpec{{}, S(0), S(1), Slot::constant(0.0), 0.03, 0.09, false, 0.2, 2},
+                      GearSpec{{}, Z, Z, Z, 0.01, -0.02, false, 0.7, 2}, 2, 2721);
+  CheckDataDerivative(GearSpec{{}, S(2), S(0), S(1), 18.0, 60.0, true, -0.1, 2},
+                      GearSpec{{}, Z, Z, Z, 1.0, 3.0, true, 0.0, 2}, 3, 2722);
+  CheckDataDerivative(GearSpec{{}, Slot::constant(0.4), S(0), S(1), 24.0, 18.0, false, 0.0, 2},
+                      GearSpec{{}, Slot::constant(1.3), Z, Z, -2.0, 1.0, false, 0.5, 2}, 2, 2723);
+  CheckDataDerivative(RackPinionSpec{{}, S(1), S(0), 0.04, 0.01, false, 2},
+                      RackPinionSpec{{}, Z, Z, 0.5, -0.3, false, 2}, 2, 2724);
+  CheckDataDerivative(RackPinionSpec{{}, S(0), S(1), 0.5, 0.0, true, 3}, RackPinionSpec{{}, Z, Z, -0.2, 0.4, true, 3},
+                      2, 2725);
+  CheckDataDerivative(BeltSpec{{}, S(0), S(1), 0.08, 0.05, false, 0.0, 2}, BeltSpec{{}, Z, Z, 0.3, -0.1, false, 0.2, 2},
+                      2, 2726);
+  CheckDataDerivative(BeltSpec{{}, S(1), S(0), 0.08, 0.12, true, 0.3, 2}, BeltSpec{{}, Z, Z, -0.05, 0.2, true, 1.0, 2},
+                      2, 2727);
+}
+
 // The values of one row of a kind at q (the relation it states, whatever its scaling).
 template <class Spec>
 double Row(const Spec& s, std::initializer_list<double> q) {

@@ -25,10 +25,14 @@
 /// h = 10⁻³ |p|; for a parameter inside a sine or cosine (an angle), h⁴/30 of the fifth derivative: 3·10⁻¹⁴
 /// relative. Rounding adds about ε |Φ's terms| / h.
 ///
-/// A kind that differentiates its own data (DataDifferentiable: the planar distance, pin, point on a line and polar
-/// vector, most rows of the large linkages, and the spatial distance's length) gives its equations' derivatives itself, exactly and in one evaluation: D is then applied
-/// to its data alone (a datum's rate: exact for the scene's arithmetic of degree ≤ 4 in p, a length L itself
-/// among it) and the kind's data_derivative() chains it (DistanceSpec::data_derivative(); ReachedConstraints::rates).
+/// A kind that differentiates its own data (DataDifferentiable: the planar distance, pin, prismatic pair, point on a
+/// line, constant and segment angles and polar vector, most rows of the large linkages; the drivers and driven
+/// equations through their laws, MotionLaw::rate_along(); the spatial distance, the nine spatial joints, the joint
+/// drivers and the screw through their attachments; the gear, rack and belt) gives its equations' derivatives
+/// itself, exactly and in one evaluation: D is then applied to its data alone (a datum's rate: exact for the
+/// scene's arithmetic of degree ≤ 4 in p, a length L itself among it; a harmonic law's frequency enters f through
+/// the chain rule, not D) and the kind's data_derivative() chains it (DistanceSpec::data_derivative();
+/// ReachedConstraints::rates).
 ///
 /// The higher orders' derivatives along the motion's own sensitivities, (q, q̇) ← (s, ṡ), are taken apart from p,
 /// with the swept model. The velocity's is exact: with B = ∂(Φq q̇ + Φt)/∂q, γ = −(Φq q̇)q q̇ − 2 Φqt q̇ − Φtt is a
@@ -96,7 +100,7 @@ struct ParameterReach {
 /// p + h, p + 2h), one block per span of the reach, holding copies of the span's constraints with their rows. All
 /// that the derivatives along p read once the reach is known (keep_reached_only()).
 ///
-/// Where the span's kind differentiates its own data (DataDifferentiable: the distances, pin, point on a line, polar vector), `rates`
+/// Where the span's kind differentiates its own data (DataDifferentiable, above), `rates`
 /// holds its data's rates along p (ConstraintBlock::data_rates()), and the derivatives there are the kind's, exact
 /// and in one evaluation instead of four (a bar's length: the differences' 2(h/L)⁴ gone). Not with co-moving
 /// coordinates (ParameterReach::comotion: the models move q there), where every span is differenced.

@@ -71,6 +71,39 @@ struct ConstantAngleSpec {
     kin::V2 ud = kin::vel(b, qd) - kin::vel(a, qd), vd = kin::vel(d, qd) - kin::vel(c, qd);
     out[0] = -2.0 * (std::cos(angle) * kin::cross(ud, vd) - std::sin(angle) * kin::dot(ud, vd)) / ref;
   }
+  /// The data a parameter may move (DistanceSpec::data_members()): the segments' fixed points, the angle, and ref
+  /// (the scale of the row, from the placement, which a parameter may move too).
+  static constexpr auto data_members() {
+    return std::tuple{&ConstantAngleSpec::a, &ConstantAngleSpec::b, &ConstantAngleSpec::c, &ConstantAngleSpec::d,
+                      &ConstantAngleSpec::angle, &ConstantAngleSpec::ref};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). With B(x, y) = cos α (x × y) − sin α (x · y) and
+  /// B′(x, y) = ∂B/∂α = −sin α (x × y) − cos α (x · y), the k-th time derivative of Φ is
+  /// Σ_i C(k, i) B(u⁽ⁱ⁾, v⁽ᵏ⁻ⁱ⁾) / ref; the data move u and v (û, v̂: their fixed points' rates; their motion
+  /// u̇, ü is the coordinates'), α and ref:
+  ///
+  ///   ∂Φ⁽ᵏ⁾/∂p = [B(û, v⁽ᵏ⁾) + B(u⁽ᵏ⁾, v̂) + α̂ Σ_i C(k, i) B′(u⁽ⁱ⁾, v⁽ᵏ⁻ⁱ⁾)] / ref − Φ⁽ᵏ⁾ ref̂ / ref,
+  ///
+  /// Φ⁽¹⁾ = Φq q̇ and Φ⁽²⁾ = Φq q̈ − γ.
+  void data_derivative(const ConstantAngleSpec& rate, int order, const double* q, const double* qd,
+                       const double* qdd, double, double* out) const {
+    const double ca = std::cos(angle), sa = std::sin(angle);
+    auto B = [&](const kin::V2& x, const kin::V2& y) { return ca * kin::cross(x, y) - sa * kin::dot(x, y); };
+    auto Bp = [&](const kin::V2& x, const kin::V2& y) { return -sa * kin::cross(x, y) - ca * kin::dot(x, y); };
+    const kin::V2 u = kin::pos(b, q) - kin::pos(a, q), v = kin::pos(d, q) - kin::pos(c, q);
+    const kin::V2 uh = kin::pos(rate.b, q) - kin::pos(rate.a, q), vh = kin::pos(rate.d, q) - kin::pos(rate.c, q);
+    // u, v and their time derivatives up to `order`; the data's rates touch only the undifferentiated ones
+    kin::V2 du[3] = {u, {0, 0}, {0, 0}}, dv[3] = {v, {0, 0}, {0, 0}};
+    if (order >= 1) du[1] = kin::vel(b, qd) - kin::vel(a, qd), dv[1] = kin::vel(d, qd) - kin::vel(c, qd);
+    if (order == 2) du[2] = kin::vel(b, qdd) - kin::vel(a, qdd), dv[2] = kin::vel(d, qdd) - kin::vel(c, qdd);
+    static constexpr double kBinomial[3][3] = {{1, 0, 0}, {1, 1, 0}, {1, 2, 1}};
+    double value = 0.0, along_angle = 0.0;
+    for (int i = 0; i <= order; ++i) {
+      value += kBinomial[order][i] * B(du[i], dv[order - i]);
+      along_angle += kBinomial[order][i] * Bp(du[i], dv[order - i]);
+    }
+    out[0] = (B(uh, dv[order]) + B(du[order], vh) + rate.angle * along_angle - value * rate.ref / ref) / ref;
+  }
 
   /// @copydoc DistanceSpec::joint_count
   JointCount joint_count() const { return JointCount::other(); }

@@ -61,6 +61,14 @@ struct CoordinateDriverSpec {
   /// @par Driver
   /// For a driver: γ = f''(t) (0 for a linear law); `q` and `qd` are not read.
   void gamma(const double*, const double*, double t, double* out) const { out[0] = law.evaluate(t).ddf; }
+  /// The data a parameter may move (DistanceSpec::data_members()): the law (its coefficients, values or program).
+  static constexpr auto data_members() { return std::tuple{&CoordinateDriverSpec::law}; }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): −∂f/∂p, −∂f′/∂p, −∂f″/∂p at t, of the law's
+  /// rate (MotionLaw::rate_along: exact along a polynomial's, a table's or a harmonic's data).
+  void data_derivative(const CoordinateDriverSpec& rate, int order, const double*, const double*, const double*,
+                       double t, double* out) const {
+    out[0] = detail::minus_law_rate(rate.law, order, t);
+  }
 
   /// @copydoc DistanceSpec::joint_count
   /// A driver is not counted.

@@ -91,6 +91,15 @@ struct EquationSpec {
   void gamma(const double* q, const double* qd, double t, double* out) const {
     out[0] = g->gamma(q, qd, t) + (law ? law->evaluate(t).ddf : 0.0);
   }
+  /// The data a parameter may move (DistanceSpec::data_members()): the law. The expression is no datum: a parameter
+  /// it reads is a constant of its tapes, and a parameter that reaches g has the equation differenced.
+  static constexpr auto data_members() { return std::tuple{&EquationSpec::law}; }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): −∂f/∂p, −∂f′/∂p, −∂f″/∂p of the law's rate
+  /// (CoordinateDriverSpec::data_derivative()), 0 without a law.
+  void data_derivative(const EquationSpec& rate, int order, const double*, const double*, const double*, double t,
+                       double* out) const {
+    out[0] = rate.law ? detail::minus_law_rate(*rate.law, order, t) : 0.0;
+  }
 
   /// @copydoc DistanceSpec::joint_count
   /// An equation with a law is a driver; without one, no joint (the count is undefined).

@@ -76,6 +76,19 @@ struct JointDistanceDriverSpec {
   void gamma(const double* q, const double* qd, double t, double* out) const {
     out[0] = detail3::row_gamma(att.data(), kCompact.rows[0], q, qd, 1.0) + law.evaluate(t).ddf;
   }
+  /// The data a parameter may move (DistanceSpec::data_members()): the sides, through their attachments
+  /// (SpatialJointSpec::data_members()), and the law.
+  static constexpr auto data_members() {
+    return std::tuple{&JointDistanceDriverSpec::a, &JointDistanceDriverSpec::b, &JointDistanceDriverSpec::att,
+                      &JointDistanceDriverSpec::law};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): the row X · Y − f(t) along its attachments
+  /// (detail3::row_data_derivative()) and its law (CoordinateDriverSpec::data_derivative()).
+  void data_derivative(const JointDistanceDriverSpec& rate, int order, const double* q, const double* qd,
+                       const double* qdd, double t, double* out) const {
+    out[0] = detail3::row_data_derivative(att.data(), rate.att.data(), kCompact.rows[0], order, q, qd, qdd) +
+             detail::minus_law_rate(rate.law, order, t);
+  }
 };
 
 /// Driver on the rotation of a revolute or cylindrical joint: the angle θ of x_b about z_a measured from x_a,
@@ -136,6 +149,20 @@ struct JointAngleDriverSpec {
   /// θ̈ = (c s̈ − s c̈)/ρ − (c ṡ − s ċ) ρ̇/ρ², ρ̇ = 2 (c ċ + s ṡ); γ keeps the q̈-free parts of c̈, s̈, plus f''(t).
   void gamma(const double* q, const double* qd, double t, double* out) const {
     out[0] = -angle().bias(att.data(), q, qd) + law.evaluate(t).ddf;
+  }
+  /// The data a parameter may move (DistanceSpec::data_members()): the sides, through their attachments (the
+  /// reference directions the angle is measured from), and the law.
+  static constexpr auto data_members() {
+    return std::tuple{&JointAngleDriverSpec::a, &JointAngleDriverSpec::b, &JointAngleDriverSpec::att,
+                      &JointAngleDriverSpec::law};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): θ's along the attachments
+  /// (detail3::AngleRows::data_derivative()) and the law's, which enters the row as − f(t)
+  /// (CoordinateDriverSpec::data_derivative()).
+  void data_derivative(const JointAngleDriverSpec& rate, int order, const double* q, const double* qd,
+                       const double* qdd, double t, double* out) const {
+    out[0] = angle().data_derivative(att.data(), rate.att.data(), order, q, qd, qdd) +
+             detail::minus_law_rate(rate.law, order, t);
   }
 
 

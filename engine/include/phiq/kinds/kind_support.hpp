@@ -7,11 +7,13 @@
 #include <cmath>
 #include <algorithm>
 #include <array>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
+#include "phiq/motion_law.hpp"
 #include "phiq/types.hpp"
 
 namespace phiq {
@@ -154,6 +156,23 @@ inline bool datum_rate(Frame2& rate, const std::array<const Frame2*, 4>& v, doub
 inline bool datum_rate(kin::V2& rate, const std::array<const kin::V2*, 4>& v, double h) {
   return datum_rate(rate.x, {&v[0]->x, &v[1]->x, &v[2]->x, &v[3]->x}, h) &&
          datum_rate(rate.y, {&v[0]->y, &v[1]->y, &v[2]->y, &v[3]->y}, h);
+}
+// −∂f/∂p, −∂f′/∂p or −∂f″/∂p (`order` 0, 1, 2) at t, of a law's rate along a parameter: the derivative along its
+// law of a driver's row whose law enters as − f(t) (CoordinateDriverSpec::data_derivative()).
+inline double minus_law_rate(const MotionLaw& rate, int order, double t) {
+  const LawValue v = rate.evaluate(t);
+  return -(order == 0 ? v.f : order == 1 ? v.df : v.ddf);
+}
+// A motion law's rate is the law ∂f/∂p (MotionLaw::rate_along); an optional law's, when all five have one.
+inline bool datum_rate(MotionLaw& rate, const std::array<const MotionLaw*, 4>& v, double h) {
+  rate = MotionLaw::rate_along(rate, v, h);
+  return true;
+}
+inline bool datum_rate(std::optional<MotionLaw>& rate, const std::array<const std::optional<MotionLaw>*, 4>& v,
+                       double h) {
+  for (const auto* law : v)
+    if (law->has_value() != rate.has_value()) return false;
+  return !rate || datum_rate(*rate, {&**v[0], &**v[1], &**v[2], &**v[3]}, h);
 }
 
 // `rate` made of `at` with each datum of Spec::data_members() replaced by its rate along the parameter over the

@@ -78,6 +78,51 @@ struct PrismaticSpec {
     out[0] = 0.0;
     out[1] = -phidd;
   }
+  /// The data a parameter may move (DistanceSpec::data_members()): the frames' constant slots, the local points, the
+  /// axis and the relative angle.
+  static constexpr auto data_members() {
+    return std::tuple{&PrismaticSpec::a, &PrismaticSpec::b, &PrismaticSpec::sa, &PrismaticSpec::sb,
+                      &PrismaticSpec::axis, &PrismaticSpec::angle};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). Row 0 reads only angles: ψ̂_b − ψ̂_a − θ̂0 at
+  /// order 0, nothing at orders 1 and 2. Row 1 is e × h; with the data's rates ê = R(ψ_a) û + ψ̂_a e⊥ and
+  /// ĥ = r̂_b + â_b − r̂_a − â_a, â_k = R(ψ_k) ŝ_k + ψ̂_k (R(ψ_k) s_k)⊥ (ψ̂ the rate of a constant ψ), and the
+  /// motion's ė = ω_a e⊥, ë = α_a e⊥ − ω_a² e, ḣ, ḧ (their data parts ∂ė = ω_a ê⊥, ∂ë = α_a ê⊥ − ω_a² ê,
+  /// ∂ḣ = ω_b â_b⊥ − ω_a â_a⊥, ∂ḧ = α_b â_b⊥ − ω_b² â_b − α_a â_a⊥ + ω_a² â_a):
+  ///
+  ///   ∂Φ1/∂p = ê × h + e × ĥ,   ∂(Φq q̇)1/∂p = ∂ė × h + ė × ĥ + ê × ḣ + e × ∂ḣ,
+  ///   ∂(Φq q̈ − γ)1/∂p = ∂ë × h + ë × ĥ + 2 (∂ė × ḣ + ė × ∂ḣ) + ê × ḧ + e × ∂ḧ.
+  void data_derivative(const PrismaticSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
+    const Geometry g = geometry(q);
+    const double pa = a.psi.of(q), pb = b.psi.of(q), psia = rate.a.psi.of(q), psib = rate.b.psi.of(q);
+    const kin::V2 eh = kin::rotate(pa, rate.axis) + psia * kin::perp(g.e);
+    const kin::V2 ha = kin::rotate(pa, rate.sa) + psia * kin::perp(g.arm_a);
+    const kin::V2 hb = kin::rotate(pb, rate.sb) + psib * kin::perp(g.arm_b);
+    const kin::V2 hh = kin::V2{rate.b.x.of(q), rate.b.y.of(q)} + hb - kin::V2{rate.a.x.of(q), rate.a.y.of(q)} - ha;
+    if (order == 0) {
+      out[0] = psib - psia - rate.angle;
+      out[1] = kin::cross(eh, g.h) + kin::cross(g.e, hh);
+      return;
+    }
+    out[0] = 0.0;
+    const double wa = a.psi.rate(qd), wb = b.psi.rate(qd);
+    const kin::V2 ed = wa * kin::perp(g.e), edh = wa * kin::perp(eh);
+    const kin::V2 hd = kin::V2{b.x.rate(qd), b.y.rate(qd)} + wb * kin::perp(g.arm_b) -
+                       kin::V2{a.x.rate(qd), a.y.rate(qd)} - wa * kin::perp(g.arm_a);
+    const kin::V2 hdh = wb * kin::perp(hb) - wa * kin::perp(ha);
+    if (order == 1) {
+      out[1] = kin::cross(edh, g.h) + kin::cross(ed, hh) + kin::cross(eh, hd) + kin::cross(g.e, hdh);
+      return;
+    }
+    const double aa = a.psi.rate(qdd), ab = b.psi.rate(qdd);
+    const kin::V2 edd = aa * kin::perp(g.e) - (wa * wa) * g.e, eddh = aa * kin::perp(eh) - (wa * wa) * eh;
+    const kin::V2 hdd = kin::V2{b.x.rate(qdd), b.y.rate(qdd)} + ab * kin::perp(g.arm_b) - (wb * wb) * g.arm_b -
+                        kin::V2{a.x.rate(qdd), a.y.rate(qdd)} - aa * kin::perp(g.arm_a) + (wa * wa) * g.arm_a;
+    const kin::V2 hddh = ab * kin::perp(hb) - (wb * wb) * hb - aa * kin::perp(ha) + (wa * wa) * ha;
+    out[1] = kin::cross(eddh, g.h) + kin::cross(edd, hh) + 2.0 * (kin::cross(edh, hd) + kin::cross(ed, hdh)) +
+             kin::cross(eh, hdd) + kin::cross(g.e, hddh);
+  }
 
 
   /// @copydoc DistanceSpec::joint_count

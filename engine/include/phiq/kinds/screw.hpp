@@ -88,6 +88,23 @@ struct ScrewSpec {
     for (int r = 0; r < 4; ++r) out[r] = detail3::row_gamma(att.data(), kCompact.rows[r], q, qd, 1.0);
     out[4] = -angle().bias(att.data(), q, qd) - k() * detail3::row_gamma(att.data(), kCompact.rows[6], q, qd, 1.0);
   }
+  /// The data a parameter may move (DistanceSpec::data_members()): the sides, through their attachments, and the
+  /// pitch.
+  static constexpr auto data_members() {
+    return std::tuple{&ScrewSpec::a, &ScrewSpec::b, &ScrewSpec::att, &ScrewSpec::pitch};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): the four rows of the axis along the attachments
+  /// (detail3::row_data_derivative()); the helix θ − k d, k = 2π/p, as θ's (AngleRows::data_derivative()) minus
+  /// k̂ d⁽ⁱ⁾ + k d̂⁽ⁱ⁾, k̂ = −2π p̂/p².
+  void data_derivative(const ScrewSpec& rate, int order, const double* q, const double* qd, const double* qdd, double,
+                       double* out) const {
+    for (int r = 0; r < 4; ++r)
+      out[r] = detail3::row_data_derivative(att.data(), rate.att.data(), kCompact.rows[r], order, q, qd, qdd);
+    const double kh = -2.0 * std::numbers::pi * rate.pitch / (pitch * pitch);
+    out[4] = angle().data_derivative(att.data(), rate.att.data(), order, q, qd, qdd) -
+             kh * detail3::row_time_derivative(att.data(), kCompact.rows[6], order, q, qd, qdd) -
+             k() * detail3::row_data_derivative(att.data(), rate.att.data(), kCompact.rows[6], order, q, qd, qdd);
+  }
   /// @copydoc DistanceSpec::joint_count
   /// A screw between bodies or ground removes 5 freedoms (one left: the turn and travel together).
   JointCount joint_count() const { return JointCount::joint(3, kRows); }

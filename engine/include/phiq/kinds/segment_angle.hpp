@@ -63,6 +63,27 @@ struct SegmentAngleSpec {
     double th = theta.of(q), w = theta.rate(qd), sn = std::sin(th), cs = std::cos(th);
     out[0] = -2.0 * w * (dd.x * cs + dd.y * sn) + w * w * (d.x * sn - d.y * cs);
   }
+  /// The data a parameter may move (DistanceSpec::data_members()): the segment's fixed ends and a constant θ.
+  static constexpr auto data_members() {
+    return std::tuple{&SegmentAngleSpec::a, &SegmentAngleSpec::b, &SegmentAngleSpec::theta};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). Φ = d × w with d = b − a, w = (cos θ, sin θ),
+  /// so Φ⁽ᵏ⁾ = Σ_i C(k, i) d⁽ⁱ⁾ × w⁽ᵏ⁻ⁱ⁾; the data move d (d̂, the fixed ends' rates) and a constant θ (ŵ = θ̂ w⊥,
+  /// whose w does not move), so that ∂Φ⁽ᵏ⁾/∂p = d̂ × w⁽ᵏ⁾ + d⁽ᵏ⁾ × ŵ, with ẇ = ω w⊥, ẅ = α w⊥ − ω² w.
+  void data_derivative(const SegmentAngleSpec& rate, int order, const double* q, const double* qd,
+                       const double* qdd, double, double* out) const {
+    const double th = theta.of(q);
+    const kin::V2 w{std::cos(th), std::sin(th)}, wh = rate.theta.of(q) * kin::perp(w);
+    const kin::V2 dh = kin::pos(rate.b, q) - kin::pos(rate.a, q);
+    kin::V2 dk = kin::pos(b, q) - kin::pos(a, q), wk = w;
+    if (order == 1) {
+      dk = kin::vel(b, qd) - kin::vel(a, qd), wk = theta.rate(qd) * kin::perp(w);
+    } else if (order == 2) {
+      const double om = theta.rate(qd);
+      dk = kin::vel(b, qdd) - kin::vel(a, qdd), wk = theta.rate(qdd) * kin::perp(w) - (om * om) * w;
+    }
+    out[0] = kin::cross(dh, wk) + kin::cross(dk, wh);
+  }
 
   /// @copydoc DistanceSpec::joint_count
   JointCount joint_count() const { return JointCount::other(); }

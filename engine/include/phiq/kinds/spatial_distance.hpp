@@ -4,6 +4,7 @@
 /// is documented on DistanceSpec, and kinds/registry.hpp lists every kind.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <tuple>
 
@@ -23,7 +24,7 @@ struct SpatialDistanceSpec {
   static constexpr int kRows = 1;  ///< one row, a length
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "distance";
-  Attachment3 ends[2];  ///< A, B
+  std::array<Attachment3, 2> ends;  ///< A, B
   double length = 1.0;  ///< L > 0 (checked when added)
 
   /// @copydoc DistanceSpec::depends_on_time
@@ -39,33 +40,39 @@ struct SpatialDistanceSpec {
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double, double* phi) const {
-    phi[0] = detail3::row_value(ends, kDef, q, 0.5 / length, length * length);
+    phi[0] = detail3::row_value(ends.data(), kDef, q, 0.5 / length, length * length);
   }
   /// @copydoc DistanceSpec::jacobian
   template <class Sink>
   void jacobian(const double* q, double, Sink& s) const {
-    detail3::row_jacobian(ends, kDef, q, s, 0, 0.5 / length);
+    detail3::row_jacobian(ends.data(), kDef, q, s, 0, 0.5 / length);
   }
   /// @copydoc DistanceSpec::phi_t
   void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
   /// @copydoc DistanceSpec::gamma
   void gamma(const double* q, const double* qd, double, double* out) const {
-    out[0] = detail3::row_gamma(ends, kDef, q, qd, 0.5 / length);
+    out[0] = detail3::row_gamma(ends.data(), kDef, q, qd, 0.5 / length);
   }
-  /// The data a parameter may move (DistanceSpec::data_members()): the length. A parameter that moves an end's
-  /// local point is differenced from the models along it, as for the kinds without derivatives of their own.
-  static constexpr auto data_members() { return std::tuple{&SpatialDistanceSpec::length}; }
-  /// Derivatives along the length (DistanceSpec::data_derivative()). Φ = (|d|² − L²)/(2L), d = B − A, whose Φq and
-  /// γ are 1/(2L) times what does not hold L:
+  /// The data a parameter may move (DistanceSpec::data_members()): the ends (their local points, a fixed end's
+  /// place) and the length.
+  static constexpr auto data_members() {
+    return std::tuple{&SpatialDistanceSpec::ends, &SpatialDistanceSpec::length};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). Φ = (|d|² − L²)/(2L), d = B − A, whose Φq and
+  /// γ are 1/(2L) times what does not hold L; the ends move d·d as a row of the joints
+  /// (detail3::row_data_derivative(): Dk, the derivative of d·d's k-th time derivative along the ends):
   ///
-  ///   ∂Φ/∂p = −L̇ (Φ + L) / L,   ∂(Φq q̇)/∂p = −(L̇/L) Φq q̇,   ∂(Φq q̈ − γ)/∂p = −(L̇/L) (Φq q̈ − γ).
+  ///   ∂Φ/∂p = −L̇ (Φ + L) / L + D0/(2L),   ∂(Φq q̇)/∂p = −(L̇/L) Φq q̇ + D1/(2L),
+  ///   ∂(Φq q̈ − γ)/∂p = −(L̇/L) (Φq q̈ − γ) + D2/(2L).
   void data_derivative(const SpatialDistanceSpec& rate, int order, const double* q, const double* qd,
                        const double* qdd, double t, double* out) const {
     const double k = rate.length / length;
+    const double ends_term =
+        detail3::row_data_derivative(ends.data(), rate.ends.data(), kDef, order, q, qd, qdd) / (2.0 * length);
     double value = 0.0;
     if (order == 0) {
       residual(q, t, &value);
-      out[0] = -k * (value + length);
+      out[0] = -k * (value + length) + ends_term;
       return;
     }
     const double* v = order == 1 ? qd : qdd;
@@ -76,7 +83,7 @@ struct SpatialDistanceSpec {
       gamma(q, qd, t, &g);
       value -= g;
     }
-    out[0] = -k * value;
+    out[0] = -k * value + ends_term;
   }
 
 

@@ -124,6 +124,78 @@ inline double row_gamma(const Attachment3* a, const RowDef& d, const double* q, 
                kin3::dot(x, bias(a, d.y, qd)));
 }
 
+/// An attachment's X and time derivatives Ẋ, Ẍ (up to `order`, into x), and their derivatives along the data's
+/// rates `r` (an Attachment3 of the rates: r̂ and p̂ constants, read only where a's slot is a constant, and ŝ; into
+/// xh). X = r + B(p, p, s) is quadratic in p and linear in s (file comment of spatial_attachment.hpp), so exactly
+///   X̂ = r̂ + 2 B(p, p̂, s) + B(p, p, ŝ),   ∂Ẋ = 2 B(p̂, ṗ, s) + 2 B(p, ṗ, ŝ),
+///   ∂Ẍ = 2 B(p̂, p̈, s) + 2 B(p, p̈, ŝ) + 2 B(ṗ, ṗ, ŝ).
+inline void attachment_data_derivatives(const Attachment3& a, const Attachment3& r, int order, const double* q,
+                                        const double* qd, const double* qdd, kin3::V3 x[3], kin3::V3 xh[3]) {
+  // a coordinate slot is no datum: its rate is 0 whatever `r` holds there
+  auto rate_of = [&](const Slot& at, const Slot& rate) { return at.is_coordinate() ? 0.0 : rate.of(q); };
+  x[0] = a.value(q);
+  xh[0] = kin3::V3{rate_of(a.r[0], r.r[0]), rate_of(a.r[1], r.r[1]), rate_of(a.r[2], r.r[2])};
+  if (order >= 1) x[1] = a.rate(q, qd), xh[1] = kin3::V3{};
+  if (order == 2) x[2] = a.rate(q, qdd) + a.bias(qd), xh[2] = kin3::V3{};
+  // the rotations only where something turns: most attachments (natural points, folded ground places, a body's
+  // point a parameter does not move) have neither a local vector that moves nor a constant frame that turns
+  const bool arm_moves = !kin3::is_zero(r.s);
+  std::array<double, 4> ph{};
+  bool frame_turns = false;
+  if (a.rotates())
+    for (int k = 0; k < 4; ++k) frame_turns = (ph[k] = rate_of(a.p[k], r.p[k])) != 0.0 || frame_turns;
+  if (!arm_moves && !frame_turns) return;
+  const std::array<double, 4> p = a.euler(q);
+  if (frame_turns) xh[0] = xh[0] + 2.0 * kin3::bilinear(p.data(), ph.data(), a.s);
+  if (arm_moves) xh[0] = xh[0] + kin3::rotate(p.data(), r.s);
+  if (order == 0) return;
+  const std::array<double, 4> pd = a.euler_rates(qd);
+  if (frame_turns) xh[1] = xh[1] + 2.0 * kin3::bilinear(ph.data(), pd.data(), a.s);
+  if (arm_moves) xh[1] = xh[1] + 2.0 * kin3::bilinear(p.data(), pd.data(), r.s);
+  if (order == 1) return;
+  const std::array<double, 4> pdd = a.euler_rates(qdd);
+  if (frame_turns) xh[2] = xh[2] + 2.0 * kin3::bilinear(ph.data(), pdd.data(), a.s);
+  if (arm_moves)
+    xh[2] = xh[2] + 2.0 * (kin3::bilinear(p.data(), pdd.data(), r.s) + kin3::bilinear(pd.data(), pd.data(), r.s));
+}
+/// The same for a term (att[plus] − att[minus], or a constant axis: no motion, no data), `r` the rates of `a`.
+inline void term_data_derivatives(const Attachment3* a, const Attachment3* r, Term t, int order, const double* q,
+                                  const double* qd, const double* qdd, kin3::V3 x[3], kin3::V3 xh[3]) {
+  for (int k = 0; k < 3; ++k) x[k] = xh[k] = kin3::V3{};
+  if (t.axis >= 0) {
+    x[0] = kin3::unit_axis(t.axis);
+    return;
+  }
+  kin3::V3 y[3], yh[3];
+  for (const auto& [index, sign] : {std::pair{t.plus, 1.0}, std::pair{t.minus, -1.0}}) {
+    if (index < 0) continue;
+    attachment_data_derivatives(a[index], r[index], order, q, qd, qdd, y, yh);
+    for (int k = 0; k <= order; ++k) x[k] = x[k] + sign * y[k], xh[k] = xh[k] + sign * yh[k];
+  }
+}
+/// The derivative of X · Y's `order`-th time derivative along the data (`r`: the rates of `a`), at fixed q, q̇, q̈:
+/// Σ_i C(k, i) (X̂⁽ⁱ⁾ · Y⁽ᵏ⁻ⁱ⁾ + X⁽ⁱ⁾ · Ŷ⁽ᵏ⁻ⁱ⁾). For a row w (X · Y − c) with w and c fixed, w times it is
+/// ∂Φ/∂p, ∂(Φq q̇)/∂p or ∂(Φq q̈ − γ)/∂p (the row's Ẍ · Y + 2 Ẋ · Ẏ + X · Ÿ is Φq q̈ − γ).
+inline double row_data_derivative(const Attachment3* a, const Attachment3* r, const RowDef& d, int order,
+                                  const double* q, const double* qd, const double* qdd) {
+  kin3::V3 x[3], xh[3], y[3], yh[3];
+  term_data_derivatives(a, r, d.x, order, q, qd, qdd, x, xh);
+  term_data_derivatives(a, r, d.y, order, q, qd, qdd, y, yh);
+  static constexpr double kBinomial[3][3] = {{1, 0, 0}, {1, 1, 0}, {1, 2, 1}};
+  double sum = 0.0;
+  for (int i = 0; i <= order; ++i)
+    sum += kBinomial[order][i] * (kin3::dot(xh[i], y[order - i]) + kin3::dot(x[i], yh[order - i]));
+  return sum;
+}
+
+/// The `order`-th time derivative of a row's X · Y at (q, q̇, q̈): X · Y, Ẋ · Y + X · Ẏ, or Φq q̈ − γ of the row.
+inline double row_time_derivative(const Attachment3* a, const RowDef& d, int order, const double* q, const double* qd,
+                                  const double* qdd) {
+  if (order == 0) return row_value(a, d, q, 1.0, 0.0);
+  if (order == 1) return row_rate(a, d, q, qd, 1.0);
+  return row_rate(a, d, q, qdd, 1.0) - row_gamma(a, d, q, qd, 1.0);
+}
+
 /// The attachments a joint's rows read, in the order of their indices (`index[i]`: the Attach index of the i-th),
 /// and the rows with their terms renumbered into that list: a joint stores only those (a point on a plane reads 3
 /// of the 8), since every evaluation streams them.
@@ -214,6 +286,29 @@ struct AngleRows {
     const double rho = cv * cv + sv * sv, rhod = 2.0 * (cv * cd + sv * sd);
     return (cv * sb - sv * cb) / rho - (cv * sd - sv * cd) * rhod / (rho * rho);
   }
+  /// The derivative of θ (`order` 0), θ̇ (1) or θ̈ (2) along the attachments' data (`r`: the rates of `a`), at fixed
+  /// q, q̇, q̈: with c⁽ᵏ⁾, s⁽ᵏ⁾ the products' time derivatives and ĉ⁽ᵏ⁾, ŝ⁽ᵏ⁾ theirs along the data
+  /// (row_data_derivative()), ρ = c² + s², N1 = c ṡ − s ċ, N2 = c s̈ − s c̈, θ̇ = N1/ρ, θ̈ = N2/ρ − N1 ρ̇/ρ², each
+  /// differentiated by the product and quotient rules.
+  double data_derivative(const Attachment3* a, const Attachment3* r, int order, const double* q, const double* qd,
+                         const double* qdd) const {
+    const double cv = row_value(a, c, q, 1.0, 0.0), sv = row_value(a, s, q, 1.0, 0.0);
+    const double ch = row_data_derivative(a, r, c, 0, q, qd, qdd), sh = row_data_derivative(a, r, s, 0, q, qd, qdd);
+    const double rho = cv * cv + sv * sv, rhoh = 2.0 * (cv * ch + sv * sh);
+    if (order == 0) return (cv * sh - sv * ch) / rho;
+    const double cd = row_rate(a, c, q, qd, 1.0), sd = row_rate(a, s, q, qd, 1.0);
+    const double cdh = row_data_derivative(a, r, c, 1, q, qd, qdd), sdh = row_data_derivative(a, r, s, 1, q, qd, qdd);
+    const double n1 = cv * sd - sv * cd, n1h = ch * sd + cv * sdh - sh * cd - sv * cdh;
+    if (order == 1) return n1h / rho - n1 * rhoh / (rho * rho);
+    // c̈ = Φq q̈ − γ of the row
+    const double cdd = row_rate(a, c, q, qdd, 1.0) - row_gamma(a, c, q, qd, 1.0);
+    const double sdd = row_rate(a, s, q, qdd, 1.0) - row_gamma(a, s, q, qd, 1.0);
+    const double cddh = row_data_derivative(a, r, c, 2, q, qd, qdd), sddh = row_data_derivative(a, r, s, 2, q, qd, qdd);
+    const double n2 = cv * sdd - sv * cdd, n2h = ch * sdd + cv * sddh - sh * cdd - sv * cddh;
+    const double rhod = 2.0 * (cv * cd + sv * sd), rhodh = 2.0 * (ch * cd + cv * cdh + sh * sd + sv * sdh);
+    const double rho2 = rho * rho;
+    return n2h / rho - n2 * rhoh / rho2 - (n1h * rhod + n1 * rhodh) / rho2 + 2.0 * n1 * rhod * rhoh / (rho2 * rho);
+  }
 };
 /// Draws a joint: the arms of the bodies it joins, and `mark` at its point (on ground when a side is ground).
 template <class Sketch>
@@ -231,6 +326,32 @@ void side_slots(const JointSide3& s, F& f) {
   if (s.vector) f(s.vector->x, Unit::kNone), f(s.vector->y, Unit::kNone), f(s.vector->z, Unit::kNone);
 }
 }  // namespace detail3
+
+/// The rates of an attachment's data along a design parameter (detail::datum_rate, DistanceSpec::data_derivative()):
+/// its slots' (constants their rate, coordinates none) and its local vector's.
+inline bool datum_rate(Attachment3& rate, const std::array<const Attachment3*, 4>& v, double h) {
+  auto slot = [&](Slot& r, auto member, int k) {
+    return detail::datum_rate(r, {&(v[0]->*member)[k], &(v[1]->*member)[k], &(v[2]->*member)[k],
+                                  &(v[3]->*member)[k]}, h);
+  };
+  bool ok = true;
+  for (int k = 0; k < 3; ++k) ok = ok && slot(rate.r[k], &Attachment3::r, k);
+  for (int k = 0; k < 4; ++k) ok = ok && slot(rate.p[k], &Attachment3::p, k);
+  return ok && detail::datum_rate(rate.s.x, {&v[0]->s.x, &v[1]->s.x, &v[2]->s.x, &v[3]->s.x}, h) &&
+         detail::datum_rate(rate.s.y, {&v[0]->s.y, &v[1]->s.y, &v[2]->s.y, &v[3]->s.y}, h) &&
+         detail::datum_rate(rate.s.z, {&v[0]->s.z, &v[1]->s.z, &v[2]->s.z, &v[3]->s.z}, h);
+}
+/// The rates of a list of attachments, each's.
+template <std::size_t N>
+bool datum_rate(std::array<Attachment3, N>& rate, const std::array<const std::array<Attachment3, N>*, 4>& v, double h) {
+  for (std::size_t i = 0; i < N; ++i)
+    if (!datum_rate(rate[i], {&(*v[0])[i], &(*v[1])[i], &(*v[2])[i], &(*v[3])[i]}, h)) return false;
+  return true;
+}
+/// A joint's side, as given, is not what its rows read: its attachments (`att`, derived from the sides) are, and
+/// they carry the side's rates (a side that turns from a body to ground changes their slots and is refused there).
+/// The side's "rate" is left as the side itself, and never read.
+inline bool datum_rate(JointSide3&, const std::array<const JointSide3*, 4>&, double) { return true; }
 
 /// A spatial joint between two sides, its rows given by `Traits` (one struct per joint type below). The sides
 /// are data; setup() (called by ModelBuilder::add, or by hand before evaluating a spec built in code) validates
@@ -281,6 +402,19 @@ struct SpatialJointSpec {
   /// @copydoc DistanceSpec::gamma
   void gamma(const double* q, const double* qd, double, double* out) const {
     for (int r = 0; r < kRows; ++r) out[r] = detail3::row_gamma(att.data(), kCompact.rows[r], q, qd, 1.0);
+  }
+  /// The data a parameter may move (DistanceSpec::data_members()): the sides, through the attachments the rows
+  /// read (a side's local point, axis and reference direction, a ground frame's place).
+  static constexpr auto data_members() {
+    return std::tuple{&SpatialJointSpec::a, &SpatialJointSpec::b, &SpatialJointSpec::att};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): each row's, X · Y differentiated along its
+  /// attachments' rates (detail3::row_data_derivative(): exact, the attachments being quadratic in the Euler
+  /// parameters and linear in the local vectors).
+  void data_derivative(const SpatialJointSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
+    for (int r = 0; r < kRows; ++r)
+      out[r] = detail3::row_data_derivative(att.data(), rate.att.data(), kCompact.rows[r], order, q, qd, qdd);
   }
 
   /// @copydoc DistanceSpec::joint_count

@@ -14,6 +14,7 @@
 
 #include <array>
 #include <cmath>
+#include <tuple>
 
 #include "phiq/kinds/kind_support.hpp"
 
@@ -62,6 +63,24 @@ struct LinearTransmission {
   void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
   /// @copydoc phiq::DistanceSpec::gamma
   void gamma(const double*, const double*, double, double* out) const { out[0] = 0.0; }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): the row Σ w_k q_k − c is linear in q, its
+  /// coefficients and constants functions of the data whose rates `Derived::row_rate(rate)` gives (ŵ, ĉ, and the
+  /// rates of constant slots), so ∂Φ/∂p = Σ ŵ_k q_k + Σ_constants w_k q̂_k − ĉ, and the higher orders Σ ŵ_k q_k⁽ᵏ⁾
+  /// (Φt = γ = 0).
+  void data_derivative(const Derived& rate, int order, const double* q, const double* qd, const double* qdd, double,
+                       double* out) const {
+    const detail::LinearRow row = self().row(), r = self().row_rate(rate);
+    double sum = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      if (order == 0) {
+        sum += r.w[k] * row.slot[k].of(q);
+        if (!row.slot[k].is_coordinate()) sum += row.w[k] * r.slot[k].value();
+      } else {
+        sum += r.w[k] * row.slot[k].rate(order == 1 ? qd : qdd);
+      }
+    }
+    out[0] = order == 0 ? sum - r.c : sum;
+  }
   /// @copydoc phiq::DistanceSpec::joint_count
   /// A transmission between two bodies is a higher pair: one freedom.
   JointCount joint_count() const { return JointCount::joint(self().dimension == 3 ? 3 : 2, 1); }
@@ -144,6 +163,16 @@ struct GearSpec : LinearTransmission<GearSpec> {
     const double k = (internal ? -r2 : r2) / r1;
     return detail::LinearRow{{first, second, carrier}, {1.0, k, -(1.0 + k)}, phase};
   }
+  /// The data a parameter may move (DistanceSpec::data_members()): fixed angles, the radii and the phase.
+  static constexpr auto data_members() {
+    return std::tuple{&GearSpec::first, &GearSpec::second, &GearSpec::carrier, &GearSpec::r1, &GearSpec::r2,
+                      &GearSpec::phase};
+  }
+  /// The rates of row()'s coefficients along the data's `rate`: k̂ = ±(r̂2 r1 − r2 r̂1)/r1², the fixed angles', φ̂.
+  detail::LinearRow row_rate(const GearSpec& rate) const {
+    const double kd = (internal ? -1.0 : 1.0) * (rate.r2 * r1 - r2 * rate.r1) / (r1 * r1);
+    return detail::LinearRow{{rate.first, rate.second, rate.carrier}, {0.0, kd, -kd}, rate.phase};
+  }
 };
 
 /// Rack and pinion: the rack's travel x equals the pinion's pitch radius times its rotation θ (a rack along +x
@@ -205,6 +234,16 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
   detail::LinearRow row() const {
     return detail::LinearRow{{rack, pinion, Slot::constant(0)}, {1.0, reversed ? radius : -radius, 0.0}, offset};
   }
+  /// The data a parameter may move (DistanceSpec::data_members()): a fixed pinion angle, the radius, the offset.
+  static constexpr auto data_members() {
+    return std::tuple{&RackPinionSpec::rack, &RackPinionSpec::pinion, &RackPinionSpec::radius,
+                      &RackPinionSpec::offset};
+  }
+  /// The rates of row()'s coefficients along the data's `rate` (GearSpec::row_rate()).
+  detail::LinearRow row_rate(const RackPinionSpec& rate) const {
+    return detail::LinearRow{{rate.rack, rate.pinion, Slot::constant(0)},
+                             {0.0, reversed ? rate.radius : -rate.radius, 0.0}, rate.offset};
+  }
 };
 
 /// Belt or chain between two pulleys (sprockets) of radii r1, r2 (or tooth counts), without slip: the belt's
@@ -265,6 +304,15 @@ struct BeltSpec : LinearTransmission<BeltSpec> {
   /// The row as a linear form (LinearTransmission evaluates it).
   detail::LinearRow row() const {
     return detail::LinearRow{{first, second, Slot::constant(0)}, {1.0, (crossed ? r2 : -r2) / r1, 0.0}, phase};
+  }
+  /// The data a parameter may move (DistanceSpec::data_members()): fixed angles, the radii and the phase.
+  static constexpr auto data_members() {
+    return std::tuple{&BeltSpec::first, &BeltSpec::second, &BeltSpec::r1, &BeltSpec::r2, &BeltSpec::phase};
+  }
+  /// The rates of row()'s coefficients along the data's `rate` (GearSpec::row_rate()).
+  detail::LinearRow row_rate(const BeltSpec& rate) const {
+    const double kd = (crossed ? 1.0 : -1.0) * (rate.r2 * r1 - r2 * rate.r1) / (r1 * r1);
+    return detail::LinearRow{{rate.first, rate.second, Slot::constant(0)}, {0.0, kd, 0.0}, rate.phase};
   }
 };
 
