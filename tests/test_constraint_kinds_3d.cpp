@@ -289,10 +289,19 @@ TEST(ConstraintKinds3d, JointAngleDriver) {
   d.law = phiq::MotionLaw::harmonic(0.4, 2.5, 1.3, 0.2);
   d.setup();
   CheckSpec(d, kN, Opts(431, true));
+  // along its data: the law, then the attachments (the reference directions) too
+  phiq::JointAngleDriverSpec rate = d;
+  rate.law = phiq::MotionLaw::polynomial({0.3, -1.2, 0.5});
+  CheckDataDerivative(d, rate, kN, 451);
+  for (phiq::Attachment3& e : rate.att) e = RandomAttachmentRate(rng);
+  CheckDataDerivative(d, rate, kN, 454);
   d.a = GroundSide(rng);
   d.law = phiq::MotionLaw::polynomial({0.1, -3.0, 0.7});
   d.setup();
   CheckSpec(d, kN, Opts(432, true));
+  rate = d;
+  for (phiq::Attachment3& e : rate.att) e = RandomAttachmentRate(rng);
+  CheckDataDerivative(d, rate, kN, 455);
 }
 
 TEST(ConstraintKinds3d, JointDistanceDriver) {
@@ -302,34 +311,14 @@ TEST(ConstraintKinds3d, JointDistanceDriver) {
   d.law = phiq::MotionLaw::harmonic(0.1, 0.5, 2.0, 0.0);
   d.setup();
   CheckSpec(d, kN, Opts(441, true));
-}
-
-TEST(ConstraintKinds3d, JointDriversAlongTheirLaws) {
-  std::mt19937 rng(450);
-  phiq::JointAngleDriverSpec a;
-  a.a = BodySide(0, rng), a.b = BodySide(7, rng);
-  a.law = phiq::MotionLaw::harmonic(0.4, 2.5, 1.3, 0.2);
-  a.setup();
-  phiq::JointAngleDriverSpec a_rate = a;
-  a_rate.law = phiq::MotionLaw::polynomial({0.3, -1.2, 0.5});
-  CheckDataDerivative(a, a_rate, kN, 451);
-  for (phiq::Attachment3& e : a_rate.att) e = RandomAttachmentRate(rng);  // the reference directions too
-  CheckDataDerivative(a, a_rate, kN, 454);
-  phiq::JointAngleDriverSpec g = a;  // from ground
-  g.a = GroundSide(rng);
-  g.setup();
-  phiq::JointAngleDriverSpec g_rate = g;
-  for (phiq::Attachment3& e : g_rate.att) e = RandomAttachmentRate(rng);
-  CheckDataDerivative(g, g_rate, kN, 455);
-  phiq::JointDistanceDriverSpec d;
-  d.a = BodySide(0, rng), d.b = GroundSide(rng);
-  d.law = phiq::MotionLaw::polynomial({0.1, 0.4});
+  // along its data: the law, then the attachments too, from ground
+  d.b = GroundSide(rng);
   d.setup();
-  phiq::JointDistanceDriverSpec d_rate = d;
-  d_rate.law = phiq::MotionLaw::harmonic(0.0, 0.2, 2.0, 0.5);
-  CheckDataDerivative(d, d_rate, kN, 452);
-  for (phiq::Attachment3& e : d_rate.att) e = RandomAttachmentRate(rng);  // its sides' data too
-  CheckDataDerivative(d, d_rate, kN, 453);
+  phiq::JointDistanceDriverSpec rate = d;
+  rate.law = phiq::MotionLaw::polynomial({0.2, 0.4});
+  CheckDataDerivative(d, rate, kN, 452);
+  for (phiq::Attachment3& e : rate.att) e = RandomAttachmentRate(rng);
+  CheckDataDerivative(d, rate, kN, 453);
 }
 
 // ---- what the rows mean -------------------------------------------------------------------------------------------

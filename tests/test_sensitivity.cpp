@@ -566,6 +566,22 @@ TEST(Sensitivity, AConstraintReadingACoMovingCoordinateIsInTheReach) {
   }
 }
 
+// A scene read twice: as it is (its reached kinds' own derivatives) and with its models along each parameter kept
+// whole (every constraint differenced from them: SceneOverrides::keep_sensitivity_models).
+std::pair<Scene, Scene> own_and_kept(const std::string& text, const std::string& path) {
+  SceneOverrides keep;
+  keep.keep_sensitivity_models = true;
+  return {parse_scene(text, path), parse_scene(text, path, {}, keep)};
+}
+
+// The sweeps of the two readings of own_and_kept() in `form`.
+std::pair<SensitivityTrace, SensitivityTrace> own_and_kept_sweeps(const std::pair<Scene, Scene>& scenes,
+                                                                    SensitivityForm form) {
+  SweepOptions a = scenes.first.sweep, b = scenes.second.sweep;
+  a.sensitivity_form = b.sensitivity_form = form;
+  return {sweep_sensitivities(*scenes.first.model, a), sweep_sensitivities(*scenes.second.model, b)};
+}
+
 // sensitivity_along() keeps of the four models along a parameter only the constraints it reaches
 // (keep_reached_only()): the sweeps give the same bits as with the models kept, in both forms, a curve's co-moving
 // parameter included; where the reached kinds differentiate their own data (the driver's law along ω), their rates
@@ -644,19 +660,15 @@ TEST(Sensitivity, KindsThatDifferentiateTheirDataAreExactAtAnyStep) {
                                                  "sensitivities: [{parameter: L2, step: 0.015}, {parameter: L3, step: 0.05}]");
   for (const std::string& text : {std::string(kCrankSlider), coarse}) {
     const bool large = text == coarse;
-    const Scene s = parse_scene(text, "crank_slider.yaml");
-    SceneOverrides keep;
-    keep.keep_sensitivity_models = true;
-    const Scene kept = parse_scene(text, "crank_slider.yaml", {}, keep);
+    const auto scenes = own_and_kept(text, "crank_slider.yaml");
+    const Scene& s = scenes.first;
     for (const OutputSensitivity& p : s.sweep.sensitivities) {
       ASSERT_TRUE(p.reached) << p.name;
       ASSERT_EQ(p.reached->rates.size(), 1u) << p.name;  // one constraint each: the crank, the rod
       EXPECT_NE(p.reached->rates[0], nullptr) << p.name;
     }
     for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
-      SweepOptions a = s.sweep, b = kept.sweep;
-      a.sensitivity_form = b.sensitivity_form = form;
-      const SensitivityTrace exact = sweep_sensitivities(*s.model, a), differenced = sweep_sensitivities(*kept.model, b);
+      const auto [exact, differenced] = own_and_kept_sweeps(scenes, form);
       ASSERT_EQ(exact.s.size(), 91u);
       ASSERT_EQ(differenced.s.size(), 91u);
       const Index n = s.model->num_coordinates(), xb = s.model->coordinate_index("xB");
@@ -695,19 +707,15 @@ TEST(Sensitivity, ADriversLawIsDifferentiatedAlongItsData) {
   text = test::replace_first(text, "parameters: {L2: 0.3, L3: 1.0}", "parameters: {L2: 0.3, L3: 1.0, W: 2.0}");
   text = test::replace_first(text, "sensitivities: [L2, {parameter: L3, step: 1e-3}]",
                              "sensitivities: [{parameter: W, step: 0.2}]");
-  const Scene s = parse_scene(text, "swing.yaml");
-  SceneOverrides keep;
-  keep.keep_sensitivity_models = true;
-  const Scene kept = parse_scene(text, "swing.yaml", {}, keep);
+  const auto scenes = own_and_kept(text, "swing.yaml");
+  const Scene& s = scenes.first;
   const OutputSensitivity& w = s.sweep.sensitivities.at(0);
   ASSERT_TRUE(w.reached);
   ASSERT_EQ(w.reached->rates.size(), 1u);  // the driver alone
   EXPECT_NE(w.reached->rates[0], nullptr);
   const double A = 1.2, W = 2.0;
   for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
-    SweepOptions a = s.sweep, b = kept.sweep;
-    a.sensitivity_form = b.sensitivity_form = form;
-    const SensitivityTrace exact = sweep_sensitivities(*s.model, a), differenced = sweep_sensitivities(*kept.model, b);
+    const auto [exact, differenced] = own_and_kept_sweeps(scenes, form);
     ASSERT_EQ(exact.s.size(), 91u);
     ASSERT_EQ(differenced.s.size(), 91u);
     const Index n = s.model->num_coordinates(), xb = s.model->coordinate_index("xB");
@@ -742,10 +750,8 @@ TEST(Sensitivity, SpatialJointsDifferentiateTheirDataThroughTheScene) {
   const std::string text = test::replace_first(
       test::slurp(model_path("spatial/rssr.yaml")), "output: {velocities: true, accelerations: true}",
       "output: {velocities: true, accelerations: true, sensitivities: [a, b, d, e, L]}");
-  const Scene s = parse_scene(text, "rssr.yaml");
-  SceneOverrides keep;
-  keep.keep_sensitivity_models = true;
-  const Scene kept = parse_scene(text, "rssr.yaml", {}, keep);
+  const auto scenes = own_and_kept(text, "rssr.yaml");
+  const Scene& s = scenes.first;
   ASSERT_EQ(s.sweep.sensitivities.size(), 5u);
   for (const OutputSensitivity& p : s.sweep.sensitivities) {
     ASSERT_TRUE(p.reached) << p.name;
@@ -753,9 +759,7 @@ TEST(Sensitivity, SpatialJointsDifferentiateTheirDataThroughTheScene) {
     for (const auto& r : p.reached->rates) EXPECT_NE(r, nullptr) << p.name;
   }
   for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
-    SweepOptions a = s.sweep, b = kept.sweep;
-    a.sensitivity_form = b.sensitivity_form = form;
-    const SensitivityTrace exact = sweep_sensitivities(*s.model, a), differenced = sweep_sensitivities(*kept.model, b);
+    const auto [exact, differenced] = own_and_kept_sweeps(scenes, form);
     ASSERT_EQ(exact.s.size(), 73u);
     ASSERT_EQ(differenced.s.size(), exact.s.size());
     double scale = 0.0, worst = 0.0;
