@@ -22,6 +22,7 @@
 #include "phiq/constraint_block.hpp"
 #include "phiq/model.hpp"
 #include "phiq/spatial_attachment.hpp"
+#include "phiq/kinds/loop.hpp"
 #include "phiq/kinds/spatial_joints.hpp"
 #include "phiq/types.hpp"
 #include "kind_checks.hpp"
@@ -293,8 +294,18 @@ template <std::size_t N>
 void MoveDatum(std::array<phiq::Attachment3, N>& x, const std::array<phiq::Attachment3, N>& r, double e) {
   for (std::size_t i = 0; i < N; ++i) MoveDatum(x[i], r[i], e);
 }
-// A joint's side as given is not read by its rows (its attachments are): it does not move.
+// A joint's side as given is not read by its rows (its attachments are): it does not move; nor do the natural
+// points that kinds keep beside their attachments.
 inline void MoveDatum(phiq::JointSide3&, const phiq::JointSide3&, double) {}
+inline void MoveDatum(phiq::Point3&, const phiq::Point3&, double) {}
+// A loop's links: constant lengths and angle terms, offsets and factors (coordinates are no data).
+inline void MoveDatum(std::vector<phiq::LoopSpec::Link>& x, const std::vector<phiq::LoopSpec::Link>& r, double e) {
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    MoveDatum(x[i].length, r[i].length, e), MoveDatum(x[i].offset, r[i].offset, e);
+    for (std::size_t j = 0; j < x[i].terms.size(); ++j)
+      MoveDatum(x[i].terms[j].angle, r[i].terms[j].angle, e), MoveDatum(x[i].terms[j].sign, r[i].terms[j].sign, e);
+  }
+}
 // A law moved along its rate (MotionLaw::rate_along: a law too): f + e ∂f/∂p.
 inline void MoveDatum(phiq::MotionLaw& x, const phiq::MotionLaw& r, double e) {
   x = phiq::MotionLaw::sum({{1.0, x}, {e, r}});

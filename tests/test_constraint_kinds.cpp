@@ -346,7 +346,8 @@ TEST(ConstraintKinds, PolarAlongItsData) {
 
 // ---- LoopSpec -------------------------------------------------------------------------------------------------
 
-TEST(ConstraintKinds, LoopWithSliderNegativeSignsAndOffsets) {
+// A loop with every kind of link: a slider, negative signs, offsets, a constant angle term, a fixed link.
+phiq::LoopSpec SliderLoop() {
   using Link = phiq::LoopSpec::Link;
   phiq::LoopSpec loop;
   loop.links = {
@@ -360,7 +361,26 @@ TEST(ConstraintKinds, LoopWithSliderNegativeSignsAndOffsets) {
       Link{C(0.35), -2.0, {}},
   };
   loop.closure = {0.9, -0.2};
-  CheckSpec(loop, 3, Opts(801));
+  return loop;
+}
+
+TEST(ConstraintKinds, LoopWithSliderNegativeSignsAndOffsets) { CheckSpec(SliderLoop(), 3, Opts(801)); }
+
+TEST(ConstraintKinds, LoopAlongItsData) {
+  // every datum a loop has: constant lengths, offsets, a constant angle term, the terms' factors, the closure; a
+  // slider's travel (a coordinate) is no datum
+  using Link = phiq::LoopSpec::Link;
+  const phiq::LoopSpec loop = SliderLoop();
+  phiq::LoopSpec rate;
+  rate.links = {
+      Link{C(0.8), 0.2, {{C(0.0), 0.0}}},
+      Link{C(-0.5), 0.7, {{C(0.0), 0.3}, {C(0.0), 0.0}}},
+      Link{C(0.0), -0.4, {{C(0.0), 0.0}, {C(0.0), 0.0}, {C(0.0), -0.2}}},
+      Link{C(1.1), 0.0, {{C(0.6), 0.4}, {C(0.0), 0.0}}},
+      Link{C(0.3), 0.9, {}},
+  };
+  rate.closure = {-0.7, 0.4};
+  CheckDataDerivative(loop, rate, 3, 811);
 }
 
 TEST(ConstraintKinds, LoopRelativeFourBar) {
@@ -462,6 +482,9 @@ TEST(ConstraintKinds, CouplerOfTwoCoordinates) {
   phiq::CouplerSpec c{S(2), S(0), -0.3, 1.7, 0.25};
   CheckSpec(c, 3, Opts(1101));
   phiq::CouplerSpec gear{S(0), S(1), 0.1, 0.05, 0.0};  // an external gear pair, pitch radii 0.1 and 0.05
+  // along its data: the coefficients (a negative a too) and the constant
+  CheckDataDerivative(c, phiq::CouplerSpec{S(2), S(0), 0.4, -0.9, 1.3}, 3, 1111);
+  CheckDataDerivative(gear, phiq::CouplerSpec{S(0), S(1), 0.02, -0.01, 0.0}, 2, 1112);
   CheckSpec(gear, 2, Opts(1102));
 }
 

@@ -278,6 +278,23 @@ TEST(ConstraintKinds3d, DotOfVectorsAndSegments) {
   vs.end_units[0] = phiq::Unit::kNone;
   vs.value = -0.8, vs.ref = 1.3;
   CheckSpec(vs, kN, Opts(421));
+  // along its data: c, ref, and the ends' data (the natural ends' none; a body's axis and a ground point)
+  std::mt19937 rng(422);
+  phiq::DotSpec rate = vs;
+  for (Attachment3& e : rate.ends) e = RandomAttachmentRate(rng);
+  rate.value = 0.7, rate.ref = -0.4;
+  CheckDataDerivative(vs, rate, kN, 423);
+  phiq::DotSpec bodies;  // a body's axis across a segment from a ground point to a body's point
+  bodies.ends[0] = Attachment3::body_vector(Body(0), V3{0.3, -0.6, 0.2}), bodies.ends[1] = Attachment3::zero();
+  bodies.ends[2] = Attachment3::body_point(Body(7), V3{0.5, 0.1, -0.4});
+  bodies.ends[3] = Attachment3::body_point(Frame3::ground(), V3{-0.2, 0.9, 0.3});
+  bodies.end_units[0] = phiq::Unit::kNone;
+  bodies.value = 0.1, bodies.ref = 0.9;
+  CheckSpec(bodies, kN, Opts(424));
+  rate = bodies;
+  for (Attachment3& e : rate.ends) e = RandomAttachmentRate(rng);
+  rate.value = -0.3, rate.ref = 0.2;
+  CheckDataDerivative(bodies, rate, kN, 425);
 }
 
 // ---- drivers ------------------------------------------------------------------------------------------------------

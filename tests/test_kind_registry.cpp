@@ -63,11 +63,11 @@ TEST(KindRegistry, EveryKindThatDifferentiatesItsDataHasACheckOfIt) {
   EXPECT_TRUE(missing.empty()) << "kinds without a CheckDataDerivative test: " << ::testing::PrintToString(missing);
   EXPECT_EQ(differentiating,
             (std::vector<std::string>{
-                "distance", "pin", "point_on_line", "constant_angle", "angle", "polar", "prismatic", "equation",
-                "driver",  // planar
-                "distance", "spherical", "revolute", "prismatic", "cylindrical", "universal", "planar", "rigid",
+                "distance", "pin", "point_on_line", "constant_angle", "angle", "polar", "prismatic", "loop",
+                "equation", "coupler", "driver",  // planar
+                "distance", "dot", "spherical", "revolute", "prismatic", "cylindrical", "universal", "planar", "rigid",
                 "point_on_line", "point_on_plane", "joint_distance_driver", "joint_angle_driver",  // spatial
-                "gear", "rack_pinion", "belt", "screw"}));  // transmissions
+                "gear", "rack_pinion", "belt", "screw", "spatial_gear", "polar3", "angle3"}));  // transmissions, mixed
 }
 
 TEST(KindRegistry, EverySceneExampleIsDocumentedInTheModelsReadme) {

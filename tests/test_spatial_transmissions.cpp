@@ -49,18 +49,25 @@ TEST(SpatialTransmissions, ScrewDerivatives) {
   }
 }
 
+// `s` with every attachment's data moving at random rates (r̂, p̂ read where the slots are constants, ŝ).
+template <class Spec>
+Spec WithRandomAttachmentRates(const Spec& s, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Spec r = s;
+  for (Attachment3& a : r.att) {
+    for (Slot& k : a.r) k = Slot::constant(u(rng));
+    for (Slot& k : a.p) k = Slot::constant(u(rng));
+    a.s = Random(rng);
+  }
+  return r;
+}
+
 TEST(SpatialTransmissions, ScrewAlongItsData) {
   // the sides' attachments (points, axes, reference directions, a ground's place) and the pitch move
   std::mt19937 rng(2725);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   auto rate_of = [&](const ScrewSpec& s) {
-    ScrewSpec r = s;
-    for (Attachment3& a : r.att) {
-      for (Slot& k : a.r) k = Slot::constant(u(rng));
-      for (Slot& k : a.p) k = Slot::constant(u(rng));
-      a.s = Random(rng);
-    }
-    r.pitch = 7.0 * u(rng);
+    ScrewSpec r = WithRandomAttachmentRates(s, rng);
+    r.pitch = 7.0 * std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
     return r;
   };
   for (double pitch : {50.0, -80.0}) {
@@ -86,6 +93,29 @@ TEST(SpatialTransmissions, SpatialGearDerivatives) {
   CheckSpec(g, kN, Opts(2733));
 }
 
+TEST(SpatialTransmissions, SpatialGearAlongItsData) {
+  // the shafts' attachments (housings, a ground's place and axes), the tooth counts and the phase
+  std::mt19937 rng(2734);
+  SpatialGearSpec g;
+  g.a1 = Side(Frame3::ground(), rng), g.b1 = Side(Body(0), rng);
+  g.a2 = Side(Body(0), rng), g.b2 = Side(Body(7), rng);
+  g.theta1 = S(20), g.theta2 = S(21), g.z1 = 15, g.z2 = 40, g.phase = 0.3;
+  g.setup();
+  for (bool reversed : {false, true}) {
+    g.reversed = reversed;
+    SpatialGearSpec rate = g;
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (auto* att : {&rate.att1, &rate.att2})
+      for (Attachment3& a : *att) {
+        for (Slot& k : a.r) k = Slot::constant(u(rng));
+        for (Slot& k : a.p) k = Slot::constant(u(rng));
+        a.s = Random(rng);
+      }
+    rate.z1 = 2.0, rate.z2 = -3.0, rate.phase = 0.8;
+    CheckDataDerivative(g, rate, kN, reversed ? 2736 : 2735);
+  }
+}
+
 TEST(SpatialTransmissions, MixedCoordinateDerivatives) {
   std::mt19937 rng(2741);
   SpatialPolarSpec p;
@@ -104,6 +134,31 @@ TEST(SpatialTransmissions, MixedCoordinateDerivatives) {
   seg.segment = true, seg.a = Side(Body(7), rng), seg.from = Nat(14), seg.to = Nat(17), seg.theta = S(21);
   seg.setup();
   CheckSpec(seg, kN, Opts(2745));
+}
+
+TEST(SpatialTransmissions, MixedCoordinatesAlongTheirData) {
+  std::mt19937 rng(2751);
+  // the 3D polar: the centre's side through its attachments, the radius; then a constant θ that turns
+  SpatialPolarSpec p;
+  p.center = Side(Body(0), rng), p.point = Nat(14), p.radius = 0.6, p.theta = S(20);
+  p.setup();
+  SpatialPolarSpec rate = WithRandomAttachmentRates(p, rng);
+  rate.radius = -0.4, rate.theta = Slot::constant(0.0);
+  CheckDataDerivative(p, rate, kN, 2752);
+  p.center = Side(Frame3::ground(), rng), p.radius = -1.3, p.theta = Slot::constant(0.7);
+  p.setup();
+  rate = WithRandomAttachmentRates(p, rng);
+  rate.radius = 0.9, rate.theta = Slot::constant(1.2);
+  CheckDataDerivative(p, rate, kN, 2753);
+  // the rotation and segment angles, through their attachments
+  SpatialAngleSpec r;
+  r.a = Side(Body(0), rng), r.b = Side(Body(7), rng), r.theta = S(20);
+  r.setup();
+  CheckDataDerivative(r, WithRandomAttachmentRates(r, rng), kN, 2754);
+  SpatialAngleSpec seg;
+  seg.segment = true, seg.a = Side(Frame3::ground(), rng), seg.from = Nat(14), seg.to = Nat(17), seg.theta = S(21);
+  seg.setup();
+  CheckDataDerivative(seg, WithRandomAttachmentRates(seg, rng), kN, 2755);
 }
 
 TEST(SpatialTransmissions, ScrewRisesOnePitchPerTurn) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cmath>
+#include <tuple>
 
 #include "phiq/kinds/kind_support.hpp"
 
@@ -64,6 +65,17 @@ struct CouplerSpec {
   /// @copydoc DistanceSpec::gamma
   /// Φ is linear in q: γ = 0.
   void gamma(const double*, const double*, double, double* out) const { out[0] = 0.0; }
+  /// The data a parameter may move (DistanceSpec::data_members()): the coefficients and the constant.
+  static constexpr auto data_members() { return std::tuple{&CouplerSpec::a, &CouplerSpec::b, &CouplerSpec::c}; }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). Φ⁽ᵏ⁾ = (a q_i⁽ᵏ⁾ + b q_j⁽ᵏ⁾ − c δ_k0) / |a|, so
+  /// ∂Φ⁽ᵏ⁾/∂p = (â q_i⁽ᵏ⁾ + b̂ q_j⁽ᵏ⁾ − ĉ δ_k0) / |a| − Φ⁽ᵏ⁾ â / a (|a| moves as sign(a) â).
+  void data_derivative(const CouplerSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
+    const double* v = order == 0 ? q : order == 1 ? qd : qdd;
+    const double x = first.of(v), y = second.of(v), k0 = order == 0 ? 1.0 : 0.0;  // both are coordinates
+    const double phi = (a * x + b * y - k0 * c) / std::fabs(a);
+    out[0] = (rate.a * x + rate.b * y - k0 * rate.c) / std::fabs(a) - phi * rate.a / a;
+  }
 
   /// @copydoc DistanceSpec::joint_count
   /// Between the angles (or an angle and a travel) of two bodies, a coupler is a gear pair or rack and pinion: a

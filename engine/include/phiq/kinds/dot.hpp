@@ -4,7 +4,9 @@
 /// is documented on DistanceSpec, and kinds/registry.hpp lists every kind.
 #pragma once
 
+#include <array>
 #include <cmath>
+#include <tuple>
 
 #include "phiq/kinds/spatial_joints.hpp"  // detail3: the row formulas
 #include "phiq/spatial_attachment.hpp"
@@ -23,7 +25,7 @@ struct DotSpec {
   static constexpr int kRows = 1;  ///< one row, unitless
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "dot";
-  Attachment3 ends[4];  ///< D1 = ends[0] − ends[1], D2 = ends[2] − ends[3]
+  std::array<Attachment3, 4> ends;  ///< D1 = ends[0] − ends[1], D2 = ends[2] − ends[3]
   Unit end_units[2] = {Unit::kLength, Unit::kLength};  ///< what D1's and D2's ends measure (kNone for vectors)
   double value = 0.0;  ///< c, in the product of the directions' units
   double ref = 1.0;    ///< set by ModelBuilder::add from the initial placement
@@ -41,18 +43,31 @@ struct DotSpec {
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double, double* phi) const {
-    phi[0] = detail3::row_value(ends, kDef, q, 1.0 / ref, value);
+    phi[0] = detail3::row_value(ends.data(), kDef, q, 1.0 / ref, value);
   }
   /// @copydoc DistanceSpec::jacobian
   template <class Sink>
   void jacobian(const double* q, double, Sink& s) const {
-    detail3::row_jacobian(ends, kDef, q, s, 0, 1.0 / ref);
+    detail3::row_jacobian(ends.data(), kDef, q, s, 0, 1.0 / ref);
   }
   /// @copydoc DistanceSpec::phi_t
   void phi_t(const double*, double, double* out) const { out[0] = 0.0; }
   /// @copydoc DistanceSpec::gamma
   void gamma(const double* q, const double* qd, double, double* out) const {
-    out[0] = detail3::row_gamma(ends, kDef, q, qd, 1.0 / ref);
+    out[0] = detail3::row_gamma(ends.data(), kDef, q, qd, 1.0 / ref);
+  }
+  /// The data a parameter may move (DistanceSpec::data_members()): the directions' ends (local points and axes, a
+  /// fixed end's place), c, and ref (the row's scale, from the placement).
+  static constexpr auto data_members() { return std::tuple{&DotSpec::ends, &DotSpec::value, &DotSpec::ref}; }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). With P⁽ᵏ⁾ the k-th time derivative of D1 · D2 and
+  /// P̂⁽ᵏ⁾ its derivative along the ends (detail3::row_data_derivative()), Φ⁽ᵏ⁾ = (P⁽ᵏ⁾ − c δ_k0) / ref and
+  ///   ∂Φ⁽ᵏ⁾/∂p = (P̂⁽ᵏ⁾ − ĉ δ_k0) / ref − Φ⁽ᵏ⁾ ref̂ / ref.
+  void data_derivative(const DotSpec& rate, int order, const double* q, const double* qd, const double* qdd, double,
+                       double* out) const {
+    const double k0 = order == 0 ? 1.0 : 0.0;
+    const double phi = (detail3::row_time_derivative(ends.data(), kDef, order, q, qd, qdd) - k0 * value) / ref;
+    const double along = detail3::row_data_derivative(ends.data(), rate.ends.data(), kDef, order, q, qd, qdd);
+    out[0] = (along - k0 * rate.value) / ref - phi * rate.ref / ref;
   }
 
 

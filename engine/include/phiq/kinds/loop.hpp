@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cmath>
+#include <tuple>
+#include <array>
 #include <vector>
 
 #include "phiq/kinds/kind_support.hpp"
@@ -116,6 +118,49 @@ struct LoopSpec {
     out[0] = gx;
     out[1] = gy;
   }
+  /// The data a parameter may move (DistanceSpec::data_members()): the links (constant lengths, offsets, constant
+  /// angle terms and their factors) and the closure vector.
+  static constexpr auto data_members() { return std::tuple{&LoopSpec::links, &LoopSpec::closure}; }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). Per link, with u = (cos θ, sin θ), u⊥ its turn
+  /// by +90°, ω = θ̇ and α = θ̈ (Σ sign · q̇, q̈), and the data's rates ℓ̂ (a constant length), θ̂ = ô + Σ (ŝign q +
+  /// sign q̂) (q̂ of a constant angle), ∂ω = Σ ŝign q̇, ∂α = Σ ŝign q̈:
+  ///
+  ///   ∂Φ/∂p = Σ ℓ̂ u + ℓ θ̂ u⊥ − ĉ,   ∂(Φq q̇)/∂p = Σ ℓ̇ θ̂ u⊥ + (ℓ̂ ω + ℓ ∂ω) u⊥ − ℓ ω θ̂ u,
+  ///   ∂(Φq q̈ − γ)/∂p = Σ ℓ̈ θ̂ u⊥ + 2 ℓ̇ (∂ω u⊥ − ω θ̂ u) + ℓ̂ (α u⊥ − ω² u) + ℓ (∂α u⊥ − 2 ω ∂ω u)
+  ///                    − ℓ θ̂ (α u + ω² u⊥).
+  /// @pre `rate` has the links and terms of this loop (what datum_rate() makes).
+  void data_derivative(const LoopSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
+    kin::V2 sum = order == 0 ? -1.0 * rate.closure : kin::V2{0, 0};
+    for (std::size_t i = 0; i < links.size(); ++i) {
+      const Link& k = links[i];
+      const Link& r = rate.links[i];
+      const double th = angle_of(k, q), l = k.length.of(q);
+      const double lh = k.length.is_coordinate() ? 0.0 : r.length.value();
+      double thh = r.offset, dw = 0.0, da = 0.0;
+      for (std::size_t j = 0; j < k.terms.size(); ++j) {
+        const Term& t = k.terms[j];
+        const Term& tr = r.terms[j];
+        thh += tr.sign * t.angle.of(q) + (t.angle.is_coordinate() ? 0.0 : t.sign * tr.angle.value());
+        if (order >= 1) dw += tr.sign * t.angle.rate(qd);
+        if (order == 2) da += tr.sign * t.angle.rate(qdd);
+      }
+      const kin::V2 u{std::cos(th), std::sin(th)}, up = kin::perp(u);
+      if (order == 0) {
+        sum = sum + lh * u + (l * thh) * up;
+        continue;
+      }
+      const double w = rate_of(k, qd), ld = k.length.rate(qd);
+      if (order == 1) {
+        sum = sum + (ld * thh + lh * w + l * dw) * up - (l * w * thh) * u;
+        continue;
+      }
+      const double al = rate_of(k, qdd), ldd = k.length.rate(qdd);
+      sum = sum + (ldd * thh + 2.0 * ld * dw + lh * al + l * da - l * thh * w * w) * up -
+            (2.0 * ld * w * thh + lh * w * w + 2.0 * l * w * dw + l * thh * al) * u;
+    }
+    out[0] = sum.x, out[1] = sum.y;
+  }
 
   /// @copydoc DistanceSpec::joint_count
   JointCount joint_count() const { return JointCount::other(); }
@@ -153,5 +198,30 @@ struct LoopSpec {
     return spec;
   }
 };
+
+/// The rates of a loop's links along a design parameter (detail::datum_rate, LoopSpec::data_derivative()): link by
+/// link its length's (a constant's rate, a coordinate none), its offset's, and its terms' angles and factors; false
+/// where the four loops differ in links or terms.
+inline bool datum_rate(std::vector<LoopSpec::Link>& rate, const std::array<const std::vector<LoopSpec::Link>*, 4>& v,
+                       double h) {
+  for (const auto* links : v)
+    if (links->size() != rate.size()) return false;
+  for (std::size_t i = 0; i < rate.size(); ++i) {
+    LoopSpec::Link& r = rate[i];
+    auto at = [&](std::size_t k) -> const LoopSpec::Link& { return (*v[k])[i]; };
+    for (std::size_t k = 0; k < 4; ++k)
+      if (at(k).terms.size() != r.terms.size()) return false;
+    if (!detail::datum_rate(r.length, {&at(0).length, &at(1).length, &at(2).length, &at(3).length}, h) ||
+        !detail::datum_rate(r.offset, {&at(0).offset, &at(1).offset, &at(2).offset, &at(3).offset}, h))
+      return false;
+    for (std::size_t j = 0; j < r.terms.size(); ++j) {
+      auto term = [&](std::size_t k) -> const LoopSpec::Term& { return at(k).terms[j]; };
+      if (!detail::datum_rate(r.terms[j].angle, {&term(0).angle, &term(1).angle, &term(2).angle, &term(3).angle}, h) ||
+          !detail::datum_rate(r.terms[j].sign, {&term(0).sign, &term(1).sign, &term(2).sign, &term(3).sign}, h))
+        return false;
+    }
+  }
+  return true;
+}
 
 }  // namespace phiq

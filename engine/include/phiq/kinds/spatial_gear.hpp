@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cmath>
+#include <tuple>
 
 #include "phiq/kinds/spatial_joints.hpp"
 #include "phiq/kinds/kind_support.hpp"
@@ -95,6 +96,24 @@ struct SpatialGearSpec {
     out[0] = -kAngle.bias(att1.data(), q, qd);
     out[1] = -kAngle.bias(att2.data(), q, qd);
     out[2] = 0.0;
+  }
+  /// The data a parameter may move (DistanceSpec::data_members()): the shafts' sides through their attachments, the
+  /// tooth counts and the phase.
+  static constexpr auto data_members() {
+    return std::tuple{&SpatialGearSpec::a1, &SpatialGearSpec::b1, &SpatialGearSpec::a2, &SpatialGearSpec::b2,
+                      &SpatialGearSpec::z1, &SpatialGearSpec::z2, &SpatialGearSpec::phase, &SpatialGearSpec::att1,
+                      &SpatialGearSpec::att2};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): the shafts' angles along their attachments
+  /// (detail3::AngleRows::data_derivative()); the ratio row θ1 + k θ2 − φ, k = ±z2/z1, as k̂ θ2⁽ⁿ⁾ − φ̂ δ_n0 with
+  /// k̂ = ±(ẑ2 z1 − z2 ẑ1)/z1².
+  void data_derivative(const SpatialGearSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
+    out[0] = kAngle.data_derivative(att1.data(), rate.att1.data(), order, q, qd, qdd);
+    out[1] = kAngle.data_derivative(att2.data(), rate.att2.data(), order, q, qd, qdd);
+    const double kh = (reversed ? -1.0 : 1.0) * (rate.z2 * z1 - z2 * rate.z1) / (z1 * z1);
+    const double* v = order == 0 ? q : order == 1 ? qd : qdd;
+    out[2] = kh * theta2.of(v) - (order == 0 ? rate.phase : 0.0);  // θ2 is a coordinate
   }
   /// @copydoc DistanceSpec::joint_count
   /// Two angle coordinates and their rows count for nothing; the mesh removes one freedom.

@@ -352,6 +352,13 @@ bool datum_rate(std::array<Attachment3, N>& rate, const std::array<const std::ar
 /// they carry the side's rates (a side that turns from a body to ground changes their slots and is refused there).
 /// The side's "rate" is left as the side itself, and never read.
 inline bool datum_rate(JointSide3&, const std::array<const JointSide3*, 4>&, double) { return true; }
+/// The rates of a spatial point's slots (detail::datum_rate): a natural point's coordinates have none, a fixed
+/// component its constant's.
+inline bool datum_rate(Point3& rate, const std::array<const Point3*, 4>& v, double h) {
+  return detail::datum_rate(rate.x, {&v[0]->x, &v[1]->x, &v[2]->x, &v[3]->x}, h) &&
+         detail::datum_rate(rate.y, {&v[0]->y, &v[1]->y, &v[2]->y, &v[3]->y}, h) &&
+         detail::datum_rate(rate.z, {&v[0]->z, &v[1]->z, &v[2]->z, &v[3]->z}, h);
+}
 
 /// A spatial joint between two sides, its rows given by `Traits` (one struct per joint type below). The sides
 /// are data; setup() (called by ModelBuilder::add, or by hand before evaluating a spec built in code) validates

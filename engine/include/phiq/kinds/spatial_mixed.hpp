@@ -13,6 +13,7 @@
 #include <cmath>
 #include <array>
 #include <string>
+#include <tuple>
 
 #include "phiq/kinds/spatial_joints.hpp"
 #include "phiq/kinds/kind_support.hpp"
@@ -101,6 +102,47 @@ struct SpatialPolarSpec {
       out[k] = detail3::row_gamma(a, dp, q, qd, 1.0) + detail3::row_gamma(a, dx, q, qd, -rc) +
                detail3::row_gamma(a, dy, q, qd, -rs) + 2.0 * w * (-rs * xd + rc * yd) -
                w * w * (rc * value(3 + k, q) + rs * value(6 + k, q));
+    }
+  }
+  /// The data a parameter may move (DistanceSpec::data_members()): the centre's side and the point through the
+  /// attachments, the radius, and a constant θ.
+  static constexpr auto data_members() {
+    return std::tuple{&SpatialPolarSpec::center, &SpatialPolarSpec::point, &SpatialPolarSpec::radius,
+                      &SpatialPolarSpec::theta, &SpatialPolarSpec::att};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). Row k is V − ρc X − ρs Y (V = P − P_a, X = x_a,
+  /// Y = y_a, their k-th components; ρc = r cos θ, ρs = r sin θ), so with Leibniz's rule
+  ///   Φ⁽ⁿ⁾ = V⁽ⁿ⁾ − Σ_i C(n, i) (ρc⁽ⁱ⁾ X⁽ⁿ⁻ⁱ⁾ + ρs⁽ⁱ⁾ Y⁽ⁿ⁻ⁱ⁾),   ρc′ = −ω ρs, ρs′ = ω ρc, ρc″ = −ω² ρc − α ρs,
+  /// ρs″ = −ω² ρs + α ρc; along the data V̂, X̂, Ŷ come from the attachments (detail3::row_data_derivative()) and
+  /// (ρ̂c, ρ̂s) = (r̂/r) (ρc, ρs) + θ̂ (−ρs, ρc) (θ̂ of a constant θ), their time derivatives by the same rule.
+  void data_derivative(const SpatialPolarSpec& rate, int order, const double* q, const double* qd,
+                       const double* qdd, double, double* out) const {
+    const double th = theta.of(q), w = order >= 1 ? theta.rate(qd) : 0.0, al = order == 2 ? theta.rate(qdd) : 0.0;
+    const double rc = radius * std::cos(th), rs = radius * std::sin(th);
+    const double thh = theta.is_coordinate() ? 0.0 : rate.theta.value(), rr = rate.radius / radius;
+    // (ρc, ρs) and their first two time derivatives, for the values and for their rates along the data
+    auto motion = [&](double c, double s, double mc[3], double ms[3]) {
+      mc[0] = c, ms[0] = s;
+      mc[1] = -w * s, ms[1] = w * c;
+      mc[2] = -w * w * c - al * s, ms[2] = -w * w * s + al * c;
+    };
+    double mc[3], ms[3], hc[3], hs[3];
+    motion(rc, rs, mc, ms);
+    motion(rr * rc - thh * rs, rr * rs + thh * rc, hc, hs);
+    static constexpr double kBinomial[3][3] = {{1, 0, 0}, {1, 1, 0}, {1, 2, 1}};
+    const Attachment3 *a = att.data(), *ra = rate.att.data();
+    for (int k = 0; k < 3; ++k) {
+      double d = detail3::row_data_derivative(a, ra, kCompact.rows[k], order, q, qd, qdd);
+      for (int i = 0; i <= order; ++i) {
+        const detail3::RowDef &dx = kCompact.rows[3 + k], &dy = kCompact.rows[6 + k];
+        const int j = order - i;
+        d -= kBinomial[order][i] *
+             (hc[i] * detail3::row_time_derivative(a, dx, j, q, qd, qdd) +
+              mc[i] * detail3::row_data_derivative(a, ra, dx, j, q, qd, qdd) +
+              hs[i] * detail3::row_time_derivative(a, dy, j, q, qd, qdd) +
+              ms[i] * detail3::row_data_derivative(a, ra, dy, j, q, qd, qdd));
+      }
+      out[k] = d;
     }
   }
   /// @copydoc DistanceSpec::joint_count
@@ -207,6 +249,18 @@ struct SpatialAngleSpec {
   /// θ̈ is in Φq q̈: γ = −(θ(D)̈'s q̈-free part).
   void gamma(const double* q, const double* qd, double, double* out) const {
     out[0] = -angle().bias(att.data(), q, qd);
+  }
+  /// The data a parameter may move (DistanceSpec::data_members()): the sides and the segment's ends, through the
+  /// attachments (θ is a coordinate).
+  static constexpr auto data_members() {
+    return std::tuple{&SpatialAngleSpec::a, &SpatialAngleSpec::b, &SpatialAngleSpec::from, &SpatialAngleSpec::to,
+                      &SpatialAngleSpec::att};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): θ(D)'s along the attachments
+  /// (detail3::AngleRows::data_derivative()).
+  void data_derivative(const SpatialAngleSpec& rate, int order, const double* q, const double* qd,
+                       const double* qdd, double, double* out) const {
+    out[0] = angle().data_derivative(att.data(), rate.att.data(), order, q, qd, qdd);
   }
   /// @copydoc DistanceSpec::joint_count
   /// A rotation angle between bodies adds a coordinate and the row that fixes it: it counts for no freedom, and
