@@ -306,6 +306,21 @@ inline void MoveDatum(std::vector<phiq::LoopSpec::Link>& x, const std::vector<ph
       MoveDatum(x[i].terms[j].angle, r[i].terms[j].angle, e), MoveDatum(x[i].terms[j].sign, r[i].terms[j].sign, e);
   }
 }
+// The rates of a spatial attachment's data along a parameter, at random in [−1, 1]: r̂, p̂ (read where the
+// attachment's slots are constants: a ground frame that moves and turns) and ŝ.
+inline phiq::Attachment3 RandomAttachmentRate(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  phiq::Attachment3 r;
+  for (Slot& k : r.r) k = Slot::constant(u(rng));
+  for (Slot& k : r.p) k = Slot::constant(u(rng));
+  r.s = phiq::kin3::V3{u(rng), u(rng), u(rng)};
+  return r;
+}
+// Every attachment of `att` at random rates (the rate spec of a spatial kind's attachments).
+template <std::size_t N>
+void RandomizeAttachmentRates(std::array<phiq::Attachment3, N>& att, std::mt19937& rng) {
+  for (phiq::Attachment3& a : att) a = RandomAttachmentRate(rng);
+}
 // A law moved along its rate (MotionLaw::rate_along: a law too): f + e ∂f/∂p.
 inline void MoveDatum(phiq::MotionLaw& x, const phiq::MotionLaw& r, double e) {
   x = phiq::MotionLaw::sum({{1.0, x}, {e, r}});

@@ -60,21 +60,11 @@ Spec Joint(const JointSide3& a, const JointSide3& b) {
   return s;
 }
 
-// The rates of an attachment's data along a parameter: r̂ and p̂ (read where its slots are constants: a ground
-// frame that moves and turns) and ŝ, random.
-phiq::Attachment3 RandomAttachmentRate(std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  phiq::Attachment3 r;
-  for (Slot& k : r.r) k = C(u(rng));
-  for (Slot& k : r.p) k = C(u(rng));
-  r.s = RandomVector(rng);
-  return r;
-}
 // A joint's derivatives along its data (CheckDataDerivative), every attachment moving at random rates.
 template <class Spec>
 void CheckJointAlongItsData(const Spec& joint, std::mt19937& rng, std::uint32_t seed) {
   Spec rate = joint;
-  for (phiq::Attachment3& a : rate.att) a = RandomAttachmentRate(rng);
+  RandomizeAttachmentRates(rate.att, rng);
   CheckDataDerivative(joint, rate, kN, seed, 3);
 }
 
@@ -248,8 +238,8 @@ TEST(ConstraintKinds3d, Distance) {
   std::mt19937 rng(414);
   phiq::SpatialDistanceSpec rate = between_points, body_rate = between_bodies;
   rate.length = -0.6, body_rate.length = 1.3;
-  for (phiq::Attachment3& e : rate.ends) e = RandomAttachmentRate(rng);
-  for (phiq::Attachment3& e : body_rate.ends) e = RandomAttachmentRate(rng);
+  RandomizeAttachmentRates(rate.ends, rng);
+  RandomizeAttachmentRates(body_rate.ends, rng);
   CheckDataDerivative(between_points, rate, kN, 412);
   CheckDataDerivative(between_bodies, body_rate, kN, 413);
   // a bar from a ground point that moves (folded into constants) to a body
@@ -259,7 +249,7 @@ TEST(ConstraintKinds3d, Distance) {
       1.1};
   grounded.prepare(nullptr);
   phiq::SpatialDistanceSpec ground_rate = grounded;
-  for (phiq::Attachment3& e : ground_rate.ends) e = RandomAttachmentRate(rng);
+  RandomizeAttachmentRates(ground_rate.ends, rng);
   ground_rate.length = 0.0;
   CheckDataDerivative(grounded, ground_rate, kN, 415);
 }
@@ -281,7 +271,7 @@ TEST(ConstraintKinds3d, DotOfVectorsAndSegments) {
   // along its data: c, ref, and the ends' data (the natural ends' none; a body's axis and a ground point)
   std::mt19937 rng(422);
   phiq::DotSpec rate = vs;
-  for (Attachment3& e : rate.ends) e = RandomAttachmentRate(rng);
+  RandomizeAttachmentRates(rate.ends, rng);
   rate.value = 0.7, rate.ref = -0.4;
   CheckDataDerivative(vs, rate, kN, 423);
   phiq::DotSpec bodies;  // a body's axis across a segment from a ground point to a body's point
@@ -292,7 +282,7 @@ TEST(ConstraintKinds3d, DotOfVectorsAndSegments) {
   bodies.value = 0.1, bodies.ref = 0.9;
   CheckSpec(bodies, kN, Opts(424));
   rate = bodies;
-  for (Attachment3& e : rate.ends) e = RandomAttachmentRate(rng);
+  RandomizeAttachmentRates(rate.ends, rng);
   rate.value = -0.3, rate.ref = 0.2;
   CheckDataDerivative(bodies, rate, kN, 425);
 }
@@ -310,14 +300,14 @@ TEST(ConstraintKinds3d, JointAngleDriver) {
   phiq::JointAngleDriverSpec rate = d;
   rate.law = phiq::MotionLaw::polynomial({0.3, -1.2, 0.5});
   CheckDataDerivative(d, rate, kN, 451);
-  for (phiq::Attachment3& e : rate.att) e = RandomAttachmentRate(rng);
+  RandomizeAttachmentRates(rate.att, rng);
   CheckDataDerivative(d, rate, kN, 454);
   d.a = GroundSide(rng);
   d.law = phiq::MotionLaw::polynomial({0.1, -3.0, 0.7});
   d.setup();
   CheckSpec(d, kN, Opts(432, true));
   rate = d;
-  for (phiq::Attachment3& e : rate.att) e = RandomAttachmentRate(rng);
+  RandomizeAttachmentRates(rate.att, rng);
   CheckDataDerivative(d, rate, kN, 455);
 }
 
@@ -334,7 +324,7 @@ TEST(ConstraintKinds3d, JointDistanceDriver) {
   phiq::JointDistanceDriverSpec rate = d;
   rate.law = phiq::MotionLaw::polynomial({0.2, 0.4});
   CheckDataDerivative(d, rate, kN, 452);
-  for (phiq::Attachment3& e : rate.att) e = RandomAttachmentRate(rng);
+  RandomizeAttachmentRates(rate.att, rng);
   CheckDataDerivative(d, rate, kN, 453);
 }
 

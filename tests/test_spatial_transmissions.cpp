@@ -52,13 +52,8 @@ TEST(SpatialTransmissions, ScrewDerivatives) {
 // `s` with every attachment's data moving at random rates (r̂, p̂ read where the slots are constants, ŝ).
 template <class Spec>
 Spec WithRandomAttachmentRates(const Spec& s, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
   Spec r = s;
-  for (Attachment3& a : r.att) {
-    for (Slot& k : a.r) k = Slot::constant(u(rng));
-    for (Slot& k : a.p) k = Slot::constant(u(rng));
-    a.s = Random(rng);
-  }
+  RandomizeAttachmentRates(r.att, rng);
   return r;
 }
 
@@ -104,13 +99,8 @@ TEST(SpatialTransmissions, SpatialGearAlongItsData) {
   for (bool reversed : {false, true}) {
     g.reversed = reversed;
     SpatialGearSpec rate = g;
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    for (auto* att : {&rate.att1, &rate.att2})
-      for (Attachment3& a : *att) {
-        for (Slot& k : a.r) k = Slot::constant(u(rng));
-        for (Slot& k : a.p) k = Slot::constant(u(rng));
-        a.s = Random(rng);
-      }
+    RandomizeAttachmentRates(rate.att1, rng);
+    RandomizeAttachmentRates(rate.att2, rng);
     rate.z1 = 2.0, rate.z2 = -3.0, rate.phase = 0.8;
     CheckDataDerivative(g, rate, kN, reversed ? 2736 : 2735);
   }

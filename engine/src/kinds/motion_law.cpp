@@ -5,6 +5,7 @@
 #include <limits>
 #include <unsupported/Eigen/Splines>
 
+#include "phiq/kinds/kind_support.hpp"
 #include "phiq/text.hpp"
 
 namespace phiq {
@@ -29,12 +30,10 @@ void require_finite(double v, const char* what) {
   if (!std::isfinite(v)) throw Error(std::string("motion law: ") + what + " is not finite");
 }
 
-// The fourth-order central difference of a datum over its values at p − 2h, p − h, p + h, p + 2h (the weights of
-// MotionLaw::rate_along's fallback, and detail::datum_rate's).
+// The weights of detail::central_difference() (kinds/kind_support.hpp), times h: MotionLaw::rate_along's fallback
+// sums the four laws with them.
 constexpr std::array<double, 4> kDifference{1.0 / 12.0, -8.0 / 12.0, 8.0 / 12.0, -1.0 / 12.0};
-double difference(double m2, double m1, double p1, double p2, double h) {
-  return ((m2 - p2) + 8.0 * (p1 - m1)) / (12.0 * h);
-}
+using detail::central_difference;
 // The four copies as the type T, or nulls where one is another kind.
 template <class T>
 std::array<const T*, 4> copies_as(const std::array<const MotionLaw::Impl*, 4>& along) {
@@ -71,7 +70,8 @@ struct Polynomial final : MotionLaw::Impl {
       if (p->c.size() != c.size()) return nullptr;
     auto r = std::make_shared<Polynomial>();
     r->c.resize(c.size());
-    for (std::size_t k = 0; k < c.size(); ++k) r->c[k] = difference(o[0]->c[k], o[1]->c[k], o[2]->c[k], o[3]->c[k], h);
+    for (std::size_t k = 0; k < c.size(); ++k)
+      r->c[k] = central_difference(o[0]->c[k], o[1]->c[k], o[2]->c[k], o[3]->c[k], h);
     return r;
   }
 };
@@ -111,7 +111,9 @@ std::shared_ptr<const MotionLaw::Impl> Harmonic::rate(const std::array<const Imp
   if (!all_of_kind(o)) return nullptr;
   auto r = std::make_shared<HarmonicRate>();
   r->at = *this;
-  const auto d = [&](double Harmonic::*m) { return difference(o[0]->*m, o[1]->*m, o[2]->*m, o[3]->*m, h); };
+  const auto d = [&](double Harmonic::*m) {
+    return central_difference(o[0]->*m, o[1]->*m, o[2]->*m, o[3]->*m, h);
+  };
   r->rate.offset = d(&Harmonic::offset);
   r->rate.amplitude = d(&Harmonic::amplitude);
   r->rate.omega = d(&Harmonic::omega);
@@ -157,8 +159,8 @@ struct Table final : MotionLaw::Impl {
         return nullptr;
     Spline::ControlPointVectorType rc(ctrls.rows(), ctrls.cols());
     for (Eigen::Index k = 0; k < ctrls.cols(); ++k)
-      rc(0, k) = difference(o[0]->spline.ctrls()(0, k), o[1]->spline.ctrls()(0, k), o[2]->spline.ctrls()(0, k),
-                            o[3]->spline.ctrls()(0, k), h);
+      rc(0, k) = central_difference(o[0]->spline.ctrls()(0, k), o[1]->spline.ctrls()(0, k),
+                                    o[2]->spline.ctrls()(0, k), o[3]->spline.ctrls()(0, k), h);
     auto r = std::make_shared<Table>();
     r->t0 = t0;
     r->t1 = t1;

@@ -9,6 +9,7 @@
 
 #include "phiq/output_plan.hpp"
 #include "phiq/evaluation.hpp"  // JacobianView: Φq over values held here
+#include "phiq/kinds/kind_support.hpp"  // detail::central_difference
 #include "phiq/text.hpp"
 #include "solve/factorisation.hpp"
 #include "solve/models_along.hpp"
@@ -25,7 +26,7 @@ constexpr std::array<double, 4> kWeight = {1.0, -8.0, 8.0, -1.0};
 // D f over the rows of `reach` into `d` (its other rows untouched), as differences of the pairs: exactly zero where
 // the four models agree.
 double difference_at(const std::array<Eigen::VectorXd, 4>& f, Index r, double h) {
-  return ((f[0][r] - f[3][r]) + 8.0 * (f[2][r] - f[1][r])) / (12.0 * h);
+  return detail::central_difference(f[0][r], f[1][r], f[2][r], f[3][r], h);
 }
 void difference_on(const ParameterReach& reach, const std::array<Eigen::VectorXd, 4>& f, double h, Eigen::VectorXd& d) {
   for (const Index r : reach.rows) d[r] = difference_at(f, r, h);

@@ -96,7 +96,7 @@ struct ConstantAngleSpec {
     kin::V2 du[3] = {u, {0, 0}, {0, 0}}, dv[3] = {v, {0, 0}, {0, 0}};
     if (order >= 1) du[1] = kin::vel(b, qd) - kin::vel(a, qd), dv[1] = kin::vel(d, qd) - kin::vel(c, qd);
     if (order == 2) du[2] = kin::vel(b, qdd) - kin::vel(a, qdd), dv[2] = kin::vel(d, qdd) - kin::vel(c, qdd);
-    static constexpr double kBinomial[3][3] = {{1, 0, 0}, {1, 1, 0}, {1, 2, 1}};
+    using detail::kBinomial;
     double value = 0.0, along_angle = 0.0;
     for (int i = 0; i <= order; ++i) {
       value += kBinomial[order][i] * B(du[i], dv[order - i]);

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <tuple>
 
-#include "phiq/kinds/spatial_joints.hpp"  // detail3: the row formulas
+#include "phiq/kinds/spatial_rows.hpp"  // detail3: the row formulas
 #include "phiq/spatial_attachment.hpp"
 #include "phiq/kinds/kind_support.hpp"
 
@@ -60,14 +60,14 @@ struct DotSpec {
   /// fixed end's place), c, and ref (the row's scale, from the placement).
   static constexpr auto data_members() { return std::tuple{&DotSpec::ends, &DotSpec::value, &DotSpec::ref}; }
   /// Derivatives along the data (DistanceSpec::data_derivative()). With P⁽ᵏ⁾ the k-th time derivative of D1 · D2 and
-  /// P̂⁽ᵏ⁾ its derivative along the ends (detail3::row_data_derivative()), Φ⁽ᵏ⁾ = (P⁽ᵏ⁾ − c δ_k0) / ref and
+  /// P̂⁽ᵏ⁾ its derivative along the ends (detail3::row_derivatives(), one pass), Φ⁽ᵏ⁾ = (P⁽ᵏ⁾ − c δ_k0) / ref and
   ///   ∂Φ⁽ᵏ⁾/∂p = (P̂⁽ᵏ⁾ − ĉ δ_k0) / ref − Φ⁽ᵏ⁾ ref̂ / ref.
   void data_derivative(const DotSpec& rate, int order, const double* q, const double* qd, const double* qdd, double,
                        double* out) const {
     const double k0 = order == 0 ? 1.0 : 0.0;
-    const double phi = (detail3::row_time_derivative(ends.data(), kDef, order, q, qd, qdd) - k0 * value) / ref;
-    const double along = detail3::row_data_derivative(ends.data(), rate.ends.data(), kDef, order, q, qd, qdd);
-    out[0] = (along - k0 * rate.value) / ref - phi * rate.ref / ref;
+    const detail3::RowDerivatives d = detail3::row_derivatives(ends.data(), rate.ends.data(), kDef, order, q, qd, qdd);
+    const double phi = (d.value[order] - k0 * value) / ref;
+    out[0] = (d.along[order] - k0 * rate.value) / ref - phi * rate.ref / ref;
   }
 
 

@@ -117,12 +117,21 @@ concept DataDifferentiable = requires(const K k, const double* q, double* out) {
 
 /// @cond internal
 namespace detail {
+// C(k, i) for k, i ≤ 2: Leibniz's rule for the time derivatives of a product, up to the second (the kinds'
+// derivatives along their data, data_derivative()).
+inline constexpr double kBinomial[3][3] = {{1, 0, 0}, {1, 1, 0}, {1, 2, 1}};
+// The fourth-order central difference of values at p − 2h, p − h, p + h, p + 2h, in pairs (exactly zero where the
+// four agree): what every rate along a design parameter is made of (the data's here, the laws' coefficients, the
+// rows a kind does not differentiate itself: sensitivity.cpp).
+inline double central_difference(double m2, double m1, double p1, double p2, double h) {
+  return ((m2 - p2) + 8.0 * (p1 - m1)) / (12.0 * h);
+}
 // The rates of a kind's data along a design parameter (DistanceSpec::data_derivative()), from its values in the
 // four models at p − 2h, p − h, p + h, p + 2h by the fourth-order central difference (sensitivity.hpp): one datum
 // of each type a kind lists in data_members(), `rate` holding the swept model's datum on entry. False where the
 // datum is not data that moves: a coordinate in one model and another slot in the next.
 inline bool datum_rate(double& rate, const std::array<const double*, 4>& v, double h) {
-  rate = ((*v[0] - *v[3]) + 8.0 * (*v[2] - *v[1])) / (12.0 * h);
+  rate = central_difference(*v[0], *v[1], *v[2], *v[3], h);
   return std::isfinite(rate);
 }
 // A constant's rate, as a constant slot; a coordinate's (the swept model's in the four), the constant 0: it is no

@@ -101,9 +101,10 @@ struct ScrewSpec {
     for (int r = 0; r < 4; ++r)
       out[r] = detail3::row_data_derivative(att.data(), rate.att.data(), kCompact.rows[r], order, q, qd, qdd);
     const double kh = -2.0 * std::numbers::pi * rate.pitch / (pitch * pitch);
-    out[4] = angle().data_derivative(att.data(), rate.att.data(), order, q, qd, qdd) -
-             kh * detail3::row_time_derivative(att.data(), kCompact.rows[6], order, q, qd, qdd) -
-             k() * detail3::row_data_derivative(att.data(), rate.att.data(), kCompact.rows[6], order, q, qd, qdd);
+    const detail3::RowDerivatives d =
+        detail3::row_derivatives(att.data(), rate.att.data(), kCompact.rows[6], order, q, qd, qdd);
+    out[4] = angle().data_derivative(att.data(), rate.att.data(), order, q, qd, qdd) - kh * d.value[order] -
+             k() * d.along[order];
   }
   /// @copydoc DistanceSpec::joint_count
   /// A screw between bodies or ground removes 5 freedoms (one left: the turn and travel together).

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <tuple>
 
-#include "phiq/kinds/spatial_joints.hpp"  // detail3: the row formulas
+#include "phiq/kinds/spatial_rows.hpp"  // detail3: the row formulas
 #include "phiq/spatial_attachment.hpp"
 #include "phiq/kinds/kind_support.hpp"
 

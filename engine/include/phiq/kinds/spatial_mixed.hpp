@@ -113,8 +113,9 @@ struct SpatialPolarSpec {
   /// Derivatives along the data (DistanceSpec::data_derivative()). Row k is V − ρc X − ρs Y (V = P − P_a, X = x_a,
   /// Y = y_a, their k-th components; ρc = r cos θ, ρs = r sin θ), so with Leibniz's rule
   ///   Φ⁽ⁿ⁾ = V⁽ⁿ⁾ − Σ_i C(n, i) (ρc⁽ⁱ⁾ X⁽ⁿ⁻ⁱ⁾ + ρs⁽ⁱ⁾ Y⁽ⁿ⁻ⁱ⁾),   ρc′ = −ω ρs, ρs′ = ω ρc, ρc″ = −ω² ρc − α ρs,
-  /// ρs″ = −ω² ρs + α ρc; along the data V̂, X̂, Ŷ come from the attachments (detail3::row_data_derivative()) and
-  /// (ρ̂c, ρ̂s) = (r̂/r) (ρc, ρs) + θ̂ (−ρs, ρc) (θ̂ of a constant θ), their time derivatives by the same rule.
+  /// ρs″ = −ω² ρs + α ρc; along the data V̂, X̂, Ŷ come from the attachments (detail3::row_derivatives(), one pass
+  /// a row) and (ρ̂c, ρ̂s) = (r̂/r) (ρc, ρs) + θ̂ (−ρs, ρc) (θ̂ of a constant θ), their time derivatives by the same
+  /// rule.
   void data_derivative(const SpatialPolarSpec& rate, int order, const double* q, const double* qd,
                        const double* qdd, double, double* out) const {
     const double th = theta.of(q), w = order >= 1 ? theta.rate(qd) : 0.0, al = order == 2 ? theta.rate(qdd) : 0.0;
@@ -129,18 +130,16 @@ struct SpatialPolarSpec {
     double mc[3], ms[3], hc[3], hs[3];
     motion(rc, rs, mc, ms);
     motion(rr * rc - thh * rs, rr * rs + thh * rc, hc, hs);
-    static constexpr double kBinomial[3][3] = {{1, 0, 0}, {1, 1, 0}, {1, 2, 1}};
+    using detail::kBinomial;
     const Attachment3 *a = att.data(), *ra = rate.att.data();
     for (int k = 0; k < 3; ++k) {
       double d = detail3::row_data_derivative(a, ra, kCompact.rows[k], order, q, qd, qdd);
+      const detail3::RowDerivatives x = detail3::row_derivatives(a, ra, kCompact.rows[3 + k], order, q, qd, qdd);
+      const detail3::RowDerivatives y = detail3::row_derivatives(a, ra, kCompact.rows[6 + k], order, q, qd, qdd);
       for (int i = 0; i <= order; ++i) {
-        const detail3::RowDef &dx = kCompact.rows[3 + k], &dy = kCompact.rows[6 + k];
         const int j = order - i;
         d -= kBinomial[order][i] *
-             (hc[i] * detail3::row_time_derivative(a, dx, j, q, qd, qdd) +
-              mc[i] * detail3::row_data_derivative(a, ra, dx, j, q, qd, qdd) +
-              hs[i] * detail3::row_time_derivative(a, dy, j, q, qd, qdd) +
-              ms[i] * detail3::row_data_derivative(a, ra, dy, j, q, qd, qdd));
+             (hc[i] * x.value[j] + mc[i] * x.along[j] + hs[i] * y.value[j] + ms[i] * y.along[j]);
       }
       out[k] = d;
     }
