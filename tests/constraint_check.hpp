@@ -328,6 +328,13 @@ inline void MoveDatum(phiq::MotionLaw& x, const phiq::MotionLaw& r, double e) {
 inline void MoveDatum(std::optional<phiq::MotionLaw>& x, const std::optional<phiq::MotionLaw>& r, double e) {
   if (x && r) MoveDatum(*x, *r, e);
 }
+// An expression moves with the parameters its text reads (CompiledExpression::along_constants()), not by a step
+// along its rate: a spec whose expression has a rate is checked against the spec made at p + e
+// (CheckDataDerivativeOf()).
+inline void MoveDatum(std::shared_ptr<const phiq::CompiledExpression>&,
+                      const std::shared_ptr<const phiq::CompiledExpression>& r, double) {
+  if (r) ADD_FAILURE() << "an expression's rate moves no copy of it: check it with CheckDataDerivativeOf()";
+}
 template <class Spec>
 Spec MovedAlongData(const Spec& spec, const Spec& rate, double e) {
   Spec moved = spec;
@@ -336,9 +343,10 @@ Spec MovedAlongData(const Spec& spec, const Spec& rate, double e) {
 }
 
 // data_derivative() of every order against the fourth-order central difference of Φ, Φq q̇ + Φt and Φq q̈ − γ
-// along spec + e·rate, at random states (q, q̇, q̈, t).
-template <class Spec>
-void CheckDataDerivative(const Spec& spec, const Spec& rate, int n_coords, std::uint32_t seed, int samples = 6) {
+// along moved(e), the spec at p + e (moved(0) is `spec`), at random states (q, q̇, q̈, t).
+template <class Spec, class Moved>
+void CheckDataDerivativeOf(const Spec& spec, const Spec& rate, const Moved& moved, int n_coords, std::uint32_t seed,
+                           int samples = 6) {
   static_assert(phiq::DataDifferentiable<Spec>);
   (void)phiq::test::DataCheckOf<Spec>::registered;  // tests/test_kind_registry.cpp: this kind's check exists
   constexpr int m = Spec::kRows;
@@ -373,14 +381,20 @@ void CheckDataDerivative(const Spec& spec, const Spec& rate, int n_coords, std::
       spec.data_derivative(rate, order, q, st.qd.data(), acc.qd.data(), st.t, exact.data());
       EXPECT_EQ(exact[m], kSentinel) << "data_derivative writes past its rows";
       const double e = 1e-4;
-      const auto f2 = term(MovedAlongData(spec, rate, -2 * e), order), f1 = term(MovedAlongData(spec, rate, -e), order),
-                 g1 = term(MovedAlongData(spec, rate, e), order), g2 = term(MovedAlongData(spec, rate, 2 * e), order);
+      const auto f2 = term(moved(-2 * e), order), f1 = term(moved(-e), order), g1 = term(moved(e), order),
+                 g2 = term(moved(2 * e), order);
       for (int r = 0; r < m; ++r) {
         const double fd = ((f2[r] - g2[r]) + 8.0 * (g1[r] - f1[r])) / (12.0 * e);
         EXPECT_NEAR(exact[r], fd, Tol(kJacTol, fd)) << "order " << order << ", row " << r;
       }
     }
   }
+}
+
+// CheckDataDerivativeOf() along spec + e·rate.
+template <class Spec>
+void CheckDataDerivative(const Spec& spec, const Spec& rate, int n_coords, std::uint32_t seed, int samples = 6) {
+  CheckDataDerivativeOf(spec, rate, [&](double e) { return MovedAlongData(spec, rate, e); }, n_coords, seed, samples);
 }
 
 // ---- Model: blocks, pattern and CSC plumbing ------------------------------------------------------------------

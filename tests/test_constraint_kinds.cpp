@@ -465,14 +465,58 @@ TEST(ConstraintKinds, EquationWithLaw) {
 }
 
 TEST(ConstraintKinds, EquationAlongItsData) {
-  // a driven equation: its law moves; the expression is no datum
+  // a driven equation whose text reads no parameter: its law moves, its expression has no rate
   const auto g = CompileCrank("xA*yA - sin(theta2)");
   const phiq::EquationSpec e{g, phiq::MotionLaw::harmonic(0.1, 0.6, 1.7, -0.3), phiq::Unit::kNone};
-  const phiq::EquationSpec rate{g, phiq::MotionLaw::polynomial({-0.4, 0.9, 0.25}), phiq::Unit::kNone};
+  const phiq::EquationSpec rate{nullptr, phiq::MotionLaw::polynomial({-0.4, 0.9, 0.25}), phiq::Unit::kNone};
   CheckDataDerivative(e, rate, 4, 1011);
   // without a law, nothing moves
   const phiq::EquationSpec still{g, std::nullopt, phiq::Unit::kNone};
-  CheckDataDerivative(still, still, 4, 1012, 2);
+  CheckDataDerivative(still, phiq::EquationSpec{nullptr, std::nullopt, phiq::Unit::kNone}, 4, 1012, 2);
+}
+
+TEST(ConstraintKinds, EquationAlongTheParametersItsTextReads) {
+  // L2 = p and L3 = 1 + 2p², read by the text (a parameter defined from another moves with it), and a law in p:
+  // the equation at p against its rate, which detail::datum_rate makes of four copies at a 10 % step (exact: L2
+  // and L3 of degree ≤ 4 in p), its expression differentiated along its constants
+  const std::string text = "xA - L2*cos(theta2) + 0.1*t^2*yA*L3 + atan2(yA, xA + L3) + L2^2*sqrt(L3 + yA^2)";
+  auto at = [&](double p) {
+    auto g = phiq::CompiledExpression::compile(text, [p](const std::string& name) -> std::optional<phiq::NameBinding> {
+      using K = phiq::NameBinding::Kind;
+      if (name == "theta2") return phiq::NameBinding{K::kCoordinate, 0};
+      if (name == "xA") return phiq::NameBinding{K::kCoordinate, 1};
+      if (name == "yA") return phiq::NameBinding{K::kCoordinate, 2};
+      if (name == "L2") return phiq::NameBinding{K::kConstant, -1, p};
+      if (name == "L3") return phiq::NameBinding{K::kConstant, -1, 1.0 + 2.0 * p * p};
+      if (name == "t") return phiq::NameBinding{K::kTime};
+      return std::nullopt;
+    });
+    return phiq::EquationSpec{g, phiq::MotionLaw::harmonic(0.1 * p, 0.6, 1.7, -0.3), phiq::Unit::kLength};
+  };
+  const double p = 0.3, h = 0.03;
+  const phiq::EquationSpec e = at(p), m2 = at(p - 2 * h), m1 = at(p - h), p1 = at(p + h), p2 = at(p + 2 * h);
+  EXPECT_EQ(e.g->constants(), (std::vector<double>{p, 1.0 + 2.0 * p * p}));
+  ASSERT_TRUE(e.g->same_source(*m2.g));
+  phiq::EquationSpec rate;
+  ASSERT_TRUE(phiq::detail::spec_data_rate(e, {&m2, &m1, &p1, &p2}, h, rate));
+  ASSERT_NE(rate.g, nullptr);
+  EXPECT_EQ(rate.g->coordinates(), (std::vector<Index>{0, 1, 2}));
+  CheckDataDerivativeOf(e, rate, [&](double x) { return at(p + x); }, 4, 1013);
+  // constants that do not move give no rate; one that moves an exponent has none the kind can give (differenced)
+  EXPECT_EQ(e.g->along_constants({0.0, 0.0}), nullptr);
+  auto power = [](double p) {
+    return phiq::CompiledExpression::compile("xA^n - 1", [p](const std::string& name) -> std::optional<phiq::NameBinding> {
+      if (name == "xA") return phiq::NameBinding{phiq::NameBinding::Kind::kCoordinate, 0};
+      if (name == "n") return phiq::NameBinding{phiq::NameBinding::Kind::kConstant, -1, p};
+      return std::nullopt;
+    });
+  };
+  EXPECT_THROW(power(2.0)->along_constants({1.0}), phiq::Error);
+  const phiq::EquationSpec pe{power(2.0), std::nullopt, phiq::Unit::kNone}, pm{power(1.9), std::nullopt, phiq::Unit::kNone};
+  phiq::EquationSpec none;
+  EXPECT_FALSE(phiq::detail::spec_data_rate(pe, {&pm, &pm, &pe, &pe}, 0.1, none));
+  // another text is another function: no rate
+  EXPECT_FALSE(e.g->same_source(*CompileCrank("xA - L2*cos(theta2)")));
 }
 
 // ---- CouplerSpec ----------------------------------------------------------------------------------------------

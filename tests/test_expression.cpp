@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <sstream>
 
@@ -363,6 +364,55 @@ TEST(Expression, AngleDifferenceIsRecognisedFromTheTopLevelForm) {
   // kept when a family instantiates the expression for its members
   auto e = CompiledExpression::compile("atan2(yA, xA) - theta2", resolve);
   EXPECT_TRUE(e->rebind({5, 6, 7}, {0.0, 0.0, 0.0}, "atan2(y1, x1) - a1")->angle_difference());
+}
+
+// h = Σ rate_j ∂g/∂c_j (along_constants()) of a family member: a parameter L and a placeholder that the member binds
+// to a constant c, against central differences of the member compiled and rebound at L + e·rL, c + e·rc: its value,
+// gradient, ∂/∂t and γ (each a derivative of g's along the constants).
+TEST(Expression, RateAlongItsConstantsOfARebindingMatchesTheirDifferences) {
+  const std::string text = "x0*cos(x1*L + t) + L^2*x2^3 - x1*sqrt(L + x2^2)";
+  auto base = [&](double L) {
+    return CompiledExpression::compile(text, [L](const std::string& n) -> std::optional<NameBinding> {
+      for (int k = 0; k < 3; ++k)
+        if (n == "x" + std::to_string(k)) return NameBinding{NameBinding::Kind::kCoordinate, k};
+      if (n == "L") return NameBinding{NameBinding::Kind::kConstant, -1, L};
+      if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+      return std::nullopt;
+    });
+  };
+  const double L = 0.8, c = 0.7, rL = 0.5, rc = -2.0;
+  // compiled index 1 is the member's constant c; 0 and 2 its coordinates 4 and 6
+  auto member = [&](double e) { return base(L + e * rL)->rebind({4, -1, 6}, {0.0, c + e * rc, 0.0}, text); };
+  const auto g = member(0.0);
+  EXPECT_EQ(g->constants(), (std::vector<double>{L, c}));
+  EXPECT_TRUE(g->same_source(*member(0.1)));
+  EXPECT_FALSE(g->same_source(*base(L)->rebind({4, 5, 6}, {0.0, 0.0, 0.0}, text)));  // c a coordinate there
+  const auto h = g->along_constants({rL, rc});
+  ASSERT_NE(h, nullptr);
+  EXPECT_EQ(h->coordinates(), (std::vector<Index>{4, 6}));
+  EXPECT_EQ(h->constants(), std::vector<double>{});
+  const double q[7] = {0, 0, 0, 0, 0.9, 0, -0.4}, qd[7] = {0, 0, 0, 0, 1.3, 0, 0.6};
+  const double t = 0.35, e = 1e-3;
+  const auto m2 = member(-2 * e), m1 = member(-e), p1 = member(e), p2 = member(2 * e);
+  auto fd = [&](const std::function<double(const CompiledExpression&)>& f) {
+    return ((f(*m2) - f(*p2)) + 8.0 * (f(*p1) - f(*m1))) / (12.0 * e);
+  };
+  EXPECT_NEAR(h->value(q, t), fd([&](const CompiledExpression& x) { return x.value(q, t); }), 1e-10);
+  EXPECT_NEAR(h->partial_t(q, t), fd([&](const CompiledExpression& x) { return x.partial_t(q, t); }), 1e-10);
+  EXPECT_NEAR(h->gamma(q, qd, t), fd([&](const CompiledExpression& x) { return x.gamma(q, qd, t); }), 1e-9);
+  double dh[2];
+  h->gradient(q, t, dh);
+  for (int k = 0; k < 2; ++k)
+    EXPECT_NEAR(dh[k], fd([&](const CompiledExpression& x) {
+      double dg[2];
+      x.gradient(q, t, dg);
+      return dg[k];
+    }), 1e-10) << "column " << k;
+  // another member, its constant moving alike: the same derivative on its own coordinates
+  EXPECT_EQ(base(L)->rebind({1, -1, 3}, {0.0, c, 0.0}, text)->along_constants({rL, rc})->coordinates(),
+            (std::vector<Index>{1, 3}));
+  EXPECT_EQ(g->along_constants({0.0, 0.0}), nullptr);
+  EXPECT_THROW(g->along_constants({1.0}), Error);
 }
 
 TEST(Expression, ConstantExpressions) {

@@ -185,6 +185,16 @@ TEST(MotionLaw, RateAlongItsDataIsExact) {
   check_rate([](double p) { return MotionLaw::polynomial({p, -p * p, 0.5, 0.2 * p * p * p}); }, 0.7, 0.07, 1e-9);
   check_rate([](double p) { return MotionLaw::harmonic(0.1 + p * p, 0.5 + 0.3 * p, 2.0 + p - 0.2 * p * p, 0.2 * p); },
              0.7, 0.07, 1e-8);
+  // an expression: differentiated along the parameters its text reads (CompiledExpression::along_constants())
+  check_rate([](double p) {
+    return MotionLaw::expression(CompiledExpression::compile(
+        "a*sin(a*t) + b*t^2", [p](const std::string& n) -> std::optional<NameBinding> {
+          if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+          if (n == "a") return NameBinding{NameBinding::Kind::kConstant, -1, p};
+          if (n == "b") return NameBinding{NameBinding::Kind::kConstant, -1, 0.5 - p * p};
+          return std::nullopt;
+        }));
+  }, 1.2, 0.12, 1e-8);
   // a table's values that move (its times fixed): the spline is linear in the values
   check_rate([](double p) {
     return MotionLaw::table({-0.5, 0.4, 1.1, 2.0, 3.5}, {p, 0.2 * p * p, -0.3, 1.0 - p, 0.5 * p});
@@ -192,10 +202,11 @@ TEST(MotionLaw, RateAlongItsDataIsExact) {
 }
 
 TEST(MotionLaw, RateOfLawsWhoseDataDoNotMatchIsTheirDifference) {
-  // an expression's parameters are constants of its tapes: the four laws are differenced, fourth order in h
+  // an expression whose exponent moves (its power of a constant exponent has no rate along it): the four laws
+  // are differenced, fourth order in h
   auto expression = [](double p) {
     return MotionLaw::expression(CompiledExpression::compile(
-        "a*sin(a*t) + t^2", [p](const std::string& n) -> std::optional<NameBinding> {
+        "a*sin(t) + (1 + t)^a", [p](const std::string& n) -> std::optional<NameBinding> {
           if (n == "t") return NameBinding{NameBinding::Kind::kTime};
           if (n == "a") return NameBinding{NameBinding::Kind::kConstant, -1, p};
           return std::nullopt;

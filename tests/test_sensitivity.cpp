@@ -741,6 +741,48 @@ TEST(Sensitivity, ADriversLawIsDifferentiatedAlongItsData) {
   }
 }
 
+// The crank-slider written as the notes write Φ, in equations whose texts read L2 and L3, the rod's rational in
+// L3: the equations differentiate their texts along the parameters (CompiledExpression::along_constants()), so
+// that at steps of 10 % the sensitivities of x_B stay at the closed form to 1e-9, in both forms, where the kept
+// models' differences along L3 are off by more than 10⁻⁶.
+TEST(Sensitivity, EquationsAreDifferentiatedAlongTheParametersTheirTextsRead) {
+  std::string text = test::replace_first(
+      kCrankSlider, "  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}\n"
+                    "  - {name: rod, type: distance, points: [A, B], length: L3}\n",
+      "  - {name: crank_x, type: equation, expr: \"xA - L2*cos(theta2)\", unit: length}\n"
+      "  - {name: crank_y, type: equation, expr: \"yA - L2*sin(theta2)\", unit: length}\n"
+      "  - {name: rod, type: equation, expr: \"((xB - xA)^2 + yA^2)/L3 - L3\", unit: length}\n");
+  text = test::replace_first(text, "sensitivities: [L2, {parameter: L3, step: 1e-3}]",
+                             "sensitivities: [{parameter: L2, step: 0.03}, {parameter: L3, step: 0.1}]");
+  const auto scenes = own_and_kept(text, "crank_slider_equations.yaml");
+  const Scene& s = scenes.first;
+  for (const OutputSensitivity& p : s.sweep.sensitivities) {
+    ASSERT_TRUE(p.reached) << p.name;
+    ASSERT_EQ(p.reached->rates.size(), 1u) << p.name;  // crank_x and crank_y along L2, the rod along L3
+    EXPECT_NE(p.reached->rates[0], nullptr) << p.name;
+  }
+  for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
+    const auto [exact, differenced] = own_and_kept_sweeps(scenes, form);
+    ASSERT_EQ(exact.s.size(), 91u);
+    const Index xb = s.model->coordinate_index("xB");
+    const SensitivityLayout layout{s.model->num_coordinates()};
+    double worst_exact = 0.0, worst_differenced = 0.0;
+    for (std::size_t k = 0; k < exact.s.size(); ++k)
+      for (int which : {2, 3}) {
+        const std::size_t j = which == 2 ? 0 : 1;
+        const auto want = slider_sensitivities(exact.rows.t[k], which);
+        for (int o = 0; o < 3; ++o) {
+          const double e = exact.s[k][layout.offset(j, o) + xb], d = differenced.s[k][layout.offset(j, o) + xb];
+          EXPECT_NEAR(e, want[o], 1e-9) << to_string(form) << " t = " << exact.rows.t[k] << ", L" << which;
+          worst_exact = std::max(worst_exact, std::fabs(e - want[o]));
+          worst_differenced = std::max(worst_differenced, std::fabs(d - want[o]));
+        }
+      }
+    EXPECT_GT(worst_differenced, 1e-6) << to_string(form) << ": the differences at a 10 % step";
+    EXPECT_LT(worst_exact, 1e-9) << to_string(form);
+  }
+}
+
 // The RSSR four-bar in space: its crank's and rocker's arms (a, b: the coupler's ends on the bodies), the rocker's
 // ground hinge (d, e: a revolute's folded ground attachment) and the coupler's length reach constraints whose kinds
 // differentiate their own data (a spatial distance, a revolute), read through the scene: every reached span holds

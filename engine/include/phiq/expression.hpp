@@ -95,8 +95,13 @@ class CompiledExpression {
                                                            bool allow_time = true);
 
   /// The same function: the same text, coordinates and programs (a scene's parameter is a constant of the tapes,
-  /// so a scene read at two values of a parameter its expression reads gives two different functions).
-  bool operator==(const CompiledExpression&) const = default;
+  /// so a scene read at two values of a parameter its expression reads gives two different functions). Where the
+  /// function came from (same_source()) is not compared.
+  bool operator==(const CompiledExpression& o) const {
+    return text_ == o.text_ && coords_ == o.coords_ && depends_on_time_ == o.depends_on_time_ &&
+           angle_difference_ == o.angle_difference_ && value_ == o.value_ && gradient_ == o.gradient_ &&
+           partial_t_ == o.partial_t_;
+  }
   /// The text it was compiled from.
   const std::string& text() const { return text_; }
   /// Coordinates g depends on, ascending; gradient() writes ∂g/∂q for these, in this order.
@@ -131,7 +136,33 @@ class CompiledExpression {
   std::shared_ptr<const CompiledExpression> rebind(const std::vector<Index>& target, const std::vector<double>& value,
                                                    std::string text) const;
 
+  /// The constants c of g that a scene's data can move, with their values: the parameters its text reads (in the
+  /// order it first reads them), then, for a family member (rebind()), the values its rebinding gave the compiled
+  /// indices that are no coordinate of the member, in index order. Empty for an expression made by
+  /// along_constants(), or rebound twice.
+  const std::vector<double>& constants() const { return constants_; }
+  /// True when `other` was compiled from the same text against the same names (the same coordinates, the same
+  /// parameters whatever their values, the same rebinding), so that their constants() match one to one: an
+  /// equation of a scene read at two values of a parameter.
+  bool same_source(const CompiledExpression& other) const;
+  /// h = Σ_j rate[j] ∂g/∂c_j with c = constants() held at their values: g's rate along a design parameter that
+  /// moves c at `rate` (EquationSpec::data_derivative()), compiled with its derivatives as g is, exactly (symbolic
+  /// differentiation along the constants, then the same tapes: h's value, Φq-like gradient and ∂/∂t, and its γ by
+  /// Taylor mode). Null when every rate is 0. Symbolic work once per text and rates: family members whose
+  /// constants move alike share it (rebound from one compilation). Throws phiq::Error when `rate` is not of
+  /// constants()' size, or when a constant that moves is an exponent (u^c: g's power with a constant exponent is
+  /// not the general power a moving exponent needs), or the derivative exceeds the tape limit.
+  std::shared_ptr<const CompiledExpression> along_constants(const std::vector<double>& rate) const;
+
+  /// @cond internal
+  struct Source;
+  friend struct CompiledExpressionBuilder;
+  /// @endcond
+
  private:
+  std::shared_ptr<const Source> source_;  // the text and the names it was compiled with: along_constants() reads it
+  std::vector<double> constants_;         // constants()
+  std::vector<Index> target_;             // rebind()'s target (empty unless rebound)
   std::string text_;
   std::vector<Index> coords_;
   bool depends_on_time_ = false;

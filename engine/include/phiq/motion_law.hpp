@@ -41,9 +41,10 @@ class MotionLaw {
   /// `at` p and its copies `along` at p − 2h, p − h, p + h, p + 2h (the scene read there). The data's rates are the
   /// fourth-order central difference of the copies' data (exact for data of degree ≤ 4 in p), and f is
   /// differentiated along them exactly: a polynomial's coefficients and a table's values enter f linearly, a
-  /// harmonic's frequency and phase through the chain rule. Laws whose data cannot be matched (an expression, whose
-  /// parameters are constants of its tapes; a table whose times move; laws of other kinds) get the fourth-order
-  /// difference of the four laws themselves, a sum(). Pre-condition: the five laws have values, h > 0.
+  /// harmonic's frequency and phase through the chain rule, an expression along the parameters its text reads
+  /// (CompiledExpression::along_constants()). Laws whose data cannot be matched (a table whose times move, an
+  /// expression whose exponent moves, laws of other kinds) get the fourth-order difference of the four laws
+  /// themselves, a sum(). Pre-condition: the five laws have values, h > 0.
   static MotionLaw rate_along(const MotionLaw& at, const std::array<const MotionLaw*, 4>& along, double h);
 
   /// f, f', f'' at t; NaN outside [domain_begin(), domain_end()]. Throws phiq::Error on a default-constructed law.

@@ -27,7 +27,8 @@
 ///
 /// A kind that differentiates its own data (DataDifferentiable: the planar distance, pin, prismatic pair, point on a
 /// line, constant and segment angles, polar vector, loop closure and coupler, most rows of the large linkages; the
-/// drivers and driven equations through their laws, MotionLaw::rate_along(); the spatial distance and dot product, the
+/// drivers through their laws, MotionLaw::rate_along(); equations along the parameters their texts read, exactly
+/// (CompiledExpression::along_constants(): ∂g/∂p compiled as g is), and their laws; the spatial distance and dot product, the
 /// nine spatial joints, the joint drivers, the screw, the spatial gear and the mixed polar and angle coordinates
 /// through their attachments; the gear, rack and belt) gives its equations' derivatives itself, exactly and in one
 /// evaluation: D is then applied to its data alone (a datum's rate: exact for the scene's arithmetic of degree ≤ 4 in

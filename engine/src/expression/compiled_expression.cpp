@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <mutex>
 #include <optional>
 
 #include "expression/messages.hpp"
 #include "expression/parser.hpp"
+#include "expression/symbolic.hpp"
 #include "expression/tape_builder.hpp"
 #include "phiq/expression.hpp"
 
@@ -47,6 +49,127 @@ bool is_angle_difference(const GiNaC::ex& g) {
 }
 }  // namespace
 
+// Where a compiled expression came from: its text (a family's with placeholders) and every name it read, with what
+// the name was then, so that along_constants() can parse it again with the constants that move as symbols.
+struct CompiledExpression::Source {
+  std::string text;
+  bool allow_time = true;
+  std::vector<std::pair<std::string, NameBinding>> names;  // in the order the text first reads them; pi excluded
+  std::size_t parameters = 0;                              // how many of them are constants (kConstant)
+  // along_constants()' derivatives by their rates (of the parameters, then of the compiled indices): family
+  // members whose constants move alike share one symbolic differentiation
+  mutable std::mutex mutex;
+  mutable std::map<std::vector<double>, std::shared_ptr<const CompiledExpression>> rates;
+};
+
+// What compile() and along_constants() share: g's tapes and what is read of it.
+struct CompiledExpressionBuilder {
+  // The coordinates g depends on, its flags, and its value, gradient and ∂/∂t tapes into `out`.
+  static void finish(CompiledExpression& out, const GiNaC::ex& g, const std::map<Index, GiNaC::realsymbol>& symbol_of_coord,
+                     const std::map<std::string, Index>& coord_of_symbol,
+                     const std::map<std::string, double>& value_of_constant, const GiNaC::realsymbol& tsym) {
+    using namespace GiNaC;
+    // Keep only the coordinates the expression really depends on, in ascending index order.
+    std::vector<std::pair<realsymbol, Index>> used;
+    for (auto& [i, s] : symbol_of_coord)
+      if (g.has(s)) used.emplace_back(s, i);
+    out.depends_on_time_ = g.has(tsym);
+    out.angle_difference_ = is_angle_difference(g);
+    const std::string& text = out.text_;
+    try {
+      std::vector<ex> grad;
+      for (std::size_t k = 0; k < used.size(); ++k) grad.push_back(g.diff(used[k].first));
+      auto build = [&](const std::vector<ex>& outs) {
+        return detail::compile_tape(outs, coord_of_symbol, value_of_constant, text);
+      };
+      out.value_ = build({g});
+      out.gradient_ = build(grad);
+      out.partial_t_ = build({g.diff(tsym)});
+      const std::size_t size = out.value_.size() + out.gradient_.size() + out.partial_t_.size();
+      if (size > CompiledExpression::kMaxTapeSize)
+        throw expression_error(text, "its derivatives compile to " + std::to_string(size) +
+                                         " instructions; the limit is " + std::to_string(CompiledExpression::kMaxTapeSize));
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw expression_error(text, clean_ginac_message(e.what()));
+    }
+    for (auto& [s, i] : used) out.coords_.push_back(i);
+  }
+
+  // Σ_j key[j] ∂g/∂c_j of `source`'s text, key holding the rates of its parameters (source.parameters of them),
+  // then of its compiled indices (a family's placeholders that a member binds to constants): the constants that
+  // move become symbols, the others are folded as compile() folds them.
+  static std::shared_ptr<const CompiledExpression> differentiate(const CompiledExpression::Source& source,
+                                                                 const std::vector<double>& key) {
+    using namespace GiNaC;
+    std::map<std::string, Index> coord_of_symbol;
+    std::map<std::string, double> value_of_constant;
+    std::map<Index, realsymbol> symbol_of_coord;
+    realsymbol tsym("t");
+    std::vector<std::pair<realsymbol, double>> moving;  // the symbols that move, with their rates
+    std::map<std::string, std::size_t> parameter_of;    // parameter name -> its place in key
+    for (const auto& [name, b] : source.names)
+      if (b.kind == NameBinding::Kind::kConstant) parameter_of.emplace(name, parameter_of.size());
+    std::map<std::string, realsymbol> moving_of;
+    auto lookup = [&](const std::string& name) -> detail::ParsedName {
+      if (name == "pi") return {M_PI, {}};
+      auto it = std::find_if(source.names.begin(), source.names.end(), [&](const auto& n) { return n.first == name; });
+      if (it == source.names.end()) throw expression_error(source.text, "unknown name '" + name.substr(0, 40) + "'");
+      const NameBinding& b = it->second;
+      switch (b.kind) {
+        case NameBinding::Kind::kTime:
+          return {std::nullopt, tsym};
+        case NameBinding::Kind::kConstant: {
+          const double rate = key[parameter_of.at(name)];
+          if (rate == 0.0) return {b.value, {}};
+          auto [m, fresh] = moving_of.try_emplace(name, "c:" + name);
+          if (fresh) {
+            value_of_constant[m->second.get_name()] = b.value;
+            moving.emplace_back(m->second, rate);
+          }
+          return {std::nullopt, m->second};
+        }
+        case NameBinding::Kind::kCoordinate:
+          break;
+      }
+      auto [it2, fresh] = symbol_of_coord.try_emplace(b.coordinate, "q:" + std::to_string(b.coordinate));
+      if (fresh) coord_of_symbol[it2->second.get_name()] = b.coordinate;
+      return {std::nullopt, it2->second};
+    };
+    ex g;
+    try {
+      g = detail::parse_expression(source.text, lookup, value_of_constant);
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw expression_error(source.text, clean_ginac_message(e.what()));
+    }
+    for (std::size_t k = source.parameters; k < key.size(); ++k) {
+      if (key[k] == 0.0) continue;
+      auto it = symbol_of_coord.find(static_cast<Index>(k - source.parameters));
+      if (it != symbol_of_coord.end()) moving.emplace_back(it->second, key[k]);
+    }
+    // a moving exponent: g's power of a constant exponent (phiq_pow) is not the general power its rate needs
+    for (auto e = g.preorder_begin(); e != g.preorder_end(); ++e)
+      if (detail::is_power(*e))
+        for (const auto& [s, rate] : moving)
+          if (e->op(1).has(s)) throw expression_error(source.text, "a constant that moves is an exponent");
+    ex d = 0;
+    for (const auto& [s, rate] : moving) d += numeric(rate) * g.diff(s);
+    auto out = std::make_shared<CompiledExpression>();
+    out->text_ = "rate of " + source.text;
+    try {
+      finish(*out, d, symbol_of_coord, coord_of_symbol, value_of_constant, tsym);
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw expression_error(source.text, clean_ginac_message(e.what()));
+    }
+    return out;
+  }
+};
+
 std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std::string& text,
                                                                       const NameResolver& resolve,
                                                                       bool allow_time) {
@@ -57,11 +180,20 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
                 std::to_string(kMaxTextLength));
   auto out = std::make_shared<CompiledExpression>();
   out->text_ = text;
+  auto source = std::make_shared<Source>();
+  source->text = text;
+  source->allow_time = allow_time;
 
   std::map<std::string, Index> coord_of_symbol;     // symbol name -> coordinate index
   std::map<std::string, double> value_of_constant;  // symbol name -> value folded in by the tape builder
   std::map<Index, realsymbol> symbol_of_coord;      // one symbol per coordinate, however many names it has
   realsymbol tsym("t");
+  auto note = [&](const std::string& name, const NameBinding& b) {
+    for (const auto& n : source->names)
+      if (n.first == name) return;
+    source->names.emplace_back(name, b);
+    if (b.kind == NameBinding::Kind::kConstant) out->constants_.push_back(b.value), ++source->parameters;
+  };
   auto lookup = [&](const std::string& name) -> detail::ParsedName {
     if (name == "pi") return {M_PI, {}};
     const std::optional<NameBinding> b = resolve(name);
@@ -72,13 +204,16 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
     switch (b->kind) {
       case NameBinding::Kind::kTime:
         if (!allow_time) throw expression_error(text, "time 't' is not allowed here");
+        note(name, *b);
         return {std::nullopt, tsym};
       case NameBinding::Kind::kConstant:
         if (!std::isfinite(b->value)) throw expression_error(text, "'" + name + "' is not finite");
+        note(name, *b);
         return {b->value, {}};
       case NameBinding::Kind::kCoordinate:
         break;
     }
+    note(name, *b);
     auto [it, fresh] = symbol_of_coord.try_emplace(b->coordinate, "q:" + std::to_string(b->coordinate));
     if (fresh) coord_of_symbol[it->second.get_name()] = b->coordinate;
     return {std::nullopt, it->second};
@@ -92,34 +227,49 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   } catch (const std::exception& e) {  // GiNaC's own refusals, e.g. division by an exact zero
     throw expression_error(text, clean_ginac_message(e.what()));
   }
-
-  // Keep only the coordinates the expression really depends on, in ascending index order.
-  std::vector<std::pair<realsymbol, Index>> used;
-  for (auto& [i, s] : symbol_of_coord)
-    if (g.has(s)) used.emplace_back(s, i);
-  out->depends_on_time_ = g.has(tsym);
-  out->angle_difference_ = is_angle_difference(g);
-
-  try {
-    std::vector<ex> grad;
-    for (std::size_t k = 0; k < used.size(); ++k) grad.push_back(g.diff(used[k].first));
-    auto build = [&](const std::vector<ex>& outs) {
-      return detail::compile_tape(outs, coord_of_symbol, value_of_constant, out->text_);
-    };
-    out->value_ = build({g});
-    out->gradient_ = build(grad);
-    out->partial_t_ = build({g.diff(tsym)});
-    const std::size_t size = out->value_.size() + out->gradient_.size() + out->partial_t_.size();
-    if (size > kMaxTapeSize)
-      throw expression_error(text, "its derivatives compile to " + std::to_string(size) +
-                                       " instructions; the limit is " + std::to_string(kMaxTapeSize));
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw expression_error(text, clean_ginac_message(e.what()));
-  }
-  for (auto& [s, i] : used) out->coords_.push_back(i);
+  CompiledExpressionBuilder::finish(*out, g, symbol_of_coord, coord_of_symbol, value_of_constant, tsym);
+  out->source_ = std::move(source);
   return out;
+}
+
+bool CompiledExpression::same_source(const CompiledExpression& o) const {
+  if (!source_ || !o.source_ || target_ != o.target_ || constants_.size() != o.constants_.size()) return false;
+  if (source_ == o.source_) return true;
+  const Source& a = *source_;
+  const Source& b = *o.source_;
+  if (a.text != b.text || a.allow_time != b.allow_time || a.names.size() != b.names.size()) return false;
+  for (std::size_t k = 0; k < a.names.size(); ++k) {
+    const auto& [na, ba] = a.names[k];
+    const auto& [nb, bb] = b.names[k];
+    if (na != nb || ba.kind != bb.kind || ba.coordinate != bb.coordinate) return false;
+  }
+  return true;
+}
+
+std::shared_ptr<const CompiledExpression> CompiledExpression::along_constants(const std::vector<double>& rate) const {
+  if (rate.size() != constants_.size())
+    throw Error("expression \"" + text_ + "\": " + std::to_string(rate.size()) + " rates for " +
+                std::to_string(constants_.size()) + " constants");
+  if (std::all_of(rate.begin(), rate.end(), [](double r) { return r == 0.0; })) return nullptr;
+  if (!source_) throw Error("expression \"" + text_ + "\": not compiled from a text");
+  // the rates of the parameters, then of the compiled indices (0 where a member binds a coordinate)
+  const std::size_t parameters = source_->parameters;
+  std::vector<double> key(rate.begin(), rate.begin() + static_cast<std::ptrdiff_t>(parameters));
+  std::vector<double> value(target_.size(), 0.0);
+  key.resize(parameters + target_.size(), 0.0);
+  for (std::size_t k = 0, j = parameters; k < target_.size(); ++k)
+    if (target_[k] < 0) key[parameters + k] = rate[j], value[k] = constants_[j], ++j;
+  std::shared_ptr<const CompiledExpression> d;
+  {
+    std::lock_guard<std::mutex> lock(source_->mutex);
+    if (auto it = source_->rates.find(key); it != source_->rates.end()) d = it->second;
+  }
+  if (!d) {
+    d = CompiledExpressionBuilder::differentiate(*source_, key);
+    std::lock_guard<std::mutex> lock(source_->mutex);
+    source_->rates.emplace(key, d);
+  }
+  return target_.empty() ? d : d->rebind(target_, value, "rate of " + text_);
 }
 
 std::string CompiledExpression::listing() const {
@@ -157,6 +307,13 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::rebind(const std::
   out->text_ = std::move(text);
   out->depends_on_time_ = depends_on_time_;
   out->angle_difference_ = angle_difference_;
+  if (source_ && target_.empty()) {  // its constants: the parameters', then those the rebinding gives
+    out->source_ = source_;
+    out->target_ = target;
+    out->constants_ = constants_;
+    for (std::size_t k = 0; k < target.size(); ++k)
+      if (target[k] < 0) out->constants_.push_back(value[k]);
+  }
   auto patch = [&](const Tape& in) {
     Tape tape = in;
     for (Tape::Instr& ins : tape.code_) {

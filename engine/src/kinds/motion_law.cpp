@@ -209,6 +209,23 @@ struct Expression final : MotionLaw::Impl {
     const auto* o = dynamic_cast<const Expression*>(&other);
     return o && (f == o->f || *f == *o->f);
   }
+  // f's rate along its constants (the parameters its text reads): the expression ∂f/∂p, exact; 0 where none moves.
+  std::shared_ptr<const MotionLaw::Impl> rate(const std::array<const MotionLaw::Impl*, 4>& along,
+                                              double h) const override {
+    const auto c = copies_as<Expression>(along);
+    std::shared_ptr<const CompiledExpression> r;
+    if (!all_of_kind(c) || !detail::expression_rate(*f, {c[0]->f.get(), c[1]->f.get(), c[2]->f.get(), c[3]->f.get()},
+                                                    h, r))
+      return nullptr;
+    if (!r) {
+      auto zero = std::make_shared<Polynomial>();
+      zero->c = {0.0};
+      return zero;
+    }
+    auto out = std::make_shared<Expression>();
+    out->f = std::move(r);
+    return out;
+  }
 };
 
 }  // namespace

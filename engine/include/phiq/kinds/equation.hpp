@@ -91,14 +91,31 @@ struct EquationSpec {
   void gamma(const double* q, const double* qd, double t, double* out) const {
     out[0] = g->gamma(q, qd, t) + (law ? law->evaluate(t).ddf : 0.0);
   }
-  /// The data a parameter may move (DistanceSpec::data_members()): the law. The expression is no datum: a parameter
-  /// it reads is a constant of its tapes, and a parameter that reaches g has the equation differenced.
-  static constexpr auto data_members() { return std::tuple{&EquationSpec::law}; }
-  /// Derivatives along the data (DistanceSpec::data_derivative()): −∂f/∂p, −∂f′/∂p, −∂f″/∂p of the law's rate
-  /// (CoordinateDriverSpec::data_derivative()), 0 without a law.
-  void data_derivative(const EquationSpec& rate, int order, const double*, const double*, const double*, double t,
-                       double* out) const {
-    out[0] = rate.law ? detail::minus_law_rate(*rate.law, order, t) : 0.0;
+  /// The data a parameter may move (DistanceSpec::data_members()): the expression's constants (the parameters its
+  /// text reads, CompiledExpression::constants()) and the law.
+  static constexpr auto data_members() { return std::tuple{&EquationSpec::g, &EquationSpec::law}; }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). `rate.g` is h = ∂g/∂p at fixed q and t
+  /// (CompiledExpression::along_constants(), null where g's constants do not move), compiled as g is: the
+  /// derivatives along p of Φ, Φq q̇ + Φt and Φq q̈ − γ are h, hq q̇ + ht and hq q̈ − γ(h), exact as g's own
+  /// (∂/∂p commutes with the derivatives in q and t); minus the law's rate (CoordinateDriverSpec::data_derivative()).
+  void data_derivative(const EquationSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double t, double* out) const {
+    double d = 0.0;
+    if (const CompiledExpression* h = rate.g.get()) {
+      if (order == 0) {
+        d = h->value(q, t);
+      } else {
+        thread_local std::vector<double> grad;
+        const auto& cols = h->coordinates();
+        grad.resize(cols.size());
+        h->gradient(q, t, grad.data());
+        const double* v = order == 1 ? qd : qdd;
+        for (std::size_t k = 0; k < cols.size(); ++k) d += grad[k] * v[cols[k]];
+        if (order == 1) d += h->depends_on_time() ? h->partial_t(q, t) : 0.0;
+        else d -= h->gamma(q, qd, t);
+      }
+    }
+    out[0] = d + (rate.law ? detail::minus_law_rate(*rate.law, order, t) : 0.0);
   }
 
   /// @copydoc DistanceSpec::joint_count

@@ -183,6 +183,32 @@ inline bool datum_rate(std::optional<MotionLaw>& rate, const std::array<const st
     if (law->has_value() != rate.has_value()) return false;
   return !rate || datum_rate(*rate, {&**v[0], &**v[1], &**v[2], &**v[3]}, h);
 }
+// An expression's rate along a parameter (CompiledExpression::along_constants()): its constants' rates by the
+// central difference, the expression differentiated along them exactly; `rate` null where none moves. False where
+// the five were not compiled from one text against the same names, or its rate cannot be compiled.
+inline bool expression_rate(const CompiledExpression& at, const std::array<const CompiledExpression*, 4>& v,
+                            double h, std::shared_ptr<const CompiledExpression>& rate) {
+  for (const CompiledExpression* e : v)
+    if (!e || !e->same_source(at)) return false;
+  std::vector<double> r(at.constants().size());
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    r[k] = central_difference(v[0]->constants()[k], v[1]->constants()[k], v[2]->constants()[k],
+                              v[3]->constants()[k], h);
+    if (!std::isfinite(r[k])) return false;
+  }
+  try {
+    rate = at.along_constants(r);
+  } catch (const Error&) {
+    return false;
+  }
+  return true;
+}
+// An equation's expression: its rate, null where its constants do not move.
+inline bool datum_rate(std::shared_ptr<const CompiledExpression>& rate,
+                       const std::array<const std::shared_ptr<const CompiledExpression>*, 4>& v, double h) {
+  if (!rate) return false;
+  return expression_rate(*rate, {v[0]->get(), v[1]->get(), v[2]->get(), v[3]->get()}, h, rate);
+}
 
 // `rate` made of `at` with each datum of Spec::data_members() replaced by its rate along the parameter over the
 // four specs `along` (ConstraintBlock::data_rates()). False when it has none: a datum is no data that moves, or a
