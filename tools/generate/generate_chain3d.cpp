@@ -8,6 +8,7 @@
 // (θ a multiple of π). Twisted row (--twist A, |sin A| ≥ 0.01): o = u (all hinges on one line), couplers of length
 // √(3 − 2 cos A) between skew cranks; nonsingular at every θ, so it runs through any number of turns.
 // Indexed families (`for i in 0..N`) keep the file's size independent of N.
+#include <numbers>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -27,7 +28,6 @@ namespace {
 using emit::Name;
 using emit::SceneText;
 
-constexpr double kPi = 3.14159265358979323846;
 // The rough placement (so that the first solve is an assembly): the exact solution at t = 0 with every point shifted
 // by kShift along u, off its hinge's plane; the assembly moves each crank back on its own. A placement off the
 // solution along the chain's motion (every crank turned a little), or one that lengthened every coupler a little
@@ -41,7 +41,7 @@ constexpr double kMinSinTwist = 0.01;
 void check(const GenerateOptions& o) {
   gen::check_size_and_coords(o);
   if (o.twist == 0.0) {
-    const double lo = std::min(o.from, o.to) / kPi, hi = std::max(o.from, o.to) / kPi;
+    const double lo = std::min(o.from, o.to) / std::numbers::pi, hi = std::max(o.from, o.to) / std::numbers::pi;
     if (std::floor(hi) >= std::ceil(lo))
       throw std::invalid_argument(
           "--from and --to: the parallelogram row of chain3d is singular where the cranks lie along the row of "

@@ -3,6 +3,7 @@
 // scene_writer.hpp; the indexed families (`for k in ...`) are built here and written with SceneText::raw.
 #include "generate_linkages.hpp"
 
+#include <numbers>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -21,7 +22,6 @@ using emit::Name;
 using emit::PointRef;
 using emit::SceneText;
 
-constexpr double kPi = 3.14159265358979323846;
 
 using gen::footer;
 using gen::header;
@@ -106,7 +106,8 @@ std::string scissor_reference_point(const GenerateOptions& o) {
          "(a rises to the right from the left joint, b to the left from the right joint; reference point at the "
          "middle = the crossing pin), s = (xs, ys, psis) the slider");
   t.raw("parameters:\n  N: " + str(n) + "\n  s: " + shortest(s) + "    # sin(from)\n  hc: " + shortest(0.5 * c) +
-        "    # cos(from)/2\n  from: " + shortest(o.from) + "\n  pmf: " + shortest(kPi - o.from) + "    # pi - from\n");
+        "    # cos(from)/2\n  from: " + shortest(o.from) + "\n  pmf: " + shortest(std::numbers::pi - o.from) +
+        "    # pi - from\n");
   t.section("coordinates");
   t.coordinate(Name{"xs"}, c);
   t.coordinate(Name{"ys"}, 0.0);
@@ -362,13 +363,14 @@ std::string grid_reference_point(const GenerateOptions& o) {
 }  // namespace
 
 std::string scissor_scene(const GenerateOptions& o) {
-  check(o, kPi / 2, "the scissor's bar angle must lie strictly between 0 (flat) and pi/2 (vertical), "
+  check(o, std::numbers::pi / 2, "the scissor's bar angle must lie strictly between 0 (flat) and pi/2 (vertical), "
                     "where the linkage is singular");
   return o.coords == "natural" ? scissor_natural(o) : scissor_reference_point(o);
 }
 
 std::string grid_scene(const GenerateOptions& o) {
-  check(o, kPi, "the grid's row angles must lie strictly between 0 and pi, where the cells are flat (singular)");
+  check(o, std::numbers::pi,
+        "the grid's row angles must lie strictly between 0 and pi, where the cells are flat (singular)");
   return o.coords == "natural" ? grid_natural(o) : grid_reference_point(o);
 }
 
