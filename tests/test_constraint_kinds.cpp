@@ -505,14 +505,16 @@ TEST(ConstraintKinds, EquationAlongTheParametersItsTextReads) {
   // constants that do not move give no rate; one that moves an exponent has none the kind can give (differenced)
   EXPECT_EQ(e.g->along_constants({0.0, 0.0}), nullptr);
   auto power = [](double p) {
+    using K = phiq::NameBinding::Kind;
     return phiq::CompiledExpression::compile("xA^n - 1", [p](const std::string& name) -> std::optional<phiq::NameBinding> {
-      if (name == "xA") return phiq::NameBinding{phiq::NameBinding::Kind::kCoordinate, 0};
-      if (name == "n") return phiq::NameBinding{phiq::NameBinding::Kind::kConstant, -1, p};
+      if (name == "xA") return phiq::NameBinding{K::kCoordinate, 0};
+      if (name == "n") return phiq::NameBinding{K::kConstant, -1, p};
       return std::nullopt;
     });
   };
   EXPECT_THROW(power(2.0)->along_constants({1.0}), phiq::Error);
-  const phiq::EquationSpec pe{power(2.0), std::nullopt, phiq::Unit::kNone}, pm{power(1.9), std::nullopt, phiq::Unit::kNone};
+  const phiq::EquationSpec pe{power(2.0), std::nullopt, phiq::Unit::kNone};
+  const phiq::EquationSpec pm{power(1.9), std::nullopt, phiq::Unit::kNone};
   phiq::EquationSpec none;
   EXPECT_FALSE(phiq::detail::spec_data_rate(pe, {&pm, &pm, &pe, &pe}, 0.1, none));
   // another text is another function: no rate

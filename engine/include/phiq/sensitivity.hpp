@@ -28,12 +28,12 @@
 /// A kind that differentiates its own data (DataDifferentiable: the planar distance, pin, prismatic pair, point on a
 /// line, constant and segment angles, polar vector, loop closure and coupler, most rows of the large linkages; the
 /// drivers through their laws, MotionLaw::rate_along(); equations along the parameters their texts read, exactly
-/// (CompiledExpression::along_constants(): ∂g/∂p compiled as g is), and their laws; the spatial distance and dot product, the
-/// nine spatial joints, the joint drivers, the screw, the spatial gear and the mixed polar and angle coordinates
-/// through their attachments; the gear, rack and belt) gives its equations' derivatives itself, exactly and in one
-/// evaluation: D is then applied to its data alone (a datum's rate: exact for the scene's arithmetic of degree ≤ 4 in
-/// p, a length L itself among it; a harmonic law's frequency enters f through the chain rule, not D) and the kind's
-/// data_derivative() chains it (DistanceSpec::data_derivative(); ReachedConstraints::rates).
+/// (CompiledExpression::along_constants(): ∂g/∂p compiled as g is), and their laws; the spatial distance and dot
+/// product, the nine spatial joints, the joint drivers, the screw, the spatial gear and the mixed polar and angle
+/// coordinates through their attachments; the gear, rack and belt) gives its equations' derivatives itself, exactly
+/// and in one evaluation: D is then applied to its data alone (a datum's rate: exact for the scene's arithmetic of
+/// degree ≤ 4 in p, a length L itself among it; a harmonic law's frequency enters f through the chain rule, not D)
+/// and the kind's data_derivative() chains it (DistanceSpec::data_derivative(); ReachedConstraints::rates).
 ///
 /// The higher orders' derivatives along the motion's own sensitivities, (q, q̇) ← (s, ṡ), are taken apart from p,
 /// with the swept model. The velocity's is exact: with B = ∂(Φq q̇ + Φt)/∂q, γ = −(Φq q̇)q q̇ − 2 Φqt q̇ − Φtt is a

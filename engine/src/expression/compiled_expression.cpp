@@ -65,7 +65,8 @@ struct CompiledExpression::Source {
 // What compile() and along_constants() share: g's tapes and what is read of it.
 struct CompiledExpressionBuilder {
   // The coordinates g depends on, its flags, and its value, gradient and ∂/∂t tapes into `out`.
-  static void finish(CompiledExpression& out, const GiNaC::ex& g, const std::map<Index, GiNaC::realsymbol>& symbol_of_coord,
+  static void finish(CompiledExpression& out, const GiNaC::ex& g,
+                     const std::map<Index, GiNaC::realsymbol>& symbol_of_coord,
                      const std::map<std::string, Index>& coord_of_symbol,
                      const std::map<std::string, double>& value_of_constant, const GiNaC::realsymbol& tsym) {
     using namespace GiNaC;
@@ -87,8 +88,8 @@ struct CompiledExpressionBuilder {
       out.partial_t_ = build({g.diff(tsym)});
       const std::size_t size = out.value_.size() + out.gradient_.size() + out.partial_t_.size();
       if (size > CompiledExpression::kMaxTapeSize)
-        throw expression_error(text, "its derivatives compile to " + std::to_string(size) +
-                                         " instructions; the limit is " + std::to_string(CompiledExpression::kMaxTapeSize));
+        throw expression_error(text, "its derivatives compile to " + std::to_string(size) + " instructions; the limit is " +
+                                         std::to_string(CompiledExpression::kMaxTapeSize));
     } catch (const Error&) {
       throw;
     } catch (const std::exception& e) {
@@ -155,8 +156,13 @@ struct CompiledExpressionBuilder {
       if (detail::is_power(*e))
         for (const auto& [s, rate] : moving)
           if (e->op(1).has(s)) throw expression_error(source.text, "a constant that moves is an exponent");
+    // the rates reach GiNaC as symbols too (folded by the tape builder), as every number does (parser.cpp says why)
     ex d = 0;
-    for (const auto& [s, rate] : moving) d += numeric(rate) * g.diff(s);
+    for (const auto& [s, rate] : moving) {
+      const realsymbol r("r:" + s.get_name());
+      value_of_constant[r.get_name()] = rate;
+      d += r * g.diff(s);
+    }
     auto out = std::make_shared<CompiledExpression>();
     out->text_ = "rate of " + source.text;
     try {
