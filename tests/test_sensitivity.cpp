@@ -651,6 +651,33 @@ TEST(Sensitivity, ModelsAlongAParameterAreReleasedButForItsReach) {
             "sensitivity to 'R': the rates of its kept constraints' data are not one for each span of their reach");
 }
 
+// The worst deviations of `exact`'s and `differenced`'s ∂x_B/∂L, ∂ẋ_B/∂L, ∂ẍ_B/∂L (L2 the first parameter, L3
+// the second) from the crank-slider's closed form over every row, each of `exact`'s expected within 1e-9 of it and,
+// with `agree`, within 1e-10 (relative) of `differenced`'s.
+std::pair<double, double> slider_deviations(const Scene& s, const SensitivityTrace& exact,
+                                            const SensitivityTrace& differenced, SensitivityForm form, bool agree) {
+  EXPECT_EQ(exact.s.size(), 91u);
+  EXPECT_EQ(differenced.s.size(), exact.s.size());
+  const Index xb = s.model->coordinate_index("xB");
+  const SensitivityLayout layout{s.model->num_coordinates()};
+  double worst_exact = 0.0, worst_differenced = 0.0;
+  for (std::size_t k = 0; k < std::min(exact.s.size(), differenced.s.size()); ++k)
+    for (int which : {2, 3}) {
+      const std::size_t j = which == 2 ? 0 : 1;
+      const auto want = slider_sensitivities(exact.rows.t[k], which);
+      for (int o = 0; o < 3; ++o) {
+        const double e = exact.s[k][layout.offset(j, o) + xb], d = differenced.s[k][layout.offset(j, o) + xb];
+        EXPECT_NEAR(e, want[o], 1e-9) << to_string(form) << " t = " << exact.rows.t[k] << ", L" << which;
+        if (agree) {
+          EXPECT_NEAR(e, d, 1e-10 * std::max(1.0, std::fabs(d))) << to_string(form);
+        }
+        worst_exact = std::max(worst_exact, std::fabs(e - want[o]));
+        worst_differenced = std::max(worst_differenced, std::fabs(d - want[o]));
+      }
+    }
+  return {worst_exact, worst_differenced};
+}
+
 // The crank-slider's crank (polar) and rod (distance) differentiate their own data (DataDifferentiable): the
 // constraints kept along L2 and L3 hold their data's rates, and the sensitivities are the kinds' derivatives, exact
 // whatever the step. With a step of 5 % the rod's differences are off by 2(h/L)⁴ ≈ 10⁻⁵ (the models kept, which
@@ -669,25 +696,7 @@ TEST(Sensitivity, KindsThatDifferentiateTheirDataAreExactAtAnyStep) {
     }
     for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
       const auto [exact, differenced] = own_and_kept_sweeps(scenes, form);
-      ASSERT_EQ(exact.s.size(), 91u);
-      ASSERT_EQ(differenced.s.size(), 91u);
-      const Index n = s.model->num_coordinates(), xb = s.model->coordinate_index("xB");
-      const SensitivityLayout layout{n};
-      double worst_exact = 0.0, worst_differenced = 0.0;
-      for (std::size_t k = 0; k < exact.s.size(); ++k)
-        for (int which : {2, 3}) {
-          const std::size_t j = which == 2 ? 0 : 1;
-          const auto want = slider_sensitivities(exact.rows.t[k], which);
-          for (int o = 0; o < 3; ++o) {
-            const double e = exact.s[k][layout.offset(j, o) + xb], d = differenced.s[k][layout.offset(j, o) + xb];
-            EXPECT_NEAR(e, want[o], 1e-9) << to_string(form) << " t = " << exact.rows.t[k] << ", L" << which;
-            if (!large) {
-              EXPECT_NEAR(e, d, 1e-10 * std::max(1.0, std::fabs(d))) << to_string(form);
-            }
-            worst_exact = std::max(worst_exact, std::fabs(e - want[o]));
-            worst_differenced = std::max(worst_differenced, std::fabs(d - want[o]));
-          }
-        }
+      const auto [worst_exact, worst_differenced] = slider_deviations(s, exact, differenced, form, !large);
       if (large) {
         EXPECT_GT(worst_differenced, 1e-6) << to_string(form) << ": the differences at a 5 % step";
       }
@@ -763,21 +772,7 @@ TEST(Sensitivity, EquationsAreDifferentiatedAlongTheParametersTheirTextsRead) {
   }
   for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
     const auto [exact, differenced] = own_and_kept_sweeps(scenes, form);
-    ASSERT_EQ(exact.s.size(), 91u);
-    const Index xb = s.model->coordinate_index("xB");
-    const SensitivityLayout layout{s.model->num_coordinates()};
-    double worst_exact = 0.0, worst_differenced = 0.0;
-    for (std::size_t k = 0; k < exact.s.size(); ++k)
-      for (int which : {2, 3}) {
-        const std::size_t j = which == 2 ? 0 : 1;
-        const auto want = slider_sensitivities(exact.rows.t[k], which);
-        for (int o = 0; o < 3; ++o) {
-          const double e = exact.s[k][layout.offset(j, o) + xb], d = differenced.s[k][layout.offset(j, o) + xb];
-          EXPECT_NEAR(e, want[o], 1e-9) << to_string(form) << " t = " << exact.rows.t[k] << ", L" << which;
-          worst_exact = std::max(worst_exact, std::fabs(e - want[o]));
-          worst_differenced = std::max(worst_differenced, std::fabs(d - want[o]));
-        }
-      }
+    const auto [worst_exact, worst_differenced] = slider_deviations(s, exact, differenced, form, false);
     EXPECT_GT(worst_differenced, 1e-6) << to_string(form) << ": the differences at a 10 % step";
     EXPECT_LT(worst_exact, 1e-9) << to_string(form);
   }
