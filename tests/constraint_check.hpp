@@ -32,6 +32,15 @@ namespace {
 using phiq::Index;
 using phiq::Slot;
 
+// How the kinds' tests write a spec's slots: a coordinate's, a constant's; a spatial natural point and a body frame
+// on consecutive coordinates (x, y, z; then the four Euler parameters).
+inline Slot S(Index i) { return Slot::coordinate(i); }
+inline Slot C(double v) { return Slot::constant(v); }
+inline phiq::Point3 Nat(Index first) { return phiq::Point3{S(first), S(first + 1), S(first + 2)}; }
+inline phiq::Frame3 Body(Index first) {
+  return phiq::Frame3{S(first), S(first + 1), S(first + 2), S(first + 3), S(first + 4), S(first + 5), S(first + 6)};
+}
+
 // ---- tolerances and steps -------------------------------------------------------------------------------------
 
 constexpr double kJacStep = 1e-6;     // relative step of the first differences (q and t)

@@ -10,7 +10,7 @@ namespace phiq {
 namespace {
 
 // The crank-slider with crank length L2 and rod 1: x_B = L2 cos θ + sqrt(1 − L2² sin² θ), θ = 2t.
-Model crank_slider(double l2, const Model* share) {
+Model crank_slider_case(double l2, const Model* share) {
   ModelBuilder b;
   auto S = Slot::coordinate;
   auto C = Slot::constant;
@@ -80,7 +80,7 @@ TEST(Batch, EveryCaseMatchesItsClosedFormAndSharesTheAnalysis) {
   const std::vector<double> lengths{0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8};
   std::vector<Model> models;
   models.reserve(lengths.size());  // the first model must not move: the others refer to its analysis
-  for (double l : lengths) models.push_back(crank_slider(l, models.empty() ? nullptr : &models[0]));
+  for (double l : lengths) models.push_back(crank_slider_case(l, models.empty() ? nullptr : &models[0]));
   std::vector<const Model*> ptrs;
   for (const Model& m : models) ptrs.push_back(&m);
   SweepOptions opt;
@@ -110,9 +110,9 @@ TEST(Batch, AFailedCaseDoesNotStopTheOthers) {
   // a crank longer than the rod cannot turn: that case fails, the others do not
   std::vector<Model> models;
   models.reserve(3);
-  models.push_back(crank_slider(0.3, nullptr));
-  models.push_back(crank_slider(1.5, &models[0]));
-  models.push_back(crank_slider(0.5, &models[0]));
+  models.push_back(crank_slider_case(0.3, nullptr));
+  models.push_back(crank_slider_case(1.5, &models[0]));
+  models.push_back(crank_slider_case(0.5, &models[0]));
   SweepOptions opt;
   opt.t_end = M_PI;
   opt.steps = 60;
@@ -137,8 +137,8 @@ TEST(Batch, AFailedCaseDoesNotStopTheOthers) {
 TEST(Batch, EachCaseStartsFromItsOwnPlacement) {
   std::vector<Model> models;
   models.reserve(2);
-  models.push_back(crank_slider(0.3, nullptr));
-  models.push_back(crank_slider(0.3, &models[0]));
+  models.push_back(crank_slider_case(0.3, nullptr));
+  models.push_back(crank_slider_case(0.3, &models[0]));
   SweepOptions opt;
   opt.t_end = 1.0;
   opt.steps = 10;
@@ -163,7 +163,7 @@ TEST(Batch, EachCaseStartsFromItsOwnPlacement) {
 }
 
 TEST(Batch, ModelsOfAnotherStructureAreAnalysedOnTheirOwn) {
-  Model a = crank_slider(0.3, nullptr);
+  Model a = crank_slider_case(0.3, nullptr);
   ModelBuilder b;
   b.add_coordinate("x", 0.0);
   b.add_driver("d", 0, MotionLaw::linear(0.0, 1.0));

@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
 // The crank-slider with `steps` steps: 10^7 sweep for minutes.
-std::string crank_slider(long steps) {
+std::string crank_slider_text(long steps) {
   std::string scene = slurp(phiq::test::model_path("seed/crank_slider_mixed.yaml"));
   scene.replace(scene.find("steps: 180"), 10, "steps: " + std::to_string(steps));
   return scene;
@@ -57,7 +57,7 @@ int wait_status(pid_t pid) {
 // kill -9 cannot be caught: the temporary must have no name while it is written (O_TMPFILE), so that nothing is
 // left however the process ends; an existing output stays as it was.
 TEST_F(Cli, KillNineInTheMiddleOfARunLeavesNoTemporary) {
-  write("long.yaml", crank_slider(10000000));
+  write("long.yaml", crank_slider_text(10000000));
   write("out.csv", "t,old\n0,0\n");
   const pid_t pid = spawn(dir_, "run long.yaml -o out.csv --summary s.json", "run");
   std::this_thread::sleep_for(700ms);  // loaded and sweeping, rows written to the temporary
@@ -70,7 +70,7 @@ TEST_F(Cli, KillNineInTheMiddleOfARunLeavesNoTemporary) {
 // Outputs are renamed onto their targets under the lock of their directory: while another process holds it, a
 // finished run waits, with nothing published; once it is released, both files appear.
 TEST_F(Cli, ACommitWaitsForTheLockOfItsDirectory) {
-  write("s.yaml", crank_slider(36));
+  write("s.yaml", crank_slider_text(36));
   const int dfd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);  // (not inherited by phiq)
   ASSERT_GE(dfd, 0);
   ASSERT_EQ(::flock(dfd, LOCK_EX), 0);
@@ -87,8 +87,8 @@ TEST_F(Cli, ACommitWaitsForTheLockOfItsDirectory) {
 // Two runs of different scenes writing the same CSV and summary at the same time: whatever the order, the CSV and
 // the summary that remain are one run's (the summary names its scene; the CSV's row count is that scene's).
 TEST_F(Cli, ConcurrentWritersOfOnePairLeaveOneWritersPair) {
-  write("a.yaml", crank_slider(2000));
-  write("b.yaml", crank_slider(2001));
+  write("a.yaml", crank_slider_text(2000));
+  write("b.yaml", crank_slider_text(2001));
   for (int round = 0; round < 6; ++round) {
     const pid_t a = spawn(dir_, "run -q a.yaml -o out.csv --summary s.json", "a");
     const pid_t b = spawn(dir_, "run -q b.yaml -o out.csv --summary s.json", "b");
@@ -106,7 +106,7 @@ TEST_F(Cli, ConcurrentWritersOfOnePairLeaveOneWritersPair) {
 // and says how many; the cases still running leave nothing. The signal comes once the first case's file is there
 // (not after a fixed time, which a loaded machine or a sanitizer build may not reach a case in).
 TEST_F(Cli, AnInterruptedBatchKeepsTheCasesItFinished) {
-  write("s.yaml", crank_slider(100000));  // a few tenths of a second a case
+  write("s.yaml", crank_slider_text(100000));  // a few tenths of a second a case
   std::string cases = "L2\n";
   for (int k = 0; k < 40; ++k) cases += "0.3\n";
   write("cases.csv", cases);

@@ -38,8 +38,6 @@
 
 namespace {
 
-Slot S(Index i) { return Slot::coordinate(i); }
-Slot C(double v) { return Slot::constant(v); }
 
 // ---- expressions ----------------------------------------------------------------------------------------------
 

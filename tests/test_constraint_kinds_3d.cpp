@@ -29,16 +29,10 @@ using phiq::JointSide3;
 using phiq::Point3;
 using phiq::kin3::V3;
 
-Slot S(Index i) { return Slot::coordinate(i); }
-Slot C(double v) { return Slot::constant(v); }
 
 // Coordinates of the random states: body 0 at 0..6, body 1 at 7..13 (x, y, z, e0..e3), a natural point at 14..16,
 // a natural vector at 17..19, a second natural point at 20..22.
 constexpr int kN = 23;
-Frame3 Body(Index first) {
-  return Frame3{S(first), S(first + 1), S(first + 2), S(first + 3), S(first + 4), S(first + 5), S(first + 6)};
-}
-Point3 Nat(Index first) { return Point3{S(first), S(first + 1), S(first + 2)}; }
 
 // Local data of a side, fixed per test from its own seed: points in [-1, 1]³, axes and references random.
 V3 RandomVector(std::mt19937& rng) {

@@ -23,7 +23,7 @@ CsvTable parse(const std::string& text, const std::string& path = "a.csv") { ret
 
 // The message of the phiq::Error that f throws; fails the test (and returns "") if it throws nothing.
 template <class F>
-std::string error_of(F&& f) {
+std::string refusal(F&& f) {
   try {
     f();
   } catch (const Error& e) {
@@ -104,46 +104,46 @@ TEST(CsvParse, HeaderOnlyIsAnEmptyTable) {
 
 TEST(CsvParse, TrailingBlankLinesAreIgnoredButABlankLineInsideIsAnError) {
   EXPECT_EQ(parse("t,x\n0,1\n\n\r\n").rows.size(), 1u);
-  EXPECT_EQ(error_of([] { parse("t,x\n0,1\n\n0.1,2\n"); }), "a.csv:3: blank line before the last row");
+  EXPECT_EQ(refusal([] { parse("t,x\n0,1\n\n0.1,2\n"); }), "a.csv:3: blank line before the last row");
 }
 
 TEST(CsvParse, WrongFieldCountGivesLineAndBothCounts) {
-  EXPECT_EQ(error_of([] { parse("t,x,y\n0,1,2\n0.1,2\n"); }), "a.csv:3: 2 fields, the header has 3");
-  EXPECT_EQ(error_of([] { parse("t,x,y\r\n0,1,2,3\r\n"); }), "a.csv:2: 4 fields, the header has 3");
-  EXPECT_EQ(error_of([] { parse("t,x\n5\n"); }), "a.csv:2: 1 field, the header has 2");
+  EXPECT_EQ(refusal([] { parse("t,x,y\n0,1,2\n0.1,2\n"); }), "a.csv:3: 2 fields, the header has 3");
+  EXPECT_EQ(refusal([] { parse("t,x,y\r\n0,1,2,3\r\n"); }), "a.csv:2: 4 fields, the header has 3");
+  EXPECT_EQ(refusal([] { parse("t,x\n5\n"); }), "a.csv:2: 1 field, the header has 2");
 }
 
 TEST(CsvParse, NonNumberFieldNamesColumnAndText) {
-  EXPECT_EQ(error_of([] { parse("t,xA,xB\n0,1,2\n0.1,2,abc\n", "res/B.csv"); }),
+  EXPECT_EQ(refusal([] { parse("t,xA,xB\n0,1,2\n0.1,2,abc\n", "res/B.csv"); }),
             "res/B.csv:3: column 'xB': 'abc' is not a number");
-  EXPECT_EQ(error_of([] { parse("t,xA\n0,\n"); }), "a.csv:2: column 'xA': '' is not a number");
-  EXPECT_EQ(error_of([] { parse("t,xA\n0,1.5x\n"); }), "a.csv:2: column 'xA': '1.5x' is not a number");
-  EXPECT_EQ(error_of([] { parse("t,xA\n0,+-1\n"); }), "a.csv:2: column 'xA': '+-1' is not a number");
-  EXPECT_EQ(error_of([] { parse("t,xA\n0,1e400\n"); }), "a.csv:2: column 'xA': '1e400' is out of the range of a double");
+  EXPECT_EQ(refusal([] { parse("t,xA\n0,\n"); }), "a.csv:2: column 'xA': '' is not a number");
+  EXPECT_EQ(refusal([] { parse("t,xA\n0,1.5x\n"); }), "a.csv:2: column 'xA': '1.5x' is not a number");
+  EXPECT_EQ(refusal([] { parse("t,xA\n0,+-1\n"); }), "a.csv:2: column 'xA': '+-1' is not a number");
+  EXPECT_EQ(refusal([] { parse("t,xA\n0,1e400\n"); }), "a.csv:2: column 'xA': '1e400' is out of the range of a double");
   EXPECT_EQ(parse("t,xA\n0,1e-400\n").rows[0][1], 0.0);  // underflow is still the number written
 }
 
 TEST(CsvParse, MessagesStayOneLine) {
-  const std::string msg = error_of([] { parse("t,xA\n0,1\r2\n"); });
+  const std::string msg = refusal([] { parse("t,xA\n0,1\r2\n"); });
   EXPECT_EQ(msg, "a.csv:2: column 'xA': '1\\x0d2' is not a number");
-  const std::string long_msg = error_of([] { parse("t,xA\n0," + std::string(5000, 'z') + "\n"); });
+  const std::string long_msg = refusal([] { parse("t,xA\n0," + std::string(5000, 'z') + "\n"); });
   EXPECT_LT(long_msg.size(), 120u);
   EXPECT_EQ(long_msg.find('\n'), std::string::npos);
 }
 
 TEST(CsvParse, DuplicateColumnNamesAreRejected) {
-  EXPECT_EQ(error_of([] { parse("t,xA,yA,xA\n0,1,2,3\n"); }), "a.csv:1: duplicate column name 'xA' (columns 2 and 4)");
+  EXPECT_EQ(refusal([] { parse("t,xA,yA,xA\n0,1,2,3\n"); }), "a.csv:1: duplicate column name 'xA' (columns 2 and 4)");
 }
 
 TEST(CsvParse, EmptyColumnNamesAreRejected) {
-  EXPECT_EQ(error_of([] { parse("t,,yA\n0,1,2\n"); }), "a.csv:1: column 2 has an empty name");
-  EXPECT_EQ(error_of([] { parse("t,xA,\n0,1,2\n"); }), "a.csv:1: column 3 has an empty name");
+  EXPECT_EQ(refusal([] { parse("t,,yA\n0,1,2\n"); }), "a.csv:1: column 2 has an empty name");
+  EXPECT_EQ(refusal([] { parse("t,xA,\n0,1,2\n"); }), "a.csv:1: column 3 has an empty name");
 }
 
 TEST(CsvParse, EmptyFileOrMissingHeaderIsRejected) {
-  EXPECT_EQ(error_of([] { parse(""); }), "a.csv:1: empty file, expected a header line");
-  EXPECT_EQ(error_of([] { parse("\n0,1\n"); }), "a.csv:1: missing header line (the first line is blank)");
-  EXPECT_EQ(error_of([] { parse("0,1.5\n0.1,2.5\n"); }), "a.csv:1: missing header line (the first line is all numbers)");
+  EXPECT_EQ(refusal([] { parse(""); }), "a.csv:1: empty file, expected a header line");
+  EXPECT_EQ(refusal([] { parse("\n0,1\n"); }), "a.csv:1: missing header line (the first line is blank)");
+  EXPECT_EQ(refusal([] { parse("0,1.5\n0.1,2.5\n"); }), "a.csv:1: missing header line (the first line is all numbers)");
 }
 
 TEST(CsvRead, ReadsAFile) {
@@ -167,14 +167,14 @@ TEST(CsvRead, ParseErrorsNameTheFile) {
     std::ofstream f(path, std::ios::binary);
     f << "t,xA\n0,1\n0.1,oops\n";
   }
-  const std::string msg = error_of([&] { read_csv_table(path); });
+  const std::string msg = refusal([&] { read_csv_table(path); });
   std::remove(path.c_str());
   EXPECT_EQ(msg, path + ":3: column 'xA': 'oops' is not a number");
 }
 
 TEST(CsvRead, MissingFileThrowsWithThePath) {
   const std::string path = ::testing::TempDir() + "phiq_no_such_dir/none.csv";
-  const std::string msg = error_of([&] { read_csv_table(path); });
+  const std::string msg = refusal([&] { read_csv_table(path); });
   EXPECT_EQ(msg.rfind(path + ": cannot read: ", 0), 0u) << msg;
 }
 
@@ -362,21 +362,21 @@ TEST(CsvCompare, UnknownColumnInOptionsThrows) {
   CsvTable a = parse("t,x,y\n0,1,2\n", "A.csv"), b = parse("t,x,z\n0,1,2\n", "B.csv");
   CompareOptions opt;
   opt.columns = {"x", "foo"};
-  EXPECT_EQ(error_of([&] { compare_csv(a, b, opt); }), "column 'foo' is not in A.csv");
+  EXPECT_EQ(refusal([&] { compare_csv(a, b, opt); }), "column 'foo' is not in A.csv");
   opt.columns = {"y"};
-  EXPECT_EQ(error_of([&] { compare_csv(a, b, opt); }), "column 'y' is not in B.csv");
+  EXPECT_EQ(refusal([&] { compare_csv(a, b, opt); }), "column 'y' is not in B.csv");
   opt.columns = {"z"};
-  EXPECT_EQ(error_of([&] { compare_csv(a, b, opt); }), "column 'z' is not in A.csv");
+  EXPECT_EQ(refusal([&] { compare_csv(a, b, opt); }), "column 'z' is not in A.csv");
 }
 
 TEST(CsvCompare, NegativeOrNanToleranceThrows) {
   CsvTable a = tx({1.0});
   CompareOptions opt;
   opt.rtol = -1e-9;
-  EXPECT_TRUE(contains(error_of([&] { compare_csv(a, a, opt); }), "rtol")) << "negative rtol";
+  EXPECT_TRUE(contains(refusal([&] { compare_csv(a, a, opt); }), "rtol")) << "negative rtol";
   opt.rtol = 1e-9;
   opt.atol = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_TRUE(contains(error_of([&] { compare_csv(a, a, opt); }), "atol")) << "NaN atol";
+  EXPECT_TRUE(contains(refusal([&] { compare_csv(a, a, opt); }), "atol")) << "NaN atol";
   opt.atol = 0.0;
   opt.rtol = kInf;  // allowed: accepts any two finite numbers
   EXPECT_TRUE(compare_csv(tx({0.0, 1.0}), tx({0.0, 1e300}), opt).equal);

@@ -16,8 +16,6 @@ namespace {
 
 using phiq::Curve;
 using phiq::kin::V2;
-Slot S(Index i) { return Slot::coordinate(i); }
-Slot C(double v) { return Slot::constant(v); }
 
 std::vector<V2> circle_points(int n, V2 centre, double r, double phase = 0.3) {
   std::vector<V2> p;

@@ -14,9 +14,6 @@
 namespace phiq {
 namespace {
 
-bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
-}
 
 TEST(Derivatives, UnsolvedPositionIsAFailureNamingTheWorstConstraint) {
   const Model m = test::crank_slider_model(2.0, 0.0);
@@ -108,9 +105,9 @@ TEST(Derivatives, TheCheckCostsOneResidualAtMostAndChangesNoBits) {
       none.tolerance = std::numeric_limits<double>::infinity();
       ASSERT_EQ(solve_velocity(m, t, none, unchecked), SolveStatus::kSuccess);
       ASSERT_EQ(solve_acceleration(m, t, none, unchecked), SolveStatus::kSuccess);
-      EXPECT_TRUE(same_bits(ws.q, unchecked.q));
-      EXPECT_TRUE(same_bits(ws.qd, unchecked.qd));
-      EXPECT_TRUE(same_bits(ws.qdd, unchecked.qdd));
+      EXPECT_TRUE(test::same_bits(ws.q, unchecked.q));
+      EXPECT_TRUE(test::same_bits(ws.qd, unchecked.qd));
+      EXPECT_TRUE(test::same_bits(ws.qdd, unchecked.qdd));
       EXPECT_EQ(ws.counters.factorizations, unchecked.counters.factorizations);
     }
   }

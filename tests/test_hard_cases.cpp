@@ -15,7 +15,7 @@ using namespace phiq;
 constexpr double kTol = 1e-10;  // the scenes' Newton tolerance (NewtonOptions / solver.tolerance default)
 
 // Every row of a sweep: q, q̇, q̈ and the largest scaled residual max_i |Φ_i| / scale_i of the delivered Φ.
-struct Rows {
+struct HardRows {
   test::Trace tr;
   std::vector<double> residual;
   SweepSummary sum;
@@ -23,12 +23,12 @@ struct Rows {
 };
 
 // Sweeps `sc` with its own settings on `threads` threads, asking for Φ at every row.
-Rows sweep_scene(const Scene& sc, int threads) {
+HardRows sweep_hard_scene(const Scene& sc, int threads) {
   SweepOptions opt = sc.sweep;
   opt.threads = threads;
   if (opt.chunk_steps == 0) opt.chunk_steps = opt.steps;  // one chunk, in order: the rows' own work is counted
   opt.residuals = true;
-  Rows r;
+  HardRows r;
   Workspace ws(*sc.model);
   r.status = run_sweep(*sc.model, opt, ws, [&](const StepView& s) {
     r.tr.t.push_back(s.t);
@@ -42,7 +42,7 @@ Rows sweep_scene(const Scene& sc, int threads) {
 }
 
 // No NaN or infinity anywhere, every row's every constraint within the tolerance, every time point delivered.
-void expect_sound(const Rows& r, const Scene& sc, const std::string& what) {
+void expect_sound(const HardRows& r, const Scene& sc, const std::string& what) {
   ASSERT_EQ(r.status, SolveStatus::kSuccess) << what << ": " << r.sum.message;
   ASSERT_EQ(r.tr.t.size(), static_cast<std::size_t>(sc.sweep.steps + 1)) << what;
   ASSERT_EQ(r.tr.qd.size(), r.tr.t.size()) << what;
@@ -89,7 +89,7 @@ TEST(HardCases, MillimetresAgreeWithMetres) {
 
   for (int threads : {1, 2}) {
     const std::string what = threads == 1 ? "in order" : "on 2 threads";
-    const Rows ra = sweep_scene(m, threads), rb = sweep_scene(mm, threads);
+    const HardRows ra = sweep_hard_scene(m, threads), rb = sweep_hard_scene(mm, threads);
     expect_sound(ra, m, "m " + what);
     expect_sound(rb, mm, "mm " + what);
     if (HasFatalFailure()) return;
@@ -140,7 +140,7 @@ TEST(HardCases, LengthsFromMillimetresToKilometres) {
 
   for (int threads : {1, 2}) {
     const std::string what = threads == 1 ? "in order" : "on 2 threads";
-    const Rows run = sweep_scene(sc, threads);
+    const HardRows run = sweep_hard_scene(sc, threads);
     expect_sound(run, sc, what);
     if (HasFatalFailure()) return;
     double e_a = 0, e_b = 0, e_v = 0, e_acc = 0;
@@ -326,7 +326,7 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   };
   const Index th = index_of("theta");
   ASSERT_LT(th, m.num_coordinates());
-  auto deviation = [&](const Rows& r) {  // from the closed form, at the bottom, the middle and the top
+  auto deviation = [&](const HardRows& r) {  // from the closed form, at the bottom, the middle and the top
     double worst = 0.0;
     for (std::size_t k = 0; k < r.tr.t.size(); ++k) {
       const Eigen::VectorXd& q = r.tr.q[k];
@@ -341,7 +341,7 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   };
   // q̇ and q̈ against the closed form's derivatives (θ̇ = 0.9 rad/s, θ̈ = 0), relative to the top joints' speed
   // (2000 · 0.9 · cos θ ≈ 1.7e3 m/s) and acceleration (2000 · 0.81 · sin θ ≈ 480 m/s² at the start)
-  auto derivative_deviation = [&](const Rows& r) {
+  auto derivative_deviation = [&](const HardRows& r) {
     double worst = 0.0;
     for (std::size_t k = 0; k < r.tr.qd.size() && k < r.tr.qdd.size(); ++k) {
       const double s = std::sin(r.tr.q[k](th)), c = std::cos(r.tr.q[k](th)), w = r.tr.qd[k](th);
@@ -357,11 +357,11 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
     return worst;
   };
 
-  const Rows usual = sweep_scene(sc, 1);
+  const HardRows usual = sweep_hard_scene(sc, 1);
   ASSERT_EQ(usual.status, SolveStatus::kSuccess) << usual.sum.message;
   EXPECT_TRUE(usual.sum.warnings.empty());
   sc.sweep.newton.tolerance = 1e-16;
-  const Rows r = sweep_scene(sc, 1);
+  const HardRows r = sweep_hard_scene(sc, 1);
   ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.sum.message;
   int rounding = 0;
   for (const SweepWarning& w : r.sum.warnings) {
@@ -392,7 +392,7 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   {
     const Predictor usual_predictor = sc.sweep.predictor;
     sc.sweep.predictor = Predictor::kPrevious;
-    const Rows p = sweep_scene(sc, 1);
+    const HardRows p = sweep_hard_scene(sc, 1);
     sc.sweep.predictor = usual_predictor;
     ASSERT_EQ(p.status, SolveStatus::kSuccess) << p.sum.message;
     EXPECT_GE(p.sum.counters.newton_iterations, 3 * sc.sweep.steps) << "several reused steps a row";
@@ -433,7 +433,7 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   // level, thousands of tolerances here, not by the 100 tolerances the seam check allows a regular solve; the check
   // allows 10× the rounding level such stops report, so every chunk is accepted (before, the rest ran in order).
   sc.sweep.chunk_steps = 5;
-  const Rows p = sweep_scene(sc, 2);
+  const HardRows p = sweep_hard_scene(sc, 2);
   ASSERT_EQ(p.status, SolveStatus::kSuccess) << p.sum.message;
   for (const SweepWarning& w : p.sum.warnings) EXPECT_NE(w.kind, "parallel_fallback") << w.message;
   EXPECT_EQ(p.sum.parallel_chunks, 4);
@@ -455,7 +455,7 @@ TEST(HardCases, AFreshWorkspaceOnOneThreadRepeatsASweepToTheBit) {
   sc.sweep.steps = 20;
   sc.sweep.t_end = 0.02;
   sc.sweep.newton.tolerance = 1e-16;
-  const Rows a = sweep_scene(sc, 1), b = sweep_scene(sc, 1);
+  const HardRows a = sweep_hard_scene(sc, 1), b = sweep_hard_scene(sc, 1);
   ASSERT_EQ(a.status, SolveStatus::kSuccess) << a.sum.message;
   ASSERT_EQ(b.status, SolveStatus::kSuccess) << b.sum.message;
   EXPECT_FALSE(a.sum.warnings.empty()) << "rows at their rounding level";

@@ -26,7 +26,7 @@ struct TempDir {
   }
 };
 
-std::string error_of(const std::string& path) {
+std::string read_refusal(const std::string& path) {
   try {
     read_result_table(path);
   } catch (const Error& e) {
@@ -55,7 +55,7 @@ std::string make_file(const TempDir& tmp, const std::string& name, const char* r
 TEST(Hdf5Reader, RefusesWhatIsNotPhiqResults) {
   TempDir tmp;
   const std::string text = tmp.write("text.h5", "t,x\n0,1\n");
-  EXPECT_EQ(error_of(text).rfind(text + ": not a readable HDF5 file: ", 0), 0u) << error_of(text);
+  EXPECT_EQ(read_refusal(text).rfind(text + ": not a readable HDF5 file: ", 0), 0u) << read_refusal(text);
   // a real file cut after its signature and superblock start
   const std::string good = make_file(tmp, "good.h5", "phiq results", 1);
   std::string bytes;
@@ -65,13 +65,13 @@ TEST(Hdf5Reader, RefusesWhatIsNotPhiqResults) {
   }
   const std::string cut = tmp.write("cut.dat", bytes.substr(0, 100));
   EXPECT_TRUE(is_hdf5_file(cut));  // by its signature, whatever its name
-  EXPECT_EQ(error_of(cut).rfind(cut + ": not a readable HDF5 file: ", 0), 0u) << error_of(cut);
+  EXPECT_EQ(read_refusal(cut).rfind(cut + ": not a readable HDF5 file: ", 0), 0u) << read_refusal(cut);
   const std::string other = make_file(tmp, "other.h5", nullptr, 0);
-  EXPECT_EQ(error_of(other), other + ": not phiq results: attribute 'format' is missing");
+  EXPECT_EQ(read_refusal(other), other + ": not phiq results: attribute 'format' is missing");
   const std::string v2 = make_file(tmp, "v2.h5", "phiq results", 2);
-  EXPECT_EQ(error_of(v2), v2 + ": HDF5 results format version 2 (this phiq reads 1)");
+  EXPECT_EQ(read_refusal(v2), v2 + ": HDF5 results format version 2 (this phiq reads 1)");
   const std::string missing = (tmp.dir / "missing.h5").string();
-  EXPECT_EQ(error_of(missing), missing + ": cannot read: No such file or directory");
+  EXPECT_EQ(read_refusal(missing), missing + ": cannot read: No such file or directory");
   // the smallest valid file: /t alone
   const CsvTable t = read_result_table(good);
   EXPECT_EQ(t.columns, std::vector<std::string>{"t"});

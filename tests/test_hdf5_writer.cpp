@@ -19,11 +19,11 @@ using namespace phiq;
 namespace h5 = phiq::detail::h5;
 namespace fs = std::filesystem;
 
-struct TempDir {
+struct ScratchDir {
   fs::path dir = fs::temp_directory_path() /
                  ("phiq_h5_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-  TempDir() { fs::remove_all(dir), fs::create_directories(dir); }
-  ~TempDir() { fs::remove_all(dir); }
+  ScratchDir() { fs::remove_all(dir), fs::create_directories(dir); }
+  ~ScratchDir() { fs::remove_all(dir); }
 };
 
 // The sweep of `scene_text`, written to `h5_path` by an Hdf5Writer with `options` and to CSV text by CsvFormat.
@@ -79,7 +79,7 @@ hsize_t rows_of(hid_t file, const char* name, hsize_t* columns = nullptr) {
 // The four-bar with every kind of output, over 73 rows in blocks of 5 (the buffer holds 5 rows): the read-back
 // table equals the CSV's bit for bit, and the datasets, their shapes, names and units are the documented ones.
 TEST(Hdf5Writer, HoldsTheCsvDoublesInTheDocumentedLayout) {
-  TempDir tmp;
+  ScratchDir tmp;
   const Scene scene = parse_scene(test::kFourbarOutputs, "fourbar_outputs.yaml");
   const std::string path = (tmp.dir / "r.h5").string();
   Hdf5Options o;
@@ -136,7 +136,7 @@ TEST(Hdf5Writer, HoldsTheCsvDoublesInTheDocumentedLayout) {
 // better: 73 rows with room for 34 go in blocks of 25 (3 × 25 = 75: 2 rows of slack; 34 would leave 29), and the
 // uncompressed /q takes exactly those 75 rows × 8 doubles on disk.
 TEST(Hdf5Writer, ChunksFitTheExpectedRows) {
-  TempDir tmp;
+  ScratchDir tmp;
   const Scene scene = parse_scene(test::kFourbarOutputs, "fourbar_outputs.yaml");
   const std::string path = (tmp.dir / "r.h5").string();
   Hdf5Options o;
@@ -154,7 +154,7 @@ TEST(Hdf5Writer, ChunksFitTheExpectedRows) {
 
 // Deflate with shuffle stores the same doubles (lossless), in less room than without.
 TEST(Hdf5Writer, DeflateIsLossless) {
-  TempDir tmp;
+  ScratchDir tmp;
   const Scene scene = parse_scene(test::kFourbarOutputs, "fourbar_outputs.yaml");
   Hdf5Options o;
   o.expected_rows = 73;
@@ -169,7 +169,7 @@ TEST(Hdf5Writer, DeflateIsLossless) {
 
 // Errors are phiq::Error naming the path (or the name shown for it), never HDF5's printed stack.
 TEST(Hdf5Writer, ErrorsNameThePath) {
-  TempDir tmp;
+  ScratchDir tmp;
   const Scene scene = parse_scene(test::kFourbarOutputs, "fourbar_outputs.yaml");
   const std::string missing = (tmp.dir / "nodir" / "r.h5").string();
   try {

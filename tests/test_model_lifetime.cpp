@@ -26,9 +26,6 @@ Solved solve_at(const Model& m, double t, Workspace& ws) {
   return {ws.q, ws.qd, ws.qdd};
 }
 
-bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
-}
 
 TEST(ModelLifetime, WorkspacesFollowModelsOfAGrowingVector) {
   // Reference: the same solves with models that never move.
@@ -57,9 +54,9 @@ TEST(ModelLifetime, WorkspacesFollowModelsOfAGrowingVector) {
     const auto i = static_cast<std::size_t>(k);
     EXPECT_EQ(&spaces[i].model(), &models[i]);
     const Solved s = solve_at(models[i], 0.25, spaces[i]);
-    EXPECT_TRUE(same_bits(s.q, expected[i].q)) << k;
-    EXPECT_TRUE(same_bits(s.qd, expected[i].qd)) << k;
-    EXPECT_TRUE(same_bits(s.qdd, expected[i].qdd)) << k;
+    EXPECT_TRUE(test::same_bits(s.q, expected[i].q)) << k;
+    EXPECT_TRUE(test::same_bits(s.qd, expected[i].qd)) << k;
+    EXPECT_TRUE(test::same_bits(s.qdd, expected[i].qdd)) << k;
   }
   // and a sweep with a workspace made before the growth
   SweepOptions opt;

@@ -34,17 +34,17 @@ time: {start: 0, end: 4, steps: 40}
 output: {velocities: true, accelerations: true, joints: [cyl, rail], orientations: {bodies: [screw], as: axis_angle}}
 )";
 
-struct Rows {
+struct JointRows {
   std::vector<double> t;
   std::vector<std::vector<JointMotion>> joints;
   std::vector<std::vector<OrientationMotion>> orientations;
 };
 
-Rows sweep_rows(const Scene& s, int threads) {
+JointRows sweep_rows(const Scene& s, int threads) {
   SweepOptions o = s.sweep;
   o.threads = threads;
   Workspace ws(*s.model);
-  Rows r;
+  JointRows r;
   SweepSummary sum;
   const SolveStatus st = run_sweep(*s.model, o, ws, [&](const StepView& v) {
     r.t.push_back(v.t);
@@ -63,7 +63,7 @@ TEST(OutputJoints, AnglesAndDistancesFollowTheDriversThroughTurns) {
   EXPECT_EQ(s.sweep.joints[1].measure, JointMeasure::kDistance);
   for (int threads : {1, 2, 3}) {
     SCOPED_TRACE("threads " + std::to_string(threads));
-    const Rows r = sweep_rows(s, threads);
+    const JointRows r = sweep_rows(s, threads);
     ASSERT_EQ(r.t.size(), 41u);
     for (std::size_t k = 0; k < r.t.size(); ++k) {
       const double t = r.t[k];
@@ -94,7 +94,7 @@ TEST(OutputJoints, RowsLeftUnwrittenStillUnwrap) {
   // every 7th row only: the angle jumps 1.4 rad between written rows, and the unwritten ones carried it
   const Scene s = parse_scene(test::replace_first(kScrew, "output: {", "output: {every: 7, "), "every.yaml");
   for (int threads : {1, 2}) {
-    const Rows r = sweep_rows(s, threads);
+    const JointRows r = sweep_rows(s, threads);
     ASSERT_EQ(r.t.size(), 6u);
     for (std::size_t k = 0; k < r.t.size(); ++k) EXPECT_NEAR(r.joints[k][0].value, 2 * r.t[k], 1e-9) << threads;
   }
@@ -110,7 +110,7 @@ TEST(OutputJoints, RockerAngleAgreesWithItsAngularVelocity) {
                              "output: {velocities: true, accelerations: true, joints: [rocker_hinge, crank_hinge], "
                              "orientations: [rocker, crank]}");
   const Scene s = parse_scene(text, "rssr.yaml");
-  const Rows r = sweep_rows(s, 2);
+  const JointRows r = sweep_rows(s, 2);
   ASSERT_EQ(r.t.size(), 73u);
   for (std::size_t k = 0; k < r.t.size(); ++k) {
     SCOPED_TRACE("t = " + std::to_string(r.t[k]));

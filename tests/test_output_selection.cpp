@@ -33,7 +33,7 @@ time: {start: 0, end: 2, steps: )" + std::to_string(steps) + R"(}
 output: )" + output + "\n";
 }
 
-std::string error_of(const std::string& output) {
+std::string refusal_of(const std::string& output) {
   try {
     parse_scene(scene(output), "sel.yaml");
   } catch (const SceneError& e) {
@@ -56,29 +56,29 @@ TEST(OutputSelection, NamesAndPatternsSelectColumnsInSceneOrder) {
 }
 
 TEST(OutputSelection, BadSelectionsAreOneLineErrorsNamingTheField) {
-  EXPECT_NE(error_of("{coordinates: ['z*']}").find("output.coordinates[0]: pattern 'z*' selects no coordinate"),
+  EXPECT_NE(refusal_of("{coordinates: ['z*']}").find("output.coordinates[0]: pattern 'z*' selects no coordinate"),
             std::string::npos)
-      << error_of("{coordinates: ['z*']}");
-  EXPECT_NE(error_of("{velocities: [theta, 'q?']}").find("output.velocities[1]: pattern 'q?' selects no coordinate"),
+      << refusal_of("{coordinates: ['z*']}");
+  EXPECT_NE(refusal_of("{velocities: [theta, 'q?']}").find("output.velocities[1]: pattern 'q?' selects no coordinate"),
             std::string::npos)
-      << error_of("{velocities: [theta, 'q?']}");
-  EXPECT_NE(error_of("{accelerations: [nope]}").find("unknown coordinate 'nope'"), std::string::npos);
-  EXPECT_NE(error_of("{coordinates: [x1, x1]}").find("listed twice"), std::string::npos);
-  EXPECT_NE(error_of("{every: 0}").find("output.every"), std::string::npos) << error_of("{every: 0}");
-  EXPECT_NE(error_of("{window: [1, 0.5]}").find("output.window: begin must not be above end"), std::string::npos)
-      << error_of("{window: [1, 0.5]}");
-  EXPECT_NE(error_of("{window: [1]}").find("output.window: must be [begin, end] (s)"), std::string::npos);
+      << refusal_of("{velocities: [theta, 'q?']}");
+  EXPECT_NE(refusal_of("{accelerations: [nope]}").find("unknown coordinate 'nope'"), std::string::npos);
+  EXPECT_NE(refusal_of("{coordinates: [x1, x1]}").find("listed twice"), std::string::npos);
+  EXPECT_NE(refusal_of("{every: 0}").find("output.every"), std::string::npos) << refusal_of("{every: 0}");
+  EXPECT_NE(refusal_of("{window: [1, 0.5]}").find("output.window: begin must not be above end"), std::string::npos)
+      << refusal_of("{window: [1, 0.5]}");
+  EXPECT_NE(refusal_of("{window: [1]}").find("output.window: must be [begin, end] (s)"), std::string::npos);
 }
 
-struct Written {
+struct SweptRows {
   std::vector<Index> steps;
   std::vector<Eigen::VectorXd> q, qd;
   std::vector<double> bx;  // the output point B's x
   SweepSummary sum;
 };
 
-Written sweep(const Scene& s, int threads, Index chunk) {
-  Written w;
+SweptRows sweep(const Scene& s, int threads, Index chunk) {
+  SweptRows w;
   SweepOptions opt = s.sweep;
   opt.threads = threads;
   opt.chunk_steps = chunk;
@@ -101,11 +101,11 @@ TEST(OutputSelection, EveryKthRowInAWindowIsTheFullSweepsRowsAndCostsOnlyThem) {
   const Scene all = parse_scene(scene("{velocities: true, points: [B]}"), "sel.yaml");
   const Scene some = parse_scene(scene("{velocities: true, points: [B], every: 4, window: [0.5, 1.5]}"), "sel.yaml");
   for (Index chunk : {Index{24}, Index{5}}) {  // (the same chunk layout: rows are the same bits for each)
-    const Written full = sweep(all, 1, chunk);
+    const SweptRows full = sweep(all, 1, chunk);
     ASSERT_EQ(full.steps.size(), 25u);
     EXPECT_EQ(full.sum.counters.point_evaluations, 25);
     for (int threads : {1, 2}) {
-      const Written w = sweep(some, threads, chunk);
+      const SweptRows w = sweep(some, threads, chunk);
       ASSERT_EQ(w.steps, (std::vector<Index>{8, 12, 16})) << threads << " threads, chunk " << chunk;
       for (std::size_t i = 0; i < w.steps.size(); ++i) {
         const std::size_t k = static_cast<std::size_t>(w.steps[i]);

@@ -21,7 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* kCrankSlider = R"(phiq: 1
+const char* kReachCrankSlider = R"(phiq: 1
 parameters: {L2: 0.3, L3: 1.0, unused: 5}
 coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}
 points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
@@ -72,7 +72,7 @@ std::vector<std::string> reached(const Model& m, const ParameterReach& r) {
 
 // A length reaches its one constraint, and nothing else: the driver's law is the same law in every model.
 TEST(ParameterReach, ALengthReachesItsConstraintOnly) {
-  const Scene s = parse_scene(kCrankSlider, "c.yaml");
+  const Scene s = parse_scene(kReachCrankSlider, "c.yaml");
   const OutputSensitivity l2 = sensitivity_along(s, "L2", 0.3), l3 = sensitivity_along(s, "L3", 1.0);
   ASSERT_TRUE(l2.reach && l3.reach);  // sensitivity_along() finds it
   EXPECT_EQ(reached(*s.model, *l2.reach), (std::vector<std::string>{"crank"}));
@@ -97,7 +97,7 @@ TEST(ParameterReach, ALengthReachesItsConstraintOnly) {
 // as a parameter nothing reads.
 TEST(ParameterReach, ALawsCoefficientReachesItsDriver) {
   const std::string text = test::replace_first(
-      test::replace_first(kCrankSlider, "unused: 5}", "unused: 5, w: 2}"), "rate: 2}", "rate: w}");
+      test::replace_first(kReachCrankSlider, "unused: 5}", "unused: 5, w: 2}"), "rate: 2}", "rate: w}");
   const Scene s = parse_scene(text, "c.yaml");
   OutputSensitivity w = sensitivity_along(s, "w", 2.0);
   EXPECT_EQ(reached(*s.model, *w.reach), (std::vector<std::string>{"motor"}));
@@ -190,7 +190,7 @@ TEST(ParameterReach, OneBarOfAFamilyIsOneSpan) {
 
 // Models whose blocks cannot be matched to the swept model's (here another scene's) reach everything.
 TEST(ParameterReach, ModelsWhoseBlocksDoNotMatchReachEverything) {
-  const Scene s = parse_scene(kCrankSlider, "c.yaml");
+  const Scene s = parse_scene(kReachCrankSlider, "c.yaml");
   const Scene other = load_scene(test::model_path("seed/fourbar_natural.yaml"));
   SceneOverrides keep;
   keep.keep_sensitivity_models = true;
@@ -240,11 +240,11 @@ TEST(ParameterReach, AddJacobianProductIsTheJacobiansProductOnEveryScene) {
 // same_data(): a constraint is the same as itself in another build of the scene (its driver's law too), and differs
 // exactly where the parameter moved its data.
 TEST(ParameterReach, SameDataComparesTheConstraintsData) {
-  const Scene a = parse_scene(kCrankSlider, "c.yaml");
-  const Scene b = parse_scene(kCrankSlider, "c.yaml");
+  const Scene a = parse_scene(kReachCrankSlider, "c.yaml");
+  const Scene b = parse_scene(kReachCrankSlider, "c.yaml");
   SceneOverrides o;
   o.parameters = {{"L3", 1.25}};
-  const Scene c = parse_scene(kCrankSlider, "c.yaml", {}, o);
+  const Scene c = parse_scene(kReachCrankSlider, "c.yaml", {}, o);
   for (std::size_t k = 0; k < a.model->blocks().size(); ++k) {
     const ConstraintBlock& x = *a.model->blocks()[k];
     const std::string kind = x.kind();
@@ -310,7 +310,7 @@ void expect_reach_changes_nothing(const Scene& s, const std::vector<std::string>
 }
 
 TEST(ParameterReach, SensitivitiesOverTheReachAreThoseOverEveryConstraint) {
-  expect_reach_changes_nothing(parse_scene(kCrankSlider, "c.yaml"), {"L2", "L3"});
+  expect_reach_changes_nothing(parse_scene(kReachCrankSlider, "c.yaml"), {"L2", "L3"});
   expect_reach_changes_nothing(parse_scene(kBars, "bars.yaml"), {"R7", "L"});
   expect_reach_changes_nothing(load_scene(test::model_path("spatial/rssr.yaml")), {"L"});
 }

@@ -12,14 +12,14 @@
 namespace phiq {
 namespace {
 
-constexpr double kTol = 1e-10;
+constexpr double kNewtonTol = 1e-10;
 
 Index sum_of_rows(const SweepAccuracy& a) { return a.converged.rows + a.rounding_level.rows + a.singular.rows; }
 
 // |q_j − exact| in units of the tolerance test of coordinate j.
 double in_tolerances(const Model& m, Index j, double q, double exact) {
   return std::fabs(q - exact) /
-         (kTol * m.tolerance_scales().coordinate_scale(j) + ToleranceScales::kUlpFloor * std::fabs(q));
+         (kNewtonTol * m.tolerance_scales().coordinate_scale(j) + ToleranceScales::kUlpFloor * std::fabs(q));
 }
 
 // A scissor lift of 4000 stages: its top joints, 4000 m up, are known to a few tolerances only (the rounding of Φ

@@ -32,7 +32,6 @@ output: {velocities: true}
 
 // The good scene with the first occurrence of `from` replaced; the error a scene gives.
 std::string variant(const std::string& from, const std::string& to) { return test::replace_first(kGood, from, to); }
-std::string error_of(const std::string& text) { return test::scene_error(text); }
 
 TEST(Scene, GoodSceneBuildsTheModelItDescribes) {
   Scene s = parse_scene(kGood, "good.yaml");

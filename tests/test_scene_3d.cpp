@@ -14,7 +14,7 @@ namespace phiq {
 namespace {
 
 // A door on one hinge, driven by its angle; a natural point and vector beside it.
-const char* kGood = R"(phiq: 1
+const char* kGood3d = R"(phiq: 1
 dimension: 3
 parameters: {h: 2}
 coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}
@@ -27,11 +27,10 @@ drivers:
 time: {start: 0, end: 1, steps: 4}
 )";
 
-std::string variant(const std::string& from, const std::string& to) { return test::replace_first(kGood, from, to); }
-std::string error_of(const std::string& text) { return test::scene_error(text); }
+std::string edited(const std::string& from, const std::string& to) { return test::replace_first(kGood3d, from, to); }
 
 TEST(Scene3d, GoodSceneBuildsBodiesJointsAndDrivers) {
-  Scene s = parse_scene(kGood, "good.yaml");
+  Scene s = parse_scene(kGood3d, "good.yaml");
   const Model& m = *s.model;
   EXPECT_EQ(m.num_coordinates(), 7);
   EXPECT_EQ(m.num_equations(), 7);
@@ -196,41 +195,41 @@ output: {velocities: true, accelerations: true}
 }
 
 TEST(Scene3d, BadInputIsOneLineNamingTheField) {
-  EXPECT_HAS(error_of(variant("axis: [0, 0, 1]}", "axis: [0, 0, 0]}")), "between[0].axis: must not be the zero vector");
-  EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: dor, at: [0, 0, h]}")), "unknown body 'dor'");
+  EXPECT_HAS(error_of(edited("axis: [0, 0, 1]}", "axis: [0, 0, 0]}")), "between[0].axis: must not be the zero vector");
+  EXPECT_HAS(error_of(edited("{body: door, at: [0, 0, h]}", "{body: dor, at: [0, 0, h]}")), "unknown body 'dor'");
   // all-zero Euler parameters are no orientation: refused at the body, not "Gauss-Newton step is not finite"
-  EXPECT_HAS(error_of(variant("e0: 1,", "e0: 0,")),
+  EXPECT_HAS(error_of(edited("e0: 1,", "e0: 0,")),
              "bad.yaml:6:9: bodies.door: body 'door': its Euler parameters are all 0 in the placement");
-  EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: door, at: [0, h]}")),
+  EXPECT_HAS(error_of(edited("{body: door, at: [0, 0, h]}", "{body: door, at: [0, h]}")),
              "between[1].at: expected a list of 3 numbers");
-  EXPECT_HAS(error_of(variant("{body: door, at: [0, 0, h]}", "{body: door, ref: [0, 0, 3]}")),
+  EXPECT_HAS(error_of(edited("{body: door, at: [0, 0, h]}", "{body: door, ref: [0, 0, 3]}")),
              "ref must not be zero or along the axis");
-  EXPECT_HAS(error_of(variant("door: [x, y, z, e0, e1, e2, e3]", "door: [x, y, z]")),
+  EXPECT_HAS(error_of(edited("door: [x, y, z, e0, e1, e2, e3]", "door: [x, y, z]")),
              "a body is [x, y, z, e0, e1, e2, e3], or {at: [x, y, z], orientation: {...}} (dimension: 3)");
-  EXPECT_HAS(error_of(variant("type: revolute", "type: loop")), "'loop' is a planar constraint");
-  EXPECT_HAS(error_of(variant("type: revolute", "type: hinge")), "unknown constraint type 'hinge'");
-  EXPECT_HAS(error_of(variant("joint: hinge", "joint: hing")), "drivers[0].joint: unknown joint 'hing'");
-  EXPECT_HAS(error_of(variant("joint: hinge,", "joint: hinge, measure: distance,")),
+  EXPECT_HAS(error_of(edited("type: revolute", "type: loop")), "'loop' is a planar constraint");
+  EXPECT_HAS(error_of(edited("type: revolute", "type: hinge")), "unknown constraint type 'hinge'");
+  EXPECT_HAS(error_of(edited("joint: hinge", "joint: hing")), "drivers[0].joint: unknown joint 'hing'");
+  EXPECT_HAS(error_of(edited("joint: hinge,", "joint: hinge, measure: distance,")),
              "joint 'hinge' is a revolute joint");
-  EXPECT_HAS(error_of(variant("type: revolute", "type: cylindrical")), "needs 'measure: angle' or 'measure: distance'");
-  EXPECT_HAS(error_of(variant("type: revolute", "type: spherical")), "joint 'hinge' is a spherical joint");
-  EXPECT_HAS(error_of(variant("joint: hinge,", "joint: hinge, coordinate: x,")), "one of 'coordinate', 'expr' or 'joint'");
-  EXPECT_HAS(error_of(variant("{body: ground, at: [0, 0, h], axis: [0, 0, 1]}", "{point: P}")), "unknown point 'P'");
-  const std::string with_point = variant("bodies:", "points: {P: [1, 2, 3]}\nbodies:");
+  EXPECT_HAS(error_of(edited("type: revolute", "type: cylindrical")), "needs 'measure: angle' or 'measure: distance'");
+  EXPECT_HAS(error_of(edited("type: revolute", "type: spherical")), "joint 'hinge' is a spherical joint");
+  EXPECT_HAS(error_of(edited("joint: hinge,", "joint: hinge, coordinate: x,")), "one of 'coordinate', 'expr' or 'joint'");
+  EXPECT_HAS(error_of(edited("{body: ground, at: [0, 0, h], axis: [0, 0, 1]}", "{point: P}")), "unknown point 'P'");
+  const std::string with_point = edited("bodies:", "points: {P: [1, 2, 3]}\nbodies:");
   const std::string natural_a = with_point.substr(0, with_point.find("{body: ground")) + "{point: P}" +
                                 with_point.substr(with_point.find(", {body: door"));
   EXPECT_HAS(error_of(natural_a), "side a: needs a body or ground");
-  EXPECT_HAS(error_of(variant("bodies:", "points: {P: [1, 2]}\nbodies:")), "a point is [x, y, z] (dimension: 3)");
-  EXPECT_HAS(error_of(variant("bodies:", "vectors: {u: [1, 2]}\nbodies:")), "a vector is [ux, uy, uz]");
-  EXPECT_HAS(error_of(variant("bodies:", "points: {door: [1, 2, 3]}\nbodies:")), "duplicate point, body or vector name");
-  EXPECT_HAS(error_of(variant("dimension: 3", "dimension: 4")), "dimension");
+  EXPECT_HAS(error_of(edited("bodies:", "points: {P: [1, 2]}\nbodies:")), "a point is [x, y, z] (dimension: 3)");
+  EXPECT_HAS(error_of(edited("bodies:", "vectors: {u: [1, 2]}\nbodies:")), "a vector is [ux, uy, uz]");
+  EXPECT_HAS(error_of(edited("bodies:", "points: {door: [1, 2, 3]}\nbodies:")), "duplicate point, body or vector name");
+  EXPECT_HAS(error_of(edited("dimension: 3", "dimension: 4")), "dimension");
 }
 
-// The door of kGood written as a map: phiq adds door_x … door_e3 with the placement and orientation as initial
+// The door of kGood3d written as a map: phiq adds door_x … door_e3 with the placement and orientation as initial
 // guesses; every form of orientation gives the Euler parameters of the same rotation.
 TEST(Scene3d, BodiesWrittenAsMapsBringTheirCoordinates) {
   auto door = [](const std::string& body) {
-    std::string s = test::replace_first(kGood, "coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\n", "");
+    std::string s = test::replace_first(kGood3d, "coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\n", "");
     return test::replace_first(s, "door: [x, y, z, e0, e1, e2, e3]", "door: " + body);
   };
   const double c = std::cos(0.15), sn = std::sin(0.15);  // a turn of 0.3 about z
@@ -285,13 +284,13 @@ TEST(Scene3d, BodiesWrittenAsMapsBringTheirCoordinates) {
 
 // A hinge about x measures its angle from y on both sides unless the scene says otherwise; the scene records it.
 TEST(Scene3d, JointAngleReferencesAreRecorded) {
-  const Scene s = parse_scene(kGood, "good.yaml");
+  const Scene s = parse_scene(kGood3d, "good.yaml");
   ASSERT_EQ(s.joint_angles.size(), 1u);
   EXPECT_EQ(s.joint_angles[0].driver, "open");
   EXPECT_EQ(s.joint_angles[0].joint, "hinge");
   EXPECT_EQ(s.joint_angles[0].ref_a, (std::array<double, 3>{1, 0, 0}));
   EXPECT_FALSE(s.joint_angles[0].stated_a);
-  std::string about_x = variant("axis: [0, 0, 1]}", "axis: [1, 0, 0]}");
+  std::string about_x = edited("axis: [0, 0, 1]}", "axis: [1, 0, 0]}");
   about_x = test::replace_first(about_x, "{body: door, at: [0, 0, h]}", "{body: door, at: [0, 0, h], axis: [0.95, 0.1, 0], ref: [0, 0, 1]}");
   const Scene x = parse_scene(about_x, "x.yaml");
   ASSERT_EQ(x.joint_angles.size(), 1u);
@@ -300,7 +299,7 @@ TEST(Scene3d, JointAngleReferencesAreRecorded) {
   EXPECT_FALSE(x.joint_angles[0].stated_a);
   EXPECT_TRUE(x.joint_angles[0].stated_b);
   // the axis of a spatial joint is on its sides: a prismatic's planar `axis` field says where it goes
-  EXPECT_HAS(error_of(variant("type: revolute, between:", "type: prismatic, axis: [0, 0, 1], between:")),
+  EXPECT_HAS(error_of(edited("type: revolute, between:", "type: prismatic, axis: [0, 0, 1], between:")),
              "constraints[0].axis: in dimension 3 a joint's axis is given on each side");
 }
 

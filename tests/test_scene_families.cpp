@@ -13,7 +13,6 @@ namespace phiq {
 namespace {
 
 // The error a scene gives.
-std::string error_of(const std::string& text) { return test::scene_error(text); }
 
 // The N = 3 four-bar of `phiq generate nfourbar 3` with families (line numbers matter: messages name them) ...
 const char* kFamilies = R"(phiq: 1

@@ -13,12 +13,12 @@ using test::angle_diff;
 
 Scene load(const std::string& name) { return load_scene(test::model_path("seed/" + name)); }
 
-struct Angles {
+struct SeedAngles {
   double crank, coupler, rocker;  // absolute: crank O→A, coupler A→B, rocker C→B
 };
 
 // Crank, coupler and rocker angles from each formulation's coordinates.
-Angles angles_of(const std::string& formulation, const Model& m, const Eigen::VectorXd& q) {
+SeedAngles angles_of(const std::string& formulation, const Model& m, const Eigen::VectorXd& q) {
   auto c = [&](const char* n) { return q(m.coordinate_index(n)); };
   const double L1 = 1.0;
   if (formulation == "relative")
@@ -43,10 +43,10 @@ TEST(SeedModels, FourFourBarFormulationsAgreeOverAFullTurn) {
   }
   double worst = 0.0;
   for (std::size_t k = 0; k < 361; ++k) {
-    Angles ref = angles_of(forms[0], *scenes[0].model, traces[0].q[k]);
+    SeedAngles ref = angles_of(forms[0], *scenes[0].model, traces[0].q[k]);
     EXPECT_NEAR(angle_diff(ref.crank, traces[0].t[k]), 0.0, 1e-12);
     for (int f = 1; f < 4; ++f) {
-      Angles a = angles_of(forms[f], *scenes[f].model, traces[f].q[k]);
+      SeedAngles a = angles_of(forms[f], *scenes[f].model, traces[f].q[k]);
       worst = std::max({worst, std::fabs(angle_diff(a.crank, ref.crank)), std::fabs(angle_diff(a.coupler, ref.coupler)),
                         std::fabs(angle_diff(a.rocker, ref.rocker))});
     }

@@ -35,7 +35,7 @@ struct Swept {
 
 // The scene at parameter = value, swept as `phiq run` sweeps it, with q, q̇, q̈ and, when `sensitivity` is given,
 // its sensitivities.
-Swept sweep_at(const std::string& text, const std::string& path, const std::string& parameter, double value,
+Swept sweep_scene_at(const std::string& text, const std::string& path, const std::string& parameter, double value,
                const OutputSensitivity* sensitivity) {
   Swept r;
   SceneOverrides o;
@@ -93,7 +93,7 @@ TEST(SensitivityScenes, EveryParameterOfEverySceneMatchesResolvedSweeps) {
         left_out.push_back(who + ": structure (" + why.substr(0, 60) + ")");
         continue;
       }
-      const Swept base = sweep_at(text, path, name, value, &sens);
+      const Swept base = sweep_scene_at(text, path, name, value, &sens);
       if (!base.failure.empty()) {
         left_out.push_back(who + ": the sweep fails (" + base.failure.substr(0, 80) + ")");
         continue;
@@ -118,10 +118,10 @@ TEST(SensitivityScenes, EveryParameterOfEverySceneMatchesResolvedSweeps) {
       std::array<double, 3> best{INFINITY, INFINITY, INFINITY}, scales{}, worst_ts{};
       for (double relative_step : {1e-2, 1e-3, 1e-4, 2e-5}) {
         const double delta = value == 0.0 ? relative_step : relative_step * std::fabs(value);
-        const Swept up = sweep_at(text, path, name, value + delta, nullptr);
-        const Swept down = sweep_at(text, path, name, value - delta, nullptr);
-        const Swept up2 = sweep_at(text, path, name, value + delta / 2, nullptr);
-        const Swept down2 = sweep_at(text, path, name, value - delta / 2, nullptr);
+        const Swept up = sweep_scene_at(text, path, name, value + delta, nullptr);
+        const Swept down = sweep_scene_at(text, path, name, value - delta, nullptr);
+        const Swept up2 = sweep_scene_at(text, path, name, value + delta / 2, nullptr);
+        const Swept down2 = sweep_scene_at(text, path, name, value - delta / 2, nullptr);
         const std::string failure = up.failure + down.failure + up2.failure + down2.failure;
         if (!failure.empty()) reference_failure = "a sweep at p ± δ fails (" + failure.substr(0, 80) + ")";
         else if (up.t != base.t || down.t != base.t || up2.t != base.t || down2.t != base.t)

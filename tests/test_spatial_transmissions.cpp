@@ -21,10 +21,7 @@ using kin3::V3;
 
 // Coordinates of the random states: body 0 at 0..6, body 1 at 7..13, natural points at 14..16 and 17..19, angle
 // coordinates at 20 and 21.
-constexpr int kN = 22;
-Slot S(Index i) { return Slot::coordinate(i); }
-Frame3 Body(Index f) { return Frame3{S(f), S(f + 1), S(f + 2), S(f + 3), S(f + 4), S(f + 5), S(f + 6)}; }
-Point3 Nat(Index f) { return Point3{S(f), S(f + 1), S(f + 2)}; }
+constexpr int kCoords = 22;
 V3 Random(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   return V3{u(rng), u(rng), u(rng)};
@@ -42,10 +39,10 @@ TEST(SpatialTransmissions, ScrewDerivatives) {
     ScrewSpec s;
     s.a = Side(Body(0), rng), s.b = Side(Body(7), rng), s.pitch = pitch;
     s.setup();
-    CheckSpec(s, kN, Opts(2722));
+    CheckSpec(s, kCoords, Opts(2722));
     s.a = Side(Frame3::ground(), rng);
     s.setup();
-    CheckSpec(s, kN, Opts(2723));
+    CheckSpec(s, kCoords, Opts(2723));
   }
 }
 
@@ -69,10 +66,10 @@ TEST(SpatialTransmissions, ScrewAlongItsData) {
     ScrewSpec s;
     s.a = Side(Body(0), rng), s.b = Side(Body(7), rng), s.pitch = pitch;
     s.setup();
-    CheckDataDerivative(s, rate_of(s), kN, 2726, 3);
+    CheckDataDerivative(s, rate_of(s), kCoords, 2726, 3);
     s.a = Side(Frame3::ground(), rng);
     s.setup();
-    CheckDataDerivative(s, rate_of(s), kN, 2727, 3);
+    CheckDataDerivative(s, rate_of(s), kCoords, 2727, 3);
   }
 }
 
@@ -83,9 +80,9 @@ TEST(SpatialTransmissions, SpatialGearDerivatives) {
   g.a2 = Side(Body(0), rng), g.b2 = Side(Body(7), rng);
   g.theta1 = S(20), g.theta2 = S(21), g.z1 = 15, g.z2 = 40, g.phase = 0.3;
   g.setup();
-  CheckSpec(g, kN, Opts(2732));
+  CheckSpec(g, kCoords, Opts(2732));
   g.reversed = true;
-  CheckSpec(g, kN, Opts(2733));
+  CheckSpec(g, kCoords, Opts(2733));
 }
 
 TEST(SpatialTransmissions, SpatialGearAlongItsData) {
@@ -102,7 +99,7 @@ TEST(SpatialTransmissions, SpatialGearAlongItsData) {
     RandomizeAttachmentRates(rate.att1, rng);
     RandomizeAttachmentRates(rate.att2, rng);
     rate.z1 = 2.0, rate.z2 = -3.0, rate.phase = 0.8;
-    CheckDataDerivative(g, rate, kN, reversed ? 2736 : 2735);
+    CheckDataDerivative(g, rate, kCoords, reversed ? 2736 : 2735);
   }
 }
 
@@ -111,19 +108,19 @@ TEST(SpatialTransmissions, MixedCoordinateDerivatives) {
   SpatialPolarSpec p;
   p.center = Side(Body(0), rng), p.point = Nat(14), p.radius = 0.6, p.theta = S(20);
   p.setup();
-  CheckSpec(p, kN, Opts(2742));
+  CheckSpec(p, kCoords, Opts(2742));
   p.center = Side(Frame3::ground(), rng), p.radius = -1.3;
   p.setup();
-  CheckSpec(p, kN, Opts(2743));
+  CheckSpec(p, kCoords, Opts(2743));
 
   SpatialAngleSpec r;  // a body's turn about another's axis
   r.a = Side(Body(0), rng), r.b = Side(Body(7), rng), r.theta = S(20);
   r.setup();
-  CheckSpec(r, kN, Opts(2744));
+  CheckSpec(r, kCoords, Opts(2744));
   SpatialAngleSpec seg;  // a segment of natural points about a moving axis
   seg.segment = true, seg.a = Side(Body(7), rng), seg.from = Nat(14), seg.to = Nat(17), seg.theta = S(21);
   seg.setup();
-  CheckSpec(seg, kN, Opts(2745));
+  CheckSpec(seg, kCoords, Opts(2745));
 }
 
 TEST(SpatialTransmissions, MixedCoordinatesAlongTheirData) {
@@ -134,21 +131,21 @@ TEST(SpatialTransmissions, MixedCoordinatesAlongTheirData) {
   p.setup();
   SpatialPolarSpec rate = WithRandomAttachmentRates(p, rng);
   rate.radius = -0.4, rate.theta = Slot::constant(0.0);
-  CheckDataDerivative(p, rate, kN, 2752);
+  CheckDataDerivative(p, rate, kCoords, 2752);
   p.center = Side(Frame3::ground(), rng), p.radius = -1.3, p.theta = Slot::constant(0.7);
   p.setup();
   rate = WithRandomAttachmentRates(p, rng);
   rate.radius = 0.9, rate.theta = Slot::constant(1.2);
-  CheckDataDerivative(p, rate, kN, 2753);
+  CheckDataDerivative(p, rate, kCoords, 2753);
   // the rotation and segment angles, through their attachments
   SpatialAngleSpec r;
   r.a = Side(Body(0), rng), r.b = Side(Body(7), rng), r.theta = S(20);
   r.setup();
-  CheckDataDerivative(r, WithRandomAttachmentRates(r, rng), kN, 2754);
+  CheckDataDerivative(r, WithRandomAttachmentRates(r, rng), kCoords, 2754);
   SpatialAngleSpec seg;
   seg.segment = true, seg.a = Side(Frame3::ground(), rng), seg.from = Nat(14), seg.to = Nat(17), seg.theta = S(21);
   seg.setup();
-  CheckDataDerivative(seg, WithRandomAttachmentRates(seg, rng), kN, 2755);
+  CheckDataDerivative(seg, WithRandomAttachmentRates(seg, rng), kCoords, 2755);
 }
 
 TEST(SpatialTransmissions, ScrewRisesOnePitchPerTurn) {

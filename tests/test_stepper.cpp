@@ -39,9 +39,6 @@ SliderExact slider_exact(double t) {
   return {r * c + D, 2 * dx, 4 * ddx};
 }
 
-bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), sizeof(double) * a.size()) == 0;
-}
 
 StepperOptions stepper_options(const SweepOptions& o) {
   StepperOptions s;
@@ -79,9 +76,9 @@ TEST(Stepper, OnASweepsGridGivesItsRowsBitForBitWithItsWork) {
     EXPECT_EQ(ss.assembled, k == 0);
     EXPECT_TRUE(ss.moved);
     EXPECT_EQ(stepper.time(), tr.t[k]);
-    EXPECT_TRUE(same_bits(stepper.q(), tr.q[k])) << "row " << k;
-    EXPECT_TRUE(same_bits(stepper.qd(), tr.qd[k])) << "row " << k;
-    EXPECT_TRUE(same_bits(stepper.qdd(), tr.qdd[k])) << "row " << k;
+    EXPECT_TRUE(test::same_bits(stepper.q(), tr.q[k])) << "row " << k;
+    EXPECT_TRUE(test::same_bits(stepper.qd(), tr.qd[k])) << "row " << k;
+    EXPECT_TRUE(test::same_bits(stepper.qdd(), tr.qdd[k])) << "row " << k;
   }
   const SweepSummary& s = stepper.summary();
   EXPECT_EQ(s.status, SolveStatus::kSuccess);
@@ -153,7 +150,7 @@ TEST(Stepper, NonUniformTimesForwardAndBackMatchTheClosedForm) {
   EXPECT_FALSE(ss.moved);
   EXPECT_EQ(stepper.workspace().counters.newton_iterations, before.newton_iterations);
   EXPECT_EQ(stepper.summary().steps_completed, static_cast<Index>(times.size()));
-  EXPECT_TRUE(same_bits(stepper.q(), q));
+  EXPECT_TRUE(test::same_bits(stepper.q(), q));
   // A step that would not move time is a programming error.
   EXPECT_THROW((void)stepper.step(std::nextafter(stepper.time(), 1.0)), Error);
   EXPECT_THROW((void)stepper.step(NAN), Error);
@@ -183,8 +180,8 @@ TEST(Stepper, SingularPositionsWarnAsRunSweep) {
     for (Index k = 0; k <= o.steps; ++k) {
       StepSummary ss;
       ASSERT_EQ(stepper.step(o.time_of(k), &ss), SolveStatus::kSuccess) << ss.message;
-      ASSERT_TRUE(same_bits(stepper.q(), tr.q[k])) << "row " << k;
-      ASSERT_TRUE(same_bits(stepper.qd(), tr.qd[k])) << "row " << k;
+      ASSERT_TRUE(test::same_bits(stepper.q(), tr.q[k])) << "row " << k;
+      ASSERT_TRUE(test::same_bits(stepper.qd(), tr.qd[k])) << "row " << k;
     }
     const auto bif = of_kind(stepper.summary().warnings, "bifurcation");
     const auto bif_swept = of_kind(swept.warnings, "bifurcation");
@@ -239,8 +236,8 @@ TEST(Stepper, AFailedStepKeepsTheStateAndTheNextStepSucceeds) {
     EXPECT_FALSE(ss.moved);
     EXPECT_EQ(stepper.summary().failed_time, 2.5);
     EXPECT_EQ(stepper.time(), 0.7);
-    EXPECT_TRUE(same_bits(stepper.q(), q));
-    EXPECT_TRUE(same_bits(stepper.qd(), qd));
+    EXPECT_TRUE(test::same_bits(stepper.q(), q));
+    EXPECT_TRUE(test::same_bits(stepper.qd(), qd));
     ASSERT_EQ(stepper.step(1.5, &ss), SolveStatus::kSuccess) << ss.message;
     EXPECT_TRUE(ss.message.empty());
     EXPECT_EQ(stepper.summary().status, SolveStatus::kSuccess);
@@ -264,9 +261,9 @@ TEST(Stepper, AFailedStepKeepsTheStateAndTheNextStepSucceeds) {
   EXPECT_GT(ss.subdivisions, 0);
   EXPECT_TRUE(ss.warnings.empty());
   EXPECT_EQ(stepper.time(), 0.4);
-  EXPECT_TRUE(same_bits(stepper.q(), q));
-  EXPECT_TRUE(same_bits(stepper.qd(), qd));
-  EXPECT_TRUE(same_bits(stepper.qdd(), qdd));
+  EXPECT_TRUE(test::same_bits(stepper.q(), q));
+  EXPECT_TRUE(test::same_bits(stepper.qd(), qd));
+  EXPECT_TRUE(test::same_bits(stepper.qdd(), qdd));
   ASSERT_EQ(stepper.step(0.43, &ss), SolveStatus::kSuccess) << ss.message;
   EXPECT_NEAR(stepper.q()(psi), 2.2 + 0.43, 1e-12);
   EXPECT_EQ(stepper.summary().steps_completed, 6);
@@ -288,7 +285,7 @@ TEST(Stepper, RestartAssemblesAgainFromThePlacement) {
   placement << 4.0, 0.3 * std::cos(4.0) + 0.01, 0.3 * std::sin(4.0) - 0.01, slider_exact(2.0).x + 0.02;
   stepper.restart(placement);
   EXPECT_FALSE(stepper.started());
-  EXPECT_TRUE(same_bits(stepper.q(), placement));
+  EXPECT_TRUE(test::same_bits(stepper.q(), placement));
   StepSummary ss;
   ASSERT_EQ(stepper.step(2.0, &ss), SolveStatus::kSuccess) << ss.message;
   EXPECT_TRUE(ss.assembled);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -45,6 +46,11 @@ inline std::string scene_error(const std::string& text, const std::string& file 
 
 #define EXPECT_HAS(msg, part) EXPECT_NE((msg).find(part), std::string::npos) << (msg)
 
+// The same doubles bit for bit (a NaN equal to itself: what "the same results" means across runs and threads).
+inline bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return a.size() == b.size() &&
+         std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())) == 0;
+}
 inline bool contains(const std::vector<std::string>& v, const std::string& s) {
   return std::find(v.begin(), v.end(), s) != v.end();
 }
@@ -226,3 +232,8 @@ inline std::string generate_error(const tools::GenerateOptions& o) {
 inline double angle_diff(double a, double b) { return std::remainder(a - b, 2.0 * M_PI); }
 
 }  // namespace phiq::test
+
+namespace phiq {
+// A scene text's one-line error (test::scene_error() with its defaults): what the scene tests compare.
+inline std::string error_of(const std::string& text) { return test::scene_error(text); }
+}  // namespace phiq

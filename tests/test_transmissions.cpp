@@ -16,7 +16,6 @@
 namespace phiq {
 namespace {
 
-Slot S(Index i) { return Slot::coordinate(i); }
 
 TEST(Transmissions, GearDerivatives) {
   GearSpec external{{}, S(0), S(1), Slot::constant(0.0), 0.03, 0.09, false, 0.2, 2};
