@@ -62,39 +62,59 @@ struct CompiledExpression::Source {
   mutable std::map<std::vector<double>, std::shared_ptr<const CompiledExpression>> rates;
 };
 
-// What compile() and along_constants() share: g's tapes and what is read of it.
+// The symbols an expression is parsed into, and the values the tape builder folds in for the others.
+struct Symbols {
+  std::map<std::string, Index> coord_of_symbol;          // symbol name -> coordinate index
+  std::map<std::string, double> value_of_constant;       // symbol name -> value folded in by the tape builder
+  std::map<Index, GiNaC::realsymbol> symbol_of_coord;    // one symbol per coordinate, however many names it has
+  GiNaC::realsymbol t{"t"};
+  GiNaC::ex coordinate(Index i) {
+    auto [it, fresh] = symbol_of_coord.try_emplace(i, "q:" + std::to_string(i));
+    if (fresh) coord_of_symbol[it->second.get_name()] = i;
+    return it->second;
+  }
+};
+
+// What compile() and along_constants() share: the symbolic work, g's tapes and what is read of it.
 struct CompiledExpressionBuilder {
-  // The coordinates g depends on, its flags, and its value, gradient and ∂/∂t tapes into `out`.
-  static void finish(CompiledExpression& out, const GiNaC::ex& g,
-                     const std::map<Index, GiNaC::realsymbol>& symbol_of_coord,
-                     const std::map<std::string, Index>& coord_of_symbol,
-                     const std::map<std::string, double>& value_of_constant, const GiNaC::realsymbol& tsym) {
-    using namespace GiNaC;
-    // Keep only the coordinates the expression really depends on, in ascending index order.
-    std::vector<std::pair<realsymbol, Index>> used;
-    for (auto& [i, s] : symbol_of_coord)
-      if (g.has(s)) used.emplace_back(s, i);
-    out.depends_on_time_ = g.has(tsym);
-    out.angle_difference_ = is_angle_difference(g);
-    const std::string& text = out.text_;
+  // f(), GiNaC's own refusals (division by an exact zero, a derivative it cannot take) made one-line errors naming
+  // `text`.
+  template <class F>
+  static auto symbolic(const std::string& text, F&& f) {
     try {
-      std::vector<ex> grad;
-      for (std::size_t k = 0; k < used.size(); ++k) grad.push_back(g.diff(used[k].first));
-      auto build = [&](const std::vector<ex>& outs) {
-        return detail::compile_tape(outs, coord_of_symbol, value_of_constant, text);
-      };
-      out.value_ = build({g});
-      out.gradient_ = build(grad);
-      out.partial_t_ = build({g.diff(tsym)});
-      const std::size_t size = out.value_.size() + out.gradient_.size() + out.partial_t_.size();
-      if (size > CompiledExpression::kMaxTapeSize)
-        throw expression_error(text, "its derivatives compile to " + std::to_string(size) + " instructions; the limit is " +
-                                         std::to_string(CompiledExpression::kMaxTapeSize));
+      return f();
     } catch (const Error&) {
       throw;
     } catch (const std::exception& e) {
       throw expression_error(text, clean_ginac_message(e.what()));
     }
+  }
+
+  // The coordinates g depends on, its flags, and its value, gradient and ∂/∂t tapes into `out`.
+  static void finish(CompiledExpression& out, const GiNaC::ex& g, const Symbols& sym) {
+    using namespace GiNaC;
+    // Keep only the coordinates the expression really depends on, in ascending index order.
+    std::vector<std::pair<realsymbol, Index>> used;
+    for (auto& [i, s] : sym.symbol_of_coord)
+      if (g.has(s)) used.emplace_back(s, i);
+    out.depends_on_time_ = g.has(sym.t);
+    out.angle_difference_ = is_angle_difference(g);
+    const std::string& text = out.text_;
+    symbolic(text, [&] {
+      std::vector<ex> grad;
+      for (std::size_t k = 0; k < used.size(); ++k) grad.push_back(g.diff(used[k].first));
+      auto build = [&](const std::vector<ex>& outs) {
+        return detail::compile_tape(outs, sym.coord_of_symbol, sym.value_of_constant, text);
+      };
+      out.value_ = build({g});
+      out.gradient_ = build(grad);
+      out.partial_t_ = build({g.diff(sym.t)});
+      const std::size_t size = out.value_.size() + out.gradient_.size() + out.partial_t_.size();
+      if (size > CompiledExpression::kMaxTapeSize)
+        throw expression_error(text, "its derivatives compile to " + std::to_string(size) +
+                                         " instructions; the limit is " +
+                                         std::to_string(CompiledExpression::kMaxTapeSize));
+    });
     for (auto& [s, i] : used) out.coords_.push_back(i);
   }
 
@@ -104,10 +124,7 @@ struct CompiledExpressionBuilder {
   static std::shared_ptr<const CompiledExpression> differentiate(const CompiledExpression::Source& source,
                                                                  const std::vector<double>& key) {
     using namespace GiNaC;
-    std::map<std::string, Index> coord_of_symbol;
-    std::map<std::string, double> value_of_constant;
-    std::map<Index, realsymbol> symbol_of_coord;
-    realsymbol tsym("t");
+    Symbols sym;
     std::vector<std::pair<realsymbol, double>> moving;  // the symbols that move, with their rates
     std::map<std::string, std::size_t> parameter_of;    // parameter name -> its place in key
     for (const auto& [name, b] : source.names)
@@ -120,13 +137,13 @@ struct CompiledExpressionBuilder {
       const NameBinding& b = it->second;
       switch (b.kind) {
         case NameBinding::Kind::kTime:
-          return {std::nullopt, tsym};
+          return {std::nullopt, sym.t};
         case NameBinding::Kind::kConstant: {
           const double rate = key[parameter_of.at(name)];
           if (rate == 0.0) return {b.value, {}};
           auto [m, fresh] = moving_of.try_emplace(name, "c:" + name);
           if (fresh) {
-            value_of_constant[m->second.get_name()] = b.value;
+            sym.value_of_constant[m->second.get_name()] = b.value;
             moving.emplace_back(m->second, rate);
           }
           return {std::nullopt, m->second};
@@ -134,44 +151,33 @@ struct CompiledExpressionBuilder {
         case NameBinding::Kind::kCoordinate:
           break;
       }
-      auto [it2, fresh] = symbol_of_coord.try_emplace(b.coordinate, "q:" + std::to_string(b.coordinate));
-      if (fresh) coord_of_symbol[it2->second.get_name()] = b.coordinate;
-      return {std::nullopt, it2->second};
+      return {std::nullopt, sym.coordinate(b.coordinate)};
     };
-    ex g;
-    try {
-      g = detail::parse_expression(source.text, lookup, value_of_constant);
-    } catch (const Error&) {
-      throw;
-    } catch (const std::exception& e) {
-      throw expression_error(source.text, clean_ginac_message(e.what()));
-    }
-    for (std::size_t k = source.parameters; k < key.size(); ++k) {
-      if (key[k] == 0.0) continue;
-      auto it = symbol_of_coord.find(static_cast<Index>(k - source.parameters));
-      if (it != symbol_of_coord.end()) moving.emplace_back(it->second, key[k]);
-    }
-    // a moving exponent: g's power of a constant exponent (phiq_pow) is not the general power its rate needs
-    for (auto e = g.preorder_begin(); e != g.preorder_end(); ++e)
-      if (detail::is_power(*e))
-        for (const auto& [s, rate] : moving)
-          if (e->op(1).has(s)) throw expression_error(source.text, "a constant that moves is an exponent");
-    // the rates reach GiNaC as symbols too (folded by the tape builder), as every number does (parser.cpp says why)
-    ex d = 0;
-    for (const auto& [s, rate] : moving) {
-      const realsymbol r("r:" + s.get_name());
-      value_of_constant[r.get_name()] = rate;
-      d += r * g.diff(s);
-    }
+    const ex d = symbolic(source.text, [&] {
+      const ex g = detail::parse_expression(source.text, lookup, sym.value_of_constant);
+      for (std::size_t k = source.parameters; k < key.size(); ++k) {
+        if (key[k] == 0.0) continue;
+        auto it = sym.symbol_of_coord.find(static_cast<Index>(k - source.parameters));
+        if (it != sym.symbol_of_coord.end()) moving.emplace_back(it->second, key[k]);
+      }
+      // a moving exponent: g's power of a constant exponent (phiq_pow) is not the general power its rate needs
+      for (auto e = g.preorder_begin(); e != g.preorder_end(); ++e)
+        if (detail::is_power(*e))
+          for (const auto& [s, rate] : moving)
+            if (e->op(1).has(s)) throw expression_error(source.text, "a constant that moves is an exponent");
+      // the rates reach GiNaC as symbols too (folded by the tape builder), as every number does (parser.cpp says
+      // why)
+      ex sum = 0;
+      for (const auto& [s, rate] : moving) {
+        const realsymbol r("r:" + s.get_name());
+        sym.value_of_constant[r.get_name()] = rate;
+        sum += r * g.diff(s);
+      }
+      return sum;
+    });
     auto out = std::make_shared<CompiledExpression>();
     out->text_ = "rate of " + source.text;
-    try {
-      finish(*out, d, symbol_of_coord, coord_of_symbol, value_of_constant, tsym);
-    } catch (const Error&) {
-      throw;
-    } catch (const std::exception& e) {
-      throw expression_error(source.text, clean_ginac_message(e.what()));
-    }
+    finish(*out, d, sym);
     return out;
   }
 };
@@ -179,7 +185,6 @@ struct CompiledExpressionBuilder {
 std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std::string& text,
                                                                       const NameResolver& resolve,
                                                                       bool allow_time) {
-  using namespace GiNaC;
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw Error("expression is empty");
   if (text.size() > kMaxTextLength)
     throw Error("expression of " + std::to_string(text.size()) + " characters; the limit is " +
@@ -190,10 +195,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   source->text = text;
   source->allow_time = allow_time;
 
-  std::map<std::string, Index> coord_of_symbol;     // symbol name -> coordinate index
-  std::map<std::string, double> value_of_constant;  // symbol name -> value folded in by the tape builder
-  std::map<Index, realsymbol> symbol_of_coord;      // one symbol per coordinate, however many names it has
-  realsymbol tsym("t");
+  Symbols sym;
   auto note = [&](const std::string& name, const NameBinding& b) {
     for (const auto& n : source->names)
       if (n.first == name) return;
@@ -211,7 +213,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
       case NameBinding::Kind::kTime:
         if (!allow_time) throw expression_error(text, "time 't' is not allowed here");
         note(name, *b);
-        return {std::nullopt, tsym};
+        return {std::nullopt, sym.t};
       case NameBinding::Kind::kConstant:
         if (!std::isfinite(b->value)) throw expression_error(text, "'" + name + "' is not finite");
         note(name, *b);
@@ -220,20 +222,12 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
         break;
     }
     note(name, *b);
-    auto [it, fresh] = symbol_of_coord.try_emplace(b->coordinate, "q:" + std::to_string(b->coordinate));
-    if (fresh) coord_of_symbol[it->second.get_name()] = b->coordinate;
-    return {std::nullopt, it->second};
+    return {std::nullopt, sym.coordinate(b->coordinate)};
   };
 
-  ex g;
-  try {
-    g = detail::parse_expression(text, lookup, value_of_constant);
-  } catch (const Error&) {
-    throw;
-  } catch (const std::exception& e) {  // GiNaC's own refusals, e.g. division by an exact zero
-    throw expression_error(text, clean_ginac_message(e.what()));
-  }
-  CompiledExpressionBuilder::finish(*out, g, symbol_of_coord, coord_of_symbol, value_of_constant, tsym);
+  const GiNaC::ex g = CompiledExpressionBuilder::symbolic(
+      text, [&] { return detail::parse_expression(text, lookup, sym.value_of_constant); });
+  CompiledExpressionBuilder::finish(*out, g, sym);
   out->source_ = std::move(source);
   return out;
 }
