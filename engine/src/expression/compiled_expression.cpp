@@ -62,6 +62,18 @@ struct CompiledExpression::Source {
   mutable std::map<std::vector<double>, std::shared_ptr<const CompiledExpression>> rates;
 };
 
+// GiNaC is not thread-safe: its expressions count references without atomics, and every expression shares the
+// library's flyweights (the numbers 0, 1, −1, …), so two threads that merely build expressions race on them
+// (ThreadSanitizer reports it at once for two threads compiling). Scenes are read on several threads (`phiq batch`,
+// `phiq tolerance`, sensitivity_along()), so every use of GiNaC holds this lock, from the first symbol made to the
+// last expression destroyed; the tapes it compiles to are plain data and run without it.
+namespace {
+std::mutex& ginac_mutex() {
+  static std::mutex m;
+  return m;
+}
+}  // namespace
+
 // The symbols an expression is parsed into, and the values the tape builder folds in for the others.
 struct Symbols {
   std::map<std::string, Index> coord_of_symbol;          // symbol name -> coordinate index
@@ -124,6 +136,7 @@ struct CompiledExpressionBuilder {
   static std::shared_ptr<const CompiledExpression> differentiate(const CompiledExpression::Source& source,
                                                                  const std::vector<double>& key) {
     using namespace GiNaC;
+    const std::lock_guard<std::mutex> ginac(ginac_mutex());
     Symbols sym;
     std::vector<std::pair<realsymbol, double>> moving;  // the symbols that move, with their rates
     std::map<std::string, std::size_t> parameter_of;    // parameter name -> its place in key
@@ -195,6 +208,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   source->text = text;
   source->allow_time = allow_time;
 
+  const std::lock_guard<std::mutex> ginac(ginac_mutex());
   Symbols sym;
   auto note = [&](const std::string& name, const NameBinding& b) {
     for (const auto& n : source->names)
