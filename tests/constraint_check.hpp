@@ -293,6 +293,8 @@ inline void MoveDatum(phiq::Frame2& x, const phiq::Frame2& r, double e) {
 inline void MoveDatum(phiq::kin::V2& x, const phiq::kin::V2& r, double e) {
   MoveDatum(x.x, r.x, e), MoveDatum(x.y, r.y, e);
 }
+// A curve's frame moves; the curve itself is no datum (a rate spec holds the swept spec's curve).
+inline void MoveDatum(phiq::CurveOn& x, const phiq::CurveOn& r, double e) { MoveDatum(x.frame, r.frame, e); }
 // A spatial attachment: its constants and its local vector (coordinates are no data).
 inline void MoveDatum(phiq::Attachment3& x, const phiq::Attachment3& r, double e) {
   for (int k = 0; k < 3; ++k) MoveDatum(x.r[k], r.r[k], e);

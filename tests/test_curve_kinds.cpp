@@ -162,6 +162,55 @@ TEST(ConstraintKinds, FlatFollowerOnCircleAndSpline) {
   CheckSpec(g, 3, Opts(2705));
 }
 
+// ---- derivatives along the data ----------------------------------------------------------------------------------
+
+TEST(ConstraintKinds, PointOnCurveAlongItsData) {
+  // a roller of a body on a circle of a turning cam whose pivot moves: the pivot, the roller's point and radius
+  const auto circle = Curve::circle({0.3, -0.1}, 1.3);
+  phiq::PointOnCurveSpec roller{phiq::Frame2{S(0), S(1), S(2)}, {0.1, 0.25},
+                                {phiq::Frame2{C(0.2), C(0.5), S(3)}, circle}, 0.2, S(4)};
+  phiq::PointOnCurveSpec rate{phiq::Frame2{C(0), C(0), C(0)}, {0.3, -0.7},
+                              {phiq::Frame2{C(0.4), C(-0.6), C(0)}, circle}, 0.9, S(4)};
+  CheckDataDerivative(roller, rate, 5, 2711);
+  // a point at a constant angle (its turn a datum) on an open ground spline turned by a datum, offset
+  const auto spline = Curve::spline({{-3, 0}, {-1, 1.5}, {1, 1.2}, {3.5, -0.5}}, false);
+  phiq::PointOnCurveSpec point{phiq::Frame2{S(0), S(1), C(0.3)}, {0.2, -0.4},
+                               {phiq::Frame2{C(0.2), C(-0.1), C(0.4)}, spline}, -0.15, S(2)};
+  phiq::PointOnCurveSpec turns{phiq::Frame2{C(0), C(0), C(0.8)}, {-0.5, 0.6},
+                               {phiq::Frame2{C(0.1), C(0.2), C(-0.5)}, spline}, 0.3, S(2)};
+  CheckDataDerivative(point, turns, 3, 2712);
+  // a pin in a slot of a moving body: only its local point moves (no offset, no frame data)
+  phiq::PointOnCurveSpec pin{phiq::Frame2{S(0), S(1), S(2)}, {0.3, -0.2},
+                             {phiq::Frame2{S(3), S(4), S(5)}, Curve::spline(circle_points(5, {0.1, 0}, 2.0), true)},
+                             0.0, S(6)};
+  phiq::PointOnCurveSpec arm = pin;
+  arm.a = phiq::Frame2{C(0), C(0), C(0)}, arm.sa = {1.0, 0.5}, arm.on.frame = arm.a;
+  CheckDataDerivative(pin, arm, 7, 2713);
+}
+
+TEST(ConstraintKinds, FlatFollowerAlongItsData) {
+  // a follower body on a circle of a cam turning about a pivot that moves: the face's point and direction, the pivot
+  const auto circle = Curve::circle({0.3, 0.1}, 0.9);
+  phiq::FlatFollowerSpec k{phiq::Frame2{S(0), S(1), S(2)}, {0.2, -0.1}, {0.6, 0.8},
+                           {phiq::Frame2{C(0.1), C(0.2), S(3)}, circle}, S(4)};
+  phiq::FlatFollowerSpec rate{phiq::Frame2{C(0), C(0), C(0)}, {0.2, 0.5}, {-0.3, 0.4},
+                              {phiq::Frame2{C(0.3), C(-0.2), C(0)}, circle}, S(4)};
+  CheckDataDerivative(k, rate, 5, 2714);
+  // a translating follower at a constant angle (a datum) on a ground profile turned by a datum
+  const auto profile = Curve::spline(circle_points(5, {0.2, 0}, 2.5), true);
+  phiq::FlatFollowerSpec g{phiq::Frame2{C(0.1), S(0), C(0.2)}, {0.1, 0.3}, {1, 0},
+                           {phiq::Frame2{C(0.05), C(-0.02), C(0.3)}, profile}, S(1)};
+  phiq::FlatFollowerSpec every{phiq::Frame2{C(0.4), C(0), C(0.7)}, {-0.3, 0.2}, {0.1, 0.9},
+                               {phiq::Frame2{C(-0.2), C(0.6), C(-0.4)}, profile}, S(1)};
+  CheckDataDerivative(g, every, 2, 2715);
+  // a follower on a cam, both bodies free: only the face's point moves (every frame slot is a coordinate)
+  phiq::FlatFollowerSpec both{phiq::Frame2{S(0), S(1), S(2)}, {0, 0}, {1, 0},
+                              {phiq::Frame2{S(3), S(4), S(5)}, profile}, S(6)};
+  phiq::FlatFollowerSpec point = both;
+  point.a = phiq::Frame2{C(0), C(0), C(0)}, point.sa = {0.7, -0.2}, point.axis = {0, 0}, point.on.frame = point.a;
+  CheckDataDerivative(both, point, 7, 2716);
+}
+
 // ---- the added coordinate -------------------------------------------------------------------------------------
 
 TEST(CurveKinds, TheModelAddsTheCurveParameterWithItsNearestPointAsGuess) {

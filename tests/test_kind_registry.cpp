@@ -64,7 +64,7 @@ TEST(KindRegistry, EveryKindThatDifferentiatesItsDataHasACheckOfIt) {
   EXPECT_EQ(differentiating,
             (std::vector<std::string>{
                 "distance", "pin", "point_on_line", "constant_angle", "angle", "polar", "prismatic", "loop",
-                "equation", "coupler", "driver",  // planar
+                "equation", "coupler", "driver", "point_on_curve", "flat_cam",  // planar
                 "distance", "dot", "spherical", "revolute", "prismatic", "cylindrical", "universal", "planar", "rigid",
                 "point_on_line", "point_on_plane", "joint_distance_driver", "joint_angle_driver",  // spatial
                 "gear", "rack_pinion", "belt", "screw", "spatial_gear", "polar3", "angle3"}));  // transmissions, mixed

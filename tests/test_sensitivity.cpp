@@ -778,6 +778,56 @@ TEST(Sensitivity, EquationsAreDifferentiatedAlongTheParametersTheirTextsRead) {
   }
 }
 
+// The eccentric circular cam under a translating roller follower (models/cams/eccentric_roller.yaml): the roller's
+// radius ρ moves the cam constraint's offset and not its curve (no co-moving contact), so the constraint
+// differentiates its own data and the follower's height y = e sin θ + D, D = √((R + ρ)² − e² cos² θ), has
+//   ∂y/∂ρ = A/D,   ∂ẏ/∂ρ = −ω N A/D³,   ∂ÿ/∂ρ = ω² (3 N² A/D⁵ − e² cos 2θ A/D³),   A = R + ρ, N = e² sin θ cos θ,
+// θ = ω t: to 1e-9 of their scale in both forms, at a step of 40 % of ρ (the kind's derivative does not depend on
+// it). The kept models' differences agree to 1e-10: at fixed q the constraint is linear in ρ, so its differences
+// are exact too; what the kind's own derivative saves is the four copies of the constraint and their evaluations.
+TEST(Sensitivity, ARollersRadiusIsDifferentiatedByTheCamConstraint) {
+  const std::string text = test::replace_first(test::slurp(model_path("cams/eccentric_roller.yaml")),
+                                               "output: {velocities: true, accelerations: true}",
+                                               "output: {velocities: true, accelerations: true, sensitivities: "
+                                               "[{parameter: rho, step: 0.004}]}");
+  const auto scenes = own_and_kept(text, "eccentric_roller.yaml");
+  const Scene& s = scenes.first;
+  ASSERT_EQ(s.sweep.sensitivities.size(), 1u);
+  const OutputSensitivity& p = s.sweep.sensitivities[0];
+  ASSERT_TRUE(p.reached);
+  EXPECT_TRUE(p.reach->comotion.empty());
+  ASSERT_EQ(p.reached->rates.size(), 1u);  // the cam constraint alone
+  EXPECT_NE(p.reached->rates[0], nullptr);
+  const double R = 0.05, e = 0.015, rho = 0.01, w = 2.0, A = R + rho;
+  const Index yf = s.model->coordinate_index("yf");
+  const SensitivityLayout layout{s.model->num_coordinates()};
+  for (SensitivityForm form : {SensitivityForm::kDirect, SensitivityForm::kAdjoint}) {
+    const auto [exact, differenced] = own_and_kept_sweeps(scenes, form);
+    ASSERT_EQ(exact.s.size(), 73u);
+    ASSERT_EQ(differenced.s.size(), exact.s.size());
+    double worst_exact = 0.0, worst_differenced = 0.0;
+    for (std::size_t k = 0; k < exact.s.size(); ++k) {
+      const double th = w * exact.rows.t[k], c = std::cos(th), sn = std::sin(th);
+      const double D = std::sqrt(A * A - e * e * c * c), N = e * e * sn * c;
+      const double want[3] = {A / D, -w * N * A / std::pow(D, 3),
+                              w * w * (3.0 * N * N * A / std::pow(D, 5) - e * e * std::cos(2.0 * th) * A / std::pow(D, 3))};
+      const double scale[3] = {1.0, w, w * w};
+      for (int o = 0; o < 3; ++o) {
+        worst_exact = std::max(worst_exact, std::fabs(exact.s[k][layout.offset(0, o) + yf] - want[o]) / scale[o]);
+        worst_differenced =
+            std::max(worst_differenced, std::fabs(differenced.s[k][layout.offset(0, o) + yf] - want[o]) / scale[o]);
+      }
+    }
+    EXPECT_LT(worst_exact, 1e-9) << to_string(form);
+    EXPECT_LT(worst_differenced, 1e-9) << to_string(form);
+    for (std::size_t k = 0; k < exact.s.size(); ++k)
+      for (int o = 0; o < 3; ++o) {
+        const double d = differenced.s[k][layout.offset(0, o) + yf];
+        EXPECT_NEAR(exact.s[k][layout.offset(0, o) + yf], d, 1e-10 * std::max(1.0, std::fabs(d))) << to_string(form);
+      }
+  }
+}
+
 // The RSSR four-bar in space: its crank's and rocker's arms (a, b: the coupler's ends on the bodies), the rocker's
 // ground hinge (d, e: a revolute's folded ground attachment) and the coupler's length reach constraints whose kinds
 // differentiate their own data (a spatial distance, a revolute), read through the scene: every reached span holds

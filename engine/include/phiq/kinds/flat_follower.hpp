@@ -4,6 +4,7 @@
 /// form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -90,6 +91,55 @@ struct FlatFollowerSpec {
     const kin::V2 wdd = (-wb * wb) * g.w + (2.0 * wb * sd) * kin::perp(g.w2) + (sd * sd) * g.w3;
     out[0] = -(-wa * wa * kin::cross(g.e, g.h) + 2.0 * kin::cross(ed, hd) + kin::cross(g.e, hdd));
     out[1] = -(-wa * wa * kin::cross(g.e, g.w) + 2.0 * kin::cross(ed, wd) + kin::cross(g.e, wdd));
+  }
+
+  /// The data a parameter may move (DistanceSpec::data_members()): the follower's frame (its constant slots), the
+  /// face's point and direction (as normalised), and the cam's frame. The profile itself is no datum: where a
+  /// parameter changes its shape the constraint is differenced (PointOnCurveSpec::data_members()).
+  static constexpr auto data_members() {
+    return std::tuple{&FlatFollowerSpec::a, &FlatFollowerSpec::sa, &FlatFollowerSpec::axis, &FlatFollowerSpec::on};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()): Φ0 = e × h and Φ1 = e × w are products, so
+  /// their k-th time derivatives along p are Σᵢ C(k, i) (ê⁽ⁱ⁾ × h⁽ᵏ⁻ⁱ⁾ + e⁽ⁱ⁾ × ĥ⁽ᵏ⁻ⁱ⁾), and alike with w, where
+  /// ê = R_a û + ψ̂_a e⊥ (detail::turned_data_derivative()), ĥ = r̂_b + ψ̂_b C⊥ − P̂_a with C = R_b c(s), and
+  /// ŵ = ψ̂_b w⊥; C, w and their time derivatives are carried by b along the profile (detail::carried_along_curve()).
+  void data_derivative(const FlatFollowerSpec& rate, int order, const double* q, const double* qd,
+                       const double* qdd, double, double* out) const {
+    const Geometry g = geometry(q);
+    const Frame2& b = on.frame;
+    const double wa = order >= 1 ? a.psi.rate(qd) : 0.0, wb = order >= 1 ? b.psi.rate(qd) : 0.0;
+    const double sd = order >= 1 ? s.rate(qd) : 0.0;
+    const double aa = order == 2 ? a.psi.rate(qdd) : 0.0, ab = order == 2 ? b.psi.rate(qdd) : 0.0;
+    const double sdd = order == 2 ? s.rate(qdd) : 0.0;
+    // the motion: e, the arm R_a s_a, C, w and h = r_b + C − r_a − R_a s_a, with their first two time derivatives
+    auto turning = [&](const kin::V2& v, double w, double al) {
+      return std::array<kin::V2, 3>{v, w * kin::perp(v), al * kin::perp(v) - (w * w) * v};
+    };
+    const std::array<kin::V2, 3> e = turning(g.e, wa, aa), arm = turning(g.arm_a, wa, aa);
+    kin::V2 c[3], w[3];
+    const kin::V2 cv[3] = {g.c, g.w, g.w2}, wv[3] = {g.w, g.w2, g.w3};
+    detail::carried_along_curve(cv, wb, ab, sd, sdd, c);
+    detail::carried_along_curve(wv, wb, ab, sd, sdd, w);
+    auto translation = [&](const Frame2& f, int k) {
+      const double* v = k == 0 ? q : k == 1 ? qd : qdd;
+      return k == 0 ? kin::V2{f.x.of(v), f.y.of(v)} : kin::V2{f.x.rate(v), f.y.rate(v)};
+    };
+    std::array<kin::V2, 3> h{}, eh{}, hh{}, wh{};
+    const double psid_b = rate.on.frame.psi.of(q);
+    for (int k = 0; k <= order; ++k) {
+      h[k] = translation(b, k) + c[k] - translation(a, k) - arm[k];
+      eh[k] = detail::turned_data_derivative(a.psi, axis, rate.a.psi, rate.axis, k, q, qd, qdd);
+      hh[k] = psid_b * kin::perp(c[k]) - detail::point_data_derivative(a, sa, rate.a, rate.sa, k, q, qd, qdd);
+      wh[k] = psid_b * kin::perp(w[k]);
+    }
+    hh[0] = hh[0] + kin::V2{rate.on.frame.x.of(q), rate.on.frame.y.of(q)};
+    double d0 = 0.0, d1 = 0.0;
+    for (int i = 0; i <= order; ++i) {
+      const double m = detail::kBinomial[order][i];
+      d0 += m * (kin::cross(eh[i], h[order - i]) + kin::cross(e[i], hh[order - i]));
+      d1 += m * (kin::cross(eh[i], w[order - i]) + kin::cross(e[i], wh[order - i]));
+    }
+    out[0] = d0, out[1] = d1;
   }
 
   /// @copydoc DistanceSpec::joint_count

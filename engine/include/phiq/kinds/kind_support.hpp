@@ -18,6 +18,8 @@
 
 namespace phiq {
 
+struct CurveOn;
+
 /// What a joint is drawn as in the mechanism's sketch (mechanism_sketch.hpp), as a kind's sketch() says.
 enum class JointMark {
   kRevolute,   ///< a pin: a circle (planar), a hinge (spatial)
@@ -120,6 +122,26 @@ namespace detail {
 // C(k, i) for k, i ≤ 2: Leibniz's rule for the time derivatives of a product, up to the second (the kinds'
 // derivatives along their data, data_derivative()).
 inline constexpr double kBinomial[3][3] = {{1, 0, 0}, {1, 1, 0}, {1, 2, 1}};
+// The time derivative of order `order` (0, 1, 2) of the rate along a design parameter of u = R(ψ) s, a vector
+// carried by a frame of angle slot `psi`, whose rates are ψ̂ (`psi_rate`: a constant angle's; 0 for a coordinate,
+// which is no datum) and ŝ; ω = ψ̇, α = ψ̈ (the kinds' data_derivative()):
+//   order 0: R ŝ + ψ̂ u⊥,   1: ω (R ŝ)⊥ − ψ̂ ω u,   2: α (R ŝ)⊥ − ω² R ŝ − ψ̂ (α u + ω² u⊥).
+inline kin::V2 turned_data_derivative(const Slot& psi, const kin::V2& s, const Slot& psi_rate, const kin::V2& s_rate,
+                                      int order, const double* q, const double* qd, const double* qdd) {
+  const double angle = psi.of(q), psid = psi_rate.of(q);
+  const kin::V2 u = kin::rotate(angle, s), ud = kin::rotate(angle, s_rate);
+  if (order == 0) return ud + psid * kin::perp(u);
+  const double w = psi.rate(qd);
+  if (order == 1) return w * kin::perp(ud) - (psid * w) * u;
+  const double al = psi.rate(qdd);
+  return al * kin::perp(ud) - (w * w) * ud - psid * (al * u + (w * w) * kin::perp(u));
+}
+// The same of a point r + R(ψ) s of frame f, its rates `rf` (constant slots) and `rs`: r̂ joins order 0.
+inline kin::V2 point_data_derivative(const Frame2& f, const kin::V2& s, const Frame2& rf, const kin::V2& rs,
+                                     int order, const double* q, const double* qd, const double* qdd) {
+  const kin::V2 turned = turned_data_derivative(f.psi, s, rf.psi, rs, order, q, qd, qdd);
+  return order == 0 ? kin::V2{rf.x.of(q), rf.y.of(q)} + turned : turned;
+}
 // The fourth-order central difference of values at p − 2h, p − h, p + h, p + 2h, in pairs (exactly zero where the
 // four agree): what every rate along a design parameter is made of (the data's here, the laws' coefficients, the
 // rows a kind does not differentiate itself: sensitivity.cpp).
@@ -203,6 +225,9 @@ inline bool expression_rate(const CompiledExpression& at, const std::array<const
   }
   return true;
 }
+// A curve and the frame that carries it (kinds/curve.hpp, where it is defined): the frame's rates; false where the
+// curve itself is not the same in the four (its shape moves: the constraint is differenced).
+inline bool datum_rate(CurveOn& rate, const std::array<const CurveOn*, 4>& v, double h);
 // An equation's expression: its rate, null where its constants do not move.
 inline bool datum_rate(std::shared_ptr<const CompiledExpression>& rate,
                        const std::array<const std::shared_ptr<const CompiledExpression>*, 4>& v, double h) {

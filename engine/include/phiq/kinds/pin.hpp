@@ -87,16 +87,8 @@ struct PinSpec {
   ///   ∂Φ/∂p: ṙ + u̇ + ψ̂ u⊥,   ∂(Φq q̇)/∂p: ω u̇⊥ − ψ̂ ω u,   ∂(Φq q̈ − γ)/∂p: α u̇⊥ − ω² u̇ − ψ̂ (α u + ω² u⊥).
   void data_derivative(const PinSpec& rate, int order, const double* q, const double* qd, const double* qdd,
                        double, double* out) const {
-    auto side = [&](const Frame2& f, const kin::V2& s, const Frame2& rf, const kin::V2& rs) {
-      const double psi = f.psi.of(q), psid = rf.psi.of(q);
-      const kin::V2 u = kin::rotate(psi, s), ud = kin::rotate(psi, rs);
-      if (order == 0) return kin::V2{rf.x.of(q), rf.y.of(q)} + ud + psid * kin::perp(u);
-      const double w = f.psi.rate(qd);
-      if (order == 1) return w * kin::perp(ud) - (psid * w) * u;
-      const double al = f.psi.rate(qdd);
-      return al * kin::perp(ud) - (w * w) * ud - psid * (al * u + (w * w) * kin::perp(u));
-    };
-    const kin::V2 d = side(a, sa, rate.a, rate.sa) - side(b, sb, rate.b, rate.sb);
+    const kin::V2 d = detail::point_data_derivative(a, sa, rate.a, rate.sa, order, q, qd, qdd) -
+                      detail::point_data_derivative(b, sb, rate.b, rate.sb, order, q, qd, qdd);
     out[0] = d.x, out[1] = d.y;
   }
 

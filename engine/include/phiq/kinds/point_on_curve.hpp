@@ -85,6 +85,46 @@ struct PointOnCurveSpec {
     out[0] = ga.x + gb.x, out[1] = ga.y + gb.y;
   }
 
+  /// The data a parameter may move (DistanceSpec::data_members()): the point's frame (its constant slots) and
+  /// local point, the curve's frame and the roller's radius. The curve itself is no datum: where a parameter changes
+  /// its shape (a radius, a profile's points) the constraint is differenced, s moving with the curve's length.
+  static constexpr auto data_members() {
+    return std::tuple{&PointOnCurveSpec::a, &PointOnCurveSpec::sa, &PointOnCurveSpec::on,
+                      &PointOnCurveSpec::offset};
+  }
+  /// Derivatives along the data (DistanceSpec::data_derivative()). With P = R_b p(s) and N = R_b n(s), carried by
+  /// frame b along the curve (their time derivatives in detail::carried_along_curve()), ψ̂_b and r̂_b the rates of
+  /// b's constant slots, ρ̂ the radius's, and P̂_a the point's (detail::point_data_derivative()):
+  ///
+  ///   ∂Φ/∂p = P̂_a − r̂_b − ψ̂_b P⊥ − ρ̂ N,   and its time derivatives: P̂_a⁽ᵏ⁾ − ψ̂_b P⁽ᵏ⁾⊥ − ρ̂ N⁽ᵏ⁾ (k = 1, 2).
+  void data_derivative(const PointOnCurveSpec& rate, int order, const double* q, const double* qd,
+                       const double* qdd, double, double* out) const {
+    const Frame2& b = on.frame;
+    const double psid = rate.on.frame.psi.of(q), rhod = rate.offset;
+    kin::V2 d = detail::point_data_derivative(a, sa, rate.a, rate.sa, order, q, qd, qdd);
+    if (order == 0) d = d - kin::V2{rate.on.frame.x.of(q), rate.on.frame.y.of(q)};
+    const double at = s.of(q), pb = b.psi.of(q);
+    const double w = order >= 1 ? b.psi.rate(qd) : 0.0, sd = order >= 1 ? s.rate(qd) : 0.0;
+    const double al = order == 2 ? b.psi.rate(qdd) : 0.0, sdd = order == 2 ? s.rate(qdd) : 0.0;
+    auto carried = [&](const kin::V2 v[3]) {  // the order-th time derivative of R_b v(s)
+      const kin::V2 world[3] = {kin::rotate(pb, v[0]), kin::rotate(pb, v[1]), kin::rotate(pb, v[2])};
+      kin::V2 out3[3];
+      detail::carried_along_curve(world, w, al, sd, sdd, out3);
+      return out3[order];
+    };
+    if (psid != 0.0) {
+      kin::V2 p[3];
+      detail::offset_curve(*on.curve, at, offset, p);
+      d = d - psid * kin::perp(carried(p));
+    }
+    if (rhod != 0.0) {
+      kin::V2 n[3];
+      detail::curve_normal_derivatives(*on.curve, at, n);
+      d = d - rhod * carried(n);
+    }
+    out[0] = d.x, out[1] = d.y;
+  }
+
   /// @copydoc DistanceSpec::joint_count
   /// A higher pair between bodies or ground: 2 rows and 1 added coordinate remove 1 freedom.
   JointCount joint_count() const {
