@@ -164,18 +164,22 @@ class BareLoop {
 // loop iterates until the last Newton step is below 1e-10, which with quadratic convergence lands far below it;
 // phiq's default stops when its error estimate is within 1e-10 (the cubic predictor: most steps need no Newton
 // step), and so does full Newton when no step is needed; `tight` is phiq asked for 1e-13, about what the bare loop
-// delivers.
+// delivers. `in_order` is the default in one chunk, as the bare loop runs: the default cuts the sweep into the chunks
+// that give the same bits on every thread count even on one thread (SweepOptions::chunk_steps), each a seed, a seam
+// step and a factorisation more.
 void BM_NFourBarStepVsBareLoop(benchmark::State& state) {
   const Index n = state.range(0), steps = state.range(1);
   Model m = nfourbar(n, M_PI / 4, M_PI / 2);
   Workspace ws(m);
   BareLoop bare(n, M_PI / 4, M_PI / 2);
-  SweepOptions modified, full, tight;
-  modified.steps = full.steps = tight.steps = steps;
+  SweepOptions modified, full, tight, in_order;
+  modified.steps = full.steps = tight.steps = in_order.steps = steps;
+  in_order.chunk_steps = steps;  // one chunk: no seeds, no seams (the default cuts chunks even on one thread)
   full.newton.jacobian_update = JacobianUpdate::kEveryIteration;
   tight.newton.tolerance = 1e-13;  // the bare loop's accuracy (its last step overshoots 1e-10 by orders)
   double phiq_s = 0, full_s = 0, tight_s = 0, bare_s = 0, phiq_err = 0, full_err = 0, tight_err = 0, bare_err = 0;
-  Index bare_it = 0, phiq_fact = 0, full_fact = 0, phiq_newton = 0;
+  double order_s = 0, order_err = 0;
+  Index bare_it = 0, phiq_fact = 0, full_fact = 0, phiq_newton = 0, order_newton = 0, order_fact = 0;
   const Index stride = std::max<Index>(1, n / 64);
   std::vector<double> kept;  // sin θ and the tips' y of every row, checked after the timed sweep
   auto keep = [&](const StepView& v) {
@@ -211,6 +215,13 @@ void BM_NFourBarStepVsBareLoop(benchmark::State& state) {
     tight_s += seconds_since(t0);
     if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
     check(tight_err);
+    ws.q = m.initial_positions();
+    t0 = Clock::now();
+    (void)run_sweep(m, in_order, ws, keep, &sum);
+    order_s += seconds_since(t0);
+    if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
+    check(order_err);
+    order_newton += sum.counters.newton_iterations, order_fact += sum.counters.factorizations;
     bare.reset();
     for (Index k = 0; k <= steps; ++k) {
       const double t = static_cast<double>(k) / static_cast<double>(steps);
@@ -234,6 +245,10 @@ void BM_NFourBarStepVsBareLoop(benchmark::State& state) {
   state.counters["phiq_fact_per_step"] = static_cast<double>(phiq_fact) / rows;
   state.counters["full_fact_per_step"] = static_cast<double>(full_fact) / rows;
   state.counters["bare_fact_per_step"] = static_cast<double>(bare_it) / rows + 1.0;
+  state.counters["in_order_per_bare"] = order_s / bare_s;
+  state.counters["in_order_newton_per_step"] = static_cast<double>(order_newton) / rows;
+  state.counters["in_order_fact_per_step"] = static_cast<double>(order_fact) / rows;
+  state.counters["in_order_error"] = order_err;
   state.counters["phiq_error"] = phiq_err;
   state.counters["full_error"] = full_err;
   state.counters["bare_error"] = bare_err;
