@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "bench_kinematics_timing.hpp"
@@ -194,38 +195,29 @@ void BM_NFourBarStepVsBareLoop(benchmark::State& state) {
     kept.clear();
   };
   kept.reserve(static_cast<std::size_t>((steps + 1) * (n / stride + 2)));
-  for (auto _ : state) {
+  // one sweep from the start, its time added to `seconds` and its deviation from the closed form to `err`
+  auto timed = [&](const SweepOptions& o, double& seconds, double& err) {
     SweepSummary sum;
     ws.q = m.initial_positions();
-    auto t0 = Clock::now();
-    (void)run_sweep(m, modified, ws, keep, &sum);
+    const auto t0 = Clock::now();
+    (void)run_sweep(m, o, ws, keep, &sum);
     const double e = seconds_since(t0);
     if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
-    check(phiq_err);
-    phiq_s += e, phiq_fact += sum.counters.factorizations, phiq_newton += sum.counters.newton_iterations;
-    ws.q = m.initial_positions();
-    t0 = Clock::now();
-    (void)run_sweep(m, full, ws, keep, &sum);
-    full_s += seconds_since(t0), full_fact += sum.counters.factorizations;
-    if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
-    check(full_err);
-    ws.q = m.initial_positions();
-    t0 = Clock::now();
-    (void)run_sweep(m, tight, ws, keep, &sum);
-    tight_s += seconds_since(t0);
-    if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
-    check(tight_err);
-    ws.q = m.initial_positions();
-    t0 = Clock::now();
-    (void)run_sweep(m, in_order, ws, keep, &sum);
-    order_s += seconds_since(t0);
-    if (sum.status != SolveStatus::kSuccess) state.SkipWithError(sum.message.c_str());
-    check(order_err);
-    order_newton += sum.counters.newton_iterations, order_fact += sum.counters.factorizations;
+    check(err);
+    seconds += e;
+    return std::pair{e, sum.counters};
+  };
+  for (auto _ : state) {
+    const auto [e, work] = timed(modified, phiq_s, phiq_err);
+    phiq_fact += work.factorizations, phiq_newton += work.newton_iterations;
+    full_fact += timed(full, full_s, full_err).second.factorizations;
+    (void)timed(tight, tight_s, tight_err);
+    const WorkCounters in_order_work = timed(in_order, order_s, order_err).second;
+    order_newton += in_order_work.newton_iterations, order_fact += in_order_work.factorizations;
     bare.reset();
     for (Index k = 0; k <= steps; ++k) {
       const double t = static_cast<double>(k) / static_cast<double>(steps);
-      t0 = Clock::now();
+      const auto t0 = Clock::now();
       bare_it += bare.step(t);
       bare_s += seconds_since(t0);
       bare_err = std::max(bare_err, bare.position_error(t));
