@@ -47,7 +47,8 @@ struct OutputPlan {
   /// (sensitivity.hpp); written for the coordinate columns, as `x.d_P`, `x.v.d_P`, `x.a.d_P`.
   std::vector<OutputSensitivity> sensitivities;
   /// How the sensitivities are solved: kAuto takes the adjoint form where it costs less than the direct one for
-  /// the coordinates whose columns are written (effective_sensitivity_form()); SweepSummary says which.
+  /// the coordinates whose columns are written (effective_sensitivity_form()), and the direct form, every
+  /// coordinate's, when no column is written (a caller reading StepView::sensitivities); SweepSummary says which.
   SensitivityForm sensitivity_form = SensitivityForm::kAuto;
   /// The coordinates the adjoint form solves for: those whose q, q̇ or q̈ columns are written, ascending.
   std::vector<Index> sensitivity_outputs() const;

@@ -27,6 +27,7 @@
 ///
 /// A kind that differentiates its own data (DataDifferentiable: the planar distance, pin, prismatic pair, point on a
 /// line, constant and segment angles, polar vector, loop closure and coupler, most rows of the large linkages; the
+/// point on a curve and the flat follower along all but their curve's shape; the
 /// drivers through their laws, MotionLaw::rate_along(); equations along the parameters their texts read, exactly
 /// (CompiledExpression::along_constants(): ∂g/∂p compiled as g is), and their laws; the spatial distance and dot
 /// product, the nine spatial joints, the joint drivers, the screw, the spatial gear and the mixed polar and angle
@@ -58,6 +59,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -149,6 +151,21 @@ ParameterReach whole_model_reach(const Model& model);
 
 /// The default difference step for a parameter of value p: 10⁻³ |p|, or 10⁻³ for p = 0.
 double default_sensitivity_step(double p);
+
+/// Builds the mechanism with one design parameter at `value`, everything else as in the swept model: the same
+/// coordinates, constraints and rows, only data differing. `share`, when not null, is the swept model: build with
+/// ModelBuilder::share_analysis_with(*share), so that the model shares its pattern and symbolic analysis.
+using ModelAtParameter = std::function<Model(double value, const Model* share)>;
+
+/// The sensitivity along the parameter `name` of a model built in code (a scene's parameters have
+/// sensitivity_along() of scene.hpp, which reads the scene again): `model` is build(value, nullptr) or the same
+/// mechanism, and the models at value − 2h, − h, + h, + 2h are built by `build`, one at a time, of which only the
+/// constraints the parameter reaches are kept (ReachedConstraints; all four models when `keep_models`); h = `step`,
+/// or default_sensitivity_step(value) for step ≤ 0. The result goes into SweepOptions::sensitivities or
+/// solve_sensitivities() with `model`. Throws phiq::Error with check_sensitivity_models()' line when a model along
+/// p has another structure, and what `build` throws.
+OutputSensitivity sensitivity_along(const Model& model, const std::string& name, double value,
+                                    const ModelAtParameter& build, double step = 0.0, bool keep_models = false);
 
 /// How a row's sensitivities are solved.
 ///

@@ -194,13 +194,12 @@ OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name,
                                     const SceneLimits& limits, const SceneOverrides& overrides) {
   OutputSensitivity s;
   s.name = name, s.value = value, s.step = step > 0.0 ? step : default_sensitivity_step(value);
-  const double shifts[4] = {-2.0, -1.0, 1.0, 2.0};
   auto read_at = [&](std::size_t k) {
     SceneOverrides moved = overrides;
     moved.sensitivity_models = false;
     moved.share_analysis_with = scene.model.get();
     moved.parameters_source.clear();
-    const double at = value + shifts[k] * s.step;
+    const double at = value + detail::kShift[k] * s.step;
     bool replaced = false;
     for (auto& [n, v] : moved.parameters)
       if (n == name) v = at, replaced = true;
@@ -212,30 +211,9 @@ OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name,
                        " from " + shortest(value) + ") the scene cannot be read: " + e.what());
     }
   };
-  // The models along p are the whole model again, and only what p reaches is read of them: each is read, checked
-  // and compared with the scene's model in turn, and only the constraints that differ are kept of it, so that one
-  // is in memory at a time (ReachedConstraints). Kept whole when asked, or when their blocks do not match the
-  // model's (then p reaches everything).
-  const Model& model = *scene.model;
-  std::array<detail::AlongModel, 4> along;
-  std::array<std::vector<std::unique_ptr<ConstraintBlock>>, 4> copies;
-  bool whole = overrides.keep_sensitivity_models;
-  for (std::size_t k = 0; k < 4; ++k) {
-    std::shared_ptr<const Model> m = read_at(k);
-    if (std::string why = detail::check_model_along(model, s, k, *m); !why.empty()) throw SceneError(why);
-    whole = whole || !detail::blocks_match(model, *m);
-    if (whole) s.models[k] = std::move(m);
-    else along[k] = detail::along_model_copied(model, *m, copies[k]);
-  }
-  if (whole) {
-    for (std::size_t k = 0; k < 4; ++k)
-      if (!s.models[k]) s.models[k] = read_at(k);  // (read before their blocks were found not to match)
-    if (const std::string why = check_sensitivity_models(model, s); !why.empty()) throw SceneError(why);
-    s.reach = std::make_shared<const ParameterReach>(parameter_reach(model, s));
-    return s;
-  }
-  s.reach = std::make_shared<const ParameterReach>(detail::reach_of(model, along, s.step));
-  s.reached = detail::reached_of(model, along, s.reach, s.step);
+  // The models along p are the whole model again, and only what p reaches is read of them (complete_along()).
+  detail::complete_along(*scene.model, s, overrides.keep_sensitivity_models, read_at,
+                         [](const std::string& why) { throw SceneError(why); });
   return s;
 }
 

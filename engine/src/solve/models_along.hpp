@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,6 +14,9 @@
 #include "phiq/sensitivity.hpp"
 
 namespace phiq::detail {
+
+// The shifts of the four models along a parameter, in units of the step h: p − 2h, p − h, p + h, p + 2h.
+inline constexpr std::array<double, 4> kShift = {-2.0, -1.0, 1.0, 2.0};
 
 // What the reach reads of one model along the parameter: which constraints differ from the swept model's, and where
 // each that differs is: its block (`source`) and its index there (`at`; empty: the same index, `source` the
@@ -47,5 +51,14 @@ ParameterReach reach_of(const Model& model, const std::array<AlongModel, 4>& alo
 // The constraints of `reach` as the four models hold them (keep_reached_only()).
 std::shared_ptr<const ReachedConstraints> reached_of(const Model& model, const std::array<AlongModel, 4>& along,
                                                      const std::shared_ptr<const ParameterReach>& reach, double step);
+
+// `s` (name, value and step set) completed with the models along p that read_at(k) gives (k = 0 … 3: at p − 2h,
+// − h, + h, + 2h), each read, checked and compared with `model` in turn, so that one is in memory at a time: its
+// reach and the constraints that differ (ReachedConstraints), or the four models whole when `keep` or when their
+// blocks do not match `model`'s (then p reaches everything). `fail` receives check_sensitivity_models()' line for
+// a model that cannot stand for `model` moved along p, and throws (sensitivity_along() of scenes and of models).
+void complete_along(const Model& model, OutputSensitivity& s, bool keep,
+                    const std::function<std::shared_ptr<const Model>(std::size_t k)>& read_at,
+                    const std::function<void(const std::string&)>& fail);
 
 }  // namespace phiq::detail

@@ -216,4 +216,48 @@ void detail::evaluate_over_reach(const ParameterReach& reach, const Model* m, co
     for (const Index r : reach.rows) f[r] -= scratch[r];
 }
 
+void detail::complete_along(const Model& model, OutputSensitivity& s, bool keep,
+                            const std::function<std::shared_ptr<const Model>(std::size_t k)>& read_at,
+                            const std::function<void(const std::string&)>& fail) {
+  std::array<AlongModel, 4> along;
+  std::array<std::vector<std::unique_ptr<ConstraintBlock>>, 4> copies;
+  bool whole = keep;
+  for (std::size_t k = 0; k < 4; ++k) {
+    std::shared_ptr<const Model> m = read_at(k);
+    if (std::string why = check_model_along(model, s, k, *m); !why.empty()) {
+      fail(why);
+      throw Error(why);  // (fail throws)
+    }
+    whole = whole || !blocks_match(model, *m);
+    if (whole) s.models[k] = std::move(m);
+    else along[k] = along_model_copied(model, *m, copies[k]);
+  }
+  if (whole) {
+    for (std::size_t k = 0; k < 4; ++k)
+      if (!s.models[k]) s.models[k] = read_at(k);  // (read before their blocks were found not to match)
+    if (const std::string why = check_sensitivity_models(model, s); !why.empty()) {
+      fail(why);
+      throw Error(why);
+    }
+    s.reach = std::make_shared<const ParameterReach>(parameter_reach(model, s));
+    return;
+  }
+  s.reach = std::make_shared<const ParameterReach>(reach_of(model, along, s.step));
+  s.reached = reached_of(model, along, s.reach, s.step);
+}
+
+OutputSensitivity sensitivity_along(const Model& model, const std::string& name, double value,
+                                    const ModelAtParameter& build, double step, bool keep_models) {
+  if (!build) throw Error("sensitivity to '" + name + "': no function builds the model along it");
+  OutputSensitivity s;
+  s.name = name, s.value = value, s.step = step > 0.0 ? step : default_sensitivity_step(value);
+  if (!std::isfinite(value) || !std::isfinite(s.step))
+    throw Error("sensitivity to '" + name + "': its value and step must be finite");
+  detail::complete_along(
+      model, s, keep_models,
+      [&](std::size_t k) { return std::make_shared<const Model>(build(value + detail::kShift[k] * s.step, &model)); },
+      [](const std::string& why) { throw Error(why); });
+  return s;
+}
+
 }  // namespace phiq

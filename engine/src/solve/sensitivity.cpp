@@ -19,8 +19,8 @@ namespace phiq {
 
 namespace {
 
-// The shifts of the four models, in units of h, and the weights of D f = Σ w_k f(k h) / (12 h).
-constexpr std::array<double, 4> kShift = {-2.0, -1.0, 1.0, 2.0};
+// The shifts of the four models, in units of h (detail::kShift), and the weights of D f = Σ w_k f(k h) / (12 h).
+using detail::kShift;
 constexpr std::array<double, 4> kWeight = {1.0, -8.0, 8.0, -1.0};
 
 // D f over the rows of `reach` into `d` (its other rows untouched), as differences of the pairs: exactly zero where
