@@ -229,3 +229,60 @@ def test_sensitivities_reach_python_as_the_clis_columns(tmp_path):
     assert adjoint.summary["counters"]["sensitivity_solves"] == 181 * 4 * 4
     first = header.index("xB.d_L2")
     assert np.max(np.abs(adjoint.table[:, first:] - table[:, first:])) < 1e-10 * np.max(np.abs(table[:, first:]))
+
+
+def test_sensitivities_asked_for_in_python_at_the_scenes_loaded_values(tmp_path):
+    # run_sweep(..., sensitivities=[...]) on a scene loaded with L2 = 0.35 (no output.sensitivities in its text):
+    # the models along each parameter are read as the scene was (L2 given), so ∂x_B/∂L2 and ∂x_B/∂L3 meet the
+    # closed form x_B = L2 cos θ + √(L3² − L2² sin² θ) at L2 = 0.35, θ = 2t, and L3 reaches the rod alone.
+    path = os.path.join(MODELS, "seed/crank_slider_mixed.yaml")
+    scene = phiq.load_scene(path, parameters={"L2": 0.35})
+    assert scene.options.sensitivity_names == []
+    result = phiq.run_sweep(scene, sensitivities=["L2", ("L3", 1e-2)])
+    assert result.ok, result.message
+    xb = result.coordinate_names.index("xB")
+    theta = 2 * result.t
+    l2, l3 = 0.35, 1.0
+    w = np.sqrt(l3**2 - (l2 * np.sin(theta)) ** 2)
+    assert np.max(np.abs(result.sensitivity("L2")[:, xb] - (np.cos(theta) - l2 * np.sin(theta) ** 2 / w))) < 1e-9
+    assert np.max(np.abs(result.sensitivity("L3")[:, xb] - l3 / w)) < 1e-9
+    # ∂ẋ_B/∂L3 = d/dt (L3 / w) = L3 L2² sin θ cos θ θ̇ / w³
+    want = l3 * l2**2 * np.sin(theta) * np.cos(theta) * 2 / w**3
+    assert np.max(np.abs(result.sensitivity("L3", 1)[:, xb] - want)) < 1e-9
+    # the same through the options, and the names they hold
+    options = scene.options
+    options.set_sensitivities(scene, ["L3"])
+    assert options.sensitivity_names == ["L3"]
+    only_l3 = phiq.run_sweep(scene, options)
+    assert np.array_equal(only_l3.sensitivity("L3")[:, xb], phiq.run_sweep(scene, sensitivities=["L3"]).sensitivity("L3")[:, xb])
+    with pytest.raises(KeyError, match="or pass it in run_sweep's sensitivities"):
+        only_l3.sensitivity("L2")
+    options.set_sensitivities(scene, [])
+    assert options.sensitivity_names == []
+    with pytest.raises(phiq.SceneError, match="'L9' is not a parameter of .*crank_slider_mixed.yaml .its parameters: L2"):
+        phiq.run_sweep(scene, sensitivities=["L9"])
+    with pytest.raises(phiq.SceneError, match="parameter 'L2' is listed twice"):
+        phiq.run_sweep(scene, sensitivities=["L2", "L2"])
+    with pytest.raises(phiq.SceneError, match="the step of 'L2' must be a positive finite number"):
+        phiq.run_sweep(scene, sensitivities=[("L2", float("nan"))])
+    with pytest.raises(TypeError, match="a name or a .name, step. tuple"):
+        phiq.run_sweep(scene, sensitivities=[3])
+
+
+def test_sensitivities_read_the_scene_again_with_its_loaded_parameters():
+    # A pin in a circular slot of radius R = r k (models/slots/circular_slot.yaml with a factor k), loaded with
+    # k = 1.2: along r the circle grows at the rate k, so the slot is differenced from the scene read at r ± h,
+    # r ± 2h with k = 1.2 as loaded (read with the file's k = 1, those models would hold another circle).
+    # y = cy + √(R² − (x − cx)²): ∂y/∂r = k R / √(R² − (x − cx)²).
+    with open(os.path.join(MODELS, "slots/circular_slot.yaml")) as f:
+        text = f.read()
+    text = text.replace("v: 0.35}", "v: 0.35, k: 1}").replace("radius: r}", "radius: r*k}")
+    assert "r*k" in text and "k: 1}" in text
+    scene = phiq.parse_scene(text, "slot_k.yaml", parameters={"k": 1.2})
+    result = phiq.run_sweep(scene, sensitivities=["r"])
+    assert result.ok, result.message
+    k, big_r, cx = 1.2, 0.6, 0.2
+    x = result.q[:, result.coordinate_names.index("x")]
+    want = k * big_r / np.sqrt(big_r**2 - (x - cx) ** 2)
+    got = result.sensitivity("r")[:, result.coordinate_names.index("y")]
+    assert np.max(np.abs(got - want)) < 1e-9

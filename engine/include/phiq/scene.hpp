@@ -56,6 +56,10 @@ struct Scene {
   /// The scene's `parameters` in file order, with their values (the caller's overrides applied): what
   /// SceneOverrides, `phiq batch` and `output.sensitivities` may name.
   std::vector<std::pair<std::string, double>> parameters;
+  /// The values the caller's overrides gave (SceneOverrides::parameters), as given: what reading the scene again as
+  /// this one repeats (sensitivity_along() takes them in its `overrides`; a parameter defined from another is not
+  /// among them, and moves with it).
+  std::vector<std::pair<std::string, double>> overridden;
   int dimension = 2;             ///< the scene's `dimension` (2: planar, 3: spatial)
   /// The frame of each moving body, in the order of Model::body_names() (planar scenes fill planar_bodies,
   /// spatial ones spatial_bodies): where `phiq animate` reads a body's pose from q.

@@ -19,7 +19,7 @@ phiq releases the GIL while it works; Ctrl-C stops a sweep at its next delivered
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, List, Optional
+from typing import Any, List, Optional, Sequence, Tuple, Union
 
 from . import _phiq
 from ._phiq import (AssemblySummary, ConstraintInfo, JacobianUpdate, LinearSummary, Model, NewtonOptions,
@@ -46,19 +46,24 @@ __all__ = [
 
 
 def run_sweep(scene: Scene, options: Optional[SweepOptions] = None, *, identifier_names: bool = False,
-              **overrides: Any) -> SweepResult:
+              sensitivities: Optional[Sequence[Union[str, Tuple[str, float]]]] = None, **overrides: Any) -> SweepResult:
     """Sweep a scene as ``phiq run`` does: the assembly from its rough placement (redundant constraints of a
     consistent model left out of the square solves), then every time point of the grid.
 
     ``options``: the SweepOptions to use (default: ``scene.options``); keyword arguments then set its fields, e.g.
     ``run_sweep(scene, threads=2, steps=1000, accelerations=False)`` (TypeError for a name SweepOptions lacks).
     ``identifier_names``: name the columns as Python identifiers (``theta2__v`` for ``theta2.v``).
+    ``sensitivities``: parameters of the scene whose sensitivities ∂q/∂p (and ∂q̇/∂p, ∂q̈/∂p) to deliver instead of
+    its ``output.sensitivities``, each a name or a ``(name, step)`` tuple (SweepOptions.set_sensitivities); read
+    them with SweepResult.sensitivity.
     Every thread count gives the same bits. Returns a SweepResult (check ``ok``, or call ``raise_for_status()``).
     """
     opts = scene.options if options is None else options
-    if overrides:
+    if overrides or sensitivities is not None:
         if options is not None:
             opts = _copy_options(options)
+        if sensitivities is not None:
+            opts.set_sensitivities(scene, list(sensitivities))
         for name, value in overrides.items():
             if not hasattr(opts, name) or name.startswith("_"):
                 fields = sorted(n for n in dir(opts) if not n.startswith("_") and not callable(getattr(opts, n)))

@@ -110,7 +110,8 @@ class SweepResult:
         raise KeyError(f"no output point '{name}' in this result (its columns: {', '.join(self.columns)})")
 
     def sensitivity(self, parameter: str, order: int = 0) -> np.ndarray:
-        """Sensitivities to a parameter of the scene's ``output.sensitivities``: ∂q/∂p (order 0), ∂q̇/∂p (1) or
+        """Sensitivities to a parameter of the scene's ``output.sensitivities`` (or of run_sweep's
+        ``sensitivities``): ∂q/∂p (order 0), ∂q̇/∂p (1) or
         ∂q̈/∂p (2), rows × the columns of ``q`` (``qd``, ``qdd``) in their order; NaN on a singular position."""
         if order not in (0, 1, 2):
             raise ValueError(f"order must be 0, 1 or 2, not {order}")
@@ -120,7 +121,8 @@ class SweepResult:
             if names and all(n in self._index for n in names):
                 return self.table[:, [self._index[n] for n in names]]
         raise KeyError(f"no sensitivities of order {order} to '{parameter}' in this result (list the parameter in "
-                       f"the scene's output.sensitivities; its columns: {', '.join(self.columns)})")
+                       f"the scene's output.sensitivities or pass it in run_sweep's sensitivities; its columns: "
+                       f"{', '.join(self.columns)})")
 
     def __len__(self) -> int:
         return self.table.shape[0]

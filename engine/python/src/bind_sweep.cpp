@@ -3,6 +3,9 @@
 
 #include "bindings.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace phiq::python {
 
 namespace {
@@ -118,7 +121,59 @@ void bind_sweep(py::module_& m) {
                              },
                              "drivers whose law is written (NAME.f, NAME.df, NAME.ddf)")
       .def("rows_written", [](const SweepOptions& o) { return rows_written(o); },
-           "rows a successful sweep with these options delivers");
+           "rows a successful sweep with these options delivers")
+      .def_property_readonly("sensitivity_names",
+                             [](const SweepOptions& o) {
+                               std::vector<std::string> n;
+                               for (const OutputSensitivity& s : o.sensitivities) n.push_back(s.name);
+                               return n;
+                             },
+                             "parameters whose sensitivities are delivered (columns x.d_P, x.v.d_P, x.a.d_P)")
+      .def(
+          "set_sensitivities",
+          [](SweepOptions& o, const Scene& scene, const py::list& parameters) {
+            // (name, step) pairs read with the GIL held, the scene read again along each without it
+            std::vector<std::pair<std::string, double>> asked;
+            for (const py::handle& p : parameters) {
+              if (py::isinstance<py::str>(p)) {
+                asked.emplace_back(p.cast<std::string>(), 0.0);
+              } else if (py::isinstance<py::tuple>(p) && py::len(p) == 2) {
+                asked.emplace_back(p[py::int_(0)].cast<std::string>(), p[py::int_(1)].cast<double>());
+              } else {
+                throw py::type_error("set_sensitivities: each parameter is a name or a (name, step) tuple, not " +
+                                     py::repr(p).cast<std::string>());
+              }
+            }
+            std::vector<OutputSensitivity> out;
+            SceneOverrides as_read;  // the scene read again as it was (its parameters given when loaded)
+            as_read.parameters = scene.overridden;
+            {
+              py::gil_scoped_release free;
+              for (const auto& [name, step] : asked) {
+                if (std::any_of(out.begin(), out.end(), [&](const OutputSensitivity& s) { return s.name == name; }))
+                  throw SceneError("sensitivities: parameter '" + name + "' is listed twice");
+                if (!(step >= 0.0) || !std::isfinite(step))
+                  throw SceneError("sensitivities: the step of '" + name + "' must be a positive finite number "
+                                   "(0: the default)");
+                const auto it = std::find_if(scene.parameters.begin(), scene.parameters.end(),
+                                             [&](const auto& nv) { return nv.first == name; });
+                if (it == scene.parameters.end()) {
+                  std::string known;
+                  for (const auto& nv : scene.parameters) known += (known.empty() ? "" : ", ") + nv.first;
+                  throw SceneError("sensitivities: '" + name + "' is not a parameter of " + scene.path + " (its "
+                                   "parameters: " + (known.empty() ? "none" : known) + ")");
+                }
+                out.push_back(sensitivity_along(scene, name, it->second, step, {}, as_read));
+              }
+            }
+            o.sensitivities = std::move(out);
+          },
+          py::arg("scene"), py::arg("parameters"),
+          "Deliver the sensitivities to these parameters of `scene` (the scene these options sweep): each a name, or "
+          "a (name, step) tuple for the difference step of the data's rates (default 1e-3 |p|). As the scene's "
+          "output.sensitivities: its text read again at p ± h, p ± 2h, only what p reaches kept. An empty list "
+          "delivers none. Raises SceneError (a ValueError) for a name the scene has no parameter of, a name "
+          "listed twice or a parameter that changes the structure.");
 
   py::class_<SweepWarning>(m, "SweepWarning", "Something to know about a delivered row (it is within tolerance).")
       .def_readonly("t", &SweepWarning::t, "time of the row concerned")

@@ -141,6 +141,7 @@ Scene read_tree(const YAML::Node& root, const std::string& text, const std::stri
   reader.overrides_ = &overrides;
   Scene scene = reader.read(root);
   scene.text = text;
+  scene.overridden = overrides.parameters;
   // A predictor that needs derivatives the scene does not output would compute extra work silently: refuse.
   if (reader.predictor_given()) {
     const Predictor p = scene.sweep.predictor;
