@@ -297,3 +297,48 @@ TEST_F(Cli, SetGivesTheScenesParametersTheirValuesForTheRun) {
 }
 
 }  // namespace
+
+namespace {
+
+// `--sensitivity NAME[=STEP]`: the run delivers the sensitivities a scene's output.sensitivities would, the same
+// columns and bytes, here with --set's L2 kept when the scene is read again along L3; refused in one line (exit 2,
+// no output) for a name that is no parameter, one asked for twice and a step that is not a number.
+TEST_F(Cli, SensitivityOptionDeliversWhatTheScenesOutputWould) {
+  const std::string scene = phiq::test::model_path("seed/crank_slider_mixed.yaml");
+  const fs::path listed = dir_ / "listed.yaml", by_text = dir_ / "text.csv", by_option = dir_ / "option.csv";
+  std::ofstream(listed) << phiq::test::replace_first(
+      slurp(scene), "output: {velocities: true, accelerations: true}",
+      "output: {velocities: true, accelerations: true, sensitivities: [L2, {parameter: L3, step: 0.01}]}");
+  ASSERT_EQ(run("run -q " + listed.string() + " --set L2=0.25 -o " + by_text.string()).code, 0);
+  const Result r = run("run -q " + scene + " --set L2=0.25 --sensitivity L2 --sensitivity L3=0.01 -o " +
+                       by_option.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string text = slurp(by_option);
+  EXPECT_EQ(text, slurp(by_text));
+  EXPECT_NE(text.find(",xB.d_L2,"), std::string::npos);
+  EXPECT_NE(text.find(",xB.a.d_L3\n"), std::string::npos);
+  const phiq::CsvTable t = phiq::read_csv_table(by_option.string());
+  const auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(t.columns.begin(), t.columns.end(), name) - t.columns.begin());
+  };
+  const double l2 = 0.25, l3 = 1.0;
+  for (const auto& row : t.rows) {  // ∂x_B/∂L3 = L3 / √(L3² − L2² sin² θ)
+    const double s = std::sin(row[col("theta2")]);
+    EXPECT_NEAR(row[col("xB.d_L3")], l3 / std::sqrt(l3 * l3 - l2 * l2 * s * s), 1e-9) << "t = " << row[0];
+  }
+  const fs::path none = dir_ / "none.csv";
+  for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+           {"--sensitivity L9", "--sensitivity: 'L9' is not a parameter of " + scene + " (its parameters: L2, L3"},
+           {"--sensitivity L2 --sensitivity L2=0.1", "--sensitivity: parameter 'L2' is asked for twice"},
+           {"--sensitivity L2=fast", "--sensitivity L2=fast: 'fast' is not a number"},
+           {"--sensitivity L2=-1", "--sensitivity: the step of 'L2' must be a positive finite number"}}) {
+    const Result bad = run("run -q " + scene + " " + args + " -o " + none.string());
+    EXPECT_EQ(bad.code, 2) << args;
+    EXPECT_NE(bad.err.find(says), std::string::npos) << bad.err;
+    EXPECT_TRUE(phiq::test::one_phiq_line(bad.err)) << bad.err;
+    EXPECT_FALSE(fs::exists(none)) << args;
+  }
+}
+
+}  // namespace
+

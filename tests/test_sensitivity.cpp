@@ -890,8 +890,8 @@ TEST(Sensitivity, ARollersRadiusIsDifferentiatedByTheCamConstraint) {
     for (std::size_t k = 0; k < exact.s.size(); ++k) {
       const double th = w * exact.rows.t[k], c = std::cos(th), sn = std::sin(th);
       const double D = std::sqrt(A * A - e * e * c * c), N = e * e * sn * c;
-      const double want[3] = {A / D, -w * N * A / std::pow(D, 3),
-                              w * w * (3.0 * N * N * A / std::pow(D, 5) - e * e * std::cos(2.0 * th) * A / std::pow(D, 3))};
+      const double d3 = std::pow(D, 3), d5 = std::pow(D, 5);
+      const double want[3] = {A / D, -w * N * A / d3, w * w * (3.0 * N * N * A / d5 - e * e * std::cos(2.0 * th) * A / d3)};
       const double scale[3] = {1.0, w, w * w};
       for (int o = 0; o < 3; ++o) {
         worst_exact = std::max(worst_exact, std::fabs(exact.s[k][layout.offset(0, o) + yf] - want[o]) / scale[o]);

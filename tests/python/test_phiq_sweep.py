@@ -254,16 +254,18 @@ def test_sensitivities_asked_for_in_python_at_the_scenes_loaded_values(tmp_path)
     options.set_sensitivities(scene, ["L3"])
     assert options.sensitivity_names == ["L3"]
     only_l3 = phiq.run_sweep(scene, options)
-    assert np.array_equal(only_l3.sensitivity("L3")[:, xb], phiq.run_sweep(scene, sensitivities=["L3"]).sensitivity("L3")[:, xb])
+    by_keyword = phiq.run_sweep(scene, sensitivities=["L3"])
+    assert np.array_equal(only_l3.sensitivity("L3")[:, xb], by_keyword.sensitivity("L3")[:, xb])
     with pytest.raises(KeyError, match="or pass it in run_sweep's sensitivities"):
         only_l3.sensitivity("L2")
     options.set_sensitivities(scene, [])
     assert options.sensitivity_names == []
-    with pytest.raises(phiq.SceneError, match="'L9' is not a parameter of .*crank_slider_mixed.yaml .its parameters: L2"):
+    unknown = "sensitivities: 'L9' is not a parameter of .*crank_slider_mixed.yaml .its parameters: L2"
+    with pytest.raises(phiq.SceneError, match=unknown):
         phiq.run_sweep(scene, sensitivities=["L9"])
-    with pytest.raises(phiq.SceneError, match="parameter 'L2' is listed twice"):
+    with pytest.raises(phiq.SceneError, match="sensitivities: parameter .L2. is asked for twice"):
         phiq.run_sweep(scene, sensitivities=["L2", "L2"])
-    with pytest.raises(phiq.SceneError, match="the step of 'L2' must be a positive finite number"):
+    with pytest.raises(phiq.SceneError, match="sensitivities: the step of .L2. must be a positive finite number"):
         phiq.run_sweep(scene, sensitivities=[("L2", float("nan"))])
     with pytest.raises(TypeError, match="a name or a .name, step. tuple"):
         phiq.run_sweep(scene, sensitivities=[3])

@@ -88,6 +88,27 @@ void add_set_option(CLI::App* command, std::vector<std::string>* sets) {
       ->allow_extra_args(false);  // one NAME=VALUE an occurrence: the scene after it stays the scene
 }
 
+std::vector<SensitivityRequest> sensitivity_requests(const std::vector<std::string>& args) {
+  std::vector<SensitivityRequest> out;
+  for (const std::string& text : args) {
+    if (text.find('=') == std::string::npos) {
+      out.push_back({text, 0.0});
+    } else {
+      auto [name, step] = tolerance::parse_named_value("--sensitivity", text);
+      out.push_back({std::move(name), step});
+    }
+  }
+  return out;
+}
+
+void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args) {
+  command->add_option("--sensitivity", *args,
+                      "NAME or NAME=STEP: deliver the sensitivities to the scene parameter NAME (columns x.d_NAME, "
+                      "x.v.d_NAME, x.a.d_NAME; STEP the difference step of its data's rates), instead of the "
+                      "scene's output.sensitivities (repeat per parameter)")
+      ->allow_extra_args(false);
+}
+
 std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets) {
   try {
     const SceneOverrides o = parameter_settings(sets);

@@ -38,6 +38,11 @@ SceneOverrides parameter_settings(const std::vector<std::string>& sets);
 // Registers `--set NAME=VALUE` (repeatable) on `command`, into `sets`.
 void add_set_option(CLI::App* command, std::vector<std::string>* sets);
 
+// `--sensitivity NAME` or `NAME=STEP` (repeatable): the parameters whose sensitivities a run delivers instead of
+// the scene's output.sensitivities. Throws phiq::Error for a STEP that is not a number.
+std::vector<SensitivityRequest> sensitivity_requests(const std::vector<std::string>& args);
+void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args);
+
 // The scene at `path` ("-": standard input, named kStdinScene), with the parameters `sets` gives
 // (parameter_settings()); on a scene or --set error its one line is printed and the result is empty (the command
 // exits 2).

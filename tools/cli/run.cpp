@@ -23,7 +23,8 @@ namespace {
 
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb,
-            ProgressBar::Mode progress_mode, bool identifier_names, const std::vector<std::string>& sets) {
+            ProgressBar::Mode progress_mode, bool identifier_names, const std::vector<std::string>& sets,
+            const std::vector<std::string>& sensitivity_args) {
   const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
@@ -43,6 +44,16 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets);
   if (!loaded) return 2;
   phiq::Scene& scene = *loaded;
+  if (!sensitivity_args.empty()) {  // instead of the scene's output.sensitivities
+    try {
+      scene.sweep.sensitivities =
+          phiq::sensitivities_of(scene, sensitivity_requests(sensitivity_args), "--sensitivity");
+    } catch (const phiq::SceneError& e) {
+      return fail(e.what(), 2);
+    } catch (const phiq::Error& e) {  // a STEP that is not a number
+      return fail(e.what(), 2);
+    }
+  }
   const double load_s = since(load_start);
 
   // Every output exists (as a temporary, or a device opened) before the solve: an unwritable path fails now, not
@@ -233,6 +244,7 @@ Command register_run(CLI::App& app) {
     int deflate = 0;
     std::string names = "dotted";
     std::vector<std::string> sets;
+    std::vector<std::string> sensitivities;
   };
   auto a = std::make_shared<Args>();
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
@@ -270,12 +282,13 @@ Command register_run(CLI::App& app) {
       ->capture_default_str()
       ->check(one_of({"dotted", "identifiers"}));
   add_set_option(run, &a->sets);
+  add_sensitivity_option(run, &a->sensitivities);
   return {run, [a] {
             using Mode = ProgressBar::Mode;
             const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
             return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet,
                                                a->summary_path, cap_threads("run", a->threads, a->quiet), a->memory_gb,
-                                               mode, a->names == "identifiers", a->sets));
+                                               mode, a->names == "identifiers", a->sets, a->sensitivities));
           }};
 }
 

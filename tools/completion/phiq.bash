@@ -23,7 +23,7 @@ _phiq() {
 
   local opts=""
   case "$cmd" in
-    run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names --set" ;;
+    run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names --set --sensitivity" ;;
     check) opts="--help --json --time --set" ;;
     assemble) opts="--help --output --quiet --set" ;;
     batch) opts="--help --output --quiet --threads --summary --names --resume" ;;
@@ -50,7 +50,7 @@ _phiq() {
                                           closed-form:nfourbar closed-form:chain3d" -- "$cur")); return ;;
     --summary|--junit|-o|--output|--covariance|--plot) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     --threads|--memory|--steps|--from|--to|--twist|--time|--rtol|--atol|--columns|--positions|--tolerances|\
-    --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column|--set) return ;;  # a value of the user's
+    --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column|--set|--sensitivity) return ;;  # a value of the user's
   esac
   if [[ "$cur" == -* ]]; then
     COMPREPLY=($(compgen -W "$opts" -- "$cur"))

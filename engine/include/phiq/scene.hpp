@@ -104,6 +104,22 @@ struct SceneOverrides {
 OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name, double value, double step = 0.0,
                                     const SceneLimits& limits = {}, const SceneOverrides& overrides = {});
 
+/// A parameter whose sensitivities a caller asks for beside the scene's text (`phiq run --sensitivity`, Python's
+/// run_sweep(sensitivities=...)), as an entry of its `output.sensitivities` would.
+struct SensitivityRequest {
+  std::string name;   ///< a parameter of the scene
+  double step = 0.0;  ///< the difference step of the data's rates; 0: default_sensitivity_step() of its value
+};
+
+/// The sensitivities of `scene` to `requests`, for SweepOptions::sensitivities (in their order): each parameter's
+/// models read from the scene's text as `scene` was read (its Scene::overridden values), by sensitivity_along().
+/// Throws SceneError, one line starting with `source` (the option or argument they came from), for a name that is
+/// no parameter of the scene (the message lists them), a name asked for twice, a step that is not 0 or a positive
+/// finite number, and what sensitivity_along() throws.
+std::vector<OutputSensitivity> sensitivities_of(const Scene& scene, const std::vector<SensitivityRequest>& requests,
+                                                const std::string& source = "sensitivities",
+                                                const SceneLimits& limits = {});
+
 /// Loads and validates a scene file. Throws SceneError (never crashes) for unreadable files, YAML syntax errors,
 /// unknown or duplicate fields and names, wrong types, NaN or infinite numbers and impossible values.
 Scene load_scene(const std::string& path, const SceneLimits& limits = {});

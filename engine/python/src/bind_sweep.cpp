@@ -3,9 +3,6 @@
 
 #include "bindings.hpp"
 
-#include <algorithm>
-#include <cmath>
-
 namespace phiq::python {
 
 namespace {
@@ -132,39 +129,22 @@ void bind_sweep(py::module_& m) {
       .def(
           "set_sensitivities",
           [](SweepOptions& o, const Scene& scene, const py::list& parameters) {
-            // (name, step) pairs read with the GIL held, the scene read again along each without it
-            std::vector<std::pair<std::string, double>> asked;
+            // the (name, step) pairs read with the GIL held, the scene read again along each without it
+            std::vector<SensitivityRequest> asked;
             for (const py::handle& p : parameters) {
               if (py::isinstance<py::str>(p)) {
-                asked.emplace_back(p.cast<std::string>(), 0.0);
+                asked.push_back({p.cast<std::string>(), 0.0});
               } else if (py::isinstance<py::tuple>(p) && py::len(p) == 2) {
-                asked.emplace_back(p[py::int_(0)].cast<std::string>(), p[py::int_(1)].cast<double>());
+                asked.push_back({p[py::int_(0)].cast<std::string>(), p[py::int_(1)].cast<double>()});
               } else {
                 throw py::type_error("set_sensitivities: each parameter is a name or a (name, step) tuple, not " +
                                      py::repr(p).cast<std::string>());
               }
             }
             std::vector<OutputSensitivity> out;
-            SceneOverrides as_read;  // the scene read again as it was (its parameters given when loaded)
-            as_read.parameters = scene.overridden;
             {
               py::gil_scoped_release free;
-              for (const auto& [name, step] : asked) {
-                if (std::any_of(out.begin(), out.end(), [&](const OutputSensitivity& s) { return s.name == name; }))
-                  throw SceneError("sensitivities: parameter '" + name + "' is listed twice");
-                if (!(step >= 0.0) || !std::isfinite(step))
-                  throw SceneError("sensitivities: the step of '" + name + "' must be a positive finite number "
-                                   "(0: the default)");
-                const auto it = std::find_if(scene.parameters.begin(), scene.parameters.end(),
-                                             [&](const auto& nv) { return nv.first == name; });
-                if (it == scene.parameters.end()) {
-                  std::string known;
-                  for (const auto& nv : scene.parameters) known += (known.empty() ? "" : ", ") + nv.first;
-                  throw SceneError("sensitivities: '" + name + "' is not a parameter of " + scene.path + " (its "
-                                   "parameters: " + (known.empty() ? "none" : known) + ")");
-                }
-                out.push_back(sensitivity_along(scene, name, it->second, step, {}, as_read));
-              }
+              out = sensitivities_of(scene, asked);
             }
             o.sensitivities = std::move(out);
           },

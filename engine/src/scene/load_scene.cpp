@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "phiq/parsed_scene.hpp"
@@ -216,6 +217,33 @@ OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name,
   detail::complete_along(*scene.model, s, overrides.keep_sensitivity_models, read_at,
                          [](const std::string& why) { throw SceneError(why); });
   return s;
+}
+
+std::vector<OutputSensitivity> sensitivities_of(const Scene& scene, const std::vector<SensitivityRequest>& requests,
+                                                const std::string& source, const SceneLimits& limits) {
+  SceneOverrides as_read;  // the scene read again as it was: the parameters its reader was given
+  as_read.parameters = scene.overridden;
+  std::vector<OutputSensitivity> out;
+  for (const SensitivityRequest& r : requests) {
+    if (std::any_of(out.begin(), out.end(), [&](const OutputSensitivity& s) { return s.name == r.name; }))
+      throw SceneError(source + ": parameter '" + r.name + "' is asked for twice");
+    if (!(r.step >= 0.0) || !std::isfinite(r.step))
+      throw SceneError(source + ": the step of '" + r.name + "' must be a positive finite number (0: the default)");
+    const auto it = std::find_if(scene.parameters.begin(), scene.parameters.end(),
+                                 [&](const auto& nv) { return nv.first == r.name; });
+    if (it == scene.parameters.end()) {
+      std::string known;
+      for (const auto& nv : scene.parameters) known += (known.empty() ? "" : ", ") + nv.first;
+      throw SceneError(source + ": '" + r.name + "' is not a parameter of " + scene.path +
+                       (known.empty() ? " (it has none)" : " (its parameters: " + known + ")"));
+    }
+    try {
+      out.push_back(sensitivity_along(scene, r.name, it->second, r.step, limits, as_read));
+    } catch (const SceneError& e) {
+      throw SceneError(source + ": " + e.what());
+    }
+  }
+  return out;
 }
 
 Scene load_scene(const std::string& path, const SceneLimits& limits) {
