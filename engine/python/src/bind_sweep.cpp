@@ -7,6 +7,14 @@ namespace phiq::python {
 
 namespace {
 
+// The names of a plan's outputs of one sort (points, drivers, sensitivities), in order.
+template <class Items>
+std::vector<std::string> names_of(const Items& items) {
+  std::vector<std::string> n;
+  for (const auto& item : items) n.push_back(item.name);
+  return n;
+}
+
 py::dict counters_dict(const WorkCounters& c) {
   return py::dict(py::arg("newton_iterations") = c.newton_iterations,
                   py::arg("residual_evaluations") = c.residual_evaluations,
@@ -103,28 +111,13 @@ void bind_sweep(py::module_& m) {
       .def_readwrite("window_end", &SweepOptions::window_end, "write rows with t ≤ this")
       .def_readwrite("max_residual_column", &SweepOptions::max_residual_column, "write the largest scaled residual of all rows (column residual)")
       .def_readwrite("residual_columns", &SweepOptions::residual_columns, "constraint indices whose residual is written")
-      .def_property_readonly("point_names",
-                             [](const SweepOptions& o) {
-                               std::vector<std::string> n;
-                               for (const OutputPoint& p : o.points) n.push_back(p.name);
-                               return n;
-                             },
+      .def_property_readonly("point_names", [](const SweepOptions& o) { return names_of(o.points); },
                              "output points of the scene (their columns NAME.x, NAME.y, …)")
-      .def_property_readonly("driver_names",
-                             [](const SweepOptions& o) {
-                               std::vector<std::string> n;
-                               for (const OutputDriver& d : o.driver_columns) n.push_back(d.name);
-                               return n;
-                             },
+      .def_property_readonly("driver_names", [](const SweepOptions& o) { return names_of(o.driver_columns); },
                              "drivers whose law is written (NAME.f, NAME.df, NAME.ddf)")
       .def("rows_written", [](const SweepOptions& o) { return rows_written(o); },
            "rows a successful sweep with these options delivers")
-      .def_property_readonly("sensitivity_names",
-                             [](const SweepOptions& o) {
-                               std::vector<std::string> n;
-                               for (const OutputSensitivity& s : o.sensitivities) n.push_back(s.name);
-                               return n;
-                             },
+      .def_property_readonly("sensitivity_names", [](const SweepOptions& o) { return names_of(o.sensitivities); },
                              "parameters whose sensitivities are delivered (columns x.d_P, x.v.d_P, x.a.d_P)")
       .def(
           "set_sensitivities",
