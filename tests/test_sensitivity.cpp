@@ -859,6 +859,60 @@ TEST(Sensitivity, ModelsBuiltInCodeHaveTheirParametersDifferentiated) {
   EXPECT_THROW((void)sensitivity_along(model, "L2", 0.3, ModelAtParameter{}), Error);
 }
 
+// A Stepper (a simulator's own clock) delivers the sensitivities of each step as a sweep's rows: the crank-slider
+// built in code, L2 and L3 along it, stepped at uneven times forward and back against the closed form (1e-9), and
+// over a grid the very bits of run_sweep in order. The adjoint form and models of another mechanism are refused.
+TEST(Sensitivity, AStepperDeliversTheSensitivitiesOfEachStep) {
+  const Model model = crank_slider_built(0.3, 1.0, nullptr);
+  StepperOptions so;
+  so.sensitivities = {
+      sensitivity_along(model, "L2", 0.3, [](double v, const Model* m) { return crank_slider_built(v, 1.0, m); }),
+      sensitivity_along(model, "L3", 1.0, [](double v, const Model* m) { return crank_slider_built(0.3, v, m); })};
+  const Index xb = model.coordinate_index("xB"), n = model.num_coordinates();
+  const SensitivityLayout layout{n};
+  {
+    Stepper stepper(model, so);
+    EXPECT_EQ(stepper.sensitivities(), nullptr);  // before the first step
+    for (const double t : {0.0, 0.13, 0.4, 0.37, 0.9, 1.55, 1.2, 2.6}) {
+      ASSERT_EQ(stepper.step(t), SolveStatus::kSuccess) << t;
+      const double* sens = stepper.sensitivities();
+      ASSERT_NE(sens, nullptr);
+      for (std::size_t j = 0; j < 2; ++j) {
+        const auto want = slider_sensitivities(t, j == 0 ? 2 : 3);
+        for (int order = 0; order < 3; ++order)
+          EXPECT_NEAR(sens[layout.offset(j, order) + xb], want[order], 1e-9) << "t = " << t << ", L" << (j + 2);
+      }
+    }
+  }
+  // over a grid: run_sweep's rows in order, to the bit
+  SweepOptions o;
+  o.t_begin = 0.0, o.t_end = M_PI, o.steps = 30, o.chunk_steps = 30;
+  o.velocities = o.accelerations = true;
+  o.sensitivities = so.sensitivities;
+  const SensitivityTrace swept = sweep_sensitivities(model, o);
+  ASSERT_EQ(swept.s.size(), 31u);
+  Stepper stepper(model, so);
+  for (Index k = 0; k <= o.steps; ++k) {
+    ASSERT_EQ(stepper.step(o.time_of(k)), SolveStatus::kSuccess) << k;
+    const std::vector<double>& want = swept.s[static_cast<std::size_t>(k)];
+    ASSERT_EQ(want.size(), static_cast<std::size_t>(layout.size(2)));
+    EXPECT_EQ(std::memcmp(stepper.sensitivities(), want.data(), sizeof(double) * want.size()), 0) << "row " << k;
+  }
+  StepperOptions adjoint = so;
+  adjoint.sensitivity_form = SensitivityForm::kAdjoint;
+  EXPECT_THROW(Stepper(model, adjoint), Error);
+  StepperOptions other = so;
+  other.sensitivities = {sensitivity_along(slot_by_arc(0.5), "r", 0.5, [](double v, const Model* m) {
+    return slot_by_arc(v, m);
+  })};
+  try {
+    Stepper refused(model, other);
+    ADD_FAILURE() << "models of another mechanism were accepted";
+  } catch (const Error& e) {
+    EXPECT_HAS(std::string(e.what()), "StepperOptions: sensitivity to 'r'");
+  }
+}
+
 // The eccentric circular cam under a translating roller follower (models/cams/eccentric_roller.yaml): the roller's
 // radius ρ moves the cam constraint's offset and not its curve (no co-moving contact), so the constraint
 // differentiates its own data and the follower's height y = e sin θ + D, D = √((R + ρ)² − e² cos² θ), has

@@ -79,3 +79,40 @@ def test_redundant_and_inconsistent_scenes():
     assert door.step(0.0).ok and door.step(0.05).ok
     with pytest.raises(ValueError, match="hinge3"):
         phiq.Stepper(phiq.load_scene(os.path.join(MODELS, "redundant", "door_misaligned.yaml")))
+
+
+def test_each_step_delivers_its_sensitivities():
+    # A stepper on the crank-slider loaded with L2 = 0.35, asked for L2 and L3: at uneven times, forward and back,
+    # ∂x_B/∂L2 = cos θ − L2 sin² θ / w and ∂x_B/∂L3 = L3 / w, w = √(L3² − L2² sin² θ), θ = 2t (1e-9); over the grid
+    # the sweep's sensitivity columns to the bit.
+    scene = phiq.load_scene(CRANK_SLIDER, parameters={"L2": 0.35})
+    stepper = phiq.Stepper(scene, sensitivities=["L2", ("L3", 1e-2)])
+    assert stepper.sensitivity_names == ["L2", "L3"]
+    with pytest.raises(ValueError, match="no state yet"):
+        stepper.sensitivity("L2")
+    xb = stepper.model.coordinate_index("xB")
+    l2, l3 = 0.35, 1.0
+    for t in (0.0, 0.21, 0.5, 0.45, 1.3, 2.9, 2.2):
+        assert stepper.step(t).ok
+        th = 2 * t
+        w = math.sqrt(l3**2 - (l2 * math.sin(th)) ** 2)
+        assert abs(stepper.sensitivity("L2")[xb] - (math.cos(th) - l2 * math.sin(th) ** 2 / w)) < 1e-9
+        assert abs(stepper.sensitivity("L3")[xb] - l3 / w) < 1e-9
+        assert stepper.sensitivity("L3", 2).shape == (4,)
+    with pytest.raises(KeyError, match="no sensitivities to 'omega'"):
+        stepper.sensitivity("omega")
+    with pytest.raises(ValueError, match="order must be 0, 1 or 2"):
+        stepper.sensitivity("L2", 3)
+    opts = scene.options
+    sweep = phiq.run_sweep(scene, threads=1, chunk_steps=opts.steps + 1, sensitivities=["L2", ("L3", 1e-2)])
+    gridded = phiq.Stepper(scene, sensitivities=["L2", ("L3", 1e-2)])
+    for k in range(opts.steps + 1):
+        assert gridded.step(opts.time_of(k)).ok
+        for name in ("L2", "L3"):
+            for order in (0, 1, 2):
+                assert np.array_equal(gridded.sensitivity(name, order), sweep.sensitivity(name, order)[k]), (k, name)
+    with pytest.raises(phiq.SceneError, match="sensitivities: 'L9' is not a parameter"):
+        phiq.Stepper(scene, sensitivities=["L9"])
+    with pytest.raises(TypeError, match="Stepper: each parameter is a name or a .name, step. tuple"):
+        phiq.Stepper(scene, sensitivities=[1.5])
+    assert phiq.Stepper(scene).sensitivity_names == []  # the scene lists none

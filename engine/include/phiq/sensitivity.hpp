@@ -112,6 +112,11 @@ struct ReachedConstraints {
   /// per model, per span of the reach (empty where `rates` holds the span's: what is read of it then)
   std::array<std::vector<std::unique_ptr<ConstraintBlock>>, 4> along;
   std::vector<std::unique_ptr<ConstraintBlock>> rates;  ///< per span of the reach: its data's rates, or null
+  /// The swept model's n when they were kept: check_sensitivity_models() refuses them for another model (and spans
+  /// outside its blocks, or of other kinds), whose constraints they do not stand for.
+  Index coordinates = 0;
+  Index equations = 0;  ///< the swept model's m when they were kept (see coordinates)
+  Index nonzeros = 0;   ///< the nonzeros of its Φq (see coordinates)
 };
 
 /// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the

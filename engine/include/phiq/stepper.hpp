@@ -28,6 +28,13 @@ struct StepperOptions : SolverSettings {
   /// construction or restart()) is exactly a singular one: the points that bracket it for the branch's own
   /// velocity lie at a fraction of this step on either side. The steps taken may differ from it.
   double expected_step = 0.01;
+  /// Design parameters whose sensitivities ∂q/∂p (with ∂q̇/∂p, ∂q̈/∂p as q̇, q̈ are solved) every step delivers
+  /// (Stepper::sensitivities()), solved with the step's own factorisation of Φq: as a sweep's rows
+  /// (OutputPlan::sensitivities; sensitivity_along() of scene.hpp or of sensitivity.hpp makes them).
+  std::vector<OutputSensitivity> sensitivities;
+  /// How they are solved: kAuto is the direct form, every coordinate's (a stepper writes no columns); kAdjoint
+  /// solves for no coordinate here, and is refused.
+  SensitivityForm sensitivity_form = SensitivityForm::kAuto;
 };
 
 /// What one Stepper::step did.
@@ -58,7 +65,8 @@ class Stepper {
  public:
   /// A stepper for `model`, its placement the model's initial positions. Throws phiq::Error for settings no step can
   /// honour (those run_sweep refuses in SolverSettings; a predictor whose derivatives are not solved; a point that
-  /// reads a coordinate the model does not have; expected_step not finite or zero).
+  /// reads a coordinate the model does not have; expected_step not finite or zero; a sensitivity whose models do
+  /// not match the model, check_sensitivity_models(); the adjoint form).
   explicit Stepper(const Model& model, StepperOptions options = {});
   ~Stepper();  ///< frees the workspace and the history
   Stepper(Stepper&&) noexcept;             ///< takes over the other stepper's state; the other is not used after it
@@ -97,6 +105,10 @@ class Stepper {
   /// Motions of StepperOptions::points at the current state, in that order; null when none are listed or before
   /// started().
   const PointMotion* point_motions() const;
+  /// Sensitivities of the current state to StepperOptions::sensitivities, laid out as SensitivityLayout{n} says
+  /// (parameter j's ∂q/∂p at offset(j, 0), ∂q̇/∂p at offset(j, 1), ∂q̈/∂p at offset(j, 2); NaN for the derivatives
+  /// not solved, and all at a singular position); null when none are asked for or before started().
+  const double* sensitivities() const;
 
   /// Everything the steps did since construction, as run_sweep's summary says it of a sweep: counters, subdivisions,
   /// singular positions, the smallest rcond, warnings (in the order raised; each slow_convergence stands alone,

@@ -4,6 +4,7 @@
 
 #include "bindings.hpp"
 
+#include <algorithm>
 #include <memory>
 #include <optional>
 
@@ -20,7 +21,8 @@ struct PyStepper {
 };
 
 std::unique_ptr<PyStepper> stepper_for_scene(std::shared_ptr<const Scene> scene, std::optional<bool> velocities,
-                                             std::optional<bool> accelerations) {
+                                             std::optional<bool> accelerations,
+                                             const std::optional<std::vector<SensitivityRequest>>& sensitivities) {
   auto s = std::make_unique<PyStepper>();
   s->scene = std::move(scene);
   const Scene& sc = *s->scene;
@@ -31,6 +33,12 @@ std::unique_ptr<PyStepper> stepper_for_scene(std::shared_ptr<const Scene> scene,
   o.velocities = velocities.value_or(sc.sweep.velocities);
   o.accelerations = accelerations.value_or(sc.sweep.accelerations);
   o.points = sc.sweep.points;
+  if (sensitivities) {
+    py::gil_scoped_release free;  // the scene read again along each parameter
+    o.sensitivities = sensitivities_of(sc, *sensitivities);
+  } else {
+    o.sensitivities = sc.sweep.sensitivities;
+  }
   if (sc.sweep.steps > 0) o.expected_step = (sc.sweep.t_end - sc.sweep.t_begin) / static_cast<double>(sc.sweep.steps);
   s->stepper = std::make_unique<Stepper>(s->square.model(*sc.model), std::move(o));
   s->stepper->restart(s->square.start);
@@ -63,15 +71,18 @@ void bind_stepper(py::module_& m) {
                         "gives run_sweep's rows to the bit, at a sweep's cost per step. A step that fails leaves the "
                         "stepper at its last good state.")
       .def(py::init([](std::shared_ptr<const Scene> scene, std::optional<bool> velocities,
-                       std::optional<bool> accelerations) {
-             return stepper_for_scene(std::move(scene), velocities, accelerations);
+                       std::optional<bool> accelerations, const std::optional<py::list>& sensitivities) {
+             std::optional<std::vector<SensitivityRequest>> asked;
+             if (sensitivities) asked = sensitivity_requests(*sensitivities, "Stepper");
+             return stepper_for_scene(std::move(scene), velocities, accelerations, asked);
            }),
            py::arg("scene"), py::kw_only(), py::arg("velocities") = py::none(),
-           py::arg("accelerations") = py::none(),
+           py::arg("accelerations") = py::none(), py::arg("sensitivities") = py::none(),
            "A stepper for a scene: its solver settings, output points and rough placement (a redundant scene "
            "assembled and solved on its independent rows, as run_sweep does); velocities and accelerations as the "
-           "scene's output asks unless given. ValueError when the scene cannot be prepared (inconsistent, "
-           "under-driven).")
+           "scene's output asks unless given; the sensitivities of its output.sensitivities, or of `sensitivities` "
+           "(names or (name, step) tuples, as run_sweep's) at every step. ValueError when the scene cannot be "
+           "prepared (inconsistent, under-driven) or names no such parameter.")
       .def(py::init([](const Model& model, bool velocities, bool accelerations, Predictor predictor,
                        std::optional<NewtonOptions> newton, std::optional<NewtonOptions> assembly,
                        int max_subdivisions, double expected_step) {
@@ -134,6 +145,31 @@ void bind_stepper(py::module_& m) {
             return out;
           },
           "the output points' motions at the current state: name → (position, velocity, acceleration)")
+      .def_property_readonly("sensitivity_names",
+                             [](const PyStepper& s) { return names_of(s.stepper->options().sensitivities); },
+                             "parameters whose sensitivities every step delivers (sensitivity())")
+      .def(
+          "sensitivity",
+          [](const PyStepper& s, const std::string& parameter, int order) {
+            if (order < 0 || order > 2) throw py::value_error("order must be 0, 1 or 2, not " + std::to_string(order));
+            const auto& asked = s.stepper->options().sensitivities;
+            const auto it = std::find_if(asked.begin(), asked.end(),
+                                         [&](const OutputSensitivity& p) { return p.name == parameter; });
+            if (it == asked.end())
+              throw py::key_error("the stepper delivers no sensitivities to '" + parameter +
+                                  "' (give it in Stepper(scene, sensitivities=[...]))");
+            const double* all = s.stepper->sensitivities();
+            if (!all) throw py::value_error("the stepper has no state yet: step() first");
+            const Index n = s.stepper->model().num_coordinates();
+            const std::size_t j = static_cast<std::size_t>(it - asked.begin());
+            const double* first = all + SensitivityLayout{n}.offset(j, order);
+            py::array_t<double> out(n);
+            std::copy(first, first + n, out.mutable_data());
+            return out;
+          },
+          py::arg("parameter"), py::arg("order") = 0,
+          "The current state's ∂q/∂p (order 0), ∂q̇/∂p (1) or ∂q̈/∂p (2) for a parameter of sensitivity_names, in the "
+          "order of q (NaN where not solved, and at a singular position)")
       .def_property_readonly("summary", [](const PyStepper& s) { return s.stepper->summary(); },
                              "everything the steps did so far, as a sweep's SweepSummary (to_dict() for JSON)")
       .def_property_readonly("model", [](const PyStepper& s) -> const Model& { return s.stepper->model(); },

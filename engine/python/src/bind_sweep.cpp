@@ -7,14 +7,6 @@ namespace phiq::python {
 
 namespace {
 
-// The names of a plan's outputs of one sort (points, drivers, sensitivities), in order.
-template <class Items>
-std::vector<std::string> names_of(const Items& items) {
-  std::vector<std::string> n;
-  for (const auto& item : items) n.push_back(item.name);
-  return n;
-}
-
 py::dict counters_dict(const WorkCounters& c) {
   return py::dict(py::arg("newton_iterations") = c.newton_iterations,
                   py::arg("residual_evaluations") = c.residual_evaluations,
@@ -122,18 +114,7 @@ void bind_sweep(py::module_& m) {
       .def(
           "set_sensitivities",
           [](SweepOptions& o, const Scene& scene, const py::list& parameters) {
-            // the (name, step) pairs read with the GIL held, the scene read again along each without it
-            std::vector<SensitivityRequest> asked;
-            for (const py::handle& p : parameters) {
-              if (py::isinstance<py::str>(p)) {
-                asked.push_back({p.cast<std::string>(), 0.0});
-              } else if (py::isinstance<py::tuple>(p) && py::len(p) == 2) {
-                asked.push_back({p[py::int_(0)].cast<std::string>(), p[py::int_(1)].cast<double>()});
-              } else {
-                throw py::type_error("set_sensitivities: each parameter is a name or a (name, step) tuple, not " +
-                                     py::repr(p).cast<std::string>());
-              }
-            }
+            const std::vector<SensitivityRequest> asked = sensitivity_requests(parameters, "set_sensitivities");
             std::vector<OutputSensitivity> out;
             {
               py::gil_scoped_release free;

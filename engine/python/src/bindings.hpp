@@ -8,6 +8,7 @@
 #include <pybind11/stl.h>
 
 #include <string>
+#include <vector>
 
 #include <phiq/phiq.hpp>
 
@@ -30,6 +31,31 @@ inline Eigen::VectorXd coordinate_vector(const Model& model, const Eigen::Ref<co
     throw Error(std::string(what) + " has " + std::to_string(v.size()) + " entries; the model has " +
                 std::to_string(model.num_coordinates()) + " coordinates");
   return v;
+}
+
+/// The names of a plan's outputs of one sort (points, drivers, sensitivities), in order.
+template <class Items>
+std::vector<std::string> names_of(const Items& items) {
+  std::vector<std::string> n;
+  for (const auto& item : items) n.push_back(item.name);
+  return n;
+}
+
+/// The parameters a Python caller asks for sensitivities to: each a name or a (name, step) tuple (TypeError naming
+/// `who` otherwise); read with the GIL held.
+inline std::vector<SensitivityRequest> sensitivity_requests(const py::list& parameters, const char* who) {
+  std::vector<SensitivityRequest> asked;
+  for (const py::handle& p : parameters) {
+    if (py::isinstance<py::str>(p)) {
+      asked.push_back({p.cast<std::string>(), 0.0});
+    } else if (py::isinstance<py::tuple>(p) && py::len(p) == 2) {
+      asked.push_back({p[py::int_(0)].cast<std::string>(), p[py::int_(1)].cast<double>()});
+    } else {
+      throw py::type_error(std::string(who) + ": each parameter is a name or a (name, step) tuple, not " +
+                           py::repr(p).cast<std::string>());
+    }
+  }
+  return asked;
 }
 
 /// Prepares a scene's model for the square sweep as `phiq run` does (prepare_scene, the GIL released): "" on

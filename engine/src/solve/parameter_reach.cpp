@@ -135,6 +135,8 @@ std::shared_ptr<const ReachedConstraints> detail::reached_of(const Model& model,
                                                              double step) {
   auto reached = std::make_shared<ReachedConstraints>();
   reached->reach = reach;
+  reached->coordinates = model.num_coordinates(), reached->equations = model.num_equations();
+  reached->nonzeros = model.jacobian_pattern().nnz();
   for (std::size_t k = 0; k < 4; ++k)
     for (const ParameterReach::Span& span : reach->spans) {
       std::unique_ptr<ConstraintBlock> copy = model.blocks()[span.block]->empty_copy();

@@ -146,6 +146,23 @@ std::string check_sensitivity_models(const Model& model, const OutputSensitivity
   if (detail::models_released(s)) {
     if (!s.reach || s.reach != s.reached->reach)
       return who + "its models were released, and its reach is not the one their constraints were kept for";
+    const ReachedConstraints& r = *s.reached;
+    if (r.coordinates != model.num_coordinates() || r.equations != model.num_equations() ||
+        r.nonzeros != model.jacobian_pattern().nnz())
+      return who + "its constraints were kept for a model of " + std::to_string(r.coordinates) + " coordinates, " +
+             std::to_string(r.equations) + " rows and " + std::to_string(r.nonzeros) + " nonzeros, not this one's " +
+             std::to_string(model.num_coordinates()) + ", " + std::to_string(model.num_equations()) + " and " +
+             std::to_string(model.jacobian_pattern().nnz());
+    const auto& blocks = model.blocks();
+    for (std::size_t j = 0; j < s.reach->spans.size(); ++j) {
+      const ParameterReach::Span& span = s.reach->spans[j];
+      const ConstraintBlock* kept = j < r.rates.size() && r.rates[j] ? r.rates[j].get()
+                                    : j < r.along[0].size()          ? r.along[0][j].get()
+                                                                     : nullptr;
+      if (span.block >= blocks.size() || span.end > blocks[span.block]->size() || span.begin >= span.end ||
+          !kept || std::string_view(kept->kind()) != blocks[span.block]->kind())
+        return who + "its kept constraints are not this model's (span " + std::to_string(j) + ")";
+    }
     return "";
   }
   for (std::size_t k = 0; k < s.models.size(); ++k) {

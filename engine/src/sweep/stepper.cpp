@@ -61,6 +61,12 @@ Stepper::Stepper(const Model& model, StepperOptions options) : impl_(std::make_u
   SweepOptions& s = impl_->sweep;
   static_cast<SolverSettings&>(s) = o;
   s.velocities = o.velocities, s.accelerations = o.accelerations, s.points = o.points;
+  for (const OutputSensitivity& p : o.sensitivities)
+    if (const std::string why = check_sensitivity_models(model, p); !why.empty()) throw Error("StepperOptions: " + why);
+  if (o.sensitivity_form != SensitivityForm::kAuto && o.sensitivity_form != SensitivityForm::kDirect)
+    throw Error("StepperOptions: sensitivity_form must be auto or direct (a stepper writes no coordinate columns for "
+                "the adjoint form to solve for)");
+  s.sensitivities = o.sensitivities, s.sensitivity_form = o.sensitivity_form;
   s.threads = 1;
   impl_->make_sweeper(0.0);  // refuses a predictor whose derivatives are not solved, before any step
 }
@@ -184,6 +190,9 @@ const Eigen::VectorXd& Stepper::qd() const { return impl_->started ? impl_->swee
 const Eigen::VectorXd& Stepper::qdd() const { return impl_->started ? impl_->sweeper->state().qdd : impl_->ws.qdd; }
 const PointMotion* Stepper::point_motions() const {
   return impl_->started ? impl_->sweeper->point_motions() : nullptr;
+}
+const double* Stepper::sensitivities() const {
+  return impl_->started ? impl_->sweeper->motions().sensitivities : nullptr;
 }
 const SweepSummary& Stepper::summary() const { return impl_->sum; }
 const Workspace& Stepper::workspace() const { return impl_->ws; }
