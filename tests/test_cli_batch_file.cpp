@@ -3,6 +3,7 @@
 // named and left out; an unwritable output fails at once; an interrupted batch publishes whole cases, in order.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -200,6 +201,52 @@ TEST_F(Cli, BatchOneFileInterruptedKeepsWholeCasesInOrder) {
   EXPECT_EQ(phiq::test::count(summary, "\"file\": \"" + out.string() + "\""), k_written);
   EXPECT_EQ(files(),
             (std::vector<std::string>{"all.csv", "cases.csv", "cs.yaml", "s.json", "stderr.txt", "stdout.txt"}));
+}
+
+}  // namespace
+
+namespace {
+
+// `phiq batch --sensitivity NAME`: every case delivers the sensitivities the scene's output.sensitivities would,
+// each at its own parameters (∂x_B/∂L3 = L3 / √(L3² − L2² sin² θ) of the case's L2, L3), one file or a directory
+// of cases alike, the same bytes as the scene listing them; a name that is no parameter fails at once in one line
+// with no output.
+TEST_F(Cli, BatchSensitivityOptionGivesEachCaseItsOwn) {
+  const std::string text = slurp(phiq::test::model_path("seed/crank_slider_mixed.yaml"));
+  const fs::path scene = write("cs.yaml", text);
+  const fs::path listed = write("listed.yaml", phiq::test::replace_first(
+      text, "output: {velocities: true, accelerations: true}",
+      "output: {velocities: true, accelerations: true, sensitivities: [L3]}"));
+  const fs::path list = write("cases.csv", "L2,L3\n0.2,1.0\n0.35,1.1\n");
+  const auto batch = [&](const fs::path& s, const std::string& out, const std::string& more) {
+    return run("batch -q " + s.string() + " " + list.string() + " -o " + (dir_ / out).string() + more);
+  };
+  ASSERT_EQ(batch(listed, "listed.csv", "").code, 0);
+  const Result r = batch(scene, "option.csv", " --sensitivity L3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(slurp(dir_ / "option.csv"), slurp(dir_ / "listed.csv"));
+  ASSERT_EQ(batch(listed, "listed_dir", "").code, 0);
+  ASSERT_EQ(batch(scene, "option_dir", " --sensitivity L3").code, 0);
+  for (const char* k : {"case0.csv", "case1.csv"})
+    EXPECT_EQ(slurp(dir_ / "option_dir" / k), slurp(dir_ / "listed_dir" / k)) << k;
+  const phiq::CsvTable t = phiq::read_csv_table((dir_ / "option.csv").string());
+  const auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(t.columns.begin(), t.columns.end(), name) - t.columns.begin());
+  };
+  ASSERT_EQ(t.rows.size(), 2u * 181u);
+  for (const auto& row : t.rows) {
+    const double l2 = row[col("case")] == 0.0 ? 0.2 : 0.35, l3 = row[col("case")] == 0.0 ? 1.0 : 1.1;
+    const double s = std::sin(row[col("theta2")]);
+    EXPECT_NEAR(row[col("xB.d_L3")], l3 / std::sqrt(l3 * l3 - l2 * l2 * s * s), 1e-9) << "case " << row[col("case")];
+  }
+  for (const std::string out : {"bad.csv", "bad_dir"}) {
+    const Result bad = batch(scene, out, " --sensitivity L9");
+    EXPECT_EQ(bad.code, 2) << out;
+    EXPECT_NE(bad.err.find("--sensitivity: 'L9' is not a parameter of " + scene.string() + " (its parameters: L2, L3)"),
+              std::string::npos) << bad.err;
+    EXPECT_TRUE(one_phiq_line(bad.err)) << bad.err;
+    EXPECT_FALSE(fs::exists(dir_ / out)) << out;
+  }
 }
 
 }  // namespace

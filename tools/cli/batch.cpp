@@ -24,7 +24,8 @@ namespace {
 // `phiq batch SCENE CASES.csv -o DIR`: the scene swept once per row of CASES.csv (columns: parameter names), the
 // cases in parallel, sharing one symbolic analysis; DIR/case<k>.csv per successful case (k from 0, the row order).
 int cmd_batch(const std::string& scene_path, const std::string& cases_path, const std::string& dir, bool quiet,
-              int threads, const std::string& summary_path, bool identifier_names, bool resume) {
+              int threads, const std::string& summary_path, bool identifier_names, bool resume,
+              const std::vector<std::string>& sensitivity_args) {
   int join_status = 0;
   const std::unique_ptr<BatchRanks> ranks = BatchRanks::join_command("batch", "batch", &join_status);
   if (!ranks) return join_status;
@@ -35,9 +36,15 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     return ranks->finish(fail(e.what(), 2));
   }
   if (cases.rows.empty()) return ranks->finish(fail(cases_path + ": no cases (one row per parameter set)", 2));
+  std::vector<phiq::SensitivityRequest> asked;
+  try {
+    asked = sensitivity_requests(sensitivity_args);
+  } catch (const phiq::Error& e) {  // a STEP that is not a number
+    return ranks->finish(fail(e.what(), 2));
+  }
   if (is_one_file_output(dir))  // OUT.csv / OUT.h5: every case in one file (batch_file.cpp)
     return ranks->finish(batch_to_one_file(
-        {scene_path, cases_path, dir, summary_path, quiet, threads, identifier_names, resume}, cases, *ranks));
+        {scene_path, cases_path, dir, summary_path, quiet, threads, identifier_names, resume, asked}, cases, *ranks));
   if (ranks->size() > 1)
     return ranks->finish(fail("batch: -o " + dir + ": under mpirun a batch writes one file (-o OUT.csv or OUT.h5)", 2));
   if (resume)
@@ -67,6 +74,7 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   for (std::size_t k = 0; k < cases.rows.size(); ++k) {
     phiq::SceneOverrides o = case_overrides(cases, k, cases_path);
     if (!scenes.empty()) o.share_analysis_with = scenes.front().model.get();
+    o.sensitivity_models = asked.empty();  // (--sensitivity replaces the scene's)
     try {
       scenes.push_back(tree->read(o));
     } catch (const phiq::SceneError& e) {
@@ -85,6 +93,14 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
       return fail(std::string(e.what()) + (from_case ? " (case " + std::to_string(k) + " of " + cases_path +
                                                            ", line " + std::to_string(k + 2) + ")"
                                                      : ""),
+                  2);
+    }
+    if (asked.empty()) continue;
+    try {  // the first case's error is the option's (an unknown name); a later one's is its case's
+      scenes.back().sweep.sensitivities = phiq::sensitivities_of(scenes.back(), asked, "--sensitivity");
+    } catch (const phiq::SceneError& e) {
+      return fail(std::string(e.what()) + (k == 0 ? "" : " (case " + std::to_string(k) + " of " + cases_path +
+                                                           ", line " + std::to_string(k + 2) + ")"),
                   2);
     }
   }
@@ -258,6 +274,7 @@ Command register_batch(CLI::App& app) {
     std::string summary;
     std::string names = "dotted";
     bool resume = false;
+    std::vector<std::string> sensitivities;
   };
   auto a = std::make_shared<Args>();
   CLI::App* batch = app.add_subcommand("batch", "Sweep the scene once per parameter set of a CSV, the cases in parallel");
@@ -282,10 +299,11 @@ Command register_batch(CLI::App& app) {
   batch->add_flag("--resume", a->resume,
                   "Keep the cases an interrupted run of this batch wrote to OUT.csv or OUT.h5 and run only the "
                   "others (a missing OUT: the whole batch)");
+  add_sensitivity_option(batch, &a->sensitivities);
   return {batch, [a] {
             const int cases_threads = cap_threads("batch", a->threads, a->quiet);
             return cmd_batch(a->scene, a->cases, a->dir, a->quiet, cases_threads, a->summary, a->names == "identifiers",
-                             a->resume);
+                             a->resume, a->sensitivities);
           }};
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -20,6 +21,9 @@ struct BatchArgs {
   int threads = 0;  // 0: all cores
   bool identifier_names = false;
   bool resume = false;  // go on after the cases an earlier run committed to `out` (batch_resume.hpp)
+  // --sensitivity: the parameters whose sensitivities every case delivers instead of the scene's
+  // output.sensitivities (empty: the scene's)
+  std::vector<SensitivityRequest> sensitivities;
 };
 
 // True when `-o PATH` names one output file rather than a directory of case files: PATH ends in .csv, .h5 or

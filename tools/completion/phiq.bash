@@ -26,7 +26,7 @@ _phiq() {
     run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names --set --sensitivity" ;;
     check) opts="--help --json --time --set" ;;
     assemble) opts="--help --output --quiet --set" ;;
-    batch) opts="--help --output --quiet --threads --summary --names --resume" ;;
+    batch) opts="--help --output --quiet --threads --summary --names --resume --sensitivity" ;;
     compare) opts="--help --rtol --atol --columns --json --junit" ;;
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
     plot) opts="--help --output --columns --positions --set" ;;
