@@ -206,7 +206,8 @@ const char* to_string(SensitivityForm form);
 /// else kDirect: direct P·((order + 1) solves and (0, 2, 8) evaluations) against adjoint O·(1, 2, 4) solves and
 /// (0, 4, 15) evaluations, for P parameters and O output coordinates (their reaches cost both forms alike). At
 /// order 0 that is the adjoint when the parameters outnumber the outputs; with q̇ or q̈ and one output, from 2
-/// parameters (bench/README.md, "Sensitivities": 1.4 of the direct form's time at 1, 0.91 at 2). Any other form
+/// parameters (bench/README.md, "Sensitivities": 1.4 of the direct form's time at 1, 0.91 at 2). With no output
+/// coordinate (a caller reading every coordinate's, StepView::sensitivities, a Stepper), kDirect. Any other form
 /// as given.
 SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t parameters, std::size_t outputs,
                                            int order);

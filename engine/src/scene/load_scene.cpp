@@ -232,10 +232,10 @@ std::vector<OutputSensitivity> sensitivities_of(const Scene& scene, const std::v
     const auto it = std::find_if(scene.parameters.begin(), scene.parameters.end(),
                                  [&](const auto& nv) { return nv.first == r.name; });
     if (it == scene.parameters.end()) {
-      std::string known;
-      for (const auto& nv : scene.parameters) known += (known.empty() ? "" : ", ") + nv.first;
+      std::vector<std::string> names;
+      for (const auto& nv : scene.parameters) names.push_back(nv.first);
       throw SceneError(source + ": '" + r.name + "' is not a parameter of " + scene.path +
-                       (known.empty() ? " (it has none)" : " (its parameters: " + known + ")"));
+                       detail::scene::parameters_note(names));
     }
     try {
       out.push_back(sensitivity_along(scene, r.name, it->second, r.step, limits, as_read));

@@ -13,16 +13,20 @@ namespace phiq::detail::scene {
 
 // An override that names no parameter: located where the names were given (a batch header) when the caller says
 // where, else in the scene.
+std::string parameters_note(std::vector<std::string> names) {
+  std::sort(names.begin(), names.end());
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  return list.empty() ? " (it has none)" : " (its parameters: " + list + ")";
+}
+
 void SceneReader::unknown_override(const Cursor& c, const std::string& name) const {
   if (overrides_->parameters_source.empty())
     c.fail("'" + name + "' (given for this run) is not a parameter of the scene");
   std::vector<std::string> names;
   for (const auto& [n, v] : parameters_) names.push_back(n);
-  std::sort(names.begin(), names.end());
-  std::string list;
-  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
   throw SceneError(single_line(overrides_->parameters_source + ": '" + name + "' is not a parameter of " + file_ +
-                               (list.empty() ? " (it has none)" : " (its parameters: " + list + ")")));
+                               parameters_note(names)));
 }
 
 void SceneReader::read_parameters(const Cursor& c) {

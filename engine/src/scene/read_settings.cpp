@@ -284,11 +284,7 @@ void SceneReader::output_sensitivities(const Cursor& c, OutputPlan& plan) {
     if (it == parameters_.end()) {
       std::vector<std::string> names;
       for (const auto& [n, v] : parameters_) names.push_back(n);
-      std::sort(names.begin(), names.end());
-      std::string list;
-      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-      name.fail("'" + s.name + "' is not a parameter of the scene" +
-                (list.empty() ? " (it has none)" : " (its parameters: " + list + ")"));
+      name.fail("'" + s.name + "' is not a parameter of the scene" + parameters_note(names));
     }
     if (!seen.insert(s.name).second) name.fail("parameter '" + s.name + "' listed twice");
     s.value = it->second;

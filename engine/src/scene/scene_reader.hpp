@@ -44,6 +44,10 @@ class KindFields;
 // "'x' is a coordinate: a law is a function of t alone ...": the message for a coordinate in a law expression.
 std::string coordinate_in_law(const std::string& name);
 
+// " (its parameters: A, B)" naming `names` sorted, or " (it has none)": what a message about a name that is no
+// parameter of the scene ends with.
+std::string parameters_note(std::vector<std::string> names);
+
 class SceneReader {
   template <class C>
   friend class KindFields;  // the scene vocabulary the constraint kinds read themselves with

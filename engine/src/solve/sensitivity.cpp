@@ -275,6 +275,7 @@ const char* to_string(SensitivityForm form) {
 SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t parameters, std::size_t outputs,
                                            int order) {
   if (form != SensitivityForm::kAuto) return form;
+  if (outputs == 0) return SensitivityForm::kDirect;  // the adjoint would solve for none: every coordinate's
   const int o = std::clamp(order, 0, 2);
   constexpr double kSolvesPerOutput[3] = {1.0, 2.0, 4.0};  // λ; μ; τ and ν
   constexpr double kEvaluations[3] = {0.0, 4.0, 15.0};     // Φq along the motion (and along q̈)

@@ -13,10 +13,8 @@ namespace phiq::detail {
 
 // The form a sweep with `plan` solves its sensitivities in, for `outputs` written coordinates
 // (OutputPlan::sensitivity_outputs()): effective_sensitivity_form() at the plan's derivative order. run_sweep reports
-// it, each Sweeper solves in it. With no coordinate written, kAuto is the direct form: the reader is then on_step,
-// whose StepView::sensitivities hold every coordinate's (the adjoint form would solve for none and leave all NaN).
+// it, each Sweeper solves in it (the direct form when no coordinate is written: on_step reads them all).
 inline SensitivityForm sweep_sensitivity_form(const OutputPlan& plan, std::size_t outputs) {
-  if (outputs == 0 && plan.sensitivity_form == SensitivityForm::kAuto) return SensitivityForm::kDirect;
   return effective_sensitivity_form(plan.sensitivity_form, plan.sensitivities.size(), outputs,
                                     plan.accelerations ? 2 : plan.velocities ? 1 : 0);
 }

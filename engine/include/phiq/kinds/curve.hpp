@@ -78,49 +78,35 @@ class Curve {
 struct CurveOn {
   Frame2 frame;                        ///< the body that carries the curve: x, y (m), ψ (rad); constants for ground
   std::shared_ptr<const Curve> curve;  ///< the curve in that frame's local coordinates (m)
-  /// The same frame and the same curve (by what it holds, not by address: each model reads its own).
-  bool operator==(const CurveOn& o) const {
-    return frame == o.frame && (curve == o.curve || (curve && o.curve && *curve == *o.curve));
-  }
+  /// The same curve (by what it holds, not by address: each model reads its own).
+  bool same_curve(const CurveOn& o) const { return curve == o.curve || (curve && o.curve && *curve == *o.curve); }
+  /// The same frame and the same curve (same_curve()).
+  bool operator==(const CurveOn& o) const { return frame == o.frame && same_curve(o); }
 };
 
 /// @cond internal
 namespace detail {
 /// The curve offset by ρ along its right normal, p = c + ρ n, and its first two derivatives in s, into d[0..2]
-/// (PointOnCurveSpec has the formulas). ρ = 0 is the curve itself.
-/// The unit tangent u = c′/|c′| and right normal n = −u⊥ of a curve at a point (c, c′, c″, c‴ in `c`), with the
-/// tangent's turn per unit s, κ = c′ × c″ / |c′|², and κ′: n′ = κ u, n″ = κ′ u − κ² n.
-struct CurveNormal {
-  kin::V2 u, n;
-  double k, dk;
-};
-inline CurveNormal curve_normal(const kin::V2 c[4]) {
-  const double g2 = kin::dot(c[1], c[1]), g = std::sqrt(g2);
-  const kin::V2 u = (1.0 / g) * c[1];
-  const double k = kin::cross(c[1], c[2]) / g2;
-  const double dk = kin::cross(c[1], c[3]) / g2 - 2.0 * kin::cross(c[1], c[2]) * kin::dot(c[1], c[2]) / (g2 * g2);
-  return {u, -1.0 * kin::perp(u), k, dk};  // the right normal: outwards on a CCW profile
-}
-inline void offset_curve(const Curve& curve, double s, double rho, kin::V2 d[3]) {
+/// (PointOnCurveSpec has the formulas). ρ = 0 is the curve itself. With `normal`, also n, n′ = κ u and
+/// n″ = κ′ u − κ² n into normal[0..2] (p's rate along ρ), from the same evaluation of the curve.
+inline void offset_curve(const Curve& curve, double s, double rho, kin::V2 d[3], kin::V2* normal = nullptr) {
   kin::V2 c[4];
   curve.evaluate(s, c);
   d[0] = c[0], d[1] = c[1], d[2] = c[2];
+  if (rho == 0.0 && !normal) return;
+  const double g2 = kin::dot(c[1], c[1]), g = std::sqrt(g2);
+  const kin::V2 u = (1.0 / g) * c[1], n = -1.0 * kin::perp(u);  // the right normal: outwards on a CCW profile
+  const double k = kin::cross(c[1], c[2]) / g2;  // the tangent's turn per unit s
+  const double dk = kin::cross(c[1], c[3]) / g2 - 2.0 * kin::cross(c[1], c[2]) * kin::dot(c[1], c[2]) / (g2 * g2);
+  if (normal) normal[0] = n, normal[1] = k * u, normal[2] = dk * u - (k * k) * n;
   if (rho == 0.0) return;
-  const CurveNormal f = curve_normal(c);
-  d[0] = c[0] + rho * f.n;
-  d[1] = c[1] + (rho * f.k) * f.u;
-  d[2] = c[2] + rho * (f.dk * f.u - (f.k * f.k) * f.n);
-}
-/// n, n′, n″ at s (curve_normal()): the rate of the offset curve p = c + ρ n along ρ.
-inline void curve_normal_derivatives(const Curve& curve, double s, kin::V2 n[3]) {
-  kin::V2 c[4];
-  curve.evaluate(s, c);
-  const CurveNormal f = curve_normal(c);
-  n[0] = f.n, n[1] = f.k * f.u, n[2] = f.dk * f.u - (f.k * f.k) * f.n;
+  d[0] = c[0] + rho * n;
+  d[1] = c[1] + (rho * k) * u;
+  d[2] = c[2] + rho * (dk * u - (k * k) * n);
 }
 inline bool datum_rate(CurveOn& rate, const std::array<const CurveOn*, 4>& v, double h) {
   for (const CurveOn* o : v)
-    if (!(o->curve == rate.curve || (o->curve && rate.curve && *o->curve == *rate.curve))) return false;
+    if (!o->same_curve(rate)) return false;
   return datum_rate(rate.frame, {&v[0]->frame, &v[1]->frame, &v[2]->frame, &v[3]->frame}, h);
 }
 /// The time derivatives V, V′, V″ of V = R(ψ_b) v(s(t)) of a vector v(s) carried by frame b along a curve, from the

@@ -126,8 +126,9 @@ struct FlatFollowerSpec {
     };
     std::array<kin::V2, 3> h{}, eh{}, hh{}, wh{};
     const double psid_b = rate.on.frame.psi.of(q);
+    h[0] = g.h;
     for (int k = 0; k <= order; ++k) {
-      h[k] = translation(b, k) + c[k] - translation(a, k) - arm[k];
+      if (k > 0) h[k] = translation(b, k) + c[k] - translation(a, k) - arm[k];
       eh[k] = detail::turned_data_derivative(a.psi, axis, rate.a.psi, rate.axis, k, q, qd, qdd);
       hh[k] = psid_b * kin::perp(c[k]) - detail::point_data_derivative(a, sa, rate.a, rate.sa, k, q, qd, qdd);
       wh[k] = psid_b * kin::perp(w[k]);

@@ -112,15 +112,11 @@ struct PointOnCurveSpec {
       detail::carried_along_curve(world, w, al, sd, sdd, out3);
       return out3[order];
     };
-    if (psid != 0.0) {
-      kin::V2 p[3];
-      detail::offset_curve(*on.curve, at, offset, p);
-      d = d - psid * kin::perp(carried(p));
-    }
-    if (rhod != 0.0) {
-      kin::V2 n[3];
-      detail::curve_normal_derivatives(*on.curve, at, n);
-      d = d - rhod * carried(n);
+    if (psid != 0.0 || rhod != 0.0) {
+      kin::V2 p[3], n[3];
+      detail::offset_curve(*on.curve, at, offset, p, n);
+      if (psid != 0.0) d = d - psid * kin::perp(carried(p));
+      if (rhod != 0.0) d = d - rhod * carried(n);
     }
     out[0] = d.x, out[1] = d.y;
   }
