@@ -778,17 +778,13 @@ TEST(Sensitivity, EquationsAreDifferentiatedAlongTheParametersTheirTextsRead) {
   }
 }
 
-// The crank-slider of kCrankSlider built in code (the README's tour) with its crank L2 and rod L3, sharing
-// `share`'s analysis when given: a mechanism whose parameters no scene holds.
-Model crank_slider_built(double l2, double l3, const Model* share) {
-  ModelBuilder b;
-  const Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.28),
-              ya = b.add_coordinate("yA", 0.03), xb = b.add_coordinate("xB", 1.25);
-  b.add("crank", PolarSpec{{Slot::coordinate(xa), Slot::coordinate(ya)}, {}, l2, Slot::coordinate(th)});
-  b.add("rod", DistanceSpec{{Slot::coordinate(xa), Slot::coordinate(ya)}, {Slot::coordinate(xb), {}}, l3});
-  b.add_driver("motor", th, MotionLaw::linear(0.0, 2.0));
-  if (share) b.share_analysis_with(*share);
-  return std::move(b).build();
+// The README's crank-slider (test::readme_crank_slider) with its crank, or its rod, at `v`: what
+// sensitivity_along() of a model built in code builds the models along L2 and L3 with.
+Model readme_slider_along_l2(double v, const Model* share) {
+  return test::readme_crank_slider(v, 1.0, MotionLaw::linear(0.0, 2.0), share);
+}
+Model readme_slider_along_l3(double v, const Model* share) {
+  return test::readme_crank_slider(0.3, v, MotionLaw::linear(0.0, 2.0), share);
 }
 
 // sensitivity_along() of a model built in code: the four models along L2 and L3 built by the caller's function,
@@ -797,9 +793,8 @@ Model crank_slider_built(double l2, double l3, const Model* share) {
 // kept whole to 1e-10 at the default step; with no column written, the sweep solves them in the direct form, every
 // coordinate's. A function that builds another structure, or none, is refused in a line.
 TEST(Sensitivity, ModelsBuiltInCodeHaveTheirParametersDifferentiated) {
-  const Model model = crank_slider_built(0.3, 1.0, nullptr);
-  const ModelAtParameter along_l2 = [](double v, const Model* share) { return crank_slider_built(v, 1.0, share); };
-  const ModelAtParameter along_l3 = [](double v, const Model* share) { return crank_slider_built(0.3, v, share); };
+  const Model model = test::readme_crank_slider();
+  const ModelAtParameter along_l2 = readme_slider_along_l2, along_l3 = readme_slider_along_l3;
   SweepOptions o;
   o.t_begin = 0.0, o.t_end = M_PI, o.steps = 90;
   o.velocities = o.accelerations = true;
@@ -844,7 +839,7 @@ TEST(Sensitivity, ModelsBuiltInCodeHaveTheirParametersDifferentiated) {
   }
   // a function that adds a coordinate away from the nominal value builds another structure
   const ModelAtParameter grows = [](double v, const Model* share) {
-    if (v == 0.3) return crank_slider_built(v, 1.0, share);
+    if (v == 0.3) return readme_slider_along_l2(v, share);
     ModelBuilder b;
     b.add_coordinate("x", 0.0);
     b.add_driver("push", 0, MotionLaw::linear(0.0, 1.0));
@@ -863,11 +858,11 @@ TEST(Sensitivity, ModelsBuiltInCodeHaveTheirParametersDifferentiated) {
 // built in code, L2 and L3 along it, stepped at uneven times forward and back against the closed form (1e-9), and
 // over a grid the very bits of run_sweep in order. The adjoint form and models of another mechanism are refused.
 TEST(Sensitivity, AStepperDeliversTheSensitivitiesOfEachStep) {
-  const Model model = crank_slider_built(0.3, 1.0, nullptr);
+  const Model model = test::readme_crank_slider();
   StepperOptions so;
   so.sensitivities = {
-      sensitivity_along(model, "L2", 0.3, [](double v, const Model* m) { return crank_slider_built(v, 1.0, m); }),
-      sensitivity_along(model, "L3", 1.0, [](double v, const Model* m) { return crank_slider_built(0.3, v, m); })};
+      sensitivity_along(model, "L2", 0.3, readme_slider_along_l2),
+      sensitivity_along(model, "L3", 1.0, readme_slider_along_l3)};
   const Index xb = model.coordinate_index("xB"), n = model.num_coordinates();
   const SensitivityLayout layout{n};
   {

@@ -14,18 +14,6 @@
 namespace phiq {
 namespace {
 
-// The README's crank-slider (engine/README.md, "Using the API"): q = [θ2, xA, yA, xB], r = 0.3, L = 1, θ2 = 2t,
-// from its rough placement. `law` drives θ2 (default: the README's 2t).
-Model readme_crank_slider(const MotionLaw& law = MotionLaw::linear(0.0, 2.0)) {
-  ModelBuilder b;
-  Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3), ya = b.add_coordinate("yA", 0.0),
-        xb = b.add_coordinate("xB", 1.3);
-  b.add("crank", PolarSpec{{Slot::coordinate(xa), Slot::coordinate(ya)}, {}, 0.3, Slot::coordinate(th)});
-  b.add("rod", DistanceSpec{{Slot::coordinate(xa), Slot::coordinate(ya)}, {Slot::coordinate(xb), {}}, 1.0});
-  b.add_driver("motor", th, law);
-  return std::move(b).build();
-}
-
 // x_B, ẋ_B, ẍ_B of the crank-slider at θ = 2t: x_B = r cos θ + √(L² − r² sin² θ), differentiated in θ twice, times
 // θ̇ = 2 and θ̇² = 4.
 struct SliderExact {
@@ -59,7 +47,7 @@ std::vector<SweepWarning> of_kind(const std::vector<SweepWarning>& all, const st
 // README showed before over the same times (solve_position, solve_velocity, solve_acceleration) does nearly three
 // times the Newton iterations and four times the factorisations.
 TEST(Stepper, OnASweepsGridGivesItsRowsBitForBitWithItsWork) {
-  const Model model = readme_crank_slider();
+  const Model model = test::readme_crank_slider();
   SweepOptions o;
   o.t_begin = 0, o.t_end = 1, o.steps = 100, o.threads = 1;
   o.chunk_steps = o.steps;  // in order: one chunk (a sweep in chunks starts each from a seed of its own)
@@ -114,7 +102,7 @@ TEST(Stepper, OnASweepsGridGivesItsRowsBitForBitWithItsWork) {
 // (2) Times the caller chooses: spacing growing as k² (steps from 0.01 to 0.59 s, θ up to 18 rad), then back down
 // with another spacing, crossing the times of the way up. Every state is the closed form's.
 TEST(Stepper, NonUniformTimesForwardAndBackMatchTheClosedForm) {
-  const Model model = readme_crank_slider();
+  const Model model = test::readme_crank_slider();
   Stepper stepper(model);
   std::vector<double> times;
   for (int k = 0; k <= 30; ++k) times.push_back(0.01 * k * k);
@@ -225,7 +213,7 @@ TEST(Stepper, SingularPositionsWarnAsRunSweep) {
 // returns to the state before the step, not to the last sub-step).
 TEST(Stepper, AFailedStepKeepsTheStateAndTheNextStepSucceeds) {
   {
-    const Model model = readme_crank_slider(MotionLaw::table({0.0, 1.0, 2.0}, {0.0, 2.0, 4.0}));
+    const Model model = test::readme_crank_slider(0.3, 1.0, MotionLaw::table({0.0, 1.0, 2.0}, {0.0, 2.0, 4.0}));
     Stepper stepper(model);
     ASSERT_EQ(stepper.step(0.5), SolveStatus::kSuccess) << stepper.summary().message;
     ASSERT_EQ(stepper.step(0.7), SolveStatus::kSuccess) << stepper.summary().message;
@@ -272,7 +260,7 @@ TEST(Stepper, AFailedStepKeepsTheStateAndTheNextStepSucceeds) {
 // (5) restart() after a jump of the caller's clock: the next step assembles from the new placement (the predictor's
 // history forgotten), and the summary keeps counting. A moved stepper goes on where it was.
 TEST(Stepper, RestartAssemblesAgainFromThePlacement) {
-  const Model model = readme_crank_slider();
+  const Model model = test::readme_crank_slider();
   Stepper first(model);
   for (const double t : {0.0, 0.1, 0.2}) ASSERT_EQ(first.step(t), SolveStatus::kSuccess);
   Stepper stepper = std::move(first);
@@ -302,7 +290,7 @@ TEST(Stepper, RestartAssemblesAgainFromThePlacement) {
 
 // Settings no step can honour are refused when the stepper is made, as run_sweep refuses them.
 TEST(Stepper, RefusesSettingsNoStepCanHonour) {
-  const Model model = readme_crank_slider();
+  const Model model = test::readme_crank_slider();
   StepperOptions o;
   o.max_subdivisions = -1;
   EXPECT_THROW(Stepper s(model, o), Error);

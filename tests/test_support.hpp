@@ -228,6 +228,21 @@ inline std::string generate_error(const tools::GenerateOptions& o) {
   return "(no error)";
 }
 
+// The README's crank-slider built in code (engine/README.md, "Using the API"): q = [θ2, xA, yA, xB] from its rough
+// placement, crank `l2`, rod `l3`, θ2 driven by `law` (the README's 2t); sharing `share`'s analysis when given (the
+// models along a length, sensitivity_along()).
+inline Model readme_crank_slider(double l2 = 0.3, double l3 = 1.0, const MotionLaw& law = MotionLaw::linear(0.0, 2.0),
+                                 const Model* share = nullptr) {
+  ModelBuilder b;
+  const Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3),
+              ya = b.add_coordinate("yA", 0.0), xb = b.add_coordinate("xB", 1.3);
+  b.add("crank", PolarSpec{{Slot::coordinate(xa), Slot::coordinate(ya)}, {}, l2, Slot::coordinate(th)});
+  b.add("rod", DistanceSpec{{Slot::coordinate(xa), Slot::coordinate(ya)}, {Slot::coordinate(xb), {}}, l3});
+  b.add_driver("motor", th, law);
+  if (share) b.share_analysis_with(*share);
+  return std::move(b).build();
+}
+
 // Difference of two angles, wrapped to (-pi, pi].
 inline double angle_diff(double a, double b) { return std::remainder(a - b, 2.0 * M_PI); }
 

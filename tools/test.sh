@@ -14,7 +14,7 @@ if [ "${1:-}" = "--quick" ]; then quick=1; shift; fi
 jobs="$(nproc)"
 
 "$root/tools/install_deps.sh"
-# Both configurations are unity builds (CMake joins each target's files in groups of 8; the test files excepted):
+# Both configurations are unity builds (CMake joins each target's files in groups of 8, the tests' too):
 # the headers, CLI11's and Eigen's inline code above all, compiled once a group rather than once a file.
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build "$root/build" -j "$jobs"
