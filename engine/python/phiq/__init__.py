@@ -19,7 +19,7 @@ phiq releases the GIL while it works; Ctrl-C stops a sweep at its next delivered
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import _phiq
 from ._phiq import (AssemblySummary, ConstraintInfo, JacobianUpdate, LinearSummary, Model, NewtonOptions,
@@ -27,6 +27,7 @@ from ._phiq import (AssemblySummary, ConstraintInfo, JacobianUpdate, LinearSumma
                     StepSummary, Stepper, SweepOptions, SweepSummary, SweepWarning, Unit, WorkCounters, Workspace,
                     analyse_rank, assemble, constraint_kinds, load_scene, parse_scene, solve_acceleration,
                     solve_position, solve_velocity)
+from ._batch import BatchResult, run_batch_tables
 from ._builder import SceneBuilder
 from ._results import SolveError, SweepResult
 
@@ -35,12 +36,12 @@ SceneError.__doc__ = ("A scene that cannot be used (a ValueError): one line 'FIL
                       "for a SceneBuilder the Python line of the entry at fault.")
 
 __all__ = [
-    "AssemblySummary", "CheckReport", "ConstraintInfo", "JacobianUpdate", "LinearSummary", "Model", "NewtonOptions",
+    "AssemblySummary", "BatchResult", "CheckReport", "ConstraintInfo", "JacobianUpdate", "LinearSummary", "Model", "NewtonOptions",
     "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError", "SensitivityForm", "SolveError",
     "SolveStatus",
     "StepSummary", "Stepper", "SweepOptions", "SweepResult", "SweepSummary", "SweepWarning", "Unit", "WorkCounters",
     "Workspace",
-    "analyse_rank", "assemble", "check", "constraint_kinds", "load_scene", "parse_scene", "run_sweep",
+    "analyse_rank", "assemble", "check", "constraint_kinds", "load_scene", "parse_scene", "run_batch", "run_sweep",
     "solve_acceleration", "solve_position", "solve_velocity",
 ]
 
@@ -64,13 +65,37 @@ def run_sweep(scene: Scene, options: Optional[SweepOptions] = None, *, identifie
             opts = _copy_options(options)
         if sensitivities is not None:
             opts.set_sensitivities(scene, list(sensitivities))
-        for name, value in overrides.items():
-            if not hasattr(opts, name) or name.startswith("_"):
-                fields = sorted(n for n in dir(opts) if not n.startswith("_") and not callable(getattr(opts, n)))
-                raise TypeError(f"run_sweep() got an unexpected keyword argument '{name}' (SweepOptions fields: "
-                                f"{', '.join(fields)})")
-            setattr(opts, name, value)
+        _set_fields(opts, overrides, "run_sweep")
     return SweepResult(_phiq._sweep_scene(scene, opts, identifier_names))
+
+
+def run_batch(scene: Scene, cases: Any, *, threads: int = 0, identifier_names: bool = False,
+              sensitivities: Optional[Sequence[Union[str, Tuple[str, float]]]] = None,
+              **overrides: Any) -> BatchResult:
+    """Sweep a scene for many sets of parameter values, as ``phiq batch`` does: each case is the scene read again
+    with its values (over the values ``scene`` was loaded with), sharing its pattern and symbolic analysis, and
+    swept on one thread; the cases run in parallel on ``threads`` threads (0: all cores), every thread count giving
+    the same bits, those of ``run_sweep`` on the scene loaded with the case's values.
+
+    ``cases``: a mapping of parameter names to equally long sequences of values (a dict, a pandas.DataFrame), or a
+    sequence of mappings of the same names; each name a parameter of the scene (SceneError otherwise).
+    Keyword arguments set fields of every case's SweepOptions (its own: a time range or a point may depend on its
+    values), as in run_sweep (TypeError for a name SweepOptions lacks). ``sensitivities``: as run_sweep's, at each
+    case's values. A case whose values make the scene impossible, or whose sweep fails, fails alone: BatchResult's
+    ``failed`` and ``messages`` name it. Ctrl-C stops every case at its next row (KeyboardInterrupt).
+    """
+    _set_fields(_copy_options(scene.options), overrides, "run_batch")  # a bad name or type before any case runs
+    return run_batch_tables(scene, cases, sensitivities, overrides, identifier_names, threads)
+
+
+def _set_fields(opts: SweepOptions, fields: Dict[str, Any], who: str) -> None:
+    """Sets SweepOptions fields by name, TypeError naming ``who`` and listing the fields for a name it lacks."""
+    for name, value in fields.items():
+        if not hasattr(opts, name) or name.startswith("_"):
+            names = sorted(n for n in dir(opts) if not n.startswith("_") and not callable(getattr(opts, n)))
+            raise TypeError(f"{who}() got an unexpected keyword argument '{name}' (SweepOptions fields: "
+                            f"{', '.join(names)})")
+        setattr(opts, name, value)
 
 
 def _copy_options(options: SweepOptions) -> SweepOptions:

@@ -21,6 +21,7 @@ void bind_scene(py::module_& m);
 void bind_solve(py::module_& m);
 void bind_sweep(py::module_& m);
 void bind_sweep_result(py::module_& m);
+void bind_batch_result(py::module_& m);
 void bind_stepper(py::module_& m);
 
 /// A vector the caller passed as `what`, checked to have the model's n entries: phiq::Error (ValueError in Python)
@@ -58,17 +59,20 @@ inline std::vector<SensitivityRequest> sensitivity_requests(const py::list& para
   return asked;
 }
 
-/// Prepares a scene's model for the square sweep as `phiq run` does (prepare_scene, the GIL released): "" on
-/// success, else the one line the CLI prints for an inconsistent or under-driven scene ("t = T: …"), with the
-/// assembly's summary in square->assembly.
+/// Prepares a scene's model for the square sweep as `phiq run` does (prepare_scene), without the GIL: "" on success,
+/// else the one line the CLI prints for an inconsistent or under-driven scene ("t = T: …"), with the assembly's
+/// summary in square->assembly.
+inline std::string square_for_sweep(const Scene& scene, double t_begin, const NewtonOptions& assembly,
+                                    SquareScene* square) {
+  const SolveStatus st = prepare_scene(*scene.model, t_begin, assembly, square);
+  return st == SolveStatus::kSuccess ? "" : "t = " + format_time(t_begin) + ": " + square->assembly.message;
+}
+
+/// square_for_sweep() called with the GIL held: it is released meanwhile.
 inline std::string prepare_for_sweep(const Scene& scene, double t_begin, const NewtonOptions& assembly,
                                      SquareScene* square) {
-  SolveStatus st;
-  {
-    py::gil_scoped_release free;
-    st = prepare_scene(*scene.model, t_begin, assembly, square);
-  }
-  return st == SolveStatus::kSuccess ? "" : "t = " + format_time(t_begin) + ": " + square->assembly.message;
+  py::gil_scoped_release free;
+  return square_for_sweep(scene, t_begin, assembly, square);
 }
 
 /// A copy of an Eigen vector as a new numpy array (the caller owns it).

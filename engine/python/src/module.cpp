@@ -18,5 +18,6 @@ PYBIND11_MODULE(_phiq, m) {
   phiq::python::bind_solve(m);
   phiq::python::bind_sweep(m);
   phiq::python::bind_sweep_result(m);
+  phiq::python::bind_batch_result(m);
   phiq::python::bind_stepper(m);
 }

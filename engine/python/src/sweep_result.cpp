@@ -4,29 +4,15 @@
 // takes it back every 50 ms only, to let Python's signal handlers run, so that Ctrl-C stops a long sweep at its
 // next delivered row (KeyboardInterrupt).
 
-#include "bindings.hpp"
+#include "sweep_table.hpp"
 
 #include <chrono>
 #include <memory>
 
 namespace phiq::python {
 
-py::dict summary_dict(const SweepSummary& s);  // bind_sweep.cpp
-
-namespace {
-
-/// The delivered rows of a sweep and its summary. Columns: t, the q columns, the q̇ columns, the q̈ columns, then
-/// the outputs (points, drivers, residuals, rcond), named as the CSV's.
-struct SweepTable {
-  std::unique_ptr<double[]> data;  // rows × columns, row-major; room for the rows a successful sweep delivers
-  Index rows = 0;
-  std::vector<std::string> columns;
-  Index q_columns = 0, v_columns = 0, a_columns = 0, output_columns = 0;
-  SweepSummary summary;
-  Index width() const { return static_cast<Index>(columns.size()); }
-};
-
-std::shared_ptr<SweepTable> sweep_scene(const Scene& scene, const SweepOptions& opt, bool identifier_names) {
+std::shared_ptr<SweepTable> sweep_into_table(const Scene& scene, const SweepOptions& opt, bool identifier_names,
+                                             const std::function<bool()>& keep_going) {
   auto table = std::make_shared<SweepTable>();
   // The columns from the scene's model and these options, as `phiq run` names them.
   CsvFormat format(*scene.model, opt);
@@ -41,7 +27,7 @@ std::shared_ptr<SweepTable> sweep_scene(const Scene& scene, const SweepOptions& 
   table->data.reset(new double[static_cast<std::size_t>(std::max<Index>(capacity, 1) * width)]);
 
   SquareScene square;
-  if (std::string why = prepare_for_sweep(scene, opt.t_begin, opt.assembly, &square); !why.empty()) {
+  if (std::string why = square_for_sweep(scene, opt.t_begin, opt.assembly, &square); !why.empty()) {
     // inconsistent or under-driven: nothing is swept
     table->summary.status = square.assembly.status;
     table->summary.message = std::move(why);
@@ -57,26 +43,36 @@ std::shared_ptr<SweepTable> sweep_scene(const Scene& scene, const SweepOptions& 
   const Index nq = table->q_columns, nv = table->v_columns, na = table->a_columns;
   const std::vector<Index>&qc = opt.coordinate_columns, &vc = opt.written_velocities(),
   &ac = opt.written_accelerations();
-  bool interrupted = false;
   auto next_check = std::chrono::steady_clock::now() + std::chrono::milliseconds(50);
+  (void)run_sweep(model, opt, ws, [&](const StepView& step) {  // the status is in the summary
+    if (table->rows >= capacity) throw Error("run_sweep delivered more rows than rows_written() counts");
+    double* row = table->data.get() + table->rows * width;
+    *row++ = step.t;
+    for (Index j = 0; j < nq; ++j) *row++ = step.q[qc[static_cast<std::size_t>(j)]];
+    for (Index j = 0; j < nv; ++j) *row++ = (*step.qd)[vc[static_cast<std::size_t>(j)]];
+    for (Index j = 0; j < na; ++j) *row++ = (*step.qdd)[ac[static_cast<std::size_t>(j)]];
+    if (table->output_columns > 0) format.append_output_values(step, row);
+    ++table->rows;
+    if (const auto now = std::chrono::steady_clock::now(); now >= next_check) {
+      next_check = now + std::chrono::milliseconds(50);
+      return keep_going();
+    }
+    return true;
+  }, &table->summary);
+  return table;
+}
+
+namespace {
+
+std::shared_ptr<SweepTable> sweep_scene(const Scene& scene, const SweepOptions& opt, bool identifier_names) {
+  bool interrupted = false;
+  std::shared_ptr<SweepTable> table;
   {
     py::gil_scoped_release free;
-    (void)run_sweep(model, opt, ws, [&](const StepView& step) {  // the status is in the summary
-      if (table->rows >= capacity) throw Error("run_sweep delivered more rows than rows_written() counts");
-      double* row = table->data.get() + table->rows * width;
-      *row++ = step.t;
-      for (Index j = 0; j < nq; ++j) *row++ = step.q[qc[static_cast<std::size_t>(j)]];
-      for (Index j = 0; j < nv; ++j) *row++ = (*step.qd)[vc[static_cast<std::size_t>(j)]];
-      for (Index j = 0; j < na; ++j) *row++ = (*step.qdd)[ac[static_cast<std::size_t>(j)]];
-      if (table->output_columns > 0) format.append_output_values(step, row);
-      ++table->rows;
-      if (const auto now = std::chrono::steady_clock::now(); now >= next_check) {
-        next_check = now + std::chrono::milliseconds(50);
-        py::gil_scoped_acquire hold;
-        if (PyErr_CheckSignals() != 0) return !(interrupted = true);  // the exception stays set for below
-      }
-      return true;
-    }, &table->summary);
+    table = sweep_into_table(scene, opt, identifier_names, [&] {
+      py::gil_scoped_acquire hold;
+      return !(interrupted = PyErr_CheckSignals() != 0);  // the exception stays set for below
+    });
   }
   if (interrupted) throw py::error_already_set();
   return table;
