@@ -4,17 +4,13 @@ keyword fields on every case, the forms the cases may take, and bad input: unkno
 values make the scene impossible or whose sweep fails (failing alone, named)."""
 import math
 import os
-import signal
 import subprocess
-import sys
-import textwrap
-import time
 
 import numpy as np
 import pytest
 
 import phiq
-from conftest import package_env
+from conftest import crank_slider_builder, seconds_to_interrupt
 
 
 def crank_slider(models):
@@ -131,22 +127,16 @@ def test_bad_cases_are_named(models):
 def test_ctrl_c_stops_every_case_promptly(models):
     """A batch of a minute on two threads, interrupted half a second after it starts, raises KeyboardInterrupt
     within a few seconds (every case stops at its next check)."""
-    script = textwrap.dedent(f"""
-        import time, phiq
-        scene = phiq.load_scene({crank_slider(models)!r})
-        print("sweeping", flush=True)
-        start = time.monotonic()
-        try:
-            phiq.run_batch(scene, {{"L2": [0.3] * 64}}, threads=2, steps=10_000_000, every=100_000,
-                           velocities=False, accelerations=False)
-            print("finished", flush=True)
-        except KeyboardInterrupt:
-            print(f"interrupted after {{time.monotonic() - start:.2f}} s", flush=True)
-    """)
-    child = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True, env=package_env())
-    assert child.stdout.readline().strip() == "sweeping"
-    time.sleep(0.5)
-    child.send_signal(signal.SIGINT)
-    out, _ = child.communicate(timeout=120)
-    assert out.startswith("interrupted after"), out
-    assert float(out.split()[2]) < 10.0
+    call = ('phiq.run_batch(scene, {"L2": [0.3] * 64}, threads=2, steps=10_000_000, every=100_000, '
+            'velocities=False, accelerations=False)')
+    assert seconds_to_interrupt(f"scene = phiq.load_scene({crank_slider(models)!r})", call) < 10.0
+
+
+def test_a_scene_built_in_code_with_its_own_sensitivities():
+    """A SceneBuilder's scene is read again from its text for each case, the sensitivities its output lists too."""
+    b = crank_slider_builder(sensitivities=["L3"])
+    batch = phiq.run_batch(b.build(), {"L3": [0.9, 1.3]}).raise_for_status()
+    theta, l3 = 2 * batch.t, batch.values[:, :1]
+    root = np.sqrt(l3**2 - 0.09 * np.sin(theta) ** 2)
+    xb = batch.cases[0].coordinate_names.index("xB")
+    assert np.max(np.abs(batch.sensitivity("L3")[:, :, xb] - l3 / root)) < 1e-9

@@ -1,6 +1,5 @@
 """Models built in code (engine/python/phiq/_builder.py): the scene format's own words as keyword arguments, the
 same model and the same bits as the scene file, and a message that points at the Python line at fault."""
-import math
 import os
 
 import numpy as np
@@ -8,22 +7,7 @@ import pytest
 
 import phiq
 
-from conftest import MODELS
-
-
-def crank_slider_builder():
-    b = phiq.SceneBuilder("crank_slider_mixed")
-    b.parameters(L2=0.3, L3=1.0)
-    b.coordinates(theta2=0.0, xA=0.28, yA=0.03, xB=1.25)
-    b.point("O", [0, 0])
-    b.point("A", ["xA", "yA"])
-    b.point("B", ["xB", 0])
-    b.constraint("crank", type="polar", point="A", origin="O", length="L2", angle="theta2")
-    b.constraint("rod", type="distance", points=["A", "B"], length="L3")
-    b.driver("motor", coordinate="theta2", law={"type": "linear", "initial": 0, "rate": 2})
-    b.time(start=0, end=math.pi, steps=180)
-    b.output(velocities=True, accelerations=True)
-    return b
+from conftest import MODELS, crank_slider_builder
 
 
 def test_built_in_code_equals_the_scene_file():
