@@ -6,7 +6,9 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <bit>
 #include <charconv>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 
@@ -300,6 +302,44 @@ TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
   EXPECT_DOUBLE_EQ(v[13], rocker);
   EXPECT_GE(v[14], v[13]);  // the largest over all rows is at least the rocker's
   EXPECT_LE(v[14], 1e-10);
+}
+
+TEST(CsvFormat, ARowsValuesAreTheDoublesItsTextReads) {
+  // every column kind (coordinates, q̇, points, a driver, residuals, rcond) and a step whose q holds a −0
+  Scene scene = parse_scene(fourbar_scene("{velocities: true, accelerations: true, points: [B, {name: P, body: "
+                                          "coupler, at: [0, 0.3]}], drivers: [motor], residuals: [rocker], "
+                                          "max_residual: true, rcond: true}", 4), "fourbar.yaml");
+  const CsvFormat csv(*scene.model, scene.sweep);
+  ASSERT_EQ(csv.num_values(), csv.column_names().size());
+  Workspace ws(*scene.model);
+  Index rows = 0;
+  SweepSummary sum;
+  const SolveStatus st = run_sweep(*scene.model, scene.sweep, ws, [&](const StepView& s) {
+    Eigen::VectorXd q = s.q;
+    q(0) = -0.0;
+    const StepView step{s.step, s.t, q, s.qd, s.qdd, s.points, s.phi, s.rcond, s.joints, s.orientations,
+                        s.sensitivities};
+    std::string text;
+    csv.append_row(step, text);
+    std::vector<double> values(csv.num_values() + 1, 7.0);  // one past the end: not written
+    csv.append_values(step, values.data());
+    EXPECT_EQ(values.back(), 7.0);
+    std::size_t k = 0;
+    for (const char* p = text.data(); *p != '\n'; ++k) {
+      double read = 0.0;
+      const auto [end, ec] = std::from_chars(p, text.data() + text.size(), read);
+      EXPECT_EQ(ec, std::errc());
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(values[k]), std::bit_cast<std::uint64_t>(read))
+          << "column " << csv.column_names()[k] << " at step " << s.step;
+      p = *end == ',' ? end + 1 : end;
+    }
+    EXPECT_EQ(k, csv.num_values());
+    EXPECT_FALSE(std::signbit(values[1]));  // −0 as the text writes it: 0
+    ++rows;
+    return true;
+  }, &sum);
+  ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
+  EXPECT_EQ(rows, 5);
 }
 
 // The text a row's values should have: shortest round-trip (std::to_chars), −0 written as 0, one value at a time.

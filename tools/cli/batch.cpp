@@ -248,8 +248,9 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     t.shared_analyses = static_cast<std::size_t>(sum.shared_analyses);
     t.threads = sum.threads;
     t.load_seconds = load_s, t.solve_seconds = sum.solve_seconds;
-    return commit_batch_summary(outputs, *summary_file, {scene_path, cases_path, dir, summary_path}, t,
-                                std::move(results), status);
+    BatchArgs args;  // (what the summary names)
+    args.scene = scene_path, args.cases = cases_path, args.out = dir, args.summary = summary_path;
+    return commit_batch_summary(outputs, *summary_file, args, t, std::move(results), status);
   }
   return status;
 }

@@ -384,24 +384,15 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     const phiq::CsvFormat rows_format(*scene->model, scene->sweep);  // the case's own output points
     const std::string prefix = std::to_string(k) + ",";
     bool last = false;
-    const std::vector<Index>& qd_cols = one.written_velocities();
-    const std::vector<Index>& qdd_cols = one.written_accelerations();
-    std::vector<double> row(hdf5 ? 2 + one.coordinate_columns.size() + qd_cols.size() + qdd_cols.size() +
-                                       rows_format.num_output_values()
-                                 : 0);
+    std::vector<double> row(hdf5 ? 1 + rows_format.num_values() : 0);  // the case, then the row's values
     setup_done();
     long long format_case_ns = 0;
     phiq::SweepSummary s;
     (void)phiq::run_sweep(model, one, ws, [&](const phiq::StepView& step) {
       const auto f0 = Clock::now();
       if (hdf5) {  // the values Hdf5Writer::append_row() would store, the case first
-        double* v = row.data();
-        *v++ = static_cast<double>(k);
-        *v++ = step.t;
-        for (Index c : one.coordinate_columns) *v++ = step.q(c);
-        for (Index c : qd_cols) *v++ = (*step.qd)(c);
-        for (Index c : qdd_cols) *v++ = (*step.qdd)(c);
-        rows_format.append_output_values(step, v);
+        row[0] = static_cast<double>(k);
+        rows_format.append_values(step, row.data() + 1);
         rows.values.insert(rows.values.end(), row.begin(), row.end());
       } else {
         rows.text += prefix;

@@ -58,6 +58,12 @@ class CsvFormat {
   /// Writes those columns' values for this step to out[0 .. num_output_values()), as append_row() formats them
   /// (the HDF5 writer's row: the same doubles as the CSV's). Throws phiq::Error as append_row() does.
   void append_output_values(const StepView& step, double* out) const;
+  /// The number of columns of a row, t's included: column_names().size().
+  std::size_t num_values() const;
+  /// Writes the whole row's values for this step to out[0 .. num_values()): t, the coordinates' columns, then
+  /// append_output_values()' — the doubles append_row() formats, −0 written as 0 as it writes it (what a result
+  /// held in memory keeps: Python's run_sweep table, a batch's HDF5 rows). Throws phiq::Error as append_row() does.
+  void append_values(const StepView& step, double* out) const;
 
  private:
   const Model& model_;
@@ -66,6 +72,7 @@ class CsvFormat {
   const OutputPlan* plan_ = nullptr;  // the other outputs, when made from an output plan
   ColumnNaming naming_ = ColumnNaming::kDotted;
   std::vector<std::string> dotted_names() const;  // the names of format 1
+  void check_coordinates(const StepView& step) const;  // throws unless the step carries the columns' vectors
   void append_coordinates(const StepView& step, std::string& out) const;  // the q, q̇, q̈ columns
   void append_outputs(const StepView& step, std::string& out) const;      // the columns after the coordinates
   template <class Emit>

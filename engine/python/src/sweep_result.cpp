@@ -40,18 +40,10 @@ std::shared_ptr<SweepTable> sweep_into_table(const Scene& scene, const SweepOpti
   Workspace ws(model);
   ws.q = square.start;
 
-  const Index nq = table->q_columns, nv = table->v_columns, na = table->a_columns;
-  const std::vector<Index>&qc = opt.coordinate_columns, &vc = opt.written_velocities(),
-  &ac = opt.written_accelerations();
   auto next_check = std::chrono::steady_clock::now() + std::chrono::milliseconds(50);
   (void)run_sweep(model, opt, ws, [&](const StepView& step) {  // the status is in the summary
     if (table->rows >= capacity) throw Error("run_sweep delivered more rows than rows_written() counts");
-    double* row = table->data.get() + table->rows * width;
-    *row++ = step.t;
-    for (Index j = 0; j < nq; ++j) *row++ = step.q[qc[static_cast<std::size_t>(j)]];
-    for (Index j = 0; j < nv; ++j) *row++ = (*step.qd)[vc[static_cast<std::size_t>(j)]];
-    for (Index j = 0; j < na; ++j) *row++ = (*step.qdd)[ac[static_cast<std::size_t>(j)]];
-    if (table->output_columns > 0) format.append_output_values(step, row);
+    format.append_values(step, table->data.get() + table->rows * width);
     ++table->rows;
     if (const auto now = std::chrono::steady_clock::now(); now >= next_check) {
       next_check = now + std::chrono::milliseconds(50);

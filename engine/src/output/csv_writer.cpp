@@ -239,6 +239,21 @@ std::size_t CsvFormat::num_output_values() const {
   return n;
 }
 
+std::size_t CsvFormat::num_values() const {
+  return 1 + columns_.size() + v_columns_.size() + a_columns_.size() + num_output_values();
+}
+
+void CsvFormat::append_values(const StepView& s, double* out) const {
+  check_coordinates(s);
+  auto store = [](double v) { return v == 0.0 ? 0.0 : v; };  // −0 → 0, as put() writes it
+  *out++ = store(s.t);
+  const Eigen::VectorXd* groups[3] = {&s.q, s.qd, s.qdd};
+  const std::vector<Index>* cols[3] = {&columns_, &v_columns_, &a_columns_};
+  for (int g = 0; g < 3; ++g)
+    for (Index c : *cols[g]) *out++ = store((*groups[g])(c));
+  if (plan_) for_each_output(s, [&](double v) { *out++ = store(v); });
+}
+
 void CsvFormat::append_row(const StepView& s, std::string& out) const {
   put(s.t, out);
   append_coordinates(s, out);
@@ -246,12 +261,16 @@ void CsvFormat::append_row(const StepView& s, std::string& out) const {
   out += '\n';
 }
 
-void CsvFormat::append_coordinates(const StepView& s, std::string& out) const {
+void CsvFormat::check_coordinates(const StepView& s) const {
   if (velocities_ && !s.qd) throw Error("CsvFormat: step has no velocities");
   if (accelerations_ && !s.qdd) throw Error("CsvFormat: step has no accelerations");
   if (s.q.size() != model_.num_coordinates() || (velocities_ && s.qd->size() != s.q.size()) ||
       (accelerations_ && s.qdd->size() != s.q.size()))
     throw Error("CsvFormat: step's vectors are not the model's size");
+}
+
+void CsvFormat::append_coordinates(const StepView& s, std::string& out) const {
+  check_coordinates(s);
   // q's columns, then q̇'s, then q̈'s: group g's values are [first[g], first[g + 1]) of the row's coordinate part
   const double* groups[3] = {s.q.data(), velocities_ ? s.qd->data() : nullptr,
                              accelerations_ ? s.qdd->data() : nullptr};
