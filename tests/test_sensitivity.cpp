@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cli_test_support.hpp"
+#include "phiq/parsed_scene.hpp"
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
 
@@ -162,6 +163,55 @@ TEST(Sensitivity, CrankSliderAgainstTheClosedFormAndItsTimeDerivatives) {
   }();
   EXPECT_EQ(r.summary.counters.factorizations, p.summary.counters.factorizations);
   EXPECT_EQ(p.summary.counters.sensitivity_solves, 0);
+}
+
+// A caller's sensitivities (SceneOverrides::sensitivities: `phiq batch --sensitivity`, Python's run_batch) replace
+// the scene's own: the same sweep as sensitivities_of() on the scene read without them, at the overrides' values;
+// a bad request is refused naming its source; without models they are listed, checked.
+TEST(Sensitivity, TheCallersRequestsReplaceTheScenesOwn) {
+  SceneOverrides o;
+  o.parameters = {{"L2", 0.25}};
+  o.sensitivities = {{"L3", 2e-3}};
+  o.sensitivities_source = "cases.csv";
+  ParsedScene tree(kCrankSlider, "crank_slider.yaml");
+  const Scene asked = tree.read(o);
+  ASSERT_EQ(asked.sweep.sensitivities.size(), 1u);
+  EXPECT_EQ(asked.sweep.sensitivities[0].name, "L3");
+  EXPECT_EQ(asked.sweep.sensitivities[0].step, 2e-3);  // the request's, not the scene's entry's 1e-3
+  SceneOverrides plain;
+  plain.parameters = o.parameters;
+  Scene then = tree.read(plain);
+  then.sweep.sensitivities = sensitivities_of(then, {{"L3", 2e-3}}, "--sensitivity");
+  const SensitivityTrace a = sweep_sensitivities(*asked.model, asked.sweep);
+  const SensitivityTrace b = sweep_sensitivities(*then.model, then.sweep);
+  ASSERT_EQ(a.s.size(), 91u);
+  EXPECT_EQ(a.s, b.s);
+  const Index xb = asked.model->coordinate_index("xB");
+  for (std::size_t k = 0; k < a.s.size(); ++k)
+    EXPECT_NEAR(a.s[k][static_cast<std::size_t>(xb)], slider_derivatives(2.0 * a.rows.t[k], 0.25, 1.0, 3)[0], 1e-9);
+  auto refused = [&](std::vector<SensitivityRequest> requests, bool models) {
+    SceneOverrides bad = o;
+    bad.sensitivities = std::move(requests);
+    bad.sensitivity_models = models;
+    try {
+      (void)tree.read(bad);
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(read)");
+  };
+  EXPECT_EQ(refused({{"L9", 0.0}}, true), "cases.csv: 'L9' is not a parameter of crank_slider.yaml (its parameters: "
+                                          "L2, L3)");
+  EXPECT_EQ(refused({{"L2", 0.0}, {"L2", 1e-4}}, false), "cases.csv: parameter 'L2' is asked for twice");
+  EXPECT_EQ(refused({{"L2", -1.0}}, false),
+            "cases.csv: the step of 'L2' must be a positive finite number (0: the default)");
+  SceneOverrides listed = o;
+  listed.sensitivity_models = false;
+  const Scene without = tree.read(listed);
+  ASSERT_EQ(without.sweep.sensitivities.size(), 1u);
+  EXPECT_EQ(without.sweep.sensitivities[0].value, 1.0);
+  EXPECT_EQ(without.sweep.sensitivities[0].models[0], nullptr);
+  EXPECT_EQ(without.sweep.sensitivities[0].reached, nullptr);
 }
 
 // The models along `parameter` at `value` of `scene` (read with `read_with`), built through the C++ API as the

@@ -74,14 +74,17 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   for (std::size_t k = 0; k < cases.rows.size(); ++k) {
     phiq::SceneOverrides o = case_overrides(cases, k, cases_path);
     if (!scenes.empty()) o.share_analysis_with = scenes.front().model.get();
-    o.sensitivity_models = asked.empty();  // (--sensitivity replaces the scene's)
+    o.sensitivities = asked, o.sensitivities_source = "--sensitivity";  // (empty: the scene's own)
     try {
       scenes.push_back(tree->read(o));
     } catch (const phiq::SceneError& e) {
       // The case is named only when its parameters cause the error: an error of the scene itself (its YAML, a
       // field) is the same without them. Cases after the first loaded the same scene, so theirs are theirs.
       bool from_case = k > 0;
-      if (std::string(e.what()).rfind(o.parameters_source + ": ", 0) == 0) return fail(e.what(), 2);
+      const std::string what = e.what();
+      if (what.rfind(o.parameters_source + ": ", 0) == 0) return fail(what, 2);
+      // the first case's error in --sensitivity is the option's (an unknown name); a later one's is its case's
+      if (k == 0 && what.rfind(o.sensitivities_source + ": ", 0) == 0) return fail(what, 2);
       if (!from_case) {
         try {
           (void)tree->read();
@@ -93,14 +96,6 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
       return fail(std::string(e.what()) + (from_case ? " (case " + std::to_string(k) + " of " + cases_path +
                                                            ", line " + std::to_string(k + 2) + ")"
                                                      : ""),
-                  2);
-    }
-    if (asked.empty()) continue;
-    try {  // the first case's error is the option's (an unknown name); a later one's is its case's
-      scenes.back().sweep.sensitivities = phiq::sensitivities_of(scenes.back(), asked, "--sensitivity");
-    } catch (const phiq::SceneError& e) {
-      return fail(std::string(e.what()) + (k == 0 ? "" : " (case " + std::to_string(k) + " of " + cases_path +
-                                                           ", line " + std::to_string(k + 2) + ")"),
                   2);
     }
   }

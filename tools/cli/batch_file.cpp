@@ -208,10 +208,8 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
   try {
     trees.push_back(phiq::ParsedScene::load(a.scene));
     phiq::SceneOverrides plain;
-    plain.sensitivity_models = a.sensitivities.empty();  // (--sensitivity replaces the scene's)
+    plain.sensitivities = a.sensitivities, plain.sensitivities_source = "--sensitivity";  // (empty: the scene's)
     reference = trees.front().read(plain);
-    if (!a.sensitivities.empty())
-      reference->sweep.sensitivities = phiq::sensitivities_of(*reference, a.sensitivities, "--sensitivity");
   } catch (const phiq::SceneError& e) {
     return fail(e.what(), 2);
   }
@@ -351,12 +349,10 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     };
     phiq::SceneOverrides o = case_overrides(cases, k, a.cases);
     o.share_analysis_with = reference->model.get();
-    o.sensitivity_models = a.sensitivities.empty();
+    o.sensitivities = a.sensitivities, o.sensitivities_source = "--sensitivity";
     std::optional<phiq::Scene> scene;
     try {
       scene = tree.read(o);
-      if (!a.sensitivities.empty())
-        scene->sweep.sensitivities = phiq::sensitivities_of(*scene, a.sensitivities, "--sensitivity");
     } catch (const phiq::SceneError& e) {  // its parameters make the scene impossible (a negative length)
       report.outcome["status"] = "scene error";
       report.outcome["message"] = e.what();

@@ -72,6 +72,13 @@ struct Scene {
   SweepOptions sweep;
 };
 
+/// A parameter whose sensitivities a caller asks for beside the scene's text (`phiq run --sensitivity`, Python's
+/// run_sweep(sensitivities=...)), as an entry of its `output.sensitivities` would.
+struct SensitivityRequest {
+  std::string name;   ///< a parameter of the scene
+  double step = 0.0;  ///< the difference step of the data's rates; 0: default_sensitivity_step() of its value
+};
+
 /// Changes to a scene made by the caller rather than the file (batch mode, `phiq batch`).
 struct SceneOverrides {
   /// Parameter values replacing the file's, by name; each must be a parameter of the scene (else SceneError). A
@@ -92,6 +99,12 @@ struct SceneOverrides {
   /// constraints each parameter reaches in them (keep_reached_only()): the same results, a fraction of the memory.
   /// True serves a comparison with another reach (every constraint's, whole_model_reach()).
   bool keep_sensitivity_models = false;
+  /// Parameters whose sensitivities the caller asks for (`phiq batch --sensitivity`, Python's run_batch): they
+  /// replace the scene's `output.sensitivities`, made as sensitivities_of() makes them (their models only with
+  /// `sensitivity_models`). Empty: the scene's own.
+  std::vector<SensitivityRequest> sensitivities;
+  /// What sensitivities' errors start with: where the caller's requests came from ("--sensitivity").
+  std::string sensitivities_source = "sensitivities";
 };
 
 /// The sensitivity along the scene parameter `name` at `value`: its models at value − 2h, − h, + h, + 2h
@@ -103,13 +116,6 @@ struct SceneOverrides {
 /// the scene cannot be read: WHY", or check_sensitivity_models()' line when a moved model has another structure.
 OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name, double value, double step = 0.0,
                                     const SceneLimits& limits = {}, const SceneOverrides& overrides = {});
-
-/// A parameter whose sensitivities a caller asks for beside the scene's text (`phiq run --sensitivity`, Python's
-/// run_sweep(sensitivities=...)), as an entry of its `output.sensitivities` would.
-struct SensitivityRequest {
-  std::string name;   ///< a parameter of the scene
-  double step = 0.0;  ///< the difference step of the data's rates; 0: default_sensitivity_step() of its value
-};
 
 /// The sensitivities of `scene` to `requests`, for SweepOptions::sensitivities (in their order): each parameter's
 /// models read from the scene's text as `scene` was read (its Scene::overridden values), by sensitivity_along().

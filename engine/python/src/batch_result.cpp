@@ -98,11 +98,10 @@ py::dict batch_scene(const Scene& scene, const std::vector<std::string>& names,
       std::unique_ptr<ParsedScene>& tree = trees.local();
       if (!tree) tree = std::make_unique<ParsedScene>(scene.text, scene.path);
       SceneOverrides o = case_overrides(scene, names, all_values + k * names.size());
-      o.sensitivity_models = asked.empty();  // (sensitivities asked for replace the scene's)
+      o.sensitivities = asked, o.sensitivities_source = "run_batch: sensitivities";  // (empty: the scene's own)
       std::optional<Scene> one;
       try {
         one = tree->read(o);
-        if (!asked.empty()) one->sweep.sensitivities = sensitivities_of(*one, asked, "run_batch: sensitivities");
       } catch (const SceneError& e) {  // its values make the scene impossible (a negative length)
         out.scene_errors[k] = e.what();
         return;

@@ -100,17 +100,52 @@ void refuse_non_utf8_encoding(const std::string& text, const std::string& path) 
                    ": the scene is not text (a NUL byte)");
 }
 
-// The models along each parameter of the scene's `output.sensitivities` (sensitivity_along()), refused naming the
-// scene's entry.
-void build_sensitivity_models(Scene& scene, const SceneLimits& limits, const SceneOverrides& overrides) {
-  if (!overrides.sensitivity_models) return;
-  for (OutputSensitivity& s : scene.sweep.sensitivities) {
+// The caller's requests checked against the scene — a parameter of it, asked for once, a step 0 or positive and
+// finite — as sensitivities without their models (their values the scene's, their steps the default for 0).
+std::vector<OutputSensitivity> requested(const Scene& scene, const std::vector<SensitivityRequest>& requests,
+                                         const std::string& source) {
+  std::vector<OutputSensitivity> out;
+  for (const SensitivityRequest& r : requests) {
+    if (std::any_of(out.begin(), out.end(), [&](const OutputSensitivity& s) { return s.name == r.name; }))
+      throw SceneError(source + ": parameter '" + r.name + "' is asked for twice");
+    if (!(r.step >= 0.0) || !std::isfinite(r.step))
+      throw SceneError(source + ": the step of '" + r.name + "' must be a positive finite number (0: the default)");
+    const auto it = std::find_if(scene.parameters.begin(), scene.parameters.end(),
+                                 [&](const auto& nv) { return nv.first == r.name; });
+    if (it == scene.parameters.end()) {
+      std::vector<std::string> names;
+      for (const auto& nv : scene.parameters) names.push_back(nv.first);
+      throw SceneError(source + ": '" + r.name + "' is not a parameter of " + scene.path +
+                       detail::scene::parameters_note(names));
+    }
+    OutputSensitivity s;
+    s.name = r.name, s.value = it->second, s.step = r.step > 0.0 ? r.step : default_sensitivity_step(it->second);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+// The models along each of `sensitivities` (sensitivity_along(), the scene read again with `overrides`), refused
+// naming `source`.
+void build_models_along(const Scene& scene, std::vector<OutputSensitivity>& sensitivities, const SceneLimits& limits,
+                        const SceneOverrides& overrides, const std::string& source) {
+  for (OutputSensitivity& s : sensitivities) {
     try {
       s = sensitivity_along(scene, s.name, s.value, s.step, limits, overrides);
     } catch (const SceneError& e) {
-      throw SceneError(scene.path + ": output.sensitivities: " + e.what());
+      throw SceneError(source + ": " + e.what());
     }
   }
+}
+
+// The scene's sensitivities: the caller's requests in place of its `output.sensitivities`, when it made any, and
+// the models along each parameter when asked for.
+void build_sensitivity_models(Scene& scene, const SceneLimits& limits, const SceneOverrides& overrides) {
+  const bool requests = !overrides.sensitivities.empty();
+  if (requests) scene.sweep.sensitivities = requested(scene, overrides.sensitivities, overrides.sensitivities_source);
+  if (!overrides.sensitivity_models) return;
+  build_models_along(scene, scene.sweep.sensitivities, limits, overrides,
+                     requests ? overrides.sensitivities_source : scene.path + ": output.sensitivities");
 }
 
 // The checks and the parse of parse_scene(), before the tree is read: what a ParsedScene does once.
@@ -199,6 +234,7 @@ OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name,
   auto read_at = [&](std::size_t k) {
     SceneOverrides moved = overrides;
     moved.sensitivity_models = false;
+    moved.sensitivities.clear();  // (the models along p need no sensitivities of their own)
     moved.share_analysis_with = scene.model.get();
     moved.parameters_source.clear();
     const double at = value + detail::kShift[k] * s.step;
@@ -223,26 +259,8 @@ std::vector<OutputSensitivity> sensitivities_of(const Scene& scene, const std::v
                                                 const std::string& source, const SceneLimits& limits) {
   SceneOverrides as_read;  // the scene read again as it was: the parameters its reader was given
   as_read.parameters = scene.overridden;
-  std::vector<OutputSensitivity> out;
-  for (const SensitivityRequest& r : requests) {
-    if (std::any_of(out.begin(), out.end(), [&](const OutputSensitivity& s) { return s.name == r.name; }))
-      throw SceneError(source + ": parameter '" + r.name + "' is asked for twice");
-    if (!(r.step >= 0.0) || !std::isfinite(r.step))
-      throw SceneError(source + ": the step of '" + r.name + "' must be a positive finite number (0: the default)");
-    const auto it = std::find_if(scene.parameters.begin(), scene.parameters.end(),
-                                 [&](const auto& nv) { return nv.first == r.name; });
-    if (it == scene.parameters.end()) {
-      std::vector<std::string> names;
-      for (const auto& nv : scene.parameters) names.push_back(nv.first);
-      throw SceneError(source + ": '" + r.name + "' is not a parameter of " + scene.path +
-                       detail::scene::parameters_note(names));
-    }
-    try {
-      out.push_back(sensitivity_along(scene, r.name, it->second, r.step, limits, as_read));
-    } catch (const SceneError& e) {
-      throw SceneError(source + ": " + e.what());
-    }
-  }
+  std::vector<OutputSensitivity> out = requested(scene, requests, source);
+  build_models_along(scene, out, limits, as_read, source);
   return out;
 }
 
