@@ -23,7 +23,8 @@ _phiq() {
 
   local opts=""
   case "$cmd" in
-    run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names --set --sensitivity" ;;
+    run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names --set
+               --sensitivity" ;;
     check) opts="--help --json --time --set" ;;
     assemble) opts="--help --output --quiet --set" ;;
     batch) opts="--help --output --quiet --threads --summary --names --resume --sensitivity" ;;
@@ -45,12 +46,14 @@ _phiq() {
     --coords) COMPREPLY=($(compgen -W "natural reference-point" -- "$cur")); return ;;
     --newton) COMPREPLY=($(compgen -W "modified full modified,full" -- "$cur")); return ;;
     --linear-solvers) COMPREPLY=($(compgen -W "klu umfpack dense klu,umfpack" -- "$cur")); return ;;
-    --predictors) COMPREPLY=($(compgen -W "auto previous secant parabolic linear hermite quadratic cubic" -- "$cur")); return ;;
+    --predictors) COMPREPLY=($(compgen -W "auto previous secant parabolic linear hermite quadratic cubic" -- "$cur"))
+                  return ;;
     --reference) COMPREPLY=($(compgen -W "auto numerical closed-form:crank-slider closed-form:fourbar
                                           closed-form:nfourbar closed-form:chain3d" -- "$cur")); return ;;
     --summary|--junit|-o|--output|--covariance|--plot) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     --threads|--memory|--steps|--from|--to|--twist|--time|--rtol|--atol|--columns|--positions|--tolerances|\
-    --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column|--set|--sensitivity) return ;;  # a value of the user's
+    --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column|--set|\
+    --sensitivity) return ;;  # a value of the user's
   esac
   if [[ "$cur" == -* ]]; then
     COMPREPLY=($(compgen -W "$opts" -- "$cur"))
