@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """phiq.run_batch against `phiq batch`: the 2 000-case crank-slider batch of bench/README.md ("Batches": L2 and L3 on
 a 40 × 50 grid within ±3 % of 0.3 and 1.0, 181 rows of q, q̇, q̈ each, 362 000 steps), from Python into memory
-against the whole CLI command writing one CSV, on 1 and 2 threads.
+against the whole CLI command writing one CSV, and run_batch with the sensitivities to both lengths, on 1 and 2
+threads.
 
     PYTHONPATH=build/python /usr/bin/python3 bench/python_batch.py build/tools/phiq [RUNS]
 
@@ -51,9 +52,13 @@ def main():
             def command():
                 subprocess.run([cli, "batch", "-q", SCENE, "cases.csv", "-o", "all.csv", "--threads", str(threads)],
                                cwd=tmp, check=True)
-            for name, work in (("run_batch", python), ("phiq batch", command)):
+            def sensitivities():  # ∂q/∂p, ∂q̇/∂p, ∂q̈/∂p along both lengths, at each case's own values
+                batch = phiq.run_batch(phiq.load_scene(SCENE), values, threads=threads, sensitivities=["L2", "L3"])
+                assert batch.ok and batch.sensitivity("L3").shape == (2000, 181, 4)
+
+            for name, work in (("run_batch", python), ("phiq batch", command), ("+ ∂/∂L2, L3", sensitivities)):
                 med, lo, hi = timed(runs, work)
-                print(f"{threads} thread{'s' if threads > 1 else ' '} {name:>10}: {med:.3f} s ({lo:.3f}–{hi:.3f}), "
+                print(f"{threads} thread{'s' if threads > 1 else ' '} {name:>11}: {med:.3f} s ({lo:.3f}–{hi:.3f}), "
                       f"{steps / med:,.0f} steps/s")
 
 

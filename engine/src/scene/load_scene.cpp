@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 #include "phiq/parsed_scene.hpp"
@@ -125,13 +126,46 @@ std::vector<OutputSensitivity> requested(const Scene& scene, const std::vector<S
   return out;
 }
 
-// The models along each of `sensitivities` (sensitivity_along(), the scene read again with `overrides`), refused
-// naming `source`.
-void build_models_along(const Scene& scene, std::vector<OutputSensitivity>& sensitivities, const SceneLimits& limits,
-                        const SceneOverrides& overrides, const std::string& source) {
+// The scene read again with other overrides: from the tree it was read from, so that the four models along a
+// parameter cost four reads, not four parses of its text.
+using ReadScene = std::function<Scene(const SceneOverrides&)>;
+
+// sensitivity_along(), its models read by `read`.
+OutputSensitivity along(const Scene& scene, const std::string& name, double value, double step,
+                        const SceneOverrides& overrides, const ReadScene& read) {
+  OutputSensitivity s;
+  s.name = name, s.value = value, s.step = step > 0.0 ? step : default_sensitivity_step(value);
+  auto read_at = [&](std::size_t k) {
+    SceneOverrides moved = overrides;
+    moved.sensitivity_models = false;
+    moved.sensitivities.clear();  // (the models along p need no sensitivities of their own)
+    moved.share_analysis_with = scene.model.get();
+    moved.parameters_source.clear();
+    const double at = value + detail::kShift[k] * s.step;
+    bool replaced = false;
+    for (auto& [n, v] : moved.parameters)
+      if (n == name) v = at, replaced = true;
+    if (!replaced) moved.parameters.emplace_back(name, at);
+    try {
+      return std::shared_ptr<const Model>(std::move(read(moved).model));
+    } catch (const SceneError& e) {
+      throw SceneError("with " + name + " = " + shortest(at) + " (the difference step " + shortest(s.step) +
+                       " from " + shortest(value) + ") the scene cannot be read: " + e.what());
+    }
+  };
+  // The models along p are the whole model again, and only what p reaches is read of them (complete_along()).
+  detail::complete_along(*scene.model, s, overrides.keep_sensitivity_models, read_at,
+                         [](const std::string& why) { throw SceneError(why); });
+  return s;
+}
+
+// The models along each of `sensitivities` (the scene read again by `read` with `overrides`), refused naming
+// `source`.
+void build_models_along(const Scene& scene, std::vector<OutputSensitivity>& sensitivities,
+                        const SceneOverrides& overrides, const std::string& source, const ReadScene& read) {
   for (OutputSensitivity& s : sensitivities) {
     try {
-      s = sensitivity_along(scene, s.name, s.value, s.step, limits, overrides);
+      s = along(scene, s.name, s.value, s.step, overrides, read);
     } catch (const SceneError& e) {
       throw SceneError(source + ": " + e.what());
     }
@@ -140,12 +174,12 @@ void build_models_along(const Scene& scene, std::vector<OutputSensitivity>& sens
 
 // The scene's sensitivities: the caller's requests in place of its `output.sensitivities`, when it made any, and
 // the models along each parameter when asked for.
-void build_sensitivity_models(Scene& scene, const SceneLimits& limits, const SceneOverrides& overrides) {
+void build_sensitivity_models(Scene& scene, const SceneOverrides& overrides, const ReadScene& read) {
   const bool requests = !overrides.sensitivities.empty();
   if (requests) scene.sweep.sensitivities = requested(scene, overrides.sensitivities, overrides.sensitivities_source);
   if (!overrides.sensitivity_models) return;
-  build_models_along(scene, scene.sweep.sensitivities, limits, overrides,
-                     requests ? overrides.sensitivities_source : scene.path + ": output.sensitivities");
+  build_models_along(scene, scene.sweep.sensitivities, overrides,
+                     requests ? overrides.sensitivities_source : scene.path + ": output.sensitivities", read);
 }
 
 // The checks and the parse of parse_scene(), before the tree is read: what a ParsedScene does once.
@@ -186,7 +220,9 @@ Scene read_tree(const YAML::Node& root, const std::string& text, const std::stri
       throw SceneError(path + ": solver.predictor: '" + to_string(p) +
                        "' needs the derivatives it extrapolates with in the output (velocities / accelerations)");
   }
-  build_sensitivity_models(scene, limits, overrides);
+  build_sensitivity_models(scene, overrides, [&](const SceneOverrides& o) {
+    return read_tree(root, text, path, limits, o);
+  });
   return scene;
 }
 
@@ -229,30 +265,10 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
 
 OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name, double value, double step,
                                     const SceneLimits& limits, const SceneOverrides& overrides) {
-  OutputSensitivity s;
-  s.name = name, s.value = value, s.step = step > 0.0 ? step : default_sensitivity_step(value);
-  auto read_at = [&](std::size_t k) {
-    SceneOverrides moved = overrides;
-    moved.sensitivity_models = false;
-    moved.sensitivities.clear();  // (the models along p need no sensitivities of their own)
-    moved.share_analysis_with = scene.model.get();
-    moved.parameters_source.clear();
-    const double at = value + detail::kShift[k] * s.step;
-    bool replaced = false;
-    for (auto& [n, v] : moved.parameters)
-      if (n == name) v = at, replaced = true;
-    if (!replaced) moved.parameters.emplace_back(name, at);
-    try {
-      return std::shared_ptr<const Model>(std::move(parse_scene(scene.text, scene.path, limits, moved).model));
-    } catch (const SceneError& e) {
-      throw SceneError("with " + name + " = " + shortest(at) + " (the difference step " + shortest(s.step) +
-                       " from " + shortest(value) + ") the scene cannot be read: " + e.what());
-    }
-  };
-  // The models along p are the whole model again, and only what p reaches is read of them (complete_along()).
-  detail::complete_along(*scene.model, s, overrides.keep_sensitivity_models, read_at,
-                         [](const std::string& why) { throw SceneError(why); });
-  return s;
+  const YAML::Node root = parse_tree(scene.text, scene.path, limits);  // parsed once for the four models
+  return along(scene, name, value, step, overrides, [&](const SceneOverrides& o) {
+    return read_tree(root, scene.text, scene.path, limits, o);
+  });
 }
 
 std::vector<OutputSensitivity> sensitivities_of(const Scene& scene, const std::vector<SensitivityRequest>& requests,
@@ -260,7 +276,11 @@ std::vector<OutputSensitivity> sensitivities_of(const Scene& scene, const std::v
   SceneOverrides as_read;  // the scene read again as it was: the parameters its reader was given
   as_read.parameters = scene.overridden;
   std::vector<OutputSensitivity> out = requested(scene, requests, source);
-  build_models_along(scene, out, limits, as_read, source);
+  if (out.empty()) return out;
+  const YAML::Node root = parse_tree(scene.text, scene.path, limits);  // parsed once for every model along them
+  build_models_along(scene, out, as_read, source, [&](const SceneOverrides& o) {
+    return read_tree(root, scene.text, scene.path, limits, o);
+  });
   return out;
 }
 
