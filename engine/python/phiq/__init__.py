@@ -7,6 +7,7 @@ A five-minute tour is in engine/python/README.md. In short::
     result = phiq.run_sweep(scene, threads=2)      # t, q, qd, qdd: numpy arrays (rows × coordinates)
     xB = result["xB"]                              # a column by name
     report = phiq.check(scene)                     # rank, dof, Grübler, redundant and conflicting constraints
+    batch = phiq.run_batch(scene, {"L2": [0.2, 0.3, 0.4]})   # the cases in parallel; batch["xB"]: cases × rows
 
 Numerical outcomes are statuses (``SolveStatus``) in the returned summaries and results, never exceptions:
 a sweep that fails returns the rows it delivered, with ``ok`` False and phiq's one-line ``message``;
@@ -36,11 +37,10 @@ SceneError.__doc__ = ("A scene that cannot be used (a ValueError): one line 'FIL
                       "for a SceneBuilder the Python line of the entry at fault.")
 
 __all__ = [
-    "AssemblySummary", "BatchResult", "CheckReport", "ConstraintInfo", "JacobianUpdate", "LinearSummary", "Model", "NewtonOptions",
-    "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError", "SensitivityForm", "SolveError",
-    "SolveStatus",
-    "StepSummary", "Stepper", "SweepOptions", "SweepResult", "SweepSummary", "SweepWarning", "Unit", "WorkCounters",
-    "Workspace",
+    "AssemblySummary", "BatchResult", "CheckReport", "ConstraintInfo", "JacobianUpdate", "LinearSummary", "Model",
+    "NewtonOptions", "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError",
+    "SensitivityForm", "SolveError", "SolveStatus", "StepSummary", "Stepper", "SweepOptions", "SweepResult",
+    "SweepSummary", "SweepWarning", "Unit", "WorkCounters", "Workspace",
     "analyse_rank", "assemble", "check", "constraint_kinds", "load_scene", "parse_scene", "run_batch", "run_sweep",
     "solve_acceleration", "solve_position", "solve_velocity",
 ]

@@ -55,8 +55,8 @@ py::dict batch_scene(const Scene& scene, const std::vector<std::string>& names,
                      int threads) {
   if (values.ndim() != 2 || values.shape(1) != static_cast<py::ssize_t>(names.size()))
     throw Error("run_batch: the cases' values are " + std::to_string(values.ndim()) + "-dimensional with " +
-                std::to_string(values.ndim() == 2 ? values.shape(1) : 0) + " columns; they need one column for each of the " +
-                std::to_string(names.size()) + " parameter names");
+                std::to_string(values.ndim() == 2 ? values.shape(1) : 0) +
+                " columns; they need one column for each of the " + std::to_string(names.size()) + " parameter names");
   if (threads < 0) throw Error("run_batch: threads must be ≥ 0 (0: all cores), not " + std::to_string(threads));
   const std::size_t n = static_cast<std::size_t>(values.shape(0));
   const double* all_values = values.data();
@@ -64,7 +64,8 @@ py::dict batch_scene(const Scene& scene, const std::vector<std::string>& names,
       sensitivities ? sensitivity_requests(*sensitivities, "run_batch") : std::vector<SensitivityRequest>{};
   const std::vector<std::pair<std::string, py::object>> fields = [&] {
     std::vector<std::pair<std::string, py::object>> f;
-    for (const auto& [name, value] : option_fields) f.emplace_back(name.cast<std::string>(), py::reinterpret_borrow<py::object>(value));
+    for (const auto& [name, value] : option_fields)
+      f.emplace_back(name.cast<std::string>(), py::reinterpret_borrow<py::object>(value));
     return f;
   }();
 
