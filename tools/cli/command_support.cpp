@@ -109,14 +109,16 @@ void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args) {
       ->allow_extra_args(false);
 }
 
-std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets) {
+std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets,
+                                    const std::vector<std::string>& sensitivity_args) {
   try {
-    const SceneOverrides o = parameter_settings(sets);
+    SceneOverrides o = parameter_settings(sets);
+    o.sensitivities = sensitivity_requests(sensitivity_args), o.sensitivities_source = "--sensitivity";
     if (path == "-") return phiq::parse_scene(load_stdin_text(), kStdinScene, SceneLimits{}, o);
     return phiq::load_scene(path, SceneLimits{}, o);
   } catch (const phiq::SceneError& e) {
     fail(e.what(), 2);
-  } catch (const phiq::Error& e) {  // a --set that is not NAME=VALUE
+  } catch (const phiq::Error& e) {  // a --set that is not NAME=VALUE, a --sensitivity STEP that is not a number
     fail(e.what(), 2);
   }
   return std::nullopt;

@@ -44,9 +44,11 @@ std::vector<SensitivityRequest> sensitivity_requests(const std::vector<std::stri
 void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args);
 
 // The scene at `path` ("-": standard input, named kStdinScene), with the parameters `sets` gives
-// (parameter_settings()); on a scene or --set error its one line is printed and the result is empty (the command
-// exits 2).
-std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets = {});
+// (parameter_settings()) and the sensitivities `sensitivity_args` asks for in place of its output.sensitivities
+// (sensitivity_requests(): made as the scene is read, SceneOverrides::sensitivities); on a scene, --set or
+// --sensitivity error its one line is printed and the result is empty (the command exits 2).
+std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets = {},
+                                    const std::vector<std::string>& sensitivity_args = {});
 
 // How the scene given as `path` is named in messages: kStdinScene for "-", else the path.
 inline std::string scene_label(const std::string& path) { return path == "-" ? kStdinScene : path; }

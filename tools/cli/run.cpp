@@ -41,19 +41,10 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     return fail("run: standard output: cannot write: it is closed", 3);
   set_interrupt_subject(scene_path, "; no output written");
   const auto load_start = Clock::now();
-  std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets);
+  // (--sensitivity's parameters in place of the scene's output.sensitivities, whose models are then not made)
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets, sensitivity_args);
   if (!loaded) return 2;
   phiq::Scene& scene = *loaded;
-  if (!sensitivity_args.empty()) {  // instead of the scene's output.sensitivities
-    try {
-      scene.sweep.sensitivities =
-          phiq::sensitivities_of(scene, sensitivity_requests(sensitivity_args), "--sensitivity");
-    } catch (const phiq::SceneError& e) {
-      return fail(e.what(), 2);
-    } catch (const phiq::Error& e) {  // a STEP that is not a number
-      return fail(e.what(), 2);
-    }
-  }
   const double load_s = since(load_start);
 
   // Every output exists (as a temporary, or a device opened) before the solve: an unwritable path fails now, not

@@ -50,7 +50,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     throw Error("SweepOptions: " + why);
   if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
   if (opt.row_buffer_bytes == 0) throw Error("SweepOptions: row_buffer_bytes must be > 0");
-  detail::check_solver_settings(model, opt, opt.points, "SweepOptions");
+  detail::check_solver_settings(model, opt, opt.points, opt.sensitivities, "SweepOptions");
   for (const OutputJoint& j : opt.joints)
     if (j.max_coordinate() >= model.num_coordinates())
       throw Error("SweepOptions: output joint '" + j.name + "' reads a coordinate the model does not have");
@@ -58,8 +58,6 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     for (const Slot& e : o.e)
       if (e.is_coordinate() && e.coord() >= model.num_coordinates())
         throw Error("SweepOptions: output orientation '" + o.name + "' reads a coordinate the model does not have");
-  for (const OutputSensitivity& p : opt.sensitivities)
-    if (const std::string why = check_sensitivity_models(model, p); !why.empty()) throw Error("SweepOptions: " + why);
   if (opt.orientation_form.form != "matrix" && opt.orientation_form.form != "axis_angle" &&
       !is_euler_sequence(opt.orientation_form.form))
     throw Error("SweepOptions: orientation_form '" + opt.orientation_form.form + "' is not matrix, axis_angle or an "
@@ -141,7 +139,9 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
 }  // namespace
 
 void detail::check_solver_settings(const Model& model, const SolverSettings& s, const std::vector<OutputPoint>& points,
-                                   const std::string& who) {
+                                   const std::vector<OutputSensitivity>& sensitivities, const std::string& who) {
+  for (const OutputSensitivity& p : sensitivities)
+    if (const std::string why = check_sensitivity_models(model, p); !why.empty()) throw Error(who + ": " + why);
   if (s.max_subdivisions < 0) throw Error(who + ": max_subdivisions must be >= 0");
   const std::vector<Predictor>& predictors = all_predictors();
   if (std::find(predictors.begin(), predictors.end(), s.predictor) == predictors.end())

@@ -55,14 +55,12 @@ struct Stepper::Impl {
 
 Stepper::Stepper(const Model& model, StepperOptions options) : impl_(std::make_unique<Impl>(model, std::move(options))) {
   const StepperOptions& o = impl_->options;
-  detail::check_solver_settings(model, o, o.points, "StepperOptions");
+  detail::check_solver_settings(model, o, o.points, o.sensitivities, "StepperOptions");
   if (!std::isfinite(o.expected_step) || o.expected_step == 0.0)
     throw Error("StepperOptions: expected_step must be finite and non-zero");
   SweepOptions& s = impl_->sweep;
   static_cast<SolverSettings&>(s) = o;
   s.velocities = o.velocities, s.accelerations = o.accelerations, s.points = o.points;
-  for (const OutputSensitivity& p : o.sensitivities)
-    if (const std::string why = check_sensitivity_models(model, p); !why.empty()) throw Error("StepperOptions: " + why);
   if (o.sensitivity_form != SensitivityForm::kAuto && o.sensitivity_form != SensitivityForm::kDirect)
     throw Error("StepperOptions: sensitivity_form must be auto or direct (a stepper writes no coordinate columns for "
                 "the adjoint form to solve for)");

@@ -121,10 +121,11 @@ struct Run {
   }
 };
 
-// Throws phiq::Error for solver settings no step can honour, and for output points that read a coordinate `model`
-// does not have, naming `who` (the options' type) in the message: run_sweep's checks, and a Stepper's.
+// Throws phiq::Error for solver settings no step can honour, for output points that read a coordinate `model`
+// does not have and for sensitivities whose models do not stand for `model` (check_sensitivity_models()), naming
+// `who` (the options' type) in the message: run_sweep's checks, and a Stepper's.
 void check_solver_settings(const Model& model, const SolverSettings& s, const std::vector<OutputPoint>& points,
-                           const std::string& who);
+                           const std::vector<OutputSensitivity>& sensitivities, const std::string& who);
 
 // Adds the work counted in `now` since `before` to `into`.
 inline void add_counters(WorkCounters& into, const WorkCounters& now, const WorkCounters& before) {

@@ -120,15 +120,15 @@ struct FlatFollowerSpec {
     const kin::V2 cv[3] = {g.c, g.w, g.w2}, wv[3] = {g.w, g.w2, g.w3};
     detail::carried_along_curve(cv, wb, ab, sd, sdd, c);
     detail::carried_along_curve(wv, wb, ab, sd, sdd, w);
-    auto translation = [&](const Frame2& f, int k) {
-      const double* v = k == 0 ? q : k == 1 ? qd : qdd;
-      return k == 0 ? kin::V2{f.x.of(v), f.y.of(v)} : kin::V2{f.x.rate(v), f.y.rate(v)};
+    auto translation_rate = [&](const Frame2& f, int k) {  // ṙ (k = 1) or r̈ (k = 2) of a frame's origin
+      const double* v = k == 1 ? qd : qdd;
+      return kin::V2{f.x.rate(v), f.y.rate(v)};
     };
     std::array<kin::V2, 3> h{}, eh{}, hh{}, wh{};
     const double psid_b = rate.on.frame.psi.of(q);
     h[0] = g.h;
     for (int k = 0; k <= order; ++k) {
-      if (k > 0) h[k] = translation(b, k) + c[k] - translation(a, k) - arm[k];
+      if (k > 0) h[k] = translation_rate(b, k) + c[k] - translation_rate(a, k) - arm[k];
       eh[k] = detail::turned_data_derivative(a.psi, axis, rate.a.psi, rate.axis, k, q, qd, qdd);
       hh[k] = psid_b * kin::perp(c[k]) - detail::point_data_derivative(a, sa, rate.a, rate.sa, k, q, qd, qdd);
       wh[k] = psid_b * kin::perp(w[k]);
