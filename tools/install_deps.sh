@@ -1,5 +1,9 @@
 #!/usr/bin/env bash
-# Installs phiq's build and test dependencies from Debian 12's packages (nothing else is downloaded).
+# Installs phiq's dependencies from Debian 12's packages (nothing else is downloaded).
+#   tools/install_deps.sh          what the library, the `phiq` command and the Python package need to build and run
+#                                  (README command 1, tools/setup.sh)
+#   tools/install_deps.sh --test   the above and the test suite's tools: sanitizers, fuzzing, headless Chromium,
+#                                  Node.js and the glTF validator, the benchmark peers (README command 2, tools/test.sh)
 # Idempotent: does nothing when every package is already installed. Needs root (or sudo).
 set -euo pipefail
 
@@ -11,29 +15,32 @@ packages=(
   libyaml-cpp-dev      # scene parser (YAML, with line/column of every node)
   libginac-dev         # exact symbolic derivatives of equation constraints
   libcli11-dev         # command line parser
-  nlohmann-json3-dev   # JSON output (check --json)
-  clang libclang-rt-14-dev  # libFuzzer + AddressSanitizer/UndefinedBehaviorSanitizer build (tests/fuzz)
-  doxygen              # API reference (target phiq_docs)
-  libgtest-dev         # GoogleTest
-  libbenchmark-dev     # Google Benchmark
-  libsimbody-dev       # optional peer for the benchmark (bench/bench_peers.cpp); skipped with a message if absent
-  python3-matplotlib   # tools/plot/plot_bench.py (the figure of bench/README.md); its ctest is skipped if absent
+  nlohmann-json3-dev   # JSON output (check --json, summaries)
   libhdf5-dev          # HDF5 1.10 (serial flavour, C interface): `phiq run -o OUT.h5`, `phiq compare` of HDF5
-  python3-h5py python3-numpy python3-pytest  # tests/python/test_hdf5_output.py; its ctest is skipped if absent
-  python3-dev python3-pybind11 pybind11-dev  # the Python package phiq (engine/python/), for /usr/bin/python3
-  python3-scipy        # phiq's Jacobian in Python is a scipy.sparse.csc_matrix
-  python3-pandas       # SweepResult.to_pandas() (optional for users; its test needs it)
-  mypy                 # stubgen: the package's type stubs (_phiq.pyi); the type-checking test of tests/python
-  help2man             # the man page phiq.1, generated from `phiq --help` at install (skipped with a note if absent)
-  nodejs               # runs the Khronos glTF-Validator on `phiq animate`'s .glb files (ctest gltf_validator), and
-                       # drives Chromium over its DevTools pipe in ctest browser_viewer
   libjs-three          # three.js r111 and its OrbitControls, embedded at build time into `phiq animate -o OUT.html`
-  chromium             # headless browser of ctest browser_viewer (the HTML viewer's pages; skipped if absent)
-  openmpi-bin libopenmpi-dev  # `mpirun -np K phiq batch` (tools/cli/batch_ranks.hpp) and its ctest mpi_batch
-  libmumps-dev         # MUMPS, distributed sparse LU: bench/bench_mumps.cpp against KLU (engine/README.md)
+  openmpi-bin libopenmpi-dev  # `mpirun -np K phiq batch` (tools/cli/batch_ranks.hpp); found at configure time
+  python3-dev python3-pybind11 pybind11-dev  # the Python package phiq (engine/python/), for /usr/bin/python3
+  python3-numpy python3-scipy  # phiq's arrays, and its Jacobian as a scipy.sparse.csc_matrix
+  mypy                 # stubgen: the package's type stubs (_phiq.pyi), made at every build of the module
+  help2man             # the man page phiq.1, generated from `phiq --help` at install
+  libgtest-dev libbenchmark-dev  # GoogleTest and Google Benchmark: found when the tree is configured, so that
+                                 # README command 2 builds in command 1's build directory without reconfiguring it
 )
+test_packages=(
+  clang libclang-rt-14-dev  # libFuzzer + AddressSanitizer/UndefinedBehaviorSanitizer build (tests/fuzz)
+  doxygen              # API reference (target phiq_docs, ctest api_docs)
+  libsimbody-dev       # peer for the benchmark (bench/bench_peers.cpp); skipped with a message if absent
+  libmumps-dev         # MUMPS, distributed sparse LU: bench/bench_mumps.cpp against KLU
+  python3-matplotlib   # tools/plot/plot_bench.py (the figure of bench/README.md)
+  python3-h5py python3-pytest python3-pandas  # the pytest suites (tests/python), HDF5 read back independently
+  nodejs               # the Khronos glTF-Validator on `phiq animate`'s .glb files (ctest gltf_validator), and
+                       # Chromium driven over its DevTools pipe (ctest browser_viewer)
+  chromium             # headless browser of ctest browser_viewer (the HTML viewer's pages)
+)
+test=0
+if [ "${1:-}" = "--test" ]; then test=1; packages+=("${test_packages[@]}"); fi
 # npm (Debian's package, unless a node install already brings its own) installs the validator below
-command -v npm >/dev/null 2>&1 || packages+=(npm)
+if [ "$test" = 1 ] && ! command -v npm >/dev/null 2>&1; then packages+=(npm); fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -49,6 +56,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
+[ "$test" = 1 ] || exit 0
 
 # The Khronos glTF-Validator (npm package gltf-validator, a fixed version) into tools/gltf_validator/, beside the
 # sources and ignored by git: the tests run it from there and download nothing themselves.

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# README command (1): install the dependencies, build phiq (Release, in build/), install its Python package, and run
-# the default scene.
+# README command (1): install what phiq needs, build the library, the `phiq` command and the Python package (Release,
+# in build/), install the package for /usr/bin/python3, and run the default scene. The tests and benchmarks are
+# built by README command (2), tools/test.sh, in the same build directory.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+source "$root/tools/build_config.sh"
 "$root/tools/install_deps.sh"
-cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$root/build" -j "$(nproc)"
+phiq_configure_release "$root"
+cmake --build "$root/build" -j "$(nproc)" --target phiq phiq_python
 # The Python package, where Debian's /usr/bin/python3 finds it in a fresh shell: /usr/local as root, else the
 # user's ~/.local (engine/python/README.md).
 if [ "$(id -u)" -eq 0 ]; then py_prefix=/usr/local; else py_prefix="$HOME/.local"; fi

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # README command (2): the whole test suite. .ci/run calls it.
-#   tools/test.sh            1. Release build (build/) and its ctest suite, with the installed-package consumer,
-#                               the regression comparisons and the benchmark smoke run;
+#   tools/test.sh            0. the test-only packages (tools/install_deps.sh --test);
+#                            1. Release build (build/, as tools/setup.sh configures it) and its ctest suite, with the
+#                               installed-package consumer, the regression comparisons and the benchmark smoke run;
 #                            2. the same suite built with clang under AddressSanitizer + UndefinedBehaviorSanitizer
 #                               (build-asan/), preceded by bounded libFuzzer runs: the scene loader (40 s), then the
 #                               expression compiler (20 s).
@@ -13,10 +14,10 @@ quick=0
 if [ "${1:-}" = "--quick" ]; then quick=1; shift; fi
 jobs="$(nproc)"
 
-"$root/tools/install_deps.sh"
-# Both configurations are unity builds (CMake joins each target's files in groups of 8, the tests' too):
-# the headers, CLI11's and Eigen's inline code above all, compiled once a group rather than once a file.
-cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON >/dev/null
+source "$root/tools/build_config.sh"
+"$root/tools/install_deps.sh" --test
+# build/ as README command (1) configured it: what that command built is not compiled again.
+phiq_configure_release "$root"
 cmake --build "$root/build" -j "$jobs"
 (cd "$root/build" && ctest --output-on-failure -j "$jobs" "$@")
 [ "$quick" = 1 ] && exit 0
