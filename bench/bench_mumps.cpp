@@ -1,6 +1,6 @@
 // MUMPS (the distributed multifrontal LU of Debian's libmumps-dev, on MPI ranks) against phiq's KLU on the same
 // Jacobian: the nfourbar model of N loops (2N + 3 coordinates) at its first position, the matrix every drive step
-// of a sweep factorises. What engine/README.md's paper on one model larger than one machine is grounded on.
+// of a sweep factorises. What engine/README.md's note on one model larger than one machine is grounded on.
 //
 //   mpirun -np R build/bench/phiq_bench_mumps N [REPEATS]
 //

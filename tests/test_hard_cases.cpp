@@ -446,7 +446,7 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
 }
 
 // What a workspace carries between sweeps (the LU's pivot order, the Newton contraction) may move the last bits of
-// rows at their rounding level (engine/README.md, Thread safety: Reproducibility); a fresh workspace on one thread
+// rows at their rounding level (engine/README.md, Threads and reproducibility); a fresh workspace on one thread
 // repeats the sweep to the bit. The 2000-stage lift at a tolerance below its rounding, where every row ends at the
 // level its last bits set: q, q̇ and q̈ of every row identical in two sweeps, each from a fresh workspace.
 TEST(HardCases, AFreshWorkspaceOnOneThreadRepeatsASweepToTheBit) {

@@ -1,4 +1,4 @@
-// The pieces of the extension module phiq._phiq, one file per pipeline stage (model, scene, solve, sweep), and
+// The pieces of the extension module phiq._phiq, one file per part (module.cpp binds the seven of them), and
 // what they share: the conversions of coordinate vectors, with their size checked against the model.
 #pragma once
 
