@@ -136,14 +136,16 @@ def test_tools_readme_names_every_option_and_no_other():
     named = set(re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", text))
     every = set().union(*options.values()) | {"--help", "--version"}
     assert not (every - named), f"tools/README.md does not document {sorted(every - named)}"
-    # Options of the scripts it documents (tools/*.sh, tools/*/*.py) are named too: they must exist in one of them.
+    # An option a table of it documents (first cell of a row) belongs to a command or to one of tools/' scripts.
     scripts = ""
-    for p in list(tree_files(suffixes=(".sh", ".py"))):
-        if rel(p).startswith("tools/"):
+    for p in tree_files(suffixes=(".sh", ".py")):
+        if rel(p).startswith("tools" + os.sep):
             with open(p, encoding="utf-8") as f:
                 scripts += f.read()
-    unknown = sorted(o for o in named - every if o not in scripts)
-    assert not unknown, f"tools/README.md names options no command or script has: {unknown}"
+    tabled = {o for line in text.splitlines() if line.startswith("|")
+              for o in re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", line.split("|")[1])}
+    unknown = sorted(o for o in tabled - every if o not in scripts)
+    assert not unknown, f"tools/README.md documents options no command or script has: {unknown}"
 
 
 # `phiq COMMAND ... --option` written on one line of a README (a command line in a code block or in the text)
