@@ -31,17 +31,13 @@ LONG_FUNCTIONS = {
     ("engine/src/sweep/parallel_sweep.cpp", "parallel_sweep"): 440,
     ("tools/cli/batch_file.cpp", "batch_to_one_file"): 345,
     ("tools/cli/tolerance.cpp", "cmd_tolerance"): 292,
-    ("engine/src/solve/kinematics.cpp", "solve_position"): 281,
     ("tools/cli/batch.cpp", "cmd_batch"): 224,
-    ("tools/accuracy/sweep_accuracy.cpp", "measure_accuracy"): 220,
     ("tools/animate/gltf_motion.cpp", "motion_glb"): 211,
     ("tools/cli/run.cpp", "cmd_run"): 198,
     ("engine/src/sweep/predictors.cpp", "Sweeper::predict"): 198,
     ("tools/plot/plot_svg.cpp", "plot_svg"): 183,
     ("tools/animate/html_motion.cpp", "viewer_motion"): 161,
-    ("engine/python/src/bind_model.cpp", "bind_model"): 158,
     ("engine/src/sweep/singular_positions.cpp", "Sweeper::singular_point"): 156,
-    ("engine/python/src/bind_solve.cpp", "bind_solve"): 152,
 }
 
 # (document, unit, budget): README.md and tests/README.md in words, bench/README.md in lines (issue "the first

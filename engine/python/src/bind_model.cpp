@@ -46,9 +46,8 @@ void state_property(py::class_<Workspace>& c, const char* name, const char* doc)
       py::return_value_policy::reference_internal, doc);
 }
 
-}  // namespace
-
-void bind_model(py::module_& m) {
+// Unit, SolveStatus and ConstraintInfo: what the model's and the solves' answers are made of.
+void bind_vocabulary(py::module_& m) {
   py::enum_<Unit>(m, "Unit", "What a coordinate or a constraint row measures.")
       .value("NONE", Unit::kNone, "unknown or unitless: compared with the tolerance itself")
       .value("LENGTH", Unit::kLength, "metres: compared with the tolerance times its length scale")
@@ -83,7 +82,9 @@ void bind_model(py::module_& m) {
         return "ConstraintInfo(name='" + c.name + "', kind='" + std::string(c.kind) + "', first_row=" +
                std::to_string(c.first_row) + ", rows=" + std::to_string(c.rows) + ")";
       });
+}
 
+void bind_model_class(py::module_& m) {
   py::class_<Model>(m, "Model",
                     "An immutable mechanism: coordinates, constraints, the fixed pattern of Φq and its symbolic "
                     "analysis. Obtained from a Scene (load_scene, parse_scene, SceneBuilder.build); it lives as "
@@ -159,7 +160,10 @@ void bind_model(py::module_& m) {
                std::to_string(md.num_equations()) + " equations, " + std::to_string(md.constraints().size()) +
                " constraints>";
       });
+}
 
+// The Workspace with its counters, and the registry's list of kinds.
+void bind_workspace(py::module_& m) {
   py::class_<WorkCounters>(m, "WorkCounters", "Work done, counted where it happens.")
       .def_readonly("newton_iterations", &WorkCounters::newton_iterations, "Newton steps")
       .def_readonly("residual_evaluations", &WorkCounters::residual_evaluations, "evaluations of Φ (line-search trials included)")
@@ -205,6 +209,15 @@ void bind_model(py::module_& m) {
       },
       "Every scene form of every constraint kind in phiq's registry: dicts of kind, section ('constraints', "
       "'drivers', 'bodies', 'vectors'), type, dimension (2 or 3) and a one-line example of the scene entry.");
+}
+
+}  // namespace
+
+// In this order: a type is bound before the signatures that name it.
+void bind_model(py::module_& m) {
+  bind_vocabulary(m);
+  bind_model_class(m);
+  bind_workspace(m);
 }
 
 }  // namespace phiq::python

@@ -18,9 +18,8 @@ void check_workspace(const Model& model, const Workspace& ws) {
   if (&ws.model() != &model) throw Error("workspace was made for another model");
 }
 
-}  // namespace
-
-void bind_solve(py::module_& m) {
+// The three problems: their options, summaries and solves.
+void bind_kinematics(py::module_& m) {
   py::enum_<JacobianUpdate>(m, "JacobianUpdate", "Which matrix each Newton iteration solves with.")
       .value("EVERY_ITERATION", JacobianUpdate::kEveryIteration, "full Newton: Φq factorised at every iterate")
       .value("WHEN_SLOW", JacobianUpdate::kWhenSlow,
@@ -110,7 +109,10 @@ void bind_solve(py::module_& m) {
       },
       py::arg("model"), py::arg("t"), py::arg("workspace"), py::arg("tolerance") = DerivativeOptions{}.tolerance,
       "Solve Φq q̈ = γ at workspace.q, workspace.qd into workspace.qdd (q checked as in solve_velocity).");
+}
 
+// The rank analysis and the minimum-norm assembly.
+void bind_rank_and_assembly(py::module_& m) {
   py::class_<RankReport>(m, "RankReport", "Rank and redundancy of the constraint equations at one configuration.")
       .def_readonly("coordinates", &RankReport::coordinates, "n")
       .def_readonly("equations", &RankReport::equations, "m, all rows (kinematic and rheonomic)")
@@ -171,6 +173,13 @@ void bind_solve(py::module_& m) {
       [](const Model& model, const PositionSummary& s) { return worst_rows(model, s.worst_rows); },
       py::arg("model"), py::arg("summary"),
       "The worst rows at the end of a position solve: (row name, |Φ_i| / scale_i), largest first.");
+}
+
+}  // namespace
+
+void bind_solve(py::module_& m) {
+  bind_kinematics(m);
+  bind_rank_and_assembly(m);
 }
 
 }  // namespace phiq::python

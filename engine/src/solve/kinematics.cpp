@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 namespace phiq {
@@ -217,69 +218,114 @@ std::string PositionSummary::BriefReport() const {
   return s.str();
 }
 
-SolveStatus solve_position(const Model& model, double t, const NewtonOptions& opt, Workspace& ws,
-                           PositionSummary* summary) {
-  check_workspace(model, ws);
-  detail::check_newton_options(opt);
-  PositionSummary local;
-  PositionSummary& sum = summary ? *summary : local;
-  sum = PositionSummary{};
+namespace {
+
+// One position solve, in the parts of a Newton iteration: the start, the tests before a step, the factorisation,
+// the step with the test of a reused matrix, the line search, the stop at the rounding level and the acceptance of
+// a step. The members are what an iteration hands to the next.
+class PositionSolve {
+ public:
+  PositionSolve(const Model& model, double t, const NewtonOptions& opt, Workspace& ws, PositionSummary& sum)
+      : model_(model), t_(t), opt_(opt), ws_(ws), sum_(sum), carried_theta_(ws.newton_contraction) {}
+  SolveStatus run();
+
+ private:
+  // One iteration's step from the current iterate to its trial point (ws.trial, ws.trial_phi).
+  struct Step {
+    StepPass full;             // the full step's measures
+    double theta = -1.0;       // contraction θ = ‖Δq_k‖ / ‖Δq_k−1‖ in the tolerance-scaled norm (−1: unknown)
+    double eta = 1.0;          // error of the new iterate per unit of the step: θ/(1−θ) where θ is known
+    double alpha = 1.0;        // the line search's fraction of the full step
+    double size = 0.0;         // the step in units of the tolerance test
+    double error = 0.0;        // the trial's estimated error, min(η, 1) times that
+    ResidualCheck trial;       // of the trial point
+    bool with_jacobian = false;  // Φq evaluated at the trial
+    bool known_ok = false;       // a full step whose error is within NewtonOptions::known_to
+    bool refresh = false;        // a reused matrix to be replaced at this iterate
+  };
+
+  SolveStatus finish(SolveStatus st, std::string msg);
+  std::optional<SolveStatus> start();
+  std::optional<SolveStatus> stop_before_step(int it);
+  std::optional<SolveStatus> factorize_unless_reused();
+  std::optional<SolveStatus> newton_step(Step& s);
+  std::optional<SolveStatus> line_search(Step& s);
+  SolveStatus stop_at_rounding_level(bool known_before, const Step& s, int it);
+  bool accept(const Step& s);
+  void refresh_matrix() { reuse_ = false, prev_norm_ = -1.0; }
+
+  const Model& model_;
+  const double t_;
+  const NewtonOptions& opt_;
+  Workspace& ws_;
+  PositionSummary& sum_;
   // The contraction last observed with a reused factorisation, if any: it estimates the error of the first step of
   // this solve (same age of the matrix in a sweep). It is kept until a solve measures it again — a solve accepted
   // without a step, or one that refactorised at once, says nothing new about it — and dropped on a failure.
-  const double carried_theta = ws.newton_contraction;
-
+  const double carried_theta_;
   // Whether ws.jacobian_values hold Φq at the current iterate (evaluated with Φ at the accepted trial point and
   // not yet factorised): the loop knows it without comparing points; the point is recorded once, at the end.
-  ws.has_jacobian = false;
-  ws.factorized_at_solution = false;
-  ws.factorized_solves_to = std::numeric_limits<double>::quiet_NaN();
-  bool jacobian_at_q = false;
-
-  bool factorized_here = false;  // this solve factorised (at an iterate whose point is not recorded)
-  double drift = 0.0;            // sum of the steps' sizes (tolerance units) since that factorisation
+  bool jacobian_at_q_ = false;
+  bool factorized_here_ = false;  // this solve factorised (at an iterate whose point is not recorded)
+  double drift_ = 0.0;            // sum of the steps' sizes (tolerance units) since that factorisation
   // The solve stopped at its rounding level after a step from a point within the tolerance of that factorisation:
   // the step is the rounding itself, q is known no better than its size, and the factorisation is Φq at the
   // solution to that accuracy (see stop_at_rounding_level).
-  bool factorized_at_rounding_level = false;
-  ResidualCheck check;  // of the current iterate (its worst row is the residual reported on success)
-  auto finish = [&](SolveStatus st, std::string msg) {
-    sum.status = st;
-    if (st != SolveStatus::kSuccess) ws.newton_contraction = -1.0;
-    if (st == SolveStatus::kSuccess) {
-      sum.residual = check.worst;  // max_i |Φ_i| / scale_i, from the pass that tested it
-      // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
-      // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
-      // Otherwise they factorise at the solution, from the Jacobian evaluated there with Φ if there is one.
-      if (factorized_here ? ws.has_factorization && (drift <= 1.0 || factorized_at_rounding_level)
-                          : ws.has_factorization && ws.factorized_t == t && ws.factorized_q.size() == ws.q.size() &&
-                                step_within(model, ws.q - ws.factorized_q, ws.q, opt.tolerance, 1.0)) {
-        ws.factorized_q = ws.q;
-        ws.factorized_t = t;
-        ws.factorized_at_solution = true;
-      } else if (jacobian_at_q) {
-        ws.jacobian_q = ws.q;
-        ws.jacobian_t = t;
-        ws.has_jacobian = true;
-      }
-      return st;
-    }
-    sum.worst_rows = worst_rows(model, ws.phi, 3);
-    sum.residual = sum.worst_rows.empty() ? 0.0 : sum.worst_rows[0].second;
-    sum.message = std::move(msg);
-    if (!sum.worst_rows.empty()) sum.message += "; worst constraints: " + describe_rows(model, sum.worst_rows);
-    return st;
-  };
+  bool factorized_at_rounding_level_ = false;
+  ResidualCheck check_;  // of the current iterate (its worst row is the residual reported on success)
+  bool step_ok_ = false;
+  // Modified Newton reuses the workspace's factorisation until it contracts badly; then (and always for full
+  // Newton) every iteration factorises at its iterate.
+  bool reuse_ = false;
+  double prev_norm_ = -1.0;   // scaled size of the previous step taken with the same kind of matrix
+  double theta_seen_ = -1.0;  // largest contraction observed with the reused matrix in this solve
+  int reused_steps_ = 1;      // steps taken with the reused matrix once a contraction is known
+  static constexpr int kMaxReusedSteps = 4;
+  int stagnant_ = 0;              // consecutive fresh-matrix steps that contracted by ½ or worse
+  double accepted_error_ = -1.0;  // newton_step's error estimate of the current iterate (units of the tolerance test)
+};
 
-  if (!ws.lu) {
-    model.residual(ws.q.data(), t, ws.phi.data());
-    return finish(SolveStatus::kNotSquare, not_square_message(model));
+SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
+  sum_.status = st;
+  if (st != SolveStatus::kSuccess) ws_.newton_contraction = -1.0;
+  if (st == SolveStatus::kSuccess) {
+    sum_.residual = check_.worst;  // max_i |Φ_i| / scale_i, from the pass that tested it
+    // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
+    // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
+    // Otherwise they factorise at the solution, from the Jacobian evaluated there with Φ if there is one.
+    if (factorized_here_ ? ws_.has_factorization && (drift_ <= 1.0 || factorized_at_rounding_level_)
+                         : ws_.has_factorization && ws_.factorized_t == t_ && ws_.factorized_q.size() == ws_.q.size() &&
+                               step_within(model_, ws_.q - ws_.factorized_q, ws_.q, opt_.tolerance, 1.0)) {
+      ws_.factorized_q = ws_.q;
+      ws_.factorized_t = t_;
+      ws_.factorized_at_solution = true;
+    } else if (jacobian_at_q_) {
+      ws_.jacobian_q = ws_.q;
+      ws_.jacobian_t = t_;
+      ws_.has_jacobian = true;
+    }
+    return st;
   }
-  if (!all_finite(ws.q)) {
-    ws.phi.setConstant(std::numeric_limits<double>::quiet_NaN());
+  sum_.worst_rows = worst_rows(model_, ws_.phi, 3);
+  sum_.residual = sum_.worst_rows.empty() ? 0.0 : sum_.worst_rows[0].second;
+  sum_.message = std::move(msg);
+  if (!sum_.worst_rows.empty()) sum_.message += "; worst constraints: " + describe_rows(model_, sum_.worst_rows);
+  return st;
+}
+
+// The start point: Φ there (and Φq where it will be factorised), or the solve's end when it cannot start.
+std::optional<SolveStatus> PositionSolve::start() {
+  ws_.has_jacobian = false;
+  ws_.factorized_at_solution = false;
+  ws_.factorized_solves_to = std::numeric_limits<double>::quiet_NaN();
+  if (!ws_.lu) {
+    model_.residual(ws_.q.data(), t_, ws_.phi.data());
+    return finish(SolveStatus::kNotSquare, not_square_message(model_));
+  }
+  if (!all_finite(ws_.q)) {
+    ws_.phi.setConstant(std::numeric_limits<double>::quiet_NaN());
     return finish(SolveStatus::kNonFinite, "starting point has non-finite coordinates");
   }
-
   // Φq comes with Φ (one pass over the constraints instead of two) at every point where it will be factorised: the
   // start and each trial when the next iteration factorises at its iterate (full Newton; modified Newton once it
   // has refreshed), unless the trial's step already passes the tolerance (it is then expected to be the solution);
@@ -287,217 +333,253 @@ SolveStatus solve_position(const Model& model, double t, const NewtonOptions& op
   // velocities follow). A wrong guess costs one separate Jacobian evaluation, or one wasted. The trial's Φq goes
   // straight into jacobian_values: once the iterate's own Φq is factorised nothing needs it, and where it is not
   // (jacobian_at_q, a reused matrix) a rejected trial only costs its evaluation again — no second array of Φq.
-  bool step_ok = false;
-  // Modified Newton reuses the workspace's factorisation until it contracts badly; then (and always for full
-  // Newton) every iteration factorises at its iterate.
-  bool reuse = opt.jacobian_update == JacobianUpdate::kWhenSlow && ws.has_factorization;
+  reuse_ = opt_.jacobian_update == JacobianUpdate::kWhenSlow && ws_.has_factorization;
   // The start point too: where its first iteration will factorise there anyway, Φq comes with Φ; and where the
   // caller factorises next (velocities follow) at a start its estimate expects to be accepted as it is.
-  const bool start_expected = opt.jacobian_with_residual && opt.start_error >= 0.0 && opt.start_error <= 1.0;
-  if (!reuse || start_expected) {
-    model.residual_and_jacobian(ws.q.data(), t, ws.phi.data(), ws.jacobian_values.data());
-    ++ws.counters.jacobian_evaluations;
-    jacobian_at_q = true;
+  const bool start_expected = opt_.jacobian_with_residual && opt_.start_error >= 0.0 && opt_.start_error <= 1.0;
+  if (!reuse_ || start_expected) {
+    model_.residual_and_jacobian(ws_.q.data(), t_, ws_.phi.data(), ws_.jacobian_values.data());
+    ++ws_.counters.jacobian_evaluations;
+    jacobian_at_q_ = true;
   } else {
-    model.residual(ws.q.data(), t, ws.phi.data());
+    model_.residual(ws_.q.data(), t_, ws_.phi.data());
   }
-  ++ws.counters.residual_evaluations;
-  check = check_residual(model, ws.phi, opt.tolerance, ws.q, t);
-  double prev_norm = -1.0;   // scaled size of the previous step taken with the same kind of matrix
-  double theta_seen = -1.0;  // largest contraction observed with the reused matrix in this solve
-  int reused_steps = 1;      // steps taken with the reused matrix once a contraction is known
-  constexpr int kMaxReusedSteps = 4;
-  int stagnant = 0;  // consecutive fresh-matrix steps that contracted by ½ or worse
-  double accepted_error = -1.0;  // take_step's error estimate of the current iterate (units of the tolerance test)
-  // The iteration limit counts steps taken; a step discarded to refresh a reused factorisation does not count.
-  for (;;) {
-    const int it = sum.iterations;
-    if (!check.finite) return finish(SolveStatus::kNonFinite, "constraint residual is not finite");
-    const bool within = check.within;
-    if (within && (it == 0 ? !(opt.start_error > 1.0) : step_ok)) {
-      if (theta_seen >= 0.0) ws.newton_contraction = theta_seen;
-      sum.error_estimate = it == 0 ? opt.start_error : accepted_error;
-      return finish(SolveStatus::kSuccess, "");
-    }
-    // The residual holds but the steps have stopped shrinking fast: full-Newton steps contracting by ½ or worse
-    // twice in a row (linear convergence at a singular position, or steps at the rounding level of an
-    // ill-conditioned Φq), or the iteration limit reached. More iterations would not make q more accurate.
-    if (it > 0 && (it >= opt.max_iterations || stagnant >= 2) && within) {
-      sum.slow_convergence = sum.linear_convergence = true;
-      sum.error_estimate = accepted_error;
-      (void)finish(SolveStatus::kSuccess, "");  // (returned below, after its message)
-      sum.message = "residual within tolerance but the Newton steps stopped converging quadratically (a singular "
-                    "position, or Φq too ill-conditioned for this tolerance)";
-      return SolveStatus::kSuccess;
-    }
-    if (it >= opt.max_iterations)
-      return finish(SolveStatus::kNotConverged,
-                    "Newton did not converge in " + std::to_string(opt.max_iterations) + " iterations");
+  ++ws_.counters.residual_evaluations;
+  check_ = check_residual(model_, ws_.phi, opt_.tolerance, ws_.q, t_);
+  return std::nullopt;
+}
 
-    std::string msg;
-    if (!reuse) {
-      // Φq at this iterate, unless the factors are there already. Its point is not copied per iteration: the loop
-      // counts how far it has moved since (drift), and records it once, at the end, if that is the solution.
-      SolveStatus st = SolveStatus::kSuccess;
-      if (!factors_at_q(ws, t)) {
-        st = factorize_at_q(model, t, ws, &sum.rcond, &msg, jacobian_at_q);
-        ws.factorized_t = std::numeric_limits<double>::quiet_NaN();  // point not recorded (yet)
-        if (st == SolveStatus::kSuccess) ++sum.factorizations;
-      } else {
-        sum.rcond = ws.lu->rcond();
-      }
-      jacobian_at_q = false;  // factorised (or failed): jacobian_values are no longer news
-      if (st != SolveStatus::kSuccess) return finish(st, msg);
-      factorized_here = true;
-      drift = 0.0;
+// The tests at an iterate before its step: accepted, converging too slowly to go on, or out of iterations. The
+// iteration limit counts steps taken; a step discarded to refresh a reused factorisation does not count.
+std::optional<SolveStatus> PositionSolve::stop_before_step(int it) {
+  if (!check_.finite) return finish(SolveStatus::kNonFinite, "constraint residual is not finite");
+  const bool within = check_.within;
+  if (within && (it == 0 ? !(opt_.start_error > 1.0) : step_ok_)) {
+    if (theta_seen_ >= 0.0) ws_.newton_contraction = theta_seen_;
+    sum_.error_estimate = it == 0 ? opt_.start_error : accepted_error_;
+    return finish(SolveStatus::kSuccess, "");
+  }
+  // The residual holds but the steps have stopped shrinking fast: full-Newton steps contracting by ½ or worse
+  // twice in a row (linear convergence at a singular position, or steps at the rounding level of an
+  // ill-conditioned Φq), or the iteration limit reached. More iterations would not make q more accurate.
+  if (it > 0 && (it >= opt_.max_iterations || stagnant_ >= 2) && within) {
+    sum_.slow_convergence = sum_.linear_convergence = true;
+    sum_.error_estimate = accepted_error_;
+    (void)finish(SolveStatus::kSuccess, "");  // (returned below, after its message)
+    sum_.message = "residual within tolerance but the Newton steps stopped converging quadratically (a singular "
+                   "position, or Φq too ill-conditioned for this tolerance)";
+    return SolveStatus::kSuccess;
+  }
+  if (it >= opt_.max_iterations)
+    return finish(SolveStatus::kNotConverged,
+                  "Newton did not converge in " + std::to_string(opt_.max_iterations) + " iterations");
+  return std::nullopt;
+}
+
+// Φq factorised at this iterate unless a reused matrix serves or its factors are there already. Its point is not
+// copied per iteration: the loop counts how far it has moved since (drift), and records it once, at the end, if
+// that is the solution.
+std::optional<SolveStatus> PositionSolve::factorize_unless_reused() {
+  if (reuse_) {
+    sum_.rcond = ws_.lu->rcond();
+    return std::nullopt;
+  }
+  std::string msg;
+  SolveStatus st = SolveStatus::kSuccess;
+  if (!factors_at_q(ws_, t_)) {
+    st = factorize_at_q(model_, t_, ws_, &sum_.rcond, &msg, jacobian_at_q_);
+    ws_.factorized_t = std::numeric_limits<double>::quiet_NaN();  // point not recorded (yet)
+    if (st == SolveStatus::kSuccess) ++sum_.factorizations;
+  } else {
+    sum_.rcond = ws_.lu->rcond();
+  }
+  jacobian_at_q_ = false;  // factorised (or failed): jacobian_values are no longer news
+  if (st != SolveStatus::kSuccess) return finish(st, msg);
+  factorized_here_ = true;
+  drift_ = 0.0;
+  return std::nullopt;
+}
+
+// The Newton step and its full trial point, with the test of a reused matrix (s.refresh: replace it here).
+std::optional<SolveStatus> PositionSolve::newton_step(Step& s) {
+  // ws.step = Φq⁻¹Φ: the Newton step is −ws.step (no negated copy of Φ; the LU's rounding is sign-symmetric)
+  if (!ws_.lu->solve(solve_rhs(model_, ws_, ws_.phi), ws_.step.data()))
+    return finish(SolveStatus::kLinearSolverFailed, "sparse solve failed: " + ws_.lu->last_message());
+  // the full step's trial point and measures in one pass (the trial is wasted when the matrix is refreshed)
+  s.full = take_step(model_, ws_.q, ws_.step, 1.0, opt_.tolerance, ws_.trial);
+  if (!s.full.finite) {
+    if (reuse_) {  // an old factorisation may be singular where the current iterate is not
+      s.refresh = true;
+      return std::nullopt;
+    }
+    std::string why = non_finite_jacobian_at(model_, ws_.q.data(), t_);
+    if (!why.empty()) return finish(SolveStatus::kNonFinite, why);
+    return finish(SolveStatus::kSingularJacobian, "Newton step is not finite (Jacobian numerically singular)");
+  }
+  // A reused matrix that contracts worse than max_contraction is replaced by a fresh one at this iterate (the step
+  // just computed is discarded).
+  s.theta = prev_norm_ > 0.0 ? s.full.norm / prev_norm_ : (reuse_ && carried_theta_ >= 0.0 ? 2.0 * carried_theta_ : -1.0);
+  if (reuse_ && prev_norm_ > 0.0) {
+    theta_seen_ = std::max(theta_seen_, s.theta);
+    // Refresh on a slow contraction, or when the steps left (the iteration limit, or kMaxReusedSteps: a
+    // factorisation costs about two solves) cannot reach the tolerance at this rate: after j more steps the
+    // error is about θ^(j+1)/(1−θ)·|Δq| (Hairer & Wanner IV.8), or the level q is known to (known_to).
+    ++reused_steps_;
+    const int left = std::min(opt_.max_iterations - sum_.iterations - 1, kMaxReusedSteps - reused_steps_);
+    if (s.theta > opt_.max_contraction || left < 0 ||
+        !(std::pow(s.theta, left + 1) / (1.0 - s.theta) * s.full.size <= std::max(1.0, opt_.known_to)))
+      s.refresh = true;
+  }
+  // Error of the new iterate: θ/(1−θ)·|Δq| where a contraction is known, else the step itself.
+  s.eta = (s.theta >= 0.0 && s.theta < 1.0) ? s.theta / (1.0 - s.theta) : 1.0;
+  return std::nullopt;
+}
+
+// Backtracking on the scaled merit: a full step whenever it helps, a shorter one from a rough placement. A reused
+// matrix whose full step does not decrease the merit is refreshed rather than backtracked along (s.refresh).
+std::optional<SolveStatus> PositionSolve::line_search(Step& s) {
+  for (int bt = 0;; ++bt) {
+    s.size = bt == 0 ? s.full.size : take_step(model_, ws_.q, ws_.step, s.alpha, opt_.tolerance, ws_.trial).size;
+    s.error = std::min(s.eta, 1.0) * s.size;
+    step_ok_ = s.error <= 1.0;
+    s.known_ok = bt == 0 && s.error <= opt_.known_to;
+    s.with_jacobian = step_ok_ || s.known_ok ? opt_.jacobian_with_residual : !reuse_;
+    if (s.with_jacobian) {
+      model_.residual_and_jacobian(ws_.trial.data(), t_, ws_.trial_phi.data(), ws_.jacobian_values.data());
+      jacobian_at_q_ = false;  // the values are the trial's now
+      ++ws_.counters.jacobian_evaluations;
     } else {
-      sum.rcond = ws.lu->rcond();
+      model_.residual(ws_.trial.data(), t_, ws_.trial_phi.data());
     }
-    // ws.step = Φq⁻¹Φ: the Newton step is −ws.step (no negated copy of Φ; the LU's rounding is sign-symmetric)
-    if (!ws.lu->solve(solve_rhs(model, ws, ws.phi), ws.step.data()))
-      return finish(SolveStatus::kLinearSolverFailed, "sparse solve failed: " + ws.lu->last_message());
-    // the full step's trial point and measures in one pass (the trial is wasted when the matrix is refreshed)
-    const StepPass full_step = take_step(model, ws.q, ws.step, 1.0, opt.tolerance, ws.trial);
-    const double norm = full_step.norm;
-    if (!full_step.finite) {
-      if (reuse) {  // an old factorisation may be singular where the current iterate is not
-        reuse = false, prev_norm = -1.0;
-        continue;
-      }
-      std::string why = non_finite_jacobian_at(model, ws.q.data(), t);
-      if (!why.empty()) return finish(SolveStatus::kNonFinite, why);
-      return finish(SolveStatus::kSingularJacobian, "Newton step is not finite (Jacobian numerically singular)");
+    ++ws_.counters.residual_evaluations;
+    s.trial = check_residual(model_, ws_.trial_phi, opt_.tolerance, ws_.trial, t_);
+    if (!opt_.line_search || s.trial.merit <= (1.0 - 1e-4 * s.alpha) * check_.merit || s.trial.within)
+      return std::nullopt;
+    if (reuse_) {
+      s.refresh = true;
+      return std::nullopt;
     }
-    // Contraction θ = ‖Δq_k‖ / ‖Δq_k−1‖ in the tolerance-scaled norm. A reused matrix that contracts worse than
-    // max_contraction is replaced by a fresh one at this iterate (the step just computed is discarded).
-    double theta = prev_norm > 0.0 ? norm / prev_norm : (reuse && carried_theta >= 0.0 ? 2.0 * carried_theta : -1.0);
-    if (reuse && prev_norm > 0.0) {
-      theta_seen = std::max(theta_seen, theta);
-      // Refresh on a slow contraction, or when the steps left (the iteration limit, or kMaxReusedSteps: a
-      // factorisation costs about two solves) cannot reach the tolerance at this rate: after j more steps the
-      // error is about θ^(j+1)/(1−θ)·|Δq| (Hairer & Wanner IV.8), or the level q is known to (known_to).
-      ++reused_steps;
-      const int left = std::min(opt.max_iterations - sum.iterations - 1, kMaxReusedSteps - reused_steps);
-      if (theta > opt.max_contraction || left < 0 ||
-          !(std::pow(theta, left + 1) / (1.0 - theta) * full_step.size <= std::max(1.0, opt.known_to))) {
-        reuse = false, prev_norm = -1.0;
-        continue;
-      }
+    if (bt >= opt_.max_backtracks) {
+      return finish(SolveStatus::kNotConverged,
+                    "no decrease of the residual along the Newton direction (the constraints may have no "
+                    "solution near this guess)");
     }
+    s.alpha *= 0.5;
+    ++sum_.backtracks;
+  }
+}
 
-    // Error of the new iterate: θ/(1−θ)·|Δq| where a contraction is known, else the step itself.
-    const double eta = (theta >= 0.0 && theta < 1.0) ? theta / (1.0 - theta) : 1.0;
-    // Backtracking on the scaled merit: a full step whenever it helps, a shorter one from a rough placement. A
-    // reused matrix whose full step does not decrease the merit is refreshed rather than backtracked along.
-    double alpha = 1.0;
-    double step_size = 0.0;   // the step in units of the tolerance test
-    double step_error = 0.0;  // the trial's estimated error, θ/(1−θ) times that
-    ResidualCheck trial_check;
-    bool with_jacobian = false;  // Φq evaluated at the trial
-    bool known_ok = false;       // a full step whose error is within NewtonOptions::known_to
-    bool refresh = false;
-    for (int bt = 0;; ++bt) {
-      step_size = bt == 0 ? full_step.size : take_step(model, ws.q, ws.step, alpha, opt.tolerance, ws.trial).size;
-      step_error = std::min(eta, 1.0) * step_size;
-      step_ok = step_error <= 1.0;
-      known_ok = bt == 0 && step_error <= opt.known_to;
-      with_jacobian = step_ok || known_ok ? opt.jacobian_with_residual : !reuse;
-      if (with_jacobian) {
-        model.residual_and_jacobian(ws.trial.data(), t, ws.trial_phi.data(), ws.jacobian_values.data());
-        jacobian_at_q = false;  // the values are the trial's now
-        ++ws.counters.jacobian_evaluations;
-      } else {
-        model.residual(ws.trial.data(), t, ws.trial_phi.data());
-      }
-      ++ws.counters.residual_evaluations;
-      trial_check = check_residual(model, ws.trial_phi, opt.tolerance, ws.trial, t);
-      if (!opt.line_search || trial_check.merit <= (1.0 - 1e-4 * alpha) * check.merit || trial_check.within) break;
-      if (reuse) {
-        refresh = true;
-        break;
-      }
-      if (bt >= opt.max_backtracks) {
-        return finish(SolveStatus::kNotConverged,
-                      "no decrease of the residual along the Newton direction (the constraints may have no "
-                      "solution near this guess)");
-      }
-      alpha *= 0.5;
-      ++sum.backtracks;
+// The solve ends at the rounding level of q: `known_before`, the step ended the solve within
+// NewtonOptions::known_to. Its error is then the larger of min(η, 1) × its size (η from a contraction observed)
+// and of its size up to known_to: a step that is mostly rounding does not contract, however well the steps before
+// it did, and q is known no better than that level.
+SolveStatus PositionSolve::stop_at_rounding_level(bool known_before, const Step& s, int it) {
+  Index worst = 0;
+  const double size = step_ratio(model_, ws_.step, ws_.q, opt_.tolerance, &worst);
+  const double worst_ratio =
+      known_before ? std::max(std::min(s.eta, 1.0) * size, std::min(size, opt_.known_to)) : size;
+  sum_.rounding_level = worst_ratio;
+  sum_.rounding_measured = !known_before && it > 0;
+  sum_.error_estimate = worst_ratio;
+  // The contraction seen with a reused matrix: the rounding in its last step makes it an overestimate, which
+  // the next solve's first step may use as such (kept, as a success's).
+  if (theta_seen_ >= 0.0) ws_.newton_contraction = theta_seen_;
+  (void)finish(SolveStatus::kSuccess, "");  // (its status is returned below, with the message set)
+  // Known to within twice the tolerance: as good as the tolerance test's own estimate promises (it is an
+  // estimate, not a bound), nothing to warn about. A 2000-stage scissor lift sits there at the default
+  // tolerance (its top joints, 600 m up, are known to 1.2 tolerances).
+  if (worst_ratio <= kQuietRoundingLevel) return SolveStatus::kSuccess;
+  sum_.slow_convergence = true;
+  const std::string& name = model_.coordinate_names()[static_cast<std::size_t>(worst)];
+  sum_.message = known_before
+                     ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
+                       "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a long "
+                       "chain or Φq ill-conditioned): up to " +
+                           scientific(worst_ratio, 3) + " × the tolerance at '" + name +
+                           "', which is how well q is known there"
+                     : "the residual is at its rounding level and the Newton steps no longer reduce it: they are "
+                       "the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
+                           scientific(worst_ratio, 3) + " × the tolerance at '" + name +
+                           "', which is how well q is known there";
+  return SolveStatus::kSuccess;
+}
+
+// The trial point becomes the iterate; returns whether the step started within the tolerance of the
+// factorisation's point.
+bool PositionSolve::accept(const Step& s) {
+  ++ws_.counters.newton_iterations;
+  ++sum_.iterations;
+  stagnant_ = (!reuse_ && s.alpha == 1.0 && prev_norm_ > 0.0 && s.theta >= 0.5) ? stagnant_ + 1 : 0;
+  prev_norm_ = s.alpha == 1.0 ? s.full.norm : -1.0;  // a shortened step says nothing about the contraction
+  ws_.q.swap(ws_.trial);
+  ws_.phi.swap(ws_.trial_phi);
+  const bool step_from_factorization = drift_ <= 1.0;
+  drift_ += s.size;  // max-norm distance from the factorisation's point, by the triangle inequality
+  // The error reported (and carried by a sweep to the rows it extrapolates): the contraction estimate, or the
+  // step's size times the residual's reduction when that is the larger — the size of the next step, were it
+  // taken. Where the steps are the rounding of Φ amplified along a long chain, the residual no longer falls and
+  // θ measured on the previous solve's steps says nothing of it: the error is then about the step itself.
+  accepted_error_ = std::max(s.error, check_.worst > 0.0 ? s.size * (s.trial.worst / check_.worst) : 0.0);
+  jacobian_at_q_ = s.with_jacobian;
+  check_ = s.trial;
+  return step_from_factorization;
+}
+
+SolveStatus PositionSolve::run() {
+  if (const auto done = start()) return *done;
+  for (;;) {
+    const int it = sum_.iterations;
+    if (const auto done = stop_before_step(it)) return *done;
+    if (const auto done = factorize_unless_reused()) return *done;
+    Step s;
+    if (const auto done = newton_step(s)) return *done;
+    if (s.refresh) {
+      refresh_matrix();
+      continue;
     }
+    if (const auto done = line_search(s)) return *done;
+    const bool within = check_.within;
     // At the rounding level: the residual already holds, and a full Newton step above the tolerance does not even
     // halve the merit (a step that corrects a real error of q shrinks a residual within tolerance by orders of
     // magnitude, stale matrix or not). The step is then the rounding of Φ amplified by Φq⁻¹ — on a long chain
     // (10⁵ scissor stages) it exceeds the tolerance however often Newton repeats it — and it says how well q is
     // known. Stop at the better point of the two, with a warning, instead of refactorising in search of a
     // contraction that cannot come.
-    const bool rounding_level = within && !step_ok && alpha == 1.0 && !(trial_check.merit < 0.5 * check.merit);
-    // `known_before`: the step ended the solve within NewtonOptions::known_to. Its error is then the larger of
-    // min(η, 1) × its size (η from a contraction observed) and of its size up to known_to: a step that is mostly
-    // rounding does not contract, however well the steps before it did, and q is known no better than that level.
-    auto stop_at_rounding_level = [&](bool known_before) {
-      Index worst = 0;
-      const double size = step_ratio(model, ws.step, ws.q, opt.tolerance, &worst);
-      const double worst_ratio =
-          known_before ? std::max(std::min(eta, 1.0) * size, std::min(size, opt.known_to)) : size;
-      sum.rounding_level = worst_ratio;
-      sum.rounding_measured = !known_before && it > 0;
-      sum.error_estimate = worst_ratio;
-      // The contraction seen with a reused matrix: the rounding in its last step makes it an overestimate, which
-      // the next solve's first step may use as such (kept, as a success's).
-      if (theta_seen >= 0.0) ws.newton_contraction = theta_seen;
-      (void)finish(SolveStatus::kSuccess, "");  // (its status is returned below, with the message set)
-      // Known to within twice the tolerance: as good as the tolerance test's own estimate promises (it is an
-      // estimate, not a bound), nothing to warn about. A 2000-stage scissor lift sits there at the default
-      // tolerance (its top joints, 600 m up, are known to 1.2 tolerances).
-      if (worst_ratio <= kQuietRoundingLevel) return SolveStatus::kSuccess;
-      sum.slow_convergence = true;
-      const std::string& name = model.coordinate_names()[static_cast<std::size_t>(worst)];
-      sum.message = known_before
-                        ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
-                          "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a long "
-                          "chain or Φq ill-conditioned): up to " +
-                              scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there"
-                        : "the residual is at its rounding level and the Newton steps no longer reduce it: they are "
-                          "the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
-                              scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there";
-      return SolveStatus::kSuccess;
-    };
-    if (rounding_level && !(trial_check.within && trial_check.merit < check.merit)) return stop_at_rounding_level(false);
+    const bool rounding_level = within && !step_ok_ && s.alpha == 1.0 && !(s.trial.merit < 0.5 * check_.merit);
+    if (rounding_level && !(s.trial.within && s.trial.merit < check_.merit)) return stop_at_rounding_level(false, s, it);
     // Within the level the previous positions are known to: the step is taken and ends the solve, as at a stop at
     // the rounding level (below), without the iterations that would only measure the rounding again.
     // Not where Φq is ill-conditioned: linear convergence there marks a singular position (a dead point), which
     // the sweep must still see.
-    const bool within_known = known_ok && !step_ok && alpha == 1.0 && trial_check.within && !rounding_level &&
-                              sum.rcond >= detail::kLinearSingularRcond;
-    if (refresh && !rounding_level && !within_known) {
-      reuse = false, prev_norm = -1.0;
+    const bool within_known = s.known_ok && !step_ok_ && s.alpha == 1.0 && s.trial.within && !rounding_level &&
+                              sum_.rcond >= detail::kLinearSingularRcond;
+    if (s.refresh && !rounding_level && !within_known) {
+      refresh_matrix();
       continue;
     }
-    ++ws.counters.newton_iterations;
-    ++sum.iterations;
-    stagnant = (!reuse && alpha == 1.0 && prev_norm > 0.0 && theta >= 0.5) ? stagnant + 1 : 0;
-    prev_norm = alpha == 1.0 ? norm : -1.0;  // a shortened step says nothing about the contraction
-    ws.q.swap(ws.trial);
-    ws.phi.swap(ws.trial_phi);
-    const bool step_from_factorization = drift <= 1.0;
-    drift += step_size;  // max-norm distance from the factorisation's point, by the triangle inequality
-    // The error reported (and carried by a sweep to the rows it extrapolates): the contraction estimate, or the
-    // step's size times the residual's reduction when that is the larger — the size of the next step, were it
-    // taken. Where the steps are the rounding of Φ amplified along a long chain, the residual no longer falls and
-    // θ measured on the previous solve's steps says nothing of it: the error is then about the step itself.
-    accepted_error = std::max(step_error, check.worst > 0.0 ? step_size * (trial_check.worst / check.worst) : 0.0);
-    jacobian_at_q = with_jacobian;
-    check = trial_check;
+    const bool step_from_factorization = accept(s);
     if (rounding_level || within_known) {
       // The step just taken is the rounding of Φ amplified by Φq⁻¹ (within known_to: that, and the start's own
       // error up to that level): it moved q by about as much as q is known, so the factorisation made where it
       // started is Φq at the solution to the accuracy q has. Velocities and accelerations reuse it rather than
       // refactorise (on a 10⁵-stage scissor lift a quarter of the rows stop here, and each paid a second
       // factorisation).
-      factorized_at_rounding_level = step_from_factorization;
-      return stop_at_rounding_level(within_known);
+      factorized_at_rounding_level_ = step_from_factorization;
+      return stop_at_rounding_level(within_known, s, it);
     }
   }
+}
+
+}  // namespace
+
+SolveStatus solve_position(const Model& model, double t, const NewtonOptions& opt, Workspace& ws,
+                           PositionSummary* summary) {
+  check_workspace(model, ws);
+  detail::check_newton_options(opt);
+  PositionSummary local;
+  PositionSummary& sum = summary ? *summary : local;
+  sum = PositionSummary{};
+  return PositionSolve(model, t, opt, ws, sum).run();
 }
 
 }  // namespace phiq
