@@ -260,7 +260,7 @@ Command register_run(CLI::App& app) {
       ->capture_default_str()
       ->check(thread_count());
   run->add_option("--memory", a->memory_gb,
-                  "GB the drive steps may use with --threads 0: fewer threads when theirs would not fit (0: what the "
+                  "GB the whole process may reach with --threads 0: fewer threads when theirs would not fit (0: what the "
                   "system reports available)")
       ->capture_default_str()
       ->check(number(0.0, 1e6, false, "a number of GB from 0 (what the system reports available) to 1000000"));

@@ -141,7 +141,7 @@ Command register_sweep_accuracy(CLI::App& app) {
   accuracy->add_option("--json", acc->json_path, "JSON to write ('-': standard output)")->transform(output_path("", false));
   accuracy->add_option("--tolerances", acc->tolerances, "Newton tolerances (default 1e-4,1e-5,...,1e-14)");
   accuracy->add_option("--steps-list", acc->steps, "Step counts (default: the scene's x 1/4, 1, 4)");
-  accuracy->add_option("--predictors", acc->predictors, "Of previous,secant,parabolic,linear,quadratic,cubic,auto (default: all but auto)");
+  accuracy->add_option("--predictors", acc->predictors, "Of previous,secant,parabolic,linear,hermite,quadratic,cubic,auto (default: all but auto)");
   accuracy->add_option("--newton", acc->newton, "Of modified,full (default: both)");
   accuracy->add_option("--linear-solvers", acc->linear_solvers, "Of klu,umfpack,dense (default: klu,umfpack)");
   accuracy->add_option("--reference", acc->reference, "auto, numerical or closed-form:KIND[:NAME=VALUE,...]")->capture_default_str();
