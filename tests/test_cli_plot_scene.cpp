@@ -141,4 +141,19 @@ TEST_F(Cli, PlotRefusesAResultOfAnotherSceneInOneLine) {
   EXPECT_FALSE(fs::exists(svg));
 }
 
+// Without a result, a scene that cannot be swept exits 1 as `phiq run` does, with its reason in one line, and no file.
+TEST_F(Cli, PlotAndAnimateWithoutAResultSayWhyTheSceneCannotBeSwept) {
+  const std::string nat = phiq::test::model_path("seed/fourbar_natural.yaml");  // a rocker of 5 m cannot close it
+  for (const std::string command : {"plot", "animate"}) {
+    const fs::path out = dir_ / (command == "plot" ? "p.svg" : "p.html");
+    const Result r = run(command + " " + nat + " --set L4=5 -o " + out.string());
+    EXPECT_EQ(r.code, 1) << command;
+    EXPECT_TRUE(phiq::test::one_phiq_line(r.err)) << r.err;
+    EXPECT_EQ(r.err.rfind("phiq: " + command + ": " + nat + ": step 0, t = 0: initial assembly failed", 0), 0u)
+        << r.err;
+    EXPECT_FALSE(fs::exists(out)) << command;
+  }
+  EXPECT_EQ(files(), (std::vector<std::string>{"stderr.txt", "stdout.txt"}));
+}
+
 }  // namespace
