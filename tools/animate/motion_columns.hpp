@@ -1,7 +1,8 @@
 // What `phiq animate` reads of a result, for its .glb (gltf_motion.*) and its HTML viewer (html_motion.*) alike:
 // the column t and the column of every coordinate the drawing reads (the sketch's points, the bodies' frames),
-// checked once with one line for a result that is not the scene's, then q (and q̇, from the `NAME.v` columns when
-// the result has them all) at any row, each value checked finite.
+// checked once (a result whose output leaves one out: MissingCoordinate, naming the output to add), then q (and
+// q̇, from the `NAME.v` columns when the result has them all) at any row, each value checked finite. That the
+// result is the scene's at all, plot and animate check before (tools/cli/drawn_result.hpp).
 #pragma once
 
 #include <Eigen/Core>

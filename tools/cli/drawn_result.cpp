@@ -68,7 +68,6 @@ CsvTable read_scene_result(const Scene& scene, const std::string& path) {
   }
   CsvFormat format(*scene.model, scene.sweep);
   const std::vector<std::string> dotted = format.column_names();
-  std::vector<std::string> expected = dotted;
   const std::set<std::string> have(table.columns.begin(), table.columns.end());
   try {  // `phiq run --names identifiers`: the same columns under other names, read back dotted
     format.set_naming(ColumnNaming::kIdentifiers);
@@ -82,9 +81,9 @@ CsvTable read_scene_result(const Scene& scene, const std::string& path) {
   } catch (const Error&) {  // names that collide as identifiers: no such result was written
   }
   const std::string refused = path + ": its columns are not the output of " + scene.path + ": ";
-  for (const std::string& c : expected)
+  for (const std::string& c : dotted)
     if (!have.count(c)) throw DrawError(refused + "no column '" + c + "'", 2);
-  const std::set<std::string> written(expected.begin(), expected.end());
+  const std::set<std::string> written(dotted.begin(), dotted.end());
   for (const std::string& c : table.columns)
     if (!written.count(c) && !sensitivity_column(scene, written, c))
       throw DrawError(refused + "column '" + c + "' is not one it writes", 2);
