@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cstring>
+#include <map>
 #include <set>
 
 #include "command_support.hpp"  // make_square()
@@ -73,9 +74,9 @@ CsvTable read_scene_result(const Scene& scene, const std::string& path) {
     format.set_naming(ColumnNaming::kIdentifiers);
     const std::vector<std::string> identifiers = format.column_names();
     if (identifiers != dotted && std::set<std::string>(identifiers.begin(), identifiers.end()) == have) {
-      for (std::string& c : table.columns)
-        c = dotted[static_cast<std::size_t>(std::find(identifiers.begin(), identifiers.end(), c) -
-                                            identifiers.begin())];
+      std::map<std::string, std::size_t> at;  // a result of 10⁴ coordinates: no search per column
+      for (std::size_t k = 0; k < identifiers.size(); ++k) at.emplace(identifiers[k], k);
+      for (std::string& c : table.columns) c = dotted[at.at(c)];
       return table;
     }
   } catch (const Error&) {  // names that collide as identifiers: no such result was written
