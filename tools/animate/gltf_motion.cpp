@@ -101,6 +101,19 @@ enum Material { kBody, kLink, kJoint, kFixedJoint };
 
 }  // namespace
 
+std::vector<Slot> glb_reads(const Scene& scene, const MechanismSketch& sketch) {
+  std::vector<Slot> read;
+  for (const Frame2& f : scene.planar_bodies) read.insert(read.end(), {f.x, f.y, f.psi});
+  for (const Frame3& f : scene.spatial_bodies) read.insert(read.end(), {f.x, f.y, f.z, f.e0, f.e1, f.e2, f.e3});
+  for (const SketchSegment& s : sketch.segments)
+    if (s.line == SketchLine::kBar)
+      for (const OutputPoint* p : {&s.from, &s.to})
+        for (const Slot& x : slots_of(*p)) read.push_back(x);
+  for (const SketchJoint& j : sketch.joints)
+    for (const Slot& x : slots_of(j.at)) read.push_back(x);
+  return read;
+}
+
 std::string motion_glb(const Scene& scene, const CsvTable& table, const std::string& result) {
   const Model& model = *scene.model;
   const bool spatial = scene.dimension == 3;
@@ -108,20 +121,10 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
   const std::string title =
       scene.name.empty() ? std::filesystem::path(scene.path).stem().string() : scene.name;
 
-  // ---- the columns the motion reads: t and every coordinate of the bodies, links and joints
-  std::vector<Slot> read;
-  for (const Frame2& f : scene.planar_bodies) read.insert(read.end(), {f.x, f.y, f.psi});
-  for (const Frame3& f : scene.spatial_bodies) read.insert(read.end(), {f.x, f.y, f.z, f.e0, f.e1, f.e2, f.e3});
   std::vector<const SketchSegment*> links;
   for (const SketchSegment& s : sketch.segments)
-    if (s.line == SketchLine::kBar) {
-      links.push_back(&s);
-      for (const OutputPoint* p : {&s.from, &s.to})
-        for (const Slot& x : slots_of(*p)) read.push_back(x);
-    }
-  for (const SketchJoint& j : sketch.joints)
-    for (const Slot& x : slots_of(j.at)) read.push_back(x);
-  const MotionColumns columns(scene, read, table, result);
+    if (s.line == SketchLine::kBar) links.push_back(&s);
+  const MotionColumns columns(scene, glb_reads(scene, sketch), table, result);
   const std::size_t nodes = scene.planar_bodies.size() + scene.spatial_bodies.size() + links.size() +
                             sketch.joints.size();
   if (nodes == 0) throw Error(scene.path + ": nothing to animate (no moving body, link or joint)");

@@ -8,13 +8,17 @@
 #include <string>
 
 #include "phiq/csv_compare.hpp"
+#include "phiq/mechanism_sketch.hpp"
 #include "phiq/scene.hpp"
 
 namespace phiq::tools {
 
-// The .glb of `table`, the result of `scene` read from `result` (named in messages). Throws phiq::Error with one
-// line for a result that is not the scene's (a coordinate the drawing reads has no column, no column t, a value
-// that is not finite, times not increasing as 32-bit floats) or a scene with nothing to animate.
+// The slots the .glb reads: the moving bodies' frames, the ends of the sketch's links, its joints.
+std::vector<Slot> glb_reads(const Scene& scene, const MechanismSketch& sketch);
+
+// The .glb of `table`, the result of `scene` read from `result` (named in messages). Throws MissingCoordinate
+// (motion_columns.hpp) for a coordinate the drawing reads without a column, phiq::Error with one line for a result
+// without t, a value that is not finite, times not increasing as 32-bit floats, or a scene with nothing to animate.
 std::string motion_glb(const Scene& scene, const CsvTable& table, const std::string& result);
 
 }  // namespace phiq::tools

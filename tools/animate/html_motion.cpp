@@ -104,12 +104,10 @@ ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, co
     nlohmann::json& to = s.line == SketchLine::kBar ? links : arms;
     to.push_back(point(s.from)), to.push_back(point(s.to));
   }
-  std::vector<Slot> read;
-  for (const OutputPoint* p : points)
-    for (const Slot& x : slots_of(*p)) read.push_back(x);
-  for (const SketchJoint& j : sketch.joints)
-    for (const Slot& x : {j.guide.x, j.guide.y, j.guide.psi}) read.push_back(x);  // a prismatic block's angle
-  const MotionColumns columns(scene, read, table, result);
+  // a joint away from every line (a pivot on ground, a cam's roller, a slider's block) is a point of its own, moved
+  // with the others: without it a mechanism drawn by its joints alone would have nothing to animate
+  for (const SketchJoint& j : sketch.joints) point(j.at);
+  const MotionColumns columns(scene, sketch_reads(sketch), table, result);
   std::map<std::string, std::size_t> col;
   for (std::size_t c = 0; c < table.columns.size(); ++c) col[table.columns[c]] = c;
 

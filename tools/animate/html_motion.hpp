@@ -28,8 +28,9 @@ struct ViewerMotion {
 constexpr std::size_t kFrameBudget = std::size_t{8} << 20;
 
 // The motion of `table`, the result of `scene` read from `result`, drawn with `sketch` (which must outlive the
-// returned frames). Throws phiq::Error with one line for a result that is not the scene's (a coordinate the
-// drawing reads has no column, no t, a value read that is not finite, t decreasing) or a scene with nothing to draw.
+// returned frames). Throws MissingCoordinate (motion_columns.hpp) for a coordinate the drawing reads without a
+// column, phiq::Error with one line for a result without t, a value read that is not finite, t decreasing, or a
+// scene with nothing to draw.
 ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, const CsvTable& table,
                            const std::string& result, std::size_t budget = kFrameBudget);
 

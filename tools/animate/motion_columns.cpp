@@ -8,17 +8,6 @@
 
 namespace phiq::tools {
 
-std::vector<Slot> slots_of(const OutputPoint& p) {
-  switch (p.kind) {
-    case OutputPointKind::kPlanarPoint: return {p.point.x, p.point.y};
-    case OutputPointKind::kPlanarBodyPoint: return {p.body.x, p.body.y, p.body.psi};
-    default: {
-      const Attachment3& a = p.spatial;
-      return {a.r[0], a.r[1], a.r[2], a.p[0], a.p[1], a.p[2], a.p[3]};
-    }
-  }
-}
-
 MotionColumns::MotionColumns(const Scene& scene, const std::vector<Slot>& read, const CsvTable& table,
                              std::string result)
     : table_(table), result_(std::move(result)) {
@@ -37,8 +26,8 @@ MotionColumns::MotionColumns(const Scene& scene, const std::vector<Slot>& read, 
     const std::string& name = model.coordinate_names()[static_cast<std::size_t>(j)];
     const auto c = col.find(name);
     if (c == col.end())
-      throw Error(result_ + ": no column '" + name + "', a coordinate of " + scene.path +
-                  " that its motion reads: not a result of this scene (or its output leaves the coordinate out)");
+      throw MissingCoordinate(result_ + " lacks coordinate '" + name + "': add it to output.coordinates in " +
+                              scene.path);
     q_.emplace_back(j, c->second);
     const auto v = col.find(name + ".v");
     if (v == col.end()) all_rates = false;

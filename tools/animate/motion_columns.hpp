@@ -1,7 +1,8 @@
 // What `phiq animate` reads of a result, for its .glb (gltf_motion.*) and its HTML viewer (html_motion.*) alike:
 // the column t and the column of every coordinate the drawing reads (the sketch's points, the bodies' frames),
-// checked once with one line for a result that is not the scene's, then q (and q̇, from the `NAME.v` columns when
-// the result has them all) at any row, each value checked finite.
+// checked once (a result whose output leaves one out: MissingCoordinate, naming the output to add), then q (and
+// q̇, from the `NAME.v` columns when the result has them all) at any row, each value checked finite. That the
+// result is the scene's at all, plot and animate check before (tools/cli/drawn_result.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -13,16 +14,21 @@
 #include "phiq/csv_compare.hpp"
 #include "phiq/output_points.hpp"
 #include "phiq/scene.hpp"
+#include "plot_mechanism.hpp"  // slots_of()
 
 namespace phiq::tools {
 
-// The slots whose values place an output point.
-std::vector<Slot> slots_of(const OutputPoint& p);
+// A result of the scene whose output leaves out a coordinate the drawing reads: what() says which and where to add
+// it ("r.csv lacks coordinate 'xc': add it to output.coordinates in s.yaml"); the command adds its own remedy.
+class MissingCoordinate : public Error {
+ public:
+  using Error::Error;
+};
 
 class MotionColumns {
  public:
-  // The columns of the coordinates among `read`. Throws phiq::Error with one line (naming `result`) for a table
-  // without t, without one of those coordinates, or without rows.
+  // The columns of the coordinates among `read`. Throws MissingCoordinate for a table without one of those
+  // coordinates, phiq::Error with one line (naming `result`) for one without t or without rows.
   MotionColumns(const Scene& scene, const std::vector<Slot>& read, const CsvTable& table, std::string result);
 
   std::size_t t_column() const { return t_; }

@@ -1,6 +1,7 @@
-// `phiq animate SCENE RESULT -o OUT.glb|OUT.html`: the motion of a result as a glTF 2.0 binary
+// `phiq animate SCENE [RESULT] -o OUT.glb|OUT.html`: the motion of a result as a glTF 2.0 binary
 // (tools/animate/gltf_motion.*) or a self-contained HTML viewer (tools/animate/html_page.*), chosen by the output's
-// extension; its options, the checks of its input and the atomic write.
+// extension; without RESULT, of the scene swept here with the outputs the drawing needs (drawn_result.hpp); its
+// options, the checks of its input and the atomic write.
 #include <memory>
 #include <string>
 
@@ -8,9 +9,10 @@
 #include "command_line.hpp"
 #include "command_support.hpp"
 #include "commands.hpp"
+#include "drawn_result.hpp"
 #include "gltf_motion.hpp"
 #include "html_page.hpp"
-#include "phiq/hdf5_reader.hpp"
+#include "motion_columns.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -22,6 +24,9 @@ struct AnimateOptions {
   std::vector<std::string> columns;  // the HTML's plots (as phiq plot --columns)
   std::vector<std::string> sets;     // --set NAME=VALUE: the scene's parameters as the run had them
 };
+
+// What the messages and the page call the result of a sweep run here.
+constexpr const char* kSwept = "its sweep";
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -38,8 +43,22 @@ int cmd_animate(const AnimateOptions& o) {
   std::string text;
   try {
     const Scene scene = load_scene(o.scene, SceneLimits{}, parameter_settings(o.sets));
-    const CsvTable table = read_result_table(o.result);
-    text = html ? motion_html(scene, table, o.result, o.columns) : motion_glb(scene, table, o.result);
+    if (o.result.empty()) {  // the scene swept here, with the coordinates the drawing reads (and joints to plot)
+      set_interrupt_subject("animate: " + o.out, "; no output written");
+      const MechanismSketch sketch = sketch_mechanism(*scene.model);
+      const DrawnOutputs add{coordinates_of(html ? sketch_reads(sketch) : glb_reads(scene, sketch)), html};
+      const CsvTable table = sweep_scene(scene, add);
+      text = html ? motion_html(scene, table, kSwept, o.columns) : motion_glb(scene, table, kSwept);
+    } else {
+      const CsvTable table = read_scene_result(scene, o.result);
+      text = html ? motion_html(scene, table, o.result, o.columns) : motion_glb(scene, table, o.result);
+    }
+  } catch (const MissingCoordinate& e) {
+    std::string again = "phiq animate " + o.scene + " -o " + o.out;
+    for (const std::string& s : o.sets) again += " --set " + s;
+    return fail("animate: " + std::string(e.what()) + ", or run `" + again + "` without a result", 2);
+  } catch (const DrawError& e) {
+    return fail("animate: " + std::string(e.what()), e.status());
   } catch (const SceneError& e) {
     return fail("animate: " + std::string(e.what()), 2);
   } catch (const Error& e) {
@@ -60,13 +79,15 @@ int cmd_animate(const AnimateOptions& o) {
 Command register_animate(CLI::App& app) {
   auto options = std::make_shared<AnimateOptions>();
   CLI::App* animate = app.add_subcommand(
-      "animate", "Write the motion of a result as a glTF 2.0 binary (.glb: a node per body, link and joint, "
-                 "keyframed at the result's rows) or as one self-contained HTML page that plays it (.html)");
+      "animate", "Write the motion of a result (or, without one, of the scene swept here) as a glTF 2.0 binary "
+                 "(.glb: a node per body, link and joint, keyframed at the result's rows) or as one self-contained "
+                 "HTML page that plays it (.html)");
   animate->add_option("scene", options->scene, "Scene file (YAML)")->required();
-  animate->add_option("result", options->result, "Result of `phiq run` for this scene (CSV or HDF5)")->required();
+  animate->add_option("result", options->result, "Result of `phiq run` for this scene (CSV or HDF5); none: the "
+                                                 "scene is swept here with the outputs the drawing needs");
   animate->add_option("-o,--output", options->out, "File to write: *.glb (glTF binary) or *.html (viewer)")->required();
-  animate->add_option("--columns", options->columns, "HTML: columns plotted against t (default: as phiq plot, the "
-                                                     "driven and the moving coordinates, at most 6)")
+  animate->add_option("--columns", options->columns, "HTML: columns plotted against t (default: as phiq plot, what "
+                                                     "is driven, the joints' measures, the coordinates that move)")
       ->delimiter(',');
   add_set_option(animate, &options->sets);
   return {animate, [options] { return cmd_animate(*options); }};

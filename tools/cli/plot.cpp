@@ -1,4 +1,4 @@
-// `phiq plot SCENE RESULT.csv -o OUT.svg`: its options and the check that the SVG replaces no input; the drawing
+// `phiq plot SCENE [RESULT] -o OUT.svg`: its options and the check that the SVG replaces no input; the drawing
 // itself is tools/plot/plot_svg.cpp.
 #include <memory>
 
@@ -15,11 +15,14 @@ Command register_plot(CLI::App& app) {
   CLI::App* plot = app.add_subcommand("plot", "Draw the mechanism at a few positions with its traced points, and "
                                               "columns against time, as SVG");
   plot->add_option("scene", options->scene, "Scene file (YAML)")->required();
-  plot->add_option("result", options->csv, "CSV written by `phiq run` for this scene")->required();
+  plot->add_option("result", options->csv, "Result of `phiq run` for this scene (CSV or HDF5); none: the scene is "
+                                           "swept here with the outputs the drawing needs");
   plot->add_option("-o,--output", options->out, "SVG file to write ('-': standard output)")
       ->required()
       ->transform(output_path("", false));
-  plot->add_option("--columns", options->columns, "Columns to plot against t (default: the driven and the moving coordinates, at most 6)")
+  plot->add_option("--columns", options->columns,
+                   "Columns to plot against t (default: what is driven, the joints' measures, the coordinates that move, "
+                   "Euler parameters last; at most 6)")
       ->delimiter(',');
   plot->add_option("--positions", options->positions, "Rows at which the mechanism is drawn, evenly spread")
       ->capture_default_str()

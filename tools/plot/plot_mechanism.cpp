@@ -44,6 +44,29 @@ std::string ground_pivot(double x, double y, const std::string& id = "") {
 
 }  // namespace
 
+std::vector<Slot> slots_of(const OutputPoint& p) {
+  switch (p.kind) {
+    case OutputPointKind::kPlanarPoint: return {p.point.x, p.point.y};
+    case OutputPointKind::kPlanarBodyPoint: return {p.body.x, p.body.y, p.body.psi};
+    default: {
+      const Attachment3& a = p.spatial;
+      return {a.r[0], a.r[1], a.r[2], a.p[0], a.p[1], a.p[2], a.p[3]};
+    }
+  }
+}
+
+std::vector<Slot> sketch_reads(const MechanismSketch& sketch) {
+  std::vector<Slot> read;
+  for (const SketchSegment& s : sketch.segments)
+    for (const OutputPoint* p : {&s.from, &s.to})
+      for (const Slot& x : slots_of(*p)) read.push_back(x);
+  for (const SketchJoint& j : sketch.joints) {
+    for (const Slot& x : slots_of(j.at)) read.push_back(x);
+    for (const Slot& x : {j.guide.x, j.guide.y, j.guide.psi}) read.push_back(x);  // a prismatic block's angle
+  }
+  return read;
+}
+
 std::pair<double, double> project(const P3& p, bool spatial) {
   if (!spatial) return {p[0], p[1]};
   // seen from (1, 1, 1): screen right is (y − x)/√2 and up the rest of z; x − y instead mirrors the picture

@@ -15,6 +15,12 @@
 
 namespace phiq::tools {
 
+// The slots whose values place an output point.
+std::vector<Slot> slots_of(const OutputPoint& p);
+
+// The slots the drawing of `sketch` reads: the ends of its lines, its joints and the frames of its prismatic guides.
+std::vector<Slot> sketch_reads(const MechanismSketch& sketch);
+
 struct MechanismFrames {
   const Model* model = nullptr;
   const MechanismSketch* sketch = nullptr;

@@ -31,6 +31,20 @@ Quantity of_unit(Unit u, int order) {
 
 }  // namespace
 
+std::string joint_of_column(const Scene& scene, const std::string& column, Unit* unit) {
+  if (scene.dimension != 3) return "";
+  for (const auto& [tail, u] : {std::pair<const char*, Unit>{".angle", Unit::kAngle}, {".distance", Unit::kLength}}) {
+    if (!ends_with(column, tail)) continue;
+    const std::string name = column.substr(0, column.size() - std::string(tail).size());
+    for (const ConstraintInfo& c : scene.model->constraints())
+      if (c.name == name && (c.kind == "revolute" || c.kind == "cylindrical" || c.kind == "prismatic")) {
+        if (unit) *unit = u;
+        return name;
+      }
+  }
+  return "";
+}
+
 Quantity column_quantity(const Scene& scene, const std::string& column) {
   const Model& model = *scene.model;
   if (column == "t") return {"time", "s"};
@@ -54,6 +68,12 @@ Quantity column_quantity(const Scene& scene, const std::string& column) {
         const std::string tail = std::string(".") + (order == 1 ? "v" : (order == 2 ? "a" : "")) + axis;
         if (column == p.name + tail) return of_unit(Unit::kLength, order);
       }
+  for (int order : {0, 1, 2}) {  // a joint's measure `J.angle`, `J.distance`, and their rates `.v`, `.a`
+    if (order > 0 && !ends_with(column, order == 1 ? ".v" : ".a")) continue;
+    Unit u = Unit::kLength;
+    if (!joint_of_column(scene, order == 0 ? column : column.substr(0, column.size() - 2), &u).empty())
+      return of_unit(u, order);
+  }
   if (ends_with(column, ".residual")) return {"residual", ""};
   if (ends_with(column, ".ddf")) return {"driver law, second rate", ""};
   if (ends_with(column, ".df")) return {"driver law, rate", ""};
@@ -69,21 +89,33 @@ std::vector<std::string> default_columns(const Scene& scene, const CsvTable& tab
       if (std::isfinite(row[c])) lo = std::min(lo, row[c]), hi = std::max(hi, row[c]);
     return hi - lo > 1e-9 * (1.0 + std::max(std::fabs(lo), std::fabs(hi)));
   };
-  std::set<Index> driven;
+  std::set<Index> driven, euler;
   for (const auto& block : model.blocks())
     if (auto* t = dynamic_cast<const TypedBlock<CoordinateDriverSpec>*>(block.get()))
       for (std::size_t i = 0; i < t->size(); ++i) driven.insert(t->spec(i).coordinate.coord());
-  std::vector<std::string> out;
-  std::vector<std::size_t> moving;
+  for (const Frame3& f : scene.spatial_bodies)
+    for (const Slot& e : {f.e0, f.e1, f.e2, f.e3})
+      if (e.is_coordinate()) euler.insert(e.coord());
+  std::set<std::string> driven_joints;
+  for (const JointAngleReference& j : scene.joint_angles) driven_joints.insert(j.joint);
   std::set<std::string> written;  // the coordinate columns
   for (Index k : scene.sweep.coordinate_columns) written.insert(model.coordinate_names()[static_cast<std::size_t>(k)]);
+  // in order of preference: driven coordinates and joints, the joints' measures, the other coordinates that move,
+  // their Euler parameters last (four numbers of one turn, which say less than any of the others)
+  std::vector<std::size_t> ranked[4];
   for (std::size_t c = 1; c < table.columns.size(); ++c) {
-    if (!written.count(table.columns[c]) || !changes(c)) continue;
-    const Index j = model.coordinate_index(table.columns[c]);
-    if (driven.count(j)) out.push_back(table.columns[c]);
-    else moving.push_back(c);
+    const std::string& name = table.columns[c];
+    if (!changes(c)) continue;
+    if (const std::string joint = joint_of_column(scene, name); !joint.empty()) {
+      ranked[driven_joints.count(joint) ? 0 : 1].push_back(c);
+    } else if (written.count(name)) {
+      const Index j = model.coordinate_index(name);
+      ranked[driven.count(j) ? 0 : euler.count(j) ? 3 : 2].push_back(c);
+    }
   }
-  for (std::size_t c : moving) out.push_back(table.columns[c]);
+  std::vector<std::string> out;
+  for (const auto& rank : ranked)
+    for (std::size_t c : rank) out.push_back(table.columns[c]);
   if (out.empty())
     for (std::size_t c = 1; c < table.columns.size(); ++c)
       if (changes(c)) out.push_back(table.columns[c]);

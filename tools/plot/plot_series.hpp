@@ -24,9 +24,14 @@ struct Quantity {
 // The quantity of `column` of `scene`'s results (dotted names, CsvFormat's default).
 Quantity column_quantity(const Scene& scene, const std::string& column);
 
-// The columns drawn when none is asked for: the coordinates a coordinate driver drives, then those whose value
-// changes over the rows, in column order, at most `most`; never a constant. Without either: the first columns after
-// t that change, else the first columns after t.
+// The joint whose measure `column` is (`J.angle` of a spatial revolute or cylindrical joint, `J.distance` of a
+// prismatic or cylindrical one), with its unit in `*unit`; empty for any other column.
+std::string joint_of_column(const Scene& scene, const std::string& column, Unit* unit = nullptr);
+
+// The columns drawn when none is asked for, those whose value changes over the rows, in this order: the
+// coordinates a coordinate driver drives and the measures of joints a joint driver drives; the other joints'
+// measures (output.joints); the other coordinates; Euler parameters last; each group in column order, at most
+// `most`, never a constant. Without any: the first columns after t that change, else the first columns after t.
 std::vector<std::string> default_columns(const Scene& scene, const CsvTable& table, std::size_t most);
 
 // The columns to plot: `asked` (--columns), else default_columns(…, 6). Throws phiq::Error with one line for a

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "phiq/csv_compare.hpp"
 
@@ -24,6 +26,18 @@ bool is_hdf5_file(const std::string& path);
 ///         attribute, a dataset that is not floating point, of rank above 2, or whose row count differs from /t's,
 ///         or a duplicate column name.
 CsvTable read_hdf5_table(const std::string& path);
+
+/// How an HDF5 result was made: the root attributes its writer records (hdf5_writer.hpp).
+struct Hdf5Provenance {
+  std::string scene_path;  ///< `scene_path`: the scene as the run named it
+  std::string scene_text;  ///< `scene`: the scene's text
+  /// `parameter_names` and `parameter_values`: the values the run used (its --set applied); empty when absent
+  std::vector<std::pair<std::string, double>> parameters;
+};
+
+/// The provenance of the HDF5 results at `path`. Throws phiq::Error as read_hdf5_table() does for a file that is
+/// not phiq's results, and "PATH: attribute 'NAME' is missing" (or of another type) for one without them.
+Hdf5Provenance read_hdf5_provenance(const std::string& path);
 
 /// read_hdf5_table() for a file with the HDF5 signature or a name ending in .h5 / .hdf5, read_csv_table()
 /// otherwise; throws what they throw.

@@ -140,4 +140,19 @@ long long read_integer_attribute(hid_t object, const char* name, const std::stri
   return v;
 }
 
+std::vector<double> read_doubles_attribute(hid_t object, const char* name, const std::string& what) {
+  const std::string where = what + ": attribute '" + name + "'";
+  if (H5Aexists(object, name) <= 0) throw Error(where + " is missing");
+  const Hid a = checked(H5Aopen(object, name, H5P_DEFAULT), H5Aclose, where);
+  const Hid ftype = checked(H5Aget_type(a.get()), H5Tclose, where);
+  const Hid space = checked(H5Aget_space(a.get()), H5Sclose, where);
+  if (H5Tget_class(ftype.get()) != H5T_FLOAT || H5Sget_simple_extent_ndims(space.get()) != 1)
+    throw Error(where + " is not a list of numbers");
+  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
+  if (n < 0) throw Error(where + ": " + last_error());
+  std::vector<double> v(static_cast<std::size_t>(n));
+  if (n > 0) check(H5Aread(a.get(), H5T_NATIVE_DOUBLE, v.data()), where);
+  return v;
+}
+
 }  // namespace phiq::detail::h5

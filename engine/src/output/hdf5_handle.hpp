@@ -83,5 +83,6 @@ void write_attribute(hid_t object, const char* name, const std::vector<double>& 
 std::string read_string_attribute(hid_t object, const char* name, const std::string& what);
 std::vector<std::string> read_strings_attribute(hid_t object, const char* name, const std::string& what);
 long long read_integer_attribute(hid_t object, const char* name, const std::string& what);
+std::vector<double> read_doubles_attribute(hid_t object, const char* name, const std::string& what);
 
 }  // namespace phiq::detail::h5

@@ -65,17 +65,19 @@ bool is_hdf5_file(const std::string& path) {
   return f && std::fread(head, 1, sizeof head, f.get()) == sizeof head && std::memcmp(head, kSignature, 8) == 0;
 }
 
-CsvTable read_hdf5_table(const std::string& path) {
+namespace {
+
+// The file at `path` opened read-only, its format and version checked (read_hdf5_table()'s errors).
+Hid open_results(const std::string& path) {
   {  // the system's reason for a file that cannot be opened, before HDF5's
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
     if (!f) throw Error(path + ": cannot read: " + std::strerror(errno));
   }
-  const detail::h5::QuietErrors quiet;
   const Hid fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, path);
   detail::h5::check(H5Pset_file_locking(fapl.get(), false, true), path);  // read-only: a lock protects nothing
   const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl.get());
   if (id < 0) throw Error(path + ": not a readable HDF5 file: " + detail::h5::last_error());
-  const Hid file(id, H5Fclose);
+  Hid file(id, H5Fclose);
   try {
     const std::string format = detail::h5::read_string_attribute(file.get(), "format", "not phiq results");
     if (format != "phiq results") throw Error("format '" + format + "' is not 'phiq results'");
@@ -86,6 +88,31 @@ CsvTable read_hdf5_table(const std::string& path) {
   } catch (const Error& e) {
     throw Error(path + ": " + e.what());
   }
+  return file;
+}
+
+}  // namespace
+
+Hdf5Provenance read_hdf5_provenance(const std::string& path) {
+  const detail::h5::QuietErrors quiet;
+  const Hid file = open_results(path);
+  Hdf5Provenance p;
+  p.scene_path = detail::h5::read_string_attribute(file.get(), "scene_path", path);
+  p.scene_text = detail::h5::read_string_attribute(file.get(), "scene", path);
+  if (H5Aexists(file.get(), "parameter_names") > 0) {
+    const std::vector<std::string> names = detail::h5::read_strings_attribute(file.get(), "parameter_names", path);
+    const std::vector<double> values = detail::h5::read_doubles_attribute(file.get(), "parameter_values", path);
+    if (names.size() != values.size())
+      throw Error(path + ": " + std::to_string(names.size()) + " parameter names but " +
+                  std::to_string(values.size()) + " values");
+    for (std::size_t k = 0; k < names.size(); ++k) p.parameters.emplace_back(names[k], values[k]);
+  }
+  return p;
+}
+
+CsvTable read_hdf5_table(const std::string& path) {
+  const detail::h5::QuietErrors quiet;
+  const Hid file = open_results(path);
   CsvTable table;
   table.path = path;
   std::vector<Block> blocks;
