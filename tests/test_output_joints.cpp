@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "phiq/phiq.hpp"
@@ -148,6 +149,46 @@ TEST(OutputJoints, ColumnsAreNamedAndBadEntriesRefused) {
       test::replace_first(kScrew, "joints: [cyl, rail]", "joints: [ball]"), "constraints:\n",
       "constraints:\n  - {name: ball, type: spherical, between: [{body: screw}, {body: slider, at: [0, 0, -1]}]}\n");
   EXPECT_HAS(test::scene_error(ball), "output.joints[0]: joint 'ball' is a spherical joint");
+}
+
+// A screw of pitch p = 4 mm driven through turns by its angle, then by its travel: its output angle and travel are
+// the driven value and the helix's other coordinate, d = p θ / 2π, with their rates (the angle unwrapped past ±π).
+TEST(OutputJoints, DrivenScrewAngleAndTravelFollowItsDriver) {
+  const std::string by_angle = R"(phiq: 1
+dimension: 3
+bodies:
+  nut: {at: [0, 0, 0]}
+constraints:
+  - {name: ls, type: screw, between: [{body: ground, axis: [0, 0, 1]}, {body: nut, axis: [0, 0, 1]}], pitch: 0.004}
+drivers:
+  - {name: crank, joint: ls, measure: angle, law: {type: linear, initial: 0, rate: 2}}
+time: {start: 0, end: 4, steps: 40}
+output: {velocities: true, accelerations: true, joints: [ls]}
+)";
+  const double p = 0.004, k = 2 * M_PI / p;  // radians per metre of travel
+  const std::string by_travel =
+      test::replace_first(by_angle, "measure: angle, law: {type: linear, initial: 0, rate: 2}",
+                          "measure: distance, law: {type: linear, initial: 0, rate: 0.004}");
+  for (const auto& [text, theta_rate] : {std::pair{by_angle, 2.0}, std::pair{by_travel, 0.004 * k}}) {
+    const Scene s = parse_scene(text, "screw.yaml");
+    ASSERT_EQ(s.sweep.joints.size(), 2u);  // the angle, then the travel
+    for (int threads : {1, 2}) {
+      SCOPED_TRACE("threads " + std::to_string(threads) + ", angle rate " + std::to_string(theta_rate));
+      const JointRows r = sweep_rows(s, threads);
+      ASSERT_EQ(r.t.size(), 41u);
+      for (std::size_t i = 0; i < r.t.size(); ++i) {
+        const double t = r.t[i];
+        const JointMotion &angle = r.joints[i][0], &travel = r.joints[i][1];
+        // (the rates and accelerations come from linear solves through the helix's k ≈ 1571 rad/m: rounding ×k)
+        EXPECT_NEAR(angle.value, theta_rate * t, 1e-12) << t;  // up to 8 rad driven, 8π by the travel
+        EXPECT_NEAR(angle.rate, theta_rate, 1e-11) << t;
+        EXPECT_NEAR(angle.acceleration, 0.0, 1e-10) << t;
+        EXPECT_NEAR(travel.value * k, theta_rate * t, 1e-12) << t;
+        EXPECT_NEAR(travel.rate * k, theta_rate, 1e-11) << t;
+        EXPECT_NEAR(travel.acceleration * k, 0.0, 1e-10) << t;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -148,6 +148,12 @@ def test_the_registry_is_visible_from_python():
     assert all(k["example"] for k in kinds)
     # one entry per scene form: as many as the kinds' forms, each type once per dimension and section
     assert len(types) == len({(k["type"], k["dimension"], k["section"]) for k in kinds})
+    # the joint traits: what a driver drives is measured, a shaft measures its angle; a screw measures both
+    assert all(set(k["drives"]) <= set(k["measures"]) for k in kinds)
+    assert all("angle" in k["measures"] for k in kinds if k["shaft"])
+    screw = [k for k in kinds if k["type"] == "screw"]
+    both = ["angle", "distance"]
+    assert [(k["measures"], k["drives"], k["shaft"]) for k in screw] == [(both, both, True)]
 
 
 def test_everything_public_has_a_docstring():

@@ -1,9 +1,9 @@
 /// @file
 /// Joint measures and body orientations that a sweep outputs, so that users of spatial scenes read a hinge's
 /// angle, a slider's travel or a body's attitude instead of computing them from Euler parameters:
-/// - a joint's angle (revolute, cylindrical): θ of x_b about z_a measured from x_a, as the joint angle driver
-///   measures it (kinds/joint_drivers.hpp), unwrapped over turns along the sweep; its distance (prismatic,
-///   cylindrical): d = z_a · (P_b − P_a);
+/// - a joint's angle (as its kind's JointTraits::measures say: revolute, cylindrical, screw): θ of x_b about z_a
+///   measured from x_a, as the joint angle driver measures it (kinds/joint_drivers.hpp), unwrapped over turns along
+///   the sweep; its distance (prismatic, cylindrical, screw): d = z_a · (P_b − P_a);
 /// - a body's orientation as its rotation matrix, an axis and angle, or the angles of an Euler sequence
 ///   (orientation.hpp), with its angular velocity ω and acceleration α in the world frame.
 /// Values, rates and accelerations are exact (from q, q̇, q̈ through Attachment3), not differences along the sweep.

@@ -199,16 +199,26 @@ void bind_workspace(py::module_& m) {
       "constraint_kinds",
       [] {
         py::list kinds;
+        auto names = [](const JointTraits::Coordinates& c) {
+          py::list l;
+          if (c.angle) l.append("angle");
+          if (c.distance) l.append("distance");
+          return l;
+        };
         ConstraintKinds::for_each([&]<class K>() {
+          const JointTraits joint = joint_traits<K>();
           for (const SceneForm& f : K::kScene)
             kinds.append(py::dict(py::arg("kind") = K::kKind, py::arg("section") = f.section,
                                   py::arg("type") = f.type, py::arg("dimension") = f.dimension,
-                                  py::arg("example") = f.example));
+                                  py::arg("example") = f.example, py::arg("measures") = names(joint.measures),
+                                  py::arg("drives") = names(joint.drives), py::arg("shaft") = joint.shaft));
         });
         return kinds;
       },
       "Every scene form of every constraint kind in phiq's registry: dicts of kind, section ('constraints', "
-      "'drivers', 'bodies', 'vectors'), type, dimension (2 or 3) and a one-line example of the scene entry.");
+      "'drivers', 'bodies', 'vectors'), type, dimension (2 or 3), a one-line example of the scene entry, and for a "
+      "named spatial joint its JointTraits: what `output.joints` measures of it and a joint driver may drive "
+      "('angle', 'distance'), and whether it is a shaft.");
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "phiq/kinds/registry.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace phiq::detail::scene {
@@ -151,7 +152,9 @@ class KindFields {
   std::pair<JointSide3, JointSide3> sides3(const char* /*between*/) const { return r_.sides3(c_, type_); }
   // One side of a spatial joint (the axis of a mixed coordinate).
   JointSide3 side3(const char* field) const { return r_.side3(c_.require(field)); }
-  // The sides of a named joint that turns about its axis (revolute, cylindrical, screw), declared above.
+  // The types of joint a shaft turns in (JointTraits::shaft), for messages: "revolute, cylindrical or screw".
+  static std::string shaft_types() { return joint_type_list([](const JointTraits& t) { return t.shaft; }); }
+  // The sides of a named joint that turns about its axis (a shaft: JointTraits), declared above.
   std::pair<JointSide3, JointSide3> turning_joint(const char* field) const {
     return turning_joint_of(c_.require(field));
   }
@@ -180,9 +183,8 @@ class KindFields {
     const std::string name = n.name();
     const auto it = r_.joints3_.find(name);
     if (it == r_.joints3_.end()) n.fail("unknown joint '" + name + "' (a named spatial joint of 'constraints', above)");
-    const std::string& t = it->second.type;
-    if (t != "revolute" && t != "cylindrical" && t != "screw")
-      n.fail("joint '" + name + "' is a " + t + " joint: a shaft turns in a revolute, cylindrical or screw joint");
+    if (!it->second.traits.shaft)
+      n.fail("joint '" + name + "' is a " + it->second.type + " joint: a shaft turns in a " + shaft_types() + " joint");
     return {it->second.a, it->second.b};
   }
   Slot angle_of(const C& n) const {

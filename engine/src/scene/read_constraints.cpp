@@ -84,14 +84,6 @@ constexpr bool read_as_constraint() {
     if (std::string_view(f.section) == "constraints") return true;
   return false;
 }
-// A spatial joint's sides, kept by name for the joint drivers that measure it.
-template <class K>
-constexpr bool is_spatial_joint() {
-  return requires(const K& k) {
-    { k.a } -> std::convertible_to<JointSide3>;
-    { k.b } -> std::convertible_to<JointSide3>;
-  };
-}
 bool in_dimension(const SceneForm& f, int dimension) { return f.dimension == 0 || f.dimension == dimension; }
 
 // The constraint types of one dimension, in registry order, for the message about an unknown one.
@@ -132,8 +124,8 @@ const std::unordered_map<std::string, SceneReader::KindReader<C>>& SceneReader::
 template <class K, class C>
 void SceneReader::read_kind(const C& c, const std::string& type, const std::string& name) {
   K spec = K::read(KindFields<C>(*this, c, type));
-  if constexpr (is_spatial_joint<K>())
-    if (!name.empty()) joints3_[name] = Joint3{type, spec.a, spec.b};
+  if constexpr (SpatialJointKind<K>)  // kept by name, for the drivers, outputs and shafts that refer to it
+    if (!name.empty()) joints3_[name] = Joint3{type, joint_traits<K>(), spec.a, spec.b};
   add(c, name, std::move(spec));
 }
 

@@ -1,5 +1,6 @@
 // The drivers section (scene_reader.hpp): drivers of a coordinate, of an expression, or of a named spatial joint
 // (its angle or its distance), each with its motion law.
+#include "phiq/kinds/registry.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace phiq::detail::scene {
@@ -14,23 +15,22 @@ void SceneReader::read_joint_driver(const C& c, const std::string& name, MotionL
   auto it = joints3_.find(joint);
   if (it == joints3_.end()) j.fail("unknown joint '" + joint + "' (a named spatial joint of 'constraints')");
   const Joint3& J = it->second;
+  const JointTraits::Coordinates drives = J.traits.drives;  // what its kind lets a driver drive
   std::string measure;
   if (auto m = c.field("measure"); m.present()) {
     measure = m.text();
     if (measure != "angle" && measure != "distance") m.fail("measure is angle or distance");
-  } else if (J.type == "revolute") {
-    measure = "angle";
-  } else if (J.type == "prismatic") {
-    measure = "distance";
-  } else if (J.type == "cylindrical" || J.type == "screw") {
+  } else if (drives.angle && drives.distance) {
     c.fail("a " + J.type + " joint's driver needs 'measure: angle' or 'measure: distance'");
+  } else if (drives.angle) {
+    measure = "angle";
+  } else if (drives.distance) {
+    measure = "distance";
   }
-  const bool both = J.type == "cylindrical" || J.type == "screw";
-  const bool angle_ok = J.type == "revolute" || both;
-  const bool distance_ok = J.type == "prismatic" || both;
-  if ((measure == "angle" && !angle_ok) || (measure == "distance" && !distance_ok) || measure.empty())
-    j.fail("joint '" + joint + "' is a " + J.type + " joint: drivers measure the angle of a revolute, " +
-           "cylindrical or screw joint, or the distance of a prismatic, cylindrical or screw one");
+  if ((measure == "angle" && !drives.angle) || (measure == "distance" && !drives.distance) || measure.empty())
+    j.fail("joint '" + joint + "' is a " + J.type + " joint: drivers measure the angle of a " +
+           joint_type_list([](const JointTraits& t) { return t.drives.angle; }) + " joint, or the distance of a " +
+           joint_type_list([](const JointTraits& t) { return t.drives.distance; }) + " one");
   if (measure == "angle") {
     const kin3::V3 ra = detail3::reference_direction(J.a), rb = detail3::reference_direction(J.b);
     joint_angles_.push_back(JointAngleReference{name.empty() ? c.path() : name, joint, {ra.x, ra.y, ra.z},

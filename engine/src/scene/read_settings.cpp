@@ -7,6 +7,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "phiq/kinds/registry.hpp"
 #include "scene/scene_reader.hpp"
 #include "sweep/time_grid.hpp"
 
@@ -134,7 +135,8 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
   }
 }
 
-// `joints: [NAME, ...]`: named spatial joints; a revolute's angle, a prismatic's distance, a cylindrical's both.
+// `joints: [NAME, ...]`: named spatial joints, each with what its kind measures (JointTraits): a revolute's angle, a
+// prismatic's distance, a cylindrical's or a screw's both.
 void SceneReader::output_joints(const Cursor& js, OutputPlan& plan) const {
   if (!spatial_) js.fail("joint outputs are of spatial joints (dimension: 3); in the plane, output the angle coordinate");
   std::set<std::string> seen;
@@ -144,14 +146,15 @@ void SceneReader::output_joints(const Cursor& js, OutputPlan& plan) const {
     if (it == joints3_.end()) i.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
     if (!seen.insert(n).second) i.fail("joint listed twice");
     const Joint3& J = it->second;
-    const bool angle = J.type == "revolute" || J.type == "cylindrical";
-    const bool distance = J.type == "prismatic" || J.type == "cylindrical";
-    if (!angle && !distance)
-      i.fail("joint '" + n + "' is a " + J.type + " joint: outputs measure the angle of a revolute or cylindrical " +
-             "joint, or the distance of a prismatic or cylindrical one (output its bodies' orientations instead)");
+    const JointTraits::Coordinates measures = J.traits.measures;
+    if (!measures.any())
+      i.fail("joint '" + n + "' is a " + J.type + " joint: outputs measure the angle of a " +
+             joint_type_list([](const JointTraits& t) { return t.measures.angle; }) + " joint, or the distance of a " +
+             joint_type_list([](const JointTraits& t) { return t.measures.distance; }) +
+             " one (output its bodies' orientations instead)");
     try {
-      if (angle) plan.joints.push_back(output_joint(n, JointMeasure::kAngle, J.a, J.b));
-      if (distance) plan.joints.push_back(output_joint(n, JointMeasure::kDistance, J.a, J.b));
+      if (measures.angle) plan.joints.push_back(output_joint(n, JointMeasure::kAngle, J.a, J.b));
+      if (measures.distance) plan.joints.push_back(output_joint(n, JointMeasure::kDistance, J.a, J.b));
     } catch (const Error& e) {
       i.fail(e.what());
     }

@@ -214,9 +214,11 @@ class SceneReader {
   std::vector<Frame2> planar_bodies_;
   std::vector<Frame3> spatial_bodies_;
   NameTable<Point3> vectors_;
-  // Named spatial joints, for the drivers that measure them.
+  // Named spatial joints, for the drivers, outputs and shafts that refer to them: what each offers is its kind's
+  // JointTraits (kinds/registry.hpp lists the types each accepts).
   struct Joint3 {
     std::string type;
+    JointTraits traits;
     JointSide3 a, b;
   };
   std::unordered_map<std::string, Joint3> joints3_;

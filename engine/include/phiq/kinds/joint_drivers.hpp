@@ -1,7 +1,8 @@
 /// @file
-/// Drivers on a spatial joint: its translation (prismatic, cylindrical, screw) or its rotation (revolute, cylindrical, screw). One constraint kind (or one family of
-/// kinds sharing a row table): equation, derivatives, validation, joint count, sketch and scene form; the contract
-/// is documented on DistanceSpec, and kinds/registry.hpp lists every kind.
+/// Drivers on a spatial joint: its translation or its rotation, as the joint's kind allows (JointTraits::drives:
+/// a prismatic's translation, a revolute's rotation, a cylindrical's or a screw's either). One constraint kind each:
+/// equation, derivatives, validation, joint count, sketch and scene form; the contract is documented on
+/// DistanceSpec, and kinds/registry.hpp lists every kind.
 #pragma once
 
 #include <cmath>
@@ -12,7 +13,7 @@
 
 namespace phiq {
 
-/// Driver on the translation of a prismatic or cylindrical joint: the distance of P_b from P_a along z_a.
+/// Driver on the translation of a joint (prismatic, cylindrical, screw): the distance of P_b from P_a along z_a.
 ///   Φ = z_a · (P_b − P_a) − f(t),   Φt = −f'(t)        (1 row, a length)
 /// Scene: a driver `{joint: NAME, measure: distance}`.
 struct JointDistanceDriverSpec {
@@ -91,7 +92,7 @@ struct JointDistanceDriverSpec {
   }
 };
 
-/// Driver on the rotation of a revolute or cylindrical joint: the angle θ of x_b about z_a measured from x_a,
+/// Driver on the rotation of a joint (revolute, cylindrical, screw): the angle θ of x_b about z_a measured from x_a,
 /// with c = x_a · x_b and s = y_a · x_b (so x_b = cos θ x_a + sin θ y_a when the axes are aligned):
 ///   Φ = atan2(s cos f − c sin f,  c cos f + s sin f)     = θ − f(t) wrapped to (−π, π]
 /// The difference is taken as the angle of (c, s) turned back by f, not as atan2(s, c) − f: smooth at any θ, so a

@@ -272,4 +272,32 @@ struct SceneForm {
   const char* example;  ///< the documented YAML entry, one line
 };
 
+/// What a named spatial joint of some kind offers the rest of its scene: the coordinates it measures (the columns
+/// of `output.joints`), those a joint driver may drive (`measure: angle | distance`), and whether it is a shaft
+/// (it turns about its axis z_a: the shaft of a `spatial_gear`, the joint of a `rotation_angle`). A kind states
+/// them beside its kKind as `static constexpr JointTraits kJoint{...}`; a kind that states none is no such joint.
+/// kinds/registry.hpp derives from them the joint types the scene reader accepts and its messages' lists.
+struct JointTraits {
+  /// A joint's coordinates: its angle θ, the turn of x_b about z_a from x_a (c = x_a · x_b, s = y_a · x_b), and
+  /// its distance d = z_a · (P_b − P_a), the travel along the axis.
+  struct Coordinates {
+    bool angle = false;     ///< θ (rad)
+    bool distance = false;  ///< d (m)
+    /// Whether it has either.
+    constexpr bool any() const { return angle || distance; }
+  };
+  Coordinates measures;  ///< what `output.joints` writes of it (columns `J.angle`, `J.distance`)
+  Coordinates drives;    ///< what a joint driver may drive (and, when only one, the driver's default measure)
+  bool shaft = false;    ///< turns about its axis in its bearing (side a the housing, side b the shaft)
+};
+
+/// The joint traits of kind K: its kJoint, or none.
+template <class K>
+constexpr JointTraits joint_traits() {
+  if constexpr (requires { K::kJoint; })
+    return K::kJoint;
+  else
+    return JointTraits{};
+}
+
 }  // namespace phiq

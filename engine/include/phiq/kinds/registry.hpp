@@ -2,13 +2,17 @@
 /// The registry of constraint kinds: the one list that the model builder, the scene reader, the mechanism sketch,
 /// the Grübler count, the documentation and the tests iterate over. A new kind is one header in kinds/ (its
 /// equation in a comment, residual, Jacobian entries, Φt, γ, the validation of its data, its joint count, its
-/// sketch, its scene forms and its value equality), one line below, and one finite-difference test; the
-/// ConstraintKind concept refuses at compile time a registered kind that lacks any of these members, and tests/test_kind_registry.cpp fails for
-/// one without a finite-difference check, without its scene examples in models/README.md, or with a constraint type
-/// missing from the fuzzing dictionary or claimed by another kind.
+/// sketch, its scene forms, its value equality and, for a joint that others refer to by name, its JointTraits), one
+/// line below, and one finite-difference test; the ConstraintKind concept refuses at compile time a registered kind
+/// that lacks any of these members, and tests/test_kind_registry.cpp fails for one without a finite-difference
+/// check, without its scene examples in models/README.md, or with a constraint type missing from the fuzzing
+/// dictionary or claimed by another kind. The joint types that joint drivers, `output.joints` and shafts accept are
+/// derived from the kinds' JointTraits (joint_types(), below).
 #pragma once
 
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "phiq/kinds/constant_angle.hpp"
 #include "phiq/kinds/coordinate_driver.hpp"
@@ -110,5 +114,60 @@ static_assert(all_kinds(static_cast<ConstraintKinds*>(nullptr)),
               "a registered constraint kind lacks a member of the ConstraintKind concept (see DistanceSpec)");
 }  // namespace detail
 /// @endcond
+
+/// A kind read as a named spatial joint: its sides a and b (the scene reader keeps them by name, for the joint
+/// drivers, `output.joints` and the shafts that refer to the joint).
+template <class K>
+concept SpatialJointKind = requires(const K& k) {
+  { k.a } -> std::convertible_to<JointSide3>;
+  { k.b } -> std::convertible_to<JointSide3>;
+};
+
+/// @cond internal
+namespace detail {
+// A kind with joint traits (JointTraits) is a spatial joint written in the constraints section of dimension 3; what
+// a driver drives of it, its outputs measure (the driven value can be read back), and a shaft measures its angle.
+template <class K>
+constexpr bool joint_traits_fit() {
+  const JointTraits t = joint_traits<K>();
+  if (!t.measures.any() && !t.drives.any() && !t.shaft) return true;
+  if ((t.drives.angle && !t.measures.angle) || (t.drives.distance && !t.measures.distance)) return false;
+  if (t.shaft && !t.measures.angle) return false;
+  if constexpr (!SpatialJointKind<K>) return false;
+  for (const SceneForm& f : K::kScene)
+    if (std::string_view(f.section) != "constraints" || f.dimension != 3) return false;
+  return true;
+}
+template <class... K>
+constexpr bool all_joint_traits_fit(KindList<K...>*) {
+  return (joint_traits_fit<K>() && ...);
+}
+static_assert(all_joint_traits_fit(static_cast<ConstraintKinds*>(nullptr)),
+              "a kind with JointTraits must be a spatial joint (sides a and b) written only as a constraint of "
+              "dimension 3, measure what it drives, and measure its angle if a shaft");
+}  // namespace detail
+/// @endcond
+
+/// The scene types of the joints whose traits satisfy `select` (a predicate on JointTraits), in registry order:
+/// the one list of the joint types that `output.joints`, the joint drivers and the shafts of transmissions accept.
+template <class Select>
+std::vector<std::string_view> joint_types(Select select) {
+  std::vector<std::string_view> types;
+  ConstraintKinds::for_each([&]<class K>() {
+    if (select(joint_traits<K>()))
+      for (const SceneForm& f : K::kScene) types.push_back(f.type);
+  });
+  return types;
+}
+
+/// joint_types(select) as a message lists them: "revolute, cylindrical or screw".
+template <class Select>
+std::string joint_type_list(Select select) {
+  const std::vector<std::string_view> types = joint_types(select);
+  std::string list;
+  for (std::size_t k = 0; k < types.size(); ++k)
+    list += (k == 0 ? "" : k + 1 == types.size() ? " or " : ", ") + std::string(types[k]);
+  return list;
+}
 
 }  // namespace phiq

@@ -40,6 +40,9 @@ struct ScrewSpec {
   static constexpr int kRows = 5;  ///< the cylindrical joint's 4 rows and the helix
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "screw";
+  /// Its angle and its travel (tied by the pitch): output, driven (either one), and a shaft.
+  static constexpr JointTraits kJoint{
+      .measures = {.angle = true, .distance = true}, .drives = {.angle = true, .distance = true}, .shaft = true};
   /// @var a
   /// @brief Side a (the nut, or ground): its axis z_a is the screw's axis.
   JointSide3 a, b;      ///< side b (the screw)

@@ -148,6 +148,8 @@ struct SpatialJointSpec {
   static constexpr int kRows = Traits::kRows;  ///< the freedoms the joint removes
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = Traits::kKind;
+  /// What a named joint of this type measures and may be driven by (JointTraits): `Traits::kJoint`, or nothing.
+  static constexpr JointTraits kJoint = joint_traits<Traits>();
   /// @var a
   /// @brief Side a: its joint frame carries the axis of one-sided rows (lines, planes).
   JointSide3 a, b;  ///< side b
@@ -269,6 +271,8 @@ struct Spherical {
 struct Revolute {
   static constexpr int kRows = 5;  ///< rows: the freedoms it removes
   static constexpr const char* kKind = "revolute";  ///< scene type and diagnostics name
+  /// its angle: output, driven, and a shaft
+  static constexpr JointTraits kJoint{.measures = {.angle = true}, .drives = {.angle = true}, .shaft = true};
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
       {"constraints", "revolute", 3, "- {name: hinge, type: revolute, between: [{body: ground, at: [0, 0, 1], "
@@ -283,6 +287,9 @@ struct Revolute {
 struct Cylindrical {
   static constexpr int kRows = 4;  ///< rows: the freedoms it removes
   static constexpr const char* kKind = "cylindrical";  ///< scene type and diagnostics name
+  /// its angle and its distance: output, driven (one each), and a shaft
+  static constexpr JointTraits kJoint{
+      .measures = {.angle = true, .distance = true}, .drives = {.angle = true, .distance = true}, .shaft = true};
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
       {"constraints", "cylindrical", 3, "- {name: cyl, type: cylindrical, between: [{body: ground, axis: [1, 0, "
@@ -296,6 +303,8 @@ struct Cylindrical {
 struct Prismatic {
   static constexpr int kRows = 5;  ///< rows: the freedoms it removes
   static constexpr const char* kKind = "prismatic";  ///< scene type and diagnostics name
+  /// its distance: output and driven
+  static constexpr JointTraits kJoint{.measures = {.distance = true}, .drives = {.distance = true}};
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
       {"constraints", "prismatic", 3, "- {name: slide, type: prismatic, between: [{body: ground, axis: [1, 0, 0]}, "

@@ -294,7 +294,7 @@ struct SpatialAngleSpec {
     } else {
       f.expect({"type", "name", "between", "joint", "angle"});
       if (f.present("joint") == f.present("between"))
-        f.fail("", "give either 'between: [S1, S2]' or 'joint: NAME' (a revolute, cylindrical or screw joint)");
+        f.fail("", "give either 'between: [S1, S2]' or 'joint: NAME' (a " + f.shaft_types() + " joint)");
       std::tie(s.a, s.b) = f.present("joint") ? f.turning_joint("joint") : f.sides3("between");
     }
     s.theta = Slot::coordinate(f.coordinate("angle"));
