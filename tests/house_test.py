@@ -216,3 +216,13 @@ def test_cxx_sources_are_formatted():
     lines = sorted({rel(l.split(":")[0]) for l in done.stderr.splitlines() if ": error:" in l})
     assert done.returncode == 0, ("not formatted as .clang-format says (run tools/format.sh): " +
                                   ", ".join(lines[:20]) + (f" and {len(lines) - 20} more files" if len(lines) > 20 else ""))
+
+
+def test_readme_cpp_tour_is_the_compiled_one():
+    # README.md's C++ block (its #include aside) is the code tests/test_api_example.cpp compiles and checks.
+    with open(os.path.join(ROOT, "tests", "test_api_example.cpp"), encoding="utf-8") as f:
+        block = f.read().split("// ---- begin README ----\n")[1].split("// ---- end README ----")[0]
+    compiled = [l[2:] if l.startswith("  ") else l for l in block.rstrip().split("\n")]
+    with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:
+        shown = re.search(r"```cpp\n(.*?)```", f.read(), re.S).group(1).rstrip().split("\n")
+    assert [l for l in shown if not l.startswith("#include")] == compiled, "README.md's C++ tour drifted"

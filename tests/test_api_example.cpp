@@ -17,6 +17,7 @@ TEST(ApiExample, ReadmeTourRunsAndMatchesTheClosedForm) {
     EXPECT_NEAR(qdd(0), 0.0, 1e-12);
     ++rows;
   };
+  // clang-format off
   // ---- begin README ----
   using namespace phiq;
   ModelBuilder b;                                       // the notes' crank-slider, q = [θ2, xA, yA, xB]
@@ -31,6 +32,7 @@ TEST(ApiExample, ReadmeTourRunsAndMatchesTheClosedForm) {
     if (const double t = 0.01 * k; stepper.step(t) == SolveStatus::kSuccess)
       use(t, stepper.q(), stepper.qd(), stepper.qdd()); // positions, velocities, accelerations
   // ---- end README ----
+  // clang-format on
   EXPECT_EQ(rows, 101);
   EXPECT_LT(worst, 1e-10);
   // the sweep's work: the assembly, then one modified-Newton iteration and one factorisation per step (the loop of
