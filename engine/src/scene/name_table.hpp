@@ -33,7 +33,8 @@ class NameTable {
   void reserve(std::size_t more) {
     const std::size_t n = values_.size() + more;
     index_.reserve(n);
-    if (n > values_.capacity()) values_.reserve(std::max(n, 2 * values_.capacity())), names_.reserve(values_.capacity());
+    if (n > values_.capacity())
+      values_.reserve(std::max(n, 2 * values_.capacity())), names_.reserve(values_.capacity());
   }
   const std::string& name(Index k) const { return names_[static_cast<std::size_t>(k)]; }
   T& operator[](Index k) { return values_[static_cast<std::size_t>(k)]; }
