@@ -330,5 +330,73 @@ TEST(RedundantScenes, ParallelogramWithFifthBarCountsZero) {
   EXPECT_EQ(*s.model->grubler(), 0);
 }
 
+// A body turning about a fixed axis at 0.25 + 1.7 t rad, 64 steps over 8 s: chunks of 16 steps, 3.4 rad each.
+// A chunk's seed, found over that span at once, lands on −e (the same orientation), where the sweep in order
+// follows e on continuously; the seed is turned to the sign its motion continues with before the chunk starts.
+const char* kTurningBody = R"(phiq: 1
+name: turning
+dimension: 3
+bodies:
+  b: {at: [0, 0, 0]}
+constraints:
+  - {name: hinge, type: revolute,
+     between: [{body: ground, axis: [0, 0, 1], ref: [1, 0, 0]}, {body: b, axis: [0, 0, 1], ref: [1, 0, 0]}]}
+drivers:
+  - {name: motor, joint: hinge, measure: angle, law: {type: linear, initial: 0.25, rate: 1.7}}
+time: {start: 0, end: 8, steps: 64}
+output: {velocities: true, accelerations: true}
+)";
+
+TEST(SpatialScenes, TurningBodyKeepsItsThreadsAcrossTheSignOfItsEulerParameters) {
+  const Scene s = parse_scene(kTurningBody, "turning.yaml");
+  const Model& m = *s.model;
+  const Index e0 = m.coordinate_index("b_e0"), e3 = m.coordinate_index("b_e3");
+  SweepOptions opt = s.sweep;
+  test::Trace one, two, in_order;
+  SweepSummary s1, s2, so;
+  opt.threads = 1;
+  ASSERT_EQ(test::sweep(m, opt, &one, &s1), SolveStatus::kSuccess) << s1.message;
+  opt.threads = 2;
+  ASSERT_EQ(test::sweep(m, opt, &two, &s2), SolveStatus::kSuccess) << s2.message;
+  for (const SweepWarning& w : s2.warnings) ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
+  EXPECT_EQ(s2.threads, 2);
+  EXPECT_EQ(s2.parallel_chunks, 4);  // every chunk delivered as computed: none ran in order after a fallback
+  ASSERT_EQ(two.t.size(), 65u);
+  ASSERT_EQ(one.t.size(), 65u);
+  opt.threads = 1, opt.chunk_steps = opt.steps;
+  ASSERT_EQ(test::sweep(m, opt, &in_order, &so), SolveStatus::kSuccess) << so.message;
+  for (std::size_t k = 0; k < two.t.size(); ++k) {
+    SCOPED_TRACE("t = " + std::to_string(two.t[k]));
+    // the same bits on one thread and two
+    EXPECT_EQ(two.t[k], one.t[k]);
+    EXPECT_TRUE(two.q[k] == one.q[k] && two.qd[k] == one.qd[k] && two.qdd[k] == one.qdd[k]);
+    // e = (cos θ/2, 0, 0, sin θ/2), continuous from row 0: θ itself modulo 4π, not only the orientation (2π)
+    const double theta = 0.25 + 1.7 * two.t[k];
+    EXPECT_NEAR(std::remainder(2.0 * std::atan2(two.q[k][e3], two.q[k][e0]) - theta, 4.0 * M_PI), 0.0, 1e-10);
+    EXPECT_NEAR(two.qd[k][e3], 0.85 * std::cos(theta / 2), 1e-10);
+    EXPECT_NEAR((two.q[k] - in_order.q[k]).lpNorm<Eigen::Infinity>(), 0.0, 1e-10);
+  }
+}
+
+TEST(SpatialScenes, CardanBranchSwitchFallsBackNamingTheBranch) {
+  // The near-singular Cardan joint's chunk seeded on the other assembly mode (θ2 + π: another orientation, not
+  // −e) is still refused at its seam, and the warning says it was another branch, not a failure or a sign.
+  const Scene s = Load("spatial/cardan_near_singular.yaml");
+  SweepOptions opt = s.sweep;
+  opt.threads = 2;
+  SweepSummary sum;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(*s.model, opt, &tr, &sum), SolveStatus::kSuccess) << sum.message;
+  ASSERT_EQ(sum.warnings.size(), 1u);
+  EXPECT_EQ(sum.warnings[0].kind, "parallel_fallback");
+  const std::string& why = sum.warnings[0].message;
+  EXPECT_NE(why.find("did not continue the sweep in order: its first row is another branch: "), std::string::npos)
+      << why;
+  EXPECT_NE(why.find(" tolerances from where the sweep in order arrives; the remaining steps ran in order"),
+            std::string::npos)
+      << why;
+  ExpectCardanClosedForm(*s.model, tr, 89.0 * M_PI / 180.0, 1.5, "x2");
+}
+
 }  // namespace
 }  // namespace phiq

@@ -11,6 +11,8 @@
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <sstream>
+#include <string>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -21,6 +23,7 @@
 
 #include "phiq/text.hpp"
 #include "solve/factorisation.hpp"
+#include "sweep/euler_signs.hpp"
 #include "sweep/streamed_rows.hpp"
 
 namespace phiq::detail {
@@ -32,6 +35,24 @@ namespace {
 // finite distance away).
 bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b, double tol, double limit) {
   return detail::scaled_distance(model, a.data(), b, a.data(), tol) <= limit;
+}
+
+// Why a parallel chunk's first row q0 (null: it did not converge, `failure` saying why) is not where the sweep in
+// order arrives, seam_q (null: unknown), beyond `limit` tolerances: the parallel_fallback warning's cause.
+std::string rejection_cause(const Model& model, const std::string& failure, const Eigen::VectorXd* seam_q,
+                            const double* q0, double tol, double limit) {
+  if (!q0) return "its first row did not converge from its seed (" + failure + ")";
+  if (!seam_q) return "the chunk before it did not reach the chunk's first time point (its seam step failed)";
+  Eigen::VectorXd turned = Eigen::Map<const Eigen::VectorXd>(q0, seam_q->size());
+  if (EulerSeedSigns(model).turn_like(seam_q->data(), turned) &&
+      same_solution(model, *seam_q, turned.data(), tol, limit))
+    return "its first row has the other sign of a body's Euler parameters (e and −e: one orientation) than the "
+           "sweep in order";
+  std::ostringstream m;
+  m.precision(3);
+  m << "its first row is another branch: " << detail::scaled_distance(model, seam_q->data(), q0, seam_q->data(), tol)
+    << " tolerances from where the sweep in order arrives";
+  return m.str();
 }
 
 // Sub-steps of a positions-only sweep's first seed (see seed_one).
@@ -209,9 +230,16 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   // must start where the sweep, continued in order from the last delivered row, arrives (the previous chunk's
   // seam). Two solutions of the same problem agree to 100 tolerances, or, where Newton stopped at the rounding level
   // (a long chain), to 10× how well that stop says q is known: another branch is a finite distance away.
+  auto seam_limit = [&](const Chunk& ch) { return std::max(100.0, 10.0 * std::max(seam_rounding, ch.first_rounding)); };
   auto continues = [&](const Chunk& ch, const double* q0) {
-    const double limit = std::max(100.0, 10.0 * std::max(seam_rounding, ch.first_rounding));
-    return ch.k0 == 1 || (seam_known && same_solution(model, seam_q, q0, opt.newton.tolerance, limit));
+    return ch.k0 == 1 || (seam_known && same_solution(model, seam_q, q0, opt.newton.tolerance, seam_limit(ch)));
+  };
+  // Why a chunk whose first row is q0 (null: it has none) does not continue the sweep, for the parallel_fallback
+  // warning (set by the caller's thread, which alone delivers).
+  std::string fallback_cause;
+  auto not_continued = [&](const Chunk& ch, const double* q0) {
+    fallback_cause = rejection_cause(model, ch.sum.message, seam_known ? &seam_q : nullptr, q0, opt.newton.tolerance,
+                                     seam_limit(ch));
   };
   // A chunk delivered (its first `good` rows): the state an ordered continuation starts from, its seam, and its
   // summary, up to its last good row. Returns 0 when every row was good, 3 when it failed after them (the rest
@@ -259,7 +287,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
       good_sum.singular_positions = ch.sum.singular_positions;
       good_sum.min_rcond = ch.sum.min_rcond, good_sum.min_rcond_time = ch.sum.min_rcond_time;
       if (stream) {
-        if (ch.good == 0 && !continues(ch, st.q.data())) return outcome = 1, false;
+        if (ch.good == 0 && !continues(ch, st.q.data())) return not_continued(ch, st.q.data()), outcome = 1, false;
         ++ch.good;
         if (!run.deliver(k, st.q, st.qd, st.qdd, s.motions(), w.phi, s.rcond(), s.det_sign(),
                          s.det_sign_time(), s.row_quality())) {
@@ -314,6 +342,7 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     if (stream && outcome == 0) {
       if (ch.good == 0) {
         outcome = 1;  // no first row: rejected, the rest runs in order
+        not_continued(ch, nullptr);
       } else {
         add_counters(others, ch.sum.counters, WorkCounters{});
         outcome = finish(ch, ch.end.q, ch.end.qd, ch.end.qdd);
@@ -327,7 +356,8 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   // Accepts and delivers a chunk computed ahead: 0 delivered, 1 rejected (the rest runs in order), 2 stopped by the
   // caller, 3 failed after its first rows, which are delivered (the rest runs in order from there).
   auto deliver_chunk = [&](Chunk& ch) {
-    if (ch.good == 0 || !continues(ch, ch.rows[0].q.data())) return 1;
+    if (ch.good == 0 || !continues(ch, ch.rows[0].q.data()))
+      return not_continued(ch, ch.good == 0 ? nullptr : ch.rows[0].q.data()), 1;
     for (Index k = ch.k0; k < ch.k0 + ch.good; ++k) {
       const Row& r = ch.rows[static_cast<std::size_t>(k - ch.k0)];
       if (!run.deliver(k, r.q, r.qd, r.qdd, r.motions(), r.phi, r.rcond, r.det_sign,
@@ -370,6 +400,8 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
   Sweeper seeder(model, seed_options, *sws, seed_summary);
   seeder.adopt(run.time_of(0));
   release(sws);
+  EulerSeedSigns euler_signs(model);  // each seed on the sign of Euler parameters the sweep in order continues with
+  euler_signs.start(run.time_of(0), last_q, need_v ? last_qd : Eigen::VectorXd());
 
   // The schedule. `threads` loops run the work as it becomes ready: the seeding (in order, one thread at a time,
   // first whenever fewer chunks are ready than threads, so that it stays ahead) and the seeded chunks (lowest
@@ -415,6 +447,9 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
       first[static_cast<std::size_t>(c)] = row;  // (chunk c − 1, which ends here, is not claimed before: ready)
       seeds[static_cast<std::size_t>(c)] = seeder.state().q;
       seed_error[static_cast<std::size_t>(c)] = seeder.state_error();
+      // (a seed turned to −e is checked by a Newton step, as an unknown one is)
+      if (euler_signs.align(run.time_of(row), seeds[static_cast<std::size_t>(c)]))
+        seed_error[static_cast<std::size_t>(c)] = INFINITY;
       seed_rounding[static_cast<std::size_t>(c)] = seeder.take_rounding_level();
     }
     const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();
@@ -524,8 +559,8 @@ void parallel_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, 
     if (fallback)
       sum.warnings.push_back({run.time_of(resume), "parallel_fallback",
                               "the parallel chunk starting at t = " + format_time(run.time_of(resume)) +
-                                  " did not continue the sweep in order (another branch, or a failure); the "
-                                  "remaining steps ran in order"});
+                                  " did not continue the sweep in order: " + fallback_cause +
+                                  "; the remaining steps ran in order"});
     ws.start_afresh();  // as a chunk starts: from the row alone, whatever the workspace solved last
     Sweeper rest(model, opt, ws, sum);
     rest.adopt(run.time_of(resume - 1));

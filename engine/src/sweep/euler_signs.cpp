@@ -1,0 +1,124 @@
+// A parallel chunk's seed turned to the sign of Euler parameters its bodies' motion continues with (euler_signs.hpp).
+#include "sweep/euler_signs.hpp"
+
+#include <cmath>
+
+#include "phiq/constraint_block.hpp"
+#include "phiq/kinds/euler_parameters.hpp"
+
+namespace phiq::detail {
+
+namespace {
+
+using Quat = std::array<double, 4>;
+
+// A seed is turned over only where it is clearly the opposite of the orientation expected (the 4-vectors within
+// 26° of opposite): where the motion is not at a steady rate the extrapolation errs, and a seed left as it is
+// costs at worst the chunk (the seam check refuses it), one turned wrongly too. The near-singular Cardan joint's
+// output shaft, extrapolated from row 0's rate over a chunk (its speed falls from 57 times the input's), comes
+// out at −0.64 with its seed on the right sign.
+constexpr double kOpposite = -0.9;
+
+// The Hamilton product a ⊗ b (scalar part first).
+Quat product(const Quat& a, const Quat& b) {
+  return {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3], a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+          a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1], a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+}
+Quat conjugate(const Quat& a) { return {a[0], -a[1], -a[2], -a[3]}; }
+
+// The turn by angle 2·half about the unit axis along v (any axis when v is zero).
+Quat turn(double half, double vx, double vy, double vz) {
+  const double norm = std::sqrt(vx * vx + vy * vy + vz * vz), s = norm > 0.0 ? std::sin(half) / norm : 0.0;
+  return {std::cos(half), s * vx, s * vy, s * vz};
+}
+
+}  // namespace
+
+EulerSeedSigns::EulerSeedSigns(const Model& model) {
+  // A body's sign is free when its Euler parameters are coordinates or constants 0 (−e then solves its equations
+  // too); a constant non-zero one fixes it.
+  for (const auto& block : model.blocks()) {
+    const auto* euler = dynamic_cast<const TypedBlock<EulerParametersSpec>*>(block.get());
+    if (!euler) continue;
+    for (std::size_t i = 0; i < euler->size(); ++i) {
+      std::array<Index, 4> body{};
+      bool free = true;
+      for (int k = 0; k < 4; ++k) {
+        const Slot& s = euler->spec(i).e[k];
+        body[static_cast<std::size_t>(k)] = s.coord();
+        free = free && (s.is_coordinate() || s.value() == 0.0);
+      }
+      if (free) bodies_.push_back(body);
+    }
+  }
+  last_.resize(bodies_.size()), before_.resize(bodies_.size()), rate_.resize(bodies_.size());
+}
+
+void EulerSeedSigns::start(double t0, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  has_rate_ = qd.size() == q.size();
+  for (std::size_t b = 0; b < bodies_.size(); ++b)
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Index j = bodies_[b][k];
+      last_[b][k] = j < 0 ? 0.0 : q[j];
+      rate_[b][k] = j < 0 || !has_rate_ ? 0.0 : qd[j];
+    }
+  t_last_ = t0;
+  known_ = 1;
+}
+
+namespace {
+
+// Turns q's Euler parameters of `body` (0 − x: a zero stays +0, as the sweep in order has it).
+void turn_over(const std::array<Index, 4>& body, Eigen::VectorXd& q) {
+  for (const Index j : body)
+    if (j >= 0) q[j] = 0.0 - q[j];
+}
+
+}  // namespace
+
+bool EulerSeedSigns::turn_like(const double* reference, Eigen::VectorXd& q) const {
+  bool turned = false;
+  for (const std::array<Index, 4>& body : bodies_) {
+    double dot = 0.0;
+    for (const Index j : body)
+      if (j >= 0) dot += q[j] * reference[j];
+    if (dot < 0.0) turn_over(body, q), turned = true;
+  }
+  return turned;
+}
+
+bool EulerSeedSigns::align(double t, Eigen::VectorXd& seed) {
+  bool turned = false;
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const std::array<Index, 4>& body = bodies_[b];
+    Quat e{};
+    for (std::size_t k = 0; k < 4; ++k) e[k] = body[k] < 0 ? 0.0 : seed[body[k]];
+    // the orientation expected at t, turning at a constant rate: the turn from the seed before last to the last,
+    // carried on over (t − t_last) (ė = ½ ω ⊗ e: from row 0 and its rate, the turn ω (t − t0))
+    // (with neither, the seed keeps its sign: a positions-only first seed, which the seeding pass reached in
+    // sub-steps, knows its sign better than row 0 alone does)
+    Quat expected{};
+    if (known_ >= 2) {
+      const Quat r = product(last_[b], conjugate(before_[b]));
+      const double half = std::atan2(std::sqrt(r[1] * r[1] + r[2] * r[2] + r[3] * r[3]), r[0]);
+      const double s = (t - t_last_) / (t_last_ - t_before_);
+      expected = product(turn(s * half, r[1], r[2], r[3]), last_[b]);
+    } else if (has_rate_) {
+      const Quat w = product(rate_[b], conjugate(last_[b]));  // ½ ω
+      const double half = std::sqrt(w[1] * w[1] + w[2] * w[2] + w[3] * w[3]) * (t - t_last_);
+      expected = product(turn(half, w[1], w[2], w[3]), last_[b]);
+    }
+    const double dot = e[0] * expected[0] + e[1] * expected[1] + e[2] * expected[2] + e[3] * expected[3];
+    if (dot < kOpposite) {
+      turn_over(body, seed);
+      for (double& x : e) x = 0.0 - x;
+      turned = true;
+    }
+    before_[b] = last_[b], last_[b] = e;
+  }
+  t_before_ = t_last_, t_last_ = t;
+  ++known_;
+  return turned;
+}
+
+}  // namespace phiq::detail

@@ -1,0 +1,47 @@
+// The sign of a parallel chunk's seed's Euler parameters. e and −e are one orientation, so both solve a spatial
+// body's equations, and the seeding pass, stepping a chunk's whole span at once, reaches whichever its Newton is
+// nearer: a body turning more than a quarter turn per chunk span gets a seed on −e, and the chunk, though in the
+// right orientation, is refused at its seam (the sweep in order follows e continuously). Each seed is turned, body
+// by body, to the sign its motion continues with, before the chunk starts from it (parallel_sweep.cpp).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "phiq/model.hpp"
+
+namespace phiq::detail {
+
+// The coordinates (e0 … e3) of each body whose four Euler parameters are all coordinates, and the seeds' Euler
+// parameters before the one being aligned (their times, the sign they continue with). A seed's sign is that of the
+// orientation extrapolated at its time as a rotation: at constant turning rate, from the two seeds before it, or
+// from row 0 and its q̇ (positions only: the first seed keeps the sign the seeding pass reached in sub-steps); right
+// while a body turns less than a half turn per chunk span (an extrapolation of e itself, component by component,
+// turns the sign before a quarter turn). A seed is turned only where it is clearly opposite (euler_signs.cpp).
+class EulerSeedSigns {
+ public:
+  explicit EulerSeedSigns(const Model& model);
+  // Whether the model has a body whose sign can be wrong (else align() does nothing).
+  bool empty() const { return bodies_.empty(); }
+  // Row 0's position at t0, and its q̇ where the sweep solves it (empty otherwise).
+  void start(double t0, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  // Turns `seed`'s Euler parameters, body by body, to the sign of the orientation extrapolated at t from the
+  // seeds aligned before (seeds come in time order). Returns whether any body's were turned.
+  bool align(double t, Eigen::VectorXd& seed);
+  // Turns q's Euler parameters, body by body, to the sign of those of `reference` (same size). Returns whether any
+  // body's were turned.
+  bool turn_like(const double* reference, Eigen::VectorXd& q) const;
+
+ private:
+  using Quat = std::array<double, 4>;
+  std::vector<std::array<Index, 4>> bodies_;
+  // per body: the last two aligned seeds' (row 0's first) Euler parameters, and row 0's rate
+  std::vector<Quat> last_, before_, rate_;
+  double t_last_ = 0.0, t_before_ = 0.0;
+  int known_ = 0;  // seeds (row 0 included) in last_, before_
+  bool has_rate_ = false;
+};
+
+}  // namespace phiq::detail
