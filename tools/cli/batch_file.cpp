@@ -253,6 +253,16 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       } else if (a.resume) {
         resumed = read_resume_point(a.out, header, n);
       }
+      if (resumed.first > 0) {  // an earlier run cut inside its last case: that case runs again
+        phiq::SceneOverrides o = case_overrides(cases, resumed.first - 1, a.cases);
+        o.share_analysis_with = reference->model.get();
+        std::size_t case_rows = 0;  // (a case whose scene cannot be read writes none)
+        try {
+          case_rows = static_cast<std::size_t>(phiq::rows_written(trees.front().read(o).sweep));
+        } catch (const phiq::SceneError&) {
+        }
+        drop_unfinished_case(resumed, case_rows, a.out);
+      }
       if (hdf5) check_hdf5_target(a.out);
       file = &outputs.add(a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
                                       : phiq::AtomicOutputFile::Hold::kOpen);
@@ -268,6 +278,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
         if (resumed.first > 0) {  // the earlier file, copied to be appended to (its own stays whole meanwhile)
           std::filesystem::copy_file(a.out, file->temporary_path(), std::filesystem::copy_options::overwrite_existing);
           o.append = true;
+          o.append_after_rows = resumed.rows;
         }
         h5 = std::make_unique<phiq::Hdf5Writer>(file->temporary_path(), *reference->model, reference->sweep, o);
       } else if (resumed.first > 0) {

@@ -54,6 +54,8 @@ struct Hdf5Options {
   /// the plan's datasets must be there with its columns and all with as many rows, else phiq::Error "PATH: cannot
   /// write: not results of this layout: …". The file's bytes then depend on how it was written, not its values.
   bool append = false;
+  /// With `append`: the file's rows kept, those after them cut (a batch's last case, cut inside it, run again).
+  std::size_t append_after_rows = static_cast<std::size_t>(-1);
 };
 
 /// Version of the batch layout (Hdf5Options::case_column): the run layout with a /case dataset first.

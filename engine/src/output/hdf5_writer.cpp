@@ -76,7 +76,7 @@ struct Hdf5Writer::Impl {
   std::string cannot(const std::string& why) const { return path + ": cannot write: " + why; }
   void create(const Hdf5Options& o);
   void create_dataset(Group& g, const Hdf5Options& o);
-  void open_to_append(const Hid& fapl);  // Hdf5Options::append
+  void open_to_append(const Hid& fapl, std::size_t keep_rows);  // Hdf5Options::append
   void flush();
 };
 
@@ -163,7 +163,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   if (o.deflate > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0) throw Error(cannot("HDF5 has no deflate filter"));
 
   const Hid fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, cannot("file access list"));
-  if (o.append) return open_to_append(fapl);
+  if (o.append) return open_to_append(fapl, o.append_after_rows);
   // The 1.8 file format: attributes larger than 64 KiB (the names of 10⁴ coordinates) go to dense storage, and
   // readers from HDF5 1.8 on (MATLAB, older h5py) can open the file.
   check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18), cannot("file format"));
@@ -197,7 +197,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   }
 }
 
-void Hdf5Writer::Impl::open_to_append(const Hid& fapl) {
+void Hdf5Writer::Impl::open_to_append(const Hid& fapl, std::size_t keep_rows) {
   check(H5Pset_file_locking(fapl.get(), false, true), cannot("file locking"));
   file = checked(H5Fopen(file_path.c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, path + ": cannot write");
   // each group's dataset as this plan makes it: its columns, and as many rows as every other
@@ -216,6 +216,12 @@ void Hdf5Writer::Impl::open_to_append(const Hid& fapl) {
     if (dims[0] != written_rows) throw Error(what + " has another number of rows");
     g.held.resize(block_rows * g.columns.size());
   }
+  if (keep_rows >= written_rows) return;
+  for (Group& g : groups) {
+    const hsize_t extent[2] = {keep_rows, g.columns.size()};
+    check(H5Dset_extent(g.dataset.get(), extent), cannot(std::string("dataset /") + g.name));
+  }
+  written_rows = keep_rows;
 }
 
 void Hdf5Writer::Impl::create_dataset(Group& g, const Hdf5Options& o) {
