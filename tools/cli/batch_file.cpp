@@ -15,6 +15,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 
 #include "batch_resume.hpp"
@@ -456,7 +457,13 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       if (m.kind == CaseMessage::Kind::kDone) deliver(static_cast<std::size_t>(m.k), from_message(std::move(m)));
     };
     h.halted = halted;
-    all_threads = run_cases(ranks, resumed.first, n, a.threads, h);
+    try {
+      all_threads = run_cases(ranks, resumed.first, n, a.threads, h);
+    } catch (const std::bad_alloc&) {  // a worker's: nothing is published (the temporaries go with `outputs`)
+      return fail(a.scene + ": out of memory after " + std::to_string(cases_written) + " of " + std::to_string(n) +
+                      " cases on " + std::to_string(a.threads) + " threads (fewer --threads); no output written",
+                  1);
+    }
     if (!writer) return 0;  // (rank 0 says how the batch went)
   }
   const double solve_s = since(solve_start);
