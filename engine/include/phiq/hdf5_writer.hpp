@@ -70,8 +70,8 @@ class Hdf5Writer {
   /// attributes and each dataset's `columns` and `units`. The model and the plan must outlive the writer.
   /// Throws phiq::Error "PATH: cannot write: REASON" (an index out of range as CsvFormat does).
   Hdf5Writer(const std::string& path, const Model& model, const OutputPlan& plan, const Hdf5Options& options = {});
-  /// Closes the file if close() was not called; what was not written is lost and errors are ignored (a caller that
-  /// failed removes the file).
+  /// Gives the file up if close() did not close it (not called, or failed): it is left incomplete, for the caller
+  /// to remove, and errors are ignored.
   ~Hdf5Writer();
   Hdf5Writer(const Hdf5Writer&) = delete;
   Hdf5Writer& operator=(const Hdf5Writer&) = delete;

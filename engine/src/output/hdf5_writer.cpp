@@ -1,5 +1,8 @@
 #include "phiq/hdf5_writer.hpp"
 
+#include <sys/mman.h>  // memfd_create
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstring>
 #include <vector>
@@ -45,6 +48,19 @@ std::size_t choose_block_rows(std::size_t row_bytes, const Hdf5Options& o) {
   return best;
 }
 
+// A file given up (a write failed, or the writer was destroyed before close()) cannot simply be closed: HDF5
+// flushes its cached metadata and chunks on closing, the flush fails again on a full disk, the close fails, and
+// HDF5 1.10 closes the half-released file once more when the process exits: SIGSEGV. The file is the caller's to
+// remove, so its descriptor is pointed at an anonymous memory file first, where the flush and the close succeed.
+void divert_to_memory(hid_t file) {
+  void* handle = nullptr;  // the sec2 driver's: its descriptor
+  if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || handle == nullptr) return;
+  const int sink = memfd_create("phiq-hdf5-given-up", MFD_CLOEXEC);
+  if (sink < 0) return;
+  (void)dup2(sink, *static_cast<int*>(handle));
+  ::close(sink);
+}
+
 }  // namespace
 
 // One dataset: its columns' names and units, the rows held for the next write, and where they go.
@@ -71,6 +87,12 @@ struct Hdf5Writer::Impl {
   bool closed = false;
 
   Impl(const std::string& p, const Model& m, const OutputPlan& pl) : path(p), model(m), plan(pl), format(m, pl) {}
+  // Still open here: the file is given up (its datasets close after this, then the file).
+  ~Impl() {
+    if (file.get() >= 0) divert_to_memory(file.get());
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
   std::string file_path;  // what H5Fcreate opens (`path` names it in messages)
 
   std::string cannot(const std::string& why) const { return path + ": cannot write: " + why; }
@@ -279,7 +301,7 @@ Hdf5Writer::Hdf5Writer(const std::string& path, const Model& model, const Output
 
 Hdf5Writer::~Hdf5Writer() {
   const QuietErrors quiet;
-  impl_.reset();  // the datasets, then the file (members in reverse order): HDF5 closes what was written
+  impl_.reset();  // the datasets, then the file (members in reverse order), given up unless close() closed them
 }
 
 void Hdf5Writer::append_row(const StepView& s) {
@@ -351,6 +373,8 @@ void Hdf5Writer::close() {
   const QuietErrors quiet;
   w.closed = true;
   w.flush();
+  // everything to the disk while the file can still be given up (~Impl): a failed H5Fclose leaves it unusable
+  if (H5Fflush(w.file.get(), H5F_SCOPE_LOCAL) < 0) throw Error(w.cannot(detail::h5::last_error()));
   for (Group& g : w.groups)
     if (!g.dataset.close()) throw Error(w.cannot(detail::h5::last_error()));
   if (!w.file.close()) throw Error(w.cannot(detail::h5::last_error()));  // H5Fclose writes the metadata
