@@ -272,3 +272,12 @@ def test_sensitivities_read_the_scene_again_with_its_loaded_parameters():
     want = k * big_r / np.sqrt(big_r**2 - (x - cx) ** 2)
     got = result.sensitivity("r")[:, result.coordinate_names.index("y")]
     assert np.max(np.abs(got - want)) < 1e-9
+
+
+def test_options_of_another_scene_are_named_as_such():
+    """Options hold indices into their scene's model: another scene's are refused naming the cause."""
+    four_bar = phiq.parse_scene(EVERY_OUTPUT, "fourbar.yaml")
+    crank_slider = phiq.load_scene(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"))
+    with pytest.raises(phiq.SceneError, match=r"crank_slider_mixed\.yaml: the options name coordinates or "
+                                              r"constraints this scene does not have .*made for another scene"):
+        phiq.run_sweep(crank_slider, four_bar.options)
