@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "phiq/hdf5_reader.hpp"
+#include "phiq/hdf5_writer.hpp"
+#include "phiq/scene.hpp"
 
 #include "cli_test_support.hpp"
 #include "test_support.hpp"
@@ -88,6 +90,43 @@ TEST_F(BatchResume, AnHdf5OutputIsCompletedToTheValuesOfOneRun) {
   EXPECT_NE(slurp(dir_ / "part.h5"), earlier);
 }
 
+// An earlier file cut inside a case (a full disk, a partial copy): the case is run again, not kept as complete.
+TEST_F(BatchResume, ACaseCutInsideIsRunAgain) {
+  for (std::size_t kept : {0u, 2u, 6u}) {
+    const std::string whole = first_cases(kept), next = first_cases(kept + 1);
+    std::size_t cut = whole.size();
+    for (int row = 0; row < 8; ++row) cut = next.find('\n', cut) + 1;  // 8 of the case's 21 rows
+    ASSERT_LT(cut, next.size());
+    write("cut.csv", next.substr(0, cut));
+    const Result r = resume("cut.csv");
+    EXPECT_EQ(r.code, 1) << r.err;  // case 3
+    EXPECT_EQ(slurp(dir_ / "cut.csv"), full_) << kept;
+  }
+}
+
+// The same for HDF5: the file written as an earlier run would have, cut 8 rows into case 5.
+TEST_F(BatchResume, AnHdf5CaseCutInsideIsRunAgain) {
+  ASSERT_EQ(run("batch -q " + scene_ + " " + cases_ + " -o " + (dir_ / "full.h5").string()).code, 1);  // case 3
+  const phiq::CsvTable full = phiq::read_result_table((dir_ / "full.h5").string());
+  const phiq::Scene scene = phiq::load_scene(scene_);
+  phiq::Hdf5Options o;
+  o.case_column = true;
+  {
+    phiq::Hdf5Writer w((dir_ / "cut.h5").string(), *scene.model, scene.sweep, o);
+    for (const std::vector<double>& row : full.rows) {
+      if (row[0] == 5 && w.rows() == 4 * 21 + 8) break;  // cases 0, 1, 2, 4 whole
+      w.append_values(row.data());
+    }
+    w.close();
+  }
+  ASSERT_EQ(phiq::read_result_table((dir_ / "cut.h5").string()).rows.size(), 4u * 21u + 8u);
+  const Result r = resume("cut.h5");
+  EXPECT_EQ(r.code, 1) << r.err;  // case 3, left out earlier
+  const phiq::CsvTable resumed = phiq::read_result_table((dir_ / "cut.h5").string());
+  EXPECT_EQ(resumed.columns, full.columns);
+  EXPECT_EQ(resumed.rows, full.rows);  // every double, exactly
+}
+
 TEST_F(BatchResume, AMissingOutputIsTheWholeBatch) {
   const Result r = resume("new.csv");
   EXPECT_EQ(r.code, 1) << r.err;  // case 3
@@ -103,6 +142,7 @@ TEST_F(BatchResume, WhatIsNotAnEarlierOutputOfThisBatchIsRefusedAndKept) {
       {header + "x" + row, "line 2 does not begin with one of its 12 cases"},
       {header + "12," + row.substr(2), "line 2 does not begin with one of its 12 cases"},
       {first_cases(3) + row, "case 0 after case 2"},
+      {first_cases(1) + row, "not an output of this batch: case 0 has 22 rows, more than its 21"},
   };
   for (const auto& [text, why] : bad) {
     write("bad.csv", text);

@@ -114,6 +114,8 @@ def test_bad_cases_are_named(models):
         phiq.run_batch(scene, {"L2": [0.2, 0.3], "L3": [1.0]})
     with pytest.raises(ValueError, match="case 1 gives L2; every case gives the names of case 0: L2, L3"):
         phiq.run_batch(scene, [{"L2": 0.2, "L3": 1.0}, {"L2": 0.3}])
+    with pytest.raises(TypeError, match=r"run_batch: cases are a mapping of parameter names .* case 0 is 0\.4$"):
+        phiq.run_batch(scene, [0.4, 0.3])
     # a case whose values make the scene impossible fails alone, named, and the others are swept
     batch = phiq.run_batch(scene, {"L3": [1.0, -1.0, 1.2]}, threads=2)
     assert batch.failed == [1] and batch.cases[1] is None

@@ -248,6 +248,11 @@ def test_sensitivities_asked_for_in_python_at_the_scenes_loaded_values(tmp_path)
         phiq.run_sweep(scene, sensitivities=[("L2", float("nan"))])
     with pytest.raises(TypeError, match="a name or a .name, step. tuple"):
         phiq.run_sweep(scene, sensitivities=[3])
+    # a step that leaves L2 ± h on L2 would difference a parameter that did not move (every sensitivity 0)
+    with pytest.raises(phiq.SceneError, match=r"sensitivity to 'L2': the difference step 1e-300 does not move L2 ="):
+        phiq.run_sweep(scene, sensitivities=[("L2", 1e-300)])
+    with pytest.raises(phiq.SceneError, match=r"the difference step 1e-17 does not move L2 ="):
+        phiq.run_batch(scene, {"L3": [1.0]}, sensitivities=[("L2", 1e-17)])
 
 
 def test_sensitivities_read_the_scene_again_with_its_loaded_parameters():
@@ -267,3 +272,12 @@ def test_sensitivities_read_the_scene_again_with_its_loaded_parameters():
     want = k * big_r / np.sqrt(big_r**2 - (x - cx) ** 2)
     got = result.sensitivity("r")[:, result.coordinate_names.index("y")]
     assert np.max(np.abs(got - want)) < 1e-9
+
+
+def test_options_of_another_scene_are_named_as_such():
+    """Options hold indices into their scene's model: another scene's are refused naming the cause."""
+    four_bar = phiq.parse_scene(EVERY_OUTPUT, "fourbar.yaml")
+    crank_slider = phiq.load_scene(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"))
+    with pytest.raises(phiq.SceneError, match=r"crank_slider_mixed\.yaml: the options name coordinates or "
+                                              r"constraints this scene does not have .*made for another scene"):
+        phiq.run_sweep(crank_slider, four_bar.options)

@@ -15,6 +15,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 
 #include "batch_resume.hpp"
@@ -253,6 +254,16 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       } else if (a.resume) {
         resumed = read_resume_point(a.out, header, n);
       }
+      if (resumed.first > 0) {  // an earlier run cut inside its last case: that case runs again
+        phiq::SceneOverrides o = case_overrides(cases, resumed.first - 1, a.cases);
+        o.share_analysis_with = reference->model.get();
+        std::size_t case_rows = 0;  // (a case whose scene cannot be read writes none)
+        try {
+          case_rows = static_cast<std::size_t>(phiq::rows_written(trees.front().read(o).sweep));
+        } catch (const phiq::SceneError&) {
+        }
+        drop_unfinished_case(resumed, case_rows, a.out);
+      }
       if (hdf5) check_hdf5_target(a.out);
       file = &outputs.add(a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
                                       : phiq::AtomicOutputFile::Hold::kOpen);
@@ -268,6 +279,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
         if (resumed.first > 0) {  // the earlier file, copied to be appended to (its own stays whole meanwhile)
           std::filesystem::copy_file(a.out, file->temporary_path(), std::filesystem::copy_options::overwrite_existing);
           o.append = true;
+          o.append_after_rows = resumed.rows;
         }
         h5 = std::make_unique<phiq::Hdf5Writer>(file->temporary_path(), *reference->model, reference->sweep, o);
       } else if (resumed.first > 0) {
@@ -445,7 +457,13 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       if (m.kind == CaseMessage::Kind::kDone) deliver(static_cast<std::size_t>(m.k), from_message(std::move(m)));
     };
     h.halted = halted;
-    all_threads = run_cases(ranks, resumed.first, n, a.threads, h);
+    try {
+      all_threads = run_cases(ranks, resumed.first, n, a.threads, h);
+    } catch (const std::bad_alloc&) {  // a worker's: nothing is published (the temporaries go with `outputs`)
+      return fail(a.scene + ": out of memory after " + std::to_string(cases_written) + " of " + std::to_string(n) +
+                      " cases on " + std::to_string(a.threads) + " threads (fewer --threads); no output written",
+                  1);
+    }
     if (!writer) return 0;  // (rank 0 says how the batch went)
   }
   const double solve_s = since(solve_start);

@@ -9,9 +9,11 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -323,8 +325,13 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
     return threads;
   }
   std::atomic<std::size_t> next_case{first};
+  // The first exception of a worker (out of memory), rethrown here once every worker has stopped: escaping the
+  // thread below, it would abort the process. The other workers take no case after it.
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  std::atomic<bool> failed{false};
   auto next = [&]() -> std::optional<std::size_t> {
-    if (h.halted()) return std::nullopt;
+    if (h.halted() || failed.load()) return std::nullopt;
     const std::size_t k = next_case++;
     return k < n ? std::optional<std::size_t>(k) : std::nullopt;
   };
@@ -333,7 +340,13 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
   std::thread local([&] {
     arena.execute([&] {
       tbb::parallel_for(0, threads, [&](int w) {
-        for (std::optional<std::size_t> k; (k = next());) h.run_here(*k, w);
+        try {
+          for (std::optional<std::size_t> k; (k = next());) h.run_here(*k, w);
+        } catch (...) {
+          const std::lock_guard<std::mutex> lock(failure_mutex);
+          if (!failure) failure = std::current_exception();
+          failed = true;
+        }
       }, tbb::simple_partitioner());
     });
   });
@@ -345,6 +358,7 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
     return k ? static_cast<std::int64_t>(*k) : std::int64_t{-1};
   });
   local.join();
+  if (failure) std::rethrow_exception(failure);
   return threads + remote_workers;
 }
 

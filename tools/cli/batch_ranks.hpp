@@ -113,7 +113,8 @@ struct CaseHandlers {
 // run_for_0's message. Returns when this rank's part is done: on rank 0, every case handed out and every worker's
 // last message received, or at once when halted() (the workers still out then abandoned: BatchRanks::abandon).
 // run_here and deliver may run at the same time (rank 0's workers and its answering thread). Returns the worker
-// threads of the whole job on rank 0 (every rank's `threads` summed), this rank's own elsewhere.
+// threads of the whole job on rank 0 (every rank's `threads` summed), this rank's own elsewhere. An exception of
+// run_here (std::bad_alloc) stops the handing out of cases and is thrown here once rank 0's workers have stopped.
 int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h);
 
 }  // namespace phiq::tools

@@ -44,7 +44,9 @@ ResumePoint read_resume_point(const std::string& out, const std::string& header,
       p.in_file[static_cast<std::size_t>(k)] = 1;
       ++p.cases_in_file;
       last = k;
+      p.last_case_bytes = p.bytes - line.size() - 1, p.last_case_row = p.rows, p.last_case_rows = 0;
     }
+    ++p.rows, ++p.last_case_rows;
   }
   if (in.bad()) throw ResumeError(out + ": --resume: cannot read: " + std::strerror(errno));
   p.first = static_cast<std::size_t>(last + 1);
@@ -77,10 +79,22 @@ ResumePoint read_resume_point_hdf5(const std::string& out, const std::vector<std
       p.in_file[c] = 1;
       ++p.cases_in_file;
       last = k;
+      p.last_case_row = r, p.last_case_rows = 0;
     }
+    ++p.rows, ++p.last_case_rows;
   }
   p.first = static_cast<std::size_t>(last + 1);
   return p;
+}
+
+void drop_unfinished_case(ResumePoint& p, std::size_t case_rows, const std::string& out) {
+  if (p.first == 0 || p.last_case_rows == case_rows) return;
+  const std::size_t k = p.first - 1;
+  if (p.last_case_rows > case_rows)
+    throw ResumeError(out + ": --resume: not an output of this batch: case " + std::to_string(k) + " has " +
+                      std::to_string(p.last_case_rows) + " rows, more than its " + std::to_string(case_rows));
+  p.first = k, p.in_file.resize(k), --p.cases_in_file;
+  p.bytes = p.last_case_bytes, p.rows = p.last_case_row, p.last_case_rows = 0;
 }
 
 std::uint64_t copy_resumed_cases(const std::string& out, const ResumePoint& p, AtomicOutputFile& file) {

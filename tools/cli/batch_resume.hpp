@@ -23,7 +23,11 @@ struct ResumePoint {
   std::size_t first = 0;          // the first case to run (0: the whole batch)
   std::size_t cases_in_file = 0;  // the cases OUT holds
   std::vector<char> in_file;      // per case before `first`: 1 in OUT, 0 left out (it failed earlier)
-  std::uint64_t bytes = 0;        // OUT's size
+  std::uint64_t bytes = 0;        // OUT's size (CSV): the bytes kept
+  std::size_t rows = 0;           // OUT's rows: those kept
+  std::size_t last_case_rows = 0;  // the rows of the last case in OUT (case first − 1)
+  std::uint64_t last_case_bytes = 0;  // where that case begins: its first row's byte (CSV) …
+  std::size_t last_case_row = 0;      // … and row
 };
 
 // Where the batch of `cases` cases whose CSV begins with `header` (its newline included) goes on after OUT: a
@@ -36,6 +40,11 @@ ResumePoint read_resume_point(const std::string& out, const std::string& header,
 // columns and doubles); its cases must be whole numbers of the batch, in order. Throws ResumeError as above, and
 // for a file that is not phiq's HDF5 results.
 ResumePoint read_resume_point_hdf5(const std::string& out, const std::vector<std::string>& columns, std::size_t cases);
+
+// OUT cut inside its last case (an earlier run stopped by a full disk, a file copied in part): when that case
+// has fewer rows than it writes (`case_rows`), it is dropped from `p`, to be run again. Throws ResumeError for
+// more rows than that.
+void drop_unfinished_case(ResumePoint& p, std::size_t case_rows, const std::string& out);
 
 // Copies OUT's bytes (the cases kept) into `file`, the batch's new output; returns how many. Throws phiq::Error.
 std::uint64_t copy_resumed_cases(const std::string& out, const ResumePoint& p, AtomicOutputFile& file);

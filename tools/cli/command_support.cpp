@@ -95,6 +95,8 @@ std::vector<SensitivityRequest> sensitivity_requests(const std::vector<std::stri
       out.push_back({text, 0.0});
     } else {
       auto [name, step] = tolerance::parse_named_value("--sensitivity", text);
+      if (step == 0.0)  // (0 is SensitivityRequest's "the default": NAME alone asks for it; negative: refused there)
+        throw Error("--sensitivity " + text + ": the step must be positive (NAME alone: the default step)");
       out.push_back({std::move(name), step});
     }
   }

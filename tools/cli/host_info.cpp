@@ -1,7 +1,11 @@
-// host_info.hpp: the host's name and CPU model.
+// host_info.hpp: the host's name, CPU model and memory available.
 #include "host_info.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
 
 #include <climits>
 #include <fstream>
@@ -27,6 +31,27 @@ std::string cpu_model() {
     if (v < line.size()) return line.substr(v);
   }
   return "unknown";
+}
+
+double memory_available() {
+  double available = 0.0;
+  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char line[256];
+    double kb = 0.0;
+    while (std::fgets(line, sizeof line, f))
+      if (std::sscanf(line, "MemAvailable: %lf kB", &kb) == 1) break;
+    std::fclose(f);
+    available = 1024.0 * kb;
+  }
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return available;
+  double mapped = 0.0;  // the address space the process holds already (/proc/self/statm: its size in pages)
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%lf", &mapped) == 1) mapped *= static_cast<double>(sysconf(_SC_PAGESIZE));
+    std::fclose(f);
+  }
+  const double left = std::max(static_cast<double>(limit.rlim_cur) - mapped, 1.0);
+  return available > 0.0 ? std::min(available, left) : left;
 }
 
 }  // namespace phiq::tools

@@ -8,6 +8,8 @@
 // for the file system's, never a status the table of tools/README.md does not list.
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <new>
@@ -20,11 +22,14 @@
 #include "commands.hpp"
 #include "phiq/phiq.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_command(int argc, char** argv) {
   using namespace phiq::tools;
   // before anything opens a file or starts a thread
   ensure_standard_descriptors();
   start_interrupts();
+  phiq::silence_hdf5_errors();  // phiq says what went wrong with an HDF5 file, in one line
 
   CLI::App app{"phiq: sparse, large-scale multibody kinematics"};
   // every format another program parses, with its version: a harness checks the ones it reads
@@ -62,4 +67,17 @@ int main(int argc, char** argv) {
     return fail(std::string("internal error: ") + e.what(), 1);
   }
   return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int status = run_command(argc, argv);
+  // An HDF5 file whose close failed (a full disk) would crash HDF5's exit handler, which closes it again: the
+  // error is reported and every output committed or removed by now, so the process ends without the handlers.
+  if (phiq::hdf5_file_left_open()) {
+    std::fflush(nullptr);
+    std::_Exit(status);
+  }
+  return status;
 }

@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <iostream>
 #include <memory>
+#include <new>
 #include <optional>
 #include <set>
 
@@ -19,6 +21,7 @@
 #include "command_line.hpp"
 #include "command_support.hpp"
 #include "commands.hpp"
+#include "host_info.hpp"  // memory_available: --samples refused when their outputs cannot fit
 #include "tolerance_input.hpp"
 #include "tolerance_report.hpp"
 #include "tolerance_spread.hpp"
@@ -146,6 +149,23 @@ SampledCase sample_case(ParsedScene& tree, const SceneOverrides& o, const std::v
   return c;
 }
 
+// Why the outputs of `samples` cases (each `rows` × `outputs` values kept to the end, with its parameters' and its
+// bookkeeping) cannot fit in the memory this process may still take; nothing when they can, or it is unknown.
+std::optional<std::string> samples_out_of_memory(const ToleranceArgs& a, std::size_t rows, std::size_t outputs,
+                                                 std::size_t parameters) {
+  const double per_case = 8.0 * static_cast<double>(rows * outputs + 2 * parameters) + 96.0;
+  const double need = per_case * static_cast<double>(a.samples), have = memory_available();
+  if (!(have > 0.0) || need <= have) return std::nullopt;
+  auto gb = [](double bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g GB", bytes / 1e9);
+    return std::string(text);
+  };
+  return a.scene + ": --samples " + std::to_string(a.samples) + " would keep " + gb(need) + " of outputs (" +
+         std::to_string(rows) + " rows × " + std::to_string(outputs) + " outputs a case) and " + gb(have) +
+         " are available: fewer --samples or --columns; no output written";
+}
+
 int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   const bool writer = ranks.rank() == 0;  // under mpirun, rank 0 alone writes and prints
   std::vector<NamedPath> outs{{"-o", a.out}};
@@ -249,6 +269,11 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   AtomicOutputFile *csv_file = nullptr, *summary_file = nullptr, *plot_file = nullptr;
   int status = 0;
   if (writer) {
+    if (const auto why = samples_out_of_memory(a, static_cast<std::size_t>(rows_written(scene.sweep)),
+                                               columns.size(), spread.parameters.size()))
+      status = fail(*why, 1);
+  }
+  if (writer && status == 0) {
     try {
       csv_file = &outputs.add(a.out);
       if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
@@ -354,7 +379,13 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
       if (!v.empty()) std::memcpy(v.data(), m.values.data(), v.size() * sizeof(double));
     };
     h.halted = [&] { return stop.load() || remote_stop.load(); };
-    threads_used = run_cases(ranks, 0, n_cases, threads_used, h);
+    try {
+      threads_used = run_cases(ranks, 0, n_cases, threads_used, h);
+    } catch (const std::bad_alloc&) {  // a worker's: the cases' outputs and models took what there was
+      return fail(a.scene + ": out of memory with " + std::to_string(n_cases) + " samples on " +
+                      std::to_string(threads_used) + " threads (fewer --samples, --columns or --threads); no output "
+                      "written", 1);
+    }
     if (!writer) return 0;  // (rank 0 reports)
     if (stop.load() || remote_stop.load())
       return fail(a.scene + ": interrupted (" + signal_name(stop.load() ? interrupt_signal() : SIGTERM) +

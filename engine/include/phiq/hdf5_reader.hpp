@@ -43,4 +43,16 @@ Hdf5Provenance read_hdf5_provenance(const std::string& path);
 /// otherwise; throws what they throw.
 CsvTable read_result_table(const std::string& path);
 
+/// Turns HDF5's own printing of errors off for the rest of the process. phiq reports HDF5's errors as lines of its
+/// own (HDF5 is silenced while phiq reads and writes), but HDF5 1.10 also prints when the process exits: "HDF5:
+/// infinite loop closing library" and a dump, after a corrupt file's metadata failed to load (it keeps blocks it
+/// cannot release). A program whose errors are phiq's lines (the `phiq` command) calls this first; one that uses
+/// HDF5 itself keeps HDF5's printing.
+void silence_hdf5_errors();
+
+/// True when an HDF5 file phiq wrote could not be closed (its last flush failed: a full disk, a file-size limit).
+/// HDF5 1.10 then crashes closing it again when the process exits; a program that has reported the error and
+/// committed its other outputs ends with std::_Exit instead (the `phiq` command does).
+bool hdf5_file_left_open();
+
 }  // namespace phiq

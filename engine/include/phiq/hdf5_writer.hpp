@@ -54,6 +54,8 @@ struct Hdf5Options {
   /// the plan's datasets must be there with its columns and all with as many rows, else phiq::Error "PATH: cannot
   /// write: not results of this layout: …". The file's bytes then depend on how it was written, not its values.
   bool append = false;
+  /// With `append`: the file's rows kept, those after them cut (a batch's last case, cut inside it, run again).
+  std::size_t append_after_rows = static_cast<std::size_t>(-1);
 };
 
 /// Version of the batch layout (Hdf5Options::case_column): the run layout with a /case dataset first.
@@ -68,8 +70,8 @@ class Hdf5Writer {
   /// attributes and each dataset's `columns` and `units`. The model and the plan must outlive the writer.
   /// Throws phiq::Error "PATH: cannot write: REASON" (an index out of range as CsvFormat does).
   Hdf5Writer(const std::string& path, const Model& model, const OutputPlan& plan, const Hdf5Options& options = {});
-  /// Closes the file if close() was not called; what was not written is lost and errors are ignored (a caller that
-  /// failed removes the file).
+  /// Gives the file up if close() did not close it (not called, or failed): it is left incomplete, for the caller
+  /// to remove, and errors are ignored.
   ~Hdf5Writer();
   Hdf5Writer(const Hdf5Writer&) = delete;
   Hdf5Writer& operator=(const Hdf5Writer&) = delete;

@@ -29,6 +29,10 @@ def case_table(cases: Any) -> Tuple[List[str], np.ndarray]:
     rows = list(cases)
     if not rows:
         return [], np.zeros((0, 0))
+    if not hasattr(rows[0], "keys"):
+        raise TypeError(f"run_batch: cases are a mapping of parameter names to one value per case ({{'L2': [0.4, "
+                        f"0.3]}}, a pandas.DataFrame) or a sequence of such mappings, one per case; case 0 is "
+                        f"{rows[0]!r}")
     names = [str(k) for k in rows[0].keys()]
     values = np.empty((len(rows), len(names)))
     for k, case in enumerate(rows):

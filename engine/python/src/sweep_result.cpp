@@ -14,6 +14,16 @@ namespace phiq::python {
 std::shared_ptr<SweepTable> sweep_into_table(const Scene& scene, const SweepOptions& opt, bool identifier_names,
                                              const std::function<bool()>& keep_going) {
   auto table = std::make_shared<SweepTable>();
+  // Options hold indices into the model they were made for: another scene's name coordinates or constraints this
+  // one may not have (CsvFormat's own words would not say why).
+  try {
+    (void)CsvFormat(*scene.model, opt);
+  } catch (const Error&) {
+    throw SceneError(scene.path + ": the options name coordinates or constraints this scene does not have (" +
+                     std::to_string(scene.model->num_coordinates()) + " coordinates, " +
+                     std::to_string(scene.model->constraints().size()) +
+                     " constraints): they were made for another scene; start from this scene's .options");
+  }
   // The columns from the scene's model and these options, as `phiq run` names them.
   CsvFormat format(*scene.model, opt);
   format.set_naming(identifier_names ? ColumnNaming::kIdentifiers : ColumnNaming::kDotted);

@@ -136,6 +136,10 @@ CsvTable parse_csv_table(const std::string& text, const std::string& path) {
     const std::string_view name = trim(line.substr(start, comma == std::string_view::npos ? comma : comma - start));
     const std::size_t col = table.columns.size() + 1;
     if (name.empty()) fail(1, "column " + std::to_string(col) + " has an empty name");
+    // (a file separated by tabs or semicolons reads as one column whose name holds them: its rows are then blamed)
+    if (const std::size_t sep = name.find_first_of("\t;"); sep != std::string_view::npos)
+      fail(1, "the header's column '" + shown(name) + "' holds a " + (name[sep] == ';' ? "semicolon" : "tab") +
+                  ": the values must be separated by commas");
     auto [it, fresh] = seen.emplace(name, col);
     if (!fresh)
       fail(1, "duplicate column name '" + shown(name) + "' (columns " + std::to_string(it->second) + " and " +

@@ -97,7 +97,8 @@ namespace {
 // The attribute's strings (variable-length, as phiq writes them), with the number of elements of its space.
 std::vector<std::string> read_strings(hid_t object, const char* name, const std::string& what, bool scalar) {
   const std::string where = what + ": attribute '" + name + "'";
-  if (H5Aexists(object, name) <= 0) throw Error(where + " is missing");
+  if (const htri_t exists = H5Aexists(object, name); exists <= 0)  // (< 0: unreadable, a corrupt header)
+    throw Error(where + (exists < 0 ? ": " + last_error() : std::string(" is missing")));
   const Hid a = checked(H5Aopen(object, name, H5P_DEFAULT), H5Aclose, where);
   const Hid ftype = checked(H5Aget_type(a.get()), H5Tclose, where);
   if (H5Tget_class(ftype.get()) != H5T_STRING || H5Tis_variable_str(ftype.get()) <= 0)
@@ -129,7 +130,8 @@ std::vector<std::string> read_strings_attribute(hid_t object, const char* name, 
 
 long long read_integer_attribute(hid_t object, const char* name, const std::string& what) {
   const std::string where = what + ": attribute '" + name + "'";
-  if (H5Aexists(object, name) <= 0) throw Error(where + " is missing");
+  if (const htri_t exists = H5Aexists(object, name); exists <= 0)  // (< 0: unreadable, a corrupt header)
+    throw Error(where + (exists < 0 ? ": " + last_error() : std::string(" is missing")));
   const Hid a = checked(H5Aopen(object, name, H5P_DEFAULT), H5Aclose, where);
   const Hid ftype = checked(H5Aget_type(a.get()), H5Tclose, where);
   const Hid space = checked(H5Aget_space(a.get()), H5Sclose, where);

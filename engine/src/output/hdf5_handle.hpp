@@ -5,6 +5,7 @@
 
 #include <hdf5.h>
 
+#include <atomic>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +13,10 @@
 #include "phiq/types.hpp"
 
 namespace phiq::detail::h5 {
+
+// Files whose H5Fclose failed (a full disk as it flushed): HDF5 1.10 leaves them half released, and closes them
+// again, crashing, when the process exits (phiq::hdf5_file_left_open()).
+inline std::atomic<int> files_left_open{0};
 
 // One hid_t and the function that closes it (H5Fclose, H5Dclose, H5Sclose, H5Tclose, H5Pclose, H5Aclose, H5Gclose):
 // every identifier is closed on every path, exceptions included, so that a failed write leaves no open file behind
@@ -34,6 +39,7 @@ class Hid {
   // Closes now and reports whether HDF5 could (H5Fclose flushes the file: its failure is a write error).
   bool close() {
     const bool ok = id_ < 0 || close_(id_) >= 0;
+    if (!ok && close_ == &H5Fclose) ++files_left_open;
     id_ = H5I_INVALID_HID;
     return ok;
   }

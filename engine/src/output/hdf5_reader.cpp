@@ -32,7 +32,16 @@ struct Block {
   hsize_t rows = 0;
 };
 
-Block read_block(hid_t file, const char* name, const std::string& path) {
+// Whether a dataset of `elements` doubles can be stored in a file of `file_bytes`: deflate, the only filter phiq
+// writes, shrinks data at most about 1032-fold. A corrupt or crafted file may claim 10¹¹ rows in a few KB, which
+// would otherwise be allocated before a byte is read.
+bool fits_in_file(hid_t dataset, double elements, double file_bytes) {
+  const Hid dcpl(H5Dget_create_plist(dataset), H5Pclose);
+  const bool filtered = dcpl.get() >= 0 && H5Pget_nfilters(dcpl.get()) > 0;
+  return 8.0 * elements <= file_bytes * (filtered ? 1032.0 : 1.0);
+}
+
+Block read_block(hid_t file, const char* name, const std::string& path, double file_bytes) {
   const std::string what = path + ": dataset /" + name;
   Block b;
   const Hid d = checked(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose, what);
@@ -43,6 +52,10 @@ Block read_block(hid_t file, const char* name, const std::string& path) {
   if (rank != 1 && rank != 2) throw Error(what + " has rank " + std::to_string(rank) + ", not 1 or 2");
   hsize_t dims[2] = {0, 1};
   H5Sget_simple_extent_dims(space.get(), dims, nullptr);
+  if (!fits_in_file(d.get(), static_cast<double>(dims[0]) * static_cast<double>(dims[1]), file_bytes))
+    throw Error(what + " claims " + std::to_string(dims[0]) + " rows of " + std::to_string(dims[1]) +
+                " columns, more than the file's " + std::to_string(static_cast<long long>(file_bytes)) +
+                " bytes hold: a corrupt or truncated file");
   b.columns = detail::h5::read_strings_attribute(d.get(), "columns", what);
   if (b.columns.size() != dims[1])
     throw Error(what + ": " + std::to_string(dims[1]) + " columns, but its 'columns' attribute names " +
@@ -67,11 +80,13 @@ bool is_hdf5_file(const std::string& path) {
 
 namespace {
 
-// The file at `path` opened read-only, its format and version checked (read_hdf5_table()'s errors).
-Hid open_results(const std::string& path) {
+// The file at `path` opened read-only, its format and version checked (read_hdf5_table()'s errors); its size in
+// bytes into `file_bytes` (what a dataset's declared extent is held to).
+Hid open_results(const std::string& path, double& file_bytes) {
   {  // the system's reason for a file that cannot be opened, before HDF5's
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
     if (!f) throw Error(path + ": cannot read: " + std::strerror(errno));
+    if (std::fseek(f.get(), 0, SEEK_END) == 0) file_bytes = static_cast<double>(std::ftell(f.get()));
   }
   const Hid fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, path);
   detail::h5::check(H5Pset_file_locking(fapl.get(), false, true), path);  // read-only: a lock protects nothing
@@ -95,7 +110,8 @@ Hid open_results(const std::string& path) {
 
 Hdf5Provenance read_hdf5_provenance(const std::string& path) {
   const detail::h5::QuietErrors quiet;
-  const Hid file = open_results(path);
+  double file_bytes = 0.0;
+  const Hid file = open_results(path, file_bytes);
   Hdf5Provenance p;
   p.scene_path = detail::h5::read_string_attribute(file.get(), "scene_path", path);
   p.scene_text = detail::h5::read_string_attribute(file.get(), "scene", path);
@@ -112,7 +128,8 @@ Hdf5Provenance read_hdf5_provenance(const std::string& path) {
 
 CsvTable read_hdf5_table(const std::string& path) {
   const detail::h5::QuietErrors quiet;
-  const Hid file = open_results(path);
+  double file_bytes = 0.0;
+  const Hid file = open_results(path, file_bytes);
   CsvTable table;
   table.path = path;
   std::vector<Block> blocks;
@@ -126,7 +143,7 @@ CsvTable read_hdf5_table(const std::string& path) {
       if (blocks.size() < 2 && std::string(name) == "t") throw Error(path + ": no dataset /t");
       continue;
     }
-    blocks.push_back(read_block(file.get(), name, path));
+    blocks.push_back(read_block(file.get(), name, path, file_bytes));
     if (blocks.back().rows != blocks.front().rows)
       throw Error(path + ": dataset /" + name + " has " + std::to_string(blocks.back().rows) + " rows, /t has " +
                   std::to_string(blocks.front().rows));
@@ -153,6 +170,10 @@ CsvTable read_hdf5_table(const std::string& path) {
   }
   return table;
 }
+
+void silence_hdf5_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+bool hdf5_file_left_open() { return detail::h5::files_left_open.load() > 0; }
 
 CsvTable read_result_table(const std::string& path) {
   if (is_hdf5_file(path) || has_hdf5_extension(path)) return read_hdf5_table(path);

@@ -1,5 +1,8 @@
 #include "phiq/hdf5_writer.hpp"
 
+#include <sys/mman.h>  // memfd_create
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstring>
 #include <vector>
@@ -45,6 +48,19 @@ std::size_t choose_block_rows(std::size_t row_bytes, const Hdf5Options& o) {
   return best;
 }
 
+// A file given up (a write failed, or the writer was destroyed before close()) cannot simply be closed: HDF5
+// flushes its cached metadata and chunks on closing, the flush fails again on a full disk, the close fails, and
+// HDF5 1.10 closes the half-released file once more when the process exits: SIGSEGV. The file is the caller's to
+// remove, so its descriptor is pointed at an anonymous memory file first, where the flush and the close succeed.
+void divert_to_memory(hid_t file) {
+  void* handle = nullptr;  // the sec2 driver's: its descriptor
+  if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || handle == nullptr) return;
+  const int sink = memfd_create("phiq-hdf5-given-up", MFD_CLOEXEC);
+  if (sink < 0) return;
+  (void)dup2(sink, *static_cast<int*>(handle));
+  ::close(sink);
+}
+
 }  // namespace
 
 // One dataset: its columns' names and units, the rows held for the next write, and where they go.
@@ -71,12 +87,18 @@ struct Hdf5Writer::Impl {
   bool closed = false;
 
   Impl(const std::string& p, const Model& m, const OutputPlan& pl) : path(p), model(m), plan(pl), format(m, pl) {}
+  // Still open here: the file is given up (its datasets close after this, then the file).
+  ~Impl() {
+    if (file.get() >= 0) divert_to_memory(file.get());
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
   std::string file_path;  // what H5Fcreate opens (`path` names it in messages)
 
   std::string cannot(const std::string& why) const { return path + ": cannot write: " + why; }
   void create(const Hdf5Options& o);
   void create_dataset(Group& g, const Hdf5Options& o);
-  void open_to_append(const Hid& fapl);  // Hdf5Options::append
+  void open_to_append(const Hid& fapl, std::size_t keep_rows);  // Hdf5Options::append
   void flush();
 };
 
@@ -163,7 +185,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   if (o.deflate > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0) throw Error(cannot("HDF5 has no deflate filter"));
 
   const Hid fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, cannot("file access list"));
-  if (o.append) return open_to_append(fapl);
+  if (o.append) return open_to_append(fapl, o.append_after_rows);
   // The 1.8 file format: attributes larger than 64 KiB (the names of 10⁴ coordinates) go to dense storage, and
   // readers from HDF5 1.8 on (MATLAB, older h5py) can open the file.
   check(H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V18, H5F_LIBVER_V18), cannot("file format"));
@@ -197,7 +219,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   }
 }
 
-void Hdf5Writer::Impl::open_to_append(const Hid& fapl) {
+void Hdf5Writer::Impl::open_to_append(const Hid& fapl, std::size_t keep_rows) {
   check(H5Pset_file_locking(fapl.get(), false, true), cannot("file locking"));
   file = checked(H5Fopen(file_path.c_str(), H5F_ACC_RDWR, fapl.get()), H5Fclose, path + ": cannot write");
   // each group's dataset as this plan makes it: its columns, and as many rows as every other
@@ -216,6 +238,12 @@ void Hdf5Writer::Impl::open_to_append(const Hid& fapl) {
     if (dims[0] != written_rows) throw Error(what + " has another number of rows");
     g.held.resize(block_rows * g.columns.size());
   }
+  if (keep_rows >= written_rows) return;
+  for (Group& g : groups) {
+    const hsize_t extent[2] = {keep_rows, g.columns.size()};
+    check(H5Dset_extent(g.dataset.get(), extent), cannot(std::string("dataset /") + g.name));
+  }
+  written_rows = keep_rows;
 }
 
 void Hdf5Writer::Impl::create_dataset(Group& g, const Hdf5Options& o) {
@@ -273,7 +301,7 @@ Hdf5Writer::Hdf5Writer(const std::string& path, const Model& model, const Output
 
 Hdf5Writer::~Hdf5Writer() {
   const QuietErrors quiet;
-  impl_.reset();  // the datasets, then the file (members in reverse order): HDF5 closes what was written
+  impl_.reset();  // the datasets, then the file (members in reverse order), given up unless close() closed them
 }
 
 void Hdf5Writer::append_row(const StepView& s) {
@@ -345,6 +373,8 @@ void Hdf5Writer::close() {
   const QuietErrors quiet;
   w.closed = true;
   w.flush();
+  // everything to the disk while the file can still be given up (~Impl): a failed H5Fclose leaves it unusable
+  if (H5Fflush(w.file.get(), H5F_SCOPE_LOCAL) < 0) throw Error(w.cannot(detail::h5::last_error()));
   for (Group& g : w.groups)
     if (!g.dataset.close()) throw Error(w.cannot(detail::h5::last_error()));
   if (!w.file.close()) throw Error(w.cannot(detail::h5::last_error()));  // H5Fclose writes the metadata

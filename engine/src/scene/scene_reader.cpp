@@ -2,6 +2,7 @@
 // (family ranges and numbers use them), the solver before the constraints (length scale, linear solver), time and
 // output last — then the model built from them.
 #include <memory>
+#include <string_view>
 
 #include "phiq/text.hpp"
 #include "scene/family_expansion.hpp"
@@ -27,11 +28,17 @@ Scene SceneReader::read(const YAML::Node& root) {
   for (const std::string& n : parameter_order_) scene.parameters.emplace_back(n, parameters_.at(n));
   check_family_total(top);  // the parameters give the ranges of the families in the sections
   read_coordinates(top.field("coordinates"));
-  if (auto p = top.field("points"); p.present()) read_points(p);
-  if (auto b = top.field("bodies"); b.present()) read_bodies(b);
-  if (auto v = top.field("vectors"); v.present()) {
-    if (!spatial_) v.fail("natural unit vectors need 'dimension: 3'");
-    read_vectors(v);
+  try {
+    if (auto p = top.field("points"); p.present()) read_points(p);
+    if (auto b = top.field("bodies"); b.present()) read_bodies(b);
+    if (auto v = top.field("vectors"); v.present()) {
+      if (!spatial_) v.fail("natural unit vectors need 'dimension: 3'");
+      read_vectors(v);
+    }
+  } catch (const SceneError& e) {  // a name unknown for want of the section that would have named it
+    if (builder_.num_coordinates() > 0 || std::string_view(e.what()).find("unknown name '") == std::string::npos)
+      throw;
+    throw SceneError(std::string(e.what()) + ": the scene has no `coordinates` section (names and start values)");
   }
   if (builder_.num_coordinates() == 0)
     top.fail("at least one coordinate is needed: a `coordinates` section, or bodies written as maps");

@@ -2,8 +2,10 @@
 // found once per sweep, and the derivatives along the parameter evaluated over those constraints only.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "phiq/sensitivity.hpp"
+#include "phiq/text.hpp"
 #include "solve/models_along.hpp"
 #include "solve/sensitivity_internal.hpp"
 
@@ -221,6 +223,21 @@ void detail::evaluate_over_reach(const ParameterReach& reach, const Model* m, co
 void detail::complete_along(const Model& model, OutputSensitivity& s, bool keep,
                             const std::function<std::shared_ptr<const Model>(std::size_t k)>& read_at,
                             const std::function<void(const std::string&)>& fail) {
+  // A step that leaves p ± h or p ± 2h on p (or two of them on one double) differences a parameter that did not
+  // move: every sensitivity would read 0, and no constraint would seem to read p.
+  double below = -std::numeric_limits<double>::infinity();
+  for (const double shift : {-2.0, -1.0, 0.0, 1.0, 2.0}) {
+    const double at = s.value + shift * s.step;
+    if (!(at > below)) {
+      const std::string why = "sensitivity to '" + s.name + "': the difference step " + shortest(s.step) +
+                              " does not move " + s.name + " = " + shortest(s.value) + " (" + s.name + " ± h, " +
+                              s.name + " ± 2h and " + s.name + " must be five doubles; the default step is " +
+                              shortest(default_sensitivity_step(s.value)) + ")";
+      fail(why);
+      throw Error(why);  // (fail throws)
+    }
+    below = at;
+  }
   std::array<AlongModel, 4> along;
   std::array<std::vector<std::unique_ptr<ConstraintBlock>>, 4> copies;
   bool whole = keep;
