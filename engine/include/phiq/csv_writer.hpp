@@ -9,8 +9,7 @@
 #include <vector>
 
 #include "phiq/model.hpp"
-#include "phiq/output_plan.hpp"
-#include "phiq/sweep.hpp"
+#include "phiq/output_plan.hpp"  // OutputPlan, StepView
 
 namespace phiq {
 

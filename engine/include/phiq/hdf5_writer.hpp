@@ -13,8 +13,7 @@
 
 #include "phiq/csv_writer.hpp"
 #include "phiq/model.hpp"
-#include "phiq/output_plan.hpp"
-#include "phiq/sweep.hpp"
+#include "phiq/output_plan.hpp"  // OutputPlan, StepView
 
 namespace phiq {
 
