@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "phiq/model.hpp"
-#include "phiq/output_plan.hpp"
-#include "phiq/sweep.hpp"
+#include "phiq/output_plan.hpp"  // OutputPlan, StepView
 
 namespace phiq {
+
+class Model;  // model.hpp: CsvFormat keeps a reference, its source reads it
 
 /// How the columns of a result CSV are named (tools/README.md, `phiq run --names`).
 enum class ColumnNaming {

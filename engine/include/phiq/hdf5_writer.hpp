@@ -12,11 +12,11 @@
 #include <vector>
 
 #include "phiq/csv_writer.hpp"
-#include "phiq/model.hpp"
-#include "phiq/output_plan.hpp"
-#include "phiq/sweep.hpp"
+#include "phiq/output_plan.hpp"  // OutputPlan, StepView
 
 namespace phiq {
+
+class Model;  // model.hpp: read in the writer's source
 
 /// HDF5 results format version: the root attribute `format_version` (tools/README.md, "HDF5 results").
 inline constexpr int kHdf5Format = 1;

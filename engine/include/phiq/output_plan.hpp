@@ -1,11 +1,17 @@
 /// @file
 /// What a sweep outputs, described once: the output plan that run_sweep reads to know what to compute at every row
-/// and that the writers (CsvFormat, the plots) read to lay out their columns. A scene's `output` section is read
-/// into one (Scene::sweep); it is separate from the time grid and the solver settings so that a writer needs the
-/// plan and the model only, never the scene or the sweep's other settings.
+/// and that the writers (CsvFormat, the plots) read to lay out their columns, and the step view, the values of one
+/// delivered row that the writers read. A scene's `output` section is read into one (Scene::sweep); it is separate
+/// from the time grid and the solver settings so that a writer needs the plan and the model only, never the scene
+/// or the sweep's other settings. It lies below the solver (sensitivity.hpp), the sweep (sweep.hpp) and the writers
+/// (csv_writer.hpp, hdf5_writer.hpp), which all include it, and includes none of them.
 #pragma once
 
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -13,10 +19,53 @@
 #include "phiq/motion_law.hpp"
 #include "phiq/output_joints.hpp"
 #include "phiq/output_points.hpp"
-#include "phiq/sensitivity.hpp"
 #include "phiq/types.hpp"
 
 namespace phiq {
+
+class Model;                // model.hpp
+struct ParameterReach;      // sensitivity.hpp
+struct ReachedConstraints;  // sensitivity.hpp
+
+/// How a row's sensitivities are solved: the direct form, one solve with Φq per parameter and derivative order,
+/// giving every coordinate's sensitivity; or the adjoint form, per output coordinate, for every parameter at once
+/// (sensitivity.hpp describes both, and effective_sensitivity_form() what kAuto stands for).
+enum class SensitivityForm { kAuto, kDirect, kAdjoint };
+
+/// "auto", "direct", "adjoint".
+const char* to_string(SensitivityForm form);
+
+/// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the
+/// model built at p − 2h, p − h, p + h, p + 2h (in that order), each with the same coordinates, rows and Φq pattern
+/// as the model swept (check_sensitivity_models()), or, once its reach is known, only the constraints the reach
+/// holds of them (`reached`). A scene's `output: {sensitivities: [...]}` builds it (models/README.md); the C++ API
+/// with sensitivity_along() (scene.hpp: it keeps the reached constraints, reading the models one at a time), or by
+/// hand (the models; keep_reached_only() then releases them). sensitivity.hpp defines what it points to.
+struct OutputSensitivity {
+  std::string name;  ///< the parameter's name, the columns' suffix (`x.d_NAME`)
+  double value = 0.0;  ///< p
+  double step = 0.0;   ///< h > 0
+  std::array<std::shared_ptr<const Model>, 4> models;  ///< at p − 2h, p − h, p + h, p + 2h
+  /// What the parameter reaches (parameter_reach(): sensitivity_along() sets it, run_sweep() finds it once for the
+  /// sweep when it is null). Null: solve_sensitivities() finds it at each call (O(constraints) comparisons, fewer
+  /// operations than the evaluations of unreached constraints it spares).
+  std::shared_ptr<const ParameterReach> reach;
+  /// The constraints of `reach` in the four models (keep_reached_only()): when set, the derivatives along p read
+  /// these, and `models` may be null. sensitivity_along() keeps these and not the models: a model along p is the
+  /// whole model again (nfourbar 10⁵: 80 MB), what p reaches a fraction of it.
+  std::shared_ptr<const ReachedConstraints> reached;
+};
+
+/// Where the sensitivities of one row are: for parameter j (0 ≤ j < parameters), the n values of ∂q/∂p_j from
+/// `data + j·3n`, then ∂q̇/∂p_j, then ∂q̈/∂p_j (n each; NaN where not computed: q̇'s without velocities, q̈'s
+/// without accelerations, all at a singular position, where Φq has no inverse).
+struct SensitivityLayout {
+  Index coordinates = 0;  ///< n
+  /// Offset of parameter j's block of `order` (0: q, 1: q̇, 2: q̈) in a row's values.
+  Index offset(std::size_t j, int order) const { return (3 * static_cast<Index>(j) + order) * coordinates; }
+  /// Values a row holds for `parameters` parameters.
+  Index size(std::size_t parameters) const { return 3 * static_cast<Index>(parameters) * coordinates; }
+};
 
 /// A driver whose law is output: columns `NAME.f` = f(t), and `NAME.df`, `NAME.ddf` with velocities /
 /// accelerations.
@@ -98,6 +147,28 @@ struct OutputPlan {
   std::vector<Index> residual_columns;
   /// Write the largest scaled residual of all rows (column `residual`); needs `residuals`.
   bool max_residual_column = false;
+};
+
+
+/// What the step callback sees. qd / qdd are null when not computed.
+struct StepView {
+  Index step;                  ///< k, from 0
+  double t;                    ///< t_k
+  const Eigen::VectorXd& q;    ///< positions (valid during the callback only)
+  const Eigen::VectorXd* qd;   ///< velocities, or null when not asked for
+  const Eigen::VectorXd* qdd;  ///< accelerations, or null when not asked for
+  /// Motions of OutputPlan::points, in that order (null when none are listed); velocity / acceleration
+  /// components are filled when q̇ / q̈ are solved.
+  const PointMotion* points = nullptr;
+  const Eigen::VectorXd* phi = nullptr;  ///< Φ(q, t) when OutputPlan::residuals, else null
+  double rcond = 0.0;                    ///< when OutputPlan::condition (see there), else 0
+  /// Measures of OutputPlan::joints, in that order (null when none): angles unwrapped over the sweep's turns.
+  const JointMotion* joints = nullptr;
+  /// Orientations of OutputPlan::orientations, in that order (null when none).
+  const OrientationMotion* orientations = nullptr;
+  /// Sensitivities to OutputPlan::sensitivities laid out as SensitivityLayout says (null when none are listed):
+  /// ∂q/∂p always, ∂q̇/∂p and ∂q̈/∂p when velocities / accelerations are delivered; NaN at a singular position.
+  const double* sensitivities = nullptr;
 };
 
 }  // namespace phiq

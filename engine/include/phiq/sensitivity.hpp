@@ -65,6 +65,7 @@
 #include <vector>
 
 #include "phiq/kinematics.hpp"
+#include "phiq/output_plan.hpp"  // OutputSensitivity, SensitivityForm, SensitivityLayout
 
 namespace phiq {
 
@@ -119,27 +120,6 @@ struct ReachedConstraints {
   Index nonzeros = 0;   ///< the nonzeros of its Φq (see coordinates)
 };
 
-/// One design parameter whose sensitivities a sweep outputs: its name and value, the difference step h and the
-/// model built at p − 2h, p − h, p + h, p + 2h (in that order), each with the same coordinates, rows and Φq pattern
-/// as the model swept (check_sensitivity_models()), or, once its reach is known, only the constraints the reach
-/// holds of them (`reached`). A scene's `output: {sensitivities: [...]}` builds it (models/README.md); the C++ API
-/// with sensitivity_along() (scene.hpp: it keeps the reached constraints, reading the models one at a time), or by
-/// hand (the models; keep_reached_only() then releases them).
-struct OutputSensitivity {
-  std::string name;  ///< the parameter's name, the columns' suffix (`x.d_NAME`)
-  double value = 0.0;  ///< p
-  double step = 0.0;   ///< h > 0
-  std::array<std::shared_ptr<const Model>, 4> models;  ///< at p − 2h, p − h, p + h, p + 2h
-  /// What the parameter reaches (parameter_reach(): sensitivity_along() sets it, run_sweep() finds it once for the
-  /// sweep when it is null). Null: solve_sensitivities() finds it at each call (O(constraints) comparisons, fewer
-  /// operations than the evaluations of unreached constraints it spares).
-  std::shared_ptr<const ParameterReach> reach;
-  /// The constraints of `reach` in the four models (keep_reached_only()): when set, the derivatives along p read
-  /// these, and `models` may be null. sensitivity_along() keeps these and not the models: a model along p is the
-  /// whole model again (nfourbar 10⁵: 80 MB), what p reaches a fraction of it.
-  std::shared_ptr<const ReachedConstraints> reached;
-};
-
 /// Keeps of `s`'s models only the constraints its reach holds (ReachedConstraints), finding the reach first when
 /// `s.reach` is null, and releases the models: the sweep's results are the same bits. A reach of everything
 /// (models whose blocks do not match the model's) keeps the models. Pre-condition: check_sensitivity_models() passed.
@@ -172,7 +152,7 @@ using ModelAtParameter = std::function<Model(double value, const Model* share)>;
 OutputSensitivity sensitivity_along(const Model& model, const std::string& name, double value,
                                     const ModelAtParameter& build, double step = 0.0, bool keep_models = false);
 
-/// How a row's sensitivities are solved.
+/// How a row's sensitivities are solved (SensitivityForm, output_plan.hpp).
 ///
 /// Direct: one solve with Φq per parameter and derivative order, giving every coordinate's sensitivity (above).
 ///
@@ -196,11 +176,7 @@ OutputSensitivity sensitivity_along(const Model& model, const std::string& name,
 /// curved slot passes one), it would be off by percents, so a row whose sixth- and fourth-order second differences
 /// disagree (by more than 10⁻⁴ of the largest entry) is solved in the direct form instead, whose differences along
 /// the motion are first differences only: WorkCounters::sensitivity_direct_rows counts them.
-enum class SensitivityForm { kAuto, kDirect, kAdjoint };
-
-/// "auto", "direct", "adjoint".
-const char* to_string(SensitivityForm form);
-
+///
 /// The form kAuto stands for at derivative order `order` (0: q, 1: and q̇, 2: and q̈): kAdjoint when it costs
 /// less, counting solves with Φq and evaluations of Φq or γ as half a solve (measured on nfourbar 10³: 0.4–0.6),
 /// else kDirect: direct P·((order + 1) solves and (0, 2, 8) evaluations) against adjoint O·(1, 2, 4) solves and
@@ -217,17 +193,6 @@ SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t par
 /// for `s.reach`; else one line naming the parameter and what differs (a parameter that
 /// sets a family's size or a count changes the structure: it has no derivative).
 std::string check_sensitivity_models(const Model& model, const OutputSensitivity& s);
-
-/// Where the sensitivities of one row are: for parameter j (0 ≤ j < parameters), the n values of ∂q/∂p_j from
-/// `data + j·3n`, then ∂q̇/∂p_j, then ∂q̈/∂p_j (n each; NaN where not computed: q̇'s without velocities, q̈'s
-/// without accelerations, all at a singular position, where Φq has no inverse).
-struct SensitivityLayout {
-  Index coordinates = 0;  ///< n
-  /// Offset of parameter j's block of `order` (0: q, 1: q̇, 2: q̈) in a row's values.
-  Index offset(std::size_t j, int order) const { return (3 * static_cast<Index>(j) + order) * coordinates; }
-  /// Values a row holds for `parameters` parameters.
-  Index size(std::size_t parameters) const { return 3 * static_cast<Index>(parameters) * coordinates; }
-};
 
 /// The sensitivities of the state in `ws` to each parameter of `parameters`, into `out` (SensitivityLayout): ∂q/∂p
 /// always, ∂q̇/∂p for order ≥ 1 and ∂q̈/∂p for order 2 (NaN otherwise). Pre-conditions: ws.q solves the position

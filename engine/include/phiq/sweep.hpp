@@ -10,7 +10,8 @@
 #include <vector>
 
 #include "phiq/kinematics.hpp"
-#include "phiq/output_plan.hpp"
+#include "phiq/output_plan.hpp"  // OutputPlan, StepView
+#include "phiq/sensitivity.hpp"  // SweepSummary::sensitivity_form, the plan's sensitivities
 
 namespace phiq {
 
@@ -118,27 +119,6 @@ struct SweepOptions : TimeGrid, OutputPlan, SolverSettings, ParallelSettings {};
 
 /// The rows a sweep with these options delivers when it succeeds: the time points OutputPlan::writes_row selects.
 Index rows_written(const SweepOptions& o);
-
-/// What the step callback sees. qd / qdd are null when not computed.
-struct StepView {
-  Index step;                  ///< k, from 0
-  double t;                    ///< t_k
-  const Eigen::VectorXd& q;    ///< positions (valid during the callback only)
-  const Eigen::VectorXd* qd;   ///< velocities, or null when not asked for
-  const Eigen::VectorXd* qdd;  ///< accelerations, or null when not asked for
-  /// Motions of OutputPlan::points, in that order (null when none are listed); velocity / acceleration
-  /// components are filled when q̇ / q̈ are solved.
-  const PointMotion* points = nullptr;
-  const Eigen::VectorXd* phi = nullptr;  ///< Φ(q, t) when OutputPlan::residuals, else null
-  double rcond = 0.0;                    ///< when OutputPlan::condition (see there), else 0
-  /// Measures of OutputPlan::joints, in that order (null when none): angles unwrapped over the sweep's turns.
-  const JointMotion* joints = nullptr;
-  /// Orientations of OutputPlan::orientations, in that order (null when none).
-  const OrientationMotion* orientations = nullptr;
-  /// Sensitivities to OutputPlan::sensitivities laid out as SensitivityLayout says (null when none are listed):
-  /// ∂q/∂p always, ∂q̇/∂p and ∂q̈/∂p when velocities / accelerations are delivered; NaN at a singular position.
-  const double* sensitivities = nullptr;
-};
 
 /// Something the caller should know about a delivered row (the row itself is within tolerance).
 struct SweepWarning {

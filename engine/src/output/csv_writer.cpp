@@ -14,6 +14,8 @@
 #include <tbb/task_arena.h>
 
 #include "base/names.hpp"
+#include "phiq/model.hpp"
+#include "phiq/kinematics.hpp"  // scaled_residual: the `residual` column is the convergence test's measure
 
 namespace phiq {
 

@@ -9,6 +9,7 @@
 
 #include "output/hdf5_handle.hpp"
 #include "phiq/csv_writer.hpp"
+#include "phiq/model.hpp"
 #include "phiq/version.hpp"
 
 namespace phiq {

@@ -263,15 +263,6 @@ bool detail::sensitivities_with_factors(const Model& model, const std::vector<Ou
   return true;
 }
 
-const char* to_string(SensitivityForm form) {
-  switch (form) {
-    case SensitivityForm::kAuto: return "auto";
-    case SensitivityForm::kDirect: return "direct";
-    case SensitivityForm::kAdjoint: return "adjoint";
-  }
-  return "?";
-}
-
 SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t parameters, std::size_t outputs,
                                            int order) {
   if (form != SensitivityForm::kAuto) return form;
@@ -285,15 +276,6 @@ SensitivityForm effective_sensitivity_form(SensitivityForm form, std::size_t par
   const double direct = static_cast<double>(parameters) * ((o + 1) + 0.5 * kDirectEvaluations[o]);
   const double adjoint = static_cast<double>(outputs) * kSolvesPerOutput[o] + 0.5 * kEvaluations[o];
   return adjoint < direct ? SensitivityForm::kAdjoint : SensitivityForm::kDirect;
-}
-
-std::vector<Index> OutputPlan::sensitivity_outputs() const {
-  std::vector<Index> out(coordinate_columns);
-  for (const std::vector<Index>* more : {&written_velocities(), &written_accelerations()})
-    out.insert(out.end(), more->begin(), more->end());
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
 }
 
 bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::vector<OutputSensitivity>& parameters,

@@ -1,0 +1,27 @@
+// What an output plan writes (output_plan.hpp), decided with the writers that write it: the coordinates whose
+// sensitivity columns are written, which the sweep solves the adjoint form for.
+#include "phiq/output_plan.hpp"
+
+#include <algorithm>
+
+namespace phiq {
+
+const char* to_string(SensitivityForm form) {
+  switch (form) {
+    case SensitivityForm::kAuto: return "auto";
+    case SensitivityForm::kDirect: return "direct";
+    case SensitivityForm::kAdjoint: return "adjoint";
+  }
+  return "?";
+}
+
+std::vector<Index> OutputPlan::sensitivity_outputs() const {
+  std::vector<Index> out(coordinate_columns);
+  for (const std::vector<Index>* more : {&written_velocities(), &written_accelerations()})
+    out.insert(out.end(), more->begin(), more->end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+}  // namespace phiq

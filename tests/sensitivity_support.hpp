@@ -1,0 +1,125 @@
+// Helpers shared by the sensitivity tests (test_sensitivity*.cpp): the crank-slider's closed form by nested dual
+// numbers, its scene, and a sweep's rows with their sensitivities.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq::test {
+
+// Forward-mode dual numbers, nested for mixed higher derivatives: Dual<Dual<double>> carries ∂/∂a, ∂/∂b and
+// ∂²/∂a∂b exactly. Only what the closed forms below use.
+template <class T>
+struct Dual {
+  T v{}, d{};
+};
+template <class T> Dual<T> operator+(Dual<T> a, Dual<T> b) { return {a.v + b.v, a.d + b.d}; }
+template <class T> Dual<T> operator-(Dual<T> a, Dual<T> b) { return {a.v - b.v, a.d - b.d}; }
+template <class T> Dual<T> operator*(Dual<T> a, Dual<T> b) { return {a.v * b.v, a.d * b.v + a.v * b.d}; }
+template <class T> Dual<T> operator/(Dual<T> a, Dual<T> b) { return {a.v / b.v, (a.d * b.v - a.v * b.d) / (b.v * b.v)}; }
+inline double sqrt_(double x) { return std::sqrt(x); }
+inline double sin_(double x) { return std::sin(x); }
+inline double cos_(double x) { return std::cos(x); }
+template <class T> Dual<T> sqrt_(Dual<T> a) {
+  const T r = sqrt_(a.v);
+  return {r, a.d / (r + r)};
+}
+template <class T> Dual<T> sin_(Dual<T> a) { return {sin_(a.v), a.d * cos_(a.v)}; }
+template <class T> Dual<T> cos_(Dual<T> a) { return {cos_(a.v), T{} - a.d * sin_(a.v)}; }
+
+// The slider of the notes' crank-slider: x_B = L2 cos θ + √(L3² − L2² sin² θ).
+template <class T>
+T slider(T theta, T l2, T l3) {
+  const T s = sin_(theta);
+  return l2 * cos_(theta) + sqrt_(l3 * l3 - l2 * l2 * s * s);
+}
+
+using D1 = Dual<double>;
+using D2 = Dual<D1>;
+using D3 = Dual<D2>;
+
+// ∂x_B/∂L, ∂²x_B/∂θ∂L and ∂³x_B/∂θ²∂L at (θ, L2, L3), `which` = 2 for L2, 3 for L3: θ carries the two inner
+// directions, L the outer one.
+inline std::array<double, 3> slider_derivatives(double theta, double l2, double l3, int which) {
+  auto constant = [](double x) { return D3{D2{D1{x, 0}, D1{0, 0}}, D2{D1{0, 0}, D1{0, 0}}}; };
+  const D3 th{D2{D1{theta, 1}, D1{1, 0}}, D2{D1{0, 0}, D1{0, 0}}};
+  D3 a = constant(l2), b = constant(l3);
+  (which == 2 ? a : b).d = D2{D1{1, 0}, D1{0, 0}};
+  const D3 x = slider(th, a, b);
+  return {x.d.v.v, x.d.v.d, x.d.d.d};
+}
+
+// x_B's derivatives in θ alone, x′, x″, x‴ at (θ, L2, L3): θ carries all three directions.
+inline std::array<double, 3> slider_theta_derivatives(double theta, double l2, double l3) {
+  auto constant = [](double x) { return D3{D2{D1{x, 0}, D1{0, 0}}, D2{D1{0, 0}, D1{0, 0}}}; };
+  const D3 th{D2{D1{theta, 1}, D1{1, 0}}, D2{D1{1, 0}, D1{0, 0}}};
+  const D3 x = slider(th, constant(l2), constant(l3));
+  return {x.d.v.v, x.d.d.v, x.d.d.d};
+}
+
+// ∂x_B/∂L, ∂ẋ_B/∂L, ∂ẍ_B/∂L of kCrankSlider (L2 = 0.3, L3 = 1) at time t: θ = 2t, θ̈ = 0, so 1, 2 and 4 times the
+// θ-derivatives above.
+inline std::array<double, 3> slider_sensitivities(double t, int which) {
+  const auto d = slider_derivatives(2.0 * t, 0.3, 1.0, which);
+  return {d[0], 2.0 * d[1], 4.0 * d[2]};
+}
+
+inline const char* const kCrankSlider = R"(phiq: 1
+name: crank_slider
+parameters: {L2: 0.3, L3: 1.0}
+coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}
+points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: rod, type: distance, points: [A, B], length: L3}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
+time: {start: 0, end: pi, steps: 90}
+output: {velocities: true, accelerations: true, sensitivities: [L2, {parameter: L3, step: 1e-3}]}
+)";
+
+// Every delivered row's sensitivities, with the row's time and state.
+struct SensitivityTrace {
+  Trace rows;
+  std::vector<std::vector<double>> s;
+  SweepSummary summary;
+};
+
+inline SensitivityTrace sweep_sensitivities(const Model& model, const SweepOptions& o,
+                                            const Eigen::VectorXd* start = nullptr) {
+  SensitivityTrace r;
+  Workspace ws(model);
+  if (start) ws.q = *start;
+  const Index size = SensitivityLayout{model.num_coordinates()}.size(o.sensitivities.size());
+  const SolveStatus st = run_sweep(model, o, ws, [&](const StepView& v) {
+    r.rows.t.push_back(v.t);
+    r.rows.q.push_back(v.q);
+    if (v.qd) r.rows.qd.push_back(*v.qd);
+    if (v.qdd) r.rows.qdd.push_back(*v.qdd);
+    EXPECT_NE(v.sensitivities, nullptr);
+    if (v.sensitivities) r.s.emplace_back(v.sensitivities, v.sensitivities + size);
+    return true;
+  }, &r.summary);
+  EXPECT_EQ(st, SolveStatus::kSuccess) << r.summary.message;
+  return r;
+}
+
+// The models along `parameter` at `value` of `scene` (read with `read_with`), built through the C++ API as the
+// scene's `output.sensitivities` builds them.
+inline OutputSensitivity along(const Scene& scene, const std::string& parameter, double value,
+                               SceneOverrides read_with = {}) {
+  read_with.sensitivity_models = false;
+  const OutputSensitivity s = sensitivity_along(scene, parameter, value, 0.0, {}, read_with);
+  EXPECT_EQ(s.step, default_sensitivity_step(value));
+  EXPECT_EQ(check_sensitivity_models(*scene.model, s), "");
+  return s;
+}
+
+}  // namespace phiq::test
