@@ -33,12 +33,10 @@ class ResultRows : public phiq::RowWriter {
       : csv_(csv), h5_(h5), file_(file), spool_(spool), progress_(progress), stop_(stop_flag()) {}
   void encode(const phiq::StepView& step, std::string& out) const override {
     if (!h5_) return csv_.append_row(step, out);
-    const std::size_t at = out.size(), n = csv_.num_values();
     thread_local std::vector<double> row;  // (the bytes of `out` are not doubles: packed by a copy)
-    row.resize(n);
+    row.resize(csv_.num_values());
     csv_.append_values(step, row.data());
-    out.resize(at + n * sizeof(double));
-    std::memcpy(out.data() + at, row.data(), n * sizeof(double));
+    out.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(double));
   }
   std::size_t max_row_bytes() const override {
     return h5_ ? csv_.num_values() * sizeof(double) : csv_.max_row_chars();
