@@ -1,25 +1,12 @@
-// The parallel sweep (parallel_sweep.hpp): the schedule of seeds and chunks on the task arena's threads, a chunk's
-// rows from its seed with its seam step, the seam check that accepts a chunk as the sequential sweep's continuation,
-// and the delivery in order on the caller's thread, falling back to the sweep in order after a chunk that does not
-// continue it. The rows a chunk computes are held in buffers recycled through the workspace (chunk_parts.hpp); with
-// a RowWriter they are encoded by the thread that computes them, and the caller's thread only writes them.
+// A parallel sweep's chunks (chunked_sweep.hpp): a chunk's rows from its seed with its seam step, streamed to the
+// caller or held (encoded by the thread that computes them when a RowWriter takes the rows), the seam check that
+// accepts a chunk as the sequential sweep's continuation, and the delivery of a held chunk in order on the caller's
+// thread. The schedule that seeds and runs them is in chunk_schedule.cpp.
 #include "sweep/parallel_sweep.hpp"
 
 #include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <condition_variable>
-#include <exception>
-#include <mutex>
-#include <thread>
-#include <utility>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
-#include "phiq/text.hpp"
 #include "sweep/chunked_sweep.hpp"
 #include "sweep/streamed_rows.hpp"
 
