@@ -57,13 +57,29 @@ class ResultRows : public phiq::RowWriter {
     seconds += since(w0);
     return !stop_.load();
   }
+  // A row computed on this thread: formatted straight into what is gathered for the file (CSV), or into the HDF5
+  // writer's block, with no encoded copy in between.
+  bool write_row(const phiq::StepView& step) override {
+    const auto w0 = Clock::now();
+    if (h5_) {
+      const std::size_t rows_before = h5_->rows();
+      h5_->append_row(step);
+      if (file_) hand_blocks_to_disk(*h5_, rows_before, *file_);
+    } else {
+      csv_.append_row(step, pending_);
+      if (pending_.size() > kPendingBytes) flush();
+    }
+    progress_.update(step.step + 1);
+    seconds += since(w0);
+    return !stop_.load();
+  }
   // The CSV text gathered and not yet written (the header, rows one by one) goes out.
   void flush() {
     put(pending_);
     pending_.clear();
   }
   std::string& pending() { return pending_; }
-  double seconds = 0.0;  // writing rows
+  double seconds = 0.0;  // writing rows (and formatting those computed on this thread: write_row())
 
  private:
   static constexpr std::size_t kPendingBytes = std::size_t{1} << 20;

@@ -244,6 +244,14 @@ class RowWriter {
   /// calling thread; every written row comes through here exactly once, in order. False stops the sweep (status
   /// kCancelled) after them.
   virtual bool write(const std::string& encoded, Index rows, Index last_step) = 0;
+  /// Writes one row computed on the calling thread, in its turn (the rows a sweep delivers as it computes them,
+  /// with no other thread to encode them): encode(), then write(), unless a writer has a shorter way. False stops
+  /// the sweep (status kCancelled).
+  virtual bool write_row(const StepView& step) {
+    std::string encoded;
+    encode(step, encoded);
+    return write(encoded, 1, step.step);
+  }
 };
 
 /// run_sweep with its rows encoded and written by `writer` instead of handed to a step callback: the same rows, the

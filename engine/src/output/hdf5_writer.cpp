@@ -346,10 +346,7 @@ void Hdf5Writer::append_packed_rows(const std::string& packed) {
     const std::size_t k = w.held_rows;
     for (Group& g : w.groups) {  // in column order: each group takes its slice of the row
       const std::size_t m = g.columns.size();
-      double* out = g.held.data() + k * m;
-      std::memcpy(out, row, m * sizeof(double));  // (a copy: `packed` holds bytes, not doubles)
-      for (double* v = out; v != out + m; ++v)
-        if (*v == 0.0) *v = 0.0;  // −0 → 0, as append_values()
+      std::memcpy(g.held.data() + k * m, row, m * sizeof(double));  // (a copy: `packed` holds bytes, not doubles)
       row += m * sizeof(double);
     }
     if (++w.held_rows == w.block_rows) {

@@ -24,7 +24,6 @@ struct Run {
   const std::function<bool(const StepView&)>& on_step;
   RowWriter* writer;  // in place of on_step: rows encoded, then written in order (RowWriter)
   SweepSummary& sum;
-  std::string encoded;  // a row encoded on the calling thread (deliver()), then written
 
   // Whether a parallel chunk encodes its rows itself, for write_encoded(): with a writer, unless joint angles are
   // written (each row's is unwrapped from the row before, which only the delivery in order knows).
@@ -50,12 +49,7 @@ struct Run {
     unwrap_joints(k, motions.joints);
     if (!opt.writes_row(k, time_of(k))) return true;  // solved, not written (OutputPlan::every, window)
     const StepView view = view_of(k, q, qd, qdd, motions, phi, rcond, joints.empty() ? nullptr : joints.data());
-    if (writer) {
-      encoded.clear();
-      writer->encode(view, encoded);
-      return written(writer->write(encoded, 1, k), k);
-    }
-    return written(!on_step || on_step(view), k);
+    return written(writer ? writer->write_row(view) : !on_step || on_step(view), k);
   }
   // What the caller sees of row k (the joints' measures unwrapped already).
   StepView view_of(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
