@@ -167,6 +167,48 @@ TEST(Hdf5Writer, DeflateIsLossless) {
   EXPECT_LT(fs::file_size(packed), fs::file_size(plain));
 }
 
+// Rows packed as CsvFormat::append_values packs them, given 7 at a time across blocks of 5 (as a parallel sweep's
+// chunks hand them to phiq run's writer), make the file append_row() makes: the CSV's doubles bit for bit. Bytes
+// that are not whole rows are refused, naming the path.
+TEST(Hdf5Writer, PackedRowsHoldTheCsvDoubles) {
+  ScratchDir tmp;
+  const Scene scene = parse_scene(test::kFourbarOutputs, "fourbar_outputs.yaml");
+  Eigen::VectorXd q = scene.model->initial_positions();
+  std::unique_ptr<Model> solved;
+  AssemblySummary as;
+  ASSERT_EQ(prepare_square(*scene.model, scene.sweep.t_begin, {}, q, &solved, &as), SolveStatus::kSuccess);
+  Workspace ws(*solved);
+  ws.q = q;
+  const CsvFormat csv(*scene.model, scene.sweep);
+  const std::string path = (tmp.dir / "r.h5").string();
+  Hdf5Options o;
+  o.buffer_bytes = 5 * 30 * sizeof(double);
+  Hdf5Writer h5w(path, *scene.model, scene.sweep, o);
+  ASSERT_EQ(h5w.row_values(), csv.num_values());
+  std::string text = csv.header(), packed;
+  std::vector<double> row(csv.num_values());
+  SweepSummary sum;
+  (void)run_sweep(*solved, scene.sweep, ws, [&](const StepView& s) {  // its status is sum.status, checked below
+    csv.append_row(s, text);
+    csv.append_values(s, row.data());
+    packed.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(double));
+    if (packed.size() == 7 * row.size() * sizeof(double)) h5w.append_packed_rows(packed), packed.clear();
+    return true;
+  }, &sum);
+  ASSERT_EQ(sum.status, SolveStatus::kSuccess) << sum.message;
+  h5w.append_packed_rows(packed);
+  EXPECT_EQ(h5w.rows(), 73u);
+  try {
+    h5w.append_packed_rows(std::string(sizeof(double), '\0'));
+    FAIL() << "a part of a row accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(path + ": cannot write", 0), 0u) << e.what();
+  }
+  EXPECT_EQ(h5w.rows(), 73u);
+  h5w.close();
+  expect_same_bits(read_hdf5_table(path), parse_csv_table(text, "r.csv"));
+}
+
 // Errors are phiq::Error naming the path (or the name shown for it), never HDF5's printed stack.
 TEST(Hdf5Writer, ErrorsNameThePath) {
   ScratchDir tmp;

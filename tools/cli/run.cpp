@@ -7,6 +7,8 @@
 #include <cstring>
 #include <iostream>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "cli_support.hpp"
 #include "command_line.hpp"
@@ -20,6 +22,81 @@
 namespace phiq::tools {
 
 namespace {
+
+// The rows of `phiq run`: encoded by the sweep's threads as CSV text or, for HDF5, packed doubles
+// (CsvFormat::append_values: the same doubles as the CSV's), and written here in order, on the calling thread.
+class ResultRows : public phiq::RowWriter {
+ public:
+  // `h5` null: CSV to `file`, or with no file to `spool`.
+  ResultRows(const phiq::CsvFormat& csv, phiq::Hdf5Writer* h5, phiq::AtomicOutputFile* file, std::FILE* spool,
+             ProgressBar& progress)
+      : csv_(csv), h5_(h5), file_(file), spool_(spool), progress_(progress), stop_(stop_flag()) {}
+  void encode(const phiq::StepView& step, std::string& out) const override {
+    if (!h5_) return csv_.append_row(step, out);
+    thread_local std::vector<double> row;  // (the bytes of `out` are not doubles: packed by a copy)
+    row.resize(csv_.num_values());
+    csv_.append_values(step, row.data());
+    out.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(double));
+  }
+  std::size_t max_row_bytes() const override {
+    return h5_ ? csv_.num_values() * sizeof(double) : csv_.max_row_chars();
+  }
+  bool write(const std::string& encoded, phiq::Index, phiq::Index last_step) override {
+    const auto w0 = Clock::now();
+    if (h5_) {
+      const std::size_t rows_before = h5_->rows();
+      h5_->append_packed_rows(encoded);
+      if (file_) hand_blocks_to_disk(*h5_, rows_before, *file_);
+    } else if (pending_.size() + encoded.size() <= kPendingBytes) {  // rows one by one: gathered
+      pending_ += encoded;
+    } else {  // a chunk's rows: written as they are
+      flush();
+      put(encoded);
+    }
+    progress_.update(last_step + 1);
+    seconds += since(w0);
+    return !stop_.load();
+  }
+  // A row computed on this thread: formatted straight into what is gathered for the file (CSV), or into the HDF5
+  // writer's block, with no encoded copy in between.
+  bool write_row(const phiq::StepView& step) override {
+    const auto w0 = Clock::now();
+    if (h5_) {
+      const std::size_t rows_before = h5_->rows();
+      h5_->append_row(step);
+      if (file_) hand_blocks_to_disk(*h5_, rows_before, *file_);
+    } else {
+      csv_.append_row(step, pending_);
+      if (pending_.size() > kPendingBytes) flush();
+    }
+    progress_.update(step.step + 1);
+    seconds += since(w0);
+    return !stop_.load();
+  }
+  // The CSV text gathered and not yet written (the header, rows one by one) goes out.
+  void flush() {
+    put(pending_);
+    pending_.clear();
+  }
+  std::string& pending() { return pending_; }
+  double seconds = 0.0;  // writing rows (and formatting those computed on this thread: write_row())
+
+ private:
+  static constexpr std::size_t kPendingBytes = std::size_t{1} << 20;
+  void put(const std::string& text) {
+    if (text.empty()) return;
+    if (file_) file_->write(text);
+    else if (std::fwrite(text.data(), 1, text.size(), spool_) != text.size())
+      throw phiq::Error("cannot write the temporary file for standard output");
+  }
+  const phiq::CsvFormat& csv_;
+  phiq::Hdf5Writer* h5_;
+  phiq::AtomicOutputFile* file_;
+  std::FILE* spool_;
+  ProgressBar& progress_;
+  const std::atomic<bool>& stop_;
+  std::string pending_;
+};
 
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb,
@@ -114,7 +191,6 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   // Where the CSV goes: the output file, or standard output after success, spooled through an anonymous temporary
   // file so that memory stays bounded however long the sweep is.
   std::FILE* spool = nullptr;
-  std::string buffer = h5 ? "" : csv.header();
   if (!file && !(spool = std::tmpfile())) return fail("cannot create a temporary file for standard output", 3);
   struct CloseSpool {
     std::FILE* f;
@@ -122,35 +198,15 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
       if (f) std::fclose(f);
     }
   } close_spool{spool};
-  auto flush = [&] {
-    if (file) file->write(buffer);
-    else if (std::fwrite(buffer.data(), 1, buffer.size(), spool) != buffer.size())
-      throw phiq::Error("cannot write the temporary file for standard output");
-    buffer.clear();
-  };
 
   phiq::SweepSummary summary;
-  double write_s = 0.0;  // formatting and writing rows, timed inside the step callback
   ProgressBar progress(scene.sweep.steps + 1,
                                     quiet ? ProgressBar::Mode::kNever : progress_mode);
+  ResultRows rows(csv, h5.get(), file, spool, progress);
+  if (!h5) rows.pending() = csv.header();
   try {
-    StopOnSignal stop_on_signal;  // a signal stops the sweep at its next row
-    const std::atomic<bool>& stop = stop_flag();
-    (void)phiq::run_sweep(  // its status is summary.status, read below
-        model, scene.sweep, ws, [&](const phiq::StepView& step) {
-      const auto w0 = Clock::now();
-      if (h5) {
-        const std::size_t rows_before = h5->rows();
-        h5->append_row(step);
-        if (file) hand_blocks_to_disk(*h5, rows_before, *file);
-      } else {
-        csv.append_row(step, buffer);
-        if (buffer.size() > (1u << 20)) flush();
-      }
-      progress.update(step.step + 1);
-      write_s += since(w0);
-      return !stop.load();
-    }, &summary);
+    StopOnSignal stop_on_signal;  // a signal stops the sweep at its next rows
+    (void)phiq::run_sweep(model, scene.sweep, ws, rows, &summary);  // its status is summary.status, read below
   } catch (const phiq::Error& e) {
     progress.finish();
     return fail(scene_path + ": " + e.what(), 3);
@@ -178,13 +234,14 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
           phiq::SolveStatus::kSuccess)
         why += "; rank analysis: " + as.message;
     }
-    return failed(model, summary, {load_s, summary.solve_seconds - write_s, write_s}, why);
+    return failed(model, summary, {load_s, summary.solve_seconds - rows.seconds, rows.seconds}, why);
   }
+  double write_s = rows.seconds;  // writing rows (the sweep's threads encode them: in solve_seconds)
   const double solve_s = summary.solve_seconds - write_s;
   const auto final_write = Clock::now();
   try {
     if (h5) h5->close();
-    flush();
+    rows.flush();
     if (file) {
       file->finish();
     } else {

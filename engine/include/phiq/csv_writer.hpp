@@ -53,6 +53,8 @@ class CsvFormat {
   /// (throws phiq::Error otherwise, or when its vectors are not the model's size). A wide row (more than 1 024
   /// coordinate values) is formatted in parallel by the current task arena's threads: `phiq run --threads 1` is one.
   void append_row(const StepView& step, std::string& out) const;
+  /// At most how many characters append_row() appends (every value at its longest shortest round-trip text).
+  std::size_t max_row_chars() const;
   /// The number of columns after the coordinates' (points, drivers, residuals, rcond): 0 without an output plan.
   std::size_t num_output_values() const;
   /// Writes those columns' values for this step to out[0 .. num_output_values()), as append_row() formats them

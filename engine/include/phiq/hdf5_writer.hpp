@@ -84,6 +84,11 @@ class Hdf5Writer {
   /// before they are written (a batch's cases, written in case order). −0 is stored as 0. Throws phiq::Error as
   /// append_row() does.
   void append_values(const double* row);
+  /// Adds the rows packed one after another in `packed`, each as append_values() takes it (row_values() doubles,
+  /// native byte order, −0 written as 0 already, as CsvFormat::append_values() writes it): rows encoded on other
+  /// threads (RowWriter) and written here in order. Throws phiq::Error as append_values() does, and when `packed`
+  /// does not hold whole rows.
+  void append_packed_rows(const std::string& packed);
   /// Values per row that append_values() takes.
   std::size_t row_values() const;
   /// Writes the rows still held and closes the file. Throws phiq::Error "PATH: cannot write: REASON".

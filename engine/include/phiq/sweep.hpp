@@ -4,6 +4,7 @@
 /// accelerations when asked for.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <string>
 #include <utility>
@@ -206,5 +207,38 @@ struct SweepSummary {
 /// `assembly` settings solve_position refuses, a predictor whose derivatives are not computed).
 SolveStatus run_sweep(const Model& model, const SweepOptions& options, Workspace& ws,
                       const std::function<bool(const StepView&)>& on_step, SweepSummary* summary);
+
+/// Where the rows of a sweep go when they are encoded (CSV text, packed doubles) by the threads that compute them
+/// and written in order by the calling thread: run_sweep's overload below. A sweep in parallel chunks encodes each
+/// chunk's rows as it computes them and hands the chunk's bytes to write() once every row before them is written,
+/// so that neither the encoding nor the copies of the rows it reads wait on the calling thread.
+class RowWriter {
+ public:
+  virtual ~RowWriter() = default;
+  /// Appends the encoding of `step`, a row the output plan writes, to `out`. Called on any of the sweep's threads,
+  /// several at once: it must change nothing shared. Throws phiq::Error to stop the sweep (rethrown by run_sweep).
+  virtual void encode(const StepView& step, std::string& out) const = 0;
+  /// At most how many bytes encode() appends for one row: what the rows a chunk holds until written take.
+  virtual std::size_t max_row_bytes() const = 0;
+  /// Takes the encodings of `rows` written rows in time order, the last of them time point `last_step`, on the
+  /// calling thread; every written row comes through here exactly once, in order. False stops the sweep (status
+  /// kCancelled) after them.
+  virtual bool write(const std::string& encoded, Index rows, Index last_step) = 0;
+  /// Writes one row computed on the calling thread, in its turn (the rows a sweep delivers as it computes them,
+  /// with no other thread to encode them): encode(), then write(), unless a writer has a shorter way. False stops
+  /// the sweep (status kCancelled).
+  virtual bool write_row(const StepView& step) {
+    std::string encoded;
+    encode(step, encoded);
+    return write(encoded, 1, step.step);
+  }
+};
+
+/// run_sweep with its rows encoded and written by `writer` instead of handed to a step callback: the same rows, the
+/// same summary, and the same bytes for every thread count. With OutputPlan::joints that measure angles (each
+/// unwrapped from the row before it) the rows are encoded in order on the calling thread, as a step callback reads
+/// them.
+SolveStatus run_sweep(const Model& model, const SweepOptions& options, Workspace& ws, RowWriter& writer,
+                      SweepSummary* summary);
 
 }  // namespace phiq

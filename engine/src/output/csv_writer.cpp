@@ -263,6 +263,8 @@ void CsvFormat::append_row(const StepView& s, std::string& out) const {
   out += '\n';
 }
 
+std::size_t CsvFormat::max_row_chars() const { return num_values() * kMaxValueChars + 1; }
+
 void CsvFormat::check_coordinates(const StepView& s) const {
   if (velocities_ && !s.qd) throw Error("CsvFormat: step has no velocities");
   if (accelerations_ && !s.qdd) throw Error("CsvFormat: step has no accelerations");

@@ -362,6 +362,29 @@ void Hdf5Writer::append_values(const double* row) {
   }
 }
 
+void Hdf5Writer::append_packed_rows(const std::string& packed) {
+  Impl& w = *impl_;
+  if (w.closed) throw Error(w.cannot("already closed"));
+  const std::size_t row_bytes = row_values() * sizeof(double);
+  if (packed.size() % row_bytes != 0) throw Error(w.cannot("packed rows of another width (phiq bug)"));
+  for (const char* row = packed.data(); row != packed.data() + packed.size();) {
+    if (w.held_rows == w.block_rows) {  // as append_row()
+      const QuietErrors quiet;
+      w.flush();
+    }
+    const std::size_t k = w.held_rows;
+    for (Group& g : w.groups) {  // in column order: each group takes its slice of the row
+      const std::size_t m = g.columns.size();
+      std::memcpy(g.held.data() + k * m, row, m * sizeof(double));  // (a copy: `packed` holds bytes, not doubles)
+      row += m * sizeof(double);
+    }
+    if (++w.held_rows == w.block_rows) {
+      const QuietErrors quiet;
+      w.flush();
+    }
+  }
+}
+
 std::size_t Hdf5Writer::row_values() const {
   std::size_t n = 0;
   for (const Group& g : impl_->groups) n += g.columns.size();

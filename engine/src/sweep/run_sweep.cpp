@@ -41,8 +41,8 @@ void note_parameters_nothing_reads(const SweepOptions& opt, SweepSummary& sum) {
 
 // run_sweep's body, run inside a task arena of `threads` (run_sweep's count: opt.threads, or all cores for 0).
 SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspace& ws,
-                           const std::function<bool(const StepView&)>& on_step, SweepSummary* summary,
-                           int threads) {
+                           const std::function<bool(const StepView&)>& on_step, RowWriter* writer,
+                           SweepSummary* summary, int threads) {
   if (&ws.model() != &model) throw Error("workspace was made for another model");
   if (opt.steps < 0) throw Error("SweepOptions: steps must be >= 0");
   if (!std::isfinite(opt.t_begin) || !std::isfinite(opt.t_end)) throw Error("SweepOptions: times must be finite");
@@ -99,7 +99,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   }
 
   ws.start_afresh();  // the sweep's results depend on the model, the options and ws.q only
-  Run run{opt, on_step, sum};
+  Run run{opt, on_step, sum, writer};
   Sweeper sw(model, opt, ws, sum);
   if (!sw.assemble(run.time_of(0))) {
     run.failed(0);
@@ -118,9 +118,12 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // The chunks are cut alike for every thread count (automatic_chunk_steps), and a chunk computes the same rows
   // whichever thread runs it (each starts from a workspace started afresh): one thread runs them in order, with
   // their seeds, so that its rows are, to the bit, those of any other thread count.
-  const detail::HeldRows rows = detail::held_rows(model, opt, static_cast<bool>(on_step));
+  // (a writer reads every row as a step callback does: the chunks are cut as for one)
+  const detail::HeldRows rows = detail::held_rows(model, opt, static_cast<bool>(on_step) || writer,
+                                                  run.chunks_encode() ? writer->max_row_bytes() : 0);
   const Index chunk =
-      opt.chunk_steps > 0 ? opt.chunk_steps : detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows);
+      opt.chunk_steps > 0 ? opt.chunk_steps
+                          : detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows);
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
   if (ws.lu)
     threads = detail::threads_with_room_for_rows(opt, rows.row_bytes, rows.caller_reads_rows, chunk, threads,
@@ -153,8 +156,11 @@ void detail::check_solver_settings(const Model& model, const SolverSettings& s, 
       throw Error(who + ": output point '" + p.name + "' reads a coordinate the model does not have");
 }
 
-SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws,
-                      const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
+namespace {
+
+SolveStatus run_sweep_with(const Model& model, const SweepOptions& opt, Workspace& ws,
+                           const std::function<bool(const StepView&)>& on_step, RowWriter* writer,
+                           SweepSummary* summary) {
   if (opt.threads < 0) throw Error("SweepOptions: threads must be >= 0 (0: all cores)");
   // Everything the sweep runs, the model's parallel evaluation of large models included, stays on its threads:
   // threads = 1 is one thread.
@@ -166,9 +172,21 @@ SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws
     SweepOptions with_reach = opt;
     for (OutputSensitivity& p : with_reach.sensitivities)
       if (!p.reach) p.reach = std::make_shared<const ParameterReach>(parameter_reach(model, p));
-    return arena.execute([&] { return sweep_in_arena(model, with_reach, ws, on_step, summary, threads); });
+    return arena.execute([&] { return sweep_in_arena(model, with_reach, ws, on_step, writer, summary, threads); });
   }
-  return arena.execute([&] { return sweep_in_arena(model, opt, ws, on_step, summary, threads); });
+  return arena.execute([&] { return sweep_in_arena(model, opt, ws, on_step, writer, summary, threads); });
+}
+
+}  // namespace
+
+SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws,
+                      const std::function<bool(const StepView&)>& on_step, SweepSummary* summary) {
+  return run_sweep_with(model, opt, ws, on_step, nullptr, summary);
+}
+
+SolveStatus run_sweep(const Model& model, const SweepOptions& opt, Workspace& ws, RowWriter& writer,
+                      SweepSummary* summary) {
+  return run_sweep_with(model, opt, ws, {}, &writer, summary);
 }
 
 Index rows_written(const SweepOptions& o) {

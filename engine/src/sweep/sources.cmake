@@ -1,6 +1,7 @@
 # engine/src/sweep/: the sources of this stage (engine/CMakeLists.txt includes this file).
 target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/batch.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/chunk_schedule.cpp
   ${CMAKE_CURRENT_LIST_DIR}/euler_signs.cpp
   ${CMAKE_CURRENT_LIST_DIR}/parallel_sweep.cpp
   ${CMAKE_CURRENT_LIST_DIR}/predictors.cpp

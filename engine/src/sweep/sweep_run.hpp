@@ -4,6 +4,7 @@
 // so that both paths may inline deliver() and sequential(), which run on every row.
 #pragma once
 
+#include <algorithm>
 #include <functional>
 #include <string>
 #include <vector>
@@ -17,11 +18,19 @@ namespace phiq::detail {
 // The per-run bookkeeping shared by the sequential and parallel paths.
 struct Run {
   // A constructor, not aggregate initialisation: the members below start as their initialisers say.
-  Run(const SweepOptions& o, const std::function<bool(const StepView&)>& f, SweepSummary& s)
-      : opt(o), on_step(f), sum(s) {}
+  Run(const SweepOptions& o, const std::function<bool(const StepView&)>& f, SweepSummary& s, RowWriter* w = nullptr)
+      : opt(o), on_step(f), writer(w), sum(s) {}
   const SweepOptions& opt;
   const std::function<bool(const StepView&)>& on_step;
+  RowWriter* writer;  // in place of on_step: rows encoded, then written in order (RowWriter)
   SweepSummary& sum;
+
+  // Whether a parallel chunk encodes its rows itself, for write_encoded(): with a writer, unless joint angles are
+  // written (each row's is unwrapped from the row before, which only the delivery in order knows).
+  bool chunks_encode() const {
+    return writer && std::none_of(opt.joints.begin(), opt.joints.end(),
+                                  [](const OutputJoint& j) { return j.measure == JointMeasure::kAngle; });
+  }
 
   double time_of(Index k) const { return opt.time_of(k); }  // TimeGrid::time_of
   // Sign of det Φq at the last delivered regular row whose sign is known, its time, and whether a singular row
@@ -39,23 +48,36 @@ struct Run {
     count_row(time_of(k), det_sign, det_sign_t, quality);
     unwrap_joints(k, motions.joints);
     if (!opt.writes_row(k, time_of(k))) return true;  // solved, not written (OutputPlan::every, window)
-    StepView view{k,
-                  time_of(k),
-                  q,
-                  opt.velocities ? &qd : nullptr,
-                  opt.accelerations ? &qdd : nullptr,
-                  motions.points,
-                  opt.residuals ? &phi : nullptr,
-                  opt.condition ? rcond : 0.0,
-                  joints.empty() ? nullptr : joints.data(),
-                  motions.orientations,
-                  motions.sensitivities};
-    if (on_step && !on_step(view)) {
-      sum.status = SolveStatus::kCancelled;
-      sum.message = "stopped by the caller after step " + std::to_string(k);
-      return false;
-    }
-    return true;
+    const StepView view = view_of(k, q, qd, qdd, motions, phi, rcond, joints.empty() ? nullptr : joints.data());
+    return written(writer ? writer->write_row(view) : !on_step || on_step(view), k);
+  }
+  // What the caller sees of row k (the joints' measures unwrapped already).
+  StepView view_of(Index k, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd,
+                   const RowMotions& motions, const Eigen::VectorXd& phi, double rcond,
+                   const JointMotion* joint_measures) const {
+    return {k,
+            time_of(k),
+            q,
+            opt.velocities ? &qd : nullptr,
+            opt.accelerations ? &qdd : nullptr,
+            motions.points,
+            opt.residuals ? &phi : nullptr,
+            opt.condition ? rcond : 0.0,
+            joint_measures,
+            motions.orientations,
+            motions.sensitivities};
+  }
+  // Rows a parallel chunk encoded (chunks_encode()), `rows` of them up to time point k, each counted already
+  // (count_row()): written. False when the caller stops the sweep.
+  bool write_encoded(const std::string& text, Index rows, Index k) {
+    return rows == 0 || written(writer->write(text, rows, k), k);
+  }
+  // The caller's answer to the rows up to time point k: false stops the sweep, as cancelled.
+  bool written(bool go_on, Index k) {
+    if (go_on) return true;
+    sum.status = SolveStatus::kCancelled;
+    sum.message = "stopped by the caller after step " + std::to_string(k);
+    return false;
   }
   // The joint measures of the rows delivered so far, angles unwrapped: each row's angle is the 2π-multiple of its
   // wrapped value nearest to the last row's plus the rates' trapezoid over the step (every time point is
