@@ -79,11 +79,14 @@ void BM_BatchCases(benchmark::State& state) {
               const std::string prefix = std::to_string(k) + ",";
               text.clear();
               SweepSummary s;
-              (void)run_sweep(model, one, ws, [&](const StepView& step) {
-                text += prefix;
-                format.append_row(step, text);
-                return true;
-              }, &s);
+              (void)run_sweep(
+                  model, one, ws,
+                  [&](const StepView& step) {
+                    text += prefix;
+                    format.append_row(step, text);
+                    return true;
+                  },
+                  &s);
               if (s.status != SolveStatus::kSuccess) ++failed;
               rows += s.steps_completed;
               bytes += static_cast<long long>(text.size());
@@ -122,7 +125,8 @@ void BM_BatchNFourBar(benchmark::State& state) {
   const auto b0 = std::chrono::steady_clock::now();
   std::vector<Model> models;
   models.reserve(kCases);
-  for (int k = 0; k < kCases; ++k) models.push_back(phiq_bench::nfourbar(kLoops, M_PI / 4 + 0.01 * k, M_PI / 2 * (1 + 0.01 * k)));
+  for (int k = 0; k < kCases; ++k)
+    models.push_back(phiq_bench::nfourbar(kLoops, M_PI / 4 + 0.01 * k, M_PI / 2 * (1 + 0.01 * k)));
   const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - b0).count();
   std::vector<const Model*> pointers;
   for (const Model& m : models) pointers.push_back(&m);
@@ -157,6 +161,12 @@ void BM_BatchNFourBar(benchmark::State& state) {
   state.counters["per_core_vs_single"] = ratios[ratios.size() / 2];
   state.counters["setup_ms_per_case"] = 1e3 * setup / kCases;
 }
-BENCHMARK(BM_BatchNFourBar)->ArgName("threads")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(5);
+BENCHMARK(BM_BatchNFourBar)
+    ->ArgName("threads")
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(5);
 
 }  // namespace

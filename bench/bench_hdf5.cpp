@@ -45,12 +45,15 @@ void BM_Hdf5SweepWriting(benchmark::State& state) {
     const auto s0 = Clock::now();
     Hdf5Writer w(path, m, plan, h);
     double wr = 0;
-    if (run_sweep(m, o, ws, [&](const StepView& s) {
-      const auto w0 = Clock::now();
-      w.append_row(s);
-      wr += seconds_since(w0);
-      return true;
-    }, nullptr) != SolveStatus::kSuccess)
+    if (run_sweep(
+            m, o, ws,
+            [&](const StepView& s) {
+              const auto w0 = Clock::now();
+              w.append_row(s);
+              wr += seconds_since(w0);
+              return true;
+            },
+            nullptr) != SolveStatus::kSuccess)
       state.SkipWithError("the sweep failed");
     const auto c0 = Clock::now();
     w.close();

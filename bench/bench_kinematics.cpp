@@ -23,8 +23,8 @@
 namespace {
 
 using namespace phiq;
-using phiq_bench::nfourbar;
 using phiq_bench::Clock;
+using phiq_bench::nfourbar;
 using phiq_bench::seconds_since;
 
 Model crank_slider() {
@@ -44,7 +44,9 @@ Model crank_slider() {
 // run on this shared, noisy machine.
 struct Kernel {
   explicit Kernel(const Model& m)
-      : lu(m.symbolic()->make_numeric()), values(m.jacobian_pattern().nnz()), b(m.num_equations()),
+      : lu(m.symbolic()->make_numeric()),
+        values(m.jacobian_pattern().nnz()),
+        b(m.num_equations()),
         x(m.num_coordinates()) {
     b.setOnes();
   }
@@ -78,15 +80,18 @@ void run_steps(benchmark::State& state, const Model& m, Index steps, double t_en
     ws.q = m.initial_positions();
     const auto t0 = Clock::now();
     double in_kernel = 0.0;
-    (void)run_sweep(m, opt, ws, [&](const StepView& s) {  // its status is sum.status, checked below
-      // every 10th row, one bare kernel at this very state (its time is taken out of the sweep's)
-      if (s.step % 10 == 0) {
-        const auto k0 = Clock::now();
-        kernel_s += kernel.time_one(m, s.q), ++kernels;
-        in_kernel += seconds_since(k0);
-      }
-      return true;
-    }, &sum);
+    (void)run_sweep(
+        m, opt, ws,
+        [&](const StepView& s) {  // its status is sum.status, checked below
+          // every 10th row, one bare kernel at this very state (its time is taken out of the sweep's)
+          if (s.step % 10 == 0) {
+            const auto k0 = Clock::now();
+            kernel_s += kernel.time_one(m, s.q), ++kernels;
+            in_kernel += seconds_since(k0);
+          }
+          return true;
+        },
+        &sum);
     const double t = seconds_since(t0) - in_kernel;
     state.SetIterationTime(t);
     sweep_s += t;
@@ -98,8 +103,8 @@ void run_steps(benchmark::State& state, const Model& m, Index steps, double t_en
   state.counters["step_per_kernel"] = (sweep_s / static_cast<double>(rows)) / (kernel_s / static_cast<double>(kernels));
   state.counters["newton_per_step"] = static_cast<double>(sum.counters.newton_iterations) / (steps + 1);
   state.counters["factorizations_per_step"] = static_cast<double>(sum.counters.factorizations) / (steps + 1);
-  state.counters["pivoting_per_step"] = static_cast<double>(ws.lu->pivoting_factorizations()) /
-                                        static_cast<double>(state.iterations() * (steps + 1));
+  state.counters["pivoting_per_step"] =
+      static_cast<double>(ws.lu->pivoting_factorizations()) / static_cast<double>(state.iterations() * (steps + 1));
   state.counters["coordinates"] = static_cast<double>(m.num_coordinates());
 }
 
@@ -114,7 +119,8 @@ LinearSolverKind kind_arg(const benchmark::State& state) { return static_cast<Li
 void solver_args(benchmark::internal::Benchmark* b) {
   b->ArgNames({"N", "lu"});
   for (int64_t n = 10; n <= 100000; n *= 10)
-    for (LinearSolverKind k : {LinearSolverKind::kKlu, LinearSolverKind::kUmfpack}) b->Args({n, static_cast<int64_t>(k)});
+    for (LinearSolverKind k : {LinearSolverKind::kKlu, LinearSolverKind::kUmfpack})
+      b->Args({n, static_cast<int64_t>(k)});
 }
 
 // nfourbar, a quarter turn (π/4 → 3π/4) in 50 steps per iteration. lu: 0 UMFPACK, 1 KLU.
@@ -128,10 +134,12 @@ BENCHMARK(BM_NFourBarSweepStep)->Apply(solver_args)->Unit(benchmark::kMillisecon
 // row scaling at every refactorisation), 32-bit, on the same matrix. The kernel a user calling the library gets,
 // beside the one phiq configures (Kernel: refactorisations without scaling, its rcond and sign scan).
 struct KluAsItComes {
-  explicit KluAsItComes(const Model& m) : ap(m.jacobian_pattern().col_ptr.begin(), m.jacobian_pattern().col_ptr.end()),
-                                          ai(m.jacobian_pattern().row_idx.begin(), m.jacobian_pattern().row_idx.end()),
-                                          values(static_cast<std::size_t>(m.jacobian_pattern().nnz())),
-                                          b(m.num_equations()), x(m.num_coordinates()) {
+  explicit KluAsItComes(const Model& m)
+      : ap(m.jacobian_pattern().col_ptr.begin(), m.jacobian_pattern().col_ptr.end()),
+        ai(m.jacobian_pattern().row_idx.begin(), m.jacobian_pattern().row_idx.end()),
+        values(static_cast<std::size_t>(m.jacobian_pattern().nnz())),
+        b(m.num_equations()),
+        x(m.num_coordinates()) {
     klu_defaults(&common);
     symbolic = klu_analyze(static_cast<int>(x.size()), ap.data(), ai.data(), &common);
     b.setOnes();
@@ -284,7 +292,13 @@ void BM_NFourBarSymbolicReuse(benchmark::State& state) {
   state.counters["step_us"] = 1e6 * step_s;
   state.counters["step_speedup"] = (step_s + fact_per_step * (fresh_s - reuse_s) / it) / step_s;
 }
-BENCHMARK(BM_NFourBarSymbolicReuse)->ArgName("N")->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMicrosecond)->UseManualTime();
+BENCHMARK(BM_NFourBarSymbolicReuse)
+    ->ArgName("N")
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseManualTime();
 
 }  // namespace
 

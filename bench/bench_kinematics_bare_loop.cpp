@@ -17,8 +17,8 @@
 namespace {
 
 using namespace phiq;
-using phiq_bench::nfourbar;
 using phiq_bench::Clock;
+using phiq_bench::nfourbar;
 using phiq_bench::seconds_since;
 
 // ---- The bare loop: hand-written Newton over KLU refactor -----------------------------------------------
@@ -38,15 +38,16 @@ class BareLoop {
     std::vector<std::vector<Index>> rows_of_col(static_cast<std::size_t>(nc));
     auto put = [&](Index r, Index c) { rows_of_col[static_cast<std::size_t>(c)].push_back(r); };
     Index r = 0;
-    for (Index i = 0; i <= n; ++i, ++r) put(r, 2 * i), put(r, 2 * i + 1);                       // cranks
-    for (Index i = 0; i < n; ++i, ++r) put(r, 2 * i), put(r, 2 * i + 1), put(r, 2 * i + 2), put(r, 2 * i + 3);  // couplers
-    put(r, 0), put(r, 1), put(r, nc - 1), ++r;  // angle of crank 0
-    put(r, nc - 1);                              // driver
+    for (Index i = 0; i <= n; ++i, ++r) put(r, 2 * i), put(r, 2 * i + 1);  // cranks
+    for (Index i = 0; i < n; ++i, ++r)
+      put(r, 2 * i), put(r, 2 * i + 1), put(r, 2 * i + 2), put(r, 2 * i + 3);  // couplers
+    put(r, 0), put(r, 1), put(r, nc - 1), ++r;                                 // angle of crank 0
+    put(r, nc - 1);                                                            // driver
     colp_.assign(static_cast<std::size_t>(nc + 1), 0);
     for (Index c = 0; c < nc; ++c) {
       std::sort(rows_of_col[static_cast<std::size_t>(c)].begin(), rows_of_col[static_cast<std::size_t>(c)].end());
-      colp_[static_cast<std::size_t>(c + 1)] = colp_[static_cast<std::size_t>(c)] +
-                                               static_cast<int>(rows_of_col[static_cast<std::size_t>(c)].size());
+      colp_[static_cast<std::size_t>(c + 1)] =
+          colp_[static_cast<std::size_t>(c)] + static_cast<int>(rows_of_col[static_cast<std::size_t>(c)].size());
       for (Index rr : rows_of_col[static_cast<std::size_t>(c)]) rowi_.push_back(static_cast<int>(rr));
     }
     val_.assign(rowi_.size(), 0.0);
@@ -60,7 +61,8 @@ class BareLoop {
     klu_free_symbolic(&symbolic_, &common_);
   }
   void reset() {
-    for (Index i = 0; i <= n_; ++i) q_[2 * i] = static_cast<double>(i) + std::cos(theta0_), q_[2 * i + 1] = std::sin(theta0_);
+    for (Index i = 0; i <= n_; ++i)
+      q_[2 * i] = static_cast<double>(i) + std::cos(theta0_), q_[2 * i + 1] = std::sin(theta0_);
     q_[static_cast<std::size_t>(dim_ - 1)] = theta0_;
   }
   // One drive step to time t: Newton from the previous position, then velocity and acceleration. Returns the
@@ -88,7 +90,8 @@ class BareLoop {
     const double th = theta0_ + rate_ * t;
     double e = 0;
     for (Index i = 0; i <= n_; ++i)
-      e = std::max({e, std::fabs(q_[2 * i] - static_cast<double>(i) - std::cos(th)), std::fabs(q_[2 * i + 1] - std::sin(th))});
+      e = std::max(
+          {e, std::fabs(q_[2 * i] - static_cast<double>(i) - std::cos(th)), std::fabs(q_[2 * i + 1] - std::sin(th))});
     return e;
   }
 
@@ -131,8 +134,10 @@ class BareLoop {
         v[k] = d;
       }
     }
-    if (!numeric_) numeric_ = klu_factor(colp_.data(), rowi_.data(), v.data(), symbolic_, &common_);
-    else klu_refactor(colp_.data(), rowi_.data(), v.data(), symbolic_, numeric_, &common_);
+    if (!numeric_)
+      numeric_ = klu_factor(colp_.data(), rowi_.data(), v.data(), symbolic_, &common_);
+    else
+      klu_refactor(colp_.data(), rowi_.data(), v.data(), symbolic_, numeric_, &common_);
   }
   void gamma() {
     Index r = 0;
@@ -245,6 +250,10 @@ void BM_NFourBarStepVsBareLoop(benchmark::State& state) {
   state.counters["full_error"] = full_err;
   state.counters["bare_error"] = bare_err;
 }
-BENCHMARK(BM_NFourBarStepVsBareLoop)->ArgNames({"N", "steps"})->ArgsProduct({{1000, 10000, 100000}, {50, 1000}})->Unit(benchmark::kMillisecond)->UseManualTime();
+BENCHMARK(BM_NFourBarStepVsBareLoop)
+    ->ArgNames({"N", "steps"})
+    ->ArgsProduct({{1000, 10000, 100000}, {50, 1000}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
 
 }  // namespace

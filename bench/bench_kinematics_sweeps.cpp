@@ -19,8 +19,8 @@
 namespace {
 
 using namespace phiq;
-using phiq_bench::nfourbar;
 using phiq_bench::Clock;
+using phiq_bench::nfourbar;
 using phiq_bench::seconds_since;
 
 // One sweep of `m` from its initial positions, timed: its wall time in seconds (the summary in *sum).
@@ -103,7 +103,14 @@ void BM_NFourBarParallelSweep(benchmark::State& state) {
   state.counters["speedup_rows_read"] = median(read_speedups);
   state.counters["chunking_cost_one_thread"] = median(chunking_costs);
 }
-BENCHMARK(BM_NFourBarParallelSweep)->ArgName("N")->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(9);
+BENCHMARK(BM_NFourBarParallelSweep)
+    ->ArgName("N")
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(9);
 
 // Parallel drive steps of a positions-only sweep of 100 steps (chunks of 16, 7 of them): the short sweep of a large
 // model, where a chunk's start-up is a larger share than in the 1000-step sweep above and where the first seed,
@@ -134,7 +141,14 @@ void BM_NFourBarParallelPositions(benchmark::State& state) {
   state.counters["speedup"] = speedups[speedups.size() / 2];
   state.counters["seed_share"] = seed / t2;
 }
-BENCHMARK(BM_NFourBarParallelPositions)->ArgName("N")->Arg(10)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(5);
+BENCHMARK(BM_NFourBarParallelPositions)
+    ->ArgName("N")
+    ->Arg(10)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(5);
 
 // What outputs cost (issue 5, section 3): the same nfourbar sweep (a quarter turn in 200 steps) with the output
 // lists a scene can have, timed interleaved in one loop, per step. The engine plans the work from the list, so the
@@ -159,8 +173,12 @@ void BM_NFourBarOutputCost(benchmark::State& state) {
     return o;
   };
   std::vector<Variant> variants;
-  for (const auto& [name, v, a] : {std::tuple{"q", false, false}, {"q_res_rcond", false, false}, {"qv", true, false},
-                                   {"qva", true, true}, {"qva_points", true, true}, {"qva_secant", true, true}})
+  for (const auto& [name, v, a] : {std::tuple{"q", false, false},
+                                   {"q_res_rcond", false, false},
+                                   {"qv", true, false},
+                                   {"qva", true, true},
+                                   {"qva_points", true, true},
+                                   {"qva_secant", true, true}})
     variants.push_back(Variant{name, make(v, a), 0.0, 0, {}});
   variants[1].opt.residuals = variants[1].opt.condition = true;
   for (Index i = 0; i <= n; ++i)  // every crank tip: an upper bound of what points cost
@@ -205,7 +223,14 @@ void BM_NFourBarOutputCost(benchmark::State& state) {
     state.counters[std::string(v.name) + "_per_q"] = v.per_q[v.per_q.size() / 2];
   }
 }
-BENCHMARK(BM_NFourBarOutputCost)->ArgName("N")->Arg(10)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(7);
+BENCHMARK(BM_NFourBarOutputCost)
+    ->ArgName("N")
+    ->Arg(10)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(7);
 
 // Writing the result CSV (issue 4: a wide CSV must not dominate a large run): one row of q, q̇, q̈ of nfourbar formatted
 // by CsvFormat::append_row (shortest round-trip text), in a task arena of 1 thread and of 2, interleaved, against the
@@ -220,10 +245,13 @@ void BM_CsvRowFormatting(benchmark::State& state) {
   o.threads = 1;
   Eigen::VectorXd q, qd, qdd;  // the last row: values as a run writes them
   const auto s0 = Clock::now();
-  if (run_sweep(m, o, ws, [&](const StepView& s) {
-    if (s.step == steps) q = s.q, qd = *s.qd, qdd = *s.qdd;
-    return true;
-  }, nullptr) != SolveStatus::kSuccess)
+  if (run_sweep(
+          m, o, ws,
+          [&](const StepView& s) {
+            if (s.step == steps) q = s.q, qd = *s.qd, qdd = *s.qdd;
+            return true;
+          },
+          nullptr) != SolveStatus::kSuccess)
     state.SkipWithError("the sweep failed");
   const double step_s = seconds_since(s0) / static_cast<double>(steps);
   std::vector<Index> columns(static_cast<std::size_t>(m.num_coordinates()));
@@ -263,6 +291,14 @@ void BM_CsvRowFormatting(benchmark::State& state) {
   state.counters["format_per_step_1t"] = per_row_1 / step_s;
   state.counters["format_per_step_2t"] = per_row_2 / step_s;
 }
-BENCHMARK(BM_CsvRowFormatting)->ArgName("N")->Arg(10)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(5);
+BENCHMARK(BM_CsvRowFormatting)
+    ->ArgName("N")
+    ->Arg(10)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(5);
 
 }  // namespace

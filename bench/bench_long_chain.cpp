@@ -54,13 +54,16 @@ void BM_LongChainNoDrift(benchmark::State& state) {
     residual.clear(), deviation.clear(), finite = true;
     phiq::tools::ClosedFormErrors err(*exact);
     Workspace ws(m);
-    (void)run_sweep(m, opt, ws, [&](const StepView& s) {  // its status is sum.status, checked below
-      finite = finite && s.q.allFinite() && s.phi && s.phi->allFinite() && (!s.qd || s.qd->allFinite()) &&
-               (!s.qdd || s.qdd->allFinite());
-      residual.push_back(s.phi ? scaled_residual(m, *s.phi) : INFINITY);
-      deviation.push_back(err.add(s.t, s.q.data(), s.qd ? s.qd->data() : nullptr, s.qdd ? s.qdd->data() : nullptr));
-      return true;
-    }, &sum);
+    (void)run_sweep(
+        m, opt, ws,
+        [&](const StepView& s) {  // its status is sum.status, checked below
+          finite = finite && s.q.allFinite() && s.phi && s.phi->allFinite() && (!s.qd || s.qd->allFinite()) &&
+                   (!s.qdd || s.qdd->allFinite());
+          residual.push_back(s.phi ? scaled_residual(m, *s.phi) : INFINITY);
+          deviation.push_back(err.add(s.t, s.q.data(), s.qd ? s.qd->data() : nullptr, s.qdd ? s.qdd->data() : nullptr));
+          return true;
+        },
+        &sum);
     deviation_v = std::max(err.v_error, err.a_error);
     state.SetIterationTime(sum.solve_seconds);
   }
@@ -81,9 +84,12 @@ void BM_LongChainNoDrift(benchmark::State& state) {
   state.counters["factorizations_per_step"] = static_cast<double>(sum.counters.factorizations) / kSteps;
   state.counters["ms_per_step"] = 1e3 * sum.solve_seconds / (kSteps + 1);
   const double floor = opt.newton.tolerance + ToleranceScales::kUlpFloor * static_cast<double>(n + 1);
-  if (!finite) state.SkipWithError("a value is not finite");
-  else if (max_residual > floor) state.SkipWithError("a residual exceeds the tolerance");
-  else if (max_deviation > 1e-9 || deviation_v > 1e-9) state.SkipWithError("off the parallelogram by more than 1e-9");
+  if (!finite)
+    state.SkipWithError("a value is not finite");
+  else if (max_residual > floor)
+    state.SkipWithError("a residual exceeds the tolerance");
+  else if (max_deviation > 1e-9 || deviation_v > 1e-9)
+    state.SkipWithError("off the parallelogram by more than 1e-9");
 }
 
 BENCHMARK(BM_LongChainNoDrift)
@@ -121,11 +127,14 @@ void BM_LongChainFlatStart(benchmark::State& state) {
   for (auto _ : state) {
     Workspace ws(flat), ws_regular(regular);
     phiq::tools::ClosedFormErrors err(*exact), start(*exact);
-    (void)run_sweep(flat, opt, ws, [&](const StepView& s) {  // its status is sum.status, checked below
-      err.add(s.t, s.q.data(), nullptr, nullptr);
-      if (s.t == 0.0 && derivs) start.add(s.t, s.q.data(), s.qd->data(), s.qdd->data());
-      return true;
-    }, &sum);
+    (void)run_sweep(
+        flat, opt, ws,
+        [&](const StepView& s) {  // its status is sum.status, checked below
+          err.add(s.t, s.q.data(), nullptr, nullptr);
+          if (s.t == 0.0 && derivs) start.add(s.t, s.q.data(), s.qd->data(), s.qdd->data());
+          return true;
+        },
+        &sum);
     (void)run_sweep(regular, opt, ws_regular, nullptr, &reg);
     flat_seconds += sum.solve_seconds, regular_seconds += reg.solve_seconds;
     q_error = err.q_error, v_start = start.v_error / w, a_start = start.a_error / (w * w);

@@ -87,9 +87,10 @@ int main(int argc, char** argv) {
       solve.push_back(since(t0));
     }
     std::printf("N = %ld loops, n = %d coordinates, nnz = %zu, %d MPI rank(s)\n", n_loops, n, a.size(), ranks);
-    std::printf("KLU (phiq, rank 0): model and analysis %.4g ms, first factorisation %.4g ms, refactorisation "
-                "%.4g ms, solve %.4g ms\n",
-                1e3 * build_s, 1e3 * first_s, 1e3 * median(refactor), 1e3 * median(solve));
+    std::printf(
+        "KLU (phiq, rank 0): model and analysis %.4g ms, first factorisation %.4g ms, refactorisation "
+        "%.4g ms, solve %.4g ms\n",
+        1e3 * build_s, 1e3 * first_s, 1e3 * median(refactor), 1e3 * median(solve));
   }
 
   // Every rank: MUMPS.
@@ -114,8 +115,9 @@ int main(int argc, char** argv) {
     dmumps_c(&id);
     const double s = since(t0);
     if (id.infog[0] < 0) {
-      if (rank == 0) std::fprintf(stderr, "phiq_bench_mumps: MUMPS job %d: INFOG(1) = %d, INFOG(2) = %d\n", job,
-                                  id.infog[0], id.infog[1]);
+      if (rank == 0)
+        std::fprintf(stderr, "phiq_bench_mumps: MUMPS job %d: INFOG(1) = %d, INFOG(2) = %d\n", job, id.infog[0],
+                     id.infog[1]);
       MPI_Abort(MPI_COMM_WORLD, 1);
     }
     return s;
@@ -137,10 +139,11 @@ int main(int argc, char** argv) {
       diff = std::max(diff, std::abs(x[i] - x_klu[i]));
       biggest = std::max(biggest, std::abs(x_klu[i]));
     }
-    std::printf("MUMPS %s (%d rank(s)): analysis %.4g ms, factorisation %.4g ms, solve %.4g ms, memory %d MB "
-                "largest rank, %d MB all; |x_MUMPS - x_KLU| / |x|max = %.1e\n",
-                MUMPS_VERSION, ranks, 1e3 * analysis_s, 1e3 * median(factor), 1e3 * median(solve), id.infog[20],
-                id.infog[21], diff / biggest);
+    std::printf(
+        "MUMPS %s (%d rank(s)): analysis %.4g ms, factorisation %.4g ms, solve %.4g ms, memory %d MB "
+        "largest rank, %d MB all; |x_MUMPS - x_KLU| / |x|max = %.1e\n",
+        MUMPS_VERSION, ranks, 1e3 * analysis_s, 1e3 * median(factor), 1e3 * median(solve), id.infog[20], id.infog[21],
+        diff / biggest);
   }
   id.job = -2;
   dmumps_c(&id);

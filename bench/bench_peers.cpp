@@ -69,7 +69,15 @@ struct Elapsed {
 class DenseNFourBar {
  public:
   DenseNFourBar(int n, Start start)
-      : n_(n), size_(2 * n + 3), start_(start), q_(size_), qd_(size_), qdd_(size_), phi_(size_), rhs_(size_), dq_(size_),
+      : n_(n),
+        size_(2 * n + 3),
+        start_(start),
+        q_(size_),
+        qd_(size_),
+        qdd_(size_),
+        phi_(size_),
+        rhs_(size_),
+        dq_(size_),
         jac_(size_, size_) {
     reset();
   }
@@ -182,8 +190,10 @@ class DenseNFourBar {
 class PhiqNFourBar {
  public:
   PhiqNFourBar(int n, Start start)
-      : n_(n), predictor_(start == Start::kPrevious ? phiq::Predictor::kPrevious : phiq::Predictor::kQuadratic),
-        model_(nfourbar(n, kTheta0, kRate)), ws_(model_) {}
+      : n_(n),
+        predictor_(start == Start::kPrevious ? phiq::Predictor::kPrevious : phiq::Predictor::kQuadratic),
+        model_(nfourbar(n, kTheta0, kRate)),
+        ws_(model_) {}
 
   // Runs `steps` drive steps from t = 0; returns the time of the drive steps and merges into dev.
   Elapsed run(int steps, Deviation& dev) {
@@ -197,20 +207,23 @@ class PhiqNFourBar {
     Elapsed timed;
     Stamp mark{};
     phiq::SweepSummary sum;
-    (void)phiq::run_sweep(model_, opt, ws_, [&](const phiq::StepView& s) {  // its status is sum.status, checked below
-      if (s.step > 0) timed.add(mark, now());
-      Deviation d;
-      for (int i = 0; i <= n_; ++i) {
-        const ExactTip e = exact_tip(i, s.t);
-        d.position = std::max({d.position, std::abs(s.q[2 * i] - e.x), std::abs(s.q[2 * i + 1] - e.y)});
-        d.velocity = std::max({d.velocity, std::abs((*s.qd)[2 * i] - e.vx), std::abs((*s.qd)[2 * i + 1] - e.vy)});
-        d.acceleration =
-            std::max({d.acceleration, std::abs((*s.qdd)[2 * i] - e.ax), std::abs((*s.qdd)[2 * i + 1] - e.ay)});
-      }
-      dev.merge(d);
-      mark = now();
-      return true;
-    }, &sum);
+    (void)phiq::run_sweep(
+        model_, opt, ws_,
+        [&](const phiq::StepView& s) {  // its status is sum.status, checked below
+          if (s.step > 0) timed.add(mark, now());
+          Deviation d;
+          for (int i = 0; i <= n_; ++i) {
+            const ExactTip e = exact_tip(i, s.t);
+            d.position = std::max({d.position, std::abs(s.q[2 * i] - e.x), std::abs(s.q[2 * i + 1] - e.y)});
+            d.velocity = std::max({d.velocity, std::abs((*s.qd)[2 * i] - e.vx), std::abs((*s.qd)[2 * i + 1] - e.vy)});
+            d.acceleration =
+                std::max({d.acceleration, std::abs((*s.qdd)[2 * i] - e.ax), std::abs((*s.qdd)[2 * i + 1] - e.ay)});
+          }
+          dev.merge(d);
+          mark = now();
+          return true;
+        },
+        &sum);
     if (sum.status != phiq::SolveStatus::kSuccess) throw std::runtime_error("phiq: " + sum.message);
     newton_ += sum.counters.newton_iterations;
     return timed;
@@ -230,8 +243,10 @@ std::string one_line(const char* what) {
   std::string out;
   for (const char* c = what; *c; ++c) {
     const bool space = *c == ' ' || *c == '\n' || *c == '\t' || *c == '\r';
-    if (!space) out += *c;
-    else if (!out.empty() && out.back() != ' ') out += ' ';
+    if (!space)
+      out += *c;
+    else if (!out.empty() && out.back() != ' ')
+      out += ' ';
   }
   while (!out.empty() && out.back() == ' ') out.pop_back();
   return out;

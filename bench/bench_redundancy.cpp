@@ -48,8 +48,7 @@ void BM_RankAnalysisBraced(benchmark::State& st) {
   o.ordering = st.range(1) == 0 ? RankOrdering::kModelOrder : RankOrdering::kFillReducing;
   RankReport r;
   for (auto _ : st) r = analyse_rank(*m, q, 0.0, o);
-  if (static_cast<Index>(r.redundant_rows.size()) != n - 1 || r.dof != 1)
-    st.SkipWithError("wrong redundancy count");
+  if (static_cast<Index>(r.redundant_rows.size()) != n - 1 || r.dof != 1) st.SkipWithError("wrong redundancy count");
   st.counters["redundant"] = static_cast<double>(r.redundant_rows.size());
   st.counters["equations"] = static_cast<double>(m->num_equations());
 }
@@ -78,7 +77,8 @@ void sweep_steps(benchmark::State& st, const Model& m) {
   for (auto _ : st) {
     Workspace ws(m);
     SweepSummary s;
-    if (run_sweep(m, o, ws, [](const StepView&) { return true; }, &s) != SolveStatus::kSuccess)
+    if (run_sweep(
+            m, o, ws, [](const StepView&) { return true; }, &s) != SolveStatus::kSuccess)
       st.SkipWithError(s.message.c_str());
     seconds += s.solve_seconds;
   }
@@ -113,8 +113,7 @@ void BM_IterationDropRowsKlu(benchmark::State& st) {
     ws.has_factorization = false;
     LinearSummary ls;
     solved->residual(ws.q.data(), 0.0, ws.phi.data());
-    if (solve_velocity(*solved, 0.0, unchecked, ws, &ls) != SolveStatus::kSuccess)
-      st.SkipWithError(ls.message.c_str());
+    if (solve_velocity(*solved, 0.0, unchecked, ws, &ls) != SolveStatus::kSuccess) st.SkipWithError(ls.message.c_str());
     benchmark::DoNotOptimize(ws.qd.data());
   }
 }
@@ -146,8 +145,13 @@ void BM_IterationNormalEquationsCholmod(benchmark::State& st) {
 // ordering 0: model order (quadratic fill on a chain: stopped at 10^4), 1: fill-reducing
 BENCHMARK(BM_RankAnalysisBraced)
     ->ArgNames({"N", "fill"})
-    ->Args({1000, 0})->Args({3000, 0})->Args({10000, 0})
-    ->Args({1000, 1})->Args({10000, 1})->Args({100000, 1})->Args({1000000, 1})
+    ->Args({1000, 0})
+    ->Args({3000, 0})
+    ->Args({10000, 0})
+    ->Args({1000, 1})
+    ->Args({10000, 1})
+    ->Args({100000, 1})
+    ->Args({1000000, 1})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_AssembleBraced) SIZES;
 BENCHMARK(BM_StepBracedReduced) SIZES;

@@ -90,8 +90,8 @@ std::string nfourbar_parameters_scene(Index n, int parameters) {
        "length: 1}\n  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}\n"
        "drivers:\n  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: "
        "1.5707963267948966}}\ntime: {start: 0, end: 1, steps: 100}\n"
-       "output: {coordinates: [y" + std::to_string(n) + "], velocities: true, accelerations: true, sensitivities: [" +
-       list + "]}\n";
+       "output: {coordinates: [y" +
+       std::to_string(n) + "], velocities: true, accelerations: true, sensitivities: [" + list + "]}\n";
   return s;
 }
 
@@ -122,8 +122,6 @@ BENCHMARK(BM_SensitivityForms)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->Iterations(3);
-
-
 
 // What evaluating only a parameter's reach saves (ParameterReach): the scene of BM_SensitivityForms (P cranks'
 // lengths, each read by its one bar), swept with each parameter's reach as parameter_reach() finds it against the

@@ -84,8 +84,10 @@ void BM_StepperVsSweep(benchmark::State& state) {
   for (auto _ : state) {
     const bool first = stepper_first.size() <= stepper_second.size();
     double e_sweep, e_step;
-    if (first) e_step = step(), e_sweep = sweep();
-    else e_sweep = sweep(), e_step = step();
+    if (first)
+      e_step = step(), e_sweep = sweep();
+    else
+      e_sweep = sweep(), e_step = step();
     const double e_hand = hand_loop();
     state.SetIterationTime(e_step);
     sweep_s += e_sweep, stepper_s += e_step, hand_s += e_hand;
@@ -112,6 +114,12 @@ void BM_StepperVsSweep(benchmark::State& state) {
     state.counters[std::string(name) + "_factorizations_per_step"] = static_cast<double>(work->factorizations) / r;
   }
 }
-BENCHMARK(BM_StepperVsSweep)->ArgName("N")->Arg(10)->Arg(1000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(20);
+BENCHMARK(BM_StepperVsSweep)
+    ->ArgName("N")
+    ->Arg(10)
+    ->Arg(1000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(20);
 
 }  // namespace

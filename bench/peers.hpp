@@ -15,12 +15,12 @@
 
 namespace phiq_bench {
 
-inline constexpr double kTheta0 = M_PI / 4;    // θ(0), rad
-inline constexpr double kRate = M_PI / 2;      // θ̇, rad/s
-inline constexpr int kStepsPerSweep = 50;      // a quarter turn
+inline constexpr double kTheta0 = M_PI / 4;            // θ(0), rad
+inline constexpr double kRate = M_PI / 2;              // θ̇, rad/s
+inline constexpr int kStepsPerSweep = 50;              // a quarter turn
 inline constexpr double kStep = 1.0 / kStepsPerSweep;  // h, s
-inline constexpr double kTolerance = 1e-10;    // positions (and Simbody's velocities), metres / max norm
-inline constexpr double kCheckTolerance = 1e-8;  // a peer whose tips leave the exact solution by more fails
+inline constexpr double kTolerance = 1e-10;            // positions (and Simbody's velocities), metres / max norm
+inline constexpr double kCheckTolerance = 1e-8;        // a peer whose tips leave the exact solution by more fails
 
 inline double theta_at(double t) { return kTheta0 + kRate * t; }
 

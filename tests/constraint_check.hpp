@@ -43,9 +43,9 @@ inline phiq::Frame3 Body(Index first) {
 
 // ---- tolerances and steps -------------------------------------------------------------------------------------
 
-constexpr double kJacStep = 1e-6;     // relative step of the first differences (q and t)
-constexpr double kJacTol = 1e-6;      // relative to max(1, |entry|)
-constexpr double kGammaStep = 4e-3;   // step of the coarser second difference (Richardson with h and h/2)
+constexpr double kJacStep = 1e-6;    // relative step of the first differences (q and t)
+constexpr double kJacTol = 1e-6;     // relative to max(1, |entry|)
+constexpr double kGammaStep = 4e-3;  // step of the coarser second difference (Richardson with h and h/2)
 // The path s ↦ (q + s q̇, t + s) moves faster with larger velocities, and the truncation error of the second difference
 // grows with the sixth power of the speed: the step is taken per unit of path speed, so that every sample is
 // differentiated equally well. (Samples differ between compilers: GCC and clang evaluate the random draws in
@@ -55,8 +55,8 @@ double GammaStep(const std::vector<double>& qd) {
   for (double v : qd) speed = std::max(speed, std::fabs(v));
   return kGammaStep / speed;
 }
-constexpr double kGammaTol = 1e-7;    // relative to max(1, |γ|)
-constexpr double kSentinel = 7.25e77; // written past the rows a kind owns; must survive
+constexpr double kGammaTol = 1e-7;     // relative to max(1, |γ|)
+constexpr double kSentinel = 7.25e77;  // written past the rows a kind owns; must survive
 
 double Tol(double rel, double value) { return rel * std::max(1.0, std::fabs(value)); }
 
@@ -155,7 +155,7 @@ struct CheckOptions {
   std::uint32_t seed = 20240607;
   bool time_dependent = false;  // what depends_on_time() must answer
   int samples = 6;
-  std::vector<double> kinks;    // times the γ stencil must keep clear of
+  std::vector<double> kinks;  // times the γ stencil must keep clear of
 };
 
 CheckOptions Opts(std::uint32_t seed, bool time_dependent = false, int samples = 6, std::vector<double> kinks = {}) {
@@ -405,7 +405,8 @@ void CheckDataDerivativeOf(const Spec& spec, const Spec& rate, const Moved& move
 // CheckDataDerivativeOf() along spec + e·rate.
 template <class Spec>
 void CheckDataDerivative(const Spec& spec, const Spec& rate, int n_coords, std::uint32_t seed, int samples = 6) {
-  CheckDataDerivativeOf(spec, rate, [&](double e) { return MovedAlongData(spec, rate, e); }, n_coords, seed, samples);
+  CheckDataDerivativeOf(
+      spec, rate, [&](double e) { return MovedAlongData(spec, rate, e); }, n_coords, seed, samples);
 }
 
 // ---- Model: blocks, pattern and CSC plumbing ------------------------------------------------------------------
@@ -458,8 +459,8 @@ void CheckModel(const phiq::Model& model, std::uint32_t seed, int samples = 6) {
       const std::vector<double> fp = residual(qp, st.t), fm = residual(qm, st.t);
       for (Index r = 0; r < m; ++r) {
         const double fd = (fp[r] - fm[r]) / (qp[j] - qm[j]);
-        EXPECT_NEAR(jac(r, j), fd, Tol(kJacTol, fd)) << "Phi_q(" << model.row_name(r) << ", "
-                                                     << model.coordinate_names()[j] << ")";
+        EXPECT_NEAR(jac(r, j), fd, Tol(kJacTol, fd))
+            << "Phi_q(" << model.row_name(r) << ", " << model.coordinate_names()[j] << ")";
       }
     }
 

@@ -24,8 +24,8 @@ struct Glb {
     const std::string type = acc["type"];
     const std::size_t n = type == "SCALAR" ? 1 : (type == "VEC3" ? 3 : 4);
     EXPECT_EQ(acc["componentType"], 5126);
-    const std::size_t at = view["byteOffset"].get<std::size_t>() + acc.value("byteOffset", std::size_t{0}) +
-                           k * n * sizeof(float);
+    const std::size_t at =
+        view["byteOffset"].get<std::size_t>() + acc.value("byteOffset", std::size_t{0}) + k * n * sizeof(float);
     std::vector<double> v(n);
     for (std::size_t c = 0; c < n; ++c) {
       float f;

@@ -20,19 +20,38 @@ template <class T>
 struct Dual {
   T v{}, d{};
 };
-template <class T> Dual<T> operator+(Dual<T> a, Dual<T> b) { return {a.v + b.v, a.d + b.d}; }
-template <class T> Dual<T> operator-(Dual<T> a, Dual<T> b) { return {a.v - b.v, a.d - b.d}; }
-template <class T> Dual<T> operator*(Dual<T> a, Dual<T> b) { return {a.v * b.v, a.d * b.v + a.v * b.d}; }
-template <class T> Dual<T> operator/(Dual<T> a, Dual<T> b) { return {a.v / b.v, (a.d * b.v - a.v * b.d) / (b.v * b.v)}; }
+template <class T>
+Dual<T> operator+(Dual<T> a, Dual<T> b) {
+  return {a.v + b.v, a.d + b.d};
+}
+template <class T>
+Dual<T> operator-(Dual<T> a, Dual<T> b) {
+  return {a.v - b.v, a.d - b.d};
+}
+template <class T>
+Dual<T> operator*(Dual<T> a, Dual<T> b) {
+  return {a.v * b.v, a.d * b.v + a.v * b.d};
+}
+template <class T>
+Dual<T> operator/(Dual<T> a, Dual<T> b) {
+  return {a.v / b.v, (a.d * b.v - a.v * b.d) / (b.v * b.v)};
+}
 inline double sqrt_(double x) { return std::sqrt(x); }
 inline double sin_(double x) { return std::sin(x); }
 inline double cos_(double x) { return std::cos(x); }
-template <class T> Dual<T> sqrt_(Dual<T> a) {
+template <class T>
+Dual<T> sqrt_(Dual<T> a) {
   const T r = sqrt_(a.v);
   return {r, a.d / (r + r)};
 }
-template <class T> Dual<T> sin_(Dual<T> a) { return {sin_(a.v), a.d * cos_(a.v)}; }
-template <class T> Dual<T> cos_(Dual<T> a) { return {cos_(a.v), T{} - a.d * sin_(a.v)}; }
+template <class T>
+Dual<T> sin_(Dual<T> a) {
+  return {sin_(a.v), a.d * cos_(a.v)};
+}
+template <class T>
+Dual<T> cos_(Dual<T> a) {
+  return {cos_(a.v), T{} - a.d * sin_(a.v)};
+}
 
 // The slider of the notes' crank-slider: x_B = L2 cos θ + √(L3² − L2² sin² θ).
 template <class T>
@@ -98,15 +117,18 @@ inline SensitivityTrace sweep_sensitivities(const Model& model, const SweepOptio
   Workspace ws(model);
   if (start) ws.q = *start;
   const Index size = SensitivityLayout{model.num_coordinates()}.size(o.sensitivities.size());
-  const SolveStatus st = run_sweep(model, o, ws, [&](const StepView& v) {
-    r.rows.t.push_back(v.t);
-    r.rows.q.push_back(v.q);
-    if (v.qd) r.rows.qd.push_back(*v.qd);
-    if (v.qdd) r.rows.qdd.push_back(*v.qdd);
-    EXPECT_NE(v.sensitivities, nullptr);
-    if (v.sensitivities) r.s.emplace_back(v.sensitivities, v.sensitivities + size);
-    return true;
-  }, &r.summary);
+  const SolveStatus st = run_sweep(
+      model, o, ws,
+      [&](const StepView& v) {
+        r.rows.t.push_back(v.t);
+        r.rows.q.push_back(v.q);
+        if (v.qd) r.rows.qd.push_back(*v.qd);
+        if (v.qdd) r.rows.qdd.push_back(*v.qdd);
+        EXPECT_NE(v.sensitivities, nullptr);
+        if (v.sensitivities) r.s.emplace_back(v.sensitivities, v.sensitivities + size);
+        return true;
+      },
+      &r.summary);
   EXPECT_EQ(st, SolveStatus::kSuccess) << r.summary.message;
   return r;
 }

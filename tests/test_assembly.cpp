@@ -19,7 +19,6 @@
 namespace phiq {
 namespace {
 
-
 TEST(Assembly, FifthBarAssemblesDropsItsRedundantRowAndSweepsExactly) {
   test::Prepared p = test::prepare("redundant/parallelogram_fifth_bar.yaml");
   const Model& full = *p.scene.model;
@@ -72,7 +71,8 @@ constraints:
 drivers:
   - {name: motor, coordinate: psi, law: {type: linear, initial: 0.2, rate: 1}}
 time: {start: 0, end: 1, steps: 10}
-)", offset);
+)",
+                offset);
   return parse_scene(text, "planar_door.yaml");
 }
 
@@ -165,7 +165,8 @@ constraints:
   - {name: coupler, type: distance, points: [A, B], length: 3}
   - {name: rocker, type: distance, points: [C, B], length: 1}
 time: {start: 0, end: 0, steps: 0}
-)", "impossible.yaml");
+)",
+                         "impossible.yaml");
   Eigen::VectorXd q = sc.model->initial_positions();
   AssemblySummary as;
   const SolveStatus st = assemble(*sc.model, 0.0, {}, q, &as);

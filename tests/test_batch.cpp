@@ -30,10 +30,13 @@ std::string sweep_text(const Scene& scene) {
   const CsvFormat format(*scene.model, scene.sweep);
   std::string text = format.header();
   SweepSummary sum;
-  (void)run_sweep(*scene.model, scene.sweep, ws, [&](const StepView& s) {
-    format.append_row(s, text);
-    return true;
-  }, &sum);
+  (void)run_sweep(
+      *scene.model, scene.sweep, ws,
+      [&](const StepView& s) {
+        format.append_row(s, text);
+        return true;
+      },
+      &sum);
   EXPECT_EQ(sum.status, SolveStatus::kSuccess) << sum.message;
   return text;
 }
@@ -42,15 +45,16 @@ std::string sweep_text(const Scene& scene) {
 // with those parameters written in (the same rows, byte for byte), also after a read its parameters made fail
 // (a negative rod) and after a copy (its own tree); and the cases share the first one's symbolic analysis.
 TEST(Batch, ParsedSceneReadsEachCaseAsParseSceneDoes) {
-  const std::string text = "parameters: {L2: 0.3, L3: 1.0}\n"
-                           "coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}\n"
-                           "points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}\n"
-                           "constraints:\n"
-                           "  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}\n"
-                           "  - {name: rod, type: distance, points: [A, B], length: L3}\n"
-                           "drivers:\n"
-                           "  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}\n"
-                           "time: {start: 0, end: pi, steps: 36}\n";
+  const std::string text =
+      "parameters: {L2: 0.3, L3: 1.0}\n"
+      "coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}\n"
+      "points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}\n"
+      "constraints:\n"
+      "  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}\n"
+      "  - {name: rod, type: distance, points: [A, B], length: L3}\n"
+      "drivers:\n"
+      "  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}\n"
+      "time: {start: 0, end: pi, steps: 36}\n";
   ParsedScene parsed(text, "cs.yaml");
   const Scene first = parsed.read();
   EXPECT_EQ(sweep_text(first), sweep_text(parse_scene(text, "cs.yaml")));
@@ -68,7 +72,8 @@ TEST(Batch, ParsedSceneReadsEachCaseAsParseSceneDoes) {
       const Scene scene = own.read(o);
       EXPECT_EQ(scene.model->symbolic(), first.model->symbolic());
       std::string written = text;
-      written.replace(0, written.find('\n'), "parameters: {L2: " + std::to_string(l2) + ", L3: " + std::to_string(l3) + "}");
+      written.replace(0, written.find('\n'),
+                      "parameters: {L2: " + std::to_string(l2) + ", L3: " + std::to_string(l3) + "}");
       ASSERT_EQ(std::stod(std::to_string(l2)), l2);  // the text holds the very doubles
       EXPECT_EQ(sweep_text(scene), sweep_text(parse_scene(written, "cs.yaml"))) << l2 << " " << l3;
     }
@@ -146,13 +151,14 @@ TEST(Batch, EachCaseStartsFromItsOwnPlacement) {
   starts[1](3) = -starts[1](3);  // the slider mirrored: the other assembly branch
   std::vector<double> first_x(2, 0.0);
   std::mutex mu;
-  BatchSummary sum = run_batch({&models[0], &models[1]}, std::vector<SweepOptions>(2, opt), 1,
-                               [&](std::size_t c, const StepView& s) {
-                                 std::lock_guard<std::mutex> lock(mu);
-                                 if (s.step == 0) first_x[c] = s.q(3);
-                                 return true;
-                               },
-                               &starts);
+  BatchSummary sum = run_batch(
+      {&models[0], &models[1]}, std::vector<SweepOptions>(2, opt), 1,
+      [&](std::size_t c, const StepView& s) {
+        std::lock_guard<std::mutex> lock(mu);
+        if (s.step == 0) first_x[c] = s.q(3);
+        return true;
+      },
+      &starts);
   ASSERT_EQ(sum.failed, 0);
   EXPECT_NEAR(first_x[0], 1.3, 1e-12);   // L2 cos 0 + sqrt(L3² − 0) with the slider to the right
   EXPECT_NEAR(first_x[1], -0.7, 1e-12);  // L2 cos 0 − L3: the mirrored branch

@@ -105,7 +105,8 @@ constraints:
   - {name: circle, type: equation, expr: "x^2 + y^2 - 1"}
   - {name: diagonal, type: equation, expr: "x - y"}
 time: {start: 0, end: 0, steps: 0}
-)", "one_block.yaml");
+)",
+                               "one_block.yaml");
   TriangularBlocks tb;
   ASSERT_TRUE(detail::triangular_blocks(*sc.model, &tb));
   EXPECT_EQ(tb.count(), 1);

@@ -151,8 +151,9 @@ TEST(Cams, BadCurvesNameTheConstraint) {
                                                 "spline: [[0, 0], [2, 0], [2, 2], [1, 0.5], [0, 2]], closed: true");
   EXPECT_HAS(test::scene_error(notch), "constraint 'cam': flat_cam: the profile is not convex");
   const std::string unnamed = test::replace_first(text, "{name: cam, type: flat_cam", "{type: flat_cam");
-  EXPECT_HAS(test::scene_error(unnamed), "a constraint with a coordinate of its own needs a name (its coordinate "
-                                         "is NAME.s)");
+  EXPECT_HAS(test::scene_error(unnamed),
+             "a constraint with a coordinate of its own needs a name (its coordinate "
+             "is NAME.s)");
 }
 
 }  // namespace

@@ -121,7 +121,7 @@ TEST(GenerateChain3d, GeometryIsAnOrthonormalFrameWithItsEulerParameters) {
   EXPECT_NEAR(dot(g.u, g.e1), 0.0, 1e-16);
   for (const auto& v : {g.u, g.e1, g.e2}) EXPECT_NEAR(dot(v, v), 1.0, 1e-15);
   for (int k = 0; k < 3; ++k) EXPECT_NE(std::fabs(g.u[static_cast<std::size_t>(k)]), 1.0);  // not a coordinate axis
-  auto rotate = [](const tools::chain3d::Quat& p, const tools::chain3d::Vec& s) {  // R(p) s
+  auto rotate = [](const tools::chain3d::Quat& p, const tools::chain3d::Vec& s) {           // R(p) s
     const tools::chain3d::Vec e{p[1], p[2], p[3]}, exs = tools::chain3d::cross(e, s);
     const double c = p[0] * p[0] - dot(e, e), es = dot(e, s);
     tools::chain3d::Vec r;
@@ -140,11 +140,11 @@ TEST(GenerateChain3d, GeometryIsAnOrthonormalFrameWithItsEulerParameters) {
 }
 
 TEST(GenerateChain3d, HeaderCountsAndASizeIndependentOfN) {
-  EXPECT_NE(tools::generate_scene(chain3d(5, "natural")).find(
-                "# Counts: 19 coordinates, 18 kinematic equations + 1 driver = 19 equations; 1 dof\n"),
+  EXPECT_NE(tools::generate_scene(chain3d(5, "natural"))
+                .find("# Counts: 19 coordinates, 18 kinematic equations + 1 driver = 19 equations; 1 dof\n"),
             std::string::npos);
-  EXPECT_NE(tools::generate_scene(chain3d(5, "reference-point")).find(
-                "# Counts: 42 coordinates, 41 kinematic equations + 1 driver = 42 equations; 1 dof\n"),
+  EXPECT_NE(tools::generate_scene(chain3d(5, "reference-point"))
+                .find("# Counts: 42 coordinates, 41 kinematic equations + 1 driver = 42 equations; 1 dof\n"),
             std::string::npos);
   for (const char* coords : {"natural", "reference-point"})
     for (double twist : {0.0, 1.0}) {

@@ -25,7 +25,9 @@ namespace fs = std::filesystem;
 using Pose = std::pair<std::array<double, 3>, std::array<double, 4>>;  // translation; rotation (x, y, z, w)
 
 // Stored as float32: equal to the pose within its rounding (half an ulp, 2⁻²⁴ relative) and 1e-9.
-bool close(double stored, double exact) { return std::fabs(stored - exact) <= 1e-9 + std::ldexp(std::fabs(exact), -24); }
+bool close(double stored, double exact) {
+  return std::fabs(stored - exact) <= 1e-9 + std::ldexp(std::fabs(exact), -24);
+}
 
 class Animate : public Cli {
  protected:
@@ -62,8 +64,8 @@ class Animate : public Cli {
       for (int c = 0; c < 3; ++c) ASSERT_TRUE(close(t[c], p.first[c])) << name << " row " << k << " t" << c;
       const double sign = either_sign && r[3] * p.second[3] + r[2] * p.second[2] < 0 ? -1.0 : 1.0;
       for (int c = 0; c < 4; ++c)
-        ASSERT_TRUE(close(r[c], sign * p.second[c])) << name << " row " << k << " r" << c << ": " << r[c]
-                                                     << " vs " << sign * p.second[c];
+        ASSERT_TRUE(close(r[c], sign * p.second[c]))
+            << name << " row " << k << " r" << c << ": " << r[c] << " vs " << sign * p.second[c];
     }
   }
   // The time accessor: a keyframe per row, min and max the first and last t.
@@ -120,9 +122,12 @@ TEST_F(Animate, NaturalLinksFollowTheirPoints) {
     const double th = std::atan2(by - ay, bx - ax);
     return Pose{{ax, ay, 0.0}, {0.0, 0.0, std::sin(th / 2), std::cos(th / 2)}};
   };
-  expect_poses(g, "crank", [&](std::size_t k) { return link(0, 0, at(k, "xA"), at(k, "yA")); }, true);
-  expect_poses(g, "coupler", [&](std::size_t k) { return link(at(k, "xA"), at(k, "yA"), at(k, "xB"), at(k, "yB")); }, true);
-  expect_poses(g, "rocker", [&](std::size_t k) { return link(1.0, 0, at(k, "xB"), at(k, "yB")); }, true);
+  expect_poses(
+      g, "crank", [&](std::size_t k) { return link(0, 0, at(k, "xA"), at(k, "yA")); }, true);
+  expect_poses(
+      g, "coupler", [&](std::size_t k) { return link(at(k, "xA"), at(k, "yA"), at(k, "xB"), at(k, "yB")); }, true);
+  expect_poses(
+      g, "rocker", [&](std::size_t k) { return link(1.0, 0, at(k, "xB"), at(k, "yB")); }, true);
   // a distance's link has a constant length: its box is that length, no scale channel
   const int n = g.node("coupler");
   EXPECT_EQ(g.channel(n, "scale").second, -1);

@@ -99,13 +99,19 @@ TEST_F(AnimateHtml, PlanarPointsAndVelocitiesAreTheResultsAtEveryRow) {
   for (std::size_t k = 0; k < rows; ++k) {
     EXPECT_EQ(data["t"][k].get<double>(), at(k, "t"));
     const double* p = &pos[k * 8];
-    EXPECT_NEAR(p[0], 0.0, tol_x); EXPECT_NEAR(p[1], 0.0, tol_y);  // O
-    EXPECT_NEAR(p[2], at(k, "xA"), tol_x); EXPECT_NEAR(p[3], at(k, "yA"), tol_y);
-    EXPECT_NEAR(p[4], at(k, "xB"), tol_x); EXPECT_NEAR(p[5], at(k, "yB"), tol_y);
-    EXPECT_NEAR(p[6], 1.0, tol_x); EXPECT_NEAR(p[7], 0.0, tol_y);  // C
+    EXPECT_NEAR(p[0], 0.0, tol_x);
+    EXPECT_NEAR(p[1], 0.0, tol_y);  // O
+    EXPECT_NEAR(p[2], at(k, "xA"), tol_x);
+    EXPECT_NEAR(p[3], at(k, "yA"), tol_y);
+    EXPECT_NEAR(p[4], at(k, "xB"), tol_x);
+    EXPECT_NEAR(p[5], at(k, "yB"), tol_y);
+    EXPECT_NEAR(p[6], 1.0, tol_x);
+    EXPECT_NEAR(p[7], 0.0, tol_y);  // C
     const double* v = &vel[k * 8];
-    EXPECT_NEAR(v[2], at(k, "xA.v"), tol_v); EXPECT_NEAR(v[3], at(k, "yA.v"), tol_v);
-    EXPECT_NEAR(v[4], at(k, "xB.v"), tol_v); EXPECT_NEAR(v[5], at(k, "yB.v"), tol_v);
+    EXPECT_NEAR(v[2], at(k, "xA.v"), tol_v);
+    EXPECT_NEAR(v[3], at(k, "yA.v"), tol_v);
+    EXPECT_NEAR(v[4], at(k, "xB.v"), tol_v);
+    EXPECT_NEAR(v[5], at(k, "yB.v"), tol_v);
     EXPECT_EQ(v[0], 0.0);
   }
   // the extent is the points' own: the crank tip reaches x = -0.4
@@ -151,7 +157,8 @@ TEST_F(AnimateHtml, LargeChainsKeepEvenlySpreadRowsWithinTheBudget) {
   ASSERT_LT(most, rows);
   const std::vector<std::size_t> kept = data["kept"];
   ASSERT_EQ(kept.size(), most);
-  for (std::size_t k = 0; k < most; ++k) EXPECT_EQ(kept[k], static_cast<std::size_t>(std::llround(k * 300.0 / (most - 1))));
+  for (std::size_t k = 0; k < most; ++k)
+    EXPECT_EQ(kept[k], static_cast<std::size_t>(std::llround(k * 300.0 / (most - 1))));
   EXPECT_EQ(data["frames"].get<std::string>().size(), (most * points * 2 * 2 + 2) / 3 * 4);
   EXPECT_LT(html.size(), std::size_t{10} << 20);
 }

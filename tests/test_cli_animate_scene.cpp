@@ -96,9 +96,8 @@ TEST_F(Cli, AnimateNamesTheOutputToAddInOneLine) {
     const Result r = run("animate " + planetary + " " + csv.string() + " -o " + target.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_EQ(r.err, "phiq: animate: " + csv.string() + " lacks coordinate '" + coordinate +
-                         "': add it to output.coordinates in " +
-                         planetary + ", or run `phiq animate " + planetary + " -o " + target.string() +
-                         "` without a result\n");
+                         "': add it to output.coordinates in " + planetary + ", or run `phiq animate " + planetary +
+                         " -o " + target.string() + "` without a result\n");
     EXPECT_FALSE(fs::exists(target));
   }
   // with --set, the command to run again repeats it; a good page already there is kept
@@ -193,8 +192,8 @@ TEST_F(Cli, AnimateRefusesAResultOfAnotherSceneByItsRecordAndColumns) {
   const fs::path traced_scene = write("traced.yaml", traced), csv = dir_ / "traced.csv";
   Result r = run("run -q " + traced_scene.string() + " -o " + csv.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  refused(nat + " " + csv.string(), {csv.string() + ": its columns are not the output of " + nat +
-                                     ": column 'B.x' is not one it writes"});
+  refused(nat + " " + csv.string(),
+          {csv.string() + ": its columns are not the output of " + nat + ": column 'B.x' is not one it writes"});
   // a run's own columns with --sensitivity and identifier names are its output still
   for (const std::string extra : {"--sensitivity L2", "--names identifiers"}) {
     r = run("run -q " + nat + " " + extra + " -o " + csv.string());

@@ -16,10 +16,10 @@
 namespace {
 
 using phiq::test::Cli;
+using phiq::test::kFourbarOutputs;
+using phiq::test::one_phiq_line;
 using phiq::test::Result;
 using phiq::test::slurp;
-using phiq::test::one_phiq_line;
-using phiq::test::kFourbarOutputs;
 namespace fs = std::filesystem;
 
 // phiq batch: one CSV per case, each the closed form of its own crank length; a case that cannot run writes
@@ -43,7 +43,8 @@ TEST_F(Cli, BatchSweepsEveryParameterSetInParallel) {
     double worst = 0;
     for (const auto& row : t.rows) {
       const double th = row[1], s = std::sin(th);
-      worst = std::max(worst, std::fabs(row[4] - (l2[k] * std::cos(th) + std::sqrt(l3[k] * l3[k] - l2[k] * l2[k] * s * s))));
+      worst = std::max(worst,
+                       std::fabs(row[4] - (l2[k] * std::cos(th) + std::sqrt(l3[k] * l3[k] - l2[k] * l2[k] * s * s))));
     }
     EXPECT_LT(worst, 1e-9) << "case " << k;
   }

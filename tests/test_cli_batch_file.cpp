@@ -18,14 +18,15 @@
 namespace {
 
 using phiq::test::Cli;
+using phiq::test::one_phiq_line;
 using phiq::test::Result;
 using phiq::test::slurp;
-using phiq::test::one_phiq_line;
 namespace fs = std::filesystem;
 
 // The seed's crank-slider with these parameter values written into its text, as the batch overrides them.
 std::string with_parameters(std::string scene, const std::string& l2, const std::string& l3) {
-  for (const auto& [line, value] : {std::pair<std::string, std::string>{"  L2: 0.3     # m", l2}, {"  L3: 1.0     # m", l3}}) {
+  for (const auto& [line, value] :
+       {std::pair<std::string, std::string>{"  L2: 0.3     # m", l2}, {"  L3: 1.0     # m", l3}}) {
     const std::size_t at = scene.find(line);
     EXPECT_NE(at, std::string::npos) << line;
     if (at != std::string::npos) scene.replace(at, line.size(), line.substr(0, 6) + value);
@@ -51,8 +52,8 @@ std::string with_case(const std::string& csv, std::size_t k) {
 TEST_F(Cli, BatchOneCsvIsTheRunsOfItsCases) {
   const std::string scene_text = slurp(phiq::test::model_path("seed/crank_slider_mixed.yaml"));
   const fs::path scene = write("cs.yaml", scene_text);
-  const std::vector<std::pair<std::string, std::string>> params = {
-      {"0.2", "1.0"}, {"0.3", "1.0"}, {"1.5", "1.0"}, {"0.4", "1.2"}, {"0.3", "-1.0"}, {"0.25", "0.9"}};
+  const std::vector<std::pair<std::string, std::string>> params = {{"0.2", "1.0"}, {"0.3", "1.0"},  {"1.5", "1.0"},
+                                                                   {"0.4", "1.2"}, {"0.3", "-1.0"}, {"0.25", "0.9"}};
   std::string cases = "L2,L3\n";
   for (const auto& [l2, l3] : params) cases += l2 + "," + l3 + "\n";
   const fs::path list = write("cases.csv", cases);
@@ -70,8 +71,8 @@ TEST_F(Cli, BatchOneCsvIsTheRunsOfItsCases) {
 
   std::string expected;
   for (std::size_t k = 0; k < params.size(); ++k) {
-    const fs::path one = write("case" + std::to_string(k) + ".yaml", with_parameters(scene_text, params[k].first,
-                                                                                      params[k].second));
+    const fs::path one =
+        write("case" + std::to_string(k) + ".yaml", with_parameters(scene_text, params[k].first, params[k].second));
     const fs::path csv = dir_ / ("run" + std::to_string(k) + ".csv");
     const Result rr = run("run -q " + one.string() + " -o " + csv.string());
     if (k == 2 || k == 4) {  // the failing cases fail alone too
@@ -147,8 +148,7 @@ TEST_F(Cli, BatchOneFileUnwritableOutputFailsAtOnce) {
                          " -o " + (dir_ / "nodir" / name).string());
     EXPECT_EQ(r.code, 3) << r.err;
     EXPECT_TRUE(one_phiq_line(r.err));
-    EXPECT_NE(r.err.find(std::string("nodir/") + name + ": cannot write: No such file or directory"),
-              std::string::npos)
+    EXPECT_NE(r.err.find(std::string("nodir/") + name + ": cannot write: No such file or directory"), std::string::npos)
         << r.err;
     EXPECT_EQ(files(), (std::vector<std::string>{"cases.csv", "stderr.txt", "stdout.txt"}));
   }
@@ -214,9 +214,9 @@ namespace {
 TEST_F(Cli, BatchSensitivityOptionGivesEachCaseItsOwn) {
   const std::string text = slurp(phiq::test::model_path("seed/crank_slider_mixed.yaml"));
   const fs::path scene = write("cs.yaml", text);
-  const fs::path listed = write("listed.yaml", phiq::test::replace_first(
-      text, "output: {velocities: true, accelerations: true}",
-      "output: {velocities: true, accelerations: true, sensitivities: [L3]}"));
+  const fs::path listed = write(
+      "listed.yaml", phiq::test::replace_first(text, "output: {velocities: true, accelerations: true}",
+                                               "output: {velocities: true, accelerations: true, sensitivities: [L3]}"));
   const fs::path list = write("cases.csv", "L2,L3\n0.2,1.0\n0.35,1.1\n");
   const auto batch = [&](const fs::path& s, const std::string& out, const std::string& more) {
     return run("batch -q " + s.string() + " " + list.string() + " -o " + (dir_ / out).string() + more);
@@ -243,7 +243,8 @@ TEST_F(Cli, BatchSensitivityOptionGivesEachCaseItsOwn) {
     const Result bad = batch(scene, out, " --sensitivity L9");
     EXPECT_EQ(bad.code, 2) << out;
     EXPECT_NE(bad.err.find("--sensitivity: 'L9' is not a parameter of " + scene.string() + " (its parameters: L2, L3)"),
-              std::string::npos) << bad.err;
+              std::string::npos)
+        << bad.err;
     EXPECT_TRUE(one_phiq_line(bad.err)) << bad.err;
     EXPECT_FALSE(fs::exists(dir_ / out)) << out;
   }

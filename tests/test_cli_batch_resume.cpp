@@ -160,9 +160,9 @@ TEST_F(BatchResume, WhatIsNotAnEarlierOutputOfThisBatchIsRefusedAndKept) {
   EXPECT_NE(h5.err.find("text.h5: not a readable HDF5 file"), std::string::npos) << h5.err;
   EXPECT_EQ(slurp(dir_ / "text.h5"), "t,x\n0,1\n");
   // HDF5 results of another scene: other columns
-  ASSERT_EQ(run("run -q " + phiq::test::model_path("seed/fourbar_natural.yaml") + " -o " + (dir_ / "other.h5").string())
-                .code,
-            0);
+  ASSERT_EQ(
+      run("run -q " + phiq::test::model_path("seed/fourbar_natural.yaml") + " -o " + (dir_ / "other.h5").string()).code,
+      0);
   const std::string other = slurp(dir_ / "other.h5");
   const Result o = resume("other.h5");
   EXPECT_EQ(o.code, 2);

@@ -16,9 +16,9 @@
 namespace {
 
 using phiq::test::Cli;
+using phiq::test::one_phiq_line;
 using phiq::test::Result;
 using phiq::test::slurp;
-using phiq::test::one_phiq_line;
 namespace fs = std::filesystem;
 
 TEST_F(Cli, CheckReportsCountsAndAssembly) {
@@ -82,10 +82,10 @@ time: {start: 0, end: 1, steps: 10}
 TEST_F(Cli, CheckJsonReportsRankDofAndRedundantConstraints) {
   Result r = run("check --json " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml"));
   ASSERT_EQ(r.code, 0) << r.err << r.out;
-  for (const char* part : {"\"coordinates\": 12", "\"equations\": 13", "\"rank\": 11", "\"dof\": 1",
-                           "\"driven_dof\": 0", "\"grubler\": ", "\"redundant\": [\n    \"A3\"\n  ]",
-                           "\"name\": \"A3[1]\"", "\"consistent\": true", "\"conflicts\": []",
-                           "\"rank_uncertain\": false"})
+  for (const char* part :
+       {"\"coordinates\": 12", "\"equations\": 13", "\"rank\": 11", "\"dof\": 1", "\"driven_dof\": 0",
+        "\"grubler\": ", "\"redundant\": [\n    \"A3\"\n  ]", "\"name\": \"A3[1]\"", "\"consistent\": true",
+        "\"conflicts\": []", "\"rank_uncertain\": false"})
     EXPECT_NE(r.out.find(part), std::string::npos) << part << "\n" << r.out;
   Result text = run("check " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml"));
   EXPECT_NE(text.out.find("redundant     A3\n"), std::string::npos) << text.out;
@@ -114,7 +114,8 @@ TEST_F(Cli, RunRefusesInconsistentRedundancyInOneLineAndWritesNothing) {
 
 TEST_F(Cli, AssembleWritesTheAssembledCoordinatesAsOneCsvRow) {
   const fs::path out = dir_ / "q.csv";
-  Result r = run("assemble " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml") + " -o " + out.string());
+  Result r =
+      run("assemble " + phiq::test::model_path("redundant/parallelogram_fifth_bar.yaml") + " -o " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string text = slurp(out);
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2) << text;
@@ -132,7 +133,6 @@ TEST_F(Cli, AssembleWritesTheAssembledCoordinatesAsOneCsvRow) {
   EXPECT_EQ(run("assemble " + p.string() + " -o " + (dir_ / "door.csv").string()).code, 1);
   EXPECT_FALSE(fs::exists(dir_ / "door.csv"));
 }
-
 
 TEST_F(Cli, CheckAnalysesTheConfigurationAtTheTimeAsked) {
   const std::string scene = phiq::test::model_path("redundant/parallelogram_change_point.yaml");

@@ -54,7 +54,8 @@ TEST_F(Cli, IdentifierNamesAreTheDottedOnesSpelledForPython) {
 TEST_F(Cli, IdentifierNamesThatWouldCollideAreRefused) {
   std::string text = phiq::test::kFourbarOutputs;
   text.replace(text.find("yB: 1.0}"), 8, "yB: 1.0, theta2__v: 0}");
-  text.replace(text.find("constraints:\n"), 13, "constraints:\n  - {name: spare, type: equation, expr: \"theta2__v\"}\n");
+  text.replace(text.find("constraints:\n"), 13,
+               "constraints:\n  - {name: spare, type: equation, expr: \"theta2__v\"}\n");
   const fs::path scene = write("c.yaml", text), csv = dir_ / "c.csv";
   ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0) << "dotted names do not collide";
   fs::remove(csv);
@@ -69,7 +70,8 @@ TEST_F(Cli, IdentifierNamesThatWouldCollideAreRefused) {
 // numpy.genfromtxt(names=True) keeps every identifier name as written, where it drops the dots of format 1
 // (`theta2.v` → `theta2v`, which then collides with a coordinate `theta2v`, renamed `theta2v_1` silently).
 TEST_F(Cli, NumpyKeepsTheIdentifierNames) {
-  if (std::system("/usr/bin/python3 -c 'import numpy' 2>/dev/null") != 0) GTEST_SKIP() << "no /usr/bin/python3 with numpy";
+  if (std::system("/usr/bin/python3 -c 'import numpy' 2>/dev/null") != 0)
+    GTEST_SKIP() << "no /usr/bin/python3 with numpy";
   std::string text = phiq::test::kFourbarOutputs;
   text.replace(text.find("yB: 1.0}"), 8, "yB: 1.0, theta2v: 0}");
   text.replace(text.find("constraints:\n"), 13, "constraints:\n  - {name: spare, type: equation, expr: \"theta2v\"}\n");
@@ -88,7 +90,8 @@ TEST_F(Cli, NumpyKeepsTheIdentifierNames) {
   auto numpy_names = [&](const fs::path& csv, const char* kind) {
     const fs::path out = dir_ / "py.out", err = dir_ / "py.err";
     const int st = std::system(("/usr/bin/python3 " + script.string() + " " + csv.string() + " " + kind + " >" +
-                                out.string() + " 2>" + err.string()).c_str());
+                                out.string() + " 2>" + err.string())
+                                   .c_str());
     return Result{WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(out), slurp(err)};
   };
   Result i = numpy_names(ident, "i");
@@ -120,7 +123,8 @@ TEST_F(Cli, CompareReadsBothNamings) {
   Result r = run("compare " + dotted.string() + " " + ident.string());
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("agree: 73 rows x 30 columns (identical)"), std::string::npos) << r.err;
-  const phiq::CompareResult c = phiq::compare_csv(phiq::read_csv_table(dotted.string()), phiq::read_csv_table(ident.string()));
+  const phiq::CompareResult c =
+      phiq::compare_csv(phiq::read_csv_table(dotted.string()), phiq::read_csv_table(ident.string()));
   EXPECT_TRUE(c.only_in_a.empty());
   EXPECT_TRUE(c.only_in_b.empty());
   EXPECT_EQ(c.compared[9], "theta2.v") << "A's names";

@@ -13,8 +13,8 @@
 namespace {
 
 using phiq::test::Cli;
-using phiq::test::Result;
 using phiq::test::one_phiq_line;
+using phiq::test::Result;
 namespace fs = std::filesystem;
 
 TEST_F(Cli, UsageErrorsAndHelp) {
@@ -24,10 +24,11 @@ TEST_F(Cli, UsageErrorsAndHelp) {
   Result h = run("run --help");
   EXPECT_EQ(h.code, 0);
   EXPECT_NE(h.out.find("--output"), std::string::npos);
-  EXPECT_EQ(run("--version").out,
-            "phiq 0.1.0 (scene format 1, CSV format 1, HDF5 results format 1, check --json format 1, run --summary "
-            "format 2, batch --summary format 1, sweep-accuracy --json format 2, compare --json format 1, tolerance CSV "
-            "format 1, tolerance --summary format 1)\n");
+  EXPECT_EQ(
+      run("--version").out,
+      "phiq 0.1.0 (scene format 1, CSV format 1, HDF5 results format 1, check --json format 1, run --summary "
+      "format 2, batch --summary format 1, sweep-accuracy --json format 2, compare --json format 1, tolerance CSV "
+      "format 1, tolerance --summary format 1)\n");
 }
 
 // Command-line errors are one line, "phiq: <command>: <what>", exit 2, with readable ranges.

@@ -102,8 +102,10 @@ TEST_F(Cli, CompareJsonNamesEachColumnsWorstCell) {
   EXPECT_EQ(x["name"], "x");
   EXPECT_EQ(x["equal"], false);
   EXPECT_EQ(x["mismatches"], 1);
-  EXPECT_EQ(x["worst"], nlohmann::json({{"line", 3}, {"t", 0.5}, {"a", 2.0}, {"b", 2.5}, {"diff", 0.5},
-                                        {"tol", tol_x}, {"ratio", 0.5 / tol_x}}));
+  EXPECT_EQ(
+      x["worst"],
+      nlohmann::json(
+          {{"line", 3}, {"t", 0.5}, {"a", 2.0}, {"b", 2.5}, {"diff", 0.5}, {"tol", tol_x}, {"ratio", 0.5 / tol_x}}));
   const auto& y = j["columns"][2];
   EXPECT_EQ(y["worst"]["line"], 4);
   EXPECT_EQ(y["worst"]["t"], 1.0);
@@ -170,21 +172,30 @@ TEST_F(Cli, CompareJunitHasOneTestCasePerColumn) {
                                 "    f = c.find('failure')\n"
                                 "    print(c.get('name'), '|', 'ok' if f is None else f.get('message'))\n");
   const fs::path out = dir_ / "py.out";
-  const int st = std::system(("/usr/bin/python3 " + script.string() + " " + xml.string() + " >" + out.string()).c_str());
+  const int st =
+      std::system(("/usr/bin/python3 " + script.string() + " " + xml.string() + " >" + out.string()).c_str());
   ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "not well-formed XML:\n" << text;
   const std::string tol_x = phiq::shortest(1e-12 + 1e-9 * 2.5), tol_y = phiq::shortest(1e-12 + 1e-9 * 7.5);
-  EXPECT_EQ(slurp(out), "testsuites 5 3 0\n"
-                        "testsuite 5 3\n"
-                        "t | ok\n"
-                        "x | 1 cell beyond tolerance; worst at line 3 (t = 0.5): 2 vs 2.5 (|diff| 0.5 > tol " + tol_x + ")\n"
-                        "y | 1 cell beyond tolerance; worst at line 4 (t = 1): 7 vs 7.5 (|diff| 0.5 > tol " + tol_y + ")\n"
-                        "z | only in " + b.string() + " (not in " + a.string() + ")\n"
-                        "(row count) | ok\n");
+  EXPECT_EQ(slurp(out),
+            "testsuites 5 3 0\n"
+            "testsuite 5 3\n"
+            "t | ok\n"
+            "x | 1 cell beyond tolerance; worst at line 3 (t = 0.5): 2 vs 2.5 (|diff| 0.5 > tol " +
+                tol_x +
+                ")\n"
+                "y | 1 cell beyond tolerance; worst at line 4 (t = 1): 7 vs 7.5 (|diff| 0.5 > tol " +
+                tol_y +
+                ")\n"
+                "z | only in " +
+                b.string() + " (not in " + a.string() +
+                ")\n"
+                "(row count) | ok\n");
   // equal files: every case passes, exit 0; with --columns only the columns chosen are cases
   r = run("compare --junit " + xml.string() + " " + a.string() + " " + a.string());
   EXPECT_EQ(r.code, 0);
   EXPECT_NE(slurp(xml).find("<testsuites name=\"phiq compare\" tests=\"4\" failures=\"0\" errors=\"0\">"),
-            std::string::npos) << slurp(xml);
+            std::string::npos)
+      << slurp(xml);
   r = run("compare --columns t --junit " + xml.string() + " " + a.string() + " " + b.string());
   EXPECT_EQ(r.code, 0);
   EXPECT_NE(slurp(xml).find("tests=\"2\" failures=\"0\""), std::string::npos) << slurp(xml);  // t, the rows

@@ -66,7 +66,8 @@ constraints:
   - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
   - {name: rod, type: distance, points: [A, B], length: L3}
 drivers:
-  - {name: motor, coordinate: theta2, law: {type: expression, f: ")" + law + R"("}}
+  - {name: motor, coordinate: theta2, law: {type: expression, f: ")" +
+                                             law + R"("}}
 time: {start: 0, end: 1, steps: 10}
 output: {velocities: true, accelerations: true}
 )");

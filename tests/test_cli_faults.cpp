@@ -97,8 +97,8 @@ TEST_F(Cli, ConcurrentWritersOfOnePairLeaveOneWritersPair) {
     const std::string csv = slurp(dir_ / "out.csv"), summary = slurp(dir_ / "s.json");
     const long rows = std::count(csv.begin(), csv.end(), '\n') - 1;
     const bool from_a = summary.find("\"scene\": \"a.yaml\"") != std::string::npos;
-    EXPECT_EQ(rows, from_a ? 2001 : 2002) << "round " << round << ": the summary of " << (from_a ? "a" : "b")
-                                           << " with a CSV of " << rows << " rows";
+    EXPECT_EQ(rows, from_a ? 2001 : 2002)
+        << "round " << round << ": the summary of " << (from_a ? "a" : "b") << " with a CSV of " << rows << " rows";
   }
 }
 

@@ -181,8 +181,9 @@ TEST_F(Cli, GenerateRefusesBadOptions) {
   // than time.steps takes (it was written, a kilobyte, and refused by `phiq check` only after minutes)
   Result r = run("generate nfourbar 1000000000000 -o " + (dir_ / "x.yaml").string());
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err, "phiq: generate: N = 1000000000000: nfourbar in natural coordinates is at most N = 9999999 (its "
-                   "families would make more entries than a scene may, SceneLimits::max_family_instances)\n");
+  EXPECT_EQ(r.err,
+            "phiq: generate: N = 1000000000000: nfourbar in natural coordinates is at most N = 9999999 (its "
+            "families would make more entries than a scene may, SceneLimits::max_family_instances)\n");
   EXPECT_EQ(run("generate scissor 3333334 -o " + (dir_ / "x.yaml").string()).code, 2);
   // an item twice is most likely another one mistyped
   r = run("generate nfourbar 3 --outputs q,v,v -o " + (dir_ / "x.yaml").string());
@@ -246,16 +247,18 @@ TEST_F(Cli, GeneratedChain3dRuns) {
   for (int k = 0; k < 3; ++k)
     EXPECT_NEAR(c[axes[k]].back(), 10 * e1[k] + std::cos(th) * e1[k] + std::sin(th) * e2[k], 1e-9) << axes[k];
   // the twisted row in reference-point coordinates through a full turn, and the options it refuses
-  ASSERT_EQ(run("generate chain3d 4 --coords reference-point --twist 2 --from 0 --to 6.3 --steps 100 -o " +
-                scene.string()).code, 0);
+  ASSERT_EQ(
+      run("generate chain3d 4 --coords reference-point --twist 2 --from 0 --to 6.3 --steps 100 -o " + scene.string())
+          .code,
+      0);
   EXPECT_NE(slurp(scene).find("--coords reference-point --twist 2:"), std::string::npos);
   r = run("run -q " + scene.string() + " -o " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(columns_of(slurp(out))["t"].size(), 101u);
   const std::string x = " -o " + (dir_ / "x.yaml").string();
-  EXPECT_EQ(run("generate chain3d 5 --from 0" + x).code, 2);            // the parallelogram row lies flat
-  EXPECT_EQ(run("generate chain3d 5 --twist 3.1415926" + x).code, 2);   // neighbours opposite: singular
-  EXPECT_EQ(run("generate nfourbar 5 --twist 1" + x).code, 2);          // chain3d only
+  EXPECT_EQ(run("generate chain3d 5 --from 0" + x).code, 2);           // the parallelogram row lies flat
+  EXPECT_EQ(run("generate chain3d 5 --twist 3.1415926" + x).code, 2);  // neighbours opposite: singular
+  EXPECT_EQ(run("generate nfourbar 5 --twist 1" + x).code, 2);         // chain3d only
   EXPECT_FALSE(fs::exists(dir_ / "x.yaml"));
 }
 

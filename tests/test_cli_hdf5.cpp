@@ -86,8 +86,7 @@ TEST_F(Cli, Hdf5NeedsAFile) {
   r = run("run " + scene.string() + " -o " + fifo.string());  // a FIFO would block until read: refused first
   EXPECT_EQ(r.code, 3);
   EXPECT_TRUE(one_phiq_line(r.err)) << r.err;
-  EXPECT_NE(r.err.find("fifo.h5: cannot write HDF5 to a device, FIFO or open descriptor"), std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("fifo.h5: cannot write HDF5 to a device, FIFO or open descriptor"), std::string::npos) << r.err;
   EXPECT_EQ(files(), (Names{"fb.yaml", "fifo.h5", "stderr.txt", "stdout.txt"}));
 }
 

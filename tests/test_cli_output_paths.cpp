@@ -23,9 +23,9 @@
 namespace {
 
 using phiq::test::Cli;
+using phiq::test::one_phiq_line;
 using phiq::test::Result;
 using phiq::test::slurp;
-using phiq::test::one_phiq_line;
 namespace fs = std::filesystem;
 
 // "-" is standard output, as in most tools: run -o - gives the bytes run gives without -o (one thread: the same
@@ -120,7 +120,8 @@ TEST_F(Cli, SymlinkOutputsReplaceTheirTargetAndKeepTheLink) {
   EXPECT_EQ(slurp(dir_ / "results/new.csv").rfind("t,theta2,", 0), 0u);
 
   write("log.txt", "before\n");
-  const std::string cmd = std::string(PHIQ_CLI) + " assemble -q " + scene + " -o /dev/stdout >>" + (dir_ / "log.txt").string();
+  const std::string cmd =
+      std::string(PHIQ_CLI) + " assemble -q " + scene + " -o /dev/stdout >>" + (dir_ / "log.txt").string();
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   EXPECT_EQ(slurp(dir_ / "log.txt").rfind("before\nt,theta2,", 0), 0u) << slurp(dir_ / "log.txt");
   EXPECT_FALSE(fs::is_symlink(dir_ / "log.txt"));
@@ -141,11 +142,13 @@ TEST_F(Cli, OutputsThatAreInputsOrEachOtherAreRefused) {
       {"run " + s + " -o " + d + "/hard.yaml", "the same file as the scene"},
       {"run " + s + " -o " + d + "/./s.yaml", "the same file as the scene"},
       {"run " + s + " --summary " + s, "run: --summary " + s + ": the same file as the scene"},
-      {"run " + s + " -o " + d + "/a.csv --summary " + d + "/a.csv", "-o " + d + "/a.csv and --summary " + d + "/a.csv are the same file"},
+      {"run " + s + " -o " + d + "/a.csv --summary " + d + "/a.csv",
+       "-o " + d + "/a.csv and --summary " + d + "/a.csv are the same file"},
       {"assemble " + s + " -o " + d + "/link.yaml", "assemble: -o "},
       {"sweep-accuracy " + s + " -o " + d + "/x.csv --json " + d + "/x.csv", "are the same file"},
       {"sweep-accuracy " + s + " --json " + s, "the same file as the scene"},
-      {"plot " + s + " " + csv.string() + " -o " + csv.string(), "plot: -o " + csv.string() + ": the same file as the result"},
+      {"plot " + s + " " + csv.string() + " -o " + csv.string(),
+       "plot: -o " + csv.string() + ": the same file as the result"},
       {"plot " + s + " " + csv.string() + " -o " + s, "the same file as the scene"},
   };
   for (const auto& [args, says] : cases) {
@@ -163,7 +166,8 @@ TEST_F(Cli, OutputsThatAreInputsOrEachOtherAreRefused) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("the same file as the cases"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(cases_csv), "L2\n0.2\n");
-  EXPECT_EQ(files(), (std::vector<std::string>{"hard.yaml", "link.yaml", "out", "r.csv", "s.yaml", "stderr.txt", "stdout.txt"}));
+  EXPECT_EQ(files(),
+            (std::vector<std::string>{"hard.yaml", "link.yaml", "out", "r.csv", "s.yaml", "stderr.txt", "stdout.txt"}));
 }
 
 // An empty output path is refused (it used to mean standard output); nothing goes to standard output.
@@ -192,14 +196,16 @@ TEST_F(Cli, LostStandardOutputIsAnError) {
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   };
   if (fs::exists("/dev/full")) {
-    for (const std::string& args :
-         std::vector<std::string>{"check " + scene, "check --json " + scene, "assemble -q " + scene, "run -q " + scene}) {
+    for (const std::string& args : std::vector<std::string>{"check " + scene, "check --json " + scene,
+                                                            "assemble -q " + scene, "run -q " + scene}) {
       EXPECT_EQ(status(args, ">/dev/full"), 3) << args << ": " << slurp(err);
       EXPECT_TRUE(one_phiq_line(slurp(err))) << args;
-      EXPECT_NE(slurp(err).find("standard output: cannot write: No space left on device"), std::string::npos) << slurp(err);
+      EXPECT_NE(slurp(err).find("standard output: cannot write: No space left on device"), std::string::npos)
+          << slurp(err);
     }
   }
-  for (const std::string& args : std::vector<std::string>{"run -q " + scene, "check " + scene, "assemble -q " + scene}) {
+  for (const std::string& args :
+       std::vector<std::string>{"run -q " + scene, "check " + scene, "assemble -q " + scene}) {
     EXPECT_EQ(status(args, ">&-"), 3) << args << ": " << slurp(err);
     EXPECT_TRUE(one_phiq_line(slurp(err))) << args;
     EXPECT_NE(slurp(err).find("standard output: cannot write: it is closed"), std::string::npos) << slurp(err);

@@ -14,9 +14,9 @@
 namespace {
 
 using phiq::test::Cli;
+using phiq::test::kFourbarOutputs;
 using phiq::test::Result;
 using phiq::test::slurp;
-using phiq::test::kFourbarOutputs;
 namespace fs = std::filesystem;
 
 TEST_F(Cli, PlotDrawsTheMechanismTracesAndColumns) {
@@ -48,8 +48,10 @@ TEST_F(Cli, PlotDrawsTheMechanismTracesAndColumns) {
   ASSERT_EQ(run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string() + " --positions 3").code, 0);
   const std::string d = slurp(svg);
   std::size_t series = 0, mech = 0;
-  for (std::size_t q = d.find("class=\"series\""); q != std::string::npos; q = d.find("class=\"series\"", q + 1)) ++series;
-  for (std::size_t q = d.find("class=\"mechanism\""); q != std::string::npos; q = d.find("class=\"mechanism\"", q + 1)) ++mech;
+  for (std::size_t q = d.find("class=\"series\""); q != std::string::npos; q = d.find("class=\"series\"", q + 1))
+    ++series;
+  for (std::size_t q = d.find("class=\"mechanism\""); q != std::string::npos; q = d.find("class=\"mechanism\"", q + 1))
+    ++mech;
   EXPECT_EQ(series, 6u);
   EXPECT_EQ(mech, 12u);
   // a redundant scene writing only its crank angle: drawn from a sweep solved as `phiq run` solves it
@@ -61,7 +63,8 @@ TEST_F(Cli, PlotDrawsTheMechanismTracesAndColumns) {
   ASSERT_EQ(rr.code, 0) << rr.err;
   const std::string rs = slurp(svg);
   std::size_t red_lines = 0;
-  for (std::size_t q = rs.find("class=\"mechanism\""); q != std::string::npos; q = rs.find("class=\"mechanism\"", q + 1))
+  for (std::size_t q = rs.find("class=\"mechanism\""); q != std::string::npos;
+       q = rs.find("class=\"mechanism\"", q + 1))
     ++red_lines;
   EXPECT_EQ(red_lines, 25u);  // 5 rows × (3 crank arms + 2 coupler arms)
   // the left-out redundant row is still within the tolerance, evaluated on the whole scene model
@@ -77,7 +80,8 @@ coordinates: {a: 0, b: 0}
 constraints: [{name: tie, type: equation, expr: "b - 2*a", unit: length}]
 drivers: [{name: m, coordinate: a, law: {type: linear, initial: 0, rate: 1}}]
 time: {start: 0, end: 1, steps: 10}
-)"), csv = dir_ / "c.csv", svg = dir_ / "c.svg";
+)"),
+                 csv = dir_ / "c.csv", svg = dir_ / "c.svg";
   ASSERT_EQ(run("run -q " + scene.string() + " -o " + csv.string()).code, 0);
   Result r = run("plot " + scene.string() + " " + csv.string() + " -o " + svg.string());
   EXPECT_EQ(r.code, 0) << r.err;
@@ -118,7 +122,8 @@ TEST_F(Cli, PlotRefusesBadInputWithOneLineAndNoFile) {
   ASSERT_EQ(ok.code, 0) << ok.err;
   const std::string drawn = slurp(svg);
   std::size_t lines = 0;
-  for (std::size_t q = drawn.find("class=\"mechanism\""); q != std::string::npos; q = drawn.find("class=\"mechanism\"", q + 1))
+  for (std::size_t q = drawn.find("class=\"mechanism\""); q != std::string::npos;
+       q = drawn.find("class=\"mechanism\"", q + 1))
     ++lines;
   EXPECT_EQ(lines, 20u);
   fs::remove(svg);

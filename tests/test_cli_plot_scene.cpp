@@ -24,8 +24,7 @@ namespace fs = std::filesystem;
 std::vector<std::string> captures(const std::string& s, const std::string& re) {
   std::vector<std::string> v;
   const std::regex r(re);
-  for (auto it = std::sregex_iterator(s.begin(), s.end(), r); it != std::sregex_iterator(); ++it)
-    v.push_back((*it)[1]);
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), r); it != std::sregex_iterator(); ++it) v.push_back((*it)[1]);
   return v;
 }
 

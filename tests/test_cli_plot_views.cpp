@@ -26,8 +26,7 @@ namespace fs = std::filesystem;
 std::vector<std::string> all(const std::string& s, const std::string& re) {
   std::vector<std::string> v;
   const std::regex r(re);
-  for (auto it = std::sregex_iterator(s.begin(), s.end(), r); it != std::sregex_iterator(); ++it)
-    v.push_back((*it)[1]);
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), r); it != std::sregex_iterator(); ++it) v.push_back((*it)[1]);
   return v;
 }
 
@@ -44,8 +43,8 @@ class Plot : public Cli {
   }
   // min and max of a column of the result
   std::pair<double, double> range(const std::string& column) {
-    const std::size_t c = static_cast<std::size_t>(
-        std::find(table.columns.begin(), table.columns.end(), column) - table.columns.begin());
+    const std::size_t c =
+        static_cast<std::size_t>(std::find(table.columns.begin(), table.columns.end(), column) - table.columns.begin());
     double lo = 1e300, hi = -1e300;
     for (const auto& row : table.rows) lo = std::min(lo, row[c]), hi = std::max(hi, row[c]);
     return {lo, hi};
@@ -66,8 +65,9 @@ TEST_F(Plot, SpatialMechanismIsDrawnInIsometricViewWithItsAxesAndMovingColumns) 
   // the view from (1, 1, 1), right-handed as space is: x towards the lower left, y towards the lower right, z up
   // (screen coordinates: y down), so that x turns to y counterclockwise seen from the viewer, as about z
   std::map<std::string, std::array<double, 2>> axis;
-  const std::regex line("data-axis=\"([xyz])\" x1=\"([-0-9.]+)\" y1=\"([-0-9.]+)\" x2=\"([-0-9.]+)\" "
-                        "y2=\"([-0-9.]+)\"");
+  const std::regex line(
+      "data-axis=\"([xyz])\" x1=\"([-0-9.]+)\" y1=\"([-0-9.]+)\" x2=\"([-0-9.]+)\" "
+      "y2=\"([-0-9.]+)\"");
   for (auto it = std::sregex_iterator(s.begin(), s.end(), line); it != std::sregex_iterator(); ++it)
     axis[(*it)[1]] = {std::stod((*it)[4]) - std::stod((*it)[2]), -(std::stod((*it)[5]) - std::stod((*it)[3]))};
   ASSERT_EQ(axis.size(), 3u);
@@ -146,7 +146,8 @@ TEST_F(Plot, PrismaticPairsAreBlocksOnTheirGuides) {
   EXPECT_EQ(count(s, "class=\"hatch\""), 3u * 5u + 6u);  // the guide on ground at each row, the ground pivot O
   EXPECT_EQ(count(s, "<g class=\"ground\">"), 1u);
   // the block lies along the guide: ground's x axis, no rotation
-  EXPECT_EQ(all(s, "class=\"joint prismatic\"[^>]*rotate\\((-?[0-9.]+) "), (std::vector<std::string>{"0.0", "0.0", "0.0"}));
+  EXPECT_EQ(all(s, "class=\"joint prismatic\"[^>]*rotate\\((-?[0-9.]+) "),
+            (std::vector<std::string>{"0.0", "0.0", "0.0"}));
 }
 
 TEST_F(Cli, PlotRefusesAColumnWithNaNInOneLine) {

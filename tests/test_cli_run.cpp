@@ -22,9 +22,9 @@
 namespace {
 
 using phiq::test::Cli;
+using phiq::test::kFourbarOutputs;
 using phiq::test::Result;
 using phiq::test::slurp;
-using phiq::test::kFourbarOutputs;
 namespace fs = std::filesystem;
 
 TEST_F(Cli, RunWritesTheCsvWithTheDocumentedColumns) {
@@ -107,10 +107,10 @@ TEST_F(Cli, SummaryJsonCountsWhatWasComputed) {
   Result r = run("run -q " + scene.string() + " -o " + (dir_ / "p.csv").string() + " --summary " + sum.string());
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string j = slurp(sum);
-  for (const char* part : {"\"steps\": 11", "\"threads\": 1", "\"velocity_solves\": 0", "\"acceleration_solves\": 0",
-                           "\"gamma_evaluations\": 0", "\"phi_t_evaluations\": 0", "\"load_seconds\": ",
-                           "\"solve_seconds\": ", "\"write_seconds\": ", "\"linear_solver\": \"klu\"", "\"warnings\": []",
-                           "\"min_rcond\": null"})
+  for (const char* part :
+       {"\"steps\": 11", "\"threads\": 1", "\"velocity_solves\": 0", "\"acceleration_solves\": 0",
+        "\"gamma_evaluations\": 0", "\"phi_t_evaluations\": 0", "\"load_seconds\": ", "\"solve_seconds\": ",
+        "\"write_seconds\": ", "\"linear_solver\": \"klu\"", "\"warnings\": []", "\"min_rcond\": null"})
     EXPECT_NE(j.find(part), std::string::npos) << part << "\n" << j;
   // the sweep's wall time holds the solve and the writing done in the sweep (the final flush comes after it)
   auto number = [&](const std::string& key) {
@@ -122,7 +122,8 @@ TEST_F(Cli, SummaryJsonCountsWhatWasComputed) {
   EXPECT_GE(number("solve_seconds"), 0.0) << j;
   // with velocities and accelerations: one of each per row
   ASSERT_EQ(run("generate nfourbar 3 --steps 10 -o " + scene.string()).code, 0);
-  ASSERT_EQ(run("run -q " + scene.string() + " -o " + (dir_ / "p.csv").string() + " --summary " + sum.string()).code, 0);
+  ASSERT_EQ(run("run -q " + scene.string() + " -o " + (dir_ / "p.csv").string() + " --summary " + sum.string()).code,
+            0);
   const std::string j2 = slurp(sum);
   EXPECT_NE(j2.find("\"velocity_solves\": 11"), std::string::npos) << j2;
   EXPECT_NE(j2.find("\"acceleration_solves\": 11"), std::string::npos) << j2;
@@ -151,8 +152,9 @@ TEST_F(Cli, RunWritesTheListedOutputsAndCountsThem) {
   Result r = run("run -q --threads 1 " + scene.string() + " -o " + csv.string() + " --summary " + sum.string());
   ASSERT_EQ(r.code, 0) << r.err;
   const phiq::CsvTable t = phiq::read_csv_table(csv.string());
-  const std::vector<std::string> tail = {"B.x", "B.y", "B.vx", "B.vy", "P.x", "P.y", "P.vx", "P.vy", "motor.f",
-                                         "motor.df", "rocker.residual", "residual", "rcond"};
+  const std::vector<std::string> tail = {
+      "B.x",      "B.y",  "B.vx", "B.vy", "P.x", "P.y", "P.vx", "P.vy", "motor.f", "motor.df", "rocker.residual",
+      "residual", "rcond"};
   ASSERT_EQ(t.columns.size(), 1 + 16 + tail.size());
   EXPECT_TRUE(std::equal(tail.begin(), tail.end(), t.columns.end() - static_cast<long>(tail.size())));
   ASSERT_EQ(t.rows.size(), 73u);
@@ -310,8 +312,8 @@ TEST_F(Cli, SensitivityOptionDeliversWhatTheScenesOutputWould) {
       slurp(scene), "output: {velocities: true, accelerations: true}",
       "output: {velocities: true, accelerations: true, sensitivities: [L2, {parameter: L3, step: 0.01}]}");
   ASSERT_EQ(run("run -q " + listed.string() + " --set L2=0.25 -o " + by_text.string()).code, 0);
-  const Result r = run("run -q " + scene + " --set L2=0.25 --sensitivity L2 --sensitivity L3=0.01 -o " +
-                       by_option.string());
+  const Result r =
+      run("run -q " + scene + " --set L2=0.25 --sensitivity L2 --sensitivity L3=0.01 -o " + by_option.string());
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string text = slurp(by_option);
   EXPECT_EQ(text, slurp(by_text));
@@ -341,4 +343,3 @@ TEST_F(Cli, SensitivityOptionDeliversWhatTheScenesOutputWould) {
 }
 
 }  // namespace
-

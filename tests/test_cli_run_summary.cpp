@@ -138,7 +138,8 @@ TEST_F(Cli, RunSummaryOnSuccessHasTheSameFields) {
   std::string text = phiq::test::kFourbarOutputs;
   text.replace(text.find("name: fourbar_outputs\n"), 22, "");
   const fs::path unnamed = write("unnamed.yaml", text);
-  ASSERT_EQ(run("run -q " + unnamed.string() + " -o " + (dir_ / "ok.csv").string() + " --summary " + sum.string()).code, 0);
+  ASSERT_EQ(run("run -q " + unnamed.string() + " -o " + (dir_ / "ok.csv").string() + " --summary " + sum.string()).code,
+            0);
   EXPECT_TRUE(Json::parse(slurp(sum))["name"].is_null());
 }
 
@@ -166,8 +167,10 @@ TEST_F(Cli, RunReadsTheSceneFromStandardInput) {
 // says why, the CSV is not written.
 TEST_F(Cli, SweepAccuracyJsonTellsWhyItFailed) {
   const fs::path scene = write("reach.yaml", kOutOfReach), json = dir_ / "a.json", csv = dir_ / "a.csv";
-  Result r = run("sweep-accuracy " + scene.string() + " --tolerances 1e-6 --steps-list 10 --predictors previous"
-                 " --newton modified --linear-solvers klu --repeat 1 -o " + csv.string() + " --json " + json.string());
+  Result r = run("sweep-accuracy " + scene.string() +
+                 " --tolerances 1e-6 --steps-list 10 --predictors previous"
+                 " --newton modified --linear-solvers klu --repeat 1 -o " +
+                 csv.string() + " --json " + json.string());
   EXPECT_EQ(r.code, 1);
   EXPECT_TRUE(one_phiq_line(r.err));
   EXPECT_FALSE(fs::exists(csv));

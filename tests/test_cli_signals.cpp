@@ -16,9 +16,9 @@
 namespace {
 
 using phiq::test::Cli;
+using phiq::test::one_phiq_line;
 using phiq::test::Result;
 using phiq::test::slurp;
-using phiq::test::one_phiq_line;
 namespace fs = std::filesystem;
 
 TEST_F(Cli, InterruptStopsCleanlyWithoutOutput) {
@@ -27,7 +27,8 @@ TEST_F(Cli, InterruptStopsCleanlyWithoutOutput) {
   scene.replace(scene.find("steps: 180"), 10, "steps: 10000000");
   fs::path p = write("long.yaml", scene);
   const auto t0 = std::chrono::steady_clock::now();
-  Result r = run_prefixed("timeout --preserve-status -s INT 0.5 ", "run " + p.string() + " -o " + (dir_ / "out.csv").string());
+  Result r =
+      run_prefixed("timeout --preserve-status -s INT 0.5 ", "run " + p.string() + " -o " + (dir_ / "out.csv").string());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(r.code, 130) << r.err;
   EXPECT_LT(seconds, 5.0);
@@ -48,9 +49,9 @@ TEST_F(Cli, TermAndHangupStopARunLikeInterrupt) {
   const fs::path p = write("long.yaml", long_scene());
   for (const auto& [sig, status] : {std::pair<std::string, int>{"TERM", 143}, {"HUP", 129}, {"INT", 130}}) {
     const auto t0 = std::chrono::steady_clock::now();
-    Result r = run_prefixed("timeout --preserve-status -s " + sig + " 0.5 ",
-                            "run " + p.string() + " -o " + (dir_ / "out.csv").string() + " --summary " +
-                                (dir_ / "s.json").string());
+    Result r = run_prefixed(
+        "timeout --preserve-status -s " + sig + " 0.5 ",
+        "run " + p.string() + " -o " + (dir_ / "out.csv").string() + " --summary " + (dir_ / "s.json").string());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     EXPECT_EQ(r.code, status) << sig << ": " << r.err;
     EXPECT_LT(seconds, 5.0) << sig;

@@ -20,8 +20,8 @@
 namespace {
 
 using phiq::test::Cli;
-using phiq::test::Result;
 using phiq::test::one_phiq_line;
+using phiq::test::Result;
 using phiq::test::slurp;
 namespace fs = std::filesystem;
 
@@ -117,8 +117,10 @@ TEST_F(Cli, ToleranceSetMovesTheNominalPoint) {
 // A ± limit is uniform on [p − l, p + l]: its standard deviation l/√3 is what the linear spread uses.
 TEST_F(Cli, ToleranceLimitIsUniformWithSdLimitOverRootThree) {
   const fs::path out = dir_ / "tol.csv";
-  const Result r = run("tolerance " + kCrankSlider + " --limit L2=0.003 --columns xB --samples 2000 --names "
-                       "identifiers -q -o " + out.string());
+  const Result r = run("tolerance " + kCrankSlider +
+                       " --limit L2=0.003 --columns xB --samples 2000 --names "
+                       "identifiers -q -o " +
+                       out.string());
   ASSERT_EQ(r.code, 0) << r.err;
   const phiq::CsvTable table = phiq::read_csv_table(out.string());
   EXPECT_EQ(table.columns, (std::vector<std::string>{"t", "xB", "xB__sd_linear", "xB__sd_mc", "xB__mean_mc"}));
@@ -142,8 +144,8 @@ TEST_F(Cli, ToleranceCovarianceGivesSqrtGSigmaG) {
   const double s2 = 0.001, s3 = 0.002, rho = 0.6;
   const fs::path cov = write("cov.csv", "L2,L3\n1e-06,1.2e-06\n1.2e-06,4e-06\n");
   const fs::path out = dir_ / "tol.csv";
-  const Result r = run("tolerance " + kCrankSlider + " --covariance " + cov.string() + " --columns xB -q -o " +
-                       out.string());
+  const Result r =
+      run("tolerance " + kCrankSlider + " --covariance " + cov.string() + " --columns xB -q -o " + out.string());
   ASSERT_EQ(r.code, 0) << r.err;
   const phiq::CsvTable table = phiq::read_csv_table(out.string());
   const std::size_t row = 30;  // t = π/6: θ = π/3
@@ -198,7 +200,8 @@ TEST_F(Cli, ToleranceNamesFailedCasesAndReportsDisagreementNearSingularPositions
   // that the sweep passes the dead point within its tolerance
   phiq::tolerance::Tolerance l1;
   l1.name = "L1", l1.spread = 0.25;
-  const Eigen::MatrixXd d = phiq::tolerance::sample_offsets(phiq::tolerance::parameter_spread({l1}, nullptr), samples, 1);
+  const Eigen::MatrixXd d =
+      phiq::tolerance::sample_offsets(phiq::tolerance::parameter_spread({l1}, nullptr), samples, 1);
   std::set<long> failed, expected;
   for (const auto& f : j["failed"]) {
     failed.insert(f["case"].get<long>());
@@ -231,8 +234,8 @@ TEST_F(Cli, ToleranceReportsAParameterNoOutputDependsOn) {
   const Result r = run("tolerance " + scene.string() + " --sd spare=0.1 --sd L3=0.002 --columns xB --samples 100 -o " +
                        out.string() + " --summary " + summary.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("note: no output depends on spare (its sensitivities are zero at every row)"),
-            std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("note: no output depends on spare (its sensitivities are zero at every row)"), std::string::npos)
+      << r.err;
   const auto j = nlohmann::json::parse(slurp(summary));
   EXPECT_EQ(j["parameters"][0]["name"], "spare");
   EXPECT_EQ(j["parameters"][0]["independent"], true);

@@ -37,7 +37,6 @@
 
 namespace {
 
-
 // ---- expressions ----------------------------------------------------------------------------------------------
 
 std::shared_ptr<const phiq::CompiledExpression> CompileOfT(const std::string& text) {
@@ -162,9 +161,10 @@ TEST(ConstraintKinds, PinBodyGround) {
 
 TEST(ConstraintKinds, PinAlongItsData) {
   // a body pinned to ground: the ground frame's position and angle and both local points move
-  const phiq::PinSpec p{phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{C(1.0), C(-0.5), C(0.3)}, {0.45, 0.25}, {0.2, 0.4}};
-  const phiq::PinSpec rate{phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{C(0.6), C(-1.2), C(0.9)}, {1.1, -0.3},
-                           {0.5, 0.7}};
+  const phiq::PinSpec p{
+      phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{C(1.0), C(-0.5), C(0.3)}, {0.45, 0.25}, {0.2, 0.4}};
+  const phiq::PinSpec rate{
+      phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{C(0.6), C(-1.2), C(0.9)}, {1.1, -0.3}, {0.5, 0.7}};
   CheckDataDerivative(p, rate, 3, 231);
   // two bodies, their arms move
   const phiq::PinSpec q{phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{S(3), S(4), S(5)}, {0.3, -0.2}, {-0.5, 0.1}};
@@ -184,40 +184,52 @@ TEST(ConstraintKinds, PinBodyNaturalPoint) {
 // ---- PrismaticSpec --------------------------------------------------------------------------------------------
 
 TEST(ConstraintKinds, PrismaticBothBodiesMoving) {
-  phiq::PrismaticSpec p{phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{S(3), S(4), S(5)}, {0.3, 0.1}, {-0.2, 0.5},
-                        {0.6, 0.8}, 0.4};
+  phiq::PrismaticSpec p{
+      phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{S(3), S(4), S(5)}, {0.3, 0.1}, {-0.2, 0.5}, {0.6, 0.8}, 0.4};
   CheckSpec(p, 6, Opts(301));
 }
 
 TEST(ConstraintKinds, PrismaticWithGroundSide) {
   // a is ground (the axis does not turn)
-  phiq::PrismaticSpec g{phiq::Frame2{C(0.5), C(-0.2), C(0.3)}, phiq::Frame2{S(0), S(1), S(2)}, {0.2, -0.1},
-                        {0.25, 0.15}, {0.8, -0.6}, -0.3};
+  phiq::PrismaticSpec g{phiq::Frame2{C(0.5), C(-0.2), C(0.3)},
+                        phiq::Frame2{S(0), S(1), S(2)},
+                        {0.2, -0.1},
+                        {0.25, 0.15},
+                        {0.8, -0.6},
+                        -0.3};
   CheckSpec(g, 3, Opts(302));
   // b is ground (the axis turns with a)
-  phiq::PrismaticSpec h{phiq::Frame2{S(1), S(2), S(0)}, phiq::Frame2{C(-1.0), C(0.4), C(0.9)}, {-0.35, 0.2},
-                        {0.1, 0.3}, {0.0, 1.0}, 0.9};
+  phiq::PrismaticSpec h{
+      phiq::Frame2{S(1), S(2), S(0)}, phiq::Frame2{C(-1.0), C(0.4), C(0.9)}, {-0.35, 0.2}, {0.1, 0.3}, {0.0, 1.0}, 0.9};
   CheckSpec(h, 3, Opts(303));
 }
 
 TEST(ConstraintKinds, PrismaticAlongItsData) {
   // a slider on a ground guide: the guide's frame (position and angle), both local points, the axis and the angle
-  const phiq::PrismaticSpec g{phiq::Frame2{C(0.5), C(-0.2), C(0.3)}, phiq::Frame2{S(0), S(1), S(2)}, {0.2, -0.1},
-                              {0.25, 0.15}, {0.8, -0.6}, -0.3};
-  const phiq::PrismaticSpec everything{phiq::Frame2{C(0.7), C(-0.4), C(1.1)}, phiq::Frame2{C(0), C(0), C(0)},
-                                       {0.6, 0.9}, {-0.3, 1.2}, {0.5, 0.4}, 0.8};
+  const phiq::PrismaticSpec g{phiq::Frame2{C(0.5), C(-0.2), C(0.3)},
+                              phiq::Frame2{S(0), S(1), S(2)},
+                              {0.2, -0.1},
+                              {0.25, 0.15},
+                              {0.8, -0.6},
+                              -0.3};
+  const phiq::PrismaticSpec everything{
+      phiq::Frame2{C(0.7), C(-0.4), C(1.1)}, phiq::Frame2{C(0), C(0), C(0)}, {0.6, 0.9}, {-0.3, 1.2}, {0.5, 0.4}, 0.8};
   CheckDataDerivative(g, everything, 3, 311);
   // two moving bodies (the axis turns with a): the arms and the axis move
-  const phiq::PrismaticSpec p{phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{S(3), S(4), S(5)}, {0.3, 0.1},
-                              {-0.2, 0.5}, {0.6, 0.8}, 0.4};
-  const phiq::PrismaticSpec arms{phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{C(0), C(0), C(0)}, {-0.9, 0.4},
-                                 {0.7, 0.2}, {-0.8, 0.6}, 0.0};
+  const phiq::PrismaticSpec p{
+      phiq::Frame2{S(0), S(1), S(2)}, phiq::Frame2{S(3), S(4), S(5)}, {0.3, 0.1}, {-0.2, 0.5}, {0.6, 0.8}, 0.4};
+  const phiq::PrismaticSpec arms{
+      phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{C(0), C(0), C(0)}, {-0.9, 0.4}, {0.7, 0.2}, {-0.8, 0.6}, 0.0};
   CheckDataDerivative(p, arms, 6, 312);
   // b on a ground frame that moves, a's guide turning
-  const phiq::PrismaticSpec h{phiq::Frame2{S(1), S(2), S(0)}, phiq::Frame2{C(-1.0), C(0.4), C(0.9)}, {-0.35, 0.2},
-                              {0.1, 0.3}, {0.0, 1.0}, 0.9};
-  const phiq::PrismaticSpec ground{phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{C(0.3), C(-0.8), C(-0.6)},
-                                   {0.0, 0.0}, {0.5, -0.5}, {0.0, 0.0}, -0.2};
+  const phiq::PrismaticSpec h{
+      phiq::Frame2{S(1), S(2), S(0)}, phiq::Frame2{C(-1.0), C(0.4), C(0.9)}, {-0.35, 0.2}, {0.1, 0.3}, {0.0, 1.0}, 0.9};
+  const phiq::PrismaticSpec ground{phiq::Frame2{C(0), C(0), C(0)},
+                                   phiq::Frame2{C(0.3), C(-0.8), C(-0.6)},
+                                   {0.0, 0.0},
+                                   {0.5, -0.5},
+                                   {0.0, 0.0},
+                                   -0.2};
   CheckDataDerivative(h, ground, 3, 313);
 }
 
@@ -243,7 +255,8 @@ TEST(ConstraintKinds, PointOnLineAlongItsData) {
   // a fixed point on a moving line
   phiq::PointOnLineSpec f{phiq::Point2{C(0.4), C(-0.2)}, phiq::Point2{S(0), S(1)}, phiq::Point2{S(2), S(3)}};
   f.ref = 0.8;
-  phiq::PointOnLineSpec moves{phiq::Point2{C(-0.7), C(1.1)}, phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)}};
+  phiq::PointOnLineSpec moves{phiq::Point2{C(-0.7), C(1.1)}, phiq::Point2{C(0.0), C(0.0)},
+                              phiq::Point2{C(0.0), C(0.0)}};
   moves.ref = 0.0;
   CheckDataDerivative(f, moves, 4, 412);
 }
@@ -280,8 +293,8 @@ TEST(ConstraintKinds, ConstantAngleAlongItsData) {
   phiq::ConstantAngleSpec m{phiq::Point2{S(0), S(1)}, phiq::Point2{S(2), S(3)}, phiq::Point2{S(0), S(1)},
                             phiq::Point2{S(4), S(5)}};
   m.angle = 2.1, m.ref = 0.8;
-  phiq::ConstantAngleSpec turn{phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)},
-                               phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)}};
+  phiq::ConstantAngleSpec turn{phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)}, phiq::Point2{C(0.0), C(0.0)},
+                               phiq::Point2{C(0.0), C(0.0)}};
   turn.angle = 1.0, turn.ref = 0.0;
   CheckDataDerivative(m, turn, 6, 512);
 }
@@ -437,8 +450,8 @@ TEST(ConstraintKinds, CouplerOfTwoCoordinates) {
 
 TEST(ModelPlumbing, CrankSliderJacobianPhiTAndGamma) {
   phiq::ModelBuilder b;
-  const Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3),
-              ya = b.add_coordinate("yA", 0.0), xb = b.add_coordinate("xB", 1.3);
+  const Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3), ya = b.add_coordinate("yA", 0.0),
+              xb = b.add_coordinate("xB", 1.3);
   b.add("crank", phiq::PolarSpec{phiq::Point2{S(xa), S(ya)}, phiq::Point2{C(0), C(0)}, 0.3, S(th)});
   b.add("coupler", phiq::DistanceSpec{phiq::Point2{S(xa), S(ya)}, phiq::Point2{S(xb), C(0.0)}, 1.0});
   b.add_driver("motor", th, phiq::MotionLaw::linear(0.0, 2.0));
@@ -467,15 +480,15 @@ TEST(ModelPlumbing, RelativeFourBarAccumulatesDuplicateEntries) {
   loop.closure = {1.1, 0.0};
   b.add("loop", loop);
   b.add_driver("motor", p2, phiq::MotionLaw::harmonic(0.4, 0.5, 2.0, 0.1));
-  auto g = phiq::CompiledExpression::compile(
-      "s - 0.3*cos(psi2) - 0.2*t*psi3", [&](const std::string& name) -> std::optional<phiq::NameBinding> {
-        using K = phiq::NameBinding::Kind;
-        if (name == "t") return phiq::NameBinding{K::kTime};
-        if (name == "psi2") return phiq::NameBinding{K::kCoordinate, p2};
-        if (name == "psi3") return phiq::NameBinding{K::kCoordinate, p3};
-        if (name == "s") return phiq::NameBinding{K::kCoordinate, sx};
-        return std::nullopt;
-      });
+  auto g = phiq::CompiledExpression::compile("s - 0.3*cos(psi2) - 0.2*t*psi3",
+                                             [&](const std::string& name) -> std::optional<phiq::NameBinding> {
+                                               using K = phiq::NameBinding::Kind;
+                                               if (name == "t") return phiq::NameBinding{K::kTime};
+                                               if (name == "psi2") return phiq::NameBinding{K::kCoordinate, p2};
+                                               if (name == "psi3") return phiq::NameBinding{K::kCoordinate, p3};
+                                               if (name == "s") return phiq::NameBinding{K::kCoordinate, sx};
+                                               return std::nullopt;
+                                             });
   b.add("output", phiq::EquationSpec{g, std::nullopt, phiq::Unit::kLength});
   const phiq::Model model = std::move(b).build();
 

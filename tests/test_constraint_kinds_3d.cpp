@@ -29,7 +29,6 @@ using phiq::JointSide3;
 using phiq::Point3;
 using phiq::kin3::V3;
 
-
 // Coordinates of the random states: body 0 at 0..6, body 1 at 7..13 (x, y, z, e0..e3), a natural point at 14..16,
 // a natural vector at 17..19, a second natural point at 20..22.
 constexpr int kN = 23;
@@ -120,7 +119,12 @@ TEST(ConstraintKinds3d, PointOnPlane) { CheckJoint<phiq::PointOnPlaneSpec>(390);
 TEST(ConstraintKinds3d, ConstantAttachmentsFoldToTheirValue) {
   const double half = M_PI / 6.0;
   const V3 u{1.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0};
-  const Frame3 fixed{C(0.3), C(-1.2), C(2.0), C(std::cos(half)), C(std::sin(half) * u.x), C(std::sin(half) * u.y),
+  const Frame3 fixed{C(0.3),
+                     C(-1.2),
+                     C(2.0),
+                     C(std::cos(half)),
+                     C(std::sin(half) * u.x),
+                     C(std::sin(half) * u.y),
                      C(std::sin(half) * u.z)};
   const V3 at{0.4, -0.7, 1.1};
   const phiq::Attachment3 point = phiq::Attachment3::body_point(fixed, at);
@@ -134,8 +138,8 @@ TEST(ConstraintKinds3d, ConstantAttachmentsFoldToTheirValue) {
   EXPECT_EQ(x.z, y.z);
   // Rodrigues: R at = cos φ at + sin φ (u × at) + (1 − cos φ)(u · at) u, φ = 60°
   const double c = std::cos(2 * half), n = std::sin(2 * half);
-  const V3 rodrigues = phiq::kin3::V3{0.3, -1.2, 2.0} + c * at + n * phiq::kin3::cross(u, at) +
-                       ((1.0 - c) * phiq::kin3::dot(u, at)) * u;
+  const V3 rodrigues =
+      phiq::kin3::V3{0.3, -1.2, 2.0} + c * at + n * phiq::kin3::cross(u, at) + ((1.0 - c) * phiq::kin3::dot(u, at)) * u;
   EXPECT_NEAR(y.x, rodrigues.x, 1e-15);
   EXPECT_NEAR(y.y, rodrigues.y, 1e-15);
   EXPECT_NEAR(y.z, rodrigues.z, 1e-15);
@@ -209,12 +213,10 @@ TEST(ConstraintKinds3d, JointsWithNaturalSides) {
   CheckSpec(Joint<phiq::SpatialRevoluteSpec>(BodySide(0, rng), JointSide3::natural_point(Nat(14), Nat(17))), kN,
             Opts(403));
   // a universal joint between two natural vectors' ends (the cross: u · v = 0)
-  CheckSpec(Joint<phiq::UniversalSpec>(JointSide3::natural_point(Nat(20), Nat(17)), BodySide(7, rng)), kN,
-            Opts(404));
+  CheckSpec(Joint<phiq::UniversalSpec>(JointSide3::natural_point(Nat(20), Nat(17)), BodySide(7, rng)), kN, Opts(404));
   // a natural point on a body's plane, on a body's line
   CheckSpec(Joint<phiq::PointOnPlaneSpec>(BodySide(0, rng), JointSide3::natural_point(Nat(14))), kN, Opts(405));
-  CheckSpec(Joint<phiq::SpatialPointOnLineSpec>(BodySide(7, rng), JointSide3::natural_point(Nat(20))), kN,
-            Opts(406));
+  CheckSpec(Joint<phiq::SpatialPointOnLineSpec>(BodySide(7, rng), JointSide3::natural_point(Nat(20))), kN, Opts(406));
 }
 
 // ---- natural-coordinate rigid-body conditions ---------------------------------------------------------------------
@@ -224,9 +226,9 @@ TEST(ConstraintKinds3d, Distance) {
       {phiq::Attachment3::natural(Nat(14)), phiq::Attachment3::natural(Point3{S(20), C(0.3), S(22)})}, 1.7};
   CheckSpec(between_points, kN, Opts(410));
   // a bar with ball joints at two body points
-  phiq::SpatialDistanceSpec between_bodies{
-      {phiq::Attachment3::body_point(Body(0), V3{0.3, -0.2, 0.5}), phiq::Attachment3::body_point(Body(7), V3{-1, 0.4, 0})},
-      0.45};
+  phiq::SpatialDistanceSpec between_bodies{{phiq::Attachment3::body_point(Body(0), V3{0.3, -0.2, 0.5}),
+                                            phiq::Attachment3::body_point(Body(7), V3{-1, 0.4, 0})},
+                                           0.45};
   CheckSpec(between_bodies, kN, Opts(411));
   // derivatives along the length and the ends: the natural point's constant y, the bodies' local points
   std::mt19937 rng(414);
@@ -237,10 +239,9 @@ TEST(ConstraintKinds3d, Distance) {
   CheckDataDerivative(between_points, rate, kN, 412);
   CheckDataDerivative(between_bodies, body_rate, kN, 413);
   // a bar from a ground point that moves (folded into constants) to a body
-  phiq::SpatialDistanceSpec grounded{
-      {phiq::Attachment3::body_point(Frame3::ground(), V3{0.5, 0.2, -0.3}),
-       phiq::Attachment3::body_point(Body(7), V3{-1, 0.4, 0})},
-      1.1};
+  phiq::SpatialDistanceSpec grounded{{phiq::Attachment3::body_point(Frame3::ground(), V3{0.5, 0.2, -0.3}),
+                                      phiq::Attachment3::body_point(Body(7), V3{-1, 0.4, 0})},
+                                     1.1};
   grounded.prepare(nullptr);
   phiq::SpatialDistanceSpec ground_rate = grounded;
   RandomizeAttachmentRates(ground_rate.ends, rng);
@@ -402,10 +403,11 @@ phiq::Frame3 AddBody(phiq::ModelBuilder& b, const std::string& name) {
 TEST(ConstraintKinds3d, ModelOfSpatialKindsThroughItsPattern) {
   phiq::ModelBuilder b;
   const Frame3 crank = AddBody(b, "crank"), rocker = AddBody(b, "rocker");
-  b.add("hinge", phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{0, 0, 0}),
-                                           JointSide3::body(crank, V3{0, 0, 0}), {}});
+  b.add("hinge", phiq::SpatialRevoluteSpec{
+                     JointSide3::body(Frame3::ground(), V3{0, 0, 0}), JointSide3::body(crank, V3{0, 0, 0}), {}});
   b.add("pivot", phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{1, 0.5, 0}, V3{1, 0, 0}),
-                                           JointSide3::body(rocker, V3{0, 0, 0}, V3{1, 0, 0}), {}});
+                                           JointSide3::body(rocker, V3{0, 0, 0}, V3{1, 0, 0}),
+                                           {}});
   b.add("coupler", phiq::SpatialDistanceSpec{{phiq::Attachment3::body_point(crank, V3{0.2, 0, 0}),
                                               phiq::Attachment3::body_point(rocker, V3{0, 0.6, 0})},
                                              0.9});
@@ -456,7 +458,8 @@ TEST(ConstraintKinds3d, JointDriversLawsBoundTheTimeDomain) {
     opt.t_begin = 0.5, opt.t_end = 3.0, opt.steps = 10;
     phiq::SweepSummary sum;
     Index rows = 0;
-    EXPECT_EQ(phiq::run_sweep(m, opt, ws, [&](const phiq::StepView&) { return ++rows, true; }, &sum),
+    EXPECT_EQ(phiq::run_sweep(
+                  m, opt, ws, [&](const phiq::StepView&) { return ++rows, true; }, &sum),
               phiq::SolveStatus::kOutsideTimeDomain);
     EXPECT_EQ(rows, 0);
     EXPECT_NE(sum.message.find("driver 'motor' is defined on [0.5, 2] only"), std::string::npos) << sum.message;
@@ -532,8 +535,7 @@ TEST(Grubler, UndefinedWithoutBodiesOrWithNonJoints) {
   {  // a spatial body and a planar joint mixed
     phiq::ModelBuilder b;
     const Frame3 f = AddBody(b, "door");
-    b.add("hinge", phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{}),
-                                             JointSide3::body(f, V3{}), {}});
+    b.add("hinge", phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{}), JointSide3::body(f, V3{}), {}});
     b.add("flat", phiq::PinSpec{phiq::Frame2{C(0), C(0), C(0)}, phiq::Frame2{S(0), S(1), S(4)}, {0, 0}, {0, 0}});
     EXPECT_FALSE(std::move(b).build().grubler().has_value());
   }
@@ -541,8 +543,9 @@ TEST(Grubler, UndefinedWithoutBodiesOrWithNonJoints) {
     phiq::ModelBuilder b;
     const Frame3 f = AddBody(b, "door");
     for (int k = 0; k < 3; ++k)
-      b.add("hinge" + std::to_string(k), phiq::SpatialRevoluteSpec{JointSide3::body(Frame3::ground(), V3{0, 0, 1.0 * k}),
-                                                                   JointSide3::body(f, V3{0, 0, 1.0 * k}), {}});
+      b.add("hinge" + std::to_string(k),
+            phiq::SpatialRevoluteSpec{
+                JointSide3::body(Frame3::ground(), V3{0, 0, 1.0 * k}), JointSide3::body(f, V3{0, 0, 1.0 * k}), {}});
     const phiq::Model m = std::move(b).build();
     ASSERT_TRUE(m.grubler().has_value());
     EXPECT_EQ(*m.grubler(), -9);

@@ -40,9 +40,13 @@ TEST(Coupler, RowHasTheUnitOfItsFirstCoordinateAndCountsAsAHigherPair) {
   b.add_body("gear1", Frame2{Slot::coordinate(x1), Slot::coordinate(y1), Slot::coordinate(p1)});
   b.add_body("gear2", Frame2{Slot::coordinate(x2), Slot::coordinate(y2), Slot::coordinate(p2)});
   b.add("pivot1", PinSpec{Frame2{Slot::coordinate(x1), Slot::coordinate(y1), Slot::coordinate(p1)},
-                          Frame2{S0, S0, S0}, {0, 0}, {0, 0}});
+                          Frame2{S0, S0, S0},
+                          {0, 0},
+                          {0, 0}});
   b.add("pivot2", PinSpec{Frame2{Slot::coordinate(x2), Slot::coordinate(y2), Slot::coordinate(p2)},
-                          Frame2{Slot::constant(0.3), S0, S0}, {0, 0}, {0, 0}});
+                          Frame2{Slot::constant(0.3), S0, S0},
+                          {0, 0},
+                          {0, 0}});
   b.add("mesh", CouplerSpec{Slot::coordinate(p1), Slot::coordinate(p2), 0.2, 0.1, 0.0});
   b.add_driver("motor", p1, MotionLaw::linear(0.0, 1.0));
   Model m = std::move(b).build();

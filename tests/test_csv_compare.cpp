@@ -270,8 +270,9 @@ TEST(CsvCompare, WorstCellIsReportedWithColumnRowTimeAndValues) {
   CsvTable a2 = parse("xB.a\n1.25\n"), b2 = parse("xB.a\n1.2500001\n");
   CompareResult r2 = compare_csv(a2, b2, {});
   EXPECT_TRUE(std::isnan(r2.worst_t));
-  EXPECT_EQ(r2.summary(), "differ: 1 cell beyond tolerance; worst xB.a at line 2: 1.25 vs 1.2500001 "
-                          "(|diff| 1e-07 > tol 1.25e-09)");
+  EXPECT_EQ(r2.summary(),
+            "differ: 1 cell beyond tolerance; worst xB.a at line 2: 1.25 vs 1.2500001 "
+            "(|diff| 1e-07 > tol 1.25e-09)");
 }
 
 TEST(CsvCompare, NanEqualsNanButNotANumber) {
@@ -330,8 +331,7 @@ TEST(CsvCompare, HeaderDifferencesAreNotEqualByDefault) {
   EXPECT_EQ(r.compared, (Strings{"t", "x"}));  // matched by name, in A's order
   EXPECT_EQ(r.only_in_a, (Strings{"y"}));
   EXPECT_EQ(r.only_in_b, (Strings{"z"}));
-  EXPECT_EQ(r.summary(),
-            "differ: the shared 1 row x 2 columns agree (identical); columns only in A: y; only in B: z");
+  EXPECT_EQ(r.summary(), "differ: the shared 1 row x 2 columns agree (identical); columns only in A: y; only in B: z");
 
   CompareResult sub = compare_csv(parse("t,x\n0,1\n"), parse("t,x,x.v\n0,1,0\n"), {});
   EXPECT_FALSE(sub.equal);
@@ -347,8 +347,7 @@ TEST(CsvCompare, RestrictingToSharedColumnsIgnoresHeaderDifferences) {
   EXPECT_EQ(r.compared, (Strings{"t", "x"}));  // A's order, repeats dropped
   EXPECT_EQ(r.only_in_a, (Strings{"y"}));      // still reported
   EXPECT_TRUE(r.columns_restricted);
-  EXPECT_EQ(r.summary(),
-            "agree: 2 rows x 2 columns (identical); not compared: columns only in A: y; only in B: z");
+  EXPECT_EQ(r.summary(), "agree: 2 rows x 2 columns (identical); not compared: columns only in A: y; only in B: z");
 
   // and the restricted columns are still really compared
   CsvTable b2 = parse("t,z,x\n0,9,1\n0.1,9,1.5\n");
@@ -391,7 +390,8 @@ TEST(CsvCompare, EmptyTablesAgreeWhenHeadersMatch) {
 
 // Each column's own worst cell, beside the overall one: row, t, both values, tolerance and ratio, counted apart.
 TEST(CsvCompare, EachColumnHasItsOwnWorstCell) {
-  const CsvTable a = parse("t,x,y\n0,1,5\n0.5,2,6\n1,3,7\n"), b = parse("t,x,y\n0,1,5\n0.5,2.5,6\n1,3.25,7.5\n", "b.csv");
+  const CsvTable a = parse("t,x,y\n0,1,5\n0.5,2,6\n1,3,7\n"),
+                 b = parse("t,x,y\n0,1,5\n0.5,2.5,6\n1,3.25,7.5\n", "b.csv");
   const CompareResult r = compare_csv(a, b);
   ASSERT_EQ(r.per_column.size(), 3u);
   EXPECT_EQ(r.per_column[0].column, "t");

@@ -115,15 +115,23 @@ TEST(Curves, BadCurvesAreRefusedWithOneLine) {
     }
     return std::string("(accepted)");
   };
-  EXPECT_EQ(message([] { Curve::spline({{0, 0}, {1, 0}, {1, 1}}, true); }),
+  EXPECT_EQ(message([] {
+              Curve::spline({{0, 0}, {1, 0}, {1, 1}}, true);
+            }),
             "a spline needs at least 4 distinct points (3 given)");
-  EXPECT_EQ(message([] { Curve::spline({{0, 0}, {1, 0}, {1, 0}, {1, 1}, {0, 1}}, false); }),
+  EXPECT_EQ(message([] {
+              Curve::spline({{0, 0}, {1, 0}, {1, 0}, {1, 1}, {0, 1}}, false);
+            }),
             "spline points 2 and 3 are the same point");
   // a closed spline's last point may repeat its first: it is dropped, leaving 3 here
-  EXPECT_EQ(message([] { Curve::spline({{0, 0}, {1, 0}, {1, 1}, {0, 0}}, true); }),
+  EXPECT_EQ(message([] {
+              Curve::spline({{0, 0}, {1, 0}, {1, 1}, {0, 0}}, true);
+            }),
             "a spline needs at least 4 distinct points (3 given)");
   EXPECT_EQ(message([] { Curve::circle({0, 0}, 0.0); }), "the circle's radius must be positive and finite");
-  EXPECT_EQ(message([] { Curve::radius_table({0, 1, 1, 2}, {1, 1, 1, 1}); }),
+  EXPECT_EQ(message([] {
+              Curve::radius_table({0, 1, 1, 2}, {1, 1, 1, 1});
+            }),
             "profile entry 3: the angles must increase");
   EXPECT_FALSE(Curve::spline({{0, 0}, {2, 0}, {2, 2}, {1, 0.5}, {0, 2}}, true)->convex());  // a notch
   EXPECT_TRUE(Curve::spline(circle_points(8, {0.3, 0}, 1.0), true)->convex());
@@ -133,30 +141,42 @@ TEST(Curves, BadCurvesAreRefusedWithOneLine) {
 
 TEST(ConstraintKinds, PointOnCurveBodyOnBodySpline) {
   // a pin of body a (0..2) in a closed spline slot of body b (3..5), s = 6
-  phiq::PointOnCurveSpec k{phiq::Frame2{S(0), S(1), S(2)}, {0.3, -0.2},
+  phiq::PointOnCurveSpec k{phiq::Frame2{S(0), S(1), S(2)},
+                           {0.3, -0.2},
                            {phiq::Frame2{S(3), S(4), S(5)}, Curve::spline(circle_points(5, {0.1, 0}, 2.0), true)},
-                           0.0, S(6)};
+                           0.0,
+                           S(6)};
   CheckSpec(k, 7, Opts(2701));
 }
 
 TEST(ConstraintKinds, PointOnCurveRollerOnACircleAndOnAGroundSpline) {
   // a roller (offset curve) of a body on a circle of a turning body
-  phiq::PointOnCurveSpec roller{phiq::Frame2{S(0), S(1), S(2)}, {0.1, 0.25},
-                                {phiq::Frame2{S(3), C(0.5), S(4)}, Curve::circle({0.3, -0.1}, 1.3)}, 0.2, S(5)};
+  phiq::PointOnCurveSpec roller{phiq::Frame2{S(0), S(1), S(2)},
+                                {0.1, 0.25},
+                                {phiq::Frame2{S(3), C(0.5), S(4)}, Curve::circle({0.3, -0.1}, 1.3)},
+                                0.2,
+                                S(5)};
   CheckSpec(roller, 6, Opts(2702));
   // a natural point on an open ground spline, offset: the spline continues its end pieces past its ends
-  phiq::PointOnCurveSpec point{phiq::Frame2{S(1), S(0), C(0.0)}, {0, 0},
-                               {phiq::Frame2{C(0.2), C(-0.1), C(0.4)},
-                                Curve::spline({{-3, 0}, {-1, 1.5}, {1, 1.2}, {3.5, -0.5}}, false)},
-                               -0.15, S(2)};
+  phiq::PointOnCurveSpec point{
+      phiq::Frame2{S(1), S(0), C(0.0)},
+      {0, 0},
+      {phiq::Frame2{C(0.2), C(-0.1), C(0.4)}, Curve::spline({{-3, 0}, {-1, 1.5}, {1, 1.2}, {3.5, -0.5}}, false)},
+      -0.15,
+      S(2)};
   CheckSpec(point, 3, Opts(2703));
 }
 
 TEST(ConstraintKinds, FlatFollowerOnCircleAndSpline) {
-  phiq::FlatFollowerSpec k{phiq::Frame2{S(0), S(1), S(2)}, {0.2, -0.1}, {0.6, 0.8},
-                           {phiq::Frame2{S(3), S(4), S(5)}, Curve::circle({0.3, 0.1}, 0.9)}, S(6)};
+  phiq::FlatFollowerSpec k{phiq::Frame2{S(0), S(1), S(2)},
+                           {0.2, -0.1},
+                           {0.6, 0.8},
+                           {phiq::Frame2{S(3), S(4), S(5)}, Curve::circle({0.3, 0.1}, 0.9)},
+                           S(6)};
   CheckSpec(k, 7, Opts(2704));
-  phiq::FlatFollowerSpec g{phiq::Frame2{C(0.1), S(0), C(0.0)}, {0, 0}, {1, 0},
+  phiq::FlatFollowerSpec g{phiq::Frame2{C(0.1), S(0), C(0.0)},
+                           {0, 0},
+                           {1, 0},
                            {phiq::Frame2{C(0), C(0), S(1)}, Curve::spline(circle_points(5, {0.2, 0}, 2.5), true)},
                            S(2)};
   CheckSpec(g, 3, Opts(2705));
@@ -167,22 +187,24 @@ TEST(ConstraintKinds, FlatFollowerOnCircleAndSpline) {
 TEST(ConstraintKinds, PointOnCurveAlongItsData) {
   // a roller of a body on a circle of a turning cam whose pivot moves: the pivot, the roller's point and radius
   const auto circle = Curve::circle({0.3, -0.1}, 1.3);
-  phiq::PointOnCurveSpec roller{phiq::Frame2{S(0), S(1), S(2)}, {0.1, 0.25},
-                                {phiq::Frame2{C(0.2), C(0.5), S(3)}, circle}, 0.2, S(4)};
-  phiq::PointOnCurveSpec rate{phiq::Frame2{C(0), C(0), C(0)}, {0.3, -0.7},
-                              {phiq::Frame2{C(0.4), C(-0.6), C(0)}, circle}, 0.9, S(4)};
+  phiq::PointOnCurveSpec roller{
+      phiq::Frame2{S(0), S(1), S(2)}, {0.1, 0.25}, {phiq::Frame2{C(0.2), C(0.5), S(3)}, circle}, 0.2, S(4)};
+  phiq::PointOnCurveSpec rate{
+      phiq::Frame2{C(0), C(0), C(0)}, {0.3, -0.7}, {phiq::Frame2{C(0.4), C(-0.6), C(0)}, circle}, 0.9, S(4)};
   CheckDataDerivative(roller, rate, 5, 2711);
   // a point at a constant angle (its turn a datum) on an open ground spline turned by a datum, offset
   const auto spline = Curve::spline({{-3, 0}, {-1, 1.5}, {1, 1.2}, {3.5, -0.5}}, false);
-  phiq::PointOnCurveSpec point{phiq::Frame2{S(0), S(1), C(0.3)}, {0.2, -0.4},
-                               {phiq::Frame2{C(0.2), C(-0.1), C(0.4)}, spline}, -0.15, S(2)};
-  phiq::PointOnCurveSpec turns{phiq::Frame2{C(0), C(0), C(0.8)}, {-0.5, 0.6},
-                               {phiq::Frame2{C(0.1), C(0.2), C(-0.5)}, spline}, 0.3, S(2)};
+  phiq::PointOnCurveSpec point{
+      phiq::Frame2{S(0), S(1), C(0.3)}, {0.2, -0.4}, {phiq::Frame2{C(0.2), C(-0.1), C(0.4)}, spline}, -0.15, S(2)};
+  phiq::PointOnCurveSpec turns{
+      phiq::Frame2{C(0), C(0), C(0.8)}, {-0.5, 0.6}, {phiq::Frame2{C(0.1), C(0.2), C(-0.5)}, spline}, 0.3, S(2)};
   CheckDataDerivative(point, turns, 3, 2712);
   // a pin in a slot of a moving body: only its local point moves (no offset, no frame data)
-  phiq::PointOnCurveSpec pin{phiq::Frame2{S(0), S(1), S(2)}, {0.3, -0.2},
+  phiq::PointOnCurveSpec pin{phiq::Frame2{S(0), S(1), S(2)},
+                             {0.3, -0.2},
                              {phiq::Frame2{S(3), S(4), S(5)}, Curve::spline(circle_points(5, {0.1, 0}, 2.0), true)},
-                             0.0, S(6)};
+                             0.0,
+                             S(6)};
   phiq::PointOnCurveSpec arm = pin;
   arm.a = phiq::Frame2{C(0), C(0), C(0)}, arm.sa = {1.0, 0.5}, arm.on.frame = arm.a;
   CheckDataDerivative(pin, arm, 7, 2713);
@@ -191,21 +213,24 @@ TEST(ConstraintKinds, PointOnCurveAlongItsData) {
 TEST(ConstraintKinds, FlatFollowerAlongItsData) {
   // a follower body on a circle of a cam turning about a pivot that moves: the face's point and direction, the pivot
   const auto circle = Curve::circle({0.3, 0.1}, 0.9);
-  phiq::FlatFollowerSpec k{phiq::Frame2{S(0), S(1), S(2)}, {0.2, -0.1}, {0.6, 0.8},
-                           {phiq::Frame2{C(0.1), C(0.2), S(3)}, circle}, S(4)};
-  phiq::FlatFollowerSpec rate{phiq::Frame2{C(0), C(0), C(0)}, {0.2, 0.5}, {-0.3, 0.4},
-                              {phiq::Frame2{C(0.3), C(-0.2), C(0)}, circle}, S(4)};
+  phiq::FlatFollowerSpec k{
+      phiq::Frame2{S(0), S(1), S(2)}, {0.2, -0.1}, {0.6, 0.8}, {phiq::Frame2{C(0.1), C(0.2), S(3)}, circle}, S(4)};
+  phiq::FlatFollowerSpec rate{
+      phiq::Frame2{C(0), C(0), C(0)}, {0.2, 0.5}, {-0.3, 0.4}, {phiq::Frame2{C(0.3), C(-0.2), C(0)}, circle}, S(4)};
   CheckDataDerivative(k, rate, 5, 2714);
   // a translating follower at a constant angle (a datum) on a ground profile turned by a datum
   const auto profile = Curve::spline(circle_points(5, {0.2, 0}, 2.5), true);
-  phiq::FlatFollowerSpec g{phiq::Frame2{C(0.1), S(0), C(0.2)}, {0.1, 0.3}, {1, 0},
-                           {phiq::Frame2{C(0.05), C(-0.02), C(0.3)}, profile}, S(1)};
-  phiq::FlatFollowerSpec every{phiq::Frame2{C(0.4), C(0), C(0.7)}, {-0.3, 0.2}, {0.1, 0.9},
-                               {phiq::Frame2{C(-0.2), C(0.6), C(-0.4)}, profile}, S(1)};
+  phiq::FlatFollowerSpec g{
+      phiq::Frame2{C(0.1), S(0), C(0.2)}, {0.1, 0.3}, {1, 0}, {phiq::Frame2{C(0.05), C(-0.02), C(0.3)}, profile}, S(1)};
+  phiq::FlatFollowerSpec every{phiq::Frame2{C(0.4), C(0), C(0.7)},
+                               {-0.3, 0.2},
+                               {0.1, 0.9},
+                               {phiq::Frame2{C(-0.2), C(0.6), C(-0.4)}, profile},
+                               S(1)};
   CheckDataDerivative(g, every, 2, 2715);
   // a follower on a cam, both bodies free: only the face's point moves (every frame slot is a coordinate)
-  phiq::FlatFollowerSpec both{phiq::Frame2{S(0), S(1), S(2)}, {0, 0}, {1, 0},
-                              {phiq::Frame2{S(3), S(4), S(5)}, profile}, S(6)};
+  phiq::FlatFollowerSpec both{
+      phiq::Frame2{S(0), S(1), S(2)}, {0, 0}, {1, 0}, {phiq::Frame2{S(3), S(4), S(5)}, profile}, S(6)};
   phiq::FlatFollowerSpec point = both;
   point.a = phiq::Frame2{C(0), C(0), C(0)}, point.sa = {0.7, -0.2}, point.axis = {0, 0}, point.on.frame = point.a;
   CheckDataDerivative(both, point, 7, 2716);
@@ -216,16 +241,20 @@ TEST(ConstraintKinds, FlatFollowerAlongItsData) {
 TEST(CurveKinds, TheModelAddsTheCurveParameterWithItsNearestPointAsGuess) {
   phiq::ModelBuilder b;
   const Index x = b.add_coordinate("x", 0.3), y = b.add_coordinate("y", 2.0);
-  const Index id = b.add("slot", phiq::PointOnCurveSpec{phiq::Frame2{S(x), S(y), C(0)}, {0, 0},
+  const Index id = b.add("slot", phiq::PointOnCurveSpec{phiq::Frame2{S(x), S(y), C(0)},
+                                                        {0, 0},
                                                         {phiq::Frame2{C(0), C(0), C(0)}, Curve::circle({0, 0}, 1.0)},
-                                                        0.0, C(0)});
+                                                        0.0,
+                                                        C(0)});
   b.add_driver("drive", x, phiq::MotionLaw::linear(0.3, 0.0));
   EXPECT_EQ(b.num_coordinates(), 3);
   EXPECT_EQ(b.coordinate_name(2), "slot.s");
   // a second constraint of that name adds nothing
-  EXPECT_THROW(b.add("slot", phiq::PointOnCurveSpec{phiq::Frame2{S(x), S(y), C(0)}, {0, 0},
-                                                     {phiq::Frame2{C(0), C(0), C(0)}, Curve::circle({0, 0}, 1.0)},
-                                                     0.0, C(0)}),
+  EXPECT_THROW(b.add("slot", phiq::PointOnCurveSpec{phiq::Frame2{S(x), S(y), C(0)},
+                                                    {0, 0},
+                                                    {phiq::Frame2{C(0), C(0), C(0)}, Curve::circle({0, 0}, 1.0)},
+                                                    0.0,
+                                                    C(0)}),
                phiq::Error);
   EXPECT_EQ(b.num_coordinates(), 3);
   const phiq::Model m = std::move(b).build();
@@ -233,7 +262,7 @@ TEST(CurveKinds, TheModelAddsTheCurveParameterWithItsNearestPointAsGuess) {
   // the parameter of the point of the unit circle nearest to (0.3, 2): its angle, as arc length
   EXPECT_NEAR(m.initial_positions()(2), std::atan2(2.0, 0.3), 1e-12);
   EXPECT_FALSE(m.grubler().has_value());  // a natural point: no joint count
-  CheckModel(m, 2706);  // the added coordinate's column in the model's CSC pattern and evaluations
+  CheckModel(m, 2706);                    // the added coordinate's column in the model's CSC pattern and evaluations
 }
 
 TEST(CurveKinds, AFlatFollowerNeedsAConvexProfile) {
@@ -241,8 +270,8 @@ TEST(CurveKinds, AFlatFollowerNeedsAConvexProfile) {
   const Index y = b.add_coordinate("y", 3.0), th = b.add_coordinate("th", 0.0);
   auto notch = Curve::spline({{0, 0}, {2, 0}, {2, 2}, {1, 0.5}, {0, 2}}, true);
   try {
-    b.add("cam", phiq::FlatFollowerSpec{phiq::Frame2{C(0), S(y), C(0)}, {0, 0}, {1, 0},
-                                        {phiq::Frame2{C(0), C(0), S(th)}, notch}, C(0)});
+    b.add("cam", phiq::FlatFollowerSpec{
+                     phiq::Frame2{C(0), S(y), C(0)}, {0, 0}, {1, 0}, {phiq::Frame2{C(0), C(0), S(th)}, notch}, C(0)});
     ADD_FAILURE() << "a notched profile accepted";
   } catch (const phiq::Error& e) {
     EXPECT_EQ(std::string(e.what()),

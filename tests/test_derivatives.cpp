@@ -14,7 +14,6 @@
 namespace phiq {
 namespace {
 
-
 TEST(Derivatives, UnsolvedPositionIsAFailureNamingTheWorstConstraint) {
   const Model m = test::crank_slider_model(2.0, 0.0);
   Workspace ws(m);  // q: the rough placement, not a solution
@@ -32,10 +31,10 @@ TEST(Derivatives, UnsolvedPositionIsAFailureNamingTheWorstConstraint) {
   LinearSummary ls;
   EXPECT_EQ(solve_velocity(m, 0.5, ws, &ls), SolveStatus::kPositionNotSolved);
   EXPECT_EQ(ls.status, SolveStatus::kPositionNotSolved);
-  EXPECT_EQ(ls.message.rfind("q does not solve the position problem at t = 0.5: constraint '" + m.row_name(worst) +
-                                 "' residual ",
-                             0),
-            0u)
+  EXPECT_EQ(
+      ls.message.rfind(
+          "q does not solve the position problem at t = 0.5: constraint '" + m.row_name(worst) + "' residual ", 0),
+      0u)
       << ls.message;
   EXPECT_HAS(ls.message, "> tolerance 1e-10");
   EXPECT_EQ(ls.message.find('\n'), std::string::npos);

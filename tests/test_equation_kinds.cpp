@@ -95,16 +95,18 @@ TEST(ConstraintKinds, EquationAlongTheParametersItsTextReads) {
   ASSERT_TRUE(phiq::detail::spec_data_rate(e, {&m2, &m1, &p1, &p2}, h, rate));
   ASSERT_NE(rate.g, nullptr);
   EXPECT_EQ(rate.g->coordinates(), (std::vector<Index>{0, 1, 2}));
-  CheckDataDerivativeOf(e, rate, [&](double x) { return at(p + x); }, 4, 1013);
+  CheckDataDerivativeOf(
+      e, rate, [&](double x) { return at(p + x); }, 4, 1013);
   // constants that do not move give no rate; one that moves an exponent has none the kind can give (differenced)
   EXPECT_EQ(e.g->along_constants({0.0, 0.0}), nullptr);
   auto power = [](double p) {
     using K = phiq::NameBinding::Kind;
-    return phiq::CompiledExpression::compile("xA^n - 1", [p](const std::string& name) -> std::optional<phiq::NameBinding> {
-      if (name == "xA") return phiq::NameBinding{K::kCoordinate, 0};
-      if (name == "n") return phiq::NameBinding{K::kConstant, -1, p};
-      return std::nullopt;
-    });
+    return phiq::CompiledExpression::compile("xA^n - 1",
+                                             [p](const std::string& name) -> std::optional<phiq::NameBinding> {
+                                               if (name == "xA") return phiq::NameBinding{K::kCoordinate, 0};
+                                               if (name == "n") return phiq::NameBinding{K::kConstant, -1, p};
+                                               return std::nullopt;
+                                             });
   };
   EXPECT_THROW(power(2.0)->along_constants({1.0}), phiq::Error);
   const phiq::EquationSpec pe{power(2.0), std::nullopt, phiq::Unit::kNone};
@@ -123,21 +125,25 @@ TEST(EquationKind, AtanDriverPassesPlusMinusPi) {
   for (const char* driver : {"drivers:\n  - {expr: \"atan2(yA - y0, xA - x0)\", unit: angle, law: {type: linear, "
                              "initial: 0, rate: 1}}\n",
                              "  - {type: equation, expr: \"atan2(yA - y0, xA - x0) - t\", unit: angle}\n"}) {
-    const std::string text = std::string("phiq: 1\nparameters: {x0: 0.5, y0: 0.25}\ncoordinates: {xA: 1.5, yA: 0.25}\n"
-                                         "points: {O: [x0, y0], A: [xA, yA]}\n") +
+    const std::string text = std::string(
+                                 "phiq: 1\nparameters: {x0: 0.5, y0: 0.25}\ncoordinates: {xA: 1.5, yA: 0.25}\n"
+                                 "points: {O: [x0, y0], A: [xA, yA]}\n") +
                              "constraints:\n  - {name: crank, type: distance, points: [O, A], length: 1}\n" + driver +
                              "time: {start: 0, end: 7, steps: 70}\noutput: {velocities: true}\n";
     const Scene sc = parse_scene(text, "atan_driver.yaml");
     Workspace ws(*sc.model);
     SweepSummary sum;
     int rows = 0;
-    const SolveStatus st = run_sweep(*sc.model, sc.sweep, ws, [&](const StepView& v) {
-      EXPECT_NEAR(v.q(0), 0.5 + std::cos(v.t), 1e-9) << "t = " << v.t;
-      EXPECT_NEAR(v.q(1), 0.25 + std::sin(v.t), 1e-9) << "t = " << v.t;
-      EXPECT_NEAR((*v.qd)(0), -std::sin(v.t), 1e-8) << "t = " << v.t;
-      ++rows;
-      return true;
-    }, &sum);
+    const SolveStatus st = run_sweep(
+        *sc.model, sc.sweep, ws,
+        [&](const StepView& v) {
+          EXPECT_NEAR(v.q(0), 0.5 + std::cos(v.t), 1e-9) << "t = " << v.t;
+          EXPECT_NEAR(v.q(1), 0.25 + std::sin(v.t), 1e-9) << "t = " << v.t;
+          EXPECT_NEAR((*v.qd)(0), -std::sin(v.t), 1e-8) << "t = " << v.t;
+          ++rows;
+          return true;
+        },
+        &sum);
     ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
     EXPECT_EQ(rows, 71);
   }

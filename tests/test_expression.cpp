@@ -52,7 +52,8 @@ TEST(Expression, TimeDerivativesAreExact) {
 }
 
 TEST(Expression, SecondDerivativesAgainstFiniteDifferences) {
-  auto e = CompiledExpression::compile("atan2(yA, xA) * sqrt(xA^2 + yA^2) + exp(-theta2) / (1 + xA^2) + abs(yA)^3", resolve);
+  auto e =
+      CompiledExpression::compile("atan2(yA, xA) * sqrt(xA^2 + yA^2) + exp(-theta2) / (1 + xA^2) + abs(yA)^3", resolve);
   const double q[3] = {0.3, 0.8, -0.6}, qd[3] = {-1.1, 0.7, 0.4};
   // −γ = d²/ds² g(q + s q̇) at s = 0 (no t); Richardson on central differences
   auto g_at = [&](double s) {
@@ -124,7 +125,7 @@ TEST(Expression, ComplexOrHugeConstantsAreRefusedNotHandedToGiNaC) {
   EXPECT_HAS(compile_message("atan2(log(-cos(0)), 0)*xA"), "not a finite real number (NaN)");
   EXPECT_HAS(compile_message("xA/(1 - 1)"), "division by zero");
   EXPECT_HAS(compile_message("xA/0"), "division by zero");
-  EXPECT_HAS(compile_message("xA/(xA - xA)"), "division by zero");  // GiNaC's own refusal, one line
+  EXPECT_HAS(compile_message("xA/(xA - xA)"), "division by zero");            // GiNaC's own refusal, one line
   EXPECT_HAS(compile_message("xA/((t - (3 + t)) + 3)"), "division by zero");  // two 3s, two symbols to GiNaC
   EXPECT_HAS(compile_message("xA - 1e400"), "number '1e400' is out of the range of a double");
 }
@@ -195,8 +196,8 @@ TEST(Expression, LiteralsFoldToTheValuesTheTextMeans) {
 // The value, gradient, ∂/∂t and γ of e at (q, t) along (q̇, 1) against central differences (Richardson for γ):
 // the check of every order the tapes provide. `scale` is the size of the derivatives checked (tolerances relative
 // to it). All of them must be finite.
-void expect_derivatives_match_differences(const CompiledExpression& e, const double q[3], const double qd[3],
-                                          double t, double scale) {
+void expect_derivatives_match_differences(const CompiledExpression& e, const double q[3], const double qd[3], double t,
+                                          double scale) {
   const std::vector<Index>& cols = e.coordinates();
   std::vector<double> grad(cols.size());
   e.gradient(q, t, grad.data());
@@ -356,8 +357,8 @@ TEST(Expression, AngleDifferenceIsRecognisedFromTheTopLevelForm) {
   EXPECT_TRUE(angle("atan2(yA - 0.25, xA - 0.5) - t"));
   EXPECT_TRUE(angle("-atan2(yA, xA) + theta2"));
   EXPECT_TRUE(angle("atan2(yA, xA) - atan2(xA, yA) - 0.3*t^2"));
-  EXPECT_FALSE(angle("2*atan2(yA, xA) - t"));       // jumps by 4π
-  EXPECT_FALSE(angle("sin(atan2(yA, xA)) - t"));    // no jump at all
+  EXPECT_FALSE(angle("2*atan2(yA, xA) - t"));     // jumps by 4π
+  EXPECT_FALSE(angle("sin(atan2(yA, xA)) - t"));  // no jump at all
   EXPECT_FALSE(angle("atan2(yA, xA)*xA - t"));
   EXPECT_FALSE(angle("theta2 - t"));
   EXPECT_FALSE(angle("atan(yA/xA) - t"));
@@ -404,10 +405,12 @@ TEST(Expression, RateAlongItsConstantsOfARebindingMatchesTheirDifferences) {
   h->gradient(q, t, dh);
   for (int k = 0; k < 2; ++k)
     EXPECT_NEAR(dh[k], fd([&](const CompiledExpression& x) {
-      double dg[2];
-      x.gradient(q, t, dg);
-      return dg[k];
-    }), 1e-10) << "column " << k;
+                  double dg[2];
+                  x.gradient(q, t, dg);
+                  return dg[k];
+                }),
+                1e-10)
+        << "column " << k;
   // another member, its constant moving alike: the same derivative on its own coordinates
   EXPECT_EQ(base(L)->rebind({1, -1, 3}, {0.0, c, 0.0}, text)->along_constants({rL, rc})->coordinates(),
             (std::vector<Index>{1, 3}));

@@ -382,8 +382,8 @@ TEST(Generate, FamilyFormIsTheExplicitModel) {
     std::int64_t n;
   };
   for (Case c : {Case{"scissor", 1}, Case{"scissor", 2}, Case{"scissor", 7}, Case{"grid", 1}, Case{"grid", 2},
-                 Case{"grid", 3}, Case{"grid", 5}, Case{"grid", 7}, Case{"grid", 9}, Case{"grid", 10},
-                 Case{"grid", 13}, Case{"grid", 20}, Case{"grid", 30}})
+                 Case{"grid", 3}, Case{"grid", 5}, Case{"grid", 7}, Case{"grid", 9}, Case{"grid", 10}, Case{"grid", 13},
+                 Case{"grid", 20}, Case{"grid", 30}})
     for (const char* coords : {"natural", "reference-point"})
       for (auto [from, to] : {std::pair{0.3, 1.2}, std::pair{1.1, 0.4}}) {
         SCOPED_TRACE(std::string(c.kind) + " " + std::to_string(c.n) + " " + coords + " " + std::to_string(from));

@@ -30,14 +30,17 @@ HardRows sweep_hard_scene(const Scene& sc, int threads) {
   opt.residuals = true;
   HardRows r;
   Workspace ws(*sc.model);
-  r.status = run_sweep(*sc.model, opt, ws, [&](const StepView& s) {
-    r.tr.t.push_back(s.t);
-    r.tr.q.push_back(s.q);
-    if (s.qd) r.tr.qd.push_back(*s.qd);
-    if (s.qdd) r.tr.qdd.push_back(*s.qdd);
-    r.residual.push_back(s.phi ? scaled_residual(*sc.model, *s.phi) : INFINITY);
-    return true;
-  }, &r.sum);
+  r.status = run_sweep(
+      *sc.model, opt, ws,
+      [&](const StepView& s) {
+        r.tr.t.push_back(s.t);
+        r.tr.q.push_back(s.q);
+        if (s.qd) r.tr.qd.push_back(*s.qd);
+        if (s.qdd) r.tr.qdd.push_back(*s.qdd);
+        r.residual.push_back(s.phi ? scaled_residual(*sc.model, *s.phi) : INFINITY);
+        return true;
+      },
+      &r.sum);
   return r;
 }
 
@@ -80,11 +83,13 @@ TEST(HardCases, MillimetresAgreeWithMetres) {
     unit[static_cast<std::size_t>(j)] = is_angle(name) ? 1.0 : 1e-3;
     // scales: the coordinate's shortest link, 1000× in millimetres
     EXPECT_DOUBLE_EQ(b.tolerance_scales().coordinate_scale(j),
-                     (is_angle(name) ? 1.0 : 1000.0) * a.tolerance_scales().coordinate_scale(j)) << name;
+                     (is_angle(name) ? 1.0 : 1000.0) * a.tolerance_scales().coordinate_scale(j))
+        << name;
   }
   for (Index i = 0; i < a.num_equations(); ++i)
     EXPECT_DOUBLE_EQ(b.tolerance_scales().row_scale(i),
-                     (a.row_unit(i) == Unit::kLength ? 1000.0 : 1.0) * a.tolerance_scales().row_scale(i)) << a.row_name(i);
+                     (a.row_unit(i) == Unit::kLength ? 1000.0 : 1.0) * a.tolerance_scales().row_scale(i))
+        << a.row_name(i);
   EXPECT_DOUBLE_EQ(a.tolerance_scales().row_scale(0), 0.4);  // crank[0]: its own length, not the model's 1.2 m
 
   for (int threads : {1, 2}) {
@@ -156,11 +161,12 @@ TEST(HardCases, LengthsFromMillimetresToKilometres) {
       e_a = std::max({e_a, std::fabs(Q(xa) - r * cs), std::fabs(Q(ya) - r * sn)});
       e_b = std::max(e_b, std::fabs(Q(xb) - x));
       e_v = std::max({e_v, std::fabs(V(xa) + r * w * sn), std::fabs(V(ya) - r * w * cs), std::fabs(V(xb) - v)});
-      e_acc = std::max({e_acc, std::fabs(A(xa) + r * w * w * cs), std::fabs(A(ya) + r * w * w * sn),
-                        std::fabs(A(xb) - a)});
+      e_acc =
+          std::max({e_acc, std::fabs(A(xa) + r * w * w * cs), std::fabs(A(ya) + r * w * w * sn), std::fabs(A(xb) - a)});
     }
-    std::printf("crank_slider_span, %s: crank tip %.3g r, slider %.3g m, velocities %.3g r w, accelerations %.3g r w^2\n",
-                what.c_str(), e_a / r, e_b, e_v / (r * w), e_acc / (r * w * w));
+    std::printf(
+        "crank_slider_span, %s: crank tip %.3g r, slider %.3g m, velocities %.3g r w, accelerations %.3g r w^2\n",
+        what.c_str(), e_a / r, e_b, e_v / (r * w), e_acc / (r * w * w));
     // positions: each to the tolerance of its own link (crank tip measured 1e-16 r; slider 7.7e-12 m in order —
     // the assembly, then 1 ulp of 1000 m —, 2.3e-9 m at the first row of a parallel chunk)
     EXPECT_LE(e_a, kTol * r) << what;
@@ -199,13 +205,16 @@ ChainRun long_chain(bool derivatives) {
   Workspace ws(m);
   const auto exact = test::nfourbar_exact(m, M_PI / 4, M_PI / 2);
   tools::ClosedFormErrors err(*exact);
-  const SolveStatus st = run_sweep(m, opt, ws, [&](const StepView& s) {
-    r.finite = r.finite && s.q.allFinite() && s.phi && s.phi->allFinite() && (!s.qd || s.qd->allFinite()) &&
-               (!s.qdd || s.qdd->allFinite());
-    r.residual.push_back(s.phi ? scaled_residual(m, *s.phi) : INFINITY);
-    r.deviation.push_back(err.add(s.t, s.q.data(), s.qd ? s.qd->data() : nullptr, s.qdd ? s.qdd->data() : nullptr));
-    return true;
-  }, &r.sum);
+  const SolveStatus st = run_sweep(
+      m, opt, ws,
+      [&](const StepView& s) {
+        r.finite = r.finite && s.q.allFinite() && s.phi && s.phi->allFinite() && (!s.qd || s.qd->allFinite()) &&
+                   (!s.qdd || s.qdd->allFinite());
+        r.residual.push_back(s.phi ? scaled_residual(m, *s.phi) : INFINITY);
+        r.deviation.push_back(err.add(s.t, s.q.data(), s.qd ? s.qd->data() : nullptr, s.qdd ? s.qdd->data() : nullptr));
+        return true;
+      },
+      &r.sum);
   r.deviation_v = err.v_error, r.deviation_a = err.a_error;
   EXPECT_EQ(st, SolveStatus::kSuccess) << r.sum.message;
   EXPECT_EQ(r.residual.size(), static_cast<std::size_t>(kChainSteps + 1));
@@ -230,27 +239,27 @@ void expect_no_drift(const ChainRun& r, const char* what) {
   const double first100 = max_of(r.residual, 1, 101), last100 = max_of(r.residual, kChainSteps - 99, kChainSteps + 1);
   EXPECT_LE(last100, 10.0 * first100) << what << ": first 100 steps " << first100 << ", last 100 " << last100;
   for (std::size_t k = 0; k < r.deviation.size(); ++k) EXPECT_LE(r.deviation[k], 1e-9) << what << " step " << k;
-  std::printf("%s: residual step 1 %.3g, step %ld %.3g, max of steps 1-100 %.3g, of the last 100 %.3g; deviation "
-              "max %.3g, velocities %.3g, accelerations %.3g; %ld Newton iterations, %ld factorisations, %.2f s\n",
-              what, r.residual[1], static_cast<long>(kChainSteps), r.residual[kChainSteps], first100, last100,
-              max_of(r.deviation, 0, r.deviation.size()), r.deviation_v, r.deviation_a,
-              static_cast<long>(r.sum.counters.newton_iterations), static_cast<long>(r.sum.counters.factorizations),
-              r.sum.solve_seconds);
+  std::printf(
+      "%s: residual step 1 %.3g, step %ld %.3g, max of steps 1-100 %.3g, of the last 100 %.3g; deviation "
+      "max %.3g, velocities %.3g, accelerations %.3g; %ld Newton iterations, %ld factorisations, %.2f s\n",
+      what, r.residual[1], static_cast<long>(kChainSteps), r.residual[kChainSteps], first100, last100,
+      max_of(r.deviation, 0, r.deviation.size()), r.deviation_v, r.deviation_a,
+      static_cast<long>(r.sum.counters.newton_iterations), static_cast<long>(r.sum.counters.factorizations),
+      r.sum.solve_seconds);
 }
 
 // Positions, velocities and accelerations (the cubic predictor; Φq factorised at every solution for q̇ and q̈): the
 // prediction errs by about 1e-12 m here, so most steps are accepted without a Newton step, each carrying the error
-// of the one before plus its own extrapolation's (the error budget, Sweeper::predict() in engine/src/sweep/predictors.cpp), and a Newton step comes
-// when that sum reaches the tolerance. So the residual of a step lies anywhere below the tolerance (single steps
-// say nothing; the windows of expect_no_drift do), every position stays within 2 tolerances of the parallelogram
-// (measured 9.2e-11 m), and there are a few Newton steps, not one per step (measured 16 in 1000). Velocities and
-// accelerations: the linear solves along the chain, within 1e-9 of the exact θ̇ = π/2 rad/s motion (measured
-// 1.4e-10 and 2.4e-10).
-// A four-bar of a 10⁶ m ground and coupler on a 10⁻⁶ m crank and a 1.5·10⁻⁶ m rocker, natural coordinates, placed
-// with B 0.4 rad of rocker off: the coupler's row, held to tol · 10⁶ m = 10⁻⁴ m, passes at the placement, which was
-// taken as the first row (the rocker 0.73 rad off the closed form, exit 0). The placement is now taken only after
-// a Newton step from it is within the tolerance: every row is as close to the closed form as double precision
-// allows (B's x near 10⁶ m is known to an ulp, 1.2·10⁻¹⁰ m, 8·10⁻⁵ rad of the rocker).
+// of the one before plus its own extrapolation's (the error budget, Sweeper::predict() in
+// engine/src/sweep/predictors.cpp), and a Newton step comes when that sum reaches the tolerance. So the residual of a
+// step lies anywhere below the tolerance (single steps say nothing; the windows of expect_no_drift do), every position
+// stays within 2 tolerances of the parallelogram (measured 9.2e-11 m), and there are a few Newton steps, not one per
+// step (measured 16 in 1000). Velocities and accelerations: the linear solves along the chain, within 1e-9 of the exact
+// θ̇ = π/2 rad/s motion (measured 1.4e-10 and 2.4e-10). A four-bar of a 10⁶ m ground and coupler on a 10⁻⁶ m crank and
+// a 1.5·10⁻⁶ m rocker, natural coordinates, placed with B 0.4 rad of rocker off: the coupler's row, held to tol · 10⁶ m
+// = 10⁻⁴ m, passes at the placement, which was taken as the first row (the rocker 0.73 rad off the closed form, exit
+// 0). The placement is now taken only after a Newton step from it is within the tolerance: every row is as close to the
+// closed form as double precision allows (B's x near 10⁶ m is known to an ulp, 1.2·10⁻¹⁰ m, 8·10⁻⁵ rad of the rocker).
 TEST(HardCases, BadlyScaledFourBarIsSolvedToWhatDoublesAllowFromItsFirstRow) {
   const Scene sc = parse_scene(R"Y(phiq: 1
 parameters: {L1: 1e6, L2: 1e-6, L3: 1e6, L4: 1.5e-6}
@@ -264,23 +273,27 @@ constraints:
 drivers:
   - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 1}}
 time: {start: 0, end: 2*pi, steps: 72}
-)Y", "badly_scaled.yaml");
+)Y",
+                               "badly_scaled.yaml");
   const double L1 = 1e6, L2 = 1e-6, L4 = 1.5e-6;  // L3 = L1 (the closed form below uses it so)
   const Index xB = sc.model->coordinate_index("xB"), yB = sc.model->coordinate_index("yB");
   Workspace ws(*sc.model);
   SweepSummary sum;
   double worst = 0.0;
-  const SolveStatus st = run_sweep(*sc.model, sc.sweep, ws, [&](const StepView& v) {
-    // the closed form about C, free of cancellation: B·A' = (L4² + |A'|² − L3²)/2 with A' = A − C, L1 = L3
-    const double th = v.t, ax = L2 * std::cos(th), ay = L2 * std::sin(th);
-    const double k = 0.5 * (L4 * L4 + (-2 * L1 * ax + ax * ax + ay * ay));
-    const double px = ax - L1, py = ay, r = std::hypot(px, py), a0 = std::atan2(py, px);
-    const double c = std::acos(std::clamp(k / (L4 * r), -1.0, 1.0));
-    const double phi = std::atan2(v.q[yB], v.q[xB] - L1);
-    worst = std::max(worst, std::min(std::fabs(std::remainder(phi - a0 - c, 2 * M_PI)),
-                                     std::fabs(std::remainder(phi - a0 + c, 2 * M_PI))));
-    return true;
-  }, &sum);
+  const SolveStatus st = run_sweep(
+      *sc.model, sc.sweep, ws,
+      [&](const StepView& v) {
+        // the closed form about C, free of cancellation: B·A' = (L4² + |A'|² − L3²)/2 with A' = A − C, L1 = L3
+        const double th = v.t, ax = L2 * std::cos(th), ay = L2 * std::sin(th);
+        const double k = 0.5 * (L4 * L4 + (-2 * L1 * ax + ax * ax + ay * ay));
+        const double px = ax - L1, py = ay, r = std::hypot(px, py), a0 = std::atan2(py, px);
+        const double c = std::acos(std::clamp(k / (L4 * r), -1.0, 1.0));
+        const double phi = std::atan2(v.q[yB], v.q[xB] - L1);
+        worst = std::max(worst, std::min(std::fabs(std::remainder(phi - a0 - c, 2 * M_PI)),
+                                         std::fabs(std::remainder(phi - a0 + c, 2 * M_PI))));
+        return true;
+      },
+      &sum);
   ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
   EXPECT_LT(worst, 1e-4);
 }
@@ -311,9 +324,10 @@ TEST(HardCases, LongChainPositionsOnlyDoNotDrift) {
 // instead of refactorising in search of a contraction that cannot come: the sweep succeeds, warns once per stretch
 // of such rows, naming the coordinate and how well it is known, costs hardly more factorisations than at the
 // default tolerance (1e-10, where no row warns), and its positions, velocities and accelerations are as close to
-// the closed form L_k = (0, k sin θ), R_k = (cos θ, k sin θ) as the default's (measured: 1.2e-10 and 1.1e-10 m at the top, 600 m up, with the quadratic
-// predictor; 2.1e-10 m at the default with the cubic one, whose rows take one Newton step each: the top joints are
-// at their rounding level, about 1.2 tolerances, which a step's error estimate does not see).
+// the closed form L_k = (0, k sin θ), R_k = (cos θ, k sin θ) as the default's (measured: 1.2e-10 and 1.1e-10 m at the
+// top, 600 m up, with the quadratic predictor; 2.1e-10 m at the default with the cubic one, whose rows take one Newton
+// step each: the top joints are at their rounding level, about 1.2 tolerances, which a step's error estimate does not
+// see).
 TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   Scene sc = parse_scene(tools::generate_scene(test::generate_options("scissor", 2000, "natural", 0.3, 1.2, 1000)),
                          "scissor.yaml");
@@ -437,12 +451,14 @@ TEST(HardCases, LongChainBelowItsRoundingLevelStopsThereAndSaysSo) {
   ASSERT_EQ(p.status, SolveStatus::kSuccess) << p.sum.message;
   for (const SweepWarning& w : p.sum.warnings) EXPECT_NE(w.kind, "parallel_fallback") << w.message;
   EXPECT_EQ(p.sum.parallel_chunks, 4);
-  EXPECT_LE(deviation(p), 3e-10);  // as the sequential sweep (measured 1.7–1.8e-10)
+  EXPECT_LE(deviation(p), 3e-10);              // as the sequential sweep (measured 1.7–1.8e-10)
   EXPECT_LE(derivative_deviation(p), 1.5e-9);  // measured 8.1e-10
-  std::printf("deviation from the closed form: tolerance 1e-10 %.3g, 1e-16 (rounding-level stops) %.3g, in parallel "
-              "chunks %.3g; q̇, q̈ relative %.3g, %.3g, %.3g; factorisations %ld, %ld\n", deviation(usual), deviation(r),
-              deviation(p), derivative_deviation(usual), derivative_deviation(r), derivative_deviation(p),
-              static_cast<long>(usual.sum.counters.factorizations), static_cast<long>(r.sum.counters.factorizations));
+  std::printf(
+      "deviation from the closed form: tolerance 1e-10 %.3g, 1e-16 (rounding-level stops) %.3g, in parallel "
+      "chunks %.3g; q̇, q̈ relative %.3g, %.3g, %.3g; factorisations %ld, %ld\n",
+      deviation(usual), deviation(r), deviation(p), derivative_deviation(usual), derivative_deviation(r),
+      derivative_deviation(p), static_cast<long>(usual.sum.counters.factorizations),
+      static_cast<long>(r.sum.counters.factorizations));
 }
 
 // What a workspace carries between sweeps (the LU's pivot order, the Newton contraction) may move the last bits of

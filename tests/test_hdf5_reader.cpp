@@ -43,9 +43,8 @@ std::string make_file(const TempDir& tmp, const std::string& name, const char* r
   if (version) h5::write_attribute(f.get(), "format_version", version);
   const hsize_t n = 3;
   const h5::Hid space = h5::checked(H5Screate_simple(1, &n, nullptr), H5Sclose, "t");
-  const h5::Hid t =
-      h5::checked(H5Dcreate2(f.get(), "t", H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
-                  H5Dclose, "t");
+  const h5::Hid t = h5::checked(
+      H5Dcreate2(f.get(), "t", H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose, "t");
   const double v[3] = {0.0, 0.5, 1.0};
   h5::check(H5Dwrite(t.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v), "t");
   h5::write_attribute(t.get(), "columns", std::vector<std::string>{"t"});

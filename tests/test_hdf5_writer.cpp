@@ -44,11 +44,14 @@ Written write_both(const Scene& scene, const std::string& h5_path, Hdf5Options o
   w.csv = csv.header();
   Hdf5Writer h5w(h5_path, *scene.model, scene.sweep, options);
   SweepSummary sum;
-  (void)run_sweep(model, scene.sweep, ws, [&](const StepView& s) {  // its status is sum.status, checked below
-    csv.append_row(s, w.csv);
-    h5w.append_row(s);
-    return true;
-  }, &sum);
+  (void)run_sweep(
+      model, scene.sweep, ws,
+      [&](const StepView& s) {  // its status is sum.status, checked below
+        csv.append_row(s, w.csv);
+        h5w.append_row(s);
+        return true;
+      },
+      &sum);
   EXPECT_EQ(sum.status, SolveStatus::kSuccess) << sum.message;
   w.rows = h5w.rows();
   w.block_rows = h5w.block_rows();
@@ -188,13 +191,16 @@ TEST(Hdf5Writer, PackedRowsHoldTheCsvDoubles) {
   std::string text = csv.header(), packed;
   std::vector<double> row(csv.num_values());
   SweepSummary sum;
-  (void)run_sweep(*solved, scene.sweep, ws, [&](const StepView& s) {  // its status is sum.status, checked below
-    csv.append_row(s, text);
-    csv.append_values(s, row.data());
-    packed.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(double));
-    if (packed.size() == 7 * row.size() * sizeof(double)) h5w.append_packed_rows(packed), packed.clear();
-    return true;
-  }, &sum);
+  (void)run_sweep(
+      *solved, scene.sweep, ws,
+      [&](const StepView& s) {  // its status is sum.status, checked below
+        csv.append_row(s, text);
+        csv.append_values(s, row.data());
+        packed.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(double));
+        if (packed.size() == 7 * row.size() * sizeof(double)) h5w.append_packed_rows(packed), packed.clear();
+        return true;
+      },
+      &sum);
   ASSERT_EQ(sum.status, SolveStatus::kSuccess) << sum.message;
   h5w.append_packed_rows(packed);
   EXPECT_EQ(h5w.rows(), 73u);

@@ -77,8 +77,8 @@ TEST(HeaderLayering, NoHeaderReachesItself) {
 // The output plan and the step view, and the writers that read them, include neither the sweep nor the solver
 // (directly or through another phiq header): a writer is built against the plan and the model.
 TEST(HeaderLayering, ThePlanAndTheWritersIncludeNoSweepOrSolver) {
-  const std::vector<std::string> above = {"phiq/sweep.hpp",    "phiq/sensitivity.hpp", "phiq/stepper.hpp",
-                                          "phiq/batch.hpp",    "phiq/scene.hpp",       "phiq/kinematics.hpp",
+  const std::vector<std::string> above = {"phiq/sweep.hpp",    "phiq/sensitivity.hpp",  "phiq/stepper.hpp",
+                                          "phiq/batch.hpp",    "phiq/scene.hpp",        "phiq/kinematics.hpp",
                                           "phiq/assembly.hpp", "phiq/rank_analysis.hpp"};
   for (const char* header : {"phiq/output_plan.hpp", "phiq/csv_writer.hpp", "phiq/hdf5_writer.hpp"}) {
     const std::set<std::string> reached = reached_from(header);

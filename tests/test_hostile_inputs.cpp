@@ -25,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Case {
-  std::string file, name;           // the catalogue file (category) and the case's name
+  std::string file, name;  // the catalogue file (category) and the case's name
   std::map<std::string, std::string> files, copies;
   std::string setup, prefix, run;
   int exit = 0;
@@ -33,9 +33,9 @@ struct Case {
   std::map<std::string, std::string> match;  // file -> regex searched in its bytes afterwards
   int lines = 1;
   std::vector<std::string> keep, absent, created;
-  bool any_files = false;           // `created: any`: the command may leave other files (checked by `absent`)
+  bool any_files = false;  // `created: any`: the command may leave other files (checked by `absent`)
   double timeout = 30;
-  bool sanitizers = true;           // `sanitizers: false`: not run in a sanitizer build (limits ASan cannot run under)
+  bool sanitizers = true;  // `sanitizers: false`: not run in a sanitizer build (limits ASan cannot run under)
 };
 
 // `%xHH` in a case's texts is the byte HH, so that a catalogue in UTF-8 can hold the invalid bytes of hostile input.
@@ -90,7 +90,8 @@ std::vector<Case> load_catalogue() {
       if (n["stderr"]) c.stderr_regex = unescape(n["stderr"].as<std::string>());
       if (n["stdout"]) c.stdout_regex = unescape(n["stdout"].as<std::string>());
       if (n["match"])
-        for (const auto& kv : n["match"]) c.match[unescape(kv.first.as<std::string>())] = unescape(kv.second.as<std::string>());
+        for (const auto& kv : n["match"])
+          c.match[unescape(kv.first.as<std::string>())] = unescape(kv.second.as<std::string>());
       if (n["lines"]) c.lines = n["lines"].as<int>();
       if (n["timeout"]) c.timeout = n["timeout"].as<double>();
       if (n["sanitizers"]) c.sanitizers = n["sanitizers"].as<bool>();
@@ -196,8 +197,8 @@ TEST_P(Hostile, Case) {
   const fs::path err = dir.parent_path() / ("phiq_hostile_" + c.file + "_" + c.name + ".stderr");
   std::ostringstream cmd;
   cmd << "cd " << shell_quote(dir.string()) << " && { " << c.prefix << " timeout -s KILL " << c.timeout << " "
-      << PHIQ_CLI << " " << c.run << " </dev/null >" << shell_quote(out.string()) << " 2>"
-      << shell_quote(err.string()) << "; }";
+      << PHIQ_CLI << " " << c.run << " </dev/null >" << shell_quote(out.string()) << " 2>" << shell_quote(err.string())
+      << "; }";
   const int st = std::system(cmd.str().c_str());
   const int code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
   const std::string stderr_text = slurp(err), stdout_text = slurp(out);
@@ -213,8 +214,8 @@ TEST_P(Hostile, Case) {
       EXPECT_EQ(stderr_text.rfind("phiq: ", 0), 0u) << "stderr: " << stderr_text;
     }
     // (matched without the final newline, so that `$` ends the line)
-    const std::string line = stderr_text.empty() || stderr_text.back() != '\n' ? stderr_text
-                                                                              : stderr_text.substr(0, stderr_text.size() - 1);
+    const std::string line =
+        stderr_text.empty() || stderr_text.back() != '\n' ? stderr_text : stderr_text.substr(0, stderr_text.size() - 1);
     EXPECT_TRUE(std::regex_search(line, std::regex(c.stderr_regex)))
         << "stderr: " << stderr_text << "does not match: " << c.stderr_regex;
     // what phiq writes on stderr is text a terminal and a log can hold: no NUL, no invalid UTF-8 left raw

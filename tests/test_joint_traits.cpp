@@ -60,8 +60,8 @@ std::vector<JointForm> joint_forms() {
   ConstraintKinds::for_each([&]<class K>() {
     if constexpr (SpatialJointKind<K>)
       for (const SceneForm& f : K::kScene)
-        if (std::string_view(f.section) == "constraints" && std::string_view(f.example).find("between:") !=
-                                                                std::string_view::npos)
+        if (std::string_view(f.section) == "constraints" &&
+            std::string_view(f.example).find("between:") != std::string_view::npos)
           forms.push_back({K::kKind, f.type, joint_traits<K>(), f.example});
   });
   return forms;
@@ -118,10 +118,9 @@ TEST(JointTraits, OutputJointsAcceptEveryJointThatMeasuresAndNoOther) {
 }
 
 TEST(JointTraits, JointDriversAcceptWhatTheJointDrivesAndNothingElse) {
-  const std::string refusal = "drivers measure the angle of a " +
-                              list_of([](const JointTraits& t) { return t.drives.angle; }) +
-                              " joint, or the distance of a " +
-                              list_of([](const JointTraits& t) { return t.drives.distance; }) + " one";
+  const std::string refusal =
+      "drivers measure the angle of a " + list_of([](const JointTraits& t) { return t.drives.angle; }) +
+      " joint, or the distance of a " + list_of([](const JointTraits& t) { return t.drives.distance; }) + " one";
   int driven = 0;
   for (const JointForm& f : joint_forms()) {
     SCOPED_TRACE(f.kind + " (" + f.type + ")");
@@ -156,8 +155,7 @@ TEST(JointTraits, ShaftsAreTheJointsThatTurnAboutTheirAxis) {
   int shafts = 0;
   for (const JointForm& f : joint_forms()) {
     SCOPED_TRACE(f.kind + " (" + f.type + ")");
-    const std::string text =
-        scene_with(f, "  - {name: turn, type: rotation_angle, joint: J, angle: theta}\n", "");
+    const std::string text = scene_with(f, "  - {name: turn, type: rotation_angle, joint: J, angle: theta}\n", "");
     if (f.traits.shaft) {
       ++shafts;
       EXPECT_NO_THROW(parse_scene(text, "joint.yaml"));

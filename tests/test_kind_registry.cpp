@@ -89,9 +89,8 @@ TEST(KindRegistry, EverySceneExampleIsDocumentedInTheModelsReadme) {
   const std::string readme = read_file(PHIQ_SOURCE_DIR "/models/README.md");
   ASSERT_FALSE(readme.empty());
   for (const FormOf& f : all_forms())
-    EXPECT_NE(readme.find(f.example), std::string::npos)
-        << "models/README.md lacks the example of kind '" << f.kind << "' (" << f.section << ", " << f.type
-        << "): " << f.example;
+    EXPECT_NE(readme.find(f.example), std::string::npos) << "models/README.md lacks the example of kind '" << f.kind
+                                                         << "' (" << f.section << ", " << f.type << "): " << f.example;
 }
 
 TEST(KindRegistry, EveryConstraintTypeIsInTheFuzzingDictionary) {
@@ -199,14 +198,15 @@ TEST(KindRegistry, TheReadmesListTheJointTypesOfTheJointTraits) {
     EXPECT_FALSE(types.empty());
     return types;
   };
-  const std::set<std::string> measured = traits_say([](const phiq::JointTraits& t) { return t.measures.any(); }),
-                              driven = traits_say([](const phiq::JointTraits& t) { return t.drives.any(); }),
-                              shafts = traits_say([](const phiq::JointTraits& t) { return t.shaft; });
+  const std::set<std::string> measured = traits_say([](const phiq::JointTraits&t) { return t.measures.any(); }),
+                              driven = traits_say([](const phiq::JointTraits&t) { return t.drives.any(); }),
+                              shafts = traits_say([](const phiq::JointTraits&t) { return t.shaft; });
   const std::string models = read_file(PHIQ_SOURCE_DIR "/models/README.md"),
                     tools = read_file(PHIQ_SOURCE_DIR "/tools/README.md");
   EXPECT_EQ(joint_types_named(models, "| `joints` |", "\n"), measured) << "models/README.md, output: joints";
   EXPECT_EQ(joint_types_named(tools, "per joint J of `output.joints`", "\n"), measured) << "tools/README.md";
-  EXPECT_EQ(joint_types_named(models, "| `joint: J`, `measure: angle` or `distance` |", "\n"), driven) << "models/README.md, joint drivers";
+  EXPECT_EQ(joint_types_named(models, "| `joint: J`, `measure: angle` or `distance` |", "\n"), driven)
+      << "models/README.md, joint drivers";
   EXPECT_EQ(joint_types_named(models, "`shafts: [J1, J2]`", ")"), shafts) << "models/README.md, spatial_gear";
   EXPECT_EQ(joint_types_named(models, "`joint: J` (a named", ")"), shafts) << "models/README.md, rotation_angle";
 }

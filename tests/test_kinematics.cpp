@@ -73,7 +73,7 @@ TEST(Kinematics, NotesWorkedExampleJacobianAndGamma) {
     for (Index k = p.col_ptr[c]; k < p.col_ptr[c + 1]; ++k) J(p.row_idx[k], c) = vals[k];
   Eigen::MatrixXd notes(4, 4);
   notes << kL2 * std::sin(th), 1, 0, 0,  //
-      -kL2 * std::cos(th), 0, 1, 0,       //
+      -kL2 * std::cos(th), 0, 1, 0,      //
       0, 2 * xa - 2 * xb, 2 * ya, 2 * xb - 2 * xa, 1, 0, 0, 0;
   notes.row(2) /= 2 * kL3;
   // phiq orders rows as added: crank (2 rows), rod, motor — the same order as the notes.
@@ -305,8 +305,7 @@ TEST(Kinematics, AStepWithinTheLevelQIsKnownToEndsTheSolve) {
   EXPECT_FALSE(known.rounding_measured) << "an end within the level measures nothing a sweep should carry";
   EXPECT_TRUE(known.slow_convergence);
   EXPECT_FALSE(known.linear_convergence) << "a stop at the level q is known to, not a singular position";
-  EXPECT_NE(known.message.find("within the level q can be known to here"), std::string::npos)
-      << known.message;
+  EXPECT_NE(known.message.find("within the level q can be known to here"), std::string::npos) << known.message;
   EXPECT_NEAR(ws.q(3), exact(3), 1e-12);  // Newton's step itself is as good as ever
 
   // The slider driven next to its dead centre (θ = 2e-5 rad): Φq's pivot ratio is about 1e-5
@@ -485,8 +484,9 @@ TEST(Kinematics, RoundingFloorIsTheRowsSensitivityToItsCoordinates) {
   Model m = std::move(b).build();
   const Eigen::VectorXd q = m.initial_positions();
   const double dx = xb - xa, dy = yb - ya;
-  const double expected = ToleranceScales::kUlpFloor *
-                          (std::fabs(dx) * (std::fabs(xa) + std::fabs(xb)) + std::fabs(dy) * (std::fabs(ya) + std::fabs(yb))) / len;
+  const double expected =
+      ToleranceScales::kUlpFloor *
+      (std::fabs(dx) * (std::fabs(xa) + std::fabs(xb)) + std::fabs(dy) * (std::fabs(ya) + std::fabs(yb))) / len;
   EXPECT_NEAR(m.row_rounding_floor(0, q.data(), 0.0), expected, 1e-14 * expected);
 
   // A driver atan(x) = t at x = 10^26: the row hardly moves with x (∂/∂x = 1/(1 + x²)), so the floor is
@@ -496,7 +496,8 @@ coordinates: {x: 1e26}
 drivers:
   - {name: d, expr: "atan(x)", unit: angle, law: {type: linear, initial: 0, rate: 1}}
 time: {start: 0, end: 2, steps: 4}
-)Y", "atan.yaml");
+)Y",
+                               "atan.yaml");
   const Eigen::VectorXd qx = sc.model->initial_positions();
   EXPECT_NEAR(sc.model->row_rounding_floor(0, qx.data(), 2.0), ToleranceScales::kUlpFloor * 1e26 / (1.0 + 1e52), 1e-52);
   EXPECT_THROW(sc.model->row_rounding_floor(1, qx.data(), 2.0), Error);
@@ -509,16 +510,19 @@ TEST(Kinematics, ADriveBeyondAnAsymptoteFailsWhereThePositionsStopExisting) {
   for (const auto& [expr, rate, t_star] : {std::tuple{"atan(x)", 1.0, M_PI / 2}, std::tuple{"1/x", -1.0, 1.0}}) {
     const std::string start = rate > 0 ? "0" : "1";
     const std::string text = "coordinates: {x: " + start + "}\ndrivers:\n  - {name: d, expr: \"" + expr +
-                             "\", unit: angle, law: {type: linear, initial: " + start + ", rate: " +
-                             std::to_string(rate) + "}}\ntime: {start: 0, end: 2, steps: 4}\n";
+                             "\", unit: angle, law: {type: linear, initial: " + start +
+                             ", rate: " + std::to_string(rate) + "}}\ntime: {start: 0, end: 2, steps: 4}\n";
     const Scene sc = parse_scene(text, "asymptote.yaml");
     Workspace ws(*sc.model);
     SweepSummary sum;
     double last_t = -1.0;
-    const SolveStatus st = run_sweep(*sc.model, sc.sweep, ws, [&](const StepView& v) {
-      last_t = v.t;
-      return true;
-    }, &sum);
+    const SolveStatus st = run_sweep(
+        *sc.model, sc.sweep, ws,
+        [&](const StepView& v) {
+          last_t = v.t;
+          return true;
+        },
+        &sum);
     EXPECT_NE(st, SolveStatus::kSuccess) << expr;
     EXPECT_LT(last_t, t_star) << expr;
     EXPECT_GT(sum.failed_time, t_star - 0.5) << expr << ": " << sum.message;

@@ -98,7 +98,8 @@ TEST_P(SparseLu, TransposedSolveAndDeterminantSignMatchDenseLu) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Kinds, SparseLu,
-                         ::testing::Values(LinearSolverKind::kUmfpack, LinearSolverKind::kKlu, LinearSolverKind::kDense),
+                         ::testing::Values(LinearSolverKind::kUmfpack, LinearSolverKind::kKlu,
+                                           LinearSolverKind::kDense),
                          [](const auto& info) { return std::string(to_string(info.param)); });
 
 TEST(LinearSolver, KluRefactorisesWithTheOldPivotsWhileTheyHold) {
@@ -165,8 +166,8 @@ TEST(LinearSolver, KluChecksALowPivotRatioWithAPivotSearchBeforeReportingIt) {
 }
 
 // A pinned pivot order (what each workspace of a parallel sweep holds, pinned at row 0):
-// restore_pinned_pivot_order() returns to it, even after a search replaced it, so that the factors of a matrix depend on
-// that matrix and the pinned order only, bit for bit, whatever was factorised in between. A pin needs factors.
+// restore_pinned_pivot_order() returns to it, even after a search replaced it, so that the factors of a matrix depend
+// on that matrix and the pinned order only, bit for bit, whatever was factorised in between. A pin needs factors.
 TEST(LinearSolver, KluReturnsToAPinnedPivotOrderWhateverWasFactorisedSince) {
   Sys s = random_system(300, 7);
   auto sym = analyse(LinearSolverKind::kKlu, s.p);
@@ -258,13 +259,13 @@ TEST(LinearSolver, KluBlockSignsSeeBlocksThatTurnNegativeTogether) {
     EXPECT_EQ(running->block_signs(), fresh->block_signs());
     return std::make_pair(fresh->determinant_sign(), fresh->block_signs());
   };
-  const auto all_positive = signs({2, 2, 2}, {3, 3, 3});             // det 5 each
+  const auto all_positive = signs({2, 2, 2}, {3, 3, 3});  // det 5 each
   // pivots on the blocks' 1s, except where a = d = 1e4 (the 1s then below 1e-3 of their columns): the same
   // signs, other pivot rows
   const auto two_swapped = signs({1e4, 1e4, 2}, {1e4, 1e4, 3});
   const auto two_negative = signs({1e-4, 1e-4, 2}, {1e-4, 1e-4, 3});  // det −1 in blocks 0 and 1
   const auto third_negative = signs({2, 2, 0.01}, {3, 3, 0.01});
-  EXPECT_EQ(two_negative.first, all_positive.first);  // det A keeps its sign ...
+  EXPECT_EQ(two_negative.first, all_positive.first);    // det A keeps its sign ...
   EXPECT_NE(two_negative.second, all_positive.second);  // ... the blocks do not
   EXPECT_EQ(two_swapped, all_positive);
   EXPECT_EQ(third_negative.first, -all_positive.first);
@@ -274,7 +275,8 @@ TEST(LinearSolver, KluBlockSignsSeeBlocksThatTurnNegativeTogether) {
   // a library that factorises A whole has no blocks to tell
   auto dense = analyse(LinearSolverKind::kUmfpack, p)->make_numeric();
   std::vector<double> v(static_cast<std::size_t>(p->nnz()), 1.0);
-  for (Index i = 0; i < 6; ++i) v[static_cast<std::size_t>(slot[static_cast<std::size_t>(4 * (i / 2) + 3 * (i % 2))])] = 3.0;
+  for (Index i = 0; i < 6; ++i)
+    v[static_cast<std::size_t>(slot[static_cast<std::size_t>(4 * (i / 2) + 3 * (i % 2))])] = 3.0;
   ASSERT_EQ(dense->factorize(v.data()), FactorStatus::kOk);
   EXPECT_EQ(dense->block_signs(), 0u);
 }
@@ -450,8 +452,10 @@ TEST(LinearSolver, KluTransversalSearchesTheColumnsInTheOrderThatStaysWithinItsB
         for (Index k = pattern->col_ptr[c]; k < pattern->col_ptr[c + 1]; ++k) {
           const double v = values[static_cast<std::size_t>(k)];
           const Index i = pattern->row_idx[k];
-          if (transposed) r(c) += v * x(i);
-          else r(i) += v * x(c);
+          if (transposed)
+            r(c) += v * x(i);
+          else
+            r(i) += v * x(c);
         }
       return r.cwiseAbs().maxCoeff();
     };

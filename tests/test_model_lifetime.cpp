@@ -26,7 +26,6 @@ Solved solve_at(const Model& m, double t, Workspace& ws) {
   return {ws.q, ws.qd, ws.qdd};
 }
 
-
 TEST(ModelLifetime, WorkspacesFollowModelsOfAGrowingVector) {
   // Reference: the same solves with models that never move.
   std::vector<Solved> expected;

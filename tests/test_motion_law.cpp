@@ -82,7 +82,9 @@ TEST(MotionLaw, ExpressionLawPowersThroughZero) {
     if (n == "t") return NameBinding{NameBinding::Kind::kTime};
     return std::nullopt;
   };
-  auto law = [&](const std::string& text) { return MotionLaw::expression(CompiledExpression::compile(text, time_only)); };
+  auto law = [&](const std::string& text) {
+    return MotionLaw::expression(CompiledExpression::compile(text, time_only));
+  };
   for (int round = 0; round < 4; ++round) {  // GiNaC's term order changes between compilations: each must hold
     LawValue a = law("0.1 + (2*t)^2").evaluate(0.0);
     EXPECT_EQ(a.f, 0.1);
@@ -129,8 +131,7 @@ TEST(MotionLaw, ADefaultConstructedLawHasNoFunctionAndNoDriverTakesIt) {
     return "accepted";
   };
   const std::string refused = "': its motion law has no function (a default-constructed MotionLaw)";
-  EXPECT_EQ(refusal([](ModelBuilder& b) { b.add_driver("motor", 0, MotionLaw{}); }),
-            "constraint 'motor" + refused);
+  EXPECT_EQ(refusal([](ModelBuilder& b) { b.add_driver("motor", 0, MotionLaw{}); }), "constraint 'motor" + refused);
   EXPECT_EQ(refusal([](ModelBuilder& b) { b.add_driver("motor", 0, MotionLaw::linear(0.0, 1.0)); }), "accepted");
   const Frame3 body{Slot::coordinate(0), Slot::coordinate(1), Slot::coordinate(2), Slot::coordinate(3),
                     Slot::coordinate(4), Slot::coordinate(5), Slot::coordinate(6)};
@@ -140,8 +141,8 @@ TEST(MotionLaw, ADefaultConstructedLawHasNoFunctionAndNoDriverTakesIt) {
             }),
             "constraint 'turn" + refused);
   EXPECT_EQ(refusal([&](ModelBuilder& b) {
-              b.add("lift", JointDistanceDriverSpec{JointSide3::body(Frame3::ground(), {}),
-                                                    JointSide3::body(body, {}), MotionLaw{}});
+              b.add("lift", JointDistanceDriverSpec{JointSide3::body(Frame3::ground(), {}), JointSide3::body(body, {}),
+                                                    MotionLaw{}});
             }),
             "constraint 'lift" + refused);
   const auto g = CompiledExpression::compile("x", [](const std::string& name) -> std::optional<NameBinding> {
@@ -151,7 +152,6 @@ TEST(MotionLaw, ADefaultConstructedLawHasNoFunctionAndNoDriverTakesIt) {
   EXPECT_EQ(refusal([&](ModelBuilder& b) { b.add("eq", EquationSpec{g, MotionLaw{}}); }), "constraint 'eq" + refused);
   EXPECT_EQ(refusal([&](ModelBuilder& b) { b.add("eq", EquationSpec{g, std::nullopt}); }), "accepted");
 }
-
 
 // ---- a law's rate along a design parameter ------------------------------------------------------------------------
 
@@ -186,27 +186,31 @@ TEST(MotionLaw, RateAlongItsDataIsExact) {
   check_rate([](double p) { return MotionLaw::harmonic(0.1 + p * p, 0.5 + 0.3 * p, 2.0 + p - 0.2 * p * p, 0.2 * p); },
              0.7, 0.07, 1e-8);
   // an expression: differentiated along the parameters its text reads (CompiledExpression::along_constants())
-  check_rate([](double p) {
-    return MotionLaw::expression(CompiledExpression::compile(
-        "a*sin(a*t) + b*t^2", [p](const std::string& n) -> std::optional<NameBinding> {
-          if (n == "t") return NameBinding{NameBinding::Kind::kTime};
-          if (n == "a") return NameBinding{NameBinding::Kind::kConstant, -1, p};
-          if (n == "b") return NameBinding{NameBinding::Kind::kConstant, -1, 0.5 - p * p};
-          return std::nullopt;
-        }));
-  }, 1.2, 0.12, 1e-8);
+  check_rate(
+      [](double p) {
+        return MotionLaw::expression(
+            CompiledExpression::compile("a*sin(a*t) + b*t^2", [p](const std::string& n) -> std::optional<NameBinding> {
+              if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+              if (n == "a") return NameBinding{NameBinding::Kind::kConstant, -1, p};
+              if (n == "b") return NameBinding{NameBinding::Kind::kConstant, -1, 0.5 - p * p};
+              return std::nullopt;
+            }));
+      },
+      1.2, 0.12, 1e-8);
   // a table's values that move (its times fixed): the spline is linear in the values
-  check_rate([](double p) {
-    return MotionLaw::table({-0.5, 0.4, 1.1, 2.0, 3.5}, {p, 0.2 * p * p, -0.3, 1.0 - p, 0.5 * p});
-  }, 0.7, 0.07, 1e-9);
+  check_rate(
+      [](double p) {
+        return MotionLaw::table({-0.5, 0.4, 1.1, 2.0, 3.5}, {p, 0.2 * p * p, -0.3, 1.0 - p, 0.5 * p});
+      },
+      0.7, 0.07, 1e-9);
 }
 
 TEST(MotionLaw, RateOfLawsWhoseDataDoNotMatchIsTheirDifference) {
   // an expression whose exponent moves (its power of a constant exponent has no rate along it): the four laws
   // are differenced, fourth order in h
   auto expression = [](double p) {
-    return MotionLaw::expression(CompiledExpression::compile(
-        "a*sin(t) + (1 + t)^a", [p](const std::string& n) -> std::optional<NameBinding> {
+    return MotionLaw::expression(
+        CompiledExpression::compile("a*sin(t) + (1 + t)^a", [p](const std::string& n) -> std::optional<NameBinding> {
           if (n == "t") return NameBinding{NameBinding::Kind::kTime};
           if (n == "a") return NameBinding{NameBinding::Kind::kConstant, -1, p};
           return std::nullopt;

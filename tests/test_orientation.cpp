@@ -37,8 +37,7 @@ M of(const RotationMatrix& r) {
   return m;
 }
 
-const char* const kSequences[] = {"xyz", "xzy", "yxz", "yzx", "zxy", "zyx",
-                                  "xyx", "xzx", "yxy", "yzy", "zxz", "zyz"};
+const char* const kSequences[] = {"xyz", "xzy", "yxz", "yzx", "zxy", "zyx", "xyx", "xzx", "yxy", "yzy", "zxz", "zyz"};
 
 TEST(Orientation, AxisAngleIsRodrigues) {
   // R = I cos φ + (1 − cos φ) u uᵀ + sin φ [u]×, for u = (1, 2, 2)/3 and φ = 0.7

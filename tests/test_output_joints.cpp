@@ -47,12 +47,15 @@ JointRows sweep_rows(const Scene& s, int threads) {
   Workspace ws(*s.model);
   JointRows r;
   SweepSummary sum;
-  const SolveStatus st = run_sweep(*s.model, o, ws, [&](const StepView& v) {
-    r.t.push_back(v.t);
-    r.joints.emplace_back(v.joints, v.joints + o.joints.size());
-    if (v.orientations) r.orientations.emplace_back(v.orientations, v.orientations + o.orientations.size());
-    return true;
-  }, &sum);
+  const SolveStatus st = run_sweep(
+      *s.model, o, ws,
+      [&](const StepView& v) {
+        r.t.push_back(v.t);
+        r.joints.emplace_back(v.joints, v.joints + o.joints.size());
+        if (v.orientations) r.orientations.emplace_back(v.orientations, v.orientations + o.orientations.size());
+        return true;
+      },
+      &sum);
   EXPECT_EQ(st, SolveStatus::kSuccess) << sum.message;
   return r;
 }
@@ -132,14 +135,14 @@ TEST(OutputJoints, ColumnsAreNamedAndBadEntriesRefused) {
   CsvFormat f(*s.model, s.sweep);
   const std::vector<std::string> names = f.column_names();
   const std::vector<std::string> tail(names.end() - 19, names.end());
-  EXPECT_EQ(tail, (std::vector<std::string>{
-                      "cyl.angle", "cyl.angle.v", "cyl.angle.a", "cyl.distance", "cyl.distance.v", "cyl.distance.a",
-                      "rail.distance", "rail.distance.v", "rail.distance.a", "screw.ux", "screw.uy", "screw.uz",
-                      "screw.angle", "screw.omega_x", "screw.omega_y", "screw.omega_z", "screw.alpha_x",
-                      "screw.alpha_y", "screw.alpha_z"}));
+  EXPECT_EQ(tail, (std::vector<std::string>{"cyl.angle", "cyl.angle.v", "cyl.angle.a", "cyl.distance", "cyl.distance.v",
+                                            "cyl.distance.a", "rail.distance", "rail.distance.v", "rail.distance.a",
+                                            "screw.ux", "screw.uy", "screw.uz", "screw.angle", "screw.omega_x",
+                                            "screw.omega_y", "screw.omega_z", "screw.alpha_x", "screw.alpha_y",
+                                            "screw.alpha_z"}));
   auto with = [&](const std::string& output) {
-    return test::scene_error(test::replace_first(
-        kScrew, "joints: [cyl, rail], orientations: {bodies: [screw], as: axis_angle}", output));
+    return test::scene_error(
+        test::replace_first(kScrew, "joints: [cyl, rail], orientations: {bodies: [screw], as: axis_angle}", output));
   };
   EXPECT_HAS(with("joints: [cyl, cy]"), "output.joints[1]: unknown joint 'cy'");
   EXPECT_HAS(with("joints: [cyl, cyl]"), "joint listed twice");

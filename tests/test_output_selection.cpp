@@ -29,8 +29,10 @@ constraints:
   - {name: rocker, type: distance, points: [C, B], length: L4}
 drivers:
   - {name: motor, coordinate: theta, law: {type: linear, initial: 0, rate: 3}}
-time: {start: 0, end: 2, steps: )" + std::to_string(steps) + R"(}
-output: )" + output + "\n";
+time: {start: 0, end: 2, steps: )" +
+         std::to_string(steps) + R"(}
+output: )" +
+         output + "\n";
 }
 
 std::string refusal_of(const std::string& output) {
@@ -83,20 +85,24 @@ SweptRows sweep(const Scene& s, int threads, Index chunk) {
   opt.threads = threads;
   opt.chunk_steps = chunk;
   Workspace ws(*s.model);
-  const SolveStatus st = run_sweep(*s.model, opt, ws, [&](const StepView& v) {
-    w.steps.push_back(v.step);
-    w.q.push_back(v.q);
-    w.qd.push_back(*v.qd);
-    w.bx.push_back(v.points[0].r[0]);
-    return true;
-  }, &w.sum);
+  const SolveStatus st = run_sweep(
+      *s.model, opt, ws,
+      [&](const StepView& v) {
+        w.steps.push_back(v.step);
+        w.q.push_back(v.q);
+        w.qd.push_back(*v.qd);
+        w.bx.push_back(v.points[0].r[0]);
+        return true;
+      },
+      &w.sum);
   EXPECT_EQ(st, SolveStatus::kSuccess) << w.sum.message;
   return w;
 }
 
 // Every 4th row within t ∈ [0.5, 1.5] of 24 steps over [0, 2] (h = 1/12): k = 8, 12, 16 (t = 2/3, 1, 4/3; k = 4
 // is t = 1/3 and k = 20 is t = 5/3, outside). The same bits as those rows of the sweep that writes all, on one and
-// two threads, in one chunk and in chunks of 5; points evaluated at the written rows only; every time point solved and counted.
+// two threads, in one chunk and in chunks of 5; points evaluated at the written rows only; every time point solved and
+// counted.
 TEST(OutputSelection, EveryKthRowInAWindowIsTheFullSweepsRowsAndCostsOnlyThem) {
   const Scene all = parse_scene(scene("{velocities: true, points: [B]}"), "sel.yaml");
   const Scene some = parse_scene(scene("{velocities: true, points: [B], every: 4, window: [0.5, 1.5]}"), "sel.yaml");
@@ -116,8 +122,7 @@ TEST(OutputSelection, EveryKthRowInAWindowIsTheFullSweepsRowsAndCostsOnlyThem) {
       }
       EXPECT_EQ(w.sum.steps_completed, 25);
       EXPECT_EQ(w.sum.counters.point_evaluations, 3);
-      EXPECT_EQ(w.sum.accuracy.converged.rows + w.sum.accuracy.rounding_level.rows + w.sum.accuracy.singular.rows,
-                25);
+      EXPECT_EQ(w.sum.accuracy.converged.rows + w.sum.accuracy.rounding_level.rows + w.sum.accuracy.singular.rows, 25);
     }
   }
 }

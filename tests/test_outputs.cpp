@@ -37,8 +37,10 @@ constraints:
   - {name: rocker, type: distance, points: [C, B], length: L4}
 drivers:
   - {name: motor, coordinate: theta2, law: {type: harmonic, offset: 0.5, amplitude: 2, frequency: 1.5}}
-time: {start: 0, end: 2, steps: )" + std::to_string(steps) + R"(}
-output: )" + output + "\n";
+time: {start: 0, end: 2, steps: )" +
+         std::to_string(steps) + R"(}
+output: )" +
+         output + "\n";
 }
 
 struct Rows {
@@ -55,14 +57,17 @@ Rows sweep_scene(const Scene& scene, SweepSummary* sum, int threads = 1, Index c
   opt.threads = threads;
   opt.chunk_steps = chunk;
   Workspace ws(*scene.model);
-  const SolveStatus st = run_sweep(*scene.model, opt, ws, [&](const StepView& s) {
-    r.t.push_back(s.t);
-    r.q.push_back(s.q);
-    if (s.points) r.points.emplace_back(s.points, s.points + opt.points.size());
-    if (s.phi) r.phi.push_back(*s.phi);
-    r.rcond.push_back(s.rcond);
-    return true;
-  }, sum);
+  const SolveStatus st = run_sweep(
+      *scene.model, opt, ws,
+      [&](const StepView& s) {
+        r.t.push_back(s.t);
+        r.q.push_back(s.q);
+        if (s.points) r.points.emplace_back(s.points, s.points + opt.points.size());
+        if (s.phi) r.phi.push_back(*s.phi);
+        r.rcond.push_back(s.rcond);
+        return true;
+      },
+      sum);
   EXPECT_EQ(st, SolveStatus::kSuccess) << sum->message;
   return r;
 }
@@ -95,7 +100,9 @@ TEST(OutputPoints, PlanarBodyPointMatchesTheClosedForm) {
 TEST(OutputPoints, SweepPointsAreExactAndTheirDerivativesMatchFiniteDifferences) {
   const int steps = 2000;  // h = 1e-3: central differences to ~h² = 1e-6
   Scene scene = parse_scene(fourbar_scene("{velocities: true, accelerations: true, points: [A, "
-                                          "{name: P, body: coupler, at: [0.1, 0.3]}]}", steps), "fourbar.yaml");
+                                          "{name: P, body: coupler, at: [0.1, 0.3]}]}",
+                                          steps),
+                            "fourbar.yaml");
   ASSERT_EQ(scene.sweep.points.size(), 2u);
   SweepSummary sum;
   Rows r = sweep_scene(scene, &sum);
@@ -104,8 +111,7 @@ TEST(OutputPoints, SweepPointsAreExactAndTheirDerivativesMatchFiniteDifferences)
   double worst_v = 0, worst_a = 0;
   for (std::size_t k = 0; k < r.t.size(); ++k) {
     // A is the crank tip: 0.4 (cos θ, sin θ), θ = 0.5 + 2 sin(1.5 t)
-    const double t = r.t[k], th = 0.5 + 2 * std::sin(1.5 * t), w = 3 * std::cos(1.5 * t),
-                 al = -4.5 * std::sin(1.5 * t);
+    const double t = r.t[k], th = 0.5 + 2 * std::sin(1.5 * t), w = 3 * std::cos(1.5 * t), al = -4.5 * std::sin(1.5 * t);
     const PointMotion& a = r.points[k][0];
     ASSERT_NEAR(a.r[0], 0.4 * std::cos(th), 1e-9);
     ASSERT_NEAR(a.r[1], 0.4 * std::sin(th), 1e-9);
@@ -161,7 +167,8 @@ drivers:
   - {name: motor, joint: hinge, measure: angle, law: {type: polynomial, coefficients: [-0.3, 3, 0.5]}}
 time: {start: 0, end: 1, steps: 40}
 output: {velocities: true, accelerations: true, points: [P, {name: T, body: disk, at: [1, 0, 0]}]}
-)Y", "disk.yaml");
+)Y",
+                            "disk.yaml");
   ASSERT_EQ(scene.sweep.points.size(), 2u);
   EXPECT_EQ(scene.sweep.points[1].dimension(), 3);
   SweepSummary sum;
@@ -192,8 +199,8 @@ output: {velocities: true, accelerations: true, points: [P, {name: T, body: disk
 // make the position work independent of the outputs, so the counts below are exact.
 struct Plan {
   const char* output;
-  bool v, a;        // q̇ and q̈ solved
-  Index points;     // output points
+  bool v, a;     // q̇ and q̈ solved
+  Index points;  // output points
 };
 
 TEST(OutputPlan, TheSweepDoesOnlyTheWorkTheOutputListsAsksFor) {
@@ -237,7 +244,9 @@ TEST(OutputPlan, ResidualsAndConditionAreDeliveredWithoutExtraEvaluations) {
   const int steps = 30;
   Scene plain = parse_scene(fourbar_scene("{velocities: true}", steps), "fourbar.yaml");
   Scene asked = parse_scene(fourbar_scene("{velocities: true, residuals: [rocker, A], max_residual: true, "
-                                          "rcond: true}", steps), "fourbar.yaml");
+                                          "rcond: true}",
+                                          steps),
+                            "fourbar.yaml");
   EXPECT_TRUE(asked.sweep.residuals);
   EXPECT_TRUE(asked.sweep.condition);
   ASSERT_EQ(asked.sweep.residual_columns.size(), 2u);
@@ -272,7 +281,9 @@ TEST(OutputPlan, ResidualsAndConditionAreDeliveredWithoutExtraEvaluations) {
 TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
   Scene scene = parse_scene(fourbar_scene("{velocities: true, coordinates: [theta2], points: [B, {name: P, body: "
                                           "coupler, at: [0, 0.3]}], drivers: [motor], residuals: [rocker], "
-                                          "max_residual: true, rcond: true}", 4), "fourbar.yaml");
+                                          "max_residual: true, rcond: true}",
+                                          4),
+                            "fourbar.yaml");
   CsvFormat csv(*scene.model, scene.sweep);
   EXPECT_EQ(csv.header(),
             "t,theta2,theta2.v,B.x,B.y,B.vx,B.vy,P.x,P.y,P.vx,P.vy,motor.f,motor.df,rocker.residual,residual,rcond\n");
@@ -281,15 +292,18 @@ TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
   SweepSummary sum;
   Workspace ws(*scene.model);
   double rocker = -1;
-  const SolveStatus st = run_sweep(*scene.model, scene.sweep, ws, [&](const StepView& s) {
-    if (s.step == 1) {
-      csv.append_row(s, row);
-      // the rocker's one row (a length), scaled by the model's length scale
-      const ConstraintInfo& c = scene.model->constraints()[scene.sweep.residual_columns[0]];
-      rocker = std::fabs((*s.phi)(c.first_row)) / scene.model->length_scale();
-    }
-    return true;
-  }, &sum);
+  const SolveStatus st = run_sweep(
+      *scene.model, scene.sweep, ws,
+      [&](const StepView& s) {
+        if (s.step == 1) {
+          csv.append_row(s, row);
+          // the rocker's one row (a length), scaled by the model's length scale
+          const ConstraintInfo& c = scene.model->constraints()[scene.sweep.residual_columns[0]];
+          rocker = std::fabs((*s.phi)(c.first_row)) / scene.model->length_scale();
+        }
+        return true;
+      },
+      &sum);
   ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
   EXPECT_EQ(scene.model->length_scale(), 1.0);  // the largest length in the constraints' data: the rocker's
   std::vector<double> v;
@@ -308,36 +322,41 @@ TEST(CsvFormat, ARowsValuesAreTheDoublesItsTextReads) {
   // every column kind (coordinates, q̇, points, a driver, residuals, rcond) and a step whose q holds a −0
   Scene scene = parse_scene(fourbar_scene("{velocities: true, accelerations: true, points: [B, {name: P, body: "
                                           "coupler, at: [0, 0.3]}], drivers: [motor], residuals: [rocker], "
-                                          "max_residual: true, rcond: true}", 4), "fourbar.yaml");
+                                          "max_residual: true, rcond: true}",
+                                          4),
+                            "fourbar.yaml");
   const CsvFormat csv(*scene.model, scene.sweep);
   ASSERT_EQ(csv.num_values(), csv.column_names().size());
   Workspace ws(*scene.model);
   Index rows = 0;
   SweepSummary sum;
-  const SolveStatus st = run_sweep(*scene.model, scene.sweep, ws, [&](const StepView& s) {
-    Eigen::VectorXd q = s.q;
-    q(0) = -0.0;
-    const StepView step{s.step, s.t, q, s.qd, s.qdd, s.points, s.phi, s.rcond, s.joints, s.orientations,
-                        s.sensitivities};
-    std::string text;
-    csv.append_row(step, text);
-    std::vector<double> values(csv.num_values() + 1, 7.0);  // one past the end: not written
-    csv.append_values(step, values.data());
-    EXPECT_EQ(values.back(), 7.0);
-    std::size_t k = 0;
-    for (const char* p = text.data(); *p != '\n'; ++k) {
-      double read = 0.0;
-      const auto [end, ec] = std::from_chars(p, text.data() + text.size(), read);
-      EXPECT_EQ(ec, std::errc());
-      EXPECT_EQ(std::bit_cast<std::uint64_t>(values[k]), std::bit_cast<std::uint64_t>(read))
-          << "column " << csv.column_names()[k] << " at step " << s.step;
-      p = *end == ',' ? end + 1 : end;
-    }
-    EXPECT_EQ(k, csv.num_values());
-    EXPECT_FALSE(std::signbit(values[1]));  // −0 as the text writes it: 0
-    ++rows;
-    return true;
-  }, &sum);
+  const SolveStatus st = run_sweep(
+      *scene.model, scene.sweep, ws,
+      [&](const StepView& s) {
+        Eigen::VectorXd q = s.q;
+        q(0) = -0.0;
+        const StepView step{s.step, s.t,     q,        s.qd,           s.qdd,          s.points,
+                            s.phi,  s.rcond, s.joints, s.orientations, s.sensitivities};
+        std::string text;
+        csv.append_row(step, text);
+        std::vector<double> values(csv.num_values() + 1, 7.0);  // one past the end: not written
+        csv.append_values(step, values.data());
+        EXPECT_EQ(values.back(), 7.0);
+        std::size_t k = 0;
+        for (const char* p = text.data(); *p != '\n'; ++k) {
+          double read = 0.0;
+          const auto [end, ec] = std::from_chars(p, text.data() + text.size(), read);
+          EXPECT_EQ(ec, std::errc());
+          EXPECT_EQ(std::bit_cast<std::uint64_t>(values[k]), std::bit_cast<std::uint64_t>(read))
+              << "column " << csv.column_names()[k] << " at step " << s.step;
+          p = *end == ',' ? end + 1 : end;
+        }
+        EXPECT_EQ(k, csv.num_values());
+        EXPECT_FALSE(std::signbit(values[1]));  // −0 as the text writes it: 0
+        ++rows;
+        return true;
+      },
+      &sum);
   ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
   EXPECT_EQ(rows, 5);
 }
@@ -362,8 +381,17 @@ TEST(CsvFormat, WideRowsFormattedInParallelReadAsTheSequentialText) {
   ASSERT_EQ(n, 4003);
   // values of every shape: −0, signed, tiny, huge, subnormal, integers, 17 significant digits
   Eigen::VectorXd q(n), qd(n), qdd(n);
-  const double special[] = {-0.0, 0.0, 1.0, -2.5, 1e-300, -1.7976931348623157e308, 4.9406564584124654e-324,
-                            0.1, 1.0 / 3.0, -123456789.0, 2.2250738585072014e-308};
+  const double special[] = {-0.0,
+                            0.0,
+                            1.0,
+                            -2.5,
+                            1e-300,
+                            -1.7976931348623157e308,
+                            4.9406564584124654e-324,
+                            0.1,
+                            1.0 / 3.0,
+                            -123456789.0,
+                            2.2250738585072014e-308};
   for (Index j = 0; j < n; ++j) {
     q(j) = j < 11 ? special[j] : std::sin(0.37 * static_cast<double>(j)) * std::pow(10.0, j % 40 - 20);
     qd(j) = -std::cos(1.3 * static_cast<double>(j)) * (1 + j);

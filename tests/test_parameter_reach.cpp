@@ -96,8 +96,8 @@ TEST(ParameterReach, ALengthReachesItsConstraintOnly) {
 // ∂θ2/∂w = t, ∂θ̇2/∂w = 1, ∂θ̈2/∂w = 0, with the crank-slider following (x_B moves as ∂x_B/∂θ2 · t). Not reported
 // as a parameter nothing reads.
 TEST(ParameterReach, ALawsCoefficientReachesItsDriver) {
-  const std::string text = test::replace_first(
-      test::replace_first(kReachCrankSlider, "unused: 5}", "unused: 5, w: 2}"), "rate: 2}", "rate: w}");
+  const std::string text = test::replace_first(test::replace_first(kReachCrankSlider, "unused: 5}", "unused: 5, w: 2}"),
+                                               "rate: 2}", "rate: w}");
   const Scene s = parse_scene(text, "c.yaml");
   OutputSensitivity w = sensitivity_along(s, "w", 2.0);
   EXPECT_EQ(reached(*s.model, *w.reach), (std::vector<std::string>{"motor"}));
@@ -109,18 +109,21 @@ TEST(ParameterReach, ALawsCoefficientReachesItsDriver) {
   int rows = 0;
   SweepSummary sum;
   Workspace ws(*s.model);
-  ASSERT_EQ(run_sweep(*s.model, o, ws, [&](const StepView& v) {
-              const double t = v.t, th = v.q[theta];
-              EXPECT_NEAR(v.sensitivities[layout.offset(0, 0) + theta], t, 1e-12) << t;
-              EXPECT_NEAR(v.sensitivities[layout.offset(0, 1) + theta], 1.0, 1e-12) << t;
-              EXPECT_NEAR(v.sensitivities[layout.offset(0, 2) + theta], 0.0, 1e-11) << t;
-              // x_B = L2 cos θ + √(L3² − L2² sin² θ): ∂x_B/∂w = ∂x_B/∂θ · t
-              const double r = std::sqrt(1.0 - 0.09 * std::sin(th) * std::sin(th));
-              const double dx = -0.3 * std::sin(th) - 0.09 * std::sin(th) * std::cos(th) / r;
-              EXPECT_NEAR(v.sensitivities[layout.offset(0, 0) + xb], dx * t, 1e-10) << t;
-              ++rows;
-              return true;
-            }, &sum),
+  ASSERT_EQ(run_sweep(
+                *s.model, o, ws,
+                [&](const StepView& v) {
+                  const double t = v.t, th = v.q[theta];
+                  EXPECT_NEAR(v.sensitivities[layout.offset(0, 0) + theta], t, 1e-12) << t;
+                  EXPECT_NEAR(v.sensitivities[layout.offset(0, 1) + theta], 1.0, 1e-12) << t;
+                  EXPECT_NEAR(v.sensitivities[layout.offset(0, 2) + theta], 0.0, 1e-11) << t;
+                  // x_B = L2 cos θ + √(L3² − L2² sin² θ): ∂x_B/∂w = ∂x_B/∂θ · t
+                  const double r = std::sqrt(1.0 - 0.09 * std::sin(th) * std::sin(th));
+                  const double dx = -0.3 * std::sin(th) - 0.09 * std::sin(th) * std::cos(th) / r;
+                  EXPECT_NEAR(v.sensitivities[layout.offset(0, 0) + xb], dx * t, 1e-10) << t;
+                  ++rows;
+                  return true;
+                },
+                &sum),
             SolveStatus::kSuccess);
   EXPECT_EQ(rows, 91);
   for (const SweepWarning& warning : sum.warnings) EXPECT_NE(warning.kind, "no_dependence") << warning.message;
@@ -183,8 +186,7 @@ TEST(ParameterReach, OneBarOfAFamilyIsOneSpan) {
   EXPECT_EQ(l.reach->rows.size(), 40u);  // the 40 couplers
   bool couplers = false;
   for (const auto& span : l.reach->spans)
-    if (std::string(s.model->blocks()[span.block]->kind()) == "distance")
-      couplers = span.begin == 41 && span.end == 81;
+    if (std::string(s.model->blocks()[span.block]->kind()) == "distance") couplers = span.begin == 41 && span.end == 81;
   EXPECT_TRUE(couplers);
 }
 

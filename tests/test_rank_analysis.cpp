@@ -94,7 +94,8 @@ time: {start: 0, end: 1, steps: 10}
 
 Scene parallelogram(double unit) {
   // the same mechanism in metres (unit 1) or millimetres (unit 1000): lengths scale, angles do not
-  std::string text = "parameters: {L: " + std::to_string(unit) + ", R: " + std::to_string(unit) + "}\n" + kParallelogram;
+  std::string text =
+      "parameters: {L: " + std::to_string(unit) + ", R: " + std::to_string(unit) + "}\n" + kParallelogram;
   Scene sc = parse_scene(text, "parallelogram.yaml");
   return sc;
 }
@@ -115,7 +116,8 @@ TEST(RankAnalysis, RankDropsOnlyAtTheChangePointWhateverTheUnits) {
     EXPECT_TRUE(general.redundant_rows.empty()) << unit;
     EXPECT_FALSE(general.uncertain) << general.message;
     // Flat: cranks and coupler on the x axis. Both cranks' vertical motion is one constraint too few: the
-    // kinematic rank drops to 7 (2 freedoms): with every link horizontal the x rows fix x only, and A2's x row is O2 + A1 − O1.
+    // kinematic rank drops to 7 (2 freedoms): with every link horizontal the x rows fix x only, and A2's x row is O2 +
+    // A1 − O1.
     const RankReport flat = analyse_rank(m, parallelogram_at(m, 0.0, unit), 0.0);
     EXPECT_EQ(flat.rank, 7) << unit;
     EXPECT_EQ(flat.dof, 2) << unit;

@@ -34,7 +34,8 @@ TEST(RedundantScenes, CrankSlider3dHasGrublerMinusTwoMovesWithOneDofAndIsTheCran
   EXPECT_EQ(r.redundant_rows.size(), 3u);  // 24 equations of rank 21
   EXPECT_TRUE(p.assembly.consistent);
   const Model& m = *p.scene.model;
-  const Index xs = m.coordinate_index("slider_x"), ys = m.coordinate_index("slider_y"), zs = m.coordinate_index("slider_z");
+  const Index xs = m.coordinate_index("slider_x"), ys = m.coordinate_index("slider_y"),
+              zs = m.coordinate_index("slider_z");
   const double L2 = 0.3, L3 = 1.0;
   sweep(p, [&](const StepView& s) {
     // θ = 2t; x_B = L2 cos θ + √(L3² − L2² sin² θ); its rates by differentiation
@@ -42,8 +43,8 @@ TEST(RedundantScenes, CrankSlider3dHasGrublerMinusTwoMovesWithOneDofAndIsTheCran
     const double root = std::sqrt(L3 * L3 - L2 * L2 * sn * sn);
     const double x = L2 * cs + root;
     const double dx_dth = -L2 * sn - L2 * L2 * sn * cs / root;
-    const double d2x_dth2 = -L2 * cs - L2 * L2 * (cs * cs - sn * sn) / root -
-                            L2 * L2 * L2 * L2 * sn * sn * cs * cs / (root * root * root);
+    const double d2x_dth2 =
+        -L2 * cs - L2 * L2 * (cs * cs - sn * sn) / root - L2 * L2 * L2 * L2 * sn * sn * cs * cs / (root * root * root);
     EXPECT_NEAR(s.q(xs), x, 1e-9) << s.t;
     EXPECT_NEAR(s.q(ys), 0.0, 1e-9);
     EXPECT_NEAR(s.q(zs), 0.0, 1e-9);
@@ -68,9 +69,7 @@ TEST(RedundantScenes, DoorOnThreeHingesTurnsWithOneDofAndItsRedundantHingesListe
   // the door turns about z with the driver: e = (cos(φ/2), 0, 0, sin(φ/2)), φ = t
   const Model& m = *p.scene.model;
   const Index e0 = m.coordinate_index("door_e0"), e3 = m.coordinate_index("door_e3");
-  sweep(p, [&](const StepView& s) {
-    EXPECT_NEAR(std::atan2(s.q(e3), s.q(e0)) * 2.0, s.t, 1e-9) << s.t;
-  });
+  sweep(p, [&](const StepView& s) { EXPECT_NEAR(std::atan2(s.q(e3), s.q(e0)) * 2.0, s.t, 1e-9) << s.t; });
 }
 
 TEST(RedundantScenes, MisalignedDoorIsInconsistentWithTheThirdHingeAmongTheConflicts) {

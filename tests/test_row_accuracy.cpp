@@ -36,17 +36,20 @@ TEST(RowAccuracy, ALongChainsRowsAtTheRoundingLevelAreCountedAndBoundTheirError)
   double real = 0.0;
   Workspace ws(m);
   SweepSummary sum;
-  ASSERT_EQ(run_sweep(m, sc.sweep, ws, [&](const StepView& v) {
-              const double s = std::sin(v.q(th)), c = std::cos(v.q(th));
-              for (int level : {1, 2000, 4000}) {
-                const std::string l = std::to_string(level);
-                const Index xl = m.coordinate_index("xl" + l), yl = m.coordinate_index("yl" + l);
-                const Index xr = m.coordinate_index("xr" + l), yr = m.coordinate_index("yr" + l);
-                real = std::max({real, in_tolerances(m, xl, v.q(xl), 0.0), in_tolerances(m, yl, v.q(yl), level * s),
-                                 in_tolerances(m, xr, v.q(xr), c), in_tolerances(m, yr, v.q(yr), level * s)});
-              }
-              return true;
-            }, &sum),
+  ASSERT_EQ(run_sweep(
+                m, sc.sweep, ws,
+                [&](const StepView& v) {
+                  const double s = std::sin(v.q(th)), c = std::cos(v.q(th));
+                  for (int level : {1, 2000, 4000}) {
+                    const std::string l = std::to_string(level);
+                    const Index xl = m.coordinate_index("xl" + l), yl = m.coordinate_index("yl" + l);
+                    const Index xr = m.coordinate_index("xr" + l), yr = m.coordinate_index("yr" + l);
+                    real = std::max({real, in_tolerances(m, xl, v.q(xl), 0.0), in_tolerances(m, yl, v.q(yl), level * s),
+                                     in_tolerances(m, xr, v.q(xr), c), in_tolerances(m, yr, v.q(yr), level * s)});
+                  }
+                  return true;
+                },
+                &sum),
             SolveStatus::kSuccess)
       << sum.message;
   const SweepAccuracy& a = sum.accuracy;
@@ -75,16 +78,19 @@ TEST(RowAccuracy, ASweepStartedOnASingularPositionCountsThatRowAsSingular) {
     Workspace ws(m);
     SweepSummary sum;
     double real = 0.0;  // rows after the first: crank tip i at (i + cos θ, sin θ), θ = 0.5 t
-    ASSERT_EQ(run_sweep(m, opt, ws, [&](const StepView& v) {
-                if (v.step == 0) return true;
-                const double c = std::cos(0.5 * v.t), s = std::sin(0.5 * v.t);
-                for (int i = 0; i <= 100; ++i) {
-                  const Index x = m.coordinate_index("x" + std::to_string(i));
-                  const Index y = m.coordinate_index("y" + std::to_string(i));
-                  real = std::max({real, in_tolerances(m, x, v.q(x), i + c), in_tolerances(m, y, v.q(y), s)});
-                }
-                return true;
-              }, &sum),
+    ASSERT_EQ(run_sweep(
+                  m, opt, ws,
+                  [&](const StepView& v) {
+                    if (v.step == 0) return true;
+                    const double c = std::cos(0.5 * v.t), s = std::sin(0.5 * v.t);
+                    for (int i = 0; i <= 100; ++i) {
+                      const Index x = m.coordinate_index("x" + std::to_string(i));
+                      const Index y = m.coordinate_index("y" + std::to_string(i));
+                      real = std::max({real, in_tolerances(m, x, v.q(x), i + c), in_tolerances(m, y, v.q(y), s)});
+                    }
+                    return true;
+                  },
+                  &sum),
               SolveStatus::kSuccess)
         << sum.message;
     EXPECT_LE(real, sum.accuracy.converged.worst_error) << threads << " threads";

@@ -330,14 +330,16 @@ points: {P: [x, y], A: [1, 1], B: [1, 1]}
 constraints:
   - {name: online, type: point_on_line, point: P, line: [A, B]}
 time: {start: 0, end: 1, steps: 10}
-)"), "bad.yaml:4:5: constraints[0]: constraint 'online': point_on_line: the line's two points are the same "
-       "fixed point");
+)"),
+             "bad.yaml:4:5: constraints[0]: constraint 'online': point_on_line: the line's two points are the same "
+             "fixed point");
   EXPECT_HAS(test::scene_error(R"(coordinates: {x: 0.5, y: 0.1}
 points: {P: [x, y], O: [0, 0]}
 constraints:
   - {name: ang, type: constant_angle, segments: [[O, P], [O, O]], angle: 0.5}
 time: {start: 0, end: 1, steps: 10}
-)"), "constraint 'ang': constant_angle: a segment's two ends are the same fixed point");
+)"),
+             "constraint 'ang': constant_angle: a segment's two ends are the same fixed point");
 }
 
 TEST(Scene, EverySeedSceneLoads) {
@@ -375,11 +377,13 @@ TEST(SceneSolver, PredictorIsASettingThatNeedsItsDerivativesInTheOutput) {
       "coordinates: {x: 0.1}\ndrivers: [{coordinate: x, law: {type: linear, initial: 0, rate: 1}}]\n"
       "time: {start: 0, end: 1, steps: 2}\n";
   EXPECT_EQ(parse_scene(base, "s.yaml").sweep.predictor, Predictor::kAuto);
-  EXPECT_EQ(parse_scene(base + "solver: {predictor: cubic}\noutput: {velocities: true, accelerations: true}\n",
-                        "s.yaml").sweep.predictor,
-            Predictor::kCubic);
+  EXPECT_EQ(
+      parse_scene(base + "solver: {predictor: cubic}\noutput: {velocities: true, accelerations: true}\n", "s.yaml")
+          .sweep.predictor,
+      Predictor::kCubic);
   EXPECT_EQ(parse_scene(base + "solver: {predictor: parabolic}\noutput: {velocities: false, accelerations: false}\n",
-                        "s.yaml").sweep.predictor,
+                        "s.yaml")
+                .sweep.predictor,
             Predictor::kParabolic);
   for (const auto& [text, message] :
        {std::pair<std::string, std::string>{"solver: {predictor: quartic}\n",

@@ -213,7 +213,8 @@ TEST(Scene3d, BadInputIsOneLineNamingTheField) {
              "joint 'hinge' is a revolute joint");
   EXPECT_HAS(error_of(edited("type: revolute", "type: cylindrical")), "needs 'measure: angle' or 'measure: distance'");
   EXPECT_HAS(error_of(edited("type: revolute", "type: spherical")), "joint 'hinge' is a spherical joint");
-  EXPECT_HAS(error_of(edited("joint: hinge,", "joint: hinge, coordinate: x,")), "one of 'coordinate', 'expr' or 'joint'");
+  EXPECT_HAS(error_of(edited("joint: hinge,", "joint: hinge, coordinate: x,")),
+             "one of 'coordinate', 'expr' or 'joint'");
   EXPECT_HAS(error_of(edited("{body: ground, at: [0, 0, h], axis: [0, 0, 1]}", "{point: P}")), "unknown point 'P'");
   const std::string with_point = edited("bodies:", "points: {P: [1, 2, 3]}\nbodies:");
   const std::string natural_a = with_point.substr(0, with_point.find("{body: ground")) + "{point: P}" +
@@ -233,13 +234,14 @@ TEST(Scene3d, BodiesWrittenAsMapsBringTheirCoordinates) {
     return test::replace_first(s, "door: [x, y, z, e0, e1, e2, e3]", "door: " + body);
   };
   const double c = std::cos(0.15), sn = std::sin(0.15);  // a turn of 0.3 about z
-  for (const std::string& body : {std::string("{at: [0, 0, h], orientation: {axis: [0, 0, 2], angle: 0.3}}"),
-                                  std::string("{at: [0, 0, h], orientation: {euler: zyx, angles: [0.3, 0, 0]}}"),
-                                  std::string("{at: [0, 0, h], orientation: {euler: zxz, angles: [0.1, 0, 0.2]}}"),
-                                  std::string("{at: [0, 0, h], orientation: {x: [cos(0.3), sin(0.3), 0]}}"),
-                                  std::string("{at: [0, 0, h], orientation: {z: [0, 0, 1], x: [cos(0.3), sin(0.3), 5]}}"),
-                                  std::string("{at: [0, 0, h], orientation: {euler_parameters: [2*cos(0.15), 0, 0, "
-                                              "2*sin(0.15)]}}")}) {
+  for (const std::string& body :
+       {std::string("{at: [0, 0, h], orientation: {axis: [0, 0, 2], angle: 0.3}}"),
+        std::string("{at: [0, 0, h], orientation: {euler: zyx, angles: [0.3, 0, 0]}}"),
+        std::string("{at: [0, 0, h], orientation: {euler: zxz, angles: [0.1, 0, 0.2]}}"),
+        std::string("{at: [0, 0, h], orientation: {x: [cos(0.3), sin(0.3), 0]}}"),
+        std::string("{at: [0, 0, h], orientation: {z: [0, 0, 1], x: [cos(0.3), sin(0.3), 5]}}"),
+        std::string("{at: [0, 0, h], orientation: {euler_parameters: [2*cos(0.15), 0, 0, "
+                    "2*sin(0.15)]}}")}) {
     SCOPED_TRACE(body);
     const Scene s = parse_scene(door(body), "map.yaml");
     const Model& m = *s.model;
@@ -255,9 +257,9 @@ TEST(Scene3d, BodiesWrittenAsMapsBringTheirCoordinates) {
   const std::string fixed = test::replace_first(
       door("{at: [0, 0, h]}"), "bodies:\n",
       "bodies:\n  wall: {at: [0, 0, h], orientation: {axis: [1, 0, 0], angle: pi/2}, fixed: true}\n");
-  const Scene f = parse_scene(test::replace_first(fixed, "{body: ground, at: [0, 0, h], axis: [0, 0, 1]}",
-                                                  "{body: wall, axis: [0, -1, 0]}"),
-                              "fixed.yaml");
+  const Scene f = parse_scene(
+      test::replace_first(fixed, "{body: ground, at: [0, 0, h], axis: [0, 0, 1]}", "{body: wall, axis: [0, -1, 0]}"),
+      "fixed.yaml");
   EXPECT_EQ(f.model->num_coordinates(), 7);
   Workspace ws(*f.model);
   SweepSummary sum;
@@ -273,7 +275,8 @@ TEST(Scene3d, BodiesWrittenAsMapsBringTheirCoordinates) {
   EXPECT_HAS(error_of(door("{orientation: {axis: [0, 0, 0], angle: 1}}")),
              "bodies.door.orientation: the rotation axis must be a non-zero finite vector");
   EXPECT_HAS(error_of(door("{at: [0, 0]}")), "bodies.door.at: expected a list of 3 numbers");
-  EXPECT_HAS(error_of(door("{at: [0, 0, 0], angle: 1}")), "bodies.door.angle: unknown field 'angle' (allowed: at, orientation, fixed)");
+  EXPECT_HAS(error_of(door("{at: [0, 0, 0], angle: 1}")),
+             "bodies.door.angle: unknown field 'angle' (allowed: at, orientation, fixed)");
   EXPECT_HAS(error_of(test::replace_first(door("{}"), "parameters: {h: 2}", "parameters: {h: 2, door_z: 1}")),
              "bodies.door: its coordinate 'door_z' is already a parameter");
   EXPECT_HAS(error_of(test::replace_first(door("{}"), "bodies:", "coordinates: {door_e1: 0}\nbodies:")),
@@ -291,7 +294,8 @@ TEST(Scene3d, JointAngleReferencesAreRecorded) {
   EXPECT_EQ(s.joint_angles[0].ref_a, (std::array<double, 3>{1, 0, 0}));
   EXPECT_FALSE(s.joint_angles[0].stated_a);
   std::string about_x = edited("axis: [0, 0, 1]}", "axis: [1, 0, 0]}");
-  about_x = test::replace_first(about_x, "{body: door, at: [0, 0, h]}", "{body: door, at: [0, 0, h], axis: [0.95, 0.1, 0], ref: [0, 0, 1]}");
+  about_x = test::replace_first(about_x, "{body: door, at: [0, 0, h]}",
+                                "{body: door, at: [0, 0, h], axis: [0.95, 0.1, 0], ref: [0, 0, 1]}");
   const Scene x = parse_scene(about_x, "x.yaml");
   ASSERT_EQ(x.joint_angles.size(), 1u);
   EXPECT_EQ(x.joint_angles[0].ref_a, (std::array<double, 3>{0, 1, 0}));  // within 25° of x: y

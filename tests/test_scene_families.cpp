@@ -119,8 +119,8 @@ time: {start: 0, end: 1, steps: 1}
   EXPECT_EQ(m.coordinate_names(), names);
   for (Index r = 0; r < m.num_coordinates(); ++r) {
     const std::string& n = names[static_cast<std::size_t>(r)];
-    EXPECT_EQ(m.initial_positions()(r), std::stod(n.substr(1, 1)) * 100 + std::stod(n.substr(3, 1)) * 10 +
-                                            std::stod(n.substr(5, 1)) + 0.5);
+    EXPECT_EQ(m.initial_positions()(r),
+              std::stod(n.substr(1, 1)) * 100 + std::stod(n.substr(3, 1)) * 10 + std::stod(n.substr(5, 1)) + 0.5);
     EXPECT_EQ(m.constraints()[static_cast<std::size_t>(r)].name, "fix" + n.substr(1));
   }
   // each row reads its own coordinate, with value 0.5 at the initial point and derivative 1
@@ -168,7 +168,8 @@ time: {start: 0, end: 1, steps: 4}
 
 TEST(SceneFamilies, EmptyFamiliesAndBoundsFromEnclosingIndices) {
   // B < A: no member; a range given by expressions
-  std::string s = family_variant("  - for i in 0..N-1:\n", "  - for k in 1..0:\n      - {type: bogus}\n  - for i in N-3..(N*2-2)/2:\n");
+  std::string s = family_variant("  - for i in 0..N-1:\n",
+                                 "  - for k in 1..0:\n      - {type: bogus}\n  - for i in N-3..(N*2-2)/2:\n");
   Scene sc = parse_scene(s, "ok.yaml");
   EXPECT_EQ(sc.model->constraints().size(), 9u);
 }
@@ -196,10 +197,11 @@ TEST(SceneFamilies, ErrorsNameTheMember) {
   EXPECT_EQ(error_of(family_variant("x{i}: i + c", "x{i}: i + d")),
             "bad.yaml:5:11: coordinates.for i in 0..N[i=0].x{i}: expression \"i + d\": unknown name 'd'");
   // a member error points at the member's item; with several items in the body, the item is named too
-  EXPECT_EQ(error_of(family_variant("length: 1}\n  - for i in 0..N-1:\n",
-                                    "length: 1}\n      - {name: \"extra{i}\", type: distance, points: [O, Q], length: 1}\n"
-                                    "  - for i in 0..N-1:\n")),
-            "bad.yaml:15:56: constraints[0].for i in 0..N[i=0][1].points[1]: unknown point 'Q'");
+  EXPECT_EQ(
+      error_of(family_variant("length: 1}\n  - for i in 0..N-1:\n",
+                              "length: 1}\n      - {name: \"extra{i}\", type: distance, points: [O, Q], length: 1}\n"
+                              "  - for i in 0..N-1:\n")),
+      "bad.yaml:15:56: constraints[0].for i in 0..N[i=0][1].points[1]: unknown point 'Q'");
 }
 
 TEST(SceneFamilies, NamesThatCollideAfterExpansion) {
@@ -253,8 +255,9 @@ TEST(SceneFamilies, MalformedFamiliesAndLimits) {
             "points 4, constraints 7), more than the 12 they may make (SceneLimits::max_family_instances)");
   // the budget counts every entry made, nested families included: those whose range uses an enclosing index are
   // checked as they are expanded (here 2 x 1 counted beforehand, then 10 x 1 for i = 0 and 11 x 1 for i = 1)
-  const std::string nested = "phiq: 1\nparameters: {N: 9}\ncoordinates:\n  for i in 0..1:\n    for j in 0..N+i:\n"
-                             "      x{i}_{j}: 0\ntime: {start: 0, end: 1, steps: 1}\n";
+  const std::string nested =
+      "phiq: 1\nparameters: {N: 9}\ncoordinates:\n  for i in 0..1:\n    for j in 0..N+i:\n"
+      "      x{i}_{j}: 0\ntime: {start: 0, end: 1, steps: 1}\n";
   EXPECT_EQ(test::scene_error(nested, "few.yaml", few),
             "few.yaml:5:5: coordinates.for i in 0..1[i=1].for j in 0..N+i: the family would make 11 x 1 entries; "
             "families may make 12 entries in all and 0 are left (SceneLimits::max_family_instances)");
@@ -263,9 +266,10 @@ TEST(SceneFamilies, MalformedFamiliesAndLimits) {
   std::string indent = "  ";
   for (int d = 0; d < 9; ++d) deep += indent + "for i" + std::to_string(d) + " in 0..0:\n", indent += "  ";
   deep += indent + "x: 0\ntime: {start: 0, end: 1, steps: 1}\n";
-  EXPECT_EQ(error_of(deep), "bad.yaml:10:19: coordinates.for i0 in 0..0.for i1 in 0..0.for i2 in 0..0.for i3 in "
-                            "0..0.for i4 in 0..0.for i5 in 0..0.for i6 in 0..0.for i7 in 0..0.for i8 in 0..0: "
-                            "families nested more than 8 deep");
+  EXPECT_EQ(error_of(deep),
+            "bad.yaml:10:19: coordinates.for i0 in 0..0.for i1 in 0..0.for i2 in 0..0.for i3 in "
+            "0..0.for i4 in 0..0.for i5 in 0..0.for i6 in 0..0.for i7 in 0..0.for i8 in 0..0: "
+            "families nested more than 8 deep");
 }
 
 // A scene whose families fit one by one but not together is refused before any is expanded: the limit was consumed
@@ -274,8 +278,8 @@ TEST(SceneFamilies, MalformedFamiliesAndLimits) {
 // expanding them would report first.
 TEST(SceneFamilies, FamiliesOverTheLimitTogetherAreRefusedBeforeAnyIsExpanded) {
   auto scene = [](std::int64_t n, const std::string& value) {
-    return "phiq: 1\nparameters: {N: " + std::to_string(n) + "}\ncoordinates:\n  for k in 0..N-1:\n    q{k}: " +
-           value + "\nconstraints:\n  - for k in 0..N-1:\n"
+    return "phiq: 1\nparameters: {N: " + std::to_string(n) + "}\ncoordinates:\n  for k in 0..N-1:\n    q{k}: " + value +
+           "\nconstraints:\n  - for k in 0..N-1:\n"
            "      - {name: \"fix{k}\", type: equation, expr: \"q{k} - 0.5*k\", unit: length}\n"
            "time: {start: 0, end: 1, steps: 1}\n";
   };
@@ -308,12 +312,12 @@ TEST(SceneFamilies, FamiliesOverTheLimitTogetherAreRefusedBeforeAnyIsExpanded) {
     parse_scene(scene(500, "0.5*k"), "many.yaml", limits, bigger);
     ADD_FAILURE();
   } catch (const SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("the families would make 1002 entries in all"), std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("the families would make 1002 entries in all"), std::string::npos) << e.what();
   }
   // nested families count one entry per member beforehand: they make at least that many
-  const std::string nested = "phiq: 1\nparameters: {N: 1000}\ncoordinates:\n  for i in 0..N:\n"
-                             "    for j in 0..1:\n      x{i}_{j}: 0\ntime: {start: 0, end: 1, steps: 1}\n";
+  const std::string nested =
+      "phiq: 1\nparameters: {N: 1000}\ncoordinates:\n  for i in 0..N:\n"
+      "    for j in 0..1:\n      x{i}_{j}: 0\ntime: {start: 0, end: 1, steps: 1}\n";
   EXPECT_EQ(error(nested, limits),
             "many.yaml:4:3: coordinates.for i in 0..N: the families would make at least 1001 entries in all "
             "(coordinates 1001), more than the 1000 they may make (SceneLimits::max_family_instances)");

@@ -21,8 +21,7 @@ struct SeedAngles {
 SeedAngles angles_of(const std::string& formulation, const Model& m, const Eigen::VectorXd& q) {
   auto c = [&](const char* n) { return q(m.coordinate_index(n)); };
   const double L1 = 1.0;
-  if (formulation == "relative")
-    return {c("psi2"), c("psi2") + c("psi3"), c("psi2") + c("psi3") + c("psi4") + M_PI};
+  if (formulation == "relative") return {c("psi2"), c("psi2") + c("psi3"), c("psi2") + c("psi3") + c("psi4") + M_PI};
   if (formulation == "reference_point") return {c("psi2"), c("psi3"), c("psi4")};
   if (formulation == "natural")
     return {c("theta2"), std::atan2(c("yB") - c("yA"), c("xB") - c("xA")), std::atan2(c("yB"), c("xB") - L1)};

@@ -24,14 +24,14 @@
 namespace phiq {
 namespace {
 
-using test::model_path;
-using test::sweep;
-using test::Trace;
-using test::kCrankSlider;
-using test::SensitivityTrace;
-using test::sweep_sensitivities;
-using test::slider_derivatives;
 using test::along;
+using test::kCrankSlider;
+using test::model_path;
+using test::SensitivityTrace;
+using test::slider_derivatives;
+using test::sweep;
+using test::sweep_sensitivities;
+using test::Trace;
 
 TEST(Sensitivity, CrankSliderAgainstTheClosedFormAndItsTimeDerivatives) {
   const Scene s = parse_scene(kCrankSlider, "crank_slider.yaml");
@@ -70,7 +70,8 @@ TEST(Sensitivity, CrankSliderAgainstTheClosedFormAndItsTimeDerivatives) {
   const SensitivityTrace p = [&] {
     SensitivityTrace t;
     Workspace ws(*s.model);
-    (void)run_sweep(*s.model, plain, ws, [](const StepView&) { return true; }, &t.summary);
+    (void)run_sweep(
+        *s.model, plain, ws, [](const StepView&) { return true; }, &t.summary);
     return t;
   }();
   EXPECT_EQ(r.summary.counters.factorizations, p.summary.counters.factorizations);
@@ -112,8 +113,9 @@ TEST(Sensitivity, TheCallersRequestsReplaceTheScenesOwn) {
     }
     return std::string("(read)");
   };
-  EXPECT_EQ(refused({{"L9", 0.0}}, true), "cases.csv: 'L9' is not a parameter of crank_slider.yaml (its parameters: "
-                                          "L2, L3)");
+  EXPECT_EQ(refused({{"L9", 0.0}}, true),
+            "cases.csv: 'L9' is not a parameter of crank_slider.yaml (its parameters: "
+            "L2, L3)");
   EXPECT_EQ(refused({{"L2", 0.0}, {"L2", 1e-4}}, false), "cases.csv: parameter 'L2' is asked for twice");
   EXPECT_EQ(refused({{"L2", -1.0}}, false),
             "cases.csv: the step of 'L2' must be a positive finite number (0: the default)");
@@ -142,9 +144,10 @@ TEST(Sensitivity, AlongAParameterAsTheScenesOwnOutput) {
     (void)sensitivity_along(api, "L3", 1.0, 0.6);
     FAIL() << "L3 = -0.2 was read";
   } catch (const SceneError& e) {
-    EXPECT_EQ(std::string(e.what()), "with L3 = -0.19999999999999996 (the difference step 0.6 from 1) the scene "
-                                     "cannot be read: c.yaml:8:57: constraints[1].length: must be positive, got L3 "
-                                     "= -0.19999999999999996");
+    EXPECT_EQ(std::string(e.what()),
+              "with L3 = -0.19999999999999996 (the difference step 0.6 from 1) the scene "
+              "cannot be read: c.yaml:8:57: constraints[1].length: must be positive, got L3 "
+              "= -0.19999999999999996");
   }
 }
 
@@ -303,16 +306,17 @@ TEST(Sensitivity, SolveSensitivitiesOnAWorkspaceEqualsTheSweeps) {
 
 TEST(Sensitivity, AParameterTheMotionDoesNotDependOnGivesZeros) {
   // `unused` reaches no constraint: its column is zero (reported by its values, not an error).
-  const std::string text = test::replace_first(
-      test::replace_first(kCrankSlider, "{L2: 0.3, L3: 1.0}", "{L2: 0.3, L3: 1.0, unused: 5}"),
-      "sensitivities: [L2, {parameter: L3, step: 1e-3}]", "sensitivities: [unused]");
+  const std::string text =
+      test::replace_first(test::replace_first(kCrankSlider, "{L2: 0.3, L3: 1.0}", "{L2: 0.3, L3: 1.0, unused: 5}"),
+                          "sensitivities: [L2, {parameter: L3, step: 1e-3}]", "sensitivities: [unused]");
   const Scene s = parse_scene(text, "c.yaml");
   const SensitivityTrace r = sweep_sensitivities(*s.model, s.sweep);
   for (const auto& row : r.s)
     for (double v : row) EXPECT_EQ(v, 0.0);
   ASSERT_EQ(r.summary.warnings.size(), 1u);
   EXPECT_EQ(r.summary.warnings[0].kind, "no_dependence");
-  EXPECT_EQ(r.summary.warnings[0].message, "no constraint or driver reads the parameter 'unused': its sensitivities are zero");
+  EXPECT_EQ(r.summary.warnings[0].message,
+            "no constraint or driver reads the parameter 'unused': its sensitivities are zero");
   // a parameter that is read is not reported
   const Scene both = parse_scene(kCrankSlider, "c.yaml");
   const SensitivityTrace read = sweep_sensitivities(*both.model, both.sweep);
@@ -326,7 +330,8 @@ TEST(Sensitivity, SceneRefusals) {
   };
   EXPECT_EQ(test::scene_error(with("[L9]")),
             "bad.yaml:12:65: output.sensitivities[0]: 'L9' is not a parameter of the scene (its parameters: L2, L3)");
-  EXPECT_EQ(test::scene_error(with("[L2, L2]")), "bad.yaml:12:69: output.sensitivities[1]: parameter 'L2' listed twice");
+  EXPECT_EQ(test::scene_error(with("[L2, L2]")),
+            "bad.yaml:12:69: output.sensitivities[1]: parameter 'L2' listed twice");
   EXPECT_EQ(test::scene_error(with("[{parameter: L2, step: 0}]")),
             "bad.yaml:12:87: output.sensitivities[0].step: the difference step must be positive");
   EXPECT_EQ(test::scene_error(with("[{parameter: L2, by: 1}]")).substr(0, 43),

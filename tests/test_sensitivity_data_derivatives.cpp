@@ -21,12 +21,12 @@
 namespace phiq {
 namespace {
 
-using test::model_path;
 using test::kCrankSlider;
+using test::model_path;
 using test::SensitivityTrace;
-using test::sweep_sensitivities;
-using test::slider_theta_derivatives;
 using test::slider_sensitivities;
+using test::slider_theta_derivatives;
+using test::sweep_sensitivities;
 
 // A scene read twice: as it is (its reached kinds' own derivatives) and with its models along each parameter kept
 // whole (every constraint differenced from them: SceneOverrides::keep_sensitivity_models).
@@ -38,7 +38,7 @@ std::pair<Scene, Scene> own_and_kept(const std::string& text, const std::string&
 
 // The sweeps of the two readings of own_and_kept() in `form`.
 std::pair<SensitivityTrace, SensitivityTrace> own_and_kept_sweeps(const std::pair<Scene, Scene>& scenes,
-                                                                    SensitivityForm form) {
+                                                                  SensitivityForm form) {
   SweepOptions a = scenes.first.sweep, b = scenes.second.sweep;
   a.sensitivity_form = b.sensitivity_form = form;
   return {sweep_sensitivities(*scenes.first.model, a), sweep_sensitivities(*scenes.second.model, b)};
@@ -76,8 +76,9 @@ std::pair<double, double> slider_deviations(const Scene& s, const SensitivityTra
 // whatever the step. With a step of 5 % the rod's differences are off by 2(h/L)⁴ ≈ 10⁻⁵ (the models kept, which
 // difference), while the kinds' stay at the closed form to 1e-9; at the default step the two agree to 1e-10.
 TEST(Sensitivity, KindsThatDifferentiateTheirDataAreExactAtAnyStep) {
-  const std::string coarse = test::replace_first(kCrankSlider, "sensitivities: [L2, {parameter: L3, step: 1e-3}]",
-                                                 "sensitivities: [{parameter: L2, step: 0.015}, {parameter: L3, step: 0.05}]");
+  const std::string coarse =
+      test::replace_first(kCrankSlider, "sensitivities: [L2, {parameter: L3, step: 1e-3}]",
+                          "sensitivities: [{parameter: L2, step: 0.015}, {parameter: L3, step: 0.05}]");
   for (const std::string& text : {std::string(kCrankSlider), coarse}) {
     const bool large = text == coarse;
     const auto scenes = own_and_kept(text, "crank_slider.yaml");
@@ -148,12 +149,13 @@ TEST(Sensitivity, ADriversLawIsDifferentiatedAlongItsData) {
 // that at steps of 10 % the sensitivities of x_B stay at the closed form to 1e-9, in both forms, where the kept
 // models' differences along L3 are off by more than 10⁻⁶.
 TEST(Sensitivity, EquationsAreDifferentiatedAlongTheParametersTheirTextsRead) {
-  std::string text = test::replace_first(
-      kCrankSlider, "  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}\n"
-                    "  - {name: rod, type: distance, points: [A, B], length: L3}\n",
-      "  - {name: crank_x, type: equation, expr: \"xA - L2*cos(theta2)\", unit: length}\n"
-      "  - {name: crank_y, type: equation, expr: \"yA - L2*sin(theta2)\", unit: length}\n"
-      "  - {name: rod, type: equation, expr: \"((xB - xA)^2 + yA^2)/L3 - L3\", unit: length}\n");
+  std::string text =
+      test::replace_first(kCrankSlider,
+                          "  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}\n"
+                          "  - {name: rod, type: distance, points: [A, B], length: L3}\n",
+                          "  - {name: crank_x, type: equation, expr: \"xA - L2*cos(theta2)\", unit: length}\n"
+                          "  - {name: crank_y, type: equation, expr: \"yA - L2*sin(theta2)\", unit: length}\n"
+                          "  - {name: rod, type: equation, expr: \"((xB - xA)^2 + yA^2)/L3 - L3\", unit: length}\n");
   text = test::replace_first(text, "sensitivities: [L2, {parameter: L3, step: 1e-3}]",
                              "sensitivities: [{parameter: L2, step: 0.03}, {parameter: L3, step: 0.1}]");
   const auto scenes = own_and_kept(text, "crank_slider_equations.yaml");
@@ -203,7 +205,8 @@ TEST(Sensitivity, ARollersRadiusIsDifferentiatedByTheCamConstraint) {
       const double th = w * exact.rows.t[k], c = std::cos(th), sn = std::sin(th);
       const double D = std::sqrt(A * A - e * e * c * c), N = e * e * sn * c;
       const double d3 = std::pow(D, 3), d5 = std::pow(D, 5);
-      const double want[3] = {A / D, -w * N * A / d3, w * w * (3.0 * N * N * A / d5 - e * e * std::cos(2.0 * th) * A / d3)};
+      const double want[3] = {A / D, -w * N * A / d3,
+                              w * w * (3.0 * N * N * A / d5 - e * e * std::cos(2.0 * th) * A / d3)};
       const double scale[3] = {1.0, w, w * w};
       for (int o = 0; o < 3; ++o) {
         worst_exact = std::max(worst_exact, std::fabs(exact.s[k][layout.offset(0, o) + yf] - want[o]) / scale[o]);
@@ -259,8 +262,9 @@ TEST(Sensitivity, SpatialJointsDifferentiateTheirDataThroughTheScene) {
 // point B to L1 and L3, and their time derivatives, are the same in both, each kind giving its own derivatives. At a
 // 6 % step, where the bars' differences would be off by 2(h/L)⁴ ≈ 3·10⁻⁵.
 TEST(Sensitivity, TheFourBarInBarsAndInPinsHasOneSensitivity) {
-  const std::string output = "output: {velocities: true, accelerations: true, sensitivities: "
-                             "[{parameter: L1, step: 0.06}, {parameter: L3, step: 0.072}]}";
+  const std::string output =
+      "output: {velocities: true, accelerations: true, sensitivities: "
+      "[{parameter: L1, step: 0.06}, {parameter: L3, step: 0.072}]}";
   auto read = [&](const char* rel) {
     const std::string text = test::slurp(model_path(rel));
     return parse_scene(test::replace_first(text, "output: {velocities: true, accelerations: true}", output), rel);
@@ -269,7 +273,8 @@ TEST(Sensitivity, TheFourBarInBarsAndInPinsHasOneSensitivity) {
   for (const Scene* s : {&bars, &pins})
     for (const OutputSensitivity& p : s->sweep.sensitivities)
       for (const auto& r : p.reached->rates) EXPECT_NE(r, nullptr) << p.name;  // every reached span its own
-  const SensitivityTrace a = sweep_sensitivities(*bars.model, bars.sweep), b = sweep_sensitivities(*pins.model, pins.sweep);
+  const SensitivityTrace a = sweep_sensitivities(*bars.model, bars.sweep),
+                         b = sweep_sensitivities(*pins.model, pins.sweep);
   ASSERT_EQ(a.s.size(), 361u);
   ASSERT_EQ(b.s.size(), 361u);
   const Model& mb = *bars.model;
@@ -286,11 +291,10 @@ TEST(Sensitivity, TheFourBarInBarsAndInPinsHasOneSensitivity) {
       auto at = [&](int o, Index i) { return b.s[k][lp.offset(j, o) + i]; };
       const double s0 = at(0, p4), s1 = at(1, p4), s2 = at(2, p4);
       // ∂B/∂p, ∂Ḃ/∂p, ∂B̈/∂p from the rocker's ∂r4/∂p, ∂ψ4/∂p and their time derivatives
-      const double want[3][2] = {
-          {at(0, x4) - uy * s0, at(0, y4) + ux * s0},
-          {at(1, x4) - uy * s1 - ux * w * s0, at(1, y4) + ux * s1 - uy * w * s0},
-          {at(2, x4) - uy * s2 - ux * (al * s0 + 2 * w * s1) + uy * w * w * s0,
-           at(2, y4) + ux * s2 - uy * (al * s0 + 2 * w * s1) - ux * w * w * s0}};
+      const double want[3][2] = {{at(0, x4) - uy * s0, at(0, y4) + ux * s0},
+                                 {at(1, x4) - uy * s1 - ux * w * s0, at(1, y4) + ux * s1 - uy * w * s0},
+                                 {at(2, x4) - uy * s2 - ux * (al * s0 + 2 * w * s1) + uy * w * w * s0,
+                                  at(2, y4) + ux * s2 - uy * (al * s0 + 2 * w * s1) - ux * w * w * s0}};
       for (int o = 0; o < 3; ++o) {
         const double got[2] = {a.s[k][la.offset(j, o) + xb], a.s[k][la.offset(j, o) + yb]};
         for (int c = 0; c < 2; ++c) {

@@ -20,13 +20,13 @@
 namespace phiq {
 namespace {
 
-using test::model_path;
+using test::along;
 using test::kCrankSlider;
+using test::model_path;
 using test::SensitivityTrace;
-using test::sweep_sensitivities;
 using test::slider_derivatives;
 using test::slider_sensitivities;
-using test::along;
+using test::sweep_sensitivities;
 
 // The adjoint form (SensitivityForm::kAdjoint) against the direct one on the same sweep, every coordinate an
 // output: relative 1e-10 of each order's largest value, on planar, spatial and redundant scenes (the transposed
@@ -150,14 +150,14 @@ TEST(Sensitivity, TheFormIsChosenByItsCost) {
     }
 
   // With q̇ and q̈ and one output: the direct form for one parameter, the adjoint from two.
-  const Scene single = parse_scene(
-      test::replace_first(one, "sensitivities: [L2, {parameter: L3, step: 1e-3}]", "sensitivities: [L2]"),
-      "crank_slider.yaml");
+  const Scene single =
+      parse_scene(test::replace_first(one, "sensitivities: [L2, {parameter: L3, step: 1e-3}]", "sensitivities: [L2]"),
+                  "crank_slider.yaml");
   const SensitivityTrace rs = sweep_sensitivities(*single.model, single.sweep);
   EXPECT_EQ(rs.summary.sensitivity_form, SensitivityForm::kDirect);
   EXPECT_EQ(rs.summary.counters.sensitivity_solves, 91 * 3);
-  const Scene forced = parse_scene(
-      test::replace_first(one, "output: {", "output: {sensitivity_form: direct, "), "crank_slider.yaml");
+  const Scene forced =
+      parse_scene(test::replace_first(one, "output: {", "output: {sensitivity_form: direct, "), "crank_slider.yaml");
   EXPECT_EQ(forced.sweep.sensitivity_form, SensitivityForm::kDirect);
   const SensitivityTrace direct = sweep_sensitivities(*forced.model, forced.sweep);
   EXPECT_EQ(direct.summary.sensitivity_form, SensitivityForm::kDirect);
@@ -192,9 +192,9 @@ TEST(Sensitivity, TheFormIsChosenByItsCost) {
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 3, 2, 0), SensitivityForm::kAdjoint);
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 1, 1, 1), SensitivityForm::kDirect);  // 3, 4
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 1, 1), SensitivityForm::kAdjoint);
-  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 1, 1, 2), SensitivityForm::kDirect);  // 7, 11.5
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 1, 1, 2), SensitivityForm::kDirect);   // 7, 11.5
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 1, 2), SensitivityForm::kAdjoint);  // 14, 11.5
-  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 2, 2), SensitivityForm::kDirect);  // 14, 15.5
+  EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 2, 2, 2), SensitivityForm::kDirect);   // 14, 15.5
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAuto, 3, 2, 2), SensitivityForm::kAdjoint);
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kAdjoint, 1, 9, 2), SensitivityForm::kAdjoint);
   EXPECT_EQ(effective_sensitivity_form(SensitivityForm::kDirect, 9, 1, 0), SensitivityForm::kDirect);

@@ -23,8 +23,8 @@ namespace {
 
 using test::model_path;
 using test::SensitivityTrace;
-using test::sweep_sensitivities;
 using test::slider_sensitivities;
+using test::sweep_sensitivities;
 
 // An eccentric circular cam (radius R, eccentricity e, turning at ω) under a flat-faced follower: the face's height
 // is y = R + e sin ωt, so ∂y/∂R = 1, ∂y/∂e = sin ωt, ∂y/∂ω = e t cos ωt and their time derivatives, exactly. Over
@@ -61,13 +61,12 @@ TEST(Sensitivity, ACamsRadiusOverTenTurnsAgainstTheClosedForm) {
     double worst[3][3] = {};
     for (std::size_t k = 0; k < r.s.size(); ++k) {
       const double t = r.rows.t[k], c = std::cos(w * t), sn = std::sin(w * t);
-      const double exact[3][3] = {{1.0, 0.0, 0.0},                                             // R
-                                  {sn, w * c, -w * w * sn},                                     // e
+      const double exact[3][3] = {{1.0, 0.0, 0.0},                                                    // R
+                                  {sn, w * c, -w * w * sn},                                           // e
                                   {e * t * c, e * (c - w * t * sn), -e * w * (2 * sn + w * t * c)}};  // ω
       for (std::size_t j = 0; j < 3; ++j)
         for (int order = 0; order < 3; ++order)
-          worst[j][order] = std::max(worst[j][order],
-                                     std::fabs(r.s[k][layout.offset(j, order) + y] - exact[j][order]));
+          worst[j][order] = std::max(worst[j][order], std::fabs(r.s[k][layout.offset(j, order) + y] - exact[j][order]));
     }
     for (std::size_t j = 0; j < 3; ++j)
       for (int order = 0; order < 3; ++order)
@@ -84,7 +83,8 @@ TEST(Sensitivity, ACamsRadiusOverTenTurnsAgainstTheClosedForm) {
 Model slot_by_arc(double r, const Model* share = nullptr) {
   ModelBuilder b;
   const double s0 = 0.3;
-  const Index x = b.add_coordinate("x", 0.2 + r * std::cos(s0 / r)), y = b.add_coordinate("y", 0.1 + r * std::sin(s0 / r));
+  const Index x = b.add_coordinate("x", 0.2 + r * std::cos(s0 / r)),
+              y = b.add_coordinate("y", 0.1 + r * std::sin(s0 / r));
   PointOnCurveSpec slot;
   slot.a = Frame2{Slot::coordinate(x), Slot::coordinate(y), Slot{}};
   slot.on = CurveOn{Frame2{}, Curve::circle({0.2, 0.1}, r)};
@@ -122,9 +122,8 @@ TEST(Sensitivity, AConstraintReadingACoMovingCoordinateIsInTheReach) {
     double worst = 0.0;
     for (std::size_t k = 0; k < tr.s.size(); ++k) {
       const double phi = (0.3 + w * tr.rows.t[k]) / r, c = std::cos(phi), sn = std::sin(phi), g = w / r;
-      const double want[3][2] = {{c + phi * sn, sn - phi * c},
-                                 {g * phi * c, g * phi * sn},
-                                 {g * g * (c - phi * sn), g * g * (sn + phi * c)}};
+      const double want[3][2] = {
+          {c + phi * sn, sn - phi * c}, {g * phi * c, g * phi * sn}, {g * g * (c - phi * sn), g * g * (sn + phi * c)}};
       for (int order = 0; order < 3; ++order) {
         worst = std::max(worst, std::fabs(tr.s[k][layout.offset(0, order) + xi] - want[order][0]));
         worst = std::max(worst, std::fabs(tr.s[k][layout.offset(0, order) + yi] - want[order][1]));
@@ -286,9 +285,8 @@ TEST(Sensitivity, ModelsBuiltInCodeHaveTheirParametersDifferentiated) {
 TEST(Sensitivity, AStepperDeliversTheSensitivitiesOfEachStep) {
   const Model model = test::readme_crank_slider();
   StepperOptions so;
-  so.sensitivities = {
-      sensitivity_along(model, "L2", 0.3, readme_slider_along_l2),
-      sensitivity_along(model, "L3", 1.0, readme_slider_along_l3)};
+  so.sensitivities = {sensitivity_along(model, "L2", 0.3, readme_slider_along_l2),
+                      sensitivity_along(model, "L3", 1.0, readme_slider_along_l3)};
   const Index xb = model.coordinate_index("xB"), n = model.num_coordinates();
   const SensitivityLayout layout{n};
   {
@@ -323,9 +321,8 @@ TEST(Sensitivity, AStepperDeliversTheSensitivitiesOfEachStep) {
   adjoint.sensitivity_form = SensitivityForm::kAdjoint;
   EXPECT_THROW(Stepper(model, adjoint), Error);
   StepperOptions other = so;
-  other.sensitivities = {sensitivity_along(slot_by_arc(0.5), "r", 0.5, [](double v, const Model* m) {
-    return slot_by_arc(v, m);
-  })};
+  other.sensitivities = {
+      sensitivity_along(slot_by_arc(0.5), "r", 0.5, [](double v, const Model* m) { return slot_by_arc(v, m); })};
   try {
     Stepper refused(model, other);
     ADD_FAILURE() << "models of another mechanism were accepted";

@@ -25,18 +25,18 @@ namespace fs = std::filesystem;
 
 struct Swept {
   std::vector<double> t;
-  std::vector<Eigen::VectorXd> q[3];         // q, q̇, q̈
-  std::vector<std::vector<double>> s;        // sensitivities, when asked
-  std::string failure;                       // why the sweep failed, else ""
-  Index singular_rows = 0;                   // rows at a singular position (their sensitivities are NaN)
-  double min_rcond = 0.0;                    // the smallest reciprocal condition of Φq at a row
-  bool passes_singular = false;              // a bifurcation or ill-conditioning warning
+  std::vector<Eigen::VectorXd> q[3];   // q, q̇, q̈
+  std::vector<std::vector<double>> s;  // sensitivities, when asked
+  std::string failure;                 // why the sweep failed, else ""
+  Index singular_rows = 0;             // rows at a singular position (their sensitivities are NaN)
+  double min_rcond = 0.0;              // the smallest reciprocal condition of Φq at a row
+  bool passes_singular = false;        // a bifurcation or ill-conditioning warning
 };
 
 // The scene at parameter = value, swept as `phiq run` sweeps it, with q, q̇, q̈ and, when `sensitivity` is given,
 // its sensitivities.
 Swept sweep_scene_at(const std::string& text, const std::string& path, const std::string& parameter, double value,
-               const OutputSensitivity* sensitivity) {
+                     const OutputSensitivity* sensitivity) {
   Swept r;
   SceneOverrides o;
   o.parameters = {{parameter, value}};
@@ -55,16 +55,20 @@ Swept sweep_scene_at(const std::string& text, const std::string& path, const std
   ws.q = sq.start;
   SweepSummary sum;
   const Index size = SensitivityLayout{m.num_coordinates()}.size(s.sweep.sensitivities.size());
-  const SolveStatus st = run_sweep(m, s.sweep, ws, [&](const StepView& v) {
-    r.t.push_back(v.t);
-    r.q[0].push_back(v.q), r.q[1].push_back(*v.qd), r.q[2].push_back(*v.qdd);
-    if (v.sensitivities) r.s.emplace_back(v.sensitivities, v.sensitivities + size);
-    return true;
-  }, &sum);
+  const SolveStatus st = run_sweep(
+      m, s.sweep, ws,
+      [&](const StepView& v) {
+        r.t.push_back(v.t);
+        r.q[0].push_back(v.q), r.q[1].push_back(*v.qd), r.q[2].push_back(*v.qdd);
+        if (v.sensitivities) r.s.emplace_back(v.sensitivities, v.sensitivities + size);
+        return true;
+      },
+      &sum);
   if (st != SolveStatus::kSuccess) r.failure = sum.message;
   r.singular_rows = sum.singular_positions;
   r.min_rcond = sum.min_rcond;
-  for (const SweepWarning& w : sum.warnings) r.passes_singular |= w.kind == "bifurcation" || w.kind == "ill_conditioned";
+  for (const SweepWarning& w : sum.warnings)
+    r.passes_singular |= w.kind == "bifurcation" || w.kind == "ill_conditioned";
   return r;
 }
 
@@ -123,7 +127,8 @@ TEST(SensitivityScenes, EveryParameterOfEverySceneMatchesResolvedSweeps) {
         const Swept up2 = sweep_scene_at(text, path, name, value + delta / 2, nullptr);
         const Swept down2 = sweep_scene_at(text, path, name, value - delta / 2, nullptr);
         const std::string failure = up.failure + down.failure + up2.failure + down2.failure;
-        if (!failure.empty()) reference_failure = "a sweep at p ± δ fails (" + failure.substr(0, 80) + ")";
+        if (!failure.empty())
+          reference_failure = "a sweep at p ± δ fails (" + failure.substr(0, 80) + ")";
         else if (up.t != base.t || down.t != base.t || up2.t != base.t || down2.t != base.t)
           reference_failure = "it moves the time grid";
         if (!reference_failure.empty()) break;

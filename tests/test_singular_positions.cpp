@@ -139,9 +139,7 @@ TEST(SingularPositions, NFourBarFullTurnInWholeDegreesStaysOnTheParallelogram) {
   }
 }
 
-TEST(SingularPositions, ParallelSweepsPassThemAsTheSequentialOneDoes) {
-  full_turn_in_whole_degrees(10, 2);
-}
+TEST(SingularPositions, ParallelSweepsPassThemAsTheSequentialOneDoes) { full_turn_in_whole_degrees(10, 2); }
 
 // Steps that miss the singular positions: at each flat position all N loops of nfourbar are singular at once. A
 // single loop (N = 1) changes the sign of det Φq there, which the sweep reports at the first row after it; an even
@@ -287,11 +285,14 @@ void expect_parallelogram_branch(const std::string& scene, const std::vector<dou
   ws.q = p.q;
   SweepSummary sum;
   double worst = 0, worst_v = 0;
-  ASSERT_EQ(run_sweep(m, p.scene.sweep, ws, [&](const StepView& s) {
-              worst = std::max({worst, std::fabs(s.q[psi2] - s.q[psi1]), std::fabs(s.q[psic])});
-              worst_v = std::max({worst_v, std::fabs((*s.qd)[psi2] - 2 * M_PI), std::fabs((*s.qd)[psic])});
-              return true;
-            }, &sum),
+  ASSERT_EQ(run_sweep(
+                m, p.scene.sweep, ws,
+                [&](const StepView& s) {
+                  worst = std::max({worst, std::fabs(s.q[psi2] - s.q[psi1]), std::fabs(s.q[psic])});
+                  worst_v = std::max({worst_v, std::fabs((*s.qd)[psi2] - 2 * M_PI), std::fabs((*s.qd)[psic])});
+                  return true;
+                },
+                &sum),
             SolveStatus::kSuccess)
       << sum.message;
   // near a crossing Φq's smallest singular value is O(distance), so a residual at tolerance allows a larger
@@ -324,10 +325,13 @@ TEST(SingularPositions, ARockerDrivenBeyondItsRangeStopsAtTheDeadPointAndNamesIt
   ws.q = p.q;
   SweepSummary sum;
   double last_t = -1;
-  const SolveStatus st = run_sweep(*p.solved, p.scene.sweep, ws, [&](const StepView& s) {
-    last_t = s.t;
-    return true;
-  }, &sum);
+  const SolveStatus st = run_sweep(
+      *p.solved, p.scene.sweep, ws,
+      [&](const StepView& s) {
+        last_t = s.t;
+        return true;
+      },
+      &sum);
   ASSERT_NE(st, SolveStatus::kSuccess);
   const double t_star = std::acos(-7.0 / 8.0) - 2.2;
   EXPECT_EQ(sum.failed_time, 0.44);  // the grid row that could not be reached
@@ -357,7 +361,9 @@ std::string dead_point_scene(const std::string& end) {
          "  - {name: rocker, type: distance, points: [C, B], length: c}\n"
          "drivers:\n"
          "  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.5, rate: 1}}\n"
-         "time: {start: 0, end: " + end + ", steps: 20}\n"
+         "time: {start: 0, end: " +
+         end +
+         ", steps: 20}\n"
          "output: {velocities: true, accelerations: true}\n";
 }
 
@@ -371,14 +377,14 @@ Eigen::Vector2d dead_point_b(double th) {
 TEST(SingularPositions, ARowLandingOnADeadPointStopsThereInsteadOfReportingASpeed) {
   const double t_star = std::acos(7.0 / 32.0) - 0.5;
   for (const bool exact_end : {true, false}) {
-    const Scene scene = parse_scene(dead_point_scene(exact_end ? "acos(7/32) - 0.5" : "acos(7/32) - 0.5 - 1e-4"),
-                                    "dead.yaml");
+    const Scene scene =
+        parse_scene(dead_point_scene(exact_end ? "acos(7/32) - 0.5" : "acos(7/32) - 0.5 - 1e-4"), "dead.yaml");
     test::Trace tr;
     SweepSummary sum;
     const SolveStatus st = test::sweep(*scene.model, scene.sweep, &tr, &sum);
     const Index xb = scene.model->coordinate_index("xB"), yb = scene.model->coordinate_index("yB");
     for (std::size_t k = 0; k < tr.t.size(); ++k) {  // every delivered row on the closed form
-      const double th = 0.5 + tr.t[k], h = 1e-8;  // truncation ~h²/(t* − t)² of the speed
+      const double th = 0.5 + tr.t[k], h = 1e-8;     // truncation ~h²/(t* − t)² of the speed
       const Eigen::Vector2d b = dead_point_b(th), v = (dead_point_b(th + h) - dead_point_b(th - h)) / (2 * h);
       EXPECT_NEAR(tr.q[k](xb), b.x(), 1e-9) << "row " << k;
       EXPECT_NEAR(tr.q[k](yb), b.y(), 1e-9) << "row " << k;

@@ -124,8 +124,10 @@ TEST(SpatialScenes, MisalignedDoorViolatesOnlyItsThirdHinge) {
   const Eigen::VectorXd phi = Residual(m, q, 0.4);
   for (Index r = 0; r < m.num_equations(); ++r) {
     const std::string row = m.row_name(r);
-    if (row == "hinge3[0]") EXPECT_NEAR(phi(r), 0.01, 1e-15);  // ground point 1 cm along x: Φ = P_a − P_b
-    else EXPECT_LT(std::fabs(phi(r)), 1e-12) << row;
+    if (row == "hinge3[0]")
+      EXPECT_NEAR(phi(r), 0.01, 1e-15);  // ground point 1 cm along x: Φ = P_a − P_b
+    else
+      EXPECT_LT(std::fabs(phi(r)), 1e-12) << row;
   }
 }
 

@@ -239,14 +239,17 @@ TEST(SpatialTransmissions, RefusesBadDataNamingTheConstraint) {
   EXPECT_EQ(test::scene_error(head + "  - {name: sc, type: screw, between: [{body: ground}, {body: s}], pitch: 0}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'sc': screw: the pitch must not be zero (a screw of no "
             "pitch is a revolute joint)");
-  EXPECT_EQ(test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, h2], angles: [a, b], teeth: [9, 9]}\n"),
-            "bad.yaml:11:5: constraints[3]: constraint 'g': spatial_gear: the shafts are parallel at the placement "
-            "(parallel shafts mesh by a 'gear' between their rotation angles)");
-  EXPECT_EQ(test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, h1], angles: [a, b], teeth: [9, 9]}\n"),
-            "bad.yaml:11:43: constraints[3].shafts: the two shafts must be different joints");
-  EXPECT_EQ(test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, sl], angles: [a, b], teeth: [9, 9]}\n"),
-            "bad.yaml:11:48: constraints[3].shafts[1]: joint 'sl' is a prismatic joint: a shaft turns in a revolute, "
-            "cylindrical or screw joint");
+  EXPECT_EQ(
+      test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, h2], angles: [a, b], teeth: [9, 9]}\n"),
+      "bad.yaml:11:5: constraints[3]: constraint 'g': spatial_gear: the shafts are parallel at the placement "
+      "(parallel shafts mesh by a 'gear' between their rotation angles)");
+  EXPECT_EQ(
+      test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, h1], angles: [a, b], teeth: [9, 9]}\n"),
+      "bad.yaml:11:43: constraints[3].shafts: the two shafts must be different joints");
+  EXPECT_EQ(
+      test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, sl], angles: [a, b], teeth: [9, 9]}\n"),
+      "bad.yaml:11:48: constraints[3].shafts[1]: joint 'sl' is a prismatic joint: a shaft turns in a revolute, "
+      "cylindrical or screw joint");
   EXPECT_EQ(test::scene_error(head + "  - {name: c, type: polar, point: P, radius: 0, angle: a}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'c': polar: the radius is zero (the angle would be "
             "undetermined)");

@@ -27,7 +27,6 @@ SliderExact slider_exact(double t) {
   return {r * c + D, 2 * dx, 4 * ddx};
 }
 
-
 StepperOptions stepper_options(const SweepOptions& o) {
   StepperOptions s;
   static_cast<SolverSettings&>(s) = o;

@@ -91,13 +91,16 @@ void sweep_prepared(Prepared& p, Check check) {
   SweepSummary sum;
   Eigen::VectorXd phi(full.num_equations());
   Index rows = 0;
-  const SolveStatus st = run_sweep(*p.solved, p.scene.sweep, ws, [&](const StepView& s) {
-    full.residual(s.q.data(), s.t, phi.data());
-    EXPECT_LE(scaled_residual(full, phi), 1e-9) << "t = " << s.t;
-    check(s);
-    ++rows;
-    return true;
-  }, &sum);
+  const SolveStatus st = run_sweep(
+      *p.solved, p.scene.sweep, ws,
+      [&](const StepView& s) {
+        full.residual(s.q.data(), s.t, phi.data());
+        EXPECT_LE(scaled_residual(full, phi), 1e-9) << "t = " << s.t;
+        check(s);
+        ++rows;
+        return true;
+      },
+      &sum);
   ASSERT_EQ(st, SolveStatus::kSuccess) << sum.message;
   EXPECT_EQ(rows, p.scene.sweep.steps + 1);
 }
@@ -143,8 +146,8 @@ inline SweptScene sweep_scene(const std::string& rel) {
 inline Model crank_slider_model(double omega = 1.0, double theta0 = 0.0,
                                 LinearSolverKind lu = LinearSolverKind::kUmfpack) {
   ModelBuilder b;
-  Index th = b.add_coordinate("theta2", theta0), xa = b.add_coordinate("xA", 0.25),
-        ya = b.add_coordinate("yA", 0.05), xb = b.add_coordinate("xB", 1.2);
+  Index th = b.add_coordinate("theta2", theta0), xa = b.add_coordinate("xA", 0.25), ya = b.add_coordinate("yA", 0.05),
+        xb = b.add_coordinate("xB", 1.2);
   auto S = Slot::coordinate;
   auto C = Slot::constant;
   b.add("crank", PolarSpec{{S(xa), S(ya)}, {C(0), C(0)}, 0.3, S(th)});
@@ -160,8 +163,8 @@ inline Model nfourbar_model(Index n, double theta0, double rate, LinearSolverKin
   return phiq_bench::nfourbar(n, theta0, rate, lu);
 }
 
-// Its exact motion (the parallelogram, tools/accuracy/closed_forms.hpp) bound to the model's coordinates, for t in [0, 1]
-// (θ = theta0 + rate·t).
+// Its exact motion (the parallelogram, tools/accuracy/closed_forms.hpp) bound to the model's coordinates, for t in [0,
+// 1] (θ = theta0 + rate·t).
 inline std::unique_ptr<tools::ClosedForm> nfourbar_exact(const Model& m, double theta0, double rate) {
   char spec[96];
   std::snprintf(spec, sizeof spec, "nfourbar:from=%.17g,to=%.17g", theta0, theta0 + rate);
@@ -241,8 +244,8 @@ inline std::string generate_error(const tools::GenerateOptions& o) {
 inline Model readme_crank_slider(double l2 = 0.3, double l3 = 1.0, const MotionLaw& law = MotionLaw::linear(0.0, 2.0),
                                  const Model* share = nullptr) {
   ModelBuilder b;
-  const Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3),
-              ya = b.add_coordinate("yA", 0.0), xb = b.add_coordinate("xB", 1.3);
+  const Index th = b.add_coordinate("theta2", 0.0), xa = b.add_coordinate("xA", 0.3), ya = b.add_coordinate("yA", 0.0),
+              xb = b.add_coordinate("xB", 1.3);
   b.add("crank", PolarSpec{{Slot::coordinate(xa), Slot::coordinate(ya)}, {}, l2, Slot::coordinate(th)});
   b.add("rod", DistanceSpec{{Slot::coordinate(xa), Slot::coordinate(ya)}, {Slot::coordinate(xb), {}}, l3});
   b.add_driver("motor", th, law);

@@ -20,8 +20,9 @@ auto C = Slot::constant;
 // |OB| = 1.6) and acos(−0.68) (folded, |OB| = 0.8).
 Model rocker_driven(double from, double rate) {
   ModelBuilder b;
-  Index xa = b.add_coordinate("xA", 0.1), ya = b.add_coordinate("yA", 0.4), xb = b.add_coordinate("xB", 1.0 + std::cos(from)),
-        yb = b.add_coordinate("yB", std::sin(from)), th4 = b.add_coordinate("theta4", from);
+  Index xa = b.add_coordinate("xA", 0.1), ya = b.add_coordinate("yA", 0.4),
+        xb = b.add_coordinate("xB", 1.0 + std::cos(from)), yb = b.add_coordinate("yB", std::sin(from)),
+        th4 = b.add_coordinate("theta4", from);
   Point2 O{C(0), C(0)}, A{S(xa), S(ya)}, B{S(xb), S(yb)}, Cc{C(1), C(0)};
   b.add("crank", DistanceSpec{O, A, 0.4});
   b.add("coupler", DistanceSpec{A, B, 1.2});
@@ -58,8 +59,8 @@ TEST(Sweep, ALawNotDefinedAheadStopsNamingTheDriver) {
   // "a dead point" or "the drive leaves the reachable range" (what the failure was reported as).
   for (const auto& [law, t_end, t_star] : {std::tuple{"sqrt(1 - t)", 2.0, 1.0}, std::tuple{"exp(t)", 720.0, 709.78}}) {
     const Scene sc = parse_scene(std::string("coordinates: {x: 1}\ndrivers:\n  - {name: push, coordinate: x, law: "
-                                             "{type: expression, f: \"") + law + "\"}}\ntime: {start: 0, end: " +
-                                     std::to_string(t_end) + ", steps: 4}\n",
+                                             "{type: expression, f: \"") +
+                                     law + "\"}}\ntime: {start: 0, end: " + std::to_string(t_end) + ", steps: 4}\n",
                                  "law.yaml");
     Workspace ws(*sc.model);
     SweepSummary sum;
@@ -155,9 +156,9 @@ TEST(Sweep, PredictorsReachTheSameSolutions) {
 
 // Each order of extrapolation saves Newton iterations, with positions only (the parabola against the previous
 // position and the secant), with q̇ only (linear → hermite) and with q̇, q̈ (linear → quadratic → cubic), and the
-// solutions stay within the tolerance of the closed form. On finer steps the cubic predictor errs by about 1e-11 m per step, so that most steps are
-// accepted without a Newton step (predict()'s error budget brings one when the carried errors add up to the
-// tolerance).
+// solutions stay within the tolerance of the closed form. On finer steps the cubic predictor errs by about 1e-11 m per
+// step, so that most steps are accepted without a Newton step (predict()'s error budget brings one when the carried
+// errors add up to the tolerance).
 TEST(Sweep, BetterPredictorsNeedFewerNewtonIterations) {
   Model m = crank_slider();
   auto iterations = [&](Predictor p, bool derivatives, Index steps, bool accelerations = true) {
@@ -173,11 +174,13 @@ TEST(Sweep, BetterPredictorsNeedFewerNewtonIterations) {
     for (std::size_t k = 0; k < tr.t.size(); ++k) EXPECT_NEAR(tr.q[k](3), slider_x(tr.t[k]), 2e-10) << to_string(p);
     return sum.counters.newton_iterations;
   };
-  const Index previous = iterations(Predictor::kPrevious, false, 720), secant = iterations(Predictor::kSecant, false, 720),
+  const Index previous = iterations(Predictor::kPrevious, false, 720),
+              secant = iterations(Predictor::kSecant, false, 720),
               parabolic = iterations(Predictor::kParabolic, false, 720);
   EXPECT_LT(parabolic, secant);
   EXPECT_LT(parabolic, previous);
-  const Index linear = iterations(Predictor::kLinear, true, 720), quadratic = iterations(Predictor::kQuadratic, true, 720),
+  const Index linear = iterations(Predictor::kLinear, true, 720),
+              quadratic = iterations(Predictor::kQuadratic, true, 720),
               cubic = iterations(Predictor::kCubic, true, 720);
   EXPECT_LT(quadratic, linear);
   EXPECT_LT(cubic, quadratic);
@@ -196,17 +199,18 @@ TEST(Sweep, BetterPredictorsNeedFewerNewtonIterations) {
   // weighs the errors of three rows, by |−3/2| + 3 + |−1/2| = 5 at equal steps, where the cubic's carries its
   // current row's only, so the carried errors reach the tolerance sooner.
   EXPECT_LT(fine_hermite, 2880 * 3 / 5);
-  std::printf("Newton iterations over 720 steps: previous %ld, secant %ld, parabolic %ld; linear %ld, quadratic %ld, "
-              "cubic %ld; q̇ only: linear %ld, hermite %ld; over 2880 steps: quadratic %ld, cubic %ld, hermite %ld\n",
-              static_cast<long>(previous), static_cast<long>(secant), static_cast<long>(parabolic),
-              static_cast<long>(linear), static_cast<long>(quadratic), static_cast<long>(cubic),
-              static_cast<long>(linear_v), static_cast<long>(hermite), static_cast<long>(fine_quadratic),
-              static_cast<long>(fine_cubic), static_cast<long>(fine_hermite));
+  std::printf(
+      "Newton iterations over 720 steps: previous %ld, secant %ld, parabolic %ld; linear %ld, quadratic %ld, "
+      "cubic %ld; q̇ only: linear %ld, hermite %ld; over 2880 steps: quadratic %ld, cubic %ld, hermite %ld\n",
+      static_cast<long>(previous), static_cast<long>(secant), static_cast<long>(parabolic), static_cast<long>(linear),
+      static_cast<long>(quadratic), static_cast<long>(cubic), static_cast<long>(linear_v), static_cast<long>(hermite),
+      static_cast<long>(fine_quadratic), static_cast<long>(fine_cubic), static_cast<long>(fine_hermite));
 }
 
 // The hermite predictor is the cubic through the current row (position and velocity) and the two rows before: a
-// coordinate driven by a cubic law is predicted exactly once three rows are known, and its error estimate (the next, quartic term) is then zero, so those steps take no Newton iteration; a quartic law is
-// not (the estimate sees the quartic term).
+// coordinate driven by a cubic law is predicted exactly once three rows are known, and its error estimate (the next,
+// quartic term) is then zero, so those steps take no Newton iteration; a quartic law is not (the estimate sees the
+// quartic term).
 TEST(Sweep, HermitePredictorIsExactForCubicMotion) {
   auto sweep = [](std::vector<double> coefficients) {
     ModelBuilder b;
@@ -224,11 +228,14 @@ TEST(Sweep, HermitePredictorIsExactForCubicMotion) {
     Workspace ws(m);
     SweepSummary sum;
     Index before = 0;
-    (void)run_sweep(m, opt, ws, [&](const StepView&) {  // its status is sum.status, checked below
-      per_row.push_back(ws.counters.newton_iterations - before);
-      before = ws.counters.newton_iterations;
-      return true;
-    }, &sum);
+    (void)run_sweep(
+        m, opt, ws,
+        [&](const StepView&) {  // its status is sum.status, checked below
+          per_row.push_back(ws.counters.newton_iterations - before);
+          before = ws.counters.newton_iterations;
+          return true;
+        },
+        &sum);
     EXPECT_EQ(sum.status, SolveStatus::kSuccess) << sum.message;
     return per_row;
   };
@@ -285,7 +292,8 @@ TEST(Sweep, SettingsNoSweepCanHonourAreRefusedBeforeTheFirstRow) {
       Workspace ws(m);
       Index rows = 0;
       try {
-        (void)run_sweep(m, opt, ws, [&](const StepView&) { return ++rows, true; }, nullptr);  // throws: the test
+        (void)run_sweep(
+            m, opt, ws, [&](const StepView&) { return ++rows, true; }, nullptr);  // throws: the test
       } catch (const Error& e) {
         EXPECT_EQ(rows, 0) << e.what();
         return e.what();
@@ -298,8 +306,7 @@ TEST(Sweep, SettingsNoSweepCanHonourAreRefusedBeforeTheFirstRow) {
               "SweepOptions::newton: max_contraction must be in (0, 1)");
     EXPECT_EQ(refusal([](SweepOptions& o) { o.assembly.max_iterations = -1; }),
               "SweepOptions::assembly: max_iterations must be >= 0");
-    EXPECT_EQ(refusal([](SweepOptions& o) { o.max_subdivisions = -1; }),
-              "SweepOptions: max_subdivisions must be >= 0");
+    EXPECT_EQ(refusal([](SweepOptions& o) { o.max_subdivisions = -1; }), "SweepOptions: max_subdivisions must be >= 0");
     EXPECT_EQ(refusal([](SweepOptions& o) { o.predictor = static_cast<Predictor>(99); }),
               "SweepOptions: predictor is not a Predictor");
     EXPECT_EQ(refusal([](SweepOptions& o) { o.max_subdivisions = 0; }), "accepted");
@@ -322,7 +329,8 @@ TEST(Sweep, ATimeGridWhoseStepsDoNotMoveTimeIsRefused) {
       Index rows = 0;
       SweepSummary sum;
       try {
-        (void)run_sweep(m, opt, ws, [&](const StepView&) { return ++rows, true; }, &sum);  // throws: the test
+        (void)run_sweep(
+            m, opt, ws, [&](const StepView&) { return ++rows, true; }, &sum);  // throws: the test
       } catch (const Error& e) {
         EXPECT_EQ(rows, 0) << e.what();
         return e.what();
@@ -375,7 +383,9 @@ TEST(Sweep, CallbackCanStopTheSweep) {
   opt.steps = 50;
   int rows = 0;
   SweepSummary sum;
-  EXPECT_EQ(run_sweep(m, opt, ws, [&](const StepView&) { return ++rows < 5; }, &sum), SolveStatus::kCancelled);
+  EXPECT_EQ(run_sweep(
+                m, opt, ws, [&](const StepView&) { return ++rows < 5; }, &sum),
+            SolveStatus::kCancelled);
   EXPECT_EQ(rows, 5);
 }
 
@@ -399,7 +409,6 @@ TEST(Sweep, ReverseTimeAndSingleStepSweeps) {
   EXPECT_NEAR(one.q[0](3), tr.q.front()(3), 1e-12);
 }
 
-
 // A warning that recurs is said once per stretch of rows (detail::once_per_stretch, run_sweep's slow_convergence):
 // consecutive rows and rows up to two quiet rows apart join one stretch, whose first warning says how far it went
 // and, with quiet rows in it, how many of its rows warned; a sub-step's warning stands alone; other kinds keep their
@@ -410,10 +419,18 @@ TEST(Sweep, ARecurringWarningIsSaidOncePerStretchOfRows) {
   auto at = [&](double row, const char* kind = "slow_convergence") {
     return SweepWarning{1.0 + row / 100.0, kind, std::string("w") + std::to_string(static_cast<int>(row * 10))};
   };
-  std::vector<SweepWarning> w = {at(3), at(4), at(5),             // consecutive: one stretch
-                                 at(9), at(11), at(12), at(15),   // 1 and 2 quiet rows between: one stretch
-                                 at(19, "ill_conditioned"),       // another kind, in its place
-                                 at(19), at(22.5), at(23), at(40)};  // a sub-step alone, 3 quiet rows: new stretches
+  std::vector<SweepWarning> w = {at(3),
+                                 at(4),
+                                 at(5),  // consecutive: one stretch
+                                 at(9),
+                                 at(11),
+                                 at(12),
+                                 at(15),                     // 1 and 2 quiet rows between: one stretch
+                                 at(19, "ill_conditioned"),  // another kind, in its place
+                                 at(19),
+                                 at(22.5),
+                                 at(23),
+                                 at(40)};  // a sub-step alone, 3 quiet rows: new stretches
   detail::once_per_stretch(w, "slow_convergence", opt);
   ASSERT_EQ(w.size(), 7u);
   EXPECT_EQ(w[0].message, "w30; the same at the next 2 rows, to t = 1.05");

@@ -44,7 +44,8 @@ class SweepAccuracy : public ::testing::Test {
   };
   Result run(const std::string& args) {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(PHIQ_CLI) + " sweep-accuracy " + args + " >" + out.string() + " 2>" + err.string();
+    const std::string cmd =
+        std::string(PHIQ_CLI) + " sweep-accuracy " + args + " >" + out.string() + " 2>" + err.string();
     const int st = std::system(cmd.c_str());
     return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(out), slurp(err)};
   }
@@ -78,11 +79,12 @@ TEST_F(SweepAccuracy, CrankSliderGridAgainstItsClosedForm) {
   const fs::path csv = dir_ / "acc.csv";
   Result r = run(seed("crank_slider_mixed") +
                  " --tolerances 1e-6,1e-10,1e-12 --steps-list 45,180 --predictors previous,cubic --newton modified"
-                 " --linear-solvers klu --repeat 1 -o " + csv.string());
+                 " --linear-solvers klu --repeat 1 -o " +
+                 csv.string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(slurp(csv).substr(0, slurp(csv).find('\n')), kHeader);
   const auto rs = rows(csv);
-  ASSERT_EQ(rs.size(), 12u);  // 3 tolerances × 2 step counts × 2 predictors
+  ASSERT_EQ(rs.size(), 12u);            // 3 tolerances × 2 step counts × 2 predictors
   std::map<std::string, double> err_q;  // "steps/predictor/tolerance" → err_q
   int defaults = 0;
   for (const auto& row : rs) {
@@ -95,7 +97,8 @@ TEST_F(SweepAccuracy, CrankSliderGridAgainstItsClosedForm) {
     for (const char* e : {"err_q", "err_v", "err_a"}) EXPECT_GE(std::stod(row.at(e)), 0.0) << e;
     err_q[row.at("steps") + "/" + row.at("predictor") + "/" + row.at("tolerance")] = std::stod(row.at("err_q"));
     // the scene's own settings: 180 steps, tolerance 1e-10, auto = cubic (it outputs q̈), modified Newton, KLU
-    const bool is_default = row.at("steps") == "180" && row.at("tolerance") == "1e-10" && row.at("predictor") == "cubic";
+    const bool is_default =
+        row.at("steps") == "180" && row.at("tolerance") == "1e-10" && row.at("predictor") == "cubic";
     EXPECT_EQ(row.at("default"), is_default ? "1" : "0");
     defaults += is_default;
   }
@@ -110,8 +113,10 @@ TEST_F(SweepAccuracy, CrankSliderGridAgainstItsClosedForm) {
 
 TEST_F(SweepAccuracy, JsonHasTheSettingsTheDefaultAndTheReference) {
   const fs::path json = dir_ / "acc.json";
-  Result r = run(seed("fourbar_natural") + " --tolerances 1e-5,1e-12 --steps-list 90 --predictors quadratic"
-                 " --newton modified,full --linear-solvers klu,umfpack --repeat 1 --json " + json.string());
+  Result r = run(seed("fourbar_natural") +
+                 " --tolerances 1e-5,1e-12 --steps-list 90 --predictors quadratic"
+                 " --newton modified,full --linear-solvers klu,umfpack --repeat 1 --json " +
+                 json.string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(r.out.empty());  // with --json and no -o, nothing on standard output
   const auto j = nlohmann::json::parse(slurp(json));
@@ -147,8 +152,10 @@ TEST_F(SweepAccuracy, WithoutAClosedFormTheReferenceIsTheSceneAtTightTolerance) 
   for (const char* scene : {"slider.yaml", "wrong.yaml"}) {
     const fs::path csv = dir_ / "acc.csv";
     // modified Newton: full Newton's quadratic convergence overshoots any tolerance here (error 2e-16 at 1e-5)
-    Result r = run((dir_ / scene).string() + " --tolerances 1e-4,1e-12 --steps-list 60 --predictors quadratic"
-                   " --newton modified --linear-solvers klu --repeat 1 -o " + csv.string());
+    Result r = run((dir_ / scene).string() +
+                   " --tolerances 1e-4,1e-12 --steps-list 60 --predictors quadratic"
+                   " --newton modified --linear-solvers klu --repeat 1 -o " +
+                   csv.string());
     ASSERT_EQ(r.code, 0) << r.err;
     const auto rs = rows(csv);
     ASSERT_EQ(rs.size(), 2u);
@@ -168,7 +175,8 @@ TEST_F(SweepAccuracy, RedundantScenesAreSweptAsPhiqRunSweepsThem) {
   const fs::path csv = dir_ / "acc.csv";
   Result r = run(test::model_path("redundant/door_three_hinges.yaml") +
                  " --tolerances 1e-4,1e-11 --steps-list 30 --predictors previous --newton full --linear-solvers klu"
-                 " --repeat 1 -o " + csv.string());
+                 " --repeat 1 -o " +
+                 csv.string());
   ASSERT_EQ(r.code, 0) << r.err;
   const auto rs = rows(csv);
   ASSERT_EQ(rs.size(), 2u);
@@ -200,7 +208,7 @@ TEST_F(SweepAccuracy, BadInputIsOneLineAndWritesNothing) {
       {cs + " --newton half", "--newton"},
       {cs + " --linear-solvers mumps", "--linear-solvers"},
       {cs + " --repeat 0", "--repeat"},
-      {cs + " --reference closed-form:fourbar", "does not satisfy"},     // the wrong mechanism, asked for explicitly
+      {cs + " --reference closed-form:fourbar", "does not satisfy"},  // the wrong mechanism, asked for explicitly
       {cs + " --reference closed-form:crank-slider:omega=3", "does not satisfy"},  // the wrong drive
       {cs + " --reference closed-form:pendulum", "unknown closed form"},
       {seed("fourbar_natural") + " --reference closed-form:fourbar:branch=-1", "another assembly branch"},
@@ -256,7 +264,8 @@ TEST_F(SweepAccuracy, CtrlCWritesNothing) {
   // nfourbar 200 over a long grid, interrupted after a moment (SIGINT, or SIGTERM as from a job scheduler): exit
   // 128 + the signal, no file, no temporary left
   const fs::path scene = dir_ / "nf.yaml", csv = dir_ / "acc.csv", json = dir_ / "acc.json";
-  ASSERT_EQ(std::system((std::string(PHIQ_CLI) + " generate nfourbar 200 --steps 400 -o " + scene.string()).c_str()), 0);
+  ASSERT_EQ(std::system((std::string(PHIQ_CLI) + " generate nfourbar 200 --steps 400 -o " + scene.string()).c_str()),
+            0);
   for (const auto& [sig, status] : {std::pair<std::string, std::string>{"INT", "130\n"}, {"TERM", "143\n"}}) {
     const std::string cmd = "sh -c '" + std::string(PHIQ_CLI) + " sweep-accuracy " + scene.string() + " -o " +
                             csv.string() + " --json " + json.string() + " 2>" + (dir_ / "err.txt").string() +
@@ -276,14 +285,15 @@ TEST_F(SweepAccuracy, CtrlCWritesNothing) {
 TEST(SweepAccuracyApi, DefaultGridSkipsPredictorsTheSceneCannotFeed) {
   // Positions only: linear, quadratic and cubic need q̇ / q̈, which the scene does not compute; they are left out,
   // said so.
-  std::string text = "phiq: 1\nname: crank_slider_positions\nparameters: {L2: 0.3, L3: 1.0}\n"
-                     "coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}\n"
-                     "points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}\n"
-                     "constraints:\n"
-                     "  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}\n"
-                     "  - {name: rod, type: distance, points: [A, B], length: L3}\n"
-                     "drivers:\n  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}\n"
-                     "time: {start: 0, end: pi, steps: 40}\noutput: {velocities: false, accelerations: false}\n";
+  std::string text =
+      "phiq: 1\nname: crank_slider_positions\nparameters: {L2: 0.3, L3: 1.0}\n"
+      "coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}\n"
+      "points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}\n"
+      "constraints:\n"
+      "  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}\n"
+      "  - {name: rod, type: distance, points: [A, B], length: L3}\n"
+      "drivers:\n  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}\n"
+      "time: {start: 0, end: pi, steps: 40}\noutput: {velocities: false, accelerations: false}\n";
   Scene s = parse_scene(text, "positions.yaml");
   tools::AccuracyOptions o;
   o.tolerances = {1e-6, 1e-12};

@@ -56,9 +56,9 @@ Record record(const Model& model, SweepOptions opt, int threads, Workspace* reus
   o << to_string(st) << '|' << sum.message << '|' << sum.steps_completed << '|' << sum.failed_step << '|'
     << sum.subdivisions << '|' << sum.singular_positions << '|' << sum.min_rcond << '@' << sum.min_rcond_time << '|'
     << sum.parallel_chunks << '|' << c.newton_iterations << ' ' << c.residual_evaluations << ' '
-    << c.jacobian_evaluations << ' ' << c.factorizations << ' ' << c.pivoting_factorizations << ' '
-    << c.velocity_solves << ' ' << c.acceleration_solves << ' ' << c.phi_t_evaluations << ' '
-    << c.gamma_evaluations << ' ' << c.point_evaluations;
+    << c.jacobian_evaluations << ' ' << c.factorizations << ' ' << c.pivoting_factorizations << ' ' << c.velocity_solves
+    << ' ' << c.acceleration_solves << ' ' << c.phi_t_evaluations << ' ' << c.gamma_evaluations << ' '
+    << c.point_evaluations;
   for (const RowClassAccuracy* a : {&sum.accuracy.converged, &sum.accuracy.rounding_level, &sum.accuracy.singular})
     o << '|' << a->rows << ' ' << a->worst_error << '@' << a->worst_time << ' ' << a->unestimated;
   for (const SweepWarning& w : sum.warnings) o << '\n' << w.t << ' ' << w.kind << ' ' << w.message;

@@ -314,13 +314,14 @@ TEST(ParallelSweep, AnExceptionFromTheCallbackPropagates) {
   for (Index throw_at : {Index{0}, Index{3}, Index{57}, Index{400}}) {
     Workspace ws(m);
     Index seen = 0;
-    EXPECT_THROW((void)run_sweep(m, opt, ws,
-                           [&](const StepView& v) {
-                             if (v.step == throw_at) throw std::runtime_error("stop here");
-                             ++seen;
-                             return true;
-                           },
-                           nullptr),
+    EXPECT_THROW((void)run_sweep(
+                     m, opt, ws,
+                     [&](const StepView& v) {
+                       if (v.step == throw_at) throw std::runtime_error("stop here");
+                       ++seen;
+                       return true;
+                     },
+                     nullptr),
                  std::runtime_error);
     EXPECT_EQ(seen, throw_at);
   }

@@ -74,8 +74,8 @@ TEST(SweepRowWriter, EncodedRowsAreTheBytesAStepCallbackWritesOnEveryThreadCount
     {
       Workspace ws(*solved);
       ws.q = q;
-      (void)run_sweep(*solved, opt, ws, [&](const StepView& s) { return csv.append_row(s, by_callback), true; },
-                      &callback_sum);
+      (void)run_sweep(
+          *solved, opt, ws, [&](const StepView& s) { return csv.append_row(s, by_callback), true; }, &callback_sum);
     }
     ASSERT_FALSE(by_callback.empty()) << what;
     for (int threads : {1, 2, 3}) {
@@ -85,8 +85,8 @@ TEST(SweepRowWriter, EncodedRowsAreTheBytesAStepCallbackWritesOnEveryThreadCount
       WrittenCsvRows rows(csv);
       SweepSummary sum;
       (void)run_sweep(*solved, opt, ws, rows, &sum);
-      EXPECT_TRUE(rows.text == by_callback) << what << ": the rows written on " << threads
-                                            << " threads differ from a step callback's";
+      EXPECT_TRUE(rows.text == by_callback)
+          << what << ": the rows written on " << threads << " threads differ from a step callback's";
       EXPECT_EQ(writer_summary_text(sum), writer_summary_text(callback_sum)) << what << ", " << threads << " threads";
       EXPECT_EQ(rows.written_rows, std::count(by_callback.begin(), by_callback.end(), '\n')) << what;
     }

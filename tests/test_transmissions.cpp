@@ -16,7 +16,6 @@
 namespace phiq {
 namespace {
 
-
 TEST(Transmissions, GearDerivatives) {
   GearSpec external{{}, S(0), S(1), Slot::constant(0.0), 0.03, 0.09, false, 0.2, 2};
   CheckSpec(external, 2, Opts(2701));
@@ -189,8 +188,9 @@ TEST(Transmissions, RefusesBadData) {
 }
 
 TEST(Transmissions, SceneErrorsNameTheField) {
-  const std::string head = "phiq: 1\ncoordinates: {x: 0, y: 0, psi: 0}\nbodies: {g: [x, y, psi]}\n"
-                           "time: {start: 0, end: 1, steps: 1}\nconstraints:\n";
+  const std::string head =
+      "phiq: 1\ncoordinates: {x: 0, y: 0, psi: 0}\nbodies: {g: [x, y, psi]}\n"
+      "time: {start: 0, end: 1, steps: 1}\nconstraints:\n";
   EXPECT_EQ(test::scene_error(head + "  - {name: m, type: gear, between: [g, psi], radii: [1, 2], teeth: [1, 2]}\n"),
             "bad.yaml:6:5: constraints[0]: give either 'radii: [r1, r2]' or 'teeth: [z1, z2]'");
   EXPECT_EQ(test::scene_error(head + "  - {name: m, type: gear, between: [g, nope], teeth: [12, 30]}\n"),

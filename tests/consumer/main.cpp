@@ -21,9 +21,8 @@ int main() {
   using namespace phiq;
   const double a = 0.4, b = 1.2, c = 1.0, d = 1.0, omega = 1.5;  // crank, coupler, rocker, ground; rad/s
   ModelBuilder mb;
-  const Index xa = mb.add_coordinate("xA", 0.38), ya = mb.add_coordinate("yA", 0.05),
-              xb = mb.add_coordinate("xB", 1.1), yb = mb.add_coordinate("yB", 0.95),
-              th = mb.add_coordinate("theta2", 0.0);
+  const Index xa = mb.add_coordinate("xA", 0.38), ya = mb.add_coordinate("yA", 0.05), xb = mb.add_coordinate("xB", 1.1),
+              yb = mb.add_coordinate("yB", 0.95), th = mb.add_coordinate("theta2", 0.0);
   const auto S = Slot::coordinate;
   const auto C = Slot::constant;
   const Point2 O{C(0), C(0)}, A{S(xa), S(ya)}, B{S(xb), S(yb)}, Cc{C(d), C(0)};

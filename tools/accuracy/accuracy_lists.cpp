@@ -63,9 +63,12 @@ std::vector<Predictor> parse_predictors(const std::string& list) {
 std::vector<JacobianUpdate> parse_newton(const std::string& list) {
   std::vector<JacobianUpdate> out;
   for (const std::string& item : split(list, "--newton")) {
-    if (item == "modified") out.push_back(JacobianUpdate::kWhenSlow);
-    else if (item == "full") out.push_back(JacobianUpdate::kEveryIteration);
-    else throw std::invalid_argument("--newton: '" + item + "' is modified or full");
+    if (item == "modified")
+      out.push_back(JacobianUpdate::kWhenSlow);
+    else if (item == "full")
+      out.push_back(JacobianUpdate::kEveryIteration);
+    else
+      throw std::invalid_argument("--newton: '" + item + "' is modified or full");
   }
   return out;
 }
@@ -73,10 +76,14 @@ std::vector<JacobianUpdate> parse_newton(const std::string& list) {
 std::vector<LinearSolverKind> parse_linear_solvers(const std::string& list) {
   std::vector<LinearSolverKind> out;
   for (const std::string& item : split(list, "--linear-solvers")) {
-    if (item == "klu") out.push_back(LinearSolverKind::kKlu);
-    else if (item == "umfpack") out.push_back(LinearSolverKind::kUmfpack);
-    else if (item == "dense") out.push_back(LinearSolverKind::kDense);
-    else throw std::invalid_argument("--linear-solvers: '" + item + "' is klu, umfpack or dense");
+    if (item == "klu")
+      out.push_back(LinearSolverKind::kKlu);
+    else if (item == "umfpack")
+      out.push_back(LinearSolverKind::kUmfpack);
+    else if (item == "dense")
+      out.push_back(LinearSolverKind::kDense);
+    else
+      throw std::invalid_argument("--linear-solvers: '" + item + "' is klu, umfpack or dense");
   }
   return out;
 }

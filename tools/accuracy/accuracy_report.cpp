@@ -30,11 +30,12 @@ std::string accuracy_csv(const AccuracyReport& r) {
   const std::string scene = csv_field(r.scene_name.empty() ? r.scene_path : r.scene_name);
   for (const AccuracyRow& row : r.rows) {
     const AccuracySetting& st = row.setting;
-    s += scene + "," + csv_field(r.reference_kind) + "," + shortest(st.tolerance) + "," + std::to_string(st.steps) + "," +
-         to_string(st.predictor) + "," + newton_name(st.newton) + "," + to_string(st.linear_solver) + "," +
-         significant_or_empty(row.err_q, 6) + "," + significant_or_empty(row.err_v, 6) + "," + significant_or_empty(row.err_a, 6) + "," +
-         significant_or_empty(row.iterations_per_step, 6) + "," + significant_or_empty(row.factorizations_per_step, 6) + "," +
-         significant_or_empty(row.us_per_step, 4) + "," + csv_field(row.status) + "," + (row.is_default ? "1" : "0") + "\n";
+    s += scene + "," + csv_field(r.reference_kind) + "," + shortest(st.tolerance) + "," + std::to_string(st.steps) +
+         "," + to_string(st.predictor) + "," + newton_name(st.newton) + "," + to_string(st.linear_solver) + "," +
+         significant_or_empty(row.err_q, 6) + "," + significant_or_empty(row.err_v, 6) + "," +
+         significant_or_empty(row.err_a, 6) + "," + significant_or_empty(row.iterations_per_step, 6) + "," +
+         significant_or_empty(row.factorizations_per_step, 6) + "," + significant_or_empty(row.us_per_step, 4) + "," +
+         csv_field(row.status) + "," + (row.is_default ? "1" : "0") + "\n";
   }
   return s;
 }

@@ -38,7 +38,8 @@ class Params {
   }
   std::string describe() const {
     std::string s = kind_ + ":";
-    for (std::size_t k = 0; k < values_.size(); ++k) s += (k ? "," : "") + values_[k].first + "=" + shortest(values_[k].second);
+    for (std::size_t k = 0; k < values_.size(); ++k)
+      s += (k ? "," : "") + values_[k].first + "=" + shortest(values_[k].second);
     return s;
   }
 
@@ -81,11 +82,16 @@ class CrankSlider final : public ClosedForm {
 
  protected:
   bool terms_of(const std::string& n, Binding& b) const override {
-    if (n == "theta2") b = {{{Term::kAngle, 0, 1.0}}, true};
-    else if (n == "xA") b = {{{Term::kCos, 0, L2_}}, false};
-    else if (n == "yA") b = {{{Term::kSin, 0, L2_}}, false};
-    else if (n == "xB") b = {{{Term::kCos, 0, L2_}, {Term::kCos, 1, L3_}}, false};
-    else return false;
+    if (n == "theta2")
+      b = {{{Term::kAngle, 0, 1.0}}, true};
+    else if (n == "xA")
+      b = {{{Term::kCos, 0, L2_}}, false};
+    else if (n == "yA")
+      b = {{{Term::kSin, 0, L2_}}, false};
+    else if (n == "xB")
+      b = {{{Term::kCos, 0, L2_}, {Term::kCos, 1, L3_}}, false};
+    else
+      return false;
     return true;
   }
   void angles(double t, std::vector<Motion>& out) const override {
@@ -124,24 +130,40 @@ class FourBar final : public ClosedForm {
     const T xA{T::kCos, 0, L2_}, yA{T::kSin, 0, L2_}, xB0{T::kConstant, -1, L1_}, xB{T::kCos, 2, L4_},
         yB{T::kSin, 2, L4_};
     // natural and mixed: points A, B and the crank angle
-    if (n == "theta2" || n == "psi2") b = {{{T::kAngle, 0, 1.0}}, true};
-    else if (n == "xA") b = {{xA}, false};
-    else if (n == "yA") b = {{yA}, false};
-    else if (n == "xB") b = {{xB0, xB}, false};
-    else if (n == "yB") b = {{yB}, false};
+    if (n == "theta2" || n == "psi2")
+      b = {{{T::kAngle, 0, 1.0}}, true};
+    else if (n == "xA")
+      b = {{xA}, false};
+    else if (n == "yA")
+      b = {{yA}, false};
+    else if (n == "xB")
+      b = {{xB0, xB}, false};
+    else if (n == "yB")
+      b = {{yB}, false};
     // reference point: each link's centre and its angle (the rocker's axis runs from C to B)
-    else if (n == "x2") b = {{{T::kCos, 0, L2_ / 2}}, false};
-    else if (n == "y2") b = {{{T::kSin, 0, L2_ / 2}}, false};
-    else if (n == "x3") b = {{xA, {T::kCos, 1, L3_ / 2}}, false};
-    else if (n == "y3") b = {{yA, {T::kSin, 1, L3_ / 2}}, false};
-    else if (n == "psi3" && !relative_) b = {{{T::kAngle, 1, 1.0}}, true};
-    else if (n == "x4") b = {{xB0, {T::kCos, 2, L4_ / 2}}, false};
-    else if (n == "y4") b = {{{T::kSin, 2, L4_ / 2}}, false};
-    else if (n == "psi4" && !relative_) b = {{{T::kAngle, 2, 1.0}}, true};
+    else if (n == "x2")
+      b = {{{T::kCos, 0, L2_ / 2}}, false};
+    else if (n == "y2")
+      b = {{{T::kSin, 0, L2_ / 2}}, false};
+    else if (n == "x3")
+      b = {{xA, {T::kCos, 1, L3_ / 2}}, false};
+    else if (n == "y3")
+      b = {{yA, {T::kSin, 1, L3_ / 2}}, false};
+    else if (n == "psi3" && !relative_)
+      b = {{{T::kAngle, 1, 1.0}}, true};
+    else if (n == "x4")
+      b = {{xB0, {T::kCos, 2, L4_ / 2}}, false};
+    else if (n == "y4")
+      b = {{{T::kSin, 2, L4_ / 2}}, false};
+    else if (n == "psi4" && !relative_)
+      b = {{{T::kAngle, 2, 1.0}}, true};
     // relative: joint angles, ψ3 = θ3 − θ2 at A and ψ4 = θ4 + π − θ3 at B (the third link runs B→C)
-    else if (n == "psi3") b = {{{T::kAngle, 1, 1.0}, {T::kAngle, 0, -1.0}}, true};
-    else if (n == "psi4") b = {{{T::kAngle, 2, 1.0}, {T::kConstant, -1, kPi}, {T::kAngle, 1, -1.0}}, true};
-    else return false;
+    else if (n == "psi3")
+      b = {{{T::kAngle, 1, 1.0}, {T::kAngle, 0, -1.0}}, true};
+    else if (n == "psi4")
+      b = {{{T::kAngle, 2, 1.0}, {T::kConstant, -1, kPi}, {T::kAngle, 1, -1.0}}, true};
+    else
+      return false;
     return true;
   }
   // The relative formulation names its joint angles psi2..psi4 like the reference-point bodies' angles; it is the
@@ -161,7 +183,9 @@ class FourBar final : public ClosedForm {
     const double c3 = std::cos(th3), s3 = std::sin(th3), c4 = std::cos(th4), s4 = std::sin(th4);
     // [−L3 s3, L4 s4; L3 c3, −L4 c4] [x3; x4] = r, for the rates (x = ω) and the accelerations (x = α)
     const double m11 = -L3_ * s3, m12 = L4_ * s4, m21 = L3_ * c3, m22 = -L4_ * c4, det = m11 * m22 - m12 * m21;
-    auto solve = [&](double r1, double r2) { return std::pair{(r1 * m22 - m12 * r2) / det, (m11 * r2 - m21 * r1) / det}; };
+    auto solve = [&](double r1, double r2) {
+      return std::pair{(r1 * m22 - m12 * r2) / det, (m11 * r2 - m21 * r1) / det};
+    };
     const double w2 = th2.v, a2 = th2.a;
     const auto [w3, w4] = solve(L2_ * s2 * w2, -L2_ * c2 * w2);
     const auto [a3, a4] = solve(L2_ * (c2 * w2 * w2 + s2 * a2) + L3_ * c3 * w3 * w3 - L4_ * c4 * w4 * w4,
@@ -191,15 +215,24 @@ class NFourBar final : public ClosedForm {
     auto [prefix, i] = split_index(n);
     const double x = static_cast<double>(i);
     if (i < 0) return false;
-    if (prefix == "x") b = {{{T::kConstant, -1, x}, {T::kCos, 0, 1.0}}, false};
-    else if (prefix == "y") b = {{{T::kSin, 0, 1.0}}, false};
-    else if (prefix == "xc") b = {{{T::kConstant, -1, x}, {T::kCos, 0, 0.5}}, false};
-    else if (prefix == "yc") b = {{{T::kSin, 0, 0.5}}, false};
-    else if (prefix == "psi") b = {{{T::kAngle, 0, 1.0}}, true};
-    else if (prefix == "xk") b = {{{T::kConstant, -1, x + 0.5}, {T::kCos, 0, 1.0}}, false};
-    else if (prefix == "yk") b = {{{T::kSin, 0, 1.0}}, false};
-    else if (prefix == "phi") b = {{{T::kConstant, -1, 0.0}}, true};
-    else return false;
+    if (prefix == "x")
+      b = {{{T::kConstant, -1, x}, {T::kCos, 0, 1.0}}, false};
+    else if (prefix == "y")
+      b = {{{T::kSin, 0, 1.0}}, false};
+    else if (prefix == "xc")
+      b = {{{T::kConstant, -1, x}, {T::kCos, 0, 0.5}}, false};
+    else if (prefix == "yc")
+      b = {{{T::kSin, 0, 0.5}}, false};
+    else if (prefix == "psi")
+      b = {{{T::kAngle, 0, 1.0}}, true};
+    else if (prefix == "xk")
+      b = {{{T::kConstant, -1, x + 0.5}, {T::kCos, 0, 1.0}}, false};
+    else if (prefix == "yk")
+      b = {{{T::kSin, 0, 1.0}}, false};
+    else if (prefix == "phi")
+      b = {{{T::kConstant, -1, 0.0}}, true};
+    else
+      return false;
     return true;
   }
   void angles(double t, std::vector<Motion>& out) const override {
@@ -279,10 +312,18 @@ void ClosedForm::evaluate(double t, double* q, double* v, double* a) const {
     for (const Term& term : bound_[j].terms) {
       Motion f;
       switch (term.kind) {
-        case Term::kConstant: f = {1.0, 0.0, 0.0}; break;
-        case Term::kAngle: f = angles_[static_cast<std::size_t>(term.angle)]; break;
-        case Term::kCos: f = cos_of(angles_[static_cast<std::size_t>(term.angle)]); break;
-        case Term::kSin: f = sin_of(angles_[static_cast<std::size_t>(term.angle)]); break;
+        case Term::kConstant:
+          f = {1.0, 0.0, 0.0};
+          break;
+        case Term::kAngle:
+          f = angles_[static_cast<std::size_t>(term.angle)];
+          break;
+        case Term::kCos:
+          f = cos_of(angles_[static_cast<std::size_t>(term.angle)]);
+          break;
+        case Term::kSin:
+          f = sin_of(angles_[static_cast<std::size_t>(term.angle)]);
+          break;
       }
       m.q += term.coef * f.q, m.v += term.coef * f.v, m.a += term.coef * f.a;
     }
@@ -312,18 +353,22 @@ std::unique_ptr<ClosedForm> make_closed_form(const std::string& spec) {
   const std::size_t colon = spec.find(':');
   const std::string kind = spec.substr(0, colon);
   std::unique_ptr<Params> p;
-  if (kind == "crank-slider") p = std::make_unique<Params>(kind, std::vector<std::pair<std::string, double>>{
-                                   {"L2", 0.3}, {"L3", 1.0}, {"theta0", 0.0}, {"omega", 2.0}});
+  if (kind == "crank-slider")
+    p = std::make_unique<Params>(
+        kind, std::vector<std::pair<std::string, double>>{{"L2", 0.3}, {"L3", 1.0}, {"theta0", 0.0}, {"omega", 2.0}});
   else if (kind == "fourbar")
-    p = std::make_unique<Params>(kind, std::vector<std::pair<std::string, double>>{
-                                           {"L1", 1.0}, {"L2", 0.4}, {"L3", 1.2}, {"L4", 1.0}, {"theta0", 0.0},
-                                           {"omega", 1.0}, {"branch", 1.0}});
+    p = std::make_unique<Params>(
+        kind,
+        std::vector<std::pair<std::string, double>>{
+            {"L1", 1.0}, {"L2", 0.4}, {"L3", 1.2}, {"L4", 1.0}, {"theta0", 0.0}, {"omega", 1.0}, {"branch", 1.0}});
   else if (kind == "nfourbar")
-    p = std::make_unique<Params>(kind, std::vector<std::pair<std::string, double>>{{"from", kPi / 4}, {"to", 3 * kPi / 4}});
+    p = std::make_unique<Params>(kind,
+                                 std::vector<std::pair<std::string, double>>{{"from", kPi / 4}, {"to", 3 * kPi / 4}});
   else if (kind == "chain3d")
-    p = std::make_unique<Params>(kind, std::vector<std::pair<std::string, double>>{
-                                           {"from", kPi / 4}, {"to", 3 * kPi / 4}, {"twist", 0.0}});
-  else throw std::invalid_argument("unknown closed form '" + kind + "' (crank-slider, fourbar, nfourbar, chain3d)");
+    p = std::make_unique<Params>(
+        kind, std::vector<std::pair<std::string, double>>{{"from", kPi / 4}, {"to", 3 * kPi / 4}, {"twist", 0.0}});
+  else
+    throw std::invalid_argument("unknown closed form '" + kind + "' (crank-slider, fourbar, nfourbar, chain3d)");
   if (colon != std::string::npos) {
     const std::string rest = spec.substr(colon + 1);
     std::size_t start = 0;
@@ -336,7 +381,8 @@ std::unique_ptr<ClosedForm> make_closed_form(const std::string& spec) {
       const char* b = item.data() + eq + 1;
       auto r = std::from_chars(b, item.data() + item.size(), v);
       if (r.ec != std::errc() || r.ptr != item.data() + item.size() || !std::isfinite(v))
-        throw std::invalid_argument(kind + ": " + item.substr(0, eq) + ": not a finite number: '" + item.substr(eq + 1) + "'");
+        throw std::invalid_argument(kind + ": " + item.substr(0, eq) + ": not a finite number: '" +
+                                    item.substr(eq + 1) + "'");
       p->set(item.substr(0, eq), v);
       start = end + 1;
     }

@@ -75,8 +75,8 @@ class ClosedFormErrors {
 };
 
 // Parses "KIND[:NAME=VALUE,...]" (KIND crank-slider, fourbar, nfourbar or chain3d; parameters in describe() order,
-// defaults those of models/seed/ and of `phiq generate nfourbar` and `chain3d`). Throws std::invalid_argument for an unknown kind or
-// parameter, a value that is not a finite number, or impossible geometry.
+// defaults those of models/seed/ and of `phiq generate nfourbar` and `chain3d`). Throws std::invalid_argument for an
+// unknown kind or parameter, a value that is not a finite number, or impossible geometry.
 std::unique_ptr<ClosedForm> make_closed_form(const std::string& spec);
 
 // The closed form a scene's `name` suggests ("crank_slider_*", "fourbar_*", "nfourbar_*", "chain3d_*"), or "" if

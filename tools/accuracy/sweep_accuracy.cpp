@@ -100,14 +100,16 @@ class NumericalReference final : public Reference {
     Rows r;
     SweepSummary sum;
     (void)run_sweep(  // its status is sum.status, read below
-        model_, o, ws, [&](const StepView& s) {
-      if (stopped(stop_)) return false;
-      if (s.step % substeps_ != 0) return true;
-      r.q.insert(r.q.end(), s.q.data(), s.q.data() + s.q.size());
-      if (s.qd) r.v.insert(r.v.end(), s.qd->data(), s.qd->data() + s.qd->size());
-      if (s.qdd) r.a.insert(r.a.end(), s.qdd->data(), s.qdd->data() + s.qdd->size());
-      return true;
-    }, &sum);
+        model_, o, ws,
+        [&](const StepView& s) {
+          if (stopped(stop_)) return false;
+          if (s.step % substeps_ != 0) return true;
+          r.q.insert(r.q.end(), s.q.data(), s.q.data() + s.q.size());
+          if (s.qd) r.v.insert(r.v.end(), s.qd->data(), s.qd->data() + s.qd->size());
+          if (s.qdd) r.a.insert(r.a.end(), s.qdd->data(), s.qdd->data() + s.qdd->size());
+          return true;
+        },
+        &sum);
     if (sum.status == SolveStatus::kCancelled) throw AccuracyCancelled();
     if (sum.status != SolveStatus::kSuccess)
       throw std::runtime_error("the numerical reference (tolerance 1e-14, full Newton, " + std::to_string(o.steps) +
@@ -214,12 +216,14 @@ std::unique_ptr<Reference> closed_form_reference(const std::string& spec, bool a
     f->bind(model.coordinate_names());
     const double r = fit_residual(model, *f, so);
     if (!(r <= kFitResidual))
-      misfit = f->describe() + " does not satisfy the scene's constraints (scaled residual " + significant_or_empty(r, 3) +
+      misfit = f->describe() + " does not satisfy the scene's constraints (scaled residual " +
+               significant_or_empty(r, 3) +
                "): another mechanism or drive; give its parameters, e.g. closed-form:crank-slider:omega=1";
     // Both assembly branches satisfy the constraints: the scene's is the one it assembles into at t_begin.
     else if (const double d = branch_distance(model, *f, so.t_begin, start); !(d <= kFitBranch))
-      misfit = f->describe() + " is another assembly branch than the scene's (scaled distance " + significant_or_empty(d, 3) +
-               " at t = " + significant_or_empty(so.t_begin, 6) + "), e.g. closed-form:fourbar:branch=-1";
+      misfit = f->describe() + " is another assembly branch than the scene's (scaled distance " +
+               significant_or_empty(d, 3) + " at t = " + significant_or_empty(so.t_begin, 6) +
+               "), e.g. closed-form:fourbar:branch=-1";
   } catch (const std::invalid_argument& e) {
     misfit = e.what();
   }
@@ -318,8 +322,8 @@ void AccuracyRuns::errors(const AccuracySetting& set, std::size_t done, std::siz
   AccuracyRow row;
   row.setting = set;
   const AccuracySetting& d = rep_.scene_default;
-  row.is_default = tol == d.tolerance && st == d.steps && resolved(p, so_) == d.predictor && nu == d.newton &&
-                   lu == d.linear_solver;
+  row.is_default =
+      tol == d.tolerance && st == d.steps && resolved(p, so_) == d.predictor && nu == d.newton && lu == d.linear_solver;
   // First run: errors and counts (not timed: the comparison with the reference is the callback's work).
   const auto n = static_cast<std::size_t>(model_.num_coordinates());
   const Eigen::VectorXd& scale = model_.tolerance_scales().coordinate_scale;
@@ -331,18 +335,20 @@ void AccuracyRuns::errors(const AccuracySetting& set, std::size_t done, std::siz
     ws.lu = numeric(lu);
     ws.q = start_;
     (void)run_sweep(  // its status is sum.status, read below
-        model_, o, ws, [&](const StepView& s) {
-      ref_.at(st, s.step, s.t, rq.data(), rv.data(), ra.data());
-      for (std::size_t j = 0; j < n; ++j) {
-        const auto jj = static_cast<Index>(j);
-        double e = s.q(jj) - rq[j];
-        if (ref_.is_angle(jj)) e = std::remainder(e, kTwoPi);
-        worst(eq, std::fabs(e) / scale(jj));
-        if (s.qd) worst(ev, std::fabs((*s.qd)(jj) - rv[j]) / scale(jj));
-        if (s.qdd) worst(ea, std::fabs((*s.qdd)(jj) - ra[j]) / scale(jj));
-      }
-      return !stopped(opt_.stop);
-    }, &sum);
+        model_, o, ws,
+        [&](const StepView& s) {
+          ref_.at(st, s.step, s.t, rq.data(), rv.data(), ra.data());
+          for (std::size_t j = 0; j < n; ++j) {
+            const auto jj = static_cast<Index>(j);
+            double e = s.q(jj) - rq[j];
+            if (ref_.is_angle(jj)) e = std::remainder(e, kTwoPi);
+            worst(eq, std::fabs(e) / scale(jj));
+            if (s.qd) worst(ev, std::fabs((*s.qd)(jj)-rv[j]) / scale(jj));
+            if (s.qdd) worst(ea, std::fabs((*s.qdd)(jj)-ra[j]) / scale(jj));
+          }
+          return !stopped(opt_.stop);
+        },
+        &sum);
   }
   if (sum.status == SolveStatus::kCancelled) throw AccuracyCancelled();
   if (sum.status != SolveStatus::kSuccess) {
@@ -363,8 +369,8 @@ void AccuracyRuns::errors(const AccuracySetting& set, std::size_t done, std::siz
   if (progress_) {
     // a stream: GCC 12 warns (-Wrestrict, a false positive) on "/" + std::to_string(...)
     std::ostringstream line;
-    line << done << "/" << total << " " << setting_text(set) << ": err_q " << significant_or_empty(row.err_q, 2)
-         << ", " << significant_or_empty(row.iterations_per_step, 3) << " iterations per step";
+    line << done << "/" << total << " " << setting_text(set) << ": err_q " << significant_or_empty(row.err_q, 2) << ", "
+         << significant_or_empty(row.iterations_per_step, 3) << " iterations per step";
     progress_(line.str());
   }
   timed_.push_back({rep_.rows.size(), o});

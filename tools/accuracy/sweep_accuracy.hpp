@@ -30,19 +30,19 @@ struct AccuracyRow {
   // length scale for lengths, 1 for angles): positions (angles modulo 2π), velocities (1/s), accelerations (1/s²).
   // NaN when the scene does not output that derivative or the sweep failed.
   double err_q = 0.0, err_v = 0.0, err_a = 0.0;
-  double iterations_per_step = 0.0;       // Newton iterations of the drive steps (the assembly left out)
-  double factorizations_per_step = 0.0;   // numeric LU factorisations, including those for q̇ and q̈
-  double us_per_step = 0.0;               // best wall time of run_sweep over the timing rounds ÷ steps, µs
-  std::string status = "ok";              // "ok", or the solver's status words when the sweep failed
-  bool is_default = false;                // the scene's own settings (predictor auto resolved)
+  double iterations_per_step = 0.0;      // Newton iterations of the drive steps (the assembly left out)
+  double factorizations_per_step = 0.0;  // numeric LU factorisations, including those for q̇ and q̈
+  double us_per_step = 0.0;              // best wall time of run_sweep over the timing rounds ÷ steps, µs
+  std::string status = "ok";             // "ok", or the solver's status words when the sweep failed
+  bool is_default = false;               // the scene's own settings (predictor auto resolved)
 };
 
 // The grid and the reference. Empty lists mean the defaults (below).
 struct AccuracyOptions {
-  std::vector<double> tolerances;            // default 1e-4, 1e-5, ..., 1e-14
-  std::vector<Index> steps;                  // default the scene's steps × {1/4, 1, 4}
-  std::vector<Predictor> predictors;         // default previous, secant, parabolic, linear, quadratic, cubic
-  std::vector<JacobianUpdate> newton;        // default modified, full
+  std::vector<double> tolerances;                // default 1e-4, 1e-5, ..., 1e-14
+  std::vector<Index> steps;                      // default the scene's steps × {1/4, 1, 4}
+  std::vector<Predictor> predictors;             // default previous, secant, parabolic, linear, quadratic, cubic
+  std::vector<JacobianUpdate> newton;            // default modified, full
   std::vector<LinearSolverKind> linear_solvers;  // default klu, umfpack
   // "auto" (the closed form the scene's name suggests if it satisfies the scene's constraints, else numerical),
   // "numerical" (the same scene at tolerance 1e-14, full Newton, reference_substeps sub-steps per step), or
@@ -63,8 +63,8 @@ struct AccuracyCancelled : std::runtime_error {
 
 struct AccuracyReport {
   std::string scene_path, scene_name;
-  std::string reference;        // "closed-form:<spec>" or "numerical: tolerance 1e-14, full Newton, ..."
-  std::string reference_kind;   // "closed-form:<kind>" or "numerical"
+  std::string reference;       // "closed-form:<spec>" or "numerical: tolerance 1e-14, full Newton, ..."
+  std::string reference_kind;  // "closed-form:<kind>" or "numerical"
   Index coordinates = 0;
   double length_scale = 1.0;
   AccuracySetting scene_default;

@@ -81,7 +81,8 @@ Shape sphere(std::string name, int material, double r) {
     for (int j = 0; j <= kLon; ++j) {
       const double th = M_PI * i / kLat, ph = 2 * M_PI * j / kLon;
       const double n[3] = {std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
-      for (int c = 0; c < 3; ++c) s.nrm.push_back(static_cast<float>(n[c])), s.pos.push_back(static_cast<float>(r * n[c]));
+      for (int c = 0; c < 3; ++c)
+        s.nrm.push_back(static_cast<float>(n[c])), s.pos.push_back(static_cast<float>(r * n[c]));
     }
   for (int i = 0; i < kLat; ++i)
     for (int j = 0; j < kLon; ++j) {
@@ -118,15 +119,14 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
   const Model& model = *scene.model;
   const bool spatial = scene.dimension == 3;
   const MechanismSketch sketch = sketch_mechanism(model);
-  const std::string title =
-      scene.name.empty() ? std::filesystem::path(scene.path).stem().string() : scene.name;
+  const std::string title = scene.name.empty() ? std::filesystem::path(scene.path).stem().string() : scene.name;
 
   std::vector<const SketchSegment*> links;
   for (const SketchSegment& s : sketch.segments)
     if (s.line == SketchLine::kBar) links.push_back(&s);
   const MotionColumns columns(scene, glb_reads(scene, sketch), table, result);
-  const std::size_t nodes = scene.planar_bodies.size() + scene.spatial_bodies.size() + links.size() +
-                            sketch.joints.size();
+  const std::size_t nodes =
+      scene.planar_bodies.size() + scene.spatial_bodies.size() + links.size() + sketch.joints.size();
   if (nodes == 0) throw Error(scene.path + ": nothing to animate (no moving body, link or joint)");
 
   // ---- the transforms of every node at every row
@@ -136,7 +136,10 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
     tracks.push_back({model.body_names()[k], -1, {}, {}, {}});
   for (const SketchSegment* s : links)
     tracks.push_back({s->constraint >= 0 ? model.constraints()[static_cast<std::size_t>(s->constraint)].name : "link",
-                      -1, {}, {}, {}});
+                      -1,
+                      {},
+                      {},
+                      {}});
   for (const SketchJoint& j : sketch.joints) {
     std::string name = j.constraint >= 0 ? model.constraints()[static_cast<std::size_t>(j.constraint)].name : "joint";
     if (j.end >= 0) name += ".end" + std::to_string(j.end);
@@ -257,9 +260,10 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
   doc["asset"] = {{"version", "2.0"}, {"generator", std::string("phiq ") + kVersion}, {"extras", {{"scene", title}}}};
   doc["accessors"] = doc["bufferViews"] = nlohmann::json::array();
   gltf::BufferBuilder buffer(doc);
-  std::vector<std::array<int, 3>> prims;  // position, normal, indices accessor of each shape
+  std::vector<std::array<int, 3>> prims;                     // position, normal, indices accessor of each shape
   buffer.begin_view(gltf::kArrayBuffer, 3 * sizeof(float));  // positions and normals: float VEC3 each
-  for (const Shape& s : shapes) prims.push_back({buffer.add_floats(s.pos, 3, true), buffer.add_floats(s.nrm, 3, false), 0});
+  for (const Shape& s : shapes)
+    prims.push_back({buffer.add_floats(s.pos, 3, true), buffer.add_floats(s.nrm, 3, false), 0});
   buffer.begin_view(gltf::kElementArrayBuffer);
   for (std::size_t k = 0; k < shapes.size(); ++k) prims[k][2] = buffer.add_indices(shapes[k].idx);
   const double colours[4][3] = {{0.27, 0.45, 0.70}, {0.90, 0.50, 0.10}, {0.25, 0.25, 0.25}, {0.05, 0.05, 0.05}};
@@ -270,16 +274,16 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
     if (m < 0) {
       const double* c = colours[shapes[k].material];
       m = static_cast<int>(doc["materials"].size());
-      doc["materials"].push_back({{"name", material_names[shapes[k].material]},
-                                  {"pbrMetallicRoughness",
-                                   {{"baseColorFactor", {c[0], c[1], c[2], 1.0}},
-                                    {"metallicFactor", 0.0},
-                                    {"roughnessFactor", 0.6}}}});
+      doc["materials"].push_back(
+          {{"name", material_names[shapes[k].material]},
+           {"pbrMetallicRoughness",
+            {{"baseColorFactor", {c[0], c[1], c[2], 1.0}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.6}}}});
     }
     doc["meshes"].push_back({{"name", shapes[k].name},
-                             {"primitives", {{{"attributes", {{"POSITION", prims[k][0]}, {"NORMAL", prims[k][1]}}},
-                                              {"indices", prims[k][2]},
-                                              {"material", m}}}}});
+                             {"primitives",
+                              {{{"attributes", {{"POSITION", prims[k][0]}, {"NORMAL", prims[k][1]}}},
+                                {"indices", prims[k][2]},
+                                {"material", m}}}}});
   }
   buffer.begin_view(0);
   const int input = buffer.add_floats(times, 1, true);
@@ -293,13 +297,13 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
     if (!tr.s.empty()) node["scale"] = {tr.s[0], tr.s[1], tr.s[2]};
     doc["nodes"].push_back(node);
     doc["scenes"][0]["nodes"].push_back(k);
-    const bool fixed = k >= tracks.size() - sketch.joints.size() &&
-                       sketch.joints[k - (tracks.size() - sketch.joints.size())].fixed;
+    const bool fixed =
+        k >= tracks.size() - sketch.joints.size() && sketch.joints[k - (tracks.size() - sketch.joints.size())].fixed;
     if (!moves || fixed) continue;
     auto channel = [&](const std::vector<float>& v, int components, const char* path) {
       if (v.empty()) return;
-      samplers.push_back({{"input", input}, {"output", buffer.add_floats(v, components, false)},
-                          {"interpolation", "LINEAR"}});
+      samplers.push_back(
+          {{"input", input}, {"output", buffer.add_floats(v, components, false)}, {"interpolation", "LINEAR"}});
       channels.push_back({{"sampler", samplers.size() - 1}, {"target", {{"node", k}, {"path", path}}}});
     };
     channel(tr.t, 3, "translation");

@@ -37,8 +37,8 @@ std::vector<std::size_t> spread(std::size_t n, std::size_t most) {
     return rows;
   }
   for (std::size_t k = 0; k < most; ++k) {
-    const auto r = static_cast<std::size_t>(std::llround(static_cast<double>(k) * static_cast<double>(n - 1) /
-                                                         static_cast<double>(most - 1)));
+    const auto r = static_cast<std::size_t>(
+        std::llround(static_cast<double>(k) * static_cast<double>(n - 1) / static_cast<double>(most - 1)));
     if (rows.empty() || rows.back() != r) rows.push_back(r);
   }
   return rows;
@@ -51,8 +51,7 @@ std::string base64(const std::string& bytes) {
   for (std::size_t i = 0; i < bytes.size(); i += 3) {
     const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
     std::uint32_t v = 0;
-    for (std::size_t k = 0; k < 3; ++k)
-      v = (v << 8) | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
+    for (std::size_t k = 0; k < 3; ++k) v = (v << 8) | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
     for (std::size_t k = 0; k < 4; ++k) out += k <= n ? a[(v >> (18 - 6 * k)) & 63] : '=';
   }
   return out;
@@ -75,10 +74,14 @@ class Quantizer {
 // The letter of a joint's mark in the viewer's data: r(evolute), p(rismatic), s(pherical), o (a link's end).
 char mark_letter(JointMark m) {
   switch (m) {
-    case JointMark::kRevolute: return 'r';
-    case JointMark::kPrismatic: return 'p';
-    case JointMark::kSpherical: return 's';
-    default: return 'o';
+    case JointMark::kRevolute:
+      return 'r';
+    case JointMark::kPrismatic:
+      return 'p';
+    case JointMark::kSpherical:
+      return 's';
+    default:
+      return 'o';
   }
 }
 
@@ -151,7 +154,8 @@ ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, co
     out.frames.traces.emplace_back(p.name, std::move(path));
   }
   if (points.empty() && out.frames.traces.empty())
-    throw Error(scene.path + ": nothing to animate (its constraints draw no line or joint: loops, drivers and "
+    throw Error(scene.path +
+                ": nothing to animate (its constraints draw no line or joint: loops, drivers and "
                 "equations draw none; output.points traces no point)");
 
   // ---- positions (and velocities) at the kept rows, and their extent
@@ -159,8 +163,8 @@ ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, co
   out.frames.model = &model, out.frames.sketch = &sketch, out.frames.spatial = dim == 3;
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, vmax = 0.0;
   auto extend = [&](const std::array<double, 3>& x) {
-    for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], x[static_cast<std::size_t>(c)]),
-                                hi[c] = std::max(hi[c], x[static_cast<std::size_t>(c)]);
+    for (int c = 0; c < 3; ++c)
+      lo[c] = std::min(lo[c], x[static_cast<std::size_t>(c)]), hi[c] = std::max(hi[c], x[static_cast<std::size_t>(c)]);
   };
   for (std::size_t r : out.rows) {
     columns.positions(r, q);

@@ -19,9 +19,9 @@
 namespace phiq::tools {
 
 struct ViewerMotion {
-  nlohmann::json data;             // the viewer's input (viewer.js)
-  std::vector<std::size_t> rows;   // the result's rows kept as frames, first and last included
-  MechanismFrames frames;          // q at the kept rows and the traces: the planar drawing's box (plot_mechanism.hpp)
+  nlohmann::json data;            // the viewer's input (viewer.js)
+  std::vector<std::size_t> rows;  // the result's rows kept as frames, first and last included
+  MechanismFrames frames;         // q at the kept rows and the traces: the planar drawing's box (plot_mechanism.hpp)
 };
 
 // Bytes of frame data (positions and velocities, base64) the page holds at most by default.

@@ -30,7 +30,8 @@ std::string fill(std::string_view page, const std::map<std::string, std::string>
   std::size_t from = 0;
   for (std::size_t at = page.find("{{"); at != std::string_view::npos; at = page.find("{{", from)) {
     const std::size_t end = page.find("}}", at);
-    const auto value = end == std::string_view::npos ? slots.end() : slots.find(std::string(page.substr(at + 2, end - at - 2)));
+    const auto value =
+        end == std::string_view::npos ? slots.end() : slots.find(std::string(page.substr(at + 2, end - at - 2)));
     out.append(page.substr(from, at - from));
     if (value == slots.end()) {
       out.append("{{");
@@ -65,14 +66,17 @@ std::string motion_html(const Scene& scene, const CsvTable& table, const std::st
     view_html = "<div id=\"gl\"></div>";
   } else {
     const svg::Box& b = view.box;
-    data["box"] = {{"x0", b.x0}, {"y0", b.y0}, {"w", b.w}, {"h", b.h},
+    data["box"] = {{"x0", b.x0},     {"y0", b.y0},     {"w", b.w},       {"h", b.h},
                    {"xmin", b.xmin}, {"xmax", b.xmax}, {"ymin", b.ymin}, {"ymax", b.ymax}};
     // two layers: the still background painted once, the moving one (planar.js) repainted each frame on its own
-    const std::string open = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + px(kSide) + "\" height=\"" + px(kSide) +
-                 "\" viewBox=\"0 0 " + px(kSide) + " " + px(kSide) + "\" font-family=\"sans-serif\" font-size=\"12\"";
-    view_html = "<div id=\"planar\">\n" + open + " id=\"background-svg\">\n<rect width=\"100%\" height=\"100%\" "
-                "fill=\"white\"/>\n" + mechanism_background(motion.frames, view, GroundPivots::kUses) + "</svg>\n" +
-                open + " id=\"mechanism-svg\">\n<g id=\"moving\"></g>\n</svg>\n</div>";
+    const std::string open = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + px(kSide) + "\" height=\"" +
+                             px(kSide) + "\" viewBox=\"0 0 " + px(kSide) + " " + px(kSide) +
+                             "\" font-family=\"sans-serif\" font-size=\"12\"";
+    view_html = "<div id=\"planar\">\n" + open +
+                " id=\"background-svg\">\n<rect width=\"100%\" height=\"100%\" "
+                "fill=\"white\"/>\n" +
+                mechanism_background(motion.frames, view, GroundPivots::kUses) + "</svg>\n" + open +
+                " id=\"mechanism-svg\">\n<g id=\"moving\"></g>\n</svg>\n</div>";
   }
 
   // ---- the plots: phiq plot's panels of the chosen columns, at most kPlotRows rows each
@@ -80,8 +84,7 @@ std::string motion_html(const Scene& scene, const CsvTable& table, const std::st
   plotted.columns = table.columns;
   {
     const std::size_t n = table.rows.size(), most = std::min(n, kPlotRows);
-    for (std::size_t k = 0; k < most; ++k)
-      plotted.rows.push_back(table.rows[most == 1 ? 0 : k * (n - 1) / (most - 1)]);
+    for (std::size_t k = 0; k < most; ++k) plotted.rows.push_back(table.rows[most == 1 ? 0 : k * (n - 1) / (most - 1)]);
   }
   std::map<std::string, std::size_t> col;
   for (std::size_t c = 0; c < table.columns.size(); ++c) col[table.columns[c]] = c;
@@ -101,11 +104,12 @@ std::string motion_html(const Scene& scene, const CsvTable& table, const std::st
                             " has no velocity columns (the scene's output: {velocities: true} writes them)";
 
   const std::size_t rows = table.rows.size(), kept = motion.rows.size();
-  const std::string about =
-      escape(scene.path) + ", " + escape(result) + ": " + std::to_string(rows) + " rows, " +
-      (kept == rows ? std::string("every one a frame") : std::to_string(kept) + " of them frames (evenly spread; the "
-                                                                               "poses between are interpolated)") +
-      ". Written by phiq " + kVersion + (spatial ? "; three.js r111 (MIT licence)" : "") + ".";
+  const std::string about = escape(scene.path) + ", " + escape(result) + ": " + std::to_string(rows) + " rows, " +
+                            (kept == rows ? std::string("every one a frame")
+                                          : std::to_string(kept) +
+                                                " of them frames (evenly spread; the "
+                                                "poses between are interpolated)") +
+                            ". Written by phiq " + kVersion + (spatial ? "; three.js r111 (MIT licence)" : "") + ".";
   // the JSON sits in a <script> element: "</" must not end it early (\/ is the same in JSON)
   std::string json;
   for (char c : data.dump()) {
@@ -115,9 +119,14 @@ std::string motion_html(const Scene& scene, const CsvTable& table, const std::st
   std::string scripts;
   if (spatial) scripts += script(assets::kThreeJs) + script(assets::kOrbitJs);
   scripts += script(assets::kViewerJs) + script(spatial ? assets::kSpatialJs : assets::kPlanarJs);
-  return fill(assets::kPage,
-              {{"TITLE", escape(title)}, {"GENERATOR", std::string("phiq ") + kVersion}, {"CSS", std::string(assets::kCss)},
-               {"VIEW", view_html}, {"PLOTS", plots}, {"ABOUT", about}, {"DATA", json}, {"SCRIPTS", scripts}});
+  return fill(assets::kPage, {{"TITLE", escape(title)},
+                              {"GENERATOR", std::string("phiq ") + kVersion},
+                              {"CSS", std::string(assets::kCss)},
+                              {"VIEW", view_html},
+                              {"PLOTS", plots},
+                              {"ABOUT", about},
+                              {"DATA", json},
+                              {"SCRIPTS", scripts}});
 }
 
 }  // namespace phiq::tools

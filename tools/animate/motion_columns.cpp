@@ -30,8 +30,10 @@ MotionColumns::MotionColumns(const Scene& scene, const std::vector<Slot>& read, 
                               scene.path);
     q_.emplace_back(j, c->second);
     const auto v = col.find(name + ".v");
-    if (v == col.end()) all_rates = false;
-    else qd_.emplace_back(j, v->second);
+    if (v == col.end())
+      all_rates = false;
+    else
+      qd_.emplace_back(j, v->second);
   }
   if (!all_rates) qd_.clear();
   if (table.rows.empty()) throw Error(result_ + ": no rows");

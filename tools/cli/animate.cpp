@@ -79,15 +79,19 @@ int cmd_animate(const AnimateOptions& o) {
 Command register_animate(CLI::App& app) {
   auto options = std::make_shared<AnimateOptions>();
   CLI::App* animate = app.add_subcommand(
-      "animate", "Write the motion of a result (or, without one, of the scene swept here) as a glTF 2.0 binary "
-                 "(.glb: a node per body, link and joint, keyframed at the result's rows) or as one self-contained "
-                 "HTML page that plays it (.html)");
+      "animate",
+      "Write the motion of a result (or, without one, of the scene swept here) as a glTF 2.0 binary "
+      "(.glb: a node per body, link and joint, keyframed at the result's rows) or as one self-contained "
+      "HTML page that plays it (.html)");
   animate->add_option("scene", options->scene, "Scene file (YAML)")->required();
-  animate->add_option("result", options->result, "Result of `phiq run` for this scene (CSV or HDF5); none: the "
-                                                 "scene is swept here with the outputs the drawing needs");
+  animate->add_option("result", options->result,
+                      "Result of `phiq run` for this scene (CSV or HDF5); none: the "
+                      "scene is swept here with the outputs the drawing needs");
   animate->add_option("-o,--output", options->out, "File to write: *.glb (glTF binary) or *.html (viewer)")->required();
-  animate->add_option("--columns", options->columns, "HTML: columns plotted against t (default: as phiq plot, what "
-                                                     "is driven, the joints' measures, the coordinates that move)")
+  animate
+      ->add_option("--columns", options->columns,
+                   "HTML: columns plotted against t (default: as phiq plot, what "
+                   "is driven, the joints' measures, the coordinates that move)")
       ->delimiter(',');
   add_set_option(animate, &options->sets);
   return {animate, [options] { return cmd_animate(*options); }};

@@ -58,7 +58,8 @@ int cmd_assemble(const std::string& scene_arg, const std::string& out_path, bool
     return fail(e.what(), 3);
   }
   if (!quiet)
-    std::cerr << "phiq: " << printable(scene_path) << ": " << as.BriefReport() << ", moved " << scientific(as.moved, 3) << "\n";
+    std::cerr << "phiq: " << printable(scene_path) << ": " << as.BriefReport() << ", moved " << scientific(as.moved, 3)
+              << "\n";
   return 0;
 }
 

@@ -28,8 +28,8 @@ std::string cannot_write(const std::string& path, const std::string& why) { retu
 // file the shell opened, which must be written through the descriptor (its offset, O_APPEND), not replaced.
 int own_descriptor(const std::string& p) {
   const std::string pid = "/proc/" + std::to_string(::getpid()) + "/fd/";
-  for (const std::string& prefix : {std::string("/dev/fd/"), std::string("/proc/self/fd/"),
-                                    std::string("/proc/thread-self/fd/"), pid}) {
+  for (const std::string& prefix :
+       {std::string("/dev/fd/"), std::string("/proc/self/fd/"), std::string("/proc/thread-self/fd/"), pid}) {
     if (p.size() <= prefix.size() || p.compare(0, prefix.size(), prefix) != 0) continue;
     int fd = 0;
     const char* first = p.data() + prefix.size();

@@ -65,7 +65,8 @@ class AtomicOutputFile {
   // failed write, a batch's file is cut back to the cases it holds whole. Throws phiq::Error for a direct file
   // (nothing written there can be taken back), after finish(), or on an I/O error.
   void truncate(std::uint64_t size);
-  // finish() then publish(), under the lock of the target's directory (DirectoryLock). Throws phiq::Error on an I/O error (the temporary is then removed by the destructor).
+  // finish() then publish(), under the lock of the target's directory (DirectoryLock). Throws phiq::Error on an I/O
+  // error (the temporary is then removed by the destructor).
   void commit();
   // Flushes and closes: to disk (fsync) for a temporary. After it only publish() remains; throws phiq::Error.
   void finish();
@@ -73,7 +74,7 @@ class AtomicOutputFile {
   // caller holds the DirectoryLock of the target (OutputSet does) when outputs must change together.
   void publish();
 
-  const std::string& path() const { return path_; }  // as given
+  const std::string& path() const { return path_; }      // as given
   const std::string& target() const { return target_; }  // the file replaced (resolve_output_path)
   // The named temporary file while it exists (until publish() or destruction); empty for a direct file and for an
   // unnamed temporary (nothing to remove on a signal).

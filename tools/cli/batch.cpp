@@ -12,7 +12,7 @@
 #include "command_line.hpp"
 #include "command_support.hpp"
 #include "commands.hpp"
-#include "run_summary.hpp"  // a case's outcome as run --summary writes it
+#include "run_summary.hpp"       // a case's outcome as run --summary writes it
 #include "phiq/csv_compare.hpp"  // read_csv_table: the cases
 #include "phiq/parsed_scene.hpp"
 #include "phiq/phiq.hpp"
@@ -93,8 +93,8 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
           from_case = std::string(plain.what()) != e.what();
         }
       }
-      return fail(std::string(e.what()) + (from_case ? " (case " + std::to_string(k) + " of " + cases_path +
-                                                           ", line " + std::to_string(k + 2) + ")"
+      return fail(std::string(e.what()) + (from_case ? " (case " + std::to_string(k) + " of " + cases_path + ", line " +
+                                                           std::to_string(k + 2) + ")"
                                                      : ""),
                   2);
     }
@@ -152,34 +152,37 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   phiq::BatchSummary sum;
   {
     StopOnSignal stop_on_signal;  // a signal stops every case at its next row
-    sum = phiq::run_batch(models, sweeps, threads, [&](std::size_t c, const phiq::StepView& step) {
-      const std::size_t k = swept[c];
-      formats[k].append_row(step, buffers[k]);
-      // written every 1 MB and at the case's last row: a finished case holds no rows in memory while others run
-      const bool last = step.step == sweeps[c].steps;
-      if (buffers[k].size() > (1u << 20) || last) {
-        try {
-          if (!files[k])  // held open (unnamed) when written at once, else closed between writes
-            files[k] = &outputs.add(case_file(k), last ? phiq::AtomicOutputFile::Hold::kOpen
-                                                       : phiq::AtomicOutputFile::Hold::kClosedBetweenWrites);
-          files[k]->write(buffers[k]);
-          if (last) {
-            outputs.commit_one(*files[k]);
-            written[k] = 1;
+    sum = phiq::run_batch(
+        models, sweeps, threads,
+        [&](std::size_t c, const phiq::StepView& step) {
+          const std::size_t k = swept[c];
+          formats[k].append_row(step, buffers[k]);
+          // written every 1 MB and at the case's last row: a finished case holds no rows in memory while others run
+          const bool last = step.step == sweeps[c].steps;
+          if (buffers[k].size() > (1u << 20) || last) {
+            try {
+              if (!files[k])  // held open (unnamed) when written at once, else closed between writes
+                files[k] = &outputs.add(case_file(k), last ? phiq::AtomicOutputFile::Hold::kOpen
+                                                           : phiq::AtomicOutputFile::Hold::kClosedBetweenWrites);
+              files[k]->write(buffers[k]);
+              if (last) {
+                outputs.commit_one(*files[k]);
+                written[k] = 1;
+              }
+            } catch (const phiq::Error& e) {
+              write_errors[k] = e.what();
+              if (files[k]) outputs.drop(*files[k]);
+              files[k] = nullptr;
+              return false;
+            }
+            if (last)
+              std::string().swap(buffers[k]);
+            else
+              buffers[k].clear();
           }
-        } catch (const phiq::Error& e) {
-          write_errors[k] = e.what();
-          if (files[k]) outputs.drop(*files[k]);
-          files[k] = nullptr;
-          return false;
-        }
-        if (last)
-          std::string().swap(buffers[k]);
-        else
-          buffers[k].clear();
-      }
-      return !stop.load();
-    }, &starts);
+          return !stop.load();
+        },
+        &starts);
   }
   std::size_t cases_written = 0;
   for (char w : written) cases_written += w != 0;
@@ -203,7 +206,8 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
   for (std::size_t k = 0; k < scenes.size(); ++k) {
     if (!prepare_errors[k].empty()) {
       ++failed;
-      std::cerr << "phiq: " << printable(scene_path + ": case " + std::to_string(k) + ": " + prepare_errors[k]) +
+      std::cerr << "phiq: "
+                << printable(scene_path + ": case " + std::to_string(k) + ": " + prepare_errors[k]) +
                        "; no output written\n";
       phiq::SweepSummary at_start;  // the first position, before any sweep
       at_start.status = squares[k].assembly.status;
@@ -216,22 +220,23 @@ int cmd_batch(const std::string& scene_path, const std::string& cases_path, cons
     }
     const phiq::SweepSummary& s = sum.cases[c++];
     // (a case whose last row was written is complete, even if a signal or a later case asked it to stop)
-    const std::string why = !write_errors[k].empty()                                  ? write_errors[k]
-                            : written[k]                                              ? ""
-                            : s.status != phiq::SolveStatus::kSuccess ? s.message : "not written";
+    const std::string why = !write_errors[k].empty()                  ? write_errors[k]
+                            : written[k]                              ? ""
+                            : s.status != phiq::SolveStatus::kSuccess ? s.message
+                                                                      : "not written";
     output_error |= !write_errors[k].empty();
     result(k, *models[c - 1], s, write_errors[k]);
     if (!why.empty()) {
       ++failed;
-      std::cerr << "phiq: " << printable(scene_path + ": case " + std::to_string(k) + ": " + why) +
-                       "; no output written\n";
+      std::cerr << "phiq: "
+                << printable(scene_path + ": case " + std::to_string(k) + ": " + why) + "; no output written\n";
     } else if (!quiet) {
       std::cerr << "phiq: " << printable(scene_path + ": case " + std::to_string(k) + ": " + s.BriefReport()) << "\n";
     }
   }
   if (!quiet)
-    std::cerr << "phiq: " << printable(scene_path) << ": " << scenes.size() - failed << " of " << scenes.size() << " cases in "
-              << printable(dir) << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
+    std::cerr << "phiq: " << printable(scene_path) << ": " << scenes.size() - failed << " of " << scenes.size()
+              << " cases in " << printable(dir) << ", " << sum.threads << " threads, " << sum.shared_analyses + 1
               << " cases on one symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
               << scientific(sum.solve_seconds, 3) << " s\n";
   const int status = output_error ? 3 : failed ? 1 : 0;
@@ -273,21 +278,24 @@ Command register_batch(CLI::App& app) {
     std::vector<std::string> sensitivities;
   };
   auto a = std::make_shared<Args>();
-  CLI::App* batch = app.add_subcommand("batch", "Sweep the scene once per parameter set of a CSV, the cases in parallel");
+  CLI::App* batch =
+      app.add_subcommand("batch", "Sweep the scene once per parameter set of a CSV, the cases in parallel");
   batch->add_option("scene", a->scene, "Scene file (YAML)")->required();
   batch->add_option("cases", a->cases, "CSV: a header of parameter names, one row of values per case")->required();
-  batch->add_option("-o,--output", a->dir,
-                    "OUT.csv or OUT.h5: one file, a `case` column (row of CASES.csv, from 0) first; else a directory "
-                    "for case<k>.csv")
+  batch
+      ->add_option("-o,--output", a->dir,
+                   "OUT.csv or OUT.h5: one file, a `case` column (row of CASES.csv, from 0) first; else a directory "
+                   "for case<k>.csv")
       ->required()
       ->check(directory_given());
   batch->add_flag("-q,--quiet", a->quiet, "Print only failures on standard error");
   batch->add_option("--threads", a->threads, "Threads for the cases (0: all cores)")
       ->capture_default_str()
       ->check(thread_count());
-  batch->add_option("--summary", a->summary,
-                     "Write the batch summary as JSON (each case's outcome, why it failed) to this file ('-': standard "
-                     "output)")
+  batch
+      ->add_option("--summary", a->summary,
+                   "Write the batch summary as JSON (each case's outcome, why it failed) to this file ('-': standard "
+                   "output)")
       ->transform(output_path("", false));
   batch->add_option("--names", a->names, "Column names: dotted (theta2.v) or identifiers (theta2__v), as run's")
       ->capture_default_str()

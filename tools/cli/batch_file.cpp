@@ -265,8 +265,8 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
         drop_unfinished_case(resumed, case_rows, a.out);
       }
       if (hdf5) check_hdf5_target(a.out);
-      file = &outputs.add(a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
-                                      : phiq::AtomicOutputFile::Hold::kOpen);
+      file = &outputs.add(
+          a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites : phiq::AtomicOutputFile::Hold::kOpen);
       if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
       if (hdf5) {
         phiq::Hdf5Options o;
@@ -373,7 +373,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     }
     phiq::SquareScene square;
     if (const auto why = make_square(*scene, &square)) {  // as `phiq run`: one that cannot be fails alone
-      phiq::SweepSummary at_start;  // the first position, before any sweep
+      phiq::SweepSummary at_start;                        // the first position, before any sweep
       at_start.status = square.assembly.status;
       at_start.message = *why;
       at_start.failed_step = 0;
@@ -396,20 +396,23 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     setup_done();
     long long format_case_ns = 0;
     phiq::SweepSummary s;
-    (void)phiq::run_sweep(model, one, ws, [&](const phiq::StepView& step) {
-      const auto f0 = Clock::now();
-      if (hdf5) {  // the values Hdf5Writer::append_row() would store, the case first
-        row[0] = static_cast<double>(k);
-        rows_format.append_values(step, row.data() + 1);
-        rows.values.insert(rows.values.end(), row.begin(), row.end());
-      } else {
-        rows.text += prefix;
-        rows_format.append_row(step, rows.text);
-      }
-      last = step.step == one.steps;
-      format_case_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - f0).count();
-      return !halted();
-    }, &s);
+    (void)phiq::run_sweep(
+        model, one, ws,
+        [&](const phiq::StepView& step) {
+          const auto f0 = Clock::now();
+          if (hdf5) {  // the values Hdf5Writer::append_row() would store, the case first
+            row[0] = static_cast<double>(k);
+            rows_format.append_values(step, row.data() + 1);
+            rows.values.insert(rows.values.end(), row.begin(), row.end());
+          } else {
+            rows.text += prefix;
+            rows_format.append_row(step, rows.text);
+          }
+          last = step.step == one.steps;
+          format_case_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - f0).count();
+          return !halted();
+        },
+        &s);
     result.format_ns = format_case_ns;
     result.sweep_ns = static_cast<long long>(s.solve_seconds * 1e9) - format_case_ns;
     add_outcome(report.outcome, model, s);
@@ -486,8 +489,8 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
   } catch (const phiq::Error& e) {
     publish_error = e.what();
   }
-  const std::string written_text = std::to_string(published ? cases_written : 0) + " of " + std::to_string(n) +
-                                   " cases written to " + a.out;
+  const std::string written_text =
+      std::to_string(published ? cases_written : 0) + " of " + std::to_string(n) + " cases written to " + a.out;
   // Interrupted (not by an output error): the cases from the first unfinished one on are missing from the file.
   const bool stopped = interrupted && write_error.empty() && publish_error.empty();
   const std::size_t first_missing = in_order.next();
@@ -500,7 +503,7 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       r.outcome["status"] = "missing";  // what --resume runs
     else if (!r.outcome.contains("status"))
       r.outcome["status"] = "not run";  // the batch stopped before its turn
-    if (stopped) continue;  // (the one line below says it all)
+    if (stopped) continue;              // (the one line below says it all)
     if (r.failed)
       std::cerr << "phiq: " << printable(r.line) << "\n";
     else if (!a.quiet && r.complete)
@@ -539,13 +542,12 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
                    (published ? " (whole cases, in order)" : ""),
                3);
   else if (!a.quiet)
-    std::cerr << "phiq: " << printable(a.scene) << ": " << n - failed << " of " << n << " cases in "
-              << printable(a.out) << ", " << (ranks.size() > 1 ? ranks.describe() + ", " : "")
-              << all_threads << " threads, " << shared.load()
-              << " cases on the scene's symbolic analysis, load " << scientific(load_s, 3) << " s, solve "
-              << scientific(solve_s, 3) << " s (thread-seconds: set-up " << scientific(seconds(setup_ns), 3)
-              << ", sweep " << scientific(seconds(sweep_ns), 3) << ", rows " << scientific(seconds(format_ns), 3)
-              << ", write " << scientific(seconds(write_ns), 3) << ")\n";
+    std::cerr << "phiq: " << printable(a.scene) << ": " << n - failed << " of " << n << " cases in " << printable(a.out)
+              << ", " << (ranks.size() > 1 ? ranks.describe() + ", " : "") << all_threads << " threads, "
+              << shared.load() << " cases on the scene's symbolic analysis, load " << scientific(load_s, 3)
+              << " s, solve " << scientific(solve_s, 3) << " s (thread-seconds: set-up "
+              << scientific(seconds(setup_ns), 3) << ", sweep " << scientific(seconds(sweep_ns), 3) << ", rows "
+              << scientific(seconds(format_ns), 3) << ", write " << scientific(seconds(write_ns), 3) << ")\n";
   if (summary_file)
     return commit_batch_summary(outputs, *summary_file, a, totals(), results(), output_error ? 3 : failed ? 1 : 0);
   return output_error ? 3 : failed ? 1 : 0;

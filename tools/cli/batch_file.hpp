@@ -40,8 +40,8 @@ struct BatchTotals {
   std::string directory;   // -o DIR (empty for one file)
   std::string output;      // -o OUT.csv|OUT.h5 (empty for a directory)
   std::size_t cases = 0, failed = 0, written = 0, shared_analyses = 0;
-  int threads = 1;  // on every rank
-  int ranks = 1;    // MPI ranks (batch_ranks.hpp)
+  int threads = 1;          // on every rank
+  int ranks = 1;            // MPI ranks (batch_ranks.hpp)
   std::string interrupted;  // the signal that stopped a one-file batch ("SIGTERM"), else empty
   double load_seconds = 0.0, solve_seconds = 0.0;
 };

@@ -133,8 +133,7 @@ std::unique_ptr<BatchRanks> BatchRanks::join() {
   return r;
 }
 
-std::unique_ptr<BatchRanks> BatchRanks::join_command(const std::string& command, const std::string& work,
-                                                     int* status) {
+std::unique_ptr<BatchRanks> BatchRanks::join_command(const std::string& command, const std::string& work, int* status) {
   if (launched_without_support()) {
     *status = fail(command + ": started by mpirun with several processes, but this phiq was built without MPI " +
                        "(PHIQ_MPI=OFF): each would run the whole " + work + "; run it without mpirun",
@@ -309,18 +308,21 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
   tbb::task_arena arena(threads);
   if (ranks.rank() > 0) {  // a worker rank: its threads ask rank 0 for cases and send it their results
     arena.execute([&] {
-      tbb::parallel_for(0, threads, [&](int w) {
-        CaseMessage last;  // the result of the case before: none yet (a request alone)
-        std::optional<std::int64_t> k = ranks.send(w, last)->answer();
-        while (k && !h.halted()) {
-          // the next case asked for now, with the last result: its answer travels while this case runs
-          const std::unique_ptr<BatchRanks::Sent> next = ranks.send(w, last);
-          last = h.run_for_0(static_cast<std::size_t>(*k), w);
-          k = next->answer();
-        }
-        last.asks = false;  // the last result, and no request: this worker is done
-        (void)ranks.send(w, last);
-      }, tbb::simple_partitioner());
+      tbb::parallel_for(
+          0, threads,
+          [&](int w) {
+            CaseMessage last;  // the result of the case before: none yet (a request alone)
+            std::optional<std::int64_t> k = ranks.send(w, last)->answer();
+            while (k && !h.halted()) {
+              // the next case asked for now, with the last result: its answer travels while this case runs
+              const std::unique_ptr<BatchRanks::Sent> next = ranks.send(w, last);
+              last = h.run_for_0(static_cast<std::size_t>(*k), w);
+              k = next->answer();
+            }
+            last.asks = false;  // the last result, and no request: this worker is done
+            (void)ranks.send(w, last);
+          },
+          tbb::simple_partitioner());
     });
     return threads;
   }
@@ -339,15 +341,18 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
   // thread answers the other ranks' workers, if any
   std::thread local([&] {
     arena.execute([&] {
-      tbb::parallel_for(0, threads, [&](int w) {
-        try {
-          for (std::optional<std::size_t> k; (k = next());) h.run_here(*k, w);
-        } catch (...) {
-          const std::lock_guard<std::mutex> lock(failure_mutex);
-          if (!failure) failure = std::current_exception();
-          failed = true;
-        }
-      }, tbb::simple_partitioner());
+      tbb::parallel_for(
+          0, threads,
+          [&](int w) {
+            try {
+              for (std::optional<std::size_t> k; (k = next());) h.run_here(*k, w);
+            } catch (...) {
+              const std::lock_guard<std::mutex> lock(failure_mutex);
+              if (!failure) failure = std::current_exception();
+              failed = true;
+            }
+          },
+          tbb::simple_partitioner());
     });
   });
   serve_remote_workers(ranks, remote_workers, h.halted, [&](CaseMessage m) {

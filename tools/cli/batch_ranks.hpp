@@ -24,7 +24,7 @@ struct CaseMessage {
   enum class Kind : std::int32_t { kNone = 0, kDone = 1, kStopped = 2 };  // stopped: a signal ended it early
   Kind kind = Kind::kNone;  // the result carried: none (the first request), a case done, or stopped
   bool asks = true;         // a request for the next case (false: the worker's last message)
-  std::int64_t k = -1;  // the case
+  std::int64_t k = -1;      // the case
   bool complete = false, failed = false, on_shared_analysis = false;
   std::string line, outcome_json, text;  // report line, its --summary entry (JSON), its CSV rows
   std::string values;                    // its HDF5 row values (doubles, as bytes)
@@ -101,8 +101,8 @@ class BatchRanks {
 
 // What run_cases() does with a case.
 struct CaseHandlers {
-  std::function<void(std::size_t k, int worker)> run_here;           // rank 0: run case k and take its result
-  std::function<CaseMessage(std::size_t k, int worker)> run_for_0;   // other ranks: run case k, for rank 0
+  std::function<void(std::size_t k, int worker)> run_here;          // rank 0: run case k and take its result
+  std::function<CaseMessage(std::size_t k, int worker)> run_for_0;  // other ranks: run case k, for rank 0
   std::function<void(CaseMessage)> deliver;  // rank 0: another rank's message with a result (kDone, kStopped)
   std::function<bool()> halted;              // hand out no more cases (on rank 0; elsewhere: stop asking)
 };

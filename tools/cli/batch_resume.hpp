@@ -20,12 +20,12 @@ struct ResumeError : Error {
 };
 
 struct ResumePoint {
-  std::size_t first = 0;          // the first case to run (0: the whole batch)
-  std::size_t cases_in_file = 0;  // the cases OUT holds
-  std::vector<char> in_file;      // per case before `first`: 1 in OUT, 0 left out (it failed earlier)
-  std::uint64_t bytes = 0;        // OUT's size (CSV): the bytes kept
-  std::size_t rows = 0;           // OUT's rows: those kept
-  std::size_t last_case_rows = 0;  // the rows of the last case in OUT (case first − 1)
+  std::size_t first = 0;              // the first case to run (0: the whole batch)
+  std::size_t cases_in_file = 0;      // the cases OUT holds
+  std::vector<char> in_file;          // per case before `first`: 1 in OUT, 0 left out (it failed earlier)
+  std::uint64_t bytes = 0;            // OUT's size (CSV): the bytes kept
+  std::size_t rows = 0;               // OUT's rows: those kept
+  std::size_t last_case_rows = 0;     // the rows of the last case in OUT (case first − 1)
   std::uint64_t last_case_bytes = 0;  // where that case begins: its first row's byte (CSV) …
   std::size_t last_case_row = 0;      // … and row
 };

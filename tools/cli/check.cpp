@@ -22,8 +22,8 @@ std::string joint_angle_line(const phiq::JointAngleReference& r) {
     return "[" + phiq::shortest(v[0]) + ", " + phiq::shortest(v[1]) + ", " + phiq::shortest(v[2]) + "]";
   };
   auto how = [](bool stated) { return stated ? " (stated)" : " (default: state `ref` to choose)"; };
-  return r.driver + ": joint " + r.joint + " from x_a = " + vec(r.ref_a) + how(r.stated_a) + " to x_b = " +
-         vec(r.ref_b) + how(r.stated_b) + ", in the sides' body frames";
+  return r.driver + ": joint " + r.joint + " from x_a = " + vec(r.ref_a) + how(r.stated_a) +
+         " to x_b = " + vec(r.ref_b) + how(r.stated_b) + ", in the sides' body frames";
 }
 
 int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at, const std::vector<std::string>& sets) {
@@ -40,10 +40,11 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
   Eigen::VectorXd q = model.initial_positions();
   phiq::AssemblySummary as;
   const double t0 = at ? *at : scene.sweep.t_begin;  // rank belongs to a configuration: `--time` picks another
-  (void)phiq::assemble(  // its status is as.status, read below
+  (void)phiq::assemble(                              // its status is as.status, read below
       model, t0, assembly_options(scene), q, &as);
   const bool ok = as.status == phiq::SolveStatus::kSuccess;
-  const bool analysed = as.rank.coordinates == model.num_coordinates() && as.status != phiq::SolveStatus::kOutsideTimeDomain;
+  const bool analysed =
+      as.rank.coordinates == model.num_coordinates() && as.status != phiq::SolveStatus::kOutsideTimeDomain;
   const phiq::RankReport& rk = as.rank;
   // inconsistent names its conflicts; not consistent without any is "not known" (the independent equations
   // themselves do not hold: AssemblySummary::consistent)
@@ -73,9 +74,8 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
     a["message"] = as.message;
     a["worst"] = nlohmann::ordered_json::array();
     for (const auto& [row, value] : as.worst_rows)
-      a["worst"].push_back({{"constraint", model.constraints()[model.constraint_of_row(row)].name},
-                            {"row", row},
-                            {"residual", value}});
+      a["worst"].push_back(
+          {{"constraint", model.constraints()[model.constraint_of_row(row)].name}, {"row", row}, {"residual", value}});
     j["assembly"] = a;
     // The redundancy analysis at the assembled position (or where the assembly stopped); null when not run.
     auto or_null = [&](auto v) { return analysed ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
@@ -108,8 +108,8 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
 
   std::cout << "scene         " << scene_path << (scene.name.empty() ? "" : " (" + scene.name + ")") << "\n"
             << "coordinates   " << model.num_coordinates() << "\n"
-            << "equations     " << model.num_equations() << " (" << model.num_equations() - drivers
-            << " kinematic, " << drivers << " rheonomic)\n"
+            << "equations     " << model.num_equations() << " (" << model.num_equations() - drivers << " kinematic, "
+            << drivers << " rheonomic)\n"
             << "constraints   " << model.constraints().size() << "\n"
             << "jacobian      " << model.num_equations() << " x " << model.num_coordinates() << ", "
             << model.jacobian_pattern().nnz() << " non-zeros\n"
@@ -129,8 +129,8 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
             << "redundant     " << (rk.redundant.empty() ? "none" : joined(rk.redundant)) << "\n"
             << "consistent    "
             << (!consistency_known ? "not known: the independent equations do not hold"
-                : as.consistent     ? "yes"
-                                    : "no: conflicting " + joined(as.conflicts))
+                : as.consistent    ? "yes"
+                                   : "no: conflicting " + joined(as.conflicts))
             << "\n";
   for (const phiq::JointAngleReference& r : scene.joint_angles)
     std::cout << "joint angle   " << joint_angle_line(r) << "\n";
@@ -149,12 +149,12 @@ Command register_check(CLI::App& app) {
     std::vector<std::string> sets;
   };
   auto a = std::make_shared<Args>();
-  CLI::App* check = app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
+  CLI::App* check =
+      app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
   check->add_option("scene", a->path, "Scene file (YAML; '-': standard input)")->required();
   check->add_flag("--json", a->json, "Print one JSON object (format: tools/README.md)");
-  CLI::Option* at =
-      check->add_option("--time", a->time, "Assemble and analyse at this time instead of time.start")
-          ->check(any_number());
+  CLI::Option* at = check->add_option("--time", a->time, "Assemble and analyse at this time instead of time.start")
+                        ->check(any_number());
   add_set_option(check, &a->sets);
   return {check, [a, at] {
             return with_stdout_checked(

@@ -33,9 +33,9 @@ const char* signal_name(int sig);
 void quiet_interrupts();
 // Whether a signal came (or, in a StopOnSignal, asked the sweep to stop), and which one.
 const std::atomic<bool>& stop_flag();
-int interrupt_signal();            // 0 when none
-int interrupt_exit_status();       // 128 + interrupt_signal()
-std::string interrupt_message();   // "interrupted (SIGTERM)"
+int interrupt_signal();           // 0 when none
+int interrupt_exit_status();      // 128 + interrupt_signal()
+std::string interrupt_message();  // "interrupted (SIGTERM)"
 
 // The mode in which a signal asks the running sweep to stop (stop_flag()) instead of exiting at once.
 class StopOnSignal {

@@ -35,8 +35,8 @@ std::string printable(const std::string& text) {
       cp = (cp << 6) | (c & 0x3Fu);
     }
     // overlong forms, surrogates and code points past U+10FFFF are not UTF-8 either
-    if (valid && ((len == 2 && cp < 0x80) || (len == 3 && cp < 0x800) || (len == 4 && (cp < 0x10000 || cp > 0x10FFFF)) ||
-                  (cp >= 0xD800 && cp <= 0xDFFF)))
+    if (valid && ((len == 2 && cp < 0x80) || (len == 3 && cp < 0x800) ||
+                  (len == 4 && (cp < 0x10000 || cp > 0x10FFFF)) || (cp >= 0xD800 && cp <= 0xDFFF)))
       valid = false;
     if (valid) {
       out.append(line, i, static_cast<std::size_t>(len));
@@ -104,10 +104,11 @@ std::vector<SensitivityRequest> sensitivity_requests(const std::vector<std::stri
 }
 
 void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args) {
-  command->add_option("--sensitivity", *args,
-                      "NAME or NAME=STEP: deliver the sensitivities to the scene parameter NAME (columns x.d_NAME, "
-                      "x.v.d_NAME, x.a.d_NAME; STEP the difference step of its data's rates), instead of the "
-                      "scene's output.sensitivities (repeat per parameter)")
+  command
+      ->add_option("--sensitivity", *args,
+                   "NAME or NAME=STEP: deliver the sensitivities to the scene parameter NAME (columns x.d_NAME, "
+                   "x.v.d_NAME, x.a.d_NAME; STEP the difference step of its data's rates), instead of the "
+                   "scene's output.sensitivities (repeat per parameter)")
       ->allow_extra_args(false);
 }
 

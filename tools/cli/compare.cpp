@@ -69,7 +69,9 @@ Command register_compare(CLI::App& app) {
       ->capture_default_str()
       ->check(tolerance);
   compare->add_option("--atol", a->subject.options.atol, "Absolute tolerance")->capture_default_str()->check(tolerance);
-  compare->add_option("--columns", a->subject.options.columns, "Compare only these columns (default: all; headers must match)")
+  compare
+      ->add_option("--columns", a->subject.options.columns,
+                   "Compare only these columns (default: all; headers must match)")
       ->delimiter(',');
   // a flag, not an option: `--json` alone (standard output) never takes the next argument, a CSV, for its file
   compare->add_flag("--json{-}", a->json, "Write the comparison as JSON to standard output, or --json=FILE")

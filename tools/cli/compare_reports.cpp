@@ -32,8 +32,13 @@ double difference(double a, double b) {
 
 // The worst cell of a column: its file line (the header is line 1), t, both values, difference, tolerance, ratio.
 Json cell(std::size_t row, double t, double a, double b, double tol, double ratio) {
-  return Json{{"line", row + 2}, {"t", std::isnan(t) ? Json(nullptr) : number(t)}, {"a", number(a)},
-              {"b", number(b)}, {"diff", number(difference(a, b))}, {"tol", number(tol)}, {"ratio", number(ratio)}};
+  return Json{{"line", row + 2},
+              {"t", std::isnan(t) ? Json(nullptr) : number(t)},
+              {"a", number(a)},
+              {"b", number(b)},
+              {"diff", number(difference(a, b))},
+              {"tol", number(tol)},
+              {"ratio", number(ratio)}};
 }
 
 bool have_cells(const CompareResult& r) { return std::min(r.rows_a, r.rows_b) > 0; }
@@ -54,12 +59,23 @@ std::string xml(const std::string& text) {
   std::string out;
   for (char c : printable(text)) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -91,10 +107,12 @@ std::string compare_json(const CompareSubject& s, const CompareResult& r) {
   }
   j["columns"] = Json::array();
   for (const ColumnComparison& c : r.per_column) {
-    Json o{{"name", c.column}, {"equal", c.mismatches == 0}, {"mismatches", c.mismatches},
+    Json o{{"name", c.column},
+           {"equal", c.mismatches == 0},
+           {"mismatches", c.mismatches},
            {"max_abs_diff", number(c.max_abs_diff)}};
-    o["worst"] = have_cells(r) ? cell(c.worst_row, c.worst_t, c.worst_a, c.worst_b, c.worst_tol, c.worst_ratio)
-                               : Json(nullptr);
+    o["worst"] =
+        have_cells(r) ? cell(c.worst_row, c.worst_t, c.worst_a, c.worst_b, c.worst_tol, c.worst_ratio) : Json(nullptr);
     j["columns"].push_back(o);
   }
   return json_text(j, 2) + "\n";

@@ -18,7 +18,8 @@ struct CompareSubject {
 std::string compare_json(const CompareSubject& s, const CompareResult& r);
 
 // The comparison as JUnit XML: one test suite, one test case per column (compared, or, without --columns, found in
-// one file only) and one for the row counts; a failure names the column's worst cell: line, t, both values, difference, tolerance.
+// one file only) and one for the row counts; a failure names the column's worst cell: line, t, both values, difference,
+// tolerance.
 std::string compare_junit(const CompareSubject& s, const CompareResult& r);
 
 }  // namespace phiq::tools

@@ -150,9 +150,8 @@ void add_outputs(const Scene& scene, const DrawnOutputs& add, OutputPlan& plan) 
   extend(plan.coordinate_columns);
   if (!add.joints) return;
   for (OutputJoint& j : measured_joints(scene)) {
-    const bool listed = std::any_of(plan.joints.begin(), plan.joints.end(), [&](const OutputJoint& o) {
-      return o.name == j.name && o.measure == j.measure;
-    });
+    const bool listed = std::any_of(plan.joints.begin(), plan.joints.end(),
+                                    [&](const OutputJoint& o) { return o.name == j.name && o.measure == j.measure; });
     if (!listed) plan.joints.push_back(std::move(j));
   }
 }
@@ -177,11 +176,13 @@ CsvTable sweep_scene(const Scene& scene, const DrawnOutputs& add) {
   SweepSummary summary;
   try {
     (void)run_sweep(  // its status is summary.status, read below
-        model, options, ws, [&](const StepView& step) {
+        model, options, ws,
+        [&](const StepView& step) {
           table.rows.emplace_back(format.num_values());
           format.append_values(step, table.rows.back().data());
           return true;
-        }, &summary);
+        },
+        &summary);
   } catch (const Error& e) {
     throw DrawError(scene.path + ": " + e.what(), 1);
   }

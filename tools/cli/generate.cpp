@@ -22,20 +22,23 @@ Command register_generate(CLI::App& app) {
   GenerateOptions& gen = a->gen;
   CLI::App* generate = app.add_subcommand("generate", "Write a scalable scene (nfourbar, scissor, grid, chain3d)");
   generate->add_option("kind", gen.kind, "nfourbar, scissor, grid or chain3d")->required();
-  generate->add_option("N", gen.n, "Size: four-bars (nfourbar), stages (scissor), cells (grid), spatial loops (chain3d)")
+  generate
+      ->add_option("N", gen.n, "Size: four-bars (nfourbar), stages (scissor), cells (grid), spatial loops (chain3d)")
       ->required()
       ->check(any_whole_number());
   generate->add_option("-o,--output", a->out, "Scene file to write ('-': standard output)")
       ->required()
       ->transform(output_path("", false));
   generate->add_option("--steps", gen.steps, "Sweep intervals")->capture_default_str()->check(any_whole_number());
-  CLI::Option* from = generate->add_option("--from", gen.from, "Driven angle at t = 0 (rad; default pi/4, scissor 0.3)");
+  CLI::Option* from =
+      generate->add_option("--from", gen.from, "Driven angle at t = 0 (rad; default pi/4, scissor 0.3)");
   from->check(any_number());
   CLI::Option* to = generate->add_option("--to", gen.to, "Driven angle at t = 1 (rad; default 3pi/4, scissor 1.2)");
   to->check(any_number());
   generate->add_option("--coords", gen.coords, "natural or reference-point")->capture_default_str();
-  generate->add_option("--twist", gen.twist,
-                       "chain3d: phase between neighbouring cranks on one hinge line (rad; 0: the parallelogram row)")
+  generate
+      ->add_option("--twist", gen.twist,
+                   "chain3d: phase between neighbouring cranks on one hinge line (rad; 0: the parallelogram row)")
       ->capture_default_str()
       ->check(any_number());
   generate->add_option("--outputs", a->outputs, "Which of q (positions), v, a the scene asks for")

@@ -55,8 +55,8 @@ class ProgressBar {
     bar.resize(kWidth, '.');
     char eta[32] = "";
     if (done > 0 && done < rows_) std::snprintf(eta, sizeof eta, ", %.0f s left", elapsed * (1.0 / f - 1.0));
-    std::fprintf(stderr, "\rphiq: [%s] %3d%% %lld/%lld rows, %.1f s%s\033[K", bar.c_str(),
-                 static_cast<int>(100.0 * f), done, rows_, elapsed, eta);
+    std::fprintf(stderr, "\rphiq: [%s] %3d%% %lld/%lld rows, %.1f s%s\033[K", bar.c_str(), static_cast<int>(100.0 * f),
+                 done, rows_, elapsed, eta);
     std::fflush(stderr);
     drawn_ = true;
   }

@@ -38,9 +38,7 @@ class ResultRows : public phiq::RowWriter {
     csv_.append_values(step, row.data());
     out.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(double));
   }
-  std::size_t max_row_bytes() const override {
-    return h5_ ? csv_.num_values() * sizeof(double) : csv_.max_row_chars();
-  }
+  std::size_t max_row_bytes() const override { return h5_ ? csv_.num_values() * sizeof(double) : csv_.max_row_chars(); }
   bool write(const std::string& encoded, phiq::Index, phiq::Index last_step) override {
     const auto w0 = Clock::now();
     if (h5_) {
@@ -85,7 +83,8 @@ class ResultRows : public phiq::RowWriter {
   static constexpr std::size_t kPendingBytes = std::size_t{1} << 20;
   void put(const std::string& text) {
     if (text.empty()) return;
-    if (file_) file_->write(text);
+    if (file_)
+      file_->write(text);
     else if (std::fwrite(text.data(), 1, text.size(), spool_) != text.size())
       throw phiq::Error("cannot write the temporary file for standard output");
   }
@@ -99,8 +98,8 @@ class ResultRows : public phiq::RowWriter {
 };
 
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
-            bool quiet, const std::string& summary_path, int threads, double memory_gb,
-            ProgressBar::Mode progress_mode, bool identifier_names, const std::vector<std::string>& sets,
+            bool quiet, const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode,
+            bool identifier_names, const std::vector<std::string>& sets,
             const std::vector<std::string>& sensitivity_args) {
   const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
@@ -110,12 +109,10 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   if (const auto clash = output_clash(outs, {{"the scene", scene_arg == "-" ? "" : scene_arg}}))
     return fail("run: " + *clash, 2);
   const bool hdf5 = result_format(format, out_path) == ResultFormat::kHdf5;
-  if (deflate > 0 && !hdf5)
-    return fail("run: --deflate compresses HDF5 results only (-o FILE.h5 or --format hdf5)", 2);
+  if (deflate > 0 && !hdf5) return fail("run: --deflate compresses HDF5 results only (-o FILE.h5 or --format hdf5)", 2);
   if (hdf5 && out_path.empty())
     return fail("run: --format hdf5 needs -o FILE: HDF5 is not written to standard output", 2);
-  if (out_path.empty() && stdout_was_closed())
-    return fail("run: standard output: cannot write: it is closed", 3);
+  if (out_path.empty() && stdout_was_closed()) return fail("run: standard output: cannot write: it is closed", 3);
   set_interrupt_subject(scene_path, "; no output written");
   const auto load_start = Clock::now();
   // (--sensitivity's parameters in place of the scene's output.sensitivities, whose models are then not made)
@@ -133,8 +130,8 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     if (hdf5) check_hdf5_target(out_path);
     // HDF5 opens its file by name, and its name must be a real path (not /proc/self/fd/N): a named temporary
     if (!out_path.empty())
-      file = &outputs.add(out_path, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites
-                                         : phiq::AtomicOutputFile::Hold::kOpen);
+      file = &outputs.add(
+          out_path, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites : phiq::AtomicOutputFile::Hold::kOpen);
     if (!summary_path.empty()) summary_file = &outputs.add(summary_path);
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);
@@ -151,7 +148,9 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
         return fail(e.what(), 3);
       }
     return fail(scene_path + ": " + why +
-                    (summary_file ? "; wrote the summary only" : outs.empty() ? "" : "; no output written"),
+                    (summary_file   ? "; wrote the summary only"
+                     : outs.empty() ? ""
+                                    : "; no output written"),
                 1);
   };
   // inconsistent or under-driven models stop here, naming the constraints
@@ -200,12 +199,11 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   } close_spool{spool};
 
   phiq::SweepSummary summary;
-  ProgressBar progress(scene.sweep.steps + 1,
-                                    quiet ? ProgressBar::Mode::kNever : progress_mode);
+  ProgressBar progress(scene.sweep.steps + 1, quiet ? ProgressBar::Mode::kNever : progress_mode);
   ResultRows rows(csv, h5.get(), file, spool, progress);
   if (!h5) rows.pending() = csv.header();
   try {
-    StopOnSignal stop_on_signal;  // a signal stops the sweep at its next rows
+    StopOnSignal stop_on_signal;                                    // a signal stops the sweep at its next rows
     (void)phiq::run_sweep(model, scene.sweep, ws, rows, &summary);  // its status is summary.status, read below
   } catch (const phiq::Error& e) {
     progress.finish();
@@ -215,8 +213,7 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
 
   // (also a signal that came after the last row: the command stops before committing, as it said it would)
   if (summary.status == phiq::SolveStatus::kCancelled || stop_flag().load())
-    return fail(scene_path + ": " + interrupt_message() + "; no output written",
-                interrupt_exit_status());
+    return fail(scene_path + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
   if (summary.status != phiq::SolveStatus::kSuccess) {
     std::string why = summary.message;
     // A square model not assembled at its first position: singular there (redundant constraints and missing
@@ -225,8 +222,9 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     // (Not when the first position was assembled and the sweep stopped at its singular start: the rank there
     // counts the loops lying flat at once as freedoms not driven.)
     if (summary.failed_step == 0 && summary.assembly.status != phiq::SolveStatus::kSuccess &&
-        summary.status != phiq::SolveStatus::kOutsideTimeDomain && summary.status != phiq::SolveStatus::kOutsideDomain &&
-        summary.status != phiq::SolveStatus::kNonFinite && !square.reduced) {
+        summary.status != phiq::SolveStatus::kOutsideTimeDomain &&
+        summary.status != phiq::SolveStatus::kOutsideDomain && summary.status != phiq::SolveStatus::kNonFinite &&
+        !square.reduced) {
       Eigen::VectorXd q = scene.model->initial_positions();
       phiq::AssemblySummary as;
       std::unique_ptr<phiq::Model> unused;
@@ -262,15 +260,16 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   }
   if (!quiet) {
     if (!redundancy.rank.redundant.empty())
-      std::cerr << "phiq: " << printable(scene_path) << ": redundant equations left out of the solve (consistent): "
-                << joined(redundancy.rank.redundant) << "\n";
+      std::cerr << "phiq: " << printable(scene_path)
+                << ": redundant equations left out of the solve (consistent): " << joined(redundancy.rank.redundant)
+                << "\n";
     for (const auto& w : summary.warnings)
-      std::cerr << "phiq: " << printable(scene_path) << ": warning: t = " << phiq::format_time(w.t) << ": " << w.kind << ": "
-                << w.message << "\n";
+      std::cerr << "phiq: " << printable(scene_path) << ": warning: t = " << phiq::format_time(w.t) << ": " << w.kind
+                << ": " << w.message << "\n";
     std::cerr << "phiq: " << printable(scene_path) << ": " << summary.BriefReport();
     if (summary.min_rcond > 0)
-      std::cerr << ", min rcond " << scientific(summary.min_rcond, 3) << " at t = "
-                << phiq::format_time(summary.min_rcond_time);
+      std::cerr << ", min rcond " << scientific(summary.min_rcond, 3)
+                << " at t = " << phiq::format_time(summary.min_rcond_time);
     if (const phiq::RowClassAccuracy& r = summary.accuracy.rounding_level; r.rows > 0)
       std::cerr << "; " << r.rows << " row(s) known only to " << phiq::significant(r.worst_error, 3)
                 << " tolerances (the rounding level; worst at t = " << phiq::format_time(r.worst_time) << ")";
@@ -303,9 +302,10 @@ Command register_run(CLI::App& app) {
   run->add_option("--format", a->format,
                   "Results format: csv or hdf5 (default: hdf5 for an output ending in .h5 or .hdf5, else csv)")
       ->check(one_of({"csv", "hdf5"}));
-  run->add_option("--deflate", a->deflate,
-                  "HDF5: shuffle and deflate (gzip) every dataset at this level, 1-9 (0: uncompressed; bench/README.md: "
-                  "it costs more time than it saves on a fast disk)")
+  run->add_option(
+         "--deflate", a->deflate,
+         "HDF5: shuffle and deflate (gzip) every dataset at this level, 1-9 (0: uncompressed; bench/README.md: "
+         "it costs more time than it saves on a fast disk)")
       ->capture_default_str()
       ->check(whole_number(0, 9, "uncompressed"));
   run->add_flag("-q,--quiet", a->quiet, "Do not print the run summary on standard error");
@@ -316,9 +316,10 @@ Command register_run(CLI::App& app) {
   run->add_option("--threads", a->threads, "Threads for the drive steps (0: all cores; 1: in order)")
       ->capture_default_str()
       ->check(thread_count());
-  run->add_option("--memory", a->memory_gb,
-                  "GB the whole process may reach with --threads 0: fewer threads when theirs would not fit (0: what the "
-                  "system reports available)")
+  run->add_option(
+         "--memory", a->memory_gb,
+         "GB the whole process may reach with --threads 0: fewer threads when theirs would not fit (0: what the "
+         "system reports available)")
       ->capture_default_str()
       ->check(number(0.0, 1e6, false, "a number of GB from 0 (what the system reports available) to 1000000"));
   run->add_option("--progress", a->progress,
@@ -331,13 +332,14 @@ Command register_run(CLI::App& app) {
       ->check(one_of({"dotted", "identifiers"}));
   add_set_option(run, &a->sets);
   add_sensitivity_option(run, &a->sensitivities);
-  return {run, [a] {
-            using Mode = ProgressBar::Mode;
-            const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
-            return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet,
-                                               a->summary_path, cap_threads("run", a->threads, a->quiet), a->memory_gb,
-                                               mode, a->names == "identifiers", a->sets, a->sensitivities));
-          }};
+  return {
+      run, [a] {
+        using Mode = ProgressBar::Mode;
+        const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
+        return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet, a->summary_path,
+                                           cap_threads("run", a->threads, a->quiet), a->memory_gb, mode,
+                                           a->names == "identifiers", a->sets, a->sensitivities));
+      }};
 }
 
 }  // namespace phiq::tools

@@ -79,10 +79,11 @@ int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
   const auto t0 = Clock::now();
   try {
     StopOnSignal stop_on_signal;
-    rep = measure_accuracy(scene, o, a.verbose ? std::function<void(const std::string&)>([](const std::string& l) {
-                                      std::cerr << "phiq: sweep-accuracy: " << l << "\n";
-                                    })
-                                               : std::function<void(const std::string&)>());
+    rep = measure_accuracy(scene, o,
+                           a.verbose ? std::function<void(const std::string&)>([](const std::string& l) {
+                             std::cerr << "phiq: sweep-accuracy: " << l << "\n";
+                           })
+                                     : std::function<void(const std::string&)>());
   } catch (const AccuracyCancelled&) {
     return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
   } catch (const std::invalid_argument& e) {
@@ -134,17 +135,21 @@ int run_sweep_accuracy_command(const SweepAccuracyArgs& a) {
 
 Command register_sweep_accuracy(CLI::App& app) {
   auto acc = std::make_shared<SweepAccuracyArgs>();
-  CLI::App* accuracy = app.add_subcommand("sweep-accuracy", "Error against a reference and time per step, per solver setting");
+  CLI::App* accuracy =
+      app.add_subcommand("sweep-accuracy", "Error against a reference and time per step, per solver setting");
   accuracy->add_option("scene", acc->scene, "Scene file (YAML)")->required();
   accuracy->add_option("-o,--output", acc->csv_path, "CSV to write (default: standard output unless --json)")
       ->transform(output_path(" (without the option, or '-': standard output)", false));
-  accuracy->add_option("--json", acc->json_path, "JSON to write ('-': standard output)")->transform(output_path("", false));
+  accuracy->add_option("--json", acc->json_path, "JSON to write ('-': standard output)")
+      ->transform(output_path("", false));
   accuracy->add_option("--tolerances", acc->tolerances, "Newton tolerances (default 1e-4,1e-5,...,1e-14)");
   accuracy->add_option("--steps-list", acc->steps, "Step counts (default: the scene's x 1/4, 1, 4)");
-  accuracy->add_option("--predictors", acc->predictors, "Of previous,secant,parabolic,linear,hermite,quadratic,cubic,auto (default: all but auto)");
+  accuracy->add_option("--predictors", acc->predictors,
+                       "Of previous,secant,parabolic,linear,hermite,quadratic,cubic,auto (default: all but auto)");
   accuracy->add_option("--newton", acc->newton, "Of modified,full (default: both)");
   accuracy->add_option("--linear-solvers", acc->linear_solvers, "Of klu,umfpack,dense (default: klu,umfpack)");
-  accuracy->add_option("--reference", acc->reference, "auto, numerical or closed-form:KIND[:NAME=VALUE,...]")->capture_default_str();
+  accuracy->add_option("--reference", acc->reference, "auto, numerical or closed-form:KIND[:NAME=VALUE,...]")
+      ->capture_default_str();
   accuracy->add_option("--repeat", acc->repeat, "Timed runs per setting (best of)")
       ->capture_default_str()
       ->check(whole_number(1, 1000));

@@ -1,7 +1,8 @@
 // `phiq tolerance SCENE --sd P=σ ... -o OUT.csv`: the spread of the scene's outputs over toleranced parameters,
 // first order from the exact sensitivities of one nominal sweep, and Monte Carlo from sampled parameter sets swept in
 // parallel on the nominal model's symbolic analysis (run_cases: over this process's threads and, under mpirun, the
-// ranks), with their agreement. The numbers are tools/tolerance/; what is written, tolerance_report.*; the format, tools/README.md.
+// ranks), with their agreement. The numbers are tools/tolerance/; what is written, tolerance_report.*; the format,
+// tools/README.md.
 #include <signal.h>
 #include <tbb/info.h>
 
@@ -132,17 +133,20 @@ SampledCase sample_case(ParsedScene& tree, const SceneOverrides& o, const std::v
   std::size_t rows = 0;
   const char* grid = "its time grid differs from the nominal scene's (a parameter sets the sweep's time range)";
   SweepSummary s;
-  (void)run_sweep(model, one, ws, [&](const StepView& step) {
-    const std::size_t r = rows++;
-    if (r >= t.size() || std::fabs(step.t - t[r]) > 1e-12 * (1.0 + std::fabs(t[r]))) {
-      c.why = grid;
-      c.values.clear();
-      return false;
-    }
-    for (const OutputColumn& col : columns)
-      c.values.push_back((col.order == 0 ? step.q : col.order == 1 ? *step.qd : *step.qdd)(col.coordinate));
-    return !stop.load();
-  }, &s);
+  (void)run_sweep(
+      model, one, ws,
+      [&](const StepView& step) {
+        const std::size_t r = rows++;
+        if (r >= t.size() || std::fabs(step.t - t[r]) > 1e-12 * (1.0 + std::fabs(t[r]))) {
+          c.why = grid;
+          c.values.clear();
+          return false;
+        }
+        for (const OutputColumn& col : columns)
+          c.values.push_back((col.order == 0 ? step.q : col.order == 1 ? *step.qd : *step.qdd)(col.coordinate));
+        return !stop.load();
+      },
+      &s);
   if (c.why.empty() && s.status != SolveStatus::kSuccess) c.why = s.message;
   if (c.why.empty() && rows != t.size()) c.why = grid;
   if (!c.why.empty()) c.values.clear();
@@ -206,7 +210,7 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
     if (it == scene.parameters.end()) {
       std::vector<std::string> names;
       for (const auto& p : scene.parameters) names.push_back(p.first);
-      const std::string where = t.from_covariance ? a.covariance
+      const std::string where = t.from_covariance                                     ? a.covariance
                                 : t.distribution == tolerance::Distribution::kUniform ? "tolerance: --limit"
                                                                                       : "tolerance: --sd";
       return fail(where + ": '" + t.name + "' is not a parameter of " + a.scene +
@@ -237,9 +241,9 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
     for (const OutputColumn& c : columns)
       for (const char* suffix : {"", ".sd_linear", ".sd_mc", ".mean_mc"})
         if (!seen.insert(identifier_column_name(c.name + suffix)).second)
-          return fail("tolerance: --names identifiers: two columns would be named " +
-                          identifier_column_name(c.name + suffix),
-                      2);
+          return fail(
+              "tolerance: --names identifiers: two columns would be named " + identifier_column_name(c.name + suffix),
+              2);
   }
 
   // ---- the models along each parameter (sensitivities), sharing the nominal model's analysis
@@ -269,8 +273,8 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   AtomicOutputFile *csv_file = nullptr, *summary_file = nullptr, *plot_file = nullptr;
   int status = 0;
   if (writer) {
-    if (const auto why = samples_out_of_memory(a, static_cast<std::size_t>(rows_written(scene.sweep)),
-                                               columns.size(), spread.parameters.size()))
+    if (const auto why = samples_out_of_memory(a, static_cast<std::size_t>(rows_written(scene.sweep)), columns.size(),
+                                               spread.parameters.size()))
       status = fail(*why, 1);
   }
   if (writer && status == 0) {
@@ -302,21 +306,24 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
     Workspace ws(model);
     ws.q = square.start;
     Eigen::VectorXd g(static_cast<Eigen::Index>(np));
-    (void)run_sweep(model, scene.sweep, ws, [&](const StepView& step) {
-      t.push_back(step.t);
-      for (std::size_t o = 0; o < columns.size(); ++o) {
-        const OutputColumn& c = columns[o];
-        const Eigen::VectorXd& v = c.order == 0 ? step.q : c.order == 1 ? *step.qd : *step.qdd;
-        spreads[o].nominal.push_back(v(c.coordinate));
-        for (std::size_t j = 0; j < np; ++j) {
-          g(static_cast<Eigen::Index>(j)) = step.sensitivities[layout.offset(j, c.order) + c.coordinate];
-          if (std::isfinite(g(static_cast<Eigen::Index>(j))))
-            largest_sensitivity[j] = std::max(largest_sensitivity[j], std::fabs(g(static_cast<Eigen::Index>(j))));
-        }
-        spreads[o].sd_linear.push_back(tolerance::linear_sd(g, spread.sigma));
-      }
-      return !stop.load();
-    }, &nominal_summary);
+    (void)run_sweep(
+        model, scene.sweep, ws,
+        [&](const StepView& step) {
+          t.push_back(step.t);
+          for (std::size_t o = 0; o < columns.size(); ++o) {
+            const OutputColumn& c = columns[o];
+            const Eigen::VectorXd& v = c.order == 0 ? step.q : c.order == 1 ? *step.qd : *step.qdd;
+            spreads[o].nominal.push_back(v(c.coordinate));
+            for (std::size_t j = 0; j < np; ++j) {
+              g(static_cast<Eigen::Index>(j)) = step.sensitivities[layout.offset(j, c.order) + c.coordinate];
+              if (std::isfinite(g(static_cast<Eigen::Index>(j))))
+                largest_sensitivity[j] = std::max(largest_sensitivity[j], std::fabs(g(static_cast<Eigen::Index>(j))));
+            }
+            spreads[o].sd_linear.push_back(tolerance::linear_sd(g, spread.sigma));
+          }
+          return !stop.load();
+        },
+        &nominal_summary);
   }
   if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
   if (nominal_summary.status != SolveStatus::kSuccess)
@@ -328,7 +335,8 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   std::vector<std::string> why_failed(n_cases);
   auto values_of = [&](std::size_t k) {
     std::vector<double> v(np);
-    for (std::size_t j = 0; j < np; ++j) v[j] = nominal[j] + offsets(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
+    for (std::size_t j = 0; j < np; ++j)
+      v[j] = nominal[j] + offsets(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
     return v;
   };
   tolerance::CaseValues cases;
@@ -383,8 +391,10 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
       threads_used = run_cases(ranks, 0, n_cases, threads_used, h);
     } catch (const std::bad_alloc&) {  // a worker's: the cases' outputs and models took what there was
       return fail(a.scene + ": out of memory with " + std::to_string(n_cases) + " samples on " +
-                      std::to_string(threads_used) + " threads (fewer --samples, --columns or --threads); no output "
-                      "written", 1);
+                      std::to_string(threads_used) +
+                      " threads (fewer --samples, --columns or --threads); no output "
+                      "written",
+                  1);
     }
     if (!writer) return 0;  // (rank 0 reports)
     if (stop.load() || remote_stop.load())
@@ -419,7 +429,8 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   if (succeeded < 2)
     return fail(a.scene + ": " + std::to_string(succeeded) + " of " + std::to_string(n_cases) +
                     " sampled cases succeeded: no Monte Carlo spread (first failure: " +
-                    (failed.empty() ? std::string("none") : case_label(failed.front(), spread) + ": " + failed.front().message) +
+                    (failed.empty() ? std::string("none")
+                                    : case_label(failed.front(), spread) + ": " + failed.front().message) +
                     "); no output written",
                 1);
 
@@ -436,7 +447,8 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   // ---- the report on standard error: failures always, the rest unless --quiet
   const std::size_t shown = std::min<std::size_t>(failed.size(), 20);
   for (std::size_t i = 0; i < shown; ++i)
-    std::cerr << "phiq: " << printable(a.scene + ": " + case_label(failed[i], spread) + ": " + failed[i].message) << "\n";
+    std::cerr << "phiq: " << printable(a.scene + ": " + case_label(failed[i], spread) + ": " + failed[i].message)
+              << "\n";
   if (failed.size() > shown)
     std::cerr << "phiq: " << printable(a.scene) << ": and " << failed.size() - shown << " more failed cases"
               << (summary_file ? " (all named in the summary)" : " (--summary names them all)") << "\n";
@@ -450,9 +462,10 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
   for (const OutputSpread& s : spreads) {
     if (!s.agreement.disagrees) continue;
     ++disagreeing;
-    std::cerr << "phiq: " << printable(a.scene + ": " + s.name) << ": linear and Monte Carlo spreads disagree: "
-              << significant(s.agreement.worst, 3) << " standard errors at t = " << format_time(s.agreement.worst_t)
-              << " (sd_linear " << significant(s.agreement.sd_linear_at_worst, 4) << ", sd_mc "
+    std::cerr << "phiq: " << printable(a.scene + ": " + s.name)
+              << ": linear and Monte Carlo spreads disagree: " << significant(s.agreement.worst, 3)
+              << " standard errors at t = " << format_time(s.agreement.worst_t) << " (sd_linear "
+              << significant(s.agreement.sd_linear_at_worst, 4) << ", sd_mc "
               << significant(s.agreement.sd_mc_at_worst, 4)
               << "; expected near a singular position, where the first-order model fails)\n";
   }
@@ -462,10 +475,10 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
     for (const OutputSpread& s : spreads)
       if (s.agreement.worst >= worst) worst = s.agreement.worst, where = s.name;
     std::cerr << "phiq: " << printable(a.scene) << ": " << succeeded << " of " << n_cases << " cases on "
-              << (ranks.size() > 1 ? ranks.describe() + ", " : "") << threads_used << " threads, " << columns.size() << " outputs, " << disagreeing
-              << " disagreeing (worst " << significant(worst, 3) << " standard errors, " << printable(where)
-              << "; threshold " << significant(a.threshold, 3) << "), " << scientific(run.solve_seconds, 3)
-              << " s; wrote " << printable(a.out) << "\n";
+              << (ranks.size() > 1 ? ranks.describe() + ", " : "") << threads_used << " threads, " << columns.size()
+              << " outputs, " << disagreeing << " disagreeing (worst " << significant(worst, 3) << " standard errors, "
+              << printable(where) << "; threshold " << significant(a.threshold, 3) << "), "
+              << scientific(run.solve_seconds, 3) << " s; wrote " << printable(a.out) << "\n";
   }
   return 0;
 }
@@ -477,13 +490,15 @@ Command register_tolerance(CLI::App& app) {
   CLI::App* tol = app.add_subcommand(
       "tolerance", "Spread of the outputs over toleranced parameters: first order (sensitivities) and Monte Carlo");
   tol->add_option("scene", a->scene, "Scene file (YAML)")->required();
-  tol->add_option("-o,--output", a->out, "CSV to write: t, then per output y, y.sd_linear, y.sd_mc, y.mean_mc "
-                                         "('-': standard output)")
+  tol->add_option("-o,--output", a->out,
+                  "CSV to write: t, then per output y, y.sd_linear, y.sd_mc, y.mean_mc "
+                  "('-': standard output)")
       ->required()
       ->transform(output_path("", false));
   tol->add_option("--sd", a->sd, "NAME=SD: the parameter is normal with this standard deviation (repeat per parameter)")
       ->allow_extra_args(false);  // one NAME=SD an occurrence: the scene after it stays the scene
-  tol->add_option("--limit", a->limit, "NAME=L: the parameter is uniform on [p - L, p + L] (standard deviation L/sqrt(3))")
+  tol->add_option("--limit", a->limit,
+                  "NAME=L: the parameter is uniform on [p - L, p + L] (standard deviation L/sqrt(3))")
       ->allow_extra_args(false);
   tol->add_option("--covariance", a->covariance,
                   "CSV: a header of parameter names and their covariance matrix (symmetric positive definite), one "
@@ -501,8 +516,9 @@ Command register_tolerance(CLI::App& app) {
                   "Standard errors beyond which the linear and Monte Carlo spreads of an output disagree")
       ->capture_default_str()
       ->check(number(0.0, 1e6, false, "a positive number of standard errors"));
-  tol->add_option("--summary", a->summary, "Write the JSON summary (parameters, covariance, failed cases, agreement) "
-                                            "to this file ('-': standard output)")
+  tol->add_option("--summary", a->summary,
+                  "Write the JSON summary (parameters, covariance, failed cases, agreement) "
+                  "to this file ('-': standard output)")
       ->transform(output_path("", false));
   tol->add_option("--plot", a->plot, "Write an SVG of one output with its nominal curve and both ±2σ bands")
       ->transform(output_path("", false));

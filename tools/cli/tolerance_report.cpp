@@ -67,7 +67,9 @@ nlohmann::ordered_json tolerance_summary(const ToleranceRun& run, const std::vec
     const auto i = static_cast<Eigen::Index>(k);
     json e{{"name", p.name}, {"nominal", run.nominal[k]}};
     e["distribution"] = p.distribution == tolerance::Distribution::kUniform ? "uniform" : "normal";
-    e["source"] = p.from_covariance ? "covariance" : p.distribution == tolerance::Distribution::kUniform ? "limit" : "sd";
+    e["source"] = p.from_covariance                                     ? "covariance"
+                  : p.distribution == tolerance::Distribution::kUniform ? "limit"
+                                                                        : "sd";
     if (p.distribution == tolerance::Distribution::kUniform) e["limit"] = p.spread;
     e["sd"] = std::sqrt(spread.sigma(i, i));
     e["independent"] = std::find(run.independent.begin(), run.independent.end(), p.name) != run.independent.end();
@@ -148,11 +150,13 @@ std::string tolerance_svg(const Scene& scene, const std::vector<double>& t, cons
     for (const auto& [x, y] : c) l.push_back({b.sx(x), b.sy(y)});
     return l;
   };
-  std::string svg_text = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" "
-                         "width=\"" + px(W) + "\" height=\"" + px(H) + "\" viewBox=\"0 0 " + px(W) + " " + px(H) +
-                         "\" font-family=\"sans-serif\" font-size=\"12\">\n<title>" +
-                         escape((scene.name.empty() ? scene.path : scene.name) + ": " + s.name) +
-                         " with its 2-sigma bands</title>\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  std::string svg_text =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" "
+      "width=\"" +
+      px(W) + "\" height=\"" + px(H) + "\" viewBox=\"0 0 " + px(W) + " " + px(H) +
+      "\" font-family=\"sans-serif\" font-size=\"12\">\n<title>" +
+      escape((scene.name.empty() ? scene.path : scene.name) + ": " + s.name) +
+      " with its 2-sigma bands</title>\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   svg_text += axes(b, "t (s)", column_quantity(scene, s.name).label(), 8, 5);
   // the linear band, filled: upper edge forwards, lower edge backwards
   Line band = to_px(lin_hi);
@@ -168,8 +172,8 @@ std::string tolerance_svg(const Scene& scene, const std::vector<double>& t, cons
   svg_text += polyline("band-mc", kPalette[1], 1.2, to_px(mc_lo), dash);
   svg_text += polyline("nominal", "#000000", 1.5, to_px(nominal), " data-column=\"" + escape(s.name) + "\"");
   const double lx = b.x0 + b.w - 6, ly = b.y0 + 14;
-  svg_text += "<text class=\"legend\" x=\"" + px(lx) + "\" y=\"" + px(ly) + "\" text-anchor=\"end\">" +
-              escape(s.name) + " (nominal)</text>\n";
+  svg_text += "<text class=\"legend\" x=\"" + px(lx) + "\" y=\"" + px(ly) + "\" text-anchor=\"end\">" + escape(s.name) +
+              " (nominal)</text>\n";
   svg_text += "<text class=\"legend\" x=\"" + px(lx) + "\" y=\"" + px(ly + 14) + "\" text-anchor=\"end\" fill=\"" +
               kPalette[0] + "\">nominal ± 2 sd_linear (first order)</text>\n";
   svg_text += "<text class=\"legend\" x=\"" + px(lx) + "\" y=\"" + px(ly + 28) + "\" text-anchor=\"end\" fill=\"" +

@@ -18,18 +18,19 @@ void header(std::string& s, const GenerateOptions& o, const std::string& what, c
             std::int64_t coordinates, std::int64_t kinematic, const std::string& names) {
   emit::SceneText t(1024);
   gen::header(t, o, what,
-              driven + " = crank 0's angle (rad), linear from " + shortest_unsigned_zero(o.from) + " at t = 0 to " + shortest_unsigned_zero(o.to) +
-                  " at t = 1; every crank at that angle (the parallelogram solution)",
+              driven + " = crank 0's angle (rad), linear from " + shortest_unsigned_zero(o.from) + " at t = 0 to " +
+                  shortest_unsigned_zero(o.to) + " at t = 1; every crank at that angle (the parallelogram solution)",
               coordinates, kinematic, 1, names);
   s += t.take();
 }
 
 void footer(std::string& s, const GenerateOptions& o, const std::string& driven) {
-  s += "drivers:\n  - {name: motor, coordinate: " + driven + ", law: {type: linear, initial: " + shortest_unsigned_zero(o.from) +
+  s += "drivers:\n  - {name: motor, coordinate: " + driven +
+       ", law: {type: linear, initial: " + shortest_unsigned_zero(o.from) +
        ", rate: " + shortest_unsigned_zero(o.to - o.from) + "}}\n";
   s += "time: {start: 0, end: 1, steps: " + std::to_string(o.steps) + "}\n";
-  s += std::string("output: {velocities: ") + (o.v ? "true" : "false") + ", accelerations: " +
-       (o.a ? "true" : "false") + "}\n";
+  s += std::string("output: {velocities: ") + (o.v ? "true" : "false") +
+       ", accelerations: " + (o.a ? "true" : "false") + "}\n";
 }
 
 // The scenes are written with indexed families (`for i in 0..N`, models/README.md), so their size does not depend
@@ -133,8 +134,10 @@ std::int64_t max_n(const GenerateOptions& o) {
   if (fits(hi)) return hi;
   while (lo < hi) {
     const std::int64_t mid = lo + (hi - lo + 1) / 2;
-    if (fits(mid)) lo = mid;
-    else hi = mid - 1;
+    if (fits(mid))
+      lo = mid;
+    else
+      hi = mid - 1;
   }
   return lo;
 }
@@ -148,8 +151,8 @@ std::string generate_scene(const GenerateOptions& o) {
   // Finite options can still make numbers of the scene that are not: the driver's rate, and chain3d's phases
   // from + i·twist up to i = N; the loader would refuse the scene ('-inf' is not a finite number).
   if (!std::isfinite(o.to - o.from))
-    throw std::invalid_argument("--from and --to: the driven range to - from = " + shortest_unsigned_zero(o.to - o.from) +
-                                " is not finite");
+    throw std::invalid_argument(
+        "--from and --to: the driven range to - from = " + shortest_unsigned_zero(o.to - o.from) + " is not finite");
   if (!std::isfinite(std::fabs(o.from) + static_cast<double>(o.n) * std::fabs(o.twist)))
     throw std::invalid_argument("--twist: crank N's phase from + N*twist is not finite");
   if (o.twist != 0.0 && o.kind != "chain3d") throw std::invalid_argument("--twist applies to chain3d only");

@@ -48,25 +48,26 @@ void check(const GenerateOptions& o) {
           "pivots (the angle a multiple of pi); the driven range must not reach one (--twist runs through full "
           "turns)");
   } else if (!(std::fabs(std::sin(o.twist)) >= kMinSinTwist)) {
-    throw std::invalid_argument("--twist: |sin(twist)| must be at least 0.01 (at a multiple of pi neighbouring "
-                                "cranks are parallel or opposite on their common axis: singular)");
+    throw std::invalid_argument(
+        "--twist: |sin(twist)| must be at least 0.01 (at a multiple of pi neighbouring "
+        "cranks are parallel or opposite on their common axis: singular)");
   }
 }
 
 // `name`x, `name`y, `name`z: the components of a vector as parameters.
 std::string vector_parameters(const std::string& name, const chain3d::Vec& v, const std::string& comment) {
-  return "  " + name + "x: " + shortest(v[0]) + "    # " + comment + "\n  " + name + "y: " + shortest(v[1]) + "\n  " + name +
-         "z: " + shortest(v[2]) + "\n";
+  return "  " + name + "x: " + shortest(v[0]) + "    # " + comment + "\n  " + name + "y: " + shortest(v[1]) + "\n  " +
+         name + "z: " + shortest(v[2]) + "\n";
 }
 
 // The parameters both styles read: the size, the drive's start, the twist, the coupler length, the pivot step, the
 // axes, and the rough placement's shift.
 std::string parameters(const GenerateOptions& o, const chain3d::Geometry& g) {
   const bool twisted = o.twist != 0.0;
-  return "parameters:\n  N: " + gen::str(o.n) + "\n  from: " + shortest(o.from) + "    # crank 0's angle at t = 0\n  tw: " +
-         shortest(o.twist) + "    # crank i+1's phase ahead of crank i\n  L: " + shortest(chain3d::coupler_length(o.twist)) +
-         "    # coupler length\n" +
-         vector_parameters("o", twisted ? g.u : g.e1, "pivot step: O_i = i (ox, oy, oz)") +
+  return "parameters:\n  N: " + gen::str(o.n) + "\n  from: " + shortest(o.from) +
+         "    # crank 0's angle at t = 0\n  tw: " + shortest(o.twist) +
+         "    # crank i+1's phase ahead of crank i\n  L: " + shortest(chain3d::coupler_length(o.twist)) +
+         "    # coupler length\n" + vector_parameters("o", twisted ? g.u : g.e1, "pivot step: O_i = i (ox, oy, oz)") +
          vector_parameters("u", g.u, "hinge axis") + vector_parameters("e1", g.e1, "crank direction at angle 0") +
          vector_parameters("e2", g.e2, "u x e1: crank direction at angle pi/2") + "  shift: " + shortest(kShift) +
          "    # rough placement: the solution at t = 0 shifted along u, off the hinges' planes\n";
@@ -74,8 +75,8 @@ std::string parameters(const GenerateOptions& o, const chain3d::Geometry& g) {
 
 // The drive's description.
 std::string drive(const GenerateOptions& o, const std::string& what) {
-  return what + " = crank 0's angle about u from e1 towards e2 (rad), linear from " + shortest(o.from) + " at t = 0 to " +
-         shortest(o.to) + " at t = 1; crank i at that angle + i*tw";
+  return what + " = crank 0's angle about u from e1 towards e2 (rad), linear from " + shortest(o.from) +
+         " at t = 0 to " + shortest(o.to) + " at t = 1; crank i at that angle + i*tw";
 }
 
 std::string what(const GenerateOptions& o) {
@@ -83,7 +84,9 @@ std::string what(const GenerateOptions& o) {
     return "row of N spatial loops: N + 1 unit cranks on parallel hinges (axis u = (1, 2, 2)/3) pinned along "
            "d = (2, 1, -2)/3, their tips joined by N unit couplers with ball joints (the parallelogram row), 1 dof";
   return "twisted row of N spatial loops: N + 1 unit cranks on one hinge axis u = (1, 2, 2)/3, pinned one unit "
-         "apart along it, neighbours " + shortest(o.twist) + " rad apart in phase, tips joined by couplers of length "
+         "apart along it, neighbours " +
+         shortest(o.twist) +
+         " rad apart in phase, tips joined by couplers of length "
          "sqrt(3 - 2 cos twist) with ball joints, 1 dof";
 }
 
@@ -118,8 +121,10 @@ SceneText begin(const GenerateOptions& o, const chain3d::Geometry& g, const Styl
 // at t = 0 to `to` at t = 1, and the footer; returns the scene.
 std::string finish(SceneText& t, const GenerateOptions& o, Name driven) {
   t.section("drivers");
-  if (driven.family == "theta") t.linear_driver(Name{"motor"}, driven, o.from, o.to - o.from);
-  else t.joint_driver(Name{"motor"}, driven, o.from, o.to - o.from);
+  if (driven.family == "theta")
+    t.linear_driver(Name{"motor"}, driven, o.from, o.to - o.from);
+  else
+    t.joint_driver(Name{"motor"}, driven, o.from, o.to - o.from);
   gen::footer(t, o);
   return t.take();
 }
@@ -140,14 +145,15 @@ std::string chain3d_natural(const GenerateOptions& o) {
   t.section("points");
   t.raw("  for i in 0..N:\n    P{i}: [\"x{i}\", \"y{i}\", \"z{i}\"]\n");
   t.section("constraints");
-  t.raw("  - for i in 0..N:\n"
-        "      - {name: \"crank{i}\", type: distance, points: [[i*ox, i*oy, i*oz], \"P{i}\"], length: 1}\n"
-        "      - {name: \"plane{i}\", type: point_on_plane, between: [{body: ground, at: [i*ox, i*oy, i*oz], axis: "
-        "[ux, uy, uz]}, {point: \"P{i}\"}]}\n"
-        "  - for i in 0..N-1:\n"
-        "      - {name: \"coupler{i}\", type: distance, points: [\"P{i}\", \"P{i+1}\"], length: L}\n"
-        "  - {name: crank0_angle, type: equation, unit: length, expr: \"cos(theta)*(e2x*x0 + e2y*y0 + e2z*z0) - "
-        "sin(theta)*(e1x*x0 + e1y*y0 + e1z*z0)\"}\n");
+  t.raw(
+      "  - for i in 0..N:\n"
+      "      - {name: \"crank{i}\", type: distance, points: [[i*ox, i*oy, i*oz], \"P{i}\"], length: 1}\n"
+      "      - {name: \"plane{i}\", type: point_on_plane, between: [{body: ground, at: [i*ox, i*oy, i*oz], axis: "
+      "[ux, uy, uz]}, {point: \"P{i}\"}]}\n"
+      "  - for i in 0..N-1:\n"
+      "      - {name: \"coupler{i}\", type: distance, points: [\"P{i}\", \"P{i+1}\"], length: L}\n"
+      "  - {name: crank0_angle, type: equation, unit: length, expr: \"cos(theta)*(e2x*x0 + e2y*y0 + e2z*z0) - "
+      "sin(theta)*(e1x*x0 + e1y*y0 + e1z*z0)\"}\n");
   return finish(t, o, Name{"theta"});
 }
 
@@ -176,15 +182,17 @@ std::string chain3d_reference_point(const GenerateOptions& o) {
     c += std::string("    e") + k + "c{i}: qa" + k + "*cos((from + i*tw)/2) + qb" + k + "*sin((from + i*tw)/2)\n";
   t.raw(c);
   t.section("bodies");
-  t.raw("  for i in 0..N:\n    crank{i}: [\"xc{i}\", \"yc{i}\", \"zc{i}\", \"e0c{i}\", \"e1c{i}\", \"e2c{i}\", "
-        "\"e3c{i}\"]\n");
+  t.raw(
+      "  for i in 0..N:\n    crank{i}: [\"xc{i}\", \"yc{i}\", \"zc{i}\", \"e0c{i}\", \"e1c{i}\", \"e2c{i}\", "
+      "\"e3c{i}\"]\n");
   t.section("constraints");
-  t.raw("  - for i in 0..N:\n"
-        "      - {name: \"pivot{i}\", type: revolute, between: [{body: ground, at: [i*ox, i*oy, i*oz], axis: [ux, uy, "
-        "uz], ref: [e1x, e1y, e1z]}, {body: \"crank{i}\", at: [-0.5, 0, 0]}]}\n"
-        "  - for i in 0..N-1:\n"
-        "      - {name: \"coupler{i}\", type: distance, between: [{body: \"crank{i}\", at: [0.5, 0, 0]}, {body: "
-        "\"crank{i+1}\", at: [0.5, 0, 0]}], length: L}\n");
+  t.raw(
+      "  - for i in 0..N:\n"
+      "      - {name: \"pivot{i}\", type: revolute, between: [{body: ground, at: [i*ox, i*oy, i*oz], axis: [ux, uy, "
+      "uz], ref: [e1x, e1y, e1z]}, {body: \"crank{i}\", at: [-0.5, 0, 0]}]}\n"
+      "  - for i in 0..N-1:\n"
+      "      - {name: \"coupler{i}\", type: distance, between: [{body: \"crank{i}\", at: [0.5, 0, 0]}, {body: "
+      "\"crank{i+1}\", at: [0.5, 0, 0]}], length: L}\n");
   return finish(t, o, Name{"pivot0"});
 }
 

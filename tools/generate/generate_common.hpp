@@ -25,8 +25,9 @@ inline void check_size_and_coords(const GenerateOptions& o) {
   if (o.coords != "natural" && o.coords != "reference-point")
     throw std::invalid_argument("--coords is natural or reference-point");
   if (const std::int64_t most = max_n(o); o.n > most)
-    throw std::invalid_argument("N = " + str(o.n) + ": " + o.kind + " in " + o.coords + " coordinates is at most N = " +
-                                str(most) + " (its families would make more entries than a scene may, SceneLimits::"
+    throw std::invalid_argument("N = " + str(o.n) + ": " + o.kind + " in " + o.coords +
+                                " coordinates is at most N = " + str(most) +
+                                " (its families would make more entries than a scene may, SceneLimits::"
                                 "max_family_instances)");
   if (o.steps > kMaxSteps)
     throw std::invalid_argument("--steps must be at most " + str(kMaxSteps) + " (a scene's time.steps), got " +
@@ -41,8 +42,8 @@ inline void header(emit::SceneText& t, const GenerateOptions& o, const std::stri
             (o.twist != 0.0 ? " --twist " + shortest(o.twist) : std::string()) + ": " + what);
   t.comment("Drive: " + drive);
   t.comment("Counts: " + str(coordinates) + " coordinates, " + str(kinematic) + " kinematic equations + " +
-            str(drivers) + (drivers == 1 ? " driver" : " drivers") + " = " + str(kinematic + drivers) +
-            " equations; " + str(coordinates - kinematic) + " dof");
+            str(drivers) + (drivers == 1 ? " driver" : " drivers") + " = " + str(kinematic + drivers) + " equations; " +
+            str(coordinates - kinematic) + " dof");
   t.comment("Names: " + names);
   t.field("phiq", "1");
   t.field("name", o.kind + "_" + str(o.n) + "_" + (natural ? "natural" : "reference_point"));

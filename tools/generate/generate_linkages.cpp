@@ -22,7 +22,6 @@ using emit::Name;
 using emit::PointRef;
 using emit::SceneText;
 
-
 using gen::footer;
 using gen::header;
 using gen::str;
@@ -42,8 +41,8 @@ void check(const GenerateOptions& o, double singular_at, const std::string& what
 const char* const kScissorWhat = "scissor lift of N stages (unit bars crossing at their midpoints), 1 dof";
 
 std::string scissor_drive(const GenerateOptions& o, const std::string& coordinate) {
-  return coordinate + " = the bars' angle to the horizontal (rad), linear from " + shortest(o.from) +
-         " at t = 0 to " + shortest(o.to) + " at t = 1";
+  return coordinate + " = the bars' angle to the horizontal (rad), linear from " + shortest(o.from) + " at t = 0 to " +
+         shortest(o.to) + " at t = 1";
 }
 
 // The scenes are written with indexed families (`for k in 0..N-1`, models/README.md), so that their size does not
@@ -66,26 +65,29 @@ std::string scissor_natural(const GenerateOptions& o) {
         "    # sin(from)\n  hc: " + shortest(0.5 * c) + "    # c/2\n");
   t.section("coordinates");
   t.coordinate(Name{"xr", 0}, c);
-  t.raw("  for k in 0..N-1:\n"
-        "    xm{k}: hc\n    ym{k}: (k + 0.5)*s\n"
-        "    xl{k+1}: 0\n    yl{k+1}: (k+1)*s\n"
-        "    xr{k+1}: c\n    yr{k+1}: (k+1)*s\n");
+  t.raw(
+      "  for k in 0..N-1:\n"
+      "    xm{k}: hc\n    ym{k}: (k + 0.5)*s\n"
+      "    xl{k+1}: 0\n    yl{k+1}: (k+1)*s\n"
+      "    xr{k+1}: c\n    yr{k+1}: (k+1)*s\n");
   t.coordinate(Name{"theta"}, o.from);
   t.section("points");
   t.point(Name{"L", 0}, Component::of(0.0), Component::of(0.0));
   t.point(Name{"R", 0}, Name{"xr", 0}, Component::of(0.0));
-  t.raw("  for k in 0..N-1:\n"
-        "    M{k}: [\"xm{k}\", \"ym{k}\"]\n"
-        "    L{k+1}: [\"xl{k+1}\", \"yl{k+1}\"]\n"
-        "    R{k+1}: [\"xr{k+1}\", \"yr{k+1}\"]\n");
+  t.raw(
+      "  for k in 0..N-1:\n"
+      "    M{k}: [\"xm{k}\", \"ym{k}\"]\n"
+      "    L{k+1}: [\"xl{k+1}\", \"yl{k+1}\"]\n"
+      "    R{k+1}: [\"xr{k+1}\", \"yr{k+1}\"]\n");
   t.section("constraints");
-  t.raw("  - for k in 0..N-1:\n"
-        "      - {name: \"a{k}\", type: distance, points: [\"L{k}\", \"R{k+1}\"], length: 1}\n"
-        "      - {name: \"b{k}\", type: distance, points: [\"R{k}\", \"L{k+1}\"], length: 1}\n"
-        "      - {name: \"mida{k}\", type: distance, points: [\"L{k}\", \"M{k}\"], length: 0.5}\n"
-        "      - {name: \"midb{k}\", type: distance, points: [\"R{k}\", \"M{k}\"], length: 0.5}\n"
-        "      - {name: \"ona{k}\", type: point_on_line, point: \"M{k}\", line: [\"L{k}\", \"R{k+1}\"]}\n"
-        "      - {name: \"onb{k}\", type: point_on_line, point: \"M{k}\", line: [\"R{k}\", \"L{k+1}\"]}\n");
+  t.raw(
+      "  - for k in 0..N-1:\n"
+      "      - {name: \"a{k}\", type: distance, points: [\"L{k}\", \"R{k+1}\"], length: 1}\n"
+      "      - {name: \"b{k}\", type: distance, points: [\"R{k}\", \"L{k+1}\"], length: 1}\n"
+      "      - {name: \"mida{k}\", type: distance, points: [\"L{k}\", \"M{k}\"], length: 0.5}\n"
+      "      - {name: \"midb{k}\", type: distance, points: [\"R{k}\", \"M{k}\"], length: 0.5}\n"
+      "      - {name: \"ona{k}\", type: point_on_line, point: \"M{k}\", line: [\"L{k}\", \"R{k+1}\"]}\n"
+      "      - {name: \"onb{k}\", type: point_on_line, point: \"M{k}\", line: [\"R{k}\", \"L{k+1}\"]}\n");
   t.segment_angle(Name{"angle"}, Name{"L", 0}, Name{"R", 1}, Name{"theta"});
   t.section("drivers");
   t.linear_driver(Name{"motor"}, Name{"theta"}, o.from, o.to - o.from);
@@ -112,26 +114,29 @@ std::string scissor_reference_point(const GenerateOptions& o) {
   t.coordinate(Name{"xs"}, c);
   t.coordinate(Name{"ys"}, 0.0);
   t.coordinate(Name{"psis"}, 0.0);
-  t.raw("  for k in 0..N-1:\n"
-        "    xa{k}: hc\n    ya{k}: (k + 0.5)*s\n    psia{k}: from\n"
-        "    xb{k}: hc\n    yb{k}: (k + 0.5)*s\n    psib{k}: pmf\n");
+  t.raw(
+      "  for k in 0..N-1:\n"
+      "    xa{k}: hc\n    ya{k}: (k + 0.5)*s\n    psia{k}: from\n"
+      "    xb{k}: hc\n    yb{k}: (k + 0.5)*s\n    psib{k}: pmf\n");
   t.section("bodies");
   t.body(Name{"s"}, Name{"xs"}, Name{"ys"}, Name{"psis"});
-  t.raw("  for k in 0..N-1:\n"
-        "    a{k}: [\"xa{k}\", \"ya{k}\", \"psia{k}\"]\n"
-        "    b{k}: [\"xb{k}\", \"yb{k}\", \"psib{k}\"]\n");
+  t.raw(
+      "  for k in 0..N-1:\n"
+      "    a{k}: [\"xa{k}\", \"ya{k}\", \"psia{k}\"]\n"
+      "    b{k}: [\"xb{k}\", \"yb{k}\", \"psib{k}\"]\n");
   t.section("constraints");
   const Name ground{"ground"};
   t.revolute(Name{"pivot"}, Attach{Name{"a", 0}, -0.5, 0.0}, Attach{ground, 0.0, 0.0});
   t.prismatic(Name{"guide"}, Attach{ground, 0.0, 0.0}, Attach{Name{"s"}, 0.0, 0.0});
   t.revolute(Name{"slide"}, Attach{Name{"b", 0}, -0.5, 0.0}, Attach{Name{"s"}, 0.0, 0.0});
-  t.raw("  - for k in 0..N-2:\n"
-        "      - {name: \"cross{k}\", type: revolute, between: [{body: \"a{k}\", at: [0, 0]}, {body: \"b{k}\", "
-        "at: [0, 0]}]}\n"
-        "      - {name: \"right{k+1}\", type: revolute, between: [{body: \"a{k}\", at: [0.5, 0]}, {body: "
-        "\"b{k+1}\", at: [-0.5, 0]}]}\n"
-        "      - {name: \"left{k+1}\", type: revolute, between: [{body: \"b{k}\", at: [0.5, 0]}, {body: "
-        "\"a{k+1}\", at: [-0.5, 0]}]}\n");
+  t.raw(
+      "  - for k in 0..N-2:\n"
+      "      - {name: \"cross{k}\", type: revolute, between: [{body: \"a{k}\", at: [0, 0]}, {body: \"b{k}\", "
+      "at: [0, 0]}]}\n"
+      "      - {name: \"right{k+1}\", type: revolute, between: [{body: \"a{k}\", at: [0.5, 0]}, {body: "
+      "\"b{k+1}\", at: [-0.5, 0]}]}\n"
+      "      - {name: \"left{k+1}\", type: revolute, between: [{body: \"b{k}\", at: [0.5, 0]}, {body: "
+      "\"a{k+1}\", at: [-0.5, 0]}]}\n");
   t.revolute(Name{"cross", n - 1}, Attach{Name{"a", n - 1}, 0.0, 0.0}, Attach{Name{"b", n - 1}, 0.0, 0.0});
   t.section("drivers");
   t.linear_driver(Name{"motor"}, Name{"psia", 0}, o.from, o.to - o.from);
@@ -148,7 +153,7 @@ std::string scissor_reference_point(const GenerateOptions& o) {
 // (i + Σ_{k<j} cos θ_k, Σ_{k<j} sin θ_k), horizontal bars stay horizontal.
 
 struct GridShape {
-  std::int64_t cols = 1, rows = 1, last = 1;  // C, R, cells of the top row
+  std::int64_t cols = 1, rows = 1, last = 1;                                       // C, R, cells of the top row
   std::int64_t width(std::int64_t j) const { return j + 1 < rows ? cols : last; }  // w_j: cells of row j
 };
 
@@ -169,9 +174,9 @@ double row_rate(const GenerateOptions& o, std::int64_t j) { return j % 2 == 0 ? 
 const char* const kGridWhat = "lattice of N parallelogram cells of unit bars, one shear dof per cell row";
 
 std::string grid_drive(const GenerateOptions& o, const std::string& coordinate) {
-  return coordinate + " = the angle of row j's vertical bars to the horizontal (rad), linear from " +
-         shortest(o.from) + " to " + shortest(o.to) + " in even rows j and from " +
-         shortest(o.to) + " to " + shortest(o.from) + " in odd rows";
+  return coordinate + " = the angle of row j's vertical bars to the horizontal (rad), linear from " + shortest(o.from) +
+         " to " + shortest(o.to) + " in even rows j and from " + shortest(o.to) + " to " + shortest(o.from) +
+         " in odd rows";
 }
 
 std::string grid_shape_text(const GridShape& g) {
@@ -204,18 +209,20 @@ std::string range(std::int64_t a, std::int64_t b) { return str(a) + ".." + str(b
 void grid_parameters(SceneText& t, const GenerateOptions& o, const GridShape& g) {
   t.raw("parameters:\n  N: " + str(o.n) + "\n  C: " + str(g.cols) + "    # cells per row\n  L: " + str(g.last) +
         "    # cells of the last row\n  R: " + str(g.rows) + "    # rows\n  from: " + shortest(o.from) + "\n  to: " +
-        shortest(o.to) + "\n  ca: " + shortest(std::cos(o.from)) + "\n  sa: " + shortest(std::sin(o.from)) + "\n  cb: " +
-        shortest(std::cos(o.to)) + "\n  sb: " + shortest(std::sin(o.to)) + "\n  hca: " + shortest(0.5 * std::cos(o.from)) +
-        "\n  hsa: " + shortest(0.5 * std::sin(o.from)) + "\n  hcb: " + shortest(0.5 * std::cos(o.to)) + "\n  hsb: " +
-        shortest(0.5 * std::sin(o.to)) + "\n");
+        shortest(o.to) + "\n  ca: " + shortest(std::cos(o.from)) + "\n  sa: " + shortest(std::sin(o.from)) +
+        "\n  cb: " + shortest(std::cos(o.to)) + "\n  sb: " + shortest(std::sin(o.to)) +
+        "\n  hca: " + shortest(0.5 * std::cos(o.from)) + "\n  hsa: " + shortest(0.5 * std::sin(o.from)) +
+        "\n  hcb: " + shortest(0.5 * std::cos(o.to)) + "\n  hsb: " + shortest(0.5 * std::sin(o.to)) + "\n");
 }
 
 // The drivers: motor<j> drives row j's angle from `from` (even j) or `to` (odd j) at the rate of row_rate.
 void grid_drivers(SceneText& t, const GenerateOptions& o, const GridShape& g, const std::string& coordinate) {
   const RowPairs p = row_pairs(g);
   auto law = [&](const std::string& jt, std::int64_t parity) {
-    return "      - {name: \"motor" + jt + "\", coordinate: \"" + coordinate + jt + "\", law: {type: linear, "
-           "initial: " + shortest(row_initial(o, parity)) + ", rate: " + shortest(row_rate(o, parity)) + "}}\n";
+    return "      - {name: \"motor" + jt + "\", coordinate: \"" + coordinate + jt +
+           "\", law: {type: linear, "
+           "initial: " +
+           shortest(row_initial(o, parity)) + ", rate: " + shortest(row_rate(o, parity)) + "}}\n";
   };
   t.section("drivers");
   t.raw("  - for k in " + range(0, p.pairs - 1) + ":\n" + law("{2*k}", 0) + law("{2*k+1}", 1));
@@ -248,7 +255,8 @@ std::string grid_natural(const GenerateOptions& o) {
   t.raw("  for k in " + range(p.pairs, p.pairs) + ":    # the last row" + (p.odd_tail ? "s" : "") + "\n" +
         (p.odd_tail ? row(false, "C", "i") + row(true, "L", "m") : row(false, "L", "i")));
   t.section("points");
-  t.raw("  for j in " + range(0, r - 2) + ":\n    for i in 0..C:\n      P{i}_{j+1}: [\"x{i}_{j+1}\", \"y{i}_{j+1}\"]\n");
+  t.raw("  for j in " + range(0, r - 2) +
+        ":\n    for i in 0..C:\n      P{i}_{j+1}: [\"x{i}_{j+1}\", \"y{i}_{j+1}\"]\n");
   t.raw("  for i in 0..L:\n    P{i}_" + str(r) + ": [\"x{i}_" + str(r) + "\", \"y{i}_" + str(r) + "\"]\n");
   t.section("constraints");
   // Row j (text jt, j + 1 text j1t) of width w; node row j is ground for j = 0.
@@ -338,14 +346,14 @@ std::string grid_reference_point(const GenerateOptions& o) {
       s += ind + "- for i in " + range(a, b) + ":\n";
       for (char c : pairs_at(a, w, wn)) {
         if (c == 'u')
-          s += ind + "    - {name: \"up{i}_" + j1t + "\", type: revolute, between: [" + top + ", {body: \"v{i}_" +
-               j1t + "\", at: [-0.5, 0]}]}\n";
+          s += ind + "    - {name: \"up{i}_" + j1t + "\", type: revolute, between: [" + top + ", {body: \"v{i}_" + j1t +
+               "\", at: [-0.5, 0]}]}\n";
         if (c == 'l')
-          s += ind + "    - {name: \"left{i}_" + j1t + "\", type: revolute, between: [" + top +
-               ", {body: \"h{i-1}_" + j1t + "\", at: [0.5, 0]}]}\n";
+          s += ind + "    - {name: \"left{i}_" + j1t + "\", type: revolute, between: [" + top + ", {body: \"h{i-1}_" +
+               j1t + "\", at: [0.5, 0]}]}\n";
         if (c == 'r')
-          s += ind + "    - {name: \"right{i}_" + j1t + "\", type: revolute, between: [" + top +
-               ", {body: \"h{i}_" + j1t + "\", at: [-0.5, 0]}]}\n";
+          s += ind + "    - {name: \"right{i}_" + j1t + "\", type: revolute, between: [" + top + ", {body: \"h{i}_" +
+               j1t + "\", at: [-0.5, 0]}]}\n";
       }
       a = b + 1;
     }
@@ -363,8 +371,9 @@ std::string grid_reference_point(const GenerateOptions& o) {
 }  // namespace
 
 std::string scissor_scene(const GenerateOptions& o) {
-  check(o, std::numbers::pi / 2, "the scissor's bar angle must lie strictly between 0 (flat) and pi/2 (vertical), "
-                    "where the linkage is singular");
+  check(o, std::numbers::pi / 2,
+        "the scissor's bar angle must lie strictly between 0 (flat) and pi/2 (vertical), "
+        "where the linkage is singular");
   return o.coords == "natural" ? scissor_natural(o) : scissor_reference_point(o);
 }
 
@@ -408,8 +417,8 @@ std::uint64_t grid_family_entries(const GenerateOptions& o) {
   const std::uint64_t drivers = fam(p.pairs, 2) + (p.odd_tail ? 2 : 1);
   if (o.coords == "natural") {
     // coordinates: per pair of rows 4 entries (theta, the nodes' family, twice), each node 2; then the tail
-    const std::uint64_t coordinates =
-        fam(p.pairs, 4) + 2 * fam(p.pairs, 2 * (c + 1)) + (p.odd_tail ? 4 + 2 * (c + 1) + 2 * (l + 1) : 2 + 2 * (l + 1));
+    const std::uint64_t coordinates = fam(p.pairs, 4) + 2 * fam(p.pairs, 2 * (c + 1)) +
+                                      (p.odd_tail ? 4 + 2 * (c + 1) + 2 * (l + 1) : 2 + 2 * (l + 1));
     const std::uint64_t points = fam(r - 1, 1) + fam(r - 1, c + 1) + fam(l + 1, 1);
     // row 0 (its vertical and horizontal bars' families), rows 1 ... R-2 (3 items each), row R-1
     const std::uint64_t constraints = fam(w0 + 1, 1) + fam(w0, 1) + fam(r - 2, 3) + fam(r - 2, 2 * c + 1) +
@@ -417,9 +426,9 @@ std::uint64_t grid_family_entries(const GenerateOptions& o) {
     return coordinates + points + constraints + drivers;
   }
   // coordinates: per row 2 entries (the vertical and the horizontal bars' families), 3 per bar
-  const std::uint64_t coordinates = fam(p.pairs, 4) + 2 * fam(p.pairs, 3 * (c + 1) + 3 * c) +
-                                    (p.odd_tail ? 4 + 3 * (c + 1) + 3 * c + 3 * (l + 1) + 3 * l
-                                                : 2 + 3 * (l + 1) + 3 * l);
+  const std::uint64_t coordinates =
+      fam(p.pairs, 4) + 2 * fam(p.pairs, 3 * (c + 1) + 3 * c) +
+      (p.odd_tail ? 4 + 3 * (c + 1) + 3 * c + 3 * (l + 1) + 3 * l : 2 + 3 * (l + 1) + 3 * l);
   const std::uint64_t bodies = fam(r - 1, 2) + fam(r - 1, 2 * c + 1) + 2 + fam(l + 1, 1) + fam(l, 1);
   const std::uint64_t constraints = fam(w0 + 1, 1) + (r > 2 ? (r - 2) * grid_pair_entries(c, c) : 0) +
                                     (r > 1 ? grid_pair_entries(c, l) : 0) + grid_pair_entries(l, -1);

@@ -84,9 +84,7 @@ class SceneText {
   void segment_angle(Name n, PointRef a, PointRef b, Name angle) {
     w("  - {name: ", n, ", type: segment_angle, segment: [", a, ", ", b, "], angle: ", angle, "}\n");
   }
-  void revolute(Name n, Attach a, Attach b) {
-    w("  - {name: ", n, ", type: revolute, between: [", a, ", ", b, "]}\n");
-  }
+  void revolute(Name n, Attach a, Attach b) { w("  - {name: ", n, ", type: revolute, between: [", a, ", ", b, "]}\n"); }
   // Body b slides along body a's x axis (axis [1, 0]) without turning relative to it.
   void prismatic(Name n, Attach a, Attach b) {
     w("  - {name: ", n, ", type: prismatic, between: [", a, ", ", b, "]}\n");

@@ -30,8 +30,9 @@ std::string grey(std::size_t f, std::size_t n) {
 // Ground under a fixed pivot at pixel (x, y): a triangle down to a base line, hatched beneath (a group with an id:
 // a drawing that others use).
 std::string ground_pivot(double x, double y, const std::string& id = "") {
-  std::string s = "<g class=\"ground\"" + (id.empty() ? "" : " id=\"" + id + "\"") + ">\n<polygon points=\"" + px(x) + "," + px(y) + " " + px(x - 8) + "," +
-                  px(y + 12) + " " + px(x + 8) + "," + px(y + 12) + "\" fill=\"white\" stroke=\"black\"/>\n";
+  std::string s = "<g class=\"ground\"" + (id.empty() ? "" : " id=\"" + id + "\"") + ">\n<polygon points=\"" + px(x) +
+                  "," + px(y) + " " + px(x - 8) + "," + px(y + 12) + " " + px(x + 8) + "," + px(y + 12) +
+                  "\" fill=\"white\" stroke=\"black\"/>\n";
   s += "<line x1=\"" + px(x - 13) + "\" x2=\"" + px(x + 13) + "\" y1=\"" + px(y + 12) + "\" y2=\"" + px(y + 12) +
        "\" stroke=\"black\"/>\n";
   for (int k = 0; k < 6; ++k) {
@@ -46,8 +47,10 @@ std::string ground_pivot(double x, double y, const std::string& id = "") {
 
 std::vector<Slot> slots_of(const OutputPoint& p) {
   switch (p.kind) {
-    case OutputPointKind::kPlanarPoint: return {p.point.x, p.point.y};
-    case OutputPointKind::kPlanarBodyPoint: return {p.body.x, p.body.y, p.body.psi};
+    case OutputPointKind::kPlanarPoint:
+      return {p.point.x, p.point.y};
+    case OutputPointKind::kPlanarBodyPoint:
+      return {p.body.x, p.body.y, p.body.psi};
     default: {
       const Attachment3& a = p.spatial;
       return {a.r[0], a.r[1], a.r[2], a.p[0], a.p[1], a.p[2], a.p[3]};
@@ -128,9 +131,11 @@ std::string mechanism_background(const MechanismFrames& m, const MechanismView& 
     }
     const double bar = b.sx(b.xmin + len) - b.sx(b.xmin);
     s += "<line class=\"scale\" x1=\"" + px(x0 + 10) + "\" x2=\"" + px(x0 + 10 + bar) + "\" y1=\"" +
-         px(y0 + side + 18) + "\" y2=\"" + px(y0 + side + 18) + "\" stroke=\"black\" stroke-width=\"2\"/>\n<text "
-         "class=\"scale-label\" x=\"" + px(x0 + 16 + bar) + "\" y=\"" + px(y0 + side + 22) + "\">" + label(len) +
-         " m (axes: " + label(len) + " m each)</text>\n";
+         px(y0 + side + 18) + "\" y2=\"" + px(y0 + side + 18) +
+         "\" stroke=\"black\" stroke-width=\"2\"/>\n<text "
+         "class=\"scale-label\" x=\"" +
+         px(x0 + 16 + bar) + "\" y=\"" + px(y0 + side + 22) + "\">" + label(len) + " m (axes: " + label(len) +
+         " m each)</text>\n";
   } else {
     s += axes(b, "x (m)", "y (m)", 6, 6);
   }

@@ -153,8 +153,10 @@ std::vector<std::pair<Quantity, std::vector<std::size_t>>> group(const Scene& sc
     const Quantity q = column_quantity(scene, series[k]);
     auto g = std::find_if(groups.begin(), groups.end(),
                           [&](const auto& e) { return e.first.name == q.name && e.first.unit == q.unit; });
-    if (g == groups.end()) groups.push_back({q, {k}});
-    else g->second.push_back(k);
+    if (g == groups.end())
+      groups.push_back({q, {k}});
+    else
+      g->second.push_back(k);
   }
   return groups;
 }
@@ -192,8 +194,9 @@ std::string series_panels(const Scene& scene, const CsvTable& table, const std::
       Line pts;
       for (const auto& row : table.rows) pts.push_back({b.sx(row[0]), b.sy(row[c])});
       s += polyline("series", kPalette[k % 8], 1.5, pts, " data-column=\"" + escape(series[k]) + "\"");
-      s += "<text class=\"legend\" x=\"" + px(b.x0 + b.w - 6) + "\" y=\"" + px(b.y0 + 14 + 13 * static_cast<double>(i)) +
-           "\" text-anchor=\"end\" fill=\"" + kPalette[k % 8] + "\">" + escape(series[k]) + "</text>\n";
+      s += "<text class=\"legend\" x=\"" + px(b.x0 + b.w - 6) + "\" y=\"" +
+           px(b.y0 + 14 + 13 * static_cast<double>(i)) + "\" text-anchor=\"end\" fill=\"" + kPalette[k % 8] + "\">" +
+           escape(series[k]) + "</text>\n";
     }
     s += "</g>\n";
   }

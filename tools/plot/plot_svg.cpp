@@ -96,20 +96,22 @@ std::map<std::size_t, Eigen::VectorXd> swept_positions(const Scene& scene, const
   SweepSummary sum;
   std::string mismatch;
   (void)run_sweep(  // its status is sum.status, read below
-      swept, opt, ws, [&](const StepView& v) {
-    const auto row = static_cast<std::size_t>(v.step);
-    for (const auto& [j, c] : checked) {
-      const double mine = v.q(j);
-      if (!(std::fabs(table.rows[row][c] - mine) <= 1e-6 * (1.0 + std::fabs(mine))))
-        mismatch = "row " + std::to_string(row + 2) + ", column '" + model.coordinate_names()[j] +
-                   "': " + label(table.rows[row][c]) + ", the scene gives " + label(mine);
-    }
-    if (!(std::fabs(table.rows[row][0] - v.t) <= 1e-12 * (1.0 + std::fabs(v.t))))
-      mismatch = "row " + std::to_string(row + 2) + ": t = " + label(table.rows[row][0]) + ", the scene gives " +
-                 label(v.t);
-    if (std::binary_search(drawn.begin(), drawn.end(), row)) solved[row] = v.q;
-    return mismatch.empty();
-  }, &sum);
+      swept, opt, ws,
+      [&](const StepView& v) {
+        const auto row = static_cast<std::size_t>(v.step);
+        for (const auto& [j, c] : checked) {
+          const double mine = v.q(j);
+          if (!(std::fabs(table.rows[row][c] - mine) <= 1e-6 * (1.0 + std::fabs(mine))))
+            mismatch = "row " + std::to_string(row + 2) + ", column '" + model.coordinate_names()[j] +
+                       "': " + label(table.rows[row][c]) + ", the scene gives " + label(mine);
+        }
+        if (!(std::fabs(table.rows[row][0] - v.t) <= 1e-12 * (1.0 + std::fabs(v.t))))
+          mismatch = "row " + std::to_string(row + 2) + ": t = " + label(table.rows[row][0]) + ", the scene gives " +
+                     label(v.t);
+        if (std::binary_search(drawn.begin(), drawn.end(), row)) solved[row] = v.q;
+        return mismatch.empty();
+      },
+      &sum);
   if (!mismatch.empty()) throw DrawError(result + " is not the result of " + scene.path + ": " + mismatch, 2);
   if (sum.status != SolveStatus::kSuccess) throw DrawError(scene.path + ": " + sum.message, 1);
   return solved;
@@ -122,10 +124,12 @@ std::string svg_document(const Scene& scene, const CsvTable& table, const std::m
   constexpr double W = 1100, M = 60, side = 420;
   const std::size_t panels = panel_count(scene, series);
   const double H = std::max(side + 2 * M, M + static_cast<double>(panels) * 200.0 + 10);
-  std::string svg_text = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" "
-                         "width=\"" + px(W) + "\" height=\"" + px(H) + "\" viewBox=\"0 0 " + px(W) + " " + px(H) +
-                         "\" font-family=\"sans-serif\" font-size=\"12\">\n<title>" + escape(title) +
-                         "</title>\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  std::string svg_text =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" "
+      "width=\"" +
+      px(W) + "\" height=\"" + px(H) + "\" viewBox=\"0 0 " + px(W) + " " + px(H) +
+      "\" font-family=\"sans-serif\" font-size=\"12\">\n<title>" + escape(title) +
+      "</title>\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   svg_text += mechanism_panel(frames, M, M, side);
   const double x0 = M + side + 90;
   svg_text += series_panels(scene, table, col, series, x0, M, W - x0 - 20, H - M - 50);

@@ -82,8 +82,8 @@ Covariance read_covariance(const std::string& path) {
       const double a = c.matrix(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
       const double b = c.matrix(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i));
       if (std::fabs(a - b) > 1e-12 * largest)
-        fail("not symmetric: (" + c.names[i] + ", " + c.names[j] + ") = " + shortest(a) + " but (" + c.names[j] +
-             ", " + c.names[i] + ") = " + shortest(b));
+        fail("not symmetric: (" + c.names[i] + ", " + c.names[j] + ") = " + shortest(a) + " but (" + c.names[j] + ", " +
+             c.names[i] + ") = " + shortest(b));
     }
   try {
     (void)cholesky(c.matrix, c.names);

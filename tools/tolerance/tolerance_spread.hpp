@@ -30,10 +30,10 @@ struct Agreement {
   double worst = 0.0;
   double worst_t = std::numeric_limits<double>::quiet_NaN();  // where (t), NaN when no row is compared
   double sd_linear_at_worst = 0.0, sd_mc_at_worst = 0.0;
-  bool disagrees = false;             // worst > the threshold
-  std::size_t rows_compared = 0;      // rows where either spread is above the floor
+  bool disagrees = false;               // worst > the threshold
+  std::size_t rows_compared = 0;        // rows where either spread is above the floor
   std::size_t rows_without_spread = 0;  // both at or below the floor (a driven coordinate: no spread to compare)
-  std::size_t rows_singular = 0;      // σ_lin not finite: the sensitivities are not defined there
+  std::size_t rows_singular = 0;        // σ_lin not finite: the sensitivities are not defined there
 };
 
 // One output over the sweep's rows.

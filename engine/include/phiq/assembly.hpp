@@ -42,23 +42,24 @@ AssemblyOptions assembly_options(const NewtonOptions& newton);
 /// What assemble() did.
 struct AssemblySummary {
   SolveStatus status = SolveStatus::kNotConverged;  ///< kSuccess, kInconsistent, kNotConverged, kNonFinite, ...
-  int iterations = 0;      ///< Gauss-Newton steps
-  int factorizations = 0;  ///< of Ã Ãᵀ (one per step)
-  int rank_updates = 0;    ///< times the independent set was chosen again at a new configuration
-  double residual = 0.0;   ///< max_i |Φ_i| / scale_i over all rows at the end
+  int iterations = 0;                               ///< Gauss-Newton steps
+  int factorizations = 0;                           ///< of Ã Ãᵀ (one per step)
+  int rank_updates = 0;   ///< times the independent set was chosen again at a new configuration
+  double residual = 0.0;  ///< max_i |Φ_i| / scale_i over all rows at the end
   /// How far the placement moved: max_j |q_j − q₀_j| / coordinate scale_j.
   double moved = 0.0;
-  RankReport rank;         ///< at the final configuration
+  RankReport rank;  ///< at the final configuration
   /// False when redundant equations are not satisfied where the independent ones are (the model is inconsistent:
   /// status kInconsistent), or when the independent equations themselves could not be satisfied (kNotConverged:
   /// nothing is known of the redundant ones).
   bool consistent = true;
   std::vector<Index> violated_rows;    ///< the redundant rows not satisfied (inconsistent models)
-  std::vector<std::string> conflicts;  ///< constraints that cannot hold together: each violated redundant row and the rows it is a combination of (empty when consistent)
+  std::vector<std::string> conflicts;  ///< constraints that cannot hold together: each violated redundant row and the
+                                       ///< rows it is a combination of (empty when consistent)
   /// (row, |Φ_i| / scale_i), largest first, at most 3; empty on success and for kOutsideTimeDomain (t outside the
   /// drivers' domain, or not finite: Φ means nothing there)
   std::vector<std::pair<Index, double>> worst_rows;
-  std::string message;     ///< one line; empty on a clean success
+  std::string message;  ///< one line; empty on a clean success
   /// One line: status, iterations, residual, rank, redundant and conflicting constraints.
   std::string BriefReport() const;
 };

@@ -32,8 +32,8 @@ BatchSummary run_batch(const std::vector<const Model*>& models, const SweepOptio
 /// `starts`, when given (as many as models, each of its model's size, else phiq::Error), is each case's rough
 /// placement instead of its model's initial positions: what prepare_scene() gives a redundant scene (its
 /// assembled position, for the model without the redundant rows).
-BatchSummary run_batch(const std::vector<const Model*>& models, const std::vector<SweepOptions>& options,
-                       int threads, const std::function<bool(std::size_t, const StepView&)>& on_step,
+BatchSummary run_batch(const std::vector<const Model*>& models, const std::vector<SweepOptions>& options, int threads,
+                       const std::function<bool(std::size_t, const StepView&)>& on_step,
                        const std::vector<Eigen::VectorXd>* starts = nullptr);
 
 }  // namespace phiq

@@ -144,7 +144,6 @@ class ConstraintBlock {
                                double /*t*/, double* /*out*/) const {}
 };
 
-
 namespace detail {
 /// Pattern mode: records the column of every entry that falls on a coordinate.
 struct PatternSink {
@@ -163,8 +162,10 @@ struct ValueSink {
   double* values;
   void operator()(int, const Slot& s, double v) {
     if (!s.is_coordinate()) return;
-    if constexpr (kOverwrite) values[*slot++] = v;
-    else values[*slot++] += v;
+    if constexpr (kOverwrite)
+      values[*slot++] = v;
+    else
+      values[*slot++] += v;
   }
 };
 }  // namespace detail
@@ -189,7 +190,7 @@ class TypedBlock final : public ConstraintBlock {
  public:
   /// One constraint of the block: its data and where its rows and Jacobian entries are in the model.
   struct Entry {
-    Spec spec;  ///< the constraint's data and equations
+    Spec spec;        ///< the constraint's data and equations
     EntryIndex row0;  ///< first global row (the constraint owns rows row0 … row0 + Spec::kRows − 1)
     EntryIndex nz0;   ///< index of its first Jacobian entry in the model's triplet list, set by build_pattern()
   };
@@ -209,13 +210,17 @@ class TypedBlock final : public ConstraintBlock {
   }
   void jacobian(std::size_t begin, std::size_t end, const double* q, double t, const EntryIndex* slot_of_entry,
                 double* csc_values, bool overwrite) const override {
-    if (overwrite) evaluate<false, true>(begin, end, q, t, nullptr, slot_of_entry, csc_values);
-    else evaluate<false, false>(begin, end, q, t, nullptr, slot_of_entry, csc_values);
+    if (overwrite)
+      evaluate<false, true>(begin, end, q, t, nullptr, slot_of_entry, csc_values);
+    else
+      evaluate<false, false>(begin, end, q, t, nullptr, slot_of_entry, csc_values);
   }
   void residual_and_jacobian(std::size_t begin, std::size_t end, const double* q, double t, double* phi,
                              const EntryIndex* slot_of_entry, double* csc_values, bool overwrite) const override {
-    if (overwrite) evaluate<true, true>(begin, end, q, t, phi, slot_of_entry, csc_values);
-    else evaluate<true, false>(begin, end, q, t, phi, slot_of_entry, csc_values);
+    if (overwrite)
+      evaluate<true, true>(begin, end, q, t, phi, slot_of_entry, csc_values);
+    else
+      evaluate<true, false>(begin, end, q, t, phi, slot_of_entry, csc_values);
   }
   void phi_t(std::size_t begin, std::size_t end, const double* q, double t, double* out) const override {
     for (std::size_t i = begin; i < end; ++i)
@@ -266,8 +271,10 @@ class TypedBlock final : public ConstraintBlock {
       e.spec.for_each_slot([&](const Slot& s, Unit u) {
         if (!s.is_coordinate() || u == Unit::kNone) return;
         Unit& cu = units[static_cast<std::size_t>(s.coord())];
-        if (cu == Unit::kNone) cu = u;
-        else if (cu != u) cu = Unit::kNone;  // used as both: fall back to the plain tolerance
+        if (cu == Unit::kNone)
+          cu = u;
+        else if (cu != u)
+          cu = Unit::kNone;  // used as both: fall back to the plain tolerance
       });
   }
   void row_units(const std::vector<Unit>& coordinate_units, std::vector<Unit>& units) const override {
@@ -291,8 +298,9 @@ class TypedBlock final : public ConstraintBlock {
   int added_coordinates(std::size_t i, Index* coordinate, double* scale, int capacity) const override {
     if constexpr (requires { Spec::kAddedCoordinates; }) {
       constexpr int kAdded = static_cast<int>(std::size(Spec::kAddedCoordinates));
-      static_assert(requires(const Spec& k) { k.added_scale(0); },
-                    "a kind with added coordinates states what each is measured in proportion to (added_scale)");
+      static_assert(
+          requires(const Spec& k) { k.added_scale(0); },
+          "a kind with added coordinates states what each is measured in proportion to (added_scale)");
       const Spec& spec = entries_[i].spec;
       const int count = std::min(kAdded, capacity);
       for (int k = 0; k < count; ++k) {
@@ -319,10 +327,10 @@ class TypedBlock final : public ConstraintBlock {
       for (std::size_t i = begin; i < end; ++i) {
         Entry e = entries_[i];  // its rows: the swept model's
         const std::size_t j = i - begin;
-        if (!detail::spec_data_rate(entries_[i].spec,
-                                    {&a[0]->entries_[j].spec, &a[1]->entries_[j].spec, &a[2]->entries_[j].spec,
-                                     &a[3]->entries_[j].spec},
-                                    h, e.spec))
+        if (!detail::spec_data_rate(
+                entries_[i].spec,
+                {&a[0]->entries_[j].spec, &a[1]->entries_[j].spec, &a[2]->entries_[j].spec, &a[3]->entries_[j].spec}, h,
+                e.spec))
           return nullptr;
         rates->entries_.push_back(e);
       }
@@ -348,8 +356,8 @@ class TypedBlock final : public ConstraintBlock {
  private:
   // Φq of constraints [begin, end) into their CSC slots (stored or added), and with kResidual their Φ too.
   template <bool kResidual, bool kOverwrite>
-  void evaluate(std::size_t begin, std::size_t end, const double* q, double t, double* phi, const EntryIndex* slot_of_entry,
-                double* csc_values) const {
+  void evaluate(std::size_t begin, std::size_t end, const double* q, double t, double* phi,
+                const EntryIndex* slot_of_entry, double* csc_values) const {
     for (std::size_t i = begin; i < end; ++i) {
       const Entry& e = entries_[i];
       detail::ValueSink<kOverwrite> sink{slot_of_entry + e.nz0, csc_values};

@@ -14,9 +14,9 @@ namespace phiq {
 /// A CSV of numbers as phiq writes it (see csv_writer.hpp): one header line of column names, then one row of
 /// numbers per time step.
 struct CsvTable {
-  std::string path;                        ///< Where the table came from; used in messages only.
-  std::vector<std::string> columns;        ///< Column names from the header, in file order; unique and non-empty.
-  std::vector<std::vector<double>> rows;   ///< Data rows in file order; each has columns.size() values.
+  std::string path;                       ///< Where the table came from; used in messages only.
+  std::vector<std::string> columns;       ///< Column names from the header, in file order; unique and non-empty.
+  std::vector<std::vector<double>> rows;  ///< Data rows in file order; each has columns.size() values.
 };
 
 /// Parses CSV text: a header line of column names, then rows of numbers.
@@ -67,11 +67,11 @@ struct ColumnComparison {
   /// both tables have rows.
   std::size_t worst_row = 0;
   double worst_t = std::numeric_limits<double>::quiet_NaN();  ///< Column "t" of A at worst_row, NaN without one.
-  double worst_a = 0;      ///< Value in A at its worst cell.
-  double worst_b = 0;      ///< Value in B at its worst cell.
-  double worst_tol = 0;    ///< Tolerance there, atol + rtol*max(|a|,|b|) (0 for NaN or inf against another value).
-  double worst_ratio = 0;  ///< |a-b| / worst_tol there (inf for NaN or inf against another value).
-  double max_abs_diff = 0; ///< Largest |a-b| over its cells, counted as CompareResult::max_abs_diff.
+  double worst_a = 0;                                         ///< Value in A at its worst cell.
+  double worst_b = 0;                                         ///< Value in B at its worst cell.
+  double worst_tol = 0;     ///< Tolerance there, atol + rtol*max(|a|,|b|) (0 for NaN or inf against another value).
+  double worst_ratio = 0;   ///< |a-b| / worst_tol there (inf for NaN or inf against another value).
+  double max_abs_diff = 0;  ///< Largest |a-b| over its cells, counted as CompareResult::max_abs_diff.
 };
 
 /// What compare_csv() found. The "worst" fields describe the cell with the largest ratio
@@ -89,7 +89,7 @@ struct CompareResult {
   std::size_t rows_a = 0;  ///< Data rows in A.
   std::size_t rows_b = 0;  ///< Data rows in B.
 
-  std::string worst_column;  ///< Column of the worst cell.
+  std::string worst_column;   ///< Column of the worst cell.
   std::size_t worst_row = 0;  ///< 0-based data row of the worst cell (file line worst_row + 2).
   /// Value of column "t" in A at worst_row, NaN if A has no column "t".
   double worst_t = std::numeric_limits<double>::quiet_NaN();

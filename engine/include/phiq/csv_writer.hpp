@@ -70,10 +70,10 @@ class CsvFormat {
  private:
   const Model& model_;
   std::vector<Index> columns_, v_columns_, a_columns_;  // the q, q̇ and q̈ columns
-  bool velocities_, accelerations_;  // q̇ / q̈ are delivered: the points' and drivers' derivative columns too
+  bool velocities_, accelerations_;   // q̇ / q̈ are delivered: the points' and drivers' derivative columns too
   const OutputPlan* plan_ = nullptr;  // the other outputs, when made from an output plan
   ColumnNaming naming_ = ColumnNaming::kDotted;
-  std::vector<std::string> dotted_names() const;  // the names of format 1
+  std::vector<std::string> dotted_names() const;       // the names of format 1
   void check_coordinates(const StepView& step) const;  // throws unless the step carries the columns' vectors
   void append_coordinates(const StepView& step, std::string& out) const;  // the q, q̇, q̈ columns
   void append_outputs(const StepView& step, std::string& out) const;      // the columns after the coordinates

@@ -37,7 +37,7 @@ const Eigen::VectorXd& evaluate_phi_t(const Model& model, const Eigen::VectorXd&
 
 /// Evaluates γ(q, q̇, t) = −(Φq q̇)q q̇ − 2 Φqt q̇ − Φtt (m entries) into ws.rhs and returns it: the right-hand side
 /// of the acceleration equation Φq q̈ = γ. Throws as evaluate_jacobian(), also for a qd of the wrong size.
-const Eigen::VectorXd& evaluate_gamma(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                                      double t, Workspace& ws);
+const Eigen::VectorXd& evaluate_gamma(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                                      Workspace& ws);
 
 }  // namespace phiq

@@ -30,16 +30,40 @@ class Tape {
   /// Instruction codes: loads of inputs, arithmetic, and the supported functions (kSign is csgn). kPowInt is a^k and
   /// kPowHalf is √a^k for an integer k in imm (exact repeated squaring); kPow is a^b.
   enum class Op : std::uint8_t {
-    kConst, kLoadQ, kLoadQd, kLoadT,
-    kAdd, kSub, kMul, kDiv, kNeg, kPowInt, kPowHalf, kPow, kSqrt,
-    kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2, kExp, kLog, kSinh, kCosh, kTanh, kAbs, kSign,
+    kConst,
+    kLoadQ,
+    kLoadQd,
+    kLoadT,
+    kAdd,
+    kSub,
+    kMul,
+    kDiv,
+    kNeg,
+    kPowInt,
+    kPowHalf,
+    kPow,
+    kSqrt,
+    kSin,
+    kCos,
+    kTan,
+    kAsin,
+    kAcos,
+    kAtan,
+    kAtan2,
+    kExp,
+    kLog,
+    kSinh,
+    kCosh,
+    kTanh,
+    kAbs,
+    kSign,
   };
   /// One instruction; its result is the register with its own index (static single assignment).
   struct Instr {
-    Op op;                 ///< what it computes
-    std::uint32_t a = 0;   ///< first operand register (or the input index for loads)
-    std::uint32_t b = 0;   ///< second operand register
-    double imm = 0.0;      ///< constant value, or integer exponent for kPowInt and kPowHalf
+    Op op;                                          ///< what it computes
+    std::uint32_t a = 0;                            ///< first operand register (or the input index for loads)
+    std::uint32_t b = 0;                            ///< second operand register
+    double imm = 0.0;                               ///< constant value, or integer exponent for kPowInt and kPowHalf
     bool operator==(const Instr&) const = default;  ///< field by field
   };
 
@@ -51,7 +75,7 @@ class Tape {
 
   /// The same program: instruction for instruction (constants by value), and the same outputs.
   bool operator==(const Tape&) const = default;
-  std::size_t size() const { return code_.size(); }  ///< number of instructions
+  std::size_t size() const { return code_.size(); }            ///< number of instructions
   std::size_t num_outputs() const { return outputs_.size(); }  ///< number of outputs
   /// The program as text, one instruction per line ("r3 = mul r1 r2"; constants as hexadecimal floats, so that
   /// equal listings are the same program bit for bit), then its outputs. For tests and debugging.
@@ -84,9 +108,9 @@ using NameResolver = std::function<std::optional<NameBinding>(const std::string&
 class CompiledExpression {
  public:
   /// Hostile-input limits: longer or deeper texts, or derivatives that compile to more instructions, are refused.
-  static constexpr std::size_t kMaxTextLength = 4096;       ///< characters
-  static constexpr int kMaxNesting = 64;                    ///< parentheses
-  static constexpr std::size_t kMaxTapeSize = 50000;        ///< instructions over value, gradient and Φt
+  static constexpr std::size_t kMaxTextLength = 4096;  ///< characters
+  static constexpr int kMaxNesting = 64;               ///< parentheses
+  static constexpr std::size_t kMaxTapeSize = 50000;   ///< instructions over value, gradient and Φt
 
   /// Parses and differentiates `text`. Throws phiq::Error with a one-line message naming the expression and the
   /// offending name or token when the text is malformed, uses an unknown name or an unsupported function.

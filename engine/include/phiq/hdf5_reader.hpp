@@ -18,8 +18,9 @@ bool has_hdf5_extension(const std::string& path);
 /// cannot be read or is shorter.
 bool is_hdf5_file(const std::string& path);
 
-/// Reads HDF5 results of format version kHdf5Format: the datasets /case (a batch's file), /t, /q, /qd, /qdd, /points, /drivers, /residuals,
-/// /rcond that are present, in that order, their columns named by each dataset's `columns` attribute.
+/// Reads HDF5 results of format version kHdf5Format: the datasets /case (a batch's file), /t, /q, /qd, /qdd, /points,
+/// /drivers, /residuals, /rcond that are present, in that order, their columns named by each dataset's `columns`
+/// attribute.
 /// @return The table, columns and rows in the order of the CSV of the same run, with CsvTable::path = `path`.
 /// @throws phiq::Error with one line "PATH: what is wrong" for a file that is not HDF5 or cannot be opened
 ///         ("PATH: not a readable HDF5 file: REASON"), another format or version, a missing or malformed `columns`

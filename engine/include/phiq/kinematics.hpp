@@ -15,23 +15,23 @@
 namespace phiq {
 
 /// Outcome of a solve: what the caller can act on. Only kSuccess leaves a valid solution in the workspace.
-enum class [[nodiscard]] SolveStatus {
-  kSuccess,             ///< solved to tolerance
-  kNotConverged,        ///< Newton reached its iteration limit, or could not decrease the residual
-  kSingularJacobian,    ///< Φq is singular here (singular position, redundant or missing constraints)
-  kLinearSolverFailed,  ///< the sparse library failed (out of memory, invalid data)
-  kNonFinite,           ///< NaN or Inf in Φ, Φq or a solution (e.g. a law outside its table, sqrt of a negative; a
-                        ///< derivative that does not exist, sqrt at 0, with the constraint and coordinate named)
-  kNotSquare,           ///< equations ≠ coordinates: not solvable by the square driven-system path
-  kOutsideTimeDomain,   ///< a driver's law is not defined at the requested time
-  kCancelled,           ///< the caller's step callback asked to stop
-  kInconsistent,        ///< redundant constraints that cannot hold together (assembly.hpp names them)
-  /// solve_velocity / solve_acceleration at a q that does not solve the position problem Φ(q, t) = 0 (to
-  /// DerivativeOptions::tolerance): its q̇ or q̈ would mean nothing. The message names the worst constraint.
-  kPositionNotSolved,
-  /// a coordinate left the range where a constraint's equations are defined (a curve parameter past the end of an
-  /// open curve, Model::outside_domain()): the message names the constraint, and the sweep's the time
-  kOutsideDomain,
+enum class [[nodiscard]] SolveStatus{
+    kSuccess,             ///< solved to tolerance
+    kNotConverged,        ///< Newton reached its iteration limit, or could not decrease the residual
+    kSingularJacobian,    ///< Φq is singular here (singular position, redundant or missing constraints)
+    kLinearSolverFailed,  ///< the sparse library failed (out of memory, invalid data)
+    kNonFinite,           ///< NaN or Inf in Φ, Φq or a solution (e.g. a law outside its table, sqrt of a negative; a
+                          ///< derivative that does not exist, sqrt at 0, with the constraint and coordinate named)
+    kNotSquare,           ///< equations ≠ coordinates: not solvable by the square driven-system path
+    kOutsideTimeDomain,   ///< a driver's law is not defined at the requested time
+    kCancelled,           ///< the caller's step callback asked to stop
+    kInconsistent,        ///< redundant constraints that cannot hold together (assembly.hpp names them)
+    /// solve_velocity / solve_acceleration at a q that does not solve the position problem Φ(q, t) = 0 (to
+    /// DerivativeOptions::tolerance): its q̇ or q̈ would mean nothing. The message names the worst constraint.
+    kPositionNotSolved,
+    /// a coordinate left the range where a constraint's equations are defined (a curve parameter past the end of an
+    /// open curve, Model::outside_domain()): the message names the constraint, and the sweep's the time
+    kOutsideDomain,
 };
 /// Lower-case words, e.g. "singular Jacobian".
 const char* to_string(SolveStatus s);
@@ -95,8 +95,8 @@ struct PositionSummary {
   int iterations = 0;                               ///< Newton steps taken (linear solves)
   int factorizations = 0;                           ///< of them, steps with a fresh factorisation of Φq
   int backtracks = 0;                               ///< step halvings by the line search
-  double residual = 0.0;  ///< max_i |Φ_i| / scale_i at the end
-  double rcond = 0.0;     ///< of the last factorisation (0 if none)
+  double residual = 0.0;                            ///< max_i |Φ_i| / scale_i at the end
+  double rcond = 0.0;                               ///< of the last factorisation (0 if none)
   /// Success at the iteration limit with the residual within tolerance but steps still above it: the linear
   /// convergence of Newton at a singular position (a dead point, a bifurcation). The constraints hold to tolerance;
   /// the position itself is less accurate (about √tol). message says so.

@@ -3,8 +3,8 @@
 /// (values, every Newton iteration) → solve.
 ///
 /// The symbolic object is immutable after analyse() and may be shared by any number of threads; each thread owns
-/// its numeric object (make_numeric()), which co-owns the symbolic object it was made from. UMFPACK's "singular matrix" warning is reported as kSingular, distinct from
-/// a failure of the library (kFailed: out of memory, invalid data).
+/// its numeric object (make_numeric()), which co-owns the symbolic object it was made from. UMFPACK's "singular matrix"
+/// warning is reported as kSingular, distinct from a failure of the library (kFailed: out of memory, invalid data).
 #pragma once
 
 #include <cstdint>

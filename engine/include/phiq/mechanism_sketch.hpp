@@ -22,22 +22,22 @@ enum class SketchLine {
 
 /// One line of the drawing.
 struct SketchSegment {
-  OutputPoint from;                     ///< first end
-  OutputPoint to;                       ///< second end
-  SketchLine line = SketchLine::kBar;   ///< a link or a body's arm
-  Index constraint = -1;                ///< index into Model::constraints() of the constraint that drew it first
+  OutputPoint from;                    ///< first end
+  OutputPoint to;                      ///< second end
+  SketchLine line = SketchLine::kBar;  ///< a link or a body's arm
+  Index constraint = -1;               ///< index into Model::constraints() of the constraint that drew it first
 };
 
 /// One joint of the drawing.
 struct SketchJoint {
-  OutputPoint at;                       ///< where it is
+  OutputPoint at;                         ///< where it is
   JointMark mark = JointMark::kRevolute;  ///< how it is drawn
   /// kPrismatic: the guide's direction in the frame of `guide` (a planar direction in x, y); otherwise unused.
   kin::V2 axis{1, 0};
-  Frame2 guide;                         ///< kPrismatic: the body (or ground) carrying the guide
-  bool fixed = false;                   ///< it does not move (a ground pivot: drawn hatched)
-  int end = -1;                         ///< kPoint: which end (0, 1) of its constraint's link; −1 for a joint
-  Index constraint = -1;                ///< index into Model::constraints() of the constraint that drew it first
+  Frame2 guide;           ///< kPrismatic: the body (or ground) carrying the guide
+  bool fixed = false;     ///< it does not move (a ground pivot: drawn hatched)
+  int end = -1;           ///< kPoint: which end (0, 1) of its constraint's link; −1 for a joint
+  Index constraint = -1;  ///< index into Model::constraints() of the constraint that drew it first
 };
 
 /// The drawing of a model: its lines and joints, each once (a segment named by two constraints, e.g. a distance and

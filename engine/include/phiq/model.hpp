@@ -141,8 +141,8 @@ struct ConstraintInfo {
 /// hardly depends on large coordinates (atan(x) at x = 10²⁶, a driver 1/x) gets no floor from them: its residual
 /// is held to the tolerance. floor_j of a coordinate is kUlpFloor · |q_j|.
 struct ToleranceScales {
-  Eigen::VectorXd row_scale;              ///< per row, metres for length rows, 1 for angle and unitless rows
-  Eigen::VectorXd coordinate_scale;       ///< per coordinate, metres for length coordinates, 1 otherwise
+  Eigen::VectorXd row_scale;         ///< per row, metres for length rows, 1 for angle and unitless rows
+  Eigen::VectorXd coordinate_scale;  ///< per coordinate, metres for length coordinates, 1 otherwise
   /// 1 / row_scale: the Newton loop's per-iteration tests multiply instead of dividing.
   Eigen::VectorXd inverse_row_scale;
   Eigen::VectorXd inverse_coordinate_scale;  ///< 1 / coordinate_scale (see inverse_row_scale)
@@ -172,7 +172,7 @@ inline const Model& model_of(const ModelAnchor* anchor, const char* what) {
 /// (a member added later and forgotten in a hand-written move would silently be left behind).
 struct ModelData {
   std::vector<std::string> names_;
-  detail::NameIndex index_of_;  ///< coordinate names → indices (names in names_)
+  detail::NameIndex index_of_;          ///< coordinate names → indices (names in names_)
   detail::NameIndex constraint_index_;  ///< constraint names → indices (names in constraints_[k].name)
   Eigen::VectorXd initial_;
   std::vector<Unit> coordinate_units_;
@@ -313,7 +313,6 @@ class Model : private detail::ModelData {
   /// dropped: the arrays are the same).
   const std::vector<Index>& solve_entries() const { return solve_entries_; }
 
-
   /// Earliest / latest time at which every driver is defined (tabulated laws have a finite range).
   double time_domain_begin() const { return time_begin_; }
   double time_domain_end() const { return time_end_; }  ///< see time_domain_begin()
@@ -371,9 +370,9 @@ class Model : private detail::ModelData {
 /// Invalid data (unknown coordinate index, non-positive length, NaN, duplicate names) throws phiq::Error.
 class ModelBuilder {
  public:
-  ModelBuilder();                          ///< an empty model
-  ~ModelBuilder();                         ///< discards an unbuilt model
-  ModelBuilder(ModelBuilder&&) noexcept;   ///< moves the model being built
+  ModelBuilder();                         ///< an empty model
+  ~ModelBuilder();                        ///< discards an unbuilt model
+  ModelBuilder(ModelBuilder&&) noexcept;  ///< moves the model being built
 
   /// Adds coordinate `name` with its initial guess; returns its index in q. Throws phiq::Error for an empty or
   /// duplicate name or a non-finite value.
@@ -452,8 +451,8 @@ class ModelBuilder {
   const Model* share_analysis_with_ = nullptr;
   // The Grübler–Kutzbach count, gathered while adding: bodies per dimension, freedoms removed by joints per
   // dimension, and whether a constraint that is not a joint was added.
-  Index bodies_[2] = {0, 0};     ///< planar, spatial
-  Index removed_[2] = {0, 0};    ///< by planar joints, by spatial joints
+  Index bodies_[2] = {0, 0};   ///< planar, spatial
+  Index removed_[2] = {0, 0};  ///< by planar joints, by spatial joints
   bool joints_of_dimension_[2] = {false, false};
   bool non_joint_ = false;
   detail::NameIndex body_names_;  ///< duplicate check in O(1) without a node per name: scenes reach 10^6 bodies
@@ -469,8 +468,8 @@ TypedBlock<Spec>& ModelBuilder::block_for() {
 
 template <ConstraintKind Spec>
 Index ModelBuilder::add(const std::string& name, Spec spec) {
-  const std::string label = name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(model_.constraints_.size())
-                                         : name;
+  const std::string label =
+      name.empty() ? std::string(Spec::kKind) + "#" + std::to_string(model_.constraints_.size()) : name;
   spec.for_each_slot([&](const Slot& s, Unit) { check_slot(s, label); });
   // (here, not at the first solve: a law without a function would otherwise read as the time domain [0, 0] and
   // throw from inside Φ, on a worker thread when the model is evaluated in parallel)

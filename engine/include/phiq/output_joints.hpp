@@ -26,7 +26,7 @@ enum class JointMeasure {
 
 /// A joint measure output. Build with output_joint().
 struct OutputJoint {
-  std::string name;  ///< the joint's name, the columns' prefix
+  std::string name;                             ///< the joint's name, the columns' prefix
   JointMeasure measure = JointMeasure::kAngle;  ///< what is measured
   /// The attachments read: the angle's x_a, y_a, x_b; the distance's P_a, P_b, z_a.
   std::array<Attachment3, 3> att{};
@@ -69,7 +69,7 @@ struct OrientationForm {
 /// A body whose orientation is output: its Euler-parameter slots. With velocities, columns `B.omega_x, B.omega_y,
 /// B.omega_z` (rad/s); with accelerations, `B.alpha_x, B.alpha_y, B.alpha_z` (rad/s², world frame).
 struct OutputOrientation {
-  std::string name;      ///< the body's name
+  std::string name;       ///< the body's name
   std::array<Slot, 4> e;  ///< e0 … e3
 };
 

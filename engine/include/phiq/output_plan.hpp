@@ -42,9 +42,9 @@ const char* to_string(SensitivityForm form);
 /// with sensitivity_along() (scene.hpp: it keeps the reached constraints, reading the models one at a time), or by
 /// hand (the models; keep_reached_only() then releases them). sensitivity.hpp defines what it points to.
 struct OutputSensitivity {
-  std::string name;  ///< the parameter's name, the columns' suffix (`x.d_NAME`)
-  double value = 0.0;  ///< p
-  double step = 0.0;   ///< h > 0
+  std::string name;                                    ///< the parameter's name, the columns' suffix (`x.d_NAME`)
+  double value = 0.0;                                  ///< p
+  double step = 0.0;                                   ///< h > 0
   std::array<std::shared_ptr<const Model>, 4> models;  ///< at p − 2h, p − h, p + h, p + 2h
   /// What the parameter reaches (parameter_reach(): sensitivity_along() sets it, run_sweep() finds it once for the
   /// sweep when it is null). Null: solve_sensitivities() finds it at each call (O(constraints) comparisons, fewer
@@ -148,7 +148,6 @@ struct OutputPlan {
   /// Write the largest scaled residual of all rows (column `residual`); needs `residuals`.
   bool max_residual_column = false;
 };
-
 
 /// What the step callback sees. qd / qdd are null when not computed.
 struct StepView {

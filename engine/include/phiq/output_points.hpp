@@ -19,21 +19,21 @@ namespace phiq {
 
 /// How an output point's position follows from q.
 enum class OutputPointKind {
-  kPlanarPoint,      ///< a natural point (x, y slots): r = (x, y)
-  kPlanarBodyPoint,  ///< a point fixed on a planar body: r = r_body + R(ψ) s, s in the body's frame
-  kSpatialPoint,     ///< a natural point in space (x, y, z slots)
+  kPlanarPoint,       ///< a natural point (x, y slots): r = (x, y)
+  kPlanarBodyPoint,   ///< a point fixed on a planar body: r = r_body + R(ψ) s, s in the body's frame
+  kSpatialPoint,      ///< a natural point in space (x, y, z slots)
   kSpatialBodyPoint,  ///< a point fixed on a spatial body: r = r_body + R(e) s, e the body's Euler parameters
 };
 
 /// A point whose motion is output. Build with planar_point() or planar_body_point().
 struct OutputPoint {
-  std::string name;  ///< column prefix (`name.x`, `name.vx`, ...)
+  std::string name;                                      ///< column prefix (`name.x`, `name.vx`, ...)
   OutputPointKind kind = OutputPointKind::kPlanarPoint;  ///< how its position follows from q
-  Point2 point;      ///< kPlanarPoint: its slots
-  Frame2 body;       ///< kPlanarBodyPoint: the body's frame
-  double local_x = 0.0;  ///< kPlanarBodyPoint: s_x, the point in the body's frame (m)
-  double local_y = 0.0;  ///< kPlanarBodyPoint: s_y (m)
-  Attachment3 spatial;   ///< kSpatialPoint, kSpatialBodyPoint: the point as r + R(p) s
+  Point2 point;                                          ///< kPlanarPoint: its slots
+  Frame2 body;                                           ///< kPlanarBodyPoint: the body's frame
+  double local_x = 0.0;                                  ///< kPlanarBodyPoint: s_x, the point in the body's frame (m)
+  double local_y = 0.0;                                  ///< kPlanarBodyPoint: s_y (m)
+  Attachment3 spatial;                                   ///< kSpatialPoint, kSpatialBodyPoint: the point as r + R(p) s
 
   /// Components of its position (2 for the planar kinds; 3 for the spatial ones).
   int dimension() const {

@@ -67,11 +67,11 @@ struct RankReport {
   std::vector<Index> independent_rows;  ///< a maximal independent set of rows, ascending (the square solve keeps these)
   std::vector<Index> redundant_rows;    ///< the other rows, ascending
   std::vector<std::string> redundant;   ///< names of the constraints owning redundant rows, in model order, once each
-  double tolerance = 0.0;          ///< δ used
+  double tolerance = 0.0;               ///< δ used
   RankOrdering ordering = RankOrdering::kModelOrder;  ///< the order used (kAuto resolved)
-  double smallest_pivot = 0.0;     ///< smallest |R_kk| / largest row norm of an independent equation (1 if none)
-  bool dense_checked = false;      ///< the dense cross-check ran
-  Index dense_rank = -1;           ///< its rank of all rows (−1 when it did not run)
+  double smallest_pivot = 0.0;  ///< smallest |R_kk| / largest row norm of an independent equation (1 if none)
+  bool dense_checked = false;   ///< the dense cross-check ran
+  Index dense_rank = -1;        ///< its rank of all rows (−1 when it did not run)
   /// The rank is uncertain: a pivot or singular value within RankOptions::margin of the tolerance, or the sparse and
   /// dense ranks disagree. `message` says which; the numbers above are the sparse QR's.
   bool uncertain = false;
@@ -120,8 +120,8 @@ class ScaledJacobianRows {
   std::shared_ptr<const detail::ModelAnchor> model_;  // where the model is now (Model::anchor_)
   std::vector<Index> rows_;
   std::shared_ptr<const CscPattern> pattern_;
-  std::vector<Index> source_;    // entry k is Φq's value source_[k] · coordinate_scale(column) / row_scale(row)
-  std::vector<double> full_;     // Φq values (scratch of evaluate())
+  std::vector<Index> source_;  // entry k is Φq's value source_[k] · coordinate_scale(column) / row_scale(row)
+  std::vector<double> full_;   // Φq values (scratch of evaluate())
 };
 
 /// The scaled Jacobian at (q, t) restricted to `rows` (in that order), as a pattern and values: a one-off

@@ -25,34 +25,34 @@ class SceneError : public std::runtime_error {
 /// count bounds the memory of the YAML tree (about 0.5 KiB a node in yaml-cpp 0.7, see models/README.md).
 struct SceneLimits {
   std::size_t max_file_bytes = std::size_t{128} << 20;  ///< 128 MiB
-  int max_depth = 32;                                    ///< nesting of maps and lists
+  int max_depth = 32;                                   ///< nesting of maps and lists
   /// Scalars + maps + lists. yaml-cpp's tree costs about 470 bytes a value, so this bounds the loader's memory
   /// (10^6 values: 0.48 GB); larger models are written with families (`for i in A..B`), which cost no values.
   std::size_t max_nodes = 1'000'000;
-  std::size_t max_scalar_bytes = 16384;                  ///< one value (expressions are shorter still, see expression.hpp)
+  std::size_t max_scalar_bytes = 16384;  ///< one value (expressions are shorter still, see expression.hpp)
   /// Entries (coordinates, points, bodies, constraints, drivers) that indexed families (`for i in A..B`) may make
   /// in all; a nested family counts as one entry of its parent per member, plus what it makes.
   std::size_t max_family_instances = 50'000'000;
-  int max_family_depth = 8;                              ///< families nested in families
+  int max_family_depth = 8;  ///< families nested in families
 };
 
 /// Where a joint angle driver measures its joint's angle from: the reference directions x_a, x_b of the joint's
 /// two sides, in their bodies' frames, as the scene states them or as phiq chose them (a default: x, or y for an
 /// axis within 25° of x). phiq check lists them, so that the zero of a driven angle is never chosen silently.
 struct JointAngleReference {
-  std::string driver;            ///< the driver's name
-  std::string joint;             ///< the joint it drives
+  std::string driver;             ///< the driver's name
+  std::string joint;              ///< the joint it drives
   std::array<double, 3> ref_a{};  ///< x_a in side a's body frame (its part perpendicular to the axis is used)
   std::array<double, 3> ref_b{};  ///< x_b in side b's body frame
-  bool stated_a = false;         ///< x_a is the scene's `ref` (else the default)
-  bool stated_b = false;         ///< x_b is the scene's `ref` (else the default)
+  bool stated_a = false;          ///< x_a is the scene's `ref` (else the default)
+  bool stated_b = false;          ///< x_b is the scene's `ref` (else the default)
 };
 
 /// A loaded scene: the model, the sweep and what to output.
 struct Scene {
-  std::string path;              ///< the file it was read from (or the name given to parse_scene)
-  std::string name;              ///< the scene's `name` field (may be empty)
-  std::string text;              ///< the text it was parsed from (written into HDF5 results: how they were made)
+  std::string path;  ///< the file it was read from (or the name given to parse_scene)
+  std::string name;  ///< the scene's `name` field (may be empty)
+  std::string text;  ///< the text it was parsed from (written into HDF5 results: how they were made)
   /// The scene's `parameters` in file order, with their values (the caller's overrides applied): what
   /// SceneOverrides, `phiq batch` and `output.sensitivities` may name.
   std::vector<std::pair<std::string, double>> parameters;
@@ -60,13 +60,13 @@ struct Scene {
   /// this one repeats (sensitivity_along() takes them in its `overrides`; a parameter defined from another is not
   /// among them, and moves with it).
   std::vector<std::pair<std::string, double>> overridden;
-  int dimension = 2;             ///< the scene's `dimension` (2: planar, 3: spatial)
+  int dimension = 2;  ///< the scene's `dimension` (2: planar, 3: spatial)
   /// The frame of each moving body, in the order of Model::body_names() (planar scenes fill planar_bodies,
   /// spatial ones spatial_bodies): where `phiq animate` reads a body's pose from q.
   std::vector<Frame2> planar_bodies;
-  std::vector<Frame3> spatial_bodies;  ///< see planar_bodies
+  std::vector<Frame3> spatial_bodies;             ///< see planar_bodies
   std::vector<JointAngleReference> joint_angles;  ///< the reference directions of the joint angle drivers
-  std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: a CsvFormat keeps its address)
+  std::unique_ptr<Model> model;                   ///< the mechanism (held by pointer: a CsvFormat keeps its address)
   /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns
   /// written, coordinates defaulting to all).
   SweepOptions sweep;

@@ -171,9 +171,9 @@ OutputSensitivity sensitivity_along(const Model& model, const std::string& name,
 /// q, q̇, q̈) whatever the number of parameters, and a row 15 more evaluations of Φq; the direct form costs 1, 2
 /// or 3 solves per parameter and, with q̇, 2 evaluations of γ (with q̈, and 4 of Φq and 4 of γ) along its
 /// sensitivities. Both
-/// evaluate each parameter's reach alike. The second derivative along the motion is that of a smooth Φq: where the seven
-/// points straddle a place where Φq is not smooth (a spline's knot, where its third derivative jumps, as a pin in a
-/// curved slot passes one), it would be off by percents, so a row whose sixth- and fourth-order second differences
+/// evaluate each parameter's reach alike. The second derivative along the motion is that of a smooth Φq: where the
+/// seven points straddle a place where Φq is not smooth (a spline's knot, where its third derivative jumps, as a pin in
+/// a curved slot passes one), it would be off by percents, so a row whose sixth- and fourth-order second differences
 /// disagree (by more than 10⁻⁴ of the largest entry) is solved in the direct form instead, whose differences along
 /// the motion are first differences only: WorkCounters::sensitivity_direct_rows counts them.
 ///

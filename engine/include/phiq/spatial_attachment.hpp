@@ -58,7 +58,7 @@ inline V3 rotate(const double p[4], V3 s) { return bilinear(p, p, s); }
 /// A point or a vector that moves with the coordinates: X = r + R(p) s (file comment). Built by the factories
 /// below; ground and fixed points are attachments of constants.
 struct Attachment3 {
-  bool operator==(const Attachment3&) const = default;  ///< slot by slot, and the local vector
+  bool operator==(const Attachment3&) const = default;                    ///< slot by slot, and the local vector
   Slot r[3] = {Slot::constant(0), Slot::constant(0), Slot::constant(0)};  ///< translation part (m, or a vector)
   Slot p[4] = {Slot::constant(1), Slot::constant(0), Slot::constant(0), Slot::constant(0)};  ///< Euler parameters
   kin3::V3 s;  ///< the local vector rotated by R(p): a point or an axis fixed in the body
@@ -109,9 +109,7 @@ struct Attachment3 {
     return rotates() ? v + rotated_rate(q, qd) : v;
   }
   /// R(p) s at q (kept out of the callers: only moving frames need it).
-  [[gnu::noinline]] kin3::V3 rotated(const double* q) const {
-    return kin3::rotate(euler(q).data(), s);
-  }
+  [[gnu::noinline]] kin3::V3 rotated(const double* q) const { return kin3::rotate(euler(q).data(), s); }
   /// 2 B(p, ṗ, s) at (q, q̇).
   [[gnu::noinline]] kin3::V3 rotated_rate(const double* q, const double* qd) const {
     return 2.0 * kin3::bilinear(euler(q).data(), euler_rates(qd).data(), s);

@@ -68,7 +68,7 @@ class Stepper {
   /// reads a coordinate the model does not have; expected_step not finite or zero; a sensitivity whose models do
   /// not match the model, check_sensitivity_models(); the adjoint form).
   explicit Stepper(const Model& model, StepperOptions options = {});
-  ~Stepper();  ///< frees the workspace and the history
+  ~Stepper();                              ///< frees the workspace and the history
   Stepper(Stepper&&) noexcept;             ///< takes over the other stepper's state; the other is not used after it
   Stepper& operator=(Stepper&&) noexcept;  ///< see the move constructor
   Stepper(const Stepper&) = delete;
@@ -120,7 +120,7 @@ class Stepper {
   /// The workspace the steps solve in: its counters and the factorisation of Φq (its q, q̇, q̈ are the steps'
   /// scratch: read the state from q(), qd(), qdd()).
   const Workspace& workspace() const;
-  const Model& model() const;              ///< the model stepped
+  const Model& model() const;             ///< the model stepped
   const StepperOptions& options() const;  ///< the options it was made with
 
  private:

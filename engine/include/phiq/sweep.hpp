@@ -18,8 +18,8 @@ namespace phiq {
 
 /// How successive positions are started: an extrapolation of the solutions already found, of the order the
 /// computed quantities allow. Its error is what Newton has to correct: O(h) from the previous position, O(h²)
-/// (secant, linear), O(h³) (parabolic, quadratic), O(h⁴) (cubic, hermite), so that a better predictor needs fewer Newton
-/// iterations per step, down to none once its error is within the tolerance (bench/README.md).
+/// (secant, linear), O(h³) (parabolic, quadratic), O(h⁴) (cubic, hermite), so that a better predictor needs fewer
+/// Newton iterations per step, down to none once its error is within the tolerance (bench/README.md).
 enum class Predictor {
   /// The best the computed quantities allow: cubic with q̇ and q̈, hermite with q̇ only, parabolic with positions
   /// only.
@@ -58,11 +58,11 @@ bool predictor_needs_accelerations(Predictor p);
 
 /// The time points of a sweep.
 struct TimeGrid {
-  double t_begin = 0.0;   ///< first time point (s)
+  double t_begin = 0.0;  ///< first time point (s)
   /// last time point (s); may be below t_begin. With steps > 0 every step must move time: t_end ≠ t_begin and
   /// |t_end − t_begin| / steps above 8 ulps of the larger of |t_begin|, |t_end| (else run_sweep throws phiq::Error)
   double t_end = 1.0;
-  Index steps = 100;      ///< intervals: steps + 1 time points, t_k = t_begin + k (t_end − t_begin) / steps
+  Index steps = 100;  ///< intervals: steps + 1 time points, t_k = t_begin + k (t_end − t_begin) / steps
   /// t_k, computed from k, not accumulated, so that the last point is t_end exactly (steps = 0: t_begin).
   double time_of(Index k) const {
     if (steps == 0) return t_begin;
@@ -78,7 +78,7 @@ struct SolverSettings {
   /// acceleration (or the previous position) while it contracts well — one factorisation per drive step instead
   /// of three (bench/README.md).
   NewtonOptions newton{1e-10, 20, true, 12, JacobianUpdate::kWhenSlow};
-  NewtonOptions assembly{1e-10, 100, true, 30};              ///< initial position from the rough placement
+  NewtonOptions assembly{1e-10, 100, true, 30};  ///< initial position from the rough placement
   int max_subdivisions = 8;  ///< a failed step is retried as 2, 4, … sub-steps, down to h / 2^max_subdivisions
 };
 
@@ -123,7 +123,7 @@ Index rows_written(const SweepOptions& o);
 
 /// Something the caller should know about a delivered row (the row itself is within tolerance).
 struct SweepWarning {
-  double t;             ///< time of the row concerned
+  double t;  ///< time of the row concerned
   /// "slow_convergence": Newton converged only linearly (singular position nearby), or stopped at the rounding
   /// level of Φ above the tolerance (a long chain; the message says how well q is known; once per stretch of
   /// rows, up to two rows without it apart, the message says how long and how many); "ill_conditioned": Φq is
@@ -170,7 +170,7 @@ struct SweepAccuracy {
 /// What run_sweep did (Ceres-style summary).
 struct SweepSummary {
   SolveStatus status = SolveStatus::kSuccess;  ///< the outcome; kSuccess when every time point was delivered
-  std::string message;       ///< one line naming the step, time, cause and constraints; empty on success
+  std::string message;  ///< one line naming the step, time, cause and constraints; empty on success
   /// Time points solved, in order from the first: all of them delivered to the callback, save those the output
   /// plan does not write (OutputPlan::writes_row: `every`, the time window)
   Index steps_completed = 0;
@@ -180,11 +180,11 @@ struct SweepSummary {
   /// model swept, |Φ_i| / scale_i), largest first, at most 3, as `message` names them (Model::row_name()); empty
   /// on success, or when the failure is not a position's (a derivative, the time domain, a redundancy conflict).
   std::vector<std::pair<Index, double>> worst_rows;
-  PositionSummary assembly;  ///< the initial position problem
-  WorkCounters counters;     ///< work done by this sweep
-  Index subdivisions = 0;    ///< sub-steps inserted after Newton failures
-  Index singular_positions = 0;  ///< rows at singular positions (bifurcations) passed, each with a warning
-  double min_rcond = 0.0;    ///< smallest reciprocal condition estimate seen (0 if none)
+  PositionSummary assembly;            ///< the initial position problem
+  WorkCounters counters;               ///< work done by this sweep
+  Index subdivisions = 0;              ///< sub-steps inserted after Newton failures
+  Index singular_positions = 0;        ///< rows at singular positions (bifurcations) passed, each with a warning
+  double min_rcond = 0.0;              ///< smallest reciprocal condition estimate seen (0 if none)
   double min_rcond_time = 0.0;         ///< where min_rcond was seen
   std::vector<SweepWarning> warnings;  ///< in time order
   double solve_seconds = 0.0;          ///< wall time of the sweep, the callback's own work included

@@ -94,35 +94,35 @@ static_assert(sizeof(Slot) == 8, "a slot is one word");
 /// A planar point given by two slots (natural coordinates, or a fixed point, or a mix such as (xB, 0)).
 struct Point2 {
   bool operator==(const Point2&) const = default;  ///< slot by slot
-  Slot x;  ///< x coordinate (m)
-  Slot y;  ///< y coordinate (m)
+  Slot x;                                          ///< x coordinate (m)
+  Slot y;                                          ///< y coordinate (m)
 };
 
 /// A planar body frame in reference-point coordinates: position of its reference point and orientation angle.
 /// Ground is a frame of constants.
 struct Frame2 {
   bool operator==(const Frame2&) const = default;  ///< slot by slot
-  Slot x;    ///< x of the reference point (m)
-  Slot y;    ///< y of the reference point (m)
-  Slot psi;  ///< orientation (rad)
+  Slot x;                                          ///< x of the reference point (m)
+  Slot y;                                          ///< y of the reference point (m)
+  Slot psi;                                        ///< orientation (rad)
 };
 
 /// A spatial point given by three slots (natural coordinates, or a fixed point): also a natural unit vector's
 /// components (ux, uy, uz).
 struct Point3 {
   bool operator==(const Point3&) const = default;  ///< slot by slot
-  Slot x;  ///< x coordinate (m; unitless for a vector)
-  Slot y;  ///< y coordinate
-  Slot z;  ///< z coordinate
+  Slot x;                                          ///< x coordinate (m; unitless for a vector)
+  Slot y;                                          ///< y coordinate
+  Slot z;                                          ///< z coordinate
 };
 
 /// A spatial body frame in reference-point coordinates: position of its reference point and its orientation as
 /// Euler parameters (a unit quaternion, e0 the scalar part). Ground is a frame of constants with e = (1, 0, 0, 0).
 struct Frame3 {
   bool operator==(const Frame3&) const = default;  ///< slot by slot
-  Slot x;   ///< x of the reference point (m)
-  Slot y;   ///< y of the reference point (m)
-  Slot z;   ///< z of the reference point (m)
+  Slot x;                                          ///< x of the reference point (m)
+  Slot y;                                          ///< y of the reference point (m)
+  Slot z;                                          ///< z of the reference point (m)
   Slot e0;  ///< Euler parameter e0 (scalar part; unitless): e0² + e1² + e2² + e3² = 1 is the body's own constraint
   Slot e1;  ///< Euler parameter e1
   Slot e2;  ///< Euler parameter e2

@@ -21,11 +21,11 @@ struct WorkCounters {
   Index factorizations = 0;        ///< numeric LU factorisations
   /// Those of them that searched for pivots (KLU: not a refactorisation with the pivot order of an earlier one)
   Index pivoting_factorizations = 0;
-  Index velocity_solves = 0;       ///< solves of Φq q̇ = −Φt
-  Index acceleration_solves = 0;   ///< solves of Φq q̈ = γ
-  Index phi_t_evaluations = 0;     ///< evaluations of Φt (velocity right-hand sides)
-  Index gamma_evaluations = 0;     ///< evaluations of γ (acceleration right-hand sides)
-  Index point_evaluations = 0;     ///< output point motions evaluated (one per point and delivered row)
+  Index velocity_solves = 0;      ///< solves of Φq q̇ = −Φt
+  Index acceleration_solves = 0;  ///< solves of Φq q̈ = γ
+  Index phi_t_evaluations = 0;    ///< evaluations of Φt (velocity right-hand sides)
+  Index gamma_evaluations = 0;    ///< evaluations of γ (acceleration right-hand sides)
+  Index point_evaluations = 0;    ///< output point motions evaluated (one per point and delivered row)
   /// Solves for sensitivities to design parameters (sensitivity.hpp): one per parameter, derivative order and
   /// delivered row, each with the row's factorisation
   Index sensitivity_solves = 0;
@@ -56,36 +56,36 @@ class Workspace {
   /// Generalized coordinates. Starts at the model's initial positions; algorithms read and write it, and so may
   /// the caller (e.g. to give a better starting guess). Keep its size.
   Eigen::VectorXd q;
-  Eigen::VectorXd qd;      ///< velocities q̇ (written by solve_velocity; starts at zero)
-  Eigen::VectorXd qdd;     ///< accelerations q̈ (written by solve_acceleration; starts at zero)
-  WorkCounters counters;   ///< work done with this workspace so far (never reset by the algorithms)
+  Eigen::VectorXd qd;     ///< velocities q̇ (written by solve_velocity; starts at zero)
+  Eigen::VectorXd qdd;    ///< accelerations q̈ (written by solve_acceleration; starts at zero)
+  WorkCounters counters;  ///< work done with this workspace so far (never reset by the algorithms)
 
   /// @name Scratch of the algorithms (src/solve/); callers need not touch it
   /// Its values may be read; a vector resized by the caller makes every solve refuse the workspace (phiq::Error).
   ///@{
-  Eigen::VectorXd phi;                   ///< Φ at q
-  Eigen::VectorXd rhs;                   ///< right-hand side of the last velocity or acceleration solve
-  Eigen::VectorXd step;                  ///< Φq⁻¹Φ of the last Newton iteration (its step was −α times this)
-  Eigen::VectorXd trial;                 ///< line-search trial point
-  Eigen::VectorXd trial_phi;             ///< Φ at the trial point
+  Eigen::VectorXd phi;        ///< Φ at q
+  Eigen::VectorXd rhs;        ///< right-hand side of the last velocity or acceleration solve
+  Eigen::VectorXd step;       ///< Φq⁻¹Φ of the last Newton iteration (its step was −α times this)
+  Eigen::VectorXd trial;      ///< line-search trial point
+  Eigen::VectorXd trial_phi;  ///< Φ at the trial point
   /// Φq values in jacobian_pattern() order. The Newton loop evaluates Φq together with Φ at its trial points
   /// where it will factorise (NewtonOptions::jacobian_with_residual); a solve that ends with such values at its
   /// solution, not yet factorised, records their point (jacobian_q, jacobian_t) and sets has_jacobian, for the
   /// velocity solve that follows.
   std::vector<double> jacobian_values;
-  Eigen::VectorXd jacobian_q;            ///< see jacobian_values
-  double jacobian_t = 0.0;               ///< see jacobian_q
-  bool has_jacobian = false;             ///< jacobian_values hold Φq at (jacobian_q, jacobian_t), not yet factorised
+  Eigen::VectorXd jacobian_q;  ///< see jacobian_values
+  double jacobian_t = 0.0;     ///< see jacobian_q
+  bool has_jacobian = false;   ///< jacobian_values hold Φq at (jacobian_q, jacobian_t), not yet factorised
   /// Models with dropped rows (Model::without_rows()): the values of the kept rows in solve_pattern() order, and
   /// the right-hand side of the kept rows; empty otherwise.
   std::vector<double> solve_values;
-  Eigen::VectorXd solve_rhs;             ///< see solve_values
-  std::unique_ptr<SparseLuNumeric> lu;   ///< numeric factors; null for non-square models
+  Eigen::VectorXd solve_rhs;            ///< see solve_values
+  std::unique_ptr<SparseLuNumeric> lu;  ///< numeric factors; null for non-square models
   /// The point (q, t) of the current factorisation, so that velocity and acceleration reuse it exactly when it is
   /// still valid and refactorise otherwise.
   Eigen::VectorXd factorized_q;
-  double factorized_t = 0.0;             ///< see factorized_q
-  bool has_factorization = false;        ///< lu holds valid factors at (factorized_q, factorized_t)
+  double factorized_t = 0.0;       ///< see factorized_q
+  bool has_factorization = false;  ///< lu holds valid factors at (factorized_q, factorized_t)
   /// The factors are of Φq at the solution the last solve_position converged to (set by that solve when its last
   /// factorisation is within the tolerance of the solution — or, at a stop at the rounding level, was made where
   /// the last step, a rounding-level one, started: q is known no better than that step — and by the sweep's

@@ -120,9 +120,12 @@ py::dict batch_scene(const Scene& scene, const std::vector<std::string>& names,
     const auto start = std::chrono::steady_clock::now();
     tbb::task_arena arena(arena_threads);
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t k = r.begin(); k != r.end() && !stop.load(); ++k) run_case(k);
-      }, tbb::simple_partitioner());
+      tbb::parallel_for(
+          tbb::blocked_range<std::size_t>(0, n, 1),
+          [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t k = r.begin(); k != r.end() && !stop.load(); ++k) run_case(k);
+          },
+          tbb::simple_partitioner());
     });
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }

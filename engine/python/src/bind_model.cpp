@@ -73,14 +73,15 @@ void bind_vocabulary(py::module_& m) {
 
   py::class_<ConstraintInfo>(m, "ConstraintInfo", "One constraint of a model, as diagnostics name it.")
       .def_readonly("name", &ConstraintInfo::name, "as given in the scene")
-      .def_property_readonly("kind", [](const ConstraintInfo& c) { return std::string(c.kind); },
-                             "its kind (the registry's name, e.g. 'distance')")
+      .def_property_readonly(
+          "kind", [](const ConstraintInfo& c) { return std::string(c.kind); },
+          "its kind (the registry's name, e.g. 'distance')")
       .def_readonly("first_row", &ConstraintInfo::first_row, "its first row in Φ")
       .def_readonly("rows", &ConstraintInfo::rows, "how many rows of Φ it owns")
       .def_readonly("depends_on_time", &ConstraintInfo::depends_on_time, "rheonomic (a driver, an equation in t)")
       .def("__repr__", [](const ConstraintInfo& c) {
-        return "ConstraintInfo(name='" + c.name + "', kind='" + std::string(c.kind) + "', first_row=" +
-               std::to_string(c.first_row) + ", rows=" + std::to_string(c.rows) + ")";
+        return "ConstraintInfo(name='" + c.name + "', kind='" + std::string(c.kind) +
+               "', first_row=" + std::to_string(c.first_row) + ", rows=" + std::to_string(c.rows) + ")";
       });
 }
 
@@ -94,12 +95,15 @@ void bind_model_class(py::module_& m) {
       .def_property_readonly("coordinate_names", &Model::coordinate_names, "names of q's entries, in order")
       .def("coordinate_index", &Model::coordinate_index, py::arg("name"),
            "Index in q of the coordinate `name`; ValueError for an unknown name.")
-      .def("constraint_index", [](const Model& md, const std::string& name) { return md.constraint_index(name); },
-           py::arg("name"), "Index in constraints of the constraint `name`; ValueError for an unknown name.")
-      .def("constraint", [](const Model& md, const std::string& name) { return md.constraint(name); },
-           py::arg("name"), "The ConstraintInfo of constraint `name` (its first_row and rows); ValueError if unknown.")
-      .def("row_index", [](const Model& md, const std::string& name) { return md.row_index(name); },
-           py::arg("row_name"), "The row of Φ named 'name' or 'name[k]' (row_name's inverse); ValueError if unknown.")
+      .def(
+          "constraint_index", [](const Model& md, const std::string& name) { return md.constraint_index(name); },
+          py::arg("name"), "Index in constraints of the constraint `name`; ValueError for an unknown name.")
+      .def(
+          "constraint", [](const Model& md, const std::string& name) { return md.constraint(name); }, py::arg("name"),
+          "The ConstraintInfo of constraint `name` (its first_row and rows); ValueError if unknown.")
+      .def(
+          "row_index", [](const Model& md, const std::string& name) { return md.row_index(name); }, py::arg("row_name"),
+          "The row of Φ named 'name' or 'name[k]' (row_name's inverse); ValueError if unknown.")
       .def_property_readonly(
           "coordinate_units",
           [](const Model& md) {
@@ -115,17 +119,16 @@ void bind_model_class(py::module_& m) {
       .def_property_readonly("grubler", &Model::grubler,
                              "Grübler–Kutzbach count of the joints, or None where it is not defined")
       .def_property_readonly("length_scale", &Model::length_scale, "the model's characteristic length (m)")
-      .def_property_readonly("nonzeros", [](const Model& md) { return md.jacobian_pattern().nnz(); },
-                             "entries of Φq's fixed pattern")
-      .def_property_readonly("linear_solver", [](const Model& md) { return to_string(md.linear_solver()); },
-                             "'klu', 'umfpack' or 'dense'")
-      .def_property_readonly("time_domain",
-                             [](const Model& md) {
-                               return py::make_tuple(md.time_domain_begin(), md.time_domain_end());
-                             },
-                             "(begin, end): where every driver is defined")
-      .def_property_readonly("initial_positions", [](const Model& md) { return to_numpy(md.initial_positions()); },
-                             "the rough placement of the scene (a new array)")
+      .def_property_readonly(
+          "nonzeros", [](const Model& md) { return md.jacobian_pattern().nnz(); }, "entries of Φq's fixed pattern")
+      .def_property_readonly(
+          "linear_solver", [](const Model& md) { return to_string(md.linear_solver()); }, "'klu', 'umfpack' or 'dense'")
+      .def_property_readonly(
+          "time_domain", [](const Model& md) { return py::make_tuple(md.time_domain_begin(), md.time_domain_end()); },
+          "(begin, end): where every driver is defined")
+      .def_property_readonly(
+          "initial_positions", [](const Model& md) { return to_numpy(md.initial_positions()); },
+          "the rough placement of the scene (a new array)")
       .def(
           "residual",
           [](const Model& md, const Eigen::Ref<const Eigen::VectorXd>& q, double t) {
@@ -166,10 +169,12 @@ void bind_model_class(py::module_& m) {
 void bind_workspace(py::module_& m) {
   py::class_<WorkCounters>(m, "WorkCounters", "Work done, counted where it happens.")
       .def_readonly("newton_iterations", &WorkCounters::newton_iterations, "Newton steps")
-      .def_readonly("residual_evaluations", &WorkCounters::residual_evaluations, "evaluations of Φ (line-search trials included)")
+      .def_readonly("residual_evaluations", &WorkCounters::residual_evaluations,
+                    "evaluations of Φ (line-search trials included)")
       .def_readonly("jacobian_evaluations", &WorkCounters::jacobian_evaluations, "evaluations of Φq values")
       .def_readonly("factorizations", &WorkCounters::factorizations, "numeric LU factorisations")
-      .def_readonly("pivoting_factorizations", &WorkCounters::pivoting_factorizations, "of them, those that searched for pivots")
+      .def_readonly("pivoting_factorizations", &WorkCounters::pivoting_factorizations,
+                    "of them, those that searched for pivots")
       .def_readonly("velocity_solves", &WorkCounters::velocity_solves, "solves of Φq q̇ = −Φt")
       .def_readonly("acceleration_solves", &WorkCounters::acceleration_solves, "solves of Φq q̈ = γ")
       .def_readonly("phi_t_evaluations", &WorkCounters::phi_t_evaluations, "evaluations of Φt")
@@ -208,10 +213,10 @@ void bind_workspace(py::module_& m) {
         ConstraintKinds::for_each([&]<class K>() {
           const JointTraits joint = joint_traits<K>();
           for (const SceneForm& f : K::kScene)
-            kinds.append(py::dict(py::arg("kind") = K::kKind, py::arg("section") = f.section,
-                                  py::arg("type") = f.type, py::arg("dimension") = f.dimension,
-                                  py::arg("example") = f.example, py::arg("measures") = names(joint.measures),
-                                  py::arg("drives") = names(joint.drives), py::arg("shaft") = joint.shaft));
+            kinds.append(py::dict(py::arg("kind") = K::kKind, py::arg("section") = f.section, py::arg("type") = f.type,
+                                  py::arg("dimension") = f.dimension, py::arg("example") = f.example,
+                                  py::arg("measures") = names(joint.measures), py::arg("drives") = names(joint.drives),
+                                  py::arg("shaft") = joint.shaft));
         });
         return kinds;
       },

@@ -35,14 +35,16 @@ void bind_scene(py::module_& m) {
             return d;
           },
           "the scene's parameters and their values (overrides applied), in file order")
-      .def_property_readonly("model", [](const Scene& s) -> const Model& { return *s.model; },
-                             py::return_value_policy::reference_internal, "the mechanism (a Model)")
-      .def_property_readonly("options", [](const Scene& s) { return s.sweep; },
-                             "a copy of the scene's SweepOptions (time grid, solver, outputs), to change and pass "
-                             "to run_sweep")
+      .def_property_readonly(
+          "model", [](const Scene& s) -> const Model& { return *s.model; }, py::return_value_policy::reference_internal,
+          "the mechanism (a Model)")
+      .def_property_readonly(
+          "options", [](const Scene& s) { return s.sweep; },
+          "a copy of the scene's SweepOptions (time grid, solver, outputs), to change and pass "
+          "to run_sweep")
       .def("__repr__", [](const Scene& s) {
-        return "<phiq.Scene '" + (s.name.empty() ? s.path : s.name) + "': " +
-               std::to_string(s.model->num_coordinates()) + " coordinates, " +
+        return "<phiq.Scene '" + (s.name.empty() ? s.path : s.name) +
+               "': " + std::to_string(s.model->num_coordinates()) + " coordinates, " +
                std::to_string(s.model->num_equations()) + " equations>";
       });
 
@@ -50,7 +52,8 @@ void bind_scene(py::module_& m) {
       "load_scene",
       [](const std::string& path, const std::optional<std::map<std::string, double>>& parameters,
          const Scene* share_analysis_with) {
-        const SceneOverrides o = overrides_of(parameters, share_analysis_with ? share_analysis_with->model.get() : nullptr);
+        const SceneOverrides o =
+            overrides_of(parameters, share_analysis_with ? share_analysis_with->model.get() : nullptr);
         py::gil_scoped_release free;
         return std::make_shared<Scene>(load_scene(path, SceneLimits{}, o));
       },
@@ -62,7 +65,8 @@ void bind_scene(py::module_& m) {
       "parse_scene",
       [](const std::string& text, const std::string& path,
          const std::optional<std::map<std::string, double>>& parameters, const Scene* share_analysis_with) {
-        const SceneOverrides o = overrides_of(parameters, share_analysis_with ? share_analysis_with->model.get() : nullptr);
+        const SceneOverrides o =
+            overrides_of(parameters, share_analysis_with ? share_analysis_with->model.get() : nullptr);
         py::gil_scoped_release free;
         return std::make_shared<Scene>(parse_scene(text, path, SceneLimits{}, o));
       },

@@ -34,28 +34,37 @@ void bind_kinematics(py::module_& m) {
            py::arg("max_backtracks") = 12, py::arg("jacobian_update") = JacobianUpdate::kEveryIteration)
       .def_readwrite("tolerance", &NewtonOptions::tolerance,
                      "every row |Φ_i| ≤ tol · scale_i and the estimated error of q within tol · scale_j")
-      .def_readwrite("max_iterations", &NewtonOptions::max_iterations, "Newton iterations before giving up (NOT_CONVERGED)")
+      .def_readwrite("max_iterations", &NewtonOptions::max_iterations,
+                     "Newton iterations before giving up (NOT_CONVERGED)")
       .def_readwrite("line_search", &NewtonOptions::line_search, "backtracking on ½‖Φ/scale‖²")
-      .def_readwrite("max_backtracks", &NewtonOptions::max_backtracks, "halvings of a step before the line search gives up")
-      .def_readwrite("jacobian_update", &NewtonOptions::jacobian_update, "full Newton (EVERY_ITERATION) or modified Newton (WHEN_SLOW)")
-      .def_readwrite("max_contraction", &NewtonOptions::max_contraction, "modified Newton refactorises when the observed contraction exceeds this")
-      .def_readwrite("start_error", &NewtonOptions::start_error, "estimated error of the start in units of the tolerance test (negative: unknown)")
-      .def_readwrite("known_to", &NewtonOptions::known_to, "how well q can be known here, in tolerances (0: no limit measured)")
+      .def_readwrite("max_backtracks", &NewtonOptions::max_backtracks,
+                     "halvings of a step before the line search gives up")
+      .def_readwrite("jacobian_update", &NewtonOptions::jacobian_update,
+                     "full Newton (EVERY_ITERATION) or modified Newton (WHEN_SLOW)")
+      .def_readwrite("max_contraction", &NewtonOptions::max_contraction,
+                     "modified Newton refactorises when the observed contraction exceeds this")
+      .def_readwrite("start_error", &NewtonOptions::start_error,
+                     "estimated error of the start in units of the tolerance test (negative: unknown)")
+      .def_readwrite("known_to", &NewtonOptions::known_to,
+                     "how well q can be known here, in tolerances (0: no limit measured)")
       .def("__repr__", [](const NewtonOptions& o) {
-        return "NewtonOptions(tolerance=" + shortest(o.tolerance) + ", max_iterations=" +
-               std::to_string(o.max_iterations) + ", jacobian_update=" + to_string(o.jacobian_update) + ")";
+        return "NewtonOptions(tolerance=" + shortest(o.tolerance) +
+               ", max_iterations=" + std::to_string(o.max_iterations) +
+               ", jacobian_update=" + to_string(o.jacobian_update) + ")";
       });
 
   py::class_<PositionSummary>(m, "PositionSummary", "What solve_position did.")
       .def_readonly("status", &PositionSummary::status, "the outcome (SolveStatus)")
-      .def_property_readonly("ok", [](const PositionSummary& s) { return s.status == SolveStatus::kSuccess; },
-                             "True when status is SolveStatus.SUCCESS")
+      .def_property_readonly(
+          "ok", [](const PositionSummary& s) { return s.status == SolveStatus::kSuccess; },
+          "True when status is SolveStatus.SUCCESS")
       .def_readonly("iterations", &PositionSummary::iterations, "Newton steps taken")
       .def_readonly("factorizations", &PositionSummary::factorizations, "Newton steps with a fresh factorisation of Φq")
       .def_readonly("backtracks", &PositionSummary::backtracks, "step halvings by the line search")
       .def_readonly("residual", &PositionSummary::residual, "max_i |Φ_i| / scale_i at the end")
       .def_readonly("rcond", &PositionSummary::rcond, "of the last factorisation")
-      .def_readonly("slow_convergence", &PositionSummary::slow_convergence, "converged only linearly (a singular position) or stopped at the rounding level")
+      .def_readonly("slow_convergence", &PositionSummary::slow_convergence,
+                    "converged only linearly (a singular position) or stopped at the rounding level")
       .def_readonly("error_estimate", &PositionSummary::error_estimate,
                     "estimated error of q in units of the tolerance test (≤ 1: within it; negative: unknown)")
       .def_readonly("message", &PositionSummary::message, "one line; empty on a clean success")
@@ -64,8 +73,9 @@ void bind_kinematics(py::module_& m) {
 
   py::class_<LinearSummary>(m, "LinearSummary", "What solve_velocity or solve_acceleration did.")
       .def_readonly("status", &LinearSummary::status, "the outcome (SolveStatus)")
-      .def_property_readonly("ok", [](const LinearSummary& s) { return s.status == SolveStatus::kSuccess; },
-                             "True when status is SolveStatus.SUCCESS")
+      .def_property_readonly(
+          "ok", [](const LinearSummary& s) { return s.status == SolveStatus::kSuccess; },
+          "True when status is SolveStatus.SUCCESS")
       .def_readonly("rcond", &LinearSummary::rcond, "reciprocal condition estimate of the factorisation used")
       .def_readonly("message", &LinearSummary::message, "one line; empty on success")
       .def("__repr__", [](const LinearSummary& s) {
@@ -116,8 +126,10 @@ void bind_rank_and_assembly(py::module_& m) {
   py::class_<RankReport>(m, "RankReport", "Rank and redundancy of the constraint equations at one configuration.")
       .def_readonly("coordinates", &RankReport::coordinates, "n")
       .def_readonly("equations", &RankReport::equations, "m, all rows (kinematic and rheonomic)")
-      .def_readonly("kinematic_equations", &RankReport::kinematic_equations, "rows of constraints that do not depend on t")
-      .def_readonly("driver_equations", &RankReport::driver_equations, "rows of rheonomic constraints (drivers, equations in t)")
+      .def_readonly("kinematic_equations", &RankReport::kinematic_equations,
+                    "rows of constraints that do not depend on t")
+      .def_readonly("driver_equations", &RankReport::driver_equations,
+                    "rows of rheonomic constraints (drivers, equations in t)")
       .def_readonly("rank", &RankReport::rank, "rank of the kinematic rows")
       .def_readonly("dof", &RankReport::dof, "n − rank: degrees of freedom (drivers not counted)")
       .def_readonly("driven_rank", &RankReport::driven_rank, "rank of all rows")
@@ -126,20 +138,23 @@ void bind_rank_and_assembly(py::module_& m) {
       .def_readonly("independent_rows", &RankReport::independent_rows, "a maximal independent set of rows, ascending")
       .def_readonly("redundant_rows", &RankReport::redundant_rows, "the other rows, ascending")
       .def_readonly("redundant", &RankReport::redundant, "names of the constraints owning redundant rows")
-      .def_readonly("uncertain", &RankReport::uncertain, "a pivot or singular value near the tolerance, or the sparse and dense ranks disagree")
+      .def_readonly("uncertain", &RankReport::uncertain,
+                    "a pivot or singular value near the tolerance, or the sparse and dense ranks disagree")
       .def_readonly("message", &RankReport::message, "one line; empty when nothing is uncertain")
       .def("brief_report", &RankReport::BriefReport)
       .def("__repr__", [](const RankReport& r) { return "<RankReport: " + r.BriefReport() + ">"; });
 
   py::class_<AssemblySummary>(m, "AssemblySummary", "What assemble() did.")
       .def_readonly("status", &AssemblySummary::status, "the outcome (SolveStatus)")
-      .def_property_readonly("ok", [](const AssemblySummary& s) { return s.status == SolveStatus::kSuccess; },
-                             "True when status is SolveStatus.SUCCESS")
+      .def_property_readonly(
+          "ok", [](const AssemblySummary& s) { return s.status == SolveStatus::kSuccess; },
+          "True when status is SolveStatus.SUCCESS")
       .def_readonly("iterations", &AssemblySummary::iterations, "Gauss-Newton steps")
       .def_readonly("residual", &AssemblySummary::residual, "max_i |Φ_i| / scale_i over all rows at the end")
       .def_readonly("moved", &AssemblySummary::moved, "max_j |q_j − q0_j| / scale_j")
       .def_readonly("rank", &AssemblySummary::rank, "the RankReport at the final configuration")
-      .def_readonly("consistent", &AssemblySummary::consistent, "False when redundant equations cannot hold where the independent ones do")
+      .def_readonly("consistent", &AssemblySummary::consistent,
+                    "False when redundant equations cannot hold where the independent ones do")
       .def_readonly("conflicts", &AssemblySummary::conflicts, "constraints that cannot hold together")
       .def_readonly("message", &AssemblySummary::message, "one line; empty on a clean success")
       .def("brief_report", &AssemblySummary::BriefReport)
@@ -169,8 +184,7 @@ void bind_rank_and_assembly(py::module_& m) {
       },
       py::arg("model"), py::arg("q"), py::arg("t"), "Rank analysis of Φq(q, t): a RankReport.");
   m.def(
-      "worst_rows",
-      [](const Model& model, const PositionSummary& s) { return worst_rows(model, s.worst_rows); },
+      "worst_rows", [](const Model& model, const PositionSummary& s) { return worst_rows(model, s.worst_rows); },
       py::arg("model"), py::arg("summary"),
       "The worst rows at the end of a position solve: (row name, |Φ_i| / scale_i), largest first.");
 }

@@ -50,8 +50,9 @@ std::unique_ptr<PyStepper> stepper_for_scene(std::shared_ptr<const Scene> scene,
 void bind_stepper(py::module_& m) {
   py::class_<StepSummary>(m, "StepSummary", "What one Stepper.step did.")
       .def_readonly("status", &StepSummary::status, "the outcome (SolveStatus)")
-      .def_property_readonly("ok", [](const StepSummary& s) { return s.status == SolveStatus::kSuccess; },
-                             "True when status is SolveStatus.SUCCESS")
+      .def_property_readonly(
+          "ok", [](const StepSummary& s) { return s.status == SolveStatus::kSuccess; },
+          "True when status is SolveStatus.SUCCESS")
       .def_readonly("t", &StepSummary::t, "the time asked for")
       .def_readonly("message", &StepSummary::message, "one line naming the time, the cause and the worst constraints")
       .def_readonly("assembled", &StepSummary::assembled, "the step assembled from the placement")
@@ -76,16 +77,16 @@ void bind_stepper(py::module_& m) {
              if (sensitivities) asked = sensitivity_requests(*sensitivities, "Stepper");
              return stepper_for_scene(std::move(scene), velocities, accelerations, asked);
            }),
-           py::arg("scene"), py::kw_only(), py::arg("velocities") = py::none(),
-           py::arg("accelerations") = py::none(), py::arg("sensitivities") = py::none(),
+           py::arg("scene"), py::kw_only(), py::arg("velocities") = py::none(), py::arg("accelerations") = py::none(),
+           py::arg("sensitivities") = py::none(),
            "A stepper for a scene: its solver settings, output points and rough placement (a redundant scene "
            "assembled and solved on its independent rows, as run_sweep does); velocities and accelerations as the "
            "scene's output asks unless given; the sensitivities of its output.sensitivities, or of `sensitivities` "
            "(names or (name, step) tuples, as run_sweep's) at every step. ValueError when the scene cannot be "
            "prepared (inconsistent, under-driven) or names no such parameter.")
       .def(py::init([](const Model& model, bool velocities, bool accelerations, Predictor predictor,
-                       std::optional<NewtonOptions> newton, std::optional<NewtonOptions> assembly,
-                       int max_subdivisions, double expected_step) {
+                       std::optional<NewtonOptions> newton, std::optional<NewtonOptions> assembly, int max_subdivisions,
+                       double expected_step) {
              StepperOptions o;
              o.velocities = velocities, o.accelerations = accelerations, o.predictor = predictor;
              if (newton) o.newton = *newton;
@@ -117,16 +118,21 @@ void bind_stepper(py::module_& m) {
             s.stepper->restart(coordinate_vector(s.stepper->model(), placement, "placement"));
           },
           py::arg("placement"), "Forget the history (a jump of the clock): the next step assembles from placement.")
-      .def_property_readonly("started", [](const PyStepper& s) { return s.stepper->started(); },
-                             "a step has succeeded since construction or the last restart()")
-      .def_property_readonly("time", [](const PyStepper& s) { return s.stepper->time(); },
-                             "time of the current state (NaN before the first success)")
-      .def_property_readonly("q", [](const PyStepper& s) -> const Eigen::VectorXd& { return s.stepper->q(); },
-                             py::return_value_policy::reference_internal, "positions of the current state (read-only view)")
-      .def_property_readonly("qd", [](const PyStepper& s) -> const Eigen::VectorXd& { return s.stepper->qd(); },
-                             py::return_value_policy::reference_internal, "velocities (empty when not solved)")
-      .def_property_readonly("qdd", [](const PyStepper& s) -> const Eigen::VectorXd& { return s.stepper->qdd(); },
-                             py::return_value_policy::reference_internal, "accelerations (empty when not solved)")
+      .def_property_readonly(
+          "started", [](const PyStepper& s) { return s.stepper->started(); },
+          "a step has succeeded since construction or the last restart()")
+      .def_property_readonly(
+          "time", [](const PyStepper& s) { return s.stepper->time(); },
+          "time of the current state (NaN before the first success)")
+      .def_property_readonly(
+          "q", [](const PyStepper& s) -> const Eigen::VectorXd& { return s.stepper->q(); },
+          py::return_value_policy::reference_internal, "positions of the current state (read-only view)")
+      .def_property_readonly(
+          "qd", [](const PyStepper& s) -> const Eigen::VectorXd& { return s.stepper->qd(); },
+          py::return_value_policy::reference_internal, "velocities (empty when not solved)")
+      .def_property_readonly(
+          "qdd", [](const PyStepper& s) -> const Eigen::VectorXd& { return s.stepper->qdd(); },
+          py::return_value_policy::reference_internal, "accelerations (empty when not solved)")
       .def_property_readonly(
           "points",
           [](const PyStepper& s) {
@@ -145,9 +151,9 @@ void bind_stepper(py::module_& m) {
             return out;
           },
           "the output points' motions at the current state: name → (position, velocity, acceleration)")
-      .def_property_readonly("sensitivity_names",
-                             [](const PyStepper& s) { return names_of(s.stepper->options().sensitivities); },
-                             "parameters whose sensitivities every step delivers (sensitivity())")
+      .def_property_readonly(
+          "sensitivity_names", [](const PyStepper& s) { return names_of(s.stepper->options().sensitivities); },
+          "parameters whose sensitivities every step delivers (sensitivity())")
       .def(
           "sensitivity",
           [](const PyStepper& s, const std::string& parameter, int order) {
@@ -170,10 +176,12 @@ void bind_stepper(py::module_& m) {
           py::arg("parameter"), py::arg("order") = 0,
           "The current state's ∂q/∂p (order 0), ∂q̇/∂p (1) or ∂q̈/∂p (2) for a parameter of sensitivity_names, in the "
           "order of q (NaN where not solved, and at a singular position)")
-      .def_property_readonly("summary", [](const PyStepper& s) { return s.stepper->summary(); },
-                             "everything the steps did so far, as a sweep's SweepSummary (to_dict() for JSON)")
-      .def_property_readonly("model", [](const PyStepper& s) -> const Model& { return s.stepper->model(); },
-                             py::return_value_policy::reference_internal, "the model stepped");
+      .def_property_readonly(
+          "summary", [](const PyStepper& s) { return s.stepper->summary(); },
+          "everything the steps did so far, as a sweep's SweepSummary (to_dict() for JSON)")
+      .def_property_readonly(
+          "model", [](const PyStepper& s) -> const Model& { return s.stepper->model(); },
+          py::return_value_policy::reference_internal, "the model stepped");
 }
 
 }  // namespace phiq::python

@@ -51,16 +51,19 @@ std::shared_ptr<SweepTable> sweep_into_table(const Scene& scene, const SweepOpti
   ws.q = square.start;
 
   auto next_check = std::chrono::steady_clock::now() + std::chrono::milliseconds(50);
-  (void)run_sweep(model, opt, ws, [&](const StepView& step) {  // the status is in the summary
-    if (table->rows >= capacity) throw Error("run_sweep delivered more rows than rows_written() counts");
-    format.append_values(step, table->data.get() + table->rows * width);
-    ++table->rows;
-    if (const auto now = std::chrono::steady_clock::now(); now >= next_check) {
-      next_check = now + std::chrono::milliseconds(50);
-      return keep_going();
-    }
-    return true;
-  }, &table->summary);
+  (void)run_sweep(
+      model, opt, ws,
+      [&](const StepView& step) {  // the status is in the summary
+        if (table->rows >= capacity) throw Error("run_sweep delivered more rows than rows_written() counts");
+        format.append_values(step, table->data.get() + table->rows * width);
+        ++table->rows;
+        if (const auto now = std::chrono::steady_clock::now(); now >= next_check) {
+          next_check = now + std::chrono::milliseconds(50);
+          return keep_going();
+        }
+        return true;
+      },
+      &table->summary);
   return table;
 }
 

@@ -38,14 +38,22 @@ std::size_t utf8_sequence_length(const std::string& text, std::size_t i) {
   // the lead byte gives the length and the range of the second byte (no overlong forms, no surrogates, <= U+10FFFF)
   std::size_t n = 0;
   unsigned char lo = 0x80, hi = 0xbf;
-  if (c >= 0xc2 && c <= 0xdf) n = 2;
-  else if (c == 0xe0) n = 3, lo = 0xa0;
-  else if (c == 0xed) n = 3, hi = 0x9f;
-  else if (c >= 0xe1 && c <= 0xef) n = 3;
-  else if (c == 0xf0) n = 4, lo = 0x90;
-  else if (c >= 0xf1 && c <= 0xf3) n = 4;
-  else if (c == 0xf4) n = 4, hi = 0x8f;
-  else return 0;
+  if (c >= 0xc2 && c <= 0xdf)
+    n = 2;
+  else if (c == 0xe0)
+    n = 3, lo = 0xa0;
+  else if (c == 0xed)
+    n = 3, hi = 0x9f;
+  else if (c >= 0xe1 && c <= 0xef)
+    n = 3;
+  else if (c == 0xf0)
+    n = 4, lo = 0x90;
+  else if (c >= 0xf1 && c <= 0xf3)
+    n = 4;
+  else if (c == 0xf4)
+    n = 4, hi = 0x8f;
+  else
+    return 0;
   if (i + n > text.size() || byte(i + 1) < lo || byte(i + 1) > hi) return 0;
   for (std::size_t k = 2; k < n; ++k)
     if (byte(i + k) < 0x80 || byte(i + k) > 0xbf) return 0;
@@ -59,9 +67,12 @@ std::string single_line(const std::string& text) {
   for (std::size_t i = 0; i < text.size();) {
     const unsigned char c = static_cast<unsigned char>(text[i]);
     const std::size_t n = utf8_sequence_length(text, i);
-    if (c == '\n') out += "\\n";
-    else if (c == '\r') out += "\\r";
-    else if (c == '\t') out += "\\t";
+    if (c == '\n')
+      out += "\\n";
+    else if (c == '\r')
+      out += "\\r";
+    else if (c == '\t')
+      out += "\\t";
     else if (c < 0x20 || c == 0x7f || n == 0) {  // a control character, or a byte that is not UTF-8
       out += "\\x";
       out += hex[c >> 4];

@@ -76,9 +76,9 @@ std::mutex& ginac_mutex() {
 
 // The symbols an expression is parsed into, and the values the tape builder folds in for the others.
 struct Symbols {
-  std::map<std::string, Index> coord_of_symbol;          // symbol name -> coordinate index
-  std::map<std::string, double> value_of_constant;       // symbol name -> value folded in by the tape builder
-  std::map<Index, GiNaC::realsymbol> symbol_of_coord;    // one symbol per coordinate, however many names it has
+  std::map<std::string, Index> coord_of_symbol;        // symbol name -> coordinate index
+  std::map<std::string, double> value_of_constant;     // symbol name -> value folded in by the tape builder
+  std::map<Index, GiNaC::realsymbol> symbol_of_coord;  // one symbol per coordinate, however many names it has
   GiNaC::realsymbol t{"t"};
   GiNaC::ex coordinate(Index i) {
     auto [it, fresh] = symbol_of_coord.try_emplace(i, "q:" + std::to_string(i));
@@ -196,8 +196,7 @@ struct CompiledExpressionBuilder {
 };
 
 std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std::string& text,
-                                                                      const NameResolver& resolve,
-                                                                      bool allow_time) {
+                                                                      const NameResolver& resolve, bool allow_time) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw Error("expression is empty");
   if (text.size() > kMaxTextLength)
     throw Error("expression of " + std::to_string(text.size()) + " characters; the limit is " +

@@ -19,8 +19,8 @@ inline Error expression_error(const std::string& text, const std::string& what) 
   // whole code points: never cut inside a UTF-8 sequence
   while (cut > 0 && cut < text.size() && (static_cast<unsigned char>(text[cut]) & 0xc0) == 0x80) --cut;
   std::ostringstream s;
-  s << "expression \"" << single_line(text.substr(0, cut)) << (cut < text.size() ? "..." : "") << "\": "
-    << single_line(what);
+  s << "expression \"" << single_line(text.substr(0, cut)) << (cut < text.size() ? "..." : "")
+    << "\": " << single_line(what);
   return Error(s.str());
 }
 
@@ -33,19 +33,32 @@ inline std::string lookalike_hint(const std::string& token) {
     const char* ascii;
   };
   static const Lookalike table[] = {
-      {"\u2212", "U+2212 MINUS SIGN", "-"},       {"\u2010", "U+2010 HYPHEN", "-"},
-      {"\u2011", "U+2011 NON-BREAKING HYPHEN", "-"}, {"\u2012", "U+2012 FIGURE DASH", "-"},
-      {"\u2013", "U+2013 EN DASH", "-"},          {"\u2014", "U+2014 EM DASH", "-"},
-      {"\ufe63", "U+FE63 SMALL HYPHEN-MINUS", "-"}, {"\uff0d", "U+FF0D FULLWIDTH HYPHEN-MINUS", "-"},
-      {"\u00d7", "U+00D7 MULTIPLICATION SIGN", "*"}, {"\u22c5", "U+22C5 DOT OPERATOR", "*"},
-      {"\u00b7", "U+00B7 MIDDLE DOT", "*"},       {"\u2217", "U+2217 ASTERISK OPERATOR", "*"},
-      {"\u2219", "U+2219 BULLET OPERATOR", "*"},  {"\u00f7", "U+00F7 DIVISION SIGN", "/"},
-      {"\u2215", "U+2215 DIVISION SLASH", "/"},   {"\u2044", "U+2044 FRACTION SLASH", "/"},
-      {"\uff0b", "U+FF0B FULLWIDTH PLUS SIGN", "+"}, {"\uff08", "U+FF08 FULLWIDTH LEFT PARENTHESIS", "("},
-      {"\uff09", "U+FF09 FULLWIDTH RIGHT PARENTHESIS", ")"}, {"\u00a0", "U+00A0 NO-BREAK SPACE", " "},
-      {"\u2009", "U+2009 THIN SPACE", " "},        {"\u202f", "U+202F NARROW NO-BREAK SPACE", " "},
-      {"\u03c0", "U+03C0 GREEK SMALL LETTER PI", "pi"}, {"\u2032", "U+2032 PRIME", "'"},
-      {"\u00b2", "U+00B2 SUPERSCRIPT TWO", "^2"},  {"\u00b3", "U+00B3 SUPERSCRIPT THREE", "^3"},
+      {"\u2212", "U+2212 MINUS SIGN", "-"},
+      {"\u2010", "U+2010 HYPHEN", "-"},
+      {"\u2011", "U+2011 NON-BREAKING HYPHEN", "-"},
+      {"\u2012", "U+2012 FIGURE DASH", "-"},
+      {"\u2013", "U+2013 EN DASH", "-"},
+      {"\u2014", "U+2014 EM DASH", "-"},
+      {"\ufe63", "U+FE63 SMALL HYPHEN-MINUS", "-"},
+      {"\uff0d", "U+FF0D FULLWIDTH HYPHEN-MINUS", "-"},
+      {"\u00d7", "U+00D7 MULTIPLICATION SIGN", "*"},
+      {"\u22c5", "U+22C5 DOT OPERATOR", "*"},
+      {"\u00b7", "U+00B7 MIDDLE DOT", "*"},
+      {"\u2217", "U+2217 ASTERISK OPERATOR", "*"},
+      {"\u2219", "U+2219 BULLET OPERATOR", "*"},
+      {"\u00f7", "U+00F7 DIVISION SIGN", "/"},
+      {"\u2215", "U+2215 DIVISION SLASH", "/"},
+      {"\u2044", "U+2044 FRACTION SLASH", "/"},
+      {"\uff0b", "U+FF0B FULLWIDTH PLUS SIGN", "+"},
+      {"\uff08", "U+FF08 FULLWIDTH LEFT PARENTHESIS", "("},
+      {"\uff09", "U+FF09 FULLWIDTH RIGHT PARENTHESIS", ")"},
+      {"\u00a0", "U+00A0 NO-BREAK SPACE", " "},
+      {"\u2009", "U+2009 THIN SPACE", " "},
+      {"\u202f", "U+202F NARROW NO-BREAK SPACE", " "},
+      {"\u03c0", "U+03C0 GREEK SMALL LETTER PI", "pi"},
+      {"\u2032", "U+2032 PRIME", "'"},
+      {"\u00b2", "U+00B2 SUPERSCRIPT TWO", "^2"},
+      {"\u00b3", "U+00B3 SUPERSCRIPT THREE", "^3"},
       {"\u221a", "U+221A SQUARE ROOT", "sqrt("},
   };
   for (const Lookalike& l : table)

@@ -63,7 +63,10 @@ class ExpressionParser {
   Node constant(double v) {
     if (!std::isfinite(v))
       fail(std::string("a constant part of it is not a finite real number (") +
-           (std::isnan(v) ? "NaN" : v > 0 ? "+inf" : "-inf") + ")");
+           (std::isnan(v) ? "NaN"
+            : v > 0       ? "+inf"
+                          : "-inf") +
+           ")");
     if (v == 0.0) return Node{0, true, 0.0};
     const std::string symbol_name = "k:" + std::to_string(value_of_constant_.size());
     value_of_constant_[symbol_name] = v;
@@ -136,34 +139,45 @@ class ExpressionParser {
     if (op == Op::kDiv && b.constant && b.value == 0.0) fail("division by zero");
     if (a.constant && b.constant) return constant(apply(op, a.value, b.value, 0.0));
     switch (op) {
-      case Op::kAdd: return settle(a.e + b.e);
-      case Op::kSub: return settle(a.e - b.e);
-      case Op::kMul: return settle(a.e * b.e);
-      case Op::kDiv: return settle(a.e / b.e);
+      case Op::kAdd:
+        return settle(a.e + b.e);
+      case Op::kSub:
+        return settle(a.e - b.e);
+      case Op::kMul:
+        return settle(a.e * b.e);
+      case Op::kDiv:
+        return settle(a.e / b.e);
       case Op::kPow:
         if (!b.constant) return settle(GiNaC::pow(a.e, b.e));
         if (b.value == 0.0) return constant(1.0);  // x^0 = 1, also at x = 0 (as the tape's power computes it)
-        if (b.value == 1.0) return a;               // x^1 = x, for GiNaC too (x^1 - x cancels)
+        if (b.value == 1.0) return a;              // x^1 = x, for GiNaC too (x^1 - x cancels)
         return settle(constant_power(a.e, b.e));
-      default: fail("internal: binary operation " + std::to_string(static_cast<int>(op)));
+      default:
+        fail("internal: binary operation " + std::to_string(static_cast<int>(op)));
     }
   }
 
   Node sum() {
     Node n = product();
     for (;;) {
-      if (accept('+')) n = binary_op(Op::kAdd, n, product());
-      else if (accept('-')) n = binary_op(Op::kSub, n, product());
-      else return n;
+      if (accept('+'))
+        n = binary_op(Op::kAdd, n, product());
+      else if (accept('-'))
+        n = binary_op(Op::kSub, n, product());
+      else
+        return n;
     }
   }
 
   Node product() {
     Node n = unary();
     for (;;) {
-      if (accept('*')) n = binary_op(Op::kMul, n, unary());
-      else if (accept('/')) n = binary_op(Op::kDiv, n, unary());
-      else return n;
+      if (accept('*'))
+        n = binary_op(Op::kMul, n, unary());
+      else if (accept('/'))
+        n = binary_op(Op::kDiv, n, unary());
+      else
+        return n;
     }
   }
 
@@ -225,8 +239,7 @@ class ExpressionParser {
     const std::string literal = text_.substr(start, pos_ - start);
     char* end = nullptr;
     const double v = std::strtod(literal.c_str(), &end);
-    if (end != literal.c_str() + literal.size())
-      fail("'" + literal.substr(0, 40) + "' is not a number");
+    if (end != literal.c_str() + literal.size()) fail("'" + literal.substr(0, 40) + "' is not a number");
     if (!std::isfinite(v)) fail("number '" + literal.substr(0, 40) + "' is out of the range of a double");
     return constant(v);
   }
@@ -247,8 +260,8 @@ class ExpressionParser {
     const FunctionSpec& f = it->second;
     if (static_cast<int>(args.size()) != f.arity) {
       pos_ = start;
-      fail_at("'" + name + "' takes " + std::to_string(f.arity) + " argument" + (f.arity == 1 ? "" : "s") +
-              ", not " + std::to_string(args.size()));
+      fail_at("'" + name + "' takes " + std::to_string(f.arity) + " argument" + (f.arity == 1 ? "" : "s") + ", not " +
+              std::to_string(args.size()));
     }
     return call_function(f, args);
   }
@@ -262,8 +275,7 @@ class ExpressionParser {
 
 }  // namespace
 
-GiNaC::ex parse_expression(const std::string& text, NameLookup name,
-                           std::map<std::string, double>& value_of_constant) {
+GiNaC::ex parse_expression(const std::string& text, NameLookup name, std::map<std::string, double>& value_of_constant) {
   ExpressionParser parser(text, std::move(name), value_of_constant);
   return parser.parse().e;
 }

@@ -22,7 +22,6 @@ using NameLookup = std::function<ParsedName(const std::string&)>;
 // The GiNaC expression of `text`. Each folded constant reaches it as a real symbol whose value is entered in
 // value_of_constant (for the tape builder). Throws phiq::Error with a one-line message (column, offending token)
 // when the text is malformed; GiNaC's own refusals escape as its exceptions.
-GiNaC::ex parse_expression(const std::string& text, NameLookup name,
-                           std::map<std::string, double>& value_of_constant);
+GiNaC::ex parse_expression(const std::string& text, NameLookup name, std::map<std::string, double>& value_of_constant);
 
 }  // namespace phiq::detail

@@ -42,8 +42,8 @@ std::string supported_function_list() {
 namespace {
 GiNaC::ex constant_power_derivative(const GiNaC::ex& u, const GiNaC::ex& p, unsigned wrt);
 unsigned constant_power_serial() {
-  static const unsigned serial = GiNaC::function::register_new(
-      GiNaC::function_options("phiq_pow", 2).derivative_func(constant_power_derivative));
+  static const unsigned serial =
+      GiNaC::function::register_new(GiNaC::function_options("phiq_pow", 2).derivative_func(constant_power_derivative));
   return serial;
 }
 }  // namespace

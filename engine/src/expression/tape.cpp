@@ -22,10 +22,18 @@ void Tape::evaluate(const double* q, const double* qd, double t, double* out) co
   for (std::size_t i = 0; i < n; ++i) {
     const Instr& in = code_[i];
     switch (in.op) {
-      case Op::kLoadQ: r[i] = q[in.a]; break;
-      case Op::kLoadQd: r[i] = qd[in.a]; break;
-      case Op::kLoadT: r[i] = t; break;
-      default: r[i] = apply(in.op, r[in.a], r[in.b], in.imm); break;
+      case Op::kLoadQ:
+        r[i] = q[in.a];
+        break;
+      case Op::kLoadQd:
+        r[i] = qd[in.a];
+        break;
+      case Op::kLoadT:
+        r[i] = t;
+        break;
+      default:
+        r[i] = apply(in.op, r[in.a], r[in.b], in.imm);
+        break;
     }
   }
   for (std::size_t k = 0; k < outputs_.size(); ++k) out[k] = r[outputs_[k]];
@@ -39,7 +47,9 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
   };
   thread_local std::vector<J> r;
   if (r.size() < code_.size()) r.resize(code_.size());
-  auto unary = [](const J& a, double f, double f1, double f2) { return J{f, f1 * a.d, f1 * a.h + 0.5 * f2 * a.d * a.d}; };
+  auto unary = [](const J& a, double f, double f1, double f2) {
+    return J{f, f1 * a.d, f1 * a.h + 0.5 * f2 * a.d * a.d};
+  };
   const std::size_t n = code_.size();
   for (std::size_t i = 0; i < n; ++i) {
     const Instr& in = code_[i];
@@ -47,14 +57,30 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
     const J& b = r[in.b];
     J w;
     switch (in.op) {
-      case Op::kConst: w = {in.imm, 0.0, 0.0}; break;
-      case Op::kLoadQ: w = {q[in.a], qd[in.a], 0.0}; break;
-      case Op::kLoadQd: w = {qd[in.a], 0.0, 0.0}; break;  // q̇ is held fixed along the direction (q̈ = 0)
-      case Op::kLoadT: w = {t, 1.0, 0.0}; break;
-      case Op::kAdd: w = {a.v + b.v, a.d + b.d, a.h + b.h}; break;
-      case Op::kSub: w = {a.v - b.v, a.d - b.d, a.h - b.h}; break;
-      case Op::kNeg: w = {-a.v, -a.d, -a.h}; break;
-      case Op::kMul: w = {a.v * b.v, a.v * b.d + a.d * b.v, a.v * b.h + a.d * b.d + a.h * b.v}; break;
+      case Op::kConst:
+        w = {in.imm, 0.0, 0.0};
+        break;
+      case Op::kLoadQ:
+        w = {q[in.a], qd[in.a], 0.0};
+        break;
+      case Op::kLoadQd:
+        w = {qd[in.a], 0.0, 0.0};
+        break;  // q̇ is held fixed along the direction (q̈ = 0)
+      case Op::kLoadT:
+        w = {t, 1.0, 0.0};
+        break;
+      case Op::kAdd:
+        w = {a.v + b.v, a.d + b.d, a.h + b.h};
+        break;
+      case Op::kSub:
+        w = {a.v - b.v, a.d - b.d, a.h - b.h};
+        break;
+      case Op::kNeg:
+        w = {-a.v, -a.d, -a.h};
+        break;
+      case Op::kMul:
+        w = {a.v * b.v, a.v * b.d + a.d * b.v, a.v * b.h + a.d * b.d + a.h * b.v};
+        break;
       case Op::kDiv: {
         const double w0 = a.v / b.v, w1 = (a.d - w0 * b.d) / b.v;
         w = {w0, w1, (a.h - w0 * b.h - w1 * b.d) / b.v};
@@ -92,8 +118,12 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
         w = unary(a, s0, 0.5 / s0, -0.25 / (s0 * a.v));
         break;
       }
-      case Op::kSin: w = unary(a, std::sin(a.v), std::cos(a.v), -std::sin(a.v)); break;
-      case Op::kCos: w = unary(a, std::cos(a.v), -std::sin(a.v), -std::cos(a.v)); break;
+      case Op::kSin:
+        w = unary(a, std::sin(a.v), std::cos(a.v), -std::sin(a.v));
+        break;
+      case Op::kCos:
+        w = unary(a, std::cos(a.v), -std::sin(a.v), -std::cos(a.v));
+        break;
       case Op::kTan: {
         const double tn = std::tan(a.v), sec2 = 1.0 + tn * tn;
         w = unary(a, tn, sec2, 2.0 * tn * sec2);
@@ -125,17 +155,29 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
         w = unary(a, e, e, e);
         break;
       }
-      case Op::kLog: w = unary(a, std::log(a.v), 1.0 / a.v, -1.0 / (a.v * a.v)); break;
-      case Op::kSinh: w = unary(a, std::sinh(a.v), std::cosh(a.v), std::sinh(a.v)); break;
-      case Op::kCosh: w = unary(a, std::cosh(a.v), std::sinh(a.v), std::cosh(a.v)); break;
+      case Op::kLog:
+        w = unary(a, std::log(a.v), 1.0 / a.v, -1.0 / (a.v * a.v));
+        break;
+      case Op::kSinh:
+        w = unary(a, std::sinh(a.v), std::cosh(a.v), std::sinh(a.v));
+        break;
+      case Op::kCosh:
+        w = unary(a, std::cosh(a.v), std::sinh(a.v), std::cosh(a.v));
+        break;
       case Op::kTanh: {
         const double th = std::tanh(a.v), s2 = 1.0 - th * th;
         w = unary(a, th, s2, -2.0 * th * s2);
         break;
       }
-      case Op::kAbs: w = unary(a, std::fabs(a.v), (a.v > 0) - (a.v < 0), 0.0); break;
-      case Op::kSign: w = {static_cast<double>((a.v > 0) - (a.v < 0)), 0.0, 0.0}; break;
-      default: w = {std::nan(""), std::nan(""), std::nan("")}; break;
+      case Op::kAbs:
+        w = unary(a, std::fabs(a.v), (a.v > 0) - (a.v < 0), 0.0);
+        break;
+      case Op::kSign:
+        w = {static_cast<double>((a.v > 0) - (a.v < 0)), 0.0, 0.0};
+        break;
+      default:
+        w = {std::nan(""), std::nan(""), std::nan("")};
+        break;
     }
     r[i] = w;
   }
@@ -144,10 +186,9 @@ void Tape::taylor2(const double* q, const double* qd, double t, double out[3]) c
 }
 
 std::string Tape::listing() const {
-  static const char* const names[] = {"const", "loadq", "loadqd", "loadt", "add",  "sub",  "mul",   "div",
-                                      "neg",   "powint", "powhalf", "pow", "sqrt", "sin",  "cos",   "tan",
-                                      "asin",  "acos",  "atan",   "atan2", "exp",  "log",  "sinh",  "cosh",
-                                      "tanh",  "abs",   "sign"};
+  static const char* const names[] = {"const",  "loadq",   "loadqd", "loadt", "add",  "sub",  "mul",  "div",  "neg",
+                                      "powint", "powhalf", "pow",    "sqrt",  "sin",  "cos",  "tan",  "asin", "acos",
+                                      "atan",   "atan2",   "exp",    "log",   "sinh", "cosh", "tanh", "abs",  "sign"};
   std::ostringstream s;
   char imm[64];
   for (std::size_t i = 0; i < code_.size(); ++i) {
@@ -155,9 +196,15 @@ std::string Tape::listing() const {
     std::snprintf(imm, sizeof imm, "%a", in.imm);
     s << 'r' << i << " = " << names[static_cast<int>(in.op)];
     switch (in.op) {
-      case Op::kConst: s << ' ' << imm; break;
-      case Op::kLoadQ: case Op::kLoadQd: s << ' ' << in.a; break;
-      case Op::kLoadT: break;
+      case Op::kConst:
+        s << ' ' << imm;
+        break;
+      case Op::kLoadQ:
+      case Op::kLoadQd:
+        s << ' ' << in.a;
+        break;
+      case Op::kLoadT:
+        break;
       default:
         s << " r" << in.a;
         if (is_binary(in.op)) s << " r" << in.b;

@@ -109,7 +109,10 @@ class TapeBuilder {
       const double v = apply(op, tape_.code_[a].imm, tape_.code_[b].imm, imm);
       if (!std::isfinite(v))
         fail(std::string("a constant part of it is not a finite real number (") +
-             (std::isnan(v) ? "NaN" : v > 0 ? "+inf" : "-inf") + ")");
+             (std::isnan(v) ? "NaN"
+              : v > 0       ? "+inf"
+                            : "-inf") +
+             ")");
       op = Op::kConst, a = 0, b = 0, imm = v;
     }
     if (tape_.code_.size() >= CompiledExpression::kMaxTapeSize)
@@ -120,9 +123,12 @@ class TapeBuilder {
     if (it != cse_.end()) return it->second;
     // the fingerprint: the operation, and the inputs' indices, the constants' bits or the operands' fingerprints
     std::uint64_t h = mix(0x7068697100000000ULL, static_cast<std::uint64_t>(op));
-    if (op == Op::kConst) h = mix(h, bits(imm));
-    else if (!reads_registers(op)) h = mix(h, a);
-    else h = mix(mix(mix(h, fingerprint_[a]), is_binary(op) ? fingerprint_[b] : 0), bits(imm));
+    if (op == Op::kConst)
+      h = mix(h, bits(imm));
+    else if (!reads_registers(op))
+      h = mix(h, a);
+    else
+      h = mix(mix(mix(h, fingerprint_[a]), is_binary(op) ? fingerprint_[b] : 0), bits(imm));
     tape_.code_.push_back(Tape::Instr{op, a, b, imm});
     fingerprint_.push_back(h);
     auto reg = static_cast<std::uint32_t>(tape_.code_.size() - 1);

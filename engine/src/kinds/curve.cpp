@@ -25,8 +25,7 @@ std::shared_ptr<const Curve> Curve::spline(std::vector<kin::V2> p, bool closed) 
   for (std::size_t k = 0; k < p.size(); ++k)
     if (!finite(p[k])) throw Error("spline point " + std::to_string(k + 1) + " is not finite");
   if (closed && p.size() > 1 && p.front().x == p.back().x && p.front().y == p.back().y) p.pop_back();
-  if (p.size() < 4)
-    throw Error("a spline needs at least 4 distinct points (" + std::to_string(p.size()) + " given)");
+  if (p.size() < 4) throw Error("a spline needs at least 4 distinct points (" + std::to_string(p.size()) + " given)");
   const std::size_t n = p.size(), pieces = closed ? n : n - 1;
   auto curve = std::shared_ptr<Curve>(new Curve());
   Curve& c = *curve;

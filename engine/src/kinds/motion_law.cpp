@@ -111,9 +111,7 @@ std::shared_ptr<const MotionLaw::Impl> Harmonic::rate(const std::array<const Imp
   if (!all_of_kind(o)) return nullptr;
   auto r = std::make_shared<HarmonicRate>();
   r->at = *this;
-  const auto d = [&](double Harmonic::*m) {
-    return central_difference(o[0]->*m, o[1]->*m, o[2]->*m, o[3]->*m, h);
-  };
+  const auto d = [&](double Harmonic::*m) { return central_difference(o[0]->*m, o[1]->*m, o[2]->*m, o[3]->*m, h); };
   r->rate.offset = d(&Harmonic::offset);
   r->rate.amplitude = d(&Harmonic::amplitude);
   r->rate.omega = d(&Harmonic::omega);
@@ -159,8 +157,8 @@ struct Table final : MotionLaw::Impl {
         return nullptr;
     Spline::ControlPointVectorType rc(ctrls.rows(), ctrls.cols());
     for (Eigen::Index k = 0; k < ctrls.cols(); ++k)
-      rc(0, k) = central_difference(o[0]->spline.ctrls()(0, k), o[1]->spline.ctrls()(0, k),
-                                    o[2]->spline.ctrls()(0, k), o[3]->spline.ctrls()(0, k), h);
+      rc(0, k) = central_difference(o[0]->spline.ctrls()(0, k), o[1]->spline.ctrls()(0, k), o[2]->spline.ctrls()(0, k),
+                                    o[3]->spline.ctrls()(0, k), h);
     auto r = std::make_shared<Table>();
     r->t0 = t0;
     r->t1 = t1;
@@ -214,8 +212,8 @@ struct Expression final : MotionLaw::Impl {
                                               double h) const override {
     const auto c = copies_as<Expression>(along);
     std::shared_ptr<const CompiledExpression> r;
-    if (!all_of_kind(c) || !detail::expression_rate(*f, {c[0]->f.get(), c[1]->f.get(), c[2]->f.get(), c[3]->f.get()},
-                                                    h, r))
+    if (!all_of_kind(c) ||
+        !detail::expression_rate(*f, {c[0]->f.get(), c[1]->f.get(), c[2]->f.get(), c[3]->f.get()}, h, r))
       return nullptr;
     if (!r) {
       auto zero = std::make_shared<Polynomial>();
@@ -271,8 +269,8 @@ MotionLaw MotionLaw::harmonic(double offset, double amplitude, double frequency,
 
 MotionLaw MotionLaw::table(std::vector<double> t, std::vector<double> values) {
   if (t.size() != values.size())
-    throw Error("motion law: table has " + std::to_string(t.size()) + " times but " +
-                std::to_string(values.size()) + " values");
+    throw Error("motion law: table has " + std::to_string(t.size()) + " times but " + std::to_string(values.size()) +
+                " values");
   if (t.size() < 2) throw Error("motion law: table needs at least 2 points");
   for (std::size_t k = 0; k < t.size(); ++k) {
     require_finite(t[k], "table time");
@@ -331,8 +329,8 @@ MotionLaw MotionLaw::rate_along(const MotionLaw& at, const std::array<const Moti
   if (!at.impl_ || !along[0]->impl_ || !along[1]->impl_ || !along[2]->impl_ || !along[3]->impl_)
     throw Error("motion law: the rate of a default-constructed law");
   MotionLaw law;
-  law.impl_ = at.impl_->rate({along[0]->impl_.get(), along[1]->impl_.get(), along[2]->impl_.get(),
-                              along[3]->impl_.get()}, h);
+  law.impl_ =
+      at.impl_->rate({along[0]->impl_.get(), along[1]->impl_.get(), along[2]->impl_.get(), along[3]->impl_.get()}, h);
   if (law.impl_) {
     law.description_ = "rate of " + at.description_;
     return law;

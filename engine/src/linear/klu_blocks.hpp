@@ -35,9 +35,7 @@ struct Klu<int> {
     return klu_refactor(ap, ai, ax, s, f, c) != 0;
   }
   static bool solve(Symbolic* s, Numeric* f, int n, double* b, Common* c) { return klu_solve(s, f, n, 1, b, c) != 0; }
-  static bool tsolve(Symbolic* s, Numeric* f, int n, double* b, Common* c) {
-    return klu_tsolve(s, f, n, 1, b, c) != 0;
-  }
+  static bool tsolve(Symbolic* s, Numeric* f, int n, double* b, Common* c) { return klu_tsolve(s, f, n, 1, b, c) != 0; }
   static void free_numeric(Numeric** f, Common* c) { klu_free_numeric(f, c); }
 };
 
@@ -56,9 +54,7 @@ struct Klu<SuiteSparse_long> {
   static bool refactor(Int* ap, Int* ai, double* ax, Symbolic* s, Numeric* f, Common* c) {
     return klu_l_refactor(ap, ai, ax, s, f, c) != 0;
   }
-  static bool solve(Symbolic* s, Numeric* f, Int n, double* b, Common* c) {
-    return klu_l_solve(s, f, n, 1, b, c) != 0;
-  }
+  static bool solve(Symbolic* s, Numeric* f, Int n, double* b, Common* c) { return klu_l_solve(s, f, n, 1, b, c) != 0; }
   static bool tsolve(Symbolic* s, Numeric* f, Int n, double* b, Common* c) {
     return klu_l_tsolve(s, f, n, 1, b, c) != 0;
   }
@@ -73,7 +69,8 @@ int permutation_sign(const Int* p, Index n) {
   for (Index i = 0; i < n; ++i) {
     if (seen[static_cast<std::size_t>(i)]) continue;
     Index len = 0;
-    for (Index j = i; !seen[static_cast<std::size_t>(j)]; j = static_cast<Index>(p[j])) seen[static_cast<std::size_t>(j)] = 1, ++len;
+    for (Index j = i; !seen[static_cast<std::size_t>(j)]; j = static_cast<Index>(p[j]))
+      seen[static_cast<std::size_t>(j)] = 1, ++len;
     if (len % 2 == 0) sign = -sign;
   }
   return sign;
@@ -118,7 +115,8 @@ template <class Int>
 double mean_jump(const std::vector<Int>& p) {
   if (p.size() < 2) return 0.0;
   double sum = 0.0;
-  for (std::size_t k = 1; k < p.size(); ++k) sum += static_cast<double>(std::llabs(static_cast<long long>(p[k]) - p[k - 1]));
+  for (std::size_t k = 1; k < p.size(); ++k)
+    sum += static_cast<double>(std::llabs(static_cast<long long>(p[k]) - p[k - 1]));
   return sum / static_cast<double>(p.size() - 1);
 }
 
@@ -157,7 +155,8 @@ KluAnalysis resequence_blocks(const Int* ap, const Int* ai, typename Klu<Int>::S
         for (Int p = ap[Q[k]]; p < ap[Q[k] + 1]; ++p)
           if (const Int rb = block_of_row[static_cast<std::size_t>(ai[p])]; rb != b) f(rb, b);
   };
-  each_tie([&](Int from, Int to) { ++first[static_cast<std::size_t>(from) + 1], ++indegree[static_cast<std::size_t>(to)]; });
+  each_tie(
+      [&](Int from, Int to) { ++first[static_cast<std::size_t>(from) + 1], ++indegree[static_cast<std::size_t>(to)]; });
   for (Int b = 0; b < nb; ++b) {
     first[static_cast<std::size_t>(b) + 1] += first[static_cast<std::size_t>(b)];
     for (Int k = R[b]; k < R[b + 1]; ++k) {
@@ -168,7 +167,8 @@ KluAnalysis resequence_blocks(const Int* ap, const Int* ai, typename Klu<Int>::S
   std::vector<Int> successors(static_cast<std::size_t>(first[static_cast<std::size_t>(nb)]));
   {
     std::vector<Int> next(first.begin(), first.end() - 1);
-    each_tie([&](Int from, Int to) { successors[static_cast<std::size_t>(next[static_cast<std::size_t>(from)]++)] = to; });
+    each_tie(
+        [&](Int from, Int to) { successors[static_cast<std::size_t>(next[static_cast<std::size_t>(from)]++)] = to; });
   }
   // Kahn's algorithm by a priority: the blocks in the order taken.
   auto order_by = [&](const std::vector<Int>& key, bool ascending) {
@@ -176,7 +176,9 @@ KluAnalysis resequence_blocks(const Int* ap, const Int* ai, typename Klu<Int>::S
     order.reserve(static_cast<std::size_t>(nb));
     using Item = std::pair<Int, Int>;  // (±key, block)
     std::priority_queue<Item, std::vector<Item>, std::greater<Item>> ready;
-    auto push = [&](Int b) { ready.push({ascending ? key[static_cast<std::size_t>(b)] : -key[static_cast<std::size_t>(b)], b}); };
+    auto push = [&](Int b) {
+      ready.push({ascending ? key[static_cast<std::size_t>(b)] : -key[static_cast<std::size_t>(b)], b});
+    };
     for (Int b = 0; b < nb; ++b)
       if (left[static_cast<std::size_t>(b)] == 0) push(b);
     while (!ready.empty()) {
@@ -184,7 +186,8 @@ KluAnalysis resequence_blocks(const Int* ap, const Int* ai, typename Klu<Int>::S
       ready.pop();
       order.push_back(b);
       for (Int e = first[static_cast<std::size_t>(b)]; e < first[static_cast<std::size_t>(b) + 1]; ++e)
-        if (--left[static_cast<std::size_t>(successors[static_cast<std::size_t>(e)])] == 0) push(successors[static_cast<std::size_t>(e)]);
+        if (--left[static_cast<std::size_t>(successors[static_cast<std::size_t>(e)])] == 0)
+          push(successors[static_cast<std::size_t>(e)]);
     }
     return order;  // all nb blocks: the ties of a block triangular form have no cycle
   };

@@ -87,7 +87,7 @@ class KluNumeric final : public SparseLuNumeric {
   // Per block: the parity of the pivot order's rows and the fixed columns (block_parities of Pnum and Q, xor-ed),
   // of the last pivoting factorisation; empty for a single block (block_signs() is then 0).
   std::vector<unsigned char> block_parity_;
-  std::uint64_t block_signs_ = 0;  // block_signs() of the last factorisation (scan_diagonal)
+  std::uint64_t block_signs_ = 0;        // block_signs() of the last factorisation (scan_diagonal)
   unsigned negative_parity_offset_ = 0;  // xor of block_parity_: taken out of the blocks' product again for u_sign_
   // The reciprocals of the row scale factors of the last pivoting factorisation, in pivot order (KLU's Rs, the
   // largest |entry| of each row); empty while the factors are of the scaled matrix (right after pivoting), used
@@ -186,12 +186,12 @@ class KluSymbolic final : public KluSymbolicBase, public std::enable_shared_from
   double estimated_entries() const { return symbolic_->lnz + symbolic_->unz + static_cast<double>(symbolic_->nzoff); }
 
   std::shared_ptr<const CscPattern> pattern_;
-  std::vector<int> ap32_, ai32_;        // the pattern with 32-bit indices (Int = int only)
-  Int* ap_ = nullptr;                   // the pattern as KLU reads it
+  std::vector<int> ap32_, ai32_;  // the pattern with 32-bit indices (Int = int only)
+  Int* ap_ = nullptr;             // the pattern as KLU reads it
   Int* ai_ = nullptr;
   typename Api::Symbolic* symbolic_ = nullptr;  // read-only after construction: shared by all numeric objects
-  int q_sign_ = 1;                      // parity of the fixed column permutation Q
-  std::vector<unsigned char> q_block_parity_;  // block_parities of Q (empty for a single block)
+  int q_sign_ = 1;                              // parity of the fixed column permutation Q
+  std::vector<unsigned char> q_block_parity_;   // block_parities of Q (empty for a single block)
 };
 
 // P R⁻¹ A Q = L U with L unit lower triangular and R > 0 (KLU's row scaling): sign det A = sign P · sign Q ·
@@ -339,11 +339,12 @@ FactorStatus KluNumeric<Int>::factor_with_pivoting(const double* values) {
 template <class Int>
 FactorStatus KluNumeric<Int>::factorize(const double* values) {
   if (numeric_ && !forget_pivots_) {
-    keep_row_scale();  // first refactorisation after a pivot search: keep KLU's scales
+    keep_row_scale();    // first refactorisation after a pivot search: keep KLU's scales
     common_.scale = -1;  // KLU frees its Rs: the factors and the solves are of the unscaled matrix
-    const bool ok = !inverse_row_scale_.empty() &&
-                    Api::refactor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, numeric_, &common_) &&
-                    common_.status == KLU_OK;
+    const bool ok =
+        !inverse_row_scale_.empty() &&
+        Api::refactor(sym_.ap_, sym_.ai_, const_cast<double*>(values), sym_.symbolic_, numeric_, &common_) &&
+        common_.status == KLU_OK;
     if (ok) {
       const double rc = scan_diagonal();
       if (rc >= kDegradation * rcond_at_pivoting_ && !(rc < kCheckedBelow && rc < 0.1 * rcond_at_pivoting_)) {

@@ -18,11 +18,11 @@ std::shared_ptr<const SparseLuSymbolic> analyse_klu(std::shared_ptr<const CscPat
 
 /// What analyse_klu chose, for tests and diagnostics.
 struct KluAnalysis {
-  int index_bits = 0;         ///< 32 or 64
-  Index blocks = 0;           ///< diagonal blocks of the block triangular form
-  bool resequenced = false;   ///< the blocks follow the pattern's order instead of KLU's
-  double klu_jump = 0.0;      ///< mean distance between consecutive columns in KLU's own order
-  double jump = 0.0;          ///< the same in the order used
+  int index_bits = 0;        ///< 32 or 64
+  Index blocks = 0;          ///< diagonal blocks of the block triangular form
+  bool resequenced = false;  ///< the blocks follow the pattern's order instead of KLU's
+  double klu_jump = 0.0;     ///< mean distance between consecutive columns in KLU's own order
+  double jump = 0.0;         ///< the same in the order used
   /// The column order BTF's maximum transversal searched (klu_lu.cpp, KluSymbolic::analyze_bounded): 0 the
   /// pattern's, within its bound; 1 reversed, the pattern's having exceeded it; 2 the pattern's without a bound,
   /// both having exceeded it.

@@ -13,18 +13,24 @@ namespace phiq {
 
 const char* to_string(FactorStatus s) {
   switch (s) {
-    case FactorStatus::kOk: return "ok";
-    case FactorStatus::kSingular: return "singular";
-    case FactorStatus::kFailed: return "failed";
+    case FactorStatus::kOk:
+      return "ok";
+    case FactorStatus::kSingular:
+      return "singular";
+    case FactorStatus::kFailed:
+      return "failed";
   }
   return "?";
 }
 
 const char* to_string(LinearSolverKind k) {
   switch (k) {
-    case LinearSolverKind::kUmfpack: return "umfpack";
-    case LinearSolverKind::kKlu: return "klu";
-    case LinearSolverKind::kDense: return "dense";
+    case LinearSolverKind::kUmfpack:
+      return "umfpack";
+    case LinearSolverKind::kKlu:
+      return "klu";
+    case LinearSolverKind::kDense:
+      return "dense";
   }
   return "?";
 }
@@ -33,14 +39,22 @@ namespace {
 
 std::string umfpack_status_text(int status) {
   switch (status) {
-    case UMFPACK_OK: return "ok";
-    case UMFPACK_WARNING_singular_matrix: return "singular matrix";
-    case UMFPACK_ERROR_out_of_memory: return "out of memory";
-    case UMFPACK_ERROR_invalid_matrix: return "invalid matrix";
-    case UMFPACK_ERROR_different_pattern: return "pattern changed since the symbolic analysis";
-    case UMFPACK_ERROR_invalid_Symbolic_object: return "invalid symbolic object";
-    case UMFPACK_ERROR_invalid_Numeric_object: return "invalid numeric object";
-    default: return "sparse LU (UMFPACK) failed (an error it does not name)";
+    case UMFPACK_OK:
+      return "ok";
+    case UMFPACK_WARNING_singular_matrix:
+      return "singular matrix";
+    case UMFPACK_ERROR_out_of_memory:
+      return "out of memory";
+    case UMFPACK_ERROR_invalid_matrix:
+      return "invalid matrix";
+    case UMFPACK_ERROR_different_pattern:
+      return "pattern changed since the symbolic analysis";
+    case UMFPACK_ERROR_invalid_Symbolic_object:
+      return "invalid symbolic object";
+    case UMFPACK_ERROR_invalid_Numeric_object:
+      return "invalid numeric object";
+    default:
+      return "sparse LU (UMFPACK) failed (an error it does not name)";
   }
 }
 
@@ -101,8 +115,8 @@ class UmfpackSymbolic final : public SparseLuSymbolic, public std::enable_shared
     double info[UMFPACK_INFO];
     // Pattern-only analysis (Ax = NULL): the column pre-ordering depends on the pattern, which is fixed per model;
     // the numeric factorisation still pivots on the values of every iteration.
-    int status = umfpack_dl_symbolic(p.rows, p.cols, p.col_ptr.data(), p.row_idx.data(), nullptr, &symbolic_,
-                                     control_, info);
+    int status =
+        umfpack_dl_symbolic(p.rows, p.cols, p.col_ptr.data(), p.row_idx.data(), nullptr, &symbolic_, control_, info);
     if (status != UMFPACK_OK)
       throw Error("sparse LU (UMFPACK): " +
                   detail::unusable_pattern(p, "cannot be analysed", status == UMFPACK_ERROR_out_of_memory));
@@ -116,7 +130,7 @@ class UmfpackSymbolic final : public SparseLuSymbolic, public std::enable_shared
   }
 
   std::shared_ptr<const CscPattern> pattern_;  // shared with the Model
-  void* symbolic_ = nullptr;   // read-only after construction: shared by all numeric objects
+  void* symbolic_ = nullptr;                   // read-only after construction: shared by all numeric objects
   double control_[UMFPACK_CONTROL];
 };
 
@@ -131,8 +145,8 @@ FactorStatus UmfpackNumeric::factorize(const double* values) {
   values_ = values;
   ++factorizations_;
   const CscPattern& p = *sym_.pattern_;
-  int status = umfpack_dl_numeric(p.col_ptr.data(), p.row_idx.data(), values, sym_.symbolic_, &numeric_, control_,
-                                  info_);
+  int status =
+      umfpack_dl_numeric(p.col_ptr.data(), p.row_idx.data(), values, sym_.symbolic_, &numeric_, control_, info_);
   rcond_ = info_[UMFPACK_RCOND];
   if (status == UMFPACK_OK) {
     message_.clear();
@@ -150,8 +164,8 @@ bool UmfpackNumeric::solve_system(int sys, const double* b, double* x) {
     return false;
   }
   const CscPattern& p = *sym_.pattern_;
-  int status = umfpack_dl_wsolve(sys, p.col_ptr.data(), p.row_idx.data(), values_, x, b, numeric_, control_,
-                                 info_, wi_.data(), w_.data());
+  int status = umfpack_dl_wsolve(sys, p.col_ptr.data(), p.row_idx.data(), values_, x, b, numeric_, control_, info_,
+                                 wi_.data(), w_.data());
   if (status != UMFPACK_OK) {
     message_ = umfpack_status_text(status);
     return false;
@@ -228,9 +242,12 @@ std::shared_ptr<const SparseLuSymbolic> analyse(LinearSolverKind kind, std::shar
     throw Error("sparse LU needs a square matrix, got " + std::to_string(pattern->rows) + " x " +
                 std::to_string(pattern->cols));
   switch (kind) {
-    case LinearSolverKind::kUmfpack: return std::make_shared<UmfpackSymbolic>(pattern);
-    case LinearSolverKind::kKlu: return detail::analyse_klu(std::move(pattern));
-    case LinearSolverKind::kDense: return std::make_shared<DenseSymbolic>(pattern);
+    case LinearSolverKind::kUmfpack:
+      return std::make_shared<UmfpackSymbolic>(pattern);
+    case LinearSolverKind::kKlu:
+      return detail::analyse_klu(std::move(pattern));
+    case LinearSolverKind::kDense:
+      return std::make_shared<DenseSymbolic>(pattern);
   }
   throw Error("unknown linear solver kind");
 }

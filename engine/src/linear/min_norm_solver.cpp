@@ -14,7 +14,7 @@ struct MinNormSolver::Impl {
   detail::CholmodCommon common;
   cholmod_common& cc = common.cc;
   cholmod_factor* L = nullptr;
-  cholmod_sparse A;  // a view of the pattern and the caller's values
+  cholmod_sparse A;       // a view of the pattern and the caller's values
   std::vector<double> y;  // solve scratch for min_norm(): no allocation per iteration
   // cholmod_l_solve2's solution and workspace, kept from one solve to the next (allocated once)
   cholmod_dense *X = nullptr, *Y = nullptr, *E = nullptr;
@@ -69,8 +69,9 @@ bool MinNormSolver::solve(const double* b, double* y) {
   B.dtype = CHOLMOD_DOUBLE;
   Impl& im = *impl_;
   if (!cholmod_l_solve2(CHOLMOD_A, im.L, &B, nullptr, &im.X, nullptr, &im.Y, &im.E, &im.cc)) {
-    message_ = std::string("minimum-norm solver (CHOLMOD): ") +
-               (im.cc.status == CHOLMOD_OUT_OF_MEMORY ? "out of memory in the solve" : "the solve with the factors failed");
+    message_ =
+        std::string("minimum-norm solver (CHOLMOD): ") +
+        (im.cc.status == CHOLMOD_OUT_OF_MEMORY ? "out of memory in the solve" : "the solve with the factors failed");
     return false;
   }
   std::copy_n(static_cast<const double*>(im.X->x), r, y);

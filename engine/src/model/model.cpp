@@ -16,9 +16,12 @@ namespace phiq {
 
 const char* to_string(Unit u) {
   switch (u) {
-    case Unit::kNone: return "none";
-    case Unit::kLength: return "length";
-    case Unit::kAngle: return "angle";
+    case Unit::kNone:
+      return "none";
+    case Unit::kLength:
+      return "length";
+    case Unit::kAngle:
+      return "angle";
   }
   return "?";
 }
@@ -66,9 +69,7 @@ Index Model::coordinate_index(const std::string& name) const {
 
 Index Model::find_coordinate(std::string_view name) const { return index_of_.find(name, coordinate_name_of()); }
 
-Index Model::find_constraint(std::string_view name) const {
-  return constraint_index_.find(name, constraint_name_of());
-}
+Index Model::find_constraint(std::string_view name) const { return constraint_index_.find(name, constraint_name_of()); }
 
 Index Model::constraint_index(std::string_view name) const {
   const Index k = find_constraint(name);
@@ -150,7 +151,8 @@ void for_each_range(const Blocks& blocks, F&& f) {
 }  // namespace
 
 void Model::residual(const double* q, double t, double* phi) const {
-  for_each_range(blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) { b.residual(i0, i1, q, t, phi); });
+  for_each_range(blocks_,
+                 [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) { b.residual(i0, i1, q, t, phi); });
 }
 
 bool Model::prepare_jacobian_values(double* csc_values) const {
@@ -177,11 +179,13 @@ void Model::residual_and_jacobian(const double* q, double t, double* phi, double
 
 void Model::phi_t(const double* q, double t, double* out) const {
   std::fill(out, out + num_equations(), 0.0);
-  for_each_range(time_blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) { b.phi_t(i0, i1, q, t, out); });
+  for_each_range(time_blocks_,
+                 [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) { b.phi_t(i0, i1, q, t, out); });
 }
 
 void Model::gamma(const double* q, const double* qd, double t, double* out) const {
-  for_each_range(blocks_, [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) { b.gamma(i0, i1, q, qd, t, out); });
+  for_each_range(blocks_,
+                 [&](const ConstraintBlock& b, std::size_t i0, std::size_t i1) { b.gamma(i0, i1, q, qd, t, out); });
 }
 
 double Model::row_rounding_floor(Index row, const double* q, double t) const {
@@ -191,8 +195,10 @@ double Model::row_rounding_floor(Index row, const double* q, double t) const {
     std::size_t lo = 0, hi = b->size();  // the first constraint starting after `row` is in [lo, hi]
     while (lo < hi) {
       const std::size_t mid = lo + (hi - lo) / 2;
-      if (b->first_row(mid) <= row) lo = mid + 1;
-      else hi = mid;
+      if (b->first_row(mid) <= row)
+        lo = mid + 1;
+      else
+        hi = mid;
     }
     if (lo == 0) continue;
     const Index first = b->first_row(lo - 1);
@@ -314,8 +320,7 @@ void ModelBuilder::check_slot(const Slot& s, const std::string& name) const {
   if (s.is_coordinate() && s.coord() >= num_coordinates())
     throw Error("constraint '" + name + "': coordinate index " + std::to_string(s.coord()) + " out of range (" +
                 std::to_string(num_coordinates()) + " coordinates)");
-  if (!s.is_coordinate() && !std::isfinite(s.value()))
-    throw Error("constraint '" + name + "': constant is not finite");
+  if (!s.is_coordinate() && !std::isfinite(s.value())) throw Error("constraint '" + name + "': constant is not finite");
 }
 
 Index ModelBuilder::add_info(const std::string& name, const char* kind, int rows, bool depends_on_time) {
@@ -327,7 +332,6 @@ Index ModelBuilder::add_info(const std::string& name, const char* kind, int rows
   for (int r = 0; r < rows; ++r) model_.row_constraint_.push_back(id);
   return id;
 }
-
 
 void ModelBuilder::count_joint(const JointCount& c) {
   if (c.role == JointCount::Role::kOther) non_joint_ = true;
@@ -344,7 +348,9 @@ void ModelBuilder::check_body(const std::string& name, std::initializer_list<Slo
       throw Error("body '" + name + "': coordinate index out of range");
     if (!s.is_coordinate() && !std::isfinite(s.value())) throw Error("body '" + name + "': constant is not finite");
   }
-  const auto name_of = [this](Index k) -> const std::string& { return model_.body_names_[static_cast<std::size_t>(k)]; };
+  const auto name_of = [this](Index k) -> const std::string& {
+    return model_.body_names_[static_cast<std::size_t>(k)];
+  };
   if (!body_names_.insert(name, static_cast<Index>(model_.body_names_.size()), name_of))
     throw Error("duplicate body name '" + name + "'");
 }
@@ -366,7 +372,8 @@ Index ModelBuilder::add_body(const std::string& name, const Frame3& f) {
     norm2 += v * v;
   }
   if (!(norm2 > 0.0))
-    throw Error("body '" + name + "': its Euler parameters are all 0 in the placement, which is no orientation "
+    throw Error("body '" + name +
+                "': its Euler parameters are all 0 in the placement, which is no orientation "
                 "(1, 0, 0, 0 is the body unturned)");
   if (f.e0.is_coordinate() || f.e1.is_coordinate() || f.e2.is_coordinate() || f.e3.is_coordinate())
     add(name + ".euler", EulerParametersSpec{{f.e0, f.e1, f.e2, f.e3}});
@@ -391,8 +398,7 @@ void ModelBuilder::tolerance_scales(const CscPattern& pattern, const std::vector
   const auto length_coordinate = [&](Index j) {
     return m.coordinate_units_[static_cast<std::size_t>(j)] == Unit::kLength;
   };
-  if (n >= INT32_MAX)
-    throw Error("the model has " + std::to_string(n) + " coordinates; phiq handles fewer than 2^31");
+  if (n >= INT32_MAX) throw Error("the model has " + std::to_string(n) + " coordinates; phiq handles fewer than 2^31");
 
   // The pattern by rows, as Φqᵀ's: the columns of row i are cols[begin[i] … begin[i + 1] − 1].
   const CscPattern by_rows = transpose_pattern(pattern, nullptr);
@@ -448,7 +454,7 @@ void ModelBuilder::tolerance_scales(const CscPattern& pattern, const std::vector
 Model ModelBuilder::build() && {
   Model& m = model_;
   const Index n = m.num_coordinates(), rows = m.num_equations();
-  m.initial_.conservativeResize(n);  // add_coordinate() and reserve() leave room beyond n
+  m.initial_.conservativeResize(n);                    // add_coordinate() and reserve() leave room beyond n
   m.constraint_index_ = std::move(constraint_names_);  // kept for Model::constraint_index()
   body_names_.clear();
 
@@ -456,7 +462,8 @@ Model ModelBuilder::build() && {
   std::vector<Index> trip_rows, trip_cols;
   for (auto& b : m.blocks_) b->build_pattern(trip_rows, trip_cols);
   if (static_cast<Index>(trip_rows.size()) >= INT32_MAX)
-    throw Error("the model's Jacobian has " + std::to_string(trip_rows.size()) + " entries; phiq handles fewer than 2^31");
+    throw Error("the model's Jacobian has " + std::to_string(trip_rows.size()) +
+                " entries; phiq handles fewer than 2^31");
   std::vector<Index> slots;
   auto pattern = std::make_shared<CscPattern>(build_csc_pattern(rows, n, trip_rows, trip_cols, &slots));
   m.slot_of_entry_.assign(slots.begin(), slots.end());

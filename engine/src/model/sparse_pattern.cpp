@@ -49,7 +49,8 @@ CscPattern transpose_pattern(const CscPattern& a, std::vector<Index>* source_ent
   t.cols = a.rows;
   t.col_ptr.assign(static_cast<std::size_t>(a.rows) + 1, 0);
   for (Index r : a.row_idx) ++t.col_ptr[static_cast<std::size_t>(r) + 1];
-  for (Index i = 0; i < a.rows; ++i) t.col_ptr[static_cast<std::size_t>(i) + 1] += t.col_ptr[static_cast<std::size_t>(i)];
+  for (Index i = 0; i < a.rows; ++i)
+    t.col_ptr[static_cast<std::size_t>(i) + 1] += t.col_ptr[static_cast<std::size_t>(i)];
   t.row_idx.assign(static_cast<std::size_t>(a.nnz()), 0);
   if (source_entry) source_entry->assign(static_cast<std::size_t>(a.nnz()), 0);
   std::vector<Index> next(t.col_ptr.begin(), t.col_ptr.end() - 1);

@@ -103,9 +103,7 @@ std::string fmt_list(const std::vector<std::string>& names) {
   return s;
 }
 
-std::string plural(std::size_t n, const char* word) {
-  return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
-}
+std::string plural(std::size_t n, const char* word) { return std::to_string(n) + " " + word + (n == 1 ? "" : "s"); }
 
 void check_tolerance(const char* name, double v) {
   if (!(v >= 0.0)) throw Error(std::string("compare_csv: ") + name + " must be >= 0, got " + shortest(v));
@@ -161,8 +159,7 @@ CsvTable parse_csv_table(const std::string& text, const std::string& path) {
       fail(lines.number(), "blank line before the last row");
     }
     const std::size_t nfields = 1 + static_cast<std::size_t>(std::count(line.begin(), line.end(), ','));
-    if (nfields != ncols)
-      fail(lines.number(), plural(nfields, "field") + ", the header has " + std::to_string(ncols));
+    if (nfields != ncols) fail(lines.number(), plural(nfields, "field") + ", the header has " + std::to_string(ncols));
     std::vector<double> row(ncols);
     std::size_t start = 0;
     for (std::size_t j = 0; j < ncols; ++j) {

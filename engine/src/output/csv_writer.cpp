@@ -56,10 +56,10 @@ void CsvFormat::set_naming(ColumnNaming naming) {
   if (naming == ColumnNaming::kIdentifiers) {
     // Python's keywords (attribute access cannot spell them) and the names numpy.genfromtxt renames
     static const std::set<std::string> reserved = {
-        "False", "None",   "True",  "and",      "as",     "assert", "async", "await",  "break",  "class",
-        "continue", "def", "del",   "elif",     "else",   "except", "finally", "for",  "from",   "global",
-        "if",    "import", "in",    "is",       "lambda", "nonlocal", "not", "or",     "pass",   "raise",
-        "return", "try",   "while", "with",     "yield",  "file",   "print"};
+        "False",    "None",   "True",  "and",  "as",     "assert",   "async",   "await", "break", "class",
+        "continue", "def",    "del",   "elif", "else",   "except",   "finally", "for",   "from",  "global",
+        "if",       "import", "in",    "is",   "lambda", "nonlocal", "not",     "or",    "pass",  "raise",
+        "return",   "try",    "while", "with", "yield",  "file",     "print"};
     std::map<std::string, std::string> first;  // identifier form -> the dotted name that has it
     for (const std::string& d : dotted_names()) {
       const std::string id = identifier_column_name(d);
@@ -315,8 +315,8 @@ void CsvFormat::append_coordinates(const StepView& s, std::string& out) const {
         [&](const tbb::blocked_range<std::size_t>& r) {
           for (std::size_t b = r.begin(); b < r.end(); ++b) {
             char* w = base + b * stride;
-            length[b] = static_cast<std::size_t>(
-                format(b * kValuesPerTask, std::min(total, (b + 1) * kValuesPerTask), w) - w);
+            length[b] =
+                static_cast<std::size_t>(format(b * kValuesPerTask, std::min(total, (b + 1) * kValuesPerTask), w) - w);
           }
         },
         tbb::simple_partitioner());

@@ -78,8 +78,7 @@ void write_attribute(hid_t object, const char* name, const std::vector<std::stri
 void write_attribute(hid_t object, const char* name, long long value) {
   const std::string what = std::string("attribute '") + name + "'";
   const Hid space = checked(H5Screate(H5S_SCALAR), H5Sclose, what);
-  const Hid a =
-      checked(H5Acreate2(object, name, H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
+  const Hid a = checked(H5Acreate2(object, name, H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose, what);
   check(H5Awrite(a.get(), H5T_NATIVE_LLONG, &value), what);
 }
 

@@ -119,8 +119,8 @@ Hdf5Provenance read_hdf5_provenance(const std::string& path) {
     const std::vector<std::string> names = detail::h5::read_strings_attribute(file.get(), "parameter_names", path);
     const std::vector<double> values = detail::h5::read_doubles_attribute(file.get(), "parameter_values", path);
     if (names.size() != values.size())
-      throw Error(path + ": " + std::to_string(names.size()) + " parameter names but " +
-                  std::to_string(values.size()) + " values");
+      throw Error(path + ": " + std::to_string(names.size()) + " parameter names but " + std::to_string(values.size()) +
+                  " values");
     for (std::size_t k = 0; k < names.size(); ++k) p.parameters.emplace_back(names[k], values[k]);
   }
   return p;
@@ -153,8 +153,7 @@ CsvTable read_hdf5_table(const std::string& path) {
     for (const std::string& c : b.columns) {
       if (c.empty())
         throw Error(path + ": empty column name (column " + std::to_string(table.columns.size() + 1) + ")");
-      if (!seen.emplace(c, table.columns.size() + 1).second)
-        throw Error(path + ": duplicate column name '" + c + "'");
+      if (!seen.emplace(c, table.columns.size() + 1).second) throw Error(path + ": duplicate column name '" + c + "'");
       table.columns.push_back(c);
     }
   const std::size_t rows = static_cast<std::size_t>(blocks.front().rows);

@@ -79,8 +79,8 @@ struct Hdf5Writer::Impl {
   const OutputPlan& plan;
   CsvFormat format;
   Hid file;
-  std::vector<Group> groups;  // in CSV column order
-  Group *batch_case = nullptr;  // /case (Hdf5Options::case_column)
+  std::vector<Group> groups;    // in CSV column order
+  Group* batch_case = nullptr;  // /case (Hdf5Options::case_column)
   Group *t = nullptr, *q = nullptr, *qd = nullptr, *qdd = nullptr;
   std::vector<Group*> outputs;  // points, drivers, residuals, rcond: the CsvFormat::append_output_values() slices
   std::vector<double> output_row;
@@ -115,7 +115,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     groups.push_back(std::move(g));
     return &groups.back();
   };
-  groups.reserve(12);  // pointers into it are kept
+  groups.reserve(12);   // pointers into it are kept
   if (o.case_column) {  // first, as the batch CSV's `case` column
     groups.push_back(Group{"case", {"case"}, {""}, true, {}, {}});
     batch_case = &groups.back();
@@ -158,10 +158,8 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   auto none = [](std::size_t) { return std::string(); };
   for (Group* g : {take("points", point_units.size(), [&](std::size_t k) { return point_units[k]; }),
                    take("joints", joint_units.size(), [&](std::size_t k) { return joint_units[k]; }),
-                   take("orientations", orientation_units.size(),
-                        [&](std::size_t k) { return orientation_units[k]; }),
-                   take("drivers", plan.driver_columns.size() * per_driver, none),
-                   take("residuals", residuals, none)})
+                   take("orientations", orientation_units.size(), [&](std::size_t k) { return orientation_units[k]; }),
+                   take("drivers", plan.driver_columns.size() * per_driver, none), take("residuals", residuals, none)})
     if (g) outputs.push_back(g);
   if (plan.condition) {
     outputs.push_back(take("rcond", 1, none));
@@ -181,8 +179,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   output_row.resize(format.num_output_values());
 
   block_rows = choose_block_rows((names.size() + o.case_column) * sizeof(double), o);
-  if (o.deflate < 0 || o.deflate > 9)
-    throw Error(cannot("deflate level " + std::to_string(o.deflate) + " is not 0–9"));
+  if (o.deflate < 0 || o.deflate > 9) throw Error(cannot("deflate level " + std::to_string(o.deflate) + " is not 0–9"));
   if (o.deflate > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) <= 0) throw Error(cannot("HDF5 has no deflate filter"));
 
   const Hid fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, cannot("file access list"));
@@ -197,8 +194,8 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   // the same bytes, which regression suites compare.
   const Hid fcpl = checked(H5Pcreate(H5P_FILE_CREATE), H5Pclose, cannot("file creation list"));
   check(H5Pset_obj_track_times(fcpl.get(), false), cannot("file creation list"));
-  file = checked(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), H5Fclose,
-                 path + ": cannot write");
+  file =
+      checked(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()), H5Fclose, path + ": cannot write");
   const std::string attrs = cannot("attributes");
   try {
     write_attribute(file.get(), "format", std::string("phiq results"));
@@ -260,7 +257,7 @@ void Hdf5Writer::Impl::create_dataset(Group& g, const Hdf5Options& o) {
   const Hid space = checked(H5Screate_simple(rank, dims, maxdims), H5Sclose, what);
   const Hid dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, what);
   check(H5Pset_chunk(dcpl.get(), rank, chunk), what);
-  check(H5Pset_obj_track_times(dcpl.get(), false), what);  // the same bytes on every run (above)
+  check(H5Pset_obj_track_times(dcpl.get(), false), what);          // the same bytes on every run (above)
   check(H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER), what);  // every element is written: no fill to write first
   if (o.deflate > 0) {
     if (o.shuffle) check(H5Pset_shuffle(dcpl.get()), what);
@@ -291,8 +288,7 @@ void Hdf5Writer::Impl::flush() {
   held_rows = 0;
 }
 
-Hdf5Writer::Hdf5Writer(const std::string& path, const Model& model, const OutputPlan& plan,
-                       const Hdf5Options& options)
+Hdf5Writer::Hdf5Writer(const std::string& path, const Model& model, const OutputPlan& plan, const Hdf5Options& options)
     : impl_(std::make_unique<Impl>(options.shown_path.empty() ? path : options.shown_path, model, plan)) {
   const QuietErrors quiet;
   impl_->file_path = path;

@@ -25,13 +25,15 @@ std::uint64_t bits(double v) {
 }
 PointKey key_of(const OutputPoint& p) {
   switch (p.kind) {
-    case OutputPointKind::kPlanarPoint: return {0, bits(p.point.x), bits(p.point.y)};
+    case OutputPointKind::kPlanarPoint:
+      return {0, bits(p.point.x), bits(p.point.y)};
     case OutputPointKind::kPlanarBodyPoint:
       return {1, bits(p.body.x), bits(p.body.y), bits(p.body.psi), bits(p.local_x), bits(p.local_y)};
     default: {
       const Attachment3& a = p.spatial;
-      return {2, bits(a.r[0]), bits(a.r[1]), bits(a.r[2]), bits(a.p[0]), bits(a.p[1]), bits(a.p[2]), bits(a.p[3]),
-              bits(a.s.x), bits(a.s.y), bits(a.s.z)};
+      return {
+          2,           bits(a.r[0]), bits(a.r[1]), bits(a.r[2]), bits(a.p[0]), bits(a.p[1]), bits(a.p[2]), bits(a.p[3]),
+          bits(a.s.x), bits(a.s.y),  bits(a.s.z)};
     }
   }
 }

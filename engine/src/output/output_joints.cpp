@@ -58,8 +58,7 @@ OutputJoint output_joint(std::string name, JointMeasure measure, const JointSide
 }
 
 JointMotion evaluate_joint(const OutputJoint& j, const double* q, const double* qd, const double* qdd) {
-  const Motion3 m0 = motion(j.att[0], q, qd, qdd), m1 = motion(j.att[1], q, qd, qdd),
-                m2 = motion(j.att[2], q, qd, qdd);
+  const Motion3 m0 = motion(j.att[0], q, qd, qdd), m1 = motion(j.att[1], q, qd, qdd), m2 = motion(j.att[2], q, qd, qdd);
   JointMotion out;
   if (j.measure == JointMeasure::kDistance) {
     // d = z_a · (P_b − P_a)

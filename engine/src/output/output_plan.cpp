@@ -8,9 +8,12 @@ namespace phiq {
 
 const char* to_string(SensitivityForm form) {
   switch (form) {
-    case SensitivityForm::kAuto: return "auto";
-    case SensitivityForm::kDirect: return "direct";
-    case SensitivityForm::kAdjoint: return "adjoint";
+    case SensitivityForm::kAuto:
+      return "auto";
+    case SensitivityForm::kDirect:
+      return "direct";
+    case SensitivityForm::kAdjoint:
+      return "adjoint";
   }
   return "?";
 }

@@ -7,8 +7,10 @@ namespace phiq {
 
 Index OutputPoint::max_coordinate() const {
   switch (kind) {
-    case OutputPointKind::kPlanarPoint: return std::max(point.x.coord(), point.y.coord());
-    case OutputPointKind::kPlanarBodyPoint: return std::max({body.x.coord(), body.y.coord(), body.psi.coord()});
+    case OutputPointKind::kPlanarPoint:
+      return std::max(point.x.coord(), point.y.coord());
+    case OutputPointKind::kPlanarBodyPoint:
+      return std::max({body.x.coord(), body.y.coord(), body.psi.coord()});
     case OutputPointKind::kSpatialPoint:
     case OutputPointKind::kSpatialBodyPoint: {
       Index m = -1;

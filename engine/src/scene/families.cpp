@@ -35,8 +35,7 @@ void TCursor::check_fields(std::initializer_list<const char*> allowed, std::uint
     bool ok = false;
     for (const char* a : allowed) ok = ok || e.key == a;
     if (!ok)
-      fail_at(*fx_->file, e.key_mark, where,
-              "unknown field '" + e.key + "' (allowed: " + allowed_list(allowed) + ")");
+      fail_at(*fx_->file, e.key_mark, where, "unknown field '" + e.key + "' (allowed: " + allowed_list(allowed) + ")");
   }
   node_->checked_fields = sig;
 }

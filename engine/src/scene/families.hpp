@@ -36,12 +36,12 @@ struct ScalarPlan {
   bool number_ready = false;                 // number():
   bool number_constant = false;              //   the same for every member: number_value
   double number_value = 0.0;
-  std::shared_ptr<const IndexExpr> number;   //   else evaluated per member
+  std::shared_ptr<const IndexExpr> number;  //   else evaluated per member
   static constexpr Index kNotLooked = -2;
-  Index entity = kNotLooked;                 // a coordinate, point or body named without template: its index
-  Index last = -1, stride = 1;               // a templated reference: the last index found, the step before it
+  Index entity = kNotLooked;    // a coordinate, point or body named without template: its index
+  Index last = -1, stride = 1;  // a templated reference: the last index found, the step before it
   struct Equation;
-  std::shared_ptr<Equation> equation;        // equation and law expressions
+  std::shared_ptr<Equation> equation;  // equation and law expressions
 };
 
 // An equation or law expression in a family. Either the same for every member (`shared`), or compiled once with
@@ -69,8 +69,8 @@ struct TNode {
     YAML::Mark key_mark;
     bool key_scalar = true;
     std::shared_ptr<TNode> value;
-    std::shared_ptr<Family> family;                        // a nested `for` entry (map sections)
-    mutable std::shared_ptr<const NameTemplate> name;      // the key as a name, compiled on first use
+    std::shared_ptr<Family> family;                    // a nested `for` entry (map sections)
+    mutable std::shared_ptr<const NameTemplate> name;  // the key as a name, compiled on first use
   };
   Kind kind = Kind::kNull;
   bool templated = false;  // a scalar with braces
@@ -79,7 +79,7 @@ struct TNode {
   std::string text;        // scalar
   std::vector<Entry> map;
   std::vector<TNode> seq;
-  std::shared_ptr<Family> family;  // a list item that is a nested family {for ...: [...]}
+  std::shared_ptr<Family> family;             // a list item that is a nested family {for ...: [...]}
   mutable std::uintptr_t checked_fields = 0;  // expect_map() passed for this list of fields
   mutable std::shared_ptr<ScalarPlan> plan;
 };
@@ -94,10 +94,10 @@ struct FamilyRange {
 
 // One `for NAME in A..B` with its body (a map in map sections, a list in list sections).
 struct Family : FamilyRange {
-  std::string key;    // as written
-  std::string path;   // of the key, with the marks of the enclosing families
-  YAML::Mark mark;    // of the key
-  int depth = 0;      // 0 for a family in a section, 1 inside it, ...
+  std::string key;   // as written
+  std::string path;  // of the key, with the marks of the enclosing families
+  YAML::Mark mark;   // of the key
+  int depth = 0;     // 0 for a family in a section, 1 inside it, ...
   TNode body;
 };
 

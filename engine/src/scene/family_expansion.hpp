@@ -91,8 +91,10 @@ template <class Each>
 void SceneReader::expand_list(const Family& f, Each& each) {
   for_each_member(f, [&] {
     for (const TNode& item : f.body.seq) {
-      if (item.family) expand_list(*item.family, each);
-      else each(TCursor(&item, &families_));
+      if (item.family)
+        expand_list(*item.family, each);
+      else
+        each(TCursor(&item, &families_));
     }
   });
 }

@@ -52,9 +52,7 @@ std::size_t number_end(const std::string& text, std::size_t i) {
 
 }  // namespace
 
-std::string clip(const std::string& text, std::size_t n) {
-  return text.size() > n ? text.substr(0, n) + "..." : text;
-}
+std::string clip(const std::string& text, std::size_t n) { return text.size() > n ? text.substr(0, n) + "..." : text; }
 // Labels of family texts in messages, worded as the symbolic front end words its own ("expression "...": ...").
 std::string expression_label(const std::string& text) {
   std::string s = "expression \"";
@@ -173,17 +171,23 @@ class IndexParser {
   void sum() {
     product();
     for (;;) {
-      if (take('+')) product(), emit({Op::kAdd}, -1);
-      else if (take('-')) product(), emit({Op::kSub}, -1);
-      else return;
+      if (take('+'))
+        product(), emit({Op::kAdd}, -1);
+      else if (take('-'))
+        product(), emit({Op::kSub}, -1);
+      else
+        return;
     }
   }
   void product() {
     unary();
     for (;;) {
-      if (take('*')) unary(), emit({Op::kMul}, -1);
-      else if (take('/')) unary(), emit({Op::kDiv}, -1);
-      else return;
+      if (take('*'))
+        unary(), emit({Op::kMul}, -1);
+      else if (take('/'))
+        unary(), emit({Op::kDiv}, -1);
+      else
+        return;
     }
   }
   // Signs, then a power: -x^2 is -(x^2), 2^-1 is 2^(-1), a^b^c is a^(b^c).
@@ -191,8 +195,10 @@ class IndexParser {
     if (++nesting_ > kMaxNesting) fail("nested more than " + std::to_string(kMaxNesting) + " levels deep");
     bool negative = false;
     for (;;) {
-      if (take('-')) negative = !negative;
-      else if (!take('+')) break;
+      if (take('-'))
+        negative = !negative;
+      else if (!take('+'))
+        break;
     }
     primary();
     if (take('^')) unary(), emit({Op::kPow}, -1);
@@ -249,8 +255,8 @@ class IndexParser {
   }
   void call(const std::string& name) {
     static const std::map<std::string, Fn> functions = {
-        {"sin", Fn::kSin},   {"cos", Fn::kCos},   {"tan", Fn::kTan},   {"asin", Fn::kAsin}, {"acos", Fn::kAcos},
-        {"atan", Fn::kAtan}, {"exp", Fn::kExp},   {"log", Fn::kLog},   {"sqrt", Fn::kSqrt}, {"sinh", Fn::kSinh},
+        {"sin", Fn::kSin},   {"cos", Fn::kCos},   {"tan", Fn::kTan}, {"asin", Fn::kAsin}, {"acos", Fn::kAcos},
+        {"atan", Fn::kAtan}, {"exp", Fn::kExp},   {"log", Fn::kLog}, {"sqrt", Fn::kSqrt}, {"sinh", Fn::kSinh},
         {"cosh", Fn::kCosh}, {"tanh", Fn::kTanh}, {"abs", Fn::kAbs}};
     if (name == "atan2") {
       sum();
@@ -261,7 +267,8 @@ class IndexParser {
     }
     auto it = functions.find(name);
     if (it == functions.end())
-      fail("function '" + name + "' is not supported (supported: sin cos tan asin acos atan atan2 exp log sqrt "
+      fail("function '" + name +
+           "' is not supported (supported: sin cos tan asin acos atan atan2 exp log sqrt "
            "sinh cosh tanh abs)");
     sum();
     if (!take(')')) fail("missing ')' (" + name + " takes one argument)");
@@ -277,8 +284,7 @@ class IndexParser {
   int depth_ = 0, nesting_ = 0;
 };
 
-IndexExpr::IndexExpr(const std::string& text, const std::string& label, const Meanings& meaning,
-                     bool allow_templates)
+IndexExpr::IndexExpr(const std::string& text, const std::string& label, const Meanings& meaning, bool allow_templates)
     : label_(label) {
   IndexParser(*this, text, meaning, allow_templates).parse();
 }
@@ -293,8 +299,12 @@ double IndexExpr::run(const Env& env) const {
   std::string name;
   for (const Instr& in : code_) {
     switch (in.op) {
-      case Op::kConst: s[n++] = in.imm; break;
-      case Op::kIndex: s[n++] = env.index[in.a]; break;
+      case Op::kConst:
+        s[n++] = in.imm;
+        break;
+      case Op::kIndex:
+        s[n++] = env.index[in.a];
+        break;
       case Op::kName: {
         const NameTemplate& t = *templates_[in.a];
         t.render(env, name);
@@ -303,29 +313,69 @@ double IndexExpr::run(const Env& env) const {
         s[n++] = it->second;
         break;
       }
-      case Op::kAdd: --n, s[n - 1] = s[n - 1] + s[n]; break;
-      case Op::kSub: --n, s[n - 1] = s[n - 1] - s[n]; break;
-      case Op::kMul: --n, s[n - 1] = s[n - 1] * s[n]; break;
-      case Op::kDiv: --n, s[n - 1] = s[n - 1] / s[n]; break;
-      case Op::kPow: --n, s[n - 1] = std::pow(s[n - 1], s[n]); break;
-      case Op::kAtan2: --n, s[n - 1] = std::atan2(s[n - 1], s[n]); break;
-      case Op::kNeg: s[n - 1] = -s[n - 1]; break;
+      case Op::kAdd:
+        --n, s[n - 1] = s[n - 1] + s[n];
+        break;
+      case Op::kSub:
+        --n, s[n - 1] = s[n - 1] - s[n];
+        break;
+      case Op::kMul:
+        --n, s[n - 1] = s[n - 1] * s[n];
+        break;
+      case Op::kDiv:
+        --n, s[n - 1] = s[n - 1] / s[n];
+        break;
+      case Op::kPow:
+        --n, s[n - 1] = std::pow(s[n - 1], s[n]);
+        break;
+      case Op::kAtan2:
+        --n, s[n - 1] = std::atan2(s[n - 1], s[n]);
+        break;
+      case Op::kNeg:
+        s[n - 1] = -s[n - 1];
+        break;
       case Op::kFn: {
         double& x = s[n - 1];
         switch (in.fn) {
-          case Fn::kSin: x = std::sin(x); break;
-          case Fn::kCos: x = std::cos(x); break;
-          case Fn::kTan: x = std::tan(x); break;
-          case Fn::kAsin: x = std::asin(x); break;
-          case Fn::kAcos: x = std::acos(x); break;
-          case Fn::kAtan: x = std::atan(x); break;
-          case Fn::kExp: x = std::exp(x); break;
-          case Fn::kLog: x = std::log(x); break;
-          case Fn::kSqrt: x = std::sqrt(x); break;
-          case Fn::kSinh: x = std::sinh(x); break;
-          case Fn::kCosh: x = std::cosh(x); break;
-          case Fn::kTanh: x = std::tanh(x); break;
-          case Fn::kAbs: x = std::fabs(x); break;
+          case Fn::kSin:
+            x = std::sin(x);
+            break;
+          case Fn::kCos:
+            x = std::cos(x);
+            break;
+          case Fn::kTan:
+            x = std::tan(x);
+            break;
+          case Fn::kAsin:
+            x = std::asin(x);
+            break;
+          case Fn::kAcos:
+            x = std::acos(x);
+            break;
+          case Fn::kAtan:
+            x = std::atan(x);
+            break;
+          case Fn::kExp:
+            x = std::exp(x);
+            break;
+          case Fn::kLog:
+            x = std::log(x);
+            break;
+          case Fn::kSqrt:
+            x = std::sqrt(x);
+            break;
+          case Fn::kSinh:
+            x = std::sinh(x);
+            break;
+          case Fn::kCosh:
+            x = std::cosh(x);
+            break;
+          case Fn::kTanh:
+            x = std::tanh(x);
+            break;
+          case Fn::kAbs:
+            x = std::fabs(x);
+            break;
         }
         break;
       }

@@ -137,9 +137,8 @@ class KindFields {
     const bool radii = present("radii"), teeth = present("teeth");
     if (radii == teeth) fail("", "give either 'radii: [r1, r2]' or 'teeth: [z1, z2]'");
     if (radii) return number_pair("radii");
-    return pair_of("teeth", "expected two tooth counts [z1, z2]", [&](const C& n) {
-      return static_cast<double>(n.integer(1, 1000000));
-    });
+    return pair_of("teeth", "expected two tooth counts [z1, z2]",
+                   [&](const C& n) { return static_cast<double>(n.integer(1, 1000000)); });
   }
 
   // ---- dimension 3
@@ -153,7 +152,9 @@ class KindFields {
   // One side of a spatial joint (the axis of a mixed coordinate).
   JointSide3 side3(const char* field) const { return r_.side3(c_.require(field)); }
   // The types of joint a shaft turns in (JointTraits::shaft), for messages: "revolute, cylindrical or screw".
-  static std::string shaft_types() { return joint_type_list([](const JointTraits& t) { return t.shaft; }); }
+  static std::string shaft_types() {
+    return joint_type_list([](const JointTraits& t) { return t.shaft; });
+  }
   // The sides of a named joint that turns about its axis (a shaft: JointTraits), declared above.
   std::pair<JointSide3, JointSide3> turning_joint(const char* field) const {
     return turning_joint_of(c_.require(field));
@@ -193,7 +194,8 @@ class KindFields {
       if (s == kGround) return Slot::constant(0.0);
       if (const Index k = r_.entry_at(n, s, r_.bodies_); k >= 0) return r_.bodies_[k].psi;
     } else if (s == kGround || r_.entry_at(n, s, r_.bodies3_) >= 0) {
-      n.fail("'" + s + "' is a body: in dimension 3 a transmission relates angle coordinates (define the body's "
+      n.fail("'" + s +
+             "' is a body: in dimension 3 a transmission relates angle coordinates (define the body's "
              "rotation about its axis with a rotation_angle constraint)");
     }
     const Index j = r_.builder_.find_coordinate(s);

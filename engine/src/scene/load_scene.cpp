@@ -56,8 +56,7 @@ class ShapeGuard final : public YAML::EventHandler {
   }
   void enter(const YAML::Mark& m) {
     count(m);
-    if (++depth_ > limits_.max_depth)
-      fail(m, "nested more than " + std::to_string(limits_.max_depth) + " levels deep");
+    if (++depth_ > limits_.max_depth) fail(m, "nested more than " + std::to_string(limits_.max_depth) + " levels deep");
   }
   [[noreturn]] void fail(const YAML::Mark& m, const std::string& what) const {
     throw SceneError(path_ + ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1) + ": " + what);
@@ -82,12 +81,18 @@ std::string yaml_error(const std::string& path, const YAML::Exception& e) {
 void refuse_non_utf8_encoding(const std::string& text, const std::string& path) {
   const auto starts = [&](const char* bom, std::size_t n) { return text.compare(0, n, bom, n) == 0; };
   const char* encoding = nullptr;
-  if (starts("\xff\xfe\0\0", 4)) encoding = "UTF-32 (little-endian, with a byte order mark)";
-  else if (starts("\0\0\xfe\xff", 4)) encoding = "UTF-32 (big-endian, with a byte order mark)";
-  else if (starts("\xff\xfe", 2)) encoding = "UTF-16 (little-endian, with a byte order mark)";
-  else if (starts("\xfe\xff", 2)) encoding = "UTF-16 (big-endian, with a byte order mark)";
-  else if (text.size() >= 2 && text[0] != '\0' && text[1] == '\0') encoding = "UTF-16 (little-endian)";
-  else if (text.size() >= 2 && text[0] == '\0' && text[1] != '\0') encoding = "UTF-16 (big-endian)";
+  if (starts("\xff\xfe\0\0", 4))
+    encoding = "UTF-32 (little-endian, with a byte order mark)";
+  else if (starts("\0\0\xfe\xff", 4))
+    encoding = "UTF-32 (big-endian, with a byte order mark)";
+  else if (starts("\xff\xfe", 2))
+    encoding = "UTF-16 (little-endian, with a byte order mark)";
+  else if (starts("\xfe\xff", 2))
+    encoding = "UTF-16 (big-endian, with a byte order mark)";
+  else if (text.size() >= 2 && text[0] != '\0' && text[1] == '\0')
+    encoding = "UTF-16 (little-endian)";
+  else if (text.size() >= 2 && text[0] == '\0' && text[1] != '\0')
+    encoding = "UTF-16 (big-endian)";
   if (encoding)
     throw SceneError(path + ": the scene is " + encoding + "; phiq reads UTF-8: convert it (iconv -f " +
                      (std::string(encoding).rfind("UTF-32", 0) == 0 ? "UTF-32" : "UTF-16") + " -t UTF-8)");
@@ -149,8 +154,8 @@ OutputSensitivity along(const Scene& scene, const std::string& name, double valu
     try {
       return std::shared_ptr<const Model>(std::move(read(moved).model));
     } catch (const SceneError& e) {
-      throw SceneError("with " + name + " = " + shortest(at) + " (the difference step " + shortest(s.step) +
-                       " from " + shortest(value) + ") the scene cannot be read: " + e.what());
+      throw SceneError("with " + name + " = " + shortest(at) + " (the difference step " + shortest(s.step) + " from " +
+                       shortest(value) + ") the scene cannot be read: " + e.what());
     }
   };
   // The models along p are the whole model again, and only what p reaches is read of them (complete_along()).
@@ -220,9 +225,8 @@ Scene read_tree(const YAML::Node& root, const std::string& text, const std::stri
       throw SceneError(path + ": solver.predictor: '" + to_string(p) +
                        "' needs the derivatives it extrapolates with in the output (velocities / accelerations)");
   }
-  build_sensitivity_models(scene, overrides, [&](const SceneOverrides& o) {
-    return read_tree(root, text, path, limits, o);
-  });
+  build_sensitivity_models(scene, overrides,
+                           [&](const SceneOverrides& o) { return read_tree(root, text, path, limits, o); });
   return scene;
 }
 
@@ -266,9 +270,8 @@ Scene parse_scene(const std::string& text, const std::string& path, const SceneL
 OutputSensitivity sensitivity_along(const Scene& scene, const std::string& name, double value, double step,
                                     const SceneLimits& limits, const SceneOverrides& overrides) {
   const YAML::Node root = parse_tree(scene.text, scene.path, limits);  // parsed once for the four models
-  return along(scene, name, value, step, overrides, [&](const SceneOverrides& o) {
-    return read_tree(root, scene.text, scene.path, limits, o);
-  });
+  return along(scene, name, value, step, overrides,
+               [&](const SceneOverrides& o) { return read_tree(root, scene.text, scene.path, limits, o); });
 }
 
 std::vector<OutputSensitivity> sensitivities_of(const Scene& scene, const std::vector<SensitivityRequest>& requests,
@@ -278,9 +281,8 @@ std::vector<OutputSensitivity> sensitivities_of(const Scene& scene, const std::v
   std::vector<OutputSensitivity> out = requested(scene, requests, source);
   if (out.empty()) return out;
   const YAML::Node root = parse_tree(scene.text, scene.path, limits);  // parsed once for every model along them
-  build_models_along(scene, out, as_read, source, [&](const SceneOverrides& o) {
-    return read_tree(root, scene.text, scene.path, limits, o);
-  });
+  build_models_along(scene, out, as_read, source,
+                     [&](const SceneOverrides& o) { return read_tree(root, scene.text, scene.path, limits, o); });
   return out;
 }
 

@@ -66,8 +66,9 @@ std::pair<Frame2, kin::V2> SceneReader::attachment(const C& c) const {
     return {Frame2{p.x, p.y, Slot::constant(0.0)}, kin::V2{0, 0}};
   }
   if (auto axis = c.field("axis"); axis.present())  // where a spatial joint writes it
-    axis.fail("in dimension 2 a side has no axis: a revolute turns about z, and a prismatic's sliding axis is its "
-              "own field (axis: [x, y], in the first body's frame) beside `between`");
+    axis.fail(
+        "in dimension 2 a side has no axis: a revolute turns about z, and a prismatic's sliding axis is its "
+        "own field (axis: [x, y], in the first body's frame) beside `between`");
   c.expect_map({"body", "at"});
   Frame2 f = body(c.require("body"));
   kin::V2 at{0, 0};
@@ -140,8 +141,9 @@ void SceneReader::read_constraint(const C& c) {
   const auto it = readers.find(type);
   if (it == readers.end()) {
     if (kind_readers<C>(!spatial_).count(type))
-      c.require("type").fail("'" + type + (spatial_ ? "' is a planar constraint; this scene has 'dimension: 3'"
-                                                    : "' is a spatial constraint: it needs 'dimension: 3'"));
+      c.require("type").fail("'" + type +
+                             (spatial_ ? "' is a planar constraint; this scene has 'dimension: 3'"
+                                       : "' is a spatial constraint: it needs 'dimension: 3'"));
     c.require("type").fail("unknown constraint type '" + type + "' (" + (spatial_ ? "dimension 3: " : "") +
                            constraint_types(spatial_ ? 3 : 2) + ")");
   }
@@ -193,7 +195,8 @@ kin3::V3 SceneReader::direction3(const C& c) const {
 // A side of a spatial joint: {body: B, at: [x, y, z], axis: [..], ref: [..]} or {point: P, vector: u}.
 template <class C>
 JointSide3 SceneReader::side3(const C& c) const {
-  if (!c.is_map()) c.fail("expected {body: NAME, at: [x, y, z], axis: [x, y, z], ref: [x, y, z]} or {point: NAME, vector: NAME}");
+  if (!c.is_map())
+    c.fail("expected {body: NAME, at: [x, y, z], axis: [x, y, z], ref: [x, y, z]} or {point: NAME, vector: NAME}");
   if (c.field("point").present()) {
     c.expect_map({"point", "vector"});
     std::optional<Point3> v;

@@ -33,8 +33,12 @@ void SceneReader::read_joint_driver(const C& c, const std::string& name, MotionL
            joint_type_list([](const JointTraits& t) { return t.drives.distance; }) + " one");
   if (measure == "angle") {
     const kin3::V3 ra = detail3::reference_direction(J.a), rb = detail3::reference_direction(J.b);
-    joint_angles_.push_back(JointAngleReference{name.empty() ? c.path() : name, joint, {ra.x, ra.y, ra.z},
-                                                {rb.x, rb.y, rb.z}, J.a.ref.has_value(), J.b.ref.has_value()});
+    joint_angles_.push_back(JointAngleReference{name.empty() ? c.path() : name,
+                                                joint,
+                                                {ra.x, ra.y, ra.z},
+                                                {rb.x, rb.y, rb.z},
+                                                J.a.ref.has_value(),
+                                                J.b.ref.has_value()});
     JointAngleDriverSpec d;
     d.a = J.a, d.b = J.b, d.law = std::move(law);
     add(c, name, std::move(d));

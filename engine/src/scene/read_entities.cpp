@@ -133,8 +133,9 @@ EulerParameters SceneReader::orientation(const C& o) const {
   const bool by_sequence = o.field("euler").present() || o.field("angles").present();
   const bool by_parameters = o.field("euler_parameters").present();
   if (int(by_axis) + int(by_axes) + int(by_sequence) + int(by_parameters) != 1)
-    o.fail("an orientation is one of {axis: [ux, uy, uz], angle: a}, the world directions of one or two body axes "
-           "{x: [..], z: [..]}, {euler: zyx, angles: [a, b, c]} or {euler_parameters: [e0, e1, e2, e3]}");
+    o.fail(
+        "an orientation is one of {axis: [ux, uy, uz], angle: a}, the world directions of one or two body axes "
+        "{x: [..], z: [..]}, {euler: zyx, angles: [a, b, c]} or {euler_parameters: [e0, e1, e2, e3]}");
   auto array3 = [&](const auto& c) {
     const kin3::V3 v = vec3(c);
     return std::array<double, 3>{v.x, v.y, v.z};
@@ -144,7 +145,8 @@ EulerParameters SceneReader::orientation(const C& o) const {
     if (by_sequence) {
       const auto seq = o.require("euler");
       if (!is_euler_sequence(seq.text()))
-        seq.fail("'" + seq.text() + "' is not an Euler sequence: three of x, y, z, no two neighbours equal "
+        seq.fail("'" + seq.text() +
+                 "' is not an Euler sequence: three of x, y, z, no two neighbours equal "
                  "(zyx, xyz, zxz, ...), rotations about the axes as already rotated");
       return euler_parameters_from_sequence(seq.text(), array3(o.require("angles")));
     }
@@ -204,7 +206,8 @@ void SceneReader::body_from_map(const C& value, const std::string& name, Slot* v
     try {
       v[i] = Slot::coordinate(builder_.add_coordinate(coordinate, initial[i]));
     } catch (const Error&) {
-      value.fail("its coordinate '" + coordinate + "' is already a coordinate (bodies written as maps name their "
+      value.fail("its coordinate '" + coordinate +
+                 "' is already a coordinate (bodies written as maps name their "
                  "coordinates NAME_x, NAME_y, ...)");
     }
   }

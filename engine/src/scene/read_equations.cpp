@@ -55,7 +55,7 @@ std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const T
       std::string prefix = "phiq_template_";
       while (text.find(prefix) != std::string::npos) prefix += "_";
       std::string rewritten;
-      std::map<std::string, std::string> placeholder_of;  // token -> placeholder identifier
+      std::map<std::string, std::string> placeholder_of;      // token -> placeholder identifier
       std::vector<std::pair<std::string, std::string>> back;  // placeholder identifier -> token
       std::size_t last = 0;
       for (const NameToken& t : tokens) {
@@ -86,8 +86,7 @@ std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const T
             return NameBinding{NameBinding::Kind::kCoordinate, add(n, P{P::Kind::kTemplate, -1, 0, k})};
         for (std::size_t k = fx.frames.size(); k-- > 0;)
           if (fx.frames[k].family->index == n)
-            return NameBinding{NameBinding::Kind::kCoordinate,
-                               add(n, P{P::Kind::kIndex, -1, static_cast<int>(k), 0})};
+            return NameBinding{NameBinding::Kind::kCoordinate, add(n, P{P::Kind::kIndex, -1, static_cast<int>(k), 0})};
         if (n == "t") return NameBinding{NameBinding::Kind::kTime};
         if (Index j = builder_.find_coordinate(n); j >= 0) {
           if (!allow_coordinates) throw labelled(expression_label(text), coordinate_in_law(n));
@@ -124,10 +123,14 @@ std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const T
       value[k] = fx.index[static_cast<std::size_t>(p.depth)];
     } else {
       eq.names[p.name]->render(fx.env(), name);
-      if (Index j = eq.allow_coordinates ? builder_.find_coordinate(name) : -1; j >= 0) target[k] = j;
-      else if (auto v = parameter(name)) value[k] = *v;
-      else if (builder_.find_coordinate(name) >= 0) throw labelled(expression_label(text), coordinate_in_law(name));
-      else throw labelled(expression_label(text), "unknown name '" + name + "'");
+      if (Index j = eq.allow_coordinates ? builder_.find_coordinate(name) : -1; j >= 0)
+        target[k] = j;
+      else if (auto v = parameter(name))
+        value[k] = *v;
+      else if (builder_.find_coordinate(name) >= 0)
+        throw labelled(expression_label(text), coordinate_in_law(name));
+      else
+        throw labelled(expression_label(text), "unknown name '" + name + "'");
     }
   }
   return eq.compiled->rebind(target, value, text);

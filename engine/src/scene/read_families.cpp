@@ -160,7 +160,8 @@ TNode SceneReader::copy(const YAML::Node& n, const std::string& path, const YAML
     t.templated = t.text.find_first_of("{}") != std::string::npos;
   } else if (n.IsSequence()) {
     t.kind = TNode::Kind::kSeq;
-    for (std::size_t i = 0; i < n.size(); ++i) t.seq.push_back(copy(n[i], path + "[" + std::to_string(i) + "]", n.Mark()));
+    for (std::size_t i = 0; i < n.size(); ++i)
+      t.seq.push_back(copy(n[i], path + "[" + std::to_string(i) + "]", n.Mark()));
   } else if (n.IsMap()) {
     t.kind = TNode::Kind::kMap;
     for (auto it = n.begin(); it != n.end(); ++it) {
@@ -186,11 +187,11 @@ void SceneReader::check_family_total(const Cursor& top) {
   constexpr std::uint64_t kAll = std::numeric_limits<std::uint64_t>::max();  // at least this many (saturated)
   auto add = [](std::uint64_t a, std::uint64_t b) { return b > kAll - a ? kAll : a + b; };
   std::uint64_t total = 0;
-  bool nested = false;  // bodies hold families: they make more than counted
+  bool nested = false;                                          // bodies hold families: they make more than counted
   std::vector<std::pair<std::string, std::uint64_t>> sections;  // entries by section, in order
-  std::optional<std::pair<YAML::Mark, std::string>> over;         // the family that takes the total beyond
-  auto count = [&](const std::string& section, const std::string& key, const YAML::Mark& mark,
-                   const std::string& path, std::size_t entries, bool holds_families) {
+  std::optional<std::pair<YAML::Mark, std::string>> over;       // the family that takes the total beyond
+  auto count = [&](const std::string& section, const std::string& key, const YAML::Mark& mark, const std::string& path,
+                   std::size_t entries, bool holds_families) {
     const auto [lo, hi] = range_bounds(parse_range(key, mark, path, {}), mark, path);
     if (hi < lo || entries == 0) return;
     const auto members = static_cast<std::uint64_t>(hi - lo) + 1;
@@ -208,7 +209,7 @@ void SceneReader::check_family_total(const Cursor& top) {
     for (auto it = c.node().begin(); it != c.node().end(); ++it) {
       if (!family_key(it->first)) continue;
       const YAML::Node body = it->second;  // a handle, by value: yaml-cpp's iterators give temporaries
-      if (!body.IsMap()) continue;  // parse_family says what is wrong
+      if (!body.IsMap()) continue;         // parse_family says what is wrong
       bool holds = false;
       for (auto b = body.begin(); b != body.end() && !holds; ++b) holds = family_key(b->first);
       count(section, it->first.Scalar(), it->first.Mark(), c.join(it->first.Scalar()), body.size(), holds);
@@ -228,8 +229,8 @@ void SceneReader::check_family_total(const Cursor& top) {
         if (b->IsMap())
           for (auto e = b->begin(); e != b->end() && !holds; ++e) holds = family_key(e->first);
       const std::string key = item.begin()->first.Scalar();
-      count(section, key, item.begin()->first.Mark(), c.path() + "[" + std::to_string(i) + "]." + key,
-            body.size(), holds);
+      count(section, key, item.begin()->first.Mark(), c.path() + "[" + std::to_string(i) + "]." + key, body.size(),
+            holds);
     }
   }
   if (!over) return;
@@ -237,9 +238,9 @@ void SceneReader::check_family_total(const Cursor& top) {
   for (const auto& [section, n] : sections)
     by_section += (by_section.empty() ? "" : ", ") + section + " " + std::to_string(n);
   fail_at(file_, over->first, over->second,
-          "the families would make " + std::string(nested || total == kAll ? "at least " : "") +
-              std::to_string(total) + " entries in all (" + by_section + "), more than the " +
-              std::to_string(limits_.max_family_instances) + " they may make (SceneLimits::max_family_instances)");
+          "the families would make " + std::string(nested || total == kAll ? "at least " : "") + std::to_string(total) +
+              " entries in all (" + by_section + "), more than the " + std::to_string(limits_.max_family_instances) +
+              " they may make (SceneLimits::max_family_instances)");
 }
 
 }  // namespace phiq::detail::scene

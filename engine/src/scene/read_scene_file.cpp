@@ -29,12 +29,12 @@ std::string read_scene_file(const std::string& path, const SceneLimits& limits) 
   } closer{fd};
   struct stat st;
   if (::fstat(fd, &st) != 0) throw refuse(std::string("cannot read the scene file: ") + std::strerror(errno));
-  const char* what = S_ISDIR(st.st_mode)    ? "a directory"
-                     : S_ISCHR(st.st_mode)  ? "a character device"
-                     : S_ISBLK(st.st_mode)  ? "a block device"
-                     : S_ISSOCK(st.st_mode) ? "a socket"
+  const char* what = S_ISDIR(st.st_mode)                           ? "a directory"
+                     : S_ISCHR(st.st_mode)                         ? "a character device"
+                     : S_ISBLK(st.st_mode)                         ? "a block device"
+                     : S_ISSOCK(st.st_mode)                        ? "a socket"
                      : S_ISREG(st.st_mode) || S_ISFIFO(st.st_mode) ? nullptr
-                                                                  : "not a regular file";
+                                                                   : "not a regular file";
   if (what) throw refuse(std::string("is ") + what + ", not a scene file");
   auto too_large = [&](std::uint64_t bytes, const char* more) {
     return refuse("the scene is " + std::string(more) + std::to_string(bytes >> 20) + " MiB; the limit is " +
@@ -44,7 +44,9 @@ std::string read_scene_file(const std::string& path, const SceneLimits& limits) 
     throw too_large(static_cast<std::uint64_t>(st.st_size), "");
   if (S_ISFIFO(st.st_mode)) {
     // a pipe whose writer has not come (or writes nothing) is waited for a bounded time, not for ever
-    struct pollfd p{fd, POLLIN, 0};
+    struct pollfd p {
+      fd, POLLIN, 0
+    };
     int ready;
     do ready = ::poll(&p, 1, kFifoWaitMilliseconds);
     while (ready < 0 && errno == EINTR);

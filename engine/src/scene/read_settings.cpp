@@ -116,10 +116,14 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
     if (auto ss = c.field("sensitivities"); ss.present()) output_sensitivities(ss, plan);
     if (auto f = c.field("sensitivity_form"); f.present()) {
       const std::string form = f.text();
-      if (form == "auto") plan.sensitivity_form = SensitivityForm::kAuto;
-      else if (form == "direct") plan.sensitivity_form = SensitivityForm::kDirect;
-      else if (form == "adjoint") plan.sensitivity_form = SensitivityForm::kAdjoint;
-      else f.fail("sensitivity_form is auto, direct or adjoint");
+      if (form == "auto")
+        plan.sensitivity_form = SensitivityForm::kAuto;
+      else if (form == "direct")
+        plan.sensitivity_form = SensitivityForm::kDirect;
+      else if (form == "adjoint")
+        plan.sensitivity_form = SensitivityForm::kAdjoint;
+      else
+        f.fail("sensitivity_form is auto, direct or adjoint");
     }
     if (auto v = c.field("max_residual"); v.present()) plan.max_residual_column = v.boolean();
     if (auto v = c.field("rcond"); v.present()) plan.condition = v.boolean();
@@ -138,7 +142,8 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
 // `joints: [NAME, ...]`: named spatial joints, each with what its kind measures (JointTraits): a revolute's angle, a
 // prismatic's distance, a cylindrical's or a screw's both.
 void SceneReader::output_joints(const Cursor& js, OutputPlan& plan) const {
-  if (!spatial_) js.fail("joint outputs are of spatial joints (dimension: 3); in the plane, output the angle coordinate");
+  if (!spatial_)
+    js.fail("joint outputs are of spatial joints (dimension: 3); in the plane, output the angle coordinate");
   std::set<std::string> seen;
   for (const Cursor& i : js.items()) {
     const std::string n = i.name();
@@ -170,7 +175,8 @@ void SceneReader::output_orientations(const Cursor& os, OutputPlan& plan) const 
     if (auto as = os.field("as"); as.present()) {
       const std::string f = as.text();
       if (f != "matrix" && f != "axis_angle" && !is_euler_sequence(f))
-        as.fail("'" + f + "' is not an orientation form: matrix, axis_angle, or an Euler sequence (zyx, xyz, zxz, ...)");
+        as.fail("'" + f +
+                "' is not an orientation form: matrix, axis_angle, or an Euler sequence (zyx, xyz, zxz, ...)");
       plan.orientation_form.form = f;
     }
   }
@@ -183,7 +189,8 @@ void SceneReader::output_orientations(const Cursor& os, OutputPlan& plan) const 
     if (plan.orientation_form.form == "axis_angle")
       for (const OutputJoint& j : plan.joints)
         if (j.name == n && j.measure == JointMeasure::kAngle)
-          i.fail("the columns '" + n + ".angle' of joint '" + n + "' and of this body's axis and angle would share a "
+          i.fail("the columns '" + n + ".angle' of joint '" + n +
+                 "' and of this body's axis and angle would share a "
                  "name: write the orientation in another form, or rename one");
     const Frame3& f = bodies3_[k];
     plan.orientations.push_back(OutputOrientation{n, {f.e0, f.e1, f.e2, f.e3}});
@@ -250,9 +257,12 @@ void SceneReader::read_solver(const Cursor& c, SolverSettings& o) {
   if (auto v = c.field("max_subdivisions"); v.present()) o.max_subdivisions = static_cast<int>(v.integer(0, 30));
   if (auto v = c.field("newton"); v.present()) {
     const std::string s = v.text();
-    if (s == "modified") o.newton.jacobian_update = JacobianUpdate::kWhenSlow;
-    else if (s == "full") o.newton.jacobian_update = JacobianUpdate::kEveryIteration;
-    else v.fail("newton is modified or full");
+    if (s == "modified")
+      o.newton.jacobian_update = JacobianUpdate::kWhenSlow;
+    else if (s == "full")
+      o.newton.jacobian_update = JacobianUpdate::kEveryIteration;
+    else
+      v.fail("newton is modified or full");
   }
   if (auto v = c.field("predictor"); v.present()) {
     if (!predictor_from_string(v.text(), &o.predictor)) v.fail(std::string("predictor is ") + predictor_names());
@@ -260,10 +270,14 @@ void SceneReader::read_solver(const Cursor& c, SolverSettings& o) {
   if (auto v = c.field("length_scale"); v.present()) builder_.set_length_scale(positive(v));
   if (auto v = c.field("linear_solver"); v.present()) {
     const std::string s = v.text();
-    if (s == "umfpack") builder_.set_linear_solver(LinearSolverKind::kUmfpack);
-    else if (s == "klu") builder_.set_linear_solver(LinearSolverKind::kKlu);
-    else if (s == "dense") builder_.set_linear_solver(LinearSolverKind::kDense);
-    else v.fail("linear_solver is umfpack, klu or dense");
+    if (s == "umfpack")
+      builder_.set_linear_solver(LinearSolverKind::kUmfpack);
+    else if (s == "klu")
+      builder_.set_linear_solver(LinearSolverKind::kKlu);
+    else if (s == "dense")
+      builder_.set_linear_solver(LinearSolverKind::kDense);
+    else
+      v.fail("linear_solver is umfpack, klu or dense");
   }
   predictor_field_ = c.field("predictor").present();
 }

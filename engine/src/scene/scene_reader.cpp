@@ -36,8 +36,7 @@ Scene SceneReader::read(const YAML::Node& root) {
       read_vectors(v);
     }
   } catch (const SceneError& e) {  // a name unknown for want of the section that would have named it
-    if (builder_.num_coordinates() > 0 || std::string_view(e.what()).find("unknown name '") == std::string::npos)
-      throw;
+    if (builder_.num_coordinates() > 0 || std::string_view(e.what()).find("unknown name '") == std::string::npos) throw;
     throw SceneError(std::string(e.what()) + ": the scene has no `coordinates` section (names and start values)");
   }
   if (builder_.num_coordinates() == 0)
@@ -45,8 +44,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   read_solver(top.field("solver"), scene.sweep);  // before constraints: length scale, linear solver
 
   reserve_ = [&](std::size_t more) { builder_.reserve(0, static_cast<Index>(more)); };
-  if (auto c = top.field("constraints"); c.present())
-    read_list(c, [&](const auto& item) { read_constraint(item); });
+  if (auto c = top.field("constraints"); c.present()) read_list(c, [&](const auto& item) { read_constraint(item); });
   if (auto d = top.field("drivers"); d.present()) read_list(d, [&](const auto& item) { read_driver(item); });
 
   read_time(top.require("time"), scene.sweep);

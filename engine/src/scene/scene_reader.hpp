@@ -104,8 +104,7 @@ class SceneReader {
   std::pair<std::int64_t, std::int64_t> range_bounds(const FamilyRange& r, const YAML::Mark& mark,
                                                      const std::string& path) const;
   std::shared_ptr<Family> parse_family(const std::string& key, const YAML::Mark& key_mark, const YAML::Node& body,
-                                       const std::string& path, const std::vector<std::string>& enclosing,
-                                       bool list);
+                                       const std::string& path, const std::vector<std::string>& enclosing, bool list);
   std::optional<std::string> family_item_key(const YAML::Node& item, const std::string& path) const;
   TNode copy(const YAML::Node& n, const std::string& path, const YAML::Mark& parent_mark) const;
   void check_family_total(const Cursor& top);
@@ -262,8 +261,7 @@ void SceneReader::add(const C& c, const std::string& name, Spec spec) {
   } catch (const Error&) {
     // the builder registers the name only when it adds the constraint: a name it has is a duplicate (reported
     // before anything else wrong with the constraint, as a check before adding would)
-    if (builder_.has_constraint(label))
-      c.field("name").fail("duplicate constraint or driver name '" + label + "'");
+    if (builder_.has_constraint(label)) c.field("name").fail("duplicate constraint or driver name '" + label + "'");
     throw;
   }
   // Any other equation of constants and t holds at no position (or at isolated times): said here, where its line

@@ -149,7 +149,7 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
   model.residual(q.data(), t, phi.data());
   kept_scaled(phi, b);
   double f = 0.5 * b.squaredNorm();
-  double mu = 0.0;  // Levenberg-Marquardt regularisation, only while plain Gauss-Newton fails
+  double mu = 0.0;            // Levenberg-Marquardt regularisation, only while plain Gauss-Newton fails
   Eigen::VectorXd assembled;  // the last iterate at which the kept rows held (empty if none yet)
   while (sum.iterations < opt.max_iterations) {
     if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
@@ -164,14 +164,15 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
     }
     ++sum.factorizations;
     if (fs != FactorStatus::kOk)
-      return *why = solver->last_message(), fs == FactorStatus::kFailed ? SolveStatus::kLinearSolverFailed
-                                                                        : SolveStatus::kSingularJacobian;
+      return *why = solver->last_message(),
+             fs == FactorStatus::kFailed ? SolveStatus::kLinearSolverFailed : SolveStatus::kSingularJacobian;
     ++sum.iterations;
     if (within) {
       pull = (q0 - q).cwiseQuotient(sc.coordinate_scale);
       rhs = b;
       solver->multiply_add(pull.data(), rhs.data());  // Φ̃ + Ã p
-      if (!solver->min_norm(rhs.data(), d.data())) return *why = solver->last_message(), SolveStatus::kLinearSolverFailed;
+      if (!solver->min_norm(rhs.data(), d.data()))
+        return *why = solver->last_message(), SolveStatus::kLinearSolverFailed;
       d = (pull - d).cwiseProduct(sc.coordinate_scale);
       if (!d.allFinite()) return *why = "projection step is not finite", SolveStatus::kNonFinite;
       q += d;

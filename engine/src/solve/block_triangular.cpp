@@ -80,7 +80,8 @@ SolveStatus assemble_by_blocks(const Model& model, double t, double tolerance, i
   sum.blocks = tb.count(), sum.largest = tb.largest;
   if (tb.count() < 2 || tb.largest > kLargestDenseBlock) {
     sum.status = SolveStatus::kNotSquare;
-    sum.message = tb.count() < 2 ? "Φq's pattern is one block" : "a block of Φq's pattern is too large to solve densely";
+    sum.message =
+        tb.count() < 2 ? "Φq's pattern is one block" : "a block of Φq's pattern is too large to solve densely";
     return sum.status;
   }
   const CscPattern& pattern = model.jacobian_pattern();

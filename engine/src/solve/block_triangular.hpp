@@ -37,11 +37,11 @@ bool triangular_blocks(const Model& model, TriangularBlocks* out);
 /// What assemble_by_blocks() did.
 struct BlockAssemblySummary {
   SolveStatus status = SolveStatus::kNotConverged;
-  Index blocks = 0;           ///< strongly connected blocks of Φq's pattern
-  Index largest = 0;          ///< rows in the largest
-  Index iterations = 0;       ///< Newton steps, over all blocks
-  int most_iterations = 0;    ///< the most any one block took
-  std::string message;        ///< one line on a failure (which block, why); empty on success
+  Index blocks = 0;         ///< strongly connected blocks of Φq's pattern
+  Index largest = 0;        ///< rows in the largest
+  Index iterations = 0;     ///< Newton steps, over all blocks
+  int most_iterations = 0;  ///< the most any one block took
+  std::string message;      ///< one line on a failure (which block, why); empty on success
 };
 
 /// Blocks larger than this are not solved densely: assemble_by_blocks() declines them (kNotSquare).

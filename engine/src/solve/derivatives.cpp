@@ -25,11 +25,9 @@ using detail::not_square_message;
 using detail::solve_rhs;
 
 // The first non-finite row of a right-hand side (Φt or γ, one entry per equation), or "".
-std::string non_finite_row(const Model& model, const Eigen::VectorXd& rhs, const std::string& what,
-                           const char* why) {
+std::string non_finite_row(const Model& model, const Eigen::VectorXd& rhs, const std::string& what, const char* why) {
   for (Index i = 0; i < rhs.size(); ++i)
-    if (!std::isfinite(rhs(i)))
-      return what + " of '" + model.row_name(i) + "' is not finite" + why;
+    if (!std::isfinite(rhs(i))) return what + " of '" + model.row_name(i) + "' is not finite" + why;
   return "";
 }
 
@@ -90,10 +88,9 @@ std::string position_not_solved(const Model& model, double t, double tol, Worksp
     worst = i, worst_scaled = scaled;
   }
   if (worst < 0) return "";
-  return "q does not solve the position problem at t = " + format_time(t) + ": constraint '" +
-         model.row_name(worst) + "' residual " + significant(worst_scaled, 3) + " > tolerance " +
-         significant(tol, 3) + " (|Φ| / scale; solve_position first, or pass the tolerance q was solved to in " +
-         "DerivativeOptions)";
+  return "q does not solve the position problem at t = " + format_time(t) + ": constraint '" + model.row_name(worst) +
+         "' residual " + significant(worst_scaled, 3) + " > tolerance " + significant(tol, 3) +
+         " (|Φ| / scale; solve_position first, or pass the tolerance q was solved to in " + "DerivativeOptions)";
 }
 
 // The public linear solves: q checked (DerivativeOptions::tolerance), Φq factorised at (ws.q, t) unless it is
@@ -159,8 +156,7 @@ SolveStatus derivatives_at_solution(const Model& model, double t, Workspace& ws,
     sum.rcond = ws.lu->rcond();
   } else {
     std::string msg;
-    const SolveStatus st =
-        factorize_at_q(model, t, ws, &sum.rcond, &msg, ws.has_jacobian && ws.jacobian_t == t);
+    const SolveStatus st = factorize_at_q(model, t, ws, &sum.rcond, &msg, ws.has_jacobian && ws.jacobian_t == t);
     if (st == SolveStatus::kSingularJacobian) return fail(st, "velocities are not unique here: " + msg);
     if (st != SolveStatus::kSuccess) return fail(st, msg);
     // the point is not recorded (factorized_q is another's): no (q, t) may match it, so that public solves and the

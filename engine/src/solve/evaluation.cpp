@@ -48,8 +48,8 @@ const Eigen::VectorXd& evaluate_phi_t(const Model& model, const Eigen::VectorXd&
   return ws.rhs;
 }
 
-const Eigen::VectorXd& evaluate_gamma(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd,
-                                      double t, Workspace& ws) {
+const Eigen::VectorXd& evaluate_gamma(const Model& model, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, double t,
+                                      Workspace& ws) {
   check_point(model, ws, q, "q");
   check_point(model, ws, qd, "qd");
   model.gamma(q.data(), qd.data(), t, ws.rhs.data());

@@ -25,14 +25,16 @@ void detail::check_workspace(const Model& model, const Workspace& ws) {
   if (ws.phi.size() != m || ws.rhs.size() != m || ws.trial_phi.size() != m || ws.step.size() != n ||
       ws.trial.size() != n || static_cast<Index>(ws.jacobian_values.size()) != model.jacobian_pattern().nnz() ||
       ws.solve_values.size() != model.solve_entries().size() || ws.solve_rhs.size() != solve_rows)
-    throw Error("workspace scratch has the wrong size (phi, rhs, step, trial, trial_phi, jacobian_values, "
-                "solve_values, solve_rhs keep the sizes the Workspace was made with)");
+    throw Error(
+        "workspace scratch has the wrong size (phi, rhs, step, trial, trial_phi, jacobian_values, "
+        "solve_values, solve_rhs keep the sizes the Workspace was made with)");
 }
 
 const double* detail::solve_values(const Model& model, Workspace& ws) {
   if (model.dropped_rows().empty()) return ws.jacobian_values.data();
   const std::vector<Index>& from = model.solve_entries();  // the kept rows only (Model::without_rows())
-  for (std::size_t k = 0; k < from.size(); ++k) ws.solve_values[k] = ws.jacobian_values[static_cast<std::size_t>(from[k])];
+  for (std::size_t k = 0; k < from.size(); ++k)
+    ws.solve_values[k] = ws.jacobian_values[static_cast<std::size_t>(from[k])];
   return ws.solve_values.data();
 }
 
@@ -55,7 +57,8 @@ std::string non_finite_jacobian(const Model& model, const double* values) {
         const Index r = p.row_idx[static_cast<std::size_t>(k)];
         const Index row = model.dropped_rows().empty() ? r : model.solve_rows()[static_cast<std::size_t>(r)];
         return std::string(detail::kNonFiniteJacobian) + "∂'" + model.row_name(row) + "'/∂'" +
-               model.coordinate_names()[static_cast<std::size_t>(j)] + "' = " + significant(values[k], 3) + detail::kNoDerivative;
+               model.coordinate_names()[static_cast<std::size_t>(j)] + "' = " + significant(values[k], 3) +
+               detail::kNoDerivative;
       }
   return "";
 }
@@ -71,8 +74,8 @@ std::string detail::non_finite_jacobian_at(const Model& model, const double* q, 
   return non_finite_jacobian(model, kept.data());
 }
 
-SolveStatus detail::factorize_at_q(const Model& model, double t, Workspace& ws, double* rcond,
-                                   std::string* message, bool values_at_q) {
+SolveStatus detail::factorize_at_q(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
+                                   bool values_at_q) {
   ws.has_factorization = false;
   ws.factorized_solves_to = std::numeric_limits<double>::quiet_NaN();
   if (!values_at_q) {
@@ -124,8 +127,8 @@ bool detail::pin_pivot_order_at(const Model& model, Workspace& ws, const Eigen::
   return pinned;
 }
 
-SolveStatus detail::ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond,
-                                      std::string* message, bool values_at_q) {
+SolveStatus detail::ensure_factorized(const Model& model, double t, Workspace& ws, double* rcond, std::string* message,
+                                      bool values_at_q) {
   if (!ws.lu) {
     *message = not_square_message(model);
     return SolveStatus::kNotSquare;

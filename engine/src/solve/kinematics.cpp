@@ -23,17 +23,28 @@ const char* to_string(JacobianUpdate u) {
 
 const char* to_string(SolveStatus s) {
   switch (s) {
-    case SolveStatus::kSuccess: return "success";
-    case SolveStatus::kNotConverged: return "not converged";
-    case SolveStatus::kSingularJacobian: return "singular Jacobian";
-    case SolveStatus::kLinearSolverFailed: return "linear solver failed";
-    case SolveStatus::kNonFinite: return "non-finite value";
-    case SolveStatus::kNotSquare: return "not square";
-    case SolveStatus::kOutsideTimeDomain: return "outside time domain";
-    case SolveStatus::kCancelled: return "cancelled";
-    case SolveStatus::kInconsistent: return "inconsistent redundant constraints";
-    case SolveStatus::kPositionNotSolved: return "position not solved";
-    case SolveStatus::kOutsideDomain: return "outside a constraint's domain";
+    case SolveStatus::kSuccess:
+      return "success";
+    case SolveStatus::kNotConverged:
+      return "not converged";
+    case SolveStatus::kSingularJacobian:
+      return "singular Jacobian";
+    case SolveStatus::kLinearSolverFailed:
+      return "linear solver failed";
+    case SolveStatus::kNonFinite:
+      return "non-finite value";
+    case SolveStatus::kNotSquare:
+      return "not square";
+    case SolveStatus::kOutsideTimeDomain:
+      return "outside time domain";
+    case SolveStatus::kCancelled:
+      return "cancelled";
+    case SolveStatus::kInconsistent:
+      return "inconsistent redundant constraints";
+    case SolveStatus::kPositionNotSolved:
+      return "position not solved";
+    case SolveStatus::kOutsideDomain:
+      return "outside a constraint's domain";
   }
   return "?";
 }
@@ -87,9 +98,9 @@ template <class Step>
 double step_ratio(const Model& model, const Step& dq, const Eigen::VectorXd& q, double tol, Index* worst = nullptr) {
   if (q.size() == 0) return 0.0;
   Index j = 0;
-  const double r = (dq.array().abs() /
-                    (tol * model.tolerance_scales().coordinate_scale.array() + kUlpFloor * q.array().abs()))
-                       .maxCoeff(&j);
+  const double r =
+      (dq.array().abs() / (tol * model.tolerance_scales().coordinate_scale.array() + kUlpFloor * q.array().abs()))
+          .maxCoeff(&j);
   if (worst) *worst = j;
   return std::isnan(r) ? std::numeric_limits<double>::infinity() : r;
 }
@@ -213,7 +224,8 @@ double scaled_step(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& 
 
 std::string PositionSummary::BriefReport() const {
   std::ostringstream s;
-  s << "position: " << to_string(status) << ", " << iterations << " iterations, scaled residual " << scientific(residual, 3);
+  s << "position: " << to_string(status) << ", " << iterations << " iterations, scaled residual "
+    << scientific(residual, 3);
   if (!message.empty()) s << " (" << message << ")";
   return s.str();
 }
@@ -232,13 +244,13 @@ class PositionSolve {
  private:
   // One iteration's step from the current iterate to its trial point (ws.trial, ws.trial_phi).
   struct Step {
-    StepPass full;             // the full step's measures
-    double theta = -1.0;       // contraction θ = ‖Δq_k‖ / ‖Δq_k−1‖ in the tolerance-scaled norm (−1: unknown)
-    double eta = 1.0;          // error of the new iterate per unit of the step: θ/(1−θ) where θ is known
-    double alpha = 1.0;        // the line search's fraction of the full step
-    double size = 0.0;         // the step in units of the tolerance test
-    double error = 0.0;        // the trial's estimated error, min(η, 1) times that
-    ResidualCheck trial;       // of the trial point
+    StepPass full;        // the full step's measures
+    double theta = -1.0;  // contraction θ = ‖Δq_k‖ / ‖Δq_k−1‖ in the tolerance-scaled norm (−1: unknown)
+    double eta = 1.0;     // error of the new iterate per unit of the step: θ/(1−θ) where θ is known
+    double alpha = 1.0;   // the line search's fraction of the full step
+    double size = 0.0;    // the step in units of the tolerance test
+    double error = 0.0;   // the trial's estimated error, min(η, 1) times that
+    ResidualCheck trial;  // of the trial point
     bool with_jacobian = false;  // Φq evaluated at the trial
     bool known_ok = false;       // a full step whose error is within NewtonOptions::known_to
     bool refresh = false;        // a reused matrix to be replaced at this iterate
@@ -366,8 +378,9 @@ std::optional<SolveStatus> PositionSolve::stop_before_step(int it) {
     sum_.slow_convergence = sum_.linear_convergence = true;
     sum_.error_estimate = accepted_error_;
     (void)finish(SolveStatus::kSuccess, "");  // (returned below, after its message)
-    sum_.message = "residual within tolerance but the Newton steps stopped converging quadratically (a singular "
-                   "position, or Φq too ill-conditioned for this tolerance)";
+    sum_.message =
+        "residual within tolerance but the Newton steps stopped converging quadratically (a singular "
+        "position, or Φq too ill-conditioned for this tolerance)";
     return SolveStatus::kSuccess;
   }
   if (it >= opt_.max_iterations)
@@ -418,7 +431,8 @@ std::optional<SolveStatus> PositionSolve::newton_step(Step& s) {
   }
   // A reused matrix that contracts worse than max_contraction is replaced by a fresh one at this iterate (the step
   // just computed is discarded).
-  s.theta = prev_norm_ > 0.0 ? s.full.norm / prev_norm_ : (reuse_ && carried_theta_ >= 0.0 ? 2.0 * carried_theta_ : -1.0);
+  s.theta =
+      prev_norm_ > 0.0 ? s.full.norm / prev_norm_ : (reuse_ && carried_theta_ >= 0.0 ? 2.0 * carried_theta_ : -1.0);
   if (reuse_ && prev_norm_ > 0.0) {
     theta_seen_ = std::max(theta_seen_, s.theta);
     // Refresh on a slow contraction, or when the steps left (the iteration limit, or kMaxReusedSteps: a
@@ -476,8 +490,7 @@ std::optional<SolveStatus> PositionSolve::line_search(Step& s) {
 SolveStatus PositionSolve::stop_at_rounding_level(bool known_before, const Step& s, int it) {
   Index worst = 0;
   const double size = step_ratio(model_, ws_.step, ws_.q, opt_.tolerance, &worst);
-  const double worst_ratio =
-      known_before ? std::max(std::min(s.eta, 1.0) * size, std::min(size, opt_.known_to)) : size;
+  const double worst_ratio = known_before ? std::max(std::min(s.eta, 1.0) * size, std::min(size, opt_.known_to)) : size;
   sum_.rounding_level = worst_ratio;
   sum_.rounding_measured = !known_before && it > 0;
   sum_.error_estimate = worst_ratio;
@@ -491,16 +504,15 @@ SolveStatus PositionSolve::stop_at_rounding_level(bool known_before, const Step&
   if (worst_ratio <= kQuietRoundingLevel) return SolveStatus::kSuccess;
   sum_.slow_convergence = true;
   const std::string& name = model_.coordinate_names()[static_cast<std::size_t>(worst)];
-  sum_.message = known_before
-                     ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
-                       "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a long "
-                       "chain or Φq ill-conditioned): up to " +
-                           scientific(worst_ratio, 3) + " × the tolerance at '" + name +
-                           "', which is how well q is known there"
-                     : "the residual is at its rounding level and the Newton steps no longer reduce it: they are "
-                       "the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
-                           scientific(worst_ratio, 3) + " × the tolerance at '" + name +
-                           "', which is how well q is known there";
+  sum_.message =
+      known_before
+          ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
+            "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a long "
+            "chain or Φq ill-conditioned): up to " +
+                scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there"
+          : "the residual is at its rounding level and the Newton steps no longer reduce it: they are "
+            "the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
+                scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there";
   return SolveStatus::kSuccess;
 }
 
@@ -546,7 +558,8 @@ SolveStatus PositionSolve::run() {
     // known. Stop at the better point of the two, with a warning, instead of refactorising in search of a
     // contraction that cannot come.
     const bool rounding_level = within && !step_ok_ && s.alpha == 1.0 && !(s.trial.merit < 0.5 * check_.merit);
-    if (rounding_level && !(s.trial.within && s.trial.merit < check_.merit)) return stop_at_rounding_level(false, s, it);
+    if (rounding_level && !(s.trial.within && s.trial.merit < check_.merit))
+      return stop_at_rounding_level(false, s, it);
     // Within the level the previous positions are known to: the step is taken and ends the solve, as at a stop at
     // the rounding level (below), without the iterations that would only measure the rounding again.
     // Not where Φq is ill-conditioned: linear convergence there marks a singular position (a dead point), which

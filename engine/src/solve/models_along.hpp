@@ -43,7 +43,8 @@ std::string check_model_along(const Model& model, const OutputSensitivity& s, st
 AlongModel along_model(const Model& model, const Model& m);
 
 // The same with the constraints that differ copied into `copies` (one block per block of `model`): `m` may go.
-AlongModel along_model_copied(const Model& model, const Model& m, std::vector<std::unique_ptr<ConstraintBlock>>& copies);
+AlongModel along_model_copied(const Model& model, const Model& m,
+                              std::vector<std::unique_ptr<ConstraintBlock>>& copies);
 
 // The reach of the four models along p (parameter_reach()), h = `step`.
 ParameterReach reach_of(const Model& model, const std::array<AlongModel, 4>& along, double step);

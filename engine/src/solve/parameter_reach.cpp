@@ -25,7 +25,6 @@ bool detail::blocks_match(const Model& a, const Model& b) {
   return true;
 }
 
-
 ParameterReach whole_model_reach(const Model& model) {
   ParameterReach r;
   r.everything = true;
@@ -122,8 +121,10 @@ ParameterReach detail::reach_of(const Model& model, const std::array<AlongModel,
     const std::size_t rows_each = static_cast<std::size_t>(block.rows_per_constraint());
     for (std::size_t i = 0; i < block.size(); ++i) {
       if (!reached[b][i]) continue;
-      if (!r.spans.empty() && r.spans.back().block == b && r.spans.back().end == i) ++r.spans.back().end;
-      else r.spans.push_back({b, i, i + 1});
+      if (!r.spans.empty() && r.spans.back().block == b && r.spans.back().end == i)
+        ++r.spans.back().end;
+      else
+        r.spans.push_back({b, i, i + 1});
       for (std::size_t k = 0; k < rows_each; ++k) r.rows.push_back(block.first_row(i) + static_cast<Index>(k));
     }
   }
@@ -131,8 +132,7 @@ ParameterReach detail::reach_of(const Model& model, const std::array<AlongModel,
   return r;
 }
 
-std::shared_ptr<const ReachedConstraints> detail::reached_of(const Model& model,
-                                                             const std::array<AlongModel, 4>& along,
+std::shared_ptr<const ReachedConstraints> detail::reached_of(const Model& model, const std::array<AlongModel, 4>& along,
                                                              const std::shared_ptr<const ParameterReach>& reach,
                                                              double step) {
   auto reached = std::make_shared<ReachedConstraints>();
@@ -154,11 +154,11 @@ std::shared_ptr<const ReachedConstraints> detail::reached_of(const Model& model,
   if (reach->comotion.empty())
     for (std::size_t j = 0; j < reach->spans.size(); ++j) {
       const ParameterReach::Span& span = reach->spans[j];
-      reached->rates[j] = model.blocks()[span.block]->data_rates(
-          span.begin, span.end,
-          {reached->along[0][j].get(), reached->along[1][j].get(), reached->along[2][j].get(),
-           reached->along[3][j].get()},
-          step);
+      reached->rates[j] =
+          model.blocks()[span.block]->data_rates(span.begin, span.end,
+                                                 {reached->along[0][j].get(), reached->along[1][j].get(),
+                                                  reached->along[2][j].get(), reached->along[3][j].get()},
+                                                 step);
       if (reached->rates[j])
         for (auto& copies : reached->along) copies[j] = copies[j]->empty_copy();
     }
@@ -203,7 +203,9 @@ void detail::evaluate_over_reach(const ParameterReach& reach, const Model* m, co
     const ConstraintBlock& block = reached ? *reached->along[k][j] : *m->blocks()[s.block];
     const std::size_t begin = reached ? 0 : s.begin, end = reached ? block.size() : s.end;
     switch (which) {
-      case AlongParameter::kResidual: block.residual(begin, end, q, t, f); break;
+      case AlongParameter::kResidual:
+        block.residual(begin, end, q, t, f);
+        break;
       case AlongParameter::kVelocityTerm:  // Φq q̇ into f, Φt into the scratch (it writes time-dependent rows only)
         block.add_jacobian_product(begin, end, q, t, qd, f);
         block.phi_t(begin, end, q, t, scratch);
@@ -248,8 +250,10 @@ void detail::complete_along(const Model& model, OutputSensitivity& s, bool keep,
       throw Error(why);  // (fail throws)
     }
     whole = whole || !blocks_match(model, *m);
-    if (whole) s.models[k] = std::move(m);
-    else along[k] = along_model_copied(model, *m, copies[k]);
+    if (whole)
+      s.models[k] = std::move(m);
+    else
+      along[k] = along_model_copied(model, *m, copies[k]);
   }
   if (whole) {
     for (std::size_t k = 0; k < 4; ++k)

@@ -97,10 +97,10 @@ void transpose(const CscPattern& a, const std::vector<double>& av, CscPattern* t
 }
 
 struct SparseRank {
-  std::vector<char> live;        // per column of A (an equation)
+  std::vector<char> live;  // per column of A (an equation)
   Index rank = 0;
-  bool order_kept = true;        // SuiteSparseQR pivoted the columns in the given order (no singleton moved ahead)
-  double smallest_pivot = 1.0;   // min |R_kk| of the live columns (absolute)
+  bool order_kept = true;       // SuiteSparseQR pivoted the columns in the given order (no singleton moved ahead)
+  double smallest_pivot = 1.0;  // min |R_kk| of the live columns (absolute)
 };
 
 // Rank-revealing QR of A (n × k, columns = equations) in the fixed column order: SuiteSparseQR with Heath's method
@@ -140,8 +140,9 @@ SparseRank sparse_rank(const CscPattern& a, const std::vector<double>& av, doubl
   out.rank = row;
   cholmod_l_free_sparse(&R, &c.cc);
   if (E) cholmod_l_free(static_cast<std::size_t>(a.cols), sizeof(SuiteSparse_long), E, &c.cc);
-  if (out.rank != rank) throw Error("SuiteSparseQR: rank " + std::to_string(rank) + " but " +
-                                    std::to_string(out.rank) + " live pivots found in R");
+  if (out.rank != rank)
+    throw Error("SuiteSparseQR: rank " + std::to_string(rank) + " but " + std::to_string(out.rank) +
+                " live pivots found in R");
   return out;
 }
 
@@ -169,7 +170,8 @@ std::vector<Index> fill_reducing(const CscPattern& at, const std::vector<Index>&
 
 RankReport analyse_rank(const Model& model, const Eigen::VectorXd& q, double t, const RankOptions& options) {
   const Index n = model.num_coordinates(), m = model.num_equations();
-  if (q.size() != n || !q.allFinite()) throw Error("analyse_rank: q must have " + std::to_string(n) + " finite entries");
+  if (q.size() != n || !q.allFinite())
+    throw Error("analyse_rank: q must have " + std::to_string(n) + " finite entries");
   if (!(options.tolerance > 0.0 && options.tolerance < 1.0)) throw Error("RankOptions: tolerance must be in (0, 1)");
   RankReport rep;
   rep.coordinates = n;

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "phiq/output_plan.hpp"
-#include "phiq/evaluation.hpp"  // JacobianView: Φq over values held here
+#include "phiq/evaluation.hpp"          // JacobianView: Φq over values held here
 #include "phiq/kinds/kind_support.hpp"  // detail::central_difference
 #include "phiq/text.hpp"
 #include "solve/factorisation.hpp"
@@ -55,8 +55,8 @@ void along_parameter(const Model& model, const OutputSensitivity& p, const Param
   if (!reach.comotion.empty()) sc.moved = Eigen::Map<const Eigen::VectorXd>(q, n), at = sc.moved.data();
   // the constraints kept of the models (keep_reached_only()) when they hold this reach, else the models
   const ReachedConstraints* reached = p.reached && p.reached->reach.get() == &reach ? p.reached.get() : nullptr;
-  const bool rated = reached && std::any_of(reached->rates.begin(), reached->rates.end(),
-                                            [](const auto& r) { return r != nullptr; });
+  const bool rated =
+      reached && std::any_of(reached->rates.begin(), reached->rates.end(), [](const auto& r) { return r != nullptr; });
   const bool differenced =
       !rated || std::any_of(reached->rates.begin(), reached->rates.end(), [](const auto& r) { return !r; });
   if (differenced) {
@@ -80,8 +80,7 @@ void along_parameter(const Model& model, const OutputSensitivity& p, const Param
     }
     const Index rows = block.rows_per_constraint();  // the span's rows, differenced as difference_on()
     for (std::size_t i = s.begin; i < s.end; ++i)
-      for (Index r = block.first_row(i); r < block.first_row(i) + rows; ++r)
-        d[r] = difference_at(sc.f, r, h);
+      for (Index r = block.first_row(i); r < block.first_row(i) + rows; ++r) d[r] = difference_at(sc.f, r, h);
   }
 }
 
@@ -99,8 +98,7 @@ double dot_on(const ParameterReach& reach, const Eigen::VectorXd& v, const Eigen
 // Where Φq is linear in q (bars, linear drivers) both are rounding, about ε Σ|w| |Φq|: 10⁻¹² of Φq's largest
 // entry is their floor.
 bool smooth_along_motion(const std::array<std::vector<double>, 7>& at) {
-  constexpr double kSixth[7] = {2.0 / 180,   -27.0 / 180, 270.0 / 180, -490.0 / 180,
-                                270.0 / 180, -27.0 / 180, 2.0 / 180};
+  constexpr double kSixth[7] = {2.0 / 180, -27.0 / 180, 270.0 / 180, -490.0 / 180, 270.0 / 180, -27.0 / 180, 2.0 / 180};
   constexpr double kFourth[5] = {-1.0 / 12, 16.0 / 12, -30.0 / 12, 16.0 / 12, -1.0 / 12};
   double gap = 0.0, largest = 0.0, entry = 0.0;
   for (std::size_t i = 0; i < at[0].size(); ++i) {
@@ -123,8 +121,7 @@ JacobianView jacobian_view(const CscPattern& pattern, std::vector<double>& value
 
 double default_sensitivity_step(double p) { return p == 0.0 ? 1e-3 : 1e-3 * std::fabs(p); }
 
-std::string detail::check_model_along(const Model& model, const OutputSensitivity& s, std::size_t k,
-                                      const Model& m) {
+std::string detail::check_model_along(const Model& model, const OutputSensitivity& s, std::size_t k, const Model& m) {
   const CscPattern& a = m.jacobian_pattern();
   const CscPattern& b = model.jacobian_pattern();
   if (m.num_coordinates() != model.num_coordinates() || m.num_equations() != model.num_equations() ||
@@ -159,8 +156,8 @@ std::string check_sensitivity_models(const Model& model, const OutputSensitivity
       const ConstraintBlock* kept = j < r.rates.size() && r.rates[j] ? r.rates[j].get()
                                     : j < r.along[0].size()          ? r.along[0][j].get()
                                                                      : nullptr;
-      if (span.block >= blocks.size() || span.end > blocks[span.block]->size() || span.begin >= span.end ||
-          !kept || std::string_view(kept->kind()) != blocks[span.block]->kind())
+      if (span.block >= blocks.size() || span.end > blocks[span.block]->size() || span.begin >= span.end || !kept ||
+          std::string_view(kept->kind()) != blocks[span.block]->kind())
         return who + "its kept constraints are not this model's (span " + std::to_string(j) + ")";
     }
     return "";
@@ -172,8 +169,8 @@ std::string check_sensitivity_models(const Model& model, const OutputSensitivity
   return "";
 }
 
-bool detail::sensitivities_with_factors(const Model& model, const std::vector<OutputSensitivity>& parameters,
-                                        double t, const double* q, const double* qd, const double* qdd, int order,
+bool detail::sensitivities_with_factors(const Model& model, const std::vector<OutputSensitivity>& parameters, double t,
+                                        const double* q, const double* qd, const double* qdd, int order,
                                         SparseLuNumeric& lu, Workspace& ws, SensitivityScratch& sc, double* out) {
   const Index n = model.num_coordinates(), m = model.num_equations();
   const SensitivityLayout layout{n};
@@ -295,7 +292,8 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
   // terms are their differences applied to a vector. ε moves the fastest coordinate by 10⁻³ of its scale for the
   // fourth-order first differences; the second difference, whose rounding grows as 1/ε², is of sixth order at
   // 2·10⁻² (rounding and truncation both near 10⁻¹² of the terms: at 5·10⁻³ and fourth order the crank-slider's
-  // ∂ẍ_B/∂L3 was 10× less accurate than the direct form's). t moves by at most ε's cap (a body at rest moves in t only).
+  // ∂ẍ_B/∂L3 was 10× less accurate than the direct form's). t moves by at most ε's cap (a body at rest moves in t
+  // only).
   const double* cs = model.tolerance_scales().coordinate_scale.data();
   const double v_rate = order >= 1 ? fastest(qd, cs, n) : 0.0, a_rate = order >= 2 ? fastest(qdd, cs, n) : 0.0;
   const double e1 = 1e-3 / std::max(v_rate, 1e-3), e2 = 2e-2 / std::max(v_rate, 2e-2);
@@ -415,8 +413,8 @@ bool detail::adjoint_sensitivities_with_factors(const Model& model, const std::v
         if (c.coordinate == i) out[layout.offset(j, 0) + i] += q[i] * c.rate;
       if (order >= 1) out[layout.offset(j, 1) + i] = dot_on(reach, sc.mu, sc.a[j]) - dot_on(reach, sc.lambda, sc.b[j]);
       if (order >= 2)
-        out[layout.offset(j, 2) + i] = dot_on(reach, sc.nu, sc.a[j]) + 2.0 * dot_on(reach, sc.mu, sc.b[j]) -
-                                       dot_on(reach, sc.lambda, sc.c[j]);
+        out[layout.offset(j, 2) + i] =
+            dot_on(reach, sc.nu, sc.a[j]) + 2.0 * dot_on(reach, sc.mu, sc.b[j]) - dot_on(reach, sc.lambda, sc.c[j]);
     }
   }
   return true;
@@ -440,7 +438,8 @@ SolveStatus solve_sensitivities_in(const Model& model, const std::vector<OutputS
     for (Index i : *outputs) {
       if (i < 0 || i >= model.num_coordinates())
         throw Error(name + ": output coordinate " + std::to_string(i) + " out of range");
-      if (seen[static_cast<std::size_t>(i)]++) throw Error(name + ": output coordinate " + std::to_string(i) + " repeated");
+      if (seen[static_cast<std::size_t>(i)]++)
+        throw Error(name + ": output coordinate " + std::to_string(i) + " repeated");
     }
   }
   LinearSummary local;
@@ -463,11 +462,10 @@ SolveStatus solve_sensitivities_in(const Model& model, const std::vector<OutputS
   detail::SensitivityScratch scratch;
   const double* qd = order >= 1 ? ws.qd.data() : nullptr;
   const double* qdd = order >= 2 ? ws.qdd.data() : nullptr;
-  const bool ok =
-      outputs ? detail::adjoint_sensitivities_with_factors(model, parameters, *outputs, t, ws.q.data(), qd, qdd, order,
-                                                           *ws.lu, ws, scratch, out)
-              : detail::sensitivities_with_factors(model, parameters, t, ws.q.data(), qd, qdd, order, *ws.lu, ws,
-                                                   scratch, out);
+  const bool ok = outputs ? detail::adjoint_sensitivities_with_factors(model, parameters, *outputs, t, ws.q.data(), qd,
+                                                                       qdd, order, *ws.lu, ws, scratch, out)
+                          : detail::sensitivities_with_factors(model, parameters, t, ws.q.data(), qd, qdd, order,
+                                                               *ws.lu, ws, scratch, out);
   if (!ok) {
     std::fill(out, out + layout.size(parameters.size()), std::numeric_limits<double>::quiet_NaN());
     sum.message = "sparse LU solve failed: " + ws.lu->last_message();
@@ -486,8 +484,7 @@ SolveStatus solve_sensitivities(const Model& model, const std::vector<OutputSens
 SolveStatus solve_sensitivities_adjoint(const Model& model, const std::vector<OutputSensitivity>& parameters,
                                         const std::vector<Index>& outputs, double t, int order, Workspace& ws,
                                         double* out, LinearSummary* summary) {
-  return solve_sensitivities_in(model, parameters, &outputs, t, order, ws, out, summary,
-                                "solve_sensitivities_adjoint");
+  return solve_sensitivities_in(model, parameters, &outputs, t, order, ws, out, summary, "solve_sensitivities_adjoint");
 }
 
 }  // namespace phiq

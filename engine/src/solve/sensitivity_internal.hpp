@@ -16,7 +16,9 @@ namespace phiq::detail {
 // it, each Sweeper solves in it (the direct form when no coordinate is written: on_step reads them all).
 inline SensitivityForm sweep_sensitivity_form(const OutputPlan& plan, std::size_t outputs) {
   return effective_sensitivity_form(plan.sensitivity_form, plan.sensitivities.size(), outputs,
-                                    plan.accelerations ? 2 : plan.velocities ? 1 : 0);
+                                    plan.accelerations ? 2
+                                    : plan.velocities  ? 1
+                                                       : 0);
 }
 
 // The vectors one row's sensitivities are computed in, kept between rows (no allocation per row).
@@ -51,23 +53,23 @@ enum class AlongParameter {
 // other row is left as it is. `scratch` (one entry per row of Φ, like `f`) holds Φt or γ on the way. `qd` is read
 // by kVelocityTerm and kAccelerationTerm, `qdd` by kAccelerationTerm (else null). With `skip_rated`, the spans whose
 // data's rates `reached` holds are not evaluated (their kind gives their derivatives: the rows may hold anything).
-void evaluate_over_reach(const ParameterReach& reach, const Model* m, const ReachedConstraints* reached,
-                         std::size_t k, AlongParameter which, const double* q, const double* qd, const double* qdd,
-                         double t, double* f, double* scratch, bool skip_rated = false);
+void evaluate_over_reach(const ParameterReach& reach, const Model* m, const ReachedConstraints* reached, std::size_t k,
+                         AlongParameter which, const double* q, const double* qd, const double* qdd, double t,
+                         double* f, double* scratch, bool skip_rated = false);
 
 // Writes the sensitivities of (q, q̇, q̈) at t to every parameter into `out` (SensitivityLayout; derivatives above
 // `order` are NaN), solving with `lu`, the factors of the swept model's Φq at q. `ws` lends the right-hand side
 // of the kept rows (models with dropped rows) and counts the solves. Returns false when a solve fails (then the
 // values are NaN).
 bool sensitivities_with_factors(const Model& model, const std::vector<OutputSensitivity>& parameters, double t,
-                                const double* q, const double* qd, const double* qdd, int order,
-                                SparseLuNumeric& lu, Workspace& ws, SensitivityScratch& scratch, double* out);
+                                const double* q, const double* qd, const double* qdd, int order, SparseLuNumeric& lu,
+                                Workspace& ws, SensitivityScratch& scratch, double* out);
 
 // The same in the adjoint form (SensitivityForm::kAdjoint), for the coordinates `outputs` only; every other entry
 // of `out` is NaN.
 bool adjoint_sensitivities_with_factors(const Model& model, const std::vector<OutputSensitivity>& parameters,
-                                        const std::vector<Index>& outputs, double t, const double* q,
-                                        const double* qd, const double* qdd, int order, SparseLuNumeric& lu,
-                                        Workspace& ws, SensitivityScratch& scratch, double* out);
+                                        const std::vector<Index>& outputs, double t, const double* q, const double* qd,
+                                        const double* qdd, int order, SparseLuNumeric& lu, Workspace& ws,
+                                        SensitivityScratch& scratch, double* out);
 
 }  // namespace phiq::detail

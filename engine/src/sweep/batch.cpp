@@ -14,8 +14,8 @@ BatchSummary run_batch(const std::vector<const Model*>& models, const SweepOptio
   return run_batch(models, std::vector<SweepOptions>(models.size(), options), threads, on_step);
 }
 
-BatchSummary run_batch(const std::vector<const Model*>& models, const std::vector<SweepOptions>& options,
-                       int threads, const std::function<bool(std::size_t, const StepView&)>& on_step,
+BatchSummary run_batch(const std::vector<const Model*>& models, const std::vector<SweepOptions>& options, int threads,
+                       const std::function<bool(std::size_t, const StepView&)>& on_step,
                        const std::vector<Eigen::VectorXd>* starts) {
   if (options.size() != models.size()) throw Error("run_batch: one SweepOptions per model is needed");
   for (const Model* m : models)
@@ -40,9 +40,9 @@ BatchSummary run_batch(const std::vector<const Model*>& models, const std::vecto
       SweepOptions one = options[c];
       one.threads = 1;  // parallel over cases, not within one
       (void)run_sweep(  // the status is the case summary's (out.cases[c].status)
-          *models[c], one, ws, on_step ? [&](const StepView& s) { return on_step(c, s); }
-                                             : std::function<bool(const StepView&)>{},
-                &out.cases[c]);
+          *models[c], one, ws,
+          on_step ? [&](const StepView& s) { return on_step(c, s); } : std::function<bool(const StepView&)>{},
+          &out.cases[c]);
     });
   });
   for (std::size_t c = 0; c < models.size(); ++c) {

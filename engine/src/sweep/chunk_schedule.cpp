@@ -56,9 +56,9 @@ ChunkedSweep::ChunkedSweep(const Model& model, const SweepOptions& opt, Workspac
   // How far the work may run ahead of the delivery: chunks seeded beyond the next one to deliver. As many as the
   // row buffer allows, at least one per thread, and at most 16 per thread so that rows are delivered (and Ctrl-C
   // seen) every few thousand steps however long the sweep.
-  ahead_ = std::max<Index>(
-      threads, std::min<Index>(16 * threads, static_cast<Index>(static_cast<double>(opt.row_buffer_bytes) /
-                                                                layout.held_bytes(chunk + max_shift_))));
+  ahead_ = std::max<Index>(threads,
+                           std::min<Index>(16 * threads, static_cast<Index>(static_cast<double>(opt.row_buffer_bytes) /
+                                                                            layout.held_bytes(chunk + max_shift_))));
 
   // Seeds: the position at each chunk's first row, found in order with the chunk's span as the step (positions
   // only, the parabolic predictor over the seeds before, subdivision on failure), one at a time, just ahead of the
@@ -237,8 +237,7 @@ void ChunkedSweep::finish_in_order() {
   rest.leave_state_in_workspace();
 }
 
-HeldRows held_rows(const Model& model, const SweepOptions& opt, bool caller_reads_rows,
-                   std::size_t encoded_row_bytes) {
+HeldRows held_rows(const Model& model, const SweepOptions& opt, bool caller_reads_rows, std::size_t encoded_row_bytes) {
   const Index n = model.num_coordinates();
   // Rows keep q̇ whenever it is solved (q̈ needs it, and so does an ordered continuation's predictor).
   const bool need_v = opt.velocities || opt.accelerations, need_a = opt.accelerations;
@@ -250,8 +249,8 @@ HeldRows held_rows(const Model& model, const SweepOptions& opt, bool caller_read
   constexpr Index kMotionDoubles = static_cast<Index>(sizeof(PointMotion) / sizeof(double));
   static_assert(sizeof(PointMotion) == 9 * sizeof(double), "PointMotion is stored as 9 doubles in chunk rows");
   const Index n_sensitivities = SensitivityLayout{n}.size(opt.sensitivities.size());
-  const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles +
-                      n_sensitivities + 1;
+  const Index width =
+      n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles + n_sensitivities + 1;
   return {caller_reads_rows, 8.0 * static_cast<double>(std::max<Index>(width, 1)),
           static_cast<double>(encoded_row_bytes)};
 }

@@ -52,8 +52,7 @@ double ChunkedSweep::seam_limit(const Chunk& ch) const {
 // Whether a chunk whose first row is at q0 continues the sweep in order: chunk 0 does by construction; another
 // must start where the sweep, continued in order from the last delivered row, arrives (the previous chunk's seam).
 bool ChunkedSweep::continues(const Chunk& ch, const double* q0) const {
-  return ch.k0 == 1 ||
-         (at_.seam_known && same_solution(model_, at_.seam_q, q0, opt_.newton.tolerance, seam_limit(ch)));
+  return ch.k0 == 1 || (at_.seam_known && same_solution(model_, at_.seam_q, q0, opt_.newton.tolerance, seam_limit(ch)));
 }
 
 // A chunk whose first row is q0 (null: it has none) does not continue the sweep: why, for the fallback warning.
@@ -118,8 +117,7 @@ bool ChunkedSweep::keep_row(ChunkRun& cr) {
     hold_row(cr);
     return true;
   }
-  if (ch.good == 0 && !continues(ch, st.q.data()))
-    return not_continued(ch, st.q.data()), cr.outcome = kRejected, false;
+  if (ch.good == 0 && !continues(ch, st.q.data())) return not_continued(ch, st.q.data()), cr.outcome = kRejected, false;
   ++ch.good;
   if (!run_.deliver(k, st.q, st.qd, st.qdd, s.motions(), cr.w.phi, s.rcond(), s.det_sign(), s.det_sign_time(),
                     s.row_quality())) {
@@ -230,8 +228,10 @@ int ChunkedSweep::deliver_chunk(Chunk& ch) {
       run_.count_row(run_.time_of(k), r.det_sign, r.det_sign_t, r.quality);
     }
     if (!run_.write_encoded(ch.encoded, ch.encoded_rows, ch.last_encoded)) {
-      if (failed_end) stopped_at(failed_end->q, failed_end->qd, failed_end->qdd);
-      else stopped_at(last.q, last.qd, last.qdd);
+      if (failed_end)
+        stopped_at(failed_end->q, failed_end->qd, failed_end->qdd);
+      else
+        stopped_at(last.q, last.qd, last.qdd);
       return kStopped;
     }
   } else {

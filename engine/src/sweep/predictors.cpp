@@ -9,20 +9,28 @@ namespace phiq {
 
 const char* to_string(Predictor p) {
   switch (p) {
-    case Predictor::kAuto: return "auto";
-    case Predictor::kPrevious: return "previous";
-    case Predictor::kSecant: return "secant";
-    case Predictor::kLinear: return "linear";
-    case Predictor::kQuadratic: return "quadratic";
-    case Predictor::kCubic: return "cubic";
-    case Predictor::kParabolic: return "parabolic";
-    case Predictor::kHermite: return "hermite";
+    case Predictor::kAuto:
+      return "auto";
+    case Predictor::kPrevious:
+      return "previous";
+    case Predictor::kSecant:
+      return "secant";
+    case Predictor::kLinear:
+      return "linear";
+    case Predictor::kQuadratic:
+      return "quadratic";
+    case Predictor::kCubic:
+      return "cubic";
+    case Predictor::kParabolic:
+      return "parabolic";
+    case Predictor::kHermite:
+      return "hermite";
   }
   return "?";
 }
 
 const std::vector<Predictor>& all_predictors() {
-  static const std::vector<Predictor> all = {Predictor::kAuto,     Predictor::kPrevious, Predictor::kSecant,
+  static const std::vector<Predictor> all = {Predictor::kAuto,      Predictor::kPrevious, Predictor::kSecant,
                                              Predictor::kParabolic, Predictor::kLinear,   Predictor::kHermite,
                                              Predictor::kQuadratic, Predictor::kCubic};
   return all;
@@ -60,14 +68,22 @@ namespace detail {
 
 int predictor_history_depth(Predictor p) {
   switch (p) {
-    case Predictor::kPrevious: return 1;
-    case Predictor::kSecant: return 2;
-    case Predictor::kParabolic: return 3;
-    case Predictor::kHermite: return 3;
-    case Predictor::kLinear: return 1;
-    case Predictor::kQuadratic: return 1;
-    case Predictor::kCubic: return 2;
-    case Predictor::kAuto: break;
+    case Predictor::kPrevious:
+      return 1;
+    case Predictor::kSecant:
+      return 2;
+    case Predictor::kParabolic:
+      return 3;
+    case Predictor::kHermite:
+      return 3;
+    case Predictor::kLinear:
+      return 1;
+    case Predictor::kQuadratic:
+      return 1;
+    case Predictor::kCubic:
+      return 2;
+    case Predictor::kAuto:
+      break;
   }
   return 0;
 }
@@ -91,8 +107,7 @@ void Sweeper::predict(double t1) {
     // positions only, from a singular start: along the branch's own q̇ and q̈ there (singular_point()), which no
     // history of positions tells; Newton then takes its steps (no error estimate).
     const double hh = 0.5 * h * h;
-    for (Index j = 0; j < n; ++j)
-      ws_->q[j] = predicted_[j] = current_.q[j] + h * branch_qd_[j] + hh * branch_qdd_[j];
+    for (Index j = 0; j < n; ++j) ws_->q[j] = predicted_[j] = current_.q[j] + h * branch_qd_[j] + hh * branch_qdd_[j];
     extrapolated_ = true;
     newton_.start_error = INFINITY;
     return;
@@ -122,7 +137,13 @@ void Sweeper::predict(double t1) {
   auto nodes = [&] {
     auto inv = [](double d) { return d != 0.0 ? 1.0 / d : 0.0; };
     Nodes nd{{tc, k > 0 ? th(0) : tc, k > 1 ? th(1) : tc, k > 2 ? th(2) : tc},
-             {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q}, 0, 0, 0, 0, 0, 0};
+             {k > 0 ? x(0) : q, k > 1 ? x(1) : q, k > 2 ? x(2) : q},
+             0,
+             0,
+             0,
+             0,
+             0,
+             0};
     const double* T = nd.T;
     nd.i01 = inv(T[0] - T[1]), nd.i12 = inv(T[1] - T[2]), nd.i23 = inv(T[2] - T[3]);
     nd.i02 = inv(T[0] - T[2]), nd.i13 = inv(T[1] - T[3]), nd.i03 = inv(T[0] - T[3]);
@@ -165,8 +186,10 @@ void Sweeper::predict(double t1) {
             p += w2 * d012, next = w3 * (d012 - d123) * i03;
           }
         }
-        if (estimated) e = next;
-        else p += next;  // the highest term is the prediction's own, with no estimate beyond it
+        if (estimated)
+          e = next;
+        else
+          p += next;  // the highest term is the prediction's own, with no estimate beyond it
         return p;
       });
       extrapolated_ = order > 0;
@@ -205,8 +228,10 @@ void Sweeper::predict(double t1) {
               p += add, add = w4 * d0;
             }
           }
-          if (estimated) nx = add;
-          else p += add;  // the highest term is the prediction's own, with no estimate beyond it
+          if (estimated)
+            nx = add;
+          else
+            p += add;  // the highest term is the prediction's own, with no estimate beyond it
         }
         if (next) *next = nx;
         return p;
@@ -267,7 +292,8 @@ void Sweeper::predict(double t1) {
       extrapolated_ = true;
       break;
     }
-    case Predictor::kAuto: break;
+    case Predictor::kAuto:
+      break;
   }
   // The prediction is as far from the solution as the rows it extrapolates (how well each was solved) plus the
   // extrapolation's own error; accepted without a Newton step, its error becomes the next row's to carry. So the

@@ -34,9 +34,9 @@ using detail::Sweeper;
 void note_parameters_nothing_reads(const SweepOptions& opt, SweepSummary& sum) {
   for (const OutputSensitivity& p : opt.sensitivities)
     if (p.reach && p.reach->spans.empty())
-      sum.warnings.push_back({opt.t_begin, "no_dependence",
-                              "no constraint or driver reads the parameter '" + p.name +
-                                  "': its sensitivities are zero"});
+      sum.warnings.push_back(
+          {opt.t_begin, "no_dependence",
+           "no constraint or driver reads the parameter '" + p.name + "': its sensitivities are zero"});
 }
 
 // run_sweep's body, run inside a task arena of `threads` (run_sweep's count: opt.threads, or all cores for 0).
@@ -60,7 +60,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
         throw Error("SweepOptions: output orientation '" + o.name + "' reads a coordinate the model does not have");
   if (opt.orientation_form.form != "matrix" && opt.orientation_form.form != "axis_angle" &&
       !is_euler_sequence(opt.orientation_form.form))
-    throw Error("SweepOptions: orientation_form '" + opt.orientation_form.form + "' is not matrix, axis_angle or an "
+    throw Error("SweepOptions: orientation_form '" + opt.orientation_form.form +
+                "' is not matrix, axis_angle or an "
                 "Euler sequence");
   if (opt.sensitivity_form != SensitivityForm::kAuto && opt.sensitivity_form != SensitivityForm::kDirect &&
       opt.sensitivity_form != SensitivityForm::kAdjoint)
@@ -107,8 +108,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   }
   note_parameters_nothing_reads(opt, sum);
   sw.row_outputs(0);
-  if (!run.deliver(0, sw.state().q, sw.state().qd, sw.state().qdd, sw.motions(), ws.phi, sw.rcond(),
-                   sw.det_sign(), sw.det_sign_time(), sw.row_quality())) {
+  if (!run.deliver(0, sw.state().q, sw.state().qd, sw.state().qdd, sw.motions(), ws.phi, sw.rcond(), sw.det_sign(),
+                   sw.det_sign_time(), sw.row_quality())) {
     sw.leave_state_in_workspace();
     return done(sum.status);
   }
@@ -121,9 +122,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // (a writer reads every row as a step callback does: the chunks are cut as for one)
   const detail::HeldRows rows = detail::held_rows(model, opt, static_cast<bool>(on_step) || writer,
                                                   run.chunks_encode() ? writer->max_row_bytes() : 0);
-  const Index chunk =
-      opt.chunk_steps > 0 ? opt.chunk_steps
-                          : detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows);
+  const Index chunk = opt.chunk_steps > 0 ? opt.chunk_steps
+                                          : detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows);
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
   if (ws.lu)
     threads = detail::threads_with_room_for_rows(opt, rows.row_bytes, rows.caller_reads_rows, chunk, threads,
@@ -134,8 +134,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     return done(sum.status);
   }
 
-  detail::parallel_sweep(model, opt, ws, run, sw, rows, chunk, n_chunks, threads, others, counted_begin,
-                         counted_end);
+  detail::parallel_sweep(model, opt, ws, run, sw, rows, chunk, n_chunks, threads, others, counted_begin, counted_end);
   return done(sum.status);
 }
 

@@ -14,8 +14,8 @@
 namespace phiq::detail {
 
 namespace {
-constexpr int kSides = 6;              // the regular points a singular row's derivatives are extrapolated from
-constexpr double kSideOffset = 0.6;     // δ, as a fraction of the step: the sides are t ± δ, ± 2δ, ± 3δ
+constexpr int kSides = 6;            // the regular points a singular row's derivatives are extrapolated from
+constexpr double kSideOffset = 0.6;  // δ, as a fraction of the step: the sides are t ± δ, ± 2δ, ± 3δ
 // δ where the sweep starts at the singular position and its first side is reached by the least-squares assembly from
 // the singular position itself (a single loop: no block-triangular form to solve it by), with nothing of the motion
 // to predict from: kept as close as before the sides moved out, and the start's derivatives are known the less well
@@ -38,9 +38,10 @@ std::string Sweeper::singular_throughout(const Eigen::VectorXd& qs, double t) {
   if (nearby < 0)
     return ": redundant or missing constraints, or several loops folded or aligned at once (no solution near it "
            "was assembled to tell which)";
-  return std::string(" on the branch the drive follows from there, though a solution near it is regular: the "
-                     "position is singular, several loops folded or aligned at once, rather than the model short "
-                     "of drivers or constraints") +
+  return std::string(
+             " on the branch the drive follows from there, though a solution near it is regular: the "
+             "position is singular, several loops folded or aligned at once, rather than the model short "
+             "of drivers or constraints") +
          (has_current_ ? "" : "; start the drive off it");
 }
 
@@ -132,9 +133,9 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
         }
         if (!ws_->q.allFinite()) {
           ws_->q = qs;
-          return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " +
-                                                          format_time(t) + "), and no position near it at t = " +
-                                                          format_time(ts) + " was found: " + as.message);
+          return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " + format_time(t) +
+                                                          "), and no position near it at t = " + format_time(ts) +
+                                                          " was found: " + as.message);
         }
       }
     } else {
@@ -201,9 +202,8 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
   singular_row_ = true;
   std::ostringstream m;
   m.precision(3);
-  m << (has_current_ ? "bifurcation passed" : "the sweep starts at a bifurcation")
-    << ": Φq is singular here (rcond " << rc
-    << "), so the velocity is not unique; " << (need_v_ ? "reported is" : "the next step follows")
+  m << (has_current_ ? "bifurcation passed" : "the sweep starts at a bifurcation") << ": Φq is singular here (rcond "
+    << rc << "), so the velocity is not unique; " << (need_v_ ? "reported is" : "the next step follows")
     << " the branch's own (extrapolated from t ± " << d << ", ± " << 2 * d << " and ± " << 3 * d;
   if (need_v_) {
     m << "; it differs from the extrapolation from ± " << d << " and ± " << 2 * d << " by " << qd_spread << " in q̇";

@@ -39,9 +39,7 @@ std::string Sweeper::conflicting_redundancy(double t1) {
   const double tol = opt_.newton.tolerance;
   const Eigen::VectorXd& rs = model_.tolerance_scales().row_scale;
   const std::vector<Index>& kept = model_.solve_rows();
-  auto holds = [&](Index i) {
-    return detail::row_within(model_, i, std::fabs(ws_->phi(i)) / rs(i), tol, ws_->q, t1);
-  };
+  auto holds = [&](Index i) { return detail::row_within(model_, i, std::fabs(ws_->phi(i)) / rs(i), tol, ws_->q, t1); };
   ws_->q = current_.q;
   Eigen::VectorXd rhs(static_cast<Index>(kept.size())), step(model_.num_coordinates());
   bool kept_hold = false;

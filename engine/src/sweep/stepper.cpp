@@ -53,7 +53,8 @@ struct Stepper::Impl {
   void undo(std::size_t warnings, Index singular_positions);
 };
 
-Stepper::Stepper(const Model& model, StepperOptions options) : impl_(std::make_unique<Impl>(model, std::move(options))) {
+Stepper::Stepper(const Model& model, StepperOptions options)
+    : impl_(std::make_unique<Impl>(model, std::move(options))) {
   const StepperOptions& o = impl_->options;
   detail::check_solver_settings(model, o, o.points, o.sensitivities, "StepperOptions");
   if (!std::isfinite(o.expected_step) || o.expected_step == 0.0)
@@ -62,8 +63,9 @@ Stepper::Stepper(const Model& model, StepperOptions options) : impl_(std::make_u
   static_cast<SolverSettings&>(s) = o;
   s.velocities = o.velocities, s.accelerations = o.accelerations, s.points = o.points;
   if (o.sensitivity_form != SensitivityForm::kAuto && o.sensitivity_form != SensitivityForm::kDirect)
-    throw Error("StepperOptions: sensitivity_form must be auto or direct (a stepper writes no coordinate columns for "
-                "the adjoint form to solve for)");
+    throw Error(
+        "StepperOptions: sensitivity_form must be auto or direct (a stepper writes no coordinate columns for "
+        "the adjoint form to solve for)");
   s.sensitivities = o.sensitivities, s.sensitivity_form = o.sensitivity_form;
   s.threads = 1;
   impl_->make_sweeper(0.0);  // refuses a predictor whose derivatives are not solved, before any step
@@ -140,8 +142,8 @@ SolveStatus Stepper::step(double t, StepSummary* summary) {
     if (t == now) return SolveStatus::kSuccess;  // the current state, re-delivered
     const double rounding = 8.0 * std::numeric_limits<double>::epsilon() * std::max(std::fabs(t), std::fabs(now));
     if (std::fabs(t - now) <= rounding)
-      throw Error("Stepper::step: t = " + format_time(t) + " is within 8 ulps of the current time " +
-                  format_time(now) + ", not equal: the step would not move time");
+      throw Error("Stepper::step: t = " + format_time(t) + " is within 8 ulps of the current time " + format_time(now) +
+                  ", not equal: the step would not move time");
   }
   SweepSummary& sum = s.sum;
   const WorkCounters before = s.ws.counters;
@@ -171,8 +173,8 @@ SolveStatus Stepper::step(double t, StepSummary* summary) {
 void Stepper::restart(const Eigen::VectorXd& placement) {
   Impl& s = *impl_;
   if (placement.size() != s.model->num_coordinates())
-    throw Error("Stepper::restart: the placement has " + std::to_string(placement.size()) +
-                " entries, the model " + std::to_string(s.model->num_coordinates()) + " coordinates");
+    throw Error("Stepper::restart: the placement has " + std::to_string(placement.size()) + " entries, the model " +
+                std::to_string(s.model->num_coordinates()) + " coordinates");
   s.ws.q = placement;
   s.started = false;
   s.previous_t = NAN;
@@ -186,9 +188,7 @@ double Stepper::time() const { return impl_->started ? impl_->sweeper->state().t
 const Eigen::VectorXd& Stepper::q() const { return impl_->started ? impl_->sweeper->state().q : impl_->ws.q; }
 const Eigen::VectorXd& Stepper::qd() const { return impl_->started ? impl_->sweeper->state().qd : impl_->ws.qd; }
 const Eigen::VectorXd& Stepper::qdd() const { return impl_->started ? impl_->sweeper->state().qdd : impl_->ws.qdd; }
-const PointMotion* Stepper::point_motions() const {
-  return impl_->started ? impl_->sweeper->point_motions() : nullptr;
-}
+const PointMotion* Stepper::point_motions() const { return impl_->started ? impl_->sweeper->point_motions() : nullptr; }
 const double* Stepper::sensitivities() const {
   return impl_->started ? impl_->sweeper->motions().sensitivities : nullptr;
 }

@@ -15,14 +15,15 @@ std::string SweepSummary::BriefReport() const {
   if (counters.sensitivity_solves)
     s << ", " << counters.sensitivity_solves << " sensitivity solves (" << to_string(sensitivity_form)
       << (counters.sensitivity_direct_rows ? ", " + std::to_string(counters.sensitivity_direct_rows) + " rows direct"
-                                           : std::string()) << ")";
+                                           : std::string())
+      << ")";
   if (subdivisions) s << ", " << subdivisions << " step subdivisions";
   if (singular_positions) s << ", " << singular_positions << " singular positions passed";
   if (threads > 1)
     s << ", " << threads << " threads (" << parallel_chunks << " parallel chunk" << (parallel_chunks == 1 ? ")" : "s)");
   if (!warnings.empty())
-    s << ", " << warnings.size() << (warnings.size() == 1 ? " warning" : " warnings") << " (first at t = "
-      << warnings[0].t << ")";
+    s << ", " << warnings.size() << (warnings.size() == 1 ? " warning" : " warnings")
+      << " (first at t = " << warnings[0].t << ")";
   s.precision(3);
   s << ", " << std::scientific << solve_seconds << " s";
   if (!message.empty()) s << " — " << message;

@@ -78,8 +78,8 @@ bool Sweeper::advance(double t1, int depth) {
   // unless the sub-steps avoid it, so all statuses are retried.
   if (depth >= opt_.max_subdivisions) {
     const std::string why = ps.message;
-    const std::string beyond = "no assembly beyond t = " + format_time(current_.t) + " (sub-steps down to t = " +
-                               format_time(t1) + " tried";
+    const std::string beyond =
+        "no assembly beyond t = " + format_time(current_.t) + " (sub-steps down to t = " + format_time(t1) + " tried";
     if (const std::string undefined = undefined_at(t1); !undefined.empty())
       return fail(SolveStatus::kNonFinite, beyond + "): " + undefined);
     if (const std::string conflict = conflicting_redundancy(t1); !conflict.empty())
@@ -89,7 +89,7 @@ bool Sweeper::advance(double t1, int depth) {
     const bool no_derivative = st == SolveStatus::kNonFinite && why.rfind(detail::kNonFiniteJacobian, 0) == 0;
     sum_.worst_rows = ps.worst_rows;  // the last sub-step's position, the one `why` describes
     return fail(st, beyond +
-                        (no_derivative   ? "): "
+                        (no_derivative  ? "): "
                          : dead.empty() ? ": the drive leaves the reachable range, or the mechanism "
                                           "passes a singular position): "
                                         : "): " + dead + "; ") +
@@ -112,8 +112,9 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
     Index singular_positions;
     double min_rcond, min_rcond_time, rounding_level, known_to;
     bool ill_conditioned;
-  } const noted{sum_.warnings.size(), sum_.singular_positions, sum_.min_rcond, sum_.min_rcond_time,
-                rounding_level_, known_to_, ill_conditioned_};
+  } const noted{sum_.warnings.size(), sum_.singular_positions, sum_.min_rcond,
+                sum_.min_rcond_time,  rounding_level_,         known_to_,
+                ill_conditioned_};
   // A position beyond the end of an open curve solves its equations (the end piece continues), but is no
   // position of the mechanism: the slot or profile ends there. (The sweep names the step and its time.)
   if (std::string off = model_.outside_domain(ws_->q.data()); !off.empty())
@@ -123,7 +124,7 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
   // (a row accepted within NewtonOptions::known_to, the rounding level rows before it measured, is at that
   // level too, though its own Newton did not stop there: known to its estimate, not to the tolerance)
-  row_class_ = ps.linear_convergence                                   ? RowClass::kSingular
+  row_class_ = ps.linear_convergence                                     ? RowClass::kSingular
                : ps.slow_convergence || row_error_ > kQuietRoundingLevel ? RowClass::kRoundingLevel
                                                                          : RowClass::kConverged;
   rounding_level_ = std::max(rounding_level_, ps.rounding_level);
@@ -131,9 +132,9 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   // measured since the last one that converged to the tolerance (a step from a point Newton reached, not the
   // first step from a prediction, which corrects the prediction's own error too; nor a row that ended within
   // it). Dropped again as soon as a row converges to the tolerance.
-  known_to_ = ps.rounding_measured                              ? std::max(known_to_, ps.rounding_level)
+  known_to_ = ps.rounding_measured                                   ? std::max(known_to_, ps.rounding_level)
               : ps.rounding_level == 0.0 && ps.error_estimate <= 1.0 ? 0.0
-                                                                   : known_to_;
+                                                                     : known_to_;
   if (ps.slow_convergence) sum_.warnings.push_back({t, "slow_convergence", ps.message});
   // Positions only: Φq is factorised at the solution where nothing else would tell the row's state, the first row
   // (a sweep that starts on a singular position; an assembly accepted as placed factorises nowhere) and the last
@@ -199,9 +200,9 @@ void Sweeper::remember(double t) {
   if (depth_ > 0 && has_current_) {
     std::rotate(history_.rbegin(), history_.rbegin() + 1, history_.rend());
     std::rotate(history_t_.rbegin(), history_t_.rbegin() + 1, history_t_.rend());
-    Eigen::VectorXd& x = predictor_ == Predictor::kLinear                                        ? current_.qd
+    Eigen::VectorXd& x = predictor_ == Predictor::kLinear                                         ? current_.qd
                          : predictor_ == Predictor::kQuadratic || predictor_ == Predictor::kCubic ? current_.qdd
-                                                                                                 : current_.q;
+                                                                                                  : current_.q;
     history_[0].swap(x);
     history_t_[0] = current_.t;
     std::rotate(history_error_.rbegin(), history_error_.rbegin() + 1, history_error_.rend());
@@ -255,12 +256,12 @@ void Sweeper::row_sensitivities() {
   const Index solves_before = w->counters.sensitivity_solves, direct_before = w->counters.sensitivity_direct_rows;
   const double* qd = order >= 1 ? current_.qd.data() : nullptr;
   const double* qdd = order >= 2 ? current_.qdd.data() : nullptr;
-  const bool ok = sensitivity_form_ == SensitivityForm::kAdjoint
-                      ? adjoint_sensitivities_with_factors(model_, opt_.sensitivities, sensitivity_outputs_, t,
-                                                           current_.q.data(), qd, qdd, order, *w->lu, *w,
-                                                           sensitivity_scratch_, sensitivities_.data())
-                      : sensitivities_with_factors(model_, opt_.sensitivities, t, current_.q.data(), qd, qdd, order,
-                                                   *w->lu, *w, sensitivity_scratch_, sensitivities_.data());
+  const bool ok =
+      sensitivity_form_ == SensitivityForm::kAdjoint
+          ? adjoint_sensitivities_with_factors(model_, opt_.sensitivities, sensitivity_outputs_, t, current_.q.data(),
+                                               qd, qdd, order, *w->lu, *w, sensitivity_scratch_, sensitivities_.data())
+          : sensitivities_with_factors(model_, opt_.sensitivities, t, current_.q.data(), qd, qdd, order, *w->lu, *w,
+                                       sensitivity_scratch_, sensitivities_.data());
   if (w != ws_) {
     ws_->counters.sensitivity_solves += w->counters.sensitivity_solves - solves_before;
     ws_->counters.sensitivity_direct_rows += w->counters.sensitivity_direct_rows - direct_before;

@@ -53,8 +53,10 @@ inline void add_row_quality(SweepAccuracy& a, double t, const RowQuality& r) {
                         : r.row_class == RowClass::kRoundingLevel ? a.rounding_level
                                                                   : a.singular;
   ++c.rows;
-  if (!std::isfinite(r.error)) ++c.unestimated;
-  else if (r.error > c.worst_error) c.worst_error = r.error, c.worst_time = t;
+  if (!std::isfinite(r.error))
+    ++c.unestimated;
+  else if (r.error > c.worst_error)
+    c.worst_error = r.error, c.worst_time = t;
 }
 
 // A sign of det Φq is ±1 at a regular position and 0 at a singular one; kSignUnknown where no factorisation tells
@@ -134,7 +136,8 @@ class Sweeper {
       for (std::size_t i = 0; i < opt_.points.size(); ++i)
         points_[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
       for (std::size_t i = 0; i < opt_.orientations.size(); ++i)
-        orientations_[i] = evaluate_orientation(opt_.orientations[i], opt_.orientation_form, current_.q.data(), qd, qdd);
+        orientations_[i] =
+            evaluate_orientation(opt_.orientations[i], opt_.orientation_form, current_.q.data(), qd, qdd);
       ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
       rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
       if (!opt_.sensitivities.empty()) row_sensitivities();
@@ -358,21 +361,23 @@ class Sweeper {
   std::vector<double> history_t_;
   std::vector<double> history_error_;  // the estimated error of q at those rows (units of the tolerance test)
   int depth_ = 0, known_ = 0;
-  double current_error_ = INFINITY;  // the estimated error of current_.q (PositionSummary::error_estimate)
-  double row_error_ = INFINITY;      // that of the row being converged, until remember() makes it current
+  double current_error_ = INFINITY;            // the estimated error of current_.q (PositionSummary::error_estimate)
+  double row_error_ = INFINITY;                // that of the row being converged, until remember() makes it current
   RowClass row_class_ = RowClass::kConverged;  // how the row being converged ended (converged())
   RowClass current_class_ = RowClass::kConverged;  // and current_'s (remember(): singular_row_ overrides it)
-  bool extrapolated_ = false;  // the last prediction moved from current_ (jumped() has something to compare)
+  bool extrapolated_ = false;   // the last prediction moved from current_ (jumped() has something to compare)
   bool position_only_ = false;  // inside advance_position()
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
   std::vector<JointMotion> joints_ = std::vector<JointMotion>(opt_.joints.size());
   std::vector<OrientationMotion> orientations_ = std::vector<OrientationMotion>(opt_.orientations.size());
   double rcond_ = 0.0;
-  std::vector<double> sensitivities_ =
-      std::vector<double>(static_cast<std::size_t>(SensitivityLayout{model_.num_coordinates()}.size(opt_.sensitivities.size())));
+  std::vector<double> sensitivities_ = std::vector<double>(
+      static_cast<std::size_t>(SensitivityLayout{model_.num_coordinates()}.size(opt_.sensitivities.size())));
   SensitivityScratch sensitivity_scratch_;
-  // The coordinates whose columns are written, and the form the sensitivities are solved in (effective_sensitivity_form)
-  std::vector<Index> sensitivity_outputs_ = opt_.sensitivities.empty() ? std::vector<Index>{} : opt_.sensitivity_outputs();
+  // The coordinates whose columns are written, and the form the sensitivities are solved in
+  // (effective_sensitivity_form)
+  std::vector<Index> sensitivity_outputs_ =
+      opt_.sensitivities.empty() ? std::vector<Index>{} : opt_.sensitivity_outputs();
   SensitivityForm sensitivity_form_ = sweep_sensitivity_form(opt_, sensitivity_outputs_.size());
   // Factors at the row where the workspace's are elsewhere; shared by a copy (a Stepper's way back), which never
   // solves at the same time.
@@ -385,13 +390,13 @@ class Sweeper {
     Index factorizations = -1;
     double t = NAN;
   } derivative_factors_;
-  double last_rcond_ = 0.0;         // PositionSummary::rcond of the last converged position (near_singular())
-  Eigen::VectorXd predicted_;       // the last prediction (for jumped())
-  bool bracketing_ = false;         // inside singular_point(): no nested bracketing
-  bool singular_row_ = false;       // the current state is a singular position (its derivatives bracketed)
-  Orientation det_sign_{0, 0};      // of Φq at the last delivered row (det_sign())
-  Orientation current_sign_;         // and at current_ (sign_at_solution() when it converged)
-  Orientation current_row_sign_;     // what current_'s row reports (converged()), and at which time
+  double last_rcond_ = 0.0;       // PositionSummary::rcond of the last converged position (near_singular())
+  Eigen::VectorXd predicted_;     // the last prediction (for jumped())
+  bool bracketing_ = false;       // inside singular_point(): no nested bracketing
+  bool singular_row_ = false;     // the current state is a singular position (its derivatives bracketed)
+  Orientation det_sign_{0, 0};    // of Φq at the last delivered row (det_sign())
+  Orientation current_sign_;      // and at current_ (sign_at_solution() when it converged)
+  Orientation current_row_sign_;  // what current_'s row reports (converged()), and at which time
   double current_row_sign_t_ = 0.0, det_sign_t_ = 0.0;
   // The workspace's factorisation count when this sweeper took it: the ones after it are its own (converged()).
   Index factorizations_before_ = ws_->counters.factorizations;
@@ -401,9 +406,9 @@ class Sweeper {
   // prediction from that row extrapolates along them (predict()), NaN once used.
   Eigen::VectorXd branch_qd_, branch_qdd_;
   double branch_t_ = NAN;
-  double rounding_level_ = 0.0;     // see take_rounding_level()
-  double known_to_ = 0.0;           // the rounding level carried to the next solves (converged())
-  bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)
+  double rounding_level_ = 0.0;   // see take_rounding_level()
+  double known_to_ = 0.0;         // the rounding level carried to the next solves (converged())
+  bool ill_conditioned_ = false;  // the last delivered state was near-singular (one warning per stretch)
   double default_step_ = (opt_.t_end - opt_.t_begin) / static_cast<double>(std::max<Index>(opt_.steps, 1));
 };
 

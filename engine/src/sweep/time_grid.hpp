@@ -27,8 +27,7 @@ inline std::string time_grid_problem(double t_begin, double t_end, Index steps) 
     m << "the span from t = " << format_time(t_begin) << " to " << format_time(t_end) << " is not a finite number";
     return m.str();
   }
-  const double rounding =
-      8.0 * std::numeric_limits<double>::epsilon() * std::max(std::fabs(t_begin), std::fabs(t_end));
+  const double rounding = 8.0 * std::numeric_limits<double>::epsilon() * std::max(std::fabs(t_begin), std::fabs(t_end));
   if (std::fabs(h) > rounding && std::isnormal(h)) return "";
   m << steps << " steps from t = " << format_time(t_begin) << " to " << format_time(t_end) << " are " << std::fabs(h)
     << " s each, below the rounding of the times (8 ulps: " << rounding << " s): they would not move time";

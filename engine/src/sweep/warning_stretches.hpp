@@ -26,16 +26,16 @@ inline void once_per_stretch(std::vector<SweepWarning>& warnings, const char* ki
   const double h = (opt.t_end - opt.t_begin) / static_cast<double>(opt.steps);
   std::vector<SweepWarning> kept;
   kept.reserve(warnings.size());
-  bool open = false;           // a stretch is open: its warning is kept[first]
+  bool open = false;  // a stretch is open: its warning is kept[first]
   std::size_t first = 0;
   Index first_row = 0, last_row = 0, more = 0;  // the stretch's first and last rows; rows after the first that warned
   double last_t = 0.0;
   auto close = [&] {
     if (open && more > 0) {
       const Index span = last_row - first_row;
-      kept[first].message += "; the same at " + (more == span ? "the next " + std::to_string(more)
-                                                              : std::to_string(more) + " of the next " +
-                                                                    std::to_string(span)) +
+      kept[first].message += "; the same at " +
+                             (more == span ? "the next " + std::to_string(more)
+                                           : std::to_string(more) + " of the next " + std::to_string(span)) +
                              " rows, to t = " + format_time(last_t);
     }
     open = false, more = 0;

@@ -1,6 +1,7 @@
 /// @file
-/// A constant angle between two segments (natural coordinates). One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
+/// A constant angle between two segments (natural coordinates). One constraint kind: its equation, derivatives,
+/// validation, joint count, sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists
+/// every kind).
 #pragma once
 
 #include <cmath>
@@ -26,7 +27,7 @@ struct ConstantAngleSpec {
   /// @brief B, end of segment u (m).
   /// @var c
   /// @brief C, start of segment v = D − C (m).
-  Point2 a, b, c, d;  ///< D, end of segment v (m)
+  Point2 a, b, c, d;   ///< D, end of segment v (m)
   double angle = 0.0;  ///< α, the constant angle from u to v (rad, counter-clockwise), finite
   /// |u||v| at the initial placement (m²), set when the constraint is added (1 if either segment has zero length).
   /// It scales the row and does not change the solution.
@@ -74,8 +75,8 @@ struct ConstantAngleSpec {
   /// The data a parameter may move (DistanceSpec::data_members()): the segments' fixed points, the angle, and ref
   /// (the scale of the row, from the placement, which a parameter may move too).
   static constexpr auto data_members() {
-    return std::tuple{&ConstantAngleSpec::a, &ConstantAngleSpec::b, &ConstantAngleSpec::c, &ConstantAngleSpec::d,
-                      &ConstantAngleSpec::angle, &ConstantAngleSpec::ref};
+    return std::tuple{&ConstantAngleSpec::a, &ConstantAngleSpec::b,     &ConstantAngleSpec::c,
+                      &ConstantAngleSpec::d, &ConstantAngleSpec::angle, &ConstantAngleSpec::ref};
   }
   /// Derivatives along the data (DistanceSpec::data_derivative()). With B(x, y) = cos α (x × y) − sin α (x · y) and
   /// B′(x, y) = ∂B/∂α = −sin α (x × y) − cos α (x · y), the k-th time derivative of Φ is
@@ -85,8 +86,8 @@ struct ConstantAngleSpec {
   ///   ∂Φ⁽ᵏ⁾/∂p = [B(û, v⁽ᵏ⁾) + B(u⁽ᵏ⁾, v̂) + α̂ Σ_i C(k, i) B′(u⁽ⁱ⁾, v⁽ᵏ⁻ⁱ⁾)] / ref − Φ⁽ᵏ⁾ ref̂ / ref,
   ///
   /// Φ⁽¹⁾ = Φq q̇ and Φ⁽²⁾ = Φq q̈ − γ.
-  void data_derivative(const ConstantAngleSpec& rate, int order, const double* q, const double* qd,
-                       const double* qdd, double, double* out) const {
+  void data_derivative(const ConstantAngleSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
     const double ca = std::cos(angle), sa = std::sin(angle);
     auto B = [&](const kin::V2& x, const kin::V2& y) { return ca * kin::cross(x, y) - sa * kin::dot(x, y); };
     auto Bp = [&](const kin::V2& x, const kin::V2& y) { return -sa * kin::cross(x, y) - ca * kin::dot(x, y); };
@@ -124,9 +125,9 @@ struct ConstantAngleSpec {
     sk.bar(c, d);
   }
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "constant_angle", 2, "- {name: bend, type: constant_angle, segments: [[A, B], [B, C]], "
-                                           "angle: pi/3}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "constant_angle", 2,
+                                          "- {name: bend, type: constant_angle, segments: [[A, B], [B, C]], "
+                                          "angle: pi/3}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static ConstantAngleSpec read(const Fields& f) {

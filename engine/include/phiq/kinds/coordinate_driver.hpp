@@ -20,7 +20,7 @@ struct CoordinateDriverSpec {
   /// Added with ModelBuilder::add_driver() or, in a scene, as a driver given by `coordinate`.
   static constexpr const char* kKind = "driver";
   Slot coordinate;  ///< q_j, the driven coordinate; must be a coordinate (checked when the constraint is added)
-  MotionLaw law;  ///< f(t), the prescribed value of q_j, in q_j's unit; defines the time range of the model
+  MotionLaw law;    ///< f(t), the prescribed value of q_j, in q_j's unit; defines the time range of the model
 
   /// @copydoc DistanceSpec::depends_on_time
   /// A driver always depends on time.

@@ -28,11 +28,11 @@ struct CouplerSpec {
   static constexpr int kRows = 1;  ///< one row
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "coupler";
-  Slot first;                 ///< q_i (a coordinate): the row takes its unit
-  Slot second;                ///< q_j (a coordinate)
-  double a = 1.0;             ///< coefficient of q_i, non-zero and finite
-  double b = -1.0;            ///< coefficient of q_j, non-zero and finite
-  double c = 0.0;             ///< the constant, finite
+  Slot first;       ///< q_i (a coordinate): the row takes its unit
+  Slot second;      ///< q_j (a coordinate)
+  double a = 1.0;   ///< coefficient of q_i, non-zero and finite
+  double b = -1.0;  ///< coefficient of q_j, non-zero and finite
+  double c = 0.0;   ///< the constant, finite
 
   /// @copydoc DistanceSpec::depends_on_time
   bool depends_on_time() const { return false; }
@@ -69,8 +69,8 @@ struct CouplerSpec {
   static constexpr auto data_members() { return std::tuple{&CouplerSpec::a, &CouplerSpec::b, &CouplerSpec::c}; }
   /// Derivatives along the data (DistanceSpec::data_derivative()). Φ⁽ᵏ⁾ = (a q_i⁽ᵏ⁾ + b q_j⁽ᵏ⁾ − c δ_k0) / |a|, so
   /// ∂Φ⁽ᵏ⁾/∂p = (â q_i⁽ᵏ⁾ + b̂ q_j⁽ᵏ⁾ − ĉ δ_k0) / |a| − Φ⁽ᵏ⁾ â / a (|a| moves as sign(a) â).
-  void data_derivative(const CouplerSpec& rate, int order, const double* q, const double* qd, const double* qdd,
-                       double, double* out) const {
+  void data_derivative(const CouplerSpec& rate, int order, const double* q, const double* qd, const double* qdd, double,
+                       double* out) const {
     const double* v = order == 0 ? q : order == 1 ? qd : qdd;
     const double x = first.of(v), y = second.of(v), k0 = order == 0 ? 1.0 : 0.0;  // both are coordinates
     const double phi = (a * x + b * y - k0 * c) / std::fabs(a);
@@ -94,16 +94,17 @@ struct CouplerSpec {
   template <class Sketch>
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "coupler", 0, "- {name: gears, type: coupler, coordinates: [theta2, theta5], "
-                                    "coefficients: [0.1, 0.05], constant: 0}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "coupler", 0,
+                                          "- {name: gears, type: coupler, coordinates: [theta2, theta5], "
+                                          "coefficients: [0.1, 0.05], constant: 0}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static CouplerSpec read(const Fields& f) {
     f.expect({"type", "name", "coordinates", "coefficients", "constant"});
     const auto [i, j] = f.coordinate_pair("coordinates");
     const auto [a, b] = f.number_pair("coefficients");
-    return CouplerSpec{Slot::coordinate(i), Slot::coordinate(j), a, b, f.present("constant") ? f.number("constant") : 0.0};
+    return CouplerSpec{Slot::coordinate(i), Slot::coordinate(j), a, b,
+                       f.present("constant") ? f.number("constant") : 0.0};
   }
 };
 

@@ -96,7 +96,7 @@ inline void offset_curve(const Curve& curve, double s, double rho, kin::V2 d[3],
   if (rho == 0.0 && !normal) return;
   const double g2 = kin::dot(c[1], c[1]), g = std::sqrt(g2);
   const kin::V2 u = (1.0 / g) * c[1], n = -1.0 * kin::perp(u);  // the right normal: outwards on a CCW profile
-  const double k = kin::cross(c[1], c[2]) / g2;  // the tangent's turn per unit s
+  const double k = kin::cross(c[1], c[2]) / g2;                 // the tangent's turn per unit s
   const double dk = kin::cross(c[1], c[3]) / g2 - 2.0 * kin::cross(c[1], c[2]) * kin::dot(c[1], c[2]) / (g2 * g2);
   if (normal) normal[0] = n, normal[1] = k * u, normal[2] = dk * u - (k * k) * n;
   if (rho == 0.0) return;
@@ -112,8 +112,7 @@ inline bool datum_rate(CurveOn& rate, const std::array<const CurveOn*, 4>& v, do
 /// The time derivatives V, V′, V″ of V = R(ψ_b) v(s(t)) of a vector v(s) carried by frame b along a curve, from the
 /// world vectors R_b v, R_b v′, R_b v″ (`w`) and the motion (ω, α of ψ_b, ṡ, s̈):
 ///   V′ = ω V⊥ + ṡ R_b v′,   V″ = α V⊥ − ω² V + 2 ω ṡ (R_b v′)⊥ + s̈ R_b v′ + ṡ² R_b v″.
-inline void carried_along_curve(const kin::V2 w[3], double omega, double alpha, double sd, double sdd,
-                                kin::V2 out[3]) {
+inline void carried_along_curve(const kin::V2 w[3], double omega, double alpha, double sd, double sdd, kin::V2 out[3]) {
   out[0] = w[0];
   out[1] = omega * kin::perp(w[0]) + sd * w[1];
   out[2] = alpha * kin::perp(w[0]) - (omega * omega) * w[0] + (2.0 * omega * sd) * kin::perp(w[1]) + sdd * w[1] +
@@ -141,8 +140,10 @@ CurveOn read_curve(const Fields& entry, const char* field) {
   if (forms != 1) f.fail("", "a curve is one of spline, circle, line or profile");
   if (f.present("closed") && !f.present("spline")) f.fail("closed", "only a spline is closed or open");
   const std::string who = entry.type() + (entry.name().empty() ? "" : " '" + entry.name() + "'") + ": ";
-  const char* which = f.present("spline") ? "spline" : f.present("circle") ? "circle" : f.present("line") ? "line"
-                                                                                                          : "profile";
+  const char* which = f.present("spline")   ? "spline"
+                      : f.present("circle") ? "circle"
+                      : f.present("line")   ? "line"
+                                            : "profile";
   try {
     if (f.present("spline")) {
       out.curve = Curve::spline(f.vec2_list("spline"), f.present("closed") && f.flag("closed"));

@@ -1,6 +1,7 @@
 /// @file
-/// The distance between two points (natural coordinates): a bar. One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
+/// The distance between two points (natural coordinates): a bar. One constraint kind: its equation, derivatives,
+/// validation, joint count, sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists
+/// every kind).
 #pragma once
 
 #include <cmath>
@@ -33,7 +34,7 @@ struct DistanceSpec {
   static constexpr const char* kKind = "distance";
   /// @var a
   /// @brief A, first end point (m).
-  Point2 a, b;  ///< B, second end point (m)
+  Point2 a, b;          ///< B, second end point (m)
   double length = 1.0;  ///< L, the distance |B − A|, metres, finite and > 0 (checked when the constraint is added)
 
   /// Whether Φ depends explicitly on time t. When false, Φt = 0 and Φtt = 0: phi_t() is never called and the model
@@ -142,9 +143,7 @@ struct DistanceSpec {
   /// The data a design parameter may move, for data_derivative(): member pointers to numbers, Slots and Point2s
   /// (a coordinate slot is no datum: its rate is 0). Optional, with data_derivative(): a kind without them has its
   /// derivatives along a parameter differenced from the four models along it (sensitivity.hpp).
-  static constexpr auto data_members() {
-    return std::tuple{&DistanceSpec::a, &DistanceSpec::b, &DistanceSpec::length};
-  }
+  static constexpr auto data_members() { return std::tuple{&DistanceSpec::a, &DistanceSpec::b, &DistanceSpec::length}; }
   /// The derivative of the constraint's equations along its data at fixed (q, q̇, q̈, t), `rate` holding each
   /// datum's rate along the parameter (data_members(): numbers their rate, constant slots a constant holding
   /// theirs, coordinate slots 0): ∂Φ/∂p (`order` 0), ∂(Φq q̇ + Φt)/∂p (1), ∂(Φq q̈ − γ)/∂p (2), kRows values at

@@ -25,10 +25,10 @@ struct DotSpec {
   static constexpr int kRows = 1;  ///< one row, unitless
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "dot";
-  std::array<Attachment3, 4> ends;  ///< D1 = ends[0] − ends[1], D2 = ends[2] − ends[3]
+  std::array<Attachment3, 4> ends;                     ///< D1 = ends[0] − ends[1], D2 = ends[2] − ends[3]
   Unit end_units[2] = {Unit::kLength, Unit::kLength};  ///< what D1's and D2's ends measure (kNone for vectors)
-  double value = 0.0;  ///< c, in the product of the directions' units
-  double ref = 1.0;    ///< set by ModelBuilder::add from the initial placement
+  double value = 0.0;                                  ///< c, in the product of the directions' units
+  double ref = 1.0;                                    ///< set by ModelBuilder::add from the initial placement
 
   /// @copydoc DistanceSpec::depends_on_time
   bool depends_on_time() const { return false; }
@@ -70,7 +70,6 @@ struct DotSpec {
     out[0] = (d.along[order] - k0 * rate.value) / ref - phi * rate.ref / ref;
   }
 
-
   /// @copydoc DistanceSpec::joint_count
   JointCount joint_count() const { return JointCount::other(); }
   /// @copydoc DistanceSpec::prepare
@@ -88,8 +87,9 @@ struct DotSpec {
   template <class Sketch>
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {{"constraints", "dot", 3, "- {name: w_across_crank, type: dot, "
-        "directions: [w, [O, A]], value: 0}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "dot", 3,
+                                          "- {name: w_across_crank, type: dot, "
+                                          "directions: [w, [O, A]], value: 0}"}};
   /// @copydoc DistanceSpec::read
   /// A direction is a vector name or a segment [A, B] of points (B − A).
   template <class Fields>
@@ -102,6 +102,7 @@ struct DotSpec {
     spec.value = f.number("value");
     return spec;
   }
+
  private:
   static constexpr detail3::RowDef kDef = {detail3::T(0, 1), detail3::T(2, 3), Unit::kNone};
 };

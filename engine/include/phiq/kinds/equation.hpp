@@ -1,6 +1,7 @@
 /// @file
-/// A general equation written as text, optionally driven by a motion law. One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
+/// A general equation written as text, optionally driven by a motion law. One constraint kind: its equation,
+/// derivatives, validation, joint count, sketch and scene form (the contract is documented on DistanceSpec;
+/// kinds/registry.hpp lists every kind).
 #pragma once
 
 #include <cmath>
@@ -29,7 +30,7 @@ struct EquationSpec {
   /// copies of the spec share it.
   std::shared_ptr<const CompiledExpression> g;
   std::optional<MotionLaw> law;  ///< f(t), in g's unit; none means f ≡ 0
-  Unit unit = Unit::kNone;  ///< what g measures: the row's unit, for its tolerance (Unit::kNone: plain tol)
+  Unit unit = Unit::kNone;       ///< what g measures: the row's unit, for its tolerance (Unit::kNone: plain tol)
   /// @copydoc DistanceSpec::operator==
   /// Equations compare g by its program (CompiledExpression::operator==: a parameter is a constant of the tape).
   bool operator==(const EquationSpec& o) const {
@@ -55,7 +56,8 @@ struct EquationSpec {
   }
   /// @copydoc DistanceSpec::residual
   /// @par Equation
-  /// For an equation: Φ = g(q, t) − f(t) (wrapped to (−π, π] when g is an angle, above). g is evaluated with thread-local scratch (see CompiledExpression).
+  /// For an equation: Φ = g(q, t) − f(t) (wrapped to (−π, π] when g is an angle, above). g is evaluated with
+  /// thread-local scratch (see CompiledExpression).
   void residual(const double* q, double t, double* phi) const {
     const double d = g->value(q, t) - (law ? law->evaluate(t).f : 0.0);
     phi[0] = g->angle_difference() ? wrapped_angle(d) : d;
@@ -111,8 +113,10 @@ struct EquationSpec {
         h->gradient(q, t, grad.data());
         const double* v = order == 1 ? qd : qdd;
         for (std::size_t k = 0; k < cols.size(); ++k) d += grad[k] * v[cols[k]];
-        if (order == 1) d += h->depends_on_time() ? h->partial_t(q, t) : 0.0;
-        else d -= h->gamma(q, qd, t);
+        if (order == 1)
+          d += h->depends_on_time() ? h->partial_t(q, t) : 0.0;
+        else
+          d -= h->gamma(q, qd, t);
       }
     }
     out[0] = d + (rate.law ? detail::minus_law_rate(*rate.law, order, t) : 0.0);
@@ -130,8 +134,9 @@ struct EquationSpec {
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
       {"constraints", "equation", 0, "- {name: crank_x, type: equation, expr: \"xA - L2*cos(theta2)\", unit: length}"},
-      {"drivers", "expr", 0, "- {name: lift, expr: yA, unit: length, law: {type: harmonic, amplitude: 0.1, "
-                             "frequency: 1}}"}};
+      {"drivers", "expr", 0,
+       "- {name: lift, expr: yA, unit: length, law: {type: harmonic, amplitude: 0.1, "
+       "frequency: 1}}"}};
   /// @copydoc DistanceSpec::read
   /// (The driver form, `expr` under `drivers`, is read with the other drivers.)
   template <class Fields>

@@ -65,9 +65,9 @@ struct EulerParametersSpec {
   template <class Sketch>
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {
-      {"bodies", "(every spatial body: BODY.euler)", 3, "crank: [crank_x, crank_y, crank_z, crank_e0, crank_e1, "
-                                                        "crank_e2, crank_e3]"}};
+  static constexpr SceneForm kScene[] = {{"bodies", "(every spatial body: BODY.euler)", 3,
+                                          "crank: [crank_x, crank_y, crank_z, crank_e0, crank_e1, "
+                                          "crank_e2, crank_e3]"}};
 };
 
 }  // namespace phiq

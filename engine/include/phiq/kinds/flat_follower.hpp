@@ -103,8 +103,8 @@ struct FlatFollowerSpec {
   /// their k-th time derivatives along p are Σᵢ C(k, i) (ê⁽ⁱ⁾ × h⁽ᵏ⁻ⁱ⁾ + e⁽ⁱ⁾ × ĥ⁽ᵏ⁻ⁱ⁾), and alike with w, where
   /// ê = R_a û + ψ̂_a e⊥ (detail::turned_data_derivative()), ĥ = r̂_b + ψ̂_b C⊥ − P̂_a with C = R_b c(s), and
   /// ŵ = ψ̂_b w⊥; C, w and their time derivatives are carried by b along the profile (detail::carried_along_curve()).
-  void data_derivative(const FlatFollowerSpec& rate, int order, const double* q, const double* qd,
-                       const double* qdd, double, double* out) const {
+  void data_derivative(const FlatFollowerSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
     const Geometry g = geometry(q);
     const Frame2& b = on.frame;
     const double wa = order >= 1 ? a.psi.rate(qd) : 0.0, wb = order >= 1 ? b.psi.rate(qd) : 0.0;
@@ -157,8 +157,9 @@ struct FlatFollowerSpec {
     detail::require(std::isfinite(n) && n > 0.0, "flat_cam: the face's direction must be a non-zero finite vector");
     axis = (1.0 / n) * axis;
     detail::require(std::isfinite(sa.x) && std::isfinite(sa.y), "flat_cam: the face's point is not finite");
-    detail::require(on.curve->convex(), "flat_cam: the profile is not convex (it turns both ways): a flat face "
-                                        "would touch it at more than one point");
+    detail::require(on.curve->convex(),
+                    "flat_cam: the profile is not convex (it turns both ways): a flat face "
+                    "would touch it at more than one point");
   }
   /// @copydoc PointOnCurveSpec::added_initial
   /// For a flat follower: the profile's point farthest towards the face, in the direction of the face's normal

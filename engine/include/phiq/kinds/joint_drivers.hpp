@@ -31,8 +31,10 @@ struct JointDistanceDriverSpec {
   template <class Sketch>
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {{"drivers", "joint (measure: distance)", 3, "- {name: push, joint: slider, "
-        "measure: distance, law: {type: linear, initial: 0, rate: 0.1}}"}};
+  static constexpr SceneForm kScene[] = {{"drivers", "joint (measure: distance)", 3,
+                                          "- {name: push, joint: slider, "
+                                          "measure: distance, law: {type: linear, initial: 0, rate: 0.1}}"}};
+
  private:
   static constexpr detail3::RowDef kDefs[1] = {
       {detail3::T(detail3::kZa), detail3::T(detail3::kPb, detail3::kPa), Unit::kLength}};
@@ -101,6 +103,7 @@ struct JointDistanceDriverSpec {
 struct JointAngleDriverSpec {
   /// @copydoc DistanceSpec::operator==
   bool operator==(const JointAngleDriverSpec&) const = default;
+
  private:
   // c = x_a · x_b and s = y_a · x_b
   static constexpr detail3::RowDef kDefs[2] = {{detail3::T(detail3::kXa), detail3::T(detail3::kXb), Unit::kNone},
@@ -166,7 +169,6 @@ struct JointAngleDriverSpec {
              detail::minus_law_rate(rate.law, order, t);
   }
 
-
   /// @copydoc DistanceSpec::joint_count
   /// A driver is not counted.
   JointCount joint_count() const { return JointCount::driver(); }
@@ -178,8 +180,10 @@ struct JointAngleDriverSpec {
   template <class Sketch>
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {{"drivers", "joint (measure: angle)", 3, "- {name: crank_motor, "
-        "joint: crank_hinge, law: {type: linear, initial: 0, rate: 1}}"}};
+  static constexpr SceneForm kScene[] = {{"drivers", "joint (measure: angle)", 3,
+                                          "- {name: crank_motor, "
+                                          "joint: crank_hinge, law: {type: linear, initial: 0, rate: 1}}"}};
+
  private:
   // c = x_a · x_b and s = y_a · x_b
   static detail3::AngleRows angle() { return {kCompact.rows[0], kCompact.rows[1]}; }

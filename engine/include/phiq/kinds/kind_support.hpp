@@ -28,7 +28,6 @@ enum class JointMark {
   kPoint,      ///< the end of a natural-coordinate link (a natural point, moving or fixed)
 };
 
-
 namespace kin {
 struct V2 {
   double x, y;
@@ -137,8 +136,8 @@ inline kin::V2 turned_data_derivative(const Slot& psi, const kin::V2& s, const S
   return al * kin::perp(ud) - (w * w) * ud - psid * (al * u + (w * w) * kin::perp(u));
 }
 // The same of a point r + R(ψ) s of frame f, its rates `rf` (constant slots) and `rs`: r̂ joins order 0.
-inline kin::V2 point_data_derivative(const Frame2& f, const kin::V2& s, const Frame2& rf, const kin::V2& rs,
-                                     int order, const double* q, const double* qd, const double* qdd) {
+inline kin::V2 point_data_derivative(const Frame2& f, const kin::V2& s, const Frame2& rf, const kin::V2& rs, int order,
+                                     const double* q, const double* qd, const double* qdd) {
   const kin::V2 turned = turned_data_derivative(f.psi, s, rf.psi, rs, order, q, qd, qdd);
   return order == 0 ? kin::V2{rf.x.of(q), rf.y.of(q)} + turned : turned;
 }
@@ -208,14 +207,14 @@ inline bool datum_rate(std::optional<MotionLaw>& rate, const std::array<const st
 // An expression's rate along a parameter (CompiledExpression::along_constants()): its constants' rates by the
 // central difference, the expression differentiated along them exactly; `rate` null where none moves. False where
 // the five were not compiled from one text against the same names, or its rate cannot be compiled.
-inline bool expression_rate(const CompiledExpression& at, const std::array<const CompiledExpression*, 4>& v,
-                            double h, std::shared_ptr<const CompiledExpression>& rate) {
+inline bool expression_rate(const CompiledExpression& at, const std::array<const CompiledExpression*, 4>& v, double h,
+                            std::shared_ptr<const CompiledExpression>& rate) {
   for (const CompiledExpression* e : v)
     if (!e || !e->same_source(at)) return false;
   std::vector<double> r(at.constants().size());
   for (std::size_t k = 0; k < r.size(); ++k) {
-    r[k] = central_difference(v[0]->constants()[k], v[1]->constants()[k], v[2]->constants()[k],
-                              v[3]->constants()[k], h);
+    r[k] =
+        central_difference(v[0]->constants()[k], v[1]->constants()[k], v[2]->constants()[k], v[3]->constants()[k], h);
     if (!std::isfinite(r[k])) return false;
   }
   try {
@@ -242,9 +241,12 @@ template <class Spec>
 bool spec_data_rate(const Spec& at, const std::array<const Spec*, 4>& along, double h, Spec& rate) {
   rate = at;
   bool ok = true;
-  std::apply([&](auto... m) { ((ok = ok && datum_rate(rate.*m, {&(along[0]->*m), &(along[1]->*m), &(along[2]->*m),
-                                                                 &(along[3]->*m)}, h)), ...); },
-             Spec::data_members());
+  std::apply(
+      [&](auto... m) {
+        ((ok = ok && datum_rate(rate.*m, {&(along[0]->*m), &(along[1]->*m), &(along[2]->*m), &(along[3]->*m)}, h)),
+         ...);
+      },
+      Spec::data_members());
   for (const Spec* s : along) {
     Spec other = *s;
     std::apply([&](auto... m) { ((other.*m = at.*m), ...); }, Spec::data_members());

@@ -1,6 +1,7 @@
 /// @file
-/// The closure of a kinematic loop in relative coordinates. One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
+/// The closure of a kinematic loop in relative coordinates. One constraint kind: its equation, derivatives, validation,
+/// joint count, sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every
+/// kind).
 #pragma once
 
 #include <cmath>
@@ -26,18 +27,18 @@ struct LoopSpec {
   /// One term sign · q_j of the angle θ_k of a link.
   struct Term {
     bool operator==(const Term&) const = default;  ///< the slot and its factor
-    Slot angle;  ///< q_j, an angle (rad): usually a coordinate (absolute or relative joint angle)
+    Slot angle;         ///< q_j, an angle (rad): usually a coordinate (absolute or relative joint angle)
     double sign = 1.0;  ///< its factor in θ_k: +1 or −1 (any finite factor is accepted)
   };
   /// One link of the loop: the vector ℓ_k (cos θ_k, sin θ_k), with θ_k = offset + Σ_terms sign · q_j.
   struct Link {
     bool operator==(const Link&) const = default;  ///< datum by datum
-    Slot length;  ///< ℓ_k (m): a constant link length, or a coordinate (e.g. a slider travel)
-    double offset = 0.0;  ///< constant part of θ_k (rad), finite
+    Slot length;              ///< ℓ_k (m): a constant link length, or a coordinate (e.g. a slider travel)
+    double offset = 0.0;      ///< constant part of θ_k (rad), finite
     std::vector<Term> terms;  ///< the variable part of θ_k; empty for a link of constant direction
   };
   std::vector<Link> links;  ///< the links of the loop, at least one (checked when the constraint is added)
-  kin::V2 closure{0, 0};  ///< c, the constant closure vector (m): (0, 0) when the loop returns to its start
+  kin::V2 closure{0, 0};    ///< c, the constant closure vector (m): (0, 0) when the loop returns to its start
 
   /// @copydoc DistanceSpec::depends_on_time
   /// A loop is time-independent.
@@ -129,8 +130,8 @@ struct LoopSpec {
   ///   ∂(Φq q̈ − γ)/∂p = Σ ℓ̈ θ̂ u⊥ + 2 ℓ̇ (∂ω u⊥ − ω θ̂ u) + ℓ̂ (α u⊥ − ω² u) + ℓ (∂α u⊥ − 2 ω ∂ω u)
   ///                    − ℓ θ̂ (α u + ω² u⊥).
   /// @pre `rate` has the links and terms of this loop (what datum_rate() makes).
-  void data_derivative(const LoopSpec& rate, int order, const double* q, const double* qd, const double* qdd,
-                       double, double* out) const {
+  void data_derivative(const LoopSpec& rate, int order, const double* q, const double* qd, const double* qdd, double,
+                       double* out) const {
     kin::V2 sum = order == 0 ? -1.0 * rate.closure : kin::V2{0, 0};
     for (std::size_t i = 0; i < links.size(); ++i) {
       const Link& k = links[i];
@@ -175,9 +176,10 @@ struct LoopSpec {
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "loop", 2, "- {name: closure, type: loop, links: [{length: L2, angles: [psi2]}, {length: L3, "
-                                 "angles: [psi2, psi3]}, {length: L4, angles: [psi2, psi3, psi4]}], closure: [L1, "
-                                 "0]}"}};
+      {"constraints", "loop", 2,
+       "- {name: closure, type: loop, links: [{length: L2, angles: [psi2]}, {length: L3, "
+       "angles: [psi2, psi3]}, {length: L4, angles: [psi2, psi3, psi4]}], closure: [L1, "
+       "0]}"}};
   /// @copydoc DistanceSpec::read
   /// A loop's `links` are maps {length, angles, offset}, the angles coordinate names with an optional sign.
   template <class Fields>

@@ -1,6 +1,7 @@
 /// @file
-/// The coincidence of two attachment points: revolute pairs and fixed points in the plane. One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
+/// The coincidence of two attachment points: revolute pairs and fixed points in the plane. One constraint kind: its
+/// equation, derivatives, validation, joint count, sketch and scene form (the contract is documented on DistanceSpec;
+/// kinds/registry.hpp lists every kind).
 #pragma once
 
 #include <cmath>
@@ -85,13 +86,12 @@ struct PinSpec {
   /// rate of a constant ψ, ω = ψ̇ and α = ψ̈ (a side's terms enter a minus b):
   ///
   ///   ∂Φ/∂p: ṙ + u̇ + ψ̂ u⊥,   ∂(Φq q̇)/∂p: ω u̇⊥ − ψ̂ ω u,   ∂(Φq q̈ − γ)/∂p: α u̇⊥ − ω² u̇ − ψ̂ (α u + ω² u⊥).
-  void data_derivative(const PinSpec& rate, int order, const double* q, const double* qd, const double* qdd,
-                       double, double* out) const {
+  void data_derivative(const PinSpec& rate, int order, const double* q, const double* qd, const double* qdd, double,
+                       double* out) const {
     const kin::V2 d = detail::point_data_derivative(a, sa, rate.a, rate.sa, order, q, qd, qdd) -
                       detail::point_data_derivative(b, sb, rate.b, rate.sb, order, q, qd, qdd);
     out[0] = d.x, out[1] = d.y;
   }
-
 
   /// @copydoc DistanceSpec::joint_count
   /// A pin between bodies or ground is a revolute pair (2 freedoms); with a natural point the count is undefined.
@@ -111,8 +111,9 @@ struct PinSpec {
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "revolute", 2, "- {name: A, type: revolute, between: [{body: crank, at: [0.2, 0]}, "
-                                     "{body: coupler, at: [-0.6, 0]}]}"},
+      {"constraints", "revolute", 2,
+       "- {name: A, type: revolute, between: [{body: crank, at: [0.2, 0]}, "
+       "{body: coupler, at: [-0.6, 0]}]}"},
       {"constraints", "fixed_point", 2, "- {name: pin, type: fixed_point, point: P, at: [0.5, 0]}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
@@ -122,12 +123,15 @@ struct PinSpec {
       const Point2 p = f.point("point");
       const kin::V2 at = f.vec2("at");
       return PinSpec{Frame2{p.x, p.y, Slot::constant(0)},
-                     Frame2{Slot::constant(at.x), Slot::constant(at.y), Slot::constant(0)}, {0, 0}, {0, 0}};
+                     Frame2{Slot::constant(at.x), Slot::constant(at.y), Slot::constant(0)},
+                     {0, 0},
+                     {0, 0}};
     }
     f.expect({"type", "name", "between"});
     const auto [ea, eb] = f.attachments("between", "a revolute joins two attachments");
     return PinSpec{ea.frame, eb.frame, ea.at, eb.at};
   }
+
  private:
   /// @cond internal
   /// Whether the attachment turns with a coordinate: then Φ depends on its ψ.

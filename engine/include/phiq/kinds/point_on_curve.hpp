@@ -31,8 +31,8 @@ struct PointOnCurveSpec {
   /// @var a
   /// @brief Frame of the point: a body (x, y in m, ψ in rad), a natural point (ψ constant, sa = 0) or ground.
   Frame2 a;
-  kin::V2 sa{0, 0};  ///< s_a, the point in a's local frame (m)
-  CurveOn on;        ///< the curve and the frame b that carries it
+  kin::V2 sa{0, 0};     ///< s_a, the point in a's local frame (m)
+  CurveOn on;           ///< the curve and the frame b that carries it
   double offset = 0.0;  ///< ρ, the roller's radius (m); 0 for a knife edge or a pin
   Slot s;               ///< the curve parameter (m along the curve): the added coordinate
 
@@ -89,16 +89,15 @@ struct PointOnCurveSpec {
   /// local point, the curve's frame and the roller's radius. The curve itself is no datum: where a parameter changes
   /// its shape (a radius, a profile's points) the constraint is differenced, s moving with the curve's length.
   static constexpr auto data_members() {
-    return std::tuple{&PointOnCurveSpec::a, &PointOnCurveSpec::sa, &PointOnCurveSpec::on,
-                      &PointOnCurveSpec::offset};
+    return std::tuple{&PointOnCurveSpec::a, &PointOnCurveSpec::sa, &PointOnCurveSpec::on, &PointOnCurveSpec::offset};
   }
   /// Derivatives along the data (DistanceSpec::data_derivative()). With P = R_b p(s) and N = R_b n(s), carried by
   /// frame b along the curve (their time derivatives in detail::carried_along_curve()), ψ̂_b and r̂_b the rates of
   /// b's constant slots, ρ̂ the radius's, and P̂_a the point's (detail::point_data_derivative()):
   ///
   ///   ∂Φ/∂p = P̂_a − r̂_b − ψ̂_b P⊥ − ρ̂ N,   and its time derivatives: P̂_a⁽ᵏ⁾ − ψ̂_b P⁽ᵏ⁾⊥ − ρ̂ N⁽ᵏ⁾ (k = 1, 2).
-  void data_derivative(const PointOnCurveSpec& rate, int order, const double* q, const double* qd,
-                       const double* qdd, double, double* out) const {
+  void data_derivative(const PointOnCurveSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
     const Frame2& b = on.frame;
     const double psid = rate.on.frame.psi.of(q), rhod = rate.offset;
     kin::V2 d = detail::point_data_derivative(a, sa, rate.a, rate.sa, order, q, qd, qdd);

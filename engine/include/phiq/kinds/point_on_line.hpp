@@ -1,6 +1,7 @@
 /// @file
-/// A point on the straight line through two points (natural coordinates). One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
+/// A point on the straight line through two points (natural coordinates). One constraint kind: its equation,
+/// derivatives, validation, joint count, sketch and scene form (the contract is documented on DistanceSpec;
+/// kinds/registry.hpp lists every kind).
 #pragma once
 
 #include <cmath>

@@ -1,6 +1,7 @@
 /// @file
-/// A point at a distance and an angle from another (mixed coordinates: the notes' crank). One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
+/// A point at a distance and an angle from another (mixed coordinates: the notes' crank). One constraint kind: its
+/// equation, derivatives, validation, joint count, sketch and scene form (the contract is documented on DistanceSpec;
+/// kinds/registry.hpp lists every kind).
 #pragma once
 
 #include <cmath>
@@ -22,9 +23,9 @@ struct PolarSpec {
   static constexpr const char* kKind = "polar";
   /// @var p
   /// @brief P, the point placed at distance L from o (m).
-  Point2 p, o;  ///< O, the origin of the polar vector (m)
+  Point2 p, o;          ///< O, the origin of the polar vector (m)
   double length = 1.0;  ///< L, metres, finite (a negative L points against θ)
-  Slot theta;  ///< θ, the direction of P − O against the x axis (rad): a coordinate or a constant
+  Slot theta;           ///< θ, the direction of P − O against the x axis (rad): a coordinate or a constant
 
   /// @copydoc DistanceSpec::depends_on_time
   /// A polar constraint is time-independent.
@@ -74,8 +75,8 @@ struct PolarSpec {
   ///
   ///   ∂Φ/∂p = ṗ − ȯ − L̇ u − L θ̂ u⊥,   ∂(Φq q̇)/∂p = −L̇ ω u⊥ + L θ̂ ω u,
   ///   ∂(Φq q̈ − γ)/∂p = L̇ (ω² u − α u⊥) + L θ̂ (α u + ω² u⊥).
-  void data_derivative(const PolarSpec& rate, int order, const double* q, const double* qd, const double* qdd,
-                       double, double* out) const {
+  void data_derivative(const PolarSpec& rate, int order, const double* q, const double* qd, const double* qdd, double,
+                       double* out) const {
     const double th = theta.of(q), c = std::cos(th), s = std::sin(th), Ld = rate.length, thd = rate.theta.of(q);
     if (order == 0) {
       out[0] = rate.p.x.of(q) - rate.o.x.of(q) - Ld * c + length * s * thd;

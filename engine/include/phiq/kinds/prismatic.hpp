@@ -1,6 +1,7 @@
 /// @file
-/// The planar prismatic pair between two bodies (reference-point coordinates). One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
+/// The planar prismatic pair between two bodies (reference-point coordinates). One constraint kind: its equation,
+/// derivatives, validation, joint count, sketch and scene form (the contract is documented on DistanceSpec;
+/// kinds/registry.hpp lists every kind).
 #pragma once
 
 #include <cmath>
@@ -26,8 +27,8 @@ struct PrismaticSpec {
   /// @var sa
   /// @brief s_a, a point of the sliding line in a's local frame (m).
   kin::V2 sa{0, 0}, sb{0, 0};  ///< s_b, the point of b kept on the line, in b's local frame (m)
-  kin::V2 axis{1, 0};  ///< u, direction of the line in a's local frame; normalised when the constraint is added
-  double angle = 0.0;  ///< θ0, the constant relative angle ψ_b − ψ_a (rad)
+  kin::V2 axis{1, 0};          ///< u, direction of the line in a's local frame; normalised when the constraint is added
+  double angle = 0.0;          ///< θ0, the constant relative angle ψ_b − ψ_a (rad)
 
   /// @copydoc DistanceSpec::depends_on_time
   /// A prismatic pair is time-independent.
@@ -70,8 +71,8 @@ struct PrismaticSpec {
     Geometry g = geometry(q);
     double wa = a.psi.rate(qd), wb = b.psi.rate(qd);
     kin::V2 edot = wa * kin::perp(g.e);
-    kin::V2 hdot = kin::V2{b.x.rate(qd), b.y.rate(qd)} + wb * kin::perp(g.arm_b) -
-                   kin::V2{a.x.rate(qd), a.y.rate(qd)} - wa * kin::perp(g.arm_a);
+    kin::V2 hdot = kin::V2{b.x.rate(qd), b.y.rate(qd)} + wb * kin::perp(g.arm_b) - kin::V2{a.x.rate(qd), a.y.rate(qd)} -
+                   wa * kin::perp(g.arm_a);
     // q̈-free parts: ë = −ψ̇a² e, ḧ = −ψ̇b² R_b s_b + ψ̇a² R_a s_a
     kin::V2 hdd = (wa * wa) * g.arm_a - (wb * wb) * g.arm_b;
     double phidd = -wa * wa * kin::cross(g.e, g.h) + 2.0 * kin::cross(edot, hdot) + kin::cross(g.e, hdd);
@@ -81,8 +82,8 @@ struct PrismaticSpec {
   /// The data a parameter may move (DistanceSpec::data_members()): the frames' constant slots, the local points, the
   /// axis and the relative angle.
   static constexpr auto data_members() {
-    return std::tuple{&PrismaticSpec::a, &PrismaticSpec::b, &PrismaticSpec::sa, &PrismaticSpec::sb,
-                      &PrismaticSpec::axis, &PrismaticSpec::angle};
+    return std::tuple{&PrismaticSpec::a,  &PrismaticSpec::b,    &PrismaticSpec::sa,
+                      &PrismaticSpec::sb, &PrismaticSpec::axis, &PrismaticSpec::angle};
   }
   /// Derivatives along the data (DistanceSpec::data_derivative()). Row 0 reads only angles: ψ̂_b − ψ̂_a − θ̂0 at
   /// order 0, nothing at orders 1 and 2. Row 1 is e × h; with the data's rates ê = R(ψ_a) û + ψ̂_a e⊥ and
@@ -124,7 +125,6 @@ struct PrismaticSpec {
              kin::cross(eh, hdd) + kin::cross(g.e, hddh);
   }
 
-
   /// @copydoc DistanceSpec::joint_count
   /// A prismatic pair between bodies or ground removes 2 freedoms.
   JointCount joint_count() const { return detail::planar_pair_joint_count(a, b); }
@@ -145,9 +145,9 @@ struct PrismaticSpec {
     sk.slider(a, axis, b, sb);
   }
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "prismatic", 2, "- {name: slide, type: prismatic, between: [{body: ground}, {body: slider}], "
-                                      "axis: [1, 0]}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "prismatic", 2,
+                                          "- {name: slide, type: prismatic, between: [{body: ground}, {body: slider}], "
+                                          "axis: [1, 0]}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static PrismaticSpec read(const Fields& f) {
@@ -161,6 +161,7 @@ struct PrismaticSpec {
     if (spec.axis.x == 0.0 && spec.axis.y == 0.0) f.fail("axis", "the axis must not be zero");
     return spec;
   }
+
  private:
   /// @cond internal
   /// The vectors of the equations at q: e = R(ψ_a) u, arm_k = R(ψ_k) s_k, h = P_b − P_a.

@@ -96,8 +96,8 @@ struct KindList {
 /// a type, as `revolute` in the plane and in space, are told apart by the scene's dimension).
 using ConstraintKinds =
     KindList<DistanceSpec, PinSpec, PointOnLineSpec, ConstantAngleSpec, SegmentAngleSpec, PolarSpec, PrismaticSpec,
-             LoopSpec, EquationSpec, CouplerSpec, CoordinateDriverSpec,
-             PointOnCurveSpec, FlatFollowerSpec,  // higher pairs on curves
+             LoopSpec, EquationSpec, CouplerSpec, CoordinateDriverSpec, PointOnCurveSpec,
+             FlatFollowerSpec,  // higher pairs on curves
              EulerParametersSpec, UnitVectorSpec, SpatialDistanceSpec, DotSpec, SphericalSpec, SpatialRevoluteSpec,
              SpatialPrismaticSpec, CylindricalSpec, UniversalSpec, PlanarSpec, RigidSpec, SpatialPointOnLineSpec,
              PointOnPlaneSpec, JointDistanceDriverSpec, JointAngleDriverSpec,

@@ -25,6 +25,7 @@ namespace phiq {
 struct ScrewSpec {
   /// @copydoc DistanceSpec::operator==
   bool operator==(const ScrewSpec&) const = default;
+
  private:
   // the cylindrical rows, then c, s and d
   static constexpr detail3::RowDef kDefs[7] = {
@@ -45,8 +46,8 @@ struct ScrewSpec {
       .measures = {.angle = true, .distance = true}, .drives = {.angle = true, .distance = true}, .shaft = true};
   /// @var a
   /// @brief Side a (the nut, or ground): its axis z_a is the screw's axis.
-  JointSide3 a, b;      ///< side b (the screw)
-  double pitch = 1.0;   ///< p, the travel per turn (m), non-zero; negative for a left-handed thread
+  JointSide3 a, b;     ///< side b (the screw)
+  double pitch = 1.0;  ///< p, the travel per turn (m), non-zero; negative for a left-handed thread
   /// The rows' attachments and the rows renumbered into them (detail3::compact_rows).
   static constexpr auto kCompact = detail3::compact_rows(kDefs);
   std::array<Attachment3, kCompact.count> att{};  ///< derived by setup(): the attachments the rows read
@@ -123,8 +124,9 @@ struct ScrewSpec {
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "screw", 3, "- {name: lead_screw, type: screw, between: [{body: ground, axis: [0, 0, 1]}, "
-                                  "{body: nut, axis: [0, 0, 1]}], pitch: 0.005}"}};
+      {"constraints", "screw", 3,
+       "- {name: lead_screw, type: screw, between: [{body: ground, axis: [0, 0, 1]}, "
+       "{body: nut, axis: [0, 0, 1]}], pitch: 0.005}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static ScrewSpec read(const Fields& f) {

@@ -1,6 +1,7 @@
 /// @file
-/// The angle coordinate of a segment (natural coordinates mixed with an angle). One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form (the contract is documented on DistanceSpec; kinds/registry.hpp lists every kind).
+/// The angle coordinate of a segment (natural coordinates mixed with an angle). One constraint kind: its equation,
+/// derivatives, validation, joint count, sketch and scene form (the contract is documented on DistanceSpec;
+/// kinds/registry.hpp lists every kind).
 #pragma once
 
 #include <cmath>
@@ -23,7 +24,7 @@ struct SegmentAngleSpec {
   /// @var a
   /// @brief A, start of the segment (m).
   Point2 a, b;  ///< B, end of the segment (m)
-  Slot theta;  ///< θ, the angle of b − a against the x axis (rad): usually a coordinate; a constant fixes it
+  Slot theta;   ///< θ, the angle of b − a against the x axis (rad): usually a coordinate; a constant fixes it
 
   /// @copydoc DistanceSpec::depends_on_time
   /// A segment angle is time-independent.
@@ -70,8 +71,8 @@ struct SegmentAngleSpec {
   /// Derivatives along the data (DistanceSpec::data_derivative()). Φ = d × w with d = b − a, w = (cos θ, sin θ),
   /// so Φ⁽ᵏ⁾ = Σ_i C(k, i) d⁽ⁱ⁾ × w⁽ᵏ⁻ⁱ⁾; the data move d (d̂, the fixed ends' rates) and a constant θ (ŵ = θ̂ w⊥,
   /// whose w does not move), so that ∂Φ⁽ᵏ⁾/∂p = d̂ × w⁽ᵏ⁾ + d⁽ᵏ⁾ × ŵ, with ẇ = ω w⊥, ẅ = α w⊥ − ω² w.
-  void data_derivative(const SegmentAngleSpec& rate, int order, const double* q, const double* qd,
-                       const double* qdd, double, double* out) const {
+  void data_derivative(const SegmentAngleSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
     const double th = theta.of(q);
     const kin::V2 w{std::cos(th), std::sin(th)}, wh = rate.theta.of(q) * kin::perp(w);
     const kin::V2 dh = kin::pos(rate.b, q) - kin::pos(rate.a, q);
@@ -99,8 +100,8 @@ struct SegmentAngleSpec {
     sk.bar(a, b);
   }
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "segment_angle", 2, "- {name: crank_angle, type: segment_angle, segment: [O, A], "
+  static constexpr SceneForm kScene[] = {{"constraints", "segment_angle", 2,
+                                          "- {name: crank_angle, type: segment_angle, segment: [O, A], "
                                           "angle: theta2}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>

@@ -25,7 +25,7 @@ struct SpatialDistanceSpec {
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "distance";
   std::array<Attachment3, 2> ends;  ///< A, B
-  double length = 1.0;  ///< L > 0 (checked when added)
+  double length = 1.0;              ///< L > 0 (checked when added)
 
   /// @copydoc DistanceSpec::depends_on_time
   bool depends_on_time() const { return false; }
@@ -55,17 +55,15 @@ struct SpatialDistanceSpec {
   }
   /// The data a parameter may move (DistanceSpec::data_members()): the ends (their local points, a fixed end's
   /// place) and the length.
-  static constexpr auto data_members() {
-    return std::tuple{&SpatialDistanceSpec::ends, &SpatialDistanceSpec::length};
-  }
+  static constexpr auto data_members() { return std::tuple{&SpatialDistanceSpec::ends, &SpatialDistanceSpec::length}; }
   /// Derivatives along the data (DistanceSpec::data_derivative()). Φ = (|d|² − L²)/(2L), d = B − A, whose Φq and
   /// γ are 1/(2L) times what does not hold L; the ends move d·d as a row of the joints
   /// (detail3::row_data_derivative(): Dk, the derivative of d·d's k-th time derivative along the ends):
   ///
   ///   ∂Φ/∂p = −L̇ (Φ + L) / L + D0/(2L),   ∂(Φq q̇)/∂p = −(L̇/L) Φq q̇ + D1/(2L),
   ///   ∂(Φq q̈ − γ)/∂p = −(L̇/L) (Φq q̈ − γ) + D2/(2L).
-  void data_derivative(const SpatialDistanceSpec& rate, int order, const double* q, const double* qd,
-                       const double* qdd, double t, double* out) const {
+  void data_derivative(const SpatialDistanceSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double t, double* out) const {
     const double k = rate.length / length;
     const double ends_term =
         detail3::row_data_derivative(ends.data(), rate.ends.data(), kDef, order, q, qd, qdd) / (2.0 * length);
@@ -86,7 +84,6 @@ struct SpatialDistanceSpec {
     out[0] = -k * value + ends_term;
   }
 
-
   /// @copydoc DistanceSpec::joint_count
   /// A distance between body (or ground) points is a bar with two ball joints, removing one freedom; between
   /// natural points it is no joint.
@@ -104,7 +101,8 @@ struct SpatialDistanceSpec {
   void prepare(const double* /*q0*/) {
     detail::require(std::isfinite(length) && length > 0.0, "distance: length must be positive and finite");
     for (Attachment3& e : ends) {
-      detail::require(std::isfinite(e.s.x) && std::isfinite(e.s.y) && std::isfinite(e.s.z), "distance: point is not finite");
+      detail::require(std::isfinite(e.s.x) && std::isfinite(e.s.y) && std::isfinite(e.s.z),
+                      "distance: point is not finite");
       e.fold_constant();
     }
   }
@@ -138,6 +136,7 @@ struct SpatialDistanceSpec {
     spec.length = f.positive("length");
     return spec;
   }
+
  private:
   static constexpr detail3::RowDef kDef = {detail3::T(1, 0), detail3::T(1, 0), Unit::kLength};
 };

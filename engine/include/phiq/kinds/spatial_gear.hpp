@@ -36,16 +36,16 @@ struct SpatialGearSpec {
   static constexpr int kRows = 3;  ///< the two shafts' angles and the ratio
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "spatial_gear";
-  JointSide3 a1;              ///< shaft 1's joint, side a: the housing (its z is the axis)
-  JointSide3 b1;              ///< shaft 1's joint, side b: the shaft
-  JointSide3 a2;              ///< shaft 2's joint, side a
-  JointSide3 b2;              ///< shaft 2's joint, side b
-  Slot theta1;                ///< θ1 (rad): a coordinate
-  Slot theta2;                ///< θ2 (rad): a coordinate
-  double z1 = 1.0;            ///< gear 1's tooth count (or pitch radius), > 0
-  double z2 = 1.0;            ///< gear 2's tooth count (or pitch radius), > 0
-  bool reversed = false;      ///< the relation z1 θ1 − z2 θ2 = z1 φ
-  double phase = 0.0;         ///< φ (rad)
+  JointSide3 a1;                      ///< shaft 1's joint, side a: the housing (its z is the axis)
+  JointSide3 b1;                      ///< shaft 1's joint, side b: the shaft
+  JointSide3 a2;                      ///< shaft 2's joint, side a
+  JointSide3 b2;                      ///< shaft 2's joint, side b
+  Slot theta1;                        ///< θ1 (rad): a coordinate
+  Slot theta2;                        ///< θ2 (rad): a coordinate
+  double z1 = 1.0;                    ///< gear 1's tooth count (or pitch radius), > 0
+  double z2 = 1.0;                    ///< gear 2's tooth count (or pitch radius), > 0
+  bool reversed = false;              ///< the relation z1 θ1 − z2 θ2 = z1 φ
+  double phase = 0.0;                 ///< φ (rad)
   std::array<Attachment3, 4> att1{};  ///< derived by setup(): x_a, y_a, z_a, x_b of shaft 1's joint
   std::array<Attachment3, 4> att2{};  ///< the same of shaft 2's joint
 
@@ -100,9 +100,9 @@ struct SpatialGearSpec {
   /// The data a parameter may move (DistanceSpec::data_members()): the shafts' sides through their attachments, the
   /// tooth counts and the phase.
   static constexpr auto data_members() {
-    return std::tuple{&SpatialGearSpec::a1, &SpatialGearSpec::b1, &SpatialGearSpec::a2, &SpatialGearSpec::b2,
-                      &SpatialGearSpec::z1, &SpatialGearSpec::z2, &SpatialGearSpec::phase, &SpatialGearSpec::att1,
-                      &SpatialGearSpec::att2};
+    return std::tuple{&SpatialGearSpec::a1,    &SpatialGearSpec::b1,   &SpatialGearSpec::a2,
+                      &SpatialGearSpec::b2,    &SpatialGearSpec::z1,   &SpatialGearSpec::z2,
+                      &SpatialGearSpec::phase, &SpatialGearSpec::att1, &SpatialGearSpec::att2};
   }
   /// Derivatives along the data (DistanceSpec::data_derivative()): the shafts' angles along their attachments
   /// (detail3::AngleRows::data_derivative()); the ratio row θ1 + k θ2 − φ, k = ±z2/z1, as k̂ θ2⁽ⁿ⁾ − φ̂ δ_n0 with
@@ -132,9 +132,9 @@ struct SpatialGearSpec {
   template <class Sketch>
   void sketch(Sketch&) const {}
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "spatial_gear", 3, "- {name: bevel, type: spatial_gear, shafts: [input_bearing, "
-                                         "output_bearing], angles: [theta1, theta2], teeth: [15, 30]}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "spatial_gear", 3,
+                                          "- {name: bevel, type: spatial_gear, shafts: [input_bearing, "
+                                          "output_bearing], angles: [theta1, theta2], teeth: [15, 30]}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static SpatialGearSpec read(const Fields& f) {

@@ -238,8 +238,9 @@ struct SpatialJointSpec {
       return spec;
     }
     if (f.present("axis"))  // where a planar prismatic writes it
-      f.fail("axis", "in dimension 3 a joint's axis is given on each side, in that body's frame: between: "
-                     "[{body: A, axis: [x, y, z]}, {body: B, axis: [x, y, z]}]");
+      f.fail("axis",
+             "in dimension 3 a joint's axis is given on each side, in that body's frame: between: "
+             "[{body: A, axis: [x, y, z]}, {body: B, axis: [x, y, z]}]");
     f.expect({"type", "name", "between"});
     std::tie(spec.a, spec.b) = f.sides3("between");
     return spec;
@@ -250,87 +251,91 @@ namespace joint3 {
 using detail3::Axis;
 using detail3::RowDef;
 using detail3::T;
-using namespace detail3;  // the attachment indices kPa …
+using namespace detail3;                   // the attachment indices kPa …
 inline constexpr Unit kL = Unit::kLength;  ///< shorthand for the row tables: a length row
 inline constexpr Unit kA = Unit::kAngle;   ///< shorthand for the row tables: an angle row
 
 /// Spherical joint (ball): the points coincide.   Φ = P_a − P_b   (3 rows, lengths)
 struct Spherical {
-  static constexpr int kRows = 3;  ///< rows: the freedoms it removes
+  static constexpr int kRows = 3;                    ///< rows: the freedoms it removes
   static constexpr const char* kKind = "spherical";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
       {"constraints", "spherical", 3, "- {name: base, type: spherical, between: [{body: ground}, {body: B1}]}"},
       {"constraints", "fixed_point", 3, "- {name: fixP, type: fixed_point, point: P, at: [1, 2, 3]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
-  static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL},
-                                             {Axis(2), T(kPa, kPb), kL}};
+  static constexpr RowDef kRowDefs[kRows] = {
+      {Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL}, {Axis(2), T(kPa, kPb), kL}};
 };
 /// Revolute joint: spherical, and the axes parallel.
 ///   Φ = [P_a − P_b;  x_a · z_b;  y_a · z_b]   (5 rows: 3 lengths, 2 angles)
 struct Revolute {
-  static constexpr int kRows = 5;  ///< rows: the freedoms it removes
+  static constexpr int kRows = 5;                   ///< rows: the freedoms it removes
   static constexpr const char* kKind = "revolute";  ///< scene type and diagnostics name
   /// its angle: output, driven, and a shaft
   static constexpr JointTraits kJoint{.measures = {.angle = true}, .drives = {.angle = true}, .shaft = true};
   /// its scene forms (SceneForm)
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "revolute", 3, "- {name: hinge, type: revolute, between: [{body: ground, at: [0, 0, 1], "
-                                     "axis: [0, 0, 1]}, {body: door, at: [0, 0, 1]}]}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "revolute", 3,
+                                          "- {name: hinge, type: revolute, between: [{body: ground, at: [0, 0, 1], "
+                                          "axis: [0, 0, 1]}, {body: door, at: [0, 0, 1]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
-  static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL},
-                                             {Axis(2), T(kPa, kPb), kL}, {T(kXa), T(kZb), kA},
+  static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL},
+                                             {Axis(1), T(kPa, kPb), kL},
+                                             {Axis(2), T(kPa, kPb), kL},
+                                             {T(kXa), T(kZb), kA},
                                              {T(kYa), T(kZb), kA}};
 };
 /// Cylindrical joint: the axes parallel, and P_b on the line of a (through P_a along z_a).
 ///   Φ = [x_a · z_b;  y_a · z_b;  x_a · (P_b − P_a);  y_a · (P_b − P_a)]   (4 rows: 2 angles, 2 lengths)
 struct Cylindrical {
-  static constexpr int kRows = 4;  ///< rows: the freedoms it removes
+  static constexpr int kRows = 4;                      ///< rows: the freedoms it removes
   static constexpr const char* kKind = "cylindrical";  ///< scene type and diagnostics name
   /// its angle and its distance: output, driven (one each), and a shaft
   static constexpr JointTraits kJoint{
       .measures = {.angle = true, .distance = true}, .drives = {.angle = true, .distance = true}, .shaft = true};
   /// its scene forms (SceneForm)
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "cylindrical", 3, "- {name: cyl, type: cylindrical, between: [{body: ground, axis: [1, 0, "
-                                        "0]}, {body: screw, axis: [1, 0, 0]}]}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "cylindrical", 3,
+                                          "- {name: cyl, type: cylindrical, between: [{body: ground, axis: [1, 0, "
+                                          "0]}, {body: screw, axis: [1, 0, 0]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
-  static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kZb), kA}, {T(kYa), T(kZb), kA},
-                                             {T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL}};
+  static constexpr RowDef kRowDefs[kRows] = {
+      {T(kXa), T(kZb), kA}, {T(kYa), T(kZb), kA}, {T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL}};
 };
 /// Prismatic joint: cylindrical, and no rotation about the axis (x_b stays along x_a).
 ///   Φ = [x_a · z_b;  y_a · z_b;  x_a · (P_b − P_a);  y_a · (P_b − P_a);  y_a · x_b]   (5 rows)
 struct Prismatic {
-  static constexpr int kRows = 5;  ///< rows: the freedoms it removes
+  static constexpr int kRows = 5;                    ///< rows: the freedoms it removes
   static constexpr const char* kKind = "prismatic";  ///< scene type and diagnostics name
   /// its distance: output and driven
   static constexpr JointTraits kJoint{.measures = {.distance = true}, .drives = {.distance = true}};
   /// its scene forms (SceneForm)
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "prismatic", 3, "- {name: slide, type: prismatic, between: [{body: ground, axis: [1, 0, 0]}, "
-                                      "{body: slider, axis: [1, 0, 0]}]}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "prismatic", 3,
+                                          "- {name: slide, type: prismatic, between: [{body: ground, axis: [1, 0, 0]}, "
+                                          "{body: slider, axis: [1, 0, 0]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
-  static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kZb), kA}, {T(kYa), T(kZb), kA},
-                                             {T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL},
+  static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kZb), kA},
+                                             {T(kYa), T(kZb), kA},
+                                             {T(kXa), T(kPb, kPa), kL},
+                                             {T(kYa), T(kPb, kPa), kL},
                                              {T(kYa), T(kXb), kA}};
 };
 /// Universal (Hooke) joint: spherical, and the two axes kept perpendicular (the cross).
 ///   Φ = [P_a − P_b;  z_a · z_b]   (4 rows: 3 lengths, 1 angle)
 struct Universal {
-  static constexpr int kRows = 4;  ///< rows: the freedoms it removes
+  static constexpr int kRows = 4;                    ///< rows: the freedoms it removes
   static constexpr const char* kKind = "universal";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "universal", 3, "- {name: cross, type: universal, between: [{body: s1, axis: [1, 0, 0]}, "
-                                      "{body: s2, axis: [0, 1, 0]}]}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "universal", 3,
+                                          "- {name: cross, type: universal, between: [{body: s1, axis: [1, 0, 0]}, "
+                                          "{body: s2, axis: [0, 1, 0]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
-  static constexpr RowDef kRowDefs[kRows] = {{Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL},
-                                             {Axis(2), T(kPa, kPb), kL}, {T(kZa), T(kZb), kA}};
+  static constexpr RowDef kRowDefs[kRows] = {
+      {Axis(0), T(kPa, kPb), kL}, {Axis(1), T(kPa, kPb), kL}, {Axis(2), T(kPa, kPb), kL}, {T(kZa), T(kZb), kA}};
 };
 /// Planar joint: the normals parallel, and P_b in the plane of a (through P_a, normal z_a).
 ///   Φ = [x_a · z_b;  y_a · z_b;  z_a · (P_b − P_a)]   (3 rows: 2 angles, 1 length)
 struct Planar {
-  static constexpr int kRows = 3;  ///< rows: the freedoms it removes
+  static constexpr int kRows = 3;                 ///< rows: the freedoms it removes
   static constexpr const char* kKind = "planar";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
@@ -341,7 +346,7 @@ struct Planar {
 /// Rigid joint (weld): the points coincide and the joint frames stay aligned (x_b ∥ x_a, y_b ∥ y_a, z_b ∥ z_a).
 ///   Φ = [P_a − P_b;  x_a · y_b;  y_a · z_b;  z_a · x_b]   (6 rows: 3 lengths, 3 angles)
 struct Rigid {
-  static constexpr int kRows = 6;  ///< rows: the freedoms it removes
+  static constexpr int kRows = 6;                ///< rows: the freedoms it removes
   static constexpr const char* kKind = "rigid";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
   static constexpr SceneForm kScene[] = {
@@ -354,11 +359,11 @@ struct Rigid {
 /// Point on line: P_b on the line of a (through P_a along z_a).
 ///   Φ = [x_a · (P_b − P_a);  y_a · (P_b − P_a)]   (2 rows, lengths)
 struct PointOnLine {
-  static constexpr int kRows = 2;  ///< rows: the freedoms it removes
+  static constexpr int kRows = 2;                        ///< rows: the freedoms it removes
   static constexpr const char* kKind = "point_on_line";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "point_on_line", 3, "- {name: axis2, type: point_on_line, between: [{body: ground, axis: [1, "
+  static constexpr SceneForm kScene[] = {{"constraints", "point_on_line", 3,
+                                          "- {name: axis2, type: point_on_line, between: [{body: ground, axis: [1, "
                                           "0, 0]}, {body: s2, at: [0, 0, 1]}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
   static constexpr RowDef kRowDefs[kRows] = {{T(kXa), T(kPb, kPa), kL}, {T(kYa), T(kPb, kPa), kL}};
@@ -366,25 +371,25 @@ struct PointOnLine {
 /// Point on plane: P_b in the plane of a (through P_a, normal z_a).
 ///   Φ = z_a · (P_b − P_a)   (1 row, a length)
 struct PointOnPlane {
-  static constexpr int kRows = 1;  ///< rows: the freedoms it removes
+  static constexpr int kRows = 1;                         ///< rows: the freedoms it removes
   static constexpr const char* kKind = "point_on_plane";  ///< scene type and diagnostics name
   /// its scene forms (SceneForm)
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "point_on_plane", 3, "- {name: plane0, type: point_on_plane, between: [{body: ground, "
-                                           "axis: [1, 2, 2]}, {point: P0}]}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "point_on_plane", 3,
+                                          "- {name: plane0, type: point_on_plane, between: [{body: ground, "
+                                          "axis: [1, 2, 2]}, {point: P0}]}"}};
   /// The rows, each w (X · Y − c) with w = 1, c = 0, and its unit.
   static constexpr RowDef kRowDefs[kRows] = {{T(kZa), T(kPb, kPa), kL}};
 };
 }  // namespace joint3
 
-using SphericalSpec = SpatialJointSpec<joint3::Spherical>;              ///< scene type `spherical` (dimension 3)
-using SpatialRevoluteSpec = SpatialJointSpec<joint3::Revolute>;         ///< scene type `revolute` (dimension 3)
-using CylindricalSpec = SpatialJointSpec<joint3::Cylindrical>;          ///< scene type `cylindrical`
-using SpatialPrismaticSpec = SpatialJointSpec<joint3::Prismatic>;       ///< scene type `prismatic` (dimension 3)
-using UniversalSpec = SpatialJointSpec<joint3::Universal>;              ///< scene type `universal`
-using PlanarSpec = SpatialJointSpec<joint3::Planar>;                    ///< scene type `planar`
-using RigidSpec = SpatialJointSpec<joint3::Rigid>;                      ///< scene type `rigid`
-using SpatialPointOnLineSpec = SpatialJointSpec<joint3::PointOnLine>;   ///< scene type `point_on_line` (dim. 3)
-using PointOnPlaneSpec = SpatialJointSpec<joint3::PointOnPlane>;        ///< scene type `point_on_plane`
+using SphericalSpec = SpatialJointSpec<joint3::Spherical>;             ///< scene type `spherical` (dimension 3)
+using SpatialRevoluteSpec = SpatialJointSpec<joint3::Revolute>;        ///< scene type `revolute` (dimension 3)
+using CylindricalSpec = SpatialJointSpec<joint3::Cylindrical>;         ///< scene type `cylindrical`
+using SpatialPrismaticSpec = SpatialJointSpec<joint3::Prismatic>;      ///< scene type `prismatic` (dimension 3)
+using UniversalSpec = SpatialJointSpec<joint3::Universal>;             ///< scene type `universal`
+using PlanarSpec = SpatialJointSpec<joint3::Planar>;                   ///< scene type `planar`
+using RigidSpec = SpatialJointSpec<joint3::Rigid>;                     ///< scene type `rigid`
+using SpatialPointOnLineSpec = SpatialJointSpec<joint3::PointOnLine>;  ///< scene type `point_on_line` (dim. 3)
+using PointOnPlaneSpec = SpatialJointSpec<joint3::PointOnPlane>;       ///< scene type `point_on_plane`
 
 }  // namespace phiq

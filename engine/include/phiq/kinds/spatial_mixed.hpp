@@ -30,6 +30,7 @@ namespace phiq {
 struct SpatialPolarSpec {
   /// @copydoc DistanceSpec::operator==
   bool operator==(const SpatialPolarSpec&) const = default;
+
  private:
   // rows k: (P_b − P_a)_k, (x_a)_k, (y_a)_k
   static constexpr detail3::RowDef kDefs[9] = {
@@ -116,8 +117,8 @@ struct SpatialPolarSpec {
   /// ρs″ = −ω² ρs + α ρc; along the data V̂, X̂, Ŷ come from the attachments (detail3::row_derivatives(), one pass
   /// a row) and (ρ̂c, ρ̂s) = (r̂/r) (ρc, ρs) + θ̂ (−ρs, ρc) (θ̂ of a constant θ), their time derivatives by the same
   /// rule.
-  void data_derivative(const SpatialPolarSpec& rate, int order, const double* q, const double* qd,
-                       const double* qdd, double, double* out) const {
+  void data_derivative(const SpatialPolarSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
     const double th = theta.of(q), w = order >= 1 ? theta.rate(qd) : 0.0, al = order == 2 ? theta.rate(qdd) : 0.0;
     const double rc = radius * std::cos(th), rs = radius * std::sin(th);
     const double thh = theta.is_coordinate() ? 0.0 : rate.theta.value(), rr = rate.radius / radius;
@@ -138,8 +139,7 @@ struct SpatialPolarSpec {
       const detail3::RowDerivatives y = detail3::row_derivatives(a, ra, kCompact.rows[6 + k], order, q, qd, qdd);
       for (int i = 0; i <= order; ++i) {
         const int j = order - i;
-        d -= kBinomial[order][i] *
-             (hc[i] * x.value[j] + mc[i] * x.along[j] + hs[i] * y.value[j] + ms[i] * y.along[j]);
+        d -= kBinomial[order][i] * (hc[i] * x.value[j] + mc[i] * x.along[j] + hs[i] * y.value[j] + ms[i] * y.along[j]);
       }
       out[k] = d;
     }
@@ -157,8 +157,9 @@ struct SpatialPolarSpec {
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "polar", 3, "- {name: crank, type: polar, point: A, center: {body: ground, axis: [1, 2, 2]}, "
-                                  "radius: 0.3, angle: theta}"}};
+      {"constraints", "polar", 3,
+       "- {name: crank, type: polar, point: A, center: {body: ground, axis: [1, 2, 2]}, "
+       "radius: 0.3, angle: theta}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static SpatialPolarSpec read(const Fields& f) {
@@ -192,12 +193,12 @@ struct SpatialAngleSpec {
   static constexpr int kRows = 1;  ///< one row, an angle
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "angle3";
-  JointSide3 a;               ///< the axis z_a and the reference x_a (a body or ground)
-  JointSide3 b;               ///< `rotation_angle`: the turning body (its reference direction x_b is D)
-  bool segment = false;       ///< D = B − A (natural points) instead of x_b
-  Point3 from;                ///< A, for a segment
-  Point3 to;                  ///< B, for a segment
-  Slot theta;                 ///< θ (rad), a coordinate
+  JointSide3 a;                      ///< the axis z_a and the reference x_a (a body or ground)
+  JointSide3 b;                      ///< `rotation_angle`: the turning body (its reference direction x_b is D)
+  bool segment = false;              ///< D = B − A (natural points) instead of x_b
+  Point3 from;                       ///< A, for a segment
+  Point3 to;                         ///< B, for a segment
+  Slot theta;                        ///< θ (rad), a coordinate
   std::array<Attachment3, 4> att{};  ///< derived by setup(): x_a, y_a, then D's head and tail
 
   /// Validates the data and derives `att`. Throws phiq::Error.
@@ -257,8 +258,8 @@ struct SpatialAngleSpec {
   }
   /// Derivatives along the data (DistanceSpec::data_derivative()): θ(D)'s along the attachments
   /// (detail3::AngleRows::data_derivative()).
-  void data_derivative(const SpatialAngleSpec& rate, int order, const double* q, const double* qd,
-                       const double* qdd, double, double* out) const {
+  void data_derivative(const SpatialAngleSpec& rate, int order, const double* q, const double* qd, const double* qdd,
+                       double, double* out) const {
     out[0] = angle().data_derivative(att.data(), rate.att.data(), order, q, qd, qdd);
   }
   /// @copydoc DistanceSpec::joint_count
@@ -277,10 +278,11 @@ struct SpatialAngleSpec {
     if (segment) sk.bar3(Attachment3::natural(from), Attachment3::natural(to));
   }
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "rotation_angle", 3, "- {name: shaft_angle, type: rotation_angle, between: [{body: ground, "
-                                           "axis: [1, 0, 0]}, {body: shaft, axis: [1, 0, 0]}], angle: theta1}"},
-      {"constraints", "segment_angle", 3, "- {name: crank_angle, type: segment_angle, segment: [O, A], "
+  static constexpr SceneForm kScene[] = {{"constraints", "rotation_angle", 3,
+                                          "- {name: shaft_angle, type: rotation_angle, between: [{body: ground, "
+                                          "axis: [1, 0, 0]}, {body: shaft, axis: [1, 0, 0]}], angle: theta1}"},
+                                         {"constraints", "segment_angle", 3,
+                                          "- {name: crank_angle, type: segment_angle, segment: [O, A], "
                                           "axis: {body: ground, axis: [0, 0, 1]}, angle: theta}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>

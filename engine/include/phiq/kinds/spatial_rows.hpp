@@ -220,8 +220,8 @@ struct AngleRows {
 /// its slots' (constants their rate, coordinates none) and its local vector's.
 inline bool datum_rate(Attachment3& rate, const std::array<const Attachment3*, 4>& v, double h) {
   auto slot = [&](Slot& r, auto member, int k) {
-    return detail::datum_rate(r, {&(v[0]->*member)[k], &(v[1]->*member)[k], &(v[2]->*member)[k],
-                                  &(v[3]->*member)[k]}, h);
+    return detail::datum_rate(r, {&(v[0]->*member)[k], &(v[1]->*member)[k], &(v[2]->*member)[k], &(v[3]->*member)[k]},
+                              h);
   };
   bool ok = true;
   for (int k = 0; k < 3; ++k) ok = ok && slot(rate.r[k], &Attachment3::r, k);

@@ -165,8 +165,8 @@ struct GearSpec : LinearTransmission<GearSpec> {
   }
   /// The data a parameter may move (DistanceSpec::data_members()): fixed angles, the radii and the phase.
   static constexpr auto data_members() {
-    return std::tuple{&GearSpec::first, &GearSpec::second, &GearSpec::carrier, &GearSpec::r1, &GearSpec::r2,
-                      &GearSpec::phase};
+    return std::tuple{&GearSpec::first, &GearSpec::second, &GearSpec::carrier,
+                      &GearSpec::r1,    &GearSpec::r2,     &GearSpec::phase};
   }
   /// The rates of row()'s coefficients along the data's `rate`: k̂ = ±(r̂2 r1 − r2 r̂1)/r1², the fixed angles', φ̂.
   detail::LinearRow row_rate(const GearSpec& rate) const {
@@ -213,9 +213,9 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
                     "rack_pinion: the rack's travel and the pinion's angle must be different coordinates");
   }
   /// @copydoc DistanceSpec::kScene
-  static constexpr SceneForm kScene[] = {
-      {"constraints", "rack_pinion", 0, "- {name: steering, type: rack_pinion, rack: x_rack, pinion: pinion, "
-                                        "radius: 0.05}"}};
+  static constexpr SceneForm kScene[] = {{"constraints", "rack_pinion", 0,
+                                          "- {name: steering, type: rack_pinion, rack: x_rack, pinion: pinion, "
+                                          "radius: 0.05}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static RackPinionSpec read(const Fields& f) {
@@ -236,13 +236,12 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
   }
   /// The data a parameter may move (DistanceSpec::data_members()): a fixed pinion angle, the radius, the offset.
   static constexpr auto data_members() {
-    return std::tuple{&RackPinionSpec::rack, &RackPinionSpec::pinion, &RackPinionSpec::radius,
-                      &RackPinionSpec::offset};
+    return std::tuple{&RackPinionSpec::rack, &RackPinionSpec::pinion, &RackPinionSpec::radius, &RackPinionSpec::offset};
   }
   /// The rates of row()'s coefficients along the data's `rate` (GearSpec::row_rate()).
   detail::LinearRow row_rate(const RackPinionSpec& rate) const {
-    return detail::LinearRow{{rate.rack, rate.pinion, Slot::constant(0)},
-                             {0.0, reversed ? rate.radius : -rate.radius, 0.0}, rate.offset};
+    return detail::LinearRow{
+        {rate.rack, rate.pinion, Slot::constant(0)}, {0.0, reversed ? rate.radius : -rate.radius, 0.0}, rate.offset};
   }
 };
 
@@ -285,8 +284,9 @@ struct BeltSpec : LinearTransmission<BeltSpec> {
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
-      {"constraints", "belt", 0, "- {name: fan_belt, type: belt, between: [crank_pulley, fan_pulley], "
-                                 "radii: [0.08, 0.05]}"},
+      {"constraints", "belt", 0,
+       "- {name: fan_belt, type: belt, between: [crank_pulley, fan_pulley], "
+       "radii: [0.08, 0.05]}"},
       {"constraints", "chain", 0, "- {name: drive, type: chain, between: [sprocket1, sprocket2], teeth: [44, 16]}"}};
   /// @copydoc DistanceSpec::read
   template <class Fields>
