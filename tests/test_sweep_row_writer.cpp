@@ -39,7 +39,7 @@ class WrittenCsvRows : public RowWriter {
 
 // The summary's counts and warnings, which a writer must leave as a step callback does.
 std::string writer_summary_text(const SweepSummary& s) {
-  std::string out = to_string(s.status) + '|' + s.message + '|' + std::to_string(s.steps_completed) + '|' +
+  std::string out = std::string(to_string(s.status)) + '|' + s.message + '|' + std::to_string(s.steps_completed) + '|' +
                     std::to_string(s.parallel_chunks) + '|' + std::to_string(s.subdivisions) + '|' +
                     std::to_string(s.counters.newton_iterations) + '|' + std::to_string(s.counters.factorizations) +
                     '|' + std::to_string(s.accuracy.converged.rows) + '|' + std::to_string(s.accuracy.singular.rows);
