@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -64,6 +65,14 @@ class Cli : public ::testing::Test {
 };
 
 // How many times `what` occurs in `s` (an SVG's or a page's elements, counted by their text).
+// Every match of group 1 of `re` in `s` (an SVG's data-column attributes, say).
+inline std::vector<std::string> captures(const std::string& s, const std::string& re) {
+  std::vector<std::string> v;
+  const std::regex r(re);
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), r); it != std::sregex_iterator(); ++it) v.push_back((*it)[1]);
+  return v;
+}
+
 inline std::size_t count(const std::string& s, const std::string& what) {
   std::size_t n = 0;
   for (std::size_t p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;

@@ -14,19 +14,12 @@
 
 namespace {
 
+using phiq::test::captures;
 using phiq::test::Cli;
 using phiq::test::count;
 using phiq::test::Result;
 using phiq::test::slurp;
 namespace fs = std::filesystem;
-
-// Every match of group 1 of `re` in `s`.
-std::vector<std::string> captures(const std::string& s, const std::string& re) {
-  std::vector<std::string> v;
-  const std::regex r(re);
-  for (auto it = std::sregex_iterator(s.begin(), s.end(), r); it != std::sregex_iterator(); ++it) v.push_back((*it)[1]);
-  return v;
-}
 
 // The SVG without its <title> (which names the result).
 std::string without_title(std::string svg) {

@@ -16,19 +16,12 @@
 
 namespace {
 
+using phiq::test::captures;
 using phiq::test::Cli;
 using phiq::test::count;
 using phiq::test::Result;
 using phiq::test::slurp;
 namespace fs = std::filesystem;
-
-// Every match of group 1 of `re` in `s`.
-std::vector<std::string> all(const std::string& s, const std::string& re) {
-  std::vector<std::string> v;
-  const std::regex r(re);
-  for (auto it = std::sregex_iterator(s.begin(), s.end(), r); it != std::sregex_iterator(); ++it) v.push_back((*it)[1]);
-  return v;
-}
 
 class Plot : public Cli {
  protected:
@@ -79,14 +72,14 @@ TEST_F(Plot, SpatialMechanismIsDrawnInIsometricViewWithItsAxesAndMovingColumns) 
   EXPECT_GT(axis["z"][1], 0.0);
   EXPECT_GT(axis["x"][0] * axis["y"][1] - axis["x"][1] * axis["y"][0], 0.0) << "a mirrored view";
   // no constant column: the default columns are those that change (the Euler parameters that turn)
-  const std::vector<std::string> cols = all(s, "data-column=\"([^\"]+)\"");
+  const std::vector<std::string> cols = captures(s, "data-column=\"([^\"]+)\"");
   EXPECT_EQ(cols, (std::vector<std::string>{"crank_e0", "crank_e3", "rocker_e0", "rocker_e1"}));
   for (const std::string& c : cols) {
     const auto [lo, hi] = range(c);
     EXPECT_GT(hi - lo, 0.1) << c;
   }
   // one panel, the Euler parameters' (unitless), with ticks and its unit
-  EXPECT_EQ(all(s, "data-quantity=\"([^\"]+)\""), (std::vector<std::string>{"unitless"}));
+  EXPECT_EQ(captures(s, "data-quantity=\"([^\"]+)\""), (std::vector<std::string>{"unitless"}));
   EXPECT_NE(s.find(">unitless (1)</text>"), std::string::npos);
   EXPECT_NE(s.find(">t (s)</text>"), std::string::npos);
 }
@@ -95,29 +88,31 @@ TEST_F(Plot, PanelsPerQuantityWithTicksAndUnits) {
   const std::string s =
       plot("seed/fourbar_reference_point.yaml", " --columns psi2,x3,psi3.v,x3.v,x3.a,psi2.a --positions 4");
   // one panel per quantity, in order of first use, each labelled with its unit
-  EXPECT_EQ(all(s, "data-quantity=\"([^\"]+)\""),
+  EXPECT_EQ(captures(s, "data-quantity=\"([^\"]+)\""),
             (std::vector<std::string>{"angle", "length", "angular velocity", "velocity", "acceleration",
                                       "angular acceleration"}));
-  EXPECT_EQ(all(s, "data-unit=\"([^\"]+)\""), (std::vector<std::string>{"rad", "m", "rad/s", "m/s", "m/s²", "rad/s²"}));
+  EXPECT_EQ(captures(s, "data-unit=\"([^\"]+)\""),
+            (std::vector<std::string>{"rad", "m", "rad/s", "m/s", "m/s²", "rad/s²"}));
   for (const char* label : {">angle (rad)<", ">length (m)<", ">angular velocity (rad/s)<", ">velocity (m/s)<",
                             ">acceleration (m/s²)<", ">angular acceleration (rad/s²)<", ">x (m)<", ">y (m)<"})
     EXPECT_NE(s.find(label), std::string::npos) << label;
   // the ticks of the angle panel: psi2 runs 0 … 2π: 0, 2, 4, 6 rad (4 asked for); t: 0, 1, …, 6 s (8 asked for)
   const std::size_t angle = s.find("data-quantity=\"angle\""), next = s.find("</g>", angle);
   const std::string panel = s.substr(angle, next - angle);
-  std::vector<std::string> labels = all(panel, "class=\"tick-label\"[^>]*>([^<]+)<");
+  std::vector<std::string> labels = captures(panel, "class=\"tick-label\"[^>]*>([^<]+)<");
   EXPECT_EQ(labels, (std::vector<std::string>{"0", "1", "2", "3", "4", "5", "6", "0", "2", "4", "6"}));
   EXPECT_EQ(count(panel, "class=\"tick\""), count(panel, "class=\"tick-label\""));
   // the ground pivots O and C hatched; the two moving pivots as circles at each of the 4 rows (a full turn: the
   // last row, the first again, is not drawn on top of it)
   EXPECT_EQ(count(s, "<g class=\"ground\">"), 2u);
   EXPECT_EQ(count(s, "class=\"joint revolute\""), 2u + 2u * 4u);
-  const std::vector<std::string> t = all(s, "class=\"position\" data-t=\"([^\"]+)\"");
+  const std::vector<std::string> t = captures(s, "class=\"position\" data-t=\"([^\"]+)\"");
   EXPECT_EQ(t, (std::vector<std::string>{"0", "1.571", "3.142", "4.712"}));
   // the default columns: the driven coordinate psi2 first, then the first 5 moving ones in column order (x2, y2, x3,
   // y3, psi3; not x4 …), drawn by quantity: the angles' panel, then the lengths'
   const std::string d = plot("seed/fourbar_reference_point.yaml");
-  EXPECT_EQ(all(d, "data-column=\"([^\"]+)\""), (std::vector<std::string>{"psi2", "psi3", "x2", "y2", "x3", "y3"}));
+  EXPECT_EQ(captures(d, "data-column=\"([^\"]+)\""),
+            (std::vector<std::string>{"psi2", "psi3", "x2", "y2", "x3", "y3"}));
 }
 
 // A crank-slider of three bodies in reference-point coordinates, the slider on a guide along ground's x axis.
@@ -146,7 +141,7 @@ TEST_F(Plot, PrismaticPairsAreBlocksOnTheirGuides) {
   EXPECT_EQ(count(s, "class=\"hatch\""), 3u * 5u + 6u);  // the guide on ground at each row, the ground pivot O
   EXPECT_EQ(count(s, "<g class=\"ground\">"), 1u);
   // the block lies along the guide: ground's x axis, no rotation
-  EXPECT_EQ(all(s, "class=\"joint prismatic\"[^>]*rotate\\((-?[0-9.]+) "),
+  EXPECT_EQ(captures(s, "class=\"joint prismatic\"[^>]*rotate\\((-?[0-9.]+) "),
             (std::vector<std::string>{"0.0", "0.0", "0.0"}));
 }
 

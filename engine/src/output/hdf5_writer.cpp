@@ -101,6 +101,34 @@ struct Hdf5Writer::Impl {
   void create_dataset(Group& g, const Hdf5Options& o);
   void open_to_append(const Hid& fapl, std::size_t keep_rows);  // Hdf5Options::append
   void flush();
+  // The place of the next row in the held block; a full one (a block whose write failed) is written first, tried
+  // again, never overrun.
+  std::size_t next_row() {
+    if (held_rows == block_rows) {
+      const QuietErrors quiet;
+      flush();
+    }
+    return held_rows;
+  }
+  // The row at next_row() is held: a block that is full is written.
+  void row_held() {
+    if (++held_rows == block_rows) {
+      const QuietErrors quiet;
+      flush();
+    }
+  }
+  // A row given as its values in column order, each group taking its slice: copy(to, first value, count).
+  template <class Copy>
+  void hold_values(Copy&& copy) {
+    const std::size_t k = next_row();
+    std::size_t first = 0;
+    for (Group& g : groups) {
+      const std::size_t m = g.columns.size();
+      copy(g.held.data() + k * m, first, m);
+      first += m;
+    }
+    row_held();
+  }
 };
 
 void Hdf5Writer::Impl::create(const Hdf5Options& o) {
@@ -304,12 +332,8 @@ Hdf5Writer::~Hdf5Writer() {
 void Hdf5Writer::append_row(const StepView& s) {
   Impl& w = *impl_;
   if (w.closed) throw Error(w.cannot("already closed"));
-  if (w.held_rows == w.block_rows) {  // a block whose write failed: tried again, never overrun
-    const QuietErrors quiet;
-    w.flush();
-  }
+  const std::size_t k = w.next_row();
   if (w.batch_case) throw Error(w.cannot("a batch's rows are given with their case (append_values)"));
-  const std::size_t k = w.held_rows;
   // −0 → 0, as the CSV writes it: the two files of a run hold the same doubles
   auto store = [](double v) { return v == 0.0 ? 0.0 : v; };
   w.t->held[k] = store(s.t);
@@ -333,29 +357,15 @@ void Hdf5Writer::append_row(const StepView& s) {
       v += m;
     }
   }
-  if (++w.held_rows == w.block_rows) {
-    const QuietErrors quiet;
-    w.flush();
-  }
+  w.row_held();
 }
 
 void Hdf5Writer::append_values(const double* row) {
   Impl& w = *impl_;
   if (w.closed) throw Error(w.cannot("already closed"));
-  if (w.held_rows == w.block_rows) {  // as append_row()
-    const QuietErrors quiet;
-    w.flush();
-  }
-  const std::size_t k = w.held_rows;
-  for (Group& g : w.groups) {  // in column order: each group takes its slice of the row
-    const std::size_t m = g.columns.size();
-    std::transform(row, row + m, g.held.data() + k * m, [](double v) { return v == 0.0 ? 0.0 : v; });
-    row += m;
-  }
-  if (++w.held_rows == w.block_rows) {
-    const QuietErrors quiet;
-    w.flush();
-  }
+  w.hold_values([row](double* to, std::size_t first, std::size_t m) {
+    std::transform(row + first, row + first + m, to, [](double v) { return v == 0.0 ? 0.0 : v; });
+  });
 }
 
 void Hdf5Writer::append_packed_rows(const std::string& packed) {
@@ -363,22 +373,10 @@ void Hdf5Writer::append_packed_rows(const std::string& packed) {
   if (w.closed) throw Error(w.cannot("already closed"));
   const std::size_t row_bytes = row_values() * sizeof(double);
   if (packed.size() % row_bytes != 0) throw Error(w.cannot("packed rows of another width (phiq bug)"));
-  for (const char* row = packed.data(); row != packed.data() + packed.size();) {
-    if (w.held_rows == w.block_rows) {  // as append_row()
-      const QuietErrors quiet;
-      w.flush();
-    }
-    const std::size_t k = w.held_rows;
-    for (Group& g : w.groups) {  // in column order: each group takes its slice of the row
-      const std::size_t m = g.columns.size();
-      std::memcpy(g.held.data() + k * m, row, m * sizeof(double));  // (a copy: `packed` holds bytes, not doubles)
-      row += m * sizeof(double);
-    }
-    if (++w.held_rows == w.block_rows) {
-      const QuietErrors quiet;
-      w.flush();
-    }
-  }
+  for (const char* row = packed.data(); row != packed.data() + packed.size(); row += row_bytes)
+    w.hold_values([row](double* to, std::size_t first, std::size_t m) {
+      std::memcpy(to, row + first * sizeof(double), m * sizeof(double));  // (`packed` holds bytes, not doubles)
+    });
 }
 
 std::size_t Hdf5Writer::row_values() const {

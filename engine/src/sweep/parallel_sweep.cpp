@@ -24,14 +24,14 @@ bool same_solution(const Model& model, const Eigen::VectorXd& a, const double* b
 }
 
 // Why a parallel chunk's first row q0 (null: it did not converge, `failure` saying why) is not where the sweep in
-// order arrives, seam_q (null: unknown), beyond `limit` tolerances: the parallel_fallback warning's cause.
-std::string rejection_cause(const Model& model, const std::string& failure, const Eigen::VectorXd* seam_q,
-                            const double* q0, double tol, double limit) {
+// order arrives, seam_q (null: unknown), beyond `limit` tolerances: the parallel_fallback warning's cause. `signs`:
+// the model's bodies with Euler parameters (the sweep's own, made once).
+std::string rejection_cause(const Model& model, const EulerSeedSigns& signs, const std::string& failure,
+                            const Eigen::VectorXd* seam_q, const double* q0, double tol, double limit) {
   if (!q0) return "its first row did not converge from its seed (" + failure + ")";
   if (!seam_q) return "the chunk before it did not reach the chunk's first time point (its seam step failed)";
   Eigen::VectorXd turned = Eigen::Map<const Eigen::VectorXd>(q0, seam_q->size());
-  if (EulerSeedSigns(model).turn_like(seam_q->data(), turned) &&
-      same_solution(model, *seam_q, turned.data(), tol, limit))
+  if (signs.turn_like(seam_q->data(), turned) && same_solution(model, *seam_q, turned.data(), tol, limit))
     return "its first row has the other sign of a body's Euler parameters (e and −e: one orientation) than the "
            "sweep in order";
   std::ostringstream m;
@@ -57,7 +57,7 @@ bool ChunkedSweep::continues(const Chunk& ch, const double* q0) const {
 
 // A chunk whose first row is q0 (null: it has none) does not continue the sweep: why, for the fallback warning.
 void ChunkedSweep::not_continued(const Chunk& ch, const double* q0) {
-  fallback_cause_ = rejection_cause(model_, ch.sum.message, at_.seam_known ? &at_.seam_q : nullptr, q0,
+  fallback_cause_ = rejection_cause(model_, euler_signs_, ch.sum.message, at_.seam_known ? &at_.seam_q : nullptr, q0,
                                     opt_.newton.tolerance, seam_limit(ch));
 }
 
