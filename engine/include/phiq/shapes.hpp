@@ -24,7 +24,7 @@ namespace phiq {
 /// A triangle mesh: vertices and their indices, three per triangle, counter-clockwise seen from outside (the normal
 /// (b − a) × (c − a) points out of a closed mesh).
 struct TriangleMesh {
-  std::vector<kin3::V3> vertices;        ///< positions (m)
+  std::vector<kin3::V3> vertices;             ///< positions (m)
   std::vector<std::array<int, 3>> triangles;  ///< vertex indices
 };
 
@@ -44,26 +44,26 @@ enum class ShapeKind {
 /// A shape in a body's frame. Sizes are in metres and positive; see the file comment for each kind's own frame.
 struct Shape {
   ShapeKind kind = ShapeKind::kBox;
-  std::string name;                               ///< optional, for messages and the viewer
-  std::optional<std::array<double, 4>> colour;    ///< RGBA in [0, 1]; none: the part's (or the viewer's default)
-  kin3::V3 at;                                    ///< the shape frame's origin in the body frame (m)
+  std::string name;                                    ///< optional, for messages and the viewer
+  std::optional<std::array<double, 4>> colour;         ///< RGBA in [0, 1]; none: the part's (or the viewer's default)
+  kin3::V3 at;                                         ///< the shape frame's origin in the body frame (m)
   RotationMatrix rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< the shape frame's axes in the body frame (columns)
-  kin3::V3 size;                                  ///< kBox: edge lengths; kPlane: drawn extent in x, y
-  double radius = 0.0;                           ///< kCylinder, kSphere, kCapsule, kCone; kCurve: drawn width
-  double length = 0.0;                           ///< kCylinder, kCapsule, kCone (height), kPolygon (thickness)
-  std::vector<std::array<double, 2>> outline;     ///< kPolygon: vertices in x, y
-  std::vector<kin3::V3> points;                   ///< kCurve: the polyline in the shape frame
-  bool closed = false;                            ///< kCurve: the last point joins the first
-  std::string file;                               ///< kMesh: the file it was read from (as the scene names it)
-  double scale = 1.0;                             ///< kMesh: file units to metres
-  std::shared_ptr<const TriangleMesh> mesh;       ///< kMesh: the triangles in the shape frame, already scaled
+  kin3::V3 size;                                       ///< kBox: edge lengths; kPlane: drawn extent in x, y
+  double radius = 0.0;                                 ///< kCylinder, kSphere, kCapsule, kCone; kCurve: drawn width
+  double length = 0.0;                                 ///< kCylinder, kCapsule, kCone (height), kPolygon (thickness)
+  std::vector<std::array<double, 2>> outline;          ///< kPolygon: vertices in x, y
+  std::vector<kin3::V3> points;                        ///< kCurve: the polyline in the shape frame
+  bool closed = false;                                 ///< kCurve: the last point joins the first
+  std::string file;                                    ///< kMesh: the file it was read from (as the scene names it)
+  double scale = 1.0;                                  ///< kMesh: file units to metres
+  std::shared_ptr<const TriangleMesh> mesh;            ///< kMesh: the triangles in the shape frame, already scaled
 };
 
 /// Mass, centre of mass and inertia about the centre of mass, in the body's axes.
 struct MassProperties {
-  double mass = 0.0;                 ///< kg
-  kin3::V3 center;                   ///< centre of mass in the body frame (m)
-  std::array<double, 9> inertia{};   ///< kg·m², about the centre of mass, body axes, row-major, symmetric
+  double mass = 0.0;                ///< kg
+  kin3::V3 center;                  ///< centre of mass in the body frame (m)
+  std::array<double, 9> inertia{};  ///< kg·m², about the centre of mass, body axes, row-major, symmetric
 };
 
 /// The mass properties of `shape` filled with `density` (kg/m³), in the body frame (its placement applied). Exact
