@@ -43,7 +43,7 @@ enum class ShapeKind {
 
 /// A shape in a body's frame. Sizes are in metres and positive; see the file comment for each kind's own frame.
 struct Shape {
-  ShapeKind kind = ShapeKind::kBox;
+  ShapeKind kind = ShapeKind::kBox;                    ///< what the shape is, and so which of the fields below it reads
   std::string name;                                    ///< optional, for messages and the viewer
   std::optional<std::array<double, 4>> colour;         ///< RGBA in [0, 1]; none: the part's (or the viewer's default)
   kin3::V3 at;                                         ///< the shape frame's origin in the body frame (m)
