@@ -69,7 +69,8 @@ struct MassProperties {
 /// The mass properties of `shape` filled with `density` (kg/m³), in the body frame (its placement applied). Exact
 /// for the primitives and the extruded polygon; for a mesh by the divergence theorem over its triangles (exact for
 /// the polyhedron). Throws phiq::Error for a shape with no volume (kPlane, kCurve) and for an open mesh (see
-/// mesh_is_closed()), naming the shape.
+/// mesh_is_closed()), naming the shape; so too for a density or a size that is not a positive number, a `rotation`
+/// that is not a rotation, an outline that is not a simple polygon, and a mesh whose triangles face inwards.
 MassProperties shape_mass_properties(const Shape& shape, double density);
 
 /// The sum of several bodies' mass properties (parallel-axis theorem); all in one frame. Empty: zero mass.
@@ -78,7 +79,9 @@ MassProperties combine_mass_properties(const std::vector<MassProperties>& parts)
 /// The inertia tensor of `m` about the point `point` (parallel-axis theorem: I_c + m (|d|² 1 − d dᵀ), d = c − point).
 std::array<double, 9> inertia_about(const MassProperties& m, kin3::V3 point);
 
-/// Volume, centroid and second moments of a closed triangle mesh by the divergence theorem (unit density).
+/// Volume, centroid and second moments of a closed triangle mesh by the divergence theorem (unit density). Signed:
+/// a mesh whose triangles face inwards gives a negative volume and inertia; one of no volume, zero mass and its
+/// vertices' mean as centre. Throws phiq::Error for a vertex index out of range.
 MassProperties mesh_mass_properties(const TriangleMesh& mesh);
 
 /// True when every edge of `mesh` is shared by exactly two triangles that traverse it in opposite directions (a
@@ -92,7 +95,8 @@ TriangleMesh load_mesh_file(const std::string& path, double scale = 1.0);
 
 /// The triangles that draw `shape` in the body frame (its placement applied): primitives tessellated with
 /// `segments` around each circle (at least 8), a polygon's outline and caps, a mesh as read; a curve as a tube of
-/// its width; a plane as two triangles of its extent.
+/// its width; a plane as two triangles of its extent. Fewer than 8 segments are taken as 8. Throws phiq::Error,
+/// naming the shape, for the shapes shape_mass_properties() refuses for their sizes, placement or outline.
 TriangleMesh shape_triangles(const Shape& shape, int segments = 32);
 
 }  // namespace phiq

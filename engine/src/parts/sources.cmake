@@ -1,0 +1,10 @@
+# engine/src/parts/: the sources of this stage (engine/CMakeLists.txt includes this file).
+target_sources(phiq_engine PRIVATE
+  ${CMAKE_CURRENT_LIST_DIR}/curve_tube.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mass_properties.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mesh_file.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mesh_is_closed.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/polygon.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/shape_checks.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/shape_triangles.cpp
+)
