@@ -2,8 +2,9 @@
 // (natural coordinates + a driven crank angle), advances its own clock, calls the position, velocity and
 // acceleration solves each tick, and checks the results against Freudenstein's closed form and finite
 // differences of its own positions, and that the version macros, constant and function of its headers and library
-// agree. Exit 0 when every check holds.
+// agree; and a part's geometry (a box's mass, the mesh reader that links Assimp). Exit 0 when every check holds.
 #include <phiq/phiq.hpp>
+#include <phiq/shapes.hpp>
 
 #if !defined(PHIQ_VERSION_MAJOR) || !defined(PHIQ_VERSION_MINOR) || !defined(PHIQ_VERSION_PATCH)
 #error "phiq/version.hpp defines PHIQ_VERSION_MAJOR, _MINOR and _PATCH"
@@ -57,6 +58,21 @@ int main() {
     xb_1 = ws.q(xb);
     vb_1 = ws.qd(xb);
     ++ticks;
+  }
+  // a part's geometry: a box's mass, and the mesh reader refusing a file that is not there, naming it (Assimp, a
+  // private dependency that a static libphiq brings to this link)
+  Shape box;
+  box.size = {0.1, 0.2, 0.5};
+  const double box_mass = shape_mass_properties(box, 1000.0).mass;
+  std::string mesh_refusal = "(no error)";
+  try {
+    load_mesh_file("no_such_part.stl");
+  } catch (const Error& e) {
+    mesh_refusal = e.what();
+  }
+  if (std::fabs(box_mass - 10.0) > 1e-12 || mesh_refusal.rfind("no_such_part.stl: cannot read", 0) != 0) {
+    std::fprintf(stderr, "consumer: box mass %.17g (10 kg), mesh reader: %s\n", box_mass, mesh_refusal.c_str());
+    return 1;
   }
   // the library's own version (version()) is the headers' (kVersion), and the macros spell it
   const std::string macros = std::to_string(PHIQ_VERSION_MAJOR) + "." + std::to_string(PHIQ_VERSION_MINOR) + "." +
