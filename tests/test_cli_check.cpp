@@ -46,6 +46,28 @@ TEST_F(Cli, CheckNamesWhereJointAnglesAreMeasuredFrom) {
   EXPECT_NE(r.out.find("\"stated_a\": true,\n      \"stated_b\": true"), std::string::npos) << r.out;
 }
 
+// Each part's mass, centre and inertia with where they came from: a 1.2 × 0.04 × 0.01 m steel box of 3.768 kg and
+// Izz = m (1.2² + 0.04²)/12 = 0.452662 kg·m², and a stated crank; the JSON gives the tensors whole.
+TEST_F(Cli, CheckListsEachPartsMassAndItsSource) {
+  const fs::path scene =
+      write("parts.yaml", slurp(phiq::test::model_path("seed/fourbar_reference_point.yaml")) +
+                              "\nparts:\n  coupler: {density: 7850, shapes: [{type: box, size: [1.2, 0.04, 0.01]}]}\n"
+                              "  crank: {mass: 2, center_of_mass: [0.01, 0], inertia: 0.03}\n");
+  Result r = run("check " + scene.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("part          coupler on body coupler, 1 shape: mass 3.768 kg (from density 7850 kg/m³), "
+                       "centre [0, 0] m, Izz 0.452662 kg·m² about the centre\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("part          crank on body crank, 0 shapes: mass 2 kg (stated), centre [0.01, 0] m, Izz 0.03"),
+            std::string::npos)
+      << r.out;
+  r = run("check --json " + scene.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("\"mass_source\": \"density\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"mass_source\": \"stated\""), std::string::npos) << r.out;
+}
+
 TEST_F(Cli, CheckJsonIsOneVersionedObject) {
   Result r = run("check --json " + phiq::test::model_path("seed/fourbar_natural.yaml"));
   ASSERT_EQ(r.code, 0) << r.err;

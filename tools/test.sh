@@ -30,4 +30,4 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-asan" -DCMAKE_BUILD_TYPE=R
   -DCMAKE_UNITY_BUILD=ON -DPHIQ_SANITIZE=ON -DPHIQ_FUZZ=ON -DPHIQ_BUILD_BENCH=OFF >/dev/null
 cmake --build "$root/build-asan" -j "$jobs"
 "$root/tools/fuzz.sh" "${PHIQ_FUZZ_SECONDS:-40}" "$root/build-asan"
-(cd "$root/build-asan" && ctest --output-on-failure -j "$jobs" "$@")
+(cd "$root/build-asan" && ctest --output-on-failure -j "$jobs" -LE not_sanitized "$@")

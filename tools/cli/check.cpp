@@ -1,5 +1,6 @@
 // `phiq check SCENE [--json] [--time T]`: the scene's counts (coordinates, equations, non-zeros), the assembly from
 // its rough placement and the rank analysis there (dof, redundant and conflicting constraints), as text or JSON.
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -24,6 +25,61 @@ std::string joint_angle_line(const phiq::JointAngleReference& r) {
   auto how = [](bool stated) { return stated ? " (stated)" : " (default: state `ref` to choose)"; };
   return r.driver + ": joint " + r.joint + " from x_a = " + vec(r.ref_a) + how(r.stated_a) +
          " to x_b = " + vec(r.ref_b) + how(r.stated_b) + ", in the sides' body frames";
+}
+
+// Six significant digits: what a person checks a mass against (--json gives every digit).
+std::string g6(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+const char* mass_source(const phiq::Part& p) {
+  switch (p.mass_source) {
+    case phiq::MassSource::kStated:
+      return "stated";
+    case phiq::MassSource::kDensity:
+      return "density";
+    case phiq::MassSource::kNone:
+      break;
+  }
+  return "none";
+}
+
+// The inertia as a user reads it: planar Izz; spatial [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] (body axes, about the centre).
+std::string inertia_text(const phiq::Part& p, int dimension) {
+  const auto& I = p.mass.inertia;
+  if (dimension == 2) return "Izz " + g6(I[8]);
+  return "[Ixx, Iyy, Izz, Ixy, Ixz, Iyz] [" + g6(I[0]) + ", " + g6(I[4]) + ", " + g6(I[8]) + ", " + g6(I[1]) + ", " +
+         g6(I[2]) + ", " + g6(I[5]) + "]";
+}
+
+// "coupler on body coupler, 1 shape: mass 3.768 kg (from density 7850 kg/m³), centre [0, 0, 0] m, Izz 0.45 kg·m²".
+std::string part_line(const phiq::Part& p, int dimension) {
+  std::string s = p.name + " on " + (p.body.rfind("frame", 0) == 0 ? p.body : "body " + p.body) + ", " +
+                  std::to_string(p.shapes.size()) + (p.shapes.size() == 1 ? " shape" : " shapes");
+  if (p.mass_source == phiq::MassSource::kNone) return s + ", no mass";
+  const auto& c = p.mass.center;
+  s += ": mass " + g6(p.mass.mass) + " kg (" +
+       (p.mass_source == phiq::MassSource::kDensity ? "from density " + g6(p.density) + " kg/m³" : "stated") +
+       "), centre [" + g6(c.x) + ", " + g6(c.y) + (dimension == 3 ? ", " + g6(c.z) : "") + "] m, " +
+       inertia_text(p, dimension) + " kg·m² about the centre";
+  return s;
+}
+
+nlohmann::ordered_json parts_json(const phiq::Scene& scene) {
+  auto parts = nlohmann::ordered_json::array();
+  for (const phiq::Part& p : scene.parts) {
+    const auto& I = p.mass.inertia;
+    parts.push_back({{"name", p.name},
+                     {"body", p.body},
+                     {"shapes", p.shapes.size()},
+                     {"mass_source", mass_source(p)},
+                     {"mass", p.mass.mass},
+                     {"center_of_mass", {p.mass.center.x, p.mass.center.y, p.mass.center.z}},
+                     {"inertia", {{I[0], I[1], I[2]}, {I[3], I[4], I[5]}, {I[6], I[7], I[8]}}}});
+  }
+  return parts;
 }
 
 int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at, const std::vector<std::string>& sets) {
@@ -102,6 +158,7 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
                                    {"ref_b", r.ref_b},
                                    {"stated_a", r.stated_a},
                                    {"stated_b", r.stated_b}});
+    j["parts"] = parts_json(scene);
     std::cout << json_text(j, 2) << "\n";
     return ok ? 0 : 1;
   }
@@ -134,6 +191,7 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
             << "\n";
   for (const phiq::JointAngleReference& r : scene.joint_angles)
     std::cout << "joint angle   " << joint_angle_line(r) << "\n";
+  for (const phiq::Part& p : scene.parts) std::cout << "part          " << part_line(p, scene.dimension) << "\n";
   if (rk.uncertain) std::cout << "uncertain     " << rk.message << "\n";
   if (!ok) std::cout << "diagnosis     " << as.message << "\n";
   return ok ? 0 : 1;

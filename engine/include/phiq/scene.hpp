@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "phiq/model.hpp"
+#include "phiq/parts.hpp"
 #include "phiq/sweep.hpp"
 
 namespace phiq {
@@ -66,7 +67,10 @@ struct Scene {
   std::vector<Frame2> planar_bodies;
   std::vector<Frame3> spatial_bodies;             ///< see planar_bodies
   std::vector<JointAngleReference> joint_angles;  ///< the reference directions of the joint angle drivers
-  std::unique_ptr<Model> model;                   ///< the mechanism (held by pointer: a CsvFormat keeps its address)
+  /// The scene's `parts`, in file order: shapes and mass on its bodies (phiq/parts.hpp). Bodies without one get
+  /// derived parts where a drawing asks for them (derived_parts()), not here.
+  std::vector<Part> parts;
+  std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: a CsvFormat keeps its address)
   /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns
   /// written, coordinates defaulting to all).
   SweepOptions sweep;

@@ -183,6 +183,21 @@ class SceneReader {
   template <class C>
   MotionLaw motion_law(const C& c) const;
 
+  // ---- parts (read_parts.cpp, read_shapes.cpp) ----------------------------------------------------------------
+  void read_parts(const Cursor& c, Scene& scene);
+  static bool frame_depends_on_time(const PartFrame& f);
+  void part_frame(const Cursor& v, const std::string& name, Part& part) const;
+  Attachment3 frame_toward(const Cursor& c, bool& is_point) const;
+  void points_or_expression_frame(const Cursor& f, Part& part) const;
+  std::shared_ptr<const CompiledExpression> slot_expression(const Cursor& c, const Slot& s) const;
+  void part_mass(const Cursor& v, Part& part) const;
+  MassProperties shapes_mass(const Cursor& c, const Part& part, double density) const;
+  std::array<double, 9> inertia_tensor(const Cursor& c) const;
+  std::array<double, 4> colour(const Cursor& c) const;
+  std::vector<kin3::V3> shape_points(const Cursor& c, std::size_t n, std::size_t least) const;
+  Shape read_shape(const Cursor& c) const;
+  void read_shape_size(const Cursor& c, Shape& s) const;
+
   // ---- time, output, solver (read_settings.cpp) ---------------------------------------------------------------
   void read_time(const Cursor& c, TimeGrid& o) const;
   void read_output(const Cursor& c, OutputPlan& plan);

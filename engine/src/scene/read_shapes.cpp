@@ -1,0 +1,177 @@
+// A part's shapes (scene_reader.hpp): `parts.NAME.shapes[k]`, one map per shape, its type deciding its fields
+// (models/README.md, Parts). Sizes are positive numbers or constant expressions; a mesh file is read relative to the
+// scene's folder.
+#include <cmath>
+#include <filesystem>
+
+#include "phiq/text.hpp"
+#include "scene/scene_reader.hpp"
+
+namespace phiq::detail::scene {
+
+namespace {
+
+// The shape types and the fields each takes beside the common ones (type, name, colour, at, orientation/angle).
+struct ShapeType {
+  const char* name;
+  ShapeKind kind;
+};
+constexpr ShapeType kShapeTypes[] = {
+    {"box", ShapeKind::kBox},         {"cylinder", ShapeKind::kCylinder}, {"sphere", ShapeKind::kSphere},
+    {"capsule", ShapeKind::kCapsule}, {"cone", ShapeKind::kCone},         {"plane", ShapeKind::kPlane},
+    {"polygon", ShapeKind::kPolygon}, {"mesh", ShapeKind::kMesh},         {"curve", ShapeKind::kCurve},
+};
+
+std::string shape_type_list() {
+  std::string s;
+  for (const ShapeType& t : kShapeTypes) s += (s.empty() ? "" : ", ") + std::string(t.name);
+  return s;
+}
+
+RotationMatrix about_z(double a) {
+  const double c = std::cos(a), s = std::sin(a);
+  return {c, -s, 0, s, c, 0, 0, 0, 1};
+}
+
+}  // namespace
+
+// `colour: [r, g, b]` or `[r, g, b, a]`, each in [0, 1], or "#rrggbb".
+std::array<double, 4> SceneReader::colour(const Cursor& c) const {
+  std::array<double, 4> rgba{0, 0, 0, 1};
+  if (c.is_scalar()) {
+    const std::string s = c.text();
+    unsigned v = 0;
+    if (s.size() != 7 || s[0] != '#' || std::sscanf(s.c_str() + 1, "%6x", &v) != 1)
+      c.fail("a colour is [r, g, b], [r, g, b, a] (each from 0 to 1) or \"#rrggbb\"");
+    for (int k = 0; k < 3; ++k) rgba[static_cast<std::size_t>(k)] = ((v >> (16 - 8 * k)) & 0xff) / 255.0;
+    return rgba;
+  }
+  if (!c.is_sequence() || (c.size() != 3 && c.size() != 4))
+    c.fail("a colour is [r, g, b], [r, g, b, a] (each from 0 to 1) or \"#rrggbb\"");
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    const double v = number(c.at(k));
+    if (!(v >= 0.0 && v <= 1.0)) c.at(k).fail("a colour component is from 0 to 1");
+    rgba[k] = v;
+  }
+  return rgba;
+}
+
+// A list of `n`-component points ([x, y] or [x, y, z]) of at least `least` entries.
+std::vector<kin3::V3> SceneReader::shape_points(const Cursor& c, std::size_t n, std::size_t least) const {
+  if (!c.is_sequence() || c.size() < least) c.fail("expected a list of at least " + std::to_string(least) + " points");
+  std::vector<kin3::V3> out;
+  for (const Cursor& p : c.items()) {
+    const std::vector<double> v = numbers(p, n);
+    out.push_back({v[0], v[1], n == 3 ? v[2] : 0.0});
+  }
+  return out;
+}
+
+Shape SceneReader::read_shape(const Cursor& c) const {
+  if (!c.is_map()) c.fail("a shape is a map {type: box|cylinder|..., ...}");
+  const std::string type = c.require("type").text();
+  const ShapeType* t = nullptr;
+  for (const ShapeType& k : kShapeTypes)
+    if (type == k.name) t = &k;
+  if (!t) c.field("type").fail("unknown shape type '" + type + "' (the types: " + shape_type_list() + ")");
+  Shape s;
+  s.kind = t->kind;
+  const char* placement = spatial_ ? "orientation" : "angle";
+  switch (s.kind) {
+    case ShapeKind::kBox:
+      c.expect_map({"type", "name", "colour", "at", placement, "size"});
+      break;
+    case ShapeKind::kSphere:
+      c.expect_map({"type", "name", "colour", "at", placement, "radius"});
+      break;
+    case ShapeKind::kCylinder:
+    case ShapeKind::kCapsule:
+      c.expect_map({"type", "name", "colour", "at", placement, "radius", "length"});
+      break;
+    case ShapeKind::kCone:
+      c.expect_map({"type", "name", "colour", "at", placement, "radius", "height"});
+      break;
+    case ShapeKind::kPlane:
+      c.expect_map({"type", "name", "colour", "at", placement, "size"});
+      break;
+    case ShapeKind::kPolygon:
+      c.expect_map({"type", "name", "colour", "at", placement, "points", "thickness"});
+      break;
+    case ShapeKind::kMesh:
+      c.expect_map({"type", "name", "colour", "at", placement, "file", "scale"});
+      break;
+    case ShapeKind::kCurve:
+      c.expect_map({"type", "name", "colour", "at", placement, "points", "closed", "width"});
+      break;
+  }
+  if (auto n = c.field("name"); n.present()) s.name = n.name();
+  if (auto k = c.field("colour"); k.present()) s.colour = colour(k);
+  if (auto a = c.field("at"); a.present()) {
+    const std::vector<double> v = numbers(a, spatial_ ? 3 : 2);
+    s.at = {v[0], v[1], spatial_ ? v[2] : 0.0};
+  }
+  if (auto o = c.field(placement); o.present()) {
+    if (spatial_) {
+      const EulerParameters e = orientation(o);
+      s.rotation = rotation_matrix(e);
+    } else {
+      s.rotation = about_z(number(o));
+    }
+  }
+  read_shape_size(c, s);
+  return s;
+}
+
+// The fields that size the shape `s` (its kind already set).
+void SceneReader::read_shape_size(const Cursor& c, Shape& s) const {
+  switch (s.kind) {
+    case ShapeKind::kBox: {
+      const auto size = c.require("size");
+      if (!size.is_sequence() || size.size() != 3) size.fail("a box's size is [x, y, z] (edge lengths)");
+      s.size = {positive(size.at(0)), positive(size.at(1)), positive(size.at(2))};
+      break;
+    }
+    case ShapeKind::kPlane: {
+      const auto size = c.require("size");
+      if (!size.is_sequence() || size.size() != 2) size.fail("a plane's size is [x, y] (the drawn extent)");
+      s.size = {positive(size.at(0)), positive(size.at(1)), 0.0};
+      break;
+    }
+    case ShapeKind::kSphere:
+      s.radius = positive(c.require("radius"));
+      break;
+    case ShapeKind::kCylinder:
+    case ShapeKind::kCapsule:
+      s.radius = positive(c.require("radius")), s.length = positive(c.require("length"));
+      break;
+    case ShapeKind::kCone:
+      s.radius = positive(c.require("radius")), s.length = positive(c.require("height"));
+      break;
+    case ShapeKind::kPolygon: {
+      for (const kin3::V3& p : shape_points(c.require("points"), 2, 3)) s.outline.push_back({p.x, p.y});
+      s.length = positive(c.require("thickness"));
+      break;
+    }
+    case ShapeKind::kCurve:
+      s.points = shape_points(c.require("points"), spatial_ ? 3 : 2, 2);
+      s.closed = c.field("closed").present() && c.field("closed").boolean();
+      s.radius = c.field("width").present() ? 0.5 * positive(c.field("width")) : 0.0;
+      break;
+    case ShapeKind::kMesh: {
+      const auto f = c.require("file");
+      s.file = f.text();
+      s.scale = c.field("scale").present() ? positive(c.field("scale")) : 1.0;
+      // relative to the scene's folder, as a user writes it beside the scene
+      std::filesystem::path p(s.file);
+      if (p.is_relative()) p = std::filesystem::path(file_).parent_path() / p;
+      try {
+        s.mesh = std::make_shared<const TriangleMesh>(load_mesh_file(p.string(), s.scale));
+      } catch (const Error& e) {
+        f.fail(e.what());
+      }
+      break;
+    }
+  }
+}
+
+}  // namespace phiq::detail::scene
