@@ -2,7 +2,11 @@
 // leave no output or temporary; an output that cannot be written fails before a sweep of minutes starts.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
@@ -10,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "cli_support.hpp"
 #include "cli_test_support.hpp"
 #include "test_support.hpp"
 
@@ -98,6 +103,34 @@ TEST_F(Cli, UnwritableOutputsFailBeforeTheSweepAndNoneAppears) {
   EXPECT_EQ(r.code, 3) << r.err;
   EXPECT_TRUE(one_phiq_line(r.err));
   EXPECT_EQ(files(), (std::vector<std::string>{"a.csv", "long.yaml", "stderr.txt", "stdout.txt"}));
+}
+
+// A command that has printed its error line and is leaving when SIGTERM comes (under mpirun: the other ranks are
+// terminated when one leaves with an error, and this one with them) exits with its own status and no second line.
+// In a child process, which installs phiq's signal thread as the command does.
+TEST(Interrupts, ASignalAfterTheErrorLineAddsNoSecondLineAndKeepsItsStatus) {
+  const fs::path err = fs::temp_directory_path() / ("phiq_settle_" + std::to_string(::getpid()) + ".txt");
+  auto child = [&](bool settled) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      const int fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(fd, STDERR_FILENO);
+      phiq::tools::start_interrupts();
+      if (settled) phiq::tools::settle_interrupts(2);  // what fail() does after its line
+      ::kill(::getpid(), SIGTERM);
+      for (;;) ::pause();
+    }
+    int st = 0;
+    ::waitpid(pid, &st, 0);
+    return std::pair{WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(err)};
+  };
+  const auto [plain_code, plain_err] = child(false);
+  EXPECT_EQ(plain_code, 143);
+  EXPECT_NE(plain_err.find("interrupted (SIGTERM)"), std::string::npos) << plain_err;
+  const auto [code, text] = child(true);
+  EXPECT_EQ(code, 2);
+  EXPECT_EQ(text, "");
+  fs::remove(err);
 }
 
 }  // namespace

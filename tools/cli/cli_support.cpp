@@ -25,6 +25,7 @@ std::mutex g_mutex;
 std::vector<AtomicOutputFile*> g_live;  // files of live OutputSets whose temporaries a signal removes
 int g_stop_depth = 0;                   // live StopOnSignal objects
 bool g_quiet = false;                   // outputs committed: exit without a word
+int g_settled = -1;                     // the status of the error line already printed (−1: none)
 // (before a command names its subject, it has created no output yet)
 std::string g_subject, g_suffix = "; no output written";
 std::atomic<bool> g_stop{false};
@@ -46,11 +47,11 @@ sigset_t handled_signals() {
       if (!f->temporary_path().empty()) ::unlink(f->temporary_path().c_str());
     const std::string line = "phiq: " + (g_subject.empty() ? "" : g_subject + ": ") + "interrupted (" +
                              signal_name(sig) + ")" + g_suffix + "\n";
-    if (::write(STDERR_FILENO, line.data(), line.size()) < 0) {
+    if (g_settled < 0 && ::write(STDERR_FILENO, line.data(), line.size()) < 0) {
       // nothing more to do about it: the exit status still says what happened
     }
   }
-  ::_exit(128 + sig);
+  ::_exit(g_settled >= 0 ? g_settled : 128 + sig);
 }
 
 void wait_for_signals() {
@@ -81,6 +82,11 @@ const char* signal_name(int sig) {
       return "SIGHUP";
   }
   return "a signal";
+}
+
+void settle_interrupts(int status) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  if (g_settled < 0) g_settled = status;
 }
 
 void quiet_interrupts() {

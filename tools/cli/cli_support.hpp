@@ -31,6 +31,10 @@ const char* signal_name(int sig);
 // A second signal (or one outside a StopOnSignal) exits without a word: a worker rank of an MPI batch, which
 // writes no file and leaves the talking to rank 0.
 void quiet_interrupts();
+// The command has printed its error line and is leaving with `status`: a signal from now on removes the temporaries
+// and exits with that status without a word. Under mpirun, the ranks still running when one leaves with an error
+// are sent SIGTERM, this one too while it finishes; its one line stays the only one. fail() calls it.
+void settle_interrupts(int status);
 // Whether a signal came (or, in a StopOnSignal, asked the sweep to stop), and which one.
 const std::atomic<bool>& stop_flag();
 int interrupt_signal();           // 0 when none

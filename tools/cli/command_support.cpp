@@ -17,6 +17,7 @@ namespace phiq::tools {
 
 int fail(const std::string& msg, int code) {
   std::cerr << "phiq: " << printable(msg) << "\n";
+  settle_interrupts(code);  // the line said why it stops: a signal while it leaves adds no second one
   return code;
 }
 
