@@ -23,11 +23,11 @@ import dataclasses
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import _phiq
-from ._phiq import (AssemblySummary, ConstraintInfo, JacobianUpdate, LinearSummary, Model, NewtonOptions,
+from ._phiq import (AssemblySummary, ConstraintInfo, JacobianUpdate, LinearSummary, Model, NewtonOptions, Part,
                     PositionSummary, Predictor, RankReport, Scene, SceneError, SensitivityForm, SolveStatus,
                     StepSummary, Stepper, SweepOptions, SweepSummary, SweepWarning, Unit, WorkCounters, Workspace,
-                    analyse_rank, assemble, constraint_kinds, load_scene, parse_scene, solve_acceleration,
-                    solve_position, solve_velocity)
+                    analyse_rank, assemble, constraint_kinds, drawn_parts, load_scene, parse_scene,
+                    solve_acceleration, solve_position, solve_velocity)
 from ._batch import BatchResult, run_batch_tables
 from ._builder import SceneBuilder
 from ._results import SolveError, SweepResult
@@ -38,11 +38,11 @@ SceneError.__doc__ = ("A scene that cannot be used (a ValueError): one line 'FIL
 
 __all__ = [
     "AssemblySummary", "BatchResult", "CheckReport", "ConstraintInfo", "JacobianUpdate", "LinearSummary", "Model",
-    "NewtonOptions", "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError",
+    "NewtonOptions", "Part", "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError",
     "SensitivityForm", "SolveError", "SolveStatus", "StepSummary", "Stepper", "SweepOptions", "SweepResult",
     "SweepSummary", "SweepWarning", "Unit", "WorkCounters", "Workspace",
-    "analyse_rank", "assemble", "check", "constraint_kinds", "load_scene", "parse_scene", "run_batch", "run_sweep",
-    "solve_acceleration", "solve_position", "solve_velocity",
+    "analyse_rank", "assemble", "check", "constraint_kinds", "drawn_parts", "load_scene", "parse_scene", "run_batch",
+    "run_sweep", "solve_acceleration", "solve_position", "solve_velocity",
 ]
 
 

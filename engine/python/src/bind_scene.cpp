@@ -38,6 +38,7 @@ void bind_scene(py::module_& m) {
       .def_property_readonly(
           "model", [](const Scene& s) -> const Model& { return *s.model; }, py::return_value_policy::reference_internal,
           "the mechanism (a Model)")
+      .def_readonly("parts", &Scene::parts, "the scene's `parts` (list of Part), in file order")
       .def_property_readonly(
           "options", [](const Scene& s) { return s.sweep; },
           "a copy of the scene's SweepOptions (time grid, solver, outputs), to change and pass "

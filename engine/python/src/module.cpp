@@ -14,6 +14,7 @@ PYBIND11_MODULE(_phiq, m) {
   m.attr("__version__") = phiq::version();
   py::register_exception<phiq::SceneError>(m, "SceneError", PyExc_ValueError);
   phiq::python::bind_model(m);
+  phiq::python::bind_parts(m);
   phiq::python::bind_scene(m);
   phiq::python::bind_solve(m);
   phiq::python::bind_sweep(m);

@@ -1,0 +1,105 @@
+// Parts (phiq/parts.hpp): a scene's bodies as parts — name, the body they are on, their mass properties and shapes —
+// and their poses at a position q, for a caller that draws the mechanism or computes with its masses.
+
+#include "bindings.hpp"
+
+#include <pybind11/numpy.h>
+
+#include "phiq/drawn_parts.hpp"
+
+namespace phiq::python {
+
+namespace {
+
+const char* kind_name(ShapeKind k) {
+  switch (k) {
+    case ShapeKind::kBox:
+      return "box";
+    case ShapeKind::kCylinder:
+      return "cylinder";
+    case ShapeKind::kSphere:
+      return "sphere";
+    case ShapeKind::kCapsule:
+      return "capsule";
+    case ShapeKind::kCone:
+      return "cone";
+    case ShapeKind::kPlane:
+      return "plane";
+    case ShapeKind::kPolygon:
+      return "polygon";
+    case ShapeKind::kMesh:
+      return "mesh";
+    case ShapeKind::kCurve:
+      return "curve";
+  }
+  return "shape";
+}
+
+py::array_t<double> vector3(const kin3::V3& v) {
+  py::array_t<double> a(3);
+  auto w = a.mutable_unchecked<1>();
+  w(0) = v.x, w(1) = v.y, w(2) = v.z;
+  return a;
+}
+
+py::array_t<double> matrix3(const std::array<double, 9>& m) {
+  py::array_t<double> a({3, 3});
+  auto w = a.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < 3; ++i)
+    for (py::ssize_t j = 0; j < 3; ++j) w(i, j) = m[static_cast<std::size_t>(3 * i + j)];
+  return a;
+}
+
+const char* source_name(MassSource s) {
+  return s == MassSource::kStated ? "stated" : s == MassSource::kDensity ? "density" : "none";
+}
+
+}  // namespace
+
+void bind_parts(py::module_& m) {
+  py::class_<Part>(m, "Part", "A body as a part: its frame, its shapes and its mass (models/README.md, Parts).")
+      .def_readonly("name", &Part::name, "the part's name")
+      .def_readonly("body", &Part::body, "the body it is on, or the kind of its own frame")
+      .def_readonly("derived", &Part::derived, "made by phiq from the constraints (drawn_parts), not stated")
+      .def_property_readonly(
+          "mass", [](const Part& p) { return p.mass.mass; }, "kg (0 without mass)")
+      .def_property_readonly(
+          "center_of_mass", [](const Part& p) { return vector3(p.mass.center); }, "in the part's frame (m)")
+      .def_property_readonly(
+          "inertia", [](const Part& p) { return matrix3(p.mass.inertia); },
+          "3×3, kg·m², about the centre of mass in the part's axes")
+      .def_property_readonly(
+          "mass_source", [](const Part& p) { return source_name(p.mass_source); }, "'stated', 'density' or 'none'")
+      .def_property_readonly(
+          "shapes",
+          [](const Part& p) {
+            py::list out;
+            for (const Shape& s : p.shapes) {
+              py::dict d;
+              d["type"] = kind_name(s.kind);
+              d["name"] = s.name;
+              d["at"] = vector3(s.at);
+              d["rotation"] = matrix3(s.rotation);
+              out.append(d);
+            }
+            return out;
+          },
+          "each shape's type, name and placement in the part's frame (at, rotation)")
+      .def(
+          "pose",
+          [](const Part& p, const Eigen::Ref<const Eigen::VectorXd>& q, double t) {
+            if (max_coordinate(p.frame) >= q.size())
+              throw Error("Part.pose: q has " + std::to_string(q.size()) + " entries; part '" + p.name +
+                          "' reads coordinate " + std::to_string(max_coordinate(p.frame)));
+            const Pose pose = part_pose(p.frame, q.data(), t);
+            return py::make_tuple(vector3(pose.at), matrix3(pose.rotation));
+          },
+          py::arg("q"), py::arg("t") = 0.0,
+          "(origin, rotation) of the part's frame at (q, t): a body point s is at origin + rotation @ s")
+      .def("__repr__", [](const Part& p) { return "<phiq.Part '" + p.name + "' on " + p.body + ">"; });
+  m.def(
+      "drawn_parts", [](const Scene& s) { return drawn_parts(s); }, py::arg("scene"),
+      "The parts a drawing of the scene shows: its own, then those derived from its constraints.");
+}
+
+}  // namespace phiq::python

@@ -1,0 +1,61 @@
+"""phiq.Part from Python (engine/python/src/bind_parts.cpp): a scene's parts with their mass properties, and each
+part's pose at the rows of a sweep against the body points the joints use."""
+import math
+import os
+
+import numpy as np
+import pytest
+
+import phiq
+
+from conftest import MODELS
+
+FOURBAR = os.path.join(MODELS, "seed", "fourbar_reference_point.yaml")
+
+
+def fourbar_with_parts():
+    with open(FOURBAR, encoding="utf-8") as f:
+        text = f.read()
+    return phiq.parse_scene(text + "\nparts:\n"
+                            "  coupler: {density: 7850, shapes: [{type: box, size: [1.2, 0.04, 0.01]}]}\n"
+                            "  crank: {mass: 2.0, center_of_mass: [0.01, 0], inertia: 0.03}\n", "fourbar.yaml")
+
+
+def test_mass_properties_are_the_boxs_closed_form():
+    scene = fourbar_with_parts()
+    parts = {p.name: p for p in scene.parts}
+    coupler = parts["coupler"]
+    m = 7850 * 1.2 * 0.04 * 0.01
+    assert coupler.mass_source == "density"
+    assert coupler.mass == pytest.approx(m, rel=1e-12)
+    assert coupler.inertia[2, 2] == pytest.approx(m * (1.2 ** 2 + 0.04 ** 2) / 12, rel=1e-12)
+    assert coupler.inertia[0, 0] == pytest.approx(m * (0.04 ** 2 + 0.01 ** 2) / 12, rel=1e-12)
+    assert coupler.shapes[0]["type"] == "box"
+    crank = parts["crank"]
+    assert crank.mass_source == "stated"
+    assert crank.mass == 2.0
+    assert crank.center_of_mass[0] == 0.01
+
+
+def test_poses_follow_the_bodies_at_every_row():
+    """The coupler's end at +L3/2 in its frame is joint B: on the rocker's end, whose distance to C is L4."""
+    scene = fourbar_with_parts()
+    coupler = {p.name: p for p in scene.parts}["coupler"]
+    result = phiq.run_sweep(scene)
+    model = scene.model
+    i_x, i_y, i_psi = (model.coordinate_index(n) for n in ("x3", "y3", "psi3"))
+    worst = 0.0
+    for q, t in zip(result.q, result.t):
+        origin, rotation = coupler.pose(q, t)
+        assert np.allclose(rotation @ rotation.T, np.eye(3), atol=1e-15)
+        assert origin[0] == q[i_x] and origin[1] == q[i_y]
+        assert rotation[0, 0] == pytest.approx(math.cos(q[i_psi]), abs=1e-15)
+        b = origin + rotation @ np.array([0.6, 0.0, 0.0])
+        worst = max(worst, abs(math.hypot(b[0] - 1.0, b[1]) - 1.0))
+    assert worst < 1e-9
+
+
+def test_a_short_q_is_refused_in_one_line():
+    coupler = fourbar_with_parts().parts[0]
+    with pytest.raises(ValueError, match="Part.pose: q has 2 entries"):
+        coupler.pose(np.zeros(2))
