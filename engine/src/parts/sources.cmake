@@ -4,6 +4,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/mass_properties.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mesh_file.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mesh_is_closed.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/part_motion.cpp
   ${CMAKE_CURRENT_LIST_DIR}/part_pose.cpp
   ${CMAKE_CURRENT_LIST_DIR}/polygon.cpp
   ${CMAKE_CURRENT_LIST_DIR}/shape_checks.cpp
