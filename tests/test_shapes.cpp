@@ -42,7 +42,7 @@ Shape prism(std::vector<std::array<double, 2>> outline, double thickness) {
   return s;
 }
 Shape curve(std::vector<V3> points, double width, bool closed) {
-  Shape s = make(ShapeKind::kCurve, width);
+  Shape s = make(ShapeKind::kCurve, width / 2);  // the tube's radius
   s.points = std::move(points), s.closed = closed;
   return s;
 }

@@ -38,7 +38,8 @@ enum class ShapeKind {
   kPlane,     ///< z = 0, normal +z; `size` x, y the drawn extent (a ground plane; no mass)
   kPolygon,   ///< `outline` in x, y (a simple polygon, either orientation), extruded over `length` along z (centred)
   kMesh,      ///< `mesh`, read from `file` (STL ASCII or binary, OBJ), scaled by `scale`
-  kCurve,     ///< a polyline `points` (closed or not) drawn with width `radius` (no mass): slots, belts, threads
+  kCurve,  ///< a polyline `points` (closed or not) drawn as a tube of `radius`, half its width (no mass): slots, belts,
+           ///< threads
 };
 
 /// A shape in a body's frame. Sizes are in metres and positive; see the file comment for each kind's own frame.
@@ -49,14 +50,14 @@ struct Shape {
   kin3::V3 at;                                         ///< the shape frame's origin in the body frame (m)
   RotationMatrix rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< the shape frame's axes in the body frame (columns)
   kin3::V3 size;                                       ///< kBox: edge lengths; kPlane: drawn extent in x, y
-  double radius = 0.0;                                 ///< kCylinder, kSphere, kCapsule, kCone; kCurve: drawn width
-  double length = 0.0;                                 ///< kCylinder, kCapsule, kCone (height), kPolygon (thickness)
-  std::vector<std::array<double, 2>> outline;          ///< kPolygon: vertices in x, y
-  std::vector<kin3::V3> points;                        ///< kCurve: the polyline in the shape frame
-  bool closed = false;                                 ///< kCurve: the last point joins the first
-  std::string file;                                    ///< kMesh: the file it was read from (as the scene names it)
-  double scale = 1.0;                                  ///< kMesh: file units to metres
-  std::shared_ptr<const TriangleMesh> mesh;            ///< kMesh: the triangles in the shape frame, already scaled
+  double radius = 0.0;                         ///< kCylinder, kSphere, kCapsule, kCone; kCurve: half the drawn width
+  double length = 0.0;                         ///< kCylinder, kCapsule, kCone (height), kPolygon (thickness)
+  std::vector<std::array<double, 2>> outline;  ///< kPolygon: vertices in x, y
+  std::vector<kin3::V3> points;                ///< kCurve: the polyline in the shape frame
+  bool closed = false;                         ///< kCurve: the last point joins the first
+  std::string file;                            ///< kMesh: the file it was read from (as the scene names it)
+  double scale = 1.0;                          ///< kMesh: file units to metres
+  std::shared_ptr<const TriangleMesh> mesh;    ///< kMesh: the triangles in the shape frame, already scaled
 };
 
 /// Mass, centre of mass and inertia about the centre of mass, in the body's axes.

@@ -87,7 +87,7 @@ TriangleMesh curve_tube(const Shape& shape, int n) {
     }
   }
   TriangleMesh mesh;
-  const double half_width = shape.radius / 2.0;
+  const double half_width = shape.radius;  // the tube's radius: half the drawn width
   for (std::size_t k = 0; k < count; ++k) {
     const V3 b = kin3::cross(t[k], r[k]);  // r, b, t right-handed: the ring turns counter-clockwise about t
     for (int j = 0; j < n; ++j) {

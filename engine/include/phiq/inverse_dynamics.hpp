@@ -1,0 +1,41 @@
+/// @file
+/// Inverse dynamics of a driven mechanism (kinetostatics): with its motion known from the drivers (q, q̇, q̈ at a
+/// row), the constraints' multipliers λ follow from one transposed solve with Φq,
+///
+///     Φqᵀ λ = Q(q, q̇, q̈, t),   Q_k = Σ_b [ ∂r_b/∂q_k · (m_b (g − a_b)) + ∂θ_b/∂q_k · (−I_b α_b − ω_b × I_b ω_b) ],
+///
+/// b over the parts with mass (phiq/parts.hpp), r_b a part's centre of mass and a_b its acceleration, ω_b, α_b its
+/// angular velocity and acceleration, I_b its inertia about the centre in world axes, ∂/∂q_k from part_jacobian():
+/// the virtual work of gravity and of the inertia forces, in any coordinate family. A driver's effort (the torque
+/// or force its motor applies, conjugate to what it drives) is −λ of its row, and its power −λ (Φq q̇) = λ Φt.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+#include "phiq/kinematics.hpp"
+#include "phiq/parts.hpp"
+#include "phiq/workspace.hpp"
+
+namespace phiq {
+
+/// The loads on a mechanism's parts: a uniform gravity (m/s², world axes) acting at each part's centre of mass.
+struct Loads {
+  kin3::V3 gravity;  ///< e.g. (0, −9.81, 0) in the plane
+};
+
+/// Adds to `Q` (one entry per coordinate) the generalized forces of `loads` and of the parts' inertia at (q, q̇, q̈,
+/// t) (file comment). Parts without mass contribute nothing. Pre-condition: Q has a size the parts' coordinates fit.
+void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
+                            const double* qdd, double t, Eigen::VectorXd& Q);
+
+/// The constraints' multipliers at the motion in `ws` (q, q̇, q̈ solved at t): λ (one per equation) with Φqᵀ λ = Q,
+/// by the transposed solve of the model's LU of Φq at (q, t), factorised there if it is not already. A model with
+/// dropped (redundant) rows gives λ = 0 on them: one of the many λ then, not the minimum-norm one. Returns what the
+/// factorisation returns (kNotSquare for a model without a square solve); `message` says why on failure.
+SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, const Eigen::VectorXd& Q,
+                                   Eigen::VectorXd& lambda, std::string* message = nullptr);
+
+}  // namespace phiq

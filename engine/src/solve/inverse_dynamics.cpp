@@ -1,0 +1,74 @@
+// add_generalized_forces() and constraint_multipliers() (phiq/inverse_dynamics.hpp).
+#include "phiq/inverse_dynamics.hpp"
+
+#include "phiq/part_motion.hpp"
+#include "solve/factorisation.hpp"
+
+namespace phiq {
+
+namespace {
+
+using kin3::V3;
+
+// R I Rᵀ v: the inertia about the centre, turned into world axes, times v.
+V3 world_inertia_times(const RotationMatrix& r, const std::array<double, 9>& I, V3 v) {
+  const double b[3] = {r[0] * v.x + r[3] * v.y + r[6] * v.z, r[1] * v.x + r[4] * v.y + r[7] * v.z,
+                       r[2] * v.x + r[5] * v.y + r[8] * v.z};  // Rᵀ v
+  double c[3];
+  for (int i = 0; i < 3; ++i) c[i] = I[3 * i] * b[0] + I[3 * i + 1] * b[1] + I[3 * i + 2] * b[2];
+  return {r[0] * c[0] + r[1] * c[1] + r[2] * c[2], r[3] * c[0] + r[4] * c[1] + r[5] * c[2],
+          r[6] * c[0] + r[7] * c[1] + r[8] * c[2]};
+}
+
+}  // namespace
+
+void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
+                            const double* qdd, double t, Eigen::VectorXd& Q) {
+  for (const Part& p : parts) {
+    if (p.mass_source == MassSource::kNone || p.mass.mass == 0.0) continue;
+    const PartMotion m = part_motion(p.frame, q, qd, qdd, t);
+    const V3 c = m.pose.apply(p.mass.center) - m.pose.at;  // the centre from the origin, world axes
+    const auto [vc, ac] = m.point(p.mass.center);
+    (void)vc;
+    // the resultant force at the centre and the moment about it
+    const V3 force = p.mass.mass * (loads.gravity - ac);
+    const V3 moment = -1.0 * (world_inertia_times(m.pose.rotation, p.mass.inertia, m.alpha) +
+                              kin3::cross(m.omega, world_inertia_times(m.pose.rotation, p.mass.inertia, m.omega)));
+    const PartJacobian j = part_jacobian(p.frame, q, t);
+    for (std::size_t i = 0; i < j.coordinates.size(); ++i) {
+      const V3 dc = j.d_origin[i] + kin3::cross(j.d_angle[i], c);  // ∂r_c/∂q_k
+      Q(j.coordinates[i]) += kin3::dot(dc, force) + kin3::dot(j.d_angle[i], moment);
+    }
+  }
+}
+
+SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, const Eigen::VectorXd& Q,
+                                   Eigen::VectorXd& lambda, std::string* message) {
+  std::string why;
+  auto failed = [&](SolveStatus st) {
+    if (message) *message = why;
+    return st;
+  };
+  if (!ws.lu) return why = "constraint_multipliers: the model has no square solve", failed(SolveStatus::kNotSquare);
+  if (Q.size() != model.num_coordinates())
+    throw Error("constraint_multipliers: Q has " + std::to_string(Q.size()) + " entries, the model " +
+                std::to_string(model.num_coordinates()) + " coordinates");
+  double rcond = 0.0;
+  const SolveStatus st = detail::ensure_factorized(model, t, ws, &rcond, &why);
+  if (st != SolveStatus::kSuccess) return failed(st);
+  // the LU is of the kept rows' Φq: λ on them, 0 on the dropped ones
+  Eigen::VectorXd kept(
+      static_cast<Index>(model.solve_rows().empty() ? model.num_equations() : model.solve_rows().size()));
+  if (!ws.lu->solve_transposed(Q.data(), kept.data()))
+    return why = ws.lu->last_message(), failed(SolveStatus::kLinearSolverFailed);
+  lambda = Eigen::VectorXd::Zero(model.num_equations());
+  if (model.dropped_rows().empty()) {
+    lambda = kept;
+  } else {
+    const std::vector<Index>& rows = model.solve_rows();
+    for (std::size_t i = 0; i < rows.size(); ++i) lambda(rows[i]) = kept(static_cast<Index>(i));
+  }
+  return SolveStatus::kSuccess;
+}
+
+}  // namespace phiq
