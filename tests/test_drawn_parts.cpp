@@ -84,6 +84,8 @@ TEST(DrawnParts, EveryJointOfTheModelsPutsAShapeOnItsBody) {
       for (const Slot* s : {&f.x, &f.y, &f.z, &f.e0, &f.e1, &f.e2, &f.e3})
         if (s->is_coordinate()) body_coordinates.insert(s->coord());
     const std::vector<Part> parts = drawn_parts(scene);
+    for (const Part& p : parts)  // every derived shape has sizes and an outline that draw
+      for (const Shape& s : p.shapes) EXPECT_NO_THROW(shape_triangles(s, 8)) << path << ": " << s.name;
     const Model& m = *scene.model;
     for (const auto& block : m.blocks())
       ConstraintKinds::for_each([&]<class K>() {

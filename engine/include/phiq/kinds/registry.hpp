@@ -45,8 +45,8 @@ namespace phiq {
 /// @cond internal
 namespace detail {
 // What a kind's sketch() is called with: the drawing primitives. mechanism_sketch.cpp implements them for the lines
-// and marks of a mechanism (it draws no kind's own geometry), drawn_parts.cpp for the derived parts (derived_parts.hpp
-// documents each primitive's shapes). A kind states its geometry once, with these.
+// and marks of a mechanism (it draws no kind's own geometry), drawn_parts.cpp for the derived parts (its comments
+// say each primitive's shapes). A kind states its geometry once, with these.
 struct SketchProbe {
   void bar(const Point2&, const Point2&, double /*length, 0: none*/ = 0.0) {}
   void arm(const Frame2&, const kin::V2&) {}
