@@ -3,8 +3,8 @@
 /// carries in that frame (phiq/shapes.hpp) and its mass properties. A scene's `parts` section (models/README.md)
 /// places them on any coordinate family: a reference-point body (its frame), natural points and vectors (an origin
 /// and the directions of its axes), or expressions of the coordinates (relative angles: an origin and an angle).
-/// A body with no part of its own gets a derived part (derived_parts()): links between the points it carries,
-/// shafts along its joints' axes, sized from the scene's length scale.
+/// A body with no part of its own gets a derived part where a drawing asks (drawn_parts(), phiq/drawn_parts.hpp):
+/// links between the points it carries, shafts along its joints' axes, sized from the model's length scale.
 ///
 /// Nothing here is computed during a sweep: a part's pose is evaluated from q when an output or a drawing asks.
 #pragma once

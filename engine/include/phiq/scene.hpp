@@ -68,7 +68,7 @@ struct Scene {
   std::vector<Frame3> spatial_bodies;             ///< see planar_bodies
   std::vector<JointAngleReference> joint_angles;  ///< the reference directions of the joint angle drivers
   /// The scene's `parts`, in file order: shapes and mass on its bodies (phiq/parts.hpp). Bodies without one get
-  /// derived parts where a drawing asks for them (derived_parts()), not here.
+  /// derived parts where a drawing asks for them (drawn_parts()), not here.
   std::vector<Part> parts;
   std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: a CsvFormat keeps its address)
   /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns

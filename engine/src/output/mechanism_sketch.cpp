@@ -67,8 +67,8 @@ class Sketcher {
     if (!marked_.insert(key_of(at)).second) return;
     out_.joints.push_back({at, m, axis, guide, !moves(at), end, constraint});
   }
-  // A link between natural points, and its ends.
-  void bar(const Point2& a, const Point2& b) {
+  // A link between natural points, and its ends (its length is the derived parts').
+  void bar(const Point2& a, const Point2& b, double /*length*/ = 0.0) {
     const OutputPoint pa = planar_point("", a), pb = planar_point("", b);
     line(pa, pb, SketchLine::kBar);
     mark(pa, JointMark::kPoint, 0), mark(pb, JointMark::kPoint, 1);
@@ -90,7 +90,7 @@ class Sketcher {
     mark(planar_body_point("", b, sb.x, sb.y), JointMark::kPrismatic, -1, axis, a);
   }
   // A spatial link between two attachments, and its ends.
-  void bar3(const Attachment3& a, const Attachment3& b) {
+  void bar3(const Attachment3& a, const Attachment3& b, double /*length*/ = 0.0) {
     line(attached(a), attached(b), SketchLine::kBar);
     mark(attached(a), JointMark::kPoint, 0), mark(attached(b), JointMark::kPoint, 1);
   }
@@ -105,6 +105,18 @@ class Sketcher {
   void joint3(const Attachment3& a, const Attachment3& b, JointMark m) {
     mark(moves(attached(a)) && !moves(attached(b)) ? attached(b) : attached(a), m);
   }
+
+  // The kinds' own geometry is the derived parts' (drawn_parts.cpp): the sketch's lines and marks have none.
+  void joint_parts3(const JointSide3&, const JointSide3&, JointForm) {}
+  void thread3(const JointSide3&, double) {}
+  void bevel_pair(const JointSide3&, const JointSide3&, const JointSide3&, const JointSide3&, double, double) {}
+  void open_chain(const std::vector<LoopSpec::Link>&) {}
+  void gear_pair(const Slot&, const Slot&, double, double, bool) {}
+  void belt(const Slot&, const Slot&, double, double, bool) {}
+  void rack(const Slot&, const Slot&, double, bool) {}
+  void curve(const CurveOn&) {}
+  void roller(const Frame2&, const kin::V2&, double) {}
+  void face(const Frame2&, const kin::V2&, const kin::V2&) {}
 
   MechanismSketch take() { return std::move(out_); }
 

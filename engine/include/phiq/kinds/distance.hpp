@@ -180,11 +180,14 @@ struct DistanceSpec {
   void prepare(const double* /*q0*/) const {
     detail::require(std::isfinite(length) && length > 0.0, "distance: length must be positive and finite");
   }
-  /// The lines that draw the constraint (mechanism_sketch.hpp): `sk.bar(p, q)` for a bar between two planar points,
-  /// `sk.arm(frame, s)` for a body's arm from its reference point to a local point. Kinds that draw nothing say why.
+  /// What draws the constraint, said once for the mechanism's sketch (mechanism_sketch.hpp) and the derived parts
+  /// (drawn_parts.hpp), through the primitives of kinds/registry.hpp (detail::SketchProbe): `sk.bar(p, q, L)` for a
+  /// bar between two planar points (L its length, 0 if the kind has none), `sk.arm(frame, s)` for a body's arm from
+  /// its reference point to a local point, and the kinds' own geometry (a gear's pitch circle, a cam's profile, …).
+  /// Kinds that draw nothing say why.
   template <class Sketch>
   void sketch(Sketch& sk) const {
-    sk.bar(a, b);
+    sk.bar(a, b, length);
   }
   /// How scenes write it (models/README.md).
   static constexpr SceneForm kScene[] = {

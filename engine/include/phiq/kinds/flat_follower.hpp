@@ -182,10 +182,13 @@ struct FlatFollowerSpec {
   /// @copydoc PointOnCurveSpec::outside_domain
   std::string outside_domain(const double* q) const { return detail::outside_curve(*on.curve, s.of(q)); }
   /// @copydoc DistanceSpec::sketch
-  /// A flat follower draws the arm of its face's point (the sketch has no curves: the profile is not drawn).
+  /// A flat follower draws the arm of its face's point (the mechanism's sketch has no curves), and on the parts the
+  /// profile on its body and the face.
   template <class Sketch>
   void sketch(Sketch& sk) const {
     sk.arm(a, sa);
+    sk.curve(on);
+    sk.face(a, sa, axis);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {

@@ -28,6 +28,16 @@ enum class JointMark {
   kPoint,      ///< the end of a natural-coordinate link (a natural point, moving or fixed)
 };
 
+/// What a spatial joint puts on the bodies it joins among their derived parts (drawn_parts.hpp), as its sketch()
+/// says (the sketch's `joint_parts3`).
+enum class JointForm {
+  kBall,    ///< a ball on each side (spherical, and the joints that have no axis of their own to draw)
+  kHinge,   ///< a shaft along the axis on side b, a fork about it on side a (revolute)
+  kShaft,   ///< a shaft along the axis on side b, a sleeve about it on side a (cylindrical, screw)
+  kCross,   ///< a cylinder along each side's own axis through the joint point: together, the cross (universal)
+  kSlider,  ///< a block on side b, a guide along the axis on side a (prismatic)
+};
+
 namespace kin {
 struct V2 {
   double x, y;

@@ -171,9 +171,12 @@ struct LoopSpec {
     for (const auto& l : links) detail::require(std::isfinite(l.offset), "loop: link offset is not finite");
   }
   /// @copydoc DistanceSpec::sketch
-  /// A loop draws nothing: its links are angles, with no points of the plane to draw between.
+  /// A loop has no points of the plane for the mechanism's sketch; on the parts, its links as an open chain from the
+  /// origin, each starting where the one before it ends (the closure vector is the ground's).
   template <class Sketch>
-  void sketch(Sketch&) const {}
+  void sketch(Sketch& sk) const {
+    sk.open_chain(links);
+  }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
       {"constraints", "loop", 2,

@@ -153,10 +153,13 @@ struct PointOnCurveSpec {
   /// "" while s is on the curve; on an open curve past an end, what happened (Model::outside_domain).
   std::string outside_domain(const double* q) const { return detail::outside_curve(*on.curve, s.of(q)); }
   /// @copydoc DistanceSpec::sketch
-  /// A point on a curve draws the point's arm (the sketch has no curves: the slot or profile is not drawn).
+  /// A point on a curve draws the point's arm (the mechanism's sketch has no curves), and on the parts the slot or
+  /// profile on its body and a roller of radius ρ.
   template <class Sketch>
   void sketch(Sketch& sk) const {
     sk.arm(a, sa);
+    sk.curve(on);
+    if (offset > 0.0) sk.roller(a, sa, offset);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {

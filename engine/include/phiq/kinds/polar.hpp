@@ -103,10 +103,10 @@ struct PolarSpec {
     detail::require(length != 0.0, "polar: the length is zero (the angle would be undetermined)");
   }
   /// @copydoc DistanceSpec::sketch
-  /// A polar constraint draws its arm, o to p.
+  /// A polar constraint draws its arm, o to p, of length |L|.
   template <class Sketch>
   void sketch(Sketch& sk) const {
-    sk.bar(o, p);
+    sk.bar(o, p, std::fabs(length));
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {

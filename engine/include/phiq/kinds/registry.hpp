@@ -44,15 +44,27 @@ namespace phiq {
 
 /// @cond internal
 namespace detail {
-// What a kind's sketch() is called with: the drawing primitives (mechanism_sketch.cpp implements them).
+// What a kind's sketch() is called with: the drawing primitives. mechanism_sketch.cpp implements them for the lines
+// and marks of a mechanism (it draws no kind's own geometry), drawn_parts.cpp for the derived parts (its comments
+// say each primitive's shapes). A kind states its geometry once, with these.
 struct SketchProbe {
-  void bar(const Point2&, const Point2&) {}
+  void bar(const Point2&, const Point2&, double /*length, 0: none*/ = 0.0) {}
   void arm(const Frame2&, const kin::V2&) {}
   void pivot(const Frame2&, const kin::V2&, const Frame2&, const kin::V2&) {}
   void slider(const Frame2&, const kin::V2&, const Frame2&, const kin::V2&) {}
-  void bar3(const Attachment3&, const Attachment3&) {}
+  void bar3(const Attachment3&, const Attachment3&, double /*length, 0: none*/ = 0.0) {}
   void arm3(const Attachment3&) {}
   void joint3(const Attachment3&, const Attachment3&, JointMark) {}
+  void joint_parts3(const JointSide3&, const JointSide3&, JointForm) {}
+  void thread3(const JointSide3&, double /*pitch*/) {}
+  void bevel_pair(const JointSide3&, const JointSide3&, const JointSide3&, const JointSide3&, double, double) {}
+  void open_chain(const std::vector<LoopSpec::Link>&) {}
+  void gear_pair(const Slot&, const Slot&, double, double, bool /*internal*/) {}
+  void belt(const Slot&, const Slot&, double, double, bool /*crossed*/) {}
+  void rack(const Slot& /*travel*/, const Slot& /*pinion*/, double /*radius*/, bool /*reversed*/) {}
+  void curve(const CurveOn&) {}
+  void roller(const Frame2&, const kin::V2&, double /*radius*/) {}
+  void face(const Frame2&, const kin::V2&, const kin::V2& /*direction*/) {}
 };
 // What a kind's jacobian() is called with: (local row, slot, value).
 struct SinkProbe {

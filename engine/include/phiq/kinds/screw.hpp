@@ -117,10 +117,12 @@ struct ScrewSpec {
   /// For a screw: setup().
   void prepare(const double* /*q0*/) { setup(); }
   /// @copydoc DistanceSpec::sketch
-  /// A screw draws the arms of its bodies and a hinge at its point.
+  /// A screw draws the arms of its bodies and a hinge at its point; on the parts a shaft in a sleeve, and its
+  /// thread (a helix of lead `pitch`) about side b's axis.
   template <class Sketch>
   void sketch(Sketch& sk) const {
-    detail3::sketch_joint(a, b, JointMark::kRevolute, sk);
+    detail3::sketch_joint(a, b, JointMark::kRevolute, JointForm::kShaft, sk);
+    sk.thread3(b, pitch);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {

@@ -110,7 +110,7 @@ struct SpatialDistanceSpec {
   /// A spatial distance draws its bar, and the arms of the bodies it joins.
   template <class Sketch>
   void sketch(Sketch& sk) const {
-    sk.bar3(ends[0], ends[1]);
+    sk.bar3(ends[0], ends[1], length);
     sk.arm3(ends[0]);
     sk.arm3(ends[1]);
   }

@@ -128,9 +128,12 @@ struct SpatialGearSpec {
                     "between their rotation angles)");
   }
   /// @copydoc DistanceSpec::sketch
-  /// A spatial gear draws nothing: its shafts are drawn by their joints.
+  /// A spatial gear's shafts are drawn by their joints; it draws its two pitch circles, on the shafts (sides b),
+  /// of the ratio z1 : z2, at the pitch cones' bases about the point where the axes cross.
   template <class Sketch>
-  void sketch(Sketch&) const {}
+  void sketch(Sketch& sk) const {
+    sk.bevel_pair(a1, b1, a2, b2, z1, z2);
+  }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {{"constraints", "spatial_gear", 3,
                                           "- {name: bevel, type: spatial_gear, shafts: [input_bearing, "

@@ -117,13 +117,15 @@ inline double joint_arm(const JointSide3& a, const JointSide3& b) {
   const double la = a.frame.is_fixed() ? 0.0 : kin3::norm(a.at), lb = b.frame.is_fixed() ? 0.0 : kin3::norm(b.at);
   return std::max(la, lb);
 }
-/// Draws a joint: the arms of the bodies it joins, and `mark` at its point (on ground when a side is ground).
+/// Draws a joint: the arms of the bodies it joins, `mark` at its point (on ground when a side is ground), and its
+/// `form` on the bodies' derived parts.
 template <class Sketch>
-void sketch_joint(const JointSide3& a, const JointSide3& b, JointMark mark, Sketch& sk) {
+void sketch_joint(const JointSide3& a, const JointSide3& b, JointMark mark, JointForm form, Sketch& sk) {
   const Attachment3 pa = Attachment3::body_point(a.frame, a.at), pb = Attachment3::body_point(b.frame, b.at);
   sk.arm3(pa);
   sk.arm3(pb);
   sk.joint3(pa, pb, mark);
+  sk.joint_parts3(a, b, form);
 }
 /// Reports the slots of a side: its position (lengths), Euler parameters and vector (unitless).
 template <class F>
@@ -215,14 +217,21 @@ struct SpatialJointSpec {
   void prepare(const double* /*q0*/) { setup(); }
   /// @copydoc DistanceSpec::sketch
   /// A spatial joint draws the arms of the bodies it joins, and a mark at its point (a hinge for a revolute, a
-  /// block for a prismatic pair, a ball for the others), on ground when a side is ground.
+  /// block for a prismatic pair, a ball for the others), on ground when a side is ground; on the bodies' parts a
+  /// shaft and a fork (revolute), a shaft and a sleeve (cylindrical), the cross (universal), a block on a guide
+  /// (prismatic), a ball (the others).
   template <class Sketch>
   void sketch(Sketch& sk) const {
     const std::string_view kind = Traits::kKind;
     const JointMark mark = kind == "revolute"    ? JointMark::kRevolute
                            : kind == "prismatic" ? JointMark::kPrismatic
                                                  : JointMark::kSpherical;
-    detail3::sketch_joint(a, b, mark, sk);
+    const JointForm form = kind == "revolute"      ? JointForm::kHinge
+                           : kind == "prismatic"   ? JointForm::kSlider
+                           : kind == "cylindrical" ? JointForm::kShaft
+                           : kind == "universal"   ? JointForm::kCross
+                                                   : JointForm::kBall;
+    detail3::sketch_joint(a, b, mark, form, sk);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr const auto& kScene = Traits::kScene;

@@ -150,10 +150,10 @@ struct SpatialPolarSpec {
   /// @copydoc DistanceSpec::prepare
   void prepare(const double* /*q0*/) { setup(); }
   /// @copydoc DistanceSpec::sketch
-  /// A 3D polar draws its arm, centre to point.
+  /// A 3D polar draws its arm, centre to point, of length |r|.
   template <class Sketch>
   void sketch(Sketch& sk) const {
-    sk.bar3(Attachment3::body_point(center.frame, center.at), Attachment3::natural(point));
+    sk.bar3(Attachment3::body_point(center.frame, center.at), Attachment3::natural(point), std::fabs(radius));
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {

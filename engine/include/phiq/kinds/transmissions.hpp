@@ -44,8 +44,8 @@ inline void require_positive_pair(double r1, double r2, const char* message) {
 /// @endcond
 
 /// What the transmissions share: one time-independent row, linear in q (`Derived::row()`, a detail::LinearRow), so
-/// Φt = 0 and γ = 0; a higher pair removing one freedom in the scene's dimension (`Derived::dimension`); nothing to
-/// draw (the bodies are drawn by their joints).
+/// Φt = 0 and γ = 0; a higher pair removing one freedom in the scene's dimension (`Derived::dimension`). Each kind's
+/// sketch() draws its own geometry (the bodies are drawn by their joints).
 template <class Derived>
 struct LinearTransmission {
   /// No data of its own: the derived kind's operator== compares its own.
@@ -84,9 +84,6 @@ struct LinearTransmission {
   /// @copydoc phiq::DistanceSpec::joint_count
   /// A transmission between two bodies is a higher pair: one freedom.
   JointCount joint_count() const { return JointCount::joint(self().dimension == 3 ? 3 : 2, 1); }
-  /// @copydoc phiq::DistanceSpec::sketch
-  template <class Sketch>
-  void sketch(Sketch&) const {}
 
  private:
   const Derived& self() const { return static_cast<const Derived&>(*this); }
@@ -158,6 +155,12 @@ struct GearSpec : LinearTransmission<GearSpec> {
     return g;
   }
 
+  /// @copydoc DistanceSpec::sketch
+  /// A gear pair draws the pitch circles of the gears on their bodies (a ring for an internal gear).
+  template <class Sketch>
+  void sketch(Sketch& sk) const {
+    sk.gear_pair(first, second, r1, r2, internal);
+  }
   /// The row as a linear form (LinearTransmission evaluates it).
   detail::LinearRow row() const {
     const double k = (internal ? -r2 : r2) / r1;
@@ -230,6 +233,13 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
     return s;
   }
 
+  /// @copydoc DistanceSpec::sketch
+  /// A rack and pinion draws the pinion's pitch circle on its body and the rack on the body whose coordinate is the
+  /// travel.
+  template <class Sketch>
+  void sketch(Sketch& sk) const {
+    sk.rack(rack, pinion, radius, reversed);
+  }
   /// The row as a linear form (LinearTransmission evaluates it).
   detail::LinearRow row() const {
     return detail::LinearRow{{rack, pinion, Slot::constant(0)}, {1.0, reversed ? radius : -radius, 0.0}, offset};
@@ -301,6 +311,12 @@ struct BeltSpec : LinearTransmission<BeltSpec> {
     return b;
   }
 
+  /// @copydoc DistanceSpec::sketch
+  /// A belt or chain draws its pulleys on their bodies and its path (tangents and arcs) around them.
+  template <class Sketch>
+  void sketch(Sketch& sk) const {
+    sk.belt(first, second, r1, r2, crossed);
+  }
   /// The row as a linear form (LinearTransmission evaluates it).
   detail::LinearRow row() const {
     return detail::LinearRow{{first, second, Slot::constant(0)}, {1.0, (crossed ? r2 : -r2) / r1, 0.0}, phase};
