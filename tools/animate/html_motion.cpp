@@ -110,7 +110,7 @@ ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, co
   // a joint away from every line (a pivot on ground, a cam's roller, a slider's block) is a point of its own, moved
   // with the others: without it a mechanism drawn by its joints alone would have nothing to animate
   for (const SketchJoint& j : sketch.joints) point(j.at);
-  const MotionColumns columns(scene, sketch_reads(sketch), table, result);
+  const MotionColumns columns(scene, drawing_reads(scene, sketch), table, result);
   std::map<std::string, std::size_t> col;
   for (std::size_t c = 0; c < table.columns.size(); ++c) col[table.columns[c]] = c;
 
