@@ -48,34 +48,39 @@ std::string path_of(const std::vector<P2>& pts, bool closed) {
   return closed ? d + "Z" : d;
 }
 
-// One shape seen along z: its outline (polygon), its polyline (curve: `radius` is half its width) or the hull of
-// its triangles.
+}  // namespace
+
+std::vector<std::array<double, 2>> shape_outline(const Shape& shape) {
+  std::vector<std::array<double, 2>> out;
+  const auto& r = shape.rotation;
+  auto place = [&](double x, double y, double z) {
+    out.push_back({shape.at.x + r[0] * x + r[1] * y + r[2] * z, shape.at.y + r[3] * x + r[4] * y + r[5] * z});
+  };
+  if (shape.kind == ShapeKind::kCurve) {
+    for (const kin3::V3& p : shape.points) place(p.x, p.y, p.z);
+  } else if (shape.kind == ShapeKind::kPolygon) {
+    for (const auto& [x, y] : shape.outline) place(x, y, 0.0);
+  } else {
+    std::vector<P2> pts;
+    for (const kin3::V3& v : shape_triangles(shape, kPartSegments).vertices) pts.emplace_back(v.x, v.y);
+    for (const P2& p : hull(std::move(pts))) out.push_back({p.first, p.second});
+  }
+  return out;
+}
+
+namespace {
+
+// One shape seen along z, as shape_outline() gives it.
 std::string planar_shape(const Part& part, const Shape& shape, const Pose& pose, const ScreenOf& screen,
                          double pixels_per_metre) {
   const std::string colour = hex_colour(shape_colour(part, shape));
+  std::vector<P2> pts;
+  for (const auto& [x, y] : shape_outline(shape)) pts.push_back(screen(world(pose, {x, y, 0.0})));
   const std::string head = "<path class=\"part\" data-part=\"" + svg::escape(part.name) + "\" data-shape=\"" +
                            svg::escape(shape.name) + "\" d=\"";
-  std::vector<P2> pts;
-  if (shape.kind == ShapeKind::kCurve) {
-    for (const kin3::V3& p : shape.points) {
-      const auto& r = shape.rotation;
-      const kin3::V3 b{shape.at.x + r[0] * p.x + r[1] * p.y + r[2] * p.z,
-                       shape.at.y + r[3] * p.x + r[4] * p.y + r[5] * p.z,
-                       shape.at.z + r[6] * p.x + r[7] * p.y + r[8] * p.z};
-      pts.push_back(screen(world(pose, b)));
-    }
+  if (shape.kind == ShapeKind::kCurve)  // `radius` is half its width
     return head + path_of(pts, shape.closed) + "\" fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"" +
            svg::px(std::max(1.0, 2 * shape.radius * pixels_per_metre)) + "\" stroke-linejoin=\"round\"/>\n";
-  }
-  if (shape.kind == ShapeKind::kPolygon) {
-    const auto& r = shape.rotation;
-    for (const auto& [x, y] : shape.outline)
-      pts.push_back(screen(world(pose, {shape.at.x + r[0] * x + r[1] * y, shape.at.y + r[3] * x + r[4] * y,
-                                        shape.at.z + r[6] * x + r[7] * y})));
-  } else {
-    for (const kin3::V3& v : shape_triangles(shape, kPartSegments).vertices) pts.push_back(screen(world(pose, v)));
-    pts = hull(std::move(pts));
-  }
   return head + path_of(pts, true) + "\" fill=\"" + colour + "\" fill-opacity=\"0.55\" stroke=\"" + colour +
          "\" stroke-width=\"1\"/>\n";
 }

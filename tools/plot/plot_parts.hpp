@@ -25,6 +25,10 @@ using ScreenOf = std::function<std::pair<double, double>(const std::array<double
 std::string parts_svg(const std::vector<Part>& parts, const Eigen::VectorXd& q, double t, bool spatial,
                       const ScreenOf& screen, double pixels_per_metre, double opacity);
 
+// A shape seen along z, in its part's frame (x, y): a polygon's outline, a curve's points, else the convex hull of
+// its triangles (a box a rectangle, a cylinder along z a circle of kPartSegments points).
+std::vector<std::array<double, 2>> shape_outline(const Shape& shape);
+
 // Points that bound the parts at (q, t): each part's origin ± its reach (part_reach()) along each axis.
 std::vector<std::array<double, 3>> parts_extent(const std::vector<Part>& parts, const std::vector<double>& reach,
                                                 const Eigen::VectorXd& q, double t);
