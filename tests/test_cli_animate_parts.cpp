@@ -119,4 +119,63 @@ TEST_F(AnimateParts, GlbHoldsANodePerPartPosedByPartPose) {
   EXPECT_EQ(g.doc["materials"].size(), 3u);
 }
 
+// int16 codes of base64 `b64` (the viewer's encoding, html_motion.cpp).
+std::vector<int> int16_codes(const std::string& b64) {
+  static const std::string a = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string bytes;
+  for (std::size_t i = 0; i + 3 < b64.size(); i += 4) {
+    std::uint32_t v = 0;
+    int n = 0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const std::size_t c = a.find(b64[i + k]);
+      v = (v << 6) | (c == std::string::npos ? 0u : static_cast<std::uint32_t>(c));
+      n += c != std::string::npos;
+    }
+    for (int k = 0; k < n - 1; ++k) bytes += static_cast<char>((v >> (16 - 8 * k)) & 0xff);
+  }
+  std::vector<int> out;
+  for (std::size_t i = 0; i + 1 < bytes.size(); i += 2)
+    out.push_back(static_cast<std::int16_t>(static_cast<unsigned char>(bytes[i]) |
+                                            (static_cast<unsigned char>(bytes[i + 1]) << 8)));
+  return out;
+}
+
+TEST_F(AnimateParts, HtmlHoldsEachPartAndItsPoses) {
+  const fs::path csv = dir_ / "cardan.csv", html = dir_ / "cardan.html";
+  const SceneRun r = run_scene("spatial/cardan.yaml", csv);
+  ASSERT_EQ(
+      run("animate " + phiq::test::model_path("spatial/cardan.yaml") + " " + csv.string() + " -o " + html.string())
+          .code,
+      0);
+  const std::string page = slurp(html);
+  const std::size_t from = page.find('>', page.find("id=\"phiq-data\"")) + 1;
+  const nlohmann::json data = nlohmann::json::parse(page.substr(from, page.find("</script>", from) - from));
+  const nlohmann::json& parts = data["parts"];
+  const std::vector<phiq::Part> drawn = phiq::drawn_parts(r.scene);
+  ASSERT_EQ(parts["names"].size(), drawn.size());
+  ASSERT_EQ(parts["geometries"].size(), drawn.size());  // four different parts: four geometries
+  const std::vector<std::size_t> kept = data["kept"];
+  ASSERT_EQ(kept.size(), r.table.rows.size());  // 73 rows fit the budget: every one a frame
+  const std::vector<int> codes = int16_codes(parts["poses"]);
+  ASSERT_EQ(codes.size(), 7 * drawn.size() * kept.size());
+  const std::vector<double> lo = parts["lo"], hi = parts["hi"];
+  for (std::size_t k = 0; k < drawn.size(); ++k) {
+    EXPECT_EQ(parts["names"][k], drawn[k].name);
+    const auto& shapes = parts["geometries"][parts["geometry"][k].get<int>()];
+    ASSERT_EQ(shapes.size(), drawn[k].shapes.size());
+    for (std::size_t s = 0; s < shapes.size(); ++s) EXPECT_EQ(shapes[s]["name"], drawn[k].shapes[s].name);
+    for (std::size_t f = 0; f < kept.size(); f += 6) {
+      const phiq::Pose p = phiq::part_pose(drawn[k].frame, r.q[kept[f]].data(), r.table.rows[kept[f]][0]);
+      const int* c = &codes[7 * (f * drawn.size() + k)];
+      const double at[3] = {p.at.x, p.at.y, p.at.z};
+      for (int i = 0; i < 3; ++i)  // within a step of the code
+        EXPECT_NEAR(lo[i] + (c[i] + 32767) * (hi[i] - lo[i]) / 65534, at[i], (hi[i] - lo[i]) / 65534 + 1e-12);
+      std::vector<double> q(4);
+      for (int i = 0; i < 4; ++i) q[i] = -1 + (c[3 + i] + 32767) * 2.0 / 65534;
+      const std::array<double, 9> m = matrix_of(q);
+      for (int i = 0; i < 9; ++i) EXPECT_NEAR(m[i], p.rotation[i], 2e-4) << drawn[k].name << " frame " << f;
+    }
+  }
+}
+
 }  // namespace
