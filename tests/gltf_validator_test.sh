@@ -1,8 +1,8 @@
 #!/bin/sh
-# ctest gltf_validator: `phiq animate` on a planar reference-point four-bar, a natural-coordinate one and the
-# spatial RSSR, each .glb checked by the Khronos glTF-Validator (npm package gltf-validator, installed by
-# tools/install_deps.sh into tools/gltf_validator/; nothing is downloaded here): no error, and the validator's
-# warnings and infos listed. Skipped (exit 77) when node or the validator is absent.
+# ctest gltf_validator: `phiq animate` on a planar reference-point four-bar, a natural-coordinate one, the
+# spatial RSSR and the Cardan joint (its parts: meshes, one material per colour), each .glb checked by the Khronos
+# glTF-Validator (npm package gltf-validator, installed by tools/install_deps.sh into tools/gltf_validator/; nothing
+# is downloaded here): no error, and the validator's warnings and infos listed. Skipped (exit 77) when node or the validator is absent.
 # Usage: gltf_validator_test.sh PHIQ MODELS_DIR VALIDATOR_DIR WORK_DIR
 set -u
 phiq="$1"; models="$2"; work="$4"
@@ -11,7 +11,7 @@ command -v node >/dev/null 2>&1 || { echo "gltf_validator: node not found (tools
 [ -f "$validator/package.json" ] || { echo "gltf_validator: $validator absent (tools/install_deps.sh installs it): skipped"; exit 77; }
 rm -rf "$work" && mkdir -p "$work" || exit 1
 status=0
-for m in seed/fourbar_reference_point seed/fourbar_natural spatial/rssr; do
+for m in seed/fourbar_reference_point seed/fourbar_natural spatial/rssr spatial/cardan; do
   name=$(basename "$m")
   "$phiq" run -q "$models/$m.yaml" -o "$work/$name.csv" || { echo "gltf_validator: phiq run $m failed"; exit 1; }
   "$phiq" animate "$models/$m.yaml" "$work/$name.csv" -o "$work/$name.glb" || { echo "gltf_validator: phiq animate $m failed"; exit 1; }

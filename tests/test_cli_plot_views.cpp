@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <filesystem>
 #include <map>
@@ -143,6 +144,65 @@ TEST_F(Plot, PrismaticPairsAreBlocksOnTheirGuides) {
   // the block lies along the guide: ground's x axis, no rotation
   EXPECT_EQ(captures(s, "class=\"joint prismatic\"[^>]*rotate\\((-?[0-9.]+) "),
             (std::vector<std::string>{"0.0", "0.0", "0.0"}));
+}
+
+// The parts under the sketch: a filled outline per planar shape at each drawn row (a box a rectangle of its sides'
+// ratio, centred between the crank's pins; a cylinder seen along z a circle; a polygon its outline), a curve a
+// polyline of its width.
+TEST_F(Plot, PlanarPartsAreFilledOutlinesUnderTheSketch) {
+  std::string text = slurp(phiq::test::model_path("seed/fourbar_reference_point.yaml"));
+  text +=
+      "parts:\n"
+      "  crank: {shapes: [{name: bar, type: box, size: [0.4, 0.05, 0.01]},"
+      " {name: hub, type: cylinder, radius: 0.03, length: 0.02, at: [0.2, 0]}]}\n"
+      "  coupler: {colour: \"#e6801a\", shapes: [{name: plate, type: polygon, points: [[-0.3, 0], [0.3, 0], [0, 0.1]],"
+      " thickness: 0.01}]}\n"
+      "  rocker: {shapes: [{name: slot, type: curve, points: [[-0.3, 0], [0.3, 0]], width: 0.02}]}\n";
+  const fs::path scene = write("parts.yaml", text), svg = dir_ / "p.svg";
+  const Result r = run("plot " + scene.string() + " -o " + svg.string() + " --positions 3");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string s = slurp(svg);
+  EXPECT_EQ(count(s, "class=\"part\""), 4u * 3u);
+  EXPECT_EQ(count(s, "class=\"part\" data-part=\"crank\" data-shape=\"bar\""), 3u);
+  // the last row: its parts come before its sketch (drawn under it)
+  const std::string last = s.substr(s.rfind("<g class=\"position\""));
+  ASSERT_LT(last.find("class=\"part\""), last.find("class=\"joint"));
+  auto points = [&](const std::string& shape) {
+    const std::vector<std::string> d = captures(last, "data-shape=\"" + shape + "\" d=\"([^\"]+)\"");
+    EXPECT_EQ(d.size(), 1u) << shape;
+    std::vector<std::array<double, 2>> p;
+    const std::regex num("[ML](-?[0-9.]+) (-?[0-9.]+)");
+    for (auto it = std::sregex_iterator(d[0].begin(), d[0].end(), num); it != std::sregex_iterator(); ++it)
+      p.push_back({std::stod((*it)[1]), std::stod((*it)[2])});
+    return p;
+  };
+  const auto bar = points("bar"), hub = points("hub"), plate = points("plate"), slot = points("slot");
+  ASSERT_EQ(bar.size(), 4u);
+  const double side0 = std::hypot(bar[1][0] - bar[0][0], bar[1][1] - bar[0][1]),
+               side1 = std::hypot(bar[2][0] - bar[1][0], bar[2][1] - bar[1][1]);
+  EXPECT_NEAR(std::max(side0, side1) / std::min(side0, side1), 8.0, 0.1);
+  // the bar's centre is the crank's reference point, midway between its pins O and A (the first two joints)
+  const std::vector<std::string> cx = captures(last, "class=\"joint revolute\" cx=\"([0-9.]+)\""),
+                                 cy = captures(last, "class=\"joint revolute\" cx=\"[0-9.]+\" cy=\"([0-9.]+)\"");
+  ASSERT_GE(cx.size(), 2u);
+  EXPECT_NEAR((bar[0][0] + bar[2][0]) / 2, (std::stod(cx[0]) + std::stod(cx[1])) / 2, 0.15);
+  EXPECT_NEAR((bar[0][1] + bar[2][1]) / 2, (std::stod(cy[0]) + std::stod(cy[1])) / 2, 0.15);
+  // the hub seen along z: 32 points at one distance from their centre, the pin A's
+  ASSERT_EQ(hub.size(), 32u);
+  double mx = 0, my = 0;
+  for (const auto& p : hub) mx += p[0] / 32, my += p[1] / 32;
+  for (const auto& p : hub)
+    EXPECT_NEAR(std::hypot(p[0] - mx, p[1] - my), side0 < side1 ? side0 * 0.6 : side1 * 0.6, 0.2);
+  EXPECT_EQ(plate.size(), 3u);
+  EXPECT_EQ(slot.size(), 2u);
+  EXPECT_NE(last.find("data-shape=\"plate\" d=\"" + captures(last, "data-shape=\"plate\" d=\"([^\"]+)\"")[0] +
+                      "\" fill=\"#e6801a\""),
+            std::string::npos);
+  // the slot: a stroke as wide as 0.02 m is in pixels (the bar's 0.05 m side)
+  const std::vector<std::string> width =
+      captures(last, "data-shape=\"slot\" d=\"[^\"]+\" fill=\"none\"[^>]*stroke-width=\"([0-9.]+)\"");
+  ASSERT_EQ(width.size(), 1u);
+  EXPECT_NEAR(std::stod(width[0]), 0.4 * std::min(side0, side1), 0.15);
 }
 
 TEST_F(Cli, PlotRefusesAColumnWithNaNInOneLine) {

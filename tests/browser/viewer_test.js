@@ -2,7 +2,9 @@
 // For each page: no console error or uncaught exception while it loads, shows frames and plays; screenshots of
 // the mechanism at the first and the last frame differ where a point moved (the window around its first position
 // changes) and agree on everything away from the mechanism in both (the ground, its pivots, axes, grid); and the
-// middle frame, trails and velocity vectors on, matches the committed reference within a tolerance.
+// middle frame, trails and velocity vectors on, matches the committed reference within a tolerance. A page named
+// parts_NAME shows parts (solids that sweep the view, so the first and last frames are not compared): its middle
+// frame against its reference, and a part named with its pose when picked.
 // Usage: node viewer_test.js CHROMIUM REFERENCE_DIR OUT_DIR [--update] [--timing] NAME=PAGE.html ...
 //   --update  writes the references (REFERENCE_DIR/NAME.png) instead of comparing with them
 //   --timing  also plays each page for 4 s and prints the frame interval and draw time the page measured
@@ -50,6 +52,36 @@ function half(img) {
   return {width: w, height: h, rgb};
 }
 
+// The middle frame with trails and velocity vectors, at half size, against the reference (or written, --update).
+async function compareMiddle(tab, name, frames, clip) {
+  await tab.evaluate('document.getElementById("trails").checked = true; document.getElementById("vectors").checked = !document.getElementById("vectors").disabled');
+  await tab.evaluate(`phiqViewer.show(${Math.floor(frames / 2)})`);
+  await tab.evaluate(settle);
+  const middle = half(png.decode(await tab.screenshot(clip)));
+  const ref = path.join(refDir, `${name}.png`);
+  fs.writeFileSync(path.join(outDir, `${name}_middle.png`), png.encode(middle));
+  if (update) {
+    fs.writeFileSync(ref, png.encode(middle));
+    console.log(`wrote ${ref}`);
+  } else if (!fs.existsSync(ref)) {
+    check(false, `${name}: no reference ${ref} (--update writes it)`);
+  } else {
+    const want = png.decode(fs.readFileSync(ref));
+    check(want.width === middle.width && want.height === middle.height, `${name}: ${middle.width} × ${middle.height} pixels, as the reference`);
+    if (want.width === middle.width && want.height === middle.height) {
+      let off = 0, sum = 0;
+      for (let i = 0; i < want.width * want.height; ++i) {
+        const d = diff(want, middle, i);
+        off += d > 40, sum += d;
+      }
+      const n = want.width * want.height;
+      check(off <= 0.005 * n && sum / n <= 1.5,
+            `${name}: against ${path.basename(ref)}: ${off} pixels differ by more than 40 (at most ${Math.floor(0.005 * n)}), mean difference ${(sum / n).toFixed(3)} (at most 1.5)`);
+    }
+  }
+
+}
+
 async function testPage(browser, name, page) {
   const tab = await browser.newPage(1280, 720);
   await tab.goto('file://' + path.resolve(page) + '#paused');
@@ -58,6 +90,15 @@ async function testPage(browser, name, page) {
   check(frames > 1, `${name}: the page holds ${frames} frames`);
   const view = await tab.evaluate('(() => { const r = document.getElementById("view").firstElementChild.getBoundingClientRect(); return {x: r.left, y: r.top, width: r.width, height: r.height}; })()');
   const clip = {x: Math.round(view.x), y: Math.round(view.y), width: Math.round(view.width), height: Math.round(view.height)};
+  if (name.startsWith('parts_')) {
+    const first = await tab.evaluate('phiq.parts.names[0]');
+    const said = await tab.evaluate('phiqViewer.pick(0)');
+    check(said.startsWith(first + ': origin ('), `${name}: picking part 0 names it with its pose: "${said}"`);
+    await tab.evaluate('phiqViewer.pick(-1)');
+    await compareMiddle(tab, name, frames, clip);
+    check(tab.errors.length === 0, `${name}: no console error${tab.errors.length ? ': ' + tab.errors.join('; ') : ''}`);
+    return;
+  }
   // first and last frame, the mechanism alone (no trails, no vectors)
   await tab.evaluate('document.getElementById("trails").checked = false; document.getElementById("vectors").checked = false');
   const shots = [], points = [];
@@ -105,32 +146,7 @@ async function testPage(browser, name, page) {
   const fixed = points[0].filter((p, i) => !p.moving && Math.hypot(p.x - points[1][i].x, p.y - points[1][i].y) < 0.5);
   check(fixed.length === points[0].filter((p) => !p.moving).length, `${name}: the ${fixed.length} fixed points stay where they are`);
 
-  // the reference: the middle frame with trails and velocity vectors, at half size
-  await tab.evaluate('document.getElementById("trails").checked = true; document.getElementById("vectors").checked = !document.getElementById("vectors").disabled');
-  await tab.evaluate(`phiqViewer.show(${Math.floor(frames / 2)})`);
-  await tab.evaluate(settle);
-  const middle = half(png.decode(await tab.screenshot(clip)));
-  const ref = path.join(refDir, `${name}.png`);
-  fs.writeFileSync(path.join(outDir, `${name}_middle.png`), png.encode(middle));
-  if (update) {
-    fs.writeFileSync(ref, png.encode(middle));
-    console.log(`wrote ${ref}`);
-  } else if (!fs.existsSync(ref)) {
-    check(false, `${name}: no reference ${ref} (--update writes it)`);
-  } else {
-    const want = png.decode(fs.readFileSync(ref));
-    check(want.width === middle.width && want.height === middle.height, `${name}: ${middle.width} × ${middle.height} pixels, as the reference`);
-    if (want.width === middle.width && want.height === middle.height) {
-      let off = 0, sum = 0;
-      for (let i = 0; i < want.width * want.height; ++i) {
-        const d = diff(want, middle, i);
-        off += d > 40, sum += d;
-      }
-      const n = want.width * want.height;
-      check(off <= 0.005 * n && sum / n <= 1.5,
-            `${name}: against ${path.basename(ref)}: ${off} pixels differ by more than 40 (at most ${Math.floor(0.005 * n)}), mean difference ${(sum / n).toFixed(3)} (at most 1.5)`);
-    }
-  }
+  await compareMiddle(tab, name, frames, clip);
 
   // it plays: the clock moves the pose (the slider), and nothing goes wrong on the way
   const before = await tab.evaluate('document.getElementById("time").value');

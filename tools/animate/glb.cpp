@@ -59,14 +59,22 @@ int BufferBuilder::add_floats(const std::vector<float>& v, int components, bool 
   return static_cast<int>(doc_["accessors"].size()) - 1;
 }
 
-int BufferBuilder::add_indices(const std::vector<std::uint16_t>& v) {
+int BufferBuilder::add_indices(const std::vector<std::uint32_t>& v) {
   pad(bin_, '\0');
+  const bool narrow = std::all_of(v.begin(), v.end(), [](std::uint32_t i) { return i < 65535; });
   doc_["accessors"].push_back({{"bufferView", doc_["bufferViews"].size()},
                                {"byteOffset", bin_.size() - view_start_},
-                               {"componentType", kUnsignedShort},
+                               {"componentType", narrow ? kUnsignedShort : kUnsignedInt},
                                {"count", v.size()},
                                {"type", "SCALAR"}});
-  bin_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(std::uint16_t));
+  if (narrow) {
+    for (std::uint32_t i : v) {
+      const auto s = static_cast<std::uint16_t>(i);
+      bin_.append(reinterpret_cast<const char*>(&s), sizeof s);
+    }
+  } else {
+    bin_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(std::uint32_t));
+  }
   return static_cast<int>(doc_["accessors"].size()) - 1;
 }
 

@@ -12,7 +12,7 @@
 namespace phiq::tools::gltf {
 
 // Component types and buffer view targets of the specification.
-constexpr int kFloat = 5126, kUnsignedShort = 5123;
+constexpr int kFloat = 5126, kUnsignedShort = 5123, kUnsignedInt = 5125;
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 
 // The one buffer of a .glb and its views: accessors are appended to a view, each at a 4-byte aligned offset, and
@@ -26,8 +26,8 @@ class BufferBuilder {
   // A float accessor of `count` elements of `components` (1: SCALAR, 3: VEC3, 4: VEC4); with_bounds writes its
   // min and max (needed for POSITION and animation inputs). Returns its index.
   int add_floats(const std::vector<float>& v, int components, bool with_bounds);
-  // An accessor of unsigned short indices. Returns its index.
-  int add_indices(const std::vector<std::uint16_t>& v);
+  // An accessor of indices: unsigned short when every one fits, else unsigned int. Returns its index.
+  int add_indices(const std::vector<std::uint32_t>& v);
   // Closes the last view and writes "buffers" and "bufferViews"; returns the BIN chunk's content.
   std::string finish();
 

@@ -1,8 +1,9 @@
-// `phiq animate SCENE RESULT -o OUT.glb`: the motion of a scene's result as a glTF 2.0 binary. A node per moving
-// body (its reference point and orientation: planar bodies in the z = 0 plane rotated about z by ψ, spatial ones
+// `phiq animate SCENE RESULT -o OUT.glb`: the motion of a scene's result as a glTF 2.0 binary. A node per part the
+// drawing shows (phiq/drawn_parts.hpp: its shapes' triangles, keyframed by part_pose()); a scene without parts gets
+// today's sketch instead: a node per moving body (planar bodies in the z = 0 plane rotated about z by ψ, spatial ones
 // by their Euler parameters as the quaternion (e1, e2, e3, e0)), per link of the sketch (natural coordinates, a
-// spatial distance: origin at its first point, x axis along it) and per joint (a ball at its point), keyframed at
-// the result's rows; simple shapes sized from the sketch (mechanism_sketch.hpp).
+// spatial distance: origin at its first point, x axis along it) and per joint (a ball at its point); a body without
+// a part keeps its box. Keyframes at the result's rows; a spatial scene's nodes under a root turning z up.
 #pragma once
 
 #include <string>

@@ -6,7 +6,10 @@
 
 #include "motion_columns.hpp"
 #include "phiq/phiq.hpp"
+#include "part_drawing.hpp"
+#include "phiq/drawn_parts.hpp"
 #include "plot_draw.hpp"
+#include "plot_parts.hpp"
 
 namespace phiq::tools {
 
@@ -85,6 +88,112 @@ char mark_letter(JointMark m) {
   }
 }
 
+// The paths of the points the scene traces, at `rows`, from their columns. Throws phiq::Error for a column missing
+// or a value that is not a finite number.
+std::vector<std::pair<std::string, std::vector<std::array<double, 3>>>> traced_paths(
+    const Scene& scene, const CsvTable& table, const MotionColumns& columns, const std::string& result,
+    const std::vector<std::size_t>& trace_rows) {
+  std::map<std::string, std::size_t> col;
+  for (std::size_t c = 0; c < table.columns.size(); ++c) col[table.columns[c]] = c;
+  std::vector<std::pair<std::string, std::vector<std::array<double, 3>>>> out;
+  for (const OutputPoint& p : scene.sweep.points) {
+    std::vector<std::size_t> c;
+    for (const char* axis : {"x", "y", "z"}) {
+      if (axis[0] == 'z' && p.dimension() != 3) break;
+      const auto it = col.find(p.name + "." + axis);
+      if (it == col.end())
+        throw Error(result + ": no column '" + p.name + "." + axis + "', a point that " + scene.path +
+                    " traces: not a result of this scene");
+      c.push_back(it->second);
+    }
+    std::vector<std::array<double, 3>> path;
+    for (std::size_t r : trace_rows) {
+      std::array<double, 3> x{0, 0, 0};
+      for (std::size_t k = 0; k < c.size(); ++k) {
+        x[k] = table.rows[r][c[k]];
+        if (!std::isfinite(x[k]))
+          throw Error(columns.at_row(r) + ", column '" + table.columns[c[k]] + "': not a finite number");
+      }
+      path.push_back(x);
+    }
+    out.emplace_back(p.name, std::move(path));
+  }
+  return out;
+}
+
+// Bytes of base64 a frame takes: the points' positions (and velocities), the parts' poses (7 int16 each).
+std::size_t frame_bytes(std::size_t points, int dim, bool velocities, std::size_t parts) {
+  return (points * static_cast<std::size_t>(dim) * 2 * (velocities ? 2 : 1) * 4 + parts * 7 * 2 * 4 + 2) / 3;
+}
+
+// The parts in the viewer's data (viewer.js documents the fields): each part's name and geometry (the same shapes
+// once: 10⁴ alike links share one), its poses at the kept rows quantized as the points' are; and points bounding
+// the parts at those rows, for the planar view's box.
+nlohmann::json parts_data(const std::vector<Part>& parts, bool spatial, const MechanismFrames& frames,
+                          std::vector<std::array<double, 3>>& bounds) {
+  nlohmann::json names = nlohmann::json::array(), geometry_of = nlohmann::json::array();
+  nlohmann::json geometries = nlohmann::json::array();
+  std::map<std::string, int> known;
+  std::string fixed;
+  std::vector<double> reach;
+  for (const Part& part : parts) {
+    nlohmann::json g = nlohmann::json::array();
+    for (const Shape& shape : part.shapes) {
+      nlohmann::json one = {{"name", shape.name}, {"colour", hex_colour(shape_colour(part, shape))}};
+      if (spatial) {
+        const LitMesh lit = lit_mesh(shape_triangles(shape, kPartSegments));
+        one["p"] = base64(std::string(reinterpret_cast<const char*>(lit.pos.data()), lit.pos.size() * sizeof(float)));
+        one["i"] =
+            base64(std::string(reinterpret_cast<const char*>(lit.idx.data()), lit.idx.size() * sizeof(std::uint32_t)));
+      } else {
+        nlohmann::json xy = nlohmann::json::array();
+        for (const auto& [x, y] : shape_outline(shape)) xy.push_back(x), xy.push_back(y);
+        one["outline"] = xy;
+        if (shape.kind == ShapeKind::kCurve) one["width"] = 2 * shape.radius, one["closed"] = shape.closed;
+      }
+      g.push_back(one);
+    }
+    const auto [it, fresh] = known.emplace(g.dump(), static_cast<int>(geometries.size()));
+    if (fresh) geometries.push_back(g);
+    names.push_back(part.name), geometry_of.push_back(it->second);
+    fixed += part.fixed ? '1' : '0';
+    reach.push_back(part_reach(part));
+  }
+  // the poses: origin and quaternion (x, y, z, w; on the side of the previous frame's) of every part at every frame
+  std::vector<std::array<double, 7>> poses;
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (std::size_t f = 0; f < frames.q.size(); ++f)
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const Pose p = part_pose(parts[k].frame, frames.q[f].data(), frames.t[f]);
+      std::array<double, 4> r = quaternion(p.rotation);
+      if (f > 0) {
+        const auto& b = poses[poses.size() - parts.size()];
+        if (r[0] * b[3] + r[1] * b[4] + r[2] * b[5] + r[3] * b[6] < 0)
+          for (double& c : r) c = -c;
+      }
+      const double at[3] = {p.at.x, p.at.y, p.at.z};
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = std::min(lo[c], at[c]), hi[c] = std::max(hi[c], at[c]);
+        std::array<double, 3> x{p.at.x, p.at.y, p.at.z}, y = x;
+        x[static_cast<std::size_t>(c)] -= reach[k], y[static_cast<std::size_t>(c)] += reach[k];
+        bounds.push_back(x), bounds.push_back(y);
+      }
+      poses.push_back({at[0], at[1], at[2], r[0], r[1], r[2], r[3]});
+    }
+  std::string bytes;
+  const Quantizer axes[3] = {{lo[0], hi[0]}, {lo[1], hi[1]}, {lo[2], hi[2]}}, unit(-1.0, 1.0);
+  for (const auto& p : poses)
+    for (int c = 0; c < 7; ++c) (c < 3 ? axes[c] : unit).put(p[static_cast<std::size_t>(c)], bytes);
+  nlohmann::json out = {{"names", names},
+                        {"geometry", geometry_of},
+                        {"geometries", geometries},
+                        {"fixed", fixed},
+                        {"poses", base64(bytes)}};
+  out["lo"] = parts.empty() ? nlohmann::json::array() : nlohmann::json({lo[0], lo[1], lo[2]});
+  out["hi"] = parts.empty() ? nlohmann::json::array() : nlohmann::json({hi[0], hi[1], hi[2]});
+  return out;
+}
+
 }  // namespace
 
 ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, const CsvTable& table,
@@ -110,9 +219,7 @@ ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, co
   // a joint away from every line (a pivot on ground, a cam's roller, a slider's block) is a point of its own, moved
   // with the others: without it a mechanism drawn by its joints alone would have nothing to animate
   for (const SketchJoint& j : sketch.joints) point(j.at);
-  const MotionColumns columns(scene, sketch_reads(sketch), table, result);
-  std::map<std::string, std::size_t> col;
-  for (std::size_t c = 0; c < table.columns.size(); ++c) col[table.columns[c]] = c;
+  const MotionColumns columns(scene, drawing_reads(scene, sketch), table, result);
 
   // ---- every row checked (a value that is not a number, t going back); the rows kept within the budget
   Eigen::VectorXd q = model.initial_positions(), qd = Eigen::VectorXd::Zero(model.num_coordinates());
@@ -125,35 +232,15 @@ ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, co
                   svg::label(table.rows[r - 1][t_col]) + ")");
   }
   const bool velocities = columns.has_velocities() && !points.empty();
-  const std::size_t per_frame = (points.size() * static_cast<std::size_t>(dim) * 2 * (velocities ? 2 : 1) * 4 + 2) / 3;
+  const std::vector<Part> parts = drawn_parts(scene);
+  const std::size_t per_frame = frame_bytes(points.size(), dim, velocities, parts.size());
   const std::size_t most = std::clamp<std::size_t>(per_frame ? budget / per_frame : kMostFrames, 2, kMostFrames);
   out.rows = spread(n_rows, most);
 
   // ---- the traced points: their columns, sampled
   const std::vector<std::size_t> trace_rows = spread(n_rows, kTraceSamples);
-  for (const OutputPoint& p : scene.sweep.points) {
-    std::vector<std::size_t> c;
-    for (const char* axis : {"x", "y", "z"}) {
-      if (axis[0] == 'z' && p.dimension() != 3) break;
-      const auto it = col.find(p.name + "." + axis);
-      if (it == col.end())
-        throw Error(result + ": no column '" + p.name + "." + axis + "', a point that " + scene.path +
-                    " traces: not a result of this scene");
-      c.push_back(it->second);
-    }
-    std::vector<std::array<double, 3>> path;
-    for (std::size_t r : trace_rows) {
-      std::array<double, 3> x{0, 0, 0};
-      for (std::size_t k = 0; k < c.size(); ++k) {
-        x[k] = table.rows[r][c[k]];
-        if (!std::isfinite(x[k]))
-          throw Error(columns.at_row(r) + ", column '" + table.columns[c[k]] + "': not a finite number");
-      }
-      path.push_back(x);
-    }
-    out.frames.traces.emplace_back(p.name, std::move(path));
-  }
-  if (points.empty() && out.frames.traces.empty())
+  out.frames.traces = traced_paths(scene, table, columns, result, trace_rows);
+  if (points.empty() && out.frames.traces.empty() && parts.empty())
     throw Error(scene.path +
                 ": nothing to animate (its constraints draw no line or joint: loops, drivers and "
                 "equations draw none; output.points traces no point)");
@@ -181,6 +268,8 @@ ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, co
   }
   for (const auto& tr : out.frames.traces)
     for (const auto& x : tr.second) extend(x);
+  data["parts"] = parts_data(parts, dim == 3, out.frames, out.frames.part_bounds);
+  for (const auto& x : out.frames.part_bounds) extend(x);
 
   // ---- the JSON: frames and velocities quantized, traces likewise, joints with their marks
   data["dimension"] = dim;

@@ -46,7 +46,7 @@ int cmd_animate(const AnimateOptions& o) {
     if (o.result.empty()) {  // the scene swept here, with the coordinates the drawing reads (and joints to plot)
       set_interrupt_subject("animate: " + o.out, "; no output written");
       const MechanismSketch sketch = sketch_mechanism(*scene.model);
-      const DrawnOutputs add{coordinates_of(html ? sketch_reads(sketch) : glb_reads(scene, sketch)), html};
+      const DrawnOutputs add{coordinates_of(html ? drawing_reads(scene, sketch) : glb_reads(scene, sketch)), html};
       const CsvTable table = sweep_scene(scene, add);
       text = html ? motion_html(scene, table, kSwept, o.columns) : motion_glb(scene, table, kSwept);
     } else {

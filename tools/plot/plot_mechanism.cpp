@@ -7,6 +7,9 @@
 
 #include "phiq/phiq.hpp"
 #include "plot_draw.hpp"
+#include "part_drawing.hpp"
+#include "phiq/drawn_parts.hpp"
+#include "plot_parts.hpp"
 
 namespace phiq::tools {
 
@@ -70,6 +73,12 @@ std::vector<Slot> sketch_reads(const MechanismSketch& sketch) {
   return read;
 }
 
+std::vector<Slot> drawing_reads(const Scene& scene, const MechanismSketch& sketch) {
+  std::vector<Slot> read = sketch_reads(sketch);
+  for (const Slot& x : part_reads(drawn_parts(scene))) read.push_back(x);
+  return read;
+}
+
 std::pair<double, double> project(const P3& p, bool spatial) {
   if (!spatial) return {p[0], p[1]};
   // seen from (1, 1, 1): screen right is (y − x)/√2 and up the rest of z; x − y instead mirrors the picture
@@ -92,6 +101,7 @@ MechanismView mechanism_view(const MechanismFrames& m, double x0, double y0, dou
   }
   for (const auto& tr : m.traces)
     for (const P3& p : tr.second) extend(p);
+  for (const P3& p : m.part_bounds) extend(p);
   if (!(xmax >= xmin)) xmin = -1, xmax = 1, ymin = -1, ymax = 1;  // nothing to draw
   // in space, the axes from the origin: a round length, at most 0.3 of the drawing, inside the panel with their names
   double len = 0.0;
@@ -171,6 +181,9 @@ std::string mechanism_panel(const MechanismFrames& m, double x0, double y0, doub
     const Eigen::VectorXd& q = m.q[f];
     const std::string colour = grey(f, m.q.size());
     s += "<g class=\"position\" data-t=\"" + label(m.t[f]) + "\">\n";
+    const double n = static_cast<double>(m.q.size());
+    s += parts_svg(m.parts, q, m.t[f], m.spatial, screen, b.w / (b.xmax - b.xmin),
+                   f + 1 == m.q.size() ? 1.0 : 0.25 + 0.5 * static_cast<double>(f) / std::max(1.0, n - 1));
     for (const SketchSegment& seg : sk.segments) {
       const auto a = screen(at(seg.from, q)), c = screen(at(seg.to, q));
       s += polyline("mechanism", colour, 2, {a, c});

@@ -1,4 +1,5 @@
-// `phiq plot`'s drawing of the mechanism: its sketch (engine/include/phiq/mechanism_sketch.hpp) at a few rows, the
+// `phiq plot`'s drawing of the mechanism: its parts (plot_parts.hpp) and its sketch
+// (engine/include/phiq/mechanism_sketch.hpp) over them at a few rows, the
 // ground hatched under fixed pivots and guides, revolute joints as circles, prismatic ones as blocks on their
 // guides, link ends as dots, and the paths of the traced points. Planar scenes in x, y with ticks and units;
 // spatial ones in an isometric view (x, y, z with z up) with the three axes drawn.
@@ -11,6 +12,8 @@
 #include <vector>
 
 #include "phiq/mechanism_sketch.hpp"
+#include "phiq/parts.hpp"
+#include "phiq/scene.hpp"
 #include "plot_draw.hpp"
 
 namespace phiq::tools {
@@ -21,6 +24,9 @@ std::vector<Slot> slots_of(const OutputPoint& p);
 // The slots the drawing of `sketch` reads: the ends of its lines, its joints and the frames of its prismatic guides.
 std::vector<Slot> sketch_reads(const MechanismSketch& sketch);
 
+// sketch_reads() and the slots the frames of the scene's drawn parts read (part_reads()).
+std::vector<Slot> drawing_reads(const Scene& scene, const MechanismSketch& sketch);
+
 struct MechanismFrames {
   const Model* model = nullptr;
   const MechanismSketch* sketch = nullptr;
@@ -29,6 +35,8 @@ struct MechanismFrames {
   std::vector<double> t;           // t of each drawn row
   // traced output points: name and position at every row (z = 0 in the plane)
   std::vector<std::pair<std::string, std::vector<std::array<double, 3>>>> traces;
+  std::vector<Part> parts;                         // the parts drawn (phiq/drawn_parts.hpp), under the sketch
+  std::vector<std::array<double, 3>> part_bounds;  // points bounding the parts at every row (for the extent)
 };
 
 // The panel, in the square at (x0, y0) of side `side` pixels.

@@ -13,7 +13,10 @@
 #include "phiq/csv_compare.hpp"
 #include "phiq/phiq.hpp"
 #include "plot_draw.hpp"
+#include "part_drawing.hpp"
+#include "phiq/drawn_parts.hpp"
 #include "plot_mechanism.hpp"
+#include "plot_parts.hpp"
 #include "plot_series.hpp"
 
 namespace phiq::tools {
@@ -147,7 +150,7 @@ std::string plot_text(const Scene& scene, const PlotOptions& o, const MechanismS
   // Columns against time: as asked, else the driven and the moving coordinates (at most 6), never a constant.
   const std::vector<std::string> series = plotted_columns(scene, table, o.columns, result);
   // The mechanism: every coordinate its lines read must be in the result, else it is swept again.
-  const std::vector<Index> needed = coordinates_of(sketch_reads(sketch));
+  const std::vector<Index> needed = coordinates_of(drawing_reads(scene, sketch));
   bool all_in_csv = true;
   for (Index j : needed) all_in_csv = all_in_csv && col.count(model.coordinate_names()[j]);
   for (Index j : needed)  // a coordinate of the drawing that is not a number: as for a plotted column
@@ -169,6 +172,11 @@ std::string plot_text(const Scene& scene, const PlotOptions& o, const MechanismS
     frames.q.push_back(all_in_csv ? q : solved.at(r));
     frames.t.push_back(table.rows[r][0]);
   }
+  frames.parts = drawn_parts(scene);
+  std::vector<double> reach;
+  for (const Part& part : frames.parts) reach.push_back(part_reach(part));
+  for (std::size_t f = 0; f < frames.q.size(); ++f)
+    for (const auto& x : parts_extent(frames.parts, reach, frames.q[f], frames.t[f])) frames.part_bounds.push_back(x);
   for (const OutputPoint& p : scene.sweep.points) {
     const std::size_t cx = col.at(p.name + ".x"), cy = col.at(p.name + ".y");
     const auto cz = p.dimension() == 3 ? col.find(p.name + ".z") : col.end();
@@ -177,7 +185,7 @@ std::string plot_text(const Scene& scene, const PlotOptions& o, const MechanismS
     frames.traces.emplace_back(p.name, std::move(path));
   }
   // An empty panel without a word reads as a broken drawing: say why.
-  if (sketch.segments.empty() && sketch.joints.empty() && frames.traces.empty())
+  if (sketch.segments.empty() && sketch.joints.empty() && frames.traces.empty() && frames.parts.empty())
     std::cerr << "phiq: plot: " << o.scene << ": nothing of the mechanism to draw (its constraints make no lines: "
               << "loops, drivers and equations draw none; output.points lists no point to trace): the SVG has "
               << "the columns against t only\n";
@@ -215,7 +223,7 @@ int plot_svg(const PlotOptions& o) {
   try {
     // without a result: the scene swept here with every coordinate the drawing reads and the measures of its
     // spatial joints (which the default columns prefer)
-    if (o.csv.empty()) table = sweep_scene(scene, {coordinates_of(sketch_reads(sketch)), true});
+    if (o.csv.empty()) table = sweep_scene(scene, {coordinates_of(drawing_reads(scene, sketch)), true});
     text = plot_text(scene, o, sketch, table);
   } catch (const DrawError& e) {
     return plot_fail(e.what(), e.status());

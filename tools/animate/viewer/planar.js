@@ -3,7 +3,8 @@
 // few <path> elements, one per kind of mark (links, revolute pins, prismatic blocks, ...), whatever the number of
 // loops, and only what the pixels can show (pairs(), Sparse below): a 10^4-loop chain is a handful of elements of
 // a few hundred strokes, not 10^5 elements. The marks are phiq plot's: pins white circles, sliders blocks on their
-// guides, link ends dots.
+// guides, link ends dots. Under them the parts: a filled outline per shape (a path per shape of each distinct
+// geometry, holding every part that shares it), their frames on request, the part under the pointer named.
 'use strict';
 
 (function () {
@@ -18,7 +19,69 @@
     layer.appendChild(e);
     return e;
   }
-  // drawn bottom to top: trails, guides, lines, marks, vectors
+  // drawn bottom to top: parts, trails, guides, lines, marks, vectors
+  const parts = phiq.parts, N = parts.names.length;
+  const members = parts.geometries.map(() => []);
+  parts.geometry.forEach((g, k) => members[g].push(k));
+  const partPaths = parts.geometries.map((shapes) => shapes.map((sh) => sh.width !== undefined
+    ? path('part', {fill: 'none', stroke: sh.colour, 'stroke-width': Math.max(1, sh.width * kx), 'stroke-linejoin': 'round'})
+    : path('part', {fill: sh.colour, 'fill-opacity': 0.55, stroke: sh.colour, 'stroke-width': 1})));
+  const partAxes = [path('part-frame', {fill: 'none', stroke: '#d62728', 'stroke-width': 1.5}),
+                    path('part-frame', {fill: 'none', stroke: '#2ca02c', 'stroke-width': 1.5})];
+  const sx = (x) => b.x0 + (x - b.xmin) * kx, sy = (y) => b.y0 + b.h - (y - b.ymin) * ky;
+  function drawParts(place, frames) {
+    const axes = [[], []];
+    partPaths.forEach((shapes, g) => shapes.forEach((el, i) => {
+      const sh = parts.geometries[g][i], o = sh.outline, d = [];
+      for (const k of members[g]) {
+        const x0 = place[7 * k], y0 = place[7 * k + 1], a = 2 * Math.atan2(place[7 * k + 5], place[7 * k + 6]);
+        const c = Math.cos(a), s = Math.sin(a);
+        for (let v = 0; v < o.length; v += 2)
+          d.push((v ? 'L' : 'M') + r1(sx(x0 + c * o[v] - s * o[v + 1])) + ' ' + r1(sy(y0 + s * o[v] + c * o[v + 1])));
+        if (sh.width === undefined || sh.closed) d.push('Z');
+      }
+      el.setAttribute('d', d.join(''));
+    }));
+    if (frames)
+      for (let k = 0; k < N; ++k) {
+        const X0 = sx(place[7 * k]), Y0 = sy(place[7 * k + 1]), a = 2 * Math.atan2(place[7 * k + 5], place[7 * k + 6]);
+        axes[0].push('M' + r1(X0) + ' ' + r1(Y0) + 'l' + r1(24 * Math.cos(a)) + ' ' + r1(-24 * Math.sin(a)));
+        axes[1].push('M' + r1(X0) + ' ' + r1(Y0) + 'l' + r1(-24 * Math.sin(a)) + ' ' + r1(-24 * Math.cos(a)));
+      }
+    partAxes[0].setAttribute('d', axes[0].join('')), partAxes[1].setAttribute('d', axes[1].join(''));
+  }
+  // the part under the pointer: the last drawn whose outline holds the point (a curve: within its half width)
+  let shown = null;
+  function partAt(event) {
+    const m = svg.getScreenCTM().inverse(), pt = svg.createSVGPoint();
+    pt.x = event.clientX, pt.y = event.clientY;
+    const u = pt.matrixTransform(m), wx = b.xmin + (u.x - b.x0) / kx, wy = b.ymin + (b.y0 + b.h - u.y) / ky;
+    const place = shown;
+    for (let k = N - 1; k >= 0 && place; --k) {
+      const a = 2 * Math.atan2(place[7 * k + 5], place[7 * k + 6]), c = Math.cos(a), s = Math.sin(a);
+      const dx = wx - place[7 * k], dy = wy - place[7 * k + 1], px = c * dx + s * dy, py = -s * dx + c * dy;
+      for (const sh of parts.geometries[parts.geometry[k]]) {
+        const o = sh.outline;
+        let inside = false;
+        if (sh.width === undefined) {
+          for (let i = 0, j = o.length - 2; i < o.length; j = i, i += 2)
+            if ((o[i + 1] > py) !== (o[j + 1] > py) && px < o[i] + (py - o[i + 1]) * (o[j] - o[i]) / (o[j + 1] - o[i + 1])) inside = !inside;
+        } else {
+          for (let i = 2; i < o.length && !inside; i += 2) {
+            const ex = o[i] - o[i - 2], ey = o[i + 1] - o[i - 1], l2 = ex * ex + ey * ey;
+            const t = l2 > 0 ? Math.max(0, Math.min(1, ((px - o[i - 2]) * ex + (py - o[i - 1]) * ey) / l2)) : 0;
+            inside = Math.hypot(px - o[i - 2] - t * ex, py - o[i - 1] - t * ey) <= Math.max(sh.width / 2, 3 / kx);
+          }
+        }
+        if (inside) return k;
+      }
+    }
+    return -1;
+  }
+  if (N) {
+    svg.addEventListener('mousemove', (e) => phiq.pick(partAt(e)));
+    svg.addEventListener('click', (e) => phiq.pick(partAt(e)));
+  }
   const trails = phiq.traces.map((tr) => path('trail', {fill: 'none', stroke: tr.colour, 'stroke-width': 1.5,
                                                         'data-point': tr.name}));
   const guides = path('guide', {fill: 'none', stroke: '#222', 'stroke-width': 1});
@@ -85,6 +148,8 @@
 
   phiq.start({
     draw(p, show) {
+      shown = p.parts;
+      drawParts(p.parts, show.frames);
       const pos = p.pos;
       for (let i = 0; i < P; ++i) {
         X[i] = b.x0 + (pos[2 * i] - b.xmin) * kx;

@@ -3,7 +3,9 @@
 // length and turned onto it), its joints one instanced mesh of balls, the ground a grid under the mechanism and the
 // axes at the origin: a pose costs one matrix per line and per joint and a few buffer uploads, however many loops;
 // a large mechanism is drawn as segments and dots (lines(), joints() below).
-// Colours as in the .glb: links orange, bodies' arms blue, joints grey, ground pivots black.
+// Colours as in the .glb: links orange, bodies' arms blue, joints grey, ground pivots black. The parts: one
+// instanced mesh per shape of each distinct geometry (10^4 alike parts: one draw call per shape), posed each frame;
+// their frames (a checkbox) one set of segments; the part under the pointer named with its pose (phiq.pick).
 'use strict';
 
 (function () {
@@ -106,6 +108,59 @@
   const placeLinks = lines(d.links, 0xe6801a), placeArms = lines(d.arms, 0x4573b3);
   const placeJoints = joints(moving, 0x404040), placeGround = joints(fixed, 0x0d0d0d);
 
+  // ---- the parts
+  const parts = phiq.parts, N = parts.names.length;
+  const bytes = (b64) => Uint8Array.from(atob(b64), (c) => c.charCodeAt(0)).buffer;
+  const members = parts.geometries.map(() => []), slot = new Int32Array(N);
+  parts.geometry.forEach((g, k) => { slot[k] = members[g].length; members[g].push(k); });
+  const partMeshes = parts.geometries.map((shapes, g) => shapes.map((sh) => {
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(bytes(sh.p)), 3));
+    geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(bytes(sh.i)), 1));
+    geometry.computeVertexNormals();  // the vertices are split at edges: smooth where curved, sharp at edges
+    const mesh = add(new THREE.InstancedMesh(geometry, new THREE.MeshLambertMaterial({color: sh.colour}), members[g].length));
+    mesh.userData.parts = members[g];
+    return mesh;
+  }));
+  const pickable = [].concat(...partMeshes);
+  const frameXyz = new Float32Array(18 * N), frameRgb = new Float32Array(18 * N);
+  for (let k = 0; k < N; ++k)
+    for (let a = 0; a < 3; ++a) for (let e = 0; e < 2; ++e) frameRgb[18 * k + 6 * a + 3 * e + a] = 0.85;
+  const frameGeometry = new THREE.BufferGeometry();
+  frameGeometry.setAttribute('position', new THREE.BufferAttribute(frameXyz, 3));
+  frameGeometry.setAttribute('color', new THREE.BufferAttribute(frameRgb, 3));
+  const partAxes = add(new THREE.LineSegments(frameGeometry, new THREE.LineBasicMaterial({vertexColors: THREE.VertexColors})));
+  const unit = new THREE.Vector3(1, 1, 1), axis = new THREE.Vector3(), origin = new THREE.Vector3();
+  function placeParts(place, frames) {
+    for (let k = 0; k < N; ++k) {
+      origin.fromArray(place, 7 * k);
+      q.fromArray(place, 7 * k + 3);
+      m.compose(origin, q, unit);
+      for (const mesh of partMeshes[parts.geometry[k]]) mesh.setMatrixAt(slot[k], m);
+      if (frames)
+        for (let a = 0; a < 3; ++a) {
+          axis.set(a === 0 ? 1 : 0, a === 1 ? 1 : 0, a === 2 ? 1 : 0).applyQuaternion(q).multiplyScalar(0.15 * size);
+          origin.toArray(frameXyz, 18 * k + 6 * a);
+          axis.add(origin).toArray(frameXyz, 18 * k + 6 * a + 3);
+        }
+    }
+    for (const mesh of pickable) mesh.instanceMatrix.needsUpdate = true;
+    partAxes.visible = frames;
+    frameGeometry.attributes.position.needsUpdate = true;
+  }
+  const ray = new THREE.Raycaster(), pointer = new THREE.Vector2();
+  function partAt(event) {
+    const r = renderer.domElement.getBoundingClientRect();
+    pointer.set((event.clientX - r.left) / r.width * 2 - 1, 1 - (event.clientY - r.top) / r.height * 2);
+    ray.setFromCamera(pointer, camera);
+    const hit = ray.intersectObjects(pickable)[0];
+    return hit && hit.instanceId !== undefined ? hit.object.userData.parts[hit.instanceId] : -1;
+  }
+  if (N) {
+    renderer.domElement.addEventListener('mousemove', (e) => phiq.pick(partAt(e)));
+    renderer.domElement.addEventListener('click', (e) => phiq.pick(partAt(e)));
+  }
+
   const trails = phiq.traces.map((tr) => {
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(tr.pos, 3));
@@ -141,6 +196,7 @@
 
   phiq.start({
     draw(p, show) {
+      placeParts(p.parts, show.frames);
       placeLinks(p.pos), placeArms(p.pos), placeJoints(p.pos);
       if (!groundPlaced) placeGround(p.pos), groundPlaced = true;
       trails.forEach((line) => line.geometry.setDrawRange(0, show.trails ? p.samples : 0));

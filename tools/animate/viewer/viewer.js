@@ -20,6 +20,11 @@
 //   traces, trace_t  the traced output points ({name, colour, data: the frames' encoding}) at the times trace_t
 //   plot_t         the t range of the plots' axes (their cursor); box: the planar view's pixel box (planar.js)
 //   velocity_note  why there are no velocity vectors, when there are none
+//   parts          the parts drawn (phiq/drawn_parts.hpp): {names, geometry: a geometry index per part, fixed: a
+//                  character per part, geometries: per geometry its shapes ({name, colour, and in space p: base64
+//                  float32 x, y, z per vertex, i: base64 uint32 three per triangle; in the plane outline: x, y, ...
+//                  in the part's frame, width and closed for a curve}), poses: base64 int16, frame-major, 7 per part
+//                  (origin over parts.lo .. parts.hi, quaternion x, y, z, w over -1 .. 1)}
 'use strict';
 
 const phiq = (function () {
@@ -28,7 +33,7 @@ const phiq = (function () {
 
   // int16 codes (base64) onto [lo, hi] per component
   function decode(b64, lo, hi) {
-    const bin = atob(b64), n = bin.length >> 1, out = new Float32Array(n);
+    const bin = atob(b64), n = bin.length >> 1, out = new Float32Array(n), D = lo.length;
     const step = lo.map((l, c) => (hi[c] - l) / 65534);
     for (let i = 0; i < n; ++i) {
       let code = bin.charCodeAt(2 * i) | (bin.charCodeAt(2 * i + 1) << 8);
@@ -41,6 +46,9 @@ const phiq = (function () {
   const frames = decode(data.frames, data.lo, data.hi);
   const vmaxes = new Array(D).fill(data.vmax);
   const velocities = data.velocities ? decode(data.velocities, vmaxes.map((v) => -v), vmaxes) : null;
+  const parts = data.parts || {names: [], geometry: [], geometries: [], fixed: '', poses: '', lo: [], hi: []};
+  const N = parts.names.length;
+  const partFrames = N ? decode(parts.poses, parts.lo.concat([-1, -1, -1, -1]), parts.hi.concat([1, 1, 1, 1])) : null;
   const traces = data.traces.map((tr) => ({name: tr.name, colour: tr.colour, pos: decode(tr.data, data.lo, data.hi)}));
 
   // the last index i with a[i] <= x (0 if none)
@@ -54,7 +62,7 @@ const phiq = (function () {
     return lo;
   }
 
-  const pos = new Float32Array(P * D), vel = velocities ? new Float32Array(P * D) : null;
+  const pos = new Float32Array(P * D), vel = velocities ? new Float32Array(P * D) : null, place = new Float32Array(7 * N);
   // The pose at time t: linear between the frames around it.
   function pose(t) {
     const i = Math.min(below(T, t), F - 1), j = Math.min(i + 1, F - 1);
@@ -62,13 +70,26 @@ const phiq = (function () {
     const a = i * P * D, b = j * P * D;
     for (let k = 0; k < P * D; ++k) pos[k] = frames[a + k] + w * (frames[b + k] - frames[a + k]);
     if (vel) for (let k = 0; k < P * D; ++k) vel[k] = velocities[a + k] + w * (velocities[b + k] - velocities[a + k]);
-    return {t, frame: w < 0.5 ? i : j, pos, vel, samples: data.trace_t.length ? below(data.trace_t, t) + 1 : 0};
+    // the parts: origins linear, quaternions normalised linear (consecutive frames share a sign)
+    for (let k = 0; k < 7 * N; k += 7) {
+      const pa = i * 7 * N + k, pb = j * 7 * N + k;
+      let n = 0;
+      for (let c = 0; c < 7; ++c) {
+        place[k + c] = partFrames[pa + c] + w * (partFrames[pb + c] - partFrames[pa + c]);
+        if (c >= 3) n += place[k + c] * place[k + c];
+      }
+      n = Math.sqrt(n) || 1;
+      for (let c = 3; c < 7; ++c) place[k + c] /= n;
+    }
+    return {t, frame: w < 0.5 ? i : j, pos, vel, parts: place, samples: data.trace_t.length ? below(data.trace_t, t) + 1 : 0};
   }
 
   // ---- controls
   const play = document.getElementById('play'), slider = document.getElementById('time');
   const timeText = document.getElementById('time-value'), speedSelect = document.getElementById('speed');
   const trails = document.getElementById('trails'), vectors = document.getElementById('vectors');
+  const partFramesBox = document.getElementById('part-frames'), partInfo = document.getElementById('part-info');
+  if (!N) partFramesBox.disabled = true;
   const t0 = T[0], t1 = T[F - 1], span = t1 - t0;
   // speed: simulated seconds per second; the default plays the whole result in about 8 s
   const speeds = [0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000];
@@ -109,7 +130,8 @@ const phiq = (function () {
   function render() {
     const p = pose(t);
     const started = performance.now();
-    view.draw(p, {trails: trails.checked, vectors: vectors.checked && !!vel});
+    view.draw(p, {trails: trails.checked, vectors: vectors.checked && !!vel, frames: partFramesBox.checked});
+    if (picked >= 0) describe(picked, p.parts);
     drawTimes.push(performance.now() - started);
     if (drawTimes.length > 600) drawTimes.shift();
     const u = span > 0 ? (t - t0) / span : 0;
@@ -148,7 +170,27 @@ const phiq = (function () {
     if (e.key === ' ' && e.target.tagName !== 'BUTTON') { e.preventDefault(); setPlaying(!playing); }
   });
   slider.addEventListener('input', () => { setPlaying(false); t = t0 + span * slider.value / 10000; dirty = true; });
-  for (const box of [trails, vectors]) box.addEventListener('change', () => { dirty = true; });
+  for (const box of [trails, vectors, partFramesBox]) box.addEventListener('change', () => { dirty = true; });
+
+  // the part under the pointer (the view finds it): its name and pose at the time shown
+  let picked = -1;
+  function describe(k, place) {
+    const f = (v) => (+v).toPrecision(4), o = 7 * k;
+    const at = 'origin (' + Array.from(place.slice(o, o + D), f).join(', ') + ') m';
+    const q = place.slice(o + 3, o + 7), angle = 2 * Math.atan2(Math.hypot(q[0], q[1], q[2]), q[3]);
+    let turn;
+    if (D === 2) {
+      turn = 'angle ' + f(2 * Math.atan2(q[2], q[3]) * 180 / Math.PI) + '\u00b0';
+    } else {
+      const s = Math.hypot(q[0], q[1], q[2]) || 1;
+      turn = 'turned ' + f(angle * 180 / Math.PI) + '\u00b0 about (' + [q[0] / s, q[1] / s, q[2] / s].map(f).join(', ') + ')';
+    }
+    partInfo.textContent = parts.names[k] + ': ' + at + ', ' + turn;
+  }
+  function pick(k) {
+    picked = k;
+    if (k < 0) partInfo.textContent = ''; else describe(k, pose(t).parts);
+  }
 
   function stats(list) {
     if (!list.length) return null;
@@ -158,7 +200,7 @@ const phiq = (function () {
   }
 
   return {
-    data, traces, below,
+    data, traces, below, parts, pick,
     // Called by the view once built: draws the first pose and starts the clock. The page's address may ask for a
     // frame and a still picture: #frame=K (K a frame index, or "last"), paused.
     start(v) {
@@ -176,6 +218,7 @@ const phiq = (function () {
         play() { intervals.length = drawTimes.length = 0; last = null; setPlaying(true); },
         pause() { setPlaying(false); },
         points() { return view.screenPoints(pose(t).pos); },
+        pick(k) { pick(k); return partInfo.textContent; },
         timing() { return {frameInterval: stats(intervals), draw: stats(drawTimes)}; },
       };
     },
