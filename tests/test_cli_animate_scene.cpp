@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "phiq/csv_compare.hpp"
+#include "phiq/drawn_parts.hpp"
+#include "phiq/phiq.hpp"
 
 #include "cli_test_support.hpp"
 #include "glb_reader.hpp"
@@ -90,8 +92,8 @@ TEST_F(Cli, AnimateNamesTheOutputToAddInOneLine) {
   const std::string planetary = phiq::test::model_path("transmissions/planetary.yaml");
   const fs::path csv = dir_ / "pl.csv";
   ASSERT_EQ(run("run -q " + planetary + " -o " + csv.string()).code, 0);
-  // the page reads the sketch's points (the carrier's arm first), the .glb the bodies' frames too (the sun's first)
-  for (const auto& [out, coordinate] : {std::pair<std::string, std::string>{"pl.html", "xc"}, {"pl.glb", "xs"}}) {
+  // both read the drawn parts' frames, the bodies' (the sun's first) before the sketch's points (the carrier's arm)
+  for (const auto& [out, coordinate] : {std::pair<std::string, std::string>{"pl.html", "xs"}, {"pl.glb", "xs"}}) {
     const fs::path target = dir_ / out;
     const Result r = run("animate " + planetary + " " + csv.string() + " -o " + target.string());
     EXPECT_EQ(r.code, 2);
@@ -111,13 +113,20 @@ TEST_F(Cli, AnimateNamesTheOutputToAddInOneLine) {
             std::string::npos)
       << r.err;
   EXPECT_EQ(slurp(page), good);
-  // the larger module moves the planet's centre out: the sweep ran with it (arm = m (24 + 18) / 2)
+  // the larger module moves the planet's centre out: the sweep ran with it (arm = m (24 + 18) / 2, the farthest
+  // part origin); the drawing reaches the ring's pitch circle (m 60 / 2) and the half width of its line
   const nlohmann::json d = viewer_data(good);
-  EXPECT_NEAR(d["hi"][0].get<double>(), 0.005 * 21, 1e-12);
+  EXPECT_NEAR(d["parts"]["hi"][0].get<double>(), 0.005 * 21, 1e-12);
+  const nlohmann::json& parts = d["parts"];
+  const nlohmann::json& ring = parts["geometries"][parts["geometry"][3].get<int>()];
+  ASSERT_EQ(parts["names"][3], "ring");
+  ASSERT_EQ(ring.size(), 2u);
+  ASSERT_EQ(ring[1]["name"], "planet_ring.pitch_circle");
+  EXPECT_NEAR(d["hi"][0].get<double>(), 0.005 * 30 + ring[1]["width"].get<double>() / 2, 1e-12);
 }
 
 // A cam with a roller follower draws no line, only its joints (the disc's bearing on ground, the rod's block on
-// its guide): they are its points, the block at the rod's (xf, yf) of every row.
+// its guide) over its parts: the joints are its points, the block at the rod's (xf, yf) of every row.
 TEST_F(Cli, AnimateACamWithARollerFollowerByItsJoints) {
   const std::string cam = phiq::test::model_path("cams/eccentric_roller.yaml");
   const fs::path csv = dir_ / "cam.csv", html = dir_ / "cam.html";
@@ -132,11 +141,32 @@ TEST_F(Cli, AnimateACamWithARollerFollowerByItsJoints) {
   EXPECT_EQ(d["joints"]["p"], nlohmann::json({0, 1}));
   const phiq::CsvTable table = phiq::read_csv_table(csv.string());
   ASSERT_EQ(d["kept"].size(), table.rows.size());
-  // the rod's travel: the extent of y is the bearing's 0 to the highest yf, decoded to the quantization's step
+  // the extent of y: the drawn parts' (the disc's profile, the rod's roller, the guide on ground) at every row, each
+  // part's origin ± its farthest vertex; the guide, fixed, reaches above the rod's highest yf
   double top = 0.0;
   for (const auto& row : table.rows) top = std::max(top, row[5]);
   ASSERT_EQ(table.columns[5], "yf");
-  EXPECT_EQ(d["hi"][1].get<double>(), top);
+  const phiq::Scene scene = phiq::load_scene(cam);
+  const std::vector<phiq::Part> parts = phiq::drawn_parts(scene);
+  ASSERT_EQ(parts.size(), 3u);
+  double lowest = INFINITY, highest = -INFINITY;
+  for (const phiq::Part& part : parts) {
+    double reach = 0.0;
+    for (const phiq::Shape& shape : part.shapes)
+      for (const phiq::kin3::V3& v : phiq::shape_triangles(shape, 8).vertices)
+        reach = std::max(reach, std::hypot(v.x, v.y, v.z));
+    for (const auto& row : table.rows) {
+      Eigen::VectorXd q = scene.model->initial_positions();
+      for (std::size_t c = 1; c < 7; ++c) q(scene.model->find_coordinate(table.columns[c])) = row[c];
+      const double y = phiq::part_pose(part.frame, q.data(), row[0]).at.y;
+      lowest = std::min(lowest, y - reach), highest = std::max(highest, y + reach);
+    }
+  }
+  const double lo = d["lo"][1], hi = d["hi"][1];
+  EXPECT_EQ(lo, lowest);
+  EXPECT_EQ(hi, highest);
+  EXPECT_GT(hi, top + 0.01);  // above the roller (rho = 0.01) at the rod's highest
+  // the block at (xf, yf) of every row, decoded to the quantization's step over [lo, hi]
   const std::string b64 = d["frames"];
   std::string bytes;
   int bits = 0, value = 0;
@@ -151,7 +181,7 @@ TEST_F(Cli, AnimateACamWithARollerFollowerByItsJoints) {
     const std::size_t at = k * 8 + 6;  // row k, point 1, y
     const auto code = static_cast<std::int16_t>(static_cast<unsigned char>(bytes[at]) |
                                                 (static_cast<unsigned char>(bytes[at + 1]) << 8));
-    EXPECT_NEAR((code + 32767) * top / 65534, table.rows[k][5], 0.5 * top / 65534 + 1e-15) << k;
+    EXPECT_NEAR(lo + (code + 32767) * (hi - lo) / 65534, table.rows[k][5], 0.5 * (hi - lo) / 65534 + 1e-15) << k;
   }
   // without a result: the same page data
   ASSERT_EQ(run("animate " + cam + " -o " + (dir_ / "swept.html").string()).code, 0);
