@@ -59,3 +59,39 @@ def test_a_short_q_is_refused_in_one_line():
     coupler = fourbar_with_parts().parts[0]
     with pytest.raises(ValueError, match="Part.pose: q has 2 entries"):
         coupler.pose(np.zeros(2))
+
+
+def test_driver_efforts_of_the_crank_slider_are_the_closed_form():
+    """A 2 kg slider and a 1 kg crank (centre at L2/2) under gravity, the crank turned at 2 rad/s: the motor's
+    torque is m_s ẋ ẍ / θ̇ (the slider's kinetic energy; gravity does no work on it) plus m_c g (L2/2) cos θ (it holds
+    the crank up; θ̈ = 0 and the crank's centre moves on a circle)."""
+    with open(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"), encoding="utf-8") as f:
+        text = f.read()
+    scene = phiq.parse_scene(text + "\nloads: {gravity: [0, -9.81]}\nparts:\n"
+                             "  slider: {frame: {at: B}, mass: 2.0, center_of_mass: [0, 0], inertia: 0.01}\n"
+                             "  crank: {frame: {origin: O, x: A}, mass: 1.0, center_of_mass: [L2/2, 0], "
+                             "inertia: 0.0075}\n", "crank_slider.yaml")
+    result = phiq.run_sweep(scene)
+    names, efforts = phiq.driver_efforts(scene, result)
+    assert names == ["motor"]
+    r, L, w = 0.3, 1.0, 2.0
+    worst = 0.0
+    for t, tau in zip(result.t, efforts[:, 0]):
+        th = w * t
+        s, c = math.sin(th), math.cos(th)
+        root = math.sqrt(L * L - r * r * s * s)
+        dx = -r * s - r * r * s * c / root
+        d2x = -r * c - r * r * (c * c - s * s) / root - r ** 4 * s * s * c * c / root ** 3
+        exact = 2.0 * (w * dx) * (w * w * d2x) / w + 1.0 * 9.81 * (r / 2) * c
+        worst = max(worst, abs(tau - exact))
+    assert worst < 1e-9
+    assert np.max(np.abs(efforts)) > 1.0  # a torque of newton-metres: the check is not of zeros
+
+
+def test_driver_efforts_need_velocities_and_accelerations():
+    scene = fourbar_with_parts()
+    options = scene.options
+    options.velocities = options.accelerations = False
+    result = phiq.run_sweep(scene, options)
+    with pytest.raises(ValueError, match="no velocities or accelerations"):
+        phiq.driver_efforts(scene, result)

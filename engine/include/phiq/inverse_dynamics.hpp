@@ -21,11 +21,6 @@
 
 namespace phiq {
 
-/// The loads on a mechanism's parts: a uniform gravity (m/s², world axes) acting at each part's centre of mass.
-struct Loads {
-  kin3::V3 gravity;  ///< e.g. (0, −9.81, 0) in the plane
-};
-
 /// Adds to `Q` (one entry per coordinate) the generalized forces of `loads` and of the parts' inertia at (q, q̇, q̈,
 /// t) (file comment). Parts without mass contribute nothing. Pre-condition: Q has a size the parts' coordinates fit.
 void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
@@ -37,5 +32,15 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
 /// factorisation returns (kNotSquare for a model without a square solve); `message` says why on failure.
 SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, const Eigen::VectorXd& Q,
                                    Eigen::VectorXd& lambda, std::string* message = nullptr);
+
+/// The constraints that depend on time (the drivers, and equations in t), in model order: whose efforts
+/// driver_efforts() gives.
+std::vector<Index> rheonomic_constraints(const Model& model);
+
+/// The effort of each of rheonomic_constraints() at the motion in `ws` (q, q̇, q̈ at t) under `loads`: −λ of its
+/// first row, the torque or force its motor applies, conjugate to what it drives (a coordinate, a joint's angle or
+/// distance, an expression). As constraint_multipliers() for the status and `message`.
+SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, const Loads& loads, double t,
+                           Workspace& ws, std::vector<double>& efforts, std::string* message = nullptr);
 
 }  // namespace phiq

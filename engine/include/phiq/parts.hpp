@@ -86,6 +86,11 @@ struct Part {
   bool fixed = false;                           ///< its frame reads no coordinate and no time (ground)
 };
 
+/// The loads on a mechanism's parts (the scene's `loads`): a uniform gravity acting at each part's centre of mass.
+struct Loads {
+  kin3::V3 gravity;  ///< m/s², world axes, e.g. (0, −9.81, 0) in the plane
+};
+
 /// The largest coordinate index `frame` reads, −1 if none.
 Index max_coordinate(const PartFrame& frame);
 

@@ -70,6 +70,7 @@ struct Scene {
   /// The scene's `parts`, in file order: shapes and mass on its bodies (phiq/parts.hpp). Bodies without one get
   /// derived parts where a drawing asks for them (drawn_parts()), not here.
   std::vector<Part> parts;
+  Loads loads;                   ///< the scene's `loads` (gravity), for inverse dynamics (phiq/inverse_dynamics.hpp)
   std::unique_ptr<Model> model;  ///< the mechanism (held by pointer: a CsvFormat keeps its address)
   /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns
   /// written, coordinates defaulting to all).

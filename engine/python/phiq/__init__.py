@@ -41,9 +41,19 @@ __all__ = [
     "NewtonOptions", "Part", "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError",
     "SensitivityForm", "SolveError", "SolveStatus", "StepSummary", "Stepper", "SweepOptions", "SweepResult",
     "SweepSummary", "SweepWarning", "Unit", "WorkCounters", "Workspace",
-    "analyse_rank", "assemble", "check", "constraint_kinds", "drawn_parts", "load_scene", "parse_scene", "run_batch",
-    "run_sweep", "solve_acceleration", "solve_position", "solve_velocity",
+    "analyse_rank", "assemble", "check", "constraint_kinds", "drawn_parts", "driver_efforts", "load_scene",
+    "parse_scene", "run_batch", "run_sweep", "solve_acceleration", "solve_position", "solve_velocity",
 ]
+
+
+def driver_efforts(scene: Scene, result: SweepResult) -> Tuple[List[str], Any]:
+    """Each driver's effort along a sweep of ``scene`` (the motor torque or force, conjugate to what it drives), from
+    the parts' mass and the scene's ``loads``: inverse dynamics at every row (engine/include/phiq/inverse_dynamics.hpp).
+    ``result`` needs velocities, accelerations and every coordinate. Returns (driver names, rows × drivers array)."""
+    if result.qd is None or result.qdd is None:
+        raise ValueError("driver_efforts: the result has no velocities or accelerations (output velocities and "
+                         "accelerations: true)")
+    return _phiq.driver_efforts(scene, result.t, result.q, result.qd, result.qdd)
 
 
 def run_sweep(scene: Scene, options: Optional[SweepOptions] = None, *, identifier_names: bool = False,

@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 
 #include "phiq/drawn_parts.hpp"
+#include "phiq/inverse_dynamics.hpp"
 
 namespace phiq::python {
 
@@ -97,6 +98,40 @@ void bind_parts(py::module_& m) {
           py::arg("q"), py::arg("t") = 0.0,
           "(origin, rotation) of the part's frame at (q, t): a body point s is at origin + rotation @ s")
       .def("__repr__", [](const Part& p) { return "<phiq.Part '" + p.name + "' on " + p.body + ">"; });
+  m.def(
+      "driver_efforts",
+      [](const Scene& s, const Eigen::Ref<const Eigen::VectorXd>& t, const Eigen::Ref<const Eigen::MatrixXd>& q,
+         const Eigen::Ref<const Eigen::MatrixXd>& qd, const Eigen::Ref<const Eigen::MatrixXd>& qdd) {
+        const Model& model = *s.model;
+        const Index n = model.num_coordinates();
+        if (q.cols() != n || qd.cols() != n || qdd.cols() != n || q.rows() != t.size() || qd.rows() != t.size() ||
+            qdd.rows() != t.size())
+          throw Error(
+              "driver_efforts: q, qd and qdd need one row per time and one column per coordinate of the "
+              "scene (" +
+              std::to_string(n) + "): a sweep with velocities, accelerations and every coordinate");
+        py::list names;
+        for (Index c : rheonomic_constraints(model))
+          names.append(model.constraints()[static_cast<std::size_t>(c)].name);
+        Eigen::MatrixXd out(t.size(), static_cast<Index>(names.size()));
+        {
+          py::gil_scoped_release free;
+          Workspace ws(model);
+          std::vector<double> e;
+          for (Index k = 0; k < t.size(); ++k) {
+            ws.q = q.row(k).transpose(), ws.qd = qd.row(k).transpose(), ws.qdd = qdd.row(k).transpose();
+            std::string why;
+            if (driver_efforts(model, s.parts, s.loads, t(k), ws, e, &why) != SolveStatus::kSuccess)
+              throw Error("driver_efforts: at t = " + std::to_string(t(k)) + ": " + why);
+            for (std::size_t j = 0; j < e.size(); ++j) out(k, static_cast<Index>(j)) = e[j];
+          }
+        }
+        return py::make_tuple(names, out);
+      },
+      py::arg("scene"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
+      "Inverse dynamics: each driver's effort (−λ of its row: the torque or force its motor applies) at every row "
+      "of a motion, under the scene's `loads` and its parts' mass (phiq/inverse_dynamics.hpp). Returns (names, "
+      "rows × drivers array). phiq.driver_efforts(scene, result) takes a SweepResult.");
   m.def(
       "drawn_parts", [](const Scene& s) { return drawn_parts(s); }, py::arg("scene"),
       "The parts a drawing of the scene shows: its own, then those derived from its constraints.");

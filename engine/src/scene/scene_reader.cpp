@@ -14,7 +14,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   Cursor top(root, "", &file_, YAML::Mark());
   if (!root.IsDefined() || root.IsNull()) top.fail("the scene is empty");
   top.expect_map({"phiq", "name", "description", "dimension", "parameters", "coordinates", "points", "bodies",
-                  "vectors", "constraints", "drivers", "parts", "time", "output", "solver"});
+                  "vectors", "constraints", "drivers", "parts", "loads", "time", "output", "solver"});
   if (auto v = top.field("phiq"); v.present() && v.integer(1, 1) != 1) v.fail("unsupported format version");
 
   Scene scene;
@@ -48,6 +48,13 @@ Scene SceneReader::read(const YAML::Node& root) {
   if (auto d = top.field("drivers"); d.present()) read_list(d, [&](const auto& item) { read_driver(item); });
 
   if (auto p = top.field("parts"); p.present()) read_parts(p, scene);  // (before the tables of names are freed)
+  if (auto l = top.field("loads"); l.present()) {
+    l.expect_map({"gravity"});
+    if (auto g = l.field("gravity"); g.present()) {
+      const std::vector<double> v = numbers(g, spatial_ ? 3 : 2);
+      scene.loads.gravity = {v[0], v[1], spatial_ ? v[2] : 0.0};
+    }
+  }
   read_time(top.require("time"), scene.sweep);
   read_output(top.field("output"), scene.sweep);
   scene.dimension = spatial_ ? 3 : 2;

@@ -71,4 +71,23 @@ SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, 
   return SolveStatus::kSuccess;
 }
 
+std::vector<Index> rheonomic_constraints(const Model& model) {
+  std::vector<Index> out;
+  for (std::size_t c = 0; c < model.constraints().size(); ++c)
+    if (model.constraints()[c].depends_on_time) out.push_back(static_cast<Index>(c));
+  return out;
+}
+
+SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, const Loads& loads, double t,
+                           Workspace& ws, std::vector<double>& efforts, std::string* message) {
+  Eigen::VectorXd Q = Eigen::VectorXd::Zero(model.num_coordinates()), lambda;
+  add_generalized_forces(parts, loads, ws.q.data(), ws.qd.data(), ws.qdd.data(), t, Q);
+  const SolveStatus st = constraint_multipliers(model, t, ws, Q, lambda, message);
+  efforts.clear();
+  if (st != SolveStatus::kSuccess) return st;
+  for (Index c : rheonomic_constraints(model))
+    efforts.push_back(-lambda(model.constraints()[static_cast<std::size_t>(c)].first_row));
+  return st;
+}
+
 }  // namespace phiq
