@@ -1,15 +1,20 @@
-// `phiq animate SCENE RESULT -o OUT.glb`: the glTF's node transforms at every row equal the poses computed here
-// from the result's coordinates (planar reference-point bodies, natural-coordinate links, spatial bodies with Euler
-// parameters), its time accessor is the result's t, its container and accessors are consistent; bad input is one
-// line, exit 2, and no file written or damaged. The Khronos validator runs on the same files in ctest gltf_validator.
+// `phiq animate SCENE RESULT -o OUT.glb`: the transforms of the glTF's nodes (one per drawn part) at every row
+// equal the poses computed here from the result's coordinates (planar reference-point bodies, natural-coordinate
+// links, spatial bodies with Euler parameters), its time accessor is the result's t, its container and accessors are
+// consistent; bad input is one line, exit 2, and no file written or damaged. The Khronos validator runs on the same
+// files in ctest gltf_validator.
 #include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <string>
 
+#include "phiq/drawn_parts.hpp"
 #include "phiq/hdf5_reader.hpp"
+#include "phiq/phiq.hpp"
 
 #include "cli_test_support.hpp"
 #include "glb_reader.hpp"
@@ -91,32 +96,42 @@ TEST_F(Animate, ReferencePointBodiesFollowTheirCoordinates) {
   const Glb g = animate("seed/fourbar_reference_point.yaml", ".csv");
   EXPECT_EQ(g.doc["scenes"][0]["name"], "fourbar_reference_point");
   EXPECT_EQ(g.doc["animations"][0]["name"], "fourbar_reference_point");
-  // three bodies and the four revolute pairs (O and C on ground: still, no channel)
-  EXPECT_EQ(g.doc["nodes"].size(), 7u);
-  for (const char* j : {"O", "A", "B", "C"}) EXPECT_GE(g.node(j), 0) << j;
-  EXPECT_EQ(g.channel(g.node("O"), "translation").second, -1);
-  EXPECT_GE(g.channel(g.node("A"), "translation").second, 0);
+  // a node per drawn part: the three bodies and the ground, which holds the pins of O and C (still: no channel)
+  const phiq::Scene scene = phiq::load_scene(phiq::test::model_path("seed/fourbar_reference_point.yaml"));
+  ASSERT_EQ(phiq::drawn_parts(scene).size(), 4u);
+  EXPECT_EQ(g.doc["nodes"].size(), 4u);
+  for (const char* p : {"crank", "coupler", "rocker", "ground"}) EXPECT_GE(g.node(p), 0) << p;
+  EXPECT_EQ(g.channel(g.node("ground"), "translation").second, -1);
+  EXPECT_GE(g.channel(g.node("crank"), "translation").second, 0);
   expect_times(g);
   for (const char* b : {"crank", "coupler", "rocker"}) {
     const std::string s = b == std::string("crank") ? "2" : (b == std::string("coupler") ? "3" : "4");
     expect_poses(g, b, [&](std::size_t k) { return planar(at(k, "x" + s), at(k, "y" + s), at(k, "psi" + s)); });
   }
-  // the crank's box spans its two pair points, ±L2/2 along x, and half its thickness (its extent in z) beyond
-  const int mesh = g.doc["nodes"][g.node("crank")]["mesh"];
-  const int pos = g.doc["meshes"][mesh]["primitives"][0]["attributes"]["POSITION"];
-  const auto& lo = g.doc["accessors"][pos]["min"];
-  const auto& hi = g.doc["accessors"][pos]["max"];
-  const double half = hi[2].get<double>();
+  // the crank's links run from its centre to its two pair points, ±L2/2 along x, and half their thickness (their
+  // extent in z) beyond; its pins sit on those points
+  const auto& crank = g.doc["meshes"][g.doc["nodes"][g.node("crank")]["mesh"].get<int>()]["primitives"];
+  std::map<std::string, std::pair<nlohmann::json, nlohmann::json>> box;  // shape: (min, max)
+  for (const auto& prim : crank) {
+    const auto& a = g.doc["accessors"][prim["attributes"]["POSITION"].get<int>()];
+    box[prim["extras"]["name"]] = {a["min"], a["max"]};
+  }
+  ASSERT_EQ(box.size(), 4u);
+  const double half = box["O.link"].second[2].get<double>();
   EXPECT_GT(half, 0.0);
-  EXPECT_FLOAT_EQ(lo[2].get<double>(), -half);
-  EXPECT_NEAR(hi[0].get<double>() - half, 0.2, 1e-7);
-  EXPECT_NEAR(lo[0].get<double>() + half, -0.2, 1e-7);
+  EXPECT_FLOAT_EQ(box["O.link"].first[2].get<double>(), -half);
+  EXPECT_NEAR(box["O.link"].first[0].get<double>() + half, -0.2, 1e-7);
+  EXPECT_NEAR(box["A.link"].second[0].get<double>() - half, 0.2, 1e-7);
+  for (const auto& [pin, x] : {std::pair<std::string, double>{"O.pin", -0.2}, {"A.pin", 0.2}})
+    EXPECT_NEAR((box[pin].first[0].get<double>() + box[pin].second[0].get<double>()) / 2, x, 1e-7) << pin;
 }
 
 TEST_F(Animate, NaturalLinksFollowTheirPoints) {
   const Glb g = animate("seed/fourbar_natural.yaml", ".h5");  // the HDF5 result, read as the CSV is
-  // three links (the crank's angle constraint draws the same bar), and their four end points
-  EXPECT_EQ(g.doc["nodes"].size(), 7u);
+  // a node per drawn part: three links (the crank's angle constraint draws the same bar as its distance)
+  const phiq::Scene scene = phiq::load_scene(phiq::test::model_path("seed/fourbar_natural.yaml"));
+  ASSERT_EQ(phiq::drawn_parts(scene).size(), 3u);
+  EXPECT_EQ(g.doc["nodes"].size(), 3u);
   expect_times(g);
   auto link = [&](double ax, double ay, double bx, double by) {
     const double th = std::atan2(by - ay, bx - ax);
@@ -128,17 +143,23 @@ TEST_F(Animate, NaturalLinksFollowTheirPoints) {
       g, "coupler", [&](std::size_t k) { return link(at(k, "xA"), at(k, "yA"), at(k, "xB"), at(k, "yB")); }, true);
   expect_poses(
       g, "rocker", [&](std::size_t k) { return link(1.0, 0, at(k, "xB"), at(k, "yB")); }, true);
-  // a distance's link has a constant length: its box is that length, no scale channel
+  // a distance's link has a constant length: its bar is that length and its radius beyond, no scale channel
   const int n = g.node("coupler");
   EXPECT_EQ(g.channel(n, "scale").second, -1);
   const int pos = g.doc["meshes"][g.doc["nodes"][n]["mesh"].get<int>()]["primitives"][0]["attributes"]["POSITION"];
-  EXPECT_NEAR(g.doc["accessors"][pos]["max"][0].get<double>(), 1.2, 1e-6);
-  // the moving end B follows its point
-  const auto [in, out] = g.channel(g.node("coupler.end1"), "translation");
+  const double radius = g.doc["accessors"][pos]["max"][1].get<double>();
+  EXPECT_GT(radius, 0.0);
+  EXPECT_NEAR(g.doc["accessors"][pos]["max"][0].get<double>() - radius, 1.2, 1e-6);
+  // the moving end B follows its point: the coupler's origin (A) and 1.2 along its turned x
+  const auto [in, out] = g.channel(n, "translation");
+  const auto [rin, rout] = g.channel(n, "rotation");
   ASSERT_GE(out, 0);
+  ASSERT_GE(rout, 0);
   for (std::size_t k = 0; k < table.rows.size(); k += 37) {
-    EXPECT_TRUE(close(g.floats(out, k)[0], at(k, "xB")));
-    EXPECT_TRUE(close(g.floats(out, k)[1], at(k, "yB")));
+    const std::vector<double> t = g.floats(out, k), r = g.floats(rout, k);
+    const double c = 1 - 2 * r[2] * r[2], s = 2 * r[2] * r[3];  // cos, sin of the turn about z
+    EXPECT_NEAR(t[0] + 1.2 * c, at(k, "xB"), 1e-6) << k;
+    EXPECT_NEAR(t[1] + 1.2 * s, at(k, "yB"), 1e-6) << k;
   }
 }
 
