@@ -142,7 +142,8 @@ TEST_F(Cli, AnimateACamWithARollerFollowerByItsJoints) {
   const phiq::CsvTable table = phiq::read_csv_table(csv.string());
   ASSERT_EQ(d["kept"].size(), table.rows.size());
   // the extent of y: the drawn parts' (the disc's profile, the rod's roller, the guide on ground) at every row, each
-  // part's origin ± its farthest vertex; the guide, fixed, reaches above the rod's highest yf
+  // the tighter of its box's (its shapes' vertices in its frame) posed corners and its origin ± its farthest vertex;
+  // the guide reaches above the roller
   double top = 0.0;
   for (const auto& row : table.rows) top = std::max(top, row[5]);
   ASSERT_EQ(table.columns[5], "yf");
@@ -151,15 +152,25 @@ TEST_F(Cli, AnimateACamWithARollerFollowerByItsJoints) {
   ASSERT_EQ(parts.size(), 3u);
   double lowest = INFINITY, highest = -INFINITY;
   for (const phiq::Part& part : parts) {
+    phiq::kin3::V3 a{INFINITY, INFINITY, INFINITY}, b{-INFINITY, -INFINITY, -INFINITY};
     double reach = 0.0;
     for (const phiq::Shape& shape : part.shapes)
-      for (const phiq::kin3::V3& v : phiq::shape_triangles(shape, 8).vertices)
+      for (const phiq::kin3::V3& v : phiq::shape_triangles(shape, 8).vertices) {
+        a = {std::min(a.x, v.x), std::min(a.y, v.y), std::min(a.z, v.z)};
+        b = {std::max(b.x, v.x), std::max(b.y, v.y), std::max(b.z, v.z)};
         reach = std::max(reach, std::hypot(v.x, v.y, v.z));
+      }
     for (const auto& row : table.rows) {
       Eigen::VectorXd q = scene.model->initial_positions();
       for (std::size_t c = 1; c < 7; ++c) q(scene.model->find_coordinate(table.columns[c])) = row[c];
-      const double y = phiq::part_pose(part.frame, q.data(), row[0]).at.y;
-      lowest = std::min(lowest, y - reach), highest = std::max(highest, y + reach);
+      const phiq::Pose pose = phiq::part_pose(part.frame, q.data(), row[0]);
+      double down = INFINITY, up = -INFINITY;
+      for (int k = 0; k < 8; ++k) {
+        const double y = pose.apply({k & 1 ? b.x : a.x, k & 2 ? b.y : a.y, k & 4 ? b.z : a.z}).y;
+        down = std::min(down, y), up = std::max(up, y);
+      }
+      lowest = std::min(lowest, std::max(down, pose.at.y - reach));
+      highest = std::max(highest, std::min(up, pose.at.y + reach));
     }
   }
   const double lo = d["lo"][1], hi = d["hi"][1];

@@ -135,7 +135,7 @@ nlohmann::json parts_data(const std::vector<Part>& parts, bool spatial, const Me
   nlohmann::json geometries = nlohmann::json::array();
   std::map<std::string, int> known;
   std::string fixed;
-  std::vector<double> reach;
+  std::vector<PartBox> boxes;
   for (const Part& part : parts) {
     nlohmann::json g = nlohmann::json::array();
     for (const Shape& shape : part.shapes) {
@@ -157,7 +157,7 @@ nlohmann::json parts_data(const std::vector<Part>& parts, bool spatial, const Me
     if (fresh) geometries.push_back(g);
     names.push_back(part.name), geometry_of.push_back(it->second);
     fixed += part.fixed ? '1' : '0';
-    reach.push_back(part_reach(part));
+    boxes.push_back(part_box(part));
   }
   // the poses: origin and quaternion (x, y, z, w; on the side of the previous frame's) of every part at every frame
   std::vector<std::array<double, 7>> poses;
@@ -172,12 +172,8 @@ nlohmann::json parts_data(const std::vector<Part>& parts, bool spatial, const Me
           for (double& c : r) c = -c;
       }
       const double at[3] = {p.at.x, p.at.y, p.at.z};
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = std::min(lo[c], at[c]), hi[c] = std::max(hi[c], at[c]);
-        std::array<double, 3> x{p.at.x, p.at.y, p.at.z}, y = x;
-        x[static_cast<std::size_t>(c)] -= reach[k], y[static_cast<std::size_t>(c)] += reach[k];
-        bounds.push_back(x), bounds.push_back(y);
-      }
+      for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], at[c]), hi[c] = std::max(hi[c], at[c]);
+      posed_bounds(boxes[k], p, bounds);
       poses.push_back({at[0], at[1], at[2], r[0], r[1], r[2], r[3]});
     }
   std::string bytes;

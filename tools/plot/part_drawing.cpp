@@ -135,11 +135,30 @@ std::array<double, 4> quaternion(const RotationMatrix& r) {
   return q;
 }
 
-double part_reach(const Part& part) {
-  double reach = 0.0;
+PartBox part_box(const Part& part) {
+  PartBox box{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}, 0.0};
   for (const Shape& s : part.shapes)
-    for (const kin3::V3& v : shape_triangles(s, 8).vertices) reach = std::max(reach, std::hypot(v.x, v.y, v.z));
-  return reach;
+    for (const kin3::V3& v : shape_triangles(s, 8).vertices) {
+      box.lo = {std::min(box.lo.x, v.x), std::min(box.lo.y, v.y), std::min(box.lo.z, v.z)};
+      box.hi = {std::max(box.hi.x, v.x), std::max(box.hi.y, v.y), std::max(box.hi.z, v.z)};
+      box.reach = std::max(box.reach, std::hypot(v.x, v.y, v.z));
+    }
+  if (box.lo.x > box.hi.x) box = {};
+  return box;
+}
+
+void posed_bounds(const PartBox& box, const Pose& pose, std::vector<std::array<double, 3>>& out) {
+  std::array<double, 3> lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (int k = 0; k < 8; ++k) {
+    const kin3::V3 x =
+        pose.apply({k & 1 ? box.hi.x : box.lo.x, k & 2 ? box.hi.y : box.lo.y, k & 4 ? box.hi.z : box.lo.z});
+    const double c[3] = {x.x, x.y, x.z};
+    for (std::size_t a = 0; a < 3; ++a) lo[a] = std::min(lo[a], c[a]), hi[a] = std::max(hi[a], c[a]);
+  }
+  const double at[3] = {pose.at.x, pose.at.y, pose.at.z};
+  for (std::size_t a = 0; a < 3; ++a)
+    lo[a] = std::max(lo[a], at[a] - box.reach), hi[a] = std::min(hi[a], at[a] + box.reach);
+  out.push_back(lo), out.push_back(hi);
 }
 
 }  // namespace phiq::tools

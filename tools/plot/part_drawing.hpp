@@ -1,6 +1,6 @@
 // What every drawing of a scene's parts shares (phiq/drawn_parts.hpp: the .glb, the HTML viewer, the SVG): the
 // slots a part's frame reads, a shape's triangles ready to light, its colour, a rotation as a quaternion, and the
-// part's reach from its origin (for the drawings' extent).
+// part's box in its own frame (for the drawings' extent).
 #pragma once
 
 #include <array>
@@ -37,7 +37,17 @@ std::string hex_colour(const std::array<double, 4>& rgba);
 // candidates, accurate to rounding for every rotation).
 std::array<double, 4> quaternion(const RotationMatrix& r);
 
-// The largest distance from the part's origin to a vertex of its shapes (0 without shapes).
-double part_reach(const Part& part);
+// What bounds the part's shapes in its own frame: the least and greatest x, y, z of their vertices, and the largest
+// distance of one from the origin (all 0 without shapes).
+struct PartBox {
+  kin3::V3 lo, hi;
+  double reach = 0.0;
+};
+PartBox part_box(const Part& part);
+
+// Two points (least, greatest x, y, z) bounding the part at `pose`, appended to `out`: per axis the tighter of its
+// box's posed corners (a link turned to any angle: not a circle of its length about its origin) and its origin ±
+// its reach (a disc turned 45°: not its box's diagonal).
+void posed_bounds(const PartBox& box, const Pose& pose, std::vector<std::array<double, 3>>& out);
 
 }  // namespace phiq::tools

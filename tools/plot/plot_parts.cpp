@@ -136,19 +136,10 @@ std::string parts_svg(const std::vector<Part>& parts, const Eigen::VectorXd& q, 
   return s + "</g>\n";
 }
 
-std::vector<std::array<double, 3>> parts_extent(const std::vector<Part>& parts, const std::vector<double>& reach,
+std::vector<std::array<double, 3>> parts_extent(const std::vector<Part>& parts, const std::vector<PartBox>& boxes,
                                                 const Eigen::VectorXd& q, double t) {
   std::vector<std::array<double, 3>> out;
-  for (std::size_t k = 0; k < parts.size(); ++k) {
-    const Pose p = part_pose(parts[k].frame, q.data(), t);
-    const double r = reach[k];
-    for (int a = 0; a < 3; ++a)
-      for (double side : {-r, r}) {
-        P3 x{p.at.x, p.at.y, p.at.z};
-        x[static_cast<std::size_t>(a)] += side;
-        out.push_back(x);
-      }
-  }
+  for (std::size_t k = 0; k < parts.size(); ++k) posed_bounds(boxes[k], part_pose(parts[k].frame, q.data(), t), out);
   return out;
 }
 

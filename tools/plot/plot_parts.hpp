@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "part_drawing.hpp"
 #include "phiq/parts.hpp"
 
 namespace phiq::tools {
@@ -29,8 +30,8 @@ std::string parts_svg(const std::vector<Part>& parts, const Eigen::VectorXd& q, 
 // its triangles (a box a rectangle, a cylinder along z a circle of kPartSegments points).
 std::vector<std::array<double, 2>> shape_outline(const Shape& shape);
 
-// Points that bound the parts at (q, t): each part's origin ± its reach (part_reach()) along each axis.
-std::vector<std::array<double, 3>> parts_extent(const std::vector<Part>& parts, const std::vector<double>& reach,
+// Points that bound the parts at (q, t): each part's posed_bounds().
+std::vector<std::array<double, 3>> parts_extent(const std::vector<Part>& parts, const std::vector<PartBox>& boxes,
                                                 const Eigen::VectorXd& q, double t);
 
 }  // namespace phiq::tools

@@ -173,10 +173,10 @@ std::string plot_text(const Scene& scene, const PlotOptions& o, const MechanismS
     frames.t.push_back(table.rows[r][0]);
   }
   frames.parts = drawn_parts(scene);
-  std::vector<double> reach;
-  for (const Part& part : frames.parts) reach.push_back(part_reach(part));
+  std::vector<PartBox> boxes;
+  for (const Part& part : frames.parts) boxes.push_back(part_box(part));
   for (std::size_t f = 0; f < frames.q.size(); ++f)
-    for (const auto& x : parts_extent(frames.parts, reach, frames.q[f], frames.t[f])) frames.part_bounds.push_back(x);
+    for (const auto& x : parts_extent(frames.parts, boxes, frames.q[f], frames.t[f])) frames.part_bounds.push_back(x);
   for (const OutputPoint& p : scene.sweep.points) {
     const std::size_t cx = col.at(p.name + ".x"), cy = col.at(p.name + ".y");
     const auto cz = p.dimension() == 3 ? col.find(p.name + ".z") : col.end();
