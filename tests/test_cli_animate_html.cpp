@@ -6,13 +6,16 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
 
+#include "phiq/drawn_parts.hpp"
 #include "phiq/hdf5_reader.hpp"
+#include "phiq/phiq.hpp"
 
 #include "cli_test_support.hpp"
 #include "test_support.hpp"
@@ -114,8 +117,16 @@ TEST_F(AnimateHtml, PlanarPointsAndVelocitiesAreTheResultsAtEveryRow) {
     EXPECT_NEAR(v[5], at(k, "yB.v"), tol_v);
     EXPECT_EQ(v[0], 0.0);
   }
-  // the extent is the points' own: the crank tip reaches x = -0.4
-  EXPECT_NEAR(lo[0], -0.4, 1e-9);
+  // the extent holds the points and the drawn links about them: the crank tip reaches x = -0.4, its link's box
+  // (radius r about the bar) r beyond at the least, r √2 (a corner turned 45°) at the most
+  const nlohmann::json& parts = data["parts"];
+  ASSERT_EQ(parts["names"], nlohmann::json({"crank", "coupler", "rocker"}));
+  double r = 0.0;
+  for (const double c : parts["geometries"][parts["geometry"][0].get<int>()][0]["outline"]) r = std::max(r, -c);
+  const phiq::Scene scene = phiq::load_scene(phiq::test::model_path("seed/fourbar_natural.yaml"));
+  EXPECT_NEAR(r, scene.model->length_scale() / 50, 1e-12);  // a derived link's radius (drawn_parts.cpp)
+  EXPECT_LE(lo[0], -0.4 - r);
+  EXPECT_GE(lo[0], -0.4 - r * std::sqrt(2.0) - 1e-12);
   // phiq plot's default columns, with their panels; the planar view's background with its hatched ground pivots
   EXPECT_EQ(count(html, "class=\"panel\""), 2u);  // angle (theta2) and length (xA, yA, xB, yB)
   for (const char* c : {"theta2", "xA", "yA", "xB", "yB"})
@@ -146,20 +157,31 @@ TEST_F(AnimateHtml, ColumnsAsAskedAndSpatialScenesInWebGl) {
 }
 
 TEST_F(AnimateHtml, LargeChainsKeepEvenlySpreadRowsWithinTheBudget) {
+  constexpr std::size_t kFrameBudget = std::size_t{8} << 20;  // tools/animate/html_motion.hpp (in the phiq program)
   const fs::path scene = dir_ / "chain.yaml";
   ASSERT_EQ(run("generate nfourbar 2000 --steps 300 --outputs q,v -o " + scene.string()).code, 0);
   const std::string html = animate(scene.string());
   const std::size_t rows = table.rows.size(), points = data["points"];
   ASSERT_EQ(rows, 301u);
   EXPECT_EQ(points, 2u * 2001);  // the crank pivots (i, 0) and the tips P_i (the driving angle's O is the pivot (0, 0))
-  // bytes of a frame: positions and velocities, 2 bytes a component, base64
-  const std::size_t per_frame = (points * 2 * 2 * 2 * 4 + 2) / 3, most = (std::size_t{8} << 20) / per_frame;
+  // a drawn part per crank, coupler and rocker, and the ground's pins
+  const std::size_t parts = data["parts"]["names"].size();
+  EXPECT_EQ(parts, phiq::drawn_parts(phiq::load_scene(scene.string())).size());
+  // bytes of a frame: positions and velocities, 2 bytes a component, and the parts' poses (origin and quaternion),
+  // base64; the rows kept are as many as fit kFrameBudget
+  const std::size_t per_frame = (points * 2 * 2 * 2 * 4 + parts * 7 * 2 * 4 + 2) / 3, most = kFrameBudget / per_frame;
   ASSERT_LT(most, rows);
   const std::vector<std::size_t> kept = data["kept"];
   ASSERT_EQ(kept.size(), most);
   for (std::size_t k = 0; k < most; ++k)
     EXPECT_EQ(kept[k], static_cast<std::size_t>(std::llround(k * 300.0 / (most - 1))));
-  EXPECT_EQ(data["frames"].get<std::string>().size(), (most * points * 2 * 2 + 2) / 3 * 4);
+  const std::size_t frames = data["frames"].get<std::string>().size(),
+                    velocities = data["velocities"].get<std::string>().size(),
+                    poses = data["parts"]["poses"].get<std::string>().size();
+  EXPECT_EQ(frames, (most * points * 2 * 2 + 2) / 3 * 4);
+  EXPECT_EQ(velocities, frames);
+  EXPECT_EQ(poses, (most * parts * 7 * 2 + 2) / 3 * 4);
+  EXPECT_LE(frames + velocities + poses, kFrameBudget + 12);  // base64's padding, one per string
   EXPECT_LT(html.size(), std::size_t{10} << 20);
 }
 

@@ -62,7 +62,9 @@ TEST_F(AnimateParts, GlbHoldsANodePerPartPosedByPartPose) {
   ASSERT_EQ(a.code, 0) << a.err;
   const Glb g = phiq::test::parse_glb(slurp(glb));
   const std::vector<phiq::Part> parts = phiq::drawn_parts(r.scene);
-  ASSERT_EQ(parts.size(), 4u);
+  ASSERT_EQ(parts.size(), 5u);  // the four stated, and the ground's derived one (the fork of its hinge)
+  EXPECT_TRUE(parts[4].derived);
+  EXPECT_EQ(parts[4].name, "ground");
   // a node per part, and the root that turns phiq's z up to glTF's +y (a quarter turn about x) holding them all
   ASSERT_EQ(g.doc["nodes"].size(), parts.size() + 1);
   const auto& root = g.doc["nodes"][parts.size()];
@@ -97,10 +99,20 @@ TEST_F(AnimateParts, GlbHoldsANodePerPartPosedByPartPose) {
       }
       const auto& material = g.doc["materials"][prim["material"].get<int>()];
       colours.insert(material["name"].get<std::string>());
-      EXPECT_FLOAT_EQ(material["pbrMetallicRoughness"]["baseColorFactor"][0].get<double>(), (*part.colour)[0]);
+      const double red = part.colour ? (*part.colour)[0] : 0.72;  // a derived part: light grey (shape_colour())
+      EXPECT_FLOAT_EQ(material["pbrMetallicRoughness"]["baseColorFactor"][0].get<double>(), red);
     }
-    // its keyframes: part_pose() at each row, float32
+    // its keyframes: part_pose() at each row, float32; a fixed part none, its node posed once
     const auto [tin, tout] = g.channel(n, "translation");
+    if (part.fixed) {
+      EXPECT_EQ(tout, -1) << part.name;
+      const phiq::Pose p = phiq::part_pose(part.frame, r.q[0].data(), r.table.rows[0][0]);
+      const auto& node = g.doc["nodes"][n];
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(node["translation"][c].get<double>(), (&p.at.x)[c], 1e-7) << part.name;
+      const std::array<double, 9> m = matrix_of(node["rotation"].get<std::vector<double>>());
+      for (int c = 0; c < 9; ++c) EXPECT_NEAR(m[c], p.rotation[c], 1e-7) << part.name << " R" << c;
+      continue;
+    }
     const auto [rin, rout] = g.channel(n, "rotation");
     ASSERT_GE(tout, 0);
     ASSERT_GE(rout, 0);
@@ -114,9 +126,9 @@ TEST_F(AnimateParts, GlbHoldsANodePerPartPosedByPartPose) {
       for (int c = 0; c < 9; ++c) ASSERT_NEAR(m[c], p.rotation[c], 1e-6) << part.name << " row " << k << " R" << c;
     }
   }
-  // one material per colour: blue, orange and the cross's grey
-  EXPECT_EQ(colours, (std::set<std::string>{"#4573b3", "#e6801a", "#555555"}));
-  EXPECT_EQ(g.doc["materials"].size(), 3u);
+  // one material per colour: blue, orange, the cross's grey and the derived parts' light grey
+  EXPECT_EQ(colours, (std::set<std::string>{"#4573b3", "#e6801a", "#555555", "#b8b8b8"}));
+  EXPECT_EQ(g.doc["materials"].size(), 4u);
 }
 
 // int16 codes of base64 `b64` (the viewer's encoding, html_motion.cpp).
@@ -163,7 +175,8 @@ TEST_F(AnimateParts, HtmlHoldsEachPartAndItsPoses) {
     EXPECT_EQ(parts["names"][k], drawn[k].name);
     const auto& shapes = parts["geometries"][parts["geometry"][k].get<int>()];
     ASSERT_EQ(shapes.size(), drawn[k].shapes.size());
-    for (std::size_t s = 0; s < shapes.size(); ++s) EXPECT_EQ(shapes[s]["name"], drawn[k].shapes[s].name);
+    ASSERT_EQ(parts["shapes"][k].size(), drawn[k].shapes.size());
+    for (std::size_t s = 0; s < shapes.size(); ++s) EXPECT_EQ(parts["shapes"][k][s], drawn[k].shapes[s].name);
     for (std::size_t f = 0; f < kept.size(); f += 6) {
       const phiq::Pose p = phiq::part_pose(drawn[k].frame, r.q[kept[f]].data(), r.table.rows[kept[f]][0]);
       const int* c = &codes[7 * (f * drawn.size() + k)];

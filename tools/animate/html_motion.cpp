@@ -126,12 +126,13 @@ std::size_t frame_bytes(std::size_t points, int dim, bool velocities, std::size_
   return (points * static_cast<std::size_t>(dim) * 2 * (velocities ? 2 : 1) * 4 + parts * 7 * 2 * 4 + 2) / 3;
 }
 
-// The parts in the viewer's data (viewer.js documents the fields): each part's name and geometry (the same shapes
-// once: 10⁴ alike links share one), its poses at the kept rows quantized as the points' are; and points bounding
-// the parts at those rows, for the planar view's box.
+// The parts in the viewer's data (viewer.js documents the fields): each part's name, its shapes' names and geometry
+// (the same shapes once whatever their names: 10⁴ alike links share one), its poses at the kept rows quantized as the
+// points' are; and points bounding the parts at those rows, for the planar view's box.
 nlohmann::json parts_data(const std::vector<Part>& parts, bool spatial, const MechanismFrames& frames,
                           std::vector<std::array<double, 3>>& bounds) {
   nlohmann::json names = nlohmann::json::array(), geometry_of = nlohmann::json::array();
+  nlohmann::json shape_names = nlohmann::json::array();
   nlohmann::json geometries = nlohmann::json::array();
   std::map<std::string, int> known;
   std::string fixed;
@@ -139,7 +140,7 @@ nlohmann::json parts_data(const std::vector<Part>& parts, bool spatial, const Me
   for (const Part& part : parts) {
     nlohmann::json g = nlohmann::json::array();
     for (const Shape& shape : part.shapes) {
-      nlohmann::json one = {{"name", shape.name}, {"colour", hex_colour(shape_colour(part, shape))}};
+      nlohmann::json one = {{"colour", hex_colour(shape_colour(part, shape))}};
       if (spatial) {
         const LitMesh lit = lit_mesh(shape_triangles(shape, kPartSegments));
         one["p"] = base64(std::string(reinterpret_cast<const char*>(lit.pos.data()), lit.pos.size() * sizeof(float)));
@@ -156,6 +157,9 @@ nlohmann::json parts_data(const std::vector<Part>& parts, bool spatial, const Me
     const auto [it, fresh] = known.emplace(g.dump(), static_cast<int>(geometries.size()));
     if (fresh) geometries.push_back(g);
     names.push_back(part.name), geometry_of.push_back(it->second);
+    nlohmann::json mine = nlohmann::json::array();
+    for (const Shape& shape : part.shapes) mine.push_back(shape.name);
+    shape_names.push_back(mine);
     fixed += part.fixed ? '1' : '0';
     boxes.push_back(part_box(part));
   }
@@ -180,11 +184,8 @@ nlohmann::json parts_data(const std::vector<Part>& parts, bool spatial, const Me
   const Quantizer axes[3] = {{lo[0], hi[0]}, {lo[1], hi[1]}, {lo[2], hi[2]}}, unit(-1.0, 1.0);
   for (const auto& p : poses)
     for (int c = 0; c < 7; ++c) (c < 3 ? axes[c] : unit).put(p[static_cast<std::size_t>(c)], bytes);
-  nlohmann::json out = {{"names", names},
-                        {"geometry", geometry_of},
-                        {"geometries", geometries},
-                        {"fixed", fixed},
-                        {"poses", base64(bytes)}};
+  nlohmann::json out = {{"names", names},           {"shapes", shape_names}, {"geometry", geometry_of},
+                        {"geometries", geometries}, {"fixed", fixed},        {"poses", base64(bytes)}};
   out["lo"] = parts.empty() ? nlohmann::json::array() : nlohmann::json({lo[0], lo[1], lo[2]});
   out["hi"] = parts.empty() ? nlohmann::json::array() : nlohmann::json({hi[0], hi[1], hi[2]});
   return out;

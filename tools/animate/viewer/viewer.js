@@ -20,11 +20,11 @@
 //   traces, trace_t  the traced output points ({name, colour, data: the frames' encoding}) at the times trace_t
 //   plot_t         the t range of the plots' axes (their cursor); box: the planar view's pixel box (planar.js)
 //   velocity_note  why there are no velocity vectors, when there are none
-//   parts          the parts drawn (phiq/drawn_parts.hpp): {names, geometry: a geometry index per part, fixed: a
-//                  character per part, geometries: per geometry its shapes ({name, colour, and in space p: base64
-//                  float32 x, y, z per vertex, i: base64 uint32 three per triangle; in the plane outline: x, y, ...
-//                  in the part's frame, width and closed for a curve}), poses: base64 int16, frame-major, 7 per part
-//                  (origin over parts.lo .. parts.hi, quaternion x, y, z, w over -1 .. 1)}
+//   parts          the parts drawn (phiq/drawn_parts.hpp): {names, shapes: per part its shapes' names, geometry: a
+//                  geometry index per part, fixed: a character per part, geometries: per geometry its shapes ({colour,
+//                  and in space p: base64 float32 x, y, z per vertex, i: base64 uint32 three per triangle; in the
+//                  plane outline: x, y, ... in the part's frame, width and closed for a curve}), poses: base64 int16,
+//                  frame-major, 7 per part (origin over parts.lo .. parts.hi, quaternion x, y, z, w over -1 .. 1)}
 'use strict';
 
 const phiq = (function () {
