@@ -11,6 +11,8 @@
 #include <string>
 
 #include "phiq/csv_compare.hpp"
+#include "phiq/drawn_parts.hpp"
+#include "phiq/phiq.hpp"
 
 #include "cli_test_support.hpp"
 #include "test_support.hpp"
@@ -162,7 +164,12 @@ TEST_F(Plot, PlanarPartsAreFilledOutlinesUnderTheSketch) {
   const Result r = run("plot " + scene.string() + " -o " + svg.string() + " --positions 3");
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string s = slurp(svg);
-  EXPECT_EQ(count(s, "class=\"part\""), 4u * 3u);
+  // a path per shape of each drawn part at each row: the four stated, and the ground's derived pins at O and C
+  std::size_t shapes = 0;
+  for (const phiq::Part& part : phiq::drawn_parts(phiq::load_scene(scene.string()))) shapes += part.shapes.size();
+  EXPECT_EQ(shapes, 4u + 2u);
+  EXPECT_EQ(count(s, "class=\"part\""), shapes * 3u);
+  EXPECT_EQ(count(s, "class=\"part\" data-part=\"ground\""), 2u * 3u);
   EXPECT_EQ(count(s, "class=\"part\" data-part=\"crank\" data-shape=\"bar\""), 3u);
   // the last row: its parts come before its sketch (drawn under it)
   const std::string last = s.substr(s.rfind("<g class=\"position\""));
