@@ -121,7 +121,7 @@ TEST_F(Cli, AnimateNamesTheOutputToAddInOneLine) {
   const nlohmann::json& ring = parts["geometries"][parts["geometry"][3].get<int>()];
   ASSERT_EQ(parts["names"][3], "ring");
   ASSERT_EQ(ring.size(), 2u);
-  ASSERT_EQ(ring[1]["name"], "planet_ring.pitch_circle");
+  ASSERT_EQ(parts["shapes"][3][1], "planet_ring.pitch_circle");
   EXPECT_NEAR(d["hi"][0].get<double>(), 0.005 * 30 + ring[1]["width"].get<double>() / 2, 1e-12);
 }
 
