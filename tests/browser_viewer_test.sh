@@ -3,7 +3,8 @@
 # (natural coordinates), each with its crank tip A traced and a sweep that does not close the cycle (the first and
 # last poses differ), opened in headless Chromium by tests/browser/viewer_test.js (node, no npm package): no console
 # error, first and last frames differ where the mechanism moved and agree on the ground, the middle frame matches
-# tests/browser/reference/NAME.png; and the Cardan joint's parts, its middle frame against parts_cardan.png. Skipped (exit 77) when chromium or node is absent.
+# tests/browser/reference/NAME.png; and the parts of the Cardan joint, the roller cam and the gear train, their
+# middle frames against parts_*.png. Skipped (exit 77) when chromium or node is absent.
 # Usage: browser_viewer_test.sh PHIQ MODELS_DIR WORK_DIR [--update] [--timing]
 #   --update rewrites the references (look at them, and say why in the commit).
 set -u
@@ -29,5 +30,12 @@ done
 sed -e 's/end: 2\*pi, steps: 72/end: 2, steps: 24/' "$models/spatial/cardan.yaml" > "$work/cardan.yaml" || exit 1
 grep -q 'end: 2, steps: 24' "$work/cardan.yaml" || { echo "browser_viewer: cardan.yaml: its time line changed"; exit 1; }
 "$phiq" animate "$work/cardan.yaml" -o "$work/cardan.html" || { echo "browser_viewer: phiq animate cardan failed"; exit 1; }
+# the roller cam (its disc, roller and follower) and the two-stage gear train (pitch circles), drawn by their
+# derived parts
+for name in cams/eccentric_roller transmissions/gear_train; do
+  "$phiq" animate "$models/$name.yaml" -o "$work/$(basename "$name").html" ||
+    { echo "browser_viewer: phiq animate $name failed"; exit 1; }
+done
 exec node "$here/browser/viewer_test.js" "$chromium" "$here/browser/reference" "$work/shots" "$@" \
-  planar="$work/planar.html" spatial="$work/spatial.html" parts_cardan="$work/cardan.html"
+  planar="$work/planar.html" spatial="$work/spatial.html" parts_cardan="$work/cardan.html" \
+  parts_cam="$work/eccentric_roller.html" parts_gears="$work/gear_train.html"
