@@ -29,10 +29,18 @@
   const partAxes = [path('part-frame', {fill: 'none', stroke: '#d62728', 'stroke-width': 1.5}),
                     path('part-frame', {fill: 'none', stroke: '#2ca02c', 'stroke-width': 1.5})];
   const sx = (x) => b.x0 + (x - b.xmin) * kx, sy = (y) => b.y0 + b.h - (y - b.ymin) * ky;
+  // Level of detail, as for the lines below: a shape whose outline spans under a pixel is not drawn (a 10^4-loop
+  // chain's links are a tenth of a pixel: 3·10^4 outlines a frame cost 200 ms and showed nothing the lines do not)
+  const reach = parts.geometries.map((shapes) => shapes.map((sh) => {
+    let r = sh.width ? sh.width : 0;
+    for (let v = 0; v < sh.outline.length; v += 2) r = Math.max(r, Math.hypot(sh.outline[v], sh.outline[v + 1]));
+    return r;
+  }));
   function drawParts(place, frames) {
     const axes = [[], []];
     partPaths.forEach((shapes, g) => shapes.forEach((el, i) => {
       const sh = parts.geometries[g][i], o = sh.outline, d = [];
+      if (2 * reach[g][i] * Math.max(kx, ky) < 1) return el.setAttribute('d', '');
       for (const k of members[g]) {
         const x0 = place[7 * k], y0 = place[7 * k + 1], a = 2 * Math.atan2(place[7 * k + 5], place[7 * k + 6]);
         const c = Math.cos(a), s = Math.sin(a);
