@@ -28,24 +28,6 @@ std::string file_text(const std::string& path) {
   return s.str();
 }
 bool starts_with(const std::string& s, const std::string& p) { return s.rfind(p, 0) == 0; }
-std::set<Index> frame_coordinates(const PartFrame& f) {
-  std::set<Index> out;
-  auto slot = [&](const Slot& s) {
-    if (s.is_coordinate()) out.insert(s.coord());
-  };
-  auto att = [&](const Attachment3& a) {
-    for (const Slot& s : a.r) slot(s);
-    for (const Slot& s : a.p) slot(s);
-  };
-  slot(f.planar.x), slot(f.planar.y), slot(f.planar.psi);
-  for (const Slot* s :
-       {&f.spatial.x, &f.spatial.y, &f.spatial.z, &f.spatial.e0, &f.spatial.e1, &f.spatial.e2, &f.spatial.e3})
-    slot(*s);
-  att(f.origin), att(f.x_toward), att(f.y_toward);
-  for (const auto& e : f.at)
-    for (Index i : e->coordinates()) out.insert(i);
-  return out;
-}
 const Shape* shape_named(const std::vector<Part>& parts, const std::string& part, const std::string& shape) {
   for (const Part& p : parts)
     if (p.name == part)

@@ -91,6 +91,9 @@ struct Loads {
   kin3::V3 gravity;  ///< m/s², world axes, e.g. (0, −9.81, 0) in the plane
 };
 
+/// The coordinates `frame` reads (its slots', its expressions'), increasing, each once.
+std::vector<Index> frame_coordinates(const PartFrame& frame);
+
 /// The largest coordinate index `frame` reads, −1 if none.
 Index max_coordinate(const PartFrame& frame);
 

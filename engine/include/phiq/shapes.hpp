@@ -42,6 +42,9 @@ enum class ShapeKind {
            ///< threads
 };
 
+/// "box", "cylinder", …: the kind's name in scenes and messages.
+const char* to_string(ShapeKind kind);
+
 /// A shape in a body's frame. Sizes are in metres and positive; see the file comment for each kind's own frame.
 struct Shape {
   ShapeKind kind = ShapeKind::kBox;                    ///< what the shape is, and so which of the fields below it reads

@@ -12,30 +12,6 @@ namespace phiq::python {
 
 namespace {
 
-const char* kind_name(ShapeKind k) {
-  switch (k) {
-    case ShapeKind::kBox:
-      return "box";
-    case ShapeKind::kCylinder:
-      return "cylinder";
-    case ShapeKind::kSphere:
-      return "sphere";
-    case ShapeKind::kCapsule:
-      return "capsule";
-    case ShapeKind::kCone:
-      return "cone";
-    case ShapeKind::kPlane:
-      return "plane";
-    case ShapeKind::kPolygon:
-      return "polygon";
-    case ShapeKind::kMesh:
-      return "mesh";
-    case ShapeKind::kCurve:
-      return "curve";
-  }
-  return "shape";
-}
-
 py::array_t<double> vector3(const kin3::V3& v) {
   py::array_t<double> a(3);
   auto w = a.mutable_unchecked<1>();
@@ -77,7 +53,7 @@ void bind_parts(py::module_& m) {
             py::list out;
             for (const Shape& s : p.shapes) {
               py::dict d;
-              d["type"] = kind_name(s.kind);
+              d["type"] = to_string(s.kind);
               d["name"] = s.name;
               d["at"] = vector3(s.at);
               d["rotation"] = matrix3(s.rotation);

@@ -158,32 +158,6 @@ void product_transposed(const JR& a, double Jet::*pa, const JR& b, double Jet::*
     }
 }
 
-void frame_coordinates(const PartFrame& f, std::vector<Index>& out) {
-  auto slot = [&](const Slot& s) {
-    if (s.is_coordinate()) out.push_back(s.coord());
-  };
-  switch (f.kind) {
-    case PartFrameKind::kPlanarBody:
-      slot(f.planar.x), slot(f.planar.y), slot(f.planar.psi);
-      break;
-    case PartFrameKind::kSpatialBody:
-      for (const Slot* s :
-           {&f.spatial.x, &f.spatial.y, &f.spatial.z, &f.spatial.e0, &f.spatial.e1, &f.spatial.e2, &f.spatial.e3})
-        slot(*s);
-      break;
-    case PartFrameKind::kPoints:
-      for (const Attachment3* a : {&f.origin, &f.x_toward, &f.y_toward})
-        for (const Slot& s : a->r) slot(s);
-      break;
-    case PartFrameKind::kExpressions:
-      for (const auto& e : f.at) out.insert(out.end(), e->coordinates().begin(), e->coordinates().end());
-      if (f.angle) out.insert(out.end(), f.angle->coordinates().begin(), f.angle->coordinates().end());
-      break;
-  }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-}
-
 }  // namespace
 
 std::pair<kin3::V3, kin3::V3> PartMotion::point(kin3::V3 s) const {
@@ -208,7 +182,7 @@ PartMotion part_motion(const PartFrame& frame, const double* q, const double* qd
 
 PartJacobian part_jacobian(const PartFrame& frame, const double* q, double t) {
   PartJacobian jac;
-  frame_coordinates(frame, jac.coordinates);
+  jac.coordinates = frame_coordinates(frame);
   for (Index k : jac.coordinates) {
     const auto [o, r] = frame_jets(frame, Path{q, nullptr, nullptr, t, k});
     double w[9];

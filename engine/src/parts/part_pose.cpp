@@ -88,12 +88,10 @@ Pose part_pose(const PartFrame& f, const double* q, double t) {
   return p;
 }
 
-Index max_coordinate(const PartFrame& f) {
-  Index m = -1;
-  auto slot = [&](const Slot& s) { m = std::max(m, s.coord()); };
-  auto attachment = [&](const Attachment3& a) {
-    for (const Slot& s : a.r) slot(s);
-    for (const Slot& s : a.p) slot(s);
+std::vector<Index> frame_coordinates(const PartFrame& f) {
+  std::vector<Index> out;
+  auto slot = [&](const Slot& s) {
+    if (s.is_coordinate()) out.push_back(s.coord());
   };
   switch (f.kind) {
     case PartFrameKind::kPlanarBody:
@@ -105,16 +103,24 @@ Index max_coordinate(const PartFrame& f) {
         slot(*s);
       break;
     case PartFrameKind::kPoints:
-      attachment(f.origin), attachment(f.x_toward), attachment(f.y_toward);
+      for (const Attachment3* a : {&f.origin, &f.x_toward, &f.y_toward}) {
+        for (const Slot& s : a->r) slot(s);
+        for (const Slot& s : a->p) slot(s);
+      }
       break;
     case PartFrameKind::kExpressions:
-      for (const auto& e : f.at)
-        for (Index i : e->coordinates()) m = std::max(m, i);
-      if (f.angle)
-        for (Index i : f.angle->coordinates()) m = std::max(m, i);
+      for (const auto& e : f.at) out.insert(out.end(), e->coordinates().begin(), e->coordinates().end());
+      if (f.angle) out.insert(out.end(), f.angle->coordinates().begin(), f.angle->coordinates().end());
       break;
   }
-  return m;
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+Index max_coordinate(const PartFrame& f) {
+  const std::vector<Index> c = frame_coordinates(f);
+  return c.empty() ? -1 : c.back();
 }
 
 }  // namespace phiq

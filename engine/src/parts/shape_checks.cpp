@@ -7,9 +7,9 @@
 #include "phiq/text.hpp"
 #include "phiq/types.hpp"
 
-namespace phiq::detail::parts {
+namespace phiq {
 
-const char* kind_name(ShapeKind kind) {
+const char* to_string(ShapeKind kind) {
   switch (kind) {
     case ShapeKind::kBox:
       return "box";
@@ -33,8 +33,12 @@ const char* kind_name(ShapeKind kind) {
   return "shape";
 }
 
+}  // namespace phiq
+
+namespace phiq::detail::parts {
+
 std::string shape_label(const Shape& shape) {
-  std::string label = kind_name(shape.kind);
+  std::string label = to_string(shape.kind);
   if (!shape.name.empty()) label += " '" + single_line(shape.name) + "'";
   if (shape.kind == ShapeKind::kMesh && !shape.file.empty()) label += " (" + single_line(shape.file) + ")";
   return label;

@@ -8,9 +8,6 @@
 
 namespace phiq::detail::parts {
 
-/// The kind's word as messages write it ("box", "cylinder", …).
-const char* kind_name(ShapeKind kind);
-
 /// The shape as a message names it: "box 'lid'", "mesh 'hull' (hull.stl)", or the kind alone when it has no name.
 std::string shape_label(const Shape& shape);
 
