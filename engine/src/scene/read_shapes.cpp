@@ -2,6 +2,7 @@
 // (models/README.md, Parts). Sizes are positive numbers or constant expressions; a mesh file is read relative to the
 // scene's folder.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "phiq/text.hpp"
