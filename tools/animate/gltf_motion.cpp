@@ -261,7 +261,7 @@ class SketchTracks {
 
 }  // namespace
 
-std::vector<Slot> glb_reads(const Scene& scene, const MechanismSketch& sketch) {
+std::vector<Slot> glb_reads(const Scene& scene, const MechanismSketch& sketch, const std::vector<Part>& parts) {
   std::vector<Slot> read;
   for (const Frame2& f : scene.planar_bodies) read.insert(read.end(), {f.x, f.y, f.psi});
   for (const Frame3& f : scene.spatial_bodies) read.insert(read.end(), {f.x, f.y, f.z, f.e0, f.e1, f.e2, f.e3});
@@ -271,7 +271,7 @@ std::vector<Slot> glb_reads(const Scene& scene, const MechanismSketch& sketch) {
         for (const Slot& x : slots_of(*p)) read.push_back(x);
   for (const SketchJoint& j : sketch.joints)
     for (const Slot& x : slots_of(j.at)) read.push_back(x);
-  for (const Slot& x : part_reads(drawn_parts(scene))) read.push_back(x);
+  for (const Slot& x : part_reads(parts)) read.push_back(x);
   return read;
 }
 
@@ -280,7 +280,7 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
   const MechanismSketch sketch = sketch_mechanism(model);
   const std::vector<Part> parts = drawn_parts(scene);
   const std::string title = scene.name.empty() ? std::filesystem::path(scene.path).stem().string() : scene.name;
-  const MotionColumns columns(scene, glb_reads(scene, sketch), table, result);
+  const MotionColumns columns(scene, glb_reads(scene, sketch, parts), table, result);
   gltf::Nodes nodes;
   SketchTracks drawn(scene, sketch, parts, nodes);
   gltf::PartTracks part_tracks(parts, nodes);

@@ -15,7 +15,7 @@
 namespace phiq::tools {
 
 // The slots the .glb reads: the moving bodies' frames, the ends of the sketch's links, its joints.
-std::vector<Slot> glb_reads(const Scene& scene, const MechanismSketch& sketch);
+std::vector<Slot> glb_reads(const Scene& scene, const MechanismSketch& sketch, const std::vector<Part>& parts);
 
 // The .glb of `table`, the result of `scene` read from `result` (named in messages). Throws MissingCoordinate
 // (motion_columns.hpp) for a coordinate the drawing reads without a column, phiq::Error with one line for a result

@@ -216,7 +216,8 @@ ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, co
   // a joint away from every line (a pivot on ground, a cam's roller, a slider's block) is a point of its own, moved
   // with the others: without it a mechanism drawn by its joints alone would have nothing to animate
   for (const SketchJoint& j : sketch.joints) point(j.at);
-  const MotionColumns columns(scene, drawing_reads(scene, sketch), table, result);
+  const std::vector<Part> parts = drawn_parts(scene);  // (once: a 10⁴-loop chain has 3·10⁴)
+  const MotionColumns columns(scene, drawing_reads(sketch, parts), table, result);
 
   // ---- every row checked (a value that is not a number, t going back); the rows kept within the budget
   Eigen::VectorXd q = model.initial_positions(), qd = Eigen::VectorXd::Zero(model.num_coordinates());
@@ -229,7 +230,6 @@ ViewerMotion viewer_motion(const Scene& scene, const MechanismSketch& sketch, co
                   svg::label(table.rows[r - 1][t_col]) + ")");
   }
   const bool velocities = columns.has_velocities() && !points.empty();
-  const std::vector<Part> parts = drawn_parts(scene);
   const std::size_t per_frame = frame_bytes(points.size(), dim, velocities, parts.size());
   const std::size_t most = std::clamp<std::size_t>(per_frame ? budget / per_frame : kMostFrames, 2, kMostFrames);
   out.rows = spread(n_rows, most);

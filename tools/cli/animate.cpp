@@ -13,6 +13,7 @@
 #include "gltf_motion.hpp"
 #include "html_page.hpp"
 #include "motion_columns.hpp"
+#include "phiq/drawn_parts.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -46,7 +47,9 @@ int cmd_animate(const AnimateOptions& o) {
     if (o.result.empty()) {  // the scene swept here, with the coordinates the drawing reads (and joints to plot)
       set_interrupt_subject("animate: " + o.out, "; no output written");
       const MechanismSketch sketch = sketch_mechanism(*scene.model);
-      const DrawnOutputs add{coordinates_of(html ? drawing_reads(scene, sketch) : glb_reads(scene, sketch)), html};
+      const std::vector<Part> parts = drawn_parts(scene);
+      const DrawnOutputs add{coordinates_of(html ? drawing_reads(sketch, parts) : glb_reads(scene, sketch, parts)),
+                             html};
       const CsvTable table = sweep_scene(scene, add);
       text = html ? motion_html(scene, table, kSwept, o.columns) : motion_glb(scene, table, kSwept);
     } else {

@@ -73,9 +73,9 @@ std::vector<Slot> sketch_reads(const MechanismSketch& sketch) {
   return read;
 }
 
-std::vector<Slot> drawing_reads(const Scene& scene, const MechanismSketch& sketch) {
+std::vector<Slot> drawing_reads(const MechanismSketch& sketch, const std::vector<Part>& parts) {
   std::vector<Slot> read = sketch_reads(sketch);
-  for (const Slot& x : part_reads(drawn_parts(scene))) read.push_back(x);
+  for (const Slot& x : part_reads(parts)) read.push_back(x);
   return read;
 }
 

@@ -25,7 +25,7 @@ std::vector<Slot> slots_of(const OutputPoint& p);
 std::vector<Slot> sketch_reads(const MechanismSketch& sketch);
 
 // sketch_reads() and the slots the frames of the scene's drawn parts read (part_reads()).
-std::vector<Slot> drawing_reads(const Scene& scene, const MechanismSketch& sketch);
+std::vector<Slot> drawing_reads(const MechanismSketch& sketch, const std::vector<Part>& parts);
 
 struct MechanismFrames {
   const Model* model = nullptr;

@@ -150,7 +150,8 @@ std::string plot_text(const Scene& scene, const PlotOptions& o, const MechanismS
   // Columns against time: as asked, else the driven and the moving coordinates (at most 6), never a constant.
   const std::vector<std::string> series = plotted_columns(scene, table, o.columns, result);
   // The mechanism: every coordinate its lines read must be in the result, else it is swept again.
-  const std::vector<Index> needed = coordinates_of(drawing_reads(scene, sketch));
+  std::vector<Part> parts = drawn_parts(scene);  // (once: a 10⁴-loop chain has 3·10⁴)
+  const std::vector<Index> needed = coordinates_of(drawing_reads(sketch, parts));
   bool all_in_csv = true;
   for (Index j : needed) all_in_csv = all_in_csv && col.count(model.coordinate_names()[j]);
   for (Index j : needed)  // a coordinate of the drawing that is not a number: as for a plotted column
@@ -172,7 +173,7 @@ std::string plot_text(const Scene& scene, const PlotOptions& o, const MechanismS
     frames.q.push_back(all_in_csv ? q : solved.at(r));
     frames.t.push_back(table.rows[r][0]);
   }
-  frames.parts = drawn_parts(scene);
+  frames.parts = std::move(parts);
   std::vector<PartBox> boxes;
   for (const Part& part : frames.parts) boxes.push_back(part_box(part));
   for (std::size_t f = 0; f < frames.q.size(); ++f)
@@ -223,7 +224,7 @@ int plot_svg(const PlotOptions& o) {
   try {
     // without a result: the scene swept here with every coordinate the drawing reads and the measures of its
     // spatial joints (which the default columns prefer)
-    if (o.csv.empty()) table = sweep_scene(scene, {coordinates_of(drawing_reads(scene, sketch)), true});
+    if (o.csv.empty()) table = sweep_scene(scene, {coordinates_of(drawing_reads(sketch, drawn_parts(scene))), true});
     text = plot_text(scene, o, sketch, table);
   } catch (const DrawError& e) {
     return plot_fail(e.what(), e.status());
