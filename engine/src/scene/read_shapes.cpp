@@ -12,20 +12,14 @@ namespace phiq::detail::scene {
 
 namespace {
 
-// The shape types and the fields each takes beside the common ones (type, name, colour, at, orientation/angle).
-struct ShapeType {
-  const char* name;
-  ShapeKind kind;
-};
-constexpr ShapeType kShapeTypes[] = {
-    {"box", ShapeKind::kBox},         {"cylinder", ShapeKind::kCylinder}, {"sphere", ShapeKind::kSphere},
-    {"capsule", ShapeKind::kCapsule}, {"cone", ShapeKind::kCone},         {"plane", ShapeKind::kPlane},
-    {"polygon", ShapeKind::kPolygon}, {"mesh", ShapeKind::kMesh},         {"curve", ShapeKind::kCurve},
-};
+// The shape types, by the names to_string(ShapeKind) gives them.
+constexpr ShapeKind kShapeKinds[] = {ShapeKind::kBox,     ShapeKind::kCylinder, ShapeKind::kSphere,
+                                     ShapeKind::kCapsule, ShapeKind::kCone,     ShapeKind::kPlane,
+                                     ShapeKind::kPolygon, ShapeKind::kMesh,     ShapeKind::kCurve};
 
 std::string shape_type_list() {
   std::string s;
-  for (const ShapeType& t : kShapeTypes) s += (s.empty() ? "" : ", ") + std::string(t.name);
+  for (ShapeKind k : kShapeKinds) s += (s.empty() ? "" : ", ") + std::string(to_string(k));
   return s;
 }
 
@@ -71,12 +65,12 @@ std::vector<kin3::V3> SceneReader::shape_points(const Cursor& c, std::size_t n, 
 Shape SceneReader::read_shape(const Cursor& c) const {
   if (!c.is_map()) c.fail("a shape is a map {type: box|cylinder|..., ...}");
   const std::string type = c.require("type").text();
-  const ShapeType* t = nullptr;
-  for (const ShapeType& k : kShapeTypes)
-    if (type == k.name) t = &k;
-  if (!t) c.field("type").fail("unknown shape type '" + type + "' (the types: " + shape_type_list() + ")");
+  const ShapeKind* kind = nullptr;
+  for (const ShapeKind& k : kShapeKinds)
+    if (type == to_string(k)) kind = &k;
+  if (!kind) c.field("type").fail("unknown shape type '" + type + "' (the types: " + shape_type_list() + ")");
   Shape s;
-  s.kind = t->kind;
+  s.kind = *kind;
   const char* placement = spatial_ ? "orientation" : "angle";
   switch (s.kind) {
     case ShapeKind::kBox:
