@@ -228,6 +228,7 @@ class PartSketcher {
     return &scene_.planar_bodies[i->second];
   }
   void link(const Attachment3& a, const Attachment3& b, double length, bool spatial);
+  void add_link(Part p, bool measured);
 
   const Scene& scene_;
   const Model& model_;
@@ -235,9 +236,29 @@ class PartSketcher {
   double w_;          // a link's radius: length_scale() / 50
   std::vector<Part> planar_, spatial_, links_;
   std::vector<bool> link_measured_;  // links_[k] took its length from the placement (a later stated one replaces it)
+  // the first of links_ from each origin toward each point (attachment_key of both): a bar named again is found
+  // in one look-up, not a scan of every link (a 10⁵-loop chain has 2·10⁵)
+  std::unordered_map<std::string, std::size_t> link_at_;
   Part ground_;
   std::unordered_map<Index, std::size_t> planar_of_, spatial_of_;  // a body's coordinate → the body
 };
+
+// The bytes of a link's two ends, origin first (a signed zero of a local vector counted as +0, as == counts it).
+std::string attachment_key(const Attachment3& origin, const Attachment3& toward) {
+  static_assert(sizeof(Attachment3) == 7 * sizeof(Slot) + sizeof(kin3::V3), "no padding in a key's bytes");
+  std::string key;
+  for (Attachment3 a : {origin, toward}) {
+    a.s = {a.s.x + 0.0, a.s.y + 0.0, a.s.z + 0.0};
+    key.append(reinterpret_cast<const char*>(&a), sizeof a);
+  }
+  return key;
+}
+
+void PartSketcher::add_link(Part p, bool measured) {
+  link_at_.emplace(attachment_key(p.frame.origin, p.frame.x_toward), links_.size());
+  links_.push_back(std::move(p));
+  link_measured_.push_back(measured);
+}
 
 // A link between two points (natural, or attached to bodies): a part whose frame has its origin at a and x toward b,
 // and a capsule along x of the link's length (else their distance at the placement); between fixed points, on
@@ -249,9 +270,10 @@ void PartSketcher::link(const Attachment3& a, const Attachment3& b, double lengt
     return;
   }
   const double measured = kin3::norm(pb - pa), l = length > 0.0 ? length : measured;
-  for (std::size_t k = 0; k < links_.size(); ++k) {
-    const PartFrame& f = links_[k].frame;
-    if (!((f.origin == a && f.x_toward == b) || (f.origin == b && f.x_toward == a))) continue;
+  const auto ab = link_at_.find(attachment_key(a, b)), ba = link_at_.find(attachment_key(b, a));
+  if (ab != link_at_.end() || ba != link_at_.end()) {
+    const std::size_t k =
+        std::min(ab != link_at_.end() ? ab->second : links_.size(), ba != link_at_.end() ? ba->second : links_.size());
     if (link_measured_[k] && length > 0.0) links_[k].shapes[0].length = l, link_measured_[k] = false;
     return;
   }
@@ -268,8 +290,7 @@ void PartSketcher::link(const Attachment3& a, const Attachment3& b, double lengt
     p.frame.y_toward.r[0] = Slot::constant(y.x), p.frame.y_toward.r[1] = Slot::constant(y.y);
     p.frame.y_toward.r[2] = Slot::constant(y.z), p.frame.y_is_point = false;
   }
-  links_.push_back(std::move(p));
-  link_measured_.push_back(!(length > 0.0));
+  add_link(std::move(p), !(length > 0.0));
   put({&links_.back(), Pose{}}, *derived::capsule({}, {l, 0, 0}, w_), "link");
 }
 
@@ -299,8 +320,7 @@ void PartSketcher::open_chain(const std::vector<LoopSpec::Link>& links) {
     p.frame.at = {CompiledExpression::compile(slides ? end_x : x, coordinates, false),
                   CompiledExpression::compile(slides ? end_y : y, coordinates, false)};
     p.frame.angle = CompiledExpression::compile(angle, coordinates, false);
-    links_.push_back(std::move(p));
-    link_measured_.push_back(false);
+    add_link(std::move(p), false);
     if (slides)
       put({&links_.back(), Pose{}}, derived::box({}, about_z(0), {4 * w_, 3 * w_, 3 * w_}), "block");
     else if (auto c = derived::capsule({}, {links[k].length.value(), 0, 0}, w_))
@@ -374,8 +394,7 @@ void PartSketcher::belt(const Slot& first, const Slot& second, double r1, double
   p.frame.kind = PartFrameKind::kPoints;
   p.frame.origin = planar_attachment(g1->x, g1->y), p.frame.x_toward = planar_attachment(g2->x, g2->y);
   p.fixed = max_coordinate(p.frame) < 0;
-  links_.push_back(std::move(p));
-  link_measured_.push_back(false);
+  add_link(std::move(p), false);
   put({&links_.back(), Pose{}},
       derived::polyline(derived::belt_path(d, r1, r2, crossed, std::numbers::pi / 180), true, w_ / 2), "path");
 }
