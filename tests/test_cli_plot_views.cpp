@@ -224,4 +224,13 @@ TEST_F(Cli, PlotRefusesAColumnWithNaNInOneLine) {
   EXPECT_FALSE(fs::exists(svg));
 }
 
+TEST_F(Plot, DriverEffortsGetAPanelPerUnitByDefault) {
+  // the motor's torque and power after the angle it drives: one panel each, in N·m and W
+  const std::string s = plot("dynamics/fourbar_motor_torque.yaml");
+  EXPECT_EQ(captures(s, "data-quantity=\"([^\"]+)\""), (std::vector<std::string>{"angle", "torque", "power"}));
+  EXPECT_EQ(captures(s, "data-unit=\"([^\"]+)\""), (std::vector<std::string>{"rad", "N·m", "W"}));
+  const auto [lo, hi] = range("motor.effort");
+  EXPECT_GT(hi - lo, 1.0);  // newton-metres that change over the turn
+}
+
 }  // namespace

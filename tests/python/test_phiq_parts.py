@@ -88,6 +88,37 @@ def test_driver_efforts_of_the_crank_slider_are_the_closed_form():
     assert np.max(np.abs(efforts)) > 1.0  # a torque of newton-metres: the check is not of zeros
 
 
+def test_effort_and_power_columns_of_the_crank_slider_are_the_closed_form():
+    """The scene's output.efforts: the `motor.effort` column is the torque of the test above, `motor.power` that
+    torque times θ̇, and a Stepper delivers the same at a time it steps to."""
+    with open(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"), encoding="utf-8") as f:
+        text = f.read().replace("output: {velocities: true, accelerations: true}", "output: {efforts: all, power: true}")
+    scene = phiq.parse_scene(text + "\nloads: {gravity: [0, -9.81]}\nparts:\n"
+                             "  slider: {frame: {at: B}, mass: 2.0, center_of_mass: [0, 0], inertia: 0.01}\n"
+                             "  crank: {frame: {origin: O, x: A}, mass: 1.0, center_of_mass: [L2/2, 0], "
+                             "inertia: 0.0075}\n", "crank_slider.yaml")
+    result = phiq.run_sweep(scene).raise_for_status()
+    assert result.qd is None and result.qdd is None  # solved for the efforts, not written
+    assert result.summary["counters"]["effort_solves"] == len(result)
+    r, L, w = 0.3, 1.0, 2.0
+
+    def exact(t):
+        th = w * t
+        s, c = math.sin(th), math.cos(th)
+        root = math.sqrt(L * L - r * r * s * s)
+        dx = -r * s - r * r * s * c / root
+        d2x = -r * c - r * r * (c * c - s * s) / root - r ** 4 * s * s * c * c / root ** 3
+        return 2.0 * (w * dx) * (w * w * d2x) / w + 1.0 * 9.81 * (r / 2) * c
+
+    tau = result["motor.effort"]
+    assert max(abs(v - exact(t)) for t, v in zip(result.t, tau)) < 1e-9
+    assert np.max(np.abs(result["motor.power"] - w * tau)) < 1e-9
+    stepper = phiq.Stepper(scene)
+    stepper.step(result.t[7])
+    effort, power = stepper.efforts["motor"]
+    assert abs(effort - exact(result.t[7])) < 1e-9 and abs(power - w * effort) < 1e-9
+
+
 def test_driver_efforts_need_velocities_and_accelerations():
     scene = fourbar_with_parts()
     options = scene.options

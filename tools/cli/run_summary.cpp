@@ -63,6 +63,7 @@ std::string run_summary_json(const Scene& scene, const Model& swept, const Sweep
   j["point_evaluations"] = s.counters.point_evaluations;
   j["sensitivity_solves"] = s.counters.sensitivity_solves;
   j["sensitivity_direct_rows"] = s.counters.sensitivity_direct_rows;
+  j["effort_solves"] = s.counters.effort_solves;
   // direct or adjoint (OutputPlan::sensitivity_form resolved); absent without sensitivities
   if (s.sensitivity_form != phiq::SensitivityForm::kAuto) j["sensitivity_form"] = to_string(s.sensitivity_form);
   j["subdivisions"] = s.subdivisions;

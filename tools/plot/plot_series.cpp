@@ -74,6 +74,20 @@ Quantity column_quantity(const Scene& scene, const std::string& column) {
     if (!joint_of_column(scene, order == 0 ? column : column.substr(0, column.size() - 2), &u).empty())
       return of_unit(u, order);
   }
+  // a driver's effort: a torque where its first row is an angle, a force where a length (a panel per unit)
+  for (const char* tail : {".effort", ".power"})
+    if (ends_with(column, tail)) {
+      const std::string name = column.substr(0, column.size() - std::string(tail).size());
+      for (Index c : scene.sweep.efforts.constraints) {
+        const ConstraintInfo& ci = model.constraints()[static_cast<std::size_t>(c)];
+        if (ci.name != name) continue;
+        if (std::string(tail) == ".power") return {"power", "W"};
+        const Unit u = model.row_unit(ci.first_row);
+        return u == Unit::kAngle    ? Quantity{"torque", "N·m"}
+               : u == Unit::kLength ? Quantity{"force", "N"}
+                                    : Quantity{"effort", ""};
+      }
+    }
   if (ends_with(column, ".residual")) return {"residual", ""};
   if (ends_with(column, ".ddf")) return {"driver law, second rate", ""};
   if (ends_with(column, ".df")) return {"driver law, rate", ""};
@@ -100,12 +114,20 @@ std::vector<std::string> default_columns(const Scene& scene, const CsvTable& tab
   for (const JointAngleReference& j : scene.joint_angles) driven_joints.insert(j.joint);
   std::set<std::string> written;  // the coordinate columns
   for (Index k : scene.sweep.coordinate_columns) written.insert(model.coordinate_names()[static_cast<std::size_t>(k)]);
-  // in order of preference: driven coordinates and joints, the joints' measures, the other coordinates that move,
+  // in order of preference: driven coordinates and joints, the joints' measures and the drivers' efforts, the other
+  // coordinates that move,
   // their Euler parameters last (four numbers of one turn, which say less than any of the others)
   std::vector<std::size_t> ranked[4];
   for (std::size_t c = 1; c < table.columns.size(); ++c) {
     const std::string& name = table.columns[c];
     if (!changes(c)) continue;
+    if (ends_with(name, ".effort") || ends_with(name, ".power")) {
+      // the drivers' efforts after what they drive; not one with a singular row's NaN, which --columns may ask for
+      const bool finite = std::all_of(table.rows.begin(), table.rows.end(),
+                                      [&](const std::vector<double>& row) { return std::isfinite(row[c]); });
+      if (finite && column_quantity(scene, name).unit != "") ranked[1].push_back(c);
+      continue;
+    }
     if (const std::string joint = joint_of_column(scene, name); !joint.empty()) {
       ranked[driven_joints.count(joint) ? 0 : 1].push_back(c);
     } else if (written.count(name)) {

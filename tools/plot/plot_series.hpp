@@ -30,7 +30,8 @@ std::string joint_of_column(const Scene& scene, const std::string& column, Unit*
 
 // The columns drawn when none is asked for, those whose value changes over the rows, in this order: the
 // coordinates a coordinate driver drives and the measures of joints a joint driver drives; the other joints'
-// measures (output.joints); the other coordinates; Euler parameters last; each group in column order, at most
+// measures (output.joints) and the drivers' efforts and powers (output.efforts; not one with a NaN: a singular
+// row); the other coordinates; Euler parameters last; each group in column order, at most
 // `most`, never a constant. Without any: the first columns after t that change, else the first columns after t.
 std::vector<std::string> default_columns(const Scene& scene, const CsvTable& table, std::size_t most);
 

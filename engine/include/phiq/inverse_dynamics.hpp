@@ -33,6 +33,12 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
 SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, const Eigen::VectorXd& Q,
                                    Eigen::VectorXd& lambda, std::string* message = nullptr);
 
+/// λ with Φqᵀ λ = Q by a transposed solve with `lu`, factors of Φq's kept rows (Model::solve_rows(); all rows when
+/// none are dropped) at the motion's q: λ on the kept rows, 0 on the dropped ones; `kept` is scratch. What
+/// constraint_multipliers() and a sweep's efforts (OutputPlan::efforts) solve with. False when the solve fails.
+bool multipliers_with_factors(const Model& model, SparseLuNumeric& lu, const Eigen::VectorXd& Q, Eigen::VectorXd& kept,
+                              Eigen::VectorXd& lambda);
+
 /// The constraints that depend on time (the drivers, and equations in t), in model order: whose efforts
 /// driver_efforts() gives.
 std::vector<Index> rheonomic_constraints(const Model& model);

@@ -24,6 +24,8 @@
 namespace phiq {
 
 class Model;                // model.hpp
+struct Loads;               // parts.hpp
+struct Part;                // parts.hpp
 struct ParameterReach;      // sensitivity.hpp
 struct ReachedConstraints;  // sensitivity.hpp
 
@@ -74,6 +76,19 @@ struct OutputDriver {
   MotionLaw law;     ///< its law (shared, cheap to copy)
 };
 
+/// Driver efforts (inverse dynamics, phiq/inverse_dynamics.hpp) at every written row: for each listed constraint
+/// that depends on time, the torque or force its motor applies (−λ of its first row, conjugate to what it drives)
+/// and its power (Σ λ_i Φt_i over its rows). Solved with the row's own factorisation of Φq (one transposed solve),
+/// from q̇ and q̈ (solved for them, written or not); NaN at a singular position, where they are unbounded.
+struct OutputEfforts {
+  std::shared_ptr<const std::vector<Part>> parts;  ///< the parts whose mass and weight act
+  std::shared_ptr<const Loads> loads;              ///< gravity and the applied loads
+  std::vector<Index> constraints;                  ///< drivers (Model::constraints() indices), written in this order
+  bool power = false;                              ///< write each one's power too (`NAME.power`)
+  /// Values a row holds: the efforts, then the powers (always computed: one product each).
+  Index size() const { return 2 * static_cast<Index>(constraints.size()); }
+};
+
 /// The outputs of a sweep beyond q (models/README.md, `output`). The sweep computes only what the plan lists; the
 /// writers lay out their columns from the same plan, so that what is computed and what is written cannot disagree.
 struct OutputPlan {
@@ -99,6 +114,14 @@ struct OutputPlan {
   /// the coordinates whose columns are written (effective_sensitivity_form()), and the direct form, every
   /// coordinate's, when no column is written (a caller reading StepView::sensitivities); SweepSummary says which.
   SensitivityForm sensitivity_form = SensitivityForm::kAuto;
+  /// Driver efforts and powers at every written row (StepView::efforts), written as `NAME.effort`, `NAME.power`;
+  /// empty `constraints`: none computed.
+  OutputEfforts efforts;
+  /// Whether the sweep solves q̈: asked for, or needed by the efforts. Solved is not delivered: StepView::qdd is set
+  /// as `accelerations` says.
+  bool solves_accelerations() const { return accelerations || !efforts.constraints.empty(); }
+  /// Whether the sweep solves q̇: asked for, or needed by q̈ (see solves_accelerations()).
+  bool solves_velocities() const { return velocities || solves_accelerations(); }
   /// The coordinates the adjoint form solves for: those whose q, q̇ or q̈ columns are written, ascending.
   std::vector<Index> sensitivity_outputs() const;
   /// Deliver Φ(q, t) at every row (StepView::phi). Free: Newton's convergence test has just evaluated it.
@@ -168,6 +191,9 @@ struct StepView {
   /// Sensitivities to OutputPlan::sensitivities laid out as SensitivityLayout says (null when none are listed):
   /// ∂q/∂p always, ∂q̇/∂p and ∂q̈/∂p when velocities / accelerations are delivered; NaN at a singular position.
   const double* sensitivities = nullptr;
+  /// Efforts then powers of OutputPlan::efforts (OutputEfforts::size() values; null when none are listed); NaN at a
+  /// singular position.
+  const double* efforts = nullptr;
 };
 
 }  // namespace phiq

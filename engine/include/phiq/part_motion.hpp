@@ -39,5 +39,8 @@ struct PartJacobian {
 
 /// The Jacobian of `frame` at (q, t).
 PartJacobian part_jacobian(const PartFrame& frame, const double* q, double t);
+/// The same into `out`, its vectors' capacity reused (no allocation once they have held a frame's columns: what
+/// inverse dynamics calls at every row).
+void part_jacobian(const PartFrame& frame, const double* q, double t, PartJacobian& out);
 
 }  // namespace phiq

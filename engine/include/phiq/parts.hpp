@@ -93,6 +93,8 @@ struct Loads {
 
 /// The coordinates `frame` reads (its slots', its expressions'), increasing, each once.
 std::vector<Index> frame_coordinates(const PartFrame& frame);
+/// The same into `out` (its capacity reused: no allocation once it has held them).
+void frame_coordinates(const PartFrame& frame, std::vector<Index>& out);
 
 /// The largest coordinate index `frame` reads, −1 if none.
 Index max_coordinate(const PartFrame& frame);

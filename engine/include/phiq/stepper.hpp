@@ -35,6 +35,9 @@ struct StepperOptions : SolverSettings {
   /// How they are solved: kAuto is the direct form, every coordinate's (a stepper writes no columns); kAdjoint
   /// solves for no coordinate here, and is refused.
   SensitivityForm sensitivity_form = SensitivityForm::kAuto;
+  /// Driver efforts and powers every step delivers (Stepper::efforts()), as a sweep's rows (OutputPlan::efforts):
+  /// q̇ and q̈ are then solved whatever `velocities` and `accelerations` say.
+  OutputEfforts efforts;
 };
 
 /// What one Stepper::step did.
@@ -109,6 +112,9 @@ class Stepper {
   /// (parameter j's ∂q/∂p at offset(j, 0), ∂q̇/∂p at offset(j, 1), ∂q̈/∂p at offset(j, 2); NaN for the derivatives
   /// not solved, and all at a singular position); null when none are asked for or before started().
   const double* sensitivities() const;
+  /// Efforts then powers of StepperOptions::efforts at the current step (OutputEfforts::size() values; NaN at a
+  /// singular position), or null when none are asked for or before the first step.
+  const double* efforts() const;
 
   /// Everything the steps did since construction, as run_sweep's summary says it of a sweep: counters, subdivisions,
   /// singular positions, the smallest rcond, warnings (in the order raised; each slow_convergence stands alone,

@@ -32,6 +32,8 @@ struct WorkCounters {
   /// Rows of an adjoint-form sweep solved in the direct form instead, because Φq is not smooth along the motion
   /// within the adjoint's difference (a spline's knot: SensitivityForm)
   Index sensitivity_direct_rows = 0;
+  /// Transposed solves for driver efforts (OutputPlan::efforts): one per written row, with the row's factorisation
+  Index effort_solves = 0;
 };
 
 /// Per-thread data of the algorithms in kinematics.hpp and sweep.hpp. Not thread-safe: one thread at a time.

@@ -183,7 +183,9 @@ void bind_workspace(py::module_& m) {
       .def_readonly("sensitivity_solves", &WorkCounters::sensitivity_solves,
                     "solves for sensitivities to design parameters")
       .def_readonly("sensitivity_direct_rows", &WorkCounters::sensitivity_direct_rows,
-                    "rows of an adjoint-form sweep solved in the direct form (Φq not smooth along the motion)");
+                    "rows of an adjoint-form sweep solved in the direct form (Φq not smooth along the motion)")
+      .def_readonly("effort_solves", &WorkCounters::effort_solves,
+                    "transposed solves for driver efforts (output.efforts), one per written row");
 
   py::class_<Workspace> ws(m, "Workspace",
                            "One thread's state for the solves: q, qd, qdd (numpy views, writable in place), the "

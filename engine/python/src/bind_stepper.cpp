@@ -39,10 +39,24 @@ std::unique_ptr<PyStepper> stepper_for_scene(std::shared_ptr<const Scene> scene,
   } else {
     o.sensitivities = sc.sweep.sensitivities;
   }
+  o.efforts = sc.sweep.efforts;
   if (sc.sweep.steps > 0) o.expected_step = (sc.sweep.t_end - sc.sweep.t_begin) / static_cast<double>(sc.sweep.steps);
   s->stepper = std::make_unique<Stepper>(s->square.model(*sc.model), std::move(o));
   s->stepper->restart(s->square.start);
   return s;
+}
+
+// The driver efforts a stepper delivers (Stepper::efforts()) by driver name: (effort, power).
+py::dict efforts_of(const PyStepper& s) {
+  py::dict out;
+  const OutputEfforts& e = s.stepper->options().efforts;
+  const double* v = s.stepper->efforts();
+  if (!v) return out;
+  const std::size_t n = e.constraints.size();
+  for (std::size_t i = 0; i < n; ++i)
+    out[py::str(s.stepper->model().constraints()[static_cast<std::size_t>(e.constraints[i])].name)] =
+        py::make_tuple(v[i], v[n + i]);
+  return out;
 }
 
 }  // namespace
@@ -176,6 +190,9 @@ void bind_stepper(py::module_& m) {
           py::arg("parameter"), py::arg("order") = 0,
           "The current state's ∂q/∂p (order 0), ∂q̇/∂p (1) or ∂q̈/∂p (2) for a parameter of sensitivity_names, in the "
           "order of q (NaN where not solved, and at a singular position)")
+      .def_property_readonly("efforts", &efforts_of,
+                             "the scene's output.efforts at the current state: driver name → (effort, power) (NaN "
+                             "at a singular position); empty without them or before the first step")
       .def_property_readonly(
           "summary", [](const PyStepper& s) { return s.stepper->summary(); },
           "everything the steps did so far, as a sweep's SweepSummary (to_dict() for JSON)")

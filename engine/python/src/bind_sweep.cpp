@@ -15,7 +15,7 @@ py::dict counters_dict(const WorkCounters& c) {
       py::arg("acceleration_solves") = c.acceleration_solves, py::arg("phi_t_evaluations") = c.phi_t_evaluations,
       py::arg("gamma_evaluations") = c.gamma_evaluations, py::arg("point_evaluations") = c.point_evaluations,
       py::arg("sensitivity_solves") = c.sensitivity_solves,
-      py::arg("sensitivity_direct_rows") = c.sensitivity_direct_rows);
+      py::arg("sensitivity_direct_rows") = c.sensitivity_direct_rows, py::arg("effort_solves") = c.effort_solves);
 }
 
 py::dict accuracy_dict(const RowClassAccuracy& a) {

@@ -125,6 +125,9 @@ std::vector<std::string> CsvFormat::dotted_names() const {
     for (Index j : v_columns_) h.push_back(names[j] + ".v" + d);
     for (Index j : a_columns_) h.push_back(names[j] + ".a" + d);
   }
+  for (Index c : plan_->efforts.constraints) h.push_back(model_.constraints()[c].name + ".effort");
+  if (plan_->efforts.power)
+    for (Index c : plan_->efforts.constraints) h.push_back(model_.constraints()[c].name + ".power");
   return h;
 }
 
@@ -217,6 +220,10 @@ void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
       for (Index j : a_columns_) emit(base[layout.offset(i, 2) + j]);
     }
   }
+  if (const std::size_t n = plan_->efforts.constraints.size(); n > 0) {
+    if (!s.efforts) throw Error("CsvFormat: step has no efforts");
+    for (std::size_t i = 0; i < (plan_->efforts.power ? 2 * n : n); ++i) emit(s.efforts[i]);
+  }
 }
 
 void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
@@ -238,6 +245,7 @@ std::size_t CsvFormat::num_output_values() const {
   n += plan_->orientations.size() *
        (static_cast<std::size_t>(plan_->orientation_form.size()) + 3 * (velocities_ + accelerations_));
   n += plan_->sensitivities.size() * (columns_.size() + v_columns_.size() + a_columns_.size());
+  n += plan_->efforts.constraints.size() * (plan_->efforts.power ? 2 : 1);
   return n;
 }
 

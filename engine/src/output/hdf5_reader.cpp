@@ -135,7 +135,7 @@ CsvTable read_hdf5_table(const std::string& path) {
   std::vector<Block> blocks;
   // a batch's file (hdf5_writer.hpp, Hdf5Options::case_column) has /case first: the column `case` of its CSV
   for (const char* name : {"case", "t", "q", "qd", "qdd", "points", "joints", "orientations", "drivers", "residuals",
-                           "rcond", "sensitivities"}) {
+                           "rcond", "sensitivities", "efforts"}) {
     const htri_t exists = H5Lexists(file.get(), name, H5P_DEFAULT);
     if (exists < 0) throw Error(path + ": " + detail::h5::last_error());
     if (exists == 0) {

@@ -143,7 +143,7 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
     groups.push_back(std::move(g));
     return &groups.back();
   };
-  groups.reserve(12);   // pointers into it are kept
+  groups.reserve(16);   // pointers into it are kept
   if (o.case_column) {  // first, as the batch CSV's `case` column
     groups.push_back(Group{"case", {"case"}, {""}, true, {}, {}});
     batch_case = &groups.back();
@@ -203,7 +203,17 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   }
   if (Group* g = take("sensitivities", sensitivity_units.size(), [&](std::size_t k) { return sensitivity_units[k]; }))
     outputs.push_back(g);
-  if (at != names.size() || groups.size() > 12) throw Error(cannot("the columns do not match the CSV's (phiq bug)"));
+  // A driver's effort: a force where its first row is a length, a torque where it is an angle (J per the row's unit
+  // otherwise, which the scene does not state: ""); its power in watts.
+  std::vector<std::string> effort_units;
+  for (Index c : plan.efforts.constraints) {
+    const Unit u = model.row_unit(model.constraints()[static_cast<std::size_t>(c)].first_row);
+    effort_units.push_back(u == Unit::kLength ? "N" : u == Unit::kAngle ? "N m" : "");
+  }
+  if (plan.efforts.power) effort_units.insert(effort_units.end(), plan.efforts.constraints.size(), "W");
+  if (Group* g = take("efforts", effort_units.size(), [&](std::size_t k) { return effort_units[k]; }))
+    outputs.push_back(g);
+  if (at != names.size() || groups.size() > 16) throw Error(cannot("the columns do not match the CSV's (phiq bug)"));
   output_row.resize(format.num_output_values());
 
   block_rows = choose_block_rows((names.size() + o.case_column) * sizeof(double), o);

@@ -64,7 +64,8 @@ struct Path {
   // d/ds e = ∇e · q̇ + ∂e/∂t, d²/ds² e = ∇e · q̈ − γ (γ holds the Hessian's and the time terms).
   Jet expression(const CompiledExpression& e) const {
     const std::vector<Index>& c = e.coordinates();
-    std::vector<double> g(c.size());
+    thread_local std::vector<double> g;  // (capacity kept: part_motion runs at every row of a sweep's efforts)
+    g.resize(c.size());
     e.gradient(q, t, g.data());
     Jet j{e.value(q, t), 0.0, 0.0};
     if (k >= 0) {
@@ -182,7 +183,13 @@ PartMotion part_motion(const PartFrame& frame, const double* q, const double* qd
 
 PartJacobian part_jacobian(const PartFrame& frame, const double* q, double t) {
   PartJacobian jac;
-  jac.coordinates = frame_coordinates(frame);
+  part_jacobian(frame, q, t, jac);
+  return jac;
+}
+
+void part_jacobian(const PartFrame& frame, const double* q, double t, PartJacobian& jac) {
+  frame_coordinates(frame, jac.coordinates);
+  jac.d_origin.clear(), jac.d_angle.clear();
   for (Index k : jac.coordinates) {
     const auto [o, r] = frame_jets(frame, Path{q, nullptr, nullptr, t, k});
     double w[9];
@@ -190,7 +197,6 @@ PartJacobian part_jacobian(const PartFrame& frame, const double* q, double t) {
     jac.d_origin.push_back({o[0].d, o[1].d, o[2].d});
     jac.d_angle.push_back(vee(w));
   }
-  return jac;
 }
 
 }  // namespace phiq

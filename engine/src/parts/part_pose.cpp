@@ -90,6 +90,12 @@ Pose part_pose(const PartFrame& f, const double* q, double t) {
 
 std::vector<Index> frame_coordinates(const PartFrame& f) {
   std::vector<Index> out;
+  frame_coordinates(f, out);
+  return out;
+}
+
+void frame_coordinates(const PartFrame& f, std::vector<Index>& out) {
+  out.clear();
   auto slot = [&](const Slot& s) {
     if (s.is_coordinate()) out.push_back(s.coord());
   };
@@ -115,7 +121,6 @@ std::vector<Index> frame_coordinates(const PartFrame& f) {
   }
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
 }
 
 Index max_coordinate(const PartFrame& f) {

@@ -59,7 +59,8 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
   bool coordinates_listed = false;
   if (c.present()) {
     c.expect_map({"velocities", "accelerations", "coordinates", "points", "joints", "orientations", "drivers",
-                  "residuals", "max_residual", "rcond", "every", "window", "sensitivities", "sensitivity_form"});
+                  "residuals", "max_residual", "rcond", "every", "window", "sensitivities", "sensitivity_form",
+                  "efforts", "power"});
     // true / false, or the coordinates whose derivative is written (q̇ or q̈ is solved whole either way)
     auto derivative = [&](const char* key, bool& asked, std::optional<std::vector<Index>>& columns) {
       const Cursor d = c.field(key);
@@ -125,6 +126,7 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
       else
         f.fail("sensitivity_form is auto, direct or adjoint");
     }
+    read_output_efforts(c);
     if (auto v = c.field("max_residual"); v.present()) plan.max_residual_column = v.boolean();
     if (auto v = c.field("rcond"); v.present()) plan.condition = v.boolean();
     plan.residuals = plan.max_residual_column || !residual_names_.empty();

@@ -72,6 +72,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   // Models that are not square (redundant constraints, missing drivers) load: the rank analysis and the
   // minimum-norm assembly (assembly.hpp) tell what they are, and `phiq run` solves the redundant ones.
   resolve_output_residuals(scene);
+  resolve_output_efforts(scene);
   return scene;
 }
 

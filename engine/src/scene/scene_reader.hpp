@@ -207,6 +207,8 @@ class SceneReader {
   void output_joints(const Cursor& js, OutputPlan& plan) const;
   void output_orientations(const Cursor& os, OutputPlan& plan) const;
   void resolve_output_residuals(Scene& scene) const;
+  void read_output_efforts(const Cursor& output);   // read_efforts.cpp
+  void resolve_output_efforts(Scene& scene) const;  // read_efforts.cpp
   void read_solver(const Cursor& c, SolverSettings& o);
 
   const std::string& file_;
@@ -242,6 +244,10 @@ class SceneReader {
   bool predictor_field_ = false;
   std::unordered_map<std::string, MotionLaw> driver_laws_;  // named drivers, for `output: drivers`
   std::vector<std::string> residual_names_;                 // `output: residuals`, resolved after the build
+  // `output: efforts` (the field; its items when it lists names) and `power`, resolved after the build
+  std::optional<Cursor> efforts_field_;
+  std::vector<Cursor> effort_items_;
+  bool efforts_power_ = false;
 
  public:
   bool predictor_given() const { return predictor_field_; }

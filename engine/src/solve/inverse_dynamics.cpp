@@ -34,7 +34,8 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
     const V3 force = p.mass.mass * (loads.gravity - ac);
     const V3 moment = -1.0 * (world_inertia_times(m.pose.rotation, p.mass.inertia, m.alpha) +
                               kin3::cross(m.omega, world_inertia_times(m.pose.rotation, p.mass.inertia, m.omega)));
-    const PartJacobian j = part_jacobian(p.frame, q, t);
+    thread_local PartJacobian j;  // its vectors' capacity kept from row to row
+    part_jacobian(p.frame, q, t, j);
     for (std::size_t i = 0; i < j.coordinates.size(); ++i) {
       const V3 dc = j.d_origin[i] + kin3::cross(j.d_angle[i], c);  // ∂r_c/∂q_k
       Q(j.coordinates[i]) += kin3::dot(dc, force) + kin3::dot(j.d_angle[i], moment);
@@ -56,19 +57,24 @@ SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, 
   double rcond = 0.0;
   const SolveStatus st = detail::ensure_factorized(model, t, ws, &rcond, &why);
   if (st != SolveStatus::kSuccess) return failed(st);
-  // the LU is of the kept rows' Φq: λ on them, 0 on the dropped ones
-  Eigen::VectorXd kept(
-      static_cast<Index>(model.solve_rows().empty() ? model.num_equations() : model.solve_rows().size()));
-  if (!ws.lu->solve_transposed(Q.data(), kept.data()))
+  Eigen::VectorXd kept;
+  if (!multipliers_with_factors(model, *ws.lu, Q, kept, lambda))
     return why = ws.lu->last_message(), failed(SolveStatus::kLinearSolverFailed);
-  lambda = Eigen::VectorXd::Zero(model.num_equations());
-  if (model.dropped_rows().empty()) {
+  return SolveStatus::kSuccess;
+}
+
+bool multipliers_with_factors(const Model& model, SparseLuNumeric& lu, const Eigen::VectorXd& Q, Eigen::VectorXd& kept,
+                              Eigen::VectorXd& lambda) {
+  const std::vector<Index>& rows = model.solve_rows();
+  kept.resize(static_cast<Index>(rows.empty() ? model.num_equations() : rows.size()));
+  if (!lu.solve_transposed(Q.data(), kept.data())) return false;
+  if (rows.empty()) {
     lambda = kept;
   } else {
-    const std::vector<Index>& rows = model.solve_rows();
+    lambda.setZero(model.num_equations());
     for (std::size_t i = 0; i < rows.size(); ++i) lambda(rows[i]) = kept(static_cast<Index>(i));
   }
-  return SolveStatus::kSuccess;
+  return true;
 }
 
 std::vector<Index> rheonomic_constraints(const Model& model) {

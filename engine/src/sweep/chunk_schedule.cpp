@@ -33,8 +33,8 @@ ChunkedSweep::ChunkedSweep(const Model& model, const SweepOptions& opt, Workspac
       n_chunks_(n_chunks),
       threads_(threads),
       others_(others),
-      need_v_(opt.velocities || opt.accelerations),
-      need_a_(opt.accelerations),
+      need_v_(opt.solves_velocities()),
+      need_a_(opt.solves_accelerations()),
       encode_(run.chunks_encode()),
       first_(static_cast<std::size_t>(n_chunks) + 1),
       max_shift_(chunk / 2),
@@ -67,6 +67,7 @@ ChunkedSweep::ChunkedSweep(const Model& model, const SweepOptions& opt, Workspac
   seed_options_.velocities = seed_options_.accelerations = false;
   seed_options_.predictor = Predictor::kParabolic;
   seed_options_.points.clear(), seed_options_.residuals = seed_options_.condition = false;  // seeds deliver no rows
+  seed_options_.efforts = OutputEfforts{};
   counted_begin = ws.counters;  // (the work of the seeds and chunks, in pool workspaces, is counted with them)
   Workspace* sws = pool_.acquire();
   sws->q = at_.q;
@@ -240,17 +241,17 @@ void ChunkedSweep::finish_in_order() {
 HeldRows held_rows(const Model& model, const SweepOptions& opt, bool caller_reads_rows, std::size_t encoded_row_bytes) {
   const Index n = model.num_coordinates();
   // Rows keep q̇ whenever it is solved (q̈ needs it, and so does an ordered continuation's predictor).
-  const bool need_v = opt.velocities || opt.accelerations, need_a = opt.accelerations;
+  const bool need_v = opt.solves_velocities(), need_a = opt.solves_accelerations();
   // a row's layout in the chunk buffers: q, q̇, q̈ as solved, then Φ, rcond, the point motions and the
-  // sensitivities as asked
+  // sensitivities and efforts as asked
   const Index m = model.num_equations();
   const Index n_phi = opt.residuals ? m : 0, n_rcond = opt.condition ? 1 : 0;
   const Index n_points = static_cast<Index>(opt.points.size());
   constexpr Index kMotionDoubles = static_cast<Index>(sizeof(PointMotion) / sizeof(double));
   static_assert(sizeof(PointMotion) == 9 * sizeof(double), "PointMotion is stored as 9 doubles in chunk rows");
   const Index n_sensitivities = SensitivityLayout{n}.size(opt.sensitivities.size());
-  const Index width =
-      n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles + n_sensitivities + 1;
+  const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles +
+                      n_sensitivities + opt.efforts.size() + 1;
   return {caller_reads_rows, 8.0 * static_cast<double>(std::max<Index>(width, 1)),
           static_cast<double>(encoded_row_bytes)};
 }

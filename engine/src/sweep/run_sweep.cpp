@@ -11,6 +11,7 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
+#include "phiq/parts.hpp"
 #include "phiq/sweep.hpp"
 #include "phiq/text.hpp"
 #include "sweep/parallel_sweep.hpp"
@@ -51,6 +52,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   if (opt.chunk_steps < 0) throw Error("SweepOptions: chunk_steps must be >= 0 (0: automatic)");
   if (opt.row_buffer_bytes == 0) throw Error("SweepOptions: row_buffer_bytes must be > 0");
   detail::check_solver_settings(model, opt, opt.points, opt.sensitivities, "SweepOptions");
+  detail::check_efforts(model, opt, "SweepOptions");
   for (const OutputJoint& j : opt.joints)
     if (j.max_coordinate() >= model.num_coordinates())
       throw Error("SweepOptions: output joint '" + j.name + "' reads a coordinate the model does not have");
@@ -139,6 +141,22 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
 }
 
 }  // namespace
+
+void detail::check_efforts(const Model& model, const OutputPlan& plan, const std::string& who) {
+  const OutputEfforts& e = plan.efforts;
+  if (e.constraints.empty()) return;
+  if (!e.parts || !e.loads) throw Error(who + ": efforts need the parts and the loads");
+  for (Index c : e.constraints) {
+    if (c < 0 || c >= static_cast<Index>(model.constraints().size()))
+      throw Error(who + ": an effort's constraint " + std::to_string(c) + " is not one of the model's");
+    if (!model.constraints()[static_cast<std::size_t>(c)].depends_on_time)
+      throw Error(who + ": '" + model.constraints()[static_cast<std::size_t>(c)].name +
+                  "' does not depend on time: no motor drives it, it has no effort");
+  }
+  for (const Part& p : *e.parts)
+    if (max_coordinate(p.frame) >= model.num_coordinates())
+      throw Error(who + ": part '" + p.name + "' reads a coordinate the model does not have");
+}
 
 void detail::check_solver_settings(const Model& model, const SolverSettings& s, const std::vector<OutputPoint>& points,
                                    const std::vector<OutputSensitivity>& sensitivities, const std::string& who) {

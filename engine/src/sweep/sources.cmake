@@ -6,6 +6,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/parallel_sweep.cpp
   ${CMAKE_CURRENT_LIST_DIR}/predictors.cpp
   ${CMAKE_CURRENT_LIST_DIR}/resources.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/row_efforts.cpp
   ${CMAKE_CURRENT_LIST_DIR}/run_sweep.cpp
   ${CMAKE_CURRENT_LIST_DIR}/singular_positions.cpp
   ${CMAKE_CURRENT_LIST_DIR}/step_failures.cpp

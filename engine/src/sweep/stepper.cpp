@@ -67,6 +67,8 @@ Stepper::Stepper(const Model& model, StepperOptions options)
         "StepperOptions: sensitivity_form must be auto or direct (a stepper writes no coordinate columns for "
         "the adjoint form to solve for)");
   s.sensitivities = o.sensitivities, s.sensitivity_form = o.sensitivity_form;
+  s.efforts = o.efforts;
+  detail::check_efforts(model, s, "StepperOptions");
   s.threads = 1;
   impl_->make_sweeper(0.0);  // refuses a predictor whose derivatives are not solved, before any step
 }
@@ -192,6 +194,7 @@ const PointMotion* Stepper::point_motions() const { return impl_->started ? impl
 const double* Stepper::sensitivities() const {
   return impl_->started ? impl_->sweeper->motions().sensitivities : nullptr;
 }
+const double* Stepper::efforts() const { return impl_->started ? impl_->sweeper->motions().efforts : nullptr; }
 const SweepSummary& Stepper::summary() const { return impl_->sum; }
 const Workspace& Stepper::workspace() const { return impl_->ws; }
 const Model& Stepper::model() const { return *impl_->model; }

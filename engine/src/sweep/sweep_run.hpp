@@ -65,7 +65,8 @@ struct Run {
             opt.condition ? rcond : 0.0,
             joint_measures,
             motions.orientations,
-            motions.sensitivities};
+            motions.sensitivities,
+            motions.efforts};
   }
   // Rows a parallel chunk encoded (chunks_encode()), `rows` of them up to time point k, each counted already
   // (count_row()): written. False when the caller stops the sweep.
@@ -143,6 +144,10 @@ struct Run {
   }
 };
 
+// Throws phiq::Error, naming `who`, for efforts (OutputPlan::efforts) the model or the plan cannot give: a constraint
+// it does not have or that does not depend on time, no parts or loads, no accelerations solved (run_sweep.cpp).
+void check_efforts(const Model& model, const OutputPlan& plan, const std::string& who);
+
 // Throws phiq::Error for solver settings no step can honour, for output points that read a coordinate `model`
 // does not have and for sensitivities whose models do not stand for `model` (check_sensitivity_models()), naming
 // `who` (the options' type) in the message: run_sweep's checks, and a Stepper's.
@@ -163,6 +168,7 @@ inline void add_counters(WorkCounters& into, const WorkCounters& now, const Work
   into.point_evaluations += now.point_evaluations - before.point_evaluations;
   into.sensitivity_solves += now.sensitivity_solves - before.sensitivity_solves;
   into.sensitivity_direct_rows += now.sensitivity_direct_rows - before.sensitivity_direct_rows;
+  into.effort_solves += now.effort_solves - before.effort_solves;
 }
 
 }  // namespace phiq::detail

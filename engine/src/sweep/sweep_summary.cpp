@@ -17,6 +17,7 @@ std::string SweepSummary::BriefReport() const {
       << (counters.sensitivity_direct_rows ? ", " + std::to_string(counters.sensitivity_direct_rows) + " rows direct"
                                            : std::string())
       << ")";
+  if (counters.effort_solves) s << ", " << counters.effort_solves << " effort solves";
   if (subdivisions) s << ", " << subdivisions << " step subdivisions";
   if (singular_positions) s << ", " << singular_positions << " singular positions passed";
   if (threads > 1)

@@ -11,8 +11,8 @@ namespace phiq::detail {
 
 Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum)
     : model_(m), opt_(o), ws_(&ws), sum_(sum) {
-  need_v_ = o.velocities || o.accelerations;  // q̈ needs q̇
-  need_a_ = o.accelerations;
+  need_v_ = o.solves_velocities();  // (q̈ needs q̇)
+  need_a_ = o.solves_accelerations();
   // With velocities every step factorises at its solution: Φq there comes with the residual that accepts it.
   newton_ = o.newton;
   newton_.jacobian_with_residual = o.newton.jacobian_with_residual || need_v_;
@@ -226,6 +226,28 @@ void Sweeper::restore() {
   if (need_a_) ws_->qdd = current_.qdd;
 }
 
+Workspace* Sweeper::row_factors() {
+  const double t = current_.t;
+  Workspace* w = ws_;
+  // With velocities the row's velocity solve has just used the workspace's factors (of Φq at this row's solution,
+  // or at Newton's last iterate within the tolerance of it): the row's other solves use the same ones.
+  if (!(ws_->lu && derivative_factors_.ws == ws_ && derivative_factors_.t == t &&
+        derivative_factors_.factorizations == ws_->counters.factorizations)) {
+    if (!sensitivity_ws_) sensitivity_ws_ = std::make_shared<Workspace>(model_);
+    w = sensitivity_ws_.get();
+    if (!w->lu) return nullptr;
+    w->q = current_.q;  // (factorised again only if its factors are not at this row already: sensitivities')
+    const WorkCounters before = w->counters;
+    double rc = 0.0;
+    std::string why;
+    const SolveStatus st = ensure_factorized(model_, t, *w, &rc, &why);
+    ws_->counters.jacobian_evaluations += w->counters.jacobian_evaluations - before.jacobian_evaluations;
+    ws_->counters.factorizations += w->counters.factorizations - before.factorizations;
+    if (st != SolveStatus::kSuccess) return nullptr;
+  }
+  return w->lu->rcond() >= kSingularRcond ? w : nullptr;
+}
+
 void Sweeper::row_sensitivities() {
   // NaN where they are not defined (sensitivities_with_factors() writes every value itself otherwise).
   auto not_defined = [&] {
@@ -233,25 +255,9 @@ void Sweeper::row_sensitivities() {
   };
   // At a singular position Φq has no inverse (the row's bifurcation warning says where).
   if (singular_row_) return not_defined();
+  Workspace* w = row_factors();
+  if (!w) return not_defined();
   const double t = current_.t;
-  Workspace* w = ws_;
-  // With velocities the row's velocity solve has just used the workspace's factors (of Φq at this row's solution,
-  // or at Newton's last iterate within the tolerance of it): the sensitivities are solved with the same ones.
-  if (!(ws_->lu && derivative_factors_.ws == ws_ && derivative_factors_.t == t &&
-        derivative_factors_.factorizations == ws_->counters.factorizations)) {
-    if (!sensitivity_ws_) sensitivity_ws_ = std::make_shared<Workspace>(model_);
-    w = sensitivity_ws_.get();
-    if (!w->lu) return not_defined();
-    w->q = current_.q;
-    const WorkCounters before = w->counters;
-    double rc = 0.0;
-    std::string why;
-    const SolveStatus st = ensure_factorized(model_, t, *w, &rc, &why);
-    ws_->counters.jacobian_evaluations += w->counters.jacobian_evaluations - before.jacobian_evaluations;
-    ws_->counters.factorizations += w->counters.factorizations - before.factorizations;
-    if (st != SolveStatus::kSuccess) return not_defined();
-  }
-  if (!(w->lu->rcond() >= kSingularRcond)) return not_defined();
   const int order = need_a_ ? 2 : need_v_ ? 1 : 0;
   const Index solves_before = w->counters.sensitivity_solves, direct_before = w->counters.sensitivity_direct_rows;
   const double* qd = order >= 1 ? current_.qd.data() : nullptr;

@@ -38,6 +38,7 @@ struct RowMotions {
   const JointMotion* joints = nullptr;
   const OrientationMotion* orientations = nullptr;
   const double* sensitivities = nullptr;
+  const double* efforts = nullptr;  // OutputEfforts::size() values
 };
 
 // The class of a delivered row in SweepAccuracy, and its estimated error (units of the tolerance test; infinite
@@ -141,6 +142,7 @@ class Sweeper {
       ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
       rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
       if (!opt_.sensitivities.empty()) row_sensitivities();
+      if (!opt_.efforts.constraints.empty()) row_efforts();
     }
     det_sign_ = current_row_sign_;
     det_sign_t_ = current_row_sign_t_;
@@ -187,7 +189,7 @@ class Sweeper {
   RowMotions motions() const {
     return {point_motions(), joints_.empty() ? nullptr : joints_.data(),
             orientations_.empty() ? nullptr : orientations_.data(),
-            sensitivities_.empty() ? nullptr : sensitivities_.data()};
+            sensitivities_.empty() ? nullptr : sensitivities_.data(), efforts_.empty() ? nullptr : efforts_.data()};
   }
   double rcond() const { return rcond_; }
 
@@ -336,6 +338,12 @@ class Sweeper {
   // Φq at its position: the workspace's when the row's velocity solve used them, else a factorisation of its own
   // (positions only), which leaves the workspace's, and so the next steps' bits, as they are (sweeper.cpp).
   void row_sensitivities();
+  // The plan's driver efforts and powers at the current state (efforts_), by one transposed solve with the same
+  // factors as row_sensitivities() (sweeper_efforts.cpp); NaN at a singular position.
+  void row_efforts();
+  // The factors of Φq at the current row: the workspace's when the row's velocity solve has just used them, else
+  // those of sensitivity_ws_, factorised at the row; null where Φq is singular or cannot be factorised.
+  Workspace* row_factors();
   // Singular positions (singular_positions.cpp): the branch's own derivatives at one, and why Φq stays singular
   // around one or no position lies beyond it (a dead point).
   std::string singular_throughout(const Eigen::VectorXd& qs, double t);
@@ -374,6 +382,8 @@ class Sweeper {
   std::vector<double> sensitivities_ = std::vector<double>(
       static_cast<std::size_t>(SensitivityLayout{model_.num_coordinates()}.size(opt_.sensitivities.size())));
   SensitivityScratch sensitivity_scratch_;
+  std::vector<double> efforts_ = std::vector<double>(static_cast<std::size_t>(opt_.efforts.size()));
+  Eigen::VectorXd effort_q_, effort_kept_, effort_lambda_, effort_phi_t_;  // row_efforts()'s Q, λ, Φt
   // The coordinates whose columns are written, and the form the sensitivities are solved in
   // (effective_sensitivity_form)
   std::vector<Index> sensitivity_outputs_ =

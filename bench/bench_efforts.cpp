@@ -1,0 +1,90 @@
+// What driver efforts cost: nfourbar (natural coordinates, the scene `phiq generate` writes) with a unit mass on
+// every link (the derived parts of drawn_parts(): a bar per crank and coupler, mass 1 kg at its middle, I = L²/12)
+// under gravity, swept a quarter turn in 100 steps on one thread, each row formatted as a CSV line. With efforts:
+// the motor's torque and power by inverse dynamics (one transposed solve per row). Counter `ratio`: the sweep with
+// efforts ÷ the sweep with q, q̇, q̈ only, interleaved iteration by iteration and summed (issue target ≤ 1.3).
+//
+//   build/bench/phiq_bench --benchmark_filter=EffortsSweep --benchmark_counters_tabular=true
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "phiq/drawn_parts.hpp"
+#include "phiq/inverse_dynamics.hpp"
+#include "phiq/phiq.hpp"
+
+namespace {
+
+using namespace phiq;
+
+std::string massive_nfourbar_scene(Index n) {
+  return "phiq: 1\nparameters: {N: " + std::to_string(n) +
+         ", c: 0.7071067811865476, s: 0.7071067811865475}\n"
+         "coordinates:\n  for i in 0..N:\n    x{i}: i + c\n    y{i}: s\n  theta: 0.7853981633974483\n"
+         "points:\n  O: [0, 0]\n  for i in 0..N:\n    P{i}: [\"x{i}\", \"y{i}\"]\n"
+         "constraints:\n  - for i in 0..N:\n      - {name: \"crank{i}\", type: distance, points: [[i, 0], \"P{i}\"], "
+         "length: 1}\n  - for i in 0..N-1:\n      - {name: \"coupler{i}\", type: distance, points: [\"P{i}\", "
+         "\"P{i+1}\"], length: 1}\n  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}\n"
+         "drivers:\n  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: "
+         "1.5707963267948966}}\ntime: {start: 0, end: 1, steps: 100}\n"
+         "loads: {gravity: [0, -9.81]}\noutput: {velocities: true, accelerations: true}\n";
+}
+
+double csv_sweep_seconds(const Scene& s, const SweepOptions& o) {
+  Workspace ws(*s.model);
+  SweepSummary sum;
+  const CsvFormat format(*s.model, o);
+  std::string line;
+  const auto t0 = std::chrono::steady_clock::now();
+  const SolveStatus st = run_sweep(
+      *s.model, o, ws,
+      [&](const StepView& v) {
+        line.clear();
+        format.append_row(v, line);
+        benchmark::DoNotOptimize(line.data());
+        return true;
+      },
+      &sum);
+  if (st != SolveStatus::kSuccess) throw Error(sum.message);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// range(0) = N. Manual time: the sweep with efforts.
+void BM_EffortsSweep(benchmark::State& state) {
+  const Scene s = parse_scene(massive_nfourbar_scene(state.range(0)), "nfourbar.yaml");
+  auto parts = std::make_shared<std::vector<Part>>();
+  for (Part p : drawn_parts(s)) {
+    if (p.fixed) continue;
+    constexpr double kLength = 1.0;  // every link of this scene, along its frame's x from its origin
+    p.mass.mass = 1.0, p.mass.center = {kLength / 2, 0, 0};
+    p.mass.inertia = {0, 0, 0, 0, kLength * kLength / 12, 0, 0, 0, kLength * kLength / 12};  // a slender bar
+    p.mass_source = MassSource::kStated, p.shapes.clear();
+    parts->push_back(std::move(p));
+  }
+  SweepOptions plain = s.sweep;
+  plain.threads = 1;
+  SweepOptions with = plain;
+  with.efforts.parts = parts;
+  with.efforts.loads = std::make_shared<const Loads>(s.loads);
+  with.efforts.constraints = rheonomic_constraints(*s.model);
+  with.efforts.power = true;
+  double a_sum = 0, b_sum = 0;
+  for (auto _ : state) {
+    const double a = csv_sweep_seconds(s, with), b = csv_sweep_seconds(s, plain);
+    a_sum += a, b_sum += b;
+    state.SetIterationTime(a);
+  }
+  state.counters["parts"] = static_cast<double>(parts->size());
+  state.counters["ratio"] = a_sum / b_sum;
+}
+BENCHMARK(BM_EffortsSweep)
+    ->Arg(10)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->ArgName("N")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,66 @@
+// The scene's `output: efforts` and `power` (models/README.md): which drivers' efforts a sweep writes, resolved to
+// constraints once the model is built, with the parts and loads they are computed from (OutputPlan::efforts).
+#include <memory>
+#include <set>
+
+#include "phiq/inverse_dynamics.hpp"
+#include "scene/scene_reader.hpp"
+
+namespace phiq::detail::scene {
+
+void SceneReader::read_output_efforts(const Cursor& output) {
+  const Cursor e = output.field("efforts");
+  if (auto p = output.field("power"); p.present()) {
+    efforts_power_ = p.boolean();
+    if (efforts_power_ && !e.present()) p.fail("power is written with the efforts: list `efforts` too");
+  }
+  if (!e.present()) return;
+  efforts_field_ = e;
+  if (e.is_scalar()) {
+    if (e.text() != "all") e.fail("expected `all` or a list of drivers");
+    return;
+  }
+  std::set<std::string> seen;
+  for (const Cursor& i : e.items()) {
+    const std::string n = i.name();
+    if (!builder_.has_constraint(n)) i.fail("unknown driver '" + n + "'");
+    if (!seen.insert(n).second) i.fail("driver listed twice");
+    effort_items_.push_back(i);
+  }
+}
+
+void SceneReader::resolve_output_efforts(Scene& scene) const {
+  if (!efforts_field_) return;
+  const Model& model = *scene.model;
+  OutputEfforts& out = scene.sweep.efforts;
+  if (effort_items_.empty()) {
+    out.constraints = rheonomic_constraints(model);
+    if (out.constraints.empty()) efforts_field_->fail("the scene has no driver: no effort to write");
+  } else {
+    std::unordered_map<std::string, Index> index;
+    for (std::size_t k = 0; k < model.constraints().size(); ++k)
+      index.emplace(model.constraints()[k].name, static_cast<Index>(k));
+    for (const Cursor& i : effort_items_) {
+      const Index c = index.at(i.name());
+      if (!model.constraints()[static_cast<std::size_t>(c)].depends_on_time)
+        i.fail("'" + i.name() + "' does not depend on time: no motor drives it, it has no effort");
+      out.constraints.push_back(c);
+    }
+  }
+  // the parts with mass, without their shapes (a mesh's triangles are not read by the dynamics)
+  auto massive = std::make_shared<std::vector<Part>>();
+  for (const Part& p : scene.parts)
+    if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0) {
+      massive->push_back(p);
+      massive->back().shapes.clear();
+    }
+  if (massive->empty())
+    efforts_field_->fail(
+        "no part has mass and no load is applied: every effort would be zero (give parts a mass "
+        "or a density, or apply loads)");
+  out.parts = std::move(massive);
+  out.loads = std::make_shared<const Loads>(scene.loads);
+  out.power = efforts_power_;
+}
+
+}  // namespace phiq::detail::scene

@@ -1,0 +1,45 @@
+// Sweeper::row_efforts(): a written row's driver efforts and powers (OutputPlan::efforts), by inverse dynamics with
+// the row's own factors of Φq (phiq/inverse_dynamics.hpp).
+#include <algorithm>
+#include <limits>
+
+#include "phiq/inverse_dynamics.hpp"
+#include "phiq/parts.hpp"
+#include "sweep/sweeper.hpp"
+
+namespace phiq::detail {
+
+void Sweeper::row_efforts() {
+  const OutputEfforts& e = opt_.efforts;
+  const std::size_t n = e.constraints.size();
+  auto not_defined = [&] { std::fill(efforts_.begin(), efforts_.end(), std::numeric_limits<double>::quiet_NaN()); };
+  // At a singular position the multipliers are not unique and a driver's effort may be unbounded: NaN, which the
+  // row's bifurcation warning explains, rather than a huge number from a nearly singular solve.
+  if (singular_row_) return not_defined();
+  Workspace* w = row_factors();
+  if (!w) return not_defined();
+  const double t = current_.t;
+  effort_q_.setZero(model_.num_coordinates());
+  add_generalized_forces(*e.parts, *e.loads, current_.q.data(), current_.qd.data(), current_.qdd.data(), t, effort_q_);
+  if (!multipliers_with_factors(model_, *w->lu, effort_q_, effort_kept_, effort_lambda_)) return not_defined();
+  ++ws_->counters.effort_solves;
+  effort_phi_t_.resize(model_.num_equations());
+  model_.phi_t(current_.q.data(), t, effort_phi_t_.data());
+  const std::vector<ConstraintInfo>& cs = model_.constraints();
+  for (std::size_t i = 0; i < n; ++i) {
+    const ConstraintInfo& c = cs[static_cast<std::size_t>(e.constraints[i])];
+    double power = 0.0;
+    for (Index r = c.first_row; r < c.first_row + c.rows; ++r) power += effort_lambda_(r) * effort_phi_t_(r);
+    efforts_[i] = -effort_lambda_(c.first_row);
+    efforts_[n + i] = power;
+  }
+  // A driver whose row was dropped as redundant shares its load with the equations it repeats: not its own.
+  for (Index r : model_.dropped_rows())
+    for (std::size_t i = 0; i < n; ++i) {
+      const ConstraintInfo& c = cs[static_cast<std::size_t>(e.constraints[i])];
+      if (r >= c.first_row && r < c.first_row + c.rows)
+        efforts_[i] = efforts_[n + i] = std::numeric_limits<double>::quiet_NaN();
+    }
+}
+
+}  // namespace phiq::detail

@@ -1,0 +1,147 @@
+// Driver efforts as sweep outputs (OutputPlan::efforts, the scene's `output: efforts`): each written row's torque
+// and power are the inverse dynamics of that row (phiq/inverse_dynamics.hpp), asking for them leaves the motion's
+// bits as they are, every thread count gives the same bits, and a singular row has none.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "phiq/inverse_dynamics.hpp"
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+std::string effort_scene_text(const std::string& rel) {
+  std::ifstream in(test::model_path(rel));
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  text.erase(text.find("output:"));  // the tests write their own
+  return text;
+}
+
+// The notes' four-bar in natural coordinates with three massive links under gravity.
+std::string massive_fourbar(const std::string& output) {
+  return effort_scene_text("seed/fourbar_natural.yaml") +
+         "parts:\n"
+         "  crank: {frame: {origin: O, x: A}, center_of_mass: [L2/2, 0], mass: 1.0, inertia: L2*L2/12}\n"
+         "  coupler: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 2.0, inertia: 2.0*L3*L3/12}\n"
+         "  rocker: {frame: {origin: C, x: B}, center_of_mass: [L4/2, 0], mass: 1.5, inertia: 1.5*L4*L4/12}\n"
+         "loads: {gravity: [0, -9.81]}\n"
+         "output: " +
+         output + "\n";
+}
+
+struct EffortRows {
+  std::vector<double> t;
+  std::vector<Eigen::VectorXd> q, qd, qdd;
+  std::vector<std::vector<double>> efforts;
+};
+
+EffortRows sweep_efforts(const Scene& s, SweepOptions opt, SweepSummary* sum = nullptr) {
+  EffortRows r;
+  Workspace ws(*s.model);
+  const std::size_t n = static_cast<std::size_t>(opt.efforts.size());
+  const SolveStatus st = run_sweep(
+      *s.model, opt, ws,
+      [&](const StepView& v) {
+        r.t.push_back(v.t), r.q.push_back(v.q);
+        if (v.qd) r.qd.push_back(*v.qd);
+        if (v.qdd) r.qdd.push_back(*v.qdd);
+        r.efforts.emplace_back(v.efforts, v.efforts + n);
+        return true;
+      },
+      sum);
+  EXPECT_EQ(st, SolveStatus::kSuccess);
+  return r;
+}
+
+TEST(SweepEfforts, EachRowsEffortAndPowerAreItsInverseDynamics) {
+  const Scene s = parse_scene(massive_fourbar("{velocities: true, accelerations: true, efforts: all, power: true}"),
+                              "fourbar.yaml");
+  ASSERT_EQ(s.sweep.efforts.constraints.size(), 1u);
+  SweepSummary sum;
+  const EffortRows r = sweep_efforts(s, s.sweep, &sum);
+  ASSERT_EQ(r.t.size(), 361u);
+  EXPECT_EQ(sum.counters.effort_solves, 361);
+  Workspace ws(*s.model);
+  double worst = 0.0, worst_power = 0.0, scale = 0.0;
+  for (std::size_t k = 0; k < r.t.size(); ++k) {
+    ws.q = r.q[k], ws.qd = r.qd[k], ws.qdd = r.qdd[k];
+    std::vector<double> tau;
+    std::string why;
+    ASSERT_EQ(driver_efforts(*s.model, s.parts, s.loads, r.t[k], ws, tau, &why), SolveStatus::kSuccess) << why;
+    worst = std::max(worst, std::fabs(r.efforts[k][0] - tau[0]));
+    worst_power = std::max(worst_power, std::fabs(r.efforts[k][1] - r.efforts[k][0] * 1.0));  // θ̇ = 1 rad/s
+    scale = std::max(scale, std::fabs(tau[0]));
+  }
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LT(worst, 1e-9 * scale);         // the row's factors are Φq at q, or at Newton's last iterate within tol
+  EXPECT_LT(worst_power, 1e-12 * scale);  // P = λ Φt = τ θ̇ for a coordinate driven at a constant rate
+}
+
+TEST(SweepEfforts, AskingForEffortsLeavesTheMotionsBitsAndEveryThreadCountGivesTheSame) {
+  const Scene with =
+      parse_scene(massive_fourbar("{velocities: true, accelerations: true, efforts: [motor]}"), "fourbar.yaml");
+  const Scene bare = parse_scene(massive_fourbar("{velocities: true, accelerations: true}"), "fourbar.yaml");
+  const Scene only = parse_scene(massive_fourbar("{efforts: [motor], coordinates: [xB]}"), "fourbar.yaml");
+  SweepOptions one = with.sweep;
+  one.threads = 1;
+  const EffortRows a = sweep_efforts(with, one);
+  test::Trace b;
+  ASSERT_EQ(test::sweep(*bare.model, bare.sweep, &b), SolveStatus::kSuccess);
+  const EffortRows c = sweep_efforts(only, only.sweep);  // q̈ solved for the efforts, not delivered
+  EXPECT_TRUE(c.qd.empty());
+  EXPECT_TRUE(c.qdd.empty());
+  SweepOptions two = with.sweep;
+  two.threads = 2;
+  SweepSummary sum2;
+  const EffortRows d = sweep_efforts(with, two, &sum2);
+  EXPECT_GT(sum2.parallel_chunks, 1);
+  ASSERT_EQ(a.t.size(), b.t.size());
+  ASSERT_EQ(a.t.size(), c.t.size());
+  ASSERT_EQ(a.t.size(), d.t.size());
+  for (std::size_t k = 0; k < a.t.size(); ++k) {
+    EXPECT_EQ(a.q[k], b.q[k]) << k;
+    EXPECT_EQ(a.q[k], c.q[k]) << k;
+    EXPECT_EQ(a.q[k], d.q[k]) << k;
+    EXPECT_EQ(a.efforts[k][0], c.efforts[k][0]) << k;
+    EXPECT_EQ(a.efforts[k][0], d.efforts[k][0]) << k;
+  }
+}
+
+TEST(SweepEfforts, ASingularRowHasNoEffort) {
+  // The change-point four-bar lands on its two singular positions at steps 120 and 300.
+  const Scene s = parse_scene(effort_scene_text("hard/change_point_exact.yaml") +
+                                  "parts:\n  coupler: {mass: 1.0, inertia: 0.1, center_of_mass: [1, 0]}\n"
+                                  "loads: {gravity: [0, -9.81]}\n"
+                                  "output: {efforts: all}\n",
+                              "change_point.yaml");
+  const EffortRows r = sweep_efforts(s, s.sweep);
+  ASSERT_EQ(r.t.size(), 361u);
+  for (std::size_t k = 0; k < r.t.size(); ++k) {
+    if (k == 120 || k == 300)
+      EXPECT_TRUE(std::isnan(r.efforts[k][0])) << k;
+    else
+      EXPECT_TRUE(std::isfinite(r.efforts[k][0])) << k;
+  }
+}
+
+TEST(SweepEfforts, TheSceneRefusesEffortsItCannotGiveInOneLine) {
+  const std::string fourbar = effort_scene_text("seed/fourbar_natural.yaml");
+  EXPECT_NE(error_of(fourbar + "output: {efforts: all}\n").find("no part has mass and no load is applied"),
+            std::string::npos)
+      << error_of(fourbar + "output: {efforts: all}\n");
+  const std::string massive = massive_fourbar("{efforts: ");
+  EXPECT_NE(error_of(massive + "[pump]}").find("unknown driver 'pump'"), std::string::npos);
+  EXPECT_NE(error_of(massive + "[crank]}").find("'crank' does not depend on time"), std::string::npos);
+  EXPECT_NE(error_of(massive + "[motor, motor]}").find("driver listed twice"), std::string::npos);
+  EXPECT_NE(error_of(massive + "some}").find("expected `all` or a list of drivers"), std::string::npos);
+  EXPECT_NE(error_of(massive_fourbar("{power: true}")).find("list `efforts` too"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace phiq
