@@ -38,7 +38,9 @@ double spring_energy(const AppliedLoads& loads, const Eigen::VectorXd& q, double
     v += 0.5 * s.stiffness * (l - s.free_length) * (l - s.free_length) + s.preload * l;
   }
   for (const TorsionalSpring& s : loads.torsional_springs) {
-    const double a = s.angle->value(q.data(), t) - s.free_angle;
+    const double a =
+        s.angle ? s.angle->value(q.data(), t) - s.free_angle
+                : std::remainder(evaluate_joint(*s.joint, q.data(), nullptr, nullptr).value - s.free_angle, 2 * M_PI);
     v += 0.5 * s.stiffness * a * a;
   }
   return v;
@@ -124,7 +126,10 @@ TEST(AppliedLoads, SpringForcesAreTheirEnergysGradientInEveryCoordinateFamily) {
       "    - {name: s1, between: [{part: crank, at: [a, 0.05, 0.02]}, {part: rocker, at: [0, b, 0.1]}],\n"
       "       stiffness: 500, free_length: 0.4}\n"
       "    - {name: s2, between: [{part: rocker, at: [0.1, 0.2, 0]}, {point: [0.3, 0.3, 0.3]}], stiffness: 50,\n"
-      "       free_length: 0.1}\n");
+      "       free_length: 0.1}\n"
+      "  torsional_springs:\n"
+      "    - {name: t1, joint: rocker_hinge, stiffness: 20, free_angle: 0.3, damping: 2}\n"
+      "    - {name: t2, joint: crank_hinge, stiffness: 7, free_angle: -2.5}\n");
 }
 
 TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) {
@@ -170,6 +175,59 @@ TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) 
     EXPECT_GT(loads_power, 1.0) << form;  // watts: the loads take part in the balance
     EXPECT_LT(balance, 1e-9 * scale) << form;
   }
+}
+
+// ω · (R I Rᵀ α): the rate of a part's rotational kinetic energy ½ ω · I_world ω (the rate of I_world does no work).
+double rotational_energy_rate(const Part& p, const PartMotion& pm) {
+  const RotationMatrix& r = pm.pose.rotation;
+  const kin3::V3 a = pm.alpha;
+  const double b[3] = {r[0] * a.x + r[3] * a.y + r[6] * a.z, r[1] * a.x + r[4] * a.y + r[7] * a.z,
+                       r[2] * a.x + r[5] * a.y + r[8] * a.z};
+  double c[3];
+  for (int i = 0; i < 3; ++i)
+    c[i] = p.mass.inertia[3 * i] * b[0] + p.mass.inertia[3 * i + 1] * b[1] + p.mass.inertia[3 * i + 2] * b[2];
+  const kin3::V3 d{r[0] * c[0] + r[1] * c[1] + r[2] * c[2], r[3] * c[0] + r[4] * c[1] + r[5] * c[2],
+                   r[6] * c[0] + r[7] * c[1] + r[8] * c[2]};
+  return kin3::dot(pm.omega, d);
+}
+
+TEST(AppliedLoads, DriverPowerBalancesInSpaceWithAJointSpringAndLoadsInPartAxes) {
+  Scene s =
+      parse_scene(model_text("spatial/rssr.yaml") +
+                      "\nparts:\n"
+                      "  crank: {mass: 1.0, center_of_mass: [0.1, 0, 0], inertia: [0.01, 0.02, 0.025]}\n"
+                      "  rocker: {mass: 2.0, center_of_mass: [0, 0.25, 0], inertia: [0.05, 0.01, 0.05]}\n"
+                      "loads:\n"
+                      "  gravity: [0, 0, -9.81]\n"
+                      "  forces: [{part: crank, at: [a, 0, 0], force: [5, 2*sin(t), 3], axes: part}]\n"
+                      "  torques: [{part: rocker, torque: [1 + 0.5*cos(t), 0.5, -0.2], axes: part}]\n"
+                      "  torsional_springs: [{joint: rocker_hinge, stiffness: 15, free_angle: 1.2, damping: 3}]\n",
+                  "rssr.yaml");
+  const Model& m = *s.model;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
+  Workspace ws(m);
+  std::vector<double> efforts;
+  double balance = 0.0, scale = 0.0, loads_power = 0.0;
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    const double t = tr.t[k];
+    ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
+    std::string why;
+    ASSERT_EQ(driver_efforts(m, s.parts, s.loads, t, ws, efforts, &why), SolveStatus::kSuccess) << why;
+    double energy_rate = 0.0;
+    for (const Part& p : s.parts) {
+      const PartMotion pm = part_motion(p.frame, ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
+      const auto [v, a] = pm.point(p.mass.center);
+      energy_rate +=
+          p.mass.mass * kin3::dot(v, a) + rotational_energy_rate(p, pm) - p.mass.mass * kin3::dot(s.loads.gravity, v);
+    }
+    const double power = applied_power(*s.loads.applied, ws.q.data(), ws.qd.data(), t);
+    balance = std::max(balance, std::fabs(efforts[0] * 1.0 - (energy_rate - power)));  // the hinge turns at 1 rad/s
+    scale = std::max(scale, std::fabs(efforts[0]));
+    loads_power = std::max(loads_power, std::fabs(power));
+  }
+  EXPECT_GT(loads_power, 1.0);
+  EXPECT_LT(balance, 1e-9 * scale);
 }
 
 TEST(AppliedLoads, AForceInPartAxesIsTheSameForceTurnedIntoWorldAxes) {
@@ -231,6 +289,17 @@ TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
   EXPECT_HAS(m, "foo");
   m = error("  torques:\n    - {name: a, part: crank, torque: 1}\n    - {name: a, part: rocker, torque: 1}\n");
   EXPECT_HAS(m, "loads.torques[1].name: duplicate load name 'a'");
+  m = error("  torsional_springs:\n    - {joint: O, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].joint: a joint's angle is a spatial joint's");
+  m = error("  torsional_springs:\n    - {coordinate: psi2, angle: psi2, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0]: a torsional spring acts on one of");
+  const std::string rssr = model_text("spatial/rssr.yaml") + "\nloads:\n  torsional_springs:\n";
+  m = test::scene_error(rssr + "    - {joint: hinge, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].joint: unknown joint 'hinge'");
+  m = test::scene_error(rssr + "    - {joint: coupler, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].joint: unknown joint 'coupler'");  // a distance: no joint
+  m = test::scene_error(model_text("spatial/rssr.yaml") + "\nloads:\n  torques: [{part: crank, torque: 1}]\n");
+  EXPECT_HAS(m, "loads.torques[0].torque: torque is [x, y, z]");
 }
 
 }  // namespace

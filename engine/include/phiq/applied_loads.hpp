@@ -2,7 +2,7 @@
 /// Applied loads on a mechanism's parts (the scene's `loads` besides gravity, models/README.md): forces at points
 /// of parts and torques on parts, each a vector of expressions of t, the coordinates and the parameters, in world or
 /// part axes; linear spring-dampers between two points (of parts, or fixed in the world); torsional spring-dampers on
-/// an angle (a coordinate, or an expression of the coordinates such as a relative angle ψ3 − ψ2).
+/// an angle (a coordinate, an expression of the coordinates such as a relative angle ψ3 − ψ2, a spatial joint's).
 ///
 /// Their generalized forces are their virtual work, Q_k = Σ ∂x/∂q_k · F + ∂θ/∂q_k · M, from each part's exact
 /// Jacobian (part_jacobian(), phiq/part_motion.hpp), so they hold in every coordinate family; dampers read the
@@ -15,9 +15,11 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "phiq/output_joints.hpp"
 #include "phiq/parts.hpp"
 
 namespace phiq {
@@ -70,10 +72,14 @@ struct LinearSpring {
 /// A torsional spring-damper on an angle θ(q, t): the moment τ = k (θ − θ0) + c θ̇ resisting θ's increase.
 struct TorsionalSpring {
   std::string name;                                 ///< the scene's name for it
-  std::shared_ptr<const CompiledExpression> angle;  ///< θ: a coordinate, or an expression of them
-  double stiffness = 0.0;                           ///< k (N·m/rad), ≥ 0
-  double free_angle = 0.0;                          ///< θ0 (rad)
-  double damping = 0.0;                             ///< c (N·m·s/rad), ≥ 0
+  std::shared_ptr<const CompiledExpression> angle;  ///< θ: a coordinate, or an expression of them; or null and:
+  /// θ a spatial joint's angle (its kind's measure, phiq/output_joints.hpp), known only modulo a turn: θ − θ0 is
+  /// taken in (−π, π].
+  std::optional<OutputJoint> joint;
+  std::vector<Index> joint_coordinates;  ///< the coordinates the joint's angle reads, increasing
+  double stiffness = 0.0;                ///< k (N·m/rad), ≥ 0
+  double free_angle = 0.0;               ///< θ0 (rad)
+  double damping = 0.0;                  ///< c (N·m·s/rad), ≥ 0
 };
 
 /// The applied loads of a scene, read once and shared (Loads::applied holds them by pointer).

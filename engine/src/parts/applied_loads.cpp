@@ -1,6 +1,8 @@
 // add_applied_forces() and applied_power() (phiq/applied_loads.hpp).
 #include "phiq/applied_loads.hpp"
 
+#include <cmath>
+
 #include "phiq/part_motion.hpp"
 
 namespace phiq {
@@ -51,23 +53,47 @@ SpringState spring_state(const LinearSpring& s, const double* q, const double* q
   return st;
 }
 
-// A torsional spring's angle, its rate (0 without q̇) and its moment.
+// A torsional spring's angle from its free angle, its rate (0 without q̇) and its moment.
 struct AngleState {
-  double angle = 0.0, rate = 0.0, moment = 0.0;
+  double from_free = 0.0, rate = 0.0, moment = 0.0;  // θ − θ0, θ̇, τ
 };
+
+// The coordinates a torsional spring's angle reads, increasing.
+const std::vector<Index>& angle_coordinates(const TorsionalSpring& s) {
+  return s.angle ? s.angle->coordinates() : s.joint_coordinates;
+}
+
+// θ − θ0 and ∂θ/∂q_k for angle_coordinates(), into `gradient`: an expression's own gradient, or a joint angle's
+// rate along each coordinate's unit velocity (exact: the rate is linear in q̇).
+double angle_from_free(const TorsionalSpring& s, const double* q, double t, std::vector<double>& gradient) {
+  if (s.angle) {
+    gradient.resize(s.angle->coordinates().size());
+    s.angle->gradient(q, t, gradient.data());
+    return s.angle->value(q, t) - s.free_angle;
+  }
+  const std::vector<Index>& c = s.joint_coordinates;
+  gradient.assign(c.size(), 0.0);
+  if (!c.empty()) {
+    std::vector<double> unit(static_cast<std::size_t>(c.back()) + 1, 0.0);
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      unit[static_cast<std::size_t>(c[i])] = 1.0;
+      gradient[i] = evaluate_joint(*s.joint, q, unit.data(), nullptr).rate;
+      unit[static_cast<std::size_t>(c[i])] = 0.0;
+    }
+  }
+  return std::remainder(evaluate_joint(*s.joint, q, nullptr, nullptr).value - s.free_angle, 2.0 * M_PI);
+}
 
 AngleState angle_state(const TorsionalSpring& s, const double* q, const double* qd, double t,
                        std::vector<double>& gradient) {
-  const CompiledExpression& e = *s.angle;
   AngleState st;
-  st.angle = e.value(q, t);
-  gradient.resize(e.coordinates().size());
-  e.gradient(q, t, gradient.data());
+  st.from_free = angle_from_free(s, q, t, gradient);
   if (qd) {
-    st.rate = e.partial_t(q, t);
-    for (std::size_t i = 0; i < gradient.size(); ++i) st.rate += gradient[i] * qd[e.coordinates()[i]];
+    const std::vector<Index>& c = angle_coordinates(s);
+    st.rate = s.angle ? s.angle->partial_t(q, t) : 0.0;
+    for (std::size_t i = 0; i < c.size(); ++i) st.rate += gradient[i] * qd[c[i]];
   }
-  st.moment = s.stiffness * (st.angle - s.free_angle) + s.damping * st.rate;
+  st.moment = s.stiffness * st.from_free + s.damping * st.rate;
   return st;
 }
 
@@ -100,7 +126,7 @@ void add_applied_forces(const AppliedLoads& loads, const double* q, const double
   std::vector<double> gradient;
   for (const TorsionalSpring& s : loads.torsional_springs) {
     const AngleState st = angle_state(s, q, qd, t, gradient);
-    const std::vector<Index>& c = s.angle->coordinates();
+    const std::vector<Index>& c = angle_coordinates(s);
     for (std::size_t i = 0; i < c.size(); ++i) Q(c[i]) -= st.moment * gradient[i];
   }
 }

@@ -65,25 +65,7 @@ void SceneReader::read_loads(const Cursor& c, Scene& scene) const {
   if (auto ss = c.field("springs"); ss.present())
     for (const Cursor& s : ss.items()) applied->springs.push_back(linear_spring(s, scene, names));
   if (auto ts = c.field("torsional_springs"); ts.present())
-    for (const Cursor& s : ts.items()) {
-      s.expect_map({"name", "coordinate", "angle", "stiffness", "free_angle", "damping"});
-      TorsionalSpring spring;
-      spring.name = load_name(s, names);
-      const Cursor on_coordinate = s.field("coordinate"), angle = s.field("angle");
-      if (on_coordinate.present() == angle.present())
-        s.fail("a torsional spring acts on a `coordinate: NAME` or an `angle: EXPRESSION` of the coordinates");
-      if (on_coordinate.present()) {
-        const std::string n = builder_.coordinate_name(coordinate(on_coordinate));
-        spring.angle = CompiledExpression::compile(n, resolver(true, n), false);
-      } else {
-        spring.angle = compile(angle, false);
-        if (spring.angle->coordinates().empty()) angle.fail("the angle reads no coordinate: the spring exerts nothing");
-      }
-      spring.stiffness = non_negative(s.require("stiffness"));
-      if (auto a0 = s.field("free_angle"); a0.present()) spring.free_angle = number(a0);
-      if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
-      applied->torsional_springs.push_back(std::move(spring));
-    }
+    for (const Cursor& s : ts.items()) applied->torsional_springs.push_back(torsional_spring(s, names));
   if (!applied->empty()) scene.loads.applied = std::move(applied);
 }
 
@@ -143,6 +125,48 @@ double SceneReader::non_negative(const Cursor& c) const {
   const double v = number(c);
   if (v < 0.0) c.fail("must not be negative, got " + c.text());
   return v;
+}
+
+// A torsional spring-damper on `coordinate: NAME`, `angle: EXPRESSION` of the coordinates, or a spatial `joint`'s
+// angle.
+TorsionalSpring SceneReader::torsional_spring(const Cursor& s, std::set<std::string>& names) const {
+  s.expect_map({"name", "coordinate", "angle", "joint", "stiffness", "free_angle", "damping"});
+  TorsionalSpring spring;
+  spring.name = load_name(s, names);
+  const Cursor on_coordinate = s.field("coordinate"), angle = s.field("angle"), joint = s.field("joint");
+  if (on_coordinate.present() + angle.present() + joint.present() != 1)
+    s.fail("a torsional spring acts on one of `coordinate: NAME`, `angle: EXPRESSION` or `joint: NAME`");
+  if (on_coordinate.present()) {
+    const std::string n = builder_.coordinate_name(coordinate(on_coordinate));
+    spring.angle = CompiledExpression::compile(n, resolver(true, n), false);
+  } else if (angle.present()) {
+    spring.angle = compile(angle, false);
+    if (spring.angle->coordinates().empty()) angle.fail("the angle reads no coordinate: the spring exerts nothing");
+  } else {
+    const std::string n = joint.name();
+    if (!spatial_) joint.fail("a joint's angle is a spatial joint's; in the plane write the `angle` of coordinates");
+    const auto it = joints3_.find(n);
+    if (it == joints3_.end()) joint.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
+    if (!it->second.traits.measures.angle)
+      joint.fail("joint '" + n + "' is a " + it->second.type + ": it has no angle");
+    try {
+      spring.joint = output_joint(n, JointMeasure::kAngle, it->second.a, it->second.b);
+    } catch (const Error& e) {
+      joint.fail(e.what());
+    }
+    std::set<Index> read;
+    for (const Attachment3& a : spring.joint->att) {
+      for (const Slot& k : a.r)
+        if (k.is_coordinate()) read.insert(k.coord());
+      for (const Slot& k : a.p)
+        if (k.is_coordinate()) read.insert(k.coord());
+    }
+    spring.joint_coordinates.assign(read.begin(), read.end());
+  }
+  spring.stiffness = non_negative(s.require("stiffness"));
+  if (auto a0 = s.field("free_angle"); a0.present()) spring.free_angle = number(a0);
+  if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
+  return spring;
 }
 
 // A linear spring-damper: `between: [END, END]`, each {part: P, at: [..]} or {point: [..]} (fixed in the world).

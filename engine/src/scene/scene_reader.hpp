@@ -210,6 +210,7 @@ class SceneReader {
   LoadAxes load_axes(const Cursor& c) const;
   double non_negative(const Cursor& c) const;
   LinearSpring linear_spring(const Cursor& s, const Scene& scene, std::set<std::string>& names) const;
+  TorsionalSpring torsional_spring(const Cursor& s, std::set<std::string>& names) const;
 
   // ---- time, output, solver (read_settings.cpp) ---------------------------------------------------------------
   void read_time(const Cursor& c, TimeGrid& o) const;
