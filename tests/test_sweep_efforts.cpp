@@ -130,6 +130,21 @@ TEST(SweepEfforts, ASingularRowHasNoEffort) {
   }
 }
 
+TEST(SweepEfforts, AnAppliedForceAloneGivesTheStaticTorque) {
+  // Massless links, 10 N straight down at the crank's tip A: the motor holds the crank with τ = 10 N · x_A (the
+  // coupler and the rocker, unloaded and massless, carry nothing).
+  const Scene s = parse_scene(effort_scene_text("seed/fourbar_natural.yaml") +
+                                  "parts:\n  crank: {frame: {origin: O, x: A}}\n"
+                                  "loads: {forces: [{name: weight, part: crank, at: [L2, 0], force: [0, -10]}]}\n"
+                                  "output: {efforts: all, coordinates: [xA]}\n",
+                              "held_crank.yaml");
+  const EffortRows r = sweep_efforts(s, s.sweep);
+  ASSERT_EQ(r.t.size(), 361u);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < r.t.size(); ++k) worst = std::max(worst, std::fabs(r.efforts[k][0] - 10.0 * r.q[k](0)));
+  EXPECT_LT(worst, 1e-9);
+}
+
 TEST(SweepEfforts, TheSceneRefusesEffortsItCannotGiveInOneLine) {
   const std::string fourbar = effort_scene_text("seed/fourbar_natural.yaml");
   EXPECT_NE(error_of(fourbar + "output: {efforts: all}\n").find("no part has mass and no load is applied"),

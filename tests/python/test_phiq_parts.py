@@ -119,6 +119,25 @@ def test_effort_and_power_columns_of_the_crank_slider_are_the_closed_form():
     assert abs(effort - exact(result.t[7])) < 1e-9 and abs(power - w * effort) < 1e-9
 
 
+def test_driver_efforts_balance_a_force_on_the_slider():
+    """No masses, a force F = -40 - 10 xB along x on the slider (the scene's loads.forces): the motor's power
+    balances the force's, so its torque is -F dxB/dtheta."""
+    with open(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"), encoding="utf-8") as f:
+        text = f.read()
+    scene = phiq.parse_scene(text + "\nparts:\n  slider: {frame: {at: B}}\n"
+                             "loads:\n  forces: [{name: push, part: slider, force: [-40 - 10*xB, 0]}]\n",
+                             "crank_slider.yaml")
+    result = phiq.run_sweep(scene)
+    _, efforts = phiq.driver_efforts(scene, result)
+    r, L = 0.3, 1.0
+    th = 2.0 * np.asarray(result.t)
+    s, c = np.sin(th), np.cos(th)
+    root = np.sqrt(L * L - r * r * s * s)
+    exact = (40 + 10 * (r * c + root)) * (-r * s - r * r * s * c / root)
+    assert np.max(np.abs(efforts[:, 0] - exact)) < 1e-9 * np.max(np.abs(exact))
+    assert np.max(np.abs(exact)) > 10.0
+
+
 def test_driver_efforts_need_velocities_and_accelerations():
     scene = fourbar_with_parts()
     options = scene.options

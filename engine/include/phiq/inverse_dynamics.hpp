@@ -6,7 +6,8 @@
 ///
 /// b over the parts with mass (phiq/parts.hpp), r_b a part's centre of mass and a_b its acceleration, ω_b, α_b its
 /// angular velocity and acceleration, I_b its inertia about the centre in world axes, ∂/∂q_k from part_jacobian():
-/// the virtual work of gravity and of the inertia forces, in any coordinate family. A driver's effort (the torque
+/// the virtual work of gravity and of the inertia forces, in any coordinate family, plus the applied loads'
+/// (phiq/applied_loads.hpp). A driver's effort (the torque
 /// or force its motor applies, conjugate to what it drives) is −λ of its row, and its power −λ (Φq q̇) = λ Φt.
 #pragma once
 

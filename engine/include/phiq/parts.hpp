@@ -86,9 +86,13 @@ struct Part {
   bool fixed = false;                           ///< its frame reads no coordinate and no time (ground)
 };
 
-/// The loads on a mechanism's parts (the scene's `loads`): a uniform gravity acting at each part's centre of mass.
+struct AppliedLoads;  // phiq/applied_loads.hpp
+
+/// The loads on a mechanism's parts (the scene's `loads`): a uniform gravity acting at each part's centre of mass,
+/// and the applied forces, torques and springs (phiq/applied_loads.hpp), shared: a copy costs a pointer's.
 struct Loads {
-  kin3::V3 gravity;  ///< m/s², world axes, e.g. (0, −9.81, 0) in the plane
+  kin3::V3 gravity;                             ///< m/s², world axes, e.g. (0, −9.81, 0) in the plane
+  std::shared_ptr<const AppliedLoads> applied;  ///< forces, torques, springs; null: none
 };
 
 /// The coordinates `frame` reads (its slots', its expressions'), increasing, each once.

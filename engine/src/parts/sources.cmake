@@ -1,5 +1,6 @@
 # engine/src/parts/: the sources of this stage (engine/CMakeLists.txt includes this file).
 target_sources(phiq_engine PRIVATE
+  ${CMAKE_CURRENT_LIST_DIR}/applied_loads.cpp
   ${CMAKE_CURRENT_LIST_DIR}/curve_tube.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mass_properties.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mesh_file.cpp

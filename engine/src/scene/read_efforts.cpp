@@ -3,6 +3,7 @@
 #include <memory>
 #include <set>
 
+#include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "scene/scene_reader.hpp"
 
@@ -54,7 +55,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       massive->push_back(p);
       massive->back().shapes.clear();
     }
-  if (massive->empty())
+  if (massive->empty() && !(scene.loads.applied && !scene.loads.applied->empty()))
     efforts_field_->fail(
         "no part has mass and no load is applied: every effort would be zero (give parts a mass "
         "or a density, or apply loads)");

@@ -48,13 +48,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   if (auto d = top.field("drivers"); d.present()) read_list(d, [&](const auto& item) { read_driver(item); });
 
   if (auto p = top.field("parts"); p.present()) read_parts(p, scene);  // (before the tables of names are freed)
-  if (auto l = top.field("loads"); l.present()) {
-    l.expect_map({"gravity"});
-    if (auto g = l.field("gravity"); g.present()) {
-      const std::vector<double> v = numbers(g, spatial_ ? 3 : 2);
-      scene.loads.gravity = {v[0], v[1], spatial_ ? v[2] : 0.0};
-    }
-  }
+  if (auto l = top.field("loads"); l.present()) read_loads(l, scene);  // (after the parts they act on)
   read_time(top.require("time"), scene.sweep);
   read_output(top.field("output"), scene.sweep);
   scene.dimension = spatial_ ? 3 : 2;

@@ -9,6 +9,7 @@
 //   read_constraints.cpp constraints, each read by its kind (kinds/registry.hpp, through kind_fields.hpp), and the
 //                        attachments, sides and segments they refer to
 //   read_drivers.cpp     drivers, joint drivers and motion laws
+//   read_loads.cpp       loads: gravity, forces, torques, springs (after the parts they act on)
 //   read_settings.cpp    time, output, solver
 // The readers are templates over the cursor type C: Cursor (a plain entry of the YAML tree) or TCursor (a member
 // of a family, families.hpp). The .cpp that defines a member template used elsewhere instantiates it explicitly
@@ -22,11 +23,13 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
+#include "phiq/applied_loads.hpp"
 #include "phiq/orientation.hpp"
 #include "phiq/scene.hpp"
 #include "scene/families.hpp"
@@ -197,6 +200,17 @@ class SceneReader {
   std::vector<kin3::V3> shape_points(const Cursor& c, std::size_t n, std::size_t least) const;
   Shape read_shape(const Cursor& c) const;
   void read_shape_size(const Cursor& c, Shape& s) const;
+
+  // ---- loads (read_loads.cpp) ---------------------------------------------------------------------------------
+  void read_loads(const Cursor& c, Scene& scene) const;
+  PartFrame load_frame(const Cursor& c, const Scene& scene) const;
+  PartFrame ground_frame() const;
+  kin3::V3 load_vector(const Cursor& c, const char* what) const;
+  std::array<std::shared_ptr<const CompiledExpression>, 3> load_components(const Cursor& c, const char* what) const;
+  LoadAxes load_axes(const Cursor& c) const;
+  double non_negative(const Cursor& c) const;
+  LinearSpring linear_spring(const Cursor& s, const Scene& scene, std::set<std::string>& names) const;
+  TorsionalSpring torsional_spring(const Cursor& s, std::set<std::string>& names) const;
 
   // ---- time, output, solver (read_settings.cpp) ---------------------------------------------------------------
   void read_time(const Cursor& c, TimeGrid& o) const;

@@ -1,6 +1,7 @@
 // add_generalized_forces() and constraint_multipliers() (phiq/inverse_dynamics.hpp).
 #include "phiq/inverse_dynamics.hpp"
 
+#include "phiq/applied_loads.hpp"
 #include "phiq/part_motion.hpp"
 #include "solve/factorisation.hpp"
 
@@ -41,6 +42,7 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
       Q(j.coordinates[i]) += kin3::dot(dc, force) + kin3::dot(j.d_angle[i], moment);
     }
   }
+  if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
 }
 
 SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, const Eigen::VectorXd& Q,

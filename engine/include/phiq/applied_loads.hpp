@@ -1,0 +1,108 @@
+/// @file
+/// Applied loads on a mechanism's parts (the scene's `loads` besides gravity, models/README.md): forces at points
+/// of parts and torques on parts, each a vector of expressions of t, the coordinates and the parameters, in world or
+/// part axes; linear spring-dampers between two points (of parts, or fixed in the world); torsional spring-dampers on
+/// an angle (a coordinate, an expression of the coordinates such as a relative angle ψ3 − ψ2, a spatial joint's).
+///
+/// Their generalized forces are their virtual work, Q_k = Σ ∂x/∂q_k · F + ∂θ/∂q_k · M, from each part's exact
+/// Jacobian (part_jacobian(), phiq/part_motion.hpp), so they hold in every coordinate family; dampers read the
+/// points' velocities from part_motion(). Expressions are compiled once, when the scene is read; evaluating them
+/// reads the compiled tapes only. An expression cannot read q̇ (no name stands for a velocity): a velocity-dependent
+/// load is a damper.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "phiq/output_joints.hpp"
+#include "phiq/parts.hpp"
+
+namespace phiq {
+
+/// The axes a force's or torque's components are given in.
+enum class LoadAxes {
+  kWorld,  ///< the world's
+  kPart,   ///< the part's frame, turning with it
+};
+
+/// A force at a point of a part.
+struct AppliedForce {
+  std::string name;                  ///< the scene's name for it
+  std::string part;                  ///< the part (or body) it acts on
+  PartFrame frame;                   ///< that part's frame
+  kin3::V3 at;                       ///< the point it acts at, in the part's frame
+  LoadAxes axes = LoadAxes::kWorld;  ///< the axes of its components
+  /// Its components (N), expressions of t, q and the parameters; null: 0 (z in the plane).
+  std::array<std::shared_ptr<const CompiledExpression>, 3> components;
+};
+
+/// A torque (a couple) on a part.
+struct AppliedTorque {
+  std::string name;                  ///< the scene's name for it
+  std::string part;                  ///< the part (or body) it acts on
+  PartFrame frame;                   ///< that part's frame
+  LoadAxes axes = LoadAxes::kWorld;  ///< the axes of its components
+  /// Its components (N·m) as for AppliedForce: in the plane only z.
+  std::array<std::shared_ptr<const CompiledExpression>, 3> components;
+};
+
+/// One end of a linear spring: a point of a part, or a point fixed in the world (a ground frame).
+struct SpringEnd {
+  std::string part;  ///< the part (or body) it is on; "ground" for a world point
+  PartFrame frame;   ///< that part's frame (ground's for a world point)
+  kin3::V3 at;       ///< the point, in that frame
+};
+
+/// A linear spring-damper between two points: the tension f = k (L − L0) + c L̇ + preload along the line between
+/// them, pulling them together when positive. Where L = 0 the line has no direction and it exerts nothing.
+struct LinearSpring {
+  std::string name;          ///< the scene's name for it
+  SpringEnd a, b;            ///< its ends
+  double stiffness = 0.0;    ///< k (N/m), ≥ 0
+  double free_length = 0.0;  ///< L0 (m), ≥ 0
+  double damping = 0.0;      ///< c (N·s/m), ≥ 0
+  double preload = 0.0;      ///< tension at L = L0 at rest (N)
+};
+
+/// A torsional spring-damper on an angle θ(q, t): the moment τ = k (θ − θ0) + c θ̇ resisting θ's increase.
+struct TorsionalSpring {
+  std::string name;                                 ///< the scene's name for it
+  std::shared_ptr<const CompiledExpression> angle;  ///< θ: a coordinate, or an expression of them; or null and:
+  /// θ a spatial joint's angle (its kind's measure, phiq/output_joints.hpp), known only modulo a turn: θ − θ0 is
+  /// taken in (−π, π].
+  std::optional<OutputJoint> joint;
+  std::vector<Index> joint_coordinates;  ///< the coordinates the joint's angle reads, increasing
+  double stiffness = 0.0;                ///< k (N·m/rad), ≥ 0
+  double free_angle = 0.0;               ///< θ0 (rad)
+  double damping = 0.0;                  ///< c (N·m·s/rad), ≥ 0
+};
+
+/// The applied loads of a scene, read once and shared (Loads::applied holds them by pointer).
+struct AppliedLoads {
+  std::vector<AppliedForce> forces;                ///< `forces`
+  std::vector<AppliedTorque> torques;              ///< `torques`
+  std::vector<LinearSpring> springs;               ///< `springs`
+  std::vector<TorsionalSpring> torsional_springs;  ///< `torsional_springs`
+  /// True when there is none.
+  bool empty() const { return forces.empty() && torques.empty() && springs.empty() && torsional_springs.empty(); }
+};
+
+/// A force's or torque's components at (q, t) in world axes.
+kin3::V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 3>& components, LoadAxes axes,
+                          const Pose& pose, const double* q, double t);
+
+/// Adds to `Q` (one entry per coordinate) the generalized forces of `loads` at (q, q̇, t): their virtual work per
+/// δq_k. `qd` may be null: the dampers then exert nothing. Pre-condition: Q has an entry for every coordinate the
+/// loads read. Thread-safe.
+void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, double t, Eigen::VectorXd& Q);
+
+/// The power of `loads` at (q, q̇, t) (W): Σ F · v of the forces at their points' velocities, M · ω of the
+/// torques, −f L̇ of the springs, −τ θ̇ of the torsional ones. With frames that do not depend on t it is Q · q̇.
+double applied_power(const AppliedLoads& loads, const double* q, const double* qd, double t);
+
+}  // namespace phiq

@@ -1,0 +1,160 @@
+// add_applied_forces() and applied_power() (phiq/applied_loads.hpp).
+#include "phiq/applied_loads.hpp"
+
+#include <cmath>
+
+#include "phiq/part_motion.hpp"
+
+namespace phiq {
+
+namespace {
+
+using kin3::V3;
+
+// R v: a vector of the frame's axes in the world's.
+V3 turned(const RotationMatrix& r, V3 v) {
+  return {r[0] * v.x + r[1] * v.y + r[2] * v.z, r[3] * v.x + r[4] * v.y + r[5] * v.z,
+          r[6] * v.x + r[7] * v.y + r[8] * v.z};
+}
+
+// Q_k += (∂x/∂q_k) · F for the force F at the body point s of `frame`, and ∂θ/∂q_k · M for the moment M.
+void add_virtual_work(const PartFrame& frame, V3 s, V3 force, V3 moment, const double* q, double t,
+                      Eigen::VectorXd& Q) {
+  thread_local PartJacobian j;  // its vectors' capacity kept from row to row (a sweep's efforts)
+  part_jacobian(frame, q, t, j);
+  if (j.coordinates.empty()) return;
+  const V3 arm = turned(part_pose(frame, q, t).rotation, s);  // R s, world axes
+  for (std::size_t i = 0; i < j.coordinates.size(); ++i)
+    Q(j.coordinates[i]) +=
+        kin3::dot(j.d_origin[i] + kin3::cross(j.d_angle[i], arm), force) + kin3::dot(j.d_angle[i], moment);
+}
+
+// The velocity of a spring's end: 0 without q̇.
+V3 end_velocity(const SpringEnd& e, const double* q, const double* qd, double t) {
+  if (!qd) return {};
+  return part_motion(e.frame, q, qd, nullptr, t).point(e.at).first;
+}
+
+// A spring's state at (q, q̇, t): its ends in the world, the unit vector from a to b, and its tension.
+struct SpringState {
+  V3 xa, xb, unit;
+  double length = 0.0, rate = 0.0, tension = 0.0;
+};
+
+SpringState spring_state(const LinearSpring& s, const double* q, const double* qd, double t) {
+  SpringState st;
+  st.xa = part_pose(s.a.frame, q, t).apply(s.a.at);
+  st.xb = part_pose(s.b.frame, q, t).apply(s.b.at);
+  const V3 d = st.xb - st.xa;
+  st.length = kin3::norm(d);
+  if (st.length == 0.0) return st;  // no direction: no force (LinearSpring)
+  st.unit = (1.0 / st.length) * d;
+  if (s.damping != 0.0) st.rate = kin3::dot(st.unit, end_velocity(s.b, q, qd, t) - end_velocity(s.a, q, qd, t));
+  st.tension = s.stiffness * (st.length - s.free_length) + s.damping * st.rate + s.preload;
+  return st;
+}
+
+// A torsional spring's angle from its free angle, its rate (0 without q̇) and its moment.
+struct AngleState {
+  double from_free = 0.0, rate = 0.0, moment = 0.0;  // θ − θ0, θ̇, τ
+};
+
+// The coordinates a torsional spring's angle reads, increasing.
+const std::vector<Index>& angle_coordinates(const TorsionalSpring& s) {
+  return s.angle ? s.angle->coordinates() : s.joint_coordinates;
+}
+
+// θ − θ0 and ∂θ/∂q_k for angle_coordinates(), into `gradient`: an expression's own gradient, or a joint angle's
+// rate along each coordinate's unit velocity (exact: the rate is linear in q̇).
+double angle_from_free(const TorsionalSpring& s, const double* q, double t, std::vector<double>& gradient) {
+  if (s.angle) {
+    gradient.resize(s.angle->coordinates().size());
+    s.angle->gradient(q, t, gradient.data());
+    return s.angle->value(q, t) - s.free_angle;
+  }
+  const std::vector<Index>& c = s.joint_coordinates;
+  gradient.assign(c.size(), 0.0);
+  if (!c.empty()) {
+    std::vector<double> unit(static_cast<std::size_t>(c.back()) + 1, 0.0);
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      unit[static_cast<std::size_t>(c[i])] = 1.0;
+      gradient[i] = evaluate_joint(*s.joint, q, unit.data(), nullptr).rate;
+      unit[static_cast<std::size_t>(c[i])] = 0.0;
+    }
+  }
+  return std::remainder(evaluate_joint(*s.joint, q, nullptr, nullptr).value - s.free_angle, 2.0 * M_PI);
+}
+
+AngleState angle_state(const TorsionalSpring& s, const double* q, const double* qd, double t,
+                       std::vector<double>& gradient) {
+  AngleState st;
+  st.from_free = angle_from_free(s, q, t, gradient);
+  if (qd) {
+    const std::vector<Index>& c = angle_coordinates(s);
+    st.rate = s.angle ? s.angle->partial_t(q, t) : 0.0;
+    for (std::size_t i = 0; i < c.size(); ++i) st.rate += gradient[i] * qd[c[i]];
+  }
+  st.moment = s.stiffness * st.from_free + s.damping * st.rate;
+  return st;
+}
+
+}  // namespace
+
+V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 3>& components, LoadAxes axes,
+                    const Pose& pose, const double* q, double t) {
+  double v[3] = {0.0, 0.0, 0.0};
+  for (int k = 0; k < 3; ++k)
+    if (components[static_cast<std::size_t>(k)]) v[k] = components[static_cast<std::size_t>(k)]->value(q, t);
+  const V3 c{v[0], v[1], v[2]};
+  return axes == LoadAxes::kPart ? turned(pose.rotation, c) : c;
+}
+
+void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, double t, Eigen::VectorXd& Q) {
+  for (const AppliedForce& f : loads.forces) {
+    const V3 force = world_components(f.components, f.axes, part_pose(f.frame, q, t), q, t);
+    add_virtual_work(f.frame, f.at, force, {}, q, t, Q);
+  }
+  for (const AppliedTorque& m : loads.torques) {
+    const V3 moment = world_components(m.components, m.axes, part_pose(m.frame, q, t), q, t);
+    add_virtual_work(m.frame, {}, {}, moment, q, t, Q);
+  }
+  for (const LinearSpring& s : loads.springs) {
+    const SpringState st = spring_state(s, q, qd, t);
+    // the tension pulls a toward b and b toward a
+    add_virtual_work(s.a.frame, s.a.at, st.tension * st.unit, {}, q, t, Q);
+    add_virtual_work(s.b.frame, s.b.at, -st.tension * st.unit, {}, q, t, Q);
+  }
+  std::vector<double> gradient;
+  for (const TorsionalSpring& s : loads.torsional_springs) {
+    const AngleState st = angle_state(s, q, qd, t, gradient);
+    const std::vector<Index>& c = angle_coordinates(s);
+    for (std::size_t i = 0; i < c.size(); ++i) Q(c[i]) -= st.moment * gradient[i];
+  }
+}
+
+double applied_power(const AppliedLoads& loads, const double* q, const double* qd, double t) {
+  double power = 0.0;
+  for (const AppliedForce& f : loads.forces) {
+    const PartMotion m = part_motion(f.frame, q, qd, nullptr, t);
+    power += kin3::dot(world_components(f.components, f.axes, m.pose, q, t), m.point(f.at).first);
+  }
+  for (const AppliedTorque& tq : loads.torques) {
+    const PartMotion m = part_motion(tq.frame, q, qd, nullptr, t);
+    power += kin3::dot(world_components(tq.components, tq.axes, m.pose, q, t), m.omega);
+  }
+  for (const LinearSpring& s : loads.springs) {
+    const SpringState st = spring_state(s, q, qd, t);
+    if (st.length == 0.0) continue;
+    // the rate of L from the ends' velocities (spring_state() computes it only for a damper)
+    const double rate = kin3::dot(st.unit, end_velocity(s.b, q, qd, t) - end_velocity(s.a, q, qd, t));
+    power -= st.tension * rate;
+  }
+  std::vector<double> gradient;
+  for (const TorsionalSpring& s : loads.torsional_springs) {
+    const AngleState st = angle_state(s, q, qd, t, gradient);
+    power -= st.moment * st.rate;
+  }
+  return power;
+}
+
+}  // namespace phiq

@@ -1,0 +1,207 @@
+// The `loads` section (scene_reader.hpp, models/README.md "Loads"): gravity, and the applied forces, torques,
+// linear and torsional spring-dampers (phiq/applied_loads.hpp), on the scene's parts or on its bodies. Read after
+// the parts, whose frames the loads act on.
+#include <cmath>
+#include <set>
+
+#include "phiq/applied_loads.hpp"
+#include "phiq/text.hpp"
+#include "scene/scene_reader.hpp"
+
+namespace phiq::detail::scene {
+
+namespace {
+
+// A load's name, or its place ("loads.forces[1]") when it has none; refused when another load has it.
+std::string load_name(const Cursor& c, std::set<std::string>& names) {
+  const Cursor n = c.field("name");
+  if (!n.present()) return c.path();
+  std::string name = n.name();
+  if (!names.insert(name).second) n.fail("duplicate load name '" + name + "'");
+  return name;
+}
+
+}  // namespace
+
+void SceneReader::read_loads(const Cursor& c, Scene& scene) const {
+  c.expect_map({"gravity", "forces", "torques", "springs", "torsional_springs"});
+  if (auto g = c.field("gravity"); g.present()) {
+    const std::vector<double> v = numbers(g, spatial_ ? 3 : 2);
+    scene.loads.gravity = {v[0], v[1], spatial_ ? v[2] : 0.0};
+  }
+  auto applied = std::make_shared<AppliedLoads>();
+  std::set<std::string> names;
+  if (auto fs = c.field("forces"); fs.present())
+    for (const Cursor& f : fs.items()) {
+      f.expect_map({"name", "part", "at", "force", "axes"});
+      AppliedForce force;
+      force.name = load_name(f, names);
+      const Cursor part = f.require("part");
+      force.part = part.name();
+      force.frame = load_frame(part, scene);
+      if (auto at = f.field("at"); at.present()) force.at = load_vector(at, "at");
+      force.axes = load_axes(f.field("axes"));
+      force.components = load_components(f.require("force"), "force");
+      applied->forces.push_back(std::move(force));
+    }
+  if (auto ts = c.field("torques"); ts.present())
+    for (const Cursor& m : ts.items()) {
+      m.expect_map({"name", "part", "torque", "axes"});
+      AppliedTorque torque;
+      torque.name = load_name(m, names);
+      const Cursor part = m.require("part");
+      torque.part = part.name();
+      torque.frame = load_frame(part, scene);
+      torque.axes = load_axes(m.field("axes"));
+      const Cursor value = m.require("torque");
+      if (spatial_) {
+        torque.components = load_components(value, "torque");
+      } else {
+        if (!value.is_scalar()) value.fail("a torque in the plane is one number or expression (about z)");
+        torque.components[2] = compile(value, true);
+      }
+      applied->torques.push_back(std::move(torque));
+    }
+  if (auto ss = c.field("springs"); ss.present())
+    for (const Cursor& s : ss.items()) applied->springs.push_back(linear_spring(s, scene, names));
+  if (auto ts = c.field("torsional_springs"); ts.present())
+    for (const Cursor& s : ts.items()) applied->torsional_springs.push_back(torsional_spring(s, names));
+  if (!applied->empty()) scene.loads.applied = std::move(applied);
+}
+
+// The frame of the part, body or ground that `c` names: a part of the scene first, else a body's own frame.
+PartFrame SceneReader::load_frame(const Cursor& c, const Scene& scene) const {
+  const std::string n = c.name();
+  for (const Part& p : scene.parts)
+    if (p.name == n) return p.frame;
+  PartFrame f = ground_frame();
+  if (n == kGround) return f;
+  const Index b = spatial_ ? entry_at(c, n, bodies3_) : entry_at(c, n, bodies_);
+  if (b < 0) c.fail("unknown part '" + n + "' (no part nor body of the scene has that name)");
+  if (spatial_)
+    f.spatial = bodies3_[b];
+  else
+    f.planar = bodies_[b];
+  return f;
+}
+
+PartFrame SceneReader::ground_frame() const {
+  PartFrame f;
+  f.kind = spatial_ ? PartFrameKind::kSpatialBody : PartFrameKind::kPlanarBody;
+  if (spatial_) f.spatial = Frame3::ground();
+  return f;
+}
+
+// A point or vector of constants, [x, y] in the plane, [x, y, z] in space.
+kin3::V3 SceneReader::load_vector(const Cursor& c, const char* what) const {
+  const std::size_t n = spatial_ ? 3 : 2;
+  if (!c.is_sequence() || c.size() != n)
+    c.fail(std::string(what) + " is " + (spatial_ ? "[x, y, z]" : "[x, y]") + " (numbers or constant expressions)");
+  const std::vector<double> v = numbers(c, n);
+  return {v[0], v[1], spatial_ ? v[2] : 0.0};
+}
+
+// A vector of expressions of t, the coordinates and the parameters; the plane's has no z.
+std::array<std::shared_ptr<const CompiledExpression>, 3> SceneReader::load_components(const Cursor& c,
+                                                                                      const char* what) const {
+  const std::size_t n = spatial_ ? 3 : 2;
+  if (!c.is_sequence() || c.size() != n)
+    c.fail(std::string(what) + " is " + (spatial_ ? "[x, y, z]" : "[x, y]") +
+           " (numbers or expressions of t, the coordinates and the parameters)");
+  std::array<std::shared_ptr<const CompiledExpression>, 3> out;
+  for (std::size_t k = 0; k < n; ++k) out[k] = compile(c.at(k), true);
+  return out;
+}
+
+LoadAxes SceneReader::load_axes(const Cursor& c) const {
+  if (!c.present()) return LoadAxes::kWorld;
+  const std::string s = c.text();
+  if (s == "world") return LoadAxes::kWorld;
+  if (s == "part") return LoadAxes::kPart;
+  c.fail("axes is world or part, got '" + s + "'");
+}
+
+double SceneReader::non_negative(const Cursor& c) const {
+  const double v = number(c);
+  if (v < 0.0) c.fail("must not be negative, got " + c.text());
+  return v;
+}
+
+// A torsional spring-damper on `coordinate: NAME`, `angle: EXPRESSION` of the coordinates, or a spatial `joint`'s
+// angle.
+TorsionalSpring SceneReader::torsional_spring(const Cursor& s, std::set<std::string>& names) const {
+  s.expect_map({"name", "coordinate", "angle", "joint", "stiffness", "free_angle", "damping"});
+  TorsionalSpring spring;
+  spring.name = load_name(s, names);
+  const Cursor on_coordinate = s.field("coordinate"), angle = s.field("angle"), joint = s.field("joint");
+  if (on_coordinate.present() + angle.present() + joint.present() != 1)
+    s.fail("a torsional spring acts on one of `coordinate: NAME`, `angle: EXPRESSION` or `joint: NAME`");
+  if (on_coordinate.present()) {
+    const std::string n = builder_.coordinate_name(coordinate(on_coordinate));
+    spring.angle = CompiledExpression::compile(n, resolver(true, n), false);
+  } else if (angle.present()) {
+    spring.angle = compile(angle, false);
+    if (spring.angle->coordinates().empty()) angle.fail("the angle reads no coordinate: the spring exerts nothing");
+  } else {
+    const std::string n = joint.name();
+    if (!spatial_) joint.fail("a joint's angle is a spatial joint's; in the plane write the `angle` of coordinates");
+    const auto it = joints3_.find(n);
+    if (it == joints3_.end()) joint.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
+    if (!it->second.traits.measures.angle)
+      joint.fail("joint '" + n + "' is a " + it->second.type + ": it has no angle");
+    try {
+      spring.joint = output_joint(n, JointMeasure::kAngle, it->second.a, it->second.b);
+    } catch (const Error& e) {
+      joint.fail(e.what());
+    }
+    std::set<Index> read;
+    for (const Attachment3& a : spring.joint->att) {
+      for (const Slot& k : a.r)
+        if (k.is_coordinate()) read.insert(k.coord());
+      for (const Slot& k : a.p)
+        if (k.is_coordinate()) read.insert(k.coord());
+    }
+    spring.joint_coordinates.assign(read.begin(), read.end());
+  }
+  spring.stiffness = non_negative(s.require("stiffness"));
+  if (auto a0 = s.field("free_angle"); a0.present()) spring.free_angle = number(a0);
+  if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
+  return spring;
+}
+
+// A linear spring-damper: `between: [END, END]`, each {part: P, at: [..]} or {point: [..]} (fixed in the world).
+LinearSpring SceneReader::linear_spring(const Cursor& s, const Scene& scene, std::set<std::string>& names) const {
+  s.expect_map({"name", "between", "stiffness", "free_length", "damping", "preload"});
+  LinearSpring spring;
+  spring.name = load_name(s, names);
+  const Cursor between = s.require("between");
+  if (!between.is_sequence() || between.size() != 2)
+    between.fail("between is two ends [{part: A, at: [..]}, {part: B, at: [..]} or {point: [..]}]");
+  SpringEnd* ends[2] = {&spring.a, &spring.b};
+  for (std::size_t k = 0; k < 2; ++k) {
+    const Cursor e = between.at(k);
+    e.expect_map({"part", "at", "point"});
+    SpringEnd& end = *ends[k];
+    if (auto p = e.field("point"); p.present()) {
+      if (e.field("part").present() || e.field("at").present())
+        p.fail("an end is {part: P, at: [..]} or a world {point: [..]}, not both");
+      end.part = kGround;
+      end.frame = ground_frame();
+      end.at = load_vector(p, "point");
+      continue;
+    }
+    const Cursor part = e.require("part");
+    end.part = part.name();
+    end.frame = load_frame(part, scene);
+    if (auto at = e.field("at"); at.present()) end.at = load_vector(at, "at");
+  }
+  if (spring.a.part == spring.b.part && spring.a.at == spring.b.at)
+    between.fail("the spring's two ends are the same point");
+  spring.stiffness = non_negative(s.require("stiffness"));
+  spring.free_length = non_negative(s.require("free_length"));
+  if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
+  if (auto p = s.field("preload"); p.present()) spring.preload = number(p);
+  return spring;
+}
+
+}  // namespace phiq::detail::scene

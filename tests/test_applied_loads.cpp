@@ -1,0 +1,306 @@
+// Applied loads (phiq/applied_loads.hpp, the scene's `loads`): a force on a crank-slider's slider against the
+// motor torque's closed form; springs' and torsional springs' generalized forces against central differences of
+// their potential energy, in natural, reference-point and spatial coordinates; virtual power with masses, gravity,
+// a spring, a damper, a force and a torque in all four formulations of the four-bar; a force in part axes against
+// the same force written in world axes; and the bad input the reader refuses.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "phiq/applied_loads.hpp"
+#include "phiq/inverse_dynamics.hpp"
+#include "phiq/part_motion.hpp"
+#include "phiq/phiq.hpp"
+#include "fourbar_parts.hpp"
+
+namespace phiq {
+namespace {
+
+std::string model_text(const std::string& rel) {
+  std::ifstream in(test::model_path(rel));
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+Eigen::VectorXd applied_q(const Scene& s, const Eigen::VectorXd& q, double t) {
+  Eigen::VectorXd Q = Eigen::VectorXd::Zero(s.model->num_coordinates());
+  add_applied_forces(*s.loads.applied, q.data(), nullptr, t, Q);
+  return Q;
+}
+
+// The potential energy of the scene's springs at (q, t): ½ k (L − L0)² + preload · L, ½ k (θ − θ0)².
+double spring_energy(const AppliedLoads& loads, const Eigen::VectorXd& q, double t) {
+  double v = 0.0;
+  for (const LinearSpring& s : loads.springs) {
+    const double l =
+        kin3::norm(part_pose(s.b.frame, q.data(), t).apply(s.b.at) - part_pose(s.a.frame, q.data(), t).apply(s.a.at));
+    v += 0.5 * s.stiffness * (l - s.free_length) * (l - s.free_length) + s.preload * l;
+  }
+  for (const TorsionalSpring& s : loads.torsional_springs) {
+    const double a =
+        s.angle ? s.angle->value(q.data(), t) - s.free_angle
+                : std::remainder(evaluate_joint(*s.joint, q.data(), nullptr, nullptr).value - s.free_angle, 2 * M_PI);
+    v += 0.5 * s.stiffness * a * a;
+  }
+  return v;
+}
+
+TEST(AppliedLoads, TheCrankSlidersMotorBalancesAForceOnTheSlider) {
+  // F = −40 − 10 xB + 5 sin t on the slider along x, no masses: the motor's power balances the force's,
+  // τ θ̇ + F ẋB = 0, so τ = −F ∂xB/∂θ with xB = r cos θ + √(L² − r² sin² θ)
+  Scene s = parse_scene(model_text("seed/crank_slider_mixed.yaml") +
+                            "\nparts:\n  slider: {frame: {at: B}}\n"
+                            "loads:\n  forces:\n    - {name: push, part: slider, force: [-40 - 10*xB + 5*sin(t), 0]}\n",
+                        "crank_slider.yaml");
+  const Model& m = *s.model;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
+  Workspace ws(m);
+  const Index theta = m.find_coordinate("theta2");
+  const double r = 0.3, L = 1.0;
+  double worst = 0.0, peak = 0.0;
+  std::vector<double> efforts;
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
+    std::string why;
+    ASSERT_EQ(driver_efforts(m, s.parts, s.loads, tr.t[k], ws, efforts, &why), SolveStatus::kSuccess) << why;
+    ASSERT_EQ(efforts.size(), 1u);
+    const double th = tr.q[k](theta), sn = std::sin(th), cs = std::cos(th);
+    const double root = std::sqrt(L * L - r * r * sn * sn);
+    const double xb = r * cs + root, dxb = -r * sn - r * r * sn * cs / root;
+    const double force = -40.0 - 10.0 * xb + 5.0 * std::sin(tr.t[k]);
+    const double exact = -force * dxb;
+    worst = std::max(worst, std::fabs(efforts[0] - exact));
+    peak = std::max(peak, std::fabs(exact));
+  }
+  EXPECT_GT(peak, 10.0);  // newton-metres: the check is not of zeros
+  EXPECT_LT(worst, 1e-9 * peak);
+}
+
+// Q of the springs against −∂V/∂q_k by central differences, every coordinate of the model, at its rough placement.
+void expect_spring_forces_are_the_energys_gradient(const std::string& rel, const std::string& loads) {
+  Scene s = parse_scene(model_text(rel) + "\nloads:\n" + loads, rel);
+  ASSERT_TRUE(s.loads.applied);
+  const AppliedLoads& a = *s.loads.applied;
+  const Eigen::VectorXd q = s.model->initial_positions();
+  const Eigen::VectorXd Q = applied_q(s, q, 0.0);
+  const double h = 1e-6;
+  double worst = 0.0, scale = 0.0;
+  for (Index k = 0; k < q.size(); ++k) {
+    Eigen::VectorXd up = q, down = q;
+    up(k) += h, down(k) -= h;
+    const double fd = -(spring_energy(a, up, 0.0) - spring_energy(a, down, 0.0)) / (2 * h);
+    worst = std::max(worst, std::fabs(Q(k) - fd));
+    scale = std::max(scale, std::fabs(fd));
+  }
+  EXPECT_GT(scale, 1.0) << rel;  // newtons: the springs are loaded at this placement
+  EXPECT_LT(worst, 1e-7 * scale) << rel;
+}
+
+TEST(AppliedLoads, SpringForcesAreTheirEnergysGradientInEveryCoordinateFamily) {
+  expect_spring_forces_are_the_energys_gradient(
+      "seed/fourbar_reference_point.yaml",
+      "  springs:\n"
+      "    - {name: s1, between: [{part: crank, at: [0.1, 0.02]}, {part: rocker, at: [-0.2, 0.05]}],\n"
+      "       stiffness: 300, free_length: 0.5, preload: 7}\n"
+      "    - {name: s2, between: [{point: [0.5, 1.5]}, {part: coupler, at: [0.3, 0]}], stiffness: 80,\n"
+      "       free_length: 0.2}\n"
+      "  torsional_springs:\n"
+      "    - {name: t1, angle: psi3 - psi2, stiffness: 20, free_angle: 0.3}\n"
+      "    - {name: t2, coordinate: psi4, stiffness: 5, free_angle: -0.5}\n");
+  expect_spring_forces_are_the_energys_gradient(
+      "seed/fourbar_natural.yaml",
+      "  springs:\n"
+      "    - {name: s1, between: [{part: crank, at: [0.2, 0.05]}, {part: rocker, at: [0.3, 0.1]}],\n"
+      "       stiffness: 300, free_length: 0.5, preload: -3}\n"
+      "  torsional_springs:\n"
+      "    - {name: t1, angle: \"atan2(yB - yA, xB - xA) - theta2\", stiffness: 20, free_angle: 0.3}\n"
+      "    - {name: t2, coordinate: theta2, stiffness: 5}\n"
+      "parts:\n"
+      "  crank: {frame: {origin: O, x: A}}\n"
+      "  rocker: {frame: {origin: C, x: B}}\n");
+  expect_spring_forces_are_the_energys_gradient(
+      "spatial/rssr.yaml",
+      "  springs:\n"
+      "    - {name: s1, between: [{part: crank, at: [a, 0.05, 0.02]}, {part: rocker, at: [0, b, 0.1]}],\n"
+      "       stiffness: 500, free_length: 0.4}\n"
+      "    - {name: s2, between: [{part: rocker, at: [0.1, 0.2, 0]}, {point: [0.3, 0.3, 0.3]}], stiffness: 50,\n"
+      "       free_length: 0.1}\n"
+      "  torsional_springs:\n"
+      "    - {name: t1, joint: rocker_hinge, stiffness: 20, free_angle: 0.3, damping: 2}\n"
+      "    - {name: t2, joint: crank_hinge, stiffness: 7, free_angle: -2.5}\n");
+}
+
+TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) {
+  // Σ effort × driven rate = d(kinetic)/dt + d(gravity's potential)/dt − power of the applied loads, every row
+  const std::string loads =
+      "loads:\n"
+      "  gravity: [0, -9.81]\n"
+      "  forces:\n"
+      "    - {name: wind, part: coupler, at: [0.1, 0.05], force: [3 + 2*sin(t), -5*cos(t)], axes: part}\n"
+      "  torques:\n"
+      "    - {name: brake, part: rocker, torque: -2 - 0.5*sin(t)}\n"
+      "  springs:\n"
+      "    - {name: spring, between: [{part: crank, at: [0.05, 0.02]}, {part: rocker, at: [0.2, 0.05]}],\n"
+      "       stiffness: 300, free_length: 0.6, preload: 4}\n"
+      "    - {name: damper, between: [{point: [0.5, 1.6]}, {part: coupler, at: [0.2, 0]}], stiffness: 0,\n"
+      "       free_length: 0, damping: 25}\n";
+  for (const std::string form : {"relative", "natural", "reference_point", "mixed"}) {
+    Scene s = parse_scene(
+        test::seed_text("fourbar_" + form + ".yaml") + "\nparts:\n" + test::fourbar_parts(form) + loads, form);
+    const Model& m = *s.model;
+    test::Trace tr;
+    ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess) << form;
+    Workspace ws(m);
+    std::vector<double> efforts;
+    double balance = 0.0, scale = 0.0, loads_power = 0.0;
+    for (std::size_t k = 0; k < tr.t.size(); ++k) {
+      const double t = tr.t[k];
+      ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
+      std::string why;
+      ASSERT_EQ(driver_efforts(m, s.parts, s.loads, t, ws, efforts, &why), SolveStatus::kSuccess) << why;
+      double energy_rate = 0.0;
+      for (const Part& p : s.parts) {
+        const PartMotion pm = part_motion(p.frame, ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
+        const auto [v, a] = pm.point(p.mass.center);
+        energy_rate += p.mass.mass * kin3::dot(v, a) + p.mass.inertia[8] * pm.omega.z * pm.alpha.z -
+                       p.mass.mass * kin3::dot(s.loads.gravity, v);
+      }
+      const double power = applied_power(*s.loads.applied, ws.q.data(), ws.qd.data(), t);
+      balance = std::max(balance, std::fabs(efforts[0] * 1.0 - (energy_rate - power)));  // θ̇ = 1 rad/s
+      scale = std::max(scale, std::fabs(efforts[0]));
+      loads_power = std::max(loads_power, std::fabs(power));
+    }
+    EXPECT_GT(loads_power, 1.0) << form;  // watts: the loads take part in the balance
+    EXPECT_LT(balance, 1e-9 * scale) << form;
+  }
+}
+
+// ω · (R I Rᵀ α): the rate of a part's rotational kinetic energy ½ ω · I_world ω (the rate of I_world does no work).
+double rotational_energy_rate(const Part& p, const PartMotion& pm) {
+  const RotationMatrix& r = pm.pose.rotation;
+  const kin3::V3 a = pm.alpha;
+  const double b[3] = {r[0] * a.x + r[3] * a.y + r[6] * a.z, r[1] * a.x + r[4] * a.y + r[7] * a.z,
+                       r[2] * a.x + r[5] * a.y + r[8] * a.z};
+  double c[3];
+  for (int i = 0; i < 3; ++i)
+    c[i] = p.mass.inertia[3 * i] * b[0] + p.mass.inertia[3 * i + 1] * b[1] + p.mass.inertia[3 * i + 2] * b[2];
+  const kin3::V3 d{r[0] * c[0] + r[1] * c[1] + r[2] * c[2], r[3] * c[0] + r[4] * c[1] + r[5] * c[2],
+                   r[6] * c[0] + r[7] * c[1] + r[8] * c[2]};
+  return kin3::dot(pm.omega, d);
+}
+
+TEST(AppliedLoads, DriverPowerBalancesInSpaceWithAJointSpringAndLoadsInPartAxes) {
+  Scene s =
+      parse_scene(model_text("spatial/rssr.yaml") +
+                      "\nparts:\n"
+                      "  crank: {mass: 1.0, center_of_mass: [0.1, 0, 0], inertia: [0.01, 0.02, 0.025]}\n"
+                      "  rocker: {mass: 2.0, center_of_mass: [0, 0.25, 0], inertia: [0.05, 0.01, 0.05]}\n"
+                      "loads:\n"
+                      "  gravity: [0, 0, -9.81]\n"
+                      "  forces: [{part: crank, at: [a, 0, 0], force: [5, 2*sin(t), 3], axes: part}]\n"
+                      "  torques: [{part: rocker, torque: [1 + 0.5*cos(t), 0.5, -0.2], axes: part}]\n"
+                      "  torsional_springs: [{joint: rocker_hinge, stiffness: 15, free_angle: 1.2, damping: 3}]\n",
+                  "rssr.yaml");
+  const Model& m = *s.model;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
+  Workspace ws(m);
+  std::vector<double> efforts;
+  double balance = 0.0, scale = 0.0, loads_power = 0.0;
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    const double t = tr.t[k];
+    ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
+    std::string why;
+    ASSERT_EQ(driver_efforts(m, s.parts, s.loads, t, ws, efforts, &why), SolveStatus::kSuccess) << why;
+    double energy_rate = 0.0;
+    for (const Part& p : s.parts) {
+      const PartMotion pm = part_motion(p.frame, ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
+      const auto [v, a] = pm.point(p.mass.center);
+      energy_rate +=
+          p.mass.mass * kin3::dot(v, a) + rotational_energy_rate(p, pm) - p.mass.mass * kin3::dot(s.loads.gravity, v);
+    }
+    const double power = applied_power(*s.loads.applied, ws.q.data(), ws.qd.data(), t);
+    balance = std::max(balance, std::fabs(efforts[0] * 1.0 - (energy_rate - power)));  // the hinge turns at 1 rad/s
+    scale = std::max(scale, std::fabs(efforts[0]));
+    loads_power = std::max(loads_power, std::fabs(power));
+  }
+  EXPECT_GT(loads_power, 1.0);
+  EXPECT_LT(balance, 1e-9 * scale);
+}
+
+TEST(AppliedLoads, AForceInPartAxesIsTheSameForceTurnedIntoWorldAxes) {
+  // (30, 40) N in the crank's axes at a point of it, and the same written in world axes from the crank's angle
+  struct Form {
+    std::string rel, parts, world;
+  };
+  const Form forms[] = {
+      {"seed/fourbar_reference_point.yaml", "", "[30*cos(psi2) - 40*sin(psi2), 30*sin(psi2) + 40*cos(psi2)]"},
+      {"seed/fourbar_natural.yaml", "parts:\n  crank: {frame: {origin: O, x: A}}\n",
+       "[(30*xA - 40*yA)/sqrt(xA^2 + yA^2), (30*yA + 40*xA)/sqrt(xA^2 + yA^2)]"}};
+  for (const Form& f : forms) {
+    auto with_force = [&](const std::string& force, const std::string& axes) {
+      return parse_scene(model_text(f.rel) + "\n" + f.parts +
+                             "loads:\n  forces:\n    - {part: crank, at: [0.1, 0.02], " + "force: " + force +
+                             ", axes: " + axes + "}\n",
+                         f.rel);
+    };
+    const Scene in_part = with_force("[30, 40]", "part"), in_world = with_force(f.world, "world");
+    Eigen::VectorXd q = in_part.model->initial_positions();
+    for (int trial = 0; trial < 3; ++trial) {
+      for (Index k = 0; k < q.size(); ++k) q(k) += 0.1 * std::sin(1.0 + k + 7.0 * trial);  // a generic placement
+      const Eigen::VectorXd a = applied_q(in_part, q, 0.0), b = applied_q(in_world, q, 0.0);
+      EXPECT_GT(a.norm(), 1.0) << f.rel;
+      EXPECT_LT((a - b).norm(), 1e-12 * a.norm()) << f.rel << "\n" << a.transpose() << "\n" << b.transpose();
+    }
+  }
+}
+
+TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
+  const std::string base = test::seed_text("fourbar_reference_point.yaml") + "\nloads:\n";
+  auto error = [&](const std::string& loads) { return test::scene_error(base + loads); };
+  std::string m = error("  forces:\n    - {part: wheel, force: [1, 0]}\n");
+  EXPECT_HAS(m, "loads.forces[0].part: unknown part 'wheel'");
+  m = error("  torsional_springs:\n    - {coordinate: psi9, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].coordinate: unknown coordinate 'psi9'");
+  m = error("  forces:\n    - {part: crank, force: [1, 0, 0]}\n");
+  EXPECT_HAS(m, "loads.forces[0].force: force is [x, y]");
+  m = error("  forces:\n    - {part: crank, at: [0.1, 0, 0], force: [1, 0]}\n");
+  EXPECT_HAS(m, "loads.forces[0].at: at is [x, y]");
+  m = error("  forces:\n    - {part: crank, force: [1, 0], where: 2}\n");
+  EXPECT_HAS(m, "loads.forces[0].where: unknown field 'where'");
+  m = error("  forces:\n    - {part: crank, force: [1, 0], axes: body}\n");
+  EXPECT_HAS(m, "loads.forces[0].axes: axes is world or part, got 'body'");
+  m = error("  torques:\n    - {part: crank, torque: [0, 0, 1]}\n");
+  EXPECT_HAS(m, "loads.torques[0].torque: a torque in the plane is one number or expression");
+  m = error(
+      "  springs:\n    - {between: [{part: crank}, {point: [1, 0]}], stiffness: 10, free_length: 1, damping: -2}\n");
+  EXPECT_HAS(m, "loads.springs[0].damping: must not be negative, got -2");
+  m = error(
+      "  springs:\n    - {between: [{part: crank, at: [0.1, 0]}, {part: crank, at: [0.1, 0]}], stiffness: 10, "
+      "free_length: 1}\n");
+  EXPECT_HAS(m, "loads.springs[0].between: the spring's two ends are the same point");
+  m = error(
+      "  springs:\n    - {between: [{part: crank, point: [1, 0]}, {part: rocker}], stiffness: 1, free_length: 1}\n");
+  EXPECT_HAS(m, "loads.springs[0].between[0].point: an end is {part: P, at: [..]} or a world {point: [..]}");
+  m = error("  torsional_springs:\n    - {angle: psi3 - psi2 + foo, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].angle:");
+  EXPECT_HAS(m, "foo");
+  m = error("  torques:\n    - {name: a, part: crank, torque: 1}\n    - {name: a, part: rocker, torque: 1}\n");
+  EXPECT_HAS(m, "loads.torques[1].name: duplicate load name 'a'");
+  m = error("  torsional_springs:\n    - {joint: O, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].joint: a joint's angle is a spatial joint's");
+  m = error("  torsional_springs:\n    - {coordinate: psi2, angle: psi2, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0]: a torsional spring acts on one of");
+  const std::string rssr = model_text("spatial/rssr.yaml") + "\nloads:\n  torsional_springs:\n";
+  m = test::scene_error(rssr + "    - {joint: hinge, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].joint: unknown joint 'hinge'");
+  m = test::scene_error(rssr + "    - {joint: coupler, stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].joint: unknown joint 'coupler'");  // a distance: no joint
+  m = test::scene_error(model_text("spatial/rssr.yaml") + "\nloads:\n  torques: [{part: crank, torque: 1}]\n");
+  EXPECT_HAS(m, "loads.torques[0].torque: torque is [x, y, z]");
+}
+
+}  // namespace
+}  // namespace phiq
