@@ -262,6 +262,54 @@ TEST(AsmtImport, RackTravelsPitchRadiusTimesThePinionsTurn) {
   EXPECT_LE(worst, 1e-10);
 }
 
+// tests/data/asmt/joint_zoo.asmt: one part per joint type on a ground marker, each placed (with turned markers,
+// offsets, an angle and a distance) so that OndselSolver's definition of its joint holds exactly. phiq's rows must
+// vanish there and leave each part the freedoms its joint leaves: Σ (6 − removed) = 0 fixed + 1 revolute + 2
+// cylindrical + 1 translational + 3 spherical + 2 universal + 3 planar + 5 point-in-plane + 4 point-in-line + 4
+// line-in-plane + 4 parallel + 5 perpendicular + 5 angle + 3 no-rotation + 5 sph-sph = 47.
+Eigen::VectorXd AsmtResidualAtPlacement(const std::string& text) {
+  const Scene scene = parse_scene(import_asmt(text, "zoo.asmt").yaml, "zoo.asmt");
+  Eigen::VectorXd phi(scene.model->num_equations());
+  scene.model->residual(scene.model->initial_positions().data(), 0.0, phi.data());
+  return phi;
+}
+
+TEST(AsmtImport, EveryJointTypeHoldsAtItsPlacementAndLeavesItsFreedoms) {
+  const std::string text = AsmtText(AsmtOwn("joint_zoo.asmt"));
+  const AsmtImport imported = import_asmt(text, "zoo.asmt");
+  EXPECT_EQ(imported.parts, 15);
+  EXPECT_EQ(imported.joints, 15);
+  const Scene scene = parse_scene(imported.yaml, "zoo.asmt");
+  // rows: 6+5+4+5+3+4+3+1+2 = 33 of the direct kinds; line-in-plane 1 + 1 dot, parallel 2 dots, perpendicular
+  // 1, angle 1, no-rotation 3, sph-sph 1: 10; the dots' 11 natural points on the parts (o, z; o, z; o, z; o, z;
+  // o, x, y: a ground marker's are constants) pinned by 3 rows each; 15 normalisations
+  EXPECT_EQ(scene.model->num_equations(), 33 + 10 + 3 * 11 + 15);
+  EXPECT_EQ(scene.model->num_coordinates(), 15 * 7 + 3 * 11);
+  EXPECT_LE(AsmtResidualAtPlacement(text).cwiseAbs().maxCoeff(), 1e-14);
+  Eigen::VectorXd q = scene.model->initial_positions();
+  AssemblySummary summary;
+  ASSERT_EQ(assemble(*scene.model, 0.0, {}, q, &summary), SolveStatus::kSuccess) << summary.message;
+  EXPECT_EQ(summary.rank.rank, scene.model->num_equations());  // no row redundant
+  EXPECT_EQ(summary.rank.dof, 47);
+  EXPECT_LE(summary.moved, 1e-13);
+  // the offsets, the angle and the distance are read, each with its sign: moved by 0.1, its row is off by what
+  // OndselSolver's definition gives
+  const std::pair<std::string, double> moved[] = {
+      {"offset\n\t\t\t\t\t0.3\n", 0.1},                                       // planar: z_I·(P_J − P_I) − offset
+      {"offset\n\t\t\t\t\t-0.2\n", 0.1},                                      // point in plane
+      {"theIzJz\n\t\t\t\t\t0.7\n", std::cos(0.7) - std::cos(0.8)},            // z_I·z_J − cos θ
+      {"distanceIJ\n\t\t\t\t\t1.5\n", (1.5 * 1.5 - 1.6 * 1.6) / (2 * 1.6)}};  // (|d|² − L²)/2L
+  for (const auto& [field, expected] : moved) {
+    SCOPED_TRACE(field);
+    const std::size_t at = field.rfind('\t') + 1;
+    const double value = std::stod(field.substr(at));
+    const std::string changed = field.substr(0, at) + shortest(value + (value < 0 ? -0.1 : 0.1)) + "\n";
+    ASSERT_NE(text.find(field), std::string::npos);
+    const Eigen::VectorXd phi = AsmtResidualAtPlacement(test::replace_first(text, field, changed));
+    EXPECT_NEAR(phi.cwiseAbs().maxCoeff(), std::abs(expected), 1e-12);
+  }
+}
+
 // The one-line message of an .asmt text (empty when it converts and loads).
 std::string AsmtError(const std::string& text) {
   try {
