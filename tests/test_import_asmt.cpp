@@ -262,6 +262,21 @@ TEST(AsmtImport, RackTravelsPitchRadiusTimesThePinionsTurn) {
   EXPECT_LE(worst, 1e-10);
 }
 
+TEST(AsmtImport, DrivenScrewRisesItsPitchPerTurn) {
+  const AsmtRun r = AsmtSweep(AsmtOwn("screw_driven.asmt"));
+  ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
+  ASSERT_EQ(r.trace.q.size(), 13u);
+  double worst = 0.0;
+  for (std::size_t k = 0; k < r.trace.q.size(); ++k) {
+    const double t = r.trace.t[k];
+    const Eigen::Vector3d nut = AsmtBodyPosition(*r.scene.model, r.trace.q[k], "Nut");
+    worst = std::max(worst, (nut - Eigen::Vector3d(0, 0, 1 + 0.5 * t / (2 * M_PI))).norm());
+    const Eigen::Matrix3d turn = Eigen::AngleAxisd(t, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    worst = std::max(worst, (AsmtBodyRotation(*r.scene.model, r.trace.q[k], "Nut") - turn).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(worst, 1e-10);
+}
+
 // tests/data/asmt/joint_zoo.asmt: one part per joint type on a ground marker, each placed (with turned markers,
 // offsets, an angle and a distance) so that OndselSolver's definition of its joint holds exactly. phiq's rows must
 // vanish there and leave each part the freedoms its joint leaves: Σ (6 − removed) = 0 fixed + 1 revolute + 2

@@ -92,7 +92,7 @@ class SceneWriter {
   double value(const Joint& j, const std::string& key, double fallback, bool required = false) const;
   void joint(const Joint& j);
   void gear(const Joint& j, const std::string& name, const Where& wi, const Where& wj);
-  void rack_pinion(const Joint& j, const std::string& name, const Where& wi, const Where& wj);
+  void travel_and_turn(const std::string& name, const Where& wi, const Where& wj, int axis_k, double per_turn);
   void motion(const Motion& m);
   std::string time_grid() const;
   std::string parts_and_mass();
@@ -171,9 +171,9 @@ void SceneWriter::joint(const Joint& j) {
                                                             {"PointInPlaneJoint", "point_on_plane"},
                                                             {"PointInLineJoint", "point_on_line"}};
   static const std::map<std::string, std::set<std::string>> fields = {
-      {"PlanarJoint", {"offset"}},         {"PointInPlaneJoint", {"offset"}}, {"LineInPlaneJoint", {"offset"}},
-      {"AngleJoint", {"theIzJz"}},         {"SphSphJoint", {"distanceIJ"}},   {"GearJoint", {"radiusI", "radiusJ"}},
-      {"RackPinionJoint", {"pitchRadius"}}};
+      {"PlanarJoint", {"offset"}},          {"PointInPlaneJoint", {"offset"}}, {"LineInPlaneJoint", {"offset"}},
+      {"AngleJoint", {"theIzJz"}},          {"SphSphJoint", {"distanceIJ"}},   {"GearJoint", {"radiusI", "radiusJ"}},
+      {"RackPinionJoint", {"pitchRadius"}}, {"ScrewJoint", {"pitch"}}};
   const bool known = direct.count(j.type) || fields.count(j.type) || j.type == "ParallelAxesJoint" ||
                      j.type == "PerpendicularJoint" || j.type == "NoRotationJoint";
   if (!known)
@@ -216,8 +216,10 @@ void SceneWriter::joint(const Joint& j) {
                  << "], length: " << num(value(j, "distanceIJ", 0.0, true)) << "}\n";
   } else if (j.type == "GearJoint") {
     gear(j, name, wi, wj);
-  } else {
-    rack_pinion(j, name, wi, wj);
+  } else if (j.type == "ScrewJoint") {  // 2π z − pitch θ = c: z = pitch θ / 2π + c'
+    travel_and_turn(name, wi, wj, 2, -value(j, "pitch", 0.0, true) / (2 * M_PI));
+  } else {  // x + pitchRadius θ = c
+    travel_and_turn(name, wi, wj, 0, value(j, "pitchRadius", 0.0, true));
   }
 }
 
@@ -243,17 +245,17 @@ void SceneWriter::gear(const Joint& j, const std::string& name, const Where& wi,
                << "], coefficients: [1, " << num(ratio) << "], constant: " << num(orbit_j + ratio * orbit_i) << "}\n";
 }
 
-// OndselSolver's rack and pinion: J's displacement along I's x plus pitchRadius times J's turn about I's z, held
-// at its value in the file's placement.
-void SceneWriter::rack_pinion(const Joint& j, const std::string& name, const Where& wi, const Where& wj) {
-  const double r = value(j, "pitchRadius", 0.0, true);
+// OndselSolver's rack and pinion and screw, one row each: J's travel along I's x (rack) or z (screw), plus
+// `per_turn` times J's turn about I's z (phiq's rotation_angle), held at its value in the file's placement.
+void SceneWriter::travel_and_turn(const std::string& name, const Where& wi, const Where& wj, int axis_k,
+                                  double per_turn) {
   std::array<std::string, 3> o, x, p;
   point(name + "_I_o", wi, Eigen::Vector3d::Zero(), &o);
-  point(name + "_I_x", wi, Eigen::Vector3d::UnitX(), &x);
+  point(name + "_I_" + "xyz"[axis_k], wi, Eigen::Vector3d::Unit(axis_k), &x);
   point(name + "_J_o", wj, Eigen::Vector3d::Zero(), &p);
   const Eigen::Matrix3d &Ri = wi.world.R, &Rj = wj.world.R;
   const double turn = std::atan2(Ri.col(1).dot(Rj.col(0)), Ri.col(0).dot(Rj.col(0)));
-  const double along = Ri.col(0).dot(wj.world.p - wi.world.p);
+  const double travel = Ri.col(axis_k).dot(wj.world.p - wi.world.p);
   const std::string th = names_.make(name + "_turn");
   coordinates_ << "  " << th << ": " << num(turn) << "\n";
   constraints_ << "  - {name: " << names_.make(th + "_def") << ", type: rotation_angle, between: [" << side(wi) << ", "
@@ -261,7 +263,7 @@ void SceneWriter::rack_pinion(const Joint& j, const std::string& name, const Whe
   std::string expr;
   for (std::size_t i = 0; i < 3; ++i)
     expr += (i ? " + " : "") + std::string("(") + x[i] + " - " + o[i] + ")*(" + p[i] + " - " + o[i] + ")";
-  expr += " + " + num(r) + "*" + th + " - (" + num(along + r * turn) + ")";
+  expr += " + (" + num(per_turn) + ")*" + th + " - (" + num(travel + per_turn * turn) + ")";
   constraints_ << "  - {name: " << name << ", type: equation, unit: length, expr: \"" << expr << "\"}\n";
 }
 

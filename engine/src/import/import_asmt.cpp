@@ -30,7 +30,8 @@ bool is_asmt_path(const std::string& path) {
   return ext == ".asmt";
 }
 
-namespace {
+namespace detail::asmt {
+namespace {  // (in detail::asmt: a unity build may join this file with others' anonymous helpers)
 
 // The tab-separated fields of one line, trailing blanks dropped.
 std::vector<std::string> fields(const std::string& line) {
@@ -52,21 +53,23 @@ std::vector<std::string> fields(const std::string& line) {
 std::vector<double> row_values(const std::vector<std::string>& f, std::size_t count, const std::string& path,
                                int line) {
   if (f.size() != count + 2)
-    detail::asmt::refuse(path, line,
-                         "TimeSeries row '" + f[0] + "' has " + std::to_string(f.size() - 1) +
-                             " values; the Time row has " + std::to_string(count + 1));
+    refuse(path, line,
+           "TimeSeries row '" + f[0] + "' has " + std::to_string(f.size() - 1) + " values; the Time row has " +
+               std::to_string(count + 1));
   std::vector<double> v;
   for (std::size_t k = 2; k < f.size(); ++k) {
     char* end = nullptr;
     v.push_back(std::strtod(f[k].c_str(), &end));
-    if (end == f[k].c_str() || *end) detail::asmt::refuse(path, line, "'" + f[k] + "' is not a number");
+    if (end == f[k].c_str() || *end) refuse(path, line, "'" + f[k] + "' is not a number");
   }
   return v;
 }
 
 }  // namespace
+}  // namespace detail::asmt
 
 AsmtTimeSeries read_asmt_time_series(const std::string& text, const std::string& path) {
+  using detail::asmt::fields, detail::asmt::row_values;
   AsmtTimeSeries out;
   std::size_t at = 0;
   bool inside = false;
