@@ -43,9 +43,10 @@ struct AsmtRun {
   SolveStatus status = SolveStatus::kSuccess;
   std::string message;
 };
-AsmtRun AsmtSweep(const std::string& path, double tolerance = 1e-10) {
+AsmtRun AsmtSweep(const std::string& path, double tolerance = 1e-10, bool velocities = false) {
   AsmtRun r;
   r.scene = load_scene(path);
+  r.scene.sweep.velocities = velocities;
   r.scene.sweep.newton.tolerance = r.scene.sweep.assembly.tolerance = tolerance;
   SquareScene square;
   const SolveStatus prepared = prepare_scene(*r.scene.model, r.scene.sweep.t_begin, r.scene.sweep.assembly, &square);
@@ -205,6 +206,35 @@ TEST(AsmtImport, GearsFollowTheirTimeSeries) {
     EXPECT_LE(d.motion, 10 * tolerance);    // 1e-10: 6.0e-11, 1e-13: 4.5e-14
     EXPECT_LE(d.placement, 1e-14);          // 8.0e-15
   }
+}
+
+// Gears.asmt's stored velocities (its README: consistent, unlike parm.asmt's): each part's VX, VY, VZ against q̇ of
+// its reference point, OmegaX, OmegaY, OmegaZ (world frame) against 2 E(e) ė of its Euler parameters.
+TEST(AsmtImport, GearsVelocitiesFollowTheirTimeSeries) {
+  PHIQ_NEED_ASMT_SAMPLES();
+  const std::string path = AsmtSample("Gears.asmt");
+  const AsmtTimeSeries series = read_asmt_time_series(AsmtText(path), path);
+  const AsmtRun r = AsmtSweep(path, 1e-13, true);
+  ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
+  ASSERT_EQ(r.trace.qd.size(), series.time.size());
+  double dv = 0.0, dw = 0.0;
+  for (const AsmtPartSeries& part : series.parts) {
+    ASSERT_EQ(part.labels[9], "OmegaX");
+    const Index x = r.scene.model->coordinate_index(part.name + "_x"), e = x + 3;
+    for (std::size_t k = 0; k < series.time.size(); ++k) {
+      auto at = [&](int row) { return part.columns[static_cast<std::size_t>(row)][k]; };
+      const Eigen::VectorXd &q = r.trace.q[k], &qd = r.trace.qd[k];
+      dv = std::max(dv, (qd.segment<3>(x) - Eigen::Vector3d(at(6), at(7), at(8))).cwiseAbs().maxCoeff());
+      Eigen::Matrix<double, 3, 4> E;
+      E << -q(e + 1), q(e), -q(e + 3), q(e + 2), -q(e + 2), q(e + 3), q(e), -q(e + 1), -q(e + 3), -q(e + 2), q(e + 1),
+          q(e);
+      const Eigen::Vector3d omega = 2 * E * qd.segment<4>(e);
+      dw = std::max(dw, (omega - Eigen::Vector3d(at(9), at(10), at(11))).cwiseAbs().maxCoeff());
+    }
+  }
+  std::printf("Gears.asmt velocities: reference points within %.3g, angular velocities within %.3g\n", dv, dw);
+  EXPECT_LE(dv, 1e-9);
+  EXPECT_LE(dw, 1e-9);
 }
 
 TEST(AsmtImport, ParallelogramFollowsItsTimeSeries) {
@@ -381,12 +411,17 @@ TEST_F(Cli, AsmtRunsDirectlyAndThroughConvertToTheSameBytes) {
     EXPECT_GT(a.size(), 100u);
     EXPECT_EQ(a, b);
   }
-  // a bad file: one line, exit 2, nothing written
+  // a bad file, or none: one line naming it, exit 2, nothing written
   const fs::path bad = write("bad.asmt", "OndselSolver\nAssembly\n\tName\n");
-  const Result r = run("convert " + bad.string() + " -o " + (dir_ / "out.yaml").string());
-  EXPECT_EQ(r.code, 2);
-  EXPECT_TRUE(one_phiq_line(r.err));
-  EXPECT_FALSE(fs::exists(dir_ / "out.yaml"));
+  for (const std::string& command : {"convert " + bad.string() + " -o ", "run " + bad.string() + " -o ",
+                                     "run " + (dir_ / "none.asmt").string() + " -o "}) {
+    SCOPED_TRACE(command);
+    const Result r = run(command + (dir_ / "out.yaml").string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(one_phiq_line(r.err));
+    EXPECT_NE(r.err.find(".asmt:"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out.yaml"));
+  }
 }
 
 }  // namespace test

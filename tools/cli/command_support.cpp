@@ -6,8 +6,6 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <iostream>
 
 #include "phiq/text.hpp"
@@ -117,15 +115,8 @@ void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args) {
 
 // (command_support.hpp)
 std::optional<AsmtImport> import_or_report(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    fail(path + ": cannot be read", 2);
-    return std::nullopt;
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
   try {
-    AsmtImport imported = import_asmt(text.str(), path);
+    AsmtImport imported = import_asmt_file(path);
     for (const std::string& why : imported.skipped)
       std::fprintf(stderr, "phiq: not mapped: %s\n", printable(why).c_str());
     return imported;

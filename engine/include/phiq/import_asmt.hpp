@@ -24,6 +24,10 @@ struct AsmtImport {
 /// no phiq kind, a marker of an unknown part, a general motion, ...): never an approximation.
 AsmtImport import_asmt(const std::string& text, const std::string& path);
 
+/// import_asmt() of the file at `path`, read as load_scene() reads a scene (its size limit; FIFOs, directories and
+/// devices handled as there). Throws SceneError "PATH: REASON" when it cannot be read, and as import_asmt().
+AsmtImport import_asmt_file(const std::string& path);
+
 /// True when `path` ends in `.asmt` (any case): what load_scene() and the command line convert first.
 bool is_asmt_path(const std::string& path);
 

@@ -9,6 +9,7 @@
 
 #include "import/asmt_model.hpp"
 #include "phiq/scene.hpp"
+#include "scene/read_scene_file.hpp"
 
 namespace phiq {
 
@@ -21,6 +22,10 @@ AsmtImport import_asmt(const std::string& text, const std::string& path) {
   out.yaml = detail::asmt::write_scene(a);
   out.skipped = std::move(a.skipped);
   return out;
+}
+
+AsmtImport import_asmt_file(const std::string& path) {
+  return import_asmt(detail::scene::read_scene_file(path, SceneLimits{}), path);
 }
 
 bool is_asmt_path(const std::string& path) {
