@@ -355,6 +355,27 @@ TEST(AsmtImport, EveryJointTypeHoldsAtItsPlacementAndLeavesItsFreedoms) {
   }
 }
 
+// tests/data/asmt/compound_joints.asmt: OndselSolver's compound joints, each on a ground marker at a placement that
+// holds it: x² + y² = distanceIJ² of J's origin in I's frame (CylSph; 1 freedom removed), with z axes parallel
+// (RevCyl; 3) and J's origin in I's x-y plane (RevRev; 4): 5 + 3 + 2 freedoms left.
+TEST(AsmtImport, CompoundJointsHoldAtTheirPlacementAndLeaveTheirFreedoms) {
+  const std::string text = AsmtText(AsmtOwn("compound_joints.asmt"));
+  const Scene scene = parse_scene(import_asmt(text, "compound.asmt").yaml, "compound.asmt");
+  // 3 parts; natural points on the parts: CylSph J's origin, RevCyl's and RevRev's J origin, x and y tips
+  EXPECT_EQ(scene.model->num_coordinates(), 3 * 7 + 3 * 7);
+  EXPECT_EQ(scene.model->num_equations(), 3 + 3 * 7 + 1 + 3 + 4);
+  EXPECT_LE(AsmtResidualAtPlacement(text).cwiseAbs().maxCoeff(), 1e-14);
+  Eigen::VectorXd q = scene.model->initial_positions();
+  AssemblySummary summary;
+  ASSERT_EQ(assemble(*scene.model, 0.0, {}, q, &summary), SolveStatus::kSuccess) << summary.message;
+  EXPECT_EQ(summary.rank.rank, scene.model->num_equations());
+  EXPECT_EQ(summary.rank.dof, 10);
+  // the first distanceIJ (CylSph's) made 1.1: its row (x² + y² − L²)/2L
+  const std::string field = "distanceIJ\n\t\t\t\t\t1.0\n";
+  const Eigen::VectorXd phi = AsmtResidualAtPlacement(test::replace_first(text, field, "distanceIJ\n\t\t\t\t\t1.1\n"));
+  EXPECT_NEAR(phi.cwiseAbs().maxCoeff(), (1.1 * 1.1 - 1.0) / 2.2, 1e-12);
+}
+
 // The one-line message of an .asmt text (empty when it converts and loads).
 std::string AsmtError(const std::string& text) {
   try {

@@ -92,6 +92,7 @@ class SceneWriter {
   double value(const Joint& j, const std::string& key, double fallback, bool required = false) const;
   void joint(const Joint& j);
   void gear(const Joint& j, const std::string& name, const Where& wi, const Where& wj);
+  void radial_distance(const Joint& j, const std::string& name, const Where& wi, const Where& wj);
   void travel_and_turn(const std::string& name, const Where& wi, const Where& wj, int axis_k, double per_turn);
   void motion(const Motion& m);
   std::string time_grid() const;
@@ -173,7 +174,8 @@ void SceneWriter::joint(const Joint& j) {
   static const std::map<std::string, std::set<std::string>> fields = {
       {"PlanarJoint", {"offset"}},          {"PointInPlaneJoint", {"offset"}}, {"LineInPlaneJoint", {"offset"}},
       {"AngleJoint", {"theIzJz"}},          {"SphSphJoint", {"distanceIJ"}},   {"GearJoint", {"radiusI", "radiusJ"}},
-      {"RackPinionJoint", {"pitchRadius"}}, {"ScrewJoint", {"pitch"}}};
+      {"RackPinionJoint", {"pitchRadius"}}, {"ScrewJoint", {"pitch"}},         {"CylSphJoint", {"distanceIJ"}},
+      {"RevCylJoint", {"distanceIJ"}},      {"RevRevJoint", {"distanceIJ"}}};
   const bool known = direct.count(j.type) || fields.count(j.type) || j.type == "ParallelAxesJoint" ||
                      j.type == "PerpendicularJoint" || j.type == "NoRotationJoint";
   if (!known)
@@ -214,6 +216,15 @@ void SceneWriter::joint(const Joint& j) {
   } else if (j.type == "SphSphJoint") {
     constraints_ << "  - {name: " << name << ", type: distance, between: [" << side(wi) << ", " << side(wj)
                  << "], length: " << num(value(j, "distanceIJ", 0.0, true)) << "}\n";
+  } else if (j.type == "CylSphJoint" || j.type == "RevCylJoint" || j.type == "RevRevJoint") {
+    radial_distance(j, name, wi, wj);
+    if (j.type != "CylSphJoint") {  // z_J parallel to z_I
+      dot(name + "_zx", segment(I, wi, 2), segment(J, wj, 0), 0.0);
+      dot(name + "_zy", segment(I, wi, 2), segment(J, wj, 1), 0.0);
+    }
+    if (j.type == "RevRevJoint")  // and J's origin in I's x-y plane
+      constraints_ << "  - {name: " << names_.make(name + "_z") << ", type: point_on_plane, between: [" << side(wi)
+                   << ", " << side(wj) << "]}\n";
   } else if (j.type == "GearJoint") {
     gear(j, name, wi, wj);
   } else if (j.type == "ScrewJoint") {  // 2π z − pitch θ = c: z = pitch θ / 2π + c'
@@ -243,6 +254,27 @@ void SceneWriter::gear(const Joint& j, const std::string& name, const Where& wi,
   const double ratio = ri / rj;
   constraints_ << "  - {name: " << name << ", type: coupler, coordinates: [" << tj << ", " << ti
                << "], coefficients: [1, " << num(ratio) << "], constant: " << num(orbit_j + ratio * orbit_i) << "}\n";
+}
+
+// OndselSolver's distance of J's origin from I's z axis, x² + y² = distanceIJ² in I's frame (the CylSph, RevCyl and
+// RevRev joints' first row), divided by 2 distanceIJ as phiq's distance rows are.
+void SceneWriter::radial_distance(const Joint& j, const std::string& name, const Where& wi, const Where& wj) {
+  const double l = value(j, "distanceIJ", 0.0, true);
+  if (!(l > 0.0))
+    refuse(a_.path, j.line, j.type + " '" + j.name + "': distanceIJ must be positive (0: a PointInLine joint)");
+  std::array<std::string, 3> o, x, y, p;
+  point(name + "_I_o", wi, Eigen::Vector3d::Zero(), &o);
+  point(name + "_I_x", wi, Eigen::Vector3d::UnitX(), &x);
+  point(name + "_I_y", wi, Eigen::Vector3d::UnitY(), &y);
+  point(name + "_J_o", wj, Eigen::Vector3d::Zero(), &p);
+  std::string ex, ey;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::string d = "(" + p[i] + " - " + o[i] + ")";
+    ex += (i ? " + " : "") + std::string("(") + x[i] + " - " + o[i] + ")*" + d;
+    ey += (i ? " + " : "") + std::string("(") + y[i] + " - " + o[i] + ")*" + d;
+  }
+  constraints_ << "  - {name: " << name << ", type: equation, unit: length, expr: \"((" << ex << ")^2 + (" << ey
+               << ")^2 - " << num(l * l) << ")/" << num(2 * l) << "\"}\n";
 }
 
 // OndselSolver's rack and pinion and screw, one row each: J's travel along I's x (rack) or z (screw), plus
