@@ -357,23 +357,42 @@ TEST(AsmtImport, EveryJointTypeHoldsAtItsPlacementAndLeavesItsFreedoms) {
 
 // tests/data/asmt/compound_joints.asmt: OndselSolver's compound joints, each on a ground marker at a placement that
 // holds it: x² + y² = distanceIJ² of J's origin in I's frame (CylSph; 1 freedom removed), with z axes parallel
-// (RevCyl; 3) and J's origin in I's x-y plane (RevRev; 4): 5 + 3 + 2 freedoms left.
+// (RevCyl; 3) and J's origin in I's x-y plane (RevRev; 4); a constant-velocity joint (origins together,
+// x_I·y_J + y_I·x_J = 0; 4): 5 + 3 + 2 + 2 freedoms left.
 TEST(AsmtImport, CompoundJointsHoldAtTheirPlacementAndLeaveTheirFreedoms) {
   const std::string text = AsmtText(AsmtOwn("compound_joints.asmt"));
   const Scene scene = parse_scene(import_asmt(text, "compound.asmt").yaml, "compound.asmt");
-  // 3 parts; natural points on the parts: CylSph J's origin, RevCyl's and RevRev's J origin, x and y tips
-  EXPECT_EQ(scene.model->num_coordinates(), 3 * 7 + 3 * 7);
-  EXPECT_EQ(scene.model->num_equations(), 3 + 3 * 7 + 1 + 3 + 4);
+  // 4 parts; natural points on the parts: CylSph J's origin, RevCyl's, RevRev's and the CV joint's J origin, x and
+  // y tips (10 points, each pinned by 3 rows); rows 1 + 3 + 4 + 4; 4 normalisations
+  EXPECT_EQ(scene.model->num_coordinates(), 4 * 7 + 10 * 3);
+  EXPECT_EQ(scene.model->num_equations(), 4 + 10 * 3 + 1 + 3 + 4 + 4);
   EXPECT_LE(AsmtResidualAtPlacement(text).cwiseAbs().maxCoeff(), 1e-14);
   Eigen::VectorXd q = scene.model->initial_positions();
   AssemblySummary summary;
   ASSERT_EQ(assemble(*scene.model, 0.0, {}, q, &summary), SolveStatus::kSuccess) << summary.message;
   EXPECT_EQ(summary.rank.rank, scene.model->num_equations());
-  EXPECT_EQ(summary.rank.dof, 10);
+  EXPECT_EQ(summary.rank.dof, 12);
   // the first distanceIJ (CylSph's) made 1.1: its row (x² + y² − L²)/2L
   const std::string field = "distanceIJ\n\t\t\t\t\t1.0\n";
   const Eigen::VectorXd phi = AsmtResidualAtPlacement(test::replace_first(text, field, "distanceIJ\n\t\t\t\t\t1.1\n"));
   EXPECT_NEAR(phi.cwiseAbs().maxCoeff(), (1.1 * 1.1 - 1.0) / 2.2, 1e-12);
+}
+
+// tests/data/asmt/cv_shafts.asmt: shafts on revolutes 30° apart joined by a constant-velocity joint; the first
+// turned at 1 rad/s, x_I·y_J + y_I·x_J = (1 − cos β) sin(θ1 + θ2) = 0 turns the second by −t about its own axis.
+TEST(AsmtImport, ConstantVelocityJointTurnsTheSecondShaftAtTheSameRate) {
+  const AsmtRun r = AsmtSweep(AsmtOwn("cv_shafts.asmt"));
+  ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
+  ASSERT_EQ(r.trace.q.size(), 25u);
+  const Eigen::Matrix3d tilt = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  double worst = 0.0;
+  for (std::size_t k = 0; k < r.trace.q.size(); ++k) {
+    const double t = r.trace.t[k];
+    const Eigen::Matrix3d expected = tilt * Eigen::AngleAxisd(-t, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    worst =
+        std::max(worst, (AsmtBodyRotation(*r.scene.model, r.trace.q[k], "Shaft2") - expected).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(worst, 1e-10);
 }
 
 // The one-line message of an .asmt text (empty when it converts and loads).

@@ -175,7 +175,7 @@ void SceneWriter::joint(const Joint& j) {
       {"PlanarJoint", {"offset"}},          {"PointInPlaneJoint", {"offset"}}, {"LineInPlaneJoint", {"offset"}},
       {"AngleJoint", {"theIzJz"}},          {"SphSphJoint", {"distanceIJ"}},   {"GearJoint", {"radiusI", "radiusJ"}},
       {"RackPinionJoint", {"pitchRadius"}}, {"ScrewJoint", {"pitch"}},         {"CylSphJoint", {"distanceIJ"}},
-      {"RevCylJoint", {"distanceIJ"}},      {"RevRevJoint", {"distanceIJ"}}};
+      {"RevCylJoint", {"distanceIJ"}},      {"RevRevJoint", {"distanceIJ"}},   {"ConstantVelocityJoint", {}}};
   const bool known = direct.count(j.type) || fields.count(j.type) || j.type == "ParallelAxesJoint" ||
                      j.type == "PerpendicularJoint" || j.type == "NoRotationJoint";
   if (!known)
@@ -225,6 +225,18 @@ void SceneWriter::joint(const Joint& j) {
     if (j.type == "RevRevJoint")  // and J's origin in I's x-y plane
       constraints_ << "  - {name: " << names_.make(name + "_z") << ", type: point_on_plane, between: [" << side(wi)
                    << ", " << side(wj) << "]}\n";
+  } else if (j.type == "ConstantVelocityJoint") {  // the origins together, x_I·y_J + y_I·x_J = 0
+    constraints_ << "  - {name: " << name << ", type: spherical, between: [" << side(wi) << ", " << side(wj) << "]}\n";
+    std::array<std::string, 3> io, ix, iy, jo, jx, jy;
+    point(I + "_o", wi, Eigen::Vector3d::Zero(), &io), point(I + "_x", wi, Eigen::Vector3d::UnitX(), &ix);
+    point(I + "_y", wi, Eigen::Vector3d::UnitY(), &iy), point(J + "_o", wj, Eigen::Vector3d::Zero(), &jo);
+    point(J + "_x", wj, Eigen::Vector3d::UnitX(), &jx), point(J + "_y", wj, Eigen::Vector3d::UnitY(), &jy);
+    std::string expr;
+    for (std::size_t i = 0; i < 3; ++i)
+      expr += (i ? " + " : "") + std::string("(") + ix[i] + " - " + io[i] + ")*(" + jy[i] + " - " + jo[i] + ") + (" +
+              iy[i] + " - " + io[i] + ")*(" + jx[i] + " - " + jo[i] + ")";
+    constraints_ << "  - {name: " << names_.make(name + "_cv") << ", type: equation, unit: none, expr: \"" << expr
+                 << "\"}\n";
   } else if (j.type == "GearJoint") {
     gear(j, name, wi, wj);
   } else if (j.type == "ScrewJoint") {  // 2π z − pitch θ = c: z = pitch θ / 2π + c'
