@@ -395,6 +395,22 @@ TEST(AsmtImport, ConstantVelocityJointTurnsTheSecondShaftAtTheSameRate) {
   EXPECT_LE(worst, 1e-10);
 }
 
+// Names phiq or YAML would read otherwise become names of their own: `#` and `-` as `_`, a leading digit prefixed,
+// YAML's null and booleans and phiq's `t` suffixed, a name taken twice numbered.
+TEST(AsmtImport, NamesBecomePhiqNames) {
+  std::string text = AsmtText(AsmtOwn("slider_crank.asmt"));
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"CrankPin", "Yes"},
+                                 {"RodPin", "2nd_rod_a"},
+                                 {"Crank", "null"},
+                                 {"Rod", "2nd#rod-a"},
+                                 {"Slider", "t"}})
+    for (std::size_t at = 0; (at = text.find(from, at)) != std::string::npos; at += to.size())
+      text.replace(at, from.size(), to);
+  const Scene scene = parse_scene(import_asmt(text, "names.asmt").yaml, "names.asmt");
+  EXPECT_EQ(scene.model->body_names(), (std::vector<std::string>{"null_", "n_2nd_rod_a", "t_"}));
+  EXPECT_GE(scene.model->coordinate_index("t__x"), 0);
+}
+
 // The one-line message of an .asmt text (empty when it converts and loads).
 std::string AsmtError(const std::string& text) {
   try {

@@ -36,7 +36,11 @@ class Names {
     std::string base;
     for (char c : raw) base += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
     if (base.empty() || std::isdigit(static_cast<unsigned char>(base[0]))) base = "n_" + base;
-    if (base == "t" || base == "pi" || base == "ground") base += "_";
+    std::string lower;
+    for (char c : base) lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    static const std::set<std::string> reserved = {"t",   "pi", "ground", "null", "true", "false",
+                                                   "yes", "no", "on",     "off",  "y",    "n"};
+    if (reserved.count(lower)) base += "_";  // phiq's names, and YAML's words for null and booleans
     std::string name = base;
     for (int k = 2; taken(name, body); ++k) name = base + "_" + std::to_string(k);
     used_.insert(name);
