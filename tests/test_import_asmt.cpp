@@ -450,6 +450,31 @@ TEST(AsmtImport, BadInputIsOneLineNamingFileAndLine) {
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
 
+// Every prefix of a file, cut at each line and inside it: refused by the reader with one line naming the file and a
+// line, or converted to a scene that loads; never another exception, never a crash.
+TEST(AsmtImport, EveryTruncationIsRefusedInOneLineOrLoads) {
+  for (const char* file : {"slider_crank.asmt", "rack_pinion_driven.asmt", "compound_joints.asmt"}) {
+    SCOPED_TRACE(file);
+    const std::string text = AsmtText(AsmtOwn(file));
+    int refused = 0;
+    for (std::size_t cut = 0; cut < text.size(); cut = text.find('\n', cut + 1)) {
+      for (const std::size_t at : {cut, std::min(cut + 3, text.size())}) {
+        AsmtImport imported;
+        try {
+          imported = import_asmt(text.substr(0, at), "bad.asmt");
+        } catch (const SceneError& e) {
+          ++refused;
+          EXPECT_EQ(std::string(e.what()).rfind("bad.asmt:", 0), 0u) << e.what();
+          EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+          continue;
+        }
+        EXPECT_NO_THROW((void)parse_scene(imported.yaml, "bad.asmt")) << "cut at " << at;
+      }
+    }
+    EXPECT_GT(refused, 100);
+  }
+}
+
 }  // namespace
 
 namespace test {
