@@ -238,7 +238,7 @@ void Reader::assembly_field(const Node& f, Assembly& a) {
       } else if (set.text == "Motions") {
         for (const Node& m : set.children) a.motions.push_back(motion(m));
       } else if (!set.children.empty()) {
-        refuse(path_, set.line, "ConstraintSets " + set.text + " is not read (general constraints have no phiq form)");
+        refuse(path_, set.line, "ConstraintSets " + set.text + ": not read (phiq has no form for it)");
       }
     }
     return;
