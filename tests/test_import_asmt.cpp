@@ -311,6 +311,33 @@ TEST(AsmtImport, DrivenScrewRisesItsPitchPerTurn) {
   EXPECT_LE(worst, 1e-10);
 }
 
+// tests/data/asmt/general_motion.asmt: a block's marker J moved by a general motion from a turned ground marker I
+// (Rz(2.3) Ry(0.6) Rx(0.3), at (0.5, −0.5, 1)): J's origin at (cos t, sin t, t/2) in I's axes, J's axes turned by
+// Rx(0.1 t) Ry(0.2) Rz(0.3 t) (RotationOrder 1 2 3) from I's; J sits in the block at (0.1, 0.2, 0.3), turned Rz(0.25).
+TEST(AsmtImport, GeneralMotionPlacesItsMarkerAsItsExpressionsSay) {
+  const AsmtRun r = AsmtSweep(AsmtOwn("general_motion.asmt"), 1e-12);  // (at 1e-10: within 1.1e-10)
+  ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
+  ASSERT_EQ(r.trace.q.size(), 21u);
+  using Eigen::AngleAxisd, Eigen::Vector3d;
+  const Eigen::Matrix3d ri =
+      (AngleAxisd(2.3, Vector3d::UnitZ()) * AngleAxisd(0.6, Vector3d::UnitY()) * AngleAxisd(0.3, Vector3d::UnitX()))
+          .toRotationMatrix();
+  const Eigen::Matrix3d in_block = AngleAxisd(0.25, Vector3d::UnitZ()).toRotationMatrix();
+  double worst = 0.0;
+  for (std::size_t k = 0; k < r.trace.q.size(); ++k) {
+    const double t = r.trace.t[k];
+    const Vector3d marker = Vector3d(0.5, -0.5, 1) + ri * Vector3d(std::cos(t), std::sin(t), 0.5 * t);
+    const Eigen::Matrix3d axes = ri * (AngleAxisd(0.1 * t, Vector3d::UnitX()) * AngleAxisd(0.2, Vector3d::UnitY()) *
+                                       AngleAxisd(0.3 * t, Vector3d::UnitZ()))
+                                          .toRotationMatrix();
+    const Eigen::Matrix3d body = axes * in_block.transpose();
+    const Vector3d origin = marker - body * Vector3d(0.1, 0.2, 0.3);
+    worst = std::max(worst, (AsmtBodyRotation(*r.scene.model, r.trace.q[k], "Block") - body).cwiseAbs().maxCoeff());
+    worst = std::max(worst, (AsmtBodyPosition(*r.scene.model, r.trace.q[k], "Block") - origin).norm());
+  }
+  EXPECT_LE(worst, 1e-10);
+}
+
 // tests/data/asmt/joint_zoo.asmt: one part per joint type on a ground marker, each placed (with turned markers,
 // offsets, an angle and a distance) so that OndselSolver's definition of its joint holds exactly. phiq's rows must
 // vanish there and leave each part the freedoms its joint leaves: Σ (6 − removed) = 0 fixed + 1 revolute + 2

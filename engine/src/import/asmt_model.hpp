@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <string>
 #include <utility>
 #include <vector>
@@ -47,6 +48,12 @@ struct Joint {
 struct Motion {
   std::string type, name, joint, expression;  // expression: of `time`, as the file writes it
   int line = 0, joint_line = 0, expression_line = 0;
+  // A GeneralMotion: J's origin in I's axes (rIJI1..3) and J's orientation relative to I as Euler angles (angIJJ1..3)
+  // about the axes RotationOrder names ("1 2 3": x, then y, then z, each turned with the ones before).
+  std::string marker_i, marker_j, rotation_order;
+  int line_i = 0, line_j = 0, order_line = 0;
+  std::array<std::string, 6> general;
+  std::array<int, 6> general_lines{};
 };
 
 struct Assembly {

@@ -116,6 +116,7 @@ class Reader {
   Part part(const Node& n);
   Joint joint(const Node& n) const;
   Motion motion(const Node& n) const;
+  Motion general_motion(const Node& n, Motion m) const;
   void simulation(const Node& n, Assembly& a);
   void assembly_field(const Node& f, Assembly& a);
 
@@ -181,8 +182,9 @@ Motion Reader::motion(const Node& n) const {
   Motion m;
   m.type = n.text, m.line = n.line, m.name = name_of(n, n.text);
   const std::string what = m.type + " '" + m.name + "'";
+  if (m.type == "GeneralMotion") return general_motion(n, m);
   if (m.type != "RotationalMotion" && m.type != "TranslationalMotion")
-    refuse(path_, n.line, what + ": only rotational and translational motions (of a joint) have a phiq driver");
+    refuse(path_, n.line, what + ": not a motion phiq reads (rotational, translational, general)");
   const Node* joint = find(n, "MotionJoint");
   if (!joint)
     refuse(path_, n.line, what + ": a motion between markers (no MotionJoint) is not read; drive a joint instead");
@@ -201,6 +203,27 @@ Motion Reader::motion(const Node& n) const {
     refuse(path_, n.line,
            what + " has no " + (m.type == "RotationalMotion" ? "RotationZ" : "TranslationZ") +
                " (the file may be truncated)");
+  return m;
+}
+
+Motion Reader::general_motion(const Node& n, Motion m) const {
+  const std::string what = m.type + " '" + m.name + "'";
+  const Node& mi = need(n, "MarkerI", what);
+  const Node& mj = need(n, "MarkerJ", what);
+  m.marker_i = value(mi).text, m.line_i = value(mi).line;
+  m.marker_j = value(mj).text, m.line_j = value(mj).line;
+  static const char* keys[6] = {"rIJI1", "rIJI2", "rIJI3", "angIJJ1", "angIJJ2", "angIJJ3"};
+  for (std::size_t k = 0; k < 6; ++k) {
+    const Node& v = value(need(n, keys[k], what));
+    m.general[k] = v.text, m.general_lines[k] = v.line;
+  }
+  const Node& order = value(need(n, "RotationOrder", what));
+  m.rotation_order = order.text, m.order_line = order.line;
+  for (const Node& f : n.children) {
+    bool known = f.text == "Name" || f.text == "MarkerI" || f.text == "MarkerJ" || f.text == "RotationOrder";
+    for (const char* k : keys) known = known || f.text == k;
+    if (!known) refuse(path_, f.line, what + ": field '" + f.text + "' is not read");
+  }
   return m;
 }
 

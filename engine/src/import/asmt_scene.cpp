@@ -99,6 +99,7 @@ class SceneWriter {
   void radial_distance(const Joint& j, const std::string& name, const Where& wi, const Where& wj);
   void travel_and_turn(const std::string& name, const Where& wi, const Where& wj, int axis_k, double per_turn);
   void motion(const Motion& m);
+  void general_motion(const Motion& m);
   std::string time_grid() const;
   std::string parts_and_mass();
 
@@ -362,7 +363,78 @@ std::string expression(const std::string& e, const std::string& path, int line) 
   return out;
 }
 
+// The rotation R_a(φ) R_b(θ) R_c(ψ) of a RotationOrder "a b c" (1: x, 2: y, 3: z), its entries as texts of the
+// angles' expressions.
+using TextMatrix = std::array<std::array<std::string, 3>, 3>;
+TextMatrix axis_rotation(int axis, const std::string& angle) {
+  TextMatrix m;
+  for (std::size_t r = 0; r < 3; ++r)
+    for (std::size_t c = 0; c < 3; ++c) m[r][c] = r == c ? "1" : "0";
+  const std::size_t i = static_cast<std::size_t>(axis + 1) % 3, j = static_cast<std::size_t>(axis + 2) % 3;
+  m[i][i] = m[j][j] = "cos(" + angle + ")";
+  m[j][i] = "sin(" + angle + ")";
+  m[i][j] = "(-sin(" + angle + "))";
+  return m;
+}
+TextMatrix product(const TextMatrix& a, const TextMatrix& b) {
+  TextMatrix m;
+  for (std::size_t r = 0; r < 3; ++r)
+    for (std::size_t c = 0; c < 3; ++c) {
+      std::string sum;
+      for (std::size_t k = 0; k < 3; ++k) {
+        if (a[r][k] == "0" || b[k][c] == "0") continue;
+        const std::string term = a[r][k] == "1" ? b[k][c] : b[k][c] == "1" ? a[r][k] : a[r][k] + "*" + b[k][c];
+        sum += (sum.empty() ? "" : " + ") + term;
+      }
+      m[r][c] = sum.empty() ? "0" : sum;
+    }
+  return m;
+}
+
+// OndselSolver's general motion: J's origin in I's axes is rIJI(t), J's axes in I's are the Euler rotation of
+// angIJJ(t). Six `expr` drivers over natural points pinned to the markers: the three displacements, and three
+// direction cosines (y_I·x_J, z_I·x_J, z_I·y_J, the rows a Fixed joint uses) against the rotation's entries.
+void SceneWriter::general_motion(const Motion& m) {
+  const Where wi = marker(m.marker_i, m.line_i), wj = marker(m.marker_j, m.line_j);
+  const std::string name = names_.make(m.name);
+  std::array<std::array<std::string, 3>, 4> ip;  // I's origin, x, y, z tips
+  std::array<std::array<std::string, 3>, 3> jp;  // J's origin, x, y tips
+  point(name + "_I_o", wi, Eigen::Vector3d::Zero(), &ip[0]);
+  for (int k = 0; k < 3; ++k) point(name + "_I_" + "xyz"[k], wi, Eigen::Vector3d::Unit(k), &ip[k + 1]);
+  point(name + "_J_o", wj, Eigen::Vector3d::Zero(), &jp[0]);
+  for (int k = 0; k < 2; ++k) point(name + "_J_" + "xyz"[k], wj, Eigen::Vector3d::Unit(k), &jp[k + 1]);
+  auto dot = [](const std::array<std::string, 3>& a, const std::array<std::string, 3>& o,
+                const std::array<std::string, 3>& b, const std::array<std::string, 3>& p) {
+    std::string s;
+    for (std::size_t i = 0; i < 3; ++i)
+      s += (i ? " + " : "") + std::string("(") + a[i] + " - " + o[i] + ")*(" + b[i] + " - " + p[i] + ")";
+    return s;
+  };
+  std::array<std::string, 6> f;
+  for (std::size_t k = 0; k < 6; ++k) f[k] = expression(m.general[k], a_.path, m.general_lines[k]);
+  std::istringstream order(m.rotation_order);
+  TextMatrix rotation;
+  for (std::size_t r = 0; r < 3; ++r)
+    for (std::size_t c = 0; c < 3; ++c) rotation[r][c] = r == c ? "1" : "0";
+  for (std::size_t k = 0; k < 3; ++k) {
+    int axis = 0;
+    if (!(order >> axis) || axis < 1 || axis > 3)
+      refuse(a_.path, m.order_line, "RotationOrder '" + m.rotation_order + "' is not three axes 1, 2, 3");
+    rotation = product(rotation, axis_rotation(axis - 1, f[3 + k]));
+  }
+  auto driver = [&](const std::string& suffix, const std::string& g, const std::string& unit, const std::string& law) {
+    drivers_ << "  - {name: " << names_.make(name + suffix) << ", expr: \"" << g << "\", unit: " << unit
+             << ", law: {type: expression, f: \"" << law << "\"}}\n";
+  };
+  for (std::size_t k = 0; k < 3; ++k)
+    driver(std::string("_") + "xyz"[k], dot(ip[k + 1], ip[0], jp[0], ip[0]), "length", f[k]);
+  driver("_yx", dot(ip[2], ip[0], jp[1], jp[0]), "none", rotation[1][0]);
+  driver("_zx", dot(ip[3], ip[0], jp[1], jp[0]), "none", rotation[2][0]);
+  driver("_zy", dot(ip[3], ip[0], jp[2], jp[0]), "none", rotation[2][1]);
+}
+
 void SceneWriter::motion(const Motion& m) {
+  if (m.type == "GeneralMotion") return general_motion(m);
   const std::string prefix = "/" + a_.name + "/";
   const std::string jname = m.joint.rfind(prefix, 0) == 0 ? m.joint.substr(prefix.size()) : "";
   const auto it = joints_.find(jname);
