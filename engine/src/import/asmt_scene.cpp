@@ -369,7 +369,7 @@ using TextMatrix = std::array<std::array<std::string, 3>, 3>;
 TextMatrix axis_rotation(int axis, const std::string& angle) {
   TextMatrix m;
   for (std::size_t r = 0; r < 3; ++r)
-    for (std::size_t c = 0; c < 3; ++c) m[r][c] = r == c ? "1" : "0";
+    for (std::size_t c = 0; c < 3; ++c) m[r][c] = std::string(1, r == c ? '1' : '0');
   const std::size_t i = static_cast<std::size_t>(axis + 1) % 3, j = static_cast<std::size_t>(axis + 2) % 3;
   m[i][i] = m[j][j] = "cos(" + angle + ")";
   m[j][i] = "sin(" + angle + ")";
@@ -415,7 +415,7 @@ void SceneWriter::general_motion(const Motion& m) {
   std::istringstream order(m.rotation_order);
   TextMatrix rotation;
   for (std::size_t r = 0; r < 3; ++r)
-    for (std::size_t c = 0; c < 3; ++c) rotation[r][c] = r == c ? "1" : "0";
+    for (std::size_t c = 0; c < 3; ++c) rotation[r][c] = std::string(1, r == c ? '1' : '0');
   for (std::size_t k = 0; k < 3; ++k) {
     int axis = 0;
     if (!(order >> axis) || axis < 1 || axis > 3)
