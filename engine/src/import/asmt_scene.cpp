@@ -219,8 +219,11 @@ void SceneWriter::joint(const Joint& j) {
     dot(name + "_zx", segment(I, wi, 2), segment(J, wj, 0), 0.0);
     dot(name + "_zy", segment(I, wi, 2), segment(J, wj, 1), 0.0);
   } else if (j.type == "SphSphJoint") {
+    const double l = value(j, "distanceIJ", 0.0, true);
+    if (!(l > 0.0))
+      refuse(a_.path, j.line, "SphSphJoint '" + j.name + "': distanceIJ must be positive (0: a SphericalJoint)");
     constraints_ << "  - {name: " << name << ", type: distance, between: [" << side(wi) << ", " << side(wj)
-                 << "], length: " << num(value(j, "distanceIJ", 0.0, true)) << "}\n";
+                 << "], length: " << num(l) << "}\n";
   } else if (j.type == "CylSphJoint" || j.type == "RevCylJoint" || j.type == "RevRevJoint") {
     radial_distance(j, name, wi, wj);
     if (j.type != "CylSphJoint") {  // z_J parallel to z_I
