@@ -477,7 +477,12 @@ TEST(AsmtImport, BadInputIsOneLineNamingFileAndLine) {
       1 + static_cast<int>(std::count(good.begin(), good.begin() + good.find("/SliderCrank/Crank/A"), '\n'));
   EXPECT_EQ(AsmtError(ghost),
             "bad.asmt:" + std::to_string(ghost_line) + ": marker '/SliderCrank/Ghost/A' is on an unknown part 'Ghost'");
-  for (const std::string& e : {truncated_error, no_time, AsmtError(wobble), AsmtError(ghost)})
+  // a motion's expression phiq cannot parse, named at its line
+  const std::string unclosed = test::replace_first(good, "2.0d*pi*time", "2.0d*pi*(time");
+  const int unclosed_line = 1 + static_cast<int>(std::count(good.begin(), good.begin() + good.find("2.0d*pi"), '\n'));
+  EXPECT_EQ(AsmtError(unclosed).rfind("bad.asmt:" + std::to_string(unclosed_line) + ": the motion's expression", 0), 0u)
+      << AsmtError(unclosed);
+  for (const std::string& e : {truncated_error, no_time, AsmtError(wobble), AsmtError(ghost), AsmtError(unclosed)})
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
 }
 

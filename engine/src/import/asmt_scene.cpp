@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "import/asmt_model.hpp"
+#include "phiq/expression.hpp"
 #include "phiq/text.hpp"
 
 namespace phiq::detail::asmt {
@@ -362,6 +363,15 @@ std::string expression(const std::string& e, const std::string& path, int line) 
       refuse(path, line,
              "the motion's expression '" + e + "' has '" + std::string(1, c) + "', which phiq does not read");
     }
+  }
+  try {  // refused here, at the file's line, rather than by the scene reader at a line of the converted text
+    const NameResolver time_only = [](const std::string& name) -> std::optional<NameBinding> {
+      if (name == "t") return NameBinding{NameBinding::Kind::kTime};
+      return std::nullopt;
+    };
+    (void)CompiledExpression::compile(out, time_only);
+  } catch (const Error& error) {
+    refuse(path, line, "the motion's expression '" + e + "': " + error.what());
   }
   return out;
 }
