@@ -1,6 +1,6 @@
 # cmake -DPHIQ=phiq -DHELP2MAN=help2man -DVERSION=0.1.0 -DOUT=phiq.1 -P man_page.cmake: the man page phiq(1), help2man's rendering of
 # `phiq --help`, with a COMMANDS section holding each command's own --help (help2man reads only the top level).
-set(commands run check assemble batch compare generate plot sweep-accuracy)
+set(commands run check assemble batch compare generate convert plot sweep-accuracy)
 get_filename_component(dir ${OUT} DIRECTORY)
 set(include_file ${dir}/phiq_man_commands.h2m)
 set(text "[COMMANDS]\n")

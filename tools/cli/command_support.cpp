@@ -113,12 +113,30 @@ void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args) {
       ->allow_extra_args(false);
 }
 
+// (command_support.hpp)
+std::optional<AsmtImport> import_or_report(const std::string& path) {
+  try {
+    AsmtImport imported = import_asmt_file(path);
+    for (const std::string& why : imported.skipped)
+      std::fprintf(stderr, "phiq: not mapped: %s\n", printable(why).c_str());
+    return imported;
+  } catch (const SceneError& e) {
+    fail(e.what(), 2);
+  }
+  return std::nullopt;
+}
+
 std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets,
                                     const std::vector<std::string>& sensitivity_args) {
   try {
     SceneOverrides o = parameter_settings(sets);
     o.sensitivities = sensitivity_requests(sensitivity_args), o.sensitivities_source = "--sensitivity";
     if (path == "-") return phiq::parse_scene(load_stdin_text(), kStdinScene, SceneLimits{}, o);
+    if (is_asmt_path(path)) {  // converted here rather than in load_scene(), to list what it leaves out
+      const std::optional<AsmtImport> imported = import_or_report(path);
+      if (!imported) return std::nullopt;
+      return phiq::parse_scene(imported->yaml, path, SceneLimits{}, o);
+    }
     return phiq::load_scene(path, SceneLimits{}, o);
   } catch (const phiq::SceneError& e) {
     fail(e.what(), 2);

@@ -18,6 +18,7 @@ struct Command {
 // In the order `phiq --help` lists them.
 Command register_run(CLI::App& app);
 Command register_generate(CLI::App& app);
+Command register_convert(CLI::App& app);
 Command register_batch(CLI::App& app);
 Command register_assemble(CLI::App& app);
 Command register_check(CLI::App& app);

@@ -45,10 +45,10 @@ int run_command(int argc, char** argv) {
                                         std::to_string(phiq::kToleranceCsvFormat) + ", tolerance --summary format " +
                                         std::to_string(phiq::kToleranceSummaryFormat) + ")");
   app.require_subcommand(1);
-  const std::vector<Command> commands{register_run(app),      register_generate(app), register_batch(app),
-                                      register_assemble(app), register_check(app),    register_plot(app),
-                                      register_animate(app),  register_compare(app),  register_sweep_accuracy(app),
-                                      register_tolerance(app)};
+  const std::vector<Command> commands{
+      register_run(app),      register_generate(app),       register_convert(app),  register_batch(app),
+      register_assemble(app), register_check(app),          register_plot(app),     register_animate(app),
+      register_compare(app),  register_sweep_accuracy(app), register_tolerance(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

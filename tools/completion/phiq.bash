@@ -11,7 +11,7 @@ _phiq() {
     words=("${COMP_WORDS[@]}")
     cword=$COMP_CWORD
   }
-  local commands="run check assemble batch compare generate plot animate sweep-accuracy tolerance"
+  local commands="run check assemble batch compare generate convert plot animate sweep-accuracy tolerance"
   local cmd="" i
   for ((i = 1; i < cword; i++)); do
     case " $commands " in *" ${words[i]} "*) cmd="${words[i]}"; break ;; esac
@@ -30,6 +30,7 @@ _phiq() {
     batch) opts="--help --output --quiet --threads --summary --names --resume --sensitivity" ;;
     compare) opts="--help --rtol --atol --columns --json --junit" ;;
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
+    convert) opts="--help --output" ;;
     plot) opts="--help --output --columns --positions --set" ;;
     animate) opts="--help --output --columns --set" ;;
     sweep-accuracy) opts="--help --output --json --tolerances --steps-list --predictors --newton --linear-solvers

@@ -9,6 +9,7 @@
 #include <functional>
 #include <sstream>
 
+#include "phiq/import_asmt.hpp"
 #include "phiq/parsed_scene.hpp"
 #include "phiq/scene.hpp"
 #include "phiq/text.hpp"
@@ -230,6 +231,12 @@ Scene read_tree(const YAML::Node& root, const std::string& text, const std::stri
   return scene;
 }
 
+// The scene's text: the file's, or the phiq scene an `.asmt` file converts to (phiq/import_asmt.hpp).
+std::string scene_text(const std::string& path, const SceneLimits& limits) {
+  std::string text = detail::scene::read_scene_file(path, limits);
+  return is_asmt_path(path) ? import_asmt(text, path).yaml : text;
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& text, const std::string& path, const SceneLimits& limits,
@@ -244,7 +251,7 @@ struct ParsedScene::Tree {
 };
 
 ParsedScene ParsedScene::load(const std::string& path, const SceneLimits& limits) {
-  return ParsedScene(detail::scene::read_scene_file(path, limits), path, limits);
+  return ParsedScene(scene_text(path, limits), path, limits);
 }
 
 ParsedScene::ParsedScene(std::string text, std::string path, const SceneLimits& limits)
@@ -291,7 +298,7 @@ Scene load_scene(const std::string& path, const SceneLimits& limits) {
 }
 
 Scene load_scene(const std::string& path, const SceneLimits& limits, const SceneOverrides& overrides) {
-  return parse_scene(detail::scene::read_scene_file(path, limits), path, limits, overrides);
+  return parse_scene(scene_text(path, limits), path, limits, overrides);
 }
 
 }  // namespace phiq

@@ -1,0 +1,51 @@
+/// @file
+/// FreeCAD Assembly / OndselSolver `.asmt` files read as phiq scenes. The file is converted to the text of a phiq
+/// scene (models/README.md), which load_scene() then reads: one source of truth for the model, and `phiq convert`
+/// writes that same text. Parts become bodies (Euler parameters), markers the sides of joints, joints phiq's
+/// spatial kinds, motions joint drivers with expression laws, SimulationParameters the time grid.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace phiq {
+
+/// What import_asmt() made of a file.
+struct AsmtImport {
+  std::string yaml;                  ///< the phiq scene (dimension 3, lengths in the file's unit: FreeCAD's mm)
+  std::vector<std::string> skipped;  ///< "FILE:LINE: what: why not mapped", once each (also comments in `yaml`)
+  int parts = 0;                     ///< parts read (each a body)
+  int joints = 0;                    ///< joints read (each one or more constraints)
+  int motions = 0;                   ///< motions read (each a driver)
+};
+
+/// Converts the text of an `.asmt` file; `path` names it in messages. Throws SceneError, one line "PATH:LINE: what"
+/// for a file that is truncated, malformed, or holds an element phiq cannot represent exactly (a joint type with
+/// no phiq kind, a marker of an unknown part, a general motion, ...): never an approximation.
+AsmtImport import_asmt(const std::string& text, const std::string& path);
+
+/// import_asmt() of the file at `path`, read as load_scene() reads a scene (its size limit; FIFOs, directories and
+/// devices handled as there). Throws SceneError "PATH: REASON" when it cannot be read, and as import_asmt().
+AsmtImport import_asmt_file(const std::string& path);
+
+/// True when `path` ends in `.asmt` (any case): what load_scene() and the command line convert first.
+bool is_asmt_path(const std::string& path);
+
+/// One part's stored results in an `.asmt` file's TimeSeries.
+struct AsmtPartSeries {
+  std::string name;                          ///< the part's name as the file writes it (`/Assembly/Part` → `Part`)
+  std::vector<std::vector<double>> columns;  ///< X Y Z Bryantx Bryanty Bryantz ..., each over the output times
+  std::vector<std::string> labels;           ///< the row labels, in the file's order
+};
+
+/// The TimeSeries of an `.asmt` file: output times (the file's `Input` column dropped) and each part's rows.
+struct AsmtTimeSeries {
+  std::vector<double> time;           ///< the output times
+  std::vector<AsmtPartSeries> parts;  ///< each part's rows, in the file's order
+};
+
+/// Reads the TimeSeries after the assembly (empty when the file has none). Throws SceneError naming FILE:LINE for a
+/// row whose length differs from the times'.
+AsmtTimeSeries read_asmt_time_series(const std::string& text, const std::string& path);
+
+}  // namespace phiq
