@@ -145,6 +145,44 @@ TEST(SweepEfforts, AnAppliedForceAloneGivesTheStaticTorque) {
   EXPECT_LT(worst, 1e-9);
 }
 
+TEST(SweepEfforts, ARedundantParallelogramNeedsTheTorqueOfItsFourBar) {
+  // The fifth bar (crank3, massless) repeats what the parallelogram already imposes: the model is swept on its
+  // independent rows, and the motor's torque is that of the four-bar without it, row by row.
+  const std::string massive =
+      "parts:\n  crank1: {mass: 1.0, inertia: 0.1, center_of_mass: [0.5, 0]}\n"
+      "  crank2: {mass: 1.0, inertia: 0.1, center_of_mass: [0.5, 0]}\n"
+      "  coupler: {mass: 2.0, inertia: 0.2, center_of_mass: [0.5, 0]}\n"
+      "loads: {gravity: [0, -9.81]}\noutput: {efforts: all}\n";
+  const std::string five = effort_scene_text("redundant/parallelogram_fifth_bar.yaml");
+  std::string four;
+  std::istringstream lines(five);
+  for (std::string line; std::getline(lines, line);)
+    if (line.find("crank3") == std::string::npos && line.find("x3:") == std::string::npos &&
+        line.find("y3:") == std::string::npos && line.find("psi3:") == std::string::npos)
+      four += line + "\n";
+  std::vector<std::vector<double>> torque;
+  for (const std::string& text : {five, four}) {
+    const Scene s = parse_scene(text + massive, "parallelogram.yaml");
+    SquareScene square;
+    ASSERT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &square), SolveStatus::kSuccess)
+        << square.assembly.message;
+    const Model& m = square.model(*s.model);
+    Workspace ws(m);
+    ws.q = square.start;
+    std::vector<double> tau;
+    ASSERT_EQ(run_sweep(m, s.sweep, ws, [&](const StepView& v) { return tau.push_back(v.efforts[0]), true; }),
+              SolveStatus::kSuccess);
+    torque.push_back(tau);
+  }
+  EXPECT_FALSE(torque[0].empty());
+  ASSERT_EQ(torque[0].size(), torque[1].size());
+  double worst = 0.0, scale = 0.0;
+  for (std::size_t k = 0; k < torque[0].size(); ++k)
+    worst = std::max(worst, std::fabs(torque[0][k] - torque[1][k])), scale = std::max(scale, std::fabs(torque[1][k]));
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LT(worst, 1e-9 * scale);
+}
+
 TEST(SweepEfforts, TheSceneRefusesEffortsItCannotGiveInOneLine) {
   const std::string fourbar = effort_scene_text("seed/fourbar_natural.yaml");
   EXPECT_NE(error_of(fourbar + "output: {efforts: all}\n").find("no part has mass and no load is applied"),
