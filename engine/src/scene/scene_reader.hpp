@@ -208,6 +208,7 @@ class SceneReader {
   void output_orientations(const Cursor& os, OutputPlan& plan) const;
   void resolve_output_residuals(Scene& scene) const;
   void read_solver(const Cursor& c, SolverSettings& o);
+  void read_clearance(const Cursor& c, Scene& scene) const;  // output.clearance (read_clearance.cpp)
 
   const std::string& file_;
   const SceneLimits& limits_;
