@@ -34,8 +34,8 @@ Part clearance_body_part(const Scene& s, const std::string& name, const std::str
   p.frame.kind = PartFrameKind::kPlanarBody;
   if (body != "ground") {
     const auto& names = s.model->body_names();
-    p.frame.planar = s.planar_bodies[static_cast<std::size_t>(std::find(names.begin(), names.end(), body) -
-                                                              names.begin())];
+    p.frame.planar =
+        s.planar_bodies[static_cast<std::size_t>(std::find(names.begin(), names.end(), body) - names.begin())];
   }
   p.fixed = body == "ground";
   p.shapes.push_back(std::move(shape));
@@ -65,15 +65,16 @@ ClearanceRows clearance_rows(const Scene& scene) {
   ClearanceRows rows;
   Workspace ws(*scene.model);
   SweepSummary summary;
-  EXPECT_EQ(run_sweep(*scene.model, o, ws,
-                      [&](const StepView& v) {
-                        rows.t.push_back(v.t);
-                        rows.q.push_back(v.q);
-                        rows.qd.push_back(*v.qd);
-                        rows.qdd.push_back(*v.qdd);
-                        return true;
-                      },
-                      &summary),
+  EXPECT_EQ(run_sweep(
+                *scene.model, o, ws,
+                [&](const StepView& v) {
+                  rows.t.push_back(v.t);
+                  rows.q.push_back(v.q);
+                  rows.qd.push_back(*v.qd);
+                  rows.qdd.push_back(*v.qdd);
+                  return true;
+                },
+                &summary),
             SolveStatus::kSuccess);
   return rows;
 }
@@ -117,8 +118,8 @@ TEST(Clearance, TwoSpheresOnMovingPointsAreTheirCentresDistanceLessTheRadii) {
 
 // The ground pivot O against the rocker pin B over a crank turn: |OB| is least when the crank folds onto the
 // coupler, |OB| = L3 − L2 = 0.8, B at the angle acos((0.8² + L1² − L4²) / (2 · 0.8 · L1)) = acos(0.4) and the
-// crank opposite, t* = π + acos(0.4) (the rocker at its limit); greatest, L3 + L2, at t = acos(0.8). The minimum lies between rows (a step of
-// 2π/90) and is refined there to its time and distance.
+// crank opposite, t* = π + acos(0.4) (the rocker at its limit); greatest, L3 + L2, at t = acos(0.8). The minimum lies
+// between rows (a step of 2π/90) and is refined there to its time and distance.
 TEST(Clearance, FourBarPivotToRockerPinMinimumIsTheLawOfCosinesExtreme) {
   Scene s = clearance_fourbar("", 90);
   s.parts.push_back(clearance_body_part(s, "pivot", "ground", clearance_sphere(0.02, {0, 0, 0})));

@@ -46,8 +46,8 @@ TEST(ClearanceScene, AdjacentPartsAreThoseTheJointsJoin) {
   for (const auto& ab : adjacent_parts(*s.model, s.parts)) adjacent.push_back(clearance_pair_names(s, ab));
   std::sort(adjacent.begin(), adjacent.end());
   // `bare` is on the coupler: adjacent to it, and to what it is jointed to
-  const std::vector<std::string> expected{"coupler-bare", "coupler-pin", "crank-bare", "crank-coupler",
-                                          "pin-bare",     "pivot-crank"};
+  const std::vector<std::string> expected{"coupler-bare",  "coupler-pin", "crank-bare",
+                                          "crank-coupler", "pin-bare",    "pivot-crank"};
   EXPECT_EQ(adjacent, expected);
   // all pairs with shapes: 5 parts, 10 pairs, less pivot-screw (both fixed) and the 3 adjacent with shapes
   const auto pairs = clearance_pairs(*s.model, s.parts, s.clearance);

@@ -62,9 +62,9 @@ class ClearanceGeometry {
  public:
   /// The geometry of `parts` (those without shapes have none). Throws phiq::Error naming a shape FCL cannot take.
   explicit ClearanceGeometry(const std::vector<Part>& parts);
-  ~ClearanceGeometry();                                           ///< frees the FCL objects
-  ClearanceGeometry(ClearanceGeometry&&) noexcept;                ///< takes over the other's objects
-  ClearanceGeometry& operator=(ClearanceGeometry&&) noexcept;     ///< see the move constructor
+  ~ClearanceGeometry();                                        ///< frees the FCL objects
+  ClearanceGeometry(ClearanceGeometry&&) noexcept;             ///< takes over the other's objects
+  ClearanceGeometry& operator=(ClearanceGeometry&&) noexcept;  ///< see the move constructor
   /// The signed distance between parts a and b at their poses. Pre-condition: both have shapes.
   PairDistance distance(Index a, const Pose& pose_a, Index b, const Pose& pose_b) const;
   /// A radius about the part's frame origin that holds all its shapes (m).
@@ -93,11 +93,11 @@ struct InterferenceInterval {
 
 /// Everything measured about one pair.
 struct PairClearance {
-  Index a = -1, b = -1;                             ///< indices into the parts
-  std::vector<double> row_distance;                 ///< the signed distance at each row
-  std::vector<ClearanceMinimum> minima;             ///< the local minima over time, in time order
-  ClearanceMinimum worst;                           ///< the smallest of them, with its sensitivities
-  std::vector<InterferenceInterval> interference;   ///< in time order
+  Index a = -1, b = -1;                            ///< indices into the parts
+  std::vector<double> row_distance;                ///< the signed distance at each row
+  std::vector<ClearanceMinimum> minima;            ///< the local minima over time, in time order
+  ClearanceMinimum worst;                          ///< the smallest of them, with its sensitivities
+  std::vector<InterferenceInterval> interference;  ///< in time order
   /// Intervals between rows (not refined) where the bound from the speeds could not prove that the distance stays
   /// above min(worst, threshold), even after subdividing them: 0 when the bound held.
   Index unproven_intervals = 0;
@@ -105,10 +105,10 @@ struct PairClearance {
 
 /// What clearance_along() measured.
 struct ClearanceReport {
-  std::vector<double> times;         ///< the rows' times
-  std::vector<PairClearance> pairs;  ///< the pairs measured (for `all`: those that come within the threshold)
-  Index pairs_selected = 0;          ///< the pairs the plan selects (for `all`, before the broad phase)
-  double threshold = 0.0;            ///< the plan's
+  std::vector<double> times;            ///< the rows' times
+  std::vector<PairClearance> pairs;     ///< the pairs measured (for `all`: those that come within the threshold)
+  Index pairs_selected = 0;             ///< the pairs the plan selects (for `all`, before the broad phase)
+  double threshold = 0.0;               ///< the plan's
   std::vector<std::string> parameters;  ///< the sensitivities' parameters, in order
   Index positions_solved = 0;           ///< positions solved between rows (refinement and subdivision)
   bool interferes() const;              ///< some pair overlaps at some time
@@ -117,16 +117,16 @@ struct ClearanceReport {
 
 /// The rows a clearance pass reads: t, q, q̇ and q̈ of each row of a sweep (what run_sweep's on_step delivers).
 struct ClearanceRows {
-  std::vector<double> t;                ///< times, increasing
+  std::vector<double> t;                    ///< times, increasing
   std::vector<Eigen::VectorXd> q, qd, qdd;  ///< one per row
 };
 
 /// How clearance_along() solves positions between rows and what it differentiates.
 struct ClearanceOptions {
-  SolverSettings solver;                           ///< for the positions between rows (a Stepper)
-  std::vector<OutputSensitivity> sensitivities;    ///< parameters of the worst clearances' sensitivities
-  double time_tolerance = 1e-9;                    ///< refined times to this fraction of the step
-  int max_subdivision_depth = 6;                   ///< halvings of an interval the speed bound cannot prove
+  SolverSettings solver;                         ///< for the positions between rows (a Stepper)
+  std::vector<OutputSensitivity> sensitivities;  ///< parameters of the worst clearances' sensitivities
+  double time_tolerance = 1e-9;                  ///< refined times to this fraction of the step
+  int max_subdivision_depth = 6;                 ///< halvings of an interval the speed bound cannot prove
 };
 
 /// Clearance of `plan`'s pairs of `parts` over `rows` of a sweep of `model` (see the file comment). Throws

@@ -99,8 +99,8 @@ class Tracer {
     stepper_.restart(rows_.q[k] + tau * rows_.qd[k] + 0.5 * tau * tau * rows_.qdd[k]);
     StepSummary summary;
     if (stepper_.step(t, &summary) != SolveStatus::kSuccess)
-      throw Error("clearance: t = " + format_time(t) + ": the position between rows cannot be solved: " +
-                  summary.message);
+      throw Error("clearance: t = " + format_time(t) +
+                  ": the position between rows cannot be solved: " + summary.message);
     ++solved_;
     return stepper_.q();
   }
@@ -308,10 +308,10 @@ std::vector<std::pair<Index, Index>> broad_phase(const std::vector<Part>& parts,
   std::vector<std::vector<PartState>> states(n);
   for (std::size_t k = 0; k < n; ++k)
     for (std::size_t p = 0; p < parts.size(); ++p)
-      states[k].push_back(selection.shaped[p] ? part_state(parts[p], geometry.bounding_radius(static_cast<Index>(p)),
-                                                           rows.q[k].data(), rows.qd[k].data(), rows.qdd[k].data(),
-                                                           rows.t[k])
-                                              : PartState{});
+      states[k].push_back(selection.shaped[p]
+                              ? part_state(parts[p], geometry.bounding_radius(static_cast<Index>(p)), rows.q[k].data(),
+                                           rows.qd[k].data(), rows.qdd[k].data(), rows.t[k])
+                              : PartState{});
   std::set<std::pair<Index, Index>> found;
   for (std::size_t k = 0; k + (n > 1 ? 1 : 0) < n; ++k) {
     const std::size_t k1 = n > 1 ? k + 1 : k;
@@ -356,8 +356,7 @@ ClearanceReport clearance_along(const Model& model, const std::vector<Part>& par
     // `all` reports the pairs that come within the threshold (or could not be proven not to)
     if (plan.all && pc.worst.at.distance > plan.threshold && pc.unproven_intervals == 0) continue;
     if (!options.sensitivities.empty())
-      pc.worst.sensitivities =
-          minimum_sensitivities(model, parts, a, b, pc.worst, tracer.solve(pc.worst.t), options);
+      pc.worst.sensitivities = minimum_sensitivities(model, parts, a, b, pc.worst, tracer.solve(pc.worst.t), options);
     report.pairs.push_back(std::move(pc));
   }
   report.positions_solved = tracer.solved();

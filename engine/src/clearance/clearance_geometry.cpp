@@ -66,10 +66,18 @@ PlacedGeometry placed(const Shape& s) {
   g.in_part.linear() = to_matrix(s.rotation);
   g.in_part.translation() = fcl::Vector3d(s.at.x, s.at.y, s.at.z);
   switch (s.kind) {
-    case ShapeKind::kBox: g.geometry = std::make_shared<fcl::Boxd>(s.size.x, s.size.y, s.size.z); break;
-    case ShapeKind::kSphere: g.geometry = std::make_shared<fcl::Sphered>(s.radius); break;
-    case ShapeKind::kCylinder: g.geometry = std::make_shared<fcl::Cylinderd>(s.radius, s.length); break;
-    case ShapeKind::kCapsule: g.geometry = std::make_shared<fcl::Capsuled>(s.radius, s.length); break;
+    case ShapeKind::kBox:
+      g.geometry = std::make_shared<fcl::Boxd>(s.size.x, s.size.y, s.size.z);
+      break;
+    case ShapeKind::kSphere:
+      g.geometry = std::make_shared<fcl::Sphered>(s.radius);
+      break;
+    case ShapeKind::kCylinder:
+      g.geometry = std::make_shared<fcl::Cylinderd>(s.radius, s.length);
+      break;
+    case ShapeKind::kCapsule:
+      g.geometry = std::make_shared<fcl::Capsuled>(s.radius, s.length);
+      break;
     case ShapeKind::kCone:
       // FCL's cone is centred on its axis' midpoint; phiq's has its base in z = 0
       g.geometry = std::make_shared<fcl::Coned>(s.radius, s.length);

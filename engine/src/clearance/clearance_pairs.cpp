@@ -20,7 +20,8 @@ std::vector<std::vector<Index>> parts_of_constraints(const Model& model, const s
   std::vector<std::vector<Index>> parts_of_coordinate(static_cast<std::size_t>(model.num_coordinates()));
   for (std::size_t p = 0; p < parts.size(); ++p)
     for (Index j : frame_coordinates(parts[p].frame))
-      if (j < model.num_coordinates()) parts_of_coordinate[static_cast<std::size_t>(j)].push_back(static_cast<Index>(p));
+      if (j < model.num_coordinates())
+        parts_of_coordinate[static_cast<std::size_t>(j)].push_back(static_cast<Index>(p));
   std::vector<std::set<Index>> found(model.constraints().size());
   const CscPattern& pattern = model.jacobian_pattern();
   for (Index j = 0; j < pattern.cols; ++j) {

@@ -36,7 +36,8 @@ std::vector<std::pair<Index, Index>> part_pairs(const Cursor& c, const std::vect
 
 void SceneReader::read_clearance(const Cursor& c, Scene& scene) const {
   if (!c.present()) return;
-  if (!c.is_map()) c.fail("clearance is a map {pairs: [[A, B], ...] | all, skip: adjacent | [[A, B], ...], threshold: D}");
+  if (!c.is_map())
+    c.fail("clearance is a map {pairs: [[A, B], ...] | all, skip: adjacent | [[A, B], ...], threshold: D}");
   c.expect_map({"pairs", "skip", "threshold"});
   ClearancePlan& plan = scene.clearance;
   plan.requested = true;
