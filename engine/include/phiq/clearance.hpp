@@ -69,6 +69,8 @@ class ClearanceGeometry {
   PairDistance distance(Index a, const Pose& pose_a, Index b, const Pose& pose_b) const;
   /// A radius about the part's frame origin that holds all its shapes (m).
   double bounding_radius(Index part) const;
+  /// A box in world axes that holds the part's shapes at `pose` (each shape's own box, turned: not the tightest).
+  std::pair<kin3::V3, kin3::V3> world_box(Index part, const Pose& pose) const;
   bool has_shapes(Index part) const;  ///< the part carries at least one shape
 
  private:
@@ -108,6 +110,7 @@ struct ClearanceReport {
   std::vector<double> times;            ///< the rows' times
   std::vector<PairClearance> pairs;     ///< the pairs measured (for `all`: those that come within the threshold)
   Index pairs_selected = 0;             ///< the pairs the plan selects (for `all`, before the broad phase)
+  Index pairs_measured = 0;             ///< the pairs measured at the rows (for `all`, those the broad phase keeps)
   double threshold = 0.0;               ///< the plan's
   std::vector<std::string> parameters;  ///< the sensitivities' parameters, in order
   Index positions_solved = 0;           ///< positions solved between rows (refinement and subdivision)

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "clearance/clearance_internal.hpp"
 #include "phiq/part_motion.hpp"
@@ -160,11 +161,14 @@ class PairPass {
            Index b)
       : tracer_(tracer), rows_(rows), options_(options), threshold_(threshold), a_(a), b_(b) {}
 
-  PairClearance run() {
+  // The pair over the sweep; nothing when `beyond_threshold_only` and the rows and the speed bound between them
+  // prove it farther than the threshold at every time (what `pairs: all` does not report).
+  std::optional<PairClearance> run(bool beyond_threshold_only) {
     PairClearance out;
     out.a = a_, out.b = b_;
     const std::size_t n = rows_.t.size();
     for (std::size_t k = 0; k < n; ++k) samples_.push_back(tracer_.at_row(a_, b_, k));
+    if (beyond_threshold_only && proven_beyond_threshold()) return std::nullopt;
     for (const Sample& s : samples_) out.row_distance.push_back(s.d.distance);
     std::vector<bool> refined(n > 0 ? n - 1 : 0, false);  // steps next to a refined minimum
     for (std::size_t k = 0; k < n; ++k) {
@@ -183,6 +187,14 @@ class PairPass {
   }
 
  private:
+  bool proven_beyond_threshold() const {
+    for (std::size_t k = 0; k < samples_.size(); ++k) {
+      if (samples_[k].d.distance <= threshold_) return false;
+      if (k + 1 < samples_.size() && lower_bound(samples_[k], samples_[k + 1]) <= threshold_) return false;
+    }
+    return true;
+  }
+
   double step_at(std::size_t k) const {
     const std::size_t n = rows_.t.size();
     if (n < 2) return 1.0;
@@ -299,37 +311,66 @@ std::vector<double> minimum_sensitivities(const Model& model, const std::vector<
   return out;
 }
 
+// Steps whose boxes go into one query of the broad phase: fewer updates of the tree, slightly larger boxes.
+constexpr std::size_t kStepsPerQuery = 4;
+
 // `pairs: all`: the selected pairs whose boxes, each swept over a step and grown by half the threshold, overlap on
 // some step (the others are farther than the threshold at every time).
 std::vector<std::pair<Index, Index>> broad_phase(const std::vector<Part>& parts, const ClearanceGeometry& geometry,
                                                  const detail::PairSelection& selection, const ClearanceRows& rows,
                                                  double threshold) {
-  const std::size_t n = rows.t.size();
-  std::vector<std::vector<PartState>> states(n);
-  for (std::size_t k = 0; k < n; ++k)
-    for (std::size_t p = 0; p < parts.size(); ++p)
-      states[k].push_back(selection.shaped[p]
-                              ? part_state(parts[p], geometry.bounding_radius(static_cast<Index>(p)), rows.q[k].data(),
-                                           rows.qd[k].data(), rows.qdd[k].data(), rows.t[k])
-                              : PartState{});
-  std::set<std::pair<Index, Index>> found;
-  for (std::size_t k = 0; k + (n > 1 ? 1 : 0) < n; ++k) {
-    const std::size_t k1 = n > 1 ? k + 1 : k;
-    const double h = rows.t[k1] - rows.t[k];
-    std::vector<detail::SweptBox> boxes(parts.size(), {{1, 1, 1}, {0, 0, 0}});
+  // each part's state and box at a row, two rows at a time: over a step, a point lies within speed · h/2 of its
+  // place at the nearer row
+  struct AtRow {
+    std::vector<double> speed, accel;
+    std::vector<std::pair<kin3::V3, kin3::V3>> box;
+  };
+  auto at_row = [&](std::size_t k, AtRow& r) {
+    r.speed.assign(parts.size(), 0.0), r.accel.assign(parts.size(), 0.0), r.box.resize(parts.size());
     for (std::size_t p = 0; p < parts.size(); ++p) {
       if (!selection.shaped[p]) continue;
-      const PartState &s0 = states[k][p], &s1 = states[k1][p];
-      const double speed = std::max(s0.speed + s0.accel * h, s1.speed + s1.accel * h);
-      const double r = geometry.bounding_radius(static_cast<Index>(p)) + 0.5 * speed * h + 0.5 * threshold;
-      const kin3::V3 c0 = s0.motion.pose.at, c1 = s1.motion.pose.at;
-      boxes[p].lo = {std::min(c0.x, c1.x) - r, std::min(c0.y, c1.y) - r, std::min(c0.z, c1.z) - r};
-      boxes[p].hi = {std::max(c0.x, c1.x) + r, std::max(c0.y, c1.y) + r, std::max(c0.z, c1.z) + r};
+      const auto i = static_cast<Index>(p);
+      const PartState s = part_state(parts[p], geometry.bounding_radius(i), rows.q[k].data(), rows.qd[k].data(),
+                                     rows.qdd[k].data(), rows.t[k]);
+      r.speed[p] = s.speed, r.accel[p] = s.accel;
+      r.box[p] = geometry.world_box(i, s.motion.pose);
     }
-    for (const auto& [a, b] : detail::overlapping_boxes(boxes))
-      if (selection.selects(a, b)) found.insert({a, b});
+  };
+  const std::size_t n = rows.t.size();
+  std::vector<std::pair<Index, Index>> found;
+  detail::BroadPhase tree(selection.shaped);
+  std::vector<detail::SweptBox> boxes(parts.size());
+  AtRow r0, r1;
+  at_row(0, r0);
+  const double inf = std::numeric_limits<double>::infinity();
+  const detail::SweptBox empty{{inf, inf, inf}, {-inf, -inf, -inf}};
+  std::fill(boxes.begin(), boxes.end(), empty);
+  for (std::size_t k = 0; k + (n > 1 ? 1 : 0) < n; ++k) {
+    const std::size_t k1 = n > 1 ? k + 1 : k;
+    at_row(k1, r1);
+    const double h = rows.t[k1] - rows.t[k];
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      if (!selection.shaped[p]) continue;
+      const double speed = std::max(r0.speed[p] + r0.accel[p] * h, r1.speed[p] + r1.accel[p] * h);
+      const double r = 0.5 * speed * h + 0.5 * threshold;
+      const auto &b0 = r0.box[p], &b1 = r1.box[p];
+      detail::SweptBox& b = boxes[p];
+      b.lo = {std::min({b.lo.x, b0.first.x - r, b1.first.x - r}), std::min({b.lo.y, b0.first.y - r, b1.first.y - r}),
+              std::min({b.lo.z, b0.first.z - r, b1.first.z - r})};
+      b.hi = {std::max({b.hi.x, b0.second.x + r, b1.second.x + r}),
+              std::max({b.hi.y, b0.second.y + r, b1.second.y + r}),
+              std::max({b.hi.z, b0.second.z + r, b1.second.z + r})};
+    }
+    std::swap(r0, r1);
+    // one query of the tree for kStepsPerQuery steps: the boxes hold the parts over all of them
+    if ((k + 1) % kStepsPerQuery != 0 && k1 + 1 < n) continue;
+    for (const auto& [a, b] : tree.overlapping(boxes))
+      if (selection.selects(a, b)) found.emplace_back(a, b);
+    std::fill(boxes.begin(), boxes.end(), empty);
   }
-  return {found.begin(), found.end()};
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  return found;
 }
 
 }  // namespace
@@ -350,9 +391,12 @@ ClearanceReport clearance_along(const Model& model, const std::vector<Part>& par
   else
     for (const auto& ab : selection.listed)
       if (selection.selects(ab.first, ab.second)) pairs.push_back(ab);
+  report.pairs_measured = static_cast<Index>(pairs.size());
   Tracer tracer(model, parts, geometry, rows, options);
   for (const auto& [a, b] : pairs) {
-    PairClearance pc = PairPass(tracer, rows, options, plan.threshold, a, b).run();
+    std::optional<PairClearance> measured = PairPass(tracer, rows, options, plan.threshold, a, b).run(plan.all);
+    if (!measured) continue;
+    PairClearance& pc = *measured;
     // `all` reports the pairs that come within the threshold (or could not be proven not to)
     if (plan.all && pc.worst.at.distance > plan.threshold && pc.unproven_intervals == 0) continue;
     if (!options.sensitivities.empty())

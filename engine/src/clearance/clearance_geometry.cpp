@@ -131,6 +131,22 @@ ClearanceGeometry& ClearanceGeometry::operator=(ClearanceGeometry&&) noexcept = 
 
 double ClearanceGeometry::bounding_radius(Index part) const { return impl_->radius[static_cast<std::size_t>(part)]; }
 
+std::pair<kin3::V3, kin3::V3> ClearanceGeometry::world_box(Index part, const Pose& pose) const {
+  const double inf = std::numeric_limits<double>::infinity();
+  fcl::Vector3d lo(inf, inf, inf), hi(-inf, -inf, -inf);
+  const fcl::Transform3d tf = to_transform(pose);
+  for (const PlacedGeometry& g : impl_->parts[static_cast<std::size_t>(part)]) {
+    const fcl::Transform3d t = tf * g.in_part;
+    // the box's centre moved, its half extents through |R|
+    const fcl::AABBd& box = g.geometry->aabb_local;
+    const fcl::Vector3d centre = t * box.center();
+    const fcl::Vector3d half = t.linear().cwiseAbs() * (0.5 * (box.max_ - box.min_));
+    lo = lo.cwiseMin(centre - half);
+    hi = hi.cwiseMax(centre + half);
+  }
+  return {v3(lo), v3(hi)};
+}
+
 bool ClearanceGeometry::has_shapes(Index part) const { return !impl_->parts[static_cast<std::size_t>(part)].empty(); }
 
 namespace {

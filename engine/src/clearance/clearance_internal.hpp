@@ -2,6 +2,7 @@
 // broad phase that finds the pairs worth measuring among them.
 #pragma once
 
+#include <memory>
 #include <set>
 #include <utility>
 #include <vector>
@@ -14,10 +15,11 @@ namespace phiq::detail {
 struct PairSelection {
   PairSelection(const Model& model, const std::vector<Part>& parts, const ClearancePlan& plan);
   bool all = false;
-  std::set<std::pair<Index, Index>> skipped;  // a < b
-  std::set<std::pair<Index, Index>> listed;   // a < b
-  std::vector<bool> shaped, fixed;            // per part
-  Index count = 0;                            // the pairs selected
+  std::vector<std::pair<Index, Index>> skipped;  // a < b, sorted, each once
+  std::vector<std::vector<Index>> skipped_with;  // per part, the parts it is skipped with (a few)
+  std::set<std::pair<Index, Index>> listed;      // a < b
+  std::vector<bool> shaped, fixed;               // per part
+  Index count = 0;                               // the pairs selected
   bool eligible(Index a, Index b) const;
   bool selects(Index a, Index b) const;
 };
@@ -27,8 +29,18 @@ struct SweptBox {
   kin3::V3 lo, hi;
 };
 
-// The pairs of `boxes` that overlap (a < b, each once), by FCL's dynamic AABB tree; parts with no box (lo > hi)
-// take no part.
-std::vector<std::pair<Index, Index>> overlapping_boxes(const std::vector<SweptBox>& boxes);
+// FCL's dynamic AABB tree over one box per part (those `present`), kept from one step to the next: each step moves
+// the boxes and updates the tree rather than building it again.
+class BroadPhase {
+ public:
+  explicit BroadPhase(const std::vector<bool>& present);
+  ~BroadPhase();
+  // The pairs of `boxes` (one per part; those not present ignored) that overlap: a < b, each once.
+  std::vector<std::pair<Index, Index>> overlapping(const std::vector<SweptBox>& boxes);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace phiq::detail

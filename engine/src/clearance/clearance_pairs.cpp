@@ -103,16 +103,20 @@ std::vector<std::pair<Index, Index>> adjacent_parts(const Model& model, const st
 
 detail::PairSelection::PairSelection(const Model& model, const std::vector<Part>& parts, const ClearancePlan& plan)
     : all(plan.all) {
-  for (const auto& [a, b] : plan.skip) skipped.insert(ordered(a, b));
+  for (const auto& [a, b] : plan.skip) skipped.push_back(ordered(a, b));
   if (plan.skip_adjacent)
-    for (const auto& ab : adjacent_parts(model, parts)) skipped.insert(ab);
+    for (const auto& ab : adjacent_parts(model, parts)) skipped.push_back(ab);
+  std::sort(skipped.begin(), skipped.end());
+  skipped.erase(std::unique(skipped.begin(), skipped.end()), skipped.end());
+  skipped_with.resize(parts.size());
+  for (const auto& [a, b] : skipped) skipped_with[static_cast<std::size_t>(a)].push_back(b);
   for (const auto& [a, b] : plan.pairs) listed.insert(ordered(a, b));
   for (const Part& p : parts) {
     shaped.push_back(!p.shapes.empty());
     fixed.push_back(p.fixed);
   }
   if (!all) {
-    for (const auto& ab : listed) count += skipped.count(ab) ? 0 : 1;
+    for (const auto& ab : listed) count += std::binary_search(skipped.begin(), skipped.end(), ab) ? 0 : 1;
     return;
   }
   Index n = 0, nf = 0;
@@ -128,7 +132,8 @@ bool detail::PairSelection::eligible(Index a, Index b) const {
 
 bool detail::PairSelection::selects(Index a, Index b) const {
   const auto ab = ordered(a, b);
-  if (skipped.count(ab)) return false;
+  const auto& with = skipped_with[static_cast<std::size_t>(ab.first)];
+  if (std::find(with.begin(), with.end(), ab.second) != with.end()) return false;
   return all ? eligible(a, b) : listed.count(ab) > 0;
 }
 
