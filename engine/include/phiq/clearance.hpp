@@ -95,7 +95,8 @@ struct InterferenceInterval {
 
 /// Everything measured about one pair.
 struct PairClearance {
-  Index a = -1, b = -1;                            ///< indices into the parts
+  Index a = -1;                                    ///< index of part A into the parts
+  Index b = -1;                                    ///< index of part B into the parts
   std::vector<double> row_distance;                ///< the signed distance at each row
   std::vector<ClearanceMinimum> minima;            ///< the local minima over time, in time order
   ClearanceMinimum worst;                          ///< the smallest of them, with its sensitivities
@@ -120,8 +121,10 @@ struct ClearanceReport {
 
 /// The rows a clearance pass reads: t, q, q̇ and q̈ of each row of a sweep (what run_sweep's on_step delivers).
 struct ClearanceRows {
-  std::vector<double> t;                    ///< times, increasing
-  std::vector<Eigen::VectorXd> q, qd, qdd;  ///< one per row
+  std::vector<double> t;             ///< times, increasing
+  std::vector<Eigen::VectorXd> q;    ///< positions, one per row
+  std::vector<Eigen::VectorXd> qd;   ///< velocities, one per row
+  std::vector<Eigen::VectorXd> qdd;  ///< accelerations, one per row
 };
 
 /// How clearance_along() solves positions between rows and what it differentiates.
