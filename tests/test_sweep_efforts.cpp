@@ -170,8 +170,11 @@ TEST(SweepEfforts, ARedundantParallelogramNeedsTheTorqueOfItsFourBar) {
     Workspace ws(m);
     ws.q = square.start;
     std::vector<double> tau;
-    ASSERT_EQ(run_sweep(m, s.sweep, ws, [&](const StepView& v) { return tau.push_back(v.efforts[0]), true; }),
-              SolveStatus::kSuccess);
+    const auto keep = [&](const StepView& v) {
+      tau.push_back(v.efforts[0]);
+      return true;
+    };
+    ASSERT_EQ(run_sweep(m, s.sweep, ws, keep, nullptr), SolveStatus::kSuccess);
     torque.push_back(tau);
   }
   EXPECT_FALSE(torque[0].empty());

@@ -27,5 +27,6 @@ Command register_animate(CLI::App& app);
 Command register_compare(CLI::App& app);
 Command register_sweep_accuracy(CLI::App& app);
 Command register_tolerance(CLI::App& app);
+Command register_clearance(CLI::App& app);
 
 }  // namespace phiq::tools

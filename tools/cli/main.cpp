@@ -3,9 +3,10 @@
 //
 // Exit status: 0 success; 1 the mechanism could not be solved (the message names step, time and constraints), or
 // `compare` found a difference; 2 bad input (scene, CSV or command line); 3 an output (a file, standard output)
-// could not be written; 128 + the signal when interrupted (130 SIGINT, 143 SIGTERM, 129 SIGHUP). An exception no
-// command caught is one of these too (out of memory, an error of the file system, an internal error): exit 1, or 3
-// for the file system's, never a status the table of tools/README.md does not list.
+// could not be written; 4 `clearance --fail-on-interference` found parts interfering; 128 + the signal when
+// interrupted (130 SIGINT, 143 SIGTERM, 129 SIGHUP). An exception no command caught is one of these too (out of
+// memory, an error of the file system, an internal error): exit 1, or 3 for the file system's, never a status the
+// table of tools/README.md does not list.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -46,9 +47,9 @@ int run_command(int argc, char** argv) {
                                         std::to_string(phiq::kToleranceSummaryFormat) + ")");
   app.require_subcommand(1);
   const std::vector<Command> commands{
-      register_run(app),      register_generate(app),       register_convert(app),  register_batch(app),
-      register_assemble(app), register_check(app),          register_plot(app),     register_animate(app),
-      register_compare(app),  register_sweep_accuracy(app), register_tolerance(app)};
+      register_run(app),      register_generate(app),       register_convert(app),   register_batch(app),
+      register_assemble(app), register_check(app),          register_plot(app),      register_animate(app),
+      register_compare(app),  register_sweep_accuracy(app), register_tolerance(app), register_clearance(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -11,7 +11,7 @@ _phiq() {
     words=("${COMP_WORDS[@]}")
     cword=$COMP_CWORD
   }
-  local commands="run check assemble batch compare generate convert plot animate sweep-accuracy tolerance"
+  local commands="run check assemble batch compare generate convert plot animate sweep-accuracy tolerance clearance"
   local cmd="" i
   for ((i = 1; i < cword; i++)); do
     case " $commands " in *" ${words[i]} "*) cmd="${words[i]}"; break ;; esac
@@ -37,6 +37,7 @@ _phiq() {
                           --reference --repeat --quiet --verbose" ;;
     tolerance) opts="--help --output --sd --limit --covariance --samples --seed --columns --threshold --summary --plot
                      --plot-column --threads --names --quiet --set" ;;
+    clearance) opts="--help --output --fail-on-interference --quiet --set" ;;
   esac
 
   # values of the options that take a fixed set of words, or files

@@ -62,7 +62,8 @@ struct SpringEnd {
 /// them, pulling them together when positive. Where L = 0 the line has no direction and it exerts nothing.
 struct LinearSpring {
   std::string name;          ///< the scene's name for it
-  SpringEnd a, b;            ///< its ends
+  SpringEnd a;               ///< its first end
+  SpringEnd b;               ///< its second end
   double stiffness = 0.0;    ///< k (N/m), ≥ 0
   double free_length = 0.0;  ///< L0 (m), ≥ 0
   double damping = 0.0;      ///< c (N·s/m), ≥ 0

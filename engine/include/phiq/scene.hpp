@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "phiq/clearance.hpp"
 #include "phiq/model.hpp"
 #include "phiq/parts.hpp"
 #include "phiq/sweep.hpp"
@@ -75,6 +76,8 @@ struct Scene {
   /// Time grid, solver settings and the output plan (its OutputPlan part: what the sweep computes and the columns
   /// written, coordinates defaulting to all).
   SweepOptions sweep;
+  /// The scene's `output.clearance`: the pairs of parts whose distance `phiq clearance` measures (clearance.hpp).
+  ClearancePlan clearance;
 };
 
 /// A parameter whose sensitivities a caller asks for beside the scene's text (`phiq run --sensitivity`, Python's

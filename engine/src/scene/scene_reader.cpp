@@ -51,6 +51,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   if (auto l = top.field("loads"); l.present()) read_loads(l, scene);  // (after the parts they act on)
   read_time(top.require("time"), scene.sweep);
   read_output(top.field("output"), scene.sweep);
+  if (auto o = top.field("output"); o.present() && o.is_map()) read_clearance(o.field("clearance"), scene);
   scene.dimension = spatial_ ? 3 : 2;
   scene.planar_bodies = std::move(planar_bodies_), scene.spatial_bodies = std::move(spatial_bodies_);
   scene.joint_angles = std::move(joint_angles_);

@@ -224,6 +224,7 @@ class SceneReader {
   void read_output_efforts(const Cursor& output);   // read_efforts.cpp
   void resolve_output_efforts(Scene& scene) const;  // read_efforts.cpp
   void read_solver(const Cursor& c, SolverSettings& o);
+  void read_clearance(const Cursor& c, Scene& scene) const;  // output.clearance (read_clearance.cpp)
 
   const std::string& file_;
   const SceneLimits& limits_;

@@ -15,6 +15,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/read_parts.cpp
   ${CMAKE_CURRENT_LIST_DIR}/read_loads.cpp
   ${CMAKE_CURRENT_LIST_DIR}/read_shapes.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/read_clearance.cpp
   ${CMAKE_CURRENT_LIST_DIR}/read_scene_file.cpp
   ${CMAKE_CURRENT_LIST_DIR}/load_scene.cpp
 )
