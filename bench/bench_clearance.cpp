@@ -56,20 +56,8 @@ SweepOptions clearance_sweep_options() {
 }
 
 ClearanceRows clearance_rows_of(const Model& model) {
-  ClearanceRows rows;
   Workspace ws(model);
-  SweepSummary summary;
-  (void)run_sweep(
-      model, clearance_sweep_options(), ws,
-      [&](const StepView& v) {
-        rows.t.push_back(v.t);
-        rows.q.push_back(v.q);
-        rows.qd.push_back(*v.qd);
-        rows.qdd.push_back(*v.qdd);
-        return true;
-      },
-      &summary);
-  return rows;
+  return sweep_rows(model, clearance_sweep_options(), ws);
 }
 
 // The kinematic step: the sweep that makes the rows, per row.

@@ -60,22 +60,10 @@ Shape clearance_box(kin3::V3 size, kin3::V3 at) {
 
 // The rows of the scene's sweep with q̇ and q̈.
 ClearanceRows clearance_rows(const Scene& scene) {
-  SweepOptions o = scene.sweep;
-  o.velocities = o.accelerations = true;
-  ClearanceRows rows;
   Workspace ws(*scene.model);
   SweepSummary summary;
-  EXPECT_EQ(run_sweep(
-                *scene.model, o, ws,
-                [&](const StepView& v) {
-                  rows.t.push_back(v.t);
-                  rows.q.push_back(v.q);
-                  rows.qd.push_back(*v.qd);
-                  rows.qdd.push_back(*v.qdd);
-                  return true;
-                },
-                &summary),
-            SolveStatus::kSuccess);
+  ClearanceRows rows = sweep_rows(*scene.model, scene.sweep, ws, &summary);
+  EXPECT_EQ(summary.status, SolveStatus::kSuccess) << summary.message;
   return rows;
 }
 

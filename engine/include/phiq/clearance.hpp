@@ -127,6 +127,10 @@ struct ClearanceRows {
   std::vector<Eigen::VectorXd> qdd;  ///< accelerations, one per row
 };
 
+/// The rows of a sweep of `model` with `options` (q̇ and q̈ solved whatever they say), from ws.q; the sweep's
+/// outcome in *summary (the rows before a failure are kept).
+ClearanceRows sweep_rows(const Model& model, SweepOptions options, Workspace& ws, SweepSummary* summary = nullptr);
+
 /// How clearance_along() solves positions between rows and what it differentiates.
 struct ClearanceOptions {
   SolverSettings solver;                         ///< for the positions between rows (a Stepper)
