@@ -69,7 +69,7 @@ class Tracer {
  public:
   Tracer(const Model& model, const std::vector<Part>& parts, const ClearanceGeometry& geometry,
          const ClearanceRows& rows, const ClearanceOptions& options)
-      : parts_(parts), geometry_(geometry), rows_(rows), options_(options), stepper_(model, stepper_options(options)) {}
+      : parts_(parts), geometry_(geometry), rows_(rows), stepper_(model, stepper_options(options)) {}
 
   static StepperOptions stepper_options(const ClearanceOptions& o) {
     StepperOptions s;
@@ -120,7 +120,6 @@ class Tracer {
   const std::vector<Part>& parts_;
   const ClearanceGeometry& geometry_;
   const ClearanceRows& rows_;
-  const ClearanceOptions& options_;
   Stepper stepper_;
   Index solved_ = 0;
 };
