@@ -35,8 +35,9 @@ SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, 
                                    Eigen::VectorXd& lambda, std::string* message = nullptr);
 
 /// λ with Φqᵀ λ = Q by a transposed solve with `lu`, factors of Φq's kept rows (Model::solve_rows(); all rows when
-/// none are dropped) at the motion's q: λ on the kept rows, 0 on the dropped ones; `kept` is scratch. What
-/// constraint_multipliers() and a sweep's efforts (OutputPlan::efforts) solve with. False when the solve fails.
+/// none are dropped) at the motion's q: λ on the kept rows, 0 on the dropped ones; `kept` is scratch, used only
+/// with dropped rows. What constraint_multipliers() and a sweep's efforts (OutputPlan::efforts) solve with. False
+/// when the solve fails.
 bool multipliers_with_factors(const Model& model, SparseLuNumeric& lu, const Eigen::VectorXd& Q, Eigen::VectorXd& kept,
                               Eigen::VectorXd& lambda);
 

@@ -1,6 +1,7 @@
 // add_applied_forces() and applied_power() (phiq/applied_loads.hpp).
 #include "phiq/applied_loads.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "phiq/part_motion.hpp"
@@ -17,13 +18,14 @@ V3 turned(const RotationMatrix& r, V3 v) {
           r[6] * v.x + r[7] * v.y + r[8] * v.z};
 }
 
-// Q_k += (∂x/∂q_k) · F for the force F at the body point s of `frame`, and ∂θ/∂q_k · M for the moment M.
-void add_virtual_work(const PartFrame& frame, V3 s, V3 force, V3 moment, const double* q, double t,
+// Q_k += (∂x/∂q_k) · F for the force F at the body point s of `frame` (at `pose`, its pose at (q, t)), and
+// ∂θ/∂q_k · M for the moment M.
+void add_virtual_work(const PartFrame& frame, const Pose& pose, V3 s, V3 force, V3 moment, const double* q, double t,
                       Eigen::VectorXd& Q) {
   thread_local PartJacobian j;  // its vectors' capacity kept from row to row (a sweep's efforts)
   part_jacobian(frame, q, t, j);
   if (j.coordinates.empty()) return;
-  const V3 arm = turned(part_pose(frame, q, t).rotation, s);  // R s, world axes
+  const V3 arm = turned(pose.rotation, s);  // R s, world axes
   for (std::size_t i = 0; i < j.coordinates.size(); ++i)
     Q(j.coordinates[i]) +=
         kin3::dot(j.d_origin[i] + kin3::cross(j.d_angle[i], arm), force) + kin3::dot(j.d_angle[i], moment);
@@ -37,14 +39,16 @@ V3 end_velocity(const SpringEnd& e, const double* q, const double* qd, double t)
 
 // A spring's state at (q, q̇, t): its ends in the world, the unit vector from a to b, and its tension.
 struct SpringState {
+  Pose pa, pb;  // the ends' frames
   V3 xa, xb, unit;
   double length = 0.0, rate = 0.0, tension = 0.0;
 };
 
 SpringState spring_state(const LinearSpring& s, const double* q, const double* qd, double t) {
   SpringState st;
-  st.xa = part_pose(s.a.frame, q, t).apply(s.a.at);
-  st.xb = part_pose(s.b.frame, q, t).apply(s.b.at);
+  st.pa = part_pose(s.a.frame, q, t), st.pb = part_pose(s.b.frame, q, t);
+  st.xa = st.pa.apply(s.a.at);
+  st.xb = st.pb.apply(s.b.at);
   const V3 d = st.xb - st.xa;
   st.length = kin3::norm(d);
   if (st.length == 0.0) return st;  // no direction: no force (LinearSpring)
@@ -75,7 +79,8 @@ double angle_from_free(const TorsionalSpring& s, const double* q, double t, std:
   const std::vector<Index>& c = s.joint_coordinates;
   gradient.assign(c.size(), 0.0);
   if (!c.empty()) {
-    std::vector<double> unit(static_cast<std::size_t>(c.back()) + 1, 0.0);
+    thread_local std::vector<double> unit;  // (capacity kept from row to row; all zeros between uses)
+    unit.resize(std::max(unit.size(), static_cast<std::size_t>(c.back()) + 1), 0.0);
     for (std::size_t i = 0; i < c.size(); ++i) {
       unit[static_cast<std::size_t>(c[i])] = 1.0;
       gradient[i] = evaluate_joint(*s.joint, q, unit.data(), nullptr).rate;
@@ -111,20 +116,20 @@ V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 
 
 void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, double t, Eigen::VectorXd& Q) {
   for (const AppliedForce& f : loads.forces) {
-    const V3 force = world_components(f.components, f.axes, part_pose(f.frame, q, t), q, t);
-    add_virtual_work(f.frame, f.at, force, {}, q, t, Q);
+    const Pose pose = part_pose(f.frame, q, t);
+    add_virtual_work(f.frame, pose, f.at, world_components(f.components, f.axes, pose, q, t), {}, q, t, Q);
   }
   for (const AppliedTorque& m : loads.torques) {
-    const V3 moment = world_components(m.components, m.axes, part_pose(m.frame, q, t), q, t);
-    add_virtual_work(m.frame, {}, {}, moment, q, t, Q);
+    const Pose pose = part_pose(m.frame, q, t);
+    add_virtual_work(m.frame, pose, {}, {}, world_components(m.components, m.axes, pose, q, t), q, t, Q);
   }
   for (const LinearSpring& s : loads.springs) {
     const SpringState st = spring_state(s, q, qd, t);
     // the tension pulls a toward b and b toward a
-    add_virtual_work(s.a.frame, s.a.at, st.tension * st.unit, {}, q, t, Q);
-    add_virtual_work(s.b.frame, s.b.at, -st.tension * st.unit, {}, q, t, Q);
+    add_virtual_work(s.a.frame, st.pa, s.a.at, st.tension * st.unit, {}, q, t, Q);
+    add_virtual_work(s.b.frame, st.pb, s.b.at, -st.tension * st.unit, {}, q, t, Q);
   }
-  std::vector<double> gradient;
+  thread_local std::vector<double> gradient;  // (capacity kept from row to row)
   for (const TorsionalSpring& s : loads.torsional_springs) {
     const AngleState st = angle_state(s, q, qd, t, gradient);
     const std::vector<Index>& c = angle_coordinates(s);
@@ -149,7 +154,7 @@ double applied_power(const AppliedLoads& loads, const double* q, const double* q
     const double rate = kin3::dot(st.unit, end_velocity(s.b, q, qd, t) - end_velocity(s.a, q, qd, t));
     power -= st.tension * rate;
   }
-  std::vector<double> gradient;
+  thread_local std::vector<double> gradient;
   for (const TorsionalSpring& s : loads.torsional_springs) {
     const AngleState st = angle_state(s, q, qd, t, gradient);
     power -= st.moment * st.rate;

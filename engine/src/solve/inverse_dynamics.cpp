@@ -68,14 +68,14 @@ SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, 
 bool multipliers_with_factors(const Model& model, SparseLuNumeric& lu, const Eigen::VectorXd& Q, Eigen::VectorXd& kept,
                               Eigen::VectorXd& lambda) {
   const std::vector<Index>& rows = model.solve_rows();
-  kept.resize(static_cast<Index>(rows.empty() ? model.num_equations() : rows.size()));
-  if (!lu.solve_transposed(Q.data(), kept.data())) return false;
-  if (rows.empty()) {
-    lambda = kept;
-  } else {
-    lambda.setZero(model.num_equations());
-    for (std::size_t i = 0; i < rows.size(); ++i) lambda(rows[i]) = kept(static_cast<Index>(i));
+  if (rows.empty()) {  // every row kept: λ straight from the solve
+    lambda.resize(model.num_equations());
+    return lu.solve_transposed(Q.data(), lambda.data());
   }
+  kept.resize(static_cast<Index>(rows.size()));
+  if (!lu.solve_transposed(Q.data(), kept.data())) return false;
+  lambda.setZero(model.num_equations());
+  for (std::size_t i = 0; i < rows.size(); ++i) lambda(rows[i]) = kept(static_cast<Index>(i));
   return true;
 }
 

@@ -33,13 +33,22 @@ void Sweeper::row_efforts() {
     efforts_[i] = -effort_lambda_(c.first_row);
     efforts_[n + i] = power;
   }
+  for (std::size_t i : efforts_dropped_) efforts_[i] = efforts_[n + i] = std::numeric_limits<double>::quiet_NaN();
+}
+
+std::vector<std::size_t> Sweeper::dropped_efforts() const {
   // A driver whose row was dropped as redundant shares its load with the equations it repeats: not its own.
-  for (Index r : model_.dropped_rows())
-    for (std::size_t i = 0; i < n; ++i) {
-      const ConstraintInfo& c = cs[static_cast<std::size_t>(e.constraints[i])];
-      if (r >= c.first_row && r < c.first_row + c.rows)
-        efforts_[i] = efforts_[n + i] = std::numeric_limits<double>::quiet_NaN();
-    }
+  std::vector<std::size_t> out;
+  const std::vector<Index>& cs = opt_.efforts.constraints;
+  for (std::size_t i = 0; i < cs.size(); ++i) {
+    const ConstraintInfo& c = model_.constraints()[static_cast<std::size_t>(cs[i])];
+    for (Index r : model_.dropped_rows())
+      if (r >= c.first_row && r < c.first_row + c.rows) {
+        out.push_back(i);
+        break;
+      }
+  }
+  return out;
 }
 
 }  // namespace phiq::detail

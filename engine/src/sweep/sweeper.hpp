@@ -341,6 +341,9 @@ class Sweeper {
   // The plan's driver efforts and powers at the current state (efforts_), by one transposed solve with the same
   // factors as row_sensitivities() (sweeper_efforts.cpp); NaN at a singular position.
   void row_efforts();
+  // The efforts (indices into OutputEfforts::constraints) of drivers the model dropped as redundant: NaN at every
+  // row, found once (row_efforts.cpp).
+  std::vector<std::size_t> dropped_efforts() const;
   // The factors of Φq at the current row: the workspace's when the row's velocity solve has just used them, else
   // those of sensitivity_ws_, factorised at the row; null where Φq is singular or cannot be factorised.
   Workspace* row_factors();
@@ -384,6 +387,7 @@ class Sweeper {
   SensitivityScratch sensitivity_scratch_;
   std::vector<double> efforts_ = std::vector<double>(static_cast<std::size_t>(opt_.efforts.size()));
   Eigen::VectorXd effort_q_, effort_kept_, effort_lambda_, effort_phi_t_;  // row_efforts()'s Q, λ, Φt
+  std::vector<std::size_t> efforts_dropped_ = dropped_efforts();
   // The coordinates whose columns are written, and the form the sensitivities are solved in
   // (effective_sensitivity_form)
   std::vector<Index> sensitivity_outputs_ =
