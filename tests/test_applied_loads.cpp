@@ -132,6 +132,55 @@ TEST(AppliedLoads, SpringForcesAreTheirEnergysGradientInEveryCoordinateFamily) {
       "    - {name: t2, joint: crank_hinge, stiffness: 7, free_angle: -2.5}\n");
 }
 
+// ω · (R I Rᵀ α): the rate of a part's rotational kinetic energy ½ ω · I_world ω (the rate of I_world does no work).
+double rotational_energy_rate(const Part& p, const PartMotion& pm) {
+  const RotationMatrix& r = pm.pose.rotation;
+  const kin3::V3 a = pm.alpha;
+  const double b[3] = {r[0] * a.x + r[3] * a.y + r[6] * a.z, r[1] * a.x + r[4] * a.y + r[7] * a.z,
+                       r[2] * a.x + r[5] * a.y + r[8] * a.z};
+  double c[3];
+  for (int i = 0; i < 3; ++i)
+    c[i] = p.mass.inertia[3 * i] * b[0] + p.mass.inertia[3 * i + 1] * b[1] + p.mass.inertia[3 * i + 2] * b[2];
+  const kin3::V3 d{r[0] * c[0] + r[1] * c[1] + r[2] * c[2], r[3] * c[0] + r[4] * c[1] + r[5] * c[2],
+                   r[6] * c[0] + r[7] * c[1] + r[8] * c[2]};
+  return kin3::dot(pm.omega, d);
+}
+
+// Over a scene's sweep, whose driver turns at 1 rad/s: the largest |τ θ̇ − (d/dt kinetic energy + d/dt gravity's
+// potential − the applied loads' power)|, the largest |τ| and the largest |applied power|.
+struct LoadedPowerBalance {
+  double balance = 0.0, scale = 0.0, loads_power = 0.0;
+};
+LoadedPowerBalance loaded_power_balance(const Scene& s) {
+  LoadedPowerBalance b;
+  const Model& m = *s.model;
+  test::Trace tr;
+  EXPECT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
+  Workspace ws(m);
+  std::vector<double> efforts;
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    const double t = tr.t[k];
+    ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
+    std::string why;
+    if (driver_efforts(m, s.parts, s.loads, t, ws, efforts, &why) != SolveStatus::kSuccess) {
+      ADD_FAILURE() << why;
+      return {INFINITY, 0.0, 0.0};
+    }
+    double energy_rate = 0.0;
+    for (const Part& p : s.parts) {
+      const PartMotion pm = part_motion(p.frame, ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
+      const auto [v, a] = pm.point(p.mass.center);
+      energy_rate +=
+          p.mass.mass * kin3::dot(v, a) + rotational_energy_rate(p, pm) - p.mass.mass * kin3::dot(s.loads.gravity, v);
+    }
+    const double power = applied_power(*s.loads.applied, ws.q.data(), ws.qd.data(), t);
+    b.balance = std::max(b.balance, std::fabs(efforts[0] * 1.0 - (energy_rate - power)));
+    b.scale = std::max(b.scale, std::fabs(efforts[0]));
+    b.loads_power = std::max(b.loads_power, std::fabs(power));
+  }
+  return b;
+}
+
 TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) {
   // Σ effort × driven rate = d(kinetic)/dt + d(gravity's potential)/dt − power of the applied loads, every row
   const std::string loads =
@@ -149,46 +198,11 @@ TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) 
   for (const std::string form : {"relative", "natural", "reference_point", "mixed"}) {
     Scene s = parse_scene(
         test::seed_text("fourbar_" + form + ".yaml") + "\nparts:\n" + test::fourbar_parts(form) + loads, form);
-    const Model& m = *s.model;
-    test::Trace tr;
-    ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess) << form;
-    Workspace ws(m);
-    std::vector<double> efforts;
-    double balance = 0.0, scale = 0.0, loads_power = 0.0;
-    for (std::size_t k = 0; k < tr.t.size(); ++k) {
-      const double t = tr.t[k];
-      ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
-      std::string why;
-      ASSERT_EQ(driver_efforts(m, s.parts, s.loads, t, ws, efforts, &why), SolveStatus::kSuccess) << why;
-      double energy_rate = 0.0;
-      for (const Part& p : s.parts) {
-        const PartMotion pm = part_motion(p.frame, ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
-        const auto [v, a] = pm.point(p.mass.center);
-        energy_rate += p.mass.mass * kin3::dot(v, a) + p.mass.inertia[8] * pm.omega.z * pm.alpha.z -
-                       p.mass.mass * kin3::dot(s.loads.gravity, v);
-      }
-      const double power = applied_power(*s.loads.applied, ws.q.data(), ws.qd.data(), t);
-      balance = std::max(balance, std::fabs(efforts[0] * 1.0 - (energy_rate - power)));  // θ̇ = 1 rad/s
-      scale = std::max(scale, std::fabs(efforts[0]));
-      loads_power = std::max(loads_power, std::fabs(power));
-    }
+    const LoadedPowerBalance b = loaded_power_balance(s);
+    const double balance = b.balance, scale = b.scale, loads_power = b.loads_power;
     EXPECT_GT(loads_power, 1.0) << form;  // watts: the loads take part in the balance
     EXPECT_LT(balance, 1e-9 * scale) << form;
   }
-}
-
-// ω · (R I Rᵀ α): the rate of a part's rotational kinetic energy ½ ω · I_world ω (the rate of I_world does no work).
-double rotational_energy_rate(const Part& p, const PartMotion& pm) {
-  const RotationMatrix& r = pm.pose.rotation;
-  const kin3::V3 a = pm.alpha;
-  const double b[3] = {r[0] * a.x + r[3] * a.y + r[6] * a.z, r[1] * a.x + r[4] * a.y + r[7] * a.z,
-                       r[2] * a.x + r[5] * a.y + r[8] * a.z};
-  double c[3];
-  for (int i = 0; i < 3; ++i)
-    c[i] = p.mass.inertia[3 * i] * b[0] + p.mass.inertia[3 * i + 1] * b[1] + p.mass.inertia[3 * i + 2] * b[2];
-  const kin3::V3 d{r[0] * c[0] + r[1] * c[1] + r[2] * c[2], r[3] * c[0] + r[4] * c[1] + r[5] * c[2],
-                   r[6] * c[0] + r[7] * c[1] + r[8] * c[2]};
-  return kin3::dot(pm.omega, d);
 }
 
 TEST(AppliedLoads, DriverPowerBalancesInSpaceWithAJointSpringAndLoadsInPartAxes) {
@@ -203,29 +217,8 @@ TEST(AppliedLoads, DriverPowerBalancesInSpaceWithAJointSpringAndLoadsInPartAxes)
                       "  torques: [{part: rocker, torque: [1 + 0.5*cos(t), 0.5, -0.2], axes: part}]\n"
                       "  torsional_springs: [{joint: rocker_hinge, stiffness: 15, free_angle: 1.2, damping: 3}]\n",
                   "rssr.yaml");
-  const Model& m = *s.model;
-  test::Trace tr;
-  ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
-  Workspace ws(m);
-  std::vector<double> efforts;
-  double balance = 0.0, scale = 0.0, loads_power = 0.0;
-  for (std::size_t k = 0; k < tr.t.size(); ++k) {
-    const double t = tr.t[k];
-    ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
-    std::string why;
-    ASSERT_EQ(driver_efforts(m, s.parts, s.loads, t, ws, efforts, &why), SolveStatus::kSuccess) << why;
-    double energy_rate = 0.0;
-    for (const Part& p : s.parts) {
-      const PartMotion pm = part_motion(p.frame, ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
-      const auto [v, a] = pm.point(p.mass.center);
-      energy_rate +=
-          p.mass.mass * kin3::dot(v, a) + rotational_energy_rate(p, pm) - p.mass.mass * kin3::dot(s.loads.gravity, v);
-    }
-    const double power = applied_power(*s.loads.applied, ws.q.data(), ws.qd.data(), t);
-    balance = std::max(balance, std::fabs(efforts[0] * 1.0 - (energy_rate - power)));  // the hinge turns at 1 rad/s
-    scale = std::max(scale, std::fabs(efforts[0]));
-    loads_power = std::max(loads_power, std::fabs(power));
-  }
+  const LoadedPowerBalance b = loaded_power_balance(s);
+  const double balance = b.balance, scale = b.scale, loads_power = b.loads_power;
   EXPECT_GT(loads_power, 1.0);
   EXPECT_LT(balance, 1e-9 * scale);
 }
