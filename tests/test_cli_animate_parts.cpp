@@ -20,6 +20,7 @@ namespace {
 
 using phiq::test::Cli;
 using phiq::test::Glb;
+using phiq::test::slurp;
 namespace fs = std::filesystem;
 
 // The rotation matrix (row-major) of the unit quaternion (x, y, z, w).

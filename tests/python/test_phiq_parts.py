@@ -145,3 +145,28 @@ def test_driver_efforts_need_velocities_and_accelerations():
     result = phiq.run_sweep(scene, options)
     with pytest.raises(ValueError, match="no velocities or accelerations"):
         phiq.driver_efforts(scene, result)
+
+
+def test_pendulum_pivot_reaction_is_the_closed_form():
+    """A bar (mass m, centre l from its pivot) turned at a constant rate ω about a ground pin under gravity: the pin
+    pushes the bar with F = m (a_G - g), a_G = -ω² l (cos θ, sin θ) pointing at the pivot, and no moment; the
+    Stepper's reactions are the row's."""
+    m, l, w, g = 2.0, 0.5, 3.0, 9.81
+    scene = phiq.parse_scene(
+        "phiq: 1\nname: pendulum\ncoordinates: {x: 0.5, y: 0, psi: 0}\nbodies: {bar: [x, y, psi]}\n"
+        "constraints:\n  - {name: pivot, type: revolute, between: [{body: bar, at: [-0.5, 0]}, {body: ground}]}\n"
+        "drivers:\n  - {name: motor, coordinate: psi, law: {type: linear, initial: 0, rate: 3}}\n"
+        "parts:\n  bar: {mass: 2.0, center_of_mass: [0, 0], inertia: 0.1}\n"
+        "loads: {gravity: [0, -9.81]}\ntime: {start: 0, end: 2, steps: 40}\n"
+        "output: {coordinates: [psi], efforts: all, reactions: all}\n", "pendulum.yaml")
+    result = phiq.run_sweep(scene).raise_for_status()
+    th = w * np.asarray(result.t)
+    fx = m * (-w * w * l * np.cos(th))
+    fy = m * (-w * w * l * np.sin(th) + g)
+    assert np.max(np.abs(result["pivot.Fx"] - fx)) < 1e-9
+    assert np.max(np.abs(result["pivot.Fy"] - fy)) < 1e-9
+    assert np.max(np.abs(result["pivot.Mz"])) < 1e-9
+    assert np.max(np.abs(result["motor.effort"] - m * g * l * np.cos(th))) < 1e-9
+    stepper = phiq.Stepper(scene)
+    stepper.step(result.t[5])
+    assert np.allclose(stepper.reactions["pivot"], (fx[5], fy[5], 0.0), rtol=0, atol=1e-9)

@@ -88,6 +88,11 @@ Quantity column_quantity(const Scene& scene, const std::string& column) {
                                     : Quantity{"effort", ""};
       }
     }
+  for (const OutputReaction& r : scene.sweep.efforts.reactions) {  // a joint's reaction: forces and moments
+    const std::string& name = model.constraints()[static_cast<std::size_t>(r.constraint)].name;
+    if (column.size() == name.size() + 3 && column.compare(0, name.size(), name) == 0 && column[name.size()] == '.')
+      return column[name.size() + 1] == 'F' ? Quantity{"force", "N"} : Quantity{"torque", "N·m"};
+  }
   if (ends_with(column, ".residual")) return {"residual", ""};
   if (ends_with(column, ".ddf")) return {"driver law, second rate", ""};
   if (ends_with(column, ".df")) return {"driver law, rate", ""};

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "phiq/constraint_kinds.hpp"
+#include "phiq/kinds/reaction_site.hpp"
 
 namespace phiq {
 
@@ -112,6 +113,13 @@ class ConstraintBlock {
   /// an open curve: PointOnCurveSpec::outside_domain()), and what happened; {size(), ""} when there is none.
   /// Kinds without a domain are always inside. Thread-safe.
   virtual std::pair<std::size_t, std::string> outside_domain(const double* /*q*/) const { return {size(), ""}; }
+  /// Adds Φq,iᵀ y to `out` (one entry per coordinate) for constraint i at (q, t): Σ_r y[row0 + r] ∂Φ_r/∂q, y
+  /// indexed by the model's rows. What a joint's reaction is made of (joint_reactions.hpp). Thread-safe.
+  virtual void add_transposed_product(std::size_t i, const double* q, double t, const double* y, double* out) const = 0;
+  /// Whether the kind states where its reaction acts (ReactionSite, kinds/reaction_site.hpp).
+  virtual bool has_reaction_site() const { return false; }
+  /// Constraint i's ReactionSite at q, when has_reaction_site(); else false. Thread-safe.
+  virtual bool reaction_site(std::size_t /*i*/, const double* /*q*/, ReactionSite& /*out*/) const { return false; }
   /// The coordinates constraint i adds (a kind with kAddedCoordinates: a curve's parameter) and the length each is
   /// measured in proportion to (PointOnCurveSpec::added_scale()): at most `capacity` of them into `coordinate` and
   /// `scale`, returning how many it adds (0 for the kinds that add none). For the sensitivities' co-motion
@@ -281,6 +289,23 @@ class TypedBlock final : public ConstraintBlock {
     for (const Entry& e : entries_)
       for (int r = 0; r < Spec::kRows; ++r)
         units[static_cast<std::size_t>(e.row0 + r)] = e.spec.row_unit(r, coordinate_units);
+  }
+  void add_transposed_product(std::size_t i, const double* q, double t, const double* y, double* out) const override {
+    const double* yi = y + entries_[i].row0;
+    auto sink = [&](int r, const Slot& s, double value) {
+      if (s.is_coordinate()) out[s.coord()] += value * yi[r];
+    };
+    entries_[i].spec.jacobian(q, t, sink);
+  }
+  bool has_reaction_site() const override {
+    return requires(const Spec& k, const double* at) { k.reaction_site(at); };
+  }
+  bool reaction_site(std::size_t i, const double* q, ReactionSite& out) const override {
+    if constexpr (requires(const Spec& k, const double* at) { k.reaction_site(at); }) {
+      out = entries_[i].spec.reaction_site(q);
+      return true;
+    }
+    return false;
   }
   std::pair<std::size_t, std::string> outside_domain(const double* q) const override {
     if constexpr (requires(const Spec& k, const double* at) { k.outside_domain(at); }) {

@@ -76,6 +76,12 @@ struct OutputDriver {
   MotionLaw law;     ///< its law (shared, cheap to copy)
 };
 
+/// A joint whose reaction a sweep writes (OutputEfforts::reactions).
+struct OutputReaction {
+  Index constraint = -1;  ///< Model::constraints() index; its kind has a ReactionSite (reaction_width() > 0)
+  bool spatial = false;   ///< six values (Fx, Fy, Fz, Mx, My, Mz) rather than three (Fx, Fy, Mz)
+};
+
 /// Driver efforts (inverse dynamics, phiq/inverse_dynamics.hpp) at every written row: for each listed constraint
 /// that depends on time, the torque or force its motor applies (−λ of its first row, conjugate to what it drives)
 /// and its power (Σ λ_i Φt_i over its rows). Solved with the row's own factorisation of Φq (one transposed solve),
@@ -85,8 +91,17 @@ struct OutputEfforts {
   std::shared_ptr<const Loads> loads;              ///< gravity and the applied loads
   std::vector<Index> constraints;                  ///< drivers (Model::constraints() indices), written in this order
   bool power = false;                              ///< write each one's power too (`NAME.power`)
-  /// Values a row holds: the efforts, then the powers (always computed: one product each).
-  Index size() const { return 2 * static_cast<Index>(constraints.size()); }
+  /// Joints whose reactions are written (phiq/joint_reactions.hpp), in this order: `NAME.Fx`, `NAME.Fy`, `NAME.Mz`
+  /// for a planar joint, `NAME.Fx` … `NAME.Mz` (six) for a spatial one; minimum-norm where indeterminate.
+  std::vector<OutputReaction> reactions;
+  /// Values a row holds: the efforts, then the powers (always computed: one product each), then the reactions.
+  Index size() const {
+    Index n = 2 * static_cast<Index>(constraints.size());
+    for (const OutputReaction& r : reactions) n += r.spatial ? 6 : 3;
+    return n;
+  }
+  /// Whether anything is computed: efforts or reactions.
+  bool active() const { return !constraints.empty() || !reactions.empty(); }
 };
 
 /// The outputs of a sweep beyond q (models/README.md, `output`). The sweep computes only what the plan lists; the
@@ -119,7 +134,7 @@ struct OutputPlan {
   OutputEfforts efforts;
   /// Whether the sweep solves q̈: asked for, or needed by the efforts. Solved is not delivered: StepView::qdd is set
   /// as `accelerations` says.
-  bool solves_accelerations() const { return accelerations || !efforts.constraints.empty(); }
+  bool solves_accelerations() const { return accelerations || efforts.active(); }
   /// Whether the sweep solves q̇: asked for, or needed by q̈ (see solves_accelerations()).
   bool solves_velocities() const { return velocities || solves_accelerations(); }
   /// The coordinates the adjoint form solves for: those whose q, q̇ or q̈ columns are written, ascending.

@@ -130,7 +130,9 @@ struct SweepWarning {
   /// near-singular (rcond below 1e-7; once per stretch of such rows); "bifurcation": Φq is singular at this row,
   /// the velocity is not unique and the branch's own is reported; "parallel_fallback": the parallel sweep
   /// continued in order; "no_dependence": a parameter of OutputPlan::sensitivities changes no constraint or
-  /// driver (its ParameterReach is empty: its sensitivities are exactly zero; at the first row)
+  /// driver (its ParameterReach is empty: its sensitivities are exactly zero; at the first row); "indeterminate":
+  /// written joint reactions (OutputEfforts::reactions) that redundant constraints leave undetermined, named at
+  /// the first row (their minimum-norm values are written)
   std::string kind;
 
   std::string message;  ///< one line

@@ -59,6 +59,23 @@ py::dict efforts_of(const PyStepper& s) {
   return out;
 }
 
+// The joint reactions a stepper delivers by joint name: (Fx, Fy, Mz), or (Fx, Fy, Fz, Mx, My, Mz) in space.
+py::dict reactions_of(const PyStepper& s) {
+  py::dict out;
+  const OutputEfforts& e = s.stepper->options().efforts;
+  const double* v = s.stepper->efforts();
+  if (!v) return out;
+  v += 2 * e.constraints.size();
+  for (const OutputReaction& r : e.reactions) {
+    const int n = r.spatial ? 6 : 3;
+    py::tuple values(n);
+    for (int k = 0; k < n; ++k) values[static_cast<std::size_t>(k)] = v[k];
+    out[py::str(s.stepper->model().constraints()[static_cast<std::size_t>(r.constraint)].name)] = values;
+    v += n;
+  }
+  return out;
+}
+
 }  // namespace
 
 void bind_stepper(py::module_& m) {
@@ -193,6 +210,9 @@ void bind_stepper(py::module_& m) {
       .def_property_readonly("efforts", &efforts_of,
                              "the scene's output.efforts at the current state: driver name → (effort, power) (NaN "
                              "at a singular position); empty without them or before the first step")
+      .def_property_readonly("reactions", &reactions_of,
+                             "the scene's output.reactions at the current state: joint name → (Fx, Fy, Mz), in "
+                             "space (Fx, Fy, Fz, Mx, My, Mz), N and N m about the joint's point, world axes")
       .def_property_readonly(
           "summary", [](const PyStepper& s) { return s.stepper->summary(); },
           "everything the steps did so far, as a sweep's SweepSummary (to_dict() for JSON)")

@@ -128,6 +128,12 @@ std::vector<std::string> CsvFormat::dotted_names() const {
   for (Index c : plan_->efforts.constraints) h.push_back(model_.constraints()[c].name + ".effort");
   if (plan_->efforts.power)
     for (Index c : plan_->efforts.constraints) h.push_back(model_.constraints()[c].name + ".power");
+  static constexpr const char* kSpatial[] = {".Fx", ".Fy", ".Fz", ".Mx", ".My", ".Mz"};
+  static constexpr const char* kPlanar[] = {".Fx", ".Fy", ".Mz"};
+  for (const OutputReaction& r : plan_->efforts.reactions)
+    for (int k = 0; k < (r.spatial ? 6 : 3); ++k)
+      h.push_back(model_.constraints()[static_cast<std::size_t>(r.constraint)].name +
+                  (r.spatial ? kSpatial : kPlanar)[k]);
   return h;
 }
 
@@ -220,9 +226,11 @@ void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
       for (Index j : a_columns_) emit(base[layout.offset(i, 2) + j]);
     }
   }
-  if (const std::size_t n = plan_->efforts.constraints.size(); n > 0) {
+  if (plan_->efforts.active()) {
     if (!s.efforts) throw Error("CsvFormat: step has no efforts");
+    const std::size_t n = plan_->efforts.constraints.size();
     for (std::size_t i = 0; i < (plan_->efforts.power ? 2 * n : n); ++i) emit(s.efforts[i]);
+    for (std::size_t i = 2 * n; i < static_cast<std::size_t>(plan_->efforts.size()); ++i) emit(s.efforts[i]);
   }
 }
 
@@ -246,6 +254,7 @@ std::size_t CsvFormat::num_output_values() const {
        (static_cast<std::size_t>(plan_->orientation_form.size()) + 3 * (velocities_ + accelerations_));
   n += plan_->sensitivities.size() * (columns_.size() + v_columns_.size() + a_columns_.size());
   n += plan_->efforts.constraints.size() * (plan_->efforts.power ? 2 : 1);
+  n += static_cast<std::size_t>(plan_->efforts.size()) - 2 * plan_->efforts.constraints.size();  // reactions
   return n;
 }
 

@@ -1,10 +1,12 @@
-// The scene's `output: efforts` and `power` (models/README.md): which drivers' efforts a sweep writes, resolved to
-// constraints once the model is built, with the parts and loads they are computed from (OutputPlan::efforts).
+// The scene's `output: efforts`, `power` and `reactions` (models/README.md): which drivers' efforts and which joints'
+// reactions a sweep writes, resolved to constraints once the model is built, with the parts and loads they are
+// computed from (OutputPlan::efforts).
 #include <memory>
 #include <set>
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
+#include "phiq/joint_reactions.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace phiq::detail::scene {
@@ -14,6 +16,20 @@ void SceneReader::read_output_efforts(const Cursor& output) {
   if (auto p = output.field("power"); p.present()) {
     efforts_power_ = p.boolean();
     if (efforts_power_ && !e.present()) p.fail("power is written with the efforts: list `efforts` too");
+  }
+  if (const Cursor r = output.field("reactions"); r.present()) {
+    reactions_field_ = r;
+    if (r.is_scalar()) {
+      if (r.text() != "all") r.fail("expected `all` or a list of joints");
+    } else {
+      std::set<std::string> seen;
+      for (const Cursor& i : r.items()) {
+        const std::string n = i.name();
+        if (!builder_.has_constraint(n)) i.fail("unknown joint '" + n + "'");
+        if (!seen.insert(n).second) i.fail("joint listed twice");
+        reaction_items_.push_back(i);
+      }
+    }
   }
   if (!e.present()) return;
   efforts_field_ = e;
@@ -31,13 +47,33 @@ void SceneReader::read_output_efforts(const Cursor& output) {
 }
 
 void SceneReader::resolve_output_efforts(Scene& scene) const {
-  if (!efforts_field_) return;
+  if (!efforts_field_ && !reactions_field_) return;
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
-  if (effort_items_.empty()) {
+  if (reactions_field_) {
+    if (reaction_items_.empty()) {  // all: every joint with a reaction that no driver moves
+      for (std::size_t c = 0; c < model.constraints().size(); ++c)
+        if (const int w = reaction_width(model, static_cast<Index>(c));
+            w > 0 && !model.constraints()[c].depends_on_time)
+          out.reactions.push_back({static_cast<Index>(c), w == 6});
+      if (out.reactions.empty())
+        reactions_field_->fail(
+            "no constraint of the scene joins bodies (revolute, prismatic, spatial joints): no "
+            "reaction to write");
+    }
+    for (const Cursor& i : reaction_items_) {
+      const Index c = model.find_constraint(i.name());
+      const int w = reaction_width(model, c);
+      if (w == 0)
+        i.fail("'" + i.name() + "' (" + std::string(model.constraints()[static_cast<std::size_t>(c)].kind) +
+               ") is not a joint between bodies: it has no reaction (revolute, prismatic and spatial joints have)");
+      out.reactions.push_back({c, w == 6});
+    }
+  }
+  if (efforts_field_ && effort_items_.empty()) {
     out.constraints = rheonomic_constraints(model);
     if (out.constraints.empty()) efforts_field_->fail("the scene has no driver: no effort to write");
-  } else {
+  } else if (efforts_field_) {
     std::unordered_map<std::string, Index> index;
     for (std::size_t k = 0; k < model.constraints().size(); ++k)
       index.emplace(model.constraints()[k].name, static_cast<Index>(k));
@@ -56,9 +92,10 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       massive->back().shapes.clear();
     }
   if (massive->empty() && !(scene.loads.applied && !scene.loads.applied->empty()))
-    efforts_field_->fail(
-        "no part has mass and no load is applied: every effort would be zero (give parts a mass "
-        "or a density, or apply loads)");
+    (efforts_field_ ? *efforts_field_ : *reactions_field_)
+        .fail(
+            "no part has mass and no load is applied: every effort would be zero (give parts a mass "
+            "or a density, or apply loads)");
   out.parts = std::move(massive);
   out.loads = std::make_shared<const Loads>(scene.loads);
   out.power = efforts_power_;

@@ -263,6 +263,9 @@ class SceneReader {
   std::optional<Cursor> efforts_field_;
   std::vector<Cursor> effort_items_;
   bool efforts_power_ = false;
+  // `output: reactions` (the field; its items when it lists names), resolved after the build
+  std::optional<Cursor> reactions_field_;
+  std::vector<Cursor> reaction_items_;
 
  public:
   bool predictor_given() const { return predictor_field_; }

@@ -4,6 +4,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/block_triangular.cpp
   ${CMAKE_CURRENT_LIST_DIR}/derivatives.cpp
   ${CMAKE_CURRENT_LIST_DIR}/inverse_dynamics.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/joint_reactions.cpp
   ${CMAKE_CURRENT_LIST_DIR}/evaluation.cpp
   ${CMAKE_CURRENT_LIST_DIR}/factorisation.cpp
   ${CMAKE_CURRENT_LIST_DIR}/kinematics.cpp

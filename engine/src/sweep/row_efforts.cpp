@@ -34,6 +34,36 @@ void Sweeper::row_efforts() {
     efforts_[n + i] = power;
   }
   for (std::size_t i : efforts_dropped_) efforts_[i] = efforts_[n + i] = std::numeric_limits<double>::quiet_NaN();
+  if (reactions_) row_reactions(*w->lu);
+}
+
+void Sweeper::row_reactions(SparseLuNumeric& lu) {
+  const double t = current_.t;
+  std::vector<Index> indeterminate;
+  const bool note = !reactions_noted_ && t == opt_.t_begin;
+  if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_lambda_, note ? &indeterminate : nullptr)) {
+    std::fill(efforts_.begin() + 2 * static_cast<std::ptrdiff_t>(opt_.efforts.constraints.size()), efforts_.end(),
+              std::numeric_limits<double>::quiet_NaN());
+    return;
+  }
+  reactions_->evaluate(current_.q.data(), t, effort_lambda_, efforts_.data() + 2 * opt_.efforts.constraints.size());
+  if (!note) return;
+  reactions_noted_ = true;
+  std::string names;
+  for (const OutputReaction& r : opt_.efforts.reactions)
+    if (std::find(indeterminate.begin(), indeterminate.end(), r.constraint) != indeterminate.end())
+      names += (names.empty() ? "'" : ", '") + model_.constraints()[static_cast<std::size_t>(r.constraint)].name + "'";
+  if (!names.empty())
+    sum_.warnings.push_back({t, "indeterminate",
+                             "the reactions of " + names +
+                                 " are statically indeterminate (redundant constraints): the minimum-norm ones are "
+                                 "written"});
+}
+
+std::vector<Index> Sweeper::reaction_constraints() const {
+  std::vector<Index> out;
+  for (const OutputReaction& r : opt_.efforts.reactions) out.push_back(r.constraint);
+  return out;
 }
 
 std::vector<std::size_t> Sweeper::dropped_efforts() const {

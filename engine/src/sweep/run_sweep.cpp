@@ -11,6 +11,7 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
+#include "phiq/joint_reactions.hpp"
 #include "phiq/parts.hpp"
 #include "phiq/sweep.hpp"
 #include "phiq/text.hpp"
@@ -144,8 +145,17 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
 
 void detail::check_efforts(const Model& model, const OutputPlan& plan, const std::string& who) {
   const OutputEfforts& e = plan.efforts;
-  if (e.constraints.empty()) return;
+  if (!e.active()) return;
   if (!e.parts || !e.loads) throw Error(who + ": efforts need the parts and the loads");
+  for (const OutputReaction& r : e.reactions) {
+    if (r.constraint < 0 || r.constraint >= static_cast<Index>(model.constraints().size()))
+      throw Error(who + ": a reaction's constraint " + std::to_string(r.constraint) + " is not one of the model's");
+    const ConstraintInfo& c = model.constraints()[static_cast<std::size_t>(r.constraint)];
+    const int width = reaction_width(model, r.constraint);
+    if (width == 0)
+      throw Error(who + ": '" + c.name + "' (" + std::string(c.kind) + ") states no joint point: it has no reaction");
+    if (r.spatial != (width == 6)) throw Error(who + ": reaction '" + c.name + "': `spatial` does not match its kind");
+  }
   for (Index c : e.constraints) {
     if (c < 0 || c >= static_cast<Index>(model.constraints().size()))
       throw Error(who + ": an effort's constraint " + std::to_string(c) + " is not one of the model's");

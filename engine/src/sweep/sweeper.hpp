@@ -12,11 +12,13 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "phiq/joint_reactions.hpp"
 #include "phiq/sweep.hpp"
 #include "solve/assembly_internal.hpp"
 #include "solve/kinematics_internal.hpp"
@@ -142,7 +144,7 @@ class Sweeper {
       ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
       rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
       if (!opt_.sensitivities.empty()) row_sensitivities();
-      if (!opt_.efforts.constraints.empty()) row_efforts();
+      if (opt_.efforts.active()) row_efforts();
     }
     det_sign_ = current_row_sign_;
     det_sign_t_ = current_row_sign_t_;
@@ -344,6 +346,11 @@ class Sweeper {
   // The efforts (indices into OutputEfforts::constraints) of drivers the model dropped as redundant: NaN at every
   // row, found once (row_efforts.cpp).
   std::vector<std::size_t> dropped_efforts() const;
+  // The constraints of OutputEfforts::reactions, in order (row_efforts.cpp).
+  std::vector<Index> reaction_constraints() const;
+  // The reactions of the row (after the efforts) from effort_lambda_: minimum-norm multipliers first where rows
+  // were dropped, and at the sweep's first row a warning naming the joints whose share that makes up.
+  void row_reactions(SparseLuNumeric& lu);
   // The factors of Φq at the current row: the workspace's when the row's velocity solve has just used them, else
   // those of sensitivity_ws_, factorised at the row; null where Φq is singular or cannot be factorised.
   Workspace* row_factors();
@@ -388,6 +395,12 @@ class Sweeper {
   std::vector<double> efforts_ = std::vector<double>(static_cast<std::size_t>(opt_.efforts.size()));
   Eigen::VectorXd effort_q_, effort_kept_, effort_lambda_, effort_phi_t_;  // row_efforts()'s Q, λ, Φt
   std::vector<std::size_t> efforts_dropped_ = dropped_efforts();
+  // The joints whose reactions are written (OutputEfforts::reactions); none when none are. Whether the first row has
+  // said which joints' reactions are indeterminate (a model with redundant rows; once per sweep).
+  std::optional<JointReactions> reactions_ =
+      opt_.efforts.reactions.empty() ? std::nullopt
+                                     : std::optional<JointReactions>(std::in_place, model_, reaction_constraints());
+  bool reactions_noted_ = false;
   // The coordinates whose columns are written, and the form the sensitivities are solved in
   // (effective_sensitivity_form)
   std::vector<Index> sensitivity_outputs_ =

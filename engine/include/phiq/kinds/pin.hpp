@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "phiq/kinds/kind_support.hpp"
+#include "phiq/kinds/reaction_site.hpp"
 
 namespace phiq {
 
@@ -48,6 +49,14 @@ struct PinSpec {
   void for_each_slot(F&& f) const {
     f(a.x, Unit::kLength), f(a.y, Unit::kLength), f(a.psi, Unit::kAngle);
     f(b.x, Unit::kLength), f(b.y, Unit::kLength), f(b.psi, Unit::kAngle);
+  }
+  /// The reaction (ReactionSite): on frame a, or on b when a is fixed, at the pin's point (a's attachment point).
+  ReactionSite reaction_site(const double* q) const {
+    const kin::V2 p = kin::V2{a.x.of(q), a.y.of(q)} + kin::rotate(a.psi.of(q), sa);
+    ReactionSite site;
+    site.point = {p.x, p.y, 0.0};
+    site.frame2 = detail::frame_moves(a) ? a : b;
+    return site;
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double, double* phi) const {

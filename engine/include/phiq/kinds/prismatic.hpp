@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "phiq/kinds/kind_support.hpp"
+#include "phiq/kinds/reaction_site.hpp"
 
 namespace phiq {
 
@@ -48,6 +49,15 @@ struct PrismaticSpec {
   void for_each_slot(F&& f) const {
     f(a.x, Unit::kLength), f(a.y, Unit::kLength), f(a.psi, Unit::kAngle);
     f(b.x, Unit::kLength), f(b.y, Unit::kLength), f(b.psi, Unit::kAngle);
+  }
+  /// The reaction (ReactionSite): on frame a, or on b when a is fixed, at the point s_b of the slider, which the
+  /// pair keeps on the line.
+  ReactionSite reaction_site(const double* q) const {
+    const kin::V2 p = kin::V2{b.x.of(q), b.y.of(q)} + kin::rotate(b.psi.of(q), sb);
+    ReactionSite site;
+    site.point = {p.x, p.y, 0.0};
+    site.frame2 = detail::frame_moves(a) ? a : b;
+    return site;
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double, double* phi) const {

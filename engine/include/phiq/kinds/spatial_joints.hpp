@@ -26,6 +26,7 @@
 
 #include "phiq/spatial_attachment.hpp"
 #include "phiq/kinds/kind_support.hpp"
+#include "phiq/kinds/reaction_site.hpp"
 #include "phiq/kinds/spatial_rows.hpp"
 
 namespace phiq {
@@ -174,6 +175,18 @@ struct SpatialJointSpec {
   template <class F>
   void for_each_slot(F&& f) const {
     detail3::side_slots(a, f), detail3::side_slots(b, f);
+  }
+  /// The reaction (ReactionSite): on side a's body, or on b's when a is fixed, at side a's joint point.
+  ReactionSite reaction_site(const double* q) const {
+    const Frame3& f = a.frame;
+    const kin3::V3 r{f.x.of(q), f.y.of(q), f.z.of(q)};
+    const double e[4] = {f.e0.of(q), f.e1.of(q), f.e2.of(q), f.e3.of(q)};
+    const kin3::V3 s = kin3::rotate(e, a.at);
+    ReactionSite site;
+    site.point = {r.x + s.x, r.y + s.y, r.z + s.z};
+    site.spatial = true;
+    site.frame3 = detail::frame_moves(a.frame) ? a.frame : b.frame;
+    return site;
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double, double* phi) const {

@@ -1,0 +1,66 @@
+/// @file
+/// Joint reactions (kinetostatics, after phiq/inverse_dynamics.hpp): the force and moment a joint exerts on one of
+/// the bodies it joins, from its rows' multipliers λ. A constraint c acts on the coordinates with the generalized
+/// force g = −Φq,cᵀ λ_c; restricted to the coordinates of the body its kind names (ReactionSite,
+/// kinds/reaction_site.hpp: side a's body, side b's when a is fixed), g is the virtual work of one wrench on that
+/// body, (F, M_O) about the body's origin O, with J_bᵀ (F, M_O) = g for the body's frame Jacobian J_b
+/// (part_jacobian(), phiq/part_motion.hpp). The reaction is written about the joint's point P: F and
+/// M_P = M_O + (O − P) × F, world axes. The other body receives −F and −M_P (a joint's equations do not change when
+/// both bodies move together, so its forces and moments balance).
+///
+/// A model with redundant rows has many λ (the structure is statically indeterminate): minimum_norm_multipliers()
+/// takes the one of least norm, and names the constraints whose share is not determined.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <vector>
+
+#include "phiq/kinds/reaction_site.hpp"
+#include "phiq/linear_solver.hpp"
+#include "phiq/model.hpp"
+
+namespace phiq {
+
+/// How many values constraint c's reaction has: 3 (Fx, Fy, Mz) for a planar joint, 6 for a spatial one, 0 when its
+/// kind states no ReactionSite (no reaction). Pre-condition: c is one of the model's constraints.
+int reaction_width(const Model& model, Index c);
+
+/// The reactions of a list of joints, evaluated at any (q, t, λ): built once per model (which block holds each
+/// constraint, which coordinates it reads), with scratch for evaluate(). Not thread-safe: one per thread.
+class JointReactions {
+ public:
+  /// Pre-condition: each of `constraints` has a reaction (reaction_width() > 0); else phiq::Error naming it.
+  JointReactions(const Model& model, std::vector<Index> constraints);
+  /// The values evaluate() writes: per constraint, Fx, Fy, Mz (N, N·m) for a planar joint, Fx, Fy, Fz, Mx, My, Mz
+  /// for a spatial one.
+  Index size() const { return size_; }
+  /// Whether the k-th listed joint is spatial (6 values) rather than planar (3).
+  bool spatial(std::size_t k) const { return sites_[k].spatial; }
+  /// Writes the reactions at (q, t) under multipliers `lambda` (one per model row) to out[0, size()).
+  /// Pre-condition: q has the model's coordinates; the model is the one given to the constructor.
+  void evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out);
+
+ private:
+  struct Site {
+    const ConstraintBlock* block = nullptr;
+    std::size_t index = 0;       // in its block
+    std::vector<Index> columns;  // the coordinates the constraint reads (to clear the scratch)
+    bool spatial = false;
+  };
+  std::vector<Site> sites_;
+  Index size_ = 0;
+  std::vector<double> g_;  // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
+};
+
+/// The multipliers of least norm among those with Φqᵀ λ = Q, from `lambda`, one of them (λ = 0 on the rows the model
+/// dropped as redundant: multipliers_with_factors()), and `lu`, the factors of the kept rows of Φq at q. Each
+/// dropped row r is a combination of the kept rows, Φq,r = Σ α_k Φq,k (one transposed solve with `lu`), so that
+/// n_r = e_r − Σ α_k e_k is a direction λ may move along without changing Φqᵀ λ; λ is projected off those
+/// directions. Appends to `indeterminate` (when not null) the constraints whose rows those directions move, in
+/// model order: the joints whose reactions the motion does not determine. A model without dropped rows is left as
+/// it is. Returns false when a solve fails.
+bool minimum_norm_multipliers(const Model& model, SparseLuNumeric& lu, const double* q, double t,
+                              Eigen::VectorXd& lambda, std::vector<Index>* indeterminate = nullptr);
+
+}  // namespace phiq

@@ -1,0 +1,33 @@
+/// @file
+/// Where a joint's reaction acts (phiq/joint_reactions.hpp): a kind that joins two bodies states it with a member
+/// `ReactionSite reaction_site(const double* q) const`, and its reaction (the force and moment its multipliers exert)
+/// can then be written (`output.reactions`, models/README.md). One member per kind; kinds without it have none.
+#pragma once
+
+#include "phiq/spatial_attachment.hpp"
+#include "phiq/types.hpp"
+
+namespace phiq {
+
+/// The body a joint's reaction is reported on and the point its moment is taken about.
+struct ReactionSite {
+  kin3::V3 point;        ///< the joint's point in world axes (m): the moment is about it
+  bool spatial = false;  ///< the body is `frame3` (a spatial body), else `frame2` (a planar one)
+  Frame2 frame2;         ///< the planar body (x, y, ψ; a natural point: ψ constant)
+  Frame3 frame3;         ///< the spatial body (x, y, z, e0…e3; a natural point: e constant)
+};
+
+/// @cond internal
+namespace detail {
+/// Whether a planar frame moves (reads a coordinate): a joint reports on its first side that does.
+inline bool frame_moves(const Frame2& f) { return f.x.is_coordinate() || f.y.is_coordinate() || f.psi.is_coordinate(); }
+/// The same for a spatial frame.
+inline bool frame_moves(const Frame3& f) {
+  for (const Slot* s : {&f.x, &f.y, &f.z, &f.e0, &f.e1, &f.e2, &f.e3})
+    if (s->is_coordinate()) return true;
+  return false;
+}
+}  // namespace detail
+/// @endcond
+
+}  // namespace phiq

@@ -1,0 +1,154 @@
+// JointReactions and minimum_norm_multipliers() (phiq/joint_reactions.hpp).
+#include "phiq/joint_reactions.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+
+#include "phiq/constraint_block.hpp"
+#include "phiq/part_motion.hpp"
+
+namespace phiq {
+
+namespace {
+
+using kin3::V3;
+
+// The block holding constraint c and its index there.
+std::pair<const ConstraintBlock*, std::size_t> block_of(const Model& model, Index c) {
+  const Index row =
+      model.constraints()[detail::index_in(c, static_cast<Index>(model.constraints().size()), "constraint")].first_row;
+  // a block's constraints are in increasing row order: a binary search in each block
+  for (const auto& b : model.blocks()) {
+    std::size_t lo = 0, hi = b->size();
+    while (lo < hi) {
+      const std::size_t mid = lo + (hi - lo) / 2;
+      if (b->first_row(mid) < row)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    if (lo < b->size() && b->first_row(lo) == row) return {b.get(), lo};
+  }
+  return {nullptr, 0};
+}
+
+PartFrame body_frame(const ReactionSite& s) {
+  PartFrame f;
+  f.kind = s.spatial ? PartFrameKind::kSpatialBody : PartFrameKind::kPlanarBody;
+  f.planar = s.frame2;
+  f.spatial = s.frame3;
+  return f;
+}
+
+}  // namespace
+
+int reaction_width(const Model& model, Index c) {
+  const auto [b, i] = block_of(model, c);
+  ReactionSite site;
+  if (!b || !b->reaction_site(i, model.initial_positions().data(), site)) return 0;
+  return site.spatial ? 6 : 3;
+}
+
+JointReactions::JointReactions(const Model& model, std::vector<Index> constraints)
+    : g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
+  std::vector<int> site_of(model.constraints().size(), -1);
+  // each constraint's block and index there, in one pass over the blocks
+  std::vector<std::pair<const ConstraintBlock*, std::size_t>> where(model.constraints().size(), {nullptr, 0});
+  for (const auto& b : model.blocks())
+    for (std::size_t i = 0; i < b->size(); ++i)
+      where[static_cast<std::size_t>(model.constraint_of_row(b->first_row(i)))] = {b.get(), i};
+  for (Index c : constraints) {
+    const auto [b, i] = where[detail::index_in(c, static_cast<Index>(where.size()), "constraint")];
+    const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
+    if (!b || !b->has_reaction_site())
+      throw Error("constraint '" + info.name + "' (" + std::string(info.kind) +
+                  ") states no joint point: it has no reaction to write (joints between bodies have one)");
+    Site s;
+    s.block = b, s.index = i;
+    ReactionSite rs;
+    b->reaction_site(i, model.initial_positions().data(), rs);
+    s.spatial = rs.spatial;
+    size_ += s.spatial ? 6 : 3;
+    site_of[static_cast<std::size_t>(c)] = static_cast<int>(sites_.size());
+    sites_.push_back(std::move(s));
+  }
+  // the coordinates each constraint reads, in one pass over Φq's pattern
+  const CscPattern& p = model.jacobian_pattern();
+  for (Index j = 0; j < p.cols; ++j)
+    for (Index k = p.col_ptr[static_cast<std::size_t>(j)]; k < p.col_ptr[static_cast<std::size_t>(j) + 1]; ++k) {
+      const int s = site_of[static_cast<std::size_t>(model.constraint_of_row(p.row_idx[static_cast<std::size_t>(k)]))];
+      if (s >= 0 && (sites_[static_cast<std::size_t>(s)].columns.empty() ||
+                     sites_[static_cast<std::size_t>(s)].columns.back() != j))
+        sites_[static_cast<std::size_t>(s)].columns.push_back(j);
+    }
+}
+
+void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out) {
+  PartJacobian jac;
+  for (const Site& s : sites_) {
+    ReactionSite rs;
+    s.block->reaction_site(s.index, q, rs);
+    s.block->add_transposed_product(s.index, q, t, lambda.data(), g_.data());  // Φq,cᵀ λ_c
+    // The wrench (F, M_O) whose virtual work on the body is g there: J_bᵀ w = g over the body's coordinates, in
+    // least squares (Euler parameters: 4 columns for 3 rotations, the fourth along e, on which no wrench works).
+    const PartFrame frame = body_frame(rs);
+    part_jacobian(frame, q, t, jac);
+    Eigen::Matrix<double, 6, 6> normal = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+    for (std::size_t k = 0; k < jac.coordinates.size(); ++k) {
+      const V3 o = jac.d_origin[k], a = jac.d_angle[k];
+      const Eigen::Matrix<double, 6, 1> col(o.x, o.y, o.z, a.x, a.y, a.z);
+      normal += col * col.transpose();
+      rhs -= col * g_[static_cast<std::size_t>(jac.coordinates[k])];  // g = −Φq,cᵀ λ_c
+    }
+    // Directions no coordinate moves (a planar body's z, a natural point's rotation) get no component.
+    const Eigen::Matrix<double, 6, 1> w = normal.completeOrthogonalDecomposition().solve(rhs);
+    const V3 force{w(0), w(1), w(2)}, moment_o{w(3), w(4), w(5)};
+    const V3 at = part_pose(frame, q, t).at;
+    const V3 moment = moment_o + cross(at - rs.point, force);
+    if (s.spatial) {
+      for (double v : {force.x, force.y, force.z, moment.x, moment.y, moment.z}) *out++ = v;
+    } else {
+      for (double v : {force.x, force.y, moment.z}) *out++ = v;
+    }
+    for (Index j : s.columns) g_[static_cast<std::size_t>(j)] = 0.0;
+  }
+}
+
+bool minimum_norm_multipliers(const Model& model, SparseLuNumeric& lu, const double* q, double t,
+                              Eigen::VectorXd& lambda, std::vector<Index>* indeterminate) {
+  const std::vector<Index>& dropped = model.dropped_rows();
+  const std::vector<Index>& kept = model.solve_rows();
+  if (dropped.empty()) return true;
+  const Index m = model.num_equations(), n = model.num_coordinates();
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(m, static_cast<Index>(dropped.size()));
+  Eigen::VectorXd unit = Eigen::VectorXd::Zero(m), grad(n), alpha(static_cast<Index>(kept.size()));
+  for (std::size_t d = 0; d < dropped.size(); ++d) {
+    const Index r = dropped[d];
+    const auto [b, i] = block_of(model, model.constraint_of_row(r));
+    grad.setZero();
+    unit(r) = 1.0;
+    b->add_transposed_product(i, q, t, unit.data(), grad.data());  // ∇Φ_r
+    unit(r) = 0.0;
+    if (!lu.solve_transposed(grad.data(), alpha.data())) return false;  // Φq,keptᵀ α = ∇Φ_r
+    N(r, static_cast<Index>(d)) = 1.0;
+    for (std::size_t k = 0; k < kept.size(); ++k) N(kept[k], static_cast<Index>(d)) = -alpha(static_cast<Index>(k));
+  }
+  // λ − N (NᵀN)⁻¹ Nᵀ λ: the component of λ orthogonal to every direction it may move along
+  const Eigen::VectorXd step = N.colPivHouseholderQr().solve(lambda);
+  lambda -= N * step;
+  if (indeterminate) {
+    const double big = N.cwiseAbs().maxCoeff();
+    std::vector<bool> seen(model.constraints().size(), false);
+    for (Index r = 0; r < m; ++r)
+      if (N.row(r).cwiseAbs().maxCoeff() > 1e-9 * big)
+        seen[static_cast<std::size_t>(model.constraint_of_row(r))] = true;
+    for (std::size_t c = 0; c < seen.size(); ++c)
+      if (seen[c]) indeterminate->push_back(static_cast<Index>(c));
+  }
+  return true;
+}
+
+}  // namespace phiq

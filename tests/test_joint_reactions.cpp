@@ -1,0 +1,297 @@
+// Joint reactions (phiq/joint_reactions.hpp, the scene's `output: reactions`): every kind that states a
+// ReactionSite passes a virtual-work check (the written wrench does on its body the work −λᵀ δΦ does, by finite
+// differences); a massive four-bar's pins satisfy every link's Newton–Euler equations written here, with no moment
+// at a pin; a redundant door's hinges give the minimum-norm multipliers of a dense pseudo-inverse and are named
+// indeterminate, with its driver's torque unique.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "phiq/inverse_dynamics.hpp"
+#include "phiq/joint_reactions.hpp"
+#include "phiq/part_motion.hpp"
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+// A model of two moving bodies joined by one constraint of `joint` (a scene constraint line naming bodies a, b).
+Scene reaction_two_bodies(bool spatial, const std::string& joint) {
+  std::string text = "phiq: 1\nname: two\n";
+  if (spatial)
+    text +=
+        "dimension: 3\n"
+        "coordinates: {xa: 0.1, ya: 0.2, za: -0.3, a0: 0.8, a1: 0.2, a2: -0.4, a3: 0.4, "
+        "xb: 0.7, yb: -0.1, zb: 0.4, b0: 0.5, b1: 0.5, b2: 0.5, b3: 0.5}\n"
+        "bodies: {a: [xa, ya, za, a0, a1, a2, a3], b: [xb, yb, zb, b0, b1, b2, b3]}\n";
+  else
+    text +=
+        "coordinates: {xa: 0.1, ya: 0.2, pa: 0.3, xb: 0.7, yb: -0.1, pb: 1.1}\n"
+        "bodies: {a: [xa, ya, pa], b: [xb, yb, pb]}\n";
+  text += "constraints:\n  - " + joint + "\ntime: {start: 0, end: 1, steps: 1}\n";
+  return parse_scene(text, "two.yaml");
+}
+
+kin3::V3 reaction_rotation_step(const RotationMatrix& plus, const RotationMatrix& minus, double h2) {
+  // R₊ R₋ᵀ ≈ I + [2h δθ]×, its skew part 2h δθ twice over: δθ per unit step, world axes
+  double m[9];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      m[3 * i + j] = 0.0;
+      for (int k = 0; k < 3; ++k) m[3 * i + j] += plus[3 * i + k] * minus[3 * j + k];
+    }
+  return {(m[7] - m[5]) / (4 * h2), (m[2] - m[6]) / (4 * h2), (m[3] - m[1]) / (4 * h2)};
+}
+
+// The block holding constraint c, and its index there.
+std::pair<const ConstraintBlock*, std::size_t> reaction_block_of(const Model& m, Index c) {
+  for (const auto& b : m.blocks())
+    for (std::size_t i = 0; i < b->size(); ++i)
+      if (b->first_row(i) == m.constraints()[static_cast<std::size_t>(c)].first_row) return {b.get(), i};
+  return {nullptr, 0};
+}
+
+// The virtual-work identity for the constraint of `s`: for random λ and random displacements δq of body a's
+// coordinates (Euler parameters moved perpendicular to e), −λᵀ δΦ = F · δP + M_P · δθ, δP the displacement of
+// the body's point at P and δθ its rotation, both from finite differences of the body's pose.
+void expect_reaction_virtual_work(const Scene& s, bool spatial) {
+  const Model& m = *s.model;
+  const Index c = m.find_constraint("j");
+  ASSERT_GE(c, 0);
+  ASSERT_EQ(reaction_width(m, c), spatial ? 6 : 3);
+  JointReactions jr(m, {c});
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const Eigen::VectorXd q = m.initial_positions();
+  PartFrame frame;
+  frame.kind = spatial ? PartFrameKind::kSpatialBody : PartFrameKind::kPlanarBody;
+  if (spatial)
+    frame.spatial = Frame3{Slot::coordinate(0), Slot::coordinate(1), Slot::coordinate(2), Slot::coordinate(3),
+                           Slot::coordinate(4), Slot::coordinate(5), Slot::coordinate(6)};
+  else
+    frame.planar = Frame2{Slot::coordinate(0), Slot::coordinate(1), Slot::coordinate(2)};
+  const int body_coordinates = spatial ? 7 : 3;
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m.num_equations());
+    const ConstraintInfo& info = m.constraints()[static_cast<std::size_t>(c)];
+    for (Index r = info.first_row; r < info.first_row + info.rows; ++r) lambda(r) = u(rng);
+    double w[6];
+    jr.evaluate(q.data(), 0.0, lambda, w);
+    const kin3::V3 force = spatial ? kin3::V3{w[0], w[1], w[2]} : kin3::V3{w[0], w[1], 0.0};
+    const kin3::V3 moment = spatial ? kin3::V3{w[3], w[4], w[5]} : kin3::V3{0.0, 0.0, w[2]};
+    Eigen::VectorXd dq = Eigen::VectorXd::Zero(m.num_coordinates());
+    for (int k = 0; k < body_coordinates; ++k) dq(k) = u(rng);
+    if (spatial) {  // δe ⟂ e: a rotation, not a change of |e|
+      const Eigen::Vector4d e = q.segment<4>(3), de = dq.segment<4>(3);
+      dq.segment<4>(3) = de - e * e.dot(de) / e.squaredNorm();
+    }
+    const double h = 1e-6;
+    const Eigen::VectorXd qp = q + h * dq, qm = q - h * dq;
+    Eigen::VectorXd phip(m.num_equations()), phim(m.num_equations());
+    m.residual(qp.data(), 0.0, phip.data());
+    m.residual(qm.data(), 0.0, phim.data());
+    const double work_rows = -lambda.dot(phip - phim) / (2 * h);
+    const Pose pp = part_pose(frame, qp.data(), 0.0), pm = part_pose(frame, qm.data(), 0.0),
+               p0 = part_pose(frame, q.data(), 0.0);
+    const kin3::V3 dtheta = reaction_rotation_step(pp.rotation, pm.rotation, h);
+    const kin3::V3 d_origin = (1.0 / (2 * h)) * (pp.at - pm.at);
+    // The written moment is about the joint's point P (the kind's ReactionSite): about the origin it is
+    // M_O = M_P + (P − O) × F. (That P is the joint's is checked below: a pin has no moment about it.)
+    ReactionSite site;
+    const auto [block, index] = reaction_block_of(m, c);
+    ASSERT_TRUE(block->reaction_site(index, q.data(), site));
+    const kin3::V3 m_origin = moment + kin3::cross(site.point - p0.at, force);
+    const double best = kin3::dot(force, d_origin) + kin3::dot(m_origin, dtheta);
+    EXPECT_NEAR(best, work_rows, 1e-7 * (1.0 + std::fabs(work_rows))) << info.kind << " trial " << trial;
+  }
+}
+
+TEST(JointReactions, EveryPlanarKindWithASiteDoesTheWorkOfItsMultipliers) {
+  for (const std::string joint :
+       {"{name: j, type: revolute, between: [{body: a, at: [0.3, -0.2]}, {body: b, at: [-0.1, 0.4]}]}",
+        "{name: j, type: prismatic, between: [{body: a, at: [0.3, -0.2]}, {body: b, at: [-0.1, 0.4]}], "
+        "axis: [0.6, 0.8], angle: 0.2}"}) {
+    SCOPED_TRACE(joint);
+    expect_reaction_virtual_work(reaction_two_bodies(false, joint), false);
+  }
+}
+
+TEST(JointReactions, EverySpatialKindWithASiteDoesTheWorkOfItsMultipliers) {
+  const std::string sides =
+      "between: [{body: a, at: [0.3, -0.2, 0.1], axis: [0, 0.6, 0.8]}, {body: b, at: [-0.1, 0.4, 0.2], "
+      "axis: [1, 0, 0]}]}";
+  for (const char* type : {"spherical", "revolute", "cylindrical", "prismatic", "universal", "planar", "rigid"}) {
+    SCOPED_TRACE(type);
+    expect_reaction_virtual_work(reaction_two_bodies(true, std::string("{name: j, type: ") + type + ", " + sides),
+                                 true);
+  }
+}
+
+TEST(JointReactions, KindsWithoutASiteAreRefusedByName) {
+  const Scene s = parse_scene(
+      "phiq: 1\nname: d\ncoordinates: {x: 1, y: 0.1}\npoints: {O: [0, 0], A: [x, y]}\n"
+      "constraints:\n  - {name: bar, type: distance, points: [O, A], length: 1}\ntime: {start: 0, end: 1, steps: 1}\n",
+      "d.yaml");
+  EXPECT_EQ(reaction_width(*s.model, 0), 0);
+  try {
+    JointReactions jr(*s.model, {0});
+    ADD_FAILURE() << "a distance has no reaction site";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("constraint 'bar' (distance) states no joint point"), std::string::npos)
+        << e.what();
+  }
+}
+
+std::string reaction_scene_text(const std::string& rel) {
+  std::ifstream in(test::model_path(rel));
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  text.erase(text.find("output:"));
+  return text;
+}
+
+struct ReactionRows {
+  std::vector<Eigen::VectorXd> q, qd, qdd;
+  std::vector<std::vector<double>> values;  // efforts, powers, reactions
+};
+
+ReactionRows sweep_reactions(const Scene& s, SweepSummary* sum = nullptr, const Model** swept = nullptr) {
+  ReactionRows r;
+  static std::vector<SquareScene> kept;  // the reduced models the callers read after the sweep
+  kept.emplace_back();
+  SquareScene& square = kept.back();
+  EXPECT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &square), SolveStatus::kSuccess);
+  const Model& m = square.model(*s.model);
+  if (swept) *swept = &m;
+  Workspace ws(m);
+  ws.q = square.start;
+  const std::size_t n = static_cast<std::size_t>(s.sweep.efforts.size());
+  EXPECT_EQ(run_sweep(
+                m, s.sweep, ws,
+                [&](const StepView& v) {
+                  r.q.push_back(v.q), r.qd.push_back(*v.qd), r.qdd.push_back(*v.qdd);
+                  r.values.emplace_back(v.efforts, v.efforts + n);
+                  return true;
+                },
+                sum),
+            SolveStatus::kSuccess);
+  return r;
+}
+
+// The knee four-bar (reference-point links, centres at the reference points) with masses under gravity.
+TEST(JointReactions, FourBarPinsSatisfyEveryLinksNewtonEulerEquations) {
+  std::string text = reaction_scene_text("clearance/fourbar_knee.yaml");
+  text.erase(text.find("parts:"));
+  const double m2 = 1.0, m3 = 2.0, m4 = 1.5, L2 = 0.4, L3 = 1.2, L4 = 1.0, g = 9.81;
+  text +=
+      "parts:\n"
+      "  crank: {mass: 1.0, center_of_mass: [0, 0], inertia: 1.0*L2*L2/12}\n"
+      "  coupler: {mass: 2.0, center_of_mass: [0, 0], inertia: 2.0*L3*L3/12}\n"
+      "  rocker: {mass: 1.5, center_of_mass: [0, 0], inertia: 1.5*L4*L4/12}\n"
+      "loads: {gravity: [0, -9.81]}\n"
+      "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
+  const Scene s = parse_scene(text, "knee.yaml");
+  ASSERT_EQ(s.sweep.efforts.reactions.size(), 4u);
+  const ReactionRows rows = sweep_reactions(s);
+  const Model& m = *s.model;
+  auto at = [&](const Eigen::VectorXd& q, const char* x, const char* y, const char* p, double s_local) {
+    const double psi = q(m.coordinate_index(p));
+    return Eigen::Vector2d(q(m.coordinate_index(x)) + s_local * std::cos(psi),
+                           q(m.coordinate_index(y)) + s_local * std::sin(psi));
+  };
+  auto cross2 = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); };
+  double largest_force = 0.0;
+  for (std::size_t k = 0; k < rows.q.size(); ++k) {
+    const Eigen::VectorXd &q = rows.q[k], &qdd = rows.qdd[k];
+    const std::vector<double>& v = rows.values[k];
+    const double tau = v[0];
+    // reactions O, A, B, C (after the effort and its power): each on its side a (O: crank, A: crank, B: coupler,
+    // C: rocker), about the pin
+    auto F = [&](int j) { return Eigen::Vector2d(v[2 + 3 * j], v[3 + 3 * j]); };
+    for (int j = 0; j < 4; ++j) {
+      EXPECT_NEAR(v[4 + 3 * j], 0.0, 1e-9 * (1.0 + F(j).norm())) << "a pin carries no moment, row " << k;
+      largest_force = std::max(largest_force, F(j).norm());
+    }
+    const Eigen::Vector2d O = at(q, "x2", "y2", "psi2", -L2 / 2), A = at(q, "x2", "y2", "psi2", L2 / 2),
+                          B = at(q, "x3", "y3", "psi3", L3 / 2), C = at(q, "x4", "y4", "psi4", -L4 / 2);
+    struct Link {
+      double mass, inertia;
+      const char *x, *y, *p;
+      std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> forces;  // (point, force)
+      double torque;
+    };
+    const Link links[3] = {
+        {m2, m2 * L2 * L2 / 12, "x2", "y2", "psi2", {{O, F(0)}, {A, F(1)}}, tau},
+        {m3, m3 * L3 * L3 / 12, "x3", "y3", "psi3", {{A, -F(1)}, {B, F(2)}}, 0.0},
+        {m4, m4 * L4 * L4 / 12, "x4", "y4", "psi4", {{B, -F(2)}, {C, F(3)}}, 0.0},
+    };
+    for (const Link& l : links) {
+      const Eigen::Vector2d G(q(m.coordinate_index(l.x)), q(m.coordinate_index(l.y)));
+      const Eigen::Vector2d a(qdd(m.coordinate_index(l.x)), qdd(m.coordinate_index(l.y)));
+      Eigen::Vector2d sum = Eigen::Vector2d(0, -l.mass * g);
+      double moment = l.torque;
+      for (const auto& [P, f] : l.forces) sum += f, moment += cross2(P - G, f);
+      EXPECT_NEAR((sum - l.mass * a).norm(), 0.0, 1e-8 * (1.0 + sum.norm())) << l.x << " row " << k;
+      EXPECT_NEAR(moment, l.inertia * qdd(m.coordinate_index(l.p)), 1e-8 * (1.0 + std::fabs(moment)))
+          << l.x << " row " << k;
+    }
+  }
+  EXPECT_GT(largest_force, 10.0);  // the links' weights at least: the check is not of zeros
+}
+
+// A door on three collinear hinges (10 redundant rows): its hinges' share of the load is not determined; the
+// written reactions are those of the minimum-norm multipliers, which a dense pseudo-inverse of Φqᵀ gives too.
+TEST(JointReactions, RedundantDoorHingesAreMinimumNormAndNamedIndeterminate) {
+  std::string text = reaction_scene_text("redundant/door_three_hinges.yaml");
+  text +=
+      "parts:\n  door: {mass: 20, center_of_mass: [0.4, 0, 1], inertia: [4, 5, 1.2]}\n"
+      "loads: {gravity: [0, 0, -9.81]}\n"
+      "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n";
+  const Scene s = parse_scene(text, "door.yaml");
+  ASSERT_EQ(s.sweep.efforts.reactions.size(), 3u);
+  SweepSummary sum;
+  const Model* swept = nullptr;
+  const ReactionRows rows = sweep_reactions(s, &sum, &swept);
+  ASSERT_FALSE(swept->dropped_rows().empty());
+  int named = 0;
+  for (const SweepWarning& w : sum.warnings)
+    if (w.kind == "indeterminate") {
+      ++named;
+      for (const char* h : {"'hinge1'", "'hinge2'", "'hinge3'"})
+        EXPECT_NE(w.message.find(h), std::string::npos) << w.message;
+    }
+  EXPECT_EQ(named, 1);
+  // The dense minimum-norm multipliers at a few rows, and their reactions, against the sweep's.
+  const Model& full = *s.model;  // every row: the whole Φq, which the swept model was reduced from
+  Workspace ws(full);
+  std::vector<Index> hinges;
+  for (const OutputReaction& r : s.sweep.efforts.reactions) hinges.push_back(r.constraint);
+  JointReactions jr(full, hinges);
+  for (std::size_t k = 0; k < rows.q.size(); k += 7) {
+    Eigen::VectorXd Q = Eigen::VectorXd::Zero(full.num_coordinates());
+    add_generalized_forces(*s.sweep.efforts.parts, *s.sweep.efforts.loads, rows.q[k].data(), rows.qd[k].data(),
+                           rows.qdd[k].data(), 0.0, Q);
+    const JacobianView J = evaluate_jacobian(full, rows.q[k], 0.0, ws);
+    const Eigen::MatrixXd Jt = Eigen::MatrixXd(J).transpose();
+    const Eigen::VectorXd lambda = Jt.completeOrthogonalDecomposition().solve(Q);  // least norm
+    ASSERT_LT((Jt * lambda - Q).norm(), 1e-9 * (1.0 + Q.norm()));
+    std::vector<double> expected(18);
+    jr.evaluate(rows.q[k].data(), 0.0, lambda, expected.data());
+    for (std::size_t i = 0; i < 18; ++i)
+      EXPECT_NEAR(rows.values[k][2 + i], expected[i], 1e-8 * (1.0 + std::fabs(expected[i]))) << "row " << k << " " << i;
+    // the driver's torque is unique: the dense multipliers give it too
+    const Index open = full.find_constraint("open");
+    EXPECT_NEAR(rows.values[k][0], -lambda(full.constraints()[static_cast<std::size_t>(open)].first_row),
+                1e-8 * (1.0 + std::fabs(rows.values[k][0])));
+  }
+}
+
+}  // namespace
+}  // namespace phiq
