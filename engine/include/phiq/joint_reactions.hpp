@@ -19,6 +19,7 @@
 #include "phiq/kinds/reaction_site.hpp"
 #include "phiq/linear_solver.hpp"
 #include "phiq/model.hpp"
+#include "phiq/part_motion.hpp"
 
 namespace phiq {
 
@@ -51,6 +52,7 @@ class JointReactions {
   std::vector<Site> sites_;
   Index size_ = 0;
   std::vector<double> g_;  // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
+  PartJacobian jac_;       // the body's frame Jacobian (its capacity kept: no allocation per row)
 };
 
 /// The multipliers of least norm among those with Φqᵀ λ = Q, from `lambda`, one of them (λ = 0 on the rows the model

@@ -187,8 +187,64 @@ PartJacobian part_jacobian(const PartFrame& frame, const double* q, double t) {
   return jac;
 }
 
+namespace {
+
+// ∂/∂q in closed form for the frames whose rotation is one angle or Euler parameters: what inverse dynamics calls
+// for every part at every row, where a jet pass per coordinate cost more than the rest of the row. False for the
+// other frames (spatial frames from points, expressions), which take the jets. Pre-condition: jac.coordinates set,
+// jac.d_origin and jac.d_angle zero, one per coordinate.
+bool closed_form_jacobian(const PartFrame& f, const double* q, PartJacobian& jac) {
+  auto add = [&](const Slot& s, kin3::V3 d_origin, kin3::V3 d_angle) {
+    if (!s.is_coordinate()) return;
+    const auto k = static_cast<std::size_t>(
+        std::lower_bound(jac.coordinates.begin(), jac.coordinates.end(), s.coord()) - jac.coordinates.begin());
+    jac.d_origin[k] = jac.d_origin[k] + d_origin, jac.d_angle[k] = jac.d_angle[k] + d_angle;
+  };
+  const kin3::V3 none{0, 0, 0}, ex{1, 0, 0}, ey{0, 1, 0}, ez{0, 0, 1};
+  switch (f.kind) {
+    case PartFrameKind::kPlanarBody:
+      add(f.planar.x, ex, none), add(f.planar.y, ey, none), add(f.planar.psi, none, ez);
+      return true;
+    case PartFrameKind::kSpatialBody: {
+      const Frame3& b = f.spatial;
+      add(b.x, ex, none), add(b.y, ey, none), add(b.z, ez, none);
+      // R(e/|e|): δθ = 2 E(ê) δe / |e|, E(ê) = [−ê, ê0 1 + [ê]×] (world axes; E ê = 0 drops the change of |e|)
+      const double e[4] = {b.e0.of(q), b.e1.of(q), b.e2.of(q), b.e3.of(q)};
+      const double n = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]);
+      const double k = 2.0 / (n * n);  // 2/|e| times the normalisation of ê
+      add(b.e0, none, {-k * e[1], -k * e[2], -k * e[3]});
+      add(b.e1, none, {k * e[0], k * e[3], -k * e[2]});
+      add(b.e2, none, {-k * e[3], k * e[0], k * e[1]});
+      add(b.e3, none, {k * e[2], -k * e[1], k * e[0]});
+      return true;
+    }
+    case PartFrameKind::kPoints: {
+      if (f.spatial_frame) return false;
+      // origin o, x along d = x_toward − o (a point) or x_toward (a vector): θ = atan2(d_y, d_x)
+      const Slot* o = f.origin.r;
+      const Slot* x = f.x_toward.r;
+      double dx = x[0].of(q), dy = x[1].of(q);
+      if (f.x_is_point) dx -= o[0].of(q), dy -= o[1].of(q);
+      const double d2 = dx * dx + dy * dy;
+      const kin3::V3 along_x{0, 0, -dy / d2}, along_y{0, 0, dx / d2};  // ∂θ/∂d
+      add(o[0], ex, none), add(o[1], ey, none), add(o[2], ez, none);
+      add(x[0], none, along_x), add(x[1], none, along_y);
+      if (f.x_is_point) add(o[0], none, -1.0 * along_x), add(o[1], none, -1.0 * along_y);
+      return true;
+    }
+    case PartFrameKind::kExpressions:
+      return false;
+  }
+  return false;
+}
+
+}  // namespace
+
 void part_jacobian(const PartFrame& frame, const double* q, double t, PartJacobian& jac) {
   frame_coordinates(frame, jac.coordinates);
+  jac.d_origin.assign(jac.coordinates.size(), kin3::V3{0, 0, 0});
+  jac.d_angle.assign(jac.coordinates.size(), kin3::V3{0, 0, 0});
+  if (closed_form_jacobian(frame, q, jac)) return;
   jac.d_origin.clear(), jac.d_angle.clear();
   for (Index k : jac.coordinates) {
     const auto [o, r] = frame_jets(frame, Path{q, nullptr, nullptr, t, k});

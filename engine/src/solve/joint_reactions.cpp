@@ -86,7 +86,7 @@ JointReactions::JointReactions(const Model& model, std::vector<Index> constraint
 }
 
 void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out) {
-  PartJacobian jac;
+  PartJacobian& jac = jac_;
   for (const Site& s : sites_) {
     ReactionSite rs;
     s.block->reaction_site(s.index, q, rs);
@@ -103,8 +103,11 @@ void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& 
       normal += col * col.transpose();
       rhs -= col * g_[static_cast<std::size_t>(jac.coordinates[k])];  // g = −Φq,cᵀ λ_c
     }
-    // Directions no coordinate moves (a planar body's z, a natural point's rotation) get no component.
-    const Eigen::Matrix<double, 6, 1> w = normal.completeOrthogonalDecomposition().solve(rhs);
+    // Directions no coordinate moves (a planar body's z, a natural point's rotation) get no component: their rows
+    // of the normal equations are zero, set to w_i = 0 (fixed sizes: no allocation at a row).
+    for (int i = 0; i < 6; ++i)
+      if (normal(i, i) == 0.0) normal(i, i) = 1.0, rhs(i) = 0.0;
+    const Eigen::Matrix<double, 6, 1> w = normal.ldlt().solve(rhs);
     const V3 force{w(0), w(1), w(2)}, moment_o{w(3), w(4), w(5)};
     const V3 at = part_pose(frame, q, t).at;
     const V3 moment = moment_o + cross(at - rs.point, force);
