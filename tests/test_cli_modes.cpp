@@ -68,3 +68,45 @@ TEST_F(Cli, ModesRefusesMorePathsThanAllowed) {
 }
 
 }  // namespace
+
+namespace {
+
+// The value of column `name` in data row `row` (1: the first) of a CSV.
+double cli_modes_cell(const std::string& csv, const std::string& name, int row) {
+  std::istringstream lines(csv);
+  std::string header, line;
+  std::getline(lines, header);
+  std::vector<std::string> names;
+  for (std::istringstream h(header); std::getline(h, line, ',');) names.push_back(line);
+  for (int k = 0; k < row; ++k) std::getline(lines, line);
+  std::istringstream cells(line);
+  std::string cell;
+  for (std::size_t c = 0; std::getline(cells, cell, ','); ++c)
+    if (names[c] == name) return std::stod(cell);
+  return std::nan("");
+}
+
+TEST_F(Cli, RunFromEachModeStartsThereAndStaysOnItsBranch) {
+  const std::string scene = cli_modes_model("seed/fourbar_mixed.yaml");
+  const fs::path modes = dir_ / "m.csv";
+  ASSERT_EQ(run("modes " + scene + " -q -o " + modes.string()).code, 0);
+  const std::string listed = slurp(modes);
+  for (int k = 1; k <= 2; ++k) {
+    SCOPED_TRACE(k);
+    const fs::path out = dir_ / ("r" + std::to_string(k) + ".csv");
+    const Result r = run("run " + scene + " -q --mode " + std::to_string(k) + " -o " + out.string());
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string rows = slurp(out);
+    EXPECT_NEAR(cli_modes_cell(rows, "xB", 1), cli_modes_cell(listed, "xB", k), 1e-12);
+    EXPECT_NEAR(cli_modes_cell(rows, "yB", 1), cli_modes_cell(listed, "yB", k), 1e-12);
+    // a crank-rocker keeps its branch all the way round: B on the side it started, at every row
+    const double side = cli_modes_cell(listed, "y3", k) > 0 ? 1.0 : -1.0;
+    for (int row = 1; row <= 361; row += 45) EXPECT_GT(side * cli_modes_cell(rows, "psi3", row), 0.0) << row;
+  }
+  const Result r = run("run " + scene + " -q --mode 3 -o " + (dir_ / "r3.csv").string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--mode 3: the scene has 2 real assembly modes at t = 0"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "r3.csv"));
+}
+
+}  // namespace

@@ -13,7 +13,7 @@
 /// tracked in projective coordinates on a random affine patch (paths that diverge in affine space end at points
 /// with x₀ → 0, at infinity, instead of running away) by an adaptive RK4 predictor and Newton corrector. Every
 /// endpoint is refined by Newton on the original equations and classified: real, complex, singular (condition
-/// number above ModesOptions::singular_condition, or reached by several paths) or at infinity. Paths run in parallel
+/// number above ModesOptions::singular_condition) or at infinity. Paths run in parallel
 /// (TBB); each path's arithmetic is independent of the others and the endpoints are merged in path order and
 /// sorted, so the result is the same, to the bit, on any number of threads.
 #pragma once
@@ -61,10 +61,11 @@ struct ModesOptions {
   int threads = 0;               ///< worker threads for the paths; 0: TBB's default
   std::uint64_t seed = 20261202;  ///< seed of γ, the affine patch and the fitting points: a run is reproducible
   /// An endpoint whose Jacobian's condition number (2-norm, the variables scaled) is above this is singular.
+  /// (Several paths at one regular point are counted in ModesSummary::duplicate_paths, not made singular.)
   double singular_condition = 1e9;
   /// An endpoint is real when every |Im x_v| ≤ this · (1 + |x|∞).
   double real_tolerance = 1e-8;
-  /// Endpoints closer than this · (1 + |x|∞) are one solution (reached by several paths: singular).
+  /// Endpoints closer than this · (1 + |x|∞) are one solution, reached by several paths (Endpoint::multiplicity).
   double duplicate_tolerance = 1e-6;
   int max_fit_degree = 4;  ///< the highest degree a row is fitted with (find_polynomial_system())
 };
@@ -81,7 +82,7 @@ enum class ModesStatus {
 enum class EndpointKind {
   kReal,        ///< a regular real solution
   kComplex,     ///< a regular solution with an imaginary part
-  kSingular,    ///< a solution whose Jacobian is singular (or reached by several paths)
+  kSingular,    ///< a solution whose Jacobian is singular (condition above ModesOptions::singular_condition)
   kAtInfinity,  ///< the path diverged: the homogenising coordinate went to 0
   kFailed,      ///< the path could not be tracked to its end (step below the minimum away from t = 0)
 };
@@ -108,6 +109,9 @@ struct ModesSummary {
   int singular = 0;     ///< distinct singular endpoints
   int at_infinity = 0;  ///< distinct endpoints at infinity
   int failed_paths = 0;            ///< paths that could not be tracked to t = 0
+  /// Paths that ended at a regular endpoint another path had reached: a path jumped onto another's on the way (a
+  /// regular solution is the end of one path only), so that some solution may be missing. 0 when all went well.
+  int duplicate_paths = 0;
   double seconds = 0.0;            ///< wall time of the tracking
   /// The distinct endpoints: real first, then complex, singular, at infinity, failed; within a kind in a fixed
   /// order (lexicographic in the real, then imaginary parts).

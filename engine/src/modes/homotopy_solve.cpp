@@ -146,6 +146,9 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
       point.x = e.X.tail(n) / e.X(0);
       point.residual = refine(original, point.x, &point.condition);
       infinite = !(inf_norm(point.x) < 1e8) || !point.x.allFinite();
+      // a path stopped short of t = 0 (its step collapsed in the end game) with X0 already small and no solution
+      // near it: diverging, to a solution set at infinity
+      if (!infinite && !(point.residual <= 1e-8) && e.t > 0.0 && x0 < 1e-2 * size) infinite = true;
       if (!infinite && !(point.residual <= 1e-8)) {
         ++summary.failed_paths;  // solves the squared-up system (or the path was lost), not the original
         continue;
@@ -174,12 +177,15 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
     if (same == distinct.end()) {
       distinct.push_back(std::move(point));
     } else {
+      // Several paths at one point: a multiple root (singular by its condition number), or, at a regular one, a
+      // path that jumped onto another's on the way (counted: ModesSummary::duplicate_paths)
       ++same->multiplicity;
-      if (!at_infinity) same->kind = EndpointKind::kSingular;  // several paths: a multiple root
+      if (!at_infinity) ++summary.duplicate_paths;
     }
   }
   std::sort(distinct.begin(), distinct.end(), endpoint_before);
   for (const Endpoint& d : distinct) {
+    if (d.kind == EndpointKind::kSingular) summary.duplicate_paths -= d.multiplicity - 1;  // a multiple root's own
     summary.real += d.kind == EndpointKind::kReal;
     summary.complex += d.kind == EndpointKind::kComplex;
     summary.singular += d.kind == EndpointKind::kSingular;

@@ -66,9 +66,9 @@ Eigen::VectorXcd velocity(const Homotopy& h, const Eigen::VectorXcd& X, double t
 PathEnd track_path(const Homotopy& h, std::int64_t p) {
   constexpr double kMaxStep = 0.1, kMinStep = 1e-14, kCorrectorTolerance = 1e-10;
   // A path whose step collapses below kEndGame has reached its end: a singular endpoint (several paths meet, or
-  // a solution set at infinity), where the corrector cannot converge as t → 0; the endpoint is refined and
-  // classified as such.
-  constexpr double kEndGame = 1e-6;
+  // a solution set at infinity), where the corrector cannot converge as t → 0; the endpoint is refined by Newton
+  // on the original equations and classified (a point Newton does not take onto a solution is a failed path).
+  constexpr double kEndGame = 1e-3;
   constexpr int kMaxSteps = 200000;
   PathEnd end;
   end.X = h.start(p);
