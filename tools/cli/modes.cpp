@@ -67,7 +67,8 @@ std::string report_text(const std::string& scene_path, double t, const AssemblyM
   o << scene_path << " at t = " << shortest(t) << ": " << r.modes.size() << " real assembly mode"
     << (r.modes.size() == 1 ? "" : "s") << " (" << s.paths << " paths: " << s.real << " real, " << s.complex
     << " complex, " << s.singular << " singular, " << s.at_infinity << " at infinity, " << s.failed_paths
-    << " failed; " << r.polynomials.system.variables << " unknowns, " << r.polynomials.eliminated_rows.size()
+    << " failed, " << s.duplicate_paths << " duplicate, " << s.retracked_paths << " tracked twice; "
+    << r.polynomials.system.variables << " unknowns, " << r.polynomials.eliminated_rows.size()
     << " coordinates fixed by their own rows; " << shortest(std::round(s.seconds * 1e4) / 1e4) << " s)\n";
   for (std::size_t k = 0; k < r.modes.size(); ++k) {
     const AssemblyMode& m = r.modes[k];
@@ -112,6 +113,7 @@ nlohmann::ordered_json modes_json(const std::string& scene_path, double t, const
   j["singular"] = r.summary.singular;
   j["at_infinity"] = r.summary.at_infinity;
   j["failed_paths"] = r.summary.failed_paths;
+  j["duplicate_paths"] = r.summary.duplicate_paths;
   j["coordinates"] = model.coordinate_names();
   auto modes = nlohmann::ordered_json::array();
   for (const AssemblyMode& m : r.modes) {

@@ -112,6 +112,9 @@ struct ModesSummary {
   /// Paths that ended at a regular endpoint another path had reached: a path jumped onto another's on the way (a
   /// regular solution is the end of one path only), so that some solution may be missing. 0 when all went well.
   int duplicate_paths = 0;
+  /// Paths tracked a second time, with shorter steps, because the first attempt failed or ended at another path's
+  /// regular endpoint (the counts above are those after the second attempt).
+  int retracked_paths = 0;
   double seconds = 0.0;            ///< wall time of the tracking
   /// The distinct endpoints: real first, then complex, singular, at infinity, failed; within a kind in a fixed
   /// order (lexicographic in the real, then imaginary parts).

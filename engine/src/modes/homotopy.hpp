@@ -73,7 +73,7 @@ struct PathEnd {
   int steps = 0;
 };
 
-// Tracks path p from t = 1 to t = 0.
-PathEnd track_path(const Homotopy& h, std::int64_t p);
+// Tracks path p from t = 1 to t = 0; `careful`: shorter steps and a closer corrector (a second attempt).
+PathEnd track_path(const Homotopy& h, std::int64_t p, bool careful = false);
 
 }  // namespace phiq::modes_detail

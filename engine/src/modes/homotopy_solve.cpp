@@ -132,60 +132,90 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
     });
   });
 
-  // Classify each endpoint, in path order, merging it into an earlier distinct endpoint it duplicates.
+  // Classify each endpoint, in path order, merging it into an earlier distinct endpoint it duplicates; cluster_of[p]
+  // is the distinct endpoint path p reached (−1: failed).
   std::vector<Endpoint> distinct;
-  for (const PathEnd& e : ends) {
-    Endpoint point;
-    if (!e.reached) {
-      ++summary.failed_paths;
-      continue;
-    }
-    const double x0 = std::abs(e.X(0)), size = inf_norm(e.X);
-    bool infinite = !(x0 > 1e-8 * size);
-    if (!infinite) {
-      point.x = e.X.tail(n) / e.X(0);
-      point.residual = refine(original, point.x, &point.condition);
-      infinite = !(inf_norm(point.x) < 1e8) || !point.x.allFinite();
-      // a path stopped short of t = 0 (its step collapsed in the end game) with X0 already small and no solution
-      // near it: diverging, to a solution set at infinity
-      if (!infinite && !(point.residual <= 1e-8) && e.t > 0.0 && x0 < 1e-2 * size) infinite = true;
-      if (!infinite && !(point.residual <= 1e-8)) {
-        ++summary.failed_paths;  // solves the squared-up system (or the path was lost), not the original
+  std::vector<int> cluster_of;
+  auto classify = [&] {
+    distinct.clear();
+    cluster_of.assign(ends.size(), -1);
+    summary.failed_paths = 0, summary.duplicate_paths = 0;
+    for (std::size_t path = 0; path < ends.size(); ++path) {
+      const PathEnd& e = ends[path];
+      Endpoint point;
+      if (!e.reached) {
+        ++summary.failed_paths;
         continue;
       }
+      const double x0 = std::abs(e.X(0)), size = inf_norm(e.X);
+      bool infinite = !(x0 > 1e-8 * size);
+      if (!infinite) {
+        point.x = e.X.tail(n) / e.X(0);
+        point.residual = refine(original, point.x, &point.condition);
+        infinite = !(inf_norm(point.x) < 1e8) || !point.x.allFinite();
+        // a path stopped short of t = 0 (its step collapsed in the end game) with X0 already small and no solution
+        // near it: diverging, to a solution set at infinity
+        if (!infinite && !(point.residual <= 1e-8) && e.t > 0.0 && x0 < 1e-2 * size) infinite = true;
+        if (!infinite && !(point.residual <= 1e-8)) {
+          ++summary.failed_paths;  // solves the squared-up system (or the path was lost), not the original
+          continue;
+        }
+      }
+      if (infinite) {
+        point.kind = EndpointKind::kAtInfinity;
+        Eigen::Index largest = 0;
+        e.X.tail(n).cwiseAbs().maxCoeff(&largest);
+        point.x = e.X.tail(n) / e.X(1 + largest);
+        point.residual = 0.0, point.condition = std::numeric_limits<double>::infinity();
+      } else if (!(point.condition <= options.singular_condition)) {
+        point.kind = EndpointKind::kSingular;
+      } else {
+        const double imag = point.x.imag().cwiseAbs().maxCoeff();
+        point.kind = imag <= options.real_tolerance * (1.0 + inf_norm(point.x)) ? EndpointKind::kReal
+                                                                                 : EndpointKind::kComplex;
+      }
+      if (point.kind == EndpointKind::kReal)
+        for (Eigen::Index v = 0; v < n; ++v) point.x(v) = point.x(v).real();
+      const bool at_infinity = point.kind == EndpointKind::kAtInfinity;
+      const double tolerance = (at_infinity ? 1e-4 : options.duplicate_tolerance) * (1.0 + inf_norm(point.x));
+      auto same = std::find_if(distinct.begin(), distinct.end(), [&](const Endpoint& d) {
+        return (d.kind == EndpointKind::kAtInfinity) == at_infinity && inf_norm(d.x - point.x) <= tolerance;
+      });
+      if (same == distinct.end()) {
+        cluster_of[path] = static_cast<int>(distinct.size());
+        distinct.push_back(std::move(point));
+      } else {
+        // Several paths at one point: a multiple root (singular by its condition number), or, at a regular one, a
+        // path that jumped onto another's on the way (counted: ModesSummary::duplicate_paths)
+        cluster_of[path] = static_cast<int>(same - distinct.begin());
+        ++same->multiplicity;
+        if (same->kind == EndpointKind::kReal || same->kind == EndpointKind::kComplex) ++summary.duplicate_paths;
+      }
     }
-    if (infinite) {
-      point.kind = EndpointKind::kAtInfinity;
-      Eigen::Index largest = 0;
-      e.X.tail(n).cwiseAbs().maxCoeff(&largest);
-      point.x = e.X.tail(n) / e.X(1 + largest);
-      point.residual = 0.0, point.condition = std::numeric_limits<double>::infinity();
-    } else if (!(point.condition <= options.singular_condition)) {
-      point.kind = EndpointKind::kSingular;
-    } else {
-      const double imag = point.x.imag().cwiseAbs().maxCoeff();
-      point.kind = imag <= options.real_tolerance * (1.0 + inf_norm(point.x)) ? EndpointKind::kReal
-                                                                               : EndpointKind::kComplex;
-    }
-    if (point.kind == EndpointKind::kReal)
-      for (Eigen::Index v = 0; v < n; ++v) point.x(v) = point.x(v).real();
-    const bool at_infinity = point.kind == EndpointKind::kAtInfinity;
-    const double tolerance = (at_infinity ? 1e-4 : options.duplicate_tolerance) * (1.0 + inf_norm(point.x));
-    auto same = std::find_if(distinct.begin(), distinct.end(), [&](const Endpoint& d) {
-      return (d.kind == EndpointKind::kAtInfinity) == at_infinity && inf_norm(d.x - point.x) <= tolerance;
-    });
-    if (same == distinct.end()) {
-      distinct.push_back(std::move(point));
-    } else {
-      // Several paths at one point: a multiple root (singular by its condition number), or, at a regular one, a
-      // path that jumped onto another's on the way (counted: ModesSummary::duplicate_paths)
-      ++same->multiplicity;
-      if (!at_infinity) ++summary.duplicate_paths;
-    }
+  };
+  classify();
+  // A second, careful pass over the paths that failed and those that met at a regular point (where one of them
+  // jumped), then the classification again: deterministic, as the first pass.
+  std::vector<std::int64_t> again;
+  for (std::size_t path = 0; path < ends.size(); ++path) {
+    const int c = cluster_of[path];
+    if (c < 0 || (distinct[static_cast<std::size_t>(c)].multiplicity > 1 &&
+                  (distinct[static_cast<std::size_t>(c)].kind == EndpointKind::kReal ||
+                   distinct[static_cast<std::size_t>(c)].kind == EndpointKind::kComplex)))
+      again.push_back(static_cast<std::int64_t>(path));
   }
+  if (!again.empty()) {
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, again.size(), 1), [&](const auto& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+          ends[static_cast<std::size_t>(again[k])] = modes_detail::track_path(homotopy, again[k], true);
+      });
+    });
+    classify();
+  }
+  summary.retracked_paths = static_cast<int>(again.size());
   std::sort(distinct.begin(), distinct.end(), endpoint_before);
   for (const Endpoint& d : distinct) {
-    if (d.kind == EndpointKind::kSingular) summary.duplicate_paths -= d.multiplicity - 1;  // a multiple root's own
     summary.real += d.kind == EndpointKind::kReal;
     summary.complex += d.kind == EndpointKind::kComplex;
     summary.singular += d.kind == EndpointKind::kSingular;

@@ -63,8 +63,11 @@ Eigen::VectorXcd velocity(const Homotopy& h, const Eigen::VectorXcd& X, double t
 
 }  // namespace
 
-PathEnd track_path(const Homotopy& h, std::int64_t p) {
-  constexpr double kMaxStep = 0.1, kMinStep = 1e-14, kCorrectorTolerance = 1e-10;
+PathEnd track_path(const Homotopy& h, std::int64_t p, bool careful) {
+  // careful: the second pass over the paths that failed or met another path's end (homotopy_solve.cpp), with
+  // steps ten times shorter at most and a closer first correction, which keep a path from jumping onto another
+  const double kMaxStep = careful ? 0.01 : 0.1, kFirstCorrection = careful ? 1e-5 : 1e-3;
+  constexpr double kMinStep = 1e-14, kCorrectorTolerance = 1e-10;
   // A path whose step collapses below kEndGame has reached its end: a singular endpoint (several paths meet, or
   // a solution set at infinity), where the corrector cannot converge as t → 0; the endpoint is refined by Newton
   // on the original equations and classified (a point Newton does not take onto a solution is a failed path).
@@ -94,7 +97,7 @@ PathEnd track_path(const Homotopy& h, std::int64_t p) {
       const double norm = inf_norm(delta);
       // a first correction this large means the prediction left the path's neighbourhood (it could land on
       // another path); a correction that does not contract means Newton is not converging
-      if (!std::isfinite(norm) || (it == 0 && norm > 1e-3 * size) || (it > 0 && norm > 0.5 * previous)) break;
+      if (!std::isfinite(norm) || (it == 0 && norm > kFirstCorrection * size) || (it > 0 && norm > 0.5 * previous)) break;
       Y -= delta;
       previous = norm;
       if (norm <= kCorrectorTolerance * size) {
