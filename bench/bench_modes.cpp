@@ -45,12 +45,18 @@ const char* kStewart =
     "coordinates: {x: 0.1, y: 0.05, z: 1.0, e0: 1, e1: 0.05, e2: 0.02, e3: 0.1}\n"
     "bodies: {platform: [x, y, z, e0, e1, e2, e3]}\n"
     "constraints:\n"
-    "  - {name: leg1, type: distance, between: [{body: ground, at: [1.0, 0.1, 0.05]}, {body: platform, at: [0.5, 0.3, 0.02]}], length: 1.3}\n"
-    "  - {name: leg2, type: distance, between: [{body: ground, at: [0.3, 0.9, -0.1]}, {body: platform, at: [-0.2, 0.6, 0.1]}], length: 1.1}\n"
-    "  - {name: leg3, type: distance, between: [{body: ground, at: [-0.7, 0.6, 0.08]}, {body: platform, at: [-0.5, 0.1, -0.05]}], length: 1.25}\n"
-    "  - {name: leg4, type: distance, between: [{body: ground, at: [-0.8, -0.4, 0.02]}, {body: platform, at: [-0.3, -0.5, 0.07]}], length: 1.2}\n"
-    "  - {name: leg5, type: distance, between: [{body: ground, at: [0.1, -1.0, -0.06]}, {body: platform, at: [0.2, -0.6, -0.03]}], length: 1.05}\n"
-    "  - {name: leg6, type: distance, between: [{body: ground, at: [0.9, -0.5, 0.12]}, {body: platform, at: [0.6, -0.2, 0.04]}], length: 1.15}\n"
+    "  - {name: leg1, type: distance, between: [{body: ground, at: [1.0, 0.1, 0.05]}, {body: platform, at: [0.5, 0.3, "
+    "0.02]}], length: 1.3}\n"
+    "  - {name: leg2, type: distance, between: [{body: ground, at: [0.3, 0.9, -0.1]}, {body: platform, at: [-0.2, 0.6, "
+    "0.1]}], length: 1.1}\n"
+    "  - {name: leg3, type: distance, between: [{body: ground, at: [-0.7, 0.6, 0.08]}, {body: platform, at: [-0.5, "
+    "0.1, -0.05]}], length: 1.25}\n"
+    "  - {name: leg4, type: distance, between: [{body: ground, at: [-0.8, -0.4, 0.02]}, {body: platform, at: [-0.3, "
+    "-0.5, 0.07]}], length: 1.2}\n"
+    "  - {name: leg5, type: distance, between: [{body: ground, at: [0.1, -1.0, -0.06]}, {body: platform, at: [0.2, "
+    "-0.6, -0.03]}], length: 1.05}\n"
+    "  - {name: leg6, type: distance, between: [{body: ground, at: [0.9, -0.5, 0.12]}, {body: platform, at: [0.6, "
+    "-0.2, 0.04]}], length: 1.15}\n"
     "time: {start: 0, end: 1, steps: 1}\n";
 
 phiq::Scene bench_modes_scene(const std::string& which) {
@@ -70,8 +76,8 @@ void BM_ModesPhiq(benchmark::State& state, const std::string& which) {
   }
   if (r.summary.status != phiq::ModesStatus::kSuccess) state.SkipWithError(r.summary.message.c_str());
   state.counters["paths"] = static_cast<double>(r.summary.paths);
-  state.counters["paths/s"] = benchmark::Counter(static_cast<double>(r.summary.paths) * state.iterations(),
-                                                 benchmark::Counter::kIsRate);
+  state.counters["paths/s"] =
+      benchmark::Counter(static_cast<double>(r.summary.paths) * state.iterations(), benchmark::Counter::kIsRate);
   state.counters["real"] = r.summary.real;
   state.counters["complex"] = r.summary.complex;
   state.counters["singular"] = r.summary.singular;
@@ -106,9 +112,13 @@ BENCHMARK_CAPTURE(BM_ModesPhc, fourbar, std::string("fourbar"))->Unit(benchmark:
 BENCHMARK_CAPTURE(BM_ModesPhiq, rpr3, std::string("rpr3"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ModesPhc, rpr3, std::string("rpr3"))->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ModesPhiq, stewart, std::string("stewart"))
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 BENCHMARK_CAPTURE(BM_ModesPhc, stewart, std::string("stewart"))
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 }  // namespace
 

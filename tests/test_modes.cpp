@@ -46,8 +46,10 @@ std::vector<Endpoint> modes_of_kind(const ModesSummary& s, EndpointKind kind) {
 
 TEST(ModesPolynomial, KnownIntegerSolutionsAreEveryEndpoint) {
   // (x − 1)(x − 2) = 0, (y − 3)(y + 1) = 0: exactly the four integer points, all real and regular
-  PolynomialSystem s{2, {}, {modes_poly({{2.0, {0, 0}}, {-3.0, {1, 0}}, {1.0, {2, 0}}}),
-                             modes_poly({{-3.0, {0, 0}}, {-2.0, {0, 1}}, {1.0, {0, 2}}})}};
+  PolynomialSystem s{2,
+                     {},
+                     {modes_poly({{2.0, {0, 0}}, {-3.0, {1, 0}}, {1.0, {2, 0}}}),
+                      modes_poly({{-3.0, {0, 0}}, {-2.0, {0, 1}}, {1.0, {0, 2}}})}};
   const ModesSummary r = solve_polynomial_system(s, {});
   ASSERT_EQ(r.status, ModesStatus::kSuccess);
   EXPECT_EQ(r.paths, 4);
@@ -87,7 +89,8 @@ TEST(ModesPolynomial, ComplexInfiniteAndDoubleRootsAreClassified) {
   EXPECT_LT(std::abs(far.x(0)), 1e-4);  // the direction (0, 1)
   EXPECT_NEAR(std::abs(far.x(1)), 1.0, 1e-12);
   // (x − 1)² = 0, y − 2 = 0: one double root, reached by both paths, singular
-  PolynomialSystem d{2, {}, {modes_poly({{1.0, {0, 0}}, {-2.0, {1, 0}}, {1.0, {2, 0}}}), modes_poly({{1.0, {0, 1}}, {-2.0, {0, 0}}})}};
+  PolynomialSystem d{
+      2, {}, {modes_poly({{1.0, {0, 0}}, {-2.0, {1, 0}}, {1.0, {2, 0}}}), modes_poly({{1.0, {0, 1}}, {-2.0, {0, 0}}})}};
   const ModesSummary rd = solve_polynomial_system(d, {});
   EXPECT_EQ(rd.real + rd.complex, 0);
   ASSERT_EQ(rd.singular, 1);
@@ -97,8 +100,10 @@ TEST(ModesPolynomial, ComplexInfiniteAndDoubleRootsAreClassified) {
 }
 
 TEST(ModesPolynomial, TooManyPathsAndTooFewEquationsAreRefused) {
-  PolynomialSystem s{2, {}, {modes_poly({{2.0, {0, 0}}, {-3.0, {1, 0}}, {1.0, {2, 0}}}),
-                             modes_poly({{-3.0, {0, 0}}, {-2.0, {0, 1}}, {1.0, {0, 2}}})}};
+  PolynomialSystem s{2,
+                     {},
+                     {modes_poly({{2.0, {0, 0}}, {-3.0, {1, 0}}, {1.0, {2, 0}}}),
+                      modes_poly({{-3.0, {0, 0}}, {-2.0, {0, 1}}, {1.0, {0, 2}}})}};
   ModesOptions o;
   o.max_paths = 3;
   const ModesSummary r = solve_polynomial_system(s, o);
@@ -195,8 +200,9 @@ TEST(ModesCrankSlider, TwoModesOneEachSideOfTheCrank) {
 // PHCpack's too (test_modes_phc.cpp, ThreeRprAsPhcSolvesIt).
 std::string modes_rpr_scene(double rho1, double rho2, double rho3) {
   return "phiq: 1\nname: rpr3\n"
-         "parameters: {a2: 15.91, a3x: 0, a3y: 10, b2: 17.04, b3x: 8.0, b3y: 9.0, r1: " + std::to_string(rho1) +
-         ", r2: " + std::to_string(rho2) + ", r3: " + std::to_string(rho3) + "}\n"
+         "parameters: {a2: 15.91, a3x: 0, a3y: 10, b2: 17.04, b3x: 8.0, b3y: 9.0, r1: " +
+         std::to_string(rho1) + ", r2: " + std::to_string(rho2) + ", r3: " + std::to_string(rho3) +
+         "}\n"
          "coordinates: {x: 5, y: 5, psi: 0.3, x1: 5, y1: 5, x2: 20, y2: 8, x3: 12, y3: 14}\n"
          "points: {A1: [0, 0], A2: [a2, 0], A3: [a3x, a3y], P1: [x1, y1], P2: [x2, y2], P3: [x3, y3]}\n"
          "bodies: {platform: [x, y, psi]}\n"

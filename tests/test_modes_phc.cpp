@@ -96,7 +96,8 @@ void modes_expect_same_as_phc(const PolynomialSystem& system, const ModesSummary
     for (const PhcSolution& s : theirs) {
       if (!s.real || static_cast<Eigen::Index>(s.x.size()) != e.x.size()) continue;
       double d = 0.0;
-      for (Eigen::Index v = 0; v < e.x.size(); ++v) d = std::max(d, std::abs(s.x[static_cast<std::size_t>(v)] - e.x(v)));
+      for (Eigen::Index v = 0; v < e.x.size(); ++v)
+        d = std::max(d, std::abs(s.x[static_cast<std::size_t>(v)] - e.x(v)));
       found = found || d < 1e-8;
     }
     EXPECT_TRUE(found) << "a real solution of phiq's that phc did not find";

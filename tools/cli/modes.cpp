@@ -23,8 +23,8 @@ namespace {
 // Where the rough placement assembled, and the modes nearest to it.
 struct Placement {
   bool assembled = false;
-  std::string failure;   // why it did not assemble
-  int nearest = -1;      // index into the modes
+  std::string failure;  // why it did not assemble
+  int nearest = -1;     // index into the modes
   double distance = 0.0;
   int next = -1;  // the next nearest
   double next_distance = 0.0;
@@ -56,7 +56,8 @@ Placement placement_mode(const Scene& scene, double t, const std::vector<Assembl
 std::string mode_coordinates(const Model& model, const AssemblyMode& m, const char* separator) {
   std::string text;
   for (Index j = 0; j < model.num_coordinates(); ++j)
-    text += (j ? separator : "") + model.coordinate_names()[static_cast<std::size_t>(j)] + (*separator == ',' ? ": " : " = ") + shortest(m.q(j));
+    text += (j ? separator : "") + model.coordinate_names()[static_cast<std::size_t>(j)] +
+            (*separator == ',' ? ": " : " = ") + shortest(m.q(j));
   return text;
 }
 
@@ -66,10 +67,10 @@ std::string report_text(const std::string& scene_path, double t, const AssemblyM
   std::ostringstream o;
   o << scene_path << " at t = " << shortest(t) << ": " << r.modes.size() << " real assembly mode"
     << (r.modes.size() == 1 ? "" : "s") << " (" << s.paths << " paths: " << s.real << " real, " << s.complex
-    << " complex, " << s.singular << " singular, " << s.at_infinity << " at infinity, " << s.failed_paths
-    << " failed, " << s.duplicate_paths << " duplicate, " << s.retracked_paths << " tracked twice; "
-    << r.polynomials.system.variables << " unknowns, " << r.polynomials.eliminated_rows.size()
-    << " coordinates fixed by their own rows; " << shortest(std::round(s.seconds * 1e4) / 1e4) << " s)\n";
+    << " complex, " << s.singular << " singular, " << s.at_infinity << " at infinity, " << s.failed_paths << " failed, "
+    << s.duplicate_paths << " duplicate, " << s.retracked_paths << " tracked twice; " << r.polynomials.system.variables
+    << " unknowns, " << r.polynomials.eliminated_rows.size() << " coordinates fixed by their own rows; "
+    << shortest(std::round(s.seconds * 1e4) / 1e4) << " s)\n";
   for (std::size_t k = 0; k < r.modes.size(); ++k) {
     const AssemblyMode& m = r.modes[k];
     o << "  mode " << k + 1 << (m.singular ? " (singular)" : "") << ": " << mode_coordinates(model, m, "; ")
@@ -163,8 +164,8 @@ int cmd_modes(const std::string& scene_arg, std::optional<double> at, const std:
               long long max_paths, bool quiet, const std::vector<std::string>& sets) {
   const std::string scene_path = scene_label(scene_arg);
   if (!out_path.empty() && out_path != "-") {
-    if (!modes_path_ends_with(out_path, ".yaml") && !modes_path_ends_with(out_path, ".yml") && !modes_path_ends_with(out_path, ".csv") &&
-        !modes_path_ends_with(out_path, ".json"))
+    if (!modes_path_ends_with(out_path, ".yaml") && !modes_path_ends_with(out_path, ".yml") &&
+        !modes_path_ends_with(out_path, ".csv") && !modes_path_ends_with(out_path, ".json"))
       return fail("modes: -o " + out_path + ": the file's extension says its format: .yaml, .csv or .json", 2);
     if (const auto clash = output_clash({{"-o", out_path}}, {{"the scene", scene_arg == "-" ? "" : scene_arg}}))
       return fail("modes: " + *clash, 2);
@@ -201,9 +202,10 @@ int cmd_modes(const std::string& scene_arg, std::optional<double> at, const std:
   const Placement p = placement_mode(scene, t, r.modes);
   try {
     if (file) {
-      const std::string text = modes_path_ends_with(out_path, ".csv")    ? modes_csv(model, r)
-                               : modes_path_ends_with(out_path, ".json") ? json_text(modes_json(scene_path, t, model, r, p), 2) + "\n"
-                                                              : modes_yaml(scene_path, t, model, r, p);
+      const std::string text = modes_path_ends_with(out_path, ".csv") ? modes_csv(model, r)
+                               : modes_path_ends_with(out_path, ".json")
+                                   ? json_text(modes_json(scene_path, t, model, r, p), 2) + "\n"
+                                   : modes_yaml(scene_path, t, model, r, p);
       file->write(text);
       outputs.commit();
     }
@@ -226,9 +228,10 @@ Command register_modes(CLI::App& app) {
     std::vector<std::string> sets;
   };
   auto a = std::make_shared<Args>();
-  CLI::App* cmd = app.add_subcommand(
-      "modes", "Every real assembly mode of the scene at one time (homotopy continuation), and which one the "
-               "rough placement assembles into");
+  CLI::App* cmd =
+      app.add_subcommand("modes",
+                         "Every real assembly mode of the scene at one time (homotopy continuation), and which one the "
+                         "rough placement assembles into");
   cmd->add_option("scene", a->path, "Scene file (YAML; '-': standard input)")->required();
   CLI::Option* at = cmd->add_option("--at", a->at, "The time at which the drivers are evaluated (default: time.start)")
                         ->check(any_number());

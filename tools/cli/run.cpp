@@ -97,6 +97,24 @@ class ResultRows : public phiq::RowWriter {
   std::string pending_;
 };
 
+// `--mode K`: `start` moved to real assembly mode K of the scene at its first time (phiq/modes.hpp), as `phiq modes`
+// numbers them; nothing for K = 0 (the rough placement). Else why not (": --mode …; no output written"): bad input.
+std::optional<std::string> mode_start(const phiq::Scene& scene, int mode, int threads, Eigen::VectorXd* start) {
+  if (mode <= 0) return std::nullopt;
+  phiq::ModesOptions o;
+  o.time = scene.sweep.t_begin;
+  o.threads = threads;
+  const phiq::AssemblyModes modes = phiq::find_assembly_modes(*scene.model, o);
+  if (modes.summary.status != phiq::ModesStatus::kSuccess)
+    return ": --mode: " + modes.summary.message + "; no output written";
+  if (static_cast<std::size_t>(mode) > modes.modes.size())
+    return ": --mode " + std::to_string(mode) + ": the scene has " + std::to_string(modes.modes.size()) +
+           " real assembly modes at t = " + phiq::shortest(scene.sweep.t_begin) +
+           " (phiq modes lists them); no output written";
+  *start = modes.modes[static_cast<std::size_t>(mode - 1)].q;
+  return std::nullopt;
+}
+
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode,
             bool identifier_names, const std::vector<std::string>& sets,
@@ -158,26 +176,12 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   if (const auto why = make_square(scene, &square)) {
     phiq::SweepSummary at_start;  // the first position, before any sweep
     at_start.status = square.assembly.status;
-    at_start.message = *why;
     at_start.failed_step = 0;
     at_start.failed_time = scene.sweep.t_begin;
     at_start.worst_rows = square.assembly.worst_rows;
     return failed(*scene.model, at_start, {load_s, 0.0, 0.0}, *why);
   }
-  if (mode > 0) {  // --mode K: the sweep starts from real assembly mode K (phiq/modes.hpp) instead
-    phiq::ModesOptions mo;
-    mo.time = scene.sweep.t_begin;
-    mo.threads = threads;
-    const phiq::AssemblyModes modes = phiq::find_assembly_modes(*scene.model, mo);
-    if (modes.summary.status != phiq::ModesStatus::kSuccess)
-      return fail(scene_path + ": --mode: " + modes.summary.message + "; no output written", 2);
-    if (static_cast<std::size_t>(mode) > modes.modes.size())
-      return fail(scene_path + ": --mode " + std::to_string(mode) + ": the scene has " +
-                      std::to_string(modes.modes.size()) + " real assembly modes at t = " +
-                      phiq::shortest(scene.sweep.t_begin) + " (phiq modes lists them); no output written",
-                  2);
-    square.start = modes.modes[static_cast<std::size_t>(mode - 1)].q;
-  }
+  if (const auto bad = mode_start(scene, mode, threads, &square.start)) return fail(scene_path + *bad, 2);
   const phiq::AssemblySummary& redundancy = square.assembly;
   const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;

@@ -44,9 +44,9 @@ struct Polynomial {
 
 /// A system of polynomial equations F(x) = 0 in `variables` complex unknowns.
 struct PolynomialSystem {
-  int variables = 0;                   ///< number of unknowns
-  std::vector<std::string> names;      ///< their names (for messages and phc_input_text()); may be empty
-  std::vector<Polynomial> equations;   ///< the equations; square systems have as many as unknowns
+  int variables = 0;                  ///< number of unknowns
+  std::vector<std::string> names;     ///< their names (for messages and phc_input_text()); may be empty
+  std::vector<Polynomial> equations;  ///< the equations; square systems have as many as unknowns
   /// Evaluates every equation at x (variables entries) into f (equations.size() entries).
   void evaluate(const std::complex<double>* x, std::complex<double>* f) const;
   /// The Bézout number Π deg F_i: the paths of the total-degree homotopy of a square system (saturated at 2⁶²).
@@ -58,7 +58,7 @@ struct ModesOptions {
   double time = 0.0;  ///< T, the time at which the drivers are evaluated (find_assembly_modes())
   /// Refuse (ModesStatus::kTooManyPaths) rather than track more paths than this.
   std::int64_t max_paths = 100000;
-  int threads = 0;               ///< worker threads for the paths; 0: TBB's default
+  int threads = 0;                ///< worker threads for the paths; 0: TBB's default
   std::uint64_t seed = 20261202;  ///< seed of γ, the affine patch and the fitting points: a run is reproducible
   /// An endpoint whose Jacobian's condition number (2-norm, the variables scaled) is above this is singular.
   /// (Several paths at one regular point are counted in ModesSummary::duplicate_paths, not made singular.)
@@ -93,7 +93,7 @@ const char* endpoint_kind_name(EndpointKind kind);
 /// One distinct endpoint of the homotopy (duplicates merged).
 struct Endpoint {
   EndpointKind kind = EndpointKind::kFailed;  ///< its class
-  Eigen::VectorXcd x;  ///< the solution in the system's variables (for kAtInfinity: the direction, unit norm)
+  Eigen::VectorXcd x;      ///< the solution in the system's variables (for kAtInfinity: the direction, unit norm)
   double residual = 0.0;   ///< max_i |F_i(x)| / (largest |coefficient| of F_i), after Newton's refinement
   double condition = 0.0;  ///< condition number of the Jacobian at x (variables scaled by 1 + |x|∞)
   int multiplicity = 1;    ///< how many paths ended here
@@ -102,20 +102,20 @@ struct Endpoint {
 /// What solve_polynomial_system() did.
 struct ModesSummary {
   ModesStatus status = ModesStatus::kSuccess;  ///< see ModesStatus
-  std::string message;             ///< one line when status is not kSuccess
-  std::int64_t paths = 0;          ///< paths tracked (the total degree)
-  int real = 0;         ///< distinct real regular endpoints
-  int complex = 0;      ///< distinct complex regular endpoints
-  int singular = 0;     ///< distinct singular endpoints
-  int at_infinity = 0;  ///< distinct endpoints at infinity
-  int failed_paths = 0;            ///< paths that could not be tracked to t = 0
+  std::string message;                         ///< one line when status is not kSuccess
+  std::int64_t paths = 0;                      ///< paths tracked (the total degree)
+  int real = 0;                                ///< distinct real regular endpoints
+  int complex = 0;                             ///< distinct complex regular endpoints
+  int singular = 0;                            ///< distinct singular endpoints
+  int at_infinity = 0;                         ///< distinct endpoints at infinity
+  int failed_paths = 0;                        ///< paths that could not be tracked to t = 0
   /// Paths that ended at a regular endpoint another path had reached: a path jumped onto another's on the way (a
   /// regular solution is the end of one path only), so that some solution may be missing. 0 when all went well.
   int duplicate_paths = 0;
   /// Paths tracked a second time, with shorter steps, because the first attempt failed or ended at another path's
   /// regular endpoint (the counts above are those after the second attempt).
   int retracked_paths = 0;
-  double seconds = 0.0;            ///< wall time of the tracking
+  double seconds = 0.0;  ///< wall time of the tracking
   /// The distinct endpoints: real first, then complex, singular, at infinity, failed; within a kind in a fixed
   /// order (lexicographic in the real, then imaginary parts).
   std::vector<Endpoint> endpoints;
@@ -142,9 +142,9 @@ struct ModelPolynomials {
   PolynomialSystem system;
   /// For each coordinate of the model: −1 when eliminated (fixed), else its variable (the c of an angle, s is next).
   std::vector<int> variable_of;
-  std::vector<double> fixed;     ///< the value of every eliminated coordinate (NaN for the others)
-  Eigen::VectorXd origin;        ///< q0, the placement the scaled variables are measured from
-  Eigen::VectorXd scale;         ///< the scale of each coordinate's variable (1 for angles)
+  std::vector<double> fixed;           ///< the value of every eliminated coordinate (NaN for the others)
+  Eigen::VectorXd origin;              ///< q0, the placement the scaled variables are measured from
+  Eigen::VectorXd scale;               ///< the scale of each coordinate's variable (1 for angles)
   std::vector<Index> eliminated_rows;  ///< the rows of Φ that fixed a coordinate, ascending
   /// q of a real solution x of `system`: angles as atan2(s, c) on the 2π branch nearest the placement.
   Eigen::VectorXd coordinates(const Eigen::VectorXcd& x) const;
@@ -167,7 +167,7 @@ struct AssemblyMode {
 
 /// Every real assembly mode of a model at one time.
 struct AssemblyModes {
-  ModesSummary summary;  ///< the homotopy's (status, message, counts, endpoints in the system's variables)
+  ModesSummary summary;             ///< the homotopy's (status, message, counts, endpoints in the system's variables)
   ModelPolynomials polynomials;     ///< the system solved
   std::vector<AssemblyMode> modes;  ///< the real solutions, regular and singular, in the summary's order
 };

@@ -27,8 +27,8 @@ class Random {
     return z ^ (z >> 31);
   }
   double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
-  double symmetric() { return 2.0 * uniform() - 1.0; }                         // [-1, 1)
-  cd unit_complex();                                                           // on the unit circle
+  double symmetric() { return 2.0 * uniform() - 1.0; }                        // [-1, 1)
+  cd unit_complex();                                                          // on the unit circle
  private:
   std::uint64_t state_;
 };
@@ -38,8 +38,8 @@ class Random {
 struct CompiledSystem {
   struct Term {
     cd coefficient;
-    int homogenising = 0;                       // power of X0 in the homogenised equation
-    std::vector<std::pair<int, int>> factors;   // (variable v, power ≥ 1)
+    int homogenising = 0;                      // power of X0 in the homogenised equation
+    std::vector<std::pair<int, int>> factors;  // (variable v, power ≥ 1)
   };
   int variables = 0;
   std::vector<std::vector<Term>> equations;
@@ -67,8 +67,8 @@ struct Homotopy {
 
 // Where one path ended.
 struct PathEnd {
-  Eigen::VectorXcd X;  // the last point (homogeneous, on the patch)
-  double t = 1.0;      // the t it reached (0 at a clean end)
+  Eigen::VectorXcd X;    // the last point (homogeneous, on the patch)
+  double t = 1.0;        // the t it reached (0 at a clean end)
   bool reached = false;  // tracked to t = 0, or to the end game's small t with a collapsing step
   int steps = 0;
 };

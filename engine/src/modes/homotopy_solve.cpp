@@ -79,8 +79,9 @@ double refine(const CompiledSystem& f, Eigen::VectorXcd& x, double* condition) {
   for (Eigen::Index i = 0; i < jac.rows(); ++i) jac.row(i) *= size / f.coefficient_scale[static_cast<std::size_t>(i)];
   const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(jac);
   const Eigen::VectorXd& sv = svd.singularValues();
-  *condition = sv.size() == 0 ? 1.0 : sv(sv.size() - 1) > 0.0 ? sv(0) / sv(sv.size() - 1)
-                                                                : std::numeric_limits<double>::infinity();
+  *condition = sv.size() == 0            ? 1.0
+               : sv(sv.size() - 1) > 0.0 ? sv(0) / sv(sv.size() - 1)
+                                         : std::numeric_limits<double>::infinity();
   return r;
 }
 
@@ -109,8 +110,7 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
   }
   Random random(options.seed);
   const CompiledSystem original(system);  // checks the exponents
-  const PolynomialSystem square =
-      static_cast<int>(system.equations.size()) > n ? squared_up(system, random) : system;
+  const PolynomialSystem square = static_cast<int>(system.equations.size()) > n ? squared_up(system, random) : system;
   summary.paths = square.total_degree();
   if (summary.paths > options.max_paths) {
     summary.status = ModesStatus::kTooManyPaths;
@@ -171,8 +171,8 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
         point.kind = EndpointKind::kSingular;
       } else {
         const double imag = point.x.imag().cwiseAbs().maxCoeff();
-        point.kind = imag <= options.real_tolerance * (1.0 + inf_norm(point.x)) ? EndpointKind::kReal
-                                                                                 : EndpointKind::kComplex;
+        point.kind =
+            imag <= options.real_tolerance * (1.0 + inf_norm(point.x)) ? EndpointKind::kReal : EndpointKind::kComplex;
       }
       if (point.kind == EndpointKind::kReal)
         for (Eigen::Index v = 0; v < n; ++v) point.x(v) = point.x(v).real();

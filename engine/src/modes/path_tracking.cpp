@@ -97,7 +97,8 @@ PathEnd track_path(const Homotopy& h, std::int64_t p, bool careful) {
       const double norm = inf_norm(delta);
       // a first correction this large means the prediction left the path's neighbourhood (it could land on
       // another path); a correction that does not contract means Newton is not converging
-      if (!std::isfinite(norm) || (it == 0 && norm > kFirstCorrection * size) || (it > 0 && norm > 0.5 * previous)) break;
+      if (!std::isfinite(norm) || (it == 0 && norm > kFirstCorrection * size) || (it > 0 && norm > 0.5 * previous))
+        break;
       Y -= delta;
       previous = norm;
       if (norm <= kCorrectorTolerance * size) {

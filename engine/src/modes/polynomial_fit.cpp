@@ -54,8 +54,66 @@ struct RowEvaluator {
   }
 };
 
-constexpr int kMaxMonomials = 1500;   // a row of more terms than this is refused (fitting it would take minutes)
+constexpr int kMaxMonomials = 1500;     // a row of more terms than this is refused (fitting it would take minutes)
 constexpr double kFitTolerance = 1e-9;  // relative to the row's largest sampled value
+
+// Rows that read one free coordinate and are affine in it fix that coordinate (drivers, then what driven
+// coordinates leave with one unknown), until none does: out.fixed, out.eliminated_rows, `base` (the origin with the
+// fixed values) and `eliminated` (per row) are updated.
+void eliminate_fixed_coordinates(RowEvaluator& eval, const std::vector<std::vector<Index>>& row_columns,
+                                 ModelPolynomials& out, Eigen::VectorXd& base, std::vector<bool>& eliminated) {
+  auto is_fixed = [&](Index j) { return !std::isnan(out.fixed[static_cast<std::size_t>(j)]); };
+  const Index m = static_cast<Index>(row_columns.size());
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (Index r = 0; r < m; ++r) {
+      if (eliminated[static_cast<std::size_t>(r)]) continue;
+      Index only = -1;
+      int free = 0;
+      for (Index j : row_columns[static_cast<std::size_t>(r)])
+        if (!is_fixed(j)) only = j, ++free;
+      if (free != 1) continue;
+      const double h = out.scale(only);
+      Eigen::VectorXd q = base;
+      auto at = [&](double u) {
+        q(only) = out.origin(only) + h * u;
+        return eval.row(q, r);
+      };
+      const double f0 = at(0.0), f1 = at(1.0), slope = f1 - f0;  // per unit of the scaled variable
+      const double size = std::abs(f0) + std::abs(slope);
+      bool affine = std::abs(slope) > 1e-12 * size && std::isfinite(size);
+      for (double u : {-0.71, 0.37, -1.9}) affine = affine && std::abs(at(u) - (f0 + slope * u)) <= 1e-11 * size;
+      if (!affine) continue;
+      const double value = out.origin(only) - h * f0 / slope;
+      // refine on the row itself (an affine row: one step lands on it to rounding)
+      q(only) = value;
+      const double f = eval.row(q, r);
+      out.fixed[static_cast<std::size_t>(only)] = value - h * f / slope;
+      base(only) = out.fixed[static_cast<std::size_t>(only)];
+      eliminated[static_cast<std::size_t>(r)] = true;
+      out.eliminated_rows.push_back(r);
+      changed = true;
+    }
+  }
+}
+
+// c² + s² − 1 = 0 for every free angle coordinate (angle[j]) of `out`'s system.
+void add_circle_equations(const std::vector<bool>& angle, ModelPolynomials& out) {
+  PolynomialSystem& system = out.system;
+  const int nv = system.variables;
+  for (std::size_t j = 0; j < angle.size(); ++j) {
+    const int v = out.variable_of[j];
+    if (v < 0 || !angle[j]) continue;
+    Polynomial circle;
+    std::vector<int> e(static_cast<std::size_t>(nv), 0);
+    circle.terms.push_back({-1.0, e});
+    e[static_cast<std::size_t>(v)] = 2;
+    circle.terms.push_back({1.0, e});
+    e[static_cast<std::size_t>(v)] = 0, e[static_cast<std::size_t>(v + 1)] = 2;
+    circle.terms.push_back({1.0, e});
+    system.equations.push_back(std::move(circle));
+  }
+}
 
 }  // namespace
 
@@ -91,49 +149,19 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
   const CscPattern& pattern = model.jacobian_pattern();
   std::vector<std::vector<Index>> row_columns(static_cast<std::size_t>(m));
   for (Index j = 0; j < n; ++j)
-    for (Index k = pattern.col_ptr[static_cast<std::size_t>(j)]; k < pattern.col_ptr[static_cast<std::size_t>(j) + 1]; ++k)
+    for (Index k = pattern.col_ptr[static_cast<std::size_t>(j)]; k < pattern.col_ptr[static_cast<std::size_t>(j) + 1];
+         ++k)
       row_columns[static_cast<std::size_t>(pattern.row_idx[static_cast<std::size_t>(k)])].push_back(j);
   auto constraint_name = [&](Index r) {
     return model.constraints()[static_cast<std::size_t>(model.constraint_of_row(r))].name;
   };
 
-  // 1. Rows that read one free coordinate and are affine in it fix that coordinate (drivers, then what driven
-  //    coordinates leave with one unknown), until none does.
+  // 1. Rows that read one free coordinate and are affine in it fix that coordinate.
   out.fixed.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
   Eigen::VectorXd base = out.origin;
   std::vector<bool> eliminated(static_cast<std::size_t>(m), false);
   auto is_fixed = [&](Index j) { return !std::isnan(out.fixed[static_cast<std::size_t>(j)]); };
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (Index r = 0; r < m; ++r) {
-      if (eliminated[static_cast<std::size_t>(r)]) continue;
-      Index only = -1;
-      int free = 0;
-      for (Index j : row_columns[static_cast<std::size_t>(r)])
-        if (!is_fixed(j)) only = j, ++free;
-      if (free != 1) continue;
-      const double h = out.scale(only);
-      Eigen::VectorXd q = base;
-      auto at = [&](double u) {
-        q(only) = out.origin(only) + h * u;
-        return eval.row(q, r);
-      };
-      const double f0 = at(0.0), f1 = at(1.0), slope = f1 - f0;  // per unit of the scaled variable
-      const double size = std::abs(f0) + std::abs(slope);
-      bool affine = std::abs(slope) > 1e-12 * size && std::isfinite(size);
-      for (double u : {-0.71, 0.37, -1.9}) affine = affine && std::abs(at(u) - (f0 + slope * u)) <= 1e-11 * size;
-      if (!affine) continue;
-      const double value = out.origin(only) - h * f0 / slope;
-      // refine on the row itself (an affine row: one step lands on it to rounding)
-      q(only) = value;
-      const double f = eval.row(q, r);
-      out.fixed[static_cast<std::size_t>(only)] = value - h * f / slope;
-      base(only) = out.fixed[static_cast<std::size_t>(only)];
-      eliminated[static_cast<std::size_t>(r)] = true;
-      out.eliminated_rows.push_back(r);
-      changed = true;
-    }
-  }
+  eliminate_fixed_coordinates(eval, row_columns, out, base, eliminated);
   std::sort(out.eliminated_rows.begin(), out.eliminated_rows.end());
 
   // 2. The variables: one per free coordinate, two (c, s) per free angle.
@@ -221,7 +249,8 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
         PolynomialTerm term{coefficients(k), std::vector<int>(static_cast<std::size_t>(nv), 0)};
         int w = 0;
         for (const RowCoordinate& c : reads) {
-          term.exponent[static_cast<std::size_t>(c.variable)] = basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w++)];
+          term.exponent[static_cast<std::size_t>(c.variable)] =
+              basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w++)];
           if (c.angle)
             term.exponent[static_cast<std::size_t>(c.variable + 1)] =
                 basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w++)];
@@ -232,26 +261,16 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
     }
     if (!fitted) {
       out.status = ModesStatus::kNotPolynomial;
-      out.message = "constraint '" + constraint_name(r) + "' is not polynomial in its coordinates (no polynomial of "
-                    "degree <= " + std::to_string(options.max_fit_degree) +
+      out.message = "constraint '" + constraint_name(r) +
+                    "' is not polynomial in its coordinates (no polynomial of "
+                    "degree <= " +
+                    std::to_string(options.max_fit_degree) +
                     " in them, angles as cos and sin, reproduces it): phiq modes cannot count its assemblies";
       out.system = PolynomialSystem{};
       return out;
     }
   }
-  // 4. c² + s² = 1 for every free angle.
-  for (Index j = 0; j < n; ++j) {
-    const int v = out.variable_of[static_cast<std::size_t>(j)];
-    if (v < 0 || !angle[static_cast<std::size_t>(j)]) continue;
-    Polynomial circle;
-    std::vector<int> e(static_cast<std::size_t>(nv), 0);
-    circle.terms.push_back({-1.0, e});
-    e[static_cast<std::size_t>(v)] = 2;
-    circle.terms.push_back({1.0, e});
-    e[static_cast<std::size_t>(v)] = 0, e[static_cast<std::size_t>(v + 1)] = 2;
-    circle.terms.push_back({1.0, e});
-    system.equations.push_back(std::move(circle));
-  }
+  add_circle_equations(angle, out);  // 4. c² + s² = 1 for every free angle
   return out;
 }
 

@@ -47,11 +47,16 @@ std::int64_t PolynomialSystem::total_degree() const {
 
 const char* endpoint_kind_name(EndpointKind kind) {
   switch (kind) {
-    case EndpointKind::kReal: return "real";
-    case EndpointKind::kComplex: return "complex";
-    case EndpointKind::kSingular: return "singular";
-    case EndpointKind::kAtInfinity: return "at infinity";
-    case EndpointKind::kFailed: return "failed";
+    case EndpointKind::kReal:
+      return "real";
+    case EndpointKind::kComplex:
+      return "complex";
+    case EndpointKind::kSingular:
+      return "singular";
+    case EndpointKind::kAtInfinity:
+      return "at infinity";
+    case EndpointKind::kFailed:
+      return "failed";
   }
   return "failed";
 }
@@ -126,13 +131,14 @@ void power_table(const Eigen::VectorXcd& X, int max, std::vector<cd>& powers) {
   powers.assign(static_cast<std::size_t>(count * (max + 1)), cd(1.0));
   for (int v = 0; v < count; ++v)
     for (int k = 1; k <= max; ++k)
-      powers[static_cast<std::size_t>(v * (max + 1) + k)] = powers[static_cast<std::size_t>(v * (max + 1) + k - 1)] * X(v);
+      powers[static_cast<std::size_t>(v * (max + 1) + k)] =
+          powers[static_cast<std::size_t>(v * (max + 1) + k - 1)] * X(v);
 }
 }  // namespace
 
 // shared by affine() and homogenised(): `offset` is 1 when X carries X0 first (homogenised), else 0
-static void evaluate_compiled(const CompiledSystem& s, const Eigen::VectorXcd& X, bool homogeneous,
-                              Eigen::VectorXcd& f, Eigen::MatrixXcd* jac) {
+static void evaluate_compiled(const CompiledSystem& s, const Eigen::VectorXcd& X, bool homogeneous, Eigen::VectorXcd& f,
+                              Eigen::MatrixXcd* jac) {
   const int offset = homogeneous ? 1 : 0, stride = s.max_power + 1;
   thread_local std::vector<cd> powers;
   power_table(X, s.max_power, powers);
