@@ -38,6 +38,7 @@ test_packages=(
   nodejs               # the Khronos glTF-Validator on `phiq animate`'s .glb files (ctest gltf_validator), and
                        # Chromium driven over its DevTools pipe (ctest browser_viewer)
   chromium             # headless browser of ctest browser_viewer (the HTML viewer's pages)
+  phcpack              # PHCpack's `phc -b`: phiq modes checked against it (tests/test_modes_phc.cpp, bench/bench_modes.cpp)
 )
 test=0
 if [ "${1:-}" = "--test" ]; then test=1; packages+=("${test_packages[@]}"); fi

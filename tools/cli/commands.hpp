@@ -28,5 +28,6 @@ Command register_compare(CLI::App& app);
 Command register_sweep_accuracy(CLI::App& app);
 Command register_tolerance(CLI::App& app);
 Command register_clearance(CLI::App& app);
+Command register_modes(CLI::App& app);
 
 }  // namespace phiq::tools

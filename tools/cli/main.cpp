@@ -49,7 +49,8 @@ int run_command(int argc, char** argv) {
   const std::vector<Command> commands{
       register_run(app),      register_generate(app),       register_convert(app),   register_batch(app),
       register_assemble(app), register_check(app),          register_plot(app),      register_animate(app),
-      register_compare(app),  register_sweep_accuracy(app), register_tolerance(app), register_clearance(app)};
+      register_compare(app),  register_sweep_accuracy(app), register_tolerance(app), register_clearance(app),
+      register_modes(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

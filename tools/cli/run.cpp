@@ -97,10 +97,28 @@ class ResultRows : public phiq::RowWriter {
   std::string pending_;
 };
 
+// `--mode K`: `start` moved to real assembly mode K of the scene at its first time (phiq/modes.hpp), as `phiq modes`
+// numbers them; nothing for K = 0 (the rough placement). Else why not (": --mode …; no output written"): bad input.
+std::optional<std::string> mode_start(const phiq::Scene& scene, int mode, int threads, Eigen::VectorXd* start) {
+  if (mode <= 0) return std::nullopt;
+  phiq::ModesOptions o;
+  o.time = scene.sweep.t_begin;
+  o.threads = threads;
+  const phiq::AssemblyModes modes = phiq::find_assembly_modes(*scene.model, o);
+  if (modes.summary.status != phiq::ModesStatus::kSuccess)
+    return ": --mode: " + modes.summary.message + "; no output written";
+  if (static_cast<std::size_t>(mode) > modes.modes.size())
+    return ": --mode " + std::to_string(mode) + ": the scene has " + std::to_string(modes.modes.size()) +
+           " real assembly modes at t = " + phiq::shortest(scene.sweep.t_begin) +
+           " (phiq modes lists them); no output written";
+  *start = modes.modes[static_cast<std::size_t>(mode - 1)].q;
+  return std::nullopt;
+}
+
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode,
             bool identifier_names, const std::vector<std::string>& sets,
-            const std::vector<std::string>& sensitivity_args) {
+            const std::vector<std::string>& sensitivity_args, int mode) {
   const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
@@ -158,12 +176,12 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   if (const auto why = make_square(scene, &square)) {
     phiq::SweepSummary at_start;  // the first position, before any sweep
     at_start.status = square.assembly.status;
-    at_start.message = *why;
     at_start.failed_step = 0;
     at_start.failed_time = scene.sweep.t_begin;
     at_start.worst_rows = square.assembly.worst_rows;
     return failed(*scene.model, at_start, {load_s, 0.0, 0.0}, *why);
   }
+  if (const auto bad = mode_start(scene, mode, threads, &square.start)) return fail(scene_path + *bad, 2);
   const phiq::AssemblySummary& redundancy = square.assembly;
   const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;
@@ -292,6 +310,7 @@ Command register_run(CLI::App& app) {
     std::string names = "dotted";
     std::vector<std::string> sets;
     std::vector<std::string> sensitivities;
+    int mode = 0;
   };
   auto a = std::make_shared<Args>();
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
@@ -332,13 +351,17 @@ Command register_run(CLI::App& app) {
       ->check(one_of({"dotted", "identifiers"}));
   add_set_option(run, &a->sets);
   add_sensitivity_option(run, &a->sensitivities);
+  run->add_option("--mode", a->mode,
+                  "Start from real assembly mode K as `phiq modes` numbers them (0: the rough placement)")
+      ->capture_default_str()
+      ->check(whole_number(0, 1000000, "the rough placement"));
   return {
       run, [a] {
         using Mode = ProgressBar::Mode;
         const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
         return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet, a->summary_path,
                                            cap_threads("run", a->threads, a->quiet), a->memory_gb, mode,
-                                           a->names == "identifiers", a->sets, a->sensitivities));
+                                           a->names == "identifiers", a->sets, a->sensitivities, a->mode));
       }};
 }
 

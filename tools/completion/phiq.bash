@@ -11,7 +11,7 @@ _phiq() {
     words=("${COMP_WORDS[@]}")
     cword=$COMP_CWORD
   }
-  local commands="run check assemble batch compare generate convert plot animate sweep-accuracy tolerance clearance"
+  local commands="run check assemble batch compare generate convert plot animate sweep-accuracy tolerance clearance modes"
   local cmd="" i
   for ((i = 1; i < cword; i++)); do
     case " $commands " in *" ${words[i]} "*) cmd="${words[i]}"; break ;; esac
@@ -24,7 +24,7 @@ _phiq() {
   local opts=""
   case "$cmd" in
     run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names --set
-               --sensitivity" ;;
+               --sensitivity --mode" ;;
     check) opts="--help --json --time --set" ;;
     assemble) opts="--help --output --quiet --set" ;;
     batch) opts="--help --output --quiet --threads --summary --names --resume --sensitivity" ;;
@@ -38,6 +38,7 @@ _phiq() {
     tolerance) opts="--help --output --sd --limit --covariance --samples --seed --columns --threshold --summary --plot
                      --plot-column --threads --names --quiet --set" ;;
     clearance) opts="--help --output --fail-on-interference --quiet --set" ;;
+    modes) opts="--help --at --output --threads --max-paths --quiet --set" ;;
   esac
 
   # values of the options that take a fixed set of words, or files
@@ -55,7 +56,7 @@ _phiq() {
     --summary|--junit|-o|--output|--covariance|--plot) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     --threads|--memory|--steps|--from|--to|--twist|--time|--rtol|--atol|--columns|--positions|--tolerances|\
     --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column|--set|\
-    --sensitivity) return ;;  # a value of the user's
+    --sensitivity|--at|--max-paths|--mode) return ;;  # a value of the user's
   esac
   if [[ "$cur" == -* ]]; then
     COMPREPLY=($(compgen -W "$opts" -- "$cur"))

@@ -16,6 +16,7 @@
 #include "phiq/linear_solver.hpp"
 #include "phiq/mechanism_sketch.hpp"
 #include "phiq/model.hpp"
+#include "phiq/modes.hpp"
 #include "phiq/min_norm_solver.hpp"
 #include "phiq/motion_law.hpp"
 #include "phiq/output_plan.hpp"

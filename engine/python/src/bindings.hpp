@@ -24,6 +24,7 @@ void bind_sweep_result(py::module_& m);
 void bind_batch_result(py::module_& m);
 void bind_stepper(py::module_& m);
 void bind_parts(py::module_& m);
+void bind_modes(py::module_& m);
 
 /// A vector the caller passed as `what`, checked to have the model's n entries: phiq::Error (ValueError in Python)
 /// otherwise, with the sizes in the message, as the C++ pre-condition checks word it.

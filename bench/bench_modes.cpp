@@ -1,0 +1,125 @@
+// Every assembly mode (phiq/modes.hpp): the paths per second and total time of the homotopy on the four-bar, the
+// 3-RPR parallel robot and the general Stewart–Gough platform (40 poses, each twice in Euler parameters ±e), on the
+// threads TBB gives (--threads: PHIQ_MODES_THREADS), against PHCpack's `phc -b` on the same polynomial systems in
+// the same run (the subprocess timed as a whole: its start, root count, tracking and output). bench/README.md.
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+#include "phiq/phiq.hpp"
+
+namespace {
+
+std::string bench_modes_model(const std::string& rel) {
+  std::string path = PHIQ_MODELS_DIR;
+  path += '/';
+  path += rel;
+  return path;
+}
+
+const char* kRpr3 =
+    "phiq: 1\nname: rpr3\n"
+    "parameters: {a2: 15.91, a3x: 0, a3y: 10, b2: 17.04, b3x: 8.0, b3y: 9.0, r1: 14.98, r2: 15.38, r3: 12}\n"
+    "coordinates: {x: 5, y: 5, psi: 0.3, x1: 5, y1: 5, x2: 20, y2: 8, x3: 12, y3: 14}\n"
+    "points: {A1: [0, 0], A2: [a2, 0], A3: [a3x, a3y], P1: [x1, y1], P2: [x2, y2], P3: [x3, y3]}\n"
+    "bodies: {platform: [x, y, psi]}\n"
+    "constraints:\n"
+    "  - {name: B1, type: revolute, between: [{body: platform, at: [0, 0]}, {point: P1}]}\n"
+    "  - {name: B2, type: revolute, between: [{body: platform, at: [b2, 0]}, {point: P2}]}\n"
+    "  - {name: B3, type: revolute, between: [{body: platform, at: [b3x, b3y]}, {point: P3}]}\n"
+    "  - {name: leg1, type: distance, points: [A1, P1], length: r1}\n"
+    "  - {name: leg2, type: distance, points: [A2, P2], length: r2}\n"
+    "  - {name: leg3, type: distance, points: [A3, P3], length: r3}\n"
+    "time: {start: 0, end: 1, steps: 1}\n";
+
+// A general Stewart–Gough platform: base points b_i and platform points p_i in general position (no two legs
+// meeting, neither hexagon planar), legs of fixed lengths L_i.
+const char* kStewart =
+    "phiq: 1\nname: stewart_gough\ndimension: 3\n"
+    "coordinates: {x: 0.1, y: 0.05, z: 1.0, e0: 1, e1: 0.05, e2: 0.02, e3: 0.1}\n"
+    "bodies: {platform: [x, y, z, e0, e1, e2, e3]}\n"
+    "constraints:\n"
+    "  - {name: leg1, type: distance, between: [{body: ground, at: [1.0, 0.1, 0.05]}, {body: platform, at: [0.5, 0.3, "
+    "0.02]}], length: 1.3}\n"
+    "  - {name: leg2, type: distance, between: [{body: ground, at: [0.3, 0.9, -0.1]}, {body: platform, at: [-0.2, 0.6, "
+    "0.1]}], length: 1.1}\n"
+    "  - {name: leg3, type: distance, between: [{body: ground, at: [-0.7, 0.6, 0.08]}, {body: platform, at: [-0.5, "
+    "0.1, -0.05]}], length: 1.25}\n"
+    "  - {name: leg4, type: distance, between: [{body: ground, at: [-0.8, -0.4, 0.02]}, {body: platform, at: [-0.3, "
+    "-0.5, 0.07]}], length: 1.2}\n"
+    "  - {name: leg5, type: distance, between: [{body: ground, at: [0.1, -1.0, -0.06]}, {body: platform, at: [0.2, "
+    "-0.6, -0.03]}], length: 1.05}\n"
+    "  - {name: leg6, type: distance, between: [{body: ground, at: [0.9, -0.5, 0.12]}, {body: platform, at: [0.6, "
+    "-0.2, 0.04]}], length: 1.15}\n"
+    "time: {start: 0, end: 1, steps: 1}\n";
+
+phiq::Scene bench_modes_scene(const std::string& which) {
+  if (which == "fourbar") return phiq::load_scene(bench_modes_model("seed/fourbar_mixed.yaml"));
+  return phiq::parse_scene(which == "rpr3" ? kRpr3 : kStewart, which + ".yaml");
+}
+
+void BM_ModesPhiq(benchmark::State& state, const std::string& which) {
+  const phiq::Scene scene = bench_modes_scene(which);
+  phiq::ModesOptions o;
+  o.time = scene.sweep.t_begin;
+  if (const char* t = std::getenv("PHIQ_MODES_THREADS")) o.threads = std::atoi(t);
+  phiq::AssemblyModes r;
+  for (auto _ : state) {
+    r = phiq::find_assembly_modes(*scene.model, o);
+    benchmark::DoNotOptimize(r.summary.endpoints.data());
+  }
+  if (r.summary.status != phiq::ModesStatus::kSuccess) state.SkipWithError(r.summary.message.c_str());
+  state.counters["paths"] = static_cast<double>(r.summary.paths);
+  state.counters["paths/s"] =
+      benchmark::Counter(static_cast<double>(r.summary.paths) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["real"] = r.summary.real;
+  state.counters["complex"] = r.summary.complex;
+  state.counters["singular"] = r.summary.singular;
+  state.counters["failed"] = r.summary.failed_paths;
+}
+
+void BM_ModesPhc(benchmark::State& state, const std::string& which) {
+  if (std::system("command -v phc > /dev/null 2>&1") != 0) {
+    state.SkipWithError("phc (Debian package phcpack) is not installed");
+    for (auto _ : state) {
+    }
+    return;
+  }
+  const phiq::Scene scene = bench_modes_scene(which);
+  phiq::ModesOptions o;
+  o.time = scene.sweep.t_begin;
+  const phiq::ModelPolynomials p = phiq::find_polynomial_system(*scene.model, o);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("phiq_bench_phc_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "in.phc") << phiq::phc_input_text(p.system);
+  const std::string command = "cd '" + dir.string() + "' && phc -b in.phc out.phc < /dev/null > /dev/null 2>&1";
+  for (auto _ : state) {
+    std::filesystem::remove(dir / "out.phc");
+    if (std::system(command.c_str()) != 0) state.SkipWithError("phc -b failed");
+  }
+  std::filesystem::remove_all(dir);
+}
+
+BENCHMARK_CAPTURE(BM_ModesPhiq, fourbar, std::string("fourbar"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ModesPhc, fourbar, std::string("fourbar"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ModesPhiq, rpr3, std::string("rpr3"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ModesPhc, rpr3, std::string("rpr3"))->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_ModesPhiq, stewart, std::string("stewart"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK_CAPTURE(BM_ModesPhc, stewart, std::string("stewart"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,183 @@
+/// @file
+/// Every assembly mode of a mechanism: all the solutions of its constraint equations Φ(q, T) = 0 at one time T, by
+/// polynomial homotopy continuation. Newton from a rough placement finds one assembly; this finds all of them and
+/// says which one the placement assembles into.
+///
+/// The method. Each row of Φ is recovered as a polynomial in the coordinates it reads (find_polynomial_system():
+/// the coefficients of every monomial up to degree 4 fitted by least squares to evaluations of the row, and checked
+/// on fresh points), angle coordinates entering through (c, s) = (cos θ, sin θ) with c² + s² = 1; a row no
+/// polynomial reproduces (a cam, a spline, exp) is refused with its constraint named. Rows that fix one coordinate
+/// (drivers, a polar's arm at a driven angle) are eliminated first. The square polynomial system is then solved by
+/// solve_polynomial_system(): the total-degree start system x_i^{d_i} = 1 and the homotopy
+/// H(x, t) = (1 − t) F(x) + γ t G(x) with a random complex γ (the "γ trick": no path meets a singularity for t > 0),
+/// tracked in projective coordinates on a random affine patch (paths that diverge in affine space end at points
+/// with x₀ → 0, at infinity, instead of running away) by an adaptive RK4 predictor and Newton corrector. Every
+/// endpoint is refined by Newton on the original equations and classified: real, complex, singular (condition
+/// number above ModesOptions::singular_condition) or at infinity. Paths run in parallel
+/// (TBB); each path's arithmetic is independent of the others and the endpoints are merged in path order and
+/// sorted, so the result is the same, to the bit, on any number of threads.
+#pragma once
+
+#include <complex>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "phiq/model.hpp"
+
+namespace phiq {
+
+/// One term of a polynomial: coefficient · Π_v x_v^{exponent[v]}.
+struct PolynomialTerm {
+  std::complex<double> coefficient;  ///< its coefficient
+  std::vector<int> exponent;         ///< one power per variable of the system (all ≥ 0)
+};
+
+/// A polynomial in the variables of its system: a sum of terms (no two with the same exponents).
+struct Polynomial {
+  std::vector<PolynomialTerm> terms;  ///< the terms, in any order
+  /// The total degree: the largest sum of exponents over the terms (0 for a constant or empty polynomial).
+  int degree() const;
+};
+
+/// A system of polynomial equations F(x) = 0 in `variables` complex unknowns.
+struct PolynomialSystem {
+  int variables = 0;                  ///< number of unknowns
+  std::vector<std::string> names;     ///< their names (for messages and phc_input_text()); may be empty
+  std::vector<Polynomial> equations;  ///< the equations; square systems have as many as unknowns
+  /// Evaluates every equation at x (variables entries) into f (equations.size() entries).
+  void evaluate(const std::complex<double>* x, std::complex<double>* f) const;
+  /// The Bézout number Π deg F_i: the paths of the total-degree homotopy of a square system (saturated at 2⁶²).
+  std::int64_t total_degree() const;
+};
+
+/// Settings of solve_polynomial_system() and find_assembly_modes().
+struct ModesOptions {
+  double time = 0.0;  ///< T, the time at which the drivers are evaluated (find_assembly_modes())
+  /// Refuse (ModesStatus::kTooManyPaths) rather than track more paths than this.
+  std::int64_t max_paths = 100000;
+  int threads = 0;                ///< worker threads for the paths; 0: TBB's default
+  std::uint64_t seed = 20261202;  ///< seed of γ, the affine patch and the fitting points: a run is reproducible
+  /// An endpoint whose Jacobian's condition number (2-norm, the variables scaled) is above this is singular.
+  /// (Several paths at one regular point are counted in ModesSummary::duplicate_paths, not made singular.)
+  double singular_condition = 1e9;
+  /// An endpoint is real when every |Im x_v| ≤ this · (1 + |x|∞).
+  double real_tolerance = 1e-8;
+  /// Endpoints closer than this · (1 + |x|∞) are one solution, reached by several paths (Endpoint::multiplicity).
+  double duplicate_tolerance = 1e-6;
+  int max_fit_degree = 4;  ///< the highest degree a row is fitted with (find_polynomial_system())
+};
+
+/// How a call of solve_polynomial_system() or find_assembly_modes() ended.
+enum class ModesStatus {
+  kSuccess,        ///< every path tracked (some may have failed: ModesSummary::failed_paths)
+  kNotPolynomial,  ///< a constraint is not polynomial in its coordinates (the message names it)
+  kTooManyPaths,   ///< the total degree is above ModesOptions::max_paths (the message says it)
+  kNotSquare,      ///< fewer equations than unknowns: the assemblies form a continuum (the message says it)
+};
+
+/// What kind of point a path ended at.
+enum class EndpointKind {
+  kReal,        ///< a regular real solution
+  kComplex,     ///< a regular solution with an imaginary part
+  kSingular,    ///< a solution whose Jacobian is singular (condition above ModesOptions::singular_condition)
+  kAtInfinity,  ///< the path diverged: the homogenising coordinate went to 0
+  kFailed,      ///< the path could not be tracked to its end (step below the minimum away from t = 0)
+};
+
+/// "real", "complex", "singular", "at infinity", "failed".
+const char* endpoint_kind_name(EndpointKind kind);
+
+/// One distinct endpoint of the homotopy (duplicates merged).
+struct Endpoint {
+  EndpointKind kind = EndpointKind::kFailed;  ///< its class
+  Eigen::VectorXcd x;      ///< the solution in the system's variables (for kAtInfinity: the direction, unit norm)
+  double residual = 0.0;   ///< max_i |F_i(x)| / (largest |coefficient| of F_i), after Newton's refinement
+  double condition = 0.0;  ///< condition number of the Jacobian at x (variables scaled by 1 + |x|∞)
+  int multiplicity = 1;    ///< how many paths ended here
+};
+
+/// What solve_polynomial_system() did.
+struct ModesSummary {
+  ModesStatus status = ModesStatus::kSuccess;  ///< see ModesStatus
+  std::string message;                         ///< one line when status is not kSuccess
+  std::int64_t paths = 0;                      ///< paths tracked (the total degree)
+  int real = 0;                                ///< distinct real regular endpoints
+  int complex = 0;                             ///< distinct complex regular endpoints
+  int singular = 0;                            ///< distinct singular endpoints
+  int at_infinity = 0;                         ///< distinct endpoints at infinity
+  int failed_paths = 0;                        ///< paths that could not be tracked to t = 0
+  /// Paths that ended at a regular endpoint another path had reached: a path jumped onto another's on the way (a
+  /// regular solution is the end of one path only), so that some solution may be missing. 0 when all went well.
+  int duplicate_paths = 0;
+  /// Paths tracked a second time, with shorter steps, because the first attempt failed or ended at another path's
+  /// regular endpoint (the counts above are those after the second attempt).
+  int retracked_paths = 0;
+  double seconds = 0.0;  ///< wall time of the tracking
+  /// The distinct endpoints: real first, then complex, singular, at infinity, failed; within a kind in a fixed
+  /// order (lexicographic in the real, then imaginary parts).
+  std::vector<Endpoint> endpoints;
+};
+
+/// Solves a square polynomial system (or an overdetermined one: its equations are first combined at random into as
+/// many as unknowns, and the endpoints are refined and checked on all of them; a non-solution of the original
+/// system is classified kFailed) by total-degree homotopy continuation (the file's comment). Refuses with
+/// kTooManyPaths (nothing tracked) when the total degree is above options.max_paths, with kNotSquare when there
+/// are fewer equations than unknowns. The result does not depend on options.threads. Throws phiq::Error for a
+/// system whose terms do not have `variables` exponents.
+ModesSummary solve_polynomial_system(const PolynomialSystem& system, const ModesOptions& options);
+
+/// The text of `system` in PHCpack's input format (`phc -b in out`): the number of equations and unknowns, then
+/// each equation ended by ';', coefficients in full precision, variable v as x(v + 1): x1, x2, …
+std::string phc_input_text(const PolynomialSystem& system);
+
+/// A model's equations at time T as polynomials (find_polynomial_system()).
+struct ModelPolynomials {
+  ModesStatus status = ModesStatus::kSuccess;  ///< kNotPolynomial (nothing else set) or kSuccess
+  std::string message;                         ///< names the constraint when kNotPolynomial
+  /// The system in scaled variables: a length or unitless coordinate j is q_j = q0_j + scale_j · x_v; an angle
+  /// coordinate is the pair (c, s) = (cos q_j, sin q_j), with its equation c² + s² − 1 = 0 among the equations.
+  PolynomialSystem system;
+  /// For each coordinate of the model: −1 when eliminated (fixed), else its variable (the c of an angle, s is next).
+  std::vector<int> variable_of;
+  std::vector<double> fixed;           ///< the value of every eliminated coordinate (NaN for the others)
+  Eigen::VectorXd origin;              ///< q0, the placement the scaled variables are measured from
+  Eigen::VectorXd scale;               ///< the scale of each coordinate's variable (1 for angles)
+  std::vector<Index> eliminated_rows;  ///< the rows of Φ that fixed a coordinate, ascending
+  /// q of a real solution x of `system`: angles as atan2(s, c) on the 2π branch nearest the placement.
+  Eigen::VectorXd coordinates(const Eigen::VectorXcd& x) const;
+};
+
+/// Recovers each row of Φ(·, options.time) as a polynomial (the file's comment): rows that read one coordinate and
+/// are affine in it fix it (eliminated, repeatedly, as fixed coordinates make more rows read one), and every other
+/// row is fitted, degree 1 to options.max_fit_degree, in its coordinates' scaled variables. kNotPolynomial names
+/// the first constraint no polynomial reproduces ("constraint 'cam': is not polynomial in its coordinates …").
+/// Thread-safe.
+ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& options);
+
+/// One real assembly mode of a model.
+struct AssemblyMode {
+  Eigen::VectorXd q;       ///< its coordinates (angles on the branch nearest the placement)
+  double residual = 0.0;   ///< max_i |Φ_i(q, T)| / row scale_i, Φ evaluated by the model itself
+  double condition = 0.0;  ///< of the polynomial system's Jacobian there (Endpoint::condition)
+  bool singular = false;   ///< a real singular solution (two modes meet: a singular position)
+};
+
+/// Every real assembly mode of a model at one time.
+struct AssemblyModes {
+  ModesSummary summary;             ///< the homotopy's (status, message, counts, endpoints in the system's variables)
+  ModelPolynomials polynomials;     ///< the system solved
+  std::vector<AssemblyMode> modes;  ///< the real solutions, regular and singular, in the summary's order
+};
+
+/// find_polynomial_system() then solve_polynomial_system(): every real assembly of `model` at options.time. The
+/// status and message are those of the first step that refused. Thread-safe.
+AssemblyModes find_assembly_modes(const Model& model, const ModesOptions& options);
+
+/// The distance between two positions of `model`: max_j |a_j − b_j| / scale_j, lengths scaled by the model's
+/// length_scale(), angles (radians) compared modulo 2π, other coordinates as they are.
+double mode_distance(const Model& model, const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+
+}  // namespace phiq

@@ -1,0 +1,54 @@
+// phiq.modes(scene, t): every real assembly mode of a scene (phiq/modes.hpp) as numpy arrays.
+#include "bindings.hpp"
+
+namespace phiq::python {
+
+namespace py = pybind11;
+
+void bind_modes(py::module_& m) {
+  m.def(
+      "modes",
+      [](const Scene& scene, std::optional<double> t, int threads, std::int64_t max_paths) {
+        ModesOptions o;
+        o.time = t ? *t : scene.sweep.t_begin;
+        o.threads = threads;
+        o.max_paths = max_paths;
+        AssemblyModes r;
+        {
+          py::gil_scoped_release free;
+          r = find_assembly_modes(*scene.model, o);
+        }
+        if (r.summary.status != ModesStatus::kSuccess) throw Error(r.summary.message);
+        const Index n = scene.model->num_coordinates();
+        const auto k = static_cast<Eigen::Index>(r.modes.size());
+        Eigen::MatrixXd q(k, n);
+        Eigen::VectorXd residual(k), condition(k);
+        std::vector<bool> singular;
+        for (Eigen::Index i = 0; i < k; ++i) {
+          const AssemblyMode& a = r.modes[static_cast<std::size_t>(i)];
+          q.row(i) = a.q.transpose();
+          residual(i) = a.residual, condition(i) = a.condition;
+          singular.push_back(a.singular);
+        }
+        py::dict d;
+        d["q"] = q;
+        d["coordinates"] = scene.model->coordinate_names();
+        d["residual"] = residual;
+        d["condition"] = condition;
+        d["singular"] = py::array_t<bool>(py::cast(singular));
+        d["time"] = o.time;
+        d["paths"] = r.summary.paths;
+        d["complex"] = r.summary.complex;
+        d["at_infinity"] = r.summary.at_infinity;
+        d["failed_paths"] = r.summary.failed_paths;
+        return d;
+      },
+      py::arg("scene"), py::arg("t") = py::none(), py::arg("threads") = 0, py::arg("max_paths") = 100000,
+      "Every real assembly mode of the scene at time t (default time.start), by polynomial homotopy continuation "
+      "(engine/include/phiq/modes.hpp): a dict with 'q' (modes x coordinates; a row is a placement a Workspace's q "
+      "takes), 'coordinates', 'residual', 'condition', 'singular', and the homotopy's 'paths', 'complex', "
+      "'at_infinity', 'failed_paths'. Raises ValueError naming the constraint when one is not polynomial, or when "
+      "the paths are more than max_paths.");
+}
+
+}  // namespace phiq::python

@@ -1,0 +1,277 @@
+// find_polynomial_system() (phiq/modes.hpp): the model's rows recovered as polynomials from their evaluations in
+// double. The constraint kinds evaluate only in double (residual(q, t, φ)); rather than a second, templated copy of
+// every kind, each row is fitted: it reads few coordinates (its Jacobian pattern), so the coefficients of every
+// monomial up to degree d in them are found by least squares on random points and the fit is accepted only when it
+// reproduces the row on fresh points to rounding. Angles enter through (c, s) = (cos θ, sin θ) on the unit circle,
+// in the normal form modulo c² + s² = 1 (s to the power 0 or 1), where the fit is unique.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <Eigen/QR>
+
+#include "modes/homotopy.hpp"
+
+namespace phiq {
+
+namespace {
+
+using modes_detail::Random;
+
+// One unknown of a row: coordinate j, as a scaled variable (angle false) or as the pair (c, s) (angle true).
+struct RowCoordinate {
+  Index coordinate;
+  bool angle;
+  int variable;  // its variable in the system (c for an angle; s is variable + 1)
+};
+
+// Every exponent vector over `width` local variables with total degree ≤ d, the s of each angle pair (flagged in
+// `second_of_pair`) at most 1.
+void monomials(int width, int d, const std::vector<bool>& second_of_pair, std::vector<std::vector<int>>& out,
+               std::vector<int>& current, int at, int left) {
+  if (at == width) {
+    out.push_back(current);
+    return;
+  }
+  const int top = second_of_pair[static_cast<std::size_t>(at)] ? std::min(1, left) : left;
+  for (int e = 0; e <= top; ++e) {
+    current[static_cast<std::size_t>(at)] = e;
+    monomials(width, d, second_of_pair, out, current, at + 1, left - e);
+  }
+  current[static_cast<std::size_t>(at)] = 0;
+}
+
+// The model's rows at q, one evaluation of the whole model per call (the models solved here are small).
+struct RowEvaluator {
+  const Model& model;
+  double t;
+  std::vector<double> phi;
+  double row(const Eigen::VectorXd& q, Index r) {
+    phi.resize(static_cast<std::size_t>(model.num_equations()));
+    model.residual(q.data(), t, phi.data());
+    return phi[static_cast<std::size_t>(r)];
+  }
+};
+
+constexpr int kMaxMonomials = 1500;     // a row of more terms than this is refused (fitting it would take minutes)
+constexpr double kFitTolerance = 1e-9;  // relative to the row's largest sampled value
+
+// Rows that read one free coordinate and are affine in it fix that coordinate (drivers, then what driven
+// coordinates leave with one unknown), until none does: out.fixed, out.eliminated_rows, `base` (the origin with the
+// fixed values) and `eliminated` (per row) are updated.
+void eliminate_fixed_coordinates(RowEvaluator& eval, const std::vector<std::vector<Index>>& row_columns,
+                                 ModelPolynomials& out, Eigen::VectorXd& base, std::vector<bool>& eliminated) {
+  auto is_fixed = [&](Index j) { return !std::isnan(out.fixed[static_cast<std::size_t>(j)]); };
+  const Index m = static_cast<Index>(row_columns.size());
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (Index r = 0; r < m; ++r) {
+      if (eliminated[static_cast<std::size_t>(r)]) continue;
+      Index only = -1;
+      int free = 0;
+      for (Index j : row_columns[static_cast<std::size_t>(r)])
+        if (!is_fixed(j)) only = j, ++free;
+      if (free != 1) continue;
+      const double h = out.scale(only);
+      Eigen::VectorXd q = base;
+      auto at = [&](double u) {
+        q(only) = out.origin(only) + h * u;
+        return eval.row(q, r);
+      };
+      const double f0 = at(0.0), f1 = at(1.0), slope = f1 - f0;  // per unit of the scaled variable
+      const double size = std::abs(f0) + std::abs(slope);
+      bool affine = std::abs(slope) > 1e-12 * size && std::isfinite(size);
+      for (double u : {-0.71, 0.37, -1.9}) affine = affine && std::abs(at(u) - (f0 + slope * u)) <= 1e-11 * size;
+      if (!affine) continue;
+      const double value = out.origin(only) - h * f0 / slope;
+      // refine on the row itself (an affine row: one step lands on it to rounding)
+      q(only) = value;
+      const double f = eval.row(q, r);
+      out.fixed[static_cast<std::size_t>(only)] = value - h * f / slope;
+      base(only) = out.fixed[static_cast<std::size_t>(only)];
+      eliminated[static_cast<std::size_t>(r)] = true;
+      out.eliminated_rows.push_back(r);
+      changed = true;
+    }
+  }
+}
+
+// c² + s² − 1 = 0 for every free angle coordinate (angle[j]) of `out`'s system.
+void add_circle_equations(const std::vector<bool>& angle, ModelPolynomials& out) {
+  PolynomialSystem& system = out.system;
+  const int nv = system.variables;
+  for (std::size_t j = 0; j < angle.size(); ++j) {
+    const int v = out.variable_of[j];
+    if (v < 0 || !angle[j]) continue;
+    Polynomial circle;
+    std::vector<int> e(static_cast<std::size_t>(nv), 0);
+    circle.terms.push_back({-1.0, e});
+    e[static_cast<std::size_t>(v)] = 2;
+    circle.terms.push_back({1.0, e});
+    e[static_cast<std::size_t>(v)] = 0, e[static_cast<std::size_t>(v + 1)] = 2;
+    circle.terms.push_back({1.0, e});
+    system.equations.push_back(std::move(circle));
+  }
+}
+
+}  // namespace
+
+Eigen::VectorXd ModelPolynomials::coordinates(const Eigen::VectorXcd& x) const {
+  Eigen::VectorXd q = origin;
+  for (std::size_t j = 0; j < variable_of.size(); ++j) {
+    const Eigen::Index jj = static_cast<Eigen::Index>(j);
+    if (variable_of[j] < 0) {
+      q(jj) = fixed[j];
+    } else if (system.names[static_cast<std::size_t>(variable_of[j])].rfind("cos(", 0) == 0) {
+      const double angle = std::atan2(x(variable_of[j] + 1).real(), x(variable_of[j]).real());
+      q(jj) = angle + 2.0 * std::numbers::pi * std::round((origin(jj) - angle) / (2.0 * std::numbers::pi));
+    } else {
+      q(jj) = origin(jj) + scale(jj) * x(variable_of[j]).real();
+    }
+  }
+  return q;
+}
+
+ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& options) {
+  ModelPolynomials out;
+  const Index n = model.num_coordinates(), m = model.num_equations();
+  Random random(options.seed ^ 0x5DEECE66Dull);
+  RowEvaluator eval{model, options.time, {}};
+  out.origin = model.initial_positions();
+  out.scale = Eigen::VectorXd::Ones(n);
+  std::vector<bool> angle(static_cast<std::size_t>(n));
+  for (Index j = 0; j < n; ++j) {
+    angle[static_cast<std::size_t>(j)] = model.coordinate_unit(j) == Unit::kAngle;
+    if (model.coordinate_unit(j) == Unit::kLength) out.scale(j) = model.length_scale();
+  }
+  // The coordinates each row reads, from the Jacobian's pattern.
+  const CscPattern& pattern = model.jacobian_pattern();
+  std::vector<std::vector<Index>> row_columns(static_cast<std::size_t>(m));
+  for (Index j = 0; j < n; ++j)
+    for (Index k = pattern.col_ptr[static_cast<std::size_t>(j)]; k < pattern.col_ptr[static_cast<std::size_t>(j) + 1];
+         ++k)
+      row_columns[static_cast<std::size_t>(pattern.row_idx[static_cast<std::size_t>(k)])].push_back(j);
+  auto constraint_name = [&](Index r) {
+    return model.constraints()[static_cast<std::size_t>(model.constraint_of_row(r))].name;
+  };
+
+  // 1. Rows that read one free coordinate and are affine in it fix that coordinate.
+  out.fixed.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
+  Eigen::VectorXd base = out.origin;
+  std::vector<bool> eliminated(static_cast<std::size_t>(m), false);
+  auto is_fixed = [&](Index j) { return !std::isnan(out.fixed[static_cast<std::size_t>(j)]); };
+  eliminate_fixed_coordinates(eval, row_columns, out, base, eliminated);
+  std::sort(out.eliminated_rows.begin(), out.eliminated_rows.end());
+
+  // 2. The variables: one per free coordinate, two (c, s) per free angle.
+  out.variable_of.assign(static_cast<std::size_t>(n), -1);
+  PolynomialSystem& system = out.system;
+  for (Index j = 0; j < n; ++j) {
+    if (is_fixed(j)) continue;
+    const std::string& name = model.coordinate_names()[static_cast<std::size_t>(j)];
+    out.variable_of[static_cast<std::size_t>(j)] = system.variables;
+    if (angle[static_cast<std::size_t>(j)]) {
+      system.names.push_back("cos(" + name + ")"), system.names.push_back("sin(" + name + ")");
+      system.variables += 2;
+    } else {
+      system.names.push_back(name);
+      system.variables += 1;
+    }
+  }
+  const int nv = system.variables;
+
+  // 3. Each remaining row fitted, lowest degree first.
+  for (Index r = 0; r < m; ++r) {
+    if (eliminated[static_cast<std::size_t>(r)]) continue;
+    std::vector<RowCoordinate> reads;
+    std::vector<bool> second;  // per local variable: the s of an angle pair
+    for (Index j : row_columns[static_cast<std::size_t>(r)]) {
+      if (is_fixed(j)) continue;
+      const bool a = angle[static_cast<std::size_t>(j)];
+      reads.push_back({j, a, out.variable_of[static_cast<std::size_t>(j)]});
+      second.push_back(false);
+      if (a) second.push_back(true);
+    }
+    const int width = static_cast<int>(second.size());
+    // a point: the local variables' values and the row there
+    auto sample = [&](Eigen::VectorXd& local) {
+      Eigen::VectorXd q = base;
+      int k = 0;
+      for (const RowCoordinate& c : reads) {
+        if (c.angle) {
+          const double theta = std::numbers::pi * random.symmetric();
+          local(k++) = std::cos(theta), local(k++) = std::sin(theta);
+          q(c.coordinate) = theta;
+        } else {
+          local(k) = random.symmetric();
+          q(c.coordinate) = out.origin(c.coordinate) + out.scale(c.coordinate) * local(k);
+          ++k;
+        }
+      }
+      return eval.row(q, r);
+    };
+    bool fitted = false;
+    for (int d = (width == 0 ? 0 : 1); d <= options.max_fit_degree && !fitted; ++d) {
+      std::vector<std::vector<int>> basis;
+      std::vector<int> current(static_cast<std::size_t>(width), 0);
+      monomials(width, d, second, basis, current, 0, d);
+      const int count = static_cast<int>(basis.size());
+      if (count > kMaxMonomials) break;
+      auto design = [&](int points, Eigen::MatrixXd& a, Eigen::VectorXd& b) {
+        a.resize(points, count), b.resize(points);
+        Eigen::VectorXd local(width);
+        for (int i = 0; i < points; ++i) {
+          b(i) = sample(local);
+          for (int k = 0; k < count; ++k) {
+            double v = 1.0;
+            for (int w = 0; w < width; ++w)
+              for (int e = 0; e < basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w)]; ++e) v *= local(w);
+            a(i, k) = v;
+          }
+        }
+      };
+      Eigen::MatrixXd a, a2;
+      Eigen::VectorXd b, b2;
+      design(2 * count + 8, a, b);
+      if (!b.allFinite()) break;
+      const Eigen::VectorXd coefficients = a.colPivHouseholderQr().solve(b);
+      design(count + 8, a2, b2);
+      if (!b2.allFinite()) break;
+      const double size = std::max(b.cwiseAbs().maxCoeff(), b2.cwiseAbs().maxCoeff());
+      const double error = (a2 * coefficients - b2).cwiseAbs().maxCoeff();
+      if (!(error <= kFitTolerance * size) && !(size == 0.0)) continue;
+      fitted = true;
+      Polynomial p;
+      const double largest = coefficients.cwiseAbs().maxCoeff();
+      for (int k = 0; k < count; ++k) {
+        if (!(std::abs(coefficients(k)) > 1e-11 * largest)) continue;  // rounding of a zero coefficient
+        PolynomialTerm term{coefficients(k), std::vector<int>(static_cast<std::size_t>(nv), 0)};
+        int w = 0;
+        for (const RowCoordinate& c : reads) {
+          term.exponent[static_cast<std::size_t>(c.variable)] =
+              basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w++)];
+          if (c.angle)
+            term.exponent[static_cast<std::size_t>(c.variable + 1)] =
+                basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w++)];
+        }
+        p.terms.push_back(std::move(term));
+      }
+      system.equations.push_back(std::move(p));
+    }
+    if (!fitted) {
+      out.status = ModesStatus::kNotPolynomial;
+      out.message = "constraint '" + constraint_name(r) +
+                    "' is not polynomial in its coordinates (no polynomial of "
+                    "degree <= " +
+                    std::to_string(options.max_fit_degree) +
+                    " in them, angles as cos and sin, reproduces it): phiq modes cannot count its assemblies";
+      out.system = PolynomialSystem{};
+      return out;
+    }
+  }
+  add_circle_equations(angle, out);  // 4. c² + s² = 1 for every free angle
+  return out;
+}
+
+}  // namespace phiq

@@ -1,0 +1,43 @@
+"""phiq.modes (engine/python/src/bind_modes.cpp): the four-bar's two assembly modes as arrays, each a placement that
+solves the scene's equations (checked with the model's own residual), against Freudenstein's closed form, and a cam
+refused with its constraint named."""
+import math
+import os
+
+import numpy as np
+import pytest
+
+import phiq
+
+from conftest import MODELS
+
+
+def test_fourbar_modes_are_two_placements_on_freudensteins_branches():
+    scene = phiq.load_scene(os.path.join(MODELS, "seed", "fourbar_mixed.yaml"))
+    r = phiq.modes(scene, 0.7, threads=1)
+    assert r["q"].shape == (2, len(r["coordinates"]))
+    assert r["paths"] == 4
+    assert not r["singular"].any()
+    xb, yb = r["coordinates"].index("xB"), r["coordinates"].index("yB")
+    # Freudenstein: the rocker's angles at crank 0.7 (a 0.4, b 1.2, c 1, d 1)
+    a, b, c, d, th = 0.4, 1.2, 1.0, 1.0, 0.7
+    k1, k2, k3 = d / a, d / c, (a * a - b * b + c * c + d * d) / (2 * a * c)
+    A = math.cos(th) - k1 - k2 * math.cos(th) + k3
+    B = -2 * math.sin(th)
+    C = k1 - (k2 + 1) * math.cos(th) + k3
+    root = math.sqrt(B * B - 4 * A * C)
+    expected = sorted((1 + math.cos(2 * math.atan2(-B + s * root, 2 * A)), math.sin(2 * math.atan2(-B + s * root, 2 * A)))
+                      for s in (1, -1))
+    found = sorted((q[xb], q[yb]) for q in r["q"])
+    assert np.allclose(found, expected, atol=1e-10)
+    ws = phiq.Workspace(scene.model)
+    for q in r["q"]:
+        assert np.max(np.abs(scene.model.residual(q, 0.7))) < 1e-12
+        ws.q = q  # a mode is a placement the workspace takes
+    assert np.array_equal(ws.q, r["q"][-1])
+
+
+def test_a_cam_is_refused_with_its_constraint_named():
+    scene = phiq.load_scene(os.path.join(MODELS, "cams", "eccentric_knife.yaml"))
+    with pytest.raises(ValueError, match="constraint 'cam' is not polynomial"):
+        phiq.modes(scene)

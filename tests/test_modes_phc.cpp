@@ -1,0 +1,161 @@
+// phiq's assembly modes side by side with PHCpack (`phc -b`, Debian's phcpack) on the same polynomial systems
+// (phc_input_text()): the same number of finite regular solutions, of real ones, and the same real solutions.
+// Skipped, with the reason, when phc is not installed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "phiq/phiq.hpp"
+
+namespace phiq {
+namespace {
+
+bool phc_installed() { return std::system("command -v phc > /dev/null 2>&1") == 0; }
+
+// One solution as phc writes it: the values of x1 … xn, and whether phc calls it real.
+struct PhcSolution {
+  std::vector<std::complex<double>> x;
+  bool real = false;
+  bool regular = false;
+};
+
+// Runs `phc -b` on the system's text and reads the solutions of the last "THE SOLUTIONS" section (after its
+// root refinement).
+std::vector<PhcSolution> phc_solve(const PolynomialSystem& system) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("phiq_modes_phc_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string in = (dir / "in.phc").string(), out = (dir / "out.phc").string();
+  std::ofstream(in) << phc_input_text(system);
+  const std::string command = "cd '" + dir.string() + "' && phc -b in.phc out.phc < /dev/null > /dev/null 2>&1";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  std::ifstream file(out);
+  std::stringstream all;
+  all << file.rdbuf();
+  const std::string text = all.str();
+  std::filesystem::remove_all(dir);
+  const std::size_t at = text.rfind("THE SOLUTIONS");
+  std::vector<PhcSolution> solutions;
+  if (at == std::string::npos) return solutions;
+  std::istringstream lines(text.substr(at));
+  std::string line;
+  PhcSolution current;
+  bool reading = false;
+  while (std::getline(lines, line)) {
+    if (line.find("the solution for t") != std::string::npos) {
+      reading = true;
+      current = PhcSolution{};
+      continue;
+    }
+    if (!reading) continue;
+    if (line.rfind("==", 0) == 0) {
+      // phc's own words ("real regular") are not written for every system (not for one unknown): judged here from
+      // its numbers, as phiq judges its own (the inverse condition estimate rco, the imaginary parts)
+      const std::size_t rco = line.find("rco :");
+      current.regular = rco != std::string::npos && std::stod(line.substr(rco + 5)) > 1e-10;
+      double size = 0.0, imag = 0.0;
+      for (const auto& v : current.x) size = std::max(size, std::abs(v)), imag = std::max(imag, std::abs(v.imag()));
+      current.real = imag <= 1e-8 * (1.0 + size);
+      solutions.push_back(current);
+      reading = false;
+      continue;
+    }
+    // " xK :  re  im": phc numbers the unknowns in the order it first reads them, not by name
+    std::istringstream fields(line);
+    std::string name, colon;
+    double re = 0.0, im = 0.0;
+    if (fields >> name >> colon >> re >> im && name.size() > 1 && name[0] == 'x') {
+      const std::size_t k = static_cast<std::size_t>(std::stoi(name.substr(1)) - 1);
+      if (current.x.size() <= k) current.x.resize(k + 1);
+      current.x[k] = {re, im};
+    }
+  }
+  return solutions;
+}
+
+// phc's solutions against phiq's endpoints: regular finite counts, real counts, and every real solution of one
+// found by the other (phc's variables are x1 … xn in the system's order).
+void modes_expect_same_as_phc(const PolynomialSystem& system, const ModesSummary& ours) {
+  const std::vector<PhcSolution> theirs = phc_solve(system);
+  int regular = 0, real = 0;
+  for (const PhcSolution& s : theirs) regular += s.regular, real += s.regular && s.real;
+  EXPECT_EQ(ours.real + ours.complex, regular);
+  EXPECT_EQ(ours.real, real);
+  for (const Endpoint& e : ours.endpoints) {
+    if (e.kind != EndpointKind::kReal) continue;
+    bool found = false;
+    for (const PhcSolution& s : theirs) {
+      if (!s.real || static_cast<Eigen::Index>(s.x.size()) != e.x.size()) continue;
+      double d = 0.0;
+      for (Eigen::Index v = 0; v < e.x.size(); ++v)
+        d = std::max(d, std::abs(s.x[static_cast<std::size_t>(v)] - e.x(v)));
+      found = found || d < 1e-8;
+    }
+    EXPECT_TRUE(found) << "a real solution of phiq's that phc did not find";
+  }
+}
+
+std::string modes_phc_models(const std::string& rel) {
+  std::string path = PHIQ_MODELS_DIR;
+  path += '/';
+  path += rel;
+  return path;
+}
+
+TEST(ModesPhc, IntegerSystemAsPhcSolvesIt) {
+  if (!phc_installed()) GTEST_SKIP() << "phc (Debian package phcpack) is not installed";
+  Polynomial a, b;
+  a.terms = {{2.0, {0, 0}}, {-3.0, {1, 0}}, {1.0, {2, 0}}};
+  b.terms = {{-3.0, {0, 0}}, {-2.0, {0, 1}}, {1.0, {0, 2}}};
+  const PolynomialSystem s{2, {}, {a, b}};
+  const ModesSummary ours = solve_polynomial_system(s, {});
+  ASSERT_EQ(ours.real, 4);
+  modes_expect_same_as_phc(s, ours);
+}
+
+TEST(ModesPhc, FourBarAndCrankSliderAsPhcSolvesThem) {
+  if (!phc_installed()) GTEST_SKIP() << "phc (Debian package phcpack) is not installed";
+  for (const char* rel : {"seed/fourbar_mixed.yaml", "seed/crank_slider_mixed.yaml", "seed/fourbar_natural.yaml"}) {
+    SCOPED_TRACE(rel);
+    const Scene scene = load_scene(modes_phc_models(rel));
+    ModesOptions o;
+    o.time = 0.9;
+    const AssemblyModes r = find_assembly_modes(*scene.model, o);
+    ASSERT_EQ(r.summary.status, ModesStatus::kSuccess) << r.summary.message;
+    modes_expect_same_as_phc(r.polynomials.system, r.summary);
+  }
+}
+
+TEST(ModesPhc, ThreeRprAsPhcSolvesIt) {
+  if (!phc_installed()) GTEST_SKIP() << "phc (Debian package phcpack) is not installed";
+  const std::string text =
+      "phiq: 1\nname: rpr3\n"
+      "parameters: {a2: 15.91, a3x: 0, a3y: 10, b2: 17.04, b3x: 8.0, b3y: 9.0, r1: 14.98, r2: 15.38, r3: 12}\n"
+      "coordinates: {x: 5, y: 5, psi: 0.3, x1: 5, y1: 5, x2: 20, y2: 8, x3: 12, y3: 14}\n"
+      "points: {A1: [0, 0], A2: [a2, 0], A3: [a3x, a3y], P1: [x1, y1], P2: [x2, y2], P3: [x3, y3]}\n"
+      "bodies: {platform: [x, y, psi]}\n"
+      "constraints:\n"
+      "  - {name: B1, type: revolute, between: [{body: platform, at: [0, 0]}, {point: P1}]}\n"
+      "  - {name: B2, type: revolute, between: [{body: platform, at: [b2, 0]}, {point: P2}]}\n"
+      "  - {name: B3, type: revolute, between: [{body: platform, at: [b3x, b3y]}, {point: P3}]}\n"
+      "  - {name: leg1, type: distance, points: [A1, P1], length: r1}\n"
+      "  - {name: leg2, type: distance, points: [A2, P2], length: r2}\n"
+      "  - {name: leg3, type: distance, points: [A3, P3], length: r3}\n"
+      "time: {start: 0, end: 1, steps: 1}\n";
+  const Scene scene = parse_scene(text, "rpr3.yaml");
+  const AssemblyModes r = find_assembly_modes(*scene.model, {});
+  ASSERT_EQ(r.summary.status, ModesStatus::kSuccess) << r.summary.message;
+  modes_expect_same_as_phc(r.polynomials.system, r.summary);
+}
+
+}  // namespace
+}  // namespace phiq
