@@ -179,9 +179,9 @@ TEST(UrdfImport, BadInputIsOneLineNamingFileAndLine) {
     EXPECT_EQ(error.rfind(start, 0), 0u) << error << "\nexpected to start with: " << start;
     EXPECT_EQ(error.find('\n'), std::string::npos) << error;
   };
-  // truncated: the XML reader names the line where the file ends
+  // truncated: the XML reader names the line of the element left open
   const std::string cut = good.substr(0, good.find("<joint name=\"rocker_joint\""));
-  starts(UrdfError(cut), "bad.urdf:" + std::to_string(UrdfLineOf(cut, "<joint name=\"tip\"")));
+  starts(UrdfError(cut), "bad.urdf:" + std::to_string(UrdfLineOf(cut, "<robot")) + ": malformed XML");
   EXPECT_NE(UrdfError(cut).find("truncated"), std::string::npos);
   // an unknown joint type
   const std::string hinge = test::replace_first(good, "type=\"revolute\"", "type=\"hinge\"");
