@@ -138,7 +138,10 @@ TEST(MjcfImport, EveryJointTypeLeavesItsFreedomsAndDefaultsApply) {
   EXPECT_LT((test::import_rotation(*scene.model, q, "shoulder") - Rs).norm(), 1e-12);
   const Eigen::Matrix3d Rf = Rs * Eigen::AngleAxisd(M_PI / 9, Eigen::Vector3d::UnitX()).toRotationMatrix();
   EXPECT_LT((test::import_rotation(*scene.model, q, "forearm") - Rf).norm(), 1e-12);
-  EXPECT_LT((test::import_point(*scene.model, q, "forearm") - (Eigen::Vector3d(0, 0, 1) + Rs * Eigen::Vector3d(0, 0, -0.3))).norm(), 1e-12);
+  EXPECT_LT(
+      (test::import_point(*scene.model, q, "forearm") - (Eigen::Vector3d(0, 0, 1) + Rs * Eigen::Vector3d(0, 0, -0.3)))
+          .norm(),
+      1e-12);
   EXPECT_NE(imported.yaml.find("{type: capsule, radius: 0.02, length: 0.2, colour: [0.8, 0.2, 0.2, 1]}"),
             std::string::npos);
   for (const char* what : {"<light>", "<contact>", "<tendon>", "<sensor>", "<joint damping>"})
@@ -162,16 +165,19 @@ TEST(MjcfImport, BadInputIsOneLineNamingFileAndLine) {
   starts(MjcfError(poly), "bad.xml:" + std::to_string(MjcfLineOf(good, "<joint joint1")) +
                               ": <joint> equality 'joint_line" + std::to_string(MjcfLineOf(good, "<joint joint1")) +
                               "': polycoef of degree 2");
-  const std::string twist = test::replace_first(good, "<joint name=\"wheel2_joint\"", "<joint name=\"wheel2_joint\" type=\"twist\"");
+  const std::string twist =
+      test::replace_first(good, "<joint name=\"wheel2_joint\"", "<joint name=\"wheel2_joint\" type=\"twist\"");
   starts(MjcfError(twist), "bad.xml:" + std::to_string(MjcfLineOf(good, "<joint name=\"wheel2_joint\"")) +
                                ": joint 'wheel2_joint' has type 'twist'");
   const std::string ghost = test::replace_first(good, "joint2=\"wheel1_joint\"", "joint2=\"ghost\"");
-  starts(MjcfError(ghost), "bad.xml:" + std::to_string(MjcfLineOf(good, "<joint joint1")) + ": <joint> equality: joint2 'ghost'");
+  starts(MjcfError(ghost),
+         "bad.xml:" + std::to_string(MjcfLineOf(good, "<joint joint1")) + ": <joint> equality: joint2 'ghost'");
   const std::string tendon = test::replace_first(good, "<joint joint1", "<tendon tendon1=\"t\"/><joint joint1");
   starts(MjcfError(tendon), "bad.xml:" + std::to_string(MjcfLineOf(good, "<joint joint1")) + ": <tendon> equality");
   const std::string include = test::replace_first(good, "<worldbody>", "<include file=\"more.xml\"/><worldbody>");
   starts(MjcfError(include), "bad.xml:" + std::to_string(MjcfLineOf(good, "<worldbody>")) + ": <include>");
-  const std::string cls = test::replace_first(good, "<joint name=\"wheel1_joint\"", "<joint class=\"nope\" name=\"wheel1_joint\"");
+  const std::string cls =
+      test::replace_first(good, "<joint name=\"wheel1_joint\"", "<joint class=\"nope\" name=\"wheel1_joint\"");
   starts(MjcfError(cls), "bad.xml:" + std::to_string(MjcfLineOf(good, "wheel1_joint")) + ": class 'nope'");
   starts(MjcfError("<robot/>"), "bad.xml:1: an MJCF file's root element is <mujoco>");
   const std::string connect = import_text(import_data("mjcf/fourbar.xml"));
@@ -202,8 +208,8 @@ namespace test {
 
 TEST_F(Cli, MjcfConvertWritesTheTextADirectReadSolves) {
   const std::string model = import_data("mjcf/slider_crank.xml");
-  const Result convert = run("convert " + model + " -o " + (dir_ / "sc.yaml").string() +
-                             " --drive crank_joint=2*pi*t --time 0 1 20");
+  const Result convert =
+      run("convert " + model + " -o " + (dir_ / "sc.yaml").string() + " --drive crank_joint=2*pi*t --time 0 1 20");
   ASSERT_EQ(convert.code, 0) << convert.err;
   ImportOptions o;
   o.drives = {{"crank_joint", "2*pi*t"}}, o.t_end = 1, o.steps = 20;
@@ -213,7 +219,8 @@ TEST_F(Cli, MjcfConvertWritesTheTextADirectReadSolves) {
   const Result check = run("check " + model);
   ASSERT_EQ(check.code, 0) << check.err;
   EXPECT_NE(check.out.find("dof           1 (1 not driven)"), std::string::npos) << check.out;
-  const fs::path bad = write("bad.xml", "<mujoco><worldbody><body><joint type=\"screw\"/></body></worldbody></mujoco>\n");
+  const fs::path bad =
+      write("bad.xml", "<mujoco><worldbody><body><joint type=\"screw\"/></body></worldbody></mujoco>\n");
   const Result r = run("convert " + bad.string() + " -o " + (dir_ / "out.yaml").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(one_phiq_line(r.err));

@@ -158,10 +158,10 @@ TEST(UrdfImport, JointPositionsAreURDFsAngleAboutAndTravelAlongTheAxis) {
   o.drives.emplace_back("carriage_joint", "0.25*t");
   const test::ImportRun r = import_sweep(import_urdf(text, path, o).yaml, path);
   ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
-  const Eigen::Matrix3d mount = (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) *
-                                 Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()) *
-                                 Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()))
-                                    .toRotationMatrix();
+  const Eigen::Matrix3d mount =
+      (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   for (std::size_t k = 0; k < r.trace.q.size(); ++k) {
     const double t = r.trace.t[k];
     const Eigen::Matrix3d arm = mount * Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
@@ -205,8 +205,8 @@ TEST(UrdfImport, BadInputIsOneLineNamingFileAndLine) {
          "bad.urdf:" + std::to_string(UrdfLineOf(gears, "<mimic")) + ": joint 'wheel2_joint' mimics 'wheel9'");
   // a driver of a joint the file does not have, or of one phiq drives no measure of
   starts(UrdfError(good, UrdfDrive("elbow", "t", 1, 1)), "bad.urdf: --drive elbow: the model has no joint 'elbow'");
-  starts(UrdfError(good, UrdfDrive("tip", "t", 1, 1)), "bad.urdf:" + std::to_string(UrdfLineOf(good, "<joint name=\"tip\"")) +
-                                                           ": --drive tip: a rigid joint");
+  starts(UrdfError(good, UrdfDrive("tip", "t", 1, 1)),
+         "bad.urdf:" + std::to_string(UrdfLineOf(good, "<joint name=\"tip\"")) + ": --drive tip: a rigid joint");
   starts(UrdfError("<robot name=\"r\"><link name=\"only\"/></robot>"), "bad.urdf: the model has no moving link");
 }
 

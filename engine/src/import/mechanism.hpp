@@ -23,7 +23,7 @@ struct Pose {
 
 // A shape of phiq's parts (models/README.md, Parts), placed in its body's frame.
 struct Shape {
-  std::string type;  // box, sphere, cylinder, capsule, plane, mesh
+  std::string type;                                // box, sphere, cylinder, capsule, plane, mesh
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  // box: the full edges; plane: x, y
   double radius = 0.0, length = 0.0, scale = 1.0;
   std::string file;  // a mesh's file, as phiq's scene names it (relative to the scene's folder or absolute)
@@ -34,12 +34,12 @@ struct Shape {
 struct Body {
   std::string name;  // the file's
   int line = 0;
-  Pose world;        // at the model's pose
+  Pose world;  // at the model's pose
   bool has_mass = false;
   double mass = 0.0;
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();       // in the body's frame
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();   // about the centre of mass, in the body's axes
-  std::optional<double> density;                       // mass from the shapes at this density (when !has_mass)
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();      // in the body's frame
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  // about the centre of mass, in the body's axes
+  std::optional<double> density;                      // mass from the shapes at this density (when !has_mass)
   std::vector<Shape> shapes;
   static Body named(std::string name, int line, const Pose& world = Pose{}) {
     Body b;

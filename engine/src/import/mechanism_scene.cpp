@@ -33,9 +33,7 @@ Eigen::Matrix3d axis_angle(const Eigen::Vector3d& axis, double angle) {
 namespace {
 
 std::string mnum(double v) { return shortest_unsigned_zero(v); }
-std::string mvec(const Eigen::Vector3d& v) {
-  return "[" + mnum(v.x()) + ", " + mnum(v.y()) + ", " + mnum(v.z()) + "]";
-}
+std::string mvec(const Eigen::Vector3d& v) { return "[" + mnum(v.x()) + ", " + mnum(v.y()) + ", " + mnum(v.z()) + "]"; }
 std::string mquoted(const std::string& s) {
   std::string out = "\"";
   for (char c : single_line(s)) out += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
@@ -123,8 +121,9 @@ std::string MechanismWriter::joint_coordinate(int j, const Coupler& c) {
                "': phiq couples the angles of revolute (hinge, continuous) joints");
   const std::string name = names_.make(joint_[static_cast<std::size_t>(j)] + "_angle");
   coordinates_ << "  " << name << ": 0\n";
-  constraints_ << "  - {name: " << names_.make(name + "_def") << ", type: rotation_angle, joint: "
-               << joint_[static_cast<std::size_t>(j)] << ", angle: " << name << "}\n";
+  constraints_ << "  - {name: " << names_.make(name + "_def")
+               << ", type: rotation_angle, joint: " << joint_[static_cast<std::size_t>(j)] << ", angle: " << name
+               << "}\n";
   return joint_coordinate_[j] = name;
 }
 
@@ -165,8 +164,8 @@ void MechanismWriter::drivers() {
     }
     drivers_ << "  - {name: " << names_.make("drive_" + joint_[static_cast<std::size_t>(found)])
              << ", joint: " << joint_[static_cast<std::size_t>(found)]
-             << ", measure: " << (j.kind == "revolute" ? "angle" : "distance") << ", law: {type: expression, f: "
-             << mquoted(law) << "}}\n";
+             << ", measure: " << (j.kind == "revolute" ? "angle" : "distance")
+             << ", law: {type: expression, f: " << mquoted(law) << "}}\n";
   }
 }
 
@@ -192,7 +191,8 @@ std::string MechanismWriter::parts() {
         fields << (s ? ", " : "") << "{type: " << sh.type;
         if (sh.type == "box") fields << ", size: " << mvec(sh.size);
         if (sh.type == "plane") fields << ", size: [" << mnum(sh.size.x()) << ", " << mnum(sh.size.y()) << "]";
-        if (sh.type == "sphere" || sh.type == "cylinder" || sh.type == "capsule") fields << ", radius: " << mnum(sh.radius);
+        if (sh.type == "sphere" || sh.type == "cylinder" || sh.type == "capsule")
+          fields << ", radius: " << mnum(sh.radius);
         if (sh.type == "cylinder" || sh.type == "capsule") fields << ", length: " << mnum(sh.length);
         if (sh.type == "mesh") fields << ", file: " << mquoted(sh.file) << ", scale: " << mnum(sh.scale);
         if (!sh.at.p.isZero(0.0)) fields << ", at: " << mvec(sh.at.p);
@@ -211,7 +211,8 @@ std::string MechanismWriter::parts() {
 }
 
 std::string MechanismWriter::write() {
-  if (m_.bodies.size() < 2) refuse(m_.path, 0, "the model has no moving " + std::string(m_.format == "URDF" ? "link" : "body"));
+  if (m_.bodies.size() < 2)
+    refuse(m_.path, 0, "the model has no moving " + std::string(m_.format == "URDF" ? "link" : "body"));
   std::ostringstream bodies;
   body_.push_back("ground");
   for (std::size_t k = 1; k < m_.bodies.size(); ++k) {

@@ -143,9 +143,9 @@ const std::string* MjcfReader::attr(const tinyxml2::XMLElement* e, const char* n
   return nullptr;
 }
 
-std::vector<double> MjcfReader::numbers(const tinyxml2::XMLElement* e, const char* name,
-                                        const std::string& childclass, std::vector<double> fallback,
-                                        std::size_t count_min, std::size_t count_max) const {
+std::vector<double> MjcfReader::numbers(const tinyxml2::XMLElement* e, const char* name, const std::string& childclass,
+                                        std::vector<double> fallback, std::size_t count_min,
+                                        std::size_t count_max) const {
   const std::string* text = attr(e, name, childclass);
   if (!text) return fallback;
   std::istringstream in(*text);
@@ -154,8 +154,8 @@ std::vector<double> MjcfReader::numbers(const tinyxml2::XMLElement* e, const cha
   if (!(in.eof()) || v.size() < count_min || v.size() > count_max || v.empty())
     refuse(path_, e->GetLineNum(),
            std::string("<") + e->Name() + " " + name + "=\"" + *text + "\">: " +
-               (count_min == count_max ? std::to_string(count_min) : std::to_string(count_min) + " to " +
-                                                                           std::to_string(count_max)) +
+               (count_min == count_max ? std::to_string(count_min)
+                                       : std::to_string(count_min) + " to " + std::to_string(count_max)) +
                " numbers");
   return v;
 }
@@ -184,7 +184,8 @@ Eigen::Matrix3d MjcfReader::rotation(const tinyxml2::XMLElement* e, const std::s
   if (e->Attribute("xyaxes")) {
     const std::vector<double> a = numbers(e, "xyaxes", cc, {}, 6, 6);
     const Eigen::Vector3d x = Eigen::Vector3d(a[0], a[1], a[2]).normalized();
-    const Eigen::Vector3d y = (Eigen::Vector3d(a[3], a[4], a[5]) - x.dot(Eigen::Vector3d(a[3], a[4], a[5])) * x).normalized();
+    const Eigen::Vector3d y =
+        (Eigen::Vector3d(a[3], a[4], a[5]) - x.dot(Eigen::Vector3d(a[3], a[4], a[5])) * x).normalized();
     Eigen::Matrix3d R;
     R << x, y, x.cross(y);
     return R;
@@ -217,8 +218,10 @@ void MjcfReader::geom(const tinyxml2::XMLElement* e, Body* b, const std::string&
   }
   if (attr(e, "mass", cc)) *solid_only = false;
   const std::vector<double> d = numbers(e, "density", cc, {1000}, 1, 1);
-  if (!density->has_value()) *density = d[0];
-  else if (**density != d[0]) *solid_only = false;
+  if (!density->has_value())
+    *density = d[0];
+  else if (**density != d[0])
+    *solid_only = false;
   if (e->Attribute("fromto") && (type == "capsule" || type == "cylinder")) {
     const std::vector<double> f = numbers(e, "fromto", cc, {}, 6, 6);
     const Eigen::Vector3d a(f[0], f[1], f[2]), c(f[3], f[4], f[5]);
@@ -239,7 +242,8 @@ void MjcfReader::geom(const tinyxml2::XMLElement* e, Body* b, const std::string&
   } else if (type == "mesh") {
     const std::string* name = attr(e, "mesh", cc);
     if (!name || !meshes_.count(*name))
-      refuse(path_, e->GetLineNum(), "geom of type mesh names no <mesh> asset" + (name ? " '" + *name + "'" : std::string()));
+      refuse(path_, e->GetLineNum(),
+             "geom of type mesh names no <mesh> asset" + (name ? " '" + *name + "'" : std::string()));
     const MeshAsset& mesh = meshes_.at(*name);
     *solid_only = false;
     std::string ext = std::filesystem::path(mesh.file).extension().string();
@@ -253,7 +257,8 @@ void MjcfReader::geom(const tinyxml2::XMLElement* e, Body* b, const std::string&
       m_.skip("<geom type=\"mesh\"> scaled unevenly", e->GetLineNum(), "phiq scales a mesh by one factor");
       return;
     }
-    if (!std::filesystem::exists(std::filesystem::path(mesh.file).is_absolute() ? std::filesystem::path(mesh.file) : folder / mesh.file)) {
+    if (!std::filesystem::exists(std::filesystem::path(mesh.file).is_absolute() ? std::filesystem::path(mesh.file)
+                                                                                : folder / mesh.file)) {
       m_.skip("<geom type=\"mesh\"> file not found", e->GetLineNum(), "'" + mesh.file + "' is not beside the file");
       return;
     }
@@ -313,18 +318,20 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
         const std::vector<double> d = numbers(c, "diaginertia", cc, {}, 3, 3);
         I.diagonal() << d[0], d[1], d[2];
       }
-      if (mass.empty() || I.isZero(0.0)) refuse(path_, c->GetLineNum(), "<inertial> needs mass and diaginertia or fullinertia");
+      if (mass.empty() || I.isZero(0.0))
+        refuse(path_, c->GetLineNum(), "<inertial> needs mass and diaginertia or fullinertia");
       b.has_mass = true, b.mass = mass[0], b.com = p.p, b.inertia = p.R * I * p.R.transpose();
       inertial = true;
     } else if (tag == "frame" || tag == "replicate" || tag == "include" || tag == "composite" || tag == "flexcomp") {
       refuse(path_, c->GetLineNum(), "<" + tag + ">: not read by phiq (expand it into bodies first)");
     } else {
       unmapped(c, tag == "site" || tag == "camera" || tag == "light" ? "no kinematics: phiq outputs points instead"
-                                                                      : "not an element phiq maps");
+                                                                     : "not an element phiq maps");
     }
   }
   if (!inertial && solid_only && density && !b.shapes.empty()) b.density = density;
-  if (!inertial && !solid_only) m_.skip("mass from geoms", b.line, "given per geom or by meshes: the body gets no mass");
+  if (!inertial && !solid_only)
+    m_.skip("mass from geoms", b.line, "given per geom or by meshes: the body gets no mass");
   m_.bodies.push_back(b);
   // Its joints, in order; each after the first moves a massless body of its own, at the body's pose.
   int from = parent;
@@ -349,9 +356,12 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     Joint out;
     out.line = j->GetLineNum();
     out.name = j->Attribute("name") ? j->Attribute("name") : b.name + "_joint_" + std::to_string(k);
-    if (type == "hinge") out.kind = "revolute";
-    else if (type == "slide") out.kind = "prismatic";
-    else if (type == "ball") out.kind = "spherical";
+    if (type == "hinge")
+      out.kind = "revolute";
+    else if (type == "slide")
+      out.kind = "prismatic";
+    else if (type == "ball")
+      out.kind = "spherical";
     else if (type != "free")
       refuse(path_, out.line, "joint '" + out.name + "' has type '" + type + "': MJCF's are hinge, slide, ball, free");
     const std::vector<double> p = numbers(j, "pos", cc, {0, 0, 0}, 3, 3);
@@ -362,7 +372,9 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     const Eigen::Vector3d ref = perpendicular(axis);
     out.parent = Side{from, rel.p + rel.R * at, rel.R * axis.normalized(), rel.R * ref};
     out.child = Side{to, at, axis.normalized(), ref};
-    if (type == "ball") out.parent.axis = rel.R.col(2), out.parent.ref = rel.R.col(0), out.child.axis = Eigen::Vector3d::UnitZ(), out.child.ref = Eigen::Vector3d::UnitX();
+    if (type == "ball")
+      out.parent.axis = rel.R.col(2), out.parent.ref = rel.R.col(0), out.child.axis = Eigen::Vector3d::UnitZ(),
+      out.child.ref = Eigen::Vector3d::UnitX();
     if (const std::vector<double> r = numbers(j, "ref", cc, {0}, 1, 1); r[0] != 0.0)
       joint_ref_[static_cast<int>(m_.joints.size())] = type == "hinge" ? angle(r[0]) : r[0];
     for (const char* ignored : {"range", "limited", "damping", "stiffness", "armature", "springref", "frictionloss"})
@@ -379,7 +391,8 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
 void MjcfReader::equality(const tinyxml2::XMLElement* list) {
   for (const tinyxml2::XMLElement* e = list->FirstChildElement(); e; e = e->NextSiblingElement()) {
     const std::string tag = e->Name();
-    const std::string name = e->Attribute("name") ? e->Attribute("name") : tag + "_line" + std::to_string(e->GetLineNum());
+    const std::string name =
+        e->Attribute("name") ? e->Attribute("name") : tag + "_line" + std::to_string(e->GetLineNum());
     if (e->Attribute("active") && std::string(e->Attribute("active")) == "false") {
       unmapped(e, "inactive (active=\"false\")");
       continue;
@@ -414,7 +427,8 @@ void MjcfReader::equality(const tinyxml2::XMLElement* list) {
       const char* j1 = e->Attribute("joint1");
       const char* j2 = e->Attribute("joint2");
       if (!j1 || !joint_index_.count(j1))
-        refuse(path_, e->GetLineNum(), std::string("<joint> equality: joint1 '") + (j1 ? j1 : "") + "' is not a joint of the file");
+        refuse(path_, e->GetLineNum(),
+               std::string("<joint> equality: joint1 '") + (j1 ? j1 : "") + "' is not a joint of the file");
       if (j2 && !joint_index_.count(j2))
         refuse(path_, e->GetLineNum(), std::string("<joint> equality: joint2 '") + j2 + "' is not a joint of the file");
       const std::vector<double> c = numbers(e, "polycoef", "", {0, 1, 0, 0, 0}, 1, 5);
@@ -425,7 +439,8 @@ void MjcfReader::equality(const tinyxml2::XMLElement* list) {
                      "; phiq couples joints linearly (a coupler)");
       // MuJoCo's q1 = c0 + c1 q2 on joint positions; phiq's angles are those minus each joint's ref.
       const int a = joint_index_.at(j1), b = j2 ? joint_index_.at(j2) : -1;
-      const double ra = joint_ref_.count(a) ? joint_ref_.at(a) : 0.0, rb = b >= 0 && joint_ref_.count(b) ? joint_ref_.at(b) : 0.0;
+      const double ra = joint_ref_.count(a) ? joint_ref_.at(a) : 0.0,
+                   rb = b >= 0 && joint_ref_.count(b) ? joint_ref_.at(b) : 0.0;
       const double c1 = c.size() > 1 ? c[1] : 0.0;
       m_.couplers.push_back(Coupler{name, e->GetLineNum(), a, b, c1, c[0] + (b >= 0 ? c1 * rb : 0.0) - ra});
     } else {
@@ -474,10 +489,14 @@ Mechanism MjcfReader::read(int* loops) {
       std::optional<double> density;
       for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
         const std::string t = c->Name();
-        if (t == "body") body(c, 0, "");
-        else if (t == "geom") geom(c, &m_.bodies[0], "", &solid, &density);
-        else if (t == "frame" || t == "replicate") refuse(path_, c->GetLineNum(), "<" + t + ">: not read by phiq (expand it into bodies first)");
-        else unmapped(c, "no kinematics: phiq outputs points instead");
+        if (t == "body")
+          body(c, 0, "");
+        else if (t == "geom")
+          geom(c, &m_.bodies[0], "", &solid, &density);
+        else if (t == "frame" || t == "replicate")
+          refuse(path_, c->GetLineNum(), "<" + t + ">: not read by phiq (expand it into bodies first)");
+        else
+          unmapped(c, "no kinematics: phiq outputs points instead");
       }
     } else if (tag == "equality") {
       continue;  // after every body is read

@@ -47,8 +47,9 @@ double urdf_colour(float c) {
   return std::strtod(std::string(text, end).c_str(), nullptr);
 }
 Pose urdf_pose(const urdf::Pose& p) {
-  return Pose{urdf_vector(p.position),
-              Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix()};
+  return Pose{
+      urdf_vector(p.position),
+      Eigen::Quaterniond(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z).normalized().toRotationMatrix()};
 }
 
 // "x y z" of an attribute (absent: `fallback`); refused, naming the line, when it is not three numbers.
@@ -59,7 +60,8 @@ Eigen::Vector3d urdf_triple(const tinyxml2::XMLElement* e, const char* attribute
   std::istringstream in(text);
   Eigen::Vector3d v;
   if (!(in >> v.x() >> v.y() >> v.z()) || !(in >> std::ws).eof())
-    refuse(path, e->GetLineNum(), std::string("<") + e->Name() + " " + attribute + "=\"" + text + "\">: not three numbers");
+    refuse(path, e->GetLineNum(),
+           std::string("<") + e->Name() + " " + attribute + "=\"" + text + "\">: not three numbers");
   return v;
 }
 
@@ -68,10 +70,10 @@ Pose urdf_origin(const tinyxml2::XMLElement* parent, const std::string& path) {
   const tinyxml2::XMLElement* o = parent->FirstChildElement("origin");
   const Eigen::Vector3d xyz = urdf_triple(o, "xyz", Eigen::Vector3d::Zero(), path);
   const Eigen::Vector3d rpy = urdf_triple(o, "rpy", Eigen::Vector3d::Zero(), path);
-  return Pose{xyz, (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
-                    Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-                    Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
-                       .toRotationMatrix()};
+  return Pose{
+      xyz, (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+            Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+               .toRotationMatrix()};
 }
 
 struct UrdfJointXml {
@@ -117,7 +119,8 @@ void UrdfReader::scan() {
     const char* name = e->Attribute("name");
     if (tag == "link") {
       if (!name) refuse(path_, e->GetLineNum(), "<link> without a name");
-      if (!links_.emplace(name, e).second) refuse(path_, e->GetLineNum(), std::string("a second link named '") + name + "'");
+      if (!links_.emplace(name, e).second)
+        refuse(path_, e->GetLineNum(), std::string("a second link named '") + name + "'");
     } else if (tag == "joint") {
       UrdfJointXml j;
       j.element = e, j.line = e->GetLineNum();
@@ -128,8 +131,8 @@ void UrdfReader::scan() {
         refuse(path_, j.line,
                "joint '" + j.name + "' has type '" + j.type +
                    "': URDF's are revolute, continuous, prismatic, fixed, floating, planar");
-      for (auto [tag2, field, line] : {std::tuple{"parent", &j.parent, &j.parent_line},
-                                       std::tuple{"child", &j.child, &j.child_line}}) {
+      for (auto [tag2, field, line] :
+           {std::tuple{"parent", &j.parent, &j.parent_line}, std::tuple{"child", &j.child, &j.child_line}}) {
         const tinyxml2::XMLElement* x = e->FirstChildElement(tag2);
         if (!x || !x->Attribute("link"))
           refuse(path_, j.line, "joint '" + j.name + "' has no <" + tag2 + " link=\"...\">");
@@ -187,7 +190,8 @@ void UrdfReader::unmapped(const tinyxml2::XMLElement* e) {
       {"gazebo", "simulator settings"},
   };
   const auto it = why.find(e->Name());
-  m_.skip(std::string("<") + e->Name() + ">", e->GetLineNum(), it != why.end() ? it->second : "not a URDF element phiq reads");
+  m_.skip(std::string("<") + e->Name() + ">", e->GetLineNum(),
+          it != why.end() ? it->second : "not a URDF element phiq reads");
 }
 
 std::optional<Shape> UrdfReader::shape(const tinyxml2::XMLElement* owner, const urdf::Geometry* g,
@@ -227,7 +231,8 @@ std::optional<Shape> UrdfReader::shape(const tinyxml2::XMLElement* owner, const 
         return std::nullopt;
       }
       const std::filesystem::path folder = std::filesystem::path(path_).parent_path();
-      if (!std::filesystem::exists(std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : folder / file)) {
+      if (!std::filesystem::exists(std::filesystem::path(file).is_absolute() ? std::filesystem::path(file)
+                                                                             : folder / file)) {
         m_.skip(what + " mesh file not found", line, "'" + file + "' is not beside the file");
         return std::nullopt;
       }
@@ -322,12 +327,14 @@ Mechanism UrdfReader::read(int* loops) {
       I << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
       b.has_mass = &b != &m_.bodies.front();
       b.mass = in.mass, b.com = c.p, b.inertia = c.R * I * c.R.transpose();
-      if (!b.has_mass) m_.skip("<inertial> of the root link", xml->FirstChildElement("inertial")->GetLineNum(),
-                               "the root link is the ground; its mass moves nothing");
+      if (!b.has_mass)
+        m_.skip("<inertial> of the root link", xml->FirstChildElement("inertial")->GetLineNum(),
+                "the root link is the ground; its mass moves nothing");
     }
     const bool has_visual = !link->visual_array.empty();
     std::size_t k = 0;
-    for (const tinyxml2::XMLElement* e = xml->FirstChildElement("visual"); e; e = e->NextSiblingElement("visual"), ++k) {
+    for (const tinyxml2::XMLElement* e = xml->FirstChildElement("visual"); e;
+         e = e->NextSiblingElement("visual"), ++k) {
       const urdf::VisualSharedPtr& v = link->visual_array.at(k);
       std::optional<Shape> s = shape(e, v->geometry.get(), "<visual>");
       if (s && v->material)
@@ -372,7 +379,8 @@ Mechanism UrdfReader::read(int* loops) {
     while (e && !(e->GetLineNum() == x.line && e->Attribute("name") && x.name == e->Attribute("name")))
       e = e->NextSiblingElement("joint");
     if (x.type == "floating") refuse(path_, x.line, "closing joint '" + x.name + "' is floating: it closes nothing");
-    if (e->FirstChildElement("mimic")) refuse(path_, x.line, "closing joint '" + x.name + "': a mimic on a closing joint is not read");
+    if (e->FirstChildElement("mimic"))
+      refuse(path_, x.line, "closing joint '" + x.name + "': a mimic on a closing joint is not read");
     Joint out;
     out.name = x.name, out.closing = true;
     map_joint(&out, x.type, urdf_origin(e, path_),
@@ -394,9 +402,10 @@ Mechanism UrdfReader::read(int* loops) {
     const int line = e ? e->GetLineNum() : x.line;
     const auto other = joint_index.find(j->mimic->joint_name);
     if (other == joint_index.end())
-      refuse(path_, line, "joint '" + x.name + "' mimics '" + j->mimic->joint_name + "', which is not a joint of the file");
-    m_.couplers.push_back(
-        Coupler{x.name + "_mimic", line, joint_index.at(x.name), other->second, j->mimic->multiplier, j->mimic->offset});
+      refuse(path_, line,
+             "joint '" + x.name + "' mimics '" + j->mimic->joint_name + "', which is not a joint of the file");
+    m_.couplers.push_back(Coupler{x.name + "_mimic", line, joint_index.at(x.name), other->second, j->mimic->multiplier,
+                                  j->mimic->offset});
   }
   return std::move(m_);
 }

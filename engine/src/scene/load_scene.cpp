@@ -237,10 +237,14 @@ Scene read_tree(const YAML::Node& root, const std::string& text, const std::stri
 std::string scene_text(const std::string& path, const SceneLimits& limits) {
   std::string text = detail::scene::read_scene_file(path, limits);
   switch (model_format(path)) {
-    case ModelFormat::kAsmt: return import_asmt(text, path).yaml;
-    case ModelFormat::kUrdf: return import_urdf(text, path).yaml;
-    case ModelFormat::kMjcf: return import_mjcf(text, path).yaml;
-    case ModelFormat::kScene: break;
+    case ModelFormat::kAsmt:
+      return import_asmt(text, path).yaml;
+    case ModelFormat::kUrdf:
+      return import_urdf(text, path).yaml;
+    case ModelFormat::kMjcf:
+      return import_mjcf(text, path).yaml;
+    case ModelFormat::kScene:
+      break;
   }
   return text;
 }
