@@ -21,20 +21,24 @@ Command register_convert(CLI::App& app) {
   };
   auto a = std::make_shared<Args>();
   CLI::App* convert = app.add_subcommand(
-      "convert", "Write a FreeCAD Assembly (.asmt), URDF (.urdf) or MJCF (.xml, .mjcf) model as a phiq scene");
-  convert->add_option("model", a->model, "The .asmt, .urdf, .xml or .mjcf file")->required();
+      "convert",
+      "Write a FreeCAD Assembly (.asmt), URDF (.urdf), MJCF (.xml, .mjcf) or SDF (.sdf) model as a phiq scene");
+  convert->add_option("model", a->model, "The .asmt, .urdf, .xml, .mjcf or .sdf file")->required();
   convert->add_option("-o,--output", a->out, "Scene file to write ('-': standard output)")
       ->required()
       ->transform(output_path("", false));
-  convert->add_option("--drive", a->drives,
-                      "JOINT=EXPR (URDF, MJCF; repeatable): drive the joint's angle (rad, 0 at the file's pose) or "
-                      "travel (m) by an expression of t");
-  convert->add_option("--time", a->time, "START END STEPS (URDF, MJCF): the time grid (default 0 0 0: the file's pose)")
+  convert->add_option(
+      "--drive", a->drives,
+      "JOINT=EXPR (URDF, MJCF, SDF; repeatable): drive the joint's angle (rad, 0 at the file's pose) or "
+      "travel (m) by an expression of t");
+  convert
+      ->add_option("--time", a->time,
+                   "START END STEPS (URDF, MJCF, SDF): the time grid (default 0 0 0: the file's pose)")
       ->expected(3);
   return {convert, [a] {
             const ModelFormat format = model_format(a->model);
             if (format == ModelFormat::kScene)
-              return fail("convert: " + a->model + ": not an .asmt, .urdf, .xml or .mjcf file", 2);
+              return fail("convert: " + a->model + ": not an .asmt, .urdf, .xml, .mjcf or .sdf file", 2);
             ImportOptions options;
             for (const std::string& d : a->drives) {
               const std::size_t eq = d.find('=');
@@ -49,7 +53,7 @@ Command register_convert(CLI::App& app) {
               options.t_start = a->time[0], options.t_end = a->time[1], options.steps = static_cast<int>(steps);
             }
             if (format == ModelFormat::kAsmt && (!options.drives.empty() || !a->time.empty()))
-              return fail("convert: --drive and --time are for URDF and MJCF: an .asmt file has its motions", 2);
+              return fail("convert: --drive and --time are for URDF, MJCF and SDF: an .asmt file has its motions", 2);
             const std::optional<std::string> imported = import_or_report(a->model, options);
             if (!imported) return 2;
             set_interrupt_subject("convert: " + a->out, "; no output written");

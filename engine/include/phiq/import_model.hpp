@@ -1,5 +1,6 @@
 /// @file
-/// Robot descriptions read as phiq scenes: URDF (through urdfdom) and MJCF, MuJoCo's XML (through tinyxml2), beside
+/// Robot descriptions read as phiq scenes: URDF (through urdfdom), MJCF, MuJoCo's XML (through tinyxml2), and SDF
+/// (through libsdformat), beside
 /// FreeCAD's `.asmt` (phiq/import_asmt.hpp). Each file is converted to the text of a phiq scene (models/README.md),
 /// which load_scene() then reads, so `phiq convert` writes the very text a direct read solves. Links and bodies
 /// become bodies (Euler parameters, the model's pose as the guess) with their inertials and geometry as parts, joints
@@ -20,6 +21,7 @@ enum class ModelFormat {
   kAsmt,   ///< `.asmt`: FreeCAD Assembly / OndselSolver (phiq/import_asmt.hpp)
   kUrdf,   ///< `.urdf`
   kMjcf,   ///< `.mjcf` or `.xml` (MuJoCo's MJCF, phiq's only XML format)
+  kSdf,    ///< `.sdf` (SDFormat, through libsdformat 12)
 };
 
 /// The format of the file at `path`, by its extension (any case).
@@ -58,9 +60,14 @@ ModelImport import_urdf(const std::string& text, const std::string& path, const 
 /// equality's polycoef, a joint type or geom reference it does not know), and as import_urdf() for drivers.
 ModelImport import_mjcf(const std::string& text, const std::string& path, const ImportOptions& options = {});
 
-/// import_urdf() or import_mjcf() of the file at `path`, by model_format(), read as load_scene() reads a scene (its
-/// size limit; FIFOs, directories and devices handled as there). Throws SceneError as they do, and for a path whose
-/// format is neither.
+/// Converts the text of an SDF file: its model (or its world's first), links as bodies, joints revolute,
+/// continuous, prismatic, ball, fixed and universal in any graph (loops close natively). Throws SceneError
+/// "PATH:LINE: what" for what libsdformat refuses, another joint type, a nested or static model.
+ModelImport import_sdf(const std::string& text, const std::string& path, const ImportOptions& options = {});
+
+/// import_urdf(), import_mjcf() or import_sdf() of the file at `path`, by model_format(), read as load_scene() reads a
+/// scene (its size limit; FIFOs, directories and devices handled as there). Throws SceneError as they do, and for a
+/// path whose format is none of them.
 ModelImport import_model_file(const std::string& path, const ImportOptions& options = {});
 
 }  // namespace phiq

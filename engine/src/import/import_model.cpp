@@ -18,14 +18,16 @@ ModelFormat model_format(const std::string& path) {
   if (ext == "asmt") return ModelFormat::kAsmt;
   if (ext == "urdf") return ModelFormat::kUrdf;
   if (ext == "mjcf" || ext == "xml") return ModelFormat::kMjcf;
+  if (ext == "sdf") return ModelFormat::kSdf;
   return ModelFormat::kScene;
 }
 
 ModelImport import_model_file(const std::string& path, const ImportOptions& options) {
   const ModelFormat format = model_format(path);
-  if (format != ModelFormat::kUrdf && format != ModelFormat::kMjcf)
-    throw SceneError(path + ": not a URDF (.urdf) or MJCF (.mjcf, .xml) file");
+  if (format != ModelFormat::kUrdf && format != ModelFormat::kMjcf && format != ModelFormat::kSdf)
+    throw SceneError(path + ": not a URDF (.urdf), MJCF (.mjcf, .xml) or SDF (.sdf) file");
   const std::string text = detail::scene::read_scene_file(path, SceneLimits{});
+  if (format == ModelFormat::kSdf) return import_sdf(text, path, options);
   return format == ModelFormat::kUrdf ? import_urdf(text, path, options) : import_mjcf(text, path, options);
 }
 

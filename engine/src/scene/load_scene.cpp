@@ -243,6 +243,8 @@ std::string scene_text(const std::string& path, const SceneLimits& limits) {
       return import_urdf(text, path).yaml;
     case ModelFormat::kMjcf:
       return import_mjcf(text, path).yaml;
+    case ModelFormat::kSdf:
+      return import_sdf(text, path).yaml;
     case ModelFormat::kScene:
       break;
   }
