@@ -16,15 +16,18 @@ namespace {
 
 using namespace phiq;
 
+// URDF requires a revolute joint's limits (urdfdom refuses one without); phiq lists them as not mapped.
+const std::string kLimit = "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/>";
+
 std::string import_bench_urdf(int joints) {
   std::string s = "<robot name=\"arms\">\n<link name=\"base\"/>\n";
   for (int k = 0; k < joints / 2; ++k) {
     const std::string i = std::to_string(k);
     s += "<link name=\"upper" + i + "\"/><link name=\"lower" + i + "\"/>\n<joint name=\"shoulder" + i +
          "\" type=\"revolute\"><parent link=\"base\"/><child link=\"upper" + i + "\"/><origin xyz=\"" + i +
-         " 0 0\"/><axis xyz=\"0 0 1\"/></joint>\n<joint name=\"elbow" + i +
+         " 0 0\"/><axis xyz=\"0 0 1\"/>" + kLimit + "</joint>\n<joint name=\"elbow" + i +
          "\" type=\"revolute\"><parent link=\"upper" + i + "\"/><child link=\"lower" + i +
-         "\"/><origin xyz=\"0.5 0 0\" rpy=\"0 0 0.3\"/><axis xyz=\"0 0 1\"/></joint>\n";
+         "\"/><origin xyz=\"0.5 0 0\" rpy=\"0 0 0.3\"/><axis xyz=\"0 0 1\"/>" + kLimit + "</joint>\n";
   }
   return s + "</robot>\n";
 }

@@ -103,6 +103,7 @@ class UrdfReader {
   tinyxml2::XMLDocument doc_;
   std::map<std::string, const tinyxml2::XMLElement*> links_;
   std::vector<UrdfJointXml> joints_, closing_;
+  std::set<std::string> joint_names_;
   std::map<std::string, int> body_of_link_;
   Mechanism m_;
 };
@@ -138,8 +139,7 @@ void UrdfReader::scan() {
           refuse(path_, j.line, "joint '" + j.name + "' has no <" + tag2 + " link=\"...\">");
         *field = x->Attribute("link"), *line = x->GetLineNum();
       }
-      for (const auto& other : joints_)
-        if (other.name == j.name) refuse(path_, j.line, "a second joint named '" + j.name + "'");
+      if (!joint_names_.insert(j.name).second) refuse(path_, j.line, "a second joint named '" + j.name + "'");
       (j.name.rfind("closing_", 0) == 0 ? closing_ : joints_).push_back(j);
     } else if (tag != "material") {
       unmapped(e);
