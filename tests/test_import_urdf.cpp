@@ -248,6 +248,27 @@ TEST_F(Cli, UrdfConvertWritesTheTextADirectReadSolves) {
   const Result check = run("check " + model);
   ASSERT_EQ(check.code, 0) << check.err;
   EXPECT_NE(check.out.find("dof           1 (1 not driven)"), std::string::npos) << check.out;
+  // an inconsistent loop (a door's third hinge 1 cm off the axis of the first): refused, the conflicting joints named
+  const fs::path door = write("door.urdf", R"(<robot name="door">
+  <link name="frame"/><link name="door"/><link name="pin3"/>
+  <joint name="hinge1" type="continuous"><parent link="frame"/><child link="door"/><axis xyz="0 0 1"/></joint>
+  <joint name="pin" type="fixed"><parent link="door"/><child link="pin3"/><origin xyz="0 0 2"/></joint>
+  <joint name="closing_hinge3" type="revolute"><parent link="frame"/><child link="pin3"/><origin xyz="0.01 0 2"/>
+    <axis xyz="0 0 1"/></joint>
+</robot>
+)");
+  const Result conflict = run("check " + door.string());
+  EXPECT_EQ(conflict.code, 1);
+  EXPECT_NE(conflict.out.find("consistent    no: conflicting hinge1, pin, closing_hinge3"), std::string::npos)
+      << conflict.out;
+  const Result refused =
+      run("convert " + door.string() + " -o " + (dir_ / "door.yaml").string() + " --drive hinge1=t --time 0 1 2");
+  ASSERT_EQ(refused.code, 0) << refused.err;
+  const Result door_run = run("run " + (dir_ / "door.yaml").string() + " -o " + (dir_ / "door.csv").string());
+  EXPECT_EQ(door_run.code, 1);
+  EXPECT_NE(door_run.err.find("conflicting constraints: hinge1, pin, closing_hinge3"), std::string::npos)
+      << door_run.err;
+  EXPECT_FALSE(fs::exists(dir_ / "door.csv"));
   // bad arguments and files: one line, exit 2, nothing written
   for (const std::string& args : {"convert " + model + " --drive crank_joint", "convert " + model + " --drive elbow=t",
                                   "convert " + (dir_ / "none.urdf").string(), "run " + (dir_ / "none.urdf").string()}) {
