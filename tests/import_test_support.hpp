@@ -84,6 +84,18 @@ inline double slider_crank_x(double theta) {
   return a * std::cos(theta) + std::sqrt(b * b - a * a * std::sin(theta) * std::sin(theta));
 }
 
+// The five-bar of five_bar.urdf/.xml: cranks 0.3 about (0, 0) and (0.4, 0) at θ1, θ2, distal links 0.4 meeting at
+// the end effector, on the upper branch.
+inline Eigen::Vector3d five_bar_effector(double theta1, double theta2) {
+  const double l1 = 0.3, l2 = 0.4;
+  const Eigen::Vector2d A1 = l1 * Eigen::Vector2d(std::cos(theta1), std::sin(theta1));
+  const Eigen::Vector2d A2 = Eigen::Vector2d(0.4, 0) + l1 * Eigen::Vector2d(std::cos(theta2), std::sin(theta2));
+  const Eigen::Vector2d d = A2 - A1;
+  const double h = std::sqrt(l2 * l2 - d.squaredNorm() / 4);
+  const Eigen::Vector2d E = A1 + d / 2 + h * Eigen::Vector2d(-d.y(), d.x()) / d.norm();
+  return Eigen::Vector3d(E.x(), E.y(), 0);
+}
+
 // The same four-bar written as a phiq scene, driven as the tests drive the imports (crank angle π/3 + 2πt).
 inline constexpr const char* kFourbarByHand = R"(phiq: 1
 dimension: 3

@@ -86,6 +86,29 @@ TEST(MjcfImport, FourBarClosedByConnectEqualsTheURDFAndTheSceneWrittenByHand) {
   EXPECT_EQ(imported.skipped.size(), 5u);
 }
 
+// A parallel mechanism: the five-bar's two cranks driven, its end effector where both distal links reach, in MJCF
+// (closed by `connect`) and URDF (by `closing_effector`) alike.
+TEST(MjcfImport, FiveBarParallelRobotPlacesItsEffectorAsTheClosedFormAndTheURDF) {
+  ImportOptions o;
+  o.drives = {{"motor1", "0.3*t"}, {"motor2", "-0.2*t"}}, o.t_end = 1, o.steps = 20;
+  const std::string path = import_data("mjcf/five_bar.xml"), urdf_path = import_data("urdf/five_bar.urdf");
+  const test::ImportRun mjcf = import_sweep(import_mjcf(import_text(path), path, o).yaml, path);
+  ASSERT_EQ(mjcf.status, SolveStatus::kSuccess) << mjcf.message;
+  const ModelImport urdf_import = import_urdf(import_text(urdf_path), urdf_path, o);
+  EXPECT_EQ(urdf_import.loops, 1);
+  const test::ImportRun urdf = import_sweep(urdf_import.yaml, urdf_path);
+  ASSERT_EQ(urdf.status, SolveStatus::kSuccess) << urdf.message;
+  ASSERT_EQ(mjcf.trace.q.size(), 21u);
+  ASSERT_EQ(urdf.trace.q.size(), 21u);
+  for (std::size_t k = 0; k < mjcf.trace.q.size(); ++k) {
+    const double t = mjcf.trace.t[k];
+    const Eigen::Vector3d E = test::import_point(mjcf.model(), mjcf.trace.q[k], "distal1", {0.4, 0, 0});
+    EXPECT_LT((E - test::five_bar_effector(1.9 + 0.3 * t, 1.2 - 0.2 * t)).norm(), 1e-10) << "t = " << t;
+    EXPECT_LT((E - test::import_point(urdf.model(), urdf.trace.q[k], "tip")).norm(), 1e-12) << "t = " << t;
+    EXPECT_LT((test::import_point(mjcf.model(), mjcf.trace.q[k], "distal2", {0.4, 0, 0}) - E).norm(), 1e-12);
+  }
+}
+
 TEST(MjcfImport, SliderCrankInDegreesSlidesAsItsClosedFormSays) {
   const std::string path = import_data("mjcf/slider_crank.xml");
   const ModelImport imported = import_mjcf(import_text(path), path, MjcfDrive("crank_joint", "2*pi*t", 1, 36));
