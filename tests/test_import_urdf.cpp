@@ -116,6 +116,21 @@ TEST(UrdfImport, MimicJointIsACouplerOfTheTwoAngles) {
   }
 }
 
+// A mimic of a prismatic joint: the rack's travel (an `equation` over the bodies' coordinates) coupled to the
+// pinion's angle, along a rack turned 0.2 rad about z.
+TEST(UrdfImport, MimicOfAPrismaticJointCouplesItsTravel) {
+  const std::string path = import_data("urdf/rack_pinion.urdf");
+  const test::ImportRun r =
+      import_sweep(import_urdf(import_text(path), path, UrdfDrive("pinion_joint", "2*t", 2, 20)).yaml, path);
+  ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
+  const Eigen::Vector3d along(std::cos(0.2), std::sin(0.2), 0);
+  for (std::size_t k = 0; k < r.trace.q.size(); ++k) {
+    const double t = r.trace.t[k];
+    const Eigen::Vector3d rack = test::import_point(r.model(), r.trace.q[k], "rack");
+    EXPECT_LT((rack - (Eigen::Vector3d(0.1, 0, 0) + (0.05 * 2 * t + 0.01) * along)).norm(), 1e-12) << "t = " << t;
+  }
+}
+
 // Every joint type, each with the freedoms URDF gives it: fixed 0, prismatic 1, planar 3, continuous 1, revolute 1
 // (about an oblique axis), floating 6.
 TEST(UrdfImport, EveryJointTypeLeavesItsFreedoms) {

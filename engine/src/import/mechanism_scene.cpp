@@ -3,6 +3,7 @@
 // pose, as the file's joint coordinates are), couplers over `rotation_angle` coordinates, drivers and the time grid
 // from ImportOptions, inertials and geometry as parts.
 #include <Eigen/Geometry>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <set>
@@ -99,6 +100,7 @@ class MechanismWriter {
            ", axis: " + mvec(s.axis.normalized()) + ", ref: " + mvec(s.ref.normalized()) + "}";
   }
   std::string joint_coordinate(int j, const Coupler& c);
+  std::array<std::string, 3> rotated(int b, const Eigen::Vector3d& v) const;
   void coupler(const Coupler& c);
   void drivers();
   std::string parts();
@@ -112,19 +114,63 @@ class MechanismWriter {
 };
 
 // The coordinate that holds joint j's angle (a `rotation_angle` of the joint), made once.
+// The coordinate that holds joint j's angle (a `rotation_angle` of a revolute joint) or travel (a prismatic joint's
+// z₁ · (P₂ − P₁), an `equation` over the bodies' coordinates), made once.
 std::string MechanismWriter::joint_coordinate(int j, const Coupler& c) {
   if (const auto it = joint_coordinate_.find(j); it != joint_coordinate_.end()) return it->second;
   const Joint& joint = m_.joints[static_cast<std::size_t>(j)];
-  if (joint.kind != "revolute")
+  const std::string& jname = joint_[static_cast<std::size_t>(j)];
+  if (joint.kind == "revolute") {
+    const std::string name = names_.make(jname + "_angle");
+    coordinates_ << "  " << name << ": 0\n";
+    constraints_ << "  - {name: " << names_.make(name + "_def") << ", type: rotation_angle, joint: " << jname
+                 << ", angle: " << name << "}\n";
+    return joint_coordinate_[j] = name;
+  }
+  if (joint.kind != "prismatic")
     refuse(m_.path, c.line,
            "'" + c.name + "' couples " + (joint.kind.empty() ? "a free" : joint.kind) + " joint '" + joint.name +
-               "': phiq couples the angles of revolute (hinge, continuous) joints");
-  const std::string name = names_.make(joint_[static_cast<std::size_t>(j)] + "_angle");
+               "': phiq couples revolute angles and prismatic travels");
+  // travel = (R₁ a) · (r₂ + R₂ b − r₁) − a · p, a the axis and p the point of side 1, b the point of side 2
+  const std::string name = names_.make(jname + "_travel");
+  const Eigen::Vector3d a = joint.parent.axis.normalized();
+  const std::array<std::string, 3> u = rotated(joint.parent.body, a);
+  const std::array<std::string, 3> rb = rotated(joint.child.body, joint.child.at);
+  std::string expr = name + " - (";
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::string w = "(" + rb[i];
+    if (joint.child.body > 0) w += " + " + body_[static_cast<std::size_t>(joint.child.body)] + "_" + "xyz"[i];
+    if (joint.parent.body > 0) w += " - " + body_[static_cast<std::size_t>(joint.parent.body)] + "_" + "xyz"[i];
+    expr += (i ? " + " : "") + std::string("(") + u[i] + ")*" + w + ")";
+  }
+  expr += " - (" + mnum(a.dot(joint.parent.at)) + "))";
   coordinates_ << "  " << name << ": 0\n";
-  constraints_ << "  - {name: " << names_.make(name + "_def")
-               << ", type: rotation_angle, joint: " << joint_[static_cast<std::size_t>(j)] << ", angle: " << name
-               << "}\n";
+  constraints_ << "  - {name: " << names_.make(name + "_def") << ", type: equation, unit: length, expr: \"" << expr
+               << "\"}\n";
   return joint_coordinate_[j] = name;
+}
+
+// The world components of R v, R the rotation of body `b` (its Euler parameters; constants for the ground).
+std::array<std::string, 3> MechanismWriter::rotated(int b, const Eigen::Vector3d& v) const {
+  if (b == 0) return {"(" + mnum(v.x()) + ")", "(" + mnum(v.y()) + ")", "(" + mnum(v.z()) + ")"};
+  const std::string& n = body_[static_cast<std::size_t>(b)];
+  const std::string e0 = n + "_e0", e1 = n + "_e1", e2 = n + "_e2", e3 = n + "_e3";
+  const std::string R[3][3] = {
+      {"(1 - 2*(" + e2 + "^2 + " + e3 + "^2))", "2*(" + e1 + "*" + e2 + " - " + e0 + "*" + e3 + ")",
+       "2*(" + e1 + "*" + e3 + " + " + e0 + "*" + e2 + ")"},
+      {"2*(" + e1 + "*" + e2 + " + " + e0 + "*" + e3 + ")", "(1 - 2*(" + e1 + "^2 + " + e3 + "^2))",
+       "2*(" + e2 + "*" + e3 + " - " + e0 + "*" + e1 + ")"},
+      {"2*(" + e1 + "*" + e3 + " - " + e0 + "*" + e2 + ")", "2*(" + e2 + "*" + e3 + " + " + e0 + "*" + e1 + ")",
+       "(1 - 2*(" + e1 + "^2 + " + e2 + "^2))"}};
+  std::array<std::string, 3> out;
+  for (std::size_t r = 0; r < 3; ++r) {
+    std::string sum;
+    for (std::size_t k = 0; k < 3; ++k)
+      if (v[static_cast<Eigen::Index>(k)] != 0.0)
+        sum += (sum.empty() ? "" : " + ") + R[r][k] + "*(" + mnum(v[static_cast<Eigen::Index>(k)]) + ")";
+    out[r] = sum.empty() ? "0" : "(" + sum + ")";
+  }
+  return out;
 }
 
 void MechanismWriter::coupler(const Coupler& c) {
