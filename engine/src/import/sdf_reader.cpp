@@ -106,6 +106,10 @@ Mechanism SdfReader::read(int* loops) {
   if (!model && root.WorldCount() > 0 && root.WorldByIndex(0)->ModelCount() > 0)
     model = root.WorldByIndex(0)->ModelByIndex(0);
   if (!model) refuse(path_, 0, "the file has no model");
+  if (root.WorldCount() > 0)
+    for (uint64_t k = 1; k < root.WorldByIndex(0)->ModelCount(); ++k)
+      m_.skip("<model> after the world's first", sdf_line(root.WorldByIndex(0)->ModelByIndex(k)->Element()),
+              "phiq reads one model of a world");
   m_.name = model->Name();
   if (model->ModelCount() > 0) refuse(path_, sdf_line(model->ModelByIndex(0)->Element()), "nested models are not read");
   if (model->Static()) refuse(path_, sdf_line(model->Element()), "a static model does not move");
