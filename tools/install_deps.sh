@@ -19,6 +19,8 @@ packages=(
   libhdf5-dev          # HDF5 1.10 (serial flavour, C interface): `phiq run -o OUT.h5`, `phiq compare` of HDF5
   libassimp-dev        # Assimp 5.2: the mesh files (STL, OBJ) of a body's parts (engine/src/parts/mesh_file.cpp)
   libfcl-dev libccd-dev  # FCL 0.7 and libccd: distances between parts (engine/src/clearance/, `phiq clearance`)
+  liburdfdom-dev liburdfdom-headers-dev libtinyxml2-dev  # URDF (urdfdom 3) and MJCF (tinyxml2 9) files read as scenes
+  libsdformat-dev      # SDFormat 12: SDF files read as scenes (engine/src/import/sdf_reader.cpp)
   libjs-three          # three.js r111 and its OrbitControls, embedded at build time into `phiq animate -o OUT.html`
   openmpi-bin libopenmpi-dev  # `mpirun -np K phiq batch` (tools/cli/batch_ranks.hpp); found at configure time
   python3-dev python3-pybind11 pybind11-dev  # the Python package phiq (engine/python/), for /usr/bin/python3

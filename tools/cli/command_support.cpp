@@ -114,12 +114,19 @@ void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args) {
 }
 
 // (command_support.hpp)
-std::optional<AsmtImport> import_or_report(const std::string& path) {
+std::optional<std::string> import_or_report(const std::string& path, const ImportOptions& options) {
   try {
-    AsmtImport imported = import_asmt_file(path);
-    for (const std::string& why : imported.skipped)
-      std::fprintf(stderr, "phiq: not mapped: %s\n", printable(why).c_str());
-    return imported;
+    std::string yaml;
+    std::vector<std::string> skipped;
+    if (model_format(path) == ModelFormat::kAsmt) {
+      AsmtImport imported = import_asmt_file(path);
+      yaml = std::move(imported.yaml), skipped = std::move(imported.skipped);
+    } else {
+      ModelImport imported = import_model_file(path, options);
+      yaml = std::move(imported.yaml), skipped = std::move(imported.skipped);
+    }
+    for (const std::string& why : skipped) std::fprintf(stderr, "phiq: not mapped: %s\n", printable(why).c_str());
+    return yaml;
   } catch (const SceneError& e) {
     fail(e.what(), 2);
   }
@@ -132,10 +139,10 @@ std::optional<Scene> load_or_report(const std::string& path, const std::vector<s
     SceneOverrides o = parameter_settings(sets);
     o.sensitivities = sensitivity_requests(sensitivity_args), o.sensitivities_source = "--sensitivity";
     if (path == "-") return phiq::parse_scene(load_stdin_text(), kStdinScene, SceneLimits{}, o);
-    if (is_asmt_path(path)) {  // converted here rather than in load_scene(), to list what it leaves out
-      const std::optional<AsmtImport> imported = import_or_report(path);
+    if (model_format(path) != ModelFormat::kScene) {  // converted here rather than in load_scene(), to list what
+      const std::optional<std::string> imported = import_or_report(path);  // it leaves out
       if (!imported) return std::nullopt;
-      return phiq::parse_scene(imported->yaml, path, SceneLimits{}, o);
+      return phiq::parse_scene(*imported, path, SceneLimits{}, o);
     }
     return phiq::load_scene(path, SceneLimits{}, o);
   } catch (const phiq::SceneError& e) {

@@ -30,7 +30,7 @@ _phiq() {
     batch) opts="--help --output --quiet --threads --summary --names --resume --sensitivity" ;;
     compare) opts="--help --rtol --atol --columns --json --junit" ;;
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
-    convert) opts="--help --output" ;;
+    convert) opts="--help --output --drive --time" ;;
     plot) opts="--help --output --columns --positions --set" ;;
     animate) opts="--help --output --columns --set" ;;
     sweep-accuracy) opts="--help --output --json --tolerances --steps-list --predictors --newton --linear-solvers

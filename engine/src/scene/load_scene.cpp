@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "phiq/import_asmt.hpp"
+#include "phiq/import_model.hpp"
 #include "phiq/parsed_scene.hpp"
 #include "phiq/scene.hpp"
 #include "phiq/text.hpp"
@@ -231,10 +232,23 @@ Scene read_tree(const YAML::Node& root, const std::string& text, const std::stri
   return scene;
 }
 
-// The scene's text: the file's, or the phiq scene an `.asmt` file converts to (phiq/import_asmt.hpp).
+// The scene's text: the file's, or the phiq scene an `.asmt`, URDF or MJCF file converts to (phiq/import_asmt.hpp,
+// phiq/import_model.hpp).
 std::string scene_text(const std::string& path, const SceneLimits& limits) {
   std::string text = detail::scene::read_scene_file(path, limits);
-  return is_asmt_path(path) ? import_asmt(text, path).yaml : text;
+  switch (model_format(path)) {
+    case ModelFormat::kAsmt:
+      return import_asmt(text, path).yaml;
+    case ModelFormat::kUrdf:
+      return import_urdf(text, path).yaml;
+    case ModelFormat::kMjcf:
+      return import_mjcf(text, path).yaml;
+    case ModelFormat::kSdf:
+      return import_sdf(text, path).yaml;
+    case ModelFormat::kScene:
+      break;
+  }
+  return text;
 }
 
 }  // namespace

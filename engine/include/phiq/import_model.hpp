@@ -1,0 +1,73 @@
+/// @file
+/// Robot descriptions read as phiq scenes: URDF (through urdfdom), MJCF, MuJoCo's XML (through tinyxml2), and SDF
+/// (through libsdformat), beside
+/// FreeCAD's `.asmt` (phiq/import_asmt.hpp). Each file is converted to the text of a phiq scene (models/README.md),
+/// which load_scene() then reads, so `phiq convert` writes the very text a direct read solves. Links and bodies
+/// become bodies (Euler parameters, the model's pose as the guess) with their inertials and geometry as parts, joints
+/// phiq's spatial joints, URDF mimic joints and MJCF joint equalities couplers, loop closures (URDF `closing_*`
+/// joints, MJCF `connect` and `weld`) joints like the others. A robot description has no kinematic drivers: they come
+/// from ImportOptions (`--drive` on the command line), or are added to the converted scene by hand.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace phiq {
+
+/// The formats load_scene() and the command line read, by the file's extension.
+enum class ModelFormat {
+  kScene,  ///< a phiq scene (YAML or JSON): any other extension
+  kAsmt,   ///< `.asmt`: FreeCAD Assembly / OndselSolver (phiq/import_asmt.hpp)
+  kUrdf,   ///< `.urdf`
+  kMjcf,   ///< `.mjcf` or `.xml` (MuJoCo's MJCF, phiq's only XML format)
+  kSdf,    ///< `.sdf` (SDFormat, through libsdformat 12)
+};
+
+/// The format of the file at `path`, by its extension (any case).
+ModelFormat model_format(const std::string& path);
+
+/// What the caller adds to a description that has no drivers and no time grid.
+struct ImportOptions {
+  /// Joint drivers: the file's joint name and an expression of `t` (and `pi`) for its angle (revolute,
+  /// continuous, hinge: rad, 0 at the model's pose) or travel (prismatic, slide: m), as `phiq convert --drive
+  /// JOINT=EXPR` writes them.
+  std::vector<std::pair<std::string, std::string>> drives;
+  double t_start = 0.0;  ///< the time grid's start (s)
+  double t_end = 0.0;    ///< its end (s); with no drives and t_end == t_start: the model's pose alone
+  int steps = 0;         ///< its intervals (0: one row at t_start)
+};
+
+/// What an import made of a file.
+struct ModelImport {
+  std::string yaml;                  ///< the phiq scene (dimension 3, lengths in metres)
+  std::vector<std::string> skipped;  ///< "FILE:LINE: what (N in all): why not mapped", once per kind of element
+  int bodies = 0;                    ///< moving bodies (ground not counted)
+  int joints = 0;                    ///< joints, loop closures included
+  int loops = 0;                     ///< joints that close a loop (URDF closing joints, MJCF connect and weld)
+  int couplers = 0;                  ///< couplers between joints (URDF mimic, MJCF joint equality)
+};
+
+/// Converts the text of a URDF file; `path` names it in messages and is the folder meshes are relative to.
+/// Joints named `closing_*` close loops: they are taken out before urdfdom reads the tree and joined like the others.
+/// Throws SceneError, one line "PATH:LINE: what", for malformed XML, an unknown joint type, a joint naming a missing
+/// link, a cycle or a link with two parents that no `closing_` name declares, a mimic of a missing joint, a driver of
+/// an unknown joint.
+ModelImport import_urdf(const std::string& text, const std::string& path, const ImportOptions& options = {});
+
+/// Converts the text of an MJCF file (`<mujoco>`). Throws SceneError "PATH:LINE: what" for malformed XML, an
+/// element that changes the kinematics and phiq cannot represent exactly (an `include`, a `frame`, a nonlinear joint
+/// equality's polycoef, a joint type or geom reference it does not know), and as import_urdf() for drivers.
+ModelImport import_mjcf(const std::string& text, const std::string& path, const ImportOptions& options = {});
+
+/// Converts the text of an SDF file: its model (or its world's first), links as bodies, joints revolute,
+/// continuous, prismatic, ball, fixed and universal in any graph (loops close natively). Throws SceneError
+/// "PATH:LINE: what" for what libsdformat refuses, another joint type, a nested or static model.
+ModelImport import_sdf(const std::string& text, const std::string& path, const ImportOptions& options = {});
+
+/// import_urdf(), import_mjcf() or import_sdf() of the file at `path`, by model_format(), read as load_scene() reads a
+/// scene (its size limit; FIFOs, directories and devices handled as there). Throws SceneError as they do, and for a
+/// path whose format is none of them.
+ModelImport import_model_file(const std::string& path, const ImportOptions& options = {});
+
+}  // namespace phiq

@@ -1,0 +1,306 @@
+// A mechanism::Mechanism written as a phiq scene (models/README.md): bodies as maps with Euler parameters at the
+// model's pose, joints as spatial joints whose sides state `ref` on both ends (a joint angle is then 0 at the model's
+// pose, as the file's joint coordinates are), couplers over `rotation_angle` coordinates, drivers and the time grid
+// from ImportOptions, inertials and geometry as parts.
+#include <Eigen/Geometry>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "import/mechanism.hpp"
+#include "phiq/expression.hpp"
+#include "phiq/scene.hpp"
+#include "phiq/text.hpp"
+
+namespace phiq::detail::mechanism {
+
+void refuse(const std::string& path, int line, const std::string& what) {
+  throw SceneError(path + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + what);
+}
+
+Eigen::Vector3d perpendicular(const Eigen::Vector3d& axis) {
+  const Eigen::Vector3d z = axis.normalized();
+  Eigen::Index k = 0;
+  z.cwiseAbs().minCoeff(&k);
+  return z.cross(Eigen::Vector3d::Unit(k)).cross(z).normalized();
+}
+
+Eigen::Matrix3d axis_angle(const Eigen::Vector3d& axis, double angle) {
+  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+}
+
+namespace {
+
+std::string mnum(double v) { return shortest_unsigned_zero(v); }
+std::string mvec(const Eigen::Vector3d& v) { return "[" + mnum(v.x()) + ", " + mnum(v.y()) + ", " + mnum(v.z()) + "]"; }
+std::string mquoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : single_line(s)) out += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+  return out + "\"";
+}
+std::string orientation(const Eigen::Matrix3d& R) {
+  Eigen::Quaterniond q(R);
+  q.normalize();
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  return "{euler_parameters: [" + mnum(q.w()) + ", " + mnum(q.x()) + ", " + mnum(q.y()) + ", " + mnum(q.z()) + "]}";
+}
+
+// phiq names (letters, digits, `_`) made from the file's, unique across the scene: what a name cannot hold becomes
+// `_`, a name taken gets `_2`, `_3`, ...; a body's name reserves its coordinates' names (NAME_x, ..., NAME_e3).
+class MechanismNames {
+ public:
+  std::string make(const std::string& raw, bool body = false) {
+    std::string base;
+    for (char c : raw) base += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+    if (base.empty() || std::isdigit(static_cast<unsigned char>(base[0]))) base = "n_" + base;
+    std::string lower;
+    for (char c : base) lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    static const std::set<std::string> reserved = {"t",   "pi", "ground", "null", "true", "false",
+                                                   "yes", "no", "on",     "off",  "y",    "n"};
+    if (reserved.count(lower)) base += "_";  // phiq's names, and YAML's words for null and booleans
+    std::string name = base;
+    for (int k = 2; taken(name, body); ++k) name = base + "_" + std::to_string(k);
+    used_.insert(name);
+    if (body)
+      for (const char* s : kCoordinates) used_.insert(name + s);
+    return name;
+  }
+
+ private:
+  static constexpr const char* kCoordinates[] = {"_x", "_y", "_z", "_e0", "_e1", "_e2", "_e3"};
+  bool taken(const std::string& n, bool body) const {
+    if (used_.count(n)) return true;
+    if (body)
+      for (const char* s : kCoordinates)
+        if (used_.count(n + s)) return true;
+    return false;
+  }
+  std::set<std::string> used_;
+};
+
+// A body whose mass phiq accepts: positive mass, symmetric positive definite inertia whose principal moments each
+// are at most the sum of the others.
+bool rigid_mass(const Body& b) {
+  if (!(b.mass > 0.0)) return false;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (b.inertia + b.inertia.transpose()));
+  const Eigen::Vector3d m = eig.eigenvalues();
+  return m.minCoeff() > 0.0 && m(2) <= (m(0) + m(1)) * (1 + 1e-12);
+}
+
+class MechanismWriter {
+ public:
+  MechanismWriter(Mechanism& m, const ImportOptions& o) : m_(m), o_(o) {}
+  std::string write();
+
+ private:
+  std::string side(const Side& s) const {
+    return "{body: " + body_[static_cast<std::size_t>(s.body)] + ", at: " + mvec(s.at) +
+           ", axis: " + mvec(s.axis.normalized()) + ", ref: " + mvec(s.ref.normalized()) + "}";
+  }
+  std::string joint_coordinate(int j, const Coupler& c);
+  std::array<std::string, 3> rotated(int b, const Eigen::Vector3d& v) const;
+  void coupler(const Coupler& c);
+  void drivers();
+  std::string parts();
+
+  Mechanism& m_;
+  const ImportOptions& o_;
+  MechanismNames names_;
+  std::vector<std::string> body_, joint_;
+  std::map<int, std::string> joint_coordinate_;
+  std::ostringstream coordinates_, constraints_, drivers_;
+};
+
+// The coordinate that holds joint j's angle (a `rotation_angle` of the joint), made once.
+// The coordinate that holds joint j's angle (a `rotation_angle` of a revolute joint) or travel (a prismatic joint's
+// z₁ · (P₂ − P₁), an `equation` over the bodies' coordinates), made once.
+std::string MechanismWriter::joint_coordinate(int j, const Coupler& c) {
+  if (const auto it = joint_coordinate_.find(j); it != joint_coordinate_.end()) return it->second;
+  const Joint& joint = m_.joints[static_cast<std::size_t>(j)];
+  const std::string& jname = joint_[static_cast<std::size_t>(j)];
+  if (joint.kind == "revolute") {
+    const std::string name = names_.make(jname + "_angle");
+    coordinates_ << "  " << name << ": 0\n";
+    constraints_ << "  - {name: " << names_.make(name + "_def") << ", type: rotation_angle, joint: " << jname
+                 << ", angle: " << name << "}\n";
+    return joint_coordinate_[j] = name;
+  }
+  if (joint.kind != "prismatic")
+    refuse(m_.path, c.line,
+           "'" + c.name + "' couples " + (joint.kind.empty() ? "a free" : joint.kind) + " joint '" + joint.name +
+               "': phiq couples revolute angles and prismatic travels");
+  // travel = (R₁ a) · (r₂ + R₂ b − r₁) − a · p, a the axis and p the point of side 1, b the point of side 2
+  const std::string name = names_.make(jname + "_travel");
+  const Eigen::Vector3d a = joint.parent.axis.normalized();
+  const std::array<std::string, 3> u = rotated(joint.parent.body, a);
+  const std::array<std::string, 3> rb = rotated(joint.child.body, joint.child.at);
+  std::string expr = name + " - (";
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::string w = "(" + rb[i];
+    if (joint.child.body > 0) w += " + " + body_[static_cast<std::size_t>(joint.child.body)] + "_" + "xyz"[i];
+    if (joint.parent.body > 0) w += " - " + body_[static_cast<std::size_t>(joint.parent.body)] + "_" + "xyz"[i];
+    expr += (i ? " + " : "") + std::string("(") + u[i] + ")*" + w + ")";
+  }
+  expr += " - (" + mnum(a.dot(joint.parent.at)) + "))";
+  coordinates_ << "  " << name << ": 0\n";
+  constraints_ << "  - {name: " << names_.make(name + "_def") << ", type: equation, unit: length, expr: \"" << expr
+               << "\"}\n";
+  return joint_coordinate_[j] = name;
+}
+
+// The world components of R v, R the rotation of body `b` (its Euler parameters; constants for the ground).
+std::array<std::string, 3> MechanismWriter::rotated(int b, const Eigen::Vector3d& v) const {
+  if (b == 0) return {"(" + mnum(v.x()) + ")", "(" + mnum(v.y()) + ")", "(" + mnum(v.z()) + ")"};
+  const std::string& n = body_[static_cast<std::size_t>(b)];
+  const std::string e0 = n + "_e0", e1 = n + "_e1", e2 = n + "_e2", e3 = n + "_e3";
+  const std::string R[3][3] = {
+      {"(1 - 2*(" + e2 + "^2 + " + e3 + "^2))", "2*(" + e1 + "*" + e2 + " - " + e0 + "*" + e3 + ")",
+       "2*(" + e1 + "*" + e3 + " + " + e0 + "*" + e2 + ")"},
+      {"2*(" + e1 + "*" + e2 + " + " + e0 + "*" + e3 + ")", "(1 - 2*(" + e1 + "^2 + " + e3 + "^2))",
+       "2*(" + e2 + "*" + e3 + " - " + e0 + "*" + e1 + ")"},
+      {"2*(" + e1 + "*" + e3 + " - " + e0 + "*" + e2 + ")", "2*(" + e2 + "*" + e3 + " + " + e0 + "*" + e1 + ")",
+       "(1 - 2*(" + e1 + "^2 + " + e2 + "^2))"}};
+  std::array<std::string, 3> out;
+  for (std::size_t r = 0; r < 3; ++r) {
+    std::string sum;
+    for (std::size_t k = 0; k < 3; ++k)
+      if (v[static_cast<Eigen::Index>(k)] != 0.0)
+        sum += (sum.empty() ? "" : " + ") + R[r][k] + "*(" + mnum(v[static_cast<Eigen::Index>(k)]) + ")";
+    out[r] = sum.empty() ? "0" : "(" + sum + ")";
+  }
+  return out;
+}
+
+void MechanismWriter::coupler(const Coupler& c) {
+  const std::string q = joint_coordinate(c.joint, c);
+  const std::string name = names_.make(c.name);
+  if (c.other < 0) {
+    constraints_ << "  - {name: " << name << ", type: equation, unit: angle, expr: \"" << q << " - (" << mnum(c.offset)
+                 << ")\"}\n";
+    return;
+  }
+  if (c.multiplier == 0.0)
+    refuse(m_.path, c.line, "'" + c.name + "': a multiplier of 0 holds the joint still: phiq's coupler needs one ≠ 0");
+  const std::string r = joint_coordinate(c.other, c);
+  constraints_ << "  - {name: " << name << ", type: coupler, coordinates: [" << q << ", " << r
+               << "], coefficients: [1, " << mnum(-c.multiplier) << "], constant: " << mnum(c.offset) << "}\n";
+}
+
+void MechanismWriter::drivers() {
+  const NameResolver time_only = [](const std::string& name) -> std::optional<NameBinding> {
+    if (name == "t") return NameBinding{NameBinding::Kind::kTime};
+    return std::nullopt;
+  };
+  for (const auto& [joint, law] : o_.drives) {
+    int found = -1;
+    for (std::size_t k = 0; k < m_.joints.size(); ++k)
+      if (m_.joints[k].name == joint) found = static_cast<int>(k);
+    if (found < 0) refuse(m_.path, 0, "--drive " + joint + ": the model has no joint '" + joint + "'");
+    const Joint& j = m_.joints[static_cast<std::size_t>(found)];
+    if (j.kind != "revolute" && j.kind != "prismatic")
+      refuse(m_.path, j.line,
+             "--drive " + joint + ": a " + (j.kind.empty() ? "free" : j.kind) +
+                 " joint; phiq drives a revolute joint's angle or a prismatic joint's travel");
+    try {
+      (void)CompiledExpression::compile(law, time_only);
+    } catch (const Error& e) {
+      refuse(m_.path, 0, "--drive " + joint + "=" + law + ": " + e.what());
+    }
+    drivers_ << "  - {name: " << names_.make("drive_" + joint_[static_cast<std::size_t>(found)])
+             << ", joint: " << joint_[static_cast<std::size_t>(found)]
+             << ", measure: " << (j.kind == "revolute" ? "angle" : "distance")
+             << ", law: {type: expression, f: " << mquoted(law) << "}}\n";
+  }
+}
+
+std::string MechanismWriter::parts() {
+  std::ostringstream out;
+  for (std::size_t k = 0; k < m_.bodies.size(); ++k) {
+    const Body& b = m_.bodies[k];
+    std::ostringstream fields;
+    if (b.has_mass && rigid_mass(b)) {
+      const Eigen::Matrix3d I = 0.5 * (b.inertia + b.inertia.transpose());
+      fields << ", mass: " << mnum(b.mass) << ", center_of_mass: " << mvec(b.com) << ", inertia: ["
+             << mvec(I.row(0).transpose()) << ", " << mvec(I.row(1).transpose()) << ", " << mvec(I.row(2).transpose())
+             << "]";
+    } else if (b.has_mass && b.mass > 0.0) {
+      m_.skip("inertial of '" + b.name + "'", b.line, "a mass or inertia no rigid body has; the body is given no mass");
+    } else if (b.density && !b.shapes.empty() && k > 0) {
+      fields << ", density: " << mnum(*b.density);
+    }
+    if (!b.shapes.empty()) {
+      fields << ", shapes: [";
+      for (std::size_t s = 0; s < b.shapes.size(); ++s) {
+        const Shape& sh = b.shapes[s];
+        fields << (s ? ", " : "") << "{type: " << sh.type;
+        if (sh.type == "box") fields << ", size: " << mvec(sh.size);
+        if (sh.type == "plane") fields << ", size: [" << mnum(sh.size.x()) << ", " << mnum(sh.size.y()) << "]";
+        if (sh.type == "sphere" || sh.type == "cylinder" || sh.type == "capsule")
+          fields << ", radius: " << mnum(sh.radius);
+        if (sh.type == "cylinder" || sh.type == "capsule") fields << ", length: " << mnum(sh.length);
+        if (sh.type == "mesh") fields << ", file: " << mquoted(sh.file) << ", scale: " << mnum(sh.scale);
+        if (!sh.at.p.isZero(0.0)) fields << ", at: " << mvec(sh.at.p);
+        if (!sh.at.R.isIdentity(0.0)) fields << ", orientation: " << orientation(sh.at.R);
+        if (sh.rgba)
+          fields << ", colour: [" << mnum((*sh.rgba)(0)) << ", " << mnum((*sh.rgba)(1)) << ", " << mnum((*sh.rgba)(2))
+                 << ", " << mnum((*sh.rgba)(3)) << "]";
+        fields << "}";
+      }
+      fields << "]";
+    }
+    if (fields.str().empty()) continue;
+    out << "  " << names_.make("part_" + body_[k]) << ": {body: " << body_[k] << fields.str() << "}\n";
+  }
+  return out.str().empty() ? "" : "parts:\n" + out.str();
+}
+
+std::string MechanismWriter::write() {
+  if (m_.bodies.size() < 2)
+    refuse(m_.path, 0, "the model has no moving " + std::string(m_.format == "URDF" ? "link" : "body"));
+  std::ostringstream bodies;
+  body_.push_back("ground");
+  for (std::size_t k = 1; k < m_.bodies.size(); ++k) {
+    const Body& b = m_.bodies[k];
+    body_.push_back(names_.make(b.name, true));
+    bodies << "  " << body_.back() << ": {at: " << mvec(b.world.p) << ", orientation: " << orientation(b.world.R)
+           << "}\n";
+  }
+  for (const Joint& j : m_.joints) {
+    joint_.push_back(names_.make(j.name));
+    if (j.kind.empty()) continue;  // a free body
+    constraints_ << "  - {name: " << joint_.back() << ", type: " << j.kind << ", between: [" << side(j.parent) << ", "
+                 << side(j.child) << "]}\n";
+  }
+  for (const Coupler& c : m_.couplers) coupler(c);
+  drivers();
+  const std::string mass = parts();
+  for (const auto& [what, u] : m_.unmapped)
+    m_.skipped.push_back(m_.path + ":" + std::to_string(u.line) + ": " + what +
+                         (u.count > 1 ? " (" + std::to_string(u.count) + " in all)" : "") + ": " + u.why);
+  const auto line_of = [&](const std::string& why) { return std::atoi(why.c_str() + m_.path.size() + 1); };
+  std::stable_sort(m_.skipped.begin(), m_.skipped.end(),
+                   [&](const std::string& x, const std::string& y) { return line_of(x) < line_of(y); });
+  std::ostringstream s;
+  s << "# Converted by phiq from " << single_line(m_.path) << " (" << m_.format << "): " << m_.units << "\n";
+  if (!m_.skipped.empty()) s << "# Not mapped:\n";
+  for (const std::string& why : m_.skipped) s << "#   " << single_line(why) << "\n";
+  s << "phiq: 1\nname: " << mquoted(m_.name) << "\ndescription: " << mquoted(m_.format + " model, imported by phiq")
+    << "\ndimension: 3\n";
+  if (!coordinates_.str().empty()) s << "coordinates:\n" << coordinates_.str();
+  s << "bodies:\n" << bodies.str();
+  if (!constraints_.str().empty()) s << "constraints:\n" << constraints_.str();
+  if (!drivers_.str().empty()) s << "drivers:\n" << drivers_.str();
+  s << "time: {start: " << mnum(o_.t_start) << ", end: " << mnum(o_.t_end) << ", steps: " << o_.steps << "}\n";
+  s << mass;
+  return s.str();
+}
+
+}  // namespace
+
+std::string write_mechanism_scene(Mechanism& m, const ImportOptions& options) {
+  return MechanismWriter(m, options).write();
+}
+
+}  // namespace phiq::detail::mechanism

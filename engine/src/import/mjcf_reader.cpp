@@ -1,0 +1,530 @@
+// MJCF (MuJoCo's XML) read as a mechanism::Mechanism through tinyxml2, which gives the line of every element.
+// MuJoCo's semantics kept: a body's pose relative to its parent (pos, and quat, axisangle, euler with the compiler's
+// eulerseq, xyaxes or zaxis; angles in degrees unless `<compiler angle="radian">`); joints in the body's frame at the
+// model's pose, several in one body applied in order (phiq gives each after the first a massless body of its own);
+// a body without a joint welded to its parent; default classes (`class`, `childclass`) for joints, geoms and
+// inertials; geoms as parts' shapes (sizes are half-sizes in MJCF); equality constraints `connect`, `weld` and `joint`
+// as joints and couplers.
+#include <tinyxml2.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "import/mechanism.hpp"
+#include "phiq/scene.hpp"
+
+namespace phiq {
+
+namespace detail::mechanism {
+namespace {
+
+using Attributes = std::map<std::string, std::string>;
+
+class MjcfReader {
+ public:
+  MjcfReader(const std::string& text, const std::string& path) : text_(text), path_(path) {}
+  Mechanism read(int* loops);
+
+ private:
+  void compiler(const tinyxml2::XMLElement* e);
+  void defaults(const tinyxml2::XMLElement* e, const std::string& cls, const std::string& parent);
+  void assets(const tinyxml2::XMLElement* e);
+  // The attribute as the element gives it, or its class's default (the chain up to "main"); nullptr when neither.
+  const std::string* attr(const tinyxml2::XMLElement* e, const char* name, const std::string& childclass) const;
+  std::vector<double> numbers(const tinyxml2::XMLElement* e, const char* name, const std::string& childclass,
+                              std::vector<double> fallback, std::size_t count_min, std::size_t count_max) const;
+  Eigen::Matrix3d rotation(const tinyxml2::XMLElement* e, const std::string& childclass) const;
+  Pose pose(const tinyxml2::XMLElement* e, const std::string& childclass) const;
+  void body(const tinyxml2::XMLElement* e, int parent, const std::string& childclass);
+  void geom(const tinyxml2::XMLElement* e, Body* b, const std::string& childclass, bool* solid_only,
+            std::optional<double>* density);
+  void equality(const tinyxml2::XMLElement* e);
+  int body_named(const tinyxml2::XMLElement* e, const char* attribute, bool required) const;
+  double angle(double v) const { return degrees_ ? v * M_PI / 180.0 : v; }
+  void unmapped(const tinyxml2::XMLElement* e, const std::string& why) {
+    m_.skip(std::string("<") + e->Name() + ">", e->GetLineNum(), why);
+  }
+
+  const std::string& text_;
+  const std::string& path_;
+  tinyxml2::XMLDocument doc_;
+  bool degrees_ = true;
+  std::string eulerseq_ = "xyz", meshdir_;
+  std::map<std::string, std::map<std::string, Attributes>> defaults_;  // class → element → attributes
+  std::map<std::string, std::string> parent_class_;
+  struct MeshAsset {
+    std::string file;
+    Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+  };
+  std::map<std::string, MeshAsset> meshes_;
+  std::map<std::string, int> body_index_, joint_index_;
+  std::map<int, double> joint_ref_;  // a hinge's or slide's `ref` (qpos at the model's pose), by joint index
+  int loops_ = 0;
+  Mechanism m_;
+};
+
+void MjcfReader::compiler(const tinyxml2::XMLElement* e) {
+  for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
+    const std::string name = a->Name(), value = a->Value();
+    if (name == "angle") {
+      if (value != "degree" && value != "radian")
+        refuse(path_, e->GetLineNum(), "<compiler angle=\"" + value + "\">: degree or radian");
+      degrees_ = value == "degree";
+    } else if (name == "eulerseq") {
+      if (value.size() != 3 || value.find_first_not_of("xyzXYZ") != std::string::npos)
+        refuse(path_, e->GetLineNum(), "<compiler eulerseq=\"" + value + "\">: three of x, y, z, X, Y, Z");
+      eulerseq_ = value;
+    } else if (name == "meshdir") {
+      meshdir_ = value;
+    } else {
+      m_.skip("<compiler " + name + ">", e->GetLineNum(), "a setting of MuJoCo's compiler phiq does not need");
+    }
+  }
+}
+
+void MjcfReader::defaults(const tinyxml2::XMLElement* e, const std::string& cls, const std::string& parent) {
+  parent_class_[cls] = parent;
+  for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    const std::string tag = c->Name();
+    if (tag == "default") {
+      const char* name = c->Attribute("class");
+      if (!name) refuse(path_, c->GetLineNum(), "a nested <default> without a class");
+      defaults(c, name, cls);
+    } else if (tag == "joint" || tag == "geom" || tag == "mesh") {
+      Attributes& a = defaults_[cls][tag];
+      for (const tinyxml2::XMLAttribute* x = c->FirstAttribute(); x; x = x->Next()) a[x->Name()] = x->Value();
+    } else {
+      unmapped(c, "defaults of elements phiq does not read");
+    }
+  }
+}
+
+void MjcfReader::assets(const tinyxml2::XMLElement* e) {
+  for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    if (std::string(c->Name()) != "mesh") {
+      unmapped(c, "textures, materials and height fields: phiq's parts take rgba colours only");
+      continue;
+    }
+    MeshAsset mesh;
+    const char* file = c->Attribute("file");
+    if (!file) refuse(path_, c->GetLineNum(), "<mesh> without a file (meshes given by vertices are not read)");
+    mesh.file = meshdir_.empty() ? std::string(file) : (std::filesystem::path(meshdir_) / file).string();
+    const std::vector<double> s = numbers(c, "scale", "", {1, 1, 1}, 3, 3);
+    mesh.scale = Eigen::Vector3d(s[0], s[1], s[2]);
+    std::string name = c->Attribute("name") ? c->Attribute("name") : std::filesystem::path(file).stem().string();
+    meshes_[name] = mesh;
+  }
+}
+
+const std::string* MjcfReader::attr(const tinyxml2::XMLElement* e, const char* name,
+                                    const std::string& childclass) const {
+  if (const tinyxml2::XMLAttribute* a = e->FindAttribute(name)) {
+    static thread_local std::string value;  // (read at once by the caller)
+    value = a->Value();
+    return &value;
+  }
+  std::string cls = e->Attribute("class") ? e->Attribute("class") : childclass.empty() ? "main" : childclass;
+  for (int depth = 0; depth < 64 && !cls.empty(); ++depth) {
+    const auto c = defaults_.find(cls);
+    if (c != defaults_.end())
+      if (const auto t = c->second.find(e->Name()); t != c->second.end())
+        if (const auto v = t->second.find(name); v != t->second.end()) return &v->second;
+    const auto p = parent_class_.find(cls);
+    if (p == parent_class_.end()) {
+      if (cls != "main" && !defaults_.count(cls))
+        refuse(path_, e->GetLineNum(), "class '" + cls + "' is not a <default> class of the file");
+      break;
+    }
+    cls = p->second;
+  }
+  return nullptr;
+}
+
+std::vector<double> MjcfReader::numbers(const tinyxml2::XMLElement* e, const char* name, const std::string& childclass,
+                                        std::vector<double> fallback, std::size_t count_min,
+                                        std::size_t count_max) const {
+  const std::string* text = attr(e, name, childclass);
+  if (!text) return fallback;
+  std::istringstream in(*text);
+  std::vector<double> v;
+  for (double x; in >> x;) v.push_back(x);
+  if (!(in.eof()) || v.size() < count_min || v.size() > count_max || v.empty())
+    refuse(path_, e->GetLineNum(),
+           std::string("<") + e->Name() + " " + name + "=\"" + *text + "\">: " +
+               (count_min == count_max ? std::to_string(count_min)
+                                       : std::to_string(count_min) + " to " + std::to_string(count_max)) +
+               " numbers");
+  return v;
+}
+
+Eigen::Matrix3d MjcfReader::rotation(const tinyxml2::XMLElement* e, const std::string& cc) const {
+  if (e->Attribute("quat")) {
+    const std::vector<double> q = numbers(e, "quat", cc, {}, 4, 4);
+    const Eigen::Quaterniond r(q[0], q[1], q[2], q[3]);
+    if (!(r.norm() > 0)) refuse(path_, e->GetLineNum(), "a zero quat");
+    return r.normalized().toRotationMatrix();
+  }
+  if (e->Attribute("axisangle")) {
+    const std::vector<double> a = numbers(e, "axisangle", cc, {}, 4, 4);
+    return axis_angle(Eigen::Vector3d(a[0], a[1], a[2]), angle(a[3]));
+  }
+  if (e->Attribute("euler")) {
+    const std::vector<double> a = numbers(e, "euler", cc, {}, 3, 3);
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    for (std::size_t k = 0; k < 3; ++k) {
+      const char c = eulerseq_[k];
+      const Eigen::Matrix3d step = axis_angle(Eigen::Vector3d::Unit(std::tolower(c) - 'x'), angle(a[k]));
+      R = std::islower(c) ? (R * step).eval() : (step * R).eval();  // lower case: about the moving axes
+    }
+    return R;
+  }
+  if (e->Attribute("xyaxes")) {
+    const std::vector<double> a = numbers(e, "xyaxes", cc, {}, 6, 6);
+    const Eigen::Vector3d x = Eigen::Vector3d(a[0], a[1], a[2]).normalized();
+    const Eigen::Vector3d y =
+        (Eigen::Vector3d(a[3], a[4], a[5]) - x.dot(Eigen::Vector3d(a[3], a[4], a[5])) * x).normalized();
+    Eigen::Matrix3d R;
+    R << x, y, x.cross(y);
+    return R;
+  }
+  if (e->Attribute("zaxis")) {
+    const std::vector<double> a = numbers(e, "zaxis", cc, {}, 3, 3);
+    return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), Eigen::Vector3d(a[0], a[1], a[2]))
+        .toRotationMatrix();
+  }
+  return Eigen::Matrix3d::Identity();
+}
+
+Pose MjcfReader::pose(const tinyxml2::XMLElement* e, const std::string& cc) const {
+  const std::vector<double> p = numbers(e, "pos", cc, {0, 0, 0}, 3, 3);
+  return Pose{Eigen::Vector3d(p[0], p[1], p[2]), rotation(e, cc)};
+}
+
+void MjcfReader::geom(const tinyxml2::XMLElement* e, Body* b, const std::string& cc, bool* solid_only,
+                      std::optional<double>* density) {
+  const std::string* t = attr(e, "type", cc);
+  const std::string type = t ? *t : "sphere";
+  const std::vector<double> size = numbers(e, "size", cc, {0, 0, 0}, 1, 3);
+  auto at = [&](std::size_t k) { return k < size.size() ? size[k] : 0.0; };
+  Shape s;
+  s.at = pose(e, cc);
+  if (const std::string* rgba = attr(e, "rgba", cc)) {
+    const std::vector<double> c = numbers(e, "rgba", cc, {}, 4, 4);
+    s.rgba = Eigen::Vector4d(c[0], c[1], c[2], c[3]);
+    (void)rgba;
+  }
+  if (attr(e, "mass", cc)) *solid_only = false;
+  const std::vector<double> d = numbers(e, "density", cc, {1000}, 1, 1);
+  if (!density->has_value())
+    *density = d[0];
+  else if (**density != d[0])
+    *solid_only = false;
+  if (e->Attribute("fromto") && (type == "capsule" || type == "cylinder")) {
+    const std::vector<double> f = numbers(e, "fromto", cc, {}, 6, 6);
+    const Eigen::Vector3d a(f[0], f[1], f[2]), c(f[3], f[4], f[5]);
+    s.at = Pose{0.5 * (a + c), Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), c - a).toRotationMatrix()};
+    s.type = type, s.radius = at(0), s.length = (c - a).norm();
+  } else if (e->Attribute("fromto")) {
+    unmapped(e, "a " + type + " given by fromto is not read");
+    *solid_only = false;
+    return;
+  } else if (type == "sphere") {
+    s.type = "sphere", s.radius = at(0);
+  } else if (type == "box") {
+    s.type = "box", s.size = 2.0 * Eigen::Vector3d(at(0), at(1), at(2));
+  } else if (type == "capsule" || type == "cylinder") {
+    s.type = type, s.radius = at(0), s.length = 2.0 * at(1);
+  } else if (type == "plane" && at(0) > 0 && at(1) > 0) {
+    s.type = "plane", s.size = Eigen::Vector3d(2 * at(0), 2 * at(1), 0);
+  } else if (type == "mesh") {
+    const std::string* name = attr(e, "mesh", cc);
+    if (!name || !meshes_.count(*name))
+      refuse(path_, e->GetLineNum(),
+             "geom of type mesh names no <mesh> asset" + (name ? " '" + *name + "'" : std::string()));
+    const MeshAsset& mesh = meshes_.at(*name);
+    *solid_only = false;
+    std::string ext = std::filesystem::path(mesh.file).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::filesystem::path folder = std::filesystem::path(path_).parent_path();
+    if (ext != ".stl" && ext != ".obj") {
+      m_.skip("<geom type=\"mesh\"> not STL or OBJ", e->GetLineNum(), "phiq's parts read STL and OBJ meshes");
+      return;
+    }
+    if (mesh.scale.x() != mesh.scale.y() || mesh.scale.x() != mesh.scale.z()) {
+      m_.skip("<geom type=\"mesh\"> scaled unevenly", e->GetLineNum(), "phiq scales a mesh by one factor");
+      return;
+    }
+    if (!std::filesystem::exists(std::filesystem::path(mesh.file).is_absolute() ? std::filesystem::path(mesh.file)
+                                                                                : folder / mesh.file)) {
+      m_.skip("<geom type=\"mesh\"> file not found", e->GetLineNum(), "'" + mesh.file + "' is not beside the file");
+      return;
+    }
+    // MuJoCo moves a mesh to its centre of mass and principal axes; phiq draws it in the file's own frame.
+    m_.skip("<geom type=\"mesh\"> placement", e->GetLineNum(),
+            "drawn in the mesh file's frame, not recentred at its centre of mass as MuJoCo does");
+    s.type = "mesh", s.file = mesh.file, s.scale = mesh.scale.x();
+  } else {
+    unmapped(e, "a geom of type " + type + " has no phiq shape");
+    *solid_only = false;
+    return;
+  }
+  b->shapes.push_back(s);
+}
+
+int MjcfReader::body_named(const tinyxml2::XMLElement* e, const char* attribute, bool required) const {
+  const char* name = e->Attribute(attribute);
+  if (!name) {
+    if (required) refuse(path_, e->GetLineNum(), std::string("<") + e->Name() + "> without " + attribute);
+    return 0;
+  }
+  if (std::string(name) == "world") return 0;
+  const auto it = body_index_.find(name);
+  if (it == body_index_.end())
+    refuse(path_, e->GetLineNum(), std::string(attribute) + " '" + name + "' is not a body of the file");
+  return it->second;
+}
+
+void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::string& childclass) {
+  const std::string cc = e->Attribute("childclass") ? e->Attribute("childclass") : childclass;
+  Body b;
+  b.line = e->GetLineNum();
+  b.name = e->Attribute("name") ? e->Attribute("name") : "body_" + std::to_string(m_.bodies.size());
+  b.world = m_.bodies[static_cast<std::size_t>(parent)].world * pose(e, cc);
+  const int index = static_cast<int>(m_.bodies.size());
+  if (e->Attribute("name") && !body_index_.emplace(b.name, index).second)
+    refuse(path_, b.line, "a second body named '" + b.name + "'");
+  std::vector<const tinyxml2::XMLElement*> joints, children;
+  bool solid_only = true, inertial = false;
+  std::optional<double> density;
+  for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+    const std::string tag = c->Name();
+    if (tag == "joint" || tag == "freejoint") {
+      joints.push_back(c);
+    } else if (tag == "body") {
+      children.push_back(c);
+    } else if (tag == "geom") {
+      geom(c, &b, cc, &solid_only, &density);
+    } else if (tag == "inertial") {
+      const Pose p = pose(c, cc);
+      const std::vector<double> mass = numbers(c, "mass", cc, {}, 1, 1);
+      Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
+      if (c->Attribute("fullinertia")) {
+        const std::vector<double> f = numbers(c, "fullinertia", cc, {}, 6, 6);
+        I << f[0], f[3], f[4], f[3], f[1], f[5], f[4], f[5], f[2];
+      } else {
+        const std::vector<double> d = numbers(c, "diaginertia", cc, {}, 3, 3);
+        I.diagonal() << d[0], d[1], d[2];
+      }
+      if (mass.empty() || I.isZero(0.0))
+        refuse(path_, c->GetLineNum(), "<inertial> needs mass and diaginertia or fullinertia");
+      b.has_mass = true, b.mass = mass[0], b.com = p.p, b.inertia = p.R * I * p.R.transpose();
+      inertial = true;
+    } else if (tag == "frame" || tag == "replicate" || tag == "include" || tag == "composite" || tag == "flexcomp") {
+      refuse(path_, c->GetLineNum(), "<" + tag + ">: not read by phiq (expand it into bodies first)");
+    } else {
+      unmapped(c, tag == "site" || tag == "camera" || tag == "light" ? "no kinematics: phiq outputs points instead"
+                                                                     : "not an element phiq maps");
+    }
+  }
+  if (!inertial && solid_only && density && !b.shapes.empty()) b.density = density;
+  if (!inertial && !solid_only)
+    m_.skip("mass from geoms", b.line, "given per geom or by meshes: the body gets no mass");
+  m_.bodies.push_back(b);
+  // Its joints, in order; each after the first moves a massless body of its own, at the body's pose.
+  int from = parent;
+  if (joints.empty()) {
+    Joint w;
+    w.name = b.name + "_weld", w.line = b.line, w.kind = "rigid";
+    const Pose rel = m_.bodies[static_cast<std::size_t>(from)].world.inverse() * b.world;
+    w.parent = Side{from, rel.p, rel.R.col(2), rel.R.col(0)};
+    w.child = Side{index, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()};
+    m_.joints.push_back(w);
+  }
+  for (std::size_t k = 0; k < joints.size(); ++k) {
+    const tinyxml2::XMLElement* j = joints[k];
+    int to = index;
+    if (k + 1 < joints.size()) {
+      Body step = Body::named(b.name + "_joint" + std::to_string(k + 1), j->GetLineNum(), b.world);
+      to = static_cast<int>(m_.bodies.size());
+      m_.bodies.push_back(step);
+    }
+    const std::string* t = attr(j, "type", cc);
+    const std::string type = std::string(j->Name()) == "freejoint" ? "free" : t ? *t : "hinge";
+    Joint out;
+    out.line = j->GetLineNum();
+    out.name = j->Attribute("name") ? j->Attribute("name") : b.name + "_joint_" + std::to_string(k);
+    if (type == "hinge")
+      out.kind = "revolute";
+    else if (type == "slide")
+      out.kind = "prismatic";
+    else if (type == "ball")
+      out.kind = "spherical";
+    else if (type != "free")
+      refuse(path_, out.line, "joint '" + out.name + "' has type '" + type + "': MJCF's are hinge, slide, ball, free");
+    const std::vector<double> p = numbers(j, "pos", cc, {0, 0, 0}, 3, 3);
+    const std::vector<double> a = numbers(j, "axis", cc, {0, 0, 1}, 3, 3);
+    const Eigen::Vector3d at(p[0], p[1], p[2]), axis = Eigen::Vector3d(a[0], a[1], a[2]);
+    if (!(axis.norm() > 0)) refuse(path_, out.line, "joint '" + out.name + "': a zero axis");
+    const Pose rel = m_.bodies[static_cast<std::size_t>(from)].world.inverse() * b.world;
+    const Eigen::Vector3d ref = perpendicular(axis);
+    out.parent = Side{from, rel.p + rel.R * at, rel.R * axis.normalized(), rel.R * ref};
+    out.child = Side{to, at, axis.normalized(), ref};
+    if (type == "ball")
+      out.parent.axis = rel.R.col(2), out.parent.ref = rel.R.col(0), out.child.axis = Eigen::Vector3d::UnitZ(),
+      out.child.ref = Eigen::Vector3d::UnitX();
+    if (const std::vector<double> r = numbers(j, "ref", cc, {0}, 1, 1); r[0] != 0.0)
+      joint_ref_[static_cast<int>(m_.joints.size())] = type == "hinge" ? angle(r[0]) : r[0];
+    for (const char* ignored : {"range", "limited", "damping", "stiffness", "armature", "springref", "frictionloss"})
+      if (attr(j, ignored, cc))
+        m_.skip(std::string("<joint ") + ignored + ">", out.line, "limits, springs and damping are not kinematics");
+    if (!joint_index_.emplace(out.name, static_cast<int>(m_.joints.size())).second)
+      refuse(path_, out.line, "a second joint named '" + out.name + "'");
+    m_.joints.push_back(out);
+    from = to;
+  }
+  for (const tinyxml2::XMLElement* c : children) body(c, index, cc);
+}
+
+void MjcfReader::equality(const tinyxml2::XMLElement* list) {
+  for (const tinyxml2::XMLElement* e = list->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const std::string tag = e->Name();
+    const std::string name =
+        e->Attribute("name") ? e->Attribute("name") : tag + "_line" + std::to_string(e->GetLineNum());
+    if (e->Attribute("active") && std::string(e->Attribute("active")) == "false") {
+      unmapped(e, "inactive (active=\"false\")");
+      continue;
+    }
+    if (e->Attribute("solref") || e->Attribute("solimp"))
+      m_.skip("<" + tag + " solref/solimp>", e->GetLineNum(), "phiq's constraints are exact, not soft");
+    if (tag == "connect" || tag == "weld") {
+      if (e->Attribute("site1") || e->Attribute("site2"))
+        refuse(path_, e->GetLineNum(), "<" + tag + "> between sites is not read: give body1, body2 and anchor");
+      const int b1 = body_named(e, "body1", true), b2 = body_named(e, "body2", false);
+      const std::vector<double> a = numbers(e, "anchor", "", {0, 0, 0}, 3, 3);
+      const Pose& w1 = m_.bodies[static_cast<std::size_t>(b1)].world;
+      const Pose& w2 = m_.bodies[static_cast<std::size_t>(b2)].world;
+      Joint j;
+      j.name = name, j.line = e->GetLineNum(), j.closing = true;
+      if (tag == "connect") {  // anchor in body1's frame
+        j.kind = "spherical";
+        j.parent = Side{b1, Eigen::Vector3d(a[0], a[1], a[2])};
+        j.child = Side{b2, w2.inverse().R * (w1.p + w1.R * j.parent.at - w2.p)};
+      } else {  // anchor in body2's frame; the relative pose at the model's pose
+        const std::vector<double> rel = numbers(e, "relpose", "", {0, 1, 0, 0, 0, 0, 0}, 7, 7);
+        if (rel[3] != 0 || rel[4] != 0 || rel[5] != 0 || rel[6] != 0)
+          refuse(path_, e->GetLineNum(), "<weld relpose>: phiq welds at the model's pose (omit relpose)");
+        j.kind = "rigid";
+        const Pose in1 = w1.inverse() * w2 * Pose{Eigen::Vector3d(a[0], a[1], a[2]), Eigen::Matrix3d::Identity()};
+        j.parent = Side{b1, in1.p, in1.R.col(2), in1.R.col(0)};
+        j.child = Side{b2, Eigen::Vector3d(a[0], a[1], a[2])};
+      }
+      m_.joints.push_back(j);
+      ++loops_;
+    } else if (tag == "joint") {
+      const char* j1 = e->Attribute("joint1");
+      const char* j2 = e->Attribute("joint2");
+      if (!j1 || !joint_index_.count(j1))
+        refuse(path_, e->GetLineNum(),
+               std::string("<joint> equality: joint1 '") + (j1 ? j1 : "") + "' is not a joint of the file");
+      if (j2 && !joint_index_.count(j2))
+        refuse(path_, e->GetLineNum(), std::string("<joint> equality: joint2 '") + j2 + "' is not a joint of the file");
+      const std::vector<double> c = numbers(e, "polycoef", "", {0, 1, 0, 0, 0}, 1, 5);
+      for (std::size_t k = 2; k < c.size(); ++k)
+        if (c[k] != 0.0 && j2)
+          refuse(path_, e->GetLineNum(),
+                 "<joint> equality '" + name + "': polycoef of degree " + std::to_string(k) +
+                     "; phiq couples joints linearly (a coupler)");
+      // MuJoCo's q1 = c0 + c1 q2 on joint positions; phiq's angles are those minus each joint's ref.
+      const int a = joint_index_.at(j1), b = j2 ? joint_index_.at(j2) : -1;
+      const double ra = joint_ref_.count(a) ? joint_ref_.at(a) : 0.0,
+                   rb = b >= 0 && joint_ref_.count(b) ? joint_ref_.at(b) : 0.0;
+      const double c1 = c.size() > 1 ? c[1] : 0.0;
+      m_.couplers.push_back(Coupler{name, e->GetLineNum(), a, b, c1, c[0] + (b >= 0 ? c1 * rb : 0.0) - ra});
+    } else {
+      refuse(path_, e->GetLineNum(), "<" + tag + "> equality: not read by phiq (only connect, weld and joint)");
+    }
+  }
+}
+
+Mechanism MjcfReader::read(int* loops) {
+  m_.path = path_, m_.format = "MJCF";
+  m_.units = "lengths in metres, angles in radians (the file's degrees converted), mass in kg, time in seconds.";
+  if (doc_.Parse(text_.data(), text_.size()) != tinyxml2::XML_SUCCESS)
+    refuse(path_, doc_.ErrorLineNum(), std::string("malformed XML (the file may be truncated): ") + doc_.ErrorName());
+  const tinyxml2::XMLElement* root = doc_.RootElement();
+  if (!root || std::string(root->Name()) != "mujoco")
+    refuse(path_, root ? root->GetLineNum() : 1, "an MJCF file's root element is <mujoco>");
+  m_.name = root->Attribute("model") ? root->Attribute("model") : "";
+  m_.bodies.push_back(Body::named("world", root->GetLineNum()));
+  // Settings first: compiler, defaults and assets apply to the bodies wherever they stand.
+  for (const tinyxml2::XMLElement* e = root->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const std::string tag = e->Name();
+    if (tag == "include") refuse(path_, e->GetLineNum(), "<include>: not read by phiq (merge the files first)");
+    if (tag == "compiler") compiler(e);
+  }
+  for (const tinyxml2::XMLElement* e = root->FirstChildElement("default"); e; e = e->NextSiblingElement("default"))
+    defaults(e, "main", "");
+  for (const tinyxml2::XMLElement* e = root->FirstChildElement("asset"); e; e = e->NextSiblingElement("asset"))
+    assets(e);
+  static const std::map<std::string, std::string> why = {
+      {"option", "simulation settings (gravity, timestep): phiq sweeps kinematics"},
+      {"size", "memory sizes of MuJoCo"},
+      {"visual", "MuJoCo's rendering"},
+      {"statistic", "MuJoCo's rendering"},
+      {"contact", "contacts are not constraints in phiq (phiq clearance measures distances)"},
+      {"tendon", "tendons are not read"},
+      {"actuator", "actuators are forces, not drivers: drive joints with --drive"},
+      {"sensor", "sensors: phiq outputs points, joints and orientations instead"},
+      {"keyframe", "phiq starts from the model's pose"},
+      {"custom", "user data"},
+      {"extension", "plugins"},
+  };
+  for (const tinyxml2::XMLElement* e = root->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    const std::string tag = e->Name();
+    if (tag == "worldbody") {
+      bool solid = true;
+      std::optional<double> density;
+      for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+        const std::string t = c->Name();
+        if (t == "body")
+          body(c, 0, "");
+        else if (t == "geom")
+          geom(c, &m_.bodies[0], "", &solid, &density);
+        else if (t == "frame" || t == "replicate")
+          refuse(path_, c->GetLineNum(), "<" + t + ">: not read by phiq (expand it into bodies first)");
+        else
+          unmapped(c, "no kinematics: phiq outputs points instead");
+      }
+    } else if (tag == "equality") {
+      continue;  // after every body is read
+    } else if (tag != "compiler" && tag != "default" && tag != "asset") {
+      const auto it = why.find(tag);
+      unmapped(e, it != why.end() ? it->second : "not an MJCF element phiq reads");
+    }
+  }
+  for (const tinyxml2::XMLElement* e = root->FirstChildElement("equality"); e; e = e->NextSiblingElement("equality"))
+    equality(e);
+  *loops = loops_;
+  return std::move(m_);
+}
+
+}  // namespace
+}  // namespace detail::mechanism
+
+ModelImport import_mjcf(const std::string& text, const std::string& path, const ImportOptions& options) {
+  int loops = 0;
+  detail::mechanism::Mechanism m = detail::mechanism::MjcfReader(text, path).read(&loops);
+  ModelImport out;
+  out.bodies = static_cast<int>(m.bodies.size()) - 1;
+  out.joints = static_cast<int>(m.joints.size());
+  out.loops = loops;
+  out.couplers = static_cast<int>(m.couplers.size());
+  out.yaml = detail::mechanism::write_mechanism_scene(m, options);
+  out.skipped = std::move(m.skipped);
+  return out;
+}
+
+}  // namespace phiq

@@ -1,0 +1,210 @@
+// SDF read as a mechanism::Mechanism through Debian's libsdformat 12, which checks the file against the SDFormat
+// specification, resolves every pose (`relative_to`, frames) and gives each element's line. One model (the file's, or
+// the first of its world); its frame is phiq's world frame. SDF's joints form any graph, so a loop closes natively:
+// each joint joins its parent and child links at the joint frame, at the links' poses in the file. A link that no
+// joint joins to `world` moves freely, as in SDF.
+#include <sdf/Console.hh>
+#include <sdf/Geometry.hh>
+#include <sdf/Joint.hh>
+#include <sdf/JointAxis.hh>
+#include <sdf/Link.hh>
+#include <sdf/Model.hh>
+#include <sdf/Root.hh>
+#include <sdf/Visual.hh>
+#include <sdf/World.hh>
+#include <sdf/Box.hh>
+#include <sdf/Capsule.hh>
+#include <sdf/Cylinder.hh>
+#include <sdf/Sphere.hh>
+
+#include <algorithm>
+#include <mutex>
+#include <set>
+
+#include "import/mechanism.hpp"
+#include "phiq/scene.hpp"
+
+namespace phiq {
+
+namespace detail::mechanism {
+namespace {
+
+Eigen::Vector3d sdf_vector(const ignition::math::Vector3d& v) { return {v.X(), v.Y(), v.Z()}; }
+Pose sdf_pose(const ignition::math::Pose3d& p) {
+  const ignition::math::Quaterniond& q = p.Rot();
+  return Pose{sdf_vector(p.Pos()), Eigen::Quaterniond(q.W(), q.X(), q.Y(), q.Z()).normalized().toRotationMatrix()};
+}
+int sdf_line(const sdf::ElementPtr& e) { return e && e->LineNumber() ? *e->LineNumber() : 0; }
+
+class SdfReader {
+ public:
+  SdfReader(const std::string& text, const std::string& path) : text_(text), path_(path) {}
+  Mechanism read(int* loops);
+
+ private:
+  // Children of `e` written in the file and not in `mapped`, listed once per kind.
+  void unmapped_children(const sdf::ElementPtr& e, const std::set<std::string>& mapped, const std::string& why) {
+    for (sdf::ElementPtr c = e->GetFirstElement(); c; c = c->GetNextElement(""))
+      if (c->GetExplicitlySetInFile() && !mapped.count(c->GetName()))
+        m_.skip("<" + e->GetName() + "><" + c->GetName() + ">", sdf_line(c), why);
+  }
+  void link(const sdf::Link& l, Body* b);
+
+  const std::string& text_;
+  const std::string& path_;
+  Mechanism m_;
+};
+
+void SdfReader::link(const sdf::Link& l, Body* b) {
+  const sdf::ElementPtr e = l.Element();
+  if (const sdf::ElementPtr in = e->FindElement("inertial"); in && in->GetExplicitlySetInFile()) {
+    const ignition::math::Inertiald& inertial = l.Inertial();
+    b->has_mass = true, b->mass = inertial.MassMatrix().Mass();
+    b->com = sdf_vector(inertial.Pose().Pos());
+    const ignition::math::Matrix3d I = inertial.Moi();  // about the centre, in the link's axes
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) b->inertia(r, c) = I(r, c);
+  }
+  for (uint64_t k = 0; k < l.VisualCount(); ++k) {
+    const sdf::Visual* v = l.VisualByIndex(k);
+    const sdf::Geometry* g = v->Geom();
+    ignition::math::Pose3d at;
+    (void)v->SemanticPose().Resolve(at, l.Name());
+    Shape s;
+    s.at = sdf_pose(at);
+    if (g->Type() == sdf::GeometryType::BOX) {
+      s.type = "box", s.size = sdf_vector(g->BoxShape()->Size());
+    } else if (g->Type() == sdf::GeometryType::SPHERE) {
+      s.type = "sphere", s.radius = g->SphereShape()->Radius();
+    } else if (g->Type() == sdf::GeometryType::CYLINDER) {
+      s.type = "cylinder", s.radius = g->CylinderShape()->Radius(), s.length = g->CylinderShape()->Length();
+    } else if (g->Type() == sdf::GeometryType::CAPSULE) {
+      s.type = "capsule", s.radius = g->CapsuleShape()->Radius(), s.length = g->CapsuleShape()->Length();
+    } else {
+      m_.skip("<visual><geometry> other than box, sphere, cylinder, capsule", sdf_line(v->Element()),
+              "meshes, planes and height maps of SDF are not read");
+      continue;
+    }
+    b->shapes.push_back(s);
+  }
+  unmapped_children(e, {"pose", "inertial", "visual"}, "not kinematics, or drawn from the visuals");
+}
+
+Mechanism SdfReader::read(int* loops) {
+  m_.path = path_, m_.format = "SDF";
+  m_.units = "lengths in metres, angles in radians, mass in kg, time in seconds.";
+  sdf::Root root;
+  {
+    static std::mutex sdformat_console;  // libsdformat's console is one per process: quiet while it reads
+    std::lock_guard<std::mutex> lock(sdformat_console);
+    sdf::Console::Instance()->SetQuiet(true);
+    const sdf::Errors errors = root.LoadSdfString(text_);
+    if (!errors.empty())
+      refuse(path_, errors.front().LineNumber().value_or(0), "libsdformat: " + errors.front().Message());
+  }
+  const sdf::Model* model = root.Model();
+  if (!model && root.WorldCount() > 0 && root.WorldByIndex(0)->ModelCount() > 0)
+    model = root.WorldByIndex(0)->ModelByIndex(0);
+  if (!model) refuse(path_, 0, "the file has no model");
+  if (root.WorldCount() > 0)
+    for (uint64_t k = 1; k < root.WorldByIndex(0)->ModelCount(); ++k)
+      m_.skip("<model> after the world's first", sdf_line(root.WorldByIndex(0)->ModelByIndex(k)->Element()),
+              "phiq reads one model of a world");
+  m_.name = model->Name();
+  if (model->ModelCount() > 0) refuse(path_, sdf_line(model->ModelByIndex(0)->Element()), "nested models are not read");
+  if (model->Static()) refuse(path_, sdf_line(model->Element()), "a static model does not move");
+  m_.bodies.push_back(Body::named("world", sdf_line(model->Element())));
+  std::map<std::string, int> body_of;
+  for (uint64_t k = 0; k < model->LinkCount(); ++k) {
+    const sdf::Link* l = model->LinkByIndex(k);
+    ignition::math::Pose3d pose;
+    (void)l->SemanticPose().Resolve(pose, "__model__");
+    Body b = Body::named(l->Name(), sdf_line(l->Element()), sdf_pose(pose));
+    link(*l, &b);
+    body_of[l->Name()] = static_cast<int>(m_.bodies.size());
+    m_.bodies.push_back(b);
+  }
+  for (uint64_t k = 0; k < model->JointCount(); ++k) {
+    const sdf::Joint* j = model->JointByIndex(k);
+    Joint out;
+    out.name = j->Name(), out.line = sdf_line(j->Element());
+    auto body = [&](const std::string& name, const char* side) {
+      if (name == "world") return 0;
+      const auto it = body_of.find(name);
+      if (it == body_of.end())
+        refuse(path_, out.line, "joint '" + out.name + "': " + side + " '" + name + "' is not a link of the model");
+      return it->second;
+    };
+    const int parent = body(j->ParentLinkName(), "parent"), child = body(j->ChildLinkName(), "child");
+    ignition::math::Pose3d frame;
+    (void)j->SemanticPose().Resolve(frame, "__model__");
+    const Pose J = sdf_pose(frame);
+    auto axis_of = [&](unsigned index) {
+      ignition::math::Vector3d xyz(0, 0, 1);
+      if (const sdf::JointAxis* a = j->Axis(index)) (void)a->ResolveXyz(xyz, "__model__");
+      return sdf_vector(xyz).normalized();
+    };
+    const Pose& wp = m_.bodies[static_cast<std::size_t>(parent)].world;
+    const Pose& wc = m_.bodies[static_cast<std::size_t>(child)].world;
+    auto sides = [&](const Eigen::Vector3d& a1, const Eigen::Vector3d& r1, const Eigen::Vector3d& a2,
+                     const Eigen::Vector3d& r2) {
+      out.parent = Side{parent, wp.inverse().R * (J.p - wp.p), wp.R.transpose() * a1, wp.R.transpose() * r1};
+      out.child = Side{child, wc.inverse().R * (J.p - wc.p), wc.R.transpose() * a2, wc.R.transpose() * r2};
+    };
+    switch (j->Type()) {
+      case sdf::JointType::REVOLUTE:
+      case sdf::JointType::CONTINUOUS:
+      case sdf::JointType::PRISMATIC: {
+        const Eigen::Vector3d a = axis_of(0), r = perpendicular(a);
+        sides(a, r, a, r);
+        out.kind = j->Type() == sdf::JointType::PRISMATIC ? "prismatic" : "revolute";
+        break;
+      }
+      case sdf::JointType::BALL:
+      case sdf::JointType::FIXED:
+        sides(J.R.col(2), J.R.col(0), J.R.col(2), J.R.col(0));
+        out.kind = j->Type() == sdf::JointType::BALL ? "spherical" : "rigid";
+        break;
+      case sdf::JointType::UNIVERSAL: {
+        const Eigen::Vector3d a1 = axis_of(0), a2 = axis_of(1);
+        if (std::abs(a1.dot(a2)) > 1e-9)
+          refuse(path_, out.line,
+                 "universal joint '" + out.name + "': its axes are not perpendicular in the file's pose");
+        sides(a1, perpendicular(a1), a2, perpendicular(a2));
+        out.kind = "universal";
+        break;
+      }
+      default:
+        refuse(path_, out.line,
+               "joint '" + out.name + "': SDF's " + j->Element()->GetAttribute("type")->GetAsString() +
+                   " joint has no exact phiq form here (screw: SDF does not state thread_pitch's unit)");
+    }
+    m_.joints.push_back(out);
+    const char* why = "limits, dynamics and sensors are not kinematics";
+    unmapped_children(j->Element(), {"parent", "child", "pose", "axis", "axis2"}, why);
+    for (const char* axis : {"axis", "axis2"})
+      if (const sdf::ElementPtr a = j->Element()->FindElement(axis)) unmapped_children(a, {"xyz"}, why);
+  }
+  unmapped_children(model->Element(), {"link", "joint", "pose", "static"}, "not an element phiq maps");
+  // Loops: the joints beyond a spanning tree of the links and the world.
+  *loops = std::max(0, static_cast<int>(m_.joints.size()) - static_cast<int>(model->LinkCount()));
+  return std::move(m_);
+}
+
+}  // namespace
+}  // namespace detail::mechanism
+
+ModelImport import_sdf(const std::string& text, const std::string& path, const ImportOptions& options) {
+  int loops = 0;
+  detail::mechanism::Mechanism m = detail::mechanism::SdfReader(text, path).read(&loops);
+  ModelImport out;
+  out.bodies = static_cast<int>(m.bodies.size()) - 1;
+  out.joints = static_cast<int>(m.joints.size());
+  out.loops = loops;
+  out.couplers = 0;
+  out.yaml = detail::mechanism::write_mechanism_scene(m, options);
+  out.skipped = std::move(m.skipped);
+  return out;
+}
+
+}  // namespace phiq

@@ -1,0 +1,121 @@
+// SDF files read as phiq scenes through libsdformat (phiq/import_model.hpp), tests/data/sdf/: the four-bar, whose
+// loop SDF closes natively, against its closed form and the scene written by hand; the joint types phiq reads; bad
+// input one line naming FILE:LINE.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "cli_test_support.hpp"
+#include "import_test_support.hpp"
+#include "phiq/rank_analysis.hpp"
+
+namespace phiq {
+namespace {
+
+using test::import_data, test::import_sweep, test::import_text;
+
+std::string SdfError(const std::string& text) {
+  try {
+    (void)import_sdf(text, "bad.sdf");
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+int SdfLineOf(const std::string& text, const std::string& what) {
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(text.find(what)), '\n'));
+}
+
+TEST(SdfImport, FourBarClosedNativelyFollowsItsClosedFormAndTheSceneWrittenByHand) {
+  const std::string path = import_data("sdf/fourbar.sdf");
+  ImportOptions o;
+  o.drives = {{"crank_joint", "2*pi*t"}}, o.t_end = 1, o.steps = 40;
+  const ModelImport imported = import_sdf(import_text(path), path, o);
+  EXPECT_EQ(imported.bodies, 3);
+  EXPECT_EQ(imported.joints, 4);
+  EXPECT_EQ(imported.loops, 1);
+  const test::ImportRun sdf = import_sweep(imported.yaml, path);
+  ASSERT_EQ(sdf.status, SolveStatus::kSuccess) << sdf.message;
+  const test::ImportRun hand = import_sweep(test::kFourbarByHand, "fourbar_by_hand.yaml");
+  ASSERT_EQ(hand.status, SolveStatus::kSuccess) << hand.message;
+  ASSERT_EQ(sdf.trace.q.size(), 41u);
+  for (std::size_t k = 0; k < sdf.trace.q.size(); ++k) {
+    const double t = sdf.trace.t[k];
+    const Eigen::Vector3d tip = test::import_point(sdf.model(), sdf.trace.q[k], "coupler", {0.5, 0, 0});
+    EXPECT_LT((tip - test::fourbar_rocker_tip(M_PI / 3 + 2 * M_PI * t)).norm(), 1e-10) << "t = " << t;
+    for (const char* body : {"crank", "coupler", "rocker"}) {
+      EXPECT_LT((test::import_point(sdf.model(), sdf.trace.q[k], body) -
+                 test::import_point(hand.model(), hand.trace.q[k], body))
+                    .norm(),
+                1e-12)
+          << body << " at t = " << t;
+      EXPECT_LT((test::import_rotation(sdf.model(), sdf.trace.q[k], body) -
+                 test::import_rotation(hand.model(), hand.trace.q[k], body))
+                    .norm(),
+                1e-12)
+          << body << " at t = " << t;
+    }
+  }
+  EXPECT_NE(imported.yaml.find("{body: rocker, mass: 0.5, center_of_mass: [0.2, 0, 0]"), std::string::npos);
+  const std::string text = import_text(path);
+  for (const char* what : {"<sensor", "<limit", "<plugin"}) {
+    const std::string line = path + ":" + std::to_string(SdfLineOf(text, what)) + ": ";
+    EXPECT_EQ(std::count_if(imported.skipped.begin(), imported.skipped.end(),
+                            [&](const std::string& s) { return s.rfind(line, 0) == 0; }),
+              1)
+        << what;
+  }
+  EXPECT_EQ(imported.skipped.size(), 3u);
+}
+
+TEST(SdfImport, EveryJointTypeLeavesItsFreedoms) {
+  const std::string path = import_data("sdf/joint_zoo.sdf");
+  const ModelImport imported = import_sdf(import_text(path), path);
+  for (const char* kind : {"type: rigid", "type: prismatic", "type: spherical", "type: universal", "type: revolute"})
+    EXPECT_NE(imported.yaml.find(kind), std::string::npos) << kind;
+  const Scene scene = parse_scene(imported.yaml, path);
+  const Eigen::VectorXd q = scene.model->initial_positions();
+  EXPECT_EQ(analyse_rank(*scene.model, q, 0.0).dof, 13);  // prismatic 1, ball 3, universal 2, continuous 1, free 6
+  Eigen::VectorXd phi(scene.model->num_equations());
+  scene.model->residual(q.data(), 0.0, phi.data());
+  EXPECT_LT(phi.lpNorm<Eigen::Infinity>(), 1e-12);
+}
+
+TEST(SdfImport, BadInputIsOneLineNamingFileAndLine) {
+  const std::string good = import_text(import_data("sdf/fourbar.sdf"));
+  ASSERT_EQ(SdfError(good), "");
+  auto starts = [](const std::string& error, const std::string& start) {
+    EXPECT_EQ(error.rfind(start, 0), 0u) << error << "\nexpected to start with: " << start;
+    EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  };
+  starts(SdfError(good.substr(0, good.find("<joint name=\"rocker_joint\""))), "bad.sdf");
+  const std::string screw = test::replace_first(good, "type=\"continuous\"", "type=\"screw\"");
+  starts(SdfError(screw),
+         "bad.sdf:" + std::to_string(SdfLineOf(good, "type=\"continuous\"")) + ": joint 'crank_joint'");
+  starts(SdfError(test::replace_first(good, "<child>rocker</child>", "<child>ghost</child>")), "bad.sdf");
+  EXPECT_NE(SdfError(test::replace_first(good, "<child>rocker</child>", "<child>ghost</child>")).find("ghost"),
+            std::string::npos);
+}
+
+}  // namespace
+
+namespace test {
+
+TEST_F(Cli, SdfConvertWritesTheTextADirectReadSolves) {
+  const std::string model = import_data("sdf/fourbar.sdf");
+  const Result convert =
+      run("convert " + model + " -o " + (dir_ / "fb.yaml").string() + " --drive crank_joint=2*pi*t --time 0 1 10");
+  ASSERT_EQ(convert.code, 0) << convert.err;
+  ImportOptions o;
+  o.drives = {{"crank_joint", "2*pi*t"}}, o.t_end = 1, o.steps = 10;
+  EXPECT_EQ(slurp(dir_ / "fb.yaml"), import_sdf(import_text(model), model, o).yaml);
+  const Result check = run("check " + model);
+  ASSERT_EQ(check.code, 0) << check.err;
+  EXPECT_NE(check.out.find("dof           1 (1 not driven)"), std::string::npos) << check.out;
+}
+
+}  // namespace test
+}  // namespace phiq
