@@ -270,9 +270,15 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     if (summary.min_rcond > 0)
       std::cerr << ", min rcond " << scientific(summary.min_rcond, 3)
                 << " at t = " << phiq::format_time(summary.min_rcond_time);
-    if (const phiq::RowClassAccuracy& r = summary.accuracy.rounding_level; r.rows > 0)
-      std::cerr << "; " << r.rows << " row(s) known only to " << phiq::significant(r.worst_error, 3)
-                << " tolerances (the rounding level; worst at t = " << phiq::format_time(r.worst_time) << ")";
+    if (const phiq::RowClassAccuracy& r = summary.accuracy.rounding_level; r.rows > 0) {
+      // in the coordinate's own unit ("'yB' known to ±2.1e-10 m"), the tolerance test's multiple beside it
+      std::cerr << "; " << r.rows << " row(s) known only to the rounding level: worst ";
+      if (!r.worst_coordinate.empty())
+        std::cerr << phiq::known_to_text(r.worst_coordinate, r.worst_known_to, r.worst_unit);
+      else
+        std::cerr << phiq::significant(r.worst_error, 3) << " × the tolerance test";
+      std::cerr << " at t = " << phiq::format_time(r.worst_time);
+    }
     if (file) std::cerr << "; wrote " << printable(out_path);
     std::cerr << "\n";
   }

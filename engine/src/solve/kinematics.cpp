@@ -10,6 +10,7 @@
 #include "solve/tolerance_tests.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -217,6 +218,15 @@ void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
 
 double scaled_residual(const Model& model, const Eigen::VectorXd& phi) { return max_scaled(model, phi); }
 
+std::string known_to_text(const std::string& name, double size, Unit unit) {
+  const char* symbol = unit_symbol(unit);
+  return "'" + name + "' known to ±" + significant(size, 2) + (*symbol ? " " : "") + symbol;
+}
+
+std::string known_to_text(const Model& model, Index j, double size) {
+  return known_to_text(model.coordinate_names()[static_cast<std::size_t>(j)], size, model.coordinate_unit(j));
+}
+
 double scaled_step(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& dq, const Eigen::VectorXd& q,
                    double tol) {
   return step_ratio(model, dq, q, tol);
@@ -257,12 +267,14 @@ class PositionSolve {
   };
 
   SolveStatus finish(SolveStatus st, std::string msg);
+  void locate_error();
   std::optional<SolveStatus> start();
   std::optional<SolveStatus> stop_before_step(int it);
   std::optional<SolveStatus> factorize_unless_reused();
   std::optional<SolveStatus> newton_step(Step& s);
   std::optional<SolveStatus> line_search(Step& s);
   SolveStatus stop_at_rounding_level(bool known_before, const Step& s, int it);
+  bool step_corrected_error(const Step& s);
   bool accept(const Step& s);
   void refresh_matrix() { reuse_ = false, prev_norm_ = -1.0; }
 
@@ -295,6 +307,9 @@ class PositionSolve {
   static constexpr int kMaxReusedSteps = 4;
   int stagnant_ = 0;              // consecutive fresh-matrix steps that contracted by ½ or worse
   double accepted_error_ = -1.0;  // newton_step's error estimate of the current iterate (units of the tolerance test)
+  int corrections_ = 0;           // steps step_corrected_error() kept from a stop at the rounding level
+  static constexpr int kMaxCorrections = 3;
+  static constexpr double kCorrectedContraction = 0.25;
 };
 
 SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
@@ -302,6 +317,8 @@ SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
   if (st != SolveStatus::kSuccess) ws_.newton_contraction = -1.0;
   if (st == SolveStatus::kSuccess) {
     sum_.residual = check_.worst;  // max_i |Φ_i| / scale_i, from the pass that tested it
+    if (sum_.error_estimate > kQuietRoundingLevel && sum_.iterations + (sum_.error_coordinate >= 0) > 0)
+      locate_error();
     // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
     // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
     // Otherwise they factorise at the solution, from the Jacobian evaluated there with Φ if there is one.
@@ -323,6 +340,46 @@ SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
   sum_.message = std::move(msg);
   if (!sum_.worst_rows.empty()) sum_.message += "; worst constraints: " + describe_rows(model_, sum_.worst_rows);
   return st;
+}
+
+// An error above the quiet level, told in the coordinate's own unit (PositionSummary::error_coordinate, error_size):
+// the larger, in units of the tolerance test, of the last step's worst coordinate (error_estimate there) and of
+// what the rounding of q itself does to every coordinate. The step misses the latter: on a 10⁶ m coupler over a
+// 1.5·10⁻⁶ m rocker, xB is held to its ulp (1.2·10⁻¹⁰ m, within its own test), and the rocker turns yB by as much,
+// while Newton's steps in yB, from the rounding of Φ at that xB, are 10⁻¹⁵ m. That part is estimated as Φq⁻¹ f,
+// f_i = ε Σ_j |∂Φ_i/∂q_j| |q_j|: one ulp of every coordinate through each row, with the factors at hand and Φq as
+// last evaluated (at a point near q). One pass over Φq and one solve, only for the rows a sweep reports as known
+// to more than 2 tolerances.
+void PositionSolve::locate_error() {
+  const ToleranceScales& sc = model_.tolerance_scales();
+  const auto allowed = [&](Index j) { return opt_.tolerance * sc.coordinate_scale(j) + kUlpFloor * std::fabs(ws_.q(j)); };
+  Index j = sum_.error_coordinate;
+  if (j < 0) (void)step_ratio(model_, ws_.step, ws_.q, opt_.tolerance, &j);
+  double size = sum_.error_estimate * allowed(j);
+  const CscPattern& p = model_.jacobian_pattern();
+  Eigen::VectorXd& f = ws_.trial_phi;  // (scratch: the trial is done with)
+  f.setZero();
+  for (Index c = 0; c < p.cols; ++c)
+    for (Index k = p.col_ptr[c]; k < p.col_ptr[c + 1]; ++k)
+      f(p.row_idx[k]) += std::fabs(ws_.jacobian_values[static_cast<std::size_t>(k)]) * std::fabs(ws_.q(c));
+  // Each row's rounding is its own: with one sign for all, f would be ε |q_j| times a column of Φq where one
+  // coordinate dominates, and Φq⁻¹ f that coordinate's own ulp alone (the 10⁶ m xB moves, the rocker's yB not).
+  // Signs that vary from row to row (a fixed hash of the row: the same bits on every thread count) keep them apart.
+  for (Index i = 0; i < f.size(); ++i) {
+    const bool minus = ((static_cast<std::uint32_t>(i) * 0x9E3779B1u) >> 16) & 1u;
+    f(i) *= minus ? -std::numeric_limits<double>::epsilon() : std::numeric_limits<double>::epsilon();
+  }
+  double* x = ws_.rhs.data();  // (scratch of the derivative solves: at least n entries where Φq is square)
+  if (f.allFinite() && ws_.lu->solve(solve_rhs(model_, ws_, f), x)) {
+    double worst = size / allowed(j);
+    for (Index c = 0; c < ws_.q.size(); ++c) {
+      const double e = std::fabs(x[c]);
+      if (c == j) size = std::max(size, e), worst = size / allowed(j);
+      if (e / allowed(c) > worst) worst = e / allowed(c), j = c, size = e;
+    }
+  }
+  sum_.error_coordinate = j;
+  sum_.error_size = size;
 }
 
 // The start point: Φ there (and Φq where it will be factorised), or the solve's end when it cannot start.
@@ -494,6 +551,7 @@ SolveStatus PositionSolve::stop_at_rounding_level(bool known_before, const Step&
   sum_.rounding_level = worst_ratio;
   sum_.rounding_measured = !known_before && it > 0;
   sum_.error_estimate = worst_ratio;
+  sum_.error_coordinate = worst;
   // The contraction seen with a reused matrix: the rounding in its last step makes it an overestimate, which
   // the next solve's first step may use as such (kept, as a success's).
   if (theta_seen_ >= 0.0) ws_.newton_contraction = theta_seen_;
@@ -503,17 +561,35 @@ SolveStatus PositionSolve::stop_at_rounding_level(bool known_before, const Step&
   // tolerance (its top joints, 600 m up, are known to 1.2 tolerances).
   if (worst_ratio <= kQuietRoundingLevel) return SolveStatus::kSuccess;
   sum_.slow_convergence = true;
-  const std::string& name = model_.coordinate_names()[static_cast<std::size_t>(worst)];
-  sum_.message =
-      known_before
-          ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
-            "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a long "
-            "chain or Φq ill-conditioned): up to " +
-                scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there"
-          : "the residual is at its rounding level and the Newton steps no longer reduce it: they are "
-            "the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
-                scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there";
+  const std::string known =
+      known_to_text(model_, sum_.error_coordinate, sum_.error_size) + ", which is how well q is known there";
+  sum_.message = known_before ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
+                                "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a "
+                                "long chain or Φq ill-conditioned): " +
+                                    known
+                              : "the residual is at its rounding level and the Newton steps no longer reduce it: they "
+                                "are the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned): " +
+                                    known;
   return SolveStatus::kSuccess;
+}
+
+// Whether the full step just tried, though it did not halve the merit, corrected a real error of q: the next
+// (simplified) Newton step from its trial point, with the same factors, is at most a quarter of it in the
+// tolerance test's units (each coordinate in its own unit). The merit weighs rows by their scales, not by what
+// their residuals do to q: on a four-bar of a 10⁶ m coupler and a 10⁻⁶ m crank, a coupler pin's residual of
+// 10⁻⁷ m (10⁻¹³ of its scale) puts the rocker 0.1 rad off, while the merit is the rocker row's rounding (10⁻¹⁰ m
+// of 1.5·10⁻⁶ m). At the rounding level the next step is more rounding, as large as this one (θ ≈ 1); a step that
+// corrected an error leaves one far smaller. One solve with the factors at hand, only where the merit alone would
+// stop; at most kMaxCorrections per solve, so that rounding that happens to contract cannot run on, and not for a
+// step within the level the rows before measured (NewtonOptions::known_to: that is rounding already known).
+bool PositionSolve::step_corrected_error(const Step& s) {
+  if (corrections_ >= kMaxCorrections || s.known_ok || !s.trial.finite) return false;
+  double* next = ws_.rhs.data();  // (scratch of the derivative solves: at least n entries where Φq is square)
+  if (!ws_.lu->solve(solve_rhs(model_, ws_, ws_.trial_phi), next)) return false;
+  const Eigen::Map<const Eigen::VectorXd> next_step(next, ws_.q.size());
+  if (!(step_ratio(model_, next_step, ws_.trial, opt_.tolerance) <= kCorrectedContraction * s.full.size)) return false;
+  ++corrections_;
+  return true;
 }
 
 // The trial point becomes the iterate; returns whether the step started within the tolerance of the
@@ -553,11 +629,13 @@ SolveStatus PositionSolve::run() {
     const bool within = check_.within;
     // At the rounding level: the residual already holds, and a full Newton step above the tolerance does not even
     // halve the merit (a step that corrects a real error of q shrinks a residual within tolerance by orders of
-    // magnitude, stale matrix or not). The step is then the rounding of Φ amplified by Φq⁻¹ — on a long chain
+    // magnitude, stale matrix or not), nor leaves a next step a quarter its size (step_corrected_error: where the
+    // merit is other rows' rounding). The step is then the rounding of Φ amplified by Φq⁻¹ — on a long chain
     // (10⁵ scissor stages) it exceeds the tolerance however often Newton repeats it — and it says how well q is
     // known. Stop at the better point of the two, with a warning, instead of refactorising in search of a
     // contraction that cannot come.
-    const bool rounding_level = within && !step_ok_ && s.alpha == 1.0 && !(s.trial.merit < 0.5 * check_.merit);
+    const bool rounding_level = within && !step_ok_ && s.alpha == 1.0 && !(s.trial.merit < 0.5 * check_.merit) &&
+                                !step_corrected_error(s);
     if (rounding_level && !(s.trial.within && s.trial.merit < check_.merit))
       return stop_at_rounding_level(false, s, it);
     // Within the level the previous positions are known to: the step is taken and ends the solve, as at a stop at
