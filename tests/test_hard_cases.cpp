@@ -324,7 +324,9 @@ time: {start: 0, end: 2*pi, steps: 360}
     d.replace(d.find("DRIVEN"), 6, name);
     return d;
   };
-  const Scene pinned = parse_scene(parameters + R"Y(coordinates: {theta2: 0.0, xA: 1e-6, yA: 0.0, x3: 0.5e6, y3: 0.5e-6, psi3: 1e-12, xB: 1e6, yB: 1.1e-6}
+  const Scene pinned = parse_scene(
+      parameters +
+          R"Y(coordinates: {theta2: 0.0, xA: 1e-6, yA: 0.0, x3: 0.5e6, y3: 0.5e-6, psi3: 1e-12, xB: 1e6, yB: 1.1e-6}
 points: {O: [0, 0], A: [xA, yA], B: [xB, yB], C: [L1, 0]}
 bodies: {coupler: [x3, y3, psi3]}
 constraints:
@@ -333,7 +335,7 @@ constraints:
   - {name: B, type: revolute, between: [{body: coupler, at: [L3/2, 0]}, {point: B}]}
   - {name: rocker, type: distance, points: [C, B], length: L4}
 )Y" + driven("theta2"),
-                                   "pinned.yaml");
+      "pinned.yaml");
   const Scene loop = parse_scene(parameters + R"Y(coordinates: {psi2: 0.0, psi3: 1e-12, psi4: -2.3}
 constraints:
   - name: loop

@@ -97,6 +97,16 @@ class ResultRows : public phiq::RowWriter {
   std::string pending_;
 };
 
+// The stderr line's note on rows known only to the rounding level, in the worst coordinate's own unit ("; 22
+// row(s) known only to the rounding level: worst 'yB' known to ±2.7e-10 m at t = …"); empty when there are none.
+std::string rounding_level_note(const phiq::RowClassAccuracy& r) {
+  if (r.rows == 0) return "";
+  std::string s = "; " + std::to_string(r.rows) + " row(s) known only to the rounding level: worst ";
+  s += r.worst_coordinate.empty() ? phiq::significant(r.worst_error, 3) + " × the tolerance test"
+                                  : phiq::known_to_text(r.worst_coordinate, r.worst_known_to, r.worst_unit);
+  return s + " at t = " + phiq::format_time(r.worst_time);
+}
+
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode,
             bool identifier_names, const std::vector<std::string>& sets,
@@ -270,15 +280,7 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     if (summary.min_rcond > 0)
       std::cerr << ", min rcond " << scientific(summary.min_rcond, 3)
                 << " at t = " << phiq::format_time(summary.min_rcond_time);
-    if (const phiq::RowClassAccuracy& r = summary.accuracy.rounding_level; r.rows > 0) {
-      // in the coordinate's own unit ("'yB' known to ±2.1e-10 m"), the tolerance test's multiple beside it
-      std::cerr << "; " << r.rows << " row(s) known only to the rounding level: worst ";
-      if (!r.worst_coordinate.empty())
-        std::cerr << phiq::known_to_text(r.worst_coordinate, r.worst_known_to, r.worst_unit);
-      else
-        std::cerr << phiq::significant(r.worst_error, 3) << " × the tolerance test";
-      std::cerr << " at t = " << phiq::format_time(r.worst_time);
-    }
+    std::cerr << rounding_level_note(summary.accuracy.rounding_level);
     if (file) std::cerr << "; wrote " << printable(out_path);
     std::cerr << "\n";
   }

@@ -148,7 +148,7 @@ struct RowClassAccuracy {
   /// The coordinate where worst_error is reached (PositionSummary::error_coordinate), empty when no solve said:
   /// the estimate in the coordinate's own unit is worst_known_to, in worst_unit (known_to_text()).
   std::string worst_coordinate;
-  double worst_known_to = 0.0;  ///< |δq| at worst_coordinate, in its unit (PositionSummary::error_size); 0 if none
+  double worst_known_to = 0.0;    ///< |δq| at worst_coordinate, in its unit (PositionSummary::error_size); 0 if none
   Unit worst_unit = Unit::kNone;  ///< worst_coordinate's unit (Model::coordinate_unit())
   /// Rows whose error no solve estimated: a position taken on its residual alone, or interpolated between the two
   /// sides of a singular position.

@@ -1,7 +1,7 @@
 // The position solve: Newton's method on Φ(q, t) = 0 with its step and residual tests, backtracking, the reuse
-// of a factorisation while it contracts, and the stop at the rounding level; with the statuses' names, the
-// Workspace's constructor and the check of NewtonOptions. Φq's factorisation, shared with the velocity and
-// acceleration solves (derivatives.cpp), is in factorisation.cpp.
+// of a factorisation while it contracts, and the stop at the rounding level; with the Workspace's constructor and
+// the check of NewtonOptions (the statuses' names and how well q is known: position_report.cpp). Φq's factorisation,
+// shared with the velocity and acceleration solves (derivatives.cpp), is in factorisation.cpp.
 #include "phiq/kinematics.hpp"
 #include "phiq/text.hpp"
 
@@ -10,45 +10,12 @@
 #include "solve/tolerance_tests.hpp"
 
 #include <algorithm>
-#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <optional>
 #include <sstream>
 
 namespace phiq {
-
-const char* to_string(JacobianUpdate u) {
-  return u == JacobianUpdate::kEveryIteration ? "every_iteration" : "when_slow";
-}
-
-const char* to_string(SolveStatus s) {
-  switch (s) {
-    case SolveStatus::kSuccess:
-      return "success";
-    case SolveStatus::kNotConverged:
-      return "not converged";
-    case SolveStatus::kSingularJacobian:
-      return "singular Jacobian";
-    case SolveStatus::kLinearSolverFailed:
-      return "linear solver failed";
-    case SolveStatus::kNonFinite:
-      return "non-finite value";
-    case SolveStatus::kNotSquare:
-      return "not square";
-    case SolveStatus::kOutsideTimeDomain:
-      return "outside time domain";
-    case SolveStatus::kCancelled:
-      return "cancelled";
-    case SolveStatus::kInconsistent:
-      return "inconsistent redundant constraints";
-    case SolveStatus::kPositionNotSolved:
-      return "position not solved";
-    case SolveStatus::kOutsideDomain:
-      return "outside a constraint's domain";
-  }
-  return "?";
-}
 
 Workspace::Workspace(const Model& model) : anchor_(model.anchor_) {
   if (!anchor_) throw Error("a Workspace of a Model that was moved from (it has no data)");
@@ -218,26 +185,9 @@ void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
 
 double scaled_residual(const Model& model, const Eigen::VectorXd& phi) { return max_scaled(model, phi); }
 
-std::string known_to_text(const std::string& name, double size, Unit unit) {
-  const char* symbol = unit_symbol(unit);
-  return "'" + name + "' known to ±" + significant(size, 2) + (*symbol ? " " : "") + symbol;
-}
-
-std::string known_to_text(const Model& model, Index j, double size) {
-  return known_to_text(model.coordinate_names()[static_cast<std::size_t>(j)], size, model.coordinate_unit(j));
-}
-
 double scaled_step(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& dq, const Eigen::VectorXd& q,
                    double tol) {
   return step_ratio(model, dq, q, tol);
-}
-
-std::string PositionSummary::BriefReport() const {
-  std::ostringstream s;
-  s << "position: " << to_string(status) << ", " << iterations << " iterations, scaled residual "
-    << scientific(residual, 3);
-  if (!message.empty()) s << " (" << message << ")";
-  return s.str();
 }
 
 namespace {
@@ -267,7 +217,6 @@ class PositionSolve {
   };
 
   SolveStatus finish(SolveStatus st, std::string msg);
-  void locate_error();
   std::optional<SolveStatus> start();
   std::optional<SolveStatus> stop_before_step(int it);
   std::optional<SolveStatus> factorize_unless_reused();
@@ -317,8 +266,13 @@ SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
   if (st != SolveStatus::kSuccess) ws_.newton_contraction = -1.0;
   if (st == SolveStatus::kSuccess) {
     sum_.residual = check_.worst;  // max_i |Φ_i| / scale_i, from the pass that tested it
-    if (sum_.error_estimate > kQuietRoundingLevel && sum_.iterations + (sum_.error_coordinate >= 0) > 0)
-      locate_error();
+    // an error above the quiet level, told in the coordinate's own unit (error_location.cpp)
+    if (sum_.error_estimate > kQuietRoundingLevel && sum_.iterations + (sum_.error_coordinate >= 0) > 0) {
+      Index j = sum_.error_coordinate;
+      if (j < 0) (void)step_ratio(model_, ws_.step, ws_.q, opt_.tolerance, &j);
+      detail::locate_error(model_, opt_.tolerance, sum_.error_estimate, j, ws_, &sum_.error_coordinate,
+                           &sum_.error_size);
+    }
     // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
     // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
     // Otherwise they factorise at the solution, from the Jacobian evaluated there with Φ if there is one.
@@ -340,46 +294,6 @@ SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
   sum_.message = std::move(msg);
   if (!sum_.worst_rows.empty()) sum_.message += "; worst constraints: " + describe_rows(model_, sum_.worst_rows);
   return st;
-}
-
-// An error above the quiet level, told in the coordinate's own unit (PositionSummary::error_coordinate, error_size):
-// the larger, in units of the tolerance test, of the last step's worst coordinate (error_estimate there) and of
-// what the rounding of q itself does to every coordinate. The step misses the latter: on a 10⁶ m coupler over a
-// 1.5·10⁻⁶ m rocker, xB is held to its ulp (1.2·10⁻¹⁰ m, within its own test), and the rocker turns yB by as much,
-// while Newton's steps in yB, from the rounding of Φ at that xB, are 10⁻¹⁵ m. That part is estimated as Φq⁻¹ f,
-// f_i = ε Σ_j |∂Φ_i/∂q_j| |q_j|: one ulp of every coordinate through each row, with the factors at hand and Φq as
-// last evaluated (at a point near q). One pass over Φq and one solve, only for the rows a sweep reports as known
-// to more than 2 tolerances.
-void PositionSolve::locate_error() {
-  const ToleranceScales& sc = model_.tolerance_scales();
-  const auto allowed = [&](Index j) { return opt_.tolerance * sc.coordinate_scale(j) + kUlpFloor * std::fabs(ws_.q(j)); };
-  Index j = sum_.error_coordinate;
-  if (j < 0) (void)step_ratio(model_, ws_.step, ws_.q, opt_.tolerance, &j);
-  double size = sum_.error_estimate * allowed(j);
-  const CscPattern& p = model_.jacobian_pattern();
-  Eigen::VectorXd& f = ws_.trial_phi;  // (scratch: the trial is done with)
-  f.setZero();
-  for (Index c = 0; c < p.cols; ++c)
-    for (Index k = p.col_ptr[c]; k < p.col_ptr[c + 1]; ++k)
-      f(p.row_idx[k]) += std::fabs(ws_.jacobian_values[static_cast<std::size_t>(k)]) * std::fabs(ws_.q(c));
-  // Each row's rounding is its own: with one sign for all, f would be ε |q_j| times a column of Φq where one
-  // coordinate dominates, and Φq⁻¹ f that coordinate's own ulp alone (the 10⁶ m xB moves, the rocker's yB not).
-  // Signs that vary from row to row (a fixed hash of the row: the same bits on every thread count) keep them apart.
-  for (Index i = 0; i < f.size(); ++i) {
-    const bool minus = ((static_cast<std::uint32_t>(i) * 0x9E3779B1u) >> 16) & 1u;
-    f(i) *= minus ? -std::numeric_limits<double>::epsilon() : std::numeric_limits<double>::epsilon();
-  }
-  double* x = ws_.rhs.data();  // (scratch of the derivative solves: at least n entries where Φq is square)
-  if (f.allFinite() && ws_.lu->solve(solve_rhs(model_, ws_, f), x)) {
-    double worst = size / allowed(j);
-    for (Index c = 0; c < ws_.q.size(); ++c) {
-      const double e = std::fabs(x[c]);
-      if (c == j) size = std::max(size, e), worst = size / allowed(j);
-      if (e / allowed(c) > worst) worst = e / allowed(c), j = c, size = e;
-    }
-  }
-  sum_.error_coordinate = j;
-  sum_.error_size = size;
 }
 
 // The start point: Φ there (and Φq where it will be factorised), or the solve's end when it cannot start.
@@ -634,8 +548,8 @@ SolveStatus PositionSolve::run() {
     // (10⁵ scissor stages) it exceeds the tolerance however often Newton repeats it — and it says how well q is
     // known. Stop at the better point of the two, with a warning, instead of refactorising in search of a
     // contraction that cannot come.
-    const bool rounding_level = within && !step_ok_ && s.alpha == 1.0 && !(s.trial.merit < 0.5 * check_.merit) &&
-                                !step_corrected_error(s);
+    const bool rounding_level =
+        within && !step_ok_ && s.alpha == 1.0 && !(s.trial.merit < 0.5 * check_.merit) && !step_corrected_error(s);
     if (rounding_level && !(s.trial.within && s.trial.merit < check_.merit))
       return stop_at_rounding_level(false, s, it);
     // Within the level the previous positions are known to: the step is taken and ends the solve, as at a stop at

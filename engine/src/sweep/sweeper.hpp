@@ -385,12 +385,12 @@ class Sweeper {
   std::vector<double> history_t_;
   std::vector<double> history_error_;  // the estimated error of q at those rows (units of the tolerance test)
   int depth_ = 0, known_ = 0;
-  double current_error_ = INFINITY;            // the estimated error of current_.q (PositionSummary::error_estimate)
-  double row_error_ = INFINITY;                // that of the row being converged, until remember() makes it current
+  double current_error_ = INFINITY;  // the estimated error of current_.q (PositionSummary::error_estimate)
+  double row_error_ = INFINITY;      // that of the row being converged, until remember() makes it current
   Index current_coordinate_ = -1, row_coordinate_ = -1;  // where those errors are reached (error_coordinate)
   double current_known_to_ = 0.0, row_known_to_ = 0.0;   // and their sizes there (PositionSummary::error_size)
-  RowClass row_class_ = RowClass::kConverged;  // how the row being converged ended (converged())
-  RowClass current_class_ = RowClass::kConverged;  // and current_'s (remember(): singular_row_ overrides it)
+  RowClass row_class_ = RowClass::kConverged;            // how the row being converged ended (converged())
+  RowClass current_class_ = RowClass::kConverged;        // and current_'s (remember(): singular_row_ overrides it)
   bool extrapolated_ = false;   // the last prediction moved from current_ (jumped() has something to compare)
   bool position_only_ = false;  // inside advance_position()
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
