@@ -33,7 +33,7 @@ TEST(RowAccuracy, ALongChainsRowsAtTheRoundingLevelAreCountedAndBoundTheirError)
   sc.sweep.t_end = 0.02;
   const Model& m = *sc.model;
   const Index th = m.coordinate_index("theta");
-  double real = 0.0;
+  double real = 0.0, real_m = 0.0;  // in tolerances, and in metres
   Workspace ws(m);
   SweepSummary sum;
   ASSERT_EQ(run_sweep(
@@ -46,6 +46,8 @@ TEST(RowAccuracy, ALongChainsRowsAtTheRoundingLevelAreCountedAndBoundTheirError)
                     const Index xr = m.coordinate_index("xr" + l), yr = m.coordinate_index("yr" + l);
                     real = std::max({real, in_tolerances(m, xl, v.q(xl), 0.0), in_tolerances(m, yl, v.q(yl), level * s),
                                      in_tolerances(m, xr, v.q(xr), c), in_tolerances(m, yr, v.q(yr), level * s)});
+                    real_m = std::max({real_m, std::fabs(v.q(xl)), std::fabs(v.q(yl) - level * s),
+                                       std::fabs(v.q(xr) - c), std::fabs(v.q(yr) - level * s)});
                   }
                   return true;
                 },
@@ -62,6 +64,11 @@ TEST(RowAccuracy, ALongChainsRowsAtTheRoundingLevelAreCountedAndBoundTheirError)
   // the real error is within the worst estimate (θ is exact: the driven coordinate)
   EXPECT_GT(real, 1.0);
   EXPECT_LE(real, std::max(a.converged.worst_error, a.rounding_level.worst_error));
+  // and in metres, at the coordinate the worst estimate names (a top joint: the largest floor)
+  EXPECT_FALSE(a.rounding_level.worst_coordinate.empty());
+  EXPECT_EQ(a.rounding_level.worst_unit, Unit::kLength);
+  EXPECT_LE(real_m, a.rounding_level.worst_known_to) << a.rounding_level.worst_coordinate;
+  EXPECT_GT(a.rounding_level.worst_known_to, 1e-10);  // above the tolerance test's tol · scale
 }
 
 // A chain of 100 parallelograms started on its flat position: row 0 is singular (its q̇, q̈ the branch's

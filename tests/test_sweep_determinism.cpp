@@ -60,7 +60,8 @@ Record record(const Model& model, SweepOptions opt, int threads, Workspace* reus
     << ' ' << c.acceleration_solves << ' ' << c.phi_t_evaluations << ' ' << c.gamma_evaluations << ' '
     << c.point_evaluations;
   for (const RowClassAccuracy* a : {&sum.accuracy.converged, &sum.accuracy.rounding_level, &sum.accuracy.singular})
-    o << '|' << a->rows << ' ' << a->worst_error << '@' << a->worst_time << ' ' << a->unestimated;
+    o << '|' << a->rows << ' ' << a->worst_error << '@' << a->worst_time << ' ' << a->unestimated << ' '
+      << a->worst_coordinate << ' ' << a->worst_known_to;
   for (const SweepWarning& w : sum.warnings) o << '\n' << w.t << ' ' << w.kind << ' ' << w.message;
   r.summary = o.str();
   return r;

@@ -281,3 +281,35 @@ def test_options_of_another_scene_are_named_as_such():
     with pytest.raises(phiq.SceneError, match=r"crank_slider_mixed\.yaml: the options name coordinates or "
                                               r"constraints this scene does not have .*made for another scene"):
         phiq.run_sweep(crank_slider, four_bar.options)
+
+
+# A four-bar of a 10⁶ m ground and coupler (a body on two pins) on a 10⁻⁶ m crank and a 1.5·10⁻⁶ m rocker: its rows
+# are known only to the rounding of coordinates near 10⁶ m (an ulp is 2⁻³³ m), and the summary says so at the
+# coordinate, in its own unit: B is within a few ulps of 10⁶ m, i.e. well under 10⁻⁹ m (test_hard_cases.cpp checks
+# the rocker's angle against the closed form).
+BADLY_SCALED_PINNED = """phiq: 1
+parameters: {L1: 1e6, L2: 1e-6, L3: 1e6, L4: 1.5e-6}
+coordinates: {theta2: 0.0, xA: 1e-6, yA: 0.0, x3: 0.5e6, y3: 0.5e-6, psi3: 1e-12, xB: 1e6, yB: 1.1e-6}
+points: {O: [0, 0], A: [xA, yA], B: [xB, yB], C: [L1, 0]}
+bodies: {coupler: [x3, y3, psi3]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: A, type: revolute, between: [{body: coupler, at: [-L3/2, 0]}, {point: A}]}
+  - {name: B, type: revolute, between: [{body: coupler, at: [L3/2, 0]}, {point: B}]}
+  - {name: rocker, type: distance, points: [C, B], length: L4}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 2*pi, steps: 360}
+"""
+
+
+def test_accuracy_is_stated_in_the_coordinates_unit():
+    result = phiq.run_sweep(phiq.parse_scene(BADLY_SCALED_PINNED, "pinned.yaml"), threads=1)
+    assert result.ok, result.message
+    rounding = result.summary["accuracy"]["rounding_level"]
+    assert rounding["rows"] > 0
+    assert rounding["worst_coordinate"] in result.coordinate_names
+    assert rounding["worst_unit"] == ("rad" if rounding["worst_coordinate"] in ("theta2", "psi3") else "m")
+    assert 0 < rounding["worst_known_to"] < 1e-9
+    converged = result.summary["accuracy"]["converged"]
+    assert converged["worst_coordinate"] is None or converged["worst_coordinate"] in result.coordinate_names

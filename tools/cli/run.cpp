@@ -115,6 +115,16 @@ std::optional<std::string> mode_start(const phiq::Scene& scene, int mode, int th
   return std::nullopt;
 }
 
+// The stderr line's note on rows known only to the rounding level, in the worst coordinate's own unit ("; 22
+// row(s) known only to the rounding level: worst 'yB' known to ±2.7e-10 m at t = …"); empty when there are none.
+std::string rounding_level_note(const phiq::RowClassAccuracy& r) {
+  if (r.rows == 0) return "";
+  std::string s = "; " + std::to_string(r.rows) + " row(s) known only to the rounding level: worst ";
+  s += r.worst_coordinate.empty() ? phiq::significant(r.worst_error, 3) + " × the tolerance test"
+                                  : phiq::known_to_text(r.worst_coordinate, r.worst_known_to, r.worst_unit);
+  return s + " at t = " + phiq::format_time(r.worst_time);
+}
+
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode,
             bool identifier_names, const std::vector<std::string>& sets,
@@ -288,9 +298,7 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     if (summary.min_rcond > 0)
       std::cerr << ", min rcond " << scientific(summary.min_rcond, 3)
                 << " at t = " << phiq::format_time(summary.min_rcond_time);
-    if (const phiq::RowClassAccuracy& r = summary.accuracy.rounding_level; r.rows > 0)
-      std::cerr << "; " << r.rows << " row(s) known only to " << phiq::significant(r.worst_error, 3)
-                << " tolerances (the rounding level; worst at t = " << phiq::format_time(r.worst_time) << ")";
+    std::cerr << rounding_level_note(summary.accuracy.rounding_level);
     if (file) std::cerr << "; wrote " << printable(out_path);
     std::cerr << "\n";
   }

@@ -80,6 +80,13 @@ std::string run_summary_json(const Scene& scene, const Model& swept, const Sweep
     r["rows"] = c.rows;
     r["worst_error"] = c.worst_error;
     r["worst_time"] = c.worst_time;
+    // the same estimate in the coordinate's own unit (null where no solve said which coordinate)
+    if (c.worst_coordinate.empty()) {
+      r["worst_coordinate"] = nullptr, r["worst_known_to"] = nullptr, r["worst_unit"] = nullptr;
+    } else {
+      r["worst_coordinate"] = c.worst_coordinate, r["worst_known_to"] = c.worst_known_to;
+      r["worst_unit"] = phiq::unit_symbol(c.worst_unit);
+    }
     r["unestimated"] = c.unestimated;
     return r;
   };

@@ -121,6 +121,15 @@ struct PositionSummary {
   /// where the steps are rounding noise), the rounding level at a stop there, or NewtonOptions::start_error when
   /// the start was accepted without a step; negative when unknown (a start accepted on its residual alone).
   double error_estimate = -1.0;
+  /// When error_estimate is above 2 tolerances (a stop at the rounding level, a linear convergence, an end within
+  /// NewtonOptions::known_to): the coordinate j least well known in units of its tolerance test, from the last
+  /// step (error_estimate at its worst coordinate) and from the rounding of q itself carried through Φ (Φq⁻¹ f,
+  /// f_i = ε Σ_j |∂Φ_i/∂q_j| |q_j|: what the step misses where a coordinate near 10⁶ m, held to its ulp, moves a
+  /// 10⁻⁶ m link's other end); −1 otherwise.
+  Index error_coordinate = -1;
+  /// How far q at error_coordinate may be from the solution, in its own unit (metres, radians): "yB known to
+  /// ±2e-10 m" (known_to_text()); 0 when error_coordinate is −1.
+  double error_size = 0.0;
   /// The worst rows at the end (row, |Φ_i| / scale_i), largest first, at most 3.
   std::vector<std::pair<Index, double>> worst_rows;
   std::string message;  ///< one line; empty on a clean success
@@ -177,6 +186,12 @@ SolveStatus solve_acceleration(const Model& model, double t, Workspace& ws, Line
 
 /// max_i |Φ_i| / scale_i, the measure the convergence test uses (0 for an empty model).
 double scaled_residual(const Model& model, const Eigen::VectorXd& phi);
+
+/// How well coordinate `j` is known, in its own unit, as messages say it: "'yB' known to ±2.1e-10 m" (`size`:
+/// PositionSummary::error_size, RowClassAccuracy::worst_known_to). Pre-condition: 0 ≤ j < num_coordinates().
+std::string known_to_text(const Model& model, Index j, double size);
+/// known_to_text() of a coordinate named `name` measured in `unit`.
+std::string known_to_text(const std::string& name, double size, Unit unit);
 
 /// max_j |Δq_j| / (tol · scale_j + floor_j), the measure of a change of q that the convergence test uses: ≤ 1 when
 /// `dq` is within the tolerance `tol` of the coordinates `q` (scale as in NewtonOptions::tolerance, floor a few ulps

@@ -147,6 +147,11 @@ struct RowClassAccuracy {
   /// the predictor's error budget for a prediction taken without a step); 0 when no row has one.
   double worst_error = 0.0;
   double worst_time = 0.0;  ///< the first row where worst_error is reached
+  /// The coordinate where worst_error is reached (PositionSummary::error_coordinate), empty when no solve said:
+  /// the estimate in the coordinate's own unit is worst_known_to, in worst_unit (known_to_text()).
+  std::string worst_coordinate;
+  double worst_known_to = 0.0;    ///< |δq| at worst_coordinate, in its unit (PositionSummary::error_size); 0 if none
+  Unit worst_unit = Unit::kNone;  ///< worst_coordinate's unit (Model::coordinate_unit())
   /// Rows whose error no solve estimated: a position taken on its residual alone, or interpolated between the two
   /// sides of a singular position.
   Index unestimated = 0;

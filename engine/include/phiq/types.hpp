@@ -35,6 +35,8 @@ enum class Unit : std::uint8_t {
 
 /// "none", "length" or "angle".
 const char* to_string(Unit u);
+/// The unit's symbol as messages write it after a number: "m", "rad", or "" (kNone).
+const char* unit_symbol(Unit u);
 
 /// A scalar that a constraint reads: either generalized coordinate coord() or the constant value(). Fixed points
 /// and ground are made of constant slots, so constraints never need separate "grounded" variants.

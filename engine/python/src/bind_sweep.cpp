@@ -18,9 +18,15 @@ py::dict counters_dict(const WorkCounters& c) {
       py::arg("sensitivity_direct_rows") = c.sensitivity_direct_rows, py::arg("effort_solves") = c.effort_solves);
 }
 
+// worst_coordinate, worst_known_to and worst_unit: the worst estimate in the coordinate's own unit (None where no
+// solve said which coordinate), as the run summary's JSON has them
 py::dict accuracy_dict(const RowClassAccuracy& a) {
+  const bool named = !a.worst_coordinate.empty();
   return py::dict(py::arg("rows") = a.rows, py::arg("worst_error") = a.worst_error,
-                  py::arg("worst_time") = a.worst_time, py::arg("unestimated") = a.unestimated);
+                  py::arg("worst_time") = a.worst_time, py::arg("unestimated") = a.unestimated,
+                  py::arg("worst_coordinate") = named ? py::object(py::str(a.worst_coordinate)) : py::none(),
+                  py::arg("worst_known_to") = named ? py::object(py::float_(a.worst_known_to)) : py::none(),
+                  py::arg("worst_unit") = named ? py::object(py::str(unit_symbol(a.worst_unit))) : py::none());
 }
 
 }  // namespace

@@ -26,6 +26,8 @@ const char* to_string(Unit u) {
   return "?";
 }
 
+const char* unit_symbol(Unit u) { return u == Unit::kLength ? "m" : u == Unit::kAngle ? "rad" : ""; }
+
 // ---- Model ---------------------------------------------------------------------------------------------------
 
 static_assert(std::is_nothrow_move_constructible_v<detail::ModelData> &&

@@ -1,7 +1,7 @@
 // The position solve: Newton's method on Φ(q, t) = 0 with its step and residual tests, backtracking, the reuse
-// of a factorisation while it contracts, and the stop at the rounding level; with the statuses' names, the
-// Workspace's constructor and the check of NewtonOptions. Φq's factorisation, shared with the velocity and
-// acceleration solves (derivatives.cpp), is in factorisation.cpp.
+// of a factorisation while it contracts, and the stop at the rounding level; with the Workspace's constructor and
+// the check of NewtonOptions (the statuses' names and how well q is known: position_report.cpp). Φq's factorisation,
+// shared with the velocity and acceleration solves (derivatives.cpp), is in factorisation.cpp.
 #include "phiq/kinematics.hpp"
 #include "phiq/text.hpp"
 
@@ -16,38 +16,6 @@
 #include <sstream>
 
 namespace phiq {
-
-const char* to_string(JacobianUpdate u) {
-  return u == JacobianUpdate::kEveryIteration ? "every_iteration" : "when_slow";
-}
-
-const char* to_string(SolveStatus s) {
-  switch (s) {
-    case SolveStatus::kSuccess:
-      return "success";
-    case SolveStatus::kNotConverged:
-      return "not converged";
-    case SolveStatus::kSingularJacobian:
-      return "singular Jacobian";
-    case SolveStatus::kLinearSolverFailed:
-      return "linear solver failed";
-    case SolveStatus::kNonFinite:
-      return "non-finite value";
-    case SolveStatus::kNotSquare:
-      return "not square";
-    case SolveStatus::kOutsideTimeDomain:
-      return "outside time domain";
-    case SolveStatus::kCancelled:
-      return "cancelled";
-    case SolveStatus::kInconsistent:
-      return "inconsistent redundant constraints";
-    case SolveStatus::kPositionNotSolved:
-      return "position not solved";
-    case SolveStatus::kOutsideDomain:
-      return "outside a constraint's domain";
-  }
-  return "?";
-}
 
 Workspace::Workspace(const Model& model) : anchor_(model.anchor_) {
   if (!anchor_) throw Error("a Workspace of a Model that was moved from (it has no data)");
@@ -222,14 +190,6 @@ double scaled_step(const Model& model, const Eigen::Ref<const Eigen::VectorXd>& 
   return step_ratio(model, dq, q, tol);
 }
 
-std::string PositionSummary::BriefReport() const {
-  std::ostringstream s;
-  s << "position: " << to_string(status) << ", " << iterations << " iterations, scaled residual "
-    << scientific(residual, 3);
-  if (!message.empty()) s << " (" << message << ")";
-  return s.str();
-}
-
 namespace {
 
 // One position solve, in the parts of a Newton iteration: the start, the tests before a step, the factorisation,
@@ -263,6 +223,7 @@ class PositionSolve {
   std::optional<SolveStatus> newton_step(Step& s);
   std::optional<SolveStatus> line_search(Step& s);
   SolveStatus stop_at_rounding_level(bool known_before, const Step& s, int it);
+  bool step_corrected_error(const Step& s);
   bool accept(const Step& s);
   void refresh_matrix() { reuse_ = false, prev_norm_ = -1.0; }
 
@@ -295,6 +256,9 @@ class PositionSolve {
   static constexpr int kMaxReusedSteps = 4;
   int stagnant_ = 0;              // consecutive fresh-matrix steps that contracted by ½ or worse
   double accepted_error_ = -1.0;  // newton_step's error estimate of the current iterate (units of the tolerance test)
+  int corrections_ = 0;           // steps step_corrected_error() kept from a stop at the rounding level
+  static constexpr int kMaxCorrections = 3;
+  static constexpr double kCorrectedContraction = 0.25;
 };
 
 SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
@@ -302,6 +266,13 @@ SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
   if (st != SolveStatus::kSuccess) ws_.newton_contraction = -1.0;
   if (st == SolveStatus::kSuccess) {
     sum_.residual = check_.worst;  // max_i |Φ_i| / scale_i, from the pass that tested it
+    // an error above the quiet level, told in the coordinate's own unit (error_location.cpp)
+    if (sum_.error_estimate > kQuietRoundingLevel && sum_.iterations + (sum_.error_coordinate >= 0) > 0) {
+      Index j = sum_.error_coordinate;
+      if (j < 0) (void)step_ratio(model_, ws_.step, ws_.q, opt_.tolerance, &j);
+      detail::locate_error(model_, opt_.tolerance, sum_.error_estimate, j, ws_, &sum_.error_coordinate,
+                           &sum_.error_size);
+    }
     // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
     // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
     // Otherwise they factorise at the solution, from the Jacobian evaluated there with Φ if there is one.
@@ -494,6 +465,7 @@ SolveStatus PositionSolve::stop_at_rounding_level(bool known_before, const Step&
   sum_.rounding_level = worst_ratio;
   sum_.rounding_measured = !known_before && it > 0;
   sum_.error_estimate = worst_ratio;
+  sum_.error_coordinate = worst;
   // The contraction seen with a reused matrix: the rounding in its last step makes it an overestimate, which
   // the next solve's first step may use as such (kept, as a success's).
   if (theta_seen_ >= 0.0) ws_.newton_contraction = theta_seen_;
@@ -503,17 +475,35 @@ SolveStatus PositionSolve::stop_at_rounding_level(bool known_before, const Step&
   // tolerance (its top joints, 600 m up, are known to 1.2 tolerances).
   if (worst_ratio <= kQuietRoundingLevel) return SolveStatus::kSuccess;
   sum_.slow_convergence = true;
-  const std::string& name = model_.coordinate_names()[static_cast<std::size_t>(worst)];
-  sum_.message =
-      known_before
-          ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
-            "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a long "
-            "chain or Φq ill-conditioned): up to " +
-                scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there"
-          : "the residual is at its rounding level and the Newton steps no longer reduce it: they are "
-            "the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned), up to " +
-                scientific(worst_ratio, 3) + " × the tolerance at '" + name + "', which is how well q is known there";
+  const std::string known =
+      known_to_text(model_, sum_.error_coordinate, sum_.error_size) + ", which is how well q is known there";
+  sum_.message = known_before ? "the Newton step is within the level q can be known to here (NewtonOptions::known_to, "
+                                "which a sweep measures at its previous rows: the rounding of Φ amplified by Φq⁻¹, a "
+                                "long chain or Φq ill-conditioned): " +
+                                    known
+                              : "the residual is at its rounding level and the Newton steps no longer reduce it: they "
+                                "are the rounding of Φ amplified by Φq⁻¹ (a long chain, or Φq ill-conditioned): " +
+                                    known;
   return SolveStatus::kSuccess;
+}
+
+// Whether the full step just tried, though it did not halve the merit, corrected a real error of q: the next
+// (simplified) Newton step from its trial point, with the same factors, is at most a quarter of it in the
+// tolerance test's units (each coordinate in its own unit). The merit weighs rows by their scales, not by what
+// their residuals do to q: on a four-bar of a 10⁶ m coupler and a 10⁻⁶ m crank, a coupler pin's residual of
+// 10⁻⁷ m (10⁻¹³ of its scale) puts the rocker 0.1 rad off, while the merit is the rocker row's rounding (10⁻¹⁰ m
+// of 1.5·10⁻⁶ m). At the rounding level the next step is more rounding, as large as this one (θ ≈ 1); a step that
+// corrected an error leaves one far smaller. One solve with the factors at hand, only where the merit alone would
+// stop; at most kMaxCorrections per solve, so that rounding that happens to contract cannot run on, and not for a
+// step within the level the rows before measured (NewtonOptions::known_to: that is rounding already known).
+bool PositionSolve::step_corrected_error(const Step& s) {
+  if (corrections_ >= kMaxCorrections || s.known_ok || !s.trial.finite) return false;
+  double* next = ws_.rhs.data();  // (scratch of the derivative solves: at least n entries where Φq is square)
+  if (!ws_.lu->solve(solve_rhs(model_, ws_, ws_.trial_phi), next)) return false;
+  const Eigen::Map<const Eigen::VectorXd> next_step(next, ws_.q.size());
+  if (!(step_ratio(model_, next_step, ws_.trial, opt_.tolerance) <= kCorrectedContraction * s.full.size)) return false;
+  ++corrections_;
+  return true;
 }
 
 // The trial point becomes the iterate; returns whether the step started within the tolerance of the
@@ -553,11 +543,13 @@ SolveStatus PositionSolve::run() {
     const bool within = check_.within;
     // At the rounding level: the residual already holds, and a full Newton step above the tolerance does not even
     // halve the merit (a step that corrects a real error of q shrinks a residual within tolerance by orders of
-    // magnitude, stale matrix or not). The step is then the rounding of Φ amplified by Φq⁻¹ — on a long chain
+    // magnitude, stale matrix or not), nor leaves a next step a quarter its size (step_corrected_error: where the
+    // merit is other rows' rounding). The step is then the rounding of Φ amplified by Φq⁻¹ — on a long chain
     // (10⁵ scissor stages) it exceeds the tolerance however often Newton repeats it — and it says how well q is
     // known. Stop at the better point of the two, with a warning, instead of refactorising in search of a
     // contraction that cannot come.
-    const bool rounding_level = within && !step_ok_ && s.alpha == 1.0 && !(s.trial.merit < 0.5 * check_.merit);
+    const bool rounding_level =
+        within && !step_ok_ && s.alpha == 1.0 && !(s.trial.merit < 0.5 * check_.merit) && !step_corrected_error(s);
     if (rounding_level && !(s.trial.within && s.trial.merit < check_.merit))
       return stop_at_rounding_level(false, s, it);
     // Within the level the previous positions are known to: the step is taken and ends the solve, as at a stop at

@@ -38,4 +38,9 @@ void check_newton_options(const NewtonOptions& opt, const char* what = "NewtonOp
 SolveStatus derivatives_at_solution(const Model& model, double t, Workspace& ws, bool accelerations,
                                     LinearSummary* summary);
 
+// How well q is known, in a coordinate's own unit, at a solve whose error estimate is `estimate` tolerances at its
+// worst coordinate `j` (position_report.cpp): *where and *size, PositionSummary::error_coordinate and error_size.
+// Uses ws.trial_phi and ws.rhs as scratch. Pre-condition: 0 ≤ j < n; ws.q the solution.
+void locate_error(const Model& model, double tol, double estimate, Index j, Workspace& ws, Index* where, double* size);
+
 }  // namespace phiq::detail

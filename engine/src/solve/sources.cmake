@@ -9,6 +9,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/factorisation.cpp
   ${CMAKE_CURRENT_LIST_DIR}/kinematics.cpp
   ${CMAKE_CURRENT_LIST_DIR}/parameter_reach.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/position_report.cpp
   ${CMAKE_CURRENT_LIST_DIR}/rank_analysis.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sensitivity.cpp
 )

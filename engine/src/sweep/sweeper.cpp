@@ -67,6 +67,7 @@ bool Sweeper::advance(double t1, int depth) {
     // a zero pivot exactly at a singular position: bracket it (position interpolated from both sides)
     if (singular_point(t1, 0.0, /*have_position=*/false)) {
       row_error_ = INFINITY;  // interpolated: the next step checks it
+      row_coordinate_ = -1;
       remember(t1);
       return true;
     }
@@ -122,6 +123,7 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   singular_row_ = false;
   last_rcond_ = ps.rcond;
   row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
+  row_coordinate_ = ps.error_coordinate, row_known_to_ = ps.error_size;
   // (a row accepted within NewtonOptions::known_to, the rounding level rows before it measured, is at that
   // level too, though its own Newton did not stop there: known to its estimate, not to the tolerance)
   row_class_ = ps.linear_convergence                                     ? RowClass::kSingular
@@ -212,6 +214,7 @@ void Sweeper::remember(double t) {
   has_current_ = true;
   current_.t = t;
   current_error_ = row_error_;
+  current_coordinate_ = row_coordinate_, current_known_to_ = row_known_to_;
   current_class_ = singular_row_ ? RowClass::kSingular : row_class_;
   // The converged state moves into current_ by swaps too: ws keeps the buffers of the state before, which the
   // next step overwrites (predict() writes q, the solves q̇ and q̈). Rows are delivered from state().

@@ -49,6 +49,9 @@ enum class RowClass { kConverged, kRoundingLevel, kSingular };
 struct RowQuality {
   RowClass row_class = RowClass::kConverged;
   double error = INFINITY;
+  const std::string* coordinate = nullptr;  // where `error` is reached (a name of the model's), null if not said
+  double known_to = 0.0;                    // `error` in that coordinate's unit
+  Unit unit = Unit::kNone;                  // that unit
 };
 // Adds a delivered row at t to the summary's accuracy.
 inline void add_row_quality(SweepAccuracy& a, double t, const RowQuality& r) {
@@ -58,8 +61,13 @@ inline void add_row_quality(SweepAccuracy& a, double t, const RowQuality& r) {
   ++c.rows;
   if (!std::isfinite(r.error))
     ++c.unestimated;
-  else if (r.error > c.worst_error)
+  else if (r.error > c.worst_error) {
     c.worst_error = r.error, c.worst_time = t;
+    if (r.coordinate)
+      c.worst_coordinate = *r.coordinate, c.worst_known_to = r.known_to, c.worst_unit = r.unit;
+    else
+      c.worst_coordinate.clear(), c.worst_known_to = 0.0, c.worst_unit = Unit::kNone;
+  }
 }
 
 // A sign of det Φq is ±1 at a regular position and 0 at a singular one; kSignUnknown where no factorisation tells
@@ -226,7 +234,11 @@ class Sweeper {
   // The estimated error of state().q (units of the tolerance test; infinite when unknown).
   double state_error() const { return current_error_; }
   // What the delivered row of state() says of its accuracy (SweepAccuracy): its class and estimated error.
-  RowQuality row_quality() const { return {current_class_, current_error_}; }
+  RowQuality row_quality() const {
+    if (current_coordinate_ < 0) return {current_class_, current_error_};
+    return {current_class_, current_error_, &model_.coordinate_names()[static_cast<std::size_t>(current_coordinate_)],
+            current_known_to_, model_.coordinate_unit(current_coordinate_)};
+  }
   // One more step to t1 for its position only (a parallel chunk's seam, compared with the next chunk's first row):
   // no derivatives, no outputs.
   bool advance_position(double t1) {
@@ -243,6 +255,7 @@ class Sweeper {
     known_ = 0;
     current_sign_ = current_row_sign_ = Orientation{};
     row_error_ = INFINITY;  // how well the adopted state is known is not said: the next step checks it
+    row_coordinate_ = -1;
     remember(t);
   }
 
@@ -379,10 +392,12 @@ class Sweeper {
   std::vector<double> history_t_;
   std::vector<double> history_error_;  // the estimated error of q at those rows (units of the tolerance test)
   int depth_ = 0, known_ = 0;
-  double current_error_ = INFINITY;            // the estimated error of current_.q (PositionSummary::error_estimate)
-  double row_error_ = INFINITY;                // that of the row being converged, until remember() makes it current
-  RowClass row_class_ = RowClass::kConverged;  // how the row being converged ended (converged())
-  RowClass current_class_ = RowClass::kConverged;  // and current_'s (remember(): singular_row_ overrides it)
+  double current_error_ = INFINITY;  // the estimated error of current_.q (PositionSummary::error_estimate)
+  double row_error_ = INFINITY;      // that of the row being converged, until remember() makes it current
+  Index current_coordinate_ = -1, row_coordinate_ = -1;  // where those errors are reached (error_coordinate)
+  double current_known_to_ = 0.0, row_known_to_ = 0.0;   // and their sizes there (PositionSummary::error_size)
+  RowClass row_class_ = RowClass::kConverged;            // how the row being converged ended (converged())
+  RowClass current_class_ = RowClass::kConverged;        // and current_'s (remember(): singular_row_ overrides it)
   bool extrapolated_ = false;   // the last prediction moved from current_ (jumped() has something to compare)
   bool position_only_ = false;  // inside advance_position()
   std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
