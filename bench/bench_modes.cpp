@@ -23,21 +23,6 @@ std::string bench_modes_model(const std::string& rel) {
   return path;
 }
 
-const char* kRpr3 =
-    "phiq: 1\nname: rpr3\n"
-    "parameters: {a2: 15.91, a3x: 0, a3y: 10, b2: 17.04, b3x: 8.0, b3y: 9.0, r1: 14.98, r2: 15.38, r3: 12}\n"
-    "coordinates: {x: 5, y: 5, psi: 0.3, x1: 5, y1: 5, x2: 20, y2: 8, x3: 12, y3: 14}\n"
-    "points: {A1: [0, 0], A2: [a2, 0], A3: [a3x, a3y], P1: [x1, y1], P2: [x2, y2], P3: [x3, y3]}\n"
-    "bodies: {platform: [x, y, psi]}\n"
-    "constraints:\n"
-    "  - {name: B1, type: revolute, between: [{body: platform, at: [0, 0]}, {point: P1}]}\n"
-    "  - {name: B2, type: revolute, between: [{body: platform, at: [b2, 0]}, {point: P2}]}\n"
-    "  - {name: B3, type: revolute, between: [{body: platform, at: [b3x, b3y]}, {point: P3}]}\n"
-    "  - {name: leg1, type: distance, points: [A1, P1], length: r1}\n"
-    "  - {name: leg2, type: distance, points: [A2, P2], length: r2}\n"
-    "  - {name: leg3, type: distance, points: [A3, P3], length: r3}\n"
-    "time: {start: 0, end: 1, steps: 1}\n";
-
 // A general Stewart–Gough platform: base points b_i and platform points p_i in general position (no two legs
 // meeting, neither hexagon planar), legs of fixed lengths L_i.
 const char* kStewart =
@@ -61,7 +46,8 @@ const char* kStewart =
 
 phiq::Scene bench_modes_scene(const std::string& which) {
   if (which == "fourbar") return phiq::load_scene(bench_modes_model("seed/fourbar_mixed.yaml"));
-  return phiq::parse_scene(which == "rpr3" ? kRpr3 : kStewart, which + ".yaml");
+  if (which == "rpr3") return phiq::load_scene(bench_modes_model("benchmarks/rpr3.yaml"));
+  return phiq::parse_scene(kStewart, which + ".yaml");
 }
 
 void BM_ModesPhiq(benchmark::State& state, const std::string& which) {

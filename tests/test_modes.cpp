@@ -192,32 +192,11 @@ TEST(ModesCrankSlider, TwoModesOneEachSideOfTheCrank) {
   EXPECT_NEAR(found[1], xa + reach, 1e-12);
 }
 
-// The 3-RPR planar parallel robot with its legs at fixed lengths: base A1 A2 A3, platform triangle B1 B2 B3 (a body
-// with its points pinned to natural points), legs A_i B_i. Its forward kinematics has six complex solutions for
-// generic dimensions (Gosselin and Sefrioui 1991; Merlet, Parallel Robots, ch. 4), up to six real. The base and
-// legs below are those of the six-real-mode example of the 3-RPR literature as commonly quoted (A2 = (15.91, 0),
-// A3 = (0, 10), legs 14.98, 15.38, 12); the platform is this test's own, and its count of six real modes is
-// PHCpack's too (test_modes_phc.cpp, ThreeRprAsPhcSolvesIt).
-std::string modes_rpr_scene(double rho1, double rho2, double rho3) {
-  return "phiq: 1\nname: rpr3\n"
-         "parameters: {a2: 15.91, a3x: 0, a3y: 10, b2: 17.04, b3x: 8.0, b3y: 9.0, r1: " +
-         std::to_string(rho1) + ", r2: " + std::to_string(rho2) + ", r3: " + std::to_string(rho3) +
-         "}\n"
-         "coordinates: {x: 5, y: 5, psi: 0.3, x1: 5, y1: 5, x2: 20, y2: 8, x3: 12, y3: 14}\n"
-         "points: {A1: [0, 0], A2: [a2, 0], A3: [a3x, a3y], P1: [x1, y1], P2: [x2, y2], P3: [x3, y3]}\n"
-         "bodies: {platform: [x, y, psi]}\n"
-         "constraints:\n"
-         "  - {name: B1, type: revolute, between: [{body: platform, at: [0, 0]}, {point: P1}]}\n"
-         "  - {name: B2, type: revolute, between: [{body: platform, at: [b2, 0]}, {point: P2}]}\n"
-         "  - {name: B3, type: revolute, between: [{body: platform, at: [b3x, b3y]}, {point: P3}]}\n"
-         "  - {name: leg1, type: distance, points: [A1, P1], length: r1}\n"
-         "  - {name: leg2, type: distance, points: [A2, P2], length: r2}\n"
-         "  - {name: leg3, type: distance, points: [A3, P3], length: r3}\n"
-         "time: {start: 0, end: 1, steps: 1}\n";
-}
+// The 3-RPR planar parallel robot at fixed leg lengths (models/benchmarks/rpr3.yaml says whose dimensions).
+Scene modes_rpr_scene() { return load_scene(modes_model_path("benchmarks/rpr3.yaml")); }
 
 TEST(ModesParallelRobot, ThreeRprHasSixAssembliesAllReal) {
-  const Scene scene = parse_scene(modes_rpr_scene(14.98, 15.38, 12.0), "rpr3.yaml");
+  const Scene scene = modes_rpr_scene();
   const AssemblyModes r = find_assembly_modes(*scene.model, {});
   ASSERT_EQ(r.summary.status, ModesStatus::kSuccess) << r.summary.message;
   EXPECT_EQ(r.summary.paths, 16);  // 6 linear pin rows, 3 legs and the platform's circle: 2⁴
@@ -237,7 +216,7 @@ TEST(ModesScene, ACamIsRefusedWithItsConstraintNamed) {
 }
 
 TEST(ModesDeterminism, OneAndTwoThreadsGiveTheSameBits) {
-  const Scene scene = parse_scene(modes_rpr_scene(14.98, 15.38, 12.0), "rpr3.yaml");
+  const Scene scene = modes_rpr_scene();
   ModesOptions one, two;
   one.threads = 1, two.threads = 2;
   const AssemblyModes a = find_assembly_modes(*scene.model, one), b = find_assembly_modes(*scene.model, two);

@@ -19,6 +19,13 @@
 namespace phiq {
 namespace {
 
+std::string modes_phc_models(const std::string& rel) {
+  std::string path = PHIQ_MODELS_DIR;
+  path += '/';
+  path += rel;
+  return path;
+}
+
 bool phc_installed() { return std::system("command -v phc > /dev/null 2>&1") == 0; }
 
 // One solution as phc writes it: the values of x1 … xn, and whether phc calls it real.
@@ -104,13 +111,6 @@ void modes_expect_same_as_phc(const PolynomialSystem& system, const ModesSummary
   }
 }
 
-std::string modes_phc_models(const std::string& rel) {
-  std::string path = PHIQ_MODELS_DIR;
-  path += '/';
-  path += rel;
-  return path;
-}
-
 TEST(ModesPhc, IntegerSystemAsPhcSolvesIt) {
   if (!phc_installed()) GTEST_SKIP() << "phc (Debian package phcpack) is not installed";
   Polynomial a, b;
@@ -137,21 +137,7 @@ TEST(ModesPhc, FourBarAndCrankSliderAsPhcSolvesThem) {
 
 TEST(ModesPhc, ThreeRprAsPhcSolvesIt) {
   if (!phc_installed()) GTEST_SKIP() << "phc (Debian package phcpack) is not installed";
-  const std::string text =
-      "phiq: 1\nname: rpr3\n"
-      "parameters: {a2: 15.91, a3x: 0, a3y: 10, b2: 17.04, b3x: 8.0, b3y: 9.0, r1: 14.98, r2: 15.38, r3: 12}\n"
-      "coordinates: {x: 5, y: 5, psi: 0.3, x1: 5, y1: 5, x2: 20, y2: 8, x3: 12, y3: 14}\n"
-      "points: {A1: [0, 0], A2: [a2, 0], A3: [a3x, a3y], P1: [x1, y1], P2: [x2, y2], P3: [x3, y3]}\n"
-      "bodies: {platform: [x, y, psi]}\n"
-      "constraints:\n"
-      "  - {name: B1, type: revolute, between: [{body: platform, at: [0, 0]}, {point: P1}]}\n"
-      "  - {name: B2, type: revolute, between: [{body: platform, at: [b2, 0]}, {point: P2}]}\n"
-      "  - {name: B3, type: revolute, between: [{body: platform, at: [b3x, b3y]}, {point: P3}]}\n"
-      "  - {name: leg1, type: distance, points: [A1, P1], length: r1}\n"
-      "  - {name: leg2, type: distance, points: [A2, P2], length: r2}\n"
-      "  - {name: leg3, type: distance, points: [A3, P3], length: r3}\n"
-      "time: {start: 0, end: 1, steps: 1}\n";
-  const Scene scene = parse_scene(text, "rpr3.yaml");
+  const Scene scene = load_scene(modes_phc_models("benchmarks/rpr3.yaml"));
   const AssemblyModes r = find_assembly_modes(*scene.model, {});
   ASSERT_EQ(r.summary.status, ModesStatus::kSuccess) << r.summary.message;
   modes_expect_same_as_phc(r.polynomials.system, r.summary);
