@@ -266,7 +266,7 @@ SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
   if (st != SolveStatus::kSuccess) ws_.newton_contraction = -1.0;
   if (st == SolveStatus::kSuccess) {
     sum_.residual = check_.worst;  // max_i |Φ_i| / scale_i, from the pass that tested it
-    // an error above the quiet level, told in the coordinate's own unit (error_location.cpp)
+    // an error above the quiet level, told in the coordinate's own unit (position_report.cpp)
     if (sum_.error_estimate > kQuietRoundingLevel && sum_.iterations + (sum_.error_coordinate >= 0) > 0) {
       Index j = sum_.error_coordinate;
       if (j < 0) (void)step_ratio(model_, ws_.step, ws_.q, opt_.tolerance, &j);
