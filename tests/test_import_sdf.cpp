@@ -9,7 +9,10 @@
 
 #include "cli_test_support.hpp"
 #include "import_test_support.hpp"
+#include "import/sdf_module.hpp"
 #include "phiq/rank_analysis.hpp"
+
+#include <dlfcn.h>
 
 namespace phiq {
 namespace {
@@ -115,6 +118,50 @@ TEST_F(Cli, SdfConvertWritesTheTextADirectReadSolves) {
   const Result check = run("check " + model);
   ASSERT_EQ(check.code, 0) << check.err;
   EXPECT_NE(check.out.find("dof           1 (1 not driven)"), std::string::npos) << check.out;
+}
+
+// What `ldd` lists for the file: every shared library a process of it maps at start.
+std::string SdfStartLibraries(const std::string& file) {
+  std::string out;
+  if (FILE* p = popen(("ldd " + file).c_str(), "r")) {
+    char buf[4096];
+    for (std::size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+    pclose(p);
+  }
+  return out;
+}
+
+// libsdformat (and ignition-math, whose header compiles a regex in every file's static initialiser) is mapped only
+// by a process that reads an SDF file: the module, found beside the build or by PHIQ_SDF_MODULE, carries it.
+TEST_F(Cli, SdfIsReadByAModuleOnlyAnSdfFileLoads) {
+  const std::string cli = SdfStartLibraries(PHIQ_CLI), module = SdfStartLibraries(PHIQ_SDF_MODULE_FILE);
+  ASSERT_NE(cli.find("libyaml-cpp"), std::string::npos) << cli;
+  EXPECT_EQ(cli.find("sdformat"), std::string::npos) << cli;
+  EXPECT_EQ(cli.find("ignition"), std::string::npos) << cli;
+  EXPECT_NE(module.find("libsdformat12"), std::string::npos) << module;
+
+  void* handle = dlopen(PHIQ_SDF_MODULE_FILE, RTLD_NOW | RTLD_LOCAL);
+  ASSERT_NE(handle, nullptr) << dlerror();
+  auto entry = reinterpret_cast<decltype(&phiq_sdf_reader)>(dlsym(handle, "phiq_sdf_reader"));
+  ASSERT_NE(entry, nullptr);
+  using detail::mechanism::Mechanism, detail::mechanism::kSdfModuleAbi;
+  EXPECT_EQ(entry(kSdfModuleAbi + 1, sizeof(Mechanism)), nullptr);
+  EXPECT_EQ(entry(kSdfModuleAbi, sizeof(Mechanism) + 8), nullptr);
+  EXPECT_NE(entry(kSdfModuleAbi, sizeof(Mechanism)), nullptr);
+
+  const std::string model = import_data("sdf/fourbar.sdf");
+  const Result missing = run_prefixed("PHIQ_SDF_MODULE=" + (dir_ / "none.so").string() + " ", "check " + model);
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_TRUE(one_phiq_line(missing.err));
+  EXPECT_NE(missing.err.find(model + ": reading SDF needs phiq's SDFormat module: libphiq_sdf.so not found"),
+            std::string::npos)
+      << missing.err;
+  const Result foreign =
+      run_prefixed("PHIQ_SDF_MODULE=" + write("fake.so", "not ELF").string() + " ", "check " + model);
+  EXPECT_EQ(foreign.code, 2);
+  EXPECT_TRUE(one_phiq_line(foreign.err));
+  EXPECT_NE(foreign.err.find("cannot load"), std::string::npos) << foreign.err;
+  EXPECT_EQ(missing.out + foreign.out, "");
 }
 
 }  // namespace test

@@ -2,7 +2,8 @@
 // specification, resolves every pose (`relative_to`, frames) and gives each element's line. One model (the file's, or
 // the first of its world); its frame is phiq's world frame. SDF's joints form any graph, so a loop closes natively:
 // each joint joins its parent and child links at the joint frame, at the links' poses in the file. A link that no
-// joint joins to `world` moves freely, as in SDF.
+// joint joins to `world` moves freely, as in SDF. This file is the module libphiq_sdf.so, which the engine loads on
+// the first SDF file it reads (sdf_module.hpp says why).
 #include <sdf/Console.hh>
 #include <sdf/Geometry.hh>
 #include <sdf/Joint.hh>
@@ -22,6 +23,7 @@
 #include <set>
 
 #include "import/mechanism.hpp"
+#include "import/sdf_module.hpp"
 #include "phiq/scene.hpp"
 
 namespace phiq {
@@ -194,17 +196,19 @@ Mechanism SdfReader::read(int* loops) {
 }  // namespace
 }  // namespace detail::mechanism
 
-ModelImport import_sdf(const std::string& text, const std::string& path, const ImportOptions& options) {
-  int loops = 0;
-  detail::mechanism::Mechanism m = detail::mechanism::SdfReader(text, path).read(&loops);
-  ModelImport out;
-  out.bodies = static_cast<int>(m.bodies.size()) - 1;
-  out.joints = static_cast<int>(m.joints.size());
-  out.loops = loops;
-  out.couplers = 0;
-  out.yaml = detail::mechanism::write_mechanism_scene(m, options);
-  out.skipped = std::move(m.skipped);
-  return out;
-}
-
 }  // namespace phiq
+
+extern "C" __attribute__((visibility("default"))) phiq::detail::mechanism::ReadSdf phiq_sdf_reader(
+    int abi, std::size_t mechanism_bytes) {
+  using namespace phiq::detail::mechanism;
+  if (abi != kSdfModuleAbi || mechanism_bytes != sizeof(Mechanism)) return nullptr;
+  return [](const std::string& text, const std::string& path, Mechanism& out, int& loops, std::string& error) {
+    try {
+      out = SdfReader(text, path).read(&loops);
+      return true;
+    } catch (const std::exception& e) {
+      error = e.what();
+      return false;
+    }
+  };
+}
