@@ -14,6 +14,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <vector>
 
@@ -169,6 +170,11 @@ void klu_at_scale(benchmark::State& state, const char* kind) {
   klu_l_free_numeric(&num, &c);
   klu_l_free_symbolic(&sym, &c);
 }
+// Each figure's minimum measured time; 0.01 s in ctest's smoke run (PHIQ_BENCH_SMOKE set). A benchmark's own MinTime
+// overrides --benchmark_min_time, and these timed laps are a small part of each iteration (the rest prepares it), so
+// the smoke run took 45 s at its smallest size.
+double min_time(double seconds) { return std::getenv("PHIQ_BENCH_SMOKE") ? 0.01 : seconds; }
+
 void BM_KluAtScaleGrid(benchmark::State& s) { klu_at_scale(s, "grid"); }
 void BM_KluAtScaleNFourBar(benchmark::State& s) { klu_at_scale(s, "nfourbar"); }
 void BM_KluAtScaleScissor(benchmark::State& s) { klu_at_scale(s, "scissor"); }
@@ -176,18 +182,26 @@ void klu_sizes(benchmark::internal::Benchmark* b) {
   b->ArgName("N");
   for (int64_t n = 100; n <= 1000000; n *= 10) b->Arg(n);
 }
-BENCHMARK(BM_KluAtScaleGrid)->Apply(klu_sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.5);
-BENCHMARK(BM_KluAtScaleNFourBar)->Apply(klu_sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.5);
-BENCHMARK(BM_KluAtScaleScissor)->Apply(klu_sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.5);
+BENCHMARK(BM_KluAtScaleGrid)->Apply(klu_sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(min_time(0.5));
+BENCHMARK(BM_KluAtScaleNFourBar)
+    ->Apply(klu_sizes)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->MinTime(min_time(0.5));
+BENCHMARK(BM_KluAtScaleScissor)
+    ->Apply(klu_sizes)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->MinTime(min_time(0.5));
 
 void BM_NFourBarStep(benchmark::State& s) { run(s, "nfourbar"); }
 void BM_ScissorStep(benchmark::State& s) { run(s, "scissor"); }
 void BM_GridStep(benchmark::State& s) { run(s, "grid"); }
 void BM_Chain3dStep(benchmark::State& s) { run(s, "chain3d"); }
-BENCHMARK(BM_NFourBarStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.2);
-BENCHMARK(BM_ScissorStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.2);
-BENCHMARK(BM_GridStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.2);
-BENCHMARK(BM_Chain3dStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(0.2);
+BENCHMARK(BM_NFourBarStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(min_time(0.2));
+BENCHMARK(BM_ScissorStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(min_time(0.2));
+BENCHMARK(BM_GridStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(min_time(0.2));
+BENCHMARK(BM_Chain3dStep)->Apply(sizes)->Unit(benchmark::kMillisecond)->UseManualTime()->MinTime(min_time(0.2));
 
 }  // namespace
 
