@@ -3,8 +3,9 @@
 # (natural coordinates), each with its crank tip A traced and a sweep that does not close the cycle (the first and
 # last poses differ), opened in headless Chromium by tests/browser/viewer_test.js (node, no npm package): no console
 # error, first and last frames differ where the mechanism moved and agree on the ground, the middle frame matches
-# tests/browser/reference/NAME.png; and the parts of the Cardan joint, the roller cam and the gear train, their
-# middle frames against parts_*.png. Skipped (exit 77) when chromium or node is absent.
+# tests/browser/reference/NAME.png; the parts of the Cardan joint, the roller cam and the gear train, their middle
+# frames against parts_*.png; and the four-bar knee's output.clearance, marked and coloured. Skipped (exit 77) when
+# chromium or node is absent.
 # Usage: browser_viewer_test.sh PHIQ MODELS_DIR WORK_DIR [--update] [--timing]
 #   --update rewrites the references (look at them, and say why in the commit).
 set -u
@@ -36,6 +37,9 @@ for name in cams/eccentric_roller transmissions/gear_train; do
   "$phiq" animate "$models/$name.yaml" -o "$work/$(basename "$name").html" ||
     { echo "browser_viewer: phiq animate $name failed"; exit 1; }
 done
+# the four-bar knee's output.clearance: witness points and the parts within the threshold coloured
+"$phiq" animate "$models/clearance/fourbar_knee.yaml" -o "$work/knee.html" ||
+  { echo "browser_viewer: phiq animate fourbar_knee failed"; exit 1; }
 exec node "$here/browser/viewer_test.js" "$chromium" "$here/browser/reference" "$work/shots" "$@" \
   planar="$work/planar.html" spatial="$work/spatial.html" parts_cardan="$work/cardan.html" \
-  parts_cam="$work/eccentric_roller.html" parts_gears="$work/gear_train.html"
+  parts_cam="$work/eccentric_roller.html" parts_gears="$work/gear_train.html" clearance_knee="$work/knee.html"

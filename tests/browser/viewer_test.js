@@ -4,7 +4,8 @@
 // changes) and agree on everything away from the mechanism in both (the ground, its pivots, axes, grid); and the
 // middle frame, trails and velocity vectors on, matches the committed reference within a tolerance. A page named
 // parts_NAME shows parts (solids that sweep the view, so the first and last frames are not compared): its middle
-// frame against its reference, and a part named with its pose when picked.
+// frame against its reference, and a part named with its pose when picked. A page named clearance_NAME shows a
+// scene's output.clearance: its witness points marked, its near parts coloured at a row within the threshold only.
 // Usage: node viewer_test.js CHROMIUM REFERENCE_DIR OUT_DIR [--update] [--timing] NAME=PAGE.html ...
 //   --update  writes the references (REFERENCE_DIR/NAME.png) instead of comparing with them
 //   --timing  also plays each page for 4 s and prints the frame interval and draw time the page measured
@@ -90,6 +91,30 @@ async function testPage(browser, name, page) {
   check(frames > 1, `${name}: the page holds ${frames} frames`);
   const view = await tab.evaluate('(() => { const r = document.getElementById("view").firstElementChild.getBoundingClientRect(); return {x: r.left, y: r.top, width: r.width, height: r.height}; })()');
   const clip = {x: Math.round(view.x), y: Math.round(view.y), width: Math.round(view.width), height: Math.round(view.height)};
+  if (name.startsWith('clearance_')) {
+    // output.clearance: the witness points marked; a pair's parts coloured at a row within the threshold, none at
+    // a row where every pair is clear
+    const c = await tab.evaluate(`(() => {
+      const c = phiq.clearance, rows = c.t.map((t, r) => c.pairs.filter((p) => p.near[r] === '1'));
+      const r = rows.findIndex((n) => n.length > 0), clear = rows.findIndex((n) => n.length === 0);
+      return {pairs: c.pairs.length, a: r >= 0 ? rows[r][0].a : -1, b: r >= 0 ? rows[r][0].b : -1,
+              near: r >= 0 ? phiq.below(phiq.data.t, c.t[r]) : -1, clear: clear >= 0 ? phiq.below(phiq.data.t, c.t[clear]) : -1,
+              labels: document.querySelectorAll('text.witness-label').length,
+              witness: (document.querySelector('path.witness').getAttribute('d') || '').split('M').length - 1};
+    })()`);
+    check(c.pairs > 0 && c.labels === c.pairs && c.witness === 3 * c.pairs,
+          `${name}: ${c.pairs} pairs, ${c.labels} labels, ${c.witness} witness marks (2 rings and a line each)`);
+    check(c.near >= 0 && c.clear >= 0, `${name}: a row within the threshold (frame ${c.near}) and one clear (frame ${c.clear})`);
+    await tab.evaluate(`phiqViewer.show(${c.near})`);
+    const near = await tab.evaluate('phiqViewer.near()');
+    const inked = await tab.evaluate('document.querySelector("path.near").getAttribute("d").length');
+    check(near[c.a] === 1 && near[c.b] === 1 && inked > 0, `${name}: at frame ${c.near} parts ${c.a} and ${c.b} are coloured`);
+    await tab.evaluate(`phiqViewer.show(${c.clear})`);
+    const none = await tab.evaluate('(phiqViewer.near().every((v) => v === 0) && document.querySelector("path.near").getAttribute("d") === "")');
+    check(none, `${name}: at frame ${c.clear} no part is coloured`);
+    check(tab.errors.length === 0, `${name}: no console error${tab.errors.length ? ': ' + tab.errors.join('; ') : ''}`);
+    return;
+  }
   if (name.startsWith('parts_')) {
     const first = await tab.evaluate('phiq.parts.names[0]');
     const said = await tab.evaluate('phiqViewer.pick(0)');

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <map>
 
+#include "html_clearance.hpp"
 #include "html_motion.hpp"
 #include "phiq/phiq.hpp"
 #include "phiq/version.hpp"
@@ -49,12 +50,13 @@ std::string script(std::string_view code) { return "<script>\n" + std::string(co
 }  // namespace
 
 std::string motion_html(const Scene& scene, const CsvTable& table, const std::string& result,
-                        const std::vector<std::string>& columns) {
+                        const std::vector<std::string>& columns, const ClearanceReport* clearance) {
   const MechanismSketch sketch = sketch_mechanism(*scene.model);
   ViewerMotion motion = viewer_motion(scene, sketch, table, result);
   const std::vector<std::string> series = plotted_columns(scene, table, columns, result);
   nlohmann::json& data = motion.data;
   const bool spatial = scene.dimension == 3;
+  if (clearance) data["clearance"] = viewer_clearance(scene, *clearance);
   const std::string title = scene.name.empty() ? std::filesystem::path(scene.path).stem().string() : scene.name;
 
   // ---- the mechanism: planar, an SVG whose background is phiq plot's (axes, ground) and whose moving layer

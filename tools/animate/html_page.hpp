@@ -6,14 +6,16 @@
 #include <string>
 #include <vector>
 
+#include "phiq/clearance.hpp"
 #include "phiq/csv_compare.hpp"
 #include "phiq/scene.hpp"
 
 namespace phiq::tools {
 
 // The page for `table`, the result of `scene` read from `result`; `columns` as `phiq plot --columns` (empty: its
-// defaults). Throws phiq::Error with one line for bad input (see viewer_motion(), plotted_columns()).
+// defaults); `clearance`, the scene's `output.clearance` measured (html_clearance.hpp), or null. Throws phiq::Error
+// with one line for bad input (see viewer_motion(), plotted_columns()).
 std::string motion_html(const Scene& scene, const CsvTable& table, const std::string& result,
-                        const std::vector<std::string>& columns);
+                        const std::vector<std::string>& columns, const ClearanceReport* clearance = nullptr);
 
 }  // namespace phiq::tools

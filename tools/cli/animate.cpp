@@ -3,6 +3,7 @@
 // extension; without RESULT, of the scene swept here with the outputs the drawing needs (drawn_result.hpp); its
 // options, the checks of its input and the atomic write.
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "cli_support.hpp"
@@ -33,6 +34,20 @@ bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// The scene's `output.clearance` measured along its own sweep, as `phiq clearance` measures it, for the viewer to
+// mark (html_clearance.hpp); none without it. Throws DrawError (status 1, as `phiq clearance`) when it cannot.
+std::optional<ClearanceReport> animated_clearance(const Scene& scene) {
+  if (!scene.clearance.requested) return std::nullopt;
+  SweepSummary summary;
+  try {
+    ClearanceReport report = scene_clearance(scene, &summary);
+    if (summary.status == SolveStatus::kSuccess) return report;
+  } catch (const Error& e) {
+    throw DrawError(scene.path + ": output.clearance: " + e.what(), 1);
+  }
+  throw DrawError(scene.path + ": " + summary.message, 1);
+}
+
 int cmd_animate(const AnimateOptions& o) {
   const bool html = ends_with(o.out, ".html") || ends_with(o.out, ".htm");
   if (!html && !ends_with(o.out, ".glb"))
@@ -51,10 +66,14 @@ int cmd_animate(const AnimateOptions& o) {
       const DrawnOutputs add{coordinates_of(html ? drawing_reads(sketch, parts) : glb_reads(scene, sketch, parts)),
                              html};
       const CsvTable table = sweep_scene(scene, add);
-      text = html ? motion_html(scene, table, kSwept, o.columns) : motion_glb(scene, table, kSwept);
+      const std::optional<ClearanceReport> clearance = html ? animated_clearance(scene) : std::nullopt;
+      text = html ? motion_html(scene, table, kSwept, o.columns, clearance ? &*clearance : nullptr)
+                  : motion_glb(scene, table, kSwept);
     } else {
       const CsvTable table = read_scene_result(scene, o.result);
-      text = html ? motion_html(scene, table, o.result, o.columns) : motion_glb(scene, table, o.result);
+      const std::optional<ClearanceReport> clearance = html ? animated_clearance(scene) : std::nullopt;
+      text = html ? motion_html(scene, table, o.result, o.columns, clearance ? &*clearance : nullptr)
+                  : motion_glb(scene, table, o.result);
     }
   } catch (const MissingCoordinate& e) {
     std::string again = "phiq animate " + o.scene + " -o " + o.out;

@@ -44,7 +44,9 @@ int run_command(int argc, char** argv) {
                                         std::to_string(phiq::kSweepAccuracyJsonFormat) + ", compare --json format " +
                                         std::to_string(phiq::kCompareJsonFormat) + ", tolerance CSV format " +
                                         std::to_string(phiq::kToleranceCsvFormat) + ", tolerance --summary format " +
-                                        std::to_string(phiq::kToleranceSummaryFormat) + ")");
+                                        std::to_string(phiq::kToleranceSummaryFormat) + ", clearance HDF5 format " +
+                                        std::to_string(phiq::kClearanceHdf5Format) + ", clearance --summary format " +
+                                        std::to_string(phiq::kClearanceSummaryFormat) + ")");
   app.require_subcommand(1);
   const std::vector<Command> commands{
       register_run(app),      register_generate(app),       register_convert(app),   register_batch(app),

@@ -37,7 +37,7 @@ _phiq() {
                           --reference --repeat --quiet --verbose" ;;
     tolerance) opts="--help --output --sd --limit --covariance --samples --seed --columns --threshold --summary --plot
                      --plot-column --threads --names --quiet --set" ;;
-    clearance) opts="--help --output --fail-on-interference --quiet --set" ;;
+    clearance) opts="--help --output --summary --fail-on-interference --quiet --set" ;;
     modes) opts="--help --at --output --threads --max-paths --quiet --set" ;;
   esac
 

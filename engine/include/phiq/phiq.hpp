@@ -5,6 +5,7 @@
 #include "phiq/assembly.hpp"
 #include "phiq/batch.hpp"
 #include "phiq/clearance.hpp"
+#include "phiq/clearance_files.hpp"
 #include "phiq/constraint_kinds.hpp"
 #include "phiq/constraint_kinds_3d.hpp"
 #include "phiq/csv_writer.hpp"

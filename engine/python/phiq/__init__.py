@@ -26,8 +26,8 @@ from . import _phiq
 from ._phiq import (AssemblySummary, ConstraintInfo, JacobianUpdate, LinearSummary, Model, NewtonOptions, Part,
                     PositionSummary, Predictor, RankReport, Scene, SceneError, SensitivityForm, SolveStatus,
                     StepSummary, Stepper, SweepOptions, SweepSummary, SweepWarning, Unit, WorkCounters, Workspace,
-                    analyse_rank, assemble, constraint_kinds, drawn_parts, load_scene, modes, parse_scene,
-                    solve_acceleration, solve_position, solve_velocity)
+                    analyse_rank, assemble, clearance, constraint_kinds, drawn_parts, load_scene, modes,
+                    parse_scene, solve_acceleration, solve_position, solve_velocity)
 from ._batch import BatchResult, run_batch_tables
 from ._builder import SceneBuilder
 from ._results import SolveError, SweepResult
@@ -41,8 +41,9 @@ __all__ = [
     "NewtonOptions", "Part", "PositionSummary", "Predictor", "RankReport", "Scene", "SceneBuilder", "SceneError",
     "SensitivityForm", "SolveError", "SolveStatus", "StepSummary", "Stepper", "SweepOptions", "SweepResult",
     "SweepSummary", "SweepWarning", "Unit", "WorkCounters", "Workspace",
-    "analyse_rank", "assemble", "check", "constraint_kinds", "drawn_parts", "driver_efforts", "load_scene", "modes",
-    "parse_scene", "run_batch", "run_sweep", "solve_acceleration", "solve_position", "solve_velocity",
+    "analyse_rank", "assemble", "check", "clearance", "constraint_kinds", "drawn_parts", "driver_efforts",
+    "load_scene", "modes", "parse_scene", "run_batch", "run_sweep", "solve_acceleration", "solve_position",
+    "solve_velocity",
 ]
 
 

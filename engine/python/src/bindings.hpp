@@ -1,4 +1,4 @@
-// The pieces of the extension module phiq._phiq, one file per part (module.cpp binds the seven of them), and
+// The pieces of the extension module phiq._phiq, one file per part (module.cpp binds them), and
 // what they share: the conversions of coordinate vectors, with their size checked against the model.
 #pragma once
 
@@ -25,6 +25,7 @@ void bind_batch_result(py::module_& m);
 void bind_stepper(py::module_& m);
 void bind_parts(py::module_& m);
 void bind_modes(py::module_& m);
+void bind_clearance(py::module_& m);
 
 /// A vector the caller passed as `what`, checked to have the model's n entries: phiq::Error (ValueError in Python)
 /// otherwise, with the sizes in the message, as the C++ pre-condition checks word it.

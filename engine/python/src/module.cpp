@@ -22,4 +22,5 @@ PYBIND11_MODULE(_phiq, m) {
   phiq::python::bind_batch_result(m);
   phiq::python::bind_stepper(m);
   phiq::python::bind_modes(m);
+  phiq::python::bind_clearance(m);
 }

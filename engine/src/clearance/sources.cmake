@@ -5,4 +5,5 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/clearance_broad_phase.cpp
   ${CMAKE_CURRENT_LIST_DIR}/clearance_along.cpp
   ${CMAKE_CURRENT_LIST_DIR}/clearance_scene.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/clearance_files.cpp
 )

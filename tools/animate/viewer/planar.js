@@ -26,6 +26,8 @@
   const partPaths = parts.geometries.map((shapes) => shapes.map((sh) => sh.width !== undefined
     ? path('part', {fill: 'none', stroke: sh.colour, 'stroke-width': Math.max(1, sh.width * kx), 'stroke-linejoin': 'round'})
     : path('part', {fill: sh.colour, 'fill-opacity': 0.55, stroke: sh.colour, 'stroke-width': 1})));
+  // the parts within the clearance threshold at the time shown, over their own colours
+  const nearPath = path('part near', {fill: '#d62728', 'fill-opacity': 0.7, stroke: '#d62728', 'stroke-width': 2});
   const partAxes = [path('part-frame', {fill: 'none', stroke: '#d62728', 'stroke-width': 1.5}),
                     path('part-frame', {fill: 'none', stroke: '#2ca02c', 'stroke-width': 1.5})];
   const sx = (x) => b.x0 + (x - b.xmin) * kx, sy = (y) => b.y0 + b.h - (y - b.ymin) * ky;
@@ -36,17 +38,19 @@
     for (let v = 0; v < sh.outline.length; v += 2) r = Math.max(r, Math.hypot(sh.outline[v], sh.outline[v + 1]));
     return r;
   }));
-  function drawParts(place, frames) {
-    const axes = [[], []];
+  function drawParts(place, frames, near) {
+    const axes = [[], []], nearD = [];
     partPaths.forEach((shapes, g) => shapes.forEach((el, i) => {
       const sh = parts.geometries[g][i], o = sh.outline, d = [];
       if (2 * reach[g][i] * Math.max(kx, ky) < 1) return el.setAttribute('d', '');
       for (const k of members[g]) {
         const x0 = place[7 * k], y0 = place[7 * k + 1], a = 2 * Math.atan2(place[7 * k + 5], place[7 * k + 6]);
-        const c = Math.cos(a), s = Math.sin(a);
-        for (let v = 0; v < o.length; v += 2)
-          d.push((v ? 'L' : 'M') + r1(sx(x0 + c * o[v] - s * o[v + 1])) + ' ' + r1(sy(y0 + s * o[v] + c * o[v + 1])));
-        if (sh.width === undefined || sh.closed) d.push('Z');
+        const c = Math.cos(a), s = Math.sin(a), to = near[k] ? [d, nearD] : [d];
+        for (const list of to) {
+          for (let v = 0; v < o.length; v += 2)
+            list.push((v ? 'L' : 'M') + r1(sx(x0 + c * o[v] - s * o[v + 1])) + ' ' + r1(sy(y0 + s * o[v] + c * o[v + 1])));
+          if (sh.width === undefined || sh.closed) list.push('Z');
+        }
       }
       el.setAttribute('d', d.join(''));
     }));
@@ -57,6 +61,7 @@
         axes[1].push('M' + r1(X0) + ' ' + r1(Y0) + 'l' + r1(-24 * Math.sin(a)) + ' ' + r1(-24 * Math.cos(a)));
       }
     partAxes[0].setAttribute('d', axes[0].join('')), partAxes[1].setAttribute('d', axes[1].join(''));
+    nearPath.setAttribute('d', nearD.join(''));
   }
   // the part under the pointer: the last drawn whose outline holds the point (a curve: within its half width)
   let shown = null;
@@ -117,6 +122,27 @@
   for (const j of d.prismatic) prismatic[j.joint] = j;
   const r1 = (v) => Math.round(v * 10) / 10;
   function circle(x, y, r) { return 'M' + r1(x - r) + ' ' + r1(y) + 'a' + r + ' ' + r + ' 0 1 0 ' + 2 * r + ' 0a' + r + ' ' + r + ' 0 1 0 ' + -2 * r + ' 0'; }
+  // each clearance pair's witness points at its worst pose: two rings and the line between, numbered; the numbers
+  // listed at the panel's foot with the pair, its distance and time
+  const witness = path('witness', {fill: 'none', stroke: '#d62728', 'stroke-width': 1.5});
+  if (phiq.clearance) {
+    const w = [], n = phiq.clearance.pairs.length;
+    const text = (x, y, cls, words) => {
+      const e = document.createElementNS(NS, 'text');
+      e.setAttribute('x', r1(x)), e.setAttribute('y', r1(y)), e.setAttribute('fill', '#d62728');
+      e.setAttribute('class', cls);
+      e.textContent = words;
+      layer.appendChild(e);
+    };
+    phiq.clearance.pairs.forEach((pair, k) => {
+      const ax = sx(pair.point_a[0]), ay = sy(pair.point_a[1]), bx = sx(pair.point_b[0]), by = sy(pair.point_b[1]);
+      w.push(circle(ax, ay, 4), circle(bx, by, 4), 'M' + r1(ax) + ' ' + r1(ay) + 'L' + r1(bx) + ' ' + r1(by));
+      text(Math.max(ax, bx) + 6, Math.min(ay, by) - 4 - 12 * (k % 2), 'witness-number', String(k + 1));
+      text(b.x0 + 6, b.y0 + b.h - 6 - 14 * (n - 1 - k), 'witness-label', (k + 1) + ' ' + pair.name + ': ' +
+           (+pair.distance).toPrecision(3) + ' m at t = ' + (+pair.worst_t).toPrecision(4) + ' s');
+    });
+    witness.setAttribute('d', w.join(''));
+  }
   // Level of detail: what the panel's pixels can show, whatever the number of loops. A line is drawn once per
   // pair of end pixels (10^4 cranks 0.05 px apart are one stroke), and a mark or an arrow only where no other
   // lies within `cell` pixels; lines and marks outside the panel are left out. Small mechanisms lose nothing.
@@ -157,7 +183,7 @@
   phiq.start({
     draw(p, show) {
       shown = p.parts;
-      drawParts(p.parts, show.frames);
+      drawParts(p.parts, show.frames, p.near);
       const pos = p.pos;
       for (let i = 0; i < P; ++i) {
         X[i] = b.x0 + (pos[2 * i] - b.xmin) * kx;

@@ -123,6 +123,26 @@
     return mesh;
   }));
   const pickable = [].concat(...partMeshes);
+  // output.clearance: a red copy, a little larger, of each part of a pair, shown while the pair is within the
+  // threshold; the witness points at each pair's worst pose, red dots joined by a line
+  const nearMaterial = new THREE.MeshLambertMaterial({color: 0xd62728}), nearMeshes = [];
+  const grown = new THREE.Vector3(1.02, 1.02, 1.02);
+  if (phiq.clearance) {
+    const inPairs = new Set();
+    for (const pair of phiq.clearance.pairs) inPairs.add(pair.a), inPairs.add(pair.b);
+    for (const k of inPairs)
+      for (const mesh of partMeshes[parts.geometry[k]]) {
+        const copy = add(new THREE.Mesh(mesh.geometry, nearMaterial));
+        copy.matrixAutoUpdate = false, copy.visible = false, copy.userData.part = k;
+        nearMeshes.push(copy);
+      }
+    const ends = [];
+    for (const pair of phiq.clearance.pairs) ends.push(...pair.point_a, ...pair.point_b);
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(ends), 3));
+    add(new THREE.LineSegments(g, new THREE.LineBasicMaterial({color: 0xd62728})));
+    add(new THREE.Points(g, new THREE.PointsMaterial({color: 0xd62728, size: 8, sizeAttenuation: false})));
+  }
   const frameXyz = new Float32Array(18 * N), frameRgb = new Float32Array(18 * N);
   for (let k = 0; k < N; ++k)
     for (let a = 0; a < 3; ++a) for (let e = 0; e < 2; ++e) frameRgb[18 * k + 6 * a + 3 * e + a] = 0.85;
@@ -131,7 +151,12 @@
   frameGeometry.setAttribute('color', new THREE.BufferAttribute(frameRgb, 3));
   const partAxes = add(new THREE.LineSegments(frameGeometry, new THREE.LineBasicMaterial({vertexColors: THREE.VertexColors})));
   const unit = new THREE.Vector3(1, 1, 1), axis = new THREE.Vector3(), origin = new THREE.Vector3();
-  function placeParts(place, frames) {
+  function placeParts(place, frames, near) {
+    for (const copy of nearMeshes) {
+      const k = copy.userData.part;
+      copy.visible = !!near[k];
+      if (copy.visible) copy.matrix.compose(origin.fromArray(place, 7 * k), q.fromArray(place, 7 * k + 3), grown);
+    }
     for (let k = 0; k < N; ++k) {
       origin.fromArray(place, 7 * k);
       q.fromArray(place, 7 * k + 3);
@@ -196,7 +221,7 @@
 
   phiq.start({
     draw(p, show) {
-      placeParts(p.parts, show.frames);
+      placeParts(p.parts, show.frames, p.near);
       placeLinks(p.pos), placeArms(p.pos), placeJoints(p.pos);
       if (!groundPlaced) placeGround(p.pos), groundPlaced = true;
       trails.forEach((line) => line.geometry.setDrawRange(0, show.trails ? p.samples : 0));

@@ -25,6 +25,10 @@
 //                  and in space p: base64 float32 x, y, z per vertex, i: base64 uint32 three per triangle; in the
 //                  plane outline: x, y, ... in the part's frame, width and closed for a curve}), poses: base64 int16,
 //                  frame-major, 7 per part (origin over parts.lo .. parts.hi, quaternion x, y, z, w over -1 .. 1)}
+//   clearance      the scene's output.clearance, when it has one (tools/animate/html_clearance.cpp): {threshold,
+//                  t: its sweep's rows' times, pairs: [{a, b: part indices, name, worst_t, distance, point_a,
+//                  point_b: the witness points at the worst pose (x, y, z), near: a character per row, 1 where the
+//                  pair is within the threshold}]}; the views mark the witness points and colour the near parts
 'use strict';
 
 const phiq = (function () {
@@ -62,6 +66,18 @@ const phiq = (function () {
     return lo;
   }
 
+  // the parts of the pairs within the clearance threshold at time t: those of the row of the clearance sweep nearest t
+  const clearance = data.clearance || null, near = new Uint8Array(N);
+  function nearAt(t) {
+    near.fill(0);
+    if (!clearance || !clearance.t.length) return near;
+    const ct = clearance.t;
+    let r = below(ct, t);
+    if (r + 1 < ct.length && ct[r + 1] - t < t - ct[r]) r += 1;
+    for (const pair of clearance.pairs) if (pair.near[r] === '1') near[pair.a] = near[pair.b] = 1;
+    return near;
+  }
+
   const pos = new Float32Array(P * D), vel = velocities ? new Float32Array(P * D) : null, place = new Float32Array(7 * N);
   // The pose at time t: linear between the frames around it.
   function pose(t) {
@@ -81,7 +97,7 @@ const phiq = (function () {
       n = Math.sqrt(n) || 1;
       for (let c = 3; c < 7; ++c) place[k + c] /= n;
     }
-    return {t, frame: w < 0.5 ? i : j, pos, vel, parts: place, samples: data.trace_t.length ? below(data.trace_t, t) + 1 : 0};
+    return {t, frame: w < 0.5 ? i : j, pos, vel, parts: place, near: nearAt(t), samples: data.trace_t.length ? below(data.trace_t, t) + 1 : 0};
   }
 
   // ---- controls
@@ -200,7 +216,7 @@ const phiq = (function () {
   }
 
   return {
-    data, traces, below, parts, pick,
+    data, traces, below, parts, pick, clearance,
     // Called by the view once built: draws the first pose and starts the clock. The page's address may ask for a
     // frame and a still picture: #frame=K (K a frame index, or "last"), paused.
     start(v) {
@@ -219,6 +235,7 @@ const phiq = (function () {
         pause() { setPlaying(false); },
         points() { return view.screenPoints(pose(t).pos); },
         pick(k) { pick(k); return partInfo.textContent; },
+        near() { return Array.from(nearAt(t)); },
         timing() { return {frameInterval: stats(intervals), draw: stats(drawTimes)}; },
       };
     },

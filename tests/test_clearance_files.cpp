@@ -1,0 +1,176 @@
+// A ClearanceReport as files (phiq/clearance_files.hpp, tools/cli/clearance_report.hpp): the HDF5 file read back
+// with HDF5 itself holds the CSV's values and the report's summary exactly, the same bytes on 1 and 2 threads; the
+// JSON summary of two spheres on moving points has the closed-form worst pose, interval and sensitivity.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "clearance_report.hpp"
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The four-bar (crank L2 = 0.4 at 1 rad/s about O) with a ball of radius 0.05 at the crank's tip, (L2/2 + 0.2)
+// (cos t, sin t), and a ball of radius 0.15 fixed at (0, −0.5): d = |tip − (0, −0.5)| − 0.2, least at t = 3π/2, where
+// d = 0.5 − (L2/2 + 0.2) − 0.2 = −0.1 and ∂d/∂L2 = −1/2; the balls overlap while 0.41 + 0.4 sin t < 0.04.
+std::string clearance_files_scene_text() {
+  std::ifstream in(test::model_path("seed/fourbar_reference_point.yaml"));
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  return text.substr(0, text.find("\ntime:")) +
+         "\ntime: {start: 0, end: 2*pi, steps: 90}\n"
+         "parts:\n"
+         "  tip: {body: crank, shapes: [{type: sphere, radius: 0.05, at: [0.2, 0]}]}\n"
+         "  ball: {body: ground, shapes: [{type: sphere, radius: 0.15, at: [0, -0.5]}]}\n"
+         "output: {sensitivities: [L2], clearance: {pairs: [[tip, ball]], threshold: 0.01}}\n";
+}
+
+std::vector<double> clearance_files_read(hid_t file, const char* name, std::vector<hsize_t>* dims = nullptr) {
+  const hid_t d = H5Dopen2(file, name, H5P_DEFAULT);
+  EXPECT_GE(d, 0) << name;
+  const hid_t space = H5Dget_space(d);
+  hsize_t n[2] = {0, 1};
+  const int rank = H5Sget_simple_extent_dims(space, n, nullptr);
+  if (dims) dims->assign(n, n + rank);
+  std::vector<double> v(n[0] * (rank == 2 ? n[1] : 1));
+  if (!v.empty()) H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data());
+  H5Sclose(space);
+  H5Dclose(d);
+  return v;
+}
+
+long long clearance_files_integer(hid_t file, const char* name) {
+  long long v = -1;
+  const hid_t a = H5Aopen(file, name, H5P_DEFAULT);
+  H5Aread(a, H5T_NATIVE_LLONG, &v);
+  H5Aclose(a);
+  return v;
+}
+
+std::string clearance_files_bytes(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(ClearanceFiles, Hdf5HoldsTheCsvValuesAndTheSummaryExactlyOnAnyThreadCount) {
+  Scene s = parse_scene(clearance_files_scene_text(), "balls.yaml");
+  const ClearanceReport r = scene_clearance(s);
+  ASSERT_EQ(r.pairs.size(), 1u);
+  const fs::path dir = fs::temp_directory_path() / "phiq_clearance_files";
+  fs::create_directories(dir);
+  const fs::path path = dir / "c.h5";
+  ClearanceHdf5Options o;
+  o.scene_path = "balls.yaml";
+  o.scene_text = s.text;
+  o.parameters = s.parameters;
+  write_clearance_hdf5(path.string(), r, s.parts, o);
+
+  // the CSV's text, read back: the same doubles as /t and /distance
+  std::istringstream csv(clearance_csv(r, s.parts));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "t,tip.ball");
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  std::vector<hsize_t> dims;
+  const std::vector<double> t = clearance_files_read(f, "t"), d = clearance_files_read(f, "distance", &dims);
+  ASSERT_EQ(dims, (std::vector<hsize_t>{91, 1}));
+  ASSERT_EQ(t.size(), 91u);
+  for (std::size_t k = 0; std::getline(csv, line); ++k) {
+    ASSERT_LT(k, t.size());
+    const auto comma = line.find(',');
+    EXPECT_EQ(std::strtod(line.substr(0, comma).c_str(), nullptr), t[k]) << k;
+    EXPECT_EQ(std::strtod(line.substr(comma + 1).c_str(), nullptr), d[k]) << k;
+  }
+  // the summary: the report's own values
+  const PairClearance& p = r.pairs[0];
+  const std::vector<double> worst = clearance_files_read(f, "worst", &dims);
+  ASSERT_EQ(dims, (std::vector<hsize_t>{1, 13}));
+  const std::vector<double> expected{p.worst.t,
+                                     p.worst.at.distance,
+                                     p.worst.at.point_a.x,
+                                     p.worst.at.point_a.y,
+                                     p.worst.at.point_a.z,
+                                     p.worst.at.point_b.x,
+                                     p.worst.at.point_b.y,
+                                     p.worst.at.point_b.z,
+                                     p.worst.at.normal.x,
+                                     p.worst.at.normal.y,
+                                     p.worst.at.normal.z,
+                                     1.0,
+                                     0.0};
+  for (std::size_t k = 0; k < expected.size(); ++k) EXPECT_EQ(worst[k], expected[k] == 0.0 ? 0.0 : expected[k]) << k;
+  EXPECT_EQ(clearance_files_read(f, "sensitivities", &dims), p.worst.sensitivities);
+  EXPECT_EQ(dims, (std::vector<hsize_t>{1, 1}));
+  EXPECT_EQ(clearance_files_read(f, "interference", &dims),
+            (std::vector<double>{0.0, p.interference[0].entry, p.interference[0].exit}));
+  EXPECT_EQ(dims, (std::vector<hsize_t>{1, 3}));
+  EXPECT_EQ(clearance_files_integer(f, "format_version"), kClearanceHdf5Format);
+  EXPECT_EQ(clearance_files_integer(f, "interferes"), 1);
+  EXPECT_EQ(clearance_files_integer(f, "bound_held"), 1);
+  EXPECT_EQ(clearance_files_integer(f, "pairs_selected"), 1);
+  EXPECT_EQ(clearance_files_integer(f, "positions_solved"), r.positions_solved);
+  H5Fclose(f);
+
+  // the sweep on two threads: the same report, the same bytes
+  s.sweep.threads = 2;
+  s.sweep.chunk_steps = 30;
+  const fs::path other = dir / "c2.h5";
+  write_clearance_hdf5(other.string(), scene_clearance(s), s.parts, o);
+  EXPECT_EQ(clearance_files_bytes(path), clearance_files_bytes(other));
+  fs::remove_all(dir);
+}
+
+TEST(ClearanceFiles, SummaryJsonOfTwoBallsIsTheClosedForm) {
+  const Scene s = parse_scene(clearance_files_scene_text(), "balls.yaml");
+  const ClearanceReport r = scene_clearance(s);
+  const auto j = nlohmann::json::parse(tools::clearance_summary_json(s, "balls.yaml", r));
+  EXPECT_EQ(j["format"], kClearanceSummaryFormat);
+  EXPECT_EQ(j["scene"], "balls.yaml");
+  EXPECT_EQ(j["rows"], 91);
+  EXPECT_EQ(j["threshold"], 0.01);
+  EXPECT_EQ(j["pairs_selected"], 1);
+  EXPECT_EQ(j["pairs_measured"], 1);
+  EXPECT_EQ(j["interferes"], true);
+  EXPECT_EQ(j["bound_held"], true);
+  ASSERT_EQ(j["pairs"].size(), 1u);
+  const auto& p = j["pairs"][0];
+  EXPECT_EQ(p["a"], "tip");
+  EXPECT_EQ(p["b"], "ball");
+  const auto& w = p["worst"];
+  const double h = 2 * M_PI / 90;
+  EXPECT_NEAR(w["t"].get<double>(), 1.5 * M_PI, 1e-6);
+  EXPECT_NEAR(w["distance"].get<double>(), -0.1, 1e-10);
+  EXPECT_EQ(w["refined"], true);  // 3π/2 is step 67.5: between rows
+  EXPECT_EQ(w["below_threshold"], true);
+  // the witness points on the line of centres (x = 0), the depth apart; the normal −y, B away from A
+  EXPECT_NEAR(w["point_a"][0].get<double>(), 0.0, 1e-6);
+  EXPECT_NEAR(w["point_b"][0].get<double>(), 0.0, 1e-6);
+  EXPECT_NEAR(w["point_b"][1].get<double>() - w["point_a"][1].get<double>(), 0.1, 1e-9);
+  EXPECT_NEAR(w["normal"][1].get<double>(), -1.0, 1e-9);
+  EXPECT_NEAR(w["sensitivities"]["L2"].get<double>(), -0.5, 1e-7);
+  ASSERT_EQ(p["interference"].size(), 1u);
+  // |tip − C|² = 0.41 + 0.4 sin t = 0.2²: sin t = −0.925
+  EXPECT_NEAR(p["interference"][0]["entry"].get<double>(), M_PI + std::asin(0.925), 1e-9 * h);
+  EXPECT_NEAR(p["interference"][0]["exit"].get<double>(), 2 * M_PI - std::asin(0.925), 1e-9 * h);
+  EXPECT_EQ(p["unproven_intervals"], 0);
+  // the JSON's numbers are the report's, to the bit
+  EXPECT_EQ(w["distance"].get<double>(), r.pairs[0].worst.at.distance);
+  EXPECT_EQ(p["interference"][0]["entry"].get<double>(), r.pairs[0].interference[0].entry);
+}
+
+}  // namespace
+}  // namespace phiq

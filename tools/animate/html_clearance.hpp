@@ -1,0 +1,18 @@
+// What `phiq animate SCENE -o OUT.html` shows of the scene's `output.clearance` (phiq/clearance.hpp): each pair's
+// witness points at its worst pose, and at every row which parts come within the threshold, as the JSON field
+// `clearance` of the viewer's data (tools/animate/viewer/viewer.js documents it).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "phiq/clearance.hpp"
+#include "phiq/scene.hpp"
+
+namespace phiq::tools {
+
+// The viewer's `clearance` of `report`, measured on `scene`'s parts (the first of the drawn parts, in order):
+// {threshold, t: the report's rows' times, pairs: [{a, b: part indices, name: "A / B", worst_t, distance, point_a,
+// point_b: world x, y, z, near: a character per row, 1 where the pair's distance is below the threshold}]}.
+nlohmann::json viewer_clearance(const Scene& scene, const ClearanceReport& report);
+
+}  // namespace phiq::tools
