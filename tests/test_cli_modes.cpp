@@ -1,7 +1,11 @@
 // `phiq modes` (tools/README.md): the report (count, paths, each mode, the placement's mode), the modes written as
 // CSV, JSON and YAML with the same numbers, and a cam scene refused with its constraint named, exit 2, no file;
-// the modes in `phiq check` (text, --json; the cam's line, the bound), the run summary, and `phiq animate --modes`.
+// the modes in `phiq check` (text, --json; the cam's line, the bound), the run summary, `phiq animate --modes`, and
+// `--along` against the Grashof limit.
 #include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <numbers>
 
 #include "cli_test_support.hpp"
 
@@ -245,6 +249,38 @@ TEST_F(Cli, AnimateModesDrawsOnePosePerModeAndRefusesASceneWithNone) {
   EXPECT_NE(glb.err.find("--modes: the modes are drawn from the scene alone, in the HTML viewer (-o OUT.html)"),
             std::string::npos)
       << glb.err;
+}
+
+TEST_F(Cli, ModesAlongTheDriveCountsAsTheGrashofLimitSaysAndMarksTheChanges) {
+  // crank 1.5: the loop closes (2 modes) while |AC| <= coupler + rocker = 2.2, cos θ2 >= (1 + 2.25 - 2.2²) / 3
+  // (θ2 = t over 0 … 2π), and has no real mode beyond: 13 samples π/6 apart change count twice
+  const std::string scene = cli_modes_model("seed/fourbar_mixed.yaml");
+  const fs::path csv = dir_ / "along.csv";
+  const Result r = run("modes " + scene + " --set L2=1.5 --along 13 --threads 1 -o " + csv.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string text = slurp(csv);
+  EXPECT_EQ(text.substr(0, text.find('\n')), "t,real,complex,singular,at_infinity,failed_paths");
+  const double limit = (1.0 + 2.25 - 2.2 * 2.2) / 3.0;
+  std::vector<std::size_t> changes;
+  for (int k = 0; k < 13; ++k) {
+    const double t = 2.0 * std::numbers::pi * k / 12;
+    EXPECT_NEAR(cli_modes_cell(text, "t", k + 1), t, 1e-12);
+    const double expected = std::cos(t) >= limit ? 2.0 : 0.0;
+    EXPECT_EQ(cli_modes_cell(text, "real", k + 1), expected) << "t = " << t;
+    EXPECT_EQ(cli_modes_cell(text, "real", k + 1) + cli_modes_cell(text, "complex", k + 1), 2.0) << "t = " << t;
+    if (k > 0 && (std::cos(t) >= limit) != (std::cos(2.0 * std::numbers::pi * (k - 1) / 12) >= limit))
+      changes.push_back(static_cast<std::size_t>(k));
+  }
+  ASSERT_EQ(changes, std::vector<std::size_t>({5, 8}));
+  EXPECT_NE(r.out.find("real assembly modes at 13 times from t = 0 to 6.283185307 (2 changes)"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("the count changes from 2 to 0 between t = 2.094395102 and t = 2.617993878"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("the count changes from 0 to 2 between t = 3.665191429 and t = 4.188790205"), std::string::npos)
+      << r.out;
+  const Result bad = run("modes " + scene + " --along 5 --at 1");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--along"), std::string::npos) << bad.err;
 }
 
 }  // namespace
