@@ -218,8 +218,9 @@ Command register_check(CLI::App& app) {
     std::vector<std::string> sets;
   };
   auto a = std::make_shared<Args>();
-  CLI::App* check =
-      app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
+  CLI::App* check = app.add_subcommand(
+      "check",
+      "Count coordinates and equations, rank, dof, redundancy; try the assembly; count the real assembly modes");
   check->add_option("scene", a->path, "Scene file (YAML; '-': standard input)")->required();
   check->add_flag("--json", a->json, "Print one JSON object (format: tools/README.md)");
   CLI::Option* at = check->add_option("--time", a->time, "Assemble and analyse at this time instead of time.start")
