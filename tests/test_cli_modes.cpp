@@ -218,6 +218,15 @@ TEST_F(Cli, RunSummaryNamesTheModeOfItsFirstRow) {
   EXPECT_EQ(m2["mode"], other);
   EXPECT_LT(m2["distance"].get<double>(), 1e-12);
   EXPECT_NEAR(m2["next_distance"].get<double>(), m["next_distance"].get<double>(), 1e-9);
+  // the ground 5 long: no real mode, and the failed run's summary says so (no row: nothing assembled)
+  const fs::path none = dir_ / "s0.json";
+  ASSERT_EQ(
+      run("run " + scene + " -q --set L1=5 -o " + (dir_ / "r0.csv").string() + " --summary " + none.string()).code, 1);
+  const nlohmann::json m0 = nlohmann::json::parse(slurp(none))["modes"];
+  EXPECT_EQ(m0["status"], "counted");
+  EXPECT_EQ(m0["real"], 0);
+  EXPECT_EQ(m0["assembled"], false);
+  EXPECT_TRUE(m0["mode"].is_null());
 }
 
 TEST_F(Cli, AnimateModesDrawsOnePosePerModeAndRefusesASceneWithNone) {

@@ -153,13 +153,14 @@ std::string failure_message(const phiq::Scene& scene, const phiq::SweepSummary& 
 }
 
 // The summary's `modes`: the real assembly modes at the start and the one the first row is in (mode_count.hpp;
-// those `--mode` found, else counted within the bound); null before the first row was solved (first_q empty).
+// those `--mode` found, else counted within the bound); first_q empty: no row was solved (`assembled` false, the
+// count then says why: none real, say).
 nlohmann::ordered_json summary_modes(const phiq::Scene& scene, std::optional<phiq::AssemblyModes>& found,
                                      const Eigen::VectorXd& first_q, int threads) {
-  if (first_q.size() == 0) return nlohmann::ordered_json();
   const double t = scene.sweep.t_begin;
-  return mode_count_json(found ? counted_modes(scene, t, std::move(*found), &first_q)
-                               : count_modes(scene, t, &first_q, threads));
+  const Eigen::VectorXd* position = first_q.size() ? &first_q : nullptr;
+  return mode_count_json(found ? counted_modes(scene, t, std::move(*found), position)
+                               : count_modes(scene, t, position, threads));
 }
 
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
