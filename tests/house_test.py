@@ -33,7 +33,7 @@ LONG_FUNCTIONS = {
     ("tools/cli/batch.cpp", "cmd_batch"): 229,
     ("engine/src/sweep/predictors.cpp", "Sweeper::predict"): 208,
     ("tools/animate/gltf_motion.cpp", "motion_glb"): 204,
-    ("tools/cli/run.cpp", "cmd_run"): 178,
+    ("tools/cli/run.cpp", "cmd_run"): 164,
     ("tools/animate/html_motion.cpp", "viewer_motion"): 160,
     ("engine/src/sweep/singular_positions.cpp", "Sweeper::singular_point"): 155,
 }

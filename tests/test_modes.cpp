@@ -1,5 +1,6 @@
 // Every assembly mode (phiq/modes.hpp): polynomial systems with known solutions, the four-bar against
-// Freudenstein's closed form and its Grashof limit, the crank-slider's two modes, the 3-RPR parallel robot's six
+// Freudenstein's closed form and its Grashof limit, the mode a placement is in (locate_mode()) and the distance to
+// the other against the closed form, the crank-slider's two modes, the 3-RPR parallel robot's six
 // complex assemblies, a cam refused with its constraint named, and the same bits on 1 and 2 threads.
 #include <gtest/gtest.h>
 
@@ -155,6 +156,63 @@ TEST(ModesFourBar, TwoRealModesAreFreudensteinsOpenAndCrossed) {
     }
     EXPECT_TRUE(matched[0] && matched[1]) << "T = " << T;
   }
+}
+
+// The four-bar's position in mixed coordinates (fourbar_mixed.yaml: θ2, A, the coupler's centre and angle, B) at
+// crank angle θ2 and rocker angle θ4, from the closed form: A = a(cos θ2, sin θ2), B = C + c(cos θ4, sin θ4), the
+// coupler's centre the middle of AB and its angle that of AB.
+Eigen::VectorXd modes_fourbar_position(double theta2, double theta4) {
+  const double xa = 0.4 * std::cos(theta2), ya = 0.4 * std::sin(theta2);
+  const double xb = 1.0 + std::cos(theta4), yb = std::sin(theta4);
+  Eigen::VectorXd q(8);
+  q << theta2, xa, ya, (xa + xb) / 2, (ya + yb) / 2, std::atan2(yb - ya, xb - xa), xb, yb;
+  return q;
+}
+
+TEST(ModesFourBar, ThePlacementIsFreudensteinsUpperModeAndTheOtherIsTheClosedFormDistanceAway) {
+  // fourbar_mixed.yaml's rough placement has B above the ground, (1.1, 1.0): it assembles into the closed form's
+  // solution with the larger θ4 in (−π, π] (sin θ4 > 0), at the start and at any crank angle of this crank-rocker
+  const Scene scene = load_scene(modes_model_path("seed/fourbar_mixed.yaml"));
+  const Model& model = *scene.model;
+  ASSERT_EQ(model.coordinate_names(), std::vector<std::string>({"theta2", "xA", "yA", "x3", "y3", "psi3", "xB", "yB"}));
+  for (double T : {0.0, 0.7, 2.0}) {
+    SCOPED_TRACE(T);
+    ModesOptions o;
+    o.time = T;
+    const AssemblyModes r = find_assembly_modes(model, o);
+    ASSERT_EQ(r.modes.size(), 2u);
+    Eigen::VectorXd q = model.initial_positions();
+    ASSERT_EQ(assemble(model, T, AssemblyOptions{}, q), SolveStatus::kSuccess);
+    const ModeLocation where = locate_mode(model, q, r.modes);
+    ASSERT_GE(where.mode, 0);
+    ASSERT_EQ(where.next, 1 - where.mode);
+    std::vector<double> theta4 = modes_freudenstein(0.4, 1.2, 1.0, 1.0, T);
+    ASSERT_EQ(theta4.size(), 2u);
+    for (double& a : theta4) a = std::remainder(a, 2.0 * std::numbers::pi);
+    std::sort(theta4.begin(), theta4.end());
+    ASSERT_GT(std::sin(theta4[1]), 0.0);
+    const Eigen::VectorXd upper = modes_fourbar_position(T, theta4[1]), lower = modes_fourbar_position(T, theta4[0]);
+    EXPECT_LT(mode_distance(model, r.modes[static_cast<std::size_t>(where.mode)].q, upper), 1e-10);
+    EXPECT_LT(mode_distance(model, r.modes[static_cast<std::size_t>(where.next)].q, lower), 1e-10);
+    EXPECT_LT(where.distance, 1e-9);  // the assembled position is the mode itself, to the assembly's tolerance
+    // the distance to the other mode is the closed form's, in mode_distance()'s norm written out here: the largest
+    // of |Δ length| / length scale and |Δ angle| modulo 2π over the coordinates
+    double expected = 0.0;
+    for (Index j = 0; j < 8; ++j) {
+      const bool angle = j == 0 || j == 5;
+      const double d = upper(j) - lower(j);
+      expected = std::max(
+          expected, angle ? std::abs(std::remainder(d, 2.0 * std::numbers::pi)) : std::abs(d) / model.length_scale());
+    }
+    EXPECT_GT(expected, 0.1);
+    EXPECT_NEAR(where.next_distance, expected, 1e-9);
+  }
+  // no modes: nothing located; one mode: no next
+  EXPECT_EQ(locate_mode(model, model.initial_positions(), {}).mode, -1);
+  const AssemblyModes r = find_assembly_modes(model, {});
+  const ModeLocation one = locate_mode(model, model.initial_positions(), {r.modes[1]});
+  EXPECT_EQ(one.mode, 0);
+  EXPECT_EQ(one.next, -1);
 }
 
 TEST(ModesFourBar, NoRealModeBeyondTheGrashofLimit) {

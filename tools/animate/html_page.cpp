@@ -50,7 +50,8 @@ std::string script(std::string_view code) { return "<script>\n" + std::string(co
 }  // namespace
 
 std::string motion_html(const Scene& scene, const CsvTable& table, const std::string& result,
-                        const std::vector<std::string>& columns, const ClearanceReport* clearance) {
+                        const std::vector<std::string>& columns, const ClearanceReport* clearance,
+                        const std::vector<std::string>& row_labels) {
   const MechanismSketch sketch = sketch_mechanism(*scene.model);
   ViewerMotion motion = viewer_motion(scene, sketch, table, result);
   const std::vector<std::string> series = plotted_columns(scene, table, columns, result);
@@ -101,6 +102,7 @@ std::string motion_html(const Scene& scene, const CsvTable& table, const std::st
   double tmin = plotted.rows.front()[0], tmax = plotted.rows.back()[0];
   if (!(tmax > tmin)) tmin -= 0.5, tmax += 0.5;
   data["plot_t"] = {tmin, tmax};
+  if (!row_labels.empty()) data["row_labels"] = row_labels;
   if (data["velocities"].is_null())
     data["velocity_note"] = "no velocity vectors: " + result +
                             " has no velocity columns (the scene's output: {velocities: true} writes them)";

@@ -1,7 +1,8 @@
 // `phiq animate SCENE [RESULT] -o OUT.glb|OUT.html`: the motion of a result as a glTF 2.0 binary
 // (tools/animate/gltf_motion.*) or a self-contained HTML viewer (tools/animate/html_page.*), chosen by the output's
-// extension; without RESULT, of the scene swept here with the outputs the drawing needs (drawn_result.hpp); its
-// options, the checks of its input and the atomic write.
+// extension; without RESULT, of the scene swept here with the outputs the drawing needs (drawn_result.hpp); with
+// --modes, every real assembly mode of the scene at its start (phiq/modes.hpp), one pose per mode in the HTML
+// viewer; its options, the checks of its input and the atomic write.
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,10 +26,14 @@ struct AnimateOptions {
   std::string scene, result, out;
   std::vector<std::string> columns;  // the HTML's plots (as phiq plot --columns)
   std::vector<std::string> sets;     // --set NAME=VALUE: the scene's parameters as the run had them
+  bool modes = false;                // --modes: the real assembly modes at time.start instead of a motion
 };
 
 // What the messages and the page call the result of a sweep run here.
 constexpr const char* kSwept = "its sweep";
+
+// What the page calls the modes' table.
+constexpr const char* kModes = "its assembly modes";
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -48,18 +53,66 @@ std::optional<ClearanceReport> animated_clearance(const Scene& scene) {
   throw DrawError(scene.path + ": " + summary.message, 1);
 }
 
+// Every real assembly mode of the scene at time.start as a table (t: the mode's number, 1 …, then every
+// coordinate) and a label per mode. Throws DrawError: status 2 for a scene whose modes cannot be counted (a
+// constraint not polynomial, named), 1 for one with no real mode at the start (it cannot be assembled there).
+CsvTable modes_table(const Scene& scene, std::vector<std::string>& labels) {
+  const Model& model = *scene.model;
+  const double t = scene.sweep.t_begin;
+  ModesOptions options;
+  options.time = t;
+  const AssemblyModes found = find_assembly_modes(model, options);
+  if (found.summary.status != ModesStatus::kSuccess)
+    throw DrawError(scene.path + ": --modes: " + found.summary.message, 2);
+  if (found.modes.empty())
+    throw DrawError(scene.path + ": --modes: no real assembly mode at t = " + format_time(t) + " (" +
+                        std::to_string(found.summary.paths) + " paths: " + std::to_string(found.summary.complex) +
+                        " complex, " + std::to_string(found.summary.singular) + " singular, " +
+                        std::to_string(found.summary.at_infinity) +
+                        " at infinity): the scene cannot be assembled there; nothing drawn",
+                    1);
+  // the mode the rough placement assembles into, named in its label
+  Eigen::VectorXd q = model.initial_positions();
+  AssemblySummary assembled;
+  (void)assemble(model, t, assembly_options(scene), q, &assembled);  // its status is assembled.status
+  const int placement = assembled.status == SolveStatus::kSuccess ? locate_mode(model, q, found.modes).mode : -1;
+  CsvTable table;
+  table.path = scene.path;
+  table.columns.push_back("t");
+  for (const std::string& name : model.coordinate_names()) table.columns.push_back(name);
+  const std::string count = std::to_string(found.modes.size());
+  for (std::size_t k = 0; k < found.modes.size(); ++k) {
+    const AssemblyMode& m = found.modes[k];
+    table.rows.emplace_back(1, static_cast<double>(k + 1));
+    table.rows.back().insert(table.rows.back().end(), m.q.data(), m.q.data() + m.q.size());
+    labels.push_back("mode " + std::to_string(k + 1) + " of " + count + " at t = " + format_time(t) +
+                     (static_cast<int>(k) == placement ? " (the placement's)" : "") +
+                     (m.singular ? " (singular)" : ""));
+  }
+  return table;
+}
+
 int cmd_animate(const AnimateOptions& o) {
   const bool html = ends_with(o.out, ".html") || ends_with(o.out, ".htm");
   if (!html && !ends_with(o.out, ".glb"))
     return fail("animate: -o " + o.out + ": the output is a glTF binary (*.glb) or an HTML viewer (*.html)", 2);
   if (!html && !o.columns.empty())
     return fail("animate: --columns: the plots are the HTML viewer's; a .glb has none", 2);
+  if (o.modes && (!html || !o.result.empty()))
+    return fail(std::string("animate: --modes: the modes are drawn from the scene alone, in the HTML viewer (") +
+                    (html ? "no RESULT" : "-o OUT.html") + ")",
+                2);
   if (const auto clash = output_clash({{"-o", o.out}}, {{"the scene", o.scene}, {"the result", o.result}}))
     return fail("animate: " + *clash, 2);
   std::string text;
   try {
     const Scene scene = load_scene(o.scene, SceneLimits{}, parameter_settings(o.sets));
-    if (o.result.empty()) {  // the scene swept here, with the coordinates the drawing reads (and joints to plot)
+    if (o.modes) {  // one pose per real assembly mode
+      set_interrupt_subject("animate: " + o.out, "; no output written");
+      std::vector<std::string> labels;
+      const CsvTable table = modes_table(scene, labels);
+      text = motion_html(scene, table, kModes, o.columns, nullptr, labels);
+    } else if (o.result.empty()) {  // the scene swept here, with the coordinates the drawing reads (and joints to plot)
       set_interrupt_subject("animate: " + o.out, "; no output written");
       const MechanismSketch sketch = sketch_mechanism(*scene.model);
       const std::vector<Part> parts = drawn_parts(scene);
@@ -115,6 +168,9 @@ Command register_animate(CLI::App& app) {
                    "HTML: columns plotted against t (default: as phiq plot, what "
                    "is driven, the joints' measures, the coordinates that move)")
       ->delimiter(',');
+  animate->add_flag("--modes", options->modes,
+                    "HTML: every real assembly mode of the scene at time.start, one pose per mode (the plots' t is "
+                    "the mode's number)");
   add_set_option(animate, &options->sets);
   return {animate, [options] { return cmd_animate(*options); }};
 }

@@ -1,5 +1,6 @@
 // `phiq check SCENE [--json] [--time T]`: the scene's counts (coordinates, equations, non-zeros), the assembly from
-// its rough placement and the rank analysis there (dof, redundant and conflicting constraints), as text or JSON.
+// its rough placement and the rank analysis there (dof, redundant and conflicting constraints), and its real
+// assembly modes with the one the placement is in (mode_count.hpp), as text or JSON.
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -10,6 +11,7 @@
 #include "command_line.hpp"
 #include "command_support.hpp"
 #include "commands.hpp"
+#include "mode_count.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -105,6 +107,13 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
   // inconsistent names its conflicts; not consistent without any is "not known" (the independent equations
   // themselves do not hold: AssemblySummary::consistent)
   const bool consistency_known = as.consistent || !as.conflicts.empty();
+  // the real assembly modes at t0 and the one the placement assembled into (within mode_count.hpp's bound)
+  ModeCount modes;
+  if (analysed) {
+    modes = count_modes(scene, t0, ok ? &q : nullptr, 0);
+  } else {
+    modes.state = ModeCount::State::kNotAvailable, modes.time = t0, modes.reason = as.message;
+  }
 
   if (json) {
     // `phiq check --json`, format version 1 (tools/README.md): one object on standard output.
@@ -159,6 +168,7 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
                                    {"stated_a", r.stated_a},
                                    {"stated_b", r.stated_b}});
     j["parts"] = parts_json(scene);
+    j["modes"] = mode_count_json(modes);
     std::cout << json_text(j, 2) << "\n";
     return ok ? 0 : 1;
   }
@@ -192,6 +202,7 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
   for (const phiq::JointAngleReference& r : scene.joint_angles)
     std::cout << "joint angle   " << joint_angle_line(r) << "\n";
   for (const phiq::Part& p : scene.parts) std::cout << "part          " << part_line(p, scene.dimension) << "\n";
+  std::cout << "modes         " << mode_count_text(modes, "the placement") << "\n";
   if (rk.uncertain) std::cout << "uncertain     " << rk.message << "\n";
   if (!ok) std::cout << "diagnosis     " << as.message << "\n";
   return ok ? 0 : 1;
@@ -207,8 +218,9 @@ Command register_check(CLI::App& app) {
     std::vector<std::string> sets;
   };
   auto a = std::make_shared<Args>();
-  CLI::App* check =
-      app.add_subcommand("check", "Count coordinates and equations, rank, dof, redundancy; try the assembly");
+  CLI::App* check = app.add_subcommand(
+      "check",
+      "Count coordinates and equations, rank, dof, redundancy; try the assembly; count the real assembly modes");
   check->add_option("scene", a->path, "Scene file (YAML; '-': standard input)")->required();
   check->add_flag("--json", a->json, "Print one JSON object (format: tools/README.md)");
   CLI::Option* at = check->add_option("--time", a->time, "Assemble and analyse at this time instead of time.start")

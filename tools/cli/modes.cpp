@@ -1,7 +1,7 @@
 // `phiq modes SCENE [--at T] [-o OUT.yaml|.csv|.json] [--threads N] [--max-paths N]`: every real assembly mode of
 // the scene's equations at time T, by polynomial homotopy continuation (phiq/modes.hpp), and which of them the
 // rough placement assembles into. The report goes to standard output; -o writes the modes as YAML, CSV or JSON (by
-// the file's extension).
+// the file's extension). `--along N`: the count at N times over the sweep instead, and where it changes.
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -41,15 +41,8 @@ Placement placement_mode(const Scene& scene, double t, const std::vector<Assembl
     return p;
   }
   p.assembled = true;
-  for (std::size_t k = 0; k < modes.size(); ++k) {
-    const double d = mode_distance(model, q, modes[k].q);
-    if (p.nearest < 0 || d < p.distance) {
-      p.next = p.nearest, p.next_distance = p.distance;
-      p.nearest = static_cast<int>(k), p.distance = d;
-    } else if (p.next < 0 || d < p.next_distance) {
-      p.next = static_cast<int>(k), p.next_distance = d;
-    }
-  }
+  const ModeLocation where = locate_mode(model, q, modes);
+  p.nearest = where.mode, p.distance = where.distance, p.next = where.next, p.next_distance = where.next_distance;
   return p;
 }
 
@@ -160,9 +153,65 @@ bool modes_path_ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// `--along N`: the number of real modes at N times evenly spread over time.start … time.end, and where it changes
+// (two modes meet between: a singular position); -o OUT.csv: t, real, complex, singular, at_infinity, failed_paths.
+int modes_along(const Scene& scene, const std::string& scene_path, int samples, OutputSet& outputs,
+                AtomicOutputFile* file, ModesOptions options, bool quiet) {
+  const double t0 = scene.sweep.t_begin, t1 = scene.sweep.t_end;
+  std::ostringstream report;
+  std::string csv = "t,real,complex,singular,at_infinity,failed_paths\n", changes;
+  int changed = 0;
+  std::size_t before = 0;
+  for (int k = 0; k < samples; ++k) {
+    const double t = k + 1 == samples ? t1 : t0 + (t1 - t0) * k / (samples - 1);
+    options.time = t;
+    AssemblyModes r;
+    try {
+      r = find_assembly_modes(*scene.model, options);
+    } catch (const Error& e) {
+      return fail(scene_path + ": --along: t = " + format_time(t) + ": " + e.what() + "; no output written", 2);
+    }
+    if (r.summary.status != ModesStatus::kSuccess)
+      return fail(scene_path + ": --along: t = " + format_time(t) + ": " + r.summary.message + "; no output written",
+                  2);
+    const ModesSummary& s = r.summary;
+    int singular = 0;
+    for (const AssemblyMode& m : r.modes) singular += m.singular ? 1 : 0;
+    report << "  t = " << format_time(t) << ": " << r.modes.size() << " real (" << singular << " singular), "
+           << s.complex << " complex\n";
+    csv += shortest(t) + "," + std::to_string(r.modes.size()) + "," + std::to_string(s.complex) + "," +
+           std::to_string(s.singular) + "," + std::to_string(s.at_infinity) + "," + std::to_string(s.failed_paths) +
+           "\n";
+    if (k > 0 && r.modes.size() != before) {
+      ++changed;
+      changes += "  the count changes from " + std::to_string(before) + " to " + std::to_string(r.modes.size()) +
+                 " between t = " + format_time(t0 + (t1 - t0) * (k - 1) / (samples - 1)) +
+                 " and t = " + format_time(t) + ": a singular position (two modes meet) lies between\n";
+    }
+    before = r.modes.size();
+  }
+  try {
+    if (file) {
+      file->write(csv);
+      outputs.commit();
+    }
+    if (!quiet)
+      std::cout << printable(scene_path) << ": real assembly modes at " << samples
+                << " times from t = " << format_time(t0) << " to " << format_time(t1) << " (" << changed << " change"
+                << (changed == 1 ? "" : "s") << ")\n"
+                << report.str() << changes;
+  } catch (const Error& e) {
+    return fail(e.what(), 3);
+  }
+  return 0;
+}
+
 int cmd_modes(const std::string& scene_arg, std::optional<double> at, const std::string& out_path, int threads,
-              long long max_paths, bool quiet, const std::vector<std::string>& sets) {
+              long long max_paths, bool quiet, const std::vector<std::string>& sets, int along) {
   const std::string scene_path = scene_label(scene_arg);
+  if (along > 0 && at) return fail("modes: --along: the times are spread over the scene's sweep: no --at with it", 2);
+  if (along > 0 && !out_path.empty() && out_path != "-" && !modes_path_ends_with(out_path, ".csv"))
+    return fail("modes: -o " + out_path + ": --along writes CSV (.csv)", 2);
   if (!out_path.empty() && out_path != "-") {
     if (!modes_path_ends_with(out_path, ".yaml") && !modes_path_ends_with(out_path, ".yml") &&
         !modes_path_ends_with(out_path, ".csv") && !modes_path_ends_with(out_path, ".json"))
@@ -191,6 +240,7 @@ int cmd_modes(const std::string& scene_arg, std::optional<double> at, const std:
   options.time = t;
   options.threads = threads;
   options.max_paths = max_paths;
+  if (along > 0) return modes_along(scene, scene_path, along, outputs, file, options, quiet);
   AssemblyModes r;
   try {
     r = find_assembly_modes(model, options);
@@ -226,6 +276,7 @@ Command register_modes(CLI::App& app) {
     long long max_paths = 100000;
     bool quiet = false;
     std::vector<std::string> sets;
+    int along = 0;
   };
   auto a = std::make_shared<Args>();
   CLI::App* cmd =
@@ -243,12 +294,16 @@ Command register_modes(CLI::App& app) {
   cmd->add_option("--max-paths", a->max_paths, "Refuse a scene whose homotopy has more paths than this")
       ->capture_default_str()
       ->check(whole_number(1, std::numeric_limits<int>::max()));
+  cmd->add_option("--along", a->along,
+                  "The count of real modes at N times spread over time.start … time.end, and where it changes "
+                  "(singular positions); -o: CSV")
+      ->check(whole_number(2, 1000000));
   cmd->add_flag("-q,--quiet", a->quiet, "Do not print the report on standard output");
   add_set_option(cmd, &a->sets);
   return {cmd, [a, at] {
             return with_stdout_checked(cmd_modes(a->path, at->count() ? std::optional<double>(a->at) : std::nullopt,
                                                  a->out, cap_threads("modes", a->threads, a->quiet), a->max_paths,
-                                                 a->quiet, a->sets));
+                                                 a->quiet, a->sets, a->along));
           }};
 }
 

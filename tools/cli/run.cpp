@@ -14,6 +14,7 @@
 #include "command_line.hpp"
 #include "command_support.hpp"
 #include "commands.hpp"
+#include "mode_count.hpp"
 #include "progress_bar.hpp"
 #include "result_file.hpp"
 #include "run_summary.hpp"
@@ -32,6 +33,7 @@ class ResultRows : public phiq::RowWriter {
              ProgressBar& progress)
       : csv_(csv), h5_(h5), file_(file), spool_(spool), progress_(progress), stop_(stop_flag()) {}
   void encode(const phiq::StepView& step, std::string& out) const override {
+    if (step.step == 0) first_q = step.q;  // one thread writes it, read once the sweep is over
     if (!h5_) return csv_.append_row(step, out);
     thread_local std::vector<double> row;  // (the bytes of `out` are not doubles: packed by a copy)
     row.resize(csv_.num_values());
@@ -59,6 +61,7 @@ class ResultRows : public phiq::RowWriter {
   // writer's block, with no encoded copy in between.
   bool write_row(const phiq::StepView& step) override {
     const auto w0 = Clock::now();
+    if (step.step == 0) first_q = step.q;
     if (h5_) {
       const std::size_t rows_before = h5_->rows();
       h5_->append_row(step);
@@ -77,7 +80,8 @@ class ResultRows : public phiq::RowWriter {
     pending_.clear();
   }
   std::string& pending() { return pending_; }
-  double seconds = 0.0;  // writing rows (and formatting those computed on this thread: write_row())
+  double seconds = 0.0;             // writing rows (and formatting those computed on this thread: write_row())
+  mutable Eigen::VectorXd first_q;  // the first row's positions (empty until it is solved): the summary's mode
 
  private:
   static constexpr std::size_t kPendingBytes = std::size_t{1} << 20;
@@ -99,12 +103,14 @@ class ResultRows : public phiq::RowWriter {
 
 // `--mode K`: `start` moved to real assembly mode K of the scene at its first time (phiq/modes.hpp), as `phiq modes`
 // numbers them; nothing for K = 0 (the rough placement). Else why not (": --mode …; no output written"): bad input.
-std::optional<std::string> mode_start(const phiq::Scene& scene, int mode, int threads, Eigen::VectorXd* start) {
+// The modes found are left in `found`.
+std::optional<std::string> mode_start(const phiq::Scene& scene, int mode, int threads, Eigen::VectorXd* start,
+                                      std::optional<phiq::AssemblyModes>* found) {
   if (mode <= 0) return std::nullopt;
   phiq::ModesOptions o;
   o.time = scene.sweep.t_begin;
   o.threads = threads;
-  const phiq::AssemblyModes modes = phiq::find_assembly_modes(*scene.model, o);
+  const phiq::AssemblyModes& modes = found->emplace(phiq::find_assembly_modes(*scene.model, o));
   if (modes.summary.status != phiq::ModesStatus::kSuccess)
     return ": --mode: " + modes.summary.message + "; no output written";
   if (static_cast<std::size_t>(mode) > modes.modes.size())
@@ -123,6 +129,38 @@ std::string rounding_level_note(const phiq::RowClassAccuracy& r) {
   s += r.worst_coordinate.empty() ? phiq::significant(r.worst_error, 3) + " × the tolerance test"
                                   : phiq::known_to_text(r.worst_coordinate, r.worst_known_to, r.worst_unit);
   return s + " at t = " + phiq::format_time(r.worst_time);
+}
+
+// Why a sweep failed: its message, and for a square model not assembled at its first position, what the rank
+// analysis says: singular there (redundant constraints and missing drivers in equal numbers, or a singular
+// placement), or Newton found no descent from the placement (the Jacobian of a Cardan joint at 90° drops rank
+// there). The minimum-norm assembly and its rank analysis say which. (Not when the first position was assembled and
+// the sweep stopped at its singular start: the rank there counts the loops lying flat at once as freedoms not
+// driven.)
+std::string failure_message(const phiq::Scene& scene, const phiq::SweepSummary& summary, bool reduced) {
+  std::string why = summary.message;
+  if (summary.failed_step == 0 && summary.assembly.status != phiq::SolveStatus::kSuccess &&
+      summary.status != phiq::SolveStatus::kOutsideTimeDomain && summary.status != phiq::SolveStatus::kOutsideDomain &&
+      summary.status != phiq::SolveStatus::kNonFinite && !reduced) {
+    Eigen::VectorXd q = scene.model->initial_positions();
+    phiq::AssemblySummary as;
+    std::unique_ptr<phiq::Model> unused;
+    if (phiq::prepare_square(*scene.model, scene.sweep.t_begin, assembly_options(scene), q, &unused, &as) !=
+        phiq::SolveStatus::kSuccess)
+      why += "; rank analysis: " + as.message;
+  }
+  return why;
+}
+
+// The summary's `modes`: the real assembly modes at the start and the one the first row is in (mode_count.hpp;
+// those `--mode` found, else counted within the bound); first_q empty: no row was solved (`assembled` false, the
+// count then says why: none real, say).
+nlohmann::ordered_json summary_modes(const phiq::Scene& scene, std::optional<phiq::AssemblyModes>& found,
+                                     const Eigen::VectorXd& first_q, int threads) {
+  const double t = scene.sweep.t_begin;
+  const Eigen::VectorXd* position = first_q.size() ? &first_q : nullptr;
+  return mode_count_json(found ? counted_modes(scene, t, std::move(*found), position)
+                               : count_modes(scene, t, position, threads));
 }
 
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
@@ -165,12 +203,14 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     return fail(e.what(), 3);
   }
 
+  std::optional<phiq::AssemblyModes> found;  // by --mode
   // A run that cannot be solved still commits its summary (status, where, why: for harnesses), never the CSV. Its
   // message is the line stderr gets.
-  auto failed = [&](const phiq::Model& swept, phiq::SweepSummary s, const RunTimes& times, const std::string& why) {
+  auto failed = [&](const phiq::Model& swept, phiq::SweepSummary s, const RunTimes& times, const std::string& why,
+                    const Eigen::VectorXd& first_q = {}) {
     s.message = why;
     if (summary_file) try {
-        summary_file->write(run_summary_json(scene, swept, s, times));
+        summary_file->write(run_summary_json(scene, swept, s, times, summary_modes(scene, found, first_q, threads)));
         outputs.commit_one(*summary_file);
       } catch (const phiq::Error& e) {
         return fail(e.what(), 3);
@@ -191,7 +231,7 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     at_start.worst_rows = square.assembly.worst_rows;
     return failed(*scene.model, at_start, {load_s, 0.0, 0.0}, *why);
   }
-  if (const auto bad = mode_start(scene, mode, threads, &square.start)) return fail(scene_path + *bad, 2);
+  if (const auto bad = mode_start(scene, mode, threads, &square.start, &found)) return fail(scene_path + *bad, 2);
   const phiq::AssemblySummary& redundancy = square.assembly;
   const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;
@@ -243,24 +283,8 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   if (summary.status == phiq::SolveStatus::kCancelled || stop_flag().load())
     return fail(scene_path + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
   if (summary.status != phiq::SolveStatus::kSuccess) {
-    std::string why = summary.message;
-    // A square model not assembled at its first position: singular there (redundant constraints and missing
-    // drivers in equal numbers, or a singular placement), or Newton found no descent from the placement (the
-    // Jacobian of a Cardan joint at 90° drops rank there). The minimum-norm assembly and its rank analysis say which.
-    // (Not when the first position was assembled and the sweep stopped at its singular start: the rank there
-    // counts the loops lying flat at once as freedoms not driven.)
-    if (summary.failed_step == 0 && summary.assembly.status != phiq::SolveStatus::kSuccess &&
-        summary.status != phiq::SolveStatus::kOutsideTimeDomain &&
-        summary.status != phiq::SolveStatus::kOutsideDomain && summary.status != phiq::SolveStatus::kNonFinite &&
-        !square.reduced) {
-      Eigen::VectorXd q = scene.model->initial_positions();
-      phiq::AssemblySummary as;
-      std::unique_ptr<phiq::Model> unused;
-      if (phiq::prepare_square(*scene.model, scene.sweep.t_begin, assembly_options(scene), q, &unused, &as) !=
-          phiq::SolveStatus::kSuccess)
-        why += "; rank analysis: " + as.message;
-    }
-    return failed(model, summary, {load_s, summary.solve_seconds - rows.seconds, rows.seconds}, why);
+    const std::string why = failure_message(scene, summary, square.reduced != nullptr);
+    return failed(model, summary, {load_s, summary.solve_seconds - rows.seconds, rows.seconds}, why, rows.first_q);
   }
   double write_s = rows.seconds;  // writing rows (the sweep's threads encode them: in solve_seconds)
   const double solve_s = summary.solve_seconds - write_s;
@@ -281,7 +305,9 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
       if (const auto bad = stdout_error()) throw phiq::Error(*bad);
     }
     write_s += since(final_write);
-    if (summary_file) summary_file->write(run_summary_json(scene, model, summary, {load_s, solve_s, write_s}));
+    if (summary_file)
+      summary_file->write(run_summary_json(scene, model, summary, {load_s, solve_s, write_s},
+                                           summary_modes(scene, found, rows.first_q, threads)));
     outputs.commit();
   } catch (const phiq::Error& e) {
     return fail(e.what(), 3);

@@ -26,7 +26,8 @@ void add_outcome(nlohmann::ordered_json& j, const Model& swept, const SweepSumma
 
 nlohmann::ordered_json host_json() { return {{"name", host_name()}, {"cpu", cpu_model()}}; }
 
-std::string run_summary_json(const Scene& scene, const Model& swept, const SweepSummary& s, const RunTimes& times) {
+std::string run_summary_json(const Scene& scene, const Model& swept, const SweepSummary& s, const RunTimes& times,
+                             const nlohmann::ordered_json& modes) {
   nlohmann::ordered_json j;
   j["format"] = kRunSummaryFormat;
   // where and with what it ran: a summary kept by a harness says so without the command line
@@ -96,6 +97,8 @@ std::string run_summary_json(const Scene& scene, const Model& swept, const Sweep
                    {"singular", row_class(s.accuracy.singular)}};
   j["warnings"] = nlohmann::ordered_json::array();
   for (const auto& w : s.warnings) j["warnings"].push_back({{"t", w.t}, {"kind", w.kind}, {"message", w.message}});
+  // the real assembly modes at the start and the first row's (mode_count.hpp)
+  j["modes"] = modes;
   return json_text(j, 2) + "\n";
 }
 

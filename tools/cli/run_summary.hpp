@@ -24,7 +24,9 @@ void add_outcome(nlohmann::ordered_json& j, const Model& swept, const SweepSumma
 nlohmann::ordered_json host_json();
 
 // The summary's JSON text. `swept`: the model the sweep ran on, which names the rows of s.worst_rows (the scene's
-// model, or the square model solved on its independent rows).
-std::string run_summary_json(const Scene& scene, const Model& swept, const SweepSummary& s, const RunTimes& times);
+// model, or the square model solved on its independent rows). `modes`: the summary's `modes` (mode_count.hpp; null
+// when not known).
+std::string run_summary_json(const Scene& scene, const Model& swept, const SweepSummary& s, const RunTimes& times,
+                             const nlohmann::ordered_json& modes);
 
 }  // namespace phiq::tools

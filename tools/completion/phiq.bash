@@ -32,13 +32,13 @@ _phiq() {
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
     convert) opts="--help --output --drive --time" ;;
     plot) opts="--help --output --columns --positions --set" ;;
-    animate) opts="--help --output --columns --set" ;;
+    animate) opts="--help --output --columns --modes --set" ;;
     sweep-accuracy) opts="--help --output --json --tolerances --steps-list --predictors --newton --linear-solvers
                           --reference --repeat --quiet --verbose" ;;
     tolerance) opts="--help --output --sd --limit --covariance --samples --seed --columns --threshold --summary --plot
                      --plot-column --threads --names --quiet --set" ;;
     clearance) opts="--help --output --summary --fail-on-interference --quiet --set" ;;
-    modes) opts="--help --at --output --threads --max-paths --quiet --set" ;;
+    modes) opts="--help --at --along --output --threads --max-paths --quiet --set" ;;
   esac
 
   # values of the options that take a fixed set of words, or files
@@ -56,7 +56,7 @@ _phiq() {
     --summary|--junit|-o|--output|--covariance|--plot) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     --threads|--memory|--steps|--from|--to|--twist|--time|--rtol|--atol|--columns|--positions|--tolerances|\
     --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column|--set|\
-    --sensitivity|--at|--max-paths|--mode) return ;;  # a value of the user's
+    --sensitivity|--at|--along|--max-paths|--mode) return ;;  # a value of the user's
   esac
   if [[ "$cur" == -* ]]; then
     COMPREPLY=($(compgen -W "$opts" -- "$cur"))

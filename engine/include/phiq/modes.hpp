@@ -180,4 +180,16 @@ AssemblyModes find_assembly_modes(const Model& model, const ModesOptions& option
 /// length_scale(), angles (radians) compared modulo 2π, other coordinates as they are.
 double mode_distance(const Model& model, const Eigen::VectorXd& a, const Eigen::VectorXd& b);
 
+/// Which real assembly mode a position is in: the nearest mode by mode_distance(), and the next nearest.
+struct ModeLocation {
+  int mode = -1;               ///< index into the modes of the nearest (−1: there are none)
+  double distance = 0.0;       ///< mode_distance() from the position to that mode
+  int next = -1;               ///< index of the next nearest (−1: fewer than two modes)
+  double next_distance = 0.0;  ///< mode_distance() from the position to the next nearest
+};
+
+/// The mode of `modes` nearest to q (a position of `model`, as long as its coordinates) and the next nearest, by
+/// mode_distance(); ties go to the lower index. Pure function.
+ModeLocation locate_mode(const Model& model, const Eigen::VectorXd& q, const std::vector<AssemblyMode>& modes);
+
 }  // namespace phiq

@@ -61,4 +61,19 @@ double mode_distance(const Model& model, const Eigen::VectorXd& a, const Eigen::
   return d;
 }
 
+ModeLocation locate_mode(const Model& model, const Eigen::VectorXd& q, const std::vector<AssemblyMode>& modes) {
+  ModeLocation where;
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    const double d = mode_distance(model, q, modes[k].q);
+    const int index = static_cast<int>(k);
+    if (where.mode < 0 || d < where.distance) {
+      where.next = where.mode, where.next_distance = where.distance;
+      where.mode = index, where.distance = d;
+    } else if (where.next < 0 || d < where.next_distance) {
+      where.next = index, where.next_distance = d;
+    }
+  }
+  return where;
+}
+
 }  // namespace phiq

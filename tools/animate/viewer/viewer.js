@@ -20,6 +20,8 @@
 //   traces, trace_t  the traced output points ({name, colour, data: the frames' encoding}) at the times trace_t
 //   plot_t         the t range of the plots' axes (their cursor); box: the planar view's pixel box (planar.js)
 //   velocity_note  why there are no velocity vectors, when there are none
+//   row_labels     a label per row when the rows are separate poses (phiq animate --modes): the nearest frame is
+//                  shown as it is, never interpolated, and its label replaces the time
 //   parts          the parts drawn (phiq/drawn_parts.hpp): {names, shapes: per part its shapes' names, geometry: a
 //                  geometry index per part, fixed: a character per part, geometries: per geometry its shapes ({colour,
 //                  and in space p: base64 float32 x, y, z per vertex, i: base64 uint32 three per triangle; in the
@@ -81,8 +83,9 @@ const phiq = (function () {
   const pos = new Float32Array(P * D), vel = velocities ? new Float32Array(P * D) : null, place = new Float32Array(7 * N);
   // The pose at time t: linear between the frames around it.
   function pose(t) {
-    const i = Math.min(below(T, t), F - 1), j = Math.min(i + 1, F - 1);
-    const w = j > i && T[j] > T[i] ? Math.min(1, Math.max(0, (t - T[i]) / (T[j] - T[i]))) : 0;
+    let i = Math.min(below(T, t), F - 1), j = Math.min(i + 1, F - 1);
+    let w = j > i && T[j] > T[i] ? Math.min(1, Math.max(0, (t - T[i]) / (T[j] - T[i]))) : 0;
+    if (data.row_labels) i = j = w < 0.5 ? i : j, w = 0;  // separate poses: the nearest, as it is
     const a = i * P * D, b = j * P * D;
     for (let k = 0; k < P * D; ++k) pos[k] = frames[a + k] + w * (frames[b + k] - frames[a + k]);
     if (vel) for (let k = 0; k < P * D; ++k) vel[k] = velocities[a + k] + w * (velocities[b + k] - velocities[a + k]);
@@ -152,7 +155,8 @@ const phiq = (function () {
     if (drawTimes.length > 600) drawTimes.shift();
     const u = span > 0 ? (t - t0) / span : 0;
     slider.value = Math.round(u * 10000);
-    timeText.textContent = 't = ' + t.toPrecision(5) + ' s \u00b7 row ' + (data.kept[p.frame] + 1) + '/' + data.rows;
+    timeText.textContent = data.row_labels ? data.row_labels[data.kept[p.frame]]
+      : 't = ' + t.toPrecision(5) + ' s \u00b7 row ' + (data.kept[p.frame] + 1) + '/' + data.rows;
     const f = pt[1] > pt[0] ? (t - pt[0]) / (pt[1] - pt[0]) : 0;
     for (const c of cursors) {
       const x = c.x + f * c.w;
