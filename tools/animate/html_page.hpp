@@ -12,8 +12,9 @@
 namespace phiq::tools {
 
 // The page for `table`, the result of `scene` read from `result`; `columns` as `phiq plot --columns` (empty: its
-// defaults). Throws phiq::Error with one line for bad input (see viewer_motion(), plotted_columns()).
+// defaults); `forces` > 0: the efforts and reactions drawn as arrows, that many metres per newton (force_arrows.hpp).
+// Throws phiq::Error with one line for bad input (see viewer_motion(), plotted_columns(), force_arrows()).
 std::string motion_html(const Scene& scene, const CsvTable& table, const std::string& result,
-                        const std::vector<std::string>& columns);
+                        const std::vector<std::string>& columns, double forces = 0.0);
 
 }  // namespace phiq::tools

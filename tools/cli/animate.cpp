@@ -2,6 +2,7 @@
 // (tools/animate/gltf_motion.*) or a self-contained HTML viewer (tools/animate/html_page.*), chosen by the output's
 // extension; without RESULT, of the scene swept here with the outputs the drawing needs (drawn_result.hpp); its
 // options, the checks of its input and the atomic write.
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -24,6 +25,7 @@ struct AnimateOptions {
   std::string scene, result, out;
   std::vector<std::string> columns;  // the HTML's plots (as phiq plot --columns)
   std::vector<std::string> sets;     // --set NAME=VALUE: the scene's parameters as the run had them
+  double forces = 0.0;               // --forces SCALE: the efforts and reactions as arrows, m/N (0: none)
 };
 
 // What the messages and the page call the result of a sweep run here.
@@ -39,6 +41,11 @@ int cmd_animate(const AnimateOptions& o) {
     return fail("animate: -o " + o.out + ": the output is a glTF binary (*.glb) or an HTML viewer (*.html)", 2);
   if (!html && !o.columns.empty())
     return fail("animate: --columns: the plots are the HTML viewer's; a .glb has none", 2);
+  if (!html && o.forces != 0.0)
+    return fail("animate: --forces: the force arrows are the HTML viewer's; a .glb has none", 2);
+  if (!(o.forces >= 0.0) || !std::isfinite(o.forces))
+    return fail(
+        "animate: --forces " + shortest(o.forces) + ": the scale must be a positive number of metres per newton", 2);
   if (const auto clash = output_clash({{"-o", o.out}}, {{"the scene", o.scene}, {"the result", o.result}}))
     return fail("animate: " + *clash, 2);
   std::string text;
@@ -51,10 +58,10 @@ int cmd_animate(const AnimateOptions& o) {
       const DrawnOutputs add{coordinates_of(html ? drawing_reads(sketch, parts) : glb_reads(scene, sketch, parts)),
                              html};
       const CsvTable table = sweep_scene(scene, add);
-      text = html ? motion_html(scene, table, kSwept, o.columns) : motion_glb(scene, table, kSwept);
+      text = html ? motion_html(scene, table, kSwept, o.columns, o.forces) : motion_glb(scene, table, kSwept);
     } else {
       const CsvTable table = read_scene_result(scene, o.result);
-      text = html ? motion_html(scene, table, o.result, o.columns) : motion_glb(scene, table, o.result);
+      text = html ? motion_html(scene, table, o.result, o.columns, o.forces) : motion_glb(scene, table, o.result);
     }
   } catch (const MissingCoordinate& e) {
     std::string again = "phiq animate " + o.scene + " -o " + o.out;
@@ -96,6 +103,9 @@ Command register_animate(CLI::App& app) {
                    "HTML: columns plotted against t (default: as phiq plot, what "
                    "is driven, the joints' measures, the coordinates that move)")
       ->delimiter(',');
+  animate->add_option("--forces", options->forces,
+                      "HTML: draw the scene's output.efforts and output.reactions as arrows, SCALE metres per "
+                      "newton (moments: arcs of SCALE metres per N m in the plane, arrows along their axis in space)");
   add_set_option(animate, &options->sets);
   return {animate, [options] { return cmd_animate(*options); }};
 }
