@@ -225,6 +225,61 @@ TEST(EffortSensitivity, TheFourFormulationsOfTheFourBarGiveOneSensitivity) {
   EXPECT_LT(worst, 1e-7 * scale);
 }
 
+TEST(EffortSensitivity, ARedundantParallelogramHasItsFourBarsSensitivity) {
+  // models/redundant/parallelogram_fifth_bar.yaml, swept on its independent rows (a row dropped: w and λ over the
+  // kept ones), against the four-bar without its fifth bar: ∂τ/∂r and ∂τ/∂d alike, row by row
+  std::ifstream in(test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  std::stringstream read;
+  read << in.rdbuf();
+  std::string five = read.str();
+  five.erase(five.find("output:"));
+  std::string four;
+  std::istringstream lines(five);
+  for (std::string line; std::getline(lines, line);)
+    if (line.find("crank3") == std::string::npos && line.find("x3:") == std::string::npos &&
+        line.find("y3:") == std::string::npos && line.find("psi3:") == std::string::npos)
+      four += line + "\n";
+  const std::string massive =
+      "parts:\n  crank1: {mass: 1.0, inertia: 0.1, center_of_mass: [r/2, 0]}\n"
+      "  crank2: {mass: 1.0, inertia: 0.1, center_of_mass: [r/2, 0]}\n"
+      "  coupler: {mass: 2.0, inertia: 0.2, center_of_mass: [d/2, 0]}\n"
+      "loads: {gravity: [0, -9.81]}\noutput: {efforts: all, sensitivities: [r, d]}\n";
+  std::vector<std::vector<std::vector<double>>> values;
+  for (const std::string& text : {five, four}) {
+    const Scene s = parse_scene(text + massive, "parallelogram.yaml");
+    SquareScene square;
+    ASSERT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &square), SolveStatus::kSuccess)
+        << square.assembly.message;
+    const Model& m = square.model(*s.model);
+    Workspace ws(m);
+    ws.q = square.start;
+    std::vector<std::vector<double>> rows;
+    const std::size_t size = static_cast<std::size_t>(effort_values(s.sweep.efforts, 2));
+    SweepSummary sum;
+    ASSERT_EQ(run_sweep(
+                  m, s.sweep, ws,
+                  [&](const StepView& v) {
+                    rows.emplace_back(v.efforts, v.efforts + size);
+                    return true;
+                  },
+                  &sum),
+              SolveStatus::kSuccess)
+        << sum.message;
+    values.push_back(rows);
+  }
+  ASSERT_EQ(values[0].size(), values[1].size());
+  double worst = 0.0, scale = 0.0;
+  for (std::size_t k = 0; k < values[0].size(); ++k)
+    for (std::size_t j = 2; j < 4; ++j) {
+      ASSERT_TRUE(std::isfinite(values[0][k][j])) << k;
+      worst = std::max(worst, std::fabs(values[0][k][j] - values[1][k][j]));
+      scale = std::max(scale, std::fabs(values[1][k][j]));
+    }
+  ::testing::Test::RecordProperty("worst_relative", scientific(worst / scale, 2));
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LT(worst, 1e-7 * scale);
+}
+
 TEST(EffortSensitivity, TheCsvColumnsAreNamedAfterTheEffortAndTheParameterAndHoldTheRowsValues) {
   const Scene s = parse_scene(kEffortPendulum, "pendulum.yaml");
   const CsvFormat f(*s.model, s.sweep);
