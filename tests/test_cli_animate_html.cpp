@@ -156,6 +156,61 @@ TEST_F(AnimateHtml, ColumnsAsAskedAndSpatialScenesInWebGl) {
   EXPECT_EQ(decode(data["frames"], lo, hi).size(), table.rows.size() * data["points"].get<std::size_t>() * 3);
 }
 
+TEST_F(AnimateHtml, ForceArrowsHoldTheResultsEffortsAndReactionsAtTheirJoints) {
+  // the four-bar of models/dynamics with its pins' loads: an arrow per pin (O, A, B, C) and the motor's torque at
+  // the crank's ground pin O, the values the result's columns at every kept row, each pin's point where it is
+  std::string text = slurp(phiq::test::model_path("dynamics/fourbar_pin_loads.yaml"));
+  text.erase(text.find("output:"));  // every coordinate written: the drawing reads them from the result
+  const fs::path scene = write("pins.yaml", text + "output: {efforts: all, reactions: all}\n");
+  const std::string html = animate(scene.string(), "--forces 0.05");
+  const nlohmann::json& f = data["forces"];
+  EXPECT_EQ(f["scale"], 0.05);
+  EXPECT_EQ(f["unplaced"].size(), 0u);
+  ASSERT_EQ(f["arrows"].size(), 5u);
+  const std::size_t rows = table.rows.size();
+  ASSERT_EQ(data["kept"].size(), rows);
+  const double l2 = 0.4;
+  for (std::size_t a = 0; a < 5; ++a) {
+    const nlohmann::json& arrow = f["arrows"][a];
+    const std::string name = arrow["name"];
+    EXPECT_EQ(name, a < 4 ? std::string(1, "OABC"[a]) : "motor");
+    EXPECT_EQ(arrow["kind"], a < 4 ? "reaction" : "effort");
+    ASSERT_EQ(arrow["at"].size(), 3 * rows);
+    for (std::size_t k = 0; k < rows; ++k) {
+      if (a < 4) {
+        EXPECT_EQ(arrow["force"][3 * k].get<double>(), at(k, name + ".Fx")) << name << " " << k;
+        EXPECT_EQ(arrow["force"][3 * k + 1].get<double>(), at(k, name + ".Fy")) << name << " " << k;
+        EXPECT_EQ(arrow["moment"][3 * k + 2].get<double>(), at(k, name + ".Mz")) << name << " " << k;
+      } else {
+        EXPECT_EQ(arrow["moment"][3 * k + 2].get<double>(), at(k, "motor.effort")) << k;
+        EXPECT_EQ(arrow["force"][3 * k].get<double>(), 0.0);
+      }
+      const double x = arrow["at"][3 * k], y = arrow["at"][3 * k + 1];
+      if (a == 0 || a == 4) {  // O: the ground pin at the origin
+        EXPECT_NEAR(x, 0.0, 1e-9);
+        EXPECT_NEAR(y, 0.0, 1e-9);
+      } else if (a == 1) {  // A: the crank's tip, L2 from O at the crank's angle
+        EXPECT_NEAR(x, l2 * std::cos(at(k, "psi2")), 1e-9);
+        EXPECT_NEAR(y, l2 * std::sin(at(k, "psi2")), 1e-9);
+      } else if (a == 3) {  // C: the rocker's ground pin
+        EXPECT_NEAR(x, 1.0, 1e-9);
+        EXPECT_NEAR(y, 0.0, 1e-9);
+      }
+    }
+  }
+  EXPECT_EQ(count(html, "id=\"forces\""), 1u);  // the page's check box
+  // asked for where the scene writes no efforts or reactions, or with a scale that is not positive: one line, exit 2
+  const Result none = run("animate " + phiq::test::model_path("seed/fourbar_natural.yaml") + " -o " +
+                          (dir_ / "n.html").string() + " --forces 0.1");
+  EXPECT_EQ(none.code, 2);
+  EXPECT_NE(none.err.find("--forces draws the efforts and reactions the scene writes"), std::string::npos) << none.err;
+  const Result negative = run("animate " + phiq::test::model_path("seed/fourbar_natural.yaml") + " -o " +
+                              (dir_ / "n.html").string() + " --forces -1");
+  EXPECT_EQ(negative.code, 2);
+  EXPECT_NE(negative.err.find("the scale must be a positive number"), std::string::npos) << negative.err;
+  EXPECT_FALSE(fs::exists(dir_ / "n.html"));
+}
+
 TEST_F(AnimateHtml, LargeChainsKeepEvenlySpreadRowsWithinTheBudget) {
   constexpr std::size_t kFrameBudget = std::size_t{8} << 20;  // tools/animate/html_motion.hpp (in the phiq program)
   const fs::path scene = dir_ / "chain.yaml";

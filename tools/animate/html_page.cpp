@@ -5,6 +5,7 @@
 #include <map>
 
 #include "html_clearance.hpp"
+#include "force_arrows.hpp"
 #include "html_motion.hpp"
 #include "phiq/phiq.hpp"
 #include "phiq/version.hpp"
@@ -51,9 +52,10 @@ std::string script(std::string_view code) { return "<script>\n" + std::string(co
 
 std::string motion_html(const Scene& scene, const CsvTable& table, const std::string& result,
                         const std::vector<std::string>& columns, const ClearanceReport* clearance,
-                        const std::vector<std::string>& row_labels) {
+                        const std::vector<std::string>& row_labels, double forces) {
   const MechanismSketch sketch = sketch_mechanism(*scene.model);
   ViewerMotion motion = viewer_motion(scene, sketch, table, result);
+  if (forces > 0.0) motion.data["forces"] = force_arrows(scene, table, motion.rows, motion.frames.q, result, forces);
   const std::vector<std::string> series = plotted_columns(scene, table, columns, result);
   nlohmann::json& data = motion.data;
   const bool spatial = scene.dimension == 3;

@@ -3,6 +3,7 @@
 // extension; without RESULT, of the scene swept here with the outputs the drawing needs (drawn_result.hpp); with
 // --modes, every real assembly mode of the scene at its start (phiq/modes.hpp), one pose per mode in the HTML
 // viewer; its options, the checks of its input and the atomic write.
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -27,6 +28,7 @@ struct AnimateOptions {
   std::vector<std::string> columns;  // the HTML's plots (as phiq plot --columns)
   std::vector<std::string> sets;     // --set NAME=VALUE: the scene's parameters as the run had them
   bool modes = false;                // --modes: the real assembly modes at time.start instead of a motion
+  double forces = 0.0;               // --forces SCALE: the efforts and reactions as arrows, m/N (0: none)
 };
 
 // What the messages and the page call the result of a sweep run here.
@@ -102,6 +104,12 @@ int cmd_animate(const AnimateOptions& o) {
     return fail(std::string("animate: --modes: the modes are drawn from the scene alone, in the HTML viewer (") +
                     (html ? "no RESULT" : "-o OUT.html") + ")",
                 2);
+  if (o.modes && o.forces != 0.0) return fail("animate: --forces: the modes are poses, with no efforts to draw", 2);
+  if (!html && o.forces != 0.0)
+    return fail("animate: --forces: the force arrows are the HTML viewer's; a .glb has none", 2);
+  if (!(o.forces >= 0.0) || !std::isfinite(o.forces))
+    return fail(
+        "animate: --forces " + shortest(o.forces) + ": the scale must be a positive number of metres per newton", 2);
   if (const auto clash = output_clash({{"-o", o.out}}, {{"the scene", o.scene}, {"the result", o.result}}))
     return fail("animate: " + *clash, 2);
   std::string text;
@@ -120,12 +128,12 @@ int cmd_animate(const AnimateOptions& o) {
                              html};
       const CsvTable table = sweep_scene(scene, add);
       const std::optional<ClearanceReport> clearance = html ? animated_clearance(scene) : std::nullopt;
-      text = html ? motion_html(scene, table, kSwept, o.columns, clearance ? &*clearance : nullptr)
+      text = html ? motion_html(scene, table, kSwept, o.columns, clearance ? &*clearance : nullptr, {}, o.forces)
                   : motion_glb(scene, table, kSwept);
     } else {
       const CsvTable table = read_scene_result(scene, o.result);
       const std::optional<ClearanceReport> clearance = html ? animated_clearance(scene) : std::nullopt;
-      text = html ? motion_html(scene, table, o.result, o.columns, clearance ? &*clearance : nullptr)
+      text = html ? motion_html(scene, table, o.result, o.columns, clearance ? &*clearance : nullptr, {}, o.forces)
                   : motion_glb(scene, table, o.result);
     }
   } catch (const MissingCoordinate& e) {
@@ -171,6 +179,9 @@ Command register_animate(CLI::App& app) {
   animate->add_flag("--modes", options->modes,
                     "HTML: every real assembly mode of the scene at time.start, one pose per mode (the plots' t is "
                     "the mode's number)");
+  animate->add_option("--forces", options->forces,
+                      "HTML: draw the scene's output.efforts and output.reactions as arrows, SCALE metres per "
+                      "newton (moments: arcs of SCALE metres per N m in the plane, arrows along their axis in space)");
   add_set_option(animate, &options->sets);
   return {animate, [options] { return cmd_animate(*options); }};
 }

@@ -32,7 +32,7 @@ _phiq() {
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
     convert) opts="--help --output --drive --time" ;;
     plot) opts="--help --output --columns --positions --set" ;;
-    animate) opts="--help --output --columns --modes --set" ;;
+    animate) opts="--help --output --columns --modes --forces --set" ;;
     sweep-accuracy) opts="--help --output --json --tolerances --steps-list --predictors --newton --linear-solvers
                           --reference --repeat --quiet --verbose" ;;
     tolerance) opts="--help --output --sd --limit --covariance --samples --seed --columns --threshold --summary --plot

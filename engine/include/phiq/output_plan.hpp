@@ -56,6 +56,11 @@ struct OutputSensitivity {
   /// these, and `models` may be null. sensitivity_along() keeps these and not the models: a model along p is the
   /// whole model again (nfourbar 10⁵: 80 MB), what p reaches a fraction of it.
   std::shared_ptr<const ReachedConstraints> reached;
+  /// The parts with mass and the loads of the scene at p − 2h, p − h, p + h, p + 2h (the efforts' sensitivities,
+  /// phiq/effort_sensitivity.hpp: a mass, a centre of mass or a load may read p). A scene's sensitivities set them
+  /// when it writes efforts; null: the efforts' own (p reaches the constraints only).
+  std::array<std::shared_ptr<const std::vector<Part>>, 4> parts_along;
+  std::array<std::shared_ptr<const Loads>, 4> loads_along;  ///< see parts_along
 };
 
 /// Where the sensitivities of one row are: for parameter j (0 ≤ j < parameters), the n values of ∂q/∂p_j from
@@ -104,6 +109,10 @@ struct OutputEfforts {
   bool active() const { return !constraints.empty() || !reactions.empty(); }
 };
 
+/// Values a row's StepView::efforts holds for `plan`: OutputEfforts::size(), then, with sensitivities, each effort's
+/// ∂τ/∂p (EffortSensitivityLayout of phiq/effort_sensitivity.hpp: parameter by parameter, efforts in order).
+Index effort_values(const OutputEfforts& efforts, std::size_t parameters);
+
 /// The outputs of a sweep beyond q (models/README.md, `output`). The sweep computes only what the plan lists; the
 /// writers lay out their columns from the same plan, so that what is computed and what is written cannot disagree.
 struct OutputPlan {
@@ -130,7 +139,9 @@ struct OutputPlan {
   /// coordinate's, when no column is written (a caller reading StepView::sensitivities); SweepSummary says which.
   SensitivityForm sensitivity_form = SensitivityForm::kAuto;
   /// Driver efforts and powers at every written row (StepView::efforts), written as `NAME.effort`, `NAME.power`;
-  /// empty `constraints`: none computed.
+  /// empty `constraints`: none computed. With `sensitivities`, each effort's sensitivity to each parameter too,
+  /// `NAME.effort.d_P` (phiq/effort_sensitivity.hpp), which reads every coordinate's sensitivities: the sweep then
+  /// solves them in the direct form, whatever `sensitivity_form` says (SweepSummary says so).
   OutputEfforts efforts;
   /// Whether the sweep solves q̈: asked for, or needed by the efforts. Solved is not delivered: StepView::qdd is set
   /// as `accelerations` says.
@@ -206,7 +217,8 @@ struct StepView {
   /// Sensitivities to OutputPlan::sensitivities laid out as SensitivityLayout says (null when none are listed):
   /// ∂q/∂p always, ∂q̇/∂p and ∂q̈/∂p when velocities / accelerations are delivered; NaN at a singular position.
   const double* sensitivities = nullptr;
-  /// Efforts then powers of OutputPlan::efforts (OutputEfforts::size() values; null when none are listed); NaN at a
+  /// Efforts then powers and reactions of OutputPlan::efforts (OutputEfforts::size() values), then the efforts'
+  /// sensitivities with OutputPlan::sensitivities (effort_values() in all; null when none are listed); NaN at a
   /// singular position.
   const double* efforts = nullptr;
 };

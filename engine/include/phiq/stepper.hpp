@@ -112,8 +112,9 @@ class Stepper {
   /// (parameter j's ∂q/∂p at offset(j, 0), ∂q̇/∂p at offset(j, 1), ∂q̈/∂p at offset(j, 2); NaN for the derivatives
   /// not solved, and all at a singular position); null when none are asked for or before started().
   const double* sensitivities() const;
-  /// Efforts then powers of StepperOptions::efforts at the current step (OutputEfforts::size() values; NaN at a
-  /// singular position), or null when none are asked for or before the first step.
+  /// Efforts, powers and reactions of StepperOptions::efforts at the current step, then with sensitivities each
+  /// effort's ∂τ/∂p (effort_values() values, StepView::efforts; NaN at a singular position), or null when none are
+  /// asked for or before the first step.
   const double* efforts() const;
 
   /// Everything the steps did since construction, as run_sweep's summary says it of a sweep: counters, subdivisions,

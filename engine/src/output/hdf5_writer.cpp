@@ -213,6 +213,9 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   if (plan.efforts.power) effort_units.insert(effort_units.end(), plan.efforts.constraints.size(), "W");
   for (const OutputReaction& r : plan.efforts.reactions)  // forces, then moments (N m)
     for (int k = 0; k < (r.spatial ? 6 : 3); ++k) effort_units.push_back(k < (r.spatial ? 3 : 2) ? "N" : "N m");
+  for (const OutputSensitivity& p : plan.sensitivities)  // ∂τ/∂p: the effort's unit per the parameter's ("/P")
+    for (std::size_t i = 0; i < plan.efforts.constraints.size(); ++i)
+      effort_units.push_back(effort_units[i] + "/" + p.name);
   if (Group* g = take("efforts", effort_units.size(), [&](std::size_t k) { return effort_units[k]; }))
     outputs.push_back(g);
   if (at != names.size() || groups.size() > 16) throw Error(cannot("the columns do not match the CSV's (phiq bug)"));

@@ -27,4 +27,8 @@ std::vector<Index> OutputPlan::sensitivity_outputs() const {
   return out;
 }
 
+Index effort_values(const OutputEfforts& efforts, std::size_t parameters) {
+  return efforts.size() + static_cast<Index>(efforts.constraints.size() * parameters);
+}
+
 }  // namespace phiq

@@ -154,7 +154,11 @@ OutputSensitivity along(const Scene& scene, const std::string& name, double valu
       if (n == name) v = at, replaced = true;
     if (!replaced) moved.parameters.emplace_back(name, at);
     try {
-      return std::shared_ptr<const Model>(std::move(read(moved).model));
+      Scene at_k = read(moved);
+      // the masses, centres and loads at p + kh, which the efforts' sensitivities difference (effort_sensitivity.hpp)
+      s.parts_along[k] = at_k.sweep.efforts.parts;
+      s.loads_along[k] = at_k.sweep.efforts.loads;
+      return std::shared_ptr<const Model>(std::move(at_k.model));
     } catch (const SceneError& e) {
       throw SceneError("with " + name + " = " + shortest(at) + " (the difference step " + shortest(s.step) + " from " +
                        shortest(value) + ") the scene cannot be read: " + e.what());

@@ -32,12 +32,7 @@ void difference_on(const ParameterReach& reach, const std::array<Eigen::VectorXd
   for (const Index r : reach.rows) d[r] = difference_at(f, r, h);
 }
 
-// The largest |v_j| / scale_j over the n coordinates: how fast v moves its fastest coordinate, in their scales.
-double fastest(const double* v, const double* scale, Index n) {
-  double f = 0.0;
-  for (Index j = 0; j < n; ++j) f = std::max(f, std::fabs(v[j]) / scale[j]);
-  return f;
-}
+double fastest(const double* v, const double* scale, Index n) { return detail::fastest_coordinate(v, scale, n); }
 
 // The derivative of f = `which` along the parameter over the rows of `reach`, into `d` (its other rows untouched):
 // at fixed (q, q̇, q̈), or, where the parameter moves the scale of coordinates that reached constraints add
@@ -47,9 +42,11 @@ double fastest(const double* v, const double* scale, Index n) {
 //
 // Where the kept constraints hold their data's rates (ReachedConstraints::rates: kinds that differentiate their own
 // data), those spans are the swept model's own derivatives along the data instead, one evaluation, exact.
-void along_parameter(const Model& model, const OutputSensitivity& p, const ParameterReach& reach,
-                     detail::AlongParameter which, const double* q, const double* qd, const double* qdd, double t,
-                     Index n, detail::SensitivityScratch& sc, Eigen::VectorXd& d) {
+}  // namespace
+
+void detail::along_parameter(const Model& model, const OutputSensitivity& p, const ParameterReach& reach,
+                             detail::AlongParameter which, const double* q, const double* qd, const double* qdd,
+                             double t, Index n, detail::SensitivityScratch& sc, Eigen::VectorXd& d) {
   const double h = p.step;
   const double* at = q;
   if (!reach.comotion.empty()) sc.moved = Eigen::Map<const Eigen::VectorXd>(q, n), at = sc.moved.data();
@@ -83,6 +80,16 @@ void along_parameter(const Model& model, const OutputSensitivity& p, const Param
       for (Index r = block.first_row(i); r < block.first_row(i) + rows; ++r) d[r] = difference_at(sc.f, r, h);
   }
 }
+
+double detail::fastest_coordinate(const double* v, const double* scale, Index n) {
+  double f = 0.0;
+  for (Index j = 0; j < n; ++j) f = std::max(f, std::fabs(v[j]) / scale[j]);
+  return f;
+}
+
+namespace {
+
+using detail::along_parameter;
 
 // v·w over the rows of `reach`.
 double dot_on(const ParameterReach& reach, const Eigen::VectorXd& v, const Eigen::VectorXd& w) {

@@ -14,7 +14,9 @@ namespace phiq::detail {
 // The form a sweep with `plan` solves its sensitivities in, for `outputs` written coordinates
 // (OutputPlan::sensitivity_outputs()): effective_sensitivity_form() at the plan's derivative order. run_sweep reports
 // it, each Sweeper solves in it (the direct form when no coordinate is written: on_step reads them all).
+// With efforts, whose sensitivities read every coordinate's (phiq/effort_sensitivity.hpp), the direct form.
 inline SensitivityForm sweep_sensitivity_form(const OutputPlan& plan, std::size_t outputs) {
+  if (!plan.efforts.constraints.empty()) return SensitivityForm::kDirect;
   return effective_sensitivity_form(plan.sensitivity_form, plan.sensitivities.size(), outputs,
                                     plan.accelerations ? 2
                                     : plan.velocities  ? 1
@@ -56,6 +58,33 @@ enum class AlongParameter {
 void evaluate_over_reach(const ParameterReach& reach, const Model* m, const ReachedConstraints* reached, std::size_t k,
                          AlongParameter which, const double* q, const double* qd, const double* qdd, double t,
                          double* f, double* scratch, bool skip_rated = false);
+
+// The derivative along the parameter `p` of `which` over the rows of `reach`, into `d` (its other rows untouched),
+// at fixed (q, q̇, q̈), or along (q, p) ← (q̂, 1) where p moves co-moving coordinates (sensitivity.cpp). Reads
+// scratch.f (4 vectors of m), scratch.along (m) and scratch.moved.
+void along_parameter(const Model& model, const OutputSensitivity& p, const ParameterReach& reach, AlongParameter which,
+                     const double* q, const double* qd, const double* qdd, double t, Index n,
+                     SensitivityScratch& scratch, Eigen::VectorXd& d);
+
+// The largest |v_j| / scale_j over the n coordinates: how fast v moves its fastest coordinate, in their scales.
+double fastest_coordinate(const double* v, const double* scale, Index n);
+
+// The efforts' sensitivities of one row (phiq/effort_sensitivity.hpp) into `out` (EffortSensitivityLayout):
+// `lambda` the row's multipliers (Φqᵀ λ = Q, zero on dropped rows: multipliers_with_factors()), `sensitivities`
+// the row's in the direct form (SensitivityLayout, order 2), `lu` the factors of Φq at q. NaN for a driver whose
+// row the model dropped. Returns false when a solve fails.
+struct EffortSensitivityScratch {
+  SensitivityScratch along;                    // along_parameter()'s
+  std::vector<Eigen::VectorXd> w;              // Φq⁻¹ e_r per effort (empty: a dropped row)
+  Eigen::VectorXd rhs, v, dq, qk, vk, ak, qf;  // over the coordinates
+  Eigen::VectorXd plus, minus, g[4];           // over the rows
+  Eigen::VectorXd forces[4];                   // Q at the four points of a difference
+};
+bool effort_sensitivities_with_factors(const Model& model, const OutputEfforts& efforts,
+                                       const std::vector<OutputSensitivity>& parameters, double t, const double* q,
+                                       const double* qd, const double* qdd, const Eigen::VectorXd& lambda,
+                                       const double* sensitivities, SparseLuNumeric& lu, EffortSensitivityScratch& sc,
+                                       double* out);
 
 // Writes the sensitivities of (q, q̇, q̈) at t to every parameter into `out` (SensitivityLayout; derivatives above
 // `order` are NaN), solving with `lu`, the factors of the swept model's Φq at q. `ws` lends the right-hand side

@@ -3,6 +3,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/assembly.cpp
   ${CMAKE_CURRENT_LIST_DIR}/block_triangular.cpp
   ${CMAKE_CURRENT_LIST_DIR}/derivatives.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/effort_sensitivity.cpp
   ${CMAKE_CURRENT_LIST_DIR}/inverse_dynamics.cpp
   ${CMAKE_CURRENT_LIST_DIR}/joint_reactions.cpp
   ${CMAKE_CURRENT_LIST_DIR}/evaluation.cpp

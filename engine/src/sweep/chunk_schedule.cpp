@@ -251,7 +251,7 @@ HeldRows held_rows(const Model& model, const SweepOptions& opt, bool caller_read
   static_assert(sizeof(PointMotion) == 9 * sizeof(double), "PointMotion is stored as 9 doubles in chunk rows");
   const Index n_sensitivities = SensitivityLayout{n}.size(opt.sensitivities.size());
   const Index width = n * (1 + (need_v ? 1 : 0) + (need_a ? 1 : 0)) + n_phi + n_rcond + n_points * kMotionDoubles +
-                      n_sensitivities + opt.efforts.size() + 1;
+                      n_sensitivities + effort_values(opt.efforts, opt.sensitivities.size()) + 1;
   return {caller_reads_rows, 8.0 * static_cast<double>(std::max<Index>(width, 1)),
           static_cast<double>(encoded_row_bytes)};
 }

@@ -35,7 +35,7 @@ struct Row {
   std::vector<JointMotion> joints;              // every row's (the delivery unwraps the angles row by row)
   std::vector<OrientationMotion> orientations;  // with the vectors
   std::vector<double> sensitivities;            // with the vectors (SensitivityLayout)
-  std::vector<double> efforts;                  // with the vectors (OutputEfforts::size())
+  std::vector<double> efforts;                  // with the vectors (effort_values())
   RowMotions motions() const {
     return {points.empty() ? nullptr : points.data(), joints.empty() ? nullptr : joints.data(),
             orientations.empty() ? nullptr : orientations.data(),

@@ -159,7 +159,7 @@ void ChunkedSweep::hold_row(ChunkRun& cr) {
   if (rm.sensitivities)
     r.sensitivities.assign(rm.sensitivities, rm.sensitivities + SensitivityLayout{model_.num_coordinates()}.size(
                                                                     opt_.sensitivities.size()));
-  if (rm.efforts) r.efforts.assign(rm.efforts, rm.efforts + opt_.efforts.size());
+  if (rm.efforts) r.efforts.assign(rm.efforts, rm.efforts + effort_values(opt_.efforts, opt_.sensitivities.size()));
 }
 
 // Chunk c: its rows from its seed (chunk 0: in order from row 0), then the seam step. `stream`: the caller's

@@ -34,6 +34,19 @@ void Sweeper::row_efforts() {
     efforts_[n + i] = power;
   }
   for (std::size_t i : efforts_dropped_) efforts_[i] = efforts_[n + i] = std::numeric_limits<double>::quiet_NaN();
+  // ∂τ/∂p with the multipliers before row_reactions() makes them the minimum-norm ones, and the row's direct
+  // sensitivities (sweep_sensitivity_form()): after the reactions in efforts_
+  if (n > 0 && !opt_.sensitivities.empty()) {
+    double* out = efforts_.data() + e.size();
+    if (!effort_sensitivities_with_factors(model_, e, opt_.sensitivities, t, current_.q.data(), current_.qd.data(),
+                                           current_.qdd.data(), effort_lambda_, sensitivities_.data(), *w->lu,
+                                           effort_sensitivity_scratch_, out))
+      std::fill(out, efforts_.data() + efforts_.size(), std::numeric_limits<double>::quiet_NaN());
+    else
+      for (std::size_t i : efforts_dropped_)
+        for (std::size_t j = 0; j < opt_.sensitivities.size(); ++j)
+          out[j * n + i] = std::numeric_limits<double>::quiet_NaN();
+  }
   if (reactions_) row_reactions(*w->lu);
 }
 
@@ -42,8 +55,8 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
   std::vector<Index> indeterminate;
   const bool note = !reactions_noted_ && t == opt_.t_begin;
   if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_lambda_, note ? &indeterminate : nullptr)) {
-    std::fill(efforts_.begin() + 2 * static_cast<std::ptrdiff_t>(opt_.efforts.constraints.size()), efforts_.end(),
-              std::numeric_limits<double>::quiet_NaN());
+    std::fill(efforts_.begin() + 2 * static_cast<std::ptrdiff_t>(opt_.efforts.constraints.size()),
+              efforts_.begin() + opt_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
     return;
   }
   reactions_->evaluate(current_.q.data(), t, effort_lambda_, efforts_.data() + 2 * opt_.efforts.constraints.size());

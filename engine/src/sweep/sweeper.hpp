@@ -40,7 +40,7 @@ struct RowMotions {
   const JointMotion* joints = nullptr;
   const OrientationMotion* orientations = nullptr;
   const double* sensitivities = nullptr;
-  const double* efforts = nullptr;  // OutputEfforts::size() values
+  const double* efforts = nullptr;  // effort_values() values
 };
 
 // The class of a delivered row in SweepAccuracy, and its estimated error (units of the tolerance test; infinite
@@ -407,7 +407,10 @@ class Sweeper {
   std::vector<double> sensitivities_ = std::vector<double>(
       static_cast<std::size_t>(SensitivityLayout{model_.num_coordinates()}.size(opt_.sensitivities.size())));
   SensitivityScratch sensitivity_scratch_;
-  std::vector<double> efforts_ = std::vector<double>(static_cast<std::size_t>(opt_.efforts.size()));
+  // the efforts, powers, reactions and the efforts' sensitivities (effort_values())
+  std::vector<double> efforts_ =
+      std::vector<double>(static_cast<std::size_t>(effort_values(opt_.efforts, opt_.sensitivities.size())));
+  EffortSensitivityScratch effort_sensitivity_scratch_;
   Eigen::VectorXd effort_q_, effort_kept_, effort_lambda_, effort_phi_t_;  // row_efforts()'s Q, λ, Φt
   std::vector<std::size_t> efforts_dropped_ = dropped_efforts();
   // The joints whose reactions are written (OutputEfforts::reactions); none when none are. Whether the first row has

@@ -107,6 +107,38 @@
   const dots = path('joint point', {fill: '#222', stroke: 'none'});
   const vectors = path('velocity', {fill: 'none', stroke: '#cc00cc', 'stroke-width': 1.5});
   const heads = path('velocity-head', {fill: '#cc00cc', stroke: 'none'});
+  // forces (phiq animate --forces): reactions orange, efforts red; a moment an arc of 270 degrees about its point
+  const F = d.forces || {scale: 0, arrows: []};
+  const forceLines = ['reaction', 'effort'].map((k, i) => path('force ' + k, {fill: 'none', stroke: i ? '#d62728' : '#ff7f0e', 'stroke-width': 2}));
+  const forceHeads = ['reaction', 'effort'].map((k, i) => path('force-head ' + k, {fill: i ? '#d62728' : '#ff7f0e', stroke: 'none'}));
+  function head(ex, ey, ux, uy) {
+    return 'M' + r1(ex) + ' ' + r1(ey) + 'L' + r1(ex - 8 * ux + 3.5 * uy) + ' ' + r1(ey - 8 * uy - 3.5 * ux) + 'L' +
+           r1(ex - 8 * ux - 3.5 * uy) + ' ' + r1(ey - 8 * uy + 3.5 * ux) + 'Z';
+  }
+  function drawForces(frame, show) {
+    const lines = [[], []], tips = [[], []];
+    if (show)
+      for (const a of F.arrows) {
+        const i = a.kind === 'effort' ? 1 : 0, x = sx(a.at[3 * frame]), y = sy(a.at[3 * frame + 1]);
+        const fx = a.force[3 * frame], fy = a.force[3 * frame + 1], mz = a.moment[3 * frame + 2];
+        if (fx !== null && fy !== null) {
+          const vx = fx * F.scale * kx, vy = -fy * F.scale * ky, n = Math.hypot(vx, vy);
+          if (n >= 2) {
+            lines[i].push('M' + r1(x) + ' ' + r1(y) + 'l' + r1(vx) + ' ' + r1(vy));
+            tips[i].push(head(x + vx, y + vy, vx / n, vy / n));
+          }
+        }
+        const r = mz === null ? 0 : Math.abs(mz) * F.scale * kx;
+        if (r >= 2) {
+          // from angle 0 through 270 degrees, counter-clockwise on the page for a positive moment about z
+          // ending below the point (counter-clockwise) or above it (clockwise), heading right either way
+          const ex = x, ey = mz > 0 ? y + r : y - r;
+          lines[i].push('M' + r1(x + r) + ' ' + r1(y) + 'A' + r1(r) + ' ' + r1(r) + ' 0 1 ' + (mz > 0 ? 0 : 1) + ' ' + r1(ex) + ' ' + r1(ey));
+          tips[i].push(head(ex, ey, 1, 0));
+        }
+      }
+    for (let i = 0; i < 2; ++i) forceLines[i].setAttribute('d', lines[i].join('')), forceHeads[i].setAttribute('d', tips[i].join(''));
+  }
   const legend = document.createElementNS(NS, 'g');
   phiq.traces.forEach((tr, k) => {
     const text = document.createElementNS(NS, 'text');
@@ -238,6 +270,7 @@
                  r1(ex - 7 * ux - 3 * uy) + ' ' + r1(ey - 7 * uy + 3 * ux) + 'Z');
         }
       vectors.setAttribute('d', v.join('')), heads.setAttribute('d', h.join(''));
+      drawForces(p.frame, show.forces);
     },
     // where each point is on the page (CSS pixels), and whether it moves: for scripts checking screenshots
     screenPoints(pos) {

@@ -201,6 +201,33 @@
   const vectors = new THREE.LineSegments(vecGeometry, new THREE.LineBasicMaterial({color: 0xcc00cc}));
   vectors.frustumCulled = false;
   scene.add(vectors);
+  // forces (phiq animate --forces): reactions orange, efforts red, a force from its point, a moment along its axis
+  const F = d.forces || {scale: 0, arrows: []};
+  const forcePos = new Float32Array(12 * F.arrows.length), forceColour = new Float32Array(12 * F.arrows.length);
+  const forceGeometry = new THREE.BufferGeometry();
+  forceGeometry.setAttribute('position', new THREE.BufferAttribute(forcePos, 3));
+  forceGeometry.setAttribute('color', new THREE.BufferAttribute(forceColour, 3));
+  const forceLines = new THREE.LineSegments(forceGeometry, new THREE.LineBasicMaterial({vertexColors: THREE.VertexColors}));
+  forceLines.frustumCulled = false;
+  scene.add(forceLines);
+  function placeForces(frame, show) {
+    let n = 0;
+    if (show)
+      for (const a of F.arrows) {
+        const rgb = a.kind === 'effort' ? [0.84, 0.15, 0.16] : [1.0, 0.5, 0.05];
+        for (const v of [a.force, a.moment]) {
+          if (v[3 * frame] === null) continue;
+          for (let k = 0; k < 3; ++k) {
+            forcePos[6 * n + k] = a.at[3 * frame + k];
+            forcePos[6 * n + 3 + k] = a.at[3 * frame + k] + F.scale * v[3 * frame + k];
+            forceColour[6 * n + k] = forceColour[6 * n + 3 + k] = rgb[k];
+          }
+          ++n;
+        }
+      }
+    forceGeometry.setDrawRange(0, 2 * n);
+    forceGeometry.attributes.position.needsUpdate = forceGeometry.attributes.color.needsUpdate = true;
+  }
   const legend = document.createElement('div');
   legend.className = 'legend';
   phiq.traces.forEach((tr) => {
@@ -237,6 +264,7 @@
         }
       vecGeometry.setDrawRange(0, 2 * n);
       vecGeometry.attributes.position.needsUpdate = true;
+      placeForces(p.frame, show.forces);
       renderer.render(scene, camera);
     },
     screenPoints(pos) {

@@ -22,6 +22,10 @@
 //   velocity_note  why there are no velocity vectors, when there are none
 //   row_labels     a label per row when the rows are separate poses (phiq animate --modes): the nearest frame is
 //                  shown as it is, never interpolated, and its label replaces the time
+//   forces         with `phiq animate --forces SCALE` (tools/animate/force_arrows.hpp): {scale: m per N (and per
+//                  N m: a moment's arc radius in the plane, its arrow's length in space), arrows: [{name, kind
+//                  (reaction or effort), at, force, moment: 3 values per kept row each (world axes; null at a
+//                  singular row)}], unplaced: the efforts not drawn (no joint to draw them at)}
 //   parts          the parts drawn (phiq/drawn_parts.hpp): {names, shapes: per part its shapes' names, geometry: a
 //                  geometry index per part, fixed: a character per part, geometries: per geometry its shapes ({colour,
 //                  and in space p: base64 float32 x, y, z per vertex, i: base64 uint32 three per triangle; in the
@@ -109,6 +113,8 @@ const phiq = (function () {
   const trails = document.getElementById('trails'), vectors = document.getElementById('vectors');
   const partFramesBox = document.getElementById('part-frames'), partInfo = document.getElementById('part-info');
   if (!N) partFramesBox.disabled = true;
+  const forcesBox = document.getElementById('forces');
+  if (data.forces) forcesBox.checked = true; else forcesBox.disabled = true;
   const t0 = T[0], t1 = T[F - 1], span = t1 - t0;
   // speed: simulated seconds per second; the default plays the whole result in about 8 s
   const speeds = [0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000];
@@ -149,7 +155,8 @@ const phiq = (function () {
   function render() {
     const p = pose(t);
     const started = performance.now();
-    view.draw(p, {trails: trails.checked, vectors: vectors.checked && !!vel, frames: partFramesBox.checked});
+    view.draw(p, {trails: trails.checked, vectors: vectors.checked && !!vel, frames: partFramesBox.checked,
+                  forces: forcesBox.checked && !!data.forces});
     if (picked >= 0) describe(picked, p.parts);
     drawTimes.push(performance.now() - started);
     if (drawTimes.length > 600) drawTimes.shift();
@@ -190,7 +197,7 @@ const phiq = (function () {
     if (e.key === ' ' && e.target.tagName !== 'BUTTON') { e.preventDefault(); setPlaying(!playing); }
   });
   slider.addEventListener('input', () => { setPlaying(false); t = t0 + span * slider.value / 10000; dirty = true; });
-  for (const box of [trails, vectors, partFramesBox]) box.addEventListener('change', () => { dirty = true; });
+  for (const box of [trails, vectors, partFramesBox, forcesBox]) box.addEventListener('change', () => { dirty = true; });
 
   // the part under the pointer (the view finds it): its name and pose at the time shown
   let picked = -1;

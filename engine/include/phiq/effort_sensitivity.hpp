@@ -1,0 +1,60 @@
+/// @file
+/// Sensitivities of the drivers' efforts to design parameters, ∂τ/∂p: which dimension or mass lowers the peak torque.
+///
+/// A driver's effort is τ = −λ_r, λ the multipliers of Φqᵀ λ = Q(q, q̇, q̈, p) (phiq/inverse_dynamics.hpp), r its
+/// first row. With w = Φq⁻¹ e_r (one solve with the row's factors, per driver), τ = −wᵀ Q, and differentiating
+/// totally along p, with q, q̇, q̈ moving along their sensitivities s, ṡ, s̈ (phiq/sensitivity.hpp):
+///
+///   dτ/dp = λᵀ (dΦq/dp) w − wᵀ dQ/dp,
+///
+///   (dΦq/dp) w = ∂(Φq w)/∂p |q  +  H(s, w),        H(u, v) = (Φq u)_q v, the second derivative of Φ,
+///   dQ/dp      = ∂Q/∂p |q,q̇,q̈  +  Q_q s + Q_q̇ ṡ + Q_q̈ s̈.
+///
+/// No transposed product with Φq along p is needed: ∂(Φq w)/∂p is the velocity term's derivative along p (as the
+/// sensitivities take it, over the constraints p reaches, exactly where the kinds differentiate their own data) at
+/// q̇ = ±w, halved; H(s, w) is exact from γ, a quadratic in q̇ at fixed q whose polarisation
+///
+///   H(a, b) = −[γ(a + b) + γ(−a − b) − γ(a − b) − γ(b − a)] / 8
+///
+/// cancels Φqt and Φtt (four evaluations of γ at q itself, no step). Q, trigonometric in q, is differenced: along p by
+/// the fourth-order difference of the sensitivities (the parts and loads of the scene read again at p ± h, p ± 2h:
+/// OutputSensitivity::parts_along; a mass, a centre of mass or a load that reads p), and along the motion by the same
+/// difference with a step that moves the coordinate s moves most by 10⁻³ of its scale (the direct sensitivities'
+/// rule), exact up to 10⁻¹² relative. A co-moving coordinate (ParameterReach::comotion) is moved along p as the
+/// sensitivities move it, and the motion's part taken along s − q̂.
+///
+/// Cost per written row: one direct solve per driver, and per parameter 8 evaluations of Q, 2 of the velocity term
+/// over the reach and 4 of γ per driver; the sensitivities of q, q̇, q̈ in the direct form (every coordinate's).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "phiq/kinematics.hpp"
+#include "phiq/output_plan.hpp"
+#include "phiq/workspace.hpp"
+
+namespace phiq {
+
+/// Values of the efforts' sensitivities: effort i (of OutputEfforts::constraints) to parameter j at `j·efforts + i`.
+struct EffortSensitivityLayout {
+  std::size_t efforts = 0;  ///< OutputEfforts::constraints.size()
+  /// Offset of ∂τ_i/∂p_j.
+  std::size_t offset(std::size_t j, std::size_t i) const { return j * efforts + i; }
+  /// Values for `parameters` parameters.
+  std::size_t size(std::size_t parameters) const { return parameters * efforts; }
+};
+
+/// ∂τ/∂p of each driver of `efforts` (OutputEfforts::constraints) to each of `parameters`, at the motion in `ws`
+/// (q, q̇, q̈ solved at t), into `out` (EffortSensitivityLayout, resized): solves the sensitivities (direct form,
+/// order 2) and the multipliers with one factorisation of Φq at ws.q (the file comment). The parts and loads along
+/// a parameter are its OutputSensitivity::parts_along / loads_along, or `efforts`' own where those are null (a
+/// parameter that reaches the constraints only). NaN for a driver the model dropped as redundant. Returns kSuccess,
+/// kSingularJacobian at a singular position (out NaN: τ is unbounded there), or a factorisation's failure;
+/// `message` says why. Throws phiq::Error for the pre-conditions of solve_sensitivities() and a plan whose efforts
+/// lack parts or loads. Thread-safe for distinct workspaces.
+SolveStatus solve_effort_sensitivities(const Model& model, const OutputEfforts& efforts,
+                                       const std::vector<OutputSensitivity>& parameters, double t, Workspace& ws,
+                                       std::vector<double>& out, std::string* message = nullptr);
+
+}  // namespace phiq

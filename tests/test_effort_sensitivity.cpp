@@ -1,0 +1,309 @@
+// Sensitivities of the drivers' efforts to the scene's parameters (phiq/effort_sensitivity.hpp, columns
+// `NAME.effort.d_P`): a pendulum driven with a constant angular acceleration against its closed form
+// τ = m g l cos θ + (I + m l²) α, and a massive crank-slider (polar crank, a load at the slider's pin) and the
+// massive four-bar of models/dynamics (natural coordinates) against central differences of whole sweeps re-solved
+// at p ± δ, p ± δ/2 (Richardson), every row; the columns as the CSV names them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "phiq/effort_sensitivity.hpp"
+#include "phiq/phiq.hpp"
+#include "fourbar_parts.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+// A row's time and its effort values (effort_values()).
+struct EffortSensitivityRows {
+  std::vector<double> t;
+  std::vector<std::vector<double>> values;
+  SweepSummary summary;
+};
+
+EffortSensitivityRows effort_sensitivity_sweep(const Scene& s) {
+  EffortSensitivityRows r;
+  Workspace ws(*s.model);
+  SweepOptions o = s.sweep;
+  o.newton.tolerance = 1e-12;  // the differences across δ read the positions' error over δ
+  const std::size_t size = static_cast<std::size_t>(effort_values(o.efforts, o.sensitivities.size()));
+  const SolveStatus st = run_sweep(
+      *s.model, o, ws,
+      [&](const StepView& v) {
+        r.t.push_back(v.t);
+        EXPECT_NE(v.efforts, nullptr);
+        if (v.efforts) r.values.emplace_back(v.efforts, v.efforts + size);
+        return true;
+      },
+      &r.summary);
+  EXPECT_EQ(st, SolveStatus::kSuccess) << r.summary.message;
+  return r;
+}
+
+// The scene with `parameter` = value, without sensitivities: its first effort at every row.
+std::vector<double> effort_sensitivity_efforts_at(const std::string& text, const std::string& parameter, double value) {
+  SceneOverrides o;
+  o.parameters = {{parameter, value}};
+  o.sensitivity_models = false;
+  Scene s = parse_scene(text, "efforts.yaml", {}, o);
+  s.sweep.sensitivities.clear();
+  const EffortSensitivityRows r = effort_sensitivity_sweep(s);
+  std::vector<double> tau;
+  for (const auto& v : r.values) tau.push_back(v[0]);
+  return tau;
+}
+
+// Every row's ∂τ/∂p of the first effort against central differences of re-solved sweeps (Richardson over δ and
+// δ/2, δ = 10⁻³ |p|): within 1e-6 of the largest |∂τ/∂p|, and that not zero.
+void expect_effort_sensitivities_match_resolved_sweeps(const std::string& text) {
+  const Scene s = parse_scene(text, "efforts.yaml");
+  ASSERT_EQ(s.sweep.efforts.constraints.size(), 1u);
+  ASSERT_FALSE(s.sweep.sensitivities.empty());
+  const EffortSensitivityRows base = effort_sensitivity_sweep(s);
+  EXPECT_EQ(base.summary.sensitivity_form, SensitivityForm::kDirect);
+  const std::size_t offset = static_cast<std::size_t>(s.sweep.efforts.size());
+  for (std::size_t j = 0; j < s.sweep.sensitivities.size(); ++j) {
+    const OutputSensitivity& p = s.sweep.sensitivities[j];
+    const double delta = 1e-3 * std::fabs(p.value);
+    const std::vector<double> up = effort_sensitivity_efforts_at(text, p.name, p.value + delta);
+    const std::vector<double> down = effort_sensitivity_efforts_at(text, p.name, p.value - delta);
+    const std::vector<double> up2 = effort_sensitivity_efforts_at(text, p.name, p.value + delta / 2);
+    const std::vector<double> down2 = effort_sensitivity_efforts_at(text, p.name, p.value - delta / 2);
+    ASSERT_EQ(up.size(), base.t.size());
+    ASSERT_EQ(up2.size(), base.t.size());
+    double scale = 0.0, worst = 0.0, worst_t = 0.0;
+    for (std::size_t k = 0; k < base.t.size(); ++k) {
+      const double exact = base.values[k][offset + j];
+      ASSERT_TRUE(std::isfinite(exact)) << p.name << " t = " << base.t[k];
+      const double d1 = (up[k] - down[k]) / (2 * delta), d2 = (up2[k] - down2[k]) / delta;
+      const double fd = (4 * d2 - d1) / 3;
+      scale = std::max(scale, std::fabs(exact));
+      if (std::fabs(exact - fd) > worst) worst = std::fabs(exact - fd), worst_t = base.t[k];
+    }
+    ::testing::Test::RecordProperty("worst_relative_" + p.name, scientific(worst / scale, 2));
+    EXPECT_GT(scale, 1e-2) << p.name;
+    EXPECT_LE(worst, 1e-6 * scale) << p.name << ": worst at t = " << worst_t << " (largest " << scale << ")";
+  }
+}
+
+const char* const kEffortPendulum = R"(phiq: 1
+name: pendulum
+parameters: {L: 0.8, mb: 1.5}
+coordinates: {x: 0.8, y: 0.0, th: 0.0}
+points: {O: [0, 0], P: [x, y]}
+constraints:
+  - {name: rod, type: distance, points: [O, P], length: L}
+  - {name: rod_angle, type: segment_angle, segment: [O, P], angle: th}
+drivers:
+  - {name: motor, coordinate: th, law: {type: polynomial, coefficients: [0.3, 2, 1.5]}}
+parts:
+  bob: {frame: {origin: O, x: P}, center_of_mass: [L, 0], mass: mb, inertia: 0.02}
+loads: {gravity: [0, -9.81]}
+time: {start: 0, end: 2, steps: 40}
+output: {efforts: all, sensitivities: [L, mb]}
+)";
+
+TEST(EffortSensitivity, APendulumsTorqueFollowsItsClosedFormInLengthAndMass) {
+  // θ = 0.3 + 2t + 1.5t², α = 3: τ = m g L cos θ + (I + m L²) α, so ∂τ/∂L = m g cos θ + 2 m L α and
+  // ∂τ/∂m = g L cos θ + L² α, exactly (the mass reaches no constraint: its part alone).
+  const Scene s = parse_scene(kEffortPendulum, "pendulum.yaml");
+  const EffortSensitivityRows r = effort_sensitivity_sweep(s);
+  ASSERT_EQ(r.t.size(), 41u);
+  const double g = 9.81, L = 0.8, m = 1.5, I = 0.02, alpha = 3.0;
+  const std::size_t at = static_cast<std::size_t>(s.sweep.efforts.size());
+  double worst_tau = 0.0, worst_l = 0.0, worst_m = 0.0;
+  for (std::size_t k = 0; k < r.t.size(); ++k) {
+    const double t = r.t[k], th = 0.3 + 2 * t + 1.5 * t * t;
+    worst_tau = std::max(worst_tau, std::fabs(r.values[k][0] - (m * g * L * std::cos(th) + (I + m * L * L) * alpha)));
+    worst_l = std::max(worst_l, std::fabs(r.values[k][at] - (m * g * std::cos(th) + 2 * m * L * alpha)));
+    worst_m = std::max(worst_m, std::fabs(r.values[k][at + 1] - (g * L * std::cos(th) + L * L * alpha)));
+  }
+  ::testing::Test::RecordProperty(
+      "worst_tau_L_m", scientific(worst_tau, 2) + " " + scientific(worst_l, 2) + " " + scientific(worst_m, 2));
+  // scales: |∂τ/∂L| up to 22, |∂τ/∂m| up to 10
+  EXPECT_LT(worst_tau, 1e-9);
+  EXPECT_LT(worst_l, 1e-8);
+  EXPECT_LT(worst_m, 1e-8);
+  // in the API too, at the sweep's last row
+  std::vector<double> d;
+  std::string why;
+  Workspace at_end(*s.model);
+  SweepOptions o = s.sweep;
+  o.sensitivities.clear(), o.efforts = OutputEfforts{};
+  o.velocities = o.accelerations = true;
+  ASSERT_EQ(run_sweep(
+                *s.model, o, at_end, [](const StepView&) { return true; }, nullptr),
+            SolveStatus::kSuccess);
+  ASSERT_EQ(solve_effort_sensitivities(*s.model, s.sweep.efforts, s.sweep.sensitivities, 2.0, at_end, d, &why),
+            SolveStatus::kSuccess)
+      << why;
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_NEAR(d[0], r.values.back()[at], 1e-9);
+  EXPECT_NEAR(d[1], r.values.back()[at + 1], 1e-9);
+}
+
+TEST(EffortSensitivity, AMassiveCrankSlidersTorqueMatchesResolvedSweeps) {
+  // The notes' crank-slider (a polar crank: its data differentiated by the kinds) with massive crank and rod and
+  // 5 N pushing back on the slider's pin, which the rod's part carries at its end (L3 moves where it acts).
+  expect_effort_sensitivities_match_resolved_sweeps(R"(phiq: 1
+name: crank_slider
+parameters: {L2: 0.3, L3: 1.0}
+coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}
+points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: rod, type: distance, points: [A, B], length: L3}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
+parts:
+  crank: {frame: {origin: O, x: A}, center_of_mass: [L2/2, 0], mass: 0.5, inertia: 0.5*L2*L2/12}
+  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 1.2, inertia: 1.2*L3*L3/12}
+loads:
+  gravity: [0, -9.81]
+  forces: [{name: push, part: rod, at: [L3, 0], force: [-5, 0]}]
+time: {start: 0, end: pi, steps: 60}
+output: {efforts: all, sensitivities: [L2, L3]}
+)");
+}
+
+TEST(EffortSensitivity, TheMassiveFourBarsTorqueMatchesResolvedSweeps) {
+  // models/dynamics/fourbar_motor_torque.yaml (natural coordinates; centres and inertias read L2, L3, L4)
+  std::ifstream in(test::model_path("dynamics/fourbar_motor_torque.yaml"));
+  std::stringstream read;
+  read << in.rdbuf();
+  std::string text = read.str();
+  text.erase(text.find("output:"));
+  expect_effort_sensitivities_match_resolved_sweeps(text + "output: {efforts: all, sensitivities: [L1, L2, L3]}\n");
+}
+
+TEST(EffortSensitivity, ASpatialRssrsTorqueMatchesResolvedSweeps) {
+  // models/spatial/rssr.yaml (reference points and Euler parameters, a joint driver) with a massive crank and
+  // rocker under gravity along −y: the dimensions a, b and L move the pins, the centres and the inertias
+  std::ifstream in(test::model_path("spatial/rssr.yaml"));
+  std::stringstream read;
+  read << in.rdbuf();
+  std::string text = read.str();
+  text.erase(text.find("time:"));
+  expect_effort_sensitivities_match_resolved_sweeps(
+      text +
+      "parts:\n"
+      "  crank: {mass: 0.8, center_of_mass: [a/2, 0, 0], inertia: [0.001, 0.8*a*a/12, 0.8*a*a/12]}\n"
+      "  rocker: {mass: 1.1, center_of_mass: [0, b/2, 0], inertia: [1.1*b*b/12, 0.001, 1.1*b*b/12]}\n"
+      "loads: {gravity: [0, -9.81, 0]}\n"
+      "time: {start: 0, end: 2*pi, steps: 36}\n"
+      "output: {efforts: all, sensitivities: [a, b, L]}\n");
+}
+
+TEST(EffortSensitivity, TheFourFormulationsOfTheFourBarGiveOneSensitivity) {
+  // relative angles (the parts' frames read L2, L3 in their expressions), natural, reference-point (the pins'
+  // local points read them) and mixed coordinates: ∂τ/∂L of one physical torque, alike at every row
+  const char* forms[] = {"relative", "natural", "reference_point", "mixed"};
+  std::vector<EffortSensitivityRows> rows;
+  for (const char* form : forms) {
+    std::string text = test::seed_text(std::string("fourbar_") + form + ".yaml");
+    text.erase(text.find("time:"));
+    const Scene s = parse_scene(text + "parts:\n" + test::fourbar_parts(form) +
+                                    "loads: {gravity: [0, -9.81]}\n"
+                                    "time: {start: 0, end: 2*pi, steps: 60}\n"
+                                    "output: {efforts: all, sensitivities: [L2, L3, L4]}\n",
+                                form);
+    rows.push_back(effort_sensitivity_sweep(s));
+    ASSERT_EQ(rows.back().values.size(), 61u) << form;
+  }
+  double worst = 0.0, scale = 0.0;
+  for (std::size_t f = 1; f < 4; ++f)
+    for (std::size_t k = 0; k < 61; ++k)
+      for (std::size_t j = 2; j < 5; ++j) {  // after the effort and its power
+        scale = std::max(scale, std::fabs(rows[0].values[k][j]));
+        worst = std::max(worst, std::fabs(rows[f].values[k][j] - rows[0].values[k][j]));
+      }
+  ::testing::Test::RecordProperty("worst_relative", scientific(worst / scale, 2));
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LT(worst, 1e-7 * scale);
+}
+
+TEST(EffortSensitivity, ARedundantParallelogramHasItsFourBarsSensitivity) {
+  // models/redundant/parallelogram_fifth_bar.yaml, swept on its independent rows (a row dropped: w and λ over the
+  // kept ones), against the four-bar without its fifth bar: ∂τ/∂r and ∂τ/∂d alike, row by row
+  std::ifstream in(test::model_path("redundant/parallelogram_fifth_bar.yaml"));
+  std::stringstream read;
+  read << in.rdbuf();
+  std::string five = read.str();
+  five.erase(five.find("output:"));
+  std::string four;
+  std::istringstream lines(five);
+  for (std::string line; std::getline(lines, line);)
+    if (line.find("crank3") == std::string::npos && line.find("x3:") == std::string::npos &&
+        line.find("y3:") == std::string::npos && line.find("psi3:") == std::string::npos)
+      four += line + "\n";
+  const std::string massive =
+      "parts:\n  crank1: {mass: 1.0, inertia: 0.1, center_of_mass: [r/2, 0]}\n"
+      "  crank2: {mass: 1.0, inertia: 0.1, center_of_mass: [r/2, 0]}\n"
+      "  coupler: {mass: 2.0, inertia: 0.2, center_of_mass: [d/2, 0]}\n"
+      "loads: {gravity: [0, -9.81]}\noutput: {efforts: all, sensitivities: [r, d]}\n";
+  std::vector<std::vector<std::vector<double>>> values;
+  for (const std::string& text : {five, four}) {
+    const Scene s = parse_scene(text + massive, "parallelogram.yaml");
+    SquareScene square;
+    ASSERT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &square), SolveStatus::kSuccess)
+        << square.assembly.message;
+    const Model& m = square.model(*s.model);
+    Workspace ws(m);
+    ws.q = square.start;
+    std::vector<std::vector<double>> rows;
+    const std::size_t size = static_cast<std::size_t>(effort_values(s.sweep.efforts, 2));
+    SweepSummary sum;
+    ASSERT_EQ(run_sweep(
+                  m, s.sweep, ws,
+                  [&](const StepView& v) {
+                    rows.emplace_back(v.efforts, v.efforts + size);
+                    return true;
+                  },
+                  &sum),
+              SolveStatus::kSuccess)
+        << sum.message;
+    values.push_back(rows);
+  }
+  ASSERT_EQ(values[0].size(), values[1].size());
+  double worst = 0.0, scale = 0.0;
+  for (std::size_t k = 0; k < values[0].size(); ++k)
+    for (std::size_t j = 2; j < 4; ++j) {
+      ASSERT_TRUE(std::isfinite(values[0][k][j])) << k;
+      worst = std::max(worst, std::fabs(values[0][k][j] - values[1][k][j]));
+      scale = std::max(scale, std::fabs(values[1][k][j]));
+    }
+  ::testing::Test::RecordProperty("worst_relative", scientific(worst / scale, 2));
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LT(worst, 1e-7 * scale);
+}
+
+TEST(EffortSensitivity, TheCsvColumnsAreNamedAfterTheEffortAndTheParameterAndHoldTheRowsValues) {
+  const Scene s = parse_scene(kEffortPendulum, "pendulum.yaml");
+  const CsvFormat f(*s.model, s.sweep);
+  const std::vector<std::string> names = f.column_names();
+  ASSERT_GE(names.size(), 3u);
+  EXPECT_EQ(names[names.size() - 3], "motor.effort");
+  EXPECT_EQ(names[names.size() - 2], "motor.effort.d_L");
+  EXPECT_EQ(names[names.size() - 1], "motor.effort.d_mb");
+  Workspace ws(*s.model);
+  int rows = 0;
+  ASSERT_EQ(run_sweep(
+                *s.model, s.sweep, ws,
+                [&](const StepView& v) {
+                  std::vector<double> row(f.num_values());
+                  f.append_values(v, row.data());
+                  EXPECT_EQ(row[row.size() - 2], v.efforts[2]);
+                  EXPECT_EQ(row[row.size() - 1], v.efforts[3]);
+                  ++rows;
+                  return true;
+                },
+                nullptr),
+            SolveStatus::kSuccess);
+  EXPECT_EQ(rows, 41);
+}
+
+}  // namespace
+}  // namespace phiq
