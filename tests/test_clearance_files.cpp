@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "clearance_report.hpp"
+#include "html_clearance.hpp"
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
 
@@ -118,6 +119,15 @@ TEST(ClearanceFiles, Hdf5HoldsTheCsvValuesAndTheSummaryExactlyOnAnyThreadCount) 
   EXPECT_EQ(clearance_files_read(f, "interference", &dims),
             (std::vector<double>{0.0, p.interference[0].entry, p.interference[0].exit}));
   EXPECT_EQ(dims, (std::vector<hsize_t>{1, 3}));
+  // every local minimum, in time order (the first row, where d rises, and the worst at 3π/2): pair, t, d, refined
+  std::vector<double> minima;
+  for (const ClearanceMinimum& m : p.minima)
+    minima.insert(minima.end(), {0.0, m.t, m.at.distance, m.refined ? 1.0 : 0.0});
+  ASSERT_EQ(p.minima.size(), 2u);
+  EXPECT_EQ(p.minima[0].t, 0.0);
+  EXPECT_EQ(p.minima[1].t, p.worst.t);
+  EXPECT_EQ(clearance_files_read(f, "minima", &dims), minima);
+  EXPECT_EQ(dims, (std::vector<hsize_t>{2, 4}));
   EXPECT_EQ(clearance_files_integer(f, "format_version"), kClearanceHdf5Format);
   EXPECT_EQ(clearance_files_integer(f, "interferes"), 1);
   EXPECT_EQ(clearance_files_integer(f, "bound_held"), 1);
@@ -156,10 +166,12 @@ TEST(ClearanceFiles, SummaryJsonOfTwoBallsIsTheClosedForm) {
   EXPECT_NEAR(w["distance"].get<double>(), -0.1, 1e-10);
   EXPECT_EQ(w["refined"], true);  // 3π/2 is step 67.5: between rows
   EXPECT_EQ(w["below_threshold"], true);
-  // the witness points on the line of centres (x = 0), the depth apart; the normal −y, B away from A
+  // the witness points on the line of centres (x = 0), each its ball's deepest point inside the other, on its own
+  // surface: the tip's lowest point (0, −0.4 − 0.05), the ball's highest (0, −0.5 + 0.15); the normal −y
   EXPECT_NEAR(w["point_a"][0].get<double>(), 0.0, 1e-6);
   EXPECT_NEAR(w["point_b"][0].get<double>(), 0.0, 1e-6);
-  EXPECT_NEAR(w["point_b"][1].get<double>() - w["point_a"][1].get<double>(), 0.1, 1e-9);
+  EXPECT_NEAR(w["point_a"][1].get<double>(), -0.45, 1e-9);
+  EXPECT_NEAR(w["point_b"][1].get<double>(), -0.35, 1e-9);
   EXPECT_NEAR(w["normal"][1].get<double>(), -1.0, 1e-9);
   EXPECT_NEAR(w["sensitivities"]["L2"].get<double>(), -0.5, 1e-7);
   ASSERT_EQ(p["interference"].size(), 1u);
@@ -170,6 +182,33 @@ TEST(ClearanceFiles, SummaryJsonOfTwoBallsIsTheClosedForm) {
   // the JSON's numbers are the report's, to the bit
   EXPECT_EQ(w["distance"].get<double>(), r.pairs[0].worst.at.distance);
   EXPECT_EQ(p["interference"][0]["entry"].get<double>(), r.pairs[0].interference[0].entry);
+}
+
+// The balls of clearance_files_scene_text() with the fixed one's radius 0.0504 and no threshold: they overlap only
+// while 0.41 + 0.4 sin t < 0.1004², |t − 3π/2| < acos(0.9997996) ≈ 0.02, inside the half step (π/90) either side of
+// 3π/2, which lies midway between rows 67 and 68: both rows are clear, yet the viewer colours the pair at both
+// rows (their spans hold the interval) and at no other, and carries the interval.
+TEST(ClearanceFiles, ViewerColoursPartsThatInterfereOnlyBetweenRows) {
+  std::string text = clearance_files_scene_text();
+  text.replace(text.find("radius: 0.15"), 12, "radius: 0.0504");
+  text.replace(text.find("threshold: 0.01"), 15, "threshold: 0");
+  const Scene s = parse_scene(text, "balls.yaml");
+  const ClearanceReport r = scene_clearance(s);
+  ASSERT_EQ(r.pairs.size(), 1u);
+  const PairClearance& p = r.pairs[0];
+  const double half = std::acos((0.41 - 0.1004 * 0.1004) / 0.4);
+  ASSERT_EQ(p.interference.size(), 1u);
+  EXPECT_NEAR(p.interference[0].entry, 1.5 * M_PI - half, 1e-9);
+  EXPECT_NEAR(p.interference[0].exit, 1.5 * M_PI + half, 1e-9);
+  EXPECT_GT(p.row_distance[67], 0.0);
+  EXPECT_GT(p.row_distance[68], 0.0);
+  const std::string near = tools::viewer_near_rows(r, p);
+  ASSERT_EQ(near.size(), 91u);
+  EXPECT_EQ(near, std::string(67, '0') + "11" + std::string(22, '0'));
+  const nlohmann::json v = tools::viewer_clearance(s, r);
+  EXPECT_EQ(v["pairs"][0]["near"], near);
+  EXPECT_EQ(v["pairs"][0]["interference"],
+            nlohmann::json::array({nlohmann::json::array({p.interference[0].entry, p.interference[0].exit})}));
 }
 
 }  // namespace

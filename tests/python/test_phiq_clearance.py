@@ -36,8 +36,9 @@ def test_two_balls_are_their_centres_distance_less_the_radii():
     assert np.allclose(r["distance"][:, 0], np.hypot(tip[:, 0], tip[:, 1] + 0.5) - 0.2, atol=1e-9)
     assert abs(r["worst_t"][0] - 1.5 * math.pi) < 1e-6 and abs(r["worst_distance"][0] + 0.1) < 1e-10
     assert r["refined"][0] and r["bound_held"] and r["interferes"]
-    # on the line of centres, the depth apart; the normal -y
-    assert np.allclose(r["point_b"][0] - r["point_a"][0], [0, 0.1, 0], atol=1e-9)
+    # each ball's deepest point inside the other, on its own surface: the tip's lowest, the ball's highest
+    assert np.allclose(r["point_a"][0], [0, -0.45, 0], atol=1e-9)
+    assert np.allclose(r["point_b"][0], [0, -0.35, 0], atol=1e-9)
     assert abs(r["point_a"][0][0]) < 1e-6 and np.allclose(r["normal"][0], [0, -1, 0], atol=1e-9)
     assert r["parameters"] == ["L2"] and abs(r["sensitivities"][0, 0] + 0.5) < 1e-7
     h = 2 * math.pi / 90

@@ -6,8 +6,9 @@
 /// that were not refined; and the sensitivity of each pair's worst clearance to the scene's parameters.
 ///
 /// Distances come from FCL 0.7 (with libccd): primitives as FCL's primitives, polygons, meshes, curves and planes
-/// as BVH meshes of their triangles (shape_triangles()). The depth of an overlap of two primitives is exact (EPA);
-/// where a mesh is involved it is the deepest contact of FCL's triangle pairs.
+/// as BVH meshes of their triangles (shape_triangles()). The depth of an overlap is exact for the pairs FCL has a
+/// closed form for (a sphere with a sphere, box, capsule or cylinder; two boxes), refined from libccd's MPR for the
+/// other pairs of primitives, and the deepest contact of FCL's triangle pairs where a mesh is involved.
 #pragma once
 
 #include <Eigen/Core>
@@ -49,8 +50,8 @@ std::vector<std::pair<Index, Index>> clearance_pairs(const Model& model, const s
 /// The distance between two parts at one time: signed, with the witness points in world axes.
 struct PairDistance {
   double distance = 0.0;  ///< m; negative: the depth of the overlap
-  kin3::V3 point_a;       ///< on part A (inside B when they overlap)
-  kin3::V3 point_b;       ///< on part B
+  kin3::V3 point_a;       ///< on part A's surface (when they overlap: A's deepest point inside B along the normal)
+  kin3::V3 point_b;       ///< on part B's surface (when they overlap: B's deepest point inside A, the depth away)
   /// Unit direction in which moving B away from A increases the distance (B's witness point minus A's, reversed
   /// when they overlap).
   kin3::V3 normal;

@@ -134,6 +134,19 @@ void write_clearance_contents(hid_t file, const ClearanceReport& r, const std::v
       ++intervals;
     }
   clearance_dataset(file, "interference", intervals, {"pair", "entry", "exit"}, {"", "s", "s"}, values);
+
+  // every local minimum of every pair, in pair then time order (the worst is one of its pair's)
+  values.clear();
+  std::size_t minima = 0;
+  for (std::size_t i = 0; i < k; ++i)
+    for (const ClearanceMinimum& m : r.pairs[i].minima) {
+      values.push_back(static_cast<double>(i));
+      values.push_back(clearance_stored(m.t));
+      values.push_back(clearance_stored(m.at.distance));
+      values.push_back(m.refined ? 1.0 : 0.0);
+      ++minima;
+    }
+  clearance_dataset(file, "minima", minima, {"pair", "t", "distance", "refined"}, {"", "s", "m", ""}, values);
 }
 
 }  // namespace

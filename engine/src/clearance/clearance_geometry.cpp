@@ -151,15 +151,72 @@ bool ClearanceGeometry::has_shapes(Index part) const { return !impl_->parts[stat
 
 namespace {
 
-// The signed distance of two placed shapes: FCL's distance (GJK) apart; in overlap the deepest of FCL's contacts
-// (exact for primitives: EPA or the pair's own test; for meshes the deepest triangle pair), its witness points
-// either side of the contact point along the contact normal. Not FCL 0.7's signed distance, whose EPA asserts on
-// touching shapes (gjk_libccd-inl.h, ComputeVisiblePatch).
-PairDistance shape_distance(const PlacedGeometry& ga, const fcl::Transform3d& ta, const PlacedGeometry& gb,
-                            const fcl::Transform3d& tb) {
-  fcl::DistanceRequestd request(true, false, 0.0, 0.0, 1e-12, fcl::GST_LIBCCD);
+// FCL's distance (GJK, or the pair's closed form) between two placed shapes, with its nearest points.
+fcl::DistanceResultd fcl_distance(const PlacedGeometry& ga, const fcl::Transform3d& ta, const PlacedGeometry& gb,
+                                  const fcl::Transform3d& tb) {
+  const fcl::DistanceRequestd request(true, false, 0.0, 0.0, 1e-12, fcl::GST_LIBCCD);
   fcl::DistanceResultd result;
   fcl::distance(ga.geometry.get(), ta, gb.geometry.get(), tb, request, result);
+  return result;
+}
+
+bool is_mesh(const PlacedGeometry& g) { return g.geometry->getObjectType() == fcl::OT_BVH; }
+
+// The witness points of an overlap of depth `depth` along `normal` (A to B): A moved back along −normal by the depth
+// and a gap, the nearest points of the parted shapes, A's moved forward again. For convex shapes (FCL's
+// primitives) the nearest points of the parted pair are the touching points of the minimum translation, so A's
+// point is A's deepest point inside B along the normal, B's the deepest inside A, the depth apart, each on its own
+// surface (FCL's contact position is not: for two spheres it divides the line of centres in the ratio of the
+// radii, elsewhere it is a midpoint). Where the parted pair's separation turns from the normal (FCL's MPR, used
+// for pairs without a closed form, gives a depth along a direction that is not always the least), the depth of the
+// overlap along the new direction, T (n·v) − gap, is again an upper bound on the depth and the step is repeated
+// from there while it shrinks; the depth reported is the one of the points reported. A mesh is not convex: its contact
+// is taken as FCL gives it when parting it along the normal does not leave the gap expected.
+PairDistance overlap_witnesses(const PlacedGeometry& ga, const fcl::Transform3d& ta, const PlacedGeometry& gb,
+                               const fcl::Transform3d& tb, const fcl::Contactd& contact) {
+  fcl::Vector3d n = contact.normal.normalized();
+  double depth = contact.penetration_depth;
+  PairDistance d;
+  d.distance = -depth;
+  d.point_a = v3(contact.pos + 0.5 * depth * n);
+  d.point_b = v3(contact.pos - 0.5 * depth * n);
+  const bool convex = !is_mesh(ga) && !is_mesh(gb);
+  double least = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < 32; ++iteration) {
+    const double gap = std::max(depth, 1e-6);
+    const double moved = depth + gap;
+    const fcl::Transform3d ta_parted = fcl::Translation3d(-moved * n) * ta;
+    const fcl::DistanceResultd parted = fcl_distance(ga, ta_parted, gb, tb);
+    // the gap between the nearest points, not GJK's distance, which libccd leaves less converged than its points
+    const fcl::Vector3d separation = parted.nearest_points[1] - parted.nearest_points[0];
+    const double found = separation.norm();
+    if (!(parted.min_distance > 0.0) || !(found > 0.0)) break;
+    const fcl::Vector3d a = parted.nearest_points[0] + moved * n, b = parted.nearest_points[1];
+    const fcl::Vector3d v = separation / found;
+    const double along_v = moved * n.dot(v) - found;
+    if (!convex) {
+      if (std::abs(found - gap) <= 1e-9 * moved) d.point_a = v3(a), d.point_b = v3(b);
+      break;
+    }
+    if (!(along_v < least)) break;  // no longer shrinking: the least found stands
+    least = along_v;
+    d.distance = -along_v;  // the depth the points give (libccd's MPR depth is looser)
+    d.point_a = v3(a);
+    d.point_b = v3(b);
+    if (n.dot(v) > 1.0 - 1e-15) break;
+    n = v;
+    depth = along_v;
+  }
+  return d;
+}
+
+// The signed distance of two placed shapes: FCL's distance (GJK) apart; in overlap the deepest of FCL's contacts
+// (for primitives: the pair's closed form, else libccd's MPR refined by overlap_witnesses(); for meshes the deepest
+// triangle pair), with the witness points of overlap_witnesses(). Not FCL 0.7's signed distance, whose EPA asserts
+// on touching shapes (gjk_libccd-inl.h, ComputeVisiblePatch).
+PairDistance shape_distance(const PlacedGeometry& ga, const fcl::Transform3d& ta, const PlacedGeometry& gb,
+                            const fcl::Transform3d& tb) {
+  const fcl::DistanceResultd result = fcl_distance(ga, ta, gb, tb);
   PairDistance d;
   d.distance = result.min_distance;
   d.point_a = v3(result.nearest_points[0]);
@@ -168,16 +225,17 @@ PairDistance shape_distance(const PlacedGeometry& ga, const fcl::Transform3d& ta
     fcl::CollisionRequestd creq(64, true);
     fcl::CollisionResultd cres;
     fcl::collide(ga.geometry.get(), ta, gb.geometry.get(), tb, creq, cres);
-    double depth = 0.0;
-    for (std::size_t i = 0; i < cres.numContacts(); ++i) {
-      const fcl::Contactd& c = cres.getContact(i);
-      if (c.penetration_depth < depth && i > 0) continue;
-      depth = c.penetration_depth;
-      // FCL's contact normal points from A to B
-      d.point_a = v3(c.pos + 0.5 * depth * c.normal);
-      d.point_b = v3(c.pos - 0.5 * depth * c.normal);
-    }
-    d.distance = -depth;
+    std::size_t deepest = cres.numContacts();
+    for (std::size_t i = 0; i < cres.numContacts(); ++i)
+      if (deepest == cres.numContacts() ||
+          cres.getContact(i).penetration_depth > cres.getContact(deepest).penetration_depth)
+        deepest = i;
+    // FCL's contact normal points from A to B; shapes that touch meet at the contact
+    d.distance = 0.0;
+    if (deepest < cres.numContacts() && cres.getContact(deepest).penetration_depth > 0.0)
+      d = overlap_witnesses(ga, ta, gb, tb, cres.getContact(deepest));
+    else if (deepest < cres.numContacts())
+      d.point_a = d.point_b = v3(cres.getContact(deepest).pos);
   }
   const kin3::V3 ab = d.point_b - d.point_a;
   const double len = norm(ab);

@@ -34,7 +34,9 @@
 //   clearance      the scene's output.clearance, when it has one (tools/animate/html_clearance.cpp): {threshold,
 //                  t: its sweep's rows' times, pairs: [{a, b: part indices, name, worst_t, distance, point_a,
 //                  point_b: the witness points at the worst pose (x, y, z), near: a character per row, 1 where the
-//                  pair is within the threshold}]}; the views mark the witness points and colour the near parts
+//                  pair comes within the threshold in the row's span (on the row, at a minimum or an interference
+//                  interval between rows), interference: [[entry, exit], …]}]}; the views mark the witness points
+//                  and colour the near parts
 'use strict';
 
 const phiq = (function () {
