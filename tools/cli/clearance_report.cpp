@@ -3,7 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "phiq/version.hpp"
+#include "report_header.hpp"
 
 namespace phiq::tools {
 
@@ -39,17 +39,7 @@ nlohmann::ordered_json clearance_pair_json(const ClearanceReport& r, const PairC
 }  // namespace
 
 std::string clearance_summary_json(const Scene& scene, const std::string& scene_path, const ClearanceReport& r) {
-  nlohmann::ordered_json j;
-  j["format"] = kClearanceSummaryFormat;
-  j["phiq"] = version();
-  j["scene"] = scene_path;
-  if (scene.name.empty())
-    j["name"] = nullptr;
-  else
-    j["name"] = scene.name;
-  nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
-  for (const auto& [n, v] : scene.parameters) parameters[n] = v;
-  j["parameters"] = parameters;
+  nlohmann::ordered_json j = report_header(kClearanceSummaryFormat, scene_path, scene);
   j["threshold"] = r.threshold;
   j["rows"] = r.times.size();
   j["pairs_selected"] = r.pairs_selected;

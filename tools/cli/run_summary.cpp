@@ -5,6 +5,7 @@
 
 #include "command_support.hpp"
 #include "host_info.hpp"
+#include "report_header.hpp"
 
 namespace phiq::tools {
 
@@ -28,19 +29,8 @@ nlohmann::ordered_json host_json() { return {{"name", host_name()}, {"cpu", cpu_
 
 std::string run_summary_json(const Scene& scene, const Model& swept, const SweepSummary& s, const RunTimes& times,
                              const nlohmann::ordered_json& modes) {
-  nlohmann::ordered_json j;
-  j["format"] = kRunSummaryFormat;
   // where and with what it ran: a summary kept by a harness says so without the command line
-  j["phiq"] = version();
-  j["scene"] = scene.path;
-  if (scene.name.empty())
-    j["name"] = nullptr;
-  else
-    j["name"] = scene.name;
-  // the parameters' values the run used (with `--set`): the scene's text alone does not say them
-  nlohmann::ordered_json parameters = nlohmann::ordered_json::object();
-  for (const auto& [n, v] : scene.parameters) parameters[n] = v;
-  j["parameters"] = parameters;
+  nlohmann::ordered_json j = report_header(kRunSummaryFormat, scene.path, scene);
   j["host"] = host_json();
   add_outcome(j, swept, s);
   j["steps"] = s.steps_completed;
