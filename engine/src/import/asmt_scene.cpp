@@ -14,52 +14,13 @@
 #include <sstream>
 
 #include "import/asmt_model.hpp"
+#include "import/scene_text.hpp"
 #include "phiq/expression.hpp"
 #include "phiq/text.hpp"
 
 namespace phiq::detail::asmt {
 
 namespace {
-
-std::string num(double v) { return shortest_unsigned_zero(v); }
-std::string vec(const Eigen::Vector3d& v) { return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]"; }
-std::string yaml_quoted(const std::string& s) {
-  std::string out = "\"";
-  for (char c : single_line(s)) out += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
-  return out + "\"";
-}
-
-// phiq names (letters, digits, `_`) made from the file's, unique across the scene: what a name cannot hold
-// becomes `_`, and a name taken gets `_2`, `_3`, ...
-class Names {
- public:
-  std::string make(const std::string& raw, bool body = false) {
-    std::string base;
-    for (char c : raw) base += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-    if (base.empty() || std::isdigit(static_cast<unsigned char>(base[0]))) base = "n_" + base;
-    std::string lower;
-    for (char c : base) lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    static const std::set<std::string> reserved = {"t",   "pi", "ground", "null", "true", "false",
-                                                   "yes", "no", "on",     "off",  "y",    "n"};
-    if (reserved.count(lower)) base += "_";  // phiq's names, and YAML's words for null and booleans
-    std::string name = base;
-    for (int k = 2; taken(name, body); ++k) name = base + "_" + std::to_string(k);
-    used_.insert(name);
-    if (body)
-      for (const char* s : {"_x", "_y", "_z", "_e0", "_e1", "_e2", "_e3"}) used_.insert(name + s);
-    return name;
-  }
-
- private:
-  bool taken(const std::string& n, bool body) const {
-    if (used_.count(n)) return true;
-    if (body)
-      for (const char* s : {"_x", "_y", "_z", "_e0", "_e1", "_e2", "_e3"})
-        if (used_.count(n + s)) return true;
-    return false;
-  }
-  std::set<std::string> used_;
-};
 
 // A marker found by its path: the body it is fixed in ("ground" for the assembly's), its pose there and in the world.
 struct Where {
@@ -76,11 +37,12 @@ class SceneWriter {
   Where marker(const std::string& path, int line) const;
   std::string side(const Where& w, double z_offset = 0.0) const {
     const Eigen::Vector3d at = w.local.p + z_offset * w.local.R.col(2);
-    return "{body: " + w.body + ", at: " + vec(at) + ", axis: " + vec(w.local.R.col(2)) +
-           ", ref: " + vec(w.local.R.col(0)) + "}";
+    return "{body: " + w.body + ", at: " + scene_vector(at) + ", axis: " + scene_vector(w.local.R.col(2)) +
+           ", ref: " + scene_vector(w.local.R.col(0)) + "}";
   }
   std::string axis(const Where& w) const {
-    return "{body: " + w.body + ", axis: " + vec(w.local.R.col(2)) + ", ref: " + vec(w.local.R.col(0)) + "}";
+    return "{body: " + w.body + ", axis: " + scene_vector(w.local.R.col(2)) +
+           ", ref: " + scene_vector(w.local.R.col(0)) + "}";
   }
   // A natural point at the marker's origin plus `offset` (in the marker's axes), pinned to its body; on the ground,
   // a point of constants. Returns its name; coords[i] is what an expression writes for its component i.
@@ -92,7 +54,7 @@ class SceneWriter {
   }
   void dot(const std::string& name, const std::string& a, const std::string& b, double value) {
     constraints_ << "  - {name: " << names_.make(name) << ", type: dot, directions: [" << a << ", " << b
-                 << "], value: " << num(value) << "}\n";
+                 << "], value: " << scene_number(value) << "}\n";
   }
   double value(const Joint& j, const std::string& key, double fallback, bool required = false) const;
   void joint(const Joint& j);
@@ -105,7 +67,7 @@ class SceneWriter {
   std::string parts_and_mass();
 
   Assembly& a_;
-  Names names_;
+  SceneNames names_;
   std::map<std::string, std::string> body_of_part_;
   std::map<std::string, std::pair<std::string, std::string>> joints_;  // file name → phiq name, type
   std::map<std::string, std::string> points_;                          // point base → phiq name
@@ -143,17 +105,17 @@ std::string SceneWriter::point(const std::string& base, const Where& w, const Ei
   const Eigen::Vector3d world = w.world.p + w.world.R * offset;
   std::array<std::string, 3> c;
   for (int i = 0; i < 3; ++i)
-    c[static_cast<std::size_t>(i)] = w.body == "ground" ? "(" + num(world[i]) + ")" : name + "_" + "xyz"[i];
+    c[static_cast<std::size_t>(i)] = w.body == "ground" ? "(" + scene_number(world[i]) + ")" : name + "_" + "xyz"[i];
   if (fresh) {
     points_[base] = name;
     if (w.body == "ground") {
-      points_text_ << "  " << name << ": " << vec(world) << "\n";
+      points_text_ << "  " << name << ": " << scene_vector(world) << "\n";
     } else {
       for (int i = 0; i < 3; ++i)
-        coordinates_ << "  " << c[static_cast<std::size_t>(i)] << ": " << num(world[i]) << "\n";
+        coordinates_ << "  " << c[static_cast<std::size_t>(i)] << ": " << scene_number(world[i]) << "\n";
       points_text_ << "  " << name << ": [" << c[0] << ", " << c[1] << ", " << c[2] << "]\n";
       constraints_ << "  - {name: " << names_.make(name + "_pin") << ", type: spherical, between: [{body: " << w.body
-                   << ", at: " << vec(w.local.p + w.local.R * offset) << "}, {point: " << name << "}]}\n";
+                   << ", at: " << scene_vector(w.local.p + w.local.R * offset) << "}, {point: " << name << "}]}\n";
     }
   }
   if (coords) *coords = c;
@@ -224,7 +186,7 @@ void SceneWriter::joint(const Joint& j) {
     if (!(l > 0.0))
       refuse(a_.path, j.line, "SphSphJoint '" + j.name + "': distanceIJ must be positive (0: a SphericalJoint)");
     constraints_ << "  - {name: " << name << ", type: distance, between: [" << side(wi) << ", " << side(wj)
-                 << "], length: " << num(l) << "}\n";
+                 << "], length: " << scene_number(l) << "}\n";
   } else if (j.type == "CylSphJoint" || j.type == "RevCylJoint" || j.type == "RevRevJoint") {
     radial_distance(j, name, wi, wj);
     if (j.type != "CylSphJoint") {  // z_J parallel to z_I
@@ -267,14 +229,15 @@ void SceneWriter::gear(const Joint& j, const std::string& name, const Where& wi,
   const double orbit_i = std::atan2(Ri.col(1).dot(d), Ri.col(0).dot(d));
   const double orbit_j = std::atan2(Rj.col(1).dot(-d), Rj.col(0).dot(-d));
   const std::string ti = names_.make(name + "_orbit_I"), tj = names_.make(name + "_orbit_J");
-  coordinates_ << "  " << ti << ": " << num(orbit_i) << "\n  " << tj << ": " << num(orbit_j) << "\n";
+  coordinates_ << "  " << ti << ": " << scene_number(orbit_i) << "\n  " << tj << ": " << scene_number(orbit_j) << "\n";
   constraints_ << "  - {name: " << names_.make(ti + "_def") << ", type: segment_angle, segment: [" << pi << ", " << pj
                << "], axis: " << axis(wi) << ", angle: " << ti << "}\n";
   constraints_ << "  - {name: " << names_.make(tj + "_def") << ", type: segment_angle, segment: [" << pj << ", " << pi
                << "], axis: " << axis(wj) << ", angle: " << tj << "}\n";
   const double ratio = ri / rj;
   constraints_ << "  - {name: " << name << ", type: coupler, coordinates: [" << tj << ", " << ti
-               << "], coefficients: [1, " << num(ratio) << "], constant: " << num(orbit_j + ratio * orbit_i) << "}\n";
+               << "], coefficients: [1, " << scene_number(ratio)
+               << "], constant: " << scene_number(orbit_j + ratio * orbit_i) << "}\n";
 }
 
 // OndselSolver's distance of J's origin from I's z axis, x² + y² = distanceIJ² in I's frame (the CylSph, RevCyl and
@@ -295,7 +258,7 @@ void SceneWriter::radial_distance(const Joint& j, const std::string& name, const
     ey += (i ? " + " : "") + std::string("(") + y[i] + " - " + o[i] + ")*" + d;
   }
   constraints_ << "  - {name: " << name << ", type: equation, unit: length, expr: \"((" << ex << ")^2 + (" << ey
-               << ")^2 - " << num(l * l) << ")/" << num(2 * l) << "\"}\n";
+               << ")^2 - " << scene_number(l * l) << ")/" << scene_number(2 * l) << "\"}\n";
 }
 
 // OndselSolver's rack and pinion and screw, one row each: J's travel along I's x (rack) or z (screw), plus
@@ -310,13 +273,13 @@ void SceneWriter::travel_and_turn(const std::string& name, const Where& wi, cons
   const double turn = std::atan2(Ri.col(1).dot(Rj.col(0)), Ri.col(0).dot(Rj.col(0)));
   const double travel = Ri.col(axis_k).dot(wj.world.p - wi.world.p);
   const std::string th = names_.make(name + "_turn");
-  coordinates_ << "  " << th << ": " << num(turn) << "\n";
+  coordinates_ << "  " << th << ": " << scene_number(turn) << "\n";
   constraints_ << "  - {name: " << names_.make(th + "_def") << ", type: rotation_angle, between: [" << side(wi) << ", "
                << side(wj) << "], angle: " << th << "}\n";
   std::string expr;
   for (std::size_t i = 0; i < 3; ++i)
     expr += (i ? " + " : "") + std::string("(") + x[i] + " - " + o[i] + ")*(" + p[i] + " - " + o[i] + ")";
-  expr += " + (" + num(per_turn) + ")*" + th + " - (" + num(travel + per_turn * turn) + ")";
+  expr += " + (" + scene_number(per_turn) + ")*" + th + " - (" + scene_number(travel + per_turn * turn) + ")";
   constraints_ << "  - {name: " << name << ", type: equation, unit: length, expr: \"" << expr << "\"}\n";
 }
 
@@ -476,9 +439,10 @@ std::string SceneWriter::time_grid() const {
   const double steps = std::round(span / a_.hout);
   if (std::abs(steps * a_.hout - span) > 1e-9 * std::max(1.0, std::abs(span)) || steps > 1e9)
     refuse(a_.path, a_.time_line,
-           "SimulationParameters: hout " + num(a_.hout) + " does not divide tend - tstart " + num(span) +
-               " into whole steps; phiq's grid is evenly spaced");
-  return "time: {start: " + num(a_.tstart) + ", end: " + num(a_.tend) + ", steps: " + num(steps) + "}\n";
+           "SimulationParameters: hout " + scene_number(a_.hout) + " does not divide tend - tstart " +
+               scene_number(span) + " into whole steps; phiq's grid is evenly spaced");
+  return "time: {start: " + scene_number(a_.tstart) + ", end: " + scene_number(a_.tend) +
+         ", steps: " + scene_number(steps) + "}\n";
 }
 
 // The parts' mass as phiq parts: a principal mass marker with positive mass and moments that a rigid body can have.
@@ -491,16 +455,17 @@ std::string SceneWriter::parts_and_mass() {
     if (!rigid) {
       if (p.mass_line)
         a_.skipped.push_back(a_.path + ":" + std::to_string(p.mass_line) + ": Part '" + p.name +
-                             "' PrincipalMassMarker: mass " + num(p.mass) + " and moments " + vec(m) +
+                             "' PrincipalMassMarker: mass " + scene_number(p.mass) + " and moments " + scene_vector(m) +
                              " are no rigid body's; the part is given no mass");
       continue;
     }
     const Eigen::Matrix3d& R = p.mass_frame.R;
     Eigen::Matrix3d I = R * m.asDiagonal() * R.transpose();
     I = 0.5 * (I + I.transpose()).eval();
-    out << "  " << body_of_part_.at(p.name) << ": {body: " << body_of_part_.at(p.name) << ", mass: " << num(p.mass)
-        << ", center_of_mass: " << vec(p.mass_frame.p) << ", inertia: [" << vec(I.row(0).transpose()) << ", "
-        << vec(I.row(1).transpose()) << ", " << vec(I.row(2).transpose()) << "]}\n";
+    out << "  " << body_of_part_.at(p.name) << ": {body: " << body_of_part_.at(p.name)
+        << ", mass: " << scene_number(p.mass) << ", center_of_mass: " << scene_vector(p.mass_frame.p) << ", inertia: ["
+        << scene_vector(I.row(0).transpose()) << ", " << scene_vector(I.row(1).transpose()) << ", "
+        << scene_vector(I.row(2).transpose()) << "]}\n";
   }
   return out.str().empty() ? "" : "parts:\n" + out.str();
 }
@@ -514,8 +479,9 @@ std::string SceneWriter::write() {
     Eigen::Quaterniond q(p.placement.R);
     q.normalize();
     if (q.w() < 0) q.coeffs() = -q.coeffs();
-    bodies << "  " << b << ": {at: " << vec(p.placement.p) << ", orientation: {euler_parameters: [" << num(q.w())
-           << ", " << num(q.x()) << ", " << num(q.y()) << ", " << num(q.z()) << "]}}\n";
+    bodies << "  " << b << ": {at: " << scene_vector(p.placement.p) << ", orientation: {euler_parameters: ["
+           << scene_number(q.w()) << ", " << scene_number(q.x()) << ", " << scene_number(q.y()) << ", "
+           << scene_number(q.z()) << "]}}\n";
   }
   for (const Joint& j : a_.joints) joint(j);
   for (const Motion& m : a_.motions) motion(m);
@@ -537,7 +503,7 @@ std::string SceneWriter::write() {
   if (!constraints_.str().empty()) s << "constraints:\n" << constraints_.str();
   if (!drivers_.str().empty()) s << "drivers:\n" << drivers_.str();
   s << grid << mass;
-  if (!a_.gravity.isZero(0.0)) s << "loads: {gravity: " << vec(a_.gravity) << "}\n";
+  if (!a_.gravity.isZero(0.0)) s << "loads: {gravity: " << scene_vector(a_.gravity) << "}\n";
   return s.str();
 }
 

@@ -92,6 +92,10 @@ struct Mechanism {
 // a driver of an unknown joint or one that no driver measure fits.
 std::string write_mechanism_scene(Mechanism& m, const ImportOptions& options);
 
+// What an import made of `m` (whose joints beyond a spanning tree number `loops`): its counts, its scene
+// (write_mechanism_scene()) and what was not mapped. Throws as write_mechanism_scene().
+ModelImport mechanism_import(Mechanism& m, int loops, const ImportOptions& options);
+
 // A unit vector perpendicular to `axis` (which need not be unit): the reference direction of a joint frame.
 Eigen::Vector3d perpendicular(const Eigen::Vector3d& axis);
 

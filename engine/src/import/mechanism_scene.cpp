@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "import/mechanism.hpp"
+#include "import/scene_text.hpp"
 #include "phiq/expression.hpp"
 #include "phiq/scene.hpp"
 #include "phiq/text.hpp"
@@ -18,52 +19,13 @@ namespace phiq::detail::mechanism {
 
 namespace {
 
-std::string mnum(double v) { return shortest_unsigned_zero(v); }
-std::string mvec(const Eigen::Vector3d& v) { return "[" + mnum(v.x()) + ", " + mnum(v.y()) + ", " + mnum(v.z()) + "]"; }
-std::string mquoted(const std::string& s) {
-  std::string out = "\"";
-  for (char c : single_line(s)) out += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
-  return out + "\"";
-}
 std::string orientation(const Eigen::Matrix3d& R) {
   Eigen::Quaterniond q(R);
   q.normalize();
   if (q.w() < 0) q.coeffs() = -q.coeffs();
-  return "{euler_parameters: [" + mnum(q.w()) + ", " + mnum(q.x()) + ", " + mnum(q.y()) + ", " + mnum(q.z()) + "]}";
+  return "{euler_parameters: [" + scene_number(q.w()) + ", " + scene_number(q.x()) + ", " + scene_number(q.y()) + ", " +
+         scene_number(q.z()) + "]}";
 }
-
-// phiq names (letters, digits, `_`) made from the file's, unique across the scene: what a name cannot hold becomes
-// `_`, a name taken gets `_2`, `_3`, ...; a body's name reserves its coordinates' names (NAME_x, ..., NAME_e3).
-class MechanismNames {
- public:
-  std::string make(const std::string& raw, bool body = false) {
-    std::string base;
-    for (char c : raw) base += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-    if (base.empty() || std::isdigit(static_cast<unsigned char>(base[0]))) base = "n_" + base;
-    std::string lower;
-    for (char c : base) lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    static const std::set<std::string> reserved = {"t",   "pi", "ground", "null", "true", "false",
-                                                   "yes", "no", "on",     "off",  "y",    "n"};
-    if (reserved.count(lower)) base += "_";  // phiq's names, and YAML's words for null and booleans
-    std::string name = base;
-    for (int k = 2; taken(name, body); ++k) name = base + "_" + std::to_string(k);
-    used_.insert(name);
-    if (body)
-      for (const char* s : kCoordinates) used_.insert(name + s);
-    return name;
-  }
-
- private:
-  static constexpr const char* kCoordinates[] = {"_x", "_y", "_z", "_e0", "_e1", "_e2", "_e3"};
-  bool taken(const std::string& n, bool body) const {
-    if (used_.count(n)) return true;
-    if (body)
-      for (const char* s : kCoordinates)
-        if (used_.count(n + s)) return true;
-    return false;
-  }
-  std::set<std::string> used_;
-};
 
 // A body whose mass phiq accepts: positive mass, symmetric positive definite inertia whose principal moments each
 // are at most the sum of the others.
@@ -81,8 +43,8 @@ class MechanismWriter {
 
  private:
   std::string side(const Side& s) const {
-    return "{body: " + body_[static_cast<std::size_t>(s.body)] + ", at: " + mvec(s.at) +
-           ", axis: " + mvec(s.axis.normalized()) + ", ref: " + mvec(s.ref.normalized()) + "}";
+    return "{body: " + body_[static_cast<std::size_t>(s.body)] + ", at: " + scene_vector(s.at) +
+           ", axis: " + scene_vector(s.axis.normalized()) + ", ref: " + scene_vector(s.ref.normalized()) + "}";
   }
   std::string joint_coordinate(int j, const Coupler& c);
   std::array<std::string, 3> rotated(int b, const Eigen::Vector3d& v) const;
@@ -92,7 +54,7 @@ class MechanismWriter {
 
   Mechanism& m_;
   const ImportOptions& o_;
-  MechanismNames names_;
+  SceneNames names_;
   std::vector<std::string> body_, joint_;
   std::map<int, std::string> joint_coordinate_;
   std::ostringstream coordinates_, constraints_, drivers_;
@@ -128,7 +90,7 @@ std::string MechanismWriter::joint_coordinate(int j, const Coupler& c) {
     if (joint.parent.body > 0) w += " - " + body_[static_cast<std::size_t>(joint.parent.body)] + "_" + "xyz"[i];
     expr += (i ? " + " : "") + std::string("(") + u[i] + ")*" + w + ")";
   }
-  expr += " - (" + mnum(a.dot(joint.parent.at)) + "))";
+  expr += " - (" + scene_number(a.dot(joint.parent.at)) + "))";
   coordinates_ << "  " << name << ": 0\n";
   constraints_ << "  - {name: " << names_.make(name + "_def") << ", type: equation, unit: length, expr: \"" << expr
                << "\"}\n";
@@ -137,7 +99,8 @@ std::string MechanismWriter::joint_coordinate(int j, const Coupler& c) {
 
 // The world components of R v, R the rotation of body `b` (its Euler parameters; constants for the ground).
 std::array<std::string, 3> MechanismWriter::rotated(int b, const Eigen::Vector3d& v) const {
-  if (b == 0) return {"(" + mnum(v.x()) + ")", "(" + mnum(v.y()) + ")", "(" + mnum(v.z()) + ")"};
+  if (b == 0)
+    return {"(" + scene_number(v.x()) + ")", "(" + scene_number(v.y()) + ")", "(" + scene_number(v.z()) + ")"};
   const std::string& n = body_[static_cast<std::size_t>(b)];
   const std::string e0 = n + "_e0", e1 = n + "_e1", e2 = n + "_e2", e3 = n + "_e3";
   const std::string R[3][3] = {
@@ -152,7 +115,7 @@ std::array<std::string, 3> MechanismWriter::rotated(int b, const Eigen::Vector3d
     std::string sum;
     for (std::size_t k = 0; k < 3; ++k)
       if (v[static_cast<Eigen::Index>(k)] != 0.0)
-        sum += (sum.empty() ? "" : " + ") + R[r][k] + "*(" + mnum(v[static_cast<Eigen::Index>(k)]) + ")";
+        sum += (sum.empty() ? "" : " + ") + R[r][k] + "*(" + scene_number(v[static_cast<Eigen::Index>(k)]) + ")";
     out[r] = sum.empty() ? "0" : "(" + sum + ")";
   }
   return out;
@@ -162,15 +125,16 @@ void MechanismWriter::coupler(const Coupler& c) {
   const std::string q = joint_coordinate(c.joint, c);
   const std::string name = names_.make(c.name);
   if (c.other < 0) {
-    constraints_ << "  - {name: " << name << ", type: equation, unit: angle, expr: \"" << q << " - (" << mnum(c.offset)
-                 << ")\"}\n";
+    constraints_ << "  - {name: " << name << ", type: equation, unit: angle, expr: \"" << q << " - ("
+                 << scene_number(c.offset) << ")\"}\n";
     return;
   }
   if (c.multiplier == 0.0)
     refuse(m_.path, c.line, "'" + c.name + "': a multiplier of 0 holds the joint still: phiq's coupler needs one ≠ 0");
   const std::string r = joint_coordinate(c.other, c);
   constraints_ << "  - {name: " << name << ", type: coupler, coordinates: [" << q << ", " << r
-               << "], coefficients: [1, " << mnum(-c.multiplier) << "], constant: " << mnum(c.offset) << "}\n";
+               << "], coefficients: [1, " << scene_number(-c.multiplier) << "], constant: " << scene_number(c.offset)
+               << "}\n";
 }
 
 void MechanismWriter::drivers() {
@@ -196,7 +160,7 @@ void MechanismWriter::drivers() {
     drivers_ << "  - {name: " << names_.make("drive_" + joint_[static_cast<std::size_t>(found)])
              << ", joint: " << joint_[static_cast<std::size_t>(found)]
              << ", measure: " << (j.kind == "revolute" ? "angle" : "distance")
-             << ", law: {type: expression, f: " << mquoted(law) << "}}\n";
+             << ", law: {type: expression, f: " << yaml_quoted(law) << "}}\n";
   }
 }
 
@@ -207,30 +171,31 @@ std::string MechanismWriter::parts() {
     std::ostringstream fields;
     if (b.has_mass && rigid_mass(b)) {
       const Eigen::Matrix3d I = 0.5 * (b.inertia + b.inertia.transpose());
-      fields << ", mass: " << mnum(b.mass) << ", center_of_mass: " << mvec(b.com) << ", inertia: ["
-             << mvec(I.row(0).transpose()) << ", " << mvec(I.row(1).transpose()) << ", " << mvec(I.row(2).transpose())
-             << "]";
+      fields << ", mass: " << scene_number(b.mass) << ", center_of_mass: " << scene_vector(b.com) << ", inertia: ["
+             << scene_vector(I.row(0).transpose()) << ", " << scene_vector(I.row(1).transpose()) << ", "
+             << scene_vector(I.row(2).transpose()) << "]";
     } else if (b.has_mass && b.mass > 0.0) {
       m_.skip("inertial of '" + b.name + "'", b.line, "a mass or inertia no rigid body has; the body is given no mass");
     } else if (b.density && !b.shapes.empty() && k > 0) {
-      fields << ", density: " << mnum(*b.density);
+      fields << ", density: " << scene_number(*b.density);
     }
     if (!b.shapes.empty()) {
       fields << ", shapes: [";
       for (std::size_t s = 0; s < b.shapes.size(); ++s) {
         const Shape& sh = b.shapes[s];
         fields << (s ? ", " : "") << "{type: " << sh.type;
-        if (sh.type == "box") fields << ", size: " << mvec(sh.size);
-        if (sh.type == "plane") fields << ", size: [" << mnum(sh.size.x()) << ", " << mnum(sh.size.y()) << "]";
+        if (sh.type == "box") fields << ", size: " << scene_vector(sh.size);
+        if (sh.type == "plane")
+          fields << ", size: [" << scene_number(sh.size.x()) << ", " << scene_number(sh.size.y()) << "]";
         if (sh.type == "sphere" || sh.type == "cylinder" || sh.type == "capsule")
-          fields << ", radius: " << mnum(sh.radius);
-        if (sh.type == "cylinder" || sh.type == "capsule") fields << ", length: " << mnum(sh.length);
-        if (sh.type == "mesh") fields << ", file: " << mquoted(sh.file) << ", scale: " << mnum(sh.scale);
-        if (!sh.at.p.isZero(0.0)) fields << ", at: " << mvec(sh.at.p);
+          fields << ", radius: " << scene_number(sh.radius);
+        if (sh.type == "cylinder" || sh.type == "capsule") fields << ", length: " << scene_number(sh.length);
+        if (sh.type == "mesh") fields << ", file: " << yaml_quoted(sh.file) << ", scale: " << scene_number(sh.scale);
+        if (!sh.at.p.isZero(0.0)) fields << ", at: " << scene_vector(sh.at.p);
         if (!sh.at.R.isIdentity(0.0)) fields << ", orientation: " << orientation(sh.at.R);
         if (sh.rgba)
-          fields << ", colour: [" << mnum((*sh.rgba)(0)) << ", " << mnum((*sh.rgba)(1)) << ", " << mnum((*sh.rgba)(2))
-                 << ", " << mnum((*sh.rgba)(3)) << "]";
+          fields << ", colour: [" << scene_number((*sh.rgba)(0)) << ", " << scene_number((*sh.rgba)(1)) << ", "
+                 << scene_number((*sh.rgba)(2)) << ", " << scene_number((*sh.rgba)(3)) << "]";
         fields << "}";
       }
       fields << "]";
@@ -249,8 +214,8 @@ std::string MechanismWriter::write() {
   for (std::size_t k = 1; k < m_.bodies.size(); ++k) {
     const Body& b = m_.bodies[k];
     body_.push_back(names_.make(b.name, true));
-    bodies << "  " << body_.back() << ": {at: " << mvec(b.world.p) << ", orientation: " << orientation(b.world.R)
-           << "}\n";
+    bodies << "  " << body_.back() << ": {at: " << scene_vector(b.world.p)
+           << ", orientation: " << orientation(b.world.R) << "}\n";
   }
   for (const Joint& j : m_.joints) {
     joint_.push_back(names_.make(j.name));
@@ -271,13 +236,14 @@ std::string MechanismWriter::write() {
   s << "# Converted by phiq from " << single_line(m_.path) << " (" << m_.format << "): " << m_.units << "\n";
   if (!m_.skipped.empty()) s << "# Not mapped:\n";
   for (const std::string& why : m_.skipped) s << "#   " << single_line(why) << "\n";
-  s << "phiq: 1\nname: " << mquoted(m_.name) << "\ndescription: " << mquoted(m_.format + " model, imported by phiq")
-    << "\ndimension: 3\n";
+  s << "phiq: 1\nname: " << yaml_quoted(m_.name)
+    << "\ndescription: " << yaml_quoted(m_.format + " model, imported by phiq") << "\ndimension: 3\n";
   if (!coordinates_.str().empty()) s << "coordinates:\n" << coordinates_.str();
   s << "bodies:\n" << bodies.str();
   if (!constraints_.str().empty()) s << "constraints:\n" << constraints_.str();
   if (!drivers_.str().empty()) s << "drivers:\n" << drivers_.str();
-  s << "time: {start: " << mnum(o_.t_start) << ", end: " << mnum(o_.t_end) << ", steps: " << o_.steps << "}\n";
+  s << "time: {start: " << scene_number(o_.t_start) << ", end: " << scene_number(o_.t_end) << ", steps: " << o_.steps
+    << "}\n";
   s << mass;
   return s.str();
 }
@@ -286,6 +252,17 @@ std::string MechanismWriter::write() {
 
 std::string write_mechanism_scene(Mechanism& m, const ImportOptions& options) {
   return MechanismWriter(m, options).write();
+}
+
+ModelImport mechanism_import(Mechanism& m, int loops, const ImportOptions& options) {
+  ModelImport out;
+  out.bodies = static_cast<int>(m.bodies.size()) - 1;
+  out.joints = static_cast<int>(m.joints.size());
+  out.loops = loops;
+  out.couplers = static_cast<int>(m.couplers.size());
+  out.yaml = write_mechanism_scene(m, options);
+  out.skipped = std::move(m.skipped);
+  return out;
 }
 
 }  // namespace phiq::detail::mechanism

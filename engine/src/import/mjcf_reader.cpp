@@ -517,14 +517,7 @@ Mechanism MjcfReader::read(int* loops) {
 ModelImport import_mjcf(const std::string& text, const std::string& path, const ImportOptions& options) {
   int loops = 0;
   detail::mechanism::Mechanism m = detail::mechanism::MjcfReader(text, path).read(&loops);
-  ModelImport out;
-  out.bodies = static_cast<int>(m.bodies.size()) - 1;
-  out.joints = static_cast<int>(m.joints.size());
-  out.loops = loops;
-  out.couplers = static_cast<int>(m.couplers.size());
-  out.yaml = detail::mechanism::write_mechanism_scene(m, options);
-  out.skipped = std::move(m.skipped);
-  return out;
+  return detail::mechanism::mechanism_import(m, loops, options);
 }
 
 }  // namespace phiq

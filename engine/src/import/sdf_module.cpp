@@ -87,14 +87,7 @@ ModelImport import_sdf(const std::string& text, const std::string& path, const I
   int loops = 0;
   std::string error;
   if (!module.read(text, path, m, loops, error)) throw SceneError(error);
-  ModelImport out;
-  out.bodies = static_cast<int>(m.bodies.size()) - 1;
-  out.joints = static_cast<int>(m.joints.size());
-  out.loops = loops;
-  out.couplers = 0;
-  out.yaml = detail::mechanism::write_mechanism_scene(m, options);
-  out.skipped = std::move(m.skipped);
-  return out;
+  return detail::mechanism::mechanism_import(m, loops, options);
 }
 
 }  // namespace phiq
