@@ -65,6 +65,23 @@ void add_circle_equations(const std::vector<bool>& angle, ModelPolynomials& out)
   }
 }
 
+// Row r as an angle relation (model_rows.hpp) when it is linear in the free angles it reads (`reads`) alone: no
+// polynomial in (c, s) reproduces it, a multiple-angle one holds it modulo 2π. Appends the equation and the relation.
+bool add_angle_relation(ModelRows& eval, Index r, const std::vector<RowCoordinate>& reads, const Eigen::VectorXd& base,
+                        Random& random, ModelPolynomials& out) {
+  std::vector<Index> free;
+  bool all_angles = !reads.empty();
+  for (const RowCoordinate& c : reads) free.push_back(c.coordinate), all_angles = all_angles && c.angle;
+  AngleRelation relation;
+  Polynomial p;
+  if (!all_angles ||
+      !modes_detail::angle_relation(eval, r, free, out.variable_of, base, out.system.variables, random, relation, p))
+    return false;
+  out.system.equations.push_back(std::move(p));
+  out.angle_relations.push_back(std::move(relation));
+  return true;
+}
+
 }  // namespace
 
 Eigen::VectorXd ModelPolynomials::coordinates(const Eigen::VectorXcd& x) const {
@@ -145,18 +162,7 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
       if (a) second.push_back(true);
     }
     const int width = static_cast<int>(second.size());
-    {  // linear in angles only (a gear a linkage turns): no polynomial in (c, s), a relation modulo 2π
-      std::vector<Index> free;
-      bool all_angles = !reads.empty();
-      for (const RowCoordinate& c : reads) free.push_back(c.coordinate), all_angles = all_angles && c.angle;
-      AngleRelation relation;
-      Polynomial p;
-      if (all_angles && modes_detail::angle_relation(eval, r, free, out.variable_of, base, nv, random, relation, p)) {
-        system.equations.push_back(std::move(p));
-        out.angle_relations.push_back(std::move(relation));
-        continue;
-      }
-    }
+    if (add_angle_relation(eval, r, reads, base, random, out)) continue;  // a gear a linkage turns
     // a point: the local variables' values and the row there
     auto sample = [&](Eigen::VectorXd& local) {
       Eigen::VectorXd q = base;
