@@ -98,6 +98,9 @@ TEST(ModesScenes, RssrHasEightAssembliesAsItsClosedForm) {
   // (|cos φ| < 1): eight more placements of the same kinds, not assemblies
   ASSERT_LT(std::abs(rocker_cosine(theta + std::numbers::pi)), 1.0);
   EXPECT_EQ(r.rejected, 8);
+  // solved block by block: the crank's four equations in its Euler parameters (2⁴ paths) have four real solutions
+  // of one sign (up or down, at θ or θ + π), and the rocker's (three quadrics and the coupler's quartic) 32 paths each
+  EXPECT_EQ(r.summary.paths, 16 + 4 * 32);
 }
 
 TEST(ModesScenes, CardanJointHasEightAssembliesTheCrossTwoWaysTheShaftsUpOrDown) {
@@ -129,6 +132,9 @@ TEST(ModesScenes, CardanJointHasEightAssembliesTheCrossTwoWaysTheShaftsUpOrDown)
   }
   EXPECT_EQ(hits, (std::array<int, 8>{1, 1, 1, 1, 1, 1, 1, 1}));
   EXPECT_EQ(r.rejected, 8);  // the input shaft at θ + π: the driver's polynomial form only
+  // block by block: the input shaft's four quadrics (16 paths, four real of one sign), the output shaft's four (16
+  // paths for each)
+  EXPECT_EQ(r.summary.paths, 16 + 4 * 16);
 }
 
 // The four-bar of seed/fourbar_mixed.yaml with a wheel w geared to its coupler (20 teeth on the coupler, 30 on the
