@@ -193,7 +193,7 @@ TEST(JointReactions, TheModelsTableFindsEveryConstraintsBlockAndItsWidthIsItsSit
   const Scene door = parse_scene(reaction_scene_text("redundant/door_three_hinges.yaml"), "door.yaml");
   const Model reduced = door.model->without_rows({0, 1});
   int sites = 0;
-  for (const Model* m : {planar.model.get(), door.model.get(), &reduced}) {
+  for (const Model* m : std::initializer_list<const Model*>{planar.model.get(), door.model.get(), &reduced}) {
     ASSERT_GT(m->constraints().size(), 3u);
     for (Index c = 0; c < static_cast<Index>(m->constraints().size()); ++c) {
       const auto [block, index] = m->constraint_block(c);
