@@ -2,7 +2,9 @@
 // `NAME.effort.d_P`): a pendulum driven with a constant angular acceleration against its closed form
 // τ = m g l cos θ + (I + m l²) α, and a massive crank-slider (polar crank, a load at the slider's pin) and the
 // massive four-bar of models/dynamics (natural coordinates) against central differences of whole sweeps re-solved
-// at p ± δ, p ± δ/2 (Richardson), every row; the columns as the CSV names them.
+// at p ± δ, p ± δ/2 (Richardson), every row; the columns as the CSV names them. A crank-slider whose parameters
+// reach a length, a mass, a frame, gravity, a force, a spring and a torsional spring carries parts and loads along
+// p only for those that move them, and writes the same bits as with its own forces along every parameter.
 #include <gtest/gtest.h>
 
 #include <bit>
