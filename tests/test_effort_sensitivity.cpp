@@ -149,6 +149,25 @@ TEST(EffortSensitivity, APendulumsTorqueFollowsItsClosedFormInLengthAndMass) {
   EXPECT_NEAR(d[1], r.values.back()[at + 1], 1e-9);
 }
 
+TEST(EffortSensitivity, AStepperDeliversThePendulumsClosedForm) {
+  // The Stepper finds each parameter's reach once, at construction (its steps need it: ∂τ/∂p requires it), and
+  // delivers ∂τ/∂L and ∂τ/∂m as the sweep does: the closed form of the test above at every step.
+  const Scene s = parse_scene(kEffortPendulum, "pendulum.yaml");
+  StepperOptions o;
+  o.sensitivities = s.sweep.sensitivities;
+  o.efforts = s.sweep.efforts;
+  Stepper stepper(*s.model, o);
+  const double g = 9.81, L = 0.8, m = 1.5, alpha = 3.0;
+  const std::size_t at = static_cast<std::size_t>(s.sweep.efforts.size());
+  for (const double t : {0.0, 0.35, 0.7, 1.4}) {
+    ASSERT_EQ(stepper.step(t), SolveStatus::kSuccess) << t;
+    ASSERT_NE(stepper.efforts(), nullptr);
+    const double th = 0.3 + 2 * t + 1.5 * t * t;
+    EXPECT_NEAR(stepper.efforts()[at], m * g * std::cos(th) + 2 * m * L * alpha, 1e-8) << t;
+    EXPECT_NEAR(stepper.efforts()[at + 1], g * L * std::cos(th) + L * L * alpha, 1e-8) << t;
+  }
+}
+
 TEST(EffortSensitivity, AMassiveCrankSlidersTorqueMatchesResolvedSweeps) {
   // The notes' crank-slider (a polar crank: its data differentiated by the kinds) with massive crank and rod and
   // 5 N pushing back on the slider's pin, which the rod's part carries at its end (L3 moves where it acts).
