@@ -3,12 +3,19 @@
 // under gravity, swept a quarter turn in 100 steps on one thread, each row formatted as a CSV line. With efforts:
 // the motor's torque and power by inverse dynamics (one transposed solve per row). Counter `ratio`: the sweep with
 // efforts ÷ the sweep with q, q̇, q̈ only, interleaved iteration by iteration and summed (issue target ≤ 1.3).
+// BM_EffortSensitivitySweep: the efforts' sensitivities ∂τ/∂p (phiq/effort_sensitivity.hpp) on
+// models/dynamics/fourbar_motor_torque.yaml, 2000 steps on one thread, to the motor's speed w (it reaches the
+// driver alone: Q is not differenced along it) or to the crank's length L2 (it moves a centre and an inertia too).
+// Counters: `ratio`, the sweep with efforts and their sensitivities ÷ the sweep with the sensitivities of q only;
+// `vs_differenced`, that sweep ÷ the same with the scene's own parts and loads along p (Q differenced along p).
 //
-//   build/bench/phiq_bench --benchmark_filter=EffortsSweep --benchmark_counters_tabular=true
+//   build/bench/phiq_bench --benchmark_filter='EffortsSweep|EffortSensitivitySweep' --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "phiq/drawn_parts.hpp"
@@ -86,5 +93,52 @@ BENCHMARK(BM_EffortsSweep)
     ->ArgName("N")
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
+
+// models/dynamics/fourbar_motor_torque.yaml with the motor's speed a parameter w, 2000 steps, its efforts (or
+// none) and the sensitivities to `parameter`.
+Scene motor_torque_scene(const std::string& parameter, bool efforts) {
+  std::ifstream in(std::string(PHIQ_MODELS_DIR) + "/dynamics/fourbar_motor_torque.yaml");
+  std::stringstream read;
+  read << in.rdbuf();
+  std::string text = read.str();
+  auto replace = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    if (at == std::string::npos) throw Error("fourbar_motor_torque.yaml: no '" + from + "'");
+    text.replace(at, from.size(), to);
+  };
+  replace("L4: 1.0}", "L4: 1.0, w: 6.283185307179586}");
+  replace("rate: 2*pi", "rate: w");
+  replace("steps: 120", "steps: 2000");
+  text.erase(text.find("output:"));
+  text += "output: {velocities: true, accelerations: true, " + std::string(efforts ? "efforts: all, " : "") +
+          "sensitivities: [" + parameter + "]}\n";
+  return parse_scene(text, "fourbar_motor_torque.yaml");
+}
+
+// range(0) = param: 0 the parameter w, 1 L2. Manual time: the sweep with efforts and their sensitivities.
+void BM_EffortSensitivitySweep(benchmark::State& state) {
+  const std::string parameter = state.range(0) == 0 ? "w" : "L2";
+  const Scene with = motor_torque_scene(parameter, true), plain = motor_torque_scene(parameter, false);
+  SweepOptions a_options = with.sweep, b_options = plain.sweep;
+  a_options.threads = b_options.threads = 1;
+  SweepOptions c_options = a_options;  // the scene's own parts and loads at every point along p: Q differenced
+  for (OutputSensitivity& p : c_options.sensitivities)
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (!p.parts_along[k]) p.parts_along[k] = a_options.efforts.parts;
+      if (!p.loads_along[k]) p.loads_along[k] = a_options.efforts.loads;
+    }
+  double a_sum = 0, b_sum = 0, c_sum = 0;
+  for (auto _ : state) {
+    const double a = csv_sweep_seconds(with, a_options), b = csv_sweep_seconds(plain, b_options);
+    const double c = csv_sweep_seconds(with, c_options);
+    a_sum += a, b_sum += b, c_sum += c;
+    state.SetIterationTime(a);
+  }
+  const OutputSensitivity& p = with.sweep.sensitivities.front();
+  state.counters["moves_forces"] = p.parts_along[0] || p.loads_along[0] ? 1.0 : 0.0;
+  state.counters["ratio"] = a_sum / b_sum;
+  state.counters["vs_differenced"] = a_sum / c_sum;
+}
+BENCHMARK(BM_EffortSensitivitySweep)->Arg(0)->Arg(1)->ArgName("param")->UseManualTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -2,10 +2,14 @@
 // `NAME.effort.d_P`): a pendulum driven with a constant angular acceleration against its closed form
 // τ = m g l cos θ + (I + m l²) α, and a massive crank-slider (polar crank, a load at the slider's pin) and the
 // massive four-bar of models/dynamics (natural coordinates) against central differences of whole sweeps re-solved
-// at p ± δ, p ± δ/2 (Richardson), every row; the columns as the CSV names them.
+// at p ± δ, p ± δ/2 (Richardson), every row; the columns as the CSV names them. A crank-slider whose parameters
+// reach a length, a mass, a frame, gravity, a force, a spring and a torsional spring carries parts and loads along
+// p only for those that move them, and writes the same bits as with its own forces along every parameter.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 
@@ -145,6 +149,25 @@ TEST(EffortSensitivity, APendulumsTorqueFollowsItsClosedFormInLengthAndMass) {
   EXPECT_NEAR(d[1], r.values.back()[at + 1], 1e-9);
 }
 
+TEST(EffortSensitivity, AStepperDeliversThePendulumsClosedForm) {
+  // The Stepper finds each parameter's reach once, at construction (its steps need it: ∂τ/∂p requires it), and
+  // delivers ∂τ/∂L and ∂τ/∂m as the sweep does: the closed form of the test above at every step.
+  const Scene s = parse_scene(kEffortPendulum, "pendulum.yaml");
+  StepperOptions o;
+  o.sensitivities = s.sweep.sensitivities;
+  o.efforts = s.sweep.efforts;
+  Stepper stepper(*s.model, o);
+  const double g = 9.81, L = 0.8, m = 1.5, alpha = 3.0;
+  const std::size_t at = static_cast<std::size_t>(s.sweep.efforts.size());
+  for (const double t : {0.0, 0.35, 0.7, 1.4}) {
+    ASSERT_EQ(stepper.step(t), SolveStatus::kSuccess) << t;
+    ASSERT_NE(stepper.efforts(), nullptr);
+    const double th = 0.3 + 2 * t + 1.5 * t * t;
+    EXPECT_NEAR(stepper.efforts()[at], m * g * std::cos(th) + 2 * m * L * alpha, 1e-8) << t;
+    EXPECT_NEAR(stepper.efforts()[at + 1], g * L * std::cos(th) + L * L * alpha, 1e-8) << t;
+  }
+}
+
 TEST(EffortSensitivity, AMassiveCrankSlidersTorqueMatchesResolvedSweeps) {
   // The notes' crank-slider (a polar crank: its data differentiated by the kinds) with massive crank and rod and
   // 5 N pushing back on the slider's pin, which the rod's part carries at its end (L3 moves where it acts).
@@ -278,6 +301,71 @@ TEST(EffortSensitivity, ARedundantParallelogramHasItsFourBarsSensitivity) {
   ::testing::Test::RecordProperty("worst_relative", scientific(worst / scale, 2));
   EXPECT_GT(scale, 1.0);
   EXPECT_LT(worst, 1e-7 * scale);
+}
+
+// A massive crank-slider whose parameters reach different things: the lengths L2, L3 the constraints only; mr a
+// mass; xo the pivot, a part's frame and the constraints; g, F, k, kt the gravity, a force, a spring and a torsional
+// spring.
+const char* const kEffortReachCrankSlider = R"(phiq: 1
+name: crank_slider_loads
+parameters: {L2: 0.3, L3: 1.0, mr: 1.2, xo: 0.1, g: 9.81, F: 5, k: 40, kt: 2}
+coordinates: {theta2: 0.0, xA: 0.38, yA: 0.03, xB: 1.35}
+points: {O: [xo, 0], A: [xA, yA], B: [xB, 0]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: rod, type: distance, points: [A, B], length: L3}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
+parts:
+  crank: {frame: {origin: O, x: A}, center_of_mass: [0.15, 0], mass: 0.5, inertia: 0.004}
+  rod: {frame: {origin: A, x: B}, center_of_mass: [0.5, 0], mass: mr, inertia: 0.1}
+loads:
+  gravity: [0, -g]
+  forces: [{name: push, part: rod, at: [1.0, 0], force: [-F, 0]}]
+  springs: [{name: pull, between: [{part: rod, at: [1.0, 0]}, {point: [2, 0]}], stiffness: k, free_length: 0.5}]
+  torsional_springs: [{name: twist, coordinate: theta2, stiffness: kt}]
+time: {start: 0, end: pi, steps: 30}
+output: {efforts: all, sensitivities: [L2, L3, mr, xo, g, F, k, kt]}
+)";
+
+TEST(EffortSensitivity, OnlyTheParametersThatMoveAPartOrALoadCarryThemAlong) {
+  // A parameter that reaches the constraints only leaves parts_along and loads_along null (Q is then not
+  // differenced along it: 4 evaluations of Q per row, not 8); one that moves a mass, a frame or a load sets them
+  // at all four points of the difference.
+  const Scene s = parse_scene(kEffortReachCrankSlider, "crank_slider_loads.yaml");
+  ASSERT_EQ(s.sweep.sensitivities.size(), 8u);
+  for (const OutputSensitivity& p : s.sweep.sensitivities) {
+    const bool parts = p.name == "mr" || p.name == "xo";
+    const bool loads = p.name == "g" || p.name == "F" || p.name == "k" || p.name == "kt";
+    for (std::size_t k = 0; k < 4; ++k) {
+      EXPECT_EQ(p.parts_along[k] != nullptr, parts) << p.name << " at " << k;
+      EXPECT_EQ(p.loads_along[k] != nullptr, loads) << p.name << " at " << k;
+    }
+  }
+}
+
+TEST(EffortSensitivity, ParametersThatReachNoForceGiveTheSameColumnsBitForBitAsWithTheirOwnForcesAlong) {
+  // The along-p difference of Q skipped where nothing moves is exactly the zero it replaces: the sweep with the
+  // scene's own parts and loads standing at every point along each parameter writes the same bits.
+  const Scene s = parse_scene(kEffortReachCrankSlider, "crank_slider_loads.yaml");
+  Scene along = parse_scene(kEffortReachCrankSlider, "crank_slider_loads.yaml");
+  for (OutputSensitivity& p : along.sweep.sensitivities)
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (!p.parts_along[k]) p.parts_along[k] = along.sweep.efforts.parts;
+      if (!p.loads_along[k]) p.loads_along[k] = along.sweep.efforts.loads;
+    }
+  const EffortSensitivityRows a = effort_sensitivity_sweep(s), b = effort_sensitivity_sweep(along);
+  ASSERT_EQ(a.values.size(), 31u);
+  ASSERT_EQ(b.values.size(), a.values.size());
+  for (std::size_t k = 0; k < a.values.size(); ++k)
+    for (std::size_t j = 0; j < a.values[k].size(); ++j)
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(a.values[k][j]), std::bit_cast<std::uint64_t>(b.values[k][j]))
+          << "row " << k << " value " << j;
+}
+
+TEST(EffortSensitivity, ACrankSliderWithLoadsOfEveryKindMatchesResolvedSweeps) {
+  // every parameter of the scene above, whatever it reaches, against re-solved sweeps
+  expect_effort_sensitivities_match_resolved_sweeps(kEffortReachCrankSlider);
 }
 
 TEST(EffortSensitivity, TheCsvColumnsAreNamedAfterTheEffortAndTheParameterAndHoldTheRowsValues) {

@@ -185,6 +185,33 @@ ReactionRows sweep_reactions(const Scene& s, SweepSummary* sum = nullptr, const 
   return r;
 }
 
+// Model::constraint_block(), the table JointReactions and the minimum-norm multipliers read a constraint through,
+// against a scan of the blocks, in a planar and a spatial model and in the spatial one reduced to its independent
+// rows (without_rows() shares the table); reaction_width(), the kind's trait, against the site a kind states.
+TEST(JointReactions, TheModelsTableFindsEveryConstraintsBlockAndItsWidthIsItsSites) {
+  const Scene planar = parse_scene(reaction_scene_text("clearance/fourbar_knee.yaml"), "knee.yaml");
+  const Scene door = parse_scene(reaction_scene_text("redundant/door_three_hinges.yaml"), "door.yaml");
+  const Model reduced = door.model->without_rows({0, 1});
+  int sites = 0;
+  for (const Model* m : std::initializer_list<const Model*>{planar.model.get(), door.model.get(), &reduced}) {
+    ASSERT_GT(m->constraints().size(), 3u);
+    for (Index c = 0; c < static_cast<Index>(m->constraints().size()); ++c) {
+      const auto [block, index] = m->constraint_block(c);
+      const auto [scanned, scanned_index] = reaction_block_of(*m, c);
+      ASSERT_NE(block, nullptr) << c;
+      EXPECT_EQ(block, scanned) << m->constraints()[static_cast<std::size_t>(c)].name;
+      EXPECT_EQ(index, scanned_index) << m->constraints()[static_cast<std::size_t>(c)].name;
+      ReactionSite site;
+      const bool has_site = block->reaction_site(index, m->initial_positions().data(), site);
+      EXPECT_EQ(reaction_width(*m, c), has_site ? (site.spatial ? 6 : 3) : 0)
+          << m->constraints()[static_cast<std::size_t>(c)].name;
+      sites += has_site;
+    }
+    EXPECT_THROW((void)m->constraint_block(static_cast<Index>(m->constraints().size())), Error);
+  }
+  EXPECT_GE(sites, 4 + 3 + 3);  // the knee's four pins, the door's three hinges twice
+}
+
 // The knee four-bar (reference-point links, centres at the reference points) with masses under gravity.
 TEST(JointReactions, FourBarPinsSatisfyEveryLinksNewtonEulerEquations) {
   std::string text = reaction_scene_text("clearance/fourbar_knee.yaml");

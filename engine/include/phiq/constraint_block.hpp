@@ -118,6 +118,9 @@ class ConstraintBlock {
   virtual void add_transposed_product(std::size_t i, const double* q, double t, const double* y, double* out) const = 0;
   /// Whether the kind states where its reaction acts (ReactionSite, kinds/reaction_site.hpp).
   virtual bool has_reaction_site() const { return false; }
+  /// How many values the kind's reaction has, its kReactionWidth: 3 (Fx, Fy, Mz) for a planar joint, 6 for a
+  /// spatial one; 0 when it states no ReactionSite. A fact of the kind, the same for every constraint of the block.
+  virtual int reaction_width() const { return 0; }
   /// Constraint i's ReactionSite at q, when has_reaction_site(); else false. Thread-safe.
   virtual bool reaction_site(std::size_t /*i*/, const double* /*q*/, ReactionSite& /*out*/) const { return false; }
   /// The coordinates constraint i adds (a kind with kAddedCoordinates: a curve's parameter) and the length each is
@@ -299,6 +302,14 @@ class TypedBlock final : public ConstraintBlock {
   }
   bool has_reaction_site() const override {
     return requires(const Spec& k, const double* at) { k.reaction_site(at); };
+  }
+  int reaction_width() const override {
+    if constexpr (requires(const Spec& k, const double* at) { k.reaction_site(at); }) {
+      static_assert(Spec::kReactionWidth == 3 || Spec::kReactionWidth == 6,
+                    "a kind with a reaction_site() states kReactionWidth: 3 in the plane, 6 in space");
+      return Spec::kReactionWidth;
+    }
+    return 0;
   }
   bool reaction_site(std::size_t i, const double* q, ReactionSite& out) const override {
     if constexpr (requires(const Spec& k, const double* at) { k.reaction_site(at); }) {

@@ -23,7 +23,8 @@
 /// rule), exact up to 10⁻¹² relative. A co-moving coordinate (ParameterReach::comotion) is moved along p as the
 /// sensitivities move it, and the motion's part taken along s − q̂.
 ///
-/// Cost per written row: one direct solve per driver, and per parameter 8 evaluations of Q, 2 of the velocity term
+/// Cost per written row: one direct solve per driver, and per parameter 8 evaluations of Q (4 for a parameter that
+/// moves no part, no load and no coordinate: its parts_along and loads_along null), 2 of the velocity term
 /// over the reach and 4 of γ per driver; the sensitivities of q, q̇, q̈ in the direct form (every coordinate's).
 #pragma once
 

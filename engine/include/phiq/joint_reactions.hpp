@@ -61,7 +61,8 @@ class JointReactions {
 /// n_r = e_r − Σ α_k e_k is a direction λ may move along without changing Φqᵀ λ; λ is projected off those
 /// directions. Appends to `indeterminate` (when not null) the constraints whose rows those directions move, in
 /// model order: the joints whose reactions the motion does not determine. A model without dropped rows is left as
-/// it is. Returns false when a solve fails.
+/// it is. Returns false when a solve fails. Its dense buffers (m × dropped rows) are allocated at each call; a sweep
+/// lends its own per thread instead.
 bool minimum_norm_multipliers(const Model& model, SparseLuNumeric& lu, const double* q, double t,
                               Eigen::VectorXd& lambda, std::vector<Index>* indeterminate = nullptr);
 

@@ -179,6 +179,8 @@ struct ModelData {
   std::vector<std::shared_ptr<ConstraintBlock>> blocks_;  ///< read-only once built (shared by without_rows())
   std::vector<const ConstraintBlock*> time_blocks_;
   std::vector<ConstraintInfo> constraints_;
+  /// Each constraint's block (index into blocks_) and its index there: (block, index) per constraint.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> constraint_place_;
   std::vector<Index> row_constraint_;
   std::vector<Unit> row_units_;
   std::shared_ptr<const CscPattern> pattern_ = std::make_shared<CscPattern>();
@@ -250,6 +252,14 @@ class Model : private detail::ModelData {
   /// a multi-row one (a constraint whose own name is the whole string comes first). Throws phiq::Error for a name
   /// that names no row (an unknown constraint, k out of range, or a bare multi-row name).
   Index row_index(std::string_view row_name) const;
+  /// The block of blocks() that holds constraint c (an index into constraints()) and c's index in it: O(1), a table
+  /// built with the model (what a reaction or a dropped row's gradient evaluates one constraint through). Throws
+  /// phiq::Error unless 0 ≤ c < constraints().size().
+  std::pair<const ConstraintBlock*, std::size_t> constraint_block(Index c) const {
+    const auto [b, i] =
+        constraint_place_[detail::index_in(c, static_cast<Index>(constraint_place_.size()), "constraint")];
+    return {blocks_[b].get(), i};
+  }
   /// Index into constraints() of the constraint owning `row`. Throws phiq::Error unless 0 ≤ row < m.
   Index constraint_of_row(Index row) const { return row_constraint_[detail::index_in(row, num_equations(), "row")]; }
   /// Unit of a row of Φ (for its tolerance). Throws phiq::Error unless 0 ≤ row < m.

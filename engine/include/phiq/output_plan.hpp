@@ -57,8 +57,9 @@ struct OutputSensitivity {
   /// whole model again (nfourbar 10⁵: 80 MB), what p reaches a fraction of it.
   std::shared_ptr<const ReachedConstraints> reached;
   /// The parts with mass and the loads of the scene at p − 2h, p − h, p + h, p + 2h (the efforts' sensitivities,
-  /// phiq/effort_sensitivity.hpp: a mass, a centre of mass or a load may read p). A scene's sensitivities set them
-  /// when it writes efforts; null: the efforts' own (p reaches the constraints only).
+  /// phiq/effort_sensitivity.hpp: a mass, a centre of mass, a part's frame or a load may read p). A scene's
+  /// sensitivities set those that differ from the scene's own, when it writes efforts; null: the efforts' own (p
+  /// reaches none of them: Q is then not differenced along p).
   std::array<std::shared_ptr<const std::vector<Part>>, 4> parts_along;
   std::array<std::shared_ptr<const Loads>, 4> loads_along;  ///< see parts_along
 };

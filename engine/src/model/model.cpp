@@ -469,6 +469,11 @@ Model ModelBuilder::build() && {
   std::vector<Index> slots;
   auto pattern = std::make_shared<CscPattern>(build_csc_pattern(rows, n, trip_rows, trip_cols, &slots));
   m.slot_of_entry_.assign(slots.begin(), slots.end());
+  m.constraint_place_.assign(m.constraints_.size(), {0, 0});  // (every constraint is in one block)
+  for (std::size_t b = 0; b < m.blocks_.size(); ++b)
+    for (std::size_t i = 0; i < m.blocks_[b]->size(); ++i)
+      m.constraint_place_[static_cast<std::size_t>(m.constraint_of_row(m.blocks_[b]->first_row(i)))] = {
+          static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(i)};
   m.pattern_ = pattern;
   m.solve_pattern_ = pattern;
   {  // a row that involves no coordinate holds at every position or at none: named here, before a factorisation

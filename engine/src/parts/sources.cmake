@@ -8,6 +8,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/part_motion.cpp
   ${CMAKE_CURRENT_LIST_DIR}/part_pose.cpp
   ${CMAKE_CURRENT_LIST_DIR}/polygon.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/same_forces.cpp
   ${CMAKE_CURRENT_LIST_DIR}/shape_checks.cpp
   ${CMAKE_CURRENT_LIST_DIR}/shape_triangles.cpp
 )

@@ -16,6 +16,7 @@
 #include "phiq/text.hpp"
 #include "scene/read_scene_file.hpp"
 #include "scene/scene_reader.hpp"
+#include "parts/same_forces.hpp"
 #include "solve/models_along.hpp"
 
 namespace phiq {
@@ -155,9 +156,15 @@ OutputSensitivity along(const Scene& scene, const std::string& name, double valu
     if (!replaced) moved.parameters.emplace_back(name, at);
     try {
       Scene at_k = read(moved);
-      // the masses, centres and loads at p + kh, which the efforts' sensitivities difference (effort_sensitivity.hpp)
-      s.parts_along[k] = at_k.sweep.efforts.parts;
-      s.loads_along[k] = at_k.sweep.efforts.loads;
+      // the masses, centres and loads at p + kh where p moves them, which the efforts' sensitivities difference
+      // (effort_sensitivity.hpp); left null where they are the scene's own, so that no Q is differenced along a
+      // parameter that reaches the constraints only
+      const OutputEfforts& own = scene.sweep.efforts;
+      const OutputEfforts& moved_efforts = at_k.sweep.efforts;
+      if (moved_efforts.parts && !(own.parts && detail::same_inertia(*own.parts, *moved_efforts.parts)))
+        s.parts_along[k] = moved_efforts.parts;
+      if (moved_efforts.loads && !(own.loads && detail::same_loads(*own.loads, *moved_efforts.loads)))
+        s.loads_along[k] = moved_efforts.loads;
       return std::shared_ptr<const Model>(std::move(at_k.model));
     } catch (const SceneError& e) {
       throw SceneError("with " + name + " = " + shortest(at) + " (the difference step " + shortest(s.step) + " from " +

@@ -54,9 +54,12 @@ void total_force_rate(const Model& model, const OutputEfforts& efforts, const Ou
     generalized_forces(*efforts.parts, *efforts.loads, sc.qk.data(), sc.vk.data(), sc.ak.data(), t, n, f[k]);
   }
   sc.dq = ((f[0] - f[3]) + 8.0 * (f[2] - f[1])) / (12.0 * e);
-  if (!std::any_of(p.parts_along.begin(), p.parts_along.end(), [](const auto& x) { return x != nullptr; }) &&
-      !std::any_of(p.loads_along.begin(), p.loads_along.end(), [](const auto& x) { return x != nullptr; }))
-    return;  // nothing but the constraints reads p
+  // Nothing but the constraints reads p, and no coordinate moves with it: Q along p is Q itself four times, its
+  // difference exactly zero (what the evaluations below would give, bit for bit).
+  if (std::none_of(p.parts_along.begin(), p.parts_along.end(), [](const auto& x) { return x != nullptr; }) &&
+      std::none_of(p.loads_along.begin(), p.loads_along.end(), [](const auto& x) { return x != nullptr; }) &&
+      reach.comotion.empty())
+    return;
   for (std::size_t k = 0; k < 4; ++k) {
     sc.qf = qv;
     for (const ParameterReach::Comotion& c : reach.comotion)
@@ -117,10 +120,10 @@ bool detail::effort_sensitivities_with_factors(const Model& model, const OutputE
   }
   const SensitivityLayout sl{n};
   const double qd_rate = detail::fastest_coordinate(qd, model.tolerance_scales().coordinate_scale.data(), n);
-  ParameterReach found;
   for (std::size_t j = 0; j < parameters.size(); ++j) {
     const OutputSensitivity& p = parameters[j];
-    const ParameterReach& reach = p.reach ? *p.reach : (found = parameter_reach(model, p));
+    if (!p.reach) throw Error("effort_sensitivities_with_factors: the reach of '" + p.name + "' is not known");
+    const ParameterReach& reach = *p.reach;
     const double* s = sensitivities + sl.offset(j, 0);
     sc.v = Eigen::Map<const Eigen::VectorXd>(s, n);  // s − q̂: the part along the motion
     for (const ParameterReach::Comotion& c : reach.comotion) sc.v[c.coordinate] -= q[c.coordinate] * c.rate;
@@ -152,10 +155,14 @@ SolveStatus solve_effort_sensitivities(const Model& model, const OutputEfforts& 
   if (!efforts.parts || !efforts.loads) throw Error("solve_effort_sensitivities: the efforts need parts and loads");
   const std::size_t ne = efforts.constraints.size();
   out.assign(EffortSensitivityLayout{ne}.size(parameters.size()), std::numeric_limits<double>::quiet_NaN());
+  // each parameter's reach found once, for the sensitivities and the efforts' alike (each would find it again)
+  std::vector<OutputSensitivity> with_reach = parameters;
+  for (OutputSensitivity& p : with_reach)
+    if (!p.reach) p.reach = std::make_shared<const ParameterReach>(parameter_reach(model, p));
   std::vector<double> sens(
       static_cast<std::size_t>(SensitivityLayout{model.num_coordinates()}.size(parameters.size())));
   LinearSummary sum;
-  const SolveStatus st = solve_sensitivities(model, parameters, t, 2, ws, sens.data(), &sum);
+  const SolveStatus st = solve_sensitivities(model, with_reach, t, 2, ws, sens.data(), &sum);
   if (st != SolveStatus::kSuccess) {
     if (message) *message = sum.message;
     return st;
@@ -165,7 +172,7 @@ SolveStatus solve_effort_sensitivities(const Model& model, const OutputEfforts& 
   add_generalized_forces(*efforts.parts, *efforts.loads, ws.q.data(), ws.qd.data(), ws.qdd.data(), t, Q);
   detail::EffortSensitivityScratch sc;
   if (!multipliers_with_factors(model, *ws.lu, Q, kept, lambda) ||
-      !detail::effort_sensitivities_with_factors(model, efforts, parameters, t, ws.q.data(), ws.qd.data(),
+      !detail::effort_sensitivities_with_factors(model, efforts, with_reach, t, ws.q.data(), ws.qd.data(),
                                                  ws.qdd.data(), lambda, sens.data(), *ws.lu, sc, out.data())) {
     std::fill(out.begin(), out.end(), std::numeric_limits<double>::quiet_NaN());
     if (message) *message = "sparse LU solve failed: " + ws.lu->last_message();

@@ -8,31 +8,13 @@
 
 #include "phiq/constraint_block.hpp"
 #include "phiq/part_motion.hpp"
+#include "solve/minimum_norm.hpp"
 
 namespace phiq {
 
 namespace {
 
 using kin3::V3;
-
-// The block holding constraint c and its index there.
-std::pair<const ConstraintBlock*, std::size_t> block_of(const Model& model, Index c) {
-  const Index row =
-      model.constraints()[detail::index_in(c, static_cast<Index>(model.constraints().size()), "constraint")].first_row;
-  // a block's constraints are in increasing row order: a binary search in each block
-  for (const auto& b : model.blocks()) {
-    std::size_t lo = 0, hi = b->size();
-    while (lo < hi) {
-      const std::size_t mid = lo + (hi - lo) / 2;
-      if (b->first_row(mid) < row)
-        lo = mid + 1;
-      else
-        hi = mid;
-    }
-    if (lo < b->size() && b->first_row(lo) == row) return {b.get(), lo};
-  }
-  return {nullptr, 0};
-}
 
 PartFrame body_frame(const ReactionSite& s) {
   PartFrame f;
@@ -44,33 +26,21 @@ PartFrame body_frame(const ReactionSite& s) {
 
 }  // namespace
 
-int reaction_width(const Model& model, Index c) {
-  const auto [b, i] = block_of(model, c);
-  ReactionSite site;
-  if (!b || !b->reaction_site(i, model.initial_positions().data(), site)) return 0;
-  return site.spatial ? 6 : 3;
-}
+int reaction_width(const Model& model, Index c) { return model.constraint_block(c).first->reaction_width(); }
 
 JointReactions::JointReactions(const Model& model, std::vector<Index> constraints)
     : g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
   std::vector<int> site_of(model.constraints().size(), -1);
-  // each constraint's block and index there, in one pass over the blocks
-  std::vector<std::pair<const ConstraintBlock*, std::size_t>> where(model.constraints().size(), {nullptr, 0});
-  for (const auto& b : model.blocks())
-    for (std::size_t i = 0; i < b->size(); ++i)
-      where[static_cast<std::size_t>(model.constraint_of_row(b->first_row(i)))] = {b.get(), i};
   for (Index c : constraints) {
-    const auto [b, i] = where[detail::index_in(c, static_cast<Index>(where.size()), "constraint")];
+    const auto [b, i] = model.constraint_block(c);
     const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
-    if (!b || !b->has_reaction_site())
+    if (!b->has_reaction_site())
       throw Error("constraint '" + info.name + "' (" + std::string(info.kind) +
                   ") states no joint point: it has no reaction to write (joints between bodies have one)");
     Site s;
     s.block = b, s.index = i;
-    ReactionSite rs;
-    b->reaction_site(i, model.initial_positions().data(), rs);
-    s.spatial = rs.spatial;
-    size_ += s.spatial ? 6 : 3;
+    s.spatial = b->reaction_width() == 6;
+    size_ += b->reaction_width();
     site_of[static_cast<std::size_t>(c)] = static_cast<int>(sites_.size());
     sites_.push_back(std::move(s));
   }
@@ -120,28 +90,32 @@ void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& 
   }
 }
 
-bool minimum_norm_multipliers(const Model& model, SparseLuNumeric& lu, const double* q, double t,
-                              Eigen::VectorXd& lambda, std::vector<Index>* indeterminate) {
+bool detail::minimum_norm_multipliers(const Model& model, SparseLuNumeric& lu, const double* q, double t,
+                                      Eigen::VectorXd& lambda, std::vector<Index>* indeterminate,
+                                      MinimumNormScratch& sc) {
   const std::vector<Index>& dropped = model.dropped_rows();
   const std::vector<Index>& kept = model.solve_rows();
   if (dropped.empty()) return true;
   const Index m = model.num_equations(), n = model.num_coordinates();
-  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(m, static_cast<Index>(dropped.size()));
-  Eigen::VectorXd unit = Eigen::VectorXd::Zero(m), grad(n), alpha(static_cast<Index>(kept.size()));
+  Eigen::MatrixXd& N = sc.directions;
+  N.setZero(m, static_cast<Index>(dropped.size()));
+  sc.unit.setZero(m);
+  sc.gradient.resize(n), sc.alpha.resize(static_cast<Index>(kept.size()));
   for (std::size_t d = 0; d < dropped.size(); ++d) {
     const Index r = dropped[d];
-    const auto [b, i] = block_of(model, model.constraint_of_row(r));
-    grad.setZero();
-    unit(r) = 1.0;
-    b->add_transposed_product(i, q, t, unit.data(), grad.data());  // ∇Φ_r
-    unit(r) = 0.0;
-    if (!lu.solve_transposed(grad.data(), alpha.data())) return false;  // Φq,keptᵀ α = ∇Φ_r
+    const auto [b, i] = model.constraint_block(model.constraint_of_row(r));
+    sc.gradient.setZero();
+    sc.unit(r) = 1.0;
+    b->add_transposed_product(i, q, t, sc.unit.data(), sc.gradient.data());  // ∇Φ_r
+    sc.unit(r) = 0.0;
+    if (!lu.solve_transposed(sc.gradient.data(), sc.alpha.data())) return false;  // Φq,keptᵀ α = ∇Φ_r
     N(r, static_cast<Index>(d)) = 1.0;
-    for (std::size_t k = 0; k < kept.size(); ++k) N(kept[k], static_cast<Index>(d)) = -alpha(static_cast<Index>(k));
+    for (std::size_t k = 0; k < kept.size(); ++k) N(kept[k], static_cast<Index>(d)) = -sc.alpha(static_cast<Index>(k));
   }
   // λ − N (NᵀN)⁻¹ Nᵀ λ: the component of λ orthogonal to every direction it may move along
-  const Eigen::VectorXd step = N.colPivHouseholderQr().solve(lambda);
-  lambda -= N * step;
+  sc.qr.compute(N);
+  sc.step = sc.qr.solve(lambda);
+  lambda -= N * sc.step;
   if (indeterminate) {
     const double big = N.cwiseAbs().maxCoeff();
     std::vector<bool> seen(model.constraints().size(), false);
@@ -152,6 +126,12 @@ bool minimum_norm_multipliers(const Model& model, SparseLuNumeric& lu, const dou
       if (seen[c]) indeterminate->push_back(static_cast<Index>(c));
   }
   return true;
+}
+
+bool minimum_norm_multipliers(const Model& model, SparseLuNumeric& lu, const double* q, double t,
+                              Eigen::VectorXd& lambda, std::vector<Index>* indeterminate) {
+  detail::MinimumNormScratch scratch;
+  return detail::minimum_norm_multipliers(model, lu, q, t, lambda, indeterminate, scratch);
 }
 
 }  // namespace phiq

@@ -72,7 +72,8 @@ double fastest_coordinate(const double* v, const double* scale, Index n);
 // The efforts' sensitivities of one row (phiq/effort_sensitivity.hpp) into `out` (EffortSensitivityLayout):
 // `lambda` the row's multipliers (Φqᵀ λ = Q, zero on dropped rows: multipliers_with_factors()), `sensitivities`
 // the row's in the direct form (SensitivityLayout, order 2), `lu` the factors of Φq at q. NaN for a driver whose
-// row the model dropped. Returns false when a solve fails.
+// row the model dropped. Pre-condition: every parameter's reach is set (run_sweep(), the Stepper and
+// solve_effort_sensitivities() find it once); else phiq::Error. Returns false when a solve fails.
 struct EffortSensitivityScratch {
   SensitivityScratch along;                    // along_parameter()'s
   std::vector<Eigen::VectorXd> w;              // Φq⁻¹ e_r per effort (empty: a dropped row)

@@ -54,7 +54,8 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
   const double t = current_.t;
   std::vector<Index> indeterminate;
   const bool note = !reactions_noted_ && t == opt_.t_begin;
-  if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_lambda_, note ? &indeterminate : nullptr)) {
+  if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_lambda_, note ? &indeterminate : nullptr,
+                                minimum_norm_scratch_)) {
     std::fill(efforts_.begin() + 2 * static_cast<std::ptrdiff_t>(opt_.efforts.constraints.size()),
               efforts_.begin() + opt_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
     return;

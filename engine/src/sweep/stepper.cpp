@@ -67,6 +67,9 @@ Stepper::Stepper(const Model& model, StepperOptions options)
         "StepperOptions: sensitivity_form must be auto or direct (a stepper writes no coordinate columns for "
         "the adjoint form to solve for)");
   s.sensitivities = o.sensitivities, s.sensitivity_form = o.sensitivity_form;
+  // each parameter's reach found once here, as run_sweep() does, not again at every step
+  for (OutputSensitivity& p : s.sensitivities)
+    if (!p.reach) p.reach = std::make_shared<const ParameterReach>(parameter_reach(model, p));
   s.efforts = o.efforts;
   detail::check_efforts(model, s, "StepperOptions");
   s.threads = 1;

@@ -22,6 +22,7 @@
 #include "phiq/sweep.hpp"
 #include "solve/assembly_internal.hpp"
 #include "solve/kinematics_internal.hpp"
+#include "solve/minimum_norm.hpp"
 #include "solve/sensitivity_internal.hpp"
 #include "solve/tolerance_tests.hpp"
 
@@ -419,6 +420,7 @@ class Sweeper {
       opt_.efforts.reactions.empty() ? std::nullopt
                                      : std::optional<JointReactions>(std::in_place, model_, reaction_constraints());
   bool reactions_noted_ = false;
+  MinimumNormScratch minimum_norm_scratch_;  // row_reactions()'s, with redundant rows
   // The coordinates whose columns are written, and the form the sensitivities are solved in
   // (effective_sensitivity_form)
   std::vector<Index> sensitivity_outputs_ =

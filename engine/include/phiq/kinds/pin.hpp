@@ -50,6 +50,8 @@ struct PinSpec {
     f(a.x, Unit::kLength), f(a.y, Unit::kLength), f(a.psi, Unit::kAngle);
     f(b.x, Unit::kLength), f(b.y, Unit::kLength), f(b.psi, Unit::kAngle);
   }
+  /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Mz of a planar joint.
+  static constexpr int kReactionWidth = 3;
   /// The reaction (ReactionSite): on frame a, or on b when a is fixed, at the pin's point (a's attachment point).
   ReactionSite reaction_site(const double* q) const {
     const kin::V2 p = kin::V2{a.x.of(q), a.y.of(q)} + kin::rotate(a.psi.of(q), sa);

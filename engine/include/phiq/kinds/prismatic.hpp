@@ -50,6 +50,8 @@ struct PrismaticSpec {
     f(a.x, Unit::kLength), f(a.y, Unit::kLength), f(a.psi, Unit::kAngle);
     f(b.x, Unit::kLength), f(b.y, Unit::kLength), f(b.psi, Unit::kAngle);
   }
+  /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Mz of a planar joint.
+  static constexpr int kReactionWidth = 3;
   /// The reaction (ReactionSite): on frame a, or on b when a is fixed, at the point s_b of the slider, which the
   /// pair keeps on the line.
   ReactionSite reaction_site(const double* q) const {

@@ -1,7 +1,9 @@
 /// @file
 /// Where a joint's reaction acts (phiq/joint_reactions.hpp): a kind that joins two bodies states it with a member
-/// `ReactionSite reaction_site(const double* q) const`, and its reaction (the force and moment its multipliers exert)
-/// can then be written (`output.reactions`, models/README.md). One member per kind; kinds without it have none.
+/// `ReactionSite reaction_site(const double* q) const` and the number of values its reaction has,
+/// `static constexpr int kReactionWidth` (3 in the plane, 6 in space: ConstraintBlock::reaction_width()), and its
+/// reaction (the force and moment its multipliers exert) can then be written (`output.reactions`, models/README.md).
+/// Kinds without them have none.
 #pragma once
 
 #include "phiq/spatial_attachment.hpp"

@@ -176,6 +176,8 @@ struct SpatialJointSpec {
   void for_each_slot(F&& f) const {
     detail3::side_slots(a, f), detail3::side_slots(b, f);
   }
+  /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Fz, Mx, My, Mz of a spatial joint.
+  static constexpr int kReactionWidth = 6;
   /// The reaction (ReactionSite): on side a's body, or on b's when a is fixed, at side a's joint point.
   ReactionSite reaction_site(const double* q) const {
     const Frame3& f = a.frame;
