@@ -170,288 +170,237 @@ std::optional<std::string> samples_out_of_memory(const ToleranceArgs& a, std::si
          " are available: fewer --samples or --columns; no output written";
 }
 
-int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
-  const bool writer = ranks.rank() == 0;  // under mpirun, rank 0 alone writes and prints
-  std::vector<NamedPath> outs{{"-o", a.out}};
-  if (!a.summary.empty()) outs.push_back({"--summary", a.summary});
-  if (!a.plot.empty()) outs.push_back({"--plot", a.plot});
-  if (const auto clash = output_clash(outs, {{"the scene", a.scene}, {"the covariance", a.covariance}}))
-    return fail("tolerance: " + *clash, 2);
-
-  // ---- the parameters, their covariance and the scene
-  std::vector<tolerance::Tolerance> given;
-  std::optional<tolerance::Covariance> covariance;
+// What the command reads before it sweeps: the toleranced parameters, the scene at their nominal values, the
+// outputs and the plotted one. `status` is non-zero when the command stops (its line printed).
+struct ToleranceSetup {
+  int status = 0;
   ParameterSpread spread;
   SceneOverrides settings;  // --set: the nominal point's other parameters (a toleranced one's nominal value too)
+  Scene scene;
+  std::vector<double> nominal;
+  std::vector<OutputColumn> columns;
+  std::size_t plotted = 0;
+  bool identifiers = false;
+};
+
+// The parameters, their covariance and the scene (with each toleranced parameter's model for its sensitivities).
+ToleranceSetup read_tolerance_setup(const ToleranceArgs& a) {
+  ToleranceSetup u;
+  auto stop = [&](const std::string& line, int code) {
+    u.status = fail(line, code);
+    return std::move(u);
+  };
+  std::vector<tolerance::Tolerance> given;
+  std::optional<tolerance::Covariance> covariance;
   try {
-    settings = parameter_settings(a.sets);
+    u.settings = parameter_settings(a.sets);
     for (const std::string& s : a.sd) given.push_back(tolerance::parse_tolerance("--sd", s));
     for (const std::string& s : a.limit) given.push_back(tolerance::parse_tolerance("--limit", s));
     if (!a.covariance.empty()) covariance = tolerance::read_covariance(a.covariance);
     if (given.empty() && !covariance)
       throw Error("no toleranced parameter: give --sd NAME=SD, --limit NAME=L or --covariance FILE");
-    spread = tolerance::parameter_spread(given, covariance ? &*covariance : nullptr);
+    u.spread = tolerance::parameter_spread(given, covariance ? &*covariance : nullptr);
   } catch (const Error& e) {
-    return fail("tolerance: " + std::string(e.what()), 2);
+    return stop("tolerance: " + std::string(e.what()), 2);
   }
   set_interrupt_subject(a.scene, "; no output written");
-  Scene scene;
   try {
-    SceneOverrides o = settings;
+    SceneOverrides o = u.settings;
     o.sensitivity_models = false;  // the scene's own output.sensitivities are not swept here
-    scene = load_scene(a.scene, SceneLimits{}, o);
+    u.scene = load_scene(a.scene, SceneLimits{}, o);
   } catch (const SceneError& e) {
-    return fail(e.what(), 2);
+    return stop(e.what(), 2);
   }
-  std::vector<double> nominal;
-  for (const tolerance::Tolerance& t : spread.parameters) {
-    const auto it = std::find_if(scene.parameters.begin(), scene.parameters.end(),
+  for (const tolerance::Tolerance& t : u.spread.parameters) {
+    const auto it = std::find_if(u.scene.parameters.begin(), u.scene.parameters.end(),
                                  [&](const auto& p) { return p.first == t.name; });
-    if (it == scene.parameters.end()) {
+    if (it == u.scene.parameters.end()) {
       std::vector<std::string> names;
-      for (const auto& p : scene.parameters) names.push_back(p.first);
+      for (const auto& p : u.scene.parameters) names.push_back(p.first);
       const std::string where = t.from_covariance                                     ? a.covariance
                                 : t.distribution == tolerance::Distribution::kUniform ? "tolerance: --limit"
                                                                                       : "tolerance: --sd";
-      return fail(where + ": '" + t.name + "' is not a parameter of " + a.scene +
+      return stop(where + ": '" + t.name + "' is not a parameter of " + a.scene +
                       (names.empty() ? " (it has none)" : " (its parameters: " + joined(names) + ")"),
                   2);
     }
-    nominal.push_back(it->second);
+    u.nominal.push_back(it->second);
   }
-  std::vector<OutputColumn> columns;
   try {
-    columns = a.columns.empty() ? written_columns(scene) : asked_columns(scene, a.columns);
+    u.columns = a.columns.empty() ? written_columns(u.scene) : asked_columns(u.scene, a.columns);
   } catch (const Error& e) {
-    return fail("tolerance: " + std::string(e.what()), 2);
+    return stop("tolerance: " + std::string(e.what()), 2);
   }
-  if (columns.empty()) return fail("tolerance: " + a.scene + " writes no coordinate column: give --columns", 2);
-  std::size_t plotted = 0;
+  if (u.columns.empty()) return stop("tolerance: " + a.scene + " writes no coordinate column: give --columns", 2);
   if (!a.plot_column.empty()) {
-    auto it = std::find_if(columns.begin(), columns.end(), [&](const OutputColumn& c) {
+    auto it = std::find_if(u.columns.begin(), u.columns.end(), [&](const OutputColumn& c) {
       return c.name == a.plot_column || identifier_column_name(c.name) == a.plot_column;
     });
-    if (it == columns.end())
-      return fail("tolerance: --plot-column: '" + a.plot_column + "' is not one of the outputs (--columns)", 2);
-    plotted = static_cast<std::size_t>(it - columns.begin());
+    if (it == u.columns.end())
+      return stop("tolerance: --plot-column: '" + a.plot_column + "' is not one of the outputs (--columns)", 2);
+    u.plotted = static_cast<std::size_t>(it - u.columns.begin());
   }
-  const bool identifiers = a.names == "identifiers";
-  if (identifiers) {  // names that would collide as identifiers: the scene's to change
+  u.identifiers = a.names == "identifiers";
+  if (u.identifiers) {  // names that would collide as identifiers: the scene's to change
     std::set<std::string> seen{"t"};
-    for (const OutputColumn& c : columns)
+    for (const OutputColumn& c : u.columns)
       for (const char* suffix : {"", ".sd_linear", ".sd_mc", ".mean_mc"})
         if (!seen.insert(identifier_column_name(c.name + suffix)).second)
-          return fail(
+          return stop(
               "tolerance: --names identifiers: two columns would be named " + identifier_column_name(c.name + suffix),
               2);
   }
 
-  // ---- the models along each parameter (sensitivities), sharing the nominal model's analysis
-  scene.sweep.sensitivities.clear();  // the scene's own (read without their models)
-  for (std::size_t j = 0; j < spread.parameters.size(); ++j) {
-    SceneOverrides o = settings;
+  // the models along each parameter (sensitivities), sharing the nominal model's analysis
+  u.scene.sweep.sensitivities.clear();  // the scene's own (read without their models)
+  for (std::size_t j = 0; j < u.spread.parameters.size(); ++j) {
+    SceneOverrides o = u.settings;
     o.sensitivity_models = false;  // (as the nominal scene was read)
     try {
-      scene.sweep.sensitivities.push_back(sensitivity_along(scene, spread.parameters[j].name, nominal[j], 0.0, {}, o));
+      u.scene.sweep.sensitivities.push_back(
+          sensitivity_along(u.scene, u.spread.parameters[j].name, u.nominal[j], 0.0, {}, o));
     } catch (const SceneError& e) {
-      return fail(a.scene + ": " + e.what(), 2);
+      return stop(a.scene + ": " + e.what(), 2);
     }
   }
   // The nominal sweep's written coordinates are the outputs' (--columns may name coordinates the scene does not
   // write): the adjoint form, which the sweep takes when the parameters outnumber them, solves for exactly those.
-  {
-    std::vector<Index> outs;
-    for (const OutputColumn& c : columns) outs.push_back(c.coordinate);
-    std::sort(outs.begin(), outs.end());
-    outs.erase(std::unique(outs.begin(), outs.end()), outs.end());
-    scene.sweep.coordinate_columns = outs;
-    scene.sweep.velocity_columns = scene.sweep.acceleration_columns = outs;
-  }
+  std::vector<Index> outs;
+  for (const OutputColumn& c : u.columns) outs.push_back(c.coordinate);
+  std::sort(outs.begin(), outs.end());
+  outs.erase(std::unique(outs.begin(), outs.end()), outs.end());
+  u.scene.sweep.coordinate_columns = outs;
+  u.scene.sweep.velocity_columns = u.scene.sweep.acceleration_columns = outs;
+  return u;
+}
 
-  // Every output exists before the sweeps: an unwritable path fails now; all are committed together at the end.
-  OutputSet outputs;
-  AtomicOutputFile *csv_file = nullptr, *summary_file = nullptr, *plot_file = nullptr;
-  int status = 0;
-  if (writer) {
-    if (const auto why = samples_out_of_memory(a, static_cast<std::size_t>(rows_written(scene.sweep)), columns.size(),
-                                               spread.parameters.size()))
-      status = fail(*why, 1);
-  }
-  if (writer && status == 0) {
-    try {
-      csv_file = &outputs.add(a.out);
-      if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
-      if (!a.plot.empty()) plot_file = &outputs.add(a.plot);
-    } catch (const Error& e) {
-      status = fail(e.what(), 3);
-    }
-  }
-  if ((status = ranks.agree(status)) != 0) return status;  // every rank stops where rank 0 could not go on
-  const auto start = Clock::now();
-  StopOnSignal stop_on_signal;
-  const std::atomic<bool>& stop = stop_flag();
-
-  // ---- the nominal sweep: values and first-order spreads
-  SquareScene square;
-  if (const auto why = make_square(scene, &square)) return fail(a.scene + ": the nominal scene: " + *why, 1);
-  const Model& model = square.model(*scene.model);
-  const std::size_t np = spread.parameters.size();
-  const SensitivityLayout layout{model.num_coordinates()};
+// The nominal sweep: the outputs' values and first-order spreads at every row, and each parameter's largest
+// sensitivity (zero: no output depends on it).
+struct NominalSweep {
   std::vector<double> t;
-  std::vector<OutputSpread> spreads(columns.size());
-  for (std::size_t o = 0; o < columns.size(); ++o) spreads[o].name = columns[o].name;
-  std::vector<double> largest_sensitivity(np, 0.0);
-  SweepSummary nominal_summary;
-  {
-    Workspace ws(model);
-    ws.q = square.start;
-    Eigen::VectorXd g(static_cast<Eigen::Index>(np));
-    (void)run_sweep(
-        model, scene.sweep, ws,
-        [&](const StepView& step) {
-          t.push_back(step.t);
-          for (std::size_t o = 0; o < columns.size(); ++o) {
-            const OutputColumn& c = columns[o];
-            const Eigen::VectorXd& v = c.order == 0 ? step.q : c.order == 1 ? *step.qd : *step.qdd;
-            spreads[o].nominal.push_back(v(c.coordinate));
-            for (std::size_t j = 0; j < np; ++j) {
-              g(static_cast<Eigen::Index>(j)) = step.sensitivities[layout.offset(j, c.order) + c.coordinate];
-              if (std::isfinite(g(static_cast<Eigen::Index>(j))))
-                largest_sensitivity[j] = std::max(largest_sensitivity[j], std::fabs(g(static_cast<Eigen::Index>(j))));
-            }
-            spreads[o].sd_linear.push_back(tolerance::linear_sd(g, spread.sigma));
+  std::vector<OutputSpread> spreads;
+  std::vector<double> largest_sensitivity;
+  SweepSummary summary;
+};
+NominalSweep nominal_sweep(const ToleranceSetup& u, const Model& model, const Eigen::VectorXd& start,
+                           const std::atomic<bool>& stop) {
+  const std::size_t np = u.spread.parameters.size();
+  const SensitivityLayout layout{model.num_coordinates()};
+  NominalSweep n;
+  n.spreads.resize(u.columns.size());
+  for (std::size_t o = 0; o < u.columns.size(); ++o) n.spreads[o].name = u.columns[o].name;
+  n.largest_sensitivity.assign(np, 0.0);
+  Workspace ws(model);
+  ws.q = start;
+  Eigen::VectorXd g(static_cast<Eigen::Index>(np));
+  (void)run_sweep(
+      model, u.scene.sweep, ws,
+      [&](const StepView& step) {
+        n.t.push_back(step.t);
+        for (std::size_t o = 0; o < u.columns.size(); ++o) {
+          const OutputColumn& c = u.columns[o];
+          const Eigen::VectorXd& v = c.order == 0 ? step.q : c.order == 1 ? *step.qd : *step.qdd;
+          n.spreads[o].nominal.push_back(v(c.coordinate));
+          for (std::size_t j = 0; j < np; ++j) {
+            g(static_cast<Eigen::Index>(j)) = step.sensitivities[layout.offset(j, c.order) + c.coordinate];
+            if (std::isfinite(g(static_cast<Eigen::Index>(j))))
+              n.largest_sensitivity[j] = std::max(n.largest_sensitivity[j], std::fabs(g(static_cast<Eigen::Index>(j))));
           }
-          return !stop.load();
-        },
-        &nominal_summary);
-  }
-  if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
-  if (nominal_summary.status != SolveStatus::kSuccess)
-    return fail(a.scene + ": the nominal scene: " + nominal_summary.message + "; no output written", 1);
+          n.spreads[o].sd_linear.push_back(tolerance::linear_sd(g, u.spread.sigma));
+        }
+        return !stop.load();
+      },
+      &n.summary);
+  return n;
+}
 
-  // ---- the sampled cases: built in order (each shares the nominal model's analysis), swept in parallel
-  const Eigen::MatrixXd offsets = tolerance::sample_offsets(spread, a.samples, a.seed);
-  const auto n_cases = static_cast<std::size_t>(a.samples);
-  std::vector<std::string> why_failed(n_cases);
-  auto values_of = [&](std::size_t k) {
-    std::vector<double> v(np);
-    for (std::size_t j = 0; j < np; ++j)
-      v[j] = nominal[j] + offsets(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
-    return v;
-  };
+// The sampled cases, handed out one at a time to this process's threads (and, under mpirun, to every rank's: rank 0
+// gathers their values), each read from a parsed tree of its thread's own (no YAML parse per case) and swept on one
+// thread: the same values wherever it runs. Each built from its parameter values (offsets from the nominal ones),
+// sharing the nominal model's analysis. Returns the status (non-zero: its line printed; every rank but 0 returns 0
+// when its cases are done).
+struct SampledCases {
   tolerance::CaseValues cases;
-  cases.rows = t.size(), cases.outputs = columns.size();
-  cases.values.resize(n_cases);
-  int threads_used = a.threads;
+  std::vector<std::string> why_failed;
+  int threads_used = 0;
+};
+int sample_cases(const ToleranceArgs& a, const ToleranceSetup& u, const std::vector<double>& t,
+                 const Eigen::MatrixXd& offsets, BatchRanks& ranks, const std::atomic<bool>& stop, SampledCases& out) {
+  const std::size_t np = u.spread.parameters.size(), n_cases = static_cast<std::size_t>(a.samples);
+  out.why_failed.assign(n_cases, "");
+  out.cases.rows = t.size(), out.cases.outputs = u.columns.size();
+  out.cases.values.resize(n_cases);
+  out.threads_used = a.threads <= 0 ? tbb::info::default_concurrency() : a.threads;
   auto overrides_of = [&](std::size_t k) {
     SceneOverrides o;
-    const std::vector<double> v = values_of(k);
-    for (std::size_t j = 0; j < np; ++j) o.parameters.emplace_back(spread.parameters[j].name, v[j]);
-    for (const auto& set : settings.parameters)  // the sampled values replace a toleranced one's
+    for (std::size_t j = 0; j < np; ++j)
+      o.parameters.emplace_back(u.spread.parameters[j].name,
+                                u.nominal[j] + offsets(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j)));
+    for (const auto& set : u.settings.parameters)  // the sampled values replace a toleranced one's
       if (std::none_of(o.parameters.begin(), o.parameters.end(), [&](const auto& p) { return p.first == set.first; }))
         o.parameters.push_back(set);
-    o.share_analysis_with = scene.model.get();
+    o.share_analysis_with = u.scene.model.get();
     o.sensitivity_models = false;
     return o;
   };
-  // The samples, handed out one at a time to this process's threads (and, under mpirun, to every rank's: rank 0
-  // gathers their values), each read from a parsed tree of its thread's own (no YAML parse per case) and swept on
-  // one thread: the same values wherever it runs.
-  {
-    if (threads_used <= 0) threads_used = tbb::info::default_concurrency();
-    std::vector<ParsedScene> trees(static_cast<std::size_t>(threads_used), ParsedScene(scene.text, scene.path));
-    CaseHandlers h;
-    h.run_here = [&](std::size_t k, int w) {
-      SampledCase c = sample_case(trees[static_cast<std::size_t>(w)], overrides_of(k), t, columns, stop);
-      cases.values[k] = std::move(c.values), why_failed[k] = std::move(c.why);
-    };
-    h.run_for_0 = [&](std::size_t k, int w) {
-      const SampledCase c = sample_case(trees[static_cast<std::size_t>(w)], overrides_of(k), t, columns, stop);
-      CaseMessage m;
-      m.kind = stop.load() ? CaseMessage::Kind::kStopped : CaseMessage::Kind::kDone;
-      m.k = static_cast<std::int64_t>(k);
-      m.complete = true, m.failed = !c.why.empty();
-      m.line = c.why;
-      if (!c.values.empty())
-        m.values.assign(reinterpret_cast<const char*>(c.values.data()), c.values.size() * sizeof(double));
-      return m;
-    };
-    std::atomic<bool> remote_stop{false};
-    h.deliver = [&](CaseMessage m) {
-      if (m.kind == CaseMessage::Kind::kStopped) remote_stop = true;
-      if (m.kind != CaseMessage::Kind::kDone) return;
-      const auto k = static_cast<std::size_t>(m.k);
-      why_failed[k] = std::move(m.line);
-      std::vector<double>& v = cases.values[k];
-      v.resize(m.values.size() / sizeof(double));
-      if (!v.empty()) std::memcpy(v.data(), m.values.data(), v.size() * sizeof(double));
-    };
-    h.halted = [&] { return stop.load() || remote_stop.load(); };
-    try {
-      threads_used = run_cases(ranks, 0, n_cases, threads_used, h);
-    } catch (const std::bad_alloc&) {  // a worker's: the cases' outputs and models took what there was
-      return fail(a.scene + ": out of memory with " + std::to_string(n_cases) + " samples on " +
-                      std::to_string(threads_used) +
-                      " threads (fewer --samples, --columns or --threads); no output "
-                      "written",
-                  1);
-    }
-    if (!writer) return 0;  // (rank 0 reports)
-    if (stop.load() || remote_stop.load())
-      return fail(a.scene + ": interrupted (" + signal_name(stop.load() ? interrupt_signal() : SIGTERM) +
-                      "); no output written",
-                  128 + (stop.load() ? interrupt_signal() : SIGTERM));
-  }
-  std::vector<FailedCase> failed;
-  for (std::size_t k = 0; k < n_cases; ++k)
-    if (!why_failed[k].empty()) {
-      cases.values[k].clear();
-      failed.push_back({k, values_of(k), why_failed[k]});
-    }
-  const std::size_t succeeded = cases.succeeded();
-
-  // ---- the Monte Carlo moments and the agreement
-  tolerance::monte_carlo_moments(cases, spreads);
-  // a spread at the solver's tolerance is its noise, not the tolerances' (tolerance_spread.hpp)
-  ToleranceRun run;
-  run.floor = 10.0 * scene.sweep.newton.tolerance * std::max(model.length_scale(), 1.0);
-  for (OutputSpread& s : spreads) {
-    double scale = 1.0;
-    for (double y : s.nominal) scale = std::max(scale, std::fabs(y));
-    s.agreement = tolerance::agreement(s, t, succeeded, run.floor * scale, a.threshold);
-  }
-  run.scene_path = a.scene, run.scene_name = scene.name, run.spread = &spread, run.nominal = nominal;
-  run.covariance_file = a.covariance, run.samples = a.samples, run.seed = a.seed, run.threshold = a.threshold;
-  run.failed = failed, run.threads = threads_used, run.solve_seconds = since(start);
-  run.sensitivity_form = to_string(nominal_summary.sensitivity_form);
-  for (std::size_t j = 0; j < np; ++j)
-    if (largest_sensitivity[j] == 0.0) run.independent.push_back(spread.parameters[j].name);
-  if (succeeded < 2)
-    return fail(a.scene + ": " + std::to_string(succeeded) + " of " + std::to_string(n_cases) +
-                    " sampled cases succeeded: no Monte Carlo spread (first failure: " +
-                    (failed.empty() ? std::string("none")
-                                    : case_label(failed.front(), spread) + ": " + failed.front().message) +
-                    "); no output written",
-                1);
-
-  // ---- the outputs, committed together
+  std::vector<ParsedScene> trees(static_cast<std::size_t>(out.threads_used), ParsedScene(u.scene.text, u.scene.path));
+  CaseHandlers h;
+  h.run_here = [&](std::size_t k, int w) {
+    SampledCase c = sample_case(trees[static_cast<std::size_t>(w)], overrides_of(k), t, u.columns, stop);
+    out.cases.values[k] = std::move(c.values), out.why_failed[k] = std::move(c.why);
+  };
+  h.run_for_0 = [&](std::size_t k, int w) {
+    const SampledCase c = sample_case(trees[static_cast<std::size_t>(w)], overrides_of(k), t, u.columns, stop);
+    CaseMessage m;
+    m.kind = stop.load() ? CaseMessage::Kind::kStopped : CaseMessage::Kind::kDone;
+    m.k = static_cast<std::int64_t>(k);
+    m.complete = true, m.failed = !c.why.empty();
+    m.line = c.why;
+    if (!c.values.empty())
+      m.values.assign(reinterpret_cast<const char*>(c.values.data()), c.values.size() * sizeof(double));
+    return m;
+  };
+  std::atomic<bool> remote_stop{false};
+  h.deliver = [&](CaseMessage m) {
+    if (m.kind == CaseMessage::Kind::kStopped) remote_stop = true;
+    if (m.kind != CaseMessage::Kind::kDone) return;
+    const auto k = static_cast<std::size_t>(m.k);
+    out.why_failed[k] = std::move(m.line);
+    std::vector<double>& v = out.cases.values[k];
+    v.resize(m.values.size() / sizeof(double));
+    if (!v.empty()) std::memcpy(v.data(), m.values.data(), v.size() * sizeof(double));
+  };
+  h.halted = [&] { return stop.load() || remote_stop.load(); };
   try {
-    csv_file->write(tolerance_csv(t, spreads, identifiers));
-    if (summary_file) summary_file->write(json_text(tolerance_summary(run, spreads), 2) + "\n");
-    if (plot_file) plot_file->write(tolerance_svg(scene, t, spreads[plotted], succeeded));
-    outputs.commit();
-  } catch (const Error& e) {
-    return fail(e.what(), 3);
+    out.threads_used = run_cases(ranks, 0, n_cases, out.threads_used, h);
+  } catch (const std::bad_alloc&) {  // a worker's: the cases' outputs and models took what there was
+    return fail(a.scene + ": out of memory with " + std::to_string(n_cases) + " samples on " +
+                    std::to_string(out.threads_used) +
+                    " threads (fewer --samples, --columns or --threads); no output "
+                    "written",
+                1);
   }
+  if (ranks.rank() != 0) return 0;  // (rank 0 reports)
+  if (stop.load() || remote_stop.load())
+    return fail(
+        a.scene + ": interrupted (" + signal_name(stop.load() ? interrupt_signal() : SIGTERM) + "); no output written",
+        128 + (stop.load() ? interrupt_signal() : SIGTERM));
+  return 0;
+}
 
-  // ---- the report on standard error: failures always, the rest unless --quiet
+// The report on standard error: failures always, the rest unless --quiet.
+void report_tolerance(const ToleranceArgs& a, const ToleranceRun& run, const ParameterSpread& spread,
+                      const std::vector<OutputSpread>& spreads, std::size_t succeeded, bool summary_written,
+                      const BatchRanks& ranks) {
+  const auto& failed = run.failed;
+  const auto n_cases = static_cast<std::size_t>(a.samples);
   const std::size_t shown = std::min<std::size_t>(failed.size(), 20);
   for (std::size_t i = 0; i < shown; ++i)
     std::cerr << "phiq: " << printable(a.scene + ": " + case_label(failed[i], spread) + ": " + failed[i].message)
               << "\n";
   if (failed.size() > shown)
     std::cerr << "phiq: " << printable(a.scene) << ": and " << failed.size() - shown << " more failed cases"
-              << (summary_file ? " (all named in the summary)" : " (--summary names them all)") << "\n";
+              << (summary_written ? " (all named in the summary)" : " (--summary names them all)") << "\n";
   if (!failed.empty())
     std::cerr << "phiq: " << printable(a.scene) << ": " << failed.size() << " of " << n_cases
               << " sampled cases failed (left out of the Monte Carlo spread)\n";
@@ -469,17 +418,110 @@ int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
               << significant(s.agreement.sd_mc_at_worst, 4)
               << "; expected near a singular position, where the first-order model fails)\n";
   }
-  if (!a.quiet) {
-    double worst = 0.0;
-    std::string where;
-    for (const OutputSpread& s : spreads)
-      if (s.agreement.worst >= worst) worst = s.agreement.worst, where = s.name;
-    std::cerr << "phiq: " << printable(a.scene) << ": " << succeeded << " of " << n_cases << " cases on "
-              << (ranks.size() > 1 ? ranks.describe() + ", " : "") << threads_used << " threads, " << columns.size()
-              << " outputs, " << disagreeing << " disagreeing (worst " << significant(worst, 3) << " standard errors, "
-              << printable(where) << "; threshold " << significant(a.threshold, 3) << "), "
-              << scientific(run.solve_seconds, 3) << " s; wrote " << printable(a.out) << "\n";
+  if (a.quiet) return;
+  double worst = 0.0;
+  std::string where;
+  for (const OutputSpread& s : spreads)
+    if (s.agreement.worst >= worst) worst = s.agreement.worst, where = s.name;
+  std::cerr << "phiq: " << printable(a.scene) << ": " << succeeded << " of " << n_cases << " cases on "
+            << (ranks.size() > 1 ? ranks.describe() + ", " : "") << run.threads << " threads, " << spreads.size()
+            << " outputs, " << disagreeing << " disagreeing (worst " << significant(worst, 3) << " standard errors, "
+            << printable(where) << "; threshold " << significant(a.threshold, 3) << "), "
+            << scientific(run.solve_seconds, 3) << " s; wrote " << printable(a.out) << "\n";
+}
+
+int cmd_tolerance(const ToleranceArgs& a, BatchRanks& ranks) {
+  const bool writer = ranks.rank() == 0;  // under mpirun, rank 0 alone writes and prints
+  std::vector<NamedPath> outs{{"-o", a.out}};
+  if (!a.summary.empty()) outs.push_back({"--summary", a.summary});
+  if (!a.plot.empty()) outs.push_back({"--plot", a.plot});
+  if (const auto clash = output_clash(outs, {{"the scene", a.scene}, {"the covariance", a.covariance}}))
+    return fail("tolerance: " + *clash, 2);
+  ToleranceSetup u = read_tolerance_setup(a);
+  if (u.status != 0) return u.status;
+  const ParameterSpread& spread = u.spread;
+
+  // Every output exists before the sweeps: an unwritable path fails now; all are committed together at the end.
+  OutputSet outputs;
+  AtomicOutputFile *csv_file = nullptr, *summary_file = nullptr, *plot_file = nullptr;
+  int status = 0;
+  if (writer) {
+    if (const auto why = samples_out_of_memory(a, static_cast<std::size_t>(rows_written(u.scene.sweep)),
+                                               u.columns.size(), spread.parameters.size()))
+      status = fail(*why, 1);
   }
+  if (writer && status == 0) {
+    try {
+      csv_file = &outputs.add(a.out);
+      if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
+      if (!a.plot.empty()) plot_file = &outputs.add(a.plot);
+    } catch (const Error& e) {
+      status = fail(e.what(), 3);
+    }
+  }
+  if ((status = ranks.agree(status)) != 0) return status;  // every rank stops where rank 0 could not go on
+  const auto start = Clock::now();
+  StopOnSignal stop_on_signal;
+  const std::atomic<bool>& stop = stop_flag();
+
+  SquareScene square;
+  if (const auto why = make_square(u.scene, &square)) return fail(a.scene + ": the nominal scene: " + *why, 1);
+  const Model& model = square.model(*u.scene.model);
+  NominalSweep n = nominal_sweep(u, model, square.start, stop);
+  if (stop.load()) return fail(a.scene + ": " + interrupt_message() + "; no output written", interrupt_exit_status());
+  if (n.summary.status != SolveStatus::kSuccess)
+    return fail(a.scene + ": the nominal scene: " + n.summary.message + "; no output written", 1);
+
+  const Eigen::MatrixXd offsets = tolerance::sample_offsets(spread, a.samples, a.seed);
+  SampledCases sampled;
+  if (const int s = sample_cases(a, u, n.t, offsets, ranks, stop, sampled); s != 0 || !writer) return s;
+  const auto n_cases = static_cast<std::size_t>(a.samples);
+  tolerance::CaseValues& cases = sampled.cases;
+  ToleranceRun run;
+  for (std::size_t k = 0; k < n_cases; ++k)
+    if (!sampled.why_failed[k].empty()) {
+      cases.values[k].clear();
+      std::vector<double> v(spread.parameters.size());
+      for (std::size_t j = 0; j < v.size(); ++j)
+        v[j] = u.nominal[j] + offsets(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
+      run.failed.push_back({k, v, sampled.why_failed[k]});
+    }
+  const std::size_t succeeded = cases.succeeded();
+
+  // ---- the Monte Carlo moments and the agreement
+  std::vector<OutputSpread>& spreads = n.spreads;
+  tolerance::monte_carlo_moments(cases, spreads);
+  // a spread at the solver's tolerance is its noise, not the tolerances' (tolerance_spread.hpp)
+  run.floor = 10.0 * u.scene.sweep.newton.tolerance * std::max(model.length_scale(), 1.0);
+  for (OutputSpread& s : spreads) {
+    double scale = 1.0;
+    for (double y : s.nominal) scale = std::max(scale, std::fabs(y));
+    s.agreement = tolerance::agreement(s, n.t, succeeded, run.floor * scale, a.threshold);
+  }
+  run.scene_path = a.scene, run.scene_name = u.scene.name, run.spread = &spread, run.nominal = u.nominal;
+  run.covariance_file = a.covariance, run.samples = a.samples, run.seed = a.seed, run.threshold = a.threshold;
+  run.threads = sampled.threads_used, run.solve_seconds = since(start);
+  run.sensitivity_form = to_string(n.summary.sensitivity_form);
+  for (std::size_t j = 0; j < spread.parameters.size(); ++j)
+    if (n.largest_sensitivity[j] == 0.0) run.independent.push_back(spread.parameters[j].name);
+  if (succeeded < 2)
+    return fail(a.scene + ": " + std::to_string(succeeded) + " of " + std::to_string(n_cases) +
+                    " sampled cases succeeded: no Monte Carlo spread (first failure: " +
+                    (run.failed.empty() ? std::string("none")
+                                        : case_label(run.failed.front(), spread) + ": " + run.failed.front().message) +
+                    "); no output written",
+                1);
+
+  // ---- the outputs, committed together
+  try {
+    csv_file->write(tolerance_csv(n.t, spreads, u.identifiers));
+    if (summary_file) summary_file->write(json_text(tolerance_summary(run, spreads), 2) + "\n");
+    if (plot_file) plot_file->write(tolerance_svg(u.scene, n.t, spreads[u.plotted], succeeded));
+    outputs.commit();
+  } catch (const Error& e) {
+    return fail(e.what(), 3);
+  }
+  report_tolerance(a, run, spread, spreads, succeeded, summary_file != nullptr, ranks);
   return 0;
 }
 
