@@ -139,23 +139,26 @@ TEST(AsmtCompare, RefusesAResultOfAnotherModelAndAFileWithoutTimeSeries) {
   }
 }
 
+}  // namespace
+
+namespace test {
+
 // The command: a run of the file against it, exit 1 naming the differing column; the reports' counts.
 TEST_F(Cli, CompareAResultWithAnAsmtTimeSeries) {
   PHIQ_NEED_ASMT_COMPARE_SAMPLES();
   const std::string gears = AsmtCompareSample("Gears.asmt"), csv = (dir_ / "g.csv").string();
   ASSERT_EQ(run("run -q " + gears + " -o " + csv).code, 0);
-  const test::Result r =
-      run("compare " + csv + " " + gears + " --rtol 0 --atol 1e-9 --json=" + (dir_ / "c.json").string());
+  const Result r = run("compare " + csv + " " + gears + " --rtol 0 --atol 1e-9 --json=" + (dir_ / "c.json").string());
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_NE(r.err.find("phiq: compare: not compared: velocities (VX ... OmegaZ): " + csv + " has none"),
             std::string::npos)
       << r.err;
   EXPECT_NE(r.err.find("differ: 101 cells beyond tolerance; worst Part2.Bryantz"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("Part2.Bryantz"), std::string::npos) << r.err;
-  const test::Result both = run("compare " + gears + " " + gears);
+  const Result both = run("compare " + gears + " " + gears);
   EXPECT_EQ(both.code, 2);
   EXPECT_EQ(both.err, "phiq: compare: " + gears + ", " + gears + ": two .asmt files; one must be a result\n");
 }
 
-}  // namespace
+}  // namespace test
 }  // namespace phiq

@@ -163,11 +163,11 @@ nlohmann::ordered_json summary_modes(const phiq::Scene& scene, std::optional<phi
                                : count_modes(scene, t, position, threads));
 }
 
+// `drv`: the drivers and time grid given to a robot description (--drive, --time; phiq/import_model.hpp).
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode,
             bool identifier_names, const std::vector<std::string>& sets,
-            const std::vector<std::string>& sensitivity_args, int mode,
-            const phiq::ImportOptions& import_options_given) {
+            const std::vector<std::string>& sensitivity_args, int mode, const ImportOptions& drv) {
   const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
@@ -183,7 +183,7 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   set_interrupt_subject(scene_path, "; no output written");
   const auto load_start = Clock::now();
   // (--sensitivity's parameters in place of the scene's output.sensitivities, whose models are then not made)
-  std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets, sensitivity_args, import_options_given);
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets, sensitivity_args, drv);
   if (!loaded) return 2;
   phiq::Scene& scene = *loaded;
   const double load_s = since(load_start);
@@ -397,13 +397,11 @@ Command register_run(CLI::App& app) {
       run, [a] {
         using Mode = ProgressBar::Mode;
         const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
-        phiq::ImportOptions import_options_given;
-        if (const auto bad = import_options("run", a->scene_path, a->drives, a->time, &import_options_given))
-          return fail(*bad, 2);
+        phiq::ImportOptions drives;
+        if (const auto bad = import_options("run", a->scene_path, a->drives, a->time, &drives)) return fail(*bad, 2);
         return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet, a->summary_path,
                                            cap_threads("run", a->threads, a->quiet), a->memory_gb, mode,
-                                           a->names == "identifiers", a->sets, a->sensitivities, a->mode,
-                                           import_options_given));
+                                           a->names == "identifiers", a->sets, a->sensitivities, a->mode, drives));
       }};
 }
 
