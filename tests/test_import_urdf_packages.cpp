@@ -3,6 +3,8 @@
 // refused when the shapes are what is asked for (ImportOptions::need_geometry, `phiq animate`).
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -91,6 +93,16 @@ TEST_F(UrdfPackages, MeshesAreFoundAboveTheFileAndOnTheRosPackagePathAndTheMissi
 }
 
 TEST_F(UrdfPackages, AMissingPackageIsRefusedWhenTheShapesAreAskedFor) {
+  // `phiq animate` draws the shapes: exit 2, its one line, nothing written
+  const fs::path out = dir_ / "robot.html", err = dir_ / "stderr.txt";
+  const std::string command =
+      std::string(PHIQ_CLI) + " animate " + urdf_ + " -o " + out.string() + " 2>" + err.string();
+  const int status = std::system(command.c_str());
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << status;
+  EXPECT_EQ(test::import_text(err.string()), "phiq: animate: " + urdf_ +
+                                                 ":8: <visual> mesh 'package://ghost/a.stl': its package is neither "
+                                                 "on ROS_PACKAGE_PATH nor a folder above the file\n");
+  EXPECT_FALSE(fs::exists(out));
   ImportOptions drawn;
   drawn.need_geometry = true;
   try {
