@@ -87,6 +87,33 @@ TEST(SdfImport, EveryJointTypeLeavesItsFreedoms) {
   EXPECT_LT(phi.lpNorm<Eigen::Infinity>(), 1e-12);
 }
 
+// A nested model's links and joints (arm::link, arm::wrist) placed by the model's pose: shoulder at angle t, wrist
+// at 2t; arm::link turns about its origin (1, 0.5, 0), arm::tip 0.5 m from it.
+TEST(SdfImport, NestedModelIsPlacedByItsPoseAndItsJointsScoped) {
+  const std::string path = import_data("sdf/nested_arm.sdf");
+  ImportOptions o;
+  o.drives = {{"shoulder", "t"}, {"arm::wrist", "2*t"}}, o.t_end = 1, o.steps = 10;
+  const ModelImport imported = import_sdf(import_text(path), path, o);
+  EXPECT_EQ(imported.bodies, 3);
+  EXPECT_EQ(imported.joints, 3);
+  EXPECT_EQ(imported.loops, 0);
+  const test::ImportRun r = import_sweep(imported.yaml, path);
+  ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
+  ASSERT_EQ(r.trace.q.size(), 11u);
+  for (std::size_t k = 0; k < r.trace.q.size(); ++k) {
+    const double t = r.trace.t[k];
+    const Eigen::VectorXd& q = r.trace.q[k];
+    EXPECT_LT((test::import_point(r.model(), q, "arm__link") - Eigen::Vector3d(1, 0.5, 0)).norm(), 1e-10) << t;
+    EXPECT_LT((test::import_point(r.model(), q, "arm__tip") -
+               Eigen::Vector3d(1 - 0.5 * std::sin(t), 0.5 + 0.5 * std::cos(t), 0))
+                  .norm(),
+              1e-10)
+        << t;
+    EXPECT_NEAR(test::import_yaw(r.model(), q, "arm__link"), std::remainder(M_PI / 2 + t, 2 * M_PI), 1e-10) << t;
+    EXPECT_NEAR(test::import_yaw(r.model(), q, "arm__tip"), std::remainder(M_PI / 2 + 3 * t, 2 * M_PI), 1e-10) << t;
+  }
+}
+
 TEST(SdfImport, BadInputIsOneLineNamingFileAndLine) {
   const std::string good = import_text(import_data("sdf/fourbar.sdf"));
   ASSERT_EQ(SdfError(good), "");

@@ -114,7 +114,14 @@ int cmd_animate(const AnimateOptions& o) {
     return fail("animate: " + *clash, 2);
   std::string text;
   try {
-    const Scene scene = load_scene(o.scene, SceneLimits{}, parameter_settings(o.sets));
+    // a robot description's meshes are what is drawn: one that cannot be found is an error here (need_geometry)
+    const ModelFormat format = model_format(o.scene);
+    ImportOptions drawn;
+    drawn.need_geometry = true;
+    const Scene scene =
+        format == ModelFormat::kScene || format == ModelFormat::kAsmt
+            ? load_scene(o.scene, SceneLimits{}, parameter_settings(o.sets))
+            : parse_scene(import_model_file(o.scene, drawn).yaml, o.scene, SceneLimits{}, parameter_settings(o.sets));
     if (o.modes) {  // one pose per real assembly mode
       set_interrupt_subject("animate: " + o.out, "; no output written");
       std::vector<std::string> labels;

@@ -1,6 +1,8 @@
 // The helpers every phiq command shares (command_support.hpp).
 #include "command_support.hpp"
 
+#include <cmath>
+
 #include <unistd.h>
 
 #include <cerrno>
@@ -133,14 +135,49 @@ std::optional<std::string> import_or_report(const std::string& path, const Impor
   return std::nullopt;
 }
 
+void add_import_options(CLI::App* command, std::vector<std::string>* drives, std::vector<double>* time) {
+  command->add_option(
+      "--drive", *drives,
+      "JOINT=EXPR (URDF, MJCF, SDF; repeatable): drive the joint's angle (rad, 0 at the file's pose) or "
+      "travel (m) by an expression of t");
+  command
+      ->add_option("--time", *time, "START END STEPS (URDF, MJCF, SDF): the time grid (default 0 0 0: the file's pose)")
+      ->expected(3);
+}
+
+std::optional<std::string> import_options(const std::string& command, const std::string& path,
+                                          const std::vector<std::string>& drives, const std::vector<double>& time,
+                                          ImportOptions* options) {
+  for (const std::string& d : drives) {
+    const std::size_t eq = d.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == d.size())
+      return command + ": --drive " + d + ": not JOINT=EXPR";
+    options->drives.emplace_back(d.substr(0, eq), d.substr(eq + 1));
+  }
+  if (!time.empty()) {
+    const double steps = time[2];
+    if (!(steps >= 0) || steps != std::floor(steps) || steps > 1e9)
+      return command + ": --time: STEPS must be a whole number from 0 to 1e9";
+    options->t_start = time[0], options->t_end = time[1], options->steps = static_cast<int>(steps);
+  }
+  if (drives.empty() && time.empty()) return std::nullopt;
+  const ModelFormat format = path == "-" ? ModelFormat::kScene : model_format(path);
+  if (format == ModelFormat::kAsmt)
+    return command + ": --drive and --time are for URDF, MJCF and SDF: an .asmt file has its motions";
+  if (format == ModelFormat::kScene)
+    return command + ": --drive and --time are for URDF, MJCF and SDF: a scene has its drivers and time";
+  return std::nullopt;
+}
+
 std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets,
-                                    const std::vector<std::string>& sensitivity_args) {
+                                    const std::vector<std::string>& sensitivity_args,
+                                    const ImportOptions& import_options_given) {
   try {
     SceneOverrides o = parameter_settings(sets);
     o.sensitivities = sensitivity_requests(sensitivity_args), o.sensitivities_source = "--sensitivity";
     if (path == "-") return phiq::parse_scene(load_stdin_text(), kStdinScene, SceneLimits{}, o);
     if (model_format(path) != ModelFormat::kScene) {  // converted here rather than in load_scene(), to list what
-      const std::optional<std::string> imported = import_or_report(path);  // it leaves out
+      const std::optional<std::string> imported = import_or_report(path, import_options_given);  // it leaves out
       if (!imported) return std::nullopt;
       return phiq::parse_scene(*imported, path, SceneLimits{}, o);
     }

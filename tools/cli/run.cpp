@@ -163,10 +163,11 @@ nlohmann::ordered_json summary_modes(const phiq::Scene& scene, std::optional<phi
                                : count_modes(scene, t, position, threads));
 }
 
+// `drv`: the drivers and time grid given to a robot description (--drive, --time; phiq/import_model.hpp).
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode,
             bool identifier_names, const std::vector<std::string>& sets,
-            const std::vector<std::string>& sensitivity_args, int mode) {
+            const std::vector<std::string>& sensitivity_args, int mode, const ImportOptions& drv) {
   const std::string scene_path = scene_label(scene_arg);  // "-": standard input, named <stdin>
   // Outputs that would replace the scene or each other are refused before anything is read or solved.
   std::vector<NamedPath> outs;
@@ -182,7 +183,7 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   set_interrupt_subject(scene_path, "; no output written");
   const auto load_start = Clock::now();
   // (--sensitivity's parameters in place of the scene's output.sensitivities, whose models are then not made)
-  std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets, sensitivity_args);
+  std::optional<phiq::Scene> loaded = load_or_report(scene_arg, sets, sensitivity_args, drv);
   if (!loaded) return 2;
   phiq::Scene& scene = *loaded;
   const double load_s = since(load_start);
@@ -345,6 +346,8 @@ Command register_run(CLI::App& app) {
     std::vector<std::string> sets;
     std::vector<std::string> sensitivities;
     int mode = 0;
+    std::vector<std::string> drives;  // of a URDF, MJCF or SDF file, as `phiq convert` adds them
+    std::vector<double> time;
   };
   auto a = std::make_shared<Args>();
   CLI::App* run = app.add_subcommand("run", "Solve position, velocity and acceleration over the scene's time sweep");
@@ -389,13 +392,16 @@ Command register_run(CLI::App& app) {
                   "Start from real assembly mode K as `phiq modes` numbers them (0: the rough placement)")
       ->capture_default_str()
       ->check(whole_number(0, 1000000, "the rough placement"));
+  add_import_options(run, &a->drives, &a->time);
   return {
       run, [a] {
         using Mode = ProgressBar::Mode;
         const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
+        phiq::ImportOptions drives;
+        if (const auto bad = import_options("run", a->scene_path, a->drives, a->time, &drives)) return fail(*bad, 2);
         return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet, a->summary_path,
                                            cap_threads("run", a->threads, a->quiet), a->memory_gb, mode,
-                                           a->names == "identifiers", a->sets, a->sensitivities, a->mode));
+                                           a->names == "identifiers", a->sets, a->sensitivities, a->mode, drives));
       }};
 }
 

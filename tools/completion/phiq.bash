@@ -24,7 +24,7 @@ _phiq() {
   local opts=""
   case "$cmd" in
     run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names --set
-               --sensitivity --mode" ;;
+               --sensitivity --mode --drive --time" ;;
     check) opts="--help --json --time --set" ;;
     assemble) opts="--help --output --quiet --set" ;;
     batch) opts="--help --output --quiet --threads --summary --names --resume --sensitivity" ;;
@@ -56,7 +56,7 @@ _phiq() {
     --summary|--junit|-o|--output|--covariance|--plot) COMPREPLY=($(compgen -f -- "$cur")); return ;;
     --threads|--memory|--steps|--from|--to|--twist|--time|--rtol|--atol|--columns|--positions|--tolerances|\
     --steps-list|--repeat|--outputs|--deflate|--sd|--limit|--samples|--seed|--threshold|--plot-column|--set|\
-    --sensitivity|--at|--along|--max-paths|--mode) return ;;  # a value of the user's
+    --sensitivity|--at|--along|--max-paths|--mode|--drive) return ;;  # a value of the user's
   esac
   if [[ "$cur" == -* ]]; then
     COMPREPLY=($(compgen -W "$opts" -- "$cur"))

@@ -6,7 +6,10 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "phiq/csv_compare.hpp"
 
 namespace phiq {
 
@@ -17,6 +20,8 @@ struct AsmtImport {
   int parts = 0;                     ///< parts read (each a body)
   int joints = 0;                    ///< joints read (each one or more constraints)
   int motions = 0;                   ///< motions read (each a driver)
+  /// each part's name in the file and its body's in the scene (they differ where the name is no phiq name)
+  std::vector<std::pair<std::string, std::string>> bodies;
 };
 
 /// Converts the text of an `.asmt` file; `path` names it in messages. Throws SceneError, one line "PATH:LINE: what"
@@ -47,5 +52,22 @@ struct AsmtTimeSeries {
 /// Reads the TimeSeries after the assembly (empty when the file has none). Throws SceneError naming FILE:LINE for a
 /// row whose length differs from the times'.
 AsmtTimeSeries read_asmt_time_series(const std::string& text, const std::string& path);
+
+/// A phiq result and an `.asmt` file's TimeSeries as two tables of the same columns, for compare_csv(): `t`, then
+/// per part of the TimeSeries `PART.X`, `PART.Y`, `PART.Z` (its reference point), `PART.Bryantx` … `PART.Bryantz`
+/// (rotation Rx·Ry·Rz), and, where the result holds velocities, `PART.VX` … `PART.OmegaZ` (Ω in the world frame),
+/// where it holds accelerations `PART.AX` … `PART.AlphaZ`: the TimeSeries' own names and units.
+struct AsmtComparison {
+  CsvTable result;                    ///< the phiq result's quantities, from its bodies' x, y, z, e0..e3 (and rates)
+  CsvTable series;                    ///< the TimeSeries' rows (its `Input` column dropped)
+  std::vector<std::string> left_out;  ///< quantities of the TimeSeries not compared, and why, one line each
+};
+
+/// The tables to compare between `result` (a `phiq run` of the file, dotted or identifier column names) and the
+/// TimeSeries of the `.asmt` file at `asmt_path`. A result's Bryant angle is taken modulo 2π nearest the stored one
+/// (a turn is no difference); other differences, a gear's other branch included, are kept. Throws SceneError naming
+/// the file for one that cannot be imported or holds no TimeSeries, and Error "RESULT: ..." for a result that lacks
+/// a part's x, y, z, e0..e3 columns.
+AsmtComparison asmt_comparison(const CsvTable& result, const std::string& asmt_path);
 
 }  // namespace phiq

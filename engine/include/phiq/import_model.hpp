@@ -36,6 +36,9 @@ struct ImportOptions {
   double t_start = 0.0;  ///< the time grid's start (s)
   double t_end = 0.0;    ///< its end (s); with no drives and t_end == t_start: the model's pose alone
   int steps = 0;         ///< its intervals (0: one row at t_start)
+  /// The shapes are what the caller works on (`phiq clearance`): a URDF mesh whose `package://` cannot be found is
+  /// refused rather than left out.
+  bool need_geometry = false;
 };
 
 /// What an import made of a file.
@@ -48,21 +51,26 @@ struct ModelImport {
   int couplers = 0;                  ///< couplers between joints (URDF mimic, MJCF joint equality)
 };
 
-/// Converts the text of a URDF file; `path` names it in messages and is the folder meshes are relative to.
+/// Converts the text of a URDF file; `path` names it in messages and is the folder meshes are relative to. A mesh
+/// `package://PACKAGE/FILE` is FILE in the folder PACKAGE on ROS_PACKAGE_PATH (an entry is the package or holds it),
+/// else in a folder above the file named PACKAGE or holding it; one found nowhere is listed once as not mapped.
 /// Joints named `closing_*` close loops: they are taken out before urdfdom reads the tree and joined like the others.
 /// Throws SceneError, one line "PATH:LINE: what", for malformed XML, an unknown joint type, a joint naming a missing
 /// link, a cycle or a link with two parents that no `closing_` name declares, a mimic of a missing joint, a driver of
 /// an unknown joint.
 ModelImport import_urdf(const std::string& text, const std::string& path, const ImportOptions& options = {});
 
-/// Converts the text of an MJCF file (`<mujoco>`). Throws SceneError "PATH:LINE: what" for malformed XML, an
-/// element that changes the kinematics and phiq cannot represent exactly (an `include`, a `frame`, a nonlinear joint
-/// equality's polycoef, a joint type or geom reference it does not know), and as import_urdf() for drivers.
+/// Converts the text of an MJCF file (`<mujoco>`), with the files it `include`s (relative to `path`'s folder) and its
+/// `frame`s. Throws SceneError "FILE:LINE: what" (FILE the included file where the fault is in it) for malformed XML,
+/// an include that cannot be read or includes itself, an element that changes the kinematics and phiq cannot
+/// represent exactly (a joint in a frame, a nonlinear joint equality's polycoef, a joint type, geom reference or site
+/// it does not know), and as import_urdf() for drivers.
 ModelImport import_mjcf(const std::string& text, const std::string& path, const ImportOptions& options = {});
 
 /// Converts the text of an SDF file: its model (or its world's first), links as bodies, joints revolute,
 /// continuous, prismatic, ball, fixed and universal in any graph (loops close natively). Throws SceneError
-/// "PATH:LINE: what" for what libsdformat refuses, another joint type, a nested or static model.
+/// "PATH:LINE: what" for what libsdformat refuses, another joint type, a static model. A nested model's links and
+/// joints are named as SDF scopes them (`arm::link`), placed by the model's pose.
 ModelImport import_sdf(const std::string& text, const std::string& path, const ImportOptions& options = {});
 
 /// import_urdf(), import_mjcf() or import_sdf() of the file at `path`, by model_format(), read as load_scene() reads a

@@ -65,7 +65,8 @@ struct Assembly {
   double tstart = 0.0, tend = 0.0, hout = 0.0;
   int time_line = 0;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
-  std::vector<std::string> skipped;  // "FILE:LINE: what: why", once each
+  std::vector<std::string> skipped;                         // "FILE:LINE: what: why", once each
+  std::vector<std::pair<std::string, std::string>> bodies;  // each part's name and its body's, set by write_scene()
 };
 
 // Reads the tree up to the TimeSeries. Throws SceneError "PATH:LINE: ..." for what cannot be read.

@@ -476,6 +476,7 @@ std::string SceneWriter::write() {
     if (body_of_part_.count(p.name)) refuse(a_.path, p.line, "a second part named '" + p.name + "'");
     const std::string b = names_.make(p.name, true);
     body_of_part_[p.name] = b;
+    a_.bodies.emplace_back(p.name, b);
     Eigen::Quaterniond q(p.placement.R);
     q.normalize();
     if (q.w() < 0) q.coeffs() = -q.coeffs();

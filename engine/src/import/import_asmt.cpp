@@ -21,6 +21,7 @@ AsmtImport import_asmt(const std::string& text, const std::string& path) {
   out.motions = static_cast<int>(a.motions.size());
   out.yaml = detail::asmt::write_scene(a);
   out.skipped = std::move(a.skipped);
+  out.bodies = std::move(a.bodies);
   return out;
 }
 

@@ -34,7 +34,8 @@ struct Shape {
 struct Body {
   std::string name;  // the file's
   int line = 0;
-  Pose world;  // at the model's pose
+  std::string file;  // the file of `line` when not Mechanism::path (an MJCF <include>d file)
+  Pose world;        // at the model's pose
   bool has_mass = false;
   double mass = 0.0;
   Eigen::Vector3d com = Eigen::Vector3d::Zero();      // in the body's frame
@@ -57,6 +58,7 @@ struct Side {
 struct Joint {
   std::string name;  // the file's
   int line = 0;
+  std::string file;  // as Body::file
   std::string kind;  // phiq's: revolute, prismatic, rigid, spherical, planar, cylindrical; "" for a free body
   Side parent, child;
   bool closing = false;  // closes a loop (not a tree edge)
@@ -68,6 +70,7 @@ struct Coupler {
   int line = 0;
   int joint = -1, other = -1;  // indices in Mechanism::joints
   double multiplier = 1.0, offset = 0.0;
+  std::string file;  // as Body::file
 };
 
 struct Mechanism {
@@ -79,13 +82,15 @@ struct Mechanism {
   // Elements not mapped, by what they are: the first line, how many, why (written once each as `skipped`).
   struct Unmapped {
     int line = 0, count = 0;
-    std::string why;
+    std::string why, file;  // file: as Body::file
   };
   std::map<std::string, Unmapped> unmapped;
-  void skip(const std::string& what, int line, const std::string& why) {
+  void skip(const std::string& what, int line, const std::string& why, const std::string& file = "") {
     Unmapped& u = unmapped[what];
-    if (u.count++ == 0) u.line = line, u.why = why;
+    if (u.count++ == 0) u.line = line, u.why = why, u.file = file;
   }
+  // The file an element's line is in.
+  const std::string& file_of(const std::string& file) const { return file.empty() ? path : file; }
 };
 
 // The phiq scene of a mechanism, with the drivers and time grid of `options`. Throws SceneError naming the file for

@@ -75,7 +75,7 @@ std::string MechanismWriter::joint_coordinate(int j, const Coupler& c) {
     return joint_coordinate_[j] = name;
   }
   if (joint.kind != "prismatic")
-    refuse(m_.path, c.line,
+    refuse(m_.file_of(c.file), c.line,
            "'" + c.name + "' couples " + (joint.kind.empty() ? "a free" : joint.kind) + " joint '" + joint.name +
                "': phiq couples revolute angles and prismatic travels");
   // travel = (R₁ a) · (r₂ + R₂ b − r₁) − a · p, a the axis and p the point of side 1, b the point of side 2
@@ -130,7 +130,8 @@ void MechanismWriter::coupler(const Coupler& c) {
     return;
   }
   if (c.multiplier == 0.0)
-    refuse(m_.path, c.line, "'" + c.name + "': a multiplier of 0 holds the joint still: phiq's coupler needs one ≠ 0");
+    refuse(m_.file_of(c.file), c.line,
+           "'" + c.name + "': a multiplier of 0 holds the joint still: phiq's coupler needs one ≠ 0");
   const std::string r = joint_coordinate(c.other, c);
   constraints_ << "  - {name: " << name << ", type: coupler, coordinates: [" << q << ", " << r
                << "], coefficients: [1, " << scene_number(-c.multiplier) << "], constant: " << scene_number(c.offset)
@@ -149,7 +150,7 @@ void MechanismWriter::drivers() {
     if (found < 0) refuse(m_.path, 0, "--drive " + joint + ": the model has no joint '" + joint + "'");
     const Joint& j = m_.joints[static_cast<std::size_t>(found)];
     if (j.kind != "revolute" && j.kind != "prismatic")
-      refuse(m_.path, j.line,
+      refuse(m_.file_of(j.file), j.line,
              "--drive " + joint + ": a " + (j.kind.empty() ? "free" : j.kind) +
                  " joint; phiq drives a revolute joint's angle or a prismatic joint's travel");
     try {
@@ -227,11 +228,16 @@ std::string MechanismWriter::write() {
   drivers();
   const std::string mass = parts();
   for (const auto& [what, u] : m_.unmapped)
-    m_.skipped.push_back(m_.path + ":" + std::to_string(u.line) + ": " + what +
+    m_.skipped.push_back(m_.file_of(u.file) + ":" + std::to_string(u.line) + ": " + what +
                          (u.count > 1 ? " (" + std::to_string(u.count) + " in all)" : "") + ": " + u.why);
-  const auto line_of = [&](const std::string& why) { return std::atoi(why.c_str() + m_.path.size() + 1); };
+  // the main file's lines first, in order, then each included file's (MJCF <include>)
+  const auto where = [&](const std::string& why) {
+    const bool main = why.compare(0, m_.path.size() + 1, m_.path + ":") == 0;
+    const std::size_t colon = main ? m_.path.size() : why.rfind(':', why.find(": ") - 1);
+    return std::make_pair(main ? std::string() : why.substr(0, colon), std::atoi(why.c_str() + colon + 1));
+  };
   std::stable_sort(m_.skipped.begin(), m_.skipped.end(),
-                   [&](const std::string& x, const std::string& y) { return line_of(x) < line_of(y); });
+                   [&](const std::string& x, const std::string& y) { return where(x) < where(y); });
   std::ostringstream s;
   s << "# Converted by phiq from " << single_line(m_.path) << " (" << m_.format << "): " << m_.units << "\n";
   if (!m_.skipped.empty()) s << "# Not mapped:\n";

@@ -3,8 +3,9 @@
 // eulerseq, xyaxes or zaxis; angles in degrees unless `<compiler angle="radian">`); joints in the body's frame at the
 // model's pose, several in one body applied in order (phiq gives each after the first a massless body of its own);
 // a body without a joint welded to its parent; default classes (`class`, `childclass`) for joints, geoms and
-// inertials; geoms as parts' shapes (sizes are half-sizes in MJCF); equality constraints `connect`, `weld` and `joint`
-// as joints and couplers.
+// inertials; geoms as parts' shapes (sizes are half-sizes in MJCF); `frame`s placing what they hold; `include`d files
+// (mjcf_documents.hpp); equality constraints `connect`, `weld` (between bodies or sites) and `joint` as joints and
+// couplers.
 #include <tinyxml2.h>
 
 #include <Eigen/Geometry>
@@ -14,6 +15,7 @@
 #include <sstream>
 
 #include "import/mechanism.hpp"
+#include "import/mjcf_documents.hpp"
 #include "phiq/scene.hpp"
 
 namespace phiq {
@@ -38,19 +40,38 @@ class MjcfReader {
                               std::vector<double> fallback, std::size_t count_min, std::size_t count_max) const;
   Eigen::Matrix3d rotation(const tinyxml2::XMLElement* e, const std::string& childclass) const;
   Pose pose(const tinyxml2::XMLElement* e, const std::string& childclass) const;
-  void body(const tinyxml2::XMLElement* e, int parent, const std::string& childclass);
+  // A child element with the pose of the <frame>s it stands in (identity outside any) and its class in effect.
+  struct Placed {
+    const tinyxml2::XMLElement* e;
+    Pose frame;
+    std::string childclass;
+  };
+  // The children of `e`, the contents of <frame>s among them in their place.
+  std::vector<Placed> placed(const tinyxml2::XMLElement* e, const std::string& childclass, const Pose& frame = {});
+  void body(const tinyxml2::XMLElement* e, int parent, const std::string& childclass, const Pose& frame = {});
+  // A geom (as geom()) placed by its frame, or a site recorded for the equalities that name it.
+  void placed_geom_or_site(const Placed& c, int body, bool* solid_only, std::optional<double>* density);
   void geom(const tinyxml2::XMLElement* e, Body* b, const std::string& childclass, bool* solid_only,
             std::optional<double>* density);
   void equality(const tinyxml2::XMLElement* e);
+  // A connect (spherical) or weld (rigid) equality between bodies (anchor, relpose) or sites, closing a loop.
+  Joint connect_or_weld(const tinyxml2::XMLElement* e, const std::string& name);
   int body_named(const tinyxml2::XMLElement* e, const char* attribute, bool required) const;
   double angle(double v) const { return degrees_ ? v * M_PI / 180.0 : v; }
   void unmapped(const tinyxml2::XMLElement* e, const std::string& why) {
-    m_.skip(std::string("<") + e->Name() + ">", e->GetLineNum(), why);
+    skip_at(e, std::string("<") + e->Name() + ">", why);
+  }
+  void skip_at(const tinyxml2::XMLElement* e, const std::string& what, const std::string& why) {
+    m_.skip(what, e->GetLineNum(), why, docs_.included_file(e));
+  }
+  // "FILE:LINE: what" for the element, in the file it was read from.
+  [[noreturn]] void fail(const tinyxml2::XMLElement* e, const std::string& what) const {
+    refuse(docs_.file_of(e), e->GetLineNum(), what);
   }
 
   const std::string& text_;
   const std::string& path_;
-  tinyxml2::XMLDocument doc_;
+  MjcfDocuments docs_{path_};
   bool degrees_ = true;
   std::string eulerseq_ = "xyz", meshdir_;
   std::map<std::string, std::map<std::string, Attributes>> defaults_;  // class → element → attributes
@@ -61,6 +82,11 @@ class MjcfReader {
   };
   std::map<std::string, MeshAsset> meshes_;
   std::map<std::string, int> body_index_, joint_index_;
+  struct Site {
+    int body = 0;
+    Pose at;  // in the body's frame
+  };
+  std::map<std::string, Site> sites_;
   std::map<int, double> joint_ref_;  // a hinge's or slide's `ref` (qpos at the model's pose), by joint index
   int loops_ = 0;
   Mechanism m_;
@@ -70,28 +96,27 @@ void MjcfReader::compiler(const tinyxml2::XMLElement* e) {
   for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
     const std::string name = a->Name(), value = a->Value();
     if (name == "angle") {
-      if (value != "degree" && value != "radian")
-        refuse(path_, e->GetLineNum(), "<compiler angle=\"" + value + "\">: degree or radian");
+      if (value != "degree" && value != "radian") fail(e, "<compiler angle=\"" + value + "\">: degree or radian");
       degrees_ = value == "degree";
     } else if (name == "eulerseq") {
       if (value.size() != 3 || value.find_first_not_of("xyzXYZ") != std::string::npos)
-        refuse(path_, e->GetLineNum(), "<compiler eulerseq=\"" + value + "\">: three of x, y, z, X, Y, Z");
+        fail(e, "<compiler eulerseq=\"" + value + "\">: three of x, y, z, X, Y, Z");
       eulerseq_ = value;
     } else if (name == "meshdir") {
       meshdir_ = value;
     } else {
-      m_.skip("<compiler " + name + ">", e->GetLineNum(), "a setting of MuJoCo's compiler phiq does not need");
+      skip_at(e, "<compiler " + name + ">", "a setting of MuJoCo's compiler phiq does not need");
     }
   }
 }
 
 void MjcfReader::defaults(const tinyxml2::XMLElement* e, const std::string& cls, const std::string& parent) {
   parent_class_[cls] = parent;
-  for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+  for (const tinyxml2::XMLElement* c : docs_.children(e)) {
     const std::string tag = c->Name();
     if (tag == "default") {
       const char* name = c->Attribute("class");
-      if (!name) refuse(path_, c->GetLineNum(), "a nested <default> without a class");
+      if (!name) fail(c, "a nested <default> without a class");
       defaults(c, name, cls);
     } else if (tag == "joint" || tag == "geom" || tag == "mesh") {
       Attributes& a = defaults_[cls][tag];
@@ -103,14 +128,14 @@ void MjcfReader::defaults(const tinyxml2::XMLElement* e, const std::string& cls,
 }
 
 void MjcfReader::assets(const tinyxml2::XMLElement* e) {
-  for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+  for (const tinyxml2::XMLElement* c : docs_.children(e)) {
     if (std::string(c->Name()) != "mesh") {
       unmapped(c, "textures, materials and height fields: phiq's parts take rgba colours only");
       continue;
     }
     MeshAsset mesh;
     const char* file = c->Attribute("file");
-    if (!file) refuse(path_, c->GetLineNum(), "<mesh> without a file (meshes given by vertices are not read)");
+    if (!file) fail(c, "<mesh> without a file (meshes given by vertices are not read)");
     mesh.file = meshdir_.empty() ? std::string(file) : (std::filesystem::path(meshdir_) / file).string();
     const std::vector<double> s = numbers(c, "scale", "", {1, 1, 1}, 3, 3);
     mesh.scale = Eigen::Vector3d(s[0], s[1], s[2]);
@@ -134,8 +159,7 @@ const std::string* MjcfReader::attr(const tinyxml2::XMLElement* e, const char* n
         if (const auto v = t->second.find(name); v != t->second.end()) return &v->second;
     const auto p = parent_class_.find(cls);
     if (p == parent_class_.end()) {
-      if (cls != "main" && !defaults_.count(cls))
-        refuse(path_, e->GetLineNum(), "class '" + cls + "' is not a <default> class of the file");
+      if (cls != "main" && !defaults_.count(cls)) fail(e, "class '" + cls + "' is not a <default> class of the file");
       break;
     }
     cls = p->second;
@@ -152,11 +176,10 @@ std::vector<double> MjcfReader::numbers(const tinyxml2::XMLElement* e, const cha
   std::vector<double> v;
   for (double x; in >> x;) v.push_back(x);
   if (!(in.eof()) || v.size() < count_min || v.size() > count_max || v.empty())
-    refuse(path_, e->GetLineNum(),
-           std::string("<") + e->Name() + " " + name + "=\"" + *text + "\">: " +
-               (count_min == count_max ? std::to_string(count_min)
-                                       : std::to_string(count_min) + " to " + std::to_string(count_max)) +
-               " numbers");
+    fail(e, std::string("<") + e->Name() + " " + name + "=\"" + *text + "\">: " +
+                (count_min == count_max ? std::to_string(count_min)
+                                        : std::to_string(count_min) + " to " + std::to_string(count_max)) +
+                " numbers");
   return v;
 }
 
@@ -164,7 +187,7 @@ Eigen::Matrix3d MjcfReader::rotation(const tinyxml2::XMLElement* e, const std::s
   if (e->Attribute("quat")) {
     const std::vector<double> q = numbers(e, "quat", cc, {}, 4, 4);
     const Eigen::Quaterniond r(q[0], q[1], q[2], q[3]);
-    if (!(r.norm() > 0)) refuse(path_, e->GetLineNum(), "a zero quat");
+    if (!(r.norm() > 0)) fail(e, "a zero quat");
     return r.normalized().toRotationMatrix();
   }
   if (e->Attribute("axisangle")) {
@@ -242,28 +265,27 @@ void MjcfReader::geom(const tinyxml2::XMLElement* e, Body* b, const std::string&
   } else if (type == "mesh") {
     const std::string* name = attr(e, "mesh", cc);
     if (!name || !meshes_.count(*name))
-      refuse(path_, e->GetLineNum(),
-             "geom of type mesh names no <mesh> asset" + (name ? " '" + *name + "'" : std::string()));
+      fail(e, "geom of type mesh names no <mesh> asset" + (name ? " '" + *name + "'" : std::string()));
     const MeshAsset& mesh = meshes_.at(*name);
     *solid_only = false;
     std::string ext = std::filesystem::path(mesh.file).extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     const std::filesystem::path folder = std::filesystem::path(path_).parent_path();
     if (ext != ".stl" && ext != ".obj") {
-      m_.skip("<geom type=\"mesh\"> not STL or OBJ", e->GetLineNum(), "phiq's parts read STL and OBJ meshes");
+      skip_at(e, "<geom type=\"mesh\"> not STL or OBJ", "phiq's parts read STL and OBJ meshes");
       return;
     }
     if (mesh.scale.x() != mesh.scale.y() || mesh.scale.x() != mesh.scale.z()) {
-      m_.skip("<geom type=\"mesh\"> scaled unevenly", e->GetLineNum(), "phiq scales a mesh by one factor");
+      skip_at(e, "<geom type=\"mesh\"> scaled unevenly", "phiq scales a mesh by one factor");
       return;
     }
     if (!std::filesystem::exists(std::filesystem::path(mesh.file).is_absolute() ? std::filesystem::path(mesh.file)
                                                                                 : folder / mesh.file)) {
-      m_.skip("<geom type=\"mesh\"> file not found", e->GetLineNum(), "'" + mesh.file + "' is not beside the file");
+      skip_at(e, "<geom type=\"mesh\"> file not found", "'" + mesh.file + "' is not beside the file");
       return;
     }
     // MuJoCo moves a mesh to its centre of mass and principal axes; phiq draws it in the file's own frame.
-    m_.skip("<geom type=\"mesh\"> placement", e->GetLineNum(),
+    skip_at(e, "<geom type=\"mesh\"> placement",
             "drawn in the mesh file's frame, not recentred at its centre of mass as MuJoCo does");
     s.type = "mesh", s.file = mesh.file, s.scale = mesh.scale.x();
   } else {
@@ -277,36 +299,70 @@ void MjcfReader::geom(const tinyxml2::XMLElement* e, Body* b, const std::string&
 int MjcfReader::body_named(const tinyxml2::XMLElement* e, const char* attribute, bool required) const {
   const char* name = e->Attribute(attribute);
   if (!name) {
-    if (required) refuse(path_, e->GetLineNum(), std::string("<") + e->Name() + "> without " + attribute);
+    if (required) fail(e, std::string("<") + e->Name() + "> without " + attribute);
     return 0;
   }
   if (std::string(name) == "world") return 0;
   const auto it = body_index_.find(name);
-  if (it == body_index_.end())
-    refuse(path_, e->GetLineNum(), std::string(attribute) + " '" + name + "' is not a body of the file");
+  if (it == body_index_.end()) fail(e, std::string(attribute) + " '" + name + "' is not a body of the file");
   return it->second;
 }
 
-void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::string& childclass) {
+std::vector<MjcfReader::Placed> MjcfReader::placed(const tinyxml2::XMLElement* e, const std::string& childclass,
+                                                   const Pose& frame) {
+  std::vector<Placed> out;
+  for (const tinyxml2::XMLElement* c : docs_.children(e)) {
+    if (std::string(c->Name()) != "frame") {
+      out.push_back(Placed{c, frame, childclass});
+      continue;
+    }
+    const std::string cc = c->Attribute("childclass") ? c->Attribute("childclass") : childclass;
+    for (Placed& inner : placed(c, cc, frame * pose(c, childclass))) {
+      const std::string tag = inner.e->Name();
+      if (tag == "joint" || tag == "freejoint" || tag == "inertial")
+        fail(inner.e, "<" + tag + "> inside a <frame>: phiq reads a body's joints and inertial as its own children");
+      out.push_back(std::move(inner));
+    }
+  }
+  return out;
+}
+
+void MjcfReader::placed_geom_or_site(const Placed& c, int body, bool* solid_only, std::optional<double>* density) {
+  Body& b = m_.bodies[static_cast<std::size_t>(body)];
+  if (std::string(c.e->Name()) == "geom") {
+    const std::size_t before = b.shapes.size();
+    geom(c.e, &b, c.childclass, solid_only, density);
+    if (b.shapes.size() > before) b.shapes.back().at = c.frame * b.shapes.back().at;
+    return;
+  }
+  if (const char* name = c.e->Attribute("name"))  // (a site: listed as not mapped all the same)
+    if (!sites_.emplace(name, Site{body, c.frame * pose(c.e, c.childclass)}).second)
+      fail(c.e, std::string("a second site named '") + name + "'");
+  unmapped(c.e, "no kinematics: phiq outputs points instead");
+}
+
+void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::string& childclass, const Pose& frame) {
   const std::string cc = e->Attribute("childclass") ? e->Attribute("childclass") : childclass;
   Body b;
-  b.line = e->GetLineNum();
   b.name = e->Attribute("name") ? e->Attribute("name") : "body_" + std::to_string(m_.bodies.size());
-  b.world = m_.bodies[static_cast<std::size_t>(parent)].world * pose(e, cc);
+  b.line = e->GetLineNum(), b.file = docs_.included_file(e);
+  b.world = m_.bodies[static_cast<std::size_t>(parent)].world * frame * pose(e, cc);
   const int index = static_cast<int>(m_.bodies.size());
   if (e->Attribute("name") && !body_index_.emplace(b.name, index).second)
-    refuse(path_, b.line, "a second body named '" + b.name + "'");
-  std::vector<const tinyxml2::XMLElement*> joints, children;
+    fail(e, "a second body named '" + b.name + "'");
+  std::vector<const tinyxml2::XMLElement*> joints;
+  std::vector<Placed> children, geoms_and_sites;
   bool solid_only = true, inertial = false;
   std::optional<double> density;
-  for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+  for (const Placed& p : placed(e, cc)) {
+    const tinyxml2::XMLElement* c = p.e;
     const std::string tag = c->Name();
     if (tag == "joint" || tag == "freejoint") {
       joints.push_back(c);
     } else if (tag == "body") {
-      children.push_back(c);
-    } else if (tag == "geom") {
-      geom(c, &b, cc, &solid_only, &density);
+      children.push_back(p);
+    } else if (tag == "geom" || tag == "site") {
+      geoms_and_sites.push_back(p);  // (once the body is in m_.bodies)
     } else if (tag == "inertial") {
       const Pose p = pose(c, cc);
       const std::vector<double> mass = numbers(c, "mass", cc, {}, 1, 1);
@@ -318,26 +374,26 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
         const std::vector<double> d = numbers(c, "diaginertia", cc, {}, 3, 3);
         I.diagonal() << d[0], d[1], d[2];
       }
-      if (mass.empty() || I.isZero(0.0))
-        refuse(path_, c->GetLineNum(), "<inertial> needs mass and diaginertia or fullinertia");
+      if (mass.empty() || I.isZero(0.0)) fail(c, "<inertial> needs mass and diaginertia or fullinertia");
       b.has_mass = true, b.mass = mass[0], b.com = p.p, b.inertia = p.R * I * p.R.transpose();
       inertial = true;
-    } else if (tag == "frame" || tag == "replicate" || tag == "include" || tag == "composite" || tag == "flexcomp") {
-      refuse(path_, c->GetLineNum(), "<" + tag + ">: not read by phiq (expand it into bodies first)");
+    } else if (tag == "replicate" || tag == "composite" || tag == "flexcomp") {
+      fail(c, "<" + tag + ">: not read by phiq (expand it into bodies first)");
     } else {
-      unmapped(c, tag == "site" || tag == "camera" || tag == "light" ? "no kinematics: phiq outputs points instead"
-                                                                     : "not an element phiq maps");
+      unmapped(c, tag == "camera" || tag == "light" ? "no kinematics: phiq outputs points instead"
+                                                    : "not an element phiq maps");
     }
   }
-  if (!inertial && solid_only && density && !b.shapes.empty()) b.density = density;
-  if (!inertial && !solid_only)
-    m_.skip("mass from geoms", b.line, "given per geom or by meshes: the body gets no mass");
   m_.bodies.push_back(b);
+  for (const Placed& p : geoms_and_sites) placed_geom_or_site(p, index, &solid_only, &density);
+  Body& placed_body = m_.bodies[static_cast<std::size_t>(index)];
+  if (!inertial && solid_only && density && !placed_body.shapes.empty()) placed_body.density = density;
+  if (!inertial && !solid_only) skip_at(e, "mass from geoms", "given per geom or by meshes: the body gets no mass");
   // Its joints, in order; each after the first moves a massless body of its own, at the body's pose.
   int from = parent;
   if (joints.empty()) {
     Joint w;
-    w.name = b.name + "_weld", w.line = b.line, w.kind = "rigid";
+    w.name = b.name + "_weld", w.line = b.line, w.file = b.file, w.kind = "rigid";
     const Pose rel = m_.bodies[static_cast<std::size_t>(from)].world.inverse() * b.world;
     w.parent = Side{from, rel.p, rel.R.col(2), rel.R.col(0)};
     w.child = Side{index, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()};
@@ -348,13 +404,14 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     int to = index;
     if (k + 1 < joints.size()) {
       Body step = Body::named(b.name + "_joint" + std::to_string(k + 1), j->GetLineNum(), b.world);
+      step.file = b.file;
       to = static_cast<int>(m_.bodies.size());
       m_.bodies.push_back(step);
     }
     const std::string* t = attr(j, "type", cc);
     const std::string type = std::string(j->Name()) == "freejoint" ? "free" : t ? *t : "hinge";
     Joint out;
-    out.line = j->GetLineNum();
+    out.line = j->GetLineNum(), out.file = b.file;
     out.name = j->Attribute("name") ? j->Attribute("name") : b.name + "_joint_" + std::to_string(k);
     if (type == "hinge")
       out.kind = "revolute";
@@ -363,11 +420,11 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     else if (type == "ball")
       out.kind = "spherical";
     else if (type != "free")
-      refuse(path_, out.line, "joint '" + out.name + "' has type '" + type + "': MJCF's are hinge, slide, ball, free");
+      fail(j, "joint '" + out.name + "' has type '" + type + "': MJCF's are hinge, slide, ball, free");
     const std::vector<double> p = numbers(j, "pos", cc, {0, 0, 0}, 3, 3);
     const std::vector<double> a = numbers(j, "axis", cc, {0, 0, 1}, 3, 3);
     const Eigen::Vector3d at(p[0], p[1], p[2]), axis = Eigen::Vector3d(a[0], a[1], a[2]);
-    if (!(axis.norm() > 0)) refuse(path_, out.line, "joint '" + out.name + "': a zero axis");
+    if (!(axis.norm() > 0)) fail(j, "joint '" + out.name + "': a zero axis");
     const Pose rel = m_.bodies[static_cast<std::size_t>(from)].world.inverse() * b.world;
     const Eigen::Vector3d ref = perpendicular(axis);
     out.parent = Side{from, rel.p + rel.R * at, rel.R * axis.normalized(), rel.R * ref};
@@ -379,17 +436,60 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
       joint_ref_[static_cast<int>(m_.joints.size())] = type == "hinge" ? angle(r[0]) : r[0];
     for (const char* ignored : {"range", "limited", "damping", "stiffness", "armature", "springref", "frictionloss"})
       if (attr(j, ignored, cc))
-        m_.skip(std::string("<joint ") + ignored + ">", out.line, "limits, springs and damping are not kinematics");
+        skip_at(j, std::string("<joint ") + ignored + ">", "limits, springs and damping are not kinematics");
     if (!joint_index_.emplace(out.name, static_cast<int>(m_.joints.size())).second)
-      refuse(path_, out.line, "a second joint named '" + out.name + "'");
+      fail(j, "a second joint named '" + out.name + "'");
     m_.joints.push_back(out);
     from = to;
   }
-  for (const tinyxml2::XMLElement* c : children) body(c, index, cc);
+  for (const Placed& c : children) body(c.e, index, c.childclass, c.frame);
+}
+
+Joint MjcfReader::connect_or_weld(const tinyxml2::XMLElement* e, const std::string& name) {
+  const std::string tag = e->Name();
+  Joint j;
+  j.name = name, j.line = e->GetLineNum(), j.file = docs_.included_file(e), j.closing = true;
+  j.kind = tag == "connect" ? "spherical" : "rigid";
+  if (e->Attribute("site1") || e->Attribute("site2")) {  // the sites' origins (connect) or frames (weld) coincide
+    for (const char* other : {"body1", "body2", "anchor", "relpose"})
+      if (e->Attribute(other)) fail(e, "<" + tag + "> names sites and " + other + ": MuJoCo takes one or the other");
+    Side sides[2];
+    for (int k = 0; k < 2; ++k) {
+      const std::string attribute = "site" + std::to_string(k + 1);
+      const char* site = e->Attribute(attribute.c_str());
+      if (!site) fail(e, "<" + tag + "> without " + attribute);
+      const auto it = sites_.find(site);
+      if (it == sites_.end()) fail(e, attribute + " '" + site + "' is not a site of the file");
+      const Pose& at = it->second.at;
+      sides[k] = Side{it->second.body, at.p, at.R.col(2), at.R.col(0)};
+    }
+    j.parent = sides[0], j.child = sides[1];
+    return j;
+  }
+  const int b1 = body_named(e, "body1", true), b2 = body_named(e, "body2", false);
+  const std::vector<double> a = numbers(e, "anchor", "", {0, 0, 0}, 3, 3);
+  const Eigen::Vector3d anchor(a[0], a[1], a[2]);
+  const Pose& w1 = m_.bodies[static_cast<std::size_t>(b1)].world;
+  const Pose& w2 = m_.bodies[static_cast<std::size_t>(b2)].world;
+  if (tag == "connect") {  // anchor in body1's frame
+    j.parent = Side{b1, anchor};
+    j.child = Side{b2, w2.inverse().R * (w1.p + w1.R * anchor - w2.p)};
+    return j;
+  }
+  // anchor in body2's frame; body2's pose in body1's: relpose, or (its quaternion all zeros) the model's pose
+  const std::vector<double> rel = numbers(e, "relpose", "", {0, 1, 0, 0, 0, 0, 0}, 7, 7);
+  Pose in1 = w1.inverse() * w2;
+  if (rel[3] != 0 || rel[4] != 0 || rel[5] != 0 || rel[6] != 0)
+    in1 = Pose{Eigen::Vector3d(rel[0], rel[1], rel[2]),
+               Eigen::Quaterniond(rel[3], rel[4], rel[5], rel[6]).normalized().toRotationMatrix()};
+  in1 = in1 * Pose{anchor, Eigen::Matrix3d::Identity()};
+  j.parent = Side{b1, in1.p, in1.R.col(2), in1.R.col(0)};
+  j.child = Side{b2, anchor};
+  return j;
 }
 
 void MjcfReader::equality(const tinyxml2::XMLElement* list) {
-  for (const tinyxml2::XMLElement* e = list->FirstChildElement(); e; e = e->NextSiblingElement()) {
+  for (const tinyxml2::XMLElement* e : docs_.children(list)) {
     const std::string tag = e->Name();
     const std::string name =
         e->Attribute("name") ? e->Attribute("name") : tag + "_line" + std::to_string(e->GetLineNum());
@@ -398,53 +498,31 @@ void MjcfReader::equality(const tinyxml2::XMLElement* list) {
       continue;
     }
     if (e->Attribute("solref") || e->Attribute("solimp"))
-      m_.skip("<" + tag + " solref/solimp>", e->GetLineNum(), "phiq's constraints are exact, not soft");
+      skip_at(e, "<" + tag + " solref/solimp>", "phiq's constraints are exact, not soft");
     if (tag == "connect" || tag == "weld") {
-      if (e->Attribute("site1") || e->Attribute("site2"))
-        refuse(path_, e->GetLineNum(), "<" + tag + "> between sites is not read: give body1, body2 and anchor");
-      const int b1 = body_named(e, "body1", true), b2 = body_named(e, "body2", false);
-      const std::vector<double> a = numbers(e, "anchor", "", {0, 0, 0}, 3, 3);
-      const Pose& w1 = m_.bodies[static_cast<std::size_t>(b1)].world;
-      const Pose& w2 = m_.bodies[static_cast<std::size_t>(b2)].world;
-      Joint j;
-      j.name = name, j.line = e->GetLineNum(), j.closing = true;
-      if (tag == "connect") {  // anchor in body1's frame
-        j.kind = "spherical";
-        j.parent = Side{b1, Eigen::Vector3d(a[0], a[1], a[2])};
-        j.child = Side{b2, w2.inverse().R * (w1.p + w1.R * j.parent.at - w2.p)};
-      } else {  // anchor in body2's frame; the relative pose at the model's pose
-        const std::vector<double> rel = numbers(e, "relpose", "", {0, 1, 0, 0, 0, 0, 0}, 7, 7);
-        if (rel[3] != 0 || rel[4] != 0 || rel[5] != 0 || rel[6] != 0)
-          refuse(path_, e->GetLineNum(), "<weld relpose>: phiq welds at the model's pose (omit relpose)");
-        j.kind = "rigid";
-        const Pose in1 = w1.inverse() * w2 * Pose{Eigen::Vector3d(a[0], a[1], a[2]), Eigen::Matrix3d::Identity()};
-        j.parent = Side{b1, in1.p, in1.R.col(2), in1.R.col(0)};
-        j.child = Side{b2, Eigen::Vector3d(a[0], a[1], a[2])};
-      }
-      m_.joints.push_back(j);
+      m_.joints.push_back(connect_or_weld(e, name));
       ++loops_;
     } else if (tag == "joint") {
       const char* j1 = e->Attribute("joint1");
       const char* j2 = e->Attribute("joint2");
       if (!j1 || !joint_index_.count(j1))
-        refuse(path_, e->GetLineNum(),
-               std::string("<joint> equality: joint1 '") + (j1 ? j1 : "") + "' is not a joint of the file");
+        fail(e, std::string("<joint> equality: joint1 '") + (j1 ? j1 : "") + "' is not a joint of the file");
       if (j2 && !joint_index_.count(j2))
-        refuse(path_, e->GetLineNum(), std::string("<joint> equality: joint2 '") + j2 + "' is not a joint of the file");
+        fail(e, std::string("<joint> equality: joint2 '") + j2 + "' is not a joint of the file");
       const std::vector<double> c = numbers(e, "polycoef", "", {0, 1, 0, 0, 0}, 1, 5);
       for (std::size_t k = 2; k < c.size(); ++k)
         if (c[k] != 0.0 && j2)
-          refuse(path_, e->GetLineNum(),
-                 "<joint> equality '" + name + "': polycoef of degree " + std::to_string(k) +
-                     "; phiq couples joints linearly (a coupler)");
+          fail(e, "<joint> equality '" + name + "': polycoef of degree " + std::to_string(k) +
+                      "; phiq couples joints linearly (a coupler)");
       // MuJoCo's q1 = c0 + c1 q2 on joint positions; phiq's angles are those minus each joint's ref.
       const int a = joint_index_.at(j1), b = j2 ? joint_index_.at(j2) : -1;
       const double ra = joint_ref_.count(a) ? joint_ref_.at(a) : 0.0,
                    rb = b >= 0 && joint_ref_.count(b) ? joint_ref_.at(b) : 0.0;
       const double c1 = c.size() > 1 ? c[1] : 0.0;
-      m_.couplers.push_back(Coupler{name, e->GetLineNum(), a, b, c1, c[0] + (b >= 0 ? c1 * rb : 0.0) - ra});
+      m_.couplers.push_back(
+          Coupler{name, e->GetLineNum(), a, b, c1, c[0] + (b >= 0 ? c1 * rb : 0.0) - ra, docs_.included_file(e)});
     } else {
-      refuse(path_, e->GetLineNum(), "<" + tag + "> equality: not read by phiq (only connect, weld and joint)");
+      fail(e, "<" + tag + "> equality: not read by phiq (only connect, weld and joint)");
     }
   }
 }
@@ -452,23 +530,18 @@ void MjcfReader::equality(const tinyxml2::XMLElement* list) {
 Mechanism MjcfReader::read(int* loops) {
   m_.path = path_, m_.format = "MJCF";
   m_.units = "lengths in metres, angles in radians (the file's degrees converted), mass in kg, time in seconds.";
-  if (doc_.Parse(text_.data(), text_.size()) != tinyxml2::XML_SUCCESS)
-    refuse(path_, doc_.ErrorLineNum(), std::string("malformed XML (the file may be truncated): ") + doc_.ErrorName());
-  const tinyxml2::XMLElement* root = doc_.RootElement();
+  const tinyxml2::XMLElement* root = docs_.parse(text_);
   if (!root || std::string(root->Name()) != "mujoco")
     refuse(path_, root ? root->GetLineNum() : 1, "an MJCF file's root element is <mujoco>");
   m_.name = root->Attribute("model") ? root->Attribute("model") : "";
   m_.bodies.push_back(Body::named("world", root->GetLineNum()));
   // Settings first: compiler, defaults and assets apply to the bodies wherever they stand.
-  for (const tinyxml2::XMLElement* e = root->FirstChildElement(); e; e = e->NextSiblingElement()) {
+  for (const tinyxml2::XMLElement* e : docs_.children(root)) {
     const std::string tag = e->Name();
-    if (tag == "include") refuse(path_, e->GetLineNum(), "<include>: not read by phiq (merge the files first)");
     if (tag == "compiler") compiler(e);
   }
-  for (const tinyxml2::XMLElement* e = root->FirstChildElement("default"); e; e = e->NextSiblingElement("default"))
-    defaults(e, "main", "");
-  for (const tinyxml2::XMLElement* e = root->FirstChildElement("asset"); e; e = e->NextSiblingElement("asset"))
-    assets(e);
+  for (const tinyxml2::XMLElement* e : docs_.children(root, "default")) defaults(e, "main", "");
+  for (const tinyxml2::XMLElement* e : docs_.children(root, "asset")) assets(e);
   static const std::map<std::string, std::string> why = {
       {"option", "simulation settings (gravity, timestep): phiq sweeps kinematics"},
       {"size", "memory sizes of MuJoCo"},
@@ -482,21 +555,21 @@ Mechanism MjcfReader::read(int* loops) {
       {"custom", "user data"},
       {"extension", "plugins"},
   };
-  for (const tinyxml2::XMLElement* e = root->FirstChildElement(); e; e = e->NextSiblingElement()) {
+  for (const tinyxml2::XMLElement* e : docs_.children(root)) {
     const std::string tag = e->Name();
     if (tag == "worldbody") {
       bool solid = true;
       std::optional<double> density;
-      for (const tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
-        const std::string t = c->Name();
+      for (const Placed& p : placed(e, "")) {
+        const std::string t = p.e->Name();
         if (t == "body")
-          body(c, 0, "");
-        else if (t == "geom")
-          geom(c, &m_.bodies[0], "", &solid, &density);
-        else if (t == "frame" || t == "replicate")
-          refuse(path_, c->GetLineNum(), "<" + t + ">: not read by phiq (expand it into bodies first)");
+          body(p.e, 0, p.childclass, p.frame);
+        else if (t == "geom" || t == "site")
+          placed_geom_or_site(p, 0, &solid, &density);
+        else if (t == "replicate")
+          fail(p.e, "<" + t + ">: not read by phiq (expand it into bodies first)");
         else
-          unmapped(c, "no kinematics: phiq outputs points instead");
+          unmapped(p.e, "no kinematics: phiq outputs points instead");
       }
     } else if (tag == "equality") {
       continue;  // after every body is read
@@ -505,8 +578,7 @@ Mechanism MjcfReader::read(int* loops) {
       unmapped(e, it != why.end() ? it->second : "not an MJCF element phiq reads");
     }
   }
-  for (const tinyxml2::XMLElement* e = root->FirstChildElement("equality"); e; e = e->NextSiblingElement("equality"))
-    equality(e);
+  for (const tinyxml2::XMLElement* e : docs_.children(root, "equality")) equality(e);
   *loops = loops_;
   return std::move(m_);
 }

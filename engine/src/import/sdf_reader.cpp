@@ -51,10 +51,16 @@ class SdfReader {
         m_.skip("<" + e->GetName() + "><" + c->GetName() + ">", sdf_line(c), why);
   }
   void link(const sdf::Link& l, Body* b);
+  // A model's links, then its nested models' (named MODEL::LINK, as SDF scopes them), then its joints; `placed`: the
+  // model's frame in the top model's, `prefix`: its scope ("" for the top model, "arm::" for a model arm in it).
+  void model(const sdf::Model& model, const Pose& placed, const std::string& prefix);
+  void joint(const sdf::Joint& j, const Pose& placed, const std::string& prefix);
 
   const std::string& text_;
   const std::string& path_;
   Mechanism m_;
+  std::map<std::string, int> body_of_;  // a link's scoped name → its body
+  std::size_t links_ = 0;
 };
 
 void SdfReader::link(const sdf::Link& l, Body* b) {
@@ -92,6 +98,89 @@ void SdfReader::link(const sdf::Link& l, Body* b) {
   unmapped_children(e, {"pose", "inertial", "visual"}, "not kinematics, or drawn from the visuals");
 }
 
+void SdfReader::model(const sdf::Model& model, const Pose& placed, const std::string& prefix) {
+  if (model.Static()) refuse(path_, sdf_line(model.Element()), "a static model does not move");
+  for (uint64_t k = 0; k < model.LinkCount(); ++k) {
+    const sdf::Link* l = model.LinkByIndex(k);
+    ignition::math::Pose3d pose;
+    (void)l->SemanticPose().Resolve(pose, "__model__");
+    Body b = Body::named(prefix + l->Name(), sdf_line(l->Element()), placed * sdf_pose(pose));
+    link(*l, &b);
+    body_of_[b.name] = static_cast<int>(m_.bodies.size());
+    m_.bodies.push_back(b);
+    ++links_;
+  }
+  for (uint64_t k = 0; k < model.ModelCount(); ++k) {
+    const sdf::Model* nested = model.ModelByIndex(k);
+    ignition::math::Pose3d pose;
+    (void)nested->SemanticPose().Resolve(pose, "__model__");
+    this->model(*nested, placed * sdf_pose(pose), prefix + nested->Name() + "::");
+  }
+  for (uint64_t k = 0; k < model.JointCount(); ++k) joint(*model.JointByIndex(k), placed, prefix);
+  unmapped_children(model.Element(), {"link", "joint", "pose", "static", "model"}, "not an element phiq maps");
+}
+
+void SdfReader::joint(const sdf::Joint& j, const Pose& placed, const std::string& prefix) {
+  Joint out;
+  out.name = prefix + j.Name(), out.line = sdf_line(j.Element());
+  auto body = [&](const std::string& name, const char* side) {
+    if (name == "world") return 0;
+    const auto it = body_of_.find(prefix + name);
+    if (it == body_of_.end())
+      refuse(path_, out.line, "joint '" + out.name + "': " + side + " '" + name + "' is not a link of the model");
+    return it->second;
+  };
+  const int parent = body(j.ParentLinkName(), "parent"), child = body(j.ChildLinkName(), "child");
+  ignition::math::Pose3d frame;
+  (void)j.SemanticPose().Resolve(frame, "__model__");
+  const Pose J = placed * sdf_pose(frame);
+  auto axis_of = [&](unsigned index) {
+    ignition::math::Vector3d xyz(0, 0, 1);
+    if (const sdf::JointAxis* a = j.Axis(index)) (void)a->ResolveXyz(xyz, "__model__");
+    return (placed.R * sdf_vector(xyz)).normalized();
+  };
+  const Pose& wp = m_.bodies[static_cast<std::size_t>(parent)].world;
+  const Pose& wc = m_.bodies[static_cast<std::size_t>(child)].world;
+  auto sides = [&](const Eigen::Vector3d& a1, const Eigen::Vector3d& r1, const Eigen::Vector3d& a2,
+                   const Eigen::Vector3d& r2) {
+    out.parent = Side{parent, wp.inverse().R * (J.p - wp.p), wp.R.transpose() * a1, wp.R.transpose() * r1};
+    out.child = Side{child, wc.inverse().R * (J.p - wc.p), wc.R.transpose() * a2, wc.R.transpose() * r2};
+  };
+  switch (j.Type()) {
+    case sdf::JointType::REVOLUTE:
+    case sdf::JointType::CONTINUOUS:
+    case sdf::JointType::PRISMATIC: {
+      const Eigen::Vector3d a = axis_of(0), r = perpendicular(a);
+      sides(a, r, a, r);
+      out.kind = j.Type() == sdf::JointType::PRISMATIC ? "prismatic" : "revolute";
+      break;
+    }
+    case sdf::JointType::BALL:
+    case sdf::JointType::FIXED:
+      sides(J.R.col(2), J.R.col(0), J.R.col(2), J.R.col(0));
+      out.kind = j.Type() == sdf::JointType::BALL ? "spherical" : "rigid";
+      break;
+    case sdf::JointType::UNIVERSAL: {
+      const Eigen::Vector3d a1 = axis_of(0), a2 = axis_of(1);
+      if (std::abs(a1.dot(a2)) > 1e-9)
+        refuse(path_, out.line,
+               "universal joint '" + out.name + "': its axes are not perpendicular in the file's pose");
+      sides(a1, perpendicular(a1), a2, perpendicular(a2));
+      out.kind = "universal";
+      break;
+    }
+    default:
+      refuse(path_, out.line,
+             "joint '" + out.name + "': SDF's " + j.Element()->GetAttribute("type")->GetAsString() +
+                 " joint has no exact phiq form here (screw: SDF does not state thread_pitch's unit)");
+  }
+  m_.joints.push_back(out);
+  const char* why = "limits, dynamics and sensors are not kinematics";
+  unmapped_children(j.Element(), {"parent", "child", "pose", "axis", "axis2"}, why);
+  for (const char* axis : {"axis", "axis2"})
+    if (const sdf::ElementPtr a = j.Element()->FindElement(axis)) unmapped_children(a, {"xyz"}, why);
+}
+
 Mechanism SdfReader::read(int* loops) {
   m_.path = path_, m_.format = "SDF";
   m_.units = "lengths in metres, angles in radians, mass in kg, time in seconds.";
@@ -113,83 +202,10 @@ Mechanism SdfReader::read(int* loops) {
       m_.skip("<model> after the world's first", sdf_line(root.WorldByIndex(0)->ModelByIndex(k)->Element()),
               "phiq reads one model of a world");
   m_.name = model->Name();
-  if (model->ModelCount() > 0) refuse(path_, sdf_line(model->ModelByIndex(0)->Element()), "nested models are not read");
-  if (model->Static()) refuse(path_, sdf_line(model->Element()), "a static model does not move");
   m_.bodies.push_back(Body::named("world", sdf_line(model->Element())));
-  std::map<std::string, int> body_of;
-  for (uint64_t k = 0; k < model->LinkCount(); ++k) {
-    const sdf::Link* l = model->LinkByIndex(k);
-    ignition::math::Pose3d pose;
-    (void)l->SemanticPose().Resolve(pose, "__model__");
-    Body b = Body::named(l->Name(), sdf_line(l->Element()), sdf_pose(pose));
-    link(*l, &b);
-    body_of[l->Name()] = static_cast<int>(m_.bodies.size());
-    m_.bodies.push_back(b);
-  }
-  for (uint64_t k = 0; k < model->JointCount(); ++k) {
-    const sdf::Joint* j = model->JointByIndex(k);
-    Joint out;
-    out.name = j->Name(), out.line = sdf_line(j->Element());
-    auto body = [&](const std::string& name, const char* side) {
-      if (name == "world") return 0;
-      const auto it = body_of.find(name);
-      if (it == body_of.end())
-        refuse(path_, out.line, "joint '" + out.name + "': " + side + " '" + name + "' is not a link of the model");
-      return it->second;
-    };
-    const int parent = body(j->ParentLinkName(), "parent"), child = body(j->ChildLinkName(), "child");
-    ignition::math::Pose3d frame;
-    (void)j->SemanticPose().Resolve(frame, "__model__");
-    const Pose J = sdf_pose(frame);
-    auto axis_of = [&](unsigned index) {
-      ignition::math::Vector3d xyz(0, 0, 1);
-      if (const sdf::JointAxis* a = j->Axis(index)) (void)a->ResolveXyz(xyz, "__model__");
-      return sdf_vector(xyz).normalized();
-    };
-    const Pose& wp = m_.bodies[static_cast<std::size_t>(parent)].world;
-    const Pose& wc = m_.bodies[static_cast<std::size_t>(child)].world;
-    auto sides = [&](const Eigen::Vector3d& a1, const Eigen::Vector3d& r1, const Eigen::Vector3d& a2,
-                     const Eigen::Vector3d& r2) {
-      out.parent = Side{parent, wp.inverse().R * (J.p - wp.p), wp.R.transpose() * a1, wp.R.transpose() * r1};
-      out.child = Side{child, wc.inverse().R * (J.p - wc.p), wc.R.transpose() * a2, wc.R.transpose() * r2};
-    };
-    switch (j->Type()) {
-      case sdf::JointType::REVOLUTE:
-      case sdf::JointType::CONTINUOUS:
-      case sdf::JointType::PRISMATIC: {
-        const Eigen::Vector3d a = axis_of(0), r = perpendicular(a);
-        sides(a, r, a, r);
-        out.kind = j->Type() == sdf::JointType::PRISMATIC ? "prismatic" : "revolute";
-        break;
-      }
-      case sdf::JointType::BALL:
-      case sdf::JointType::FIXED:
-        sides(J.R.col(2), J.R.col(0), J.R.col(2), J.R.col(0));
-        out.kind = j->Type() == sdf::JointType::BALL ? "spherical" : "rigid";
-        break;
-      case sdf::JointType::UNIVERSAL: {
-        const Eigen::Vector3d a1 = axis_of(0), a2 = axis_of(1);
-        if (std::abs(a1.dot(a2)) > 1e-9)
-          refuse(path_, out.line,
-                 "universal joint '" + out.name + "': its axes are not perpendicular in the file's pose");
-        sides(a1, perpendicular(a1), a2, perpendicular(a2));
-        out.kind = "universal";
-        break;
-      }
-      default:
-        refuse(path_, out.line,
-               "joint '" + out.name + "': SDF's " + j->Element()->GetAttribute("type")->GetAsString() +
-                   " joint has no exact phiq form here (screw: SDF does not state thread_pitch's unit)");
-    }
-    m_.joints.push_back(out);
-    const char* why = "limits, dynamics and sensors are not kinematics";
-    unmapped_children(j->Element(), {"parent", "child", "pose", "axis", "axis2"}, why);
-    for (const char* axis : {"axis", "axis2"})
-      if (const sdf::ElementPtr a = j->Element()->FindElement(axis)) unmapped_children(a, {"xyz"}, why);
-  }
-  unmapped_children(model->Element(), {"link", "joint", "pose", "static"}, "not an element phiq maps");
+  this->model(*model, Pose{}, "");
   // Loops: the joints beyond a spanning tree of the links and the world.
-  *loops = std::max(0, static_cast<int>(m_.joints.size()) - static_cast<int>(model->LinkCount()));
+  *loops = std::max(0, static_cast<int>(m_.joints.size()) - static_cast<int>(links_));
   return std::move(m_);
 }
 

@@ -86,7 +86,8 @@ const std::set<std::string> kUrdfJointTypes = {"revolute", "continuous", "prisma
 
 class UrdfReader {
  public:
-  UrdfReader(const std::string& text, const std::string& path) : text_(text), path_(path) {}
+  UrdfReader(const std::string& text, const std::string& path, bool need_geometry)
+      : text_(text), path_(path), need_geometry_(need_geometry) {}
   Mechanism read(int* loops);
 
  private:
@@ -100,6 +101,7 @@ class UrdfReader {
 
   const std::string& text_;
   const std::string& path_;
+  bool need_geometry_ = false;  // a mesh that cannot be found is an error, not a shape left out
   tinyxml2::XMLDocument doc_;
   std::map<std::string, const tinyxml2::XMLElement*> links_;
   std::vector<UrdfJointXml> joints_, closing_;
@@ -194,6 +196,40 @@ void UrdfReader::unmapped(const tinyxml2::XMLElement* e) {
           it != why.end() ? it->second : "not a URDF element phiq reads");
 }
 
+// The file of `uri` (package://PACKAGE/REST): REST in the folder PACKAGE found on ROS_PACKAGE_PATH (each entry the
+// package or a folder holding it), else in a folder above the URDF named PACKAGE, or holding one; relative to the
+// URDF's folder when found above it (the way a path beside it is written), absolute from ROS_PACKAGE_PATH.
+std::optional<std::string> package_file(const std::string& uri, const std::string& urdf_path) {
+  namespace fs = std::filesystem;
+  const std::string rest = uri.substr(10);
+  const std::size_t slash = rest.find('/');
+  if (slash == 0 || slash == std::string::npos) return std::nullopt;
+  const std::string package = rest.substr(0, slash), inside = rest.substr(slash + 1);
+  auto in = [&](const fs::path& folder) -> std::optional<fs::path> {
+    if (fs::is_regular_file(folder / package / inside)) return folder / package / inside;
+    if (folder.filename() == package && fs::is_regular_file(folder / inside)) return folder / inside;
+    return std::nullopt;
+  };
+  if (const char* env = std::getenv("ROS_PACKAGE_PATH")) {
+    std::string list = env;
+    for (std::size_t at = 0; at <= list.size();) {
+      std::size_t end = list.find(':', at);
+      if (end == std::string::npos) end = list.size();
+      const fs::path entry = fs::path(list.substr(at, end - at)).lexically_normal();
+      at = end + 1;
+      if (entry.empty()) continue;
+      if (const auto p = in(entry.has_filename() ? entry : entry.parent_path()))
+        return fs::absolute(*p).lexically_normal().string();
+    }
+  }
+  const fs::path folder = fs::absolute(fs::path(urdf_path)).parent_path();
+  for (fs::path above = folder; !above.empty(); above = above.parent_path()) {
+    if (const auto p = in(above)) return p->lexically_relative(folder).string();
+    if (above == above.root_path()) break;
+  }
+  return std::nullopt;
+}
+
 std::optional<Shape> UrdfReader::shape(const tinyxml2::XMLElement* owner, const urdf::Geometry* g,
                                        const std::string& what) {
   Shape s;
@@ -215,8 +251,21 @@ std::optional<Shape> UrdfReader::shape(const tinyxml2::XMLElement* owner, const 
       std::string file = mesh->filename;
       if (file.rfind("file://", 0) == 0) file = file.substr(7);
       const int line = owner->GetLineNum();
+      if (file.rfind("package://", 0) == 0) {
+        const std::optional<std::string> found = package_file(file, path_);
+        if (!found && need_geometry_)
+          refuse(path_, line,
+                 what + " mesh '" + file + "': its package is neither on ROS_PACKAGE_PATH nor a folder " +
+                     "above the file");
+        if (!found) {
+          m_.skip(what + " mesh of a package not found", line,
+                  "its package is neither on ROS_PACKAGE_PATH nor a folder above the file (the link is drawn without)");
+          return std::nullopt;
+        }
+        file = *found;
+      }
       if (file.find("://") != std::string::npos) {
-        m_.skip(what + " mesh of a package:// or other URI", line, "phiq reads mesh files by path only");
+        m_.skip(what + " mesh of a URI", line, "phiq reads mesh files by path or package:// only");
         return std::nullopt;
       }
       std::string ext = std::filesystem::path(file).extension().string();
@@ -415,7 +464,7 @@ Mechanism UrdfReader::read(int* loops) {
 
 ModelImport import_urdf(const std::string& text, const std::string& path, const ImportOptions& options) {
   int loops = 0;
-  detail::mechanism::Mechanism m = detail::mechanism::UrdfReader(text, path).read(&loops);
+  detail::mechanism::Mechanism m = detail::mechanism::UrdfReader(text, path, options.need_geometry).read(&loops);
   return detail::mechanism::mechanism_import(m, loops, options);
 }
 
