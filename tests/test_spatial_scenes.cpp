@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -382,7 +383,9 @@ TEST(SpatialScenes, TurningBodyKeepsItsThreadsAcrossTheSignOfItsEulerParameters)
 
 TEST(SpatialScenes, CardanBranchSwitchFallsBackNamingTheBranch) {
   // The near-singular Cardan joint's chunk seeded on the other assembly mode (θ2 + π: another orientation, not
-  // −e) is still refused at its seam, and the warning says it was another branch, not a failure or a sign.
+  // −e) is still refused at its seam, and the warning says it was another branch, not a failure or a sign: at the
+  // coordinate farthest from the seam, how far in its own unit, and how closely two rows of one branch agree there
+  // (the seam's 100 tolerances: 100 · 1e-10 · its scale), not "N tolerances".
   const Scene s = Load("spatial/cardan_near_singular.yaml");
   SweepOptions opt = s.sweep;
   opt.threads = 2;
@@ -392,11 +395,24 @@ TEST(SpatialScenes, CardanBranchSwitchFallsBackNamingTheBranch) {
   ASSERT_EQ(sum.warnings.size(), 1u);
   EXPECT_EQ(sum.warnings[0].kind, "parallel_fallback");
   const std::string& why = sum.warnings[0].message;
-  EXPECT_NE(why.find("did not continue the sweep in order: its first row is another branch: "), std::string::npos)
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(why, m,
+                                std::regex("did not continue the sweep in order: its first row is another branch: "
+                                           "'([^']+)' is ([^ ]+)( m| rad)? from where the sweep in order arrives, "
+                                           "where two rows of one branch agree to ±([^ ;]+)( m| rad)?; the "
+                                           "remaining steps ran in order$")))
       << why;
-  EXPECT_NE(why.find(" tolerances from where the sweep in order arrives; the remaining steps ran in order"),
-            std::string::npos)
-      << why;
+  const Index j = s.model->coordinate_index(m[1].str());  // (throws on a name the model does not have)
+  const std::string unit = unit_symbol(s.model->coordinate_unit(j));
+  EXPECT_EQ(m[3].str(), unit.empty() ? "" : " " + unit) << why;
+  EXPECT_EQ(m[5].str(), m[3].str()) << why;
+  // another orientation: an Euler parameter, or an angle, a finite distance away (measured 'q0' is 1.01)
+  const double far = std::stod(m[2].str()), agree = std::stod(m[4].str());
+  EXPECT_GE(far, 0.1) << why;
+  EXPECT_LE(far, unit == "m" ? 10.0 : 2 * M_PI) << why;
+  const double seam = 100 * opt.newton.tolerance * s.model->tolerance_scales().coordinate_scale(j);
+  EXPECT_NEAR(agree, seam, 0.05 * seam) << why;
+  EXPECT_GT(far, agree) << why;
   ExpectCardanClosedForm(*s.model, tr, 89.0 * M_PI / 180.0, 1.5, "x2");
 }
 

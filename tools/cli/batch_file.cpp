@@ -462,9 +462,9 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     h.halted = halted;
     try {
       all_threads = run_cases(ranks, resumed.first, n, a.threads, h);
-    } catch (const std::bad_alloc&) {  // a worker's: nothing is published (the temporaries go with `outputs`)
+    } catch (const std::bad_alloc& e) {  // a worker's, any rank's: nothing is published (temporaries go with `outputs`)
       return fail(a.scene + ": out of memory after " + std::to_string(cases_written) + " of " + std::to_string(n) +
-                      " cases on " + std::to_string(a.threads) + " threads (fewer --threads); no output written",
+                      " cases " + out_of_memory_where(e, a.threads) + " (fewer --threads); no output written",
                   1);
     }
     if (!writer) return 0;  // (rank 0 says how the batch went)

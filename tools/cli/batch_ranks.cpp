@@ -14,6 +14,9 @@
 #include <iostream>
 #include <limits>
 #include <mutex>
+#include <new>
+#include <optional>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -292,6 +295,7 @@ void serve_remote_workers(BatchRanks& ranks, int workers, const std::function<bo
       continue;
     }
     pause_us = 20;
+    m->rank = from;
     const bool asks = m->asks;
     const std::int64_t k = handle(std::move(*m));
     if (asks)
@@ -303,6 +307,12 @@ void serve_remote_workers(BatchRanks& ranks, int workers, const std::function<bo
 
 }  // namespace
 
+std::string out_of_memory_where(const std::bad_alloc& e, int threads) {
+  if (const auto* r = dynamic_cast<const RankOutOfMemory*>(&e))
+    return "on MPI rank " + std::to_string(r->rank) + " in case " + std::to_string(r->k);
+  return "on " + std::to_string(threads) + " threads";
+}
+
 int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h) {
   const int remote_workers = ranks.total_remote_workers(threads);
   tbb::task_arena arena(threads);
@@ -313,11 +323,17 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
           [&](int w) {
             CaseMessage last;  // the result of the case before: none yet (a request alone)
             std::optional<std::int64_t> k = ranks.send(w, last)->answer();
-            while (k && !h.halted()) {
-              // the next case asked for now, with the last result: its answer travels while this case runs
-              const std::unique_ptr<BatchRanks::Sent> next = ranks.send(w, last);
-              last = h.run_for_0(static_cast<std::size_t>(*k), w);
-              k = next->answer();
+            try {
+              while (k && !h.halted()) {
+                // the next case asked for now, with the last result: its answer travels while this case runs
+                const std::unique_ptr<BatchRanks::Sent> next = ranks.send(w, last);
+                last = h.run_for_0(static_cast<std::size_t>(*k), w);
+                k = next->answer();
+              }
+            } catch (const std::bad_alloc&) {  // told to rank 0, which stops the batch (the case's memory is freed)
+              last = CaseMessage{};
+              last.kind = CaseMessage::Kind::kOutOfMemory;
+              last.k = k ? *k : -1;
             }
             last.asks = false;  // the last result, and no request: this worker is done
             (void)ranks.send(w, last);
@@ -355,7 +371,13 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
           tbb::simple_partitioner());
     });
   });
+  std::optional<RankOutOfMemory> remote_failure;  // the first worker of another rank that ran out of memory
   serve_remote_workers(ranks, remote_workers, h.halted, [&](CaseMessage m) {
+    if (m.kind == CaseMessage::Kind::kOutOfMemory) {
+      if (!remote_failure) remote_failure.emplace(m.rank, m.k);
+      failed = true;  // no case handed out after it, here or elsewhere
+      return std::int64_t{-1};
+    }
     const bool asks = m.asks;
     if (m.kind != CaseMessage::Kind::kNone) h.deliver(std::move(m));
     if (!asks) return std::int64_t{-1};
@@ -364,6 +386,7 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
   });
   local.join();
   if (failure) std::rethrow_exception(failure);
+  if (remote_failure) throw *remote_failure;
   return threads + remote_workers;
 }
 

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
 
@@ -21,8 +22,10 @@ namespace phiq::tools {
 
 // What a worker sends rank 0 after a case: everything rank 0 needs to write and report it as if it had run it.
 struct CaseMessage {
-  enum class Kind : std::int32_t { kNone = 0, kDone = 1, kStopped = 2 };  // stopped: a signal ended it early
-  Kind kind = Kind::kNone;  // the result carried: none (the first request), a case done, or stopped
+  // stopped: a signal ended it early; out of memory: the case threw std::bad_alloc on its rank (the worker's last
+  // message: a rank's own "out of memory" goes to its silenced standard error, and would leave rank 0 waiting)
+  enum class Kind : std::int32_t { kNone = 0, kDone = 1, kStopped = 2, kOutOfMemory = 3 };
+  Kind kind = Kind::kNone;  // the result carried: none (the first request), a case done, stopped, out of memory
   bool asks = true;         // a request for the next case (false: the worker's last message)
   std::int64_t k = -1;      // the case
   bool complete = false, failed = false, on_shared_analysis = false;
@@ -30,6 +33,16 @@ struct CaseMessage {
   std::string values;                    // its HDF5 row values (doubles, as bytes)
   std::int64_t setup_ns = 0, sweep_ns = 0, format_ns = 0;
   int signal = 0;  // kStopped: the signal that stopped it
+  int rank = 0;    // the rank that sent it (set on arrival; not sent)
+};
+
+// Thrown by run_cases() on rank 0 once every worker has stopped, when a worker of rank `rank` > 0 ran out of memory
+// in case `k`: a std::bad_alloc, told by rank 0 with the rank that ran out.
+struct RankOutOfMemory : std::bad_alloc {
+  RankOutOfMemory(int r, std::int64_t c) : rank(r), k(c) {}
+  const char* what() const noexcept override { return "out of memory on another MPI rank"; }
+  int rank;
+  std::int64_t k;
 };
 
 // The job: size() ranks (1 without mpirun). Rank 0 is the writer.
@@ -99,6 +112,10 @@ class BatchRanks {
   bool mpi_ = false, abandoned_ = false, finished_ = false;
 };
 
+// Where run_cases()'s std::bad_alloc `e` happened, for the command's one line: "on MPI rank R in case K" (a
+// RankOutOfMemory), else "on T threads" (this process's `threads`).
+std::string out_of_memory_where(const std::bad_alloc& e, int threads);
+
 // What run_cases() does with a case.
 struct CaseHandlers {
   std::function<void(std::size_t k, int worker)> run_here;          // rank 0: run case k and take its result
@@ -114,7 +131,9 @@ struct CaseHandlers {
 // last message received, or at once when halted() (the workers still out then abandoned: BatchRanks::abandon).
 // run_here and deliver may run at the same time (rank 0's workers and its answering thread). Returns the worker
 // threads of the whole job on rank 0 (every rank's `threads` summed), this rank's own elsewhere. An exception of
-// run_here (std::bad_alloc) stops the handing out of cases and is thrown here once rank 0's workers have stopped.
+// run_here (std::bad_alloc) stops the handing out of cases and is thrown here once rank 0's workers have stopped; a
+// std::bad_alloc of run_for_0 on another rank ends that worker with a kOutOfMemory message, which stops the handing
+// out too, and RankOutOfMemory is thrown here on rank 0 once every worker has sent its last message.
 int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h);
 
 }  // namespace phiq::tools

@@ -373,11 +373,10 @@ int sample_cases(const ToleranceArgs& a, const ToleranceSetup& u, const std::vec
   h.halted = [&] { return stop.load() || remote_stop.load(); };
   try {
     out.threads_used = run_cases(ranks, 0, n_cases, out.threads_used, h);
-  } catch (const std::bad_alloc&) {  // a worker's: the cases' outputs and models took what there was
-    return fail(a.scene + ": out of memory with " + std::to_string(n_cases) + " samples on " +
-                    std::to_string(out.threads_used) +
-                    " threads (fewer --samples, --columns or --threads); no output "
-                    "written",
+  } catch (const std::bad_alloc& e) {  // a worker's, any rank's: the cases' outputs and models took what there was
+    return fail(a.scene + ": out of memory with " + std::to_string(n_cases) + " samples " +
+                    out_of_memory_where(e, out.threads_used) +
+                    " (fewer --samples, --columns or --threads); no output written",
                 1);
   }
   if (ranks.rank() != 0) return 0;  // (rank 0 reports)
