@@ -4,8 +4,8 @@
 #                            1. Release build (build/, as tools/setup.sh configures it) and its ctest suite, with the
 #                               installed-package consumer, the regression comparisons and the benchmark smoke run;
 #                            2. the same suite built with clang under AddressSanitizer + UndefinedBehaviorSanitizer
-#                               (build-asan/), preceded by bounded libFuzzer runs: the scene loader (40 s), then the
-#                               expression compiler (20 s).
+#                               (build-asan/), preceded by bounded libFuzzer runs side by side: the scene loader
+#                               (40 s) and the expression compiler (20 s).
 #   tools/test.sh --quick    step 1 only (the inner loop while developing)
 #   PHIQ_FUZZ_SECONDS=N      scene fuzzing time (default 40; expressions get half)
 set -euo pipefail
