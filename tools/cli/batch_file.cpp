@@ -9,8 +9,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
-#include <cstring>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -18,11 +18,11 @@
 #include <new>
 #include <optional>
 
+#include "batch_case.hpp"
 #include "batch_resume.hpp"
 #include "cli_support.hpp"
 #include "command_support.hpp"
 #include "result_file.hpp"
-#include "run_summary.hpp"  // a case's outcome as run --summary writes it
 #include "phiq/hdf5_reader.hpp"
 #include "phiq/parsed_scene.hpp"
 #include "phiq/phiq.hpp"
@@ -86,22 +86,6 @@ void add_time(Nanos& total, Clock::time_point since_t) {
 }
 double seconds(const Nanos& n) { return static_cast<double>(n.load()) * 1e-9; }
 
-// A finished case's rows, formatted in the thread that swept it: CSV text (the case column first), or the HDF5
-// row values (Hdf5Writer::append_values: the case first).
-struct CaseRows {
-  bool any = false;  // false: a failed case, left out
-  std::string text;
-  std::vector<double> values;
-};
-
-// What is said about a case once the batch ends: its line on standard error and its --summary entry.
-struct CaseReport {
-  bool complete = false;  // swept to its end (written or failed); not: a case the batch stopped before it ended
-  bool failed = false;
-  std::string line;
-  nlohmann::ordered_json outcome;
-};
-
 // Writes finished cases in case order: a case is written once every case before it has completed; those that
 // complete early wait here (about one per thread when cases take alike). `write` runs under the lock: one case
 // at a time, in order.
@@ -142,86 +126,33 @@ class InOrder {
   std::size_t next_ = 0;
 };
 
-// A case as its worker leaves it, on any rank: what rank 0 reports and writes of it.
-struct CaseResult {
-  CaseReport report;
-  CaseRows rows;
-  bool on_shared_analysis = false;
-  long long setup_ns = 0, sweep_ns = 0, format_ns = 0;
-};
-
-// A case's --summary entry before it runs.
-nlohmann::ordered_json initial_outcome(std::size_t k) {
-  return nlohmann::ordered_json{{"case", k}, {"line", k + 2}, {"file", nullptr}};
-}
-
-// A worker rank's case, for rank 0 (`signal`: the signal that stopped it, if one did).
-CaseMessage to_message(std::size_t k, const CaseResult& r, int signal) {
-  CaseMessage m;
-  m.kind = r.report.complete ? CaseMessage::Kind::kDone : CaseMessage::Kind::kStopped;
-  m.k = static_cast<std::int64_t>(k);
-  m.complete = r.report.complete, m.failed = r.report.failed, m.on_shared_analysis = r.on_shared_analysis;
-  m.line = r.report.line;
-  m.outcome_json = r.report.outcome.dump(-1, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
-  m.text = r.rows.text;
-  if (!r.rows.values.empty())
-    m.values.assign(reinterpret_cast<const char*>(r.rows.values.data()), r.rows.values.size() * sizeof(double));
-  m.setup_ns = r.setup_ns, m.sweep_ns = r.sweep_ns, m.format_ns = r.format_ns;
-  m.signal = signal;
-  return m;
-}
-
-// ... and back, on rank 0: the same report and rows as had the case run there (doubles travel as their bytes).
-CaseResult from_message(CaseMessage m) {
-  CaseResult r;
-  r.report.complete = m.complete, r.report.failed = m.failed;
-  r.report.line = std::move(m.line);
-  r.report.outcome = nlohmann::ordered_json::parse(m.outcome_json);
-  r.rows.any = m.complete && !m.failed;
-  r.rows.text = std::move(m.text);
-  r.rows.values.resize(m.values.size() / sizeof(double));
-  if (!r.rows.values.empty())  // (a CSV batch's cases carry none: memcpy to an empty vector's null is undefined)
-    std::memcpy(r.rows.values.data(), m.values.data(), r.rows.values.size() * sizeof(double));
-  r.on_shared_analysis = m.on_shared_analysis;
-  r.setup_ns = m.setup_ns, r.sweep_ns = m.sweep_ns, r.format_ns = m.format_ns;
-  return r;
-}
-
-}  // namespace
-int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& ranks) {
-  BatchArgs a = args;
-  if (a.threads <= 0) a.threads = tbb::info::default_concurrency();  // 0: all cores (of this rank)
-  const bool hdf5 = phiq::has_hdf5_extension(a.out);
-  const bool writer = ranks.rank() == 0;  // the other ranks sweep cases and print nothing
-  const std::size_t n = cases.rows.size();
-  {
-    std::vector<NamedPath> outs{{"-o", a.out}};
-    if (!a.summary.empty()) outs.push_back({"--summary", a.summary});
-    if (const auto clash = output_clash(outs, {{"the scene", a.scene}, {"the cases", a.cases}}))
-      return fail("batch: " + *clash, 2);
-  }
-  set_interrupt_subject(a.scene, "; no output written");
-  // The scene parsed once; its own parameters' scene is the model every case shares its analysis with, and the
-  // columns' names.
-  const auto load_start = Clock::now();
+// The scene parsed once (a tree per thread); its own parameters' scene, `reference`, is the model every case
+// shares its analysis with, and `format` its columns' names.
+struct BatchScene {
   std::vector<phiq::ParsedScene> trees;
   std::optional<phiq::Scene> reference;
+  std::optional<phiq::CsvFormat> format;
+  double load_s = 0.0;
+};
+// Returns the status (2: a bad scene, cases header or column name, its line printed).
+int read_batch_scene(const BatchArgs& a, const CsvTable& cases, BatchScene& s) {
+  const auto load_start = Clock::now();
   try {
-    trees.push_back(phiq::ParsedScene::load(a.scene));
+    s.trees.push_back(phiq::ParsedScene::load(a.scene));
     phiq::SceneOverrides plain;
     plain.sensitivities = a.sensitivities, plain.sensitivities_source = "--sensitivity";  // (empty: the scene's)
-    reference = trees.front().read(plain);
+    s.reference = s.trees.front().read(plain);
   } catch (const phiq::SceneError& e) {
     return fail(e.what(), 2);
   }
   try {  // a header naming no parameter is no case's error: refused before anything runs
     phiq::SceneOverrides o = case_overrides(cases, 0, a.cases);
-    o.share_analysis_with = reference->model.get();
-    (void)trees.front().read(o);
+    o.share_analysis_with = s.reference->model.get();
+    (void)s.trees.front().read(o);
   } catch (const phiq::SceneError& e) {
     if (std::string(e.what()).rfind(a.cases + ":1: ", 0) == 0) return fail(e.what(), 2);
   }  // (case 0's own error is its own: reported as its failure below)
-  phiq::CsvFormat format(*reference->model, reference->sweep);
+  phiq::CsvFormat& format = s.format.emplace(*s.reference->model, s.reference->sweep);
   try {
     if (a.identifier_names) format.set_naming(phiq::ColumnNaming::kIdentifiers);
   } catch (const phiq::Error& e) {
@@ -232,107 +163,134 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     if (std::find(names.begin(), names.end(), "case") != names.end())
       return fail(a.scene + ": a column is named 'case', the batch's case column: rename it", 2);
   }
-  for (int w = 1; w < a.threads; ++w) trees.push_back(trees.front());  // a tree per thread (ParsedScene)
-  const double load_s = since(load_start);
+  for (int w = 1; w < a.threads; ++w) s.trees.push_back(s.trees.front());  // a tree per thread (ParsedScene)
+  s.load_s = since(load_start);
+  return 0;
+}
 
-  // The output now (rank 0's alone): an unwritable path fails before any case runs, and leaves nothing. With
-  // --resume, the cases already in the file are copied first and the batch goes on after the last of them.
+// The output (rank 0's alone), made before any case runs so that an unwritable path fails then and leaves nothing:
+// the file (and the HDF5 writer on its temporary), the --summary file, the bytes of whole cases in a CSV (what it is
+// cut back to on a write error), and with --resume, where the earlier run's file ends.
+struct BatchOutput {
   OutputSet outputs;
   phiq::AtomicOutputFile* file = nullptr;
   phiq::AtomicOutputFile* summary_file = nullptr;
   std::unique_ptr<phiq::Hdf5Writer> h5;  // after `outputs`: closed before its temporary is removed
   std::uint64_t committed_bytes = 0;
   ResumePoint resumed;  // nothing earlier: the batch from case 0
-  int status = 0;
-  if (writer) {
-    const std::string header = "case," + format.header();
-    try {
-      if (a.resume && hdf5) {
-        std::vector<std::string> columns{"case"};
-        for (const std::string& c : format.column_names()) columns.push_back(c);
-        resumed = read_resume_point_hdf5(a.out, columns, n);
-      } else if (a.resume) {
-        resumed = read_resume_point(a.out, header, n);
-      }
-      if (resumed.first > 0) {  // an earlier run cut inside its last case: that case runs again
-        phiq::SceneOverrides o = case_overrides(cases, resumed.first - 1, a.cases);
-        o.share_analysis_with = reference->model.get();
-        std::size_t case_rows = 0;  // (a case whose scene cannot be read writes none)
-        try {
-          case_rows = static_cast<std::size_t>(phiq::rows_written(trees.front().read(o).sweep));
-        } catch (const phiq::SceneError&) {
-        }
-        drop_unfinished_case(resumed, case_rows, a.out);
-      }
-      if (hdf5) check_hdf5_target(a.out);
-      file = &outputs.add(
-          a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites : phiq::AtomicOutputFile::Hold::kOpen);
-      if (!a.summary.empty()) summary_file = &outputs.add(a.summary);
-      if (hdf5) {
-        phiq::Hdf5Options o;
-        o.scene_path = reference->path;
-        o.scene_text = reference->text;
-        o.expected_rows = static_cast<std::size_t>(phiq::rows_written(reference->sweep)) * n;
-        o.shown_path = file->path();
-        o.case_column = true;
-        if (a.identifier_names) o.naming = phiq::ColumnNaming::kIdentifiers;
-        if (resumed.first > 0) {  // the earlier file, copied to be appended to (its own stays whole meanwhile)
-          std::filesystem::copy_file(a.out, file->temporary_path(), std::filesystem::copy_options::overwrite_existing);
-          o.append = true;
-          o.append_after_rows = resumed.rows;
-        }
-        h5 = std::make_unique<phiq::Hdf5Writer>(file->temporary_path(), *reference->model, reference->sweep, o);
-      } else if (resumed.first > 0) {
-        committed_bytes = copy_resumed_cases(a.out, resumed, *file);
-      } else {
-        file->write(header);
-        committed_bytes = header.size();
-      }
-    } catch (const ResumeError& e) {
-      status = fail(e.what(), 2);
-    } catch (const phiq::Error& e) {
-      status = fail(e.what(), 3);
-    } catch (const std::filesystem::filesystem_error& e) {  // copying an HDF5 output to resume it
-      status = fail(a.out + ": cannot write: " + e.code().message(), 3);
+};
+// With --resume, the cases already in the file are copied first and the batch goes on after the last of them.
+// Returns the status (2: a file --resume cannot go on from, 3: an output error; its line printed).
+int open_batch_output(const BatchArgs& a, const CsvTable& cases, bool hdf5, BatchScene& s, BatchOutput& out) {
+  const std::size_t n = cases.rows.size();
+  const phiq::Scene& reference = *s.reference;
+  const std::string header = "case," + s.format->header();
+  try {
+    if (a.resume && hdf5) {
+      std::vector<std::string> columns{"case"};
+      for (const std::string& c : s.format->column_names()) columns.push_back(c);
+      out.resumed = read_resume_point_hdf5(a.out, columns, n);
+    } else if (a.resume) {
+      out.resumed = read_resume_point(a.out, header, n);
     }
+    if (out.resumed.first > 0) {  // an earlier run cut inside its last case: that case runs again
+      phiq::SceneOverrides o = case_overrides(cases, out.resumed.first - 1, a.cases);
+      o.share_analysis_with = reference.model.get();
+      std::size_t case_rows = 0;  // (a case whose scene cannot be read writes none)
+      try {
+        case_rows = static_cast<std::size_t>(phiq::rows_written(s.trees.front().read(o).sweep));
+      } catch (const phiq::SceneError&) {
+      }
+      drop_unfinished_case(out.resumed, case_rows, a.out);
+    }
+    if (hdf5) check_hdf5_target(a.out);
+    out.file = &out.outputs.add(
+        a.out, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites : phiq::AtomicOutputFile::Hold::kOpen);
+    if (!a.summary.empty()) out.summary_file = &out.outputs.add(a.summary);
+    if (hdf5) {
+      phiq::Hdf5Options o;
+      o.scene_path = reference.path;
+      o.scene_text = reference.text;
+      o.expected_rows = static_cast<std::size_t>(phiq::rows_written(reference.sweep)) * n;
+      o.shown_path = out.file->path();
+      o.case_column = true;
+      if (a.identifier_names) o.naming = phiq::ColumnNaming::kIdentifiers;
+      if (out.resumed.first > 0) {  // the earlier file, copied to be appended to (its own stays whole meanwhile)
+        std::filesystem::copy_file(a.out, out.file->temporary_path(),
+                                   std::filesystem::copy_options::overwrite_existing);
+        o.append = true;
+        o.append_after_rows = out.resumed.rows;
+      }
+      out.h5 = std::make_unique<phiq::Hdf5Writer>(out.file->temporary_path(), *reference.model, reference.sweep, o);
+    } else if (out.resumed.first > 0) {
+      out.committed_bytes = copy_resumed_cases(a.out, out.resumed, *out.file);
+    } else {
+      out.file->write(header);
+      out.committed_bytes = header.size();
+    }
+  } catch (const ResumeError& e) {
+    return fail(e.what(), 2);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  } catch (const std::filesystem::filesystem_error& e) {  // copying an HDF5 output to resume it
+    return fail(a.out + ": cannot write: " + e.code().message(), 3);
   }
-  if ((status = ranks.agree(status)) != 0) return status;  // every rank stops where rank 0 could not go on
+  return 0;
+}
 
-  // Cases commit in order as they complete. A write error stops the batch: the CSV is cut back to the cases it
-  // holds whole and published; an HDF5 file is not (a failed write may have left its structure half-written).
-  std::atomic<bool> abort{false};
-  std::atomic<int> remote_signal{0};  // a signal that stopped a case on another rank
+// How the cases went, as rank 0 gathers it: each case's report and whether it is in the file, the cases written,
+// the first write error (it stops the batch: `abort`), a signal that stopped a case on another rank, the
+// thread-seconds of each part, the cases on the reference's symbolic analysis, the threads on every rank, the
+// solve's seconds, and the first case not written when the sweep ended.
+struct BatchProgress {
+  std::vector<CaseReport> reports;
+  std::vector<char> written;
+  std::size_t cases_written = 0;
   std::string write_error;
-  std::vector<char> written(n, 0);
-  std::size_t cases_written = resumed.cases_in_file;
+  std::atomic<bool> abort{false};
+  std::atomic<int> remote_signal{0};
   Nanos setup_ns{0}, sweep_ns{0}, format_ns{0}, write_ns{0};
+  std::atomic<std::size_t> shared{0};
+  int all_threads = 0;
+  double solve_s = 0.0;
+  std::size_t first_missing = 0;
+};
+
+// The cases swept on every rank's threads (run_cases); on rank 0 each committed to the file in case order as it
+// completes. A write error stops the batch. Returns a status to exit with at once (out of memory, its line printed;
+// 0 on a rank other than 0, which reports nothing), or nothing: rank 0 goes on to publish.
+std::optional<int> sweep_batch_cases(const BatchArgs& a, const CsvTable& cases, BatchRanks& ranks, bool hdf5,
+                                     BatchScene& s, BatchOutput& out, BatchProgress& p) {
+  const std::size_t n = cases.rows.size();
+  const ResumePoint& resumed = out.resumed;
+  p.written.assign(n, 0);
+  p.cases_written = resumed.cases_in_file;
   InOrder in_order(resumed.first, [&](std::size_t k, CaseRows& rows) {
-    if (!rows.any || !write_error.empty()) return;
+    if (!rows.any || !p.write_error.empty()) return;
     const auto w0 = Clock::now();
     try {
-      if (h5) {
-        const std::size_t m = h5->row_values(), rows_before = h5->rows();
-        for (std::size_t at = 0; at < rows.values.size(); at += m) h5->append_values(rows.values.data() + at);
-        hand_blocks_to_disk(*h5, rows_before, *file);
+      if (out.h5) {
+        const std::size_t m = out.h5->row_values(), rows_before = out.h5->rows();
+        for (std::size_t at = 0; at < rows.values.size(); at += m) out.h5->append_values(rows.values.data() + at);
+        hand_blocks_to_disk(*out.h5, rows_before, *out.file);
       } else {
-        file->write(rows.text);
-        committed_bytes += rows.text.size();
+        out.file->write(rows.text);
+        out.committed_bytes += rows.text.size();
       }
-      written[k] = 1;
-      ++cases_written;
+      p.written[k] = 1;
+      ++p.cases_written;
     } catch (const phiq::Error& e) {
-      write_error = e.what();
-      abort = true;
+      p.write_error = e.what();
+      p.abort = true;
     }
-    add_time(write_ns, w0);
+    add_time(p.write_ns, w0);
   });
-
-  std::vector<CaseReport> reports(n);
-  for (std::size_t k = 0; k < n; ++k) reports[k].outcome = initial_outcome(k);
+  p.reports.resize(n);
+  for (std::size_t k = 0; k < n; ++k) p.reports[k].outcome = initial_outcome(k);
   for (std::size_t k = 0; k < resumed.first; ++k) {  // --resume: the cases before the first it runs
-    CaseReport& r = reports[k];
-    written[k] = resumed.in_file[k];
-    if (written[k]) {
+    CaseReport& r = p.reports[k];
+    p.written[k] = resumed.in_file[k];
+    if (p.written[k]) {
       r.outcome["status"] = "written earlier";  // by the run resumed (its summary has the rest)
     } else {  // it failed in the run resumed (or that run's file had already left it out)
       r.complete = r.failed = true;
@@ -340,165 +298,84 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
       r.line = a.scene + ": case " + std::to_string(k) + ": not in " + a.out + " (left out by the run resumed)";
     }
   }
-  std::atomic<std::size_t> shared{0};  // cases swept on the reference's symbolic analysis
   const std::atomic<bool>& stop = stop_flag();
-  auto halted = [&] { return stop.load() || abort.load() || remote_signal.load() != 0; };
-  const std::string left_out = "; left out of " + a.out;
-  // One case, on the thread's own tree: built, made square, swept, its rows formatted into `rows` (a written
-  // case's buffers, reused).
-  auto run_case = [&](std::size_t k, phiq::ParsedScene& tree, CaseRows rows) {
-    CaseResult result;
-    result.report.outcome = initial_outcome(k);
-    CaseReport& report = result.report;
-    auto fails = [&](const std::string& why) {
-      report.complete = report.failed = true;
-      report.line = a.scene + ": case " + std::to_string(k) + ": " + why + left_out;
-      return std::move(result);
-    };
-    const auto t0 = Clock::now();
-    auto setup_done = [&] {
-      result.setup_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
-    };
-    phiq::SceneOverrides o = case_overrides(cases, k, a.cases);
-    o.share_analysis_with = reference->model.get();
-    o.sensitivities = a.sensitivities, o.sensitivities_source = "--sensitivity";
-    std::optional<phiq::Scene> scene;
-    try {
-      scene = tree.read(o);
-    } catch (const phiq::SceneError& e) {  // its parameters make the scene impossible (a negative length)
-      report.outcome["status"] = "scene error";
-      report.outcome["message"] = e.what();
-      setup_done();
-      return fails(std::string(e.what()) + " (line " + std::to_string(k + 2) + " of " + a.cases + ")");
-    }
-    phiq::SquareScene square;
-    if (const auto why = make_square(*scene, &square)) {  // as `phiq run`: one that cannot be fails alone
-      phiq::SweepSummary at_start;                        // the first position, before any sweep
-      at_start.status = square.assembly.status;
-      at_start.message = *why;
-      at_start.failed_step = 0;
-      at_start.failed_time = scene->sweep.t_begin;
-      at_start.worst_rows = square.assembly.worst_rows;
-      add_outcome(report.outcome, *scene->model, at_start);
-      setup_done();
-      return fails(*why);
-    }
-    const phiq::Model& model = square.model(*scene->model);
-    result.on_shared_analysis = model.symbolic() && model.symbolic() == reference->model->symbolic();
-    phiq::Workspace ws(model);
-    ws.q = square.start;
-    phiq::SweepOptions one = scene->sweep;
-    one.threads = 1;  // parallel over cases, not within one: each case computed alike on any thread or rank
-    const phiq::CsvFormat rows_format(*scene->model, scene->sweep);  // the case's own output points
-    const std::string prefix = std::to_string(k) + ",";
-    bool last = false;
-    std::vector<double> row(hdf5 ? 1 + rows_format.num_values() : 0);  // the case, then the row's values
-    setup_done();
-    long long format_case_ns = 0;
-    phiq::SweepSummary s;
-    (void)phiq::run_sweep(
-        model, one, ws,
-        [&](const phiq::StepView& step) {
-          const auto f0 = Clock::now();
-          if (hdf5) {  // the values Hdf5Writer::append_row() would store, the case first
-            row[0] = static_cast<double>(k);
-            rows_format.append_values(step, row.data() + 1);
-            rows.values.insert(rows.values.end(), row.begin(), row.end());
-          } else {
-            rows.text += prefix;
-            rows_format.append_row(step, rows.text);
-          }
-          last = step.step == one.steps;
-          format_case_ns += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - f0).count();
-          return !halted();
-        },
-        &s);
-    result.format_ns = format_case_ns;
-    result.sweep_ns = static_cast<long long>(s.solve_seconds * 1e9) - format_case_ns;
-    add_outcome(report.outcome, model, s);
-    report.outcome["steps"] = s.steps_completed;
-    report.outcome["newton_iterations"] = s.counters.newton_iterations;
-    // (a case whose last row was delivered is complete, even if a signal asked it to stop there)
-    if (s.status == phiq::SolveStatus::kSuccess || (s.status == phiq::SolveStatus::kCancelled && last)) {
-      report.complete = true;
-      report.line = a.scene + ": case " + std::to_string(k) + ": " + s.BriefReport();
-      rows.any = true;
-      result.rows = std::move(rows);
-      return result;
-    }
-    if (s.status != phiq::SolveStatus::kCancelled) return fails(s.message);
-    return result;  // stopped before its end: it never completes, and no case after it is written
-  };
+  const BatchCaseSetting setting{a, cases, *s.reference->model, hdf5, stop, p.abort, p.remote_signal};
   // A case's result, wherever it ran, reaches rank 0's report and file here.
   auto deliver = [&](std::size_t k, CaseResult r) {
-    setup_ns += r.setup_ns, sweep_ns += r.sweep_ns, format_ns += r.format_ns;
-    shared += r.on_shared_analysis ? 1 : 0;
+    p.setup_ns += r.setup_ns, p.sweep_ns += r.sweep_ns, p.format_ns += r.format_ns;
+    p.shared += r.on_shared_analysis ? 1 : 0;
     const bool complete = r.report.complete;
     // the case's time on its thread (set-up, sweep, rows): the costs tools/simulate_batch_ranks.py schedules
     r.report.outcome["seconds"] = static_cast<double>(r.setup_ns + r.sweep_ns + r.format_ns) * 1e-9;
-    reports[k] = std::move(r.report);
+    p.reports[k] = std::move(r.report);
     if (complete) in_order.complete(k, std::move(r.rows));
   };
 
   const auto solve_start = Clock::now();
-  int all_threads = a.threads;  // on every rank
+  p.all_threads = a.threads;  // on every rank
   {
     StopOnSignal stop_on_signal;  // a signal stops every case at its next row
     std::vector<CaseRows> worker_rows(static_cast<std::size_t>(a.threads));  // a worker rank's buffers, reused
     CaseHandlers h;
-    h.run_here = [&](std::size_t k, int w) { deliver(k, run_case(k, trees[w], in_order.spare())); };
+    h.run_here = [&](std::size_t k, int w) { deliver(k, run_batch_case(setting, k, s.trees[w], in_order.spare())); };
     h.run_for_0 = [&](std::size_t k, int w) {
       CaseRows& rows = worker_rows[static_cast<std::size_t>(w)];
-      CaseResult r = run_case(k, trees[w], std::move(rows));
+      CaseResult r = run_batch_case(setting, k, s.trees[w], std::move(rows));
       CaseMessage m = to_message(k, r, stop.load() ? interrupt_signal() : 0);
       rows = std::move(r.rows);
       rows.any = false, rows.text.clear(), rows.values.clear();
       return m;
     };
     h.deliver = [&](CaseMessage m) {
-      if (m.kind == CaseMessage::Kind::kStopped) remote_signal = m.signal > 0 ? m.signal : 15;
+      if (m.kind == CaseMessage::Kind::kStopped) p.remote_signal = m.signal > 0 ? m.signal : 15;
       if (m.kind == CaseMessage::Kind::kDone) deliver(static_cast<std::size_t>(m.k), from_message(std::move(m)));
     };
-    h.halted = halted;
+    h.halted = [&] { return setting.halted(); };
     try {
-      all_threads = run_cases(ranks, resumed.first, n, a.threads, h);
+      p.all_threads = run_cases(ranks, resumed.first, n, a.threads, h);
     } catch (const std::bad_alloc& e) {  // a worker's, any rank's: nothing is published (temporaries go with `outputs`)
-      return fail(a.scene + ": out of memory after " + std::to_string(cases_written) + " of " + std::to_string(n) +
+      return fail(a.scene + ": out of memory after " + std::to_string(p.cases_written) + " of " + std::to_string(n) +
                       " cases " + out_of_memory_where(e, a.threads) + " (fewer --threads); no output written",
                   1);
     }
-    if (!writer) return 0;  // (rank 0 says how the batch went)
+    if (ranks.rank() != 0) return 0;  // (rank 0 says how the batch went)
   }
-  const double solve_s = since(solve_start);
-  const int signal = stop.load() ? interrupt_signal() : remote_signal.load();
-  const bool interrupted = signal != 0;
+  p.solve_s = since(solve_start);
+  p.first_missing = in_order.next();
+  return std::nullopt;
+}
 
-  // Publish what was committed: every case in order, or (interrupted, write error) the cases before the first
-  // that did not complete.
+// Rank 0, once the cases are done: publishes what was committed (every case in order, or, interrupted or after a
+// write error, the cases before the first that did not complete; an HDF5 file after a write error is not: its
+// structure may be half-written), says how the batch went and writes the --summary. Returns the exit status.
+int publish_batch(const BatchArgs& a, BatchRanks& ranks, std::size_t n, BatchScene& s, BatchOutput& out,
+                  BatchProgress& p) {
+  const int signal = stop_flag().load() ? interrupt_signal() : p.remote_signal.load();
+  const bool interrupted = signal != 0;
   std::string publish_error;
   bool published = false;
   try {
-    if (!write_error.empty() && h5) {
-      outputs.drop(*file);
+    if (!p.write_error.empty() && out.h5) {
+      out.outputs.drop(*out.file);
     } else {
-      if (!write_error.empty()) file->truncate(committed_bytes);
-      if (h5) h5->close();
-      outputs.commit_one(*file);
+      if (!p.write_error.empty()) out.file->truncate(out.committed_bytes);
+      if (out.h5) out.h5->close();
+      out.outputs.commit_one(*out.file);
       published = true;
     }
   } catch (const phiq::Error& e) {
     publish_error = e.what();
   }
   const std::string written_text =
-      std::to_string(published ? cases_written : 0) + " of " + std::to_string(n) + " cases written to " + a.out;
+      std::to_string(published ? p.cases_written : 0) + " of " + std::to_string(n) + " cases written to " + a.out;
   // Interrupted (not by an output error): the cases from the first unfinished one on are missing from the file.
-  const bool stopped = interrupted && write_error.empty() && publish_error.empty();
-  const std::size_t first_missing = in_order.next();
+  const bool stopped = interrupted && p.write_error.empty() && publish_error.empty();
+  const std::size_t first_missing = p.first_missing;
   std::size_t failed = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    CaseReport& r = reports[k];
+    CaseReport& r = p.reports[k];
     failed += r.failed;
-    if (written[k] && published) r.outcome["file"] = a.out;
+    if (p.written[k] && published) r.outcome["file"] = a.out;
     if (stopped && k >= first_missing && !r.failed)
       r.outcome["status"] = "missing";  // what --resume runs
     else if (!r.outcome.contains("status"))
@@ -511,18 +388,18 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
   }
   auto totals = [&] {
     BatchTotals t;
-    t.scene_name = reference->name;
+    t.scene_name = s.reference->name;
     t.output = a.out;
-    t.cases = n, t.failed = failed, t.written = published ? cases_written : 0, t.shared_analyses = shared.load();
-    t.threads = all_threads;
+    t.cases = n, t.failed = failed, t.written = published ? p.cases_written : 0, t.shared_analyses = p.shared.load();
+    t.threads = p.all_threads;
     t.ranks = ranks.size();
-    t.load_seconds = load_s, t.solve_seconds = solve_s;
+    t.load_seconds = s.load_s, t.solve_seconds = p.solve_s;
     if (stopped) t.interrupted = signal_name(signal);
     return t;
   };
   auto results = [&] {
     nlohmann::ordered_json all = nlohmann::ordered_json::array();
-    for (CaseReport& r : reports) all.push_back(std::move(r.outcome));
+    for (CaseReport& r : p.reports) all.push_back(std::move(r.outcome));
     return all;
   };
   if (stopped) {
@@ -533,24 +410,51 @@ int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& 
     const int code = fail(a.scene + ": interrupted (" + signal_name(signal) + "); " + written_text +
                               " (the cases before the first unfinished one)" + missing,
                           128 + signal);
-    if (summary_file) (void)commit_batch_summary(outputs, *summary_file, a, totals(), results(), code);
+    if (out.summary_file) (void)commit_batch_summary(out.outputs, *out.summary_file, a, totals(), results(), code);
     return code;
   }
-  const bool output_error = !write_error.empty() || !publish_error.empty();
+  const bool output_error = !p.write_error.empty() || !publish_error.empty();
   if (output_error)  // (the summary, as for -o DIR, is still written: it says which cases are in the file)
-    (void)fail((write_error.empty() ? publish_error : write_error) + "; " + written_text +
+    (void)fail((p.write_error.empty() ? publish_error : p.write_error) + "; " + written_text +
                    (published ? " (whole cases, in order)" : ""),
                3);
   else if (!a.quiet)
     std::cerr << "phiq: " << printable(a.scene) << ": " << n - failed << " of " << n << " cases in " << printable(a.out)
-              << ", " << (ranks.size() > 1 ? ranks.describe() + ", " : "") << all_threads << " threads, "
-              << shared.load() << " cases on the scene's symbolic analysis, load " << scientific(load_s, 3)
-              << " s, solve " << scientific(solve_s, 3) << " s (thread-seconds: set-up "
-              << scientific(seconds(setup_ns), 3) << ", sweep " << scientific(seconds(sweep_ns), 3) << ", rows "
-              << scientific(seconds(format_ns), 3) << ", write " << scientific(seconds(write_ns), 3) << ")\n";
-  if (summary_file)
-    return commit_batch_summary(outputs, *summary_file, a, totals(), results(), output_error ? 3 : failed ? 1 : 0);
+              << ", " << (ranks.size() > 1 ? ranks.describe() + ", " : "") << p.all_threads << " threads, "
+              << p.shared.load() << " cases on the scene's symbolic analysis, load " << scientific(s.load_s, 3)
+              << " s, solve " << scientific(p.solve_s, 3) << " s (thread-seconds: set-up "
+              << scientific(seconds(p.setup_ns), 3) << ", sweep " << scientific(seconds(p.sweep_ns), 3) << ", rows "
+              << scientific(seconds(p.format_ns), 3) << ", write " << scientific(seconds(p.write_ns), 3) << ")\n";
+  if (out.summary_file)
+    return commit_batch_summary(out.outputs, *out.summary_file, a, totals(), results(),
+                                output_error ? 3
+                                : failed     ? 1
+                                             : 0);
   return output_error ? 3 : failed ? 1 : 0;
+}
+
+}  // namespace
+
+int batch_to_one_file(const BatchArgs& args, const CsvTable& cases, BatchRanks& ranks) {
+  BatchArgs a = args;
+  if (a.threads <= 0) a.threads = tbb::info::default_concurrency();  // 0: all cores (of this rank)
+  const bool hdf5 = phiq::has_hdf5_extension(a.out);
+  const bool writer = ranks.rank() == 0;  // the other ranks sweep cases and print nothing
+  {
+    std::vector<NamedPath> outs{{"-o", a.out}};
+    if (!a.summary.empty()) outs.push_back({"--summary", a.summary});
+    if (const auto clash = output_clash(outs, {{"the scene", a.scene}, {"the cases", a.cases}}))
+      return fail("batch: " + *clash, 2);
+  }
+  set_interrupt_subject(a.scene, "; no output written");
+  BatchScene scene;
+  if (const int status = read_batch_scene(a, cases, scene)) return status;
+  BatchOutput out;
+  int status = writer ? open_batch_output(a, cases, hdf5, scene, out) : 0;
+  if ((status = ranks.agree(status)) != 0) return status;  // every rank stops where rank 0 could not go on
+  BatchProgress progress;
+  if (const auto stopped = sweep_batch_cases(a, cases, ranks, hdf5, scene, out, progress)) return *stopped;
+  return publish_batch(a, ranks, cases.rows.size(), scene, out, progress);
 }
 
 }  // namespace phiq::tools

@@ -163,6 +163,84 @@ nlohmann::ordered_json summary_modes(const phiq::Scene& scene, std::optional<phi
                                : count_modes(scene, t, position, threads));
 }
 
+// The run's outputs, each made (as a temporary, or a device opened) before the solve so that an unwritable path
+// fails before the sweep, and committed together at the end (or none of them appears): -o's file (null: the CSV
+// goes to standard output) and --summary's.
+struct RunOutputs {
+  OutputSet outputs;
+  phiq::AtomicOutputFile* file = nullptr;
+  phiq::AtomicOutputFile* summary_file = nullptr;
+};
+// Returns the status (3: a path that cannot be written, its line printed).
+int open_run_outputs(const std::string& out_path, const std::string& summary_path, bool hdf5, RunOutputs& out) {
+  try {
+    if (hdf5) check_hdf5_target(out_path);
+    // HDF5 opens its file by name, and its name must be a real path (not /proc/self/fd/N): a named temporary
+    if (!out_path.empty())
+      out.file = &out.outputs.add(
+          out_path, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites : phiq::AtomicOutputFile::Hold::kOpen);
+    if (!summary_path.empty()) out.summary_file = &out.outputs.add(summary_path);
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  return 0;
+}
+
+// A successful sweep's outputs finished and committed together: the HDF5 file closed, the CSV's last rows written
+// (to its file, or the spool copied to standard output), the summary (`found`: the modes --mode found). Returns the
+// status (3: an output error, its line printed).
+int commit_run(const std::string& scene_path, const phiq::Scene& scene, const phiq::Model& model,
+               const phiq::SweepSummary& summary, double load_s, ResultRows& rows, phiq::Hdf5Writer* h5,
+               std::FILE* spool, RunOutputs& out, std::optional<phiq::AssemblyModes>& found, int threads) {
+  double write_s = rows.seconds;  // writing rows (the sweep's threads encode them: in solve_seconds)
+  const double solve_s = summary.solve_seconds - write_s;
+  const auto final_write = Clock::now();
+  try {
+    if (h5) h5->close();
+    rows.flush();
+    if (out.file) {
+      out.file->finish();
+    } else {
+      // what reaches standard output cannot be taken back: a signal from here on says so
+      set_interrupt_subject(scene_path, "; standard output incomplete");
+      std::rewind(spool);
+      char chunk[1 << 16];
+      for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, spool)) > 0;)
+        if (std::fwrite(chunk, 1, n, stdout) != n)
+          throw phiq::Error(std::string("standard output: cannot write: ") + std::strerror(errno));
+      if (const auto bad = stdout_error()) throw phiq::Error(*bad);
+    }
+    write_s += since(final_write);
+    if (out.summary_file)
+      out.summary_file->write(run_summary_json(scene, model, summary, {load_s, solve_s, write_s},
+                                               summary_modes(scene, found, rows.first_q, threads)));
+    out.outputs.commit();
+  } catch (const phiq::Error& e) {
+    return fail(e.what(), 3);
+  }
+  return 0;
+}
+
+// A successful run's lines on standard error (unless --quiet): the redundant equations left out, the sweep's
+// warnings, and its brief report (`wrote`: the output file, empty for standard output).
+void report_run(const std::string& scene_path, const phiq::AssemblySummary& redundancy,
+                const phiq::SweepSummary& summary, const std::string& wrote) {
+  if (!redundancy.rank.redundant.empty())
+    std::cerr << "phiq: " << printable(scene_path)
+              << ": redundant equations left out of the solve (consistent): " << joined(redundancy.rank.redundant)
+              << "\n";
+  for (const auto& w : summary.warnings)
+    std::cerr << "phiq: " << printable(scene_path) << ": warning: t = " << phiq::format_time(w.t) << ": " << w.kind
+              << ": " << w.message << "\n";
+  std::cerr << "phiq: " << printable(scene_path) << ": " << summary.BriefReport();
+  if (summary.min_rcond > 0)
+    std::cerr << ", min rcond " << scientific(summary.min_rcond, 3)
+              << " at t = " << phiq::format_time(summary.min_rcond_time);
+  std::cerr << rounding_level_note(summary.accuracy.rounding_level);
+  if (!wrote.empty()) std::cerr << "; wrote " << printable(wrote);
+  std::cerr << "\n";
+}
+
 // `drv`: the drivers and time grid given to a robot description (--drive, --time; phiq/import_model.hpp).
 int cmd_run(const std::string& scene_arg, const std::string& out_path, const std::string& format, int deflate,
             bool quiet, const std::string& summary_path, int threads, double memory_gb, ProgressBar::Mode progress_mode,
@@ -188,21 +266,11 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   phiq::Scene& scene = *loaded;
   const double load_s = since(load_start);
 
-  // Every output exists (as a temporary, or a device opened) before the solve: an unwritable path fails now, not
-  // after the sweep; they are committed together at the end, or none of them appears.
-  OutputSet outputs;
-  phiq::AtomicOutputFile* file = nullptr;
-  phiq::AtomicOutputFile* summary_file = nullptr;
-  try {
-    if (hdf5) check_hdf5_target(out_path);
-    // HDF5 opens its file by name, and its name must be a real path (not /proc/self/fd/N): a named temporary
-    if (!out_path.empty())
-      file = &outputs.add(
-          out_path, hdf5 ? phiq::AtomicOutputFile::Hold::kClosedBetweenWrites : phiq::AtomicOutputFile::Hold::kOpen);
-    if (!summary_path.empty()) summary_file = &outputs.add(summary_path);
-  } catch (const phiq::Error& e) {
-    return fail(e.what(), 3);
-  }
+  RunOutputs out;
+  if (const int status = open_run_outputs(out_path, summary_path, hdf5, out)) return status;
+  OutputSet& outputs = out.outputs;
+  phiq::AtomicOutputFile* const file = out.file;
+  phiq::AtomicOutputFile* const summary_file = out.summary_file;
 
   std::optional<phiq::AssemblyModes> found;  // by --mode
   // A run that cannot be solved still commits its summary (status, where, why: for harnesses), never the CSV. Its
@@ -287,48 +355,10 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
     const std::string why = failure_message(scene, summary, square.reduced != nullptr);
     return failed(model, summary, {load_s, summary.solve_seconds - rows.seconds, rows.seconds}, why, rows.first_q);
   }
-  double write_s = rows.seconds;  // writing rows (the sweep's threads encode them: in solve_seconds)
-  const double solve_s = summary.solve_seconds - write_s;
-  const auto final_write = Clock::now();
-  try {
-    if (h5) h5->close();
-    rows.flush();
-    if (file) {
-      file->finish();
-    } else {
-      // what reaches standard output cannot be taken back: a signal from here on says so
-      set_interrupt_subject(scene_path, "; standard output incomplete");
-      std::rewind(spool);
-      char chunk[1 << 16];
-      for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, spool)) > 0;)
-        if (std::fwrite(chunk, 1, n, stdout) != n)
-          throw phiq::Error(std::string("standard output: cannot write: ") + std::strerror(errno));
-      if (const auto bad = stdout_error()) throw phiq::Error(*bad);
-    }
-    write_s += since(final_write);
-    if (summary_file)
-      summary_file->write(run_summary_json(scene, model, summary, {load_s, solve_s, write_s},
-                                           summary_modes(scene, found, rows.first_q, threads)));
-    outputs.commit();
-  } catch (const phiq::Error& e) {
-    return fail(e.what(), 3);
-  }
-  if (!quiet) {
-    if (!redundancy.rank.redundant.empty())
-      std::cerr << "phiq: " << printable(scene_path)
-                << ": redundant equations left out of the solve (consistent): " << joined(redundancy.rank.redundant)
-                << "\n";
-    for (const auto& w : summary.warnings)
-      std::cerr << "phiq: " << printable(scene_path) << ": warning: t = " << phiq::format_time(w.t) << ": " << w.kind
-                << ": " << w.message << "\n";
-    std::cerr << "phiq: " << printable(scene_path) << ": " << summary.BriefReport();
-    if (summary.min_rcond > 0)
-      std::cerr << ", min rcond " << scientific(summary.min_rcond, 3)
-                << " at t = " << phiq::format_time(summary.min_rcond_time);
-    std::cerr << rounding_level_note(summary.accuracy.rounding_level);
-    if (file) std::cerr << "; wrote " << printable(out_path);
-    std::cerr << "\n";
-  }
+  if (const int status =
+          commit_run(scene_path, scene, model, summary, load_s, rows, h5.get(), spool, out, found, threads))
+    return status;
+  if (!quiet) report_run(scene_path, redundancy, summary, file ? out_path : "");
   return 0;
 }
 
