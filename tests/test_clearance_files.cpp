@@ -1,9 +1,11 @@
 // A ClearanceReport as files (phiq/clearance_files.hpp, tools/cli/clearance_report.hpp): the HDF5 file read back
 // with HDF5 itself holds the CSV's values and the report's summary exactly, the same bytes on 1 and 2 threads; the
-// JSON summary of two spheres on moving points has the closed-form worst pose, interval and sensitivity.
+// JSON summary of two spheres on moving points has the closed-form worst pose, interval and sensitivity; the JSON
+// lists the four-bar knee's every local minimum as HDF5 /minima holds it.
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -182,6 +184,87 @@ TEST(ClearanceFiles, SummaryJsonOfTwoBallsIsTheClosedForm) {
   // the JSON's numbers are the report's, to the bit
   EXPECT_EQ(w["distance"].get<double>(), r.pairs[0].worst.at.distance);
   EXPECT_EQ(p["interference"][0]["entry"].get<double>(), r.pairs[0].interference[0].entry);
+}
+
+// models/clearance/fourbar_knee.yaml with sensitivities to L2 and L3: several pairs, some with more than one
+// local minimum, two interfering. The JSON's `local_minima` of each pair are HDF5 /minima's rows of that pair, in
+// order, to the bit, as many as its `minima` count; the worst's entry has /worst's witness points and /sensitivities'
+// row, the others the report's own witness points and no sensitivities (solved at the worst only).
+TEST(ClearanceFiles, SummaryJsonListsEveryMinimumAsHdf5MinimaHoldsIt) {
+  std::ifstream in(test::model_path("clearance/fourbar_knee.yaml"));
+  std::stringstream text;
+  text << in.rdbuf();
+  const Scene s = parse_scene(text.str() + "  sensitivities: [L2, L3]\n", "fourbar_knee.yaml");
+  const ClearanceReport r = scene_clearance(s);
+  ASSERT_GE(r.pairs.size(), 2u);
+  const fs::path dir = fs::temp_directory_path() / "phiq_clearance_json_minima";
+  fs::create_directories(dir);
+  const fs::path path = dir / "knee.h5";
+  write_clearance_hdf5(path.string(), r, s.parts);
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(f, 0);
+  std::vector<hsize_t> dims, worst_dims, sens_dims, in_dims;
+  const std::vector<double> minima = clearance_files_read(f, "minima", &dims),
+                            worst = clearance_files_read(f, "worst", &worst_dims),
+                            sensitivities = clearance_files_read(f, "sensitivities", &sens_dims),
+                            interference = clearance_files_read(f, "interference", &in_dims);
+  H5Fclose(f);
+  fs::remove_all(dir);
+  ASSERT_EQ(dims.size(), 2u);
+  ASSERT_EQ(dims[1], 4u);
+  ASSERT_EQ(sens_dims, (std::vector<hsize_t>{r.pairs.size(), 2}));
+
+  const auto j = nlohmann::json::parse(tools::clearance_summary_json(s, "fourbar_knee.yaml", r));
+  ASSERT_EQ(j["pairs"].size(), r.pairs.size());
+  std::size_t row = 0, intervals = 0, several = 0, nonzero = 0;
+  for (std::size_t i = 0; i < r.pairs.size(); ++i) {
+    const auto& p = j["pairs"][i];
+    const auto& list = p["local_minima"];
+    ASSERT_EQ(list.size(), p["minima"].get<std::size_t>()) << i;
+    several += list.size() > 1;
+    std::size_t with_sensitivities = 0;
+    for (std::size_t k = 0; k < list.size(); ++k, ++row) {
+      ASSERT_LT(row, dims[0]);
+      const auto& m = list[k];
+      const double* h = &minima[row * 4];
+      EXPECT_EQ(h[0], static_cast<double>(i)) << row;
+      EXPECT_EQ(m["t"].get<double>(), h[1]) << row;
+      EXPECT_EQ(m["distance"].get<double>(), h[2]) << row;
+      EXPECT_EQ(m["refined"].get<bool>() ? 1.0 : 0.0, h[3]) << row;
+      const ClearanceMinimum& own = r.pairs[i].minima[k];
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(m["point_a"][c].get<double>(),
+                  (std::array<double, 3>{own.at.point_a.x, own.at.point_a.y, own.at.point_a.z}[c]));
+        EXPECT_EQ(m["point_b"][c].get<double>(),
+                  (std::array<double, 3>{own.at.point_b.x, own.at.point_b.y, own.at.point_b.z}[c]));
+      }
+      if (!m.contains("sensitivities")) continue;
+      ++with_sensitivities;
+      const double* w = &worst[i * 13];
+      EXPECT_EQ(m["t"].get<double>(), w[0]);
+      EXPECT_EQ(m["distance"].get<double>(), w[1]);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(m["point_a"][c].get<double>(), w[2 + c]) << row;
+        EXPECT_EQ(m["point_b"][c].get<double>(), w[5 + c]) << row;
+      }
+      EXPECT_EQ(m["sensitivities"]["L2"].get<double>(), sensitivities[i * 2]);
+      EXPECT_EQ(m["sensitivities"]["L3"].get<double>(), sensitivities[i * 2 + 1]);
+      nonzero += sensitivities[i * 2] != 0.0 || sensitivities[i * 2 + 1] != 0.0;
+    }
+    EXPECT_EQ(with_sensitivities, list.empty() ? 0u : 1u) << i;
+    for (const auto& in : p["interference"]) {
+      ASSERT_LT(intervals * 3 + 2, interference.size());
+      EXPECT_EQ(interference[intervals * 3], static_cast<double>(i));
+      EXPECT_EQ(in["entry"].get<double>(), interference[intervals * 3 + 1]);
+      EXPECT_EQ(in["exit"].get<double>(), interference[intervals * 3 + 2]);
+      ++intervals;
+    }
+  }
+  EXPECT_EQ(row, dims[0]);  // every /minima row listed once
+  EXPECT_GE(intervals, 2u);
+  EXPECT_EQ(intervals * 3, interference.size());
+  EXPECT_GE(several, 1u);
+  EXPECT_GE(nonzero, 1u);
 }
 
 // The balls of clearance_files_scene_text() with the fixed one's radius 0.0504 and no threshold: they overlap only

@@ -11,15 +11,42 @@ namespace {
 
 nlohmann::ordered_json clearance_point_json(kin3::V3 p) { return nlohmann::ordered_json::array({p.x, p.y, p.z}); }
 
+// {P: ∂d/∂P} of a minimum whose sensitivities were solved; {} otherwise.
+nlohmann::ordered_json clearance_sensitivities_json(const ClearanceReport& r, const ClearanceMinimum& m) {
+  nlohmann::ordered_json sensitivities = nlohmann::ordered_json::object();
+  for (std::size_t k = 0; k < m.sensitivities.size() && k < r.parameters.size(); ++k)
+    sensitivities[r.parameters[k]] = m.sensitivities[k];
+  return sensitivities;
+}
+
+// Each of the pair's local minima (HDF5 /minima's t, distance, refined, in its order) with its witness points; the
+// sensitivities are solved at the worst only (clearance_along), so only the worst's entry carries them.
+nlohmann::ordered_json clearance_minima_json(const ClearanceReport& r, const PairClearance& p) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  bool worst_seen = false;
+  for (const ClearanceMinimum& m : p.minima) {
+    nlohmann::ordered_json j = {{"t", m.t},
+                                {"distance", m.at.distance},
+                                {"refined", m.refined},
+                                {"point_a", clearance_point_json(m.at.point_a)},
+                                {"point_b", clearance_point_json(m.at.point_b)},
+                                {"normal", clearance_point_json(m.at.normal)}};
+    // the worst is a copy of the first minimum of least distance
+    if (!worst_seen && m.t == p.worst.t && m.at.distance == p.worst.at.distance && !p.worst.sensitivities.empty()) {
+      worst_seen = true;
+      j["sensitivities"] = clearance_sensitivities_json(r, p.worst);
+    }
+    list.push_back(std::move(j));
+  }
+  return list;
+}
+
 nlohmann::ordered_json clearance_pair_json(const ClearanceReport& r, const PairClearance& p, const std::string& a,
                                            const std::string& b) {
   nlohmann::ordered_json j;
   j["a"] = a;
   j["b"] = b;
   const ClearanceMinimum& w = p.worst;
-  nlohmann::ordered_json sensitivities = nlohmann::ordered_json::object();
-  for (std::size_t k = 0; k < w.sensitivities.size() && k < r.parameters.size(); ++k)
-    sensitivities[r.parameters[k]] = w.sensitivities[k];
   j["worst"] = {{"t", w.t},
                 {"distance", w.at.distance},
                 {"refined", w.refined},
@@ -27,8 +54,9 @@ nlohmann::ordered_json clearance_pair_json(const ClearanceReport& r, const PairC
                 {"point_a", clearance_point_json(w.at.point_a)},
                 {"point_b", clearance_point_json(w.at.point_b)},
                 {"normal", clearance_point_json(w.at.normal)},
-                {"sensitivities", sensitivities}};
+                {"sensitivities", clearance_sensitivities_json(r, w)}};
   j["minima"] = p.minima.size();
+  j["local_minima"] = clearance_minima_json(r, p);
   j["interference"] = nlohmann::ordered_json::array();
   for (const InterferenceInterval& i : p.interference)
     j["interference"].push_back({{"entry", i.entry}, {"exit", i.exit}});

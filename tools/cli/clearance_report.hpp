@@ -1,7 +1,7 @@
 // `phiq clearance --summary FILE.json`: a ClearanceReport's summary as JSON (format phiq::kClearanceSummaryFormat,
-// tools/README.md, "phiq clearance"): each pair's worst pose with its witness points and sensitivities, its
-// interference intervals, and whether the bound between rows held. In the library phiq_cli so that the tests read
-// it in-process.
+// tools/README.md, "phiq clearance"): each pair's worst pose with its witness points and sensitivities, every local
+// minimum (HDF5 /minima's), its interference intervals, and whether the bound between rows held. In the library
+// phiq_cli so that the tests read it in-process.
 #pragma once
 
 #include <string>
