@@ -158,6 +158,15 @@ def test_tools_readme_names_every_option_and_no_other():
     assert not unknown, f"tools/README.md documents options no command or script has: {unknown}"
 
 
+def test_tools_readme_quotes_the_version_line_phiq_prints():
+    # Harnesses read the format versions from tools/README.md's quote of `phiq --version`: it is the binary's line.
+    printed = subprocess.run([phiq_cli(), "--version"], capture_output=True, text=True, check=True).stdout.strip()
+    with open(os.path.join(ROOT, "tools/README.md"), encoding="utf-8") as f:
+        quoted = re.search(r"`phiq --version` prints `([^`]*)`", " ".join(f.read().split()))
+    assert quoted, "tools/README.md does not quote `phiq --version`"
+    assert quoted.group(1) == " ".join(printed.split()), f"tools/README.md quotes {quoted.group(1)!r}, phiq prints {printed!r}"
+
+
 # `phiq COMMAND ... --option` written on one line of a README (a command line in a code block or in the text)
 COMMAND_LINE = re.compile(r"phiq (\w[\w-]*)((?: +[^\s`|;]+)*)")
 
