@@ -19,13 +19,12 @@ nlohmann::ordered_json initial_outcome(std::size_t k) {
 CaseResult run_batch_case(const BatchCaseSetting& setting, std::size_t k, ParsedScene& tree, CaseRows rows) {
   const BatchArgs& a = setting.args;
   const bool hdf5 = setting.hdf5;
-  const std::string left_out = "; left out of " + a.out;
   CaseResult result;
   result.report.outcome = initial_outcome(k);
   CaseReport& report = result.report;
   auto fails = [&](const std::string& why) {
     report.complete = report.failed = true;
-    report.line = a.scene + ": case " + std::to_string(k) + ": " + why + left_out;
+    report.line = a.scene + ": case " + std::to_string(k) + ": " + why + setting.left_out;
     return std::move(result);
   };
   const auto t0 = Clock::now();

@@ -54,6 +54,7 @@ struct BatchCaseSetting {
   const std::atomic<bool>& stop;
   const std::atomic<bool>& abort;
   const std::atomic<int>& remote_signal;
+  std::string left_out = "; left out of " + args.out;  // a failed case's line ends with it (built once a batch)
   bool halted() const { return stop.load() || abort.load() || remote_signal.load() != 0; }
 };
 
