@@ -23,13 +23,10 @@ Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSumm
   if (predictor_needs_velocities(predictor_) && !need_v_)
     throw Error(std::string("the ") + to_string(predictor_) + " predictor needs velocities (SweepOptions::velocities)");
   // The rows before the current one that the predictor extrapolates from, and one more for its error estimate.
-  depth_ = predictor_history_depth(predictor_);
   // Every buffer the states rotate through has the workspace's size from the start, so that a swap never hands
   // the workspace an empty vector.
   const Index n = model_.num_coordinates();
-  history_.assign(static_cast<std::size_t>(depth_), Eigen::VectorXd::Zero(n));
-  history_t_.resize(static_cast<std::size_t>(depth_));
-  history_error_.resize(static_cast<std::size_t>(depth_));
+  history_.size(predictor_history_depth(predictor_), n);
   current_.q = Eigen::VectorXd::Zero(n);
   if (need_v_) current_.qd = Eigen::VectorXd::Zero(n);
   if (need_a_) current_.qdd = Eigen::VectorXd::Zero(n);
@@ -199,17 +196,11 @@ void Sweeper::remember(double t) {
   // oldest entry's buffer becomes current_'s, assigned below without allocating). Only a state that was really
   // converged enters it (the default-constructed one has no q: found by the fuzzer with a sweep starting away
   // from t = 0).
-  if (depth_ > 0 && has_current_) {
-    std::rotate(history_.rbegin(), history_.rbegin() + 1, history_.rend());
-    std::rotate(history_t_.rbegin(), history_t_.rbegin() + 1, history_t_.rend());
+  if (has_current_) {
     Eigen::VectorXd& x = predictor_ == Predictor::kLinear                                         ? current_.qd
                          : predictor_ == Predictor::kQuadratic || predictor_ == Predictor::kCubic ? current_.qdd
                                                                                                   : current_.q;
-    history_[0].swap(x);
-    history_t_[0] = current_.t;
-    std::rotate(history_error_.rbegin(), history_error_.rbegin() + 1, history_error_.rend());
-    history_error_[0] = current_error_;
-    known_ = std::min(known_ + 1, depth_);
+    history_.push(x, current_.t, current_error_);
   }
   has_current_ = true;
   current_.t = t;

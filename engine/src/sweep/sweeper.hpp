@@ -91,6 +91,39 @@ inline Orientation orientation_of(const SparseLuNumeric& lu) {
   return {sign, sign == 1 || sign == -1 ? lu.block_signs() : 0};
 }
 
+// What the predictor extrapolates from (q for the position predictors, q̇ for linear, q̈ for quadratic and cubic)
+// at the converged rows before the current one, newest first: `depth` rows kept (predictor_history_depth), `known`
+// of them valid. Its own type so that the predictor formulas (predictors.cpp) read it without the Sweeper.
+struct PredictorHistory {
+  std::vector<Eigen::VectorXd> rows;
+  std::vector<double> t;      // their times
+  std::vector<double> error;  // the estimated error of q at those rows (units of the tolerance test)
+  int depth = 0, known = 0;
+
+  // depth rows of n zeros: every buffer the states rotate through has the workspace's size from the start, so that
+  // a swap never hands the workspace an empty vector.
+  void size(int rows_kept, Index n) {
+    depth = rows_kept;
+    rows.assign(static_cast<std::size_t>(depth), Eigen::VectorXd::Zero(n));
+    t.resize(static_cast<std::size_t>(depth));
+    error.resize(static_cast<std::size_t>(depth));
+  }
+  // The row at time `at` enters as the newest by a buffer swap: `x` gets the oldest row's buffer, which the caller
+  // overwrites without allocating.
+  void push(Eigen::VectorXd& x, double at, double x_error) {
+    if (depth == 0) return;
+    std::rotate(rows.rbegin(), rows.rbegin() + 1, rows.rend());
+    std::rotate(t.rbegin(), t.rbegin() + 1, t.rend());
+    rows[0].swap(x);
+    t[0] = at;
+    std::rotate(error.rbegin(), error.rbegin() + 1, error.rend());
+    error[0] = x_error;
+    known = std::min(known + 1, depth);
+  }
+};
+
+struct SingularSides;  // the regular points around a singular position (singular_positions.cpp)
+
 // Follows one branch of the motion step by step from an assembled or adopted state (see the file comment).
 class Sweeper {
  public:
@@ -180,7 +213,7 @@ class Sweeper {
   }
   // Moves the last converged state out and frees the history: the sweeper is not used after this.
   State take_state() {
-    history_.clear(), history_.shrink_to_fit();
+    history_.rows.clear(), history_.rows.shrink_to_fit();
     predicted_ = Eigen::VectorXd();
     return std::move(current_);
   }
@@ -253,7 +286,7 @@ class Sweeper {
   // it (the secant predictor's history starts anew).
   void adopt(double t) {
     has_current_ = false;
-    known_ = 0;
+    history_.known = 0;
     current_sign_ = current_row_sign_ = Orientation{};
     row_error_ = INFINITY;  // how well the adopted state is known is not said: the next step checks it
     row_coordinate_ = -1;
@@ -372,6 +405,14 @@ class Sweeper {
   // around one or no position lies beyond it (a dead point).
   std::string singular_throughout(const Eigen::VectorXd& qs, double t);
   bool singular_point(double t, double rc, bool have_position = true);
+  // singular_point()'s phases: the first side solved block by block at a singular start, the six sides, the
+  // first of them from a singular start, and the branch's values at t from them with the warning.
+  bool start_by_blocks(double t, double step, const Eigen::VectorXd& qs, const NewtonOptions& tight);
+  bool solve_sides(double t, double rc, const Eigen::VectorXd& qs, const std::string& lined_up,
+                   const NewtonOptions& tight, SingularSides& s);
+  bool reach_first_side(double t, double ts, double rc, const Eigen::VectorXd& qs, bool by_blocks,
+                        const NewtonOptions& tight, PositionSummary& ps);
+  bool take_branch_values(double t, double rc, bool have_position, const Eigen::VectorXd& qs, const SingularSides& s);
   std::string dead_point(double t1);
   std::string lined_up_equations();
   // The other causes of a step that failed at every subdivision (step_failures.cpp).
@@ -387,12 +428,7 @@ class Sweeper {
   Predictor predictor_;
   State current_;  // the last converged state
   bool has_current_ = false;
-  // What the predictor extrapolates from (q for the position predictors, q̇ for linear, q̈ for quadratic and
-  // cubic) at the converged rows before current_, newest first, and their times: depth_ rows, known_ of them valid.
-  std::vector<Eigen::VectorXd> history_;
-  std::vector<double> history_t_;
-  std::vector<double> history_error_;  // the estimated error of q at those rows (units of the tolerance test)
-  int depth_ = 0, known_ = 0;
+  PredictorHistory history_;         // the rows before current_ that predict() extrapolates from
   double current_error_ = INFINITY;  // the estimated error of current_.q (PositionSummary::error_estimate)
   double row_error_ = INFINITY;      // that of the row being converged, until remember() makes it current
   Index current_coordinate_ = -1, row_coordinate_ = -1;  // where those errors are reached (error_coordinate)
