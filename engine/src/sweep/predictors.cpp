@@ -332,40 +332,41 @@ bool Extrapolation::taylor(const double* v, const double* a, bool cubic) {
 
 }  // namespace
 
-// ws.q = the predictor's guess at t1 from the current state and the history (kept in predicted_ for jumped()),
+// ws.q = the predictor's guess at t1 from the current state and the history (kept in prediction_.q for jumped()),
 // and newton_.start_error = the size of the next term of the extrapolation in units of the tolerance test — its
 // error estimate, from one more row of history than the prediction needs (infinite until there is one, so that
 // Newton then takes a step). One pass over the vectors.
 void Sweeper::predict(double t1) {
   const Index n = current_.q.size();
   ws_->q.resize(n);
-  predicted_.resize(n);
-  if (current_.t == branch_t_ && branch_qd_.size() == n) {
+  prediction_.q.resize(n);
+  if (current_.t == singular_.branch_t && singular_.branch_qd.size() == n) {
     // positions only, from a singular start: along the branch's own q̇ and q̈ there (singular_point()), which no
     // history of positions tells; Newton then takes its steps (no error estimate).
     const double h = t1 - current_.t, hh = 0.5 * h * h;
-    for (Index j = 0; j < n; ++j) ws_->q[j] = predicted_[j] = current_.q[j] + h * branch_qd_[j] + hh * branch_qdd_[j];
-    extrapolated_ = true;
+    for (Index j = 0; j < n; ++j)
+      ws_->q[j] = prediction_.q[j] = current_.q[j] + h * singular_.branch_qd[j] + hh * singular_.branch_qdd[j];
+    prediction_.moved = true;
     newton_.start_error = INFINITY;
     return;
   }
-  Extrapolation x(model_, history_, current_, current_error_, t1, opt_.newton.tolerance, ws_->q.data(),
-                  predicted_.data());
+  Extrapolation x(model_, history_, current_, current_accuracy_.error, t1, opt_.newton.tolerance, ws_->q.data(),
+                  prediction_.q.data());
   switch (predictor_) {
     case Predictor::kPrevious:
     case Predictor::kSecant:
     case Predictor::kParabolic:
-      extrapolated_ = x.divided_differences(predictor_);
+      prediction_.moved = x.divided_differences(predictor_);
       break;
     case Predictor::kHermite:
-      extrapolated_ = x.hermite(current_.qd.data());
+      prediction_.moved = x.hermite(current_.qd.data());
       break;
     case Predictor::kLinear:
-      extrapolated_ = x.linear(current_.qd.data());
+      prediction_.moved = x.linear(current_.qd.data());
       break;
     case Predictor::kQuadratic:
     case Predictor::kCubic:
-      extrapolated_ = x.taylor(current_.qd.data(), current_.qdd.data(), predictor_ == Predictor::kCubic);
+      prediction_.moved = x.taylor(current_.qd.data(), current_.qdd.data(), predictor_ == Predictor::kCubic);
       break;
     case Predictor::kAuto:
       break;

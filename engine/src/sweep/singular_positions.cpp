@@ -78,7 +78,7 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
   struct Guard {
     bool& b;
     ~Guard() { b = false; }
-  } guard{bracketing_ = true};
+  } guard{singular_.bracketing = true};
   const Eigen::VectorXd qs = ws_->q;
   // named now, from Φq factorised at the singular position itself, in case it is a dead point
   const std::string lined_up = ws_->has_factorization ? lined_up_equations() : "";
@@ -228,11 +228,11 @@ bool Sweeper::take_branch_values(double t, double rc, bool have_position, const 
   double qdd_spread = 0.0;
   if (need_a_) ws_->qdd = at_t(&State::qdd), qdd_spread = relative_spread(ws_->qdd, inner(&State::qdd));
   if (!need_v_) {  // positions only: the branch's tangent for the next prediction (predict())
-    branch_qd_ = ws_->qd, branch_qdd_ = at_t(&State::qdd);
-    branch_t_ = t;
+    singular_.branch_qd = ws_->qd, singular_.branch_qdd = at_t(&State::qdd);
+    singular_.branch_t = t;
   }
   ++sum_.singular_positions;
-  singular_row_ = true;
+  singular_.at_row = true;
   std::ostringstream m;
   m.precision(3);
   m << (has_current_ ? "bifurcation passed" : "the sweep starts at a bifurcation") << ": Φq is singular here (rcond "
