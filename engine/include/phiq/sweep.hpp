@@ -88,11 +88,12 @@ struct ParallelSettings {
   /// every thread count, and the rows, the summary's counts and its warnings are the same bits on every thread
   /// count and every run: N threads run N chunks at once, one thread runs the same chunks one after the other.
   /// Each chunk starts from a seed found by a sequential pass over the chunk starts (positions only, every
-  /// chunk_steps-th time point, a row later where the seed is at or next to a singular position), and is accepted
-  /// only if the sweep, continued one step past the previous chunk (that seam step solves its position only),
-  /// reaches the same position there to within 100 × the tolerance: otherwise the rest of the sweep runs in order
-  /// (warning "parallel_fallback"). Rows are delivered in time order, and equal the sweep in order's (chunk_steps ≥
-  /// steps) to the solver tolerance; on_step is called on the calling thread.
+  /// chunk_steps-th time point, a row later where the seed is at or next to a singular position; a body's Euler
+  /// parameters turned to the sign its motion continues with), and is accepted only if the sweep, continued one
+  /// step past the previous chunk (that seam step solves its position only), reaches the same position there to
+  /// within 100 × the tolerance (10 × the rounding level where Newton stopped there, if larger): otherwise the rest
+  /// of the sweep runs in order (warning "parallel_fallback"). Rows are delivered in time order, and equal the
+  /// sweep in order's (chunk_steps ≥ steps) to the solver tolerance; on_step is called on the calling thread.
   /// Everything the sweep runs stays on these threads, the model's own parallel evaluation of large models
   /// (ModelBuilder, 65536 constraints and more) included: 1 is one thread. The threads solve in the caller's
   /// workspace and one more per extra thread (each with its own LU of Φq), which the seeding pass shares. With 0,
@@ -128,11 +129,18 @@ struct SweepWarning {
   /// level of Φ above the tolerance (a long chain; the message says how well q is known; once per stretch of
   /// rows, up to two rows without it apart, the message says how long and how many); "ill_conditioned": Φq is
   /// near-singular (rcond below 1e-7; once per stretch of such rows); "bifurcation": Φq is singular at this row,
-  /// the velocity is not unique and the branch's own is reported; "parallel_fallback": the parallel sweep
-  /// continued in order; "no_dependence": a parameter of OutputPlan::sensitivities changes no constraint or
-  /// driver (its ParameterReach is empty: its sensitivities are exactly zero; at the first row); "indeterminate":
-  /// written joint reactions (OutputEfforts::reactions) that redundant constraints leave undetermined, named at
-  /// the first row (their minimum-norm values are written)
+  /// the velocity is not unique and the branch's own is reported; "parallel_fallback": a parallel chunk starting
+  /// at t did not continue the sweep in order, and the remaining steps ran in order (the rows are the same), the
+  /// message saying which cause: its first row did not converge from its seed (the solver's reason), the chunk
+  /// before it did not reach its first time point, its first row has the other sign of a body's Euler parameters
+  /// (e and −e: one orientation), or its first row is another branch, named at the coordinate farthest from
+  /// where the sweep in order arrives, with that distance and how closely two rows of one branch agree there,
+  /// both in the coordinate's unit (m, rad; no unit for a dimensionless one, such as an Euler parameter);
+  /// "threads_reduced": fewer threads ran than asked (ParallelSettings::threads = 0 and memory_budget, or rows
+  /// too wide for every thread to hold a chunk); "no_dependence": a parameter of OutputPlan::sensitivities
+  /// changes no constraint or driver (its ParameterReach is empty: its sensitivities are exactly zero; at the
+  /// first row); "indeterminate": written joint reactions (OutputEfforts::reactions) that redundant constraints
+  /// leave undetermined, named at the first row (their minimum-norm values are written)
   std::string kind;
 
   std::string message;  ///< one line

@@ -12,57 +12,63 @@ namespace phiq::detail {
 void Sweeper::row_efforts() {
   const OutputEfforts& e = opt_.efforts;
   const std::size_t n = e.constraints.size();
-  auto not_defined = [&] { std::fill(efforts_.begin(), efforts_.end(), std::numeric_limits<double>::quiet_NaN()); };
+  auto not_defined = [&] {
+    std::fill(outputs_.efforts.begin(), outputs_.efforts.end(), std::numeric_limits<double>::quiet_NaN());
+  };
   // At a singular position the multipliers are not unique and a driver's effort may be unbounded: NaN, which the
   // row's bifurcation warning explains, rather than a huge number from a nearly singular solve.
-  if (singular_row_) return not_defined();
+  if (singular_.at_row) return not_defined();
   Workspace* w = row_factors();
   if (!w) return not_defined();
   const double t = current_.t;
-  effort_q_.setZero(model_.num_coordinates());
-  add_generalized_forces(*e.parts, *e.loads, current_.q.data(), current_.qd.data(), current_.qdd.data(), t, effort_q_);
-  if (!multipliers_with_factors(model_, *w->lu, effort_q_, effort_kept_, effort_lambda_)) return not_defined();
+  effort_work_.q.setZero(model_.num_coordinates());
+  add_generalized_forces(*e.parts, *e.loads, current_.q.data(), current_.qd.data(), current_.qdd.data(), t,
+                         effort_work_.q);
+  if (!multipliers_with_factors(model_, *w->lu, effort_work_.q, effort_work_.kept, effort_work_.lambda))
+    return not_defined();
   ++ws_->counters.effort_solves;
-  effort_phi_t_.resize(model_.num_equations());
-  model_.phi_t(current_.q.data(), t, effort_phi_t_.data());
+  effort_work_.phi_t.resize(model_.num_equations());
+  model_.phi_t(current_.q.data(), t, effort_work_.phi_t.data());
   const std::vector<ConstraintInfo>& cs = model_.constraints();
   for (std::size_t i = 0; i < n; ++i) {
     const ConstraintInfo& c = cs[static_cast<std::size_t>(e.constraints[i])];
     double power = 0.0;
-    for (Index r = c.first_row; r < c.first_row + c.rows; ++r) power += effort_lambda_(r) * effort_phi_t_(r);
-    efforts_[i] = -effort_lambda_(c.first_row);
-    efforts_[n + i] = power;
+    for (Index r = c.first_row; r < c.first_row + c.rows; ++r) power += effort_work_.lambda(r) * effort_work_.phi_t(r);
+    outputs_.efforts[i] = -effort_work_.lambda(c.first_row);
+    outputs_.efforts[n + i] = power;
   }
-  for (std::size_t i : efforts_dropped_) efforts_[i] = efforts_[n + i] = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i : effort_work_.dropped)
+    outputs_.efforts[i] = outputs_.efforts[n + i] = std::numeric_limits<double>::quiet_NaN();
   // ∂τ/∂p with the multipliers before row_reactions() makes them the minimum-norm ones, and the row's direct
-  // sensitivities (sweep_sensitivity_form()): after the reactions in efforts_
+  // sensitivities (sweep_sensitivity_form()): after the reactions in outputs_.efforts
   if (n > 0 && !opt_.sensitivities.empty()) {
-    double* out = efforts_.data() + e.size();
+    double* out = outputs_.efforts.data() + e.size();
     if (!effort_sensitivities_with_factors(model_, e, opt_.sensitivities, t, current_.q.data(), current_.qd.data(),
-                                           current_.qdd.data(), effort_lambda_, sensitivities_.data(), *w->lu,
-                                           effort_sensitivity_scratch_, out))
-      std::fill(out, efforts_.data() + efforts_.size(), std::numeric_limits<double>::quiet_NaN());
+                                           current_.qdd.data(), effort_work_.lambda, outputs_.sensitivities.data(),
+                                           *w->lu, effort_work_.sensitivity_scratch, out))
+      std::fill(out, outputs_.efforts.data() + outputs_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
     else
-      for (std::size_t i : efforts_dropped_)
+      for (std::size_t i : effort_work_.dropped)
         for (std::size_t j = 0; j < opt_.sensitivities.size(); ++j)
           out[j * n + i] = std::numeric_limits<double>::quiet_NaN();
   }
-  if (reactions_) row_reactions(*w->lu);
+  if (effort_work_.reactions) row_reactions(*w->lu);
 }
 
 void Sweeper::row_reactions(SparseLuNumeric& lu) {
   const double t = current_.t;
   std::vector<Index> indeterminate;
-  const bool note = !reactions_noted_ && t == opt_.t_begin;
-  if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_lambda_, note ? &indeterminate : nullptr,
-                                minimum_norm_scratch_)) {
-    std::fill(efforts_.begin() + 2 * static_cast<std::ptrdiff_t>(opt_.efforts.constraints.size()),
-              efforts_.begin() + opt_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
+  const bool note = !effort_work_.reactions_noted && t == opt_.t_begin;
+  if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_work_.lambda, note ? &indeterminate : nullptr,
+                                effort_work_.minimum_norm)) {
+    std::fill(outputs_.efforts.begin() + 2 * static_cast<std::ptrdiff_t>(opt_.efforts.constraints.size()),
+              outputs_.efforts.begin() + opt_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
     return;
   }
-  reactions_->evaluate(current_.q.data(), t, effort_lambda_, efforts_.data() + 2 * opt_.efforts.constraints.size());
+  effort_work_.reactions->evaluate(current_.q.data(), t, effort_work_.lambda,
+                                   outputs_.efforts.data() + 2 * opt_.efforts.constraints.size());
   if (!note) return;
-  reactions_noted_ = true;
+  effort_work_.reactions_noted = true;
   std::string names;
   for (const OutputReaction& r : opt_.efforts.reactions)
     if (std::find(indeterminate.begin(), indeterminate.end(), r.constraint) != indeterminate.end())

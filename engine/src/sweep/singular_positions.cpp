@@ -27,6 +27,14 @@ constexpr double kStartSideOffset = 0.05;
 constexpr double kBlockStartSideOffset = 0.45;
 }  // namespace
 
+// The regular points around a singular position (singular_point()): their offset δ, whether the sweep's start was
+// solved block by block, and their states at t − 3δ, t − 2δ, t − δ, t + δ, t + 2δ, t + 3δ.
+struct SingularSides {
+  double d = 0.0;
+  bool by_blocks = false;
+  State side[kSides];
+};
+
 // Why Φq stays singular on both sides of the singular position qs at t: the model is short of drivers or
 // constraints all along its motion (": redundant or missing constraints"), or the position is singular by itself,
 // several loops folded or aligned at once and kept so by the drive (nfourbar started folded: every coupler on
@@ -70,7 +78,7 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
   struct Guard {
     bool& b;
     ~Guard() { b = false; }
-  } guard{bracketing_ = true};
+  } guard{singular_.bracketing = true};
   const Eigen::VectorXd qs = ws_->q;
   // named now, from Φq factorised at the singular position itself, in case it is a dead point
   const std::string lined_up = ws_->has_factorization ? lined_up_equations() : "";
@@ -83,64 +91,47 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
   tight.known_to = 0.0;  // a level in units of the sweep's tolerance: not this one's, and these reach rounding
   tight.jacobian_update = JacobianUpdate::kEveryIteration;
   tight.max_iterations = std::max(tight.max_iterations, 30);
-  // The sweep starts at the singular position: no past motion tells the branch, and Newton cannot start from a
-  // singular Φq. A model whose Φq pattern falls into blocks (a chain of loops) is solved block by block
-  // (assemble_by_blocks), at the first side's time: each loop then starts with its input already moved, and one
-  // singular at the start moves the least it must. (Whole-system Newton moves one loop per iteration: nfourbar
-  // started flat has its far cranks leave the flat position one loop per least-squares step, so no chain longer
-  // than the iteration budget would be reached.)
-  bool by_blocks = false;
-  if (!has_current_) {
-    ws_->q = qs;
-    detail::BlockAssemblySummary bs;
-    by_blocks = detail::assemble_by_blocks(model_, t - 3 * kBlockStartSideOffset * step, tight.tolerance,
-                                           tight.max_iterations, ws_->q, &bs) == SolveStatus::kSuccess;
-    if (!by_blocks) ws_->q = qs;
-  }
-  const double d = (has_current_ ? kSideOffset : by_blocks ? kBlockStartSideOffset : kStartSideOffset) * step;
-  // Six regular points t ± δ, t ± 2δ, t ± 3δ, each predicted from the one before (the first from the last state of
-  // the sweep), so the plus side is reached straight through the singular point.
+  SingularSides sides;
+  sides.by_blocks = !has_current_ && start_by_blocks(t, step, qs, tight);
+  sides.d = (has_current_ ? kSideOffset : sides.by_blocks ? kBlockStartSideOffset : kStartSideOffset) * step;
+  if (!solve_sides(t, rc, qs, lined_up, tight, sides)) return false;
+  return take_branch_values(t, rc, have_position, qs, sides);
+}
+
+// The sweep starts at the singular position: no past motion tells the branch, and Newton cannot start from a
+// singular Φq. A model whose Φq pattern falls into blocks (a chain of loops) is solved block by block
+// (assemble_by_blocks), at the first side's time: each loop then starts with its input already moved, and one
+// singular at the start moves the least it must. (Whole-system Newton moves one loop per iteration: nfourbar
+// started flat has its far cranks leave the flat position one loop per least-squares step, so no chain longer
+// than the iteration budget would be reached.) Leaves ws.q at that first side when it succeeds, at qs otherwise.
+bool Sweeper::start_by_blocks(double t, double step, const Eigen::VectorXd& qs, const NewtonOptions& tight) {
+  ws_->q = qs;
+  detail::BlockAssemblySummary bs;
+  const bool by_blocks = detail::assemble_by_blocks(model_, t - 3 * kBlockStartSideOffset * step, tight.tolerance,
+                                                    tight.max_iterations, ws_->q, &bs) == SolveStatus::kSuccess;
+  if (!by_blocks) ws_->q = qs;
+  return by_blocks;
+}
+
+// Six regular points t ± δ, t ± 2δ, t ± 3δ, each predicted from the one before (the first from the last state of
+// the sweep), so the plus side is reached straight through the singular point. Fails (summary filled, ws.q = qs)
+// where a side cannot be reached or is singular too, saying which.
+bool Sweeper::solve_sides(double t, double rc, const Eigen::VectorXd& qs, const std::string& lined_up,
+                          const NewtonOptions& tight, SingularSides& s) {
+  const double d = s.d;
   const double offset[kSides] = {-3 * d, -2 * d, -d, d, 2 * d, 3 * d};
-  State side[kSides];
   LinearSummary ls;
   PositionSummary ps;
   for (int k = 0; k < kSides; ++k) {
     const double ts = t + offset[k];
     if (k == 0) {
-      if (has_current_) {
+      if (has_current_)
         predict(ts);
-      } else {
-        // (unless solved block by block above) the assembly (least squares, then the solution nearest the
-        // placement) finds the side's position nearest the start, and Newton (regular at ts) finishes from
-        // wherever it got, converged or not
-        AssemblyOptions ao;
-        ao.tolerance = opt_.newton.tolerance;
-        AssemblySummary as;
-        const SolveStatus assembled = by_blocks ? SolveStatus::kSuccess : phiq::assemble(model_, ts, ao, ws_->q, &as);
-        if (assembled != SolveStatus::kSuccess && ws_->q.allFinite() &&
-            solve_position(model_, ts, tight, *ws_, &ps) != SolveStatus::kSuccess) {
-          // Not a model short of constraints (the placement assembled and is square): the start is singular and
-          // the least squares from it did not reach the branch beyond it. Said as such, with the assembly's
-          // account, rather than as a zero pivot that the rank analysis of the singular position would blame on
-          // missing drivers.
-          ws_->q = qs;
-          return fail(SolveStatus::kSingularJacobian,
-                      "the sweep starts at a singular position (t = " + format_time(t) + ", Φq rcond " +
-                          scientific(rc, 2) + "), and no regular position of the branch near it was reached at t = " +
-                          format_time(ts) + " from it (" + as.BriefReport() +
-                          "): the position is singular, not the model short of drivers or constraints; start the "
-                          "drive off it");
-        }
-        if (!ws_->q.allFinite()) {
-          ws_->q = qs;
-          return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " + format_time(t) +
-                                                          "), and no position near it at t = " + format_time(ts) +
-                                                          " was found: " + as.message);
-        }
-      }
+      else if (!reach_first_side(t, ts, rc, qs, s.by_blocks, tight, ps))
+        return false;
     } else {
       const double h = offset[k] - offset[k - 1];
-      ws_->q = side[k - 1].q + h * side[k - 1].qd + (0.5 * h * h) * side[k - 1].qdd;
+      ws_->q = s.side[k - 1].q + h * s.side[k - 1].qd + (0.5 * h * h) * s.side[k - 1].qdd;
     }
     SolveStatus st = solve_position(model_, ts, tight, *ws_, &ps);
     const bool position_found = st == SolveStatus::kSuccess;
@@ -163,8 +154,50 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
         m << "the branch cannot be followed to it: " << (position_found ? ls.message : ps.message);
       return fail(SolveStatus::kSingularJacobian, m.str());
     }
-    side[k].t = ts, side[k].q = ws_->q, side[k].qd = ws_->qd, side[k].qdd = ws_->qdd;
+    s.side[k].t = ts, s.side[k].q = ws_->q, s.side[k].qd = ws_->qd, s.side[k].qdd = ws_->qdd;
   }
+  return true;
+}
+
+// The first side of a sweep that starts at the singular position qs: (unless solved block by block already) the
+// assembly (least squares, then the solution nearest the placement) finds the side's position nearest the start,
+// and Newton (regular at ts) finishes from wherever it got, converged or not. Fails (ws.q = qs) where neither
+// reaches the branch.
+bool Sweeper::reach_first_side(double t, double ts, double rc, const Eigen::VectorXd& qs, bool by_blocks,
+                               const NewtonOptions& tight, PositionSummary& ps) {
+  AssemblyOptions ao;
+  ao.tolerance = opt_.newton.tolerance;
+  AssemblySummary as;
+  const SolveStatus assembled = by_blocks ? SolveStatus::kSuccess : phiq::assemble(model_, ts, ao, ws_->q, &as);
+  if (assembled != SolveStatus::kSuccess && ws_->q.allFinite() &&
+      solve_position(model_, ts, tight, *ws_, &ps) != SolveStatus::kSuccess) {
+    // Not a model short of constraints (the placement assembled and is square): the start is singular and the
+    // least squares from it did not reach the branch beyond it. Said as such, with the assembly's account, rather
+    // than as a zero pivot that the rank analysis of the singular position would blame on missing drivers.
+    ws_->q = qs;
+    return fail(SolveStatus::kSingularJacobian,
+                "the sweep starts at a singular position (t = " + format_time(t) + ", Φq rcond " + scientific(rc, 2) +
+                    "), and no regular position of the branch near it was reached at t = " + format_time(ts) +
+                    " from it (" + as.BriefReport() +
+                    "): the position is singular, not the model short of drivers or constraints; start the drive off "
+                    "it");
+  }
+  if (!ws_->q.allFinite()) {
+    ws_->q = qs;
+    return fail(SolveStatus::kSingularJacobian, "the sweep starts at a singular position (t = " + format_time(t) +
+                                                    "), and no position near it at t = " + format_time(ts) +
+                                                    " was found: " + as.message);
+  }
+  return true;
+}
+
+// The branch's values at the singular position t from its six sides: ws.q (qs, or extrapolated where Newton met a
+// zero pivot at t itself, then checked against the tolerance), ws.qd and ws.qdd, the row marked singular, and the
+// bifurcation warning that says how well they are known.
+bool Sweeper::take_branch_values(double t, double rc, bool have_position, const Eigen::VectorXd& qs,
+                                 const SingularSides& s) {
+  const State* side = s.side;
+  const double d = s.d;
   // Symmetric means m(kδ) over ±δ, ±2δ, ±3δ, combined by Richardson extrapolation, 1.5 m(δ) − 0.6 m(2δ) + 0.1 m(3δ)
   // (the weights cancel the δ² and δ⁴ terms): the branch's value at t to O(δ⁶).
   auto at_t = [&](const Eigen::VectorXd State::*x) -> Eigen::VectorXd {
@@ -195,11 +228,11 @@ bool Sweeper::singular_point(double t, double rc, bool have_position) {
   double qdd_spread = 0.0;
   if (need_a_) ws_->qdd = at_t(&State::qdd), qdd_spread = relative_spread(ws_->qdd, inner(&State::qdd));
   if (!need_v_) {  // positions only: the branch's tangent for the next prediction (predict())
-    branch_qd_ = ws_->qd, branch_qdd_ = at_t(&State::qdd);
-    branch_t_ = t;
+    singular_.branch_qd = ws_->qd, singular_.branch_qdd = at_t(&State::qdd);
+    singular_.branch_t = t;
   }
   ++sum_.singular_positions;
-  singular_row_ = true;
+  singular_.at_row = true;
   std::ostringstream m;
   m.precision(3);
   m << (has_current_ ? "bifurcation passed" : "the sweep starts at a bifurcation") << ": Φq is singular here (rcond "

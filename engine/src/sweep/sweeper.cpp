@@ -23,13 +23,10 @@ Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSumm
   if (predictor_needs_velocities(predictor_) && !need_v_)
     throw Error(std::string("the ") + to_string(predictor_) + " predictor needs velocities (SweepOptions::velocities)");
   // The rows before the current one that the predictor extrapolates from, and one more for its error estimate.
-  depth_ = predictor_history_depth(predictor_);
   // Every buffer the states rotate through has the workspace's size from the start, so that a swap never hands
   // the workspace an empty vector.
   const Index n = model_.num_coordinates();
-  history_.assign(static_cast<std::size_t>(depth_), Eigen::VectorXd::Zero(n));
-  history_t_.resize(static_cast<std::size_t>(depth_));
-  history_error_.resize(static_cast<std::size_t>(depth_));
+  history_.size(predictor_history_depth(predictor_), n);
   current_.q = Eigen::VectorXd::Zero(n);
   if (need_v_) current_.qd = Eigen::VectorXd::Zero(n);
   if (need_a_) current_.qdd = Eigen::VectorXd::Zero(n);
@@ -63,11 +60,11 @@ bool Sweeper::advance(double t1, int depth) {
     st = SolveStatus::kNotConverged;
     ps.message = "det Φq changed sign with Φq regular at both ends (another branch?)";
   }
-  if (st == SolveStatus::kSingularJacobian && has_current_ && !bracketing_) {
+  if (st == SolveStatus::kSingularJacobian && has_current_ && !singular_.bracketing) {
     // a zero pivot exactly at a singular position: bracket it (position interpolated from both sides)
     if (singular_point(t1, 0.0, /*have_position=*/false)) {
-      row_error_ = INFINITY;  // interpolated: the next step checks it
-      row_coordinate_ = -1;
+      row_accuracy_.error = INFINITY;  // interpolated: the next step checks it
+      row_accuracy_.coordinate = -1;
       remember(t1);
       return true;
     }
@@ -120,15 +117,16 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   // position of the mechanism: the slot or profile ends there. (The sweep names the step and its time.)
   if (std::string off = model_.outside_domain(ws_->q.data()); !off.empty())
     return fail(SolveStatus::kOutsideDomain, off);
-  singular_row_ = false;
+  singular_.at_row = false;
   last_rcond_ = ps.rcond;
-  row_error_ = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
-  row_coordinate_ = ps.error_coordinate, row_known_to_ = ps.error_size;
+  row_accuracy_.error = ps.error_estimate < 0.0 ? INFINITY : ps.error_estimate;
+  row_accuracy_.coordinate = ps.error_coordinate, row_accuracy_.known_to = ps.error_size;
   // (a row accepted within NewtonOptions::known_to, the rounding level rows before it measured, is at that
   // level too, though its own Newton did not stop there: known to its estimate, not to the tolerance)
-  row_class_ = ps.linear_convergence                                     ? RowClass::kSingular
-               : ps.slow_convergence || row_error_ > kQuietRoundingLevel ? RowClass::kRoundingLevel
-                                                                         : RowClass::kConverged;
+  row_accuracy_.row_class = ps.linear_convergence ? RowClass::kSingular
+                            : ps.slow_convergence || row_accuracy_.error > kQuietRoundingLevel
+                                ? RowClass::kRoundingLevel
+                                : RowClass::kConverged;
   rounding_level_ = std::max(rounding_level_, ps.rounding_level);
   // How well the positions can be known here (NewtonOptions::known_to): the largest rounding level the rows
   // measured since the last one that converged to the tolerance (a step from a point Newton reached, not the
@@ -143,7 +141,7 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   // (a crossing in the last step: the rows before it reuse a factorisation made before it).
   double rcond = ps.rcond;
   const bool first = !has_current_;
-  if (!need_v_ && !bracketing_ && !position_only_ && ws_->lu && (first || t == opt_.t_end)) {
+  if (!need_v_ && !singular_.bracketing && !position_only_ && ws_->lu && (first || t == opt_.t_end)) {
     if (!factors_at_q(*ws_, t)) {
       std::string why;
       const SolveStatus st = ensure_factorized(model_, t, *ws_, &rcond, &why);
@@ -155,7 +153,7 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
     }
     ws_->factorized_at_solution = true;
   }
-  if (!need_v_ && first && !bracketing_ && ws_->lu && rcond < kSingularRcond) {
+  if (!need_v_ && first && !singular_.bracketing && ws_->lu && rcond < kSingularRcond) {
     // positions only, starting on a singular position: no past rows tell the next step where the branch goes, and
     // Newton from the singular position itself meets a zero pivot. The branch's q̇ and q̈ there are found as with
     // velocities (singular_point(), with its warning) and kept for the first prediction only.
@@ -163,7 +161,7 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   } else if (!need_v_ && rcond > 0.0 && rcond < kSingularRcond) {
     // positions only: nothing is computed from Φq here, but the user is told where the motion branches
     ++sum_.singular_positions;
-    singular_row_ = true;
+    singular_.at_row = true;
     std::ostringstream m;
     m.precision(3);
     m << "singular position (Φq rcond " << rcond << "): a bifurcation, velocities would not be unique here";
@@ -172,7 +170,7 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   }
   if (!position_only_ && !derivatives(t, ps.linear_convergence)) return false;
   const Orientation sign = sign_at_solution();
-  if (left_branch && has_current_ && sign.regular() && current_sign_.regular() && sign != current_sign_) {
+  if (left_branch && has_current_ && sign.regular() && signs_.current.regular() && sign != signs_.current) {
     sum_.warnings.resize(noted.warnings);
     sum_.singular_positions = noted.singular_positions;
     sum_.min_rcond = noted.min_rcond, sum_.min_rcond_time = noted.min_rcond_time;
@@ -182,14 +180,14 @@ bool Sweeper::converged(double t, const PositionSummary& ps, bool* left_branch) 
   }
   if (ws_->counters.factorizations != factorizations_seen_)  // this step's solves factorised
     factorizations_seen_ = ws_->counters.factorizations, factorized_step_t_ = t;
-  current_sign_ = sign;
+  signs_.current = sign;
   // the row's sign: the one at the solution, else (positions only) that of the last factorisation this sweeper
   // made, at an iterate a few steps back on its own path, so that a change is seen a row or two late rather than
   // not at all, with the time of the step that made it; never that of a factorisation the workspace held before
   // (another chunk's, or another sweep's: the sign of another place)
   const bool own = ws_->counters.factorizations != factorizations_before_;
-  current_row_sign_ = sign.sign != kSignUnknown || !own ? sign : orientation_of(*ws_->lu);
-  current_row_sign_t_ = sign.sign != kSignUnknown ? t : factorized_step_t_;
+  signs_.current_row = sign.sign != kSignUnknown || !own ? sign : orientation_of(*ws_->lu);
+  signs_.current_row_t = sign.sign != kSignUnknown ? t : factorized_step_t_;
   remember(t);
   return true;
 }
@@ -199,23 +197,17 @@ void Sweeper::remember(double t) {
   // oldest entry's buffer becomes current_'s, assigned below without allocating). Only a state that was really
   // converged enters it (the default-constructed one has no q: found by the fuzzer with a sweep starting away
   // from t = 0).
-  if (depth_ > 0 && has_current_) {
-    std::rotate(history_.rbegin(), history_.rbegin() + 1, history_.rend());
-    std::rotate(history_t_.rbegin(), history_t_.rbegin() + 1, history_t_.rend());
+  if (has_current_) {
     Eigen::VectorXd& x = predictor_ == Predictor::kLinear                                         ? current_.qd
                          : predictor_ == Predictor::kQuadratic || predictor_ == Predictor::kCubic ? current_.qdd
                                                                                                   : current_.q;
-    history_[0].swap(x);
-    history_t_[0] = current_.t;
-    std::rotate(history_error_.rbegin(), history_error_.rbegin() + 1, history_error_.rend());
-    history_error_[0] = current_error_;
-    known_ = std::min(known_ + 1, depth_);
+    history_.push(x, current_.t, current_accuracy_.error);
   }
   has_current_ = true;
   current_.t = t;
-  current_error_ = row_error_;
-  current_coordinate_ = row_coordinate_, current_known_to_ = row_known_to_;
-  current_class_ = singular_row_ ? RowClass::kSingular : row_class_;
+  current_accuracy_.error = row_accuracy_.error;
+  current_accuracy_.coordinate = row_accuracy_.coordinate, current_accuracy_.known_to = row_accuracy_.known_to;
+  current_accuracy_.row_class = singular_.at_row ? RowClass::kSingular : row_accuracy_.row_class;
   // The converged state moves into current_ by swaps too: ws keeps the buffers of the state before, which the
   // next step overwrites (predict() writes q, the solves q̇ and q̈). Rows are delivered from state().
   current_.q.swap(ws_->q);
@@ -234,10 +226,10 @@ Workspace* Sweeper::row_factors() {
   Workspace* w = ws_;
   // With velocities the row's velocity solve has just used the workspace's factors (of Φq at this row's solution,
   // or at Newton's last iterate within the tolerance of it): the row's other solves use the same ones.
-  if (!(ws_->lu && derivative_factors_.ws == ws_ && derivative_factors_.t == t &&
-        derivative_factors_.factorizations == ws_->counters.factorizations)) {
-    if (!sensitivity_ws_) sensitivity_ws_ = std::make_shared<Workspace>(model_);
-    w = sensitivity_ws_.get();
+  if (!(ws_->lu && row_factors_.derivatives.ws == ws_ && row_factors_.derivatives.t == t &&
+        row_factors_.derivatives.factorizations == ws_->counters.factorizations)) {
+    if (!row_factors_.own) row_factors_.own = std::make_shared<Workspace>(model_);
+    w = row_factors_.own.get();
     if (!w->lu) return nullptr;
     w->q = current_.q;  // (factorised again only if its factors are not at this row already: sensitivities')
     const WorkCounters before = w->counters;
@@ -254,10 +246,10 @@ Workspace* Sweeper::row_factors() {
 void Sweeper::row_sensitivities() {
   // NaN where they are not defined (sensitivities_with_factors() writes every value itself otherwise).
   auto not_defined = [&] {
-    std::fill(sensitivities_.begin(), sensitivities_.end(), std::numeric_limits<double>::quiet_NaN());
+    std::fill(outputs_.sensitivities.begin(), outputs_.sensitivities.end(), std::numeric_limits<double>::quiet_NaN());
   };
   // At a singular position Φq has no inverse (the row's bifurcation warning says where).
-  if (singular_row_) return not_defined();
+  if (singular_.at_row) return not_defined();
   Workspace* w = row_factors();
   if (!w) return not_defined();
   const double t = current_.t;
@@ -266,11 +258,12 @@ void Sweeper::row_sensitivities() {
   const double* qd = order >= 1 ? current_.qd.data() : nullptr;
   const double* qdd = order >= 2 ? current_.qdd.data() : nullptr;
   const bool ok =
-      sensitivity_form_ == SensitivityForm::kAdjoint
-          ? adjoint_sensitivities_with_factors(model_, opt_.sensitivities, sensitivity_outputs_, t, current_.q.data(),
-                                               qd, qdd, order, *w->lu, *w, sensitivity_scratch_, sensitivities_.data())
+      sensitivity_work_.form == SensitivityForm::kAdjoint
+          ? adjoint_sensitivities_with_factors(model_, opt_.sensitivities, sensitivity_work_.outputs, t,
+                                               current_.q.data(), qd, qdd, order, *w->lu, *w, sensitivity_work_.scratch,
+                                               outputs_.sensitivities.data())
           : sensitivities_with_factors(model_, opt_.sensitivities, t, current_.q.data(), qd, qdd, order, *w->lu, *w,
-                                       sensitivity_scratch_, sensitivities_.data());
+                                       sensitivity_work_.scratch, outputs_.sensitivities.data());
   if (w != ws_) {
     ws_->counters.sensitivity_solves += w->counters.sensitivity_solves - solves_before;
     ws_->counters.sensitivity_direct_rows += w->counters.sensitivity_direct_rows - direct_before;

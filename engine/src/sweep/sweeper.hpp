@@ -4,7 +4,8 @@
 // Its members are defined by concept: the step loop in sweeper.cpp, the predictor formulas in predictors.cpp,
 // singular positions and dead points in singular_positions.cpp, the other causes of a failed step in
 // step_failures.cpp. The small members that run on every step are defined here, in the class, so that the step
-// loop inlines them.
+// loop inlines them. Its state is held in the parts it falls into (sweeper_parts.hpp: the predictor's history, the
+// accuracy of a row, the singular-position state, the orientation of Φq, the outputs' values and buffers).
 #pragma once
 
 #include <algorithm>
@@ -25,6 +26,7 @@
 #include "solve/minimum_norm.hpp"
 #include "solve/sensitivity_internal.hpp"
 #include "solve/tolerance_tests.hpp"
+#include "sweep/sweeper_parts.hpp"
 
 namespace phiq::detail {
 
@@ -44,9 +46,7 @@ struct RowMotions {
   const double* efforts = nullptr;  // effort_values() values
 };
 
-// The class of a delivered row in SweepAccuracy, and its estimated error (units of the tolerance test; infinite
-// when no solve estimated it).
-enum class RowClass { kConverged, kRoundingLevel, kSingular };
+// A delivered row's class and its estimated error (units of the tolerance test; infinite when no solve estimated it).
 struct RowQuality {
   RowClass row_class = RowClass::kConverged;
   double error = INFINITY;
@@ -71,25 +71,7 @@ inline void add_row_quality(SweepAccuracy& a, double t, const RowQuality& r) {
   }
 }
 
-// A sign of det Φq is ±1 at a regular position and 0 at a singular one; kSignUnknown where no factorisation tells
-// it (positions only, a start accepted from its prediction).
-constexpr int kSignUnknown = 2;
-
-// Which way Φq is oriented at a factorisation: det Φq's sign, and at a regular position the fingerprint of the
-// signs of its diagonal blocks' determinants (SparseLuNumeric::block_signs(): KLU factorises a chain loop by
-// loop). Along a branch it changes exactly where the motion passes a singular position: det Φq's sign alone misses
-// an even number of loops crossing at once (nfourbar of even N through its flat position), the blocks do not.
-struct Orientation {
-  int sign = kSignUnknown;
-  std::uint64_t blocks = 0;
-  bool regular() const { return sign == 1 || sign == -1; }
-  bool operator==(const Orientation& o) const { return sign == o.sign && blocks == o.blocks; }
-  bool operator!=(const Orientation& o) const { return !(*this == o); }
-};
-inline Orientation orientation_of(const SparseLuNumeric& lu) {
-  const int sign = lu.determinant_sign();
-  return {sign, sign == 1 || sign == -1 ? lu.block_signs() : 0};
-}
+struct SingularSides;  // the regular points around a singular position (singular_positions.cpp)
 
 // Follows one branch of the motion step by step from an assembled or adopted state (see the file comment).
 class Sweeper {
@@ -122,14 +104,14 @@ class Sweeper {
     if (!need_v_) return true;
     LinearSummary ls;
     const SolveStatus st = lu_derivatives(t, need_a_, &ls);
-    if (!bracketing_ && ws_->lu &&
+    if (!singular_.bracketing && ws_->lu &&
         (st == SolveStatus::kSingularJacobian ||
          (st == SolveStatus::kSuccess &&
           (ls.rcond < kSingularRcond || (linear && ls.rcond < detail::kLinearSingularRcond)))))
       return singular_point(t, ls.rcond);
     if (st != SolveStatus::kSuccess) return fail(st, ls.message);
     note_condition(t, ls.rcond);
-    derivative_factors_ = {ws_, ws_->counters.factorizations, t};
+    row_factors_.derivatives = {ws_, ws_->counters.factorizations, t};
     return true;
   }
 
@@ -143,26 +125,26 @@ class Sweeper {
     const double* qd = need_v_ ? current_.qd.data() : nullptr;
     const double* qdd = need_a_ ? current_.qdd.data() : nullptr;
     for (std::size_t i = 0; i < opt_.joints.size(); ++i)
-      joints_[i] = evaluate_joint(opt_.joints[i], current_.q.data(), qd, qdd);
+      outputs_.joints[i] = evaluate_joint(opt_.joints[i], current_.q.data(), qd, qdd);
     if (opt_.writes_row(k, current_.t)) {
       for (std::size_t i = 0; i < opt_.points.size(); ++i)
-        points_[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
+        outputs_.points[i] = evaluate_point(opt_.points[i], current_.q.data(), qd, qdd);
       for (std::size_t i = 0; i < opt_.orientations.size(); ++i)
-        orientations_[i] =
+        outputs_.orientations[i] =
             evaluate_orientation(opt_.orientations[i], opt_.orientation_form, current_.q.data(), qd, qdd);
       ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
-      rcond_ = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
+      outputs_.rcond = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
       if (!opt_.sensitivities.empty()) row_sensitivities();
       if (opt_.efforts.active()) row_efforts();
     }
-    det_sign_ = current_row_sign_;
-    det_sign_t_ = current_row_sign_t_;
+    signs_.delivered = signs_.current_row;
+    signs_.delivered_t = signs_.current_row_t;
   }
   // Orientation of Φq at the last delivered row (row_outputs()): sign ±1, 0 at a singular position, kSignUnknown
   // where no factorisation of this sweeper's tells it; and the time it holds at (det_sign_time(): the row's, or
   // with positions only that of the step whose Newton factorised last).
-  Orientation det_sign() const { return det_sign_; }
-  double det_sign_time() const { return det_sign_t_; }
+  Orientation det_sign() const { return signs_.delivered; }
+  double det_sign_time() const { return signs_.delivered_t; }
   // The last converged state (q, and q̇, q̈ as computed), which the rows deliver.
   const State& state() const { return current_; }
   // Solves with `w` from now on: the state and the history are the sweeper's, a workspace holds only the solves'
@@ -175,13 +157,13 @@ class Sweeper {
   // Takes the branch tangent `from` found at a singular position where its state is (positions only: what the next
   // step predicts along, singular_point()), for a sweeper that adopts that state: a chunk that continues row 0.
   void take_branch_tangent(Sweeper& from) {
-    branch_qd_.swap(from.branch_qd_), branch_qdd_.swap(from.branch_qdd_);
-    branch_t_ = from.branch_t_;
+    singular_.branch_qd.swap(from.singular_.branch_qd), singular_.branch_qdd.swap(from.singular_.branch_qdd);
+    singular_.branch_t = from.singular_.branch_t;
   }
   // Moves the last converged state out and frees the history: the sweeper is not used after this.
   State take_state() {
-    history_.clear(), history_.shrink_to_fit();
-    predicted_ = Eigen::VectorXd();
+    history_.rows.clear(), history_.rows.shrink_to_fit();
+    prediction_.q = Eigen::VectorXd();
     return std::move(current_);
   }
   // Leaves the last converged state in the workspace too, as a sweep ends (the caller's workspace ends at the
@@ -195,14 +177,15 @@ class Sweeper {
   // The largest PositionSummary::rounding_level of the positions converged since the last call (0: none stopped
   // at the rounding level): how far from the exact solution, in tolerances, they may be.
   double take_rounding_level() { return std::exchange(rounding_level_, 0.0); }
-  const PointMotion* point_motions() const { return points_.empty() ? nullptr : points_.data(); }
+  const PointMotion* point_motions() const { return outputs_.points.empty() ? nullptr : outputs_.points.data(); }
   // The motions row_outputs() evaluated, for the delivery.
   RowMotions motions() const {
-    return {point_motions(), joints_.empty() ? nullptr : joints_.data(),
-            orientations_.empty() ? nullptr : orientations_.data(),
-            sensitivities_.empty() ? nullptr : sensitivities_.data(), efforts_.empty() ? nullptr : efforts_.data()};
+    return {point_motions(), outputs_.joints.empty() ? nullptr : outputs_.joints.data(),
+            outputs_.orientations.empty() ? nullptr : outputs_.orientations.data(),
+            outputs_.sensitivities.empty() ? nullptr : outputs_.sensitivities.data(),
+            outputs_.efforts.empty() ? nullptr : outputs_.efforts.data()};
   }
-  double rcond() const { return rcond_; }
+  double rcond() const { return outputs_.rcond; }
 
   // Records the cause; run_sweep prefixes the step and its grid time (the sub-step time, if any, is in `why`).
   bool fail(SolveStatus st, const std::string& why) {
@@ -233,12 +216,13 @@ class Sweeper {
   bool near_singular() const { return last_rcond_ > 0.0 && last_rcond_ < kIllConditionedRcond; }
 
   // The estimated error of state().q (units of the tolerance test; infinite when unknown).
-  double state_error() const { return current_error_; }
+  double state_error() const { return current_accuracy_.error; }
   // What the delivered row of state() says of its accuracy (SweepAccuracy): its class and estimated error.
   RowQuality row_quality() const {
-    if (current_coordinate_ < 0) return {current_class_, current_error_};
-    return {current_class_, current_error_, &model_.coordinate_names()[static_cast<std::size_t>(current_coordinate_)],
-            current_known_to_, model_.coordinate_unit(current_coordinate_)};
+    if (current_accuracy_.coordinate < 0) return {current_accuracy_.row_class, current_accuracy_.error};
+    return {current_accuracy_.row_class, current_accuracy_.error,
+            &model_.coordinate_names()[static_cast<std::size_t>(current_accuracy_.coordinate)],
+            current_accuracy_.known_to, model_.coordinate_unit(current_accuracy_.coordinate)};
   }
   // One more step to t1 for its position only (a parallel chunk's seam, compared with the next chunk's first row):
   // no derivatives, no outputs.
@@ -253,10 +237,10 @@ class Sweeper {
   // it (the secant predictor's history starts anew).
   void adopt(double t) {
     has_current_ = false;
-    known_ = 0;
-    current_sign_ = current_row_sign_ = Orientation{};
-    row_error_ = INFINITY;  // how well the adopted state is known is not said: the next step checks it
-    row_coordinate_ = -1;
+    history_.known = 0;
+    signs_.current = signs_.current_row = Orientation{};
+    row_accuracy_.error = INFINITY;  // how well the adopted state is known is not said: the next step checks it
+    row_accuracy_.coordinate = -1;
     remember(t);
   }
 
@@ -325,7 +309,7 @@ class Sweeper {
   // are solved at every row; positions only, when Newton's last factorisation is at the solution), sign 0 at a
   // singular position, else kSignUnknown.
   Orientation sign_at_solution() const {
-    if (singular_row_) return {0, 0};
+    if (singular_.at_row) return {0, 0};
     if (!ws_->lu || !ws_->has_factorization) return {};
     const bool at_solution = (need_v_ && !position_only_) || ws_->factorized_at_solution;
     return at_solution ? orientation_of(*ws_->lu) : Orientation{};
@@ -335,12 +319,12 @@ class Sweeper {
   // move, so a correction as large as the move means another solution was found. Runs every drive step: one pass
   // for the correction, and one for the move only when the correction is large at all.
   bool jumped() {
-    if (!extrapolated_) return false;  // the previous position: nothing predicted
+    if (!prediction_.moved) return false;  // the previous position: nothing predicted
     const double tol = opt_.newton.tolerance;
-    const double correction = detail::scaled_distance(model_, ws_->q.data(), predicted_.data(), ws_->q.data(), tol);
+    const double correction = detail::scaled_distance(model_, ws_->q.data(), prediction_.q.data(), ws_->q.data(), tol);
     if (!(correction > 1000.0)) return false;
     return correction >
-           0.5 * detail::scaled_distance(model_, predicted_.data(), current_.q.data(), current_.q.data(), tol);
+           0.5 * detail::scaled_distance(model_, prediction_.q.data(), current_.q.data(), current_.q.data(), tol);
   }
 
   // ws.q = the predictor's guess at t1, newton_.start_error = its error estimate (predictors.cpp).
@@ -350,11 +334,11 @@ class Sweeper {
   // ws = the current state again, after a failed attempt (sweeper.cpp).
   void restore();
 
-  // The sensitivities of the current state to the plan's parameters (sensitivities_), solved with the factors of
-  // Φq at its position: the workspace's when the row's velocity solve used them, else a factorisation of its own
+  // The sensitivities of the current state to the plan's parameters (outputs_.sensitivities), solved with the factors
+  // of Φq at its position: the workspace's when the row's velocity solve used them, else a factorisation of its own
   // (positions only), which leaves the workspace's, and so the next steps' bits, as they are (sweeper.cpp).
   void row_sensitivities();
-  // The plan's driver efforts and powers at the current state (efforts_), by one transposed solve with the same
+  // The plan's driver efforts and powers at the current state (outputs_.efforts), by one transposed solve with the same
   // factors as row_sensitivities() (sweeper_efforts.cpp); NaN at a singular position.
   void row_efforts();
   // The efforts (indices into OutputEfforts::constraints) of drivers the model dropped as redundant: NaN at every
@@ -362,16 +346,24 @@ class Sweeper {
   std::vector<std::size_t> dropped_efforts() const;
   // The constraints of OutputEfforts::reactions, in order (row_efforts.cpp).
   std::vector<Index> reaction_constraints() const;
-  // The reactions of the row (after the efforts) from effort_lambda_: minimum-norm multipliers first where rows
+  // The reactions of the row (after the efforts) from effort_work_.lambda: minimum-norm multipliers first where rows
   // were dropped, and at the sweep's first row a warning naming the joints whose share that makes up.
   void row_reactions(SparseLuNumeric& lu);
   // The factors of Φq at the current row: the workspace's when the row's velocity solve has just used them, else
-  // those of sensitivity_ws_, factorised at the row; null where Φq is singular or cannot be factorised.
+  // those of row_factors_.own, factorised at the row; null where Φq is singular or cannot be factorised.
   Workspace* row_factors();
   // Singular positions (singular_positions.cpp): the branch's own derivatives at one, and why Φq stays singular
   // around one or no position lies beyond it (a dead point).
   std::string singular_throughout(const Eigen::VectorXd& qs, double t);
   bool singular_point(double t, double rc, bool have_position = true);
+  // singular_point()'s phases: the first side solved block by block at a singular start, the six sides, the
+  // first of them from a singular start, and the branch's values at t from them with the warning.
+  bool start_by_blocks(double t, double step, const Eigen::VectorXd& qs, const NewtonOptions& tight);
+  bool solve_sides(double t, double rc, const Eigen::VectorXd& qs, const std::string& lined_up,
+                   const NewtonOptions& tight, SingularSides& s);
+  bool reach_first_side(double t, double ts, double rc, const Eigen::VectorXd& qs, bool by_blocks,
+                        const NewtonOptions& tight, PositionSummary& ps);
+  bool take_branch_values(double t, double rc, bool have_position, const Eigen::VectorXd& qs, const SingularSides& s);
   std::string dead_point(double t1);
   std::string lined_up_equations();
   // The other causes of a step that failed at every subdivision (step_failures.cpp).
@@ -387,75 +379,29 @@ class Sweeper {
   Predictor predictor_;
   State current_;  // the last converged state
   bool has_current_ = false;
-  // What the predictor extrapolates from (q for the position predictors, q̇ for linear, q̈ for quadratic and
-  // cubic) at the converged rows before current_, newest first, and their times: depth_ rows, known_ of them valid.
-  std::vector<Eigen::VectorXd> history_;
-  std::vector<double> history_t_;
-  std::vector<double> history_error_;  // the estimated error of q at those rows (units of the tolerance test)
-  int depth_ = 0, known_ = 0;
-  double current_error_ = INFINITY;  // the estimated error of current_.q (PositionSummary::error_estimate)
-  double row_error_ = INFINITY;      // that of the row being converged, until remember() makes it current
-  Index current_coordinate_ = -1, row_coordinate_ = -1;  // where those errors are reached (error_coordinate)
-  double current_known_to_ = 0.0, row_known_to_ = 0.0;   // and their sizes there (PositionSummary::error_size)
-  RowClass row_class_ = RowClass::kConverged;            // how the row being converged ended (converged())
-  RowClass current_class_ = RowClass::kConverged;        // and current_'s (remember(): singular_row_ overrides it)
-  bool extrapolated_ = false;   // the last prediction moved from current_ (jumped() has something to compare)
-  bool position_only_ = false;  // inside advance_position()
-  std::vector<PointMotion> points_ = std::vector<PointMotion>(opt_.points.size());
-  std::vector<JointMotion> joints_ = std::vector<JointMotion>(opt_.joints.size());
-  std::vector<OrientationMotion> orientations_ = std::vector<OrientationMotion>(opt_.orientations.size());
-  double rcond_ = 0.0;
-  std::vector<double> sensitivities_ = std::vector<double>(
-      static_cast<std::size_t>(SensitivityLayout{model_.num_coordinates()}.size(opt_.sensitivities.size())));
-  SensitivityScratch sensitivity_scratch_;
-  // the efforts, powers, reactions and the efforts' sensitivities (effort_values())
-  std::vector<double> efforts_ =
-      std::vector<double>(static_cast<std::size_t>(effort_values(opt_.efforts, opt_.sensitivities.size())));
-  EffortSensitivityScratch effort_sensitivity_scratch_;
-  Eigen::VectorXd effort_q_, effort_kept_, effort_lambda_, effort_phi_t_;  // row_efforts()'s Q, λ, Φt
-  std::vector<std::size_t> efforts_dropped_ = dropped_efforts();
-  // The joints whose reactions are written (OutputEfforts::reactions); none when none are. Whether the first row has
-  // said which joints' reactions are indeterminate (a model with redundant rows; once per sweep).
-  std::optional<JointReactions> reactions_ =
-      opt_.efforts.reactions.empty() ? std::nullopt
-                                     : std::optional<JointReactions>(std::in_place, model_, reaction_constraints());
-  bool reactions_noted_ = false;
-  MinimumNormScratch minimum_norm_scratch_;  // row_reactions()'s, with redundant rows
-  // The coordinates whose columns are written, and the form the sensitivities are solved in
-  // (effective_sensitivity_form)
-  std::vector<Index> sensitivity_outputs_ =
-      opt_.sensitivities.empty() ? std::vector<Index>{} : opt_.sensitivity_outputs();
-  SensitivityForm sensitivity_form_ = sweep_sensitivity_form(opt_, sensitivity_outputs_.size());
-  // Factors at the row where the workspace's are elsewhere; shared by a copy (a Stepper's way back), which never
-  // solves at the same time.
-  std::shared_ptr<Workspace> sensitivity_ws_;
-  // The factors the last derivatives() solved with: its workspace, that workspace's factorisation count then, and
-  // the row's time. row_sensitivities() solves with them while they are still the workspace's (no factorisation
-  // since) and of the same row.
-  struct {
-    const Workspace* ws = nullptr;
-    Index factorizations = -1;
-    double t = NAN;
-  } derivative_factors_;
-  double last_rcond_ = 0.0;       // PositionSummary::rcond of the last converged position (near_singular())
-  Eigen::VectorXd predicted_;     // the last prediction (for jumped())
-  bool bracketing_ = false;       // inside singular_point(): no nested bracketing
-  bool singular_row_ = false;     // the current state is a singular position (its derivatives bracketed)
-  Orientation det_sign_{0, 0};    // of Φq at the last delivered row (det_sign())
-  Orientation current_sign_;      // and at current_ (sign_at_solution() when it converged)
-  Orientation current_row_sign_;  // what current_'s row reports (converged()), and at which time
-  double current_row_sign_t_ = 0.0, det_sign_t_ = 0.0;
+  PredictorHistory history_;                // the rows before current_ that predict() extrapolates from
+  LastPrediction prediction_;               // and what it predicted last (for jumped())
+  RowAccuracy current_accuracy_;            // how well current_.q is known (remember(): a singular row is kSingular)
+  RowAccuracy row_accuracy_;                // that of the row being converged, until remember() makes it current
+  bool position_only_ = false;              // inside advance_position()
+  RowOutputValues outputs_{model_, opt_};   // what row_outputs() evaluated, for the delivery
+  SensitivityWork sensitivity_work_{opt_};  // row_sensitivities()'s own, as a thread's sweeper holds them
+  // row_efforts()' and row_reactions()'
+  EffortWork effort_work_{dropped_efforts(),
+                          opt_.efforts.reactions.empty()
+                              ? std::nullopt
+                              : std::optional<JointReactions>(std::in_place, model_, reaction_constraints())};
+  RowFactorCache row_factors_;  // the factors those solve with (row_factors())
+  double last_rcond_ = 0.0;     // PositionSummary::rcond of the last converged position (near_singular())
+  SingularState singular_;      // singular_point()'s
+  BranchOrientation signs_;     // of Φq along the branch (det_sign(), converged())
   // The workspace's factorisation count when this sweeper took it: the ones after it are its own (converged()).
   Index factorizations_before_ = ws_->counters.factorizations;
   Index factorizations_seen_ = factorizations_before_;  // the count at the last converged state
   double factorized_step_t_ = 0.0;  // the time of the last step whose solves factorised (converged())
-  // Positions only, at a singular start: the branch's q̇ and q̈ there (singular_point()) and its time; the first
-  // prediction from that row extrapolates along them (predict()), NaN once used.
-  Eigen::VectorXd branch_qd_, branch_qdd_;
-  double branch_t_ = NAN;
-  double rounding_level_ = 0.0;   // see take_rounding_level()
-  double known_to_ = 0.0;         // the rounding level carried to the next solves (converged())
-  bool ill_conditioned_ = false;  // the last delivered state was near-singular (one warning per stretch)
+  double rounding_level_ = 0.0;     // see take_rounding_level()
+  double known_to_ = 0.0;           // the rounding level carried to the next solves (converged())
+  bool ill_conditioned_ = false;    // the last delivered state was near-singular (one warning per stretch)
   double default_step_ = (opt_.t_end - opt_.t_begin) / static_cast<double>(std::max<Index>(opt_.steps, 1));
 };
 
