@@ -182,5 +182,39 @@ TEST(SweepRowWriter, AnEncodingThatThrowsStopsTheSweepAndIsRethrown) {
   EXPECT_LT(rows.written_rows, 201);  // nothing from row 600 on was written
 }
 
+// A chunk keeps its rows encoded: the threads that fit in row_buffer_bytes are counted by the encoded rows (CSV
+// text is wider than the doubles), while the chunks, cut by the doubles alone, stay those of every thread count.
+TEST(SweepRowWriter, ThreadsFitTheEncodedRowsAndTheChunksStayTheSame) {
+  const Model m = test::nfourbar_model(100, M_PI / 4, M_PI / 2);
+  SweepOptions opt;
+  opt.steps = 300;  // chunks of max(16, 300 / 16) = 18 steps
+  const double row_bytes = 8.0 * static_cast<double>(3 * m.num_coordinates() + 1);  // q, q̇, q̈ and the time
+  opt.row_buffer_bytes = static_cast<std::size_t>(40.5 * row_bytes);  // two chunks as doubles, not as CSV text
+  for (Index j = 0; j < m.num_coordinates(); ++j) opt.coordinate_columns.push_back(j);  // q, q̇, q̈ of each
+  const CsvFormat csv(m, opt);
+  ASSERT_GT(static_cast<double>(csv.max_row_chars()), 2.0 * row_bytes);
+  auto sweep = [&](int threads, SweepSummary& sum) {
+    opt.threads = threads;
+    Workspace ws(m);
+    WrittenCsvRows rows(csv);
+    EXPECT_EQ(run_sweep(m, opt, ws, rows, &sum), SolveStatus::kSuccess) << sum.message;
+    return rows.text;
+  };
+  SweepSummary one, tight, roomy;
+  const std::string by_one = sweep(1, one), by_tight = sweep(2, tight);
+  EXPECT_EQ(tight.threads, 1);
+  EXPECT_EQ(tight.parallel_chunks, 17);
+  ASSERT_EQ(tight.warnings.size(), 1u);
+  EXPECT_EQ(tight.warnings[0].kind, "threads_reduced");
+  EXPECT_NE(tight.warnings[0].message.find("run on 1 thread instead of on 2 threads"), std::string::npos)
+      << tight.warnings[0].message;
+  opt.row_buffer_bytes = 3 * 18 * csv.max_row_chars();  // two chunks of encoded rows (and two rows of doubles each)
+  const std::string by_roomy = sweep(2, roomy);
+  EXPECT_EQ(roomy.threads, 2);
+  EXPECT_EQ(roomy.parallel_chunks, 17);
+  EXPECT_TRUE(roomy.warnings.empty());
+  EXPECT_TRUE(by_one == by_tight && by_one == by_roomy) << "the same chunks: the same bytes";
+}
+
 }  // namespace
 }  // namespace phiq

@@ -24,6 +24,13 @@ namespace phiq::tools {
 
 namespace {
 
+// The rows a sweep in chunks may hold before they are written in order (SweepOptions::row_buffer_bytes), larger
+// than the library's 512 MiB: at 10^6 four-bars a row of q, q̇, q̈ is 48 MB, and 512 MiB held chunks of 11 rows for
+// one thread only (threads_reduced); 2 GiB holds two threads' chunks of 16 rows to HDF5 (as doubles: 0.86 GB each).
+// (CSV text is about three times wider: one thread there.) Where 512 MiB held a whole chunk's rows (rows under
+// 8 MB: up to about 3·10^5 coordinates with q, q̇, q̈), the chunks, and so the rows' bits, are the same.
+constexpr std::size_t kRunRowBufferBytes = std::size_t{2} << 30;
+
 // The rows of `phiq run`: encoded by the sweep's threads as CSV text or, for HDF5, packed doubles
 // (CsvFormat::append_values: the same doubles as the CSV's), and written here in order, on the calling thread.
 class ResultRows : public phiq::RowWriter {
@@ -305,6 +312,7 @@ int cmd_run(const std::string& scene_arg, const std::string& out_path, const std
   const phiq::Model& model = square.model(*scene.model);
   scene.sweep.threads = threads;
   scene.sweep.memory_budget = static_cast<std::size_t>(memory_gb * 1e9);
+  scene.sweep.row_buffer_bytes = kRunRowBufferBytes;
   phiq::Workspace ws(model);
   ws.q = square.start;
   // columns from the scene's output plan and model (its constraints); residuals of a model solved on its

@@ -25,74 +25,10 @@
 #include "phiq/constraint_block.hpp"
 #include "phiq/constraint_kinds_3d.hpp"
 #include "phiq/linear_solver.hpp"
+#include "phiq/name_index.hpp"
 #include "phiq/sparse_pattern.hpp"
 
 namespace phiq {
-
-namespace detail {
-// Names to indices for tables of millions of names (coordinates, constraint names): open addressing over
-// (hash, index) pairs, at most half full; the names themselves are kept once, by the caller, and read through
-// name_of(index). A node-based std::unordered_map<std::string, Index> costs an allocation, a copy of the name and
-// several cache misses per entry, which dominated building models of 10^6 constraints.
-class NameIndex {
- public:
-  // The index stored for `name`, or -1.
-  template <class NameOf>
-  Index find(std::string_view name, const NameOf& name_of) const {
-    if (slots_.empty()) return -1;
-    const std::uint64_t h = hash(name);
-    for (std::size_t i = h & mask_;; i = (i + 1) & mask_) {
-      const Slot& s = slots_[i];
-      if (s.id < 0) return -1;
-      if (s.hash == h && name_of(s.id) == name) return s.id;
-    }
-  }
-  // Stores `id` for `name`; false (and nothing stored) when the name is present. name_of is only called for the
-  // indices already stored.
-  template <class NameOf>
-  bool insert(std::string_view name, Index id, const NameOf& name_of) {
-    if (2 * (size_ + 1) > slots_.size()) grow(std::max<std::size_t>(16, 2 * slots_.size()));
-    const std::uint64_t h = hash(name);
-    std::size_t i = h & mask_;
-    for (; slots_[i].id >= 0; i = (i + 1) & mask_)
-      if (slots_[i].hash == h && name_of(slots_[i].id) == name) return false;
-    slots_[i] = Slot{h, id};
-    ++size_;
-    return true;
-  }
-  // Room for n names (grow only).
-  void reserve(std::size_t n) {
-    std::size_t cap = 16;
-    while (cap < 2 * n) cap *= 2;
-    if (cap > slots_.size()) grow(cap);
-  }
-  // Forgets every name and frees the memory.
-  void clear() {
-    std::vector<Slot>().swap(slots_);
-    mask_ = size_ = 0;
-  }
-
- private:
-  struct Slot {
-    std::uint64_t hash = 0;
-    Index id = -1;
-  };
-  static std::uint64_t hash(std::string_view s) { return std::hash<std::string_view>{}(s); }
-  void grow(std::size_t cap) {
-    std::vector<Slot> old(cap);
-    old.swap(slots_);
-    mask_ = cap - 1;
-    for (const Slot& s : old) {
-      if (s.id < 0) continue;
-      std::size_t i = s.hash & mask_;
-      while (slots_[i].id >= 0) i = (i + 1) & mask_;
-      slots_[i] = s;
-    }
-  }
-  std::vector<Slot> slots_;
-  std::size_t mask_ = 0, size_ = 0;
-};
-}  // namespace detail
 
 namespace detail {
 /// Throws phiq::Error for an index `i` outside [0, size) of a `what` ("row", "coordinate").

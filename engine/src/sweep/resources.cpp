@@ -85,13 +85,18 @@ Index automatic_chunk_steps(const SweepOptions& opt, double row_bytes, bool call
   return rows_fit >= kMinChunkSteps ? static_cast<Index>(rows_fit) : std::max<Index>(opt.steps, 1);
 }
 
-int threads_with_room_for_rows(const SweepOptions& opt, double row_bytes, bool caller_reads_rows, Index chunk,
-                               int threads, double t0, std::vector<SweepWarning>& warnings) {
+int threads_with_room_for_rows(const SweepOptions& opt, double row_bytes, double chunk_bytes, bool caller_reads_rows,
+                               Index chunk, int threads, double t0, std::vector<SweepWarning>& warnings) {
   if (!caller_reads_rows || threads <= 1) return threads;
-  const double rows_fit = static_cast<double>(opt.row_buffer_bytes) / row_bytes;
   const bool one_chunk = chunk >= opt.steps;
   // (one chunk by choice — a short sweep, or chunk_steps — runs in order without a word)
-  if (one_chunk && (rows_fit >= kMinChunkSteps || opt.steps <= kMinChunkSteps)) return threads;
+  if (one_chunk &&
+      (static_cast<double>(opt.row_buffer_bytes) / row_bytes >= kMinChunkSteps || opt.steps <= kMinChunkSteps))
+    return threads;
+  // a thread's chunk holds its rows as it keeps them until delivery: encoded text or doubles where the chunks
+  // encode them (CSV rows are about three times their doubles), else the vectors
+  row_bytes = chunk_bytes / static_cast<double>(std::max<Index>(chunk, 1));
+  const double rows_fit = static_cast<double>(opt.row_buffer_bytes) / row_bytes;
   const int room =
       one_chunk ? 1 : static_cast<int>(std::min<double>(threads, std::floor(rows_fit / static_cast<double>(chunk))));
   if (room >= threads) return threads;

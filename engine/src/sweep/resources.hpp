@@ -27,10 +27,11 @@ int threads_that_fit(const SweepOptions& opt, const Workspace& ws, int threads, 
 // kMinChunkSteps: a sweep whose rows are wider runs as one chunk, in order.
 Index automatic_chunk_steps(const SweepOptions& opt, double row_bytes, bool caller_reads_rows);
 
-// The threads among `threads` that have room for a chunk's rows each in row_buffer_bytes (all of them when the
+// The threads among `threads` that have room for a chunk's rows each (`chunk_bytes`: HeldRows::held_bytes(chunk),
+// the rows as a chunk holds them, `row_bytes` a row's vectors) in row_buffer_bytes (all of them when the
 // caller reads no rows: two are held per chunk); fewer come with a "threads_reduced" warning at `t0`. Only the
 // schedule changes with it, never the rows.
-int threads_with_room_for_rows(const SweepOptions& opt, double row_bytes, bool caller_reads_rows, Index chunk,
-                               int threads, double t0, std::vector<SweepWarning>& warnings);
+int threads_with_room_for_rows(const SweepOptions& opt, double row_bytes, double chunk_bytes, bool caller_reads_rows,
+                               Index chunk, int threads, double t0, std::vector<SweepWarning>& warnings);
 
 }  // namespace phiq::detail

@@ -129,8 +129,8 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
                                           : detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows);
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)
   if (ws.lu)
-    threads = detail::threads_with_room_for_rows(opt, rows.row_bytes, rows.caller_reads_rows, chunk, threads,
-                                                 run.time_of(0), sum.warnings);
+    threads = detail::threads_with_room_for_rows(opt, rows.row_bytes, rows.held_bytes(chunk), rows.caller_reads_rows,
+                                                 chunk, threads, run.time_of(0), sum.warnings);
   if (n_chunks < 2 || !ws.lu) {
     run.sequential(sw, ws, 1);
     sw.leave_state_in_workspace();
