@@ -1,5 +1,6 @@
 // What a position solve reports: the statuses' names, PositionSummary::BriefReport(), and how well q is known in
-// each coordinate's own unit (detail::locate_error(), known_to_text()).
+// each coordinate's own unit (detail::locate_error(), known_to_text(), detail::report_rounding_rows()); and the
+// check of the NewtonOptions it is given.
 #include "phiq/kinematics.hpp"
 #include "phiq/text.hpp"
 
@@ -45,6 +46,20 @@ const char* to_string(SolveStatus s) {
       return "outside a constraint's domain";
   }
   return "?";
+}
+
+void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
+  // An infinite tolerance accepts any point as the solution, a NaN start_error accepts the start unchecked (and
+  // reports NaN as its error): settings no solve can honour, each named by its field.
+  auto fail = [&](const std::string& why) { throw Error(std::string(what) + ": " + why); };
+  if (!(opt.tolerance > 0.0 && std::isfinite(opt.tolerance))) fail("tolerance must be > 0 and finite");
+  if (opt.max_iterations < 0) fail("max_iterations must be >= 0");
+  if (opt.max_backtracks < 0) fail("max_backtracks must be >= 0");
+  if (!(opt.max_contraction > 0.0 && opt.max_contraction < 1.0)) fail("max_contraction must be in (0, 1)");
+  if (std::isnan(opt.start_error)) fail("start_error must not be NaN (negative: unknown)");
+  if (!(opt.known_to >= 0.0 && std::isfinite(opt.known_to))) fail("known_to must be >= 0 and finite");
+  if (opt.jacobian_update != JacobianUpdate::kEveryIteration && opt.jacobian_update != JacobianUpdate::kWhenSlow)
+    fail("jacobian_update is not a JacobianUpdate");
 }
 
 std::string PositionSummary::BriefReport() const {
@@ -100,6 +115,23 @@ void detail::locate_error(const Model& model, double tol, double estimate, Index
   }
   *where = j;
   *size_out = size;
+}
+
+void detail::report_rounding_rows(const Model& model, double tol, Index row, const Eigen::VectorXd& q,
+                                  PositionSummary& sum) {
+  const Index j = sum.error_coordinate;
+  const double allowed = tol * model.tolerance_scales().coordinate_scale(j) + kUlpFloor * std::fabs(q(j));
+  sum.error_estimate = std::max(sum.error_estimate, sum.error_size / allowed);
+  if (!(sum.error_estimate > kQuietRoundingLevel)) return;
+  sum.rounding_level = std::max(sum.rounding_level, sum.error_estimate);
+  if (sum.slow_convergence) return;  // (a linear convergence says so already)
+  sum.slow_convergence = true;
+  sum.message = (row >= 0 ? "'" + model.row_name(row) +
+                                "' is at the rounding of its own terms (one ulp of each), which no Newton step "
+                                "resolves, and was left out of the steps: "
+                          : std::string("rows whose terms are far larger than their tolerance (a badly scaled model) "
+                                        "are known to one ulp of those terms: ")) +
+                known_to_text(model, j, sum.error_size) + ", which is how well q is known there";
 }
 
 }  // namespace phiq
