@@ -89,7 +89,9 @@ void expect_badly_scaled_units(const Model& m, const SweepSummary& sum) {
 // never met the tolerance ("no assembly beyond t = 0.0245 … did not converge in 20 iterations"; the issue's
 // version of the solver exited 0 with the rocker 0.11 rad off). Such rows, at the rounding of their own terms, are
 // left out of the steps (engine/src/solve/rounding_rows.hpp). Bound: the x rows of the pins A (terms x2, x3 ≈
-// 5·10⁵ m), B (x3, x4: 1.5·10⁶ m) and C (x4: 10⁶ m), 3·10⁶ m of terms.
+// 5·10⁵ m), B (x3, x4: 1.5·10⁶ m) and C (x4: 10⁶ m), 3·10⁶ m of terms: 2 ε · 3·10⁶ m / (L4 |sin θ4|), about
+// 9·10⁻⁴ rad (|sin θ4| ≥ 0.74 on this branch). Measured: 1.6·10⁻⁴ rad at worst, every row counted at the rounding
+// level, 'psi4' known to ±4·10⁻⁴ rad.
 TEST(BadlyScaled, ReferencePointFourBarMeetsFreudensteinToItsUlps) {
   const Scene sc = parse_scene(R"Y(phiq: 1
 parameters: {L1: 1e6, L2: 1e-6, L3: 1e6, L4: 1.5e-6}
