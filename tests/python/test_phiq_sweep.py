@@ -2,6 +2,7 @@
 thread count the same bits, output selection, failures as statuses, redundant and inconsistent scenes, pandas, the
 arrays as views of one table, and Ctrl-C."""
 import os
+import re
 import subprocess
 
 import numpy as np
@@ -313,3 +314,38 @@ def test_accuracy_is_stated_in_the_coordinates_unit():
     assert 0 < rounding["worst_known_to"] < 1e-9
     converged = result.summary["accuracy"]["converged"]
     assert converged["worst_coordinate"] is None or converged["worst_coordinate"] in result.coordinate_names
+
+
+# The same four-bar with every link a body (reference-point coordinates): the rocker's pin x4 − L4/2 cos ψ4 − L1 is a
+# multiple of an ulp of 10⁶ m whatever ψ4 is, so Newton leaves it at its rounding (test_badly_scaled.cpp) and the
+# position says how well q is known then, at a coordinate and in its unit.
+BADLY_SCALED_REFERENCE_POINT = """phiq: 1
+parameters: {L1: 1e6, L2: 1e-6, L3: 1e6, L4: 1.5e-6}
+coordinates: {x2: 0.5e-6, y2: 0.0, psi2: 0.0, x3: 0.5e6, y3: 0.559e-6, psi3: 1.118e-12,
+              x4: 1000000.0000005, y4: 0.559e-6, psi4: 0.8411}
+points: {O: [0, 0], C: [L1, 0]}
+bodies: {crank: [x2, y2, psi2], coupler: [x3, y3, psi3], rocker: [x4, y4, psi4]}
+constraints:
+  - {name: O, type: revolute, between: [{body: crank, at: [-L2/2, 0]}, {point: O}]}
+  - {name: A, type: revolute, between: [{body: crank, at: [L2/2, 0]}, {body: coupler, at: [-L3/2, 0]}]}
+  - {name: B, type: revolute, between: [{body: coupler, at: [L3/2, 0]}, {body: rocker, at: [L4/2, 0]}]}
+  - {name: C, type: revolute, between: [{body: rocker, at: [-L4/2, 0]}, {point: C}]}
+drivers:
+  - {name: motor, coordinate: psi2, law: {type: linear, initial: 0, rate: 1}}
+time: {start: 0, end: 2*pi, steps: 72}
+"""
+
+
+def test_a_position_at_its_rounding_says_how_well_in_the_coordinates_unit():
+    model = phiq.parse_scene(BADLY_SCALED_REFERENCE_POINT, "reference_point.yaml").model
+    ws = phiq.Workspace(model)
+    p = phiq.solve_position(model, 0.5, ws)
+    assert p.ok, p.message
+    assert p.error_coordinate >= 0
+    name = model.coordinate_names[p.error_coordinate]
+    unit = "rad" if name.startswith("psi") else "m"
+    assert re.fullmatch(r"'%s' known to ±\S+ %s" % (name, unit), p.known_to(model)), p.known_to(model)
+    # an ulp of 10⁶ m over the rocker's 7.5·10⁻⁷ m arm is 1.5·10⁻⁴ rad: the estimate is of that order
+    arm = 1.0 if unit == "rad" else 7.5e-7
+    assert 1e-6 < p.error_size / arm < 1e-2
+    assert "known to ±" in p.message and "tolerances" not in p.message

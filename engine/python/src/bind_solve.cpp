@@ -67,6 +67,18 @@ void bind_kinematics(py::module_& m) {
                     "converged only linearly (a singular position) or stopped at the rounding level")
       .def_readonly("error_estimate", &PositionSummary::error_estimate,
                     "estimated error of q in units of the tolerance test (≤ 1: within it; negative: unknown)")
+      .def_readonly("error_coordinate", &PositionSummary::error_coordinate,
+                    "index of the coordinate least well known when error_estimate is above 2 (or rows were left at "
+                    "their rounding), else -1")
+      .def_readonly("error_size", &PositionSummary::error_size,
+                    "how far q at error_coordinate may be from the solution, in that coordinate's own unit (m, rad)")
+      .def(
+          "known_to",
+          [](const PositionSummary& s, const Model& model) -> py::object {
+            if (s.error_coordinate < 0 || s.error_coordinate >= model.num_coordinates()) return py::none();
+            return py::str(known_to_text(model, s.error_coordinate, s.error_size));
+          },
+          py::arg("model"), "\"'yB' known to ±2e-10 m\": error_size at error_coordinate in its unit, or None")
       .def_readonly("message", &PositionSummary::message, "one line; empty on a clean success")
       .def("brief_report", &PositionSummary::BriefReport)
       .def("__repr__", [](const PositionSummary& s) { return "<PositionSummary: " + s.BriefReport() + ">"; });

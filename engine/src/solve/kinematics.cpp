@@ -1,12 +1,13 @@
 // The position solve: Newton's method on Φ(q, t) = 0 with its step and residual tests, backtracking, the reuse
-// of a factorisation while it contracts, and the stop at the rounding level; with the Workspace's constructor and
-// the check of NewtonOptions (the statuses' names and how well q is known: position_report.cpp). Φq's factorisation,
+// of a factorisation while it contracts, and the stop at the rounding level; with the Workspace's constructor (the
+// statuses' names, the check of NewtonOptions and how well q is known: position_report.cpp). Φq's factorisation,
 // shared with the velocity and acceleration solves (derivatives.cpp), is in factorisation.cpp.
 #include "phiq/kinematics.hpp"
 #include "phiq/text.hpp"
 
 #include "solve/factorisation.hpp"
 #include "solve/kinematics_internal.hpp"
+#include "solve/rounding_rows.hpp"
 #include "solve/tolerance_tests.hpp"
 
 #include <algorithm>
@@ -94,7 +95,8 @@ bool all_finite(const Eigen::VectorXd& v) { return v.allFinite(); }
 // ½ Σ (Φ_i / scale_i)², whether Φ is finite, and whether every row is within the tolerance (residual_within).
 struct ResidualCheck {
   double merit = 0.0;
-  double worst = 0.0;  // max_i |Φ_i| / scale_i
+  double worst = 0.0;       // max_i |Φ_i| / scale_i
+  double kept_worst = 0.0;  // and over the rows Newton corrects (those of merit: not at their rounding)
   bool finite = true;
   bool within = false;
 };
@@ -125,7 +127,7 @@ ResidualCheck check_residual(const Model& model, const Eigen::VectorXd& phi, dou
   const double worst = lanes_max(worsts);
   ResidualCheck c;
   c.merit = 0.5 * sum;
-  c.worst = worst;
+  c.worst = c.kept_worst = worst;
   c.finite = std::isfinite(sum) || phi.allFinite();  // a sum that overflowed is still a finite Φ
   // rows above tol are held to tol · scale_i plus their rounding floor, looked at only then
   c.within = c.finite && (worst <= tol || residual_within(model, phi, tol, q, t));
@@ -168,20 +170,6 @@ StepPass take_step(const Model& model, const Eigen::VectorXd& q, const Eigen::Ve
 }
 
 }  // namespace
-
-void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
-  // An infinite tolerance accepts any point as the solution, a NaN start_error accepts the start unchecked (and
-  // reports NaN as its error): settings no solve can honour, each named by its field.
-  auto fail = [&](const std::string& why) { throw Error(std::string(what) + ": " + why); };
-  if (!(opt.tolerance > 0.0 && std::isfinite(opt.tolerance))) fail("tolerance must be > 0 and finite");
-  if (opt.max_iterations < 0) fail("max_iterations must be >= 0");
-  if (opt.max_backtracks < 0) fail("max_backtracks must be >= 0");
-  if (!(opt.max_contraction > 0.0 && opt.max_contraction < 1.0)) fail("max_contraction must be in (0, 1)");
-  if (std::isnan(opt.start_error)) fail("start_error must not be NaN (negative: unknown)");
-  if (!(opt.known_to >= 0.0 && std::isfinite(opt.known_to))) fail("known_to must be >= 0 and finite");
-  if (opt.jacobian_update != JacobianUpdate::kEveryIteration && opt.jacobian_update != JacobianUpdate::kWhenSlow)
-    fail("jacobian_update is not a JacobianUpdate");
-}
 
 double scaled_residual(const Model& model, const Eigen::VectorXd& phi) { return max_scaled(model, phi); }
 
@@ -226,6 +214,10 @@ class PositionSolve {
   bool step_corrected_error(const Step& s);
   bool accept(const Step& s);
   void refresh_matrix() { reuse_ = false, prev_norm_ = -1.0; }
+  // Φ as Newton corrects it: without the rows at the rounding of their own terms (rounding_rows.hpp)
+  const Eigen::VectorXd& corrected(const Eigen::VectorXd& phi) {
+    return rounding_rows_.empty() ? phi : rounding_rows_.without(phi);
+  }
 
   const Model& model_;
   const double t_;
@@ -259,6 +251,7 @@ class PositionSolve {
   int corrections_ = 0;           // steps step_corrected_error() kept from a stop at the rounding level
   static constexpr int kMaxCorrections = 3;
   static constexpr double kCorrectedContraction = 0.25;
+  detail::RoundingRows rounding_rows_;  // at the current iterate, left out of its step and of the merit
 };
 
 SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
@@ -266,12 +259,16 @@ SolveStatus PositionSolve::finish(SolveStatus st, std::string msg) {
   if (st != SolveStatus::kSuccess) ws_.newton_contraction = -1.0;
   if (st == SolveStatus::kSuccess) {
     sum_.residual = check_.worst;  // max_i |Φ_i| / scale_i, from the pass that tested it
-    // an error above the quiet level, told in the coordinate's own unit (position_report.cpp)
-    if (sum_.error_estimate > kQuietRoundingLevel && sum_.iterations + (sum_.error_coordinate >= 0) > 0) {
+    // an error above the quiet level, or rows left at their rounding, told in the coordinate's own unit
+    // (position_report.cpp)
+    const bool rounding_rows = rounding_rows_.seen() && sum_.iterations > 0;
+    if (rounding_rows ||
+        (sum_.error_estimate > kQuietRoundingLevel && sum_.iterations + (sum_.error_coordinate >= 0) > 0)) {
       Index j = sum_.error_coordinate;
       if (j < 0) (void)step_ratio(model_, ws_.step, ws_.q, opt_.tolerance, &j);
-      detail::locate_error(model_, opt_.tolerance, sum_.error_estimate, j, ws_, &sum_.error_coordinate,
+      detail::locate_error(model_, opt_.tolerance, std::max(sum_.error_estimate, 0.0), j, ws_, &sum_.error_coordinate,
                            &sum_.error_size);
+      if (rounding_rows) detail::report_rounding_rows(model_, opt_.tolerance, rounding_rows_.named(), ws_.q, sum_);
     }
     // A factorisation made within the tolerance of the solution (the last step was below it) is Φq at the
     // solution to the accuracy q itself has: velocity and acceleration reuse it instead of refactorising.
@@ -387,7 +384,7 @@ std::optional<SolveStatus> PositionSolve::factorize_unless_reused() {
 // The Newton step and its full trial point, with the test of a reused matrix (s.refresh: replace it here).
 std::optional<SolveStatus> PositionSolve::newton_step(Step& s) {
   // ws.step = Φq⁻¹Φ: the Newton step is −ws.step (no negated copy of Φ; the LU's rounding is sign-symmetric)
-  if (!ws_.lu->solve(solve_rhs(model_, ws_, ws_.phi), ws_.step.data()))
+  if (!ws_.lu->solve(solve_rhs(model_, ws_, corrected(ws_.phi)), ws_.step.data()))
     return finish(SolveStatus::kLinearSolverFailed, "sparse solve failed: " + ws_.lu->last_message());
   // the full step's trial point and measures in one pass (the trial is wasted when the matrix is refreshed)
   s.full = take_step(model_, ws_.q, ws_.step, 1.0, opt_.tolerance, ws_.trial);
@@ -438,7 +435,11 @@ std::optional<SolveStatus> PositionSolve::line_search(Step& s) {
     }
     ++ws_.counters.residual_evaluations;
     s.trial = check_residual(model_, ws_.trial_phi, opt_.tolerance, ws_.trial, t_);
-    if (!opt_.line_search || s.trial.merit <= (1.0 - 1e-4 * s.alpha) * check_.merit || s.trial.within)
+    if (!rounding_rows_.empty())
+      rounding_rows_.kept_measures(model_, ws_.trial_phi, &s.trial.merit, &s.trial.kept_worst);
+    if (!opt_.line_search || s.trial.merit <= (1.0 - 1e-4 * s.alpha) * check_.merit || s.trial.within ||
+        rounding_rows_.decrease_apart_from_rounding(model_, ws_.phi, ws_.trial_phi, ws_.trial, opt_.tolerance, t_,
+                                                    1.0 - 1e-4 * s.alpha))
       return std::nullopt;
     if (reuse_) {
       s.refresh = true;
@@ -499,7 +500,7 @@ SolveStatus PositionSolve::stop_at_rounding_level(bool known_before, const Step&
 bool PositionSolve::step_corrected_error(const Step& s) {
   if (corrections_ >= kMaxCorrections || s.known_ok || !s.trial.finite) return false;
   double* next = ws_.rhs.data();  // (scratch of the derivative solves: at least n entries where Φq is square)
-  if (!ws_.lu->solve(solve_rhs(model_, ws_, ws_.trial_phi), next)) return false;
+  if (!ws_.lu->solve(solve_rhs(model_, ws_, corrected(ws_.trial_phi)), next)) return false;
   const Eigen::Map<const Eigen::VectorXd> next_step(next, ws_.q.size());
   if (!(step_ratio(model_, next_step, ws_.trial, opt_.tolerance) <= kCorrectedContraction * s.full.size)) return false;
   ++corrections_;
@@ -521,7 +522,8 @@ bool PositionSolve::accept(const Step& s) {
   // step's size times the residual's reduction when that is the larger — the size of the next step, were it
   // taken. Where the steps are the rounding of Φ amplified along a long chain, the residual no longer falls and
   // θ measured on the previous solve's steps says nothing of it: the error is then about the step itself.
-  accepted_error_ = std::max(s.error, check_.worst > 0.0 ? s.size * (s.trial.worst / check_.worst) : 0.0);
+  accepted_error_ =
+      std::max(s.error, check_.kept_worst > 0.0 ? s.size * (s.trial.kept_worst / check_.kept_worst) : 0.0);
   jacobian_at_q_ = s.with_jacobian;
   check_ = s.trial;
   return step_from_factorization;
@@ -533,6 +535,8 @@ SolveStatus PositionSolve::run() {
     const int it = sum_.iterations;
     if (const auto done = stop_before_step(it)) return *done;
     if (const auto done = factorize_unless_reused()) return *done;
+    if (rounding_rows_.find(model_, ws_.phi, ws_.jacobian_values, ws_.q, opt_.tolerance, ws_.rhs.data(), it))
+      rounding_rows_.kept_measures(model_, ws_.phi, &check_.merit, &check_.kept_worst);
     Step s;
     if (const auto done = newton_step(s)) return *done;
     if (s.refresh) {

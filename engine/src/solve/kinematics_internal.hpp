@@ -43,4 +43,9 @@ SolveStatus derivatives_at_solution(const Model& model, double t, Workspace& ws,
 // Uses ws.trial_phi and ws.rhs as scratch. Pre-condition: 0 ≤ j < n; ws.q the solution.
 void locate_error(const Model& model, double tol, double estimate, Index j, Workspace& ws, Index* where, double* size);
 
+// A solve that left rows at the rounding of their own terms out of its steps (rounding_rows.hpp), `row` the worst
+// of them, and whose error locate_error() has just placed: q is known to that, in tolerances at least, and above
+// the quiet level it is said as a stop at the rounding level is (slow_convergence, rounding_level, message).
+void report_rounding_rows(const Model& model, double tol, Index row, const Eigen::VectorXd& q, PositionSummary& sum);
+
 }  // namespace phiq::detail

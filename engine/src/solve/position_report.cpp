@@ -1,5 +1,6 @@
 // What a position solve reports: the statuses' names, PositionSummary::BriefReport(), and how well q is known in
-// each coordinate's own unit (detail::locate_error(), known_to_text()).
+// each coordinate's own unit (detail::locate_error(), known_to_text(), detail::report_rounding_rows()); and the
+// check of the NewtonOptions it is given.
 #include "phiq/kinematics.hpp"
 #include "phiq/text.hpp"
 
@@ -47,6 +48,20 @@ const char* to_string(SolveStatus s) {
   return "?";
 }
 
+void detail::check_newton_options(const NewtonOptions& opt, const char* what) {
+  // An infinite tolerance accepts any point as the solution, a NaN start_error accepts the start unchecked (and
+  // reports NaN as its error): settings no solve can honour, each named by its field.
+  auto fail = [&](const std::string& why) { throw Error(std::string(what) + ": " + why); };
+  if (!(opt.tolerance > 0.0 && std::isfinite(opt.tolerance))) fail("tolerance must be > 0 and finite");
+  if (opt.max_iterations < 0) fail("max_iterations must be >= 0");
+  if (opt.max_backtracks < 0) fail("max_backtracks must be >= 0");
+  if (!(opt.max_contraction > 0.0 && opt.max_contraction < 1.0)) fail("max_contraction must be in (0, 1)");
+  if (std::isnan(opt.start_error)) fail("start_error must not be NaN (negative: unknown)");
+  if (!(opt.known_to >= 0.0 && std::isfinite(opt.known_to))) fail("known_to must be >= 0 and finite");
+  if (opt.jacobian_update != JacobianUpdate::kEveryIteration && opt.jacobian_update != JacobianUpdate::kWhenSlow)
+    fail("jacobian_update is not a JacobianUpdate");
+}
+
 std::string PositionSummary::BriefReport() const {
   std::ostringstream s;
   s << "position: " << to_string(status) << ", " << iterations << " iterations, scaled residual "
@@ -85,12 +100,17 @@ void detail::locate_error(const Model& model, double tol, double estimate, Index
   // Each row's rounding is its own: with one sign for all, f would be ε |q_j| times a column of Φq where one
   // coordinate dominates, and Φq⁻¹ f that coordinate's own ulp alone (the 10⁶ m xB moves, the rocker's yB not).
   // Signs that vary from row to row (a fixed hash of the row: the same bits on every thread count) keep them apart.
-  for (Index i = 0; i < f.size(); ++i) {
-    const bool minus = ((static_cast<std::uint32_t>(i) * 0x9E3779B1u) >> 16) & 1u;
-    f(i) *= minus ? -std::numeric_limits<double>::epsilon() : std::numeric_limits<double>::epsilon();
-  }
+  // Any one pattern of signs may cancel where a few rows carry a coordinate (a pin's rows of 1, 3 and 2 ulps of
+  // 5·10⁵ m along a four-bar's 10⁶ m links): three patterns (fixed hashes of the row), and the worst of them.
+  constexpr std::uint32_t kHashes[] = {0x9E3779B1u, 0x85EBCA77u, 0xC2B2AE3Du};
   double* x = ws.rhs.data();  // (scratch of the derivative solves: at least n entries where Φq is square)
-  if (ws.lu && f.allFinite() && ws.lu->solve(solve_rhs(model, ws, f), x)) {
+  f *= std::numeric_limits<double>::epsilon();
+  for (const std::uint32_t hash : kHashes) {
+    for (Index i = 0; i < f.size(); ++i) {
+      const bool minus = ((static_cast<std::uint32_t>(i) * hash) >> 16) & 1u;
+      f(i) = minus ? -std::fabs(f(i)) : std::fabs(f(i));
+    }
+    if (!(ws.lu && f.allFinite() && ws.lu->solve(solve_rhs(model, ws, f), x))) break;
     double worst = size / allowed(j);
     for (Index c = 0; c < ws.q.size(); ++c) {
       const double e = std::fabs(x[c]);
@@ -100,6 +120,23 @@ void detail::locate_error(const Model& model, double tol, double estimate, Index
   }
   *where = j;
   *size_out = size;
+}
+
+void detail::report_rounding_rows(const Model& model, double tol, Index row, const Eigen::VectorXd& q,
+                                  PositionSummary& sum) {
+  const Index j = sum.error_coordinate;
+  const double allowed = tol * model.tolerance_scales().coordinate_scale(j) + kUlpFloor * std::fabs(q(j));
+  sum.error_estimate = std::max(sum.error_estimate, sum.error_size / allowed);
+  if (!(sum.error_estimate > kQuietRoundingLevel)) return;
+  sum.rounding_level = std::max(sum.rounding_level, sum.error_estimate);
+  if (sum.slow_convergence) return;  // (a linear convergence says so already)
+  sum.slow_convergence = true;
+  sum.message = (row >= 0 ? "'" + model.row_name(row) +
+                                "' is at the rounding of its own terms (one ulp of each), which no Newton step "
+                                "resolves, and was left out of the steps: "
+                          : std::string("rows whose terms are far larger than their tolerance (a badly scaled model) "
+                                        "are known to one ulp of those terms: ")) +
+                known_to_text(model, j, sum.error_size) + ", which is how well q is known there";
 }
 
 }  // namespace phiq

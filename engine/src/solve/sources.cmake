@@ -12,5 +12,6 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/parameter_reach.cpp
   ${CMAKE_CURRENT_LIST_DIR}/position_report.cpp
   ${CMAKE_CURRENT_LIST_DIR}/rank_analysis.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/rounding_rows.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sensitivity.cpp
 )
