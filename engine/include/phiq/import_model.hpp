@@ -39,6 +39,11 @@ struct ImportOptions {
   /// The shapes are what the caller works on (`phiq clearance`): a URDF mesh whose `package://` cannot be found is
   /// refused rather than left out.
   bool need_geometry = false;
+  /// Every format, `.asmt` too (`--rates`): the scene's output has `velocities: true, accelerations: true`.
+  bool rates = false;
+  /// Every format (`--forces`): the scene's output has `efforts: all` when it has drivers and `reactions: all` when
+  /// it has joints with a reaction; a model none of whose parts has mass is refused (every force would be zero).
+  bool forces = false;
 };
 
 /// What an import made of a file.
