@@ -1,5 +1,7 @@
 // What the tests of the `phiq` command (test_cli_*.cpp) share: the Cli fixture, which runs the binary in a
-// directory of its own and captures its exit status and output, and the scenes and checks several of them use.
+// directory of its own and captures its exit status and output, and the scenes and checks several of them use; and
+// TestFolder, that directory with the files a test writes into it, which the import tests (test_import_*.cpp) use
+// for their models, includes and resource folders.
 // Not in an anonymous namespace: every file's TEST_F(Cli, ...) must derive from this one fixture class.
 #pragma once
 
@@ -11,6 +13,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -32,27 +36,53 @@ inline std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-class Cli : public ::testing::Test {
+// A directory of the test's own (phiq_SUITE_TEST in the temporary directory), empty at the start and removed at the
+// end, with the files write() puts in it; environment variables set_env() sets are put back as they were.
+class TestFolder : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("phiq_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("phiq_" + std::string(info->test_suite_name()) + "_" + info->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  void TearDown() override {
+    for (const auto& [name, old] : saved_env_)
+      if (old)
+        setenv(name.c_str(), old->c_str(), 1);
+      else
+        unsetenv(name.c_str());
+    fs::remove_all(dir_);
+  }
+  // `text` written to the file `name` (a path relative to the directory; its folders made as needed).
+  fs::path write(const std::string& name, const std::string& text) {
+    fs::path p = dir_ / name;
+    fs::create_directories(p.parent_path());
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+  // The environment variable `name` set to `value` for the rest of the test.
+  void set_env(const std::string& name, const std::string& value) {
+    if (!saved_env_.count(name)) {
+      const char* old = std::getenv(name.c_str());
+      saved_env_[name] = old ? std::optional<std::string>(old) : std::nullopt;
+    }
+    setenv(name.c_str(), value.c_str(), 1);
+  }
+  fs::path dir_;
 
+ private:
+  std::map<std::string, std::optional<std::string>> saved_env_;
+};
+
+class Cli : public TestFolder {
+ protected:
   Result run(const std::string& args) { return run_prefixed("", args); }
   Result run_prefixed(const std::string& prefix, const std::string& args) {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
     const std::string cmd = prefix + std::string(PHIQ_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
     const int st = std::system(cmd.c_str());
     return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(out), slurp(err)};
-  }
-  fs::path write(const std::string& name, const std::string& text) {
-    fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p;
   }
   // The directory holds nothing but the named files (no partial or temporary output).
   std::vector<std::string> files() const {
@@ -61,7 +91,6 @@ class Cli : public ::testing::Test {
     std::sort(v.begin(), v.end());
     return v;
   }
-  fs::path dir_;
 };
 
 // How many times `what` occurs in `s` (an SVG's or a page's elements, counted by their text).

@@ -515,19 +515,32 @@ TEST(AsmtImport, EveryTruncationIsRefusedInOneLineOrLoads) {
 
 namespace test {
 
+// With `--rates --forces` (the slider-crank: its parts have mass), the direct run and the converted scene's write the
+// velocities, accelerations, the motor's effort and the joints' reactions, the same bytes; without, positions alone.
 TEST_F(Cli, AsmtRunsDirectlyAndThroughConvertToTheSameBytes) {
   for (const std::string& model : {AsmtOwn("slider_crank.asmt"), AsmtOwn("rack_pinion_driven.asmt")}) {
     SCOPED_TRACE(model);
-    const Result direct = run("run " + model + " -o " + (dir_ / "direct.csv").string());
+    const bool outputs = model.find("slider") != std::string::npos;
+    const std::string flags = outputs ? " --rates --forces" : "";
+    const Result direct = run("run " + model + flags + " -o " + (dir_ / "direct.csv").string());
     ASSERT_EQ(direct.code, 0) << direct.err;
-    const Result convert = run("convert " + model + " -o " + (dir_ / "scene.yaml").string());
+    const Result convert = run("convert " + model + flags + " -o " + (dir_ / "scene.yaml").string());
     ASSERT_EQ(convert.code, 0) << convert.err;
     const Result via = run("run " + (dir_ / "scene.yaml").string() + " -o " + (dir_ / "via.csv").string());
     ASSERT_EQ(via.code, 0) << via.err;
     const std::string a = slurp(dir_ / "direct.csv"), b = slurp(dir_ / "via.csv");
     EXPECT_GT(a.size(), 100u);
     EXPECT_EQ(a, b);
+    const std::string header = a.substr(0, a.find('\n'));
+    for (const char* column : {"Crank_x.v,", "Crank_x.a,", "Motor.effort", "CrankPin.Fx,"})
+      EXPECT_EQ(header.find(column) != std::string::npos, outputs) << column << " in " << header;
   }
+  // the flags are for imported files: a scene's `output` says what it writes
+  const Result scene = run("run " + (dir_ / "scene.yaml").string() + " --rates -o " + (dir_ / "out.csv").string());
+  EXPECT_EQ(scene.code, 2);
+  EXPECT_EQ(scene.err,
+            "phiq: run: --rates is for .asmt, URDF, MJCF and SDF files: a scene's `output` says what it "
+            "writes\n");
   // a bad file, or none: one line naming it, exit 2, nothing written
   const fs::path bad = write("bad.asmt", "OndselSolver\nAssembly\n\tName\n");
   for (const std::string& command : {"convert " + bad.string() + " -o ", "run " + bad.string() + " -o ",

@@ -1,10 +1,16 @@
 // A phiq result against an `.asmt` file's TimeSeries (asmt_comparison(), `phiq compare RESULT FILE.asmt`):
 // OndselSolver's samples (PHIQ_ASMT_SAMPLES, outside the repository; skipped, saying so, when absent) swept in
 // process and compared quantity by quantity with what the file stores, and a bad comparison refused in one line.
+// Joint and motion forces: a massive pendulum under gravity (tests/data/asmt/pendulum.asmt given a centre of mass,
+// gravity and a varying speed) with a TimeSeries written here from its closed form in OndselSolver's conventions.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
 #include <numbers>
 #include <string>
 
@@ -55,6 +61,91 @@ CsvTable AsmtCompareResult(const std::string& path, bool rates) {
   return t;
 }
 
+// The scene of an .asmt text with `--rates --forces` swept as `phiq run` sweeps it, as the table its CSV holds.
+CsvTable AsmtCompareForcesResult(const std::string& text, const std::string& path) {
+  ImportOptions options;
+  options.rates = options.forces = true;
+  Scene scene = parse_scene(import_asmt(text, path, options).yaml, path);
+  scene.sweep.newton.tolerance = scene.sweep.assembly.tolerance = 1e-13;
+  SquareScene square;
+  EXPECT_EQ(prepare_scene(*scene.model, scene.sweep.t_begin, scene.sweep.assembly, &square), SolveStatus::kSuccess);
+  const Model& m = square.model(*scene.model);
+  Workspace ws(m);
+  ws.q = square.start;
+  const CsvFormat format(m, scene.sweep);
+  std::string csv = format.header();
+  EXPECT_EQ(run_sweep(
+                m, scene.sweep, ws, [&](const StepView& v) { return format.append_row(v, csv), true; }, nullptr),
+            SolveStatus::kSuccess);
+  return parse_csv_table(csv, "result.csv");
+}
+
+// tests/data/asmt/pendulum.asmt made massive: the arm (mass 1, Izz 2 about its centre) has its centre at (1, 0, 0),
+// gravity is (0, -9.81, 0) and the motor turns J about I's z by φ(t) = 0.5 t + 0.3 sin 2t; `swapped` exchanges the
+// hinge's markers (I on the arm, the arm's angle −φ). Its TimeSeries holds the closed form, 14 digits as OndselSolver
+// writes: the arm's place and rates, then per joint and motion the force on marker I's part and the moment about
+// marker I's origin, world axes (OndselSolver's ASMTConstraintSet::updateFromMbD: aFImO, aTImO). With the arm's
+// angle θ, its centre c = (cos θ, sin θ, 0): the hinge pushes the arm with m c̈ − m g, the motor turns it with
+// I_O θ̈ − (c × m g)_z = 3 θ̈ + 9.81 cos θ; on the ground the opposite.
+std::string AsmtCompareMassivePendulum(bool swapped) {
+  std::ifstream in(std::string(PHIQ_SOURCE_DIR) + "/tests/data/asmt/pendulum.asmt", std::ios::binary);
+  std::stringstream whole;
+  whole << in.rdbuf();
+  std::string text = whole.str();
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+  };
+  replace("\t\t\t\tPosition3D\n\t\t\t\t\t0.0\t0.0\t0.0\t", "\t\t\t\tPosition3D\n\t\t\t\t\t1.0\t0.0\t0.0\t");
+  replace("ConstantGravity\n\t\t0.0\t0.0\t0.0", "ConstantGravity\n\t\t0.0\t-9.81\t0.0");
+  replace("0.5*time", "0.5*time + 0.3*sin(2*time)");
+  if (swapped) {
+    replace("/Pendulum/Pivot\n", "/Pendulum/ArmPivotTmp\n");
+    replace("/Pendulum/Arm/Pivot\n", "/Pendulum/Pivot\n");
+    replace("/Pendulum/ArmPivotTmp\n", "/Pendulum/Arm/Pivot\n");
+  }
+  const int n = 17;  // t 0..4 step 0.25
+  std::ostringstream ts;
+  const auto row = [&](const std::string& label, const std::function<double(double)>& f) {
+    ts << label << "\t0";
+    for (int k = 0; k < n; ++k) {
+      char v[32];
+      std::snprintf(v, sizeof v, "%.14g", f(0.25 * k));
+      ts << "\t" << v;
+    }
+    ts << "\n";
+  };
+  const double sign = swapped ? -1.0 : 1.0;  // the arm's angle is sign·φ
+  const auto th = [&](double t) { return sign * (0.5 * t + 0.3 * std::sin(2 * t)); };
+  const auto w = [&](double t) { return sign * (0.5 + 0.6 * std::cos(2 * t)); };
+  const auto al = [&](double t) { return sign * (-1.2 * std::sin(2 * t)); };
+  const auto zero = [](double) { return 0.0; };
+  const std::function<double(double)> hinge[3] = {
+      // on the arm
+      [&](double t) { return -std::sin(th(t)) * al(t) - std::cos(th(t)) * w(t) * w(t); },
+      [&](double t) { return std::cos(th(t)) * al(t) - std::sin(th(t)) * w(t) * w(t) + 9.81; }, zero};
+  const auto motor = [&](double t) { return 3 * al(t) + 9.81 * std::cos(th(t)); };  // on the arm
+  const double on_i = swapped ? 1.0 : -1.0;  // marker I: on the arm, or on the ground
+  ts << "TimeSeries\nNumber\tInput";
+  for (int k = 1; k <= n; ++k) ts << "\t" << k;
+  row("\nTime", [](double t) { return t; });
+  ts << "PartSeries /Pendulum/Arm\n";
+  for (const char* q : {"X", "Y", "Z", "Bryantx", "Bryanty"}) row(q, zero);
+  row("Bryantz", th);
+  for (const char* q : {"VX", "VY", "VZ", "OmegaX", "OmegaY"}) row(q, zero);
+  row("OmegaZ", w);
+  for (const char* q : {"AX", "AY", "AZ", "AlphaX", "AlphaY"}) row(q, zero);
+  row("AlphaZ", al);
+  ts << "RevoluteJointSeries\t/Pendulum/Hinge\n";
+  for (int i = 0; i < 3; ++i) row(std::string("F") + "XYZ"[i] + "onI", [&](double t) { return on_i * hinge[i](t); });
+  for (const char* q : {"TXonI", "TYonI", "TZonI"}) row(q, zero);
+  ts << "RotationalMotionSeries\t/Pendulum/Motor\n";
+  for (const char* q : {"FXonI", "FYonI", "FZonI", "TXonI", "TYonI"}) row(q, zero);
+  row("TZonI", [&](double t) { return on_i * motor(t); });
+  return text + ts.str();
+}
+
 // The columns of a comparison beyond `options`, by name, with their mismatches.
 std::map<std::string, std::size_t> AsmtCompareFailing(const AsmtComparison& c, const CompareOptions& options) {
   const CompareResult r = compare_csv(c.result, c.series, options);
@@ -73,7 +164,8 @@ TEST(AsmtCompare, GearsAgreeWithTheirTimeSeriesButForGearTwosHalfTurn) {
   PHIQ_NEED_ASMT_COMPARE_SAMPLES();
   const std::string path = AsmtCompareSample("Gears.asmt");
   const AsmtComparison c = asmt_comparison(AsmtCompareResult(path, true), path);
-  EXPECT_TRUE(c.left_out.empty());
+  ASSERT_EQ(c.left_out.size(), 1u);  // its joints' and motion's stored forces: no part has mass
+  EXPECT_EQ(c.left_out[0], "forces (FXonI ... TZonI): no part of " + path + " has mass: phiq computes no force for it");
   ASSERT_EQ(c.series.columns.size(), 1u + 2 * 18);  // t, and 18 quantities of each of the 2 parts
   EXPECT_EQ(c.series.columns[1], "Part1.X");
   EXPECT_EQ(c.series.columns[36], "Part2.AlphaZ");
@@ -101,13 +193,13 @@ TEST(AsmtCompare, ParallelogramPositionsAgreeItsZeroVelocitiesDoNot) {
   PHIQ_NEED_ASMT_COMPARE_SAMPLES();
   const std::string path = AsmtCompareSample("parm.asmt");
   const AsmtComparison positions = asmt_comparison(AsmtCompareResult(path, false), path);
-  ASSERT_EQ(positions.left_out.size(), 2u);
+  ASSERT_EQ(positions.left_out.size(), 3u);  // velocities, accelerations, forces (no part has mass)
   EXPECT_EQ(positions.left_out[0],
             "velocities (VX ... OmegaZ): result.csv has none (a scene whose output has `velocities: true`)");
   EXPECT_EQ(positions.series.columns.size(), 1u + 4 * 6);
   EXPECT_TRUE(AsmtCompareFailing(positions, {1e-11, 1e-11, {}}).empty());
   const AsmtComparison rates = asmt_comparison(AsmtCompareResult(path, true), path);
-  EXPECT_TRUE(rates.left_out.empty());
+  EXPECT_EQ(rates.left_out.size(), 1u);
   const std::map<std::string, std::size_t> failing = AsmtCompareFailing(rates, {1e-9, 1e-9, {}});
   EXPECT_EQ(failing.count("Part1.OmegaZ"), 0u);  // the fixed ground link: 0 as stored
   EXPECT_EQ(failing.count("Part2.X"), 0u);
@@ -116,6 +208,32 @@ TEST(AsmtCompare, ParallelogramPositionsAgreeItsZeroVelocitiesDoNot) {
     EXPECT_TRUE(column.find(".V") != std::string::npos || column.find(".Omega") != std::string::npos ||
                 column.find(".A") != std::string::npos)
         << column << ": " << mismatches;
+}
+
+// The hinge's reaction and the motor's effort, turned into OndselSolver's forces on marker I's part about marker I's
+// origin, agree with the closed form with either marker on the ground; the stored force negated does not.
+class AsmtCompareFiles : public test::TestFolder {};
+TEST_F(AsmtCompareFiles, JointAndMotorForcesAgreeWithTheClosedFormOnEitherMarker) {
+  for (const bool swapped : {false, true}) {
+    SCOPED_TRACE(swapped ? "marker I on the arm" : "marker I on the ground");
+    const std::string text = AsmtCompareMassivePendulum(swapped);
+    const std::string path = write(swapped ? "swapped.asmt" : "pendulum.asmt", text).string();
+    const AsmtComparison c = asmt_comparison(AsmtCompareForcesResult(text, path), path);
+    EXPECT_TRUE(c.left_out.empty()) << c.left_out.front();
+    ASSERT_EQ(c.series.columns.size(), 1u + 18 + 2 * 6);
+    EXPECT_EQ(c.series.columns[19], "Hinge.FXonI");
+    EXPECT_EQ(c.series.columns[30], "Motor.TZonI");
+    EXPECT_TRUE(AsmtCompareFailing(c, {1e-10, 1e-10, {}}).empty());
+    // the forces are not zero (gravity and the varying speed load both), and their sign is held
+    double largest = 0.0;
+    for (const auto& r : c.series.rows) largest = std::max({largest, std::abs(r[20]), std::abs(r[30])});
+    EXPECT_GT(largest, 5.0);
+    AsmtComparison flipped = c;
+    for (auto& r : flipped.series.rows) r[20] = -r[20], r[30] = -r[30];
+    const std::map<std::string, std::size_t> failing = AsmtCompareFailing(flipped, {1e-10, 1e-10, {}});
+    EXPECT_EQ(failing.size(), 2u);
+    EXPECT_EQ(failing.count("Hinge.FYonI") + failing.count("Motor.TZonI"), 2u);
+  }
 }
 
 TEST(AsmtCompare, RefusesAResultOfAnotherModelAndAFileWithoutTimeSeries) {

@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "cli_test_support.hpp"  // test::TestFolder
 #include "import_test_support.hpp"
 
 namespace phiq {
@@ -28,21 +30,9 @@ int MjcfFramesLineOf(const std::string& text, const std::string& what) {
   return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(text.find(what)), '\n'));
 }
 
-// A folder of its own for files that include each other, removed at the end.
-class MjcfIncludeFiles : public ::testing::Test {
+// A folder of its own for files that include each other (test::TestFolder), removed at the end.
+class MjcfIncludeFiles : public test::TestFolder {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("phiq_mjcf_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) {
-    const std::filesystem::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
   std::string error_of(const std::string& path) {
     try {
       (void)import_mjcf(import_text(path), path);
@@ -51,7 +41,6 @@ class MjcfIncludeFiles : public ::testing::Test {
     }
     return "";
   }
-  std::filesystem::path dir_;
 };
 
 TEST(MjcfFrames, FourBarThroughIncludeFramesAndSitesIsTheFourBar) {
@@ -89,6 +78,89 @@ TEST(MjcfFrames, FourBarThroughIncludeFramesAndSitesIsTheFourBar) {
           << body << " at t = " << t;
     }
   }
+}
+
+// An arm on a hinge and a slider on it, their joints and inertials inside nested <frame>s (positions and turns that
+// compose), against the same model written with each frame's pose composed by hand (numbers printed to 17 digits):
+// the same motion and the same efforts and reactions (`--forces`) to 1e-12.
+std::string MjcfFramesArm(bool framed) {
+  const Eigen::Quaterniond outer = Eigen::Quaterniond(0.9, 0.1, 0.3, -0.2).normalized();
+  const Eigen::Quaterniond inner = Eigen::Quaterniond(0.8, -0.4, 0.1, 0.3).normalized();
+  const Eigen::Quaterniond own = Eigen::Quaterniond(0.7, 0.2, -0.5, 0.1).normalized();  // the inertial's
+  const Eigen::Vector3d outer_at(0.1, 0.2, -0.05), inner_at(0.03, -0.02, 0.04);
+  const auto text = [](const Eigen::Vector3d& v) {
+    char s[96];
+    std::snprintf(s, sizeof s, "%.17g %.17g %.17g", v.x(), v.y(), v.z());
+    return std::string(s);
+  };
+  const auto quat = [](const Eigen::Quaterniond& q) {
+    char s[128];
+    std::snprintf(s, sizeof s, "%.17g %.17g %.17g %.17g", q.w(), q.x(), q.y(), q.z());
+    return std::string(s);
+  };
+  const Eigen::Vector3d hinge_at(0.05, 0, 0.02), hinge_axis(0, 0, 1), slide_axis(1, 0, 0), com(0.3, 0.01, 0);
+  const std::string mass = "mass=\"2\" diaginertia=\"0.02 0.05 0.06\"";
+  std::string arm, slider;
+  if (framed) {
+    arm = "<frame pos=\"" + text(outer_at) + "\" quat=\"" + quat(outer) + "\"><frame pos=\"" + text(inner_at) +
+          "\" quat=\"" + quat(inner) + "\"><joint name=\"hinge\" pos=\"" + text(hinge_at) + "\" axis=\"" +
+          text(hinge_axis) + "\"/></frame><inertial pos=\"" + text(com) + "\" quat=\"" + quat(own) + "\" " + mass +
+          "/></frame>";
+    slider = "<frame quat=\"" + quat(inner) + "\"><joint name=\"slide\" type=\"slide\" axis=\"" + text(slide_axis) +
+             "\"/><inertial pos=\"0 0 0\" mass=\"0.5\" diaginertia=\"0.001 0.001 0.001\"/></frame>";
+  } else {
+    const Eigen::Vector3d at = outer_at + outer * (inner_at + inner * hinge_at);
+    arm = "<joint name=\"hinge\" pos=\"" + text(at) + "\" axis=\"" + text(outer * inner * hinge_axis) +
+          "\"/><inertial pos=\"" + text(outer_at + outer * com) + "\" quat=\"" + quat(outer * own) + "\" " + mass +
+          "/>";
+    slider = "<joint name=\"slide\" type=\"slide\" axis=\"" + text(inner * slide_axis) +
+             "\"/><inertial pos=\"0 0 0\" mass=\"0.5\" diaginertia=\"0.001 0.001 0.001\"/>";
+  }
+  return "<mujoco>\n<compiler angle=\"radian\"/>\n<worldbody>\n<body name=\"arm\" pos=\"0 0 1\">" + arm +
+         "<geom type=\"box\" size=\"0.3 0.02 0.02\"/>\n<body name=\"slider\" pos=\"0.4 0 0\">" + slider +
+         "</body>\n</body>\n</worldbody>\n</mujoco>\n";
+}
+
+struct MjcfFramesRows {
+  std::vector<Eigen::VectorXd> q;
+  std::vector<std::vector<double>> forces;  // efforts, powers, reactions
+};
+MjcfFramesRows MjcfFramesSweep(const std::string& xml) {
+  ImportOptions o = MjcfFramesDrive("hinge", "0.8*sin(2*t)", 1, 10);
+  o.drives.emplace_back("slide", "0.1*t^2");
+  o.forces = true;
+  const ModelImport imported = import_mjcf(xml, "arm.xml", o);
+  EXPECT_TRUE(imported.skipped.empty()) << imported.skipped.front();
+  const Scene s = parse_scene(imported.yaml, "arm.xml");
+  Workspace ws(*s.model);
+  MjcfFramesRows r;
+  const std::size_t n = static_cast<std::size_t>(s.sweep.efforts.size());
+  EXPECT_EQ(n, 2u * 2 + 2 * 6);  // two drivers' efforts and powers, two joints' reactions
+  EXPECT_EQ(run_sweep(
+                *s.model, s.sweep, ws,
+                [&](const StepView& v) {
+                  r.q.push_back(v.q), r.forces.emplace_back(v.efforts, v.efforts + n);
+                  return true;
+                },
+                nullptr),
+            SolveStatus::kSuccess);
+  return r;
+}
+
+TEST(MjcfFrames, JointsAndInertialsInFramesAreTheModelWithTheirPosesComposed) {
+  const MjcfFramesRows framed = MjcfFramesSweep(MjcfFramesArm(true)), plain = MjcfFramesSweep(MjcfFramesArm(false));
+  ASSERT_EQ(framed.q.size(), 11u);
+  ASSERT_EQ(plain.q.size(), 11u);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < framed.q.size(); ++k) {
+    EXPECT_LT((framed.q[k] - plain.q[k]).lpNorm<Eigen::Infinity>(), 1e-12) << "row " << k;
+    for (std::size_t i = 0; i < framed.forces[k].size(); ++i) {
+      EXPECT_NEAR(framed.forces[k][i], plain.forces[k][i], 1e-12 * (1 + std::abs(plain.forces[k][i])))
+          << "row " << k << ", value " << i;
+      largest = std::max(largest, std::abs(plain.forces[k][i]));
+    }
+  }
+  EXPECT_GT(largest, 0.1);  // the inertials load the joints: a frame's turn of an inertial would show
 }
 
 // tip: relpose (0.5, 0, 0.1), turned π/2, in the arm's frame; cap: its site (0, 0, 0.2) on the arm's at (1, 0, 0),
@@ -139,12 +211,13 @@ TEST_F(MjcfIncludeFiles, BadIncludesFramesAndSitesAreOneLineNamingTheirFileAndLi
   write("b.xml", "<mujoco>\n\n<include file=\"a.xml\"/>\n</mujoco>\n");
   EXPECT_EQ(error_of(a),
             (dir_ / "b.xml").string() + ":3: <include file=\"a.xml\">: includes itself (through 2 file(s))");
-  // an included file's faults name it: a joint in a frame, a site no element has, a second site of a name
-  write("parts.xml", "<mujoco>\n<worldbody>\n<frame>\n<joint name=\"loose\"/>\n</frame>\n</worldbody>\n</mujoco>\n");
+  // an included file's faults name it: a joint type MJCF has not (in a frame), a site no element has, a second site
+  write("parts.xml",
+        "<mujoco>\n<worldbody>\n<body>\n<frame>\n<joint name=\"loose\" type=\"twist\"/>\n</frame>\n</body>\n"
+        "</worldbody>\n</mujoco>\n");
   const std::string framed = write("framed.xml", "<mujoco>\n<include file=\"parts.xml\"/>\n</mujoco>\n");
-  EXPECT_EQ(error_of(framed), (dir_ / "parts.xml").string() +
-                                  ":4: <joint> inside a <frame>: phiq reads a body's joints and inertial as its own "
-                                  "children");
+  EXPECT_EQ(error_of(framed),
+            (dir_ / "parts.xml").string() + ":5: joint 'loose' has type 'twist': MJCF's are hinge, slide, ball, free");
   const std::string ghost = write("ghost.xml", "<mujoco>\n<worldbody>" + body +
                                                    "</worldbody>\n<equality>\n<connect site1=\"s\" site2=\"ghost\"/>\n"
                                                    "</equality>\n</mujoco>\n");

@@ -147,6 +147,53 @@ TEST_F(Cli, SdfConvertWritesTheTextADirectReadSolves) {
   EXPECT_NE(check.out.find("dof           1 (1 not driven)"), std::string::npos) << check.out;
 }
 
+// A model pulled in by <include><uri>model://arm</uri>, found in a resource folder (the variable libsdformat does not
+// search itself, GZ_SIM_RESOURCE_PATH: phiq's find-file callback), placed by the include's pose and turned by the
+// main file's hinge; its element phiq does not map listed at its own file and line. Found in no folder: one line
+// naming the file, the <include>'s line and the URI, exit 2, nothing written.
+TEST_F(Cli, SdfIncludeIsFoundOnTheResourcePathsOrRefusedInOneLine) {
+  write("models/arm/model.config",
+        "<?xml version=\"1.0\"?>\n<model><name>arm</name><sdf version=\"1.8\">model.sdf</sdf></model>\n");
+  const fs::path arm = write("models/arm/model.sdf",
+                             "<?xml version=\"1.0\"?>\n<sdf version=\"1.8\">\n<model name=\"arm\">\n"
+                             "<link name=\"link\">\n<pose>0.5 0 0 0 0 0</pose>\n<gravity>false</gravity>\n</link>\n"
+                             "</model>\n</sdf>\n");
+  const std::string main_text =
+      "<?xml version=\"1.0\"?>\n<sdf version=\"1.8\">\n<model name=\"robot\">\n<link name=\"base\"/>\n"
+      "<joint name=\"fix\" type=\"fixed\"><parent>world</parent><child>base</child></joint>\n"
+      "<include>\n<uri>model://arm</uri>\n<pose>0 0 1 0 0 0</pose>\n</include>\n"
+      "<joint name=\"hinge\" type=\"revolute\"><parent>base</parent><child>arm::link</child>"
+      "<pose relative_to=\"base\">0 0 1 0 0 0</pose><axis><xyz>0 0 1</xyz></axis></joint>\n</model>\n</sdf>\n";
+  const std::string model = write("robot.sdf", main_text).string();
+  for (const char* variable : {"SDF_PATH", "GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH"})
+    set_env(variable, (dir_ / "none").string());
+  set_env("GZ_SIM_RESOURCE_PATH", "/nonexistent:" + (dir_ / "models").string());
+  ImportOptions o;
+  o.drives = {{"hinge", "t"}}, o.t_end = 1, o.steps = 4;
+  const ModelImport imported = import_sdf(main_text, model, o);
+  EXPECT_EQ(imported.bodies, 2);
+  EXPECT_EQ(imported.joints, 2);
+  const std::string gravity = arm.string() + ":6: <link><gravity>: not kinematics, or drawn from the visuals";
+  EXPECT_EQ(std::count(imported.skipped.begin(), imported.skipped.end(), gravity), 1) << imported.skipped.front();
+  const ImportRun r = import_sweep(imported.yaml, model);
+  ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
+  ASSERT_EQ(r.trace.q.size(), 5u);
+  for (std::size_t k = 0; k < r.trace.q.size(); ++k) {
+    const double t = r.trace.t[k];
+    const Eigen::Vector3d at(0.5 * std::cos(t), 0.5 * std::sin(t), 1);
+    EXPECT_LT((import_point(r.model(), r.trace.q[k], "arm__link") - at).norm(), 1e-10) << "t = " << t;
+  }
+  // no folder holds it
+  set_env("GZ_SIM_RESOURCE_PATH", (dir_ / "none").string());
+  const Result refused = run("convert " + model + " -o " + (dir_ / "out.yaml").string());
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_EQ(refused.err, "phiq: " + model +
+                             ":7: <include> model://arm: found in no folder of SDF_PATH, GZ_SIM_RESOURCE_PATH or "
+                             "IGN_GAZEBO_RESOURCE_PATH (each a list of folders, separated by ':', that hold the "
+                             "model's folder)\n");
+  EXPECT_FALSE(fs::exists(dir_ / "out.yaml"));
+}
+
 // What `ldd` lists for the file: every shared library a process of it maps at start.
 std::string SdfStartLibraries(const std::string& file) {
   std::string out;

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include "cli_test_support.hpp"  // test::TestFolder
 #include "import_test_support.hpp"
 
 namespace phiq {
@@ -20,32 +21,17 @@ namespace {
 namespace fs = std::filesystem;
 
 // A workspace in a folder of its own: mypkg/urdf/robot.urdf with mypkg/meshes/arm.stl beside it, and
-// ws/otherpkg/meshes/hand.stl for ROS_PACKAGE_PATH; ROS_PACKAGE_PATH as it was is put back at the end.
-class UrdfPackages : public ::testing::Test {
+// ws/otherpkg/meshes/hand.stl for ROS_PACKAGE_PATH (test::TestFolder puts ROS_PACKAGE_PATH back at the end).
+class UrdfPackages : public test::TestFolder {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("phiq_urdf_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
+    TestFolder::SetUp();
     const char* stl =
         "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\n"
         "endfacet\nendsolid t\n";
-    for (const fs::path& mesh : {dir_ / "mypkg/meshes/arm.stl", dir_ / "ws/otherpkg/meshes/hand.stl"}) {
-      fs::create_directories(mesh.parent_path());
-      std::ofstream(mesh) << stl;
-    }
-    fs::create_directories(dir_ / "mypkg/urdf");
-    urdf_ = (dir_ / "mypkg/urdf/robot.urdf").string();
-    std::ofstream(urdf_) << kRobot;
-    if (const char* old = std::getenv("ROS_PACKAGE_PATH")) saved_ = old;
-    setenv("ROS_PACKAGE_PATH", ("/nonexistent:" + (dir_ / "ws").string() + "/").c_str(), 1);
-  }
-  void TearDown() override {
-    if (saved_)
-      setenv("ROS_PACKAGE_PATH", saved_->c_str(), 1);
-    else
-      unsetenv("ROS_PACKAGE_PATH");
-    fs::remove_all(dir_);
+    for (const char* mesh : {"mypkg/meshes/arm.stl", "ws/otherpkg/meshes/hand.stl"}) write(mesh, stl);
+    urdf_ = write("mypkg/urdf/robot.urdf", kRobot).string();
+    set_env("ROS_PACKAGE_PATH", "/nonexistent:" + (dir_ / "ws").string() + "/");
   }
   static constexpr const char* kRobot = R"(<robot name="packaged">
   <link name="base"/>
@@ -64,9 +50,7 @@ class UrdfPackages : public ::testing::Test {
   <joint name="knuckle" type="fixed"><parent link="hand"/><child link="finger"/><origin xyz="0.1 0 0"/></joint>
 </robot>
 )";
-  fs::path dir_;
   std::string urdf_;
-  std::optional<std::string> saved_;
 };
 
 TEST_F(UrdfPackages, MeshesAreFoundAboveTheFileAndOnTheRosPackagePathAndTheMissingListedOnce) {

@@ -121,7 +121,7 @@ std::optional<std::string> import_or_report(const std::string& path, const Impor
     std::string yaml;
     std::vector<std::string> skipped;
     if (model_format(path) == ModelFormat::kAsmt) {
-      AsmtImport imported = import_asmt_file(path);
+      AsmtImport imported = import_asmt_file(path, options);
       yaml = std::move(imported.yaml), skipped = std::move(imported.skipped);
     } else {
       ModelImport imported = import_model_file(path, options);
@@ -135,7 +135,8 @@ std::optional<std::string> import_or_report(const std::string& path, const Impor
   return std::nullopt;
 }
 
-void add_import_options(CLI::App* command, std::vector<std::string>* drives, std::vector<double>* time) {
+void add_import_options(CLI::App* command, std::vector<std::string>* drives, std::vector<double>* time,
+                        ImportOptions* outputs) {
   command->add_option(
       "--drive", *drives,
       "JOINT=EXPR (URDF, MJCF, SDF; repeatable): drive the joint's angle (rad, 0 at the file's pose) or "
@@ -143,6 +144,10 @@ void add_import_options(CLI::App* command, std::vector<std::string>* drives, std
   command
       ->add_option("--time", *time, "START END STEPS (URDF, MJCF, SDF): the time grid (default 0 0 0: the file's pose)")
       ->expected(3);
+  command->add_flag("--rates", outputs->rates,
+                    "(.asmt, URDF, MJCF, SDF) write velocities and accelerations, as a scene's `output` asks");
+  command->add_flag("--forces", outputs->forces,
+                    "(.asmt, URDF, MJCF, SDF) write every driver's effort and every joint's reaction");
 }
 
 std::optional<std::string> import_options(const std::string& command, const std::string& path,
@@ -160,8 +165,11 @@ std::optional<std::string> import_options(const std::string& command, const std:
       return command + ": --time: STEPS must be a whole number from 0 to 1e9";
     options->t_start = time[0], options->t_end = time[1], options->steps = static_cast<int>(steps);
   }
-  if (drives.empty() && time.empty()) return std::nullopt;
   const ModelFormat format = path == "-" ? ModelFormat::kScene : model_format(path);
+  if ((options->rates || options->forces) && format == ModelFormat::kScene)
+    return command + ": " + (options->rates ? "--rates" : "--forces") +
+           " is for .asmt, URDF, MJCF and SDF files: a scene's `output` says what it writes";
+  if (drives.empty() && time.empty()) return std::nullopt;
   if (format == ModelFormat::kAsmt)
     return command + ": --drive and --time are for URDF, MJCF and SDF: an .asmt file has its motions";
   if (format == ModelFormat::kScene)

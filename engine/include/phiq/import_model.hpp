@@ -39,6 +39,11 @@ struct ImportOptions {
   /// The shapes are what the caller works on (`phiq clearance`): a URDF mesh whose `package://` cannot be found is
   /// refused rather than left out.
   bool need_geometry = false;
+  /// Every format, `.asmt` too (`--rates`): the scene's output has `velocities: true, accelerations: true`.
+  bool rates = false;
+  /// Every format (`--forces`): the scene's output has `efforts: all` when it has drivers and `reactions: all` when
+  /// it has joints with a reaction; a model none of whose parts has mass is refused (every force would be zero).
+  bool forces = false;
 };
 
 /// What an import made of a file.
@@ -63,14 +68,17 @@ ModelImport import_urdf(const std::string& text, const std::string& path, const 
 /// Converts the text of an MJCF file (`<mujoco>`), with the files it `include`s (relative to `path`'s folder) and its
 /// `frame`s. Throws SceneError "FILE:LINE: what" (FILE the included file where the fault is in it) for malformed XML,
 /// an include that cannot be read or includes itself, an element that changes the kinematics and phiq cannot
-/// represent exactly (a joint in a frame, a nonlinear joint equality's polycoef, a joint type, geom reference or site
-/// it does not know), and as import_urdf() for drivers.
+/// represent exactly (a nonlinear joint equality's polycoef, a joint type, geom reference or site it does not know),
+/// and as import_urdf() for drivers. A `frame`'s pose composes onto what it holds: bodies, geoms, sites, joints and
+/// inertials.
 ModelImport import_mjcf(const std::string& text, const std::string& path, const ImportOptions& options = {});
 
 /// Converts the text of an SDF file: its model (or its world's first), links as bodies, joints revolute,
 /// continuous, prismatic, ball, fixed and universal in any graph (loops close natively). Throws SceneError
 /// "PATH:LINE: what" for what libsdformat refuses, another joint type, a static model. A nested model's links and
-/// joints are named as SDF scopes them (`arm::link`), placed by the model's pose.
+/// joints are named as SDF scopes them (`arm::link`), placed by the model's pose. An `<include>`'s `model://NAME` is
+/// looked for as libsdformat does, then (as Gazebo's find-file callback) in the folders of SDF_PATH,
+/// GZ_SIM_RESOURCE_PATH and IGN_GAZEBO_RESOURCE_PATH; found in none, the file is refused naming the URI.
 ModelImport import_sdf(const std::string& text, const std::string& path, const ImportOptions& options = {});
 
 /// import_urdf(), import_mjcf() or import_sdf() of the file at `path`, by model_format(), read as load_scene() reads a

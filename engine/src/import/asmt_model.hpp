@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "phiq/import_model.hpp"  // ImportOptions: rates, forces
+
 namespace phiq::detail::asmt {
 
 struct Pose {
@@ -56,6 +58,17 @@ struct Motion {
   std::array<int, 6> general_lines{};
 };
 
+// Where the scene puts a joint's or motion's forces (asmt_compare.cpp): the constraint whose reaction, or the driver
+// whose effort, they are, and marker I's side, about whose origin the file states the moment.
+struct ForceSite {
+  std::string item, type;  // the joint's or motion's name and type (RevoluteJoint, RotationalMotion, ...) in the file
+  std::string name;        // its constraint or driver in the scene
+  std::string why_not;     // not empty: phiq writes no reaction for it, and why
+  std::string body;        // marker I's body ("ground": the reaction is reported on J's)
+  Pose marker;             // marker I in its body
+  double offset = 0.0;     // the reaction's point: marker I's origin moved along its z by this
+};
+
 struct Assembly {
   std::string path, name;
   std::vector<Marker> ground;  // the assembly's own markers
@@ -67,6 +80,7 @@ struct Assembly {
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
   std::vector<std::string> skipped;                         // "FILE:LINE: what: why", once each
   std::vector<std::pair<std::string, std::string>> bodies;  // each part's name and its body's, set by write_scene()
+  std::vector<ForceSite> force_sites;                       // each joint's and motion's, set by write_scene()
 };
 
 // Reads the tree up to the TimeSeries. Throws SceneError "PATH:LINE: ..." for what cannot be read.
@@ -74,7 +88,7 @@ Assembly read_assembly(const std::string& text, const std::string& path);
 
 // The phiq scene of an assembly; adds to a.skipped what the scene leaves out. Throws SceneError for an element that
 // has no exact phiq form.
-std::string write_scene(Assembly& a);
+std::string write_scene(Assembly& a, const ImportOptions& options = {});
 
 // "PATH:LINE: what" as a SceneError.
 [[noreturn]] void refuse(const std::string& path, int line, const std::string& what);

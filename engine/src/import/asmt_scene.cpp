@@ -30,7 +30,7 @@ struct Where {
 
 class SceneWriter {
  public:
-  explicit SceneWriter(Assembly& a) : a_(a) {}
+  SceneWriter(Assembly& a, const ImportOptions& o) : a_(a), o_(o) {}
   std::string write();
 
  private:
@@ -67,6 +67,7 @@ class SceneWriter {
   std::string parts_and_mass();
 
   Assembly& a_;
+  const ImportOptions& o_;
   SceneNames names_;
   std::map<std::string, std::string> body_of_part_;
   std::map<std::string, std::pair<std::string, std::string>> joints_;  // file name → phiq name, type
@@ -160,11 +161,13 @@ void SceneWriter::joint(const Joint& j) {
   const std::string name = names_.make(j.name);
   joints_[j.name] = {name, j.type};
   const double offset = value(j, "offset", 0.0);
+  a_.force_sites.push_back(ForceSite{j.name, j.type, name, "", wi.body, wi.local, offset});
   if (const auto d = direct.find(j.type); d != direct.end()) {
     constraints_ << "  - {name: " << name << ", type: " << d->second << ", between: [" << side(wi, offset) << ", "
                  << side(wj) << "]}\n";
     return;
   }
+  a_.force_sites.back().why_not = "phiq writes it as rows over points pinned to its markers, which have no reaction";
   const std::string I = name + "_I", J = name + "_J";
   if (j.type == "LineInPlaneJoint") {
     constraints_ << "  - {name: " << name << ", type: point_on_plane, between: [" << side(wi, offset) << ", "
@@ -373,6 +376,10 @@ TextMatrix product(const TextMatrix& a, const TextMatrix& b) {
 void SceneWriter::general_motion(const Motion& m) {
   const Where wi = marker(m.marker_i, m.line_i), wj = marker(m.marker_j, m.line_j);
   const std::string name = names_.make(m.name);
+  a_.force_sites.push_back(ForceSite{m.name, m.type, name,
+                                     "phiq drives it by six drivers, whose efforts are not one "
+                                     "force and torque",
+                                     wi.body, wi.local, 0.0});
   std::array<std::array<std::string, 3>, 4> ip;  // I's origin, x, y, z tips
   std::array<std::array<std::string, 3>, 3> jp;  // J's origin, x, y tips
   point(name + "_I_o", wi, Eigen::Vector3d::Zero(), &ip[0]);
@@ -427,7 +434,11 @@ void SceneWriter::motion(const Motion& m) {
                          : "travel of a translational "
                            "or cylindrical") +
                " joint");
-  drivers_ << "  - {name: " << names_.make(m.name) << ", joint: " << it->second.first
+  const std::string name = names_.make(m.name);
+  for (const ForceSite& j : a_.force_sites)  // the motion acts between its joint's markers
+    if (j.item == jname && j.type == type)
+      a_.force_sites.push_back(ForceSite{m.name, m.type, name, "", j.body, j.marker, 0.0});
+  drivers_ << "  - {name: " << name << ", joint: " << it->second.first
            << ", measure: " << (rotation ? "angle" : "distance") << ", law: {type: expression, f: \""
            << expression(m.expression, a_.path, m.expression_line) << "\"}}\n";
 }
@@ -505,11 +516,15 @@ std::string SceneWriter::write() {
   if (!drivers_.str().empty()) s << "drivers:\n" << drivers_.str();
   s << grid << mass;
   if (!a_.gravity.isZero(0.0)) s << "loads: {gravity: " << scene_vector(a_.gravity) << "}\n";
+  bool reactions = false;
+  for (const ForceSite& f : a_.force_sites)
+    reactions = reactions || (f.why_not.empty() && f.type.find("Joint") != std::string::npos);
+  s << import_output_section(a_.path, o_.rates, o_.forces, !drivers_.str().empty(), reactions, !mass.empty());
   return s.str();
 }
 
 }  // namespace
 
-std::string write_scene(Assembly& a) { return SceneWriter(a).write(); }
+std::string write_scene(Assembly& a, const ImportOptions& options) { return SceneWriter(a, options).write(); }
 
 }  // namespace phiq::detail::asmt

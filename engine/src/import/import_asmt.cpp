@@ -13,20 +13,20 @@
 
 namespace phiq {
 
-AsmtImport import_asmt(const std::string& text, const std::string& path) {
+AsmtImport import_asmt(const std::string& text, const std::string& path, const ImportOptions& options) {
   detail::asmt::Assembly a = detail::asmt::read_assembly(text, path);
   AsmtImport out;
   out.parts = static_cast<int>(a.parts.size());
   out.joints = static_cast<int>(a.joints.size());
   out.motions = static_cast<int>(a.motions.size());
-  out.yaml = detail::asmt::write_scene(a);
+  out.yaml = detail::asmt::write_scene(a, options);
   out.skipped = std::move(a.skipped);
   out.bodies = std::move(a.bodies);
   return out;
 }
 
-AsmtImport import_asmt_file(const std::string& path) {
-  return import_asmt(detail::scene::read_scene_file(path, SceneLimits{}), path);
+AsmtImport import_asmt_file(const std::string& path, const ImportOptions& options) {
+  return import_asmt(detail::scene::read_scene_file(path, SceneLimits{}), path, options);
 }
 
 bool is_asmt_path(const std::string& path) {
@@ -71,15 +71,25 @@ std::vector<double> row_values(const std::vector<std::string>& f, std::size_t co
   return v;
 }
 
+// Where `Series` ends the first word of a series' heading ("PartSeries /Asm/NAME"; OndselSolver's joints write a tab
+// before the path: "RevoluteJointSeries\t/Asm/NAME"), npos on another line.
+std::size_t series_word(const std::vector<std::string>& f) {
+  const std::size_t word = f[0].find("Series ");
+  if (word != std::string::npos) return word;
+  const bool tabbed = f.size() > 1 && f[0].size() > 6 && f[0].compare(f[0].size() - 6, 6, "Series") == 0;
+  return tabbed && f[1].rfind('/', 0) == 0 ? f[0].size() - 6 : std::string::npos;
+}
+
 }  // namespace
 }  // namespace detail::asmt
 
 AsmtTimeSeries read_asmt_time_series(const std::string& text, const std::string& path) {
-  using detail::asmt::fields, detail::asmt::row_values;
+  using detail::asmt::fields, detail::asmt::row_values, detail::asmt::series_word;
   AsmtTimeSeries out;
   std::size_t at = 0;
   bool inside = false;
-  AsmtPartSeries* part = nullptr;
+  std::vector<std::string>* labels = nullptr;  // of the part, joint or motion whose rows follow
+  std::vector<std::vector<double>>* columns = nullptr;
   for (int line = 1; at < text.size(); ++line) {
     std::size_t end = text.find('\n', at);
     if (end == std::string::npos) end = text.size();
@@ -94,15 +104,21 @@ AsmtTimeSeries read_asmt_time_series(const std::string& text, const std::string&
     if (f[0] == "Time") {
       if (f.size() < 2) detail::asmt::refuse(path, line, "the TimeSeries Time row has no values");
       out.time = row_values(f, f.size() - 2, path, line);  // (its `Input` stands where rows hold the input's value)
-    } else if (f[0].rfind("PartSeries ", 0) == 0) {
-      const std::string p = f[0].substr(f[0].find_last_of('/') + 1);
-      out.parts.push_back(AsmtPartSeries{p, {}, {}});
-      part = &out.parts.back();
-    } else if (f[0].find("Series ") != std::string::npos) {
-      part = nullptr;  // the assembly's, joints' and motions' rows are not read
-    } else if (part && f[0] != "Number") {
-      part->labels.push_back(f[0]);
-      part->columns.push_back(row_values(f, out.time.size(), path, line));
+    } else if (const std::size_t word = series_word(f); word != std::string::npos) {
+      const std::string type = f[0].substr(0, word);
+      const std::string& whole = f[0].size() > word + 6 ? f[0] : f[1];
+      const std::string name = whole.substr(whole.find_last_of('/') + 1);
+      labels = nullptr, columns = nullptr;  // the assembly's rows are not read
+      if (type == "Part") {
+        out.parts.push_back(AsmtPartSeries{name, {}, {}});
+        labels = &out.parts.back().labels, columns = &out.parts.back().columns;
+      } else if (type != "Assembly") {
+        out.items.push_back(AsmtItemSeries{type, name, {}, {}});
+        labels = &out.items.back().labels, columns = &out.items.back().columns;
+      }
+    } else if (labels && f[0] != "Number") {
+      labels->push_back(f[0]);
+      columns->push_back(row_values(f, out.time.size(), path, line));
     }
   }
   return out;

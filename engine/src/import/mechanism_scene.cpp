@@ -3,6 +3,7 @@
 // pose, as the file's joint coordinates are), couplers over `rotation_angle` coordinates, drivers and the time grid
 // from ImportOptions, inertials and geometry as parts.
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -58,6 +59,7 @@ class MechanismWriter {
   std::vector<std::string> body_, joint_;
   std::map<int, std::string> joint_coordinate_;
   std::ostringstream coordinates_, constraints_, drivers_;
+  bool massive_ = false;  // a part has mass (parts())
 };
 
 // The coordinate that holds joint j's angle (a `rotation_angle` of the joint), made once.
@@ -171,6 +173,7 @@ std::string MechanismWriter::parts() {
     const Body& b = m_.bodies[k];
     std::ostringstream fields;
     if (b.has_mass && rigid_mass(b)) {
+      massive_ = true;
       const Eigen::Matrix3d I = 0.5 * (b.inertia + b.inertia.transpose());
       fields << ", mass: " << scene_number(b.mass) << ", center_of_mass: " << scene_vector(b.com) << ", inertia: ["
              << scene_vector(I.row(0).transpose()) << ", " << scene_vector(I.row(1).transpose()) << ", "
@@ -178,6 +181,7 @@ std::string MechanismWriter::parts() {
     } else if (b.has_mass && b.mass > 0.0) {
       m_.skip("inertial of '" + b.name + "'", b.line, "a mass or inertia no rigid body has; the body is given no mass");
     } else if (b.density && !b.shapes.empty() && k > 0) {
+      massive_ = true;
       fields << ", density: " << scene_number(*b.density);
     }
     if (!b.shapes.empty()) {
@@ -251,6 +255,8 @@ std::string MechanismWriter::write() {
   s << "time: {start: " << scene_number(o_.t_start) << ", end: " << scene_number(o_.t_end) << ", steps: " << o_.steps
     << "}\n";
   s << mass;
+  const bool joints = std::any_of(m_.joints.begin(), m_.joints.end(), [](const Joint& j) { return !j.kind.empty(); });
+  s << import_output_section(m_.path, o_.rates, o_.forces, !drivers_.str().empty(), joints, massive_);
   return s.str();
 }
 

@@ -317,12 +317,7 @@ std::vector<MjcfReader::Placed> MjcfReader::placed(const tinyxml2::XMLElement* e
       continue;
     }
     const std::string cc = c->Attribute("childclass") ? c->Attribute("childclass") : childclass;
-    for (Placed& inner : placed(c, cc, frame * pose(c, childclass))) {
-      const std::string tag = inner.e->Name();
-      if (tag == "joint" || tag == "freejoint" || tag == "inertial")
-        fail(inner.e, "<" + tag + "> inside a <frame>: phiq reads a body's joints and inertial as its own children");
-      out.push_back(std::move(inner));
-    }
+    for (Placed& inner : placed(c, cc, frame * pose(c, childclass))) out.push_back(std::move(inner));
   }
   return out;
 }
@@ -350,32 +345,31 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
   const int index = static_cast<int>(m_.bodies.size());
   if (e->Attribute("name") && !body_index_.emplace(b.name, index).second)
     fail(e, "a second body named '" + b.name + "'");
-  std::vector<const tinyxml2::XMLElement*> joints;
-  std::vector<Placed> children, geoms_and_sites;
+  std::vector<Placed> joints, children, geoms_and_sites;  // each with the pose of the <frame>s it is in
   bool solid_only = true, inertial = false;
   std::optional<double> density;
   for (const Placed& p : placed(e, cc)) {
     const tinyxml2::XMLElement* c = p.e;
     const std::string tag = c->Name();
     if (tag == "joint" || tag == "freejoint") {
-      joints.push_back(c);
+      joints.push_back(p);
     } else if (tag == "body") {
       children.push_back(p);
     } else if (tag == "geom" || tag == "site") {
       geoms_and_sites.push_back(p);  // (once the body is in m_.bodies)
     } else if (tag == "inertial") {
-      const Pose p = pose(c, cc);
-      const std::vector<double> mass = numbers(c, "mass", cc, {}, 1, 1);
+      const Pose at = p.frame * pose(c, p.childclass);
+      const std::vector<double> mass = numbers(c, "mass", p.childclass, {}, 1, 1);
       Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
       if (c->Attribute("fullinertia")) {
-        const std::vector<double> f = numbers(c, "fullinertia", cc, {}, 6, 6);
+        const std::vector<double> f = numbers(c, "fullinertia", p.childclass, {}, 6, 6);
         I << f[0], f[3], f[4], f[3], f[1], f[5], f[4], f[5], f[2];
       } else {
-        const std::vector<double> d = numbers(c, "diaginertia", cc, {}, 3, 3);
+        const std::vector<double> d = numbers(c, "diaginertia", p.childclass, {}, 3, 3);
         I.diagonal() << d[0], d[1], d[2];
       }
       if (mass.empty() || I.isZero(0.0)) fail(c, "<inertial> needs mass and diaginertia or fullinertia");
-      b.has_mass = true, b.mass = mass[0], b.com = p.p, b.inertia = p.R * I * p.R.transpose();
+      b.has_mass = true, b.mass = mass[0], b.com = at.p, b.inertia = at.R * I * at.R.transpose();
       inertial = true;
     } else if (tag == "replicate" || tag == "composite" || tag == "flexcomp") {
       fail(c, "<" + tag + ">: not read by phiq (expand it into bodies first)");
@@ -400,7 +394,9 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     m_.joints.push_back(w);
   }
   for (std::size_t k = 0; k < joints.size(); ++k) {
-    const tinyxml2::XMLElement* j = joints[k];
+    const tinyxml2::XMLElement* j = joints[k].e;
+    const Pose& frame = joints[k].frame;            // its pos and axis are in the frame's axes
+    const std::string& jcc = joints[k].childclass;  // a <frame childclass> applies within it
     int to = index;
     if (k + 1 < joints.size()) {
       Body step = Body::named(b.name + "_joint" + std::to_string(k + 1), j->GetLineNum(), b.world);
@@ -408,7 +404,7 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
       to = static_cast<int>(m_.bodies.size());
       m_.bodies.push_back(step);
     }
-    const std::string* t = attr(j, "type", cc);
+    const std::string* t = attr(j, "type", jcc);
     const std::string type = std::string(j->Name()) == "freejoint" ? "free" : t ? *t : "hinge";
     Joint out;
     out.line = j->GetLineNum(), out.file = b.file;
@@ -421,9 +417,10 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
       out.kind = "spherical";
     else if (type != "free")
       fail(j, "joint '" + out.name + "' has type '" + type + "': MJCF's are hinge, slide, ball, free");
-    const std::vector<double> p = numbers(j, "pos", cc, {0, 0, 0}, 3, 3);
-    const std::vector<double> a = numbers(j, "axis", cc, {0, 0, 1}, 3, 3);
-    const Eigen::Vector3d at(p[0], p[1], p[2]), axis = Eigen::Vector3d(a[0], a[1], a[2]);
+    const std::vector<double> p = numbers(j, "pos", jcc, {0, 0, 0}, 3, 3);
+    const std::vector<double> a = numbers(j, "axis", jcc, {0, 0, 1}, 3, 3);
+    const Eigen::Vector3d at = frame.p + frame.R * Eigen::Vector3d(p[0], p[1], p[2]);
+    const Eigen::Vector3d axis = frame.R * Eigen::Vector3d(a[0], a[1], a[2]);
     if (!(axis.norm() > 0)) fail(j, "joint '" + out.name + "': a zero axis");
     const Pose rel = m_.bodies[static_cast<std::size_t>(from)].world.inverse() * b.world;
     const Eigen::Vector3d ref = perpendicular(axis);
@@ -432,10 +429,10 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     if (type == "ball")
       out.parent.axis = rel.R.col(2), out.parent.ref = rel.R.col(0), out.child.axis = Eigen::Vector3d::UnitZ(),
       out.child.ref = Eigen::Vector3d::UnitX();
-    if (const std::vector<double> r = numbers(j, "ref", cc, {0}, 1, 1); r[0] != 0.0)
+    if (const std::vector<double> r = numbers(j, "ref", jcc, {0}, 1, 1); r[0] != 0.0)
       joint_ref_[static_cast<int>(m_.joints.size())] = type == "hinge" ? angle(r[0]) : r[0];
     for (const char* ignored : {"range", "limited", "damping", "stiffness", "armature", "springref", "frictionloss"})
-      if (attr(j, ignored, cc))
+      if (attr(j, ignored, jcc))
         skip_at(j, std::string("<joint ") + ignored + ">", "limits, springs and damping are not kinematics");
     if (!joint_index_.emplace(out.name, static_cast<int>(m_.joints.size())).second)
       fail(j, "a second joint named '" + out.name + "'");

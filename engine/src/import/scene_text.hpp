@@ -7,6 +7,7 @@
 #include <set>
 #include <string>
 
+#include "phiq/scene.hpp"
 #include "phiq/text.hpp"
 
 namespace phiq::detail {
@@ -21,6 +22,22 @@ inline std::string yaml_quoted(const std::string& s) {
   std::string out = "\"";
   for (char c : single_line(s)) out += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
   return out + "\"";
+}
+
+// The `output` section an import writes when asked (ImportOptions::rates, ::forces; "" when neither is): rates are
+// velocities and accelerations; forces the efforts of every driver when the scene has drivers, and the reactions of
+// every joint that has one when it has such `joints`. Throws SceneError "PATH: --forces: ..." when forces are asked
+// of a model without `mass` (every force would be zero) or with neither drivers nor joints.
+inline std::string import_output_section(const std::string& path, bool rates, bool forces, bool drivers, bool joints,
+                                         bool mass) {
+  if (forces && !mass) throw SceneError(path + ": --forces: no part has mass: every force would be zero");
+  if (forces && !drivers && !joints)
+    throw SceneError(path + ": --forces: the model has no driver and no joint with a reaction");
+  std::string fields;
+  if (rates) fields += "velocities: true, accelerations: true";
+  if (forces && drivers) fields += std::string(fields.empty() ? "" : ", ") + "efforts: all";
+  if (forces && joints) fields += std::string(fields.empty() ? "" : ", ") + "reactions: all";
+  return fields.empty() ? "" : "output: {" + fields + "}\n";
 }
 
 // phiq names (letters, digits, `_`) made from the file's, unique across the scene: what a name cannot hold becomes

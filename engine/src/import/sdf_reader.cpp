@@ -10,6 +10,7 @@
 #include <sdf/JointAxis.hh>
 #include <sdf/Link.hh>
 #include <sdf/Model.hh>
+#include <sdf/ParserConfig.hh>
 #include <sdf/Root.hh>
 #include <sdf/Visual.hh>
 #include <sdf/World.hh>
@@ -19,8 +20,11 @@
 #include <sdf/Sphere.hh>
 
 #include <algorithm>
+#include <cstdlib>
+#include <filesystem>
 #include <mutex>
 #include <set>
+#include <sstream>
 
 #include "import/mechanism.hpp"
 #include "import/sdf_module.hpp"
@@ -37,6 +41,33 @@ Pose sdf_pose(const ignition::math::Pose3d& p) {
   return Pose{sdf_vector(p.Pos()), Eigen::Quaterniond(q.W(), q.X(), q.Y(), q.Z()).normalized().toRotationMatrix()};
 }
 int sdf_line(const sdf::ElementPtr& e) { return e && e->LineNumber() ? *e->LineNumber() : 0; }
+// The file an element was read from when an <include> brought it in; "" for the file being read.
+std::string sdf_file(const sdf::ElementPtr& e, const std::string& path) {
+  const std::string f = e ? e->FilePath() : "";
+  return f.empty() || f == path || f == "data-string" ? "" : f;
+}
+
+// The environment variables whose folders hold the models an <include><uri>model://NAME</uri> names, in the order
+// Gazebo's find-file callback searches them (libsdformat searches SDF_PATH itself, then asks the callback).
+constexpr const char* kSdfResourcePaths[] = {"SDF_PATH", "GZ_SIM_RESOURCE_PATH", "IGN_GAZEBO_RESOURCE_PATH"};
+
+// The file or folder of a URI (`model://NAME/...`, the scheme dropped) in the first folder of kSdfResourcePaths that
+// has it; "" (and the URI appended to `unresolved`) when none has.
+std::string sdf_find_resource(const std::string& uri, std::vector<std::string>* unresolved) {
+  const std::size_t scheme = uri.find("://");
+  const std::string rest = scheme == std::string::npos ? uri : uri.substr(scheme + 3);
+  for (const char* variable : kSdfResourcePaths) {
+    const char* value = std::getenv(variable);
+    std::stringstream folders(value ? value : "");
+    for (std::string folder; std::getline(folders, folder, ':');) {
+      std::error_code ec;
+      if (!folder.empty() && std::filesystem::exists(std::filesystem::path(folder) / rest, ec))
+        return (std::filesystem::path(folder) / rest).string();
+    }
+  }
+  unresolved->push_back(uri);
+  return "";
+}
 
 class SdfReader {
  public:
@@ -48,7 +79,7 @@ class SdfReader {
   void unmapped_children(const sdf::ElementPtr& e, const std::set<std::string>& mapped, const std::string& why) {
     for (sdf::ElementPtr c = e->GetFirstElement(); c; c = c->GetNextElement(""))
       if (c->GetExplicitlySetInFile() && !mapped.count(c->GetName()))
-        m_.skip("<" + e->GetName() + "><" + c->GetName() + ">", sdf_line(c), why);
+        m_.skip("<" + e->GetName() + "><" + c->GetName() + ">", sdf_line(c), why, sdf_file(c, path_));
   }
   void link(const sdf::Link& l, Body* b);
   // A model's links, then its nested models' (named MODEL::LINK, as SDF scopes them), then its joints; `placed`: the
@@ -90,7 +121,7 @@ void SdfReader::link(const sdf::Link& l, Body* b) {
       s.type = "capsule", s.radius = g->CapsuleShape()->Radius(), s.length = g->CapsuleShape()->Length();
     } else {
       m_.skip("<visual><geometry> other than box, sphere, cylinder, capsule", sdf_line(v->Element()),
-              "meshes, planes and height maps of SDF are not read");
+              "meshes, planes and height maps of SDF are not read", sdf_file(v->Element(), path_));
       continue;
     }
     b->shapes.push_back(s);
@@ -189,7 +220,18 @@ Mechanism SdfReader::read(int* loops) {
     static std::mutex sdformat_console;  // libsdformat's console is one per process: quiet while it reads
     std::lock_guard<std::mutex> lock(sdformat_console);
     sdf::Console::Instance()->SetQuiet(true);
-    const sdf::Errors errors = root.LoadSdfString(text_);
+    sdf::ParserConfig config;
+    std::vector<std::string> unresolved;
+    config.SetFindCallback([&](const std::string& uri) { return sdf_find_resource(uri, &unresolved); });
+    const sdf::Errors errors = root.LoadSdfString(text_, config);
+    if (!errors.empty() && !unresolved.empty()) {  // an <include> not found: its line, where its URI is written
+      const std::size_t at = text_.find(unresolved.front());
+      const auto before = text_.begin() + static_cast<std::ptrdiff_t>(at == std::string::npos ? 0 : at);
+      refuse(path_, at == std::string::npos ? 0 : 1 + static_cast<int>(std::count(text_.begin(), before, '\n')),
+             "<include> " + unresolved.front() +
+                 ": found in no folder of SDF_PATH, GZ_SIM_RESOURCE_PATH or IGN_GAZEBO_RESOURCE_PATH (each a list "
+                 "of folders, separated by ':', that hold the model's folder)");
+    }
     if (!errors.empty())
       refuse(path_, errors.front().LineNumber().value_or(0), "libsdformat: " + errors.front().Message());
   }
@@ -200,7 +242,7 @@ Mechanism SdfReader::read(int* loops) {
   if (root.WorldCount() > 0)
     for (uint64_t k = 1; k < root.WorldByIndex(0)->ModelCount(); ++k)
       m_.skip("<model> after the world's first", sdf_line(root.WorldByIndex(0)->ModelByIndex(k)->Element()),
-              "phiq reads one model of a world");
+              "phiq reads one model of a world", sdf_file(root.WorldByIndex(0)->ModelByIndex(k)->Element(), path_));
   m_.name = model->Name();
   m_.bodies.push_back(Body::named("world", sdf_line(model->Element())));
   this->model(*model, Pose{}, "");
