@@ -3,5 +3,5 @@
 # without recompiling what command 1 built. Unity build: CMake joins each target's files in groups of 8, so that the
 # headers (CLI11's and Eigen's inline code above all) are compiled once a group rather than once a file.
 phiq_configure_release() {
-  cmake -S "$1" -B "$1/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON >/dev/null
+  cmake -S "$1" -B "$1/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_UNITY_BUILD=ON "${@:2}" >/dev/null
 }

@@ -2,11 +2,14 @@
 # README command (2): the whole test suite. .ci/run calls it.
 #   tools/test.sh            0. the test-only packages (tools/install_deps.sh --test);
 #                            1. Release build (build/, as tools/setup.sh configures it) and its ctest suite, with the
-#                               installed-package consumer, the regression comparisons and the benchmark smoke run;
-#                            2. the same suite built with clang under AddressSanitizer + UndefinedBehaviorSanitizer
+#                               installed-package consumer, the regression comparisons, the Python package, the
+#                               hostile-input catalogue, the size tests and the benchmark smoke run, but not the
+#                               engine's GoogleTest suites (PHIQ_UNIT_TESTS=OFF: step 2 runs them, so that CI
+#                               compiles them once);
+#                            2. the whole suite built with clang under AddressSanitizer + UndefinedBehaviorSanitizer
 #                               (build-asan/), preceded by bounded libFuzzer runs side by side: the scene loader
 #                               (40 s) and the expression compiler (20 s).
-#   tools/test.sh --quick    step 1 only (the inner loop while developing)
+#   tools/test.sh --quick    step 1 with the engine's GoogleTest suites in Release (the inner loop while developing)
 #   PHIQ_FUZZ_SECONDS=N      scene fuzzing time (default 40; expressions get half)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -17,7 +20,7 @@ jobs="$(nproc)"
 source "$root/tools/build_config.sh"
 "$root/tools/install_deps.sh" --test
 # build/ as README command (1) configured it: what that command built is not compiled again.
-phiq_configure_release "$root"
+phiq_configure_release "$root" -DPHIQ_UNIT_TESTS="$([ "$quick" = 1 ] && echo ON || echo OFF)"
 cmake --build "$root/build" -j "$jobs"
 (cd "$root/build" && ctest --output-on-failure -j "$jobs" "$@")
 [ "$quick" = 1 ] && exit 0
