@@ -182,8 +182,9 @@ class KindFields {
  private:
   std::pair<JointSide3, JointSide3> turning_joint_of(const C& n) const {
     const std::string name = n.name();
-    const auto it = r_.joints3_.find(name);
-    if (it == r_.joints3_.end()) n.fail("unknown joint '" + name + "' (a named spatial joint of 'constraints', above)");
+    const auto it = r_.names_.joints3.find(name);
+    if (it == r_.names_.joints3.end())
+      n.fail("unknown joint '" + name + "' (a named spatial joint of 'constraints', above)");
     if (!it->second.traits.shaft)
       n.fail("joint '" + name + "' is a " + it->second.type + " joint: a shaft turns in a " + shaft_types() + " joint");
     return {it->second.a, it->second.b};
@@ -192,8 +193,8 @@ class KindFields {
     const std::string s = n.name();
     if (!r_.spatial_) {
       if (s == kGround) return Slot::constant(0.0);
-      if (const Index k = r_.entry_at(n, s, r_.bodies_); k >= 0) return r_.bodies_[k].psi;
-    } else if (s == kGround || r_.entry_at(n, s, r_.bodies3_) >= 0) {
+      if (const Index k = r_.entry_at(n, s, r_.names_.bodies); k >= 0) return r_.names_.bodies[k].psi;
+    } else if (s == kGround || r_.entry_at(n, s, r_.names_.bodies3) >= 0) {
       n.fail("'" + s +
              "' is a body: in dimension 3 a transmission relates angle coordinates (define the body's "
              "rotation about its axis with a rotation_angle constraint)");

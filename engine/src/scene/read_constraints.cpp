@@ -24,9 +24,9 @@ Point2 SceneReader::point(const C& c) const {
     return Point2{slot(c.at(0)), slot(c.at(1))};
   }
   const std::string s = c.name();
-  const Index k = entry_at(c, s, points_);
+  const Index k = entry_at(c, s, names_.points);
   if (k < 0) c.fail("unknown point '" + s + "'");
-  return points_[k];
+  return names_.points[k];
 }
 
 template <class C>
@@ -51,9 +51,9 @@ template <class C>
 Frame2 SceneReader::body(const C& c) const {
   const std::string s = c.name();
   if (s == kGround) return Frame2{Slot::constant(0), Slot::constant(0), Slot::constant(0)};
-  const Index k = entry_at(c, s, bodies_);
+  const Index k = entry_at(c, s, names_.bodies);
   if (k < 0) c.fail("unknown body '" + s + "'");
-  return bodies_[k];
+  return names_.bodies[k];
 }
 
 // An attachment of a revolute or prismatic pair: {body: B, at: [x, y]} (local point) or {point: P}.
@@ -126,7 +126,7 @@ template <class K, class C>
 void SceneReader::read_kind(const C& c, const std::string& type, const std::string& name) {
   K spec = K::read(KindFields<C>(*this, c, type));
   if constexpr (SpatialJointKind<K>)  // kept by name, for the drivers, outputs and shafts that refer to it
-    if (!name.empty()) joints3_[name] = Joint3{type, joint_traits<K>(), spec.a, spec.b};
+    if (!name.empty()) names_.joints3[name] = Joint3{type, joint_traits<K>(), spec.a, spec.b};
   add(c, name, std::move(spec));
 }
 
@@ -162,26 +162,26 @@ Point3 SceneReader::point3(const C& c) const {
     return Point3{slot(c.at(0)), slot(c.at(1)), slot(c.at(2))};
   }
   const std::string s = c.name();
-  const Index k = entry_at(c, s, points3_);
+  const Index k = entry_at(c, s, names_.points3);
   if (k < 0) c.fail("unknown point '" + s + "'");
-  return points3_[k];
+  return names_.points3[k];
 }
 
 template <class C>
 Point3 SceneReader::vector3(const C& c) const {
   const std::string s = c.name();
-  const Index k = entry_at(c, s, vectors_);
+  const Index k = entry_at(c, s, names_.vectors);
   if (k < 0) c.fail("unknown vector '" + s + "'");
-  return vectors_[k];
+  return names_.vectors[k];
 }
 
 template <class C>
 Frame3 SceneReader::body3(const C& c) const {
   const std::string s = c.name();
   if (s == kGround) return Frame3::ground();
-  const Index k = entry_at(c, s, bodies3_);
+  const Index k = entry_at(c, s, names_.bodies3);
   if (k < 0) c.fail("unknown body '" + s + "'");
-  return bodies3_[k];
+  return names_.bodies3[k];
 }
 
 // A non-zero finite direction.

@@ -12,8 +12,8 @@ void SceneReader::read_joint_driver(const C& c, const std::string& name, MotionL
   auto j = c.field("joint");
   if (!spatial_) j.fail("joint drivers need 'dimension: 3' (in the plane, drive a coordinate)");
   const std::string joint = j.name();
-  auto it = joints3_.find(joint);
-  if (it == joints3_.end()) j.fail("unknown joint '" + joint + "' (a named spatial joint of 'constraints')");
+  auto it = names_.joints3.find(joint);
+  if (it == names_.joints3.end()) j.fail("unknown joint '" + joint + "' (a named spatial joint of 'constraints')");
   const Joint3& J = it->second;
   const JointTraits::Coordinates drives = J.traits.drives;  // what its kind lets a driver drive
   std::string measure;
@@ -33,12 +33,12 @@ void SceneReader::read_joint_driver(const C& c, const std::string& name, MotionL
            joint_type_list([](const JointTraits& t) { return t.drives.distance; }) + " one");
   if (measure == "angle") {
     const kin3::V3 ra = detail3::reference_direction(J.a), rb = detail3::reference_direction(J.b);
-    joint_angles_.push_back(JointAngleReference{name.empty() ? c.path() : name,
-                                                joint,
-                                                {ra.x, ra.y, ra.z},
-                                                {rb.x, rb.y, rb.z},
-                                                J.a.ref.has_value(),
-                                                J.b.ref.has_value()});
+    names_.joint_angles.push_back(JointAngleReference{name.empty() ? c.path() : name,
+                                                      joint,
+                                                      {ra.x, ra.y, ra.z},
+                                                      {rb.x, rb.y, rb.z},
+                                                      J.a.ref.has_value(),
+                                                      J.b.ref.has_value()});
     JointAngleDriverSpec d;
     d.a = J.a, d.b = J.b, d.law = std::move(law);
     add(c, name, std::move(d));
@@ -56,7 +56,7 @@ void SceneReader::read_driver(const C& c) {
   std::string name;
   if (auto n = c.field("name"); n.present()) name = n.name();
   MotionLaw law = motion_law(c.require("law"));
-  if (!name.empty()) driver_laws_.emplace(name, law);  // for `output: drivers` (shared data: a cheap copy)
+  if (!name.empty()) pending_.driver_laws.emplace(name, law);  // for `output: drivers` (shared data: a cheap copy)
   const bool by_coordinate = c.field("coordinate").present(), by_expr = c.field("expr").present(),
              by_joint = c.field("joint").present();
   if (int(by_coordinate) + int(by_expr) + int(by_joint) != 1)

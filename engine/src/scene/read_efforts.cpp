@@ -14,11 +14,11 @@ namespace phiq::detail::scene {
 void SceneReader::read_output_efforts(const Cursor& output) {
   const Cursor e = output.field("efforts");
   if (auto p = output.field("power"); p.present()) {
-    efforts_power_ = p.boolean();
-    if (efforts_power_ && !e.present()) p.fail("power is written with the efforts: list `efforts` too");
+    pending_.efforts_power = p.boolean();
+    if (pending_.efforts_power && !e.present()) p.fail("power is written with the efforts: list `efforts` too");
   }
   if (const Cursor r = output.field("reactions"); r.present()) {
-    reactions_field_ = r;
+    pending_.reactions_field = r;
     if (r.is_scalar()) {
       if (r.text() != "all") r.fail("expected `all` or a list of joints");
     } else {
@@ -27,12 +27,12 @@ void SceneReader::read_output_efforts(const Cursor& output) {
         const std::string n = i.name();
         if (!builder_.has_constraint(n)) i.fail("unknown joint '" + n + "'");
         if (!seen.insert(n).second) i.fail("joint listed twice");
-        reaction_items_.push_back(i);
+        pending_.reaction_items.push_back(i);
       }
     }
   }
   if (!e.present()) return;
-  efforts_field_ = e;
+  pending_.efforts_field = e;
   if (e.is_scalar()) {
     if (e.text() != "all") e.fail("expected `all` or a list of drivers");
     return;
@@ -42,26 +42,26 @@ void SceneReader::read_output_efforts(const Cursor& output) {
     const std::string n = i.name();
     if (!builder_.has_constraint(n)) i.fail("unknown driver '" + n + "'");
     if (!seen.insert(n).second) i.fail("driver listed twice");
-    effort_items_.push_back(i);
+    pending_.effort_items.push_back(i);
   }
 }
 
 void SceneReader::resolve_output_efforts(Scene& scene) const {
-  if (!efforts_field_ && !reactions_field_) return;
+  if (!pending_.efforts_field && !pending_.reactions_field) return;
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
-  if (reactions_field_) {
-    if (reaction_items_.empty()) {  // all: every joint with a reaction that no driver moves
+  if (pending_.reactions_field) {
+    if (pending_.reaction_items.empty()) {  // all: every joint with a reaction that no driver moves
       for (std::size_t c = 0; c < model.constraints().size(); ++c)
         if (const int w = reaction_width(model, static_cast<Index>(c));
             w > 0 && !model.constraints()[c].depends_on_time)
           out.reactions.push_back({static_cast<Index>(c), w == 6});
       if (out.reactions.empty())
-        reactions_field_->fail(
+        pending_.reactions_field->fail(
             "no constraint of the scene joins bodies (revolute, prismatic, spatial joints): no "
             "reaction to write");
     }
-    for (const Cursor& i : reaction_items_) {
+    for (const Cursor& i : pending_.reaction_items) {
       const Index c = model.find_constraint(i.name());
       const int w = reaction_width(model, c);
       if (w == 0)
@@ -70,14 +70,14 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       out.reactions.push_back({c, w == 6});
     }
   }
-  if (efforts_field_ && effort_items_.empty()) {
+  if (pending_.efforts_field && pending_.effort_items.empty()) {
     out.constraints = rheonomic_constraints(model);
-    if (out.constraints.empty()) efforts_field_->fail("the scene has no driver: no effort to write");
-  } else if (efforts_field_) {
+    if (out.constraints.empty()) pending_.efforts_field->fail("the scene has no driver: no effort to write");
+  } else if (pending_.efforts_field) {
     std::unordered_map<std::string, Index> index;
     for (std::size_t k = 0; k < model.constraints().size(); ++k)
       index.emplace(model.constraints()[k].name, static_cast<Index>(k));
-    for (const Cursor& i : effort_items_) {
+    for (const Cursor& i : pending_.effort_items) {
       const Index c = index.at(i.name());
       if (!model.constraints()[static_cast<std::size_t>(c)].depends_on_time)
         i.fail("'" + i.name() + "' does not depend on time: no motor drives it, it has no effort");
@@ -92,13 +92,13 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       massive->back().shapes.clear();
     }
   if (massive->empty() && !(scene.loads.applied && !scene.loads.applied->empty()))
-    (efforts_field_ ? *efforts_field_ : *reactions_field_)
+    (pending_.efforts_field ? *pending_.efforts_field : *pending_.reactions_field)
         .fail(
             "no part has mass and no load is applied: every effort would be zero (give parts a mass "
             "or a density, or apply loads)");
   out.parts = std::move(massive);
   out.loads = std::make_shared<const Loads>(scene.loads);
-  out.power = efforts_power_;
+  out.power = pending_.efforts_power;
 }
 
 }  // namespace phiq::detail::scene

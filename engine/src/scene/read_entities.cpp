@@ -24,7 +24,7 @@ void SceneReader::unknown_override(const Cursor& c, const std::string& name) con
   if (overrides_->parameters_source.empty())
     c.fail("'" + name + "' (given for this run) is not a parameter of the scene");
   std::vector<std::string> names;
-  for (const auto& [n, v] : parameters_) names.push_back(n);
+  for (const auto& [n, v] : names_.parameters) names.push_back(n);
   throw SceneError(single_line(overrides_->parameters_source + ": '" + name + "' is not a parameter of " + file_ +
                                parameters_note(names)));
 }
@@ -37,15 +37,15 @@ void SceneReader::read_parameters(const Cursor& c) {
   for (auto& [name, key_mark, value] : c.entries()) {
     if (!valid_name(name)) value.fail("'" + name + "' is not a valid parameter name");
     if (name == "t" || name == "pi") value.fail("'" + name + "' is reserved");
-    parameters_[name] = number(value);  // may use the parameters above it
-    parameter_order_.push_back(name);
+    names_.parameters[name] = number(value);  // may use the parameters above it
+    names_.parameter_order.push_back(name);
     if (overrides_)
       for (const auto& [n, v] : overrides_->parameters)
-        if (n == name) parameters_[name] = v;
+        if (n == name) names_.parameters[name] = v;
   }
   if (overrides_)
     for (const auto& [n, v] : overrides_->parameters)
-      if (!parameters_.count(n)) unknown_override(c, n);
+      if (!names_.parameters.count(n)) unknown_override(c, n);
 }
 
 void SceneReader::read_coordinates(const Cursor& c) {
@@ -56,7 +56,7 @@ void SceneReader::read_coordinates(const Cursor& c) {
   read_map(entries, [&](const std::string& name, const auto& value) {
     if (!valid_name(name)) value.fail("'" + name + "' is not a valid coordinate name");
     if (name == "t" || name == "pi") value.fail("'" + name + "' is reserved");
-    if (parameters_.count(name)) value.fail("'" + name + "' is already a parameter");
+    if (names_.parameters.count(name)) value.fail("'" + name + "' is already a parameter");
     const double v = number(value);
     try {
       builder_.add_coordinate(name, v);  // v is finite: a duplicate name is its only error
@@ -80,7 +80,7 @@ Index SceneReader::new_entity(const C& where, const std::string& name, NameTable
 template <class C, class T>
 Index SceneReader::new_entity3(const C& where, const std::string& name, NameTable<T>& table) {
   if (!valid_name(name)) where.fail("'" + name + "' is not a valid name");
-  const bool taken = points3_.contains(name) || bodies3_.contains(name) || vectors_.contains(name);
+  const bool taken = names_.points3.contains(name) || names_.bodies3.contains(name) || names_.vectors.contains(name);
   const Index k = taken ? -1 : table.add(name);
   if (k < 0) where.fail("duplicate point, body or vector name '" + name + "'");
   return k;
@@ -88,19 +88,19 @@ Index SceneReader::new_entity3(const C& where, const std::string& name, NameTabl
 
 void SceneReader::read_points(const Cursor& c) {
   if (spatial_) {
-    reserve_ = [&](std::size_t more) { points3_.reserve(more); };
+    reserve_ = [&](std::size_t more) { names_.points3.reserve(more); };
     read_map(c.entries(), [&](const std::string& name, const auto& value) {
-      const Index k = new_entity3(value, name, points3_);
+      const Index k = new_entity3(value, name, names_.points3);
       if (value.size() != 3 || !value.is_sequence()) value.fail("a point is [x, y, z] (dimension: 3)");
-      points3_[k] = Point3{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
+      names_.points3[k] = Point3{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
     });
     return;
   }
-  reserve_ = [&](std::size_t more) { points_.reserve(more); };
+  reserve_ = [&](std::size_t more) { names_.points.reserve(more); };
   read_map(c.entries(), [&](const std::string& name, const auto& value) {
-    const Index k = new_entity(value, name, points_, bodies_);
+    const Index k = new_entity(value, name, names_.points, names_.bodies);
     if (value.size() != 2 || !value.is_sequence()) value.fail("a point is [x, y]");
-    points_[k] = Point2{slot(value.at(0)), slot(value.at(1))};
+    names_.points[k] = Point2{slot(value.at(0)), slot(value.at(1))};
   });
 }
 
@@ -202,7 +202,7 @@ void SceneReader::body_from_map(const C& value, const std::string& name, Slot* v
       continue;
     }
     const std::string coordinate = name + "_" + (dimension == 3 ? kSpatial[i] : kPlanar[i]);
-    if (parameters_.count(coordinate)) value.fail("its coordinate '" + coordinate + "' is already a parameter");
+    if (names_.parameters.count(coordinate)) value.fail("its coordinate '" + coordinate + "' is already a parameter");
     try {
       v[i] = Slot::coordinate(builder_.add_coordinate(coordinate, initial[i]));
     } catch (const Error&) {
@@ -217,10 +217,10 @@ void SceneReader::body_from_map(const C& value, const std::string& name, Slot* v
 // a spatial body's Euler normalisation `NAME.euler` is added with it.
 void SceneReader::read_bodies(const Cursor& c) {
   if (spatial_) {
-    reserve_ = [&](std::size_t more) { bodies3_.reserve(more); };
+    reserve_ = [&](std::size_t more) { names_.bodies3.reserve(more); };
     read_map(c.entries(), [&](const std::string& name, const auto& value) {
       if (name == kGround) value.fail("'ground' is predefined (the fixed frame)");
-      const Index k = new_entity3(value, name, bodies3_);
+      const Index k = new_entity3(value, name, names_.bodies3);
       Slot v[7];
       if (value.is_map()) {
         body_from_map(value, name, v, 3);
@@ -231,11 +231,11 @@ void SceneReader::read_bodies(const Cursor& c) {
       }
       Frame3 f{v[0], v[1], v[2], v[3], v[4], v[5], v[6]};
       if (f.is_fixed()) fixed_euler_parameters(value, f);
-      bodies3_[k] = f;
+      names_.bodies3[k] = f;
       if (!f.is_fixed()) {
         try {
           builder_.add_body(name, f);
-          spatial_bodies_.push_back(f);
+          names_.spatial_bodies.push_back(f);
         } catch (const Error& e) {
           value.fail(e.what());
         }
@@ -243,10 +243,10 @@ void SceneReader::read_bodies(const Cursor& c) {
     });
     return;
   }
-  reserve_ = [&](std::size_t more) { bodies_.reserve(more); };
+  reserve_ = [&](std::size_t more) { names_.bodies.reserve(more); };
   read_map(c.entries(), [&](const std::string& name, const auto& value) {
     if (name == kGround) value.fail("'ground' is predefined (the fixed frame)");
-    const Index k = new_entity(value, name, bodies_, points_);
+    const Index k = new_entity(value, name, names_.bodies, names_.points);
     Slot v[3];
     if (value.is_map()) {
       body_from_map(value, name, v, 2);
@@ -255,22 +255,22 @@ void SceneReader::read_bodies(const Cursor& c) {
       for (int i = 0; i < 3; ++i) v[i] = slot(value.at(static_cast<std::size_t>(i)));
     }
     const Frame2 f{v[0], v[1], v[2]};
-    bodies_[k] = f;
+    names_.bodies[k] = f;
     if (f.x.is_coordinate() || f.y.is_coordinate() || f.psi.is_coordinate()) {
       builder_.add_body(name, f);
-      planar_bodies_.push_back(f);
+      names_.planar_bodies.push_back(f);
     }
   });
 }
 
 // Natural unit vectors (dimension 3), each with its unit-norm constraint `NAME.unit`.
 void SceneReader::read_vectors(const Cursor& c) {
-  reserve_ = [&](std::size_t more) { vectors_.reserve(more); };
+  reserve_ = [&](std::size_t more) { names_.vectors.reserve(more); };
   read_map(c.entries(), [&](const std::string& name, const auto& value) {
-    const Index k = new_entity3(value, name, vectors_);
+    const Index k = new_entity3(value, name, names_.vectors);
     if (value.size() != 3 || !value.is_sequence()) value.fail("a vector is [ux, uy, uz]");
     const Point3 u{slot(value.at(0)), slot(value.at(1)), slot(value.at(2))};
-    vectors_[k] = u;
+    names_.vectors[k] = u;
     try {
       builder_.add_unit_vector(name, u);
     } catch (const Error& e) {

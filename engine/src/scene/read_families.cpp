@@ -82,7 +82,7 @@ std::shared_ptr<Family> SceneReader::parse_family(const std::string& key, const 
   const std::string& n = f->index;
   if (!valid_name(n)) fail("'" + n + "' is not a valid index name");
   if (n == "t" || n == "pi") fail("index '" + n + "' is reserved");
-  if (parameters_.count(n)) fail("index '" + n + "' shadows the parameter '" + n + "'");
+  if (names_.parameters.count(n)) fail("index '" + n + "' shadows the parameter '" + n + "'");
   for (const std::string& e : enclosing)
     if (e == n) fail("index '" + n + "' shadows the index of an enclosing family");
   if (builder_.find_coordinate(n) >= 0) fail("index '" + n + "' shadows the coordinate '" + n + "'");

@@ -76,12 +76,12 @@ PartFrame SceneReader::load_frame(const Cursor& c, const Scene& scene) const {
     if (p.name == n) return p.frame;
   PartFrame f = ground_frame();
   if (n == kGround) return f;
-  const Index b = spatial_ ? entry_at(c, n, bodies3_) : entry_at(c, n, bodies_);
+  const Index b = spatial_ ? entry_at(c, n, names_.bodies3) : entry_at(c, n, names_.bodies);
   if (b < 0) c.fail("unknown part '" + n + "' (no part nor body of the scene has that name)");
   if (spatial_)
-    f.spatial = bodies3_[b];
+    f.spatial = names_.bodies3[b];
   else
-    f.planar = bodies_[b];
+    f.planar = names_.bodies[b];
   return f;
 }
 
@@ -145,8 +145,8 @@ TorsionalSpring SceneReader::torsional_spring(const Cursor& s, std::set<std::str
   } else {
     const std::string n = joint.name();
     if (!spatial_) joint.fail("a joint's angle is a spatial joint's; in the plane write the `angle` of coordinates");
-    const auto it = joints3_.find(n);
-    if (it == joints3_.end()) joint.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
+    const auto it = names_.joints3.find(n);
+    if (it == names_.joints3.end()) joint.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
     if (!it->second.traits.measures.angle)
       joint.fail("joint '" + n + "' is a " + it->second.type + ": it has no angle");
     try {

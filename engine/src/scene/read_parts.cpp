@@ -53,7 +53,8 @@ void SceneReader::part_frame(const Cursor& v, const std::string& name, Part& par
   if (body.present() && frame.present()) frame.fail("a part is on a body or has a frame of its own, not both");
   if (frame.present()) return points_or_expression_frame(frame, part);
   const std::string b = body.present() ? body.name() : name;
-  const bool known = b == kGround || (spatial_ ? entry_at(v, b, bodies3_) >= 0 : entry_at(v, b, bodies_) >= 0);
+  const bool known =
+      b == kGround || (spatial_ ? entry_at(v, b, names_.bodies3) >= 0 : entry_at(v, b, names_.bodies) >= 0);
   if (!known) {
     if (body.present()) body.fail("unknown body '" + b + "'");
     v.fail("'" + name + "' is no body: give the part `body: B`, or its own `frame: {...}`");
@@ -62,10 +63,10 @@ void SceneReader::part_frame(const Cursor& v, const std::string& name, Part& par
   const Cursor where = body.present() ? body : v;
   if (spatial_) {
     part.frame.kind = PartFrameKind::kSpatialBody;
-    part.frame.spatial = b == kGround ? Frame3::ground() : bodies3_[entry_at(where, b, bodies3_)];
+    part.frame.spatial = b == kGround ? Frame3::ground() : names_.bodies3[entry_at(where, b, names_.bodies3)];
   } else {
     part.frame.kind = PartFrameKind::kPlanarBody;
-    part.frame.planar = b == kGround ? Frame2{} : bodies_[entry_at(where, b, bodies_)];
+    part.frame.planar = b == kGround ? Frame2{} : names_.bodies[entry_at(where, b, names_.bodies)];
   }
 }
 
@@ -73,7 +74,7 @@ void SceneReader::part_frame(const Cursor& v, const std::string& name, Part& par
 Attachment3 SceneReader::frame_toward(const Cursor& c, bool& is_point) const {
   is_point = true;
   if (spatial_) {
-    if (c.is_scalar() && entry_at(c, c.text(), vectors_) >= 0) {
+    if (c.is_scalar() && entry_at(c, c.text(), names_.vectors) >= 0) {
       is_point = false;
       return Attachment3::natural(vector3(c));
     }

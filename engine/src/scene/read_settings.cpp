@@ -99,8 +99,8 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
       std::set<std::string> seen;
       for (const Cursor& i : ds.items()) {
         const std::string n = i.name();
-        auto it = driver_laws_.find(n);
-        if (it == driver_laws_.end()) i.fail("unknown driver '" + n + "' (a named entry of `drivers`)");
+        auto it = pending_.driver_laws.find(n);
+        if (it == pending_.driver_laws.end()) i.fail("unknown driver '" + n + "' (a named entry of `drivers`)");
         if (!seen.insert(n).second) i.fail("driver listed twice");
         plan.driver_columns.push_back({n, it->second});
       }
@@ -111,7 +111,7 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
         const std::string n = i.name();
         if (!builder_.has_constraint(n)) i.fail("unknown constraint or driver '" + n + "'");
         if (!seen.insert(n).second) i.fail("constraint listed twice");
-        residual_names_.push_back(n);
+        pending_.residual_names.push_back(n);
       }
     }
     if (auto ss = c.field("sensitivities"); ss.present()) output_sensitivities(ss, plan);
@@ -129,7 +129,7 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
     read_output_efforts(c);
     if (auto v = c.field("max_residual"); v.present()) plan.max_residual_column = v.boolean();
     if (auto v = c.field("rcond"); v.present()) plan.condition = v.boolean();
-    plan.residuals = plan.max_residual_column || !residual_names_.empty();
+    plan.residuals = plan.max_residual_column || !pending_.residual_names.empty();
   }
   if (!coordinates_listed)
     for (Index j = 0; j < builder_.num_coordinates(); ++j) plan.coordinate_columns.push_back(j);
@@ -149,8 +149,8 @@ void SceneReader::output_joints(const Cursor& js, OutputPlan& plan) const {
   std::set<std::string> seen;
   for (const Cursor& i : js.items()) {
     const std::string n = i.name();
-    auto it = joints3_.find(n);
-    if (it == joints3_.end()) i.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
+    auto it = names_.joints3.find(n);
+    if (it == names_.joints3.end()) i.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
     if (!seen.insert(n).second) i.fail("joint listed twice");
     const Joint3& J = it->second;
     const JointTraits::Coordinates measures = J.traits.measures;
@@ -185,7 +185,7 @@ void SceneReader::output_orientations(const Cursor& os, OutputPlan& plan) const 
   std::set<std::string> seen;
   for (const Cursor& i : (os.is_map() ? os.require("bodies") : os).items()) {
     const std::string n = i.name();
-    const Index k = entry_at(i, n, bodies3_);
+    const Index k = entry_at(i, n, names_.bodies3);
     if (k < 0) i.fail("unknown body '" + n + "'");
     if (!seen.insert(n).second) i.fail("body listed twice");
     if (plan.orientation_form.form == "axis_angle")
@@ -194,7 +194,7 @@ void SceneReader::output_orientations(const Cursor& os, OutputPlan& plan) const 
           i.fail("the columns '" + n + ".angle' of joint '" + n +
                  "' and of this body's axis and angle would share a "
                  "name: write the orientation in another form, or rename one");
-    const Frame3& f = bodies3_[k];
+    const Frame3& f = names_.bodies3[k];
     plan.orientations.push_back(OutputOrientation{n, {f.e0, f.e1, f.e2, f.e3}});
   }
 }
@@ -205,9 +205,9 @@ OutputPoint SceneReader::output_point(const Cursor& c) const {
   if (spatial_) {
     if (!c.is_map()) {
       const std::string n = c.name();
-      const Index k = entry_at(c, n, points3_);
+      const Index k = entry_at(c, n, names_.points3);
       if (k < 0) c.fail("unknown point '" + n + "' (or write {name: P, body: B, at: [x, y, z]})");
-      return spatial_point(n, points3_[k]);
+      return spatial_point(n, names_.points3[k]);
     }
     c.expect_map({"name", "body", "at"});
     const std::string n = c.require("name").name();
@@ -219,9 +219,9 @@ OutputPoint SceneReader::output_point(const Cursor& c) const {
   }
   if (!c.is_map()) {
     const std::string n = c.name();
-    const Index k = entry_at(c, n, points_);
+    const Index k = entry_at(c, n, names_.points);
     if (k < 0) c.fail("unknown point '" + n + "' (or write {name: P, body: B, at: [x, y]})");
-    return planar_point(n, points_[k]);
+    return planar_point(n, names_.points[k]);
   }
   c.expect_map({"name", "body", "at"});
   const std::string n = c.require("name").name();
@@ -234,13 +234,13 @@ OutputPoint SceneReader::output_point(const Cursor& c) const {
 
 // Constraint names of `output: residuals` to indices, once the model is built (one pass over the constraints).
 void SceneReader::resolve_output_residuals(Scene& scene) const {
-  if (residual_names_.empty()) return;
+  if (pending_.residual_names.empty()) return;
   std::unordered_map<std::string, Index> wanted;
-  for (const std::string& n : residual_names_) wanted.emplace(n, -1);
+  for (const std::string& n : pending_.residual_names) wanted.emplace(n, -1);
   const auto& cs = scene.model->constraints();
   for (std::size_t k = 0; k < cs.size(); ++k)
     if (auto it = wanted.find(cs[k].name); it != wanted.end()) it->second = static_cast<Index>(k);
-  for (const std::string& n : residual_names_) scene.sweep.residual_columns.push_back(wanted.at(n));
+  for (const std::string& n : pending_.residual_names) scene.sweep.residual_columns.push_back(wanted.at(n));
 }
 
 void SceneReader::read_solver(const Cursor& c, SolverSettings& o) {
@@ -281,7 +281,7 @@ void SceneReader::read_solver(const Cursor& c, SolverSettings& o) {
     else
       v.fail("linear_solver is umfpack, klu or dense");
   }
-  predictor_field_ = c.field("predictor").present();
+  pending_.predictor_given = c.field("predictor").present();
 }
 
 }  // namespace phiq::detail::scene
@@ -299,10 +299,10 @@ void SceneReader::output_sensitivities(const Cursor& c, OutputPlan& plan) {
     const Cursor step = i.is_map() ? i.field("step") : Cursor(YAML::Node(), i.join("step"), i.file(), i.mark());
     OutputSensitivity s;
     s.name = name.name();
-    const auto it = parameters_.find(s.name);
-    if (it == parameters_.end()) {
+    const auto it = names_.parameters.find(s.name);
+    if (it == names_.parameters.end()) {
       std::vector<std::string> names;
-      for (const auto& [n, v] : parameters_) names.push_back(n);
+      for (const auto& [n, v] : names_.parameters) names.push_back(n);
       name.fail("'" + s.name + "' is not a parameter of the scene" + parameters_note(names));
     }
     if (!seen.insert(s.name).second) name.fail("parameter '" + s.name + "' listed twice");

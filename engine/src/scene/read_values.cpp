@@ -10,8 +10,8 @@
 namespace phiq::detail::scene {
 
 std::optional<double> SceneReader::parameter(const std::string& name) const {
-  auto it = parameters_.find(name);
-  if (it == parameters_.end()) return std::nullopt;
+  auto it = names_.parameters.find(name);
+  if (it == names_.parameters.end()) return std::nullopt;
   return it->second;
 }
 

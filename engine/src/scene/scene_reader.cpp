@@ -25,7 +25,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   if (overrides_ && overrides_->share_analysis_with) builder_.share_analysis_with(*overrides_->share_analysis_with);
   if (auto d = top.field("dimension"); d.present()) spatial_ = d.integer(2, 3) == 3;
   read_parameters(top.field("parameters"));
-  for (const std::string& n : parameter_order_) scene.parameters.emplace_back(n, parameters_.at(n));
+  for (const std::string& n : names_.parameter_order) scene.parameters.emplace_back(n, names_.parameters.at(n));
   check_family_total(top);  // the parameters give the ranges of the families in the sections
   read_coordinates(top.field("coordinates"));
   try {
@@ -53,11 +53,11 @@ Scene SceneReader::read(const YAML::Node& root) {
   read_output(top.field("output"), scene.sweep);
   if (auto o = top.field("output"); o.present() && o.is_map()) read_clearance(o.field("clearance"), scene);
   scene.dimension = spatial_ ? 3 : 2;
-  scene.planar_bodies = std::move(planar_bodies_), scene.spatial_bodies = std::move(spatial_bodies_);
-  scene.joint_angles = std::move(joint_angles_);
-  points_ = {}, bodies_ = {};  // not needed any more: their memory is free for the model
-  driver_laws_ = {};
-  points3_ = {}, bodies3_ = {}, vectors_ = {}, joints3_.clear();
+  scene.planar_bodies = std::move(names_.planar_bodies), scene.spatial_bodies = std::move(names_.spatial_bodies);
+  scene.joint_angles = std::move(names_.joint_angles);
+  names_.points = {}, names_.bodies = {};  // not needed any more: their memory is free for the model
+  pending_.driver_laws = {};
+  names_.points3 = {}, names_.bodies3 = {}, names_.vectors = {}, names_.joints3.clear();
 
   try {
     scene.model = std::make_unique<Model>(std::move(builder_).build());

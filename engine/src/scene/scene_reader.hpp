@@ -58,7 +58,7 @@ class SceneReader {
  public:
   SceneReader(const std::string& file, const SceneLimits& limits) : file_(file), limits_(limits) {
     families_.file = &file_;
-    families_.parameters = &parameters_;
+    families_.parameters = &names_.parameters;
     families_.budget = limits.max_family_instances;
   }
 
@@ -234,41 +234,45 @@ class SceneReader {
   const SceneOverrides* overrides_ = nullptr;  ///< the caller's changes, if any
 
  private:
-  std::unordered_map<std::string, double> parameters_;
-  std::vector<std::string> parameter_order_;  ///< the parameters' names in file order (Scene::parameters)
-  NameTable<Point2> points_;
-  NameTable<Frame2> bodies_;
-  bool spatial_ = false;  // dimension: 3
-  NameTable<Point3> points3_;
-  NameTable<Frame3> bodies3_;
-  // the frames of the moving bodies, in the order of ModelBuilder::add_body() (Scene::planar_bodies)
-  std::vector<Frame2> planar_bodies_;
-  std::vector<Frame3> spatial_bodies_;
-  NameTable<Point3> vectors_;
-  // Named spatial joints, for the drivers, outputs and shafts that refer to them: what each offers is its kind's
-  // JointTraits (kinds/registry.hpp lists the types each accepts).
-  struct Joint3 {
+  // The scene's named entities, which later sections and the outputs refer to.
+  struct Joint3 {  // a named spatial joint; what it offers is its kind's JointTraits (kinds/registry.hpp)
     std::string type;
     JointTraits traits;
     JointSide3 a, b;
   };
-  std::unordered_map<std::string, Joint3> joints3_;
-  std::vector<JointAngleReference> joint_angles_;  // Scene::joint_angles
+  struct Names {
+    std::unordered_map<std::string, double> parameters;
+    std::vector<std::string> parameter_order;  // file order (Scene::parameters)
+    NameTable<Point2> points;
+    NameTable<Frame2> bodies;
+    NameTable<Point3> points3;
+    NameTable<Frame3> bodies3;
+    NameTable<Point3> vectors;
+    // the frames of the moving bodies, in the order of ModelBuilder::add_body() (Scene::planar_bodies)
+    std::vector<Frame2> planar_bodies;
+    std::vector<Frame3> spatial_bodies;
+    std::unordered_map<std::string, Joint3> joints3;  // for the drivers, outputs and shafts that name them
+    std::vector<JointAngleReference> joint_angles;    // Scene::joint_angles
+  };
+  Names names_;
+  bool spatial_ = false;  // dimension: 3
   Families families_;
   std::function<void(std::size_t)> reserve_;  // room for that many more entries of the section being read
-  bool predictor_field_ = false;
-  std::unordered_map<std::string, MotionLaw> driver_laws_;  // named drivers, for `output: drivers`
-  std::vector<std::string> residual_names_;                 // `output: residuals`, resolved after the build
-  // `output: efforts` (the field; its items when it lists names) and `power`, resolved after the build
-  std::optional<Cursor> efforts_field_;
-  std::vector<Cursor> effort_items_;
-  bool efforts_power_ = false;
-  // `output: reactions` (the field; its items when it lists names), resolved after the build
-  std::optional<Cursor> reactions_field_;
-  std::vector<Cursor> reaction_items_;
+  // What `output` and `solver` ask of things the build makes, resolved after it.
+  struct Pending {
+    bool predictor_given = false;                            // `solver: predictor` was given
+    std::unordered_map<std::string, MotionLaw> driver_laws;  // named drivers, for `output: drivers`
+    std::vector<std::string> residual_names;                 // `output: residuals`
+    std::optional<Cursor> efforts_field;                     // `output: efforts` (its items when it lists names)
+    std::vector<Cursor> effort_items;
+    bool efforts_power = false;             // and `power`
+    std::optional<Cursor> reactions_field;  // `output: reactions` (its items when it lists names)
+    std::vector<Cursor> reaction_items;
+  };
+  Pending pending_;
 
  public:
-  bool predictor_given() const { return predictor_field_; }
+  bool predictor_given() const { return pending_.predictor_given; }
 };
 
 // Defined here, not in a .cpp: it is instantiated for every Spec of every constraint and driver kind.
