@@ -1,4 +1,4 @@
-// The `loads` section (scene_reader.hpp, models/README.md "Loads"): gravity, and the applied forces, torques,
+// The `loads` section (part_reader.hpp, models/README.md "Loads"): gravity, and the applied forces, torques,
 // linear and torsional spring-dampers (phiq/applied_loads.hpp), on the scene's parts or on its bodies. Read after
 // the parts, whose frames the loads act on.
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/text.hpp"
-#include "scene/scene_reader.hpp"
+#include "scene/part_reader.hpp"
 
 namespace phiq::detail::scene {
 
@@ -23,11 +23,11 @@ std::string load_name(const Cursor& c, std::set<std::string>& names) {
 
 }  // namespace
 
-void SceneReader::read_loads(const Cursor& c, Scene& scene) const {
+void PartReader::read_loads(const Cursor& c, Scene& scene) const {
   c.expect_map({"gravity", "forces", "torques", "springs", "torsional_springs"});
   if (auto g = c.field("gravity"); g.present()) {
-    const std::vector<double> v = numbers(g, spatial_ ? 3 : 2);
-    scene.loads.gravity = {v[0], v[1], spatial_ ? v[2] : 0.0};
+    const std::vector<double> v = r_.numbers(g, r_.spatial_ ? 3 : 2);
+    scene.loads.gravity = {v[0], v[1], r_.spatial_ ? v[2] : 0.0};
   }
   auto applied = std::make_shared<AppliedLoads>();
   std::set<std::string> names;
@@ -54,11 +54,11 @@ void SceneReader::read_loads(const Cursor& c, Scene& scene) const {
       torque.frame = load_frame(part, scene);
       torque.axes = load_axes(m.field("axes"));
       const Cursor value = m.require("torque");
-      if (spatial_) {
+      if (r_.spatial_) {
         torque.components = load_components(value, "torque");
       } else {
         if (!value.is_scalar()) value.fail("a torque in the plane is one number or expression (about z)");
-        torque.components[2] = compile(value, true);
+        torque.components[2] = r_.compile(value, true);
       }
       applied->torques.push_back(std::move(torque));
     }
@@ -70,50 +70,50 @@ void SceneReader::read_loads(const Cursor& c, Scene& scene) const {
 }
 
 // The frame of the part, body or ground that `c` names: a part of the scene first, else a body's own frame.
-PartFrame SceneReader::load_frame(const Cursor& c, const Scene& scene) const {
+PartFrame PartReader::load_frame(const Cursor& c, const Scene& scene) const {
   const std::string n = c.name();
   for (const Part& p : scene.parts)
     if (p.name == n) return p.frame;
   PartFrame f = ground_frame();
   if (n == kGround) return f;
-  const Index b = spatial_ ? entry_at(c, n, names_.bodies3) : entry_at(c, n, names_.bodies);
+  const Index b = r_.spatial_ ? r_.entry_at(c, n, r_.names_.bodies3) : r_.entry_at(c, n, r_.names_.bodies);
   if (b < 0) c.fail("unknown part '" + n + "' (no part nor body of the scene has that name)");
-  if (spatial_)
-    f.spatial = names_.bodies3[b];
+  if (r_.spatial_)
+    f.spatial = r_.names_.bodies3[b];
   else
-    f.planar = names_.bodies[b];
+    f.planar = r_.names_.bodies[b];
   return f;
 }
 
-PartFrame SceneReader::ground_frame() const {
+PartFrame PartReader::ground_frame() const {
   PartFrame f;
-  f.kind = spatial_ ? PartFrameKind::kSpatialBody : PartFrameKind::kPlanarBody;
-  if (spatial_) f.spatial = Frame3::ground();
+  f.kind = r_.spatial_ ? PartFrameKind::kSpatialBody : PartFrameKind::kPlanarBody;
+  if (r_.spatial_) f.spatial = Frame3::ground();
   return f;
 }
 
 // A point or vector of constants, [x, y] in the plane, [x, y, z] in space.
-kin3::V3 SceneReader::load_vector(const Cursor& c, const char* what) const {
-  const std::size_t n = spatial_ ? 3 : 2;
+kin3::V3 PartReader::load_vector(const Cursor& c, const char* what) const {
+  const std::size_t n = r_.spatial_ ? 3 : 2;
   if (!c.is_sequence() || c.size() != n)
-    c.fail(std::string(what) + " is " + (spatial_ ? "[x, y, z]" : "[x, y]") + " (numbers or constant expressions)");
-  const std::vector<double> v = numbers(c, n);
-  return {v[0], v[1], spatial_ ? v[2] : 0.0};
+    c.fail(std::string(what) + " is " + (r_.spatial_ ? "[x, y, z]" : "[x, y]") + " (numbers or constant expressions)");
+  const std::vector<double> v = r_.numbers(c, n);
+  return {v[0], v[1], r_.spatial_ ? v[2] : 0.0};
 }
 
 // A vector of expressions of t, the coordinates and the parameters; the plane's has no z.
-std::array<std::shared_ptr<const CompiledExpression>, 3> SceneReader::load_components(const Cursor& c,
-                                                                                      const char* what) const {
-  const std::size_t n = spatial_ ? 3 : 2;
+std::array<std::shared_ptr<const CompiledExpression>, 3> PartReader::load_components(const Cursor& c,
+                                                                                     const char* what) const {
+  const std::size_t n = r_.spatial_ ? 3 : 2;
   if (!c.is_sequence() || c.size() != n)
-    c.fail(std::string(what) + " is " + (spatial_ ? "[x, y, z]" : "[x, y]") +
+    c.fail(std::string(what) + " is " + (r_.spatial_ ? "[x, y, z]" : "[x, y]") +
            " (numbers or expressions of t, the coordinates and the parameters)");
   std::array<std::shared_ptr<const CompiledExpression>, 3> out;
-  for (std::size_t k = 0; k < n; ++k) out[k] = compile(c.at(k), true);
+  for (std::size_t k = 0; k < n; ++k) out[k] = r_.compile(c.at(k), true);
   return out;
 }
 
-LoadAxes SceneReader::load_axes(const Cursor& c) const {
+LoadAxes PartReader::load_axes(const Cursor& c) const {
   if (!c.present()) return LoadAxes::kWorld;
   const std::string s = c.text();
   if (s == "world") return LoadAxes::kWorld;
@@ -121,15 +121,15 @@ LoadAxes SceneReader::load_axes(const Cursor& c) const {
   c.fail("axes is world or part, got '" + s + "'");
 }
 
-double SceneReader::non_negative(const Cursor& c) const {
-  const double v = number(c);
+double PartReader::non_negative(const Cursor& c) const {
+  const double v = r_.number(c);
   if (v < 0.0) c.fail("must not be negative, got " + c.text());
   return v;
 }
 
 // A torsional spring-damper on `coordinate: NAME`, `angle: EXPRESSION` of the coordinates, or a spatial `joint`'s
 // angle.
-TorsionalSpring SceneReader::torsional_spring(const Cursor& s, std::set<std::string>& names) const {
+TorsionalSpring PartReader::torsional_spring(const Cursor& s, std::set<std::string>& names) const {
   s.expect_map({"name", "coordinate", "angle", "joint", "stiffness", "free_angle", "damping"});
   TorsionalSpring spring;
   spring.name = load_name(s, names);
@@ -137,16 +137,16 @@ TorsionalSpring SceneReader::torsional_spring(const Cursor& s, std::set<std::str
   if (on_coordinate.present() + angle.present() + joint.present() != 1)
     s.fail("a torsional spring acts on one of `coordinate: NAME`, `angle: EXPRESSION` or `joint: NAME`");
   if (on_coordinate.present()) {
-    const std::string n = builder_.coordinate_name(coordinate(on_coordinate));
-    spring.angle = CompiledExpression::compile(n, resolver(true, n), false);
+    const std::string n = r_.builder_.coordinate_name(r_.coordinate(on_coordinate));
+    spring.angle = CompiledExpression::compile(n, r_.resolver(true, n), false);
   } else if (angle.present()) {
-    spring.angle = compile(angle, false);
+    spring.angle = r_.compile(angle, false);
     if (spring.angle->coordinates().empty()) angle.fail("the angle reads no coordinate: the spring exerts nothing");
   } else {
     const std::string n = joint.name();
-    if (!spatial_) joint.fail("a joint's angle is a spatial joint's; in the plane write the `angle` of coordinates");
-    const auto it = names_.joints3.find(n);
-    if (it == names_.joints3.end()) joint.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
+    if (!r_.spatial_) joint.fail("a joint's angle is a spatial joint's; in the plane write the `angle` of coordinates");
+    const auto it = r_.names_.joints3.find(n);
+    if (it == r_.names_.joints3.end()) joint.fail("unknown joint '" + n + "' (a named spatial joint of 'constraints')");
     if (!it->second.traits.measures.angle)
       joint.fail("joint '" + n + "' is a " + it->second.type + ": it has no angle");
     try {
@@ -164,13 +164,13 @@ TorsionalSpring SceneReader::torsional_spring(const Cursor& s, std::set<std::str
     spring.joint_coordinates.assign(read.begin(), read.end());
   }
   spring.stiffness = non_negative(s.require("stiffness"));
-  if (auto a0 = s.field("free_angle"); a0.present()) spring.free_angle = number(a0);
+  if (auto a0 = s.field("free_angle"); a0.present()) spring.free_angle = r_.number(a0);
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
   return spring;
 }
 
 // A linear spring-damper: `between: [END, END]`, each {part: P, at: [..]} or {point: [..]} (fixed in the world).
-LinearSpring SceneReader::linear_spring(const Cursor& s, const Scene& scene, std::set<std::string>& names) const {
+LinearSpring PartReader::linear_spring(const Cursor& s, const Scene& scene, std::set<std::string>& names) const {
   s.expect_map({"name", "between", "stiffness", "free_length", "damping", "preload"});
   LinearSpring spring;
   spring.name = load_name(s, names);
@@ -200,7 +200,7 @@ LinearSpring SceneReader::linear_spring(const Cursor& s, const Scene& scene, std
   spring.stiffness = non_negative(s.require("stiffness"));
   spring.free_length = non_negative(s.require("free_length"));
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
-  if (auto p = s.field("preload"); p.present()) spring.preload = number(p);
+  if (auto p = s.field("preload"); p.present()) spring.preload = r_.number(p);
   return spring;
 }
 

@@ -1,11 +1,11 @@
-// The `parts` section (scene_reader.hpp, models/README.md "Parts"): each part a frame on a body, natural points and
+// The `parts` section (part_reader.hpp, models/README.md "Parts"): each part a frame on a body, natural points and
 // vectors, or expressions of the coordinates; its shapes (read_shapes.cpp); its mass, stated or from a density.
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
 
 #include "phiq/text.hpp"
-#include "scene/scene_reader.hpp"
+#include "scene/part_reader.hpp"
 
 namespace phiq::detail::scene {
 
@@ -16,7 +16,7 @@ constexpr double kSymmetryTolerance = 1e-9;
 
 }  // namespace
 
-void SceneReader::read_parts(const Cursor& c, Scene& scene) {
+void PartReader::read_parts(const Cursor& c, Scene& scene) const {
   if (!c.is_map()) c.fail("parts is a map NAME: {body: B, shapes: [...], mass: ...}");
   for (const Cursor::Entry& e : c.entries()) {
     const Cursor& v = e.value;
@@ -39,7 +39,7 @@ void SceneReader::read_parts(const Cursor& c, Scene& scene) {
   }
 }
 
-bool SceneReader::frame_depends_on_time(const PartFrame& f) {
+bool PartReader::frame_depends_on_time(const PartFrame& f) {
   bool t = f.angle && f.angle->depends_on_time();
   for (const auto& e : f.at) t = t || e->depends_on_time();
   return t;
@@ -47,69 +47,69 @@ bool SceneReader::frame_depends_on_time(const PartFrame& f) {
 
 // The part's frame: `body: B` (default: the body named as the part), `frame: {origin: P, x: Q|u, y: R|v}` (natural
 // coordinates), or `frame: {at: P | [x, y(, z)], angle: A, axis: [..]}` (expressions of the coordinates).
-void SceneReader::part_frame(const Cursor& v, const std::string& name, Part& part) const {
+void PartReader::part_frame(const Cursor& v, const std::string& name, Part& part) const {
   const auto body = v.field("body");
   const auto frame = v.field("frame");
   if (body.present() && frame.present()) frame.fail("a part is on a body or has a frame of its own, not both");
   if (frame.present()) return points_or_expression_frame(frame, part);
   const std::string b = body.present() ? body.name() : name;
-  const bool known =
-      b == kGround || (spatial_ ? entry_at(v, b, names_.bodies3) >= 0 : entry_at(v, b, names_.bodies) >= 0);
+  const bool known = b == kGround || (r_.spatial_ ? r_.entry_at(v, b, r_.names_.bodies3) >= 0
+                                                  : r_.entry_at(v, b, r_.names_.bodies) >= 0);
   if (!known) {
     if (body.present()) body.fail("unknown body '" + b + "'");
     v.fail("'" + name + "' is no body: give the part `body: B`, or its own `frame: {...}`");
   }
   part.body = b;
   const Cursor where = body.present() ? body : v;
-  if (spatial_) {
+  if (r_.spatial_) {
     part.frame.kind = PartFrameKind::kSpatialBody;
-    part.frame.spatial = b == kGround ? Frame3::ground() : names_.bodies3[entry_at(where, b, names_.bodies3)];
+    part.frame.spatial = b == kGround ? Frame3::ground() : r_.names_.bodies3[r_.entry_at(where, b, r_.names_.bodies3)];
   } else {
     part.frame.kind = PartFrameKind::kPlanarBody;
-    part.frame.planar = b == kGround ? Frame2{} : names_.bodies[entry_at(where, b, names_.bodies)];
+    part.frame.planar = b == kGround ? Frame2{} : r_.names_.bodies[r_.entry_at(where, b, r_.names_.bodies)];
   }
 }
 
 // An attachment a frame's axis points along: a point (a name or inline), or in space a natural unit vector's name.
-Attachment3 SceneReader::frame_toward(const Cursor& c, bool& is_point) const {
+Attachment3 PartReader::frame_toward(const Cursor& c, bool& is_point) const {
   is_point = true;
-  if (spatial_) {
-    if (c.is_scalar() && entry_at(c, c.text(), names_.vectors) >= 0) {
+  if (r_.spatial_) {
+    if (c.is_scalar() && r_.entry_at(c, c.text(), r_.names_.vectors) >= 0) {
       is_point = false;
-      return Attachment3::natural(vector3(c));
+      return Attachment3::natural(r_.vector3(c));
     }
-    return Attachment3::natural(point3(c));
+    return Attachment3::natural(r_.point3(c));
   }
-  const Point2 p = point(c);
+  const Point2 p = r_.point(c);
   return Attachment3::natural(Point3{p.x, p.y, Slot::constant(0.0)});
 }
 
-void SceneReader::points_or_expression_frame(const Cursor& f, Part& part) const {
+void PartReader::points_or_expression_frame(const Cursor& f, Part& part) const {
   if (!f.is_map()) f.fail("a frame is {origin: P, x: Q, y: R} (points, vectors) or {at: P, angle: A} (expressions)");
   PartFrame& pf = part.frame;
   if (f.field("origin").present()) {
-    if (spatial_)
+    if (r_.spatial_)
       f.expect_map({"origin", "x", "y"});
     else
       f.expect_map({"origin", "x"});
     pf.kind = PartFrameKind::kPoints;
-    pf.spatial_frame = spatial_;
+    pf.spatial_frame = r_.spatial_;
     bool origin_point = true;
     pf.origin = frame_toward(f.require("origin"), origin_point);
     if (!origin_point) f.field("origin").fail("the origin is a point, not a vector");
     pf.x_toward = frame_toward(f.require("x"), pf.x_is_point);
-    if (spatial_) pf.y_toward = frame_toward(f.require("y"), pf.y_is_point);
+    if (r_.spatial_) pf.y_toward = frame_toward(f.require("y"), pf.y_is_point);
     part.body = "frame of points";
     return;
   }
-  if (spatial_)
+  if (r_.spatial_)
     f.expect_map({"at", "angle", "axis"});
   else
     f.expect_map({"at", "angle"});
   pf.kind = PartFrameKind::kExpressions;
-  pf.spatial_frame = spatial_;
+  pf.spatial_frame = r_.spatial_;
   const auto at = f.require("at");
-  const std::size_t n = spatial_ ? 3 : 2;
+  const std::size_t n = r_.spatial_ ? 3 : 2;
   if (at.is_scalar()) {  // a point's name: its components as expressions of its slots
     bool is_point = true;
     const Attachment3 p = frame_toward(at, is_point);
@@ -117,22 +117,22 @@ void SceneReader::points_or_expression_frame(const Cursor& f, Part& part) const 
     for (std::size_t k = 0; k < n; ++k) pf.at.push_back(slot_expression(at, p.r[k]));
   } else {
     if (!at.is_sequence() || at.size() != n)
-      at.fail(spatial_ ? "at is a point or [x, y, z] (expressions)" : "at is a point or [x, y] (expressions)");
-    for (std::size_t k = 0; k < n; ++k) pf.at.push_back(compile(at.at(k), true));
+      at.fail(r_.spatial_ ? "at is a point or [x, y, z] (expressions)" : "at is a point or [x, y] (expressions)");
+    for (std::size_t k = 0; k < n; ++k) pf.at.push_back(r_.compile(at.at(k), true));
   }
-  if (auto a = f.field("angle"); a.present()) pf.angle = compile(a, true);
+  if (auto a = f.field("angle"); a.present()) pf.angle = r_.compile(a, true);
   if (auto ax = f.field("axis"); ax.present()) {
-    kin3::V3 u = direction3(ax);
+    kin3::V3 u = r_.direction3(ax);
     pf.axis = (1.0 / kin3::norm(u)) * u;
   }
   part.body = "frame of expressions";
 }
 
 // A slot as an expression: a coordinate's name, or its constant.
-std::shared_ptr<const CompiledExpression> SceneReader::slot_expression(const Cursor& c, const Slot& s) const {
-  const std::string text = s.is_coordinate() ? builder_.coordinate_name(s.coord()) : shortest(s.value());
+std::shared_ptr<const CompiledExpression> PartReader::slot_expression(const Cursor& c, const Slot& s) const {
+  const std::string text = s.is_coordinate() ? r_.builder_.coordinate_name(s.coord()) : shortest(s.value());
   try {
-    return CompiledExpression::compile(text, resolver(true, text), true);
+    return CompiledExpression::compile(text, r_.resolver(true, text), true);
   } catch (const Error& e) {
     c.fail(e.what());
   }
@@ -140,7 +140,7 @@ std::shared_ptr<const CompiledExpression> SceneReader::slot_expression(const Cur
 
 // `mass` with `center_of_mass` and `inertia` (planar: Izz about the centre; spatial: [Ixx, Iyy, Izz], six values
 // [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3×3 matrix, about the centre in body axes), or `density` over the shapes.
-void SceneReader::part_mass(const Cursor& v, Part& part) const {
+void PartReader::part_mass(const Cursor& v, Part& part) const {
   const auto mass = v.field("mass"), density = v.field("density");
   const auto com = v.field("center_of_mass"), inertia = v.field("inertia");
   if (mass.present() && density.present()) density.fail("give a part's mass or its density, not both");
@@ -149,18 +149,18 @@ void SceneReader::part_mass(const Cursor& v, Part& part) const {
     if (inertia.present()) inertia.fail("an inertia needs the part's `mass` (or give its `density`)");
   }
   if (density.present()) {
-    part.density = positive(density);
+    part.density = r_.positive(density);
     part.mass = shapes_mass(density, part, part.density);
     part.mass_source = MassSource::kDensity;
     return;
   }
   if (!mass.present()) return;
   part.mass_source = MassSource::kStated;
-  part.mass.mass = positive(mass);
+  part.mass.mass = r_.positive(mass);
   if (inertia.present()) part.mass.inertia = inertia_tensor(inertia);
   if (com.present()) {
-    const std::vector<double> c3 = numbers(com, spatial_ ? 3 : 2);
-    part.mass.center = {c3[0], c3[1], spatial_ ? c3[2] : 0.0};
+    const std::vector<double> c3 = r_.numbers(com, r_.spatial_ ? 3 : 2);
+    part.mass.center = {c3[0], c3[1], r_.spatial_ ? c3[2] : 0.0};
   }
   if (com.present() && inertia.present()) return;
   // what the stated fields leave out comes from the shapes at uniform density: their centroid, their inertia scaled
@@ -171,7 +171,7 @@ void SceneReader::part_mass(const Cursor& v, Part& part) const {
 }
 
 // The mass properties of the part's solid shapes at `density`, refused at `c` when it has none with a volume.
-MassProperties SceneReader::shapes_mass(const Cursor& c, const Part& part, double density) const {
+MassProperties PartReader::shapes_mass(const Cursor& c, const Part& part, double density) const {
   std::vector<MassProperties> each;
   for (std::size_t k = 0; k < part.shapes.size(); ++k) {
     const Shape& s = part.shapes[k];
@@ -190,19 +190,19 @@ MassProperties SceneReader::shapes_mass(const Cursor& c, const Part& part, doubl
 
 // A stated inertia tensor, checked symmetric and positive definite, with the triangle inequality of its principal
 // moments (a physical body: each at most the sum of the other two).
-std::array<double, 9> SceneReader::inertia_tensor(const Cursor& c) const {
+std::array<double, 9> PartReader::inertia_tensor(const Cursor& c) const {
   std::array<double, 9> I{};
-  if (!spatial_) {
-    I[8] = positive(c);  // Izz; a planar body turns about z only
+  if (!r_.spatial_) {
+    I[8] = r_.positive(c);  // Izz; a planar body turns about z only
     return I;
   }
   if (c.is_sequence() && c.size() == 3 && c.at(0).is_sequence()) {
     for (std::size_t i = 0; i < 3; ++i) {
-      const std::vector<double> row = numbers(c.at(i), 3);
+      const std::vector<double> row = r_.numbers(c.at(i), 3);
       for (std::size_t j = 0; j < 3; ++j) I[3 * i + j] = row[j];
     }
   } else if (c.is_sequence() && (c.size() == 3 || c.size() == 6)) {
-    const std::vector<double> v = numbers(c, 0);
+    const std::vector<double> v = r_.numbers(c, 0);
     I[0] = v[0], I[4] = v[1], I[8] = v[2];
     if (v.size() == 6) I[1] = I[3] = v[3], I[2] = I[6] = v[4], I[5] = I[7] = v[5];
   } else {

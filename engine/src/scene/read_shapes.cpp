@@ -1,4 +1,4 @@
-// A part's shapes (scene_reader.hpp): `parts.NAME.shapes[k]`, one map per shape, its type deciding its fields
+// A part's shapes (part_reader.hpp): `parts.NAME.shapes[k]`, one map per shape, its type deciding its fields
 // (models/README.md, Parts). Sizes are positive numbers or constant expressions; a mesh file is read relative to the
 // scene's folder.
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "phiq/text.hpp"
-#include "scene/scene_reader.hpp"
+#include "scene/part_reader.hpp"
 
 namespace phiq::detail::scene {
 
@@ -31,7 +31,7 @@ RotationMatrix about_z(double a) {
 }  // namespace
 
 // `colour: [r, g, b]` or `[r, g, b, a]`, each in [0, 1], or "#rrggbb".
-std::array<double, 4> SceneReader::colour(const Cursor& c) const {
+std::array<double, 4> PartReader::colour(const Cursor& c) const {
   std::array<double, 4> rgba{0, 0, 0, 1};
   if (c.is_scalar()) {
     const std::string s = c.text();
@@ -44,7 +44,7 @@ std::array<double, 4> SceneReader::colour(const Cursor& c) const {
   if (!c.is_sequence() || (c.size() != 3 && c.size() != 4))
     c.fail("a colour is [r, g, b], [r, g, b, a] (each from 0 to 1) or \"#rrggbb\"");
   for (std::size_t k = 0; k < c.size(); ++k) {
-    const double v = number(c.at(k));
+    const double v = r_.number(c.at(k));
     if (!(v >= 0.0 && v <= 1.0)) c.at(k).fail("a colour component is from 0 to 1");
     rgba[k] = v;
   }
@@ -52,17 +52,17 @@ std::array<double, 4> SceneReader::colour(const Cursor& c) const {
 }
 
 // A list of `n`-component points ([x, y] or [x, y, z]) of at least `least` entries.
-std::vector<kin3::V3> SceneReader::shape_points(const Cursor& c, std::size_t n, std::size_t least) const {
+std::vector<kin3::V3> PartReader::shape_points(const Cursor& c, std::size_t n, std::size_t least) const {
   if (!c.is_sequence() || c.size() < least) c.fail("expected a list of at least " + std::to_string(least) + " points");
   std::vector<kin3::V3> out;
   for (const Cursor& p : c.items()) {
-    const std::vector<double> v = numbers(p, n);
+    const std::vector<double> v = r_.numbers(p, n);
     out.push_back({v[0], v[1], n == 3 ? v[2] : 0.0});
   }
   return out;
 }
 
-Shape SceneReader::read_shape(const Cursor& c) const {
+Shape PartReader::read_shape(const Cursor& c) const {
   if (!c.is_map()) c.fail("a shape is a map {type: box|cylinder|..., ...}");
   const std::string type = c.require("type").text();
   const ShapeKind* kind = nullptr;
@@ -71,7 +71,7 @@ Shape SceneReader::read_shape(const Cursor& c) const {
   if (!kind) c.field("type").fail("unknown shape type '" + type + "' (the types: " + shape_type_list() + ")");
   Shape s;
   s.kind = *kind;
-  const char* placement = spatial_ ? "orientation" : "angle";
+  const char* placement = r_.spatial_ ? "orientation" : "angle";
   switch (s.kind) {
     case ShapeKind::kBox:
       c.expect_map({"type", "name", "colour", "at", placement, "size"});
@@ -102,15 +102,15 @@ Shape SceneReader::read_shape(const Cursor& c) const {
   if (auto n = c.field("name"); n.present()) s.name = n.name();
   if (auto k = c.field("colour"); k.present()) s.colour = colour(k);
   if (auto a = c.field("at"); a.present()) {
-    const std::vector<double> v = numbers(a, spatial_ ? 3 : 2);
-    s.at = {v[0], v[1], spatial_ ? v[2] : 0.0};
+    const std::vector<double> v = r_.numbers(a, r_.spatial_ ? 3 : 2);
+    s.at = {v[0], v[1], r_.spatial_ ? v[2] : 0.0};
   }
   if (auto o = c.field(placement); o.present()) {
-    if (spatial_) {
-      const EulerParameters e = orientation(o);
+    if (r_.spatial_) {
+      const EulerParameters e = r_.orientation(o);
       s.rotation = rotation_matrix(e);
     } else {
-      s.rotation = about_z(number(o));
+      s.rotation = about_z(r_.number(o));
     }
   }
   read_shape_size(c, s);
@@ -118,47 +118,47 @@ Shape SceneReader::read_shape(const Cursor& c) const {
 }
 
 // The fields that size the shape `s` (its kind already set).
-void SceneReader::read_shape_size(const Cursor& c, Shape& s) const {
+void PartReader::read_shape_size(const Cursor& c, Shape& s) const {
   switch (s.kind) {
     case ShapeKind::kBox: {
       const auto size = c.require("size");
       if (!size.is_sequence() || size.size() != 3) size.fail("a box's size is [x, y, z] (edge lengths)");
-      s.size = {positive(size.at(0)), positive(size.at(1)), positive(size.at(2))};
+      s.size = {r_.positive(size.at(0)), r_.positive(size.at(1)), r_.positive(size.at(2))};
       break;
     }
     case ShapeKind::kPlane: {
       const auto size = c.require("size");
       if (!size.is_sequence() || size.size() != 2) size.fail("a plane's size is [x, y] (the drawn extent)");
-      s.size = {positive(size.at(0)), positive(size.at(1)), 0.0};
+      s.size = {r_.positive(size.at(0)), r_.positive(size.at(1)), 0.0};
       break;
     }
     case ShapeKind::kSphere:
-      s.radius = positive(c.require("radius"));
+      s.radius = r_.positive(c.require("radius"));
       break;
     case ShapeKind::kCylinder:
     case ShapeKind::kCapsule:
-      s.radius = positive(c.require("radius")), s.length = positive(c.require("length"));
+      s.radius = r_.positive(c.require("radius")), s.length = r_.positive(c.require("length"));
       break;
     case ShapeKind::kCone:
-      s.radius = positive(c.require("radius")), s.length = positive(c.require("height"));
+      s.radius = r_.positive(c.require("radius")), s.length = r_.positive(c.require("height"));
       break;
     case ShapeKind::kPolygon: {
       for (const kin3::V3& p : shape_points(c.require("points"), 2, 3)) s.outline.push_back({p.x, p.y});
-      s.length = positive(c.require("thickness"));
+      s.length = r_.positive(c.require("thickness"));
       break;
     }
     case ShapeKind::kCurve:
-      s.points = shape_points(c.require("points"), spatial_ ? 3 : 2, 2);
+      s.points = shape_points(c.require("points"), r_.spatial_ ? 3 : 2, 2);
       s.closed = c.field("closed").present() && c.field("closed").boolean();
-      s.radius = c.field("width").present() ? 0.5 * positive(c.field("width")) : 0.0;
+      s.radius = c.field("width").present() ? 0.5 * r_.positive(c.field("width")) : 0.0;
       break;
     case ShapeKind::kMesh: {
       const auto f = c.require("file");
       s.file = f.text();
-      s.scale = c.field("scale").present() ? positive(c.field("scale")) : 1.0;
+      s.scale = c.field("scale").present() ? r_.positive(c.field("scale")) : 1.0;
       // relative to the scene's folder, as a user writes it beside the scene
       std::filesystem::path p(s.file);
-      if (p.is_relative()) p = std::filesystem::path(file_).parent_path() / p;
+      if (p.is_relative()) p = std::filesystem::path(r_.file_).parent_path() / p;
       try {
         s.mesh = std::make_shared<const TriangleMesh>(load_mesh_file(p.string(), s.scale));
       } catch (const Error& e) {

@@ -7,6 +7,7 @@
 #include "phiq/text.hpp"
 #include "scene/family_expansion.hpp"
 #include "scene/scene_reader.hpp"
+#include "scene/part_reader.hpp"
 
 namespace phiq::detail::scene {
 
@@ -47,8 +48,10 @@ Scene SceneReader::read(const YAML::Node& root) {
   if (auto c = top.field("constraints"); c.present()) read_list(c, [&](const auto& item) { read_constraint(item); });
   if (auto d = top.field("drivers"); d.present()) read_list(d, [&](const auto& item) { read_driver(item); });
 
-  if (auto p = top.field("parts"); p.present()) read_parts(p, scene);  // (before the tables of names are freed)
-  if (auto l = top.field("loads"); l.present()) read_loads(l, scene);  // (after the parts they act on)
+  if (auto p = top.field("parts"); p.present())
+    PartReader(*this).read_parts(p, scene);  // (before the tables of names are freed)
+  if (auto l = top.field("loads"); l.present())
+    PartReader(*this).read_loads(l, scene);  // (after the parts they act on)
   read_time(top.require("time"), scene.sweep);
   read_output(top.field("output"), scene.sweep);
   if (auto o = top.field("output"); o.present() && o.is_map()) read_clearance(o.field("clearance"), scene);

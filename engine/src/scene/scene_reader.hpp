@@ -9,7 +9,7 @@
 //   read_constraints.cpp constraints, each read by its kind (kinds/registry.hpp, through kind_fields.hpp), and the
 //                        attachments, sides and segments they refer to
 //   read_drivers.cpp     drivers, joint drivers and motion laws
-//   read_loads.cpp       loads: gravity, forces, torques, springs (after the parts they act on)
+//   part_reader.hpp      parts and loads, read after the model by a PartReader of their own
 //   read_settings.cpp    time, output, solver
 // The readers are templates over the cursor type C: Cursor (a plain entry of the YAML tree) or TCursor (a member
 // of a family, families.hpp). The .cpp that defines a member template used elsewhere instantiates it explicitly
@@ -54,6 +54,7 @@ std::string parameters_note(std::vector<std::string> names);
 class SceneReader {
   template <class C>
   friend class KindFields;  // the scene vocabulary the constraint kinds read themselves with
+  friend class PartReader;  // and the parts and loads (part_reader.hpp)
 
  public:
   SceneReader(const std::string& file, const SceneLimits& limits) : file_(file), limits_(limits) {
@@ -185,32 +186,6 @@ class SceneReader {
   void read_driver(const C& c);
   template <class C>
   MotionLaw motion_law(const C& c) const;
-
-  // ---- parts (read_parts.cpp, read_shapes.cpp) ----------------------------------------------------------------
-  void read_parts(const Cursor& c, Scene& scene);
-  static bool frame_depends_on_time(const PartFrame& f);
-  void part_frame(const Cursor& v, const std::string& name, Part& part) const;
-  Attachment3 frame_toward(const Cursor& c, bool& is_point) const;
-  void points_or_expression_frame(const Cursor& f, Part& part) const;
-  std::shared_ptr<const CompiledExpression> slot_expression(const Cursor& c, const Slot& s) const;
-  void part_mass(const Cursor& v, Part& part) const;
-  MassProperties shapes_mass(const Cursor& c, const Part& part, double density) const;
-  std::array<double, 9> inertia_tensor(const Cursor& c) const;
-  std::array<double, 4> colour(const Cursor& c) const;
-  std::vector<kin3::V3> shape_points(const Cursor& c, std::size_t n, std::size_t least) const;
-  Shape read_shape(const Cursor& c) const;
-  void read_shape_size(const Cursor& c, Shape& s) const;
-
-  // ---- loads (read_loads.cpp) ---------------------------------------------------------------------------------
-  void read_loads(const Cursor& c, Scene& scene) const;
-  PartFrame load_frame(const Cursor& c, const Scene& scene) const;
-  PartFrame ground_frame() const;
-  kin3::V3 load_vector(const Cursor& c, const char* what) const;
-  std::array<std::shared_ptr<const CompiledExpression>, 3> load_components(const Cursor& c, const char* what) const;
-  LoadAxes load_axes(const Cursor& c) const;
-  double non_negative(const Cursor& c) const;
-  LinearSpring linear_spring(const Cursor& s, const Scene& scene, std::set<std::string>& names) const;
-  TorsionalSpring torsional_spring(const Cursor& s, std::set<std::string>& names) const;
 
   // ---- time, output, solver (read_settings.cpp) ---------------------------------------------------------------
   void read_time(const Cursor& c, TimeGrid& o) const;
