@@ -144,7 +144,8 @@ void bind_sweep(py::module_& m) {
   py::class_<SweepWarning>(m, "SweepWarning", "Something to know about a delivered row (it is within tolerance).")
       .def_readonly("t", &SweepWarning::t, "time of the row concerned")
       .def_readonly("kind", &SweepWarning::kind,
-                    "'slow_convergence', 'ill_conditioned', 'bifurcation', 'parallel_fallback' or 'threads_reduced'")
+                    "'slow_convergence', 'ill_conditioned', 'bifurcation', 'parallel_fallback', 'threads_reduced', "
+                    "'no_dependence' or 'indeterminate'")
       .def_readonly("message", &SweepWarning::message, "one line")
       .def("__repr__", [](const SweepWarning& w) {
         return "SweepWarning(t=" + shortest(w.t) + ", kind='" + w.kind + "', message='" + w.message + "')";
