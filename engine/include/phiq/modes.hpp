@@ -6,11 +6,13 @@
 /// The method. Each row of Φ is recovered as a polynomial in the coordinates it reads (find_polynomial_system():
 /// the coefficients of every monomial up to degree 4 fitted by least squares to evaluations of the row, and checked
 /// on fresh points), angle coordinates entering through (c, s) = (cos θ, sin θ) with c² + s² = 1; a row no
-/// polynomial reproduces (a cam, a spline, exp) is refused with its constraint named. Rows that fix one coordinate
-/// (drivers, a polar's arm at a driven angle) are eliminated first. The square polynomial system is then solved by
-/// solve_polynomial_system(): the total-degree start system x_i^{d_i} = 1 and the homotopy
-/// H(x, t) = (1 − t) F(x) + γ t G(x) with a random complex γ (the "γ trick": no path meets a singularity for t > 0),
-/// tracked in projective coordinates on a random affine patch (paths that diverge in affine space end at points
+/// polynomial reproduces (a cam, a spline, exp) is refused with its constraint named. Rows affine in what they
+/// read are eliminated first: those that fix one coordinate (drivers, a polar's arm at a driven angle), then sets
+/// of them solved together (gears and belts among driven angles: linear in the angles, polynomial in no (c, s)).
+/// A spatial joint-angle driver is read as s cos f − c sin f (c, s: the joint frames' axes' products). The square
+/// polynomial system is then solved by solve_polynomial_system(): the total-degree start system x_i^{d_i} = 1 and the
+/// homotopy H(x, t) = (1 − t) F(x) + γ t G(x) with a random complex γ (the "γ trick": no path meets a singularity for t
+/// > 0), tracked in projective coordinates on a random affine patch (paths that diverge in affine space end at points
 /// with x₀ → 0, at infinity, instead of running away) by an adaptive RK4 predictor and Newton corrector. Every
 /// endpoint is refined by Newton on the original equations and classified: real, complex, singular (condition
 /// number above ModesOptions::singular_condition) or at infinity. Paths run in parallel
@@ -133,6 +135,16 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
 /// each equation ended by ';', coefficients in full precision, variable v as x(v + 1): x1, x2, …
 std::string phc_input_text(const PolynomialSystem& system);
 
+/// A row that relates free angles linearly with rational ratios (a gear or a belt between angles a linkage turns):
+/// Σ_k n_k θ_k = phase with integers n_k, solved modulo 2π as the complex polynomial
+/// Π_{n_k > 0} (c_k + i s_k)^{n_k} − e^{i·phase} Π_{n_k < 0} (c_k − i s_k)^{−n_k} = 0 (Chebyshev's multiple angles).
+struct AngleRelation {
+  Index row = -1;              ///< its row of Φ
+  std::vector<Index> angles;   ///< the angle coordinates it reads
+  std::vector<int> multiples;  ///< n_k, one per angle, their greatest common divisor 1
+  double phase = 0.0;          ///< the right-hand side (rad)
+};
+
 /// A model's equations at time T as polynomials (find_polynomial_system()).
 struct ModelPolynomials {
   ModesStatus status = ModesStatus::kSuccess;  ///< kNotPolynomial (nothing else set) or kSuccess
@@ -142,16 +154,20 @@ struct ModelPolynomials {
   PolynomialSystem system;
   /// For each coordinate of the model: −1 when eliminated (fixed), else its variable (the c of an angle, s is next).
   std::vector<int> variable_of;
-  std::vector<double> fixed;           ///< the value of every eliminated coordinate (NaN for the others)
-  Eigen::VectorXd origin;              ///< q0, the placement the scaled variables are measured from
-  Eigen::VectorXd scale;               ///< the scale of each coordinate's variable (1 for angles)
-  std::vector<Index> eliminated_rows;  ///< the rows of Φ that fixed a coordinate, ascending
-  /// q of a real solution x of `system`: angles as atan2(s, c) on the 2π branch nearest the placement.
+  std::vector<double> fixed;                   ///< the value of every eliminated coordinate (NaN for the others)
+  Eigen::VectorXd origin;                      ///< q0, the placement the scaled variables are measured from
+  Eigen::VectorXd scale;                       ///< the scale of each coordinate's variable (1 for angles)
+  std::vector<Index> eliminated_rows;          ///< the rows of Φ that fixed a coordinate, ascending
+  std::vector<AngleRelation> angle_relations;  ///< the rows solved modulo 2π, in row order
+  /// q of a real solution x of `system`: angles as atan2(s, c) on the 2π branch nearest the placement, then turned
+  /// by whole turns where an angle relation needs it to hold exactly (the relations in order; one may undo an
+  /// earlier one's that shares its angles, and find_assembly_modes() then rejects the point).
   Eigen::VectorXd coordinates(const Eigen::VectorXcd& x) const;
 };
 
 /// Recovers each row of Φ(·, options.time) as a polynomial (the file's comment): rows that read one coordinate and
-/// are affine in it fix it (eliminated, repeatedly, as fixed coordinates make more rows read one), and every other
+/// are affine in it fix it, then sets of rows affine in all they read fix what they determine (eliminated,
+/// repeatedly, as fixed coordinates make more rows affine), and every other
 /// row is fitted, degree 1 to options.max_fit_degree, in its coordinates' scaled variables. kNotPolynomial names
 /// the first constraint no polynomial reproduces ("constraint 'cam': is not polynomial in its coordinates …").
 /// Thread-safe.
@@ -170,10 +186,17 @@ struct AssemblyModes {
   ModesSummary summary;             ///< the homotopy's (status, message, counts, endpoints in the system's variables)
   ModelPolynomials polynomials;     ///< the system solved
   std::vector<AssemblyMode> modes;  ///< the real solutions, regular and singular, in the summary's order
+  /// Real solutions of the system that are no assembly: the model's own Φ is not zero there (a spatial joint-angle
+  /// driver's polynomial form also holds at the driven angle + π).
+  int rejected = 0;
+  /// Real solutions that are another's placement again: a body's Euler parameters −e for e (each mode keeps the
+  /// sign nearest the placement's).
+  int merged = 0;
 };
 
-/// find_polynomial_system() then solve_polynomial_system(): every real assembly of `model` at options.time. The
-/// status and message are those of the first step that refused. Thread-safe.
+/// find_polynomial_system() then solve_polynomial_system(): every real assembly of `model` at options.time, each
+/// checked on the model's own equations (AssemblyModes::rejected) and placements found twice merged
+/// (AssemblyModes::merged). The status and message are those of the first step that refused. Thread-safe.
 AssemblyModes find_assembly_modes(const Model& model, const ModesOptions& options);
 
 /// The distance between two positions of `model`: max_j |a_j − b_j| / scale_j, lengths scaled by the model's
