@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -26,6 +27,7 @@ struct PhcSolution {
   std::vector<std::complex<double>> x;
   bool real = false;
   bool regular = false;
+  bool singular = false;  // a solution (not "no solution") whose rco is at most 1e-10
 };
 
 // Runs `phc -b` on the system's text and reads the solutions of the last "THE SOLUTIONS" section (after its
@@ -62,8 +64,9 @@ inline std::vector<PhcSolution> phc_solve(const PolynomialSystem& system) {
       // its numbers, as phiq judges its own (the inverse condition estimate rco, the imaginary parts)
       const std::size_t rco = line.find("rco :");
       // (a path phc did not end on a solution says "no solution", whatever its rco)
-      current.regular = rco != std::string::npos && std::stod(line.substr(rco + 5)) > 1e-10 &&
-                        line.find("no solution") == std::string::npos;
+      const bool solution = rco != std::string::npos && line.find("no solution") == std::string::npos;
+      current.regular = solution && std::stod(line.substr(rco + 5)) > 1e-10;
+      current.singular = solution && !current.regular;
       double size = 0.0, imag = 0.0;
       for (const auto& v : current.x) size = std::max(size, std::abs(v)), imag = std::max(imag, std::abs(v.imag()));
       current.real = imag <= 1e-8 * (1.0 + size);
@@ -82,6 +85,66 @@ inline std::vector<PhcSolution> phc_solve(const PolynomialSystem& system) {
     }
   }
   return solutions;
+}
+
+// phc's real solutions: the regular ones, and the singular ones counted once per point (phc lists a multiple root
+// once for each path that reached it).
+struct PhcRealCounts {
+  int regular = 0;
+  int singular = 0;
+};
+
+// The system in y = x − shift: Π (y_v + shift_v)^{e_v} expanded binomially.
+inline PolynomialSystem phc_shifted(const PolynomialSystem& system, const std::vector<double>& shift) {
+  PolynomialSystem out{system.variables, system.names, {}};
+  for (const Polynomial& p : system.equations) {
+    std::map<std::vector<int>, std::complex<double>> sum{};
+    for (const PolynomialTerm& t : p.terms) {
+      std::map<std::vector<int>, std::complex<double>> expanded{
+          {std::vector<int>(t.exponent.size(), 0), t.coefficient}};
+      for (std::size_t v = 0; v < t.exponent.size(); ++v) {
+        std::map<std::vector<int>, std::complex<double>> next;
+        for (const auto& [e, c] : expanded) {
+          double binomial = 1.0;
+          for (int k = 0; k <= t.exponent[v]; ++k) {  // C(n, k) y^k shift^(n − k)
+            std::vector<int> f = e;
+            f[v] = k;
+            next[f] += c * binomial * std::pow(shift[v], t.exponent[v] - k);
+            binomial = binomial * (t.exponent[v] - k) / (k + 1);
+          }
+        }
+        expanded = std::move(next);
+      }
+      for (const auto& [e, c] : expanded) sum[e] += c;
+    }
+    Polynomial q;
+    for (const auto& [e, c] : sum) q.terms.push_back({c, e});
+    out.equations.push_back(std::move(q));
+  }
+  return out;
+}
+
+// (phc -b's polyhedral homotopy counts the roots with no coordinate zero, and a mechanism's system in displacements
+// from its placement has roots with some: the system goes to phc shifted by x = y + 0.3 + 0.1 v.)
+inline PhcRealCounts phc_real_counts(const PolynomialSystem& system) {
+  PhcRealCounts counts;
+  std::vector<std::vector<std::complex<double>>> points;
+  std::vector<double> shift;
+  for (int v = 0; v < system.variables; ++v) shift.push_back(0.3 + 0.1 * v);
+  for (const PhcSolution& s : phc_solve(phc_shifted(system, shift))) {
+    counts.regular += s.regular && s.real;
+    double size = 0.0, imag = 0.0;
+    for (const auto& v : s.x) size = std::max(size, std::abs(v)), imag = std::max(imag, std::abs(v.imag()));
+    if (!s.singular || !(imag <= 1e-5 * (1.0 + size))) continue;  // a real singular point, as phiq judges one
+    const bool again = std::any_of(points.begin(), points.end(), [&](const std::vector<std::complex<double>>& p) {
+      double d = 0.0;
+      for (std::size_t v = 0; v < p.size() && v < s.x.size(); ++v) d = std::max(d, std::abs(p[v] - s.x[v]));
+      return p.size() == s.x.size() && d <= 1e-6 * (1.0 + size);
+    });
+    if (!again) points.push_back(s.x);
+  }
+  counts.singular = static_cast<int>(points.size());
+  return counts;
 }
 
 // phc's solutions against phiq's endpoints: regular finite counts, real counts, and every real solution of one

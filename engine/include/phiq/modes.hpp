@@ -70,7 +70,27 @@ struct ModesOptions {
   /// Endpoints closer than this · (1 + |x|∞) are one solution, reached by several paths (Endpoint::multiplicity).
   double duplicate_tolerance = 1e-6;
   int max_fit_degree = 4;  ///< the highest degree a row is fitted with (find_polynomial_system())
+  /// An endpoint that several paths reach (after the careful second pass) is singular when its condition is above
+  /// this: a multiple root, which double precision places only to about √ε, so that its condition stays near 1e8
+  /// (a regular solution is the end of one path only; one that two paths reach is well conditioned).
+  double multiple_root_condition = 1e5;
+  /// find_assembly_modes(): solve a block-triangular system block by block where that is safe (ModesMethod), else
+  /// (false, or not safe) the whole system at once.
+  bool block_solve = true;
 };
+
+/// How find_assembly_modes() solved its system (ModesSummary::method).
+enum class ModesMethod {
+  kWholeSystem,  ///< one total-degree homotopy of the whole system
+  /// Block by block: the Dulmage–Mendelsohn blocks in order, each for every real solution of those before it, the
+  /// results refined and classified on the whole system. Used only when every solution carried from one block to
+  /// the next is regular and well conditioned and no path failed (a singular one, known only to √ε, would perturb
+  /// the blocks after it: a double root splits into two real or two complex ones); otherwise the whole system.
+  kBlocks,
+};
+
+/// "whole system", "block by block".
+const char* modes_method_name(ModesMethod method);
 
 /// How a call of solve_polynomial_system() or find_assembly_modes() ended.
 enum class ModesStatus {
@@ -117,7 +137,12 @@ struct ModesSummary {
   /// Paths tracked a second time, with shorter steps, because the first attempt failed or ended at another path's
   /// regular endpoint (the counts above are those after the second attempt).
   int retracked_paths = 0;
-  double seconds = 0.0;  ///< wall time of the tracking
+  double seconds = 0.0;                            ///< wall time of the tracking
+  ModesMethod method = ModesMethod::kWholeSystem;  ///< how the system was solved
+  int blocks = 1;                                  ///< the blocks solved in turn (1: the whole system)
+  /// Why the whole system was solved where the block solve was tried and found unsafe (empty otherwise): one line
+  /// naming the block and what it found there.
+  std::string method_note;
   /// The distinct endpoints: real first, then complex, singular, at infinity, failed; within a kind in a fixed
   /// order (lexicographic in the real, then imaginary parts).
   std::vector<Endpoint> endpoints;

@@ -54,8 +54,12 @@ AssemblyModes find_assembly_modes(const Model& model, const ModesOptions& option
       euler_variables.push_back(v);
       for (std::size_t k = 0; k < 4; ++k) offset(v[k]) = out.polynomials.origin(body[k]);
     }
-    if (!modes_detail::solve_in_blocks(system, euler_variables, offset, options, out.summary))
+    std::string unsafe;
+    if (!options.block_solve ||
+        !modes_detail::solve_in_blocks(system, euler_variables, offset, options, out.summary, unsafe)) {
       out.summary = solve_polynomial_system(system, options);
+      if (!unsafe.empty()) out.summary.method_note = "the block solve was not safe: " + unsafe;
+    }
     if (out.summary.status == ModesStatus::kNotSquare)
       out.summary.message = "the drivers leave the mechanism free (" + out.summary.message +
                             "): drive every freedom to count its assemblies";

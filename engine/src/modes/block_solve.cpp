@@ -2,10 +2,20 @@
 // degrees of all equations; a spatial mechanism's system is block triangular (the driven crank's Euler parameters
 // are fixed by the crank's own four equations, the rocker's then by its own), and the blocks' Bézout numbers add up
 // instead, each block solved once for every real solution of those before it: the RSSR's 512 paths become
-// 16 + 2 · 32. Complex solutions of a block are counted, not carried forward (they make no real assembly).
+// 16 + 4 · 32. Complex solutions of a block are counted, not carried forward (they make no real assembly).
+//
+// Only regular solutions are substituted: a singular one (a folded linkage's flat loop, where the next loop's two
+// circles touch) is known to about √ε only, and the blocks after it, solved at that perturbed value, would split
+// each of their double roots into two real or two complex ones — real modes lost or counted twice. Where a block
+// has a singular or ill-conditioned solution for one solution p of those before it, that block and all after it
+// are solved together for p (their multiple roots then whole, as the whole system sees them). A failed path, a
+// degenerate block or the path limit abandons the block solve (the caller then solves the whole system and says
+// why).
 #include <algorithm>
+#include <chrono>
 #include <functional>
 #include <map>
+#include <string>
 
 #include "modes/homotopy.hpp"
 #include "modes/model_rows.hpp"
@@ -111,75 +121,167 @@ PolynomialSystem substituted(const PolynomialSystem& s, const Block& b, const Ei
   return out;
 }
 
-void add_counts(ModesSummary& to, const ModesSummary& from) {
+void block_add_counts(ModesSummary& to, const ModesSummary& from) {
   to.paths += from.paths, to.complex += from.complex, to.at_infinity += from.at_infinity;
   to.failed_paths += from.failed_paths, to.duplicate_paths += from.duplicate_paths;
-  to.retracked_paths += from.retracked_paths, to.seconds += from.seconds;
+  to.retracked_paths += from.retracked_paths;
   for (const Endpoint& e : from.endpoints)
     to.singular += e.kind == EndpointKind::kSingular && !(e.x.imag().cwiseAbs().maxCoeff() <= 1e-6);
+}
+
+// A solution of the blocks so far (x: every variable, those of later blocks 0).
+struct BlockPartial {
+  Eigen::VectorXd x;
+  bool singular = false;
+};
+
+// Whether endpoint e is a real solution (a singular one to the looser accuracy double precision gives it).
+bool block_real_endpoint(const Endpoint& e, const ModesOptions& options) {
+  if (e.kind == EndpointKind::kReal) return true;
+  return e.kind == EndpointKind::kSingular &&
+         e.x.imag().cwiseAbs().maxCoeff() <= 1e3 * options.real_tolerance * (1.0 + e.x.cwiseAbs().maxCoeff());
+}
+
+// ±e: one sign carried forward (the largest component positive); e = offset + x
+void block_one_sign(const std::vector<std::array<int, 4>>& euler_variables, const Eigen::VectorXd& offset,
+                    const Block& b, Eigen::VectorXd& x) {
+  for (const auto& body : euler_variables) {
+    if (std::find(b.variables.begin(), b.variables.end(), body[0]) == b.variables.end()) continue;
+    int largest = body[0];
+    for (int v : body)
+      if (std::abs(offset(v) + x(v)) > std::abs(offset(largest) + x(largest)) + 1e-9) largest = v;
+    if (offset(largest) + x(largest) < 0.0)
+      for (int v : body) x(v) = -2.0 * offset(v) - x(v);
+  }
+}
+
+bool block_near(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const ModesOptions& options) {
+  return (a - b).cwiseAbs().maxCoeff() <= options.duplicate_tolerance * (1.0 + b.cwiseAbs().maxCoeff());
+}
+
+// Why a block's solve makes the block solve unsafe, or "" when it does not: it refused, or a path failed (a
+// solution may be missing). (Paths that met another's regular end are counted, as the whole solve counts them.)
+std::string unsafe_block(const ModesSummary& part) {
+  if (part.status != ModesStatus::kSuccess) return part.message;
+  if (part.failed_paths > 0) return std::to_string(part.failed_paths) + " paths failed";
+  return "";
+}
+
+// Whether a block has a singular or ill-conditioned finite solution: known to too few digits for the blocks after
+// it, which are then solved together with it.
+bool block_singular(const ModesSummary& part, const ModesOptions& options) {
+  return std::any_of(part.endpoints.begin(), part.endpoints.end(), [&](const Endpoint& e) {
+    return e.kind != EndpointKind::kAtInfinity && e.kind != EndpointKind::kFailed &&
+           (e.kind == EndpointKind::kSingular || !(e.condition <= options.multiple_root_condition));
+  });
+}
+
+// Whether a block's system, with the values before it put in, is degenerate: an equation vanished (a continuum of
+// solutions) or became a nonzero constant (none).
+bool block_degenerate(const PolynomialSystem& block) {
+  return std::any_of(block.equations.begin(), block.equations.end(),
+                     [](const Polynomial& p) { return p.terms.empty() || p.degree() == 0; });
 }
 
 }  // namespace
 
 bool solve_in_blocks(const PolynomialSystem& system, const std::vector<std::array<int, 4>>& euler_variables,
-                     const Eigen::VectorXd& offset, const ModesOptions& options, ModesSummary& out) {
+                     const Eigen::VectorXd& offset, const ModesOptions& options, ModesSummary& out,
+                     std::string& unsafe) {
+  unsafe.clear();
   if (static_cast<int>(system.equations.size()) != system.variables) return false;
   const std::vector<Block> blocks = system_blocks(system);
   if (blocks.size() < 2) return false;
+  const auto start_time = std::chrono::steady_clock::now();
   out = ModesSummary{};
-  struct Partial {
-    Eigen::VectorXd x;
-    bool singular = false;
-    double residual = 0.0, condition = 0.0;
+  std::vector<BlockPartial> partials{{Eigen::VectorXd::Zero(system.variables)}}, finished;
+  // Block b solved for the solution p of those before it (why not safe into `unsafe`), its real solutions carried
+  // into `into`
+  auto solve_block = [&](const Block& b, const BlockPartial& p, const std::string& name, ModesSummary& part) {
+    const PolynomialSystem block = substituted(system, b, p.x);
+    std::string why;
+    if (block_degenerate(block))
+      why = "an equation vanishes or is a nonzero constant there";
+    else if (out.paths + block.total_degree() > options.max_paths)
+      why = "the blocks' paths pass the limit of " + std::to_string(options.max_paths);
+    else
+      part = solve_polynomial_system(block, options), why = unsafe_block(part);
+    block_add_counts(out, part);
+    if (!why.empty())
+      unsafe = name + " of " + std::to_string(blocks.size()) + " (" + std::to_string(b.variables.size()) +
+               " unknowns): " + why;
+    return why.empty();
   };
-  std::vector<Partial> partials{{Eigen::VectorXd::Zero(system.variables)}};
-  for (const Block& b : blocks) {
-    std::vector<Partial> next;
-    for (const Partial& p : partials) {
-      const ModesSummary part = solve_polynomial_system(substituted(system, b, p.x), options);
-      if (part.status != ModesStatus::kSuccess) {
-        out.status = part.status, out.message = part.message;
-        return true;
+  auto carry = [&](const ModesSummary& part, const Block& b, const BlockPartial& p, std::vector<BlockPartial>& into) {
+    for (const Endpoint& e : part.endpoints) {
+      if (!block_real_endpoint(e, options)) continue;
+      BlockPartial q = p;
+      for (std::size_t v = 0; v < b.variables.size(); ++v)
+        q.x(b.variables[v]) = e.x(static_cast<Eigen::Index>(v)).real();
+      block_one_sign(euler_variables, offset, b, q.x);
+      if (std::any_of(into.begin(), into.end(), [&](const BlockPartial& o) { return block_near(o.x, q.x, options); }))
+        continue;
+      q.singular = q.singular || e.kind == EndpointKind::kSingular;
+      into.push_back(std::move(q));
+    }
+  };
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    const bool last = k + 1 == blocks.size();
+    std::vector<BlockPartial> next;
+    for (const BlockPartial& p : partials) {
+      ModesSummary part;
+      if (!solve_block(blocks[k], p, "block " + std::to_string(k + 1), part)) return false;
+      if (last || !block_singular(part, options)) {
+        carry(part, blocks[k], p, next);
+        continue;
       }
-      add_counts(out, part);
-      for (const Endpoint& e : part.endpoints) {
-        const bool real_singular =
-            e.kind == EndpointKind::kSingular &&
-            e.x.imag().cwiseAbs().maxCoeff() <= 1e3 * options.real_tolerance * (1.0 + e.x.cwiseAbs().maxCoeff());
-        if (e.kind != EndpointKind::kReal && !real_singular) continue;
-        Partial q = p;
-        for (std::size_t k = 0; k < b.variables.size(); ++k)
-          q.x(b.variables[k]) = e.x(static_cast<Eigen::Index>(k)).real();
-        // ±e: one sign carried forward (the largest component positive); e = offset + x
-        for (const auto& body : euler_variables) {
-          if (std::find(b.variables.begin(), b.variables.end(), body[0]) == b.variables.end()) continue;
-          int largest = body[0];
-          for (int v : body)
-            if (std::abs(offset(v) + q.x(v)) > std::abs(offset(largest) + q.x(largest)) + 1e-9) largest = v;
-          if (offset(largest) + q.x(largest) < 0.0)
-            for (int v : body) q.x(v) = -2.0 * offset(v) - q.x(v);
-        }
-        const bool again = std::any_of(next.begin(), next.end(), [&](const Partial& o) {
-          return (o.x - q.x).cwiseAbs().maxCoeff() <= options.duplicate_tolerance * (1.0 + q.x.cwiseAbs().maxCoeff());
-        });
-        if (again) continue;
-        q.singular = q.singular || e.kind == EndpointKind::kSingular;
-        q.residual = std::max(q.residual, e.residual), q.condition = std::max(q.condition, e.condition);
-        next.push_back(std::move(q));
+      // A singular solution here: this block and all after it solved together, for this p (the whole system's
+      // classification then sees the multiple roots whole)
+      Block rest;
+      for (std::size_t j = k; j < blocks.size(); ++j) {
+        rest.equations.insert(rest.equations.end(), blocks[j].equations.begin(), blocks[j].equations.end());
+        rest.variables.insert(rest.variables.end(), blocks[j].variables.begin(), blocks[j].variables.end());
       }
+      std::sort(rest.equations.begin(), rest.equations.end()), std::sort(rest.variables.begin(), rest.variables.end());
+      ModesSummary joint;
+      if (!solve_block(rest, p, "blocks " + std::to_string(k + 1) + " to " + std::to_string(blocks.size()), joint))
+        return false;
+      carry(joint, rest, p, finished);
     }
     partials = std::move(next);
   }
-  std::sort(partials.begin(), partials.end(), [](const Partial& a, const Partial& b) {
-    return std::lexicographical_compare(a.x.data(), a.x.data() + a.x.size(), b.x.data(), b.x.data() + b.x.size());
-  });
-  for (const Partial& p : partials) {
+  partials.insert(partials.end(), finished.begin(), finished.end());
+  // Each solution refined by Newton on the whole system and classified there, as the whole solve classifies its
+  // endpoints: its residual and condition those of all the equations (the Jacobian is block triangular: regular
+  // where every block's is).
+  const CompiledSystem whole(system);
+  std::vector<Endpoint> found;
+  for (const BlockPartial& p : partials) {
     Endpoint e;
-    e.kind = p.singular ? EndpointKind::kSingular : EndpointKind::kReal;
-    e.x = p.x.cast<cd>(), e.residual = p.residual, e.condition = p.condition;
-    out.endpoints.push_back(std::move(e));
-    (p.singular ? out.singular : out.real) += 1;
+    e.x = p.x.cast<cd>();
+    e.residual = refine_endpoint(whole, e.x, &e.condition);
+    if (!(e.residual <= 1e-8)) {
+      unsafe = "a solution of the blocks is none of the whole system (residual " + std::to_string(e.residual) + ")";
+      return false;
+    }
+    const bool singular = p.singular || !(e.condition <= options.singular_condition);
+    e.kind = singular ? EndpointKind::kSingular : EndpointKind::kReal;
+    if (!singular) e.x = e.x.real().cast<cd>();
+    const Eigen::VectorXd at = e.x.real();
+    if (std::any_of(found.begin(), found.end(), [&](const Endpoint& o) { return block_near(o.x.real(), at, options); }))
+      continue;
+    (singular ? out.singular : out.real) += 1;
+    found.push_back(std::move(e));
   }
+  std::sort(found.begin(), found.end(), [](const Endpoint& a, const Endpoint& b) {
+    if (a.kind != b.kind) return a.kind < b.kind;
+    const Eigen::VectorXd x = a.x.real(), y = b.x.real();
+    return std::lexicographical_compare(x.data(), x.data() + x.size(), y.data(), y.data() + y.size());
+  });
+  out.endpoints = std::move(found);
+  out.method = ModesMethod::kBlocks;
+  out.blocks = static_cast<int>(blocks.size());
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return true;
 }
 

@@ -76,4 +76,9 @@ struct PathEnd {
 // Tracks path p from t = 1 to t = 0; `careful`: shorter steps and a closer corrector (a second attempt).
 PathEnd track_path(const Homotopy& h, std::int64_t p, bool careful = false);
 
+// Newton (Gauss-Newton for more equations than unknowns) on f's equations from x, in place: returns the residual
+// max_i |F_i| / (largest |coefficient| of F_i) and sets *condition, the condition number of the Jacobian with the
+// variables scaled by 1 + |x|∞.
+double refine_endpoint(const CompiledSystem& f, Eigen::VectorXcd& x, double* condition);
+
 }  // namespace phiq::modes_detail

@@ -50,10 +50,12 @@ PolynomialSystem squared_up(const PolynomialSystem& s, Random& random) {
   return square;
 }
 
+}  // namespace
+
 // Newton (Gauss-Newton for more equations than unknowns) on the original equations from x; returns the residual
 // max_i |F_i| / scale_i and sets the condition number of the scaled Jacobian. Converges linearly at a singular
 // solution (ratio 1/2 at a double root): the iterations allowed let it get there too.
-double refine(const CompiledSystem& f, Eigen::VectorXcd& x, double* condition) {
+double modes_detail::refine_endpoint(const CompiledSystem& f, Eigen::VectorXcd& x, double* condition) {
   Eigen::VectorXcd value;
   Eigen::MatrixXcd jac;
   auto residual_of = [&](const Eigen::VectorXcd& y) {
@@ -84,6 +86,8 @@ double refine(const CompiledSystem& f, Eigen::VectorXcd& x, double* condition) {
                                          : std::numeric_limits<double>::infinity();
   return r;
 }
+
+namespace {
 
 int kind_rank(EndpointKind k) { return static_cast<int>(k); }
 
@@ -151,7 +155,7 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
       bool infinite = !(x0 > 1e-8 * size);
       if (!infinite) {
         point.x = e.X.tail(n) / e.X(0);
-        point.residual = refine(original, point.x, &point.condition);
+        point.residual = modes_detail::refine_endpoint(original, point.x, &point.condition);
         infinite = !(inf_norm(point.x) < 1e8) || !point.x.allFinite();
         // a path stopped short of t = 0 (its step collapsed in the end game) with X0 already small and no solution
         // near it: diverging, to a solution set at infinity
@@ -214,6 +218,16 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
     classify();
   }
   summary.retracked_paths = static_cast<int>(again.size());
+  // A point that several paths still reach after the careful pass, and where the Jacobian is far from well
+  // conditioned, is a multiple root: Newton places a double root only to about √ε, where the condition is near
+  // 1e8 (a k-fold tangency of circles gives 1e7 … 1e9), below options.singular_condition; a regular solution is
+  // the end of one path only, and one that two paths jumped onto is well conditioned (counted as duplicate).
+  for (Endpoint& d : distinct)
+    if (d.multiplicity > 1 && (d.kind == EndpointKind::kReal || d.kind == EndpointKind::kComplex) &&
+        !(d.condition <= options.multiple_root_condition)) {
+      d.kind = EndpointKind::kSingular;
+      summary.duplicate_paths -= d.multiplicity - 1;
+    }
   std::sort(distinct.begin(), distinct.end(), endpoint_before);
   for (const Endpoint& d : distinct) {
     summary.real += d.kind == EndpointKind::kReal;

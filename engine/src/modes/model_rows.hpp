@@ -5,6 +5,7 @@
 
 #include <array>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -53,12 +54,15 @@ void apply_relation_turns(const AngleRelation& relation, Eigen::VectorXd& q);
 
 // Solves a square system block by block (block_solve.cpp): its Dulmage–Mendelsohn blocks in order, each for every
 // real solution of those before it, a body's Euler parameters (`euler_variables`: the four variables of each,
-// e = offset + x) carried forward with one sign (the equations read them through the rotation, the same at ±e). `out`
-// then counts the paths of all blocks, their complex, infinite and failed ends, and holds the real solutions of the
-// whole system (one per ±e) as its endpoints. False, nothing done, when the system is one block or not structurally
-// square.
+// e = offset + x) carried forward with one sign (the equations read them through the rotation, the same at ±e), and
+// the results refined and classified on the whole system. `out` then counts the paths of all blocks, their complex,
+// infinite and failed ends, and holds the real solutions of the whole system (one per ±e) as its endpoints
+// (ModesMethod::kBlocks). False with `unsafe` empty, nothing done, when the system is one block or not square;
+// false with `unsafe` saying why (which block, what it found) when the block solve is not safe (the file's
+// comment): the caller solves the whole system.
 bool solve_in_blocks(const PolynomialSystem& system, const std::vector<std::array<int, 4>>& euler_variables,
-                     const Eigen::VectorXd& offset, const ModesOptions& options, ModesSummary& out);
+                     const Eigen::VectorXd& offset, const ModesOptions& options, ModesSummary& out,
+                     std::string& unsafe);
 
 // Fixes the coordinates affine rows determine, until none is left to fix: a row that reads one free coordinate and
 // is affine in it (a driver), then a set of rows each affine in all the free coordinates it reads (gears and

@@ -61,6 +61,10 @@ const char* endpoint_kind_name(EndpointKind kind) {
   return "failed";
 }
 
+const char* modes_method_name(ModesMethod method) {
+  return method == ModesMethod::kBlocks ? "block by block" : "whole system";
+}
+
 namespace {
 std::string phc_number(double v) {
   char buffer[40];
