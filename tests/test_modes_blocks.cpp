@@ -9,8 +9,11 @@
 // real or two complex ones; it must find the whole system's modes, or solve the whole system and say why.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -161,6 +164,42 @@ TEST(ModesBlocks, NfourbarAsPhcCountsIt) {
     EXPECT_EQ(phc.singular, 1 + (coords[0] == 'n'));
     EXPECT_EQ(static_cast<int>(r.modes.size()) + r.rejected + r.merged, phc.regular + phc.singular);
   }
+}
+
+// Every scene of models/ of at most 20 coordinates (fitting a bigger one's rows alone takes a quarter second and
+// more) whose whole system takes at most 64 paths: the block solve finds its modes (those it solves block by block
+// among them: the natural four-bars, fourbar_m and fourbar_mm, a driven-torque four-bar).
+TEST(ModesBlocks, ModelScenesAsTheWholeSystem) {
+  std::vector<std::string> compared, in_blocks;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(PHIQ_MODELS_DIR)) {
+    if (entry.path().extension() != ".yaml") continue;
+    std::optional<Scene> scene;
+    try {
+      scene = load_scene(entry.path().string());
+    } catch (const std::exception&) {
+      continue;  // not a scene (an include, a bad-input example)
+    }
+    if (scene->model->num_coordinates() > 20) continue;
+    ModesOptions o;
+    o.time = scene->sweep.t_begin, o.max_paths = 64, o.block_solve = false;
+    AssemblyModes whole;
+    try {
+      whole = find_assembly_modes(*scene->model, o);
+    } catch (const std::exception&) {
+      continue;
+    }
+    if (whole.summary.status != ModesStatus::kSuccess) continue;
+    const std::string name = std::filesystem::relative(entry.path(), PHIQ_MODELS_DIR).string();
+    SCOPED_TRACE(name);
+    o.block_solve = true, o.max_paths = 100000;
+    const AssemblyModes blocks = find_assembly_modes(*scene->model, o);
+    modes_blocks_expect_same(*scene->model, blocks, whole);
+    compared.push_back(name);
+    if (blocks.summary.method == ModesMethod::kBlocks) in_blocks.push_back(name);
+  }
+  EXPECT_GE(compared.size(), 20u);
+  for (const char* name : {"seed/fourbar_natural.yaml", "hard/fourbar_m.yaml", "hard/fourbar_mm.yaml"})
+    EXPECT_NE(std::find(in_blocks.begin(), in_blocks.end(), name), in_blocks.end()) << name;
 }
 
 }  // namespace
