@@ -88,7 +88,9 @@ inline std::vector<PhcSolution> phc_solve(const PolynomialSystem& system) {
 }
 
 // phc's real solutions: the regular ones, and the singular ones counted once per point (phc lists a multiple root
-// once for each path that reached it).
+// once for each path that reached it). (phc -b's polyhedral homotopy counts the roots with no coordinate zero, and
+// a mechanism's system in displacements from its placement has roots with some: the system goes to phc shifted by
+// x = y + 0.3 + 0.1 v.)
 struct PhcRealCounts {
   int regular = 0;
   int singular = 0;
@@ -124,26 +126,32 @@ inline PolynomialSystem phc_shifted(const PolynomialSystem& system, const std::v
   return out;
 }
 
-// (phc -b's polyhedral homotopy counts the roots with no coordinate zero, and a mechanism's system in displacements
-// from its placement has roots with some: the system goes to phc shifted by x = y + 0.3 + 0.1 v.)
 inline PhcRealCounts phc_real_counts(const PolynomialSystem& system) {
-  PhcRealCounts counts;
-  std::vector<std::vector<std::complex<double>>> points;
   std::vector<double> shift;
   for (int v = 0; v < system.variables; ++v) shift.push_back(0.3 + 0.1 * v);
+  // the real solutions in clusters (1e-5 apart at most): a point several paths reach is a multiple root, singular
+  // even where phc's rco for one of its paths is above its 1e-10 (as phiq judges its own endpoints)
+  struct Cluster {
+    std::vector<std::complex<double>> x;
+    int paths = 0;
+    bool singular = false;
+  };
+  std::vector<Cluster> clusters;
   for (const PhcSolution& s : phc_solve(phc_shifted(system, shift))) {
-    counts.regular += s.regular && s.real;
     double size = 0.0, imag = 0.0;
     for (const auto& v : s.x) size = std::max(size, std::abs(v)), imag = std::max(imag, std::abs(v.imag()));
-    if (!s.singular || !(imag <= 1e-5 * (1.0 + size))) continue;  // a real singular point, as phiq judges one
-    const bool again = std::any_of(points.begin(), points.end(), [&](const std::vector<std::complex<double>>& p) {
+    if (!(s.regular || s.singular) || !(imag <= 1e-5 * (1.0 + size))) continue;
+    auto same = std::find_if(clusters.begin(), clusters.end(), [&](const Cluster& c) {
       double d = 0.0;
-      for (std::size_t v = 0; v < p.size() && v < s.x.size(); ++v) d = std::max(d, std::abs(p[v] - s.x[v]));
-      return p.size() == s.x.size() && d <= 1e-6 * (1.0 + size);
+      for (std::size_t v = 0; v < c.x.size() && v < s.x.size(); ++v) d = std::max(d, std::abs(c.x[v] - s.x[v]));
+      return c.x.size() == s.x.size() && d <= 1e-5 * (1.0 + size);
     });
-    if (!again) points.push_back(s.x);
+    if (same == clusters.end()) same = clusters.insert(clusters.end(), Cluster{s.x});
+    ++same->paths;
+    same->singular = same->singular || s.singular;
   }
-  counts.singular = static_cast<int>(points.size());
+  PhcRealCounts counts;
+  for (const Cluster& c : clusters) (c.singular || c.paths > 1 ? counts.singular : counts.regular) += 1;
   return counts;
 }
 

@@ -15,7 +15,9 @@
 /// > 0), tracked in projective coordinates on a random affine patch (paths that diverge in affine space end at points
 /// with x₀ → 0, at infinity, instead of running away) by an adaptive RK4 predictor and Newton corrector. Every
 /// endpoint is refined by Newton on the original equations and classified: real, complex, singular (condition
-/// number above ModesOptions::singular_condition) or at infinity. Paths run in parallel
+/// number above ModesOptions::singular_condition, or reached by several paths with a condition above
+/// ModesOptions::multiple_root_condition) or at infinity. find_assembly_modes() solves a block-triangular system
+/// block by block where that is safe (ModesMethod). Paths run in parallel
 /// (TBB); each path's arithmetic is independent of the others and the endpoints are merged in path order and
 /// sorted, so the result is the same, to the bit, on any number of threads.
 #pragma once
@@ -125,12 +127,12 @@ struct Endpoint {
 struct ModesSummary {
   ModesStatus status = ModesStatus::kSuccess;  ///< see ModesStatus
   std::string message;                         ///< one line when status is not kSuccess
-  std::int64_t paths = 0;                      ///< paths tracked (the total degree)
+  std::int64_t paths = 0;                      ///< paths tracked (the total degree; block by block, all blocks')
   int real = 0;                                ///< distinct real regular endpoints
-  int complex = 0;                             ///< distinct complex regular endpoints
-  int singular = 0;                            ///< distinct singular endpoints
-  int at_infinity = 0;                         ///< distinct endpoints at infinity
-  int failed_paths = 0;                        ///< paths that could not be tracked to t = 0
+  int complex = 0;       ///< distinct complex regular endpoints (block by block: the blocks', not carried forward)
+  int singular = 0;      ///< distinct singular endpoints
+  int at_infinity = 0;   ///< distinct endpoints at infinity
+  int failed_paths = 0;  ///< paths that could not be tracked to t = 0
   /// Paths that ended at a regular endpoint another path had reached: a path jumped onto another's on the way (a
   /// regular solution is the end of one path only), so that some solution may be missing. 0 when all went well.
   int duplicate_paths = 0;
