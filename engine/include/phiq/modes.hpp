@@ -10,7 +10,9 @@
 /// read are eliminated first: those that fix one coordinate (drivers, a polar's arm at a driven angle), then sets
 /// of them solved together (gears and belts among driven angles: linear in the angles, polynomial in no (c, s)).
 /// A spatial joint-angle driver is read as s cos f − c sin f (c, s: the joint frames' axes' products). The square
-/// polynomial system is then solved by solve_polynomial_system(): the total-degree start system x_i^{d_i} = 1 and the
+/// polynomial system is then solved by solve_polynomial_system(): its degrees first lowered where rows share their
+/// highest forms (ModesOptions::lower_degrees), then the start system with the fewest paths, the total-degree
+/// x_i^{d_i} = 1 or a multi-homogeneous linear product (StartSystemChoice), and the
 /// homotopy H(x, t) = (1 − t) F(x) + γ t G(x) with a random complex γ (the "γ trick": no path meets a singularity for t
 /// > 0), tracked in projective coordinates on a random affine patch (paths that diverge in affine space end at points
 /// with x₀ → 0, at infinity, instead of running away) by an adaptive RK4 predictor and Newton corrector. Every
@@ -57,6 +59,15 @@ struct PolynomialSystem {
   std::int64_t total_degree() const;
 };
 
+/// Which start system solve_polynomial_system() tracks its paths from (ModesOptions::start_system).
+enum class StartSystemChoice {
+  kFewestPaths,  ///< total degree or multi-homogeneous, equations lowered or not: whichever has the fewest paths
+  kTotalDegree,  ///< x_i^{d_i} = 1 (the equations lowered when ModesOptions::lower_degrees and that cuts paths)
+  /// the linear-product start system of the candidate grouping of two or more groups with the fewest paths (the
+  /// total degree when there is none: a system in one variable)
+  kMultiHomogeneous,
+};
+
 /// Settings of solve_polynomial_system() and find_assembly_modes().
 struct ModesOptions {
   double time = 0.0;  ///< T, the time at which the drivers are evaluated (find_assembly_modes())
@@ -79,11 +90,22 @@ struct ModesOptions {
   /// find_assembly_modes(): solve a block-triangular system block by block where that is safe (ModesMethod), else
   /// (false, or not safe) the whole system at once.
   bool block_solve = true;
+  /// The start system: by default whichever start system has the fewest paths (StartSystemChoice).
+  StartSystemChoice start_system = StartSystemChoice::kFewestPaths;
+  /// Lower the equations' degrees first where that cuts the paths: each equation plus polynomial multiples of the
+  /// lower-degree ones before it, so that its highest-degree form cancels (the same ideal: the same finite
+  /// solutions, with their multiplicities); a Stewart–Gough platform's 8192 total-degree paths become 432.
+  bool lower_degrees = true;
+  /// More candidate groupings of the variables for the multi-homogeneous start system (each group_of[v] per
+  /// variable, as multihomogeneous_bezout_number() takes it; one of another size is ignored), besides those the
+  /// system suggests (each rotation's c, s or Euler parameters, found by their normalisations, apart from the other
+  /// variables; every variable alone).
+  std::vector<std::vector<int>> groupings;
 };
 
 /// How find_assembly_modes() solved its system (ModesSummary::method).
 enum class ModesMethod {
-  kWholeSystem,  ///< one total-degree homotopy of the whole system
+  kWholeSystem,  ///< one homotopy of the whole system
   /// Block by block: the Dulmage–Mendelsohn blocks in order, each for every real solution of those before it, the
   /// results refined and classified on the whole system. Used only when every solution carried from one block to
   /// the next is regular and well conditioned and no path failed (a singular one, known only to √ε, would perturb
@@ -98,7 +120,7 @@ const char* modes_method_name(ModesMethod method);
 enum class ModesStatus {
   kSuccess,        ///< every path tracked (some may have failed: ModesSummary::failed_paths)
   kNotPolynomial,  ///< a constraint is not polynomial in its coordinates (the message names it)
-  kTooManyPaths,   ///< the total degree is above ModesOptions::max_paths (the message says it)
+  kTooManyPaths,   ///< the start system's paths are above ModesOptions::max_paths (the message says it)
   kNotSquare,      ///< fewer equations than unknowns: the assemblies form a continuum (the message says it)
 };
 
@@ -127,7 +149,7 @@ struct Endpoint {
 struct ModesSummary {
   ModesStatus status = ModesStatus::kSuccess;  ///< see ModesStatus
   std::string message;                         ///< one line when status is not kSuccess
-  std::int64_t paths = 0;                      ///< paths tracked (the total degree; block by block, all blocks')
+  std::int64_t paths = 0;                      ///< paths tracked (the start system's; block by block, all blocks')
   int real = 0;                                ///< distinct real regular endpoints
   int complex = 0;       ///< distinct complex regular endpoints (block by block: the blocks', not carried forward)
   int singular = 0;      ///< distinct singular endpoints
@@ -139,9 +161,19 @@ struct ModesSummary {
   /// Paths tracked a second time, with shorter steps, because the first attempt failed or ended at another path's
   /// regular endpoint (the counts above are those after the second attempt).
   int retracked_paths = 0;
+  /// Paths whose end Cauchy's end game found (their step collapsed near t = 0: a singular endpoint or one at
+  /// infinity, reached by circling t = 0 until the path closes up, and the mean of its points there).
+  int end_game_paths = 0;
   double seconds = 0.0;                            ///< wall time of the tracking
   ModesMethod method = ModesMethod::kWholeSystem;  ///< how the system was solved
   int blocks = 1;                                  ///< the blocks solved in turn (1: the whole system)
+  /// The start system the paths were tracked from: "total degree", "total degree, degrees lowered" or
+  /// "multi-homogeneous {x y} {cos(a) sin(a)}" (its groups; ", degrees lowered" when they were). Block by block: the
+  /// last block's.
+  std::string start_system;
+  /// The total degree of the (squared-up) system as given, before any lowering: `paths` against this is what the
+  /// start system saved.
+  std::int64_t total_degree = 0;
   /// Why the whole system was solved where the block solve was tried and found unsafe (empty otherwise): one line
   /// naming the block and what it found there.
   std::string method_note;
@@ -152,11 +184,17 @@ struct ModesSummary {
 
 /// Solves a square polynomial system (or an overdetermined one: its equations are first combined at random into as
 /// many as unknowns, and the endpoints are refined and checked on all of them; a non-solution of the original
-/// system is classified kFailed) by total-degree homotopy continuation (the file's comment). Refuses with
-/// kTooManyPaths (nothing tracked) when the total degree is above options.max_paths, with kNotSquare when there
-/// are fewer equations than unknowns. The result does not depend on options.threads. Throws phiq::Error for a
+/// system is classified kFailed) by homotopy continuation (the file's comment). Refuses with
+/// kTooManyPaths (nothing tracked) when the start system's paths are above options.max_paths, with kNotSquare when
+/// there are fewer equations than unknowns. The result does not depend on options.threads. Throws phiq::Error for a
 /// system whose terms do not have `variables` exponents.
 ModesSummary solve_polynomial_system(const PolynomialSystem& system, const ModesOptions& options);
+
+/// The multi-homogeneous Bézout number of a square system for a grouping of its variables (group_of[v]: the group
+/// of variable v, 0 … groups − 1, every group used): the coefficient of Π_j α_j^{n_j} (n_j the variables of group j)
+/// in Π_i Σ_j d_ij α_j (d_ij: equation i's degree in group j's variables), the number of paths of the
+/// multi-homogeneous start system. One group: the total degree. Saturated at 2⁶².
+std::int64_t multihomogeneous_bezout_number(const PolynomialSystem& system, const std::vector<int>& group_of);
 
 /// The text of `system` in PHCpack's input format (`phc -b in out`): the number of equations and unknowns, then
 /// each equation ended by ';', coefficients in full precision, variable v as x(v + 1): x1, x2, …
