@@ -215,6 +215,27 @@ bool endpoint_before(const Endpoint& a, const Endpoint& b) {
   return a.multiplicity < b.multiplicity;
 }
 
+// A point that several paths still reach after the careful pass, and where the Jacobian is far from well
+// conditioned, is a multiple root: Newton places a double root only to about √ε, where the condition is near 1e8
+// (a k-fold tangency of circles gives 1e7 … 1e9), below options.singular_condition; a regular solution is the end
+// of one path only, and one that two paths jumped onto is well conditioned (counted as duplicate). Then the
+// endpoints sorted and counted by kind.
+void finish_endpoints(std::vector<Endpoint>& distinct, const ModesOptions& options, ModesSummary& summary) {
+  for (Endpoint& d : distinct)
+    if (d.multiplicity > 1 && (d.kind == EndpointKind::kReal || d.kind == EndpointKind::kComplex) &&
+        !(d.condition <= options.multiple_root_condition)) {
+      d.kind = EndpointKind::kSingular;
+      summary.duplicate_paths -= d.multiplicity - 1;
+    }
+  std::sort(distinct.begin(), distinct.end(), endpoint_before);
+  for (const Endpoint& d : distinct) {
+    summary.real += d.kind == EndpointKind::kReal;
+    summary.complex += d.kind == EndpointKind::kComplex;
+    summary.singular += d.kind == EndpointKind::kSingular;
+    summary.at_infinity += d.kind == EndpointKind::kAtInfinity;
+  }
+}
+
 }  // namespace
 
 ModesSummary solve_polynomial_system(const PolynomialSystem& system, const ModesOptions& options) {
@@ -351,23 +372,7 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
   }
   summary.retracked_paths = static_cast<int>(again.size());
   for (const PathEnd& e : ends) summary.end_game_paths += e.winding > 0;
-  // A point that several paths still reach after the careful pass, and where the Jacobian is far from well
-  // conditioned, is a multiple root: Newton places a double root only to about √ε, where the condition is near
-  // 1e8 (a k-fold tangency of circles gives 1e7 … 1e9), below options.singular_condition; a regular solution is
-  // the end of one path only, and one that two paths jumped onto is well conditioned (counted as duplicate).
-  for (Endpoint& d : distinct)
-    if (d.multiplicity > 1 && (d.kind == EndpointKind::kReal || d.kind == EndpointKind::kComplex) &&
-        !(d.condition <= options.multiple_root_condition)) {
-      d.kind = EndpointKind::kSingular;
-      summary.duplicate_paths -= d.multiplicity - 1;
-    }
-  std::sort(distinct.begin(), distinct.end(), endpoint_before);
-  for (const Endpoint& d : distinct) {
-    summary.real += d.kind == EndpointKind::kReal;
-    summary.complex += d.kind == EndpointKind::kComplex;
-    summary.singular += d.kind == EndpointKind::kSingular;
-    summary.at_infinity += d.kind == EndpointKind::kAtInfinity;
-  }
+  finish_endpoints(distinct, options, summary);
   summary.endpoints = std::move(distinct);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return summary;
