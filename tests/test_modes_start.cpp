@@ -235,5 +235,37 @@ TEST(ModesStart, EndGameFindsATripleRoot) {
   EXPECT_NEAR(std::abs(r.endpoints[0].x(1) - 2.0), 0.0, 1e-12);
 }
 
+TEST(ModesStart, MultiHomogeneousAndEndGameSameBitsOnOneAndTwoThreads) {
+  // the four-bar from a linear product over every variable alone (16 paths, most ending at infinity in some group)
+  const Scene scene = load_scene(modes_start_model("seed/fourbar_mixed.yaml"));
+  ModesOptions o;
+  o.block_solve = false, o.start_system = StartSystemChoice::kMultiHomogeneous, o.threads = 1;
+  const AssemblyModes one = find_assembly_modes(*scene.model, o);
+  o.threads = 2;
+  const AssemblyModes two = find_assembly_modes(*scene.model, o);
+  ASSERT_EQ(one.summary.status, ModesStatus::kSuccess);
+  EXPECT_EQ(one.summary.paths, 16);
+  ASSERT_EQ(one.summary.endpoints.size(), two.summary.endpoints.size());
+  for (std::size_t k = 0; k < one.summary.endpoints.size(); ++k) {
+    EXPECT_EQ(one.summary.endpoints[k].kind, two.summary.endpoints[k].kind);
+    EXPECT_TRUE(one.summary.endpoints[k].x == two.summary.endpoints[k].x) << "endpoint " << k;
+  }
+  // the end game's ends: (x − 1)³ = 0, y = 2 (three paths, one Puiseux cycle)
+  const PolynomialSystem triple{2,
+                                {},
+                                {modes_start_poly({{-1.0, {0, 0}}, {3.0, {1, 0}}, {-3.0, {2, 0}}, {1.0, {3, 0}}}),
+                                 modes_start_poly({{1.0, {0, 1}}, {-2.0, {0, 0}}})}};
+  ModesOptions t;
+  t.threads = 1;
+  const ModesSummary a = solve_polynomial_system(triple, t);
+  t.threads = 2;
+  const ModesSummary b = solve_polynomial_system(triple, t);
+  EXPECT_EQ(a.end_game_paths, 3);
+  EXPECT_EQ(b.end_game_paths, 3);
+  ASSERT_EQ(a.endpoints.size(), 1u);
+  ASSERT_EQ(b.endpoints.size(), 1u);
+  EXPECT_TRUE(a.endpoints[0].x == b.endpoints[0].x);
+}
+
 }  // namespace
 }  // namespace phiq
