@@ -77,9 +77,12 @@ TEST(ModesPolynomial, ComplexInfiniteAndDoubleRootsAreClassified) {
     EXPECT_NEAR(std::abs(e.x(1) - 2.0 * e.x(0)), 0.0, 1e-13);
   }
   // x² − 4 = 0, x y − x = 0: (±2, 1); the other two paths of the total degree 4 diverge (to the point at infinity
-  // in the y direction)
+  // in the y direction). (By default {x} {y} apart: 2 · 1 paths, both finite.)
   PolynomialSystem i{2, {}, {modes_poly({{-4.0, {0, 0}}, {1.0, {2, 0}}}), modes_poly({{1.0, {1, 1}}, {-1.0, {1, 0}}})}};
-  const ModesSummary ri = solve_polynomial_system(i, {});
+  EXPECT_EQ(solve_polynomial_system(i, {}).paths, 2);
+  ModesOptions total_degree;
+  total_degree.start_system = StartSystemChoice::kTotalDegree;
+  const ModesSummary ri = solve_polynomial_system(i, total_degree);
   EXPECT_EQ(ri.paths, 4);
   ASSERT_EQ(ri.real, 2);
   EXPECT_NEAR(ri.endpoints[0].x(0).real(), -2.0, 1e-12);

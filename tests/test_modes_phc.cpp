@@ -14,101 +14,20 @@
 
 #include <unistd.h>
 
+#include "modes_phc.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq {
 namespace {
+
+using modes_phc::modes_expect_same_as_phc;
+using modes_phc::phc_installed;
 
 std::string modes_phc_models(const std::string& rel) {
   std::string path = PHIQ_MODELS_DIR;
   path += '/';
   path += rel;
   return path;
-}
-
-bool phc_installed() { return std::system("command -v phc > /dev/null 2>&1") == 0; }
-
-// One solution as phc writes it: the values of x1 … xn, and whether phc calls it real.
-struct PhcSolution {
-  std::vector<std::complex<double>> x;
-  bool real = false;
-  bool regular = false;
-};
-
-// Runs `phc -b` on the system's text and reads the solutions of the last "THE SOLUTIONS" section (after its
-// root refinement).
-std::vector<PhcSolution> phc_solve(const PolynomialSystem& system) {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("phiq_modes_phc_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string in = (dir / "in.phc").string(), out = (dir / "out.phc").string();
-  std::ofstream(in) << phc_input_text(system);
-  const std::string command = "cd '" + dir.string() + "' && phc -b in.phc out.phc < /dev/null > /dev/null 2>&1";
-  EXPECT_EQ(std::system(command.c_str()), 0) << command;
-  std::ifstream file(out);
-  std::stringstream all;
-  all << file.rdbuf();
-  const std::string text = all.str();
-  std::filesystem::remove_all(dir);
-  const std::size_t at = text.rfind("THE SOLUTIONS");
-  std::vector<PhcSolution> solutions;
-  if (at == std::string::npos) return solutions;
-  std::istringstream lines(text.substr(at));
-  std::string line;
-  PhcSolution current;
-  bool reading = false;
-  while (std::getline(lines, line)) {
-    if (line.find("the solution for t") != std::string::npos) {
-      reading = true;
-      current = PhcSolution{};
-      continue;
-    }
-    if (!reading) continue;
-    if (line.rfind("==", 0) == 0) {
-      // phc's own words ("real regular") are not written for every system (not for one unknown): judged here from
-      // its numbers, as phiq judges its own (the inverse condition estimate rco, the imaginary parts)
-      const std::size_t rco = line.find("rco :");
-      current.regular = rco != std::string::npos && std::stod(line.substr(rco + 5)) > 1e-10;
-      double size = 0.0, imag = 0.0;
-      for (const auto& v : current.x) size = std::max(size, std::abs(v)), imag = std::max(imag, std::abs(v.imag()));
-      current.real = imag <= 1e-8 * (1.0 + size);
-      solutions.push_back(current);
-      reading = false;
-      continue;
-    }
-    // " xK :  re  im": phc numbers the unknowns in the order it first reads them, not by name
-    std::istringstream fields(line);
-    std::string name, colon;
-    double re = 0.0, im = 0.0;
-    if (fields >> name >> colon >> re >> im && name.size() > 1 && name[0] == 'x') {
-      const std::size_t k = static_cast<std::size_t>(std::stoi(name.substr(1)) - 1);
-      if (current.x.size() <= k) current.x.resize(k + 1);
-      current.x[k] = {re, im};
-    }
-  }
-  return solutions;
-}
-
-// phc's solutions against phiq's endpoints: regular finite counts, real counts, and every real solution of one
-// found by the other (phc's variables are x1 … xn in the system's order).
-void modes_expect_same_as_phc(const PolynomialSystem& system, const ModesSummary& ours) {
-  const std::vector<PhcSolution> theirs = phc_solve(system);
-  int regular = 0, real = 0;
-  for (const PhcSolution& s : theirs) regular += s.regular, real += s.regular && s.real;
-  EXPECT_EQ(ours.real + ours.complex, regular);
-  EXPECT_EQ(ours.real, real);
-  for (const Endpoint& e : ours.endpoints) {
-    if (e.kind != EndpointKind::kReal) continue;
-    bool found = false;
-    for (const PhcSolution& s : theirs) {
-      if (!s.real || static_cast<Eigen::Index>(s.x.size()) != e.x.size()) continue;
-      double d = 0.0;
-      for (Eigen::Index v = 0; v < e.x.size(); ++v)
-        d = std::max(d, std::abs(s.x[static_cast<std::size_t>(v)] - e.x(v)));
-      found = found || d < 1e-8;
-    }
-    EXPECT_TRUE(found) << "a real solution of phiq's that phc did not find";
-  }
 }
 
 TEST(ModesPhc, IntegerSystemAsPhcSolvesIt) {

@@ -84,6 +84,7 @@ std::string mode_count_text(const ModeCount& c, const std::string& subject) {
   for (const AssemblyMode& m : f.modes) singular += m.singular ? 1 : 0;
   std::string s = std::to_string(f.modes.size()) + " real at t = " + format_time(c.time) + " (" +
                   std::to_string(f.summary.paths) + (f.summary.paths == 1 ? " path" : " paths") +
+                  (f.summary.method == ModesMethod::kBlocks ? ", block by block" : "") +
                   (singular ? ", " + std::to_string(singular) + " of the modes singular" : std::string()) + ")";
   if (!c.located) return s + "; " + subject + " did not assemble";
   const ModeLocation& w = c.where;
@@ -111,6 +112,7 @@ nlohmann::ordered_json mode_count_json(const ModeCount& c) {
   j["real"] = or_null(counted, c.found.modes.size());
   j["singular"] = or_null(counted, singular);
   j["paths"] = or_null(counted, c.found.summary.paths);
+  j["method"] = or_null(counted, modes_method_name(c.found.summary.method));
   const ModeLocation& w = c.where;
   const bool in_mode = counted && c.located && w.mode >= 0, has_next = in_mode && w.next >= 0;
   j["assembled"] = or_null(counted, c.located);

@@ -63,7 +63,11 @@ std::string report_text(const std::string& scene_path, double t, const AssemblyM
     << " complex, " << s.singular << " singular, " << s.at_infinity << " at infinity, " << s.failed_paths << " failed, "
     << s.duplicate_paths << " duplicate, " << s.retracked_paths << " tracked twice; " << r.polynomials.system.variables
     << " unknowns, " << r.polynomials.eliminated_rows.size() << " coordinates fixed by their own rows; "
-    << shortest(std::round(s.seconds * 1e4) / 1e4) << " s)\n";
+    << modes_method_name(s.method);
+  if (s.method == ModesMethod::kBlocks) o << ", " << s.blocks << " blocks";
+  o << "; start: " << s.start_system << " (total degree " << s.total_degree << "), " << s.end_game_paths
+    << " ends by the end game; " << shortest(std::round(s.seconds * 1e4) / 1e4) << " s)\n";
+  if (!s.method_note.empty()) o << "  " << s.method_note << ": the whole system solved instead\n";
   for (std::size_t k = 0; k < r.modes.size(); ++k) {
     const AssemblyMode& m = r.modes[k];
     o << "  mode " << k + 1 << (m.singular ? " (singular)" : "") << ": " << mode_coordinates(model, m, "; ")
@@ -108,6 +112,12 @@ nlohmann::ordered_json modes_json(const std::string& scene_path, double t, const
   j["at_infinity"] = r.summary.at_infinity;
   j["failed_paths"] = r.summary.failed_paths;
   j["duplicate_paths"] = r.summary.duplicate_paths;
+  j["method"] = modes_method_name(r.summary.method);
+  j["blocks"] = r.summary.blocks;
+  j["method_note"] = r.summary.method_note;
+  j["start_system"] = r.summary.start_system;
+  j["total_degree"] = r.summary.total_degree;
+  j["end_game_paths"] = r.summary.end_game_paths;
   j["coordinates"] = model.coordinate_names();
   auto modes = nlohmann::ordered_json::array();
   for (const AssemblyMode& m : r.modes) {
@@ -134,7 +144,10 @@ std::string modes_yaml(const std::string& scene_path, double t, const Model& mod
   o << "scene: " << nlohmann::ordered_json(scene_path).dump() << "\ntime: " << shortest(t)
     << "\npaths: " << r.summary.paths << "\nreal: " << r.modes.size() << "\ncomplex: " << r.summary.complex
     << "\nsingular: " << r.summary.singular << "\nat_infinity: " << r.summary.at_infinity
-    << "\nfailed_paths: " << r.summary.failed_paths << "\nmodes:\n";
+    << "\nfailed_paths: " << r.summary.failed_paths << "\nmethod: " << modes_method_name(r.summary.method)
+    << "\nblocks: " << r.summary.blocks << "\nmethod_note: " << nlohmann::ordered_json(r.summary.method_note).dump()
+    << "\nstart_system: " << nlohmann::ordered_json(r.summary.start_system).dump()
+    << "\ntotal_degree: " << r.summary.total_degree << "\nend_game_paths: " << r.summary.end_game_paths << "\nmodes:\n";
   for (std::size_t k = 0; k < r.modes.size(); ++k) {
     const AssemblyMode& m = r.modes[k];
     o << "  - {mode: " << k + 1 << ", singular: " << (m.singular ? "true" : "false")

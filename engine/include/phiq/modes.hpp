@@ -6,14 +6,20 @@
 /// The method. Each row of Φ is recovered as a polynomial in the coordinates it reads (find_polynomial_system():
 /// the coefficients of every monomial up to degree 4 fitted by least squares to evaluations of the row, and checked
 /// on fresh points), angle coordinates entering through (c, s) = (cos θ, sin θ) with c² + s² = 1; a row no
-/// polynomial reproduces (a cam, a spline, exp) is refused with its constraint named. Rows that fix one coordinate
-/// (drivers, a polar's arm at a driven angle) are eliminated first. The square polynomial system is then solved by
-/// solve_polynomial_system(): the total-degree start system x_i^{d_i} = 1 and the homotopy
-/// H(x, t) = (1 − t) F(x) + γ t G(x) with a random complex γ (the "γ trick": no path meets a singularity for t > 0),
-/// tracked in projective coordinates on a random affine patch (paths that diverge in affine space end at points
+/// polynomial reproduces (a cam, a spline, exp) is refused with its constraint named. Rows affine in what they
+/// read are eliminated first: those that fix one coordinate (drivers, a polar's arm at a driven angle), then sets
+/// of them solved together (gears and belts among driven angles: linear in the angles, polynomial in no (c, s)).
+/// A spatial joint-angle driver is read as s cos f − c sin f (c, s: the joint frames' axes' products). The square
+/// polynomial system is then solved by solve_polynomial_system(): its degrees first lowered where rows share their
+/// highest forms (ModesOptions::lower_degrees), then the start system with the fewest paths, the total-degree
+/// x_i^{d_i} = 1 or a multi-homogeneous linear product (StartSystemChoice), and the
+/// homotopy H(x, t) = (1 − t) F(x) + γ t G(x) with a random complex γ (the "γ trick": no path meets a singularity for t
+/// > 0), tracked in projective coordinates on a random affine patch (paths that diverge in affine space end at points
 /// with x₀ → 0, at infinity, instead of running away) by an adaptive RK4 predictor and Newton corrector. Every
 /// endpoint is refined by Newton on the original equations and classified: real, complex, singular (condition
-/// number above ModesOptions::singular_condition) or at infinity. Paths run in parallel
+/// number above ModesOptions::singular_condition, or reached by several paths with a condition above
+/// ModesOptions::multiple_root_condition) or at infinity. find_assembly_modes() solves a block-triangular system
+/// block by block where that is safe (ModesMethod). Paths run in parallel
 /// (TBB); each path's arithmetic is independent of the others and the endpoints are merged in path order and
 /// sorted, so the result is the same, to the bit, on any number of threads.
 #pragma once
@@ -53,6 +59,15 @@ struct PolynomialSystem {
   std::int64_t total_degree() const;
 };
 
+/// Which start system solve_polynomial_system() tracks its paths from (ModesOptions::start_system).
+enum class StartSystemChoice {
+  kFewestPaths,  ///< total degree or multi-homogeneous, equations lowered or not: whichever has the fewest paths
+  kTotalDegree,  ///< x_i^{d_i} = 1 (the equations lowered when ModesOptions::lower_degrees and that cuts paths)
+  /// the linear-product start system of the candidate grouping of two or more groups with the fewest paths (the
+  /// total degree when there is none: a system in one variable)
+  kMultiHomogeneous,
+};
+
 /// Settings of solve_polynomial_system() and find_assembly_modes().
 struct ModesOptions {
   double time = 0.0;  ///< T, the time at which the drivers are evaluated (find_assembly_modes())
@@ -68,13 +83,44 @@ struct ModesOptions {
   /// Endpoints closer than this · (1 + |x|∞) are one solution, reached by several paths (Endpoint::multiplicity).
   double duplicate_tolerance = 1e-6;
   int max_fit_degree = 4;  ///< the highest degree a row is fitted with (find_polynomial_system())
+  /// An endpoint that several paths reach (after the careful second pass) is singular when its condition is above
+  /// this: a multiple root, which double precision places only to about √ε, so that its condition stays near 1e8
+  /// (a regular solution is the end of one path only; one that two paths reach is well conditioned).
+  double multiple_root_condition = 1e5;
+  /// find_assembly_modes(): solve a block-triangular system block by block where that is safe (ModesMethod), else
+  /// (false, or not safe) the whole system at once.
+  bool block_solve = true;
+  /// The start system: by default whichever start system has the fewest paths (StartSystemChoice).
+  StartSystemChoice start_system = StartSystemChoice::kFewestPaths;
+  /// Lower the equations' degrees first where that cuts the paths: each equation plus polynomial multiples of the
+  /// lower-degree ones before it, so that its highest-degree form cancels (the same ideal: the same finite
+  /// solutions, with their multiplicities); a Stewart–Gough platform's 8192 total-degree paths become 432.
+  bool lower_degrees = true;
+  /// More candidate groupings of the variables for the multi-homogeneous start system (each group_of[v] per
+  /// variable, as multihomogeneous_bezout_number() takes it; one of another size is ignored), besides those the
+  /// system suggests (each rotation's c, s or Euler parameters, found by their normalisations, apart from the other
+  /// variables; every variable alone).
+  std::vector<std::vector<int>> groupings;
 };
+
+/// How find_assembly_modes() solved its system (ModesSummary::method).
+enum class ModesMethod {
+  kWholeSystem,  ///< one homotopy of the whole system
+  /// Block by block: the Dulmage–Mendelsohn blocks in order, each for every real solution of those before it, the
+  /// results refined and classified on the whole system. Used only when every solution carried from one block to
+  /// the next is regular and well conditioned and no path failed (a singular one, known only to √ε, would perturb
+  /// the blocks after it: a double root splits into two real or two complex ones); otherwise the whole system.
+  kBlocks,
+};
+
+/// "whole system", "block by block".
+const char* modes_method_name(ModesMethod method);
 
 /// How a call of solve_polynomial_system() or find_assembly_modes() ended.
 enum class ModesStatus {
   kSuccess,        ///< every path tracked (some may have failed: ModesSummary::failed_paths)
   kNotPolynomial,  ///< a constraint is not polynomial in its coordinates (the message names it)
-  kTooManyPaths,   ///< the total degree is above ModesOptions::max_paths (the message says it)
+  kTooManyPaths,   ///< the start system's paths are above ModesOptions::max_paths (the message says it)
   kNotSquare,      ///< fewer equations than unknowns: the assemblies form a continuum (the message says it)
 };
 
@@ -103,19 +149,34 @@ struct Endpoint {
 struct ModesSummary {
   ModesStatus status = ModesStatus::kSuccess;  ///< see ModesStatus
   std::string message;                         ///< one line when status is not kSuccess
-  std::int64_t paths = 0;                      ///< paths tracked (the total degree)
+  std::int64_t paths = 0;                      ///< paths tracked (the start system's; block by block, all blocks')
   int real = 0;                                ///< distinct real regular endpoints
-  int complex = 0;                             ///< distinct complex regular endpoints
-  int singular = 0;                            ///< distinct singular endpoints
-  int at_infinity = 0;                         ///< distinct endpoints at infinity
-  int failed_paths = 0;                        ///< paths that could not be tracked to t = 0
+  int complex = 0;       ///< distinct complex regular endpoints (block by block: the blocks', not carried forward)
+  int singular = 0;      ///< distinct singular endpoints
+  int at_infinity = 0;   ///< distinct endpoints at infinity
+  int failed_paths = 0;  ///< paths that could not be tracked to t = 0
   /// Paths that ended at a regular endpoint another path had reached: a path jumped onto another's on the way (a
   /// regular solution is the end of one path only), so that some solution may be missing. 0 when all went well.
   int duplicate_paths = 0;
   /// Paths tracked a second time, with shorter steps, because the first attempt failed or ended at another path's
   /// regular endpoint (the counts above are those after the second attempt).
   int retracked_paths = 0;
-  double seconds = 0.0;  ///< wall time of the tracking
+  /// Paths whose end Cauchy's end game found (their step collapsed near t = 0: a singular endpoint or one at
+  /// infinity, reached by circling t = 0 until the path closes up, and the mean of its points there).
+  int end_game_paths = 0;
+  double seconds = 0.0;                            ///< wall time of the tracking
+  ModesMethod method = ModesMethod::kWholeSystem;  ///< how the system was solved
+  int blocks = 1;                                  ///< the blocks solved in turn (1: the whole system)
+  /// The start system the paths were tracked from: "total degree", "total degree, degrees lowered" or
+  /// "multi-homogeneous {x y} {cos(a) sin(a)}" (its groups; ", degrees lowered" when they were). Block by block: the
+  /// last block's.
+  std::string start_system;
+  /// The total degree of the (squared-up) system as given, before any lowering: `paths` against this is what the
+  /// start system saved.
+  std::int64_t total_degree = 0;
+  /// Why the whole system was solved where the block solve was tried and found unsafe (empty otherwise): one line
+  /// naming the block and what it found there.
+  std::string method_note;
   /// The distinct endpoints: real first, then complex, singular, at infinity, failed; within a kind in a fixed
   /// order (lexicographic in the real, then imaginary parts).
   std::vector<Endpoint> endpoints;
@@ -123,15 +184,31 @@ struct ModesSummary {
 
 /// Solves a square polynomial system (or an overdetermined one: its equations are first combined at random into as
 /// many as unknowns, and the endpoints are refined and checked on all of them; a non-solution of the original
-/// system is classified kFailed) by total-degree homotopy continuation (the file's comment). Refuses with
-/// kTooManyPaths (nothing tracked) when the total degree is above options.max_paths, with kNotSquare when there
-/// are fewer equations than unknowns. The result does not depend on options.threads. Throws phiq::Error for a
+/// system is classified kFailed) by homotopy continuation (the file's comment). Refuses with
+/// kTooManyPaths (nothing tracked) when the start system's paths are above options.max_paths, with kNotSquare when
+/// there are fewer equations than unknowns. The result does not depend on options.threads. Throws phiq::Error for a
 /// system whose terms do not have `variables` exponents.
 ModesSummary solve_polynomial_system(const PolynomialSystem& system, const ModesOptions& options);
+
+/// The multi-homogeneous Bézout number of a square system for a grouping of its variables (group_of[v]: the group
+/// of variable v, 0 … groups − 1, every group used): the coefficient of Π_j α_j^{n_j} (n_j the variables of group j)
+/// in Π_i Σ_j d_ij α_j (d_ij: equation i's degree in group j's variables), the number of paths of the
+/// multi-homogeneous start system. One group: the total degree. Saturated at 2⁶².
+std::int64_t multihomogeneous_bezout_number(const PolynomialSystem& system, const std::vector<int>& group_of);
 
 /// The text of `system` in PHCpack's input format (`phc -b in out`): the number of equations and unknowns, then
 /// each equation ended by ';', coefficients in full precision, variable v as x(v + 1): x1, x2, …
 std::string phc_input_text(const PolynomialSystem& system);
+
+/// A row that relates free angles linearly with rational ratios (a gear or a belt between angles a linkage turns):
+/// Σ_k n_k θ_k = phase with integers n_k, solved modulo 2π as the complex polynomial
+/// Π_{n_k > 0} (c_k + i s_k)^{n_k} − e^{i·phase} Π_{n_k < 0} (c_k − i s_k)^{−n_k} = 0 (Chebyshev's multiple angles).
+struct AngleRelation {
+  Index row = -1;              ///< its row of Φ
+  std::vector<Index> angles;   ///< the angle coordinates it reads
+  std::vector<int> multiples;  ///< n_k, one per angle, their greatest common divisor 1
+  double phase = 0.0;          ///< the right-hand side (rad)
+};
 
 /// A model's equations at time T as polynomials (find_polynomial_system()).
 struct ModelPolynomials {
@@ -142,16 +219,20 @@ struct ModelPolynomials {
   PolynomialSystem system;
   /// For each coordinate of the model: −1 when eliminated (fixed), else its variable (the c of an angle, s is next).
   std::vector<int> variable_of;
-  std::vector<double> fixed;           ///< the value of every eliminated coordinate (NaN for the others)
-  Eigen::VectorXd origin;              ///< q0, the placement the scaled variables are measured from
-  Eigen::VectorXd scale;               ///< the scale of each coordinate's variable (1 for angles)
-  std::vector<Index> eliminated_rows;  ///< the rows of Φ that fixed a coordinate, ascending
-  /// q of a real solution x of `system`: angles as atan2(s, c) on the 2π branch nearest the placement.
+  std::vector<double> fixed;                   ///< the value of every eliminated coordinate (NaN for the others)
+  Eigen::VectorXd origin;                      ///< q0, the placement the scaled variables are measured from
+  Eigen::VectorXd scale;                       ///< the scale of each coordinate's variable (1 for angles)
+  std::vector<Index> eliminated_rows;          ///< the rows of Φ that fixed a coordinate, ascending
+  std::vector<AngleRelation> angle_relations;  ///< the rows solved modulo 2π, in row order
+  /// q of a real solution x of `system`: angles as atan2(s, c) on the 2π branch nearest the placement, then turned
+  /// by whole turns where an angle relation needs it to hold exactly (the relations in order; one may undo an
+  /// earlier one's that shares its angles, and find_assembly_modes() then rejects the point).
   Eigen::VectorXd coordinates(const Eigen::VectorXcd& x) const;
 };
 
 /// Recovers each row of Φ(·, options.time) as a polynomial (the file's comment): rows that read one coordinate and
-/// are affine in it fix it (eliminated, repeatedly, as fixed coordinates make more rows read one), and every other
+/// are affine in it fix it, then sets of rows affine in all they read fix what they determine (eliminated,
+/// repeatedly, as fixed coordinates make more rows affine), and every other
 /// row is fitted, degree 1 to options.max_fit_degree, in its coordinates' scaled variables. kNotPolynomial names
 /// the first constraint no polynomial reproduces ("constraint 'cam': is not polynomial in its coordinates …").
 /// Thread-safe.
@@ -170,10 +251,17 @@ struct AssemblyModes {
   ModesSummary summary;             ///< the homotopy's (status, message, counts, endpoints in the system's variables)
   ModelPolynomials polynomials;     ///< the system solved
   std::vector<AssemblyMode> modes;  ///< the real solutions, regular and singular, in the summary's order
+  /// Real solutions of the system that are no assembly: the model's own Φ is not zero there (a spatial joint-angle
+  /// driver's polynomial form also holds at the driven angle + π).
+  int rejected = 0;
+  /// Real solutions that are another's placement again: a body's Euler parameters −e for e (each mode keeps the
+  /// sign nearest the placement's).
+  int merged = 0;
 };
 
-/// find_polynomial_system() then solve_polynomial_system(): every real assembly of `model` at options.time. The
-/// status and message are those of the first step that refused. Thread-safe.
+/// find_polynomial_system() then solve_polynomial_system(): every real assembly of `model` at options.time, each
+/// checked on the model's own equations (AssemblyModes::rejected) and placements found twice merged
+/// (AssemblyModes::merged). The status and message are those of the first step that refused. Thread-safe.
 AssemblyModes find_assembly_modes(const Model& model, const ModesOptions& options);
 
 /// The distance between two positions of `model`: max_j |a_j − b_j| / scale_j, lengths scaled by the model's

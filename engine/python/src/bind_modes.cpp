@@ -41,13 +41,18 @@ void bind_modes(py::module_& m) {
         d["complex"] = r.summary.complex;
         d["at_infinity"] = r.summary.at_infinity;
         d["failed_paths"] = r.summary.failed_paths;
+        d["method"] = modes_method_name(r.summary.method);
+        d["method_note"] = r.summary.method_note;
+        d["start_system"] = r.summary.start_system;
         return d;
       },
       py::arg("scene"), py::arg("t") = py::none(), py::arg("threads") = 0, py::arg("max_paths") = 100000,
       "Every real assembly mode of the scene at time t (default time.start), by polynomial homotopy continuation "
       "(engine/include/phiq/modes.hpp): a dict with 'q' (modes x coordinates; a row is a placement a Workspace's q "
       "takes), 'coordinates', 'residual', 'condition', 'singular', and the homotopy's 'paths', 'complex', "
-      "'at_infinity', 'failed_paths'. Raises ValueError naming the constraint when one is not polynomial, or when "
+      "'at_infinity', 'failed_paths', 'method' (whole system or block by block), 'method_note' (why not block "
+      "by block) and 'start_system' (total degree or multi-homogeneous, degrees lowered or not). Raises ValueError "
+      "naming the constraint when one is not polynomial, or when "
       "the paths are more than max_paths.");
 }
 

@@ -1,6 +1,7 @@
-// solve_polynomial_system() (phiq/modes.hpp): squares the system up, tracks every path of the total-degree homotopy
-// in parallel, refines each endpoint by Newton on the original equations, classifies it, merges duplicates and
-// sorts the endpoints so that the result does not depend on the order the paths finished in.
+// solve_polynomial_system() (phiq/modes.hpp): squares the system up, lowers its degrees and picks the start system
+// with the fewest paths (total degree or multi-homogeneous), tracks every path in parallel, refines each endpoint by
+// Newton on the original equations, classifies it, merges duplicates and sorts the endpoints so that the result does
+// not depend on the order the paths finished in.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,6 +21,7 @@ namespace {
 
 using modes_detail::cd;
 using modes_detail::CompiledSystem;
+using modes_detail::Grouping;
 using modes_detail::Homotopy;
 using modes_detail::PathEnd;
 using modes_detail::Random;
@@ -50,10 +52,125 @@ PolynomialSystem squared_up(const PolynomialSystem& s, Random& random) {
   return square;
 }
 
+// The groups a system's normalisations suggest: an equation of degree 2 whose quadratic terms are squares of two or
+// more variables (c² + s² = 1 of an angle, e·e = 1 of a body's Euler parameters, in shifted variables too) names a
+// rotation's variables. Candidates: each rotation its own group and the other variables one; all rotations one group
+// and the others one; every variable its own group (up to 16 variables).
+std::vector<std::vector<int>> candidate_groupings(const PolynomialSystem& s) {
+  const int n = s.variables;
+  std::vector<int> rotation(static_cast<std::size_t>(n), -1);
+  int rotations = 0;
+  for (const Polynomial& p : s.equations) {
+    if (p.degree() != 2) continue;
+    std::vector<int> vars;
+    bool squares = true;
+    for (const PolynomialTerm& t : p.terms) {
+      int d = 0, square = -1;
+      for (int v = 0; v < n; ++v) {
+        d += t.exponent[static_cast<std::size_t>(v)];
+        if (t.exponent[static_cast<std::size_t>(v)] == 2) square = v;
+      }
+      if (d < 2) continue;
+      squares = squares && square >= 0;
+      if (square >= 0) vars.push_back(square);
+    }
+    if (!squares || vars.size() < 2 ||
+        std::any_of(vars.begin(), vars.end(), [&](int v) { return rotation[static_cast<std::size_t>(v)] >= 0; }))
+      continue;
+    for (int v : vars) rotation[static_cast<std::size_t>(v)] = rotations;
+    ++rotations;
+  }
+  std::vector<std::vector<int>> out;
+  const bool rest = std::any_of(rotation.begin(), rotation.end(), [](int r) { return r < 0; });
+  if (rotations > 0 && (rest || rotations > 1)) {
+    std::vector<int> apart(static_cast<std::size_t>(n)), together(static_cast<std::size_t>(n));
+    for (int v = 0; v < n; ++v) {
+      const int r = rotation[static_cast<std::size_t>(v)];
+      apart[static_cast<std::size_t>(v)] = r < 0 ? rotations : r;
+      together[static_cast<std::size_t>(v)] = r < 0 ? 1 : 0;
+    }
+    if (!rest) together.assign(static_cast<std::size_t>(n), 0);
+    out.push_back(modes_detail::grouping_from(apart).group_of);
+    if (rest && rotations > 1) out.push_back(together);
+  }
+  if (n >= 2 && n <= 16) {
+    std::vector<int> each(static_cast<std::size_t>(n));
+    for (int v = 0; v < n; ++v) each[static_cast<std::size_t>(v)] = v;
+    out.push_back(each);
+  }
+  return out;
+}
+
+std::string grouping_name(const PolynomialSystem& s, const Grouping& g) {
+  if (g.groups == 1) return "total degree";
+  std::string name = "multi-homogeneous";
+  for (const auto& members : g.members) {
+    name += " {";
+    for (std::size_t k = 0; k < members.size(); ++k)
+      name += (k ? " " : "") + (s.names.empty() || s.names[static_cast<std::size_t>(members[k])].empty()
+                                    ? "x" + std::to_string(members[k] + 1)
+                                    : s.names[static_cast<std::size_t>(members[k])]);
+    name += "}";
+  }
+  return name;
+}
+
+// The system to track and its start system: of the square system and its lowered form, under one group and under
+// each candidate grouping, the one with the fewest paths that options allow (ties: the fewer groups, the system as
+// given). The linear products' forms are drawn from their own stream, so that the choice draws nothing from `random`.
+struct ChosenStart {
+  PolynomialSystem system;
+  modes_detail::StartSystem start;
+  std::string name;
+};
+
+ChosenStart choose_start(const PolynomialSystem& square, const ModesOptions& options) {
+  std::vector<PolynomialSystem> systems{square};
+  if (options.lower_degrees) {
+    PolynomialSystem lowered = modes_detail::lowered_degrees(square);
+    if (lowered.total_degree() < square.total_degree()) systems.push_back(std::move(lowered));
+  }
+  std::vector<std::vector<int>> groupings;
+  if (options.start_system != StartSystemChoice::kMultiHomogeneous)
+    groupings.push_back(std::vector<int>(static_cast<std::size_t>(square.variables), 0));
+  if (options.start_system != StartSystemChoice::kTotalDegree)
+    for (auto& g : candidate_groupings(square)) groupings.push_back(std::move(g));
+  if (options.start_system != StartSystemChoice::kTotalDegree)
+    for (const auto& g : options.groupings) {
+      if (static_cast<int>(g.size()) != square.variables || g.empty() ||
+          !std::all_of(g.begin(), g.end(), [](int j) { return j >= 0; }))
+        continue;
+      const Grouping given = modes_detail::grouping_from(g);
+      if (given.groups > 1 &&
+          std::all_of(given.members.begin(), given.members.end(), [](const auto& m) { return !m.empty(); }))
+        groupings.push_back(g);
+    }
+  if (groupings.empty()) groupings.push_back(std::vector<int>(static_cast<std::size_t>(square.variables), 0));
+  ChosenStart best;
+  std::int64_t fewest = -1;
+  for (const auto& group_of : groupings) {
+    const Grouping g = modes_detail::grouping_from(group_of);
+    for (std::size_t k = 0; k < systems.size(); ++k) {
+      const auto degrees = modes_detail::group_degrees(systems[k], g);
+      const std::int64_t paths = modes_detail::multihomogeneous_bezout(degrees, g);
+      if (fewest >= 0 && paths >= fewest) continue;
+      Random forms(options.seed ^ 0x9E3779B97F4A7C15ull);
+      modes_detail::StartSystem start;
+      if (!modes_detail::make_start_system(degrees, g, forms, start)) continue;
+      fewest = paths;
+      best.system = systems[k], best.start = std::move(start);
+      best.name = grouping_name(square, g) + (k == 1 ? ", degrees lowered" : "");
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
 // Newton (Gauss-Newton for more equations than unknowns) on the original equations from x; returns the residual
 // max_i |F_i| / scale_i and sets the condition number of the scaled Jacobian. Converges linearly at a singular
 // solution (ratio 1/2 at a double root): the iterations allowed let it get there too.
-double refine(const CompiledSystem& f, Eigen::VectorXcd& x, double* condition) {
+double modes_detail::refine_endpoint(const CompiledSystem& f, Eigen::VectorXcd& x, double* condition) {
   Eigen::VectorXcd value;
   Eigen::MatrixXcd jac;
   auto residual_of = [&](const Eigen::VectorXcd& y) {
@@ -85,6 +202,8 @@ double refine(const CompiledSystem& f, Eigen::VectorXcd& x, double* condition) {
   return r;
 }
 
+namespace {
+
 int kind_rank(EndpointKind k) { return static_cast<int>(k); }
 
 bool endpoint_before(const Endpoint& a, const Endpoint& b) {
@@ -94,6 +213,27 @@ bool endpoint_before(const Endpoint& a, const Endpoint& b) {
   for (Eigen::Index v = 0; v < a.x.size(); ++v)
     if (a.x(v).imag() != b.x(v).imag()) return a.x(v).imag() < b.x(v).imag();
   return a.multiplicity < b.multiplicity;
+}
+
+// A point that several paths still reach after the careful pass, and where the Jacobian is far from well
+// conditioned, is a multiple root: Newton places a double root only to about √ε, where the condition is near 1e8
+// (a k-fold tangency of circles gives 1e7 … 1e9), below options.singular_condition; a regular solution is the end
+// of one path only, and one that two paths jumped onto is well conditioned (counted as duplicate). Then the
+// endpoints sorted and counted by kind.
+void finish_endpoints(std::vector<Endpoint>& distinct, const ModesOptions& options, ModesSummary& summary) {
+  for (Endpoint& d : distinct)
+    if (d.multiplicity > 1 && (d.kind == EndpointKind::kReal || d.kind == EndpointKind::kComplex) &&
+        !(d.condition <= options.multiple_root_condition)) {
+      d.kind = EndpointKind::kSingular;
+      summary.duplicate_paths -= d.multiplicity - 1;
+    }
+  std::sort(distinct.begin(), distinct.end(), endpoint_before);
+  for (const Endpoint& d : distinct) {
+    summary.real += d.kind == EndpointKind::kReal;
+    summary.complex += d.kind == EndpointKind::kComplex;
+    summary.singular += d.kind == EndpointKind::kSingular;
+    summary.at_infinity += d.kind == EndpointKind::kAtInfinity;
+  }
 }
 
 }  // namespace
@@ -111,16 +251,23 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
   Random random(options.seed);
   const CompiledSystem original(system);  // checks the exponents
   const PolynomialSystem square = static_cast<int>(system.equations.size()) > n ? squared_up(system, random) : system;
-  summary.paths = square.total_degree();
+  summary.total_degree = square.total_degree();
+  const ChosenStart chosen = choose_start(square, options);
+  summary.paths = chosen.start.paths;
+  summary.start_system = chosen.name;
   if (summary.paths > options.max_paths) {
     summary.status = ModesStatus::kTooManyPaths;
-    summary.message = "the total degree is " + std::to_string(summary.paths) + " paths, above the limit of " +
-                      std::to_string(options.max_paths) + " (ModesOptions::max_paths, --max-paths)";
+    summary.message = (chosen.name == "total degree"
+                           ? "the total degree is " + std::to_string(summary.paths) + " paths"
+                           : "the start system (" + chosen.name + ") has " + std::to_string(summary.paths) + " paths") +
+                      ", above the limit of " + std::to_string(options.max_paths) +
+                      " (ModesOptions::max_paths, --max-paths)";
     return summary;
   }
-  const CompiledSystem target(square);
-  Homotopy homotopy{&target, random.unit_complex(), Eigen::VectorXcd(n + 1)};
-  for (int v = 0; v <= n; ++v) homotopy.patch(v) = random.unit_complex();
+  const CompiledSystem target(chosen.system, chosen.start.grouping);
+  const int groups = chosen.start.grouping.groups;
+  Homotopy homotopy{&target, &chosen.start, random.unit_complex(), Eigen::VectorXcd(n + groups)};
+  for (int v = 0; v < n + groups; ++v) homotopy.patch(v) = random.unit_complex();
 
   // Every path, each into its own slot: the arithmetic of a path does not depend on which thread runs it.
   std::vector<PathEnd> ends(static_cast<std::size_t>(summary.paths));
@@ -147,15 +294,25 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
         ++summary.failed_paths;
         continue;
       }
-      const double x0 = std::abs(e.X(0)), size = inf_norm(e.X);
-      bool infinite = !(x0 > 1e-8 * size);
+      const double finite = homotopy.finiteness(e.X);
+      bool infinite = !(finite > 1e-8);
       if (!infinite) {
-        point.x = e.X.tail(n) / e.X(0);
-        point.residual = refine(original, point.x, &point.condition);
+        point.x = homotopy.affine(e.X);
+        const Eigen::VectorXcd reached = point.x;
+        point.residual = modes_detail::refine_endpoint(original, point.x, &point.condition);
         infinite = !(inf_norm(point.x) < 1e8) || !point.x.allFinite();
+        // a path stopped short of t = 0 that Newton takes far from where it stopped did not end at that solution
+        // (Newton's basin is wide): diverging (its homogenising coordinate already small), or failed
+        if (!infinite && e.t > 0.0 && !(inf_norm(point.x - reached) <= 1e-2 * (1.0 + inf_norm(point.x)))) {
+          if (!(finite < 1e-2)) {
+            ++summary.failed_paths;
+            continue;
+          }
+          infinite = true;
+        }
         // a path stopped short of t = 0 (its step collapsed in the end game) with X0 already small and no solution
         // near it: diverging, to a solution set at infinity
-        if (!infinite && !(point.residual <= 1e-8) && e.t > 0.0 && x0 < 1e-2 * size) infinite = true;
+        if (!infinite && !(point.residual <= 1e-8) && e.t > 0.0 && finite < 1e-2) infinite = true;
         if (!infinite && !(point.residual <= 1e-8)) {
           ++summary.failed_paths;  // solves the squared-up system (or the path was lost), not the original
           continue;
@@ -165,7 +322,7 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
         point.kind = EndpointKind::kAtInfinity;
         Eigen::Index largest = 0;
         e.X.tail(n).cwiseAbs().maxCoeff(&largest);
-        point.x = e.X.tail(n) / e.X(1 + largest);
+        point.x = e.X.tail(n) / e.X(groups + largest);
         point.residual = 0.0, point.condition = std::numeric_limits<double>::infinity();
       } else if (!(point.condition <= options.singular_condition)) {
         point.kind = EndpointKind::kSingular;
@@ -214,13 +371,8 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
     classify();
   }
   summary.retracked_paths = static_cast<int>(again.size());
-  std::sort(distinct.begin(), distinct.end(), endpoint_before);
-  for (const Endpoint& d : distinct) {
-    summary.real += d.kind == EndpointKind::kReal;
-    summary.complex += d.kind == EndpointKind::kComplex;
-    summary.singular += d.kind == EndpointKind::kSingular;
-    summary.at_infinity += d.kind == EndpointKind::kAtInfinity;
-  }
+  for (const PathEnd& e : ends) summary.end_game_paths += e.winding > 0;
+  finish_endpoints(distinct, options, summary);
   summary.endpoints = std::move(distinct);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return summary;

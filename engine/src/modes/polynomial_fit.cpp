@@ -12,11 +12,13 @@
 #include <Eigen/QR>
 
 #include "modes/homotopy.hpp"
+#include "modes/model_rows.hpp"
 
 namespace phiq {
 
 namespace {
 
+using modes_detail::ModelRows;
 using modes_detail::Random;
 
 // One unknown of a row: coordinate j, as a scaled variable (angle false) or as the pair (c, s) (angle true).
@@ -42,60 +44,8 @@ void monomials(int width, int d, const std::vector<bool>& second_of_pair, std::v
   current[static_cast<std::size_t>(at)] = 0;
 }
 
-// The model's rows at q, one evaluation of the whole model per call (the models solved here are small).
-struct RowEvaluator {
-  const Model& model;
-  double t;
-  std::vector<double> phi;
-  double row(const Eigen::VectorXd& q, Index r) {
-    phi.resize(static_cast<std::size_t>(model.num_equations()));
-    model.residual(q.data(), t, phi.data());
-    return phi[static_cast<std::size_t>(r)];
-  }
-};
-
 constexpr int kMaxMonomials = 1500;     // a row of more terms than this is refused (fitting it would take minutes)
 constexpr double kFitTolerance = 1e-9;  // relative to the row's largest sampled value
-
-// Rows that read one free coordinate and are affine in it fix that coordinate (drivers, then what driven
-// coordinates leave with one unknown), until none does: out.fixed, out.eliminated_rows, `base` (the origin with the
-// fixed values) and `eliminated` (per row) are updated.
-void eliminate_fixed_coordinates(RowEvaluator& eval, const std::vector<std::vector<Index>>& row_columns,
-                                 ModelPolynomials& out, Eigen::VectorXd& base, std::vector<bool>& eliminated) {
-  auto is_fixed = [&](Index j) { return !std::isnan(out.fixed[static_cast<std::size_t>(j)]); };
-  const Index m = static_cast<Index>(row_columns.size());
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (Index r = 0; r < m; ++r) {
-      if (eliminated[static_cast<std::size_t>(r)]) continue;
-      Index only = -1;
-      int free = 0;
-      for (Index j : row_columns[static_cast<std::size_t>(r)])
-        if (!is_fixed(j)) only = j, ++free;
-      if (free != 1) continue;
-      const double h = out.scale(only);
-      Eigen::VectorXd q = base;
-      auto at = [&](double u) {
-        q(only) = out.origin(only) + h * u;
-        return eval.row(q, r);
-      };
-      const double f0 = at(0.0), f1 = at(1.0), slope = f1 - f0;  // per unit of the scaled variable
-      const double size = std::abs(f0) + std::abs(slope);
-      bool affine = std::abs(slope) > 1e-12 * size && std::isfinite(size);
-      for (double u : {-0.71, 0.37, -1.9}) affine = affine && std::abs(at(u) - (f0 + slope * u)) <= 1e-11 * size;
-      if (!affine) continue;
-      const double value = out.origin(only) - h * f0 / slope;
-      // refine on the row itself (an affine row: one step lands on it to rounding)
-      q(only) = value;
-      const double f = eval.row(q, r);
-      out.fixed[static_cast<std::size_t>(only)] = value - h * f / slope;
-      base(only) = out.fixed[static_cast<std::size_t>(only)];
-      eliminated[static_cast<std::size_t>(r)] = true;
-      out.eliminated_rows.push_back(r);
-      changed = true;
-    }
-  }
-}
 
 // c² + s² − 1 = 0 for every free angle coordinate (angle[j]) of `out`'s system.
 void add_circle_equations(const std::vector<bool>& angle, ModelPolynomials& out) {
@@ -115,6 +65,23 @@ void add_circle_equations(const std::vector<bool>& angle, ModelPolynomials& out)
   }
 }
 
+// Row r as an angle relation (model_rows.hpp) when it is linear in the free angles it reads (`reads`) alone: no
+// polynomial in (c, s) reproduces it, a multiple-angle one holds it modulo 2π. Appends the equation and the relation.
+bool add_angle_relation(ModelRows& eval, Index r, const std::vector<RowCoordinate>& reads, const Eigen::VectorXd& base,
+                        Random& random, ModelPolynomials& out) {
+  std::vector<Index> free;
+  bool all_angles = !reads.empty();
+  for (const RowCoordinate& c : reads) free.push_back(c.coordinate), all_angles = all_angles && c.angle;
+  AngleRelation relation;
+  Polynomial p;
+  if (!all_angles ||
+      !modes_detail::angle_relation(eval, r, free, out.variable_of, base, out.system.variables, random, relation, p))
+    return false;
+  out.system.equations.push_back(std::move(p));
+  out.angle_relations.push_back(std::move(relation));
+  return true;
+}
+
 }  // namespace
 
 Eigen::VectorXd ModelPolynomials::coordinates(const Eigen::VectorXcd& x) const {
@@ -130,6 +97,7 @@ Eigen::VectorXd ModelPolynomials::coordinates(const Eigen::VectorXcd& x) const {
       q(jj) = origin(jj) + scale(jj) * x(variable_of[j]).real();
     }
   }
+  for (const AngleRelation& relation : angle_relations) modes_detail::apply_relation_turns(relation, q);
   return q;
 }
 
@@ -137,7 +105,7 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
   ModelPolynomials out;
   const Index n = model.num_coordinates(), m = model.num_equations();
   Random random(options.seed ^ 0x5DEECE66Dull);
-  RowEvaluator eval{model, options.time, {}};
+  ModelRows eval(model, options.time);
   out.origin = model.initial_positions();
   out.scale = Eigen::VectorXd::Ones(n);
   std::vector<bool> angle(static_cast<std::size_t>(n));
@@ -156,12 +124,12 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
     return model.constraints()[static_cast<std::size_t>(model.constraint_of_row(r))].name;
   };
 
-  // 1. Rows that read one free coordinate and are affine in it fix that coordinate.
+  // 1. Affine rows fix coordinates: drivers, then gears among driven angles, pins at fixed angles (model_rows.hpp).
   out.fixed.assign(static_cast<std::size_t>(n), std::numeric_limits<double>::quiet_NaN());
   Eigen::VectorXd base = out.origin;
   std::vector<bool> eliminated(static_cast<std::size_t>(m), false);
   auto is_fixed = [&](Index j) { return !std::isnan(out.fixed[static_cast<std::size_t>(j)]); };
-  eliminate_fixed_coordinates(eval, row_columns, out, base, eliminated);
+  modes_detail::eliminate_affine_rows(eval, row_columns, out, base, eliminated);
   std::sort(out.eliminated_rows.begin(), out.eliminated_rows.end());
 
   // 2. The variables: one per free coordinate, two (c, s) per free angle.
@@ -194,6 +162,7 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
       if (a) second.push_back(true);
     }
     const int width = static_cast<int>(second.size());
+    if (add_angle_relation(eval, r, reads, base, random, out)) continue;  // a gear a linkage turns
     // a point: the local variables' values and the row there
     auto sample = [&](Eigen::VectorXd& local) {
       Eigen::VectorXd q = base;
@@ -240,6 +209,10 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
       if (!b2.allFinite()) break;
       const double size = std::max(b.cwiseAbs().maxCoeff(), b2.cwiseAbs().maxCoeff());
       const double error = (a2 * coefficients - b2).cwiseAbs().maxCoeff();
+      if (size <= 1e-12 * model.tolerance_scales().row_scale(r)) {  // holds wherever the fixed ones put it: no equation
+        fitted = true;
+        break;
+      }
       if (!(error <= kFitTolerance * size) && !(size == 0.0)) continue;
       fitted = true;
       Polynomial p;
@@ -265,7 +238,8 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
                     "' is not polynomial in its coordinates (no polynomial of "
                     "degree <= " +
                     std::to_string(options.max_fit_degree) +
-                    " in them, angles as cos and sin, reproduces it): phiq modes cannot count its assemblies";
+                    " in them, angles as cos and sin, reproduces it, nor is it linear in angles alone with "
+                    "rational ratios): phiq modes cannot count its assemblies";
       out.system = PolynomialSystem{};
       return out;
     }

@@ -61,6 +61,10 @@ const char* endpoint_kind_name(EndpointKind kind) {
   return "failed";
 }
 
+const char* modes_method_name(ModesMethod method) {
+  return method == ModesMethod::kBlocks ? "block by block" : "whole system";
+}
+
 namespace {
 std::string phc_number(double v) {
   char buffer[40];
@@ -98,21 +102,39 @@ namespace modes_detail {
 
 cd Random::unit_complex() { return std::polar(1.0, 2.0 * std::numbers::pi * uniform()); }
 
-CompiledSystem::CompiledSystem(const PolynomialSystem& s) : variables(s.variables) {
+CompiledSystem::CompiledSystem(const PolynomialSystem& s, const Grouping& grouping)
+    : variables(s.variables), groups(grouping.groups) {
   for (const Polynomial& p : s.equations) {
     const int d = p.degree();
-    std::vector<Term> terms;
-    double largest = 0.0;
+    std::vector<int> in_group(static_cast<std::size_t>(groups), 0);
     for (const PolynomialTerm& t : p.terms) {
       if (static_cast<int>(t.exponent.size()) != variables)
         throw Error("polynomial system: a term has " + std::to_string(t.exponent.size()) + " exponents for " +
                     std::to_string(variables) + " variables");
-      Term c{t.coefficient, d, {}};
+      std::vector<int> k(static_cast<std::size_t>(groups), 0);
+      for (int v = 0; v < variables; ++v) {
+        if (t.exponent[static_cast<std::size_t>(v)] < 0) throw Error("polynomial system: a negative exponent");
+        k[static_cast<std::size_t>(grouping.group_of[static_cast<std::size_t>(v)])] +=
+            t.exponent[static_cast<std::size_t>(v)];
+      }
+      for (int j = 0; j < groups; ++j)
+        in_group[static_cast<std::size_t>(j)] =
+            std::max(in_group[static_cast<std::size_t>(j)], k[static_cast<std::size_t>(j)]);
+    }
+    std::vector<Term> terms;
+    double largest = 0.0;
+    for (const PolynomialTerm& t : p.terms) {
+      Term c{t.coefficient, {}, {}};
+      std::vector<int> k(static_cast<std::size_t>(groups), 0);
       for (int v = 0; v < variables; ++v) {
         const int e = t.exponent[static_cast<std::size_t>(v)];
-        if (e < 0) throw Error("polynomial system: a negative exponent");
-        if (e > 0) c.factors.emplace_back(v, e), c.homogenising -= e;
+        if (e > 0) c.factors.emplace_back(v, e);
+        k[static_cast<std::size_t>(grouping.group_of[static_cast<std::size_t>(v)])] += e;
         max_power = std::max(max_power, e);
+      }
+      for (int j = 0; j < groups; ++j) {
+        const int h = in_group[static_cast<std::size_t>(j)] - k[static_cast<std::size_t>(j)];
+        if (h > 0) c.homogenising.emplace_back(j, h);
       }
       largest = std::max(largest, std::abs(t.coefficient));
       terms.push_back(std::move(c));
@@ -120,6 +142,7 @@ CompiledSystem::CompiledSystem(const PolynomialSystem& s) : variables(s.variable
     max_power = std::max(max_power, d);
     equations.push_back(std::move(terms));
     degree.push_back(d);
+    group_degree.push_back(std::move(in_group));
     coefficient_scale.push_back(largest > 0.0 ? largest : 1.0);
   }
 }
@@ -136,11 +159,13 @@ void power_table(const Eigen::VectorXcd& X, int max, std::vector<cd>& powers) {
 }
 }  // namespace
 
-// shared by affine() and homogenised(): `offset` is 1 when X carries X0 first (homogenised), else 0
+// shared by affine() and homogenised(): `offset` is the number of homogenising coordinates X carries first
+// (homogenised: the groups'), else 0
 static void evaluate_compiled(const CompiledSystem& s, const Eigen::VectorXcd& X, bool homogeneous, Eigen::VectorXcd& f,
                               Eigen::MatrixXcd* jac) {
-  const int offset = homogeneous ? 1 : 0, stride = s.max_power + 1;
+  const int offset = homogeneous ? s.groups : 0, stride = s.max_power + 1;
   thread_local std::vector<cd> powers;
+  thread_local std::vector<std::pair<int, int>> all;  // a term's factors as (index into X, power)
   power_table(X, s.max_power, powers);
   auto P = [&](int v, int k) { return powers[static_cast<std::size_t>(v * stride + k)]; };
   const int rows = static_cast<int>(s.equations.size());
@@ -148,21 +173,20 @@ static void evaluate_compiled(const CompiledSystem& s, const Eigen::VectorXcd& X
   if (jac) jac->setZero(rows, s.variables + offset);
   for (int i = 0; i < rows; ++i) {
     for (const CompiledSystem::Term& t : s.equations[static_cast<std::size_t>(i)]) {
+      all.clear();
+      if (homogeneous) all.insert(all.end(), t.homogenising.begin(), t.homogenising.end());
+      for (const auto& [v, e] : t.factors) all.emplace_back(v + offset, e);
       cd value = t.coefficient;
-      if (homogeneous) value *= P(0, t.homogenising);
-      for (const auto& [v, e] : t.factors) value *= P(v + offset, e);
+      for (const auto& [v, e] : all) value *= P(v, e);
       f(i) += value;
       if (!jac) continue;
       // each factor's derivative times the product of the others (recomputed: terms have few factors)
-      auto derivative_of = [&](int var, int e) {
+      for (const auto& [var, e] : all) {
         cd d = t.coefficient * static_cast<double>(e) * P(var, e - 1);
-        if (homogeneous && var != 0) d *= P(0, t.homogenising);
-        for (const auto& [w, k] : t.factors)
-          if (w + offset != var) d *= P(w + offset, k);
-        return d;
-      };
-      if (homogeneous && t.homogenising > 0) (*jac)(i, 0) += derivative_of(0, t.homogenising);
-      for (const auto& [v, e] : t.factors) (*jac)(i, v + offset) += derivative_of(v + offset, e);
+        for (const auto& [w, k] : all)
+          if (w != var) d *= P(w, k);
+        (*jac)(i, var) += d;
+      }
     }
   }
 }
