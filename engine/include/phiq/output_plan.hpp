@@ -25,6 +25,7 @@ namespace phiq {
 
 class Model;                // model.hpp
 struct Loads;               // parts.hpp
+struct NaturalJoints;       // natural_joints.hpp
 struct Part;                // parts.hpp
 struct ParameterReach;      // sensitivity.hpp
 struct ReachedConstraints;  // sensitivity.hpp
@@ -84,8 +85,10 @@ struct OutputDriver {
 
 /// A joint whose reaction a sweep writes (OutputEfforts::reactions).
 struct OutputReaction {
-  Index constraint = -1;  ///< Model::constraints() index; its kind has a ReactionSite (reaction_width() > 0)
-  bool spatial = false;   ///< six values (Fx, Fy, Fz, Mx, My, Mz) rather than three (Fx, Fy, Mz)
+  /// Model::constraints() index; its kind has a ReactionSite (reaction_width() > 0); −1 for a natural joint
+  Index constraint = -1;
+  bool spatial = false;  ///< six values (Fx, Fy, Fz, Mx, My, Mz) rather than three (Fx, Fy, Mz)
+  int natural = -1;      ///< a natural joint: its index in OutputEfforts::natural's joints, else −1
 };
 
 /// Driver efforts (inverse dynamics, phiq/inverse_dynamics.hpp) at every written row: for each listed constraint
@@ -100,6 +103,10 @@ struct OutputEfforts {
   /// Joints whose reactions are written (phiq/joint_reactions.hpp), in this order: `NAME.Fx`, `NAME.Fy`, `NAME.Mz`
   /// for a planar joint, `NAME.Fx` … `NAME.Mz` (six) for a spatial one; minimum-norm where indeterminate.
   std::vector<OutputReaction> reactions;
+  /// The natural coordinates' bodies and joints the `natural` reactions index (null: none listed).
+  std::shared_ptr<const NaturalJoints> natural;
+  /// A reaction's name (its columns' stem): its constraint's, or its natural joint's point's.
+  std::string reaction_name(const Model& model, const OutputReaction& r) const;
   /// Values a row holds: the efforts, then the powers (always computed: one product each), then the reactions.
   Index size() const {
     Index n = 2 * static_cast<Index>(constraints.size());

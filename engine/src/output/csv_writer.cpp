@@ -132,8 +132,7 @@ std::vector<std::string> CsvFormat::dotted_names() const {
   static constexpr const char* kPlanar[] = {".Fx", ".Fy", ".Mz"};
   for (const OutputReaction& r : plan_->efforts.reactions)
     for (int k = 0; k < (r.spatial ? 6 : 3); ++k)
-      h.push_back(model_.constraints()[static_cast<std::size_t>(r.constraint)].name +
-                  (r.spatial ? kSpatial : kPlanar)[k]);
+      h.push_back(plan_->efforts.reaction_name(model_, r) + (r.spatial ? kSpatial : kPlanar)[k]);
   for (const OutputSensitivity& p : plan_->sensitivities)  // ∂τ/∂p (phiq/effort_sensitivity.hpp)
     for (Index c : plan_->efforts.constraints) h.push_back(model_.constraints()[c].name + ".effort.d_" + p.name);
   return h;

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 
+#include "phiq/model.hpp"
+#include "phiq/natural_joints.hpp"
+
 namespace phiq {
 
 const char* to_string(SensitivityForm form) {
@@ -25,6 +28,11 @@ std::vector<Index> OutputPlan::sensitivity_outputs() const {
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
+}
+
+std::string OutputEfforts::reaction_name(const Model& model, const OutputReaction& r) const {
+  if (r.natural >= 0) return natural->joints.at(static_cast<std::size_t>(r.natural)).name;
+  return model.constraints().at(static_cast<std::size_t>(r.constraint)).name;
 }
 
 Index effort_values(const OutputEfforts& efforts, std::size_t parameters) {

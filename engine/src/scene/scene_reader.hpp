@@ -265,6 +265,8 @@ class SceneReader {
   bool efforts_power_ = false;
   // `output: reactions` (the field; its items when it lists names), resolved after the build
   std::optional<Cursor> reactions_field_;
+  // with `reactions`: the named natural points, kept past the tables' release for the natural joints
+  std::vector<std::pair<std::string, Attachment3>> natural_points_;
   std::vector<Cursor> reaction_items_;
 
  public:

@@ -60,12 +60,13 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
               efforts_.begin() + opt_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
     return;
   }
-  reactions_->evaluate(current_.q.data(), t, effort_lambda_, efforts_.data() + 2 * opt_.efforts.constraints.size());
+  reactions_->evaluate(current_.q.data(), current_.qd.data(), current_.qdd.data(), t, effort_lambda_,
+                       efforts_.data() + 2 * opt_.efforts.constraints.size());
   if (!note) return;
   reactions_noted_ = true;
   std::string names;
   for (const OutputReaction& r : opt_.efforts.reactions)
-    if (std::find(indeterminate.begin(), indeterminate.end(), r.constraint) != indeterminate.end())
+    if (r.natural < 0 && std::find(indeterminate.begin(), indeterminate.end(), r.constraint) != indeterminate.end())
       names += (names.empty() ? "'" : ", '") + model_.constraints()[static_cast<std::size_t>(r.constraint)].name + "'";
   if (!names.empty())
     sum_.warnings.push_back({t, "indeterminate",

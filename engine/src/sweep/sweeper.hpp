@@ -418,7 +418,7 @@ class Sweeper {
   // said which joints' reactions are indeterminate (a model with redundant rows; once per sweep).
   std::optional<JointReactions> reactions_ =
       opt_.efforts.reactions.empty() ? std::nullopt
-                                     : std::optional<JointReactions>(std::in_place, model_, reaction_constraints());
+                                     : std::optional<JointReactions>(std::in_place, model_, opt_.efforts);
   bool reactions_noted_ = false;
   MinimumNormScratch minimum_norm_scratch_;  // row_reactions()'s, with redundant rows
   // The coordinates whose columns are written, and the form the sensitivities are solved in
