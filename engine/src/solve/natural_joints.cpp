@@ -3,7 +3,9 @@
 #include "phiq/natural_joints.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <limits>
 
 #include "phiq/constraint_block.hpp"
@@ -22,8 +24,13 @@ std::vector<Attachment3*> frame_points(PartFrame& f) {
   return out;
 }
 
-bool same_point(const Attachment3& a, const Attachment3& b) {
-  return a.r[0] == b.r[0] && a.r[1] == b.r[1] && a.r[2] == b.r[2];
+// A point's slots as a key: per component whether it is a coordinate, and its index or value.
+std::array<double, 6> point_key(const Attachment3& a) {
+  std::array<double, 6> k{};
+  for (int i = 0; i < 3; ++i)
+    k[2 * i] = a.r[i].is_coordinate() ? 1.0 : 0.0,
+          k[2 * i + 1] = a.r[i].is_coordinate() ? static_cast<double>(a.r[i].coord()) : a.r[i].value();
+  return k;
 }
 
 bool moves(const PartFrame& f) {
@@ -80,17 +87,19 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
     }
     out.bodies.push_back(std::move(b));
   }
-  for (const auto& [name, point] : points) {
-    NaturalJoint j;
-    j.name = name, j.point = point;
-    for (std::size_t b = 0; b < out.bodies.size(); ++b) {
-      PartFrame f = out.bodies[b].frame;
-      for (Attachment3* a : frame_points(f))
-        if (same_point(*a, point)) {
-          j.bodies.push_back(b);
-          break;
-        }
+  std::map<std::array<double, 6>, std::vector<std::size_t>> held_by;  // a frame's point → its bodies, in order
+  for (std::size_t b = 0; b < out.bodies.size(); ++b) {
+    PartFrame f = out.bodies[b].frame;
+    for (Attachment3* a : frame_points(f)) {
+      std::vector<std::size_t>& bodies = held_by[point_key(*a)];
+      if (bodies.empty() || bodies.back() != b) bodies.push_back(b);
     }
+  }
+  for (const auto& [name, point] : points) {
+    const auto it = held_by.find(point_key(point));
+    if (it == held_by.end()) continue;
+    NaturalJoint j;
+    j.name = name, j.point = point, j.bodies = it->second;
     bool held = false;  // by ground, in a component
     for (int k = 0; k < dimension; ++k) held = held || !point.r[k].is_coordinate();
     if (j.bodies.size() >= 2 || (j.bodies.size() == 1 && held)) out.joints.push_back(std::move(j));
@@ -131,12 +140,16 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
         if (of_point[static_cast<std::size_t>(j)]) reads[c].push_back(j);
       }
     }
-  // a constraint is the body's whose points hold all the point coordinates it reads, the fewest of them
+  // a constraint is the body's whose points hold all the point coordinates it reads, the fewest of them: among
+  // the bodies that hold its first
+  std::vector<std::vector<std::size_t>> bodies_of(static_cast<std::size_t>(n));
+  for (std::size_t b = 0; b < nb; ++b)
+    for (Index c : coords[b]) bodies_of[static_cast<std::size_t>(c)].push_back(b);
   for (std::size_t c = 0; c < reads.size(); ++c) {
     if (reads[c].empty()) continue;
     std::size_t best = nb, best_size = 0;
     bool tie = false;
-    for (std::size_t b = 0; b < nb; ++b) {
+    for (std::size_t b : bodies_of[static_cast<std::size_t>(reads[c].front())]) {
       if (!std::includes(coords[b].begin(), coords[b].end(), reads[c].begin(), reads[c].end())) continue;
       if (best == nb || coords[b].size() < best_size)
         best = b, best_size = coords[b].size(), tie = false;
