@@ -159,6 +159,41 @@ void product_transposed(const JR& a, double Jet::*pa, const JR& b, double Jet::*
     }
 }
 
+// The motion of a planar frame in closed form: a body's (x, y, ψ), or an origin point and an x direction (θ its
+// angle: ω = (d × ḋ)/|d|², α = (d × d̈)/|d|² − 2 (d · ḋ)(d × ḋ)/|d|⁴). Inverse dynamics calls part_motion() for every
+// part at every row, where the jets cost as much as the row's solves. False for the other frames (the jets).
+bool planar_motion(const PartFrame& f, const double* q, const double* qd, const double* qdd, PartMotion& m) {
+  auto rate = [&](const Slot& s) { return s.is_coordinate() ? qd[s.coord()] : 0.0; };
+  auto accel = [&](const Slot& s) { return s.is_coordinate() && qdd ? qdd[s.coord()] : 0.0; };
+  double c = 1.0, s = 0.0, w = 0.0, a = 0.0;
+  if (f.kind == PartFrameKind::kPlanarBody) {
+    const Frame2& b = f.planar;
+    m.pose.at = {b.x.of(q), b.y.of(q), 0.0};
+    m.velocity = {rate(b.x), rate(b.y), 0.0}, m.acceleration = {accel(b.x), accel(b.y), 0.0};
+    const double psi = b.psi.of(q);
+    c = std::cos(psi), s = std::sin(psi), w = rate(b.psi), a = accel(b.psi);
+  } else if (f.kind == PartFrameKind::kPoints && !f.spatial_frame) {
+    const Slot* o = f.origin.r;
+    const Slot* x = f.x_toward.r;
+    m.pose.at = {o[0].of(q), o[1].of(q), o[2].of(q)};
+    m.velocity = {rate(o[0]), rate(o[1]), rate(o[2])}, m.acceleration = {accel(o[0]), accel(o[1]), accel(o[2])};
+    double dx = x[0].of(q), dy = x[1].of(q), vx = rate(x[0]), vy = rate(x[1]), ax = accel(x[0]), ay = accel(x[1]);
+    if (f.x_is_point) {
+      dx -= m.pose.at.x, dy -= m.pose.at.y, vx -= m.velocity.x, vy -= m.velocity.y;
+      ax -= m.acceleration.x, ay -= m.acceleration.y;
+    }
+    const double d2 = dx * dx + dy * dy, n = std::sqrt(d2), turn = dx * vy - dy * vx;
+    if (!(n > 0.0)) return false;                           // no direction: the jets' (and part_pose()'s) NaN
+    c = (1.0 / n) * dx, s = (1.0 / n) * dy, w = turn / d2;  // the axes as part_pose() rounds them
+    a = (dx * ay - dy * ax) / d2 - 2.0 * (dx * vx + dy * vy) * turn / (d2 * d2);
+  } else {
+    return false;
+  }
+  m.pose.rotation = {c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0};
+  m.omega = {0.0, 0.0, w}, m.alpha = {0.0, 0.0, a};
+  return true;
+}
+
 }  // namespace
 
 std::pair<kin3::V3, kin3::V3> PartMotion::point(kin3::V3 s) const {
@@ -168,8 +203,9 @@ std::pair<kin3::V3, kin3::V3> PartMotion::point(kin3::V3 s) const {
 }
 
 PartMotion part_motion(const PartFrame& frame, const double* q, const double* qd, const double* qdd, double t) {
-  const auto [o, r] = frame_jets(frame, Path{q, qd, qdd, t});
   PartMotion m;
+  if (planar_motion(frame, q, qd, qdd, m)) return m;
+  const auto [o, r] = frame_jets(frame, Path{q, qd, qdd, t});
   m.pose = part_pose(frame, q, t);
   m.velocity = {o[0].d, o[1].d, o[2].d};
   m.acceleration = {o[0].dd, o[1].dd, o[2].dd};
