@@ -416,9 +416,9 @@ class Sweeper {
   std::vector<std::size_t> efforts_dropped_ = dropped_efforts();
   // The joints whose reactions are written (OutputEfforts::reactions); none when none are. Whether the first row has
   // said which joints' reactions are indeterminate (a model with redundant rows; once per sweep).
-  std::optional<JointReactions> reactions_ =
-      opt_.efforts.reactions.empty() ? std::nullopt
-                                     : std::optional<JointReactions>(std::in_place, model_, opt_.efforts);
+  std::optional<JointReactions> reactions_ = opt_.efforts.reactions.empty()
+                                                 ? std::nullopt
+                                                 : std::optional<JointReactions>(std::in_place, model_, opt_.efforts);
   bool reactions_noted_ = false;
   MinimumNormScratch minimum_norm_scratch_;  // row_reactions()'s, with redundant rows
   // The coordinates whose columns are written, and the form the sensitivities are solved in
