@@ -16,16 +16,19 @@
 ///
 ///   H(a, b) = −[γ(a + b) + γ(−a − b) − γ(a − b) − γ(b − a)] / 8
 ///
-/// cancels Φqt and Φtt (four evaluations of γ at q itself, no step). Q, trigonometric in q, is differenced: along p by
-/// the fourth-order difference of the sensitivities (the parts and loads of the scene read again at p ± h, p ± 2h:
-/// OutputSensitivity::parts_along; a mass, a centre of mass or a load that reads p), and along the motion by the same
-/// difference with a step that moves the coordinate s moves most by 10⁻³ of its scale (the direct sensitivities'
-/// rule), exact up to 10⁻¹² relative. A co-moving coordinate (ParameterReach::comotion) is moved along p as the
-/// sensitivities move it, and the motion's part taken along s − q̂.
+/// cancels Φqt and Φtt (four evaluations of γ at q itself, no step). dQ/dp is exact too (parts/force_rate.hpp): Q
+/// again in dual numbers through the parts' frame jets, every pose, Jacobian column, velocity, acceleration and load
+/// carried with its rate along s, ṡ, s̈; what p changes of the parts and loads themselves (a mass, a centre, an
+/// inertia, a ground point of a frame, gravity, a load's point, expression or constants) by the rates of those data
+/// between the scene read at p ± h, p ± 2h (OutputSensitivity::parts_along; exact for data linear in p). Frames of
+/// expressions (relative angles) and torsional springs on a spatial joint's angle are not carried: for a parameter
+/// that meets one, Q is differenced as before (along p by the fourth-order difference over the copies, along the
+/// motion with a step that moves the coordinate s moves most by 10⁻³ of its scale; ~10⁻¹² relative). A co-moving
+/// coordinate (ParameterReach::comotion) is moved along p as the sensitivities move it.
 ///
-/// Cost per written row: one direct solve per driver, and per parameter 8 evaluations of Q (4 for a parameter that
-/// moves no part, no load and no coordinate: its parts_along and loads_along null), 2 of the velocity term
-/// over the reach and 4 of γ per driver; the sensitivities of q, q̇, q̈ in the direct form (every coordinate's).
+/// Cost per written row: one direct solve per driver, and per parameter 1 evaluation of Q in dual numbers (8 of Q
+/// where differenced), and per driver 2 of the velocity term over the reach and 4 of γ; the sensitivities of q, q̇,
+/// q̈ in the direct form (every coordinate's).
 #pragma once
 
 #include <string>

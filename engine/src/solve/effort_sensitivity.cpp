@@ -11,6 +11,7 @@
 #include "phiq/parts.hpp"
 #include "phiq/sensitivity.hpp"
 #include "phiq/text.hpp"
+#include "parts/force_rate.hpp"
 #include "solve/factorisation.hpp"
 #include "solve/models_along.hpp"
 #include "solve/sensitivity_internal.hpp"
@@ -127,8 +128,17 @@ bool detail::effort_sensitivities_with_factors(const Model& model, const OutputE
     const double* s = sensitivities + sl.offset(j, 0);
     sc.v = Eigen::Map<const Eigen::VectorXd>(s, n);  // s − q̂: the part along the motion
     for (const ParameterReach::Comotion& c : reach.comotion) sc.v[c.coordinate] -= q[c.coordinate] * c.rate;
-    total_force_rate(model, efforts, p, reach, q, qd, qdd, sensitivities + sl.offset(j, 1),
-                     sensitivities + sl.offset(j, 2), t, sc);
+    detail::ForcesAlong along{{}, {}, p.step};
+    for (std::size_t k = 0; k < 4; ++k)
+      along.parts[k] = p.parts_along[k].get(), along.loads[k] = p.loads_along[k].get();
+    sc.dq.resize(n);
+    if (sc.difference_forces ||
+        !detail::generalized_force_rate(*efforts.parts, *efforts.loads, along, q, qd, qdd, s,
+                                        sensitivities + sl.offset(j, 1), sensitivities + sl.offset(j, 2), t, sc.dq)) {
+      total_force_rate(model, efforts, p, reach, q, qd, qdd, sensitivities + sl.offset(j, 1),
+                       sensitivities + sl.offset(j, 2), t, sc);
+      ++sc.differenced;
+    }
     for (std::size_t i = 0; i < ne; ++i) {
       const Eigen::VectorXd& w = sc.w[i];
       if (w.size() == 0) continue;

@@ -80,6 +80,10 @@ struct EffortSensitivityScratch {
   Eigen::VectorXd rhs, v, dq, qk, vk, ak, qf;  // over the coordinates
   Eigen::VectorXd plus, minus, g[4];           // over the rows
   Eigen::VectorXd forces[4];                   // Q at the four points of a difference
+  // dQ/dp exactly (parts/force_rate.hpp) unless set, or where that form does not reach: then Q differenced along
+  // p and the motion, and `differenced` counts it (the tests compare the two)
+  bool difference_forces = false;
+  std::size_t differenced = 0;
 };
 bool effort_sensitivities_with_factors(const Model& model, const OutputEfforts& efforts,
                                        const std::vector<OutputSensitivity>& parameters, double t, const double* q,
