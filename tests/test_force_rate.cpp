@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "parts/force_rate.hpp"
 #include "phiq/effort_sensitivity.hpp"
@@ -117,8 +119,10 @@ TEST(ForceRate, RefusesAFrameOfExpressionsSoTheEffortsDifferenceQThere) {
                                               ws.qd.data(), ws.qdd.data(), v.data(), v.data(), v.data(), 1.0, dq));
 }
 
-TEST(ForceRate, TheEffortsSensitivitiesThroughItEqualThoseThroughTheDifferenceOfQ) {
-  const Scene s = parse_scene(kForceRateCrankSlider, "crank_slider_rates.yaml");
+// The scene's efforts' (and powers') sensitivities at its last row through the exact dQ/dp and through Q
+// differenced (EffortSensitivityScratch::difference_forces): equal to 1e-8, the exact form taken for every
+// parameter.
+void expect_force_rate_paths_agree(const Scene& s) {
   Workspace ws(*s.model);
   force_rate_swept(s, ws);
   std::vector<OutputSensitivity> ps = s.sweep.sensitivities;
@@ -141,10 +145,41 @@ TEST(ForceRate, TheEffortsSensitivitiesThroughItEqualThoseThroughTheDifferenceOf
   ASSERT_TRUE(detail::effort_sensitivities_with_factors(*s.model, s.sweep.efforts, ps, s.sweep.t_end, ws.q.data(),
                                                         ws.qd.data(), ws.qdd.data(), lambda, sens.data(), *ws.lu, b,
                                                         differenced.data()));
-  EXPECT_EQ(a.differenced, 0u);  // no parameter fell back to the difference
+  EXPECT_EQ(a.differenced, 0u) << s.path;  // no parameter fell back to the difference
   EXPECT_EQ(b.differenced, ps.size());
-  for (std::size_t j = 0; j < size; ++j)
-    EXPECT_NEAR(exact[j], differenced[j], 1e-8 * std::max(1.0, std::fabs(differenced[j]))) << ps[j].name;
+  for (std::size_t j = 0; j < size; ++j) {
+    ASSERT_TRUE(std::isfinite(exact[j])) << j;
+    EXPECT_NEAR(exact[j], differenced[j], 1e-8 * std::max(1.0, std::fabs(differenced[j]))) << "value " << j;
+  }
+}
+
+TEST(ForceRate, TheEffortsSensitivitiesThroughItEqualThoseThroughTheDifferenceOfQ) {
+  expect_force_rate_paths_agree(parse_scene(kForceRateCrankSlider, "crank_slider_rates.yaml"));
+}
+
+TEST(ForceRate, ReachesTheNaturalFourBarAndTheSpatialRssrExactly) {
+  // models/dynamics/fourbar_motor_torque.yaml (natural coordinates: L1 moves the ground pivot of the rocker's
+  // frame) and models/spatial/rssr.yaml with massive bodies (reference points and Euler parameters)
+  auto read = [](const std::string& rel, const std::string& cut) {
+    std::ifstream in(test::model_path(rel));
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    s.erase(s.find(cut));
+    return s;
+  };
+  expect_force_rate_paths_agree(
+      parse_scene(read("dynamics/fourbar_motor_torque.yaml", "output:") +
+                      "output: {efforts: all, power: true, sensitivities: [L1, L2, L3, L4]}\n",
+                  "fourbar.yaml"));
+  expect_force_rate_paths_agree(
+      parse_scene(read("spatial/rssr.yaml", "time:") +
+                      "parts:\n"
+                      "  crank: {mass: 0.8, center_of_mass: [a/2, 0, 0], inertia: [0.001, 0.8*a*a/12, 0.8*a*a/12]}\n"
+                      "  rocker: {mass: 1.1, center_of_mass: [0, b/2, 0], inertia: [1.1*b*b/12, 0.001, 1.1*b*b/12]}\n"
+                      "loads: {gravity: [0, -9.81, 0]}\ntime: {start: 0, end: 1.3, steps: 13}\n"
+                      "output: {efforts: all, sensitivities: [a, b, L]}\n",
+                  "rssr.yaml"));
 }
 
 }  // namespace

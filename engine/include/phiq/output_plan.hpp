@@ -118,7 +118,8 @@ struct OutputEfforts {
 };
 
 /// Values a row's StepView::efforts holds for `plan`: OutputEfforts::size(), then, with sensitivities, each effort's
-/// ∂τ/∂p (EffortSensitivityLayout of phiq/effort_sensitivity.hpp: parameter by parameter, efforts in order).
+/// ∂τ/∂p and each power's ∂P/∂p (EffortSensitivityLayout of phiq/effort_sensitivity.hpp: parameter by parameter,
+/// efforts in order; the powers' computed whether written or not, as the powers are).
 Index effort_values(const OutputEfforts& efforts, std::size_t parameters);
 
 /// The outputs of a sweep beyond q (models/README.md, `output`). The sweep computes only what the plan lists; the
@@ -148,8 +149,9 @@ struct OutputPlan {
   SensitivityForm sensitivity_form = SensitivityForm::kAuto;
   /// Driver efforts and powers at every written row (StepView::efforts), written as `NAME.effort`, `NAME.power`;
   /// empty `constraints`: none computed. With `sensitivities`, each effort's sensitivity to each parameter too,
-  /// `NAME.effort.d_P` (phiq/effort_sensitivity.hpp), which reads every coordinate's sensitivities: the sweep then
-  /// solves them in the direct form, whatever `sensitivity_form` says (SweepSummary says so).
+  /// `NAME.effort.d_P`, and each power's, `NAME.power.d_P` when the powers are written (phiq/effort_sensitivity.hpp),
+  /// which read every coordinate's sensitivities: the sweep then solves them in the direct form, whatever
+  /// `sensitivity_form` says (SweepSummary says so).
   OutputEfforts efforts;
   /// Whether the sweep solves q̈: asked for, or needed by the efforts. Solved is not delivered: StepView::qdd is set
   /// as `accelerations` says.

@@ -36,7 +36,7 @@ std::string OutputEfforts::reaction_name(const Model& model, const OutputReactio
 }
 
 Index effort_values(const OutputEfforts& efforts, std::size_t parameters) {
-  return efforts.size() + static_cast<Index>(efforts.constraints.size() * parameters);
+  return efforts.size() + static_cast<Index>(2 * efforts.constraints.size() * parameters);  // ∂τ/∂p, ∂P/∂p
 }
 
 }  // namespace phiq

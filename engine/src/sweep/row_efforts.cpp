@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "phiq/effort_sensitivity.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/parts.hpp"
 #include "sweep/sweeper.hpp"
@@ -23,9 +24,15 @@ void Sweeper::row_efforts() {
   add_generalized_forces(*e.parts, *e.loads, current_.q.data(), current_.qd.data(), current_.qdd.data(), t, effort_q_);
   if (!multipliers_with_factors(model_, *w->lu, effort_q_, effort_kept_, effort_lambda_)) return not_defined();
   ++ws_->counters.effort_solves;
+  // Φt at the drivers' rows only (a power reads no other; the whole model's is O(rows) at every row)
   effort_phi_t_.resize(model_.num_equations());
-  model_.phi_t(current_.q.data(), t, effort_phi_t_.data());
   const std::vector<ConstraintInfo>& cs = model_.constraints();
+  for (const Index c : e.constraints) {
+    const ConstraintInfo& info = cs[static_cast<std::size_t>(c)];
+    effort_phi_t_.segment(info.first_row, info.rows).setZero();
+    const auto [block, index] = model_.constraint_block(c);
+    block->phi_t(index, index + 1, current_.q.data(), t, effort_phi_t_.data());
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const ConstraintInfo& c = cs[static_cast<std::size_t>(e.constraints[i])];
     double power = 0.0;
@@ -38,6 +45,7 @@ void Sweeper::row_efforts() {
   // sensitivities (sweep_sensitivity_form()): after the reactions in efforts_
   if (n > 0 && !opt_.sensitivities.empty()) {
     double* out = efforts_.data() + e.size();
+    const EffortSensitivityLayout layout{n};
     if (!effort_sensitivities_with_factors(model_, e, opt_.sensitivities, t, current_.q.data(), current_.qd.data(),
                                            current_.qdd.data(), effort_lambda_, sensitivities_.data(), *w->lu,
                                            effort_sensitivity_scratch_, out))
@@ -45,7 +53,8 @@ void Sweeper::row_efforts() {
     else
       for (std::size_t i : efforts_dropped_)
         for (std::size_t j = 0; j < opt_.sensitivities.size(); ++j)
-          out[j * n + i] = std::numeric_limits<double>::quiet_NaN();
+          out[layout.offset(j, i)] = out[layout.power_offset(opt_.sensitivities.size(), j, i)] =
+              std::numeric_limits<double>::quiet_NaN();
   }
   if (reactions_) row_reactions(*w->lu);
 }
