@@ -129,6 +129,28 @@ TEST(PowerSensitivity, APendulumsPowerFollowsItsClosedFormInLengthMassAndRate) {
   for (double e : worst) EXPECT_LT(e, 1e-7);
 }
 
+TEST(PowerSensitivity, AStepperDeliversThePendulumsClosedForm) {
+  const Scene s = parse_scene(kPowerPendulum, "pendulum.yaml");
+  StepperOptions o;
+  o.sensitivities = s.sweep.sensitivities;
+  o.efforts = s.sweep.efforts;
+  Stepper stepper(*s.model, o);
+  const double g = 9.81, L = 0.8, m = 1.5, I = 0.02, alpha = 3.0, w = 2.0;
+  const std::size_t at = static_cast<std::size_t>(s.sweep.efforts.size());
+  const EffortSensitivityLayout layout{1};
+  for (const double t : {0.0, 0.35, 1.4}) {
+    ASSERT_EQ(stepper.step(t), SolveStatus::kSuccess) << t;
+    ASSERT_NE(stepper.efforts(), nullptr);
+    const double th = 0.3 + w * t + 1.5 * t * t, rate = w + 3 * t;
+    const double tau = m * g * L * std::cos(th) + (I + m * L * L) * alpha;
+    EXPECT_NEAR(stepper.efforts()[at + layout.power_offset(3, 0, 0)], (m * g * std::cos(th) + 2 * m * L * alpha) * rate,
+                1e-7)
+        << t;
+    EXPECT_NEAR(stepper.efforts()[at + layout.power_offset(3, 2, 0)], -m * g * L * std::sin(th) * t * rate + tau, 1e-7)
+        << t;
+  }
+}
+
 TEST(PowerSensitivity, AMassiveCrankSlidersPowerMatchesResolvedSweeps) {
   // a polar crank driven at a rate that reads a parameter, massive crank and rod, a load on the slider's pin
   expect_power_sensitivities_match_resolved_sweeps(R"(phiq: 1
