@@ -1,18 +1,20 @@
 // What driver efforts cost: nfourbar (natural coordinates, the scene `phiq generate` writes) with a unit mass on
 // every link (the derived parts of drawn_parts(): a bar per crank and coupler, mass 1 kg at its middle, I = L²/12)
 // under gravity, swept a quarter turn in 100 steps on one thread, each row formatted as a CSV line. With efforts:
-// the motor's torque and power by inverse dynamics (one transposed solve per row). Counter `ratio`: the sweep with
-// efforts ÷ the sweep with q, q̇, q̈ only, interleaved iteration by iteration and summed (issue target ≤ 1.3).
+// the motor's torque and power by inverse dynamics (one transposed solve per row), and with `reactions` 1 the
+// reactions at every moving joint point P{i} (phiq/natural_joints.hpp: on crank i, of the crank and couplers there).
+// Counter `ratio`: the sweep with efforts ÷ the sweep with q, q̇, q̈ only, interleaved iteration by iteration and
+// summed (issue target ≤ 1.3, with torques and reactions); `cpu_ratio` the same in the process's CPU time.
 // BM_EffortSensitivitySweep: the efforts' sensitivities ∂τ/∂p (phiq/effort_sensitivity.hpp) on
 // models/dynamics/fourbar_motor_torque.yaml, 2000 steps on one thread, to the motor's speed w (it reaches the
-// driver alone: Q is not differenced along it) or to the crank's length L2 (it moves a centre and an inertia too).
-// Counters: `ratio`, the sweep with efforts and their sensitivities ÷ the sweep with the sensitivities of q only;
-// `vs_differenced`, that sweep ÷ the same with the scene's own parts and loads along p (Q differenced along p).
+// driver alone) or to the crank's length L2 (it moves a centre and an inertia too: their rates enter dQ/dp).
+// Counters: `ratio`, the sweep with efforts and their sensitivities ÷ the sweep with the sensitivities of q only.
 //
 //   build/bench/phiq_bench --benchmark_filter='EffortsSweep|EffortSensitivitySweep' --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <ctime>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -20,6 +22,7 @@
 
 #include "phiq/drawn_parts.hpp"
 #include "phiq/inverse_dynamics.hpp"
+#include "phiq/natural_joints.hpp"
 #include "phiq/phiq.hpp"
 
 namespace {
@@ -39,12 +42,22 @@ std::string massive_nfourbar_scene(Index n) {
          "loads: {gravity: [0, -9.81]}\noutput: {velocities: true, accelerations: true}\n";
 }
 
-double csv_sweep_seconds(const Scene& s, const SweepOptions& o) {
+// The process's CPU time (s): what a one-thread sweep costs whatever else the machine runs (its thread may be
+// an arena's worker, not the caller).
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Wall-clock seconds of the sweep; the process's CPU seconds added to `cpu` when given.
+double csv_sweep_seconds(const Scene& s, const SweepOptions& o, double* cpu = nullptr) {
   Workspace ws(*s.model);
   SweepSummary sum;
   const CsvFormat format(*s.model, o);
   std::string line;
   const auto t0 = std::chrono::steady_clock::now();
+  const double c0 = process_cpu_seconds();
   const SolveStatus st = run_sweep(
       *s.model, o, ws,
       [&](const StepView& v) {
@@ -55,10 +68,11 @@ double csv_sweep_seconds(const Scene& s, const SweepOptions& o) {
       },
       &sum);
   if (st != SolveStatus::kSuccess) throw Error(sum.message);
+  if (cpu) *cpu += process_cpu_seconds() - c0;
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// range(0) = N. Manual time: the sweep with efforts.
+// range(0) = N, range(1) = reactions (0, 1). Manual time: the sweep with efforts.
 void BM_EffortsSweep(benchmark::State& state) {
   const Scene s = parse_scene(massive_nfourbar_scene(state.range(0)), "nfourbar.yaml");
   auto parts = std::make_shared<std::vector<Part>>();
@@ -77,20 +91,31 @@ void BM_EffortsSweep(benchmark::State& state) {
   with.efforts.loads = std::make_shared<const Loads>(s.loads);
   with.efforts.constraints = rheonomic_constraints(*s.model);
   with.efforts.power = true;
-  double a_sum = 0, b_sum = 0;
+  if (state.range(1) != 0) {  // each crank's moving point, named by its coordinate
+    std::vector<std::pair<std::string, Attachment3>> points;
+    for (const Part& p : *parts)
+      if (p.frame.kind == PartFrameKind::kPoints && !p.frame.origin.r[0].is_coordinate())
+        points.emplace_back("P" + std::to_string(p.frame.x_toward.r[0].coord()), p.frame.x_toward);
+    auto natural = std::make_shared<NaturalJoints>(
+        find_natural_joints(*parts, s.loads, points, s.model->num_coordinates(), false));
+    for (std::size_t j = 0; j < natural->joints.size(); ++j)
+      with.efforts.reactions.push_back({-1, false, static_cast<int>(j)});
+    with.efforts.natural = natural;
+  }
+  double a_sum = 0, b_sum = 0, a_cpu = 0, b_cpu = 0;
   for (auto _ : state) {
-    const double a = csv_sweep_seconds(s, with), b = csv_sweep_seconds(s, plain);
+    const double a = csv_sweep_seconds(s, with, &a_cpu), b = csv_sweep_seconds(s, plain, &b_cpu);
     a_sum += a, b_sum += b;
     state.SetIterationTime(a);
   }
   state.counters["parts"] = static_cast<double>(parts->size());
+  state.counters["reactions"] = static_cast<double>(with.efforts.reactions.size());
   state.counters["ratio"] = a_sum / b_sum;
+  state.counters["cpu_ratio"] = a_cpu / b_cpu;  // the same in CPU time (a loaded machine)
 }
 BENCHMARK(BM_EffortsSweep)
-    ->Arg(10)
-    ->Arg(1000)
-    ->Arg(10000)
-    ->ArgName("N")
+    ->ArgsProduct({{10, 1000, 10000}, {0, 1}})
+    ->ArgNames({"N", "reactions"})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 
@@ -121,23 +146,15 @@ void BM_EffortSensitivitySweep(benchmark::State& state) {
   const Scene with = motor_torque_scene(parameter, true), plain = motor_torque_scene(parameter, false);
   SweepOptions a_options = with.sweep, b_options = plain.sweep;
   a_options.threads = b_options.threads = 1;
-  SweepOptions c_options = a_options;  // the scene's own parts and loads at every point along p: Q differenced
-  for (OutputSensitivity& p : c_options.sensitivities)
-    for (std::size_t k = 0; k < 4; ++k) {
-      if (!p.parts_along[k]) p.parts_along[k] = a_options.efforts.parts;
-      if (!p.loads_along[k]) p.loads_along[k] = a_options.efforts.loads;
-    }
-  double a_sum = 0, b_sum = 0, c_sum = 0;
+  double a_sum = 0, b_sum = 0;
   for (auto _ : state) {
     const double a = csv_sweep_seconds(with, a_options), b = csv_sweep_seconds(plain, b_options);
-    const double c = csv_sweep_seconds(with, c_options);
-    a_sum += a, b_sum += b, c_sum += c;
+    a_sum += a, b_sum += b;
     state.SetIterationTime(a);
   }
   const OutputSensitivity& p = with.sweep.sensitivities.front();
   state.counters["moves_forces"] = p.parts_along[0] || p.loads_along[0] ? 1.0 : 0.0;
   state.counters["ratio"] = a_sum / b_sum;
-  state.counters["vs_differenced"] = a_sum / c_sum;
 }
 BENCHMARK(BM_EffortSensitivitySweep)->Arg(0)->Arg(1)->ArgName("param")->UseManualTime()->Unit(benchmark::kMillisecond);
 

@@ -65,7 +65,7 @@ void expect_reaction_virtual_work(const Scene& s, bool spatial) {
   const Index c = m.find_constraint("j");
   ASSERT_GE(c, 0);
   ASSERT_EQ(reaction_width(m, c), spatial ? 6 : 3);
-  JointReactions jr(m, {c});
+  JointReactions jr(m, std::vector<Index>{c});
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const Eigen::VectorXd q = m.initial_positions();
@@ -140,7 +140,7 @@ TEST(JointReactions, KindsWithoutASiteAreRefusedByName) {
       "d.yaml");
   EXPECT_EQ(reaction_width(*s.model, 0), 0);
   try {
-    JointReactions jr(*s.model, {0});
+    JointReactions jr(*s.model, std::vector<Index>{0});
     ADD_FAILURE() << "a distance has no reaction site";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("constraint 'bar' (distance) states no joint point"), std::string::npos)

@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 
+#include "phiq/natural_joints.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -87,14 +88,20 @@ nlohmann::json force_arrows(const Scene& scene, const CsvTable& table, const std
   const bool spatial = scene.dimension == 3;
   nlohmann::json arrows = nlohmann::json::array(), unplaced = nlohmann::json::array();
   // one arrow: its joint's point at every kept row, and force / moment columns (3 each; −1: a zero component)
+  // site: a constraint's index, or −1 − j for natural joint j (its point)
   auto add = [&](const std::string& name, const char* kind, Index site, const std::array<long, 3>& force,
                  const std::array<long, 3>& moment) {
     nlohmann::json at = nlohmann::json::array(), f = nlohmann::json::array(), m = nlohmann::json::array();
-    const Held& h = held[static_cast<std::size_t>(site)];
     for (std::size_t k = 0; k < rows.size(); ++k) {
-      ReactionSite rs;
-      h.block->reaction_site(h.index, q[k].data(), rs);
-      for (double x : {rs.point.x, rs.point.y, rs.point.z}) at.push_back(x);
+      if (site < 0) {
+        const Attachment3& p = e.natural->joints[static_cast<std::size_t>(-1 - site)].point;
+        for (const Slot& s : p.r) at.push_back(s.of(q[k].data()));
+      } else {
+        const Held& h = held[static_cast<std::size_t>(site)];
+        ReactionSite rs;
+        h.block->reaction_site(h.index, q[k].data(), rs);
+        for (double x : {rs.point.x, rs.point.y, rs.point.z}) at.push_back(x);
+      }
       for (long c : force)
         f.push_back(c < 0 ? nlohmann::json(0.0) : value(table.rows[rows[k]][static_cast<std::size_t>(c)]));
       for (long c : moment)
@@ -103,12 +110,13 @@ nlohmann::json force_arrows(const Scene& scene, const CsvTable& table, const std
     arrows.push_back({{"name", name}, {"kind", kind}, {"at", at}, {"force", f}, {"moment", m}});
   };
   for (const OutputReaction& r : e.reactions) {
-    const std::string& name = model.constraints()[static_cast<std::size_t>(r.constraint)].name;
+    const std::string name = e.reaction_name(model, r);
     auto c = [&](const char* s) { return static_cast<long>(column(name + s)); };
+    const Index site = r.natural >= 0 ? -1 - r.natural : r.constraint;
     if (r.spatial)
-      add(name, "reaction", r.constraint, {c(".Fx"), c(".Fy"), c(".Fz")}, {c(".Mx"), c(".My"), c(".Mz")});
+      add(name, "reaction", site, {c(".Fx"), c(".Fy"), c(".Fz")}, {c(".Mx"), c(".My"), c(".Mz")});
     else
-      add(name, "reaction", r.constraint, {c(".Fx"), c(".Fy"), -1}, {-1, -1, c(".Mz")});
+      add(name, "reaction", site, {c(".Fx"), c(".Fy"), -1}, {-1, -1, c(".Mz")});
   }
   const std::vector<std::vector<Index>> reads =
       e.constraints.empty() ? std::vector<std::vector<Index>>{} : coordinates_read(model);

@@ -89,7 +89,7 @@ Quantity column_quantity(const Scene& scene, const std::string& column) {
       }
     }
   for (const OutputReaction& r : scene.sweep.efforts.reactions) {  // a joint's reaction: forces and moments
-    const std::string& name = model.constraints()[static_cast<std::size_t>(r.constraint)].name;
+    const std::string name = scene.sweep.efforts.reaction_name(model, r);
     if (column.size() == name.size() + 3 && column.compare(0, name.size(), name) == 0 && column[name.size()] == '.')
       return column[name.size() + 1] == 'F' ? Quantity{"force", "N"} : Quantity{"torque", "N·m"};
   }

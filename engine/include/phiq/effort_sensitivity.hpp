@@ -16,16 +16,22 @@
 ///
 ///   H(a, b) = −[γ(a + b) + γ(−a − b) − γ(a − b) − γ(b − a)] / 8
 ///
-/// cancels Φqt and Φtt (four evaluations of γ at q itself, no step). Q, trigonometric in q, is differenced: along p by
-/// the fourth-order difference of the sensitivities (the parts and loads of the scene read again at p ± h, p ± 2h:
-/// OutputSensitivity::parts_along; a mass, a centre of mass or a load that reads p), and along the motion by the same
-/// difference with a step that moves the coordinate s moves most by 10⁻³ of its scale (the direct sensitivities'
-/// rule), exact up to 10⁻¹² relative. A co-moving coordinate (ParameterReach::comotion) is moved along p as the
-/// sensitivities move it, and the motion's part taken along s − q̂.
+/// cancels Φqt and Φtt (four evaluations of γ at q itself, no step). dQ/dp is exact too (parts/force_rate.hpp): Q
+/// again in dual numbers through the parts' frame jets, every pose, Jacobian column, velocity, acceleration and load
+/// carried with its rate along s, ṡ, s̈; what p changes of the parts and loads themselves (a mass, a centre, an
+/// inertia, a ground point of a frame, gravity, a load's point, expression or constants) by the rates of those data
+/// between the scene read at p ± h, p ± 2h (OutputSensitivity::parts_along; exact for data linear in p). Frames of
+/// expressions (relative angles) and torsional springs on a spatial joint's angle are not carried: for a parameter
+/// that meets one, Q is differenced as before (along p by the fourth-order difference over the copies, along the
+/// motion with a step that moves the coordinate s moves most by 10⁻³ of its scale; ~10⁻¹² relative). A co-moving
+/// coordinate (ParameterReach::comotion) is moved along p as the sensitivities move it.
 ///
-/// Cost per written row: one direct solve per driver, and per parameter 8 evaluations of Q (4 for a parameter that
-/// moves no part, no load and no coordinate: its parts_along and loads_along null), 2 of the velocity term
-/// over the reach and 4 of γ per driver; the sensitivities of q, q̇, q̈ in the direct form (every coordinate's).
+/// A driver's power P = Σ λ_r Φt_r over its rows: dP/dp = Σ (dλ_r/dp Φt_r + λ_r dΦt_r/dp), dλ_r/dp as −dτ/dp above
+/// with w = Φq⁻¹ e_r for each row, and dΦt/dp = ∂Φt/∂p |q + Φqt (s − q̂), the latter −[γ(a) − γ(−a)]/4 at a = s − q̂.
+///
+/// Cost per written row: one direct solve per driver row, and per parameter 1 evaluation of Q in dual numbers (8 of Q
+/// where differenced), 3 of the velocity term over the reach and 2 of γ, and per driver row 2 of the velocity term
+/// and 4 of γ; the sensitivities of q, q̇, q̈ in the direct form (every coordinate's).
 #pragma once
 
 #include <string>
@@ -37,17 +43,22 @@
 
 namespace phiq {
 
-/// Values of the efforts' sensitivities: effort i (of OutputEfforts::constraints) to parameter j at `j·efforts + i`.
+/// Values of the efforts' and powers' sensitivities: effort i (of OutputEfforts::constraints) to parameter j at
+/// `j·efforts + i`, then, after every effort's, power i to parameter j.
 struct EffortSensitivityLayout {
   std::size_t efforts = 0;  ///< OutputEfforts::constraints.size()
   /// Offset of ∂τ_i/∂p_j.
   std::size_t offset(std::size_t j, std::size_t i) const { return j * efforts + i; }
-  /// Values for `parameters` parameters.
-  std::size_t size(std::size_t parameters) const { return parameters * efforts; }
+  /// Offset of ∂P_i/∂p_j among the values for `parameters` parameters.
+  std::size_t power_offset(std::size_t parameters, std::size_t j, std::size_t i) const {
+    return (parameters + j) * efforts + i;
+  }
+  /// Values for `parameters` parameters: ∂τ/∂p, then ∂P/∂p.
+  std::size_t size(std::size_t parameters) const { return 2 * parameters * efforts; }
 };
 
-/// ∂τ/∂p of each driver of `efforts` (OutputEfforts::constraints) to each of `parameters`, at the motion in `ws`
-/// (q, q̇, q̈ solved at t), into `out` (EffortSensitivityLayout, resized): solves the sensitivities (direct form,
+/// ∂τ/∂p and ∂P/∂p of each driver of `efforts` (OutputEfforts::constraints) to each of `parameters`, at the motion in
+/// `ws` (q, q̇, q̈ solved at t), into `out` (EffortSensitivityLayout, resized): solves the sensitivities (direct form,
 /// order 2) and the multipliers with one factorisation of Φq at ws.q (the file comment). The parts and loads along
 /// a parameter are its OutputSensitivity::parts_along / loads_along, or `efforts`' own where those are null (a
 /// parameter that reaches the constraints only). NaN for a driver the model dropped as redundant. Returns kSuccess,

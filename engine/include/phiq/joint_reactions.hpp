@@ -8,6 +8,9 @@
 /// M_P = M_O + (O − P) × F, world axes. The other body receives −F and −M_P (a joint's equations do not change when
 /// both bodies move together, so its forces and moments balance).
 ///
+/// Natural coordinates' joints, points two bodies share (phiq/natural_joints.hpp), split the equations at the point
+/// among the bodies instead; their moment is zero.
+///
 /// A model with redundant rows has many λ (the structure is statically indeterminate): minimum_norm_multipliers()
 /// takes the one of least norm, and names the constraints whose share is not determined.
 #pragma once
@@ -19,6 +22,8 @@
 #include "phiq/kinds/reaction_site.hpp"
 #include "phiq/linear_solver.hpp"
 #include "phiq/model.hpp"
+#include "phiq/natural_joints.hpp"
+#include "phiq/output_plan.hpp"
 #include "phiq/part_motion.hpp"
 
 namespace phiq {
@@ -33,6 +38,10 @@ class JointReactions {
  public:
   /// Pre-condition: each of `constraints` has a reaction (reaction_width() > 0); else phiq::Error naming it.
   JointReactions(const Model& model, std::vector<Index> constraints);
+  /// The reactions `efforts` lists (OutputEfforts::reactions, in order): a constraint's, or a natural joint's of
+  /// OutputEfforts::natural. Pre-condition: as above for the constraints; a natural joint's index is one of
+  /// `natural`'s joints (else phiq::Error).
+  JointReactions(const Model& model, const OutputEfforts& efforts);
   /// The values evaluate() writes: per constraint, Fx, Fy, Mz (N, N·m) for a planar joint, Fx, Fy, Fz, Mx, My, Mz
   /// for a spatial one.
   Index size() const { return size_; }
@@ -40,7 +49,11 @@ class JointReactions {
   bool spatial(std::size_t k) const { return sites_[k].spatial; }
   /// Writes the reactions at (q, t) under multipliers `lambda` (one per model row) to out[0, size()).
   /// Pre-condition: q has the model's coordinates; the model is the one given to the constructor.
+  /// No natural joint may be listed (they read q̇ and q̈: the overload below; else phiq::Error).
   void evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out);
+  /// The same at the motion (q, q̇, q̈, t), which natural joints read (their bodies' inertia).
+  void evaluate(const double* q, const double* qd, const double* qdd, double t, const Eigen::VectorXd& lambda,
+                double* out);
 
  private:
   struct Site {
@@ -49,7 +62,25 @@ class JointReactions {
     std::vector<Index> columns;  // the coordinates the constraint reads (to clear the scratch)
     bool spatial = false;
   };
+  struct NaturalSite {
+    std::size_t joint = 0, body = 0;  // in natural_
+    std::size_t point = 0;            // the joint's place among the body's points
+  };
+  struct BodyRows {  // a natural body's own constraints, and the columns they and its forces touch
+    std::vector<std::pair<const ConstraintBlock*, std::size_t>> constraints;
+    std::vector<Index> g_columns, q_columns;
+  };
+  void add_site(const Model& model, Index c, std::vector<int>& site_of);
+  void find_columns(const Model& model, const std::vector<int>& site_of);
+  void add_natural(const Model& model, const OutputEfforts& efforts);
+  void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
+  void evaluate_natural(const NaturalSite& s, double t, const Eigen::VectorXd& lambda, double*& out);
   std::vector<Site> sites_;
+  std::vector<NaturalSite> natural_sites_;
+  std::vector<std::pair<bool, std::size_t>> order_;  // (natural, index) per listed reaction
+  std::shared_ptr<const NaturalJoints> natural_;
+  std::vector<BodyRows> body_rows_;
+  Eigen::VectorXd qx_, qdx_, qddx_, qb_;  // q, q̇, q̈ with the promoted constants; a body's Q
   Index size_ = 0;
   std::vector<double> g_;  // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
   PartJacobian jac_;       // the body's frame Jacobian (its capacity kept: no allocation per row)

@@ -25,6 +25,7 @@ namespace phiq {
 
 class Model;                // model.hpp
 struct Loads;               // parts.hpp
+struct NaturalJoints;       // natural_joints.hpp
 struct Part;                // parts.hpp
 struct ParameterReach;      // sensitivity.hpp
 struct ReachedConstraints;  // sensitivity.hpp
@@ -84,8 +85,10 @@ struct OutputDriver {
 
 /// A joint whose reaction a sweep writes (OutputEfforts::reactions).
 struct OutputReaction {
-  Index constraint = -1;  ///< Model::constraints() index; its kind has a ReactionSite (reaction_width() > 0)
-  bool spatial = false;   ///< six values (Fx, Fy, Fz, Mx, My, Mz) rather than three (Fx, Fy, Mz)
+  /// Model::constraints() index; its kind has a ReactionSite (reaction_width() > 0); −1 for a natural joint
+  Index constraint = -1;
+  bool spatial = false;  ///< six values (Fx, Fy, Fz, Mx, My, Mz) rather than three (Fx, Fy, Mz)
+  int natural = -1;      ///< a natural joint: its index in OutputEfforts::natural's joints, else −1
 };
 
 /// Driver efforts (inverse dynamics, phiq/inverse_dynamics.hpp) at every written row: for each listed constraint
@@ -100,6 +103,10 @@ struct OutputEfforts {
   /// Joints whose reactions are written (phiq/joint_reactions.hpp), in this order: `NAME.Fx`, `NAME.Fy`, `NAME.Mz`
   /// for a planar joint, `NAME.Fx` … `NAME.Mz` (six) for a spatial one; minimum-norm where indeterminate.
   std::vector<OutputReaction> reactions;
+  /// The natural coordinates' bodies and joints the `natural` reactions index (null: none listed).
+  std::shared_ptr<const NaturalJoints> natural;
+  /// A reaction's name (its columns' stem): its constraint's, or its natural joint's point's.
+  std::string reaction_name(const Model& model, const OutputReaction& r) const;
   /// Values a row holds: the efforts, then the powers (always computed: one product each), then the reactions.
   Index size() const {
     Index n = 2 * static_cast<Index>(constraints.size());
@@ -111,7 +118,8 @@ struct OutputEfforts {
 };
 
 /// Values a row's StepView::efforts holds for `plan`: OutputEfforts::size(), then, with sensitivities, each effort's
-/// ∂τ/∂p (EffortSensitivityLayout of phiq/effort_sensitivity.hpp: parameter by parameter, efforts in order).
+/// ∂τ/∂p and each power's ∂P/∂p (EffortSensitivityLayout of phiq/effort_sensitivity.hpp: parameter by parameter,
+/// efforts in order; the powers' computed whether written or not, as the powers are).
 Index effort_values(const OutputEfforts& efforts, std::size_t parameters);
 
 /// The outputs of a sweep beyond q (models/README.md, `output`). The sweep computes only what the plan lists; the
@@ -141,8 +149,9 @@ struct OutputPlan {
   SensitivityForm sensitivity_form = SensitivityForm::kAuto;
   /// Driver efforts and powers at every written row (StepView::efforts), written as `NAME.effort`, `NAME.power`;
   /// empty `constraints`: none computed. With `sensitivities`, each effort's sensitivity to each parameter too,
-  /// `NAME.effort.d_P` (phiq/effort_sensitivity.hpp), which reads every coordinate's sensitivities: the sweep then
-  /// solves them in the direct form, whatever `sensitivity_form` says (SweepSummary says so).
+  /// `NAME.effort.d_P`, and each power's, `NAME.power.d_P` when the powers are written (phiq/effort_sensitivity.hpp),
+  /// which read every coordinate's sensitivities: the sweep then solves them in the direct form, whatever
+  /// `sensitivity_form` says (SweepSummary says so).
   OutputEfforts efforts;
   /// Whether the sweep solves q̈: asked for, or needed by the efforts. Solved is not delivered: StepView::qdd is set
   /// as `accelerations` says.

@@ -113,8 +113,8 @@ class Stepper {
   /// not solved, and all at a singular position); null when none are asked for or before started().
   const double* sensitivities() const;
   /// Efforts, powers and reactions of StepperOptions::efforts at the current step, then with sensitivities each
-  /// effort's ∂τ/∂p (effort_values() values, StepView::efforts; NaN at a singular position), or null when none are
-  /// asked for or before the first step.
+  /// effort's ∂τ/∂p and each power's ∂P/∂p (effort_values() values, StepView::efforts; NaN at a singular position),
+  /// or null when none are asked for or before the first step.
   const double* efforts() const;
 
   /// Everything the steps did since construction, as run_sweep's summary says it of a sweep: counters, subdivisions,

@@ -70,7 +70,7 @@ py::dict reactions_of(const PyStepper& s) {
     const int n = r.spatial ? 6 : 3;
     py::tuple values(n);
     for (int k = 0; k < n; ++k) values[static_cast<std::size_t>(k)] = v[k];
-    out[py::str(s.stepper->model().constraints()[static_cast<std::size_t>(r.constraint)].name)] = values;
+    out[py::str(e.reaction_name(s.stepper->model(), r))] = values;
     v += n;
   }
   return out;

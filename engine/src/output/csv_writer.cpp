@@ -132,10 +132,12 @@ std::vector<std::string> CsvFormat::dotted_names() const {
   static constexpr const char* kPlanar[] = {".Fx", ".Fy", ".Mz"};
   for (const OutputReaction& r : plan_->efforts.reactions)
     for (int k = 0; k < (r.spatial ? 6 : 3); ++k)
-      h.push_back(model_.constraints()[static_cast<std::size_t>(r.constraint)].name +
-                  (r.spatial ? kSpatial : kPlanar)[k]);
+      h.push_back(plan_->efforts.reaction_name(model_, r) + (r.spatial ? kSpatial : kPlanar)[k]);
   for (const OutputSensitivity& p : plan_->sensitivities)  // ∂τ/∂p (phiq/effort_sensitivity.hpp)
     for (Index c : plan_->efforts.constraints) h.push_back(model_.constraints()[c].name + ".effort.d_" + p.name);
+  if (plan_->efforts.power)  // ∂P/∂p
+    for (const OutputSensitivity& p : plan_->sensitivities)
+      for (Index c : plan_->efforts.constraints) h.push_back(model_.constraints()[c].name + ".power.d_" + p.name);
   return h;
 }
 
@@ -232,8 +234,10 @@ void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
     if (!s.efforts) throw Error("CsvFormat: step has no efforts");
     const std::size_t n = plan_->efforts.constraints.size();
     for (std::size_t i = 0; i < (plan_->efforts.power ? 2 * n : n); ++i) emit(s.efforts[i]);
-    const std::size_t all = static_cast<std::size_t>(effort_values(plan_->efforts, plan_->sensitivities.size()));
-    for (std::size_t i = 2 * n; i < all; ++i) emit(s.efforts[i]);  // reactions, then ∂τ/∂p
+    // reactions, then ∂τ/∂p, then ∂P/∂p with the powers
+    const std::size_t taus = static_cast<std::size_t>(plan_->efforts.size()) + n * plan_->sensitivities.size();
+    const std::size_t all = plan_->efforts.power ? taus + n * plan_->sensitivities.size() : taus;
+    for (std::size_t i = 2 * n; i < all; ++i) emit(s.efforts[i]);
   }
 }
 
@@ -257,8 +261,8 @@ std::size_t CsvFormat::num_output_values() const {
        (static_cast<std::size_t>(plan_->orientation_form.size()) + 3 * (velocities_ + accelerations_));
   n += plan_->sensitivities.size() * (columns_.size() + v_columns_.size() + a_columns_.size());
   n += plan_->efforts.constraints.size() * (plan_->efforts.power ? 2 : 1);
-  n += static_cast<std::size_t>(plan_->efforts.size()) - 2 * plan_->efforts.constraints.size();  // reactions
-  n += plan_->efforts.constraints.size() * plan_->sensitivities.size();                          // ∂τ/∂p
+  n += static_cast<std::size_t>(plan_->efforts.size()) - 2 * plan_->efforts.constraints.size();           // reactions
+  n += plan_->efforts.constraints.size() * plan_->sensitivities.size() * (plan_->efforts.power ? 2 : 1);  // ∂τ, ∂P
   return n;
 }
 

@@ -216,6 +216,9 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   for (const OutputSensitivity& p : plan.sensitivities)  // ∂τ/∂p: the effort's unit per the parameter's ("/P")
     for (std::size_t i = 0; i < plan.efforts.constraints.size(); ++i)
       effort_units.push_back(effort_units[i] + "/" + p.name);
+  if (plan.efforts.power)  // ∂P/∂p
+    for (const OutputSensitivity& p : plan.sensitivities)
+      effort_units.insert(effort_units.end(), plan.efforts.constraints.size(), "W/" + p.name);
   if (Group* g = take("efforts", effort_units.size(), [&](std::size_t k) { return effort_units[k]; }))
     outputs.push_back(g);
   if (at != names.size() || groups.size() > 16) throw Error(cannot("the columns do not match the CSV's (phiq bug)"));

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 
+#include "phiq/model.hpp"
+#include "phiq/natural_joints.hpp"
+
 namespace phiq {
 
 const char* to_string(SensitivityForm form) {
@@ -27,8 +30,13 @@ std::vector<Index> OutputPlan::sensitivity_outputs() const {
   return out;
 }
 
+std::string OutputEfforts::reaction_name(const Model& model, const OutputReaction& r) const {
+  if (r.natural >= 0) return natural->joints.at(static_cast<std::size_t>(r.natural)).name;
+  return model.constraints().at(static_cast<std::size_t>(r.constraint)).name;
+}
+
 Index effort_values(const OutputEfforts& efforts, std::size_t parameters) {
-  return efforts.size() + static_cast<Index>(efforts.constraints.size() * parameters);
+  return efforts.size() + static_cast<Index>(2 * efforts.constraints.size() * parameters);  // ∂τ/∂p, ∂P/∂p
 }
 
 }  // namespace phiq

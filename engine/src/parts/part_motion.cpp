@@ -6,46 +6,18 @@
 #include <array>
 #include <cmath>
 
+#include "parts/frame_jets.hpp"
+
 namespace phiq {
 
 namespace {
 
-// A value with its first and second derivatives along the path.
-struct Jet {
-  double v = 0.0, d = 0.0, dd = 0.0;
-};
-Jet operator+(Jet a, Jet b) { return {a.v + b.v, a.d + b.d, a.dd + b.dd}; }
-Jet operator-(Jet a, Jet b) { return {a.v - b.v, a.d - b.d, a.dd - b.dd}; }
-Jet operator*(Jet a, Jet b) { return {a.v * b.v, a.d * b.v + a.v * b.d, a.dd * b.v + 2.0 * a.d * b.d + a.v * b.dd}; }
-Jet operator*(double k, Jet a) { return {k * a.v, k * a.d, k * a.dd}; }
-Jet constant(double c) { return {c, 0.0, 0.0}; }
-Jet sqrt(Jet a) {  // s² = a: 2 s s' = a', 2 s'² + 2 s s'' = a''
-  const double s = std::sqrt(a.v), d = a.d / (2.0 * s);
-  return {s, d, (a.dd - 2.0 * d * d) / (2.0 * s)};
-}
-Jet inverse(Jet a) {
-  const double r = 1.0 / a.v;
-  return {r, -a.d * r * r, -a.dd * r * r + 2.0 * a.d * a.d * r * r * r};
-}
-Jet sin(Jet a) {
-  const double s = std::sin(a.v), c = std::cos(a.v);
-  return {s, c * a.d, c * a.dd - s * a.d * a.d};
-}
-Jet cos(Jet a) {
-  const double s = std::sin(a.v), c = std::cos(a.v);
-  return {c, -s * a.d, -s * a.dd - c * a.d * a.d};
-}
-
-using JV = std::array<Jet, 3>;
-using JR = std::array<Jet, 9>;  // row-major rotation
-
-Jet dot(const JV& a, const JV& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-JV cross(const JV& a, const JV& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-JV times(Jet k, const JV& a) { return {k * a[0], k * a[1], k * a[2]}; }
-JV minus(const JV& a, const JV& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-JR columns(const JV& x, const JV& y, const JV& z) { return {x[0], y[0], z[0], x[1], y[1], z[1], x[2], y[2], z[2]}; }
+using Jet = detail::JetT<double>;
+using JV = detail::JetV<double>;
+using JR = detail::JetR<double>;
+using detail::frame_jets;
+using detail::product_transposed;
+Jet constant(double c) { return detail::constant_jet<double>(c); }
 
 // Where the path goes: along (q̇, q̈) with time (k < 0), or along coordinate k alone (a Jacobian column).
 struct Path {
@@ -83,80 +55,42 @@ struct Path {
   JV natural(const Attachment3& a) const { return {slot(a.r[0]), slot(a.r[1]), slot(a.r[2])}; }
 };
 
-JR about_z(Jet psi) {
-  const Jet c = cos(psi), s = sin(psi), o = constant(0.0), one = constant(1.0);
-  return {c, constant(0.0) - s, o, s, c, o, o, o, one};
-}
-
-// R(e/|e|) = (e0² − e·e) 1 + 2 e eᵀ + 2 e0 [e]×, e = (e1, e2, e3) after the normalisation.
-JR from_euler(std::array<Jet, 4> e) {
-  const Jet n = inverse(sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] + e[3] * e[3]));
-  for (Jet& x : e) x = n * x;
-  const Jet a = e[0] * e[0] - e[1] * e[1] - e[2] * e[2] - e[3] * e[3];
-  JR r;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) r[3 * i + j] = 2.0 * (e[1 + i] * e[1 + j]) + (i == j ? a : constant(0.0));
-  const Jet t1 = 2.0 * (e[0] * e[1]), t2 = 2.0 * (e[0] * e[2]), t3 = 2.0 * (e[0] * e[3]);
-  r[1] = r[1] - t3, r[3] = r[3] + t3, r[2] = r[2] + t2, r[6] = r[6] - t2, r[5] = r[5] - t1, r[7] = r[7] + t1;
-  return r;
-}
-
-// R = 1 + sin θ [u]× + (1 − cos θ) [u]×², u a constant unit axis.
-JR about_axis(Jet th, kin3::V3 u) {
-  const double k[9] = {0, -u.z, u.y, u.z, 0, -u.x, -u.y, u.x, 0};
-  double k2[9];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) k2[3 * i + j] = k[3 * i] * k[j] + k[3 * i + 1] * k[3 + j] + k[3 * i + 2] * k[6 + j];
-  const Jet s = sin(th), c1 = constant(1.0) - cos(th);
-  JR r;
-  for (int i = 0; i < 9; ++i) r[i] = constant(i % 4 == 0 ? 1.0 : 0.0) + k[i] * s + k2[i] * c1;
-  return r;
-}
-
-// The frame's origin and axes as jets along `p`.
-std::pair<JV, JR> frame_jets(const PartFrame& f, const Path& p) {
-  switch (f.kind) {
-    case PartFrameKind::kPlanarBody:
-      return {{p.slot(f.planar.x), p.slot(f.planar.y), constant(0.0)}, about_z(p.slot(f.planar.psi))};
-    case PartFrameKind::kSpatialBody: {
-      const Frame3& b = f.spatial;
-      return {{p.slot(b.x), p.slot(b.y), p.slot(b.z)},
-              from_euler({p.slot(b.e0), p.slot(b.e1), p.slot(b.e2), p.slot(b.e3)})};
-    }
-    case PartFrameKind::kPoints: {
-      const JV o = p.natural(f.origin);
-      JV x = p.natural(f.x_toward);
-      if (f.x_is_point) x = minus(x, o);
-      x = times(inverse(sqrt(dot(x, x))), x);
-      if (!f.spatial_frame)
-        return {o,
-                columns(x, {constant(0.0) - x[1], x[0], constant(0.0)}, {constant(0.0), constant(0.0), constant(1.0)})};
-      JV w = p.natural(f.y_toward);
-      if (f.y_is_point) w = minus(w, o);
-      JV y = minus(w, times(dot(w, x), x));
-      y = times(inverse(sqrt(dot(y, y))), y);
-      return {o, columns(x, y, cross(x, y))};
-    }
-    case PartFrameKind::kExpressions: {
-      JV o{constant(0.0), constant(0.0), constant(0.0)};
-      for (std::size_t k = 0; k < f.at.size() && k < 3; ++k) o[k] = p.expression(*f.at[k]);
-      return {o, f.angle ? about_axis(p.expression(*f.angle), f.axis) : about_axis(constant(0.0), f.axis)};
-    }
-  }
-  return {};
-}
-
 // The vector of the antisymmetric part of the 3×3 matrix m: (m32 − m23, m13 − m31, m21 − m12) / 2.
 kin3::V3 vee(const double m[9]) { return {0.5 * (m[7] - m[5]), 0.5 * (m[2] - m[6]), 0.5 * (m[3] - m[1])}; }
 
-// a bᵀ of two rotations' jets' parts: which(a) which(b)ᵀ.
-void product_transposed(const JR& a, double Jet::*pa, const JR& b, double Jet::*pb, double out[9]) {
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      double s = 0.0;
-      for (int l = 0; l < 3; ++l) s += a[3 * i + l].*pa * (b[3 * j + l].*pb);
-      out[3 * i + j] = s;
+// The motion of a planar frame in closed form: a body's (x, y, ψ), or an origin point and an x direction (θ its
+// angle: ω = (d × ḋ)/|d|², α = (d × d̈)/|d|² − 2 (d · ḋ)(d × ḋ)/|d|⁴). Inverse dynamics calls part_motion() for every
+// part at every row, where the jets cost as much as the row's solves. False for the other frames (the jets).
+bool planar_motion(const PartFrame& f, const double* q, const double* qd, const double* qdd, PartMotion& m) {
+  auto rate = [&](const Slot& s) { return s.is_coordinate() ? qd[s.coord()] : 0.0; };
+  auto accel = [&](const Slot& s) { return s.is_coordinate() && qdd ? qdd[s.coord()] : 0.0; };
+  double c = 1.0, s = 0.0, w = 0.0, a = 0.0;
+  if (f.kind == PartFrameKind::kPlanarBody) {
+    const Frame2& b = f.planar;
+    m.pose.at = {b.x.of(q), b.y.of(q), 0.0};
+    m.velocity = {rate(b.x), rate(b.y), 0.0}, m.acceleration = {accel(b.x), accel(b.y), 0.0};
+    const double psi = b.psi.of(q);
+    c = std::cos(psi), s = std::sin(psi), w = rate(b.psi), a = accel(b.psi);
+  } else if (f.kind == PartFrameKind::kPoints && !f.spatial_frame) {
+    const Slot* o = f.origin.r;
+    const Slot* x = f.x_toward.r;
+    m.pose.at = {o[0].of(q), o[1].of(q), o[2].of(q)};
+    m.velocity = {rate(o[0]), rate(o[1]), rate(o[2])}, m.acceleration = {accel(o[0]), accel(o[1]), accel(o[2])};
+    double dx = x[0].of(q), dy = x[1].of(q), vx = rate(x[0]), vy = rate(x[1]), ax = accel(x[0]), ay = accel(x[1]);
+    if (f.x_is_point) {
+      dx -= m.pose.at.x, dy -= m.pose.at.y, vx -= m.velocity.x, vy -= m.velocity.y;
+      ax -= m.acceleration.x, ay -= m.acceleration.y;
     }
+    const double d2 = dx * dx + dy * dy, n = std::sqrt(d2), turn = dx * vy - dy * vx;
+    if (!(n > 0.0)) return false;                           // no direction: the jets' (and part_pose()'s) NaN
+    c = (1.0 / n) * dx, s = (1.0 / n) * dy, w = turn / d2;  // the axes as part_pose() rounds them
+    a = (dx * ay - dy * ax) / d2 - 2.0 * (dx * vx + dy * vy) * turn / (d2 * d2);
+  } else {
+    return false;
+  }
+  m.pose.rotation = {c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0};
+  m.omega = {0.0, 0.0, w}, m.alpha = {0.0, 0.0, a};
+  return true;
 }
 
 }  // namespace
@@ -168,8 +102,9 @@ std::pair<kin3::V3, kin3::V3> PartMotion::point(kin3::V3 s) const {
 }
 
 PartMotion part_motion(const PartFrame& frame, const double* q, const double* qd, const double* qdd, double t) {
-  const auto [o, r] = frame_jets(frame, Path{q, qd, qdd, t});
   PartMotion m;
+  if (planar_motion(frame, q, qd, qdd, m)) return m;
+  const auto [o, r] = frame_jets<double>(frame, Path{q, qd, qdd, t});
   m.pose = part_pose(frame, q, t);
   m.velocity = {o[0].d, o[1].d, o[2].d};
   m.acceleration = {o[0].dd, o[1].dd, o[2].dd};
@@ -247,7 +182,7 @@ void part_jacobian(const PartFrame& frame, const double* q, double t, PartJacobi
   if (closed_form_jacobian(frame, q, jac)) return;
   jac.d_origin.clear(), jac.d_angle.clear();
   for (Index k : jac.coordinates) {
-    const auto [o, r] = frame_jets(frame, Path{q, nullptr, nullptr, t, k});
+    const auto [o, r] = frame_jets<double>(frame, Path{q, nullptr, nullptr, t, k});
     double w[9];
     product_transposed(r, &Jet::d, r, &Jet::v, w);
     jac.d_origin.push_back({o[0].d, o[1].d, o[2].d});

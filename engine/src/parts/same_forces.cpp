@@ -22,17 +22,6 @@ bool same_expressions(const std::array<std::shared_ptr<const CompiledExpression>
   return true;
 }
 
-bool same_frame(const PartFrame& a, const PartFrame& b) {
-  if (a.kind != b.kind || a.spatial_frame != b.spatial_frame || !(a.planar == b.planar) || !(a.spatial == b.spatial) ||
-      !(a.origin == b.origin) || !(a.x_toward == b.x_toward) || !(a.y_toward == b.y_toward) ||
-      a.x_is_point != b.x_is_point || a.y_is_point != b.y_is_point || !(a.axis == b.axis) ||
-      !same_expression(a.angle, b.angle) || a.at.size() != b.at.size())
-    return false;
-  for (std::size_t i = 0; i < a.at.size(); ++i)
-    if (!same_expression(a.at[i], b.at[i])) return false;
-  return true;
-}
-
 bool same_mass(const MassProperties& a, const MassProperties& b) {
   return a.mass == b.mass && a.center == b.center && a.inertia == b.inertia;
 }
@@ -72,6 +61,17 @@ bool same_applied(const AppliedLoads& a, const AppliedLoads& b) {
 }
 
 }  // namespace
+
+bool same_frame(const PartFrame& a, const PartFrame& b) {
+  if (a.kind != b.kind || a.spatial_frame != b.spatial_frame || !(a.planar == b.planar) || !(a.spatial == b.spatial) ||
+      !(a.origin == b.origin) || !(a.x_toward == b.x_toward) || !(a.y_toward == b.y_toward) ||
+      a.x_is_point != b.x_is_point || a.y_is_point != b.y_is_point || !(a.axis == b.axis) ||
+      !same_expression(a.angle, b.angle) || a.at.size() != b.at.size())
+    return false;
+  for (std::size_t i = 0; i < a.at.size(); ++i)
+    if (!same_expression(a.at[i], b.at[i])) return false;
+  return true;
+}
 
 bool same_inertia(const std::vector<Part>& a, const std::vector<Part>& b) {
   if (a.size() != b.size()) return false;

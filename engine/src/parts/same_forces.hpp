@@ -9,6 +9,9 @@
 
 namespace phiq::detail {
 
+// Whether two frames follow q and t alike: the same kind, slots, attachments and expressions.
+bool same_frame(const PartFrame& a, const PartFrame& b);
+
 // Whether `a` and `b` hold the same parts in the same order with the same frames and mass properties (names and
 // shapes are not compared: Q reads neither; a density moves the mass properties, which are). Conservative: a
 // difference that changes no Q (a massless part's frame) still counts as one.

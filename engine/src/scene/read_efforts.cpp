@@ -7,6 +7,7 @@
 #include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/joint_reactions.hpp"
+#include "phiq/natural_joints.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace phiq::detail::scene {
@@ -19,13 +20,23 @@ void SceneReader::read_output_efforts(const Cursor& output) {
   }
   if (const Cursor r = output.field("reactions"); r.present()) {
     pending_.reactions_field = r;
+    // the named points, read before their table is freed (the natural joints are found with the model)
+    if (spatial_)
+      for (Index k = 0; k < names_.points3.size(); ++k)
+        pending_.natural_points.emplace_back(names_.points3.name(k), Attachment3::natural(names_.points3[k]));
+    else
+      for (Index k = 0; k < names_.points.size(); ++k)
+        pending_.natural_points.emplace_back(
+            names_.points.name(k),
+            Attachment3::natural(Point3{names_.points[k].x, names_.points[k].y, Slot::constant(0)}));
     if (r.is_scalar()) {
       if (r.text() != "all") r.fail("expected `all` or a list of joints");
     } else {
       std::set<std::string> seen;
       for (const Cursor& i : r.items()) {
         const std::string n = i.name();
-        if (!builder_.has_constraint(n)) i.fail("unknown joint '" + n + "'");
+        if (!builder_.has_constraint(n) && !(spatial_ ? names_.points3.contains(n) : names_.points.contains(n)))
+          i.fail("unknown joint '" + n + "'");
         if (!seen.insert(n).second) i.fail("joint listed twice");
         pending_.reaction_items.push_back(i);
       }
@@ -51,17 +62,37 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
   if (pending_.reactions_field) {
+    // natural coordinates' joints: named points that parts with frames of points share (phiq/natural_joints.hpp)
+    auto natural = std::make_shared<NaturalJoints>(
+        find_natural_joints(scene.parts, scene.loads, pending_.natural_points, model.num_coordinates(), spatial_));
+    auto natural_joint = [&](const std::string& name) {
+      for (std::size_t j = 0; j < natural->joints.size(); ++j)
+        if (natural->joints[j].name == name) return static_cast<int>(j);
+      return -1;
+    };
     if (pending_.reaction_items.empty()) {  // all: every joint with a reaction that no driver moves
       for (std::size_t c = 0; c < model.constraints().size(); ++c)
         if (const int w = reaction_width(model, static_cast<Index>(c));
             w > 0 && !model.constraints()[c].depends_on_time)
           out.reactions.push_back({static_cast<Index>(c), w == 6});
+      for (std::size_t j = 0; j < natural->joints.size(); ++j)
+        out.reactions.push_back({-1, spatial_, static_cast<int>(j)});
       if (out.reactions.empty())
         pending_.reactions_field->fail(
-            "no constraint of the scene joins bodies (revolute, prismatic, spatial joints): no "
-            "reaction to write");
+            "no constraint of the scene joins bodies (revolute, prismatic, spatial joints) and no named point is "
+            "shared by parts with frames of points: no reaction to write");
     }
+    if (!natural->joints.empty()) out.natural = natural;
     for (const Cursor& i : pending_.reaction_items) {
+      if (!builder_.has_constraint(i.name())) {
+        const int j = natural_joint(i.name());
+        if (j < 0)
+          i.fail("point '" + i.name() +
+                 "' is no joint: no two parts with frames of points hold it, nor one with a component fixed");
+        out.reactions.push_back({-1, spatial_, j});
+        out.natural = natural;
+        continue;
+      }
       const Index c = model.find_constraint(i.name());
       const int w = reaction_width(model, c);
       if (w == 0)

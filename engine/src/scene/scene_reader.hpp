@@ -242,6 +242,8 @@ class SceneReader {
     std::vector<Cursor> effort_items;
     bool efforts_power = false;             // and `power`
     std::optional<Cursor> reactions_field;  // `output: reactions` (its items when it lists names)
+    // with `reactions`: the named natural points, kept past the tables' release for the natural joints
+    std::vector<std::pair<std::string, Attachment3>> natural_points;
     std::vector<Cursor> reaction_items;
   };
   Pending pending_;

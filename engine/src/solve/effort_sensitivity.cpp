@@ -11,6 +11,7 @@
 #include "phiq/parts.hpp"
 #include "phiq/sensitivity.hpp"
 #include "phiq/text.hpp"
+#include "parts/force_rate.hpp"
 #include "solve/factorisation.hpp"
 #include "solve/models_along.hpp"
 #include "solve/sensitivity_internal.hpp"
@@ -90,6 +91,26 @@ void second_derivative(const Model& model, const double* q, const Eigen::VectorX
   sc.plus = ((sc.g[2] - sc.g[0]) + (sc.g[3] - sc.g[1])) / (8.0 * alpha * beta);
 }
 
+// dΦt/dp over every row into sc.dphit: along p at fixed q (over the reach, with the co-moving coordinates) plus
+// Φqt (s − q̂), from γ at ±a (exact: γ(a) − γ(−a) = −4 Φqt a, its quadratic and constant parts cancel).
+void time_rate_along(const Model& model, const OutputSensitivity& p, const ParameterReach& reach, const double* q,
+                     double t, detail::EffortSensitivityScratch& sc) {
+  const Index n = model.num_coordinates(), m = model.num_equations();
+  sc.dphit.setZero(m);
+  sc.qk.setZero(n);
+  detail::along_parameter(model, p, reach, detail::AlongParameter::kVelocityTerm, q, sc.qk.data(), nullptr, t, n,
+                          sc.along, sc.dphit);
+  const double rate = detail::fastest_coordinate(sc.v.data(), model.tolerance_scales().coordinate_scale.data(), n);
+  if (rate == 0.0) return;
+  const double alpha = 1.0 / rate;  // a as fast as 1/s of the scales
+  sc.vk = alpha * sc.v;
+  sc.g[0].resize(m), sc.g[1].resize(m);
+  model.gamma(q, sc.vk.data(), t, sc.g[0].data());
+  sc.vk = -sc.vk;
+  model.gamma(q, sc.vk.data(), t, sc.g[1].data());
+  sc.dphit -= (sc.g[0] - sc.g[1]) / (4.0 * alpha);
+}
+
 }  // namespace
 
 bool detail::effort_sensitivities_with_factors(const Model& model, const OutputEfforts& efforts,
@@ -98,40 +119,62 @@ bool detail::effort_sensitivities_with_factors(const Model& model, const OutputE
                                                const Eigen::VectorXd& lambda, const double* sensitivities,
                                                SparseLuNumeric& lu, EffortSensitivityScratch& sc, double* out) {
   const Index n = model.num_coordinates(), m = model.num_equations();
-  const std::size_t ne = efforts.constraints.size();
+  const std::size_t ne = efforts.constraints.size(), np = parameters.size();
   const EffortSensitivityLayout layout{ne};
-  std::fill(out, out + layout.size(parameters.size()), std::numeric_limits<double>::quiet_NaN());
-  if (ne == 0 || parameters.empty()) return true;
+  std::fill(out, out + layout.size(np), std::numeric_limits<double>::quiet_NaN());
+  if (ne == 0 || np == 0) return true;
   for (auto& f : sc.along.f) f.resize(m);
   sc.along.along.resize(m);
-  // w_i = Φq⁻¹ e_r: how the motion answers a unit change of the driver's row (its λ is wᵀ Q)
-  sc.w.resize(ne);
+  // w = Φq⁻¹ e_r for every kept row r of each driver: how the motion answers a unit change of the row (λ_r = wᵀ Q).
+  // A dropped row's load is shared with the rows it repeats: NaN for the effort where it is the first, for the
+  // power where it is any.
+  sc.rows.clear();
+  sc.all_kept.assign(ne, true);
+  std::size_t used = 0;
   for (std::size_t i = 0; i < ne; ++i) {
-    const Index row =
-        factored_row(model, model.constraints()[static_cast<std::size_t>(efforts.constraints[i])].first_row);
-    if (row < 0) {
-      sc.w[i].resize(0);
-      continue;
+    const ConstraintInfo& c = model.constraints()[static_cast<std::size_t>(efforts.constraints[i])];
+    for (Index r = c.first_row; r < c.first_row + c.rows; ++r) {
+      if (factored_row(model, r) < 0) {
+        sc.all_kept[i] = false;
+        continue;
+      }
+      if (sc.w.size() <= used) sc.w.resize(used + 1);
+      sc.rhs.setZero(n);
+      sc.rhs[factored_row(model, r)] = 1.0;
+      sc.w[used].resize(n);
+      if (!lu.solve(sc.rhs.data(), sc.w[used].data())) return false;
+      sc.rows.push_back({i, r, used++});
     }
-    sc.rhs.setZero(n);
-    sc.rhs[row] = 1.0;
-    sc.w[i].resize(n);
-    if (!lu.solve(sc.rhs.data(), sc.w[i].data())) return false;
+  }
+  sc.phit.setZero(m);  // at the drivers' rows: a power reads no other
+  for (const Index c : efforts.constraints) {
+    const auto [block, index] = model.constraint_block(c);
+    block->phi_t(index, index + 1, q, t, sc.phit.data());
   }
   const SensitivityLayout sl{n};
   const double qd_rate = detail::fastest_coordinate(qd, model.tolerance_scales().coordinate_scale.data(), n);
-  for (std::size_t j = 0; j < parameters.size(); ++j) {
+  for (std::size_t j = 0; j < np; ++j) {
     const OutputSensitivity& p = parameters[j];
     if (!p.reach) throw Error("effort_sensitivities_with_factors: the reach of '" + p.name + "' is not known");
     const ParameterReach& reach = *p.reach;
     const double* s = sensitivities + sl.offset(j, 0);
     sc.v = Eigen::Map<const Eigen::VectorXd>(s, n);  // s − q̂: the part along the motion
     for (const ParameterReach::Comotion& c : reach.comotion) sc.v[c.coordinate] -= q[c.coordinate] * c.rate;
-    total_force_rate(model, efforts, p, reach, q, qd, qdd, sensitivities + sl.offset(j, 1),
-                     sensitivities + sl.offset(j, 2), t, sc);
-    for (std::size_t i = 0; i < ne; ++i) {
-      const Eigen::VectorXd& w = sc.w[i];
-      if (w.size() == 0) continue;
+    detail::ForcesAlong along{{}, {}, p.step};
+    for (std::size_t k = 0; k < 4; ++k)
+      along.parts[k] = p.parts_along[k].get(), along.loads[k] = p.loads_along[k].get();
+    sc.dq.resize(n);
+    if (sc.difference_forces ||
+        !detail::generalized_force_rate(*efforts.parts, *efforts.loads, along, q, qd, qdd, s,
+                                        sensitivities + sl.offset(j, 1), sensitivities + sl.offset(j, 2), t, sc.dq)) {
+      total_force_rate(model, efforts, p, reach, q, qd, qdd, sensitivities + sl.offset(j, 1),
+                       sensitivities + sl.offset(j, 2), t, sc);
+      ++sc.differenced;
+    }
+    time_rate_along(model, p, reach, q, t, sc);
+    sc.power.assign(ne, 0.0);
+    for (const EffortSensitivityScratch::DriverRow& dr : sc.rows) {
+      const Eigen::VectorXd& w = sc.w[dr.w];
       // ∂(Φq w)/∂p at fixed q: the velocity term's derivative along p at q̇ = w and −w (Φt's cancels), over the reach
       sc.minus.setZero(m);
       sc.qk = -w;
@@ -143,8 +186,15 @@ bool detail::effort_sensitivities_with_factors(const Model& model, const OutputE
       double along_p = 0.0;
       for (const Index r : reach.rows) along_p += lambda[r] * 0.5 * (at_w[r] - sc.minus[r]);
       second_derivative(model, q, sc.v, w, qd_rate, t, sc);
-      out[layout.offset(j, i)] = along_p + lambda.dot(sc.plus) - w.dot(sc.dq);
+      // −dλ_r/dp: the effort's rate where r is the driver's first row
+      const double minus_rate = along_p + lambda.dot(sc.plus) - w.dot(sc.dq);
+      const ConstraintInfo& c = model.constraints()[static_cast<std::size_t>(efforts.constraints[dr.effort])];
+      if (dr.row == c.first_row) out[layout.offset(j, dr.effort)] = minus_rate;
+      // P = Σ λ_r Φt_r over the driver's rows
+      sc.power[dr.effort] += -minus_rate * sc.phit[dr.row] + lambda[dr.row] * sc.dphit[dr.row];
     }
+    for (std::size_t i = 0; i < ne; ++i)
+      if (sc.all_kept[i]) out[layout.power_offset(np, j, i)] = sc.power[i];
   }
   return true;
 }

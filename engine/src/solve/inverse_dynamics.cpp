@@ -21,6 +21,31 @@ V3 world_inertia_times(const RotationMatrix& r, const std::array<double, 9>& I, 
           r[6] * c[0] + r[7] * c[1] + r[8] * c[2]};
 }
 
+// Q_k += ∂r_c/∂q_k · F + ∂θ/∂q_k · M for a planar frame, slot by slot: a body's (x, y, ψ), or an origin point and
+// an x direction (θ its angle, ∂θ/∂d = (−d_y, d_x)/|d|²), as part_jacobian()'s closed form has them but without
+// gathering the frame's coordinates (what a sweep's efforts spent most of Q's assembly in). `c` is the centre from
+// the origin. False for the other frames.
+bool add_planar_virtual_work(const PartFrame& f, const double* q, V3 c, V3 force, V3 moment, Eigen::VectorXd& Q) {
+  auto add = [&](const Slot& s, double v) {
+    if (s.is_coordinate()) Q(s.coord()) += v;
+  };
+  const double turn = c.x * force.y - c.y * force.x + moment.z;  // (c × F + M)_z, what a change of angle works on
+  if (f.kind == PartFrameKind::kPlanarBody) {
+    add(f.planar.x, force.x), add(f.planar.y, force.y), add(f.planar.psi, turn);
+    return true;
+  }
+  if (f.kind != PartFrameKind::kPoints || f.spatial_frame) return false;
+  const Slot* o = f.origin.r;
+  const Slot* x = f.x_toward.r;
+  double dx = x[0].of(q), dy = x[1].of(q);
+  if (f.x_is_point) dx -= o[0].of(q), dy -= o[1].of(q);
+  const double d2 = dx * dx + dy * dy, along_x = -dy / d2 * turn, along_y = dx / d2 * turn;
+  add(o[0], force.x), add(o[1], force.y), add(o[2], force.z);
+  add(x[0], along_x), add(x[1], along_y);
+  if (f.x_is_point) add(o[0], -along_x), add(o[1], -along_y);
+  return true;
+}
+
 }  // namespace
 
 void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
@@ -35,6 +60,7 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
     const V3 force = p.mass.mass * (loads.gravity - ac);
     const V3 moment = -1.0 * (world_inertia_times(m.pose.rotation, p.mass.inertia, m.alpha) +
                               kin3::cross(m.omega, world_inertia_times(m.pose.rotation, p.mass.inertia, m.omega)));
+    if (add_planar_virtual_work(p.frame, q, c, force, moment, Q)) continue;
     thread_local PartJacobian j;  // its vectors' capacity kept from row to row
     part_jacobian(p.frame, q, t, j);
     for (std::size_t i = 0; i < j.coordinates.size(); ++i) {

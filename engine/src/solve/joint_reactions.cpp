@@ -28,22 +28,22 @@ PartFrame body_frame(const ReactionSite& s) {
 
 int reaction_width(const Model& model, Index c) { return model.constraint_block(c).first->reaction_width(); }
 
-JointReactions::JointReactions(const Model& model, std::vector<Index> constraints)
-    : g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
-  std::vector<int> site_of(model.constraints().size(), -1);
-  for (Index c : constraints) {
-    const auto [b, i] = model.constraint_block(c);
-    const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
-    if (!b->has_reaction_site())
-      throw Error("constraint '" + info.name + "' (" + std::string(info.kind) +
-                  ") states no joint point: it has no reaction to write (joints between bodies have one)");
-    Site s;
-    s.block = b, s.index = i;
-    s.spatial = b->reaction_width() == 6;
-    size_ += b->reaction_width();
-    site_of[static_cast<std::size_t>(c)] = static_cast<int>(sites_.size());
-    sites_.push_back(std::move(s));
-  }
+void JointReactions::add_site(const Model& model, Index c, std::vector<int>& site_of) {
+  const auto [b, i] = model.constraint_block(c);
+  const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
+  if (!b->has_reaction_site())
+    throw Error("constraint '" + info.name + "' (" + std::string(info.kind) +
+                ") states no joint point: it has no reaction to write (joints between bodies have one)");
+  Site s;
+  s.block = b, s.index = i;
+  s.spatial = b->reaction_width() == 6;
+  size_ += b->reaction_width();
+  site_of[static_cast<std::size_t>(c)] = static_cast<int>(sites_.size());
+  order_.push_back({false, sites_.size()});
+  sites_.push_back(std::move(s));
+}
+
+void JointReactions::find_columns(const Model& model, const std::vector<int>& site_of) {
   // the coordinates each constraint reads, in one pass over Φq's pattern
   const CscPattern& p = model.jacobian_pattern();
   for (Index j = 0; j < p.cols; ++j)
@@ -55,9 +55,75 @@ JointReactions::JointReactions(const Model& model, std::vector<Index> constraint
     }
 }
 
+JointReactions::JointReactions(const Model& model, std::vector<Index> constraints)
+    : g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
+  std::vector<int> site_of(model.constraints().size(), -1);
+  for (Index c : constraints) add_site(model, c, site_of);
+  find_columns(model, site_of);
+}
+
+JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts)
+    : g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
+  std::vector<int> site_of(model.constraints().size(), -1);
+  for (const OutputReaction& r : efforts.reactions) {
+    if (r.natural < 0) {
+      add_site(model, r.constraint, site_of);
+      continue;
+    }
+    if (!efforts.natural || static_cast<std::size_t>(r.natural) >= efforts.natural->joints.size())
+      throw Error("JointReactions: natural joint " + std::to_string(r.natural) + " is not one of the efforts'");
+    NaturalSite s;
+    s.joint = static_cast<std::size_t>(r.natural);
+    const NaturalJoint& j = efforts.natural->joints[s.joint];
+    if (j.bodies.empty()) throw Error("JointReactions: natural joint '" + j.name + "' has no body");
+    s.body = j.bodies[0];
+    const NaturalBody& body = efforts.natural->bodies[s.body];
+    // the joint among the body's points: the one whose coordinate components are the joint's
+    s.point = body.points.size();
+    for (std::size_t k = 0; k < body.points.size() && s.point == body.points.size(); ++k) {
+      bool same = true;
+      for (int d = 0; d < (efforts.natural->spatial ? 3 : 2); ++d)
+        if (j.point.r[d].is_coordinate())
+          same = same && body.points[k].r[d] == j.point.r[d];
+        else
+          same = same && body.points[k].r[d].coord() >= model.num_coordinates();
+      if (same) s.point = k;
+    }
+    if (s.point == body.points.size())
+      throw Error("JointReactions: natural joint '" + j.name + "' is not a point of '" + body.name + "'");
+    size_ += efforts.natural->spatial ? 6 : 3;
+    order_.push_back({true, natural_sites_.size()});
+    natural_sites_.push_back(s);
+  }
+  find_columns(model, site_of);
+  if (!natural_sites_.empty()) add_natural(model, efforts);
+}
+
 void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out) {
+  if (!natural_sites_.empty())
+    throw Error("JointReactions::evaluate: natural joints read q̇ and q̈: give them (phiq bug)");
+  for (const Site& s : sites_) evaluate_site(s, q, t, lambda, out);
+}
+
+void JointReactions::evaluate(const double* q, const double* qd, const double* qdd, double t,
+                              const Eigen::VectorXd& lambda, double* out) {
+  if (!natural_sites_.empty()) {
+    const Index n = static_cast<Index>(g_.size());
+    qx_.head(n) = Eigen::Map<const Eigen::VectorXd>(q, n);
+    qdx_.head(n) = Eigen::Map<const Eigen::VectorXd>(qd, n);
+    qddx_.head(n) = Eigen::Map<const Eigen::VectorXd>(qdd, n);
+  }
+  for (const auto& [natural, k] : order_)
+    if (natural)
+      evaluate_natural(natural_sites_[k], t, lambda, out);
+    else
+      evaluate_site(sites_[k], q, t, lambda, out);
+}
+
+void JointReactions::evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda,
+                                   double*& out) {
   PartJacobian& jac = jac_;
-  for (const Site& s : sites_) {
+  {
     ReactionSite rs;
     s.block->reaction_site(s.index, q, rs);
     s.block->add_transposed_product(s.index, q, t, lambda.data(), g_.data());  // Φq,cᵀ λ_c

@@ -69,17 +69,31 @@ void along_parameter(const Model& model, const OutputSensitivity& p, const Param
 // The largest |v_j| / scale_j over the n coordinates: how fast v moves its fastest coordinate, in their scales.
 double fastest_coordinate(const double* v, const double* scale, Index n);
 
-// The efforts' sensitivities of one row (phiq/effort_sensitivity.hpp) into `out` (EffortSensitivityLayout):
-// `lambda` the row's multipliers (Φqᵀ λ = Q, zero on dropped rows: multipliers_with_factors()), `sensitivities`
-// the row's in the direct form (SensitivityLayout, order 2), `lu` the factors of Φq at q. NaN for a driver whose
-// row the model dropped. Pre-condition: every parameter's reach is set (run_sweep(), the Stepper and
-// solve_effort_sensitivities() find it once); else phiq::Error. Returns false when a solve fails.
+// The efforts' and powers' sensitivities of one row (phiq/effort_sensitivity.hpp) into `out`
+// (EffortSensitivityLayout): `lambda` the row's multipliers (Φqᵀ λ = Q, zero on dropped rows:
+// multipliers_with_factors()), `sensitivities` the row's in the direct form (SensitivityLayout, order 2), `lu` the
+// factors of Φq at q. NaN for an effort whose first row the model dropped, for a power with any row dropped.
+// Pre-condition: every parameter's reach is set (run_sweep(), the Stepper and solve_effort_sensitivities() find it
+// once); else phiq::Error. Returns false when a solve fails.
 struct EffortSensitivityScratch {
-  SensitivityScratch along;                    // along_parameter()'s
-  std::vector<Eigen::VectorXd> w;              // Φq⁻¹ e_r per effort (empty: a dropped row)
+  SensitivityScratch along;        // along_parameter()'s
+  std::vector<Eigen::VectorXd> w;  // Φq⁻¹ e_r per row of a driver (rows)
+  struct DriverRow {
+    std::size_t effort = 0;  // in OutputEfforts::constraints
+    Index row = 0;           // the model's row
+    std::size_t w = 0;       // its Φq⁻¹ e_r in w
+  };
+  std::vector<DriverRow> rows;                 // every row of each driver none of whose rows the model dropped
+  std::vector<bool> all_kept;                  // per driver: none of its rows dropped (its power defined)
+  std::vector<double> power;                   // per driver: dP/dp on the way
+  Eigen::VectorXd phit, dphit;                 // Φt and dΦt/dp over the rows (the powers')
   Eigen::VectorXd rhs, v, dq, qk, vk, ak, qf;  // over the coordinates
   Eigen::VectorXd plus, minus, g[4];           // over the rows
   Eigen::VectorXd forces[4];                   // Q at the four points of a difference
+  // dQ/dp exactly (parts/force_rate.hpp) unless set, or where that form does not reach: then Q differenced along
+  // p and the motion, and `differenced` counts it (the tests compare the two)
+  bool difference_forces = false;
+  std::size_t differenced = 0;
 };
 bool effort_sensitivities_with_factors(const Model& model, const OutputEfforts& efforts,
                                        const std::vector<OutputSensitivity>& parameters, double t, const double* q,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "phiq/effort_sensitivity.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/parts.hpp"
 #include "sweep/sweeper.hpp"
@@ -27,9 +28,15 @@ void Sweeper::row_efforts() {
   if (!multipliers_with_factors(model_, *w->lu, effort_work_.q, effort_work_.kept, effort_work_.lambda))
     return not_defined();
   ++ws_->counters.effort_solves;
+  // Φt at the drivers' rows only (a power reads no other; the whole model's is O(rows) at every row)
   effort_work_.phi_t.resize(model_.num_equations());
-  model_.phi_t(current_.q.data(), t, effort_work_.phi_t.data());
   const std::vector<ConstraintInfo>& cs = model_.constraints();
+  for (const Index c : e.constraints) {
+    const ConstraintInfo& info = cs[static_cast<std::size_t>(c)];
+    effort_work_.phi_t.segment(info.first_row, info.rows).setZero();
+    const auto [block, index] = model_.constraint_block(c);
+    block->phi_t(index, index + 1, current_.q.data(), t, effort_work_.phi_t.data());
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const ConstraintInfo& c = cs[static_cast<std::size_t>(e.constraints[i])];
     double power = 0.0;
@@ -43,6 +50,7 @@ void Sweeper::row_efforts() {
   // sensitivities (sweep_sensitivity_form()): after the reactions in outputs_.efforts
   if (n > 0 && !opt_.sensitivities.empty()) {
     double* out = outputs_.efforts.data() + e.size();
+    const EffortSensitivityLayout layout{n};
     if (!effort_sensitivities_with_factors(model_, e, opt_.sensitivities, t, current_.q.data(), current_.qd.data(),
                                            current_.qdd.data(), effort_work_.lambda, outputs_.sensitivities.data(),
                                            *w->lu, effort_work_.sensitivity_scratch, out))
@@ -50,7 +58,8 @@ void Sweeper::row_efforts() {
     else
       for (std::size_t i : effort_work_.dropped)
         for (std::size_t j = 0; j < opt_.sensitivities.size(); ++j)
-          out[j * n + i] = std::numeric_limits<double>::quiet_NaN();
+          out[layout.offset(j, i)] = out[layout.power_offset(opt_.sensitivities.size(), j, i)] =
+              std::numeric_limits<double>::quiet_NaN();
   }
   if (effort_work_.reactions) row_reactions(*w->lu);
 }
@@ -65,25 +74,19 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
               outputs_.efforts.begin() + opt_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
     return;
   }
-  effort_work_.reactions->evaluate(current_.q.data(), t, effort_work_.lambda,
+  effort_work_.reactions->evaluate(current_.q.data(), current_.qd.data(), current_.qdd.data(), t, effort_work_.lambda,
                                    outputs_.efforts.data() + 2 * opt_.efforts.constraints.size());
   if (!note) return;
   effort_work_.reactions_noted = true;
   std::string names;
   for (const OutputReaction& r : opt_.efforts.reactions)
-    if (std::find(indeterminate.begin(), indeterminate.end(), r.constraint) != indeterminate.end())
+    if (r.natural < 0 && std::find(indeterminate.begin(), indeterminate.end(), r.constraint) != indeterminate.end())
       names += (names.empty() ? "'" : ", '") + model_.constraints()[static_cast<std::size_t>(r.constraint)].name + "'";
   if (!names.empty())
     sum_.warnings.push_back({t, "indeterminate",
                              "the reactions of " + names +
                                  " are statically indeterminate (redundant constraints): the minimum-norm ones are "
                                  "written"});
-}
-
-std::vector<Index> Sweeper::reaction_constraints() const {
-  std::vector<Index> out;
-  for (const OutputReaction& r : opt_.efforts.reactions) out.push_back(r.constraint);
-  return out;
 }
 
 std::vector<std::size_t> Sweeper::dropped_efforts() const {

@@ -148,6 +148,12 @@ void detail::check_efforts(const Model& model, const OutputPlan& plan, const std
   if (!e.active()) return;
   if (!e.parts || !e.loads) throw Error(who + ": efforts need the parts and the loads");
   for (const OutputReaction& r : e.reactions) {
+    if (r.natural >= 0) {
+      if (!e.natural || static_cast<std::size_t>(r.natural) >= e.natural->joints.size() ||
+          r.spatial != e.natural->spatial)
+        throw Error(who + ": a reaction's natural joint " + std::to_string(r.natural) + " is not one of the efforts'");
+      continue;
+    }
     if (r.constraint < 0 || r.constraint >= static_cast<Index>(model.constraints().size()))
       throw Error(who + ": a reaction's constraint " + std::to_string(r.constraint) + " is not one of the model's");
     const ConstraintInfo& c = model.constraints()[static_cast<std::size_t>(r.constraint)];

@@ -344,8 +344,6 @@ class Sweeper {
   // The efforts (indices into OutputEfforts::constraints) of drivers the model dropped as redundant: NaN at every
   // row, found once (row_efforts.cpp).
   std::vector<std::size_t> dropped_efforts() const;
-  // The constraints of OutputEfforts::reactions, in order (row_efforts.cpp).
-  std::vector<Index> reaction_constraints() const;
   // The reactions of the row (after the efforts) from effort_work_.lambda: minimum-norm multipliers first where rows
   // were dropped, and at the sweep's first row a warning naming the joints whose share that makes up.
   void row_reactions(SparseLuNumeric& lu);
@@ -387,10 +385,9 @@ class Sweeper {
   RowOutputValues outputs_{model_, opt_};   // what row_outputs() evaluated, for the delivery
   SensitivityWork sensitivity_work_{opt_};  // row_sensitivities()'s own, as a thread's sweeper holds them
   // row_efforts()' and row_reactions()'
-  EffortWork effort_work_{dropped_efforts(),
-                          opt_.efforts.reactions.empty()
-                              ? std::nullopt
-                              : std::optional<JointReactions>(std::in_place, model_, reaction_constraints())};
+  EffortWork effort_work_{dropped_efforts(), opt_.efforts.reactions.empty()
+                                                 ? std::nullopt
+                                                 : std::optional<JointReactions>(std::in_place, model_, opt_.efforts)};
   RowFactorCache row_factors_;  // the factors those solve with (row_factors())
   double last_rcond_ = 0.0;     // PositionSummary::rcond of the last converged position (near_singular())
   SingularState singular_;      // singular_point()'s

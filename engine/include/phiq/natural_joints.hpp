@@ -1,0 +1,69 @@
+/// @file
+/// Joints of natural coordinates: a named natural point shared by two bodies, or held by ground in a component (a
+/// fixed point, a slider's point on a constant line), has no constraint row of its own, so its reaction comes from
+/// splitting the equations at the point among the bodies (phiq/joint_reactions.hpp writes it).
+///
+/// A body is a part whose frame is of natural points (`frame: {origin: P, x: Q}`, phiq/parts.hpp) and reads a
+/// coordinate. Each constraint whose natural-point coordinates all belong to some body's frame is that body's (the
+/// one with the fewest such coordinates: a crank's bar [O, A] and its segment angle, not the coupler [A, B] that
+/// also holds A); the others (none, or several bodies' points) act at the joints. Cut at a joint point P into a
+/// copy per body, body b's copy balances
+///
+///     R_b + Q_b(P) − Σ_{c of b} (Φq,cᵀ λ_c)(P) = 0,
+///
+/// Q_b the generalized forces of b's parts and of the loads on b alone, so R_b, the force the rest of the mechanism
+/// exerts on b at P, is read off the row's multipliers. A component of P that is constant has no row: its copy's
+/// equation needs ∂Φ_c/∂P there, which b's constraints give by their invariance under translations of all their
+/// points (true of distances, dot products, segment angles; a coordinate's equation `xA − a cos θ` is read as
+/// written relative to the fixed point), and Q_b there by differentiating b's parts and loads with that component
+/// made a coordinate. A body with two points constant along one axis shares that component's load between them in a
+/// way the points do not determine: NaN. The moment at a point joint is zero (points carry forces only); shared
+/// unit vectors (a spatial revolute in natural coordinates) are not split, and a load between two bodies (a spring,
+/// a torsional spring) is counted in the joints' reactions.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "phiq/applied_loads.hpp"
+#include "phiq/parts.hpp"
+
+namespace phiq {
+
+/// A body of natural coordinates (file comment): its frame, and what acts on it alone.
+struct NaturalBody {
+  std::string name;  ///< the part's
+  PartFrame frame;   ///< its frame (PartFrameKind::kPoints)
+  /// Its part when it has mass (shapes cleared), else empty; its frame's constant point components made coordinates
+  /// n, n + 1, … (NaturalJoints::promoted), so that Q differentiates along them.
+  std::vector<Part> parts;
+  Loads loads;  ///< gravity and the applied loads on this part alone (their frames promoted likewise)
+  /// The frame's points (origin, and x, y toward when they are points), each component's slot as the model reads
+  /// it (a coordinate, or a constant).
+  std::vector<Attachment3> points;
+};
+
+/// A joint at a named natural point (file comment).
+struct NaturalJoint {
+  std::string name;                 ///< the point's
+  Attachment3 point;                ///< its slots (r[0], r[1] and, in space, r[2])
+  std::vector<std::size_t> bodies;  ///< the bodies whose frames hold it, in part order: its reaction is on the first
+};
+
+/// The bodies and joints of a model's natural coordinates, and the promoted coordinates' values.
+struct NaturalJoints {
+  std::vector<NaturalBody> bodies;   ///< the moving parts with frames of points
+  std::vector<NaturalJoint> joints;  ///< the named points two bodies share or ground holds in a component
+  /// The constants made coordinates n + k (k in order): their values, appended to q where the bodies' Q is taken.
+  std::vector<double> promoted;
+  bool spatial = false;  ///< dimension 3: six values per joint, else three
+};
+
+/// The natural joints of `parts` (the scene's, in order) under `loads`, among `points` (the scene's named natural
+/// points, planar ones with z constant 0), for a model of `coordinates` coordinates. A point is a joint when two
+/// moving kPoints parts' frames hold it, or one does and a component of it is constant.
+NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& loads,
+                                  const std::vector<std::pair<std::string, Attachment3>>& points, Index coordinates,
+                                  bool spatial);
+
+}  // namespace phiq

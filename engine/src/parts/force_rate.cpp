@@ -1,0 +1,500 @@
+// generalized_force_rate() (parts/force_rate.hpp): Q of add_generalized_forces() and add_applied_forces() again,
+// term by term, in dual numbers whose ε part is the rate along p.
+#include "parts/force_rate.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "parts/frame_jets.hpp"
+#include "parts/same_forces.hpp"
+#include "phiq/applied_loads.hpp"
+
+namespace phiq::detail {
+
+namespace {
+
+// a + ε b with ε² = 0: b is the derivative along p of what a is the value of.
+struct Dual {
+  double v = 0.0, e = 0.0;
+  Dual() = default;
+  Dual(double value, double rate = 0.0) : v(value), e(rate) {}  // NOLINT: a constant converts implicitly
+};
+Dual operator+(Dual a, Dual b) { return {a.v + b.v, a.e + b.e}; }
+Dual operator-(Dual a, Dual b) { return {a.v - b.v, a.e - b.e}; }
+Dual operator-(Dual a) { return {-a.v, -a.e}; }
+Dual operator*(Dual a, Dual b) { return {a.v * b.v, a.e * b.v + a.v * b.e}; }
+Dual operator*(double k, Dual a) { return {k * a.v, k * a.e}; }
+Dual operator/(Dual a, Dual b) { return {a.v / b.v, (a.e * b.v - a.v * b.e) / (b.v * b.v)}; }
+Dual operator/(double k, Dual b) { return {k / b.v, -k * b.e / (b.v * b.v)}; }
+Dual sqrt(Dual a) {
+  const double r = std::sqrt(a.v);
+  return {r, a.e / (2.0 * r)};
+}
+Dual sin(Dual a) { return {std::sin(a.v), std::cos(a.v) * a.e}; }
+Dual cos(Dual a) { return {std::cos(a.v), -std::sin(a.v) * a.e}; }
+
+using DJ = JetT<Dual>;
+
+// A 3-vector of duals.
+struct DV {
+  Dual x, y, z;
+};
+DV operator+(const DV& a, const DV& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+DV operator-(const DV& a, const DV& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+DV operator*(Dual k, const DV& a) { return {k * a.x, k * a.y, k * a.z}; }
+Dual dot(const DV& a, const DV& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+DV cross(const DV& a, const DV& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+DV constant_vector(kin3::V3 v, kin3::V3 rate = {}) { return {{v.x, rate.x}, {v.y, rate.y}, {v.z, rate.z}}; }
+// R v, R row-major.
+DV turned(const Dual r[9], const DV& v) {
+  return {r[0] * v.x + r[1] * v.y + r[2] * v.z, r[3] * v.x + r[4] * v.y + r[5] * v.z,
+          r[6] * v.x + r[7] * v.y + r[8] * v.z};
+}
+// Rᵀ v.
+DV turned_back(const Dual r[9], const DV& v) {
+  return {r[0] * v.x + r[3] * v.y + r[6] * v.z, r[1] * v.x + r[4] * v.y + r[7] * v.z,
+          r[2] * v.x + r[5] * v.y + r[8] * v.z};
+}
+// The vector of the antisymmetric part of m.
+DV vee(const Dual m[9]) { return {0.5 * (m[7] - m[5]), 0.5 * (m[2] - m[6]), 0.5 * (m[3] - m[1])}; }
+
+// The slots a frame's jets read (frame_jets()), in an order that is the same for two frames of one kind.
+std::size_t frame_slots(const PartFrame& f, std::array<const Slot*, 9>& out) {
+  switch (f.kind) {
+    case PartFrameKind::kPlanarBody:
+      out = {&f.planar.x, &f.planar.y, &f.planar.psi};
+      return 3;
+    case PartFrameKind::kSpatialBody: {
+      const Frame3& b = f.spatial;
+      out = {&b.x, &b.y, &b.z, &b.e0, &b.e1, &b.e2, &b.e3};
+      return 7;
+    }
+    case PartFrameKind::kPoints:
+      out = {&f.origin.r[0],   &f.origin.r[1],   &f.origin.r[2],   &f.x_toward.r[0], &f.x_toward.r[1],
+             &f.x_toward.r[2], &f.y_toward.r[0], &f.y_toward.r[1], &f.y_toward.r[2]};
+      return 9;
+    case PartFrameKind::kExpressions:
+      break;
+  }
+  return 0;
+}
+
+// The rates along p of a frame's constants (a ground pivot at a dimension): the fourth-order difference of the
+// copies' constants, slot by slot.
+struct FrameRates {
+  std::array<const Slot*, 9> slots{};
+  std::array<double, 9> rate{};
+  std::size_t count = 0;
+  double of(const Slot& s) const {
+    for (std::size_t i = 0; i < count; ++i)
+      if (slots[i] == &s) return rate[i];
+    return 0.0;
+  }
+};
+
+// False for a frame of expressions, or copies along p that are not the same frame but for their constants (another
+// kind, another coordinate in a slot).
+bool frame_rates(const PartFrame& own, const std::array<const PartFrame*, 4>& copies, double h, FrameRates& out) {
+  if (own.kind == PartFrameKind::kExpressions) return false;
+  out.count = frame_slots(own, out.slots);
+  std::array<std::array<const Slot*, 9>, 4> along;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const PartFrame& c = copies[k] ? *copies[k] : own;
+    if (c.kind != own.kind || c.spatial_frame != own.spatial_frame || c.x_is_point != own.x_is_point ||
+        c.y_is_point != own.y_is_point)
+      return false;
+    frame_slots(c, along[k]);
+    for (std::size_t i = 0; i < out.count; ++i)
+      if (along[k][i]->coord() != out.slots[i]->coord()) return false;
+  }
+  for (std::size_t i = 0; i < out.count; ++i)
+    out.rate[i] =
+        out.slots[i]->is_coordinate()
+            ? 0.0
+            : ((along[0][i]->value() - along[3][i]->value()) + 8.0 * (along[2][i]->value() - along[1][i]->value())) /
+                  (12.0 * h);
+  return true;
+}
+
+// The path q + ε s (and q̇ + ε ṡ, q̈ + ε s̈) along the motion, or along coordinate k (a Jacobian column).
+struct DualPath {
+  const double *q, *qd, *qdd, *s, *sd, *sdd;
+  double t = 0.0;
+  Index k = -1;
+  const FrameRates* rates = nullptr;  // the walked frame's constants' rates along p (none: 0)
+
+  DJ slot(const Slot& sl) const {
+    if (!sl.is_coordinate()) return {Dual(sl.value(), rates ? rates->of(sl) : 0.0), Dual(), Dual()};
+    const Index j = sl.coord();
+    if (k >= 0) return {Dual(q[j], s[j]), Dual(j == k ? 1.0 : 0.0), Dual()};
+    return {Dual(q[j], s[j]), Dual(qd[j], sd[j]), qdd ? Dual(qdd[j], sdd[j]) : Dual()};
+  }
+  JetV<Dual> natural(const Attachment3& a) const { return {slot(a.r[0]), slot(a.r[1]), slot(a.r[2])}; }
+  // Frames of expressions are refused before any path is walked (frame_rates()).
+  DJ expression(const CompiledExpression&) const { return constant_jet<Dual>(0.0); }
+  // This path over a frame whose constants move along p at `r`.
+  DualPath over(const FrameRates& r) const {
+    DualPath p = *this;
+    p.rates = &r;
+    return p;
+  }
+};
+
+// A frame's pose and motion along the path, with their rates.
+struct DualMotion {
+  DV at, velocity, acceleration, omega, alpha;
+  Dual rotation[9];
+  // The velocity of the body point `s` (frame axes) and where it is, R s from the origin.
+  DV arm(const DV& s) const { return turned(rotation, s); }
+};
+
+DualMotion dual_motion(const PartFrame& f, const DualPath& p) {
+  const auto [o, r] = frame_jets<Dual>(f, p);
+  DualMotion m;
+  m.at = {o[0].v, o[1].v, o[2].v}, m.velocity = {o[0].d, o[1].d, o[2].d};
+  m.acceleration = {o[0].dd, o[1].dd, o[2].dd};
+  for (int i = 0; i < 9; ++i) m.rotation[i] = r[i].v;
+  Dual w[9], a[9];
+  product_transposed<Dual>(r, &DJ::d, r, &DJ::v, w);
+  product_transposed<Dual>(r, &DJ::dd, r, &DJ::v, a);
+  m.omega = vee(w), m.alpha = vee(a);
+  return m;
+}
+
+// The frame's Jacobian columns with their rates: origin and angle per coordinate it reads.
+struct DualJacobian {
+  std::vector<Index> coordinates;
+  std::vector<DV> d_origin, d_angle;
+};
+
+void dual_jacobian(const PartFrame& f, const DualPath& along, DualJacobian& j) {
+  frame_coordinates(f, j.coordinates);
+  j.d_origin.clear(), j.d_angle.clear();
+  for (const Index k : j.coordinates) {
+    DualPath p = along;
+    p.k = k;
+    const auto [o, r] = frame_jets<Dual>(f, p);
+    Dual w[9];
+    product_transposed<Dual>(r, &DJ::d, r, &DJ::v, w);
+    j.d_origin.push_back({o[0].d, o[1].d, o[2].d});
+    j.d_angle.push_back(vee(w));
+  }
+}
+
+// dq_k += ε part of (∂x/∂q_k) · F + ∂θ/∂q_k · M for the force F at the arm R s from the frame's origin.
+void add_force_rate(const DualJacobian& j, const DV& arm, const DV& force, const DV& moment, Eigen::VectorXd& dq) {
+  for (std::size_t i = 0; i < j.coordinates.size(); ++i)
+    dq[j.coordinates[i]] += (dot(j.d_origin[i] + cross(j.d_angle[i], arm), force) + dot(j.d_angle[i], moment)).e;
+}
+
+// The rate along p of the datum `get` reads of the four copies along p (the fourth-order difference over h: exact
+// for a datum linear in p), `own` standing for a copy that is null.
+template <class Source, class Get>
+double datum_rate(const std::array<const Source*, 4>& along, const Source& own, double h, Get get) {
+  double x[4];
+  for (std::size_t k = 0; k < 4; ++k) x[k] = get(along[k] ? *along[k] : own);
+  return ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h);
+}
+
+kin3::V3 vector_rate(const std::array<kin3::V3, 4>& x, double h) {
+  return (1.0 / (12.0 * h)) * ((x[0] - x[3]) + 8.0 * (x[2] - x[1]));
+}
+
+// The generalized inertia forces and weight of every part with mass, as add_generalized_forces() sums them.
+bool add_parts_rate(const std::vector<Part>& parts, const Loads& loads, const ForcesAlong& along,
+                    const DualPath& along_motion, Eigen::VectorXd& dq) {
+  std::array<const std::vector<Part>*, 4> ap = along.parts;
+  for (const auto* a : ap)
+    if (a && a->size() != parts.size()) return false;
+  const double h = along.step;
+  const DV g = constant_vector(loads.gravity, vector_rate({(along.loads[0] ? *along.loads[0] : loads).gravity,
+                                                           (along.loads[1] ? *along.loads[1] : loads).gravity,
+                                                           (along.loads[2] ? *along.loads[2] : loads).gravity,
+                                                           (along.loads[3] ? *along.loads[3] : loads).gravity},
+                                                          h));
+  thread_local DualJacobian jac;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const Part& own = parts[i];
+    std::array<const Part*, 4> copies{};
+    bool massive = own.mass_source != MassSource::kNone && own.mass.mass != 0.0;
+    std::array<const PartFrame*, 4> frames{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      copies[k] = ap[k] ? &(*ap[k])[i] : nullptr;
+      if (!copies[k]) continue;
+      frames[k] = &copies[k]->frame;
+      massive = massive || (copies[k]->mass_source != MassSource::kNone && copies[k]->mass.mass != 0.0);
+    }
+    if (!massive) continue;
+    FrameRates rates;
+    if (!frame_rates(own.frame, frames, h, rates)) return false;
+    const DualPath path = along_motion.over(rates);
+    const Dual m(own.mass.mass, datum_rate(copies, own, h, [](const Part& p) { return p.mass.mass; }));
+    std::array<kin3::V3, 4> centres;
+    for (std::size_t k = 0; k < 4; ++k) centres[k] = (copies[k] ? *copies[k] : own).mass.center;
+    const DV centre = constant_vector(own.mass.center, vector_rate(centres, h));
+    Dual inertia[9];
+    for (std::size_t e = 0; e < 9; ++e)
+      inertia[e] =
+          Dual(own.mass.inertia[e], datum_rate(copies, own, h, [e](const Part& p) { return p.mass.inertia[e]; }));
+    const DualMotion mo = dual_motion(own.frame, path);
+    const DV c = mo.arm(centre);
+    const DV ac = mo.acceleration + cross(mo.alpha, c) + cross(mo.omega, cross(mo.omega, c));
+    const DV force = m * (g - ac);
+    // R I Rᵀ v: the inertia about the centre in world axes
+    auto world_inertia = [&](const DV& v) {
+      const DV b = turned_back(mo.rotation, v);
+      const DV ib{inertia[0] * b.x + inertia[1] * b.y + inertia[2] * b.z,
+                  inertia[3] * b.x + inertia[4] * b.y + inertia[5] * b.z,
+                  inertia[6] * b.x + inertia[7] * b.y + inertia[8] * b.z};
+      return turned(mo.rotation, ib);
+    };
+    const DV moment = Dual(-1.0) * (world_inertia(mo.alpha) + cross(mo.omega, world_inertia(mo.omega)));
+    dual_jacobian(own.frame, path, jac);
+    add_force_rate(jac, c, force, moment, dq);
+  }
+  return true;
+}
+
+// The rates of the frame `frame_of` reads of `own` and of its copies along p (frame_rates()).
+template <class Get>
+bool load_frame_rates(const std::array<const AppliedLoads*, 4>& along, const PartFrame& own, double h, Get frame_of,
+                      FrameRates& out) {
+  std::array<const PartFrame*, 4> frames{};
+  for (std::size_t k = 0; k < 4; ++k) frames[k] = &frame_of(*along[k]);
+  return frame_rates(own, frames, h, out);
+}
+
+// An expression's value with its rate: ∇e · s along the motion, and the difference of its copies along p.
+Dual expression_dual(const CompiledExpression& e, const std::array<const CompiledExpression*, 4>& copies, double h,
+                     const DualPath& p) {
+  thread_local std::vector<double> g;
+  const std::vector<Index>& c = e.coordinates();
+  g.resize(c.size());
+  e.gradient(p.q, p.t, g.data());
+  double rate = 0.0, x[4];
+  for (std::size_t i = 0; i < c.size(); ++i) rate += g[i] * p.s[c[i]];
+  for (std::size_t k = 0; k < 4; ++k) x[k] = copies[k]->value(p.q, p.t);
+  return {e.value(p.q, p.t), rate + ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h)};
+}
+
+using Components = std::array<std::shared_ptr<const CompiledExpression>, 3>;
+
+// A force's or torque's components in world axes with their rates (world_components()); false where a component
+// is present in one copy along p and not in another.
+bool components_dual(const Components& own, const std::array<const Components*, 4>& copies, LoadAxes axes,
+                     const DualMotion& mo, double h, const DualPath& p, DV& out) {
+  Dual v[3];
+  for (std::size_t c = 0; c < 3; ++c) {
+    std::array<const CompiledExpression*, 4> along{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      along[k] = (*copies[k])[c].get();
+      if ((along[k] == nullptr) != (own[c] == nullptr)) return false;
+    }
+    if (own[c]) v[c] = expression_dual(*own[c], along, h, p);
+  }
+  out = {v[0], v[1], v[2]};
+  if (axes == LoadAxes::kPart) out = turned(mo.rotation, out);
+  return true;
+}
+
+// The rate of a datum of the k-th copy of an applied load (datum_rate() over AppliedLoads).
+template <class Get>
+double load_rate(const std::array<const AppliedLoads*, 4>& along, double h, Get get) {
+  double x[4];
+  for (std::size_t k = 0; k < 4; ++k) x[k] = get(*along[k]);
+  return ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h);
+}
+
+kin3::V3 load_vector_rate(const std::array<const AppliedLoads*, 4>& along, double h,
+                          kin3::V3 (*get)(const AppliedLoads&, std::size_t), std::size_t i) {
+  return vector_rate({get(*along[0], i), get(*along[1], i), get(*along[2], i), get(*along[3], i)}, h);
+}
+
+bool add_forces_and_torques_rate(const AppliedLoads& loads, const std::array<const AppliedLoads*, 4>& along, double h,
+                                 const DualPath& along_motion, Eigen::VectorXd& dq) {
+  thread_local DualJacobian jac;
+  for (std::size_t i = 0; i < loads.forces.size(); ++i) {
+    const AppliedForce& f = loads.forces[i];
+    FrameRates rates;
+    if (!load_frame_rates(
+            along, f.frame, h, [i](const AppliedLoads& a) -> const PartFrame& { return a.forces[i].frame; }, rates))
+      return false;
+    const DualPath path = along_motion.over(rates);
+    std::array<const Components*, 4> copies{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (along[k]->forces[i].axes != f.axes) return false;
+      copies[k] = &along[k]->forces[i].components;
+    }
+    const DualMotion mo = dual_motion(f.frame, path);
+    DV force;
+    if (!components_dual(f.components, copies, f.axes, mo, h, path, force)) return false;
+    const DV at =
+        constant_vector(f.at, load_vector_rate(
+                                  along, h, [](const AppliedLoads& a, std::size_t j) { return a.forces[j].at; }, i));
+    dual_jacobian(f.frame, path, jac);
+    add_force_rate(jac, mo.arm(at), force, DV{}, dq);
+  }
+  for (std::size_t i = 0; i < loads.torques.size(); ++i) {
+    const AppliedTorque& m = loads.torques[i];
+    FrameRates rates;
+    if (!load_frame_rates(
+            along, m.frame, h, [i](const AppliedLoads& a) -> const PartFrame& { return a.torques[i].frame; }, rates))
+      return false;
+    const DualPath path = along_motion.over(rates);
+    std::array<const Components*, 4> copies{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (along[k]->torques[i].axes != m.axes) return false;
+      copies[k] = &along[k]->torques[i].components;
+    }
+    const DualMotion mo = dual_motion(m.frame, path);
+    DV moment;
+    if (!components_dual(m.components, copies, m.axes, mo, h, path, moment)) return false;
+    dual_jacobian(m.frame, path, jac);
+    add_force_rate(jac, DV{}, DV{}, moment, dq);
+  }
+  return true;
+}
+
+bool add_springs_rate(const AppliedLoads& loads, const std::array<const AppliedLoads*, 4>& along, double h,
+                      const DualPath& along_motion, Eigen::VectorXd& dq) {
+  thread_local DualJacobian jac;
+  for (std::size_t i = 0; i < loads.springs.size(); ++i) {
+    const LinearSpring& sp = loads.springs[i];
+    FrameRates rates_a, rates_b;
+    if (!load_frame_rates(
+            along, sp.a.frame, h, [i](const AppliedLoads& a) -> const PartFrame& { return a.springs[i].a.frame; },
+            rates_a) ||
+        !load_frame_rates(
+            along, sp.b.frame, h, [i](const AppliedLoads& a) -> const PartFrame& { return a.springs[i].b.frame; },
+            rates_b))
+      return false;
+    const DualPath path_a = along_motion.over(rates_a), path_b = along_motion.over(rates_b);
+    const DualMotion ma = dual_motion(sp.a.frame, path_a), mb = dual_motion(sp.b.frame, path_b);
+    const DV ra = ma.arm(constant_vector(
+                 sp.a.at, load_vector_rate(
+                              along, h, [](const AppliedLoads&a, std::size_t j) { return a.springs[j].a.at; }, i))),
+             rb = mb.arm(constant_vector(
+                 sp.b.at, load_vector_rate(
+                              along, h, [](const AppliedLoads&a, std::size_t j) { return a.springs[j].b.at; }, i)));
+    const DV d = (mb.at + rb) - (ma.at + ra);
+    const Dual length = sqrt(dot(d, d));
+    if (length.v == 0.0) continue;  // no direction: no force (LinearSpring)
+    const DV unit = (1.0 / length) * d;
+    const Dual rate =
+        along_motion.qd ? dot(unit, (mb.velocity + cross(mb.omega, rb)) - (ma.velocity + cross(ma.omega, ra))) : Dual();
+    auto datum = [&](double LinearSpring::*field) {
+      return Dual(sp.*field, load_rate(along, h, [&](const AppliedLoads& a) { return a.springs[i].*field; }));
+    };
+    const Dual tension = datum(&LinearSpring::stiffness) * (length - datum(&LinearSpring::free_length)) +
+                         datum(&LinearSpring::damping) * rate + datum(&LinearSpring::preload);
+    dual_jacobian(sp.a.frame, path_a, jac);
+    add_force_rate(jac, ra, tension * unit, DV{}, dq);
+    dual_jacobian(sp.b.frame, path_b, jac);
+    add_force_rate(jac, rb, Dual(-1.0) * (tension * unit), DV{}, dq);
+  }
+  return true;
+}
+
+// γ(q, a) − γ(q, b) − …: the polarisation of γ, quadratic in q̇ at fixed q: −8 aᵀ H b, H the Hessian of e (its
+// linear and constant terms, ∂t∇e and ∂²e/∂t², cancel).
+double hessian_form(const CompiledExpression& e, const double* q, double t, const std::vector<double>& a,
+                    const std::vector<double>& b, std::vector<double>& scratch) {
+  const double sign[4][2] = {{1, 1}, {-1, -1}, {1, -1}, {-1, 1}};
+  double g[4];
+  for (int k = 0; k < 4; ++k) {
+    for (std::size_t i = 0; i < a.size(); ++i) scratch[i] = sign[k][0] * a[i] + sign[k][1] * b[i];
+    g[k] = e.gamma(q, scratch.data(), t);
+  }
+  return -((g[0] + g[1]) - (g[2] + g[3])) / 8.0;
+}
+
+bool add_torsional_rate(const AppliedLoads& loads, const std::array<const AppliedLoads*, 4>& along, double h,
+                        const DualPath& path, Index n, Eigen::VectorXd& dq) {
+  thread_local std::vector<double> a, b, scratch, g, gk;
+  a.assign(static_cast<std::size_t>(n), 0.0), b.assign(a.size(), 0.0), scratch.assign(a.size(), 0.0);
+  for (std::size_t i = 0; i < loads.torsional_springs.size(); ++i) {
+    const TorsionalSpring& ts = loads.torsional_springs[i];
+    std::array<const CompiledExpression*, 4> copies{};
+    if (!ts.angle) return false;  // a joint's angle: its second derivatives are not at hand
+    for (std::size_t k = 0; k < 4; ++k)
+      if (!(copies[k] = along[k]->torsional_springs[i].angle.get())) return false;
+    const CompiledExpression& e = *ts.angle;
+    const std::vector<Index>& c = e.coordinates();
+    g.resize(c.size());
+    e.gradient(path.q, path.t, g.data());
+    double smax = 0.0;
+    for (Index j = 0; j < n; ++j) smax = std::max(smax, std::fabs(path.s[j]));
+    const double alpha = smax > 0.0 ? 1.0 / smax : 0.0;  // s scaled to unit size: γ's rounding near its own
+    for (Index j = 0; j < n; ++j) a[static_cast<std::size_t>(j)] = alpha * path.s[j];
+    // ∂θ/∂q with its rate: H s, and the difference of the copies' gradients along p
+    std::vector<Dual> gradient(c.size());
+    std::array<std::vector<double>, 4> along_g;
+    for (std::size_t k = 0; k < 4; ++k) {
+      along_g[k].resize(c.size());
+      if (copies[k]->coordinates() != c) return false;
+      copies[k]->gradient(path.q, path.t, along_g[k].data());
+    }
+    for (std::size_t l = 0; l < c.size(); ++l) {
+      b[static_cast<std::size_t>(c[l])] = 1.0;
+      const double hs = alpha > 0.0 ? hessian_form(e, path.q, path.t, a, b, scratch) / alpha : 0.0;
+      b[static_cast<std::size_t>(c[l])] = 0.0;
+      gradient[l] =
+          Dual(g[l], hs + ((along_g[0][l] - along_g[3][l]) + 8.0 * (along_g[2][l] - along_g[1][l])) / (12.0 * h));
+    }
+    auto datum = [&](double TorsionalSpring::*field) {
+      return Dual(ts.*field, load_rate(along, h, [&](const AppliedLoads& x) { return x.torsional_springs[i].*field; }));
+    };
+    const Dual angle = expression_dual(e, copies, h, path) - datum(&TorsionalSpring::free_angle);
+    Dual rate;
+    if (path.qd) {
+      // θ̇ = ∂e/∂t + ∇e · q̇; along the motion ∂t∇e · s + sᵀ H q̇ + ∇e · ṡ, the first two −[γ(q̇ + s) − γ(q̇ − s)]/4
+      auto theta_dot = [&](const CompiledExpression& x, const std::vector<double>& grad) {
+        double r = x.partial_t(path.q, path.t);
+        for (std::size_t l = 0; l < c.size(); ++l) r += grad[l] * path.qd[c[l]];
+        return r;
+      };
+      double along_rate = 0.0;
+      for (std::size_t l = 0; l < c.size(); ++l) along_rate += g[l] * path.sd[c[l]];
+      for (Index j = 0; j < n; ++j) scratch[static_cast<std::size_t>(j)] = path.qd[j] + path.s[j];
+      const double plus = e.gamma(path.q, scratch.data(), path.t);
+      for (Index j = 0; j < n; ++j) scratch[static_cast<std::size_t>(j)] = path.qd[j] - path.s[j];
+      along_rate -= (plus - e.gamma(path.q, scratch.data(), path.t)) / 4.0;
+      double x[4];
+      for (std::size_t k = 0; k < 4; ++k) x[k] = theta_dot(*copies[k], along_g[k]);
+      rate = Dual(theta_dot(e, g), along_rate + ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h));
+    }
+    const Dual moment = datum(&TorsionalSpring::stiffness) * angle + datum(&TorsionalSpring::damping) * rate;
+    for (std::size_t l = 0; l < c.size(); ++l) dq[c[l]] -= (moment * gradient[l]).e;
+  }
+  return true;
+}
+
+bool add_applied_rate(const AppliedLoads& loads, const std::array<const AppliedLoads*, 4>& along, double h,
+                      const DualPath& path, Index n, Eigen::VectorXd& dq) {
+  for (const AppliedLoads* a : along)
+    if (a->forces.size() != loads.forces.size() || a->torques.size() != loads.torques.size() ||
+        a->springs.size() != loads.springs.size() || a->torsional_springs.size() != loads.torsional_springs.size())
+      return false;
+  return add_forces_and_torques_rate(loads, along, h, path, dq) && add_springs_rate(loads, along, h, path, dq) &&
+         add_torsional_rate(loads, along, h, path, n, dq);
+}
+
+}  // namespace
+
+bool generalized_force_rate(const std::vector<Part>& parts, const Loads& loads, const ForcesAlong& along,
+                            const double* q, const double* qd, const double* qdd, const double* s, const double* sd,
+                            const double* sdd, double t, Eigen::VectorXd& dq) {
+  dq.setZero();
+  const DualPath path{q, qd, qdd, s, sd, sdd, t};
+  if (!add_parts_rate(parts, loads, along, path, dq)) return false;
+  std::array<const AppliedLoads*, 4> applied{};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Loads* l = along.loads[k] ? along.loads[k] : &loads;
+    applied[k] = l->applied.get();
+    if ((applied[k] == nullptr || applied[k]->empty()) != (!loads.applied || loads.applied->empty())) return false;
+  }
+  if (!loads.applied || loads.applied->empty()) return true;
+  return add_applied_rate(*loads.applied, applied, along.step, path, dq.size(), dq);
+}
+
+}  // namespace phiq::detail

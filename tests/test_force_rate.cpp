@@ -1,0 +1,186 @@
+// The exact rate of the generalized forces along a parameter (parts/force_rate.hpp) against the fourth-order
+// difference of Q itself along (q + ε s, q̇ + ε ṡ, q̈ + ε s̈) with the scene's parts and loads read at p + ε, on a
+// crank-slider whose parameters reach a length, a mass, a ground pivot in a part's frame, gravity, a force, a
+// torque in the part's axes, a damped spring and a damped torsional spring; and the efforts' sensitivities through
+// it against those through the difference of Q (effort_sensitivity.cpp keeps both), row for row.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "parts/force_rate.hpp"
+#include "phiq/effort_sensitivity.hpp"
+#include "phiq/inverse_dynamics.hpp"
+#include "phiq/phiq.hpp"
+#include "solve/sensitivity_internal.hpp"
+#include "fourbar_parts.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+const char* const kForceRateCrankSlider = R"(phiq: 1
+name: crank_slider_rates
+parameters: {L2: 0.3, L3: 1.0, mr: 1.2, xo: 0.1, g: 9.81, F: 5, k: 40, c: 3, kt: 2, ct: 0.4, T: 0.7}
+coordinates: {theta2: 0.0, xA: 0.38, yA: 0.03, xB: 1.35}
+points: {O: [xo, 0], A: [xA, yA], B: [xB, 0]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: rod, type: distance, points: [A, B], length: L3}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: polynomial, coefficients: [0.2, 2, 0.8]}}
+parts:
+  crank: {frame: {origin: O, x: A}, center_of_mass: [L2/2, 0.01], mass: 0.5, inertia: 0.004}
+  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: mr, inertia: mr*L3*L3/12}
+loads:
+  gravity: [0, -g]
+  forces: [{name: push, part: rod, at: [L3, 0], force: [-F*cos(theta2), F*xB]}]
+  torques: [{name: turn, part: rod, torque: T*xA, axes: part}]
+  springs: [{name: pull, between: [{part: rod, at: [L3, 0]}, {point: [2, xo]}], stiffness: k, free_length: 0.5,
+             damping: c}]
+  torsional_springs: [{name: twist, coordinate: theta2, stiffness: kt, damping: ct}]
+time: {start: 0, end: 0.9, steps: 9}
+output: {efforts: all, sensitivities: [L2, L3, mr, xo, g, F, k, c, kt, ct, T]}
+)";
+
+// The scene swept to its last row with velocities and accelerations: the motion stays in `ws`.
+void force_rate_swept(const Scene& s, Workspace& ws) {
+  SweepOptions o = s.sweep;
+  o.sensitivities.clear(), o.efforts = OutputEfforts{};
+  o.velocities = o.accelerations = true;
+  ASSERT_EQ(run_sweep(
+                *s.model, o, ws, [](const StepView&) { return true; }, nullptr),
+            SolveStatus::kSuccess);
+}
+
+// Q at (q + e v, q̇ + e v̇, q̈ + e v̈) with the parts and loads of copy k along p (k < 0: the scene's own).
+Eigen::VectorXd force_rate_q_at(const Scene& s, const OutputSensitivity& p, int k, double e, const Workspace& ws,
+                                const Eigen::VectorXd& v, const Eigen::VectorXd& vd, const Eigen::VectorXd& vdd) {
+  const Eigen::VectorXd q = ws.q + e * v, qd = ws.qd + e * vd, qdd = ws.qdd + e * vdd;
+  Eigen::VectorXd Q = Eigen::VectorXd::Zero(s.model->num_coordinates());
+  const auto at = static_cast<std::size_t>(std::max(k, 0));
+  add_generalized_forces(k >= 0 && p.parts_along[at] ? *p.parts_along[at] : *s.sweep.efforts.parts,
+                         k >= 0 && p.loads_along[at] ? *p.loads_along[at] : *s.sweep.efforts.loads, q.data(), qd.data(),
+                         qdd.data(), s.sweep.t_end, Q);
+  return Q;
+}
+
+TEST(ForceRate, EqualsTheDifferenceOfQAlongTheMotionAndEachParameter) {
+  const Scene s = parse_scene(kForceRateCrankSlider, "crank_slider_rates.yaml");
+  Workspace ws(*s.model);
+  force_rate_swept(s, ws);
+  const Index n = s.model->num_coordinates();
+  // directions that move every coordinate, its rate and its acceleration (not a motion's: the rate is linear)
+  Eigen::VectorXd v(n), vd(n), vdd(n);
+  for (Index i = 0; i < n; ++i) v[i] = 0.3 + 0.1 * i, vd[i] = -0.7 + 0.4 * i, vdd[i] = 1.1 - 0.5 * i;
+  ASSERT_EQ(s.sweep.sensitivities.size(), 11u);
+  for (const OutputSensitivity& p : s.sweep.sensitivities) {
+    detail::ForcesAlong along{{}, {}, p.step};
+    for (std::size_t k = 0; k < 4; ++k)
+      along.parts[k] = p.parts_along[k].get(), along.loads[k] = p.loads_along[k].get();
+    Eigen::VectorXd exact(n);
+    ASSERT_TRUE(detail::generalized_force_rate(*s.sweep.efforts.parts, *s.sweep.efforts.loads, along, ws.q.data(),
+                                               ws.qd.data(), ws.qdd.data(), v.data(), vd.data(), vdd.data(),
+                                               s.sweep.t_end, exact))
+        << p.name;
+    // along the motion with the scene's own parts and loads (a step of 10⁻³: fourth order, error ~10⁻¹²), and along
+    // p at the motion's point with the copies at p ± h, p ± 2h (Q is a polynomial of degree ≤ 3 in what g, F, k,
+    // c, kt, ct, T and mr move, and those linear in p; L2, L3 and xo move the parts by steps of ~10⁻⁴)
+    Eigen::VectorXd f[4], g[4];
+    const double shift[4] = {-2, -1, 1, 2}, e = 1e-3;
+    for (int k = 0; k < 4; ++k) {
+      f[k] = force_rate_q_at(s, p, -1, shift[k] * e, ws, v, vd, vdd);
+      g[k] = force_rate_q_at(s, p, k, 0.0, ws, v, vd, vdd);
+    }
+    const Eigen::VectorXd fd =
+        ((f[0] - f[3]) + 8.0 * (f[2] - f[1])) / (12.0 * e) + ((g[0] - g[3]) + 8.0 * (g[2] - g[1])) / (12.0 * p.step);
+    ::testing::Test::RecordProperty("relative_" + p.name, scientific((exact - fd).norm() / fd.norm(), 2));
+    EXPECT_GT(fd.norm(), 1e-2) << p.name;
+    EXPECT_LT((exact - fd).norm(), 1e-8 * fd.norm())
+        << p.name << "\nexact " << exact.transpose() << "\nfd    " << fd.transpose();
+  }
+}
+
+TEST(ForceRate, RefusesAFrameOfExpressionsSoTheEffortsDifferenceQThere) {
+  // the four-bar in relative angles: its parts' frames are expressions of q (their second derivatives in t and q
+  // are not carried in dual numbers)
+  std::string text = test::seed_text("fourbar_relative.yaml");
+  text.erase(text.find("time:"));
+  const Scene s =
+      parse_scene(text + "parts:\n" + test::fourbar_parts("relative") +
+                      "loads: {gravity: [0, -9.81]}\ntime: {start: 0, end: 1, steps: 2}\noutput: {efforts: all}\n",
+                  "relative.yaml");
+  Workspace ws(*s.model);
+  force_rate_swept(s, ws);
+  const Eigen::VectorXd v = Eigen::VectorXd::Ones(s.model->num_coordinates());
+  Eigen::VectorXd dq(v.size());
+  EXPECT_FALSE(detail::generalized_force_rate(*s.sweep.efforts.parts, *s.sweep.efforts.loads, {}, ws.q.data(),
+                                              ws.qd.data(), ws.qdd.data(), v.data(), v.data(), v.data(), 1.0, dq));
+}
+
+// The scene's efforts' (and powers') sensitivities at its last row through the exact dQ/dp and through Q
+// differenced (EffortSensitivityScratch::difference_forces): equal to 1e-8, the exact form taken for every
+// parameter.
+void expect_force_rate_paths_agree(const Scene& s) {
+  Workspace ws(*s.model);
+  force_rate_swept(s, ws);
+  std::vector<OutputSensitivity> ps = s.sweep.sensitivities;
+  for (OutputSensitivity& p : ps)
+    if (!p.reach) p.reach = std::make_shared<const ParameterReach>(parameter_reach(*s.model, p));
+  const Index n = s.model->num_coordinates();
+  std::vector<double> sens(static_cast<std::size_t>(SensitivityLayout{n}.size(ps.size())));
+  ASSERT_EQ(solve_sensitivities(*s.model, ps, s.sweep.t_end, 2, ws, sens.data()), SolveStatus::kSuccess);
+  Eigen::VectorXd Q = Eigen::VectorXd::Zero(n), kept, lambda;
+  add_generalized_forces(*s.sweep.efforts.parts, *s.sweep.efforts.loads, ws.q.data(), ws.qd.data(), ws.qdd.data(),
+                         s.sweep.t_end, Q);
+  ASSERT_TRUE(multipliers_with_factors(*s.model, *ws.lu, Q, kept, lambda));
+  const std::size_t size = EffortSensitivityLayout{s.sweep.efforts.constraints.size()}.size(ps.size());
+  std::vector<double> exact(size), differenced(size);
+  detail::EffortSensitivityScratch a, b;
+  b.difference_forces = true;
+  ASSERT_TRUE(detail::effort_sensitivities_with_factors(*s.model, s.sweep.efforts, ps, s.sweep.t_end, ws.q.data(),
+                                                        ws.qd.data(), ws.qdd.data(), lambda, sens.data(), *ws.lu, a,
+                                                        exact.data()));
+  ASSERT_TRUE(detail::effort_sensitivities_with_factors(*s.model, s.sweep.efforts, ps, s.sweep.t_end, ws.q.data(),
+                                                        ws.qd.data(), ws.qdd.data(), lambda, sens.data(), *ws.lu, b,
+                                                        differenced.data()));
+  EXPECT_EQ(a.differenced, 0u) << s.path;  // no parameter fell back to the difference
+  EXPECT_EQ(b.differenced, ps.size());
+  for (std::size_t j = 0; j < size; ++j) {
+    ASSERT_TRUE(std::isfinite(exact[j])) << j;
+    EXPECT_NEAR(exact[j], differenced[j], 1e-8 * std::max(1.0, std::fabs(differenced[j]))) << "value " << j;
+  }
+}
+
+TEST(ForceRate, TheEffortsSensitivitiesThroughItEqualThoseThroughTheDifferenceOfQ) {
+  expect_force_rate_paths_agree(parse_scene(kForceRateCrankSlider, "crank_slider_rates.yaml"));
+}
+
+TEST(ForceRate, ReachesTheNaturalFourBarAndTheSpatialRssrExactly) {
+  // models/dynamics/fourbar_motor_torque.yaml (natural coordinates: L1 moves the ground pivot of the rocker's
+  // frame) and models/spatial/rssr.yaml with massive bodies (reference points and Euler parameters)
+  auto read = [](const std::string& rel, const std::string& cut) {
+    std::ifstream in(test::model_path(rel));
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string s = text.str();
+    s.erase(s.find(cut));
+    return s;
+  };
+  expect_force_rate_paths_agree(
+      parse_scene(read("dynamics/fourbar_motor_torque.yaml", "output:") +
+                      "output: {efforts: all, power: true, sensitivities: [L1, L2, L3, L4]}\n",
+                  "fourbar.yaml"));
+  expect_force_rate_paths_agree(
+      parse_scene(read("spatial/rssr.yaml", "time:") +
+                      "parts:\n"
+                      "  crank: {mass: 0.8, center_of_mass: [a/2, 0, 0], inertia: [0.001, 0.8*a*a/12, 0.8*a*a/12]}\n"
+                      "  rocker: {mass: 1.1, center_of_mass: [0, b/2, 0], inertia: [1.1*b*b/12, 0.001, 1.1*b*b/12]}\n"
+                      "loads: {gravity: [0, -9.81, 0]}\ntime: {start: 0, end: 1.3, steps: 13}\n"
+                      "output: {efforts: all, sensitivities: [a, b, L]}\n",
+                  "rssr.yaml"));
+}
+
+}  // namespace
+}  // namespace phiq

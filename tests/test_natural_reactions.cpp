@@ -1,0 +1,199 @@
+// Joint reactions at natural coordinates' shared points (phiq/natural_joints.hpp): the natural four-bar's pins O, A,
+// B, C carry the forces the reference-point four-bar's revolutes carry, under gravity, forces, a torque and a spring,
+// with the same motor torque; each of its links satisfies its Newton–Euler equations written here with them; a
+// point no two bodies share is refused by name.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "phiq/joint_reactions.hpp"
+#include "phiq/natural_joints.hpp"
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+std::string natural_reactions_scene(const std::string& rel) {
+  std::ifstream in(test::model_path(rel));
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  text.erase(text.find("time:"));
+  return text + "time: {start: 0, end: 2*pi, steps: 40}\n";
+}
+
+struct NaturalRows {
+  std::vector<double> t;
+  std::vector<Eigen::VectorXd> q, qd, qdd;
+  std::vector<std::vector<double>> values;  // efforts, powers, reactions
+};
+
+NaturalRows natural_reactions_sweep(const Scene& s) {
+  NaturalRows r;
+  SquareScene square;
+  EXPECT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &square), SolveStatus::kSuccess);
+  EXPECT_EQ(&square.model(*s.model), s.model.get());  // no redundant row: the scene's own model
+  Workspace ws(*s.model);
+  ws.q = square.start;
+  const std::size_t n = static_cast<std::size_t>(s.sweep.efforts.size());
+  SweepSummary sum;
+  EXPECT_EQ(run_sweep(
+                *s.model, s.sweep, ws,
+                [&](const StepView& v) {
+                  r.t.push_back(v.t), r.q.push_back(v.q), r.qd.push_back(*v.qd), r.qdd.push_back(*v.qdd);
+                  r.values.emplace_back(v.efforts, v.efforts + n);
+                  return true;
+                },
+                &sum),
+            SolveStatus::kSuccess)
+      << sum.message;
+  return r;
+}
+
+// The loads of both forms: gravity off the vertical, a force on the coupler (part axes), a torque on the rocker, a
+// spring from the rocker to a world point; `coupler_at`, `rocker_at` the parts' origins in the reference-point
+// form's frames (the natural frames start at A and C, the reference-point bodies at the links' centres).
+std::string natural_reactions_loads(double coupler_at, double rocker_at) {
+  std::ostringstream s;
+  s << "loads:\n  gravity: [0.8, -9.81]\n"
+    << "  forces: [{name: push, part: coupler, at: [" << coupler_at + 0.1 << ", 0.05], force: [3 + sin(t), -2], "
+    << "axes: part}]\n"
+    << "  torques: [{name: brake, part: rocker, torque: -1.5}]\n"
+    << "  springs: [{name: s, between: [{part: rocker, at: [" << rocker_at + 0.3 << ", 0]}, {point: [1.5, 1]}], "
+    << "stiffness: 40, free_length: 0.2}]\n";
+  return s.str();
+}
+
+// Mass properties of the three links (bars with their centres at mid-length): crank, coupler, rocker.
+constexpr double kNaturalMass[3] = {1.0, 2.0, 1.5}, kNaturalLength[3] = {0.4, 1.2, 1.0};
+
+std::string natural_reactions_part(const char* name, int k, double centre, const std::string& frame) {
+  std::ostringstream s;
+  s << "  " << name << ": {" << frame << "mass: " << kNaturalMass[k] << ", center_of_mass: [" << centre
+    << ", 0], inertia: " << kNaturalMass[k] * kNaturalLength[k] * kNaturalLength[k] / 12 << "}\n";
+  return s.str();
+}
+
+Scene natural_four_bar() {
+  std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
+  text += "parts:\n" + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +
+          natural_reactions_part("coupler", 1, 0.6, "frame: {origin: A, x: B}, ") +
+          natural_reactions_part("rocker", 2, 0.5, "frame: {origin: C, x: B}, ") + natural_reactions_loads(0.6, 0.5) +
+          "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
+  return parse_scene(text, "fourbar_natural.yaml");
+}
+
+TEST(NaturalReactions, FourBarPinsAndTorqueAreTheReferencePointForms) {
+  const Scene natural = natural_four_bar();
+  std::string text = natural_reactions_scene("seed/fourbar_reference_point.yaml");
+  text += "parts:\n" + natural_reactions_part("crank", 0, 0, "") + natural_reactions_part("coupler", 1, 0, "") +
+          natural_reactions_part("rocker", 2, 0, "") + natural_reactions_loads(0, 0) +
+          "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
+  const Scene reference = parse_scene(text, "fourbar_reference_point.yaml");
+  // O, A, B, C in both: points of the natural form (on the crank, crank, coupler, rocker), revolutes of the other
+  ASSERT_EQ(natural.sweep.efforts.reactions.size(), 4u);
+  ASSERT_EQ(reference.sweep.efforts.reactions.size(), 4u);
+  for (std::size_t j = 0; j < 4; ++j)
+    EXPECT_EQ(natural.sweep.efforts.reaction_name(*natural.model, natural.sweep.efforts.reactions[j]),
+              reference.sweep.efforts.reaction_name(*reference.model, reference.sweep.efforts.reactions[j]));
+  const NaturalRows a = natural_reactions_sweep(natural), b = natural_reactions_sweep(reference);
+  ASSERT_EQ(a.values.size(), b.values.size());
+  double largest = 0.0;
+  for (std::size_t k = 0; k < a.values.size(); ++k) {
+    ASSERT_EQ(a.t[k], b.t[k]);
+    const std::vector<double>&u = a.values[k], &v = b.values[k];
+    ASSERT_EQ(u.size(), 2u + 12u);
+    EXPECT_NEAR(u[0], v[0], 1e-8 * (1 + std::fabs(v[0]))) << "motor torque, row " << k;
+    for (std::size_t j = 0; j < 4; ++j) {
+      for (std::size_t c = 0; c < 2; ++c) {
+        const double x = u[2 + 3 * j + c], y = v[2 + 3 * j + c];
+        EXPECT_NEAR(x, y, 1e-8 * (1 + std::fabs(y))) << "pin " << j << " F"
+                                                     << "xy"[c] << ", row " << k;
+        largest = std::max(largest, std::fabs(y));
+      }
+      EXPECT_EQ(u[4 + 3 * j], 0.0);                                          // a point carries no moment
+      EXPECT_NEAR(v[4 + 3 * j], 0.0, 1e-9 * (1 + std::fabs(v[2 + 3 * j])));  // nor does a revolute
+    }
+  }
+  EXPECT_GT(largest, 10.0);  // the weights at least: not a comparison of zeros
+}
+
+double natural_cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Newton–Euler for each link of the natural four-bar, its centre's acceleration and its angular acceleration from
+// its two points' q̈, with the pins' forces as written (on the crank at O and A, the coupler at B, the rocker at C;
+// the other link at a pin gets the opposite), the motor torque on the crank, gravity, and the applied loads.
+TEST(NaturalReactions, EveryNaturalLinkBalancesUnderItsPinForces) {
+  const Scene s = natural_four_bar();
+  const NaturalRows rows = natural_reactions_sweep(s);
+  const Model& m = *s.model;
+  const Eigen::Vector2d g(0.8, -9.81);
+  for (std::size_t k = 0; k < rows.q.size(); ++k) {
+    // a point's position (of q), or its velocity or acceleration (of q̇, q̈: the fixed O and C's are zero)
+    auto at = [&](const Eigen::VectorXd& q, const char* p) -> Eigen::Vector2d {
+      if (p[0] == 'O') return {0, 0};
+      if (p[0] == 'C') return &q == &rows.q[k] ? Eigen::Vector2d(1, 0) : Eigen::Vector2d(0, 0);
+      const std::string n(p);
+      return {q(m.coordinate_index("x" + n)), q(m.coordinate_index("y" + n))};
+    };
+    const std::vector<double>& v = rows.values[k];
+    auto F = [&](int j) { return Eigen::Vector2d(v[2 + 3 * j], v[3 + 3 * j]); };
+    const double t = rows.t[k], tau = v[0];
+    struct Link {
+      const char *origin, *x;
+      int index;
+      std::vector<std::pair<const char*, Eigen::Vector2d>> forces;  // at points
+      double torque;
+    };
+    const Link links[3] = {{"O", "A", 0, {{"O", F(0)}, {"A", F(1)}}, tau},
+                           {"A", "B", 1, {{"A", -F(1)}, {"B", F(2)}}, 0.0},
+                           {"C", "B", 2, {{"B", -F(2)}, {"C", F(3)}}, -1.5}};
+    for (const Link& l : links) {
+      const Eigen::Vector2d o = at(rows.q[k], l.origin), d = at(rows.q[k], l.x) - o;
+      const Eigen::Vector2d dv = at(rows.qd[k], l.x) - at(rows.qd[k], l.origin);
+      const Eigen::Vector2d da = at(rows.qdd[k], l.x) - at(rows.qdd[k], l.origin);
+      const Eigen::Vector2d e = d / d.norm(), ao = at(rows.qdd[k], l.origin);
+      const double w = natural_cross(d, dv) / d.squaredNorm(), alpha = natural_cross(d, da) / d.squaredNorm();
+      const double half = kNaturalLength[l.index] / 2, mass = kNaturalMass[l.index];
+      const Eigen::Vector2d G = o + half * e,
+                            aG = ao + alpha * half * Eigen::Vector2d(-e.y(), e.x()) - w * w * half * e;
+      Eigen::Vector2d sum = mass * g;
+      double moment = l.torque;
+      for (const auto& [p, f] : l.forces) sum += f, moment += natural_cross(at(rows.q[k], p) - G, f);
+      if (l.index == 1) {  // the push, in the coupler's axes at (0.7, 0.05) from A
+        const Eigen::Vector2d n(-e.y(), e.x()), f = (3 + std::sin(t)) * e - 2 * n;
+        sum += f, moment += natural_cross(o + 0.7 * e + 0.05 * n - G, f);
+      }
+      if (l.index == 2) {  // the spring from (0.8, 0) of the rocker to (1.5, 1)
+        const Eigen::Vector2d p = o + 0.8 * e, to = Eigen::Vector2d(1.5, 1) - p;
+        const Eigen::Vector2d f = 40 * (to.norm() - 0.2) * to / to.norm();
+        sum += f, moment += natural_cross(p - G, f);
+      }
+      const double inertia = mass * kNaturalLength[l.index] * kNaturalLength[l.index] / 12;
+      EXPECT_NEAR((sum - mass * aG).norm(), 0.0, 1e-8 * (1 + sum.norm())) << l.origin << l.x << " row " << k;
+      EXPECT_NEAR(moment, inertia * alpha, 1e-8 * (1 + std::fabs(moment))) << l.origin << l.x << " row " << k;
+    }
+  }
+}
+
+TEST(NaturalReactions, APointNoTwoBodiesShareIsRefusedByName) {
+  std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
+  text += "parts:\n" + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +
+          natural_reactions_part("coupler", 1, 0.6, "frame: {origin: A, x: B}, ");
+  EXPECT_EQ(parse_scene(text + "output: {efforts: all, reactions: [A, O]}\n", "n.yaml").sweep.efforts.reactions.size(),
+            2u);
+  try {
+    (void)parse_scene(text + "output: {efforts: all, reactions: [B]}\n", "n.yaml");
+    ADD_FAILURE() << "B is on the coupler alone (no rocker part) and moves in x and y: no joint";
+  } catch (const std::exception& e) {  // SceneError
+    EXPECT_NE(std::string(e.what()).find("point 'B' is no joint"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace phiq
