@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "modes_stewart.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq {
@@ -49,26 +50,6 @@ PolynomialSystem modes_start_eigenproblem() {
   return s;
 }
 
-// The bench's general Stewart–Gough platform (bench/bench_modes.cpp): one body in x, y, z and e0 … e3, six legs.
-const char* kModesStartStewart =
-    "phiq: 1\nname: stewart_gough\ndimension: 3\n"
-    "coordinates: {x: 0.1, y: 0.05, z: 1.0, e0: 1, e1: 0.05, e2: 0.02, e3: 0.1}\n"
-    "bodies: {platform: [x, y, z, e0, e1, e2, e3]}\n"
-    "constraints:\n"
-    "  - {name: leg1, type: distance, between: [{body: ground, at: [1.0, 0.1, 0.05]}, {body: platform, at: [0.5, 0.3, "
-    "0.02]}], length: 1.3}\n"
-    "  - {name: leg2, type: distance, between: [{body: ground, at: [0.3, 0.9, -0.1]}, {body: platform, at: [-0.2, 0.6, "
-    "0.1]}], length: 1.1}\n"
-    "  - {name: leg3, type: distance, between: [{body: ground, at: [-0.7, 0.6, 0.08]}, {body: platform, at: [-0.5, "
-    "0.1, -0.05]}], length: 1.25}\n"
-    "  - {name: leg4, type: distance, between: [{body: ground, at: [-0.8, -0.4, 0.02]}, {body: platform, at: [-0.3, "
-    "-0.5, 0.07]}], length: 1.2}\n"
-    "  - {name: leg5, type: distance, between: [{body: ground, at: [0.1, -1.0, -0.06]}, {body: platform, at: [0.2, "
-    "-0.6, -0.03]}], length: 1.05}\n"
-    "  - {name: leg6, type: distance, between: [{body: ground, at: [0.9, -0.5, 0.12]}, {body: platform, at: [0.6, "
-    "-0.2, 0.04]}], length: 1.15}\n"
-    "time: {start: 0, end: 1, steps: 1}\n";
-
 // Each angle's (cos, sin) one group, every other variable another: the grouping of a model's system by its names.
 std::vector<int> modes_start_angles_apart(const PolynomialSystem& s) {
   std::vector<int> g;
@@ -99,7 +80,7 @@ TEST(ModesStart, BezoutNumbersAsCountedByHand) {
 
   // The Stewart–Gough platform: the normalisation (0, 2) and six legs of degree 2 in (x, y, z) and 4 in e:
   // α³ β⁴ in (2α + 4β)⁶ 2β = 2 · C(6, 3) · 2³ · 4³, against the total degree 4⁶ · 2
-  const Scene stewart = parse_scene(kModesStartStewart, "stewart.yaml");
+  const Scene stewart = parse_scene(phiq::test::kModesStewartScene, "stewart.yaml");
   const ModelPolynomials sp = find_polynomial_system(*stewart.model, {});
   ASSERT_EQ(sp.system.variables, 7);
   EXPECT_EQ(sp.system.total_degree(), 8192);
@@ -110,7 +91,7 @@ TEST(ModesStart, StewartGoughDegreesLoweredTo432Paths) {
   // Each leg's quartic part is |p|² (e·e)², the normalisation's e·e times a quadric: the leg less that multiple is
   // cubic; the six cubic parts 2 t·R(e) p_i span three dimensions, so three legs less combinations of the other three
   // are quadratic: 2 · 3³ · 2³ paths. Refused above one path, nothing tracked (the full solve is bench/'s).
-  const Scene stewart = parse_scene(kModesStartStewart, "stewart.yaml");
+  const Scene stewart = parse_scene(phiq::test::kModesStewartScene, "stewart.yaml");
   ModesOptions o;
   o.max_paths = 1;
   const AssemblyModes r = find_assembly_modes(*stewart.model, o);
