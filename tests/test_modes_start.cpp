@@ -1,14 +1,15 @@
 // The homotopy's start systems and end game (phiq/modes.hpp): multi-homogeneous Bézout numbers against counts by
 // hand, a bilinear system in one path per solution, the total-degree and multi-homogeneous starts finding the same
 // assembly modes, lowered degrees keeping the finite solutions (two circles lose their two circular points at
-// infinity), the Stewart–Gough platform's 8192 total-degree paths lowered to 432, and a triple root found by the
-// end game.
+// infinity), the Stewart–Gough platform's 8192 total-degree paths lowered to 432 and a few of them tracked to its
+// leg equations, and a triple root found by the end game.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "modes/homotopy.hpp"
 #include "modes_stewart.hpp"
 #include "phiq/phiq.hpp"
 
@@ -246,6 +247,54 @@ TEST(ModesStart, MultiHomogeneousAndEndGameSameBitsOnOneAndTwoThreads) {
   ASSERT_EQ(a.endpoints.size(), 1u);
   ASSERT_EQ(b.endpoints.size(), 1u);
   EXPECT_TRUE(a.endpoints[0].x == b.endpoints[0].x);
+}
+
+// A few of the Stewart–Gough platform's 432 lowered paths tracked as solve_polynomial_system() tracks them (the whole
+// solve is bench/'s): each ends at a finite point or diverges; a finite end is a solution, every equation (six legs
+// and the normalisation, as fitted from the model) zero there to 1e-9 of its largest coefficient before any
+// refinement, and Newton on the original equations keeps it where it is.
+TEST(ModesStart, StewartGoughPathsEndOnTheLegEquations) {
+  const Scene stewart = parse_scene(phiq::test::kModesStewartScene, "stewart.yaml");
+  const ModelPolynomials p = find_polynomial_system(*stewart.model, {});
+  ASSERT_EQ(p.system.variables, 7);
+  ASSERT_EQ(p.system.equations.size(), 7u);
+  const PolynomialSystem lowered = modes_detail::lowered_degrees(p.system);
+  const modes_detail::Grouping one = modes_detail::single_group(7);
+  modes_detail::Random random(20261203);
+  modes_detail::StartSystem start;
+  ASSERT_TRUE(modes_detail::make_start_system(modes_detail::group_degrees(lowered, one), one, random, start));
+  ASSERT_EQ(start.paths, 432);
+  const modes_detail::CompiledSystem target(lowered, one), original(p.system);
+  modes_detail::Homotopy h{&target, &start, random.unit_complex(), Eigen::VectorXcd(8)};
+  for (int v = 0; v < 8; ++v) h.patch(v) = random.unit_complex();
+  int finite = 0;
+  for (std::int64_t path = 0; path < 432; path += 54) {  // 8 paths spread over the start points
+    SCOPED_TRACE(path);
+    const modes_detail::PathEnd end = modes_detail::track_path(h, path);
+    ASSERT_TRUE(end.reached);
+    // a finite end is tracked to t = 0 itself, its homogenising coordinate of the patch's order; the others diverge
+    // (432 paths, 80 finite solutions: 40 at ±e), their step collapsing near t = 0 with that coordinate → 0
+    const double finiteness = h.finiteness(end.X);
+    if (!(end.t == 0.0 && finiteness > 1e-2)) {
+      EXPECT_LT(finiteness, 1e-4) << "t " << end.t;
+      EXPECT_LT(end.t, 1e-6);
+      continue;
+    }
+    ++finite;
+    const Eigen::VectorXcd x = h.affine(end.X);
+    std::vector<std::complex<double>> f(7);
+    p.system.evaluate(x.data(), f.data());
+    for (std::size_t i = 0; i < 7; ++i) {
+      double largest = 0.0;
+      for (const PolynomialTerm& t : p.system.equations[i].terms) largest = std::max(largest, std::abs(t.coefficient));
+      EXPECT_LE(std::abs(f[i]) / largest, 1e-9) << "equation " << i << " at " << x.transpose();
+    }
+    Eigen::VectorXcd refined = x;
+    double condition = 0.0;
+    EXPECT_LE(modes_detail::refine_endpoint(original, refined, &condition), 1e-12);
+    EXPECT_LE((refined - x).cwiseAbs().maxCoeff(), 1e-8 * (1.0 + x.cwiseAbs().maxCoeff()));
+  }
+  EXPECT_GE(finite, 2);
 }
 
 }  // namespace
