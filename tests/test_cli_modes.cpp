@@ -5,9 +5,11 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <fstream>
 #include <numbers>
 
 #include "cli_test_support.hpp"
+#include "modes_stewart.hpp"
 
 namespace {
 
@@ -189,7 +191,7 @@ TEST_F(Cli, CheckSkipsTheCountAboveItsBoundsAndSaysSo) {
   EXPECT_EQ(j["modes"]["message"], "not counted here: " + std::to_string(j["coordinates"].get<int>()) +
                                        " coordinates, above 40 (phiq modes counts them)");
   EXPECT_TRUE(j["modes"]["real"].is_null());
-  // four loops: few coordinates, but 4⁴ · 2 paths, above the 64 check tracks
+  // four loops: few coordinates, but 4⁴ · 2 paths (its fewest, degrees lowered or not), above the 64 check tracks
   const fs::path four = dir_ / "four.yaml";
   ASSERT_EQ(run("generate nfourbar 4 --coords natural -o " + four.string()).code, 0);
   const Result paths = run("check " + four.string());
@@ -197,6 +199,13 @@ TEST_F(Cli, CheckSkipsTheCountAboveItsBoundsAndSaysSo) {
   EXPECT_NE(paths.out.find("\nmodes         not counted here: 512 paths, above 64 (phiq modes counts them)\n"),
             std::string::npos)
       << paths.out;
+  // the Stewart–Gough platform: the paths its solve would take (degrees lowered: 432), not its total degree (8192)
+  const fs::path stewart = dir_ / "stewart.yaml";
+  std::ofstream(stewart) << phiq::test::kModesStewartScene;
+  const Result lowered = run("check " + stewart.string());
+  EXPECT_NE(lowered.out.find("\nmodes         not counted here: 432 paths, above 64 (phiq modes counts them)\n"),
+            std::string::npos)
+      << lowered.out << lowered.err;
 }
 
 TEST_F(Cli, RunSummaryNamesTheModeOfItsFirstRow) {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "generate.hpp"
+#include "modes/model_rows.hpp"
 #include "modes_phc.hpp"
 #include "phiq/phiq.hpp"
 
@@ -204,6 +205,36 @@ TEST(ModesBlocks, ModelScenesAsTheWholeSystem) {
   EXPECT_GE(compared.size(), 20u);
   for (const char* name : {"seed/fourbar_natural.yaml", "hard/fourbar_m.yaml", "hard/fourbar_mm.yaml"})
     EXPECT_NE(std::find(in_blocks.begin(), in_blocks.end(), name), in_blocks.end()) << name;
+}
+
+// The path limit of the block solve counts each block's paths as its solve takes them (degrees lowered), not its
+// total degree. x² = 1, then for each x two circles (y − x)² + z² = 2 and y² + z² = 1 (total degree 4; their
+// difference is linear, so lowered 2 paths): (x, y, z) = (±1, 0, ±1), in 2 + 2 · 2 = 6 paths (by total degrees 10).
+TEST(ModesBlocks, PathLimitCountsEachBlocksLoweredPaths) {
+  auto term = [](double c, std::vector<int> e) { return PolynomialTerm{c, std::move(e)}; };
+  PolynomialSystem s{3, {"x", "y", "z"}, {}};
+  s.equations.push_back({{term(1, {2, 0, 0}), term(-1, {0, 0, 0})}});
+  s.equations.push_back(
+      {{term(1, {0, 2, 0}), term(-2, {1, 1, 0}), term(1, {2, 0, 0}), term(1, {0, 0, 2}), term(-2, {0, 0, 0})}});
+  s.equations.push_back({{term(1, {0, 2, 0}), term(1, {0, 0, 2}), term(-1, {0, 0, 0})}});
+  ModesOptions o;
+  o.max_paths = 6;
+  ModesSummary out;
+  std::string unsafe;
+  ASSERT_TRUE(modes_detail::solve_in_blocks(s, {}, Eigen::VectorXd::Zero(3), o, out, unsafe)) << unsafe;
+  EXPECT_EQ(out.paths, 6);
+  EXPECT_EQ(out.total_degree, 10);
+  EXPECT_EQ(out.start_system, "total degree, degrees lowered");
+  ASSERT_EQ(out.real, 4);
+  EXPECT_EQ(out.complex + out.singular + out.failed_paths, 0);
+  for (const Endpoint& e : out.endpoints) {
+    EXPECT_NEAR(std::abs(e.x(0).real()), 1.0, 1e-12);
+    EXPECT_NEAR(e.x(1).real(), 0.0, 1e-12);
+    EXPECT_NEAR(std::abs(e.x(2).real()), 1.0, 1e-12);
+  }
+  o.max_paths = 5;  // the second x's block would pass it
+  EXPECT_FALSE(modes_detail::solve_in_blocks(s, {}, Eigen::VectorXd::Zero(3), o, out, unsafe));
+  EXPECT_EQ(unsafe, "block 2 of 2 (2 unknowns): the blocks' paths pass the limit of 5");
 }
 
 }  // namespace

@@ -1,14 +1,16 @@
 // The homotopy's start systems and end game (phiq/modes.hpp): multi-homogeneous Bézout numbers against counts by
 // hand, a bilinear system in one path per solution, the total-degree and multi-homogeneous starts finding the same
 // assembly modes, lowered degrees keeping the finite solutions (two circles lose their two circular points at
-// infinity), the Stewart–Gough platform's 8192 total-degree paths lowered to 432, and a triple root found by the
-// end game.
+// infinity), the Stewart–Gough platform's 8192 total-degree paths lowered to 432 and a few of them tracked to its
+// leg equations, and a triple root found by the end game.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "modes/homotopy.hpp"
+#include "modes_stewart.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq {
@@ -49,26 +51,6 @@ PolynomialSystem modes_start_eigenproblem() {
   return s;
 }
 
-// The bench's general Stewart–Gough platform (bench/bench_modes.cpp): one body in x, y, z and e0 … e3, six legs.
-const char* kModesStartStewart =
-    "phiq: 1\nname: stewart_gough\ndimension: 3\n"
-    "coordinates: {x: 0.1, y: 0.05, z: 1.0, e0: 1, e1: 0.05, e2: 0.02, e3: 0.1}\n"
-    "bodies: {platform: [x, y, z, e0, e1, e2, e3]}\n"
-    "constraints:\n"
-    "  - {name: leg1, type: distance, between: [{body: ground, at: [1.0, 0.1, 0.05]}, {body: platform, at: [0.5, 0.3, "
-    "0.02]}], length: 1.3}\n"
-    "  - {name: leg2, type: distance, between: [{body: ground, at: [0.3, 0.9, -0.1]}, {body: platform, at: [-0.2, 0.6, "
-    "0.1]}], length: 1.1}\n"
-    "  - {name: leg3, type: distance, between: [{body: ground, at: [-0.7, 0.6, 0.08]}, {body: platform, at: [-0.5, "
-    "0.1, -0.05]}], length: 1.25}\n"
-    "  - {name: leg4, type: distance, between: [{body: ground, at: [-0.8, -0.4, 0.02]}, {body: platform, at: [-0.3, "
-    "-0.5, 0.07]}], length: 1.2}\n"
-    "  - {name: leg5, type: distance, between: [{body: ground, at: [0.1, -1.0, -0.06]}, {body: platform, at: [0.2, "
-    "-0.6, -0.03]}], length: 1.05}\n"
-    "  - {name: leg6, type: distance, between: [{body: ground, at: [0.9, -0.5, 0.12]}, {body: platform, at: [0.6, "
-    "-0.2, 0.04]}], length: 1.15}\n"
-    "time: {start: 0, end: 1, steps: 1}\n";
-
 // Each angle's (cos, sin) one group, every other variable another: the grouping of a model's system by its names.
 std::vector<int> modes_start_angles_apart(const PolynomialSystem& s) {
   std::vector<int> g;
@@ -99,7 +81,7 @@ TEST(ModesStart, BezoutNumbersAsCountedByHand) {
 
   // The Stewart–Gough platform: the normalisation (0, 2) and six legs of degree 2 in (x, y, z) and 4 in e:
   // α³ β⁴ in (2α + 4β)⁶ 2β = 2 · C(6, 3) · 2³ · 4³, against the total degree 4⁶ · 2
-  const Scene stewart = parse_scene(kModesStartStewart, "stewart.yaml");
+  const Scene stewart = parse_scene(phiq::test::kModesStewartScene, "stewart.yaml");
   const ModelPolynomials sp = find_polynomial_system(*stewart.model, {});
   ASSERT_EQ(sp.system.variables, 7);
   EXPECT_EQ(sp.system.total_degree(), 8192);
@@ -110,7 +92,7 @@ TEST(ModesStart, StewartGoughDegreesLoweredTo432Paths) {
   // Each leg's quartic part is |p|² (e·e)², the normalisation's e·e times a quadric: the leg less that multiple is
   // cubic; the six cubic parts 2 t·R(e) p_i span three dimensions, so three legs less combinations of the other three
   // are quadratic: 2 · 3³ · 2³ paths. Refused above one path, nothing tracked (the full solve is bench/'s).
-  const Scene stewart = parse_scene(kModesStartStewart, "stewart.yaml");
+  const Scene stewart = parse_scene(phiq::test::kModesStewartScene, "stewart.yaml");
   ModesOptions o;
   o.max_paths = 1;
   const AssemblyModes r = find_assembly_modes(*stewart.model, o);
@@ -265,6 +247,54 @@ TEST(ModesStart, MultiHomogeneousAndEndGameSameBitsOnOneAndTwoThreads) {
   ASSERT_EQ(a.endpoints.size(), 1u);
   ASSERT_EQ(b.endpoints.size(), 1u);
   EXPECT_TRUE(a.endpoints[0].x == b.endpoints[0].x);
+}
+
+// A few of the Stewart–Gough platform's 432 lowered paths tracked as solve_polynomial_system() tracks them (the whole
+// solve is bench/'s): each ends at a finite point or diverges; a finite end is a solution, every equation (six legs
+// and the normalisation, as fitted from the model) zero there to 1e-9 of its largest coefficient before any
+// refinement, and Newton on the original equations keeps it where it is.
+TEST(ModesStart, StewartGoughPathsEndOnTheLegEquations) {
+  const Scene stewart = parse_scene(phiq::test::kModesStewartScene, "stewart.yaml");
+  const ModelPolynomials p = find_polynomial_system(*stewart.model, {});
+  ASSERT_EQ(p.system.variables, 7);
+  ASSERT_EQ(p.system.equations.size(), 7u);
+  const PolynomialSystem lowered = modes_detail::lowered_degrees(p.system);
+  const modes_detail::Grouping one = modes_detail::single_group(7);
+  modes_detail::Random random(20261203);
+  modes_detail::StartSystem start;
+  ASSERT_TRUE(modes_detail::make_start_system(modes_detail::group_degrees(lowered, one), one, random, start));
+  ASSERT_EQ(start.paths, 432);
+  const modes_detail::CompiledSystem target(lowered, one), original(p.system);
+  modes_detail::Homotopy h{&target, &start, random.unit_complex(), Eigen::VectorXcd(8)};
+  for (int v = 0; v < 8; ++v) h.patch(v) = random.unit_complex();
+  int finite = 0;
+  for (std::int64_t path = 0; path < 432; path += 54) {  // 8 paths spread over the start points
+    SCOPED_TRACE(path);
+    const modes_detail::PathEnd end = modes_detail::track_path(h, path);
+    ASSERT_TRUE(end.reached);
+    // a finite end is tracked to t = 0 itself, its homogenising coordinate of the patch's order; the others diverge
+    // (432 paths, 80 finite solutions: 40 at ±e), their step collapsing near t = 0 with that coordinate → 0
+    const double finiteness = h.finiteness(end.X);
+    if (!(end.t == 0.0 && finiteness > 1e-2)) {
+      EXPECT_LT(finiteness, 1e-4) << "t " << end.t;
+      EXPECT_LT(end.t, 1e-6);
+      continue;
+    }
+    ++finite;
+    const Eigen::VectorXcd x = h.affine(end.X);
+    std::vector<std::complex<double>> f(7);
+    p.system.evaluate(x.data(), f.data());
+    for (std::size_t i = 0; i < 7; ++i) {
+      double largest = 0.0;
+      for (const PolynomialTerm& t : p.system.equations[i].terms) largest = std::max(largest, std::abs(t.coefficient));
+      EXPECT_LE(std::abs(f[i]) / largest, 1e-9) << "equation " << i << " at " << x.transpose();
+    }
+    Eigen::VectorXcd refined = x;
+    double condition = 0.0;
+    EXPECT_LE(modes_detail::refine_endpoint(original, refined, &condition), 1e-12);
+    EXPECT_LE((refined - x).cwiseAbs().maxCoeff(), 1e-8 * (1.0 + x.cwiseAbs().maxCoeff()));
+  }
+  EXPECT_GE(finite, 2);
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 """phiq.modes (engine/python/src/bind_modes.cpp): the four-bar's two assembly modes as arrays, each a placement that
-solves the scene's equations (checked with the model's own residual), against Freudenstein's closed form, and a cam
-refused with its constraint named."""
+solves the scene's equations (checked with the model's own residual), against Freudenstein's closed form, the start
+system each solve tracked its paths from, and a cam refused with its constraint named."""
 import math
 import os
 
@@ -17,6 +17,8 @@ def test_fourbar_modes_are_two_placements_on_freudensteins_branches():
     r = phiq.modes(scene, 0.7, threads=1)
     assert r["q"].shape == (2, len(r["coordinates"]))
     assert r["paths"] == 4
+    assert r["method"] == "whole system"
+    assert r["start_system"] == "total degree"  # its 4 paths are already the fewest
     assert not r["singular"].any()
     xb, yb = r["coordinates"].index("xB"), r["coordinates"].index("yB")
     # Freudenstein: the rocker's angles at crank 0.7 (a 0.4, b 1.2, c 1, d 1)
@@ -35,6 +37,19 @@ def test_fourbar_modes_are_two_placements_on_freudensteins_branches():
         assert np.max(np.abs(scene.model.residual(q, 0.7))) < 1e-12
         ws.q = q  # a mode is a placement the workspace takes
     assert np.array_equal(ws.q, r["q"][-1])
+
+
+def test_start_system_says_the_degrees_were_lowered_block_by_block():
+    # the natural four-bar, solved block by block in 6 paths (its blocks' total degrees add up to 10): the last
+    # block's start system is named with its degrees lowered
+    scene = phiq.load_scene(os.path.join(MODELS, "seed", "fourbar_natural.yaml"))
+    r = phiq.modes(scene, threads=1)
+    assert r["method"] == "block by block"
+    assert r["start_system"] == "total degree, degrees lowered"
+    assert r["paths"] == 6
+    assert r["q"].shape[0] == 4
+    for q in r["q"]:
+        assert np.max(np.abs(scene.model.residual(q, 0.0))) < 1e-12
 
 
 def test_a_cam_is_refused_with_its_constraint_named():

@@ -21,7 +21,8 @@ void refused(const AssemblyModes& found, ModeCount& out) {
       break;
     case ModesStatus::kTooManyPaths:
       out.state = ModeCount::State::kSkipped;
-      out.reason = "not counted here: " + std::to_string(found.polynomials.system.total_degree()) + " paths, above " +
+      // the paths the solve would take (degrees lowered, the start system with the fewest), not the total degree
+      out.reason = "not counted here: " + std::to_string(s.paths) + " paths, above " +
                    std::to_string(kModeCountMaxPaths) + " (phiq modes counts them)";
       break;
     default:

@@ -16,7 +16,8 @@ namespace phiq::tools {
 // Scenes with more coordinates than this are not counted: recovering their rows as polynomials evaluates the whole
 // model for every sample of every row, quadratic in the scene's size.
 constexpr Index kModeCountMaxCoordinates = 40;
-// Nor are scenes whose total-degree homotopy has more paths than this (the fit is done, nothing is tracked).
+// Nor are scenes whose homotopy has more paths than this: those of the start system the solve takes (degrees lowered,
+// the fewest paths; the fit is done, nothing is tracked).
 constexpr std::int64_t kModeCountMaxPaths = 64;
 
 struct ModeCount {

@@ -204,11 +204,17 @@ bool solve_in_blocks(const PolynomialSystem& system, const std::vector<std::arra
     std::string why;
     if (block_degenerate(block))
       why = "an equation vanishes or is a nonzero constant there";
-    else if (out.paths + block.total_degree() > options.max_paths)
-      why = "the blocks' paths pass the limit of " + std::to_string(options.max_paths);
-    else
-      part = solve_polynomial_system(block, options), why = unsafe_block(part);
-    block_add_counts(out, part);
+    else {
+      // the block's own start system (degrees lowered, the fewest paths) within what the blocks before it left
+      ModesOptions within = options;
+      within.max_paths = options.max_paths - out.paths;
+      part = solve_polynomial_system(block, within);
+      if (part.status == ModesStatus::kTooManyPaths)
+        why = "the blocks' paths pass the limit of " + std::to_string(options.max_paths);
+      else
+        why = unsafe_block(part);
+    }
+    if (part.status != ModesStatus::kTooManyPaths) block_add_counts(out, part);
     if (!why.empty())
       unsafe = name + " of " + std::to_string(blocks.size()) + " (" + std::to_string(b.variables.size()) +
                " unknowns): " + why;
