@@ -435,9 +435,13 @@ void SceneWriter::motion(const Motion& m) {
                            "or cylindrical") +
                " joint");
   const std::string name = names_.make(m.name);
-  for (const ForceSite& j : a_.force_sites)  // the motion acts between its joint's markers
-    if (j.item == jname && j.type == type)
-      a_.force_sites.push_back(ForceSite{m.name, m.type, name, "", j.body, j.marker, 0.0});
+  // the motion acts between its joint's markers (found before the push_back, which may move the sites)
+  const auto site = std::find_if(a_.force_sites.begin(), a_.force_sites.end(),
+                                 [&](const ForceSite& j) { return j.item == jname && j.type == type; });
+  if (site != a_.force_sites.end()) {
+    ForceSite motion{m.name, m.type, name, "", site->body, site->marker, 0.0};
+    a_.force_sites.push_back(std::move(motion));
+  }
   drivers_ << "  - {name: " << name << ", joint: " << it->second.first
            << ", measure: " << (rotation ? "angle" : "distance") << ", law: {type: expression, f: \""
            << expression(m.expression, a_.path, m.expression_line) << "\"}}\n";
