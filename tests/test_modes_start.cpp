@@ -194,9 +194,11 @@ TEST(ModesStart, LoweredDegreesKeepTheFiniteSolutionsAndLoseTheCircularPoints) {
   }
   EXPECT_EQ(b.at_infinity + b.failed_paths, 0);
   ASSERT_EQ(a.at_infinity, 2);  // (1, ±i) / √2 directions: |y| = |x|, y = ±i x
-  for (const Endpoint& e : a.endpoints)
-    if (e.kind == EndpointKind::kAtInfinity)
+  for (const Endpoint& e : a.endpoints) {
+    if (e.kind == EndpointKind::kAtInfinity) {
       EXPECT_NEAR(std::abs(e.x(1) * e.x(1) + e.x(0) * e.x(0)), 0.0, 1e-6) << e.x.transpose();
+    }
+  }
 }
 
 TEST(ModesStart, EndGameFindsATripleRoot) {
