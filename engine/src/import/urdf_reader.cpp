@@ -454,7 +454,7 @@ Mechanism UrdfReader::read(int* loops) {
       refuse(path_, line,
              "joint '" + x.name + "' mimics '" + j->mimic->joint_name + "', which is not a joint of the file");
     m_.couplers.push_back(Coupler{x.name + "_mimic", line, joint_index.at(x.name), other->second, j->mimic->multiplier,
-                                  j->mimic->offset});
+                                  j->mimic->offset, ""});  // file: the URDF itself
   }
   return std::move(m_);
 }

@@ -222,7 +222,7 @@ void Homotopy::evaluate(const Eigen::VectorXcd& X, cd t, Eigen::VectorXcd& h, Ei
       for (int j = 0; j < m; ++j)
         for (const Eigen::VectorXcd& a : s.factors[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)]) {
           const Eigen::VectorXcd part = group_part(g, X, j);
-          forms.emplace_back(j, &a), values.push_back(a.transpose() * part);
+          forms.emplace_back(j, &a), values.push_back(a.cwiseProduct(part).sum());  // aᵀ part, unconjugated
         }
       value = 1.0;
       for (const cd v : values) value *= v;
