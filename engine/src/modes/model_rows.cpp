@@ -86,17 +86,22 @@ bool affine_row(ModelRows& rows, Index r, const std::vector<Index>& columns, con
 
 namespace {
 
+// The columns a row reads that no earlier pass has fixed (ModelPolynomials::fixed is NaN there).
+std::vector<Index> free_columns(const std::vector<Index>& columns, const ModelPolynomials& out) {
+  std::vector<Index> free;
+  for (Index j : columns)
+    if (std::isnan(out.fixed[static_cast<std::size_t>(j)])) free.push_back(j);
+  return free;
+}
+
 // One pass over the rows that read one free coordinate and are affine in it. True when it fixed one.
 bool eliminate_single_coordinates(ModelRows& rows, const std::vector<std::vector<Index>>& row_columns,
                                   ModelPolynomials& out, Eigen::VectorXd& base, std::vector<bool>& eliminated,
                                   Random& random) {
-  auto is_fixed = [&](Index j) { return !std::isnan(out.fixed[static_cast<std::size_t>(j)]); };
   bool fixed_any = false;
   for (std::size_t r = 0; r < row_columns.size(); ++r) {
     if (eliminated[r]) continue;
-    std::vector<Index> free;
-    for (Index j : row_columns[r])
-      if (!is_fixed(j)) free.push_back(j);
+    const std::vector<Index> free = free_columns(row_columns[r], out);
     double value = 0.0;
     Eigen::VectorXd slope;
     if (free.size() != 1 || !affine_row(rows, static_cast<Index>(r), free, out.scale, base, random, value, slope))
@@ -126,9 +131,7 @@ bool eliminate_affine_sets(ModelRows& rows, const std::vector<std::vector<Index>
   std::vector<Eigen::VectorXd> slopes;
   for (std::size_t r = 0; r < row_columns.size(); ++r) {
     if (eliminated[r]) continue;
-    std::vector<Index> free;
-    for (Index j : row_columns[r])
-      if (!is_fixed(j)) free.push_back(j);
+    const std::vector<Index> free = free_columns(row_columns[r], out);
     double value = 0.0;
     Eigen::VectorXd slope;
     if (free.size() < 2 || !affine_row(rows, static_cast<Index>(r), free, out.scale, base, random, value, slope))
