@@ -30,6 +30,7 @@ echo "== sanitizers: clang, AddressSanitizer + UndefinedBehaviorSanitizer (build
 # nothing a report uses (the tests' own code at -O0: CMakeLists.txt, PHIQ_TEST_OPTIMIZATION)
 CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
+  -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld \
   -DCMAKE_UNITY_BUILD=ON -DPHIQ_SANITIZE=ON -DPHIQ_FUZZ=ON -DPHIQ_BUILD_BENCH=OFF >/dev/null
 cmake --build "$root/build-asan" -j "$jobs"
 "$root/tools/fuzz.sh" "${PHIQ_FUZZ_SECONDS:-40}" "$root/build-asan"
