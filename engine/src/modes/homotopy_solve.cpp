@@ -106,10 +106,15 @@ std::string grouping_name(const PolynomialSystem& s, const Grouping& g) {
   std::string name = "multi-homogeneous";
   for (const auto& members : g.members) {
     name += " {";
-    for (std::size_t k = 0; k < members.size(); ++k)
-      name += (k ? " " : "") + (s.names.empty() || s.names[static_cast<std::size_t>(members[k])].empty()
-                                    ? "x" + std::to_string(members[k] + 1)
-                                    : s.names[static_cast<std::size_t>(members[k])]);
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      // appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) on a literal + std::string here
+      if (k) name += ' ';
+      const auto j = static_cast<std::size_t>(members[k]);
+      if (s.names.empty() || s.names[j].empty())
+        name.append(1, 'x').append(std::to_string(j + 1));
+      else
+        name += s.names[j];
+    }
     name += "}";
   }
   return name;
