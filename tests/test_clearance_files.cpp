@@ -121,15 +121,19 @@ TEST(ClearanceFiles, Hdf5HoldsTheCsvValuesAndTheSummaryExactlyOnAnyThreadCount) 
   EXPECT_EQ(clearance_files_read(f, "interference", &dims),
             (std::vector<double>{0.0, p.interference[0].entry, p.interference[0].exit}));
   EXPECT_EQ(dims, (std::vector<hsize_t>{1, 3}));
-  // every local minimum, in time order (the first row, where d rises, and the worst at 3π/2): pair, t, d, refined
+  // every local minimum, in time order (the first row, where d rises, and the worst at 3π/2): pair, t, d, refined,
+  // and its own ∂d/∂L2
   std::vector<double> minima;
   for (const ClearanceMinimum& m : p.minima)
-    minima.insert(minima.end(), {0.0, m.t, m.at.distance, m.refined ? 1.0 : 0.0});
+    minima.insert(minima.end(), {0.0, m.t, m.at.distance, m.refined ? 1.0 : 0.0, m.sensitivities.at(0)});
   ASSERT_EQ(p.minima.size(), 2u);
   EXPECT_EQ(p.minima[0].t, 0.0);
   EXPECT_EQ(p.minima[1].t, p.worst.t);
+  EXPECT_EQ(p.minima[1].sensitivities, p.worst.sensitivities);
+  // at t = 0, d = √(r² + 0.25) − 0.2 with r = L2/2 + 0.2 = 0.4: ∂d/∂L2 = r / (2 √0.41)
+  EXPECT_NEAR(p.minima[0].sensitivities.at(0), 0.2 / std::sqrt(0.41), 1e-9);
   EXPECT_EQ(clearance_files_read(f, "minima", &dims), minima);
-  EXPECT_EQ(dims, (std::vector<hsize_t>{2, 4}));
+  EXPECT_EQ(dims, (std::vector<hsize_t>{2, 5}));
   EXPECT_EQ(clearance_files_integer(f, "format_version"), kClearanceHdf5Format);
   EXPECT_EQ(clearance_files_integer(f, "interferes"), 1);
   EXPECT_EQ(clearance_files_integer(f, "bound_held"), 1);
@@ -188,8 +192,8 @@ TEST(ClearanceFiles, SummaryJsonOfTwoBallsIsTheClosedForm) {
 
 // models/clearance/fourbar_knee.yaml with sensitivities to L2 and L3: several pairs, some with more than one
 // local minimum, two interfering. The JSON's `local_minima` of each pair are HDF5 /minima's rows of that pair, in
-// order, to the bit, as many as its `minima` count; the worst's entry has /worst's witness points and /sensitivities'
-// row, the others the report's own witness points and no sensitivities (solved at the worst only).
+// order, to the bit, as many as its `minima` count, each with its own sensitivities (/minima's last columns); the
+// worst's entry has /worst's witness points and /sensitivities' row.
 TEST(ClearanceFiles, SummaryJsonListsEveryMinimumAsHdf5MinimaHoldsIt) {
   std::ifstream in(test::model_path("clearance/fourbar_knee.yaml"));
   std::stringstream text;
@@ -211,7 +215,7 @@ TEST(ClearanceFiles, SummaryJsonListsEveryMinimumAsHdf5MinimaHoldsIt) {
   H5Fclose(f);
   fs::remove_all(dir);
   ASSERT_EQ(dims.size(), 2u);
-  ASSERT_EQ(dims[1], 4u);
+  ASSERT_EQ(dims[1], 6u);  // pair, t, distance, refined, d_L2, d_L3
   ASSERT_EQ(sens_dims, (std::vector<hsize_t>{r.pairs.size(), 2}));
 
   const auto j = nlohmann::json::parse(tools::clearance_summary_json(s, "fourbar_knee.yaml", r));
@@ -222,11 +226,11 @@ TEST(ClearanceFiles, SummaryJsonListsEveryMinimumAsHdf5MinimaHoldsIt) {
     const auto& list = p["local_minima"];
     ASSERT_EQ(list.size(), p["minima"].get<std::size_t>()) << i;
     several += list.size() > 1;
-    std::size_t with_sensitivities = 0;
+    std::size_t worst_entries = 0;
     for (std::size_t k = 0; k < list.size(); ++k, ++row) {
       ASSERT_LT(row, dims[0]);
       const auto& m = list[k];
-      const double* h = &minima[row * 4];
+      const double* h = &minima[row * 6];
       EXPECT_EQ(h[0], static_cast<double>(i)) << row;
       EXPECT_EQ(m["t"].get<double>(), h[1]) << row;
       EXPECT_EQ(m["distance"].get<double>(), h[2]) << row;
@@ -238,8 +242,11 @@ TEST(ClearanceFiles, SummaryJsonListsEveryMinimumAsHdf5MinimaHoldsIt) {
         EXPECT_EQ(m["point_b"][c].get<double>(),
                   (std::array<double, 3>{own.at.point_b.x, own.at.point_b.y, own.at.point_b.z}[c]));
       }
-      if (!m.contains("sensitivities")) continue;
-      ++with_sensitivities;
+      ASSERT_TRUE(m.contains("sensitivities")) << row;
+      EXPECT_EQ(m["sensitivities"]["L2"].get<double>(), h[4]) << row;
+      EXPECT_EQ(m["sensitivities"]["L3"].get<double>(), h[5]) << row;
+      if (m["t"].get<double>() != r.pairs[i].worst.t) continue;
+      ++worst_entries;
       const double* w = &worst[i * 13];
       EXPECT_EQ(m["t"].get<double>(), w[0]);
       EXPECT_EQ(m["distance"].get<double>(), w[1]);
@@ -251,7 +258,7 @@ TEST(ClearanceFiles, SummaryJsonListsEveryMinimumAsHdf5MinimaHoldsIt) {
       EXPECT_EQ(m["sensitivities"]["L3"].get<double>(), sensitivities[i * 2 + 1]);
       nonzero += sensitivities[i * 2] != 0.0 || sensitivities[i * 2 + 1] != 0.0;
     }
-    EXPECT_EQ(with_sensitivities, list.empty() ? 0u : 1u) << i;
+    EXPECT_EQ(worst_entries, list.empty() ? 0u : 1u) << i;
     for (const auto& in : p["interference"]) {
       ASSERT_LT(intervals * 3 + 2, interference.size());
       EXPECT_EQ(interference[intervals * 3], static_cast<double>(i));

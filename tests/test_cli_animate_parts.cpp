@@ -1,14 +1,18 @@
 // The parts a drawing shows (phiq/drawn_parts.hpp) in `phiq animate`'s outputs: the Cardan joint's stated parts as
 // .glb nodes (one per part, named, its mesh the shapes' triangles, its keyframes part_pose() at every row, under a
-// root turning z up), and in the HTML page's JSON (each part, its shapes once per distinct mesh, its poses).
+// root turning z up), and in the HTML page's JSON (each part, its shapes once per distinct mesh, its poses); the
+// clearance's witness points as .glb nodes carried by their parts.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <string>
 
+#include "html_clearance.hpp"
 #include "phiq/drawn_parts.hpp"
 #include "phiq/phiq.hpp"
 
@@ -188,6 +192,57 @@ TEST_F(AnimateParts, HtmlHoldsEachPartAndItsPoses) {
       for (int i = 0; i < 4; ++i) q[i] = -1 + (c[3 + i] + 32767) * 2.0 / 65534;
       const std::array<double, 9> m = matrix_of(q);
       for (int i = 0; i < 9; ++i) EXPECT_NEAR(m[i], p.rotation[i], 2e-4) << drawn[k].name << " frame " << f;
+    }
+  }
+}
+
+// `output.clearance` in the .glb: the four-bar's crank (1 rad/s about O) carries a ball of radius 0.05 centred at
+// 0.4 (cos t, sin t), against a ball of radius 0.15 fixed at (0, −0.5); the worst pose is t = 3π/2. The witness on
+// the crank is its material point at radius 0.45 on the line of centres there, 0.45 (cos t, sin t) at every row;
+// the fixed ball's is (0, −0.35). Both balls ×2 exactly at the rows the viewer colours (viewer_near_rows()).
+TEST_F(AnimateParts, GlbCarriesTheClearanceWitnessPointsWithTheirParts) {
+  std::ifstream in(phiq::test::model_path("seed/fourbar_reference_point.yaml"));
+  std::stringstream base;
+  base << in.rdbuf();
+  const std::string text = base.str().substr(0, base.str().find("\ntime:")) +
+                           "\ntime: {start: 0, end: 2*pi, steps: 90}\n"
+                           "parts:\n"
+                           "  tip: {body: crank, shapes: [{type: sphere, radius: 0.05, at: [0.2, 0]}]}\n"
+                           "  ball: {body: ground, shapes: [{type: sphere, radius: 0.15, at: [0, -0.5]}]}\n"
+                           "output: {clearance: {pairs: [[tip, ball]], threshold: 0.01}}\n";
+  const fs::path scene = write("balls.yaml", text), glb = dir_ / "balls.glb";
+  const phiq::test::Result a = run("animate " + scene.string() + " -o " + glb.string());
+  ASSERT_EQ(a.code, 0) << a.err;
+  const phiq::Scene s = phiq::parse_scene(text, scene.string());
+  const phiq::ClearanceReport r = phiq::scene_clearance(s);
+  ASSERT_EQ(r.pairs.size(), 1u);
+  const std::string near = phiq::tools::viewer_near_rows(r, r.pairs[0]);
+  ASSERT_NE(near.find('1'), std::string::npos);
+  ASSERT_NE(near.find('0'), std::string::npos);
+  const Glb g = phiq::test::parse_glb(slurp(glb));
+  for (const char* part : {"tip", "ball"}) {
+    const int n = g.node(std::string("clearance tip / ball: witness on ") + part);
+    ASSERT_GE(n, 0) << part;
+    const auto& node = g.doc["nodes"][n];
+    const auto& mesh = g.doc["meshes"][node["mesh"].get<int>()];
+    EXPECT_EQ(g.doc["materials"][mesh["primitives"][0]["material"].get<int>()]["name"], "clearance witness");
+    const auto& extras = node["extras"]["clearance"];
+    EXPECT_EQ(extras["part"], part);
+    EXPECT_EQ(extras["near"], near);
+    EXPECT_EQ(extras["worst_t"].get<double>(), r.pairs[0].worst.t);
+    EXPECT_EQ(extras["interference"].size(), 1u);
+    const auto [tin, tout] = g.channel(n, "translation");
+    const auto [scale_in, sout] = g.channel(n, "scale");
+    ASSERT_GE(tout, 0) << part;
+    ASSERT_GE(sout, 0) << part;
+    ASSERT_EQ(g.doc["accessors"][tout]["count"], r.times.size());
+    for (std::size_t k = 0; k < r.times.size(); ++k) {
+      const double t = r.times[k];
+      const bool tip = std::string(part) == "tip";
+      const std::vector<double> x = g.floats(tout, k);
+      EXPECT_NEAR(x[0], tip ? 0.45 * std::cos(t) : 0.0, 1e-6) << part << " row " << k;
+      EXPECT_NEAR(x[1], tip ? 0.45 * std::sin(t) : -0.35, 1e-6) << part << " row " << k;
+      EXPECT_EQ(g.floats(sout, k)[0], near[k] == '1' ? 2.0 : 1.0) << part << " row " << k;
     }
   }
 }

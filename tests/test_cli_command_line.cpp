@@ -28,7 +28,7 @@ TEST_F(Cli, UsageErrorsAndHelp) {
       run("--version").out,
       "phiq 0.1.0 (scene format 1, CSV format 1, HDF5 results format 1, check --json format 1, run --summary "
       "format 2, batch --summary format 1, sweep-accuracy --json format 2, compare --json format 1, tolerance CSV "
-      "format 1, tolerance --summary format 1, clearance HDF5 format 2, clearance --summary format 1)\n");
+      "format 1, tolerance --summary format 1, clearance HDF5 format 3, clearance --summary format 1)\n");
 }
 
 // Command-line errors are one line, "phiq: <command>: <what>", exit 2, with readable ranges.

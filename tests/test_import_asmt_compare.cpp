@@ -29,19 +29,28 @@ std::string AsmtCompareSample(const std::string& name) { return std::string(PHIQ
   GTEST_SKIP() << "OndselSolver's sample .asmt files are not at " << PHIQ_ASMT_SAMPLES \
                << " (../shared/asmt beside the clone; cmake -DPHIQ_ASMT_SAMPLES=DIR)"
 
-// The sample swept as `phiq run` sweeps it (prepared, tolerance 1e-13), as the table of a result with dotted
-// names: t, every coordinate, and with `rates` their .v and .a columns.
-CsvTable AsmtCompareResult(const std::string& path, bool rates) {
-  Scene scene = load_scene(path);
-  scene.sweep.velocities = scene.sweep.accelerations = rates;
+// Sweeps `scene` as `phiq run` does (prepared, tolerance 1e-13): `sweep_it(model, workspace)` on its square model,
+// the workspace at its start.
+template <class Sweep>
+void AsmtCompareSweep(Scene& scene, Sweep sweep_it) {
   scene.sweep.newton.tolerance = scene.sweep.assembly.tolerance = 1e-13;
   SquareScene square;
   EXPECT_EQ(prepare_scene(*scene.model, scene.sweep.t_begin, scene.sweep.assembly, &square), SolveStatus::kSuccess);
   const Model& m = square.model(*scene.model);
   Workspace ws(m);
   ws.q = square.start;
+  sweep_it(m, ws);
+}
+
+// The sample swept as `phiq run` sweeps it, as the table of a result with dotted names: t, every coordinate, and
+// with `rates` their .v and .a columns.
+CsvTable AsmtCompareResult(const std::string& path, bool rates) {
+  Scene scene = load_scene(path);
+  scene.sweep.velocities = scene.sweep.accelerations = rates;
   test::Trace trace;
-  EXPECT_EQ(test::sweep(m, scene.sweep, &trace, nullptr, &ws), SolveStatus::kSuccess);
+  AsmtCompareSweep(scene, [&](const Model& m, Workspace& ws) {
+    EXPECT_EQ(test::sweep(m, scene.sweep, &trace, nullptr, &ws), SolveStatus::kSuccess);
+  });
   CsvTable t;
   t.path = "result.csv";
   t.columns = {"t"};
@@ -66,17 +75,14 @@ CsvTable AsmtCompareForcesResult(const std::string& text, const std::string& pat
   ImportOptions options;
   options.rates = options.forces = true;
   Scene scene = parse_scene(import_asmt(text, path, options).yaml, path);
-  scene.sweep.newton.tolerance = scene.sweep.assembly.tolerance = 1e-13;
-  SquareScene square;
-  EXPECT_EQ(prepare_scene(*scene.model, scene.sweep.t_begin, scene.sweep.assembly, &square), SolveStatus::kSuccess);
-  const Model& m = square.model(*scene.model);
-  Workspace ws(m);
-  ws.q = square.start;
-  const CsvFormat format(m, scene.sweep);
-  std::string csv = format.header();
-  EXPECT_EQ(run_sweep(
-                m, scene.sweep, ws, [&](const StepView& v) { return format.append_row(v, csv), true; }, nullptr),
-            SolveStatus::kSuccess);
+  std::string csv;
+  AsmtCompareSweep(scene, [&](const Model& m, Workspace& ws) {
+    const CsvFormat format(m, scene.sweep);
+    csv = format.header();
+    EXPECT_EQ(run_sweep(
+                  m, scene.sweep, ws, [&](const StepView& v) { return format.append_row(v, csv), true; }, nullptr),
+              SolveStatus::kSuccess);
+  });
   return parse_csv_table(csv, "result.csv");
 }
 

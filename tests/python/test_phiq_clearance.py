@@ -1,5 +1,5 @@
 """phiq.clearance (engine/python/src/bind_clearance.cpp): two balls on moving points against their closed forms, the
-arrays equal to the values `phiq clearance` writes (CSV and --summary JSON, numbers that read back to the same
+arrays (each minimum's sensitivities too) equal to the values `phiq clearance` writes (CSV and --summary JSON, numbers that read back to the same
 doubles), and a threshold below zero refused as ValueError."""
 import json
 import math
@@ -41,6 +41,11 @@ def test_two_balls_are_their_centres_distance_less_the_radii():
     assert np.allclose(r["point_b"][0], [0, -0.35, 0], atol=1e-9)
     assert abs(r["point_a"][0][0]) < 1e-6 and np.allclose(r["normal"][0], [0, -1, 0], atol=1e-9)
     assert r["parameters"] == ["L2"] and abs(r["sensitivities"][0, 0] + 0.5) < 1e-7
+    # every minimum's own: at t = 0 (the first row; d rises) d = sqrt(r^2 + 0.25) - 0.2 with r = L2/2 + 0.2 = 0.4,
+    # d d/d L2 = r / (2 sqrt(0.41)); then the worst's
+    assert r["minima"][0].shape == (2, 2) and r["minima_sensitivities"][0].shape == (2, 1)
+    assert r["minima"][0][0, 0] == 0.0 and abs(r["minima_sensitivities"][0][0, 0] - 0.2 / math.sqrt(0.41)) < 1e-9
+    assert r["minima_sensitivities"][0][1, 0] == r["sensitivities"][0, 0]
     h = 2 * math.pi / 90
     (entry, exit_), = r["interference"][0]
     assert abs(entry - (math.pi + math.asin(0.925))) < 1e-9 * h

@@ -8,6 +8,7 @@
 
 #include "glb.hpp"
 #include "gltf_nodes.hpp"
+#include "html_clearance.hpp"
 #include "part_drawing.hpp"
 #include "phiq/drawn_parts.hpp"
 #include "motion_columns.hpp"
@@ -39,13 +40,16 @@ Quat x_to(const Vec3& d) {
 
 using gltf::Track;
 
-enum Material { kBody, kLink, kJoint, kFixedJoint };
+enum Material { kBody, kLink, kJoint, kFixedJoint, kWitness };
 
-// A shape of the sketch: a mesh of one primitive in one of its four materials.
+// A shape of the sketch: a mesh of one primitive in one of its five materials.
 gltf::Mesh sketch_mesh(std::string name, Material material) {
-  static const char* const names[4] = {"body", "link", "joint", "fixed joint"};
-  static const std::array<double, 4> colours[4] = {
-      {0.27, 0.45, 0.70, 1.0}, {0.90, 0.50, 0.10, 1.0}, {0.25, 0.25, 0.25, 1.0}, {0.05, 0.05, 0.05, 1.0}};
+  static const char* const names[5] = {"body", "link", "joint", "fixed joint", "clearance witness"};
+  static const std::array<double, 4> colours[5] = {{0.27, 0.45, 0.70, 1.0},
+                                                   {0.90, 0.50, 0.10, 1.0},
+                                                   {0.25, 0.25, 0.25, 1.0},
+                                                   {0.05, 0.05, 0.05, 1.0},
+                                                   {0.85, 0.10, 0.10, 1.0}};
   return {name, {{"", names[material], colours[material], {}, {}, {}}}};
 }
 
@@ -259,6 +263,76 @@ class SketchTracks {
   std::vector<Quat> last_;
 };
 
+// The clearance's witness points (motion_glb() in gltf_motion.hpp says what they show): two tracks per pair.
+class WitnessTracks {
+ public:
+  WitnessTracks(const Scene& scene, const ClearanceReport* report, gltf::Nodes& nodes)
+      : scene_(scene), report_(report), nodes_(nodes), first_(nodes.tracks.size()) {
+    if (!report) return;
+    for (const PairClearance& p : report->pairs) {
+      const std::string a = scene.parts[static_cast<std::size_t>(p.a)].name;
+      const std::string b = scene.parts[static_cast<std::size_t>(p.b)].name;
+      const std::string near = viewer_near_rows(*report, p);
+      nlohmann::json interference = nlohmann::json::array();
+      for (const InterferenceInterval& i : p.interference) interference.push_back({i.entry, i.exit});
+      for (int side = 0; side < 2; ++side) {
+        const std::string& part = side ? b : a;
+        witnesses_.push_back({side ? p.b : p.a, side ? p.worst.local_b : p.worst.local_a, near});
+        gltf::Track tr{"clearance " + a + " / " + b + ": witness on " + part, -1, {}, {}, {}};
+        tr.extras["clearance"] = {{"pair", {a, b}},
+                                  {"part", part},
+                                  {"worst_t", p.worst.t},
+                                  {"distance", p.worst.at.distance},
+                                  {"threshold", report->threshold},
+                                  {"near", near},
+                                  {"interference", interference}};
+        nodes.tracks.push_back(std::move(tr));
+      }
+    }
+  }
+
+  // Every ball's keyframe at (q, t).
+  void row(const double* q, double t) {
+    if (witnesses_.empty()) return;
+    const std::vector<double>& times = report_->times;
+    auto above = static_cast<std::size_t>(std::upper_bound(times.begin(), times.end(), t) - times.begin());
+    std::size_t r = above == 0 ? 0 : above - 1;  // the report's row nearest t
+    if (r + 1 < times.size() && times[r + 1] - t < t - times[r]) ++r;
+    for (std::size_t k = 0; k < witnesses_.size(); ++k) {
+      const Witness& w = witnesses_[k];
+      const kin3::V3 x = part_pose(scene_.parts[static_cast<std::size_t>(w.part)].frame, q, t).apply(w.local);
+      gltf::Track& tr = nodes_.tracks[first_ + k];
+      const double scale = r < w.near.size() && w.near[r] == '1' ? 2.0 : 1.0;
+      push(tr.t, {x.x, x.y, x.z});
+      push(tr.s, {scale, scale, scale});
+    }
+  }
+
+  // The balls' mesh (one, of radius r), made when there is a ball; no scale channel where none grows.
+  void finish(double r) {
+    if (witnesses_.empty()) return;
+    const int mesh = static_cast<int>(nodes_.meshes.size());
+    nodes_.meshes.push_back(sphere("clearance witness", kWitness, r));
+    for (std::size_t k = 0; k < witnesses_.size(); ++k) {
+      gltf::Track& tr = nodes_.tracks[first_ + k];
+      tr.mesh = mesh;
+      if (std::all_of(tr.s.begin(), tr.s.end(), [](float v) { return v == 1.0f; })) tr.s.clear();
+    }
+  }
+
+ private:
+  struct Witness {
+    Index part;
+    kin3::V3 local;    // in the part's frame
+    std::string near;  // viewer_near_rows()
+  };
+  const Scene& scene_;
+  const ClearanceReport* report_;
+  gltf::Nodes& nodes_;
+  std::size_t first_;
+  std::vector<Witness> witnesses_;
+};
+
 }  // namespace
 
 std::vector<Slot> glb_reads(const Scene& scene, const MechanismSketch& sketch, const std::vector<Part>& parts) {
@@ -275,7 +349,8 @@ std::vector<Slot> glb_reads(const Scene& scene, const MechanismSketch& sketch, c
   return read;
 }
 
-std::string motion_glb(const Scene& scene, const CsvTable& table, const std::string& result) {
+std::string motion_glb(const Scene& scene, const CsvTable& table, const std::string& result,
+                       const ClearanceReport* clearance) {
   const Model& model = *scene.model;
   const MechanismSketch sketch = sketch_mechanism(model);
   const std::vector<Part> parts = drawn_parts(scene);
@@ -284,6 +359,7 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
   gltf::Nodes nodes;
   SketchTracks drawn(scene, sketch, parts, nodes);
   gltf::PartTracks part_tracks(parts, nodes);
+  WitnessTracks witnesses(scene, clearance, nodes);
   if (nodes.tracks.empty()) throw Error(scene.path + ": nothing to animate (no moving body, part, link or joint)");
 
   std::vector<float> times;
@@ -297,9 +373,11 @@ std::string motion_glb(const Scene& scene, const CsvTable& table, const std::str
     times.push_back(static_cast<float>(t));
     drawn.row(q.data(), row == 0, at_row);
     part_tracks.row(q.data(), t);
+    witnesses.row(q.data(), t);
   }
   drawn.finish(0.04 * model.length_scale());
   part_tracks.finish();
+  witnesses.finish(0.02 * model.length_scale());
   return gltf::write_glb(title, std::string("phiq ") + kVersion, nodes, times, scene.dimension == 3, result);
 }
 

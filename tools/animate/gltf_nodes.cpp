@@ -99,6 +99,7 @@ std::string write_glb(const std::string& title, const std::string& generator, No
     node["translation"] = {tr.t[0], tr.t[1], tr.t[2]};
     if (!tr.r.empty()) node["rotation"] = {tr.r[0], tr.r[1], tr.r[2], tr.r[3]};
     if (!tr.s.empty()) node["scale"] = {tr.s[0], tr.s[1], tr.s[2]};
+    if (!tr.extras.is_null()) node["extras"] = tr.extras;
     doc["nodes"].push_back(node);
     top.push_back(k);
     if (!moves || tr.still) continue;

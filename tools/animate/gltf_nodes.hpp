@@ -3,6 +3,8 @@
 // (gltf_motion.cpp) and from the parts (PartTracks), and the writer of the document and its buffer.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <array>
 #include <cstdint>
 #include <string>
@@ -30,7 +32,8 @@ struct Track {
   std::string name;
   int mesh = -1;
   std::vector<float> t, r, s;
-  bool still = false;  // no animation channel: it does not move
+  bool still = false;               // no animation channel: it does not move
+  nlohmann::json extras = nullptr;  // the node's extras (null: none)
 };
 
 struct Nodes {

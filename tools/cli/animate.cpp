@@ -134,14 +134,14 @@ int cmd_animate(const AnimateOptions& o) {
       const DrawnOutputs add{coordinates_of(html ? drawing_reads(sketch, parts) : glb_reads(scene, sketch, parts)),
                              html};
       const CsvTable table = sweep_scene(scene, add);
-      const std::optional<ClearanceReport> clearance = html ? animated_clearance(scene) : std::nullopt;
+      const std::optional<ClearanceReport> clearance = animated_clearance(scene);
       text = html ? motion_html(scene, table, kSwept, o.columns, clearance ? &*clearance : nullptr, {}, o.forces)
-                  : motion_glb(scene, table, kSwept);
+                  : motion_glb(scene, table, kSwept, clearance ? &*clearance : nullptr);
     } else {
       const CsvTable table = read_scene_result(scene, o.result);
-      const std::optional<ClearanceReport> clearance = html ? animated_clearance(scene) : std::nullopt;
+      const std::optional<ClearanceReport> clearance = animated_clearance(scene);
       text = html ? motion_html(scene, table, o.result, o.columns, clearance ? &*clearance : nullptr, {}, o.forces)
-                  : motion_glb(scene, table, o.result);
+                  : motion_glb(scene, table, o.result, clearance ? &*clearance : nullptr);
     }
   } catch (const MissingCoordinate& e) {
     std::string again = "phiq animate " + o.scene + " -o " + o.out;

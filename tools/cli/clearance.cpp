@@ -39,6 +39,14 @@ std::string clearance_summary(const Scene& scene, const ClearanceReport& r) {
     for (std::size_t j = 0; j < w.sensitivities.size(); ++j)
       s << ", d/d" << r.parameters[j] << " = " << shortest(w.sensitivities[j]);
     s << "\n";
+    if (p.minima.size() > 1 && !w.sensitivities.empty())  // the other minima, each with its own sensitivities
+      for (const ClearanceMinimum& m : p.minima) {
+        if (m.t == w.t && m.at.distance == w.at.distance) continue;
+        s << "    minimum " << shortest(m.at.distance) << " m at t = " << format_time(m.t);
+        for (std::size_t j = 0; j < m.sensitivities.size(); ++j)
+          s << ", d/d" << r.parameters[j] << " = " << shortest(m.sensitivities[j]);
+        s << "\n";
+      }
     for (const InterferenceInterval& i : p.interference)
       s << "    interferes from t = " << format_time(i.entry) << " to " << format_time(i.exit) << "\n";
     if (p.unproven_intervals > 0)

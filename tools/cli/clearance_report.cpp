@@ -19,11 +19,10 @@ nlohmann::ordered_json clearance_sensitivities_json(const ClearanceReport& r, co
   return sensitivities;
 }
 
-// Each of the pair's local minima (HDF5 /minima's t, distance, refined, in its order) with its witness points; the
-// sensitivities are solved at the worst only (clearance_along), so only the worst's entry carries them.
+// Each of the pair's local minima (HDF5 /minima's t, distance, refined, in its order) with its witness points and,
+// where the scene asks for sensitivities, its own ∂d/∂p.
 nlohmann::ordered_json clearance_minima_json(const ClearanceReport& r, const PairClearance& p) {
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
-  bool worst_seen = false;
   for (const ClearanceMinimum& m : p.minima) {
     nlohmann::ordered_json j = {{"t", m.t},
                                 {"distance", m.at.distance},
@@ -31,11 +30,7 @@ nlohmann::ordered_json clearance_minima_json(const ClearanceReport& r, const Pai
                                 {"point_a", clearance_point_json(m.at.point_a)},
                                 {"point_b", clearance_point_json(m.at.point_b)},
                                 {"normal", clearance_point_json(m.at.normal)}};
-    // the worst is a copy of the first minimum of least distance
-    if (!worst_seen && m.t == p.worst.t && m.at.distance == p.worst.at.distance && !p.worst.sensitivities.empty()) {
-      worst_seen = true;
-      j["sensitivities"] = clearance_sensitivities_json(r, p.worst);
-    }
+    if (!m.sensitivities.empty()) j["sensitivities"] = clearance_sensitivities_json(r, m);
     list.push_back(std::move(j));
   }
   return list;

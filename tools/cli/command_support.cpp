@@ -1,7 +1,10 @@
 // The helpers every phiq command shares (command_support.hpp).
 #include "command_support.hpp"
 
+#include <array>
 #include <cmath>
+#include <cstdlib>
+#include <optional>
 
 #include <unistd.h>
 
@@ -120,14 +123,16 @@ std::optional<std::string> import_or_report(const std::string& path, const Impor
   try {
     std::string yaml;
     std::vector<std::string> skipped;
+    std::string gravity;  // a robot description's, stated with --forces (an .asmt scene's comment states its own)
     if (model_format(path) == ModelFormat::kAsmt) {
       AsmtImport imported = import_asmt_file(path, options);
       yaml = std::move(imported.yaml), skipped = std::move(imported.skipped);
     } else {
       ModelImport imported = import_model_file(path, options);
-      yaml = std::move(imported.yaml), skipped = std::move(imported.skipped);
+      yaml = std::move(imported.yaml), skipped = std::move(imported.skipped), gravity = std::move(imported.gravity);
     }
     for (const std::string& why : skipped) std::fprintf(stderr, "phiq: not mapped: %s\n", printable(why).c_str());
+    if (options.forces && !gravity.empty()) std::fprintf(stderr, "phiq: gravity %s\n", printable(gravity).c_str());
     return yaml;
   } catch (const SceneError& e) {
     fail(e.what(), 2);
@@ -136,7 +141,7 @@ std::optional<std::string> import_or_report(const std::string& path, const Impor
 }
 
 void add_import_options(CLI::App* command, std::vector<std::string>* drives, std::vector<double>* time,
-                        ImportOptions* outputs) {
+                        std::string* gravity, ImportOptions* outputs) {
   command->add_option(
       "--drive", *drives,
       "JOINT=EXPR (URDF, MJCF, SDF; repeatable): drive the joint's angle (rad, 0 at the file's pose) or "
@@ -148,11 +153,34 @@ void add_import_options(CLI::App* command, std::vector<std::string>* drives, std
                     "(.asmt, URDF, MJCF, SDF) write velocities and accelerations, as a scene's `output` asks");
   command->add_flag("--forces", outputs->forces,
                     "(.asmt, URDF, MJCF, SDF) write every driver's effort and every joint's reaction");
+  command->add_option("--gravity", *gravity,
+                      "X,Y,Z (.asmt, URDF, MJCF, SDF): the gravity of the efforts and reactions instead of the "
+                      "file's or the format's default (m/s²; an .asmt file's length unit per s²; 0,0,0: none)");
 }
+
+namespace {
+
+// "X,Y,Z" as three finite numbers; nothing when it is not.
+std::optional<std::array<double, 3>> gravity_components(const std::string& text) {
+  std::array<double, 3> g{};
+  std::size_t from = 0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::size_t comma = k < 2 ? text.find(',', from) : text.size();
+    if (comma == std::string::npos) return std::nullopt;
+    const std::string part = text.substr(from, comma - from);
+    char* end = nullptr;
+    g[k] = std::strtod(part.c_str(), &end);
+    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(g[k])) return std::nullopt;
+    from = comma + 1;
+  }
+  return g;
+}
+
+}  // namespace
 
 std::optional<std::string> import_options(const std::string& command, const std::string& path,
                                           const std::vector<std::string>& drives, const std::vector<double>& time,
-                                          ImportOptions* options) {
+                                          const std::string& gravity, ImportOptions* options) {
   for (const std::string& d : drives) {
     const std::size_t eq = d.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == d.size())
@@ -166,6 +194,13 @@ std::optional<std::string> import_options(const std::string& command, const std:
     options->t_start = time[0], options->t_end = time[1], options->steps = static_cast<int>(steps);
   }
   const ModelFormat format = path == "-" ? ModelFormat::kScene : model_format(path);
+  if (!gravity.empty()) {
+    if (format == ModelFormat::kScene)
+      return command + ": --gravity is for .asmt, URDF, MJCF and SDF files: a scene's `loads.gravity` says it";
+    options->gravity = gravity_components(gravity);
+    if (!options->gravity)
+      return command + ": --gravity " + gravity + ": not X,Y,Z (three finite numbers, m/s²; 0,0,0: none)";
+  }
   if ((options->rates || options->forces) && format == ModelFormat::kScene)
     return command + ": " + (options->rates ? "--rates" : "--forces") +
            " is for .asmt, URDF, MJCF and SDF files: a scene's `output` says what it writes";

@@ -54,18 +54,18 @@ void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args);
 // and nothing.
 std::optional<std::string> import_or_report(const std::string& path, const ImportOptions& options = {});
 
-// `--drive JOINT=EXPR` (repeatable) and `--time START END STEPS` on `command` (convert, run), into `drives`, `time`;
-// `--rates` and `--forces` into `outputs`' ImportOptions::rates and ::forces.
+// `--drive JOINT=EXPR` (repeatable), `--time START END STEPS` and `--gravity X,Y,Z` on `command` (convert, run),
+// into `drives`, `time`, `gravity`; `--rates` and `--forces` into `outputs`' ImportOptions::rates and ::forces.
 void add_import_options(CLI::App* command, std::vector<std::string>* drives, std::vector<double>* time,
-                        ImportOptions* outputs);
+                        std::string* gravity, ImportOptions* outputs);
 
 // The ImportOptions those options give for the model at `path` (`options` holds the flags' rates and forces); or,
 // for a drive that is not JOINT=EXPR, a STEPS that is no whole number from 0 to 1e9, either option on a file that is
-// not URDF, MJCF or SDF, or `--rates` or `--forces` on a scene, the one-line error "COMMAND: --drive ...: why"
-// (exit 2).
+// not URDF, MJCF or SDF, a gravity that is not three finite numbers X,Y,Z, or `--rates`, `--forces` or
+// `--gravity` on a scene, the one-line error "COMMAND: --drive ...: why" (exit 2).
 std::optional<std::string> import_options(const std::string& command, const std::string& path,
                                           const std::vector<std::string>& drives, const std::vector<double>& time,
-                                          ImportOptions* options);
+                                          const std::string& gravity, ImportOptions* options);
 
 std::optional<Scene> load_or_report(const std::string& path, const std::vector<std::string>& sets = {},
                                     const std::vector<std::string>& sensitivity_args = {},

@@ -17,6 +17,7 @@ Command register_convert(CLI::App& app) {
     std::string model, out;
     std::vector<std::string> drives;
     std::vector<double> time;
+    std::string gravity;    // --gravity X,Y,Z
     ImportOptions outputs;  // --rates, --forces
   };
   auto a = std::make_shared<Args>();
@@ -27,13 +28,13 @@ Command register_convert(CLI::App& app) {
   convert->add_option("-o,--output", a->out, "Scene file to write ('-': standard output)")
       ->required()
       ->transform(output_path("", false));
-  add_import_options(convert, &a->drives, &a->time, &a->outputs);
+  add_import_options(convert, &a->drives, &a->time, &a->gravity, &a->outputs);
   return {convert, [a] {
             const ModelFormat format = model_format(a->model);
             if (format == ModelFormat::kScene)
               return fail("convert: " + a->model + ": not an .asmt, .urdf, .xml, .mjcf or .sdf file", 2);
             ImportOptions options = a->outputs;
-            if (const auto bad = import_options("convert", a->model, a->drives, a->time, &options))
+            if (const auto bad = import_options("convert", a->model, a->drives, a->time, a->gravity, &options))
               return fail(*bad, 2);
             const std::optional<std::string> imported = import_or_report(a->model, options);
             if (!imported) return 2;

@@ -386,6 +386,7 @@ Command register_run(CLI::App& app) {
     int mode = 0;
     std::vector<std::string> drives;  // of a URDF, MJCF or SDF file, as `phiq convert` adds them
     std::vector<double> time;
+    std::string gravity;          // --gravity X,Y,Z
     phiq::ImportOptions outputs;  // --rates, --forces
   };
   auto a = std::make_shared<Args>();
@@ -431,13 +432,14 @@ Command register_run(CLI::App& app) {
                   "Start from real assembly mode K as `phiq modes` numbers them (0: the rough placement)")
       ->capture_default_str()
       ->check(whole_number(0, 1000000, "the rough placement"));
-  add_import_options(run, &a->drives, &a->time, &a->outputs);
+  add_import_options(run, &a->drives, &a->time, &a->gravity, &a->outputs);
   return {
       run, [a] {
         using Mode = ProgressBar::Mode;
         const Mode mode = a->progress == "always" ? Mode::kAlways : a->progress == "never" ? Mode::kNever : Mode::kAuto;
         phiq::ImportOptions drives = a->outputs;
-        if (const auto bad = import_options("run", a->scene_path, a->drives, a->time, &drives)) return fail(*bad, 2);
+        if (const auto bad = import_options("run", a->scene_path, a->drives, a->time, a->gravity, &drives))
+          return fail(*bad, 2);
         return with_stdout_checked(cmd_run(a->scene_path, a->out_path, a->format, a->deflate, a->quiet, a->summary_path,
                                            cap_threads("run", a->threads, a->quiet), a->memory_gb, mode,
                                            a->names == "identifiers", a->sets, a->sensitivities, a->mode, drives));

@@ -24,13 +24,13 @@ _phiq() {
   local opts=""
   case "$cmd" in
     run) opts="--help --output --format --deflate --quiet --summary --threads --memory --progress --names --set
-               --sensitivity --mode --drive --time --rates --forces" ;;
+               --sensitivity --mode --drive --time --rates --forces --gravity" ;;
     check) opts="--help --json --time --set" ;;
     assemble) opts="--help --output --quiet --set" ;;
     batch) opts="--help --output --quiet --threads --summary --names --resume --sensitivity" ;;
     compare) opts="--help --rtol --atol --columns --json --junit" ;;
     generate) opts="--help --output --steps --from --to --coords --twist --outputs" ;;
-    convert) opts="--help --output --drive --time --rates --forces" ;;
+    convert) opts="--help --output --drive --time --rates --forces --gravity" ;;
     plot) opts="--help --output --columns --positions --set" ;;
     animate) opts="--help --output --columns --modes --forces --set" ;;
     sweep-accuracy) opts="--help --output --json --tolerances --steps-list --predictors --newton --linear-solvers

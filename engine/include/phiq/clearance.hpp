@@ -3,7 +3,7 @@
 /// (the penetration depth, negative, where their shapes overlap), with the witness points; each local minimum of a
 /// pair's distance refined on the continuous motion to its time and distance; every interval of interference with
 /// its entry and exit times; a bound from the parts' speeds that proves nothing closer happens between the rows
-/// that were not refined; and the sensitivity of each pair's worst clearance to the scene's parameters.
+/// that were not refined; and the sensitivity of each minimum clearance to the scene's parameters.
 ///
 /// Distances come from FCL 0.7 (with libccd): primitives as FCL's primitives, polygons, meshes, curves and planes
 /// as BVH meshes of their triangles (shape_triangles()). The depth of an overlap is exact for the pairs FCL has a
@@ -84,7 +84,9 @@ struct ClearanceMinimum {
   double t = 0.0;        ///< s
   PairDistance at;       ///< the distance and witness points there
   bool refined = false;  ///< found between the rows (the derivative of the distance zero), not only on a row
-  /// ∂d/∂p for each of the sweep's sensitivities, in their order (the worst minimum of each pair only).
+  kin3::V3 local_a;      ///< at.point_a in part A's frame (the material point of A that is the witness there)
+  kin3::V3 local_b;      ///< at.point_b in part B's frame
+  /// ∂d/∂p for each of the sweep's sensitivities, in their order (every minimum of a reported pair).
   std::vector<double> sensitivities;
 };
 
@@ -135,7 +137,7 @@ ClearanceRows sweep_rows(const Model& model, SweepOptions options, Workspace& ws
 /// How clearance_along() solves positions between rows and what it differentiates.
 struct ClearanceOptions {
   SolverSettings solver;                         ///< for the positions between rows (a Stepper)
-  std::vector<OutputSensitivity> sensitivities;  ///< parameters of the worst clearances' sensitivities
+  std::vector<OutputSensitivity> sensitivities;  ///< parameters of the minima's sensitivities
   double time_tolerance = 1e-9;                  ///< refined times to this fraction of the step
   int max_subdivision_depth = 6;                 ///< halvings of an interval the speed bound cannot prove
 };

@@ -15,7 +15,7 @@ namespace phiq {
 
 /// Clearance HDF5 format version: the root attribute `format_version` of a file whose `format` is
 /// "phiq clearance" (tools/README.md).
-inline constexpr int kClearanceHdf5Format = 2;
+inline constexpr int kClearanceHdf5Format = 3;  // 3: /minima holds each minimum's sensitivities
 
 /// `phiq clearance --summary` JSON format version (the `format` field; tools/README.md).
 inline constexpr int kClearanceSummaryFormat = 1;

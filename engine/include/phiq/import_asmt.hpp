@@ -28,7 +28,8 @@ struct AsmtImport {
 /// Converts the text of an `.asmt` file; `path` names it in messages. Throws SceneError, one line "PATH:LINE: what"
 /// for a file that is truncated, malformed, or holds an element phiq cannot represent exactly (a joint type with
 /// no phiq kind, a marker of an unknown part, ...): never an approximation. Of `options`, only
-/// `rates` and `forces` apply (an `.asmt` file has its motions and time grid).
+/// `rates`, `forces` and `gravity` (in the file's length unit per s²) apply (an `.asmt` file has its motions and
+/// time grid).
 AsmtImport import_asmt(const std::string& text, const std::string& path, const ImportOptions& options = {});
 
 /// import_asmt() of the file at `path`, read as load_scene() reads a scene (its size limit; FIFOs, directories and

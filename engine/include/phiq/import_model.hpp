@@ -9,6 +9,8 @@
 /// from ImportOptions (`--drive` on the command line), or are added to the converted scene by hand.
 #pragma once
 
+#include <array>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -44,6 +46,11 @@ struct ImportOptions {
   /// Every format (`--forces`): the scene's output has `efforts: all` when it has drivers and `reactions: all` when
   /// it has joints with a reaction; a model none of whose parts has mass is refused (every force would be zero).
   bool forces = false;
+  /// Every format (`--gravity X,Y,Z`): the gravity written as the scene's `loads.gravity`, in the scene's length
+  /// unit per s² (m/s²; an `.asmt` file's own unit), instead of the file's (MJCF `<option gravity>`, the SDF
+  /// world's `<gravity>`, `.asmt` ConstantGravity) or the default (URDF states none: 0 0 −9.81; MJCF: MuJoCo's
+  /// 0 0 −9.81; SDF: the SDFormat world's 0 0 −9.8). {0, 0, 0} turns gravity off.
+  std::optional<std::array<double, 3>> gravity;
 };
 
 /// What an import made of a file.
@@ -54,6 +61,9 @@ struct ModelImport {
   int joints = 0;                    ///< joints, loop closures included
   int loops = 0;                     ///< joints that close a loop (URDF closing joints, MJCF connect and weld)
   int couplers = 0;                  ///< couplers between joints (URDF mimic, MJCF joint equality)
+  /// The gravity the scene's `loads.gravity` holds and where it came from ("[0, 0, -9.81] m/s²: ..."), also a
+  /// comment of `yaml`.
+  std::string gravity;
 };
 
 /// Converts the text of a URDF file; `path` names it in messages and is the folder meshes are relative to. A mesh

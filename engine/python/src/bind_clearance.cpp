@@ -19,7 +19,7 @@ py::dict clearance_dict(const Scene& scene, const ClearanceReport& r, const Swee
   Eigen::VectorXd worst_t(k), worst_distance(k);
   std::vector<bool> refined;
   std::vector<Index> unproven;
-  py::list pairs, interference, minima;
+  py::list pairs, interference, minima, minima_sensitivities;
   for (Eigen::Index i = 0; i < k; ++i) {
     const PairClearance& p = r.pairs[static_cast<std::size_t>(i)];
     for (Eigen::Index row = 0; row < rows; ++row) distance(row, i) = p.row_distance[static_cast<std::size_t>(row)];
@@ -40,10 +40,17 @@ py::dict clearance_dict(const Scene& scene, const ClearanceReport& r, const Swee
     for (Eigen::Index m = 0; m < in.rows(); ++m)
       in.row(m) << p.interference[static_cast<std::size_t>(m)].entry, p.interference[static_cast<std::size_t>(m)].exit;
     interference.append(in);
-    Eigen::MatrixXd mins(static_cast<Eigen::Index>(p.minima.size()), 2);
-    for (Eigen::Index m = 0; m < mins.rows(); ++m)
-      mins.row(m) << p.minima[static_cast<std::size_t>(m)].t, p.minima[static_cast<std::size_t>(m)].at.distance;
+    Eigen::MatrixXd mins(static_cast<Eigen::Index>(p.minima.size()), 2), mins_d(mins.rows(), np);
+    for (Eigen::Index m = 0; m < mins.rows(); ++m) {
+      const ClearanceMinimum& at = p.minima[static_cast<std::size_t>(m)];
+      mins.row(m) << at.t, at.at.distance;
+      for (Eigen::Index j = 0; j < np; ++j)
+        mins_d(m, j) = static_cast<std::size_t>(j) < at.sensitivities.size()
+                           ? at.sensitivities[static_cast<std::size_t>(j)]
+                           : std::numeric_limits<double>::quiet_NaN();
+    }
     minima.append(mins);
+    minima_sensitivities.append(mins_d);
   }
   py::dict d;
   const Eigen::VectorXd t = Eigen::Map<const Eigen::VectorXd>(r.times.data(), rows);  // a copy the array owns
@@ -61,6 +68,7 @@ py::dict clearance_dict(const Scene& scene, const ClearanceReport& r, const Swee
   d["sensitivities"] = sensitivities;
   d["interference"] = interference;
   d["minima"] = minima;
+  d["minima_sensitivities"] = minima_sensitivities;
   d["unproven_intervals"] = py::array_t<Index>(py::cast(unproven));
   d["threshold"] = r.threshold;
   d["interferes"] = r.interferes();
@@ -108,7 +116,8 @@ void bind_clearance(py::module_& m) {
       "'columns' ('A.B'), 'distance' (rows x pairs, m, negative: overlap depth); per pair its worst pose "
       "'worst_t', 'worst_distance', 'point_a', 'point_b', 'normal' (pairs x 3, world axes), 'refined', "
       "'sensitivities' (pairs x 'parameters': d distance / d parameter, of output.sensitivities), 'interference' "
-      "(a (entry, exit) array per pair), 'minima' (a (t, distance) array per pair), 'unproven_intervals'; and "
+      "(a (entry, exit) array per pair), 'minima' (a (t, distance) array per pair), 'minima_sensitivities' (a "
+      "minima x 'parameters' array per pair: each minimum's own), 'unproven_intervals'; and "
       "'threshold', 'interferes', 'bound_held', 'pairs_selected', 'pairs_measured', 'positions_solved', 'summary' "
       "(the sweep's SweepSummary: a failed sweep's report holds the rows before the failure). threshold: instead "
       "of the scene's (m, 0 or more, else ValueError).");

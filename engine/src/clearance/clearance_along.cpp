@@ -203,7 +203,15 @@ class PairPass {
   ClearanceMinimum minimum_of(const Sample& s, bool refined) {
     ClearanceMinimum m;
     m.t = s.t, m.at = s.d, m.refined = refined;
+    m.local_a = in_frame(s.a.motion.pose, s.d.point_a), m.local_b = in_frame(s.b.motion.pose, s.d.point_b);
     return m;
+  }
+  // The world point x in the frame of `pose` (Rᵀ (x − at)).
+  static kin3::V3 in_frame(const Pose& pose, kin3::V3 x) {
+    const auto& r = pose.rotation;
+    const kin3::V3 d = x - pose.at;
+    return {r[0] * d.x + r[3] * d.y + r[6] * d.z, r[1] * d.x + r[4] * d.y + r[7] * d.z,
+            r[2] * d.x + r[5] * d.y + r[8] * d.z};
   }
 
   // The local minimum at row k, refined where the distance's rate changes sign on one of the steps beside it.
@@ -280,7 +288,8 @@ class PairPass {
   std::vector<ClearanceMinimum> minima_;
 };
 
-// ∂d/∂p of each sensitivity at the minimum m: n · (∂x_B/∂p − ∂x_A/∂p), each point carried by its part's frame.
+// ∂d/∂p of each sensitivity at the minimum m (each of a pair's): n · (∂x_B/∂p − ∂x_A/∂p), each point carried by its
+// part's frame.
 std::vector<double> minimum_sensitivities(const Model& model, const std::vector<Part>& parts, Index a, Index b,
                                           const ClearanceMinimum& m, const Eigen::VectorXd& q,
                                           const ClearanceOptions& options) {
@@ -398,8 +407,12 @@ ClearanceReport clearance_along(const Model& model, const std::vector<Part>& par
     PairClearance& pc = *measured;
     // `all` reports the pairs that come within the threshold (or could not be proven not to)
     if (plan.all && pc.worst.at.distance > plan.threshold && pc.unproven_intervals == 0) continue;
-    if (!options.sensitivities.empty())
-      pc.worst.sensitivities = minimum_sensitivities(model, parts, a, b, pc.worst, tracer.solve(pc.worst.t), options);
+    if (!options.sensitivities.empty()) {
+      for (ClearanceMinimum& m : pc.minima)
+        m.sensitivities = minimum_sensitivities(model, parts, a, b, m, tracer.solve(m.t), options);
+      for (const ClearanceMinimum& m : pc.minima)  // the worst is a copy of one of them
+        if (m.t == pc.worst.t && m.at.distance == pc.worst.at.distance) pc.worst.sensitivities = m.sensitivities;
+    }
     report.pairs.push_back(std::move(pc));
   }
   report.positions_solved = tracer.solved();

@@ -144,9 +144,14 @@ void write_clearance_contents(hid_t file, const ClearanceReport& r, const std::v
       values.push_back(clearance_stored(m.t));
       values.push_back(clearance_stored(m.at.distance));
       values.push_back(m.refined ? 1.0 : 0.0);
+      for (std::size_t j = 0; j < r.parameters.size(); ++j)
+        values.push_back(j < m.sensitivities.size() ? clearance_stored(m.sensitivities[j]) : std::nan(""));
       ++minima;
     }
-  clearance_dataset(file, "minima", minima, {"pair", "t", "distance", "refined"}, {"", "s", "m", ""}, values);
+  std::vector<std::string> minima_columns{"pair", "t", "distance", "refined"}, minima_units{"", "s", "m", ""};
+  minima_columns.insert(minima_columns.end(), columns.begin(), columns.end());
+  minima_units.insert(minima_units.end(), units.begin(), units.end());
+  clearance_dataset(file, "minima", minima, minima_columns, minima_units, values);
 }
 
 }  // namespace

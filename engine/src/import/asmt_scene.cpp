@@ -505,9 +505,17 @@ std::string SceneWriter::write() {
   const auto line_of = [&](const std::string& why) { return std::atoi(why.c_str() + a_.path.size() + 1); };
   std::stable_sort(a_.skipped.begin(), a_.skipped.end(),
                    [&](const std::string& x, const std::string& y) { return line_of(x) < line_of(y); });
+  const Eigen::Vector3d gravity =
+      o_.gravity ? Eigen::Vector3d((*o_.gravity)[0], (*o_.gravity)[1], (*o_.gravity)[2]) : a_.gravity;
+  if (!gravity.allFinite()) refuse(a_.path, 0, "--gravity: the components must be finite numbers");
   std::ostringstream s;
   s << "# Converted by phiq from " << single_line(a_.path) << " (FreeCAD Assembly / OndselSolver .asmt): lengths in\n"
-    << "# the file's unit (FreeCAD writes millimetres), angles in radians, time in seconds.\n";
+    << "# the file's unit (FreeCAD writes millimetres), angles in radians, time in seconds.\n"
+    << "# Gravity " << scene_vector(gravity) << " (length unit)/s²: "
+    << (o_.gravity               ? "--gravity"
+        : a_.gravity.isZero(0.0) ? "none (the file's ConstantGravity is zero or absent)"
+                                 : "the file's ConstantGravity")
+    << "\n";
   if (!a_.skipped.empty()) s << "# Not mapped:\n";
   for (const std::string& why : a_.skipped) s << "#   " << single_line(why) << "\n";
   s << "phiq: 1\nname: " << yaml_quoted(a_.name) << "\n"
@@ -519,7 +527,7 @@ std::string SceneWriter::write() {
   if (!constraints_.str().empty()) s << "constraints:\n" << constraints_.str();
   if (!drivers_.str().empty()) s << "drivers:\n" << drivers_.str();
   s << grid << mass;
-  if (!a_.gravity.isZero(0.0)) s << "loads: {gravity: " << scene_vector(a_.gravity) << "}\n";
+  if (!gravity.isZero(0.0)) s << "loads: {gravity: " << scene_vector(gravity) << "}\n";
   bool reactions = false;
   for (const ForceSite& f : a_.force_sites)
     reactions = reactions || (f.why_not.empty() && f.type.find("Joint") != std::string::npos);

@@ -8,6 +8,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "phiq/import_model.hpp"
@@ -79,6 +80,10 @@ struct Mechanism {
   std::vector<Joint> joints;
   std::vector<Coupler> couplers;
   std::vector<std::string> skipped;  // "FILE:LINE: what: why", once each
+  // Gravity (m/s²) as the file states it or as the format's default is, and where it comes from, for the scene's
+  // comment ("<option gravity> at FILE:LINE", "URDF states none: the conventional value").
+  Eigen::Vector3d gravity{0.0, 0.0, -9.81};
+  std::string gravity_from;
   // Elements not mapped, by what they are: the first line, how many, why (written once each as `skipped`).
   struct Unmapped {
     int line = 0, count = 0;
@@ -96,6 +101,10 @@ struct Mechanism {
 // The phiq scene of a mechanism, with the drivers and time grid of `options`. Throws SceneError naming the file for
 // a driver of an unknown joint or one that no driver measure fits.
 std::string write_mechanism_scene(Mechanism& m, const ImportOptions& options);
+
+// The gravity the scene of `m` holds (options.gravity, else the file's or its format's) and "[X, Y, Z] m/s²: where
+// it comes from". Throws SceneError naming the file for a gravity given that is not finite.
+std::pair<Eigen::Vector3d, std::string> gravity_used(const Mechanism& m, const ImportOptions& options);
 
 // What an import made of `m` (whose joints beyond a spanning tree number `loops`): its counts, its scene
 // (write_mechanism_scene()) and what was not mapped. Throws as write_mechanism_scene().

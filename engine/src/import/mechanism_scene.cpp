@@ -242,8 +242,10 @@ std::string MechanismWriter::write() {
   };
   std::stable_sort(m_.skipped.begin(), m_.skipped.end(),
                    [&](const std::string& x, const std::string& y) { return where(x) < where(y); });
+  const std::pair<Eigen::Vector3d, std::string> gravity = gravity_used(m_, o_);
   std::ostringstream s;
-  s << "# Converted by phiq from " << single_line(m_.path) << " (" << m_.format << "): " << m_.units << "\n";
+  s << "# Converted by phiq from " << single_line(m_.path) << " (" << m_.format << "): " << m_.units << "\n"
+    << "# Gravity " << single_line(gravity.second) << "\n";
   if (!m_.skipped.empty()) s << "# Not mapped:\n";
   for (const std::string& why : m_.skipped) s << "#   " << single_line(why) << "\n";
   s << "phiq: 1\nname: " << yaml_quoted(m_.name)
@@ -255,12 +257,24 @@ std::string MechanismWriter::write() {
   s << "time: {start: " << scene_number(o_.t_start) << ", end: " << scene_number(o_.t_end) << ", steps: " << o_.steps
     << "}\n";
   s << mass;
+  if (!gravity.first.isZero(0.0)) s << "loads: {gravity: " << scene_vector(gravity.first) << "}\n";
   const bool joints = std::any_of(m_.joints.begin(), m_.joints.end(), [](const Joint& j) { return !j.kind.empty(); });
   s << import_output_section(m_.path, o_.rates, o_.forces, !drivers_.str().empty(), joints, massive_);
   return s.str();
 }
 
 }  // namespace
+
+std::pair<Eigen::Vector3d, std::string> gravity_used(const Mechanism& m, const ImportOptions& options) {
+  Eigen::Vector3d g = m.gravity;
+  std::string from = m.gravity_from;
+  if (options.gravity) {
+    g = Eigen::Vector3d((*options.gravity)[0], (*options.gravity)[1], (*options.gravity)[2]);
+    from = "--gravity";
+    if (!g.allFinite()) refuse(m.path, 0, "--gravity: the components must be finite numbers (m/s²)");
+  }
+  return {g, scene_vector(g) + " m/s²: " + (g.isZero(0.0) ? "none, " : "") + from};
+}
 
 std::string write_mechanism_scene(Mechanism& m, const ImportOptions& options) {
   return MechanismWriter(m, options).write();
@@ -273,6 +287,7 @@ ModelImport mechanism_import(Mechanism& m, int loops, const ImportOptions& optio
   out.loops = loops;
   out.couplers = static_cast<int>(m.couplers.size());
   out.yaml = write_mechanism_scene(m, options);
+  out.gravity = gravity_used(m, options).second;
   out.skipped = std::move(m.skipped);
   return out;
 }

@@ -16,6 +16,7 @@
 
 #include "import/mechanism.hpp"
 #include "import/mjcf_documents.hpp"
+#include "import/mjcf_option.hpp"
 #include "phiq/scene.hpp"
 
 namespace phiq {
@@ -532,15 +533,17 @@ Mechanism MjcfReader::read(int* loops) {
     refuse(path_, root ? root->GetLineNum() : 1, "an MJCF file's root element is <mujoco>");
   m_.name = root->Attribute("model") ? root->Attribute("model") : "";
   m_.bodies.push_back(Body::named("world", root->GetLineNum()));
+  m_.gravity_from = "MuJoCo's default (the file has no <option gravity>)";
   // Settings first: compiler, defaults and assets apply to the bodies wherever they stand.
   for (const tinyxml2::XMLElement* e : docs_.children(root)) {
     const std::string tag = e->Name();
     if (tag == "compiler") compiler(e);
+    if (tag == "option" && read_mjcf_option(e, docs_, m_))
+      unmapped(e, "simulation settings other than gravity (timestep, integrator, ...): phiq sweeps kinematics");
   }
   for (const tinyxml2::XMLElement* e : docs_.children(root, "default")) defaults(e, "main", "");
   for (const tinyxml2::XMLElement* e : docs_.children(root, "asset")) assets(e);
   static const std::map<std::string, std::string> why = {
-      {"option", "simulation settings (gravity, timestep): phiq sweeps kinematics"},
       {"size", "memory sizes of MuJoCo"},
       {"visual", "MuJoCo's rendering"},
       {"statistic", "MuJoCo's rendering"},
@@ -570,7 +573,7 @@ Mechanism MjcfReader::read(int* loops) {
       }
     } else if (tag == "equality") {
       continue;  // after every body is read
-    } else if (tag != "compiler" && tag != "default" && tag != "asset") {
+    } else if (tag != "compiler" && tag != "option" && tag != "default" && tag != "asset") {
       const auto it = why.find(tag);
       unmapped(e, it != why.end() ? it->second : "not an MJCF element phiq reads");
     }

@@ -18,7 +18,7 @@
 namespace phiq::detail::mechanism {
 
 /// Raise when Mechanism or this boundary changes.
-inline constexpr int kSdfModuleAbi = 1;
+inline constexpr int kSdfModuleAbi = 2;
 
 /// Reads the SDF `text` (named `path` in messages) into `out` and the count of joints that close loops into
 /// `loops`; false with `error` (one line "PATH:LINE: what") when the file is refused.

@@ -14,6 +14,7 @@
 #include <sdf/Root.hh>
 #include <sdf/Visual.hh>
 #include <sdf/World.hh>
+#include <sdf/parser.hh>
 #include <sdf/Box.hh>
 #include <sdf/Capsule.hh>
 #include <sdf/Cylinder.hh>
@@ -81,6 +82,7 @@ class SdfReader {
       if (c->GetExplicitlySetInFile() && !mapped.count(c->GetName()))
         m_.skip("<" + e->GetName() + "><" + c->GetName() + ">", sdf_line(c), why, sdf_file(c, path_));
   }
+  void sdf_gravity(const sdf::Root& root);
   void link(const sdf::Link& l, Body* b);
   // A model's links, then its nested models' (named MODEL::LINK, as SDF scopes them), then its joints; `placed`: the
   // model's frame in the top model's, `prefix`: its scope ("" for the top model, "arm::" for a model arm in it).
@@ -212,6 +214,27 @@ void SdfReader::joint(const sdf::Joint& j, const Pose& placed, const std::string
     if (const sdf::ElementPtr a = j.Element()->FindElement(axis)) unmapped_children(a, {"xyz"}, why);
 }
 
+// The world's gravity as libsdformat reads it (SDFormat's default where the world has no <gravity>); a file that
+// is a bare model, with no world, gets the default of a world that has no <gravity>.
+void SdfReader::sdf_gravity(const sdf::Root& root) {
+  if (root.WorldCount() > 0) {
+    const sdf::World& world = *root.WorldByIndex(0);
+    m_.gravity = sdf_vector(world.Gravity());
+    const sdf::ElementPtr g = world.Element()->FindElement("gravity");
+    m_.gravity_from = g && g->GetExplicitlySetInFile()
+                          ? "the world's <gravity> at " + path_ + ":" + std::to_string(sdf_line(g))
+                          : "SDFormat's default: the world has no <gravity>";
+    return;
+  }
+  sdf::ElementPtr world(new sdf::Element);
+  if (!sdf::initFile("world.sdf", world)) {
+    m_.gravity_from = "the file has no <world>: the conventional value";
+    return;
+  }
+  m_.gravity = sdf_vector(world->GetElement("gravity")->Get<ignition::math::Vector3d>());
+  m_.gravity_from = "the file has no <world>: SDFormat's default of a world without <gravity>";
+}
+
 Mechanism SdfReader::read(int* loops) {
   m_.path = path_, m_.format = "SDF";
   m_.units = "lengths in metres, angles in radians, mass in kg, time in seconds.";
@@ -243,6 +266,7 @@ Mechanism SdfReader::read(int* loops) {
     for (uint64_t k = 1; k < root.WorldByIndex(0)->ModelCount(); ++k)
       m_.skip("<model> after the world's first", sdf_line(root.WorldByIndex(0)->ModelByIndex(k)->Element()),
               "phiq reads one model of a world", sdf_file(root.WorldByIndex(0)->ModelByIndex(k)->Element(), path_));
+  sdf_gravity(root);
   m_.name = model->Name();
   m_.bodies.push_back(Body::named("world", sdf_line(model->Element())));
   this->model(*model, Pose{}, "");

@@ -317,6 +317,7 @@ void UrdfReader::map_joint(Joint* out, const std::string& type, const Pose& orig
 Mechanism UrdfReader::read(int* loops) {
   m_.path = path_, m_.format = "URDF";
   m_.units = "lengths in metres, angles in radians, mass in kg, time in seconds.";
+  m_.gravity_from = "URDF states no gravity: the conventional value";
   scan();
   check_tree();
   // urdfdom reads the tree without the closing joints.
