@@ -1,5 +1,5 @@
 // Helpers shared by the sensitivity tests (test_sensitivity*.cpp): the crank-slider's closed form by nested dual
-// numbers, its scene, and a sweep's rows with their sensitivities.
+// numbers, its scene, and a sweep's rows with their sensitivities (or with their efforts' values).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -142,6 +142,49 @@ inline OutputSensitivity along(const Scene& scene, const std::string& parameter,
   EXPECT_EQ(s.step, default_sensitivity_step(value));
   EXPECT_EQ(check_sensitivity_models(*scene.model, s), "");
   return s;
+}
+
+// Every row's time and its effort values (effort_values(): efforts, powers, reactions, then their sensitivities) of
+// a sweep of `s` at Newton's tolerance 1e-12 (the differences across δ read the positions' error over δ).
+struct EffortRows {
+  std::vector<double> t;
+  std::vector<std::vector<double>> values;
+  SweepSummary summary;
+};
+
+inline EffortRows effort_rows_sweep(const Scene& s) {
+  EffortRows r;
+  Workspace ws(*s.model);
+  SweepOptions o = s.sweep;
+  o.newton.tolerance = 1e-12;
+  const std::size_t size = static_cast<std::size_t>(effort_values(o.efforts, o.sensitivities.size()));
+  const SolveStatus st = run_sweep(
+      *s.model, o, ws,
+      [&](const StepView& v) {
+        r.t.push_back(v.t);
+        EXPECT_NE(v.efforts, nullptr);
+        if (v.efforts) r.values.emplace_back(v.efforts, v.efforts + size);
+        return true;
+      },
+      &r.summary);
+  EXPECT_EQ(st, SolveStatus::kSuccess) << r.summary.message;
+  return r;
+}
+
+// The scene `text` with `parameter` = value and no sensitivities: its first driver's effort (or, with `power`, its
+// power) at every row.
+inline std::vector<double> first_driver_values_at(const std::string& text, const std::string& parameter, double value,
+                                                  bool power) {
+  SceneOverrides o;
+  o.parameters = {{parameter, value}};
+  o.sensitivity_models = false;
+  Scene s = parse_scene(text, "efforts.yaml", {}, o);
+  s.sweep.sensitivities.clear();
+  const EffortRows r = effort_rows_sweep(s);
+  const std::size_t at = power ? s.sweep.efforts.constraints.size() : 0;
+  std::vector<double> out;
+  for (const auto& v : r.values) out.push_back(v[at]);
+  return out;
 }
 
 }  // namespace phiq::test

@@ -16,48 +16,18 @@
 #include "phiq/effort_sensitivity.hpp"
 #include "phiq/phiq.hpp"
 #include "fourbar_parts.hpp"
+#include "sensitivity_support.hpp"
 #include "test_support.hpp"
 
 namespace phiq {
 namespace {
 
-// A row's time and its effort values (effort_values()).
-struct EffortSensitivityRows {
-  std::vector<double> t;
-  std::vector<std::vector<double>> values;
-  SweepSummary summary;
-};
-
-EffortSensitivityRows effort_sensitivity_sweep(const Scene& s) {
-  EffortSensitivityRows r;
-  Workspace ws(*s.model);
-  SweepOptions o = s.sweep;
-  o.newton.tolerance = 1e-12;  // the differences across δ read the positions' error over δ
-  const std::size_t size = static_cast<std::size_t>(effort_values(o.efforts, o.sensitivities.size()));
-  const SolveStatus st = run_sweep(
-      *s.model, o, ws,
-      [&](const StepView& v) {
-        r.t.push_back(v.t);
-        EXPECT_NE(v.efforts, nullptr);
-        if (v.efforts) r.values.emplace_back(v.efforts, v.efforts + size);
-        return true;
-      },
-      &r.summary);
-  EXPECT_EQ(st, SolveStatus::kSuccess) << r.summary.message;
-  return r;
-}
+using test::effort_rows_sweep;
+using EffortSensitivityRows = test::EffortRows;
 
 // The scene with `parameter` = value, without sensitivities: its first effort at every row.
 std::vector<double> effort_sensitivity_efforts_at(const std::string& text, const std::string& parameter, double value) {
-  SceneOverrides o;
-  o.parameters = {{parameter, value}};
-  o.sensitivity_models = false;
-  Scene s = parse_scene(text, "efforts.yaml", {}, o);
-  s.sweep.sensitivities.clear();
-  const EffortSensitivityRows r = effort_sensitivity_sweep(s);
-  std::vector<double> tau;
-  for (const auto& v : r.values) tau.push_back(v[0]);
-  return tau;
+  return test::first_driver_values_at(text, parameter, value, false);
 }
 
 // Every row's ∂τ/∂p of the first effort against central differences of re-solved sweeps (Richardson over δ and
@@ -66,7 +36,7 @@ void expect_effort_sensitivities_match_resolved_sweeps(const std::string& text) 
   const Scene s = parse_scene(text, "efforts.yaml");
   ASSERT_EQ(s.sweep.efforts.constraints.size(), 1u);
   ASSERT_FALSE(s.sweep.sensitivities.empty());
-  const EffortSensitivityRows base = effort_sensitivity_sweep(s);
+  const EffortSensitivityRows base = effort_rows_sweep(s);
   EXPECT_EQ(base.summary.sensitivity_form, SensitivityForm::kDirect);
   const std::size_t offset = static_cast<std::size_t>(s.sweep.efforts.size());
   for (std::size_t j = 0; j < s.sweep.sensitivities.size(); ++j) {
@@ -114,7 +84,7 @@ TEST(EffortSensitivity, APendulumsTorqueFollowsItsClosedFormInLengthAndMass) {
   // θ = 0.3 + 2t + 1.5t², α = 3: τ = m g L cos θ + (I + m L²) α, so ∂τ/∂L = m g cos θ + 2 m L α and
   // ∂τ/∂m = g L cos θ + L² α, exactly (the mass reaches no constraint: its part alone).
   const Scene s = parse_scene(kEffortPendulum, "pendulum.yaml");
-  const EffortSensitivityRows r = effort_sensitivity_sweep(s);
+  const EffortSensitivityRows r = effort_rows_sweep(s);
   ASSERT_EQ(r.t.size(), 41u);
   const double g = 9.81, L = 0.8, m = 1.5, I = 0.02, alpha = 3.0;
   const std::size_t at = static_cast<std::size_t>(s.sweep.efforts.size());
@@ -233,7 +203,7 @@ TEST(EffortSensitivity, TheFourFormulationsOfTheFourBarGiveOneSensitivity) {
                                     "time: {start: 0, end: 2*pi, steps: 60}\n"
                                     "output: {efforts: all, sensitivities: [L2, L3, L4]}\n",
                                 form);
-    rows.push_back(effort_sensitivity_sweep(s));
+    rows.push_back(effort_rows_sweep(s));
     ASSERT_EQ(rows.back().values.size(), 61u) << form;
   }
   double worst = 0.0, scale = 0.0;
@@ -354,7 +324,7 @@ TEST(EffortSensitivity, ParametersThatReachNoForceGiveTheSameColumnsBitForBitAsW
       if (!p.parts_along[k]) p.parts_along[k] = along.sweep.efforts.parts;
       if (!p.loads_along[k]) p.loads_along[k] = along.sweep.efforts.loads;
     }
-  const EffortSensitivityRows a = effort_sensitivity_sweep(s), b = effort_sensitivity_sweep(along);
+  const EffortSensitivityRows a = effort_rows_sweep(s), b = effort_rows_sweep(along);
   ASSERT_EQ(a.values.size(), 31u);
   ASSERT_EQ(b.values.size(), a.values.size());
   for (std::size_t k = 0; k < a.values.size(); ++k)

@@ -12,48 +12,18 @@
 #include "output/hdf5_handle.hpp"
 #include "phiq/effort_sensitivity.hpp"
 #include "phiq/phiq.hpp"
+#include "sensitivity_support.hpp"
 #include "test_support.hpp"
 
 namespace phiq {
 namespace {
 
-// Every row's time and its effort values (effort_values()).
-struct PowerSensitivityRows {
-  std::vector<double> t;
-  std::vector<std::vector<double>> values;
-};
-
-PowerSensitivityRows power_sensitivity_sweep(const Scene& s) {
-  PowerSensitivityRows r;
-  Workspace ws(*s.model);
-  SweepOptions o = s.sweep;
-  o.newton.tolerance = 1e-12;  // the differences across δ read the positions' error over δ
-  const std::size_t size = static_cast<std::size_t>(effort_values(o.efforts, o.sensitivities.size()));
-  SweepSummary sum;
-  const SolveStatus st = run_sweep(
-      *s.model, o, ws,
-      [&](const StepView& v) {
-        r.t.push_back(v.t);
-        if (v.efforts) r.values.emplace_back(v.efforts, v.efforts + size);
-        return true;
-      },
-      &sum);
-  EXPECT_EQ(st, SolveStatus::kSuccess) << sum.message;
-  return r;
-}
+using PowerSensitivityRows = test::EffortRows;
+using test::effort_rows_sweep;
 
 // The first driver's power at every row with `parameter` = value (no sensitivities).
 std::vector<double> power_sensitivity_powers_at(const std::string& text, const std::string& parameter, double value) {
-  SceneOverrides o;
-  o.parameters = {{parameter, value}};
-  o.sensitivity_models = false;
-  Scene s = parse_scene(text, "power.yaml", {}, o);
-  s.sweep.sensitivities.clear();
-  const PowerSensitivityRows r = power_sensitivity_sweep(s);
-  const std::size_t at = s.sweep.efforts.constraints.size();
-  std::vector<double> p;
-  for (const auto& v : r.values) p.push_back(v[at]);
-  return p;
+  return test::first_driver_values_at(text, parameter, value, true);
 }
 
 // Every row's ∂P/∂p of the first driver against re-solved sweeps (Richardson over δ = 10⁻³ |p| and δ/2): within
@@ -62,7 +32,7 @@ void expect_power_sensitivities_match_resolved_sweeps(const std::string& text) {
   const Scene s = parse_scene(text, "power.yaml");
   ASSERT_EQ(s.sweep.efforts.constraints.size(), 1u);
   ASSERT_TRUE(s.sweep.efforts.power);
-  const PowerSensitivityRows base = power_sensitivity_sweep(s);
+  const PowerSensitivityRows base = effort_rows_sweep(s);
   const std::size_t np = s.sweep.sensitivities.size(), offset = static_cast<std::size_t>(s.sweep.efforts.size());
   for (std::size_t j = 0; j < np; ++j) {
     const OutputSensitivity& p = s.sweep.sensitivities[j];
@@ -107,7 +77,7 @@ TEST(PowerSensitivity, APendulumsPowerFollowsItsClosedFormInLengthMassAndRate) {
   // θ = 0.3 + w t + 1.5 t², θ̇ = w + 3t, α = 3: P = τ θ̇ with τ = m g L cos θ + (I + m L²) α, so ∂P/∂L = (m g cos θ
   // + 2 m L α) θ̇, ∂P/∂m = (g L cos θ + L² α) θ̇ and ∂P/∂w = −m g L sin θ t θ̇ + τ (the law's rate reads w: Φt does)
   const Scene s = parse_scene(kPowerPendulum, "pendulum.yaml");
-  const PowerSensitivityRows r = power_sensitivity_sweep(s);
+  const PowerSensitivityRows r = effort_rows_sweep(s);
   ASSERT_EQ(r.values.size(), 41u);
   const double g = 9.81, L = 0.8, m = 1.5, I = 0.02, alpha = 3.0, w = 2.0;
   const std::size_t at = static_cast<std::size_t>(s.sweep.efforts.size());

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "parts/frame_jets.hpp"
+#include "parts/planar_motion.hpp"
 
 namespace phiq {
 
@@ -58,38 +59,16 @@ struct Path {
 // The vector of the antisymmetric part of the 3×3 matrix m: (m32 − m23, m13 − m31, m21 − m12) / 2.
 kin3::V3 vee(const double m[9]) { return {0.5 * (m[7] - m[5]), 0.5 * (m[2] - m[6]), 0.5 * (m[3] - m[1])}; }
 
-// The motion of a planar frame in closed form: a body's (x, y, ψ), or an origin point and an x direction (θ its
-// angle: ω = (d × ḋ)/|d|², α = (d × d̈)/|d|² − 2 (d · ḋ)(d × ḋ)/|d|⁴). Inverse dynamics calls part_motion() for every
-// part at every row, where the jets cost as much as the row's solves. False for the other frames (the jets).
-bool planar_motion(const PartFrame& f, const double* q, const double* qd, const double* qdd, PartMotion& m) {
-  auto rate = [&](const Slot& s) { return s.is_coordinate() ? qd[s.coord()] : 0.0; };
-  auto accel = [&](const Slot& s) { return s.is_coordinate() && qdd ? qdd[s.coord()] : 0.0; };
-  double c = 1.0, s = 0.0, w = 0.0, a = 0.0;
-  if (f.kind == PartFrameKind::kPlanarBody) {
-    const Frame2& b = f.planar;
-    m.pose.at = {b.x.of(q), b.y.of(q), 0.0};
-    m.velocity = {rate(b.x), rate(b.y), 0.0}, m.acceleration = {accel(b.x), accel(b.y), 0.0};
-    const double psi = b.psi.of(q);
-    c = std::cos(psi), s = std::sin(psi), w = rate(b.psi), a = accel(b.psi);
-  } else if (f.kind == PartFrameKind::kPoints && !f.spatial_frame) {
-    const Slot* o = f.origin.r;
-    const Slot* x = f.x_toward.r;
-    m.pose.at = {o[0].of(q), o[1].of(q), o[2].of(q)};
-    m.velocity = {rate(o[0]), rate(o[1]), rate(o[2])}, m.acceleration = {accel(o[0]), accel(o[1]), accel(o[2])};
-    double dx = x[0].of(q), dy = x[1].of(q), vx = rate(x[0]), vy = rate(x[1]), ax = accel(x[0]), ay = accel(x[1]);
-    if (f.x_is_point) {
-      dx -= m.pose.at.x, dy -= m.pose.at.y, vx -= m.velocity.x, vy -= m.velocity.y;
-      ax -= m.acceleration.x, ay -= m.acceleration.y;
-    }
-    const double d2 = dx * dx + dy * dy, n = std::sqrt(d2), turn = dx * vy - dy * vx;
-    if (!(n > 0.0)) return false;                           // no direction: the jets' (and part_pose()'s) NaN
-    c = (1.0 / n) * dx, s = (1.0 / n) * dy, w = turn / d2;  // the axes as part_pose() rounds them
-    a = (dx * ay - dy * ax) / d2 - 2.0 * (dx * vx + dy * vy) * turn / (d2 * d2);
-  } else {
-    return false;
-  }
-  m.pose.rotation = {c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0};
-  m.omega = {0.0, 0.0, w}, m.alpha = {0.0, 0.0, a};
+// A planar frame's motion in closed form (parts/planar_motion.hpp) as a PartMotion: inverse dynamics calls
+// part_motion() for every part at every row, where the jets cost as much as the row's solves. False for the other
+// frames (the jets).
+bool planar_part_motion(const PartFrame& f, const double* q, const double* qd, const double* qdd, PartMotion& m) {
+  detail::PlanarFrame pf;
+  detail::PlanarMotion p;
+  if (!detail::planar_frame(f, pf) || !detail::planar_motion(pf, q, qd, qdd, p)) return false;
+  m.pose.at = p.at, m.velocity = p.velocity, m.acceleration = p.acceleration;
+  m.pose.rotation = {p.cos, -p.sin, 0.0, p.sin, p.cos, 0.0, 0.0, 0.0, 1.0};
+  m.omega = {0.0, 0.0, p.omega}, m.alpha = {0.0, 0.0, p.alpha};
   return true;
 }
 
@@ -103,7 +82,7 @@ std::pair<kin3::V3, kin3::V3> PartMotion::point(kin3::V3 s) const {
 
 PartMotion part_motion(const PartFrame& frame, const double* q, const double* qd, const double* qdd, double t) {
   PartMotion m;
-  if (planar_motion(frame, q, qd, qdd, m)) return m;
+  if (planar_part_motion(frame, q, qd, qdd, m)) return m;
   const auto [o, r] = frame_jets<double>(frame, Path{q, qd, qdd, t});
   m.pose = part_pose(frame, q, t);
   m.velocity = {o[0].d, o[1].d, o[2].d};

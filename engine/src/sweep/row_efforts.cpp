@@ -23,8 +23,9 @@ void Sweeper::row_efforts() {
   if (!w) return not_defined();
   const double t = current_.t;
   effort_work_.q.setZero(model_.num_coordinates());
-  add_generalized_forces(*e.parts, *e.loads, current_.q.data(), current_.qd.data(), current_.qdd.data(), t,
-                         effort_work_.q);
+  if (!effort_work_.forces) effort_work_.forces.emplace(*e.parts);
+  effort_work_.forces->add(*e.parts, *e.loads, current_.q.data(), current_.qd.data(), current_.qdd.data(), t,
+                           effort_work_.q);
   if (!multipliers_with_factors(model_, *w->lu, effort_work_.q, effort_work_.kept, effort_work_.lambda))
     return not_defined();
   ++ws_->counters.effort_solves;

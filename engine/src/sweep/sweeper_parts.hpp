@@ -15,6 +15,7 @@
 #include "phiq/joint_reactions.hpp"
 #include "phiq/sweep.hpp"
 #include "solve/minimum_norm.hpp"
+#include "solve/part_forces.hpp"
 #include "solve/sensitivity_internal.hpp"
 
 namespace phiq::detail {
@@ -160,6 +161,7 @@ struct EffortWork {
       : dropped(std::move(dropped_efforts)), reactions(std::move(written_reactions)) {}
   EffortSensitivityScratch sensitivity_scratch;
   Eigen::VectorXd q, kept, lambda, phi_t;  // Q, the kept rows, λ, Φt
+  std::optional<PartForces> forces;        // Q's parts, gathered at the first row
   std::vector<std::size_t> dropped;
   std::optional<JointReactions> reactions;
   bool reactions_noted = false;
