@@ -30,6 +30,14 @@ Polynomial modes_start_poly(std::initializer_list<std::pair<double, std::vector<
   return p;
 }
 
+// (x − 1)³ = 0, y − 2 = 0: a triple root, the end game's (from x³ = 1: x = 1 throughout, and a cycle of two paths)
+PolynomialSystem modes_start_triple_root() {
+  return {2,
+          {},
+          {modes_start_poly({{-1.0, {0, 0}}, {3.0, {1, 0}}, {-3.0, {2, 0}}, {1.0, {3, 0}}}),
+           modes_start_poly({{1.0, {0, 1}}, {-2.0, {0, 0}}})}};
+}
+
 // (A − λ I) v = 0 with v1 + v2 + v3 = 1, A upper triangular with eigenvalues 1, 2, 3; variables λ, v1, v2, v3.
 PolynomialSystem modes_start_eigenproblem() {
   const double a[3][3] = {{1, 1, 0}, {0, 2, 1}, {0, 0, 3}};
@@ -208,10 +216,7 @@ TEST(ModesStart, LoweredDegreesKeepTheFiniteSolutionsAndLoseTheCircularPoints) {
 TEST(ModesStart, EndGameFindsATripleRoot) {
   // (x − 1)³ = 0, y − 2 = 0: the three paths of x³ = 1 all end at x = 1 (one of them x = 1 throughout, the other two
   // a Puiseux cycle of winding number 2), where Newton alone stalls; the end game's means put it to 1e-8
-  const PolynomialSystem s{2,
-                           {},
-                           {modes_start_poly({{-1.0, {0, 0}}, {3.0, {1, 0}}, {-3.0, {2, 0}}, {1.0, {3, 0}}}),
-                            modes_start_poly({{1.0, {0, 1}}, {-2.0, {0, 0}}})}};
+  const PolynomialSystem s = modes_start_triple_root();
   const ModesSummary r = solve_polynomial_system(s, {});
   ASSERT_EQ(r.status, ModesStatus::kSuccess);
   EXPECT_EQ(r.paths, 3);
@@ -266,10 +271,7 @@ TEST(ModesStart, APathAboveTheWindingLimitFailsNamed) {
   // (x − 1) ((x − 1)² + γt (x² + x + 1) / (1 − t)): one path stays at x = 1 (winding number 1, its step collapsing
   // all the same: the Jacobian is singular there), the other two are a cycle of winding number 2. With one turn
   // allowed those two fail, each named with why, neither classified from where its step collapsed.
-  const PolynomialSystem s{2,
-                           {},
-                           {modes_start_poly({{-1.0, {0, 0}}, {3.0, {1, 0}}, {-3.0, {2, 0}}, {1.0, {3, 0}}}),
-                            modes_start_poly({{1.0, {0, 1}}, {-2.0, {0, 0}}})}};
+  const PolynomialSystem s = modes_start_triple_root();
   ModesOptions o;
   o.max_winding = 1;
   const ModesSummary r = solve_polynomial_system(s, o);
@@ -306,10 +308,7 @@ TEST(ModesStart, MultiHomogeneousAndEndGameSameBitsOnOneAndTwoThreads) {
     EXPECT_TRUE(one.summary.endpoints[k].x == two.summary.endpoints[k].x) << "endpoint " << k;
   }
   // the end game's ends: (x − 1)³ = 0, y = 2 (three paths: x = 1 throughout and a cycle of two)
-  const PolynomialSystem triple{2,
-                                {},
-                                {modes_start_poly({{-1.0, {0, 0}}, {3.0, {1, 0}}, {-3.0, {2, 0}}, {1.0, {3, 0}}}),
-                                 modes_start_poly({{1.0, {0, 1}}, {-2.0, {0, 0}}})}};
+  const PolynomialSystem triple = modes_start_triple_root();
   ModesOptions t;
   t.threads = 1;
   const ModesSummary a = solve_polynomial_system(triple, t);
