@@ -194,31 +194,50 @@ double cycle_estimate(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b, cons
   return d2 > 0.0 && d1 > d2 ? std::log(kShrink) / std::log(d1 / d2) : 0.0;
 }
 
-// The radii to start the end game at, with the path's point there: the path taken from t = 0.1 (X) along the ray
-// to t = 0.1 / 4^k while it can be (above `collapsed`, where its step collapsed). A circle round t = 0 holds the
-// path's Puiseux series only inside its radius of convergence (other branch points of the homotopy cluster near
-// t = 0 when paths go to a solution set at infinity: a circle round them too permutes many paths, and does not close
-// within a few turns): the first radius where two successive estimates of the cycle number round to one integer
-// (within 0.1), then 16 and 256 times smaller; without such a radius, the three smallest the path reached.
-std::vector<std::pair<double, Eigen::VectorXcd>> end_game_radii(const Homotopy& h, Eigen::VectorXcd X, double collapsed,
-                                                                double theta, Tracking& tr) {
-  std::vector<std::pair<double, Eigen::VectorXcd>> along{{kEndGameStart, X}};
-  double stopped = 0.0;
-  for (double r = kEndGameStart; r / kShrink > std::max(kShrink * collapsed, 1e-14); r /= kShrink) {
-    if (!track_piece(h, X, Piece{std::polar(r, theta), std::polar(r / kShrink, theta)}, tr, &stopped)) break;
-    along.emplace_back(r / kShrink, X);
-  }
-  std::size_t begin = along.size() >= 3 ? along.size() - 3 : 0;
+using RaySamples = std::vector<std::pair<double, Eigen::VectorXcd>>;  // (t on the ray, X there)
+
+// The first sample k where two successive estimates of the cycle number (from samples k … k + 3) round to one
+// integer within 0.1, and that integer; (−1, 0) when there is none.
+std::pair<std::ptrdiff_t, int> settled_cycle(const RaySamples& along) {
   auto settled = [](double c) { return c >= 0.9 && std::abs(c - std::round(c)) <= 0.1; };
   for (std::size_t k = 0; k + 3 < along.size(); ++k) {
     const double c1 = cycle_estimate(along[k].second, along[k + 1].second, along[k + 2].second);
     const double c2 = cycle_estimate(along[k + 1].second, along[k + 2].second, along[k + 3].second);
-    if (settled(c1) && settled(c2) && std::round(c1) == std::round(c2)) {
-      begin = k;
+    if (settled(c1) && settled(c2) && std::round(c1) == std::round(c2))
+      return {static_cast<std::ptrdiff_t>(k), static_cast<int>(std::round(c1))};
+  }
+  return {-1, 0};
+}
+
+// The path from t = 0.1 (X) along the ray at angle theta to t = 0.1 / 4^k, k = 1, 2, …, down to `floor`, while it
+// can be taken (*collapsed: the |t| where its step collapsed, else 0), and, when `stop_at_cycle` is true, no further
+// than where its cycle-number estimates settle at 2 or more (its end is singular: the end game's).
+RaySamples sample_ray(const Homotopy& h, Eigen::VectorXcd X, double theta, double floor, bool stop_at_cycle,
+                      Tracking& tr, double* collapsed) {
+  RaySamples along{{kEndGameStart, X}};
+  double stopped = 0.0;
+  *collapsed = 0.0;
+  for (double r = kEndGameStart; r / kShrink >= floor; r /= kShrink) {
+    if (!track_piece(h, X, Piece{std::polar(r, theta), std::polar(r / kShrink, theta)}, tr, &stopped)) {
+      *collapsed = r - stopped * (r - r / kShrink);
       break;
     }
+    along.emplace_back(r / kShrink, X);
+    if (stop_at_cycle && along.size() >= 4 && settled_cycle(along).second >= 2) break;
   }
-  std::vector<std::pair<double, Eigen::VectorXcd>> radii;
+  return along;
+}
+
+// The radii to start the end game at, with the path's point there, from its samples along a ray. A circle round
+// t = 0 holds the path's Puiseux series only inside its radius of convergence (other branch points of the homotopy
+// cluster near t = 0 when paths go to a solution set at infinity: a circle round them too permutes many paths, and
+// does not close within a few turns): the first radius where the cycle-number estimates settle, then 16 and 256
+// times smaller; without such a radius, the three smallest at least 16 times above where the step collapsed.
+RaySamples end_game_radii(RaySamples along, double collapsed) {
+  const std::ptrdiff_t first = settled_cycle(along).first;
+  while (first < 0 && along.size() > 1 && along.back().first < 16.0 * collapsed) along.pop_back();
+  std::size_t begin = first >= 0 ? static_cast<std::size_t>(first) : along.size() >= 3 ? along.size() - 3 : 0;
+  RaySamples radii;
   for (std::size_t k = begin; k < along.size() && radii.size() < 3; k += 2) radii.push_back(along[k]);
   return radii;
 }
@@ -238,15 +257,27 @@ PathEnd track_path(const Homotopy& h, std::int64_t p, int max_winding, bool care
     end.failure = "its step collapsed at t = " + short_number(end.t) + ", before the end game's circle";
     return end;
   }
+  // Along the ray in pieces t = 0.1 / 4^k, whose points estimate the cycle number of the path's Puiseux series: to
+  // t = 1e-10 and then straight to 0 for a path whose end is regular; a path whose cycle number settles at 2 or more
+  // (a singular end) or whose step collapses goes to the end game.
   const Eigen::VectorXcd at_start = end.X;
-  const bool straight = track_piece(h, end.X, Piece{kEndGameStart, 0.0}, tr, &stopped);
-  end.t = straight ? 0.0 : kEndGameStart * (1.0 - stopped);
+  double collapsed = 0.0;
+  const RaySamples along = sample_ray(h, at_start, 0.0, 1e-10, true, tr, &collapsed);
+  const bool settled = collapsed == 0.0 && settled_cycle(along).second >= 2;
+  bool straight = false;
+  end.X = along.back().second, end.t = along.back().first;
+  if (collapsed == 0.0 && !settled) {
+    straight = track_piece(h, end.X, Piece{end.t, 0.0}, tr, &stopped);
+    end.t = straight ? 0.0 : end.t * (1.0 - stopped);
+  } else if (collapsed > 0.0) {
+    end.t = collapsed;
+  }
   end.reached = straight;
   if (!straight) {
-    // the end game for every path whose step collapsed, at a finite point or at infinity alike, on circles where
-    // the path's own data say its Puiseux series holds (end_game_radii)
+    // the end game for every path whose step collapsed or whose end is singular, at a finite point or at infinity
+    // alike, on circles where the path's own points say its Puiseux series holds (end_game_radii)
     EndGame game;
-    for (const auto& [r, X] : end_game_radii(h, at_start, end.t, 0.0, tr)) {
+    for (const auto& [r, X] : end_game_radii(along, collapsed > 0.0 ? collapsed : end.t)) {
       game = cauchy_end_game(h, X, r, 0.0, max_winding, tr);
       if (game.ended) break;
     }
@@ -257,7 +288,9 @@ PathEnd track_path(const Homotopy& h, std::int64_t p, int max_winding, bool care
       if (game.ended) break;
       Eigen::VectorXcd X = at_start;
       if (!track_piece(h, X, Piece{0.0, 0.0, true, kEndGameStart, 0.0, theta}, tr, &stopped)) continue;
-      for (const auto& [r, Y] : end_game_radii(h, X, 0.0, theta, tr)) {
+      double lost = 0.0;
+      const RaySamples ray = sample_ray(h, X, theta, 1e-14, false, tr, &lost);
+      for (const auto& [r, Y] : end_game_radii(ray, lost)) {
         EndGame around = cauchy_end_game(h, Y, r, theta, max_winding, tr);
         if (around.ended) {
           game = std::move(around);
@@ -269,7 +302,9 @@ PathEnd track_path(const Homotopy& h, std::int64_t p, int max_winding, bool care
       end.X = game.estimate, end.t = 0.0, end.reached = true, end.winding = game.winding;
       end.accuracy = game.accuracy;
     } else {
-      end.failure = "its step collapsed at t = " + short_number(end.t) + " and " + game.failure;
+      end.failure = (settled ? "its end is singular (its cycle number settled by t = " + short_number(end.t) + ")"
+                             : "its step collapsed at t = " + short_number(end.t)) +
+                    " and " + game.failure;
     }
   }
   end.steps = tr.steps;
