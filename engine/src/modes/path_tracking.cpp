@@ -5,12 +5,14 @@
 // The end game. A path that ends at a regular solution is tracked to t = 0 itself. One that ends at a singular
 // point (several paths meet there, or a solution set at infinity) cannot be: near t = 0 the paths that meet are
 // branches of one Puiseux series X(t) = Σ a_k t^{k/c} (c the winding number) and the corrector's step collapses.
-// Such a path is taken back to its point at t = 0.1 and run round circles |t| = r in the complex plane (Cauchy's
-// end game, Morgan, Sommese and Wampler 1991): after c turns it is back where it began, and the mean of its points
-// at equally spaced angles over those turns is X(0) by Cauchy's integral formula in s = t^{1/c} (the trapezoid rule
-// on a circle, exact to r^{K/c} for K points a turn). The radius shrinks by 4 until two estimates agree.
+// Below t = 0.1 a path is taken in pieces t = 0.1 / 4^k, whose points estimate c (|X_k − X_{k+1}| ∝ t_k^{1/c}).
+// A path whose step collapses, or whose estimates settle at c ≥ 2, is run round circles |t| = r in the complex
+// plane from the first radius where the estimates settled (Cauchy's end game, Morgan, Sommese and Wampler 1991):
+// after c turns it is back where it began, and the mean of its points at equally spaced angles over those turns is
+// X(0) by Cauchy's integral formula in s = t^{1/c} (the trapezoid rule on a circle, exact to r^{K/c} for K points a
+// turn). The radius shrinks by 4 until two estimates agree.
 //
-// Every path whose straight step collapses short of t = 0 goes through the end game, whether it ends at a finite
+// Every path whose step collapses short of t = 0 goes through the end game, whether it ends at a finite
 // singular point or at infinity: on the patch, a path to infinity is a path to a finite point with X_j0 = 0, and
 // the end game places that point as it places any other, so that the path is classified by the homogenising
 // coordinate of its end (homotopy_solve.cpp), not by where its step collapsed. The winding number is found by
