@@ -12,6 +12,7 @@
 
 #include <unistd.h>
 
+#include "modes_stewart.hpp"  // tests/: the general Stewart–Gough platform the modes tests solve too
 #include "phiq/phiq.hpp"
 
 namespace {
@@ -23,31 +24,10 @@ std::string bench_modes_model(const std::string& rel) {
   return path;
 }
 
-// A general Stewart–Gough platform: base points b_i and platform points p_i in general position (no two legs
-// meeting, neither hexagon planar), legs of fixed lengths L_i.
-const char* kStewart =
-    "phiq: 1\nname: stewart_gough\ndimension: 3\n"
-    "coordinates: {x: 0.1, y: 0.05, z: 1.0, e0: 1, e1: 0.05, e2: 0.02, e3: 0.1}\n"
-    "bodies: {platform: [x, y, z, e0, e1, e2, e3]}\n"
-    "constraints:\n"
-    "  - {name: leg1, type: distance, between: [{body: ground, at: [1.0, 0.1, 0.05]}, {body: platform, at: [0.5, 0.3, "
-    "0.02]}], length: 1.3}\n"
-    "  - {name: leg2, type: distance, between: [{body: ground, at: [0.3, 0.9, -0.1]}, {body: platform, at: [-0.2, 0.6, "
-    "0.1]}], length: 1.1}\n"
-    "  - {name: leg3, type: distance, between: [{body: ground, at: [-0.7, 0.6, 0.08]}, {body: platform, at: [-0.5, "
-    "0.1, -0.05]}], length: 1.25}\n"
-    "  - {name: leg4, type: distance, between: [{body: ground, at: [-0.8, -0.4, 0.02]}, {body: platform, at: [-0.3, "
-    "-0.5, 0.07]}], length: 1.2}\n"
-    "  - {name: leg5, type: distance, between: [{body: ground, at: [0.1, -1.0, -0.06]}, {body: platform, at: [0.2, "
-    "-0.6, -0.03]}], length: 1.05}\n"
-    "  - {name: leg6, type: distance, between: [{body: ground, at: [0.9, -0.5, 0.12]}, {body: platform, at: [0.6, "
-    "-0.2, 0.04]}], length: 1.15}\n"
-    "time: {start: 0, end: 1, steps: 1}\n";
-
 phiq::Scene bench_modes_scene(const std::string& which) {
   if (which == "fourbar") return phiq::load_scene(bench_modes_model("seed/fourbar_mixed.yaml"));
   if (which == "rpr3") return phiq::load_scene(bench_modes_model("benchmarks/rpr3.yaml"));
-  return phiq::parse_scene(kStewart, which + ".yaml");
+  return phiq::parse_scene(phiq::test::kModesStewartScene, which + ".yaml");
 }
 
 void BM_ModesPhiq(benchmark::State& state, const std::string& which) {
@@ -68,6 +48,8 @@ void BM_ModesPhiq(benchmark::State& state, const std::string& which) {
   state.counters["complex"] = r.summary.complex;
   state.counters["singular"] = r.summary.singular;
   state.counters["failed"] = r.summary.failed_paths;
+  state.counters["at_infinity"] = r.summary.at_infinity;
+  state.counters["end_game"] = r.summary.end_game_paths;
 }
 
 void BM_ModesPhc(benchmark::State& state, const std::string& which) {

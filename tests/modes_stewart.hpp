@@ -1,4 +1,5 @@
-// The bench's general Stewart–Gough platform (bench/bench_modes.cpp) as a scene: one body in x, y, z and e0 … e3,
+// A general Stewart–Gough platform as a scene (the modes tests' and bench/bench_modes.cpp's; base and platform
+// points in general position: no two legs meeting, neither hexagon planar): one body in x, y, z and e0 … e3,
 // six legs (distances from ground points to platform points). Its system's total degree is 8192; lowered, 432 paths.
 #pragma once
 

@@ -1,6 +1,7 @@
 """phiq.modes (engine/python/src/bind_modes.cpp): the four-bar's two assembly modes as arrays, each a placement that
 solves the scene's equations (checked with the model's own residual), against Freudenstein's closed form, the start
-system each solve tracked its paths from, and a cam refused with its constraint named."""
+system each solve tracked its paths from, the paths tracked against the total degree, and a cam refused with its
+constraint named."""
 import math
 import os
 
@@ -16,7 +17,8 @@ def test_fourbar_modes_are_two_placements_on_freudensteins_branches():
     scene = phiq.load_scene(os.path.join(MODELS, "seed", "fourbar_mixed.yaml"))
     r = phiq.modes(scene, 0.7, threads=1)
     assert r["q"].shape == (2, len(r["coordinates"]))
-    assert r["paths"] == 4
+    assert r["paths"] == 4  # two circles' Bézout number: the total degree, every path tracked
+    assert r["total_degree"] == 4
     assert r["method"] == "whole system"
     assert r["start_system"] == "total degree"  # its 4 paths are already the fewest
     assert not r["singular"].any()
@@ -47,6 +49,7 @@ def test_start_system_says_the_degrees_were_lowered_block_by_block():
     assert r["method"] == "block by block"
     assert r["start_system"] == "total degree, degrees lowered"
     assert r["paths"] == 6
+    assert r["total_degree"] == 10  # the blocks' own, before lowering: 2 + 2 · 4 (the lowered take 2 + 2 · 2)
     assert r["q"].shape[0] == 4
     for q in r["q"]:
         assert np.max(np.abs(scene.model.residual(q, 0.0))) < 1e-12

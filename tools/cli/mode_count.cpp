@@ -19,12 +19,20 @@ void refused(const AssemblyModes& found, ModeCount& out) {
     case ModesStatus::kNotPolynomial:
       out.state = ModeCount::State::kNotPolynomial;
       break;
-    case ModesStatus::kTooManyPaths:
+    case ModesStatus::kTooManyPaths: {
       out.state = ModeCount::State::kSkipped;
-      // the paths the solve would take (degrees lowered, the start system with the fewest), not the total degree
-      out.reason = "not counted here: " + std::to_string(s.paths) + " paths, above " +
-                   std::to_string(kModeCountMaxPaths) + " (phiq modes counts them)";
+      // the paths the solve would take (degrees lowered, the start system with the fewest), not the total degree;
+      // where the block solve gave up first (its paths past the bound, or a block not safe), why, and that these
+      // are the whole system's paths: `phiq modes`, unbounded, may take the blocks' fewer
+      const std::string paths = std::to_string(s.paths) + " paths, above " + std::to_string(kModeCountMaxPaths);
+      const std::string prefix = "the block solve was not safe: ";
+      std::string gave_up = s.method_note;
+      if (gave_up.rfind(prefix, 0) == 0) gave_up = gave_up.substr(prefix.size());
+      out.reason = gave_up.empty() ? "not counted here: " + paths + " (phiq modes counts them)"
+                                   : "not counted here: the block solve gave up at " + gave_up +
+                                         "; the whole system takes " + paths + " (phiq modes counts them)";
       break;
+    }
     default:
       out.state = ModeCount::State::kNotAvailable;
   }

@@ -68,6 +68,7 @@ std::string report_text(const std::string& scene_path, double t, const AssemblyM
   o << "; start: " << s.start_system << " (total degree " << s.total_degree << "), " << s.end_game_paths
     << " ends by the end game; " << shortest(std::round(s.seconds * 1e4) / 1e4) << " s)\n";
   if (!s.method_note.empty()) o << "  " << s.method_note << ": the whole system solved instead\n";
+  for (const auto& [path, why] : s.failures) o << "  path " << path + 1 << " failed: " << why << "\n";
   for (std::size_t k = 0; k < r.modes.size(); ++k) {
     const AssemblyMode& m = r.modes[k];
     o << "  mode " << k + 1 << (m.singular ? " (singular)" : "") << ": " << mode_coordinates(model, m, "; ")
@@ -118,6 +119,9 @@ nlohmann::ordered_json modes_json(const std::string& scene_path, double t, const
   j["start_system"] = r.summary.start_system;
   j["total_degree"] = r.summary.total_degree;
   j["end_game_paths"] = r.summary.end_game_paths;
+  auto failures = nlohmann::ordered_json::array();
+  for (const auto& [path, why] : r.summary.failures) failures.push_back({{"path", path + 1}, {"reason", why}});
+  j["failures"] = failures;
   j["coordinates"] = model.coordinate_names();
   auto modes = nlohmann::ordered_json::array();
   for (const AssemblyMode& m : r.modes) {

@@ -27,6 +27,7 @@
 #include <complex>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -101,6 +102,10 @@ struct ModesOptions {
   /// system suggests (each rotation's c, s or Euler parameters, found by their normalisations, apart from the other
   /// variables; every variable alone).
   std::vector<std::vector<int>> groupings;
+  /// The most turns round t = 0 Cauchy's end game takes to find a path's winding number (the number of paths that
+  /// meet at its end). A path whose step collapses near t = 0 and that has not closed up after this many turns (nor
+  /// after as many as the start system has paths) is failed, named in ModesSummary::failures.
+  int max_winding = 32;
 };
 
 /// How find_assembly_modes() solved its system (ModesSummary::method).
@@ -126,11 +131,13 @@ enum class ModesStatus {
 
 /// What kind of point a path ended at.
 enum class EndpointKind {
-  kReal,        ///< a regular real solution
-  kComplex,     ///< a regular solution with an imaginary part
-  kSingular,    ///< a solution whose Jacobian is singular (condition above ModesOptions::singular_condition)
-  kAtInfinity,  ///< the path diverged: the homogenising coordinate went to 0
-  kFailed,      ///< the path could not be tracked to its end (step below the minimum away from t = 0)
+  kReal,      ///< a regular real solution
+  kComplex,   ///< a regular solution with an imaginary part
+  kSingular,  ///< a solution whose Jacobian is singular (condition above ModesOptions::singular_condition)
+  /// The path diverged: the homogenising coordinate of its end on the projective patch (placed by the end game
+  /// where its step collapsed) is zero to the end's accuracy.
+  kAtInfinity,
+  kFailed,  ///< the path could not be tracked to its end (step below the minimum away from t = 0)
 };
 
 /// "real", "complex", "singular", "at infinity", "failed".
@@ -139,10 +146,14 @@ const char* endpoint_kind_name(EndpointKind kind);
 /// One distinct endpoint of the homotopy (duplicates merged).
 struct Endpoint {
   EndpointKind kind = EndpointKind::kFailed;  ///< its class
-  Eigen::VectorXcd x;      ///< the solution in the system's variables (for kAtInfinity: the direction, unit norm)
-  double residual = 0.0;   ///< max_i |F_i(x)| / (largest |coefficient| of F_i), after Newton's refinement
-  double condition = 0.0;  ///< condition number of the Jacobian at x (variables scaled by 1 + |x|∞)
-  int multiplicity = 1;    ///< how many paths ended here
+  Eigen::VectorXcd x;  ///< the solution in the system's variables (for kAtInfinity: the direction, unit norm)
+  /// max_i |F_i(x)| / (largest |coefficient| of F_i), after Newton's refinement; at infinity, of the homogenised
+  /// (and degree-lowered) equations at the end on the patch
+  double residual = 0.0;
+  /// condition number of the Jacobian at x (variables scaled by 1 + |x|∞); at infinity, of the homogenised
+  /// equations' Jacobian with the patch's rows there
+  double condition = 0.0;
+  int multiplicity = 1;  ///< how many paths ended here
 };
 
 /// What solve_polynomial_system() did.
@@ -154,7 +165,7 @@ struct ModesSummary {
   int complex = 0;       ///< distinct complex regular endpoints (block by block: the blocks', not carried forward)
   int singular = 0;      ///< distinct singular endpoints
   int at_infinity = 0;   ///< distinct endpoints at infinity
-  int failed_paths = 0;  ///< paths that could not be tracked to t = 0
+  int failed_paths = 0;  ///< paths that could not be tracked to t = 0, or whose end solves none of the equations
   /// Paths that ended at a regular endpoint another path had reached: a path jumped onto another's on the way (a
   /// regular solution is the end of one path only), so that some solution may be missing. 0 when all went well.
   int duplicate_paths = 0;
@@ -180,6 +191,9 @@ struct ModesSummary {
   /// The distinct endpoints: real first, then complex, singular, at infinity, failed; within a kind in a fixed
   /// order (lexicographic in the real, then imaginary parts).
   std::vector<Endpoint> endpoints;
+  /// Each failed path named (failed_paths of them, in path order): its number in the start system's order (from 0;
+  /// block by block, the blocks' numbers are their own) and why it failed, in one line.
+  std::vector<std::pair<std::int64_t, std::string>> failures;
 };
 
 /// Solves a square polynomial system (or an overdetermined one: its equations are first combined at random into as

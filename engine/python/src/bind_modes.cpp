@@ -37,7 +37,8 @@ void bind_modes(py::module_& m) {
         d["condition"] = condition;
         d["singular"] = py::array_t<bool>(py::cast(singular));
         d["time"] = o.time;
-        d["paths"] = r.summary.paths;
+        d["paths"] = r.summary.paths;  // tracked: the start system's (block by block, all blocks')
+        d["total_degree"] = r.summary.total_degree;
         d["complex"] = r.summary.complex;
         d["at_infinity"] = r.summary.at_infinity;
         d["failed_paths"] = r.summary.failed_paths;
@@ -49,7 +50,8 @@ void bind_modes(py::module_& m) {
       py::arg("scene"), py::arg("t") = py::none(), py::arg("threads") = 0, py::arg("max_paths") = 100000,
       "Every real assembly mode of the scene at time t (default time.start), by polynomial homotopy continuation "
       "(engine/include/phiq/modes.hpp): a dict with 'q' (modes x coordinates; a row is a placement a Workspace's q "
-      "takes), 'coordinates', 'residual', 'condition', 'singular', and the homotopy's 'paths', 'complex', "
+      "takes), 'coordinates', 'residual', 'condition', 'singular', and the homotopy's 'paths' (those tracked), "
+      "'total_degree' (of the system as given, before its degrees were lowered), 'complex', "
       "'at_infinity', 'failed_paths', 'method' (whole system or block by block), 'method_note' (why not block "
       "by block) and 'start_system' (total degree or multi-homogeneous, degrees lowered or not). Raises ValueError "
       "naming the constraint when one is not polynomial, or when "

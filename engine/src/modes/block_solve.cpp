@@ -126,6 +126,7 @@ void block_add_counts(ModesSummary& to, const ModesSummary& from) {
   to.failed_paths += from.failed_paths, to.duplicate_paths += from.duplicate_paths;
   to.retracked_paths += from.retracked_paths, to.total_degree += from.total_degree;
   to.end_game_paths += from.end_game_paths;
+  to.failures.insert(to.failures.end(), from.failures.begin(), from.failures.end());
   if (!from.start_system.empty()) to.start_system = from.start_system;
   for (const Endpoint& e : from.endpoints)
     to.singular += e.kind == EndpointKind::kSingular && !(e.x.imag().cwiseAbs().maxCoeff() <= 1e-6);

@@ -4,6 +4,7 @@
 
 #include <complex>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -112,13 +113,16 @@ struct Homotopy {
 struct PathEnd {
   Eigen::VectorXcd X;    // the last point (homogeneous, on the patch)
   double t = 1.0;        // the t it reached (0 at a clean end)
-  bool reached = false;  // tracked to t = 0, by the end game, or to a small t with a collapsing step
+  bool reached = false;  // tracked to t = 0, straight or by the end game
   int steps = 0;
-  int winding = 0;  // the winding number Cauchy's end game found (0: no end game)
+  int winding = 0;        // the winding number Cauchy's end game found (0: no end game)
+  double accuracy = 0.0;  // the end game's last two estimates of X(0) apart, over 1 + |X|∞ (0: tracked straight)
+  std::string failure;    // why the path did not reach t = 0, when it did not
 };
 
-// Tracks path p from t = 1 to t = 0; `careful`: shorter steps and a closer corrector (a second attempt).
-PathEnd track_path(const Homotopy& h, std::int64_t p, bool careful = false);
+// Tracks path p from t = 1 to t = 0, the end game turning at most max_winding times round t = 0; `careful`: shorter
+// steps and a closer corrector (a second attempt).
+PathEnd track_path(const Homotopy& h, std::int64_t p, int max_winding, bool careful = false);
 
 // The square system with each equation's highest-degree form cancelled, where it can be, by polynomial multiples of
 // the equations before it (lowest degree first): the same ideal, so the same finite solutions, in fewer paths

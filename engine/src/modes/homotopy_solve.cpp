@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <string>
 
 #include <Eigen/QR>
 #include <Eigen/SVD>
@@ -209,6 +211,38 @@ double modes_detail::refine_endpoint(const CompiledSystem& f, Eigen::VectorXcd& 
 
 namespace {
 
+// An end whose homogenising coordinate is below this (relative to its group's coordinates) is at infinity whatever
+// the accuracy of its end.
+constexpr double kAtInfinity = 1e-8;
+
+// An end at infinity: the homogenised equations' residual there (each group's coordinates scaled to |X_j|∞ = 1), and
+// the condition of their Jacobian, n × (n + groups), whose n singular values are all nonzero at a regular solution at
+// infinity (the Euler relation takes one direction per group).
+void at_infinity_residual(const CompiledSystem& target, const Grouping& g, Eigen::VectorXcd X, Endpoint& point) {
+  for (int j = 0; j < g.groups; ++j) {
+    const auto& members = g.members[static_cast<std::size_t>(j)];
+    double size = std::abs(X(j));
+    for (const int v : members) size = std::max(size, std::abs(X(g.groups + v)));
+    if (!(size > 0.0)) continue;
+    X(j) /= size;
+    for (const int v : members) X(g.groups + v) /= size;
+  }
+  Eigen::VectorXcd f;
+  Eigen::MatrixXcd jac;
+  target.homogenised(X, f, &jac);
+  point.residual = 0.0;
+  for (Eigen::Index i = 0; i < f.size(); ++i) {
+    const double scale = target.coefficient_scale[static_cast<std::size_t>(i)];
+    point.residual = std::max(point.residual, std::abs(f(i)) / scale);
+    jac.row(i) /= scale;
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(jac);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  point.condition = sv.size() == 0            ? 1.0
+                    : sv(sv.size() - 1) > 0.0 ? sv(0) / sv(sv.size() - 1)
+                                              : std::numeric_limits<double>::infinity();
+}
+
 int kind_rank(EndpointKind k) { return static_cast<int>(k); }
 
 bool endpoint_before(const Endpoint& a, const Endpoint& b) {
@@ -274,13 +308,16 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
   Homotopy homotopy{&target, &chosen.start, random.unit_complex(), Eigen::VectorXcd(n + groups)};
   for (int v = 0; v < n + groups; ++v) homotopy.patch(v) = random.unit_complex();
 
+  // c paths meet at an end of winding number c: no more turns than paths
+  const int max_winding = static_cast<int>(
+      std::clamp<std::int64_t>(std::min<std::int64_t>(options.max_winding, summary.paths), 1, 1 << 20));
   // Every path, each into its own slot: the arithmetic of a path does not depend on which thread runs it.
   std::vector<PathEnd> ends(static_cast<std::size_t>(summary.paths));
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, summary.paths, 1), [&](const auto& range) {
       for (std::int64_t p = range.begin(); p != range.end(); ++p)
-        ends[static_cast<std::size_t>(p)] = modes_detail::track_path(homotopy, p);
+        ends[static_cast<std::size_t>(p)] = modes_detail::track_path(homotopy, p, max_winding);
     });
   });
 
@@ -292,34 +329,31 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
     distinct.clear();
     cluster_of.assign(ends.size(), -1);
     summary.failed_paths = 0, summary.duplicate_paths = 0;
+    summary.failures.clear();
+    auto fail = [&](std::size_t path, const std::string& why) {
+      ++summary.failed_paths;
+      summary.failures.emplace_back(static_cast<std::int64_t>(path), why);
+    };
     for (std::size_t path = 0; path < ends.size(); ++path) {
       const PathEnd& e = ends[path];
       Endpoint point;
       if (!e.reached) {
-        ++summary.failed_paths;
+        fail(path, e.failure);
         continue;
       }
-      const double finite = homotopy.finiteness(e.X);
-      bool infinite = !(finite > 1e-8);
+      // At infinity when its homogenising coordinate is zero to the accuracy of its end: the end game's last two
+      // estimates of X(0) apart, or rounding for a path tracked straight to t = 0.
+      bool infinite = !(homotopy.finiteness(e.X) > std::max(kAtInfinity, 10.0 * e.accuracy));
       if (!infinite) {
         point.x = homotopy.affine(e.X);
-        const Eigen::VectorXcd reached = point.x;
         point.residual = modes_detail::refine_endpoint(original, point.x, &point.condition);
-        infinite = !(inf_norm(point.x) < 1e8) || !point.x.allFinite();
-        // a path stopped short of t = 0 that Newton takes far from where it stopped did not end at that solution
-        // (Newton's basin is wide): diverging (its homogenising coordinate already small), or failed
-        if (!infinite && e.t > 0.0 && !(inf_norm(point.x - reached) <= 1e-2 * (1.0 + inf_norm(point.x)))) {
-          if (!(finite < 1e-2)) {
-            ++summary.failed_paths;
-            continue;
-          }
-          infinite = true;
+        if (!(inf_norm(point.x) < 1e8) || !point.x.allFinite()) {
+          fail(path, "Newton on the equations goes off to infinity from its end");
+          continue;
         }
-        // a path stopped short of t = 0 (its step collapsed in the end game) with X0 already small and no solution
-        // near it: diverging, to a solution set at infinity
-        if (!infinite && !(point.residual <= 1e-8) && e.t > 0.0 && finite < 1e-2) infinite = true;
-        if (!infinite && !(point.residual <= 1e-8)) {
-          ++summary.failed_paths;  // solves the squared-up system (or the path was lost), not the original
+        if (!(point.residual <= 1e-8)) {  // solves the squared-up system (or the path was lost), not the original
+          fail(path, "its end solves none of the original equations to 1e-8 (residual " +
+                         std::to_string(point.residual) + ")");
           continue;
         }
       }
@@ -328,7 +362,7 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
         Eigen::Index largest = 0;
         e.X.tail(n).cwiseAbs().maxCoeff(&largest);
         point.x = e.X.tail(n) / e.X(groups + largest);
-        point.residual = 0.0, point.condition = std::numeric_limits<double>::infinity();
+        at_infinity_residual(target, chosen.start.grouping, e.X, point);
       } else if (!(point.condition <= options.singular_condition)) {
         point.kind = EndpointKind::kSingular;
       } else {
@@ -370,7 +404,7 @@ ModesSummary solve_polynomial_system(const PolynomialSystem& system, const Modes
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, again.size(), 1), [&](const auto& range) {
         for (std::size_t k = range.begin(); k != range.end(); ++k)
-          ends[static_cast<std::size_t>(again[k])] = modes_detail::track_path(homotopy, again[k], true);
+          ends[static_cast<std::size_t>(again[k])] = modes_detail::track_path(homotopy, again[k], max_winding, true);
       });
     });
     classify();

@@ -5,13 +5,27 @@
 // The end game. A path that ends at a regular solution is tracked to t = 0 itself. One that ends at a singular
 // point (several paths meet there, or a solution set at infinity) cannot be: near t = 0 the paths that meet are
 // branches of one Puiseux series X(t) = Σ a_k t^{k/c} (c the winding number) and the corrector's step collapses.
-// Such a path is taken back to its point at t = 0.1 and run round circles |t| = r in the complex plane (Cauchy's
-// end game, Morgan, Sommese and Wampler 1991): after c turns it is back where it began, and the mean of its points
-// at equally spaced angles over those turns is X(0) by Cauchy's integral formula in s = t^{1/c} (the trapezoid rule
-// on a circle, exact to r^{K/c} for K points a turn). The radius shrinks by 4 until two estimates agree.
+// Below t = 0.1 a path is taken in pieces t = 0.1 / 4^k, whose points estimate c (|X_k − X_{k+1}| ∝ t_k^{1/c}).
+// A path whose step collapses, or whose estimates settle at c ≥ 2, is run round circles |t| = r in the complex
+// plane from the first radius where the estimates settled (Cauchy's end game, Morgan, Sommese and Wampler 1991):
+// after c turns it is back where it began, and the mean of its points at equally spaced angles over those turns is
+// X(0) by Cauchy's integral formula in s = t^{1/c} (the trapezoid rule on a circle, exact to r^{K/c} for K points a
+// turn). The radius shrinks by 4 until two estimates agree.
+//
+// Every path whose step collapses short of t = 0 goes through the end game, whether it ends at a finite
+// singular point or at infinity: on the patch, a path to infinity is a path to a finite point with X_j0 = 0, and
+// the end game places that point as it places any other, so that the path is classified by the homogenising
+// coordinate of its end (homotopy_solve.cpp), not by where its step collapsed. The winding number is found by
+// turning until the path closes, up to ModesOptions::max_winding turns (and no more than the paths there are: c
+// paths meet at an end of winding number c); a path that does not close within them is failed, with its reason.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <numbers>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <Eigen/LU>
 
@@ -97,21 +111,39 @@ bool track_piece(const Homotopy& h, Eigen::VectorXcd& X, const Piece& piece, Tra
   return s >= 1.0;
 }
 
+// x in three significant digits, for a failed path's reason
+std::string short_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", x);
+  return text;
+}
+
 constexpr double kEndGameStart = 0.1;  // the radius of the first circle
 constexpr int kPointsPerTurn = 8;
-constexpr int kMaxWinding = 8;
 
-// Cauchy's end game from X on the path at t = r (the file's comment): true with *estimate = X(0) and *winding.
+// How an end game went.
+struct EndGame {
+  bool ended = false;
+  Eigen::VectorXcd estimate;  // X(0)
+  int winding = 0;
+  double accuracy = std::numeric_limits<double>::infinity();  // |last two estimates' difference| / (1 + |X|)
+  std::string failure;                                        // why not, when not ended
+};
+
+// Cauchy's end game from X on the path at t = r (the file's comment), at most max_winding turns a circle.
 // theta0: the circles begin (and the radius shrinks) on the ray at that angle.
-bool cauchy_end_game(const Homotopy& h, Eigen::VectorXcd X, double r, double theta0, Tracking& tr,
-                     Eigen::VectorXcd* estimate, int* winding) {
+EndGame cauchy_end_game(const Homotopy& h, Eigen::VectorXcd X, double r, double theta0, int max_winding, Tracking& tr) {
+  EndGame out;
   Eigen::VectorXcd previous;
+  auto closed = [](const Eigen::VectorXcd& at, const Eigen::VectorXcd& begin) {
+    return inf_norm(at - begin) <= 1e-7 * (1.0 + inf_norm(begin));
+  };
   for (int round = 0; round < 10 && r > 1e-12; ++round) {
     const Eigen::VectorXcd begin = X;
     Eigen::VectorXcd sum = Eigen::VectorXcd::Zero(X.size()), at = X;
     int turns = 0, points = 0;
     double stopped = 0.0;
-    while (turns < kMaxWinding) {
+    while (turns < max_winding) {
       for (int k = 0; k < kPointsPerTurn; ++k) {
         sum += at, ++points;
         const Piece arc{0.0,
@@ -120,67 +152,162 @@ bool cauchy_end_game(const Homotopy& h, Eigen::VectorXcd X, double r, double the
                         r,
                         theta0 + 2.0 * std::numbers::pi * k / kPointsPerTurn,
                         2.0 * std::numbers::pi / kPointsPerTurn};
-        if (!track_piece(h, at, arc, tr, &stopped)) return false;
+        if (!track_piece(h, at, arc, tr, &stopped)) {
+          out.failure = "its step collapsed on the end game's circle |t| = " + short_number(r);
+          return out;
+        }
       }
       ++turns;
-      if (inf_norm(at - begin) <= 1e-7 * (1.0 + inf_norm(begin))) break;
+      if (closed(at, begin)) break;
     }
-    if (!(inf_norm(at - begin) <= 1e-7 * (1.0 + inf_norm(begin)))) return false;
+    if (!closed(at, begin)) {
+      out.failure = "it did not close within " + std::to_string(max_winding) + (max_winding == 1 ? " turn" : " turns") +
+                    " of |t| = " + short_number(r) +
+                    " (its winding number is above the limit, ModesOptions::max_winding)";
+      return out;
+    }
     const Eigen::VectorXcd mean = sum / static_cast<double>(points);
-    *winding = turns;
-    if (previous.size() && inf_norm(mean - previous) <= 1e-9 * (1.0 + inf_norm(mean))) {
-      *estimate = mean;
-      return true;
+    out.winding = turns, out.estimate = mean;
+    if (previous.size()) out.accuracy = inf_norm(mean - previous) / (1.0 + inf_norm(mean));
+    if (previous.size() && out.accuracy <= 1e-9) {
+      out.ended = true;
+      return out;
     }
-    previous = mean, *estimate = mean;
+    previous = mean;
     const Piece inward{std::polar(r, theta0), std::polar(r / 4.0, theta0)};
-    if (!track_piece(h, X, inward, tr, &stopped)) return round > 0;  // the last estimate, if there is one
+    if (!track_piece(h, X, inward, tr, &stopped)) break;
     r /= 4.0;
   }
-  return previous.size() > 0;
+  // where the path cannot be taken closer, or after the last round: the last estimate when the last two agree to
+  // 1e-6 (its accuracy then says how good it is)
+  out.ended = previous.size() > 0 && out.winding > 0 && out.accuracy <= 1e-6;
+  if (!out.ended)
+    out.failure = "the end game's estimates of its end did not settle (apart by " + short_number(out.accuracy) + ")";
+  return out;
+}
+
+constexpr double kShrink = 4.0;  // the ratio of successive radii along the ray
+
+// log(kShrink) over log of the ratio of two successive differences along the ray: the cycle number c of the path's
+// Puiseux series X(t) = X(0) + a t^{1/c} + … (each difference shrinks by kShrink^{1/c}); 0 when the differences do
+// not shrink.
+double cycle_estimate(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b, const Eigen::VectorXcd& c) {
+  const double d1 = inf_norm(a - b), d2 = inf_norm(b - c);
+  return d2 > 0.0 && d1 > d2 ? std::log(kShrink) / std::log(d1 / d2) : 0.0;
+}
+
+using RaySamples = std::vector<std::pair<double, Eigen::VectorXcd>>;  // (t on the ray, X there)
+
+// The first sample k where two successive estimates of the cycle number (from samples k … k + 3) round to one
+// integer within 0.1, and that integer; (−1, 0) when there is none.
+std::pair<std::ptrdiff_t, int> settled_cycle(const RaySamples& along) {
+  auto settled = [](double c) { return c >= 0.9 && std::abs(c - std::round(c)) <= 0.1; };
+  for (std::size_t k = 0; k + 3 < along.size(); ++k) {
+    const double c1 = cycle_estimate(along[k].second, along[k + 1].second, along[k + 2].second);
+    const double c2 = cycle_estimate(along[k + 1].second, along[k + 2].second, along[k + 3].second);
+    if (settled(c1) && settled(c2) && std::round(c1) == std::round(c2))
+      return {static_cast<std::ptrdiff_t>(k), static_cast<int>(std::round(c1))};
+  }
+  return {-1, 0};
+}
+
+// The path from t = 0.1 (X) along the ray at angle theta to t = 0.1 / 4^k, k = 1, 2, …, down to `floor`, while it
+// can be taken (*collapsed: the |t| where its step collapsed, else 0), and, when `stop_at_cycle` is true, no further
+// than where its cycle-number estimates settle at 2 or more (its end is singular: the end game's).
+RaySamples sample_ray(const Homotopy& h, Eigen::VectorXcd X, double theta, double floor, bool stop_at_cycle,
+                      Tracking& tr, double* collapsed) {
+  RaySamples along{{kEndGameStart, X}};
+  double stopped = 0.0;
+  *collapsed = 0.0;
+  for (double r = kEndGameStart; r / kShrink >= floor; r /= kShrink) {
+    if (!track_piece(h, X, Piece{std::polar(r, theta), std::polar(r / kShrink, theta)}, tr, &stopped)) {
+      *collapsed = r - stopped * (r - r / kShrink);
+      break;
+    }
+    along.emplace_back(r / kShrink, X);
+    if (stop_at_cycle && along.size() >= 4 && settled_cycle(along).second >= 2) break;
+  }
+  return along;
+}
+
+// The radii to start the end game at, with the path's point there, from its samples along a ray. A circle round
+// t = 0 holds the path's Puiseux series only inside its radius of convergence (other branch points of the homotopy
+// cluster near t = 0 when paths go to a solution set at infinity: a circle round them too permutes many paths, and
+// does not close within a few turns): the first radius where the cycle-number estimates settle, then 16 and 256
+// times smaller; without such a radius, the three smallest at least 16 times above where the step collapsed.
+RaySamples end_game_radii(RaySamples along, double collapsed) {
+  const std::ptrdiff_t first = settled_cycle(along).first;
+  while (first < 0 && along.size() > 1 && along.back().first < 16.0 * collapsed) along.pop_back();
+  std::size_t begin = first >= 0 ? static_cast<std::size_t>(first) : along.size() >= 3 ? along.size() - 3 : 0;
+  RaySamples radii;
+  for (std::size_t k = begin; k < along.size() && radii.size() < 3; k += 2) radii.push_back(along[k]);
+  return radii;
 }
 
 }  // namespace
 
-PathEnd track_path(const Homotopy& h, std::int64_t p, bool careful) {
+PathEnd track_path(const Homotopy& h, std::int64_t p, int max_winding, bool careful) {
   // careful: the second pass over the paths that failed or met another path's end (homotopy_solve.cpp), with
   // steps ten times shorter at most and a closer first correction, which keep a path from jumping onto another
   Tracking tr{careful ? 0.01 : 0.1, careful ? 1e-5 : 1e-3};
-  // Without a converged end game, a path whose step collapses below kEndGame has reached its end all the same: the
-  // endpoint is refined by Newton on the original equations and classified (a point Newton does not take onto a
-  // solution is a failed path).
-  constexpr double kEndGame = 1e-3;
   PathEnd end;
   end.X = h.start(p);
   double stopped = 0.0;
   if (!track_piece(h, end.X, Piece{1.0, kEndGameStart}, tr, &stopped)) {
     end.t = 1.0 - stopped * (1.0 - kEndGameStart);
     end.steps = tr.steps;
+    end.failure = "its step collapsed at t = " + short_number(end.t) + ", before the end game's circle";
     return end;
   }
+  // Along the ray in pieces t = 0.1 / 4^k, whose points estimate the cycle number of the path's Puiseux series: to
+  // t = 1e-10 and then straight to 0 for a path whose end is regular; a path whose cycle number settles at 2 or more
+  // (a singular end) or whose step collapses goes to the end game.
   const Eigen::VectorXcd at_start = end.X;
-  const bool straight = track_piece(h, end.X, Piece{kEndGameStart, 0.0}, tr, &stopped);
-  end.t = straight ? 0.0 : kEndGameStart * (1.0 - stopped);
-  end.reached = straight || end.t < kEndGame;
-  // the end game for a path still at a finite distance: one whose homogenising coordinate has fallen below
-  // kInfinite of its size (in a group) diverges, and its classification needs no more (homotopy_solve.cpp)
-  constexpr double kInfinite = 1e-4;
-  if (!straight && h.finiteness(end.X) >= kInfinite) {
-    Eigen::VectorXcd estimate;
-    int winding = 0;
-    bool ended = cauchy_end_game(h, at_start, kEndGameStart, 0.0, tr, &estimate, &winding);
-    // The circle |t| = 0.1 may enclose a singular point of the homotopy other than t = 0 (the γ trick keeps them
-    // off the real segment, not far from it; the straight step collapsed there): round it, along the arc to the
-    // angle ±π/6 and in along that ray, and the end game on circles smaller than where the straight path stopped.
-    for (const double theta : {std::numbers::pi / 6.0, -std::numbers::pi / 6.0}) {
-      if (ended || end.t < 1e-8) break;
-      Eigen::VectorXcd X = at_start;
-      const double r = end.t / 4.0;
-      if (track_piece(h, X, Piece{0.0, 0.0, true, kEndGameStart, 0.0, theta}, tr, &stopped) &&
-          track_piece(h, X, Piece{std::polar(kEndGameStart, theta), std::polar(r, theta)}, tr, &stopped))
-        ended = cauchy_end_game(h, X, r, theta, tr, &estimate, &winding);
+  double collapsed = 0.0;
+  const RaySamples along = sample_ray(h, at_start, 0.0, 1e-10, true, tr, &collapsed);
+  const bool settled = collapsed == 0.0 && settled_cycle(along).second >= 2;
+  bool straight = false;
+  end.X = along.back().second, end.t = along.back().first;
+  if (collapsed == 0.0 && !settled) {
+    straight = track_piece(h, end.X, Piece{end.t, 0.0}, tr, &stopped);
+    end.t = straight ? 0.0 : end.t * (1.0 - stopped);
+  } else if (collapsed > 0.0) {
+    end.t = collapsed;
+  }
+  end.reached = straight;
+  if (!straight) {
+    // the end game for every path whose step collapsed or whose end is singular, at a finite point or at infinity
+    // alike, on circles where the path's own points say its Puiseux series holds (end_game_radii)
+    EndGame game;
+    for (const auto& [r, X] : end_game_radii(along, collapsed > 0.0 ? collapsed : end.t)) {
+      game = cauchy_end_game(h, X, r, 0.0, max_winding, tr);
+      if (game.ended) break;
     }
-    if (ended) end.X = estimate, end.t = 0.0, end.reached = true, end.winding = winding;
+    // Failing that, the same along the rays at ±π/6, reached along the arc |t| = 0.1: the straight path may have
+    // collapsed near a singular point of the homotopy other than t = 0 (the γ trick keeps them off the real segment,
+    // not far from it), or lost its accuracy near t = 0 before its Puiseux series settled.
+    for (const double theta : {std::numbers::pi / 6.0, -std::numbers::pi / 6.0}) {
+      if (game.ended) break;
+      Eigen::VectorXcd X = at_start;
+      if (!track_piece(h, X, Piece{0.0, 0.0, true, kEndGameStart, 0.0, theta}, tr, &stopped)) continue;
+      double lost = 0.0;
+      const RaySamples ray = sample_ray(h, X, theta, 1e-14, false, tr, &lost);
+      for (const auto& [r, Y] : end_game_radii(ray, lost)) {
+        EndGame around = cauchy_end_game(h, Y, r, theta, max_winding, tr);
+        if (around.ended) {
+          game = std::move(around);
+          break;
+        }
+      }
+    }
+    if (game.ended) {
+      end.X = game.estimate, end.t = 0.0, end.reached = true, end.winding = game.winding;
+      end.accuracy = game.accuracy;
+    } else {
+      end.failure = (settled ? "its end is singular (its cycle number settled by t = " + short_number(end.t) + ")"
+                             : "its step collapsed at t = " + short_number(end.t)) +
+                    " and " + game.failure;
+    }
   }
   end.steps = tr.steps;
   return end;
