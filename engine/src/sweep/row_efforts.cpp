@@ -33,6 +33,7 @@ bool Sweeper::row_efforts() {
   // A regular position with finite q, q̇, q̈ whose forces or multipliers are not finite: masses, inertias or loads
   // so large that their products overflow (a gravity of 1e308). NaN there would pass for a singular position's.
   if (!effort_work_.q.allFinite() || !effort_work_.lambda.allFinite()) {
+    not_defined();  // (a Stepper, which delivers the row whatever, then reads NaN, not the last row's values)
     Index j = 0;
     while (j + 1 < effort_work_.q.size() && std::isfinite(effort_work_.q(j))) ++j;
     return fail(SolveStatus::kNonFinite,
