@@ -207,7 +207,7 @@ TEST_F(AnimateHtml, ForceArrowsHoldTheResultsEffortsAndReactionsAtTheirJoints) {
   const Result negative = run("animate " + phiq::test::model_path("seed/fourbar_natural.yaml") + " -o " +
                               (dir_ / "n.html").string() + " --forces -1");
   EXPECT_EQ(negative.code, 2);
-  EXPECT_NE(negative.err.find("the scale must be a positive number"), std::string::npos) << negative.err;
+  EXPECT_NE(negative.err.find("a positive number of metres per newton"), std::string::npos) << negative.err;
   EXPECT_FALSE(fs::exists(dir_ / "n.html"));
 }
 

@@ -76,3 +76,17 @@ def test_a_threshold_below_zero_is_refused():
     scene = phiq.parse_scene(clearance_balls_text(), "balls.yaml")
     with pytest.raises(ValueError, match="threshold -0.001 must be 0 or more"):
         phiq.clearance(scene, threshold=-0.001)
+
+
+def test_a_threshold_beyond_a_boxs_squared_size_measures_every_pair():
+    """An infinite threshold (and 1e300, whose squares overflow) made the broad phase's boxes infinite, and FCL's
+    tree read outside its nodes (SIGSEGV): every pair is then a candidate, measured as with explicit pairs."""
+    with open(os.path.join(MODELS, "clearance", "fourbar_knee.yaml")) as f:
+        text = f.read()
+    scene = phiq.parse_scene(text, "knee.yaml")
+    near = phiq.clearance(scene, threshold=10.0)  # the broad phase keeps every pair within 10 m: all of them
+    for threshold in (1e300, math.inf):
+        r = phiq.clearance(scene, threshold=threshold)
+        assert r["columns"] == near["columns"]
+        assert r["pairs_selected"] == near["pairs_selected"] == r["pairs_measured"]
+        assert np.array_equal(r["distance"], near["distance"])

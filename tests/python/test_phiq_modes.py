@@ -59,3 +59,23 @@ def test_a_cam_is_refused_with_its_constraint_named():
     scene = phiq.load_scene(os.path.join(MODELS, "cams", "eccentric_knife.yaml"))
     with pytest.raises(ValueError, match="constraint 'cam' is not polynomial"):
         phiq.modes(scene)
+
+
+def test_options_out_of_range_are_value_errors_not_signals():
+    """A thread count of 10**7 asked TBB for an arena of that many slots (SIGSEGV); a time that is not finite blamed
+    the driver ("not polynomial"); max_paths below 1 and negative threads were taken."""
+    scene = phiq.load_scene(os.path.join(MODELS, "seed", "fourbar_natural.yaml"))
+    with pytest.raises(ValueError, match="threads must be from 0 \\(all cores\\) to 1000000, not 10000000"):
+        phiq.modes(scene, threads=10**7)
+    with pytest.raises(ValueError, match="threads must be from 0 \\(all cores\\) to 1000000, not -1"):
+        phiq.modes(scene, threads=-1)
+    with pytest.raises(ValueError, match="max_paths must be 1 or more, not 0"):
+        phiq.modes(scene, max_paths=0)
+    for t in (math.nan, math.inf):
+        with pytest.raises(ValueError, match="ModesOptions: time (nan|inf) is not finite"):
+            phiq.modes(scene, t)
+    with pytest.raises(ValueError, match="SweepOptions: threads must be from 0 \\(all cores\\) to 1000000"):
+        phiq.run_sweep(scene, threads=10**7)
+    with pytest.raises(ValueError, match="run_batch: threads must be from 0 \\(all cores\\) to 1000000"):
+        phiq.run_batch(scene, [{"L2": 0.4}], threads=10**7)
+    assert phiq.modes(scene, threads=2)["q"].shape[0] == 4  # the bound leaves every real count alone

@@ -113,7 +113,7 @@ def test_options_and_errors():
         phiq.run_sweep(scene, thread=2)
     with pytest.raises(ValueError, match="SweepOptions: steps must be >= 0"):
         phiq.run_sweep(scene, steps=-1)
-    with pytest.raises(ValueError, match="threads must be >= 0"):
+    with pytest.raises(ValueError, match="threads must be from 0 \\(all cores\\) to 1000000, not -2"):
         phiq.run_sweep(scene, threads=-2)
 
 

@@ -4,6 +4,7 @@
 // --modes, every real assembly mode of the scene at its start (phiq/modes.hpp), one pose per mode in the HTML
 // viewer; its options, the checks of its input and the atomic write.
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -107,9 +108,6 @@ int cmd_animate(const AnimateOptions& o) {
   if (o.modes && o.forces != 0.0) return fail("animate: --forces: the modes are poses, with no efforts to draw", 2);
   if (!html && o.forces != 0.0)
     return fail("animate: --forces: the force arrows are the HTML viewer's; a .glb has none", 2);
-  if (!(o.forces >= 0.0) || !std::isfinite(o.forces))
-    return fail(
-        "animate: --forces " + shortest(o.forces) + ": the scale must be a positive number of metres per newton", 2);
   if (const auto clash = output_clash({{"-o", o.out}}, {{"the scene", o.scene}, {"the result", o.result}}))
     return fail("animate: " + *clash, 2);
   std::string text;
@@ -186,9 +184,13 @@ Command register_animate(CLI::App& app) {
   animate->add_flag("--modes", options->modes,
                     "HTML: every real assembly mode of the scene at time.start, one pose per mode (the plots' t is "
                     "the mode's number)");
-  animate->add_option("--forces", options->forces,
-                      "HTML: draw the scene's output.efforts and output.reactions as arrows, SCALE metres per "
-                      "newton (moments: arcs of SCALE metres per N m in the plane, arrows along their axis in space)");
+  animate
+      ->add_option("--forces", options->forces,
+                   "HTML: draw the scene's output.efforts and output.reactions as arrows, SCALE metres per "
+                   "newton (moments: arcs of SCALE metres per N m in the plane, arrows along their axis in space)")
+      // (0 is refused, not taken as the default's "no arrows")
+      ->check(number(std::numeric_limits<double>::denorm_min(), HUGE_VAL, false,
+                     "the scale, a positive number of metres per newton"));
   add_set_option(animate, &options->sets);
   return {animate, [options] { return cmd_animate(*options); }};
 }

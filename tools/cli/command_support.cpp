@@ -2,6 +2,7 @@
 #include "command_support.hpp"
 
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <optional>
@@ -118,6 +119,16 @@ void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args) {
       ->allow_extra_args(false);
 }
 
+// An error of the scene an import of `path` wrote ("PATH:LINE:COL: field: why", at a line of a text the user has not
+// seen) as one the user can place; any other message unchanged.
+static std::string converted_scene_error(const std::string& path, const std::string& what) {
+  const std::string prefix = path + ":";
+  if (what.rfind(prefix, 0) != 0 || what.size() == prefix.size() ||
+      !std::isdigit(static_cast<unsigned char>(what[prefix.size()])))
+    return what;
+  return path + ": the scene it converts to (phiq convert) is refused at " + what.substr(prefix.size());
+}
+
 // (command_support.hpp)
 std::optional<std::string> import_or_report(const std::string& path, const ImportOptions& options) {
   try {
@@ -130,6 +141,14 @@ std::optional<std::string> import_or_report(const std::string& path, const Impor
     } else {
       ModelImport imported = import_model_file(path, options);
       yaml = std::move(imported.yaml), skipped = std::move(imported.skipped), gravity = std::move(imported.gravity);
+    }
+    // the scene phiq itself would refuse (an MJCF geom of negative size) is refused here, before the list of what
+    // was left out, so that the refusal is the one line
+    try {
+      (void)phiq::parse_scene(yaml, path);
+    } catch (const SceneError& e) {
+      fail(converted_scene_error(path, e.what()), 2);
+      return std::nullopt;
     }
     for (const std::string& why : skipped) std::fprintf(stderr, "phiq: not mapped: %s\n", printable(why).c_str());
     if (options.forces && !gravity.empty()) std::fprintf(stderr, "phiq: gravity %s\n", printable(gravity).c_str());

@@ -49,9 +49,10 @@ void add_sensitivity_option(CLI::App* command, std::vector<std::string>* args);
 // (parameter_settings()) and the sensitivities `sensitivity_args` asks for in place of its output.sensitivities
 // (sensitivity_requests(): made as the scene is read, SceneOverrides::sensitivities); on a scene, --set or
 // --sensitivity error its one line is printed and the result is empty (the command exits 2).
-// The phiq scene of an `.asmt`, URDF or MJCF file (import_asmt(), import_model_file() with `options`), what it
-// leaves out listed on standard error ("phiq: not mapped: FILE:LINE: ..."); or its error reported (exit status 2)
-// and nothing.
+// The phiq scene of an `.asmt`, URDF, MJCF or SDF file (import_asmt(), import_model_file() with `options`), read
+// once as a scene, what it leaves out listed on standard error ("phiq: not mapped: FILE:LINE: ..."); or its error,
+// or that scene's ("PATH: the scene it converts to (phiq convert) is refused at LINE:COL: ..."), reported (exit
+// status 2) and nothing.
 std::optional<std::string> import_or_report(const std::string& path, const ImportOptions& options = {});
 
 // `--drive JOINT=EXPR` (repeatable), `--time START END STEPS` and `--gravity X,Y,Z` on `command` (convert, run),

@@ -24,7 +24,7 @@ struct BatchSummary {
 /// one symbolic analysis. `on_step(case, step)` is called for every row, from the thread running that case: rows
 /// of one case in time order, different cases concurrently (the callback must be thread-safe across cases).
 /// Returning false stops that case (kCancelled). A failed case does not stop the others.
-/// Pre-conditions (phiq::Error): no null model; threads ≥ 0.
+/// Pre-conditions (phiq::Error): no null model; threads from 0 to 1000000.
 BatchSummary run_batch(const std::vector<const Model*>& models, const SweepOptions& options, int threads,
                        const std::function<bool(std::size_t, const StepView&)>& on_step);
 /// run_batch() with options per case (`options[c]` for `models[c]`; as many as models, else phiq::Error): for cases

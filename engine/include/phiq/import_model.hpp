@@ -33,11 +33,11 @@ ModelFormat model_format(const std::string& path);
 struct ImportOptions {
   /// Joint drivers: the file's joint name and an expression of `t` (and `pi`) for its angle (revolute,
   /// continuous, hinge: rad, 0 at the model's pose) or travel (prismatic, slide: m), as `phiq convert --drive
-  /// JOINT=EXPR` writes them.
+  /// JOINT=EXPR` writes them; each joint once (SceneError for a second).
   std::vector<std::pair<std::string, std::string>> drives;
-  double t_start = 0.0;  ///< the time grid's start (s)
+  double t_start = 0.0;  ///< the time grid's start (s), finite (else SceneError, as t_end)
   double t_end = 0.0;    ///< its end (s); with no drives and t_end == t_start: the model's pose alone
-  int steps = 0;         ///< its intervals (0: one row at t_start)
+  int steps = 0;         ///< its intervals (0: one row at t_start; more need t_end ≠ t_start)
   /// The shapes are what the caller works on (`phiq clearance`): a URDF mesh whose `package://` cannot be found is
   /// refused rather than left out.
   bool need_geometry = false;

@@ -71,10 +71,11 @@ enum class StartSystemChoice {
 
 /// Settings of solve_polynomial_system() and find_assembly_modes().
 struct ModesOptions {
-  double time = 0.0;  ///< T, the time at which the drivers are evaluated (find_assembly_modes())
-  /// Refuse (ModesStatus::kTooManyPaths) rather than track more paths than this.
+  double time = 0.0;  ///< T, the time at which the drivers are evaluated (find_assembly_modes()): finite
+  /// Refuse (ModesStatus::kTooManyPaths) rather than track more paths than this; 1 or more (else phiq::Error).
   std::int64_t max_paths = 100000;
-  int threads = 0;                ///< worker threads for the paths; 0: TBB's default
+  /// Worker threads for the paths; 0: TBB's default; at most 1000000 (else phiq::Error).
+  int threads = 0;
   std::uint64_t seed = 20261202;  ///< seed of γ, the affine patch and the fitting points: a run is reproducible
   /// An endpoint whose Jacobian's condition number (2-norm, the variables scaled) is above this is singular.
   /// (Several paths at one regular point are counted in ModesSummary::duplicate_paths, not made singular.)

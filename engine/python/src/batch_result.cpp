@@ -57,7 +57,8 @@ py::dict batch_scene(const Scene& scene, const std::vector<std::string>& names,
     throw Error("run_batch: the cases' values are " + std::to_string(values.ndim()) + "-dimensional with " +
                 std::to_string(values.ndim() == 2 ? values.shape(1) : 0) +
                 " columns; they need one column for each of the " + std::to_string(names.size()) + " parameter names");
-  if (threads < 0) throw Error("run_batch: threads must be ≥ 0 (0: all cores), not " + std::to_string(threads));
+  if (threads < 0 || threads > 1000000)  // (the engine's bound: a TBB arena of 10⁷ slots is SIGSEGV)
+    throw Error("run_batch: threads must be from 0 (all cores) to 1000000, not " + std::to_string(threads));
   const std::size_t n = static_cast<std::size_t>(values.shape(0));
   const double* all_values = values.data();
   const std::vector<SensitivityRequest> asked =

@@ -55,7 +55,8 @@ void bind_modes(py::module_& m) {
       "'at_infinity', 'failed_paths', 'method' (whole system or block by block), 'method_note' (why not block "
       "by block) and 'start_system' (total degree or multi-homogeneous, degrees lowered or not). Raises ValueError "
       "naming the constraint when one is not polynomial, or when "
-      "the paths are more than max_paths.");
+      "the paths are more than max_paths; for a t that is not finite, threads outside 0 to 1000000 or max_paths "
+      "below 1.");
 }
 
 }  // namespace phiq::python

@@ -10,6 +10,8 @@ namespace phiq::detail {
 
 namespace {
 
+constexpr double kLargestSide = 1e100;  // m: a box side whose square FCL's norms hold with room to spare
+
 // FCL's callback for each pair of objects whose boxes overlap: the boxes are the objects, so that is the answer.
 bool record_pair(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, void* data) {
   auto* found = static_cast<std::vector<std::pair<Index, Index>>*>(data);
@@ -43,6 +45,18 @@ BroadPhase::~BroadPhase() = default;
 
 std::vector<std::pair<Index, Index>> BroadPhase::overlapping(const std::vector<SweptBox>& boxes) {
   Impl& m = *impl_;
+  // FCL bounds a box by the norm of its half-diagonal: a side beyond ~1e154 (a threshold of 1e300 m, a speed
+  // that overflows) makes that infinite and the tree's arithmetic NaN, and its queries then read outside their
+  // nodes. Boxes that large overlap everything anyway: every pair is a candidate.
+  const auto huge = [](const SweptBox& b) {
+    return !(b.hi.x - b.lo.x < kLargestSide && b.hi.y - b.lo.y < kLargestSide && b.hi.z - b.lo.z < kLargestSide);
+  };
+  if (std::any_of(m.part.begin(), m.part.end(), [&](Index p) { return huge(boxes[static_cast<std::size_t>(p)]); })) {
+    std::vector<std::pair<Index, Index>> every;
+    for (std::size_t i = 0; i < m.part.size(); ++i)
+      for (std::size_t j = i + 1; j < m.part.size(); ++j) every.emplace_back(m.part[i], m.part[j]);
+    return every;
+  }
   for (std::size_t j = 0; j < m.objects.size(); ++j) {
     const SweptBox& b = boxes[static_cast<std::size_t>(m.part[j])];
     m.shapes[j]->side = fcl::Vector3d(b.hi.x - b.lo.x, b.hi.y - b.lo.y, b.hi.z - b.lo.z);

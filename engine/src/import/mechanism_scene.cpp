@@ -145,7 +145,19 @@ void MechanismWriter::drivers() {
     if (name == "t") return NameBinding{NameBinding::Kind::kTime};
     return std::nullopt;
   };
+  // The grid as the scene reader would refuse it, but named as the caller gave it (not at a line of the text
+  // written here, which no user has seen)
+  if (!std::isfinite(o_.t_start) || !std::isfinite(o_.t_end))
+    refuse(m_.path, 0, "--time " + shortest(o_.t_start) + " " + shortest(o_.t_end) + ": START and END must be finite");
+  if (o_.steps < 0) refuse(m_.path, 0, "--time: STEPS must be 0 or more, not " + std::to_string(o_.steps));
+  if (o_.steps > 0 && o_.t_start == o_.t_end)
+    refuse(m_.path, 0,
+           "--time: START and END are both " + shortest(o_.t_start) + ": " + std::to_string(o_.steps) +
+               " steps need END ≠ START");
+  std::set<std::string> driven;
   for (const auto& [joint, law] : o_.drives) {
+    if (!driven.insert(joint).second)
+      refuse(m_.path, 0, "--drive " + joint + ": the joint is driven twice (one --drive per joint)");
     int found = -1;
     for (std::size_t k = 0; k < m_.joints.size(); ++k)
       if (m_.joints[k].name == joint) found = static_cast<int>(k);

@@ -4,6 +4,7 @@
 // each joint joins its parent and child links at the joint frame, at the links' poses in the file. A link that no
 // joint joins to `world` moves freely, as in SDF. This file is the module libphiq_sdf.so, which the engine loads on
 // the first SDF file it reads (sdf_module.hpp says why).
+#include <console_bridge/console.h>
 #include <sdf/Console.hh>
 #include <sdf/Geometry.hh>
 #include <sdf/Joint.hh>
@@ -15,6 +16,7 @@
 #include <sdf/Visual.hh>
 #include <sdf/World.hh>
 #include <sdf/parser.hh>
+#include <tinyxml2.h>
 #include <sdf/Box.hh>
 #include <sdf/Capsule.hh>
 #include <sdf/Cylinder.hh>
@@ -35,6 +37,15 @@ namespace phiq {
 
 namespace detail::mechanism {
 namespace {
+
+// urdfdom, which libsdformat asks whether a file it cannot read as SDF is URDF, prints its refusal on standard
+// error through console_bridge ("Error: Could not find the 'robot' element"): quiet while libsdformat reads, so
+// that phiq's refusal is the one line. console_bridge's handler is one per process: this one lives as long as the
+// process, so that a handler left set by readers on two threads never dangles.
+class SdfQuietUrdfdom : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string&, console_bridge::LogLevel, const char*, int) override {}
+};
 
 Eigen::Vector3d sdf_vector(const ignition::math::Vector3d& v) { return {v.X(), v.Y(), v.Z()}; }
 Pose sdf_pose(const ignition::math::Pose3d& p) {
@@ -238,6 +249,11 @@ void SdfReader::sdf_gravity(const sdf::Root& root) {
 Mechanism SdfReader::read(int* loops) {
   m_.path = path_, m_.format = "SDF";
   m_.units = "lengths in metres, angles in radians, mass in kg, time in seconds.";
+  {  // as the URDF and MJCF readers say it (libsdformat's own message holds the whole text, and no line)
+    tinyxml2::XMLDocument xml;
+    if (xml.Parse(text_.data(), text_.size()) != tinyxml2::XML_SUCCESS)
+      refuse(path_, xml.ErrorLineNum(), std::string("malformed XML (the file may be truncated): ") + xml.ErrorName());
+  }
   sdf::Root root;
   {
     static std::mutex sdformat_console;  // libsdformat's console is one per process: quiet while it reads
@@ -246,7 +262,10 @@ Mechanism SdfReader::read(int* loops) {
     sdf::ParserConfig config;
     std::vector<std::string> unresolved;
     config.SetFindCallback([&](const std::string& uri) { return sdf_find_resource(uri, &unresolved); });
+    static SdfQuietUrdfdom quiet;
+    console_bridge::useOutputHandler(&quiet);
     const sdf::Errors errors = root.LoadSdfString(text_, config);
+    console_bridge::restorePreviousOutputHandler();
     if (!errors.empty() && !unresolved.empty()) {  // an <include> not found: its line, where its URI is written
       const std::size_t at = text_.find(unresolved.front());
       const auto before = text_.begin() + static_cast<std::ptrdiff_t>(at == std::string::npos ? 0 : at);

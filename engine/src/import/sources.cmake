@@ -24,7 +24,8 @@ target_include_directories(phiq_sdf PRIVATE ${CMAKE_CURRENT_LIST_DIR}/.. ${CMAKE
   ${CMAKE_CURRENT_BINARY_DIR}/include)
 target_compile_features(phiq_sdf PRIVATE cxx_std_20)
 target_compile_options(phiq_sdf PRIVATE -Wall -Wextra)
-target_link_libraries(phiq_sdf PRIVATE Eigen3::Eigen sdformat12::sdformat12)
+target_link_libraries(phiq_sdf PRIVATE Eigen3::Eigen sdformat12::sdformat12
+  PkgConfig::URDFDOM PkgConfig::TINYXML2)  # console_bridge (urdfdom's), tinyxml2 (the XML checked first)
 set_target_properties(phiq_sdf PROPERTIES CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON
   UNITY_BUILD OFF)
 add_dependencies(phiq_engine phiq_sdf)  # whatever links the engine can read SDF files from the build tree

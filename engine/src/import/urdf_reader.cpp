@@ -34,9 +34,9 @@ namespace {
 class UrdfMessages : public console_bridge::OutputHandler {
  public:
   void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
-    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && first_error.empty()) first_error = text;
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR) errors.push_back(text);
   }
-  std::string first_error;
+  std::vector<std::string> errors;  // in order: the first says what, a later one may name the element
 };
 
 Eigen::Vector3d urdf_vector(const urdf::Vector3& v) { return {v.x, v.y, v.z}; }
@@ -93,6 +93,7 @@ class UrdfReader {
  private:
   void scan();
   void check_tree() const;
+  urdf::ModelInterfaceSharedPtr parse_urdfdom(const char* text) const;
   void map_joint(Joint* out, const std::string& type, const Pose& origin, const Eigen::Vector3d& axis_in, int parent,
                  int child, int line);
   std::optional<Shape> shape(const tinyxml2::XMLElement* geometry_owner, const urdf::Geometry* g,
@@ -314,6 +315,39 @@ void UrdfReader::map_joint(Joint* out, const std::string& type, const Pose& orig
   }
 }
 
+// The tree (without its closing joints) as urdfdom reads it; refused, at the element its messages name, when it
+// logs an error or throws.
+urdf::ModelInterfaceSharedPtr UrdfReader::parse_urdfdom(const char* text) const {
+  urdf::ModelInterfaceSharedPtr model;
+  static std::mutex urdfdom_console;  // console_bridge's handler is one per process
+  std::lock_guard<std::mutex> lock(urdfdom_console);
+  UrdfMessages messages;
+  console_bridge::useOutputHandler(&messages);
+  try {
+    model = urdf::parseURDF(text);
+  } catch (const std::exception& e) {
+    model = nullptr;
+    messages.errors.push_back(e.what());
+  }
+  console_bridge::restorePreviousOutputHandler();
+  // An error urdfdom logged is a part of the model it dropped, even when it returns one (a mass of "abc": the
+  // link without its inertial or visuals, which this reader then indexed: "internal error: vector::_M_range_check")
+  if (!model || !messages.errors.empty()) {  // the first message says what; it or a later one names the element
+    int line = 0;
+    for (const std::string& why : messages.errors) {
+      const std::size_t open = why.find('['), close = why.find(']', open + 1);
+      if (line != 0 || open == std::string::npos || close == std::string::npos) continue;
+      const std::string name = why.substr(open + 1, close - open - 1);
+      for (const UrdfJointXml& j : joints_)
+        if (j.name == name) line = j.line;
+      if (const auto l = links_.find(name); line == 0 && l != links_.end()) line = l->second->GetLineNum();
+    }
+    refuse(path_, line,
+           "urdfdom refused the model: " + (messages.errors.empty() ? "no reason given" : messages.errors.front()));
+  }
+  return model;
+}
+
 Mechanism UrdfReader::read(int* loops) {
   m_.path = path_, m_.format = "URDF";
   m_.units = "lengths in metres, angles in radians, mass in kg, time in seconds.";
@@ -328,26 +362,7 @@ Mechanism UrdfReader::read(int* loops) {
   full.Parse(text_.data(), text_.size());
   tinyxml2::XMLPrinter printer;
   doc_.Print(&printer);
-  urdf::ModelInterfaceSharedPtr model;
-  {
-    static std::mutex urdfdom_console;  // console_bridge's handler is one per process
-    std::lock_guard<std::mutex> lock(urdfdom_console);
-    UrdfMessages messages;
-    console_bridge::useOutputHandler(&messages);
-    model = urdf::parseURDF(printer.CStr());
-    console_bridge::restorePreviousOutputHandler();
-    if (!model) {  // its message names a joint or link ("Joint [NAME] ..."): at that element's line
-      int line = 0;
-      const std::size_t open = messages.first_error.find('['), close = messages.first_error.find(']', open + 1);
-      if (open != std::string::npos && close != std::string::npos) {
-        const std::string name = messages.first_error.substr(open + 1, close - open - 1);
-        for (const UrdfJointXml& j : joints_)
-          if (j.name == name) line = j.line;
-        if (const auto l = links_.find(name); line == 0 && l != links_.end()) line = l->second->GetLineNum();
-      }
-      refuse(path_, line, "urdfdom refused the model: " + messages.first_error);
-    }
-  }
+  const urdf::ModelInterfaceSharedPtr model = parse_urdfdom(printer.CStr());
   // Bodies: the root link is the ground; the others in the tree's order, placed by their joints' origins.
   const urdf::LinkConstSharedPtr root = model->getRoot();
   m_.bodies.push_back(Body::named(root->name, links_.at(root->name)->GetLineNum()));

@@ -16,6 +16,7 @@
 #include <tbb/task_arena.h>
 
 #include "modes/homotopy.hpp"
+#include "sweep/resources.hpp"
 
 namespace phiq {
 
@@ -278,6 +279,10 @@ void finish_endpoints(std::vector<Endpoint>& distinct, const ModesOptions& optio
 }  // namespace
 
 ModesSummary solve_polynomial_system(const PolynomialSystem& system, const ModesOptions& options) {
+  if (options.threads < 0 || options.threads > detail::kMaxThreads)
+    throw Error("ModesOptions: threads must be from 0 (all cores) to 1000000, not " + std::to_string(options.threads));
+  if (options.max_paths < 1)
+    throw Error("ModesOptions: max_paths must be 1 or more, not " + std::to_string(options.max_paths));
   ModesSummary summary;
   const auto start_time = std::chrono::steady_clock::now();
   const int n = system.variables;

@@ -13,6 +13,7 @@
 
 #include "modes/homotopy.hpp"
 #include "modes/model_rows.hpp"
+#include "phiq/text.hpp"
 
 namespace phiq {
 
@@ -102,6 +103,8 @@ Eigen::VectorXd ModelPolynomials::coordinates(const Eigen::VectorXcd& x) const {
 }
 
 ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& options) {
+  // (a time that is not finite made every driver "not polynomial", which blamed the constraint for the time)
+  if (!std::isfinite(options.time)) throw Error("ModesOptions: time " + shortest(options.time) + " is not finite");
   ModelPolynomials out;
   const Index n = model.num_coordinates(), m = model.num_equations();
   Random random(options.seed ^ 0x5DEECE66Dull);

@@ -7,6 +7,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "sweep/resources.hpp"
+
 namespace phiq {
 
 BatchSummary run_batch(const std::vector<const Model*>& models, const SweepOptions& options, int threads,
@@ -26,7 +28,8 @@ BatchSummary run_batch(const std::vector<const Model*>& models, const std::vecto
       if ((*starts)[c].size() != models[c]->num_coordinates())
         throw Error("run_batch: start " + std::to_string(c) + " has the wrong size");
   }
-  if (threads < 0) throw Error("run_batch: threads must be >= 0 (0: all cores)");
+  if (threads < 0 || threads > detail::kMaxThreads)
+    throw Error("run_batch: threads must be from 0 (all cores) to 1000000, not " + std::to_string(threads));
   BatchSummary out;
   out.cases.resize(models.size());
   out.threads = threads == 0 ? tbb::info::default_concurrency() : threads;

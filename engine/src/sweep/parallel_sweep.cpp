@@ -120,7 +120,9 @@ bool ChunkedSweep::keep_row(ChunkRun& cr) {
   Sweeper& s = cr.s;
   const State& st = s.state();
   const Index k = ch.k0 + ch.good;
-  s.row_outputs(k);
+  // outputs that fail (efforts that overflow) end the chunk as a failed step does: the rest runs in order from its
+  // last good row, which fails there and says why
+  if (!s.row_outputs(k)) return ch.ok = false;
   if (ch.good == 0) ch.first_rounding = std::max(s.take_rounding_level(), ch.first_rounding);
   cr.good_sum.warnings = ch.sum.warnings, cr.good_sum.subdivisions = ch.sum.subdivisions;
   cr.good_sum.singular_positions = ch.sum.singular_positions;

@@ -9,6 +9,10 @@
 
 namespace phiq::detail {
 
+// The largest thread count the engine takes (SweepOptions::threads, run_batch(), ModesOptions::threads), as phiq's
+// --threads: phiq::Error above it, rather than a TBB task arena of that many slots (10⁷ from Python: SIGSEGV).
+inline constexpr int kMaxThreads = 1000000;
+
 // All cores (threads = 0), as many as fit: each thread beyond the first needs a workspace like the caller's `ws`
 // (which has factorised at row 0; the caller's own serves one thread, and the seeding pass shares them), beside the
 // rows held for delivery (SweepOptions::row_buffer_bytes at most). memory_budget is the whole process's: what it

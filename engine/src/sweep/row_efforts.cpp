@@ -1,6 +1,7 @@
 // Sweeper::row_efforts(): a written row's driver efforts and powers (OutputPlan::efforts), by inverse dynamics with
 // the row's own factors of Φq (phiq/inverse_dynamics.hpp).
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "phiq/effort_sensitivity.hpp"
@@ -10,11 +11,12 @@
 
 namespace phiq::detail {
 
-void Sweeper::row_efforts() {
+bool Sweeper::row_efforts() {
   const OutputEfforts& e = opt_.efforts;
   const std::size_t n = e.constraints.size();
   auto not_defined = [&] {
     std::fill(outputs_.efforts.begin(), outputs_.efforts.end(), std::numeric_limits<double>::quiet_NaN());
+    return true;
   };
   // At a singular position the multipliers are not unique and a driver's effort may be unbounded: NaN, which the
   // row's bifurcation warning explains, rather than a huge number from a nearly singular solve.
@@ -29,6 +31,19 @@ void Sweeper::row_efforts() {
   if (!multipliers_with_factors(model_, *w->lu, effort_work_.q, effort_work_.kept, effort_work_.lambda))
     return not_defined();
   ++ws_->counters.effort_solves;
+  // A regular position with finite q, q̇, q̈ whose forces or multipliers are not finite: masses, inertias or loads
+  // so large that their products overflow (a gravity of 1e308). NaN there would pass for a singular position's.
+  if (!effort_work_.q.allFinite() || !effort_work_.lambda.allFinite()) {
+    not_defined();  // (a Stepper, which delivers the row whatever, then reads NaN, not the last row's values)
+    Index j = 0;
+    while (j + 1 < effort_work_.q.size() && std::isfinite(effort_work_.q(j))) ++j;
+    return fail(SolveStatus::kNonFinite,
+                std::string("efforts: ") +
+                    (effort_work_.q.allFinite() ? "the multipliers of the parts' forces"
+                                                : "the force of the parts' masses and loads along '" +
+                                                      model_.coordinate_names()[static_cast<std::size_t>(j)] + "'") +
+                    " is not finite (an overflow: masses, inertias or loads too large for doubles)");
+  }
   // Φt at the drivers' rows only (a power reads no other; the whole model's is O(rows) at every row)
   effort_work_.phi_t.resize(model_.num_equations());
   const std::vector<ConstraintInfo>& cs = model_.constraints();
@@ -63,6 +78,7 @@ void Sweeper::row_efforts() {
               std::numeric_limits<double>::quiet_NaN();
   }
   if (effort_work_.reactions) row_reactions(*w->lu);
+  return true;
 }
 
 void Sweeper::row_reactions(SparseLuNumeric& lu) {

@@ -110,7 +110,10 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     return done(sum.status);
   }
   note_parameters_nothing_reads(opt, sum);
-  sw.row_outputs(0);
+  if (!sw.row_outputs(0)) {
+    run.failed(0);
+    return done(sum.status);
+  }
   if (!run.deliver(0, sw.state().q, sw.state().qd, sw.state().qdd, sw.motions(), ws.phi, sw.rcond(), sw.det_sign(),
                    sw.det_sign_time(), sw.row_quality())) {
     sw.leave_state_in_workspace();
@@ -194,7 +197,8 @@ namespace {
 SolveStatus run_sweep_with(const Model& model, const SweepOptions& opt, Workspace& ws,
                            const std::function<bool(const StepView&)>& on_step, RowWriter* writer,
                            SweepSummary* summary) {
-  if (opt.threads < 0) throw Error("SweepOptions: threads must be >= 0 (0: all cores)");
+  if (opt.threads < 0 || opt.threads > detail::kMaxThreads)
+    throw Error("SweepOptions: threads must be from 0 (all cores) to 1000000, not " + std::to_string(opt.threads));
   // Everything the sweep runs, the model's parallel evaluation of large models included, stays on its threads:
   // threads = 1 is one thread.
   const int threads = opt.threads == 0 ? tbb::info::default_concurrency() : opt.threads;

@@ -116,7 +116,8 @@ bool Stepper::Impl::step_to(double t, bool* assembled, bool* moved) {
     previous_t = now;
   }
   Sweeper& s = *sweeper;
-  s.row_outputs(sum.steps_completed);  // (every row is written: the points' motions, the orientation of Φq)
+  // (every row is written: the points' motions, the orientation of Φq; a Stepper has no efforts, which alone fail)
+  (void)s.row_outputs(sum.steps_completed);
   run.count_row(t, s.det_sign(), s.det_sign_time(), s.row_quality());
   return true;
 }

@@ -134,7 +134,10 @@ struct Run {
         failed(k);
         return false;
       }
-      sw.row_outputs(k);
+      if (!sw.row_outputs(k)) {
+        failed(k);
+        return false;
+      }
       const State& s = sw.state();
       if (!deliver(k, s.q, s.qd, s.qdd, sw.motions(), ws.phi, sw.rcond(), sw.det_sign(), sw.det_sign_time(),
                    sw.row_quality()))

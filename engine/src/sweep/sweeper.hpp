@@ -121,7 +121,8 @@ class Sweeper {
   // Only written rows pay for the outputs: sub-steps, the seam steps of parallel chunks and the rows between
   // written ones do not.
   // Joint measures are evaluated at every time point, written or not: the delivery unwraps angles row to row.
-  void row_outputs(Index k) {
+  // False, with the cause (fail()), where the efforts overflow (row_efforts()): the row is no result.
+  bool row_outputs(Index k) {
     const double* qd = need_v_ ? current_.qd.data() : nullptr;
     const double* qdd = need_a_ ? current_.qdd.data() : nullptr;
     for (std::size_t i = 0; i < opt_.joints.size(); ++i)
@@ -135,10 +136,11 @@ class Sweeper {
       ws_->counters.point_evaluations += static_cast<Index>(opt_.points.size());
       outputs_.rcond = opt_.condition && ws_->lu ? ws_->lu->rcond() : 0.0;
       if (!opt_.sensitivities.empty()) row_sensitivities();
-      if (opt_.efforts.active()) row_efforts();
+      if (opt_.efforts.active() && !row_efforts()) return false;
     }
     signs_.delivered = signs_.current_row;
     signs_.delivered_t = signs_.current_row_t;
+    return true;
   }
   // Orientation of Φq at the last delivered row (row_outputs()): sign ±1, 0 at a singular position, kSignUnknown
   // where no factorisation of this sweeper's tells it; and the time it holds at (det_sign_time(): the row's, or
@@ -339,8 +341,9 @@ class Sweeper {
   // (positions only), which leaves the workspace's, and so the next steps' bits, as they are (sweeper.cpp).
   void row_sensitivities();
   // The plan's driver efforts and powers at the current state (outputs_.efforts), by one transposed solve with the same
-  // factors as row_sensitivities() (sweeper_efforts.cpp); NaN at a singular position.
-  void row_efforts();
+  // factors as row_sensitivities() (row_efforts.cpp); NaN at a singular position. False, with the cause (fail()),
+  // where the parts' forces or the multipliers are not finite away from one (masses or loads that overflow).
+  bool row_efforts();
   // The efforts (indices into OutputEfforts::constraints) of drivers the model dropped as redundant: NaN at every
   // row, found once (row_efforts.cpp).
   std::vector<std::size_t> dropped_efforts() const;
