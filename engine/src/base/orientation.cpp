@@ -5,9 +5,15 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "base/quaternion_between.hpp"
 #include "phiq/types.hpp"
 
 namespace phiq {
+
+Eigen::Quaterniond detail::quaternion_between(const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+  return Eigen::Quaterniond::FromTwoVectors(from, to);
+}
+
 namespace {
 
 Eigen::Vector3d vector(const std::array<double, 3>& v) { return {v[0], v[1], v[2]}; }
@@ -38,7 +44,7 @@ EulerParameters euler_parameters_from_axis_angle(const std::array<double, 3>& ax
 EulerParameters euler_parameters_from_axes(int first_axis, const std::array<double, 3>& first,
                                            std::optional<std::pair<int, std::array<double, 3>>> second) {
   const Eigen::Vector3d a = unit(first, "a body axis's direction");
-  if (!second) return parameters(Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::Unit(first_axis), a));
+  if (!second) return parameters(detail::quaternion_between(Eigen::Vector3d::Unit(first_axis), a));
   const int k = second->first;
   if (k == first_axis) throw Error("the two directions are of the same body axis");
   const Eigen::Vector3d b_raw = unit(second->second, "a body axis's direction");

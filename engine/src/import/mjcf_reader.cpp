@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "base/quaternion_between.hpp"
 #include "import/mechanism.hpp"
 #include "import/mjcf_documents.hpp"
 #include "import/mjcf_option.hpp"
@@ -216,8 +217,7 @@ Eigen::Matrix3d MjcfReader::rotation(const tinyxml2::XMLElement* e, const std::s
   }
   if (e->Attribute("zaxis")) {
     const std::vector<double> a = numbers(e, "zaxis", cc, {}, 3, 3);
-    return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), Eigen::Vector3d(a[0], a[1], a[2]))
-        .toRotationMatrix();
+    return detail::quaternion_between(Eigen::Vector3d::UnitZ(), Eigen::Vector3d(a[0], a[1], a[2])).toRotationMatrix();
   }
   return Eigen::Matrix3d::Identity();
 }
@@ -249,7 +249,7 @@ void MjcfReader::geom(const tinyxml2::XMLElement* e, Body* b, const std::string&
   if (e->Attribute("fromto") && (type == "capsule" || type == "cylinder")) {
     const std::vector<double> f = numbers(e, "fromto", cc, {}, 6, 6);
     const Eigen::Vector3d a(f[0], f[1], f[2]), c(f[3], f[4], f[5]);
-    s.at = Pose{0.5 * (a + c), Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), c - a).toRotationMatrix()};
+    s.at = Pose{0.5 * (a + c), detail::quaternion_between(Eigen::Vector3d::UnitZ(), c - a).toRotationMatrix()};
     s.type = type, s.radius = at(0), s.length = (c - a).norm();
   } else if (e->Attribute("fromto")) {
     unmapped(e, "a " + type + " given by fromto is not read");
