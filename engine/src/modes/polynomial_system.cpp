@@ -75,21 +75,24 @@ std::string phc_number(double v) {
 
 std::string phc_input_text(const PolynomialSystem& system) {
   std::string text = std::to_string(system.equations.size());
-  if (static_cast<int>(system.equations.size()) != system.variables) text += " " + std::to_string(system.variables);
-  text += "\n";
+  if (static_cast<int>(system.equations.size()) != system.variables)
+    text.append(1, ' ').append(std::to_string(system.variables));
+  text += '\n';
   // x1 … xn whatever the system's names: those of a model ("cos(psi3)") are no names phc reads
-  auto name = [](int v) { return "x" + std::to_string(v + 1); };
+  // (every piece appended on its own: GCC 12 warns, -Wrestrict, a false positive, on a literal + std::string here)
+  auto name = [](int v) { return std::string(1, 'x').append(std::to_string(v + 1)); };
   for (const Polynomial& p : system.equations) {
     std::string line;
     for (const PolynomialTerm& t : p.terms) {
       // (re + im*i) in full precision: phc reads 'i' as the imaginary unit
-      std::string term = " + (" + phc_number(t.coefficient.real());
-      if (t.coefficient.imag() != 0.0) term += " + " + phc_number(t.coefficient.imag()) + "*i";
-      term += ")";
+      std::string term = " + (";
+      term += phc_number(t.coefficient.real());
+      if (t.coefficient.imag() != 0.0) term.append(" + ").append(phc_number(t.coefficient.imag())).append("*i");
+      term += ')';
       for (int v = 0; v < system.variables; ++v) {
         const int e = t.exponent[static_cast<std::size_t>(v)];
-        if (e == 1) term += "*" + name(v);
-        if (e > 1) term += "*" + name(v) + "^" + std::to_string(e);
+        if (e >= 1) term.append(1, '*').append(name(v));
+        if (e > 1) term.append(1, '^').append(std::to_string(e));
       }
       line += term;
     }
