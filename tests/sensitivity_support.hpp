@@ -6,6 +6,8 @@
 
 #include <array>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -185,6 +187,35 @@ inline std::vector<double> first_driver_values_at(const std::string& text, const
   std::vector<double> out;
   for (const auto& v : r.values) out.push_back(v[at]);
   return out;
+}
+
+// The text of models/REL up to (without) its first `cut`, or whole.
+inline std::string model_file_text(const std::string& rel, const std::string& cut = "") {
+  std::ifstream in(model_path(rel));
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string text = s.str();
+  if (!cut.empty()) text.erase(text.find(cut));
+  return text;
+}
+
+// models/spatial/rssr.yaml with massive bodies under gravity and damped torsional springs on both hinges' angles,
+// the rocker's constants the parameters kt, th0, ct: swept over t in [0, end] with `output`.
+inline std::string rssr_with_joint_springs(const std::string& end, const std::string& output) {
+  std::string text = model_file_text("spatial/rssr.yaml", "time:");
+  const std::string own = "L: 0.92}";
+  text.replace(text.find(own), own.size(), "L: 0.92, kt: 15, th0: 0.4, ct: 3}");
+  return text +
+         "parts:\n"
+         "  crank: {mass: 0.8, center_of_mass: [a/2, 0, 0], inertia: [0.001, 0.8*a*a/12, 0.8*a*a/12]}\n"
+         "  rocker: {mass: 1.1, center_of_mass: [0, b/2, 0], inertia: [1.1*b*b/12, 0.001, 1.1*b*b/12]}\n"
+         "loads:\n"
+         "  gravity: [0, -9.81, 0]\n"
+         "  torsional_springs:\n"
+         "    - {name: t1, joint: rocker_hinge, stiffness: kt, free_angle: th0, damping: ct}\n"
+         "    - {name: t2, joint: crank_hinge, stiffness: 7, free_angle: -1.5, damping: 0.5}\n"
+         "time: {start: 0, end: " +
+         end + ", steps: 12}\noutput: " + output + "\n";
 }
 
 }  // namespace phiq::test

@@ -1,7 +1,8 @@
 // Sensitivities of the drivers' efforts to the scene's parameters (phiq/effort_sensitivity.hpp, columns
 // `NAME.effort.d_P`): a pendulum driven with a constant angular acceleration against its closed form
 // τ = m g l cos θ + (I + m l²) α, and a massive crank-slider (polar crank, a load at the slider's pin) and the
-// massive four-bar of models/dynamics (natural coordinates) against central differences of whole sweeps re-solved
+// massive four-bar of models/dynamics (natural coordinates) and a spatial RSSR, also with torsional springs on its
+// hinges' angles, against central differences of whole sweeps re-solved
 // at p ± δ, p ± δ/2 (Richardson), every row; the columns as the CSV names them. A crank-slider whose parameters
 // reach a length, a mass, a frame, gravity, a force, a spring and a torsional spring carries parts and loads along
 // p only for those that move them, and writes the same bits as with its own forces along every parameter.
@@ -188,6 +189,13 @@ TEST(EffortSensitivity, ASpatialRssrsTorqueMatchesResolvedSweeps) {
       "loads: {gravity: [0, -9.81, 0]}\n"
       "time: {start: 0, end: 2*pi, steps: 36}\n"
       "output: {efforts: all, sensitivities: [a, b, L]}\n");
+}
+
+TEST(EffortSensitivity, ARssrWithSpringsOnItsJointsAnglesMatchesResolvedSweeps) {
+  // torsional spring-dampers on both hinges' angles (parts/force_rate.cpp carries their derivatives exactly): the
+  // dimensions move the rocker's angle, kt, th0 and ct the rocker spring's constants
+  expect_effort_sensitivities_match_resolved_sweeps(
+      test::rssr_with_joint_springs("2", "{efforts: all, sensitivities: [a, b, L, kt, th0, ct]}"));
 }
 
 TEST(EffortSensitivity, TheFourFormulationsOfTheFourBarGiveOneSensitivity) {

@@ -8,6 +8,7 @@
 #include "parts/frame_jets.hpp"
 #include "parts/same_forces.hpp"
 #include "phiq/applied_loads.hpp"
+#include "phiq/output_joints.hpp"
 
 namespace phiq::detail {
 
@@ -408,63 +409,135 @@ double hessian_form(const CompiledExpression& e, const double* q, double t, cons
   return -((g[0] + g[1]) - (g[2] + g[3])) / 8.0;
 }
 
+// A torsional spring's θ, θ̇ and ∂θ/∂q over its coordinates, each with its rate along p.
+struct AngleRates {
+  Dual angle, rate;
+  std::vector<Dual> gradient;
+};
+
+// The fourth-order difference over h of what the copies at p − 2h, p − h, p + h, p + 2h give.
+double copies_rate(const double x[4], double h) { return ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h); }
+
+// θ an expression: ∂θ/∂q's rate H s by the polarisation of γ, θ̇'s from γ at q̇ ± s.
+bool expression_angle_rates(const TorsionalSpring& ts, std::size_t i, const std::array<const AppliedLoads*, 4>& along,
+                            double h, const DualPath& path, Index n, AngleRates& out) {
+  thread_local std::vector<double> a, b, scratch, g;
+  a.assign(static_cast<std::size_t>(n), 0.0), b.assign(a.size(), 0.0), scratch.assign(a.size(), 0.0);
+  std::array<const CompiledExpression*, 4> copies{};
+  for (std::size_t k = 0; k < 4; ++k)
+    if (!(copies[k] = along[k]->torsional_springs[i].angle.get())) return false;
+  const CompiledExpression& e = *ts.angle;
+  const std::vector<Index>& c = e.coordinates();
+  g.resize(c.size());
+  e.gradient(path.q, path.t, g.data());
+  double smax = 0.0;
+  for (Index j = 0; j < n; ++j) smax = std::max(smax, std::fabs(path.s[j]));
+  const double alpha = smax > 0.0 ? 1.0 / smax : 0.0;  // s scaled to unit size: γ's rounding near its own
+  for (Index j = 0; j < n; ++j) a[static_cast<std::size_t>(j)] = alpha * path.s[j];
+  // ∂θ/∂q with its rate: H s, and the difference of the copies' gradients along p
+  out.gradient.resize(c.size());
+  std::array<std::vector<double>, 4> along_g;
+  for (std::size_t k = 0; k < 4; ++k) {
+    along_g[k].resize(c.size());
+    if (copies[k]->coordinates() != c) return false;
+    copies[k]->gradient(path.q, path.t, along_g[k].data());
+  }
+  for (std::size_t l = 0; l < c.size(); ++l) {
+    b[static_cast<std::size_t>(c[l])] = 1.0;
+    const double hs = alpha > 0.0 ? hessian_form(e, path.q, path.t, a, b, scratch) / alpha : 0.0;
+    b[static_cast<std::size_t>(c[l])] = 0.0;
+    out.gradient[l] =
+        Dual(g[l], hs + ((along_g[0][l] - along_g[3][l]) + 8.0 * (along_g[2][l] - along_g[1][l])) / (12.0 * h));
+  }
+  out.angle = expression_dual(e, copies, h, path);
+  out.rate = Dual();
+  if (path.qd) {
+    // θ̇ = ∂e/∂t + ∇e · q̇; along the motion ∂t∇e · s + sᵀ H q̇ + ∇e · ṡ, the first two −[γ(q̇ + s) − γ(q̇ − s)]/4
+    auto theta_dot = [&](const CompiledExpression& x, const std::vector<double>& grad) {
+      double r = x.partial_t(path.q, path.t);
+      for (std::size_t l = 0; l < c.size(); ++l) r += grad[l] * path.qd[c[l]];
+      return r;
+    };
+    double along_rate = 0.0;
+    for (std::size_t l = 0; l < c.size(); ++l) along_rate += g[l] * path.sd[c[l]];
+    for (Index j = 0; j < n; ++j) scratch[static_cast<std::size_t>(j)] = path.qd[j] + path.s[j];
+    const double plus = e.gamma(path.q, scratch.data(), path.t);
+    for (Index j = 0; j < n; ++j) scratch[static_cast<std::size_t>(j)] = path.qd[j] - path.s[j];
+    along_rate -= (plus - e.gamma(path.q, scratch.data(), path.t)) / 4.0;
+    double x[4];
+    for (std::size_t k = 0; k < 4; ++k) x[k] = theta_dot(*copies[k], along_g[k]);
+    out.rate = Dual(theta_dot(e, g), along_rate + copies_rate(x, h));
+  }
+  return true;
+}
+
+// θ a spatial joint's angle: evaluate_joint()'s acceleration at q̈ = 0 is q̇ᵀ H q̇ exactly (the part of Ẍ without q̈
+// is quadratic in q̇), so uᵀ H v = [θ̈(u + v) − θ̈(u − v)]/4, with no step; along p the copies' joints.
+bool joint_angle_rates(const TorsionalSpring& ts, std::size_t i, const std::array<const AppliedLoads*, 4>& along,
+                       double h, const DualPath& path, Index n, AngleRates& out) {
+  const std::vector<Index>& c = ts.joint_coordinates;
+  std::array<const OutputJoint*, 4> copies{};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const TorsionalSpring& x = along[k]->torsional_springs[i];
+    if (!x.joint || x.joint_coordinates != c) return false;
+    copies[k] = &*x.joint;
+  }
+  const OutputJoint& joint = *ts.joint;
+  thread_local std::vector<double> u, w, zero, g;  // (only the entries at c are read)
+  u.assign(static_cast<std::size_t>(n), 0.0), w.assign(u.size(), 0.0), zero.assign(u.size(), 0.0);
+  auto quadratic = [&] { return evaluate_joint(joint, path.q, w.data(), zero.data()).acceleration; };
+  // uᵀ H v over c for the directions x, y scaled to unit size (the rounding of θ̈ near its own); 0 if either is 0
+  auto hessian = [&](const double* x, const double* y) {
+    double xm = 0.0, ym = 0.0;
+    for (const Index j : c) xm = std::max(xm, std::fabs(x[j])), ym = std::max(ym, std::fabs(y[j]));
+    if (xm == 0.0 || ym == 0.0) return 0.0;
+    for (const Index j : c) w[static_cast<std::size_t>(j)] = x[j] / xm + y[j] / ym;
+    const double plus = quadratic();
+    for (const Index j : c) w[static_cast<std::size_t>(j)] = x[j] / xm - y[j] / ym;
+    return (plus - quadratic()) * xm * ym / 4.0;
+  };
+  g.resize(c.size()), out.gradient.resize(c.size());
+  double x[4], along_angle = 0.0;
+  for (std::size_t l = 0; l < c.size(); ++l) {
+    u[static_cast<std::size_t>(c[l])] = 1.0;
+    g[l] = evaluate_joint(joint, path.q, u.data(), nullptr).rate;
+    for (std::size_t k = 0; k < 4; ++k) x[k] = evaluate_joint(*copies[k], path.q, u.data(), nullptr).rate;
+    out.gradient[l] = Dual(g[l], hessian(path.s, u.data()) + copies_rate(x, h));
+    u[static_cast<std::size_t>(c[l])] = 0.0;
+    along_angle += g[l] * path.s[c[l]];
+  }
+  // the copies' angles from the own one, within a turn
+  const double theta = evaluate_joint(joint, path.q, nullptr, nullptr).value;
+  for (std::size_t k = 0; k < 4; ++k)
+    x[k] = std::remainder(evaluate_joint(*copies[k], path.q, nullptr, nullptr).value - theta, 2.0 * M_PI);
+  out.angle = Dual(theta, along_angle + copies_rate(x, h));
+  out.rate = Dual();
+  if (path.qd) {
+    // θ̇ = ∇θ · q̇ (add_applied_forces()); along the motion sᵀ H q̇ + ∇θ · ṡ
+    double rate = 0.0, along_rate = hessian(path.s, path.qd);
+    for (std::size_t l = 0; l < c.size(); ++l) rate += g[l] * path.qd[c[l]], along_rate += g[l] * path.sd[c[l]];
+    for (std::size_t k = 0; k < 4; ++k) x[k] = evaluate_joint(*copies[k], path.q, path.qd, nullptr).rate;
+    out.rate = Dual(rate, along_rate + copies_rate(x, h));
+  }
+  return true;
+}
+
 bool add_torsional_rate(const AppliedLoads& loads, const std::array<const AppliedLoads*, 4>& along, double h,
                         const DualPath& path, Index n, Eigen::VectorXd& dq) {
-  thread_local std::vector<double> a, b, scratch, g, gk;
-  a.assign(static_cast<std::size_t>(n), 0.0), b.assign(a.size(), 0.0), scratch.assign(a.size(), 0.0);
+  thread_local AngleRates st;
   for (std::size_t i = 0; i < loads.torsional_springs.size(); ++i) {
     const TorsionalSpring& ts = loads.torsional_springs[i];
-    std::array<const CompiledExpression*, 4> copies{};
-    if (!ts.angle) return false;  // a joint's angle: its second derivatives are not at hand
-    for (std::size_t k = 0; k < 4; ++k)
-      if (!(copies[k] = along[k]->torsional_springs[i].angle.get())) return false;
-    const CompiledExpression& e = *ts.angle;
-    const std::vector<Index>& c = e.coordinates();
-    g.resize(c.size());
-    e.gradient(path.q, path.t, g.data());
-    double smax = 0.0;
-    for (Index j = 0; j < n; ++j) smax = std::max(smax, std::fabs(path.s[j]));
-    const double alpha = smax > 0.0 ? 1.0 / smax : 0.0;  // s scaled to unit size: γ's rounding near its own
-    for (Index j = 0; j < n; ++j) a[static_cast<std::size_t>(j)] = alpha * path.s[j];
-    // ∂θ/∂q with its rate: H s, and the difference of the copies' gradients along p
-    std::vector<Dual> gradient(c.size());
-    std::array<std::vector<double>, 4> along_g;
-    for (std::size_t k = 0; k < 4; ++k) {
-      along_g[k].resize(c.size());
-      if (copies[k]->coordinates() != c) return false;
-      copies[k]->gradient(path.q, path.t, along_g[k].data());
-    }
-    for (std::size_t l = 0; l < c.size(); ++l) {
-      b[static_cast<std::size_t>(c[l])] = 1.0;
-      const double hs = alpha > 0.0 ? hessian_form(e, path.q, path.t, a, b, scratch) / alpha : 0.0;
-      b[static_cast<std::size_t>(c[l])] = 0.0;
-      gradient[l] =
-          Dual(g[l], hs + ((along_g[0][l] - along_g[3][l]) + 8.0 * (along_g[2][l] - along_g[1][l])) / (12.0 * h));
-    }
+    if (!(ts.angle ? expression_angle_rates(ts, i, along, h, path, n, st)
+                   : joint_angle_rates(ts, i, along, h, path, n, st)))
+      return false;
     auto datum = [&](double TorsionalSpring::*field) {
       return Dual(ts.*field, load_rate(along, h, [&](const AppliedLoads& x) { return x.torsional_springs[i].*field; }));
     };
-    const Dual angle = expression_dual(e, copies, h, path) - datum(&TorsionalSpring::free_angle);
-    Dual rate;
-    if (path.qd) {
-      // θ̇ = ∂e/∂t + ∇e · q̇; along the motion ∂t∇e · s + sᵀ H q̇ + ∇e · ṡ, the first two −[γ(q̇ + s) − γ(q̇ − s)]/4
-      auto theta_dot = [&](const CompiledExpression& x, const std::vector<double>& grad) {
-        double r = x.partial_t(path.q, path.t);
-        for (std::size_t l = 0; l < c.size(); ++l) r += grad[l] * path.qd[c[l]];
-        return r;
-      };
-      double along_rate = 0.0;
-      for (std::size_t l = 0; l < c.size(); ++l) along_rate += g[l] * path.sd[c[l]];
-      for (Index j = 0; j < n; ++j) scratch[static_cast<std::size_t>(j)] = path.qd[j] + path.s[j];
-      const double plus = e.gamma(path.q, scratch.data(), path.t);
-      for (Index j = 0; j < n; ++j) scratch[static_cast<std::size_t>(j)] = path.qd[j] - path.s[j];
-      along_rate -= (plus - e.gamma(path.q, scratch.data(), path.t)) / 4.0;
-      double x[4];
-      for (std::size_t k = 0; k < 4; ++k) x[k] = theta_dot(*copies[k], along_g[k]);
-      rate = Dual(theta_dot(e, g), along_rate + ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h));
-    }
-    const Dual moment = datum(&TorsionalSpring::stiffness) * angle + datum(&TorsionalSpring::damping) * rate;
-    for (std::size_t l = 0; l < c.size(); ++l) dq[c[l]] -= (moment * gradient[l]).e;
+    Dual angle = st.angle - datum(&TorsionalSpring::free_angle);
+    if (!ts.angle) angle.v = std::remainder(angle.v, 2.0 * M_PI);  // a joint's: within a turn (angle_from_free())
+    const Dual moment = datum(&TorsionalSpring::stiffness) * angle + datum(&TorsionalSpring::damping) * st.rate;
+    const std::vector<Index>& c = ts.angle ? ts.angle->coordinates() : ts.joint_coordinates;
+    for (std::size_t l = 0; l < c.size(); ++l) dq[c[l]] -= (moment * st.gradient[l]).e;
   }
   return true;
 }

@@ -27,9 +27,10 @@ struct ForcesAlong {
 
 // dQ/dp at (q, q̇, q̈, t) into `dq` (n entries, overwritten), `s`, `sd`, `sdd` the sensitivities of q, q̇, q̈ to p
 // (the full ones: a co-moving coordinate's included). `qdd` and `sdd` may be null together (no accelerations).
-// False, with `dq` unspecified, where this form does not reach: a part or load on a frame of expressions, a
-// torsional spring on a joint's angle, or a frame, a count or an expression's presence that differs along p; the
-// caller then differences Q (effort_sensitivity.cpp).
+// False, with `dq` unspecified, where this form does not reach: a part or load on a frame of expressions, or a
+// frame, a count, an expression's presence or a torsional spring's coordinates that differ along p; the caller
+// then differences Q (effort_sensitivity.cpp). A torsional spring's angle (an expression's or a spatial joint's)
+// is carried with its first and second derivatives, exact.
 bool generalized_force_rate(const std::vector<Part>& parts, const Loads& loads, const ForcesAlong& along,
                             const double* q, const double* qd, const double* qdd, const double* s, const double* sd,
                             const double* sdd, double t, Eigen::VectorXd& dq);
