@@ -15,6 +15,8 @@
 #include <filesystem>
 #include <new>
 #include <string>
+#include <string_view>
+#include <system_error>
 #include <vector>
 
 #include "cli_support.hpp"
@@ -25,11 +27,28 @@
 
 namespace {
 
+// "FILE: " for the first positional argument that is a file (SCENE, MODEL, RESULT), else "": what names a run that
+// failed outside any step.
+std::string first_positional(const phiq::tools::Command* c) {
+  if (c == nullptr) return "";
+  for (const CLI::Option* o : c->subcommand->get_options())
+    if (o->get_positional() && !o->results().empty()) {
+      std::error_code ec;  // a file, not generate's KIND
+      if (std::filesystem::is_regular_file(o->results().front(), ec))
+        return phiq::tools::printable(o->results().front()) + ": ";
+    }
+  return "";
+}
+
 int run_command(int argc, char** argv) {
   using namespace phiq::tools;
   // before anything opens a file or starts a thread
   ensure_standard_descriptors();
-  start_interrupts();
+  try {
+    start_interrupts();
+  } catch (const std::system_error&) {  // no thread can start: an address-space limit (ulimit -v), or no memory
+    return fail("out of memory: cannot start a thread; nothing written", 1);
+  }
   phiq::silence_hdf5_errors();  // phiq says what went wrong with an HDF5 file, in one line
 
   CLI::App app{"phiq: sparse, large-scale multibody kinematics"};
@@ -59,14 +78,23 @@ int run_command(int argc, char** argv) {
     if (e.get_exit_code() == 0) return with_stdout_checked(app.exit(e));  // --help, --version
     return usage_error(app, argc, argv, e);
   }
+  const Command* ran = nullptr;
   try {
     for (const Command& c : commands)
-      if (*c.subcommand) return c.run();
+      if (*c.subcommand) return (ran = &c)->run();
   } catch (const std::bad_alloc&) {
-    return fail("out of memory", 1);
+    // named by the command's first file (its SCENE, MODEL or RESULT): the outputs, written atomically, are gone
+    return fail(first_positional(ran) + "out of memory; no output written", 1);
   } catch (const std::filesystem::filesystem_error& e) {
     return fail(e.what(), 3);
+  } catch (const std::system_error& e) {  // a thread that could not start (EAGAIN) is memory too
+    if (e.code() == std::errc::resource_unavailable_try_again)
+      return fail(first_positional(ran) + "out of memory: cannot start a thread; no output written", 1);
+    return fail(std::string("internal error: ") + e.what(), 1);
   } catch (const std::exception& e) {
+    // TBB reports a worker it could not create as a std::runtime_error ("pthread_create has failed: …")
+    if (std::string_view(e.what()).find("pthread_create") != std::string_view::npos)
+      return fail(first_positional(ran) + "out of memory: cannot start a thread; no output written", 1);
     return fail(std::string("internal error: ") + e.what(), 1);
   }
   return 2;
