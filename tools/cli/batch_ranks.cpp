@@ -355,21 +355,28 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
   };
   // rank 0's workers, each taking the next case in order (cases complete about in order, so few wait), while this
   // thread answers the other ranks' workers, if any
+  auto fail_with_current = [&] {
+    const std::lock_guard<std::mutex> lock(failure_mutex);
+    if (!failure) failure = std::current_exception();
+    failed = true;
+  };
   std::thread local([&] {
-    arena.execute([&] {
-      tbb::parallel_for(
-          0, threads,
-          [&](int w) {
-            try {
-              for (std::optional<std::size_t> k; (k = next());) h.run_here(*k, w);
-            } catch (...) {
-              const std::lock_guard<std::mutex> lock(failure_mutex);
-              if (!failure) failure = std::current_exception();
-              failed = true;
-            }
-          },
-          tbb::simple_partitioner());
-    });
+    try {  // the arena's own start (its workers' memory) may fail too, before any case
+      arena.execute([&] {
+        tbb::parallel_for(
+            0, threads,
+            [&](int w) {
+              try {
+                for (std::optional<std::size_t> k; (k = next());) h.run_here(*k, w);
+              } catch (...) {
+                fail_with_current();
+              }
+            },
+            tbb::simple_partitioner());
+      });
+    } catch (...) {
+      fail_with_current();
+    }
   });
   std::optional<RankOutOfMemory> remote_failure;  // the first worker of another rank that ran out of memory
   serve_remote_workers(ranks, remote_workers, h.halted, [&](CaseMessage m) {
