@@ -98,7 +98,8 @@ mpirun -np 2 "$phiq" batch -q long.yaml long.csv -o big.csv --threads 1 --summar
 runner=$!
 rank1=""
 for _ in $(seq 100); do  # rank 1's process, by the rank Open MPI gives it in its environment
-  for p in $(pgrep -x phiq); do
+  for p in $(pgrep -x phiq); do  # this test's own (its folder): another checkout's mpi_batch may run beside it
+    [ "$(readlink "/proc/$p/cwd")" = "$(pwd -P)" ] || continue
     tr '\0' '\n' 2>/dev/null < "/proc/$p/environ" | grep -qx 'OMPI_COMM_WORLD_RANK=1' && rank1=$p
   done
   [ -n "$rank1" ] && break

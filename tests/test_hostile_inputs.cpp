@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -175,7 +177,9 @@ TEST_P(Hostile, Case) {
   // ASan reserves terabytes of address space for its shadow memory at start: an address-space limit kills it first
   if (!c.sanitizers) GTEST_SKIP() << "not run under sanitizers";
 #endif
-  const fs::path dir = fs::temp_directory_path() / ("phiq_hostile_" + c.file + "_" + c.name);
+  // the process id in the name: two checkouts (or two runs) testing at once must not share a case's folder
+  const fs::path dir =
+      fs::temp_directory_path() / ("phiq_hostile_" + std::to_string(::getpid()) + "_" + c.file + "_" + c.name);
   std::error_code ec;
   fs::permissions(dir, fs::perms::owner_all, fs::perm_options::add, ec);  // a case may have taken them away
   fs::remove_all(dir, ec);
