@@ -40,6 +40,11 @@ std::string first_positional(const phiq::tools::Command* c) {
   return "";
 }
 
+// The line of a thread that could not start (std::thread's EAGAIN, TBB's "pthread_create has failed").
+std::string no_thread(const phiq::tools::Command* c) {
+  return first_positional(c) + "out of memory: cannot start a thread; no output written";
+}
+
 int run_command(int argc, char** argv) {
   using namespace phiq::tools;
   // before anything opens a file or starts a thread
@@ -88,13 +93,11 @@ int run_command(int argc, char** argv) {
   } catch (const std::filesystem::filesystem_error& e) {
     return fail(e.what(), 3);
   } catch (const std::system_error& e) {  // a thread that could not start (EAGAIN) is memory too
-    if (e.code() == std::errc::resource_unavailable_try_again)
-      return fail(first_positional(ran) + "out of memory: cannot start a thread; no output written", 1);
+    if (e.code() == std::errc::resource_unavailable_try_again) return fail(no_thread(ran), 1);
     return fail(std::string("internal error: ") + e.what(), 1);
   } catch (const std::exception& e) {
     // TBB reports a worker it could not create as a std::runtime_error ("pthread_create has failed: …")
-    if (std::string_view(e.what()).find("pthread_create") != std::string_view::npos)
-      return fail(first_positional(ran) + "out of memory: cannot start a thread; no output written", 1);
+    if (std::string_view(e.what()).find("pthread_create") != std::string_view::npos) return fail(no_thread(ran), 1);
     return fail(std::string("internal error: ") + e.what(), 1);
   }
   return 2;

@@ -436,7 +436,7 @@ bool expression_angle_rates(const TorsionalSpring& ts, std::size_t i, const std:
   for (Index j = 0; j < n; ++j) a[static_cast<std::size_t>(j)] = alpha * path.s[j];
   // ∂θ/∂q with its rate: H s, and the difference of the copies' gradients along p
   out.gradient.resize(c.size());
-  std::array<std::vector<double>, 4> along_g;
+  thread_local std::array<std::vector<double>, 4> along_g;  // capacity kept from row to row
   for (std::size_t k = 0; k < 4; ++k) {
     along_g[k].resize(c.size());
     if (copies[k]->coordinates() != c) return false;
@@ -446,8 +446,8 @@ bool expression_angle_rates(const TorsionalSpring& ts, std::size_t i, const std:
     b[static_cast<std::size_t>(c[l])] = 1.0;
     const double hs = alpha > 0.0 ? hessian_form(e, path.q, path.t, a, b, scratch) / alpha : 0.0;
     b[static_cast<std::size_t>(c[l])] = 0.0;
-    out.gradient[l] =
-        Dual(g[l], hs + ((along_g[0][l] - along_g[3][l]) + 8.0 * (along_g[2][l] - along_g[1][l])) / (12.0 * h));
+    const double x[4] = {along_g[0][l], along_g[1][l], along_g[2][l], along_g[3][l]};
+    out.gradient[l] = Dual(g[l], hs + copies_rate(x, h));
   }
   out.angle = expression_dual(e, copies, h, path);
   out.rate = Dual();
