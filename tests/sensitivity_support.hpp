@@ -218,4 +218,45 @@ inline std::string rssr_with_joint_springs(const std::string& end, const std::st
          end + ", steps: 12}\noutput: " + output + "\n";
 }
 
+// A crank-slider with an arm on a frame of expressions (products and sines of its coordinates and t; the parameter d
+// and the rod's length L3 in them) that carries a mass, a force and a torque in its axes: parts/expression_rate.hpp.
+inline std::string crank_slider_with_expression_frame(const std::string& output) {
+  std::string text(kCrankSlider);
+  text.erase(text.find("drivers:"));
+  const std::string own = "L3: 1.0}";
+  text.replace(text.find(own), own.size(), "L3: 1.0, d: 0.25, m2: 0.9, F: 4}");
+  return text + R"(drivers:
+  - {name: motor, coordinate: theta2, law: {type: polynomial, coefficients: [0.2, 2, 0.8]}}
+parts:
+  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 1.2, inertia: 1.2*L3*L3/12}
+  arm: {frame: {at: [xA + d*cos(theta2)*xB, yA*sin(theta2 + t) + d*xA*yA + 0.1*L3*xB],
+                angle: theta2 + d*sin(xB*yA + t)}, center_of_mass: [0.1, 0.05], mass: m2, inertia: 0.03}
+loads:
+  gravity: [0, -9.81]
+  forces: [{name: push, part: arm, at: [d, 0.1], force: [-F*cos(theta2), F*xB]}]
+  torques: [{name: turn, part: arm, torque: F*xA*d, axes: part}]
+time: {start: 0, end: 0.9, steps: 9}
+output: )" +
+         output + "\n";
+}
+
+// models/spatial/rssr.yaml with a massive crank and an arm on a frame of expressions of both bodies' coordinates, t,
+// a and b, turned about `axis`, carrying a mass, a force and a torque in its axes: swept over t in [0, 1.3].
+inline std::string rssr_with_expression_frame(const std::string& axis, const std::string& output) {
+  return model_file_text("spatial/rssr.yaml", "time:") +
+         "parts:\n"
+         "  crank: {mass: 0.8, center_of_mass: [a/2, 0, 0], inertia: [0.001, 0.8*a*a/12, 0.8*a*a/12]}\n"
+         "  arm: {frame: {at: [a*crank_e0*cos(t) + rocker_y, rocker_z*crank_e3 + a*sin(rocker_e1),\n"
+         "                     rocker_x*rocker_e0 - b], angle: 2*crank_e3*rocker_e1 + a*t, axis: " +
+         axis +
+         "},\n"
+         "        center_of_mass: [0.05, 0.02, -0.03], mass: 0.7, inertia: [0.01, 0.02, 0.015]}\n"
+         "loads:\n"
+         "  gravity: [0, -9.81, 0]\n"
+         "  forces: [{name: push, part: arm, at: [0.1, 0, a], force: [3, -a*crank_e3, rocker_e1]}]\n"
+         "  torques: [{name: turn, part: arm, torque: [0.2, b*rocker_e0, -crank_e3], axes: part}]\n"
+         "time: {start: 0, end: 1.3, steps: 13}\noutput: " +
+         output + "\n";
+}
+
 }  // namespace phiq::test

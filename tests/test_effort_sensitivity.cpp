@@ -2,7 +2,7 @@
 // `NAME.effort.d_P`): a pendulum driven with a constant angular acceleration against its closed form
 // τ = m g l cos θ + (I + m l²) α, and a massive crank-slider (polar crank, a load at the slider's pin) and the
 // massive four-bar of models/dynamics (natural coordinates) and a spatial RSSR, also with torsional springs on its
-// hinges' angles, against central differences of whole sweeps re-solved
+// hinges' angles, and parts and loads on frames of expressions, against central differences of whole sweeps re-solved
 // at p ± δ, p ± δ/2 (Richardson), every row; the columns as the CSV names them. A crank-slider whose parameters
 // reach a length, a mass, a frame, gravity, a force, a spring and a torsional spring carries parts and loads along
 // p only for those that move them, and writes the same bits as with its own forces along every parameter.
@@ -196,6 +196,16 @@ TEST(EffortSensitivity, ARssrWithSpringsOnItsJointsAnglesMatchesResolvedSweeps) 
   // dimensions move the rocker's angle, kt, th0 and ct the rocker spring's constants
   expect_effort_sensitivities_match_resolved_sweeps(
       test::rssr_with_joint_springs("2", "{efforts: all, sensitivities: [a, b, L, kt, th0, ct]}"));
+}
+
+TEST(EffortSensitivity, PartsAndLoadsOnFramesOfExpressionsMatchResolvedSweeps) {
+  // an arm on a frame of expressions (sines and products of the coordinates and t, d and L3 in them) with a mass, a
+  // force and a torque, planar; a spatial one on the RSSR whose axis reads b: exact, no Q differenced
+  // (tests/test_force_rate.cpp counts it)
+  expect_effort_sensitivities_match_resolved_sweeps(
+      test::crank_slider_with_expression_frame("{efforts: all, sensitivities: [L2, L3, d]}"));
+  expect_effort_sensitivities_match_resolved_sweeps(
+      test::rssr_with_expression_frame("[0.3, 0.4*b, 0.866]", "{efforts: all, sensitivities: [a, b]}"));
 }
 
 TEST(EffortSensitivity, TheFourFormulationsOfTheFourBarGiveOneSensitivity) {

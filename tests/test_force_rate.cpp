@@ -1,11 +1,13 @@
 // The exact rate of the generalized forces along a parameter (parts/force_rate.hpp) against the fourth-order
 // difference of Q itself along (q + ε s, q̇ + ε ṡ, q̈ + ε s̈) with the scene's parts and loads read at p + ε, on a
 // crank-slider whose parameters reach a length, a mass, a ground pivot in a part's frame, gravity, a force, a
-// torque in the part's axes, a damped spring and a damped torsional spring, and on an RSSR with damped torsional
-// springs on its spatial hinges' angles; the efforts' sensitivities through it against those through the difference
-// of Q (effort_sensitivity.cpp keeps both), and a spring pendulum's against their closed form.
+// torque in the part's axes, a damped spring and a damped torsional spring, on an RSSR with damped torsional
+// springs on its spatial hinges' angles, and on parts and loads on frames of expressions (planar, spatial, the
+// relative four-bar); the efforts' sensitivities through it against those through the difference of Q
+// (effort_sensitivity.cpp keeps both), and a spring pendulum's against their closed form.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -112,23 +114,6 @@ TEST(ForceRate, EqualsTheDifferenceOfQAlongTheMotionAndEachParameter) {
   expect_force_rate_equals_difference_of_q(s);
 }
 
-TEST(ForceRate, RefusesAFrameOfExpressionsSoTheEffortsDifferenceQThere) {
-  // the four-bar in relative angles: its parts' frames are expressions of q (their second derivatives in t and q
-  // are not carried in dual numbers)
-  std::string text = test::seed_text("fourbar_relative.yaml");
-  text.erase(text.find("time:"));
-  const Scene s =
-      parse_scene(text + "parts:\n" + test::fourbar_parts("relative") +
-                      "loads: {gravity: [0, -9.81]}\ntime: {start: 0, end: 1, steps: 2}\noutput: {efforts: all}\n",
-                  "relative.yaml");
-  Workspace ws(*s.model);
-  force_rate_swept(s, ws);
-  const Eigen::VectorXd v = Eigen::VectorXd::Ones(s.model->num_coordinates());
-  Eigen::VectorXd dq(v.size());
-  EXPECT_FALSE(detail::generalized_force_rate(*s.sweep.efforts.parts, *s.sweep.efforts.loads, {}, ws.q.data(),
-                                              ws.qd.data(), ws.qdd.data(), v.data(), v.data(), v.data(), 1.0, dq));
-}
-
 // The scene's efforts' (and powers') sensitivities at its last row through the exact dQ/dp and through Q
 // differenced (EffortSensitivityScratch::difference_forces), with how many parameters each differenced.
 struct ForceRatePaths {
@@ -194,6 +179,64 @@ TEST(ForceRate, ReachesTheNaturalFourBarAndTheSpatialRssrExactly) {
                       "loads: {gravity: [0, -9.81, 0]}\ntime: {start: 0, end: 1.3, steps: 13}\n"
                       "output: {efforts: all, sensitivities: [a, b, L]}\n",
                   "rssr.yaml"));
+}
+
+TEST(ForceRate, CarriesFramesOfExpressionsExactlyInThePlaneAndInSpace) {
+  // parts and loads on frames of expressions: their jets by the tape's Taylor pass in dual numbers along the motion
+  // (third derivatives of sines and products of several coordinates and t), along p through their copies (d, L3 in
+  // the planar arm's expressions; a, b in the spatial one's, b in its axis too)
+  const Scene planar = parse_scene(
+      test::crank_slider_with_expression_frame("{efforts: all, power: true, sensitivities: [L2, L3, d, m2, F]}"),
+      "crank_slider_expression_frame.yaml");
+  expect_force_rate_equals_difference_of_q(planar);
+  expect_force_rate_paths_agree(planar);
+  const Scene spatial = parse_scene(
+      test::rssr_with_expression_frame("[0.3, 0.4*b, 0.866]", "{efforts: all, power: true, sensitivities: [a, b, L]}"),
+      "rssr_expression_frame.yaml");
+  expect_force_rate_equals_difference_of_q(spatial);
+  expect_force_rate_paths_agree(spatial);
+  // the four-bar in relative angles: every part's frame is one of expressions, L2 and L3 in them
+  std::string text = test::seed_text("fourbar_relative.yaml");
+  text.erase(text.find("time:"));
+  const Scene relative = parse_scene(text + "parts:\n" + test::fourbar_parts("relative") +
+                                         "loads: {gravity: [0, -9.81]}\ntime: {start: 0, end: 1, steps: 4}\n"
+                                         "output: {efforts: all, sensitivities: [L2, L3, L4]}\n",
+                                     "relative.yaml");
+  expect_force_rate_equals_difference_of_q(relative);
+  expect_force_rate_paths_agree(relative);
+}
+
+TEST(ForceRate, RefusesCopiesAlongPWithAnotherFrameOfExpressions) {
+  // the copies of the scene read along p with the arm's angle dropped from one of them, or its first component
+  // reading another coordinate: not the same frame but for its data
+  const Scene s = parse_scene(test::crank_slider_with_expression_frame("{efforts: all, sensitivities: [d]}"),
+                              "crank_slider_expression_frame.yaml");
+  Workspace ws(*s.model);
+  force_rate_swept(s, ws);
+  const std::vector<Part>& own = *s.sweep.efforts.parts;
+  const auto arm = static_cast<std::size_t>(
+      std::find_if(own.begin(), own.end(), [](const Part& p) { return p.name == "arm"; }) - own.begin());
+  ASSERT_LT(arm, own.size());
+  const Eigen::VectorXd v = Eigen::VectorXd::Ones(s.model->num_coordinates());
+  Eigen::VectorXd dq(v.size());
+  auto rate_with = [&](const std::vector<Part>& changed) {
+    detail::ForcesAlong along{{}, {}, 1e-3};
+    along.parts = {&own, &own, &changed, &own};
+    return detail::generalized_force_rate(own, *s.sweep.efforts.loads, along, ws.q.data(), ws.qd.data(), ws.qdd.data(),
+                                          v.data(), v.data(), v.data(), s.sweep.t_end, dq);
+  };
+  // copies that are the own parts: the rate along the motion alone, bit for bit
+  Eigen::VectorXd alone(v.size());
+  ASSERT_TRUE(detail::generalized_force_rate(own, *s.sweep.efforts.loads, {}, ws.q.data(), ws.qd.data(), ws.qdd.data(),
+                                             v.data(), v.data(), v.data(), s.sweep.t_end, alone));
+  EXPECT_GT(alone.norm(), 1e-2);
+  EXPECT_TRUE(rate_with(own));
+  EXPECT_EQ(dq, alone);
+  std::vector<Part> no_angle = own, other = own;
+  no_angle[arm].frame.angle = nullptr;
+  EXPECT_FALSE(rate_with(no_angle));
+  other[arm].frame.at[0] = own[arm].frame.at[1];
+  EXPECT_FALSE(rate_with(other));
 }
 
 TEST(ForceRate, CarriesATorsionalSpringOnASpatialJointsAngleExactly) {

@@ -22,10 +22,13 @@
 /// inertia, a ground point of a frame, gravity, a load's point, expression or constants) by the rates of those data
 /// between the scene read at p ± h, p ± 2h (OutputSensitivity::parts_along; exact for data linear in p); a
 /// torsional spring's angle with its second derivatives, by the polarisation of γ for an expression and of the
-/// joint's acceleration in q̇ for a spatial joint's angle. Frames of expressions (relative angles) are not carried:
-/// for a parameter that meets one, Q is differenced as before (along p by the fourth-order difference over the
-/// copies, along the motion with a step that moves the coordinate s moves most by 10⁻³ of its scale; ~10⁻¹²
-/// relative). A co-moving coordinate (ParameterReach::comotion) is moved along p as the sensitivities move it.
+/// joint's acceleration in q̇ for a spatial joint's angle; a frame of expressions (relative angles) by its
+/// expressions' second-order Taylor pass in dual numbers along (q + ε s, q̇ + ε ṡ, q̈ + ε s̈), their third
+/// derivatives included, and its copies' jets along p. Where the scene read along p is not the same structure (a
+/// frame of another kind or coordinates, a load's count, an expression present in one copy only), Q is
+/// differenced (along p by the fourth-order difference over the copies, along the motion with a step that moves
+/// the coordinate s moves most by 10⁻³ of its scale; ~10⁻¹² relative). A co-moving coordinate
+/// (ParameterReach::comotion) is moved along p as the sensitivities move it.
 ///
 /// A driver's power P = Σ λ_r Φt_r over its rows: dP/dp = Σ (dλ_r/dp Φt_r + λ_r dΦt_r/dp), dλ_r/dp as −dτ/dp above
 /// with w = Φq⁻¹ e_r for each row, and dΦt/dp = ∂Φt/∂p |q + Φqt (s − q̂), the latter −[γ(a) − γ(−a)]/4 at a = s − q̂.

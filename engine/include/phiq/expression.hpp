@@ -84,6 +84,7 @@ class Tape {
  private:
   friend class TapeBuilder;
   friend class CompiledExpression;
+  friend struct TapeInternals;  // the Taylor pass over any scalar (src/expression/taylor.hpp)
   std::vector<Instr> code_;
   std::vector<std::uint32_t> outputs_;
 };
@@ -181,6 +182,7 @@ class CompiledExpression {
   /// @cond internal
   struct Source;
   friend struct CompiledExpressionBuilder;
+  friend struct TapeInternals;
   /// @endcond
 
  private:

@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "expression/dual.hpp"
+#include "parts/expression_rate.hpp"
 #include "parts/frame_jets.hpp"
+#include "parts/frame_rates.hpp"
 #include "parts/same_forces.hpp"
 #include "phiq/applied_loads.hpp"
 #include "phiq/output_joints.hpp"
@@ -13,26 +16,6 @@
 namespace phiq::detail {
 
 namespace {
-
-// a + ε b with ε² = 0: b is the derivative along p of what a is the value of.
-struct Dual {
-  double v = 0.0, e = 0.0;
-  Dual() = default;
-  Dual(double value, double rate = 0.0) : v(value), e(rate) {}  // NOLINT: a constant converts implicitly
-};
-Dual operator+(Dual a, Dual b) { return {a.v + b.v, a.e + b.e}; }
-Dual operator-(Dual a, Dual b) { return {a.v - b.v, a.e - b.e}; }
-Dual operator-(Dual a) { return {-a.v, -a.e}; }
-Dual operator*(Dual a, Dual b) { return {a.v * b.v, a.e * b.v + a.v * b.e}; }
-Dual operator*(double k, Dual a) { return {k * a.v, k * a.e}; }
-Dual operator/(Dual a, Dual b) { return {a.v / b.v, (a.e * b.v - a.v * b.e) / (b.v * b.v)}; }
-Dual operator/(double k, Dual b) { return {k / b.v, -k * b.e / (b.v * b.v)}; }
-Dual sqrt(Dual a) {
-  const double r = std::sqrt(a.v);
-  return {r, a.e / (2.0 * r)};
-}
-Dual sin(Dual a) { return {std::sin(a.v), std::cos(a.v) * a.e}; }
-Dual cos(Dual a) { return {std::cos(a.v), -std::sin(a.v) * a.e}; }
 
 using DJ = JetT<Dual>;
 
@@ -59,70 +42,12 @@ DV turned_back(const Dual r[9], const DV& v) {
 // The vector of the antisymmetric part of m.
 DV vee(const Dual m[9]) { return {0.5 * (m[7] - m[5]), 0.5 * (m[2] - m[6]), 0.5 * (m[3] - m[1])}; }
 
-// The slots a frame's jets read (frame_jets()), in an order that is the same for two frames of one kind.
-std::size_t frame_slots(const PartFrame& f, std::array<const Slot*, 9>& out) {
-  switch (f.kind) {
-    case PartFrameKind::kPlanarBody:
-      out = {&f.planar.x, &f.planar.y, &f.planar.psi};
-      return 3;
-    case PartFrameKind::kSpatialBody: {
-      const Frame3& b = f.spatial;
-      out = {&b.x, &b.y, &b.z, &b.e0, &b.e1, &b.e2, &b.e3};
-      return 7;
-    }
-    case PartFrameKind::kPoints:
-      out = {&f.origin.r[0],   &f.origin.r[1],   &f.origin.r[2],   &f.x_toward.r[0], &f.x_toward.r[1],
-             &f.x_toward.r[2], &f.y_toward.r[0], &f.y_toward.r[1], &f.y_toward.r[2]};
-      return 9;
-    case PartFrameKind::kExpressions:
-      break;
-  }
-  return 0;
-}
-
-// The rates along p of a frame's constants (a ground pivot at a dimension): the fourth-order difference of the
-// copies' constants, slot by slot.
-struct FrameRates {
-  std::array<const Slot*, 9> slots{};
-  std::array<double, 9> rate{};
-  std::size_t count = 0;
-  double of(const Slot& s) const {
-    for (std::size_t i = 0; i < count; ++i)
-      if (slots[i] == &s) return rate[i];
-    return 0.0;
-  }
-};
-
-// False for a frame of expressions, or copies along p that are not the same frame but for their constants (another
-// kind, another coordinate in a slot).
-bool frame_rates(const PartFrame& own, const std::array<const PartFrame*, 4>& copies, double h, FrameRates& out) {
-  if (own.kind == PartFrameKind::kExpressions) return false;
-  out.count = frame_slots(own, out.slots);
-  std::array<std::array<const Slot*, 9>, 4> along;
-  for (std::size_t k = 0; k < 4; ++k) {
-    const PartFrame& c = copies[k] ? *copies[k] : own;
-    if (c.kind != own.kind || c.spatial_frame != own.spatial_frame || c.x_is_point != own.x_is_point ||
-        c.y_is_point != own.y_is_point)
-      return false;
-    frame_slots(c, along[k]);
-    for (std::size_t i = 0; i < out.count; ++i)
-      if (along[k][i]->coord() != out.slots[i]->coord()) return false;
-  }
-  for (std::size_t i = 0; i < out.count; ++i)
-    out.rate[i] =
-        out.slots[i]->is_coordinate()
-            ? 0.0
-            : ((along[0][i]->value() - along[3][i]->value()) + 8.0 * (along[2][i]->value() - along[1][i]->value())) /
-                  (12.0 * h);
-  return true;
-}
-
 // The path q + ε s (and q̇ + ε ṡ, q̈ + ε s̈) along the motion, or along coordinate k (a Jacobian column).
 struct DualPath {
   const double *q, *qd, *qdd, *s, *sd, *sdd;
   double t = 0.0;
   Index k = -1;
-  const FrameRates* rates = nullptr;  // the walked frame's constants' rates along p (none: 0)
+  const FrameRates* rates = nullptr;  // the walked frame's data's rates along p (none: 0)
 
   DJ slot(const Slot& sl) const {
     if (!sl.is_coordinate()) return {Dual(sl.value(), rates ? rates->of(sl) : 0.0), Dual(), Dual()};
@@ -131,8 +56,15 @@ struct DualPath {
     return {Dual(q[j], s[j]), Dual(qd[j], sd[j]), qdd ? Dual(qdd[j], sdd[j]) : Dual()};
   }
   JetV<Dual> natural(const Attachment3& a) const { return {slot(a.r[0]), slot(a.r[1]), slot(a.r[2])}; }
-  // Frames of expressions are refused before any path is walked (frame_rates()).
-  DJ expression(const CompiledExpression&) const { return constant_jet<Dual>(0.0); }
+  std::array<Dual, 3> axis(const PartFrame& f) const {
+    const kin3::V3 r = rates ? rates->axis : kin3::V3{};
+    return {Dual(f.axis.x, r.x), Dual(f.axis.y, r.y), Dual(f.axis.z, r.z)};
+  }
+  // Along the motion through the expression's Taylor pass in dual numbers, along p through its copies' jets.
+  DJ expression(const CompiledExpression& e) const {
+    return expression_jet_rate(e, rates ? rates->copies_of(e) : nullptr, rates ? rates->step : 1.0,
+                               {q, qd, qdd, s, sd, sdd, t}, k);
+  }
   // This path over a frame whose constants move along p at `r`.
   DualPath over(const FrameRates& r) const {
     DualPath p = *this;
@@ -194,11 +126,7 @@ template <class Source, class Get>
 double datum_rate(const std::array<const Source*, 4>& along, const Source& own, double h, Get get) {
   double x[4];
   for (std::size_t k = 0; k < 4; ++k) x[k] = get(along[k] ? *along[k] : own);
-  return ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h);
-}
-
-kin3::V3 vector_rate(const std::array<kin3::V3, 4>& x, double h) {
-  return (1.0 / (12.0 * h)) * ((x[0] - x[3]) + 8.0 * (x[2] - x[1]));
+  return copies_rate(x, h);
 }
 
 // The generalized inertia forces and weight of every part with mass, as add_generalized_forces() sums them.
@@ -275,7 +203,7 @@ Dual expression_dual(const CompiledExpression& e, const std::array<const Compile
   double rate = 0.0, x[4];
   for (std::size_t i = 0; i < c.size(); ++i) rate += g[i] * p.s[c[i]];
   for (std::size_t k = 0; k < 4; ++k) x[k] = copies[k]->value(p.q, p.t);
-  return {e.value(p.q, p.t), rate + ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h)};
+  return {e.value(p.q, p.t), rate + copies_rate(x, h)};
 }
 
 using Components = std::array<std::shared_ptr<const CompiledExpression>, 3>;
@@ -303,7 +231,7 @@ template <class Get>
 double load_rate(const std::array<const AppliedLoads*, 4>& along, double h, Get get) {
   double x[4];
   for (std::size_t k = 0; k < 4; ++k) x[k] = get(*along[k]);
-  return ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h);
+  return copies_rate(x, h);
 }
 
 kin3::V3 load_vector_rate(const std::array<const AppliedLoads*, 4>& along, double h,
@@ -414,9 +342,6 @@ struct AngleRates {
   Dual angle, rate;
   std::vector<Dual> gradient;
 };
-
-// The fourth-order difference over h of what the copies at p − 2h, p − h, p + h, p + 2h give.
-double copies_rate(const double x[4], double h) { return ((x[0] - x[3]) + 8.0 * (x[2] - x[1])) / (12.0 * h); }
 
 // θ an expression: ∂θ/∂q's rate H s by the polarisation of γ, θ̇'s from γ at q̇ ± s.
 bool expression_angle_rates(const TorsionalSpring& ts, std::size_t i, const std::array<const AppliedLoads*, 4>& along,

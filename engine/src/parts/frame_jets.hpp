@@ -32,6 +32,10 @@ JetT<T> operator*(double k, const JetT<T>& a) {
   return {k * a.v, k * a.d, k * a.dd};
 }
 template <class T>
+JetT<T> scaled(const T& k, const JetT<T>& a) {
+  return {k * a.v, k * a.d, k * a.dd};
+}
+template <class T>
 JetT<T> constant_jet(double c) {
   return {T(c), T(0.0), T(0.0)};
 }
@@ -105,21 +109,22 @@ JetR<T> from_euler(std::array<JetT<T>, 4> e) {
   return r;
 }
 
-// R = 1 + sin θ [u]× + (1 − cos θ) [u]×², u a constant unit axis.
+// R = 1 + sin θ [u]× + (1 − cos θ) [u]×², u a unit axis, constant along the path (not along p: a dual's rate).
 template <class T>
-JetR<T> about_axis(const JetT<T>& th, kin3::V3 u) {
-  const double k[9] = {0, -u.z, u.y, u.z, 0, -u.x, -u.y, u.x, 0};
-  double k2[9];
+JetR<T> about_axis(const JetT<T>& th, const std::array<T, 3>& u) {
+  const T o(0.0);
+  const T k[9] = {o, -u[2], u[1], u[2], o, -u[0], -u[1], u[0], o};
+  T k2[9];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) k2[3 * i + j] = k[3 * i] * k[j] + k[3 * i + 1] * k[3 + j] + k[3 * i + 2] * k[6 + j];
   const JetT<T> s = sin(th), c1 = constant_jet<T>(1.0) - cos(th);
   JetR<T> r;
-  for (int i = 0; i < 9; ++i) r[i] = constant_jet<T>(i % 4 == 0 ? 1.0 : 0.0) + k[i] * s + k2[i] * c1;
+  for (int i = 0; i < 9; ++i) r[i] = constant_jet<T>(i % 4 == 0 ? 1.0 : 0.0) + scaled(k[i], s) + scaled(k2[i], c1);
   return r;
 }
 
 // The frame's origin and axes as jets along the path `p`, whose slot(Slot), natural(Attachment3) and
-// expression(CompiledExpression) give its inputs as jets of T.
+// expression(CompiledExpression) give its inputs as jets of T, and axis(PartFrame) a frame of expressions' axis.
 template <class T, class Path>
 std::pair<JetV<T>, JetR<T>> frame_jets(const PartFrame& f, const Path& p) {
   const JetT<T> zero = constant_jet<T>(0.0);
@@ -146,7 +151,7 @@ std::pair<JetV<T>, JetR<T>> frame_jets(const PartFrame& f, const Path& p) {
     case PartFrameKind::kExpressions: {
       JetV<T> o{zero, zero, zero};
       for (std::size_t k = 0; k < f.at.size() && k < 3; ++k) o[k] = p.expression(*f.at[k]);
-      return {o, f.angle ? about_axis(p.expression(*f.angle), f.axis) : about_axis(zero, f.axis)};
+      return {o, about_axis(f.angle ? p.expression(*f.angle) : zero, p.axis(f))};
     }
   }
   return {};

@@ -54,6 +54,7 @@ struct Path {
     return j;
   }
   JV natural(const Attachment3& a) const { return {slot(a.r[0]), slot(a.r[1]), slot(a.r[2])}; }
+  std::array<double, 3> axis(const PartFrame& f) const { return {f.axis.x, f.axis.y, f.axis.z}; }
 };
 
 // The vector of the antisymmetric part of the 3×3 matrix m: (m32 − m23, m13 − m31, m21 − m12) / 2.

@@ -2,7 +2,9 @@
 target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/applied_loads.cpp
   ${CMAKE_CURRENT_LIST_DIR}/curve_tube.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/expression_rate.cpp
   ${CMAKE_CURRENT_LIST_DIR}/force_rate.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/frame_rates.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mass_properties.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mesh_file.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mesh_is_closed.cpp
