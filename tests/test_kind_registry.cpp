@@ -14,12 +14,14 @@
 #include <string>
 #include <string_view>
 #include <tuple>
+#include <type_traits>
 #include <typeindex>
 #include <utility>
 #include <vector>
 
 #include "kind_checks.hpp"
 #include "phiq/constraint_kinds.hpp"
+#include "phiq/model.hpp"
 
 namespace {
 
@@ -73,6 +75,23 @@ TEST(KindRegistry, EveryKindHasAFiniteDifferenceCheck) {
 
 // The kinds that differentiate their data (DataDifferentiable) are the kinds with a CheckDataDerivative test, both
 // ways; and the registry has some (the sensitivities' exact derivatives along the data rest on them).
+// ModelBuilder makes each registered kind's block in the file that compiles it (kinds/typed_blocks.hpp), by its
+// place in the list: each place gives its own kind's block, and a place past the list is refused.
+TEST(KindRegistry, EachPlaceMakesTheBlockOfItsKind) {
+  std::size_t places = 0;
+  phiq::ConstraintKinds::for_each([&]<class K>() {
+    constexpr std::size_t place = phiq::ConstraintKinds::index_of<K>();
+    static_assert(std::is_same_v<phiq::ConstraintKinds::at<place>, K>);
+    const auto block = phiq::detail::new_registered_block(place);
+    ASSERT_NE(dynamic_cast<const phiq::TypedBlock<K>*>(block.get()), nullptr) << K::kKind;
+    EXPECT_STREQ(block->kind(), K::kKind);
+    EXPECT_EQ(place, places++);
+  });
+  EXPECT_EQ(places, phiq::ConstraintKinds::size);
+  EXPECT_EQ(phiq::ConstraintKinds::index_of<int>(), phiq::ConstraintKinds::size);
+  EXPECT_THROW(phiq::detail::new_registered_block(phiq::ConstraintKinds::size), phiq::Error);
+}
+
 TEST(KindRegistry, EveryKindThatDifferentiatesItsDataHasACheckOfIt) {
   std::map<std::type_index, std::string> differentiating;
   phiq::ConstraintKinds::for_each([&]<class K>() {

@@ -404,11 +404,24 @@ class ModelBuilder {
   detail::NameIndex body_names_;  ///< duplicate check in O(1) without a node per name: scenes reach 10^6 bodies
 };
 
+namespace detail {
+/// A new, empty block of the registered kind ConstraintKinds::at<kind>. Every registered kind's TypedBlock is
+/// compiled once, in engine/src/kinds/typed_blocks*.cpp, rather than again in each file that adds constraints (they
+/// were a third of the scene readers' compile time).
+std::shared_ptr<ConstraintBlock> new_registered_block(std::size_t kind);
+}  // namespace detail
+
 template <class Spec>
 TypedBlock<Spec>& ModelBuilder::block_for() {
   // try_emplace: no node is allocated when the block exists (one lookup per added constraint)
   auto [it, inserted] = block_of_type_.try_emplace(std::type_index(typeid(Spec)), model_.blocks_.size());
-  if (inserted) model_.blocks_.push_back(std::make_shared<TypedBlock<Spec>>());
+  if (inserted) {
+    constexpr std::size_t kind = ConstraintKinds::index_of<Spec>();
+    if constexpr (kind < ConstraintKinds::size)
+      model_.blocks_.push_back(detail::new_registered_block(kind));
+    else
+      model_.blocks_.push_back(std::make_shared<TypedBlock<Spec>>());  // a kind of the caller's own
+  }
   return static_cast<TypedBlock<Spec>&>(*model_.blocks_[it->second]);
 }
 

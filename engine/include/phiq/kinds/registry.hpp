@@ -12,6 +12,8 @@
 
 #include <string>
 #include <string_view>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "phiq/kinds/constant_angle.hpp"
@@ -97,6 +99,17 @@ concept ConstraintKind = requires(K k, const K ck, const double* q, double* out,
 template <class... K>
 struct KindList {
   static constexpr std::size_t size = sizeof...(K);  ///< how many kinds
+  /// The kind at place `I` (0 ≤ I < size).
+  template <std::size_t I>
+  using at = std::tuple_element_t<I, std::tuple<K...>>;
+  /// The place of `L` in the list; `size` when it is not in it.
+  template <class L>
+  static constexpr std::size_t index_of() {
+    constexpr bool same[] = {std::is_same_v<L, K>..., false};
+    std::size_t i = 0;
+    while (i < size && !same[i]) ++i;
+    return i;
+  }
   /// Calls `f.template operator()<K>()` for every kind, in order.
   template <class F>
   static void for_each(F&& f) {

@@ -1,0 +1,6 @@
+// The TypedBlocks of part 1 of ConstraintKinds (kinds/typed_blocks.hpp).
+#include "kinds/typed_blocks.hpp"
+
+std::shared_ptr<phiq::ConstraintBlock> phiq::detail::new_block_part_1(std::size_t kind) {
+  return new_block_in_part<1>(kind);
+}
