@@ -195,7 +195,7 @@ TEST_F(Cli, ImportGravityRunsDirectlyAndThroughConvertToTheSameBytesAndBadValues
     EXPECT_EQ(slurp(dir_ / "direct.csv"), slurp(dir_ / "via.csv"));
     EXPECT_NE(slurp(dir_ / "via.csv").find("drive_hinge.effort"), std::string::npos);
   }
-  for (const std::string& bad : {"1,2", "1,2,3,4", "nan,0,0"}) {
+  for (const std::string bad : {"1,2", "1,2,3,4", "nan,0,0"}) {
     const Result r = run("run " + urdf.string() + drive + " --gravity " + bad + " -o " + (dir_ / "bad.csv").string());
     EXPECT_EQ(r.code, 2) << bad;
     EXPECT_TRUE(one_phiq_line(r.err)) << r.err;

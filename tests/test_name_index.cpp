@@ -34,7 +34,7 @@ TEST(NameIndex, NumberedNamesWithLeadingZerosOrBeyondTheirRunAreDistinctNames) {
   for (const std::string& n : names) EXPECT_TRUE(t.add(n)) << n;
   for (std::size_t k = 0; k < names.size(); ++k) EXPECT_EQ(t.find(names[k]), static_cast<Index>(k)) << names[k];
   for (const std::string& n : names) EXPECT_FALSE(t.add(n)) << n;  // each one a duplicate now
-  for (const std::string& n : {"x3", "x02", "y0", "z1", "x99999999", "theta1", "the"}) EXPECT_EQ(t.find(n), -1) << n;
+  for (const char* n : {"x3", "x02", "y0", "z1", "x99999999", "theta1", "the"}) EXPECT_EQ(t.find(n), -1) << n;
 }
 
 TEST(NameIndex, FamiliesInAnyOrderAreFoundAndRefusedTwice) {

@@ -131,12 +131,18 @@ void detail::report_rounding_rows(const Model& model, double tol, Index row, con
   sum.rounding_level = std::max(sum.rounding_level, sum.error_estimate);
   if (sum.slow_convergence) return;  // (a linear convergence says so already)
   sum.slow_convergence = true;
-  sum.message = (row >= 0 ? "'" + model.row_name(row) +
-                                "' is at the rounding of its own terms (one ulp of each), which no Newton step "
-                                "resolves, and was left out of the steps: "
-                          : std::string("rows whose terms are far larger than their tolerance (a badly scaled model) "
-                                        "are known to one ulp of those terms: ")) +
-                known_to_text(model, j, sum.error_size) + ", which is how well q is known there";
+  // appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) on a literal + std::string here
+  std::string& m = sum.message;
+  const char* const left_out =
+      "' is at the rounding of its own terms (one ulp of each), which no Newton step resolves, and was left out of "
+      "the steps: ";
+  if (row >= 0)
+    m.assign(1, '\'').append(model.row_name(row)).append(left_out);
+  else
+    m.assign(
+        "rows whose terms are far larger than their tolerance (a badly scaled model) are known to one ulp of "
+        "those terms: ");
+  m.append(known_to_text(model, j, sum.error_size)).append(", which is how well q is known there");
 }
 
 }  // namespace phiq
