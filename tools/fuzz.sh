@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Bounded libFuzzer runs (targets in tests/fuzz, built with ASan + UBSan by tools/test.sh):
 #   fuzz_scene       any bytes as a scene, for SECONDS; seeds: every scene under models/ and tests/fuzz/regressions/
-#   fuzz_expression  any bytes as an equation's text, for SECONDS/2; seeds: every expr: of those scenes
+#   fuzz_expression  any bytes as an equation's text, for SECONDS; seeds: every expr: of those scenes
 #   tools/fuzz.sh [SECONDS] [BUILD_DIR]      default 60 s, build-asan
 # Both run at once, each on one core. Exits non-zero on any crash, hang (> 10 s per input), leak or sanitizer report; the reproducer is left in
 # BUILD_DIR/fuzz/<target>/. Prints the number of inputs tried.
@@ -35,10 +35,10 @@ find "$root/models" "$root/tests/fuzz/regressions" -type f -exec cp {} "$scenes/
 grep -rhoE 'expr: "[^"]*"' "$root/models" "$root/tests/fuzz/regressions" | sed -E 's/^expr: "(.*)"$/\1/' |
   sort -u | awk -v dir="$expressions/seeds" '{ f = dir "/seed" NR; printf "%s", $0 > f; close(f) }'
 
-# The two targets side by side (libFuzzer runs on one core): the pass takes SECONDS, not SECONDS × 1.5.
+# The two targets side by side (libFuzzer runs on one core): the pass takes SECONDS, not twice that.
 (run fuzz_scene "$seconds" "$root/tests/fuzz/scene.dict") &
 scene_job=$!
 status=0
-(run fuzz_expression "$(( (seconds + 1) / 2 ))" "$root/tests/fuzz/expression.dict") || status=1
+(run fuzz_expression "$seconds" "$root/tests/fuzz/expression.dict") || status=1
 wait "$scene_job" || status=1
 exit "$status"
