@@ -106,7 +106,7 @@ void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& 
 }
 
 void JointReactions::evaluate(const double* q, const double* qd, const double* qdd, double t,
-                              const Eigen::VectorXd& lambda, double* out) {
+                              const Eigen::VectorXd& lambda, double* out, const detail::PlanarForce* planar) {
   if (!natural_sites_.empty()) {
     const Index n = static_cast<Index>(g_.size());
     qx_.head(n) = Eigen::Map<const Eigen::VectorXd>(q, n);
@@ -115,7 +115,7 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
   }
   for (const auto& [natural, k] : order_)
     if (natural)
-      evaluate_natural(natural_sites_[k], t, lambda, out);
+      evaluate_natural(natural_sites_[k], t, lambda, planar, out);
     else
       evaluate_site(sites_[k], q, t, lambda, out);
 }
