@@ -72,6 +72,7 @@ class JointReactions {
   struct NaturalSite {
     std::size_t joint = 0, body = 0;  // in natural_
     std::size_t point = 0;            // the joint's place among the body's points
+    Index at[3] = {0, 0, 0};          // its components' coordinates (n and above: promoted constants)
   };
   // The natural bodies' own constraints, and the columns they and the bodies' forces touch, body b's at
   // [first[b], first[b + 1]) of each list (flat: one allocation per list, not per body).
@@ -83,11 +84,14 @@ class JointReactions {
   // A natural body's part as OutputEfforts::parts' has it: `part` its index there when the whole model's Q computes
   // the body's weight and inertia (evaluate()'s `planar`) as the body's own Q would, bit for bit, else none; `slots`
   // its promoted planar frame's (detail::PlanarFrame), where its force is added.
+  // `applied` the loads on the body alone, when any. (A row reads these rather than the NaturalBody, whose
+  // kilobytes each, 10⁴ of them in nfourbar 10⁴, would come from memory at every row.)
   struct BodyPart {
     static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
     std::size_t part = kNone;
     Slot slots[5];
     bool x_is_point = true;
+    const AppliedLoads* applied = nullptr;
   };
   void add_site(const Model& model, Index c, std::vector<int>& site_of);
   void find_columns(const Model& model, const std::vector<int>& site_of);

@@ -91,6 +91,7 @@ JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts)
     }
     if (s.point == body.points.size())
       throw Error("JointReactions: natural joint '" + j.name + "' is not a point of '" + body.name + "'");
+    for (int d = 0; d < (efforts.natural->spatial ? 3 : 2); ++d) s.at[d] = body.points[s.point].r[d].coord();
     size_ += efforts.natural->spatial ? 6 : 3;
     order_.push_back({true, natural_sites_.size()});
     natural_sites_.push_back(s);

@@ -162,7 +162,7 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
         own.frame.body)
       continue;
     BodyPart& bp = body_parts_[b];
-    bp.part = body.part, bp.x_is_point = own.frame.x_is_point;
+    bp.part = body.part, bp.x_is_point = own.frame.x_is_point, bp.applied = body.loads.applied.get();
     std::copy(own.frame.slots, own.frame.slots + 5, bp.slots);
   }
 }
@@ -276,7 +276,6 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
 }
 
 void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarForce* planar) {
-  const NaturalBody& body = natural_->bodies[b];
   const BodyPart& part = body_parts_[b];
   if (planar && part.part != BodyPart::kNone && planar[part.part].valid) {
     // the whole model's Q computed the part's force at this row: added at the promoted frame's slots, as
@@ -285,30 +284,31 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
     std::copy(part.slots, part.slots + 5, frame.slots);
     frame.body = false, frame.x_is_point = part.x_is_point;
     detail::add_planar_force(frame, planar[part.part], qb_);
-    if (body.loads.applied) add_applied_forces(*body.loads.applied, qx_.data(), qdx_.data(), t, qb_);
+    if (part.applied) add_applied_forces(*part.applied, qx_.data(), qdx_.data(), t, qb_);
     return;
   }
+  const NaturalBody& body = natural_->bodies[b];
   add_generalized_forces(body.parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
 }
 
 void JointReactions::evaluate_natural(const NaturalSite& s, double t, const Eigen::VectorXd& lambda,
                                       const detail::PlanarForce* planar, double*& out) {
-  const NaturalBody& body = natural_->bodies[s.body];
   const BodyRows& rows = body_rows_;
   const Index n = static_cast<Index>(g_.size());
   for (std::size_t k = rows.constraints_first[s.body]; k < rows.constraints_first[s.body + 1]; ++k)
     rows.constraints[k].first->add_transposed_product(rows.constraints[k].second, qx_.data(), t, lambda.data(),
                                                       g_.data());
   body_forces(s.body, t, planar);
-  const Attachment3& p = body.points[s.point];
   double force[3] = {0.0, 0.0, 0.0};
   for (int k = 0; k < (natural_->spatial ? 3 : 2); ++k) {
-    const Index at = p.r[k].coord();
+    const Index at = s.at[k];
     if (at < n) {  // R = Σ_c (Φq,cᵀ λ_c)(P) − Q_b(P)
       force[k] = g_[static_cast<std::size_t>(at)] - qb_(at);
       continue;
     }
     // a constant component: ∂Φ_c/∂P_k = −Σ over the body's moving points' k-components (translation invariance)
+    const NaturalBody& body = natural_->bodies[s.body];
+    const Attachment3& p = body.points[s.point];
     double moving = 0.0;
     bool shared = false;  // another point of the body constant along k: the load's split between them is open
     for (const Attachment3& o : body.points) {
