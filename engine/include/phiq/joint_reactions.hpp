@@ -46,6 +46,10 @@ class JointReactions {
   /// OutputEfforts::natural. Pre-condition: as above for the constraints; a natural joint's index is one of
   /// `natural`'s joints (else phiq::Error).
   JointReactions(const Model& model, const OutputEfforts& efforts);
+  /// The joints `other` lists, its set-up (sites, columns, bodies) copied rather than found again in the model, with
+  /// scratch of its own: a sweep's chunks each evaluate on their own thread. Safe while `other` evaluates on
+  /// another thread (its set-up is not written after construction).
+  static JointReactions with_set_up_of(const JointReactions& other) { return JointReactions(other, SetUpOnly{}); }
   /// The values evaluate() writes: per constraint, Fx, Fy, Mz (N, N·m) for a planar joint, Fx, Fy, Fz, Mx, My, Mz
   /// for a spatial one.
   Index size() const { return size_; }
@@ -93,6 +97,8 @@ class JointReactions {
     bool x_is_point = true;
     const AppliedLoads* applied = nullptr;
   };
+  struct SetUpOnly {};  // with_set_up_of()'s constructor
+  JointReactions(const JointReactions& other, SetUpOnly);
   void add_site(const Model& model, Index c, std::vector<int>& site_of);
   void find_columns(const Model& model, const std::vector<int>& site_of);
   void add_natural(const Model& model, const OutputEfforts& efforts);

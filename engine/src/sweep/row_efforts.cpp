@@ -111,6 +111,13 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
                                  "written"});
 }
 
+std::optional<JointReactions> Sweeper::written_reactions(const Sweeper* like) const {
+  if (opt_.efforts.reactions.empty()) return std::nullopt;
+  if (like && &like->model_ == &model_ && &like->opt_ == &opt_ && like->effort_work_.reactions)
+    return JointReactions::with_set_up_of(*like->effort_work_.reactions);
+  return JointReactions(model_, opt_.efforts);
+}
+
 std::vector<std::size_t> Sweeper::dropped_efforts() const {
   // A driver whose row was dropped as redundant shares its load with the equations it repeats: not its own.
   std::vector<std::size_t> out;
