@@ -1,18 +1,22 @@
 // Joint reactions at natural coordinates' shared points (phiq/natural_joints.hpp): the natural four-bar's pins O, A,
 // B, C carry the forces the reference-point four-bar's revolutes carry, under gravity, forces, a torque and a spring,
-// with the same motor torque; each of its links satisfies its Newton–Euler equations written here with them; a
-// point no two bodies share is refused by name.
+// with the same motor torque; each of its links satisfies its Newton–Euler equations written here with them; the
+// bodies' weight and inertia read from the whole model's Q (a sweep's way) give the reactions their own Q gives, bit
+// for bit; a point no two bodies share is refused by name.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
+#include "phiq/inverse_dynamics.hpp"
 #include "phiq/joint_reactions.hpp"
 #include "phiq/natural_joints.hpp"
 #include "phiq/phiq.hpp"
+#include "solve/part_forces.hpp"
 #include "test_support.hpp"
 
 namespace phiq {
@@ -178,6 +182,51 @@ TEST(NaturalReactions, EveryNaturalLinkBalancesUnderItsPinForces) {
       EXPECT_NEAR((sum - mass * aG).norm(), 0.0, 1e-8 * (1 + sum.norm())) << l.origin << l.x << " row " << k;
       EXPECT_NEAR(moment, inertia * alpha, 1e-8 * (1 + std::fabs(moment))) << l.origin << l.x << " row " << k;
     }
+  }
+}
+
+// A sweep's reactions read each natural body's weight and inertia where the whole model's Q left them
+// (detail::PlanarForce), rather than the body's own Q: the same numbers, bit for bit, at every row of the four-bar
+// with gravity, a force, a torque, a spring and the fixed pins O, C (constant components, promoted). Q itself is
+// add_generalized_forces()' to the bit; a shifted cached force moves the reactions where it acts (the cache is read,
+// not passed over).
+TEST(NaturalReactions, BodyForcesFromTheModelsQAreTheBodiesOwnBitForBit) {
+  const Scene s = natural_four_bar();
+  const NaturalRows rows = natural_reactions_sweep(s);
+  const Model& m = *s.model;
+  const OutputEfforts& e = s.sweep.efforts;
+  const std::vector<Part>& parts = *e.parts;
+  ASSERT_EQ(e.natural->bodies.size(), 3u);
+  for (const NaturalBody& b : e.natural->bodies) EXPECT_EQ(parts.at(b.part).name, b.name);
+  EXPECT_EQ(e.natural->promoted.size(), 4u);  // O's and C's x and y
+  JointReactions reactions(m, e);
+  const detail::PartForces forces(parts);
+  Workspace ws(m);
+  const std::size_t n = static_cast<std::size_t>(reactions.size());
+  for (std::size_t k = 0; k < rows.q.size(); ++k) {
+    const double t = rows.t[k];
+    const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data();
+    Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), own = Q, lambda;
+    std::vector<detail::PlanarForce> planar(parts.size());
+    forces.add(parts, *e.loads, q, qd, qdd, t, Q, planar.data());
+    add_generalized_forces(parts, *e.loads, q, qd, qdd, t, own);
+    ASSERT_EQ(std::memcmp(Q.data(), own.data(), sizeof(double) * static_cast<std::size_t>(Q.size())), 0) << k;
+    for (const NaturalBody& b : e.natural->bodies) ASSERT_TRUE(planar[b.part].valid) << b.name << ", row " << k;
+    ws.q = rows.q[k];
+    ASSERT_EQ(constraint_multipliers(m, t, ws, Q, lambda), SolveStatus::kSuccess);
+    std::vector<double> general(n), cached(n), shifted(n);
+    reactions.evaluate(q, qd, qdd, t, lambda, general.data());
+    reactions.evaluate(q, qd, qdd, t, lambda, cached.data(), planar.data());
+    ASSERT_EQ(std::memcmp(general.data(), cached.data(), sizeof(double) * n), 0) << "row " << k;
+    for (std::size_t j = 0; j < n; ++j)  // the sweep's, whose λ comes from its own factors
+      EXPECT_NEAR(rows.values[k][2 + j], general[j], 1e-9 * (1 + std::fabs(general[j]))) << j << ", row " << k;
+    for (detail::PlanarForce& f : planar) f.fx += 1.0;
+    reactions.evaluate(q, qd, qdd, t, lambda, shifted.data(), planar.data());
+    // R = Φqᵀλ − Q_b: a newton more along x at each part's origin, O (the crank's) and C (the rocker's); A and B are
+    // their bodies' x points, which fx does not reach
+    for (std::size_t j : {0u, 3u})
+      EXPECT_NEAR(shifted[3 * j], general[3 * j] - 1.0, 1e-9 * (1 + std::fabs(general[3 * j]))) << j << ", " << k;
+    for (std::size_t j : {1u, 2u}) EXPECT_EQ(shifted[3 * j], general[3 * j]) << j << ", " << k;
   }
 }
 

@@ -28,6 +28,10 @@
 
 namespace phiq {
 
+namespace detail {
+struct PlanarForce;
+}  // namespace detail
+
 /// How many values constraint c's reaction has: 3 (Fx, Fy, Mz) for a planar joint, 6 for a spatial one, 0 when its
 /// kind states no ReactionSite (no reaction). Pre-condition: c is one of the model's constraints.
 int reaction_width(const Model& model, Index c);
@@ -42,6 +46,10 @@ class JointReactions {
   /// OutputEfforts::natural. Pre-condition: as above for the constraints; a natural joint's index is one of
   /// `natural`'s joints (else phiq::Error).
   JointReactions(const Model& model, const OutputEfforts& efforts);
+  /// The joints `other` lists, its set-up (sites, columns, bodies) copied rather than found again in the model, with
+  /// scratch of its own: a sweep's chunks each evaluate on their own thread. Safe while `other` evaluates on
+  /// another thread (its set-up is not written after construction).
+  static JointReactions with_set_up_of(const JointReactions& other) { return JointReactions(other, SetUpOnly{}); }
   /// The values evaluate() writes: per constraint, Fx, Fy, Mz (N, N·m) for a planar joint, Fx, Fy, Fz, Mx, My, Mz
   /// for a spatial one.
   Index size() const { return size_; }
@@ -51,9 +59,12 @@ class JointReactions {
   /// Pre-condition: q has the model's coordinates; the model is the one given to the constructor.
   /// No natural joint may be listed (they read q̇ and q̈: the overload below; else phiq::Error).
   void evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out);
-  /// The same at the motion (q, q̇, q̈, t), which natural joints read (their bodies' inertia).
+  /// The same at the motion (q, q̇, q̈, t), which natural joints read (their bodies' inertia). `planar`, when not
+  /// null, is what detail::PartForces::add() left of OutputEfforts::parts' forces at this (q, q̇, q̈, t) (internal: a
+  /// sweep's, whose Q has computed them): a natural body's part's weight and inertia are read there rather than
+  /// computed again, the same values bit for bit.
   void evaluate(const double* q, const double* qd, const double* qdd, double t, const Eigen::VectorXd& lambda,
-                double* out);
+                double* out, const detail::PlanarForce* planar = nullptr);
 
  private:
   struct Site {
@@ -65,21 +76,43 @@ class JointReactions {
   struct NaturalSite {
     std::size_t joint = 0, body = 0;  // in natural_
     std::size_t point = 0;            // the joint's place among the body's points
+    Index at[3] = {0, 0, 0};          // its components' coordinates (n and above: promoted constants)
   };
-  struct BodyRows {  // a natural body's own constraints, and the columns they and its forces touch
+  // The natural bodies' own constraints, and the columns they and the bodies' forces touch, body b's at
+  // [first[b], first[b + 1]) of each list (flat: one allocation per list, not per body).
+  struct BodyRows {
+    std::vector<std::size_t> constraints_first, g_first, q_first;
     std::vector<std::pair<const ConstraintBlock*, std::size_t>> constraints;
     std::vector<Index> g_columns, q_columns;
   };
+  // A natural body's part as OutputEfforts::parts' has it: `part` its index there when the whole model's Q computes
+  // the body's weight and inertia (evaluate()'s `planar`) as the body's own Q would, bit for bit, else none; `slots`
+  // its promoted planar frame's (detail::PlanarFrame), where its force is added.
+  // `applied` the loads on the body alone, when any. (A row reads these rather than the NaturalBody, whose
+  // kilobytes each, 10⁴ of them in nfourbar 10⁴, would come from memory at every row.)
+  struct BodyPart {
+    static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+    std::size_t part = kNone;
+    Slot slots[5];
+    bool x_is_point = true;
+    const AppliedLoads* applied = nullptr;
+  };
+  struct SetUpOnly {};  // with_set_up_of()'s constructor
+  JointReactions(const JointReactions& other, SetUpOnly);
   void add_site(const Model& model, Index c, std::vector<int>& site_of);
   void find_columns(const Model& model, const std::vector<int>& site_of);
   void add_natural(const Model& model, const OutputEfforts& efforts);
+  void find_body_parts(const Model& model, const OutputEfforts& efforts);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
-  void evaluate_natural(const NaturalSite& s, double t, const Eigen::VectorXd& lambda, double*& out);
+  void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);
+  void evaluate_natural(const NaturalSite& s, double t, const Eigen::VectorXd& lambda,
+                        const detail::PlanarForce* planar, double*& out);
   std::vector<Site> sites_;
   std::vector<NaturalSite> natural_sites_;
   std::vector<std::pair<bool, std::size_t>> order_;  // (natural, index) per listed reaction
   std::shared_ptr<const NaturalJoints> natural_;
-  std::vector<BodyRows> body_rows_;
+  BodyRows body_rows_;
+  std::vector<BodyPart> body_parts_;      // per natural body
   Eigen::VectorXd qx_, qdx_, qddx_, qb_;  // q, q̇, q̈ with the promoted constants; a body's Q
   Index size_ = 0;
   std::vector<double> g_;  // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations

@@ -33,7 +33,10 @@ namespace phiq {
 /// A body of natural coordinates (file comment): its frame, and what acts on it alone.
 struct NaturalBody {
   std::string name;  ///< the part's
-  PartFrame frame;   ///< its frame (PartFrameKind::kPoints)
+  /// Its index among the parts find_natural_joints() was given (unknown: the largest size_t), where a sweep's Q has
+  /// already computed its part's weight and inertia.
+  std::size_t part = static_cast<std::size_t>(-1);
+  PartFrame frame;  ///< its frame (PartFrameKind::kPoints)
   /// Its part when it has mass (shapes cleared), else empty; its frame's constant point components made coordinates
   /// n, n + 1, … (NaturalJoints::promoted), so that Q differentiates along them.
   std::vector<Part> parts;

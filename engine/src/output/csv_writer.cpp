@@ -154,7 +154,10 @@ constexpr std::size_t kMaxValueChars = 25;
 
 // Writes v at w (at most kMaxValueChars − 1 characters); returns the end.
 inline char* put(double v, char* w) {
-  if (v == 0.0) v = 0.0;  // −0 → 0: same value, and text diffs of results stay quiet
+  if (v == 0.0) {  // −0 → 0: same value, and text diffs of results stay quiet; std::to_chars's text of 0, at once
+    *w = '0';
+    return w + 1;
+  }
   return std::to_chars(w, w + kMaxValueChars - 1, v).ptr;
 }
 inline void put(double v, std::string& out) {
@@ -242,7 +245,25 @@ void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
 }
 
 void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
-  for_each_output(s, [&](double v) { out += ',', put(v, out); });
+  // As append_coordinates(): room for the longest text of each value, written in place, the row cut to what was
+  // written (appending each value's text to the string cost half as much again as its formatting).
+  const std::size_t start = out.size();
+  out.resize(start + num_output_values() * kMaxValueChars);
+  char *w = out.data() + start, *end = out.data() + out.size();
+  try {
+    for_each_output(s, [&](double v) {
+      if (static_cast<std::size_t>(end - w) < kMaxValueChars) {  // (never: the count is exact)
+        const std::size_t at = static_cast<std::size_t>(w - out.data());
+        out.resize(out.size() + 64 * kMaxValueChars);
+        w = out.data() + at, end = out.data() + out.size();
+      }
+      *w++ = ',', w = put(v, w);
+    });
+  } catch (...) {
+    out.resize(start);  // no room's zeros left behind
+    throw;
+  }
+  out.resize(static_cast<std::size_t>(w - out.data()));
 }
 
 void CsvFormat::append_output_values(const StepView& s, double* out) const {

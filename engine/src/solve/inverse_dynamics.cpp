@@ -47,42 +47,40 @@ bool add_planar_virtual_work(const PartFrame& f, const double* q, V3 c, V3 force
   return true;
 }
 
-// Q of a part on a planar frame from the frame's motion in scalars (parts/planar_motion.hpp): what part_motion(),
-// PartMotion::point(), the inertia's moment and add_planar_virtual_work() compute, without their terms that are
-// products with the zeros of a rotation about z and of ω, α along z. Those terms are ±0 (every factor is finite),
-// and a ±0 changes a sum only in the sign of a zero, which Q, summed from +0, never keeps: Q is the same to the
-// bit, at a fraction of the cost (a sweep's efforts spent most of their time here, 2·10⁴ parts a row at 10⁴ loops).
-// False, with Q untouched, for a direction of zero length: the general path's NaN.
-bool add_planar_part(const detail::MassivePart& p, const double* q, const double* qd, const double* qdd, V3 gravity,
-                     Eigen::VectorXd& Q) {
+// The force of a part on a planar frame from the frame's motion in scalars (parts/planar_motion.hpp): what
+// part_motion(), PartMotion::point(), the inertia's moment and add_planar_virtual_work() compute, without their
+// terms that are products with the zeros of a rotation about z and of ω, α along z. Those terms are ±0 (every factor
+// is finite), and a ±0 changes a sum only in the sign of a zero, which Q, summed from +0, never keeps: Q is the same
+// to the bit, at a fraction of the cost (a sweep's efforts spent most of their time here, 2·10⁴ parts a row at 10⁴
+// loops). False for a direction of zero length: the general path's NaN.
+bool planar_part_force(const detail::MassivePart& p, const double* q, const double* qd, const double* qdd, V3 gravity,
+                       detail::PlanarForce& f) {
   detail::PlanarMotion m;
   if (!detail::planar_motion(p.frame, q, qd, qdd, m)) return false;
-  auto add = [&](const Slot& s, double v) {
-    if (s.is_coordinate()) Q(s.coord()) += v;
-  };
   const double c = m.cos, sn = m.sin, w = m.omega, a = m.alpha, mass = p.mass;
   // the centre from the origin, as Pose::apply() and the difference round it; its acceleration a + α × r + ω × ω × r
   const double rx = (m.at.x + c * p.cx - sn * p.cy) - m.at.x, ry = (m.at.y + sn * p.cx + c * p.cy) - m.at.y;
   const double acx = (m.acceleration.x - a * ry) - w * (w * rx), acy = (m.acceleration.y + a * rx) - w * (w * ry);
-  const double fx = mass * (gravity.x - acx), fy = mass * (gravity.y - acy), fz = mass * (gravity.z - m.acceleration.z);
-  const double turn = (rx * fy - ry * fx) - p.izz * a;  // (r × F)_z − I_zz α
-  const Slot* o = p.frame.slots;
-  if (p.frame.body) {
-    add(o[0], fx), add(o[1], fy), add(o[2], turn);
-    return true;
-  }
-  const Slot* x = o + 3;
-  const double along_x = -m.dy / m.d2 * turn, along_y = m.dx / m.d2 * turn;
-  add(o[0], fx), add(o[1], fy), add(o[2], fz);
-  add(x[0], along_x), add(x[1], along_y);
-  if (p.frame.x_is_point) add(o[0], -along_x), add(o[1], -along_y);
+  f.fx = mass * (gravity.x - acx), f.fy = mass * (gravity.y - acy), f.fz = mass * (gravity.z - m.acceleration.z);
+  f.turn = (rx * f.fy - ry * f.fx) - p.izz * a;  // (r × F)_z − I_zz α
+  if (!p.frame.body) f.along_x = -m.dy / m.d2 * f.turn, f.along_y = m.dx / m.d2 * f.turn;
+  f.valid = true;
   return true;
 }
 
-// Q of one part with mass: its planar frame's closed form, or its motion and Jacobian.
+// Q of one part with mass: its planar frame's closed form, or its motion and Jacobian. With `planar`, a planar
+// frame's force is left there too (PlanarForce::valid false when the general path took it).
 void add_part(const Part& p, const detail::MassivePart& massive, V3 gravity, const double* q, const double* qd,
-              const double* qdd, double t, Eigen::VectorXd& Q) {
-  if (massive.planar && add_planar_part(massive, q, qd, qdd, gravity, Q)) return;
+              const double* qdd, double t, Eigen::VectorXd& Q, detail::PlanarForce* planar = nullptr) {
+  if (massive.planar) {
+    detail::PlanarForce f;
+    if (planar_part_force(massive, q, qd, qdd, gravity, f)) {
+      detail::add_planar_force(massive.frame, f, Q);
+      if (planar) *planar = f;
+      return;
+    }
+    if (planar) planar->valid = false;
+  }
   const PartMotion m = part_motion(p.frame, q, qd, qdd, t);
   const V3 c = m.pose.apply(p.mass.center) - m.pose.at;  // the centre from the origin, world axes
   const auto [vc, ac] = m.point(p.mass.center);
@@ -100,22 +98,21 @@ void add_part(const Part& p, const detail::MassivePart& massive, V3 gravity, con
   }
 }
 
-bool has_mass(const Part& p) { return p.mass_source != MassSource::kNone && p.mass.mass != 0.0; }
+}  // namespace
 
-detail::MassivePart massive_part(const Part& p, std::size_t index) {
-  detail::MassivePart m;
-  m.planar = detail::planar_frame(p.frame, m.frame);
+detail::MassivePart detail::massive_part(const Part& p, std::size_t index) {
+  MassivePart m;
+  m.planar = planar_frame(p.frame, m.frame);
   m.mass = p.mass.mass, m.cx = p.mass.center.x, m.cy = p.mass.center.y, m.izz = p.mass.inertia[8];
   m.part = index;
   return m;
 }
 
-}  // namespace
-
 void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
                             const double* qdd, double t, Eigen::VectorXd& Q) {
   for (std::size_t i = 0; i < parts.size(); ++i)
-    if (has_mass(parts[i])) add_part(parts[i], massive_part(parts[i], i), loads.gravity, q, qd, qdd, t, Q);
+    if (detail::has_mass(parts[i]))
+      add_part(parts[i], detail::massive_part(parts[i], i), loads.gravity, q, qd, qdd, t, Q);
   if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
 }
 
@@ -125,8 +122,9 @@ detail::PartForces::PartForces(const std::vector<Part>& parts) {
 }
 
 void detail::PartForces::add(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
-                             const double* qdd, double t, Eigen::VectorXd& Q) const {
-  for (const MassivePart& m : massive_) add_part(parts[m.part], m, loads.gravity, q, qd, qdd, t, Q);
+                             const double* qdd, double t, Eigen::VectorXd& Q, PlanarForce* planar) const {
+  for (const MassivePart& m : massive_)
+    add_part(parts[m.part], m, loads.gravity, q, qd, qdd, t, Q, planar ? planar + m.part : nullptr);
   if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
 }
 

@@ -91,12 +91,29 @@ JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts)
     }
     if (s.point == body.points.size())
       throw Error("JointReactions: natural joint '" + j.name + "' is not a point of '" + body.name + "'");
+    for (int d = 0; d < (efforts.natural->spatial ? 3 : 2); ++d) s.at[d] = body.points[s.point].r[d].coord();
     size_ += efforts.natural->spatial ? 6 : 3;
     order_.push_back({true, natural_sites_.size()});
     natural_sites_.push_back(s);
   }
   find_columns(model, site_of);
   if (!natural_sites_.empty()) add_natural(model, efforts);
+}
+
+JointReactions::JointReactions(const JointReactions& other, SetUpOnly)
+    : sites_(other.sites_),
+      natural_sites_(other.natural_sites_),
+      order_(other.order_),
+      natural_(other.natural_),
+      body_rows_(other.body_rows_),
+      body_parts_(other.body_parts_),
+      size_(other.size_),
+      g_(other.g_.size(), 0.0) {
+  if (natural_sites_.empty()) return;
+  // as add_natural() sizes them: q, q̇, q̈ with the promoted constants, Q_b zero
+  const Index n = static_cast<Index>(g_.size()), extra = static_cast<Index>(natural_->promoted.size());
+  qx_.setZero(n + extra), qdx_.setZero(n + extra), qddx_.setZero(n + extra), qb_.setZero(n + extra);
+  for (Index k = 0; k < extra; ++k) qx_(n + k) = natural_->promoted[static_cast<std::size_t>(k)];
 }
 
 void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out) {
@@ -106,7 +123,7 @@ void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& 
 }
 
 void JointReactions::evaluate(const double* q, const double* qd, const double* qdd, double t,
-                              const Eigen::VectorXd& lambda, double* out) {
+                              const Eigen::VectorXd& lambda, double* out, const detail::PlanarForce* planar) {
   if (!natural_sites_.empty()) {
     const Index n = static_cast<Index>(g_.size());
     qx_.head(n) = Eigen::Map<const Eigen::VectorXd>(q, n);
@@ -115,7 +132,7 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
   }
   for (const auto& [natural, k] : order_)
     if (natural)
-      evaluate_natural(natural_sites_[k], t, lambda, out);
+      evaluate_natural(natural_sites_[k], t, lambda, planar, out);
     else
       evaluate_site(sites_[k], q, t, lambda, out);
 }

@@ -11,6 +11,7 @@
 #include "phiq/constraint_block.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/joint_reactions.hpp"
+#include "solve/part_forces.hpp"
 
 namespace phiq {
 
@@ -47,10 +48,11 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
   NaturalJoints out;
   out.spatial = spatial;
   const int dimension = spatial ? 3 : 2;
-  for (const Part& p : parts) {
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const Part& p = parts[i];
     if (p.frame.kind != PartFrameKind::kPoints || !moves(p.frame)) continue;
     NaturalBody b;
-    b.name = p.name;
+    b.name = p.name, b.part = i;
     b.frame = p.frame;
     PartFrame promoted = p.frame;
     // each constant component of a point a coordinate of its own, past the model's (its value in `promoted`)
@@ -107,77 +109,206 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
   return out;
 }
 
+namespace {
+
+// Counts turned into the offsets of a flat list: first[k] = Σ count[< k] (count sits at first[1 …]).
+void counts_to_offsets(std::vector<std::size_t>& first) {
+  for (std::size_t k = 1; k < first.size(); ++k) first[k] += first[k - 1];
+}
+
+bool same_bits(double a, double b) { return a == b && std::signbit(a) == std::signbit(b); }
+
+// Whether `own` (a natural body's part, its constant components promoted to coordinates n + k of value
+// promoted[k]) has the force of `whole` (the same part as the whole model's Q takes it), bit for bit: the same
+// mass, centre and inertia, and frames whose slots are the same or a constant and its promoted copy, which
+// planar_motion() reads alike (the value from q; rate and acceleration 0, as JointReactions' q̇, q̈ hold there).
+bool same_planar_force(const detail::MassivePart& whole, const detail::MassivePart& own,
+                       const std::vector<double>& promoted, Index n) {
+  if (!whole.planar || !own.planar || whole.frame.body != own.frame.body ||
+      whole.frame.x_is_point != own.frame.x_is_point)
+    return false;
+  if (!same_bits(whole.mass, own.mass) || !same_bits(whole.cx, own.cx) || !same_bits(whole.cy, own.cy) ||
+      !same_bits(whole.izz, own.izz))
+    return false;
+  for (int k = 0; k < 5; ++k) {
+    const Slot a = whole.frame.slots[k], b = own.frame.slots[k];
+    if (a == b) continue;
+    if (a.is_coordinate() || !b.is_coordinate() || b.coord() < n ||
+        b.coord() - n >= static_cast<Index>(promoted.size()) ||
+        !same_bits(a.value(), promoted[static_cast<std::size_t>(b.coord() - n)]))
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void JointReactions::find_body_parts(const Model& model, const OutputEfforts& efforts) {
+  const std::vector<NaturalBody>& bodies = natural_->bodies;
+  body_parts_.assign(bodies.size(), {});
+  if (!efforts.parts || !efforts.loads) return;
+  const std::vector<Part>& parts = *efforts.parts;
+  const kin3::V3 g = efforts.loads->gravity;
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    const NaturalBody& body = bodies[b];
+    const kin3::V3 own_g = body.loads.gravity;
+    if (body.parts.size() != 1 || body.part >= parts.size() || !detail::has_mass(body.parts[0]) ||
+        !detail::has_mass(parts[body.part]) || !same_bits(g.x, own_g.x) || !same_bits(g.y, own_g.y) ||
+        !same_bits(g.z, own_g.z))
+      continue;
+    const detail::MassivePart own = detail::massive_part(body.parts[0], 0);
+    if (!same_planar_force(detail::massive_part(parts[body.part], body.part), own, natural_->promoted,
+                           model.num_coordinates()) ||
+        own.frame.body)
+      continue;
+    BodyPart& bp = body_parts_[b];
+    bp.part = body.part, bp.x_is_point = own.frame.x_is_point, bp.applied = body.loads.applied.get();
+    std::copy(own.frame.slots, own.frame.slots + 5, bp.slots);
+  }
+}
+
 void JointReactions::add_natural(const Model& model, const OutputEfforts& efforts) {
   natural_ = efforts.natural;
   const Index n = model.num_coordinates(), extra = static_cast<Index>(natural_->promoted.size());
   qx_.setZero(n + extra), qdx_.setZero(n + extra), qddx_.setZero(n + extra), qb_.setZero(n + extra);
   for (Index k = 0; k < extra; ++k) qx_(n + k) = natural_->promoted[static_cast<std::size_t>(k)];
-  // each body's point coordinates (the model's), and which coordinates are a point's at all
-  const std::size_t nb = natural_->bodies.size();
-  std::vector<std::vector<Index>> coords(nb);
-  std::vector<bool> of_point(static_cast<std::size_t>(n), false);
-  body_rows_.assign(nb, {});
+  const std::vector<NaturalBody>& bodies = natural_->bodies;
+  const std::size_t nb = bodies.size(), nc = model.constraints().size();
+  BodyRows& rows = body_rows_;
+  // each body's point coordinates (the model's, sorted: `coords` from coords_first[b]), which coordinates are a
+  // point's at all, and the columns the body's forces touch (its frame's coordinates, promoted ones included)
+  std::vector<std::size_t> coords_first(nb + 1, 0);
+  std::vector<Index> coords;
+  std::vector<char> of_point(static_cast<std::size_t>(n), 0);
+  rows.q_first.assign(nb + 1, 0);
+  rows.q_columns.clear();
   for (std::size_t b = 0; b < nb; ++b) {
-    const NaturalBody& body = natural_->bodies[b];
-    std::vector<Index>& q_columns = body_rows_[b].q_columns;
-    frame_coordinates(body.frame, q_columns);
+    const NaturalBody& body = bodies[b];
+    for (const Attachment3* a : {&body.frame.origin, &body.frame.x_toward, &body.frame.y_toward}) {
+      for (const Slot& r : a->r)
+        if (r.is_coordinate()) rows.q_columns.push_back(r.coord());
+      for (const Slot& r : a->p)
+        if (r.is_coordinate()) rows.q_columns.push_back(r.coord());
+    }
     for (const Attachment3& p : body.points)
       for (const Slot& r : p.r)
         if (r.is_coordinate()) {
-          q_columns.push_back(r.coord());
-          if (r.coord() < n) coords[b].push_back(r.coord()), of_point[static_cast<std::size_t>(r.coord())] = true;
+          rows.q_columns.push_back(r.coord());
+          if (r.coord() < n) coords.push_back(r.coord()), of_point[static_cast<std::size_t>(r.coord())] = 1;
         }
-    std::sort(coords[b].begin(), coords[b].end());
+    std::sort(coords.begin() + static_cast<std::ptrdiff_t>(coords_first[b]), coords.end());
+    coords_first[b + 1] = coords.size(), rows.q_first[b + 1] = rows.q_columns.size();
   }
-  // the point coordinates each constraint reads
-  std::vector<std::vector<Index>> reads(model.constraints().size()), all(model.constraints().size());
+  // the coordinates each constraint reads (`all` from all_first[c]), from Φq's pattern: counted, then filled
   const CscPattern& pat = model.jacobian_pattern();
-  for (Index j = 0; j < pat.cols; ++j)
-    for (Index k = pat.col_ptr[static_cast<std::size_t>(j)]; k < pat.col_ptr[static_cast<std::size_t>(j) + 1]; ++k) {
-      const auto c = static_cast<std::size_t>(model.constraint_of_row(pat.row_idx[static_cast<std::size_t>(k)]));
-      if (all[c].empty() || all[c].back() != j) {
-        all[c].push_back(j);
-        if (of_point[static_cast<std::size_t>(j)]) reads[c].push_back(j);
+  std::vector<Index> last(nc), all;
+  auto each_read = [&](auto&& visit) {  // visit(c, j) once per constraint c and column j it reads, j increasing
+    std::fill(last.begin(), last.end(), Index{-1});
+    for (Index j = 0; j < pat.cols; ++j)
+      for (Index k = pat.col_ptr[static_cast<std::size_t>(j)]; k < pat.col_ptr[static_cast<std::size_t>(j) + 1]; ++k) {
+        const auto c = static_cast<std::size_t>(model.constraint_of_row(pat.row_idx[static_cast<std::size_t>(k)]));
+        if (last[c] != j) last[c] = j, visit(c, j);
       }
-    }
+  };
+  std::vector<std::size_t> all_first(nc + 1, 0);
+  each_read([&](std::size_t c, Index) { ++all_first[c + 1]; });
+  counts_to_offsets(all_first);
+  all.resize(all_first[nc]);
+  {
+    std::vector<std::size_t> next(all_first.begin(), all_first.end() - 1);
+    each_read([&](std::size_t c, Index j) { all[next[c]++] = j; });
+  }
+  // the bodies holding each point coordinate, in body order
+  std::vector<std::size_t> bodies_first(static_cast<std::size_t>(n) + 1, 0), bodies_of(coords.size());
+  for (Index c : coords) ++bodies_first[static_cast<std::size_t>(c) + 1];
+  counts_to_offsets(bodies_first);
+  {
+    std::vector<std::size_t> next(bodies_first.begin(), bodies_first.end() - 1);
+    for (std::size_t b = 0; b < nb; ++b)
+      for (std::size_t k = coords_first[b]; k < coords_first[b + 1]; ++k)
+        bodies_of[next[static_cast<std::size_t>(coords[k])]++] = b;
+  }
   // a constraint is the body's whose points hold all the point coordinates it reads, the fewest of them: among
   // the bodies that hold its first
-  std::vector<std::vector<std::size_t>> bodies_of(static_cast<std::size_t>(n));
-  for (std::size_t b = 0; b < nb; ++b)
-    for (Index c : coords[b]) bodies_of[static_cast<std::size_t>(c)].push_back(b);
-  for (std::size_t c = 0; c < reads.size(); ++c) {
-    if (reads[c].empty()) continue;
+  std::vector<std::size_t> owner(nc, nb);
+  rows.constraints_first.assign(nb + 1, 0), rows.g_first.assign(nb + 1, 0);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const Index* read = all.data() + all_first[c];
+    const Index* read_end = all.data() + all_first[c + 1];
+    while (read != read_end && !of_point[static_cast<std::size_t>(*read)]) ++read;
+    if (read == read_end) continue;  // no point coordinate
     std::size_t best = nb, best_size = 0;
     bool tie = false;
-    for (std::size_t b : bodies_of[static_cast<std::size_t>(reads[c].front())]) {
-      if (!std::includes(coords[b].begin(), coords[b].end(), reads[c].begin(), reads[c].end())) continue;
-      if (best == nb || coords[b].size() < best_size)
-        best = b, best_size = coords[b].size(), tie = false;
-      else if (coords[b].size() == best_size)
+    const auto first = static_cast<std::size_t>(*read);
+    for (std::size_t k = bodies_first[first]; k < bodies_first[first + 1]; ++k) {
+      const std::size_t b = bodies_of[k];
+      // whether the body's sorted coordinates include every point coordinate the constraint reads
+      const Index* held = coords.data() + coords_first[b];
+      const Index* held_end = coords.data() + coords_first[b + 1];
+      bool includes = true;
+      for (const Index* r = read; r != read_end && includes; ++r) {
+        if (!of_point[static_cast<std::size_t>(*r)]) continue;
+        while (held != held_end && *held < *r) ++held;
+        includes = held != held_end && *held == *r;
+      }
+      if (!includes) continue;
+      const std::size_t size = coords_first[b + 1] - coords_first[b];
+      if (best == nb || size < best_size)
+        best = b, best_size = size, tie = false;
+      else if (size == best_size)
         tie = true;
     }
     if (best == nb || tie) continue;  // the joints' own: acts at the points bodies share
-    body_rows_[best].constraints.push_back(model.constraint_block(static_cast<Index>(c)));
-    body_rows_[best].g_columns.insert(body_rows_[best].g_columns.end(), all[c].begin(), all[c].end());
+    owner[c] = best;
+    ++rows.constraints_first[best + 1], rows.g_first[best + 1] += all_first[c + 1] - all_first[c];
   }
+  counts_to_offsets(rows.constraints_first), counts_to_offsets(rows.g_first);
+  rows.constraints.resize(rows.constraints_first[nb]), rows.g_columns.resize(rows.g_first[nb]);
+  std::vector<std::size_t> next_constraint(rows.constraints_first.begin(), rows.constraints_first.end() - 1),
+      next_g(rows.g_first.begin(), rows.g_first.end() - 1);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::size_t b = owner[c];
+    if (b == nb) continue;
+    rows.constraints[next_constraint[b]++] = model.constraint_block(static_cast<Index>(c));
+    for (std::size_t k = all_first[c]; k < all_first[c + 1]; ++k) rows.g_columns[next_g[b]++] = all[k];
+  }
+  find_body_parts(model, efforts);
 }
 
-void JointReactions::evaluate_natural(const NaturalSite& s, double t, const Eigen::VectorXd& lambda, double*& out) {
-  const NaturalBody& body = natural_->bodies[s.body];
-  const BodyRows& rows = body_rows_[s.body];
-  const Index n = static_cast<Index>(g_.size());
-  for (const auto& [block, i] : rows.constraints)
-    block->add_transposed_product(i, qx_.data(), t, lambda.data(), g_.data());
+void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarForce* planar) {
+  const BodyPart& part = body_parts_[b];
+  if (planar && part.part != BodyPart::kNone && planar[part.part].valid) {
+    // the whole model's Q computed the part's force at this row: added at the promoted frame's slots, as
+    // add_generalized_forces() of the body's part adds it
+    detail::PlanarFrame frame;
+    std::copy(part.slots, part.slots + 5, frame.slots);
+    frame.body = false, frame.x_is_point = part.x_is_point;
+    detail::add_planar_force(frame, planar[part.part], qb_);
+    if (part.applied) add_applied_forces(*part.applied, qx_.data(), qdx_.data(), t, qb_);
+    return;
+  }
+  const NaturalBody& body = natural_->bodies[b];
   add_generalized_forces(body.parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
-  const Attachment3& p = body.points[s.point];
+}
+
+void JointReactions::evaluate_natural(const NaturalSite& s, double t, const Eigen::VectorXd& lambda,
+                                      const detail::PlanarForce* planar, double*& out) {
+  const BodyRows& rows = body_rows_;
+  const Index n = static_cast<Index>(g_.size());
+  for (std::size_t k = rows.constraints_first[s.body]; k < rows.constraints_first[s.body + 1]; ++k)
+    rows.constraints[k].first->add_transposed_product(rows.constraints[k].second, qx_.data(), t, lambda.data(),
+                                                      g_.data());
+  body_forces(s.body, t, planar);
   double force[3] = {0.0, 0.0, 0.0};
   for (int k = 0; k < (natural_->spatial ? 3 : 2); ++k) {
-    const Index at = p.r[k].coord();
+    const Index at = s.at[k];
     if (at < n) {  // R = Σ_c (Φq,cᵀ λ_c)(P) − Q_b(P)
       force[k] = g_[static_cast<std::size_t>(at)] - qb_(at);
       continue;
     }
     // a constant component: ∂Φ_c/∂P_k = −Σ over the body's moving points' k-components (translation invariance)
+    const NaturalBody& body = natural_->bodies[s.body];
+    const Attachment3& p = body.points[s.point];
     double moving = 0.0;
     bool shared = false;  // another point of the body constant along k: the load's split between them is open
     for (const Attachment3& o : body.points) {
@@ -194,8 +325,9 @@ void JointReactions::evaluate_natural(const NaturalSite& s, double t, const Eige
   } else {
     for (double v : {force[0], force[1], 0.0}) *out++ = v;
   }
-  for (Index j : rows.g_columns) g_[static_cast<std::size_t>(j)] = 0.0;
-  for (Index j : rows.q_columns) qb_(j) = 0.0;
+  for (std::size_t k = rows.g_first[s.body]; k < rows.g_first[s.body + 1]; ++k)
+    g_[static_cast<std::size_t>(rows.g_columns[k])] = 0.0;
+  for (std::size_t k = rows.q_first[s.body]; k < rows.q_first[s.body + 1]; ++k) qb_(rows.q_columns[k]) = 0.0;
 }
 
 }  // namespace phiq

@@ -22,18 +22,52 @@ struct MassivePart {
   bool planar = false;                    // on a planar frame (else the general path reads the Part)
 };
 
+// What a part on a planar frame adds to Q at its frame's slots (add_planar_force()): the force at its origin
+// (fx, fy, fz), and the moment's share `turn` (a body's ψ) or its shares along x's target (along_x, along_y; taken
+// off the origin too when x's target is a point). `valid` false where the frame's direction had zero length (the
+// general path's NaN).
+struct PlanarForce {
+  double fx = 0.0, fy = 0.0, fz = 0.0, turn = 0.0, along_x = 0.0, along_y = 0.0;
+  bool valid = false;
+};
+
+// Q += `force` at `frame`'s coordinate slots, in the order add_generalized_forces() adds them: the same sums, bit
+// for bit, wherever the force was computed.
+inline void add_planar_force(const PlanarFrame& frame, const PlanarForce& force, Eigen::VectorXd& Q) {
+  auto add = [&](const Slot& s, double v) {
+    if (s.is_coordinate()) Q(s.coord()) += v;
+  };
+  const Slot* o = frame.slots;
+  if (frame.body) {
+    add(o[0], force.fx), add(o[1], force.fy), add(o[2], force.turn);
+    return;
+  }
+  const Slot* x = o + 3;
+  add(o[0], force.fx), add(o[1], force.fy), add(o[2], force.fz);
+  add(x[0], force.along_x), add(x[1], force.along_y);
+  if (frame.x_is_point) add(o[0], -force.along_x), add(o[1], -force.along_y);
+}
+
 class PartForces {
  public:
   PartForces() = default;
   // The parts with mass of `parts`, in order.
   explicit PartForces(const std::vector<Part>& parts);
   // Q += the parts' and the loads' generalized forces at (q, q̇, q̈, t), as add_generalized_forces(parts, loads, …);
-  // `parts` those this was made from.
+  // `parts` those this was made from. With `planar` (one entry per part), each part with mass on a planar frame
+  // also leaves there what it added (PlanarForce::valid false where it took the general path); the others' entries
+  // are not touched.
   void add(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd, const double* qdd,
-           double t, Eigen::VectorXd& Q) const;
+           double t, Eigen::VectorXd& Q, PlanarForce* planar = nullptr) const;
 
  private:
   std::vector<MassivePart> massive_;
 };
+
+// Whether part `p` has mass: add_generalized_forces() counts it.
+inline bool has_mass(const Part& p) { return p.mass_source != MassSource::kNone && p.mass.mass != 0.0; }
+
+// `p` (the index-th part) as its generalized forces read it.
+MassivePart massive_part(const Part& p, std::size_t index);
 
 }  // namespace phiq::detail

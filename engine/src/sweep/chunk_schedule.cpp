@@ -232,7 +232,7 @@ void ChunkedSweep::finish_in_order() {
                                      " did not continue the sweep in order: " + fallback_cause_ +
                                      "; the remaining steps ran in order"});
   ws_.start_afresh();  // as a chunk starts: from the row alone, whatever the workspace solved last
-  Sweeper rest(model_, opt_, ws_, run_.sum);
+  Sweeper rest(model_, opt_, ws_, run_.sum, &row0_sweeper_);
   rest.adopt(run_.time_of(at_.resume - 1));
   run_.sequential(rest, ws_, at_.resume);
   rest.leave_state_in_workspace();

@@ -185,7 +185,7 @@ int ChunkedSweep::run_chunk(Index c, Chunk& ch, bool stream) {
   Workspace& w = *held;
   const WorkCounters w0 = w.counters;
   ch.k0 = first_row(c), ch.k1 = last_row(c);
-  Sweeper s(model_, opt_, w, ch.sum);
+  Sweeper s(model_, opt_, w, ch.sum, &row0_sweeper_);
   if (!stream) {
     ch.rows.resize(static_cast<std::size_t>(ch.k1 - ch.k0 + 1));
     const double text_bytes = layout_.encoded_row_bytes * static_cast<double>(ch.rows.size());

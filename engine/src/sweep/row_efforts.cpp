@@ -25,9 +25,12 @@ bool Sweeper::row_efforts() {
   if (!w) return not_defined();
   const double t = current_.t;
   effort_work_.q.setZero(model_.num_coordinates());
-  if (!effort_work_.forces) effort_work_.forces.emplace(*e.parts);
+  if (!effort_work_.forces) {
+    effort_work_.forces.emplace(*e.parts);
+    if (effort_work_.reactions && e.natural) effort_work_.planar.resize(e.parts->size());
+  }
   effort_work_.forces->add(*e.parts, *e.loads, current_.q.data(), current_.qd.data(), current_.qdd.data(), t,
-                           effort_work_.q);
+                           effort_work_.q, effort_work_.planar.empty() ? nullptr : effort_work_.planar.data());
   if (!multipliers_with_factors(model_, *w->lu, effort_work_.q, effort_work_.kept, effort_work_.lambda))
     return not_defined();
   ++ws_->counters.effort_solves;
@@ -91,8 +94,10 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
               outputs_.efforts.begin() + opt_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
     return;
   }
+  // the natural bodies' weight and inertia as Q took them at this row (row_efforts())
   effort_work_.reactions->evaluate(current_.q.data(), current_.qd.data(), current_.qdd.data(), t, effort_work_.lambda,
-                                   outputs_.efforts.data() + 2 * opt_.efforts.constraints.size());
+                                   outputs_.efforts.data() + 2 * opt_.efforts.constraints.size(),
+                                   effort_work_.planar.empty() ? nullptr : effort_work_.planar.data());
   if (!note) return;
   effort_work_.reactions_noted = true;
   std::string names;
@@ -104,6 +109,13 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
                              "the reactions of " + names +
                                  " are statically indeterminate (redundant constraints): the minimum-norm ones are "
                                  "written"});
+}
+
+std::optional<JointReactions> Sweeper::written_reactions(const Sweeper* like) const {
+  if (opt_.efforts.reactions.empty()) return std::nullopt;
+  if (like && &like->model_ == &model_ && &like->opt_ == &opt_ && like->effort_work_.reactions)
+    return JointReactions::with_set_up_of(*like->effort_work_.reactions);
+  return JointReactions(model_, opt_.efforts);
 }
 
 std::vector<std::size_t> Sweeper::dropped_efforts() const {

@@ -9,8 +9,8 @@
 
 namespace phiq::detail {
 
-Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum)
-    : model_(m), opt_(o), ws_(&ws), sum_(sum) {
+Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum, const Sweeper* like)
+    : model_(m), opt_(o), ws_(&ws), sum_(sum), effort_work_(dropped_efforts(), written_reactions(like)) {
   need_v_ = o.solves_velocities();  // (q̈ needs q̇)
   need_a_ = o.solves_accelerations();
   // With velocities every step factorises at its solution: Φq there comes with the residual that accepts it.

@@ -78,7 +78,9 @@ class Sweeper {
  public:
   // Resolves the predictor (effective_predictor) and refuses one whose derivatives the options do not ask for;
   // sizes every buffer the states rotate through (sweeper.cpp).
-  Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum);
+  // `like`, when given, a sweeper of the same model and options (a sweep's first, which its chunks' sweepers run
+  // next to): the efforts' set-up is copied from it rather than built again (8 chunks a sweep at 100 steps).
+  Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum, const Sweeper* like = nullptr);
 
   // Below this reciprocal condition estimate of Φq (KLU: min/max |U_ii|, UMFPACK alike) the position is taken
   // as singular: a linear solve there loses more than ten digits, so the velocity the LU gives is rounding noise
@@ -347,6 +349,8 @@ class Sweeper {
   // The efforts (indices into OutputEfforts::constraints) of drivers the model dropped as redundant: NaN at every
   // row, found once (row_efforts.cpp).
   std::vector<std::size_t> dropped_efforts() const;
+  // The joints whose reactions are written (none when none are), with `like`'s set-up when it has one.
+  std::optional<JointReactions> written_reactions(const Sweeper* like) const;
   // The reactions of the row (after the efforts) from effort_work_.lambda: minimum-norm multipliers first where rows
   // were dropped, and at the sweep's first row a warning naming the joints whose share that makes up.
   void row_reactions(SparseLuNumeric& lu);
@@ -388,9 +392,7 @@ class Sweeper {
   RowOutputValues outputs_{model_, opt_};   // what row_outputs() evaluated, for the delivery
   SensitivityWork sensitivity_work_{opt_};  // row_sensitivities()'s own, as a thread's sweeper holds them
   // row_efforts()' and row_reactions()'
-  EffortWork effort_work_{dropped_efforts(), opt_.efforts.reactions.empty()
-                                                 ? std::nullopt
-                                                 : std::optional<JointReactions>(std::in_place, model_, opt_.efforts)};
+  EffortWork effort_work_;
   RowFactorCache row_factors_;  // the factors those solve with (row_factors())
   double last_rcond_ = 0.0;     // PositionSummary::rcond of the last converged position (near_singular())
   SingularState singular_;      // singular_point()'s

@@ -162,6 +162,9 @@ struct EffortWork {
   EffortSensitivityScratch sensitivity_scratch;
   Eigen::VectorXd q, kept, lambda, phi_t;  // Q, the kept rows, λ, Φt
   std::optional<PartForces> forces;        // Q's parts, gathered at the first row
+  // what Q's parts on planar frames added, one per part, when natural joints' reactions read their bodies' (else
+  // empty)
+  std::vector<PlanarForce> planar;
   std::vector<std::size_t> dropped;
   std::optional<JointReactions> reactions;
   bool reactions_noted = false;
