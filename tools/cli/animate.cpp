@@ -38,10 +38,6 @@ constexpr const char* kSwept = "its sweep";
 // What the page calls the modes' table.
 constexpr const char* kModes = "its assembly modes";
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // The scene's `output.clearance` measured along its own sweep, as `phiq clearance` measures it, for the viewer to
 // mark (html_clearance.hpp); none without it. Throws DrawError (status 1, as `phiq clearance`) when it cannot.
 std::optional<ClearanceReport> animated_clearance(const Scene& scene) {
@@ -96,8 +92,8 @@ CsvTable modes_table(const Scene& scene, std::vector<std::string>& labels) {
 }
 
 int cmd_animate(const AnimateOptions& o) {
-  const bool html = ends_with(o.out, ".html") || ends_with(o.out, ".htm");
-  if (!html && !ends_with(o.out, ".glb"))
+  const bool html = o.out.ends_with(".html") || o.out.ends_with(".htm");
+  if (!html && !o.out.ends_with(".glb"))
     return fail("animate: -o " + o.out + ": the output is a glTF binary (*.glb) or an HTML viewer (*.html)", 2);
   if (!html && !o.columns.empty())
     return fail("animate: --columns: the plots are the HTML viewer's; a .glb has none", 2);

@@ -94,7 +94,8 @@ std::string modes_csv(const Model& model, const AssemblyModes& r) {
     const AssemblyMode& m = r.modes[k];
     text += std::to_string(k + 1) + "," + (m.singular ? "1" : "0") + "," + shortest(m.residual) + "," +
             shortest(m.condition);
-    for (Index j = 0; j < model.num_coordinates(); ++j) text += "," + shortest(m.q(j));
+    for (Index j = 0; j < model.num_coordinates(); ++j)
+      text.append(1, ',').append(shortest(m.q(j)));  // (a literal + std::string: GCC 12's false -Wrestrict)
     text += "\n";
   }
   return text;

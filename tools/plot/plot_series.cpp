@@ -12,7 +12,8 @@ namespace phiq::tools {
 
 namespace {
 
-bool ends_with(const std::string& s, const std::string& tail) {
+// (a column named `tail` itself does not count: a name comes before it)
+bool column_ends_with(const std::string& s, const std::string& tail) {
   return s.size() > tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
@@ -34,7 +35,7 @@ Quantity of_unit(Unit u, int order) {
 std::string joint_of_column(const Scene& scene, const std::string& column, Unit* unit) {
   if (scene.dimension != 3) return "";
   for (const auto& [tail, u] : {std::pair<const char*, Unit>{".angle", Unit::kAngle}, {".distance", Unit::kLength}}) {
-    if (!ends_with(column, tail)) continue;
+    if (!column_ends_with(column, tail)) continue;
     const std::string name = column.substr(0, column.size() - std::string(tail).size());
     for (const ConstraintInfo& c : scene.model->constraints())
       if (c.name == name && (c.kind == "revolute" || c.kind == "cylindrical" || c.kind == "prismatic")) {
@@ -59,7 +60,7 @@ Quantity column_quantity(const Scene& scene, const std::string& column) {
   if (const auto u = coordinate(column)) return of_unit(*u, 0);
   for (int order : {1, 2}) {
     const std::string tail = order == 1 ? ".v" : ".a";
-    if (ends_with(column, tail))
+    if (column_ends_with(column, tail))
       if (const auto u = coordinate(column.substr(0, column.size() - 2))) return of_unit(*u, order);
   }
   for (const OutputPoint& p : scene.sweep.points)
@@ -69,14 +70,14 @@ Quantity column_quantity(const Scene& scene, const std::string& column) {
         if (column == p.name + tail) return of_unit(Unit::kLength, order);
       }
   for (int order : {0, 1, 2}) {  // a joint's measure `J.angle`, `J.distance`, and their rates `.v`, `.a`
-    if (order > 0 && !ends_with(column, order == 1 ? ".v" : ".a")) continue;
+    if (order > 0 && !column_ends_with(column, order == 1 ? ".v" : ".a")) continue;
     Unit u = Unit::kLength;
     if (!joint_of_column(scene, order == 0 ? column : column.substr(0, column.size() - 2), &u).empty())
       return of_unit(u, order);
   }
   // a driver's effort: a torque where its first row is an angle, a force where a length (a panel per unit)
   for (const char* tail : {".effort", ".power"})
-    if (ends_with(column, tail)) {
+    if (column_ends_with(column, tail)) {
       const std::string name = column.substr(0, column.size() - std::string(tail).size());
       for (Index c : scene.sweep.efforts.constraints) {
         const ConstraintInfo& ci = model.constraints()[static_cast<std::size_t>(c)];
@@ -93,10 +94,10 @@ Quantity column_quantity(const Scene& scene, const std::string& column) {
     if (column.size() == name.size() + 3 && column.compare(0, name.size(), name) == 0 && column[name.size()] == '.')
       return column[name.size() + 1] == 'F' ? Quantity{"force", "N"} : Quantity{"torque", "N·m"};
   }
-  if (ends_with(column, ".residual")) return {"residual", ""};
-  if (ends_with(column, ".ddf")) return {"driver law, second rate", ""};
-  if (ends_with(column, ".df")) return {"driver law, rate", ""};
-  if (ends_with(column, ".f")) return {"driver law", ""};
+  if (column_ends_with(column, ".residual")) return {"residual", ""};
+  if (column_ends_with(column, ".ddf")) return {"driver law, second rate", ""};
+  if (column_ends_with(column, ".df")) return {"driver law, rate", ""};
+  if (column_ends_with(column, ".f")) return {"driver law", ""};
   return {column, ""};
 }
 
@@ -126,7 +127,7 @@ std::vector<std::string> default_columns(const Scene& scene, const CsvTable& tab
   for (std::size_t c = 1; c < table.columns.size(); ++c) {
     const std::string& name = table.columns[c];
     if (!changes(c)) continue;
-    if (ends_with(name, ".effort") || ends_with(name, ".power")) {
+    if (column_ends_with(name, ".effort") || column_ends_with(name, ".power")) {
       // the drivers' efforts after what they drive; not one with a singular row's NaN, which --columns may ask for
       const bool finite = std::all_of(table.rows.begin(), table.rows.end(),
                                       [&](const std::vector<double>& row) { return std::isfinite(row[c]); });

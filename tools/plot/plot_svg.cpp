@@ -28,7 +28,7 @@ using svg::px;
 namespace {
 
 // What the SVG's title calls the result of a sweep run here.
-constexpr const char* kSwept = "its sweep";
+constexpr const char* kSweptTitle = "its sweep";
 
 int plot_fail(const std::string& msg, int code) {
   std::cerr << "phiq: plot: " << printable(msg) << "\n";
@@ -143,7 +143,7 @@ std::string svg_document(const Scene& scene, const CsvTable& table, const std::m
 // line.
 std::string plot_text(const Scene& scene, const PlotOptions& o, const MechanismSketch& sketch, const CsvTable& table) {
   const Model& model = *scene.model;
-  const std::string result = o.csv.empty() ? kSwept : o.csv;
+  const std::string result = o.csv.empty() ? kSweptTitle : o.csv;
   if (table.rows.empty()) throw DrawError(result + ": no rows", 2);
   std::map<std::string, std::size_t> col;
   for (std::size_t c = 0; c < table.columns.size(); ++c) col[table.columns[c]] = c;

@@ -29,7 +29,6 @@ ChunkedSweep::ChunkedSweep(const Model& model, const SweepOptions& opt, Workspac
       run_(run),
       row0_sweeper_(sw),
       layout_(layout),
-      chunk_(chunk),
       n_chunks_(n_chunks),
       threads_(threads),
       others_(others),

@@ -261,7 +261,7 @@ class ChunkedSweep {
   Run& run_;
   Sweeper& row0_sweeper_;  // (chunk 0 takes its branch tangent, if row 0 is a singular start)
   const HeldRows& layout_;
-  const Index chunk_, n_chunks_;
+  const Index n_chunks_;
   const int threads_;
   WorkCounters& others_;
   // Rows keep q̇ whenever it is solved (q̈ needs it, and so does an ordered continuation's predictor).
