@@ -102,6 +102,8 @@ class JointReactions {
   void add_site(const Model& model, Index c, std::vector<int>& site_of);
   void find_columns(const Model& model, const std::vector<int>& site_of);
   void add_natural(const Model& model, const OutputEfforts& efforts);
+  // qx_, q̇x_, q̈x_ (the promoted constants past the model's coordinates) and qb_ (zero) at their sizes
+  void size_natural_scratch();
   void find_body_parts(const Model& model, const OutputEfforts& efforts);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);

@@ -198,25 +198,32 @@ double cycle_estimate(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b, cons
 
 using RaySamples = std::vector<std::pair<double, Eigen::VectorXcd>>;  // (t on the ray, X there)
 
-// The first sample k where two successive estimates of the cycle number (from samples k … k + 3) round to one
-// integer within 0.1, and that integer; (−1, 0) when there is none.
-std::pair<std::ptrdiff_t, int> settled_cycle(const RaySamples& along) {
-  auto settled = [](double c) { return c >= 0.9 && std::abs(c - std::round(c)) <= 0.1; };
-  for (std::size_t k = 0; k + 3 < along.size(); ++k) {
+// Samples along a ray, and the first sample k where two successive estimates of the cycle number (from samples
+// k … k + 3) round to one integer within 0.1, with that integer ((−1, 0) while there is none): found as the samples
+// come, each window once.
+struct Ray {
+  RaySamples along;
+  std::ptrdiff_t settled_at = -1;
+  int cycle = 0;
+  void add(double t, const Eigen::VectorXcd& X) {
+    along.emplace_back(t, X);
+    if (settled_at >= 0 || along.size() < 4) return;
+    auto settled = [](double c) { return c >= 0.9 && std::abs(c - std::round(c)) <= 0.1; };
+    const std::size_t k = along.size() - 4;
     const double c1 = cycle_estimate(along[k].second, along[k + 1].second, along[k + 2].second);
     const double c2 = cycle_estimate(along[k + 1].second, along[k + 2].second, along[k + 3].second);
     if (settled(c1) && settled(c2) && std::round(c1) == std::round(c2))
-      return {static_cast<std::ptrdiff_t>(k), static_cast<int>(std::round(c1))};
+      settled_at = static_cast<std::ptrdiff_t>(k), cycle = static_cast<int>(std::round(c1));
   }
-  return {-1, 0};
-}
+};
 
 // The path from t = 0.1 (X) along the ray at angle theta to t = 0.1 / 4^k, k = 1, 2, …, down to `floor`, while it
 // can be taken (*collapsed: the |t| where its step collapsed, else 0), and, when `stop_at_cycle` is true, no further
 // than where its cycle-number estimates settle at 2 or more (its end is singular: the end game's).
-RaySamples sample_ray(const Homotopy& h, Eigen::VectorXcd X, double theta, double floor, bool stop_at_cycle,
-                      Tracking& tr, double* collapsed) {
-  RaySamples along{{kEndGameStart, X}};
+Ray sample_ray(const Homotopy& h, Eigen::VectorXcd X, double theta, double floor, bool stop_at_cycle, Tracking& tr,
+               double* collapsed) {
+  Ray ray;
+  ray.add(kEndGameStart, X);
   double stopped = 0.0;
   *collapsed = 0.0;
   for (double r = kEndGameStart; r / kShrink >= floor; r /= kShrink) {
@@ -224,10 +231,10 @@ RaySamples sample_ray(const Homotopy& h, Eigen::VectorXcd X, double theta, doubl
       *collapsed = r - stopped * (r - r / kShrink);
       break;
     }
-    along.emplace_back(r / kShrink, X);
-    if (stop_at_cycle && along.size() >= 4 && settled_cycle(along).second >= 2) break;
+    ray.add(r / kShrink, X);
+    if (stop_at_cycle && ray.cycle >= 2) break;
   }
-  return along;
+  return ray;
 }
 
 // The radii to start the end game at, with the path's point there, from its samples along a ray. A circle round
@@ -235,8 +242,9 @@ RaySamples sample_ray(const Homotopy& h, Eigen::VectorXcd X, double theta, doubl
 // cluster near t = 0 when paths go to a solution set at infinity: a circle round them too permutes many paths, and
 // does not close within a few turns): the first radius where the cycle-number estimates settle, then 16 and 256
 // times smaller; without such a radius, the three smallest at least 16 times above where the step collapsed.
-RaySamples end_game_radii(RaySamples along, double collapsed) {
-  const std::ptrdiff_t first = settled_cycle(along).first;
+RaySamples end_game_radii(const Ray& ray, double collapsed) {
+  const std::ptrdiff_t first = ray.settled_at;
+  RaySamples along = ray.along;
   while (first < 0 && along.size() > 1 && along.back().first < 16.0 * collapsed) along.pop_back();
   std::size_t begin = first >= 0 ? static_cast<std::size_t>(first) : along.size() >= 3 ? along.size() - 3 : 0;
   RaySamples radii;
@@ -264,10 +272,10 @@ PathEnd track_path(const Homotopy& h, std::int64_t p, int max_winding, bool care
   // (a singular end) or whose step collapses goes to the end game.
   const Eigen::VectorXcd at_start = end.X;
   double collapsed = 0.0;
-  const RaySamples along = sample_ray(h, at_start, 0.0, 1e-10, true, tr, &collapsed);
-  const bool settled = collapsed == 0.0 && settled_cycle(along).second >= 2;
+  const Ray real_ray = sample_ray(h, at_start, 0.0, 1e-10, true, tr, &collapsed);
+  const bool settled = collapsed == 0.0 && real_ray.cycle >= 2;
   bool straight = false;
-  end.X = along.back().second, end.t = along.back().first;
+  end.X = real_ray.along.back().second, end.t = real_ray.along.back().first;
   if (collapsed == 0.0 && !settled) {
     straight = track_piece(h, end.X, Piece{end.t, 0.0}, tr, &stopped);
     end.t = straight ? 0.0 : end.t * (1.0 - stopped);
@@ -279,7 +287,7 @@ PathEnd track_path(const Homotopy& h, std::int64_t p, int max_winding, bool care
     // the end game for every path whose step collapsed or whose end is singular, at a finite point or at infinity
     // alike, on circles where the path's own points say its Puiseux series holds (end_game_radii)
     EndGame game;
-    for (const auto& [r, X] : end_game_radii(along, collapsed > 0.0 ? collapsed : end.t)) {
+    for (const auto& [r, X] : end_game_radii(real_ray, collapsed > 0.0 ? collapsed : end.t)) {
       game = cauchy_end_game(h, X, r, 0.0, max_winding, tr);
       if (game.ended) break;
     }
@@ -291,7 +299,7 @@ PathEnd track_path(const Homotopy& h, std::int64_t p, int max_winding, bool care
       Eigen::VectorXcd X = at_start;
       if (!track_piece(h, X, Piece{0.0, 0.0, true, kEndGameStart, 0.0, theta}, tr, &stopped)) continue;
       double lost = 0.0;
-      const RaySamples ray = sample_ray(h, X, theta, 1e-14, false, tr, &lost);
+      const Ray ray = sample_ray(h, X, theta, 1e-14, false, tr, &lost);
       for (const auto& [r, Y] : end_game_radii(ray, lost)) {
         EndGame around = cauchy_end_game(h, Y, r, theta, max_winding, tr);
         if (around.ended) {

@@ -6,6 +6,7 @@
 #include <type_traits>
 
 #include "expression/taylor.hpp"
+#include "parts/frame_rates.hpp"
 
 namespace phiq::detail {
 
@@ -49,7 +50,8 @@ JetT<Dual> expression_jet_rate(const CompiledExpression& e, const std::array<con
   JetT<double> x[4];
   for (std::size_t c = 0; c < 4; ++c) x[c] = expression_jet<double>(*(*copies)[c], m, k);
   auto rate = [&](double JetT<double>::*part) {
-    return ((x[0].*part - x[3].*part) + 8.0 * (x[2].*part - x[1].*part)) / (12.0 * h);
+    const double at[4] = {x[0].*part, x[1].*part, x[2].*part, x[3].*part};
+    return copies_rate(at, h);
   };
   j.v.e += rate(&JetT<double>::v), j.d.e += rate(&JetT<double>::d), j.dd.e += rate(&JetT<double>::dd);
   return j;

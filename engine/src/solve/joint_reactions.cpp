@@ -109,11 +109,7 @@ JointReactions::JointReactions(const JointReactions& other, SetUpOnly)
       body_parts_(other.body_parts_),
       size_(other.size_),
       g_(other.g_.size(), 0.0) {
-  if (natural_sites_.empty()) return;
-  // as add_natural() sizes them: q, q̇, q̈ with the promoted constants, Q_b zero
-  const Index n = static_cast<Index>(g_.size()), extra = static_cast<Index>(natural_->promoted.size());
-  qx_.setZero(n + extra), qdx_.setZero(n + extra), qddx_.setZero(n + extra), qb_.setZero(n + extra);
-  for (Index k = 0; k < extra; ++k) qx_(n + k) = natural_->promoted[static_cast<std::size_t>(k)];
+  if (!natural_sites_.empty()) size_natural_scratch();
 }
 
 void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out) {

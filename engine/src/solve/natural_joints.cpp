@@ -167,11 +167,16 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
   }
 }
 
-void JointReactions::add_natural(const Model& model, const OutputEfforts& efforts) {
-  natural_ = efforts.natural;
-  const Index n = model.num_coordinates(), extra = static_cast<Index>(natural_->promoted.size());
+void JointReactions::size_natural_scratch() {
+  const Index n = static_cast<Index>(g_.size()), extra = static_cast<Index>(natural_->promoted.size());
   qx_.setZero(n + extra), qdx_.setZero(n + extra), qddx_.setZero(n + extra), qb_.setZero(n + extra);
   for (Index k = 0; k < extra; ++k) qx_(n + k) = natural_->promoted[static_cast<std::size_t>(k)];
+}
+
+void JointReactions::add_natural(const Model& model, const OutputEfforts& efforts) {
+  natural_ = efforts.natural;
+  size_natural_scratch();
+  const Index n = model.num_coordinates();
   const std::vector<NaturalBody>& bodies = natural_->bodies;
   const std::size_t nb = bodies.size(), nc = model.constraints().size();
   BodyRows& rows = body_rows_;
@@ -182,14 +187,11 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
   std::vector<char> of_point(static_cast<std::size_t>(n), 0);
   rows.q_first.assign(nb + 1, 0);
   rows.q_columns.clear();
+  std::vector<Index> frame_columns;  // (its capacity kept from body to body)
   for (std::size_t b = 0; b < nb; ++b) {
     const NaturalBody& body = bodies[b];
-    for (const Attachment3* a : {&body.frame.origin, &body.frame.x_toward, &body.frame.y_toward}) {
-      for (const Slot& r : a->r)
-        if (r.is_coordinate()) rows.q_columns.push_back(r.coord());
-      for (const Slot& r : a->p)
-        if (r.is_coordinate()) rows.q_columns.push_back(r.coord());
-    }
+    frame_coordinates(body.frame, frame_columns);
+    rows.q_columns.insert(rows.q_columns.end(), frame_columns.begin(), frame_columns.end());
     for (const Attachment3& p : body.points)
       for (const Slot& r : p.r)
         if (r.is_coordinate()) {

@@ -11,6 +11,12 @@ namespace phiq::detail {
 
 Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum, const Sweeper* like)
     : model_(m), opt_(o), ws_(&ws), sum_(sum), effort_work_(dropped_efforts(), written_reactions(like)) {
+  // Q's parts, gathered once a sweep: `like`'s (set in its constructor, never written after: safe to copy while it
+  // runs on another thread)
+  if (opt_.efforts.active() && opt_.efforts.parts)
+    effort_work_.forces = same_sweep(like) && like->effort_work_.forces
+                              ? like->effort_work_.forces
+                              : std::optional<PartForces>(std::in_place, *opt_.efforts.parts);
   need_v_ = o.solves_velocities();  // (q̈ needs q̇)
   need_a_ = o.solves_accelerations();
   // With velocities every step factorises at its solution: Φq there comes with the residual that accepts it.

@@ -351,6 +351,8 @@ class Sweeper {
   std::vector<std::size_t> dropped_efforts() const;
   // The joints whose reactions are written (none when none are), with `like`'s set-up when it has one.
   std::optional<JointReactions> written_reactions(const Sweeper* like) const;
+  // Whether `like` (may be null) sweeps this sweeper's model with its options: its set-up is this one's.
+  bool same_sweep(const Sweeper* like) const;
   // The reactions of the row (after the efforts) from effort_work_.lambda: minimum-norm multipliers first where rows
   // were dropped, and at the sweep's first row a warning naming the joints whose share that makes up.
   void row_reactions(SparseLuNumeric& lu);

@@ -161,7 +161,7 @@ struct EffortWork {
       : dropped(std::move(dropped_efforts)), reactions(std::move(written_reactions)) {}
   EffortSensitivityScratch sensitivity_scratch;
   Eigen::VectorXd q, kept, lambda, phi_t;  // Q, the kept rows, λ, Φt
-  std::optional<PartForces> forces;        // Q's parts, gathered at the first row
+  std::optional<PartForces> forces;        // Q's parts, gathered when the sweeper is made
   // what Q's parts on planar frames added, one per part, when natural joints' reactions read their bodies' (else
   // empty)
   std::vector<PlanarForce> planar;
