@@ -2,7 +2,7 @@
 // B, C carry the forces the reference-point four-bar's revolutes carry, under gravity, forces, a torque and a spring,
 // with the same motor torque; each of its links satisfies its Newton–Euler equations written here with them; the
 // bodies' weight and inertia read from the whole model's Q (a sweep's way) give the reactions their own Q gives, bit
-// for bit; a point no two bodies share is refused by name.
+// for bit, and so do the flat sites' sums on random natural chains; a point no two bodies share is refused by name.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <random>
 #include <sstream>
 
 #include "phiq/inverse_dynamics.hpp"
@@ -227,6 +228,91 @@ TEST(NaturalReactions, BodyForcesFromTheModelsQAreTheBodiesOwnBitForBit) {
     for (std::size_t j : {0u, 3u})
       EXPECT_NEAR(shifted[3 * j], general[3 * j] - 1.0, 1e-9 * (1 + std::fabs(general[3 * j]))) << j << ", " << k;
     for (std::size_t j : {1u, 2u}) EXPECT_EQ(shifted[3 * j], general[3 * j]) << j << ", " << k;
+  }
+}
+
+// An nfourbar in natural coordinates (cranks from G{i} to P{i}, couplers P{i} to P{i+1}) with random masses,
+// centres, inertias, gravity and, on some cranks, a torque: each P{i} on its crank, whose force is read from Q.
+Scene natural_random_nfourbar(std::mt19937& rng, int n) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::ostringstream s;
+  s.precision(17);
+  s << "phiq: 1\nparameters: {N: " << n << ", c: 0.7071067811865476, s: 0.7071067811865475}\n"
+    << "coordinates:\n  for i in 0..N:\n    x{i}: i + c\n    y{i}: s\n  theta: 0.7853981633974483\n"
+    << "points:\n  O: [0, 0]\n  for i in 0..N:\n    G{i}: [i, 0]\n    P{i}: [\"x{i}\", \"y{i}\"]\n"
+    << "constraints:\n  - for i in 0..N:\n      - {name: \"crank{i}\", type: distance, points: [\"G{i}\", \"P{i}\"], "
+       "length: 1}\n  - for i in 0..N-1:\n      - {name: \"coupler{i}\", type: distance, points: [\"P{i}\", "
+       "\"P{i+1}\"], length: 1}\n  - {name: crank0_angle, type: segment_angle, segment: [O, P0], angle: theta}\n"
+    << "drivers:\n  - {name: motor, coordinate: theta, law: {type: linear, initial: 0.7853981633974483, rate: 1.3}}\n"
+    << "time: {start: 0, end: 1, steps: 12}\nparts:\n";
+  auto part = [&](const std::string& name, const std::string& origin, const std::string& x) {
+    const double m = 0.2 + 3 * u(rng);
+    s << "  " << name << ": {frame: {origin: " << origin << ", x: " << x << "}, mass: " << m << ", center_of_mass: ["
+      << u(rng) << ", " << 0.2 * (u(rng) - 0.5) << "], inertia: " << m * (0.05 + u(rng)) / 12 << "}\n";
+  };
+  for (int i = 0; i <= n; ++i) part("crank" + std::to_string(i), "G" + std::to_string(i), "P" + std::to_string(i));
+  for (int i = 0; i < n; ++i) part("coupler" + std::to_string(i), "P" + std::to_string(i), "P" + std::to_string(i + 1));
+  s << "loads:\n  gravity: [" << u(rng) - 0.5 << ", " << -9.81 * u(rng) << "]\n  torques:\n";
+  for (int i = 0; i <= n; i += 3) s << "    - {name: t" << i << ", part: crank" << i << ", torque: " << u(rng) << "}\n";
+  s << "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n";
+  return parse_scene(s.str(), "nfourbar.yaml");
+}
+
+// The flat sites (JointReactions::NaturalSite: a moving point on a body whose force Q computed, no load its own)
+// sum the same terms as the general path, bit for bit: random natural four-bar chains, every row, every joint.
+TEST(NaturalReactions, FlatSitesAreTheGeneralPathBitForBit) {
+  std::mt19937 rng(49);
+  for (int trial = 0; trial < 4; ++trial) {
+    const Scene s = natural_random_nfourbar(rng, 3 + 2 * trial);
+    const NaturalRows rows = natural_reactions_sweep(s);
+    const Model& m = *s.model;
+    const OutputEfforts& e = s.sweep.efforts;
+    JointReactions reactions(m, e);
+    const detail::PartForces forces(*e.parts);
+    Workspace ws(m);
+    const std::size_t n = static_cast<std::size_t>(reactions.size());
+    ASSERT_EQ(n, 3 * e.natural->joints.size());
+    for (std::size_t k = 0; k < rows.q.size(); ++k) {
+      const double t = rows.t[k];
+      const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data();
+      Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), lambda;
+      std::vector<detail::PlanarForce> planar(e.parts->size());
+      forces.add(*e.parts, *e.loads, q, qd, qdd, t, Q, planar.data());
+      ws.q = rows.q[k];
+      ASSERT_EQ(constraint_multipliers(m, t, ws, Q, lambda), SolveStatus::kSuccess);
+      std::vector<double> general(n), flat(n);
+      reactions.evaluate(q, qd, qdd, t, lambda, general.data());
+      reactions.evaluate(q, qd, qdd, t, lambda, flat.data(), planar.data());
+      ASSERT_EQ(std::memcmp(general.data(), flat.data(), sizeof(double) * n), 0) << trial << ", row " << k;
+      for (detail::PlanarForce& f : planar) f.along_x += 1.0;  // read, not passed over: P{i} is its crank's x point
+      reactions.evaluate(q, qd, qdd, t, lambda, flat.data(), planar.data());
+      for (std::size_t j = 0; j < e.natural->joints.size(); ++j) {
+        if (e.natural->joints[j].name[0] != 'P') continue;
+        EXPECT_NEAR(flat[3 * j], general[3 * j] - 1.0, 1e-9 * (1 + std::fabs(general[3 * j])));
+      }
+    }
+  }
+}
+
+// for_each_planar_term() lists add_planar_force()'s terms in its order: summed per coordinate from +0, the same
+// Q bit for bit, on frames whose slots repeat coordinates and mix in constants.
+TEST(NaturalReactions, PlanarTermsSumAsAddPlanarForce) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  std::uniform_int_distribution<int> pick(0, 4);
+  for (int trial = 0; trial < 200; ++trial) {
+    detail::PlanarFrame frame;
+    for (Slot& slot : frame.slots) slot = pick(rng) == 4 ? Slot::constant(u(rng)) : Slot::coordinate(pick(rng));
+    frame.body = trial % 3 == 0, frame.x_is_point = trial % 2 == 0;
+    detail::PlanarForce f;
+    f.fx = u(rng), f.fy = u(rng), f.fz = u(rng), f.turn = u(rng), f.along_x = u(rng), f.along_y = u(rng);
+    Eigen::VectorXd Q = Eigen::VectorXd::Zero(5), terms = Q;
+    detail::add_planar_force(frame, f, Q);
+    detail::for_each_planar_term(frame, [&](const Slot& slot, int field, bool negated) {
+      const double v = f.*detail::kPlanarFields[field];
+      if (slot.is_coordinate()) terms(slot.coord()) += negated ? -v : v;
+    });
+    ASSERT_EQ(std::memcmp(Q.data(), terms.data(), sizeof(double) * 5), 0) << trial;
   }
 }
 

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <vector>
 
 #include "phiq/kinds/reaction_site.hpp"
@@ -73,10 +74,18 @@ class JointReactions {
     std::vector<Index> columns;  // the coordinates the constraint reads (to clear the scratch)
     bool spatial = false;
   };
+  // A natural joint's site. Its flat form, where the body's part is read from a sweep's Q (BodyPart::part), no load
+  // is the body's alone and the point moves in x and y (planar): component k's Q_b is the sum of the PlanarForce
+  // values terms[k] names (kPlanarFields' index, +8 when negated), in add_planar_force()'s order, and its reaction
+  // g_[at[k]] − Q_b. The same sums as the general path's without writing the body's Q (qb_) and clearing it.
   struct NaturalSite {
-    std::size_t joint = 0, body = 0;  // in natural_
-    std::size_t point = 0;            // the joint's place among the body's points
-    Index at[3] = {0, 0, 0};          // its components' coordinates (n and above: promoted constants)
+    static constexpr int kMaxTerms = 3;  // per component (a point is at most an origin and an x target)
+    std::size_t joint = 0, body = 0;     // in natural_
+    std::size_t point = 0;               // the joint's place among the body's points
+    Index at[3] = {0, 0, 0};             // its components' coordinates (n and above: promoted constants)
+    std::size_t part = 0;                // the flat form's part (OutputEfforts::parts)
+    bool flat = false;
+    std::uint8_t count[2] = {0, 0}, terms[2][kMaxTerms] = {};
   };
   // The natural bodies' own constraints, and the columns they and the bodies' forces touch, body b's at
   // [first[b], first[b + 1]) of each list (flat: one allocation per list, not per body).
@@ -105,10 +114,19 @@ class JointReactions {
   // qx_, q̇x_, q̈x_ (the promoted constants past the model's coordinates) and qb_ (zero) at their sizes
   void size_natural_scratch();
   void find_body_parts(const Model& model, const OutputEfforts& efforts);
+  void find_flat_sites(const Model& model);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);
-  void evaluate_natural(const NaturalSite& s, double t, const Eigen::VectorXd& lambda,
+  // The row's motion: q, q̇, q̈ copied into qx_, qdx_, qddx_ at the first site that reads them (a row of flat sites
+  // reads q alone).
+  struct RowMotion {
+    const double *q, *qd, *qdd;
+    bool extended;
+  };
+  void evaluate_natural(const NaturalSite& s, RowMotion& row, double t, const Eigen::VectorXd& lambda,
                         const detail::PlanarForce* planar, double*& out);
+  bool evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,
+                     const detail::PlanarForce* planar, double* out);
   std::vector<Site> sites_;
   std::vector<NaturalSite> natural_sites_;
   std::vector<std::pair<bool, std::size_t>> order_;  // (natural, index) per listed reaction

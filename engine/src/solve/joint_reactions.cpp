@@ -120,15 +120,10 @@ void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& 
 
 void JointReactions::evaluate(const double* q, const double* qd, const double* qdd, double t,
                               const Eigen::VectorXd& lambda, double* out, const detail::PlanarForce* planar) {
-  if (!natural_sites_.empty()) {
-    const Index n = static_cast<Index>(g_.size());
-    qx_.head(n) = Eigen::Map<const Eigen::VectorXd>(q, n);
-    qdx_.head(n) = Eigen::Map<const Eigen::VectorXd>(qd, n);
-    qddx_.head(n) = Eigen::Map<const Eigen::VectorXd>(qdd, n);
-  }
+  RowMotion row{q, qd, qdd, false};
   for (const auto& [natural, k] : order_)
     if (natural)
-      evaluate_natural(natural_sites_[k], t, lambda, planar, out);
+      evaluate_natural(natural_sites_[k], row, t, lambda, planar, out);
     else
       evaluate_site(sites_[k], q, t, lambda, out);
 }

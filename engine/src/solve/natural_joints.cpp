@@ -167,6 +167,33 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
   }
 }
 
+void JointReactions::find_flat_sites(const Model& model) {
+  if (natural_->spatial) return;
+  for (NaturalSite& s : natural_sites_) {
+    const BodyPart& part = body_parts_[s.body];
+    s.flat = false;
+    if (part.part == BodyPart::kNone || part.applied || s.at[0] >= model.num_coordinates() ||
+        s.at[1] >= model.num_coordinates())
+      continue;
+    detail::PlanarFrame frame;  // as body_forces() adds the part's force
+    std::copy(part.slots, part.slots + 5, frame.slots);
+    frame.body = false, frame.x_is_point = part.x_is_point;
+    bool fits = true;
+    s.count[0] = s.count[1] = 0;
+    detail::for_each_planar_term(frame, [&](const Slot& slot, int field, bool negated) {
+      for (int k = 0; k < 2; ++k) {
+        if (!slot.is_coordinate() || slot.coord() != s.at[k]) continue;
+        if (s.count[k] == NaturalSite::kMaxTerms) {
+          fits = false;
+          continue;
+        }
+        s.terms[k][s.count[k]++] = static_cast<std::uint8_t>(field + (negated ? 8 : 0));
+      }
+    });
+    s.part = part.part, s.flat = fits;
+  }
+}
+
 void JointReactions::size_natural_scratch() {
   const Index n = static_cast<Index>(g_.size()), extra = static_cast<Index>(natural_->promoted.size());
   qx_.setZero(n + extra), qdx_.setZero(n + extra), qddx_.setZero(n + extra), qb_.setZero(n + extra);
@@ -275,6 +302,7 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
     for (std::size_t k = all_first[c]; k < all_first[c + 1]; ++k) rows.g_columns[next_g[b]++] = all[k];
   }
   find_body_parts(model, efforts);
+  find_flat_sites(model);
 }
 
 void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarForce* planar) {
@@ -293,10 +321,42 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
   add_generalized_forces(body.parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
 }
 
-void JointReactions::evaluate_natural(const NaturalSite& s, double t, const Eigen::VectorXd& lambda,
+bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,
+                                   const detail::PlanarForce* planar, double* out) {
+  if (!planar || !planar[s.part].valid) return false;
+  const BodyRows& rows = body_rows_;
+  // (q, not qx_: a constraint reads the model's coordinates alone, promoted constants being the bodies')
+  for (std::size_t k = rows.constraints_first[s.body]; k < rows.constraints_first[s.body + 1]; ++k)
+    rows.constraints[k].first->add_transposed_product(rows.constraints[k].second, q, t, lambda.data(), g_.data());
+  const detail::PlanarForce& f = planar[s.part];
+  for (int k = 0; k < 2; ++k) {
+    double qb = 0.0;  // Q_b at the component, as body_forces() sums it into qb_ (from +0)
+    for (int i = 0; i < s.count[k]; ++i) {
+      const double v = f.*detail::kPlanarFields[s.terms[k][i] & 7];
+      qb += (s.terms[k][i] & 8) ? -v : v;
+    }
+    out[k] = g_[static_cast<std::size_t>(s.at[k])] - qb;
+  }
+  out[2] = 0.0;
+  for (std::size_t k = rows.g_first[s.body]; k < rows.g_first[s.body + 1]; ++k)
+    g_[static_cast<std::size_t>(rows.g_columns[k])] = 0.0;
+  return true;
+}
+
+void JointReactions::evaluate_natural(const NaturalSite& s, RowMotion& row, double t, const Eigen::VectorXd& lambda,
                                       const detail::PlanarForce* planar, double*& out) {
+  if (s.flat && evaluate_flat(s, row.q, t, lambda, planar, out)) {
+    out += 3;
+    return;
+  }
   const BodyRows& rows = body_rows_;
   const Index n = static_cast<Index>(g_.size());
+  if (!row.extended) {
+    qx_.head(n) = Eigen::Map<const Eigen::VectorXd>(row.q, n);
+    qdx_.head(n) = Eigen::Map<const Eigen::VectorXd>(row.qd, n);
+    qddx_.head(n) = Eigen::Map<const Eigen::VectorXd>(row.qdd, n);
+    row.extended = true;
+  }
   for (std::size_t k = rows.constraints_first[s.body]; k < rows.constraints_first[s.body + 1]; ++k)
     rows.constraints[k].first->add_transposed_product(rows.constraints[k].second, qx_.data(), t, lambda.data(),
                                                       g_.data());

@@ -31,6 +31,11 @@ struct PlanarForce {
   bool valid = false;
 };
 
+// PlanarForce's values by index, for for_each_planar_term() (below).
+inline constexpr double PlanarForce::*kPlanarFields[6] = {&PlanarForce::fx,      &PlanarForce::fy,
+                                                          &PlanarForce::fz,      &PlanarForce::turn,
+                                                          &PlanarForce::along_x, &PlanarForce::along_y};
+
 // Q += `force` at `frame`'s coordinate slots, in the order add_generalized_forces() adds them: the same sums, bit
 // for bit, wherever the force was computed.
 inline void add_planar_force(const PlanarFrame& frame, const PlanarForce& force, Eigen::VectorXd& Q) {
@@ -46,6 +51,23 @@ inline void add_planar_force(const PlanarFrame& frame, const PlanarForce& force,
   add(o[0], force.fx), add(o[1], force.fy), add(o[2], force.fz);
   add(x[0], force.along_x), add(x[1], force.along_y);
   if (frame.x_is_point) add(o[0], -force.along_x), add(o[1], -force.along_y);
+}
+
+// add_planar_force()'s terms, in its order, for those that read a few of its sums (JointReactions' flat sites):
+// visit(slot, field, negated), the value kPlanarFields[field], negated or not. (add_planar_force() keeps its own
+// written-out form: Q's assembly at every row, which a visitor the compiler did not inline made slower;
+// NaturalReactions.PlanarTermsSumAsAddPlanarForce holds the two to the same sums.)
+template <class Visit>
+void for_each_planar_term(const PlanarFrame& frame, Visit&& visit) {
+  const Slot* o = frame.slots;
+  if (frame.body) {
+    visit(o[0], 0, false), visit(o[1], 1, false), visit(o[2], 3, false);
+    return;
+  }
+  const Slot* x = o + 3;
+  visit(o[0], 0, false), visit(o[1], 1, false), visit(o[2], 2, false);
+  visit(x[0], 4, false), visit(x[1], 5, false);
+  if (frame.x_is_point) visit(o[0], 4, true), visit(o[1], 5, true);
 }
 
 class PartForces {
