@@ -68,19 +68,11 @@ bool planar_part_force(const detail::MassivePart& p, const double* q, const doub
   return true;
 }
 
-// Q of one part with mass: its planar frame's closed form, or its motion and Jacobian. With `planar`, a planar
-// frame's force is left there too (PlanarForce::valid false when the general path took it).
-void add_part(const Part& p, const detail::MassivePart& massive, V3 gravity, const double* q, const double* qd,
-              const double* qdd, double t, Eigen::VectorXd& Q, detail::PlanarForce* planar = nullptr) {
-  if (massive.planar) {
-    detail::PlanarForce f;
-    if (planar_part_force(massive, q, qd, qdd, gravity, f)) {
-      detail::add_planar_force(massive.frame, f, Q);
-      if (planar) *planar = f;
-      return;
-    }
-    if (planar) planar->valid = false;
-  }
+// Q of one part with mass from its motion and Jacobian: any frame. Not inlined into add_part(): its stack frame
+// and set-up (a PartMotion, a 3×3 rotation) were paid by every part of a sweep's Q, nearly all of them on planar
+// frames that never reach it.
+[[gnu::noinline]] void add_general_part(const Part& p, V3 gravity, const double* q, const double* qd, const double* qdd,
+                                        double t, Eigen::VectorXd& Q) {
   const PartMotion m = part_motion(p.frame, q, qd, qdd, t);
   const V3 c = m.pose.apply(p.mass.center) - m.pose.at;  // the centre from the origin, world axes
   const auto [vc, ac] = m.point(p.mass.center);
@@ -96,6 +88,22 @@ void add_part(const Part& p, const detail::MassivePart& massive, V3 gravity, con
     const V3 dc = j.d_origin[i] + kin3::cross(j.d_angle[i], c);  // ∂r_c/∂q_k
     Q(j.coordinates[i]) += kin3::dot(dc, force) + kin3::dot(j.d_angle[i], moment);
   }
+}
+
+// Q of one part with mass: its planar frame's closed form, or its motion and Jacobian. With `planar`, a planar
+// frame's force is left there too (PlanarForce::valid false when the general path took it).
+void add_part(const Part& p, const detail::MassivePart& massive, V3 gravity, const double* q, const double* qd,
+              const double* qdd, double t, Eigen::VectorXd& Q, detail::PlanarForce* planar = nullptr) {
+  if (massive.planar) {
+    detail::PlanarForce f;
+    if (planar_part_force(massive, q, qd, qdd, gravity, f)) {
+      detail::add_planar_force(massive.frame, f, Q);
+      if (planar) *planar = f;
+      return;
+    }
+    if (planar) planar->valid = false;
+  }
+  add_general_part(p, gravity, q, qd, qdd, t, Q);
 }
 
 }  // namespace
