@@ -8,9 +8,9 @@
 #                               compiles them once);
 #                            2. the whole suite built with clang under AddressSanitizer + UndefinedBehaviorSanitizer
 #                               (build-asan/), preceded by bounded libFuzzer runs side by side: the scene loader
-#                               and the expression compiler, 20 s each.
+#                               and the expression compiler, 10 s each.
 #   tools/test.sh --quick    step 1 with the engine's GoogleTest suites in Release (the inner loop while developing)
-#   PHIQ_FUZZ_SECONDS=N      each fuzzer's time (default 20)
+#   PHIQ_FUZZ_SECONDS=N      each fuzzer's time (default 10)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 quick=0
@@ -33,7 +33,7 @@ CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-asan" -DCMAKE_BUILD_TYPE=R
   -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld \
   -DCMAKE_UNITY_BUILD=ON -DPHIQ_SANITIZE=ON -DPHIQ_FUZZ=ON -DPHIQ_BUILD_BENCH=OFF >/dev/null
 cmake --build "$root/build-asan" -j "$jobs"
-"$root/tools/fuzz.sh" "${PHIQ_FUZZ_SECONDS:-20}" "$root/build-asan"
+"$root/tools/fuzz.sh" "${PHIQ_FUZZ_SECONDS:-10}" "$root/build-asan"
 # Reports unsymbolized (symbolize=0): LeakSanitizer starts llvm-symbolizer in every process to match its suppressions
 # of third-party leaks (tests/sanitizer_defaults.cpp), which cost each phiq process 0.1 s of its 0.18 s. Whatever
 # fails is run again symbolized, for a readable report.
