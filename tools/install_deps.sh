@@ -9,6 +9,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
+  ninja-build          # the build's generator (tools/build_config.sh): compiles a target's files while those it links are still building
   libeigen3-dev        # Eigen 3.4: vectors, dense reference LU, splines for tabulated laws
   libsuitesparse-dev   # SuiteSparse 5.12: UMFPACK, CHOLMOD, KLU, SPQR
   libtbb-dev           # oneTBB: parallel drive steps

@@ -28,7 +28,7 @@ cmake --build "$root/build" -j "$jobs"
 echo "== sanitizers: clang, AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/)"
 # Line tables only: file:line in every report's stack without full debug information, which cost compile time and
 # nothing a report uses (the tests' own code at -O0: CMakeLists.txt, PHIQ_TEST_OPTIMIZATION)
-CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+CC=clang CXX=clang++ cmake -S "$root" -B "$root/build-asan" $(phiq_generator "$root/build-asan") -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
   -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld \
   -DCMAKE_UNITY_BUILD=ON -DPHIQ_SANITIZE=ON -DPHIQ_FUZZ=ON -DPHIQ_BUILD_BENCH=OFF >/dev/null
