@@ -31,6 +31,7 @@ namespace phiq {
 
 namespace detail {
 struct PlanarForce;
+struct PlanarFrame;
 }  // namespace detail
 
 /// How many values constraint c's reaction has: 3 (Fx, Fy, Mz) for a planar joint, 6 for a spatial one, 0 when its
@@ -105,6 +106,7 @@ class JointReactions {
     Slot slots[5];
     bool x_is_point = true;
     const AppliedLoads* applied = nullptr;
+    detail::PlanarFrame frame() const;  // the promoted planar frame the slots name
   };
   struct SetUpOnly {};  // with_set_up_of()'s constructor
   JointReactions(const JointReactions& other, SetUpOnly);
@@ -117,6 +119,10 @@ class JointReactions {
   void find_flat_sites(const Model& model);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);
+  // g_ += Φq,cᵀ λ_c over body b's own constraints at `q` (with or without the promoted constants), and g_'s entries
+  // those touch cleared again
+  void add_body_constraint_forces(std::size_t b, const double* q, double t, const Eigen::VectorXd& lambda);
+  void clear_body_constraint_forces(std::size_t b);
   // The row's motion: q, q̇, q̈ copied into qx_, qdx_, qddx_ at the first site that reads them (a row of flat sites
   // reads q alone).
   struct RowMotion {

@@ -175,12 +175,9 @@ void JointReactions::find_flat_sites(const Model& model) {
     if (part.part == BodyPart::kNone || part.applied || s.at[0] >= model.num_coordinates() ||
         s.at[1] >= model.num_coordinates())
       continue;
-    detail::PlanarFrame frame;  // as body_forces() adds the part's force
-    std::copy(part.slots, part.slots + 5, frame.slots);
-    frame.body = false, frame.x_is_point = part.x_is_point;
     bool fits = true;
     s.count[0] = s.count[1] = 0;
-    detail::for_each_planar_term(frame, [&](const Slot& slot, int field, bool negated) {
+    detail::for_each_planar_term(part.frame(), [&](const Slot& slot, int field, bool negated) {
       for (int k = 0; k < 2; ++k) {
         if (!slot.is_coordinate() || slot.coord() != s.at[k]) continue;
         if (s.count[k] == NaturalSite::kMaxTerms) {
@@ -305,15 +302,19 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
   find_flat_sites(model);
 }
 
+detail::PlanarFrame JointReactions::BodyPart::frame() const {
+  detail::PlanarFrame f;
+  std::copy(slots, slots + 5, f.slots);
+  f.body = false, f.x_is_point = x_is_point;
+  return f;
+}
+
 void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarForce* planar) {
   const BodyPart& part = body_parts_[b];
   if (planar && part.part != BodyPart::kNone && planar[part.part].valid) {
     // the whole model's Q computed the part's force at this row: added at the promoted frame's slots, as
     // add_generalized_forces() of the body's part adds it
-    detail::PlanarFrame frame;
-    std::copy(part.slots, part.slots + 5, frame.slots);
-    frame.body = false, frame.x_is_point = part.x_is_point;
-    detail::add_planar_force(frame, planar[part.part], qb_);
+    detail::add_planar_force(part.frame(), planar[part.part], qb_);
     if (part.applied) add_applied_forces(*part.applied, qx_.data(), qdx_.data(), t, qb_);
     return;
   }
@@ -321,13 +322,24 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
   add_generalized_forces(body.parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
 }
 
+void JointReactions::add_body_constraint_forces(std::size_t b, const double* q, double t,
+                                                const Eigen::VectorXd& lambda) {
+  const BodyRows& rows = body_rows_;
+  for (std::size_t k = rows.constraints_first[b]; k < rows.constraints_first[b + 1]; ++k)
+    rows.constraints[k].first->add_transposed_product(rows.constraints[k].second, q, t, lambda.data(), g_.data());
+}
+
+void JointReactions::clear_body_constraint_forces(std::size_t b) {
+  const BodyRows& rows = body_rows_;
+  for (std::size_t k = rows.g_first[b]; k < rows.g_first[b + 1]; ++k)
+    g_[static_cast<std::size_t>(rows.g_columns[k])] = 0.0;
+}
+
 bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,
                                    const detail::PlanarForce* planar, double* out) {
   if (!planar || !planar[s.part].valid) return false;
-  const BodyRows& rows = body_rows_;
   // (q, not qx_: a constraint reads the model's coordinates alone, promoted constants being the bodies')
-  for (std::size_t k = rows.constraints_first[s.body]; k < rows.constraints_first[s.body + 1]; ++k)
-    rows.constraints[k].first->add_transposed_product(rows.constraints[k].second, q, t, lambda.data(), g_.data());
+  add_body_constraint_forces(s.body, q, t, lambda);
   const detail::PlanarForce& f = planar[s.part];
   for (int k = 0; k < 2; ++k) {
     double qb = 0.0;  // Q_b at the component, as body_forces() sums it into qb_ (from +0)
@@ -338,8 +350,7 @@ bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double
     out[k] = g_[static_cast<std::size_t>(s.at[k])] - qb;
   }
   out[2] = 0.0;
-  for (std::size_t k = rows.g_first[s.body]; k < rows.g_first[s.body + 1]; ++k)
-    g_[static_cast<std::size_t>(rows.g_columns[k])] = 0.0;
+  clear_body_constraint_forces(s.body);
   return true;
 }
 
@@ -357,9 +368,7 @@ void JointReactions::evaluate_natural(const NaturalSite& s, RowMotion& row, doub
     qddx_.head(n) = Eigen::Map<const Eigen::VectorXd>(row.qdd, n);
     row.extended = true;
   }
-  for (std::size_t k = rows.constraints_first[s.body]; k < rows.constraints_first[s.body + 1]; ++k)
-    rows.constraints[k].first->add_transposed_product(rows.constraints[k].second, qx_.data(), t, lambda.data(),
-                                                      g_.data());
+  add_body_constraint_forces(s.body, qx_.data(), t, lambda);
   body_forces(s.body, t, planar);
   double force[3] = {0.0, 0.0, 0.0};
   for (int k = 0; k < (natural_->spatial ? 3 : 2); ++k) {
@@ -387,8 +396,7 @@ void JointReactions::evaluate_natural(const NaturalSite& s, RowMotion& row, doub
   } else {
     for (double v : {force[0], force[1], 0.0}) *out++ = v;
   }
-  for (std::size_t k = rows.g_first[s.body]; k < rows.g_first[s.body + 1]; ++k)
-    g_[static_cast<std::size_t>(rows.g_columns[k])] = 0.0;
+  clear_body_constraint_forces(s.body);
   for (std::size_t k = rows.q_first[s.body]; k < rows.q_first[s.body + 1]; ++k) qb_(rows.q_columns[k]) = 0.0;
 }
 

@@ -25,8 +25,6 @@ bool Sweeper::row_efforts() {
   if (!w) return not_defined();
   const double t = current_.t;
   effort_work_.q.setZero(model_.num_coordinates());
-  if (!effort_work_.forces) effort_work_.forces.emplace(*e.parts);
-  if (effort_work_.reactions && e.natural && effort_work_.planar.empty()) effort_work_.planar.resize(e.parts->size());
   effort_work_.forces->add(*e.parts, *e.loads, current_.q.data(), current_.qd.data(), current_.qdd.data(), t,
                            effort_work_.q, effort_work_.planar.empty() ? nullptr : effort_work_.planar.data());
   if (!multipliers_with_factors(model_, *w->lu, effort_work_.q, effort_work_.kept, effort_work_.lambda))

@@ -17,6 +17,9 @@ Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSumm
     effort_work_.forces = same_sweep(like) && like->effort_work_.forces
                               ? like->effort_work_.forces
                               : std::optional<PartForces>(std::in_place, *opt_.efforts.parts);
+  // what Q's planar parts add, kept for the natural joints' reactions to read (row_reactions())
+  if (effort_work_.reactions && opt_.efforts.natural && opt_.efforts.parts)
+    effort_work_.planar.resize(opt_.efforts.parts->size());
   need_v_ = o.solves_velocities();  // (q̈ needs q̇)
   need_a_ = o.solves_accelerations();
   // With velocities every step factorises at its solution: Φq there comes with the residual that accepts it.
