@@ -227,14 +227,16 @@ std::unique_ptr<BatchRanks::Sent> BatchRanks::send(int worker, const CaseMessage
   s->bytes_ = pack(m);
   if (s->bytes_.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
     throw Error("batch: a case of more than 2 GiB of rows cannot be sent between MPI ranks: fewer steps per case");
-  if (m.asks) {
-    auto* recv = new MPI_Request;
-    s->recv_ = recv;
-    MPI_Irecv(&s->next_, 1, MPI_INT64_T, 0, worker, MPI_COMM_WORLD, recv);
+  // every allocation before anything is posted: a request posted and then left by a std::bad_alloc would be waited
+  // for by ~Sent for ever
+  auto send = std::make_unique<MPI_Request>(), recv = m.asks ? std::make_unique<MPI_Request>() : nullptr;
+  if (recv) {
+    MPI_Irecv(&s->next_, 1, MPI_INT64_T, 0, worker, MPI_COMM_WORLD, recv.get());
+    s->recv_ = recv.release();
   }
-  auto* send = new MPI_Request;
-  s->send_ = send;
-  MPI_Isend(s->bytes_.data(), static_cast<int>(s->bytes_.size()), MPI_BYTE, 0, worker, MPI_COMM_WORLD, send);
+  s->send_ = send.release();  // ~Sent waits for it and frees it
+  MPI_Isend(s->bytes_.data(), static_cast<int>(s->bytes_.size()), MPI_BYTE, 0, worker, MPI_COMM_WORLD,
+            static_cast<MPI_Request*>(s->send_));
 #else
   (void)worker, (void)m;
 #endif
@@ -309,7 +311,8 @@ void serve_remote_workers(BatchRanks& ranks, int workers, const std::function<bo
 
 std::string out_of_memory_where(const std::bad_alloc& e, int threads) {
   if (const auto* r = dynamic_cast<const RankOutOfMemory*>(&e))
-    return "on MPI rank " + std::to_string(r->rank) + " in case " + std::to_string(r->k);
+    return "on MPI rank " + std::to_string(r->rank) +
+           (r->k < 0 ? " before its first case" : " in case " + std::to_string(r->k));
   return "on " + std::to_string(threads) + " threads";
 }
 
@@ -317,29 +320,52 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
   const int remote_workers = ranks.total_remote_workers(threads);
   tbb::task_arena arena(threads);
   if (ranks.rank() > 0) {  // a worker rank: its threads ask rank 0 for cases and send it their results
-    arena.execute([&] {
-      tbb::parallel_for(
-          0, threads,
-          [&](int w) {
-            CaseMessage last;  // the result of the case before: none yet (a request alone)
-            std::optional<std::int64_t> k = ranks.send(w, last)->answer();
-            try {
-              while (k && !h.halted()) {
-                // the next case asked for now, with the last result: its answer travels while this case runs
-                const std::unique_ptr<BatchRanks::Sent> next = ranks.send(w, last);
-                last = h.run_for_0(static_cast<std::size_t>(*k), w);
-                k = next->answer();
+    // Rank 0 waits for every worker's last message: a worker that cannot send it (or never starts) would leave rank
+    // 0 waiting for ever, so whatever runs out of memory, the last message is "out of memory", sent by the worker or
+    // else by this thread once the arena has returned; when even that fails, the job is aborted (BatchRanks::abandon).
+    const std::unique_ptr<std::atomic<bool>[]> said_last(new std::atomic<bool>[static_cast<std::size_t>(threads)] {});
+    auto say_out_of_memory = [&](int w, std::int64_t k) {
+      CaseMessage m;
+      m.kind = CaseMessage::Kind::kOutOfMemory;
+      m.k = k;
+      m.asks = false;
+      try {
+        (void)ranks.send(w, m);
+        said_last[static_cast<std::size_t>(w)] = true;
+      } catch (const std::bad_alloc&) {
+      }
+    };
+    try {
+      arena.execute([&] {
+        tbb::parallel_for(
+            0, threads,
+            [&](int w) {
+              std::int64_t held = -1;  // the case this worker holds: running it, or sending its result
+              try {
+                CaseMessage last;  // the result of the case before: none yet (a request alone)
+                std::optional<std::int64_t> k = ranks.send(w, last)->answer();
+                while (k && !h.halted()) {
+                  // the next case asked for now, with the last result: its answer travels while this case runs
+                  const std::unique_ptr<BatchRanks::Sent> next = ranks.send(w, last);
+                  held = *k;
+                  last = h.run_for_0(static_cast<std::size_t>(*k), w);
+                  k = next->answer();
+                }
+                last.asks = false;  // the last result, and no request: this worker is done
+                (void)ranks.send(w, last);
+                said_last[static_cast<std::size_t>(w)] = true;
+              } catch (const std::bad_alloc&) {  // running a case or packing its result: told to rank 0, which stops
+                say_out_of_memory(w, held);      // the batch (the case's memory is freed by now)
               }
-            } catch (const std::bad_alloc&) {  // told to rank 0, which stops the batch (the case's memory is freed)
-              last = CaseMessage{};
-              last.kind = CaseMessage::Kind::kOutOfMemory;
-              last.k = k ? *k : -1;
-            }
-            last.asks = false;  // the last result, and no request: this worker is done
-            (void)ranks.send(w, last);
-          },
-          tbb::simple_partitioner());
-    });
+            },
+            tbb::simple_partitioner());
+      });
+    } catch (const std::bad_alloc&) {  // the arena's own start
+    }
+    for (int w = 0; w < threads; ++w)
+      if (!said_last[static_cast<std::size_t>(w)]) say_out_of_memory(w, -1);
+    for (int w = 0; w < threads; ++w)
+      if (!said_last[static_cast<std::size_t>(w)]) ranks.abandon();
     return threads;
   }
   std::atomic<std::size_t> next_case{first};

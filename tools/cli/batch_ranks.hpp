@@ -37,7 +37,8 @@ struct CaseMessage {
 };
 
 // Thrown by run_cases() on rank 0 once every worker has stopped, when a worker of rank `rank` > 0 ran out of memory
-// in case `k`: a std::bad_alloc, told by rank 0 with the rank that ran out.
+// in case `k` (running it or sending its result; −1: before its first case): a std::bad_alloc, told by rank 0 with
+// the rank that ran out.
 struct RankOutOfMemory : std::bad_alloc {
   RankOutOfMemory(int r, std::int64_t c) : rank(r), k(c) {}
   const char* what() const noexcept override { return "out of memory on another MPI rank"; }
@@ -112,8 +113,8 @@ class BatchRanks {
   bool mpi_ = false, abandoned_ = false, finished_ = false;
 };
 
-// Where run_cases()'s std::bad_alloc `e` happened, for the command's one line: "on MPI rank R in case K" (a
-// RankOutOfMemory), else "on T threads" (this process's `threads`).
+// Where run_cases()'s std::bad_alloc `e` happened, for the command's one line: "on MPI rank R in case K" or "on MPI
+// rank R before its first case" (a RankOutOfMemory), else "on T threads" (this process's `threads`).
 std::string out_of_memory_where(const std::bad_alloc& e, int threads);
 
 // What run_cases() does with a case.
@@ -132,8 +133,9 @@ struct CaseHandlers {
 // run_here and deliver may run at the same time (rank 0's workers and its answering thread). Returns the worker
 // threads of the whole job on rank 0 (every rank's `threads` summed), this rank's own elsewhere. An exception of
 // run_here (std::bad_alloc) stops the handing out of cases and is thrown here once rank 0's workers have stopped; a
-// std::bad_alloc of run_for_0 on another rank ends that worker with a kOutOfMemory message, which stops the handing
-// out too, and RankOutOfMemory is thrown here on rank 0 once every worker has sent its last message.
+// std::bad_alloc on another rank (a case, its result's message, the workers' start) ends that worker with a
+// kOutOfMemory message, which stops the handing out too, and RankOutOfMemory is thrown here on rank 0 once every
+// worker has sent its last message; a rank that cannot send even that aborts the job rather than leave rank 0 waiting.
 int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, const CaseHandlers& h);
 
 }  // namespace phiq::tools
