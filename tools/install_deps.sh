@@ -4,6 +4,9 @@
 #                                  (README command 1, tools/setup.sh)
 #   tools/install_deps.sh --test   the above and the test suite's tools: sanitizers, fuzzing, headless Chromium,
 #                                  Node.js and the glTF validator, the benchmark peers (README command 2, tools/test.sh)
+#   tools/install_deps.sh --test-build
+#                                  the first list and what configuring the test build finds (the benchmark peers,
+#                                  Doxygen): tools/test.sh installs the rest with --test while the Release build runs
 # Idempotent: does nothing when every package is already installed. Needs root (or sudo).
 set -euo pipefail
 
@@ -31,12 +34,15 @@ packages=(
   libgtest-dev libbenchmark-dev  # GoogleTest and Google Benchmark: found when the tree is configured, so that
                                  # README command 2 builds in command 1's build directory without reconfiguring it
 )
-test_packages=(
-  clang libclang-rt-14-dev  # libFuzzer + AddressSanitizer/UndefinedBehaviorSanitizer build (tests/fuzz)
-  lld                  # the sanitizer build's linker: 1.1 s of CPU for phiq_tests against GNU ld's 4.7 s
+test_build_packages=(  # found when build/ is configured
   doxygen              # API reference (target phiq_docs, ctest api_docs)
   libsimbody-dev       # peer for the benchmark (bench/bench_peers.cpp); skipped with a message if absent
   libmumps-dev         # MUMPS, distributed sparse LU: bench/bench_mumps.cpp against KLU
+)
+test_packages=(
+  "${test_build_packages[@]}"
+  clang libclang-rt-14-dev  # libFuzzer + AddressSanitizer/UndefinedBehaviorSanitizer build (tests/fuzz)
+  lld                  # the sanitizer build's linker: 1.1 s of CPU for phiq_tests against GNU ld's 4.7 s
   python3-matplotlib   # tools/plot/plot_bench.py (the figure of bench/README.md)
   python3-h5py python3-pytest python3-pandas  # the pytest suites (tests/python), HDF5 read back independently
   nodejs               # the Khronos glTF-Validator on `phiq animate`'s .glb files (ctest gltf_validator), and
@@ -45,7 +51,10 @@ test_packages=(
   phcpack              # PHCpack's `phc -b`: phiq modes checked against it (tests/test_modes_phc.cpp, bench/bench_modes.cpp)
 )
 test=0
-if [ "${1:-}" = "--test" ]; then test=1; packages+=("${test_packages[@]}"); fi
+case "${1:-}" in
+  --test) test=1; packages+=("${test_packages[@]}") ;;
+  --test-build) packages+=("${test_build_packages[@]}") ;;
+esac
 # npm (Debian's package, unless a node install already brings its own) installs the validator below
 if [ "$test" = 1 ] && ! command -v npm >/dev/null 2>&1; then packages+=(npm); fi
 
