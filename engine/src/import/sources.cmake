@@ -29,3 +29,7 @@ target_link_libraries(phiq_sdf PRIVATE Eigen3::Eigen sdformat12::sdformat12
 set_target_properties(phiq_sdf PROPERTIES CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON
   UNITY_BUILD OFF)
 add_dependencies(phiq_engine phiq_sdf)  # whatever links the engine can read SDF files from the build tree
+if(PHIQ_SANITIZE)
+  # a reader the tests pass through briefly, unoptimised as the engine's other readers are there (engine/CMakeLists.txt)
+  target_compile_options(phiq_sdf PRIVATE -O0)
+endif()
