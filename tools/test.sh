@@ -22,14 +22,14 @@ jobs="$(nproc)"
 source "$root/tools/build_config.sh"
 "$root/tools/install_deps.sh" --test-build
 mkdir -p "$root/build"
-set -m  # each background job in its own process group, so that a failure stops the whole of it
+set -m  # each background job in its own process group: the sanitizer build stops whole when a test fails
 # The other test tools (Chromium, Node.js and the validator, clang, PHCpack, pytest) download and unpack while the
 # Release build compiles: nothing before step 1's tests needs them.
 deps_log="$root/build/install_test_tools.log"
 "$root/tools/install_deps.sh" --test >"$deps_log" 2>&1 &
 deps=$!
-stop_deps() { kill -- -"$deps" 2>/dev/null || true; }
-trap stop_deps EXIT
+# (a failed build waits for it: apt and dpkg stopped halfway would leave the system's packages half-installed)
+trap 'wait "$deps" 2>/dev/null || true' EXIT
 # build/ as README command (1) configured it: what that command built is not compiled again.
 phiq_configure_release "$root" -DPHIQ_UNIT_TESTS="$([ "$quick" = 1 ] && echo ON || echo OFF)"
 cmake --build "$root/build" -j "$jobs"
