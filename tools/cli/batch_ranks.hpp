@@ -103,8 +103,9 @@ class BatchRanks {
   std::optional<CaseMessage> poll(int* from, int* tag, const std::function<bool()>& give_up);
   // Rank 0: the answer to (from, tag): the next case, or −1 (no more); not waited for once `give_up` is true.
   void answer(int from, int tag, std::int64_t k, const std::function<bool()>& give_up);
-  // Rank 0: some remote worker never got its last answer (the batch stopped, or a rank died): MPI_Finalize would
-  // wait for it, so the job is left by MPI_Abort (after the output is published).
+  // Rank 0: some remote worker never got its last answer (the batch stopped, or a rank died); another rank: one of
+  // its workers could not send rank 0 its last message. MPI_Finalize would wait for it, so the job is left by
+  // MPI_Abort (on rank 0 after the output is published).
   void abandon() { abandoned_ = true; }
 
  private:
