@@ -7,6 +7,7 @@
 #include <functional>
 #include <fstream>
 #include <sstream>
+#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "phiq/expression.hpp"
 #include "test_support.hpp"
@@ -332,7 +333,8 @@ TEST(Expression, CompilesToTheSameTapeInEveryProcess) {
     return;
   }
   const std::string mine = listings();
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "phiq_tape_listing";
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("phiq_tape_listing_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   for (int child = 0; child < 4; ++child) {
     const std::filesystem::path file = dir / ("child" + std::to_string(child) + ".txt");

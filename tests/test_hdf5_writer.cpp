@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 #include <vector>
+#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "cli_test_support.hpp"
 #include "output/hdf5_handle.hpp"
@@ -20,8 +21,9 @@ namespace h5 = phiq::detail::h5;
 namespace fs = std::filesystem;
 
 struct ScratchDir {
-  fs::path dir = fs::temp_directory_path() /
-                 ("phiq_h5_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+  fs::path dir =
+      fs::temp_directory_path() / ("phiq_h5_" + std::to_string(::getpid()) + "_" +
+                                   std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
   ScratchDir() { fs::remove_all(dir), fs::create_directories(dir); }
   ~ScratchDir() { fs::remove_all(dir); }
 };

@@ -29,7 +29,8 @@ class OutputFile : public ::testing::Test {
  protected:
   void SetUp() override {
     dir_ = std::filesystem::temp_directory_path() /
-           ("phiq_output_file_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("phiq_output_file_" + std::to_string(::getpid()) + "_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
   }

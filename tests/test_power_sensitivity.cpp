@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "output/hdf5_handle.hpp"
 #include "phiq/effort_sensitivity.hpp"
@@ -189,7 +190,8 @@ TEST(PowerSensitivity, TheColumnsAreWrittenWithThePowersOnlyAndHoldTheRowsValues
 TEST(PowerSensitivity, AnHdf5FileHoldsTheColumnsOfTheCsvWithTheirUnits) {
   // the efforts dataset: motor.effort (N m), motor.power (W), ∂τ/∂p per parameter ("N m/L" …), ∂P/∂p ("W/L" …)
   const Scene s = parse_scene(kPowerPendulum, "pendulum.yaml");
-  const std::filesystem::path path = std::filesystem::temp_directory_path() / "phiq_power_sensitivity.h5";
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("phiq_power_sensitivity_" + std::to_string(::getpid()) + ".h5");
   std::string csv;
   {
     CsvFormat f(*s.model, s.sweep);

@@ -15,6 +15,7 @@
 #include <string>
 #include <utility>
 #include <vector>
+#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "phiq/orientation.hpp"
 #include "phiq/shapes.hpp"
@@ -55,8 +56,9 @@ V3 centroid_of(const TriangleMesh& m, const std::array<int, 3>& t) {
 }
 
 struct TempDir {
-  fs::path dir = fs::temp_directory_path() /
-                 ("phiq_shapes_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+  fs::path dir =
+      fs::temp_directory_path() / ("phiq_shapes_" + std::to_string(::getpid()) + "_" +
+                                   std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
   TempDir() { fs::remove_all(dir), fs::create_directories(dir); }
   ~TempDir() { fs::remove_all(dir); }
   std::string path(const std::string& name) const { return (dir / name).string(); }
