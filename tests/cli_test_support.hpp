@@ -19,7 +19,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
-#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
+
+#include "scratch_path.hpp"
 
 namespace phiq::test {
 
@@ -43,8 +44,7 @@ class TestFolder : public ::testing::Test {
  protected:
   void SetUp() override {
     const ::testing::TestInfo* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("phiq_" + std::to_string(::getpid()) + "_" + std::string(info->test_suite_name()) + "_" + info->name());
+    dir_ = scratch_path("phiq_" + std::string(info->test_suite_name()) + "_" + info->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

@@ -12,12 +12,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "clearance_report.hpp"
 #include "html_clearance.hpp"
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
+#include "scratch_path.hpp"
 
 namespace phiq {
 namespace {
@@ -73,7 +73,7 @@ TEST(ClearanceFiles, Hdf5HoldsTheCsvValuesAndTheSummaryExactlyOnAnyThreadCount) 
   Scene s = parse_scene(clearance_files_scene_text(), "balls.yaml");
   const ClearanceReport r = scene_clearance(s);
   ASSERT_EQ(r.pairs.size(), 1u);
-  const fs::path dir = fs::temp_directory_path() / ("phiq_clearance_files_" + std::to_string(::getpid()));
+  const fs::path dir = phiq::test::scratch_path("phiq_clearance_files");
   fs::create_directories(dir);
   const fs::path path = dir / "c.h5";
   ClearanceHdf5Options o;
@@ -202,7 +202,7 @@ TEST(ClearanceFiles, SummaryJsonListsEveryMinimumAsHdf5MinimaHoldsIt) {
   const Scene s = parse_scene(text.str() + "  sensitivities: [L2, L3]\n", "fourbar_knee.yaml");
   const ClearanceReport r = scene_clearance(s);
   ASSERT_GE(r.pairs.size(), 2u);
-  const fs::path dir = fs::temp_directory_path() / ("phiq_clearance_json_minima_" + std::to_string(::getpid()));
+  const fs::path dir = phiq::test::scratch_path("phiq_clearance_json_minima");
   fs::create_directories(dir);
   const fs::path path = dir / "knee.h5";
   write_clearance_hdf5(path.string(), r, s.parts);

@@ -17,6 +17,7 @@
 #include "cli_support.hpp"
 #include "cli_test_support.hpp"
 #include "test_support.hpp"
+#include "scratch_path.hpp"
 
 namespace {
 
@@ -109,7 +110,7 @@ TEST_F(Cli, UnwritableOutputsFailBeforeTheSweepAndNoneAppears) {
 // terminated when one leaves with an error, and this one with them) exits with its own status and no second line.
 // In a child process, which installs phiq's signal thread as the command does.
 TEST(Interrupts, ASignalAfterTheErrorLineAddsNoSecondLineAndKeepsItsStatus) {
-  const fs::path err = fs::temp_directory_path() / ("phiq_settle_" + std::to_string(::getpid()) + ".txt");
+  const fs::path err = phiq::test::scratch_path("phiq_settle").concat(".txt");
   auto child = [&](bool settled) {
     const pid_t pid = ::fork();
     if (pid == 0) {

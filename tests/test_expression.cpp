@@ -7,10 +7,10 @@
 #include <functional>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "phiq/expression.hpp"
 #include "test_support.hpp"
+#include "scratch_path.hpp"
 
 namespace phiq {
 namespace {
@@ -333,8 +333,7 @@ TEST(Expression, CompilesToTheSameTapeInEveryProcess) {
     return;
   }
   const std::string mine = listings();
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("phiq_tape_listing_" + std::to_string(::getpid()));
+  const std::filesystem::path dir = phiq::test::scratch_path("phiq_tape_listing");
   std::filesystem::create_directories(dir);
   for (int child = 0; child < 4; ++child) {
     const std::filesystem::path file = dir / ("child" + std::to_string(child) + ".txt");

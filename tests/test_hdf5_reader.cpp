@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "output/hdf5_handle.hpp"
 #include "phiq/phiq.hpp"
+#include "scratch_path.hpp"
 
 namespace {
 
@@ -17,9 +17,7 @@ namespace h5 = phiq::detail::h5;
 namespace fs = std::filesystem;
 
 struct TempDir {
-  fs::path dir =
-      fs::temp_directory_path() / ("phiq_h5r_" + std::to_string(::getpid()) + "_" +
-                                   std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+  fs::path dir = phiq::test::test_scratch_path("phiq_h5r_");
   TempDir() { fs::remove_all(dir), fs::create_directories(dir); }
   ~TempDir() { fs::remove_all(dir); }
   std::string write(const std::string& name, const std::string& bytes) const {

@@ -7,12 +7,12 @@
 #include <filesystem>
 #include <string>
 #include <vector>
-#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "cli_test_support.hpp"
 #include "output/hdf5_handle.hpp"
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
+#include "scratch_path.hpp"
 
 namespace {
 
@@ -21,9 +21,7 @@ namespace h5 = phiq::detail::h5;
 namespace fs = std::filesystem;
 
 struct ScratchDir {
-  fs::path dir =
-      fs::temp_directory_path() / ("phiq_h5_" + std::to_string(::getpid()) + "_" +
-                                   std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+  fs::path dir = phiq::test::test_scratch_path("phiq_h5_");
   ScratchDir() { fs::remove_all(dir), fs::create_directories(dir); }
   ~ScratchDir() { fs::remove_all(dir); }
 };

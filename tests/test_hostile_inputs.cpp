@@ -22,6 +22,8 @@
 
 #include <unistd.h>
 
+#include "scratch_path.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -181,8 +183,7 @@ TEST_P(Hostile, Case) {
   if (!c.sanitizers) GTEST_SKIP() << "not run under sanitizers";
 #endif
   // the process id in the name: two checkouts (or two runs) testing at once must not share a case's folder
-  const fs::path dir =
-      fs::temp_directory_path() / ("phiq_hostile_" + std::to_string(::getpid()) + "_" + c.file + "_" + c.name);
+  const fs::path dir = phiq::test::scratch_path("phiq_hostile_" + c.file + "_" + c.name);
   std::error_code ec;
   fs::permissions(dir, fs::perms::owner_all, fs::perm_options::add, ec);  // a case may have taken them away
   fs::remove_all(dir, ec);

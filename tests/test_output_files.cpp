@@ -21,6 +21,7 @@
 
 #include "atomic_file.hpp"
 #include "phiq/types.hpp"
+#include "scratch_path.hpp"
 
 namespace phiq {
 namespace {
@@ -28,9 +29,7 @@ namespace {
 class OutputFile : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("phiq_output_file_" + std::to_string(::getpid()) + "_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    dir_ = phiq::test::test_scratch_path("phiq_output_file_");
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
   }

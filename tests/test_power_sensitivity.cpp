@@ -8,13 +8,13 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "output/hdf5_handle.hpp"
 #include "phiq/effort_sensitivity.hpp"
 #include "phiq/phiq.hpp"
 #include "sensitivity_support.hpp"
 #include "test_support.hpp"
+#include "scratch_path.hpp"
 
 namespace phiq {
 namespace {
@@ -190,8 +190,7 @@ TEST(PowerSensitivity, TheColumnsAreWrittenWithThePowersOnlyAndHoldTheRowsValues
 TEST(PowerSensitivity, AnHdf5FileHoldsTheColumnsOfTheCsvWithTheirUnits) {
   // the efforts dataset: motor.effort (N m), motor.power (W), ∂τ/∂p per parameter ("N m/L" …), ∂P/∂p ("W/L" …)
   const Scene s = parse_scene(kPowerPendulum, "pendulum.yaml");
-  const std::filesystem::path path =
-      std::filesystem::temp_directory_path() / ("phiq_power_sensitivity_" + std::to_string(::getpid()) + ".h5");
+  const std::filesystem::path path = phiq::test::scratch_path("phiq_power_sensitivity").concat(".h5");
   std::string csv;
   {
     CsvFormat f(*s.model, s.sweep);

@@ -15,11 +15,11 @@
 #include <string>
 #include <utility>
 #include <vector>
-#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "phiq/orientation.hpp"
 #include "phiq/shapes.hpp"
 #include "phiq/types.hpp"
+#include "scratch_path.hpp"
 
 namespace phiq::shapes_test {
 
@@ -56,9 +56,7 @@ V3 centroid_of(const TriangleMesh& m, const std::array<int, 3>& t) {
 }
 
 struct TempDir {
-  fs::path dir =
-      fs::temp_directory_path() / ("phiq_shapes_" + std::to_string(::getpid()) + "_" +
-                                   std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+  fs::path dir = phiq::test::test_scratch_path("phiq_shapes_");
   TempDir() { fs::remove_all(dir), fs::create_directories(dir); }
   ~TempDir() { fs::remove_all(dir); }
   std::string path(const std::string& name) const { return (dir / name).string(); }

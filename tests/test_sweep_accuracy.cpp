@@ -12,11 +12,11 @@
 #include <sstream>
 
 #include <nlohmann/json.hpp>
-#include <unistd.h>  // getpid: two checkouts testing at once use folders of their own
 
 #include "phiq/csv_compare.hpp"
 #include "sweep_accuracy.hpp"
 #include "test_support.hpp"
+#include "scratch_path.hpp"
 
 namespace fs = std::filesystem;
 
@@ -33,8 +33,7 @@ std::string slurp(const fs::path& p) {
 class SweepAccuracy : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("phiq_accuracy_" + std::to_string(::getpid()) + "_" +
-                                        std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    dir_ = phiq::test::test_scratch_path("phiq_accuracy_");
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

@@ -362,10 +362,10 @@ int run_cases(BatchRanks& ranks, std::size_t first, std::size_t n, int threads, 
       });
     } catch (const std::bad_alloc&) {  // the arena's own start
     }
-    for (int w = 0; w < threads; ++w)
+    for (int w = 0; w < threads; ++w) {
       if (!said_last[static_cast<std::size_t>(w)]) say_out_of_memory(w, -1);
-    for (int w = 0; w < threads; ++w)
       if (!said_last[static_cast<std::size_t>(w)]) ranks.abandon();
+    }
     return threads;
   }
   std::atomic<std::size_t> next_case{first};
