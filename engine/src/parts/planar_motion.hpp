@@ -38,8 +38,10 @@ struct PlanarMotion {
 
 // A body's (x, y, ψ), or an origin point and an x direction (θ its angle: ω = (d × ḋ)/|d|², α = (d × d̈)/|d|² −
 // 2 (d · ḋ)(d × ḋ)/|d|⁴). `qd` not null; `qdd` may be null (accelerations 0). False for a direction of zero length
-// (the jets' and part_pose()'s NaN).
-inline bool planar_motion(const PlanarFrame& f, const double* q, const double* qd, const double* qdd, PlanarMotion& m) {
+// (the jets' and part_pose()'s NaN). Always inlined: called out of line, its PlanarMotion was zeroed, written and
+// read back through memory, half of the time a sweep's efforts spent in Q (bench/bench_efforts.cpp).
+[[gnu::always_inline]] inline bool planar_motion(const PlanarFrame& f, const double* q, const double* qd,
+                                                 const double* qdd, PlanarMotion& m) {
   auto rate = [&](const Slot& s) { return s.is_coordinate() ? qd[s.coord()] : 0.0; };
   auto accel = [&](const Slot& s) { return s.is_coordinate() && qdd ? qdd[s.coord()] : 0.0; };
   const Slot* o = f.slots;
