@@ -1,7 +1,8 @@
 // Every assembly mode (phiq/modes.hpp): polynomial systems with known solutions, the four-bar against
 // Freudenstein's closed form and its Grashof limit, the mode a placement is in (locate_mode()) and the distance to
 // the other against the closed form, the crank-slider's two modes, the 3-RPR parallel robot's six
-// complex assemblies, a cam refused with its constraint named, and the same bits on 1 and 2 threads.
+// complex assemblies, a cam refused with its constraint named, a runaway law named with its time, and the same bits
+// on 1 and 2 threads.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -274,6 +275,44 @@ TEST(ModesScene, ACamIsRefusedWithItsConstraintNamed) {
   EXPECT_EQ(r.summary.status, ModesStatus::kNotPolynomial);
   EXPECT_NE(r.summary.message.find("constraint 'cam' is not polynomial"), std::string::npos) << r.summary.message;
   EXPECT_TRUE(r.modes.empty());
+}
+
+// A driver's law taken beyond what doubles resolve of its coordinate (θ2 = t: its row is −t at the placement) is the
+// time's fault, said with the constraint and the time, not "not polynomial" nor eight failed paths; just inside the
+// limit (1e11 row scales) the four-bar keeps its two modes. A time outside a table's range is refused by name.
+TEST(ModesScene, ARunawayLawIsNamedWithItsTime) {
+  const Scene scene = load_scene(modes_model_path("seed/fourbar_mixed.yaml"));
+  for (const auto& [t, said] : {std::pair{1e308, std::string("constraint 'motor' is -1e+308 at t = 1e+308")},
+                                std::pair{1e20, std::string("constraint 'motor' is -1e+20 at t = 1e+20")}}) {
+    ModesOptions o;
+    o.time = t;
+    try {
+      (void)find_assembly_modes(*scene.model, o);
+      ADD_FAILURE() << "no error at t = " << t;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(said), std::string::npos) << e.what();
+    }
+  }
+  ModesOptions inside;
+  inside.time = 9e10;
+  EXPECT_EQ(find_assembly_modes(*scene.model, inside).summary.real, 2);
+  std::string text = modes_read_text(modes_model_path("seed/fourbar_mixed.yaml"));
+  const std::string law = "law: {type: linear, initial: 0, rate: 1}";
+  ASSERT_NE(text.find(law), std::string::npos);
+  text.replace(text.find(law), law.size(), "law: {type: table, t: [0, 1, 2], values: [0, 0.5, 0.6]}");
+  const Scene tabled = parse_scene(text, "fourbar_table.yaml");
+  ModesOptions late;
+  late.time = 3;
+  EXPECT_THROW(
+      {
+        try {
+          (void)find_assembly_modes(*tabled.model, late);
+        } catch (const Error& e) {
+          EXPECT_STREQ(e.what(), "ModesOptions: driver 'motor' is not defined at t = 3");
+          throw;
+        }
+      },
+      Error);
 }
 
 TEST(ModesDeterminism, OneAndTwoThreadsGiveTheSameBits) {

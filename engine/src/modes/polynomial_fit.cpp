@@ -102,11 +102,41 @@ Eigen::VectorXd ModelPolynomials::coordinates(const Eigen::VectorXcd& x) const {
   return q;
 }
 
+namespace {
+
+// Rows the time has taken beyond what doubles resolve of their coordinates, at the initial positions: not finite,
+// or above 1e11 times the row's scale (its rounding 1e-5 of a unit; a decade below where a unit step of a coordinate
+// changes the row by less than the 1e-12 of its size that affine_row() resolves), where they were not at the
+// time-domain point nearest 0. That is a law that overflows or runs away (a linear driver at t = 1e308 or 1e20),
+// which the fit below would call not polynomial, or whose paths would all fail.
+void check_rows_resolved_at(const Model& model, double t) {
+  const double reference = std::clamp(0.0, model.time_domain_begin(), model.time_domain_end());
+  const Eigen::VectorXd q = model.initial_positions();
+  std::vector<double> at_t(static_cast<std::size_t>(model.num_equations())), at_reference(at_t.size());
+  model.residual(q.data(), t, at_t.data());
+  model.residual(q.data(), reference, at_reference.data());
+  for (std::size_t r = 0; r < at_t.size(); ++r) {
+    const double limit = 1e11 * model.tolerance_scales().row_scale(static_cast<Index>(r));
+    if (std::abs(at_t[r]) <= limit || !(std::abs(at_reference[r]) <= limit)) continue;
+    throw Error("ModesOptions: constraint '" +
+                model.constraints()[static_cast<std::size_t>(model.constraint_of_row(static_cast<Index>(r)))].name +
+                "' is " + shortest(at_t[r]) + " at t = " + shortest(t) + " at the initial positions (" +
+                shortest(at_reference[r]) + " at t = " + shortest(reference) +
+                "): its law runs beyond what doubles resolve of its coordinates there");
+  }
+}
+
+}  // namespace
+
 ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& options) {
   // (a time that is not finite made every driver "not polynomial", which blamed the constraint for the time)
   if (!std::isfinite(options.time)) throw Error("ModesOptions: time " + shortest(options.time) + " is not finite");
+  if (options.time < model.time_domain_begin() || options.time > model.time_domain_end())
+    throw Error("ModesOptions: driver '" + model.time_domain_limiter() + "' is not defined at t = " +
+                shortest(options.time));
   ModelPolynomials out;
   const Index n = model.num_coordinates(), m = model.num_equations();
+  check_rows_resolved_at(model, options.time);
   Random random(options.seed ^ 0x5DEECE66Dull);
   ModelRows eval(model, options.time);
   out.origin = model.initial_positions();
