@@ -258,8 +258,9 @@ Scene natural_random_nfourbar(std::mt19937& rng, int n) {
   return parse_scene(s.str(), "nfourbar.yaml");
 }
 
-// The flat sites (JointReactions::NaturalSite: a moving point on a body whose force Q computed, no load its own)
-// sum the same terms as the general path, bit for bit: random natural four-bar chains, every row, every joint.
+// The flat sites (JointReactions::NaturalSite: a point on a body whose force Q computed, no load its own; moving,
+// or fixed as the cranks' pivots G{i}) sum the same terms as the general path, bit for bit: random natural four-bar
+// chains, every row, every joint.
 TEST(NaturalReactions, FlatSitesAreTheGeneralPathBitForBit) {
   std::mt19937 rng(49);
   for (int trial = 0; trial < 4; ++trial) {
@@ -287,8 +288,10 @@ TEST(NaturalReactions, FlatSitesAreTheGeneralPathBitForBit) {
       for (detail::PlanarForce& f : planar) f.along_x += 1.0;  // read, not passed over: P{i} is its crank's x point
       reactions.evaluate(q, qd, qdd, t, lambda, flat.data(), planar.data());
       for (std::size_t j = 0; j < e.natural->joints.size(); ++j) {
-        if (e.natural->joints[j].name[0] != 'P') continue;
-        EXPECT_NEAR(flat[3 * j], general[3 * j] - 1.0, 1e-9 * (1 + std::fabs(general[3 * j])));
+        const char first = e.natural->joints[j].name[0];
+        if (first != 'P' && first != 'G') continue;  // (O, crank 0's angle's)
+        // G{i}, its crank's fixed origin, takes −along_x: R = −Σ g over the crank's moving point − Q_b there
+        EXPECT_NEAR(flat[3 * j], general[3 * j] + (first == 'P' ? -1.0 : 1.0), 1e-9 * (1 + std::fabs(general[3 * j])));
       }
     }
   }

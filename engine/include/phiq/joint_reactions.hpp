@@ -76,17 +76,23 @@ class JointReactions {
     bool spatial = false;
   };
   // A natural joint's site. Its flat form, where the body's part is read from a sweep's Q (BodyPart::part), no load
-  // is the body's alone and the point moves in x and y (planar): component k's Q_b is the sum of the PlanarForce
-  // values terms[k] names (kPlanarFields' index, +8 when negated), in add_planar_force()'s order, and its reaction
-  // g_[at[k]] − Q_b. The same sums as the general path's without writing the body's Q (qb_) and clearing it.
+  // is the body's alone and the model is planar: component k's Q_b is the sum of the PlanarForce values terms[k]
+  // names (kPlanarFields' index, +8 when negated), in add_planar_force()'s order, and its reaction g_[at[k]] − Q_b;
+  // along a fixed component (a ground pivot's), −Σ g_ over moving[k] (the body's points' moving components there)
+  // − Q_b, or NaN when `shared` (another of its points is fixed along it too). The same sums as the general path's
+  // without writing the body's Q (qb_) and clearing it, nor reading the body's points at every row.
   struct NaturalSite {
-    static constexpr int kMaxTerms = 3;  // per component (a point is at most an origin and an x target)
-    std::size_t joint = 0, body = 0;     // in natural_
-    std::size_t point = 0;               // the joint's place among the body's points
-    Index at[3] = {0, 0, 0};             // its components' coordinates (n and above: promoted constants)
-    std::size_t part = 0;                // the flat form's part (OutputEfforts::parts)
+    static constexpr int kMaxTerms = 3;   // per component (a point is at most an origin and an x target)
+    static constexpr int kMaxMoving = 4;  // a fixed component's moving points
+    std::size_t joint = 0, body = 0;      // in natural_
+    std::size_t point = 0;                // the joint's place among the body's points
+    Index at[3] = {0, 0, 0};              // its components' coordinates (n and above: promoted constants)
+    std::size_t part = 0;                 // the flat form's part (OutputEfforts::parts)
     bool flat = false;
     std::uint8_t count[2] = {0, 0}, terms[2][kMaxTerms] = {};
+    std::uint8_t moving_count[2] = {0, 0};
+    bool shared[2] = {false, false};
+    Index moving[2][kMaxMoving] = {};
   };
   // The natural bodies' own constraints, and the columns they and the bodies' forces touch, body b's at
   // [first[b], first[b + 1]) of each list (flat: one allocation per list, not per body).

@@ -172,11 +172,23 @@ void JointReactions::find_flat_sites(const Model& model) {
   for (NaturalSite& s : natural_sites_) {
     const BodyPart& part = body_parts_[s.body];
     s.flat = false;
-    if (part.part == BodyPart::kNone || part.applied || s.at[0] >= model.num_coordinates() ||
-        s.at[1] >= model.num_coordinates())
-      continue;
+    if (part.part == BodyPart::kNone || part.applied) continue;
     bool fits = true;
     s.count[0] = s.count[1] = 0;
+    const NaturalBody& body = natural_->bodies[s.body];
+    for (int k = 0; k < 2; ++k) {  // a fixed component's moving points, as evaluate_natural() sums them
+      s.moving_count[k] = 0, s.shared[k] = false;
+      if (s.at[k] < model.num_coordinates()) continue;
+      for (const Attachment3& o : body.points) {
+        const Index c = o.r[k].coord();
+        if (c >= model.num_coordinates())
+          s.shared[k] = s.shared[k] || &o != &body.points[s.point];
+        else if (s.moving_count[k] == NaturalSite::kMaxMoving)
+          fits = false;
+        else
+          s.moving[k][s.moving_count[k]++] = c;
+      }
+    }
     detail::for_each_planar_term(part.frame(), [&](const Slot& slot, int field, bool negated) {
       for (int k = 0; k < 2; ++k) {
         if (!slot.is_coordinate() || slot.coord() != s.at[k]) continue;
@@ -347,7 +359,13 @@ bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double
       const double v = f.*detail::kPlanarFields[s.terms[k][i] & 7];
       qb += (s.terms[k][i] & 8) ? -v : v;
     }
-    out[k] = g_[static_cast<std::size_t>(s.at[k])] - qb;
+    if (s.at[k] < static_cast<Index>(g_.size())) {
+      out[k] = g_[static_cast<std::size_t>(s.at[k])] - qb;
+      continue;
+    }
+    double moving = 0.0;  // a fixed component: as evaluate_natural() sums it
+    for (int i = 0; i < s.moving_count[k]; ++i) moving += g_[static_cast<std::size_t>(s.moving[k][i])];
+    out[k] = s.shared[k] ? std::numeric_limits<double>::quiet_NaN() : -moving - qb;
   }
   out[2] = 0.0;
   clear_body_constraint_forces(s.body);
