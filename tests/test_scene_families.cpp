@@ -1,5 +1,5 @@
 // Indexed families in scenes (`for i in A..B`): they expand to the model listed one by one (nested, in equations,
-// drivers, laws and parameters, empty or bounded by enclosing indices), and malformed families, collisions,
+// drivers, laws, parameters and parts, empty or bounded by enclosing indices), and malformed families, collisions,
 // shadowing index names and families over the size limit are one-line errors naming the member. Separate from
 // test_scene.cpp, which loads scenes written entry by entry.
 #include <gtest/gtest.h>
@@ -7,6 +7,7 @@
 #include <string>
 
 #include "phiq/phiq.hpp"
+#include "phiq/text.hpp"
 #include "test_support.hpp"
 
 namespace phiq {
@@ -87,6 +88,52 @@ TEST(SceneFamilies, ExpandToTheModelListedOneByOne) {
   ASSERT_EQ(test::sweep(*a.model, a.sweep, &ta), SolveStatus::kSuccess);
   ASSERT_EQ(test::sweep(*b.model, b.sweep, &tb), SolveStatus::kSuccess);
   for (std::size_t k = 0; k < ta.q.size(); ++k) EXPECT_EQ(ta.q[k], tb.q[k]);
+}
+
+// Parts from families (a stated mass on each crank, a density over a box on each coupler, sizes from the index)
+// are the parts listed one by one, bit for bit; a name a family repeats is refused at its member.
+TEST(SceneFamilies, PartsFromFamiliesAreThePartsListed) {
+  const std::string families = std::string(kFamilies) +
+                               "parts:\n"
+                               "  for i in 0..N:\n"
+                               "    \"crank{i}\": {frame: {origin: [i, 0], x: \"P{i}\"}, mass: 1 + i, center_of_mass: "
+                               "[0.5, 0.1*i], inertia: 0.1*(i+1), colour: [0, 0, 1]}\n"
+                               "  for i in 0..N-1:\n"
+                               "    \"coupler{i}\": {frame: {origin: \"P{i}\", x: \"P{i+1}\"}, density: 2700, shapes: "
+                               "[{type: box, size: [1, 0.02*(i+1), 0.01]}]}\n";
+  std::string listed = std::string(kFamilies) + "parts:\n";
+  for (int i = 0; i <= 3; ++i)
+    listed += "  crank" + std::to_string(i) + ": {frame: {origin: [" + std::to_string(i) + ", 0], x: P" +
+              std::to_string(i) + "}, mass: " + std::to_string(1 + i) + ", center_of_mass: [0.5, " +
+              shortest(0.1 * i) + "], inertia: " + shortest(0.1 * (i + 1)) + ", colour: [0, 0, 1]}\n";
+  for (int i = 0; i < 3; ++i)
+    listed += "  coupler" + std::to_string(i) + ": {frame: {origin: P" + std::to_string(i) + ", x: P" +
+              std::to_string(i + 1) + "}, density: 2700, shapes: [{type: box, size: [1, " + shortest(0.02 * (i + 1)) +
+              ", 0.01]}]}\n";
+  const Scene a = parse_scene(families, "families.yaml"), b = parse_scene(listed, "listed.yaml");
+  ASSERT_EQ(a.parts.size(), 7u);
+  ASSERT_EQ(b.parts.size(), 7u);
+  for (std::size_t k = 0; k < a.parts.size(); ++k) {
+    const Part &x = a.parts[k], &y = b.parts[k];
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.name, k <= 3 ? "crank" + std::to_string(k) : "coupler" + std::to_string(k - 4));
+    EXPECT_EQ(x.mass_source, y.mass_source);
+    EXPECT_EQ(x.mass.mass, y.mass.mass) << x.name;
+    EXPECT_EQ(x.mass.center.y, y.mass.center.y) << x.name;
+    EXPECT_EQ(x.mass.inertia, y.mass.inertia) << x.name;
+    EXPECT_EQ(x.colour, y.colour) << x.name;
+    EXPECT_EQ(x.frame.origin.r[0], y.frame.origin.r[0]) << x.name;
+    EXPECT_EQ(x.frame.x_toward.r[1], y.frame.x_toward.r[1]) << x.name;
+    ASSERT_EQ(x.shapes.size(), y.shapes.size());
+    if (!x.shapes.empty()) EXPECT_EQ(x.shapes[0].size.y, y.shapes[0].size.y) << x.name;
+  }
+  EXPECT_EQ(a.parts[2].mass.mass, 3.0);
+  EXPECT_NEAR(a.parts[6].mass.mass, 2700 * 1 * 0.06 * 0.01, 1e-12);  // coupler2's box, 0.02·3 wide
+  EXPECT_EQ(a.parts[6].frame.x_toward.r[0].coord(), a.model->coordinate_index("x3"));
+  EXPECT_NE(error_of(std::string(kFamilies) + "parts:\n  crank2: {frame: {origin: [2, 0], x: P2}}\n  for i in 0..N:\n" +
+                     "    \"crank{i}\": {frame: {origin: [i, 0], x: \"P{i}\"}}\n")
+                .find("parts.for i in 0..N[i=2].crank{i}: part 'crank2' is defined twice"),
+            std::string::npos);
 }
 
 TEST(SceneFamilies, NestedFamiliesExpandOuterIndexSlowest) {

@@ -15,27 +15,40 @@ namespace phiq::detail::scene {
 
 class PartReader {
  public:
-  explicit PartReader(const SceneReader& r) : r_(r) {}
+  explicit PartReader(SceneReader& r) : r_(r) {}
 
-  /// Appends the parts of `parts` (a map NAME: {body | frame, shapes, mass, ...}) to scene.parts.
-  void read_parts(const Cursor& c, Scene& scene) const;
+  /// Appends the parts of `parts` (a map NAME: {body | frame, shapes, mass, ...}, with families) to scene.parts.
+  void read_parts(const Cursor& c, Scene& scene);
   /// Reads `loads` (gravity, forces, torques, springs) into scene.loads; pre: the parts are read.
   void read_loads(const Cursor& c, Scene& scene) const;
 
  private:
-  // ---- parts (read_parts.cpp, read_shapes.cpp) ----------------------------------------------------------------
+  // ---- parts (read_parts.cpp, read_shapes.cpp): templates over the cursor, a plain entry or a family's member
   static bool frame_depends_on_time(const PartFrame& f);
-  void part_frame(const Cursor& v, const std::string& name, Part& part) const;
-  Attachment3 frame_toward(const Cursor& c, bool& is_point) const;
-  void points_or_expression_frame(const Cursor& f, Part& part) const;
-  std::shared_ptr<const CompiledExpression> slot_expression(const Cursor& c, const Slot& s) const;
-  void part_mass(const Cursor& v, Part& part) const;
-  MassProperties shapes_mass(const Cursor& c, const Part& part, double density) const;
-  std::array<double, 9> inertia_tensor(const Cursor& c) const;
-  std::array<double, 4> colour(const Cursor& c) const;
-  std::vector<kin3::V3> shape_points(const Cursor& c, std::size_t n, std::size_t least) const;
-  Shape read_shape(const Cursor& c) const;
-  void read_shape_size(const Cursor& c, Shape& s) const;
+  template <class C>
+  void read_part(const std::string& name, const C& v, Scene& scene) const;
+  template <class C>
+  void part_frame(const C& v, const std::string& name, Part& part) const;
+  template <class C>
+  Attachment3 frame_toward(const C& c, bool& is_point) const;
+  template <class C>
+  void points_or_expression_frame(const C& f, Part& part) const;
+  template <class C>
+  std::shared_ptr<const CompiledExpression> slot_expression(const C& c, const Slot& s) const;
+  template <class C>
+  void part_mass(const C& v, Part& part) const;
+  template <class C>
+  MassProperties shapes_mass(const C& c, const Part& part, double density) const;
+  template <class C>
+  std::array<double, 9> inertia_tensor(const C& c) const;
+  template <class C>
+  std::array<double, 4> colour(const C& c) const;
+  template <class C>
+  std::vector<kin3::V3> shape_points(const C& c, std::size_t n, std::size_t least) const;
+  template <class C>
+  Shape read_shape(const C& c) const;
+  template <class C>
+  void read_shape_size(const C& c, Shape& s) const;
 
   // ---- loads (read_loads.cpp) ---------------------------------------------------------------------------------
   PartFrame load_frame(const Cursor& c, const Scene& scene) const;
@@ -47,7 +60,7 @@ class PartReader {
   LinearSpring linear_spring(const Cursor& s, const Scene& scene, std::set<std::string>& names) const;
   TorsionalSpring torsional_spring(const Cursor& s, std::set<std::string>& names) const;
 
-  const SceneReader& r_;
+  SceneReader& r_;  // (not const: a family's walk keeps its state there)
 };
 
 }  // namespace phiq::detail::scene

@@ -203,7 +203,7 @@ void SceneReader::check_family_total(const Cursor& top) {
     if (!over && total > limits_.max_family_instances) over.emplace(mark, path);
   };
   auto family_key = [](const YAML::Node& key) { return key.IsScalar() && is_family_key(key.Scalar()); };
-  for (const char* section : {"coordinates", "points", "bodies", "vectors"}) {
+  for (const char* section : {"coordinates", "points", "bodies", "vectors", "parts"}) {
     const Cursor c = top.field(section);
     if (!c.present() || !c.is_map() || (!spatial_ && std::string(section) == "vectors")) continue;
     for (auto it = c.node().begin(); it != c.node().end(); ++it) {

@@ -3,8 +3,11 @@
 #include <Eigen/Eigenvalues>
 
 #include <cmath>
+#include <string>
+#include <unordered_set>
 
 #include "phiq/text.hpp"
+#include "scene/family_expansion.hpp"
 #include "scene/part_reader.hpp"
 
 namespace phiq::detail::scene {
@@ -16,27 +19,34 @@ constexpr double kSymmetryTolerance = 1e-9;
 
 }  // namespace
 
-void PartReader::read_parts(const Cursor& c, Scene& scene) const {
+void PartReader::read_parts(const Cursor& c, Scene& scene) {
   if (!c.is_map()) c.fail("parts is a map NAME: {body: B, shapes: [...], mass: ...}");
-  for (const Cursor::Entry& e : c.entries()) {
-    const Cursor& v = e.value;
-    if (!v.is_map()) v.fail("a part is a map {body: B | frame: {...}, shapes: [...], mass: ...}");
-    v.expect_map({"body", "frame", "colour", "shapes", "mass", "center_of_mass", "inertia", "density"});
-    for (const Part& p : scene.parts)
-      if (p.name == e.name) v.fail("part '" + e.name + "' is defined twice");
-    Part part;
-    part.name = e.name;
-    part_frame(v, e.name, part);
-    if (auto k = v.field("colour"); k.present()) part.colour = colour(k);
-    if (auto s = v.field("shapes"); s.present()) {
-      if (!s.is_sequence()) s.fail("shapes is a list of maps {type: box|cylinder|..., ...}");
-      for (const Cursor& item : s.items()) part.shapes.push_back(read_shape(item));
-    }
-    part_mass(v, part);
-    part.fixed = max_coordinate(part.frame) < 0 &&
-                 (part.frame.kind != PartFrameKind::kExpressions || !frame_depends_on_time(part.frame));
-    scene.parts.push_back(std::move(part));
+  std::unordered_set<std::string> names;
+  for (const Part& p : scene.parts) names.insert(p.name);
+  r_.reserve_ = [&](std::size_t more) { scene.parts.reserve(scene.parts.size() + more); };
+  r_.read_map(c.entries(), [&](const std::string& name, const auto& v) {
+    if (!names.insert(name).second) v.fail("part '" + name + "' is defined twice");
+    read_part(name, v, scene);
+  });
+  r_.reserve_ = nullptr;
+}
+
+template <class C>
+void PartReader::read_part(const std::string& name, const C& v, Scene& scene) const {
+  if (!v.is_map()) v.fail("a part is a map {body: B | frame: {...}, shapes: [...], mass: ...}");
+  v.expect_map({"body", "frame", "colour", "shapes", "mass", "center_of_mass", "inertia", "density"});
+  Part part;
+  part.name = name;
+  part_frame(v, name, part);
+  if (auto k = v.field("colour"); k.present()) part.colour = colour(k);
+  if (auto s = v.field("shapes"); s.present()) {
+    if (!s.is_sequence()) s.fail("shapes is a list of maps {type: box|cylinder|..., ...}");
+    for (const C& item : s.items()) part.shapes.push_back(read_shape(item));
   }
+  part_mass(v, part);
+  part.fixed = max_coordinate(part.frame) < 0 &&
+               (part.frame.kind != PartFrameKind::kExpressions || !frame_depends_on_time(part.frame));
+  scene.parts.push_back(std::move(part));
 }
 
 bool PartReader::frame_depends_on_time(const PartFrame& f) {
@@ -47,7 +57,8 @@ bool PartReader::frame_depends_on_time(const PartFrame& f) {
 
 // The part's frame: `body: B` (default: the body named as the part), `frame: {origin: P, x: Q|u, y: R|v}` (natural
 // coordinates), or `frame: {at: P | [x, y(, z)], angle: A, axis: [..]}` (expressions of the coordinates).
-void PartReader::part_frame(const Cursor& v, const std::string& name, Part& part) const {
+template <class C>
+void PartReader::part_frame(const C& v, const std::string& name, Part& part) const {
   const auto body = v.field("body");
   const auto frame = v.field("frame");
   if (body.present() && frame.present()) frame.fail("a part is on a body or has a frame of its own, not both");
@@ -60,7 +71,7 @@ void PartReader::part_frame(const Cursor& v, const std::string& name, Part& part
     v.fail("'" + name + "' is no body: give the part `body: B`, or its own `frame: {...}`");
   }
   part.body = b;
-  const Cursor where = body.present() ? body : v;
+  const C where = body.present() ? body : v;
   if (r_.spatial_) {
     part.frame.kind = PartFrameKind::kSpatialBody;
     part.frame.spatial = b == kGround ? Frame3::ground() : r_.names_.bodies3[r_.entry_at(where, b, r_.names_.bodies3)];
@@ -71,7 +82,8 @@ void PartReader::part_frame(const Cursor& v, const std::string& name, Part& part
 }
 
 // An attachment a frame's axis points along: a point (a name or inline), or in space a natural unit vector's name.
-Attachment3 PartReader::frame_toward(const Cursor& c, bool& is_point) const {
+template <class C>
+Attachment3 PartReader::frame_toward(const C& c, bool& is_point) const {
   is_point = true;
   if (r_.spatial_) {
     if (c.is_scalar() && r_.entry_at(c, c.text(), r_.names_.vectors) >= 0) {
@@ -84,7 +96,8 @@ Attachment3 PartReader::frame_toward(const Cursor& c, bool& is_point) const {
   return Attachment3::natural(Point3{p.x, p.y, Slot::constant(0.0)});
 }
 
-void PartReader::points_or_expression_frame(const Cursor& f, Part& part) const {
+template <class C>
+void PartReader::points_or_expression_frame(const C& f, Part& part) const {
   if (!f.is_map()) f.fail("a frame is {origin: P, x: Q, y: R} (points, vectors) or {at: P, angle: A} (expressions)");
   PartFrame& pf = part.frame;
   if (f.field("origin").present()) {
@@ -129,7 +142,8 @@ void PartReader::points_or_expression_frame(const Cursor& f, Part& part) const {
 }
 
 // A slot as an expression: a coordinate's name, or its constant.
-std::shared_ptr<const CompiledExpression> PartReader::slot_expression(const Cursor& c, const Slot& s) const {
+template <class C>
+std::shared_ptr<const CompiledExpression> PartReader::slot_expression(const C& c, const Slot& s) const {
   const std::string text = s.is_coordinate() ? r_.builder_.coordinate_name(s.coord()) : shortest(s.value());
   try {
     return CompiledExpression::compile(text, r_.resolver(true, text), true);
@@ -140,7 +154,8 @@ std::shared_ptr<const CompiledExpression> PartReader::slot_expression(const Curs
 
 // `mass` with `center_of_mass` and `inertia` (planar: Izz about the centre; spatial: [Ixx, Iyy, Izz], six values
 // [Ixx, Iyy, Izz, Ixy, Ixz, Iyz] or a 3×3 matrix, about the centre in body axes), or `density` over the shapes.
-void PartReader::part_mass(const Cursor& v, Part& part) const {
+template <class C>
+void PartReader::part_mass(const C& v, Part& part) const {
   const auto mass = v.field("mass"), density = v.field("density");
   const auto com = v.field("center_of_mass"), inertia = v.field("inertia");
   if (mass.present() && density.present()) density.fail("give a part's mass or its density, not both");
@@ -171,7 +186,8 @@ void PartReader::part_mass(const Cursor& v, Part& part) const {
 }
 
 // The mass properties of the part's solid shapes at `density`, refused at `c` when it has none with a volume.
-MassProperties PartReader::shapes_mass(const Cursor& c, const Part& part, double density) const {
+template <class C>
+MassProperties PartReader::shapes_mass(const C& c, const Part& part, double density) const {
   std::vector<MassProperties> each;
   for (std::size_t k = 0; k < part.shapes.size(); ++k) {
     const Shape& s = part.shapes[k];
@@ -190,7 +206,8 @@ MassProperties PartReader::shapes_mass(const Cursor& c, const Part& part, double
 
 // A stated inertia tensor, checked symmetric and positive definite, with the triangle inequality of its principal
 // moments (a physical body: each at most the sum of the other two).
-std::array<double, 9> PartReader::inertia_tensor(const Cursor& c) const {
+template <class C>
+std::array<double, 9> PartReader::inertia_tensor(const C& c) const {
   std::array<double, 9> I{};
   if (!r_.spatial_) {
     I[8] = r_.positive(c);  // Izz; a planar body turns about z only

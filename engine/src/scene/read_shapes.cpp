@@ -31,7 +31,8 @@ RotationMatrix about_z(double a) {
 }  // namespace
 
 // `colour: [r, g, b]` or `[r, g, b, a]`, each in [0, 1], or "#rrggbb".
-std::array<double, 4> PartReader::colour(const Cursor& c) const {
+template <class C>
+std::array<double, 4> PartReader::colour(const C& c) const {
   std::array<double, 4> rgba{0, 0, 0, 1};
   if (c.is_scalar()) {
     const std::string s = c.text();
@@ -52,17 +53,19 @@ std::array<double, 4> PartReader::colour(const Cursor& c) const {
 }
 
 // A list of `n`-component points ([x, y] or [x, y, z]) of at least `least` entries.
-std::vector<kin3::V3> PartReader::shape_points(const Cursor& c, std::size_t n, std::size_t least) const {
+template <class C>
+std::vector<kin3::V3> PartReader::shape_points(const C& c, std::size_t n, std::size_t least) const {
   if (!c.is_sequence() || c.size() < least) c.fail("expected a list of at least " + std::to_string(least) + " points");
   std::vector<kin3::V3> out;
-  for (const Cursor& p : c.items()) {
+  for (const C& p : c.items()) {
     const std::vector<double> v = r_.numbers(p, n);
     out.push_back({v[0], v[1], n == 3 ? v[2] : 0.0});
   }
   return out;
 }
 
-Shape PartReader::read_shape(const Cursor& c) const {
+template <class C>
+Shape PartReader::read_shape(const C& c) const {
   if (!c.is_map()) c.fail("a shape is a map {type: box|cylinder|..., ...}");
   const std::string type = c.require("type").text();
   const ShapeKind* kind = nullptr;
@@ -118,7 +121,8 @@ Shape PartReader::read_shape(const Cursor& c) const {
 }
 
 // The fields that size the shape `s` (its kind already set).
-void PartReader::read_shape_size(const Cursor& c, Shape& s) const {
+template <class C>
+void PartReader::read_shape_size(const C& c, Shape& s) const {
   switch (s.kind) {
     case ShapeKind::kBox: {
       const auto size = c.require("size");
@@ -168,5 +172,10 @@ void PartReader::read_shape_size(const Cursor& c, Shape& s) const {
     }
   }
 }
+
+template std::array<double, 4> PartReader::colour(const Cursor&) const;
+template std::array<double, 4> PartReader::colour(const TCursor&) const;
+template Shape PartReader::read_shape(const Cursor&) const;
+template Shape PartReader::read_shape(const TCursor&) const;
 
 }  // namespace phiq::detail::scene
