@@ -104,8 +104,8 @@ TEST(SceneFamilies, PartsFromFamiliesAreThePartsListed) {
   std::string listed = std::string(kFamilies) + "parts:\n";
   for (int i = 0; i <= 3; ++i)
     listed += "  crank" + std::to_string(i) + ": {frame: {origin: [" + std::to_string(i) + ", 0], x: P" +
-              std::to_string(i) + "}, mass: " + std::to_string(1 + i) + ", center_of_mass: [0.5, " +
-              shortest(0.1 * i) + "], inertia: " + shortest(0.1 * (i + 1)) + ", colour: [0, 0, 1]}\n";
+              std::to_string(i) + "}, mass: " + std::to_string(1 + i) + ", center_of_mass: [0.5, " + shortest(0.1 * i) +
+              "], inertia: " + shortest(0.1 * (i + 1)) + ", colour: [0, 0, 1]}\n";
   for (int i = 0; i < 3; ++i)
     listed += "  coupler" + std::to_string(i) + ": {frame: {origin: P" + std::to_string(i) + ", x: P" +
               std::to_string(i + 1) + "}, density: 2700, shapes: [{type: box, size: [1, " + shortest(0.02 * (i + 1)) +

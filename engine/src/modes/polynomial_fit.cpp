@@ -104,12 +104,16 @@ Eigen::VectorXd ModelPolynomials::coordinates(const Eigen::VectorXcd& x) const {
 
 namespace {
 
-// Rows the time has taken beyond what doubles resolve of their coordinates, at the initial positions: not finite,
-// or above 1e11 times the row's scale (its rounding 1e-5 of a unit; a decade below where a unit step of a coordinate
-// changes the row by less than the 1e-12 of its size that affine_row() resolves), where they were not at the
-// time-domain point nearest 0. That is a law that overflows or runs away (a linear driver at t = 1e308 or 1e20),
-// which the fit below would call not polynomial, or whose paths would all fail.
-void check_rows_resolved_at(const Model& model, double t) {
+// The time's checks, before the fit blames a constraint for it: finite (else every driver is "not polynomial"),
+// within the drivers' domain, and no row taken by it beyond what doubles resolve of its coordinates at the initial
+// positions: not finite, or above 1e11 times its scale (its rounding 1e-5 of a unit; a decade below where a unit
+// step of a coordinate changes the row by less than the 1e-12 of its size that affine_row() resolves) where it is
+// not at the time-domain point nearest 0. That is a law that overflows or runs away (a linear driver at t = 1e308
+// or 1e20), which the fit would call not polynomial, or whose paths would all fail.
+void check_time(const Model& model, double t) {
+  if (!std::isfinite(t)) throw Error("ModesOptions: time " + shortest(t) + " is not finite");
+  if (t < model.time_domain_begin() || t > model.time_domain_end())
+    throw Error("ModesOptions: driver '" + model.time_domain_limiter() + "' is not defined at t = " + shortest(t));
   const double reference = std::clamp(0.0, model.time_domain_begin(), model.time_domain_end());
   const Eigen::VectorXd q = model.initial_positions();
   std::vector<double> at_t(static_cast<std::size_t>(model.num_equations())), at_reference(at_t.size());
@@ -129,14 +133,9 @@ void check_rows_resolved_at(const Model& model, double t) {
 }  // namespace
 
 ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& options) {
-  // (a time that is not finite made every driver "not polynomial", which blamed the constraint for the time)
-  if (!std::isfinite(options.time)) throw Error("ModesOptions: time " + shortest(options.time) + " is not finite");
-  if (options.time < model.time_domain_begin() || options.time > model.time_domain_end())
-    throw Error("ModesOptions: driver '" + model.time_domain_limiter() + "' is not defined at t = " +
-                shortest(options.time));
+  check_time(model, options.time);
   ModelPolynomials out;
   const Index n = model.num_coordinates(), m = model.num_equations();
-  check_rows_resolved_at(model, options.time);
   Random random(options.seed ^ 0x5DEECE66Dull);
   ModelRows eval(model, options.time);
   out.origin = model.initial_positions();
