@@ -1,10 +1,15 @@
 // Indexed families in scenes (`for i in A..B`): they expand to the model listed one by one (nested, in equations,
-// drivers, laws, parameters and parts, empty or bounded by enclosing indices), and malformed families, collisions,
-// shadowing index names and families over the size limit are one-line errors naming the member. Separate from
-// test_scene.cpp, which loads scenes written entry by entry.
+// drivers, laws, parameters and parts, empty or bounded by enclosing indices; parts on one mesh share it), and
+// malformed families, collisions, shadowing index names and families over the size limit are one-line errors naming
+// the member. Separate from test_scene.cpp, which loads scenes written entry by entry.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <string>
+
+#include <unistd.h>
 
 #include "phiq/phiq.hpp"
 #include "phiq/text.hpp"
@@ -134,6 +139,29 @@ TEST(SceneFamilies, PartsFromFamiliesAreThePartsListed) {
                      "    \"crank{i}\": {frame: {origin: [i, 0], x: \"P{i}\"}}\n")
                 .find("parts.for i in 0..N[i=2].crank{i}: part 'crank2' is defined twice"),
             std::string::npos);
+}
+
+// A family of parts on one mesh file reads it once: every member shares the mesh (10⁴ links, one STL parsed); another
+// scale of the same file is a mesh of its own.
+TEST(SceneFamilies, PartsOnOneMeshShareIt) {
+  const std::filesystem::path stl =
+      std::filesystem::temp_directory_path() / ("phiq_family_mesh_" + std::to_string(::getpid()) + ".stl");
+  std::ofstream(stl) << "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                        "endloop\nendfacet\nendsolid t\n";
+  const std::string mesh = "{type: mesh, file: \"" + stl.string() + "\"";
+  const Scene s = parse_scene(std::string(kFamilies) + "parts:\n  for i in 0..N:\n    \"crank{i}\": {frame: {origin: " +
+                                  "[i, 0], x: \"P{i}\"}, shapes: [" + mesh +
+                                  "}]}\n  big: {frame: {origin: P0, x: " + "P1}, shapes: [" + mesh + ", scale: 2}]}\n",
+                              "families.yaml");
+  std::filesystem::remove(stl);
+  ASSERT_EQ(s.parts.size(), 5u);
+  for (const Part& p : s.parts) ASSERT_TRUE(p.shapes.at(0).mesh) << p.name;
+  for (std::size_t k = 1; k < 4; ++k) EXPECT_EQ(s.parts[k].shapes[0].mesh, s.parts[0].shapes[0].mesh) << k;
+  EXPECT_NE(s.parts[4].shapes[0].mesh, s.parts[0].shapes[0].mesh);
+  EXPECT_EQ(s.parts[0].shapes[0].mesh.use_count(), 4);
+  double widest = 0.0;  // (1, 0, 0) scaled by 2
+  for (const kin3::V3& v : s.parts[4].shapes[0].mesh->vertices) widest = std::max(widest, v.x);
+  EXPECT_EQ(widest, 2.0);
 }
 
 TEST(SceneFamilies, NestedFamiliesExpandOuterIndexSlowest) {

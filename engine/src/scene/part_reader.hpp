@@ -1,9 +1,10 @@
 // PartReader: the `parts` and `loads` sections of a scene (read_parts.cpp, read_shapes.cpp, read_loads.cpp), read
 // once the model's constraints are, in the vocabulary of the SceneReader that read them: its names of bodies, points
-// and joints, its numbers and expressions. It holds nothing of its own.
+// and joints, its numbers and expressions. It holds only the meshes it has read, each file once.
 #pragma once
 
 #include <array>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
@@ -61,6 +62,8 @@ class PartReader {
   TorsionalSpring torsional_spring(const Cursor& s, std::set<std::string>& names) const;
 
   SceneReader& r_;  // (not const: a family's walk keeps its state there)
+  // the meshes read so far, by file (as written, joined to the scene's folder) and scale
+  mutable std::map<std::pair<std::string, double>, std::shared_ptr<const TriangleMesh>> meshes_;
 };
 
 }  // namespace phiq::detail::scene

@@ -163,11 +163,14 @@ void PartReader::read_shape_size(const C& c, Shape& s) const {
       // relative to the scene's folder, as a user writes it beside the scene
       std::filesystem::path p(s.file);
       if (p.is_relative()) p = std::filesystem::path(r_.file_).parent_path() / p;
+      // one read per file and scale: a family of parts on one mesh shares it (10⁴ links, one STL read)
+      std::shared_ptr<const TriangleMesh>& mesh = meshes_[{p.lexically_normal().string(), s.scale}];
       try {
-        s.mesh = std::make_shared<const TriangleMesh>(load_mesh_file(p.string(), s.scale));
+        if (!mesh) mesh = std::make_shared<const TriangleMesh>(load_mesh_file(p.string(), s.scale));
       } catch (const Error& e) {
         f.fail(e.what());
       }
+      s.mesh = mesh;
       break;
     }
   }
