@@ -117,6 +117,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   }
   // the parts with mass, without their shapes (a mesh's triangles are not read by the dynamics)
   auto massive = std::make_shared<std::vector<Part>>();
+  massive->reserve(scene.parts.size());
   for (const Part& p : scene.parts)
     if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0) {
       massive->push_back(p);

@@ -5,8 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
+#include <functional>
 #include <limits>
+#include <unordered_map>
 
 #include "phiq/constraint_block.hpp"
 #include "phiq/inverse_dynamics.hpp"
@@ -34,11 +35,14 @@ std::array<double, 6> point_key(const Attachment3& a) {
   return k;
 }
 
-bool moves(const PartFrame& f) {
-  std::vector<Index> c;
-  frame_coordinates(f, c);
-  return !c.empty();
-}
+// A point_key()'s hash: its bits, mixed.
+struct PointKeyHash {
+  std::size_t operator()(const std::array<double, 6>& k) const {
+    std::size_t h = 0;
+    for (double v : k) h = h * 1000003u ^ std::hash<double>{}(v);
+    return h;
+  }
+};
 
 }  // namespace
 
@@ -48,9 +52,10 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
   NaturalJoints out;
   out.spatial = spatial;
   const int dimension = spatial ? 3 : 2;
+  out.bodies.reserve(parts.size());
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const Part& p = parts[i];
-    if (p.frame.kind != PartFrameKind::kPoints || !moves(p.frame)) continue;
+    if (p.frame.kind != PartFrameKind::kPoints || max_coordinate(p.frame) < 0) continue;  // (a frame that moves)
     NaturalBody b;
     b.name = p.name, b.part = i;
     b.frame = p.frame;
@@ -89,7 +94,8 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
     }
     out.bodies.push_back(std::move(b));
   }
-  std::map<std::array<double, 6>, std::vector<std::size_t>> held_by;  // a frame's point → its bodies, in order
+  // a frame's point → its bodies, in order
+  std::unordered_map<std::array<double, 6>, std::vector<std::size_t>, PointKeyHash> held_by(2 * out.bodies.size());
   for (std::size_t b = 0; b < out.bodies.size(); ++b) {
     PartFrame f = out.bodies[b].frame;
     for (Attachment3* a : frame_points(f)) {
