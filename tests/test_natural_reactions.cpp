@@ -84,9 +84,10 @@ std::string natural_reactions_part(const char* name, int k, double centre, const
   return s.str();
 }
 
-Scene natural_four_bar() {
+// `first`: parts listed before the links (a massless one shifts their indices among the parts with mass).
+Scene natural_four_bar(const std::string& first = "") {
   std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
-  text += "parts:\n" + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +
+  text += "parts:\n" + first + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +
           natural_reactions_part("coupler", 1, 0.6, "frame: {origin: A, x: B}, ") +
           natural_reactions_part("rocker", 2, 0.5, "frame: {origin: C, x: B}, ") + natural_reactions_loads(0.6, 0.5) +
           "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
@@ -229,6 +230,38 @@ TEST(NaturalReactions, BodyForcesFromTheModelsQAreTheBodiesOwnBitForBit) {
       EXPECT_NEAR(shifted[3 * j], general[3 * j] - 1.0, 1e-9 * (1 + std::fabs(general[3 * j]))) << j << ", " << k;
     for (std::size_t j : {1u, 2u}) EXPECT_EQ(shifted[3 * j], general[3 * j]) << j << ", " << k;
   }
+}
+
+// A massless part listed before the links (a housing drawn on ground) leaves them at other indices among the
+// efforts' parts (those with mass): their forces are still read from the sweep's Q, as a shifted PlanarForce shows
+// at O and C, and the reactions are the same.
+TEST(NaturalReactions, AMasslessPartBeforeTheLinksLeavesTheirForcesReadFromQ) {
+  const Scene s = natural_four_bar("  housing: {body: ground, shapes: [{type: box, size: [0.1, 0.1, 0.1]}]}\n");
+  const Scene plain = natural_four_bar();
+  ASSERT_EQ(s.parts.size(), 4u);
+  ASSERT_EQ(s.sweep.efforts.parts->size(), 3u);            // the housing has no mass
+  EXPECT_EQ(s.sweep.efforts.natural->bodies[0].part, 1u);  // the crank, after the housing, among all the parts
+  const NaturalRows rows = natural_reactions_sweep(s), same = natural_reactions_sweep(plain);
+  ASSERT_EQ(rows.values.size(), same.values.size());
+  for (std::size_t k = 0; k < rows.values.size(); ++k) EXPECT_EQ(rows.values[k], same.values[k]) << k;
+  const Model& m = *s.model;
+  const OutputEfforts& e = s.sweep.efforts;
+  JointReactions reactions(m, e);
+  const detail::PartForces forces(*e.parts);
+  Workspace ws(m);
+  const std::size_t k = 5, n = static_cast<std::size_t>(reactions.size());
+  const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data();
+  Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), lambda;
+  std::vector<detail::PlanarForce> planar(e.parts->size());
+  forces.add(*e.parts, *e.loads, q, qd, qdd, rows.t[k], Q, planar.data());
+  ws.q = rows.q[k];
+  ASSERT_EQ(constraint_multipliers(m, rows.t[k], ws, Q, lambda), SolveStatus::kSuccess);
+  std::vector<double> general(n), shifted(n);
+  reactions.evaluate(q, qd, qdd, rows.t[k], lambda, general.data());
+  for (detail::PlanarForce& f : planar) f.fx += 1.0;
+  reactions.evaluate(q, qd, qdd, rows.t[k], lambda, shifted.data(), planar.data());
+  for (std::size_t j : {0u, 3u})
+    EXPECT_NEAR(shifted[3 * j], general[3 * j] - 1.0, 1e-9 * (1 + std::fabs(general[3 * j])));
 }
 
 // An nfourbar in natural coordinates (cranks from G{i} to P{i}, couplers P{i} to P{i+1}) with random masses,

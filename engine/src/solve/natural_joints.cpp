@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <string_view>
 #include <unordered_map>
 
 #include "phiq/constraint_block.hpp"
@@ -155,20 +156,31 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
   if (!efforts.parts || !efforts.loads) return;
   const std::vector<Part>& parts = *efforts.parts;
   const kin3::V3 g = efforts.loads->gravity;
+  // A body's part among the efforts' parts: at its own index when they are the parts it was found among, else by
+  // name (a scene's efforts keep the parts with mass only: a massless part before it shifts every index).
+  std::unordered_map<std::string_view, std::size_t> by_name;
+  auto part_of = [&](const NaturalBody& body) {
+    if (body.part < parts.size() && parts[body.part].name == body.name) return body.part;
+    if (by_name.empty())
+      for (std::size_t i = 0; i < parts.size(); ++i) by_name.emplace(parts[i].name, i);
+    const auto it = by_name.find(body.name);
+    return it == by_name.end() ? BodyPart::kNone : it->second;
+  };
   for (std::size_t b = 0; b < bodies.size(); ++b) {
     const NaturalBody& body = bodies[b];
     const kin3::V3 own_g = body.loads.gravity;
-    if (body.parts.size() != 1 || body.part >= parts.size() || !detail::has_mass(body.parts[0]) ||
-        !detail::has_mass(parts[body.part]) || !same_bits(g.x, own_g.x) || !same_bits(g.y, own_g.y) ||
+    const std::size_t index = part_of(body);
+    if (body.parts.size() != 1 || index == BodyPart::kNone || !detail::has_mass(body.parts[0]) ||
+        !detail::has_mass(parts[index]) || !same_bits(g.x, own_g.x) || !same_bits(g.y, own_g.y) ||
         !same_bits(g.z, own_g.z))
       continue;
     const detail::MassivePart own = detail::massive_part(body.parts[0], 0);
-    if (!same_planar_force(detail::massive_part(parts[body.part], body.part), own, natural_->promoted,
+    if (!same_planar_force(detail::massive_part(parts[index], index), own, natural_->promoted,
                            model.num_coordinates()) ||
         own.frame.body)
       continue;
     BodyPart& bp = body_parts_[b];
-    bp.part = body.part, bp.x_is_point = own.frame.x_is_point, bp.applied = body.loads.applied.get();
+    bp.part = index, bp.x_is_point = own.frame.x_is_point, bp.applied = body.loads.applied.get();
     std::copy(own.frame.slots, own.frame.slots + 5, bp.slots);
   }
 }
