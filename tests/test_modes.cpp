@@ -333,5 +333,35 @@ TEST(ModesDeterminism, OneAndTwoThreadsGiveTheSameBits) {
   }
 }
 
+// A row of degree 4 in twelve coordinates, each of degree 1 in it: its 1 820 monomials of degree ≤ 4 are past what a
+// fit takes (1 500), the 794 multilinear ones are not. The fit finds each coordinate's own degree first and fits
+// those: x1 = … = x12 = x with 3 x⁴ = 3, two real modes at ±1 and two complex (±i) of four paths.
+TEST(ModesScene, AMultilinearRowOfTwelveCoordinatesIsFitted) {
+  std::string text = "phiq: 1\nname: multilinear\ncoordinates: {";
+  for (int i = 1; i <= 12; ++i) text += (i > 1 ? ", x" : "x") + std::to_string(i) + ": 0.9";
+  text +=
+      "}\nconstraints:\n  - {name: product, type: equation, "
+      "expr: \"x1*x2*x3*x4 + x5*x6*x7*x8 + x9*x10*x11*x12 - 3\"}\n";
+  for (int i = 2; i <= 12; ++i)
+    text += "  - {name: same" + std::to_string(i) + ", type: equation, expr: \"x" + std::to_string(i) + " - x" +
+            std::to_string(i - 1) + "\", unit: length}\n";
+  text += "time: {start: 0, end: 1, steps: 1}\n";
+  const Scene scene = parse_scene(text, "multilinear.yaml");
+  const AssemblyModes r = find_assembly_modes(*scene.model, {});
+  ASSERT_EQ(r.summary.status, ModesStatus::kSuccess) << r.summary.message;
+  EXPECT_EQ(r.summary.paths, 4);
+  EXPECT_EQ(r.summary.real, 2);
+  EXPECT_EQ(r.summary.complex, 2);
+  ASSERT_EQ(r.modes.size(), 2u);
+  std::vector<double> signs;
+  for (const AssemblyMode& m : r.modes) {
+    ASSERT_EQ(m.q.size(), 12);
+    for (Index j = 0; j < 12; ++j) EXPECT_NEAR(m.q(j), m.q(0), 1e-12);
+    EXPECT_NEAR(std::abs(m.q(0)), 1.0, 1e-12);
+    signs.push_back(m.q(0));
+  }
+  EXPECT_LT(signs[0] * signs[1], 0.0);
+}
+
 }  // namespace
 }  // namespace phiq

@@ -4,7 +4,8 @@
 /// says which one the placement assembles into.
 ///
 /// The method. Each row of Φ is recovered as a polynomial in the coordinates it reads (find_polynomial_system():
-/// the coefficients of every monomial up to degree 4 fitted by least squares to evaluations of the row, and checked
+/// the coefficients of every monomial up to degree 4 (each coordinate within its own degree in the row, when the
+/// monomials are many) fitted by least squares to evaluations of the row, and checked
 /// on fresh points), angle coordinates entering through (c, s) = (cos θ, sin θ) with c² + s² = 1; a row no
 /// polynomial reproduces (a cam, a spline, exp) is refused with its constraint named. Rows affine in what they
 /// read are eliminated first: those that fix one coordinate (drivers, a polar's arm at a driven angle), then sets

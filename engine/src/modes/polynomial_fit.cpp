@@ -30,19 +30,22 @@ struct RowCoordinate {
 };
 
 // Every exponent vector over `width` local variables with total degree ≤ d, the s of each angle pair (flagged in
-// `second_of_pair`) at most 1.
-void monomials(int width, int d, const std::vector<bool>& second_of_pair, std::vector<std::vector<int>>& out,
-               std::vector<int>& current, int at, int left) {
+// `second_of_pair`) at most 1 and, where `caps` is not empty, each variable's group (a scaled coordinate, or the pair
+// (c, s) of an angle, whose exponents add up) at most its cap.
+void monomials(int width, const std::vector<bool>& second_of_pair, const std::vector<int>& caps,
+               std::vector<std::vector<int>>& out, std::vector<int>& current, int at, int left) {
   if (at == width) {
     out.push_back(current);
     return;
   }
-  const int top = second_of_pair[static_cast<std::size_t>(at)] ? std::min(1, left) : left;
+  const std::size_t a = static_cast<std::size_t>(at);
+  int top = second_of_pair[a] ? std::min(1, left) : left;
+  if (!caps.empty()) top = std::min(top, caps[a] - (second_of_pair[a] ? current[a - 1] : 0));
   for (int e = 0; e <= top; ++e) {
-    current[static_cast<std::size_t>(at)] = e;
-    monomials(width, d, second_of_pair, out, current, at + 1, left - e);
+    current[a] = e;
+    monomials(width, second_of_pair, caps, out, current, at + 1, left - e);
   }
-  current[static_cast<std::size_t>(at)] = 0;
+  current[a] = 0;
 }
 
 constexpr int kMaxMonomials = 1500;     // a row of more terms than this is refused (fitting it would take minutes)
@@ -130,6 +133,169 @@ void check_time(const Model& model, double t) {
   }
 }
 
+// Above this many monomials of one degree, a row's fit first finds each read coordinate's own degree and fits only
+// the monomials those allow (a spatial chain's row is a product of one pair (c, s) per joint: of degree 1 in each,
+// 3^k monomials against the C(2k + d, d) of every degree-d one). Smaller rows fit every monomial, which costs less
+// than the probes.
+constexpr std::size_t kBoundDegreesAbove = 64;
+
+// Row r in the local variables of the coordinates it reads (`reads`: a scaled variable, or the pair (c, s) of an
+// angle), fitted by least squares on random points and accepted when it reproduces the row on fresh points to
+// kFitTolerance of the largest value sampled.
+class RowFitter {
+ public:
+  enum class Result { kFitted, kVanishes, kNotPolynomial };
+
+  RowFitter(ModelRows& eval, Index r, const std::vector<RowCoordinate>& reads, const std::vector<bool>& second,
+            const ModelPolynomials& out, const Eigen::VectorXd& base, Random& random, double row_scale)
+      : eval_(eval),
+        r_(r),
+        reads_(reads),
+        second_(second),
+        out_(out),
+        q_(base),
+        random_(random),
+        row_scale_(row_scale),
+        width_(static_cast<int>(second.size())) {}
+
+  // The lowest degree ≤ max_degree at which the row fits, its monomials in `basis` and their coefficients.
+  Result fit(int max_degree, std::vector<std::vector<int>>& basis, Eigen::VectorXd& coefficients) {
+    std::vector<int> caps;  // each local variable's group's degree, once the monomials grow past kBoundDegreesAbove
+    int highest = 0, total = 0;
+    for (int d = (width_ == 0 ? 0 : 1); d <= max_degree; ++d) {
+      basis.clear();
+      std::vector<int> current(static_cast<std::size_t>(width_), 0);
+      monomials(width_, second_, caps, basis, current, 0, d);
+      if (caps.empty() && basis.size() > kBoundDegreesAbove) {
+        if (!group_degrees(max_degree, caps, highest, total)) return Result::kNotPolynomial;
+        // no polynomial of total degree below the highest read's has it; at the degrees' sum the caps allow all
+        d = std::clamp(d, highest, total);
+        basis.clear();
+        monomials(width_, second_, caps, basis, current, 0, d);
+      }
+      if (basis.size() > static_cast<std::size_t>(kMaxMonomials)) return Result::kNotPolynomial;
+      switch (fit_basis(basis, -1, coefficients)) {
+        case Fit::kFits:
+          return Result::kFitted;
+        case Fit::kVanishes:
+          return Result::kVanishes;
+        case Fit::kNotFinite:
+          return Result::kNotPolynomial;
+        case Fit::kNoFit:
+          if (!caps.empty() && d >= total) return Result::kNotPolynomial;  // the caps' whole box did not reproduce it
+          continue;
+      }
+    }
+    return Result::kNotPolynomial;
+  }
+
+ private:
+  enum class Fit { kFits, kVanishes, kNoFit, kNotFinite };
+
+  // One sample: the local variables of read `only` (every read when only < 0) drawn afresh, angles uniformly on the
+  // circle and scaled variables in [−1, 1], the others kept in `local` and q_; the row there.
+  double sample(Eigen::VectorXd& local, int only) {
+    int k = 0;
+    for (std::size_t g = 0; g < reads_.size(); ++g) {
+      const RowCoordinate& c = reads_[g];
+      const bool draw = only < 0 || static_cast<std::size_t>(only) == g;
+      if (c.angle) {
+        if (draw) {
+          const double theta = std::numbers::pi * random_.symmetric();
+          local(k) = std::cos(theta), local(k + 1) = std::sin(theta);
+          q_(c.coordinate) = theta;
+        }
+        k += 2;
+      } else {
+        if (draw) {
+          local(k) = random_.symmetric();
+          q_(c.coordinate) = out_.origin(c.coordinate) + out_.scale(c.coordinate) * local(k);
+        }
+        ++k;
+      }
+    }
+    return eval_.row(q_, r_);
+  }
+
+  // The design matrix of `basis` at `points` samples (of read `only`, from local_ and q_ as they are) and the row.
+  bool design(const std::vector<std::vector<int>>& basis, int points, int only, Eigen::MatrixXd& a,
+              Eigen::VectorXd& b) {
+    const int count = static_cast<int>(basis.size());
+    a.resize(points, count), b.resize(points);
+    Eigen::VectorXd local = only < 0 ? Eigen::VectorXd(width_) : local_;
+    for (int i = 0; i < points; ++i) {
+      b(i) = sample(local, only);
+      for (int k = 0; k < count; ++k) {
+        double v = 1.0;
+        for (int w = 0; w < width_; ++w)
+          for (int e = 0; e < basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w)]; ++e) v *= local(w);
+        a(i, k) = v;
+      }
+    }
+    return b.allFinite();
+  }
+
+  // Least squares over `basis` on 2·count + 8 samples, checked on count + 8 fresh ones. Its monomials in the normal
+  // form are independent functions, so the design has full column rank at random points: Householder QR without
+  // pivoting, which Eigen blocks (its column-pivoting QR is not).
+  Fit fit_basis(const std::vector<std::vector<int>>& basis, int only, Eigen::VectorXd& coefficients) {
+    const int count = static_cast<int>(basis.size());
+    Eigen::MatrixXd a, a2;
+    Eigen::VectorXd b, b2;
+    if (!design(basis, 2 * count + 8, only, a, b)) return Fit::kNotFinite;
+    coefficients = a.householderQr().solve(b);
+    if (!design(basis, count + 8, only, a2, b2)) return Fit::kNotFinite;
+    const double size = std::max(b.cwiseAbs().maxCoeff(), b2.cwiseAbs().maxCoeff());
+    const double error = (a2 * coefficients - b2).cwiseAbs().maxCoeff();
+    if (size <= 1e-12 * row_scale_) return Fit::kVanishes;  // holds wherever the fixed ones put it: no equation
+    return error <= kFitTolerance * size || size == 0.0 ? Fit::kFits : Fit::kNoFit;
+  }
+
+  // Each read's degree in the row at one random point of the others (the degree of a polynomial in one group of
+  // variables, everywhere but on a set of measure zero): the lowest whose monomials in that group alone reproduce
+  // the row along it. Sets `caps` per local variable, the highest and their sum; false when a read has none ≤
+  // max_degree (nor has the row, then).
+  bool group_degrees(int max_degree, std::vector<int>& caps, int& highest, int& total) {
+    local_.resize(width_);
+    sample(local_, -1);
+    const Eigen::VectorXd anchor = q_;
+    std::vector<int> caps_of(static_cast<std::size_t>(width_), 0);
+    int k = 0;
+    for (std::size_t g = 0; g < reads_.size(); ++g) {
+      const int size = reads_[g].angle ? 2 : 1;
+      int degree = -1;
+      for (int d = 0; d <= max_degree && degree < 0; ++d) {
+        std::vector<int> only_here(static_cast<std::size_t>(width_), 0), current(only_here.size(), 0);
+        for (int i = k; i < k + size; ++i) only_here[static_cast<std::size_t>(i)] = d;
+        std::vector<std::vector<int>> basis;
+        monomials(width_, second_, only_here, basis, current, 0, d);
+        Eigen::VectorXd coefficients;
+        const Fit f = fit_basis(basis, static_cast<int>(g), coefficients);
+        q_ = anchor;
+        if (f == Fit::kNotFinite) return false;
+        if (f != Fit::kNoFit) degree = d;
+      }
+      if (degree < 0) return false;
+      for (int i = k; i < k + size; ++i) caps_of[static_cast<std::size_t>(i)] = degree;
+      highest = std::max(highest, degree), total += degree;
+      k += size;
+    }
+    caps = std::move(caps_of);
+    return true;
+  }
+
+  ModelRows& eval_;
+  Index r_;
+  const std::vector<RowCoordinate>& reads_;
+  const std::vector<bool>& second_;
+  const ModelPolynomials& out_;
+  Eigen::VectorXd q_;
+  Eigen::VectorXd local_;  // the point the group probes hold the other reads at (empty otherwise)
+  Random& random_;
+  double row_scale_;
+  int width_;
+};
+
 }  // namespace
 
 ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& options) {
@@ -193,78 +359,12 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
       second.push_back(false);
       if (a) second.push_back(true);
     }
-    const int width = static_cast<int>(second.size());
     if (add_angle_relation(eval, r, reads, base, random, out)) continue;  // a gear a linkage turns
-    // a point: the local variables' values and the row there
-    auto sample = [&](Eigen::VectorXd& local) {
-      Eigen::VectorXd q = base;
-      int k = 0;
-      for (const RowCoordinate& c : reads) {
-        if (c.angle) {
-          const double theta = std::numbers::pi * random.symmetric();
-          local(k++) = std::cos(theta), local(k++) = std::sin(theta);
-          q(c.coordinate) = theta;
-        } else {
-          local(k) = random.symmetric();
-          q(c.coordinate) = out.origin(c.coordinate) + out.scale(c.coordinate) * local(k);
-          ++k;
-        }
-      }
-      return eval.row(q, r);
-    };
-    bool fitted = false;
-    for (int d = (width == 0 ? 0 : 1); d <= options.max_fit_degree && !fitted; ++d) {
-      std::vector<std::vector<int>> basis;
-      std::vector<int> current(static_cast<std::size_t>(width), 0);
-      monomials(width, d, second, basis, current, 0, d);
-      const int count = static_cast<int>(basis.size());
-      if (count > kMaxMonomials) break;
-      auto design = [&](int points, Eigen::MatrixXd& a, Eigen::VectorXd& b) {
-        a.resize(points, count), b.resize(points);
-        Eigen::VectorXd local(width);
-        for (int i = 0; i < points; ++i) {
-          b(i) = sample(local);
-          for (int k = 0; k < count; ++k) {
-            double v = 1.0;
-            for (int w = 0; w < width; ++w)
-              for (int e = 0; e < basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w)]; ++e) v *= local(w);
-            a(i, k) = v;
-          }
-        }
-      };
-      Eigen::MatrixXd a, a2;
-      Eigen::VectorXd b, b2;
-      design(2 * count + 8, a, b);
-      if (!b.allFinite()) break;
-      const Eigen::VectorXd coefficients = a.colPivHouseholderQr().solve(b);
-      design(count + 8, a2, b2);
-      if (!b2.allFinite()) break;
-      const double size = std::max(b.cwiseAbs().maxCoeff(), b2.cwiseAbs().maxCoeff());
-      const double error = (a2 * coefficients - b2).cwiseAbs().maxCoeff();
-      if (size <= 1e-12 * model.tolerance_scales().row_scale(r)) {  // holds wherever the fixed ones put it: no equation
-        fitted = true;
-        break;
-      }
-      if (!(error <= kFitTolerance * size) && !(size == 0.0)) continue;
-      fitted = true;
-      Polynomial p;
-      const double largest = coefficients.cwiseAbs().maxCoeff();
-      for (int k = 0; k < count; ++k) {
-        if (!(std::abs(coefficients(k)) > 1e-11 * largest)) continue;  // rounding of a zero coefficient
-        PolynomialTerm term{coefficients(k), std::vector<int>(static_cast<std::size_t>(nv), 0)};
-        int w = 0;
-        for (const RowCoordinate& c : reads) {
-          term.exponent[static_cast<std::size_t>(c.variable)] =
-              basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w++)];
-          if (c.angle)
-            term.exponent[static_cast<std::size_t>(c.variable + 1)] =
-                basis[static_cast<std::size_t>(k)][static_cast<std::size_t>(w++)];
-        }
-        p.terms.push_back(std::move(term));
-      }
-      system.equations.push_back(std::move(p));
-    }
-    if (!fitted) {
+    RowFitter fitter(eval, r, reads, second, out, base, random, model.tolerance_scales().row_scale(r));
+    std::vector<std::vector<int>> basis;
+    Eigen::VectorXd coefficients;
+    const RowFitter::Result fit = fitter.fit(options.max_fit_degree, basis, coefficients);
+    if (fit == RowFitter::Result::kNotPolynomial) {
       out.status = ModesStatus::kNotPolynomial;
       out.message = "constraint '" + constraint_name(r) +
                     "' is not polynomial in its coordinates (no polynomial of "
@@ -274,6 +374,23 @@ ModelPolynomials find_polynomial_system(const Model& model, const ModesOptions& 
                     "rational ratios): phiq modes cannot count its assemblies";
       out.system = PolynomialSystem{};
       return out;
+    }
+    if (fit == RowFitter::Result::kFitted) {
+      Polynomial p;
+      const double largest = coefficients.cwiseAbs().maxCoeff();
+      for (std::size_t k = 0; k < basis.size(); ++k) {
+        const double coefficient = coefficients(static_cast<Eigen::Index>(k));
+        if (!(std::abs(coefficient) > 1e-11 * largest)) continue;  // rounding of a zero coefficient
+        PolynomialTerm term{coefficient, std::vector<int>(static_cast<std::size_t>(nv), 0)};
+        int w = 0;
+        for (const RowCoordinate& c : reads) {
+          term.exponent[static_cast<std::size_t>(c.variable)] = basis[k][static_cast<std::size_t>(w++)];
+          if (c.angle)
+            term.exponent[static_cast<std::size_t>(c.variable + 1)] = basis[k][static_cast<std::size_t>(w++)];
+        }
+        p.terms.push_back(std::move(term));
+      }
+      system.equations.push_back(std::move(p));
     }
   }
   add_circle_equations(angle, out);  // 4. c² + s² = 1 for every free angle
