@@ -26,6 +26,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
+#include <new>
 #include <set>
 #include <sstream>
 
@@ -307,6 +308,8 @@ extern "C" __attribute__((visibility("default"))) phiq::detail::mechanism::ReadS
     try {
       out = SdfReader(text, path).read(&loops);
       return true;
+    } catch (const std::bad_alloc&) {  // the machine's refusal, not the file's: the caller's out-of-memory exit
+      throw;
     } catch (const std::exception& e) {
       error = e.what();
       return false;

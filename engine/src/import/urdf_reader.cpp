@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <functional>
 #include <mutex>
+#include <new>
 #include <set>
 #include <sstream>
 
@@ -325,6 +326,9 @@ urdf::ModelInterfaceSharedPtr UrdfReader::parse_urdfdom(const char* text) const 
   console_bridge::useOutputHandler(&messages);
   try {
     model = urdf::parseURDF(text);
+  } catch (const std::bad_alloc&) {  // the machine's refusal, not the model's: phiq's out-of-memory exit
+    console_bridge::restorePreviousOutputHandler();
+    throw;
   } catch (const std::exception& e) {
     model = nullptr;
     messages.errors.push_back(e.what());
