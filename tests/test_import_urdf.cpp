@@ -3,8 +3,11 @@
 // imports; `phiq convert` writes the very text a direct read solves; bad input is one line naming FILE:LINE.
 #include <gtest/gtest.h>
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "cli_test_support.hpp"
@@ -219,6 +222,15 @@ TEST(UrdfImport, BadInputIsOneLineNamingFileAndLine) {
 <joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint>
 <joint name="ba" type="fixed"><parent link="b"/><child link="a"/></joint></robot>)";
   starts(UrdfError(cycle), "bad.urdf:2: joints ab, ba form a cycle");
+  // a joint hanging from a cycle leads into it and is not on it: the cycle is named by its own first joint
+  const std::string below = test::replace_first(cycle, "<joint name=\"ab\"",
+                                                "<link name=\"z\"/><joint name=\"az\" type=\"fixed\"><parent "
+                                                "link=\"a\"/><child link=\"z\"/></joint>\n<joint name=\"ab\"");
+  starts(UrdfError(below), "bad.urdf:3: joints ab, ba form a cycle");
+  // elements nested deeper than tinyxml2 reads: said as such, not as a truncated file
+  std::string deep = "<robot name=\"d\">\n";
+  for (int i = 0; i < 120; ++i) deep += "<link name=\"l" + std::to_string(i) + "\">";
+  starts(UrdfError(deep), "bad.urdf:2: elements nested more than 100 deep, the most the XML reader (tinyxml2) reads");
   // a mimic of a joint that does not exist
   const std::string gears = import_text(import_data("urdf/gears.urdf"));
   starts(UrdfError(test::replace_first(gears, "joint=\"wheel1_joint\"", "joint=\"wheel9\"")),
@@ -231,6 +243,40 @@ TEST(UrdfImport, BadInputIsOneLineNamingFileAndLine) {
 }
 
 // Every prefix of a file: refused in one line naming the file and a line, or converted to a scene that loads.
+// Runs `work` on a thread of `bytes` of stack: a reader that recursed once per link would overflow it.
+void OnAStackOf(std::size_t bytes, const std::function<void()>& work) {
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, bytes);
+  pthread_t thread;
+  auto run = [](void* w) -> void* {
+    (*static_cast<const std::function<void()>*>(w))();
+    return nullptr;
+  };
+  ASSERT_EQ(pthread_create(&thread, &attr, run, const_cast<std::function<void()>*>(&work)), 0);
+  pthread_join(thread, nullptr);
+  pthread_attr_destroy(&attr);
+}
+
+// A serial chain of 10 000 links, as deep as it is long, read on 1 MiB of stack (100 bytes a link): each link placed
+// 1 m along x from its parent, the last at 10 000 m. The reader walked the tree by recursion (a stack overflow at
+// 30 000 links on the main thread's 8 MiB) and checked it for cycles in O(N^2) time; both are linear now.
+TEST(UrdfImport, ASerialChainOfTenThousandLinksIsReadOnASmallStack) {
+  constexpr int kLinks = 10000;
+  std::string text = "<robot name=\"chain\"><link name=\"base\"/>\n";
+  for (int i = 0; i < kLinks; ++i) {
+    const std::string link = "l" + std::to_string(i), parent = i ? "l" + std::to_string(i - 1) : "base";
+    text += "<link name=\"" + link + "\"/><joint name=\"j" + std::to_string(i) +
+            "\" type=\"continuous\"><parent link=\"" + parent + "\"/><child link=\"" + link +
+            "\"/><origin xyz=\"1 0 0\"/><axis xyz=\"0 0 1\"/></joint>\n";
+  }
+  std::string yaml;
+  OnAStackOf(std::size_t{1} << 20, [&] { yaml = import_urdf(text + "</robot>\n", "chain.urdf").yaml; });
+  EXPECT_NE(yaml.find("\n  l0: {at: [1, 0, 0],"), std::string::npos);
+  EXPECT_NE(yaml.find("\n  l9999: {at: [10000, 0, 0],"), std::string::npos);
+  EXPECT_EQ(std::count(yaml.begin(), yaml.end(), '\n') > 2 * kLinks, true);
+}
+
 TEST(UrdfImport, EveryTruncationIsRefusedInOneLineOrLoads) {
   const std::string text = import_text(import_data("urdf/fourbar.urdf"));
   int refused = 0;

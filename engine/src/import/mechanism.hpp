@@ -13,6 +13,10 @@
 
 #include "phiq/import_model.hpp"
 
+namespace tinyxml2 {
+class XMLDocument;
+}
+
 namespace phiq::detail::mechanism {
 
 struct Pose {
@@ -118,5 +122,9 @@ Eigen::Matrix3d axis_angle(const Eigen::Vector3d& axis, double angle);
 
 // "PATH:LINE: what" as a SceneError ("PATH: what" for line 0).
 [[noreturn]] void refuse(const std::string& path, int line, const std::string& what);
+
+// Refuses a document tinyxml2 could not parse, at its error's line: "malformed XML", or elements nested deeper than
+// tinyxml2 reads (a well-formed file, named as such).
+[[noreturn]] void refuse_xml(const std::string& path, const tinyxml2::XMLDocument& doc);
 
 }  // namespace phiq::detail::mechanism

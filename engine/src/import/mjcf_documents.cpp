@@ -23,8 +23,7 @@ std::string canonical(const std::string& path) {
 
 const tinyxml2::XMLElement* MjcfDocuments::parse(const std::string& text) {
   source_[&main_] = Source{path_, {}};
-  if (main_.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS)
-    refuse(path_, main_.ErrorLineNum(), std::string("malformed XML (the file may be truncated): ") + main_.ErrorName());
+  if (main_.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS) refuse_xml(path_, main_);
   return main_.RootElement();
 }
 
@@ -76,8 +75,7 @@ const tinyxml2::XMLElement* MjcfDocuments::load(const tinyxml2::XMLElement* incl
   }
   tinyxml2::XMLDocument& doc = included_.emplace_back();
   source_[&doc] = Source{target, chain};
-  if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS)
-    refuse(target, doc.ErrorLineNum(), std::string("malformed XML (the file may be truncated): ") + doc.ErrorName());
+  if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS) refuse_xml(target, doc);
   const tinyxml2::XMLElement* root = doc.RootElement();
   if (!root || std::string(root->Name()) != "mujoco")
     refuse(target, root ? root->GetLineNum() : 1, "an included MJCF file's root element is <mujoco>");

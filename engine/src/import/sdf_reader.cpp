@@ -252,8 +252,7 @@ Mechanism SdfReader::read(int* loops) {
   m_.units = "lengths in metres, angles in radians, mass in kg, time in seconds.";
   {  // as the URDF and MJCF readers say it (libsdformat's own message holds the whole text, and no line)
     tinyxml2::XMLDocument xml;
-    if (xml.Parse(text_.data(), text_.size()) != tinyxml2::XML_SUCCESS)
-      refuse(path_, xml.ErrorLineNum(), std::string("malformed XML (the file may be truncated): ") + xml.ErrorName());
+    if (xml.Parse(text_.data(), text_.size()) != tinyxml2::XML_SUCCESS) refuse_xml(path_, xml);
   }
   sdf::Root root;
   {

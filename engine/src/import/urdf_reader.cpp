@@ -17,7 +17,6 @@
 #include <cstdlib>
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <mutex>
 #include <new>
 #include <set>
@@ -113,8 +112,7 @@ class UrdfReader {
 };
 
 void UrdfReader::scan() {
-  if (doc_.Parse(text_.data(), text_.size()) != tinyxml2::XML_SUCCESS)
-    refuse(path_, doc_.ErrorLineNum(), std::string("malformed XML (the file may be truncated): ") + doc_.ErrorName());
+  if (doc_.Parse(text_.data(), text_.size()) != tinyxml2::XML_SUCCESS) refuse_xml(path_, doc_);
   const tinyxml2::XMLElement* robot = doc_.RootElement();
   if (!robot || std::string(robot->Name()) != "robot")
     refuse(path_, robot ? robot->GetLineNum() : 1, "a URDF file's root element is <robot>");
@@ -170,17 +168,29 @@ void UrdfReader::check_tree() const {
                  "); a joint that closes a loop is named closing_* (models/README.md)");
     parent_joint[j.child] = &j;
   }
+  // Each joint leads up to its parent link's joint. A cycle is found by walking up from each joint once, marking
+  // the walk (1) and what is known to reach the root (2): linear in the joints, for a serial chain of 10^5 links
+  // too. The first joint of the file on a cycle names it, with the cycle's joints from there.
+  std::map<const UrdfJointXml*, int> state;
+  const auto up = [&](const UrdfJointXml* j) -> const UrdfJointXml* {
+    const auto it = parent_joint.find(j->parent);
+    return it == parent_joint.end() ? nullptr : it->second;
+  };
+  std::set<const UrdfJointXml*> on_cycle;
+  for (const UrdfJointXml& start : joints_) {
+    std::vector<const UrdfJointXml*> walk;
+    const UrdfJointXml* j = &start;
+    while (j && state[j] == 0) state[j] = 1, walk.push_back(j), j = up(j);
+    if (j && state[j] == 1)  // the walk came back onto itself: from j on, it is a cycle
+      on_cycle.insert(std::find(walk.begin(), walk.end(), j), walk.end());
+    for (const UrdfJointXml* w : walk) state[w] = 2;
+  }
   for (const UrdfJointXml& j : joints_) {
-    std::string link = j.parent, chain = j.name;
-    for (std::size_t steps = 0; steps <= joints_.size(); ++steps) {
-      const auto it = parent_joint.find(link);
-      if (it == parent_joint.end()) break;
-      if (it->second == &j)
-        refuse(path_, j.line,
-               "joints " + chain + " form a cycle; a joint that closes a loop is named closing_* (models/README.md)");
-      chain += ", " + it->second->name;
-      link = it->second->parent;
-    }
+    if (!on_cycle.count(&j)) continue;
+    std::string chain = j.name;
+    for (const UrdfJointXml* k = up(&j); k != &j; k = up(k)) chain += ", " + k->name;
+    refuse(path_, j.line,
+           "joints " + chain + " form a cycle; a joint that closes a loop is named closing_* (models/README.md)");
   }
 }
 
@@ -371,17 +381,23 @@ Mechanism UrdfReader::read(int* loops) {
   const urdf::LinkConstSharedPtr root = model->getRoot();
   m_.bodies.push_back(Body::named(root->name, links_.at(root->name)->GetLineNum()));
   body_of_link_[root->name] = 0;
-  std::function<void(const urdf::LinkConstSharedPtr&)> place = [&](const urdf::LinkConstSharedPtr& link) {
-    for (const urdf::JointSharedPtr& j : link->child_joints) {
-      Body b = Body::named(j->child_link_name, links_.at(j->child_link_name)->GetLineNum());
-      b.world = m_.bodies[static_cast<std::size_t>(body_of_link_.at(link->name))].world *
-                urdf_pose(j->parent_to_joint_origin_transform);
-      body_of_link_[j->child_link_name] = static_cast<int>(m_.bodies.size());
-      m_.bodies.push_back(b);
-      place(model->getLink(j->child_link_name));
+  // Depth first, a link's children in the file's order; by an explicit stack, as a serial chain of 10^5 links
+  // is as deep as it is long and would overflow the call stack.
+  std::vector<std::pair<urdf::LinkConstSharedPtr, std::size_t>> path{{root, 0}};
+  while (!path.empty()) {
+    auto& [link, next] = path.back();
+    if (next == link->child_joints.size()) {
+      path.pop_back();
+      continue;
     }
-  };
-  place(root);
+    const urdf::JointSharedPtr& j = link->child_joints[next++];
+    Body b = Body::named(j->child_link_name, links_.at(j->child_link_name)->GetLineNum());
+    b.world = m_.bodies[static_cast<std::size_t>(body_of_link_.at(link->name))].world *
+              urdf_pose(j->parent_to_joint_origin_transform);
+    body_of_link_[j->child_link_name] = static_cast<int>(m_.bodies.size());
+    m_.bodies.push_back(b);
+    path.emplace_back(model->getLink(j->child_link_name), 0);
+  }
   for (const auto& [name, element] : links_)
     if (!body_of_link_.count(name))
       refuse(path_, element->GetLineNum(), "link '" + name + "' is joined to no other (only one root is allowed)");
