@@ -199,6 +199,21 @@ TEST_F(AnimateHtml, ForceArrowsHoldTheResultsEffortsAndReactionsAtTheirJoints) {
     }
   }
   EXPECT_EQ(count(html, "id=\"forces\""), 1u);  // the page's check box
+  // the loads written along each pin's body (output.reaction_axes: joint) are drawn in world axes all the same
+  const nlohmann::json world = f["arrows"];
+  std::vector<double> world_a;
+  for (std::size_t k = 0; k < rows; ++k) world_a.push_back(at(k, "A.Fx"));
+  animate(write("turned.yaml", text + "output: {efforts: all, reactions: all, reaction_axes: joint}\n").string(),
+          "--forces 0.05");
+  ASSERT_EQ(table.rows.size(), rows);
+  double turned = 0.0;  // how far the columns moved: they are along the crank's axes now
+  for (std::size_t k = 0; k < rows; ++k) turned = std::max(turned, std::fabs(at(k, "A.Fx") - world_a[k]));
+  EXPECT_GT(turned, 1.0);
+  for (std::size_t a = 0; a < 4; ++a)
+    for (std::size_t i = 0; i < 3 * rows; ++i) {
+      const double w = world[a]["force"][i], j = data["forces"]["arrows"][a]["force"][i];
+      EXPECT_NEAR(j, w, 1e-9 * (1.0 + std::fabs(w))) << a << " " << i;
+    }
   // asked for where the scene writes no efforts or reactions, or with a scale that is not positive: one line, exit 2
   const Result none = run("animate " + phiq::test::model_path("seed/fourbar_natural.yaml") + " -o " +
                           (dir_ / "n.html").string() + " --forces 0.1");

@@ -22,7 +22,7 @@ namespace phiq {
 namespace {
 
 // A model of two moving bodies joined by one constraint of `joint` (a scene constraint line naming bodies a, b).
-Scene reaction_two_bodies(bool spatial, const std::string& joint) {
+std::string reaction_two_bodies_text(bool spatial, const std::string& joint) {
   std::string text = "phiq: 1\nname: two\n";
   if (spatial)
     text +=
@@ -34,8 +34,10 @@ Scene reaction_two_bodies(bool spatial, const std::string& joint) {
     text +=
         "coordinates: {xa: 0.1, ya: 0.2, pa: 0.3, xb: 0.7, yb: -0.1, pb: 1.1}\n"
         "bodies: {a: [xa, ya, pa], b: [xb, yb, pb]}\n";
-  text += "constraints:\n  - " + joint + "\ntime: {start: 0, end: 1, steps: 1}\n";
-  return parse_scene(text, "two.yaml");
+  return text + "constraints:\n  - " + joint + "\ntime: {start: 0, end: 1, steps: 1}\n";
+}
+Scene reaction_two_bodies(bool spatial, const std::string& joint) {
+  return parse_scene(reaction_two_bodies_text(spatial, joint), "two.yaml");
 }
 
 kin3::V3 reaction_rotation_step(const RotationMatrix& plus, const RotationMatrix& minus, double h2) {
@@ -133,6 +135,101 @@ TEST(JointReactions, EverySpatialKindWithASiteDoesTheWorkOfItsMultipliers) {
   }
 }
 
+std::string reaction_scene_text(const std::string& rel);
+
+// The reaction of constraint "j" of `s` under random multipliers, in world axes and along the joint's own
+// (OutputEfforts::reactions_in_joint_axes), at the initial positions.
+std::pair<std::vector<double>, std::vector<double>> reaction_both_axes(const Scene& s, bool spatial, int trial) {
+  const Model& m = *s.model;
+  const Index c = m.find_constraint("j");
+  OutputEfforts e;
+  e.reactions.push_back({c, spatial});
+  JointReactions world(m, e);
+  e.reactions_in_joint_axes = true;
+  JointReactions joint(m, e);
+  std::mt19937 rng(11 + trial);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m.num_equations());
+  const ConstraintInfo& info = m.constraints()[static_cast<std::size_t>(c)];
+  for (Index r = info.first_row; r < info.first_row + info.rows; ++r) lambda(r) = u(rng);
+  const Eigen::VectorXd q = m.initial_positions();
+  std::vector<double> w(spatial ? 6 : 3), j(spatial ? 6 : 3);
+  world.evaluate(q.data(), 0.0, lambda, w.data());
+  joint.evaluate(q.data(), 0.0, lambda, j.data());
+  return {w, j};
+}
+
+// Along the joint's axes, computed here from the scene's numbers (Eigen's quaternion for side a's Euler parameters):
+// the world reaction turned, and the loads a joint cannot carry zero for any multipliers — a revolute pair's moment
+// about its axis, a slide's force along it — which in world axes they are not.
+TEST(JointReactions, AlongTheJointsAxesTheLoadsItCannotCarryAreZero) {
+  const std::string planar_at = "between: [{body: a, at: [0.3, -0.2]}, {body: b, at: [-0.1, 0.4]}]";
+  const Eigen::Rotation2Dd pa(0.3);
+  struct Case {
+    std::string joint;
+    Eigen::Matrix3d axes;           // columns x, y, z of the joint's frame, world axes
+    std::vector<int> cannot_carry;  // components zero along the joint's axes
+  };
+  Eigen::Matrix3d pin = Eigen::Matrix3d::Identity(), slide = Eigen::Matrix3d::Identity();
+  pin.topLeftCorner<2, 2>() = pa.toRotationMatrix();
+  const Eigen::Vector2d e = pa * Eigen::Vector2d(0.6, 0.8);
+  slide.topLeftCorner<2, 2>() << e.x(), -e.y(), e.y(), e.x();
+  std::vector<Case> planar = {
+      {"{name: j, type: revolute, " + planar_at + "}", pin, {2}},
+      {"{name: j, type: prismatic, " + planar_at + ", axis: [0.6, 0.8], angle: 0.2}", slide, {0}}};
+  for (const Case& k : planar) {
+    SCOPED_TRACE(k.joint);
+    const Scene s = reaction_two_bodies(false, k.joint);
+    for (int trial = 0; trial < 3; ++trial) {
+      const auto [w, j] = reaction_both_axes(s, false, trial);
+      const Eigen::Vector3d turned = k.axes.transpose() * Eigen::Vector3d(w[0], w[1], 0.0);
+      EXPECT_NEAR(j[0], turned.x(), 1e-14);
+      EXPECT_NEAR(j[1], turned.y(), 1e-14);
+      EXPECT_EQ(j[2], w[2]);
+      for (int c : k.cannot_carry) {
+        EXPECT_NEAR(j[static_cast<std::size_t>(c)], 0.0, 1e-13) << "component " << c;
+        if (c == 0) EXPECT_GT(std::fabs(w[0]), 1e-3);  // (in world axes the slide's force has an x)
+      }
+    }
+  }
+  // side a: axis (0, 0.6, 0.8), reference x (the axis is far from x), turned by a's Euler parameters
+  const Eigen::Matrix3d ra = Eigen::Quaterniond(0.8, 0.2, -0.4, 0.4).normalized().toRotationMatrix();
+  Eigen::Matrix3d spatial_axes;
+  spatial_axes.col(2) = ra * Eigen::Vector3d(0, 0.6, 0.8), spatial_axes.col(0) = ra * Eigen::Vector3d(1, 0, 0);
+  spatial_axes.col(1) = spatial_axes.col(2).cross(spatial_axes.col(0));
+  const std::string sides =
+      "between: [{body: a, at: [0.3, -0.2, 0.1], axis: [0, 0.6, 0.8]}, {body: b, at: [0.3, -0.2, 0.1], "
+      "axis: [0, 0.6, 0.8]}]}";
+  const std::string crossed =
+      "between: [{body: a, at: [0.3, -0.2, 0.1], axis: [0, 0.6, 0.8]}, {body: b, at: [0.3, -0.2, 0.1], "
+      "axis: [1, 0, 0]}]}";
+  const std::vector<std::pair<const char*, std::vector<int>>> spatial = {
+      {"revolute", {5}},        {"cylindrical", {2, 5}}, {"prismatic", {2}}, {"universal", {5}},
+      {"spherical", {3, 4, 5}}, {"planar", {0, 1, 5}},   {"rigid", {}}};
+  for (const auto& [type, cannot_carry] : spatial) {
+    SCOPED_TRACE(type);
+    // both bodies at the same pose and the sides alike (the universal's axes crossed): the joint assembled
+    std::string text = reaction_two_bodies_text(
+        true, std::string("{name: j, type: ") + type + ", " + (std::string(type) == "universal" ? crossed : sides));
+    const std::string b_pose = "xb: 0.7, yb: -0.1, zb: 0.4, b0: 0.5, b1: 0.5, b2: 0.5, b3: 0.5";
+    text.replace(text.find(b_pose), b_pose.size(), "xb: 0.1, yb: 0.2, zb: -0.3, b0: 0.8, b1: 0.2, b2: -0.4, b3: 0.4");
+    const Scene s = parse_scene(text, "two.yaml");
+    for (int trial = 0; trial < 3; ++trial) {
+      const auto [w, j] = reaction_both_axes(s, true, trial);
+      const Eigen::Vector3d f = spatial_axes.transpose() * Eigen::Vector3d(w[0], w[1], w[2]);
+      const Eigen::Vector3d m = spatial_axes.transpose() * Eigen::Vector3d(w[3], w[4], w[5]);
+      const double scale = 1.0 + Eigen::Vector3d(w[0], w[1], w[2]).norm() + Eigen::Vector3d(w[3], w[4], w[5]).norm();
+      for (int i = 0; i < 3; ++i) {
+        EXPECT_NEAR(j[static_cast<std::size_t>(i)], f(i), 1e-12 * scale);
+        EXPECT_NEAR(j[static_cast<std::size_t>(3 + i)], m(i), 1e-12 * scale);
+      }
+      for (int c : cannot_carry) EXPECT_NEAR(j[static_cast<std::size_t>(c)], 0.0, 1e-12 * scale) << "component " << c;
+      if (std::string(type) == "revolute")  // about world z it carries a moment: the axes matter
+        EXPECT_GT(std::fabs(w[5]), 1e-3 * scale);
+    }
+  }
+}
+
 TEST(JointReactions, KindsWithoutASiteAreRefusedByName) {
   const Scene s = parse_scene(
       "phiq: 1\nname: d\ncoordinates: {x: 1, y: 0.1}\npoints: {O: [0, 0], A: [x, y]}\n"
@@ -183,6 +280,48 @@ ReactionRows sweep_reactions(const Scene& s, SweepSummary* sum = nullptr, const 
                 sum),
             SolveStatus::kSuccess);
   return r;
+}
+
+// The scene's `reaction_axes`: along a sweep of the massive four-bar, each pin's force along its body's axes is the
+// world one turned by that body's angle at the row.
+TEST(JointReactions, TheScenesReactionAxesTurnEachPinsForceByItsBody) {
+  const std::string base = reaction_scene_text("dynamics/fourbar_pin_loads.yaml");
+  const Scene world = parse_scene(base + "output: {velocities: true, accelerations: true, reactions: all}\n", "k.yaml");
+  const Scene joint = parse_scene(
+      base + "output: {velocities: true, accelerations: true, reactions: all, reaction_axes: joint}\n", "k.yaml");
+  EXPECT_FALSE(world.sweep.efforts.reactions_in_joint_axes);
+  ASSERT_TRUE(joint.sweep.efforts.reactions_in_joint_axes);
+  const Model* swept = nullptr;
+  const ReactionRows w = sweep_reactions(world, nullptr, &swept), j = sweep_reactions(joint);
+  ASSERT_EQ(w.values.size(), j.values.size());
+  const Model& m = *swept;
+  const std::vector<OutputReaction>& rs = world.sweep.efforts.reactions;
+  ASSERT_GE(rs.size(), 4u);
+  for (std::size_t row = 0; row < w.values.size(); ++row)
+    for (std::size_t k = 0; k < rs.size(); ++k) {
+      ReactionSite site;  // the body the pin's load is on, its angle read here
+      const auto [block, index] = reaction_block_of(m, rs[k].constraint);
+      ASSERT_TRUE(block->reaction_site(index, w.q[row].data(), site));
+      const double psi = site.frame2.psi.of(w.q[row].data());
+      const Eigen::Vector2d f(w.values[row][3 * k], w.values[row][3 * k + 1]);
+      const Eigen::Vector2d turned = Eigen::Rotation2Dd(-psi) * f;
+      EXPECT_NEAR(j.values[row][3 * k], turned.x(), 1e-12 * (1.0 + f.norm())) << row << " " << k;
+      EXPECT_NEAR(j.values[row][3 * k + 1], turned.y(), 1e-12 * (1.0 + f.norm())) << row << " " << k;
+      EXPECT_EQ(j.values[row][3 * k + 2], w.values[row][3 * k + 2]);
+    }
+  auto error = [&](const std::string& output) {
+    try {
+      (void)parse_scene(base + output, "k.yaml");
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error("output: {reactions: all, reaction_axes: body}\n").find("reaction_axes: expected `world` or `joint`"),
+            std::string::npos);
+  EXPECT_NE(error("output: {efforts: all, reaction_axes: joint}\n")
+                .find("reaction_axes: the axes of the reactions: list `reactions` too"),
+            std::string::npos);
 }
 
 // Model::constraint_block(), the table JointReactions and the minimum-norm multipliers read a constraint through,

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <optional>
+#include <string_view>
 
 #include "phiq/natural_joints.hpp"
 #include "phiq/phiq.hpp"
@@ -93,19 +94,26 @@ nlohmann::json force_arrows(const Scene& scene, const CsvTable& table, const std
                  const std::array<long, 3>& moment) {
     nlohmann::json at = nlohmann::json::array(), f = nlohmann::json::array(), m = nlohmann::json::array();
     for (std::size_t k = 0; k < rows.size(); ++k) {
+      ReactionSite rs;  // (its axes world axes but at a constraint's site)
       if (site < 0) {
         const Attachment3& p = e.natural->joints[static_cast<std::size_t>(-1 - site)].point;
         for (const Slot& s : p.r) at.push_back(s.of(q[k].data()));
       } else {
         const Held& h = held[static_cast<std::size_t>(site)];
-        ReactionSite rs;
         h.block->reaction_site(h.index, q[k].data(), rs);
         for (double x : {rs.point.x, rs.point.y, rs.point.z}) at.push_back(x);
       }
-      for (long c : force)
-        f.push_back(c < 0 ? nlohmann::json(0.0) : value(table.rows[rows[k]][static_cast<std::size_t>(c)]));
-      for (long c : moment)
-        m.push_back(c < 0 ? nlohmann::json(0.0) : value(table.rows[rows[k]][static_cast<std::size_t>(c)]));
+      // a reaction written along the joint's axes (output.reaction_axes: joint) is drawn in world axes
+      const bool turn = std::string_view(kind) == "reaction" && e.reactions_in_joint_axes;
+      for (const std::array<long, 3>* columns : {&force, &moment}) {
+        kin3::V3 v;
+        for (int i = 0; i < 3; ++i) {
+          const long c = (*columns)[static_cast<std::size_t>(i)];
+          (i == 0 ? v.x : i == 1 ? v.y : v.z) = c < 0 ? 0.0 : table.rows[rows[k]][static_cast<std::size_t>(c)];
+        }
+        if (turn) v = v.x * rs.axes[0] + v.y * rs.axes[1] + v.z * rs.axes[2];
+        for (double x : {v.x, v.y, v.z}) (columns == &force ? f : m).push_back(value(x));
+      }
     }
     arrows.push_back({{"name", name}, {"kind", kind}, {"at", at}, {"force", f}, {"moment", m}});
   };

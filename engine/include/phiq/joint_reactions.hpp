@@ -5,8 +5,9 @@
 /// kinds/reaction_site.hpp: side a's body, side b's when a is fixed), g is the virtual work of one wrench on that
 /// body, (F, M_O) about the body's origin O, with J_bᵀ (F, M_O) = g for the body's frame Jacobian J_b
 /// (part_jacobian(), phiq/part_motion.hpp). The reaction is written about the joint's point P: F and
-/// M_P = M_O + (O − P) × F, world axes. The other body receives −F and −M_P (a joint's equations do not change when
-/// both bodies move together, so its forces and moments balance).
+/// M_P = M_O + (O − P) × F, world axes, or along the joint's own (ReactionSite::axes, when OutputEfforts asks:
+/// a bearing's axial and radial loads, a guide's force along and across its slide). The other body receives −F and −M_P
+/// (a joint's equations do not change when both bodies move together, so its forces and moments balance).
 ///
 /// Natural coordinates' joints, points two bodies share (phiq/natural_joints.hpp), split the equations at the point
 /// among the bodies instead; their moment is zero.
@@ -145,6 +146,7 @@ class JointReactions {
   std::shared_ptr<const NaturalJoints> natural_;
   BodyRows body_rows_;
   std::vector<BodyPart> body_parts_;      // per natural body
+  bool joint_axes_ = false;               // constraints' reactions along ReactionSite::axes, not world axes
   Eigen::VectorXd qx_, qdx_, qddx_, qb_;  // q, q̇, q̈ with the promoted constants; a body's Q
   Index size_ = 0;
   std::vector<double> g_;  // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations

@@ -103,6 +103,9 @@ struct OutputEfforts {
   /// Joints whose reactions are written (phiq/joint_reactions.hpp), in this order: `NAME.Fx`, `NAME.Fy`, `NAME.Mz`
   /// for a planar joint, `NAME.Fx` … `NAME.Mz` (six) for a spatial one; minimum-norm where indeterminate.
   std::vector<OutputReaction> reactions;
+  /// The constraints' reactions along each joint's own axes (ReactionSite::axes: a pin's body's, a prismatic
+  /// pair's slide, a spatial joint's frame) rather than world axes; a natural point's stay in world axes.
+  bool reactions_in_joint_axes = false;
   /// The natural coordinates' bodies and joints the `natural` reactions index (null: none listed).
   std::shared_ptr<const NaturalJoints> natural;
   /// A reaction's name (its columns' stem): its constraint's, or its natural joint's point's.

@@ -212,7 +212,8 @@ void bind_stepper(py::module_& m) {
                              "at a singular position); empty without them or before the first step")
       .def_property_readonly("reactions", &reactions_of,
                              "the scene's output.reactions at the current state: joint name → (Fx, Fy, Mz), in "
-                             "space (Fx, Fy, Fz, Mx, My, Mz), N and N m about the joint's point, world axes")
+                             "space (Fx, Fy, Fz, Mx, My, Mz), N and N m about the joint's point, in world axes or "
+                             "output.reaction_axes' joint axes")
       .def_property_readonly(
           "summary", [](const PyStepper& s) { return s.stepper->summary(); },
           "everything the steps did so far, as a sweep's SweepSummary (to_dict() for JSON)")

@@ -39,6 +39,17 @@ kin3::V3 reference_direction(const JointSide3& s) {
   return n > 0.0 && std::fabs(s.axis.x / n) >= std::cos(25.0 * M_PI / 180.0) ? kin3::V3{0, 1, 0} : kin3::V3{1, 0, 0};
 }
 
+void joint_axes(const JointSide3& s, const double* q, kin3::V3 axes[3]) {
+  if (s.natural) return;
+  const LocalFrame f = local_frame(s, "joint_axes");
+  const double e[4] = {s.frame.e0.of(q), s.frame.e1.of(q), s.frame.e2.of(q), s.frame.e3.of(q)};
+  // R(p) with p·p within the solver's tolerance of 1 scales every vector by p·p: normalised, still orthogonal
+  for (int k = 0; k < 3; ++k) {
+    const kin3::V3 w = kin3::rotate(e, k == 0 ? f.x : (k == 1 ? f.y : f.z));
+    axes[k] = (1.0 / kin3::norm(w)) * w;
+  }
+}
+
 std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const JointSide3& b, const std::int8_t* index,
                                                   int count, const char* kind) {
   bool used[kCount] = {};

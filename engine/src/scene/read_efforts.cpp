@@ -18,6 +18,11 @@ void SceneReader::read_output_efforts(const Cursor& output) {
     pending_.efforts_power = p.boolean();
     if (pending_.efforts_power && !e.present()) p.fail("power is written with the efforts: list `efforts` too");
   }
+  if (const Cursor a = output.field("reaction_axes"); a.present()) {
+    if (a.text() != "world" && a.text() != "joint") a.fail("expected `world` or `joint`");
+    if (!output.field("reactions").present()) a.fail("the axes of the reactions: list `reactions` too");
+    pending_.reactions_in_joint_axes = a.text() == "joint";
+  }
   if (const Cursor r = output.field("reactions"); r.present()) {
     pending_.reactions_field = r;
     // the named points, read before their table is freed (the natural joints are found with the model)
@@ -131,6 +136,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   out.parts = std::move(massive);
   out.loads = std::make_shared<const Loads>(scene.loads);
   out.power = pending_.efforts_power;
+  out.reactions_in_joint_axes = pending_.reactions_in_joint_axes;
 }
 
 }  // namespace phiq::detail::scene

@@ -60,7 +60,7 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
   if (c.present()) {
     c.expect_map({"velocities", "accelerations", "coordinates", "points", "joints", "orientations", "drivers",
                   "residuals", "max_residual", "rcond", "every", "window", "sensitivities", "sensitivity_form",
-                  "efforts", "power", "reactions", "clearance"});
+                  "efforts", "power", "reactions", "reaction_axes", "clearance"});
     // true / false, or the coordinates whose derivative is written (q̇ or q̈ is solved whole either way)
     auto derivative = [&](const char* key, bool& asked, std::optional<std::vector<Index>>& columns) {
       const Cursor d = c.field(key);

@@ -241,6 +241,7 @@ class SceneReader {
     std::optional<Cursor> efforts_field;                     // `output: efforts` (its items when it lists names)
     std::vector<Cursor> effort_items;
     bool efforts_power = false;             // and `power`
+    bool reactions_in_joint_axes = false;   // `reaction_axes: joint`
     std::optional<Cursor> reactions_field;  // `output: reactions` (its items when it lists names)
     // with `reactions`: the named natural points, kept past the tables' release for the natural joints
     std::vector<std::pair<std::string, Attachment3>> natural_points;

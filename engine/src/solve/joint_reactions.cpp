@@ -63,7 +63,7 @@ JointReactions::JointReactions(const Model& model, std::vector<Index> constraint
 }
 
 JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts)
-    : g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
+    : joint_axes_(efforts.reactions_in_joint_axes), g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
   std::vector<int> site_of(model.constraints().size(), -1);
   for (const OutputReaction& r : efforts.reactions) {
     if (r.natural < 0) {
@@ -107,6 +107,7 @@ JointReactions::JointReactions(const JointReactions& other, SetUpOnly)
       natural_(other.natural_),
       body_rows_(other.body_rows_),
       body_parts_(other.body_parts_),
+      joint_axes_(other.joint_axes_),
       size_(other.size_),
       g_(other.g_.size(), 0.0) {
   if (!natural_sites_.empty()) size_natural_scratch();
@@ -152,9 +153,15 @@ void JointReactions::evaluate_site(const Site& s, const double* q, double t, con
     for (int i = 0; i < 6; ++i)
       if (normal(i, i) == 0.0) normal(i, i) = 1.0, rhs(i) = 0.0;
     const Eigen::Matrix<double, 6, 1> w = normal.ldlt().solve(rhs);
-    const V3 force{w(0), w(1), w(2)}, moment_o{w(3), w(4), w(5)};
+    V3 force{w(0), w(1), w(2)};
+    const V3 moment_o{w(3), w(4), w(5)};
     const V3 at = part_pose(frame, q, t).at;
-    const V3 moment = moment_o + cross(at - rs.point, force);
+    V3 moment = moment_o + cross(at - rs.point, force);
+    if (joint_axes_) {  // the same force and moment, their components along the joint's own axes
+      const V3 f = force, m = moment;
+      force = {dot(rs.axes[0], f), dot(rs.axes[1], f), dot(rs.axes[2], f)};
+      moment = {dot(rs.axes[0], m), dot(rs.axes[1], m), dot(rs.axes[2], m)};
+    }
     if (s.spatial) {
       for (double v : {force.x, force.y, force.z, moment.x, moment.y, moment.z}) *out++ = v;
     } else {

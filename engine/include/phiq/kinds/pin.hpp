@@ -52,12 +52,15 @@ struct PinSpec {
   }
   /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Mz of a planar joint.
   static constexpr int kReactionWidth = 3;
-  /// The reaction (ReactionSite): on frame a, or on b when a is fixed, at the pin's point (a's attachment point).
+  /// The reaction (ReactionSite): on frame a, or on b when a is fixed, at the pin's point (a's attachment point);
+  /// its axes that body's.
   ReactionSite reaction_site(const double* q) const {
     const kin::V2 p = kin::V2{a.x.of(q), a.y.of(q)} + kin::rotate(a.psi.of(q), sa);
     ReactionSite site;
     site.point = {p.x, p.y, 0.0};
     site.frame2 = detail::frame_moves(a) ? a : b;
+    const double psi = site.frame2.psi.of(q), c = std::cos(psi), s = std::sin(psi);
+    site.axes[0] = {c, s, 0.0}, site.axes[1] = {-s, c, 0.0};
     return site;
   }
   /// @copydoc DistanceSpec::residual

@@ -53,12 +53,14 @@ struct PrismaticSpec {
   /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Mz of a planar joint.
   static constexpr int kReactionWidth = 3;
   /// The reaction (ReactionSite): on frame a, or on b when a is fixed, at the point s_b of the slider, which the
-  /// pair keeps on the line.
+  /// pair keeps on the line; its axes x along the slide (e) and y across it.
   ReactionSite reaction_site(const double* q) const {
     const kin::V2 p = kin::V2{b.x.of(q), b.y.of(q)} + kin::rotate(b.psi.of(q), sb);
     ReactionSite site;
     site.point = {p.x, p.y, 0.0};
     site.frame2 = detail::frame_moves(a) ? a : b;
+    const kin::V2 e = geometry(q).e;
+    site.axes[0] = {e.x, e.y, 0.0}, site.axes[1] = {-e.y, e.x, 0.0};
     return site;
   }
   /// @copydoc DistanceSpec::residual

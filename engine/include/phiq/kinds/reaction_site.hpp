@@ -17,6 +17,11 @@ struct ReactionSite {
   bool spatial = false;  ///< the body is `frame3` (a spatial body), else `frame2` (a planar one)
   Frame2 frame2;         ///< the planar body (x, y, ψ; a natural point: ψ constant)
   Frame3 frame3;         ///< the spatial body (x, y, z, e0…e3; a natural point: e constant)
+  /// The joint's own axes x, y, z as unit vectors in world axes, in which a reaction may be written instead
+  /// (OutputEfforts::reactions_in_joint_axes): the reported body's axes at a planar pin, x along the slide and y
+  /// across it at a planar prismatic pair, the reported side's joint frame at a spatial joint (z its axis, x its
+  /// reference direction); world axes where the side has no axes of its own (a natural point).
+  kin3::V3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 };
 
 /// @cond internal

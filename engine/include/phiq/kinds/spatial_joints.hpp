@@ -97,6 +97,11 @@ constexpr CompactRows<kRows> compact_rows(const RowDef (&defs)[kRows]) {
 /// is well defined). phiq check reports which one each joint angle driver uses (Scene::joint_angles).
 kin3::V3 reference_direction(const JointSide3& s);
 
+/// A body side's joint frame at q, as unit vectors in world axes: z its axis, x its reference direction's part
+/// perpendicular to it, y = z × x (ReactionSite::axes). A natural side's stays world axes (it has no frame).
+/// Pre-condition: the side is valid (its joint set up).
+void joint_axes(const JointSide3& s, const double* q, kin3::V3 axes[3]);
+
 /// The attachments of a joint between sides a and b that `index[0 … count − 1]` name (Attach indices, ascending:
 /// CompactRows::index), in that order in the first `count` entries; an attachment of constants only is folded
 /// into its value (Attachment3::fold_constant). Normalises the axes, makes the reference directions perpendicular.
@@ -178,7 +183,8 @@ struct SpatialJointSpec {
   }
   /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Fz, Mx, My, Mz of a spatial joint.
   static constexpr int kReactionWidth = 6;
-  /// The reaction (ReactionSite): on side a's body, or on b's when a is fixed, at side a's joint point.
+  /// The reaction (ReactionSite): on side a's body, or on b's when a is fixed, at side a's joint point; its axes
+  /// that side's joint frame.
   ReactionSite reaction_site(const double* q) const {
     const Frame3& f = a.frame;
     const kin3::V3 r{f.x.of(q), f.y.of(q), f.z.of(q)};
@@ -187,7 +193,9 @@ struct SpatialJointSpec {
     ReactionSite site;
     site.point = {r.x + s.x, r.y + s.y, r.z + s.z};
     site.spatial = true;
-    site.frame3 = detail::frame_moves(a.frame) ? a.frame : b.frame;
+    const bool on_a = detail::frame_moves(a.frame);
+    site.frame3 = on_a ? a.frame : b.frame;
+    detail3::joint_axes(on_a ? a : b, q, site.axes);
     return site;
   }
   /// @copydoc DistanceSpec::residual
