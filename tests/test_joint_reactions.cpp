@@ -118,7 +118,13 @@ TEST(JointReactions, EveryPlanarKindWithASiteDoesTheWorkOfItsMultipliers) {
   for (const std::string joint :
        {"{name: j, type: revolute, between: [{body: a, at: [0.3, -0.2]}, {body: b, at: [-0.1, 0.4]}]}",
         "{name: j, type: prismatic, between: [{body: a, at: [0.3, -0.2]}, {body: b, at: [-0.1, 0.4]}], "
-        "axis: [0.6, 0.8], angle: 0.2}"}) {
+        "axis: [0.6, 0.8], angle: 0.2}",
+        "{name: j, type: cam, cam: {body: b, circle: {centre: [0.1, 0.2], radius: 0.5}}, follower: {body: a, at: "
+        "[0.3, -0.2]}, roller: 0.05}",
+        "{name: j, type: point_on_curve, point: {body: a, at: [0.3, -0.2]}, curve: {body: b, circle: {centre: [0.1, "
+        "0.2], radius: 0.5}}}",
+        "{name: j, type: flat_cam, cam: {body: b, circle: {centre: [0.1, 0.2], radius: 0.5}}, follower: {body: a, "
+        "at: [0.3, -0.2], direction: [0.6, 0.8]}}"}) {
     SCOPED_TRACE(joint);
     expect_reaction_virtual_work(reaction_two_bodies(false, joint), false);
   }
@@ -176,7 +182,11 @@ TEST(JointReactions, AlongTheJointsAxesTheLoadsItCannotCarryAreZero) {
   slide.topLeftCorner<2, 2>() << e.x(), -e.y(), e.y(), e.x();
   std::vector<Case> planar = {
       {"{name: j, type: revolute, " + planar_at + "}", pin, {2}},
-      {"{name: j, type: prismatic, " + planar_at + ", axis: [0.6, 0.8], angle: 0.2}", slide, {0}}};
+      {"{name: j, type: prismatic, " + planar_at + ", axis: [0.6, 0.8], angle: 0.2}", slide, {0}},
+      {"{name: j, type: flat_cam, cam: {body: b, circle: {centre: [0.1, 0.2], radius: 0.5}}, follower: {body: a, "
+       "at: [0.3, -0.2], direction: [0.6, 0.8]}}",
+       slide,
+       {0}}};
   for (const Case& k : planar) {
     SCOPED_TRACE(k.joint);
     const Scene s = reaction_two_bodies(false, k.joint);
@@ -322,6 +332,36 @@ TEST(JointReactions, TheScenesReactionAxesTurnEachPinsForceByItsBody) {
   EXPECT_NE(error("output: {efforts: all, reaction_axes: joint}\n")
                 .find("reaction_axes: the axes of the reactions: list `reactions` too"),
             std::string::npos);
+}
+
+// A roller follower lifted by an eccentric cam (models/cams/eccentric_roller.yaml) with a mass on the rod under
+// gravity: the rod's guide carries no force along y, so the cam pushes it up by m (ÿ + g) (Newton, on the rod
+// alone), along the line from the cam circle's centre to the roller's (a frictionless contact): along the cam's
+// normal, with nothing along its tangent (reaction_axes: joint).
+TEST(JointReactions, ACamPushesItsRollerAlongTheNormalWithTheRodsWeightAndInertia) {
+  const double m = 0.7, g = 9.81, e = 0.015;
+  const std::string base = reaction_scene_text("cams/eccentric_roller.yaml") +
+                           "parts:\n  rod: {mass: 0.7, center_of_mass: [0, 0], inertia: 1e-3}\n"
+                           "  disc: {mass: 2.0, center_of_mass: [0, 0], inertia: 3e-3}\n"
+                           "loads: {gravity: [0, -9.81]}\n";
+  const std::string out = "output: {velocities: true, accelerations: true, reactions: [cam]";
+  const Scene world = parse_scene(base + out + "}\n", "cam.yaml"),
+              joint = parse_scene(base + out + ", reaction_axes: joint}\n", "cam.yaml");
+  const Model* swept = nullptr;
+  const ReactionRows w = sweep_reactions(world, nullptr, &swept), j = sweep_reactions(joint);
+  const Index yf = swept->find_coordinate("yf"), th = swept->find_coordinate("th");
+  ASSERT_GE(yf, 0);
+  ASSERT_EQ(w.values.size(), 73u);
+  for (std::size_t row = 0; row < w.values.size(); ++row) {
+    const double fx = w.values[row][0], fy = w.values[row][1];
+    EXPECT_NEAR(fy, m * (w.qdd[row](yf) + g), 1e-9) << row;
+    const double t = w.q[row](th);  // the normal: from the cam circle's centre to the roller's (on x = 0)
+    const double nx = 0.0 - e * std::cos(t), ny = w.q[row](yf) - e * std::sin(t);
+    EXPECT_NEAR(fx * ny - fy * nx, 0.0, 1e-9 * std::hypot(fx, fy)) << row;
+    EXPECT_NEAR(w.values[row][2], 0.0, 1e-12) << row;  // about the roller's centre, on the force's line
+    EXPECT_NEAR(j.values[row][0], 0.0, 1e-9 * std::hypot(fx, fy)) << row;  // along the tangent
+    EXPECT_NEAR(std::fabs(j.values[row][1]), std::hypot(fx, fy), 1e-12 * std::hypot(fx, fy)) << row;
+  }
 }
 
 // Model::constraint_block(), the table JointReactions and the minimum-norm multipliers read a constraint through,

@@ -89,7 +89,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
     }
     if (!natural->joints.empty()) out.natural = natural;
     for (const Cursor& i : pending_.reaction_items) {
-      if (!builder_.has_constraint(i.name())) {
+      if (model.find_constraint(i.name()) < 0) {  // (the builder is the model now: it is asked)
         const int j = natural_joint(i.name());
         if (j < 0)
           i.fail("point '" + i.name() +

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "phiq/kinds/curve.hpp"
+#include "phiq/kinds/reaction_site.hpp"
 
 namespace phiq {
 
@@ -56,6 +57,19 @@ struct FlatFollowerSpec {
     f(a.x, Unit::kLength), f(a.y, Unit::kLength), f(a.psi, Unit::kAngle);
     f(on.frame.x, Unit::kLength), f(on.frame.y, Unit::kLength), f(on.frame.psi, Unit::kAngle);
     f(s, Unit::kLength);
+  }
+  /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Mz of a planar joint.
+  static constexpr int kReactionWidth = 3;
+  /// The reaction (ReactionSite): the cam's force on the follower a, or on the cam's frame when a is fixed, at the
+  /// contact point Q; its axes x along the face, y across it (the face carries no force along itself).
+  ReactionSite reaction_site(const double* q) const {
+    const Geometry g = geometry(q);
+    const kin::V2 contact = kin::V2{on.frame.x.of(q), on.frame.y.of(q)} + g.c;
+    ReactionSite site;
+    site.point = {contact.x, contact.y, 0.0};
+    site.frame2 = detail::frame_moves(a) ? a : on.frame;
+    site.axes[0] = {g.e.x, g.e.y, 0.0}, site.axes[1] = {-g.e.y, g.e.x, 0.0};
+    return site;
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double, double* phi) const {

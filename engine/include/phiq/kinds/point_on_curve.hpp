@@ -9,6 +9,7 @@
 #include <string>
 
 #include "phiq/kinds/curve.hpp"
+#include "phiq/kinds/reaction_site.hpp"
 
 namespace phiq {
 
@@ -53,6 +54,21 @@ struct PointOnCurveSpec {
     f(a.x, Unit::kLength), f(a.y, Unit::kLength), f(a.psi, Unit::kAngle);
     f(on.frame.x, Unit::kLength), f(on.frame.y, Unit::kLength), f(on.frame.psi, Unit::kAngle);
     f(s, Unit::kLength);
+  }
+  /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Mz of a planar joint.
+  static constexpr int kReactionWidth = 3;
+  /// The reaction (ReactionSite): the slot's or the cam's force on the point's frame a, or on the curve's when a is
+  /// fixed, at the point (a roller's centre: on the force's line); its axes x along the curve, y along its normal.
+  /// (With the multipliers of a sweep, whose row of s balances, the force is along the normal: a frictionless
+  /// contact.)
+  ReactionSite reaction_site(const double* q) const {
+    const Geometry g = geometry(q);
+    ReactionSite site;
+    site.point = {g.pa.x, g.pa.y, 0.0};
+    site.frame2 = detail::frame_moves(a) ? a : on.frame;
+    const double n = std::hypot(g.dp.x, g.dp.y);
+    if (n > 0.0) site.axes[0] = {g.dp.x / n, g.dp.y / n, 0.0}, site.axes[1] = {-g.dp.y / n, g.dp.x / n, 0.0};
+    return site;
   }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double, double* phi) const {
