@@ -169,24 +169,25 @@ void UrdfReader::check_tree() const {
     parent_joint[j.child] = &j;
   }
   // Each joint leads up to its parent link's joint. A cycle is found by walking up from each joint once, marking
-  // the walk (1) and what is known to reach the root (2): linear in the joints, for a serial chain of 10^5 links
-  // too. The first joint of the file on a cycle names it, with the cycle's joints from there.
-  std::map<const UrdfJointXml*, int> state;
+  // each joint (by its index in joints_) unseen 0, on this walk 1, done 2, on a cycle 3: linear in the joints, for a
+  // serial chain of 10^5 links too. The first joint of the file on a cycle names it, with the cycle's from there.
+  std::vector<char> state(joints_.size(), 0);
+  auto at = [&](const UrdfJointXml* j) -> char& { return state[static_cast<std::size_t>(j - joints_.data())]; };
   const auto up = [&](const UrdfJointXml* j) -> const UrdfJointXml* {
     const auto it = parent_joint.find(j->parent);
     return it == parent_joint.end() ? nullptr : it->second;
   };
-  std::set<const UrdfJointXml*> on_cycle;
   for (const UrdfJointXml& start : joints_) {
     std::vector<const UrdfJointXml*> walk;
     const UrdfJointXml* j = &start;
-    while (j && state[j] == 0) state[j] = 1, walk.push_back(j), j = up(j);
-    if (j && state[j] == 1)  // the walk came back onto itself: from j on, it is a cycle
-      on_cycle.insert(std::find(walk.begin(), walk.end(), j), walk.end());
-    for (const UrdfJointXml* w : walk) state[w] = 2;
+    while (j && at(j) == 0) at(j) = 1, walk.push_back(j), j = up(j);
+    const bool cycle = j && at(j) == 1;  // the walk came back onto itself: from j on, it is a cycle
+    for (const UrdfJointXml* w : walk) at(w) = 2;
+    if (cycle)
+      for (auto it = std::find(walk.begin(), walk.end(), j); it != walk.end(); ++it) at(*it) = 3;
   }
   for (const UrdfJointXml& j : joints_) {
-    if (!on_cycle.count(&j)) continue;
+    if (at(&j) != 3) continue;
     std::string chain = j.name;
     for (const UrdfJointXml* k = up(&j); k != &j; k = up(k)) chain += ", " + k->name;
     refuse(path_, j.line,
