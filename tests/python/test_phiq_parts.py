@@ -147,6 +147,20 @@ def test_driver_efforts_need_velocities_and_accelerations():
         phiq.driver_efforts(scene, result)
 
 
+def test_driver_efforts_name_a_load_that_is_not_finite():
+    """A force of 1/(t - 0.5) on the slider is infinite at t = 0.5: an error naming the force and the time, not a
+    row of NaN efforts."""
+    with open(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"), encoding="utf-8") as f:
+        text = f.read()
+    scene = phiq.parse_scene(text + "\nparts:\n  slider: {frame: {at: B}}\n"
+                             "loads:\n  forces: [{name: push, part: slider, force: [exp(1000*t), 0]}]\n",
+                             "crank_slider.yaml")
+    result = phiq.run_sweep(scene)
+    with pytest.raises(ValueError, match=r"at t = [0-9.]+: force 'push' on part 'slider': its value is not "
+                                         r"finite: \(inf, 0\)"):
+        phiq.driver_efforts(scene, result)
+
+
 def test_pendulum_pivot_reaction_is_the_closed_form():
     """A bar (mass m, centre l from its pivot) turned at a constant rate ω about a ground pin under gravity: the pin
     pushes the bar with F = m (a_G - g), a_G = -ω² l (cos θ, sin θ) pointing at the pivot, and no moment; the

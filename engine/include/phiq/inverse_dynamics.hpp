@@ -27,6 +27,14 @@ namespace phiq {
 void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
                             const double* qdd, double t, Eigen::VectorXd& Q);
 
+/// Why add_generalized_forces() gave a Q that is not finite at (q, q̇, q̈, t), as one phrase for a message: the first
+/// part with mass, then the first applied load, whose own generalized force is not finite, named, with what of it is
+/// not (a frame of points without a direction, a load's value, an overflow of doubles). Empty when each is finite
+/// alone. Pre-conditions as add_generalized_forces(), Q's size
+/// `num_coordinates`. Evaluates every contribution once more, alone: for the failure path, not for every row.
+std::string nonfinite_force_source(const std::vector<Part>& parts, const Loads& loads, Index num_coordinates,
+                                   const double* q, const double* qd, const double* qdd, double t);
+
 /// The constraints' multipliers at the motion in `ws` (q, q̇, q̈ solved at t): λ (one per equation) with Φqᵀ λ = Q,
 /// by the transposed solve of the model's LU of Φq at (q, t), factorised there if it is not already. A model with
 /// dropped (redundant) rows gives λ = 0 on them: one of the many λ then, not the minimum-norm one. Returns what the
@@ -47,7 +55,8 @@ std::vector<Index> rheonomic_constraints(const Model& model);
 
 /// The effort of each of rheonomic_constraints() at the motion in `ws` (q, q̇, q̈ at t) under `loads`: −λ of its
 /// first row, the torque or force its motor applies, conjugate to what it drives (a coordinate, a joint's angle or
-/// distance, an expression). As constraint_multipliers() for the status and `message`.
+/// distance, an expression). As constraint_multipliers() for the status and `message`; kNonFinite, with the part or
+/// load nonfinite_force_source() names, where Q or λ is not finite.
 SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, const Loads& loads, double t,
                            Workspace& ws, std::vector<double>& efforts, std::string* message = nullptr);
 

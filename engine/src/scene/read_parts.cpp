@@ -17,6 +17,32 @@ namespace {
 // The inertia tensor stated as a matrix is symmetric to this relative tolerance (its entries are typed by hand).
 constexpr double kSymmetryTolerance = 1e-9;
 
+bool same_slots(const Attachment3& a, const Attachment3& b) {
+  return a.r[0] == b.r[0] && a.r[1] == b.r[1] && a.r[2] == b.r[2];
+}
+
+bool zero_vector(const Attachment3& a) {
+  for (const Slot& s : a.r)
+    if (s.is_coordinate() || s.value() != 0.0) return false;
+  return true;
+}
+
+// A frame of points whose x (or y) can never give a direction: x's point the origin itself, a zero vector, or y's
+// point x's. (Points that only meet at some row are named at that row, phiq/inverse_dynamics.hpp.)
+template <class C>
+void refuse_frame_without_direction(const C& f, const PartFrame& pf) {
+  auto none = [](const Attachment3& to, bool is_point, const Attachment3& origin) {
+    return is_point ? same_slots(to, origin) : zero_vector(to);
+  };
+  if (none(pf.x_toward, pf.x_is_point, pf.origin))
+    f.field("x").fail(pf.x_is_point ? "x is the origin's point: the frame has no direction"
+                                    : "x is a zero vector: the frame has no direction");
+  if (!pf.spatial_frame) return;
+  if (none(pf.y_toward, pf.y_is_point, pf.origin) ||
+      (pf.x_is_point && pf.y_is_point && same_slots(pf.y_toward, pf.x_toward)))
+    f.field("y").fail("y is the origin's point, x's point or a zero vector: the frame has no plane");
+}
+
 }  // namespace
 
 void PartReader::read_parts(const Cursor& c, Scene& scene) {
@@ -112,6 +138,7 @@ void PartReader::points_or_expression_frame(const C& f, Part& part) const {
     if (!origin_point) f.field("origin").fail("the origin is a point, not a vector");
     pf.x_toward = frame_toward(f.require("x"), pf.x_is_point);
     if (r_.spatial_) pf.y_toward = frame_toward(f.require("y"), pf.y_is_point);
+    refuse_frame_without_direction(f, pf);
     part.body = "frame of points";
     return;
   }

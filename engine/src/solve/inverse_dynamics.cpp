@@ -181,9 +181,21 @@ SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, c
                            Workspace& ws, std::vector<double>& efforts, std::string* message) {
   Eigen::VectorXd Q = Eigen::VectorXd::Zero(model.num_coordinates()), lambda;
   add_generalized_forces(parts, loads, ws.q.data(), ws.qd.data(), ws.qdd.data(), t, Q);
-  const SolveStatus st = constraint_multipliers(model, t, ws, Q, lambda, message);
   efforts.clear();
+  if (!Q.allFinite()) {
+    if (message) {
+      *message =
+          nonfinite_force_source(parts, loads, model.num_coordinates(), ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
+      if (message->empty()) *message = "the parts' and loads' forces, each finite, overflow doubles in their sum";
+    }
+    return SolveStatus::kNonFinite;
+  }
+  const SolveStatus st = constraint_multipliers(model, t, ws, Q, lambda, message);
   if (st != SolveStatus::kSuccess) return st;
+  if (!lambda.allFinite()) {
+    if (message) *message = "the multipliers are not finite (an overflow of doubles)";
+    return SolveStatus::kNonFinite;
+  }
   for (Index c : rheonomic_constraints(model))
     efforts.push_back(-lambda(model.constraints()[static_cast<std::size_t>(c)].first_row));
   return st;

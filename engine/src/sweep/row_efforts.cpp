@@ -34,14 +34,21 @@ bool Sweeper::row_efforts() {
   // so large that their products overflow (a gravity of 1e308). NaN there would pass for a singular position's.
   if (!effort_work_.q.allFinite() || !effort_work_.lambda.allFinite()) {
     not_defined();  // (a Stepper, which delivers the row whatever, then reads NaN, not the last row's values)
-    Index j = 0;
-    while (j + 1 < effort_work_.q.size() && std::isfinite(effort_work_.q(j))) ++j;
-    return fail(SolveStatus::kNonFinite,
-                std::string("efforts: ") +
-                    (effort_work_.q.allFinite() ? "the multipliers of the parts' forces"
-                                                : "the force of the parts' masses and loads along '" +
-                                                      model_.coordinate_names()[static_cast<std::size_t>(j)] + "'") +
-                    " is not finite (an overflow: masses, inertias or loads too large for doubles)");
+    if (effort_work_.q.allFinite())
+      return fail(SolveStatus::kNonFinite,
+                  "efforts: the multipliers of the parts' forces are not finite (an overflow: "
+                  "masses, inertias or loads too large for doubles)");
+    // the part or load that made Q not finite, named (evaluated once more, alone: this row ends the sweep)
+    std::string why = nonfinite_force_source(*e.parts, *e.loads, model_.num_coordinates(), current_.q.data(),
+                                             current_.qd.data(), current_.qdd.data(), t);
+    if (why.empty()) {
+      Index j = 0;
+      while (j + 1 < effort_work_.q.size() && std::isfinite(effort_work_.q(j))) ++j;
+      why = "the force of the parts' masses and loads along '" +
+            model_.coordinate_names()[static_cast<std::size_t>(j)] +
+            "' is not finite (an overflow: their sum too large for doubles)";
+    }
+    return fail(SolveStatus::kNonFinite, "efforts: " + why);
   }
   // Φt at the drivers' rows only (a power reads no other; the whole model's is O(rows) at every row)
   effort_work_.phi_t.resize(model_.num_equations());
