@@ -53,6 +53,7 @@ class PartReader {
 
   // ---- loads (read_loads.cpp) ---------------------------------------------------------------------------------
   PartFrame load_frame(const Cursor& c, const Scene& scene) const;
+  PartFrame load_frame(const Cursor& c, const Scene& scene, const char* what) const;
   PartFrame ground_frame() const;
   kin3::V3 load_vector(const Cursor& c, const char* what) const;
   std::array<std::shared_ptr<const CompiledExpression>, 3> load_components(const Cursor& c, const char* what) const;

@@ -38,7 +38,7 @@ void PartReader::read_loads(const Cursor& c, Scene& scene) const {
       force.name = load_name(f, names);
       const Cursor part = f.require("part");
       force.part = part.name();
-      force.frame = load_frame(part, scene);
+      force.frame = load_frame(part, scene, "a force");
       if (auto at = f.field("at"); at.present()) force.at = load_vector(at, "at");
       force.axes = load_axes(f.field("axes"));
       force.components = load_components(f.require("force"), "force");
@@ -51,7 +51,7 @@ void PartReader::read_loads(const Cursor& c, Scene& scene) const {
       torque.name = load_name(m, names);
       const Cursor part = m.require("part");
       torque.part = part.name();
-      torque.frame = load_frame(part, scene);
+      torque.frame = load_frame(part, scene, "a torque");
       torque.axes = load_axes(m.field("axes"));
       const Cursor value = m.require("torque");
       if (r_.spatial_) {
@@ -69,7 +69,17 @@ void PartReader::read_loads(const Cursor& c, Scene& scene) const {
   if (!applied->empty()) scene.loads.applied = std::move(applied);
 }
 
-// The frame of the part, body or ground that `c` names: a part of the scene first, else a body's own frame.
+// The frame of the part, body or ground that `c` names: a part of the scene first, else a body's own frame. With
+// `what` (a force, a torque), one that reads no coordinate is refused: a load there does no virtual work (its
+// points' ∂/∂q are 0) and would change no effort, silently, where the scene misnamed its part.
+PartFrame PartReader::load_frame(const Cursor& c, const Scene& scene, const char* what) const {
+  PartFrame f = load_frame(c, scene);
+  if (frame_coordinates(f).empty())
+    c.fail("'" + c.name() + "' does not move (its frame reads no coordinate): " + what +
+           " on it does no work and changes no effort");
+  return f;
+}
+
 PartFrame PartReader::load_frame(const Cursor& c, const Scene& scene) const {
   const std::string n = c.name();
   for (const Part& p : scene.parts)
@@ -197,6 +207,8 @@ LinearSpring PartReader::linear_spring(const Cursor& s, const Scene& scene, std:
   }
   if (spring.a.part == spring.b.part && spring.a.at == spring.b.at)
     between.fail("the spring's two ends are the same point");
+  if (frame_coordinates(spring.a.frame).empty() && frame_coordinates(spring.b.frame).empty())
+    between.fail("neither end moves (their frames read no coordinate): the spring does no work and changes no effort");
   spring.stiffness = non_negative(s.require("stiffness"));
   spring.free_length = non_negative(s.require("free_length"));
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
