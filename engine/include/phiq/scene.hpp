@@ -29,7 +29,8 @@ struct SceneLimits {
   std::size_t max_file_bytes = std::size_t{128} << 20;  ///< 128 MiB
   int max_depth = 32;                                   ///< nesting of maps and lists
   /// Scalars + maps + lists. yaml-cpp's tree costs about 470 bytes a value, so this bounds the loader's memory
-  /// (10^6 values: 0.48 GB); larger models are written with families (`for i in A..B`), which cost no values.
+  /// (10^6 values: 0.48 GB); larger models are written with families (`for i in A..B`), which cost no values
+  /// (one converted from a URDF, MJCF, SDF or .asmt file, about 30 000 links, cannot be: it is refused).
   std::size_t max_nodes = 1'000'000;
   std::size_t max_scalar_bytes = 16384;  ///< one value (expressions are shorter still, see expression.hpp)
   /// Entries (coordinates, points, bodies, constraints, drivers) that indexed families (`for i in A..B`) may make

@@ -53,9 +53,11 @@ class ShapeGuard final : public YAML::EventHandler {
 
  private:
   void count(const YAML::Mark& m) {
-    if (++nodes_ > limits_.max_nodes)
-      fail(m, "more than " + std::to_string(limits_.max_nodes) +
-                  " values; the scene is too large (write repeated entries as families, `for i in A..B`)");
+    if (++nodes_ > limits_.max_nodes)  // families are the way out of a scene written by hand, not of a converted one
+      fail(m, "more than " + std::to_string(limits_.max_nodes) + " values; the scene is too large " +
+                  (model_format(path_) == ModelFormat::kScene
+                       ? "(write repeated entries as families, `for i in A..B`)"
+                       : "for phiq to read (SceneLimits::max_nodes; its YAML tree takes about 0.5 KB a value)"));
   }
   void enter(const YAML::Mark& m) {
     count(m);
