@@ -123,6 +123,10 @@ TEST(SingularPositions, AStartWithEveryLoopFoldedIsASingularPositionNotAModelSho
   EXPECT_EQ(test::sweep(*bricard.model, bricard.sweep, &tr, &bsum), SolveStatus::kSingularJacobian);
   EXPECT_HAS(bsum.message, "Φq stays singular around it");
   EXPECT_HAS(bsum.message, "): redundant or missing constraints");
+  // and names them: Bricard's six revolutes are square without the driver only by its redundant equation
+  EXPECT_HAS(bsum.message,
+             "constraints: 1 degree(s) of freedom not driven, the equations as many as the "
+             "coordinates only by the redundant 'J6'");
 }
 
 TEST(SingularPositions, NFourBarFullTurnInWholeDegreesStaysOnTheParallelogram) {

@@ -340,8 +340,8 @@ Eigen::VectorXd nearby_placement(const Model& model, const Eigen::VectorXd& q) {
 // constraints, all along its motion. The rank is taken at a solution assembled from q moved off it
 // (nearby_placement), not at the moved placement itself, where an overconstrained linkage (Bricard's,
 // a braced parallelogram) has full rank though it loses it on every solution.
-Index detail::driven_dof_nearby(const Model& model, const Eigen::VectorXd& q, double t,
-                                const AssemblyOptions& options) {
+Index detail::driven_dof_nearby(const Model& model, const Eigen::VectorXd& q, double t, const AssemblyOptions& options,
+                                RankReport* report) {
   Eigen::VectorXd nearby = nearby_placement(model, q);
   AssemblySummary as;
   try {
@@ -349,6 +349,7 @@ Index detail::driven_dof_nearby(const Model& model, const Eigen::VectorXd& q, do
   } catch (const Error&) {  // a placement outside an expression's domain can upset the rank analysis
     return -1;
   }
+  if (report) *report = as.rank;
   return as.rank.driven_dof;
 }
 

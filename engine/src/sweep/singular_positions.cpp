@@ -41,8 +41,15 @@ struct SingularSides {
 // its neighbour's crank, the far loops staying so as crank 0 turns), which a solution assembled near it, fully
 // driven, tells (detail::driven_dof_nearby).
 std::string Sweeper::singular_throughout(const Eigen::VectorXd& qs, double t) {
-  const Index nearby = detail::driven_dof_nearby(model_, qs, t, assembly_options(opt_.newton));
-  if (nearby > 0) return ": redundant or missing constraints";
+  RankReport rank;
+  const Index nearby = detail::driven_dof_nearby(model_, qs, t, assembly_options(opt_.newton), &rank);
+  if (nearby > 0) {  // square, and short of rank everywhere near: as many redundant rows as freedoms not driven
+    std::string names;
+    for (const std::string& n : rank.redundant) names += (names.empty() ? "'" : ", '") + n + "'";
+    return ": redundant or missing constraints: " + std::to_string(nearby) + " degree(s) of freedom not driven" +
+           (names.empty() ? std::string()
+                          : ", the equations as many as the coordinates only by the redundant " + names);
+  }
   if (nearby < 0)
     return ": redundant or missing constraints, or several loops folded or aligned at once (no solution near it "
            "was assembled to tell which)";
