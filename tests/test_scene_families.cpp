@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include "phiq/applied_loads.hpp"
 #include "phiq/phiq.hpp"
 #include "phiq/text.hpp"
 #include "test_support.hpp"
@@ -139,6 +140,81 @@ TEST(SceneFamilies, PartsFromFamiliesAreThePartsListed) {
                      "    \"crank{i}\": {frame: {origin: [i, 0], x: \"P{i}\"}}\n")
                 .find("parts.for i in 0..N[i=2].crank{i}: part 'crank2' is defined twice"),
             std::string::npos);
+}
+
+// Loads from families (a force on each coupler growing with the index, a torque, a spring to the ground and a
+// torsional spring on each crank's tip) are the loads listed one by one: the same names, parts and generalized
+// forces, bit for bit; a name a family repeats is refused at its member.
+TEST(SceneFamilies, LoadsFromFamiliesAreTheLoadsListed) {
+  const std::string parts = std::string(kFamilies) +
+                            "parts:\n"
+                            "  for i in 0..N-1:\n"
+                            "    \"coupler{i}\": {frame: {origin: \"P{i}\", x: \"P{i+1}\"}, mass: 1, "
+                            "center_of_mass: [0.5, 0], inertia: 0.1}\n";
+  const std::string families =
+      parts +
+      "loads:\n"
+      "  forces:\n"
+      "    - for i in 0..N-1:\n"
+      "        - {name: \"push{i}\", part: \"coupler{i}\", at: [0.5, 0], force: [i + 1, t*i]}\n"
+      "  torques:\n"
+      "    - for i in 0..N-1: [{name: \"turn{i}\", part: \"coupler{i}\", torque: 2*i - y0}]\n"
+      "  springs:\n"
+      "    - for i in 0..N-1:\n"
+      "        - {name: \"pull{i}\", between: [{part: \"coupler{i}\", at: [1, 0]}, {point: [i, "
+      "2]}], stiffness: 10 + i, free_length: 0.5}\n"
+      "  torsional_springs:\n"
+      "    - for i in 0..N: [{name: \"wind{i}\", angle: \"atan2(y{i}, x{i} - i)\", stiffness: "
+      "i + 1}]\n";
+  std::string listed = parts + "loads:\n  forces:\n";
+  for (int i = 0; i < 3; ++i)
+    listed += "    - {name: push" + std::to_string(i) + ", part: coupler" + std::to_string(i) +
+              ", at: [0.5, 0], force: [" + std::to_string(i + 1) + ", t*" + std::to_string(i) + "]}\n";
+  listed += "  torques:\n";
+  for (int i = 0; i < 3; ++i)
+    listed += "    - {name: turn" + std::to_string(i) + ", part: coupler" + std::to_string(i) +
+              ", torque: " + std::to_string(2 * i) + " - y0}\n";
+  listed += "  springs:\n";
+  for (int i = 0; i < 3; ++i)
+    listed += "    - {name: pull" + std::to_string(i) + ", between: [{part: coupler" + std::to_string(i) +
+              ", at: [1, 0]}, {point: [" + std::to_string(i) + ", 2]}], stiffness: " + std::to_string(10 + i) +
+              ", free_length: 0.5}\n";
+  listed += "  torsional_springs:\n";
+  for (int i = 0; i <= 3; ++i)
+    listed += "    - {name: wind" + std::to_string(i) + ", angle: \"atan2(y" + std::to_string(i) + ", x" +
+              std::to_string(i) + " - " + std::to_string(i) + ")\", stiffness: " + std::to_string(i + 1) + "}\n";
+  const Scene a = parse_scene(families, "families.yaml"), b = parse_scene(listed, "listed.yaml");
+  ASSERT_TRUE(a.loads.applied && b.loads.applied);
+  const AppliedLoads &x = *a.loads.applied, &y = *b.loads.applied;
+  ASSERT_EQ(x.forces.size(), 3u);
+  ASSERT_EQ(x.torques.size(), 3u);
+  ASSERT_EQ(x.springs.size(), 3u);
+  ASSERT_EQ(x.torsional_springs.size(), 4u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(x.forces[k].name, "push" + std::to_string(k));
+    EXPECT_EQ(x.forces[k].part, y.forces[k].part);
+    EXPECT_EQ(x.torques[k].name, y.torques[k].name);
+    EXPECT_EQ(x.springs[k].name, y.springs[k].name);
+    EXPECT_EQ(x.springs[k].stiffness, 10.0 + static_cast<double>(k));
+    EXPECT_EQ(x.springs[k].b.at.x, y.springs[k].b.at.x);
+  }
+  EXPECT_EQ(x.torsional_springs[3].name, "wind3");
+  EXPECT_EQ(x.torsional_springs[3].stiffness, 4.0);
+  // the generalized forces at a moved placement and time: equal to the bit, and not zero
+  Eigen::VectorXd q = a.model->initial_positions(), qd = Eigen::VectorXd::Zero(q.size());
+  for (Index j = 0; j < q.size(); ++j) q(j) += 0.01 * static_cast<double>(j % 5), qd(j) = 0.1 * static_cast<double>(j);
+  Eigen::VectorXd qa = Eigen::VectorXd::Zero(q.size()), qb = qa;
+  add_applied_forces(x, q.data(), qd.data(), 0.7, qa);
+  add_applied_forces(y, q.data(), qd.data(), 0.7, qb);
+  EXPECT_EQ(qa, qb);
+  EXPECT_GT(qa.norm(), 1.0);
+  EXPECT_NE(error_of(parts + "loads:\n  forces:\n    - {name: push1, part: coupler0, force: [1, 0]}\n"
+                             "    - for i in 0..N-1: [{name: \"push{i}\", part: \"coupler{i}\", force: [1, 0]}]\n")
+                .find("loads.forces[1].for i in 0..N-1[i=1]"),
+            std::string::npos)
+      << error_of(parts +
+                  "loads:\n  forces:\n    - {name: push1, part: coupler0, force: [1, 0]}\n"
+                  "    - for i in 0..N-1: [{name: \"push{i}\", part: \"coupler{i}\", force: [1, 0]}]\n");
 }
 
 // A family of parts on one mesh file reads it once: every member shares the mesh (10⁴ links, one STL parsed); another

@@ -8,6 +8,8 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "scene/scene_reader.hpp"
@@ -51,16 +53,33 @@ class PartReader {
   template <class C>
   void read_shape_size(const C& c, Shape& s) const;
 
-  // ---- loads (read_loads.cpp) ---------------------------------------------------------------------------------
-  PartFrame load_frame(const Cursor& c, const Scene& scene) const;
-  PartFrame load_frame(const Cursor& c, const Scene& scene, const char* what) const;
+  // ---- loads (read_loads.cpp): templates over the cursor, a plain entry or a family's member ------------------
+  // What a load may act on: the scene's parts, by name (found once: 10⁴ loads on 10⁴ parts compared 10⁸ names).
+  struct LoadTargets {
+    const Scene& scene;
+    std::unordered_map<std::string_view, std::size_t> parts;  // name → index in scene.parts
+  };
+  template <class C>
+  AppliedForce applied_force(const C& f, const LoadTargets& targets, std::set<std::string>& names) const;
+  template <class C>
+  AppliedTorque applied_torque(const C& m, const LoadTargets& targets, std::set<std::string>& names) const;
+  template <class C>
+  PartFrame load_frame(const C& c, const LoadTargets& targets) const;
+  template <class C>
+  PartFrame load_frame(const C& c, const LoadTargets& targets, const char* what) const;
   PartFrame ground_frame() const;
-  kin3::V3 load_vector(const Cursor& c, const char* what) const;
-  std::array<std::shared_ptr<const CompiledExpression>, 3> load_components(const Cursor& c, const char* what) const;
-  LoadAxes load_axes(const Cursor& c) const;
-  double non_negative(const Cursor& c) const;
-  LinearSpring linear_spring(const Cursor& s, const Scene& scene, std::set<std::string>& names) const;
-  TorsionalSpring torsional_spring(const Cursor& s, std::set<std::string>& names) const;
+  template <class C>
+  kin3::V3 load_vector(const C& c, const char* what) const;
+  template <class C>
+  std::array<std::shared_ptr<const CompiledExpression>, 3> load_components(const C& c, const char* what) const;
+  template <class C>
+  LoadAxes load_axes(const C& c) const;
+  template <class C>
+  double non_negative(const C& c) const;
+  template <class C>
+  LinearSpring linear_spring(const C& s, const LoadTargets& targets, std::set<std::string>& names) const;
+  template <class C>
+  TorsionalSpring torsional_spring(const C& s, std::set<std::string>& names) const;
 
   SceneReader& r_;  // (not const: a family's walk keeps its state there)
   // the meshes read so far, by file (as written, joined to the scene's folder) and scale

@@ -6,6 +6,7 @@
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/text.hpp"
+#include "scene/family_expansion.hpp"
 #include "scene/part_reader.hpp"
 
 namespace phiq::detail::scene {
@@ -13,8 +14,9 @@ namespace phiq::detail::scene {
 namespace {
 
 // A load's name, or its place ("loads.forces[1]") when it has none; refused when another load has it.
-std::string load_name(const Cursor& c, std::set<std::string>& names) {
-  const Cursor n = c.field("name");
+template <class C>
+std::string load_name(const C& c, std::set<std::string>& names) {
+  const auto n = c.field("name");
   if (!n.present()) return c.path();
   std::string name = n.name();
   if (!names.insert(name).second) n.fail("duplicate load name '" + name + "'");
@@ -31,59 +33,70 @@ void PartReader::read_loads(const Cursor& c, Scene& scene) const {
   }
   auto applied = std::make_shared<AppliedLoads>();
   std::set<std::string> names;
+  LoadTargets targets{scene, {}};
+  targets.parts.reserve(scene.parts.size());
+  for (std::size_t i = 0; i < scene.parts.size(); ++i) targets.parts.emplace(scene.parts[i].name, i);
+  // each list may hold families (`- for i in A..B: [...]`), as the constraints do
   if (auto fs = c.field("forces"); fs.present())
-    for (const Cursor& f : fs.items()) {
-      f.expect_map({"name", "part", "at", "force", "axes"});
-      AppliedForce force;
-      force.name = load_name(f, names);
-      const Cursor part = f.require("part");
-      force.part = part.name();
-      force.frame = load_frame(part, scene, "a force");
-      if (auto at = f.field("at"); at.present()) force.at = load_vector(at, "at");
-      force.axes = load_axes(f.field("axes"));
-      force.components = load_components(f.require("force"), "force");
-      applied->forces.push_back(std::move(force));
-    }
+    r_.read_list(fs, [&](const auto& f) { applied->forces.push_back(applied_force(f, targets, names)); });
   if (auto ts = c.field("torques"); ts.present())
-    for (const Cursor& m : ts.items()) {
-      m.expect_map({"name", "part", "torque", "axes"});
-      AppliedTorque torque;
-      torque.name = load_name(m, names);
-      const Cursor part = m.require("part");
-      torque.part = part.name();
-      torque.frame = load_frame(part, scene, "a torque");
-      torque.axes = load_axes(m.field("axes"));
-      const Cursor value = m.require("torque");
-      if (r_.spatial_) {
-        torque.components = load_components(value, "torque");
-      } else {
-        if (!value.is_scalar()) value.fail("a torque in the plane is one number or expression (about z)");
-        torque.components[2] = r_.compile(value, true);
-      }
-      applied->torques.push_back(std::move(torque));
-    }
+    r_.read_list(ts, [&](const auto& m) { applied->torques.push_back(applied_torque(m, targets, names)); });
   if (auto ss = c.field("springs"); ss.present())
-    for (const Cursor& s : ss.items()) applied->springs.push_back(linear_spring(s, scene, names));
+    r_.read_list(ss, [&](const auto& s) { applied->springs.push_back(linear_spring(s, targets, names)); });
   if (auto ts = c.field("torsional_springs"); ts.present())
-    for (const Cursor& s : ts.items()) applied->torsional_springs.push_back(torsional_spring(s, names));
+    r_.read_list(ts, [&](const auto& s) { applied->torsional_springs.push_back(torsional_spring(s, names)); });
   if (!applied->empty()) scene.loads.applied = std::move(applied);
+}
+
+template <class C>
+AppliedForce PartReader::applied_force(const C& f, const LoadTargets& targets, std::set<std::string>& names) const {
+  f.expect_map({"name", "part", "at", "force", "axes"});
+  AppliedForce force;
+  force.name = load_name(f, names);
+  const auto part = f.require("part");
+  force.part = part.name();
+  force.frame = load_frame(part, targets, "a force");
+  if (auto at = f.field("at"); at.present()) force.at = load_vector(at, "at");
+  force.axes = load_axes(f.field("axes"));
+  force.components = load_components(f.require("force"), "force");
+  return force;
+}
+
+template <class C>
+AppliedTorque PartReader::applied_torque(const C& m, const LoadTargets& targets, std::set<std::string>& names) const {
+  m.expect_map({"name", "part", "torque", "axes"});
+  AppliedTorque torque;
+  torque.name = load_name(m, names);
+  const auto part = m.require("part");
+  torque.part = part.name();
+  torque.frame = load_frame(part, targets, "a torque");
+  torque.axes = load_axes(m.field("axes"));
+  const auto value = m.require("torque");
+  if (r_.spatial_) {
+    torque.components = load_components(value, "torque");
+  } else {
+    if (!value.is_scalar()) value.fail("a torque in the plane is one number or expression (about z)");
+    torque.components[2] = r_.compile(value, true);
+  }
+  return torque;
 }
 
 // The frame of the part, body or ground that `c` names: a part of the scene first, else a body's own frame. With
 // `what` (a force, a torque), one that reads no coordinate is refused: a load there does no virtual work (its
 // points' ∂/∂q are 0) and would change no effort, silently, where the scene misnamed its part.
-PartFrame PartReader::load_frame(const Cursor& c, const Scene& scene, const char* what) const {
-  PartFrame f = load_frame(c, scene);
-  if (frame_coordinates(f).empty())
+template <class C>
+PartFrame PartReader::load_frame(const C& c, const LoadTargets& targets, const char* what) const {
+  PartFrame f = load_frame(c, targets);
+  if (what && frame_coordinates(f).empty())
     c.fail("'" + c.name() + "' does not move (its frame reads no coordinate): " + what +
            " on it does no work and changes no effort");
   return f;
 }
 
-PartFrame PartReader::load_frame(const Cursor& c, const Scene& scene) const {
+template <class C>
+PartFrame PartReader::load_frame(const C& c, const LoadTargets& targets) const {
   const std::string n = c.name();
-  for (const Part& p : scene.parts)
-    if (p.name == n) return p.frame;
+  if (const auto it = targets.parts.find(n); it != targets.parts.end()) return targets.scene.parts[it->second].frame;
   PartFrame f = ground_frame();
   if (n == kGround) return f;
   const Index b = r_.spatial_ ? r_.entry_at(c, n, r_.names_.bodies3) : r_.entry_at(c, n, r_.names_.bodies);
@@ -103,7 +116,8 @@ PartFrame PartReader::ground_frame() const {
 }
 
 // A point or vector of constants, [x, y] in the plane, [x, y, z] in space.
-kin3::V3 PartReader::load_vector(const Cursor& c, const char* what) const {
+template <class C>
+kin3::V3 PartReader::load_vector(const C& c, const char* what) const {
   const std::size_t n = r_.spatial_ ? 3 : 2;
   if (!c.is_sequence() || c.size() != n)
     c.fail(std::string(what) + " is " + (r_.spatial_ ? "[x, y, z]" : "[x, y]") + " (numbers or constant expressions)");
@@ -112,7 +126,8 @@ kin3::V3 PartReader::load_vector(const Cursor& c, const char* what) const {
 }
 
 // A vector of expressions of t, the coordinates and the parameters; the plane's has no z.
-std::array<std::shared_ptr<const CompiledExpression>, 3> PartReader::load_components(const Cursor& c,
+template <class C>
+std::array<std::shared_ptr<const CompiledExpression>, 3> PartReader::load_components(const C& c,
                                                                                      const char* what) const {
   const std::size_t n = r_.spatial_ ? 3 : 2;
   if (!c.is_sequence() || c.size() != n)
@@ -123,7 +138,8 @@ std::array<std::shared_ptr<const CompiledExpression>, 3> PartReader::load_compon
   return out;
 }
 
-LoadAxes PartReader::load_axes(const Cursor& c) const {
+template <class C>
+LoadAxes PartReader::load_axes(const C& c) const {
   if (!c.present()) return LoadAxes::kWorld;
   const std::string s = c.text();
   if (s == "world") return LoadAxes::kWorld;
@@ -131,7 +147,8 @@ LoadAxes PartReader::load_axes(const Cursor& c) const {
   c.fail("axes is world or part, got '" + s + "'");
 }
 
-double PartReader::non_negative(const Cursor& c) const {
+template <class C>
+double PartReader::non_negative(const C& c) const {
   const double v = r_.number(c);
   if (v < 0.0) c.fail("must not be negative, got " + c.text());
   return v;
@@ -139,11 +156,12 @@ double PartReader::non_negative(const Cursor& c) const {
 
 // A torsional spring-damper on `coordinate: NAME`, `angle: EXPRESSION` of the coordinates, or a spatial `joint`'s
 // angle.
-TorsionalSpring PartReader::torsional_spring(const Cursor& s, std::set<std::string>& names) const {
+template <class C>
+TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& names) const {
   s.expect_map({"name", "coordinate", "angle", "joint", "stiffness", "free_angle", "damping"});
   TorsionalSpring spring;
   spring.name = load_name(s, names);
-  const Cursor on_coordinate = s.field("coordinate"), angle = s.field("angle"), joint = s.field("joint");
+  const auto on_coordinate = s.field("coordinate"), angle = s.field("angle"), joint = s.field("joint");
   if (on_coordinate.present() + angle.present() + joint.present() != 1)
     s.fail("a torsional spring acts on one of `coordinate: NAME`, `angle: EXPRESSION` or `joint: NAME`");
   if (on_coordinate.present()) {
@@ -180,16 +198,17 @@ TorsionalSpring PartReader::torsional_spring(const Cursor& s, std::set<std::stri
 }
 
 // A linear spring-damper: `between: [END, END]`, each {part: P, at: [..]} or {point: [..]} (fixed in the world).
-LinearSpring PartReader::linear_spring(const Cursor& s, const Scene& scene, std::set<std::string>& names) const {
+template <class C>
+LinearSpring PartReader::linear_spring(const C& s, const LoadTargets& targets, std::set<std::string>& names) const {
   s.expect_map({"name", "between", "stiffness", "free_length", "damping", "preload"});
   LinearSpring spring;
   spring.name = load_name(s, names);
-  const Cursor between = s.require("between");
+  const auto between = s.require("between");
   if (!between.is_sequence() || between.size() != 2)
     between.fail("between is two ends [{part: A, at: [..]}, {part: B, at: [..]} or {point: [..]}]");
   SpringEnd* ends[2] = {&spring.a, &spring.b};
   for (std::size_t k = 0; k < 2; ++k) {
-    const Cursor e = between.at(k);
+    const auto e = between.at(k);
     e.expect_map({"part", "at", "point"});
     SpringEnd& end = *ends[k];
     if (auto p = e.field("point"); p.present()) {
@@ -200,9 +219,9 @@ LinearSpring PartReader::linear_spring(const Cursor& s, const Scene& scene, std:
       end.at = load_vector(p, "point");
       continue;
     }
-    const Cursor part = e.require("part");
+    const auto part = e.require("part");
     end.part = part.name();
-    end.frame = load_frame(part, scene);
+    end.frame = load_frame(part, targets);
     if (auto at = e.field("at"); at.present()) end.at = load_vector(at, "at");
   }
   if (spring.a.part == spring.b.part && spring.a.at == spring.b.at)

@@ -54,6 +54,22 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
   out.spatial = spatial;
   const int dimension = spatial ? 3 : 2;
   out.bodies.reserve(parts.size());
+  // the applied loads by the part they act on, found once: a scene with a load on each of 10⁴ parts compared every
+  // part with every load (10⁸ names)
+  struct OwnLoads {
+    std::vector<const AppliedForce*> forces;
+    std::vector<const AppliedTorque*> torques;
+    std::vector<const LinearSpring*> springs;
+  };
+  std::unordered_map<std::string_view, OwnLoads> loads_of;
+  if (loads.applied) {
+    for (const AppliedForce& f : loads.applied->forces) loads_of[f.part].forces.push_back(&f);
+    for (const AppliedTorque& f : loads.applied->torques) loads_of[f.part].torques.push_back(&f);
+    for (const LinearSpring& s : loads.applied->springs) {
+      loads_of[s.a.part].springs.push_back(&s);
+      if (s.b.part != s.a.part) loads_of[s.b.part].springs.push_back(&s);
+    }
+  }
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const Part& p = parts[i];
     if (p.frame.kind != PartFrameKind::kPoints || max_coordinate(p.frame) < 0) continue;  // (a frame that moves)
@@ -77,13 +93,13 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
       b.parts.back().frame = promoted;
     }
     b.loads.gravity = loads.gravity;
-    if (loads.applied) {
+    if (const auto it = loads_of.find(p.name); it != loads_of.end()) {
       auto own = std::make_shared<AppliedLoads>();
-      for (const AppliedForce& f : loads.applied->forces)
-        if (f.part == p.name) own->forces.push_back(f), own->forces.back().frame = promoted;
-      for (const AppliedTorque& f : loads.applied->torques)
-        if (f.part == p.name) own->torques.push_back(f), own->torques.back().frame = promoted;
-      for (const LinearSpring& s : loads.applied->springs) {
+      for (const AppliedForce* f : it->second.forces) own->forces.push_back(*f), own->forces.back().frame = promoted;
+      for (const AppliedTorque* f : it->second.torques)
+        own->torques.push_back(*f), own->torques.back().frame = promoted;
+      for (const LinearSpring* sp : it->second.springs) {
+        const LinearSpring& s = *sp;
         const bool a = s.a.part == p.name, c = s.b.part == p.name;
         const bool other_fixed = (a && (c || s.b.part == "ground")) || (c && s.a.part == "ground");
         if (!other_fixed) continue;  // a spring to another body: counted in the joints' reactions
