@@ -226,6 +226,31 @@ TEST_F(AnimateHtml, ForceArrowsHoldTheResultsEffortsAndReactionsAtTheirJoints) {
   EXPECT_FALSE(fs::exists(dir_ / "n.html"));
 }
 
+// Natural joints written along their bodies' axes (a bar's length and across it) are drawn in world axes too: the
+// four-bar of models/dynamics/fourbar_motor_torque.yaml, its shared points O, A, B, C.
+TEST_F(AnimateHtml, ForceArrowsOfNaturalJointsAreTheSameInBothAxes) {
+  std::string text = slurp(phiq::test::model_path("dynamics/fourbar_motor_torque.yaml"));
+  text.erase(text.find("output:"));
+  animate(write("natural.yaml", text + "output: {reactions: all}\n").string(), "--forces 0.05");
+  const nlohmann::json world = data["forces"]["arrows"];
+  ASSERT_EQ(world.size(), 4u);
+  const std::size_t rows = table.rows.size();
+  std::vector<double> world_b;
+  for (std::size_t k = 0; k < rows; ++k) world_b.push_back(at(k, "B.Fy"));
+  animate(write("natural_turned.yaml", text + "output: {reactions: all, reaction_axes: joint}\n").string(),
+          "--forces 0.05");
+  ASSERT_EQ(table.rows.size(), rows);
+  double turned = 0.0;  // the columns moved: along the coupler's axes now
+  for (std::size_t k = 0; k < rows; ++k) turned = std::max(turned, std::fabs(at(k, "B.Fy") - world_b[k]));
+  EXPECT_GT(turned, 1.0);
+  for (std::size_t a = 0; a < 4; ++a)
+    for (std::size_t i = 0; i < 3 * rows; ++i) {
+      const double w = world[a]["force"][i], j = data["forces"]["arrows"][a]["force"][i];
+      EXPECT_NEAR(j, w, 1e-9 * (1.0 + std::fabs(w))) << a << " " << i;
+      EXPECT_EQ(world[a]["at"][i], data["forces"]["arrows"][a]["at"][i]) << a << " " << i;
+    }
+}
+
 TEST_F(AnimateHtml, LargeChainsKeepEvenlySpreadRowsWithinTheBudget) {
   constexpr std::size_t kFrameBudget = std::size_t{8} << 20;  // tools/animate/html_motion.hpp (in the phiq program)
   const fs::path scene = dir_ / "chain.yaml";

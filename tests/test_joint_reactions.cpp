@@ -334,6 +334,46 @@ TEST(JointReactions, TheScenesReactionAxesTurnEachPinsForceByItsBody) {
             std::string::npos);
 }
 
+// Natural joints along their body's axes (reaction_axes: joint): the four-bar of
+// models/dynamics/fourbar_motor_torque.yaml, its coupler massless. A massless link pinned at both ends and loaded
+// nowhere else is a two-force member: at B (reported on the coupler, the first part that holds it) the force lies
+// along the coupler, nothing across it, though in world axes both components are not zero. At A (reported on the
+// crank) the world force turned by the crank's angle; animate --forces turns them back (AnimateHtml).
+TEST(JointReactions, ANaturalJointAlongItsBodysAxesShowsAMasslessCouplerPushingAlongItself) {
+  std::string base = reaction_scene_text("dynamics/fourbar_motor_torque.yaml");
+  const std::string massive =
+      "coupler: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 2.0, "
+      "inertia: 2.0*L3*L3/12}";
+  ASSERT_NE(base.find(massive), std::string::npos);
+  base.replace(base.find(massive), massive.size(), "coupler: {frame: {origin: A, x: B}}");
+  const std::string out = "output: {velocities: true, accelerations: true, reactions: [A, B]";
+  const Scene world = parse_scene(base + out + "}\n", "k.yaml"),
+              joint = parse_scene(base + out + ", reaction_axes: joint}\n", "k.yaml");
+  const Model* swept = nullptr;
+  const ReactionRows w = sweep_reactions(world, nullptr, &swept), j = sweep_reactions(joint);
+  ASSERT_EQ(w.values.size(), 121u);
+  const Model& m = *swept;
+  const Index xa = m.find_coordinate("xA"), ya = m.find_coordinate("yA"), xb = m.find_coordinate("xB"),
+              yb = m.find_coordinate("yB");
+  double along = 0.0;
+  for (std::size_t row = 0; row < w.values.size(); ++row) {
+    const Eigen::VectorXd& q = w.q[row];
+    const Eigen::Vector2d fa(w.values[row][0], w.values[row][1]), fb(w.values[row][3], w.values[row][4]);
+    const Eigen::Vector2d crank = Eigen::Vector2d(q(xa), q(ya)).normalized();
+    const Eigen::Vector2d coupler = Eigen::Vector2d(q(xb) - q(xa), q(yb) - q(ya)).normalized();
+    const Eigen::Vector2d across(-coupler.y(), coupler.x());
+    const double scale = 1.0 + fb.norm();
+    EXPECT_NEAR(fb.dot(across), 0.0, 1e-9 * scale) << row;  // the world force itself lies along the coupler
+    EXPECT_NEAR(j.values[row][3], fb.dot(coupler), 1e-12 * scale) << row;
+    EXPECT_NEAR(j.values[row][4], 0.0, 1e-9 * scale) << row;
+    EXPECT_NEAR(j.values[row][0], fa.dot(crank), 1e-12 * (1.0 + fa.norm())) << row;
+    EXPECT_NEAR(j.values[row][1], fa.dot(Eigen::Vector2d(-crank.y(), crank.x())), 1e-12 * (1.0 + fa.norm())) << row;
+    EXPECT_EQ(j.values[row][2], 0.0);
+    along = std::max(along, std::min(std::fabs(fb.x()), std::fabs(fb.y())));
+  }
+  EXPECT_GT(along, 1.0);  // newtons in both world components somewhere: the turn is not the identity
+}
+
 // A roller follower lifted by an eccentric cam (models/cams/eccentric_roller.yaml) with a mass on the rod under
 // gravity: the rod's guide carries no force along y, so the cam pushes it up by m (ÿ + g) (Newton, on the rod
 // alone), along the line from the cam circle's centre to the roller's (a frictionless contact): along the cam's

@@ -86,6 +86,7 @@ nlohmann::json force_arrows(const Scene& scene, const CsvTable& table, const std
     return it->second;
   };
   const std::vector<Held> held = constraint_blocks(model);
+  const std::size_t time = column("t");
   const bool spatial = scene.dimension == 3;
   nlohmann::json arrows = nlohmann::json::array(), unplaced = nlohmann::json::array();
   // one arrow: its joint's point at every kept row, and force / moment columns (3 each; −1: a zero component)
@@ -94,10 +95,11 @@ nlohmann::json force_arrows(const Scene& scene, const CsvTable& table, const std
                  const std::array<long, 3>& moment) {
     nlohmann::json at = nlohmann::json::array(), f = nlohmann::json::array(), m = nlohmann::json::array();
     for (std::size_t k = 0; k < rows.size(); ++k) {
-      ReactionSite rs;  // (its axes world axes but at a constraint's site)
-      if (site < 0) {
-        const Attachment3& p = e.natural->joints[static_cast<std::size_t>(-1 - site)].point;
-        for (const Slot& s : p.r) at.push_back(s.of(q[k].data()));
+      ReactionSite rs;
+      if (site < 0) {  // a natural joint: its point, and its body's axes (written along them in joint axes)
+        rs = natural_reaction_site(*e.natural, static_cast<std::size_t>(-1 - site), q[k].data(),
+                                   table.rows[rows[k]][time]);
+        for (double x : {rs.point.x, rs.point.y, rs.point.z}) at.push_back(x);
       } else {
         const Held& h = held[static_cast<std::size_t>(site)];
         h.block->reaction_site(h.index, q[k].data(), rs);

@@ -117,6 +117,7 @@ class JointReactions {
   };
   struct SetUpOnly {};  // with_set_up_of()'s constructor
   JointReactions(const JointReactions& other, SetUpOnly);
+  void turn_natural(const NaturalSite& s, const double* q, double t, double* force) const;
   void add_site(const Model& model, Index c, std::vector<int>& site_of);
   void find_columns(const Model& model, const std::vector<int>& site_of);
   void add_natural(const Model& model, const OutputEfforts& efforts);

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "phiq/applied_loads.hpp"
+#include "phiq/kinds/reaction_site.hpp"
 #include "phiq/parts.hpp"
 
 namespace phiq {
@@ -68,5 +69,11 @@ struct NaturalJoints {
 NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& loads,
                                   const std::vector<std::pair<std::string, Attachment3>>& points, Index coordinates,
                                   bool spatial);
+
+/// Where natural joint `j`'s reaction acts, and the axes it is written along where they are asked for
+/// (OutputEfforts::reactions_in_joint_axes): the joint's point, and the axes of the frame of the body it is reported
+/// on (its first; x toward the frame's x point: along a bar and across it). Only `point` and `axes` are set.
+/// Pre-condition: j < joints.joints.size(); q the model's coordinates.
+ReactionSite natural_reaction_site(const NaturalJoints& joints, std::size_t j, const double* q, double t);
 
 }  // namespace phiq

@@ -104,7 +104,8 @@ struct OutputEfforts {
   /// for a planar joint, `NAME.Fx` … `NAME.Mz` (six) for a spatial one; minimum-norm where indeterminate.
   std::vector<OutputReaction> reactions;
   /// The constraints' reactions along each joint's own axes (ReactionSite::axes: a pin's body's, a prismatic
-  /// pair's slide, a spatial joint's frame) rather than world axes; a natural point's stay in world axes.
+  /// pair's slide, a spatial joint's frame) rather than world axes; a natural point's along the frame of the part it
+  /// is reported on (natural_reaction_site(): x toward the frame's x point, along a bar and across it).
   bool reactions_in_joint_axes = false;
   /// The natural coordinates' bodies and joints the `natural` reactions index (null: none listed).
   std::shared_ptr<const NaturalJoints> natural;

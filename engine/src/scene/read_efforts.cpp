@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <memory>
 #include <set>
+#include <string_view>
+#include <unordered_map>
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
@@ -93,10 +95,13 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
     // natural coordinates' joints: named points that parts with frames of points share (phiq/natural_joints.hpp)
     auto natural = std::make_shared<NaturalJoints>(
         find_natural_joints(scene.parts, scene.loads, pending_.natural_points, model.num_coordinates(), spatial_));
-    auto natural_joint = [&](const std::string& name) {
+    std::unordered_map<std::string_view, int> joint_index;  // (a list of 10⁴ names scanned 10⁴ joints for each)
+    if (!pending_.reaction_items.empty())
       for (std::size_t j = 0; j < natural->joints.size(); ++j)
-        if (natural->joints[j].name == name) return static_cast<int>(j);
-      return -1;
+        joint_index.emplace(natural->joints[j].name, static_cast<int>(j));
+    auto natural_joint = [&](const std::string& name) {
+      const auto it = joint_index.find(name);
+      return it == joint_index.end() ? -1 : it->second;
     };
     if (pending_.reaction_items.empty()) {  // all: every joint with a reaction that no driver moves
       for (std::size_t c = 0; c < model.constraints().size(); ++c)

@@ -381,6 +381,22 @@ void JointReactions::clear_body_constraint_forces(std::size_t b) {
     g_[static_cast<std::size_t>(rows.g_columns[k])] = 0.0;
 }
 
+ReactionSite natural_reaction_site(const NaturalJoints& joints, std::size_t j, const double* q, double t) {
+  const NaturalJoint& joint = joints.joints[j];
+  ReactionSite rs;
+  rs.point = {joint.point.r[0].of(q), joint.point.r[1].of(q), joint.point.r[2].of(q)};
+  const Pose pose = part_pose(joints.bodies[joint.bodies.front()].frame, q, t);
+  for (int k = 0; k < 3; ++k) rs.axes[k] = {pose.rotation[k], pose.rotation[3 + k], pose.rotation[6 + k]};
+  return rs;
+}
+
+// A natural joint's force (world axes) along its body's axes, where the output asks (natural_reaction_site()).
+void JointReactions::turn_natural(const NaturalSite& s, const double* q, double t, double* force) const {
+  const ReactionSite rs = natural_reaction_site(*natural_, s.joint, q, t);
+  const kin3::V3 f{force[0], force[1], natural_->spatial ? force[2] : 0.0};
+  for (int k = 0; k < (natural_->spatial ? 3 : 2); ++k) force[k] = kin3::dot(rs.axes[k], f);
+}
+
 bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,
                                    const detail::PlanarForce* planar, double* out) {
   if (!planar || !planar[s.part].valid) return false;
@@ -402,6 +418,7 @@ bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double
     out[k] = s.shared[k] ? std::numeric_limits<double>::quiet_NaN() : -moving - qb;
   }
   out[2] = 0.0;
+  if (joint_axes_) turn_natural(s, q, t, out);
   clear_body_constraint_forces(s.body);
   return true;
 }
@@ -443,6 +460,7 @@ void JointReactions::evaluate_natural(const NaturalSite& s, RowMotion& row, doub
     }
     force[k] = shared ? std::numeric_limits<double>::quiet_NaN() : -moving - qb_(at);
   }
+  if (joint_axes_) turn_natural(s, row.q, t, force);
   if (natural_->spatial) {
     for (double v : {force[0], force[1], force[2], 0.0, 0.0, 0.0}) *out++ = v;
   } else {

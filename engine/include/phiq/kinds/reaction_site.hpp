@@ -20,7 +20,7 @@ struct ReactionSite {
   /// The joint's own axes x, y, z as unit vectors in world axes, in which a reaction may be written instead
   /// (OutputEfforts::reactions_in_joint_axes): the reported body's axes at a planar pin, x along the slide and y
   /// across it at a planar prismatic pair, the reported side's joint frame at a spatial joint (z its axis, x its
-  /// reference direction); world axes where the side has no axes of its own (a natural point).
+  /// reference direction). (A natural point's are its part's frame's: natural_reaction_site().)
   kin3::V3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 };
 
