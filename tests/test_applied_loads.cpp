@@ -5,7 +5,9 @@
 // the same force written in world axes; and the bad input the reader refuses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
@@ -179,6 +181,72 @@ LoadedPowerBalance loaded_power_balance(const Scene& s) {
     b.loads_power = std::max(b.loads_power, std::fabs(power));
   }
   return b;
+}
+
+// Every scene under models/ with masses or loads, at every written row: its drivers' power as the sweep writes it
+// (λ Φt, the `NAME.power` columns) is d(kinetic energy)/dt + d(gravity's potential)/dt − the applied loads' power
+// (springs' and dampers' too), to 1e-9 of the largest power; in whatever coordinates the scene is written.
+TEST(AppliedLoads, EveryModelWithMassesBalancesItsDriversPowerAtEveryRow) {
+  std::vector<std::filesystem::path> scenes;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(PHIQ_MODELS_DIR))
+    if (e.path().extension() == ".yaml") scenes.push_back(e.path());
+  std::sort(scenes.begin(), scenes.end());
+  std::vector<std::string> checked;
+  for (const std::filesystem::path& path : scenes) {
+    const Scene s = load_scene(path.string());
+    bool massive = s.loads.applied != nullptr;
+    for (const Part& p : s.parts) massive = massive || (p.mass_source != MassSource::kNone && p.mass.mass > 0.0);
+    if (!massive) continue;
+    SCOPED_TRACE(path.string());
+    SquareScene square;
+    ASSERT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &square), SolveStatus::kSuccess);
+    const Model& m = square.model(*s.model);
+    SweepOptions o = s.sweep;  // the drivers' efforts and powers, whatever the scene writes
+    o.efforts = OutputEfforts{};
+    o.efforts.parts = std::make_shared<const std::vector<Part>>(s.parts);
+    o.efforts.loads = std::make_shared<const Loads>(s.loads);
+    o.efforts.constraints = rheonomic_constraints(m);
+    o.efforts.power = true;
+    o.sensitivities.clear();
+    o.velocities = o.accelerations = true;
+    const std::size_t n = o.efforts.constraints.size();
+    ASSERT_GT(n, 0u);
+    Workspace ws(m);
+    ws.q = square.start;
+    double worst = 0.0, scale = 0.0;
+    std::size_t rows = 0;
+    SweepSummary sum;
+    ASSERT_EQ(run_sweep(
+                  m, o, ws,
+                  [&](const StepView& v) {
+                    double power = 0.0;
+                    for (std::size_t i = 0; i < n; ++i) power += v.efforts[n + i];
+                    if (!std::isfinite(power)) return true;  // a singular row: said so, no power
+                    double energy_rate = 0.0;
+                    for (const Part& p : s.parts) {
+                      if (p.mass_source == MassSource::kNone) continue;
+                      const PartMotion pm = part_motion(p.frame, v.q.data(), v.qd->data(), v.qdd->data(), v.t);
+                      const auto [vc, ac] = pm.point(p.mass.center);
+                      energy_rate += p.mass.mass * kin3::dot(vc, ac) + rotational_energy_rate(p, pm) -
+                                     p.mass.mass * kin3::dot(s.loads.gravity, vc);
+                    }
+                    const double loads =
+                        s.loads.applied ? applied_power(*s.loads.applied, v.q.data(), v.qd->data(), v.t) : 0.0;
+                    worst = std::max(worst, std::fabs(power - (energy_rate - loads)));
+                    scale = std::max({scale, std::fabs(power), std::fabs(energy_rate)});
+                    ++rows;
+                    return true;
+                  },
+                  &sum),
+              SolveStatus::kSuccess);
+    EXPECT_GT(rows, 10u);
+    EXPECT_GT(scale, 0.1);  // watts: the balance is not of zeros
+    EXPECT_LT(worst, 1e-9 * scale);
+    checked.push_back(path.filename().string());
+  }
+  // the scenes with masses today; a new one joins by itself
+  for (const char* name : {"fourbar_motor_torque.yaml", "fourbar_pin_loads.yaml", "rssr_bearing_loads.yaml"})
+    EXPECT_NE(std::find(checked.begin(), checked.end(), name), checked.end()) << name;
 }
 
 TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) {
