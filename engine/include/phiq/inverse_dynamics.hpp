@@ -30,8 +30,8 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
 /// Why add_generalized_forces() gave a Q that is not finite at (q, q̇, q̈, t), as one phrase for a message: the first
 /// part with mass, then the first applied load, whose own generalized force is not finite, named, with what of it is
 /// not (a frame of points without a direction, a load's value, an overflow of doubles). Empty when each is finite
-/// alone. Pre-conditions as add_generalized_forces(), Q's size
-/// `num_coordinates`. Evaluates every contribution once more, alone: for the failure path, not for every row.
+/// alone. Pre-conditions as add_generalized_forces(), Q's size `num_coordinates`. Evaluates every contribution
+/// once more, alone: for the failure path, not for every row.
 std::string nonfinite_force_source(const std::vector<Part>& parts, const Loads& loads, Index num_coordinates,
                                    const double* q, const double* qd, const double* qdd, double t);
 

@@ -88,8 +88,8 @@ template <class C>
 PartFrame PartReader::load_frame(const C& c, const LoadTargets& targets, const char* what) const {
   PartFrame f = load_frame(c, targets);
   if (what && frame_coordinates(f).empty())
-    c.fail("'" + c.name() + "' does not move (its frame reads no coordinate): " + what +
-           " on it does no work and changes no effort");
+    c.fail("'" + c.name() + "' reads no coordinate (it is fixed, or moves with t alone): " + what +
+           " on it does no work on the coordinates and changes no effort");
   return f;
 }
 
@@ -227,7 +227,7 @@ LinearSpring PartReader::linear_spring(const C& s, const LoadTargets& targets, s
   if (spring.a.part == spring.b.part && spring.a.at == spring.b.at)
     between.fail("the spring's two ends are the same point");
   if (frame_coordinates(spring.a.frame).empty() && frame_coordinates(spring.b.frame).empty())
-    between.fail("neither end moves (their frames read no coordinate): the spring does no work and changes no effort");
+    between.fail("neither end reads a coordinate: the spring does no work on the coordinates and changes no effort");
   spring.stiffness = non_negative(s.require("stiffness"));
   spring.free_length = non_negative(s.require("free_length"));
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
