@@ -9,21 +9,15 @@
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/phiq.hpp"
 #include "fourbar_parts.hpp"
+#include "sensitivity_support.hpp"
 
 namespace phiq {
 namespace {
 
-std::string diagnosed_model_text(const std::string& rel) {
-  std::ifstream in(test::model_path(rel));
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The four-bar with masses (models/dynamics/fourbar_motor_torque.yaml: crank O→A, coupler A→B, rocker C→B), its
 // `loads` line replaced by `loads`.
 Scene motor_torque(const std::string& loads) {
-  std::string text = diagnosed_model_text("dynamics/fourbar_motor_torque.yaml");
+  std::string text = test::model_file_text("dynamics/fourbar_motor_torque.yaml");
   const std::size_t at = text.find("loads: {gravity: [0, -9.81]}");
   text.replace(at, std::string("loads: {gravity: [0, -9.81]}").size(), loads);
   return parse_scene(text, "fourbar.yaml");
@@ -51,7 +45,7 @@ TEST(ForceDiagnosis, AFramesPointsThatMeetNameThePart) {
 TEST(ForceDiagnosis, ASpatialFrameWhoseYMeetsItsXHasNoPlane) {
   // rssr_natural: A = [xA, yA, 0], B = [d, yB, zB]; the frame's y toward [d, yB, 1], which is B where zB = 1
   const Scene s =
-      parse_scene(diagnosed_model_text("spatial/rssr_natural.yaml") +
+      parse_scene(test::model_file_text("spatial/rssr_natural.yaml") +
                       "\nparts:\n  c: {frame: {origin: A, x: B, y: [d, yB, 1]}, mass: 1, center_of_mass: [0.1, 0, 0], "
                       "inertia: [0.01, 0.01, 0.01]}\nloads: {gravity: [0, 0, -9.81]}\n",
                   "rssr.yaml");
@@ -95,7 +89,7 @@ TEST(ForceDiagnosis, DriverEffortsSayWhichLoadIsNotFiniteInsteadOfReturningNaN) 
 }
 
 TEST(ForceDiagnosis, AFrameThatCanNeverHaveADirectionIsRefusedWhenRead) {
-  const std::string text = diagnosed_model_text("dynamics/fourbar_motor_torque.yaml");
+  const std::string text = test::model_file_text("dynamics/fourbar_motor_torque.yaml");
   auto refused = [&](const std::string& from, const std::string& to) {
     std::string t = text;
     t.replace(t.find(from), from.size(), to);
