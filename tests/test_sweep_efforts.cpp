@@ -59,6 +59,66 @@ EffortRows sweep_efforts(const Scene& s, SweepOptions opt, SweepSummary* sum = n
   return r;
 }
 
+// A transmission's effort (output.efforts naming it) is what it applies to its first member: a pinion of inertia J1
+// driven at θ1 = 2t + 3t² meshes with a wheel of three times its radius (J2, braked by T = 5 + t against its turn):
+// θ2 = −θ1/3, and the mesh's torque on the pinion is −(T + J2·2)/3 (Newton on the wheel alone), the motor's
+// J1·6 − that; a rack of mass m driven by the same pinion (x = r θ) under a force F: the mesh pushes the rack with
+// m r·6 − F, and the motor turns with J1·6 + r (m r·6 − F). Their powers: the motor's τ θ̇, the mesh's 0.
+TEST(SweepEfforts, ATransmissionsEffortIsTheLoadItAppliesToItsFirstMember) {
+  const double j1 = 0.002, j2 = 0.04, m = 3.0, r = 0.05;
+  const std::string head =
+      "phiq: 1\nname: train\ndrivers:\n"
+      "  - {name: motor, coordinate: th1, law: {type: polynomial, coefficients: [0, 2, 3]}}\n"
+      "time: {start: 0, end: 1, steps: 10}\n"
+      "output: {velocities: true, accelerations: true, efforts: [motor, mesh], power: true}\n";
+  const Scene gears =
+      parse_scene(head +
+                      "coordinates: {th1: 0, th2: 0}\n"
+                      "constraints: [{name: mesh, type: gear, between: [th1, th2], radii: [0.05, 0.15]}]\n"
+                      "parts:\n"
+                      "  pinion: {frame: {at: [0, 0], angle: th1}, mass: 1, center_of_mass: [0, 0], "
+                      "inertia: 0.002}\n"
+                      "  wheel: {frame: {at: [0.2, 0], angle: th2}, mass: 3, center_of_mass: [0, 0], "
+                      "inertia: 0.04}\n"
+                      "loads: {torques: [{name: brake, part: wheel, torque: 5 + t}]}\n",
+                  "gears.yaml");
+  const EffortRows g = sweep_efforts(gears, gears.sweep);
+  ASSERT_EQ(g.t.size(), 11u);
+  for (std::size_t k = 0; k < g.t.size(); ++k) {
+    const double t = g.t[k], mesh = -(5.0 + t + j2 * 2.0) / 3.0;
+    EXPECT_NEAR(g.efforts[k][1], mesh, 1e-12) << t;
+    EXPECT_NEAR(g.efforts[k][0], j1 * 6.0 - mesh, 1e-12) << t;
+    EXPECT_NEAR(g.efforts[k][2], g.efforts[k][0] * (2.0 + 6.0 * t), 1e-11) << t;  // τ θ̇1
+    EXPECT_EQ(g.efforts[k][3], 0.0) << t;                                         // λ Φt, Φt = 0
+  }
+  const Scene rack =
+      parse_scene(head +
+                      "coordinates: {th1: 0, x: 0}\n"
+                      "constraints: [{name: mesh, type: rack_pinion, rack: x, pinion: th1, radius: 0.05}]\n"
+                      "parts:\n"
+                      "  pinion: {frame: {at: [0, 0], angle: th1}, mass: 1, center_of_mass: [0, 0], "
+                      "inertia: 0.002}\n"
+                      "  rack: {frame: {at: [x, -0.05], angle: 0}, mass: 3, center_of_mass: [0, 0], "
+                      "inertia: 0.1}\n"
+                      "loads: {forces: [{name: cut, part: rack, force: [-10 - 4*t, 0]}]}\n",
+                  "rack.yaml");
+  const EffortRows p = sweep_efforts(rack, rack.sweep);
+  ASSERT_EQ(p.t.size(), 11u);
+  for (std::size_t k = 0; k < p.t.size(); ++k) {
+    const double t = p.t[k], push = m * r * 6.0 - (-10.0 - 4.0 * t);
+    EXPECT_NEAR(p.efforts[k][1], push, 1e-12) << t;
+    EXPECT_NEAR(p.efforts[k][0], j1 * 6.0 + r * push, 1e-12) << t;
+  }
+  // a constraint that is neither a driver nor a transmission still has none
+  EXPECT_NE(error_of(head + "coordinates: {th1: 0, th2: 0}\n"
+                            "constraints: [{name: mesh, type: equation, expr: th1 + 3*th2}]\n"
+                            "parts: {pinion: {frame: {at: [0, 0], angle: th1}, mass: 1, center_of_mass: [0, 0], "
+                            "inertia: 0.002}}\n")
+                .find("'mesh' does not depend on time: no motor drives it, it has no effort (a driver has, and a "
+                      "transmission"),
+            std::string::npos);
+}
+
 TEST(SweepEfforts, EachRowsEffortAndPowerAreItsInverseDynamics) {
   const Scene s = parse_scene(massive_fourbar("{velocities: true, accelerations: true, efforts: all, power: true}"),
                               "fourbar.yaml");

@@ -144,8 +144,11 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       index.emplace(model.constraints()[k].name, static_cast<Index>(k));
     for (const Cursor& i : pending_.effort_items) {
       const Index c = index.at(i.name());
-      if (!model.constraints()[static_cast<std::size_t>(c)].depends_on_time)
-        i.fail("'" + i.name() + "' does not depend on time: no motor drives it, it has no effort");
+      const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
+      if (!info.depends_on_time && !is_transmission_kind(info.kind))
+        i.fail("'" + i.name() +
+               "' does not depend on time: no motor drives it, it has no effort (a driver has, and a "
+               "transmission: the load it applies to its first member)");
       out.constraints.push_back(c);
     }
   }

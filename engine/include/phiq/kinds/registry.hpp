@@ -185,6 +185,18 @@ std::vector<std::string_view> joint_types(Select select) {
   return types;
 }
 
+/// Whether `kind` (a ConstraintInfo::kind) is a transmission (gear, rack and pinion, belt: kinds/transmissions.hpp),
+/// whose one row relates its members' motions: its effort (OutputEfforts::constraints may list it as a driver), −λ of
+/// that row, is what it applies to its first member, a torque on gear 1 or pulley 1 or a force along the rack's
+/// travel, conjugate to the row's unit as a driver's effort is to what the driver drives.
+inline bool is_transmission_kind(std::string_view kind) {
+  bool found = false;
+  ConstraintKinds::for_each([&]<class K>() {
+    if constexpr (std::is_base_of_v<LinearTransmission<K>, K>) found = found || kind == K::kKind;
+  });
+  return found;
+}
+
 /// joint_types(select) as a message lists them: "revolute, cylindrical or screw".
 template <class Select>
 std::string joint_type_list(Select select) {
