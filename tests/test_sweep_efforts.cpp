@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "phiq/effort_sensitivity.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
@@ -109,6 +110,41 @@ TEST(SweepEfforts, ATransmissionsEffortIsTheLoadItAppliesToItsFirstMember) {
     EXPECT_NEAR(p.efforts[k][1], push, 1e-12) << t;
     EXPECT_NEAR(p.efforts[k][0], j1 * 6.0 + r * push, 1e-12) << t;
   }
+  // ∂/∂p of the mesh's torque −6 J2/k² − T/k (k = R/r1 the ratio) through the sensitivities, exact: along J2,
+  // −6/k²; along R, (12 J2/k³ + T/k²)/r1; the motor's the opposite, its power's θ̇1 times that
+  const Scene sens = parse_scene(
+      "phiq: 1\nname: train\nparameters: {R: 0.15, J: 0.04}\ndrivers:\n"
+      "  - {name: motor, coordinate: th1, law: {type: polynomial, coefficients: [0, 2, 3]}}\n"
+      "time: {start: 0, end: 1, steps: 10}\n"
+      "output: {velocities: true, accelerations: true, efforts: [motor, mesh], power: true, sensitivities: [J, R]}\n"
+      "coordinates: {th1: 0, th2: 0}\n"
+      "constraints: [{name: mesh, type: gear, between: [th1, th2], radii: [0.05, R]}]\n"
+      "parts:\n"
+      "  pinion: {frame: {at: [0, 0], angle: th1}, mass: 1, center_of_mass: [0, 0], inertia: 0.002}\n"
+      "  wheel: {frame: {at: [0.2, 0], angle: th2}, mass: 3, center_of_mass: [0, 0], inertia: J}\n"
+      "loads: {torques: [{name: brake, part: wheel, torque: 5 + t}]}\n",
+      "gears_sens.yaml");
+  const std::size_t base = static_cast<std::size_t>(sens.sweep.efforts.size());
+  const EffortSensitivityLayout layout{2};
+  Workspace ws(*sens.model);
+  std::size_t rows = 0;
+  SweepSummary ssum;
+  ASSERT_EQ(run_sweep(
+                *sens.model, sens.sweep, ws,
+                [&](const StepView& v) {
+                  const double t = v.t, k = 3.0, torque = 5.0 + t;
+                  const double d_j = -6.0 / (k * k), d_r = (12.0 * j2 / (k * k * k) + torque / (k * k)) / r;
+                  EXPECT_NEAR(v.efforts[base + layout.offset(0, 1)], d_j, 1e-9) << t;
+                  EXPECT_NEAR(v.efforts[base + layout.offset(1, 1)], d_r, 1e-8) << t;
+                  EXPECT_NEAR(v.efforts[base + layout.offset(1, 0)], -d_r, 1e-8) << t;
+                  EXPECT_NEAR(v.efforts[base + layout.power_offset(2, 1, 0)], -d_r * (2.0 + 6.0 * t), 1e-7) << t;
+                  ++rows;
+                  return true;
+                },
+                &ssum),
+            SolveStatus::kSuccess)
+      << ssum.message;
+  EXPECT_EQ(rows, 11u);
   // a constraint that is neither a driver nor a transmission still has none
   EXPECT_NE(error_of(head + "coordinates: {th1: 0, th2: 0}\n"
                             "constraints: [{name: mesh, type: equation, expr: th1 + 3*th2}]\n"
