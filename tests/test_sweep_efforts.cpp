@@ -67,22 +67,27 @@ EffortRows sweep_efforts(const Scene& s, SweepOptions opt, SweepSummary* sum = n
 // m r·6 − F, and the motor turns with J1·6 + r (m r·6 − F). Their powers: the motor's τ θ̇, the mesh's 0.
 TEST(SweepEfforts, ATransmissionsEffortIsTheLoadItAppliesToItsFirstMember) {
   const double j1 = 0.002, j2 = 0.04, m = 3.0, r = 0.05;
-  const std::string head =
-      "phiq: 1\nname: train\ndrivers:\n"
-      "  - {name: motor, coordinate: th1, law: {type: polynomial, coefficients: [0, 2, 3]}}\n"
-      "time: {start: 0, end: 1, steps: 10}\n"
-      "output: {velocities: true, accelerations: true, efforts: [motor, mesh], power: true}\n";
-  const Scene gears =
-      parse_scene(head +
-                      "coordinates: {th1: 0, th2: 0}\n"
-                      "constraints: [{name: mesh, type: gear, between: [th1, th2], radii: [0.05, 0.15]}]\n"
-                      "parts:\n"
-                      "  pinion: {frame: {at: [0, 0], angle: th1}, mass: 1, center_of_mass: [0, 0], "
-                      "inertia: 0.002}\n"
-                      "  wheel: {frame: {at: [0.2, 0], angle: th2}, mass: 3, center_of_mass: [0, 0], "
-                      "inertia: 0.04}\n"
-                      "loads: {torques: [{name: brake, part: wheel, torque: 5 + t}]}\n",
-                  "gears.yaml");
+  // the motor on the pinion's θ1: a scene with `parameters`, output fields `output` and `rest` (coordinates, mesh,
+  // parts)
+  const std::string pinion =
+      "  pinion: {frame: {at: [0, 0], angle: th1}, mass: 1, center_of_mass: [0, 0], inertia: 0.002}\n";
+  auto train = [&](const std::string& parameters, const std::string& output, const std::string& rest) {
+    return "phiq: 1\nname: train\n" + parameters + "drivers:\n" +
+           "  - {name: motor, coordinate: th1, law: {type: polynomial, coefficients: [0, 2, 3]}}\n"
+           "time: {start: 0, end: 1, steps: 10}\n"
+           "output: {velocities: true, accelerations: true, efforts: [motor, mesh], power: true" +
+           output + "}\n" + rest;
+  };
+  // the gear pair, its wheel's radius and inertia as written
+  auto gear_pair = [&](const std::string& radius, const std::string& inertia) {
+    return "coordinates: {th1: 0, th2: 0}\n"
+           "constraints: [{name: mesh, type: gear, between: [th1, th2], radii: [0.05, " +
+           radius + "]}]\nparts:\n" + pinion +
+           "  wheel: {frame: {at: [0.2, 0], angle: th2}, mass: 3, center_of_mass: [0, 0], inertia: " + inertia +
+           "}\n"
+           "loads: {torques: [{name: brake, part: wheel, torque: 5 + t}]}\n";
+  };
+  const Scene gears = parse_scene(train("", "", gear_pair("0.15", "0.04")), "gears.yaml");
   const EffortRows g = sweep_efforts(gears, gears.sweep);
   ASSERT_EQ(g.t.size(), 11u);
   for (std::size_t k = 0; k < g.t.size(); ++k) {
@@ -92,17 +97,14 @@ TEST(SweepEfforts, ATransmissionsEffortIsTheLoadItAppliesToItsFirstMember) {
     EXPECT_NEAR(g.efforts[k][2], g.efforts[k][0] * (2.0 + 6.0 * t), 1e-11) << t;  // τ θ̇1
     EXPECT_EQ(g.efforts[k][3], 0.0) << t;                                         // λ Φt, Φt = 0
   }
-  const Scene rack =
-      parse_scene(head +
-                      "coordinates: {th1: 0, x: 0}\n"
-                      "constraints: [{name: mesh, type: rack_pinion, rack: x, pinion: th1, radius: 0.05}]\n"
-                      "parts:\n"
-                      "  pinion: {frame: {at: [0, 0], angle: th1}, mass: 1, center_of_mass: [0, 0], "
-                      "inertia: 0.002}\n"
-                      "  rack: {frame: {at: [x, -0.05], angle: 0}, mass: 3, center_of_mass: [0, 0], "
-                      "inertia: 0.1}\n"
-                      "loads: {forces: [{name: cut, part: rack, force: [-10 - 4*t, 0]}]}\n",
-                  "rack.yaml");
+  const Scene rack = parse_scene(
+      train("", "",
+            "coordinates: {th1: 0, x: 0}\n"
+            "constraints: [{name: mesh, type: rack_pinion, rack: x, pinion: th1, radius: 0.05}]\nparts:\n" +
+                pinion +
+                "  rack: {frame: {at: [x, -0.05], angle: 0}, mass: 3, center_of_mass: [0, 0], inertia: 0.1}\n"
+                "loads: {forces: [{name: cut, part: rack, force: [-10 - 4*t, 0]}]}\n"),
+      "rack.yaml");
   const EffortRows p = sweep_efforts(rack, rack.sweep);
   ASSERT_EQ(p.t.size(), 11u);
   for (std::size_t k = 0; k < p.t.size(); ++k) {
@@ -113,17 +115,7 @@ TEST(SweepEfforts, ATransmissionsEffortIsTheLoadItAppliesToItsFirstMember) {
   // ∂/∂p of the mesh's torque −6 J2/k² − T/k (k = R/r1 the ratio) through the sensitivities, exact: along J2,
   // −6/k²; along R, (12 J2/k³ + T/k²)/r1; the motor's the opposite, its power's θ̇1 times that
   const Scene sens = parse_scene(
-      "phiq: 1\nname: train\nparameters: {R: 0.15, J: 0.04}\ndrivers:\n"
-      "  - {name: motor, coordinate: th1, law: {type: polynomial, coefficients: [0, 2, 3]}}\n"
-      "time: {start: 0, end: 1, steps: 10}\n"
-      "output: {velocities: true, accelerations: true, efforts: [motor, mesh], power: true, sensitivities: [J, R]}\n"
-      "coordinates: {th1: 0, th2: 0}\n"
-      "constraints: [{name: mesh, type: gear, between: [th1, th2], radii: [0.05, R]}]\n"
-      "parts:\n"
-      "  pinion: {frame: {at: [0, 0], angle: th1}, mass: 1, center_of_mass: [0, 0], inertia: 0.002}\n"
-      "  wheel: {frame: {at: [0.2, 0], angle: th2}, mass: 3, center_of_mass: [0, 0], inertia: J}\n"
-      "loads: {torques: [{name: brake, part: wheel, torque: 5 + t}]}\n",
-      "gears_sens.yaml");
+      train("parameters: {R: 0.15, J: 0.04}\n", ", sensitivities: [J, R]", gear_pair("R", "J")), "gears_sens.yaml");
   const std::size_t base = static_cast<std::size_t>(sens.sweep.efforts.size());
   const EffortSensitivityLayout layout{2};
   Workspace ws(*sens.model);
@@ -146,10 +138,10 @@ TEST(SweepEfforts, ATransmissionsEffortIsTheLoadItAppliesToItsFirstMember) {
       << ssum.message;
   EXPECT_EQ(rows, 11u);
   // a constraint that is neither a driver nor a transmission still has none
-  EXPECT_NE(error_of(head + "coordinates: {th1: 0, th2: 0}\n"
-                            "constraints: [{name: mesh, type: equation, expr: th1 + 3*th2}]\n"
-                            "parts: {pinion: {frame: {at: [0, 0], angle: th1}, mass: 1, center_of_mass: [0, 0], "
-                            "inertia: 0.002}}\n")
+  EXPECT_NE(error_of(train("", "",
+                           "coordinates: {th1: 0, th2: 0}\n"
+                           "constraints: [{name: mesh, type: equation, expr: th1 + 3*th2}]\nparts:\n" +
+                               pinion))
                 .find("'mesh' does not depend on time: no motor drives it, it has no effort (a driver has, and a "
                       "transmission"),
             std::string::npos);

@@ -119,14 +119,19 @@ def test_effort_and_power_columns_of_the_crank_slider_are_the_closed_form():
     assert abs(effort - exact(result.t[7])) < 1e-9 and abs(power - w * effort) < 1e-9
 
 
+def slider_pushed_by(force):
+    """The notes' crank-slider (seed/crank_slider_mixed.yaml) with a force `force` on its slider, no masses."""
+    with open(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"), encoding="utf-8") as f:
+        text = f.read()
+    return phiq.parse_scene(text + "\nparts:\n  slider: {frame: {at: B}}\n"
+                            "loads:\n  forces: [{name: push, part: slider, force: " + force + "}]\n",
+                            "crank_slider.yaml")
+
+
 def test_driver_efforts_balance_a_force_on_the_slider():
     """No masses, a force F = -40 - 10 xB along x on the slider (the scene's loads.forces): the motor's power
     balances the force's, so its torque is -F dxB/dtheta."""
-    with open(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"), encoding="utf-8") as f:
-        text = f.read()
-    scene = phiq.parse_scene(text + "\nparts:\n  slider: {frame: {at: B}}\n"
-                             "loads:\n  forces: [{name: push, part: slider, force: [-40 - 10*xB, 0]}]\n",
-                             "crank_slider.yaml")
+    scene = slider_pushed_by("[-40 - 10*xB, 0]")
     result = phiq.run_sweep(scene)
     _, efforts = phiq.driver_efforts(scene, result)
     r, L = 0.3, 1.0
@@ -148,13 +153,9 @@ def test_driver_efforts_need_velocities_and_accelerations():
 
 
 def test_driver_efforts_name_a_load_that_is_not_finite():
-    """A force of 1/(t - 0.5) on the slider is infinite at t = 0.5: an error naming the force and the time, not a
-    row of NaN efforts."""
-    with open(os.path.join(MODELS, "seed", "crank_slider_mixed.yaml"), encoding="utf-8") as f:
-        text = f.read()
-    scene = phiq.parse_scene(text + "\nparts:\n  slider: {frame: {at: B}}\n"
-                             "loads:\n  forces: [{name: push, part: slider, force: [exp(1000*t), 0]}]\n",
-                             "crank_slider.yaml")
+    """A force of exp(1000 t) on the slider overflows to infinity within the sweep: an error naming the force and the
+    time, not a row of NaN efforts."""
+    scene = slider_pushed_by("[exp(1000*t), 0]")
     result = phiq.run_sweep(scene)
     with pytest.raises(ValueError, match=r"at t = [0-9.]+: force 'push' on part 'slider': its value is not "
                                          r"finite: \(inf, 0\)"):

@@ -53,6 +53,10 @@ bool multipliers_with_factors(const Model& model, SparseLuNumeric& lu, const Eig
 /// driver_efforts() gives.
 std::vector<Index> rheonomic_constraints(const Model& model);
 
+/// Whether constraint `c` has an effort a sweep may write (OutputEfforts::constraints): a driver's (it depends on
+/// time), or a transmission's (is_transmission_kind(), phiq/kinds/registry.hpp: what it applies to its first member).
+bool has_effort(const ConstraintInfo& c);
+
 /// The effort of each of rheonomic_constraints() at the motion in `ws` (q, q̇, q̈ at t) under `loads`: −λ of its
 /// first row, the torque or force its motor applies, conjugate to what it drives (a coordinate, a joint's angle or
 /// distance, an expression). As constraint_multipliers() for the status and `message`; kNonFinite, with the part or

@@ -1,7 +1,6 @@
 // The scene's `output: efforts`, `power` and `reactions` (models/README.md): which drivers' efforts and which joints'
 // reactions a sweep writes, resolved to constraints once the model is built, with the parts and loads they are
 // computed from (OutputPlan::efforts).
-#include <algorithm>
 #include <memory>
 #include <set>
 #include <string_view>
@@ -15,27 +14,6 @@
 #include "scene/scene_reader.hpp"
 
 namespace phiq::detail::scene {
-
-namespace {
-
-// The scene types whose kinds state a ReactionSite (kinds/reaction_site.hpp) in a scene of `dimension`, in registry
-// order, as a refusal lists them: "revolute, prismatic … or cam".
-std::string reaction_type_list(int dimension) {
-  std::vector<std::string_view> types;
-  ConstraintKinds::for_each([&]<class K>() {
-    if constexpr (requires(const K& k, const double* q) { k.reaction_site(q); })
-      for (const SceneForm& f : K::kScene)
-        if (f.dimension == dimension && std::string_view(f.section) == "constraints" &&
-            std::find(types.begin(), types.end(), f.type) == types.end())
-          types.push_back(f.type);
-  });
-  std::string list;
-  for (std::size_t k = 0; k < types.size(); ++k)
-    list += (k == 0 ? "" : k + 1 == types.size() ? " or " : ", ") + std::string(types[k]);
-  return list;
-}
-
-}  // namespace
 
 void SceneReader::read_output_efforts(const Cursor& output) {
   const Cursor e = output.field("efforts");
@@ -130,7 +108,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       const int w = reaction_width(model, c);
       if (w == 0)
         i.fail("'" + i.name() + "' (" + std::string(model.constraints()[static_cast<std::size_t>(c)].kind) +
-               ") is not a joint between bodies: it has no reaction (a " + reaction_type_list(spatial_ ? 3 : 2) +
+               ") is not a joint between bodies: it has no reaction (a " + type_list(reaction_types(spatial_ ? 3 : 2)) +
                " has)");
       out.reactions.push_back({c, w == 6});
     }
@@ -144,8 +122,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       index.emplace(model.constraints()[k].name, static_cast<Index>(k));
     for (const Cursor& i : pending_.effort_items) {
       const Index c = index.at(i.name());
-      const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
-      if (!info.depends_on_time && !is_transmission_kind(info.kind))
+      if (!has_effort(model.constraints()[static_cast<std::size_t>(c)]))
         i.fail("'" + i.name() +
                "' does not depend on time: no motor drives it, it has no effort (a driver has, and a "
                "transmission: the load it applies to its first member)");

@@ -6,6 +6,7 @@
 #include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/part_motion.hpp"
+#include "solve/part_forces.hpp"
 
 namespace phiq {
 
@@ -99,7 +100,7 @@ std::string vector_load_fault(const Load& l, const char* what, const double* q, 
 std::string nonfinite_force_source(const std::vector<Part>& parts, const Loads& loads, Index num_coordinates,
                                    const double* q, const double* qd, const double* qdd, double t) {
   for (const Part& p : parts)
-    if (p.mass_source != MassSource::kNone && p.mass.mass != 0.0) {
+    if (detail::has_mass(p)) {
       std::string why = part_fault(p, loads.gravity, num_coordinates, q, qd, qdd, t);
       if (!why.empty()) return why;
     }

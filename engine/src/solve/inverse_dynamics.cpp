@@ -2,6 +2,7 @@
 #include "phiq/inverse_dynamics.hpp"
 
 #include "phiq/applied_loads.hpp"
+#include "phiq/kinds/registry.hpp"
 #include "phiq/part_motion.hpp"
 #include "solve/part_forces.hpp"
 #include "solve/factorisation.hpp"
@@ -169,6 +170,8 @@ bool multipliers_with_factors(const Model& model, SparseLuNumeric& lu, const Eig
   for (std::size_t i = 0; i < rows.size(); ++i) lambda(rows[i]) = kept(static_cast<Index>(i));
   return true;
 }
+
+bool has_effort(const ConstraintInfo& c) { return c.depends_on_time || is_transmission_kind(c.kind); }
 
 std::vector<Index> rheonomic_constraints(const Model& model) {
   std::vector<Index> out;

@@ -11,7 +11,7 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
-#include "phiq/kinds/registry.hpp"
+#include "phiq/inverse_dynamics.hpp"
 #include "phiq/joint_reactions.hpp"
 #include "phiq/parts.hpp"
 #include "phiq/sweep.hpp"
@@ -170,7 +170,7 @@ void detail::check_efforts(const Model& model, const OutputPlan& plan, const std
     if (c < 0 || c >= static_cast<Index>(model.constraints().size()))
       throw Error(who + ": an effort's constraint " + std::to_string(c) + " is not one of the model's");
     const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
-    if (!info.depends_on_time && !is_transmission_kind(info.kind))
+    if (!has_effort(info))
       throw Error(who + ": '" + info.name + "' does not depend on time: no motor drives it, it has no effort");
   }
   for (const Part& p : *e.parts)

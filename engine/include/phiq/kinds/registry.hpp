@@ -10,6 +10,7 @@
 /// derived from the kinds' JointTraits (joint_types(), below).
 #pragma once
 
+#include <algorithm>
 #include <string>
 #include <string_view>
 #include <tuple>
@@ -197,14 +198,32 @@ inline bool is_transmission_kind(std::string_view kind) {
   return found;
 }
 
-/// joint_types(select) as a message lists them: "revolute, cylindrical or screw".
-template <class Select>
-std::string joint_type_list(Select select) {
-  const std::vector<std::string_view> types = joint_types(select);
+/// Scene types as a message lists them: "revolute, cylindrical or screw".
+inline std::string type_list(const std::vector<std::string_view>& types) {
   std::string list;
   for (std::size_t k = 0; k < types.size(); ++k)
     list += (k == 0 ? "" : k + 1 == types.size() ? " or " : ", ") + std::string(types[k]);
   return list;
+}
+
+/// joint_types(select) as a message lists them (type_list()).
+template <class Select>
+std::string joint_type_list(Select select) {
+  return type_list(joint_types(select));
+}
+
+/// The scene types of the constraints whose kinds state a ReactionSite (kinds/reaction_site.hpp) in a scene of
+/// `dimension` (2 or 3), in registry order, each once: the joints `output.reactions` accepts.
+inline std::vector<std::string_view> reaction_types(int dimension) {
+  std::vector<std::string_view> types;
+  ConstraintKinds::for_each([&]<class K>() {
+    if constexpr (requires(const K& k, const double* q) { k.reaction_site(q); })
+      for (const SceneForm& f : K::kScene)
+        if (f.dimension == dimension && std::string_view(f.section) == "constraints" &&
+            std::find(types.begin(), types.end(), f.type) == types.end())
+          types.push_back(f.type);
+  });
+  return types;
 }
 
 }  // namespace phiq
