@@ -2,7 +2,8 @@
 // B, C carry the forces the reference-point four-bar's revolutes carry, under gravity, forces, a torque and a spring,
 // with the same motor torque; each of its links satisfies its Newton–Euler equations written here with them; the
 // bodies' weight and inertia read from the whole model's Q (a sweep's way) give the reactions their own Q gives, bit
-// for bit, and so do the flat sites' sums on random natural chains; a point no two bodies share is refused by name.
+// for bit, and so do the flat sites' sums on random natural chains, in both forms of Q (rigid bars' constant mass
+// matrices or their frames' motion); a point no two bodies share is refused by name.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -189,9 +190,12 @@ TEST(NaturalReactions, EveryNaturalLinkBalancesUnderItsPinForces) {
 
 // A sweep's reactions read each natural body's weight and inertia where the whole model's Q left them
 // (detail::PlanarForce), rather than the body's own Q: the same numbers, bit for bit, at every row of the four-bar
-// with gravity, a force, a torque, a spring and the fixed pins O, C (constant components, promoted). Q itself is
-// add_generalized_forces()' to the bit; a shifted cached force moves the reactions where it acts (the cache is read,
-// not passed over).
+// with gravity, a force, a torque, a spring and the fixed pins O, C (constant components, promoted). In the frames'
+// motion's form Q itself is add_generalized_forces()' to the bit; a shifted cached force moves the reactions where
+// it acts (the cache is read, not passed over). In the rigid bars' form (the links are held at their lengths by the
+// distance constraints crank, coupler, rocker) Q differs, but only along the bars' own rows: every other multiplier
+// and every reaction is the frames' motion's, and the body's own bar form (the cache marked invalid) gives the
+// cache's bits.
 TEST(NaturalReactions, BodyForcesFromTheModelsQAreTheBodiesOwnBitForBit) {
   const Scene s = natural_four_bar();
   const NaturalRows rows = natural_reactions_sweep(s);
@@ -201,40 +205,64 @@ TEST(NaturalReactions, BodyForcesFromTheModelsQAreTheBodiesOwnBitForBit) {
   ASSERT_EQ(e.natural->bodies.size(), 3u);
   for (const NaturalBody& b : e.natural->bodies) EXPECT_EQ(parts.at(b.part).name, b.name);
   EXPECT_EQ(e.natural->promoted.size(), 4u);  // O's and C's x and y
-  JointReactions reactions(m, e);
-  const detail::PartForces forces(parts);
   Workspace ws(m);
-  const std::size_t n = static_cast<std::size_t>(reactions.size());
-  for (std::size_t k = 0; k < rows.q.size(); ++k) {
-    const double t = rows.t[k];
-    const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data();
-    Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), own = Q, lambda;
-    std::vector<detail::PlanarForce> planar(parts.size());
-    forces.add(parts, *e.loads, q, qd, qdd, t, Q, planar.data());
-    add_generalized_forces(parts, *e.loads, q, qd, qdd, t, own);
-    ASSERT_EQ(std::memcmp(Q.data(), own.data(), sizeof(double) * static_cast<std::size_t>(Q.size())), 0) << k;
-    for (const NaturalBody& b : e.natural->bodies) ASSERT_TRUE(planar[b.part].valid) << b.name << ", row " << k;
-    ws.q = rows.q[k];
-    ASSERT_EQ(constraint_multipliers(m, t, ws, Q, lambda), SolveStatus::kSuccess);
-    std::vector<double> general(n), cached(n), shifted(n);
-    reactions.evaluate(q, qd, qdd, t, lambda, general.data());
-    reactions.evaluate(q, qd, qdd, t, lambda, cached.data(), planar.data());
-    ASSERT_EQ(std::memcmp(general.data(), cached.data(), sizeof(double) * n), 0) << "row " << k;
-    for (std::size_t j = 0; j < n; ++j)  // the sweep's, whose λ comes from its own factors
-      EXPECT_NEAR(rows.values[k][2 + j], general[j], 1e-9 * (1 + std::fabs(general[j]))) << j << ", row " << k;
-    for (detail::PlanarForce& f : planar) f.fx += 1.0;
-    reactions.evaluate(q, qd, qdd, t, lambda, shifted.data(), planar.data());
-    // R = Φqᵀλ − Q_b: a newton more along x at each part's origin, O (the crank's) and C (the rocker's); A and B are
-    // their bodies' x points, which fx does not reach
-    for (std::size_t j : {0u, 3u})
-      EXPECT_NEAR(shifted[3 * j], general[3 * j] - 1.0, 1e-9 * (1 + std::fabs(general[3 * j]))) << j << ", " << k;
-    for (std::size_t j : {1u, 2u}) EXPECT_EQ(shifted[3 * j], general[3 * j]) << j << ", " << k;
+  for (const bool bars : {false, true}) {
+    JointReactions reactions(m, e, bars), plain(m, e);
+    const detail::PartForces forces(parts, m, bars);
+    const std::size_t n = static_cast<std::size_t>(reactions.size());
+    double bar_rows_moved = 0.0;  // the largest change of a bar's own multiplier (the bar form taken at all)
+    for (std::size_t k = 0; k < rows.q.size(); ++k) {
+      const double t = rows.t[k];
+      const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data();
+      Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), own = Q, lambda, own_lambda;
+      std::vector<detail::PlanarForce> planar(parts.size());
+      forces.add(parts, *e.loads, q, qd, qdd, t, Q, planar.data());
+      add_generalized_forces(parts, *e.loads, q, qd, qdd, t, own);
+      const bool same_q = std::memcmp(Q.data(), own.data(), sizeof(double) * static_cast<std::size_t>(Q.size())) == 0;
+      if (!bars) ASSERT_TRUE(same_q) << k;
+      for (const NaturalBody& b : e.natural->bodies) ASSERT_TRUE(planar[b.part].valid) << b.name << ", row " << k;
+      ws.q = rows.q[k];
+      ASSERT_EQ(constraint_multipliers(m, t, ws, Q, lambda), SolveStatus::kSuccess);
+      ASSERT_EQ(constraint_multipliers(m, t, ws, own, own_lambda), SolveStatus::kSuccess);
+      for (std::size_t c = 0; c < m.constraints().size(); ++c) {
+        const Index r = m.constraints()[c].first_row;
+        const std::string& name = m.constraints()[c].name;
+        if (name == "crank" || name == "coupler" || name == "rocker")
+          bar_rows_moved = std::max(bar_rows_moved, std::fabs(lambda(r) - own_lambda(r)));
+        else
+          EXPECT_NEAR(lambda(r), own_lambda(r), 1e-10 * (1 + std::fabs(own_lambda(r)))) << name << ", row " << k;
+      }
+      std::vector<double> general(n), cached(n), own_bars(n), shifted(n);
+      plain.evaluate(q, qd, qdd, t, own_lambda, general.data());
+      reactions.evaluate(q, qd, qdd, t, lambda, cached.data(), planar.data());
+      for (std::size_t j = 0; j < n; ++j) {
+        EXPECT_NEAR(cached[j], general[j], 1e-10 * (1 + std::fabs(general[j]))) << j << ", row " << k;
+        // the sweep's, whose λ comes from its own factors
+        EXPECT_NEAR(rows.values[k][2 + j], general[j], 1e-9 * (1 + std::fabs(general[j]))) << j << ", row " << k;
+      }
+      if (!bars) ASSERT_EQ(std::memcmp(general.data(), cached.data(), sizeof(double) * n), 0) << "row " << k;
+      std::vector<detail::PlanarForce> unread = planar;  // each body's own force, in the same form
+      for (detail::PlanarForce& f : unread) f.valid = false;
+      reactions.evaluate(q, qd, qdd, t, lambda, own_bars.data(), unread.data());
+      ASSERT_EQ(std::memcmp(own_bars.data(), cached.data(), sizeof(double) * n), 0) << bars << ", row " << k;
+      for (detail::PlanarForce& f : planar) f.fx += 1.0;
+      reactions.evaluate(q, qd, qdd, t, lambda, shifted.data(), planar.data());
+      // R = Φqᵀλ − Q_b: a newton more along x at each part's origin, O (the crank's) and C (the rocker's); A and B
+      // are their bodies' x points, which fx does not reach (in either form)
+      for (std::size_t j : {0u, 3u})
+        EXPECT_NEAR(shifted[3 * j], cached[3 * j] - 1.0, 1e-9 * (1 + std::fabs(cached[3 * j]))) << j << ", " << k;
+      for (std::size_t j : {1u, 2u}) EXPECT_EQ(shifted[3 * j], cached[3 * j]) << j << ", " << k;
+    }
+    if (bars)
+      EXPECT_GT(bar_rows_moved, 1e-3);  // (the links' centripetal loads: the bar form changes their rows' λ)
+    else
+      EXPECT_EQ(bar_rows_moved, 0.0);
   }
 }
 
 // A massless part listed before the links (a housing drawn on ground) leaves them at other indices among the
 // efforts' parts (those with mass): their forces are still read from the sweep's Q, as a shifted PlanarForce shows
-// at O and C, and the reactions are the same.
+// at O and C, and the reactions are the same, in either form of Q.
 TEST(NaturalReactions, AMasslessPartBeforeTheLinksLeavesTheirForcesReadFromQ) {
   const Scene s = natural_four_bar("  housing: {body: ground, shapes: [{type: box, size: [0.1, 0.1, 0.1]}]}\n");
   const Scene plain = natural_four_bar();
@@ -246,22 +274,26 @@ TEST(NaturalReactions, AMasslessPartBeforeTheLinksLeavesTheirForcesReadFromQ) {
   for (std::size_t k = 0; k < rows.values.size(); ++k) EXPECT_EQ(rows.values[k], same.values[k]) << k;
   const Model& m = *s.model;
   const OutputEfforts& e = s.sweep.efforts;
-  JointReactions reactions(m, e);
-  const detail::PartForces forces(*e.parts);
   Workspace ws(m);
-  const std::size_t k = 5, n = static_cast<std::size_t>(reactions.size());
-  const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data();
-  Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), lambda;
-  std::vector<detail::PlanarForce> planar(e.parts->size());
-  forces.add(*e.parts, *e.loads, q, qd, qdd, rows.t[k], Q, planar.data());
-  ws.q = rows.q[k];
-  ASSERT_EQ(constraint_multipliers(m, rows.t[k], ws, Q, lambda), SolveStatus::kSuccess);
-  std::vector<double> general(n), shifted(n);
-  reactions.evaluate(q, qd, qdd, rows.t[k], lambda, general.data());
-  for (detail::PlanarForce& f : planar) f.fx += 1.0;
-  reactions.evaluate(q, qd, qdd, rows.t[k], lambda, shifted.data(), planar.data());
-  for (std::size_t j : {0u, 3u})
-    EXPECT_NEAR(shifted[3 * j], general[3 * j] - 1.0, 1e-9 * (1 + std::fabs(general[3 * j])));
+  for (const bool bars : {false, true}) {
+    JointReactions reactions(m, e, bars);
+    const detail::PartForces forces(*e.parts, m, bars);
+    const std::size_t k = 5, n = static_cast<std::size_t>(reactions.size());
+    const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data();
+    Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), lambda;
+    std::vector<detail::PlanarForce> planar(e.parts->size());
+    forces.add(*e.parts, *e.loads, q, qd, qdd, rows.t[k], Q, planar.data());
+    ws.q = rows.q[k];
+    ASSERT_EQ(constraint_multipliers(m, rows.t[k], ws, Q, lambda), SolveStatus::kSuccess);
+    std::vector<double> cached(n), shifted(n);
+    reactions.evaluate(q, qd, qdd, rows.t[k], lambda, cached.data(), planar.data());
+    for (std::size_t j = 0; j < n; ++j)
+      EXPECT_NEAR(cached[j], rows.values[k][2 + j], 1e-9 * (1 + std::fabs(cached[j]))) << bars << ", " << j;
+    for (detail::PlanarForce& f : planar) f.fx += 1.0;
+    reactions.evaluate(q, qd, qdd, rows.t[k], lambda, shifted.data(), planar.data());
+    for (std::size_t j : {0u, 3u})
+      EXPECT_NEAR(shifted[3 * j], cached[3 * j] - 1.0, 1e-9 * (1 + std::fabs(cached[3 * j]))) << bars;
+  }
 }
 
 // An nfourbar in natural coordinates (cranks from G{i} to P{i}, couplers P{i} to P{i+1}) with random masses,
@@ -293,7 +325,8 @@ Scene natural_random_nfourbar(std::mt19937& rng, int n) {
 
 // The flat sites (JointReactions::NaturalSite: a point on a body whose force Q computed, no load its own; moving,
 // or fixed as the cranks' pivots G{i}) sum the same terms as the general path, bit for bit: random natural four-bar
-// chains, every row, every joint.
+// chains, every row, every joint, in both forms of Q (the frames' motion's, whose general path is the body's own Q
+// from its frame; the rigid bars', whose general path is the body's own bar form).
 TEST(NaturalReactions, FlatSitesAreTheGeneralPathBitForBit) {
   std::mt19937 rng(49);
   for (int trial = 0; trial < 4; ++trial) {
@@ -301,30 +334,48 @@ TEST(NaturalReactions, FlatSitesAreTheGeneralPathBitForBit) {
     const NaturalRows rows = natural_reactions_sweep(s);
     const Model& m = *s.model;
     const OutputEfforts& e = s.sweep.efforts;
-    JointReactions reactions(m, e);
-    const detail::PartForces forces(*e.parts);
     Workspace ws(m);
-    const std::size_t n = static_cast<std::size_t>(reactions.size());
-    ASSERT_EQ(n, 3 * e.natural->joints.size());
-    for (std::size_t k = 0; k < rows.q.size(); ++k) {
-      const double t = rows.t[k];
-      const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data();
-      Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), lambda;
-      std::vector<detail::PlanarForce> planar(e.parts->size());
-      forces.add(*e.parts, *e.loads, q, qd, qdd, t, Q, planar.data());
-      ws.q = rows.q[k];
-      ASSERT_EQ(constraint_multipliers(m, t, ws, Q, lambda), SolveStatus::kSuccess);
-      std::vector<double> general(n), flat(n);
-      reactions.evaluate(q, qd, qdd, t, lambda, general.data());
-      reactions.evaluate(q, qd, qdd, t, lambda, flat.data(), planar.data());
-      ASSERT_EQ(std::memcmp(general.data(), flat.data(), sizeof(double) * n), 0) << trial << ", row " << k;
-      for (detail::PlanarForce& f : planar) f.along_x += 1.0;  // read, not passed over: P{i} is its crank's x point
-      reactions.evaluate(q, qd, qdd, t, lambda, flat.data(), planar.data());
-      for (std::size_t j = 0; j < e.natural->joints.size(); ++j) {
-        const char first = e.natural->joints[j].name[0];
-        if (first != 'P' && first != 'G') continue;  // (O, crank 0's angle's)
-        // G{i}, its crank's fixed origin, takes −along_x: R = −Σ g over the crank's moving point − Q_b there
-        EXPECT_NEAR(flat[3 * j], general[3 * j] + (first == 'P' ? -1.0 : 1.0), 1e-9 * (1 + std::fabs(general[3 * j])));
+    for (const bool bars : {false, true}) {
+      JointReactions reactions(m, e, bars);
+      const detail::PartForces forces(*e.parts, m, bars);
+      const std::size_t n = static_cast<std::size_t>(reactions.size());
+      ASSERT_EQ(n, 3 * e.natural->joints.size());
+      for (std::size_t k = 0; k < rows.q.size(); ++k) {
+        const double t = rows.t[k];
+        const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data();
+        Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), lambda;
+        std::vector<detail::PlanarForce> planar(e.parts->size());
+        forces.add(*e.parts, *e.loads, q, qd, qdd, t, Q, planar.data());
+        ws.q = rows.q[k];
+        ASSERT_EQ(constraint_multipliers(m, t, ws, Q, lambda), SolveStatus::kSuccess);
+        std::vector<double> general(n), flat(n);
+        std::vector<detail::PlanarForce> unread = planar;  // the general path, in the bars' form where they are
+        for (detail::PlanarForce& f : unread) f.valid = false;
+        reactions.evaluate(q, qd, qdd, t, lambda, general.data(), bars ? unread.data() : nullptr);
+        reactions.evaluate(q, qd, qdd, t, lambda, flat.data(), planar.data());
+        ASSERT_EQ(std::memcmp(general.data(), flat.data(), sizeof(double) * n), 0) << trial << bars << ", row " << k;
+        // either form, the frames' motion's reactions and motor torque (bars off the centre line: c_y ≠ 0)
+        Eigen::VectorXd own = Eigen::VectorXd::Zero(m.num_coordinates()), own_lambda;
+        add_generalized_forces(*e.parts, *e.loads, q, qd, qdd, t, own);
+        ASSERT_EQ(constraint_multipliers(m, t, ws, own, own_lambda), SolveStatus::kSuccess);
+        std::vector<double> frames(n);
+        JointReactions(m, e).evaluate(q, qd, qdd, t, own_lambda, frames.data());
+        const Index motor = m.constraints()[static_cast<std::size_t>(m.find_constraint("motor"))].first_row;
+        EXPECT_NEAR(lambda(motor), own_lambda(motor), 1e-10 * (1 + std::fabs(own_lambda(motor)))) << trial << bars;
+        for (std::size_t j = 0; j < n; ++j) {
+          EXPECT_NEAR(flat[j], frames[j], 1e-9 * (1 + std::fabs(frames[j]))) << trial << bars << ", " << j;
+          EXPECT_NEAR(flat[j], rows.values[k][2 + j], 1e-9 * (1 + std::fabs(flat[j]))) << trial << bars << ", " << j;
+        }
+        for (detail::PlanarForce& f : planar) f.along_x += 1.0;  // read, not passed over: P{i} is its crank's x point
+        reactions.evaluate(q, qd, qdd, t, lambda, flat.data(), planar.data());
+        for (std::size_t j = 0; j < e.natural->joints.size(); ++j) {
+          const char first = e.natural->joints[j].name[0];
+          if (first != 'P' && first != 'G') continue;  // (O, crank 0's angle's)
+          // G{i}, its crank's fixed origin, takes −along_x in the frames' form (R = −Σ g over the crank's moving
+          // point − Q_b: its Q at G is fx − along_x); a bar's x share is its x point's alone
+          const double moved = first == 'P' ? -1.0 : bars ? 0.0 : 1.0;
+          EXPECT_NEAR(flat[3 * j], general[3 * j] + moved, 1e-9 * (1 + std::fabs(general[3 * j])));
+        }
       }
     }
   }
@@ -340,6 +391,7 @@ TEST(NaturalReactions, PlanarTermsSumAsAddPlanarForce) {
     detail::PlanarFrame frame;
     for (Slot& slot : frame.slots) slot = pick(rng) == 4 ? Slot::constant(u(rng)) : Slot::coordinate(pick(rng));
     frame.body = trial % 3 == 0, frame.x_is_point = trial % 2 == 0;
+    frame.bar = !frame.body && frame.x_is_point && trial % 4 == 2;  // (a rigid bar's: no share taken off the origin)
     detail::PlanarForce f;
     f.fx = u(rng), f.fy = u(rng), f.fz = u(rng), f.turn = u(rng), f.along_x = u(rng), f.along_y = u(rng);
     Eigen::VectorXd Q = Eigen::VectorXd::Zero(5), terms = Q;

@@ -47,8 +47,9 @@ class JointReactions {
   JointReactions(const Model& model, std::vector<Index> constraints);
   /// The reactions `efforts` lists (OutputEfforts::reactions, in order): a constraint's, or a natural joint's of
   /// OutputEfforts::natural. Pre-condition: as above for the constraints; a natural joint's index is one of
-  /// `natural`'s joints (else phiq::Error).
-  JointReactions(const Model& model, const OutputEfforts& efforts);
+  /// `natural`'s joints (else phiq::Error). `rigid_bars`: evaluate()'s `planar` is left by a Q that takes rigid bars'
+  /// constant mass matrices (internal: a sweep's, solve/part_forces.hpp).
+  JointReactions(const Model& model, const OutputEfforts& efforts, bool rigid_bars = false);
   /// The joints `other` lists, its set-up (sites, columns, bodies) copied rather than found again in the model, with
   /// scratch of its own: a sweep's chunks each evaluate on their own thread. Safe while `other` evaluates on
   /// another thread (its set-up is not written after construction).
@@ -65,7 +66,9 @@ class JointReactions {
   /// The same at the motion (q, q̇, q̈, t), which natural joints read (their bodies' inertia). `planar`, when not
   /// null, is what detail::PartForces::add() left of OutputEfforts::parts' forces at this (q, q̇, q̈, t) (internal: a
   /// sweep's, whose Q has computed them): a natural body's part's weight and inertia are read there rather than
-  /// computed again, the same values bit for bit.
+  /// computed again, the same values bit for bit. Pre-condition: λ solves Φqᵀ λ = Q with that Q when `planar` is
+  /// given (with rigid bars as constructed: they move their own rows' multipliers), else with
+  /// add_generalized_forces()'.
   void evaluate(const double* q, const double* qd, const double* qdd, double t, const Eigen::VectorXd& lambda,
                 double* out, const detail::PlanarForce* planar = nullptr);
 
@@ -111,7 +114,8 @@ class JointReactions {
     static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
     std::size_t part = kNone;
     Slot slots[5];
-    bool x_is_point = true;
+    bool x_is_point = true, bar = false;  // bar: the part's force is a rigid bar's (solve/part_forces.hpp)
+    double bar_length = 0.0;              // the body's, when it is a rigid bar of the model
     const AppliedLoads* applied = nullptr;
     detail::PlanarFrame frame() const;  // the promoted planar frame the slots name
   };
@@ -120,10 +124,10 @@ class JointReactions {
   void turn_natural(const NaturalSite& s, const double* q, double t, double* force) const;
   void add_site(const Model& model, Index c, std::vector<int>& site_of);
   void find_columns(const Model& model, const std::vector<int>& site_of);
-  void add_natural(const Model& model, const OutputEfforts& efforts);
+  void add_natural(const Model& model, const OutputEfforts& efforts, bool rigid_bars);
   // qx_, q̇x_, q̈x_ (the promoted constants past the model's coordinates) and qb_ (zero) at their sizes
   void size_natural_scratch();
-  void find_body_parts(const Model& model, const OutputEfforts& efforts);
+  void find_body_parts(const Model& model, const OutputEfforts& efforts, bool rigid_bars);
   void find_flat_sites(const Model& model);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);

@@ -86,6 +86,14 @@ struct Part {
   bool fixed = false;                           ///< its frame reads no coordinate and no time (ground)
 };
 
+/// `p` without its shapes: what its dynamics read (a mesh's triangles are not), copied without copying them.
+inline Part without_shapes(const Part& p) {
+  Part out;
+  out.name = p.name, out.body = p.body, out.frame = p.frame, out.colour = p.colour, out.mass = p.mass;
+  out.mass_source = p.mass_source, out.density = p.density, out.derived = p.derived, out.fixed = p.fixed;
+  return out;
+}
+
 struct AppliedLoads;  // phiq/applied_loads.hpp
 
 /// The loads on a mechanism's parts (the scene's `loads`): a uniform gravity acting at each part's centre of mass,

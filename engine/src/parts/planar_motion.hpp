@@ -13,6 +13,9 @@ namespace phiq::detail {
 struct PlanarFrame {
   Slot slots[5];
   bool body = false, x_is_point = true;
+  // A rigid bar's: its force is given at its two points (the origin's share and x's, the constant mass matrix of
+  // solve/part_forces.hpp), which add_planar_force() adds as they are. planar_motion() does not read it.
+  bool bar = false;
 };
 
 // `f`'s slots into `out`; false for the other frames.

@@ -133,10 +133,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   auto massive = std::make_shared<std::vector<Part>>();
   massive->reserve(scene.parts.size());
   for (const Part& p : scene.parts)
-    if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0) {
-      massive->push_back(p);
-      massive->back().shapes.clear();
-    }
+    if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0) massive->push_back(without_shapes(p));
   if (massive->empty() && !(scene.loads.applied && !scene.loads.applied->empty()))
     (pending_.efforts_field ? *pending_.efforts_field : *pending_.reactions_field)
         .fail(

@@ -1,7 +1,11 @@
 // add_generalized_forces() and constraint_multipliers() (phiq/inverse_dynamics.hpp).
 #include "phiq/inverse_dynamics.hpp"
 
+#include <bit>
+
 #include "phiq/applied_loads.hpp"
+#include "phiq/constraint_block.hpp"
+#include "phiq/kinds/distance.hpp"
 #include "phiq/kinds/registry.hpp"
 #include "phiq/part_motion.hpp"
 #include "solve/part_forces.hpp"
@@ -48,6 +52,23 @@ bool add_planar_virtual_work(const PartFrame& f, const double* q, V3 c, V3 force
   return true;
 }
 
+// A rigid bar's force (part_forces.hpp): its weight less its constant mass matrix times q̈, at its two points (its
+// origin's z is a constant: fz is the weight's z). Always inlined into PartForces::add(), where nfourbar 10⁴'s
+// 2·10⁴ parts take it at every row.
+[[gnu::always_inline]] inline void bar_force(const detail::MassivePart& p, const double* qdd, V3 gravity,
+                                             detail::PlanarForce& f) {
+  auto accel = [&](const Slot& s) { return s.is_coordinate() && qdd ? qdd[s.coord()] : 0.0; };
+  const Slot *o = p.frame.slots, *x = o + 3;
+  const double aox = accel(o[0]), aoy = accel(o[1]), axx = accel(x[0]), axy = accel(x[1]);
+  const double gx = gravity.x, gy = gravity.y;  // (R v = (−v_y, v_x), the quarter turn)
+  f.fx = (p.m_o * gx - p.m_b * gy) - (p.oo * aox + p.ox * axx - p.m_b * axy);
+  f.fy = (p.m_o * gy + p.m_b * gx) - (p.oo * aoy + p.ox * axy + p.m_b * axx);
+  f.along_x = (p.m_x * gx + p.m_b * gy) - (p.ox * aox + p.m_b * aoy + p.xx * axx);
+  f.along_y = (p.m_x * gy - p.m_b * gx) - (p.ox * aoy - p.m_b * aox + p.xx * axy);
+  f.fz = p.mass * gravity.z, f.turn = 0.0;
+  f.valid = true;
+}
+
 // The force of a part on a planar frame from the frame's motion in scalars (parts/planar_motion.hpp): what
 // part_motion(), PartMotion::point(), the inertia's moment and add_planar_virtual_work() compute, without their
 // terms that are products with the zeros of a rotation about z and of ω, α along z. Those terms are ±0 (every factor
@@ -56,6 +77,10 @@ bool add_planar_virtual_work(const PartFrame& f, const double* q, V3 c, V3 force
 // loops). False for a direction of zero length: the general path's NaN.
 bool planar_part_force(const detail::MassivePart& p, const double* q, const double* qd, const double* qdd, V3 gravity,
                        detail::PlanarForce& f) {
+  if (p.frame.bar) {
+    bar_force(p, qdd, gravity, f);
+    return true;
+  }
   detail::PlanarMotion m;
   if (!detail::planar_motion(p.frame, q, qd, qdd, m)) return false;
   const double c = m.cos, sn = m.sin, w = m.omega, a = m.alpha, mass = p.mass;
@@ -69,7 +94,7 @@ bool planar_part_force(const detail::MassivePart& p, const double* q, const doub
   return true;
 }
 
-// Q of one part with mass from its motion and Jacobian: any frame. Not inlined into add_part(): its stack frame
+// Q of one part with mass from its motion and Jacobian: any frame. Not inlined into add_massive_part(): its stack frame
 // and set-up (a PartMotion, a 3×3 rotation) were paid by every part of a sweep's Q, nearly all of them on planar
 // frames that never reach it.
 [[gnu::noinline]] void add_general_part(const Part& p, V3 gravity, const double* q, const double* qd, const double* qdd,
@@ -91,10 +116,10 @@ bool planar_part_force(const detail::MassivePart& p, const double* q, const doub
   }
 }
 
-// Q of one part with mass: its planar frame's closed form, or its motion and Jacobian. With `planar`, a planar
-// frame's force is left there too (PlanarForce::valid false when the general path took it).
-void add_part(const Part& p, const detail::MassivePart& massive, V3 gravity, const double* q, const double* qd,
-              const double* qdd, double t, Eigen::VectorXd& Q, detail::PlanarForce* planar = nullptr) {
+}  // namespace
+
+void detail::add_massive_part(const Part& p, const MassivePart& massive, V3 gravity, const double* q, const double* qd,
+                              const double* qdd, double t, Eigen::VectorXd& Q, PlanarForce* planar) {
   if (massive.planar) {
     detail::PlanarForce f;
     if (planar_part_force(massive, q, qd, qdd, gravity, f)) {
@@ -107,33 +132,82 @@ void add_part(const Part& p, const detail::MassivePart& massive, V3 gravity, con
   add_general_part(p, gravity, q, qd, qdd, t, Q);
 }
 
-}  // namespace
-
-detail::MassivePart detail::massive_part(const Part& p, std::size_t index) {
+detail::MassivePart detail::massive_part(const Part& p, std::size_t index, double bar_length) {
   MassivePart m;
   m.planar = planar_frame(p.frame, m.frame);
   m.mass = p.mass.mass, m.cx = p.mass.center.x, m.cy = p.mass.center.y, m.izz = p.mass.inertia[8];
   m.part = index;
+  if (m.planar && !m.frame.body && m.frame.x_is_point && !m.frame.slots[2].is_coordinate() && bar_length > 0.0) {
+    const double a = m.cx / bar_length, b = m.cy / bar_length, j = m.izz / (bar_length * bar_length);
+    m.frame.bar = true;
+    m.m_o = m.mass * (1.0 - a), m.m_x = m.mass * a, m.m_b = m.mass * b;
+    m.oo = m.mass * ((1.0 - a) * (1.0 - a) + b * b) + j;
+    m.xx = m.mass * (a * a + b * b) + j;
+    m.ox = m.mass * (a * (1.0 - a) - b * b) - j;
+  }
   return m;
+}
+
+namespace {
+
+// A point's x, y slots as BarLengths' key half.
+std::array<std::uint64_t, 2> slot_bits(const Slot& x, const Slot& y) {
+  return {std::bit_cast<std::uint64_t>(x), std::bit_cast<std::uint64_t>(y)};
+}
+
+}  // namespace
+
+detail::BarLengths::BarLengths(const Model& model) {
+  if (!model.solve_rows().empty()) return;
+  for (const auto& block : model.blocks()) {
+    const auto* distances = dynamic_cast<const TypedBlock<DistanceSpec>*>(block.get());
+    if (!distances) continue;
+    for (std::size_t i = 0; i < distances->size(); ++i) {
+      const DistanceSpec& d = distances->spec(i);
+      const auto a = slot_bits(d.a.x, d.a.y), b = slot_bits(d.b.x, d.b.y);
+      length_[{a[0], a[1], b[0], b[1]}] = d.length;
+      length_[{b[0], b[1], a[0], a[1]}] = d.length;
+    }
+  }
+}
+
+double detail::BarLengths::of(const PartFrame& f) const {
+  if (length_.empty() || f.kind != PartFrameKind::kPoints || f.spatial_frame || !f.x_is_point) return 0.0;
+  const auto o = slot_bits(f.origin.r[0], f.origin.r[1]), x = slot_bits(f.x_toward.r[0], f.x_toward.r[1]);
+  const auto it = length_.find({o[0], o[1], x[0], x[1]});
+  return it == length_.end() ? 0.0 : it->second;
 }
 
 void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
                             const double* qdd, double t, Eigen::VectorXd& Q) {
   for (std::size_t i = 0; i < parts.size(); ++i)
     if (detail::has_mass(parts[i]))
-      add_part(parts[i], detail::massive_part(parts[i], i), loads.gravity, q, qd, qdd, t, Q);
+      detail::add_massive_part(parts[i], detail::massive_part(parts[i], i), loads.gravity, q, qd, qdd, t, Q);
   if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
 }
 
-detail::PartForces::PartForces(const std::vector<Part>& parts) {
+detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars) {
+  const BarLengths bars = rigid_bars ? BarLengths(model) : BarLengths();
   for (std::size_t i = 0; i < parts.size(); ++i)
-    if (has_mass(parts[i])) massive_.push_back(massive_part(parts[i], i));
+    if (has_mass(parts[i])) massive_.push_back(massive_part(parts[i], i, bars.of(parts[i].frame)));
 }
 
 void detail::PartForces::add(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
                              const double* qdd, double t, Eigen::VectorXd& Q, PlanarForce* planar) const {
-  for (const MassivePart& m : massive_)
-    add_part(parts[m.part], m, loads.gravity, q, qd, qdd, t, Q, planar ? planar + m.part : nullptr);
+  auto add = [&Q](const Slot& s, double v) {
+    if (s.is_coordinate()) Q(s.coord()) += v;
+  };
+  for (const MassivePart& m : massive_) {
+    if (!m.frame.bar) {
+      add_massive_part(parts[m.part], m, loads.gravity, q, qd, qdd, t, Q, planar ? planar + m.part : nullptr);
+      continue;
+    }
+    PlanarForce f;  // add_planar_force()'s terms of a bar (its origin's z a constant)
+    bar_force(m, qdd, loads.gravity, f);
+    const Slot* o = m.frame.slots;
+    add(o[0], f.fx), add(o[1], f.fy), add(o[3], f.along_x), add(o[4], f.along_y);
+    if (planar) planar[m.part] = f;
+  }
   if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
 }
 

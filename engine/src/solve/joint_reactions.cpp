@@ -62,7 +62,7 @@ JointReactions::JointReactions(const Model& model, std::vector<Index> constraint
   find_columns(model, site_of);
 }
 
-JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts)
+JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts, bool rigid_bars)
     : joint_axes_(efforts.reactions_in_joint_axes), g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
   std::vector<int> site_of(model.constraints().size(), -1);
   for (const OutputReaction& r : efforts.reactions) {
@@ -97,7 +97,7 @@ JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts)
     natural_sites_.push_back(s);
   }
   find_columns(model, site_of);
-  if (!natural_sites_.empty()) add_natural(model, efforts);
+  if (!natural_sites_.empty()) add_natural(model, efforts, rigid_bars);
 }
 
 JointReactions::JointReactions(const JointReactions& other, SetUpOnly)

@@ -20,8 +20,9 @@ namespace phiq {
 namespace {
 
 // The frame's points: the origin, and x and y toward when they are points (a vector has no place to act).
-std::vector<Attachment3*> frame_points(PartFrame& f) {
-  std::vector<Attachment3*> out{&f.origin};
+template <class Frame>  // PartFrame or const PartFrame
+auto frame_points(Frame& f) {
+  std::vector<decltype(&f.origin)> out{&f.origin};
   if (f.x_is_point) out.push_back(&f.x_toward);
   if (f.spatial_frame && f.y_is_point) out.push_back(&f.y_toward);
   return out;
@@ -88,8 +89,7 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
       b.points.push_back(*a);
     }
     if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0) {
-      b.parts.push_back(p);
-      b.parts.back().shapes.clear();
+      b.parts.push_back(without_shapes(p));
       b.parts.back().frame = promoted;
     }
     b.loads.gravity = loads.gravity;
@@ -114,8 +114,7 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
   // a frame's point → its bodies, in order
   std::unordered_map<std::array<double, 6>, std::vector<std::size_t>, PointKeyHash> held_by(2 * out.bodies.size());
   for (std::size_t b = 0; b < out.bodies.size(); ++b) {
-    PartFrame f = out.bodies[b].frame;
-    for (Attachment3* a : frame_points(f)) {
+    for (const Attachment3* a : frame_points(out.bodies[b].frame)) {
       std::vector<std::size_t>& bodies = held_by[point_key(*a)];
       if (bodies.empty() || bodies.back() != b) bodies.push_back(b);
     }
@@ -148,7 +147,7 @@ bool same_bits(double a, double b) { return a == b && std::signbit(a) == std::si
 bool same_planar_force(const detail::MassivePart& whole, const detail::MassivePart& own,
                        const std::vector<double>& promoted, Index n) {
   if (!whole.planar || !own.planar || whole.frame.body != own.frame.body ||
-      whole.frame.x_is_point != own.frame.x_is_point)
+      whole.frame.x_is_point != own.frame.x_is_point || whole.frame.bar != own.frame.bar)
     return false;
   if (!same_bits(whole.mass, own.mass) || !same_bits(whole.cx, own.cx) || !same_bits(whole.cy, own.cy) ||
       !same_bits(whole.izz, own.izz))
@@ -166,7 +165,7 @@ bool same_planar_force(const detail::MassivePart& whole, const detail::MassivePa
 
 }  // namespace
 
-void JointReactions::find_body_parts(const Model& model, const OutputEfforts& efforts) {
+void JointReactions::find_body_parts(const Model& model, const OutputEfforts& efforts, bool rigid_bars) {
   const std::vector<NaturalBody>& bodies = natural_->bodies;
   body_parts_.assign(bodies.size(), {});
   if (!efforts.parts || !efforts.loads) return;
@@ -182,21 +181,26 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
     const auto it = by_name.find(body.name);
     return it == by_name.end() ? BodyPart::kNone : it->second;
   };
+  // as the sweep's Q (detail::PartForces) finds them
+  const detail::BarLengths bars = rigid_bars ? detail::BarLengths(model) : detail::BarLengths();
   for (std::size_t b = 0; b < bodies.size(); ++b) {
     const NaturalBody& body = bodies[b];
     const kin3::V3 own_g = body.loads.gravity;
+    const double bar = bars.of(body.frame);  // (its frame before promotion: the model's slots)
+    body_parts_[b].bar_length = bar;
     const std::size_t index = part_of(body);
     if (body.parts.size() != 1 || index == BodyPart::kNone || !detail::has_mass(body.parts[0]) ||
         !detail::has_mass(parts[index]) || !same_bits(g.x, own_g.x) || !same_bits(g.y, own_g.y) ||
         !same_bits(g.z, own_g.z))
       continue;
-    const detail::MassivePart own = detail::massive_part(body.parts[0], 0);
-    if (!same_planar_force(detail::massive_part(parts[index], index), own, natural_->promoted,
-                           model.num_coordinates()) ||
+    const detail::MassivePart own = detail::massive_part(body.parts[0], 0, bar);
+    if (!same_planar_force(detail::massive_part(parts[index], index, bars.of(parts[index].frame)), own,
+                           natural_->promoted, model.num_coordinates()) ||
         own.frame.body)
       continue;
     BodyPart& bp = body_parts_[b];
-    bp.part = index, bp.x_is_point = own.frame.x_is_point, bp.applied = body.loads.applied.get();
+    bp.part = index, bp.x_is_point = own.frame.x_is_point, bp.bar = own.frame.bar,
+    bp.applied = body.loads.applied.get();
     std::copy(own.frame.slots, own.frame.slots + 5, bp.slots);
   }
 }
@@ -243,7 +247,7 @@ void JointReactions::size_natural_scratch() {
   for (Index k = 0; k < extra; ++k) qx_(n + k) = natural_->promoted[static_cast<std::size_t>(k)];
 }
 
-void JointReactions::add_natural(const Model& model, const OutputEfforts& efforts) {
+void JointReactions::add_natural(const Model& model, const OutputEfforts& efforts, bool rigid_bars) {
   natural_ = efforts.natural;
   size_natural_scratch();
   const Index n = model.num_coordinates();
@@ -344,14 +348,14 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
     rows.constraints[next_constraint[b]++] = model.constraint_block(static_cast<Index>(c));
     for (std::size_t k = all_first[c]; k < all_first[c + 1]; ++k) rows.g_columns[next_g[b]++] = all[k];
   }
-  find_body_parts(model, efforts);
+  find_body_parts(model, efforts, rigid_bars);
   find_flat_sites(model);
 }
 
 detail::PlanarFrame JointReactions::BodyPart::frame() const {
   detail::PlanarFrame f;
   std::copy(slots, slots + 5, f.slots);
-  f.body = false, f.x_is_point = x_is_point;
+  f.body = false, f.x_is_point = x_is_point, f.bar = bar;
   return f;
 }
 
@@ -365,6 +369,14 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
     return;
   }
   const NaturalBody& body = natural_->bodies[b];
+  if (planar && part.bar_length > 0.0 && body.parts.size() == 1) {
+    // a rigid bar whose force the sweep's Q took in its constant mass matrix's form (not found among its parts):
+    // the same form, which λ was solved with
+    detail::add_massive_part(body.parts[0], detail::massive_part(body.parts[0], 0, part.bar_length), body.loads.gravity,
+                             qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
+    if (body.loads.applied) add_applied_forces(*body.loads.applied, qx_.data(), qdx_.data(), t, qb_);
+    return;
+  }
   add_generalized_forces(body.parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
 }
 

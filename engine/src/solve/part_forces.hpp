@@ -1,25 +1,54 @@
 // Internal: add_generalized_forces() (phiq/inverse_dynamics.hpp) for a sweep, whose efforts evaluate Q at every
-// written row: the parts with mass gathered once, those on planar frames as the slots and the four numbers their
-// forces read (80 bytes each instead of a Part's kilobyte: at 2·10⁴ parts a row spent its time reading the Parts).
-// The same Q, bit for bit, as add_generalized_forces().
+// written row: the parts with mass gathered once, those on planar frames as the slots and the few numbers their
+// forces read (~100 bytes each instead of a Part's kilobyte: at 2·10⁴ parts a row spent its time reading the Parts).
+//
+// A rigid bar (a planar frame from a natural point to another that a distance constraint of the model holds at its
+// length L) takes the constant mass matrix of natural coordinates instead of its frame's motion: its centre
+// r_G = (1 − a) r_o + a r_x + b R (r_x − r_o), a = c_x / L, b = c_y / L, R the quarter turn, is linear in its two
+// points, and its kinetic energy ½ m |ṙ_G|² + ½ (I_zz / L²) |ṙ_x − ṙ_o|², so that its Q is m A_oᵀ g − M_o· r̈ at the
+// origin and m A_xᵀ g − M_x· r̈ at x, with no division, root or velocity. On the bar's length it differs from the
+// frame's motion's Q only by a multiple of the bar's own row of Φq (along the bar: what the length's equation
+// carries): λ of every other row, hence every effort and every joint's reaction, is the same; the bar's own
+// multiplier takes the difference. Q is then about four times faster at nfourbar 10⁴ (bench/README.md). Not with
+// ∂τ/∂p (PartForces' `rigid_bars`) nor where the model dropped redundant rows (BarLengths). Elsewhere the same Q,
+// bit for bit, as add_generalized_forces().
 #pragma once
 
 #include <Eigen/Core>
 
+#include <array>
+#include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "parts/planar_motion.hpp"
 #include "phiq/parts.hpp"
 
+namespace phiq {
+class Model;
+}
+
 namespace phiq::detail {
+
+// Four slots' bits, mixed (BarLengths' key).
+struct SlotsHash {
+  std::size_t operator()(const std::array<std::uint64_t, 4>& k) const {
+    std::size_t h = 0;
+    for (std::uint64_t v : k) h = h * 1000003u ^ std::hash<std::uint64_t>{}(v);
+    return h;
+  }
+};
 
 // A part with mass, as its generalized forces read it.
 struct MassivePart {
-  PlanarFrame frame;                      // its frame's slots, where `planar`
+  PlanarFrame frame;                      // its frame's slots, where `planar` (frame.bar: a rigid bar's)
   double mass = 0.0, cx = 0.0, cy = 0.0;  // its mass and its centre's x, y in its frame
   double izz = 0.0;                       // its inertia about z through the centre
-  std::size_t part = 0;                   // its index among the parts
-  bool planar = false;                    // on a planar frame (else the general path reads the Part)
+  // A rigid bar's constant mass matrix (file comment): m (1 − a), m a, m b, and the scalar parts of M_oo, M_xx and
+  // M_ox = ox I + m b R (M_xo = ox I − m b R)
+  double m_o = 0.0, m_x = 0.0, m_b = 0.0, oo = 0.0, xx = 0.0, ox = 0.0;
+  std::size_t part = 0;  // its index among the parts
+  bool planar = false;   // on a planar frame (else the general path reads the Part)
 };
 
 // What a part on a planar frame adds to Q at its frame's slots (add_planar_force()): the force at its origin
@@ -50,7 +79,7 @@ inline void add_planar_force(const PlanarFrame& frame, const PlanarForce& force,
   const Slot* x = o + 3;
   add(o[0], force.fx), add(o[1], force.fy), add(o[2], force.fz);
   add(x[0], force.along_x), add(x[1], force.along_y);
-  if (frame.x_is_point) add(o[0], -force.along_x), add(o[1], -force.along_y);
+  if (frame.x_is_point && !frame.bar) add(o[0], -force.along_x), add(o[1], -force.along_y);
 }
 
 // add_planar_force()'s terms, in its order, for those that read a few of its sums (JointReactions' flat sites):
@@ -67,14 +96,30 @@ void for_each_planar_term(const PlanarFrame& frame, Visit&& visit) {
   const Slot* x = o + 3;
   visit(o[0], 0, false), visit(o[1], 1, false), visit(o[2], 2, false);
   visit(x[0], 4, false), visit(x[1], 5, false);
-  if (frame.x_is_point) visit(o[0], 4, true), visit(o[1], 5, true);
+  if (frame.x_is_point && !frame.bar) visit(o[0], 4, true), visit(o[1], 5, true);
 }
+
+// The lengths at which a model's distance constraints hold pairs of points (rigid_bar_length()).
+class BarLengths {
+ public:
+  BarLengths() = default;
+  // `model`'s distance constraints; none when the model dropped redundant rows (their minimum-norm multipliers,
+  // unlike the others, would not be the same under a bar's Q).
+  explicit BarLengths(const Model& model);
+  // The length L at which the model holds `frame`'s origin and x point, a planar frame of points; 0 when none does.
+  double of(const PartFrame& frame) const;
+
+ private:
+  std::unordered_map<std::array<std::uint64_t, 4>, double, SlotsHash> length_;  // both orders of a, b
+};
 
 class PartForces {
  public:
   PartForces() = default;
-  // The parts with mass of `parts`, in order.
-  explicit PartForces(const std::vector<Part>& parts);
+  // The parts with mass of `parts`, in order; with `rigid_bars`, those that are rigid bars of `model` (BarLengths)
+  // with their constant mass matrix (file comment). (∂τ/∂p differentiates the frames' motion's Q, with whose λ
+  // alone its formula holds: a sweep that asks for them takes no bars.)
+  PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars);
   // Q += the parts' and the loads' generalized forces at (q, q̇, q̈, t), as add_generalized_forces(parts, loads, …);
   // `parts` those this was made from. With `planar` (one entry per part), each part with mass on a planar frame
   // also leaves there what it added (PlanarForce::valid false where it took the general path); the others' entries
@@ -89,7 +134,14 @@ class PartForces {
 // Whether part `p` has mass: add_generalized_forces() counts it.
 inline bool has_mass(const Part& p) { return p.mass_source != MassSource::kNone && p.mass.mass != 0.0; }
 
-// `p` (the index-th part) as its generalized forces read it.
-MassivePart massive_part(const Part& p, std::size_t index);
+// Q += the generalized force of `p` with mass, as `massive` (massive_part(p, …)) reads it: its planar frame's closed
+// form (a rigid bar's constant mass matrix where massive.frame.bar), or its motion and Jacobian. With `planar`, a
+// planar frame's force is left there too (PlanarForce::valid false when the general path took it).
+void add_massive_part(const Part& p, const MassivePart& massive, kin3::V3 gravity, const double* q, const double* qd,
+                      const double* qdd, double t, Eigen::VectorXd& Q, PlanarForce* planar = nullptr);
+
+// `p` (the index-th part) as its generalized forces read it; a rigid bar's (file comment) when `bar_length` > 0, its
+// frame a planar one of points (else the length is not read).
+MassivePart massive_part(const Part& p, std::size_t index, double bar_length = 0.0);
 
 }  // namespace phiq::detail

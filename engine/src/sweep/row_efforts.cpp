@@ -120,7 +120,7 @@ std::optional<JointReactions> Sweeper::written_reactions(const Sweeper* like) co
   if (opt_.efforts.reactions.empty()) return std::nullopt;
   if (same_sweep(like) && like->effort_work_.reactions)
     return JointReactions::with_set_up_of(*like->effort_work_.reactions);
-  return JointReactions(model_, opt_.efforts);
+  return JointReactions(model_, opt_.efforts, rigid_bars());
 }
 
 std::vector<std::size_t> Sweeper::dropped_efforts() const {

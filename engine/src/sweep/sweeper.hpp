@@ -353,6 +353,9 @@ class Sweeper {
   std::optional<JointReactions> written_reactions(const Sweeper* like) const;
   // Whether `like` (may be null) sweeps this sweeper's model with its options: its set-up is this one's.
   bool same_sweep(const Sweeper* like) const;
+  // Whether Q takes rigid bars' constant mass matrices (solve/part_forces.hpp): unless ∂τ/∂p is asked, whose formula
+  // holds with the frames' motion's Q alone. Q and the reactions read it alike.
+  bool rigid_bars() const { return opt_.sensitivities.empty(); }
   // The reactions of the row (after the efforts) from effort_work_.lambda: minimum-norm multipliers first where rows
   // were dropped, and at the sweep's first row a warning naming the joints whose share that makes up.
   void row_reactions(SparseLuNumeric& lu);
