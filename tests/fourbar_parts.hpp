@@ -2,21 +2,11 @@
 // (relative, natural, reference_point, mixed): what the inverse dynamics and applied loads tests load.
 #pragma once
 
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "test_support.hpp"
 
 namespace phiq::test {
-
-// The text of models/seed/NAME.
-inline std::string seed_text(const std::string& name) {
-  std::ifstream in(model_path("seed/" + name));
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // The `parts` entries of the four-bar in formulation `form`: mass properties of the three links (kg, kg·m² about
 // the centre), the centre at each link's middle, each part named as its link (crank, coupler, rocker).

@@ -5,8 +5,6 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "phiq/import_model.hpp"
@@ -16,13 +14,6 @@
 namespace phiq::test {
 
 inline std::string import_data(const std::string& name) { return std::string(PHIQ_SOURCE_DIR) + "/tests/data/" + name; }
-
-inline std::string import_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 struct ImportRun {
   Scene scene;

@@ -6,8 +6,6 @@
 
 #include <array>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -187,16 +185,6 @@ inline std::vector<double> first_driver_values_at(const std::string& text, const
   std::vector<double> out;
   for (const auto& v : r.values) out.push_back(v[at]);
   return out;
-}
-
-// The text of models/REL up to (without) its first `cut`, or whole.
-inline std::string model_file_text(const std::string& rel, const std::string& cut = "") {
-  std::ifstream in(model_path(rel));
-  std::stringstream s;
-  s << in.rdbuf();
-  std::string text = s.str();
-  if (!cut.empty()) text.erase(text.find(cut));
-  return text;
 }
 
 // models/spatial/rssr.yaml with massive bodies under gravity and damped torsional springs on both hinges' angles,

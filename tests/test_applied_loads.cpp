@@ -18,13 +18,6 @@
 namespace phiq {
 namespace {
 
-std::string model_text(const std::string& rel) {
-  std::ifstream in(test::model_path(rel));
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 Eigen::VectorXd applied_q(const Scene& s, const Eigen::VectorXd& q, double t) {
   Eigen::VectorXd Q = Eigen::VectorXd::Zero(s.model->num_coordinates());
   add_applied_forces(*s.loads.applied, q.data(), nullptr, t, Q);
@@ -51,7 +44,7 @@ double spring_energy(const AppliedLoads& loads, const Eigen::VectorXd& q, double
 TEST(AppliedLoads, TheCrankSlidersMotorBalancesAForceOnTheSlider) {
   // F = −40 − 10 xB + 5 sin t on the slider along x, no masses: the motor's power balances the force's,
   // τ θ̇ + F ẋB = 0, so τ = −F ∂xB/∂θ with xB = r cos θ + √(L² − r² sin² θ)
-  Scene s = parse_scene(model_text("seed/crank_slider_mixed.yaml") +
+  Scene s = parse_scene(test::model_file_text("seed/crank_slider_mixed.yaml") +
                             "\nparts:\n  slider: {frame: {at: B}}\n"
                             "loads:\n  forces:\n    - {name: push, part: slider, force: [-40 - 10*xB + 5*sin(t), 0]}\n",
                         "crank_slider.yaml");
@@ -82,7 +75,7 @@ TEST(AppliedLoads, TheCrankSlidersMotorBalancesAForceOnTheSlider) {
 
 // Q of the springs against −∂V/∂q_k by central differences, every coordinate of the model, at its rough placement.
 void expect_spring_forces_are_the_energys_gradient(const std::string& rel, const std::string& loads) {
-  Scene s = parse_scene(model_text(rel) + "\nloads:\n" + loads, rel);
+  Scene s = parse_scene(test::model_file_text(rel) + "\nloads:\n" + loads, rel);
   ASSERT_TRUE(s.loads.applied);
   const AppliedLoads& a = *s.loads.applied;
   const Eigen::VectorXd q = s.model->initial_positions();
@@ -265,7 +258,8 @@ TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) 
       "       free_length: 0, damping: 25}\n";
   for (const std::string form : {"relative", "natural", "reference_point", "mixed"}) {
     Scene s = parse_scene(
-        test::seed_text("fourbar_" + form + ".yaml") + "\nparts:\n" + test::fourbar_parts(form) + loads, form);
+        test::model_file_text("seed/fourbar_" + form + ".yaml") + "\nparts:\n" + test::fourbar_parts(form) + loads,
+        form);
     const LoadedPowerBalance b = loaded_power_balance(s);
     const double balance = b.balance, scale = b.scale, loads_power = b.loads_power;
     EXPECT_GT(loads_power, 1.0) << form;  // watts: the loads take part in the balance
@@ -275,7 +269,7 @@ TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) 
 
 TEST(AppliedLoads, DriverPowerBalancesInSpaceWithAJointSpringAndLoadsInPartAxes) {
   Scene s =
-      parse_scene(model_text("spatial/rssr.yaml") +
+      parse_scene(test::model_file_text("spatial/rssr.yaml") +
                       "\nparts:\n"
                       "  crank: {mass: 1.0, center_of_mass: [0.1, 0, 0], inertia: [0.01, 0.02, 0.025]}\n"
                       "  rocker: {mass: 2.0, center_of_mass: [0, 0.25, 0], inertia: [0.05, 0.01, 0.05]}\n"
@@ -302,7 +296,7 @@ TEST(AppliedLoads, AForceInPartAxesIsTheSameForceTurnedIntoWorldAxes) {
        "[(30*xA - 40*yA)/sqrt(xA^2 + yA^2), (30*yA + 40*xA)/sqrt(xA^2 + yA^2)]"}};
   for (const Form& f : forms) {
     auto with_force = [&](const std::string& force, const std::string& axes) {
-      return parse_scene(model_text(f.rel) + "\n" + f.parts +
+      return parse_scene(test::model_file_text(f.rel) + "\n" + f.parts +
                              "loads:\n  forces:\n    - {part: crank, at: [0.1, 0.02], " + "force: " + force +
                              ", axes: " + axes + "}\n",
                          f.rel);
@@ -319,7 +313,7 @@ TEST(AppliedLoads, AForceInPartAxesIsTheSameForceTurnedIntoWorldAxes) {
 }
 
 TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
-  const std::string base = test::seed_text("fourbar_reference_point.yaml") + "\nloads:\n";
+  const std::string base = test::model_file_text("seed/fourbar_reference_point.yaml") + "\nloads:\n";
   auto error = [&](const std::string& loads) { return test::scene_error(base + loads); };
   std::string m = error("  forces:\n    - {part: wheel, force: [1, 0]}\n");
   EXPECT_HAS(m, "loads.forces[0].part: unknown part 'wheel'");
@@ -354,12 +348,13 @@ TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
   EXPECT_HAS(m, "loads.torsional_springs[0].joint: a joint's angle is a spatial joint's");
   m = error("  torsional_springs:\n    - {coordinate: psi2, angle: psi2, stiffness: 1}\n");
   EXPECT_HAS(m, "loads.torsional_springs[0]: a torsional spring acts on one of");
-  const std::string rssr = model_text("spatial/rssr.yaml") + "\nloads:\n  torsional_springs:\n";
+  const std::string rssr = test::model_file_text("spatial/rssr.yaml") + "\nloads:\n  torsional_springs:\n";
   m = test::scene_error(rssr + "    - {joint: hinge, stiffness: 1}\n");
   EXPECT_HAS(m, "loads.torsional_springs[0].joint: unknown joint 'hinge'");
   m = test::scene_error(rssr + "    - {joint: coupler, stiffness: 1}\n");
   EXPECT_HAS(m, "loads.torsional_springs[0].joint: unknown joint 'coupler'");  // a distance: no joint
-  m = test::scene_error(model_text("spatial/rssr.yaml") + "\nloads:\n  torques: [{part: crank, torque: 1}]\n");
+  m = test::scene_error(test::model_file_text("spatial/rssr.yaml") +
+                        "\nloads:\n  torques: [{part: crank, torque: 1}]\n");
   EXPECT_HAS(m, "loads.torques[0].torque: torque is [x, y, z]");
 }
 

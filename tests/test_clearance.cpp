@@ -6,8 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
@@ -17,11 +15,7 @@ namespace {
 
 // The four-bar scene with `extra` appended (its parts, its output).
 Scene clearance_fourbar(const std::string& extra, int steps = 360) {
-  std::ifstream in(test::model_path("seed/fourbar_reference_point.yaml"));
-  std::stringstream s;
-  s << in.rdbuf();
-  std::string text = s.str();
-  text = text.substr(0, text.find("\ntime:"));
+  const std::string text = test::model_file_text("seed/fourbar_reference_point.yaml", "\ntime:");
   return parse_scene(text + "\ntime: {start: 0, end: 2*pi, steps: " + std::to_string(steps) + "}\n" + extra,
                      "fourbar_clearance.yaml");
 }

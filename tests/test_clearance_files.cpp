@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -28,11 +27,7 @@ namespace fs = std::filesystem;
 // (cos t, sin t), and a ball of radius 0.15 fixed at (0, −0.5): d = |tip − (0, −0.5)| − 0.2, least at t = 3π/2, where
 // d = 0.5 − (L2/2 + 0.2) − 0.2 = −0.1 and ∂d/∂L2 = −1/2; the balls overlap while 0.41 + 0.4 sin t < 0.04.
 std::string clearance_files_scene_text() {
-  std::ifstream in(test::model_path("seed/fourbar_reference_point.yaml"));
-  std::stringstream s;
-  s << in.rdbuf();
-  std::string text = s.str();
-  return text.substr(0, text.find("\ntime:")) +
+  return test::model_file_text("seed/fourbar_reference_point.yaml", "\ntime:") +
          "\ntime: {start: 0, end: 2*pi, steps: 90}\n"
          "parts:\n"
          "  tip: {body: crank, shapes: [{type: sphere, radius: 0.05, at: [0.2, 0]}]}\n"
@@ -60,13 +55,6 @@ long long clearance_files_integer(hid_t file, const char* name) {
   H5Aread(a, H5T_NATIVE_LLONG, &v);
   H5Aclose(a);
   return v;
-}
-
-std::string clearance_files_bytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 TEST(ClearanceFiles, Hdf5HoldsTheCsvValuesAndTheSummaryExactlyOnAnyThreadCount) {
@@ -147,7 +135,7 @@ TEST(ClearanceFiles, Hdf5HoldsTheCsvValuesAndTheSummaryExactlyOnAnyThreadCount) 
   s.sweep.chunk_steps = 30;
   const fs::path other = dir / "c2.h5";
   write_clearance_hdf5(other.string(), scene_clearance(s), s.parts, o);
-  EXPECT_EQ(clearance_files_bytes(path), clearance_files_bytes(other));
+  EXPECT_EQ(test::file_text(path.string()), test::file_text(other.string()));
   fs::remove_all(dir);
 }
 
@@ -196,10 +184,8 @@ TEST(ClearanceFiles, SummaryJsonOfTwoBallsIsTheClosedForm) {
 // order, to the bit, as many as its `minima` count, each with its own sensitivities (/minima's last columns); the
 // worst's entry has /worst's witness points and /sensitivities' row.
 TEST(ClearanceFiles, SummaryJsonListsEveryMinimumAsHdf5MinimaHoldsIt) {
-  std::ifstream in(test::model_path("clearance/fourbar_knee.yaml"));
-  std::stringstream text;
-  text << in.rdbuf();
-  const Scene s = parse_scene(text.str() + "  sensitivities: [L2, L3]\n", "fourbar_knee.yaml");
+  const Scene s = parse_scene(test::model_file_text("clearance/fourbar_knee.yaml") + "  sensitivities: [L2, L3]\n",
+                              "fourbar_knee.yaml");
   const ClearanceReport r = scene_clearance(s);
   ASSERT_GE(r.pairs.size(), 2u);
   const fs::path dir = phiq::test::scratch_path("phiq_clearance_json_minima");

@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
@@ -18,12 +16,8 @@ namespace {
 // The four-bar in reference-point coordinates (O = (0, 0), C = (L1, 0)) with spheres: `pivot` at O on ground, `pin`
 // at the rocker's end B, one on each link, and a `screw` head on ground far from every joint; `output` appended.
 std::string clearance_scene_text(const std::string& output, int steps = 90) {
-  std::ifstream in(test::model_path("seed/fourbar_reference_point.yaml"));
-  std::stringstream s;
-  s << in.rdbuf();
-  std::string text = s.str();
-  text = text.substr(0, text.find("\ntime:"));
-  return text + "\ntime: {start: 0, end: 2*pi, steps: " + std::to_string(steps) +
+  return test::model_file_text("seed/fourbar_reference_point.yaml", "\ntime:") +
+         "\ntime: {start: 0, end: 2*pi, steps: " + std::to_string(steps) +
          "}\n"
          "parts:\n"
          "  pivot: {body: ground, shapes: [{type: sphere, radius: 0.02}]}\n"

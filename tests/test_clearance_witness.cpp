@@ -5,8 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
@@ -124,11 +122,7 @@ TEST(ClearanceWitness, CapsuleAgainstABoxHasTheDeepestPointsOfTheDippingEnd) {
 // L1² − L4²) / (2 L1 L4)) = acos(0.28) (crank and coupler in line): the rocker's face dips into the ball most at
 // its limit, d = 0.6 sin(ψ0 − 1.2) − 0.03 − 0.1 < 0 (the ball's centre outside the box).
 std::string witness_rocker_scene_text() {
-  std::ifstream in(test::model_path("seed/fourbar_reference_point.yaml"));
-  std::stringstream s;
-  s << in.rdbuf();
-  const std::string text = s.str();
-  return text.substr(0, text.find("\ntime:")) +
+  return test::model_file_text("seed/fourbar_reference_point.yaml", "\ntime:") +
          "\ntime: {start: 0, end: 2*pi, steps: 90}\n"
          "parts:\n"
          "  rocker: {shapes: [{type: box, size: [1, 0.06, 0.02]}]}\n"

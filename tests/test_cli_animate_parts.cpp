@@ -6,10 +6,8 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 #include <string>
 
 #include "html_clearance.hpp"
@@ -201,10 +199,7 @@ TEST_F(AnimateParts, HtmlHoldsEachPartAndItsPoses) {
 // the crank is its material point at radius 0.45 on the line of centres there, 0.45 (cos t, sin t) at every row;
 // the fixed ball's is (0, −0.35). Both balls ×2 exactly at the rows the viewer colours (viewer_near_rows()).
 TEST_F(AnimateParts, GlbCarriesTheClearanceWitnessPointsWithTheirParts) {
-  std::ifstream in(phiq::test::model_path("seed/fourbar_reference_point.yaml"));
-  std::stringstream base;
-  base << in.rdbuf();
-  const std::string text = base.str().substr(0, base.str().find("\ntime:")) +
+  const std::string text = phiq::test::model_file_text("seed/fourbar_reference_point.yaml", "\ntime:") +
                            "\ntime: {start: 0, end: 2*pi, steps: 90}\n"
                            "parts:\n"
                            "  tip: {body: crank, shapes: [{type: sphere, radius: 0.05, at: [0.2, 0]}]}\n"

@@ -6,11 +6,9 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <numbers>
 #include <set>
-#include <sstream>
 
 #include "phiq/drawn_parts.hpp"
 #include "phiq/mechanism_sketch.hpp"
@@ -21,12 +19,6 @@ namespace phiq::drawn_parts_test {
 
 using kin3::V3;
 
-std::string file_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 bool starts_with(const std::string& s, const std::string& p) { return s.rfind(p, 0) == 0; }
 const Shape* shape_named(const std::vector<Part>& parts, const std::string& part, const std::string& shape) {
   for (const Part& p : parts)
@@ -334,7 +326,7 @@ TEST(DrawnParts, CamProfilesSlotsAndThreadsFollowTheirKinds) {
 // Stated parts come first, as the scene has them; their bodies (and a natural link's points) get no derived part,
 // the others do.
 TEST(DrawnParts, StatedPartsAreKeptAndTheirBodiesGetNoDerivedPart) {
-  const Scene body = parse_scene(file_text(test::model_path("seed/fourbar_reference_point.yaml")) +
+  const Scene body = parse_scene(test::model_file_text("seed/fourbar_reference_point.yaml") +
                                      "\nparts:\n  coupler: {shapes: [{type: box, size: [1.2, 0.1, 0.05]}]}\n",
                                  "stated.yaml");
   const std::vector<Part> parts = drawn_parts(body);
@@ -349,9 +341,9 @@ TEST(DrawnParts, StatedPartsAreKeptAndTheirBodiesGetNoDerivedPart) {
   EXPECT_TRUE(parts[3].fixed);
   for (std::size_t k = 1; k < parts.size(); ++k) EXPECT_TRUE(parts[k].derived);
 
-  const Scene natural = parse_scene(
-      file_text(test::model_path("seed/fourbar_natural.yaml")) + "\nparts:\n  bar: {frame: {origin: B, x: A}}\n",
-      "stated.yaml");
+  const Scene natural =
+      parse_scene(test::model_file_text("seed/fourbar_natural.yaml") + "\nparts:\n  bar: {frame: {origin: B, x: A}}\n",
+                  "stated.yaml");
   const std::vector<Part> links = drawn_parts(natural);
   std::vector<std::string> names;
   for (const Part& p : links) names.push_back(p.name);

@@ -11,7 +11,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
 #include <sstream>
 
 #include "phiq/effort_sensitivity.hpp"
@@ -165,22 +164,14 @@ output: {efforts: all, sensitivities: [L2, L3]}
 
 TEST(EffortSensitivity, TheMassiveFourBarsTorqueMatchesResolvedSweeps) {
   // models/dynamics/fourbar_motor_torque.yaml (natural coordinates; centres and inertias read L2, L3, L4)
-  std::ifstream in(test::model_path("dynamics/fourbar_motor_torque.yaml"));
-  std::stringstream read;
-  read << in.rdbuf();
-  std::string text = read.str();
-  text.erase(text.find("output:"));
+  const std::string text = test::model_file_text("dynamics/fourbar_motor_torque.yaml", "output:");
   expect_effort_sensitivities_match_resolved_sweeps(text + "output: {efforts: all, sensitivities: [L1, L2, L3]}\n");
 }
 
 TEST(EffortSensitivity, ASpatialRssrsTorqueMatchesResolvedSweeps) {
   // models/spatial/rssr.yaml (reference points and Euler parameters, a joint driver) with a massive crank and
   // rocker under gravity along −y: the dimensions a, b and L move the pins, the centres and the inertias
-  std::ifstream in(test::model_path("spatial/rssr.yaml"));
-  std::stringstream read;
-  read << in.rdbuf();
-  std::string text = read.str();
-  text.erase(text.find("time:"));
+  const std::string text = test::model_file_text("spatial/rssr.yaml", "time:");
   expect_effort_sensitivities_match_resolved_sweeps(
       text +
       "parts:\n"
@@ -214,8 +205,7 @@ TEST(EffortSensitivity, TheFourFormulationsOfTheFourBarGiveOneSensitivity) {
   const char* forms[] = {"relative", "natural", "reference_point", "mixed"};
   std::vector<EffortSensitivityRows> rows;
   for (const char* form : forms) {
-    std::string text = test::seed_text(std::string("fourbar_") + form + ".yaml");
-    text.erase(text.find("time:"));
+    const std::string text = test::model_file_text(std::string("seed/fourbar_") + form + ".yaml", "time:");
     const Scene s = parse_scene(text + "parts:\n" + test::fourbar_parts(form) +
                                     "loads: {gravity: [0, -9.81]}\n"
                                     "time: {start: 0, end: 2*pi, steps: 60}\n"
@@ -239,11 +229,7 @@ TEST(EffortSensitivity, TheFourFormulationsOfTheFourBarGiveOneSensitivity) {
 TEST(EffortSensitivity, ARedundantParallelogramHasItsFourBarsSensitivity) {
   // models/redundant/parallelogram_fifth_bar.yaml, swept on its independent rows (a row dropped: w and λ over the
   // kept ones), against the four-bar without its fifth bar: ∂τ/∂r and ∂τ/∂d alike, row by row
-  std::ifstream in(test::model_path("redundant/parallelogram_fifth_bar.yaml"));
-  std::stringstream read;
-  read << in.rdbuf();
-  std::string five = read.str();
-  five.erase(five.find("output:"));
+  const std::string five = test::model_file_text("redundant/parallelogram_fifth_bar.yaml", "output:");
   std::string four;
   std::istringstream lines(five);
   for (std::string line; std::getline(lines, line);)

@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <functional>
 #include <fstream>
-#include <sstream>
 
 #include "phiq/expression.hpp"
 #include "test_support.hpp"
@@ -343,10 +342,7 @@ TEST(Expression, CompilesToTheSameTapeInEveryProcess) {
                             std::filesystem::read_symlink("/proc/self/exe").string() +
                             " --gtest_filter=Expression.CompilesToTheSameTapeInEveryProcess >/dev/null 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-    std::ifstream in(file);
-    std::stringstream text;
-    text << in.rdbuf();
-    EXPECT_EQ(text.str(), mine) << "child process " << child;
+    EXPECT_EQ(test::file_text(file.string()), mine) << "child process " << child;
   }
   std::filesystem::remove_all(dir);
 }

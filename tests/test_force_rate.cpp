@@ -196,8 +196,7 @@ TEST(ForceRate, CarriesFramesOfExpressionsExactlyInThePlaneAndInSpace) {
   expect_force_rate_equals_difference_of_q(spatial);
   expect_force_rate_paths_agree(spatial);
   // the four-bar in relative angles: every part's frame is one of expressions, L2 and L3 in them
-  std::string text = test::seed_text("fourbar_relative.yaml");
-  text.erase(text.find("time:"));
+  const std::string text = test::model_file_text("seed/fourbar_relative.yaml", "time:");
   const Scene relative = parse_scene(text + "parts:\n" + test::fourbar_parts("relative") +
                                          "loads: {gravity: [0, -9.81]}\ntime: {start: 0, end: 1, steps: 4}\n"
                                          "output: {efforts: all, sensitivities: [L2, L3, L4]}\n",

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <regex>
 #include <set>
@@ -13,24 +12,19 @@
 #include <string>
 #include <vector>
 
+#include "test_support.hpp"
+
 namespace header_layering {
 
 namespace fs = std::filesystem;
 
 const fs::path kHeaders = fs::path(PHIQ_SOURCE_DIR) / "engine" / "include";
 
-std::string file_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The phiq headers `header` (a path below engine/include, "phiq/sweep.hpp") includes directly.
 std::vector<std::string> direct_includes(const std::string& header) {
   static const std::regex include(R"(^\s*#\s*include\s+[<"](phiq/[^">]+)[">])");
   std::vector<std::string> out;
-  std::istringstream lines(file_text(kHeaders / header));
+  std::istringstream lines(phiq::test::file_text(kHeaders / header));
   std::smatch m;
   for (std::string line; std::getline(lines, line);)
     if (std::regex_search(line, m, include)) out.push_back(m[1]);
@@ -102,7 +96,7 @@ TEST(HeaderLayering, TheOutputPlansMembersAreDefinedInOutput) {
   for (const auto& e : fs::recursive_directory_iterator(src)) {
     if (e.path().extension() != ".cpp") continue;
     const bool output = e.path().parent_path().filename() == "output";
-    std::istringstream lines(file_text(e.path()));
+    std::istringstream lines(phiq::test::file_text(e.path()));
     for (std::string line; std::getline(lines, line);) {
       if (!std::regex_search(line, definition)) continue;
       EXPECT_TRUE(output) << fs::relative(e.path(), src).generic_string() << " defines " << line;

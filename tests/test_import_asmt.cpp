@@ -9,8 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "cli_test_support.hpp"
@@ -28,13 +26,6 @@ bool AsmtSamplesPresent() { return std::filesystem::exists(AsmtSample("Gears.asm
   if (!AsmtSamplesPresent())                                                           \
   GTEST_SKIP() << "OndselSolver's sample .asmt files are not at " << PHIQ_ASMT_SAMPLES \
                << " (../shared/asmt beside the clone; cmake -DPHIQ_ASMT_SAMPLES=DIR)"
-
-std::string AsmtText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // The scene of an .asmt file swept as `phiq run` sweeps it (prepared: assembled, redundant rows left out), every
 // row kept.
@@ -90,7 +81,7 @@ TEST(AsmtImport, SampleFilesConvertWithTheirExactCounts) {
                             {"rackPinion.asmt", 5, 6, 0, 5 * 7 + 10, 6 + 3 * 5 + 5 + 11 + 5}};
   for (const Expected& c : cases) {
     SCOPED_TRACE(c.file);
-    const AsmtImport imported = import_asmt(AsmtText(AsmtSample(c.file)), c.file);
+    const AsmtImport imported = import_asmt(test::file_text(AsmtSample(c.file)), c.file);
     EXPECT_EQ(imported.parts, c.parts);
     EXPECT_EQ(imported.joints, c.joints);
     EXPECT_EQ(imported.motions, c.motions);
@@ -168,7 +159,7 @@ struct AsmtSeriesDifference {
   double position = 0.0, motion = 0.0, placement = 0.0;
 };
 AsmtSeriesDifference AsmtTimeSeriesDifference(const std::string& file, double tolerance) {
-  const std::string path = AsmtSample(file), text = AsmtText(path);
+  const std::string path = AsmtSample(file), text = test::file_text(path);
   const AsmtTimeSeries series = read_asmt_time_series(text, path);
   const AsmtRun r = AsmtSweep(path, tolerance);
   EXPECT_EQ(r.status, SolveStatus::kSuccess) << r.message;
@@ -217,7 +208,7 @@ TEST(AsmtImport, GearsFollowTheirTimeSeries) {
 TEST(AsmtImport, GearsVelocitiesFollowTheirTimeSeries) {
   PHIQ_NEED_ASMT_SAMPLES();
   const std::string path = AsmtSample("Gears.asmt");
-  const AsmtTimeSeries series = read_asmt_time_series(AsmtText(path), path);
+  const AsmtTimeSeries series = read_asmt_time_series(test::file_text(path), path);
   const AsmtRun r = AsmtSweep(path, 1e-13, true);
   ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
   ASSERT_EQ(r.trace.qd.size(), series.time.size());
@@ -351,7 +342,7 @@ Eigen::VectorXd AsmtResidualAtPlacement(const std::string& text) {
 }
 
 TEST(AsmtImport, EveryJointTypeHoldsAtItsPlacementAndLeavesItsFreedoms) {
-  const std::string text = AsmtText(AsmtOwn("joint_zoo.asmt"));
+  const std::string text = test::file_text(AsmtOwn("joint_zoo.asmt"));
   const AsmtImport imported = import_asmt(text, "zoo.asmt");
   EXPECT_EQ(imported.parts, 15);
   EXPECT_EQ(imported.joints, 15);
@@ -391,7 +382,7 @@ TEST(AsmtImport, EveryJointTypeHoldsAtItsPlacementAndLeavesItsFreedoms) {
 // (RevCyl; 3) and J's origin in I's x-y plane (RevRev; 4); a constant-velocity joint (origins together,
 // x_I·y_J + y_I·x_J = 0; 4): 5 + 3 + 2 + 2 freedoms left.
 TEST(AsmtImport, CompoundJointsHoldAtTheirPlacementAndLeaveTheirFreedoms) {
-  const std::string text = AsmtText(AsmtOwn("compound_joints.asmt"));
+  const std::string text = test::file_text(AsmtOwn("compound_joints.asmt"));
   const Scene scene = parse_scene(import_asmt(text, "compound.asmt").yaml, "compound.asmt");
   // 4 parts; natural points on the parts: CylSph J's origin, RevCyl's, RevRev's and the CV joint's J origin, x and
   // y tips (10 points, each pinned by 3 rows); rows 1 + 3 + 4 + 4; 4 normalisations
@@ -429,7 +420,7 @@ TEST(AsmtImport, ConstantVelocityJointTurnsTheSecondShaftAtTheSameRate) {
 // Names phiq or YAML would read otherwise become names of their own: `#` and `-` as `_`, a leading digit prefixed,
 // YAML's null and booleans and phiq's `t` suffixed, a name taken twice numbered.
 TEST(AsmtImport, NamesBecomePhiqNames) {
-  std::string text = AsmtText(AsmtOwn("slider_crank.asmt"));
+  std::string text = test::file_text(AsmtOwn("slider_crank.asmt"));
   for (const auto& [from, to] : {std::pair<std::string, std::string>{"CrankPin", "Yes"},
                                  {"RodPin", "2nd_rod_a"},
                                  {"Crank", "null"},
@@ -454,7 +445,7 @@ std::string AsmtError(const std::string& text) {
 }
 
 TEST(AsmtImport, BadInputIsOneLineNamingFileAndLine) {
-  const std::string good = AsmtText(AsmtOwn("slider_crank.asmt"));
+  const std::string good = test::file_text(AsmtOwn("slider_crank.asmt"));
   ASSERT_EQ(AsmtError(good), "");
   // truncated inside the joints: the joint's MarkerJ is missing
   const std::size_t cut = good.find("MarkerJ", good.find("TranslationalJoint"));
@@ -491,7 +482,7 @@ TEST(AsmtImport, BadInputIsOneLineNamingFileAndLine) {
 TEST(AsmtImport, EveryTruncationIsRefusedInOneLineOrLoads) {
   for (const char* file : {"slider_crank.asmt", "rack_pinion_driven.asmt", "compound_joints.asmt"}) {
     SCOPED_TRACE(file);
-    const std::string text = AsmtText(AsmtOwn(file));
+    const std::string text = test::file_text(AsmtOwn(file));
     int refused = 0;
     for (std::size_t cut = 0; cut < text.size(); cut = text.find('\n', cut + 1)) {
       for (const std::size_t at : {cut, std::min(cut + 3, text.size())}) {

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <sstream>
 #include <numbers>
@@ -94,10 +93,7 @@ CsvTable AsmtCompareForcesResult(const std::string& text, const std::string& pat
 // angle θ, its centre c = (cos θ, sin θ, 0): the hinge pushes the arm with m c̈ − m g, the motor turns it with
 // I_O θ̈ − (c × m g)_z = 3 θ̈ + 9.81 cos θ; on the ground the opposite.
 std::string AsmtCompareMassivePendulum(bool swapped) {
-  std::ifstream in(std::string(PHIQ_SOURCE_DIR) + "/tests/data/asmt/pendulum.asmt", std::ios::binary);
-  std::stringstream whole;
-  whole << in.rdbuf();
-  std::string text = whole.str();
+  std::string text = test::file_text(std::string(PHIQ_SOURCE_DIR) + "/tests/data/asmt/pendulum.asmt");
   const auto replace = [&](const std::string& from, const std::string& to) {
     const std::size_t at = text.find(from);
     EXPECT_NE(at, std::string::npos) << from;

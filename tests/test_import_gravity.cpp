@@ -148,7 +148,7 @@ TEST(ImportGravity, MotorTorqueOfAPendulumIsTheClosedFormWithEachFormatsGravity)
 // tests/data/asmt/pendulum.asmt (ConstantGravity 0 0 0) with its arm's centre (mass 1) at (1, 0, 0), turned by
 // θ = 0.5 t about z: --gravity g gives the motor τ = −m (c × g)_z = −(cos θ g_y − sin θ g_x), c = (cos θ, sin θ, 0).
 TEST(ImportGravity, AsmtGravityIsTheFilesUnlessGiven) {
-  std::string text = test::import_text(test::import_data("asmt/pendulum.asmt"));
+  std::string text = test::file_text(test::import_data("asmt/pendulum.asmt"));
   const std::string still = "\t\t\t\tPosition3D\n\t\t\t\t\t0.0\t0.0\t0.0\t";
   ASSERT_NE(text.find(still), std::string::npos);
   text.replace(text.find(still), still.size(), "\t\t\t\tPosition3D\n\t\t\t\t\t1.0\t0.0\t0.0\t");

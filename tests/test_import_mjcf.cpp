@@ -15,7 +15,7 @@
 namespace phiq {
 namespace {
 
-using test::import_data, test::import_sweep, test::import_text;
+using test::file_text, test::import_data, test::import_sweep;
 
 ImportOptions MjcfDrive(const std::string& joint, const std::string& law, double end, int steps) {
   ImportOptions o;
@@ -39,7 +39,7 @@ int MjcfLineOf(const std::string& text, const std::string& what) {
 
 TEST(MjcfImport, FourBarClosedByConnectEqualsTheURDFAndTheSceneWrittenByHand) {
   const std::string path = import_data("mjcf/fourbar.xml");
-  const ModelImport imported = import_mjcf(import_text(path), path, MjcfDrive("crank_joint", "2*pi*t", 1, 40));
+  const ModelImport imported = import_mjcf(file_text(path), path, MjcfDrive("crank_joint", "2*pi*t", 1, 40));
   EXPECT_EQ(imported.bodies, 3);
   EXPECT_EQ(imported.joints, 4);
   EXPECT_EQ(imported.loops, 1);
@@ -49,7 +49,7 @@ TEST(MjcfImport, FourBarClosedByConnectEqualsTheURDFAndTheSceneWrittenByHand) {
   ASSERT_EQ(hand.status, SolveStatus::kSuccess) << hand.message;
   const std::string urdf_path = import_data("urdf/fourbar.urdf");
   ImportOptions o = MjcfDrive("crank_joint", "2*pi*t", 1, 40);
-  const test::ImportRun urdf = import_sweep(import_urdf(import_text(urdf_path), urdf_path, o).yaml, urdf_path);
+  const test::ImportRun urdf = import_sweep(import_urdf(file_text(urdf_path), urdf_path, o).yaml, urdf_path);
   ASSERT_EQ(urdf.status, SolveStatus::kSuccess) << urdf.message;
   ASSERT_EQ(mjcf.trace.q.size(), 41u);
   for (std::size_t k = 0; k < mjcf.trace.q.size(); ++k) {
@@ -75,7 +75,7 @@ TEST(MjcfImport, FourBarClosedByConnectEqualsTheURDFAndTheSceneWrittenByHand) {
   EXPECT_NE(imported.yaml.find("{type: capsule, radius: 0.01, length: 0.2, at: [0.1, 0, 0]"), std::string::npos);
   EXPECT_NE(imported.yaml.find("{body: rocker, mass: 0.5, center_of_mass: [0.2, 0, 0]"), std::string::npos);
   EXPECT_NE(imported.yaml.find("{body: ground, shapes: [{type: plane, size: [2, 2]}]}"), std::string::npos);
-  const std::string text = import_text(path);
+  const std::string text = file_text(path);
   for (const char* what : {"<option", "<site", "range=", "solref=", "<actuator"}) {
     const std::string line = path + ":" + std::to_string(MjcfLineOf(text, what)) + ": ";
     EXPECT_EQ(std::count_if(imported.skipped.begin(), imported.skipped.end(),
@@ -92,9 +92,9 @@ TEST(MjcfImport, FiveBarParallelRobotPlacesItsEffectorAsTheClosedFormAndTheURDF)
   ImportOptions o;
   o.drives = {{"motor1", "0.3*t"}, {"motor2", "-0.2*t"}}, o.t_end = 1, o.steps = 20;
   const std::string path = import_data("mjcf/five_bar.xml"), urdf_path = import_data("urdf/five_bar.urdf");
-  const test::ImportRun mjcf = import_sweep(import_mjcf(import_text(path), path, o).yaml, path);
+  const test::ImportRun mjcf = import_sweep(import_mjcf(file_text(path), path, o).yaml, path);
   ASSERT_EQ(mjcf.status, SolveStatus::kSuccess) << mjcf.message;
-  const ModelImport urdf_import = import_urdf(import_text(urdf_path), urdf_path, o);
+  const ModelImport urdf_import = import_urdf(file_text(urdf_path), urdf_path, o);
   EXPECT_EQ(urdf_import.loops, 1);
   const test::ImportRun urdf = import_sweep(urdf_import.yaml, urdf_path);
   ASSERT_EQ(urdf.status, SolveStatus::kSuccess) << urdf.message;
@@ -111,7 +111,7 @@ TEST(MjcfImport, FiveBarParallelRobotPlacesItsEffectorAsTheClosedFormAndTheURDF)
 
 TEST(MjcfImport, SliderCrankInDegreesSlidesAsItsClosedFormSays) {
   const std::string path = import_data("mjcf/slider_crank.xml");
-  const ModelImport imported = import_mjcf(import_text(path), path, MjcfDrive("crank_joint", "2*pi*t", 1, 36));
+  const ModelImport imported = import_mjcf(file_text(path), path, MjcfDrive("crank_joint", "2*pi*t", 1, 36));
   const test::ImportRun r = import_sweep(imported.yaml, path);
   ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
   for (std::size_t k = 0; k < r.trace.q.size(); ++k) {
@@ -122,7 +122,7 @@ TEST(MjcfImport, SliderCrankInDegreesSlidesAsItsClosedFormSays) {
   }
   // the slider driven instead: the crank follows (on its branch, near its start)
   const test::ImportRun back =
-      import_sweep(import_mjcf(import_text(path), path, MjcfDrive("slider_joint", "-0.02*t", 1, 10)).yaml, path);
+      import_sweep(import_mjcf(file_text(path), path, MjcfDrive("slider_joint", "-0.02*t", 1, 10)).yaml, path);
   ASSERT_EQ(back.status, SolveStatus::kSuccess) << back.message;
   for (std::size_t k = 0; k < back.trace.q.size(); ++k) {
     const double theta = test::import_yaw(back.model(), back.trace.q[k], "crank");
@@ -132,7 +132,7 @@ TEST(MjcfImport, SliderCrankInDegreesSlidesAsItsClosedFormSays) {
 
 TEST(MjcfImport, JointEqualityIsACouplerOfTheTwoAngles) {
   const std::string path = import_data("mjcf/gears.xml");
-  const ModelImport imported = import_mjcf(import_text(path), path, MjcfDrive("wheel1_joint", "t", 3, 30));
+  const ModelImport imported = import_mjcf(file_text(path), path, MjcfDrive("wheel1_joint", "t", 3, 30));
   EXPECT_EQ(imported.couplers, 1);
   const test::ImportRun r = import_sweep(imported.yaml, path);
   ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
@@ -149,7 +149,7 @@ TEST(MjcfImport, JointEqualityIsACouplerOfTheTwoAngles) {
 // Default classes, childclass, degrees with eulerseq zyx, two hinges in one body, ball, slide, free and a welded body.
 TEST(MjcfImport, EveryJointTypeLeavesItsFreedomsAndDefaultsApply) {
   const std::string path = import_data("mjcf/joint_zoo.xml");
-  const ModelImport imported = import_mjcf(import_text(path), path);
+  const ModelImport imported = import_mjcf(file_text(path), path);
   const Scene scene = parse_scene(imported.yaml, path);
   const Eigen::VectorXd q = scene.model->initial_positions();
   EXPECT_EQ(analyse_rank(*scene.model, q, 0.0).dof, 12);  // 2 hinges, ball 3, slide 1, free 6; the hand welded
@@ -175,7 +175,7 @@ TEST(MjcfImport, EveryJointTypeLeavesItsFreedomsAndDefaultsApply) {
 }
 
 TEST(MjcfImport, BadInputIsOneLineNamingFileAndLine) {
-  const std::string good = import_text(import_data("mjcf/gears.xml"));
+  const std::string good = file_text(import_data("mjcf/gears.xml"));
   ASSERT_EQ(MjcfError(good), "");
   auto starts = [](const std::string& error, const std::string& start) {
     EXPECT_EQ(error.rfind(start, 0), 0u) << error << "\nexpected to start with: " << start;
@@ -205,13 +205,13 @@ TEST(MjcfImport, BadInputIsOneLineNamingFileAndLine) {
       test::replace_first(good, "<joint name=\"wheel1_joint\"", "<joint class=\"nope\" name=\"wheel1_joint\"");
   starts(MjcfError(cls), "bad.xml:" + std::to_string(MjcfLineOf(good, "wheel1_joint")) + ": class 'nope'");
   starts(MjcfError("<robot/>"), "bad.xml:1: an MJCF file's root element is <mujoco>");
-  const std::string connect = import_text(import_data("mjcf/fourbar.xml"));
+  const std::string connect = file_text(import_data("mjcf/fourbar.xml"));
   starts(MjcfError(test::replace_first(connect, "body2=\"coupler\"", "body2=\"ghost\"")),
          "bad.xml:" + std::to_string(MjcfLineOf(connect, "<connect")) + ": body2 'ghost' is not a body of the file");
 }
 
 TEST(MjcfImport, EveryTruncationIsRefusedInOneLineOrLoads) {
-  const std::string text = import_text(import_data("mjcf/joint_zoo.xml"));
+  const std::string text = file_text(import_data("mjcf/joint_zoo.xml"));
   int refused = 0;
   for (std::size_t cut = 0; cut < text.size(); cut = text.find('\n', cut + 1)) {
     ModelImport imported;
@@ -238,7 +238,7 @@ TEST_F(Cli, MjcfConvertWritesTheTextADirectReadSolves) {
   ASSERT_EQ(convert.code, 0) << convert.err;
   ImportOptions o;
   o.drives = {{"crank_joint", "2*pi*t"}}, o.t_end = 1, o.steps = 20;
-  EXPECT_EQ(slurp(dir_ / "sc.yaml"), import_mjcf(import_text(model), model, o).yaml);
+  EXPECT_EQ(slurp(dir_ / "sc.yaml"), import_mjcf(file_text(model), model, o).yaml);
   const Result ran = run("run " + (dir_ / "sc.yaml").string() + " -o " + (dir_ / "sc.csv").string());
   ASSERT_EQ(ran.code, 0) << ran.err;
   const Result check = run("check " + model);

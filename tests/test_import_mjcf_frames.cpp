@@ -17,7 +17,7 @@
 namespace phiq {
 namespace {
 
-using test::import_data, test::import_sweep, test::import_text;
+using test::file_text, test::import_data, test::import_sweep;
 
 ImportOptions MjcfFramesDrive(const std::string& joint, const std::string& law, double end, int steps) {
   ImportOptions o;
@@ -35,7 +35,7 @@ class MjcfIncludeFiles : public test::TestFolder {
  protected:
   std::string error_of(const std::string& path) {
     try {
-      (void)import_mjcf(import_text(path), path);
+      (void)import_mjcf(file_text(path), path);
     } catch (const SceneError& e) {
       return e.what();
     }
@@ -46,19 +46,19 @@ class MjcfIncludeFiles : public test::TestFolder {
 TEST(MjcfFrames, FourBarThroughIncludeFramesAndSitesIsTheFourBar) {
   const std::string path = import_data("mjcf/fourbar_frames.xml"), plain = import_data("mjcf/fourbar.xml");
   const ImportOptions drive = MjcfFramesDrive("crank_joint", "2*pi*t", 1, 40);
-  const ModelImport imported = import_mjcf(import_text(path), path, drive);
+  const ModelImport imported = import_mjcf(file_text(path), path, drive);
   EXPECT_EQ(imported.bodies, 3);
   EXPECT_EQ(imported.joints, 4);
   EXPECT_EQ(imported.loops, 1);
   // the included file's sites, listed once at its first one's line
   const std::string world = import_data("mjcf/fourbar_frames_world.xml");
-  const std::string sites = world + ":" + std::to_string(MjcfFramesLineOf(import_text(world), "<site")) +
+  const std::string sites = world + ":" + std::to_string(MjcfFramesLineOf(file_text(world), "<site")) +
                             ": <site> (2 in all): no kinematics: phiq outputs points instead";
   EXPECT_EQ(std::count(imported.skipped.begin(), imported.skipped.end(), sites), 1) << imported.yaml;
   EXPECT_NE(imported.yaml.find("{type: box, size: [0.5, 0.02, 0.01], at: [0.25, 0, 0]"), std::string::npos);
   const test::ImportRun framed = import_sweep(imported.yaml, path);
   ASSERT_EQ(framed.status, SolveStatus::kSuccess) << framed.message;
-  const test::ImportRun reference = import_sweep(import_mjcf(import_text(plain), plain, drive).yaml, plain);
+  const test::ImportRun reference = import_sweep(import_mjcf(file_text(plain), plain, drive).yaml, plain);
   ASSERT_EQ(reference.status, SolveStatus::kSuccess) << reference.message;
   ASSERT_EQ(framed.trace.q.size(), 41u);
   for (std::size_t k = 0; k < framed.trace.q.size(); ++k) {
@@ -167,7 +167,7 @@ TEST(MjcfFrames, JointsAndInertialsInFramesAreTheModelWithTheirPosesComposed) {
 // turned π/2; the arm at angle t: both where Rz(t) puts them, wherever they started.
 TEST(MjcfFrames, WeldsByRelposeAndBySitesHoldTheirBodiesAsTheClosedFormSays) {
   const std::string path = import_data("mjcf/weld_relpose.xml");
-  const ModelImport imported = import_mjcf(import_text(path), path, MjcfFramesDrive("arm_joint", "t", 1, 10));
+  const ModelImport imported = import_mjcf(file_text(path), path, MjcfFramesDrive("arm_joint", "t", 1, 10));
   EXPECT_EQ(imported.bodies, 3);
   EXPECT_EQ(imported.joints, 5);  // the hinge, two free joints, two welds
   EXPECT_EQ(imported.loops, 2);

@@ -17,7 +17,7 @@
 namespace phiq {
 namespace {
 
-using test::import_data, test::import_sweep, test::import_text;
+using test::file_text, test::import_data, test::import_sweep;
 
 std::string SdfError(const std::string& text) {
   try {
@@ -36,7 +36,7 @@ TEST(SdfImport, FourBarClosedNativelyFollowsItsClosedFormAndTheSceneWrittenByHan
   const std::string path = import_data("sdf/fourbar.sdf");
   ImportOptions o;
   o.drives = {{"crank_joint", "2*pi*t"}}, o.t_end = 1, o.steps = 40;
-  const ModelImport imported = import_sdf(import_text(path), path, o);
+  const ModelImport imported = import_sdf(file_text(path), path, o);
   EXPECT_EQ(imported.bodies, 3);
   EXPECT_EQ(imported.joints, 4);
   EXPECT_EQ(imported.loops, 1);
@@ -63,7 +63,7 @@ TEST(SdfImport, FourBarClosedNativelyFollowsItsClosedFormAndTheSceneWrittenByHan
     }
   }
   EXPECT_NE(imported.yaml.find("{body: rocker, mass: 0.5, center_of_mass: [0.2, 0, 0]"), std::string::npos);
-  const std::string text = import_text(path);
+  const std::string text = file_text(path);
   for (const char* what : {"<sensor", "<limit", "<plugin"}) {
     const std::string line = path + ":" + std::to_string(SdfLineOf(text, what)) + ": ";
     EXPECT_EQ(std::count_if(imported.skipped.begin(), imported.skipped.end(),
@@ -76,7 +76,7 @@ TEST(SdfImport, FourBarClosedNativelyFollowsItsClosedFormAndTheSceneWrittenByHan
 
 TEST(SdfImport, EveryJointTypeLeavesItsFreedoms) {
   const std::string path = import_data("sdf/joint_zoo.sdf");
-  const ModelImport imported = import_sdf(import_text(path), path);
+  const ModelImport imported = import_sdf(file_text(path), path);
   for (const char* kind : {"type: rigid", "type: prismatic", "type: spherical", "type: universal", "type: revolute"})
     EXPECT_NE(imported.yaml.find(kind), std::string::npos) << kind;
   const Scene scene = parse_scene(imported.yaml, path);
@@ -93,7 +93,7 @@ TEST(SdfImport, NestedModelIsPlacedByItsPoseAndItsJointsScoped) {
   const std::string path = import_data("sdf/nested_arm.sdf");
   ImportOptions o;
   o.drives = {{"shoulder", "t"}, {"arm::wrist", "2*t"}}, o.t_end = 1, o.steps = 10;
-  const ModelImport imported = import_sdf(import_text(path), path, o);
+  const ModelImport imported = import_sdf(file_text(path), path, o);
   EXPECT_EQ(imported.bodies, 3);
   EXPECT_EQ(imported.joints, 3);
   EXPECT_EQ(imported.loops, 0);
@@ -115,7 +115,7 @@ TEST(SdfImport, NestedModelIsPlacedByItsPoseAndItsJointsScoped) {
 }
 
 TEST(SdfImport, BadInputIsOneLineNamingFileAndLine) {
-  const std::string good = import_text(import_data("sdf/fourbar.sdf"));
+  const std::string good = file_text(import_data("sdf/fourbar.sdf"));
   ASSERT_EQ(SdfError(good), "");
   auto starts = [](const std::string& error, const std::string& start) {
     EXPECT_EQ(error.rfind(start, 0), 0u) << error << "\nexpected to start with: " << start;
@@ -141,7 +141,7 @@ TEST_F(Cli, SdfConvertWritesTheTextADirectReadSolves) {
   ASSERT_EQ(convert.code, 0) << convert.err;
   ImportOptions o;
   o.drives = {{"crank_joint", "2*pi*t"}}, o.t_end = 1, o.steps = 10;
-  EXPECT_EQ(slurp(dir_ / "fb.yaml"), import_sdf(import_text(model), model, o).yaml);
+  EXPECT_EQ(slurp(dir_ / "fb.yaml"), import_sdf(file_text(model), model, o).yaml);
   const Result check = run("check " + model);
   ASSERT_EQ(check.code, 0) << check.err;
   EXPECT_NE(check.out.find("dof           1 (1 not driven)"), std::string::npos) << check.out;

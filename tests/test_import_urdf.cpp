@@ -17,7 +17,7 @@
 namespace phiq {
 namespace {
 
-using test::import_data, test::import_sweep, test::import_text;
+using test::file_text, test::import_data, test::import_sweep;
 
 ImportOptions UrdfDrive(const std::string& joint, const std::string& law, double end, int steps) {
   ImportOptions o;
@@ -41,7 +41,7 @@ int UrdfLineOf(const std::string& text, const std::string& what) {
 
 TEST(UrdfImport, FourBarClosedByItsClosingJointFollowsItsClosedFormAndTheSceneWrittenByHand) {
   const std::string path = import_data("urdf/fourbar.urdf");
-  const ModelImport imported = import_urdf(import_text(path), path, UrdfDrive("crank_joint", "2*pi*t", 1, 40));
+  const ModelImport imported = import_urdf(file_text(path), path, UrdfDrive("crank_joint", "2*pi*t", 1, 40));
   EXPECT_EQ(imported.bodies, 4);  // crank, coupler, coupler_tip, rocker (base is the ground)
   EXPECT_EQ(imported.joints, 5);
   EXPECT_EQ(imported.loops, 1);
@@ -74,7 +74,7 @@ TEST(UrdfImport, FourBarClosedByItsClosingJointFollowsItsClosedFormAndTheSceneWr
   EXPECT_NE(imported.yaml.find("part_crank: {body: crank, mass: 0.4, center_of_mass: [0.1, 0, 0]"), std::string::npos);
   EXPECT_NE(imported.yaml.find("{type: cylinder, radius: 0.01, length: 0.5"), std::string::npos);
   EXPECT_NE(imported.yaml.find("colour: [0.6, 0.6, 0.65, 1]"), std::string::npos);
-  const std::string text = import_text(path);
+  const std::string text = file_text(path);
   auto listed = [&](const std::string& start) {
     return std::count_if(imported.skipped.begin(), imported.skipped.end(),
                          [&](const std::string& s) { return s.rfind(start, 0) == 0; });
@@ -89,7 +89,7 @@ TEST(UrdfImport, FourBarClosedByItsClosingJointFollowsItsClosedFormAndTheSceneWr
 
 TEST(UrdfImport, SliderCrankSlidesAsItsClosedFormSays) {
   const std::string path = import_data("urdf/slider_crank.urdf");
-  const ModelImport imported = import_urdf(import_text(path), path, UrdfDrive("crank_joint", "2*pi*t", 1, 36));
+  const ModelImport imported = import_urdf(file_text(path), path, UrdfDrive("crank_joint", "2*pi*t", 1, 36));
   const test::ImportRun r = import_sweep(imported.yaml, path);
   ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
   ASSERT_EQ(r.trace.q.size(), 37u);
@@ -104,7 +104,7 @@ TEST(UrdfImport, SliderCrankSlidesAsItsClosedFormSays) {
 
 TEST(UrdfImport, MimicJointIsACouplerOfTheTwoAngles) {
   const std::string path = import_data("urdf/gears.urdf");
-  const ModelImport imported = import_urdf(import_text(path), path, UrdfDrive("wheel1_joint", "t", 3, 30));
+  const ModelImport imported = import_urdf(file_text(path), path, UrdfDrive("wheel1_joint", "t", 3, 30));
   EXPECT_EQ(imported.couplers, 1);
   EXPECT_NE(imported.yaml.find("type: coupler, coordinates: [wheel2_joint_angle, wheel1_joint_angle], "
                                "coefficients: [1, 0.5], constant: 0.1"),
@@ -124,7 +124,7 @@ TEST(UrdfImport, MimicJointIsACouplerOfTheTwoAngles) {
 TEST(UrdfImport, MimicOfAPrismaticJointCouplesItsTravel) {
   const std::string path = import_data("urdf/rack_pinion.urdf");
   const test::ImportRun r =
-      import_sweep(import_urdf(import_text(path), path, UrdfDrive("pinion_joint", "2*t", 2, 20)).yaml, path);
+      import_sweep(import_urdf(file_text(path), path, UrdfDrive("pinion_joint", "2*t", 2, 20)).yaml, path);
   ASSERT_EQ(r.status, SolveStatus::kSuccess) << r.message;
   const Eigen::Vector3d along(std::cos(0.2), std::sin(0.2), 0);
   for (std::size_t k = 0; k < r.trace.q.size(); ++k) {
@@ -138,7 +138,7 @@ TEST(UrdfImport, MimicOfAPrismaticJointCouplesItsTravel) {
 // (about an oblique axis), floating 6.
 TEST(UrdfImport, EveryJointTypeLeavesItsFreedoms) {
   const std::string path = import_data("urdf/joint_zoo.urdf");
-  const ModelImport imported = import_urdf(import_text(path), path);
+  const ModelImport imported = import_urdf(file_text(path), path);
   EXPECT_EQ(imported.joints, 6);
   for (const char* kind : {"type: rigid", "type: prismatic", "type: planar", "type: revolute"})
     EXPECT_NE(imported.yaml.find(kind), std::string::npos) << kind;
@@ -170,7 +170,7 @@ TEST(UrdfImport, EveryJointTypeLeavesItsFreedoms) {
 // frame, the carriage travels along its axis (0, 2, 0) normalised, as URDF's joint positions say.
 TEST(UrdfImport, JointPositionsAreURDFsAngleAboutAndTravelAlongTheAxis) {
   const std::string path = import_data("urdf/joint_zoo.urdf");
-  std::string text = import_text(path);
+  std::string text = file_text(path);
   for (const char* free_joint : {"puck_joint", "wheel_joint", "drone_joint"}) {
     const std::size_t at = text.find("<joint name=\"" + std::string(free_joint) + "\"");
     text.erase(at, text.find("</joint>", at) + 8 - at);
@@ -196,7 +196,7 @@ TEST(UrdfImport, JointPositionsAreURDFsAngleAboutAndTravelAlongTheAxis) {
 }
 
 TEST(UrdfImport, BadInputIsOneLineNamingFileAndLine) {
-  const std::string good = import_text(import_data("urdf/fourbar.urdf"));
+  const std::string good = file_text(import_data("urdf/fourbar.urdf"));
   ASSERT_EQ(UrdfError(good), "");
   auto starts = [](const std::string& error, const std::string& start) {
     EXPECT_EQ(error.rfind(start, 0), 0u) << error << "\nexpected to start with: " << start;
@@ -232,7 +232,7 @@ TEST(UrdfImport, BadInputIsOneLineNamingFileAndLine) {
   for (int i = 0; i < 120; ++i) deep += "<link name=\"l" + std::to_string(i) + "\">";
   starts(UrdfError(deep), "bad.urdf:2: elements nested more than 100 deep, the most the XML reader (tinyxml2) reads");
   // a mimic of a joint that does not exist
-  const std::string gears = import_text(import_data("urdf/gears.urdf"));
+  const std::string gears = file_text(import_data("urdf/gears.urdf"));
   starts(UrdfError(test::replace_first(gears, "joint=\"wheel1_joint\"", "joint=\"wheel9\"")),
          "bad.urdf:" + std::to_string(UrdfLineOf(gears, "<mimic")) + ": joint 'wheel2_joint' mimics 'wheel9'");
   // a driver of a joint the file does not have, or of one phiq drives no measure of
@@ -278,7 +278,7 @@ TEST(UrdfImport, ASerialChainOfTenThousandLinksIsReadOnASmallStack) {
 }
 
 TEST(UrdfImport, EveryTruncationIsRefusedInOneLineOrLoads) {
-  const std::string text = import_text(import_data("urdf/fourbar.urdf"));
+  const std::string text = file_text(import_data("urdf/fourbar.urdf"));
   int refused = 0;
   for (std::size_t cut = 0; cut < text.size(); cut = text.find('\n', cut + 1)) {
     ModelImport imported;
@@ -306,7 +306,7 @@ TEST_F(Cli, UrdfConvertWritesTheTextADirectReadSolves) {
   EXPECT_NE(convert.err.find("phiq: not mapped: " + model + ":"), std::string::npos) << convert.err;
   ImportOptions o;
   o.drives = {{"crank_joint", "2*pi*t"}}, o.t_end = 1, o.steps = 40;
-  EXPECT_EQ(slurp(dir_ / "fourbar.yaml"), import_urdf(import_text(model), model, o).yaml);
+  EXPECT_EQ(slurp(dir_ / "fourbar.yaml"), import_urdf(file_text(model), model, o).yaml);
   const Result ran = run("run " + (dir_ / "fourbar.yaml").string() + " -o " + (dir_ / "fourbar.csv").string());
   ASSERT_EQ(ran.code, 0) << ran.err;
   EXPECT_EQ(count(slurp(dir_ / "fourbar.csv"), "\n"), 42u);

@@ -54,7 +54,7 @@ class UrdfPackages : public test::TestFolder {
 };
 
 TEST_F(UrdfPackages, MeshesAreFoundAboveTheFileAndOnTheRosPackagePathAndTheMissingListedOnce) {
-  const ModelImport imported = import_urdf(test::import_text(urdf_), urdf_);
+  const ModelImport imported = import_urdf(test::file_text(urdf_), urdf_);
   EXPECT_NE(imported.yaml.find("{type: mesh, file: \"../meshes/arm.stl\", scale: 1"), std::string::npos)
       << imported.yaml;
   const std::string hand = (dir_ / "ws/otherpkg/meshes/hand.stl").lexically_normal().string();
@@ -70,7 +70,7 @@ TEST_F(UrdfPackages, MeshesAreFoundAboveTheFileAndOnTheRosPackagePathAndTheMissi
   EXPECT_EQ(scene.model->num_coordinates(), 3 * 7);
   // without the workspace on ROS_PACKAGE_PATH the hand's mesh is missing too: 3 in all
   unsetenv("ROS_PACKAGE_PATH");
-  const ModelImport without = import_urdf(test::import_text(urdf_), urdf_);
+  const ModelImport without = import_urdf(test::file_text(urdf_), urdf_);
   ASSERT_EQ(without.skipped.size(), 1u);
   EXPECT_EQ(without.skipped.front().rfind(urdf_ + ":7: <visual> mesh of a package not found (3 in all)", 0), 0u)
       << without.skipped.front();
@@ -83,14 +83,14 @@ TEST_F(UrdfPackages, AMissingPackageIsRefusedWhenTheShapesAreAskedFor) {
       std::string(PHIQ_CLI) + " animate " + urdf_ + " -o " + out.string() + " 2>" + err.string();
   const int status = std::system(command.c_str());
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << status;
-  EXPECT_EQ(test::import_text(err.string()), "phiq: animate: " + urdf_ +
-                                                 ":8: <visual> mesh 'package://ghost/a.stl': its package is neither "
-                                                 "on ROS_PACKAGE_PATH nor a folder above the file\n");
+  EXPECT_EQ(test::file_text(err.string()), "phiq: animate: " + urdf_ +
+                                               ":8: <visual> mesh 'package://ghost/a.stl': its package is neither "
+                                               "on ROS_PACKAGE_PATH nor a folder above the file\n");
   EXPECT_FALSE(fs::exists(out));
   ImportOptions drawn;
   drawn.need_geometry = true;
   try {
-    (void)import_urdf(test::import_text(urdf_), urdf_, drawn);
+    (void)import_urdf(test::file_text(urdf_), urdf_, drawn);
     ADD_FAILURE() << "no error";
   } catch (const SceneError& e) {
     EXPECT_EQ(std::string(e.what()), urdf_ +

@@ -20,8 +20,8 @@ TEST(InverseDynamics, TheMotorTorqueIsOneInEveryFormulationAndBalancesTheEnergy)
   std::vector<std::vector<double>> torque(4);
   for (int f = 0; f < 4; ++f) {
     const std::string form = forms[f];
-    Scene s =
-        parse_scene(test::seed_text("fourbar_" + form + ".yaml") + "\nparts:\n" + test::fourbar_parts(form), form);
+    Scene s = parse_scene(
+        test::model_file_text("seed/fourbar_" + form + ".yaml") + "\nparts:\n" + test::fourbar_parts(form), form);
     const Model& m = *s.model;
     test::Trace tr;
     ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess) << forms[f];

@@ -8,9 +8,7 @@
 #include <Eigen/Dense>
 
 #include <cmath>
-#include <fstream>
 #include <random>
-#include <sstream>
 
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/joint_reactions.hpp"
@@ -141,8 +139,6 @@ TEST(JointReactions, EverySpatialKindWithASiteDoesTheWorkOfItsMultipliers) {
   }
 }
 
-std::string reaction_scene_text(const std::string& rel);
-
 // The reaction of constraint "j" of `s` under random multipliers, in world axes and along the joint's own
 // (OutputEfforts::reactions_in_joint_axes), at the initial positions.
 std::pair<std::vector<double>, std::vector<double>> reaction_both_axes(const Scene& s, bool spatial, int trial) {
@@ -255,15 +251,6 @@ TEST(JointReactions, KindsWithoutASiteAreRefusedByName) {
   }
 }
 
-std::string reaction_scene_text(const std::string& rel) {
-  std::ifstream in(test::model_path(rel));
-  std::stringstream s;
-  s << in.rdbuf();
-  std::string text = s.str();
-  text.erase(text.find("output:"));
-  return text;
-}
-
 struct ReactionRows {
   std::vector<Eigen::VectorXd> q, qd, qdd;
   std::vector<std::vector<double>> values;  // efforts, powers, reactions
@@ -295,7 +282,7 @@ ReactionRows sweep_reactions(const Scene& s, SweepSummary* sum = nullptr, const 
 // The scene's `reaction_axes`: along a sweep of the massive four-bar, each pin's force along its body's axes is the
 // world one turned by that body's angle at the row.
 TEST(JointReactions, TheScenesReactionAxesTurnEachPinsForceByItsBody) {
-  const std::string base = reaction_scene_text("dynamics/fourbar_pin_loads.yaml");
+  const std::string base = test::model_file_text("dynamics/fourbar_pin_loads.yaml", "output:");
   const Scene world = parse_scene(base + "output: {velocities: true, accelerations: true, reactions: all}\n", "k.yaml");
   const Scene joint = parse_scene(
       base + "output: {velocities: true, accelerations: true, reactions: all, reaction_axes: joint}\n", "k.yaml");
@@ -340,7 +327,7 @@ TEST(JointReactions, TheScenesReactionAxesTurnEachPinsForceByItsBody) {
 // along the coupler, nothing across it, though in world axes both components are not zero. At A (reported on the
 // crank) the world force turned by the crank's angle; animate --forces turns them back (AnimateHtml).
 TEST(JointReactions, ANaturalJointAlongItsBodysAxesShowsAMasslessCouplerPushingAlongItself) {
-  std::string base = reaction_scene_text("dynamics/fourbar_motor_torque.yaml");
+  std::string base = test::model_file_text("dynamics/fourbar_motor_torque.yaml", "output:");
   const std::string massive =
       "coupler: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 2.0, "
       "inertia: 2.0*L3*L3/12}";
@@ -380,7 +367,7 @@ TEST(JointReactions, ANaturalJointAlongItsBodysAxesShowsAMasslessCouplerPushingA
 // normal, with nothing along its tangent (reaction_axes: joint).
 TEST(JointReactions, ACamPushesItsRollerAlongTheNormalWithTheRodsWeightAndInertia) {
   const double m = 0.7, g = 9.81, e = 0.015;
-  const std::string base = reaction_scene_text("cams/eccentric_roller.yaml") +
+  const std::string base = test::model_file_text("cams/eccentric_roller.yaml", "output:") +
                            "parts:\n  rod: {mass: 0.7, center_of_mass: [0, 0], inertia: 1e-3}\n"
                            "  disc: {mass: 2.0, center_of_mass: [0, 0], inertia: 3e-3}\n"
                            "loads: {gravity: [0, -9.81]}\n";
@@ -408,8 +395,8 @@ TEST(JointReactions, ACamPushesItsRollerAlongTheNormalWithTheRodsWeightAndInerti
 // against a scan of the blocks, in a planar and a spatial model and in the spatial one reduced to its independent
 // rows (without_rows() shares the table); reaction_width(), the kind's trait, against the site a kind states.
 TEST(JointReactions, TheModelsTableFindsEveryConstraintsBlockAndItsWidthIsItsSites) {
-  const Scene planar = parse_scene(reaction_scene_text("clearance/fourbar_knee.yaml"), "knee.yaml");
-  const Scene door = parse_scene(reaction_scene_text("redundant/door_three_hinges.yaml"), "door.yaml");
+  const Scene planar = parse_scene(test::model_file_text("clearance/fourbar_knee.yaml", "output:"), "knee.yaml");
+  const Scene door = parse_scene(test::model_file_text("redundant/door_three_hinges.yaml", "output:"), "door.yaml");
   const Model reduced = door.model->without_rows({0, 1});
   int sites = 0;
   for (const Model* m : std::initializer_list<const Model*>{planar.model.get(), door.model.get(), &reduced}) {
@@ -433,7 +420,7 @@ TEST(JointReactions, TheModelsTableFindsEveryConstraintsBlockAndItsWidthIsItsSit
 
 // The knee four-bar (reference-point links, centres at the reference points) with masses under gravity.
 TEST(JointReactions, FourBarPinsSatisfyEveryLinksNewtonEulerEquations) {
-  std::string text = reaction_scene_text("clearance/fourbar_knee.yaml");
+  std::string text = test::model_file_text("clearance/fourbar_knee.yaml", "output:");
   text.erase(text.find("parts:"));
   const double m2 = 1.0, m3 = 2.0, m4 = 1.5, L2 = 0.4, L3 = 1.2, L4 = 1.0, g = 9.81;
   text +=
@@ -495,7 +482,7 @@ TEST(JointReactions, FourBarPinsSatisfyEveryLinksNewtonEulerEquations) {
 // A door on three collinear hinges (10 redundant rows): its hinges' share of the load is not determined; the
 // written reactions are those of the minimum-norm multipliers, which a dense pseudo-inverse of Φqᵀ gives too.
 TEST(JointReactions, RedundantDoorHingesAreMinimumNormAndNamedIndeterminate) {
-  std::string text = reaction_scene_text("redundant/door_three_hinges.yaml");
+  std::string text = test::model_file_text("redundant/door_three_hinges.yaml", "output:");
   text +=
       "parts:\n  door: {mass: 20, center_of_mass: [0.4, 0, 1], inertia: [4, 5, 1.2]}\n"
       "loads: {gravity: [0, 0, -9.81]}\n"

@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cctype>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -22,15 +21,9 @@
 #include "kind_checks.hpp"
 #include "phiq/constraint_kinds.hpp"
 #include "phiq/model.hpp"
+#include "test_support.hpp"
 
 namespace {
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // The kinds of the registry, by type, and their names.
 std::map<std::type_index, std::string> kinds_by_type() {
@@ -105,7 +98,7 @@ TEST(KindRegistry, EveryKindThatDifferentiatesItsDataHasACheckOfIt) {
 }
 
 TEST(KindRegistry, EverySceneExampleIsDocumentedInTheModelsReadme) {
-  const std::string readme = read_file(PHIQ_SOURCE_DIR "/models/README.md");
+  const std::string readme = phiq::test::file_text(PHIQ_SOURCE_DIR "/models/README.md");
   ASSERT_FALSE(readme.empty());
   for (const FormOf& f : all_forms())
     EXPECT_NE(readme.find(f.example), std::string::npos) << "models/README.md lacks the example of kind '" << f.kind
@@ -113,7 +106,7 @@ TEST(KindRegistry, EverySceneExampleIsDocumentedInTheModelsReadme) {
 }
 
 TEST(KindRegistry, EveryConstraintTypeIsInTheFuzzingDictionary) {
-  const std::string dict = read_file(PHIQ_SOURCE_DIR "/tests/fuzz/scene.dict");
+  const std::string dict = phiq::test::file_text(PHIQ_SOURCE_DIR "/tests/fuzz/scene.dict");
   ASSERT_FALSE(dict.empty());
   for (const FormOf& f : all_forms()) {
     if (f.section != "constraints") continue;
@@ -202,7 +195,7 @@ TEST(KindRegistry, TheModelsReadmeShowsEveryConstraintTypeAndNoOther) {
   std::set<std::string> registered;
   for (const FormOf& f : all_forms())
     if (f.section == "constraints") registered.insert(f.type);
-  const std::set<std::string> shown = readme_entry_types(read_file(PHIQ_SOURCE_DIR "/models/README.md"));
+  const std::set<std::string> shown = readme_entry_types(phiq::test::file_text(PHIQ_SOURCE_DIR "/models/README.md"));
   EXPECT_FALSE(registered.empty());
   EXPECT_EQ(readme_set_minus(registered, shown), std::vector<std::string>{}) << "types without an entry";
   EXPECT_EQ(readme_set_minus(shown, registered), std::vector<std::string>{}) << "entries of no registered type";
@@ -220,8 +213,8 @@ TEST(KindRegistry, TheReadmesListTheJointTypesOfTheJointTraits) {
   const std::set<std::string> measured = traits_say([](const phiq::JointTraits&t) { return t.measures.any(); }),
                               driven = traits_say([](const phiq::JointTraits&t) { return t.drives.any(); }),
                               shafts = traits_say([](const phiq::JointTraits&t) { return t.shaft; });
-  const std::string models = read_file(PHIQ_SOURCE_DIR "/models/README.md"),
-                    tools = read_file(PHIQ_SOURCE_DIR "/tools/README.md");
+  const std::string models = phiq::test::file_text(PHIQ_SOURCE_DIR "/models/README.md"),
+                    tools = phiq::test::file_text(PHIQ_SOURCE_DIR "/tools/README.md");
   EXPECT_EQ(joint_types_named(models, "| `joints` |", "\n"), measured) << "models/README.md, output: joints";
   EXPECT_EQ(joint_types_named(tools, "per joint J of `output.joints`", "\n"), measured) << "tools/README.md";
   EXPECT_EQ(joint_types_named(models, "| `joint: J`, `measure: angle` or `distance` |", "\n"), driven)

@@ -10,7 +10,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <random>
 #include <sstream>
 
@@ -25,12 +24,7 @@ namespace phiq {
 namespace {
 
 std::string natural_reactions_scene(const std::string& rel) {
-  std::ifstream in(test::model_path(rel));
-  std::stringstream s;
-  s << in.rdbuf();
-  std::string text = s.str();
-  text.erase(text.find("time:"));
-  return text + "time: {start: 0, end: 2*pi, steps: 40}\n";
+  return test::model_file_text(rel, "time:") + "time: {start: 0, end: 2*pi, steps: 40}\n";
 }
 
 struct NaturalRows {

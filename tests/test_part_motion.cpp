@@ -5,8 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "phiq/part_motion.hpp"
 #include "phiq/phiq.hpp"
@@ -14,13 +12,6 @@
 
 namespace phiq {
 namespace {
-
-std::string scene_file_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 using V = kin3::V3;
 double norm_of(V a) { return kin3::norm(a); }
@@ -47,8 +38,7 @@ struct Errors {
 };
 
 Errors check(const Case& c) {
-  Scene s = parse_scene(scene_file_text(test::model_path(c.scene)) + (c.parts.empty() ? "" : "\nparts:\n" + c.parts),
-                        c.scene);
+  Scene s = parse_scene(test::model_file_text(c.scene) + (c.parts.empty() ? "" : "\nparts:\n" + c.parts), c.scene);
   s.sweep.velocities = s.sweep.accelerations = true;
   test::Trace tr;
   EXPECT_EQ(test::sweep(*s.model, s.sweep, &tr), SolveStatus::kSuccess) << c.scene;
@@ -119,8 +109,8 @@ TEST(PartMotion, EveryFrameKindAgreesWithDifferencesOfItsPose) {
 
 // A reference-point body's motion is its coordinates' rates, exactly.
 TEST(PartMotion, APlanarBodysRatesAreItsCoordinatesRates) {
-  Scene s = parse_scene(
-      scene_file_text(test::model_path("seed/fourbar_reference_point.yaml")) + "\nparts:\n  crank: {}\n", "fb.yaml");
+  Scene s =
+      parse_scene(test::model_file_text("seed/fourbar_reference_point.yaml") + "\nparts:\n  crank: {}\n", "fb.yaml");
   const Model& m = *s.model;
   Eigen::VectorXd q = m.initial_positions(), qd = Eigen::VectorXd::LinSpaced(q.size(), 0.1, 0.9),
                   qdd = Eigen::VectorXd::LinSpaced(q.size(), -1.0, 1.0);

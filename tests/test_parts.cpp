@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "phiq/phiq.hpp"
 #include "test_support.hpp"
@@ -14,17 +12,14 @@ namespace phiq {
 namespace {
 
 // A scene file's text without its own `parts` section (cardan.yaml's; its last): each test appends its own.
-std::string file_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  const std::string text = s.str();
+std::string text_before_parts(const std::string& path) {
+  const std::string text = test::file_text(path);
   return text.substr(0, text.find("\nparts:\n"));
 }
 
 // A seed scene's text with a `parts` section appended.
 Scene seed_with_parts(const std::string& name, const std::string& parts) {
-  return parse_scene(file_text(test::model_path("seed/" + name)) + "\nparts:\n" + parts, "seed_" + name);
+  return parse_scene(text_before_parts(test::model_path("seed/" + name)) + "\nparts:\n" + parts, "seed_" + name);
 }
 
 const Part& part_named(const Scene& s, const std::string& name) {
@@ -105,7 +100,7 @@ TEST(PartFrames, TheCouplerIsOnePartInAllFourCoordinateFamilies) {
 // A spatial body's part: its pose is R(e) and r, the point a joint uses is pose.apply of it, the rotation
 // orthonormal; a frame of natural points and a vector in space has x along the points and y in their plane.
 TEST(PartFrames, SpatialBodiesAndNaturalFramesFollowTheirCoordinates) {
-  Scene cardan = parse_scene(file_text(test::model_path("spatial/cardan.yaml")) +
+  Scene cardan = parse_scene(text_before_parts(test::model_path("spatial/cardan.yaml")) +
                                  "\nparts:\n  s2: {shapes: [{type: cylinder, radius: 0.02, length: 1.0}]}\n",
                              "cardan.yaml");
   test::Trace tr;
@@ -132,7 +127,7 @@ TEST(PartFrames, SpatialBodiesAndNaturalFramesFollowTheirCoordinates) {
   EXPECT_LT(joints, 1e-9);
 
   // rssr_natural: the coupler A→B, y toward the rocker pivot C
-  Scene rssr = parse_scene(file_text(test::model_path("spatial/rssr_natural.yaml")) +
+  Scene rssr = parse_scene(text_before_parts(test::model_path("spatial/rssr_natural.yaml")) +
                                "\nparts:\n  coupler: {frame: {origin: A, x: B, y: C}}\n",
                            "rssr_natural.yaml");
   tr = {};
@@ -182,7 +177,7 @@ TEST(PartMass, StatedDensityAndCompletedFromShapes) {
 }
 
 TEST(PartMass, ASpatialInertiaIsAFullTensor) {
-  const std::string text = file_text(test::model_path("spatial/cardan.yaml")) + "\nparts:\n  s1: {mass: 1.5, " +
+  const std::string text = text_before_parts(test::model_path("spatial/cardan.yaml")) + "\nparts:\n  s1: {mass: 1.5, " +
                            "center_of_mass: [0, 0, 0.5], inertia: [[0.2, 0.01, 0], [0.01, 0.3, 0], [0, 0, 0.4]]}\n";
   const Scene s = parse_scene(text, "cardan.yaml");
   const Part& p = part_named(s, "s1");
@@ -193,8 +188,8 @@ TEST(PartMass, ASpatialInertiaIsAFullTensor) {
 }
 
 TEST(PartErrors, EachIsOneLineNamingTheFileThePartAndTheField) {
-  const std::string base = file_text(test::model_path("seed/fourbar_reference_point.yaml")) + "\nparts:\n";
-  const std::string spatial = file_text(test::model_path("spatial/cardan.yaml")) + "\nparts:\n";
+  const std::string base = text_before_parts(test::model_path("seed/fourbar_reference_point.yaml")) + "\nparts:\n";
+  const std::string spatial = text_before_parts(test::model_path("spatial/cardan.yaml")) + "\nparts:\n";
   struct Case {
     std::string parts, where, says;
     bool in_space = false;

@@ -6,8 +6,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "output/hdf5_handle.hpp"
 #include "phiq/effort_sensitivity.hpp"
@@ -147,11 +145,7 @@ output: {efforts: all, power: true, sensitivities: [L2, L3, w]}
 
 TEST(PowerSensitivity, TheMassiveFourBarsPowerMatchesResolvedSweeps) {
   // models/dynamics/fourbar_motor_torque.yaml (natural coordinates; centres and inertias read L2, L3, L4)
-  std::ifstream in(test::model_path("dynamics/fourbar_motor_torque.yaml"));
-  std::stringstream read;
-  read << in.rdbuf();
-  std::string text = read.str();
-  text.erase(text.find("output:"));
+  const std::string text = test::model_file_text("dynamics/fourbar_motor_torque.yaml", "output:");
   expect_power_sensitivities_match_resolved_sweeps(text +
                                                    "output: {efforts: all, power: true, sensitivities: [L1, L3]}\n");
 }

@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <regex>
 
 #include "solve/assembly_internal.hpp"
@@ -15,8 +13,6 @@
 
 namespace phiq {
 namespace {
-
-using test::model_path;
 
 std::vector<SweepWarning> of_kind(const SweepSummary& s, const std::string& kind) {
   std::vector<SweepWarning> out;
@@ -101,10 +97,7 @@ TEST(SingularPositions, AStartWithEveryLoopFoldedIsASingularPositionNotAModelSho
 
   // Bricard's overconstrained loop, its driver taken away: one freedom undriven at every position. Off its
   // solutions its Φq has full rank (its redundancy is on the motion only), so the diagnosis is made at a solution.
-  std::ifstream in(model_path("benchmarks/bricard.yaml"));
-  std::stringstream file;
-  file << in.rdbuf();
-  std::string text = file.str();
+  std::string text = test::model_file_text("benchmarks/bricard.yaml");
   const std::string driver = "  - {name: motor, joint: J1, law: {type: linear, initial: 0, rate: 1}}\n";
   ASSERT_NE(text.find(driver), std::string::npos);
   text.replace(text.find("drivers:\n" + driver), std::string("drivers:\n").size() + driver.size(), "");

@@ -6,7 +6,9 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -27,6 +29,22 @@ inline std::string model_path(const std::string& rel) {
   path += '/';
   path += rel;
   return path;
+}
+
+// The whole text of the file at `path`, read as bytes ("" if it cannot be opened).
+inline std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The text of models/REL up to (without) its first `cut`, or whole (std::out_of_range if `cut` is not in it: a test
+// whose marker is gone fails).
+inline std::string model_file_text(const std::string& rel, const std::string& cut = "") {
+  std::string text = file_text(model_path(rel));
+  if (!cut.empty()) text.erase(text.find(cut));
+  return text;
 }
 
 // `text` with its first occurrence of `from` replaced by `to` (a failure, and `text` unchanged, if it has none).

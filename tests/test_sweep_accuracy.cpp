@@ -23,13 +23,6 @@ namespace fs = std::filesystem;
 namespace phiq {
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 class SweepAccuracy : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -47,7 +40,7 @@ class SweepAccuracy : public ::testing::Test {
     const std::string cmd =
         std::string(PHIQ_CLI) + " sweep-accuracy " + args + " >" + out.string() + " 2>" + err.string();
     const int st = std::system(cmd.c_str());
-    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(out), slurp(err)};
+    return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, test::file_text(out), test::file_text(err)};
   }
   // Rows of a sweep-accuracy CSV as maps column → text.
   std::vector<std::map<std::string, std::string>> rows(const fs::path& csv) {
@@ -82,7 +75,7 @@ TEST_F(SweepAccuracy, CrankSliderGridAgainstItsClosedForm) {
                  " --linear-solvers klu --repeat 1 -o " +
                  csv.string());
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(slurp(csv).substr(0, slurp(csv).find('\n')), kHeader);
+  EXPECT_EQ(test::file_text(csv).substr(0, test::file_text(csv).find('\n')), kHeader);
   const auto rs = rows(csv);
   ASSERT_EQ(rs.size(), 12u);            // 3 tolerances × 2 step counts × 2 predictors
   std::map<std::string, double> err_q;  // "steps/predictor/tolerance" → err_q
@@ -119,7 +112,7 @@ TEST_F(SweepAccuracy, JsonHasTheSettingsTheDefaultAndTheReference) {
                  json.string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(r.out.empty());  // with --json and no -o, nothing on standard output
-  const auto j = nlohmann::json::parse(slurp(json));
+  const auto j = nlohmann::json::parse(test::file_text(json));
   EXPECT_EQ(j["format"], 2);
   EXPECT_EQ(j["phiq"], phiq::kVersion);
   EXPECT_EQ(j["status"], "success");
@@ -142,11 +135,11 @@ TEST_F(SweepAccuracy, JsonHasTheSettingsTheDefaultAndTheReference) {
 
 TEST_F(SweepAccuracy, WithoutAClosedFormTheReferenceIsTheSceneAtTightTolerance) {
   // The crank-slider under another name: no closed form is suggested, the numerical reference is used.
-  std::string text = slurp(seed("crank_slider_mixed"));
+  std::string text = test::file_text(seed("crank_slider_mixed"));
   text.replace(text.find("name: crank_slider_mixed"), 24, "name: my_slider");
   std::ofstream(dir_ / "slider.yaml") << text;
   // A scene named like a four-bar that is not one: the closed form does not fit, the run falls back with a note.
-  std::string wrong = slurp(seed("crank_slider_mixed"));
+  std::string wrong = test::file_text(seed("crank_slider_mixed"));
   wrong.replace(wrong.find("name: crank_slider_mixed"), 24, "name: fourbar_not_really");
   std::ofstream(dir_ / "wrong.yaml") << wrong;
   for (const char* scene : {"slider.yaml", "wrong.yaml"}) {
@@ -272,9 +265,10 @@ TEST_F(SweepAccuracy, CtrlCWritesNothing) {
                             " & pid=$!; sleep 1; kill -" + sig + " $pid; wait $pid; echo $? >" +
                             (dir_ / "status.txt").string() + "'";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
-    EXPECT_EQ(slurp(dir_ / "status.txt"), status) << slurp(dir_ / "err.txt");
-    EXPECT_NE(slurp(dir_ / "err.txt").find("interrupted (SIG" + sig + "); no output written"), std::string::npos)
-        << slurp(dir_ / "err.txt");
+    EXPECT_EQ(test::file_text(dir_ / "status.txt"), status) << test::file_text(dir_ / "err.txt");
+    EXPECT_NE(test::file_text(dir_ / "err.txt").find("interrupted (SIG" + sig + "); no output written"),
+              std::string::npos)
+        << test::file_text(dir_ / "err.txt");
     std::vector<std::string> left;
     for (auto& e : fs::directory_iterator(dir_)) left.push_back(e.path().filename().string());
     std::sort(left.begin(), left.end());

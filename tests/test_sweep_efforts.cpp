@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
 #include "phiq/effort_sensitivity.hpp"
@@ -15,18 +14,9 @@
 namespace phiq {
 namespace {
 
-std::string effort_scene_text(const std::string& rel) {
-  std::ifstream in(test::model_path(rel));
-  std::stringstream s;
-  s << in.rdbuf();
-  std::string text = s.str();
-  text.erase(text.find("output:"));  // the tests write their own
-  return text;
-}
-
 // The notes' four-bar in natural coordinates with three massive links under gravity.
 std::string massive_fourbar(const std::string& output) {
-  return effort_scene_text("seed/fourbar_natural.yaml") +
+  return test::model_file_text("seed/fourbar_natural.yaml", "output:") +
          "parts:\n"
          "  crank: {frame: {origin: O, x: A}, center_of_mass: [L2/2, 0], mass: 1.0, inertia: L2*L2/12}\n"
          "  coupler: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 2.0, inertia: 2.0*L3*L3/12}\n"
@@ -203,7 +193,7 @@ TEST(SweepEfforts, AskingForEffortsLeavesTheMotionsBitsAndEveryThreadCountGivesT
 
 TEST(SweepEfforts, ASingularRowHasNoEffort) {
   // The change-point four-bar lands on its two singular positions at steps 120 and 300.
-  const Scene s = parse_scene(effort_scene_text("hard/change_point_exact.yaml") +
+  const Scene s = parse_scene(test::model_file_text("hard/change_point_exact.yaml", "output:") +
                                   "parts:\n  coupler: {mass: 1.0, inertia: 0.1, center_of_mass: [1, 0]}\n"
                                   "loads: {gravity: [0, -9.81]}\n"
                                   "output: {efforts: all}\n",
@@ -221,7 +211,7 @@ TEST(SweepEfforts, ASingularRowHasNoEffort) {
 TEST(SweepEfforts, AnAppliedForceAloneGivesTheStaticTorque) {
   // Massless links, 10 N straight down at the crank's tip A: the motor holds the crank with τ = 10 N · x_A (the
   // coupler and the rocker, unloaded and massless, carry nothing).
-  const Scene s = parse_scene(effort_scene_text("seed/fourbar_natural.yaml") +
+  const Scene s = parse_scene(test::model_file_text("seed/fourbar_natural.yaml", "output:") +
                                   "parts:\n  crank: {frame: {origin: O, x: A}}\n"
                                   "loads: {forces: [{name: weight, part: crank, at: [L2, 0], force: [0, -10]}]}\n"
                                   "output: {efforts: all, coordinates: [xA]}\n",
@@ -241,7 +231,7 @@ TEST(SweepEfforts, ARedundantParallelogramNeedsTheTorqueOfItsFourBar) {
       "  crank2: {mass: 1.0, inertia: 0.1, center_of_mass: [0.5, 0]}\n"
       "  coupler: {mass: 2.0, inertia: 0.2, center_of_mass: [0.5, 0]}\n"
       "loads: {gravity: [0, -9.81]}\noutput: {efforts: all}\n";
-  const std::string five = effort_scene_text("redundant/parallelogram_fifth_bar.yaml");
+  const std::string five = test::model_file_text("redundant/parallelogram_fifth_bar.yaml", "output:");
   std::string four;
   std::istringstream lines(five);
   for (std::string line; std::getline(lines, line);)
@@ -275,7 +265,7 @@ TEST(SweepEfforts, ARedundantParallelogramNeedsTheTorqueOfItsFourBar) {
 }
 
 TEST(SweepEfforts, TheSceneRefusesEffortsItCannotGiveInOneLine) {
-  const std::string fourbar = effort_scene_text("seed/fourbar_natural.yaml");
+  const std::string fourbar = test::model_file_text("seed/fourbar_natural.yaml", "output:");
   EXPECT_NE(error_of(fourbar + "output: {efforts: all}\n").find("no part has mass and no load is applied"),
             std::string::npos)
       << error_of(fourbar + "output: {efforts: all}\n");
