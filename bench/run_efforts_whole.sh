@@ -2,8 +2,9 @@
 # What driver efforts and joint reactions cost in the whole command a user runs, `phiq run SCENE -o OUT`, timed as
 # a process (/usr/bin/time): nfourbar N (`phiq generate`) with a unit mass on every crank and coupler (slender bars,
 # families in `parts`) under gravity, written three ways: q, q̇, q̈ only; with `efforts: all, power: true`; and with
-# `reactions: all` too (the joint points P{i}). Prints per format (CSV, HDF5) the median wall and CPU time of each
-# and the ratios to the first, whose wall-time ratio the efforts target reads (bench/README.md).
+# `reactions: all` too (the joint points P{i}). Prints per format (CSV, HDF5) the median wall time of each with its
+# spread (fastest and slowest repeat), the median CPU time and peak memory, and the ratios of the medians to the
+# first, whose wall-time ratio the efforts target reads (bench/README.md).
 #
 #   bench/run_efforts_whole.sh [PHIQ] [N] [STEPS] [REPEATS] [THREADS]
 #
@@ -31,7 +32,7 @@ out='output: {velocities: true, accelerations: true'
 { cat "$dir/base.yaml"; echo "$out, efforts: all, power: true, reactions: all}"; } >"$dir/reactions.yaml"
 echo "phiq run nfourbar $n with masses, $steps steps, $threads thread(s), $repeats repeats;" \
   "load: $(cut -d' ' -f1-3 /proc/loadavg)"
-printf '%-5s %-10s %9s %9s %8s %10s\n' format scene median_s cpu_s peak_MB wall_ratio
+printf '%-5s %-10s %9s %15s %9s %8s %10s\n' format scene median_s min-max_s cpu_s peak_MB wall_ratio
 for format in csv h5; do
   for scene in plain torques reactions; do
     : >"$dir/times"
@@ -44,7 +45,8 @@ for format in csv h5; do
     done
     sort -n "$dir/times" | awk -v f="$format" -v s="$scene" '
       { wall[NR] = $1; cpu[NR] = $2 + $3; mem[NR] = $4 }
-      END { m = int((NR + 1) / 2); printf "%s %s %.3f %.3f %.0f\n", f, s, wall[m], cpu[m], mem[m] / 1024 }'
+      END { m = int((NR + 1) / 2)
+            printf "%s %s %.3f %.3f-%.3f %.3f %.0f\n", f, s, wall[m], wall[1], wall[NR], cpu[m], mem[m] / 1024 }'
   done
 done | awk '{ if ($2 == "plain") base = $3
-              printf "%-5s %-10s %9.3f %9.3f %8.0f %10.2f\n", $1, $2, $3, $4, $5, $3 / base }'
+              printf "%-5s %-10s %9.3f %15s %9.3f %8.0f %10.2f\n", $1, $2, $3, $4, $5, $6, $3 / base }'
