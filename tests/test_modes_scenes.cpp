@@ -1,8 +1,8 @@
 // Every assembly mode of the scenes with gears and spatial joint-angle drivers (phiq/modes.hpp): the planetary
 // train's one assembly at Willis' carrier angle, the RSSR linkage's eight and the Cardan joint's eight against their
 // geometry, a wheel geared to a four-bar's coupler against Freudenstein's closed form, each mode on the model's own
-// Φ = 0 to 1e-10, the geared system side by side with PHCpack (skipped, with the reason, when phc is absent), and a
-// rack whose pinion a linkage turns refused with its constraint named.
+// Φ = 0 to 1e-10, the geared system side by side with PHCpack (skipped, with the reason, when phc is absent), a
+// rack whose pinion a linkage turns refused with its constraint named, and a triple root of one unknown singular.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -222,6 +222,32 @@ time: {start: 0, end: 1, steps: 1}
 // The geared four-bar's system, its complex multiple-angle equation among them, solved by PHCpack too: the same
 // finite regular solutions, the same real ones. (The spatial scenes' systems take phc 20 s: their counts are
 // checked against their geometry above.)
+// A multiple root of one equation in one unknown, (x − 1)³ = 0 (y fixed by its own row): its three paths meet at
+// x = 1, where the derivative 3 (x − 1)² vanishes. A 1 × 1 Jacobian's σ_max / σ_min is 1 however small it is: the
+// mode is singular by its smallest singular value against the equation's scale, one endpoint of multiplicity 3, not
+// a regular one reached three times.
+TEST(ModesScenes, ATripleRootInOneUnknownIsOneSingularModeOfThreePaths) {
+  const Scene scene = parse_scene(
+      "phiq: 1\ncoordinates: {x: 0.5, y: 1.0}\nconstraints:\n"
+      "  - {name: triple, type: equation, expr: \"(x - 1)^3\"}\n"
+      "  - {name: level, type: equation, expr: \"y - 2\"}\ntime: {start: 0, end: 0, steps: 0}\n",
+      "triple.yaml");
+  ModesOptions o;
+  o.threads = 1;
+  const AssemblyModes r = find_assembly_modes(*scene.model, o);
+  ASSERT_EQ(r.summary.status, ModesStatus::kSuccess) << r.summary.message;
+  EXPECT_EQ(r.summary.paths, 3);
+  EXPECT_EQ(r.summary.singular, 1);
+  EXPECT_EQ(r.summary.real + r.summary.complex + r.summary.failed_paths + r.summary.duplicate_paths, 0);
+  ASSERT_EQ(r.summary.endpoints.size(), 1u);
+  EXPECT_EQ(r.summary.endpoints[0].multiplicity, 3);
+  EXPECT_GT(r.summary.endpoints[0].condition, o.singular_condition);
+  ASSERT_EQ(r.modes.size(), 1u);
+  EXPECT_TRUE(r.modes[0].singular);
+  EXPECT_NEAR(r.modes[0].q(scene.model->coordinate_index("x")), 1.0, 1e-6);  // (a triple root: to ε^(1/3))
+  EXPECT_EQ(r.modes[0].q(scene.model->coordinate_index("y")), 2.0);
+}
+
 TEST(ModesScenes, GearedFourBarAsPhcSolvesIt) {
   if (!modes_phc::phc_installed()) GTEST_SKIP() << "phc (Debian package phcpack) is not installed";
   const Scene scene = parse_scene(kModesScenesGearedFourBar, "geared_fourbar.yaml");

@@ -1,7 +1,7 @@
 """phiq.modes (engine/python/src/bind_modes.cpp): the four-bar's two assembly modes as arrays, each a placement that
 solves the scene's equations (checked with the model's own residual), against Freudenstein's closed form, the start
-system each solve tracked its paths from, the paths tracked against the total degree, and a cam refused with its
-constraint named."""
+system each solve tracked its paths from, the paths tracked against the total degree, a cam refused with its
+constraint named, and failed paths named with why."""
 import math
 import os
 
@@ -79,3 +79,30 @@ def test_options_out_of_range_are_value_errors_not_signals():
     with pytest.raises(ValueError, match="run_batch: threads must be from 0 \\(all cores\\) to 1000000"):
         phiq.run_batch(scene, [{"L2": 0.4}], threads=10**7)
     assert phiq.modes(scene, threads=2)["q"].shape[0] == 4  # the bound leaves every real count alone
+
+
+TRIPLE_ROOT = """phiq: 1
+coordinates: {x: 0.5, y: 1.0}
+constraints:
+  - {name: triple, type: equation, expr: "(x - 1)^3"}
+  - {name: level, type: equation, expr: "y - 2"}
+time: {start: 0, end: 0, steps: 0}
+"""
+
+
+def test_failed_paths_are_named_with_why_as_the_cli_numbers_them():
+    """(x − 1)³ = 0 in one unknown: its three paths close one cycle round t = 0 in three turns. Allowed one, each
+    fails, numbered from 1 as `phiq modes` prints them, with why; allowed the default, none fails and the one mode is
+    singular (a 1 × 1 Jacobian that vanishes)."""
+    scene = phiq.parse_scene(TRIPLE_ROOT, "triple.yaml")
+    r = phiq.modes(scene, threads=1, max_winding=1)
+    assert r["failed_paths"] == 3
+    assert [path for path, _ in r["failures"]] == [1, 2, 3]
+    assert all("did not close within 1 turn" in why for _, why in r["failures"])
+    assert r["q"].shape[0] == 0
+    r = phiq.modes(scene, threads=1)
+    assert r["failures"] == [] and r["failed_paths"] == 0
+    assert r["singular"].tolist() == [True]
+    assert abs(r["q"][0][r["coordinates"].index("x")] - 1.0) < 1e-6
+    with pytest.raises(ValueError, match="max_winding must be 1 or more, not 0"):
+        phiq.modes(scene, max_winding=0)

@@ -78,7 +78,8 @@ struct ModesOptions {
   /// Worker threads for the paths; 0: TBB's default; at most 1000000 (else phiq::Error).
   int threads = 0;
   std::uint64_t seed = 20261202;  ///< seed of γ, the affine patch and the fitting points: a run is reproducible
-  /// An endpoint whose Jacobian's condition number (2-norm, the variables scaled) is above this is singular.
+  /// An endpoint whose Jacobian's condition number (2-norm, the equations at their coefficients' scale and the
+  /// variables at the solution's: max(σ_max, 1) / σ_min) is above this is singular.
   /// (Several paths at one regular point are counted in ModesSummary::duplicate_paths, not made singular.)
   double singular_condition = 1e9;
   /// An endpoint is real when every |Im x_v| ≤ this · (1 + |x|∞).

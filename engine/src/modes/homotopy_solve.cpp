@@ -176,8 +176,11 @@ ChosenStart choose_start(const PolynomialSystem& square, const ModesOptions& opt
 }  // namespace
 
 // Newton (Gauss-Newton for more equations than unknowns) on the original equations from x; returns the residual
-// max_i |F_i| / scale_i and sets the condition number of the scaled Jacobian. Converges linearly at a singular
-// solution (ratio 1/2 at a double root): the iterations allowed let it get there too.
+// max_i |F_i| / scale_i and sets the condition number of the scaled Jacobian, max(σ_max, 1) / σ_min: its rows at
+// their coefficients' scale and the variables at the solution's, a regular solution's singular values are near 1,
+// and a Jacobian small in every direction (a multiple root of one equation in one unknown: σ_max = σ_min ≈ 0) is
+// singular however equal they are. Converges linearly at a singular solution (ratio 1/2 at a double root): the
+// iterations allowed let it get there too.
 double modes_detail::refine_endpoint(const CompiledSystem& f, Eigen::VectorXcd& x, double* condition) {
   Eigen::VectorXcd value;
   Eigen::MatrixXcd jac;
@@ -205,7 +208,7 @@ double modes_detail::refine_endpoint(const CompiledSystem& f, Eigen::VectorXcd& 
   const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(jac);
   const Eigen::VectorXd& sv = svd.singularValues();
   *condition = sv.size() == 0            ? 1.0
-               : sv(sv.size() - 1) > 0.0 ? sv(0) / sv(sv.size() - 1)
+               : sv(sv.size() - 1) > 0.0 ? std::max(sv(0), 1.0) / sv(sv.size() - 1)
                                          : std::numeric_limits<double>::infinity();
   return r;
 }
@@ -240,7 +243,7 @@ void at_infinity_residual(const CompiledSystem& target, const Grouping& g, Eigen
   const Eigen::JacobiSVD<Eigen::MatrixXcd> svd(jac);
   const Eigen::VectorXd& sv = svd.singularValues();
   point.condition = sv.size() == 0            ? 1.0
-                    : sv(sv.size() - 1) > 0.0 ? sv(0) / sv(sv.size() - 1)
+                    : sv(sv.size() - 1) > 0.0 ? std::max(sv(0), 1.0) / sv(sv.size() - 1)
                                               : std::numeric_limits<double>::infinity();
 }
 
