@@ -194,6 +194,32 @@ TEST(Assembly, ALockedStructureWithoutAPositionIsNotCalledConsistent) {
   for (const auto& [row, residual] : as.worst_rows) EXPECT_NE(sc.model->row_name(row), "motor") << as.message;
 }
 
+// (x − 1)³ = 0 (y fixed by its own row): its Jacobian vanishes at the root, where Gauss-Newton converges linearly.
+// The all-rows phase crawled there under its μ floor (1e-10, above 9 (x − 1)⁴) and spent the 100 iterations at
+// 1.7e-10, which was called "no common solution"; it now hands over to the kept rows' Gauss-Newton, which assembles.
+// A budget too short for that says the residual was still falling, naming the setting, and claims no inconsistency.
+TEST(Assembly, AMultipleRootAssemblesAndAShortBudgetSaysTheResidualStillFell) {
+  const Scene sc = parse_scene(
+      "phiq: 1\ncoordinates: {x: 0.5, y: 1.0}\nconstraints:\n"
+      "  - {name: triple, type: equation, expr: \"(x - 1)^3\"}\n"
+      "  - {name: level, type: equation, expr: \"y - 2\"}\ntime: {start: 0, end: 0, steps: 0}\n",
+      "triple.yaml");
+  const Model& m = *sc.model;
+  Eigen::VectorXd q = m.initial_positions();
+  AssemblySummary as;
+  ASSERT_EQ(assemble(m, 0.0, {}, q, &as), SolveStatus::kSuccess) << as.message;
+  EXPECT_LT(as.iterations, 100);
+  EXPECT_NEAR(q(m.coordinate_index("x")), 1.0, 1e-6);
+  EXPECT_EQ(q(m.coordinate_index("y")), 2.0);
+  AssemblyOptions shorter;
+  shorter.max_iterations = 12;
+  q = m.initial_positions();
+  EXPECT_EQ(assemble(m, 0.0, shorter, q, &as), SolveStatus::kNotConverged);
+  EXPECT_HAS(as.message, "did not reach the tolerance in 12 iterations, their residual still falling");
+  EXPECT_HAS(as.message, "solver.assembly_max_iterations");
+  EXPECT_TRUE(as.consistent);
+}
+
 // A time that is not finite is outside every time domain, said so without a driver's name (there is none to blame)
 // and without worst constraints (Φ means nothing there).
 TEST(Assembly, NonFiniteTimesAreOutsideTheTimeDomain) {

@@ -67,7 +67,7 @@ bool backtrack(const Model& model, double t, const AssemblyOptions& opt, const E
 // merit (Levenberg-Marquardt). Returns kSuccess when every row holds, kNotConverged at a least-squares minimum that
 // is not a solution (inconsistent or impossible: the caller finds out which).
 SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& opt, Eigen::VectorXd& q,
-                           AssemblySummary& sum, std::string* why) {
+                           AssemblySummary& sum, std::string* why, std::vector<double>& worst) {
   const Index n = model.num_coordinates(), m = model.num_equations();
   if (m == 0) return SolveStatus::kSuccess;
   const ToleranceScales& sc = model.tolerance_scales();
@@ -83,9 +83,18 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
   model.residual(q.data(), t, phi.data());
   scaled(phi, b);
   double f = 0.5 * b.squaredNorm(), mu = 0.0;
+  // the worst scaled row at each iteration: where it crawls (less than halved in kSlowSpan iterations) within
+  // kNearSolution tolerances, the Jacobian is vanishing at a solution (a multiple root), where μ's floor, larger than
+  // its squared entries there, shortens every step; the kept rows' Gauss-Newton (μ = 0) finishes instead
+  constexpr std::size_t kSlowSpan = 5;
+  constexpr double kNearSolution = 1e3;
   while (sum.iterations < opt.max_iterations) {
     if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
     if (scaled_rows_within(model, b, nullptr, opt.tolerance, q, t)) return SolveStatus::kSuccess;
+    worst.push_back(b.cwiseAbs().maxCoeff());
+    if (worst.size() > kSlowSpan && worst.back() <= kNearSolution * opt.tolerance &&
+        worst.back() > 0.5 * worst[worst.size() - 1 - kSlowSpan])
+      return *why = "converging slowly near a solution", SolveStatus::kNotConverged;
     jac.evaluate(q, t, jv);
     tv.resize(from.size());
     for (std::size_t k = 0; k < from.size(); ++k) tv[k] = jv[static_cast<std::size_t>(from[k])];
@@ -132,7 +141,9 @@ SolveStatus solve_all_rows(const Model& model, double t, const AssemblyOptions& 
 //     of the constraints times the distance moved); steps are taken in full, the correction phase resumes if one
 //     leaves the tolerance.
 SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt, const std::vector<Index>& kept,
-                       const Eigen::VectorXd& q0, Eigen::VectorXd& q, AssemblySummary& sum, std::string* why) {
+                       const Eigen::VectorXd& q0, Eigen::VectorXd& q, AssemblySummary& sum, std::string* why,
+                       std::vector<double>& worst) {
+  worst.clear();
   const Index n = model.num_coordinates(), k = static_cast<Index>(kept.size());
   if (k == 0) return SolveStatus::kSuccess;  // nothing to satisfy (a model without equations)
   const ToleranceScales& sc = model.tolerance_scales();
@@ -153,6 +164,7 @@ SolveStatus solve_kept(const Model& model, double t, const AssemblyOptions& opt,
   Eigen::VectorXd assembled;  // the last iterate at which the kept rows held (empty if none yet)
   while (sum.iterations < opt.max_iterations) {
     if (!b.allFinite()) return *why = "constraint residual is not finite", SolveStatus::kNonFinite;
+    worst.push_back(b.cwiseAbs().maxCoeff());
     const bool within = kept_within();
     if (within) assembled = q;
     jac.evaluate(q, t, values);
@@ -262,13 +274,14 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
   // ends, 3. its independent rows solved to rounding level and moved to the nearest assembled position, 4. the
   // redundant rows checked.
   std::string why;
-  const SolveStatus first = solve_all_rows(model, t, opt, q, sum, &why);
+  std::vector<double> all_worst, kept_worst;  // each phase's worst scaled row, iteration by iteration
+  const SolveStatus first = solve_all_rows(model, t, opt, q, sum, &why, all_worst);
   if (first == SolveStatus::kNonFinite || first == SolveStatus::kLinearSolverFailed) return finish(first, why);
   if (!q.allFinite()) return finish(SolveStatus::kNonFinite, "non-finite coordinates");
   sum.rank = analyse_rank(model, q, t, opt.rank);
   for (;;) {
     const std::vector<Index> kept = sum.rank.independent_rows;
-    const SolveStatus st = solve_kept(model, t, opt, kept, q0, q, sum, &why);
+    const SolveStatus st = solve_kept(model, t, opt, kept, q0, q, sum, &why, kept_worst);
     if (!q.allFinite()) return finish(SolveStatus::kNonFinite, "non-finite coordinates");
     // Rank belongs to the configuration: choose the independent rows again where the solve ended.
     sum.rank = analyse_rank(model, q, t, opt.rank);
@@ -293,6 +306,20 @@ SolveStatus assemble(const Model& model, double t, const AssemblyOptions& opt, E
     // parallelogram where no position exists): whether the redundant ones conflict is not known, and the worst
     // rows are named among the independent ones — a redundant driver's row, far off at a least-squares minimum
     // of the others, says nothing about the cause.
+    // Unless the iterations ran out while the residual still fell (at least halved in the last phase's last ten
+    // iterations; a least-squares minimum that is not a solution levels off): Gauss-Newton converges linearly
+    // where Φq is singular at the solution (a multiple root), so that the budget, not the equations, may be the
+    // cause; what a longer run would find is not known.
+    const std::vector<double>& last = kept_worst.size() > 10 ? kept_worst : all_worst;
+    const bool still_falling =
+        sum.iterations >= opt.max_iterations && last.size() > 10 && last.back() <= 0.5 * last[last.size() - 11];
+    if (!kept_within && still_falling)
+      return finish(SolveStatus::kNotConverged,
+                    "the independent equations did not reach the tolerance in " + std::to_string(opt.max_iterations) +
+                        " iterations, their residual still falling (slowly: Φq nearly singular, as at a multiple "
+                        "root or a singular position, or no solution near here): raise "
+                        "solver.assembly_max_iterations, or start nearer",
+                    &kept);
     if (!kept_within) {
       sum.consistent = false;
       return finish(SolveStatus::kNotConverged,
