@@ -398,6 +398,40 @@ TEST(NaturalReactions, PlanarTermsSumAsAddPlanarForce) {
   }
 }
 
+// A second part on the crank's two points (a drawn shape, or a weight from A to O) makes the crank's length row the
+// joints' rather than the crank's (two bodies hold the same coordinates): its reactions would not take back a bar's
+// Q, so no bar takes that form, and the sweep's reactions are the frames' motion's, as they are without it.
+TEST(NaturalReactions, ASecondPartOnABarsPointsKeepsItsReactionsTheFramesMotions) {
+  const std::string shape = "  shape: {frame: {origin: O, x: A}, shapes: [{type: box, size: [0.1, 0.1, 0.1]}]}\n";
+  const std::string weight =
+      "  weight: {frame: {origin: A, x: O}, mass: 0.7, center_of_mass: [0.1, 0.02], inertia: 0.01}\n";
+  for (const std::string& second : {std::string(), shape, weight}) {
+    std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
+    text += "parts:\n" + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") + second +
+            natural_reactions_part("coupler", 1, 0.6, "frame: {origin: A, x: B}, ") +
+            natural_reactions_part("rocker", 2, 0.5, "frame: {origin: C, x: B}, ") + natural_reactions_loads(0.6, 0.5) +
+            "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
+    const Scene s = parse_scene(text, "fourbar_natural.yaml");
+    const Model& m = *s.model;
+    const OutputEfforts& e = s.sweep.efforts;
+    EXPECT_EQ(JointReactions(m, e, true).rigid_bars(), second.empty()) << second;
+    const NaturalRows rows = natural_reactions_sweep(s);
+    JointReactions frames(m, e);
+    Workspace ws(m);
+    for (std::size_t k = 0; k < rows.q.size(); ++k) {
+      const double *q = rows.q[k].data(), *qd = rows.qd[k].data(), *qdd = rows.qdd[k].data(), t = rows.t[k];
+      Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), lambda;
+      add_generalized_forces(*e.parts, *e.loads, q, qd, qdd, t, Q);
+      ws.q = rows.q[k];
+      ASSERT_EQ(constraint_multipliers(m, t, ws, Q, lambda), SolveStatus::kSuccess);
+      std::vector<double> r(static_cast<std::size_t>(frames.size()));
+      frames.evaluate(q, qd, qdd, t, lambda, r.data());
+      for (std::size_t j = 0; j < r.size(); ++j)
+        EXPECT_NEAR(rows.values[k][2 + j], r[j], 1e-9 * (1 + std::fabs(r[j]))) << second << j << ", row " << k;
+    }
+  }
+}
+
 TEST(NaturalReactions, APointNoTwoBodiesShareIsRefusedByName) {
   std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
   text += "parts:\n" + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +

@@ -59,6 +59,9 @@ class JointReactions {
   Index size() const { return size_; }
   /// Whether the k-th listed joint is spatial (6 values) rather than planar (3).
   bool spatial(std::size_t k) const { return sites_[k].spatial; }
+  /// Whether evaluate()'s `planar` may come from a Q with rigid bars: as constructed, unless a natural body with
+  /// mass on a bar does not own the bar's row (internal: the sweep then takes no bar in Q).
+  bool rigid_bars() const { return rigid_bars_; }
   /// Writes the reactions at (q, t) under multipliers `lambda` (one per model row) to out[0, size()).
   /// Pre-condition: q has the model's coordinates; the model is the one given to the constructor.
   /// No natural joint may be listed (they read q̇ and q̈: the overload below; else phiq::Error).
@@ -152,6 +155,7 @@ class JointReactions {
   BodyRows body_rows_;
   std::vector<BodyPart> body_parts_;      // per natural body
   bool joint_axes_ = false;               // constraints' reactions along ReactionSite::axes, not world axes
+  bool rigid_bars_ = false;               // rigid_bars()
   Eigen::VectorXd qx_, qdx_, qddx_, qb_;  // q, q̇, q̈ with the promoted constants; a body's Q
   Index size_ = 0;
   std::vector<double> g_;  // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations

@@ -221,7 +221,7 @@ constexpr double kAtInfinity = 1e-8;
 
 // An end at infinity: the homogenised equations' residual there (each group's coordinates scaled to |X_j|∞ = 1), and
 // the condition of their Jacobian, n × (n + groups), whose n singular values are all nonzero at a regular solution at
-// infinity (the Euler relation takes one direction per group).
+// infinity (the Euler relation takes one direction per group), as refine_endpoint() takes it: max(σ_max, 1) / σ_min.
 void at_infinity_residual(const CompiledSystem& target, const Grouping& g, Eigen::VectorXcd X, Endpoint& point) {
   for (int j = 0; j < g.groups; ++j) {
     const auto& members = g.members[static_cast<std::size_t>(j)];

@@ -159,23 +159,21 @@ std::array<std::uint64_t, 2> slot_bits(const Slot& x, const Slot& y) {
 
 detail::BarLengths::BarLengths(const Model& model) {
   if (!model.solve_rows().empty()) return;
-  for (const auto& block : model.blocks()) {
-    const auto* distances = dynamic_cast<const TypedBlock<DistanceSpec>*>(block.get());
+  for (std::size_t c = 0; c < model.constraints().size(); ++c) {
+    const auto [block, i] = model.constraint_block(static_cast<Index>(c));
+    const auto* distances = dynamic_cast<const TypedBlock<DistanceSpec>*>(block);
     if (!distances) continue;
-    for (std::size_t i = 0; i < distances->size(); ++i) {
-      const DistanceSpec& d = distances->spec(i);
-      const auto a = slot_bits(d.a.x, d.a.y), b = slot_bits(d.b.x, d.b.y);
-      length_[{a[0], a[1], b[0], b[1]}] = d.length;
-      length_[{b[0], b[1], a[0], a[1]}] = d.length;
-    }
+    const DistanceSpec& d = distances->spec(i);
+    const auto a = slot_bits(d.a.x, d.a.y), b = slot_bits(d.b.x, d.b.y);
+    bar_[{a[0], a[1], b[0], b[1]}] = bar_[{b[0], b[1], a[0], a[1]}] = Bar{d.length, c};
   }
 }
 
-double detail::BarLengths::of(const PartFrame& f) const {
-  if (length_.empty() || f.kind != PartFrameKind::kPoints || f.spatial_frame || !f.x_is_point) return 0.0;
+const detail::BarLengths::Bar* detail::BarLengths::find(const PartFrame& f) const {
+  if (bar_.empty() || f.kind != PartFrameKind::kPoints || f.spatial_frame || !f.x_is_point) return nullptr;
   const auto o = slot_bits(f.origin.r[0], f.origin.r[1]), x = slot_bits(f.x_toward.r[0], f.x_toward.r[1]);
-  const auto it = length_.find({o[0], o[1], x[0], x[1]});
-  return it == length_.end() ? 0.0 : it->second;
+  const auto it = bar_.find({o[0], o[1], x[0], x[1]});
+  return it == bar_.end() ? nullptr : &it->second;
 }
 
 void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,

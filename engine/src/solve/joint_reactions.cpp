@@ -63,7 +63,9 @@ JointReactions::JointReactions(const Model& model, std::vector<Index> constraint
 }
 
 JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts, bool rigid_bars)
-    : joint_axes_(efforts.reactions_in_joint_axes), g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
+    : joint_axes_(efforts.reactions_in_joint_axes),
+      rigid_bars_(rigid_bars),
+      g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
   std::vector<int> site_of(model.constraints().size(), -1);
   for (const OutputReaction& r : efforts.reactions) {
     if (r.natural < 0) {
@@ -108,6 +110,7 @@ JointReactions::JointReactions(const JointReactions& other, SetUpOnly)
       body_rows_(other.body_rows_),
       body_parts_(other.body_parts_),
       joint_axes_(other.joint_axes_),
+      rigid_bars_(other.rigid_bars_),
       size_(other.size_),
       g_(other.g_.size(), 0.0) {
   if (!natural_sites_.empty()) size_natural_scratch();

@@ -348,6 +348,18 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
     rows.constraints[next_constraint[b]++] = model.constraint_block(static_cast<Index>(c));
     for (std::size_t k = all_first[c]; k < all_first[c + 1]; ++k) rows.g_columns[next_g[b]++] = all[k];
   }
+  // A rigid bar's Q differs from its frame's by a multiple of its own row, which its body's reactions take back only
+  // where that row is the body's (not the joints', as when another body holds the same coordinates: a second part
+  // on the bar's two points, two bars from fixed points to one point): else no bar takes that form, in Q either
+  // (rigid_bars())
+  if (rigid_bars) {
+    const detail::BarLengths bars(model);
+    for (std::size_t b = 0; b < nb && rigid_bars; ++b) {
+      const detail::BarLengths::Bar* bar = bars.find(bodies[b].frame);
+      rigid_bars = !bar || bodies[b].parts.empty() || owner[bar->constraint] == b;
+    }
+  }
+  rigid_bars_ = rigid_bars;
   find_body_parts(model, efforts, rigid_bars);
   find_flat_sites(model);
 }

@@ -99,18 +99,27 @@ void for_each_planar_term(const PlanarFrame& frame, Visit&& visit) {
   if (frame.x_is_point && !frame.bar) visit(o[0], 4, true), visit(o[1], 5, true);
 }
 
-// The lengths at which a model's distance constraints hold pairs of points (rigid_bar_length()).
+// The lengths at which a model's distance constraints hold pairs of points, and which constraint holds each.
 class BarLengths {
  public:
+  struct Bar {
+    double length = 0.0;
+    std::size_t constraint = 0;  // its index among the model's constraints
+  };
   BarLengths() = default;
   // `model`'s distance constraints; none when the model dropped redundant rows (their minimum-norm multipliers,
   // unlike the others, would not be the same under a bar's Q).
   explicit BarLengths(const Model& model);
-  // The length L at which the model holds `frame`'s origin and x point, a planar frame of points; 0 when none does.
-  double of(const PartFrame& frame) const;
+  // The distance constraint that holds `frame`'s origin and x point, a planar frame of points; null when none does.
+  const Bar* find(const PartFrame& frame) const;
+  // Its length L, 0 when none.
+  double of(const PartFrame& frame) const {
+    const Bar* b = find(frame);
+    return b ? b->length : 0.0;
+  }
 
  private:
-  std::unordered_map<std::array<std::uint64_t, 4>, double, SlotsHash> length_;  // both orders of a, b
+  std::unordered_map<std::array<std::uint64_t, 4>, Bar, SlotsHash> bar_;  // both orders of a, b
 };
 
 class PartForces {

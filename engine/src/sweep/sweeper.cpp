@@ -16,7 +16,9 @@ Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSumm
   if (opt_.efforts.active() && opt_.efforts.parts)
     effort_work_.forces = same_sweep(like) && like->effort_work_.forces
                               ? like->effort_work_.forces
-                              : std::optional<PartForces>(std::in_place, *opt_.efforts.parts, model_, rigid_bars());
+                              : std::optional<PartForces>(
+                                    std::in_place, *opt_.efforts.parts, model_,
+                                    rigid_bars() && (!effort_work_.reactions || effort_work_.reactions->rigid_bars()));
   // what Q's planar parts add, kept for the natural joints' reactions to read (row_reactions())
   if (effort_work_.reactions && opt_.efforts.natural && opt_.efforts.parts)
     effort_work_.planar.resize(opt_.efforts.parts->size());
