@@ -10,8 +10,9 @@
 // frame's motion's Q only by a multiple of the bar's own row of Φq (along the bar: what the length's equation
 // carries): λ of every other row, hence every effort and every joint's reaction, is the same; the bar's own
 // multiplier takes the difference. Q is then about four times faster at nfourbar 10⁴ (bench/README.md). Not with
-// ∂τ/∂p (PartForces' `rigid_bars`) nor where the model dropped redundant rows (BarLengths). Elsewhere the same Q,
-// bit for bit, as add_generalized_forces().
+// ∂τ/∂p (PartForces' `rigid_bars`), where the model dropped redundant rows (BarLengths), nor, with natural joints'
+// reactions, where a bar's row is not its body's (JointReactions::rigid_bars()). Elsewhere the same Q, bit for bit,
+// as add_generalized_forces().
 #pragma once
 
 #include <Eigen/Core>
