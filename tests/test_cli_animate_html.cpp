@@ -73,6 +73,16 @@ class AnimateHtml : public Cli {
     return text;
   }
   double at(std::size_t row, const std::string& name) { return table.rows[row][col.at(name)]; }
+  // The page's force arrows (`arrows` of them, each over `rows` rows) are `world`'s, to 1e-9, and with `points` at
+  // the same points: what a scene written in joint axes draws in world axes all the same.
+  void expect_arrows(const nlohmann::json& world, std::size_t arrows, std::size_t rows, bool points) {
+    for (std::size_t a = 0; a < arrows; ++a)
+      for (std::size_t i = 0; i < 3 * rows; ++i) {
+        const double w = world[a]["force"][i], j = data["forces"]["arrows"][a]["force"][i];
+        EXPECT_NEAR(j, w, 1e-9 * (1.0 + std::fabs(w))) << a << " " << i;
+        if (points) EXPECT_EQ(world[a]["at"][i], data["forces"]["arrows"][a]["at"][i]) << a << " " << i;
+      }
+  }
   phiq::CsvTable table;
   std::map<std::string, std::size_t> col;
   nlohmann::json data;
@@ -209,11 +219,7 @@ TEST_F(AnimateHtml, ForceArrowsHoldTheResultsEffortsAndReactionsAtTheirJoints) {
   double turned = 0.0;  // how far the columns moved: they are along the crank's axes now
   for (std::size_t k = 0; k < rows; ++k) turned = std::max(turned, std::fabs(at(k, "A.Fx") - world_a[k]));
   EXPECT_GT(turned, 1.0);
-  for (std::size_t a = 0; a < 4; ++a)
-    for (std::size_t i = 0; i < 3 * rows; ++i) {
-      const double w = world[a]["force"][i], j = data["forces"]["arrows"][a]["force"][i];
-      EXPECT_NEAR(j, w, 1e-9 * (1.0 + std::fabs(w))) << a << " " << i;
-    }
+  expect_arrows(world, 4, rows, false);
   // asked for where the scene writes no efforts or reactions, or with a scale that is not positive: one line, exit 2
   const Result none = run("animate " + phiq::test::model_path("seed/fourbar_natural.yaml") + " -o " +
                           (dir_ / "n.html").string() + " --forces 0.1");
@@ -243,12 +249,7 @@ TEST_F(AnimateHtml, ForceArrowsOfNaturalJointsAreTheSameInBothAxes) {
   double turned = 0.0;  // the columns moved: along the coupler's axes now
   for (std::size_t k = 0; k < rows; ++k) turned = std::max(turned, std::fabs(at(k, "B.Fy") - world_b[k]));
   EXPECT_GT(turned, 1.0);
-  for (std::size_t a = 0; a < 4; ++a)
-    for (std::size_t i = 0; i < 3 * rows; ++i) {
-      const double w = world[a]["force"][i], j = data["forces"]["arrows"][a]["force"][i];
-      EXPECT_NEAR(j, w, 1e-9 * (1.0 + std::fabs(w))) << a << " " << i;
-      EXPECT_EQ(world[a]["at"][i], data["forces"]["arrows"][a]["at"][i]) << a << " " << i;
-    }
+  expect_arrows(world, 4, rows, true);
 }
 
 TEST_F(AnimateHtml, LargeChainsKeepEvenlySpreadRowsWithinTheBudget) {

@@ -33,6 +33,7 @@ namespace phiq {
 namespace detail {
 struct PlanarForce;
 struct PlanarFrame;
+class BarLengths;
 }  // namespace detail
 
 /// How many values constraint c's reaction has: 3 (Fx, Fy, Mz) for a planar joint, 6 for a spatial one, 0 when its
@@ -117,8 +118,8 @@ class JointReactions {
     static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
     std::size_t part = kNone;
     Slot slots[5];
-    bool x_is_point = true, bar = false;  // bar: the part's force is a rigid bar's (solve/part_forces.hpp)
-    double bar_length = 0.0;              // the body's, when it is a rigid bar of the model
+    bool x_is_point = true;
+    double bar_length = 0.0;  // > 0: the body is a rigid bar, its force a bar's (solve/part_forces.hpp)
     const AppliedLoads* applied = nullptr;
     detail::PlanarFrame frame() const;  // the promoted planar frame the slots name
   };
@@ -130,7 +131,8 @@ class JointReactions {
   void add_natural(const Model& model, const OutputEfforts& efforts, bool rigid_bars);
   // qx_, q̇x_, q̈x_ (the promoted constants past the model's coordinates) and qb_ (zero) at their sizes
   void size_natural_scratch();
-  void find_body_parts(const Model& model, const OutputEfforts& efforts, bool rigid_bars);
+  // `bars`: the model's rigid bars where the sweep's Q takes them (else empty)
+  void find_body_parts(const Model& model, const OutputEfforts& efforts, const detail::BarLengths& bars);
   void find_flat_sites(const Model& model);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);

@@ -192,18 +192,14 @@ detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& mode
 
 void detail::PartForces::add(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
                              const double* qdd, double t, Eigen::VectorXd& Q, PlanarForce* planar) const {
-  auto add = [&Q](const Slot& s, double v) {
-    if (s.is_coordinate()) Q(s.coord()) += v;
-  };
   for (const MassivePart& m : massive_) {
     if (!m.frame.bar) {
       add_massive_part(parts[m.part], m, loads.gravity, q, qd, qdd, t, Q, planar ? planar + m.part : nullptr);
       continue;
     }
-    PlanarForce f;  // add_planar_force()'s terms of a bar (its origin's z a constant)
+    PlanarForce f;  // (the common case at scale, inlined here)
     bar_force(m, qdd, loads.gravity, f);
-    const Slot* o = m.frame.slots;
-    add(o[0], f.fx), add(o[1], f.fy), add(o[3], f.along_x), add(o[4], f.along_y);
+    add_planar_force(m.frame, f, Q);
     if (planar) planar[m.part] = f;
   }
   if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);

@@ -165,7 +165,7 @@ bool same_planar_force(const detail::MassivePart& whole, const detail::MassivePa
 
 }  // namespace
 
-void JointReactions::find_body_parts(const Model& model, const OutputEfforts& efforts, bool rigid_bars) {
+void JointReactions::find_body_parts(const Model& model, const OutputEfforts& efforts, const detail::BarLengths& bars) {
   const std::vector<NaturalBody>& bodies = natural_->bodies;
   body_parts_.assign(bodies.size(), {});
   if (!efforts.parts || !efforts.loads) return;
@@ -181,8 +181,6 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
     const auto it = by_name.find(body.name);
     return it == by_name.end() ? BodyPart::kNone : it->second;
   };
-  // as the sweep's Q (detail::PartForces) finds them
-  const detail::BarLengths bars = rigid_bars ? detail::BarLengths(model) : detail::BarLengths();
   for (std::size_t b = 0; b < bodies.size(); ++b) {
     const NaturalBody& body = bodies[b];
     const kin3::V3 own_g = body.loads.gravity;
@@ -199,8 +197,7 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
         own.frame.body)
       continue;
     BodyPart& bp = body_parts_[b];
-    bp.part = index, bp.x_is_point = own.frame.x_is_point, bp.bar = own.frame.bar,
-    bp.applied = body.loads.applied.get();
+    bp.part = index, bp.x_is_point = own.frame.x_is_point, bp.applied = body.loads.applied.get();
     std::copy(own.frame.slots, own.frame.slots + 5, bp.slots);
   }
 }
@@ -352,22 +349,21 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
   // where that row is the body's (not the joints', as when another body holds the same coordinates: a second part
   // on the bar's two points, two bars from fixed points to one point): else no bar takes that form, in Q either
   // (rigid_bars())
-  if (rigid_bars) {
-    const detail::BarLengths bars(model);
-    for (std::size_t b = 0; b < nb && rigid_bars; ++b) {
-      const detail::BarLengths::Bar* bar = bars.find(bodies[b].frame);
-      rigid_bars = !bar || bodies[b].parts.empty() || owner[bar->constraint] == b;
-    }
+  detail::BarLengths bars = rigid_bars ? detail::BarLengths(model) : detail::BarLengths();
+  for (std::size_t b = 0; b < nb && rigid_bars; ++b) {
+    const detail::BarLengths::Bar* bar = bars.find(bodies[b].frame);
+    rigid_bars = !bar || bodies[b].parts.empty() || owner[bar->constraint] == b;
   }
   rigid_bars_ = rigid_bars;
-  find_body_parts(model, efforts, rigid_bars);
+  if (!rigid_bars) bars = detail::BarLengths();  // (as the sweep's Q, detail::PartForces, then takes them: none)
+  find_body_parts(model, efforts, bars);
   find_flat_sites(model);
 }
 
 detail::PlanarFrame JointReactions::BodyPart::frame() const {
   detail::PlanarFrame f;
   std::copy(slots, slots + 5, f.slots);
-  f.body = false, f.x_is_point = x_is_point, f.bar = bar;
+  f.body = false, f.x_is_point = x_is_point, f.bar = bar_length > 0.0;
   return f;
 }
 
