@@ -57,12 +57,12 @@ class JointReactions {
   static JointReactions with_set_up_of(const JointReactions& other) { return JointReactions(other, SetUpOnly{}); }
   /// The values evaluate() writes: per constraint, Fx, Fy, Mz (N, N·m) for a planar joint, Fx, Fy, Fz, Mx, My, Mz
   /// for a spatial one.
-  Index size() const { return size_; }
+  Index size() const { return set_->size; }
   /// Whether the k-th listed joint is spatial (6 values) rather than planar (3).
-  bool spatial(std::size_t k) const { return sites_[k].spatial; }
+  bool spatial(std::size_t k) const { return set_->sites[k].spatial; }
   /// Whether evaluate()'s `planar` may come from a Q with rigid bars: as constructed, unless a natural body with
   /// mass on a bar does not own the bar's row (internal: the sweep then takes no bar in Q).
-  bool rigid_bars() const { return rigid_bars_; }
+  bool rigid_bars() const { return set_->rigid_bars; }
   /// Writes the reactions at (q, t) under multipliers `lambda` (one per model row) to out[0, size()).
   /// Pre-condition: q has the model's coordinates; the model is the one given to the constructor.
   /// No natural joint may be listed (they read q̇ and q̈: the overload below; else phiq::Error).
@@ -92,7 +92,7 @@ class JointReactions {
   struct NaturalSite {
     static constexpr int kMaxTerms = 3;   // per component (a point is at most an origin and an x target)
     static constexpr int kMaxMoving = 4;  // a fixed component's moving points
-    std::size_t joint = 0, body = 0;      // in natural_
+    std::size_t joint = 0, body = 0;      // in SetUp::natural
     std::size_t point = 0;                // the joint's place among the body's points
     Index at[3] = {0, 0, 0};              // its components' coordinates (n and above: promoted constants)
     std::size_t part = 0;                 // the flat form's part (OutputEfforts::parts)
@@ -101,13 +101,35 @@ class JointReactions {
     std::uint8_t moving_count[2] = {0, 0};
     bool shared[2] = {false, false};
     Index moving[2][kMaxMoving] = {};
+    // Its sums of the body's own constraints' forces, Σ Φq values × λ over BodyRows::FlatSums' groups: component k's
+    // are groups [group_first[k], group_first[k + 1]), one for a moving component (its coordinate's), one per moving
+    // point for a fixed one; each sums the body's entries in its column, in their order, as the general path's g_
+    std::uint32_t group_first[3] = {0, 0, 0};
   };
-  // The natural bodies' own constraints, and the columns they and the bodies' forces touch, body b's at
-  // [first[b], first[b + 1]) of each list (flat: one allocation per list, not per body).
+  // The natural bodies' own constraints' Jacobian entries and the columns the bodies' forces touch, body b's at
+  // [first[b], first[b + 1]) of each list (flat: one allocation per list, not per body). An entry is a value's slot in
+  // Φq's pattern, its row and column, in the pattern's order (by column, then row: a column's sum over the body's
+  // constraints runs in their order, as their rows do). `runs`: the constraints of the bodies a site reports on, as
+  // ranges of one block, whose Jacobian a row evaluates once (one call per range, not per site).
+  struct OwnEntry {
+    Index slot = 0, row = 0, column = 0;
+  };
+  struct OwnRun {
+    const ConstraintBlock* block = nullptr;
+    std::size_t begin = 0, end = 0;
+  };
   struct BodyRows {
-    std::vector<std::size_t> constraints_first, g_first, q_first;
-    std::vector<std::pair<const ConstraintBlock*, std::size_t>> constraints;
-    std::vector<Index> g_columns, q_columns;
+    std::vector<std::size_t> entries_first, q_first;
+    std::vector<OwnEntry> entries;
+    std::vector<Index> q_columns;
+    std::vector<OwnRun> runs;
+    // the flat sites' sums (NaturalSite::group_first): group g's entries are terms[term_first[g] … term_first[g + 1])
+    struct FlatSums {
+      std::vector<std::uint32_t> term_first{0};
+      std::vector<OwnEntry> terms;
+    } flat;
+    const EntryIndex* slot_of_entry = nullptr;  // the model's (Model::slot_of_entry())
+    bool overwrite = false;                     // no two entries of the model share a slot (Model::jacobian())
   };
   // A natural body's part as OutputEfforts::parts' has it: `part` its index there when the whole model's Q computes
   // the body's weight and inertia (evaluate()'s `planar`) as the body's own Q would, bit for bit, else none; `slots`
@@ -134,11 +156,14 @@ class JointReactions {
   // `bars`: the model's rigid bars where the sweep's Q takes them (else empty)
   void find_body_parts(const Model& model, const OutputEfforts& efforts, const detail::BarLengths& bars);
   void find_flat_sites(const Model& model);
+  // s's groups (NaturalSite::group_first), for a model of n coordinates
+  void add_flat_sums(NaturalSite& s, Index n);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);
-  // g_ += Φq,cᵀ λ_c over body b's own constraints at `q` (with or without the promoted constants), and g_'s entries
-  // those touch cleared again
-  void add_body_constraint_forces(std::size_t b, const double* q, double t, const Eigen::VectorXd& lambda);
+  // own_values_ = Φq's values of BodyRows::runs at (q, t), once a row
+  void evaluate_own_jacobian(const double* q, double t);
+  // g_ += Φq,cᵀ λ_c over body b's own constraints (own_values_), and g_'s entries those touch cleared again
+  void add_body_constraint_forces(std::size_t b, const Eigen::VectorXd& lambda);
   void clear_body_constraint_forces(std::size_t b);
   // The row's motion: q, q̇, q̈ copied into qx_, qdx_, qddx_ at the first site that reads them (a row of flat sites
   // reads q alone).
@@ -150,18 +175,25 @@ class JointReactions {
                         const detail::PlanarForce* planar, double*& out);
   bool evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,
                      const detail::PlanarForce* planar, double* out);
-  std::vector<Site> sites_;
-  std::vector<NaturalSite> natural_sites_;
-  std::vector<std::pair<bool, std::size_t>> order_;  // (natural, index) per listed reaction
-  std::shared_ptr<const NaturalJoints> natural_;
-  BodyRows body_rows_;
-  std::vector<BodyPart> body_parts_;      // per natural body
-  bool joint_axes_ = false;               // constraints' reactions along ReactionSite::axes, not world axes
-  bool rigid_bars_ = false;               // rigid_bars()
+  // What construction finds, never written after it: shared by with_set_up_of()'s copies (a sweep's chunks), which
+  // have scratch of their own. At nfourbar 10⁴ it is megabytes, which a copy per chunk would have the system map in
+  // again and again.
+  struct SetUp {
+    std::vector<Site> sites;
+    std::vector<NaturalSite> natural_sites;
+    std::vector<std::pair<bool, std::size_t>> order;  // (natural, index) per listed reaction
+    std::shared_ptr<const NaturalJoints> natural;
+    BodyRows body_rows;
+    std::vector<BodyPart> body_parts;  // per natural body
+    bool joint_axes = false;           // constraints' reactions along ReactionSite::axes, not world axes
+    bool rigid_bars = false;           // rigid_bars()
+    Index size = 0;
+  };
+  std::shared_ptr<SetUp> set_ = std::make_shared<SetUp>();
   Eigen::VectorXd qx_, qdx_, qddx_, qb_;  // q, q̇, q̈ with the promoted constants; a body's Q
-  Index size_ = 0;
-  std::vector<double> g_;  // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
-  PartJacobian jac_;       // the body's frame Jacobian (its capacity kept: no allocation per row)
+  std::vector<double> g_;                 // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
+  std::vector<double> own_values_;        // Φq's values (its pattern's slots) of the natural bodies' own constraints
+  PartJacobian jac_;                      // the body's frame Jacobian (its capacity kept: no allocation per row)
 };
 
 /// The multipliers of least norm among those with Φqᵀ λ = Q, from `lambda`, one of them (λ = 0 on the rows the model

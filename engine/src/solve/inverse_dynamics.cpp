@@ -186,6 +186,7 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
 
 detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars) {
   const BarLengths bars = rigid_bars ? BarLengths(model) : BarLengths();
+  massive_.reserve(parts.size());
   for (std::size_t i = 0; i < parts.size(); ++i)
     if (has_mass(parts[i])) massive_.push_back(massive_part(parts[i], i, bars.of(parts[i].frame)));
 }

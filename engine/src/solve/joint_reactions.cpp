@@ -37,10 +37,10 @@ void JointReactions::add_site(const Model& model, Index c, std::vector<int>& sit
   Site s;
   s.block = b, s.index = i;
   s.spatial = b->reaction_width() == 6;
-  size_ += b->reaction_width();
-  site_of[static_cast<std::size_t>(c)] = static_cast<int>(sites_.size());
-  order_.push_back({false, sites_.size()});
-  sites_.push_back(std::move(s));
+  set_->size += b->reaction_width();
+  site_of[static_cast<std::size_t>(c)] = static_cast<int>(set_->sites.size());
+  set_->order.push_back({false, set_->sites.size()});
+  set_->sites.push_back(std::move(s));
 }
 
 void JointReactions::find_columns(const Model& model, const std::vector<int>& site_of) {
@@ -49,9 +49,9 @@ void JointReactions::find_columns(const Model& model, const std::vector<int>& si
   for (Index j = 0; j < p.cols; ++j)
     for (Index k = p.col_ptr[static_cast<std::size_t>(j)]; k < p.col_ptr[static_cast<std::size_t>(j) + 1]; ++k) {
       const int s = site_of[static_cast<std::size_t>(model.constraint_of_row(p.row_idx[static_cast<std::size_t>(k)]))];
-      if (s >= 0 && (sites_[static_cast<std::size_t>(s)].columns.empty() ||
-                     sites_[static_cast<std::size_t>(s)].columns.back() != j))
-        sites_[static_cast<std::size_t>(s)].columns.push_back(j);
+      if (s >= 0 && (set_->sites[static_cast<std::size_t>(s)].columns.empty() ||
+                     set_->sites[static_cast<std::size_t>(s)].columns.back() != j))
+        set_->sites[static_cast<std::size_t>(s)].columns.push_back(j);
     }
 }
 
@@ -63,9 +63,8 @@ JointReactions::JointReactions(const Model& model, std::vector<Index> constraint
 }
 
 JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts, bool rigid_bars)
-    : joint_axes_(efforts.reactions_in_joint_axes),
-      rigid_bars_(rigid_bars),
-      g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
+    : g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
+  set_->joint_axes = efforts.reactions_in_joint_axes, set_->rigid_bars = rigid_bars;
   std::vector<int> site_of(model.constraints().size(), -1);
   for (const OutputReaction& r : efforts.reactions) {
     if (r.natural < 0) {
@@ -94,42 +93,34 @@ JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts,
     if (s.point == body.points.size())
       throw Error("JointReactions: natural joint '" + j.name + "' is not a point of '" + body.name + "'");
     for (int d = 0; d < (efforts.natural->spatial ? 3 : 2); ++d) s.at[d] = body.points[s.point].r[d].coord();
-    size_ += efforts.natural->spatial ? 6 : 3;
-    order_.push_back({true, natural_sites_.size()});
-    natural_sites_.push_back(s);
+    set_->size += efforts.natural->spatial ? 6 : 3;
+    set_->order.push_back({true, set_->natural_sites.size()});
+    set_->natural_sites.push_back(s);
   }
   find_columns(model, site_of);
-  if (!natural_sites_.empty()) add_natural(model, efforts, rigid_bars);
+  if (!set_->natural_sites.empty()) add_natural(model, efforts, rigid_bars);
 }
 
 JointReactions::JointReactions(const JointReactions& other, SetUpOnly)
-    : sites_(other.sites_),
-      natural_sites_(other.natural_sites_),
-      order_(other.order_),
-      natural_(other.natural_),
-      body_rows_(other.body_rows_),
-      body_parts_(other.body_parts_),
-      joint_axes_(other.joint_axes_),
-      rigid_bars_(other.rigid_bars_),
-      size_(other.size_),
-      g_(other.g_.size(), 0.0) {
-  if (!natural_sites_.empty()) size_natural_scratch();
+    : set_(other.set_), g_(other.g_.size(), 0.0), own_values_(other.own_values_.size(), 0.0) {
+  if (!set_->natural_sites.empty()) size_natural_scratch();
 }
 
 void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out) {
-  if (!natural_sites_.empty())
+  if (!set_->natural_sites.empty())
     throw Error("JointReactions::evaluate: natural joints read q̇ and q̈: give them (phiq bug)");
-  for (const Site& s : sites_) evaluate_site(s, q, t, lambda, out);
+  for (const Site& s : set_->sites) evaluate_site(s, q, t, lambda, out);
 }
 
 void JointReactions::evaluate(const double* q, const double* qd, const double* qdd, double t,
                               const Eigen::VectorXd& lambda, double* out, const detail::PlanarForce* planar) {
   RowMotion row{q, qd, qdd, false};
-  for (const auto& [natural, k] : order_)
+  evaluate_own_jacobian(q, t);
+  for (const auto& [natural, k] : set_->order)
     if (natural)
-      evaluate_natural(natural_sites_[k], row, t, lambda, planar, out);
+      evaluate_natural(set_->natural_sites[k], row, t, lambda, planar, out);
     else
-      evaluate_site(sites_[k], q, t, lambda, out);
+      evaluate_site(set_->sites[k], q, t, lambda, out);
 }
 
 void JointReactions::evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda,
@@ -160,7 +151,7 @@ void JointReactions::evaluate_site(const Site& s, const double* q, double t, con
     const V3 moment_o{w(3), w(4), w(5)};
     const V3 at = part_pose(frame, q, t).at;
     V3 moment = moment_o + cross(at - rs.point, force);
-    if (joint_axes_) {  // the same force and moment, their components along the joint's own axes
+    if (set_->joint_axes) {  // the same force and moment, their components along the joint's own axes
       const V3 f = force, m = moment;
       force = {dot(rs.axes[0], f), dot(rs.axes[1], f), dot(rs.axes[2], f)};
       moment = {dot(rs.axes[0], m), dot(rs.axes[1], m), dot(rs.axes[2], m)};

@@ -166,8 +166,8 @@ bool same_planar_force(const detail::MassivePart& whole, const detail::MassivePa
 }  // namespace
 
 void JointReactions::find_body_parts(const Model& model, const OutputEfforts& efforts, const detail::BarLengths& bars) {
-  const std::vector<NaturalBody>& bodies = natural_->bodies;
-  body_parts_.assign(bodies.size(), {});
+  const std::vector<NaturalBody>& bodies = set_->natural->bodies;
+  set_->body_parts.assign(bodies.size(), {});
   if (!efforts.parts || !efforts.loads) return;
   const std::vector<Part>& parts = *efforts.parts;
   const kin3::V3 g = efforts.loads->gravity;
@@ -185,7 +185,7 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
     const NaturalBody& body = bodies[b];
     const kin3::V3 own_g = body.loads.gravity;
     const double bar = bars.of(body.frame);  // (its frame before promotion: the model's slots)
-    body_parts_[b].bar_length = bar;
+    set_->body_parts[b].bar_length = bar;
     const std::size_t index = part_of(body);
     if (body.parts.size() != 1 || index == BodyPart::kNone || !detail::has_mass(body.parts[0]) ||
         !detail::has_mass(parts[index]) || !same_bits(g.x, own_g.x) || !same_bits(g.y, own_g.y) ||
@@ -193,24 +193,24 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
       continue;
     const detail::MassivePart own = detail::massive_part(body.parts[0], 0, bar);
     if (!same_planar_force(detail::massive_part(parts[index], index, bars.of(parts[index].frame)), own,
-                           natural_->promoted, model.num_coordinates()) ||
+                           set_->natural->promoted, model.num_coordinates()) ||
         own.frame.body)
       continue;
-    BodyPart& bp = body_parts_[b];
+    BodyPart& bp = set_->body_parts[b];
     bp.part = index, bp.x_is_point = own.frame.x_is_point, bp.applied = body.loads.applied.get();
     std::copy(own.frame.slots, own.frame.slots + 5, bp.slots);
   }
 }
 
 void JointReactions::find_flat_sites(const Model& model) {
-  if (natural_->spatial) return;
-  for (NaturalSite& s : natural_sites_) {
-    const BodyPart& part = body_parts_[s.body];
+  if (set_->natural->spatial) return;
+  for (NaturalSite& s : set_->natural_sites) {
+    const BodyPart& part = set_->body_parts[s.body];
     s.flat = false;
     if (part.part == BodyPart::kNone || part.applied) continue;
     bool fits = true;
     s.count[0] = s.count[1] = 0;
-    const NaturalBody& body = natural_->bodies[s.body];
+    const NaturalBody& body = set_->natural->bodies[s.body];
     for (int k = 0; k < 2; ++k) {  // a fixed component's moving points, as evaluate_natural() sums them
       s.moving_count[k] = 0, s.shared[k] = false;
       if (s.at[k] < model.num_coordinates()) continue;
@@ -235,22 +235,41 @@ void JointReactions::find_flat_sites(const Model& model) {
       }
     });
     s.part = part.part, s.flat = fits;
+    if (fits) add_flat_sums(s, model.num_coordinates());
   }
 }
 
+void JointReactions::add_flat_sums(NaturalSite& s, Index n) {
+  BodyRows::FlatSums& sums = set_->body_rows.flat;
+  const BodyRows& rows = set_->body_rows;
+  auto add_group = [&](Index column) {  // the body's entries in `column`, in their order
+    for (std::size_t k = rows.entries_first[s.body]; k < rows.entries_first[s.body + 1]; ++k)
+      if (rows.entries[k].column == column) sums.terms.push_back(rows.entries[k]);
+    sums.term_first.push_back(static_cast<std::uint32_t>(sums.terms.size()));
+  };
+  for (int k = 0; k < 2; ++k) {
+    s.group_first[k] = static_cast<std::uint32_t>(sums.term_first.size() - 1);
+    if (s.at[k] < n)
+      add_group(s.at[k]);
+    else
+      for (int i = 0; i < s.moving_count[k]; ++i) add_group(s.moving[k][i]);
+  }
+  s.group_first[2] = static_cast<std::uint32_t>(sums.term_first.size() - 1);
+}
+
 void JointReactions::size_natural_scratch() {
-  const Index n = static_cast<Index>(g_.size()), extra = static_cast<Index>(natural_->promoted.size());
+  const Index n = static_cast<Index>(g_.size()), extra = static_cast<Index>(set_->natural->promoted.size());
   qx_.setZero(n + extra), qdx_.setZero(n + extra), qddx_.setZero(n + extra), qb_.setZero(n + extra);
-  for (Index k = 0; k < extra; ++k) qx_(n + k) = natural_->promoted[static_cast<std::size_t>(k)];
+  for (Index k = 0; k < extra; ++k) qx_(n + k) = set_->natural->promoted[static_cast<std::size_t>(k)];
 }
 
 void JointReactions::add_natural(const Model& model, const OutputEfforts& efforts, bool rigid_bars) {
-  natural_ = efforts.natural;
+  set_->natural = efforts.natural;
   size_natural_scratch();
   const Index n = model.num_coordinates();
-  const std::vector<NaturalBody>& bodies = natural_->bodies;
+  const std::vector<NaturalBody>& bodies = set_->natural->bodies;
   const std::size_t nb = bodies.size(), nc = model.constraints().size();
-  BodyRows& rows = body_rows_;
+  BodyRows& rows = set_->body_rows;
   // each body's point coordinates (the model's, sorted: `coords` from coords_first[b]), which coordinates are a
   // point's at all, and the columns the body's forces touch (its frame's coordinates, promoted ones included)
   std::vector<std::size_t> coords_first(nb + 1, 0);
@@ -304,7 +323,6 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
   // a constraint is the body's whose points hold all the point coordinates it reads, the fewest of them: among
   // the bodies that hold its first
   std::vector<std::size_t> owner(nc, nb);
-  rows.constraints_first.assign(nb + 1, 0), rows.g_first.assign(nb + 1, 0);
   for (std::size_t c = 0; c < nc; ++c) {
     const Index* read = all.data() + all_first[c];
     const Index* read_end = all.data() + all_first[c + 1];
@@ -333,18 +351,40 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
     }
     if (best == nb || tie) continue;  // the joints' own: acts at the points bodies share
     owner[c] = best;
-    ++rows.constraints_first[best + 1], rows.g_first[best + 1] += all_first[c + 1] - all_first[c];
   }
-  counts_to_offsets(rows.constraints_first), counts_to_offsets(rows.g_first);
-  rows.constraints.resize(rows.constraints_first[nb]), rows.g_columns.resize(rows.g_first[nb]);
-  std::vector<std::size_t> next_constraint(rows.constraints_first.begin(), rows.constraints_first.end() - 1),
-      next_g(rows.g_first.begin(), rows.g_first.end() - 1);
+  // each body's own constraints' Jacobian entries, in the pattern's order (counted, then filled)
+  auto each_own_entry = [&](auto&& visit) {  // visit(b, entry)
+    for (Index j = 0; j < pat.cols; ++j)
+      for (Index k = pat.col_ptr[static_cast<std::size_t>(j)]; k < pat.col_ptr[static_cast<std::size_t>(j) + 1]; ++k) {
+        const Index r = pat.row_idx[static_cast<std::size_t>(k)];
+        const std::size_t b = owner[static_cast<std::size_t>(model.constraint_of_row(r))];
+        if (b != nb) visit(b, OwnEntry{k, r, j});
+      }
+  };
+  rows.entries_first.assign(nb + 1, 0);
+  each_own_entry([&](std::size_t b, const OwnEntry&) { ++rows.entries_first[b + 1]; });
+  counts_to_offsets(rows.entries_first);
+  rows.entries.resize(rows.entries_first[nb]);
+  {
+    std::vector<std::size_t> next(rows.entries_first.begin(), rows.entries_first.end() - 1);
+    each_own_entry([&](std::size_t b, const OwnEntry& e) { rows.entries[next[b]++] = e; });
+  }
+  // the constraints of the bodies sites report on, as ranges of one block (the model lists a block's constraints
+  // in order, so ranges follow the constraints' order)
+  std::vector<char> reported(nb, 0);
+  for (const NaturalSite& s : set_->natural_sites) reported[s.body] = 1;
+  rows.runs.clear();
   for (std::size_t c = 0; c < nc; ++c) {
-    const std::size_t b = owner[c];
-    if (b == nb) continue;
-    rows.constraints[next_constraint[b]++] = model.constraint_block(static_cast<Index>(c));
-    for (std::size_t k = all_first[c]; k < all_first[c + 1]; ++k) rows.g_columns[next_g[b]++] = all[k];
+    if (owner[c] == nb || !reported[owner[c]]) continue;
+    const auto [block, i] = model.constraint_block(static_cast<Index>(c));
+    if (!rows.runs.empty() && rows.runs.back().block == block && rows.runs.back().end == i)
+      ++rows.runs.back().end;
+    else
+      rows.runs.push_back({block, i, i + 1});
   }
+  rows.slot_of_entry = model.slot_of_entry().data();
+  rows.overwrite = static_cast<Index>(model.slot_of_entry().size()) == pat.nnz();
+  own_values_.assign(static_cast<std::size_t>(pat.nnz()), 0.0);
   // A rigid bar's Q differs from its frame's by a multiple of its own row, which its body's reactions take back only
   // where that row is the body's (not the joints', as when another body holds the same coordinates: a second part
   // on the bar's two points, two bars from fixed points to one point): else no bar takes that form, in Q either
@@ -354,7 +394,7 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
     const detail::BarLengths::Bar* bar = bars.find(bodies[b].frame);
     rigid_bars = !bar || bodies[b].parts.empty() || owner[bar->constraint] == b;
   }
-  rigid_bars_ = rigid_bars;
+  set_->rigid_bars = rigid_bars;
   if (!rigid_bars) bars = detail::BarLengths();  // (as the sweep's Q, detail::PartForces, then takes them: none)
   find_body_parts(model, efforts, bars);
   find_flat_sites(model);
@@ -368,7 +408,7 @@ detail::PlanarFrame JointReactions::BodyPart::frame() const {
 }
 
 void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarForce* planar) {
-  const BodyPart& part = body_parts_[b];
+  const BodyPart& part = set_->body_parts[b];
   if (planar && part.part != BodyPart::kNone && planar[part.part].valid) {
     // the whole model's Q computed the part's force at this row: added at the promoted frame's slots, as
     // add_generalized_forces() of the body's part adds it
@@ -376,7 +416,7 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
     if (part.applied) add_applied_forces(*part.applied, qx_.data(), qdx_.data(), t, qb_);
     return;
   }
-  const NaturalBody& body = natural_->bodies[b];
+  const NaturalBody& body = set_->natural->bodies[b];
   if (planar && part.bar_length > 0.0 && body.parts.size() == 1) {
     // a rigid bar whose force the sweep's Q took in its constant mass matrix's form (not found among its parts):
     // the same form, which λ was solved with
@@ -388,17 +428,26 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
   add_generalized_forces(body.parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
 }
 
-void JointReactions::add_body_constraint_forces(std::size_t b, const double* q, double t,
-                                                const Eigen::VectorXd& lambda) {
-  const BodyRows& rows = body_rows_;
-  for (std::size_t k = rows.constraints_first[b]; k < rows.constraints_first[b + 1]; ++k)
-    rows.constraints[k].first->add_transposed_product(rows.constraints[k].second, q, t, lambda.data(), g_.data());
+void JointReactions::evaluate_own_jacobian(const double* q, double t) {
+  const BodyRows& rows = set_->body_rows;
+  if (rows.runs.empty()) return;
+  if (!rows.overwrite) std::fill(own_values_.begin(), own_values_.end(), 0.0);  // (entries that share a slot add)
+  for (const OwnRun& r : rows.runs)
+    r.block->jacobian(r.begin, r.end, q, t, rows.slot_of_entry, own_values_.data(), rows.overwrite);
+}
+
+void JointReactions::add_body_constraint_forces(std::size_t b, const Eigen::VectorXd& lambda) {
+  const BodyRows& rows = set_->body_rows;
+  for (std::size_t k = rows.entries_first[b]; k < rows.entries_first[b + 1]; ++k) {
+    const OwnEntry& e = rows.entries[k];
+    g_[static_cast<std::size_t>(e.column)] += own_values_[static_cast<std::size_t>(e.slot)] * lambda(e.row);
+  }
 }
 
 void JointReactions::clear_body_constraint_forces(std::size_t b) {
-  const BodyRows& rows = body_rows_;
-  for (std::size_t k = rows.g_first[b]; k < rows.g_first[b + 1]; ++k)
-    g_[static_cast<std::size_t>(rows.g_columns[k])] = 0.0;
+  const BodyRows& rows = set_->body_rows;
+  for (std::size_t k = rows.entries_first[b]; k < rows.entries_first[b + 1]; ++k)
+    g_[static_cast<std::size_t>(rows.entries[k].column)] = 0.0;
 }
 
 ReactionSite natural_reaction_site(const NaturalJoints& joints, std::size_t j, const double* q, double t) {
@@ -412,16 +461,21 @@ ReactionSite natural_reaction_site(const NaturalJoints& joints, std::size_t j, c
 
 // A natural joint's force (world axes) along its body's axes, where the output asks (natural_reaction_site()).
 void JointReactions::turn_natural(const NaturalSite& s, const double* q, double t, double* force) const {
-  const ReactionSite rs = natural_reaction_site(*natural_, s.joint, q, t);
-  const kin3::V3 f{force[0], force[1], natural_->spatial ? force[2] : 0.0};
-  for (int k = 0; k < (natural_->spatial ? 3 : 2); ++k) force[k] = kin3::dot(rs.axes[k], f);
+  const ReactionSite rs = natural_reaction_site(*set_->natural, s.joint, q, t);
+  const kin3::V3 f{force[0], force[1], set_->natural->spatial ? force[2] : 0.0};
+  for (int k = 0; k < (set_->natural->spatial ? 3 : 2); ++k) force[k] = kin3::dot(rs.axes[k], f);
 }
 
 bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,
                                    const detail::PlanarForce* planar, double* out) {
   if (!planar || !planar[s.part].valid) return false;
-  // (q, not qx_: a constraint reads the model's coordinates alone, promoted constants being the bodies')
-  add_body_constraint_forces(s.body, q, t, lambda);
+  const BodyRows::FlatSums& sums = set_->body_rows.flat;
+  auto group_sum = [&](std::uint32_t g) {  // g_ at a column, as add_body_constraint_forces() sums it (from +0)
+    double sum = 0.0;
+    for (std::uint32_t k = sums.term_first[g]; k < sums.term_first[g + 1]; ++k)
+      sum += own_values_[static_cast<std::size_t>(sums.terms[k].slot)] * lambda(sums.terms[k].row);
+    return sum;
+  };
   const detail::PlanarForce& f = planar[s.part];
   for (int k = 0; k < 2; ++k) {
     double qb = 0.0;  // Q_b at the component, as body_forces() sums it into qb_ (from +0)
@@ -430,16 +484,15 @@ bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double
       qb += (s.terms[k][i] & 8) ? -v : v;
     }
     if (s.at[k] < static_cast<Index>(g_.size())) {
-      out[k] = g_[static_cast<std::size_t>(s.at[k])] - qb;
+      out[k] = group_sum(s.group_first[k]) - qb;
       continue;
     }
     double moving = 0.0;  // a fixed component: as evaluate_natural() sums it
-    for (int i = 0; i < s.moving_count[k]; ++i) moving += g_[static_cast<std::size_t>(s.moving[k][i])];
+    for (std::uint32_t g = s.group_first[k]; g < s.group_first[k + 1]; ++g) moving += group_sum(g);
     out[k] = s.shared[k] ? std::numeric_limits<double>::quiet_NaN() : -moving - qb;
   }
   out[2] = 0.0;
-  if (joint_axes_) turn_natural(s, q, t, out);
-  clear_body_constraint_forces(s.body);
+  if (set_->joint_axes) turn_natural(s, q, t, out);
   return true;
 }
 
@@ -449,7 +502,7 @@ void JointReactions::evaluate_natural(const NaturalSite& s, RowMotion& row, doub
     out += 3;
     return;
   }
-  const BodyRows& rows = body_rows_;
+  const BodyRows& rows = set_->body_rows;
   const Index n = static_cast<Index>(g_.size());
   if (!row.extended) {
     qx_.head(n) = Eigen::Map<const Eigen::VectorXd>(row.q, n);
@@ -457,17 +510,17 @@ void JointReactions::evaluate_natural(const NaturalSite& s, RowMotion& row, doub
     qddx_.head(n) = Eigen::Map<const Eigen::VectorXd>(row.qdd, n);
     row.extended = true;
   }
-  add_body_constraint_forces(s.body, qx_.data(), t, lambda);
+  add_body_constraint_forces(s.body, lambda);
   body_forces(s.body, t, planar);
   double force[3] = {0.0, 0.0, 0.0};
-  for (int k = 0; k < (natural_->spatial ? 3 : 2); ++k) {
+  for (int k = 0; k < (set_->natural->spatial ? 3 : 2); ++k) {
     const Index at = s.at[k];
     if (at < n) {  // R = Σ_c (Φq,cᵀ λ_c)(P) − Q_b(P)
       force[k] = g_[static_cast<std::size_t>(at)] - qb_(at);
       continue;
     }
     // a constant component: ∂Φ_c/∂P_k = −Σ over the body's moving points' k-components (translation invariance)
-    const NaturalBody& body = natural_->bodies[s.body];
+    const NaturalBody& body = set_->natural->bodies[s.body];
     const Attachment3& p = body.points[s.point];
     double moving = 0.0;
     bool shared = false;  // another point of the body constant along k: the load's split between them is open
@@ -480,8 +533,8 @@ void JointReactions::evaluate_natural(const NaturalSite& s, RowMotion& row, doub
     }
     force[k] = shared ? std::numeric_limits<double>::quiet_NaN() : -moving - qb_(at);
   }
-  if (joint_axes_) turn_natural(s, row.q, t, force);
-  if (natural_->spatial) {
+  if (set_->joint_axes) turn_natural(s, row.q, t, force);
+  if (set_->natural->spatial) {
     for (double v : {force[0], force[1], force[2], 0.0, 0.0, 0.0}) *out++ = v;
   } else {
     for (double v : {force[0], force[1], 0.0}) *out++ = v;

@@ -11,13 +11,13 @@ namespace phiq::detail {
 
 Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSummary& sum, const Sweeper* like)
     : model_(m), opt_(o), ws_(&ws), sum_(sum), effort_work_(dropped_efforts(), written_reactions(like)) {
-  // Q's parts, gathered once a sweep: `like`'s (set in its constructor, never written after: safe to copy while it
-  // runs on another thread)
+  // Q's parts, gathered once a sweep and shared by its chunks' sweepers (`like`'s: set in its constructor, never
+  // written after, so safe to share while it runs on another thread)
   if (opt_.efforts.active() && opt_.efforts.parts)
     effort_work_.forces = same_sweep(like) && like->effort_work_.forces
                               ? like->effort_work_.forces
-                              : std::optional<PartForces>(
-                                    std::in_place, *opt_.efforts.parts, model_,
+                              : std::make_shared<const PartForces>(
+                                    *opt_.efforts.parts, model_,
                                     rigid_bars() && (!effort_work_.reactions || effort_work_.reactions->rigid_bars()));
   // what Q's planar parts add, kept for the natural joints' reactions to read (row_reactions())
   if (effort_work_.reactions && opt_.efforts.natural && opt_.efforts.parts)

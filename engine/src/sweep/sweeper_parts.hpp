@@ -160,8 +160,8 @@ struct EffortWork {
   EffortWork(std::vector<std::size_t> dropped_efforts, std::optional<JointReactions> written_reactions)
       : dropped(std::move(dropped_efforts)), reactions(std::move(written_reactions)) {}
   EffortSensitivityScratch sensitivity_scratch;
-  Eigen::VectorXd q, kept, lambda, phi_t;  // Q, the kept rows, λ, Φt
-  std::optional<PartForces> forces;        // Q's parts, gathered when the sweeper is made
+  Eigen::VectorXd q, kept, lambda, phi_t;    // Q, the kept rows, λ, Φt
+  std::shared_ptr<const PartForces> forces;  // Q's parts, gathered once a sweep (Sweeper's constructor)
   // what Q's parts on planar frames added, one per part, when natural joints' reactions read their bodies' (else
   // empty)
   std::vector<PlanarForce> planar;
