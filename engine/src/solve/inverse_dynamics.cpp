@@ -59,14 +59,7 @@ bool add_planar_virtual_work(const PartFrame& f, const double* q, V3 c, V3 force
                                              detail::PlanarForce& f) {
   auto accel = [&](const Slot& s) { return s.is_coordinate() && qdd ? qdd[s.coord()] : 0.0; };
   const Slot *o = p.frame.slots, *x = o + 3;
-  const double aox = accel(o[0]), aoy = accel(o[1]), axx = accel(x[0]), axy = accel(x[1]);
-  const double gx = gravity.x, gy = gravity.y;  // (R v = (−v_y, v_x), the quarter turn)
-  f.fx = (p.m_o * gx - p.m_b * gy) - (p.oo * aox + p.ox * axx - p.m_b * axy);
-  f.fy = (p.m_o * gy + p.m_b * gx) - (p.oo * aoy + p.ox * axy + p.m_b * axx);
-  f.along_x = (p.m_x * gx + p.m_b * gy) - (p.ox * aox + p.m_b * aoy + p.xx * axx);
-  f.along_y = (p.m_x * gy - p.m_b * gx) - (p.ox * aoy - p.m_b * aox + p.xx * axy);
-  f.fz = p.mass * gravity.z, f.turn = 0.0;
-  f.valid = true;
+  detail::bar_force_at(p, accel(o[0]), accel(o[1]), accel(x[0]), accel(x[1]), gravity, f);
 }
 
 // The force of a part on a planar frame from the frame's motion in scalars (parts/planar_motion.hpp): what
@@ -186,22 +179,54 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
 
 detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars) {
   const BarLengths bars = rigid_bars ? BarLengths(model) : BarLengths();
-  massive_.reserve(parts.size());
-  for (std::size_t i = 0; i < parts.size(); ++i)
-    if (has_mass(parts[i])) massive_.push_back(massive_part(parts[i], i, bars.of(parts[i].frame)));
+  if (rigid_bars)  // (capacity that is not written is not mapped in)
+    bars_.reserve(parts.size());
+  else
+    massive_.reserve(parts.size());
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (!has_mass(parts[i])) continue;
+    const MassivePart m = massive_part(parts[i], i, bars.of(parts[i].frame));
+    const bool bar = m.frame.bar;
+    if (runs_.empty() || runs_.back().bars != bar) {
+      const std::size_t at = bar ? bars_.size() : massive_.size();
+      runs_.push_back({bar, at, at});
+    }
+    ++runs_.back().end;
+    if (!bar) {
+      massive_.push_back(m);
+      continue;
+    }
+    BarTerm b;
+    for (int k = 0; k < 5; ++k) b.at[k] = m.frame.slots[k].coord();  // (−1 for a constant)
+    b.m_o = m.m_o, b.m_x = m.m_x, b.m_b = m.m_b, b.oo = m.oo, b.xx = m.xx, b.ox = m.ox, b.mass = m.mass;
+    b.part = m.part;
+    bars_.push_back(b);
+  }
 }
 
 void detail::PartForces::add(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
                              const double* qdd, double t, Eigen::VectorXd& Q, PlanarForce* planar) const {
-  for (const MassivePart& m : massive_) {
-    if (!m.frame.bar) {
-      add_massive_part(parts[m.part], m, loads.gravity, q, qd, qdd, t, Q, planar ? planar + m.part : nullptr);
+  const V3 g = loads.gravity;
+  for (const Run& run : runs_) {
+    if (!run.bars) {
+      for (std::size_t k = run.begin; k < run.end; ++k) {
+        const MassivePart& m = massive_[k];
+        add_massive_part(parts[m.part], m, g, q, qd, qdd, t, Q, planar ? planar + m.part : nullptr);
+      }
       continue;
     }
-    PlanarForce f;  // (the common case at scale, inlined here)
-    bar_force(m, qdd, loads.gravity, f);
-    add_planar_force(m.frame, f, Q);
-    if (planar) planar[m.part] = f;
+    // a bar's force and add_planar_force()'s sums for a bar (its origin, then x's target), with its slots decoded
+    auto accel = [&](Index i) { return i >= 0 && qdd ? qdd[i] : 0.0; };
+    auto add = [&](Index i, double v) {
+      if (i >= 0) Q(i) += v;
+    };
+    for (std::size_t k = run.begin; k < run.end; ++k) {
+      const BarTerm& b = bars_[k];
+      PlanarForce f;
+      bar_force_at(b, accel(b.at[0]), accel(b.at[1]), accel(b.at[3]), accel(b.at[4]), g, f);
+      add(b.at[0], f.fx), add(b.at[1], f.fy), add(b.at[2], f.fz), add(b.at[3], f.along_x), add(b.at[4], f.along_y);
+      if (planar) planar[b.part] = f;
+    }
   }
   if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
 }

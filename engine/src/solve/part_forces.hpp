@@ -125,6 +125,21 @@ class BarLengths {
   std::unordered_map<std::array<std::uint64_t, 4>, Bar, SlotsHash> bar_;  // both orders of a, b
 };
 
+// A rigid bar's force from its four accelerations (origin x, y; x's target x, y): its weight less its constant mass
+// matrix times them, at its two points, read from `p` (a MassivePart, or PartForces' compact copy of one: m_o, m_x,
+// m_b, oo, xx, ox, mass). Always inlined: Q takes it for each of nfourbar 10⁴'s 2·10⁴ parts at every row.
+template <class Bar>
+[[gnu::always_inline]] inline void bar_force_at(const Bar& p, double aox, double aoy, double axx, double axy,
+                                                kin3::V3 gravity, PlanarForce& f) {
+  const double gx = gravity.x, gy = gravity.y;  // (R v = (−v_y, v_x), the quarter turn)
+  f.fx = (p.m_o * gx - p.m_b * gy) - (p.oo * aox + p.ox * axx - p.m_b * axy);
+  f.fy = (p.m_o * gy + p.m_b * gx) - (p.oo * aoy + p.ox * axy + p.m_b * axx);
+  f.along_x = (p.m_x * gx + p.m_b * gy) - (p.ox * aox + p.m_b * aoy + p.xx * axx);
+  f.along_y = (p.m_x * gy - p.m_b * gx) - (p.ox * aoy - p.m_b * aox + p.xx * axy);
+  f.fz = p.mass * gravity.z, f.turn = 0.0;
+  f.valid = true;
+}
+
 class PartForces {
  public:
   PartForces() = default;
@@ -140,7 +155,22 @@ class PartForces {
            double t, Eigen::VectorXd& Q, PlanarForce* planar = nullptr) const;
 
  private:
+  // A rigid bar as add() reads it: its frame's slots decoded (−1: a constant) and its mass matrix's numbers, 88
+  // bytes (a MassivePart's 144 and its slots' tags, read at every row, were most of Q's time at nfourbar 10⁴).
+  struct BarTerm {
+    Index at[5] = {-1, -1, -1, -1, -1};  // origin x, y, z; x's target x, y
+    double m_o = 0.0, m_x = 0.0, m_b = 0.0, oo = 0.0, xx = 0.0, ox = 0.0, mass = 0.0;
+    std::size_t part = 0;
+  };
+  // The parts with mass in order, as runs of rigid bars (bars_[begin, end)) and of the others (massive_[begin,
+  // end)): Q sums each coordinate's terms in the parts' order, as add_generalized_forces() does.
+  struct Run {
+    bool bars = false;
+    std::size_t begin = 0, end = 0;
+  };
   std::vector<MassivePart> massive_;
+  std::vector<BarTerm> bars_;
+  std::vector<Run> runs_;
 };
 
 // Whether part `p` has mass: add_generalized_forces() counts it.
