@@ -94,10 +94,13 @@ std::vector<Index> frame_coordinates(const PartFrame& f) {
   return out;
 }
 
-void frame_coordinates(const PartFrame& f, std::vector<Index>& out) {
-  out.clear();
+namespace {
+
+// visit(c) for each coordinate `f` reads, in its slots' order (repeats included).
+template <class Visit>
+void for_each_frame_coordinate(const PartFrame& f, Visit&& visit) {
   auto slot = [&](const Slot& s) {
-    if (s.is_coordinate()) out.push_back(s.coord());
+    if (s.is_coordinate()) visit(s.coord());
   };
   switch (f.kind) {
     case PartFrameKind::kPlanarBody:
@@ -115,17 +118,27 @@ void frame_coordinates(const PartFrame& f, std::vector<Index>& out) {
       }
       break;
     case PartFrameKind::kExpressions:
-      for (const auto& e : f.at) out.insert(out.end(), e->coordinates().begin(), e->coordinates().end());
-      if (f.angle) out.insert(out.end(), f.angle->coordinates().begin(), f.angle->coordinates().end());
+      for (const auto& e : f.at)
+        for (Index c : e->coordinates()) visit(c);
+      if (f.angle)
+        for (Index c : f.angle->coordinates()) visit(c);
       break;
   }
+}
+
+}  // namespace
+
+void frame_coordinates(const PartFrame& f, std::vector<Index>& out) {
+  out.clear();
+  for_each_frame_coordinate(f, [&](Index c) { out.push_back(c); });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
 Index max_coordinate(const PartFrame& f) {
-  const std::vector<Index> c = frame_coordinates(f);
-  return c.empty() ? -1 : c.back();
+  Index most = -1;  // (no list: a scene's 10⁴ parts are each asked, in reading and in checking a sweep)
+  for_each_frame_coordinate(f, [&](Index c) { most = std::max(most, c); });
+  return most;
 }
 
 }  // namespace phiq

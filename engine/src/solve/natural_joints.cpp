@@ -76,6 +76,7 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
     if (p.frame.kind != PartFrameKind::kPoints || max_coordinate(p.frame) < 0) continue;  // (a frame that moves)
     NaturalBody b;
     b.name = p.name, b.part = i;
+    b.points.reserve(3);
     b.frame = p.frame;
     PartFrame promoted = p.frame;
     // each constant component of a point a coordinate of its own, past the model's (its value in `promoted`)
@@ -119,6 +120,7 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
       if (bodies.empty() || bodies.back() != b) bodies.push_back(b);
     }
   }
+  out.joints.reserve(points.size());  // (at most; capacity that is not written is not mapped in)
   for (const auto& [name, point] : points) {
     const auto it = held_by.find(point_key(point));
     if (it == held_by.end()) continue;
