@@ -320,7 +320,8 @@ Scene natural_random_nfourbar(std::mt19937& rng, int n) {
 // The flat sites (JointReactions::NaturalSite: a point on a body whose force Q computed, no load its own; moving,
 // or fixed as the cranks' pivots G{i}) sum the same terms as the general path, bit for bit: random natural four-bar
 // chains, every row, every joint, in both forms of Q (the frames' motion's, whose general path is the body's own Q
-// from its frame; the rigid bars', whose general path is the body's own bar form).
+// from its frame; the rigid bars', whose general path is the body's own bar form). A sweep's Q, which writes only
+// the planar forces the sites read (JointReactions::planar_parts_read()), gives them the same bits.
 TEST(NaturalReactions, FlatSitesAreTheGeneralPathBitForBit) {
   std::mt19937 rng(49);
   for (int trial = 0; trial < 4; ++trial) {
@@ -348,6 +349,19 @@ TEST(NaturalReactions, FlatSitesAreTheGeneralPathBitForBit) {
         reactions.evaluate(q, qd, qdd, t, lambda, general.data(), bars ? unread.data() : nullptr);
         reactions.evaluate(q, qd, qdd, t, lambda, flat.data(), planar.data());
         ASSERT_EQ(std::memcmp(general.data(), flat.data(), sizeof(double) * n), 0) << trial << bars << ", row " << k;
+        // a sweep's Q writes only the planar forces the sites read (the cranks': every joint is a crank's point)
+        const std::vector<char> read = reactions.planar_parts_read(e.parts->size());
+        for (std::size_t p = 0; p < read.size(); ++p)
+          ASSERT_EQ(read[p] != 0, (*e.parts)[p].name.rfind("crank", 0) == 0) << (*e.parts)[p].name;
+        const detail::PartForces sweeps(*e.parts, m, bars, read);
+        Eigen::VectorXd sweeps_q = Eigen::VectorXd::Zero(m.num_coordinates());
+        std::vector<detail::PlanarForce> sweeps_planar(e.parts->size());
+        sweeps.add(*e.parts, *e.loads, q, qd, qdd, t, sweeps_q, sweeps_planar.data());
+        ASSERT_EQ(std::memcmp(Q.data(), sweeps_q.data(), sizeof(double) * static_cast<std::size_t>(Q.size())), 0);
+        for (std::size_t p = 0; p < read.size(); ++p) ASSERT_EQ(sweeps_planar[p].valid, read[p] != 0) << p;
+        std::vector<double> sweeps_flat(n);
+        reactions.evaluate(q, qd, qdd, t, lambda, sweeps_flat.data(), sweeps_planar.data());
+        ASSERT_EQ(std::memcmp(sweeps_flat.data(), flat.data(), sizeof(double) * n), 0) << trial << bars << ", " << k;
         // either form, the frames' motion's reactions and motor torque (bars off the centre line: c_y ≠ 0)
         Eigen::VectorXd own = Eigen::VectorXd::Zero(m.num_coordinates()), own_lambda;
         add_generalized_forces(*e.parts, *e.loads, q, qd, qdd, t, own);

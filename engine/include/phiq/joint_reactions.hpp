@@ -63,6 +63,9 @@ class JointReactions {
   /// Whether evaluate()'s `planar` may come from a Q with rigid bars: as constructed, unless a natural body with
   /// mass on a bar does not own the bar's row (internal: the sweep then takes no bar in Q).
   bool rigid_bars() const { return set_->rigid_bars; }
+  /// Which of OutputEfforts::parts' planar forces evaluate() reads from `planar`: one flag per part (`parts` of them;
+  /// internal: a sweep's Q leaves the others unwritten).
+  std::vector<char> planar_parts_read(std::size_t parts) const;
   /// Writes the reactions at (q, t) under multipliers `lambda` (one per model row) to out[0, size()).
   /// Pre-condition: q has the model's coordinates; the model is the one given to the constructor.
   /// No natural joint may be listed (they read q̇ and q̈: the overload below; else phiq::Error).
@@ -92,19 +95,20 @@ class JointReactions {
   struct NaturalSite {
     static constexpr int kMaxTerms = 3;   // per component (a point is at most an origin and an x target)
     static constexpr int kMaxMoving = 4;  // a fixed component's moving points
-    std::size_t joint = 0, body = 0;      // in SetUp::natural
-    std::size_t point = 0;                // the joint's place among the body's points
-    Index at[3] = {0, 0, 0};              // its components' coordinates (n and above: promoted constants)
-    std::size_t part = 0;                 // the flat form's part (OutputEfforts::parts)
+    // What the flat path reads at every row, first: one cache line of 64 bytes (10⁴ sites a row at nfourbar 10⁴).
     bool flat = false;
     std::uint8_t count[2] = {0, 0}, terms[2][kMaxTerms] = {};
     std::uint8_t moving_count[2] = {0, 0};
     bool shared[2] = {false, false};
-    Index moving[2][kMaxMoving] = {};
     // Its sums of the body's own constraints' forces, Σ Φq values × λ over BodyRows::FlatSums' groups: component k's
     // are groups [group_first[k], group_first[k + 1]), one for a moving component (its coordinate's), one per moving
     // point for a fixed one; each sums the body's entries in its column, in their order, as the general path's g_
     std::uint32_t group_first[3] = {0, 0, 0};
+    std::size_t part = 0;             // the flat form's part (OutputEfforts::parts)
+    Index at[3] = {0, 0, 0};          // its components' coordinates (n and above: promoted constants)
+    std::size_t joint = 0, body = 0;  // in SetUp::natural
+    std::size_t point = 0;            // the joint's place among the body's points
+    Index moving[2][kMaxMoving] = {};
   };
   // The natural bodies' own constraints' Jacobian entries and the columns the bodies' forces touch, body b's at
   // [first[b], first[b + 1]) of each list (flat: one allocation per list, not per body). An entry is a value's slot in

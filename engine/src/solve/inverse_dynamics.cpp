@@ -177,7 +177,9 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
   if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
 }
 
-detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars) {
+detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars,
+                               std::vector<char> planar_read)
+    : planar_read_(std::move(planar_read)) {
   const BarLengths bars = rigid_bars ? BarLengths(model) : BarLengths();
   if (rigid_bars)  // (capacity that is not written is not mapped in)
     bars_.reserve(parts.size());
@@ -207,11 +209,13 @@ detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& mode
 void detail::PartForces::add(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd,
                              const double* qdd, double t, Eigen::VectorXd& Q, PlanarForce* planar) const {
   const V3 g = loads.gravity;
+  // (a planar force no one reads is not written: at nfourbar 10⁴ the couplers' are half a megabyte a row)
+  auto kept = [&](std::size_t part) { return planar && (planar_read_.empty() || planar_read_[part]); };
   for (const Run& run : runs_) {
     if (!run.bars) {
       for (std::size_t k = run.begin; k < run.end; ++k) {
         const MassivePart& m = massive_[k];
-        add_massive_part(parts[m.part], m, g, q, qd, qdd, t, Q, planar ? planar + m.part : nullptr);
+        add_massive_part(parts[m.part], m, g, q, qd, qdd, t, Q, kept(m.part) ? planar + m.part : nullptr);
       }
       continue;
     }
@@ -225,7 +229,7 @@ void detail::PartForces::add(const std::vector<Part>& parts, const Loads& loads,
       PlanarForce f;
       bar_force_at(b, accel(b.at[0]), accel(b.at[1]), accel(b.at[3]), accel(b.at[4]), g, f);
       add(b.at[0], f.fx), add(b.at[1], f.fy), add(b.at[2], f.fz), add(b.at[3], f.along_x), add(b.at[4], f.along_y);
-      if (planar) planar[b.part] = f;
+      if (kept(b.part)) planar[b.part] = f;
     }
   }
   if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);

@@ -402,6 +402,13 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
   find_flat_sites(model);
 }
 
+std::vector<char> JointReactions::planar_parts_read(std::size_t parts) const {
+  std::vector<char> read(parts, 0);
+  for (const NaturalSite& s : set_->natural_sites)
+    if (const std::size_t p = set_->body_parts[s.body].part; p < parts) read[p] = 1;
+  return read;
+}
+
 detail::PlanarFrame JointReactions::BodyPart::frame() const {
   detail::PlanarFrame f;
   std::copy(slots, slots + 5, f.slots);

@@ -146,11 +146,11 @@ class PartForces {
   // The parts with mass of `parts`, in order; with `rigid_bars`, those that are rigid bars of `model` (BarLengths)
   // with their constant mass matrix (file comment). (∂τ/∂p differentiates the frames' motion's Q, with whose λ
   // alone its formula holds: a sweep that asks for them takes no bars.)
-  PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars);
+  PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars, std::vector<char> planar_read = {});
   // Q += the parts' and the loads' generalized forces at (q, q̇, q̈, t), as add_generalized_forces(parts, loads, …);
   // `parts` those this was made from. With `planar` (one entry per part), each part with mass on a planar frame
-  // also leaves there what it added (PlanarForce::valid false where it took the general path); the others' entries
-  // are not touched.
+  // that `planar_read` flags (every one when it was not given) also leaves there what it added (PlanarForce::valid
+  // false where it took the general path); the others' entries are not touched.
   void add(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd, const double* qdd,
            double t, Eigen::VectorXd& Q, PlanarForce* planar = nullptr) const;
 
@@ -171,6 +171,7 @@ class PartForces {
   std::vector<MassivePart> massive_;
   std::vector<BarTerm> bars_;
   std::vector<Run> runs_;
+  std::vector<char> planar_read_;  // per part (empty: every one)
 };
 
 // Whether part `p` has mass: add_generalized_forces() counts it.

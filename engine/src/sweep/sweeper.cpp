@@ -14,11 +14,14 @@ Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSumm
   // Q's parts, gathered once a sweep and shared by its chunks' sweepers (`like`'s: set in its constructor, never
   // written after, so safe to share while it runs on another thread)
   if (opt_.efforts.active() && opt_.efforts.parts)
-    effort_work_.forces = same_sweep(like) && like->effort_work_.forces
-                              ? like->effort_work_.forces
-                              : std::make_shared<const PartForces>(
-                                    *opt_.efforts.parts, model_,
-                                    rigid_bars() && (!effort_work_.reactions || effort_work_.reactions->rigid_bars()));
+    effort_work_.forces =
+        same_sweep(like) && like->effort_work_.forces
+            ? like->effort_work_.forces
+            : std::make_shared<const PartForces>(
+                  *opt_.efforts.parts, model_,
+                  rigid_bars() && (!effort_work_.reactions || effort_work_.reactions->rigid_bars()),
+                  effort_work_.reactions ? effort_work_.reactions->planar_parts_read(opt_.efforts.parts->size())
+                                         : std::vector<char>{});
   // what Q's planar parts add, kept for the natural joints' reactions to read (row_reactions())
   if (effort_work_.reactions && opt_.efforts.natural && opt_.efforts.parts)
     effort_work_.planar.resize(opt_.efforts.parts->size());
