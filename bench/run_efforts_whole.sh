@@ -34,16 +34,18 @@ echo "phiq run nfourbar $n with masses, $steps steps, $threads thread(s), $repea
   "load: $(cut -d' ' -f1-3 /proc/loadavg)"
 printf '%-5s %-10s %9s %15s %9s %8s %10s\n' format scene median_s min-max_s cpu_s peak_MB wall_ratio
 for format in csv h5; do
-  for scene in plain torques reactions; do
-    : >"$dir/times"
-    i=0
-    while [ "$i" -lt "$repeats" ]; do  # the three scenes in turn would share the drift; in blocks they are simpler
-      /usr/bin/time -f '%e %U %S %M' -a -o "$dir/times" \
+  for scene in plain torques reactions; do : >"$dir/times.$scene"; done
+  i=0
+  while [ "$i" -lt "$repeats" ]; do  # the three scenes in turn: a drift of the machine's speed hits each alike
+    for scene in plain torques reactions; do
+      /usr/bin/time -f '%e %U %S %M' -a -o "$dir/times.$scene" \
         "$phiq" run -q "$dir/$scene.yaml" -o "$dir/out.$format" --threads "$threads"
       rm -f "$dir/out.$format"
-      i=$((i + 1))
     done
-    sort -n "$dir/times" | awk -v f="$format" -v s="$scene" '
+    i=$((i + 1))
+  done
+  for scene in plain torques reactions; do
+    sort -n "$dir/times.$scene" | awk -v f="$format" -v s="$scene" '
       { wall[NR] = $1; cpu[NR] = $2 + $3; mem[NR] = $4 }
       END { m = int((NR + 1) / 2)
             printf "%s %s %.3f %.3f-%.3f %.3f %.0f\n", f, s, wall[m], wall[1], wall[NR], cpu[m], mem[m] / 1024 }'

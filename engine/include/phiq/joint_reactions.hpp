@@ -100,7 +100,7 @@ class JointReactions {
     std::uint8_t count[2] = {0, 0}, terms[2][kMaxTerms] = {};
     std::uint8_t moving_count[2] = {0, 0};
     bool shared[2] = {false, false};
-    // Its sums of the body's own constraints' forces, Σ Φq values × λ over BodyRows::FlatSums' groups: component k's
+    // Its sums of the body's own constraints' forces, Σ Φq values × λ over FlatSums' groups: component k's
     // are groups [group_first[k], group_first[k + 1]), one for a moving component (its coordinate's), one per moving
     // point for a fixed one; each sums the body's entries in its column, in their order, as the general path's g_
     std::uint32_t group_first[3] = {0, 0, 0};
@@ -122,16 +122,17 @@ class JointReactions {
     const ConstraintBlock* block = nullptr;
     std::size_t begin = 0, end = 0;
   };
+  // group g of the flat sites' sums: entries terms[term_first[g] … term_first[g + 1])
+  struct FlatSums {
+    std::vector<std::uint32_t> term_first{0};
+    std::vector<OwnEntry> terms;
+  };
   struct BodyRows {
     std::vector<std::size_t> entries_first, q_first;
     std::vector<OwnEntry> entries;
     std::vector<Index> q_columns;
     std::vector<OwnRun> runs;
-    // the flat sites' sums (NaturalSite::group_first): group g's entries are terms[term_first[g] … term_first[g + 1])
-    struct FlatSums {
-      std::vector<std::uint32_t> term_first{0};
-      std::vector<OwnEntry> terms;
-    } flat;
+    FlatSums flat;                              // the flat sites' sums (NaturalSite::group_first)
     const EntryIndex* slot_of_entry = nullptr;  // the model's (Model::slot_of_entry())
     bool overwrite = false;                     // no two entries of the model share a slot (Model::jacobian())
   };

@@ -242,7 +242,7 @@ void JointReactions::find_flat_sites(const Model& model) {
 }
 
 void JointReactions::add_flat_sums(NaturalSite& s, Index n) {
-  BodyRows::FlatSums& sums = set_->body_rows.flat;
+  FlatSums& sums = set_->body_rows.flat;
   const BodyRows& rows = set_->body_rows;
   auto add_group = [&](Index column) {  // the body's entries in `column`, in their order
     for (std::size_t k = rows.entries_first[s.body]; k < rows.entries_first[s.body + 1]; ++k)
@@ -478,7 +478,7 @@ void JointReactions::turn_natural(const NaturalSite& s, const double* q, double 
 bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,
                                    const detail::PlanarForce* planar, double* out) {
   if (!planar || !planar[s.part].valid) return false;
-  const BodyRows::FlatSums& sums = set_->body_rows.flat;
+  const FlatSums& sums = set_->body_rows.flat;
   auto group_sum = [&](std::uint32_t g) {  // g_ at a column, as add_body_constraint_forces() sums it (from +0)
     double sum = 0.0;
     for (std::uint32_t k = sums.term_first[g]; k < sums.term_first[g + 1]; ++k)
