@@ -97,6 +97,8 @@ class JointReactions {
     static constexpr int kMaxMoving = 4;  // a fixed component's moving points
     // What the flat path reads at every row, first: one cache line of 64 bytes (10⁴ sites a row at nfourbar 10⁴).
     bool flat = false;
+    // flat, moving along x and y, one Q term and one entry of Φq each (a bar's point: nfourbar's every joint)
+    bool simple = false;
     std::uint8_t count[2] = {0, 0}, terms[2][kMaxTerms] = {};
     std::uint8_t moving_count[2] = {0, 0};
     bool shared[2] = {false, false};

@@ -257,6 +257,10 @@ void JointReactions::add_flat_sums(NaturalSite& s, Index n) {
       for (int i = 0; i < s.moving_count[k]; ++i) add_group(s.moving[k][i]);
   }
   s.group_first[2] = static_cast<std::uint32_t>(sums.term_first.size() - 1);
+  s.simple = true;
+  for (int k = 0; k < 2; ++k)
+    s.simple = s.simple && s.at[k] < n && s.count[k] == 1 &&
+               sums.term_first[s.group_first[k] + 1] - sums.term_first[s.group_first[k]] == 1;
 }
 
 void JointReactions::size_natural_scratch() {
@@ -486,6 +490,18 @@ bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double
     return sum;
   };
   const detail::PlanarForce& f = planar[s.part];
+  if (s.simple && !set_->joint_axes) {  // the loops below, each of one pass, written out
+    for (int k = 0; k < 2; ++k) {
+      const OwnEntry& e = sums.terms[sums.term_first[s.group_first[k]]];
+      const double v = f.*detail::kPlanarFields[s.terms[k][0] & 7];
+      double qb = 0.0, sum = 0.0;
+      qb += (s.terms[k][0] & 8) ? -v : v;
+      sum += own_values_[static_cast<std::size_t>(e.slot)] * lambda(e.row);
+      out[k] = sum - qb;
+    }
+    out[2] = 0.0;
+    return true;
+  }
   for (int k = 0; k < 2; ++k) {
     double qb = 0.0;  // Q_b at the component, as body_forces() sums it into qb_ (from +0)
     for (int i = 0; i < s.count[k]; ++i) {
