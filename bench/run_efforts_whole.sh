@@ -9,7 +9,9 @@
 #   bench/run_efforts_whole.sh [PHIQ] [N] [STEPS] [REPEATS] [THREADS]
 #
 # Defaults: build/tools/phiq, 10000, 100 steps, 5 repeats, 1 thread (0: every core). Results go to $TMPDIR
-# (default /dev/shm: the disk's speed is not measured) and are removed.
+# (default /dev/shm: the disk's speed is not measured) and are removed. With INSTRUCTIONS=1 each scene runs once,
+# to HDF5 on 1 thread, under `valgrind --tool=callgrind`, and the script prints the instructions of the whole
+# process and their ratios instead: the same count on every run, whatever else the machine is doing.
 set -eu
 phiq=${1:-build/tools/phiq}
 n=${2:-10000}
@@ -30,6 +32,17 @@ out='output: {velocities: true, accelerations: true'
 { cat "$dir/base.yaml"; echo "$out}"; } >"$dir/plain.yaml"
 { cat "$dir/base.yaml"; echo "$out, efforts: all, power: true}"; } >"$dir/torques.yaml"
 { cat "$dir/base.yaml"; echo "$out, efforts: all, power: true, reactions: all}"; } >"$dir/reactions.yaml"
+if [ "${INSTRUCTIONS:-0}" = 1 ]; then
+  echo "phiq run nfourbar $n with masses, $steps steps, to HDF5 on 1 thread, under callgrind"
+  for scene in plain torques reactions; do
+    valgrind --tool=callgrind --callgrind-out-file="$dir/$scene.callgrind" \
+      "$phiq" run -q "$dir/$scene.yaml" -o "$dir/out.h5" --threads 1 >/dev/null 2>&1
+    rm -f "$dir/out.h5"
+    echo "$scene $(sed -n 's/^summary: //p' "$dir/$scene.callgrind")"
+  done | awk '{ if ($1 == "plain") base = $2
+                printf "%-10s %15.0f instructions %6.3f\n", $1, $2, $2 / base }'
+  exit 0
+fi
 echo "phiq run nfourbar $n with masses, $steps steps, $threads thread(s), $repeats repeats;" \
   "load: $(cut -d' ' -f1-3 /proc/loadavg)"
 printf '%-5s %-10s %9s %15s %9s %8s %10s\n' format scene median_s min-max_s cpu_s peak_MB wall_ratio
