@@ -47,6 +47,8 @@ Record record(const Model& model, SweepOptions opt, int threads, Workspace* reus
         if (s.qdd) append(r.rows, s.qdd->data(), static_cast<std::size_t>(s.qdd->size()));
         if (s.phi) append(r.rows, s.phi->data(), static_cast<std::size_t>(s.phi->size()));
         if (s.points) append(r.rows, s.points[0].r.data(), 9 * opt.points.size());
+        if (s.efforts)  // efforts, powers, reactions and their sensitivities
+          append(r.rows, s.efforts, static_cast<std::size_t>(effort_values(opt.efforts, opt.sensitivities.size())));
         return true;
       },
       &sum);
@@ -106,6 +108,35 @@ TEST(SweepDeterminism, EveryModelsSceneGivesTheSameBitsOnEveryThreadCount) {
                                   static_cast<double>(std::max<Index>(sc.sweep.steps, 1));
     expect_deterministic(*solved, opt, p.filename().string(), &q);
   }
+}
+
+// Efforts and every joint's reaction of a natural nfourbar with masses (its joints' sums, the rigid bars' Q, shared by
+// the chunks), as run_sweep delivers them: the same bytes on every thread count.
+TEST(SweepDeterminism, NaturalJointsReactionsGiveTheSameBitsOnEveryThreadCount) {
+  const std::string bar = "mass: 1, center_of_mass: [0.5, 0.1], inertia: 0.08}\n";
+  const Scene s = parse_scene(
+      "phiq: 1\nparameters: {N: 60}\ncoordinates:\n  for i in 0..N:\n    x{i}: i + 0.7071067811865476\n"
+      "    y{i}: 0.7071067811865475\n  theta: 0.7853981633974483\npoints:\n  O: [0, 0]\n  for i in 0..N:\n"
+      "    P{i}: [\"x{i}\", \"y{i}\"]\nconstraints:\n  - for i in 0..N:\n      - {name: \"crank{i}\", type: distance, "
+      "points: [[i, 0], \"P{i}\"], length: 1}\n  - for i in 0..N-1:\n      - {name: \"coupler{i}\", type: distance, "
+      "points: [\"P{i}\", \"P{i+1}\"], length: 1}\n  - {name: crank0_angle, type: segment_angle, segment: [O, P0], "
+      "angle: theta}\ndrivers:\n  - {name: motor, coordinate: theta, law: {type: linear, initial: "
+      "0.7853981633974483, rate: 1.5707963267948966}}\ntime: {start: 0, end: 1, steps: 600}\nparts:\n"
+      "  for i in 0..N:\n    \"crank{i}\": {frame: {origin: [i, 0], x: \"P{i}\"}, " +
+          bar + "  for i in 0..N-1:\n    \"coupler{i}\": {frame: {origin: \"P{i}\", x: \"P{i+1}\"}, " + bar +
+          "loads: {gravity: [0.3, -9.81]}\n"
+          "output: {velocities: true, accelerations: true, efforts: all, power: true, reactions: all}\n",
+      "nfourbar_reactions.yaml");
+  ASSERT_EQ(s.sweep.efforts.reactions.size(), 62u);  // O (crank 0's pivot) and P0 … P60, each on its crank
+  SweepSummary sum;
+  SweepOptions two = s.sweep;
+  two.threads = 2;
+  Workspace ws(*s.model);
+  ASSERT_EQ(run_sweep(
+                *s.model, two, ws, [](const StepView&) { return true; }, &sum),
+            SolveStatus::kSuccess);
+  EXPECT_GT(sum.parallel_chunks, 1);  // (the chunks' sweepers share the set-up)
+  expect_deterministic(*s.model, s.sweep, "natural nfourbar 60 with reactions");
 }
 
 // nfourbar N = 100 over two turns from θ = π/4, positions only: 1440 steps put the four flat positions on rows 270,
