@@ -155,7 +155,7 @@ class PartForces {
            double t, Eigen::VectorXd& Q, PlanarForce* planar = nullptr) const;
 
  private:
-  // A rigid bar as add() reads it: its frame's slots decoded (−1: a constant) and its mass matrix's numbers, 88
+  // A rigid bar as add() reads it: its frame's slots decoded (−1: a constant) and its mass matrix's numbers, 104
   // bytes (a MassivePart's 144 and its slots' tags, read at every row, were most of Q's time at nfourbar 10⁴).
   struct BarTerm {
     Index at[5] = {-1, -1, -1, -1, -1};  // origin x, y, z; x's target x, y
