@@ -89,18 +89,16 @@ class JointReactions {
   // A natural joint's site. Its flat form, where the body's part is read from a sweep's Q (BodyPart::part), no load
   // is the body's alone and the model is planar: component k's Q_b is the sum of the PlanarForce values terms[k]
   // names (kPlanarFields' index, +8 when negated), in add_planar_force()'s order, and its reaction g_[at[k]] − Q_b;
-  // along a fixed component (a ground pivot's), −Σ g_ over moving[k] (the body's points' moving components there)
+  // along a fixed component (a ground pivot's), −Σ g_ over the body's points' moving components there
   // − Q_b, or NaN when `shared` (another of its points is fixed along it too). The same sums as the general path's
   // without writing the body's Q (qb_) and clearing it, nor reading the body's points at every row.
   struct NaturalSite {
-    static constexpr int kMaxTerms = 3;   // per component (a point is at most an origin and an x target)
-    static constexpr int kMaxMoving = 4;  // a fixed component's moving points
+    static constexpr int kMaxTerms = 3;  // per component (a point is at most an origin and an x target)
     // What the flat path reads at every row, first: one cache line of 64 bytes (10⁴ sites a row at nfourbar 10⁴).
     bool flat = false;
     // flat, moving along x and y, one Q term and one entry of Φq each (a bar's point: nfourbar's every joint)
     bool simple = false;
     std::uint8_t count[2] = {0, 0}, terms[2][kMaxTerms] = {};
-    std::uint8_t moving_count[2] = {0, 0};
     bool shared[2] = {false, false};
     // Its sums of the body's own constraints' forces, Σ Φq values × λ over FlatSums' groups: component k's
     // are groups [group_first[k], group_first[k + 1]), one for a moving component (its coordinate's), one per moving
@@ -110,10 +108,10 @@ class JointReactions {
     Index at[3] = {0, 0, 0};          // its components' coordinates (n and above: promoted constants)
     std::size_t joint = 0, body = 0;  // in SetUp::natural
     std::size_t point = 0;            // the joint's place among the body's points
-    Index moving[2][kMaxMoving] = {};
   };
-  // The natural bodies' own constraints' Jacobian entries and the columns the bodies' forces touch, body b's at
-  // [first[b], first[b + 1]) of each list (flat: one allocation per list, not per body). An entry is a value's slot in
+  // The natural bodies' own constraints' Jacobian entries (of the bodies sites report on; the others' are empty) and
+  // the columns the bodies' forces touch, body b's at [first[b], first[b + 1]) of each list (flat: one allocation
+  // per list, not per body). An entry is a value's slot in
   // Φq's pattern, its row and column, in the pattern's order (by column, then row: a column's sum over the body's
   // constraints runs in their order, as their rows do). `runs`: the constraints of the bodies a site reports on, as
   // ranges of one block, whose Jacobian a row evaluates once (one call per range, not per site).
@@ -163,8 +161,9 @@ class JointReactions {
   // `bars`: the model's rigid bars where the sweep's Q takes them (else empty)
   void find_body_parts(const Model& model, const OutputEfforts& efforts, const detail::BarLengths& bars);
   void find_flat_sites(const Model& model);
-  // s's groups (NaturalSite::group_first), for a model of n coordinates
-  void add_flat_sums(NaturalSite& s, Index n);
+  // s's groups (NaturalSite::group_first), for a model of n coordinates; `moving`: its fixed components' moving
+  // points' coordinates
+  void add_flat_sums(NaturalSite& s, Index n, const std::vector<Index> (&moving)[2]);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);
   // own_values_ = Φq's values of BodyRows::runs at (q, t), once a row

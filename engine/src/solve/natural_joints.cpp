@@ -206,6 +206,7 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
 
 void JointReactions::find_flat_sites(const Model& model) {
   if (set_->natural->spatial) return;
+  std::vector<Index> moving[2];  // a fixed component's moving points' coordinates (its capacity kept)
   for (NaturalSite& s : set_->natural_sites) {
     const BodyPart& part = set_->body_parts[s.body];
     s.flat = false;
@@ -214,16 +215,14 @@ void JointReactions::find_flat_sites(const Model& model) {
     s.count[0] = s.count[1] = 0;
     const NaturalBody& body = set_->natural->bodies[s.body];
     for (int k = 0; k < 2; ++k) {  // a fixed component's moving points, as evaluate_natural() sums them
-      s.moving_count[k] = 0, s.shared[k] = false;
+      moving[k].clear(), s.shared[k] = false;
       if (s.at[k] < model.num_coordinates()) continue;
       for (const Attachment3& o : body.points) {
         const Index c = o.r[k].coord();
         if (c >= model.num_coordinates())
           s.shared[k] = s.shared[k] || &o != &body.points[s.point];
-        else if (s.moving_count[k] == NaturalSite::kMaxMoving)
-          fits = false;
         else
-          s.moving[k][s.moving_count[k]++] = c;
+          moving[k].push_back(c);
       }
     }
     detail::for_each_planar_term(part.frame(), [&](const Slot& slot, int field, bool negated) {
@@ -237,11 +236,11 @@ void JointReactions::find_flat_sites(const Model& model) {
       }
     });
     s.part = part.part, s.flat = fits;
-    if (fits) add_flat_sums(s, model.num_coordinates());
+    if (fits) add_flat_sums(s, model.num_coordinates(), moving);
   }
 }
 
-void JointReactions::add_flat_sums(NaturalSite& s, Index n) {
+void JointReactions::add_flat_sums(NaturalSite& s, Index n, const std::vector<Index> (&moving)[2]) {
   FlatSums& sums = set_->body_rows.flat;
   const BodyRows& rows = set_->body_rows;
   auto add_group = [&](Index column) {  // the body's entries in `column`, in their order
@@ -254,7 +253,7 @@ void JointReactions::add_flat_sums(NaturalSite& s, Index n) {
     if (s.at[k] < n)
       add_group(s.at[k]);
     else
-      for (int i = 0; i < s.moving_count[k]; ++i) add_group(s.moving[k][i]);
+      for (Index c : moving[k]) add_group(c);
   }
   s.group_first[2] = static_cast<std::uint32_t>(sums.term_first.size() - 1);
   s.simple = true;
@@ -358,13 +357,16 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
     if (best == nb || tie) continue;  // the joints' own: acts at the points bodies share
     owner[c] = best;
   }
-  // each body's own constraints' Jacobian entries, in the pattern's order (counted, then filled)
+  // the bodies sites report on: their own constraints' Jacobian entries, in the pattern's order (counted, then
+  // filled), and those constraints as ranges of one block (the model lists a block's constraints in order)
+  std::vector<char> reported(nb, 0);
+  for (const NaturalSite& s : set_->natural_sites) reported[s.body] = 1;
   auto each_own_entry = [&](auto&& visit) {  // visit(b, entry)
     for (Index j = 0; j < pat.cols; ++j)
       for (Index k = pat.col_ptr[static_cast<std::size_t>(j)]; k < pat.col_ptr[static_cast<std::size_t>(j) + 1]; ++k) {
         const Index r = pat.row_idx[static_cast<std::size_t>(k)];
         const std::size_t b = owner[static_cast<std::size_t>(model.constraint_of_row(r))];
-        if (b != nb) visit(b, OwnEntry{k, r, j});
+        if (b != nb && reported[b]) visit(b, OwnEntry{k, r, j});
       }
   };
   rows.entries_first.assign(nb + 1, 0);
@@ -375,10 +377,6 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
     std::vector<std::size_t> next(rows.entries_first.begin(), rows.entries_first.end() - 1);
     each_own_entry([&](std::size_t b, const OwnEntry& e) { rows.entries[next[b]++] = e; });
   }
-  // the constraints of the bodies sites report on, as ranges of one block (the model lists a block's constraints
-  // in order, so ranges follow the constraints' order)
-  std::vector<char> reported(nb, 0);
-  for (const NaturalSite& s : set_->natural_sites) reported[s.body] = 1;
   rows.runs.clear();
   for (std::size_t c = 0; c < nc; ++c) {
     if (owner[c] == nb || !reported[owner[c]]) continue;
