@@ -13,6 +13,7 @@
 #include <random>
 #include <sstream>
 
+#include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/joint_reactions.hpp"
 #include "phiq/natural_joints.hpp"
@@ -383,6 +384,49 @@ TEST(NaturalReactions, FlatSitesAreTheGeneralPathBitForBit) {
           // point − Q_b: its Q at G is fx − along_x); a bar's x share is its x point's alone
           const double moved = first == 'P' ? -1.0 : bars ? 0.0 : 1.0;
           EXPECT_NEAR(flat[3 * j], general[3 * j] + moved, 1e-9 * (1 + std::fabs(general[3 * j])));
+        }
+      }
+    }
+  }
+}
+
+// A sweep's Q takes the rigid bars' constant mass matrix assembled once (detail::PartForces): at every row of random
+// natural four-bar chains (bars off the centre line, gravity off the vertical, torques on some cranks), it is the sum
+// of each bar's own form (add_massive_part() on massive_part() with the bar's length) to rounding, with q̈ and
+// without it (the weights alone), and the planar forces it leaves for the sites are each bar's own, bit for bit.
+TEST(NaturalReactions, RigidBarsQIsEachBarsOwnFormAssembled) {
+  std::mt19937 rng(4949);
+  for (int trial = 0; trial < 3; ++trial) {
+    const Scene s = natural_random_nfourbar(rng, 2 + 3 * trial);
+    const NaturalRows rows = natural_reactions_sweep(s);
+    const Model& m = *s.model;
+    const OutputEfforts& e = s.sweep.efforts;
+    const std::vector<Part>& parts = *e.parts;
+    const detail::PartForces forces(parts, m, true);
+    const detail::BarLengths bars(m);
+    for (std::size_t k = 0; k < rows.q.size(); ++k) {
+      const double t = rows.t[k];
+      const double *q = rows.q[k].data(), *qd = rows.qd[k].data();
+      for (const double* qdd : {rows.qdd[k].data(), static_cast<const double*>(nullptr)}) {
+        Eigen::VectorXd Q = Eigen::VectorXd::Zero(m.num_coordinates()), each = Q;
+        std::vector<detail::PlanarForce> planar(parts.size()), own(parts.size());
+        forces.add(parts, *e.loads, q, qd, qdd, t, Q, planar.data());
+        int taken = 0;
+        for (std::size_t i = 0; i < parts.size(); ++i) {
+          const double length = bars.of(parts[i].frame);
+          taken += length > 0.0;
+          detail::add_massive_part(parts[i], detail::massive_part(parts[i], i, length), e.loads->gravity, q, qd, qdd, t,
+                                   each, own.data() + i);
+        }
+        add_applied_forces(*e.loads->applied, q, qd, t, each);
+        ASSERT_EQ(taken, static_cast<int>(parts.size()));  // every link is a bar
+        const double scale = each.cwiseAbs().maxCoeff();
+        ASSERT_GT(scale, 0.1);  // (not all zero)
+        for (Index c = 0; c < Q.size(); ++c)
+          EXPECT_NEAR(Q(c), each(c), 1e-13 * scale) << trial << ", " << k << ", " << c;
+        for (std::size_t i = 0; i < parts.size(); ++i) {
+          ASSERT_TRUE(planar[i].valid && own[i].valid) << i;
+          for (double detail::PlanarForce::*f : detail::kPlanarFields) ASSERT_EQ(planar[i].*f, own[i].*f) << i;
         }
       }
     }

@@ -127,6 +127,13 @@ class JointReactions {
     std::vector<std::uint32_t> term_first{0};
     std::vector<OwnEntry> terms;
   };
+  // A simple site's sums (NaturalSite::simple), read without FlatSums' indirections: component k's reaction is
+  // own_values_[slot[k]] λ[row[k]] − Q_b, Q_b the PlanarForce value term[k] names (kPlanarFields' index, +8 when
+  // negated). 10⁴ a row at nfourbar 10⁴.
+  struct SimpleSite {
+    std::uint32_t slot[2] = {0, 0}, row[2] = {0, 0};
+    std::uint8_t term[2] = {0, 0};
+  };
   struct BodyRows {
     std::vector<std::size_t> entries_first, q_first;
     std::vector<OwnEntry> entries;
@@ -187,6 +194,7 @@ class JointReactions {
   struct SetUp {
     std::vector<Site> sites;
     std::vector<NaturalSite> natural_sites;
+    std::vector<SimpleSite> simple_sites;             // per natural site, read where it is simple
     std::vector<std::pair<bool, std::size_t>> order;  // (natural, index) per listed reaction
     std::shared_ptr<const NaturalJoints> natural;
     BodyRows body_rows;

@@ -2,6 +2,10 @@
 #include "phiq/inverse_dynamics.hpp"
 
 #include <bit>
+#include <climits>
+#include <cstdint>
+#include <algorithm>
+#include <map>
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/constraint_block.hpp"
@@ -59,7 +63,7 @@ bool add_planar_virtual_work(const PartFrame& f, const double* q, V3 c, V3 force
                                              detail::PlanarForce& f) {
   auto accel = [&](const Slot& s) { return s.is_coordinate() && qdd ? qdd[s.coord()] : 0.0; };
   const Slot *o = p.frame.slots, *x = o + 3;
-  detail::bar_force_at(p, accel(o[0]), accel(o[1]), accel(x[0]), accel(x[1]), gravity, f);
+  detail::bar_force_at(p, detail::bar_weight(p, gravity), accel(o[0]), accel(o[1]), accel(x[0]), accel(x[1]), f);
 }
 
 // The force of a part on a planar frame from the frame's motion in scalars (parts/planar_motion.hpp): what
@@ -181,28 +185,75 @@ detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& mode
                                std::vector<char> planar_read)
     : planar_read_(std::move(planar_read)) {
   const BarLengths bars = rigid_bars ? BarLengths(model) : BarLengths();
-  if (rigid_bars)  // (capacity that is not written is not mapped in)
-    bars_.reserve(parts.size());
-  else
-    massive_.reserve(parts.size());
+  // (32-bit indices; a model too large for them keeps its bars as MassiveParts, the same forces)
+  const bool compact = model.num_coordinates() <= INT32_MAX && parts.size() <= UINT32_MAX;
+  struct Entry {
+    std::int32_t row, col;
+    double value;
+  };
+  std::vector<Entry> entries;                                        // M's, each bar's in turn
+  std::vector<std::array<double, 2>> weight;                         // w per coordinate (sized at the first bar)
+  std::vector<char> reached;                                         // the coordinates a bar's row reaches
+  std::map<std::array<std::uint64_t, 7>, std::uint32_t> mass_index;  // a BarMass's bits → its index
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (!has_mass(parts[i])) continue;
     const MassivePart m = massive_part(parts[i], i, bars.of(parts[i].frame));
-    const bool bar = m.frame.bar;
-    if (runs_.empty() || runs_.back().bars != bar) {
-      const std::size_t at = bar ? bars_.size() : massive_.size();
-      runs_.push_back({bar, at, at});
-    }
-    ++runs_.back().end;
-    if (!bar) {
+    if (!m.frame.bar || !compact) {
       massive_.push_back(m);
       continue;
     }
+    std::int32_t at[5];
+    for (int k = 0; k < 5; ++k) at[k] = static_cast<std::int32_t>(m.frame.slots[k].coord());  // (−1: a constant)
+    // bar_force_at()'s rows: the origin's x, y, then x's target's x, y, each w · g − M · q̈
+    const auto [ox, oy, oz, xx, xy] = at;
+    const double mb = m.m_b;
+    const std::array<std::int32_t, 4> rows{ox, oy, xx, xy};
+    const std::array<std::array<double, 2>, 4> w{{{m.m_o, -mb}, {mb, m.m_o}, {m.m_x, mb}, {-mb, m.m_x}}};
+    const std::array<std::array<std::pair<std::int32_t, double>, 3>, 4> terms{{{{{ox, m.oo}, {xx, m.ox}, {xy, -mb}}},
+                                                                               {{{oy, m.oo}, {xy, m.ox}, {xx, mb}}},
+                                                                               {{{ox, m.ox}, {oy, mb}, {xx, m.xx}}},
+                                                                               {{{oy, m.ox}, {ox, -mb}, {xy, m.xx}}}}};
+    for (int r = 0; r < 4; ++r) {
+      if (rows[r] < 0) continue;
+      if (weight.empty()) weight.assign(static_cast<std::size_t>(model.num_coordinates()), {0.0, 0.0});
+      if (reached.empty()) reached.assign(weight.size(), 0);
+      auto& sum = weight[static_cast<std::size_t>(rows[r])];
+      sum[0] += w[r][0], sum[1] += w[r][1];
+      reached[static_cast<std::size_t>(rows[r])] = 1;
+      for (const auto& [col, v] : terms[r])
+        if (col >= 0) entries.push_back({rows[r], col, v});
+    }
+    if (oz >= 0) bar_wz_.emplace_back(oz, m.mass);
+    if (!planar_read_.empty() && !planar_read_[i]) continue;
+    const BarMass mass{m.m_o, m.m_x, m.m_b, m.oo, m.xx, m.ox, m.mass};
+    const std::array<std::uint64_t, 7> key{
+        std::bit_cast<std::uint64_t>(mass.m_o), std::bit_cast<std::uint64_t>(mass.m_x),
+        std::bit_cast<std::uint64_t>(mass.m_b), std::bit_cast<std::uint64_t>(mass.oo),
+        std::bit_cast<std::uint64_t>(mass.xx),  std::bit_cast<std::uint64_t>(mass.ox),
+        std::bit_cast<std::uint64_t>(mass.mass)};
+    const auto [it, added] = mass_index.try_emplace(key, static_cast<std::uint32_t>(bar_masses_.size()));
+    if (added) bar_masses_.push_back(mass);
     BarTerm b;
-    for (int k = 0; k < 5; ++k) b.at[k] = m.frame.slots[k].coord();  // (−1 for a constant)
-    b.m_o = m.m_o, b.m_x = m.m_x, b.m_b = m.m_b, b.oo = m.oo, b.xx = m.xx, b.ox = m.ox, b.mass = m.mass;
-    b.part = m.part;
-    bars_.push_back(b);
+    std::copy(at, at + 5, b.at);
+    b.mass = it->second, b.part = static_cast<std::uint32_t>(m.part);
+    read_bars_.push_back(b);
+  }
+  // M's rows in the coordinates' order, each entry once (the bars' shares summed in the bars' order), its zeros
+  // dropped
+  std::stable_sort(entries.begin(), entries.end(),
+                   [](const Entry& a, const Entry& b) { return a.row != b.row ? a.row < b.row : a.col < b.col; });
+  std::size_t e = 0;
+  for (std::size_t row = 0; row < reached.size(); ++row) {
+    if (!reached[row]) continue;
+    for (; e < entries.size() && entries[e].row == static_cast<std::int32_t>(row);) {
+      double v = 0.0;
+      const std::int32_t col = entries[e].col;
+      for (; e < entries.size() && entries[e].row == static_cast<std::int32_t>(row) && entries[e].col == col; ++e)
+        v += entries[e].value;
+      if (v != 0.0) bar_cols_.push_back(col), bar_mass_.push_back(v);
+    }
+    bar_rows_.push_back(
+        {static_cast<std::int32_t>(row), static_cast<std::uint32_t>(bar_cols_.size()), weight[row][0], weight[row][1]});
   }
 }
 
@@ -211,26 +262,26 @@ void detail::PartForces::add(const std::vector<Part>& parts, const Loads& loads,
   const V3 g = loads.gravity;
   // (a planar force no one reads is not written: at nfourbar 10⁴ the couplers' are half a megabyte a row)
   auto kept = [&](std::size_t part) { return planar && (planar_read_.empty() || planar_read_[part]); };
-  for (const Run& run : runs_) {
-    if (!run.bars) {
-      for (std::size_t k = run.begin; k < run.end; ++k) {
-        const MassivePart& m = massive_[k];
-        add_massive_part(parts[m.part], m, g, q, qd, qdd, t, Q, kept(m.part) ? planar + m.part : nullptr);
-      }
-      continue;
-    }
-    // a bar's force and add_planar_force()'s sums for a bar (its origin, then x's target), with its slots decoded
-    auto accel = [&](Index i) { return i >= 0 && qdd ? qdd[i] : 0.0; };
-    auto add = [&](Index i, double v) {
-      if (i >= 0) Q(i) += v;
-    };
-    for (std::size_t k = run.begin; k < run.end; ++k) {
-      const BarTerm& b = bars_[k];
-      PlanarForce f;
-      bar_force_at(b, accel(b.at[0]), accel(b.at[1]), accel(b.at[3]), accel(b.at[4]), g, f);
-      add(b.at[0], f.fx), add(b.at[1], f.fy), add(b.at[2], f.fz), add(b.at[3], f.along_x), add(b.at[4], f.along_y);
-      if (kept(b.part)) planar[b.part] = f;
-    }
+  for (const MassivePart& m : massive_)
+    add_massive_part(parts[m.part], m, g, q, qd, qdd, t, Q, kept(m.part) ? planar + m.part : nullptr);
+  double* const sums = Q.data();
+  std::uint32_t e = 0;
+  for (const BarRow& r : bar_rows_) {
+    double s = r.wx * g.x + r.wy * g.y;
+    if (qdd)
+      for (; e < r.end; ++e) s -= bar_mass_[e] * qdd[bar_cols_[e]];
+    sums[r.coordinate] += s;
+    e = r.end;
+  }
+  for (const auto& [c, wz] : bar_wz_) sums[c] += wz * g.z;
+  if (planar && !read_bars_.empty()) {
+    thread_local std::vector<BarWeight> weights;  // each BarMass's weight under g (its capacity kept from row to row)
+    weights.resize(bar_masses_.size());
+    for (std::size_t k = 0; k < bar_masses_.size(); ++k) weights[k] = bar_weight(bar_masses_[k], g);
+    auto accel = [&](std::int32_t i) { return i >= 0 && qdd ? qdd[i] : 0.0; };
+    for (const BarTerm& b : read_bars_)
+      bar_force_at(bar_masses_[b.mass], weights[b.mass], accel(b.at[0]), accel(b.at[1]), accel(b.at[3]), accel(b.at[4]),
+                   planar[b.part]);
   }
   if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
 }

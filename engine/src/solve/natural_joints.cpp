@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <string_view>
@@ -260,6 +261,15 @@ void JointReactions::add_flat_sums(NaturalSite& s, Index n, const std::vector<In
   for (int k = 0; k < 2; ++k)
     s.simple = s.simple && s.at[k] < n && s.count[k] == 1 &&
                sums.term_first[s.group_first[k] + 1] - sums.term_first[s.group_first[k]] == 1;
+  if (!s.simple) return;
+  set_->simple_sites.resize(set_->natural_sites.size());  // (one per site, at its index)
+  SimpleSite& at = set_->simple_sites[static_cast<std::size_t>(&s - set_->natural_sites.data())];
+  for (int k = 0; k < 2; ++k) {
+    const OwnEntry& e = sums.terms[sums.term_first[s.group_first[k]]];
+    s.simple = s.simple && e.slot <= UINT32_MAX && e.row <= UINT32_MAX;
+    at.slot[k] = static_cast<std::uint32_t>(e.slot), at.row[k] = static_cast<std::uint32_t>(e.row);
+    at.term[k] = s.terms[k][0];
+  }
 }
 
 void JointReactions::size_natural_scratch() {
@@ -488,18 +498,6 @@ bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double
     return sum;
   };
   const detail::PlanarForce& f = planar[s.part];
-  if (s.simple && !set_->joint_axes) {  // the loops below, each of one pass, written out
-    for (int k = 0; k < 2; ++k) {
-      const OwnEntry& e = sums.terms[sums.term_first[s.group_first[k]]];
-      const double v = f.*detail::kPlanarFields[s.terms[k][0] & 7];
-      double qb = 0.0, sum = 0.0;
-      qb += (s.terms[k][0] & 8) ? -v : v;
-      sum += own_values_[static_cast<std::size_t>(e.slot)] * lambda(e.row);
-      out[k] = sum - qb;
-    }
-    out[2] = 0.0;
-    return true;
-  }
   for (int k = 0; k < 2; ++k) {
     double qb = 0.0;  // Q_b at the component, as body_forces() sums it into qb_ (from +0)
     for (int i = 0; i < s.count[k]; ++i) {

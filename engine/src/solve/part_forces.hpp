@@ -9,10 +9,11 @@
 // origin and m A_xᵀ g − M_x· r̈ at x, with no division, root or velocity. On the bar's length it differs from the
 // frame's motion's Q only by a multiple of the bar's own row of Φq (along the bar: what the length's equation
 // carries): λ of every other row, hence every effort and every joint's reaction, is the same; the bar's own
-// multiplier takes the difference. Q is then about four times faster at nfourbar 10⁴ (bench/README.md). Not with
-// ∂τ/∂p (PartForces' `rigid_bars`), where the model dropped redundant rows (BarLengths), nor, with natural joints'
-// reactions, where a bar's row is not its body's (JointReactions::rigid_bars()). Elsewhere the same Q, bit for bit,
-// as add_generalized_forces().
+// multiplier takes the difference. A sweep's Q assembles the bars' matrices and weights once, Q = w(g) − M q̈ over
+// the coordinates they reach: one sparse product a row (bench/README.md). Not with ∂τ/∂p (PartForces'
+// `rigid_bars`), where the model dropped redundant rows (BarLengths), nor, with natural joints' reactions, where a
+// bar's row is not its body's (JointReactions::rigid_bars()). Without bars the same Q, bit for bit, as
+// add_generalized_forces(); with them the same to rounding (the bars' shares summed per entry).
 #pragma once
 
 #include <Eigen/Core>
@@ -125,18 +126,29 @@ class BarLengths {
   std::unordered_map<std::array<std::uint64_t, 4>, Bar, SlotsHash> bar_;  // both orders of a, b
 };
 
-// A rigid bar's force from its four accelerations (origin x, y; x's target x, y): its weight less its constant mass
-// matrix times them, at its two points, read from `p` (a MassivePart, or PartForces' compact copy of one: m_o, m_x,
-// m_b, oo, xx, ox, mass). Always inlined: Q takes it for each of nfourbar 10⁴'s 2·10⁴ parts at every row.
+// A rigid bar's weight at its two points (PlanarForce's fx, fy, along_x, along_y, fz), read from `p` (a MassivePart,
+// or PartForces' shared BarMass: m_o, m_x, m_b, mass): the constant part of bar_force_at()'s force.
+struct BarWeight {
+  double fx = 0.0, fy = 0.0, along_x = 0.0, along_y = 0.0, fz = 0.0;
+};
 template <class Bar>
-[[gnu::always_inline]] inline void bar_force_at(const Bar& p, double aox, double aoy, double axx, double axy,
-                                                kin3::V3 gravity, PlanarForce& f) {
+[[gnu::always_inline]] inline BarWeight bar_weight(const Bar& p, kin3::V3 gravity) {
   const double gx = gravity.x, gy = gravity.y;  // (R v = (−v_y, v_x), the quarter turn)
-  f.fx = (p.m_o * gx - p.m_b * gy) - (p.oo * aox + p.ox * axx - p.m_b * axy);
-  f.fy = (p.m_o * gy + p.m_b * gx) - (p.oo * aoy + p.ox * axy + p.m_b * axx);
-  f.along_x = (p.m_x * gx + p.m_b * gy) - (p.ox * aox + p.m_b * aoy + p.xx * axx);
-  f.along_y = (p.m_x * gy - p.m_b * gx) - (p.ox * aoy - p.m_b * aox + p.xx * axy);
-  f.fz = p.mass * gravity.z, f.turn = 0.0;
+  return {p.m_o * gx - p.m_b * gy, p.m_o * gy + p.m_b * gx, p.m_x * gx + p.m_b * gy, p.m_x * gy - p.m_b * gx,
+          p.mass * gravity.z};
+}
+
+// A rigid bar's force from its weight `w` (bar_weight()) and its four accelerations (origin x, y; x's target x, y):
+// the weight less its constant mass matrix, read from `p` (oo, ox, xx, m_b), times them. Always inlined: Q takes it
+// for each of nfourbar 10⁴'s 2·10⁴ parts at every row.
+template <class Bar>
+[[gnu::always_inline]] inline void bar_force_at(const Bar& p, const BarWeight& w, double aox, double aoy, double axx,
+                                                double axy, PlanarForce& f) {
+  f.fx = w.fx - (p.oo * aox + p.ox * axx - p.m_b * axy);
+  f.fy = w.fy - (p.oo * aoy + p.ox * axy + p.m_b * axx);
+  f.along_x = w.along_x - (p.ox * aox + p.m_b * aoy + p.xx * axx);
+  f.along_y = w.along_y - (p.ox * aoy - p.m_b * aox + p.xx * axy);
+  f.fz = w.fz, f.turn = 0.0;
   f.valid = true;
 }
 
@@ -147,30 +159,42 @@ class PartForces {
   // with their constant mass matrix (file comment). (∂τ/∂p differentiates the frames' motion's Q, with whose λ
   // alone its formula holds: a sweep that asks for them takes no bars.)
   PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars, std::vector<char> planar_read = {});
-  // Q += the parts' and the loads' generalized forces at (q, q̇, q̈, t), as add_generalized_forces(parts, loads, …);
-  // `parts` those this was made from. With `planar` (one entry per part), each part with mass on a planar frame
-  // that `planar_read` flags (every one when it was not given) also leaves there what it added (PlanarForce::valid
-  // false where it took the general path); the others' entries are not touched.
+  // Q += the parts' and the loads' generalized forces at (q, q̇, q̈, t), as add_generalized_forces(parts, loads, …)
+  // (q̈ null: zero); `parts` those this was made from. With `planar` (one entry per part), each part with mass on a
+  // planar frame that `planar_read` flags (every one when it was not given) also leaves there what it added, as
+  // add_massive_part() would, bit for bit (PlanarForce::valid false where it took the general path); the others'
+  // entries are not touched.
   void add(const std::vector<Part>& parts, const Loads& loads, const double* q, const double* qd, const double* qdd,
            double t, Eigen::VectorXd& Q, PlanarForce* planar = nullptr) const;
 
  private:
-  // A rigid bar as add() reads it: its frame's slots decoded (−1: a constant) and its mass matrix's numbers, 104
-  // bytes (a MassivePart's 144 and its slots' tags, read at every row, were most of Q's time at nfourbar 10⁴).
-  struct BarTerm {
-    Index at[5] = {-1, -1, -1, -1, -1};  // origin x, y, z; x's target x, y
+  // A rigid bar's mass numbers (MassivePart's), shared by the bars that have the same (nfourbar's 2·10⁴ have one).
+  struct BarMass {
     double m_o = 0.0, m_x = 0.0, m_b = 0.0, oo = 0.0, xx = 0.0, ox = 0.0, mass = 0.0;
-    std::size_t part = 0;
   };
-  // The parts with mass in order, as runs of rigid bars (bars_[begin, end)) and of the others (massive_[begin,
-  // end)): Q sums each coordinate's terms in the parts' order, as add_generalized_forces() does.
-  struct Run {
-    bool bars = false;
-    std::size_t begin = 0, end = 0;
+  // A rigid bar whose PlanarForce is read (planar_read): its frame's slots decoded (−1: a constant), its BarMass
+  // and its part.
+  struct BarTerm {
+    std::int32_t at[5] = {-1, -1, -1, -1, -1};  // origin x, y, z; x's target x, y
+    std::uint32_t mass = 0;                     // its BarMass
+    std::uint32_t part = 0;                     // its index among the parts
   };
-  std::vector<MassivePart> massive_;
-  std::vector<BarTerm> bars_;
-  std::vector<Run> runs_;
+  // The rigid bars' Q, assembled once (file comment): Q_i += wx_i g_x + wy_i g_y − Σ_j M_ij q̈_j at each coordinate
+  // i the bars reach, M their constant mass matrix summed over the bars (bar_cols_, bar_mass_: the entries of the
+  // i-th row end at `end`) and w their weight per unit of gravity. One sparse product a row instead of 2·10⁴ bars'
+  // scattered sums at nfourbar 10⁴ (bench/README.md).
+  struct BarRow {
+    std::int32_t coordinate = 0;
+    std::uint32_t end = 0;
+    double wx = 0.0, wy = 0.0;
+  };
+  std::vector<MassivePart> massive_;  // the other parts with mass, in order
+  std::vector<BarRow> bar_rows_;
+  std::vector<std::int32_t> bar_cols_;
+  std::vector<double> bar_mass_;
+  std::vector<std::pair<std::int32_t, double>> bar_wz_;  // the weight along z per unit of g_z (a coordinate origin z)
+  std::vector<BarTerm> read_bars_;
+  std::vector<BarMass> bar_masses_;
   std::vector<char> planar_read_;  // per part (empty: every one)
 };
 
