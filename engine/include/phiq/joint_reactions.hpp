@@ -127,12 +127,14 @@ class JointReactions {
     std::vector<std::uint32_t> term_first{0};
     std::vector<OwnEntry> terms;
   };
-  // A simple site's sums (NaturalSite::simple), read without FlatSums' indirections: component k's reaction is
-  // own_values_[slot[k]] λ[row[k]] − Q_b, Q_b the PlanarForce value term[k] names (kPlanarFields' index, +8 when
-  // negated). 10⁴ a row at nfourbar 10⁴.
+  // A simple site (NaturalSite::simple) as a row reads it, 24 bytes, without FlatSums' indirections nor the site's
+  // own 80: component k's reaction is own_values_[slot[k]] λ[row[k]] − Q_b, Q_b the value of `part`'s PlanarForce
+  // that term[k] names (kPlanarFields' index, +8 when negated). 10⁴ a row at nfourbar 10⁴.
   struct SimpleSite {
     std::uint32_t slot[2] = {0, 0}, row[2] = {0, 0};
+    std::uint32_t part = 0;
     std::uint8_t term[2] = {0, 0};
+    bool simple = false;  // the site is simple (else the other fields are not read)
   };
   struct BodyRows {
     std::vector<std::size_t> entries_first, q_first;

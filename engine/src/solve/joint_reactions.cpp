@@ -122,22 +122,21 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
       evaluate_site(set_->sites[k], q, t, lambda, out);
       continue;
     }
-    const NaturalSite& s = set_->natural_sites[k];
-    if (simple && s.simple && planar[s.part].valid) {  // evaluate_flat()'s sums, each of one term, written out
-      const SimpleSite& e = set_->simple_sites[k];
-      const detail::PlanarForce& f = planar[s.part];
+    const SimpleSite* e = simple && k < set_->simple_sites.size() ? &set_->simple_sites[k] : nullptr;
+    if (e && e->simple && planar[e->part].valid) {  // evaluate_flat()'s sums, each of one term, written out
+      const detail::PlanarForce& f = planar[e->part];
       for (int c = 0; c < 2; ++c) {
-        const double v = f.*detail::kPlanarFields[e.term[c] & 7];
+        const double v = f.*detail::kPlanarFields[e->term[c] & 7];
         double qb = 0.0, sum = 0.0;
-        qb += (e.term[c] & 8) ? -v : v;
-        sum += own_values_[e.slot[c]] * lambda(e.row[c]);
+        qb += (e->term[c] & 8) ? -v : v;
+        sum += own_values_[e->slot[c]] * lambda(e->row[c]);
         out[c] = sum - qb;
       }
       out[2] = 0.0;
       out += 3;
       continue;
     }
-    evaluate_natural(s, row, t, lambda, planar, out);
+    evaluate_natural(set_->natural_sites[k], row, t, lambda, planar, out);
   }
 }
 

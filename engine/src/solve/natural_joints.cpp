@@ -266,10 +266,11 @@ void JointReactions::add_flat_sums(NaturalSite& s, Index n, const std::vector<In
   SimpleSite& at = set_->simple_sites[static_cast<std::size_t>(&s - set_->natural_sites.data())];
   for (int k = 0; k < 2; ++k) {
     const OwnEntry& e = sums.terms[sums.term_first[s.group_first[k]]];
-    s.simple = s.simple && e.slot <= UINT32_MAX && e.row <= UINT32_MAX;
+    s.simple = s.simple && e.slot <= UINT32_MAX && e.row <= UINT32_MAX && s.part <= UINT32_MAX;
     at.slot[k] = static_cast<std::uint32_t>(e.slot), at.row[k] = static_cast<std::uint32_t>(e.row);
     at.term[k] = s.terms[k][0];
   }
+  at.part = static_cast<std::uint32_t>(s.part), at.simple = s.simple;
 }
 
 void JointReactions::size_natural_scratch() {
