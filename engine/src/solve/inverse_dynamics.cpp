@@ -1,10 +1,10 @@
 // add_generalized_forces() and constraint_multipliers() (phiq/inverse_dynamics.hpp).
 #include "phiq/inverse_dynamics.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <climits>
 #include <cstdint>
-#include <algorithm>
 #include <map>
 
 #include "phiq/applied_loads.hpp"
