@@ -90,6 +90,39 @@ Scene natural_four_bar(const std::string& first = "") {
   return parse_scene(text, "fourbar_natural.yaml");
 }
 
+// A natural body keeps its part's mass, not a copy of the part: natural_body_parts() builds it, named as the body,
+// with the scene part's mass properties, on its frame with the promoted points (O's and C's constants as
+// coordinates n, n + 1, …), and none for a body without mass.
+TEST(NaturalReactions, ABodysPartIsBuiltOnItsPromotedPoints) {
+  const Scene s = natural_four_bar();
+  const NaturalJoints& natural = *s.sweep.efforts.natural;
+  const Index n = s.model->num_coordinates();
+  std::vector<Part> built;
+  int promoted = 0;
+  for (const NaturalBody& b : natural.bodies) {
+    natural_body_parts(b, built);
+    ASSERT_EQ(built.size(), 1u) << b.name;
+    const Part& p = built[0];
+    const Part& scene = s.parts.at(b.part);
+    EXPECT_EQ(p.name, b.name);
+    EXPECT_EQ(p.mass.mass, scene.mass.mass);
+    EXPECT_EQ(p.mass.inertia, scene.mass.inertia);
+    EXPECT_EQ(p.mass.center.x, scene.mass.center.x);
+    for (const auto& [built_point, body_point] :
+         {std::pair{&p.frame.origin, &b.points.at(0)}, std::pair{&p.frame.x_toward, &b.points.at(1)}})
+      for (int k = 0; k < 2; ++k) {
+        EXPECT_EQ(built_point->r[k], body_point->r[k]) << b.name << k;
+        ASSERT_TRUE(built_point->r[k].is_coordinate()) << b.name << k;  // (constants promoted)
+        promoted += built_point->r[k].coord() >= n;
+      }
+    NaturalBody massless = b;
+    massless.mass_source = MassSource::kNone;
+    natural_body_parts(massless, built);
+    EXPECT_TRUE(built.empty()) << b.name;
+  }
+  EXPECT_EQ(promoted, 4);  // O's and C's x and y
+}
+
 TEST(NaturalReactions, FourBarPinsAndTorqueAreTheReferencePointForms) {
   const Scene natural = natural_four_bar();
   std::string text = natural_reactions_scene("seed/fourbar_reference_point.yaml");

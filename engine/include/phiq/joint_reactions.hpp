@@ -201,8 +201,11 @@ class JointReactions {
     std::shared_ptr<const NaturalJoints> natural;
     BodyRows body_rows;
     std::vector<BodyPart> body_parts;  // per natural body
-    bool joint_axes = false;           // constraints' reactions along ReactionSite::axes, not world axes
-    bool rigid_bars = false;           // rigid_bars()
+    // per natural body, its parts (natural_body_parts()) where a site of its takes the general path at every row
+    // (not flat), else empty
+    std::vector<std::vector<Part>> body_parts_kept;
+    bool joint_axes = false;  // constraints' reactions along ReactionSite::axes, not world axes
+    bool rigid_bars = false;  // rigid_bars()
     Index size = 0;
   };
   std::shared_ptr<SetUp> set_ = std::make_shared<SetUp>();
@@ -210,6 +213,7 @@ class JointReactions {
   std::vector<double> g_;                 // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
   std::vector<double> own_values_;        // Φq's values (its pattern's slots) of the natural bodies' own constraints
   PartJacobian jac_;                      // the body's frame Jacobian (its capacity kept: no allocation per row)
+  std::vector<Part> body_part_;           // a body's parts built where they are read (body_parts_kept's others)
 };
 
 /// The multipliers of least norm among those with Φqᵀ λ = Q, from `lambda`, one of them (λ = 0 on the rows the model

@@ -37,15 +37,26 @@ struct NaturalBody {
   /// Its index among the parts find_natural_joints() was given (unknown: the largest size_t), where a sweep's Q has
   /// already computed its part's weight and inertia.
   std::size_t part = static_cast<std::size_t>(-1);
-  PartFrame frame;  ///< its frame (PartFrameKind::kPoints)
-  /// Its part when it has mass (shapes cleared), else empty; its frame's constant point components made coordinates
-  /// n, n + 1, … (NaturalJoints::promoted), so that Q differentiates along them.
-  std::vector<Part> parts;
+  PartFrame frame;  ///< its frame (PartFrameKind::kPoints), as the model reads it
+  /// Its part's mass properties when it has mass, else zero and kNone. Its part as its own Q takes it is
+  /// natural_body_parts(): not kept here (a copy of each part, ~700 bytes, 14 MB at 2·10⁴ bodies, that a sweep
+  /// whose joints read the whole model's Q never reads).
+  MassProperties mass;
+  MassSource mass_source = MassSource::kNone;  ///< see mass
   Loads loads;  ///< gravity and the applied loads on this part alone (their frames promoted likewise)
-  /// The frame's points (origin, and x, y toward when they are points), each component's slot as the model reads
-  /// it (a coordinate, or a constant).
+  /// The frame's points (origin, and x, y toward when they are points), each component's slot with the constants
+  /// promoted: coordinate n + k for NaturalJoints::promoted[k], so that Q differentiates along them.
   std::vector<Attachment3> points;
 };
+
+/// Whether body `b`'s part has mass (its own Q counts it).
+inline bool natural_body_has_mass(const NaturalBody& b) {
+  return b.mass_source != MassSource::kNone && b.mass.mass > 0.0;
+}
+
+/// Body `b`'s part as its own Q takes it, into `out` (its storage reused): none when it has no mass, else one
+/// part named as the body, with its mass properties, on its frame with its points promoted (NaturalBody::points).
+void natural_body_parts(const NaturalBody& b, std::vector<Part>& out);
 
 /// A joint at a named natural point (file comment).
 struct NaturalJoint {

@@ -90,10 +90,7 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
         }
       b.points.push_back(*a);
     }
-    if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0) {
-      b.parts.push_back(without_shapes(p));
-      b.parts.back().frame = promoted;
-    }
+    b.mass = p.mass, b.mass_source = p.mass_source;  // (natural_body_has_mass(): a mass > 0)
     b.loads.gravity = loads.gravity;
     if (const auto it = loads_of.find(p.name); it != loads_of.end()) {
       auto own = std::make_shared<AppliedLoads>();
@@ -132,6 +129,18 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
     if (j.bodies.size() >= 2 || (j.bodies.size() == 1 && held)) out.joints.push_back(std::move(j));
   }
   return out;
+}
+
+void natural_body_parts(const NaturalBody& b, std::vector<Part>& out) {
+  if (!natural_body_has_mass(b)) {
+    out.clear();
+    return;
+  }
+  out.resize(1);
+  Part& p = out[0];
+  p.name = b.name, p.frame = b.frame, p.mass = b.mass, p.mass_source = b.mass_source;
+  std::size_t k = 0;
+  for (Attachment3* a : frame_points(p.frame)) *a = b.points.at(k++);
 }
 
 namespace {
@@ -177,6 +186,7 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
   // A body's part among the efforts' parts: at its own index when they are the parts it was found among, else by
   // name (a scene's efforts keep the parts with mass only: a massless part before it shifts every index).
   std::unordered_map<std::string_view, std::size_t> by_name;
+  std::vector<Part> own_parts;  // a body's (natural_body_parts(): its storage reused)
   auto part_of = [&](const NaturalBody& body) {
     if (body.part < parts.size() && parts[body.part].name == body.name) return body.part;
     if (by_name.empty())
@@ -190,11 +200,12 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
     const double bar = bars.of(body.frame);  // (its frame before promotion: the model's slots)
     set_->body_parts[b].bar_length = bar;
     const std::size_t index = part_of(body);
-    if (body.parts.size() != 1 || index == BodyPart::kNone || !detail::has_mass(body.parts[0]) ||
+    natural_body_parts(body, own_parts);
+    if (own_parts.size() != 1 || index == BodyPart::kNone || !detail::has_mass(own_parts[0]) ||
         !detail::has_mass(parts[index]) || !same_bits(g.x, own_g.x) || !same_bits(g.y, own_g.y) ||
         !same_bits(g.z, own_g.z))
       continue;
-    const detail::MassivePart own = detail::massive_part(body.parts[0], 0, bar);
+    const detail::MassivePart own = detail::massive_part(own_parts[0], 0, bar);
     if (!same_planar_force(detail::massive_part(parts[index], index, bars.of(parts[index].frame)), own,
                            set_->natural->promoted, model.num_coordinates()) ||
         own.frame.body)
@@ -407,12 +418,18 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
   detail::BarLengths bars = rigid_bars ? detail::BarLengths(model) : detail::BarLengths();
   for (std::size_t b = 0; b < nb && rigid_bars; ++b) {
     const detail::BarLengths::Bar* bar = bars.find(bodies[b].frame);
-    rigid_bars = !bar || bodies[b].parts.empty() || owner[bar->constraint] == b;
+    rigid_bars = !bar || !natural_body_has_mass(bodies[b]) || owner[bar->constraint] == b;
   }
   set_->rigid_bars = rigid_bars;
   if (!rigid_bars) bars = detail::BarLengths();  // (as the sweep's Q, detail::PartForces, then takes them: none)
   find_body_parts(model, efforts, bars);
   find_flat_sites(model);
+  // the bodies whose sites a sweep's row takes by the general path keep their parts (the others build them where
+  // they are read: a flat site whose part's force Q did not compute)
+  set_->body_parts_kept.resize(nb);
+  for (const NaturalSite& s : set_->natural_sites)
+    if (!s.flat && set_->body_parts_kept[s.body].empty())
+      natural_body_parts(bodies[s.body], set_->body_parts_kept[s.body]);
 }
 
 std::vector<char> JointReactions::planar_parts_read(std::size_t parts) const {
@@ -439,15 +456,18 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
     return;
   }
   const NaturalBody& body = set_->natural->bodies[b];
-  if (planar && part.bar_length > 0.0 && body.parts.size() == 1) {
+  const std::vector<Part>* parts = &set_->body_parts_kept[b];
+  if (parts->empty() && natural_body_has_mass(body)) natural_body_parts(body, body_part_), parts = &body_part_;
+  if (planar && part.bar_length > 0.0 && parts->size() == 1) {
     // a rigid bar whose force the sweep's Q took in its constant mass matrix's form (not found among its parts):
     // the same form, which λ was solved with
-    detail::add_massive_part(body.parts[0], detail::massive_part(body.parts[0], 0, part.bar_length), body.loads.gravity,
-                             qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
+    const Part& p = (*parts)[0];
+    detail::add_massive_part(p, detail::massive_part(p, 0, part.bar_length), body.loads.gravity, qx_.data(),
+                             qdx_.data(), qddx_.data(), t, qb_);
     if (body.loads.applied) add_applied_forces(*body.loads.applied, qx_.data(), qdx_.data(), t, qb_);
     return;
   }
-  add_generalized_forces(body.parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
+  add_generalized_forces(*parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
 }
 
 void JointReactions::evaluate_own_jacobian(const double* q, double t) {
