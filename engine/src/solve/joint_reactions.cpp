@@ -66,6 +66,8 @@ JointReactions::JointReactions(const Model& model, const OutputEfforts& efforts,
     : g_(static_cast<std::size_t>(model.num_coordinates()), 0.0) {
   set_->joint_axes = efforts.reactions_in_joint_axes, set_->rigid_bars = rigid_bars;
   std::vector<int> site_of(model.constraints().size(), -1);
+  set_->order.reserve(efforts.reactions.size());  // (not grown by doubling: 10⁴ sites at nfourbar 10⁴)
+  set_->natural_sites.reserve(efforts.natural ? efforts.reactions.size() : 0);
   for (const OutputReaction& r : efforts.reactions) {
     if (r.natural < 0) {
       add_site(model, r.constraint, site_of);
