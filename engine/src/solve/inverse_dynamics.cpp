@@ -204,26 +204,34 @@ detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& mode
     }
     std::int32_t at[5];
     for (int k = 0; k < 5; ++k) at[k] = static_cast<std::int32_t>(m.frame.slots[k].coord());  // (−1: a constant)
-    // bar_force_at()'s rows: the origin's x, y, then x's target's x, y, each w · g − M · q̈
-    const auto [ox, oy, oz, xx, xy] = at;
-    const double mb = m.m_b;
-    const std::array<std::int32_t, 4> rows{ox, oy, xx, xy};
-    const std::array<std::array<double, 2>, 4> w{{{m.m_o, -mb}, {mb, m.m_o}, {m.m_x, mb}, {-mb, m.m_x}}};
-    const std::array<std::array<std::pair<std::int32_t, double>, 3>, 4> terms{{{{{ox, m.oo}, {xx, m.ox}, {xy, -mb}}},
-                                                                               {{{oy, m.oo}, {xy, m.ox}, {xx, mb}}},
-                                                                               {{{ox, m.ox}, {oy, mb}, {xx, m.xx}}},
-                                                                               {{{oy, m.ox}, {ox, -mb}, {xy, m.xx}}}}};
-    for (int r = 0; r < 4; ++r) {
+    // bar_force_at()'s rows (its origin's x, y, then its x point's x, y: fx, fy, along_x, along_y), each w · g − M · q̈,
+    // read off the force itself: w's columns its weight under a unit gravity along x and along y, M's column j its
+    // force at the unit acceleration of its j-th point coordinate, negated (the force is linear in both)
+    const std::int32_t rows[4] = {at[0], at[1], at[3], at[4]};
+    auto row_values = [](const PlanarForce& f) { return std::array<double, 4>{f.fx, f.fy, f.along_x, f.along_y}; };
+    auto weight_values = [](const BarWeight& w) { return std::array<double, 4>{w.fx, w.fy, w.along_x, w.along_y}; };
+    const std::array<double, 4> wx = weight_values(bar_weight(m, {1.0, 0.0, 0.0})),
+                                wy = weight_values(bar_weight(m, {0.0, 1.0, 0.0}));
+    std::array<std::array<double, 4>, 4> column;  // column[j][r]: −M[rows[r], rows[j]]
+    for (int j = 0; j < 4; ++j) {
+      double a[4] = {0.0, 0.0, 0.0, 0.0};
+      a[j] = 1.0;
+      PlanarForce f;
+      bar_force_at(m, BarWeight{}, a[0], a[1], a[2], a[3], f);
+      column[static_cast<std::size_t>(j)] = row_values(f);
+    }
+    for (std::size_t r = 0; r < 4; ++r) {
       if (rows[r] < 0) continue;
       if (weight.empty()) weight.assign(static_cast<std::size_t>(model.num_coordinates()), {0.0, 0.0});
       if (reached.empty()) reached.assign(weight.size(), 0);
       auto& sum = weight[static_cast<std::size_t>(rows[r])];
-      sum[0] += w[r][0], sum[1] += w[r][1];
+      sum[0] += wx[r], sum[1] += wy[r];
       reached[static_cast<std::size_t>(rows[r])] = 1;
-      for (const auto& [col, v] : terms[r])
-        if (col >= 0) entries.push_back({rows[r], col, v});
+      for (std::size_t j = 0; j < 4; ++j)
+        if (rows[j] >= 0 && column[j][r] != 0.0) entries.push_back({rows[r], rows[j], -column[j][r]});
     }
-    if (oz >= 0) bar_wz_.emplace_back(oz, m.mass);
+    const std::int32_t oz = at[2];
+    if (oz >= 0) bar_wz_.emplace_back(oz, bar_weight(m, {0.0, 0.0, 1.0}).fz);
     if (!planar_read_.empty() && !planar_read_[i]) continue;
     const BarMass mass{m.m_o, m.m_x, m.m_b, m.oo, m.xx, m.ox, m.mass};
     const std::array<std::uint64_t, 7> key{
