@@ -378,7 +378,9 @@ TEST(NaturalReactions, FlatSitesAreTheGeneralPathBitForBit) {
         ws.q = rows.q[k];
         ASSERT_EQ(constraint_multipliers(m, t, ws, Q, lambda), SolveStatus::kSuccess);
         std::vector<double> general(n), flat(n);
-        std::vector<detail::PlanarForce> unread = planar;  // the general path, in the bars' form where they are
+        // the general path, in the bars' form where they are (and a rigid bar's simple site, which sums its field
+        // itself where Q left no force: JointReactions::SimpleSite)
+        std::vector<detail::PlanarForce> unread = planar;
         for (detail::PlanarForce& f : unread) f.valid = false;
         reactions.evaluate(q, qd, qdd, t, lambda, general.data(), bars ? unread.data() : nullptr);
         reactions.evaluate(q, qd, qdd, t, lambda, flat.data(), planar.data());

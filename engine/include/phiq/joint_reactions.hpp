@@ -127,14 +127,21 @@ class JointReactions {
     std::vector<std::uint32_t> term_first{0};
     std::vector<OwnEntry> terms;
   };
-  // A simple site (NaturalSite::simple) as a row reads it, 24 bytes, without FlatSums' indirections nor the site's
-  // own 80: component k's reaction is own_values_[slot[k]] λ[row[k]] − Q_b, Q_b the value of `part`'s PlanarForce
-  // that term[k] names (kPlanarFields' index, +8 when negated). 10⁴ a row at nfourbar 10⁴.
+  // A simple site (NaturalSite::simple) as a row reads it, without FlatSums' indirections nor the site's own 80
+  // bytes: component k's reaction is own_values_[slot[k]] λ[row[k]] − Q_b, Q_b the value of `part`'s PlanarForce
+  // that term[k] names (kPlanarFields' index, +8 when negated). On a rigid bar (`bar`) whose PlanarForce Q did not
+  // compute (planar_parts_read()), the site sums that value itself, as detail::bar_field() does: weight[k] − ((m[k][0]
+  // q̈[a[k][0]] + m[k][1] q̈[a[k][1]]) + m[k][2] q̈[a[k][2]]), a term on a constant slot with m 0 (a ±0, which changes no
+  // sum but a zero's sign, and Q_b starts from +0): no PlanarForce is computed for it. 10⁴ a row at nfourbar 10⁴, where
+  // that saves a crank's whole force.
   struct SimpleSite {
     std::uint32_t slot[2] = {0, 0}, row[2] = {0, 0};
     std::uint32_t part = 0;
     std::uint8_t term[2] = {0, 0};
     bool simple = false;  // the site is simple (else the other fields are not read)
+    bool bar = false;
+    std::uint32_t a[2][3] = {};
+    double m[2][3] = {}, weight[2] = {};
   };
   struct BodyRows {
     std::vector<std::size_t> entries_first, q_first;
@@ -156,6 +163,10 @@ class JointReactions {
     Slot slots[5];
     bool x_is_point = true;
     double bar_length = 0.0;  // > 0: the body is a rigid bar, its force a bar's (solve/part_forces.hpp)
+    // where `part` is a rigid bar: its mass numbers (detail::bar_number()'s order) and its weight's shares of each
+    // PlanarForce field under the loads' gravity (detail::bar_weight_share())
+    bool bar_form = false;
+    double bar_numbers[4] = {}, bar_weights[6] = {};
     const AppliedLoads* applied = nullptr;
     detail::PlanarFrame frame() const;  // the promoted planar frame the slots name
   };

@@ -125,6 +125,21 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
       continue;
     }
     const SimpleSite* e = simple && k < set_->simple_sites.size() ? &set_->simple_sites[k] : nullptr;
+    // as below, where Q left no force for the part (PartForces reads planar_parts_read()): the bar's field summed
+    // here (SimpleSite), the same bits
+    if (e && e->bar && qdd && !planar[e->part].valid) {
+      for (int c = 0; c < 2; ++c) {
+        const double v = e->weight[c] -
+                         ((e->m[c][0] * qdd[e->a[c][0]] + e->m[c][1] * qdd[e->a[c][1]]) + e->m[c][2] * qdd[e->a[c][2]]);
+        double qb = 0.0, sum = 0.0;
+        qb += (e->term[c] & 8) ? -v : v;
+        sum += own_values_[e->slot[c]] * lambda(e->row[c]);
+        out[c] = sum - qb;
+      }
+      out[2] = 0.0;
+      out += 3;
+      continue;
+    }
     if (e && e->simple && planar[e->part].valid) {  // evaluate_flat()'s sums, each of one term, written out
       const detail::PlanarForce& f = planar[e->part];
       for (int c = 0; c < 2; ++c) {

@@ -206,13 +206,16 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
         !same_bits(g.z, own_g.z))
       continue;
     const detail::MassivePart own = detail::massive_part(own_parts[0], 0, bar);
-    if (!same_planar_force(detail::massive_part(parts[index], index, bars.of(parts[index].frame)), own,
-                           set_->natural->promoted, model.num_coordinates()) ||
-        own.frame.body)
-      continue;
+    const detail::MassivePart whole = detail::massive_part(parts[index], index, bars.of(parts[index].frame));
+    if (!same_planar_force(whole, own, set_->natural->promoted, model.num_coordinates()) || own.frame.body) continue;
     BodyPart& bp = set_->body_parts[b];
     bp.part = index, bp.x_is_point = own.frame.x_is_point, bp.applied = body.loads.applied.get();
     std::copy(own.frame.slots, own.frame.slots + 5, bp.slots);
+    if ((bp.bar_form = whole.frame.bar)) {  // the numbers and weight the whole model's Q takes (PartForces)
+      const detail::BarWeight w = detail::bar_weight(whole, g);
+      for (int k = 0; k < 4; ++k) bp.bar_numbers[k] = detail::bar_number(whole, k);
+      for (int f = 0; f < 6; ++f) bp.bar_weights[f] = detail::bar_weight_share(w, f);
+    }
   }
 }
 
@@ -282,6 +285,21 @@ void JointReactions::add_flat_sums(NaturalSite& s, Index n, const std::vector<In
     at.term[k] = s.terms[k][0];
   }
   at.part = static_cast<std::uint32_t>(s.part), at.simple = s.simple;
+  const BodyPart& part = set_->body_parts[s.body];
+  if (!(at.bar = at.simple && part.bar_form)) return;
+  const Slot* slots[4] = {&part.slots[0], &part.slots[1], &part.slots[3], &part.slots[4]};  // (kBarFields' a_k)
+  for (int k = 0; k < 2; ++k) {
+    const int field = at.term[k] & 7;
+    const detail::BarField& f = detail::kBarFields[field];
+    at.weight[k] = part.bar_weights[field];
+    for (int i = 0; i < f.count; ++i) {
+      const detail::BarFieldTerm& term = f.terms[i];
+      const Slot& slot = *slots[term.accel];
+      if (!slot.is_coordinate() || slot.coord() >= n) continue;  // a constant's acceleration: 0 (m 0, a ±0)
+      const double number = part.bar_numbers[term.number];
+      at.a[k][i] = static_cast<std::uint32_t>(slot.coord()), at.m[k][i] = term.minus ? -number : number;
+    }
+  }
 }
 
 void JointReactions::size_natural_scratch() {
@@ -434,8 +452,12 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
 
 std::vector<char> JointReactions::planar_parts_read(std::size_t parts) const {
   std::vector<char> read(parts, 0);
-  for (const NaturalSite& s : set_->natural_sites)
+  for (std::size_t k = 0; k < set_->natural_sites.size(); ++k) {
+    const NaturalSite& s = set_->natural_sites[k];
+    // (a rigid bar's simple site sums its force itself where Q left none: evaluate() does so without joint axes)
+    if (k < set_->simple_sites.size() && set_->simple_sites[k].bar && !set_->joint_axes) continue;
     if (const std::size_t p = set_->body_parts[s.body].part; p < parts) read[p] = 1;
+  }
   return read;
 }
 

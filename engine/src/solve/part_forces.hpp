@@ -138,16 +138,58 @@ template <class Bar>
           p.mass * gravity.z};
 }
 
+// w's share of PlanarForce field `field` (kPlanarFields' order; turn's is zero)
+inline double bar_weight_share(const BarWeight& w, int field) {
+  const double shares[6] = {w.fx, w.fy, w.fz, 0.0, w.along_x, w.along_y};
+  return shares[field];
+}
+
+// A rigid bar's force field by field (kPlanarFields' order), the one statement of its sums: the weight's share less
+// ((n₀ a₀ + n₁ a₁) + n₂ a₂), each a_k one of its frame's four accelerations (`accel`: origin x, y; x's target x, y)
+// and n_k one of its mass numbers (`number`: oo, ox, xx, m_b), negated where `minus`. fz is the weight's alone and
+// turn zero (`count` 0). Those who sum one field alone (JointReactions' simple sites) read it here, in this order,
+// and so get bar_force_at()'s bits.
+struct BarFieldTerm {
+  std::uint8_t accel = 0, number = 0;
+  bool minus = false;
+};
+struct BarField {
+  int count = 0;
+  BarFieldTerm terms[3];
+};
+inline constexpr BarField kBarFields[6] = {
+    {3, {{0, 0, false}, {2, 1, false}, {3, 3, true}}},   // fx: M_oo a_o + M_ox a_x, M_ox = ox I + m_b R
+    {3, {{1, 0, false}, {3, 1, false}, {2, 3, false}}},  // fy
+    {0, {}},                                             // fz: the weight's
+    {0, {}},                                             // turn: none (a bar has no angle of its own)
+    {3, {{0, 1, false}, {1, 3, false}, {2, 2, false}}},  // along_x: M_xo a_o + M_xx a_x, M_xo = ox I − m_b R
+    {3, {{1, 1, false}, {0, 3, true}, {3, 2, false}}},   // along_y
+};
+// mass number k of kBarFields (0 oo, 1 ox, 2 xx, 3 m_b) of `p` (a MassivePart, or PartForces' shared BarMass)
+template <class Bar>
+constexpr double bar_number(const Bar& p, int k) {
+  return k == 0 ? p.oo : k == 1 ? p.ox : k == 2 ? p.xx : p.m_b;
+}
+// field `field` of a rigid bar's force with weight share `weight` at accelerations `a` (kBarFields' sums)
+template <class Bar>
+[[gnu::always_inline]] inline double bar_field(const Bar& p, double weight, int field, const double (&a)[4]) {
+  const BarField& f = kBarFields[field];
+  if (f.count == 0) return weight;
+  auto term = [&](const BarFieldTerm& t) {
+    return (t.minus ? -bar_number(p, t.number) : bar_number(p, t.number)) * a[t.accel];
+  };
+  return weight - ((term(f.terms[0]) + term(f.terms[1])) + term(f.terms[2]));
+}
+
 // A rigid bar's force from its weight `w` (bar_weight()) and its four accelerations (origin x, y; x's target x, y):
-// the weight less its constant mass matrix, read from `p` (oo, ox, xx, m_b), times them. Always inlined: Q takes it
-// for each of nfourbar 10⁴'s 2·10⁴ parts at every row.
+// the weight less its constant mass matrix, read from `p` (oo, ox, xx, m_b), times them (kBarFields). Always
+// inlined: Q takes it for each of nfourbar 10⁴'s 2·10⁴ parts at every row.
 template <class Bar>
 [[gnu::always_inline]] inline void bar_force_at(const Bar& p, const BarWeight& w, double aox, double aoy, double axx,
                                                 double axy, PlanarForce& f) {
-  f.fx = w.fx - (p.oo * aox + p.ox * axx - p.m_b * axy);
-  f.fy = w.fy - (p.oo * aoy + p.ox * axy + p.m_b * axx);
-  f.along_x = w.along_x - (p.ox * aox + p.m_b * aoy + p.xx * axx);
-  f.along_y = w.along_y - (p.ox * aoy - p.m_b * aox + p.xx * axy);
+  const double a[4] = {aox, aoy, axx, axy};
+  f.fx = bar_field(p, w.fx, 0, a), f.fy = bar_field(p, w.fy, 1, a);
+  f.along_x = bar_field(p, w.along_x, 4, a), f.along_y = bar_field(p, w.along_y, 5, a);
   f.fz = w.fz, f.turn = 0.0;
   f.valid = true;
 }
