@@ -6,6 +6,7 @@
 #include <cstring>
 #include <map>
 #include <set>
+#include <type_traits>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -172,6 +173,27 @@ constexpr std::size_t kValuesPerTask = 1024;
 
 // Calls emit(v) for each value after the coordinate columns, in column order: the one computation of those values
 // for the CSV text and for append_output_values() (the HDF5 writer), so that the two files cannot disagree.
+namespace {
+// emit(values, count) where Emit takes a run, else emit() value by value
+template <class Emit>
+void emit_run(Emit& emit, const double* values, std::size_t count) {
+  if constexpr (std::is_invocable_v<Emit&, const double*, std::size_t>)
+    emit(values, count);
+  else
+    for (std::size_t i = 0; i < count; ++i) emit(values[i]);
+}
+// What append_output_values() and append_values() emit into: the doubles in order, each `Store`d.
+template <class Store>
+struct ValuesOut {
+  double*& out;
+  Store store;
+  void operator()(double v) { *out++ = store(v); }
+  void operator()(const double* values, std::size_t count) { out = std::transform(values, values + count, out, store); }
+};
+template <class Store>
+ValuesOut(double*&, Store) -> ValuesOut<Store>;
+}  // namespace
+
 template <class Emit>
 void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
   const auto& points = plan_->points;
@@ -236,11 +258,11 @@ void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
   if (plan_->efforts.active()) {
     if (!s.efforts) throw Error("CsvFormat: step has no efforts");
     const std::size_t n = plan_->efforts.constraints.size();
-    for (std::size_t i = 0; i < (plan_->efforts.power ? 2 * n : n); ++i) emit(s.efforts[i]);
+    emit_run(emit, s.efforts, plan_->efforts.power ? 2 * n : n);
     // reactions, then ∂τ/∂p, then ∂P/∂p with the powers
     const std::size_t taus = static_cast<std::size_t>(plan_->efforts.size()) + n * plan_->sensitivities.size();
     const std::size_t all = plan_->efforts.power ? taus + n * plan_->sensitivities.size() : taus;
-    for (std::size_t i = 2 * n; i < all; ++i) emit(s.efforts[i]);
+    emit_run(emit, s.efforts + 2 * n, all - 2 * n);
   }
 }
 
@@ -268,7 +290,7 @@ void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
 
 void CsvFormat::append_output_values(const StepView& s, double* out) const {
   if (!plan_) return;
-  for_each_output(s, [&](double v) { *out++ = v; });
+  for_each_output(s, ValuesOut{out, [](double v) { return v; }});
 }
 
 std::size_t CsvFormat::num_output_values() const {
@@ -293,13 +315,12 @@ std::size_t CsvFormat::num_values() const {
 
 void CsvFormat::append_values(const StepView& s, double* out) const {
   check_coordinates(s);
-  auto store = [](double v) { return v == 0.0 ? 0.0 : v; };  // −0 → 0, as put() writes it
-  *out++ = store(s.t);
+  *out++ = stored_value(s.t);  // (−0 → 0, as put() writes it)
   const Eigen::VectorXd* groups[3] = {&s.q, s.qd, s.qdd};
   const std::vector<Index>* cols[3] = {&columns_, &v_columns_, &a_columns_};
   for (int g = 0; g < 3; ++g)
-    for (Index c : *cols[g]) *out++ = store((*groups[g])(c));
-  if (plan_) for_each_output(s, [&](double v) { *out++ = store(v); });
+    for (Index c : *cols[g]) *out++ = stored_value((*groups[g])(c));
+  if (plan_) for_each_output(s, ValuesOut{out, stored_value});
 }
 
 void CsvFormat::append_row(const StepView& s, std::string& out) const {

@@ -353,15 +353,14 @@ void Hdf5Writer::append_row(const StepView& s) {
   const std::size_t k = w.next_row();
   if (w.batch_case) throw Error(w.cannot("a batch's rows are given with their case (append_values)"));
   // −0 → 0, as the CSV writes it: the two files of a run hold the same doubles
-  auto store = [](double v) { return v == 0.0 ? 0.0 : v; };
-  w.t->held[k] = store(s.t);
+  w.t->held[k] = stored_value(s.t);
   auto gather = [&](Group* g, const Eigen::VectorXd* v, const std::vector<Index>& cols, const char* what) {
     if (!g) return;
     if (!v) throw Error(std::string("Hdf5Writer: step has no ") + what);
     if (v->size() != w.model.num_coordinates()) throw Error("Hdf5Writer: step's vectors are not the model's size");
     const std::size_t n = cols.size();
     double* out = g->held.data() + k * n;
-    for (std::size_t c = 0; c < n; ++c) out[c] = store((*v)(cols[c]));
+    for (std::size_t c = 0; c < n; ++c) out[c] = stored_value((*v)(cols[c]));
   };
   gather(w.q, &s.q, w.plan.coordinate_columns, "positions");
   gather(w.qd, s.qd, w.plan.written_velocities(), "velocities");
@@ -371,7 +370,7 @@ void Hdf5Writer::append_row(const StepView& s) {
     const double* v = w.output_row.data();
     for (Group* g : w.outputs) {
       const std::size_t m = g->columns.size();
-      std::transform(v, v + m, g->held.data() + k * m, store);
+      std::transform(v, v + m, g->held.data() + k * m, stored_value);
       v += m;
     }
   }
@@ -382,7 +381,7 @@ void Hdf5Writer::append_values(const double* row) {
   Impl& w = *impl_;
   if (w.closed) throw Error(w.cannot("already closed"));
   w.hold_values([row](double* to, std::size_t first, std::size_t m) {
-    std::transform(row + first, row + first + m, to, [](double v) { return v == 0.0 ? 0.0 : v; });
+    std::transform(row + first, row + first + m, to, stored_value);
   });
 }
 

@@ -119,12 +119,14 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
   RowMotion row{q, qd, qdd, false};
   evaluate_own_jacobian(q, t);
   const bool simple = planar && !set_->joint_axes;  // (NaturalSite::simple's sums are in world axes)
+  const SimpleSite* const simple_sites = set_->simple_sites.data();
+  const std::size_t simple_count = set_->simple_sites.size();
   for (const auto& [natural, k] : set_->order) {
     if (!natural) {
       evaluate_site(set_->sites[k], q, t, lambda, out);
       continue;
     }
-    const SimpleSite* e = simple && k < set_->simple_sites.size() ? &set_->simple_sites[k] : nullptr;
+    const SimpleSite* e = simple && k < simple_count ? simple_sites + k : nullptr;
     // as below, where Q left no force for the part (PartForces reads planar_parts_read()): the bar's field summed
     // here (SimpleSite), the same bits
     if (e && e->bar && qdd && !planar[e->part].valid) {
