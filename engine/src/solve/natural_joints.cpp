@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <string_view>
+#include <type_traits>
 #include <unordered_map>
 
 #include "phiq/constraint_block.hpp"
@@ -20,12 +21,21 @@ namespace phiq {
 
 namespace {
 
-// The frame's points: the origin, and x and y toward when they are points (a vector has no place to act).
+// The frame's points: the origin, and x and y toward when they are points (a vector has no place to act). In place,
+// not a vector: set-up asks for them several times per body, 10⁵ allocations at nfourbar 10⁴.
+template <class Point>
+struct FramePoints {
+  Point* at[3];
+  int count = 0;
+  Point* const* begin() const { return at; }
+  Point* const* end() const { return at + count; }
+};
 template <class Frame>  // PartFrame or const PartFrame
 auto frame_points(Frame& f) {
-  std::vector<decltype(&f.origin)> out{&f.origin};
-  if (f.x_is_point) out.push_back(&f.x_toward);
-  if (f.spatial_frame && f.y_is_point) out.push_back(&f.y_toward);
+  FramePoints<std::remove_reference_t<decltype(f.origin)>> out;
+  out.at[out.count++] = &f.origin;
+  if (f.x_is_point) out.at[out.count++] = &f.x_toward;
+  if (f.spatial_frame && f.y_is_point) out.at[out.count++] = &f.y_toward;
   return out;
 }
 
@@ -215,89 +225,6 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
       const detail::BarWeight w = detail::bar_weight(whole, g);
       for (int k = 0; k < 4; ++k) bp.bar_numbers[k] = detail::bar_number(whole, k);
       for (int f = 0; f < 6; ++f) bp.bar_weights[f] = detail::bar_weight_share(w, f);
-    }
-  }
-}
-
-void JointReactions::find_flat_sites(const Model& model) {
-  if (set_->natural->spatial) return;
-  std::vector<Index> moving[2];  // a fixed component's moving points' coordinates (its capacity kept)
-  for (NaturalSite& s : set_->natural_sites) {
-    const BodyPart& part = set_->body_parts[s.body];
-    s.flat = false;
-    if (part.part == BodyPart::kNone || part.applied) continue;
-    bool fits = true;
-    s.count[0] = s.count[1] = 0;
-    const NaturalBody& body = set_->natural->bodies[s.body];
-    for (int k = 0; k < 2; ++k) {  // a fixed component's moving points, as evaluate_natural() sums them
-      moving[k].clear(), s.shared[k] = false;
-      if (s.at[k] < model.num_coordinates()) continue;
-      for (const Attachment3& o : body.points) {
-        const Index c = o.r[k].coord();
-        if (c >= model.num_coordinates())
-          s.shared[k] = s.shared[k] || &o != &body.points[s.point];
-        else
-          moving[k].push_back(c);
-      }
-    }
-    detail::for_each_planar_term(part.frame(), [&](const Slot& slot, int field, bool negated) {
-      for (int k = 0; k < 2; ++k) {
-        if (!slot.is_coordinate() || slot.coord() != s.at[k]) continue;
-        if (s.count[k] == NaturalSite::kMaxTerms) {
-          fits = false;
-          continue;
-        }
-        s.terms[k][s.count[k]++] = static_cast<std::uint8_t>(field + (negated ? 8 : 0));
-      }
-    });
-    s.part = part.part, s.flat = fits;
-    if (fits) add_flat_sums(s, model.num_coordinates(), moving);
-  }
-}
-
-void JointReactions::add_flat_sums(NaturalSite& s, Index n, const std::vector<Index> (&moving)[2]) {
-  FlatSums& sums = set_->body_rows.flat;
-  const BodyRows& rows = set_->body_rows;
-  auto add_group = [&](Index column) {  // the body's entries in `column`, in their order
-    for (std::size_t k = rows.entries_first[s.body]; k < rows.entries_first[s.body + 1]; ++k)
-      if (rows.entries[k].column == column) sums.terms.push_back(rows.entries[k]);
-    sums.term_first.push_back(static_cast<std::uint32_t>(sums.terms.size()));
-  };
-  for (int k = 0; k < 2; ++k) {
-    s.group_first[k] = static_cast<std::uint32_t>(sums.term_first.size() - 1);
-    if (s.at[k] < n)
-      add_group(s.at[k]);
-    else
-      for (Index c : moving[k]) add_group(c);
-  }
-  s.group_first[2] = static_cast<std::uint32_t>(sums.term_first.size() - 1);
-  s.simple = true;
-  for (int k = 0; k < 2; ++k)
-    s.simple = s.simple && s.at[k] < n && s.count[k] == 1 &&
-               sums.term_first[s.group_first[k] + 1] - sums.term_first[s.group_first[k]] == 1;
-  if (!s.simple) return;
-  set_->simple_sites.resize(set_->natural_sites.size());  // (one per site, at its index)
-  SimpleSite& at = set_->simple_sites[static_cast<std::size_t>(&s - set_->natural_sites.data())];
-  for (int k = 0; k < 2; ++k) {
-    const OwnEntry& e = sums.terms[sums.term_first[s.group_first[k]]];
-    s.simple = s.simple && e.slot <= UINT32_MAX && e.row <= UINT32_MAX && s.part <= UINT32_MAX;
-    at.slot[k] = static_cast<std::uint32_t>(e.slot), at.row[k] = static_cast<std::uint32_t>(e.row);
-    at.term[k] = s.terms[k][0];
-  }
-  at.part = static_cast<std::uint32_t>(s.part), at.simple = s.simple;
-  const BodyPart& part = set_->body_parts[s.body];
-  if (!(at.bar = at.simple && part.bar_form)) return;
-  const Slot* slots[4] = {&part.slots[0], &part.slots[1], &part.slots[3], &part.slots[4]};  // (kBarFields' a_k)
-  for (int k = 0; k < 2; ++k) {
-    const int field = at.term[k] & 7;
-    const detail::BarField& f = detail::kBarFields[field];
-    at.weight[k] = part.bar_weights[field];
-    for (int i = 0; i < f.count; ++i) {
-      const detail::BarFieldTerm& term = f.terms[i];
-      const Slot& slot = *slots[term.accel];
-      if (!slot.is_coordinate() || slot.coord() >= n) continue;  // a constant's acceleration: 0 (m 0, a ±0)
-      const double number = part.bar_numbers[term.number];
-      at.a[k][i] = static_cast<std::uint32_t>(slot.coord()), at.m[k][i] = term.minus ? -number : number;
     }
   }
 }
@@ -528,36 +455,6 @@ void JointReactions::turn_natural(const NaturalSite& s, const double* q, double 
   const ReactionSite rs = natural_reaction_site(*set_->natural, s.joint, q, t);
   const kin3::V3 f{force[0], force[1], set_->natural->spatial ? force[2] : 0.0};
   for (int k = 0; k < (set_->natural->spatial ? 3 : 2); ++k) force[k] = kin3::dot(rs.axes[k], f);
-}
-
-bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,
-                                   const detail::PlanarForce* planar, double* out) {
-  if (!planar || !planar[s.part].valid) return false;
-  const FlatSums& sums = set_->body_rows.flat;
-  auto group_sum = [&](std::uint32_t g) {  // g_ at a column, as add_body_constraint_forces() sums it (from +0)
-    double sum = 0.0;
-    for (std::uint32_t k = sums.term_first[g]; k < sums.term_first[g + 1]; ++k)
-      sum += own_values_[static_cast<std::size_t>(sums.terms[k].slot)] * lambda(sums.terms[k].row);
-    return sum;
-  };
-  const detail::PlanarForce& f = planar[s.part];
-  for (int k = 0; k < 2; ++k) {
-    double qb = 0.0;  // Q_b at the component, as body_forces() sums it into qb_ (from +0)
-    for (int i = 0; i < s.count[k]; ++i) {
-      const double v = f.*detail::kPlanarFields[s.terms[k][i] & 7];
-      qb += (s.terms[k][i] & 8) ? -v : v;
-    }
-    if (s.at[k] < static_cast<Index>(g_.size())) {
-      out[k] = group_sum(s.group_first[k]) - qb;
-      continue;
-    }
-    double moving = 0.0;  // a fixed component: as evaluate_natural() sums it
-    for (std::uint32_t g = s.group_first[k]; g < s.group_first[k + 1]; ++g) moving += group_sum(g);
-    out[k] = s.shared[k] ? std::numeric_limits<double>::quiet_NaN() : -moving - qb;
-  }
-  out[2] = 0.0;
-  if (set_->joint_axes) turn_natural(s, q, t, out);
-  return true;
 }
 
 void JointReactions::evaluate_natural(const NaturalSite& s, RowMotion& row, double t, const Eigen::VectorXd& lambda,
