@@ -75,9 +75,11 @@ class JointReactions {
   /// sweep's, whose Q has computed them): a natural body's part's weight and inertia are read there rather than
   /// computed again, the same values bit for bit. Pre-condition: λ solves Φqᵀ λ = Q with that Q when `planar` is
   /// given (with rigid bars as constructed: they move their own rows' multipliers), else with
-  /// add_generalized_forces()'.
+  /// add_generalized_forces()'. With `planar` and `sum_bars`, a rigid bar's simple site (a point of the bar whose
+  /// reaction is one of its force's values) sums that value from q̈ itself, bit for bit (its part's PlanarForce is
+  /// not read: planar_parts_read() leaves it out); without `sum_bars` it reads it, as every other site.
   void evaluate(const double* q, const double* qd, const double* qdd, double t, const Eigen::VectorXd& lambda,
-                double* out, const detail::PlanarForce* planar = nullptr);
+                double* out, const detail::PlanarForce* planar = nullptr, bool sum_bars = true);
 
  private:
   struct Site {
@@ -129,18 +131,23 @@ class JointReactions {
   };
   // A simple site (NaturalSite::simple) as a row reads it, without FlatSums' indirections nor the site's own 80
   // bytes: component k's reaction is own_values_[slot[k]] λ[row[k]] − Q_b, Q_b the value of `part`'s PlanarForce
-  // that term[k] names (kPlanarFields' index, +8 when negated). On a rigid bar (`bar`) whose PlanarForce Q did not
-  // compute (planar_parts_read()), the site sums that value itself, as detail::bar_field() does: weight[k] − ((m[k][0]
-  // q̈[a[k][0]] + m[k][1] q̈[a[k][1]]) + m[k][2] q̈[a[k][2]]), a term on a constant slot with m 0 (a ±0, which changes no
-  // sum but a zero's sign, and Q_b starts from +0): no PlanarForce is computed for it. 10⁴ a row at nfourbar 10⁴, where
-  // that saves a crank's whole force.
+  // that term[k] names (kPlanarFields' index, +8 when negated). On a rigid bar (`bar`) the site sums that value
+  // itself (evaluate()'s sum_bars), as detail::bar_field() does: with BarSum `form`'s numbers, weight[k] −
+  // ((m[k][0] q̈[a[k][0]] + m[k][1] q̈[a[k][1]]) + m[k][2] q̈[a[k][2]]), a term on a constant slot with m 0 (a ±0,
+  // which changes no sum but a zero's sign, and Q_b starts from +0). 10⁴ a row at nfourbar 10⁴, where that saves a
+  // crank's whole force; 52 bytes, which a row reads from memory.
   struct SimpleSite {
     std::uint32_t slot[2] = {0, 0}, row[2] = {0, 0};
     std::uint32_t part = 0;
+    std::uint32_t form = 0;  // (bar) its BarSum among SetUp::bar_sums
+    std::uint32_t a[2][3] = {};
     std::uint8_t term[2] = {0, 0};
     bool simple = false;  // the site is simple (else the other fields are not read)
     bool bar = false;
-    std::uint32_t a[2][3] = {};
+  };
+  // The numbers of a bar's simple site's sums (SimpleSite), shared by the sites whose numbers are the same bits
+  // (nfourbar's 10⁴ cranks have one).
+  struct BarSum {
     double m[2][3] = {}, weight[2] = {};
   };
   struct BodyRows {
@@ -148,9 +155,13 @@ class JointReactions {
     std::vector<OwnEntry> entries;
     std::vector<Index> q_columns;
     std::vector<OwnRun> runs;
-    FlatSums flat;                              // the flat sites' sums (NaturalSite::group_first)
-    const EntryIndex* slot_of_entry = nullptr;  // the model's (Model::slot_of_entry())
-    bool overwrite = false;                     // no two entries of the model share a slot (Model::jacobian())
+    FlatSums flat;  // the flat sites' sums (NaturalSite::group_first)
+    // own_values_' index of each of the model's Jacobian entries (as Model::slot_of_entry(), onto the own entries
+    // alone, in `entries`' order: a row reads them for 10⁴ sites, which the whole pattern's slots spread over its
+    // megabytes), and slot_of_entry its data
+    std::vector<EntryIndex> own_slot_of_entry;
+    const EntryIndex* slot_of_entry = nullptr;
+    bool overwrite = false;  // no two entries of the model share a slot (Model::jacobian())
   };
   // A natural body's part as OutputEfforts::parts' has it: `part` its index there when the whole model's Q computes
   // the body's weight and inertia (evaluate()'s `planar`) as the body's own Q would, bit for bit, else none; `slots`
@@ -186,6 +197,8 @@ class JointReactions {
   void add_flat_sums(NaturalSite& s, Index n, const std::vector<Index> (&moving)[2]);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);
+  // BodyRows::entries' slots numbered afresh, own_values_ sized to them (BodyRows::own_slot_of_entry)
+  void number_own_entries(const Model& model);
   // own_values_ = Φq's values of BodyRows::runs at (q, t), once a row
   void evaluate_own_jacobian(const double* q, double t);
   // g_ += Φq,cᵀ λ_c over body b's own constraints (own_values_), and g_'s entries those touch cleared again
@@ -208,6 +221,7 @@ class JointReactions {
     std::vector<Site> sites;
     std::vector<NaturalSite> natural_sites;
     std::vector<SimpleSite> simple_sites;             // per natural site, read where it is simple
+    std::vector<BarSum> bar_sums;                     // SimpleSite::form's
     std::vector<std::pair<bool, std::size_t>> order;  // (natural, index) per listed reaction
     std::shared_ptr<const NaturalJoints> natural;
     BodyRows body_rows;
@@ -222,7 +236,7 @@ class JointReactions {
   std::shared_ptr<SetUp> set_ = std::make_shared<SetUp>();
   Eigen::VectorXd qx_, qdx_, qddx_, qb_;  // q, q̇, q̈ with the promoted constants; a body's Q
   std::vector<double> g_;                 // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
-  std::vector<double> own_values_;        // Φq's values (its pattern's slots) of the natural bodies' own constraints
+  std::vector<double> own_values_;        // Φq's values of the natural bodies' own constraints (BodyRows' slots)
   PartJacobian jac_;                      // the body's frame Jacobian (its capacity kept: no allocation per row)
   std::vector<Part> body_part_;           // a body's parts built where they are read (body_parts_kept's others)
 };

@@ -115,24 +115,25 @@ void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& 
 }
 
 void JointReactions::evaluate(const double* q, const double* qd, const double* qdd, double t,
-                              const Eigen::VectorXd& lambda, double* out, const detail::PlanarForce* planar) {
+                              const Eigen::VectorXd& lambda, double* out, const detail::PlanarForce* planar,
+                              bool sum_bars) {
   RowMotion row{q, qd, qdd, false};
   evaluate_own_jacobian(q, t);
   const bool simple = planar && !set_->joint_axes;  // (NaturalSite::simple's sums are in world axes)
   const SimpleSite* const simple_sites = set_->simple_sites.data();
   const std::size_t simple_count = set_->simple_sites.size();
+  const BarSum* const bar_sums = set_->bar_sums.data();
   for (const auto& [natural, k] : set_->order) {
     if (!natural) {
       evaluate_site(set_->sites[k], q, t, lambda, out);
       continue;
     }
     const SimpleSite* e = simple && k < simple_count ? simple_sites + k : nullptr;
-    // as below, where Q left no force for the part (PartForces reads planar_parts_read()): the bar's field summed
-    // here (SimpleSite), the same bits
-    if (e && e->bar && qdd && !planar[e->part].valid) {
+    if (e && e->bar && sum_bars && qdd) {  // as below, the bar's field summed here (SimpleSite): the same bits
+      const BarSum& f = bar_sums[e->form];
       for (int c = 0; c < 2; ++c) {
-        const double v = e->weight[c] -
-                         ((e->m[c][0] * qdd[e->a[c][0]] + e->m[c][1] * qdd[e->a[c][1]]) + e->m[c][2] * qdd[e->a[c][2]]);
+        const double v =
+            f.weight[c] - ((f.m[c][0] * qdd[e->a[c][0]] + f.m[c][1] * qdd[e->a[c][1]]) + f.m[c][2] * qdd[e->a[c][2]]);
         double qb = 0.0, sum = 0.0;
         qb += (e->term[c] & 8) ? -v : v;
         sum += own_values_[e->slot[c]] * lambda(e->row[c]);

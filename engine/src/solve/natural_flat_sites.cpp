@@ -2,8 +2,11 @@
 // the whole model's Q computed and that has no load of its own, whose reaction is a few sums of Φq's entries times λ
 // less a few of the part's PlanarForce values. Found once at set-up (find_flat_sites(), add_flat_sums()) and summed
 // at every row (evaluate_flat(), and evaluate()'s simple sites), in the general path's order, bit for bit.
+#include <array>
+#include <bit>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <vector>
 
 #include "phiq/joint_reactions.hpp"
@@ -45,6 +48,22 @@ void JointReactions::find_flat_sites(const Model& model) {
     s.part = part.part, s.flat = fits;
     if (fits) add_flat_sums(s, model.num_coordinates(), moving);
   }
+  // the bar sites' BarSums, one per distinct bits
+  std::map<std::array<std::uint64_t, 8>, std::uint32_t> index;
+  std::vector<BarSum> shared;
+  for (SimpleSite& at : set_->simple_sites) {
+    if (!at.bar) continue;
+    const BarSum& sum = set_->bar_sums[at.form];
+    std::array<std::uint64_t, 8> key;
+    for (std::size_t k = 0; k < 2; ++k) {
+      key[4 * k] = std::bit_cast<std::uint64_t>(sum.weight[k]);
+      for (std::size_t i = 0; i < 3; ++i) key[4 * k + 1 + i] = std::bit_cast<std::uint64_t>(sum.m[k][i]);
+    }
+    const auto [it, added] = index.try_emplace(key, static_cast<std::uint32_t>(shared.size()));
+    if (added) shared.push_back(sum);
+    at.form = it->second;
+  }
+  set_->bar_sums = std::move(shared);
 }
 
 void JointReactions::add_flat_sums(NaturalSite& s, Index n, const std::vector<Index> (&moving)[2]) {
@@ -80,18 +99,21 @@ void JointReactions::add_flat_sums(NaturalSite& s, Index n, const std::vector<In
   const BodyPart& part = set_->body_parts[s.body];
   if (!(at.bar = at.simple && part.bar_form)) return;
   const Slot* slots[4] = {&part.slots[0], &part.slots[1], &part.slots[3], &part.slots[4]};  // (kBarFields' a_k)
+  BarSum sum;
   for (int k = 0; k < 2; ++k) {
     const int field = at.term[k] & 7;
     const detail::BarField& f = detail::kBarFields[field];
-    at.weight[k] = part.bar_weights[field];
+    sum.weight[k] = part.bar_weights[field];
     for (int i = 0; i < f.count; ++i) {
       const detail::BarFieldTerm& term = f.terms[i];
       const Slot& slot = *slots[term.accel];
       if (!slot.is_coordinate() || slot.coord() >= n) continue;  // a constant's acceleration: 0 (m 0, a ±0)
       const double number = part.bar_numbers[term.number];
-      at.a[k][i] = static_cast<std::uint32_t>(slot.coord()), at.m[k][i] = term.minus ? -number : number;
+      at.a[k][i] = static_cast<std::uint32_t>(slot.coord()), sum.m[k][i] = term.minus ? -number : number;
     }
   }
+  at.form = static_cast<std::uint32_t>(set_->bar_sums.size());  // (find_flat_sites() then shares equal ones)
+  set_->bar_sums.push_back(sum);
 }
 
 bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,

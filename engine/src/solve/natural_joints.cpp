@@ -353,9 +353,7 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
     else
       rows.runs.push_back({block, i, i + 1});
   }
-  rows.slot_of_entry = model.slot_of_entry().data();
-  rows.overwrite = static_cast<Index>(model.slot_of_entry().size()) == pat.nnz();
-  own_values_.assign(static_cast<std::size_t>(pat.nnz()), 0.0);
+  number_own_entries(model);
   // A rigid bar's Q differs from its frame's by a multiple of its own row, which its body's reactions take back only
   // where that row is the body's (not the joints', as when another body holds the same coordinates: a second part
   // on the bar's two points, two bars from fixed points to one point): else no bar takes that form, in Q either
@@ -381,7 +379,7 @@ std::vector<char> JointReactions::planar_parts_read(std::size_t parts) const {
   std::vector<char> read(parts, 0);
   for (std::size_t k = 0; k < set_->natural_sites.size(); ++k) {
     const NaturalSite& s = set_->natural_sites[k];
-    // (a rigid bar's simple site sums its force itself where Q left none: evaluate() does so without joint axes)
+    // (a rigid bar's simple site sums its force itself: evaluate() does so without joint axes)
     if (k < set_->simple_sites.size() && set_->simple_sites[k].bar && !set_->joint_axes) continue;
     if (const std::size_t p = set_->body_parts[s.body].part; p < parts) read[p] = 1;
   }
@@ -417,6 +415,25 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
     return;
   }
   add_generalized_forces(*parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
+}
+
+void JointReactions::number_own_entries(const Model& model) {
+  BodyRows& rows = set_->body_rows;
+  const Index nnz = model.jacobian_pattern().nnz();
+  std::vector<EntryIndex> own_of_slot(static_cast<std::size_t>(nnz), -1);
+  EntryIndex own = 0;
+  for (OwnEntry& e : rows.entries) {
+    EntryIndex& k = own_of_slot[static_cast<std::size_t>(e.slot)];
+    if (k < 0) k = own++;
+    e.slot = k;
+  }
+  const std::vector<EntryIndex>& model_slots = model.slot_of_entry();
+  rows.own_slot_of_entry.assign(model_slots.size(), 0);  // (an entry of no own constraint is never evaluated)
+  for (std::size_t e = 0; e < model_slots.size(); ++e)
+    rows.own_slot_of_entry[e] = std::max(own_of_slot[static_cast<std::size_t>(model_slots[e])], EntryIndex{0});
+  rows.slot_of_entry = rows.own_slot_of_entry.data();
+  rows.overwrite = static_cast<Index>(model_slots.size()) == nnz;
+  own_values_.assign(static_cast<std::size_t>(own), 0.0);
 }
 
 void JointReactions::evaluate_own_jacobian(const double* q, double t) {
