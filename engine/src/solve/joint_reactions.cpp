@@ -129,11 +129,10 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
       continue;
     }
     const SimpleSite* e = simple && k < simple_count ? simple_sites + k : nullptr;
-    if (e && e->bar && sum_bars && qdd) {  // as below, the bar's field summed here (SimpleSite): the same bits
-      const BarSum& f = bar_sums[e->form];
+    // evaluate_flat()'s sums, each of one term, written out, with the value Q_b of field(c)
+    auto write = [&](auto&& field) {
       for (int c = 0; c < 2; ++c) {
-        const double v =
-            f.weight[c] - ((f.m[c][0] * qdd[e->a[c][0]] + f.m[c][1] * qdd[e->a[c][1]]) + f.m[c][2] * qdd[e->a[c][2]]);
+        const double v = field(c);
         double qb = 0.0, sum = 0.0;
         qb += (e->term[c] & 8) ? -v : v;
         sum += own_values_[e->slot[c]] * lambda(e->row[c]);
@@ -141,19 +140,17 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
       }
       out[2] = 0.0;
       out += 3;
+    };
+    if (e && e->bar && sum_bars && qdd) {  // a rigid bar's field summed here (SimpleSite): the same bits
+      const BarSum& f = bar_sums[e->form];
+      write([&](int c) {
+        return f.weight[c] -
+               ((f.m[c][0] * qdd[e->a[c][0]] + f.m[c][1] * qdd[e->a[c][1]]) + f.m[c][2] * qdd[e->a[c][2]]);
+      });
       continue;
     }
-    if (e && e->simple && planar[e->part].valid) {  // evaluate_flat()'s sums, each of one term, written out
-      const detail::PlanarForce& f = planar[e->part];
-      for (int c = 0; c < 2; ++c) {
-        const double v = f.*detail::kPlanarFields[e->term[c] & 7];
-        double qb = 0.0, sum = 0.0;
-        qb += (e->term[c] & 8) ? -v : v;
-        sum += own_values_[e->slot[c]] * lambda(e->row[c]);
-        out[c] = sum - qb;
-      }
-      out[2] = 0.0;
-      out += 3;
+    if (e && e->simple && planar[e->part].valid) {  // read off the part's PlanarForce
+      write([&](int c) { return planar[e->part].*detail::kPlanarFields[e->term[c] & 7]; });
       continue;
     }
     evaluate_natural(set_->natural_sites[k], row, t, lambda, planar, out);
