@@ -63,8 +63,9 @@ class JointReactions {
   /// Whether evaluate()'s `planar` may come from a Q with rigid bars: as constructed, unless a natural body with
   /// mass on a bar does not own the bar's row (internal: the sweep then takes no bar in Q).
   bool rigid_bars() const { return set_->rigid_bars; }
-  /// Which of OutputEfforts::parts' planar forces evaluate() reads from `planar`: one flag per part (`parts` of them;
-  /// internal: a sweep's Q leaves the others unwritten).
+  /// Which of OutputEfforts::parts' planar forces evaluate() reads from `planar` with `sum_bars`: one flag per part
+  /// (`parts` of them; internal: a sweep's Q leaves the others unwritten). Without sum_bars, a site whose part's
+  /// force was left unwritten takes the general path: the same bits.
   std::vector<char> planar_parts_read(std::size_t parts) const;
   /// Writes the reactions at (q, t) under multipliers `lambda` (one per model row) to out[0, size()).
   /// Pre-condition: q has the model's coordinates; the model is the one given to the constructor.
