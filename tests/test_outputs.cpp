@@ -319,11 +319,14 @@ TEST(OutputPlan, CsvColumnsFollowTheOutputList) {
 }
 
 TEST(CsvFormat, ARowsValuesAreTheDoublesItsTextReads) {
-  // every column kind (coordinates, q̇, points, a driver, residuals, rcond) and a step whose q holds a −0
+  // every column kind (coordinates, q̇, points, a driver, residuals, rcond, efforts and reactions) and a step whose
+  // q holds a −0
   Scene scene = parse_scene(fourbar_scene("{velocities: true, accelerations: true, points: [B, {name: P, body: "
                                           "coupler, at: [0, 0.3]}], drivers: [motor], residuals: [rocker], "
-                                          "max_residual: true, rcond: true}",
-                                          4),
+                                          "max_residual: true, rcond: true, efforts: all, power: true, reactions: all}",
+                                          4) +
+                                "parts: {coupler: {mass: 2.0, center_of_mass: [0.1, 0], inertia: 0.24}}\n"
+                                "loads: {gravity: [0, -9.81]}\n",
                             "fourbar.yaml");
   const CsvFormat csv(*scene.model, scene.sweep);
   ASSERT_EQ(csv.num_values(), csv.column_names().size());
@@ -335,8 +338,8 @@ TEST(CsvFormat, ARowsValuesAreTheDoublesItsTextReads) {
       [&](const StepView& s) {
         Eigen::VectorXd q = s.q;
         q(0) = -0.0;
-        const StepView step{s.step, s.t,     q,        s.qd,           s.qdd,          s.points,
-                            s.phi,  s.rcond, s.joints, s.orientations, s.sensitivities};
+        const StepView step{s.step, s.t,     q,        s.qd,           s.qdd,           s.points,
+                            s.phi,  s.rcond, s.joints, s.orientations, s.sensitivities, s.efforts};
         std::string text;
         csv.append_row(step, text);
         std::vector<double> values(csv.num_values() + 1, 7.0);  // one past the end: not written
@@ -353,6 +356,19 @@ TEST(CsvFormat, ARowsValuesAreTheDoublesItsTextReads) {
         }
         EXPECT_EQ(k, csv.num_values());
         EXPECT_FALSE(std::signbit(values[1]));  // −0 as the text writes it: 0
+        // the values after the coordinates' straight into uneven slices (a writer's datasets), a run of efforts
+        // split across two: the same bits
+        const std::size_t n = csv.num_output_values(), first = csv.num_values() - n;
+        EXPECT_GT(n, 4u);
+        if (n <= 4) return false;
+        std::vector<double> sliced(n + 1, 7.0);
+        const std::size_t sizes[4] = {1, 0, n - 3, 2};
+        double* const out[4] = {sliced.data(), sliced.data() + 1, sliced.data() + 1, sliced.data() + n - 2};
+        csv.append_output_values(step, out, sizes, 4);
+        EXPECT_EQ(sliced.back(), 7.0);
+        for (std::size_t i = 0; i < n; ++i)
+          EXPECT_EQ(std::bit_cast<std::uint64_t>(sliced[i]), std::bit_cast<std::uint64_t>(values[first + i]))
+              << "column " << csv.column_names()[first + i] << " at step " << s.step;
         ++rows;
         return true;
       },

@@ -60,6 +60,11 @@ class CsvFormat {
   /// Writes those columns' values for this step to out[0 .. num_output_values()), as append_row() formats them
   /// (the HDF5 writer's row: the same doubles as the CSV's). Throws phiq::Error as append_row() does.
   void append_output_values(const StepView& step, double* out) const;
+  /// The same values, −0 as 0 (stored_value()), straight into `count` consecutive slices: the next sizes[i] of them
+  /// to out[i] (the HDF5 writer's datasets' rows, with no row in between). Pre-condition: the sizes add up to
+  /// num_output_values(). Throws phiq::Error as append_row() does.
+  void append_output_values(const StepView& step, double* const* out, const std::size_t* sizes,
+                            std::size_t count) const;
   /// The number of columns of a row, t's included: column_names().size().
   std::size_t num_values() const;
   /// Writes the whole row's values for this step to out[0 .. num_values()): t, the coordinates' columns, then

@@ -293,6 +293,30 @@ void CsvFormat::append_output_values(const StepView& s, double* out) const {
   for_each_output(s, ValuesOut{out, [](double v) { return v; }});
 }
 
+void CsvFormat::append_output_values(const StepView& s, double* const* out, const std::size_t* sizes,
+                                     std::size_t count) const {
+  if (!plan_) return;
+  struct Slices {
+    double* const* out;
+    const std::size_t* sizes;
+    std::size_t count, next_slice = 0, left = 0;
+    double* at = nullptr;
+    void reach() {  // the slice the next value goes to
+      while (left == 0 && next_slice < count) at = out[next_slice], left = sizes[next_slice], ++next_slice;
+    }
+    void operator()(double v) { reach(), *at++ = stored_value(v), --left; }
+    void operator()(const double* values, std::size_t n) {
+      while (n > 0) {
+        reach();
+        const std::size_t m = std::min(n, left);
+        at = std::transform(values, values + m, at, stored_value);
+        values += m, n -= m, left -= m;
+      }
+    }
+  };
+  for_each_output(s, Slices{out, sizes, count});
+}
+
 std::size_t CsvFormat::num_output_values() const {
   if (!plan_) return 0;
   const std::size_t per = 1 + velocities_ + accelerations_;

@@ -82,8 +82,9 @@ struct Hdf5Writer::Impl {
   std::vector<Group> groups;    // in CSV column order
   Group* batch_case = nullptr;  // /case (Hdf5Options::case_column)
   Group *t = nullptr, *q = nullptr, *qd = nullptr, *qdd = nullptr;
-  std::vector<Group*> outputs;  // points, drivers, residuals, rcond: the CsvFormat::append_output_values() slices
-  std::vector<double> output_row;
+  std::vector<Group*> outputs;     // points, drivers, residuals, rcond: the CsvFormat::append_output_values() slices
+  std::vector<double*> output_at;  // a row's place in each of `outputs` (append_row())
+  std::vector<std::size_t> output_size;  // each one's columns
   std::size_t block_rows = 1, held_rows = 0, written_rows = 0;
   bool closed = false;
 
@@ -222,7 +223,8 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   if (Group* g = take("efforts", effort_units.size(), [&](std::size_t k) { return effort_units[k]; }))
     outputs.push_back(g);
   if (at != names.size() || groups.size() > 16) throw Error(cannot("the columns do not match the CSV's (phiq bug)"));
-  output_row.resize(format.num_output_values());
+  output_at.resize(outputs.size());
+  for (const Group* g : outputs) output_size.push_back(g->columns.size());
 
   block_rows = choose_block_rows((names.size() + o.case_column) * sizeof(double), o);
   if (o.deflate < 0 || o.deflate > 9) throw Error(cannot("deflate level " + std::to_string(o.deflate) + " is not 0–9"));
@@ -366,13 +368,9 @@ void Hdf5Writer::append_row(const StepView& s) {
   gather(w.qd, s.qd, w.plan.written_velocities(), "velocities");
   gather(w.qdd, s.qdd, w.plan.written_accelerations(), "accelerations");
   if (!w.outputs.empty()) {
-    w.format.append_output_values(s, w.output_row.data());
-    const double* v = w.output_row.data();
-    for (Group* g : w.outputs) {
-      const std::size_t m = g->columns.size();
-      std::transform(v, v + m, g->held.data() + k * m, stored_value);
-      v += m;
-    }
+    for (std::size_t i = 0; i < w.outputs.size(); ++i)
+      w.output_at[i] = w.outputs[i]->held.data() + k * w.output_size[i];
+    w.format.append_output_values(s, w.output_at.data(), w.output_size.data(), w.outputs.size());
   }
   w.row_held();
 }
