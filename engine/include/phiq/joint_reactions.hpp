@@ -151,6 +151,13 @@ class JointReactions {
   struct BarSum {
     double m[2][3] = {}, weight[2] = {};
   };
+  // A natural body's part as the whole model's Q takes it when that is a rigid bar, while set up (find_body_parts()
+  // to find_flat_sites(), which builds its sites' BarSums): its mass numbers (detail::bar_number()'s order) and its
+  // weight's share of each PlanarForce field under the loads' gravity (detail::bar_weight_share())
+  struct BarForm {
+    bool bar = false;
+    double numbers[4] = {}, weights[6] = {};
+  };
   struct BodyRows {
     std::vector<std::size_t> entries_first, q_first;
     std::vector<OwnEntry> entries;
@@ -175,10 +182,6 @@ class JointReactions {
     Slot slots[5];
     bool x_is_point = true;
     double bar_length = 0.0;  // > 0: the body is a rigid bar, its force a bar's (solve/part_forces.hpp)
-    // where `part` is a rigid bar: its mass numbers (detail::bar_number()'s order) and its weight's shares of each
-    // PlanarForce field under the loads' gravity (detail::bar_weight_share())
-    bool bar_form = false;
-    double bar_numbers[4] = {}, bar_weights[6] = {};
     const AppliedLoads* applied = nullptr;
     detail::PlanarFrame frame() const;  // the promoted planar frame the slots name
   };
@@ -191,11 +194,15 @@ class JointReactions {
   // qx_, q̇x_, q̈x_ (the promoted constants past the model's coordinates) and qb_ (zero) at their sizes
   void size_natural_scratch();
   // `bars`: the model's rigid bars where the sweep's Q takes them (else empty)
-  void find_body_parts(const Model& model, const OutputEfforts& efforts, const detail::BarLengths& bars);
-  void find_flat_sites(const Model& model);
+  // (and `forms`, per natural body: its BarForm)
+  void find_body_parts(const Model& model, const OutputEfforts& efforts, const detail::BarLengths& bars,
+                       std::vector<BarForm>& forms);
+  void find_flat_sites(const Model& model, const std::vector<BarForm>& forms);
   // s's groups (NaturalSite::group_first), for a model of n coordinates; `moving`: its fixed components' moving
   // points' coordinates
   void add_flat_sums(NaturalSite& s, Index n, const std::vector<Index> (&moving)[2]);
+  // simple site `at`'s sums on body part `part`, a rigid bar of BarForm `form` (SimpleSite::a, and its BarSum)
+  BarSum bar_sum(SimpleSite& at, const BodyPart& part, const BarForm& form, Index n) const;
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);
   // BodyRows::entries' slots numbered afresh, own_values_ sized to them (BodyRows::own_slot_of_entry)

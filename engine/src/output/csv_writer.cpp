@@ -171,8 +171,6 @@ inline void put(double v, std::string& out) {
 constexpr std::size_t kValuesPerTask = 1024;
 }  // namespace
 
-// Calls emit(v) for each value after the coordinate columns, in column order: the one computation of those values
-// for the CSV text and for append_output_values() (the HDF5 writer), so that the two files cannot disagree.
 namespace {
 // emit(values, count) where Emit takes a run, else emit() value by value
 template <class Emit>
@@ -182,18 +180,36 @@ void emit_run(Emit& emit, const double* values, std::size_t count) {
   else
     for (std::size_t i = 0; i < count; ++i) emit(values[i]);
 }
-// What append_output_values() and append_values() emit into: the doubles in order, each `Store`d.
+// What the append_output_values() and append_values() emit into: the doubles in order, each `Store`d, into `count`
+// consecutive slices (the next sizes[i] of them to out[i]).
 template <class Store>
-struct ValuesOut {
-  double*& out;
+struct Slices {
+  double* const* out;
+  const std::size_t* sizes;
+  std::size_t count;
   Store store;
-  void operator()(double v) { *out++ = store(v); }
-  void operator()(const double* values, std::size_t count) { out = std::transform(values, values + count, out, store); }
+  std::size_t next_slice = 0, left = 0;
+  double* at = nullptr;
+  void reach() {  // the slice the next value goes to
+    while (left == 0 && next_slice < count) at = out[next_slice], left = sizes[next_slice], ++next_slice;
+  }
+  void operator()(double v) { reach(), *at++ = store(v), --left; }
+  void operator()(const double* values, std::size_t n) {
+    while (n > 0) {
+      reach();
+      const std::size_t m = std::min(n, left);
+      at = std::transform(values, values + m, at, store);
+      values += m, n -= m, left -= m;
+    }
+  }
 };
 template <class Store>
-ValuesOut(double*&, Store) -> ValuesOut<Store>;
+Slices(double* const*, const std::size_t*, std::size_t, Store) -> Slices<Store>;
+double as_computed(double v) { return v; }
 }  // namespace
 
+// Calls emit(v) for each value after the coordinate columns, in column order: the one computation of those values
+// for the CSV text and for append_output_values() (the HDF5 writer), so that the two files cannot disagree.
 template <class Emit>
 void CsvFormat::for_each_output(const StepView& s, Emit&& emit) const {
   const auto& points = plan_->points;
@@ -290,31 +306,14 @@ void CsvFormat::append_outputs(const StepView& s, std::string& out) const {
 
 void CsvFormat::append_output_values(const StepView& s, double* out) const {
   if (!plan_) return;
-  for_each_output(s, ValuesOut{out, [](double v) { return v; }});
+  const std::size_t n = num_output_values();
+  for_each_output(s, Slices{&out, &n, 1, as_computed});
 }
 
 void CsvFormat::append_output_values(const StepView& s, double* const* out, const std::size_t* sizes,
                                      std::size_t count) const {
   if (!plan_) return;
-  struct Slices {
-    double* const* out;
-    const std::size_t* sizes;
-    std::size_t count, next_slice = 0, left = 0;
-    double* at = nullptr;
-    void reach() {  // the slice the next value goes to
-      while (left == 0 && next_slice < count) at = out[next_slice], left = sizes[next_slice], ++next_slice;
-    }
-    void operator()(double v) { reach(), *at++ = stored_value(v), --left; }
-    void operator()(const double* values, std::size_t n) {
-      while (n > 0) {
-        reach();
-        const std::size_t m = std::min(n, left);
-        at = std::transform(values, values + m, at, stored_value);
-        values += m, n -= m, left -= m;
-      }
-    }
-  };
-  for_each_output(s, Slices{out, sizes, count});
+  for_each_output(s, Slices{out, sizes, count, stored_value});
 }
 
 std::size_t CsvFormat::num_output_values() const {
@@ -344,7 +343,8 @@ void CsvFormat::append_values(const StepView& s, double* out) const {
   const std::vector<Index>* cols[3] = {&columns_, &v_columns_, &a_columns_};
   for (int g = 0; g < 3; ++g)
     for (Index c : *cols[g]) *out++ = stored_value((*groups[g])(c));
-  if (plan_) for_each_output(s, ValuesOut{out, stored_value});
+  const std::size_t n = num_output_values();
+  if (plan_) for_each_output(s, Slices{&out, &n, 1, stored_value});
 }
 
 void CsvFormat::append_row(const StepView& s, std::string& out) const {

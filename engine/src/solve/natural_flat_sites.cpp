@@ -14,8 +14,9 @@
 
 namespace phiq {
 
-void JointReactions::find_flat_sites(const Model& model) {
+void JointReactions::find_flat_sites(const Model& model, const std::vector<BarForm>& forms) {
   if (set_->natural->spatial) return;
+  std::map<std::array<std::uint64_t, 8>, std::uint32_t> shared;  // a BarSum's bits → its index in bar_sums
   std::vector<Index> moving[2];  // a fixed component's moving points' coordinates (its capacity kept)
   for (NaturalSite& s : set_->natural_sites) {
     const BodyPart& part = set_->body_parts[s.body];
@@ -47,23 +48,19 @@ void JointReactions::find_flat_sites(const Model& model) {
     });
     s.part = part.part, s.flat = fits;
     if (fits) add_flat_sums(s, model.num_coordinates(), moving);
-  }
-  // the bar sites' BarSums, one per distinct bits
-  std::map<std::array<std::uint64_t, 8>, std::uint32_t> index;
-  std::vector<BarSum> shared;
-  for (SimpleSite& at : set_->simple_sites) {
-    if (!at.bar) continue;
-    const BarSum& sum = set_->bar_sums[at.form];
+    if (!fits || !s.simple || !forms[s.body].bar) continue;
+    // a rigid bar's simple site: its sums' numbers, shared with the sites whose numbers are the same bits
+    SimpleSite& at = set_->simple_sites[static_cast<std::size_t>(&s - set_->natural_sites.data())];
+    const BarSum sum = bar_sum(at, part, forms[s.body], model.num_coordinates());
     std::array<std::uint64_t, 8> key;
     for (std::size_t k = 0; k < 2; ++k) {
       key[4 * k] = std::bit_cast<std::uint64_t>(sum.weight[k]);
       for (std::size_t i = 0; i < 3; ++i) key[4 * k + 1 + i] = std::bit_cast<std::uint64_t>(sum.m[k][i]);
     }
-    const auto [it, added] = index.try_emplace(key, static_cast<std::uint32_t>(shared.size()));
-    if (added) shared.push_back(sum);
-    at.form = it->second;
+    const auto [it, added] = shared.try_emplace(key, static_cast<std::uint32_t>(set_->bar_sums.size()));
+    if (added) set_->bar_sums.push_back(sum);
+    at.form = it->second, at.bar = true;
   }
-  set_->bar_sums = std::move(shared);
 }
 
 void JointReactions::add_flat_sums(NaturalSite& s, Index n, const std::vector<Index> (&moving)[2]) {
@@ -96,24 +93,25 @@ void JointReactions::add_flat_sums(NaturalSite& s, Index n, const std::vector<In
     at.term[k] = s.terms[k][0];
   }
   at.part = static_cast<std::uint32_t>(s.part), at.simple = s.simple;
-  const BodyPart& part = set_->body_parts[s.body];
-  if (!(at.bar = at.simple && part.bar_form)) return;
+}
+
+JointReactions::BarSum JointReactions::bar_sum(SimpleSite& at, const BodyPart& part, const BarForm& form,
+                                               Index n) const {
   const Slot* slots[4] = {&part.slots[0], &part.slots[1], &part.slots[3], &part.slots[4]};  // (kBarFields' a_k)
   BarSum sum;
   for (int k = 0; k < 2; ++k) {
     const int field = at.term[k] & 7;
     const detail::BarField& f = detail::kBarFields[field];
-    sum.weight[k] = part.bar_weights[field];
+    sum.weight[k] = form.weights[field];
     for (int i = 0; i < f.count; ++i) {
       const detail::BarFieldTerm& term = f.terms[i];
       const Slot& slot = *slots[term.accel];
       if (!slot.is_coordinate() || slot.coord() >= n) continue;  // a constant's acceleration: 0 (m 0, a ±0)
-      const double number = part.bar_numbers[term.number];
+      const double number = form.numbers[term.number];
       at.a[k][i] = static_cast<std::uint32_t>(slot.coord()), sum.m[k][i] = term.minus ? -number : number;
     }
   }
-  at.form = static_cast<std::uint32_t>(set_->bar_sums.size());  // (find_flat_sites() then shares equal ones)
-  set_->bar_sums.push_back(sum);
+  return sum;
 }
 
 bool JointReactions::evaluate_flat(const NaturalSite& s, const double* q, double t, const Eigen::VectorXd& lambda,

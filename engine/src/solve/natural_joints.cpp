@@ -187,9 +187,11 @@ bool same_planar_force(const detail::MassivePart& whole, const detail::MassivePa
 
 }  // namespace
 
-void JointReactions::find_body_parts(const Model& model, const OutputEfforts& efforts, const detail::BarLengths& bars) {
+void JointReactions::find_body_parts(const Model& model, const OutputEfforts& efforts, const detail::BarLengths& bars,
+                                     std::vector<BarForm>& forms) {
   const std::vector<NaturalBody>& bodies = set_->natural->bodies;
   set_->body_parts.assign(bodies.size(), {});
+  forms.assign(bodies.size(), {});
   if (!efforts.parts || !efforts.loads) return;
   const std::vector<Part>& parts = *efforts.parts;
   const kin3::V3 g = efforts.loads->gravity;
@@ -221,10 +223,10 @@ void JointReactions::find_body_parts(const Model& model, const OutputEfforts& ef
     BodyPart& bp = set_->body_parts[b];
     bp.part = index, bp.x_is_point = own.frame.x_is_point, bp.applied = body.loads.applied.get();
     std::copy(own.frame.slots, own.frame.slots + 5, bp.slots);
-    if ((bp.bar_form = whole.frame.bar)) {  // the numbers and weight the whole model's Q takes (PartForces)
+    if ((forms[b].bar = whole.frame.bar)) {  // the numbers and weight the whole model's Q takes (PartForces)
       const detail::BarWeight w = detail::bar_weight(whole, g);
-      for (int k = 0; k < 4; ++k) bp.bar_numbers[k] = detail::bar_number(whole, k);
-      for (int f = 0; f < 6; ++f) bp.bar_weights[f] = detail::bar_weight_share(w, f);
+      for (int k = 0; k < 4; ++k) forms[b].numbers[k] = detail::bar_number(whole, k);
+      for (int f = 0; f < 6; ++f) forms[b].weights[f] = detail::bar_weight_share(w, f);
     }
   }
 }
@@ -365,8 +367,9 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
   }
   set_->rigid_bars = rigid_bars;
   if (!rigid_bars) bars = detail::BarLengths();  // (as the sweep's Q, detail::PartForces, then takes them: none)
-  find_body_parts(model, efforts, bars);
-  find_flat_sites(model);
+  std::vector<BarForm> forms;
+  find_body_parts(model, efforts, bars, forms);
+  find_flat_sites(model, forms);
   // the bodies whose sites a sweep's row takes by the general path keep their parts (the others build them where
   // they are read: a flat site whose part's force Q did not compute)
   set_->body_parts_kept.resize(nb);
