@@ -1,8 +1,9 @@
 // Joint reactions (phiq/joint_reactions.hpp, the scene's `output: reactions`): every kind that states a
 // ReactionSite passes a virtual-work check (the written wrench does on its body the work −λᵀ δΦ does, by finite
 // differences); a massive four-bar's pins satisfy every link's Newton–Euler equations written here, with no moment
-// at a pin; a redundant door's hinges give the minimum-norm multipliers of a dense pseudo-inverse and are named
-// indeterminate, with its driver's torque unique.
+// at a pin; a screw jack's thread carries its nut's weight and inertia with Mz = −p Fz / 2π; a redundant door's
+// hinges give the minimum-norm multipliers of a dense pseudo-inverse and are named indeterminate, with its driver's
+// torque unique.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -131,11 +132,13 @@ TEST(JointReactions, EveryPlanarKindWithASiteDoesTheWorkOfItsMultipliers) {
 TEST(JointReactions, EverySpatialKindWithASiteDoesTheWorkOfItsMultipliers) {
   const std::string sides =
       "between: [{body: a, at: [0.3, -0.2, 0.1], axis: [0, 0.6, 0.8]}, {body: b, at: [-0.1, 0.4, 0.2], "
-      "axis: [1, 0, 0]}]}";
-  for (const char* type : {"spherical", "revolute", "cylindrical", "prismatic", "universal", "planar", "rigid"}) {
+      "axis: [1, 0, 0]}]";
+  for (const char* type :
+       {"spherical", "revolute", "cylindrical", "prismatic", "universal", "planar", "rigid", "screw"}) {
     SCOPED_TRACE(type);
-    expect_reaction_virtual_work(reaction_two_bodies(true, std::string("{name: j, type: ") + type + ", " + sides),
-                                 true);
+    const std::string pitch = std::string(type) == "screw" ? ", pitch: 0.05" : "";
+    expect_reaction_virtual_work(
+        reaction_two_bodies(true, std::string("{name: j, type: ") + type + ", " + sides + pitch + "}"), true);
   }
 }
 
@@ -211,12 +214,16 @@ TEST(JointReactions, AlongTheJointsAxesTheLoadsItCannotCarryAreZero) {
       "axis: [1, 0, 0]}]}";
   const std::vector<std::pair<const char*, std::vector<int>>> spatial = {
       {"revolute", {5}},        {"cylindrical", {2, 5}}, {"prismatic", {2}}, {"universal", {5}},
-      {"spherical", {3, 4, 5}}, {"planar", {0, 1, 5}},   {"rigid", {}}};
+      {"spherical", {3, 4, 5}}, {"planar", {0, 1, 5}},   {"rigid", {}},      {"screw", {}}};
+  const double pitch = 0.05;  // the screw's: along its axis it carries Fz and Mz = −p Fz / 2π together
   for (const auto& [type, cannot_carry] : spatial) {
     SCOPED_TRACE(type);
+    const bool screw = std::string(type) == "screw";
     // both bodies at the same pose and the sides alike (the universal's axes crossed): the joint assembled
-    std::string text = reaction_two_bodies_text(
-        true, std::string("{name: j, type: ") + type + ", " + (std::string(type) == "universal" ? crossed : sides));
+    std::string joint =
+        std::string("{name: j, type: ") + type + ", " + (std::string(type) == "universal" ? crossed : sides);
+    if (screw) joint.insert(joint.size() - 1, ", pitch: " + std::to_string(pitch));
+    std::string text = reaction_two_bodies_text(true, joint);
     const std::string b_pose = "xb: 0.7, yb: -0.1, zb: 0.4, b0: 0.5, b1: 0.5, b2: 0.5, b3: 0.5";
     text.replace(text.find(b_pose), b_pose.size(), "xb: 0.1, yb: 0.2, zb: -0.3, b0: 0.8, b1: 0.2, b2: -0.4, b3: 0.4");
     const Scene s = parse_scene(text, "two.yaml");
@@ -230,6 +237,10 @@ TEST(JointReactions, AlongTheJointsAxesTheLoadsItCannotCarryAreZero) {
         EXPECT_NEAR(j[static_cast<std::size_t>(3 + i)], m(i), 1e-12 * scale);
       }
       for (int c : cannot_carry) EXPECT_NEAR(j[static_cast<std::size_t>(c)], 0.0, 1e-12 * scale) << "component " << c;
+      if (screw) {  // no work in the turn δθ and travel p δθ / 2π the thread lets through, and both loads there
+        EXPECT_NEAR(j[5], -pitch / (2 * M_PI) * j[2], 1e-12 * scale);
+        EXPECT_GT(std::fabs(j[2]), 1e-3 * scale);
+      }
       if (std::string(type) == "revolute")  // about world z it carries a moment: the axes matter
         EXPECT_GT(std::fabs(w[5]), 1e-3 * scale);
     }
@@ -389,6 +400,37 @@ TEST(JointReactions, ACamPushesItsRollerAlongTheNormalWithTheRodsWeightAndInerti
     EXPECT_NEAR(j.values[row][0], 0.0, 1e-9 * std::hypot(fx, fy)) << row;  // along the tangent
     EXPECT_NEAR(std::fabs(j.values[row][1]), std::hypot(fx, fy), 1e-12 * std::hypot(fx, fy)) << row;
   }
+}
+
+// A screw jack (models/transmissions/screw_jack.yaml) lifting its nut of mass m against gravity: the thread holds it
+// up by Fz = m (z̈ + g) (Newton along the axis, the nut's centre on it: no other force, no moment about x or y), with
+// Mz = −p Fz / 2π about the axis, and the driver turns it by τ = Izz θ̈ − Mz = Izz θ̈ + p m (z̈ + g) / 2π.
+TEST(JointReactions, AScrewJackHoldsItsNutsWeightAndInertiaThroughTheThread) {
+  const double m = 2.0, izz = 0.02, g = 9.81, p = 0.004;
+  const Scene s = parse_scene(test::model_file_text("transmissions/screw_jack.yaml", "output:") +
+                                  "parts:\n  nut: {mass: 2, center_of_mass: [0, 0, 0], inertia: [0.01, 0.01, 0.02]}\n"
+                                  "loads: {gravity: [0, 0, -9.81]}\n"
+                                  "output: {velocities: true, accelerations: true, efforts: [crank], "
+                                  "reactions: [lead_screw]}\n",
+                              "jack.yaml");
+  const Model* swept = nullptr;
+  const ReactionRows r = sweep_reactions(s, nullptr, &swept);
+  const Index z = swept->find_coordinate("nut_z");
+  ASSERT_GE(z, 0);
+  ASSERT_EQ(r.values.size(), 91u);
+  double largest_moment = 0.0;
+  for (std::size_t row = 0; row < r.values.size(); ++row) {
+    const std::vector<double>& v = r.values[row];  // the effort, its power, then Fx, Fy, Fz, Mx, My, Mz
+    ASSERT_EQ(v.size(), 8u);
+    const double fz = m * (r.qdd[row](z) + g), theta_dd = 2 * M_PI / p * r.qdd[row](z);
+    for (int k : {2, 3, 5, 6}) EXPECT_NEAR(v[static_cast<std::size_t>(k)], 0.0, 1e-9) << row << " component " << k;
+    EXPECT_NEAR(v[4], fz, 1e-9 * (1 + std::fabs(fz))) << row;
+    EXPECT_NEAR(v[7], -p / (2 * M_PI) * fz, 1e-12) << row;
+    EXPECT_NEAR(v[0], izz * theta_dd + p / (2 * M_PI) * fz, 1e-9 * (1 + std::fabs(v[0]))) << row;
+    EXPECT_NEAR(v[1], v[0] * 2 * M_PI / p * r.qd[row](z), 1e-9 * (1 + std::fabs(v[1]))) << row;  // τ θ̇
+    largest_moment = std::max(largest_moment, std::fabs(izz * theta_dd));
+  }
+  EXPECT_GT(largest_moment, 0.1);  // the nut's inertia counts (θ̈ up to 3π): 0.19 N·m, its weight 0.0125
 }
 
 // Model::constraint_block(), the table JointReactions and the minimum-norm multipliers read a constraint through,

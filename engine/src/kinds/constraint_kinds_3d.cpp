@@ -50,6 +50,20 @@ void joint_axes(const JointSide3& s, const double* q, kin3::V3 axes[3]) {
   }
 }
 
+ReactionSite joint_reaction_site(const JointSide3& a, const JointSide3& b, const double* q) {
+  const Frame3& f = a.frame;
+  const kin3::V3 r{f.x.of(q), f.y.of(q), f.z.of(q)};
+  const double e[4] = {f.e0.of(q), f.e1.of(q), f.e2.of(q), f.e3.of(q)};
+  const kin3::V3 s = kin3::rotate(e, a.at);
+  ReactionSite site;
+  site.point = {r.x + s.x, r.y + s.y, r.z + s.z};
+  site.spatial = true;
+  const bool on_a = detail::frame_moves(a.frame);
+  site.frame3 = on_a ? a.frame : b.frame;
+  joint_axes(on_a ? a : b, q, site.axes);
+  return site;
+}
+
 std::array<Attachment3, kCount> joint_attachments(const JointSide3& a, const JointSide3& b, const std::int8_t* index,
                                                   int count, const char* kind) {
   bool used[kCount] = {};

@@ -58,6 +58,12 @@ struct ScrewSpec {
     detail::require(pitch != 0.0, "screw: the pitch must not be zero (a screw of no pitch is a revolute joint)");
     detail3::set_up_attachments(a, b, kCompact, kKind, att);
   }
+  /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Fz, Mx, My, Mz, as a spatial joint's.
+  static constexpr int kReactionWidth = 6;
+  /// The reaction (ReactionSite) as a spatial joint's: on the nut's body (side a), or on the screw's when the nut is
+  /// ground, at side a's point; its axes side a's joint frame. Along z there the thread ties the two loads it
+  /// carries: no work in the turn and travel it lets through, Mz = −p Fz / 2π.
+  ReactionSite reaction_site(const double* q) const { return detail3::joint_reaction_site(a, b, q); }
   /// @copydoc DistanceSpec::depends_on_time
   bool depends_on_time() const { return false; }
   /// @copydoc DistanceSpec::row_unit

@@ -101,6 +101,9 @@ kin3::V3 reference_direction(const JointSide3& s);
 /// perpendicular to it, y = z × x (ReactionSite::axes). A natural side's stays world axes (it has no frame).
 /// Pre-condition: the side is valid (its joint set up).
 void joint_axes(const JointSide3& s, const double* q, kin3::V3 axes[3]);
+/// The ReactionSite of a joint between sides a and b (a spatial joint's, a screw's): on side a's body, or on b's
+/// when a is fixed, at side a's joint point; its axes that side's joint frame (joint_axes()).
+ReactionSite joint_reaction_site(const JointSide3& a, const JointSide3& b, const double* q);
 
 /// The attachments of a joint between sides a and b that `index[0 … count − 1]` name (Attach indices, ascending:
 /// CompactRows::index), in that order in the first `count` entries; an attachment of constants only is folded
@@ -185,19 +188,7 @@ struct SpatialJointSpec {
   static constexpr int kReactionWidth = 6;
   /// The reaction (ReactionSite): on side a's body, or on b's when a is fixed, at side a's joint point; its axes
   /// that side's joint frame.
-  ReactionSite reaction_site(const double* q) const {
-    const Frame3& f = a.frame;
-    const kin3::V3 r{f.x.of(q), f.y.of(q), f.z.of(q)};
-    const double e[4] = {f.e0.of(q), f.e1.of(q), f.e2.of(q), f.e3.of(q)};
-    const kin3::V3 s = kin3::rotate(e, a.at);
-    ReactionSite site;
-    site.point = {r.x + s.x, r.y + s.y, r.z + s.z};
-    site.spatial = true;
-    const bool on_a = detail::frame_moves(a.frame);
-    site.frame3 = on_a ? a.frame : b.frame;
-    detail3::joint_axes(on_a ? a : b, q, site.axes);
-    return site;
-  }
+  ReactionSite reaction_site(const double* q) const { return detail3::joint_reaction_site(a, b, q); }
   /// @copydoc DistanceSpec::residual
   void residual(const double* q, double, double* phi) const {
     for (int r = 0; r < kRows; ++r) phi[r] = detail3::row_value(att.data(), kCompact.rows[r], q, 1.0, 0.0);
