@@ -133,8 +133,8 @@ TEST(JointReactions, EverySpatialKindWithASiteDoesTheWorkOfItsMultipliers) {
   const std::string sides =
       "between: [{body: a, at: [0.3, -0.2, 0.1], axis: [0, 0.6, 0.8]}, {body: b, at: [-0.1, 0.4, 0.2], "
       "axis: [1, 0, 0]}]";
-  for (const char* type :
-       {"spherical", "revolute", "cylindrical", "prismatic", "universal", "planar", "rigid", "screw"}) {
+  for (const char* type : {"spherical", "revolute", "cylindrical", "prismatic", "universal", "planar", "rigid",
+                           "point_on_line", "point_on_plane", "screw"}) {
     SCOPED_TRACE(type);
     const std::string pitch = std::string(type) == "screw" ? ", pitch: 0.05" : "";
     expect_reaction_virtual_work(
@@ -213,8 +213,16 @@ TEST(JointReactions, AlongTheJointsAxesTheLoadsItCannotCarryAreZero) {
       "between: [{body: a, at: [0.3, -0.2, 0.1], axis: [0, 0.6, 0.8]}, {body: b, at: [0.3, -0.2, 0.1], "
       "axis: [1, 0, 0]}]}";
   const std::vector<std::pair<const char*, std::vector<int>>> spatial = {
-      {"revolute", {5}},        {"cylindrical", {2, 5}}, {"prismatic", {2}}, {"universal", {5}},
-      {"spherical", {3, 4, 5}}, {"planar", {0, 1, 5}},   {"rigid", {}},      {"screw", {}}};
+      {"revolute", {5}},
+      {"cylindrical", {2, 5}},
+      {"prismatic", {2}},
+      {"universal", {5}},
+      {"spherical", {3, 4, 5}},
+      {"planar", {0, 1, 5}},
+      {"rigid", {}},
+      {"screw", {}},
+      {"point_on_line", {2, 3, 4, 5}},  // a point sliding and turning on a's axis: pushed across it alone
+      {"point_on_plane", {0, 1, 3, 4, 5}}};
   const double pitch = 0.05;  // the screw's: along its axis it carries Fz and Mz = −p Fz / 2π together
   for (const auto& [type, cannot_carry] : spatial) {
     SCOPED_TRACE(type);
