@@ -123,6 +123,8 @@ class ConstraintBlock {
   virtual int reaction_width() const { return 0; }
   /// Constraint i's ReactionSite at q, when has_reaction_site(); else false. Thread-safe.
   virtual bool reaction_site(std::size_t /*i*/, const double* /*q*/, ReactionSite& /*out*/) const { return false; }
+  /// Constraint i's GearMesh, when its kind is a gear pair (GearSpec::gear_mesh()); else false.
+  virtual bool gear_mesh(std::size_t /*i*/, GearMesh& /*out*/) const { return false; }
   /// The coordinates constraint i adds (a kind with kAddedCoordinates: a curve's parameter) and the length each is
   /// measured in proportion to (PointOnCurveSpec::added_scale()): at most `capacity` of them into `coordinate` and
   /// `scale`, returning how many it adds (0 for the kinds that add none). For the sensitivities' co-motion
@@ -314,6 +316,13 @@ class TypedBlock final : public ConstraintBlock {
   bool reaction_site(std::size_t i, const double* q, ReactionSite& out) const override {
     if constexpr (requires(const Spec& k, const double* at) { k.reaction_site(at); }) {
       out = entries_[i].spec.reaction_site(q);
+      return true;
+    }
+    return false;
+  }
+  bool gear_mesh(std::size_t i, GearMesh& out) const override {
+    if constexpr (requires(const Spec& k) { k.gear_mesh(); }) {
+      out = entries_[i].spec.gear_mesh();
       return true;
     }
     return false;

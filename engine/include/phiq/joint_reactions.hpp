@@ -249,6 +249,18 @@ class JointReactions {
   std::vector<Part> body_part_;           // a body's parts built where they are read (body_parts_kept's others)
 };
 
+/// What turns the torques of each gear pair of `meshes` under multipliers `lambda` into the push of its teeth,
+/// added to `dq` (one value per coordinate). A gear's row relates angles alone (GearMesh), so λ turns its gears by
+/// torques and their bearings see nothing of the mesh; the teeth push at the pitch point, across the line of the
+/// centres c1 → c2 (bodies' reference points, at distance d), with F = −λ_g (1 + k)/d along t = ẑ × (c2 − c1)/d:
+/// the same torques, and F t on c1, −F t on c2, which the carrier's torque F d made up for. So dq = F t at gear 1's
+/// centre, −F t at gear 2's, and F d on the carrier's angle. It does no work in any motion that keeps the centres
+/// where the mesh needs them: δ with Φqᵀ δ = dq is the change of the other joints' multipliers (nothing at the
+/// drivers' rows or the gears'), λ + δ the multipliers under which the bearings carry the teeth's push. A mesh
+/// whose centres coincide adds nothing. Pre-condition: `lambda` has one value per model row.
+void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
+                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq);
+
 /// The multipliers of least norm among those with Φqᵀ λ = Q, from `lambda`, one of them (λ = 0 on the rows the model
 /// dropped as redundant: multipliers_with_factors()), and `lu`, the factors of the kept rows of Φq at q. Each
 /// dropped row r is a combination of the kept rows, Φq,r = Σ α_k Φq,k (one transposed solve with `lu`), so that

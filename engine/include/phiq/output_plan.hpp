@@ -19,6 +19,7 @@
 #include "phiq/motion_law.hpp"
 #include "phiq/output_joints.hpp"
 #include "phiq/output_points.hpp"
+#include "phiq/kinds/reaction_site.hpp"
 #include "phiq/types.hpp"
 
 namespace phiq {
@@ -91,6 +92,15 @@ struct OutputReaction {
   int natural = -1;      ///< a natural joint: its index in OutputEfforts::natural's joints, else −1
 };
 
+/// A gear pair between two planar bodies, in a sweep that writes reactions (OutputEfforts::meshes): its teeth push
+/// the bodies at their pitch point, which loads the bodies' reference points, about which the gears turn
+/// (add_gear_mesh_forces(), phiq/joint_reactions.hpp).
+struct OutputMesh {
+  Index constraint = -1;  ///< the gear's Model::constraints() index
+  GearMesh mesh;          ///< its angles and ratio
+  Frame2 first, second;   ///< the bodies whose ψ are mesh.first and mesh.second
+};
+
 /// Driver efforts (inverse dynamics, phiq/inverse_dynamics.hpp) at every written row: for each listed constraint
 /// that depends on time, the torque or force its motor applies (−λ of its first row, conjugate to what it drives)
 /// and its power (Σ λ_i Φt_i over its rows). Solved with the row's own factorisation of Φq (one transposed solve),
@@ -107,6 +117,8 @@ struct OutputEfforts {
   /// pair's slide, a spatial joint's frame) rather than world axes; a natural point's along the frame of the part it
   /// is reported on (natural_reaction_site(): x toward the frame's x point, along a bar and across it).
   bool reactions_in_joint_axes = false;
+  /// The gear pairs between bodies, whose tooth force the written reactions carry (empty without reactions).
+  std::vector<OutputMesh> meshes;
   /// The natural coordinates' bodies and joints the `natural` reactions index (null: none listed).
   std::shared_ptr<const NaturalJoints> natural;
   /// A reaction's name (its columns' stem): its constraint's, or its natural joint's point's.

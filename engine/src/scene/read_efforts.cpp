@@ -113,6 +113,22 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       out.reactions.push_back({c, w == 6});
     }
   }
+  if (!out.reactions.empty() && !spatial_) {  // gear pairs between bodies: their bearings carry the teeth's push
+    auto body = [&](const Slot& angle) -> const Frame2* {
+      for (const Frame2& f : scene.planar_bodies)
+        if (angle.is_coordinate() && f.psi == angle) return &f;
+      return nullptr;
+    };
+    for (std::size_t c = 0; c < model.constraints().size(); ++c) {
+      const auto [block, index] = model.constraint_block(static_cast<Index>(c));
+      OutputMesh m;
+      if (!block->gear_mesh(index, m.mesh)) continue;
+      const Frame2 *first = body(m.mesh.first), *second = body(m.mesh.second);
+      if (!first || !second) continue;  // (angle coordinates: no centres to push)
+      m.constraint = static_cast<Index>(c), m.first = *first, m.second = *second;
+      out.meshes.push_back(m);
+    }
+  }
   if (pending_.efforts_field && pending_.effort_items.empty()) {
     out.constraints = rheonomic_constraints(model);
     if (out.constraints.empty()) pending_.efforts_field->fail("the scene has no driver: no effort to write");

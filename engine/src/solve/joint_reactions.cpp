@@ -199,6 +199,24 @@ void JointReactions::evaluate_site(const Site& s, const double* q, double t, con
   }
 }
 
+void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
+                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq) {
+  auto add = [&](const Slot& s, double v) {
+    if (s.is_coordinate()) dq(s.coord()) += v;
+  };
+  for (const OutputMesh& m : meshes) {
+    const double dx = m.second.x.of(q) - m.first.x.of(q), dy = m.second.y.of(q) - m.first.y.of(q);
+    const double d = std::hypot(dx, dy);
+    if (!(d > 0.0)) continue;
+    const double f =
+        -lambda(model.constraints()[static_cast<std::size_t>(m.constraint)].first_row) * (1.0 + m.mesh.k) / d;
+    const double tx = -dy / d, ty = dx / d;
+    add(m.first.x, f * tx), add(m.first.y, f * ty);
+    add(m.second.x, -f * tx), add(m.second.y, -f * ty);
+    add(m.mesh.carrier, f * d);
+  }
+}
+
 bool detail::minimum_norm_multipliers(const Model& model, SparseLuNumeric& lu, const double* q, double t,
                                       Eigen::VectorXd& lambda, std::vector<Index>* indeterminate,
                                       MinimumNormScratch& sc) {

@@ -6,6 +6,7 @@
 
 #include "phiq/effort_sensitivity.hpp"
 #include "phiq/inverse_dynamics.hpp"
+#include "phiq/joint_reactions.hpp"
 #include "phiq/parts.hpp"
 #include "sweep/sweeper.hpp"
 
@@ -91,12 +92,21 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
   const double t = current_.t;
   std::vector<Index> indeterminate;
   const bool note = !effort_work_.reactions_noted && t == opt_.t_begin;
-  if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_work_.lambda, note ? &indeterminate : nullptr,
-                                effort_work_.minimum_norm)) {
+  auto not_defined = [&] {
     std::fill(outputs_.efforts.begin() + 2 * static_cast<std::ptrdiff_t>(opt_.efforts.constraints.size()),
               outputs_.efforts.begin() + opt_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
-    return;
+  };
+  if (!opt_.efforts.meshes.empty()) {  // the bearings of gears carry their teeth's push (add_gear_mesh_forces())
+    effort_work_.mesh_q.setZero(model_.num_coordinates());
+    add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q);
+    if (!multipliers_with_factors(model_, lu, effort_work_.mesh_q, effort_work_.kept, effort_work_.mesh_lambda))
+      return not_defined();
+    ++ws_->counters.effort_solves;
+    effort_work_.lambda += effort_work_.mesh_lambda;
   }
+  if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_work_.lambda, note ? &indeterminate : nullptr,
+                                effort_work_.minimum_norm))
+    return not_defined();
   // the natural bodies' weight and inertia as Q took them at this row (row_efforts())
   effort_work_.reactions->evaluate(current_.q.data(), current_.qd.data(), current_.qdd.data(), t, effort_work_.lambda,
                                    outputs_.efforts.data() + 2 * opt_.efforts.constraints.size(),

@@ -161,6 +161,7 @@ struct EffortWork {
       : dropped(std::move(dropped_efforts)), reactions(std::move(written_reactions)) {}
   EffortSensitivityScratch sensitivity_scratch;
   Eigen::VectorXd q, kept, lambda, phi_t;    // Q, the kept rows, λ, Φt
+  Eigen::VectorXd mesh_q, mesh_lambda;       // the gear meshes' push on their bearings, and its multipliers
   std::shared_ptr<const PartForces> forces;  // Q's parts, gathered once a sweep (Sweeper's constructor)
   // what Q's parts on planar frames added, one per part, when natural joints' reactions read their bodies' (else
   // empty)

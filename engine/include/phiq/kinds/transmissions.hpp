@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "phiq/kinds/kind_support.hpp"
+#include "phiq/kinds/reaction_site.hpp"
 
 namespace phiq {
 
@@ -163,9 +164,13 @@ struct GearSpec : LinearTransmission<GearSpec> {
   }
   /// The row as a linear form (LinearTransmission evaluates it).
   detail::LinearRow row() const {
-    const double k = (internal ? -r2 : r2) / r1;
+    const double k = ratio();
     return detail::LinearRow{{first, second, carrier}, {1.0, k, -(1.0 + k)}, phase};
   }
+  /// The mesh as a force on the gears' bearings (kinds/reaction_site.hpp): the angles and the row's ratio.
+  GearMesh gear_mesh() const { return GearMesh{first, second, carrier, ratio()}; }
+  /// k of the row: r2/r1 external, −r2/r1 internal.
+  double ratio() const { return (internal ? -r2 : r2) / r1; }
   /// The data a parameter may move (DistanceSpec::data_members()): fixed angles, the radii and the phase.
   static constexpr auto data_members() {
     return std::tuple{&GearSpec::first, &GearSpec::second, &GearSpec::carrier,

@@ -1,0 +1,128 @@
+// Gear meshes in joint reactions (add_gear_mesh_forces(), phiq/joint_reactions.hpp): a gear's row relates angles,
+// yet the bearings under its gears carry the push of its teeth. Each gear here is checked by Newton–Euler written
+// in the test: the two-stage train's pivots (fixed centres, the motor's torque and the gears' inertia) and the
+// planetary's sun, ring and planet under gravity with a turning carrier (the planet's centre accelerating, the
+// internal mesh). The drivers' efforts are the bits they are without the reactions.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+struct MeshRows {
+  std::vector<Eigen::VectorXd> q, qdd;
+  std::vector<std::vector<double>> values;  // efforts, powers, reactions
+};
+
+MeshRows sweep_meshes(const Scene& s) {
+  MeshRows r;
+  Workspace ws(*s.model);
+  const std::size_t n = static_cast<std::size_t>(s.sweep.efforts.size());
+  EXPECT_EQ(run_sweep(
+                *s.model, s.sweep, ws,
+                [&](const StepView& v) {
+                  r.q.push_back(v.q), r.qdd.push_back(*v.qdd);
+                  r.values.emplace_back(v.efforts, v.efforts + n);
+                  return true;
+                },
+                nullptr),
+            SolveStatus::kSuccess);
+  return r;
+}
+
+using V2 = Eigen::Vector2d;
+V2 perp(const V2& u) { return {-u.y(), u.x()}; }  // ẑ × u
+
+// models/transmissions/gear_train.yaml with a mass and inertia on each gear (centres on the pivots, no gravity).
+// The input gear turns under the motor's τ and the first mesh's push F1 at its pitch point (radius ρ1 = 0.03, on
+// the line to the countershaft, along +x): I1 ψ̈1 = τ + ρ1 F1y, so its pivot holds it by −F1 = (0, (τ − I1 ψ̈1)/ρ1).
+// The output gear (ρ = 0.1125, the countershaft below it along −y) turns by the second mesh alone: I3 ψ̈3 = ρ F2x,
+// its pivot −F2. The countershaft's pivot holds F1 + F2, the reactions of both.
+TEST(GearMeshes, ATrainsPivotsCarryItsTeethsPushByNewtonEuler) {
+  const std::string base = test::model_file_text("transmissions/gear_train.yaml", "\noutput:") +
+                           "\nparts:\n  input: {mass: 0.1, center_of_mass: [0, 0], inertia: 1e-4}\n"
+                           "  countershaft: {mass: 0.5, center_of_mass: [0, 0], inertia: 2e-3}\n"
+                           "  output: {mass: 0.8, center_of_mass: [0, 0], inertia: 5e-3}\n";
+  const Scene s = parse_scene(base + "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n",
+                              "train.yaml");
+  const Scene bare =
+      parse_scene(base + "output: {velocities: true, accelerations: true, efforts: all}\n", "train.yaml");
+  ASSERT_EQ(s.sweep.efforts.meshes.size(), 2u);
+  const MeshRows r = sweep_meshes(s), e = sweep_meshes(bare);
+  const Index psi1 = s.model->find_coordinate("psi1"), psi3 = s.model->find_coordinate("psi3");
+  const double i1 = 1e-4, i3 = 5e-3, rho1 = 0.005 * 12 / 2, rho3 = 0.005 * 45 / 2;
+  double largest = 0.0;
+  for (std::size_t k = 0; k < r.values.size(); ++k) {
+    const std::vector<double>& v = r.values[k];  // τ, power, then each pivot's Fx, Fy, Mz
+    ASSERT_EQ(v.size(), 11u);
+    EXPECT_EQ(v[0], e.values[k][0]) << k;  // the effort: the same bits
+    const double tau = v[0], f1y = (i1 * r.qdd[k](psi1) - tau) / rho1, f2x = i3 * r.qdd[k](psi3) / rho3;
+    const double scale = 1.0 + std::fabs(f1y) + std::fabs(f2x);
+    const double expected[9] = {0, -f1y, 0, f2x, f1y, 0, -f2x, 0, 0};
+    for (int c = 0; c < 9; ++c)
+      EXPECT_NEAR(v[static_cast<std::size_t>(2 + c)], expected[c], 1e-12 * scale) << k << " " << c;
+    largest = std::max(largest, std::fabs(f1y));
+  }
+  EXPECT_GT(largest, 0.05);
+}
+
+// models/transmissions/planetary.yaml with masses under gravity: the sun at 1 rad/s, the ring at −0.2, the carrier
+// and the planet's centre turning (uniformly, so its centre accelerates toward the sun's). Each gear's teeth push at
+// the pitch point on the line from the sun's centre to the planet's, n: the sun meshes at rs n, the ring (internal) at
+// rr n, both about the origin. The sun and ring turn uniformly (ψ̈ = 0), so each mesh's torque on them is minus the
+// motor's: the sun's mesh pushes it by −(τs/rs) ẑ × n, and its bearing holds it by (τs/rs) ẑ × n + ms g↑; the ring's
+// likewise. The planet takes the opposite pushes at rp from its centre, toward the sun and toward the ring, its
+// weight, and the pin's force (minus what the pin reports on the carrier): Newton for its centre's acceleration and
+// Euler for its ψ̈.
+TEST(GearMeshes, APlanetarysGearsMoveByNewtonEulerWithTheirTeethsPush) {
+  const double ms = 0.3, mp = 0.2, mr = 0.8, ip = 2e-4, g = 9.81;
+  const double rs = 0.004 * 24 / 2, rp = 0.004 * 18 / 2, rr = 0.004 * 60 / 2;
+  const Scene s = parse_scene(test::model_file_text("transmissions/planetary.yaml", "output:") +
+                                  "parts:\n  sun: {mass: 0.3, center_of_mass: [0, 0], inertia: 5e-4}\n"
+                                  "  carrier: {mass: 0.5, center_of_mass: [0.042, 0], inertia: 1e-3}\n"
+                                  "  planet: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
+                                  "  ring: {mass: 0.8, center_of_mass: [0, 0], inertia: 6e-3}\n"
+                                  "loads: {gravity: [0, -9.81]}\n"
+                                  "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n",
+                              "planetary.yaml");
+  ASSERT_EQ(s.sweep.efforts.meshes.size(), 2u);
+  const MeshRows r = sweep_meshes(s);
+  const Model& m = *s.model;
+  const Index xp = m.find_coordinate("xp"), yp = m.find_coordinate("yp"), psip = m.find_coordinate("psip");
+  // columns: τs, τr, two powers, then sun_bearing, carrier_bearing, ring_bearing, planet_pin (Fx, Fy, Mz each)
+  const std::vector<Index>& drivers = s.sweep.efforts.constraints;
+  ASSERT_EQ(drivers.size(), 2u);
+  ASSERT_EQ(m.constraints()[static_cast<std::size_t>(drivers[0])].name, "sun_motor");
+  double largest = 0.0;
+  for (std::size_t k = 0; k < r.values.size(); ++k) {
+    const std::vector<double>& v = r.values[k];
+    ASSERT_EQ(v.size(), 16u);
+    const double ts = v[0], tr = v[1];
+    const V2 c(r.q[k](xp), r.q[k](yp)), n = c.normalized(), t = perp(n);
+    const V2 sun = V2(v[4], v[5]), ring = V2(v[10], v[11]), pin_on_carrier = V2(v[13], v[14]);
+    const V2 up(0, g);
+    const double scale = 1.0 + (std::fabs(ts) / rs + std::fabs(tr) / rr);
+    const V2 sun_expected = (ts / rs) * t + ms * up, ring_expected = (tr / rr) * t + mr * up;
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_NEAR(sun(i), sun_expected(i), 1e-11 * scale) << k;
+      EXPECT_NEAR(ring(i), ring_expected(i), 1e-11 * scale) << k;
+    }
+    // the planet: the pushes the sun and ring take, reversed, at its pitch points c − rp n and c + rp n
+    const V2 from_sun = (ts / rs) * t, from_ring = (tr / rr) * t;
+    const V2 force = from_sun + from_ring - pin_on_carrier - mp * up;
+    EXPECT_NEAR(force.x(), mp * r.qdd[k](xp), 1e-11 * scale) << k;
+    EXPECT_NEAR(force.y(), mp * r.qdd[k](yp), 1e-11 * scale) << k;
+    auto cross = [](const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); };
+    const double moment = cross(-rp * n, from_sun) + cross(rp * n, from_ring);
+    EXPECT_NEAR(moment, ip * r.qdd[k](psip), 1e-11 * scale) << k;
+    largest = std::max(largest, std::fabs(ts));
+  }
+  EXPECT_GT(largest, 1e-2);  // the carrier's and planet's weights turn the gears
+}
+
+}  // namespace
+}  // namespace phiq
