@@ -2,7 +2,8 @@
 // yet the bearings under its gears carry the push of its teeth. Each gear here is checked by Newton–Euler written
 // in the test: the two-stage train's pivots (fixed centres, the motor's torque and the gears' inertia) and the
 // planetary's sun, ring and planet under gravity with a turning carrier (the planet's centre accelerating, the
-// internal mesh). The drivers' efforts are the bits they are without the reactions.
+// internal mesh); a rack's teeth on its pinion's pivot and its guide. The drivers' efforts are the bits they are
+// without the reactions.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -122,6 +123,49 @@ TEST(GearMeshes, APlanetarysGearsMoveByNewtonEulerWithTheirTeethsPush) {
     largest = std::max(largest, std::fabs(ts));
   }
   EXPECT_GT(largest, 1e-2);  // the carrier's and planet's weights turn the gears
+}
+
+// models/transmissions/rack_pinion.yaml with masses under gravity and the rack's reference point 0.03 below its pitch
+// line (its guide there): the rack moves along x by its teeth alone (its guide carries no x), so they push it by
+// F = (mr ẍ, 0) at the pitch point P (below the pinion's centre by r), and the pinion by −F: its pivot holds
+// (mr ẍ, mp g), and the guide the rack's weight and the moment about its point S that Euler asks for the rack,
+// M = (com − S) × (mr a − W) − (P − S) × F.
+TEST(GearMeshes, ARacksTeethPushThePinionsPivotAndTurnOnItsGuide) {
+  const double mp = 0.2, mr = 1.5, g = 9.81, r = 0.04;
+  std::string text = test::model_file_text("transmissions/rack_pinion.yaml", "output:");
+  text = test::replace_first(text, "y_rack: 0", "y_rack: -0.03");
+  text = test::replace_first(text, "between: [{body: ground}, {body: rack}]",
+                             "between: [{body: ground, at: [0, -0.03]}, {body: rack}]");
+  const Scene s = parse_scene(text +
+                                  "parts:\n  pinion: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
+                                  "  rack: {mass: 1.5, center_of_mass: [0.1, -0.02], inertia: 0.01}\n"
+                                  "loads: {gravity: [0, -9.81]}\n"
+                                  "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n",
+                              "rack.yaml");
+  ASSERT_EQ(s.sweep.efforts.meshes.size(), 1u);
+  const MeshRows rows = sweep_meshes(s);
+  const Model& m = *s.model;
+  const Index x = m.find_coordinate("x_rack"), guide = m.find_constraint("guide");
+  const Index xp = m.find_coordinate("xp"), yp = m.find_coordinate("yp");
+  const auto [block, index] = m.constraint_block(guide);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < rows.values.size(); ++k) {
+    const std::vector<double>& v = rows.values[k];  // τ, power, pivot's Fx, Fy, Mz, guide's Fx, Fy, Mz
+    ASSERT_EQ(v.size(), 8u);
+    const double xdd = rows.qdd[k](x);
+    const V2 f(mr * xdd, 0.0), weight(0.0, -mr * g), a(xdd, 0.0);
+    const V2 rack(rows.q[k](x), -0.03), com = rack + V2(0.1, -0.02);
+    const V2 pitch(rows.q[k](xp), rows.q[k](yp) - r);  // below the pinion's centre
+    ReactionSite site;
+    ASSERT_TRUE(block->reaction_site(index, rows.q[k].data(), site));
+    const V2 at(site.point.x, site.point.y);
+    auto cross = [](const V2& u, const V2& w) { return u.x() * w.y() - u.y() * w.x(); };
+    const double moment = cross(com - at, mr * a - weight) - cross(pitch - at, f);
+    const double expected[6] = {f.x(), mp * g, 0.0, 0.0, mr * g, moment};
+    for (int c = 0; c < 6; ++c) EXPECT_NEAR(v[static_cast<std::size_t>(2 + c)], expected[c], 1e-11) << k << " " << c;
+    largest = std::max(largest, std::fabs(f.x()));
+  }
+  EXPECT_GT(largest, 0.1);
 }
 
 }  // namespace

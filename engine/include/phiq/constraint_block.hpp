@@ -123,7 +123,7 @@ class ConstraintBlock {
   virtual int reaction_width() const { return 0; }
   /// Constraint i's ReactionSite at q, when has_reaction_site(); else false. Thread-safe.
   virtual bool reaction_site(std::size_t /*i*/, const double* /*q*/, ReactionSite& /*out*/) const { return false; }
-  /// Constraint i's GearMesh, when its kind is a gear pair (GearSpec::gear_mesh()); else false.
+  /// Constraint i's GearMesh, when its kind is a gear pair or a rack and pinion (GearSpec::gear_mesh()); else false.
   virtual bool gear_mesh(std::size_t /*i*/, GearMesh& /*out*/) const { return false; }
   /// The coordinates constraint i adds (a kind with kAddedCoordinates: a curve's parameter) and the length each is
   /// measured in proportion to (PointOnCurveSpec::added_scale()): at most `capacity` of them into `coordinate` and

@@ -257,7 +257,10 @@ class JointReactions {
 /// centre, −F t at gear 2's, and F d on the carrier's angle. It does no work in any motion that keeps the centres
 /// where the mesh needs them: δ with Φqᵀ δ = dq is the change of the other joints' multipliers (nothing at the
 /// drivers' rows or the gears'), λ + δ the multipliers under which the bearings carry the teeth's push. A mesh
-/// whose centres coincide adds nothing. Pre-condition: `lambda` has one value per model row.
+/// whose centres coincide adds nothing. A rack and pinion likewise: its row pushes the rack along its travel e
+/// (its body's x or y) and turns the pinion; its teeth push at P = c_p + k ẑ × e, which adds λ e on the pinion's
+/// centre and the moment of the rack's push about its reference point on its angle. Pre-condition: `lambda` has
+/// one value per model row.
 void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
                           const Eigen::VectorXd& lambda, Eigen::VectorXd& dq);
 

@@ -92,13 +92,16 @@ struct OutputReaction {
   int natural = -1;      ///< a natural joint: its index in OutputEfforts::natural's joints, else −1
 };
 
-/// A gear pair between two planar bodies, in a sweep that writes reactions (OutputEfforts::meshes): its teeth push
-/// the bodies at their pitch point, which loads the bodies' reference points, about which the gears turn
-/// (add_gear_mesh_forces(), phiq/joint_reactions.hpp).
+/// A gear pair between two planar bodies, or a rack and pinion on them, in a sweep that writes reactions
+/// (OutputEfforts::meshes): its teeth push the bodies at their pitch point, which loads the bodies' reference
+/// points, about which the gears turn (add_gear_mesh_forces(), phiq/joint_reactions.hpp).
 struct OutputMesh {
   Index constraint = -1;  ///< the gear's Model::constraints() index
   GearMesh mesh;          ///< its angles and ratio
-  Frame2 first, second;   ///< the bodies whose ψ are mesh.first and mesh.second
+  /// The bodies whose ψ are mesh.first and mesh.second; a rack's: the body whose x or y is its travel, and the
+  /// pinion's
+  Frame2 first, second;
+  int rack_axis = -1;  ///< a rack's travel: 0 its body's x, 1 its y (−1: a gear pair)
 };
 
 /// Driver efforts (inverse dynamics, phiq/inverse_dynamics.hpp) at every written row: for each listed constraint

@@ -113,7 +113,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       out.reactions.push_back({c, w == 6});
     }
   }
-  if (!out.reactions.empty() && !spatial_) {  // gear pairs between bodies: their bearings carry the teeth's push
+  if (!out.reactions.empty() && !spatial_) {  // gears and racks on bodies: their bearings carry the teeth's push
     auto body = [&](const Slot& angle) -> const Frame2* {
       for (const Frame2& f : scene.planar_bodies)
         if (angle.is_coordinate() && f.psi == angle) return &f;
@@ -124,7 +124,10 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       OutputMesh m;
       if (!block->gear_mesh(index, m.mesh)) continue;
       const Frame2 *first = body(m.mesh.first), *second = body(m.mesh.second);
-      if (!first || !second) continue;  // (angle coordinates: no centres to push)
+      for (const Frame2& f : scene.planar_bodies)  // a rack: the body whose x or y is its travel
+        if (m.mesh.rack && m.mesh.first.is_coordinate() && (f.x == m.mesh.first || f.y == m.mesh.first))
+          first = &f, m.rack_axis = f.x == m.mesh.first ? 0 : 1;
+      if (!first || !second) continue;  // (angle or travel coordinates of no body: no centres to push)
       m.constraint = static_cast<Index>(c), m.first = *first, m.second = *second;
       out.meshes.push_back(m);
     }

@@ -205,11 +205,21 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
     if (s.is_coordinate()) dq(s.coord()) += v;
   };
   for (const OutputMesh& m : meshes) {
+    const double lambda_m = lambda(model.constraints()[static_cast<std::size_t>(m.constraint)].first_row);
+    if (m.mesh.rack) {
+      // the rack pushed by −λ e at the pitch point P = c_p + k ẑ × e (its travel took −λ), the pinion by λ e there
+      // (its angle took −λ k, the moment of λ e about its centre): λ e on the pinion's centre, and the moment of
+      // −λ e about the rack's reference point on its angle
+      const double ex = m.rack_axis == 0 ? 1.0 : 0.0, ey = 1.0 - ex;
+      const double px = m.second.x.of(q) - m.mesh.k * ey, py = m.second.y.of(q) + m.mesh.k * ex;
+      add(m.second.x, lambda_m * ex), add(m.second.y, lambda_m * ey);
+      add(m.first.psi, -lambda_m * ((px - m.first.x.of(q)) * ey - (py - m.first.y.of(q)) * ex));
+      continue;
+    }
     const double dx = m.second.x.of(q) - m.first.x.of(q), dy = m.second.y.of(q) - m.first.y.of(q);
     const double d = std::hypot(dx, dy);
     if (!(d > 0.0)) continue;
-    const double f =
-        -lambda(model.constraints()[static_cast<std::size_t>(m.constraint)].first_row) * (1.0 + m.mesh.k) / d;
+    const double f = -lambda_m * (1.0 + m.mesh.k) / d;
     const double tx = -dy / d, ty = dx / d;
     add(m.first.x, f * tx), add(m.first.y, f * ty);
     add(m.second.x, -f * tx), add(m.second.y, -f * ty);

@@ -24,15 +24,16 @@ struct ReactionSite {
   kin3::V3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 };
 
-/// A gear pair as its mesh acts on its members' bearings (GearSpec::gear_mesh(), OutputEfforts::meshes): the row
-/// (θ1 − θc) + k (θ2 − θc) − φ relates angles alone, so its multiplier λ turns the members by torques; the teeth
-/// push them at their pitch point, across the line of their centres, with F = −λ (1 + k)/d (d the distance
-/// between the centres), which loads their bearings as well.
+/// A gear pair, or a rack and pinion, as its teeth push its members (GearSpec::gear_mesh(),
+/// RackPinionSpec::gear_mesh(), OutputEfforts::meshes, add_gear_mesh_forces()): its row relates coordinates
+/// alone, (θ1 − θc) + k (θ2 − θc) − φ or x + k θ − c, so its multiplier λ turns the members by torques (and pushes
+/// a rack along its travel); the teeth push at the pitch point, which loads the members' bearings as well.
 struct GearMesh {
-  Slot first;                          ///< θ1, gear 1's angle
-  Slot second;                         ///< θ2, gear 2's angle
-  Slot carrier = Slot::constant(0.0);  ///< θc, the carrier's angle (a constant 0 without one)
-  double k = 1.0;                      ///< the row's ratio: r2/r1 external, −r2/r1 internal
+  Slot first;                          ///< θ1, gear 1's angle; a rack's travel x
+  Slot second;                         ///< θ2, gear 2's angle; the pinion's angle θ
+  Slot carrier = Slot::constant(0.0);  ///< θc, the carrier's angle (a constant 0 without one, or for a rack)
+  double k = 1.0;     ///< the row's ratio: r2/r1 external, −r2/r1 internal; a rack's −r (r when reversed)
+  bool rack = false;  ///< a rack and pinion
 };
 
 /// @cond internal

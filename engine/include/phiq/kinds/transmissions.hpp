@@ -249,6 +249,8 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
   detail::LinearRow row() const {
     return detail::LinearRow{{rack, pinion, Slot::constant(0)}, {1.0, reversed ? radius : -radius, 0.0}, offset};
   }
+  /// The mesh as a push on the pinion's bearing and the rack's guide (kinds/reaction_site.hpp).
+  GearMesh gear_mesh() const { return GearMesh{rack, pinion, Slot::constant(0.0), reversed ? radius : -radius, true}; }
   /// The data a parameter may move (DistanceSpec::data_members()): a fixed pinion angle, the radius, the offset.
   static constexpr auto data_members() {
     return std::tuple{&RackPinionSpec::rack, &RackPinionSpec::pinion, &RackPinionSpec::radius, &RackPinionSpec::offset};
