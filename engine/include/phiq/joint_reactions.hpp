@@ -14,6 +14,10 @@
 ///
 /// A model with redundant rows has many λ (the structure is statically indeterminate): minimum_norm_multipliers()
 /// takes the one of least norm, and names the constraints whose share is not determined.
+///
+/// A gear's or a rack's row relates coordinates alone, so under its multiplier the bearings of its members see none
+/// of the teeth's push: add_gear_mesh_forces() gives the change of load whose solve with Φqᵀ moves λ to the
+/// multipliers under which they do (a sweep does it before evaluating the reactions).
 #pragma once
 
 #include <Eigen/Core>

@@ -98,9 +98,9 @@ struct OutputReaction {
 struct OutputMesh {
   Index constraint = -1;  ///< the gear's Model::constraints() index
   GearMesh mesh;          ///< its angles and ratio
-  /// The bodies whose ψ are mesh.first and mesh.second; a rack's: the body whose x or y is its travel, and the
-  /// pinion's
-  Frame2 first, second;
+  /// The body whose ψ is mesh.first; a rack's: the body whose x or y is its travel.
+  Frame2 first;
+  Frame2 second;       ///< the body whose ψ is mesh.second (gear 2, the pinion)
   int rack_axis = -1;  ///< a rack's travel: 0 its body's x, 1 its y (−1: a gear pair)
 };
 
