@@ -19,8 +19,10 @@ struct MeshRows {
   std::vector<std::vector<double>> values;  // efforts, powers, reactions
 };
 
-MeshRows sweep_meshes(const Scene& s) {
+// The rows of `s`, whose output finds `meshes` gears or racks between bodies.
+MeshRows sweep_meshes(const Scene& s, std::size_t meshes) {
   MeshRows r;
+  EXPECT_EQ(s.sweep.efforts.meshes.size(), meshes);
   Workspace ws(*s.model);
   const std::size_t n = static_cast<std::size_t>(s.sweep.efforts.size());
   EXPECT_EQ(run_sweep(
@@ -35,6 +37,15 @@ MeshRows sweep_meshes(const Scene& s) {
   return r;
 }
 
+// `scene` (a model's text without its output) with `parts` (a YAML map's lines), gravity if asked, and the output
+// of the efforts and, if asked, every reaction.
+Scene with_reactions(const std::string& scene, const std::string& parts, bool gravity, bool reactions = true) {
+  return parse_scene(scene + "parts:\n" + parts + (gravity ? "loads: {gravity: [0, -9.81]}\n" : "") +
+                         "output: {velocities: true, accelerations: true, efforts: all" +
+                         (reactions ? ", reactions: all}\n" : "}\n"),
+                     "meshes.yaml");
+}
+
 using V2 = Eigen::Vector2d;
 V2 perp(const V2& u) { return {-u.y(), u.x()}; }  // ẑ × u
 
@@ -44,16 +55,13 @@ V2 perp(const V2& u) { return {-u.y(), u.x()}; }  // ẑ × u
 // The output gear (ρ = 0.1125, the countershaft below it along −y) turns by the second mesh alone: I3 ψ̈3 = ρ F2x,
 // its pivot −F2. The countershaft's pivot holds F1 + F2, the reactions of both.
 TEST(GearMeshes, ATrainsPivotsCarryItsTeethsPushByNewtonEuler) {
-  const std::string base = test::model_file_text("transmissions/gear_train.yaml", "\noutput:") +
-                           "\nparts:\n  input: {mass: 0.1, center_of_mass: [0, 0], inertia: 1e-4}\n"
-                           "  countershaft: {mass: 0.5, center_of_mass: [0, 0], inertia: 2e-3}\n"
-                           "  output: {mass: 0.8, center_of_mass: [0, 0], inertia: 5e-3}\n";
-  const Scene s = parse_scene(base + "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n",
-                              "train.yaml");
-  const Scene bare =
-      parse_scene(base + "output: {velocities: true, accelerations: true, efforts: all}\n", "train.yaml");
-  ASSERT_EQ(s.sweep.efforts.meshes.size(), 2u);
-  const MeshRows r = sweep_meshes(s), e = sweep_meshes(bare);
+  const std::string train = test::model_file_text("transmissions/gear_train.yaml", "\noutput:") + "\n";
+  const std::string parts =
+      "  input: {mass: 0.1, center_of_mass: [0, 0], inertia: 1e-4}\n"
+      "  countershaft: {mass: 0.5, center_of_mass: [0, 0], inertia: 2e-3}\n"
+      "  output: {mass: 0.8, center_of_mass: [0, 0], inertia: 5e-3}\n";
+  const Scene s = with_reactions(train, parts, false), bare = with_reactions(train, parts, false, false);
+  const MeshRows r = sweep_meshes(s, 2), e = sweep_meshes(bare, 0);
   const Index psi1 = s.model->find_coordinate("psi1"), psi3 = s.model->find_coordinate("psi3");
   const double i1 = 1e-4, i3 = 5e-3, rho1 = 0.005 * 12 / 2, rho3 = 0.005 * 45 / 2;
   double largest = 0.0;
@@ -82,16 +90,13 @@ TEST(GearMeshes, ATrainsPivotsCarryItsTeethsPushByNewtonEuler) {
 TEST(GearMeshes, APlanetarysGearsMoveByNewtonEulerWithTheirTeethsPush) {
   const double ms = 0.3, mp = 0.2, mr = 0.8, ip = 2e-4, g = 9.81;
   const double rs = 0.004 * 24 / 2, rp = 0.004 * 18 / 2, rr = 0.004 * 60 / 2;
-  const Scene s = parse_scene(test::model_file_text("transmissions/planetary.yaml", "output:") +
-                                  "parts:\n  sun: {mass: 0.3, center_of_mass: [0, 0], inertia: 5e-4}\n"
-                                  "  carrier: {mass: 0.5, center_of_mass: [0.042, 0], inertia: 1e-3}\n"
-                                  "  planet: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
-                                  "  ring: {mass: 0.8, center_of_mass: [0, 0], inertia: 6e-3}\n"
-                                  "loads: {gravity: [0, -9.81]}\n"
-                                  "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n",
-                              "planetary.yaml");
-  ASSERT_EQ(s.sweep.efforts.meshes.size(), 2u);
-  const MeshRows r = sweep_meshes(s);
+  const Scene s = with_reactions(test::model_file_text("transmissions/planetary.yaml", "output:"),
+                                 "  sun: {mass: 0.3, center_of_mass: [0, 0], inertia: 5e-4}\n"
+                                 "  carrier: {mass: 0.5, center_of_mass: [0.042, 0], inertia: 1e-3}\n"
+                                 "  planet: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
+                                 "  ring: {mass: 0.8, center_of_mass: [0, 0], inertia: 6e-3}\n",
+                                 true);
+  const MeshRows r = sweep_meshes(s, 2);
   const Model& m = *s.model;
   const Index xp = m.find_coordinate("xp"), yp = m.find_coordinate("yp"), psip = m.find_coordinate("psip");
   // columns: τs, τr, two powers, then sun_bearing, carrier_bearing, ring_bearing, planet_pin (Fx, Fy, Mz each)
@@ -136,14 +141,11 @@ TEST(GearMeshes, ARacksTeethPushThePinionsPivotAndTurnOnItsGuide) {
   text = test::replace_first(text, "y_rack: 0", "y_rack: -0.03");
   text = test::replace_first(text, "between: [{body: ground}, {body: rack}]",
                              "between: [{body: ground, at: [0, -0.03]}, {body: rack}]");
-  const Scene s = parse_scene(text +
-                                  "parts:\n  pinion: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
-                                  "  rack: {mass: 1.5, center_of_mass: [0.1, -0.02], inertia: 0.01}\n"
-                                  "loads: {gravity: [0, -9.81]}\n"
-                                  "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n",
-                              "rack.yaml");
-  ASSERT_EQ(s.sweep.efforts.meshes.size(), 1u);
-  const MeshRows rows = sweep_meshes(s);
+  const Scene s = with_reactions(text,
+                                 "  pinion: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
+                                 "  rack: {mass: 1.5, center_of_mass: [0.1, -0.02], inertia: 0.01}\n",
+                                 true);
+  const MeshRows rows = sweep_meshes(s, 1);
   const Model& m = *s.model;
   const Index x = m.find_coordinate("x_rack"), guide = m.find_constraint("guide");
   const Index xp = m.find_coordinate("xp"), yp = m.find_coordinate("yp");
