@@ -2,39 +2,29 @@
 // yet the bearings under its gears carry the push of its teeth. Each gear here is checked by Newton–Euler written
 // in the test: the two-stage train's pivots (fixed centres, the motor's torque and the gears' inertia) and the
 // planetary's sun, ring and planet under gravity with a turning carrier (the planet's centre accelerating, the
-// internal mesh); a rack's teeth on its pinion's pivot and its guide. The drivers' efforts are the bits they are
+// internal mesh); three planets sharing a train's load, redundant, equally (minimum norm, by symmetry) and named
+// indeterminate; a rack's teeth on its pinion's pivot and its guide. The drivers' efforts are the bits they are
 // without the reactions.
 #include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 
 #include <cmath>
 
 #include "phiq/phiq.hpp"
+#include "reaction_rows.hpp"
 #include "test_support.hpp"
 
 namespace phiq {
 namespace {
 
-struct MeshRows {
-  std::vector<Eigen::VectorXd> q, qdd;
-  std::vector<std::vector<double>> values;  // efforts, powers, reactions
-};
+using test::ReactionRows;
 
 // The rows of `s`, whose output finds `meshes` gears or racks between bodies.
-MeshRows sweep_meshes(const Scene& s, std::size_t meshes) {
-  MeshRows r;
+ReactionRows sweep_meshes(const Scene& s, std::size_t meshes, SweepSummary* sum = nullptr,
+                          const Model** swept = nullptr) {
   EXPECT_EQ(s.sweep.efforts.meshes.size(), meshes);
-  Workspace ws(*s.model);
-  const std::size_t n = static_cast<std::size_t>(s.sweep.efforts.size());
-  EXPECT_EQ(run_sweep(
-                *s.model, s.sweep, ws,
-                [&](const StepView& v) {
-                  r.q.push_back(v.q), r.qdd.push_back(*v.qdd);
-                  r.values.emplace_back(v.efforts, v.efforts + n);
-                  return true;
-                },
-                nullptr),
-            SolveStatus::kSuccess);
-  return r;
+  return test::sweep_reactions(s, sum, swept);
 }
 
 // `scene` (a model's text without its output) with `parts` (a YAML map's lines), gravity if asked, and the output
@@ -61,7 +51,7 @@ TEST(GearMeshes, ATrainsPivotsCarryItsTeethsPushByNewtonEuler) {
       "  countershaft: {mass: 0.5, center_of_mass: [0, 0], inertia: 2e-3}\n"
       "  output: {mass: 0.8, center_of_mass: [0, 0], inertia: 5e-3}\n";
   const Scene s = with_reactions(train, parts, false), bare = with_reactions(train, parts, false, false);
-  const MeshRows r = sweep_meshes(s, 2), e = sweep_meshes(bare, 0);
+  const ReactionRows r = sweep_meshes(s, 2), e = sweep_meshes(bare, 0);
   const Index psi1 = s.model->find_coordinate("psi1"), psi3 = s.model->find_coordinate("psi3");
   const double i1 = 1e-4, i3 = 5e-3, rho1 = 0.005 * 12 / 2, rho3 = 0.005 * 45 / 2;
   double largest = 0.0;
@@ -96,7 +86,7 @@ TEST(GearMeshes, APlanetarysGearsMoveByNewtonEulerWithTheirTeethsPush) {
                                  "  planet: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
                                  "  ring: {mass: 0.8, center_of_mass: [0, 0], inertia: 6e-3}\n",
                                  true);
-  const MeshRows r = sweep_meshes(s, 2);
+  const ReactionRows r = sweep_meshes(s, 2);
   const Model& m = *s.model;
   const Index xp = m.find_coordinate("xp"), yp = m.find_coordinate("yp"), psip = m.find_coordinate("psip");
   // columns: τs, τr, two powers, then sun_bearing, carrier_bearing, ring_bearing, planet_pin (Fx, Fy, Mz each)
@@ -130,6 +120,73 @@ TEST(GearMeshes, APlanetarysGearsMoveByNewtonEulerWithTheirTeethsPush) {
   EXPECT_GT(largest, 1e-2);  // the carrier's and planet's weights turn the gears
 }
 
+// Three planets at 120° share an epicyclic train's load: their meshes are redundant (the model leaves rows out) and
+// the shares are statically indeterminate, so the minimum-norm ones are written and named; by symmetry they are
+// equal. Sun at 1 rad/s, ring held, the carrier loaded by 10 N·m, no gravity: every planet's pin carries the same
+// force turned by 120°, the three together give the carrier the 10 N·m (Euler for it: its angle turns uniformly),
+// and the sun's, ring's and carrier's bearings carry nothing (their pushes cancel). Were the shares those of the rows
+// left in the solve, one planet would carry it all.
+TEST(GearMeshes, ThreePlanetsShareTheLoadEquallyAndAreNamedIndeterminate) {
+  std::string text =
+      "phiq: 1\nname: three_planets\nparameters: {m: 0.004, arm: m*(24 + 18)/2}\ncoordinates:\n"
+      "  xs: 0\n  ys: 0\n  ps: 0\n  xc: 0\n  yc: 0\n  pc: 0\n  xr: 0\n  yr: 0\n  pr: 0\n";
+  std::string bodies = "bodies:\n  sun: [xs, ys, ps]\n  carrier: [xc, yc, pc]\n  ring: [xr, yr, pr]\n";
+  std::string joints =
+      "constraints:\n  - {name: sun_bearing, type: revolute, between: [{body: ground}, {body: sun}]}\n"
+      "  - {name: carrier_bearing, type: revolute, between: [{body: ground}, {body: carrier}]}\n"
+      "  - {name: ring_bearing, type: revolute, between: [{body: ground}, {body: ring}]}\n";
+  std::string parts =
+      "  sun: {mass: 0.3, center_of_mass: [0, 0], inertia: 5e-4}\n"
+      "  carrier: {mass: 0.5, center_of_mass: [0, 0], inertia: 1e-3}\n"
+      "  ring: {mass: 0.8, center_of_mass: [0, 0], inertia: 6e-3}\n";
+  for (int k = 0; k < 3; ++k) {
+    const std::string p = "p" + std::to_string(k),
+                      at = "[arm*cos(" + std::to_string(2 * k) + "*pi/3), arm*sin(" + std::to_string(2 * k) + "*pi/3)]";
+    text += "  x" + p + ": arm*cos(" + std::to_string(2 * k) + "*pi/3)\n  y" + p + ": arm*sin(" +
+            std::to_string(2 * k) + "*pi/3)\n  a" + p + ": 0\n";
+    bodies += "  " + p + ": [x" + p + ", y" + p + ", a" + p + "]\n";
+    joints += "  - {name: " + p + "_pin, type: revolute, between: [{body: carrier, at: " + at + "}, {body: " + p +
+              "}]}\n  - {name: sun_" + p + ", type: gear, between: [sun, " + p +
+              "], teeth: [24, 18], carrier: carrier}\n  - {name: " + p + "_ring, type: gear, between: [" + p +
+              ", ring], teeth: [18, 60], mesh: internal, carrier: carrier}\n";
+    parts += "  " + p + ": {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n";
+  }
+  const Scene s = parse_scene(text + bodies + joints +
+                                  "drivers:\n  - {name: sun_motor, coordinate: ps, law: {type: linear, initial: 0, "
+                                  "rate: 1}}\n  - {name: ring_hold, coordinate: pr, law: {type: linear, initial: 0, "
+                                  "rate: 0}}\nparts:\n" +
+                                  parts +
+                                  "loads: {torques: [{name: out, part: carrier, torque: -10}]}\n"
+                                  "time: {start: 0, end: 1, steps: 10}\noutput: {velocities: true, accelerations: "
+                                  "true, efforts: all, reactions: all}\n",
+                              "three_planets.yaml");
+  SweepSummary sum;
+  const Model* m = nullptr;
+  const ReactionRows r = sweep_meshes(s, 6, &sum, &m);
+  ASSERT_FALSE(m->dropped_rows().empty());  // the redundant mesh rows left out, as `phiq run` sweeps it
+  ASSERT_EQ(sum.warnings.size(), 1u);
+  EXPECT_EQ(sum.warnings[0].kind, "indeterminate");
+  for (const char* g : {"'sun_p0'", "'p2_ring'"}) EXPECT_NE(sum.warnings[0].message.find(g), std::string::npos) << g;
+  const double arm = 0.004 * 42 / 2;
+  for (std::size_t row = 0; row < r.values.size(); ++row) {
+    const std::vector<double>& v = r.values[row];  // 2 efforts, 2 powers, 3 bearings, 3 pins (Fx, Fy, Mz each)
+    ASSERT_EQ(v.size(), 22u);
+    for (int c = 4; c < 13; ++c) EXPECT_NEAR(v[static_cast<std::size_t>(c)], 0.0, 1e-9) << row << " " << c;
+    const double psi = r.q[row](m->find_coordinate("pc"));
+    double moment = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const V2 f(v[static_cast<std::size_t>(13 + 3 * k)], v[static_cast<std::size_t>(14 + 3 * k)]);
+      const double turn = psi + 2 * M_PI * k / 3;
+      const V2 at = arm * V2(std::cos(turn), std::sin(turn));
+      moment += at.x() * f.y() - at.y() * f.x();
+      const V2 first(v[13], v[14]), turned = Eigen::Rotation2Dd(2 * M_PI * k / 3) * first;
+      EXPECT_NEAR(f.x(), turned.x(), 1e-9) << row << " planet " << k;
+      EXPECT_NEAR(f.y(), turned.y(), 1e-9) << row << " planet " << k;
+    }
+    EXPECT_NEAR(moment, 10.0, 1e-9) << row;
+  }
+}
+
 // models/transmissions/rack_pinion.yaml with masses under gravity and the rack's reference point 0.03 below its pitch
 // line (its guide there): the rack moves along x by its teeth alone (its guide carries no x), so they push it by
 // F = (mr ẍ, 0) at the pitch point P (below the pinion's centre by r), and the pinion by −F: its pivot holds
@@ -145,7 +202,7 @@ TEST(GearMeshes, ARacksTeethPushThePinionsPivotAndTurnOnItsGuide) {
                                  "  pinion: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
                                  "  rack: {mass: 1.5, center_of_mass: [0.1, -0.02], inertia: 0.01}\n",
                                  true);
-  const MeshRows rows = sweep_meshes(s, 1);
+  const ReactionRows rows = sweep_meshes(s, 1);
   const Model& m = *s.model;
   const Index x = m.find_coordinate("x_rack"), guide = m.find_constraint("guide");
   const Index xp = m.find_coordinate("xp"), yp = m.find_coordinate("yp");

@@ -15,6 +15,7 @@
 #include "phiq/joint_reactions.hpp"
 #include "phiq/part_motion.hpp"
 #include "phiq/phiq.hpp"
+#include "reaction_rows.hpp"
 #include "test_support.hpp"
 
 namespace phiq {
@@ -270,33 +271,8 @@ TEST(JointReactions, KindsWithoutASiteAreRefusedByName) {
   }
 }
 
-struct ReactionRows {
-  std::vector<Eigen::VectorXd> q, qd, qdd;
-  std::vector<std::vector<double>> values;  // efforts, powers, reactions
-};
-
-ReactionRows sweep_reactions(const Scene& s, SweepSummary* sum = nullptr, const Model** swept = nullptr) {
-  ReactionRows r;
-  static std::vector<SquareScene> kept;  // the reduced models the callers read after the sweep
-  kept.emplace_back();
-  SquareScene& square = kept.back();
-  EXPECT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &square), SolveStatus::kSuccess);
-  const Model& m = square.model(*s.model);
-  if (swept) *swept = &m;
-  Workspace ws(m);
-  ws.q = square.start;
-  const std::size_t n = static_cast<std::size_t>(s.sweep.efforts.size());
-  EXPECT_EQ(run_sweep(
-                m, s.sweep, ws,
-                [&](const StepView& v) {
-                  r.q.push_back(v.q), r.qd.push_back(*v.qd), r.qdd.push_back(*v.qdd);
-                  r.values.emplace_back(v.efforts, v.efforts + n);
-                  return true;
-                },
-                sum),
-            SolveStatus::kSuccess);
-  return r;
-}
+using test::ReactionRows;
+using test::sweep_reactions;
 
 // The scene's `reaction_axes`: along a sweep of the massive four-bar, each pin's force along its body's axes is the
 // world one turned by that body's angle at the row.

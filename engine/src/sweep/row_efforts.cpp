@@ -96,7 +96,13 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
     std::fill(outputs_.efforts.begin() + 2 * static_cast<std::ptrdiff_t>(opt_.efforts.constraints.size()),
               outputs_.efforts.begin() + opt_.efforts.size(), std::numeric_limits<double>::quiet_NaN());
   };
-  if (!opt_.efforts.meshes.empty()) {  // the bearings of gears carry their teeth's push (add_gear_mesh_forces())
+  if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_work_.lambda, note ? &indeterminate : nullptr,
+                                effort_work_.minimum_norm))
+    return not_defined();
+  // The bearings of gears carry their teeth's push (add_gear_mesh_forces()), from each mesh's share of the load: its
+  // minimum-norm multiplier where meshes are redundant (the planets of an epicyclic train), not the share the rows
+  // left in the solve would give it (all of it to some, none to the others).
+  if (!opt_.efforts.meshes.empty()) {
     effort_work_.mesh_q.setZero(model_.num_coordinates());
     add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q);
     if (!multipliers_with_factors(model_, lu, effort_work_.mesh_q, effort_work_.kept, effort_work_.mesh_lambda))
@@ -104,24 +110,29 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
     ++ws_->counters.effort_solves;
     effort_work_.lambda += effort_work_.mesh_lambda;
   }
-  if (!minimum_norm_multipliers(model_, lu, current_.q.data(), t, effort_work_.lambda, note ? &indeterminate : nullptr,
-                                effort_work_.minimum_norm))
-    return not_defined();
   // the natural bodies' weight and inertia as Q took them at this row (row_efforts())
   effort_work_.reactions->evaluate(current_.q.data(), current_.qd.data(), current_.qdd.data(), t, effort_work_.lambda,
                                    outputs_.efforts.data() + 2 * opt_.efforts.constraints.size(),
                                    effort_work_.planar.empty() ? nullptr : effort_work_.planar.data());
   if (!note) return;
   effort_work_.reactions_noted = true;
-  std::string names;
+  std::string names, meshes;
+  auto listed = [&](Index c) {
+    return std::find(indeterminate.begin(), indeterminate.end(), c) != indeterminate.end();
+  };
+  auto name = [&](std::string& list, Index c) {
+    list += (list.empty() ? "'" : ", '") + model_.constraints()[static_cast<std::size_t>(c)].name + "'";
+  };
   for (const OutputReaction& r : opt_.efforts.reactions)
-    if (r.natural < 0 && std::find(indeterminate.begin(), indeterminate.end(), r.constraint) != indeterminate.end())
-      names += (names.empty() ? "'" : ", '") + model_.constraints()[static_cast<std::size_t>(r.constraint)].name + "'";
-  if (!names.empty())
-    sum_.warnings.push_back({t, "indeterminate",
-                             "the reactions of " + names +
-                                 " are statically indeterminate (redundant constraints): the minimum-norm ones are "
-                                 "written"});
+    if (r.natural < 0 && listed(r.constraint)) name(names, r.constraint);
+  for (const OutputMesh& m : opt_.efforts.meshes)
+    if (listed(m.constraint)) name(meshes, m.constraint);
+  if (!names.empty() || !meshes.empty())
+    sum_.warnings.push_back(
+        {t, "indeterminate",
+         (names.empty() ? "" : "the reactions of " + names) + (names.empty() || meshes.empty() ? "" : " and ") +
+             (meshes.empty() ? "" : "the shares of the load of the gears " + meshes + " (and so their bearings')") +
+             " are statically indeterminate (redundant constraints): the minimum-norm ones are written"});
 }
 
 bool Sweeper::same_sweep(const Sweeper* like) const { return like && &like->model_ == &model_ && &like->opt_ == &opt_; }
