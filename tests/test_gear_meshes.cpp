@@ -80,13 +80,26 @@ TEST(GearMeshes, ATrainsPivotsCarryItsTeethsPushByNewtonEuler) {
 TEST(GearMeshes, APlanetarysGearsMoveByNewtonEulerWithTheirTeethsPush) {
   const double ms = 0.3, mp = 0.2, mr = 0.8, ip = 2e-4, g = 9.81;
   const double rs = 0.004 * 24 / 2, rp = 0.004 * 18 / 2, rr = 0.004 * 60 / 2;
-  const Scene s = with_reactions(test::model_file_text("transmissions/planetary.yaml", "output:"),
-                                 "  sun: {mass: 0.3, center_of_mass: [0, 0], inertia: 5e-4}\n"
-                                 "  carrier: {mass: 0.5, center_of_mass: [0.042, 0], inertia: 1e-3}\n"
-                                 "  planet: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
-                                 "  ring: {mass: 0.8, center_of_mass: [0, 0], inertia: 6e-3}\n",
-                                 true);
-  const ReactionRows r = sweep_meshes(s, 2);
+  const std::string parts =
+      "  sun: {mass: 0.3, center_of_mass: [0, 0], inertia: 5e-4}\n"
+      "  carrier: {mass: 0.5, center_of_mass: [0.042, 0], inertia: 1e-3}\n"
+      "  planet: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
+      "  ring: {mass: 0.8, center_of_mass: [0, 0], inertia: 6e-3}\n";
+  const std::string planetary = test::model_file_text("transmissions/planetary.yaml", "output:");
+  const Scene s = with_reactions(planetary, parts, true);
+  SweepSummary sum;
+  const ReactionRows r = sweep_meshes(s, 2, &sum);
+  EXPECT_TRUE(sum.warnings.empty());
+  // the sun–planet mesh without its carrier: a row of absolute angles, which the turning arm does not keep, so the
+  // teeth's push does work in the motion: named at the first row
+  const Scene armless = with_reactions(
+      test::replace_first(planetary, "teeth: [24, 18], carrier: carrier}", "teeth: [24, 18]}"), parts, true);
+  SweepSummary told;
+  sweep_meshes(armless, 2, &told);
+  ASSERT_EQ(told.warnings.size(), 1u);
+  EXPECT_EQ(told.warnings[0].kind, "gear_centres");
+  EXPECT_EQ(told.warnings[0].t, 0.0);
+  EXPECT_NE(told.warnings[0].message.find("'sun_planet'"), std::string::npos) << told.warnings[0].message;
   const Model& m = *s.model;
   const Index xp = m.find_coordinate("xp"), yp = m.find_coordinate("yp"), psip = m.find_coordinate("psip");
   // columns: τs, τr, two powers, then sun_bearing, carrier_bearing, ring_bearing, planet_pin (Fx, Fy, Mz each)

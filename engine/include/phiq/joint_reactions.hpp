@@ -263,10 +263,14 @@ class JointReactions {
 /// drivers' rows or the gears'), λ + δ the multipliers under which the bearings carry the teeth's push. A mesh
 /// whose centres coincide adds nothing. A rack and pinion likewise: its row pushes the rack along its travel e
 /// (its body's x or y) and turns the pinion; its teeth push at P = c_p + k ẑ × e, which adds λ e on the pinion's
-/// centre and the moment of the rack's push about its reference point on its angle. Pre-condition: `lambda` has
-/// one value per model row.
+/// centre and the moment of the rack's push about its reference point on its angle. With the row's velocities `qd`,
+/// appends to `working` (when not null) the meshes whose push does work along q̇ (beyond 10⁻⁶ of its terms): their
+/// bodies' reference points are not centres that keep their places on the carrier, so the row does not describe
+/// their teeth (a gear on a moving arm whose carrier is not named). Pre-condition: `lambda` has one value per model
+/// row, `qd` (if not null) one per coordinate.
 void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
-                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq);
+                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd = nullptr,
+                          std::vector<Index>* working = nullptr);
 
 /// The multipliers of least norm among those with Φqᵀ λ = Q, from `lambda`, one of them (λ = 0 on the rows the model
 /// dropped as redundant: multipliers_with_factors()), and `lu`, the factors of the kept rows of Φq at q. Each

@@ -140,7 +140,10 @@ struct SweepWarning {
   /// too wide for every thread to hold a chunk); "no_dependence": a parameter of OutputPlan::sensitivities
   /// changes no constraint or driver (its ParameterReach is empty: its sensitivities are exactly zero; at the
   /// first row); "indeterminate": written joint reactions (OutputEfforts::reactions) that redundant constraints
-  /// leave undetermined, named at the first row (their minimum-norm values are written)
+  /// leave undetermined, named at the first row (their minimum-norm values are written), and gear meshes whose
+  /// share of the load they leave undetermined; "gear_centres": a gear's teeth push its bodies in a way its row does
+  /// not hold (add_gear_mesh_forces(): their push does work in the motion at the first row), so its bearings'
+  /// written loads are not its teeth's
   std::string kind;
 
   std::string message;  ///< one line

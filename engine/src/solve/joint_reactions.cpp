@@ -200,11 +200,15 @@ void JointReactions::evaluate_site(const Site& s, const double* q, double t, con
 }
 
 void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
-                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq) {
+                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd,
+                          std::vector<Index>* working) {
+  double power = 0.0, size = 0.0;  // a mesh's push's power along q̇, and the size of its terms
   auto add = [&](const Slot& s, double v) {
-    if (s.is_coordinate()) dq(s.coord()) += v;
+    if (!s.is_coordinate()) return;
+    dq(s.coord()) += v;
+    if (qd) power += v * qd[s.coord()], size += std::fabs(v * qd[s.coord()]);
   };
-  for (const OutputMesh& m : meshes) {
+  auto push = [&](const OutputMesh& m) {
     const double lambda_m = lambda(model.constraints()[static_cast<std::size_t>(m.constraint)].first_row);
     if (m.mesh.rack) {
       // the rack pushed by −λ e at the pitch point P = c_p + k ẑ × e (its travel took −λ), the pinion by λ e there
@@ -214,16 +218,21 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
       const double px = m.second.x.of(q) - m.mesh.k * ey, py = m.second.y.of(q) + m.mesh.k * ex;
       add(m.second.x, lambda_m * ex), add(m.second.y, lambda_m * ey);
       add(m.first.psi, -lambda_m * ((px - m.first.x.of(q)) * ey - (py - m.first.y.of(q)) * ex));
-      continue;
+      return;
     }
     const double dx = m.second.x.of(q) - m.first.x.of(q), dy = m.second.y.of(q) - m.first.y.of(q);
     const double d = std::hypot(dx, dy);
-    if (!(d > 0.0)) continue;
+    if (!(d > 0.0)) return;
     const double f = -lambda_m * (1.0 + m.mesh.k) / d;
     const double tx = -dy / d, ty = dx / d;
     add(m.first.x, f * tx), add(m.first.y, f * ty);
     add(m.second.x, -f * tx), add(m.second.y, -f * ty);
     add(m.mesh.carrier, f * d);
+  };
+  for (const OutputMesh& m : meshes) {
+    power = size = 0.0;
+    push(m);
+    if (working && !(std::fabs(power) <= 1e-6 * size)) working->push_back(m.constraint);
   }
 }
 

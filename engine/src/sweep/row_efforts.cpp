@@ -104,7 +104,16 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
   // left in the solve would give it (all of it to some, none to the others).
   if (!opt_.efforts.meshes.empty()) {
     effort_work_.mesh_q.setZero(model_.num_coordinates());
-    add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q);
+    std::vector<Index> working;  // checked at the sweep's first row, as the indeterminate joints are
+    add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q,
+                         current_.qd.data(), note ? &working : nullptr);
+    if (!working.empty())
+      sum_.warnings.push_back(
+          {t, "gear_centres",
+           "the teeth of '" + model_.constraints()[static_cast<std::size_t>(working[0])].name +
+               "' push its bodies in a way its row does not hold (their push does work in the motion): their "
+               "reference points are not the gears' centres on its carrier; its bearings' loads are not its "
+               "teeth's (a gear on a moving arm names the arm as its carrier)"});
     if (!multipliers_with_factors(model_, lu, effort_work_.mesh_q, effort_work_.kept, effort_work_.mesh_lambda))
       return not_defined();
     ++ws_->counters.effort_solves;
