@@ -114,19 +114,27 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
     }
   }
   if (!out.reactions.empty() && !spatial_) {  // gears and racks on bodies: their bearings carry the teeth's push
-    auto body = [&](const Slot& angle) -> const Frame2* {
-      for (const Frame2& f : scene.planar_bodies)
-        if (angle.is_coordinate() && f.psi == angle) return &f;
-      return nullptr;
+    // the planar bodies by the coordinates of their frames: (body, 0 x, 1 y, 2 ψ)
+    std::unordered_map<Index, std::pair<const Frame2*, int>> frame_of;
+    for (const Frame2& f : scene.planar_bodies) {
+      const Slot* slots[3] = {&f.x, &f.y, &f.psi};
+      for (int k = 0; k < 3; ++k)
+        if (slots[k]->is_coordinate()) frame_of.emplace(slots[k]->coord(), std::pair{&f, k});
+    }
+    // the body whose frame's component `k` (or x or y: k < 0) is the coordinate of `s`; its component in `which`
+    auto body = [&](const Slot& s, int k, int* which = nullptr) -> const Frame2* {
+      const auto i = s.is_coordinate() ? frame_of.find(s.coord()) : frame_of.end();
+      if (i == frame_of.end() || (k >= 0 ? i->second.second != k : i->second.second == 2)) return nullptr;
+      if (which) *which = i->second.second;
+      return i->second.first;
     };
     for (std::size_t c = 0; c < model.constraints().size(); ++c) {
       const auto [block, index] = model.constraint_block(static_cast<Index>(c));
       OutputMesh m;
       if (!block->gear_mesh(index, m.mesh)) continue;
-      const Frame2 *first = body(m.mesh.first), *second = body(m.mesh.second);
-      for (const Frame2& f : scene.planar_bodies)  // a rack: the body whose x or y is its travel
-        if (m.mesh.rack && m.mesh.first.is_coordinate() && (f.x == m.mesh.first || f.y == m.mesh.first))
-          first = &f, m.rack_axis = f.x == m.mesh.first ? 0 : 1;
+      // a gear's angles are its bodies' ψ; a rack's travel is its body's x or y
+      const Frame2 *first = m.mesh.rack ? body(m.mesh.first, -1, &m.rack_axis) : body(m.mesh.first, 2),
+                   *second = body(m.mesh.second, 2);
       if (!first || !second) continue;  // (angle or travel coordinates of no body: no centres to push)
       m.constraint = static_cast<Index>(c), m.first = *first, m.second = *second;
       out.meshes.push_back(m);
