@@ -111,9 +111,8 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
       sum_.warnings.push_back(
           {t, "gear_centres",
            "the teeth of '" + model_.constraints()[static_cast<std::size_t>(working[0])].name +
-               "' push its bodies in a way its row does not hold (their push does work in the motion): their "
-               "reference points are not the gears' centres on its carrier; its bearings' loads are not its "
-               "teeth's (a gear on a moving arm names the arm as its carrier)"});
+               "' do work in the motion: its bodies' reference points are not gear centres that its carrier holds "
+               "(a gear on a moving arm names the arm as its carrier), so its bearings' loads are not its teeth's"});
     if (!multipliers_with_factors(model_, lu, effort_work_.mesh_q, effort_work_.kept, effort_work_.mesh_lambda))
       return not_defined();
     ++ws_->counters.effort_solves;
