@@ -135,9 +135,11 @@ TEST(JointReactions, EverySpatialKindWithASiteDoesTheWorkOfItsMultipliers) {
       "between: [{body: a, at: [0.3, -0.2, 0.1], axis: [0, 0.6, 0.8]}, {body: b, at: [-0.1, 0.4, 0.2], "
       "axis: [1, 0, 0]}]";
   for (const char* type : {"spherical", "revolute", "cylindrical", "prismatic", "universal", "planar", "rigid",
-                           "point_on_line", "point_on_plane", "screw"}) {
+                           "point_on_line", "point_on_plane", "screw", "distance"}) {
     SCOPED_TRACE(type);
-    const std::string pitch = std::string(type) == "screw" ? ", pitch: 0.05" : "";
+    const std::string pitch = std::string(type) == "screw"      ? ", pitch: 0.05"
+                              : std::string(type) == "distance" ? ", length: 1"
+                                                                : "";
     expect_reaction_virtual_work(
         reaction_two_bodies(true, std::string("{name: j, type: ") + type + ", " + sides + pitch + "}"), true);
   }
@@ -254,6 +256,36 @@ TEST(JointReactions, AlongTheJointsAxesTheLoadsItCannotCarryAreZero) {
         EXPECT_GT(std::fabs(w[5]), 1e-3 * scale);
     }
   }
+}
+
+// A spatial distance between bodies is a bar with a ball at each end: whatever its multiplier, it pulls end A's body
+// at A along B − A and nothing else (no moment about the ball), so along its axes (x from A toward B) it carries
+// Fx alone, the bar's tension. Between natural points it is a part's own bar: no reaction.
+TEST(JointReactions, ABallEndedBarPullsAlongItselfAlone) {
+  const Scene s = reaction_two_bodies(true,
+                                      "{name: j, type: distance, between: [{body: a, at: [0.3, -0.2, 0.1]}, "
+                                      "{body: b, at: [-0.1, 0.4, 0.2]}], length: 1}");
+  const Eigen::Vector3d a =
+      Eigen::Vector3d(0.1, 0.2, -0.3) +
+      Eigen::Quaterniond(0.8, 0.2, -0.4, 0.4).toRotationMatrix() * Eigen::Vector3d(0.3, -0.2, 0.1);
+  const Eigen::Vector3d b = Eigen::Vector3d(0.7, -0.1, 0.4) +
+                            Eigen::Quaterniond(0.5, 0.5, 0.5, 0.5).toRotationMatrix() * Eigen::Vector3d(-0.1, 0.4, 0.2);
+  const Eigen::Vector3d along = (b - a).normalized();
+  for (int trial = 0; trial < 3; ++trial) {
+    const auto [w, j] = reaction_both_axes(s, true, trial);
+    const Eigen::Vector3d f(w[0], w[1], w[2]);
+    EXPECT_GT(f.norm(), 1e-3);
+    EXPECT_NEAR(f.cross(along).norm(), 0.0, 1e-12 * f.norm());
+    for (int c = 3; c < 6; ++c) EXPECT_NEAR(w[static_cast<std::size_t>(c)], 0.0, 1e-12 * f.norm()) << c;
+    EXPECT_NEAR(j[0], f.dot(along), 1e-12 * f.norm());
+    for (int c = 1; c < 6; ++c) EXPECT_NEAR(j[static_cast<std::size_t>(c)], 0.0, 1e-12 * f.norm()) << c;
+  }
+  const Scene natural = parse_scene(
+      "phiq: 1\nname: n\ndimension: 3\ncoordinates: {x: 1, y: 0.1, z: 0}\npoints: {O: [0, 0, 0], A: [x, y, z]}\n"
+      "constraints:\n  - {name: bar, type: distance, points: [O, A], length: 1}\ntime: {start: 0, end: 1, steps: 1}\n",
+      "n.yaml");
+  EXPECT_EQ(reaction_width(*natural.model, 0), 0);
+  EXPECT_THROW(JointReactions(*natural.model, std::vector<Index>{0}), Error);
 }
 
 TEST(JointReactions, KindsWithoutASiteAreRefusedByName) {

@@ -121,6 +121,9 @@ class ConstraintBlock {
   /// How many values the kind's reaction has, its kReactionWidth: 3 (Fx, Fy, Mz) for a planar joint, 6 for a
   /// spatial one; 0 when it states no ReactionSite. A fact of the kind, the same for every constraint of the block.
   virtual int reaction_width() const { return 0; }
+  /// Whether constraint i has a reaction: its kind states a ReactionSite and, where the kind tells its constraints
+  /// apart (`states_reaction()`: a spatial distance between bodies, not one between natural points), it does.
+  virtual bool states_reaction(std::size_t /*i*/) const { return false; }
   /// Constraint i's ReactionSite at q, when has_reaction_site(); else false. Thread-safe.
   virtual bool reaction_site(std::size_t /*i*/, const double* /*q*/, ReactionSite& /*out*/) const { return false; }
   /// Constraint i's GearMesh, when its kind is a gear pair or a rack and pinion (GearSpec::gear_mesh()); else false.
@@ -319,6 +322,12 @@ class TypedBlock final : public ConstraintBlock {
       return true;
     }
     return false;
+  }
+  bool states_reaction(std::size_t i) const override {
+    if constexpr (requires(const Spec& k) { k.states_reaction(); })
+      return entries_[i].spec.states_reaction();
+    else
+      return has_reaction_site();
   }
   bool gear_mesh(std::size_t i, GearMesh& out) const override {
     if constexpr (requires(const Spec& k) { k.gear_mesh(); }) {

@@ -41,7 +41,8 @@ class BarLengths;
 }  // namespace detail
 
 /// How many values constraint c's reaction has: 3 (Fx, Fy, Mz) for a planar joint, 6 for a spatial one, 0 when its
-/// kind states no ReactionSite (no reaction). Pre-condition: c is one of the model's constraints.
+/// kind states no ReactionSite or it has none (ConstraintBlock::states_reaction()). Pre-condition: c is one of the
+/// model's constraints.
 int reaction_width(const Model& model, Index c);
 
 /// The reactions of a list of joints, evaluated at any (q, t, λ): built once per model (which block holds each

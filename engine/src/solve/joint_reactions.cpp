@@ -26,12 +26,15 @@ PartFrame body_frame(const ReactionSite& s) {
 
 }  // namespace
 
-int reaction_width(const Model& model, Index c) { return model.constraint_block(c).first->reaction_width(); }
+int reaction_width(const Model& model, Index c) {
+  const auto [b, i] = model.constraint_block(c);
+  return b->states_reaction(i) ? b->reaction_width() : 0;
+}
 
 void JointReactions::add_site(const Model& model, Index c, std::vector<int>& site_of) {
   const auto [b, i] = model.constraint_block(c);
   const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
-  if (!b->has_reaction_site())
+  if (!b->states_reaction(i))
     throw Error("constraint '" + info.name + "' (" + std::string(info.kind) +
                 ") states no joint point: it has no reaction to write (joints between bodies have one)");
   Site s;

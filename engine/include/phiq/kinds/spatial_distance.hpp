@@ -7,7 +7,9 @@
 #include <array>
 #include <cmath>
 #include <tuple>
+#include <utility>
 
+#include "phiq/kinds/reaction_site.hpp"
 #include "phiq/kinds/spatial_rows.hpp"  // detail3: the row formulas
 #include "phiq/spatial_attachment.hpp"
 #include "phiq/kinds/kind_support.hpp"
@@ -29,6 +31,41 @@ struct SpatialDistanceSpec {
 
   /// @copydoc DistanceSpec::depends_on_time
   bool depends_on_time() const { return false; }
+  /// The values its reaction has (ConstraintBlock::reaction_width()): Fx, Fy, Fz, Mx, My, Mz, as a spatial joint's.
+  static constexpr int kReactionWidth = 6;
+  /// Whether this one has a reaction (ConstraintBlock::states_reaction()): a bar with a ball joint at each end
+  /// between bodies (or a body and ground), not a distance between natural points (a part's own bar).
+  bool states_reaction() const {
+    const auto [balls, body] = ball_ends();
+    return balls && body;
+  }
+  /// The reaction (ReactionSite): the bar's force on the body of end A at A, or on B's at B when A is fixed; its
+  /// x axis from that end toward the other, so that Fx is the bar's tension (y and z complete it). A bar between
+  /// balls carries no moment about them, nor any force across itself.
+  ReactionSite reaction_site(const double* q) const {
+    bool a_moves = false;
+    for (const Slot& v : ends[0].p) a_moves = a_moves || v.is_coordinate();
+    const Attachment3 &on = ends[a_moves ? 0 : 1], &other = ends[a_moves ? 1 : 0];
+    ReactionSite site;
+    site.point = on.value(q);
+    site.spatial = true;
+    site.frame3 = Frame3{on.r[0], on.r[1], on.r[2], on.p[0], on.p[1], on.p[2], on.p[3]};
+    const kin3::V3 d = other.value(q) - site.point;
+    const double n = kin3::norm(d);
+    if (n > 0.0) {
+      site.axes[0] = (1.0 / n) * d;
+      // y: the world axis least along x, made perpendicular to it; z = x × y
+      const kin3::V3 w =
+          std::fabs(site.axes[0].x) <= std::fabs(site.axes[0].y) &&
+                  std::fabs(site.axes[0].x) <= std::fabs(site.axes[0].z)
+              ? kin3::V3{1, 0, 0}
+              : (std::fabs(site.axes[0].y) <= std::fabs(site.axes[0].z) ? kin3::V3{0, 1, 0} : kin3::V3{0, 0, 1});
+      const kin3::V3 y = w - kin3::dot(w, site.axes[0]) * site.axes[0];
+      site.axes[1] = (1.0 / kin3::norm(y)) * y;
+      site.axes[2] = kin3::cross(site.axes[0], site.axes[1]);
+    }
+    return site;
+  }
   /// @copydoc DistanceSpec::row_unit
   Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kLength; }
   /// @copydoc DistanceSpec::characteristic_length
@@ -87,14 +124,18 @@ struct SpatialDistanceSpec {
   /// @copydoc DistanceSpec::joint_count
   /// A distance between body (or ground) points is a bar with two ball joints, removing one freedom; between
   /// natural points it is no joint.
-  JointCount joint_count() const {
+  JointCount joint_count() const { return ball_ends().first ? JointCount::joint(3, 1) : JointCount::other(); }
+  /// Whether each end is a body's point or fixed (a bar with a ball joint at each end), and whether one is a body's.
+  std::pair<bool, bool> ball_ends() const {
+    bool any_body = false;
     for (const Attachment3& e : ends) {
       bool body = false, fixed = true;
       for (const Slot& v : e.p) body = body || v.is_coordinate();
       for (const Slot& v : e.r) fixed = fixed && !v.is_coordinate();
-      if (!body && !fixed) return JointCount::other();
+      if (!body && !fixed) return {false, false};
+      any_body = any_body || body;
     }
-    return JointCount::joint(3, 1);
+    return {true, any_body};
   }
   /// @copydoc DistanceSpec::prepare
   /// Constant ends are folded into their values here.
