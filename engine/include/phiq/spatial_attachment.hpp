@@ -44,6 +44,14 @@ inline bool is_zero(V3 a) { return a.x == 0.0 && a.y == 0.0 && a.z == 0.0; }
 inline double component(V3 a, int k) { return k == 0 ? a.x : (k == 1 ? a.y : a.z); }
 /// The unit vector along axis k (0: x, 1: y, 2: z).
 inline V3 unit_axis(int k) { return {k == 0 ? 1.0 : 0.0, k == 1 ? 1.0 : 0.0, k == 2 ? 1.0 : 0.0}; }
+/// A unit vector perpendicular to unit vector `u`: the coordinate axis least along u (x, then y, on a tie), made
+/// perpendicular to it (that axis is at least 54.7° from u, so the result is always well defined).
+inline V3 perpendicular_unit(V3 u) {
+  const double ax = std::fabs(u.x), ay = std::fabs(u.y), az = std::fabs(u.z);
+  const V3 axis = unit_axis(ax <= ay && ax <= az ? 0 : (ay <= az ? 1 : 2));
+  const V3 p = axis - dot(axis, u) * u;
+  return (1.0 / norm(p)) * p;
+}
 
 /// B(p, r, s), the symmetric bilinear form in the Euler parameters p, r with B(p, p, s) = R(p) s (file comment).
 inline V3 bilinear(const double p[4], const double r[4], V3 s) {

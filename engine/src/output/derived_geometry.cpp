@@ -17,12 +17,7 @@ RotationMatrix about_z(double angle) {
 
 RotationMatrix z_along(V3 u) {
   const V3 z = (1.0 / kin3::norm(u)) * u;
-  // the world axis least along z, made perpendicular to it, is x
-  const V3 pick = std::fabs(z.x) <= std::fabs(z.y) && std::fabs(z.x) <= std::fabs(z.z) ? V3{1, 0, 0}
-                  : std::fabs(z.y) <= std::fabs(z.z)                                   ? V3{0, 1, 0}
-                                                                                       : V3{0, 0, 1};
-  V3 x = pick - kin3::dot(pick, z) * z;
-  x = (1.0 / kin3::norm(x)) * x;
+  const V3 x = kin3::perpendicular_unit(z);  // the world axis least along z, made perpendicular to it
   const V3 y = kin3::cross(z, x);
   return {x.x, y.x, z.x, x.y, y.y, z.y, x.z, y.z, z.z};
 }

@@ -50,13 +50,6 @@ std::vector<V3> ring_tangents(const std::vector<V3>& x, bool closed) {
   return tangent;
 }
 
-// A unit normal perpendicular to `t`, from the coordinate axis least along it.
-V3 some_normal(V3 t) {
-  const double ax = std::abs(t.x), ay = std::abs(t.y), az = std::abs(t.z);
-  const V3 axis = kin3::unit_axis(ax <= ay && ax <= az ? 0 : (ay <= az ? 1 : 2));
-  return unit(axis - kin3::dot(axis, t) * t);
-}
-
 // The normal r at x0 (tangent t0) carried to x1 (tangent t1) by two reflections: the first in the plane bisecting
 // x0 x1, the second taking the reflected tangent to t1.
 V3 carry_normal(V3 x0, V3 t0, V3 r, V3 x1, V3 t1) {
@@ -75,7 +68,7 @@ TriangleMesh curve_tube(const Shape& shape, int n) {
   const std::vector<V3> x = distinct_points(shape);
   const std::vector<V3> t = ring_tangents(x, shape.closed);
   const std::size_t count = x.size();
-  std::vector<V3> r{some_normal(t[0])};
+  std::vector<V3> r{kin3::perpendicular_unit(t[0])};
   for (std::size_t k = 0; k + 1 < count; ++k) r.push_back(carry_normal(x[k], t[k], r[k], x[k + 1], t[k + 1]));
   if (shape.closed) {
     // back at the start the carried normal is off by a turn φ about t0: each ring takes its share k φ / count

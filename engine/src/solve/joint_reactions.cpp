@@ -209,7 +209,7 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
   auto add = [&](const Slot& s, double v) {
     if (!s.is_coordinate()) return;
     dq(s.coord()) += v;
-    if (qd) power += v * qd[s.coord()], size += std::fabs(v * qd[s.coord()]);
+    if (qd) power += v * s.rate(qd), size += std::fabs(v * s.rate(qd));
   };
   auto push = [&](const OutputMesh& m) {
     const double lambda_m = lambda(model.constraints()[static_cast<std::size_t>(m.constraint)].first_row);

@@ -43,8 +43,7 @@ struct SpatialDistanceSpec {
   /// x axis from that end toward the other, so that Fx is the bar's tension (y and z complete it). A bar between
   /// balls carries no moment about them, nor any force across itself.
   ReactionSite reaction_site(const double* q) const {
-    bool a_moves = false;
-    for (const Slot& v : ends[0].p) a_moves = a_moves || v.is_coordinate();
+    const bool a_moves = of_body(ends[0]);
     const Attachment3 &on = ends[a_moves ? 0 : 1], &other = ends[a_moves ? 1 : 0];
     ReactionSite site;
     site.point = on.value(q);
@@ -54,14 +53,7 @@ struct SpatialDistanceSpec {
     const double n = kin3::norm(d);
     if (n > 0.0) {
       site.axes[0] = (1.0 / n) * d;
-      // y: the world axis least along x, made perpendicular to it; z = x × y
-      const kin3::V3 w =
-          std::fabs(site.axes[0].x) <= std::fabs(site.axes[0].y) &&
-                  std::fabs(site.axes[0].x) <= std::fabs(site.axes[0].z)
-              ? kin3::V3{1, 0, 0}
-              : (std::fabs(site.axes[0].y) <= std::fabs(site.axes[0].z) ? kin3::V3{0, 1, 0} : kin3::V3{0, 0, 1});
-      const kin3::V3 y = w - kin3::dot(w, site.axes[0]) * site.axes[0];
-      site.axes[1] = (1.0 / kin3::norm(y)) * y;
+      site.axes[1] = kin3::perpendicular_unit(site.axes[0]);  // (y, z: any completion)
       site.axes[2] = kin3::cross(site.axes[0], site.axes[1]);
     }
     return site;
@@ -125,12 +117,18 @@ struct SpatialDistanceSpec {
   /// A distance between body (or ground) points is a bar with two ball joints, removing one freedom; between
   /// natural points it is no joint.
   JointCount joint_count() const { return ball_ends().first ? JointCount::joint(3, 1) : JointCount::other(); }
+  /// Whether end `e` is a moving body's point (its Euler parameters are coordinates).
+  static bool of_body(const Attachment3& e) {
+    for (const Slot& v : e.p)
+      if (v.is_coordinate()) return true;
+    return false;
+  }
   /// Whether each end is a body's point or fixed (a bar with a ball joint at each end), and whether one is a body's.
   std::pair<bool, bool> ball_ends() const {
     bool any_body = false;
     for (const Attachment3& e : ends) {
-      bool body = false, fixed = true;
-      for (const Slot& v : e.p) body = body || v.is_coordinate();
+      const bool body = of_body(e);
+      bool fixed = true;
       for (const Slot& v : e.r) fixed = fixed && !v.is_coordinate();
       if (!body && !fixed) return {false, false};
       any_body = any_body || body;
