@@ -254,6 +254,12 @@ class JointReactions {
   std::vector<Part> body_part_;           // a body's parts built where they are read (body_parts_kept's others)
 };
 
+/// What add_gear_mesh_forces() finds at a row: the meshes it names, in `meshes`' order.
+struct MeshFindings {
+  std::vector<Index> working;  ///< meshes whose push does work along q̇: their centres are not where the row needs
+  std::vector<Index> slack;    ///< belts whose slack strand would need a negative tension (T0 < |ΔT|/2): they slip
+};
+
 /// What turns the torques of each gear pair of `meshes` under multipliers `lambda` into the push of its teeth,
 /// added to `dq` (one value per coordinate). A gear's row relates angles alone (GearMesh), so λ turns its gears by
 /// torques and their bearings see nothing of the mesh; the teeth push at the pitch point, across the line of the
@@ -264,14 +270,17 @@ class JointReactions {
 /// drivers' rows or the gears'), λ + δ the multipliers under which the bearings carry the teeth's push. A mesh
 /// whose centres coincide adds nothing. A rack and pinion likewise: its row pushes the rack along its travel e
 /// (its body's x or y) and turns the pinion; its teeth push at P = c_p + k ẑ × e, which adds λ e on the pinion's
-/// centre and the moment of the rack's push about its reference point on its angle. With the row's velocities `qd`,
-/// appends to `working` (when not null) the meshes whose push does work along q̇ (beyond 10⁻⁶ of its terms): their
-/// bodies' reference points are not centres that keep their places on the carrier, so the row does not describe
-/// their teeth (a gear on a moving arm whose carrier is not named). Pre-condition: `lambda` has one value per model
-/// row, `qd` (if not null) one per coordinate.
+/// centre and the moment of the rack's push about its reference point on its angle. A belt or chain whose strands
+/// are known (GearMesh::strands_known()) pulls its pulleys' centres by its two strands' tensions along them, which
+/// its torque −λ on pulley 1 splits (GearMesh); without them, or with overlapping pulleys, it adds nothing.
+/// With the row's velocities `qd`, appends to `found->working` (when not null) the meshes whose push does work along
+/// q̇ (beyond 10⁻⁶ of its terms): their bodies' reference points are not centres that keep their places on the
+/// carrier, so the row does not describe their teeth (a gear on a moving arm whose carrier is not named); and to
+/// `found->slack` the belts whose slack strand would need a negative tension. Pre-condition: `lambda` has one value
+/// per model row, `qd` (if not null) one per coordinate.
 void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
                           const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd = nullptr,
-                          std::vector<Index>* working = nullptr);
+                          MeshFindings* found = nullptr);
 
 /// The multipliers of least norm among those with Φqᵀ λ = Q, from `lambda`, one of them (λ = 0 on the rows the model
 /// dropped as redundant: multipliers_with_factors()), and `lu`, the factors of the kept rows of Φq at q. Each

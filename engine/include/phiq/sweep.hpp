@@ -141,9 +141,11 @@ struct SweepWarning {
   /// changes no constraint or driver (its ParameterReach is empty: its sensitivities are exactly zero; at the
   /// first row); "indeterminate": written joint reactions (OutputEfforts::reactions) that redundant constraints
   /// leave undetermined, named at the first row (their minimum-norm values are written), and gear meshes whose
-  /// share of the load they leave undetermined; "gear_centres": a gear's teeth push its bodies in a way its row does
-  /// not hold (add_gear_mesh_forces(): their push does work in the motion at the first row), so its bearings'
-  /// written loads are not its teeth's
+  /// share of the load they leave undetermined; "gear_centres": a gear's teeth (a belt's strands) push its bodies in
+  /// a way its row does not hold (add_gear_mesh_forces(): their push does work in the motion at the first row), so
+  /// its bearings' written loads are not its teeth's; "belt_pull": a belt between bodies whose strands' pull its
+  /// written bearing loads lack (GearMesh::strands_known(): no tension, or teeth without a pitch; at the first row);
+  /// "belt_slack": a belt's slack strand would need a negative tension at this row (once per stretch of rows)
   std::string kind;
 
   std::string message;  ///< one line

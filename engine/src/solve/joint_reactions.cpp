@@ -203,13 +203,30 @@ void JointReactions::evaluate_site(const Site& s, const double* q, double t, con
 }
 
 void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
-                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd,
-                          std::vector<Index>* working) {
+                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd, MeshFindings* found) {
   double power = 0.0, size = 0.0;  // a mesh's push's power along q̇, and the size of its terms
   auto add = [&](const Slot& s, double v) {
     if (!s.is_coordinate()) return;
     dq(s.coord()) += v;
     if (qd) power += v * s.rate(qd), size += std::fabs(v * s.rate(qd));
+  };
+  // A belt's strands along u∓ = c e ∓ s n (n = ẑ × e, s = (r1 ∓ r2)/d open or crossed, c = √(1 − s²)) leave
+  // pulley 1 on its +n and −n sides; their tensions T∓ turn it by r1 (T₋ − T₊) = −λ, the row's torque on it, and
+  // pull its centre by T₊ u₊ + T₋ u₋, pulley 2's by the opposite.
+  auto pull = [&](const OutputMesh& m, double lambda_m, double ex, double ey, double d) {
+    const GearMesh& b = m.mesh;
+    const double s = (b.crossed ? b.r1 + b.r2 : b.r1 - b.r2) / d;
+    if (!b.strands_known() || !(std::fabs(s) < 1.0)) return;  // (overlapping pulleys: no strands)
+    const double c = std::sqrt(1.0 - s * s), nx = -ey, ny = ex;
+    const double difference = -lambda_m / b.r1;  // T₋ − T₊
+    double upper = b.tension - 0.5 * difference, lower = b.tension + 0.5 * difference;
+    if (b.chain)
+      upper = b.tension + std::max(-difference, 0.0), lower = b.tension + std::max(difference, 0.0);
+    else if (found && std::min(upper, lower) < 0.0)
+      found->slack.push_back(m.constraint);
+    const double fx = upper * (c * ex - s * nx) + lower * (c * ex + s * nx);
+    const double fy = upper * (c * ey - s * ny) + lower * (c * ey + s * ny);
+    add(m.first.x, fx), add(m.first.y, fy), add(m.second.x, -fx), add(m.second.y, -fy);
   };
   auto push = [&](const OutputMesh& m) {
     const double lambda_m = lambda(model.constraints()[static_cast<std::size_t>(m.constraint)].first_row);
@@ -226,6 +243,7 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
     const double dx = m.second.x.of(q) - m.first.x.of(q), dy = m.second.y.of(q) - m.first.y.of(q);
     const double d = std::hypot(dx, dy);
     if (!(d > 0.0)) return;
+    if (m.mesh.belt) return pull(m, lambda_m, dx / d, dy / d, d);
     const double f = -lambda_m * (1.0 + m.mesh.k) / d;
     const double tx = -dy / d, ty = dx / d;
     add(m.first.x, f * tx), add(m.first.y, f * ty);
@@ -235,7 +253,7 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
   for (const OutputMesh& m : meshes) {
     power = size = 0.0;
     push(m);
-    if (working && !(std::fabs(power) <= 1e-6 * size)) working->push_back(m.constraint);
+    if (found && qd && !(std::fabs(power) <= 1e-6 * size)) found->working.push_back(m.constraint);
   }
 }
 

@@ -104,15 +104,17 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
   // left in the solve would give it (all of it to some, none to the others).
   if (!opt_.efforts.meshes.empty()) {
     effort_work_.mesh_q.setZero(model_.num_coordinates());
-    std::vector<Index> working;  // checked at the sweep's first row, as the indeterminate joints are
+    MeshFindings& found = effort_work_.mesh_findings;
+    found.working.clear(), found.slack.clear();
     add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q,
-                         current_.qd.data(), note ? &working : nullptr);
-    if (!working.empty())
+                         current_.qd.data(), &found);
+    if (note) note_meshes(found.working);  // checked at the sweep's first row, as the indeterminate joints are
+    if (!found.slack.empty())              // at every row (once_per_stretch() joins the rows that follow)
       sum_.warnings.push_back(
-          {t, "gear_centres",
-           "the teeth of '" + model_.constraints()[static_cast<std::size_t>(working[0])].name +
-               "' do work in the motion: its bodies' reference points are not gear centres that its carrier holds "
-               "(a gear on a moving arm names the arm as its carrier), so its bearings' loads are not its teeth's"});
+          {t, "belt_slack",
+           "'" + model_.constraints()[static_cast<std::size_t>(found.slack[0])].name +
+               "' goes slack: its torque needs its strands' tensions to differ by more than twice its tension, so it "
+               "would slip (its bearings' loads are written with its slack strand pushing)"});
     if (!multipliers_with_factors(model_, lu, effort_work_.mesh_q, effort_work_.kept, effort_work_.mesh_lambda))
       return not_defined();
     ++ws_->counters.effort_solves;
@@ -141,6 +143,31 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
          (names.empty() ? "" : "the reactions of " + names) + (names.empty() || meshes.empty() ? "" : " and ") +
              (meshes.empty() ? "" : "the shares of the load of the gears " + meshes + " (and so their bearings')") +
              " are statically indeterminate (redundant constraints): the minimum-norm ones are written"});
+}
+
+void Sweeper::note_meshes(const std::vector<Index>& working) {
+  const double t = current_.t;
+  auto name = [&](Index c) { return "'" + model_.constraints()[static_cast<std::size_t>(c)].name + "'"; };
+  if (!working.empty()) {  // the first one
+    const auto m = std::find_if(opt_.efforts.meshes.begin(), opt_.efforts.meshes.end(),
+                                [&](const OutputMesh& o) { return o.constraint == working[0]; });
+    sum_.warnings.push_back(
+        {t, "gear_centres",
+         m->mesh.belt ? "the strands of " + name(working[0]) +
+                            " do work in the motion: its bodies' reference points are not pulley centres held at "
+                            "their distance, so its bearings' loads are not its strands'"
+                      : "the teeth of " + name(working[0]) +
+                            " do work in the motion: its bodies' reference points are not gear centres that its "
+                            "carrier holds (a gear on a moving arm names the arm as its carrier), so its bearings' "
+                            "loads are not its teeth's"});
+  }
+  for (const OutputMesh& m : opt_.efforts.meshes)
+    if (m.mesh.belt && !m.mesh.strands_known())
+      sum_.warnings.push_back(
+          {t, "belt_pull",
+           "the bearings of " + name(m.constraint) + "'s pulleys carry none of its strands' pull: " +
+               (std::isnan(m.mesh.tension) ? "it states no tension"
+                                           : "its teeth state no pitch, so its radii are not known")});
 }
 
 bool Sweeper::same_sweep(const Sweeper* like) const { return like && &like->model_ == &model_ && &like->opt_ == &opt_; }

@@ -83,6 +83,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   WorkCounters counted_begin{}, counted_end{};
   auto done = [&](SolveStatus st) {
     detail::once_per_stretch(sum.warnings, "slow_convergence", opt);
+    detail::once_per_stretch(sum.warnings, "belt_slack", opt);
     sum.status = st;
     sum.counters = others;
     add_counters(sum.counters, ws.counters, before);

@@ -6,6 +6,9 @@
 /// Kinds without them have none.
 #pragma once
 
+#include <cmath>
+#include <limits>
+
 #include "phiq/spatial_attachment.hpp"
 #include "phiq/types.hpp"
 
@@ -24,7 +27,7 @@ struct ReactionSite {
   kin3::V3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 };
 
-/// A gear pair, or a rack and pinion, as its teeth push its members (GearSpec::gear_mesh(),
+/// A gear pair, a rack and pinion, or a belt, as its teeth (strands) push its members (GearSpec::gear_mesh(),
 /// RackPinionSpec::gear_mesh(), OutputEfforts::meshes, add_gear_mesh_forces()): its row relates coordinates
 /// alone, (θ1 − θc) + k (θ2 − θc) − φ or x + k θ − c, so its multiplier λ turns the members by torques (and pushes
 /// a rack along its travel); the teeth push at the pitch point, which loads the members' bearings as well.
@@ -34,6 +37,17 @@ struct GearMesh {
   Slot carrier = Slot::constant(0.0);  ///< θc, the carrier's angle (a constant 0 without one, or for a rack)
   double k = 1.0;     ///< the row's ratio: r2/r1 external, −r2/r1 internal; a rack's −r (r when reversed)
   bool rack = false;  ///< a rack and pinion
+  /// A belt or chain (BeltSpec::gear_mesh()): its two strands pull its pulleys' centres toward each other, with
+  /// tensions T0 ∓ ΔT/2 (a belt's, T0 its installation tension) or T0 and T0 + |ΔT| (a chain's, T0 its slack
+  /// strand's), where ΔT = τ1/r1 is what the row's torque on pulley 1 takes.
+  bool belt = false;
+  bool chain = false;    ///< a chain: its slack strand keeps `tension`
+  bool crossed = false;  ///< the strands cross between the pulleys
+  double r1 = 0.0;       ///< pulley 1's radius (m); 0: not known (tooth counts without a pitch)
+  double r2 = 0.0;       ///< pulley 2's radius (m)
+  double tension = std::numeric_limits<double>::quiet_NaN();  ///< T0 (N); NaN: a belt that states none
+  /// Whether a belt's or chain's strands can be drawn and their tension told: its radii in length and T0 known.
+  bool strands_known() const { return r1 > 0.0 && r2 > 0.0 && std::isfinite(tension); }
 };
 
 /// @cond internal

@@ -14,6 +14,8 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
+#include <numbers>
 #include <tuple>
 
 #include "phiq/kinds/kind_support.hpp"
@@ -268,7 +270,9 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
 ///   Φ = θ1 ∓ (r2/r1) θ2 − φ,   Φt = 0,   γ = 0      (1 row, an angle of pulley 1)
 ///
 /// Scene types `belt` and `chain` (any dimension): `between: [P1, P2]` (bodies — ψ, dimension 2 — or angle
-/// coordinates), `radii: [r1, r2]` or `teeth: [z1, z2]`, `crossed: true | false` (false), `phase: φ` (0).
+/// coordinates), `radii: [r1, r2]` or `teeth: [z1, z2]`, `crossed: true | false` (false), `phase: φ` (0); for the
+/// strands' pull on the pulleys' bearings (gear_mesh()): `tension: T0` (N, ≥ 0; a belt's installation tension, a
+/// chain's slack strand's, 0 for a chain by default) and, with teeth, `pitch: p` (m, > 0): radii z p / 2π.
 struct BeltSpec : LinearTransmission<BeltSpec> {
   /// @copydoc DistanceSpec::operator==
   bool operator==(const BeltSpec&) const = default;
@@ -282,6 +286,10 @@ struct BeltSpec : LinearTransmission<BeltSpec> {
   bool crossed = false;  ///< a crossed belt: the pulleys turn opposite ways
   double phase = 0.0;    ///< φ (rad)
   int dimension = 2;     ///< the scene's dimension (for the Grübler count)
+  bool chain = false;    ///< written as a `chain`: its slack strand keeps `tension` (0 by default)
+  bool teeth = false;    ///< r1 and r2 are tooth counts
+  double pitch = 0.0;    ///< a chain's (toothed belt's) pitch (m) with teeth; 0: not stated
+  double tension = std::numeric_limits<double>::quiet_NaN();  ///< T0 (N); NaN: not stated
 
   /// @copydoc DistanceSpec::row_unit
   Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kAngle; }
@@ -298,6 +306,10 @@ struct BeltSpec : LinearTransmission<BeltSpec> {
     detail::require(std::isfinite(phase), "belt: phase is not finite");
     detail::require(!(first.is_coordinate() && second.is_coordinate() && first.coord() == second.coord()),
                     "belt: the two pulleys must be different angles");
+    detail::require(std::isnan(tension) || (std::isfinite(tension) && tension >= 0.0),
+                    "belt: tension must be a force >= 0");
+    detail::require(pitch == 0.0 || (std::isfinite(pitch) && pitch > 0.0), "belt: pitch must be positive");
+    detail::require(pitch == 0.0 || teeth, "belt: a pitch goes with teeth");
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {
@@ -308,12 +320,17 @@ struct BeltSpec : LinearTransmission<BeltSpec> {
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static BeltSpec read(const Fields& f) {
-    f.expect({"type", "name", "between", "radii", "teeth", "crossed", "phase"});
+    f.expect({"type", "name", "between", "radii", "teeth", "crossed", "phase", "tension", "pitch"});
     BeltSpec b;
     std::tie(b.first, b.second) = f.angle_pair("between");
     std::tie(b.r1, b.r2) = f.radii_or_teeth();
+    b.teeth = f.present("teeth");
     if (f.present("crossed")) b.crossed = f.boolean("crossed");
     if (f.present("phase")) b.phase = f.number("phase");
+    b.chain = f.type() == "chain";
+    if (b.chain) b.tension = 0.0;
+    if (f.present("tension")) b.tension = f.number("tension");
+    if (f.present("pitch")) b.pitch = f.number("pitch");
     b.dimension = f.dimension();
     return b;
   }
@@ -327,6 +344,19 @@ struct BeltSpec : LinearTransmission<BeltSpec> {
   /// The row as a linear form (LinearTransmission evaluates it).
   detail::LinearRow row() const {
     return detail::LinearRow{{first, second, Slot::constant(0)}, {1.0, (crossed ? r2 : -r2) / r1, 0.0}, phase};
+  }
+  /// The strands' pull on the pulleys' bearings (kinds/reaction_site.hpp): the radii in length (unknown for tooth
+  /// counts without a pitch) and the tension at rest (unknown for a belt that states none).
+  GearMesh gear_mesh() const {
+    GearMesh m{first, second, Slot::constant(0.0), row().w[1]};
+    m.belt = true, m.chain = chain, m.crossed = crossed, m.tension = tension;
+    if (!teeth) m.r1 = r1, m.r2 = r2;
+    // a chain's links ride on polygons, between p/(2 tan(π/z)) and p/(2 sin(π/z)) from the centre; it travels z p
+    // a turn, as a toothed belt on its pitch circle does: radii z p/2π keep the strands' pull and the row's ratio
+    // (z2/z1) one
+    if (teeth && pitch > 0.0)
+      m.r1 = pitch * r1 / (2.0 * std::numbers::pi), m.r2 = pitch * r2 / (2.0 * std::numbers::pi);
+    return m;
   }
   /// The data a parameter may move (DistanceSpec::data_members()): fixed angles, the radii and the phase.
   static constexpr auto data_members() {
