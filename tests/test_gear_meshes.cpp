@@ -41,9 +41,10 @@ V2 perp(const V2& u) { return {-u.y(), u.x()}; }  // ẑ × u
 
 // models/transmissions/gear_train.yaml with a mass and inertia on each gear (centres on the pivots, no gravity).
 // The input gear turns under the motor's τ and the first mesh's push F1 at its pitch point (radius ρ1 = 0.03, on
-// the line to the countershaft, along +x): I1 ψ̈1 = τ + ρ1 F1y, so its pivot holds it by −F1 = (0, (τ − I1 ψ̈1)/ρ1).
-// The output gear (ρ = 0.1125, the countershaft below it along −y) turns by the second mesh alone: I3 ψ̈3 = ρ F2x,
-// its pivot −F2. The countershaft's pivot holds F1 + F2, the reactions of both.
+// the line to the countershaft, along +x): I1 ψ̈1 = τ + ρ1 F1y, and the teeth's 20° pressure angle parts the gears
+// by |F1y| tan 20° along that line, so its pivot holds it by −F1 = (|F1y| tan 20°, (τ − I1 ψ̈1)/ρ1). The output gear
+// (ρ = 0.1125, the countershaft below it along −y) turns by the second mesh alone: I3 ψ̈3 = ρ F2x, and is parted
+// upward by |F2x| tan 20°; its pivot holds −F2. The countershaft's pivot holds F1 + F2, the reactions of both.
 TEST(GearMeshes, ATrainsPivotsCarryItsTeethsPushByNewtonEuler) {
   const std::string train = test::model_file_text("transmissions/gear_train.yaml", "\noutput:") + "\n";
   const std::string parts =
@@ -61,7 +62,8 @@ TEST(GearMeshes, ATrainsPivotsCarryItsTeethsPushByNewtonEuler) {
     EXPECT_EQ(v[0], e.values[k][0]) << k;  // the effort: the same bits
     const double tau = v[0], f1y = (i1 * r.qdd[k](psi1) - tau) / rho1, f2x = i3 * r.qdd[k](psi3) / rho3;
     const double scale = 1.0 + std::fabs(f1y) + std::fabs(f2x);
-    const double expected[9] = {0, -f1y, 0, f2x, f1y, 0, -f2x, 0, 0};
+    const double a1 = std::fabs(f1y) * std::tan(20 * M_PI / 180), a2 = std::fabs(f2x) * std::tan(20 * M_PI / 180);
+    const double expected[9] = {a1, -f1y, 0, f2x - a1, f1y + a2, 0, -f2x, -a2, 0};
     for (int c = 0; c < 9; ++c)
       EXPECT_NEAR(v[static_cast<std::size_t>(2 + c)], expected[c], 1e-12 * scale) << k << " " << c;
     largest = std::max(largest, std::fabs(f1y));
@@ -73,10 +75,10 @@ TEST(GearMeshes, ATrainsPivotsCarryItsTeethsPushByNewtonEuler) {
 // and the planet's centre turning (uniformly, so its centre accelerates toward the sun's). Each gear's teeth push at
 // the pitch point on the line from the sun's centre to the planet's, n: the sun meshes at rs n, the ring (internal) at
 // rr n, both about the origin. The sun and ring turn uniformly (ψ̈ = 0), so each mesh's torque on them is minus the
-// motor's: the sun's mesh pushes it by −(τs/rs) ẑ × n, and its bearing holds it by (τs/rs) ẑ × n + ms g↑; the ring's
-// likewise. The planet takes the opposite pushes at rp from its centre, toward the sun and toward the ring, its
-// weight, and the pin's force (minus what the pin reports on the carrier): Newton for its centre's acceleration and
-// Euler for its ψ̈.
+// motor's: the sun's mesh pushes it by −(τs/rs) ẑ × n and, at the teeth's 20°, toward its centre by |τs/rs| tan 20°,
+// and its bearing holds it by the opposite and ms g↑; the ring's likewise, parted outward. The planet takes the
+// opposite pushes at rp from its centre (parted outward by the sun and inward by the ring), its weight, and the pin's
+// force (minus what the pin reports on the carrier): Newton for its centre's acceleration and Euler for its ψ̈.
 TEST(GearMeshes, APlanetarysGearsMoveByNewtonEulerWithTheirTeethsPush) {
   const double ms = 0.3, mp = 0.2, mr = 0.8, ip = 2e-4, g = 9.81;
   const double rs = 0.004 * 24 / 2, rp = 0.004 * 18 / 2, rr = 0.004 * 60 / 2;
@@ -115,14 +117,17 @@ TEST(GearMeshes, APlanetarysGearsMoveByNewtonEulerWithTheirTeethsPush) {
     const V2 sun = V2(v[4], v[5]), ring = V2(v[10], v[11]), pin_on_carrier = V2(v[13], v[14]);
     const V2 up(0, g);
     const double scale = 1.0 + (std::fabs(ts) / rs + std::fabs(tr) / rr);
-    const V2 sun_expected = (ts / rs) * t + ms * up, ring_expected = (tr / rr) * t + mr * up;
+    const double tan_a = std::tan(20 * M_PI / 180), sun_apart = std::fabs(ts / rs) * tan_a,
+                 ring_apart = std::fabs(tr / rr) * tan_a;
+    const V2 sun_expected = (ts / rs) * t + sun_apart * n + ms * up,
+             ring_expected = (tr / rr) * t - ring_apart * n + mr * up;
     for (int i = 0; i < 2; ++i) {
       EXPECT_NEAR(sun(i), sun_expected(i), 1e-11 * scale) << k;
       EXPECT_NEAR(ring(i), ring_expected(i), 1e-11 * scale) << k;
     }
     // the planet: the pushes the sun and ring take, reversed, at its pitch points c − rp n and c + rp n
     const V2 from_sun = (ts / rs) * t, from_ring = (tr / rr) * t;
-    const V2 force = from_sun + from_ring - pin_on_carrier - mp * up;
+    const V2 force = from_sun + from_ring + (sun_apart - ring_apart) * n - pin_on_carrier - mp * up;
     EXPECT_NEAR(force.x(), mp * r.qdd[k](xp), 1e-11 * scale) << k;
     EXPECT_NEAR(force.y(), mp * r.qdd[k](yp), 1e-11 * scale) << k;
     auto cross = [](const V2& a, const V2& b) { return a.x() * b.y() - a.y() * b.x(); };
@@ -202,9 +207,9 @@ TEST(GearMeshes, ThreePlanetsShareTheLoadEquallyAndAreNamedIndeterminate) {
 
 // models/transmissions/rack_pinion.yaml with masses under gravity and the rack's reference point 0.03 below its pitch
 // line (its guide there): the rack moves along x by its teeth alone (its guide carries no x), so they push it by
-// F = (mr ẍ, 0) at the pitch point P (below the pinion's centre by r), and the pinion by −F: its pivot holds
-// (mr ẍ, mp g), and the guide the rack's weight and the moment about its point S that Euler asks for the rack,
-// M = (com − S) × (mr a − W) − (P − S) × F.
+// F = (mr ẍ, −|mr ẍ| tan 20°) at the pitch point P (below the pinion's centre by r; the teeth's pressure angle parts
+// them), and the pinion by −F: its pivot holds (mr ẍ, mp g − |mr ẍ| tan 20°), and the guide the rack's weight, the
+// parting and the moment about its point S that Euler asks for the rack, M = (com − S) × (mr a − W) − (P − S) × F.
 TEST(GearMeshes, ARacksTeethPushThePinionsPivotAndTurnOnItsGuide) {
   const double mp = 0.2, mr = 1.5, g = 9.81, r = 0.04;
   std::string text = test::model_file_text("transmissions/rack_pinion.yaml", "output:");
@@ -225,7 +230,8 @@ TEST(GearMeshes, ARacksTeethPushThePinionsPivotAndTurnOnItsGuide) {
     const std::vector<double>& v = rows.values[k];  // τ, power, pivot's Fx, Fy, Mz, guide's Fx, Fy, Mz
     ASSERT_EQ(v.size(), 8u);
     const double xdd = rows.qdd[k](x);
-    const V2 f(mr * xdd, 0.0), weight(0.0, -mr * g), a(xdd, 0.0);
+    const double apart = std::fabs(mr * xdd) * std::tan(20 * M_PI / 180);
+    const V2 f(mr * xdd, -apart), weight(0.0, -mr * g), a(xdd, 0.0);
     const V2 rack(rows.q[k](x), -0.03), com = rack + V2(0.1, -0.02);
     const V2 pitch(rows.q[k](xp), rows.q[k](yp) - r);  // below the pinion's centre
     ReactionSite site;
@@ -233,7 +239,7 @@ TEST(GearMeshes, ARacksTeethPushThePinionsPivotAndTurnOnItsGuide) {
     const V2 at(site.point.x, site.point.y);
     auto cross = [](const V2& u, const V2& w) { return u.x() * w.y() - u.y() * w.x(); };
     const double moment = cross(com - at, mr * a - weight) - cross(pitch - at, f);
-    const double expected[6] = {f.x(), mp * g, 0.0, 0.0, mr * g, moment};
+    const double expected[6] = {f.x(), mp * g - apart, 0.0, 0.0, mr * g + apart, moment};
     for (int c = 0; c < 6; ++c) EXPECT_NEAR(v[static_cast<std::size_t>(2 + c)], expected[c], 1e-11) << k << " " << c;
     largest = std::max(largest, std::fabs(f.x()));
   }

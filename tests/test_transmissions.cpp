@@ -201,6 +201,9 @@ TEST(Transmissions, SceneErrorsNameTheField) {
             "bad.yaml:6:67: constraints[0].mesh: expected one of external, internal, got 'inner'");
   EXPECT_EQ(test::scene_error(head + "  - {name: m, type: belt, between: [g, x], radii: [0, 1]}\n"),
             "bad.yaml:6:5: constraints[0]: constraint 'm': belt: the radii (or tooth counts) must be positive");
+  EXPECT_EQ(
+      test::scene_error(head + "  - {name: m, type: gear, between: [g, x], teeth: [12, 30], pressure_angle: 2}\n"),
+      "bad.yaml:6:5: constraints[0]: constraint 'm': gear: pressure_angle must be in [0, pi/2) rad");
 }
 
 }  // namespace

@@ -267,10 +267,12 @@ struct MeshFindings {
 /// the same torques, and F t on c1, −F t on c2, which the carrier's torque F d made up for. So dq = F t at gear 1's
 /// centre, −F t at gear 2's, and F d on the carrier's angle. It does no work in any motion that keeps the centres
 /// where the mesh needs them: δ with Φqᵀ δ = dq is the change of the other joints' multipliers (nothing at the
-/// drivers' rows or the gears'), λ + δ the multipliers under which the bearings carry the teeth's push. A mesh
-/// whose centres coincide adds nothing. A rack and pinion likewise: its row pushes the rack along its travel e
-/// (its body's x or y) and turns the pinion; its teeth push at P = c_p + k ẑ × e, which adds λ e on the pinion's
-/// centre and the moment of the rack's push about its reference point on its angle. A belt or chain whose strands
+/// drivers' rows or the gears'), λ + δ the multipliers under which the bearings carry the teeth's push. The teeth's
+/// pressure angle α parts the gears as well, by |F| tan α along the line of centres (no moment about them, no work).
+/// A mesh whose centres coincide adds nothing. A rack and pinion likewise: its row pushes the rack along its travel e
+/// (its body's x or y) and turns the pinion; its teeth push at P = c_p + k ẑ × e, which adds λ e and the parting
+/// |λ| tan α on the pinion's centre, the parting on the rack across its travel and the moment of its push about its
+/// reference point on its angle. A belt or chain whose strands
 /// are known (GearMesh::strands_known()) pulls its pulleys' centres by its two strands' tensions along them, which
 /// its torque −λ on pulley 1 splits (GearMesh); without them, or with overlapping pulleys, it adds nothing.
 /// With the row's velocities `qd`, appends to `found->working` (when not null) the meshes whose push does work along

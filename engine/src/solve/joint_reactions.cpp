@@ -234,10 +234,15 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
       // the rack pushed by −λ e at the pitch point P = c_p + k ẑ × e (its travel took −λ), the pinion by λ e there
       // (its angle took −λ k, the moment of λ e about its centre): λ e on the pinion's centre, and the moment of
       // −λ e about the rack's reference point on its angle
-      const double ex = m.rack_axis == 0 ? 1.0 : 0.0, ey = 1.0 - ex;
+      // The teeth part them by |λ| tan α across e, along n = ẑ × e: the rack by s n at P (s = sign(k) |λ| tan α, away
+      // from the pinion's centre), the pinion by −s n.
+      const double ex = m.rack_axis == 0 ? 1.0 : 0.0, ey = 1.0 - ex, nx = -ey, ny = ex;
       const double px = m.second.x.of(q) - m.mesh.k * ey, py = m.second.y.of(q) + m.mesh.k * ex;
-      add(m.second.x, lambda_m * ex), add(m.second.y, lambda_m * ey);
-      add(m.first.psi, -lambda_m * ((px - m.first.x.of(q)) * ey - (py - m.first.y.of(q)) * ex));
+      const double apart = std::copysign(std::fabs(lambda_m) * std::tan(m.mesh.pressure_angle), m.mesh.k);
+      const double fx = -lambda_m * ex + apart * nx, fy = -lambda_m * ey + apart * ny;  // on the rack at P
+      add(m.second.x, -fx), add(m.second.y, -fy);
+      add(m.first.x, apart * nx), add(m.first.y, apart * ny);  // (its travel took the rest)
+      add(m.first.psi, (px - m.first.x.of(q)) * fy - (py - m.first.y.of(q)) * fx);
       return;
     }
     const double dx = m.second.x.of(q) - m.first.x.of(q), dy = m.second.y.of(q) - m.first.y.of(q);
@@ -245,9 +250,12 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
     if (!(d > 0.0)) return;
     if (m.mesh.belt) return pull(m, lambda_m, dx / d, dy / d, d);
     const double f = -lambda_m * (1.0 + m.mesh.k) / d;
-    const double tx = -dy / d, ty = dx / d;
-    add(m.first.x, f * tx), add(m.first.y, f * ty);
-    add(m.second.x, -f * tx), add(m.second.y, -f * ty);
+    // across the line of centres e they part the gears by |f| tan α: gear 1 toward its centre, away from its
+    // pitch point (−e external; +e internal, k < 0, where it meshes on the side away from the ring's centre)
+    const double apart = std::copysign(std::fabs(f) * std::tan(m.mesh.pressure_angle), -m.mesh.k);
+    const double ex = dx / d, ey = dy / d, tx = -ey, ty = ex;
+    add(m.first.x, f * tx + apart * ex), add(m.first.y, f * ty + apart * ey);
+    add(m.second.x, -f * tx - apart * ex), add(m.second.y, -f * ty - apart * ey);
     add(m.mesh.carrier, f * d);
   };
   for (const OutputMesh& m : meshes) {

@@ -37,6 +37,9 @@ struct GearMesh {
   Slot carrier = Slot::constant(0.0);  ///< θc, the carrier's angle (a constant 0 without one, or for a rack)
   double k = 1.0;     ///< the row's ratio: r2/r1 external, −r2/r1 internal; a rack's −r (r when reversed)
   bool rack = false;  ///< a rack and pinion
+  /// The teeth's pressure angle α (rad): their push has, besides the force along the pitch line that turns the
+  /// gears, tan α of it across, which parts them (not a belt's)
+  double pressure_angle = 0.0;
   /// A belt or chain (BeltSpec::gear_mesh()): its two strands pull its pulleys' centres toward each other, with
   /// tensions T0 ∓ ΔT/2 (a belt's, T0 its installation tension) or T0 and T0 + |ΔT| (a chain's, T0 its slack
   /// strand's), where ΔT = τ1/r1 is what the row's torque on pulley 1 takes.

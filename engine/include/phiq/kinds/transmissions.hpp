@@ -39,6 +39,11 @@ struct LinearRow {
     s(0, slot[0], w[0]), s(0, slot[1], w[1]), s(0, slot[2], w[2]);
   }
 };
+// The teeth's pressure angle α (rad) of a gear or rack: 20°, ISO 53's, unless the scene says (0 for friction wheels).
+constexpr double kPressureAngle = 20.0 * std::numbers::pi / 180.0;
+inline void require_pressure_angle(double alpha, const char* message) {
+  require(std::isfinite(alpha) && alpha >= 0.0 && alpha < std::numbers::pi / 2, message);
+}
 // Radii (or tooth counts) of a pair: positive and finite, else "KIND: WHAT must be positive".
 inline void require_positive_pair(double r1, double r2, const char* message) {
   require(std::isfinite(r1) && std::isfinite(r2) && r1 > 0.0 && r2 > 0.0, message);
@@ -103,7 +108,7 @@ struct LinearTransmission {
 ///
 /// Scene type `gear` (any dimension): `between: [G1, G2]` (each a body — its ψ, dimension 2 — or an angle
 /// coordinate), `radii: [r1, r2]` or `teeth: [z1, z2]`, `mesh: external | internal` (external), `carrier: C` (a
-/// body or an angle coordinate; none), `phase: φ` (0).
+/// body or an angle coordinate; none), `phase: φ` (0), `pressure_angle: α` (rad, 20° = 0.349; for the bearings' loads).
 struct GearSpec : LinearTransmission<GearSpec> {
   /// @copydoc DistanceSpec::operator==
   bool operator==(const GearSpec&) const = default;
@@ -118,6 +123,7 @@ struct GearSpec : LinearTransmission<GearSpec> {
   bool internal = false;               ///< internal mesh: gear 2 is a ring gear and both turn the same way
   double phase = 0.0;                  ///< φ (rad)
   int dimension = 2;                   ///< the scene's dimension (for the Grübler count)
+  double pressure_angle = detail::kPressureAngle;  ///< α (rad): its bearings' loads only (GearMesh)
 
   /// @copydoc DistanceSpec::row_unit
   Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kAngle; }
@@ -133,6 +139,7 @@ struct GearSpec : LinearTransmission<GearSpec> {
   void prepare(const double* /*q0*/) const {
     detail::require_positive_pair(r1, r2, "gear: the radii (or tooth counts) must be positive");
     detail::require(std::isfinite(phase), "gear: phase is not finite");
+    detail::require_pressure_angle(pressure_angle, "gear: pressure_angle must be in [0, pi/2) rad");
     detail::require(!internal || r2 > r1,
                     "gear: an internal pair's second gear is the ring: its radius must exceed the first's");
     detail::require(!(first.is_coordinate() && second.is_coordinate() && first.coord() == second.coord()),
@@ -147,13 +154,14 @@ struct GearSpec : LinearTransmission<GearSpec> {
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static GearSpec read(const Fields& f) {
-    f.expect({"type", "name", "between", "radii", "teeth", "mesh", "carrier", "phase"});
+    f.expect({"type", "name", "between", "radii", "teeth", "mesh", "carrier", "phase", "pressure_angle"});
     GearSpec g;
     std::tie(g.first, g.second) = f.angle_pair("between");
     std::tie(g.r1, g.r2) = f.radii_or_teeth();
     if (f.present("mesh")) g.internal = f.choice("mesh", {"external", "internal"}) == 1;
     if (f.present("carrier")) g.carrier = f.angle("carrier");
     if (f.present("phase")) g.phase = f.number("phase");
+    if (f.present("pressure_angle")) g.pressure_angle = f.number("pressure_angle");
     g.dimension = f.dimension();
     return g;
   }
@@ -170,7 +178,11 @@ struct GearSpec : LinearTransmission<GearSpec> {
     return detail::LinearRow{{first, second, carrier}, {1.0, k, -(1.0 + k)}, phase};
   }
   /// The mesh as a force on the gears' bearings (kinds/reaction_site.hpp): the angles and the row's ratio.
-  GearMesh gear_mesh() const { return GearMesh{first, second, carrier, ratio()}; }
+  GearMesh gear_mesh() const {
+    GearMesh m{first, second, carrier, ratio()};
+    m.pressure_angle = pressure_angle;
+    return m;
+  }
   /// k of the row: r2/r1 external, −r2/r1 internal.
   double ratio() const { return (internal ? -r2 : r2) / r1; }
   /// The data a parameter may move (DistanceSpec::data_members()): fixed angles, the radii and the phase.
@@ -191,19 +203,21 @@ struct GearSpec : LinearTransmission<GearSpec> {
 /// c (the offset, default 0) is the travel at θ = 0.
 ///
 /// Scene type `rack_pinion` (any dimension): `rack: x` (a travel coordinate), `pinion: P` (a body — its ψ,
-/// dimension 2 — or an angle coordinate), `radius: r` (> 0), `offset: c` (0), `reversed: true | false` (false).
+/// dimension 2 — or an angle coordinate), `radius: r` (> 0), `offset: c` (0), `reversed: true | false` (false),
+/// `pressure_angle: α` (rad, 20° = 0.349; for the bearings' loads).
 struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
   /// @copydoc DistanceSpec::operator==
   bool operator==(const RackPinionSpec&) const = default;
   static constexpr int kRows = 1;  ///< one row, a length
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "rack_pinion";
-  Slot rack;              ///< x, the rack's travel (m)
-  Slot pinion;            ///< θ, the pinion's angle (rad)
-  double radius = 1.0;    ///< r, the pinion's pitch radius (m), > 0
-  double offset = 0.0;    ///< c, the travel at θ = 0 (m)
-  bool reversed = false;  ///< x = −r θ + c
-  int dimension = 2;      ///< the scene's dimension (for the Grübler count)
+  Slot rack;                                       ///< x, the rack's travel (m)
+  Slot pinion;                                     ///< θ, the pinion's angle (rad)
+  double radius = 1.0;                             ///< r, the pinion's pitch radius (m), > 0
+  double offset = 0.0;                             ///< c, the travel at θ = 0 (m)
+  bool reversed = false;                           ///< x = −r θ + c
+  int dimension = 2;                               ///< the scene's dimension (for the Grübler count)
+  double pressure_angle = detail::kPressureAngle;  ///< α (rad): its bearings' loads only (GearMesh)
 
   /// @copydoc DistanceSpec::row_unit
   Unit row_unit(int, const std::vector<Unit>&) const { return Unit::kLength; }
@@ -219,6 +233,7 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
   void prepare(const double* /*q0*/) const {
     detail::require(std::isfinite(radius) && radius > 0.0, "rack_pinion: the radius must be positive");
     detail::require(std::isfinite(offset), "rack_pinion: offset is not finite");
+    detail::require_pressure_angle(pressure_angle, "rack_pinion: pressure_angle must be in [0, pi/2) rad");
     detail::require(!(rack.is_coordinate() && pinion.is_coordinate() && rack.coord() == pinion.coord()),
                     "rack_pinion: the rack's travel and the pinion's angle must be different coordinates");
   }
@@ -229,13 +244,14 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static RackPinionSpec read(const Fields& f) {
-    f.expect({"type", "name", "rack", "pinion", "radius", "offset", "reversed"});
+    f.expect({"type", "name", "rack", "pinion", "radius", "offset", "reversed", "pressure_angle"});
     RackPinionSpec s;
     s.rack = Slot::coordinate(f.coordinate("rack"));
     s.pinion = f.angle("pinion");
     s.radius = f.number("radius");
     if (f.present("offset")) s.offset = f.number("offset");
     if (f.present("reversed")) s.reversed = f.boolean("reversed");
+    if (f.present("pressure_angle")) s.pressure_angle = f.number("pressure_angle");
     s.dimension = f.dimension();
     return s;
   }
@@ -252,7 +268,11 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
     return detail::LinearRow{{rack, pinion, Slot::constant(0)}, {1.0, reversed ? radius : -radius, 0.0}, offset};
   }
   /// The mesh as a push on the pinion's bearing and the rack's guide (kinds/reaction_site.hpp).
-  GearMesh gear_mesh() const { return GearMesh{rack, pinion, Slot::constant(0.0), reversed ? radius : -radius, true}; }
+  GearMesh gear_mesh() const {
+    GearMesh m{rack, pinion, Slot::constant(0.0), reversed ? radius : -radius, true};
+    m.pressure_angle = pressure_angle;
+    return m;
+  }
   /// The data a parameter may move (DistanceSpec::data_members()): a fixed pinion angle, the radius, the offset.
   static constexpr auto data_members() {
     return std::tuple{&RackPinionSpec::rack, &RackPinionSpec::pinion, &RackPinionSpec::radius, &RackPinionSpec::offset};
