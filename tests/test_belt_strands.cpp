@@ -165,7 +165,7 @@ TEST(BeltStrands, StrandsNotKnownAreToldAndPullNothing) {
     SweepSummary sum;
     const ReactionRows r = test::sweep_reactions(belt_drive(belt), &sum);
     ASSERT_EQ(sum.warnings.size(), 1u) << belt;
-    EXPECT_EQ(sum.warnings[0].kind, "belt_pull");
+    EXPECT_EQ(sum.warnings[0].kind, "unloaded_bearings");
     EXPECT_EQ(sum.warnings[0].t, 0.0);
     EXPECT_HAS(sum.warnings[0].message, "'vee'");
     EXPECT_HAS(sum.warnings[0].message, belt.find("teeth") == std::string::npos ? "no tension" : "no pitch");

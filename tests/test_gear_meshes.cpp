@@ -246,5 +246,61 @@ TEST(GearMeshes, ARacksTeethPushThePinionsPivotAndTurnOnItsGuide) {
   EXPECT_GT(largest, 0.1);
 }
 
+// A reducer: the ring held by the ground (`between: [planet, ground]`), the sun driven at 1 rad/s, the carrier
+// loaded by 10 N·m, no gravity. The fixed ring is coaxial with the carrier, so its teeth still push the planet:
+// at the pitch points c ∓ rp n the sun and the ring push it by Fs t and Fr t (t = ẑ × n) and part it outward and
+// inward by |Fs| and |Fr| tan 20°. The sun turns uniformly: the sun's mesh takes the motor's torque, Fs = τs/rs,
+// and the sun's bearing holds the sun's opposite push. The planet turns uniformly too: Euler gives Fr = Fs, and
+// Newton the pin's force for its centre's acceleration, which the carrier's bearing carries (its centre of mass on
+// its axis); the carrier's Euler equation, that the pin's force turns it against the load.
+TEST(GearMeshes, AFixedRingStillPushesThePlanetsPin) {
+  const std::string scene =
+      "phiq: 1\nname: reducer\nparameters: {m: 0.004, arm: m*(24 + 18)/2}\n"
+      "coordinates: {xs: 0, ys: 0, ps: 0, xc: 0, yc: 0, pc: 0, xp: arm, yp: 0, pp: 0}\n"
+      "bodies: {sun: [xs, ys, ps], carrier: [xc, yc, pc], planet: [xp, yp, pp]}\nconstraints:\n"
+      "  - {name: sun_bearing, type: revolute, between: [{body: ground}, {body: sun}]}\n"
+      "  - {name: carrier_bearing, type: revolute, between: [{body: ground}, {body: carrier}]}\n"
+      "  - {name: pin, type: revolute, between: [{body: carrier, at: [arm, 0]}, {body: planet}]}\n"
+      "  - {name: sun_planet, type: gear, between: [sun, planet], teeth: [24, 18], carrier: carrier}\n"
+      "  - {name: planet_ring, type: gear, between: [planet, ground], teeth: [18, 60], mesh: internal, CARRIER}\n"
+      "drivers:\n  - {name: motor, coordinate: ps, law: {type: linear, initial: 0, rate: 1}}\n"
+      "time: {start: 0, end: 2, steps: 20}\n";
+  const std::string parts =
+      "  sun: {mass: 0.3, center_of_mass: [0, 0], inertia: 5e-4}\n"
+      "  carrier: {mass: 0.5, center_of_mass: [0, 0], inertia: 1e-3}\n"
+      "  planet: {mass: 0.2, center_of_mass: [0, 0], inertia: 2e-4}\n"
+      "loads: {torques: [{name: out, part: carrier, torque: -10}]}\n";
+  const Scene s = with_reactions(test::replace_first(scene, "CARRIER", "carrier: carrier"), parts, false);
+  SweepSummary sum;
+  const ReactionRows r = sweep_meshes(s, 2, &sum);
+  EXPECT_TRUE(sum.warnings.empty());
+  const Model& m = *s.model;
+  const Index xp = m.find_coordinate("xp"), yp = m.find_coordinate("yp");
+  const double mp = 0.2, rs = 0.004 * 24 / 2, rp = 0.004 * 18 / 2, arm = rs + rp, tan_a = std::tan(20 * M_PI / 180);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < r.values.size(); ++k) {
+    const std::vector<double>& v = r.values[k];  // τs, power, sun_bearing, carrier_bearing, pin (Fx, Fy, Mz each)
+    ASSERT_EQ(v.size(), 11u);
+    const V2 c(r.q[k](xp), r.q[k](yp)), n = c.normalized(), t = perp(n);
+    const double fs = v[0] / rs, fr = fs;  // the planet's pushes along t
+    const V2 on_planet = fs * t + fr * t + (std::fabs(fs) - std::fabs(fr)) * tan_a * n;
+    const V2 pin = mp * V2(r.qdd[k](xp), r.qdd[k](yp)) - on_planet;  // on the planet
+    const V2 sun = fs * t + std::fabs(fs) * tan_a * n;               // the sun's bearing holds its push
+    const double scale = 1.0 + std::fabs(fs);
+    const double expected[9] = {sun.x(), sun.y(), 0, pin.x(), pin.y(), 0, -pin.x(), -pin.y(), 0};
+    for (int i = 0; i < 9; ++i)
+      EXPECT_NEAR(v[static_cast<std::size_t>(2 + i)], expected[i], 1e-11 * scale) << k << " " << i;
+    EXPECT_NEAR(arm * (n.y() * pin.x() - n.x() * pin.y()), 10.0, 1e-9) << k;  // the carrier: n × (−pin) turns it
+    largest = std::max(largest, std::fabs(fs));
+  }
+  EXPECT_GT(largest, 10.0);
+  // without its carrier the fixed ring's centre is not known: said, and its push left out
+  SweepSummary told;
+  sweep_meshes(with_reactions(test::replace_first(scene, ", CARRIER", ""), parts, false), 2, &told);
+  ASSERT_FALSE(told.warnings.empty());
+  EXPECT_EQ(told.warnings[0].kind, "unloaded_bearings");
+  EXPECT_HAS(told.warnings[0].message, "'planet_ring'");
+}
+
 }  // namespace
 }  // namespace phiq

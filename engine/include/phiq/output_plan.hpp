@@ -102,6 +102,14 @@ struct OutputMesh {
   Frame2 first;
   Frame2 second;       ///< the body whose ψ is mesh.second (gear 2, the pinion)
   int rack_axis = -1;  ///< a rack's travel: 0 its body's x, 1 its y (−1: a gear pair)
+  /// A gear held fixed (the ground's or a fixed body's angle) in an epicyclic train: 0 gear 1, 1 gear 2 (−1: none).
+  /// It is coaxial with the carrier, so its frame above is the carrier's, whose reference point stands for its
+  /// centre; it takes no push.
+  int fixed = -1;
+  /// Why its bearings carry none of its push (not empty: add_gear_mesh_forces() skips it, and a sweep warns
+  /// `unloaded_bearings` with this at its first row): a belt without tension, teeth without pitch, a fixed gear
+  /// without a carrier.
+  std::string unloaded;
 };
 
 /// Driver efforts (inverse dynamics, phiq/inverse_dynamics.hpp) at every written row: for each listed constraint

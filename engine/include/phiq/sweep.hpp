@@ -143,8 +143,9 @@ struct SweepWarning {
   /// leave undetermined, named at the first row (their minimum-norm values are written), and gear meshes whose
   /// share of the load they leave undetermined; "gear_centres": a gear's teeth (a belt's strands) push its bodies in
   /// a way its row does not hold (add_gear_mesh_forces(): their push does work in the motion at the first row), so
-  /// its bearings' written loads are not its teeth's; "belt_pull": a belt between bodies whose strands' pull its
-  /// written bearing loads lack (GearMesh::strands_known(): no tension, or teeth without a pitch; at the first row);
+  /// its bearings' written loads are not its teeth's; "unloaded_bearings": a gear or belt between bodies whose push
+  /// its written bearing loads lack (OutputMesh::unloaded: a belt without tension, teeth without a pitch, a fixed gear
+  /// without a carrier; at the first row);
   /// "belt_slack": a belt's slack strand would need a negative tension at this row (once per stretch of rows)
   std::string kind;
 

@@ -1,6 +1,7 @@
 // The scene's `output: efforts`, `power` and `reactions` (models/README.md): which drivers' efforts and which joints'
 // reactions a sweep writes, resolved to constraints once the model is built, with the parts and loads they are
 // computed from (OutputPlan::efforts).
+#include <cmath>
 #include <memory>
 #include <set>
 #include <string_view>
@@ -135,7 +136,24 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       // a gear's angles are its bodies' ψ; a rack's travel is its body's x or y
       const Frame2 *first = m.mesh.rack ? body(m.mesh.first, -1, &m.rack_axis) : body(m.mesh.first, 2),
                    *second = body(m.mesh.second, 2);
-      if (!first || !second) continue;  // (angle or travel coordinates of no body: no centres to push)
+      // a gear held fixed (a constant angle: the ground's or a fixed body's) beside one that turns: in an epicyclic
+      // train it is coaxial with the carrier, whose reference point stands for its centre
+      const bool fixed1 = !first && !m.mesh.first.is_coordinate() && second && !m.mesh.rack,
+                 fixed2 = !second && !m.mesh.second.is_coordinate() && first;
+      if (fixed1 || fixed2) {
+        const Frame2* carrier = body(m.mesh.carrier, 2);
+        if (carrier && !m.mesh.belt)
+          (fixed1 ? first : second) = carrier, m.fixed = fixed1 ? 0 : 1;
+        else
+          m.unloaded = m.mesh.belt ? "one pulley is fixed" : "it meshes with a fixed gear and names no carrier body";
+      }
+      if (!first && !second) continue;  // (angle or travel coordinates of no body: no centres to push)
+      if (m.mesh.belt && m.unloaded.empty() && !m.mesh.strands_known())
+        m.unloaded = std::isnan(m.mesh.tension) ? "it states no tension" : "its teeth state no pitch";
+      if (!first || !second) {
+        if (m.unloaded.empty()) continue;  // (one member an angle coordinate of no body)
+        first = first ? first : second, second = second ? second : first;
+      }
       m.constraint = static_cast<Index>(c), m.first = *first, m.second = *second;
       out.meshes.push_back(m);
     }

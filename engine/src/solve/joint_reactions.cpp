@@ -210,13 +210,19 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
     dq(s.coord()) += v;
     if (qd) power += v * s.rate(qd), size += std::fabs(v * s.rate(qd));
   };
+  // a force on a member's centre; none on a fixed gear's (its frame is its carrier's: OutputMesh::fixed)
+  auto add_to = [&](const OutputMesh& m, int member, double fx, double fy) {
+    if (m.fixed == member) return;
+    const Frame2& b = member == 0 ? m.first : m.second;
+    add(b.x, fx), add(b.y, fy);
+  };
   // A belt's strands along u∓ = c e ∓ s n (n = ẑ × e, s = (r1 ∓ r2)/d open or crossed, c = √(1 − s²)) leave
   // pulley 1 on its +n and −n sides; their tensions T∓ turn it by r1 (T₋ − T₊) = −λ, the row's torque on it, and
   // pull its centre by T₊ u₊ + T₋ u₋, pulley 2's by the opposite.
   auto pull = [&](const OutputMesh& m, double lambda_m, double ex, double ey, double d) {
     const GearMesh& b = m.mesh;
     const double s = (b.crossed ? b.r1 + b.r2 : b.r1 - b.r2) / d;
-    if (!b.strands_known() || !(std::fabs(s) < 1.0)) return;  // (overlapping pulleys: no strands)
+    if (!(std::fabs(s) < 1.0)) return;  // (overlapping pulleys: no strands)
     const double c = std::sqrt(1.0 - s * s), nx = -ey, ny = ex;
     const double difference = -lambda_m / b.r1;  // T₋ − T₊
     double upper = b.tension - 0.5 * difference, lower = b.tension + 0.5 * difference;
@@ -226,16 +232,16 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
       found->slack.push_back(m.constraint);
     const double fx = upper * (c * ex - s * nx) + lower * (c * ex + s * nx);
     const double fy = upper * (c * ey - s * ny) + lower * (c * ey + s * ny);
-    add(m.first.x, fx), add(m.first.y, fy), add(m.second.x, -fx), add(m.second.y, -fy);
+    add_to(m, 0, fx, fy), add_to(m, 1, -fx, -fy);
   };
   auto push = [&](const OutputMesh& m) {
+    if (!m.unloaded.empty()) return;
     const double lambda_m = lambda(model.constraints()[static_cast<std::size_t>(m.constraint)].first_row);
     if (m.mesh.rack) {
-      // the rack pushed by −λ e at the pitch point P = c_p + k ẑ × e (its travel took −λ), the pinion by λ e there
-      // (its angle took −λ k, the moment of λ e about its centre): λ e on the pinion's centre, and the moment of
-      // −λ e about the rack's reference point on its angle
-      // The teeth part them by |λ| tan α across e, along n = ẑ × e: the rack by s n at P (s = sign(k) |λ| tan α, away
-      // from the pinion's centre), the pinion by −s n.
+      // the rack pushed by F = −λ e + s n at the pitch point P = c_p + k n (n = ẑ × e; its travel took −λ, and the
+      // teeth part them by s = sign(k) |λ| tan α, away from the pinion's centre), the pinion by −F there (its angle
+      // took −λ k, the moment of λ e about its centre): −F on the pinion's centre, s n on the rack across its travel,
+      // and the moment of F about the rack's reference point on its angle
       const double ex = m.rack_axis == 0 ? 1.0 : 0.0, ey = 1.0 - ex, nx = -ey, ny = ex;
       const double px = m.second.x.of(q) - m.mesh.k * ey, py = m.second.y.of(q) + m.mesh.k * ex;
       const double apart = std::copysign(std::fabs(lambda_m) * std::tan(m.mesh.pressure_angle), m.mesh.k);
@@ -254,8 +260,8 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
     // pitch point (−e external; +e internal, k < 0, where it meshes on the side away from the ring's centre)
     const double apart = std::copysign(std::fabs(f) * std::tan(m.mesh.pressure_angle), -m.mesh.k);
     const double ex = dx / d, ey = dy / d, tx = -ey, ty = ex;
-    add(m.first.x, f * tx + apart * ex), add(m.first.y, f * ty + apart * ey);
-    add(m.second.x, -f * tx - apart * ex), add(m.second.y, -f * ty - apart * ey);
+    add_to(m, 0, f * tx + apart * ex, f * ty + apart * ey);
+    add_to(m, 1, -f * tx - apart * ex, -f * ty - apart * ey);
     add(m.mesh.carrier, f * d);
   };
   for (const OutputMesh& m : meshes) {

@@ -162,12 +162,10 @@ void Sweeper::note_meshes(const std::vector<Index>& working) {
                             "loads are not its teeth's"});
   }
   for (const OutputMesh& m : opt_.efforts.meshes)
-    if (m.mesh.belt && !m.mesh.strands_known())
-      sum_.warnings.push_back(
-          {t, "belt_pull",
-           "the bearings of " + name(m.constraint) + "'s pulleys carry none of its strands' pull: " +
-               (std::isnan(m.mesh.tension) ? "it states no tension"
-                                           : "its teeth state no pitch, so its radii are not known")});
+    if (!m.unloaded.empty())
+      sum_.warnings.push_back({t, "unloaded_bearings",
+                               "the bearings of " + name(m.constraint) + " carry none of its " +
+                                   (m.mesh.belt ? "strands' pull: " : "teeth's push: ") + m.unloaded});
 }
 
 bool Sweeper::same_sweep(const Sweeper* like) const { return like && &like->model_ == &model_ && &like->opt_ == &opt_; }
