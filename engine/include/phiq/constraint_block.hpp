@@ -128,6 +128,8 @@ class ConstraintBlock {
   virtual bool reaction_site(std::size_t /*i*/, const double* /*q*/, ReactionSite& /*out*/) const { return false; }
   /// Constraint i's GearMesh, when its kind is a gear pair or a rack and pinion (GearSpec::gear_mesh()); else false.
   virtual bool gear_mesh(std::size_t /*i*/, GearMesh& /*out*/) const { return false; }
+  /// Constraint i's SpatialMesh, when its kind is a spatial gear pair (SpatialGearSpec::spatial_mesh()); else false.
+  virtual bool spatial_mesh(std::size_t /*i*/, SpatialMesh& /*out*/) const { return false; }
   /// The coordinates constraint i adds (a kind with kAddedCoordinates: a curve's parameter) and the length each is
   /// measured in proportion to (PointOnCurveSpec::added_scale()): at most `capacity` of them into `coordinate` and
   /// `scale`, returning how many it adds (0 for the kinds that add none). For the sensitivities' co-motion
@@ -332,6 +334,13 @@ class TypedBlock final : public ConstraintBlock {
   bool gear_mesh(std::size_t i, GearMesh& out) const override {
     if constexpr (requires(const Spec& k) { k.gear_mesh(); }) {
       out = entries_[i].spec.gear_mesh();
+      return true;
+    }
+    return false;
+  }
+  bool spatial_mesh(std::size_t i, SpatialMesh& out) const override {
+    if constexpr (requires(const Spec& k) { k.spatial_mesh(); }) {
+      out = entries_[i].spec.spatial_mesh();
       return true;
     }
     return false;

@@ -258,6 +258,7 @@ class JointReactions {
 struct MeshFindings {
   std::vector<Index> working;  ///< meshes whose push does work along q̇: their centres are not where the row needs
   std::vector<Index> slack;    ///< belts whose slack strand would need a negative tension (T0 < |ΔT|/2): they slip
+  std::vector<Index> skew;     ///< spatial gear pairs whose axes do not cross (worms, crossed helical): no push
 };
 
 /// What turns the torques of each gear pair of `meshes` under multipliers `lambda` into the push of its teeth,

@@ -114,6 +114,21 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       out.reactions.push_back({c, w == 6});
     }
   }
+  if (!out.reactions.empty() && spatial_) {  // bevel gears on shafts: their bearings carry the teeth's push
+    for (std::size_t c = 0; c < model.constraints().size(); ++c) {
+      const auto [block, index] = model.constraint_block(static_cast<Index>(c));
+      SpatialMesh sm;
+      if (!block->spatial_mesh(index, sm) || !(detail::frame_moves(sm.b1.frame) || detail::frame_moves(sm.b2.frame)))
+        continue;
+      OutputMesh m;
+      m.constraint = static_cast<Index>(c), m.spatial = true;
+      if (sm.r1 == 0.0) m.unloaded = "its teeth do not place its pitch point (its radii, the mean pitch radii, do)";
+      if (sm.reversed) m.unloaded = "it is reversed, so which shaft's axis points away from its gear is not told";
+      if (sm.a1.natural || sm.b1.natural || sm.a2.natural || sm.b2.natural)
+        m.unloaded = "a shaft or housing is in natural coordinates";
+      out.meshes.push_back(m);
+    }
+  }
   if (!out.reactions.empty() && !spatial_) {  // gears and racks on bodies: their bearings carry the teeth's push
     // the planar bodies by the coordinates of their frames: (body, 0 x, 1 y, 2 ψ)
     std::unordered_map<Index, std::pair<const Frame2*, int>> frame_of;

@@ -24,6 +24,54 @@ PartFrame body_frame(const ReactionSite& s) {
   return f;
 }
 
+// A spatial gear pair's push on its shafts (add_gear_mesh_forces()), through `add(j, v)` on coordinate j: false when
+// its axes do not cross (a worm or crossed helical pair), when it adds nothing. Each joint's side a gives its axis
+// z_i (from the apex toward its gear) through its point; the apex O is where they cross; the pitch point
+// P = O + (r2 z1 + r1 z2)/sin Σ is at r1 from axis 1 and r2 from axis 2. The ratio row's λ turns the angles θ1, θ2
+// by −λ and −k λ; the teeth push shaft 1 at P by F = f n + |f| tan α m1 instead (n = z1 × z2 / sin Σ, f = −λ/r1,
+// so that its moment about axis 1 is −λ; m1 ⟂ OP in the axes' plane, toward axis 1, parts the gears) and shaft 2
+// by −F (whose moment about axis 2 is −k λ): F at P on shaft 1, −F on shaft 2, λ on θ1 and k λ on θ2.
+template <class Add>
+bool push_shafts(const SpatialMesh& g, double lambda, const double* q, PartJacobian& jac, Add&& add) {
+  auto frame_of = [](const JointSide3& side) {
+    PartFrame f;
+    f.kind = PartFrameKind::kSpatialBody, f.spatial = side.frame;
+    return f;
+  };
+  auto axis_of = [&](const JointSide3& side, V3& point, V3& axis) {
+    const Pose pose = part_pose(frame_of(side), q, 0.0);
+    point = pose.apply(side.at);
+    axis = pose.apply(side.axis) - pose.at;
+    axis = (1.0 / norm(axis)) * axis;
+  };
+  V3 a1, z1, a2, z2;
+  axis_of(g.a1, a1, z1), axis_of(g.a2, a2, z2);
+  const double cos_s = dot(z1, z2), sin_s = norm(cross(z1, z2));
+  if (!(sin_s > 1e-9)) return false;
+  const V3 w = a1 - a2;  // the closest points of the axes, a1 + s1 z1 and a2 + s2 z2
+  const double d = dot(z1, w), e = dot(z2, w), s1 = (cos_s * e - d) / (sin_s * sin_s),
+               s2 = (e - cos_s * d) / (sin_s * sin_s);
+  const V3 o1 = a1 + s1 * z1, o2 = a2 + s2 * z2;
+  if (!(norm(o1 - o2) <= 1e-6 * (g.r1 + g.r2))) return false;
+  const V3 apex = 0.5 * (o1 + o2), p = apex + (1.0 / sin_s) * (g.r2 * z1 + g.r1 * z2);
+  const V3 n = (1.0 / sin_s) * cross(z1, z2), u = (1.0 / norm(p - apex)) * (p - apex);
+  const V3 m1 = z1 - dot(z1, u) * u;
+  const double f = -lambda / g.r1;
+  const V3 force = f * n + (std::fabs(f) * std::tan(g.pressure_angle) / norm(m1)) * m1;
+  auto push = [&](const JointSide3& side, V3 on) {  // `on` at P
+    if (!detail::frame_moves(side.frame)) return;
+    const PartFrame frame = frame_of(side);
+    part_jacobian(frame, q, 0.0, jac);
+    const V3 arm = p - part_pose(frame, q, 0.0).at;
+    for (std::size_t k = 0; k < jac.coordinates.size(); ++k)
+      add(jac.coordinates[k], dot(on, jac.d_origin[k] + cross(jac.d_angle[k], arm)));
+  };
+  push(g.b1, force), push(g.b2, -force);
+  if (g.theta1.is_coordinate()) add(g.theta1.coord(), lambda);
+  if (g.theta2.is_coordinate()) add(g.theta2.coord(), g.k * lambda);
+  return true;
+}
+
 }  // namespace
 
 int reaction_width(const Model& model, Index c) {
@@ -205,11 +253,14 @@ void JointReactions::evaluate_site(const Site& s, const double* q, double t, con
 void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
                           const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd, MeshFindings* found) {
   double power = 0.0, size = 0.0;  // a mesh's push's power along q̇, and the size of its terms
-  auto add = [&](const Slot& s, double v) {
-    if (!s.is_coordinate()) return;
-    dq(s.coord()) += v;
-    if (qd) power += v * s.rate(qd), size += std::fabs(v * s.rate(qd));
+  auto add_at = [&](Index j, double v) {
+    dq(j) += v;
+    if (qd) power += v * qd[j], size += std::fabs(v * qd[j]);
   };
+  auto add = [&](const Slot& s, double v) {
+    if (s.is_coordinate()) add_at(s.coord(), v);
+  };
+  PartJacobian jac;  // (spatial pairs only)
   // a force on a member's centre; none on a fixed gear's (its frame is its carrier's: OutputMesh::fixed)
   auto add_to = [&](const OutputMesh& m, int member, double fx, double fy) {
     if (m.fixed == member) return;
@@ -236,7 +287,15 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
   };
   auto push = [&](const OutputMesh& m) {
     if (!m.unloaded.empty()) return;
-    const double lambda_m = lambda(model.constraints()[static_cast<std::size_t>(m.constraint)].first_row);
+    const Index row = model.constraints()[static_cast<std::size_t>(m.constraint)].first_row;
+    const double lambda_m = lambda(row);
+    if (m.spatial) {
+      const auto [block, index] = model.constraint_block(m.constraint);
+      SpatialMesh g;
+      block->spatial_mesh(index, g);
+      if (!push_shafts(g, lambda(row + 2), q, jac, add_at) && found) found->skew.push_back(m.constraint);
+      return;
+    }
     if (m.mesh.rack) {
       // the rack pushed by F = −λ e + s n at the pitch point P = c_p + k n (n = ẑ × e; its travel took −λ, and the
       // teeth part them by s = sign(k) |λ| tan α, away from the pinion's centre), the pinion by −F there (its angle

@@ -105,11 +105,11 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
   if (!opt_.efforts.meshes.empty()) {
     effort_work_.mesh_q.setZero(model_.num_coordinates());
     MeshFindings& found = effort_work_.mesh_findings;
-    found.working.clear(), found.slack.clear();
+    found.working.clear(), found.slack.clear(), found.skew.clear();
     add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q,
                          current_.qd.data(), &found);
-    if (note) note_meshes(found.working);  // checked at the sweep's first row, as the indeterminate joints are
-    if (!found.slack.empty())              // at every row (once_per_stretch() joins the rows that follow)
+    if (note) note_meshes(found);  // checked at the sweep's first row, as the indeterminate joints are
+    if (!found.slack.empty())      // at every row (once_per_stretch() joins the rows that follow)
       sum_.warnings.push_back(
           {t, "belt_slack",
            "'" + model_.constraints()[static_cast<std::size_t>(found.slack[0])].name +
@@ -145,7 +145,8 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
              " are statically indeterminate (redundant constraints): the minimum-norm ones are written"});
 }
 
-void Sweeper::note_meshes(const std::vector<Index>& working) {
+void Sweeper::note_meshes(const MeshFindings& found) {
+  const std::vector<Index>& working = found.working;
   const double t = current_.t;
   auto name = [&](Index c) { return "'" + model_.constraints()[static_cast<std::size_t>(c)].name + "'"; };
   if (!working.empty()) {  // the first one
@@ -166,6 +167,11 @@ void Sweeper::note_meshes(const std::vector<Index>& working) {
       sum_.warnings.push_back({t, "unloaded_bearings",
                                "the bearings of " + name(m.constraint) + " carry none of its " +
                                    (m.mesh.belt ? "strands' pull: " : "teeth's push: ") + m.unloaded});
+  for (Index c : found.skew)
+    sum_.warnings.push_back({t, "unloaded_bearings",
+                             "the bearings of " + name(c) +
+                                 " carry none of its teeth's push: its axes do not cross (a worm or crossed helical "
+                                 "pair, whose push its helix sets)"});
 }
 
 bool Sweeper::same_sweep(const Sweeper* like) const { return like && &like->model_ == &model_ && &like->opt_ == &opt_; }

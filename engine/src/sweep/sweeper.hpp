@@ -361,7 +361,7 @@ class Sweeper {
   void row_reactions(SparseLuNumeric& lu);
   // The warnings about the meshes at the first row: the first of `working` (gear_centres), the meshes whose bearings
   // carry none of their push (unloaded_bearings).
-  void note_meshes(const std::vector<Index>& working);
+  void note_meshes(const MeshFindings& found);
   // The factors of Φq at the current row: the workspace's when the row's velocity solve has just used them, else
   // those of row_factors_.own, factorised at the row; null where Φq is singular or cannot be factorised.
   Workspace* row_factors();

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include "phiq/spatial_attachment.hpp"
 #include "phiq/types.hpp"
@@ -55,6 +56,12 @@ struct GearMesh {
 
 /// @cond internal
 namespace detail {
+/// The teeth's pressure angle α (rad) of a gear or rack: 20°, ISO 53's, unless the scene says (0 for friction wheels).
+constexpr double kPressureAngle = 20.0 * std::numbers::pi / 180.0;
+/// Whether α is one: finite, in [0, π/2).
+constexpr bool is_pressure_angle(double alpha) {
+  return alpha >= 0.0 && alpha < std::numbers::pi / 2;  // (false for NaN)
+}
 /// Whether a planar frame moves (reads a coordinate): a joint reports on its first side that does.
 inline bool frame_moves(const Frame2& f) { return f.x.is_coordinate() || f.y.is_coordinate() || f.psi.is_coordinate(); }
 /// The same for a spatial frame.

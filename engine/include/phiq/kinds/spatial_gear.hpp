@@ -13,6 +13,18 @@
 
 namespace phiq {
 
+/// A spatial gear pair as its teeth push its shafts (SpatialGearSpec::spatial_mesh(), add_gear_mesh_forces()): its
+/// ratio row θ1 + k θ2 − φ turns the shafts' angles by torques; the teeth push at the pitch point P, on both pitch
+/// cones, at r1 from axis 1 and r2 from axis 2 in the plane of the axes, which loads the shafts' bearings as well.
+struct SpatialMesh {
+  JointSide3 a1, b1, a2, b2;    ///< the housings and the shafts (SpatialGearSpec's)
+  Slot theta1, theta2;          ///< the shafts' angles, which the ratio row relates
+  double k = 1.0;               ///< the ratio row's coefficient of θ2
+  double r1 = 0.0, r2 = 0.0;    ///< the mean pitch radii (m); 0 for tooth counts, which do not place P
+  double pressure_angle = 0.0;  ///< α (rad): the teeth part the gears by tan α of their push
+  bool reversed = false;        ///< the relation z1 θ1 − z2 θ2: an axis away from its gear (P not placed)
+};
+
 /// Spatial gear pair. Each shaft turns in a joint (revolute, cylindrical or screw) whose side a is the housing —
 /// ground, or a carrier that moves — and side b the shaft; θ_i, an angle coordinate, is the shaft's turn in it (x_b
 /// about z_a from x_a, as `rotation_angle` measures it). The gears roll on each other: in the housing the relative
@@ -29,25 +41,28 @@ namespace phiq {
 /// because a ratio holds between turns, not orientations: 2.5 turns of one gear and half a turn of the other leave
 /// the same orientations. Parallel shafts are refused (their gears are a `gear` between two rotation angles), and
 /// so is one joint for both. Scene type `spatial_gear`: `shafts: [J1, J2]` (named joints above it),
-/// `angles: [θ1, θ2]` (coordinates), `teeth: [z1, z2]` or `radii: [r1, r2]`, `reversed` (false), `phase: φ` (0).
+/// `angles: [θ1, θ2]` (coordinates), `teeth: [z1, z2]` or `radii: [r1, r2]` (the mean pitch radii, for the
+/// bearings' loads: spatial_mesh()), `reversed` (false), `phase: φ` (0), `pressure_angle: α` (rad, 20°).
 struct SpatialGearSpec {
   /// @copydoc DistanceSpec::operator==
   bool operator==(const SpatialGearSpec&) const = default;
   static constexpr int kRows = 3;  ///< the two shafts' angles and the ratio
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "spatial_gear";
-  JointSide3 a1;                      ///< shaft 1's joint, side a: the housing (its z is the axis)
-  JointSide3 b1;                      ///< shaft 1's joint, side b: the shaft
-  JointSide3 a2;                      ///< shaft 2's joint, side a
-  JointSide3 b2;                      ///< shaft 2's joint, side b
-  Slot theta1;                        ///< θ1 (rad): a coordinate
-  Slot theta2;                        ///< θ2 (rad): a coordinate
-  double z1 = 1.0;                    ///< gear 1's tooth count (or pitch radius), > 0
-  double z2 = 1.0;                    ///< gear 2's tooth count (or pitch radius), > 0
-  bool reversed = false;              ///< the relation z1 θ1 − z2 θ2 = z1 φ
-  double phase = 0.0;                 ///< φ (rad)
-  std::array<Attachment3, 4> att1{};  ///< derived by setup(): x_a, y_a, z_a, x_b of shaft 1's joint
-  std::array<Attachment3, 4> att2{};  ///< the same of shaft 2's joint
+  JointSide3 a1;                                   ///< shaft 1's joint, side a: the housing (its z is the axis)
+  JointSide3 b1;                                   ///< shaft 1's joint, side b: the shaft
+  JointSide3 a2;                                   ///< shaft 2's joint, side a
+  JointSide3 b2;                                   ///< shaft 2's joint, side b
+  Slot theta1;                                     ///< θ1 (rad): a coordinate
+  Slot theta2;                                     ///< θ2 (rad): a coordinate
+  double z1 = 1.0;                                 ///< gear 1's tooth count (or pitch radius), > 0
+  double z2 = 1.0;                                 ///< gear 2's tooth count (or pitch radius), > 0
+  bool reversed = false;                           ///< the relation z1 θ1 − z2 θ2 = z1 φ
+  double phase = 0.0;                              ///< φ (rad)
+  bool teeth = false;                              ///< z1 and z2 are tooth counts, not radii
+  double pressure_angle = detail::kPressureAngle;  ///< α (rad): its bearings' loads only (SpatialMesh)
+  std::array<Attachment3, 4> att1{};               ///< derived by setup(): x_a, y_a, z_a, x_b of shaft 1's joint
+  std::array<Attachment3, 4> att2{};               ///< the same of shaft 2's joint
 
   /// Validates the joints and derives the attachments. Throws phiq::Error.
   void setup() {
@@ -55,6 +70,7 @@ struct SpatialGearSpec {
     detail::require(std::isfinite(z1) && std::isfinite(z2) && z1 > 0.0 && z2 > 0.0,
                     "spatial_gear: the tooth counts (or radii) must be positive");
     detail::require(std::isfinite(phase), "spatial_gear: phase is not finite");
+    detail::require(detail::is_pressure_angle(pressure_angle), "spatial_gear: pressure_angle must be in [0, pi/2) rad");
     detail::require(theta1.is_coordinate() && theta2.is_coordinate() && theta1.coord() != theta2.coord(),
                     "spatial_gear: the angles must be two different coordinates");
     const auto j1 = detail3::joint_attachments(a1, b1, kIndex, 4, kKind);
@@ -141,7 +157,7 @@ struct SpatialGearSpec {
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static SpatialGearSpec read(const Fields& f) {
-    f.expect({"type", "name", "shafts", "angles", "teeth", "radii", "reversed", "phase"});
+    f.expect({"type", "name", "shafts", "angles", "teeth", "radii", "reversed", "phase", "pressure_angle"});
     SpatialGearSpec g;
     const auto [j1, j2] = f.turning_joints("shafts");
     std::tie(g.a1, g.b1) = j1;
@@ -149,9 +165,17 @@ struct SpatialGearSpec {
     const auto [i, j] = f.coordinate_pair("angles");
     g.theta1 = Slot::coordinate(i), g.theta2 = Slot::coordinate(j);
     std::tie(g.z1, g.z2) = f.radii_or_teeth();
+    g.teeth = f.present("teeth");
     if (f.present("reversed")) g.reversed = f.boolean("reversed");
     if (f.present("phase")) g.phase = f.number("phase");
+    if (f.present("pressure_angle")) g.pressure_angle = f.number("pressure_angle");
     return g;
+  }
+  /// The mesh as a push on the shafts' bearings (SpatialMesh).
+  SpatialMesh spatial_mesh() const {
+    SpatialMesh m{a1,      b1, a2, b2, theta1, theta2, ratio(), teeth ? 0.0 : z1, teeth ? 0.0 : z2, pressure_angle,
+                  reversed};
+    return m;
   }
 
  private:

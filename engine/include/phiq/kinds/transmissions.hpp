@@ -39,11 +39,6 @@ struct LinearRow {
     s(0, slot[0], w[0]), s(0, slot[1], w[1]), s(0, slot[2], w[2]);
   }
 };
-// The teeth's pressure angle α (rad) of a gear or rack: 20°, ISO 53's, unless the scene says (0 for friction wheels).
-constexpr double kPressureAngle = 20.0 * std::numbers::pi / 180.0;
-inline void require_pressure_angle(double alpha, const char* message) {
-  require(std::isfinite(alpha) && alpha >= 0.0 && alpha < std::numbers::pi / 2, message);
-}
 // Radii (or tooth counts) of a pair: positive and finite, else "KIND: WHAT must be positive".
 inline void require_positive_pair(double r1, double r2, const char* message) {
   require(std::isfinite(r1) && std::isfinite(r2) && r1 > 0.0 && r2 > 0.0, message);
@@ -139,7 +134,7 @@ struct GearSpec : LinearTransmission<GearSpec> {
   void prepare(const double* /*q0*/) const {
     detail::require_positive_pair(r1, r2, "gear: the radii (or tooth counts) must be positive");
     detail::require(std::isfinite(phase), "gear: phase is not finite");
-    detail::require_pressure_angle(pressure_angle, "gear: pressure_angle must be in [0, pi/2) rad");
+    detail::require(detail::is_pressure_angle(pressure_angle), "gear: pressure_angle must be in [0, pi/2) rad");
     detail::require(!internal || r2 > r1,
                     "gear: an internal pair's second gear is the ring: its radius must exceed the first's");
     detail::require(!(first.is_coordinate() && second.is_coordinate() && first.coord() == second.coord()),
@@ -233,7 +228,7 @@ struct RackPinionSpec : LinearTransmission<RackPinionSpec> {
   void prepare(const double* /*q0*/) const {
     detail::require(std::isfinite(radius) && radius > 0.0, "rack_pinion: the radius must be positive");
     detail::require(std::isfinite(offset), "rack_pinion: offset is not finite");
-    detail::require_pressure_angle(pressure_angle, "rack_pinion: pressure_angle must be in [0, pi/2) rad");
+    detail::require(detail::is_pressure_angle(pressure_angle), "rack_pinion: pressure_angle must be in [0, pi/2) rad");
     detail::require(!(rack.is_coordinate() && pinion.is_coordinate() && rack.coord() == pinion.coord()),
                     "rack_pinion: the rack's travel and the pinion's angle must be different coordinates");
   }

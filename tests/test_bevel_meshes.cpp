@@ -1,0 +1,105 @@
+// Bevel gears in joint reactions (add_gear_mesh_forces(), phiq/joint_reactions.hpp): a spatial gear's rows turn
+// its shafts by torques about their axes, yet their bearings carry the push of its teeth at the pitch point. Checked
+// by Newton–Euler written in the test, with the pitch point and the textbook split of a bevel pinion's load
+// (tangential W, radial W tan α cos δ1 toward its axis, axial W tan α sin δ1 away from the apex). Worms (axes that do
+// not cross) and tooth counts (which place no pitch point) are told.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "phiq/phiq.hpp"
+#include "reaction_rows.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+using test::ReactionRows;
+using Vec3 = Eigen::Vector3d;
+
+// models/transmissions/bevel_gears.yaml (the input about x, the output about y, the apex at the origin) with `mesh`
+// for its gear's entry, a heavy output shaft (a disc about y) and a massless input, no gravity, every reaction.
+Scene bevel_pair(const std::string& mesh) {
+  std::string text = test::model_file_text("transmissions/bevel_gears.yaml", "output:");
+  text = test::replace_first(
+      text,
+      "{name: bevel, type: spatial_gear, shafts: [input_bearing, output_bearing], angles: [theta1, theta2], "
+      "teeth: [15, 30]}",
+      mesh);
+  return parse_scene(text +
+                         "parts:\n  output_shaft: {mass: 2, center_of_mass: [0, 0, 0], inertia: [0.01, 0.02, 0.01]}\n"
+                         "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n",
+                     "bevel.yaml");
+}
+
+// Mean pitch radii 0.03 (input) and 0.06: the teeth push at P = (0.06, 0.03, 0), at 0.03 from the x axis and 0.06
+// from the y axis. The output shaft turns by their moment alone, I ψ̈2 = y · (P × (−F)), which sets W; the bearing
+// holds −(−F) and the moment Euler asks for about its point, the origin; the input's bearing holds the opposite
+// push, and the motor turns the massless input against the push's moment about x.
+TEST(BevelMeshes, ABevelPairsBearingsCarryItsTeethsPushByNewtonEuler) {
+  SweepSummary sum;
+  const Scene s = bevel_pair(
+      "{name: bevel, type: spatial_gear, shafts: [input_bearing, output_bearing], angles: [theta1, theta2], "
+      "radii: [0.03, 0.06]}");
+  ASSERT_EQ(s.sweep.efforts.meshes.size(), 1u);
+  const ReactionRows r = test::sweep_reactions(s, &sum);
+  EXPECT_TRUE(sum.warnings.empty()) << sum.warnings[0].kind << ": " << sum.warnings[0].message;
+  const Index theta2 = s.model->find_coordinate("theta2");
+  const double r1 = 0.03, r2 = 0.06, i2 = 0.02, tan_a = std::tan(20 * M_PI / 180), delta1 = std::atan2(r1, r2);
+  const Vec3 p(r2, r1, 0), x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < r.values.size(); ++k) {
+    const std::vector<double>& v = r.values[k];  // τ, power, input_bearing's Fx…Mz, output_bearing's
+    ASSERT_EQ(v.size(), 14u);
+    const double w = i2 * r.qdd[k](theta2) / r2;  // along z on the input's teeth
+    const Vec3 f = w * z + std::fabs(w) * tan_a * (std::sin(delta1) * x - std::cos(delta1) * y);
+    EXPECT_NEAR(y.dot(p.cross(-f)), i2 * r.qdd[k](theta2), 1e-12);  // (the output's Euler equation about y)
+    const double motor = -x.dot(p.cross(f));
+    const Vec3 in_force = -f, in_moment = -p.cross(f) - motor * x;
+    const Vec3 out_force = f, out_moment = i2 * r.qdd[k](theta2) * y + p.cross(f);
+    const double scale = 1.0 + std::fabs(w);
+    EXPECT_NEAR(v[0], motor, 1e-11 * scale) << k;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(v[static_cast<std::size_t>(2 + c)], in_force(c), 1e-10 * scale) << k << " " << c;
+      EXPECT_NEAR(v[static_cast<std::size_t>(5 + c)], in_moment(c), 1e-10 * scale) << k << " " << c;
+      EXPECT_NEAR(v[static_cast<std::size_t>(8 + c)], out_force(c), 1e-10 * scale) << k << " " << c;
+      EXPECT_NEAR(v[static_cast<std::size_t>(11 + c)], out_moment(c), 1e-10 * scale) << k << " " << c;
+    }
+    largest = std::max(largest, std::fabs(w));
+  }
+  EXPECT_GT(largest, 0.1);
+}
+
+// Tooth counts place no pitch point, a reversed pair does not say which axis points away from its gear, and a
+// worm's axes do not cross: each is told at the first row, its bearings carrying only the shafts' torques.
+TEST(BevelMeshes, PushesThatCannotBePlacedAreTold) {
+  const std::string head =
+      "{name: bevel, type: spatial_gear, shafts: [input_bearing, output_bearing], angles: [theta1, theta2], ";
+  for (const auto& [tail, words] : std::vector<std::pair<std::string, std::string>>{
+           {"teeth: [15, 30]}", "its teeth do not place"}, {"radii: [0.03, 0.06], reversed: true}", "reversed"}}) {
+    SweepSummary sum;
+    const Scene s = bevel_pair(head + tail);
+    test::sweep_reactions(s, &sum);
+    ASSERT_EQ(sum.warnings.size(), 1u) << tail;
+    EXPECT_EQ(sum.warnings[0].kind, "unloaded_bearings");
+    EXPECT_HAS(sum.warnings[0].message, words);
+  }
+  // the output's bearing 0.05 above the apex along z: the axes no longer cross (a worm's)
+  std::string text = test::model_file_text("transmissions/bevel_gears.yaml", "output:");
+  text =
+      test::replace_first(text, "{body: ground, axis: [0, 1, 0]}", "{body: ground, at: [0, 0, 0.05], axis: [0, 1, 0]}");
+  text = test::replace_first(text, "s2_z: 0", "s2_z: 0.05");
+  text = test::replace_first(text, "teeth: [15, 30]", "radii: [0.03, 0.06]");
+  SweepSummary sum;
+  test::sweep_reactions(parse_scene(text + "parts:\n  output_shaft: {mass: 2, center_of_mass: [0, 0, 0], inertia: "
+                                           "[0.01, 0.02, 0.01]}\noutput: {velocities: true, accelerations: true, "
+                                           "efforts: all, reactions: all}\n",
+                                    "worm.yaml"),
+                        &sum);
+  ASSERT_EQ(sum.warnings.size(), 1u);
+  EXPECT_EQ(sum.warnings[0].kind, "unloaded_bearings");
+  EXPECT_HAS(sum.warnings[0].message, "do not cross");
+}
+
+}  // namespace
+}  // namespace phiq
