@@ -70,8 +70,9 @@ TEST(BevelMeshes, ABevelPairsBearingsCarryItsTeethsPushByNewtonEuler) {
   EXPECT_GT(largest, 0.1);
 }
 
-// Tooth counts place no pitch point, a reversed pair does not say which axis points away from its gear, and a
-// worm's axes do not cross: each is told at the first row, its bearings carrying only the shafts' torques.
+// Tooth counts place no pitch point, a reversed pair does not say which axis points away from its gear, a worm's
+// axes do not cross, and a `gear` between rotation angles does not know its shafts: each is told at the first row,
+// its bearings carrying only the shafts' torques.
 TEST(BevelMeshes, PushesThatCannotBePlacedAreTold) {
   const std::string head =
       "{name: bevel, type: spatial_gear, shafts: [input_bearing, output_bearing], angles: [theta1, theta2], ";
@@ -99,6 +100,16 @@ TEST(BevelMeshes, PushesThatCannotBePlacedAreTold) {
   ASSERT_EQ(sum.warnings.size(), 1u);
   EXPECT_EQ(sum.warnings[0].kind, "unloaded_bearings");
   EXPECT_HAS(sum.warnings[0].message, "do not cross");
+  // a `gear` between the shafts' rotation angles relates coordinates whose shafts it does not know
+  SweepSummary angles;
+  test::sweep_reactions(bevel_pair("{name: turn1, type: rotation_angle, joint: input_bearing, angle: theta1}\n"
+                                   "  - {name: turn2, type: rotation_angle, joint: output_bearing, angle: theta2}\n"
+                                   "  - {name: pair, type: gear, between: [theta1, theta2], radii: [0.03, 0.06]}"),
+                        &angles);
+  ASSERT_EQ(angles.warnings.size(), 1u);
+  EXPECT_EQ(angles.warnings[0].kind, "unloaded_bearings");
+  EXPECT_HAS(angles.warnings[0].message, "'pair'");
+  EXPECT_HAS(angles.warnings[0].message, "whose shafts it does not know");
 }
 
 }  // namespace

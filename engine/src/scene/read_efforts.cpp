@@ -117,6 +117,13 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   if (!out.reactions.empty() && spatial_) {  // bevel gears on shafts: their bearings carry the teeth's push
     for (std::size_t c = 0; c < model.constraints().size(); ++c) {
       const auto [block, index] = model.constraint_block(static_cast<Index>(c));
+      if (GearMesh g; block->gear_mesh(index, g)) {  // (between rotation angles: the shafts are not known)
+        OutputMesh m;
+        m.constraint = static_cast<Index>(c), m.mesh = g;
+        m.unloaded = "in dimension 3 it relates angle or travel coordinates, whose shafts it does not know";
+        out.meshes.push_back(m);
+        continue;
+      }
       SpatialMesh sm;
       if (!block->spatial_mesh(index, sm) || !(detail::frame_moves(sm.b1.frame) || detail::frame_moves(sm.b2.frame)))
         continue;
@@ -162,14 +169,14 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
         else
           m.unloaded = m.mesh.belt ? "one pulley is fixed" : "it meshes with a fixed gear and names no carrier body";
       }
-      if (!first && !second) continue;  // (angle or travel coordinates of no body: no centres to push)
+      if (!m.mesh.first.is_coordinate() && !m.mesh.second.is_coordinate()) continue;  // (nothing turns)
       if (m.mesh.belt && m.unloaded.empty() && !m.mesh.strands_known())
         m.unloaded = std::isnan(m.mesh.tension) ? "it states no tension" : "its teeth state no pitch";
-      if (!first || !second) {
-        if (m.unloaded.empty()) continue;  // (one member an angle coordinate of no body)
-        first = first ? first : second, second = second ? second : first;
-      }
-      m.constraint = static_cast<Index>(c), m.first = *first, m.second = *second;
+      if ((!first || !second) && m.unloaded.empty())
+        m.unloaded = "it relates angle or travel coordinates, not bodies', so it has no centres to push";
+      m.constraint = static_cast<Index>(c);
+      if (first) m.first = *first;
+      if (second) m.second = *second;
       out.meshes.push_back(m);
     }
   }
