@@ -102,6 +102,20 @@ TEST(GearMeshes, APlanetarysGearsMoveByNewtonEulerWithTheirTeethsPush) {
   EXPECT_EQ(told.warnings[0].kind, "gear_centres");
   EXPECT_EQ(told.warnings[0].t, 0.0);
   EXPECT_NE(told.warnings[0].message.find("'sun_planet'"), std::string::npos) << told.warnings[0].message;
+  EXPECT_HAS(told.warnings[0].message, "the same at the next");  // every row, said once
+  // started from rest, the mesh does no work at the first row: told at the second
+  const Scene from_rest = with_reactions(
+      test::replace_first(
+          test::replace_first(test::replace_first(planetary, "teeth: [24, 18], carrier: carrier}", "teeth: [24, 18]}"),
+                              "law: {type: linear, initial: 0, rate: 1}",
+                              "law: {type: polynomial, coefficients: [0, 0, 1]}"),
+          "law: {type: linear, initial: 0, rate: -0.2}", "law: {type: polynomial, coefficients: [0, 0, -0.2]}"),
+      parts, true);
+  SweepSummary later;
+  sweep_meshes(from_rest, 2, &later);
+  ASSERT_EQ(later.warnings.size(), 1u);
+  EXPECT_EQ(later.warnings[0].kind, "gear_centres");
+  EXPECT_GT(later.warnings[0].t, 0.0);
   const Model& m = *s.model;
   const Index xp = m.find_coordinate("xp"), yp = m.find_coordinate("yp"), psip = m.find_coordinate("psip");
   // columns: τs, τr, two powers, then sun_bearing, carrier_bearing, ring_bearing, planet_pin (Fx, Fy, Mz each)

@@ -142,11 +142,11 @@ struct SweepWarning {
   /// first row); "indeterminate": written joint reactions (OutputEfforts::reactions) that redundant constraints
   /// leave undetermined, named at the first row (their minimum-norm values are written), and gear meshes whose
   /// share of the load they leave undetermined; "gear_centres": a gear's teeth (a belt's strands) push its bodies in
-  /// a way its row does not hold (add_gear_mesh_forces(): their push does work in the motion at the first row), so
-  /// its bearings' written loads are not its teeth's; "unloaded_bearings": a gear or belt between bodies whose push
-  /// its written bearing loads lack (OutputMesh::unloaded: a belt without tension, teeth without a pitch, a fixed gear
-  /// without a carrier; at the first row);
-  /// "belt_slack": a belt's slack strand would need a negative tension at this row (once per stretch of rows)
+  /// a way its row does not hold (add_gear_mesh_forces(): their push does work in the motion; once per stretch of
+  /// rows), so its bearings' written loads are not its teeth's; "unloaded_bearings": a gear or belt between bodies
+  /// whose push its written bearing loads lack (OutputMesh::unloaded: a belt without tension, teeth without a pitch, a
+  /// fixed gear without a carrier; at the first row); "belt_slack": a belt's slack strand would need a negative tension
+  /// at this row (once per stretch of rows)
   std::string kind;
 
   std::string message;  ///< one line

@@ -108,13 +108,7 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
     found.working.clear(), found.slack.clear(), found.skew.clear();
     add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q,
                          current_.qd.data(), &found);
-    if (note) note_meshes(found);  // checked at the sweep's first row, as the indeterminate joints are
-    if (!found.slack.empty())      // at every row (once_per_stretch() joins the rows that follow)
-      sum_.warnings.push_back(
-          {t, "belt_slack",
-           "'" + model_.constraints()[static_cast<std::size_t>(found.slack[0])].name +
-               "' goes slack: its torque needs its strands' tensions to differ by more than twice its tension, so it "
-               "would slip (its bearings' loads are written with its slack strand pushing)"});
+    warn_meshes(found, note);
     if (!multipliers_with_factors(model_, lu, effort_work_.mesh_q, effort_work_.kept, effort_work_.mesh_lambda))
       return not_defined();
     ++ws_->counters.effort_solves;
@@ -145,23 +139,32 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
              " are statically indeterminate (redundant constraints): the minimum-norm ones are written"});
 }
 
-void Sweeper::note_meshes(const MeshFindings& found) {
-  const std::vector<Index>& working = found.working;
+void Sweeper::warn_meshes(const MeshFindings& found, bool first_row) {
   const double t = current_.t;
   auto name = [&](Index c) { return "'" + model_.constraints()[static_cast<std::size_t>(c)].name + "'"; };
-  if (!working.empty()) {  // the first one
+  // at every row (once_per_stretch() joins the rows that follow): a mesh at rest does no work, so a gear wrongly
+  // carried shows only once it turns
+  if (!found.working.empty()) {  // the first one
+    const Index c = found.working[0];
     const auto m = std::find_if(opt_.efforts.meshes.begin(), opt_.efforts.meshes.end(),
-                                [&](const OutputMesh& o) { return o.constraint == working[0]; });
+                                [&](const OutputMesh& o) { return o.constraint == c; });
     sum_.warnings.push_back(
         {t, "gear_centres",
-         m->mesh.belt ? "the strands of " + name(working[0]) +
+         m->mesh.belt ? "the strands of " + name(c) +
                             " do work in the motion: its bodies' reference points are not pulley centres held at "
                             "their distance, so its bearings' loads are not its strands'"
-                      : "the teeth of " + name(working[0]) +
+                      : "the teeth of " + name(c) +
                             " do work in the motion: its bodies' reference points are not gear centres that its "
                             "carrier holds (a gear on a moving arm names the arm as its carrier), so its bearings' "
                             "loads are not its teeth's"});
   }
+  if (!found.slack.empty())
+    sum_.warnings.push_back({t, "belt_slack",
+                             name(found.slack[0]) +
+                                 " goes slack: its torque needs its strands' tensions to differ by more than twice its "
+                                 "tension, so it would slip (its bearings' loads are written with its slack strand "
+                                 "pushing)"});
+  if (!first_row) return;  // the rest is told at the sweep's first row, as the indeterminate joints are
   for (const OutputMesh& m : opt_.efforts.meshes)
     if (!m.unloaded.empty())
       sum_.warnings.push_back({t, "unloaded_bearings",

@@ -84,6 +84,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   auto done = [&](SolveStatus st) {
     detail::once_per_stretch(sum.warnings, "slow_convergence", opt);
     detail::once_per_stretch(sum.warnings, "belt_slack", opt);
+    detail::once_per_stretch(sum.warnings, "gear_centres", opt);
     sum.status = st;
     sum.counters = others;
     add_counters(sum.counters, ws.counters, before);

@@ -359,9 +359,9 @@ class Sweeper {
   // The reactions of the row (after the efforts) from effort_work_.lambda: minimum-norm multipliers first where rows
   // were dropped, and at the sweep's first row a warning naming the joints whose share that makes up.
   void row_reactions(SparseLuNumeric& lu);
-  // The warnings about the meshes at the first row: the first of `working` (gear_centres), the meshes whose bearings
-  // carry none of their push (unloaded_bearings).
-  void note_meshes(const MeshFindings& found);
+  // The warnings about the meshes: at every row, the first of found.working (gear_centres) and of found.slack
+  // (belt_slack); at the first row, the meshes whose bearings carry none of their push (unloaded_bearings).
+  void warn_meshes(const MeshFindings& found, bool first_row);
   // The factors of Φq at the current row: the workspace's when the row's velocity solve has just used them, else
   // those of row_factors_.own, factorised at the row; null where Φq is singular or cannot be factorised.
   Workspace* row_factors();
