@@ -17,10 +17,15 @@ namespace phiq {
 /// ratio row θ1 + k θ2 − φ turns the shafts' angles by torques; the teeth push at the pitch point P, on both pitch
 /// cones, at r1 from axis 1 and r2 from axis 2 in the plane of the axes, which loads the shafts' bearings as well.
 struct SpatialMesh {
-  JointSide3 a1, b1, a2, b2;    ///< the housings and the shafts (SpatialGearSpec's)
-  Slot theta1, theta2;          ///< the shafts' angles, which the ratio row relates
+  JointSide3 a1;                ///< shaft 1's housing (its joint's side a: z its axis)
+  JointSide3 b1;                ///< shaft 1 (its joint's side b)
+  JointSide3 a2;                ///< shaft 2's housing
+  JointSide3 b2;                ///< shaft 2
+  Slot theta1;                  ///< shaft 1's angle, which the ratio row relates
+  Slot theta2;                  ///< shaft 2's angle
   double k = 1.0;               ///< the ratio row's coefficient of θ2
-  double r1 = 0.0, r2 = 0.0;    ///< the mean pitch radii (m); 0 for tooth counts, which do not place P
+  double r1 = 0.0;              ///< gear 1's mean pitch radius (m); 0 for tooth counts, which do not place P
+  double r2 = 0.0;              ///< gear 2's (m)
   double pressure_angle = 0.0;  ///< α (rad): the teeth part the gears by tan α of their push
   bool reversed = false;        ///< the relation z1 θ1 − z2 θ2: an axis away from its gear (P not placed)
 };
