@@ -275,7 +275,9 @@ struct MeshFindings {
 /// |λ| tan α on the pinion's centre, the parting on the rack across its travel and the moment of its push about its
 /// reference point on its angle. A belt or chain whose strands
 /// are known (GearMesh::strands_known()) pulls its pulleys' centres by its two strands' tensions along them, which
-/// its torque −λ on pulley 1 splits (GearMesh); without them, or with overlapping pulleys, it adds nothing.
+/// its torque −λ on pulley 1 splits (GearMesh); without them, or with overlapping pulleys, it adds nothing. A bevel
+/// pair (OutputMesh::spatial) pushes its shafts at its pitch point (SpatialMesh), or adds nothing when its axes do
+/// not cross (appended to `found->skew`). A mesh with OutputMesh::unloaded adds nothing.
 /// With the row's velocities `qd`, appends to `found->working` (when not null) the meshes whose push does work along
 /// q̇ (beyond 10⁻⁶ of its terms): their bodies' reference points are not centres that keep their places on the
 /// carrier, so the row does not describe their teeth (a gear on a moving arm whose carrier is not named); and to
