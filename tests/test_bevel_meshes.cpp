@@ -112,5 +112,59 @@ TEST(BevelMeshes, PushesThatCannotBePlacedAreTold) {
   EXPECT_HAS(angles.warnings[0].message, "whose shafts it does not know");
 }
 
+// A bevel pair in a turning housing (a carrier spun about z, the shafts' bearings on it, both driven): the pitch
+// point and the push move with the housing, and the push does no work in the motion (the pitch points roll on each
+// other), which the sweep checks at every row: no gear_centres; and the output shaft's bearing carries the push.
+TEST(BevelMeshes, APairInATurningHousingPushesWithoutWork) {
+  const std::string text =
+      "phiq: 1\nname: turning\ndimension: 3\n"
+      "coordinates: {c_x: 0, c_y: 0, c_z: 0, c_e0: 1, c_e1: 0, c_e2: 0, c_e3: 0, s1_x: 0, s1_y: 0, s1_z: 0, s1_e0: 1,"
+      " s1_e1: 0, s1_e2: 0, s1_e3: 0, s2_x: 0, s2_y: 0, s2_z: 0, s2_e0: 1, s2_e1: 0, s2_e2: 0, s2_e3: 0, theta1: 0,"
+      " theta2: 0}\n"
+      "bodies:\n  carrier: [c_x, c_y, c_z, c_e0, c_e1, c_e2, c_e3]\n"
+      "  input_shaft: [s1_x, s1_y, s1_z, s1_e0, s1_e1, s1_e2, s1_e3]\n"
+      "  output_shaft: [s2_x, s2_y, s2_z, s2_e0, s2_e1, s2_e2, s2_e3]\nconstraints:\n"
+      "  - {name: carrier_bearing, type: revolute, between: [{body: ground}, {body: carrier}]}\n"
+      "  - {name: input_bearing, type: revolute, between: [{body: carrier, axis: [1, 0, 0]}, "
+      "{body: input_shaft, axis: [1, 0, 0]}]}\n"
+      "  - {name: output_bearing, type: revolute, between: [{body: carrier, axis: [0, 1, 0]}, "
+      "{body: output_shaft, axis: [0, 1, 0]}]}\n"
+      "  - {name: bevel, type: spatial_gear, shafts: [input_bearing, output_bearing], angles: [theta1, theta2], "
+      "radii: [0.03, 0.06]}\n"
+      "drivers:\n  - {name: spin, joint: carrier_bearing, measure: angle, law: {type: linear, initial: 0, rate: 2}}\n"
+      "  - {name: motor, coordinate: theta1, law: {type: polynomial, coefficients: [0, 3, 0.5]}}\n"
+      "parts:\n  carrier: {mass: 3, center_of_mass: [0, 0, 0], inertia: [0.05, 0.05, 0.08]}\n"
+      "  input_shaft: {mass: 1, center_of_mass: [0.05, 0, 0], inertia: [0.002, 0.004, 0.004]}\n"
+      "  output_shaft: {mass: 2, center_of_mass: [0, 0, 0], inertia: [0.01, 0.02, 0.01]}\n"
+      "loads: {gravity: [0, 0, -9.81]}\ntime: {start: 0, end: 2, steps: 40}\n"
+      "output: {velocities: true, accelerations: true, efforts: all, reactions: [output_bearing]}\n";
+  SweepSummary sum;
+  const Scene s = parse_scene(text, "turning.yaml");
+  ASSERT_EQ(s.sweep.efforts.meshes.size(), 1u);
+  const ReactionRows r = test::sweep_reactions(s, &sum);
+  for (const SweepWarning& w : sum.warnings) ADD_FAILURE() << w.kind << ": " << w.message;
+  // The output shaft, axisymmetric about its axis y' (the carrier's y), turns about it by the teeth alone:
+  // I θ̈2 = τ2 = f r2 sets the push F = f z + |f| tan 20° (sin δ1 x' − cos δ1 y') on the input's teeth, −F on its
+  // own; its centre stays at the origin, so the bearing holds F and its weight, and reports the opposite on the
+  // carrier (side 1).
+  const Model& m = *s.model;
+  const Index theta2 = m.find_coordinate("theta2"), e0 = m.find_coordinate("c_e0"), e3 = m.find_coordinate("c_e3");
+  const double r1 = 0.03, r2 = 0.06, tan_a = std::tan(20 * M_PI / 180), delta1 = std::atan2(r1, r2);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < r.values.size(); ++k) {
+    const std::vector<double>& v = r.values[k];  // spin, motor, their powers, output_bearing's Fx…Mz
+    ASSERT_EQ(v.size(), 10u);
+    const double turn = 2 * std::atan2(r.q[k](e3), r.q[k](e0));
+    const Vec3 x1(std::cos(turn), std::sin(turn), 0), y1(-std::sin(turn), std::cos(turn), 0), z(0, 0, 1);
+    const double f = 0.02 * r.qdd[k](theta2) / r2;
+    const Vec3 push = f * z + std::fabs(f) * tan_a * (std::sin(delta1) * x1 - std::cos(delta1) * y1);
+    const Vec3 on_carrier = -(push + Vec3(0, 0, 2 * 9.81));
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(v[static_cast<std::size_t>(4 + c)], on_carrier(c), 1e-9 * (1 + std::fabs(f))) << k << " " << c;
+    largest = std::max(largest, std::fabs(f));
+  }
+  EXPECT_GT(largest, 0.01);  // the motor's 1 rad/s² turns the output at 0.5
+}
+
 }  // namespace
 }  // namespace phiq
