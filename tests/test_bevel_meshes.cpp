@@ -1,8 +1,8 @@
-// Bevel gears in joint reactions (add_gear_mesh_forces(), phiq/joint_reactions.hpp): a spatial gear's rows turn
-// its shafts by torques about their axes, yet their bearings carry the push of its teeth at the pitch point. Checked
-// by Newton–Euler written in the test, with the pitch point and the textbook split of a bevel pinion's load
-// (tangential W, radial W tan α cos δ1 toward its axis, axial W tan α sin δ1 away from the apex). Worms (axes that do
-// not cross) and tooth counts (which place no pitch point) are told.
+// Bevel gears and worms in joint reactions (add_gear_mesh_forces(), phiq/joint_reactions.hpp): a spatial gear's
+// rows turn its shafts by torques about their axes, yet their bearings carry the push of its teeth at the pitch
+// point. Checked by Newton–Euler written in the test, with the pitch point and the textbook split of a bevel
+// pinion's load (tangential W, radial W tan α cos δ1 toward its axis, axial W tan α sin δ1 away from the apex), in a
+// fixed and a turning housing, and a frictionless worm's. Pitch points that cannot be placed are told.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -85,7 +85,7 @@ TEST(BevelMeshes, PushesThatCannotBePlacedAreTold) {
     EXPECT_EQ(sum.warnings[0].kind, "unloaded_bearings");
     EXPECT_HAS(sum.warnings[0].message, words);
   }
-  // the output's bearing 0.05 above the apex along z: the axes no longer cross (a worm's)
+  // the output's bearing 0.05 above the apex along z: the axes no longer cross, and its radii do not span them
   std::string text = test::model_file_text("transmissions/bevel_gears.yaml", "output:");
   text =
       test::replace_first(text, "{body: ground, axis: [0, 1, 0]}", "{body: ground, at: [0, 0, 0.05], axis: [0, 1, 0]}");
@@ -99,7 +99,7 @@ TEST(BevelMeshes, PushesThatCannotBePlacedAreTold) {
                         &sum);
   ASSERT_EQ(sum.warnings.size(), 1u);
   EXPECT_EQ(sum.warnings[0].kind, "unloaded_bearings");
-  EXPECT_HAS(sum.warnings[0].message, "do not cross");
+  EXPECT_HAS(sum.warnings[0].message, "neither cross nor stand its two pitch radii apart");
   // a `gear` between the shafts' rotation angles relates coordinates whose shafts it does not know
   SweepSummary angles;
   test::sweep_reactions(bevel_pair("{name: turn1, type: rotation_angle, joint: input_bearing, angle: theta1}\n"
@@ -164,6 +164,51 @@ TEST(BevelMeshes, APairInATurningHousingPushesWithoutWork) {
     largest = std::max(largest, std::fabs(f));
   }
   EXPECT_GT(largest, 0.01);  // the motor's 1 rad/s² turns the output at 0.5
+}
+
+// A worm (one start, pitch radius 0.01, about x at the origin) and its 30-tooth wheel (pitch radius 0.05, about y
+// through (0, 0, 0.06)): the teeth push at P = (0, 0, 0.01) on the common perpendicular, frictionless. The wheel
+// turns by their moment alone, I θ̈2 = 0.05 Fx; the massless worm's motor balances theirs, τ = 0.01 Fy, and is, by
+// the ideal drive's power, −I θ̈2 / 30; the teeth part worm and wheel by |(Fx, Fy)| tan 20°. Each bearing holds
+// its shaft against them, the wheel's with the moment Euler asks about its point.
+TEST(BevelMeshes, AWormsBearingsCarryItsTeethsPushByNewtonEuler) {
+  std::string text = test::model_file_text("transmissions/bevel_gears.yaml", "output:");
+  text =
+      test::replace_first(text, "{body: ground, axis: [0, 1, 0]}", "{body: ground, at: [0, 0, 0.06], axis: [0, 1, 0]}");
+  text = test::replace_first(text, "s2_z: 0", "s2_z: 0.06");
+  text = test::replace_first(text, "teeth: [15, 30]", "teeth: [1, 30], pitch_radii: [0.01, 0.05]");
+  text = test::replace_first(text, "coefficients: [0, 2, 0.5]", "coefficients: [0, 30, 15]");
+  text = test::replace_first(text, "time: {start: 0, end: 3, steps: 60}", "time: {start: 0, end: 1, steps: 100}");
+  SweepSummary sum;
+  const Scene s =
+      parse_scene(text +
+                      "parts:\n  output_shaft: {mass: 2, center_of_mass: [0, 0, 0], inertia: [0.3, 0.5, "
+                      "0.3]}\noutput: {velocities: true, accelerations: true, efforts: all, reactions: all}\n",
+                  "worm.yaml");
+  const ReactionRows r = test::sweep_reactions(s, &sum);
+  for (const SweepWarning& w : sum.warnings) ADD_FAILURE() << w.kind << ": " << w.message;
+  const Index theta2 = s.model->find_coordinate("theta2");
+  const double i2 = 0.5, tan_a = std::tan(20 * M_PI / 180);
+  const Vec3 p(0, 0, 0.01), a2(0, 0, 0.06), x(1, 0, 0), y(0, 1, 0);
+  double largest = 0.0;
+  for (std::size_t k = 0; k < r.values.size(); ++k) {
+    const std::vector<double>& v = r.values[k];  // τ, power, input_bearing's Fx…Mz, output_bearing's
+    ASSERT_EQ(v.size(), 14u);
+    const double motor = -i2 * r.qdd[k](theta2) / 30, fx = i2 * r.qdd[k](theta2) / 0.05, fy = motor / 0.01;
+    const Vec3 f(fx, fy, -std::hypot(fx, fy) * tan_a);
+    EXPECT_NEAR(v[0], motor, 1e-10) << k;
+    const Vec3 in_force = -f, in_moment = -p.cross(f) - motor * x;
+    const Vec3 out_force = f, out_moment = i2 * r.qdd[k](theta2) * y - (p - a2).cross(-f);
+    const double scale = 1.0 + f.norm();
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(v[static_cast<std::size_t>(2 + c)], in_force(c), 1e-10 * scale) << k << " " << c;
+      EXPECT_NEAR(v[static_cast<std::size_t>(5 + c)], in_moment(c), 1e-10 * scale) << k << " " << c;
+      EXPECT_NEAR(v[static_cast<std::size_t>(8 + c)], out_force(c), 1e-10 * scale) << k << " " << c;
+      EXPECT_NEAR(v[static_cast<std::size_t>(11 + c)], out_moment(c), 1e-10 * scale) << k << " " << c;
+    }
+    largest = std::max(largest, std::fabs(fy));
+  }
+  EXPECT_GT(largest, 1.0);
 }
 
 }  // namespace

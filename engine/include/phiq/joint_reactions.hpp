@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "phiq/kinds/reaction_site.hpp"
@@ -258,7 +259,8 @@ class JointReactions {
 struct MeshFindings {
   std::vector<Index> working;  ///< meshes whose push does work along q̇: their centres are not where the row needs
   std::vector<Index> slack;    ///< belts whose slack strand would need a negative tension (T0 < |ΔT|/2): they slip
-  std::vector<Index> skew;     ///< spatial gear pairs whose axes do not cross (worms, crossed helical): no push
+  /// Spatial gear pairs whose pitch point is not placed at this row, and why: no push
+  std::vector<std::pair<Index, const char*>> unplaced;
 };
 
 /// What turns the torques of each gear pair of `meshes` under multipliers `lambda` into the push of its teeth,
@@ -276,8 +278,8 @@ struct MeshFindings {
 /// reference point on its angle. A belt or chain whose strands
 /// are known (GearMesh::strands_known()) pulls its pulleys' centres by its two strands' tensions along them, which
 /// its torque −λ on pulley 1 splits (GearMesh); without them, or with overlapping pulleys, it adds nothing. A bevel
-/// pair (OutputMesh::spatial) pushes its shafts at its pitch point (SpatialMesh), or adds nothing when its axes do
-/// not cross (appended to `found->skew`). A mesh with OutputMesh::unloaded adds nothing.
+/// or worm pair (OutputMesh::spatial) pushes its shafts at its pitch point (SpatialMesh), or adds nothing when that
+/// is not placed (appended to `found->unplaced`). A mesh with OutputMesh::unloaded adds nothing.
 /// With the row's velocities `qd`, appends to `found->working` (when not null) the meshes whose push does work along
 /// q̇ (beyond 10⁻⁶ of its terms): their bodies' reference points are not centres that keep their places on the
 /// carrier, so the row does not describe their teeth (a gear on a moving arm whose carrier is not named); and to

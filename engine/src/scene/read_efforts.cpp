@@ -129,8 +129,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
         continue;
       OutputMesh m;
       m.constraint = static_cast<Index>(c), m.spatial = true;
-      if (sm.r1 == 0.0) m.unloaded = "its teeth do not place its pitch point (its radii, the mean pitch radii, do)";
-      if (sm.reversed) m.unloaded = "it is reversed, so which shaft's axis points away from its gear is not told";
+      if (sm.r1 == 0.0) m.unloaded = "its teeth do not place its pitch point (its radii or pitch_radii do)";
       if (sm.a1.natural || sm.b1.natural || sm.a2.natural || sm.b2.natural)
         m.unloaded = "a shaft or housing is in natural coordinates";
       out.meshes.push_back(m);

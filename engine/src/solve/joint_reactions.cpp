@@ -24,15 +24,18 @@ PartFrame body_frame(const ReactionSite& s) {
   return f;
 }
 
-// A spatial gear pair's push on its shafts (add_gear_mesh_forces()), through `add(j, v)` on coordinate j: false when
-// its axes do not cross (a worm or crossed helical pair), when it adds nothing. Each joint's side a gives its axis
-// z_i (from the apex toward its gear) through its point; the apex O is where they cross; the pitch point
-// P = O + (r2 z1 + r1 z2)/sin Σ is at r1 from axis 1 and r2 from axis 2. The ratio row's λ turns the angles θ1, θ2
-// by −λ and −k λ; the teeth push shaft 1 at P by F = f n + |f| tan α m1 instead (n = z1 × z2 / sin Σ, f = −λ/r1,
-// so that its moment about axis 1 is −λ; m1 ⟂ OP in the axes' plane, toward axis 1, parts the gears) and shaft 2
-// by −F (whose moment about axis 2 is −k λ): F at P on shaft 1, −F on shaft 2, λ on θ1 and k λ on θ2.
+// A spatial gear pair's push on its shafts (add_gear_mesh_forces()), through `add(j, v)` on coordinate j: null, or
+// why it adds nothing. Each joint's side a gives its axis z_i through its point. The ratio row's λ turns the angles
+// θ1, θ2 by τ1 = −λ and τ2 = −k λ; the teeth push shaft 1 at the pitch point P by F instead, whose moment about
+// axis 1 is τ1, and shaft 2 by −F, whose moment about axis 2 is τ2: F at P on shaft 1, −F on shaft 2, λ on θ1 and
+// k λ on θ2. Where the axes cross (bevel gears; z_i from the apex O toward its gear, so not `reversed`),
+// P = O + (r2 z1 + r1 z2)/sin Σ, at r1 from axis 1 and r2 from axis 2, and F = f n + |f| tan α m1 (n = z1 × z2 /
+// sin Σ, f = τ1/r1; m1 ⟂ OP in the axes' plane, toward axis 1, parts the gears). Where they do not (worms,
+// crossed helical gears), P is on their common perpendicular ρ, r1 from axis 1 (the radii must span it), and F,
+// frictionless, has the components along t1 = z1 × ρ and t2 = −z2 × ρ that give both moments, and tan α of its
+// size along −ρ.
 template <class Add>
-bool push_shafts(const SpatialMesh& g, double lambda, const double* q, PartJacobian& jac, Add&& add) {
+const char* push_shafts(const SpatialMesh& g, double lambda, const double* q, PartJacobian& jac, Add&& add) {
   auto frame_of = [](const JointSide3& side) {
     PartFrame f;
     f.kind = PartFrameKind::kSpatialBody, f.spatial = side.frame;
@@ -47,17 +50,30 @@ bool push_shafts(const SpatialMesh& g, double lambda, const double* q, PartJacob
   V3 a1, z1, a2, z2;
   axis_of(g.a1, a1, z1), axis_of(g.a2, a2, z2);
   const double cos_s = dot(z1, z2), sin_s = norm(cross(z1, z2));
-  if (!(sin_s > 1e-9)) return false;
+  if (!(sin_s > 1e-9)) return "its shafts are parallel";
   const V3 w = a1 - a2;  // the closest points of the axes, a1 + s1 z1 and a2 + s2 z2
   const double d = dot(z1, w), e = dot(z2, w), s1 = (cos_s * e - d) / (sin_s * sin_s),
                s2 = (e - cos_s * d) / (sin_s * sin_s);
   const V3 o1 = a1 + s1 * z1, o2 = a2 + s2 * z2;
-  if (!(norm(o1 - o2) <= 1e-6 * (g.r1 + g.r2))) return false;
-  const V3 apex = 0.5 * (o1 + o2), p = apex + (1.0 / sin_s) * (g.r2 * z1 + g.r1 * z2);
-  const V3 n = (1.0 / sin_s) * cross(z1, z2), u = (1.0 / norm(p - apex)) * (p - apex);
-  const V3 m1 = z1 - dot(z1, u) * u;
-  const double f = -lambda / g.r1;
-  const V3 force = f * n + (std::fabs(f) * std::tan(g.pressure_angle) / norm(m1)) * m1;
+  const double gap = norm(o2 - o1), tan_a = std::tan(g.pressure_angle);
+  V3 p, force;
+  if (gap <= 1e-6 * (g.r1 + g.r2)) {
+    if (g.reversed) return "it is reversed, so which shaft's axis points away from its gear is not told";
+    const V3 apex = 0.5 * (o1 + o2);
+    p = apex + (1.0 / sin_s) * (g.r2 * z1 + g.r1 * z2);
+    const V3 n = (1.0 / sin_s) * cross(z1, z2), u = (1.0 / norm(p - apex)) * (p - apex);
+    const V3 m1 = z1 - dot(z1, u) * u;
+    const double f = -lambda / g.r1;
+    force = f * n + (std::fabs(f) * tan_a / norm(m1)) * m1;
+  } else {
+    if (!(std::fabs(gap - (g.r1 + g.r2)) <= 1e-6 * gap))
+      return "its axes neither cross nor stand its two pitch radii apart";
+    const V3 rho = (1.0 / gap) * (o2 - o1), t1 = cross(z1, rho), t2 = cross(rho, z2);
+    p = o1 + g.r1 * rho;
+    const double c = dot(t1, t2), b1 = -lambda / g.r1, b2 = g.k * lambda / g.r2;  // F · t1, F · t2
+    const V3 plane = ((b1 - c * b2) / (1.0 - c * c)) * t1 + ((b2 - c * b1) / (1.0 - c * c)) * t2;
+    force = plane - (norm(plane) * tan_a) * rho;
+  }
   auto push = [&](const JointSide3& side, V3 on) {  // `on` at P
     if (!detail::frame_moves(side.frame)) return;
     const PartFrame frame = frame_of(side);
@@ -69,7 +85,7 @@ bool push_shafts(const SpatialMesh& g, double lambda, const double* q, PartJacob
   push(g.b1, force), push(g.b2, -force);
   if (g.theta1.is_coordinate()) add(g.theta1.coord(), lambda);
   if (g.theta2.is_coordinate()) add(g.theta2.coord(), g.k * lambda);
-  return true;
+  return nullptr;
 }
 
 }  // namespace
@@ -293,7 +309,8 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
       const auto [block, index] = model.constraint_block(m.constraint);
       SpatialMesh g;
       block->spatial_mesh(index, g);
-      if (!push_shafts(g, lambda(row + 2), q, jac, add_at) && found) found->skew.push_back(m.constraint);
+      if (const char* why = push_shafts(g, lambda(row + 2), q, jac, add_at); why && found)
+        found->unplaced.push_back({m.constraint, why});
       return;
     }
     if (m.mesh.rack) {

@@ -105,7 +105,7 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
   if (!opt_.efforts.meshes.empty()) {
     effort_work_.mesh_q.setZero(model_.num_coordinates());
     MeshFindings& found = effort_work_.mesh_findings;
-    found.working.clear(), found.slack.clear(), found.skew.clear();
+    found.working.clear(), found.slack.clear(), found.unplaced.clear();
     add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q,
                          current_.qd.data(), &found);
     warn_meshes(found, note);
@@ -170,11 +170,9 @@ void Sweeper::warn_meshes(const MeshFindings& found, bool first_row) {
       sum_.warnings.push_back({t, "unloaded_bearings",
                                "the bearings of " + name(m.constraint) + " carry none of its " +
                                    (m.mesh.belt ? "strands' pull: " : "teeth's push: ") + m.unloaded});
-  for (Index c : found.skew)
-    sum_.warnings.push_back({t, "unloaded_bearings",
-                             "the bearings of " + name(c) +
-                                 " carry none of its teeth's push: its axes do not cross (a worm or crossed helical "
-                                 "pair, whose push its helix sets)"});
+  for (const auto& [c, why] : found.unplaced)
+    sum_.warnings.push_back(
+        {t, "unloaded_bearings", "the bearings of " + name(c) + " carry none of its teeth's push: " + why});
 }
 
 bool Sweeper::same_sweep(const Sweeper* like) const { return like && &like->model_ == &model_ && &like->opt_ == &opt_; }

@@ -47,24 +47,27 @@ struct SpatialMesh {
 /// the same orientations. Parallel shafts are refused (their gears are a `gear` between two rotation angles), and
 /// so is one joint for both. Scene type `spatial_gear`: `shafts: [J1, J2]` (named joints above it),
 /// `angles: [θ1, θ2]` (coordinates), `teeth: [z1, z2]` or `radii: [r1, r2]` (the mean pitch radii, for the
-/// bearings' loads: spatial_mesh()), `reversed` (false), `phase: φ` (0), `pressure_angle: α` (rad, 20°).
+/// bearings' loads: spatial_mesh()), `reversed` (false), `phase: φ` (0), `pressure_angle: α` (rad, 20°),
+/// `pitch_radii: [r1, r2]` (m: for the bearings' loads where the teeth give the ratio, as a worm's do).
 struct SpatialGearSpec {
   /// @copydoc DistanceSpec::operator==
   bool operator==(const SpatialGearSpec&) const = default;
   static constexpr int kRows = 3;  ///< the two shafts' angles and the ratio
   /// @copydoc DistanceSpec::kKind
   static constexpr const char* kKind = "spatial_gear";
-  JointSide3 a1;                                   ///< shaft 1's joint, side a: the housing (its z is the axis)
-  JointSide3 b1;                                   ///< shaft 1's joint, side b: the shaft
-  JointSide3 a2;                                   ///< shaft 2's joint, side a
-  JointSide3 b2;                                   ///< shaft 2's joint, side b
-  Slot theta1;                                     ///< θ1 (rad): a coordinate
-  Slot theta2;                                     ///< θ2 (rad): a coordinate
-  double z1 = 1.0;                                 ///< gear 1's tooth count (or pitch radius), > 0
-  double z2 = 1.0;                                 ///< gear 2's tooth count (or pitch radius), > 0
-  bool reversed = false;                           ///< the relation z1 θ1 − z2 θ2 = z1 φ
-  double phase = 0.0;                              ///< φ (rad)
-  bool teeth = false;                              ///< z1 and z2 are tooth counts, not radii
+  JointSide3 a1;          ///< shaft 1's joint, side a: the housing (its z is the axis)
+  JointSide3 b1;          ///< shaft 1's joint, side b: the shaft
+  JointSide3 a2;          ///< shaft 2's joint, side a
+  JointSide3 b2;          ///< shaft 2's joint, side b
+  Slot theta1;            ///< θ1 (rad): a coordinate
+  Slot theta2;            ///< θ2 (rad): a coordinate
+  double z1 = 1.0;        ///< gear 1's tooth count (or pitch radius), > 0
+  double z2 = 1.0;        ///< gear 2's tooth count (or pitch radius), > 0
+  bool reversed = false;  ///< the relation z1 θ1 − z2 θ2 = z1 φ
+  double phase = 0.0;     ///< φ (rad)
+  bool teeth = false;     ///< z1 and z2 are tooth counts, not radii
+  double pitch_r1 = 0.0;  ///< gear 1's pitch radius (m) for its bearings' loads; 0: z1 if radii
+  double pitch_r2 = 0.0;  ///< gear 2's
   double pressure_angle = detail::kPressureAngle;  ///< α (rad): its bearings' loads only (SpatialMesh)
   std::array<Attachment3, 4> att1{};               ///< derived by setup(): x_a, y_a, z_a, x_b of shaft 1's joint
   std::array<Attachment3, 4> att2{};               ///< the same of shaft 2's joint
@@ -76,6 +79,9 @@ struct SpatialGearSpec {
                     "spatial_gear: the tooth counts (or radii) must be positive");
     detail::require(std::isfinite(phase), "spatial_gear: phase is not finite");
     detail::require(detail::is_pressure_angle(pressure_angle), "spatial_gear: pressure_angle must be in [0, pi/2) rad");
+    detail::require(
+        pitch_r1 == 0.0 || (std::isfinite(pitch_r1) && std::isfinite(pitch_r2) && pitch_r1 > 0.0 && pitch_r2 > 0.0),
+        "spatial_gear: pitch_radii must be positive");
     detail::require(theta1.is_coordinate() && theta2.is_coordinate() && theta1.coord() != theta2.coord(),
                     "spatial_gear: the angles must be two different coordinates");
     const auto j1 = detail3::joint_attachments(a1, b1, kIndex, 4, kKind);
@@ -162,7 +168,8 @@ struct SpatialGearSpec {
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static SpatialGearSpec read(const Fields& f) {
-    f.expect({"type", "name", "shafts", "angles", "teeth", "radii", "reversed", "phase", "pressure_angle"});
+    f.expect(
+        {"type", "name", "shafts", "angles", "teeth", "radii", "reversed", "phase", "pressure_angle", "pitch_radii"});
     SpatialGearSpec g;
     const auto [j1, j2] = f.turning_joints("shafts");
     std::tie(g.a1, g.b1) = j1;
@@ -174,12 +181,14 @@ struct SpatialGearSpec {
     if (f.present("reversed")) g.reversed = f.boolean("reversed");
     if (f.present("phase")) g.phase = f.number("phase");
     if (f.present("pressure_angle")) g.pressure_angle = f.number("pressure_angle");
+    if (f.present("pitch_radii")) std::tie(g.pitch_r1, g.pitch_r2) = f.number_pair("pitch_radii");
     return g;
   }
   /// The mesh as a push on the shafts' bearings (SpatialMesh).
   SpatialMesh spatial_mesh() const {
     SpatialMesh m{a1,      b1, a2, b2, theta1, theta2, ratio(), teeth ? 0.0 : z1, teeth ? 0.0 : z2, pressure_angle,
                   reversed};
+    if (pitch_r1 > 0.0) m.r1 = pitch_r1, m.r2 = pitch_r2;
     return m;
   }
 
