@@ -109,10 +109,12 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
     add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q,
                          current_.qd.data(), &found);
     warn_meshes(found, note);
-    if (!multipliers_with_factors(model_, lu, effort_work_.mesh_q, effort_work_.kept, effort_work_.mesh_lambda))
-      return not_defined();
-    ++ws_->counters.effort_solves;
-    effort_work_.lambda += effort_work_.mesh_lambda;
+    if (!effort_work_.mesh_q.isZero(0.0)) {  // (meshes that push nothing here, all of them unloaded: no solve)
+      if (!multipliers_with_factors(model_, lu, effort_work_.mesh_q, effort_work_.kept, effort_work_.mesh_lambda))
+        return not_defined();
+      ++ws_->counters.effort_solves;
+      effort_work_.lambda += effort_work_.mesh_lambda;
+    }
   }
   // the natural bodies' weight and inertia as Q took them at this row (row_efforts())
   effort_work_.reactions->evaluate(current_.q.data(), current_.qd.data(), current_.qdd.data(), t, effort_work_.lambda,
