@@ -5,6 +5,7 @@
 // fixed and a turning housing, and a frictionless worm's. Pitch points that cannot be placed are told.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "phiq/phiq.hpp"
@@ -30,6 +31,13 @@ Scene bevel_pair(const std::string& mesh) {
                          "parts:\n  output_shaft: {mass: 2, center_of_mass: [0, 0, 0], inertia: [0.01, 0.02, 0.01]}\n"
                          "output: {velocities: true, accelerations: true, efforts: all, reactions: all}\n",
                      "bevel.yaml");
+}
+
+// A row's two bearings (values 2…13: the input's force and moment, then the output's) against the expected four.
+void expect_bearings(const std::vector<double>& v, const std::array<Vec3, 4>& expected, double tol, std::size_t k) {
+  for (std::size_t b = 0; b < 4; ++b)
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(v[2 + 3 * b + static_cast<std::size_t>(c)], expected[b](c), tol) << k << " " << b << " " << c;
 }
 
 // Mean pitch radii 0.03 (input) and 0.06: the teeth push at P = (0.06, 0.03, 0), at 0.03 from the x axis and 0.06
@@ -59,12 +67,7 @@ TEST(BevelMeshes, ABevelPairsBearingsCarryItsTeethsPushByNewtonEuler) {
     const Vec3 out_force = f, out_moment = i2 * r.qdd[k](theta2) * y + p.cross(f);
     const double scale = 1.0 + std::fabs(w);
     EXPECT_NEAR(v[0], motor, 1e-11 * scale) << k;
-    for (int c = 0; c < 3; ++c) {
-      EXPECT_NEAR(v[static_cast<std::size_t>(2 + c)], in_force(c), 1e-10 * scale) << k << " " << c;
-      EXPECT_NEAR(v[static_cast<std::size_t>(5 + c)], in_moment(c), 1e-10 * scale) << k << " " << c;
-      EXPECT_NEAR(v[static_cast<std::size_t>(8 + c)], out_force(c), 1e-10 * scale) << k << " " << c;
-      EXPECT_NEAR(v[static_cast<std::size_t>(11 + c)], out_moment(c), 1e-10 * scale) << k << " " << c;
-    }
+    expect_bearings(v, {in_force, in_moment, out_force, out_moment}, 1e-10 * scale, k);
     largest = std::max(largest, std::fabs(w));
   }
   EXPECT_GT(largest, 0.1);
@@ -200,12 +203,7 @@ TEST(BevelMeshes, AWormsBearingsCarryItsTeethsPushByNewtonEuler) {
     const Vec3 in_force = -f, in_moment = -p.cross(f) - motor * x;
     const Vec3 out_force = f, out_moment = i2 * r.qdd[k](theta2) * y - (p - a2).cross(-f);
     const double scale = 1.0 + f.norm();
-    for (int c = 0; c < 3; ++c) {
-      EXPECT_NEAR(v[static_cast<std::size_t>(2 + c)], in_force(c), 1e-10 * scale) << k << " " << c;
-      EXPECT_NEAR(v[static_cast<std::size_t>(5 + c)], in_moment(c), 1e-10 * scale) << k << " " << c;
-      EXPECT_NEAR(v[static_cast<std::size_t>(8 + c)], out_force(c), 1e-10 * scale) << k << " " << c;
-      EXPECT_NEAR(v[static_cast<std::size_t>(11 + c)], out_moment(c), 1e-10 * scale) << k << " " << c;
-    }
+    expect_bearings(v, {in_force, in_moment, out_force, out_moment}, 1e-10 * scale, k);
     largest = std::max(largest, std::fabs(fy));
   }
   EXPECT_GT(largest, 1.0);
