@@ -20,6 +20,7 @@
 #include "phiq/output_joints.hpp"
 #include "phiq/output_points.hpp"
 #include "phiq/kinds/reaction_site.hpp"
+#include "phiq/kinds/spatial_gear.hpp"
 #include "phiq/types.hpp"
 
 namespace phiq {
@@ -92,9 +93,10 @@ struct OutputReaction {
   int natural = -1;      ///< a natural joint: its index in OutputEfforts::natural's joints, else −1
 };
 
-/// A gear pair between two planar bodies, or a rack and pinion on them, in a sweep that writes reactions
-/// (OutputEfforts::meshes): its teeth push the bodies at their pitch point, which loads the bodies' reference
-/// points, about which the gears turn (add_gear_mesh_forces(), phiq/joint_reactions.hpp).
+/// A transmission in a sweep that writes reactions (OutputEfforts::meshes): a gear pair, rack and pinion or belt
+/// between planar bodies, whose teeth (strands) push the bodies' reference points, about which they turn, or a
+/// spatial gear pair, which pushes its shafts (add_gear_mesh_forces(), phiq/joint_reactions.hpp); or one whose push
+/// cannot be placed (`unloaded`).
 struct OutputMesh {
   Index constraint = -1;  ///< the gear's Model::constraints() index
   GearMesh mesh;          ///< its angles and ratio
@@ -102,8 +104,8 @@ struct OutputMesh {
   Frame2 first;
   Frame2 second;       ///< the body whose ψ is mesh.second (gear 2, the pinion)
   int rack_axis = -1;  ///< a rack's travel: 0 its body's x, 1 its y (−1: a gear pair)
-  /// A spatial gear pair (bevel or worm: SpatialMesh, from its constraint's block); first and second are unused.
-  bool spatial = false;
+  /// A spatial gear pair (bevel or worm), taken from its constraint's block once; mesh, first and second unused.
+  std::optional<SpatialMesh> spatial;
   /// A gear held fixed (the ground's or a fixed body's angle) in an epicyclic train: 0 gear 1, 1 gear 2 (−1: none).
   /// It is coaxial with the carrier, so its frame above is the carrier's, whose reference point stands for its
   /// centre; it takes no push.
@@ -130,7 +132,7 @@ struct OutputEfforts {
   /// pair's slide, a spatial joint's frame) rather than world axes; a natural point's along the frame of the part it
   /// is reported on (natural_reaction_site(): x toward the frame's x point, along a bar and across it).
   bool reactions_in_joint_axes = false;
-  /// The gear pairs between bodies, whose tooth force the written reactions carry (empty without reactions).
+  /// The transmissions between bodies, whose push the written reactions carry (empty without reactions).
   std::vector<OutputMesh> meshes;
   /// The natural coordinates' bodies and joints the `natural` reactions index (null: none listed).
   std::shared_ptr<const NaturalJoints> natural;

@@ -128,7 +128,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       if (!block->spatial_mesh(index, sm) || !(detail::frame_moves(sm.b1.frame) || detail::frame_moves(sm.b2.frame)))
         continue;
       OutputMesh m;
-      m.constraint = static_cast<Index>(c), m.spatial = true;
+      m.constraint = static_cast<Index>(c), m.spatial = sm;
       if (sm.r1 == 0.0) m.unloaded = "its teeth do not place its pitch point (its radii or pitch_radii do)";
       if (sm.a1.natural || sm.b1.natural || sm.a2.natural || sm.b2.natural)
         m.unloaded = "a shaft or housing is in natural coordinates";

@@ -23,6 +23,12 @@ PartFrame body_frame(const ReactionSite& s) {
   f.spatial = s.frame3;
   return f;
 }
+// A spatial body's frame (a shaft's or a housing's).
+PartFrame body_frame(const Frame3& body) {
+  ReactionSite s;
+  s.spatial = true, s.frame3 = body;
+  return body_frame(s);
+}
 
 // A spatial gear pair's push on its shafts (add_gear_mesh_forces()), through `add(j, v)` on coordinate j: null, or
 // why it adds nothing. Each joint's side a gives its axis z_i through its point. The ratio row's λ turns the angles
@@ -36,13 +42,8 @@ PartFrame body_frame(const ReactionSite& s) {
 // size along −ρ.
 template <class Add>
 const char* push_shafts(const SpatialMesh& g, double lambda, const double* q, PartJacobian& jac, Add&& add) {
-  auto frame_of = [](const JointSide3& side) {
-    PartFrame f;
-    f.kind = PartFrameKind::kSpatialBody, f.spatial = side.frame;
-    return f;
-  };
   auto axis_of = [&](const JointSide3& side, V3& point, V3& axis) {
-    const Pose pose = part_pose(frame_of(side), q, 0.0);
+    const Pose pose = part_pose(body_frame(side.frame), q, 0.0);
     point = pose.apply(side.at);
     axis = pose.apply(side.axis) - pose.at;
     axis = (1.0 / norm(axis)) * axis;
@@ -76,7 +77,7 @@ const char* push_shafts(const SpatialMesh& g, double lambda, const double* q, Pa
   }
   auto push = [&](const JointSide3& side, V3 on) {  // `on` at P
     if (!detail::frame_moves(side.frame)) return;
-    const PartFrame frame = frame_of(side);
+    const PartFrame frame = body_frame(side.frame);
     part_jacobian(frame, q, 0.0, jac);
     const V3 arm = p - part_pose(frame, q, 0.0).at;
     for (std::size_t k = 0; k < jac.coordinates.size(); ++k)
@@ -306,10 +307,7 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
     const Index row = model.constraints()[static_cast<std::size_t>(m.constraint)].first_row;
     const double lambda_m = lambda(row);
     if (m.spatial) {
-      const auto [block, index] = model.constraint_block(m.constraint);
-      SpatialMesh g;
-      block->spatial_mesh(index, g);
-      if (const char* why = push_shafts(g, lambda(row + 2), q, jac, add_at); why && found)
+      if (const char* why = push_shafts(*m.spatial, lambda(row + 2), q, jac, add_at); why && found)
         found->unplaced.push_back({m.constraint, why});
       return;
     }
