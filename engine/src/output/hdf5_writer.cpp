@@ -379,7 +379,7 @@ void Hdf5Writer::append_values(const double* row) {
   Impl& w = *impl_;
   if (w.closed) throw Error(w.cannot("already closed"));
   w.hold_values([row](double* to, std::size_t first, std::size_t m) {
-    std::transform(row + first, row + first + m, to, stored_value);
+    std::transform(row + first, row + first + m, to, [](double v) { return stored_value(v); });
   });
 }
 
