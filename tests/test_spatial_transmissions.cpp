@@ -239,10 +239,16 @@ TEST(SpatialTransmissions, RefusesBadDataNamingTheConstraint) {
   EXPECT_EQ(test::scene_error(head + "  - {name: sc, type: screw, between: [{body: ground}, {body: s}], pitch: 0}\n"),
             "bad.yaml:11:5: constraints[3]: constraint 'sc': screw: the pitch must not be zero (a screw of no "
             "pitch is a revolute joint)");
-  EXPECT_EQ(
-      test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, h2], angles: [a, b], teeth: [9, 9]}\n"),
-      "bad.yaml:11:5: constraints[3]: constraint 'g': spatial_gear: the shafts are parallel at the placement "
-      "(parallel shafts mesh by a 'gear' between their rotation angles)");
+  // parallel shafts mesh (spur and helical gears: tests/test_helical_meshes.cpp); a helix or a mesh offset is theirs
+  EXPECT_EQ(test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, h2], angles: [a, b], teeth: [9, "
+                                     "9], helix_angle: 1.6}\n"),
+            "bad.yaml:11:5: constraints[3]: constraint 'g': spatial_gear: helix_angle must be in (-pi/2, pi/2) rad");
+  EXPECT_EQ(test::scene_error(
+                test::replace_first(head, "{body: ground, axis: [2, 0, 0]}", "{body: ground, axis: [0, 2, 0]}") +
+                "  - {name: g, type: spatial_gear, shafts: [h1, h2], angles: [a, b], teeth: [9, 9], "
+                "mesh_offset: 0.1}\n"),
+            "bad.yaml:11:5: constraints[3]: constraint 'g': spatial_gear: helix_angle and mesh_offset are for parallel "
+            "shafts (these are not at the placement)");
   EXPECT_EQ(
       test::scene_error(head + "  - {name: g, type: spatial_gear, shafts: [h1, h1], angles: [a, b], teeth: [9, 9]}\n"),
       "bad.yaml:11:43: constraints[3].shafts: the two shafts must be different joints");

@@ -146,8 +146,10 @@ class PartSketcher {
         derived::polyline(derived::helix(b.at, axis, {r[0], r[3], r[6]}, 1.6 * w_, pitch, turns, 24), false, w_ / 4),
         "thread");
   }
-  void bevel_pair(const JointSide3& a1, const JointSide3& b1, const JointSide3& a2, const JointSide3& b2, double z1,
-                  double z2);
+  void spatial_gear_pair(const JointSide3& a1, const JointSide3& b1, const JointSide3& a2, const JointSide3& b2,
+                         double z1, double z2, bool reversed, double mesh_offset);
+  void parallel_gear_pair(const JointSide3& b1, const JointSide3& b2, V3 centre1, V3 axis, V3 on2, double z1, double z2,
+                          bool internal);
 
   // --- the kinds' own geometry in the plane
   void open_chain(const std::vector<LoopSpec::Link>& links);
@@ -333,14 +335,16 @@ void PartSketcher::open_chain(const std::vector<LoopSpec::Link>& links) {
 // placement (the middle of their common perpendicular), the shaft angle Σ between them, the cone angles
 // tan δ1 = sin Σ / (z2/z1 + cos Σ), δ2 = Σ − δ1, and a cone distance R of length_scale()/4: gear i a disc of radius
 // R sin δ_i (so r1 : r2 = z1 : z2) about its shaft's axis, R cos δ_i from the apex along z_a, on the shaft (side b).
-void PartSketcher::bevel_pair(const JointSide3& a1, const JointSide3& b1, const JointSide3& a2, const JointSide3& b2,
-                              double z1, double z2) {
+// Parallel shafts: radii in the ratio that fill the distance a between the axes (a z_i/(z1 + z2), or a z_i/|z2 − z1|
+// for an internal pair, whose ring is a ring), in the mid-plane mesh_offset along axis 1 from its joint's point.
+void PartSketcher::spatial_gear_pair(const JointSide3& a1, const JointSide3& b1, const JointSide3& a2,
+                                     const JointSide3& b2, double z1, double z2, bool reversed, double mesh_offset) {
   if (a1.natural || a2.natural || b1.natural || b2.natural) return;
   const Pose h1 = pose_of(a1.frame), h2 = pose_of(a2.frame);
   const V3 p1 = h1.apply(a1.at), p2 = h2.apply(a2.at);
   const V3 u1 = unit(derived::turn(h1, a1.axis)), u2 = unit(derived::turn(h2, a2.axis));
   const double c = kin3::dot(u1, u2), s = kin3::norm(kin3::cross(u1, u2));
-  if (!(s > 1e-9)) return;
+  if (!(s > 1e-9)) return parallel_gear_pair(b1, b2, p1 + mesh_offset * u1, u1, p2, z1, z2, (c > 0.0) == reversed);
   // the common perpendicular: p1 + t1 u1 and p2 + t2 u2 nearest each other
   const V3 d = p2 - p1;
   const double t1 = (kin3::dot(d, u1) - c * kin3::dot(d, u2)) / (s * s);
@@ -354,6 +358,31 @@ void PartSketcher::bevel_pair(const JointSide3& a1, const JointSide3& b1, const 
     const V3 centre = apex + (cone * std::cos(delta[i])) * axis[i];
     const V3 local = derived::to_local(pose_of(shaft[i]->frame), centre);
     put(target(shaft[i]->frame), derived::cylinder(local, shaft[i]->axis, cone * std::sin(delta[i]), w_),
+        "pitch_circle");
+  }
+}
+
+// The pitch circles of spatial_gear_pair()'s gears on parallel shafts: `centre1` on axis 1 (unit `axis`) in their
+// mid-plane, `on2` a point of axis 2.
+void PartSketcher::parallel_gear_pair(const JointSide3& b1, const JointSide3& b2, V3 centre1, V3 axis, V3 on2,
+                                      double z1, double z2, bool internal) {
+  const V3 across = (on2 - centre1) - kin3::dot(on2 - centre1, axis) * axis;
+  const double a = kin3::norm(across), sum = internal ? std::fabs(z2 - z1) : z1 + z2;
+  if (!(a > 0.0) || !(sum > 0.0)) return;
+  const V3 centre[2] = {centre1, centre1 + across};
+  const double radius[2] = {a * z1 / sum, a * z2 / sum};
+  const JointSide3* shaft[2] = {&b1, &b2};
+  for (int i = 0; i < 2; ++i) {
+    const Pose pose = pose_of(shaft[i]->frame);
+    const V3 local = derived::to_local(pose, centre[i]), local_axis = derived::to_local(pose, pose.at + axis);
+    if (!(internal && radius[i] > radius[1 - i])) {
+      put(target(shaft[i]->frame), derived::cylinder(local, local_axis, radius[i], w_), "pitch_circle");
+      continue;
+    }
+    const RotationMatrix r = derived::z_along(unit(local_axis));  // a ring gear: a ring
+    put(target(shaft[i]->frame),
+        derived::polyline(derived::helix(local, unit(local_axis), {r[0], r[3], r[6]}, radius[i], 0.0, 1, 360), true,
+                          w_ / 2),
         "pitch_circle");
   }
 }

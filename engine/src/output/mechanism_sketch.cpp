@@ -109,7 +109,8 @@ class Sketcher {
   // The kinds' own geometry is the derived parts' (drawn_parts.cpp): the sketch's lines and marks have none.
   void joint_parts3(const JointSide3&, const JointSide3&, JointForm) {}
   void thread3(const JointSide3&, double) {}
-  void bevel_pair(const JointSide3&, const JointSide3&, const JointSide3&, const JointSide3&, double, double) {}
+  void spatial_gear_pair(const JointSide3&, const JointSide3&, const JointSide3&, const JointSide3&, double, double,
+                         bool, double) {}
   void open_chain(const std::vector<LoopSpec::Link>&) {}
   void gear_pair(const Slot&, const Slot&, double, double, bool) {}
   void belt(const Slot&, const Slot&, double, double, bool) {}

@@ -114,13 +114,15 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
       out.reactions.push_back({c, w == 6});
     }
   }
-  if (!out.reactions.empty() && spatial_) {  // bevel gears on shafts: their bearings carry the teeth's push
+  if (!out.reactions.empty() && spatial_) {  // gears on shafts: their bearings carry the teeth's push
     for (std::size_t c = 0; c < model.constraints().size(); ++c) {
       const auto [block, index] = model.constraint_block(static_cast<Index>(c));
       if (GearMesh g; block->gear_mesh(index, g)) {  // (between rotation angles: the shafts are not known)
         OutputMesh m;
         m.constraint = static_cast<Index>(c), m.mesh = g;
-        m.unloaded = "in dimension 3 it relates angle or travel coordinates, whose shafts it does not know";
+        m.unloaded =
+            "in dimension 3 it relates angle or travel coordinates, whose shafts it does not know (a spatial_gear "
+            "between the shafts' joints does)";
         out.meshes.push_back(m);
         continue;
       }
@@ -129,7 +131,6 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
         continue;
       OutputMesh m;
       m.constraint = static_cast<Index>(c), m.spatial = sm;
-      if (sm.r1 == 0.0) m.unloaded = "its teeth do not place its pitch point (its radii or pitch_radii do)";
       if (sm.a1.natural || sm.b1.natural || sm.a2.natural || sm.b2.natural)
         m.unloaded = "a shaft or housing is in natural coordinates";
       out.meshes.push_back(m);

@@ -30,6 +30,24 @@ PartFrame body_frame(const Frame3& body) {
   return body_frame(s);
 }
 
+// F at P on shaft 1, −F on shaft 2, λ on θ1 and k λ on θ2 (push_shafts()).
+template <class Add>
+const char* push_at(const SpatialMesh& g, const V3& p, const V3& force, double lambda, const double* q,
+                    PartJacobian& jac, Add& add) {
+  auto push = [&](const JointSide3& side, V3 on) {  // `on` at P
+    if (!detail::frame_moves(side.frame)) return;
+    const PartFrame frame = body_frame(side.frame);
+    part_jacobian(frame, q, 0.0, jac);
+    const V3 arm = p - part_pose(frame, q, 0.0).at;
+    for (std::size_t k = 0; k < jac.coordinates.size(); ++k)
+      add(jac.coordinates[k], dot(on, jac.d_origin[k] + cross(jac.d_angle[k], arm)));
+  };
+  push(g.b1, force), push(g.b2, -force);
+  if (g.theta1.is_coordinate()) add(g.theta1.coord(), lambda);
+  if (g.theta2.is_coordinate()) add(g.theta2.coord(), g.k * lambda);
+  return nullptr;
+}
+
 // A spatial gear pair's push on its shafts (add_gear_mesh_forces()), through `add(j, v)` on coordinate j: null, or
 // why it adds nothing. Each joint's side a gives its axis z_i through its point. The ratio row's λ turns the angles
 // θ1, θ2 by τ1 = −λ and τ2 = −k λ; the teeth push shaft 1 at the pitch point P by F instead, whose moment about
@@ -39,7 +57,13 @@ PartFrame body_frame(const Frame3& body) {
 // sin Σ, f = τ1/r1; m1 ⟂ OP in the axes' plane, toward axis 1, parts the gears). Where they do not (worms,
 // crossed helical gears), P is on their common perpendicular ρ, r1 from axis 1 (the radii must span it), and F,
 // frictionless, has the components along t1 = z1 × ρ and t2 = −z2 × ρ that give both moments, and tan α of its
-// size along −ρ.
+// size along −ρ. Where they are parallel (spur and helical gears; internal where the pair turns its shafts the
+// same way), P is on the line of centres, in the mid-plane mesh_offset along axis 1 from shaft 1's point: r1 from
+// axis 1 toward axis 2, or away from it for an internal pinion, the radii found from the centre distance a and the
+// ratio where only teeth are given (a/(1 + z2/z1), a/|z2/z1 − 1|). The tooth's normal force, frictionless, is
+// F = f t − f tan ψ z1 + |f| tan α / cos ψ (∓ρ): t the way P moves on gear 1 turning about z1, ψ gear 1's helix
+// angle (right-handed > 0: a tooth line along cos ψ z1 + sin ψ t, to which F is normal), α the normal pressure
+// angle, parting the gears (on gear 1 toward its axis, or a ring's away from it).
 template <class Add>
 const char* push_shafts(const SpatialMesh& g, double lambda, const double* q, PartJacobian& jac, Add&& add) {
   auto axis_of = [&](const JointSide3& side, V3& point, V3& axis) {
@@ -51,13 +75,37 @@ const char* push_shafts(const SpatialMesh& g, double lambda, const double* q, Pa
   V3 a1, z1, a2, z2;
   axis_of(g.a1, a1, z1), axis_of(g.a2, a2, z2);
   const double cos_s = dot(z1, z2), sin_s = norm(cross(z1, z2));
-  if (!(sin_s > 1e-9)) return "its shafts are parallel";
+  const double tan_a = std::tan(g.pressure_angle);
+  V3 p, force;
+  if (!(sin_s > 1e-9)) {
+    const V3 o1 = part_pose(body_frame(g.b1.frame), q, 0.0).apply(g.b1.at) + g.mesh_offset * z1;
+    const V3 across = (a2 - o1) - dot(a2 - o1, z1) * z1;
+    const double a = norm(across), k = std::fabs(g.k);
+    if (!(a > 0.0)) return "its parallel axes are one";
+    const bool internal = (cos_s > 0.0) == g.reversed;
+    double r1 = g.r1, r2 = g.r2;
+    if (r1 == 0.0) {
+      if (!(std::fabs(k - 1.0) > 1e-12) && internal) return "it is an internal pair of equal gears";
+      r1 = a / (internal ? std::fabs(k - 1.0) : 1.0 + k), r2 = k * r1;
+    } else if (!(std::fabs(r2 / r1 - k) <= 1e-6 * k)) {
+      return "its pitch_radii are not in its teeth's ratio, as parallel shafts' gears are";
+    } else if (!(std::fabs((internal ? std::fabs(r2 - r1) : r1 + r2) - a) <= 1e-6 * a)) {
+      return internal ? "its parallel axes do not stand the difference of its pitch radii apart (it is internal)"
+                      : "its parallel axes do not stand its two pitch radii apart";
+    }
+    const V3 rho = (1.0 / a) * across;
+    const double side = internal && r1 < r2 ? -1.0 : 1.0, f = -lambda / r1;
+    p = o1 + (side * r1) * rho;
+    force = (side * f) * cross(z1, rho) - (f * std::tan(g.helix_angle)) * z1 +
+            (std::fabs(f) * tan_a / std::cos(g.helix_angle) * (internal ? 1.0 : -1.0)) * rho;
+    return push_at(g, p, force, lambda, q, jac, add);
+  }
+  if (g.r1 == 0.0) return "its teeth do not place its pitch point (its radii or pitch_radii do)";
   const V3 w = a1 - a2;  // the closest points of the axes, a1 + s1 z1 and a2 + s2 z2
   const double d = dot(z1, w), e = dot(z2, w), s1 = (cos_s * e - d) / (sin_s * sin_s),
                s2 = (e - cos_s * d) / (sin_s * sin_s);
   const V3 o1 = a1 + s1 * z1, o2 = a2 + s2 * z2;
-  const double gap = norm(o2 - o1), tan_a = std::tan(g.pressure_angle);
-  V3 p, force;
+  const double gap = norm(o2 - o1);
   if (gap <= 1e-6 * (g.r1 + g.r2)) {
     if (g.reversed) return "it is reversed, so which shaft's axis points away from its gear is not told";
     const V3 apex = 0.5 * (o1 + o2);
@@ -75,18 +123,7 @@ const char* push_shafts(const SpatialMesh& g, double lambda, const double* q, Pa
     const V3 plane = ((b1 - c * b2) / (1.0 - c * c)) * t1 + ((b2 - c * b1) / (1.0 - c * c)) * t2;
     force = plane - (norm(plane) * tan_a) * rho;
   }
-  auto push = [&](const JointSide3& side, V3 on) {  // `on` at P
-    if (!detail::frame_moves(side.frame)) return;
-    const PartFrame frame = body_frame(side.frame);
-    part_jacobian(frame, q, 0.0, jac);
-    const V3 arm = p - part_pose(frame, q, 0.0).at;
-    for (std::size_t k = 0; k < jac.coordinates.size(); ++k)
-      add(jac.coordinates[k], dot(on, jac.d_origin[k] + cross(jac.d_angle[k], arm)));
-  };
-  push(g.b1, force), push(g.b2, -force);
-  if (g.theta1.is_coordinate()) add(g.theta1.coord(), lambda);
-  if (g.theta2.is_coordinate()) add(g.theta2.coord(), g.k * lambda);
-  return nullptr;
+  return push_at(g, p, force, lambda, q, jac, add);
 }
 
 }  // namespace

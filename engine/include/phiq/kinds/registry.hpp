@@ -60,7 +60,8 @@ struct SketchProbe {
   void joint3(const Attachment3&, const Attachment3&, JointMark) {}
   void joint_parts3(const JointSide3&, const JointSide3&, JointForm) {}
   void thread3(const JointSide3&, double /*pitch*/) {}
-  void bevel_pair(const JointSide3&, const JointSide3&, const JointSide3&, const JointSide3&, double, double) {}
+  void spatial_gear_pair(const JointSide3&, const JointSide3&, const JointSide3&, const JointSide3&, double, double,
+                         bool /*reversed*/, double /*mesh_offset*/) {}
   void open_chain(const std::vector<LoopSpec::Link>&) {}
   void gear_pair(const Slot&, const Slot&, double, double, bool /*internal*/) {}
   void belt(const Slot&, const Slot&, double, double, bool /*crossed*/) {}

@@ -1,11 +1,13 @@
 /// @file
-/// Gears between two shafts at an angle in space (bevel, crossed helical, worm): the shafts' rotations in their
-/// bearings, tied by the tooth ratio. One constraint kind: its equation, derivatives, validation, joint count,
-/// sketch and scene form; the contract is documented on DistanceSpec, and kinds/registry.hpp lists every kind.
+/// Gears between two shafts in space (spur and helical on parallel shafts, bevel, crossed helical, worm): the shafts'
+/// rotations in their bearings, tied by the tooth ratio. One constraint kind: its equation, derivatives, validation,
+/// joint count, sketch and scene form; the contract is documented on DistanceSpec, and kinds/registry.hpp lists every
+/// kind.
 #pragma once
 
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <tuple>
 
 #include "phiq/kinds/spatial_joints.hpp"
@@ -15,7 +17,8 @@ namespace phiq {
 
 /// A spatial gear pair as its teeth push its shafts (SpatialGearSpec::spatial_mesh(), add_gear_mesh_forces()): its
 /// ratio row θ1 + k θ2 − φ turns the shafts' angles by torques; the teeth push at the pitch point P, on both pitch
-/// cones, at r1 from axis 1 and r2 from axis 2 in the plane of the axes, which loads the shafts' bearings as well.
+/// cones (pitch cylinders, for parallel shafts), at r1 from axis 1 and r2 from axis 2 in the plane of the axes, which
+/// loads the shafts' bearings as well.
 struct SpatialMesh {
   JointSide3 a1;                ///< shaft 1's housing (its joint's side a: z its axis)
   JointSide3 b1;                ///< shaft 1 (its joint's side b)
@@ -28,6 +31,8 @@ struct SpatialMesh {
   double r2 = 0.0;              ///< gear 2's (m)
   double pressure_angle = 0.0;  ///< α (rad): the teeth part the gears by tan α of their push
   bool reversed = false;        ///< the relation z1 θ1 − z2 θ2: an axis away from its gear (P not placed)
+  double helix_angle = 0.0;     ///< ψ (rad) of gear 1's teeth on parallel shafts: > 0 right-handed
+  double mesh_offset = 0.0;     ///< parallel shafts: the gears' mid-plane, this far along axis 1 from shaft 1's point
 };
 
 /// Spatial gear pair. Each shaft turns in a joint (revolute, cylindrical or screw) whose side a is the housing —
@@ -44,11 +49,14 @@ struct SpatialMesh {
 /// gears and worms give the tooth counts — a worm's is its number of starts —, not the pitch radii, which do not
 /// make the ratio there). The angles must be coordinates
 /// because a ratio holds between turns, not orientations: 2.5 turns of one gear and half a turn of the other leave
-/// the same orientations. Parallel shafts are refused (their gears are a `gear` between two rotation angles), and
-/// so is one joint for both. Scene type `spatial_gear`: `shafts: [J1, J2]` (named joints above it),
+/// the same orientations. On parallel shafts (spur and helical gears) the same rows hold: + for an external pair
+/// whose axes point the same way, − (`reversed`) for an internal one (a ring gear) or axes pointing opposite ways.
+/// One joint for both shafts is refused. Scene type `spatial_gear`: `shafts: [J1, J2]` (named joints above it),
 /// `angles: [θ1, θ2]` (coordinates), `teeth: [z1, z2]` or `radii: [r1, r2]` (the mean pitch radii, for the
 /// bearings' loads: spatial_mesh()), `reversed` (false), `phase: φ` (0), `pressure_angle: α` (rad, 20°),
-/// `pitch_radii: [r1, r2]` (m: for the bearings' loads where the teeth give the ratio, as a worm's do).
+/// `pitch_radii: [r1, r2]` (m: for the bearings' loads where the teeth give the ratio, as a worm's do); on parallel
+/// shafts `helix_angle: ψ` (rad, 0; > 0: gear 1's teeth right-handed) and `mesh_offset: s` (m, 0: the gears'
+/// mid-plane, s along shaft 1's axis from its joint's point), for the bearings' loads too.
 struct SpatialGearSpec {
   /// @copydoc DistanceSpec::operator==
   bool operator==(const SpatialGearSpec&) const = default;
@@ -69,6 +77,8 @@ struct SpatialGearSpec {
   double pitch_r1 = 0.0;  ///< gear 1's pitch radius (m) for its bearings' loads; 0: z1 if radii
   double pitch_r2 = 0.0;  ///< gear 2's
   double pressure_angle = detail::kPressureAngle;  ///< α (rad): its bearings' loads only (SpatialMesh)
+  double helix_angle = 0.0;                        ///< ψ (rad), parallel shafts: their bearings' loads only
+  double mesh_offset = 0.0;                        ///< s (m), parallel shafts: their bearings' loads only
   std::array<Attachment3, 4> att1{};               ///< derived by setup(): x_a, y_a, z_a, x_b of shaft 1's joint
   std::array<Attachment3, 4> att2{};               ///< the same of shaft 2's joint
 
@@ -79,6 +89,9 @@ struct SpatialGearSpec {
                     "spatial_gear: the tooth counts (or radii) must be positive");
     detail::require(std::isfinite(phase), "spatial_gear: phase is not finite");
     detail::require(detail::is_pressure_angle(pressure_angle), "spatial_gear: pressure_angle must be in [0, pi/2) rad");
+    detail::require(std::isfinite(helix_angle) && std::fabs(helix_angle) < std::numbers::pi / 2,
+                    "spatial_gear: helix_angle must be in (-pi/2, pi/2) rad");
+    detail::require(std::isfinite(mesh_offset), "spatial_gear: mesh_offset is not finite");
     detail::require(
         pitch_r1 == 0.0 || (std::isfinite(pitch_r1) && std::isfinite(pitch_r2) && pitch_r1 > 0.0 && pitch_r2 > 0.0),
         "spatial_gear: pitch_radii must be positive");
@@ -146,20 +159,23 @@ struct SpatialGearSpec {
   /// Two angle coordinates and their rows count for nothing; the mesh removes one freedom.
   JointCount joint_count() const { return JointCount::joint(3, 1); }
   /// @copydoc DistanceSpec::prepare
-  /// setup(), then the shafts' axes at the placement: parallel ones are refused.
+  /// setup(), then the shafts' axes at the placement: a helix angle or a mesh offset is refused unless they are
+  /// parallel (crossed helical gears' helices make their shafts' angle; a bevel pair's apex places its mesh).
   void prepare(const double* q0) {
     setup();
     const kin3::V3 u = att1[2].value(q0), v = att2[2].value(q0);
-    detail::require(kin3::norm(kin3::cross(u, v)) > 1e-6 * kin3::norm(u) * kin3::norm(v),
-                    "spatial_gear: the shafts are parallel at the placement (parallel shafts mesh by a 'gear' "
-                    "between their rotation angles)");
+    const bool parallel = kin3::norm(kin3::cross(u, v)) <= 1e-6 * kin3::norm(u) * kin3::norm(v);
+    detail::require(parallel || (helix_angle == 0.0 && mesh_offset == 0.0),
+                    "spatial_gear: helix_angle and mesh_offset are for parallel shafts (these are not at the "
+                    "placement)");
   }
   /// @copydoc DistanceSpec::sketch
   /// A spatial gear's shafts are drawn by their joints; it draws its two pitch circles, on the shafts (sides b),
-  /// of the ratio z1 : z2, at the pitch cones' bases about the point where the axes cross.
+  /// of the ratio z1 : z2, at the pitch cones' bases about the point where the axes cross (parallel shafts: filling
+  /// the distance between the axes, in the gears' mid-plane).
   template <class Sketch>
   void sketch(Sketch& sk) const {
-    sk.bevel_pair(a1, b1, a2, b2, z1, z2);
+    sk.spatial_gear_pair(a1, b1, a2, b2, z1, z2, reversed, mesh_offset);
   }
   /// @copydoc DistanceSpec::kScene
   static constexpr SceneForm kScene[] = {{"constraints", "spatial_gear", 3,
@@ -168,8 +184,8 @@ struct SpatialGearSpec {
   /// @copydoc DistanceSpec::read
   template <class Fields>
   static SpatialGearSpec read(const Fields& f) {
-    f.expect(
-        {"type", "name", "shafts", "angles", "teeth", "radii", "reversed", "phase", "pressure_angle", "pitch_radii"});
+    f.expect({"type", "name", "shafts", "angles", "teeth", "radii", "reversed", "phase", "pressure_angle",
+              "pitch_radii", "helix_angle", "mesh_offset"});
     SpatialGearSpec g;
     const auto [j1, j2] = f.turning_joints("shafts");
     std::tie(g.a1, g.b1) = j1;
@@ -182,12 +198,25 @@ struct SpatialGearSpec {
     if (f.present("phase")) g.phase = f.number("phase");
     if (f.present("pressure_angle")) g.pressure_angle = f.number("pressure_angle");
     if (f.present("pitch_radii")) std::tie(g.pitch_r1, g.pitch_r2) = f.number_pair("pitch_radii");
+    if (f.present("helix_angle")) g.helix_angle = f.number("helix_angle");
+    if (f.present("mesh_offset")) g.mesh_offset = f.number("mesh_offset");
     return g;
   }
   /// The mesh as a push on the shafts' bearings (SpatialMesh).
   SpatialMesh spatial_mesh() const {
-    SpatialMesh m{a1,      b1, a2, b2, theta1, theta2, ratio(), teeth ? 0.0 : z1, teeth ? 0.0 : z2, pressure_angle,
-                  reversed};
+    SpatialMesh m{a1,
+                  b1,
+                  a2,
+                  b2,
+                  theta1,
+                  theta2,
+                  ratio(),
+                  teeth ? 0.0 : z1,
+                  teeth ? 0.0 : z2,
+                  pressure_angle,
+                  reversed,
+                  helix_angle,
+                  mesh_offset};
     if (pitch_r1 > 0.0) m.r1 = pitch_r1, m.r2 = pitch_r2;
     return m;
   }
