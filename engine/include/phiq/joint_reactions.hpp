@@ -284,10 +284,11 @@ struct MeshFindings {
 /// q̇ (beyond 10⁻⁶ of its terms): their bodies' reference points are not centres that keep their places on the
 /// carrier, so the row does not describe their teeth (a gear on a moving arm whose carrier is not named); and to
 /// `found->slack` the belts whose slack strand would need a negative tension. Pre-condition: `lambda` has one value
-/// per model row, `qd` (if not null) one per coordinate.
+/// per model row, `qd` (if not null) one per coordinate. `scratch` (if not null): the spatial pairs' shafts'
+/// Jacobian, its capacity reused from row to row (a sweep lends one: no allocation per row).
 void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
                           const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd = nullptr,
-                          MeshFindings* found = nullptr);
+                          MeshFindings* found = nullptr, PartJacobian* scratch = nullptr);
 
 /// The multipliers of least norm among those with Φqᵀ λ = Q, from `lambda`, one of them (λ = 0 on the rows the model
 /// dropped as redundant: multipliers_with_factors()), and `lu`, the factors of the kept rows of Φq at q. Each

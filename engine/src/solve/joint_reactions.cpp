@@ -305,7 +305,8 @@ void JointReactions::evaluate_site(const Site& s, const double* q, double t, con
 }
 
 void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
-                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd, MeshFindings* found) {
+                          const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd, MeshFindings* found,
+                          PartJacobian* scratch) {
   double power = 0.0, size = 0.0;  // a mesh's push's power along q̇, and the size of its terms
   auto add_at = [&](Index j, double v) {
     dq(j) += v;
@@ -314,7 +315,8 @@ void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& mes
   auto add = [&](const Slot& s, double v) {
     if (s.is_coordinate()) add_at(s.coord(), v);
   };
-  PartJacobian jac;  // (spatial pairs only)
+  PartJacobian own;  // (spatial pairs only; empty, allocating nothing, unless a pair pushes without `scratch`)
+  PartJacobian& jac = scratch ? *scratch : own;
   // a force on a member's centre; none on a fixed gear's (its frame is its carrier's: OutputMesh::fixed)
   auto add_to = [&](const OutputMesh& m, int member, double fx, double fy) {
     if (m.fixed == member) return;

@@ -107,7 +107,7 @@ void Sweeper::row_reactions(SparseLuNumeric& lu) {
     MeshFindings& found = effort_work_.mesh_findings;
     found.working.clear(), found.slack.clear(), found.unplaced.clear();
     add_gear_mesh_forces(model_, opt_.efforts.meshes, current_.q.data(), effort_work_.lambda, effort_work_.mesh_q,
-                         current_.qd.data(), &found);
+                         current_.qd.data(), &found, &effort_work_.mesh_jacobian);
     warn_meshes(found, note);
     if (!effort_work_.mesh_q.isZero(0.0)) {  // (meshes that push nothing here, all of them unloaded: no solve)
       if (!multipliers_with_factors(model_, lu, effort_work_.mesh_q, effort_work_.kept, effort_work_.mesh_lambda))

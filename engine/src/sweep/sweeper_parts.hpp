@@ -163,6 +163,7 @@ struct EffortWork {
   Eigen::VectorXd q, kept, lambda, phi_t;    // Q, the kept rows, λ, Φt
   Eigen::VectorXd mesh_q, mesh_lambda;       // the gear meshes' push on their bearings, and its multipliers
   MeshFindings mesh_findings;                // what add_gear_mesh_forces() found at the row
+  PartJacobian mesh_jacobian;                // add_gear_mesh_forces()' scratch (spatial pairs' shafts)
   std::shared_ptr<const PartForces> forces;  // Q's parts, gathered once a sweep (Sweeper's constructor)
   // what Q's parts on planar frames added, one per part, when natural joints' reactions read their bodies' (else
   // empty)
