@@ -73,7 +73,8 @@ ChunkedSweep::ChunkedSweep(const Model& model, const SweepOptions& opt, Workspac
   seeder_ = std::make_unique<Sweeper>(model, seed_options_, *sws, seed_summary_);
   seeder_->adopt(run.time_of(0));
   pool_.release(sws);
-  euler_signs_.start(run.time_of(0), at_.q, need_v_ ? at_.qd : Eigen::VectorXd());
+  euler_signs_.start(run.time_of(0), at_.q, need_v_ ? at_.qd : Eigen::VectorXd(),
+                     need_a_ ? at_.qdd : Eigen::VectorXd());
 }
 
 // Finds seed sched_.seeded (the lock is not held; only the thread holding seeding_busy changes seeded).
@@ -98,13 +99,25 @@ void ChunkedSweep::seed_one() {
     ok = seeder.advance(run_.time_of(++row), 0);
   const auto at = static_cast<std::size_t>(c);
   add_counters(seeds_.work[at], w->counters, w0);
+  // Where the sweep solves velocities, the seed's too (and accelerations), for the sign of the next seed's Euler
+  // parameters (euler_signs.hpp): with the seeding's own factors, not counted (the summary counts the rows' solves;
+  // these steer the seeds' signs alone, and no bit of a seed)
+  Eigen::VectorXd seed_qd, seed_qdd;
+  if (ok && need_v_ && !euler_signs_.empty()) {
+    w->q = seeder.state().q;
+    const double t = run_.time_of(row);
+    if (solve_velocity(model_, t, *w) == SolveStatus::kSuccess) {
+      seed_qd = w->qd;
+      if (need_a_ && solve_acceleration(model_, t, *w) == SolveStatus::kSuccess) seed_qdd = w->qdd;
+    }
+  }
   pool_.release(w);
   if (ok) {
     first_[at] = row;  // (chunk c − 1, which ends here, is not claimed before: ready)
     seeds_.q[at] = seeder.state().q;
     seeds_.error[at] = seeder.state_error();
     // (a seed turned to −e is checked by a Newton step, as an unknown one is)
-    if (euler_signs_.align(run_.time_of(row), seeds_.q[at])) seeds_.error[at] = INFINITY;
+    if (euler_signs_.align(run_.time_of(row), seeds_.q[at], seed_qd, seed_qdd)) seeds_.error[at] = INFINITY;
     seeds_.rounding[at] = seeder.take_rounding_level();
   }
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - seed_start).count();

@@ -52,16 +52,24 @@ EulerSeedSigns::EulerSeedSigns(const Model& model) {
     }
   }
   last_.resize(bodies_.size()), before_.resize(bodies_.size()), rate_.resize(bodies_.size());
+  accel_.resize(bodies_.size());
 }
 
-void EulerSeedSigns::start(double t0, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
-  has_rate_ = qd.size() == q.size();
-  for (std::size_t b = 0; b < bodies_.size(); ++b)
-    for (std::size_t k = 0; k < 4; ++k) {
-      const Index j = bodies_[b][k];
-      last_[b][k] = j < 0 ? 0.0 : q[j];
-      rate_[b][k] = j < 0 || !has_rate_ ? 0.0 : qd[j];
-    }
+void EulerSeedSigns::keep_rates(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, std::size_t b, bool turned) {
+  has_rate_ = qd.size() > 0, has_accel_ = has_rate_ && qdd.size() > 0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Index j = bodies_[b][k];
+    rate_[b][k] = j < 0 || !has_rate_ ? 0.0 : (turned ? -qd[j] : qd[j]);
+    accel_[b][k] = j < 0 || !has_accel_ ? 0.0 : (turned ? -qdd[j] : qdd[j]);
+  }
+}
+
+void EulerSeedSigns::start(double t0, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    for (std::size_t k = 0; k < 4; ++k) last_[b][k] = bodies_[b][k] < 0 ? 0.0 : q[bodies_[b][k]];
+    keep_rates(qd.size() == q.size() ? qd : Eigen::VectorXd(), qdd.size() == q.size() ? qdd : Eigen::VectorXd(), b,
+               false);
+  }
   t_last_ = t0;
   known_ = 1;
 }
@@ -87,34 +95,40 @@ bool EulerSeedSigns::turn_like(const double* reference, Eigen::VectorXd& q) cons
   return turned;
 }
 
-bool EulerSeedSigns::align(double t, Eigen::VectorXd& seed) {
+bool EulerSeedSigns::align(double t, Eigen::VectorXd& seed, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
   bool turned = false;
+  const bool from_rates = has_rate_;  // (the last seed's: keep_rates() sets it for this one, body by body)
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const std::array<Index, 4>& body = bodies_[b];
     Quat e{};
     for (std::size_t k = 0; k < 4; ++k) e[k] = body[k] < 0 ? 0.0 : seed[body[k]];
-    // the orientation expected at t, turning at a constant rate: the turn from the seed before last to the last,
-    // carried on over (t − t_last) (ė = ½ ω ⊗ e: from row 0 and its rate, the turn ω (t − t0))
-    // (with neither, the seed keeps its sign: a positions-only first seed, which the seeding pass reached in
-    // sub-steps, knows its sign better than row 0 alone does)
+    // the orientation expected at t: the last seed's turned by φ = ω Δt + α Δt²/2 (ė = ½ ω ⊗ e, so ė ⊗ e* = ½ ω;
+    // ë ⊗ e* = ½ α − ¼ |ω|², whose vector part is ½ α), where its rates are known; else turning at a constant
+    // rate, the turn from the seed before last to the last carried on over (t − t_last) (with neither, the seed
+    // keeps its sign: a positions-only first seed, which the seeding pass reached in sub-steps, knows its sign
+    // better than row 0 alone does)
     Quat expected{};
-    if (known_ >= 2) {
+    if (from_rates) {
+      const double dt = t - t_last_;
+      const Quat w = product(rate_[b], conjugate(last_[b])), a = product(accel_[b], conjugate(last_[b]));  // ½ ω, ½ α
+      const double hx = w[1] * dt + 0.5 * a[1] * dt * dt, hy = w[2] * dt + 0.5 * a[2] * dt * dt,
+                   hz = w[3] * dt + 0.5 * a[3] * dt * dt;  // φ/2 (a is 0 without ë)
+      expected = product(turn(std::sqrt(hx * hx + hy * hy + hz * hz), hx, hy, hz), last_[b]);
+    } else if (known_ >= 2) {
       const Quat r = product(last_[b], conjugate(before_[b]));
       const double half = std::atan2(std::sqrt(r[1] * r[1] + r[2] * r[2] + r[3] * r[3]), r[0]);
       const double s = (t - t_last_) / (t_last_ - t_before_);
       expected = product(turn(s * half, r[1], r[2], r[3]), last_[b]);
-    } else if (has_rate_) {
-      const Quat w = product(rate_[b], conjugate(last_[b]));  // ½ ω
-      const double half = std::sqrt(w[1] * w[1] + w[2] * w[2] + w[3] * w[3]) * (t - t_last_);
-      expected = product(turn(half, w[1], w[2], w[3]), last_[b]);
     }
     const double dot = e[0] * expected[0] + e[1] * expected[1] + e[2] * expected[2] + e[3] * expected[3];
-    if (dot < kOpposite) {
+    const bool turn_this = dot < kOpposite;
+    if (turn_this) {
       turn_over(body, seed);
       for (double& x : e) x = 0.0 - x;
       turned = true;
     }
     before_[b] = last_[b], last_[b] = e;
+    keep_rates(qd, qdd, b, turn_this);
   }
   t_before_ = t_last_, t_last_ = t;
   ++known_;

@@ -16,20 +16,24 @@ namespace phiq::detail {
 
 // The coordinates (e0 … e3) of each body whose four Euler parameters are all coordinates, and the seeds' Euler
 // parameters before the one being aligned (their times, the sign they continue with). A seed's sign is that of the
-// orientation extrapolated at its time as a rotation: at constant turning rate, from the two seeds before it, or
-// from row 0 and its q̇ (positions only: the first seed keeps the sign the seeding pass reached in sub-steps); right
-// while a body turns less than a half turn per chunk span (an extrapolation of e itself, component by component,
-// turns the sign before a quarter turn). A seed is turned only where it is clearly opposite (euler_signs.cpp).
+// orientation extrapolated at its time as a rotation: from the seed before it (row 0 first) by the turn its ė and ë
+// make over the span, ω Δt + α Δt²/2, where the sweep solves velocities (and accelerations) — right however many
+// turns a body makes per chunk span, while that second-order turn errs by less than a half turn —; else at constant
+// turning rate from the two seeds before it (positions only: the first seed keeps the sign the seeding pass reached
+// in sub-steps), right while a body turns less than a half turn per chunk span (an extrapolation of e itself,
+// component by component, turns the sign before a quarter turn). A seed is turned only where it is clearly
+// opposite (euler_signs.cpp).
 class EulerSeedSigns {
  public:
   explicit EulerSeedSigns(const Model& model);
   // Whether the model has a body whose sign can be wrong (else align() does nothing).
   bool empty() const { return bodies_.empty(); }
-  // Row 0's position at t0, and its q̇ where the sweep solves it (empty otherwise).
-  void start(double t0, const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
+  // Row 0's position at t0, and its q̇ and q̈ where the sweep solves them (empty otherwise).
+  void start(double t0, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd);
   // Turns `seed`'s Euler parameters, body by body, to the sign of the orientation extrapolated at t from the
-  // seeds aligned before (seeds come in time order). Returns whether any body's were turned.
-  bool align(double t, Eigen::VectorXd& seed);
+  // seeds aligned before (seeds come in time order); its q̇ and q̈ there (each empty when not known) carry the
+  // extrapolation to the next seed. Returns whether any body's were turned.
+  bool align(double t, Eigen::VectorXd& seed, const Eigen::VectorXd& qd = {}, const Eigen::VectorXd& qdd = {});
   // Turns q's Euler parameters, body by body, to the sign of those of `reference` (same size). Returns whether any
   // body's were turned.
   bool turn_like(const double* reference, Eigen::VectorXd& q) const;
@@ -37,11 +41,13 @@ class EulerSeedSigns {
  private:
   using Quat = std::array<double, 4>;
   std::vector<std::array<Index, 4>> bodies_;
-  // per body: the last two aligned seeds' (row 0's first) Euler parameters, and row 0's rate
-  std::vector<Quat> last_, before_, rate_;
+  // per body: the last two aligned seeds' (row 0's first) Euler parameters, and the last one's ė and ë
+  std::vector<Quat> last_, before_, rate_, accel_;
   double t_last_ = 0.0, t_before_ = 0.0;
-  int known_ = 0;  // seeds (row 0 included) in last_, before_
-  bool has_rate_ = false;
+  int known_ = 0;                              // seeds (row 0 included) in last_, before_
+  bool has_rate_ = false, has_accel_ = false;  // rate_, accel_ are the last seed's
+  // rate_ and accel_ (and has_rate_, has_accel_) from `qd`, `qdd` (empty: unknown), body b turned over or not
+  void keep_rates(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, std::size_t b, bool turned);
 };
 
 }  // namespace phiq::detail
