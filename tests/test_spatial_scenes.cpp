@@ -381,35 +381,50 @@ TEST(SpatialScenes, TurningBodyKeepsItsThreadsAcrossTheSignOfItsEulerParameters)
   }
 }
 
-// The same body spun up, θ = 0.25 + 10 t + 5 t² over 2 s in 40 steps, chunks of 10: 1 to 2.2 turns per chunk span. A
-// constant rate from the seed before (or from row 0) misses the turn by more than a half, so the seed's sign was a
-// guess and a chunk fell back to the sweep in order; the seeds' own ė and ë (the sweep solves q̇ and q̈) carry the turn
-// to the next seed to second order: every chunk is delivered as computed, the same bits on one thread and two, and
-// e continuous from row 0 (θ modulo 4π).
+// The same body spun up, θ = 0.25 + 10 t + 5 t² over 2 s in 40 steps, chunks of 10: 1 to 2.2 turns per chunk span;
+// and, positions only, at 30 rad/s in 80 steps, chunks of 16: 1.9 turns. A constant rate from the two seeds before
+// misses the turn by more than a half where the body speeds up, loses whole turns where it turns more than one, and
+// a positions-only first seed, reached in sub-steps of 3 rad, may land on −e: a chunk's seed's sign was a guess and
+// the chunk fell back to the sweep in order. Row 0's and each seed's ė and ë (solved by the seeding pass where the
+// sweep does not) carry the turn to the next seed to second order: every chunk is delivered as computed, the same
+// bits on one thread and two, and e continuous from row 0 (θ modulo 4π).
 TEST(SpatialScenes, ASpunUpBodyKeepsItsThreadsAcrossTheSignOfItsEulerParameters) {
-  std::string text = kTurningBody;
-  text = test::replace_first(text, "law: {type: linear, initial: 0.25, rate: 1.7}",
-                             "law: {type: polynomial, coefficients: [0.25, 10, 5]}");
-  text = test::replace_first(text, "time: {start: 0, end: 8, steps: 64}", "time: {start: 0, end: 2, steps: 40}");
-  const Scene s = parse_scene(text, "spun_up.yaml");
-  const Model& m = *s.model;
-  const Index e0 = m.coordinate_index("b_e0"), e3 = m.coordinate_index("b_e3");
-  SweepOptions opt = s.sweep;
-  opt.chunk_steps = 10;
-  test::Trace one, two;
-  SweepSummary s1, s2;
-  opt.threads = 1;
-  ASSERT_EQ(test::sweep(m, opt, &one, &s1), SolveStatus::kSuccess) << s1.message;
-  opt.threads = 2;
-  ASSERT_EQ(test::sweep(m, opt, &two, &s2), SolveStatus::kSuccess) << s2.message;
-  for (const SweepWarning& w : s2.warnings) ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
-  EXPECT_EQ(s2.parallel_chunks, 4);
-  ASSERT_EQ(two.t.size(), 41u);
-  for (std::size_t k = 0; k < two.t.size(); ++k) {
-    SCOPED_TRACE("t = " + std::to_string(two.t[k]));
-    EXPECT_TRUE(two.q[k] == one.q[k] && two.qd[k] == one.qd[k] && two.qdd[k] == one.qdd[k]);
-    const double t = two.t[k], theta = 0.25 + 10 * t + 5 * t * t;
-    EXPECT_NEAR(std::remainder(2.0 * std::atan2(two.q[k][e3], two.q[k][e0]) - theta, 4.0 * M_PI), 0.0, 1e-9);
+  struct Case {
+    const char* law;
+    const char* time;
+    Index chunk;
+    bool rates;
+    double a1, a2;  // θ = 0.25 + a1 t + a2 t²
+  };
+  for (const Case& c : {Case{"[0.25, 10, 5]", "time: {start: 0, end: 2, steps: 40}", 10, true, 10, 5},
+                        Case{"[0.25, 30, 0]", "time: {start: 0, end: 2, steps: 80}", 16, false, 30, 0}}) {
+    SCOPED_TRACE(c.law);
+    std::string text = kTurningBody;
+    text = test::replace_first(text, "law: {type: linear, initial: 0.25, rate: 1.7}",
+                               std::string("law: {type: polynomial, coefficients: ") + c.law + "}");
+    text = test::replace_first(text, "time: {start: 0, end: 8, steps: 64}", c.time);
+    if (!c.rates) text = test::replace_first(text, "output: {velocities: true, accelerations: true}\n", "");
+    const Scene s = parse_scene(text, "spun_up.yaml");
+    const Model& m = *s.model;
+    const Index e0 = m.coordinate_index("b_e0"), e3 = m.coordinate_index("b_e3");
+    SweepOptions opt = s.sweep;
+    opt.chunk_steps = c.chunk;
+    test::Trace one, two;
+    SweepSummary s1, s2;
+    opt.threads = 1;
+    ASSERT_EQ(test::sweep(m, opt, &one, &s1), SolveStatus::kSuccess) << s1.message;
+    opt.threads = 2;
+    ASSERT_EQ(test::sweep(m, opt, &two, &s2), SolveStatus::kSuccess) << s2.message;
+    for (const SweepWarning& w : s2.warnings) ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
+    EXPECT_EQ(s2.parallel_chunks, (opt.steps + c.chunk - 1) / c.chunk);
+    ASSERT_EQ(two.t.size(), static_cast<std::size_t>(opt.steps + 1));
+    for (std::size_t k = 0; k < two.t.size(); ++k) {
+      SCOPED_TRACE("t = " + std::to_string(two.t[k]));
+      EXPECT_TRUE(two.q[k] == one.q[k]);
+      if (c.rates) EXPECT_TRUE(two.qd[k] == one.qd[k] && two.qdd[k] == one.qdd[k]);
+      const double t = two.t[k], theta = 0.25 + c.a1 * t + c.a2 * t * t;
+      EXPECT_NEAR(std::remainder(2.0 * std::atan2(two.q[k][e3], two.q[k][e0]) - theta, 4.0 * M_PI), 0.0, 1e-9);
+    }
   }
 }
 

@@ -72,9 +72,18 @@ ChunkedSweep::ChunkedSweep(const Model& model, const SweepOptions& opt, Workspac
   sws->q = at_.q;
   seeder_ = std::make_unique<Sweeper>(model, seed_options_, *sws, seed_summary_);
   seeder_->adopt(run.time_of(0));
+  // row 0's rates for the first seed's sign, solved here where the sweep does not (as the seeds' are: seed_one)
+  Eigen::VectorXd qd0 = need_v_ ? at_.qd : Eigen::VectorXd(), qdd0 = need_a_ ? at_.qdd : Eigen::VectorXd();
+  if (!euler_signs_.empty() && !need_a_) {
+    sws->q = at_.q;
+    if (need_v_) sws->qd = at_.qd;
+    if (need_v_ || solve_velocity(model, run.time_of(0), *sws) == SolveStatus::kSuccess) {
+      qd0 = sws->qd;
+      if (solve_acceleration(model, run.time_of(0), *sws) == SolveStatus::kSuccess) qdd0 = sws->qdd;
+    }
+  }
   pool_.release(sws);
-  euler_signs_.start(run.time_of(0), at_.q, need_v_ ? at_.qd : Eigen::VectorXd(),
-                     need_a_ ? at_.qdd : Eigen::VectorXd());
+  euler_signs_.start(run.time_of(0), at_.q, qd0, qdd0);
 }
 
 // Finds seed sched_.seeded (the lock is not held; only the thread holding seeding_busy changes seeded).
@@ -99,16 +108,16 @@ void ChunkedSweep::seed_one() {
     ok = seeder.advance(run_.time_of(++row), 0);
   const auto at = static_cast<std::size_t>(c);
   add_counters(seeds_.work[at], w->counters, w0);
-  // Where the sweep solves velocities, the seed's too (and accelerations), for the sign of the next seed's Euler
-  // parameters (euler_signs.hpp): with the seeding's own factors, not counted (the summary counts the rows' solves;
-  // these steer the seeds' signs alone, and no bit of a seed)
+  // The seed's velocity and acceleration, for the sign of the next seed's Euler parameters (euler_signs.hpp), in a
+  // model with free ones: with the seeding's own factors, not counted (the summary counts the rows' solves; these
+  // steer the seeds' signs alone, and no bit of a seed)
   Eigen::VectorXd seed_qd, seed_qdd;
-  if (ok && need_v_ && !euler_signs_.empty()) {
+  if (ok && !euler_signs_.empty()) {
     w->q = seeder.state().q;
     const double t = run_.time_of(row);
     if (solve_velocity(model_, t, *w) == SolveStatus::kSuccess) {
       seed_qd = w->qd;
-      if (need_a_ && solve_acceleration(model_, t, *w) == SolveStatus::kSuccess) seed_qdd = w->qdd;
+      if (solve_acceleration(model_, t, *w) == SolveStatus::kSuccess) seed_qdd = w->qdd;
     }
   }
   pool_.release(w);

@@ -16,13 +16,13 @@ namespace phiq::detail {
 
 // The coordinates (e0 … e3) of each body whose four Euler parameters are all coordinates, and the seeds' Euler
 // parameters before the one being aligned (their times, the sign they continue with). A seed's sign is that of the
-// orientation extrapolated at its time as a rotation: from the seed before it (row 0 first) by the turn its ė and ë
-// make over the span, ω Δt + α Δt²/2, where the sweep solves velocities (and accelerations) — right however many
-// turns a body makes per chunk span, while that second-order turn errs by less than a half turn —; else at constant
-// turning rate from the two seeds before it (positions only: the first seed keeps the sign the seeding pass reached
-// in sub-steps), right while a body turns less than a half turn per chunk span (an extrapolation of e itself,
-// component by component, turns the sign before a quarter turn). A seed is turned only where it is clearly
-// opposite (euler_signs.cpp).
+// orientation extrapolated at its time as a rotation: from the seed before it by the turn its ė and ë make over the
+// span, ω Δt + α Δt²/2 (the seeding pass solves them at each seed; row 0 has them where the sweep solves velocities
+// and accelerations) — right however many turns a body makes per chunk span, while that second-order turn errs by
+// less than a half turn —; else at constant turning rate from the two seeds before it (positions only: the first
+// seed keeps the sign the seeding pass reached in sub-steps), right while a body turns less than a half turn per
+// chunk span (an extrapolation of e itself, component by component, turns the sign before a quarter turn). A seed
+// is turned only where it is clearly opposite (euler_signs.cpp).
 class EulerSeedSigns {
  public:
   explicit EulerSeedSigns(const Model& model);
