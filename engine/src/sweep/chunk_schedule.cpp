@@ -72,7 +72,8 @@ ChunkedSweep::ChunkedSweep(const Model& model, const SweepOptions& opt, Workspac
   sws->q = at_.q;
   seeder_ = std::make_unique<Sweeper>(model, seed_options_, *sws, seed_summary_);
   seeder_->adopt(run.time_of(0));
-  // row 0's rates for the first seed's sign, solved here where the sweep does not (as the seeds' are: seed_one)
+  // row 0's rates for the first seed's sign, solved here where the sweep does not (as the seeds' are: seed_one; not
+  // counted)
   Eigen::VectorXd qd0 = need_v_ ? at_.qd : Eigen::VectorXd(), qdd0 = need_a_ ? at_.qdd : Eigen::VectorXd();
   if (!euler_signs_.empty() && !need_a_) {
     sws->q = at_.q;

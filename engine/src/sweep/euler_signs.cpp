@@ -56,11 +56,12 @@ EulerSeedSigns::EulerSeedSigns(const Model& model) {
 }
 
 void EulerSeedSigns::keep_rates(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, std::size_t b, bool turned) {
-  has_rate_ = qd.size() > 0, has_accel_ = has_rate_ && qdd.size() > 0;
+  has_rate_ = qd.size() > 0;
+  const bool has_accel = has_rate_ && qdd.size() > 0;
   for (std::size_t k = 0; k < 4; ++k) {
     const Index j = bodies_[b][k];
     rate_[b][k] = j < 0 || !has_rate_ ? 0.0 : (turned ? -qd[j] : qd[j]);
-    accel_[b][k] = j < 0 || !has_accel_ ? 0.0 : (turned ? -qdd[j] : qdd[j]);
+    accel_[b][k] = j < 0 || !has_accel ? 0.0 : (turned ? -qdd[j] : qdd[j]);
   }
 }
 
@@ -104,9 +105,8 @@ bool EulerSeedSigns::align(double t, Eigen::VectorXd& seed, const Eigen::VectorX
     for (std::size_t k = 0; k < 4; ++k) e[k] = body[k] < 0 ? 0.0 : seed[body[k]];
     // the orientation expected at t: the last seed's turned by φ = ω Δt + α Δt²/2 (ė = ½ ω ⊗ e, so ė ⊗ e* = ½ ω;
     // ë ⊗ e* = ½ α − ¼ |ω|², whose vector part is ½ α), where its rates are known; else turning at a constant
-    // rate, the turn from the seed before last to the last carried on over (t − t_last) (with neither, the seed
-    // keeps its sign: a positions-only first seed, which the seeding pass reached in sub-steps, knows its sign
-    // better than row 0 alone does)
+    // rate, the turn from the seed before last to the last carried on over (t − t_last) (with neither, the first
+    // seed keeps the sign the seeding pass reached: in sub-steps where the sweep solves positions only)
     Quat expected{};
     if (from_rates) {
       const double dt = t - t_last_;

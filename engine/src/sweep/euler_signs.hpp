@@ -17,18 +17,18 @@ namespace phiq::detail {
 // The coordinates (e0 … e3) of each body whose four Euler parameters are all coordinates, and the seeds' Euler
 // parameters before the one being aligned (their times, the sign they continue with). A seed's sign is that of the
 // orientation extrapolated at its time as a rotation: from the seed before it by the turn its ė and ë make over the
-// span, ω Δt + α Δt²/2 (the seeding pass solves them at each seed; row 0 has them where the sweep solves velocities
-// and accelerations) — right however many turns a body makes per chunk span, while that second-order turn errs by
-// less than a half turn —; else at constant turning rate from the two seeds before it (positions only: the first
-// seed keeps the sign the seeding pass reached in sub-steps), right while a body turns less than a half turn per
-// chunk span (an extrapolation of e itself, component by component, turns the sign before a quarter turn). A seed
-// is turned only where it is clearly opposite (euler_signs.cpp).
+// span, ω Δt + α Δt²/2 (the seeding pass solves them at row 0 and at each seed) — right however many turns a body
+// makes per chunk span, while that second-order turn errs by less than a half turn —; else (no rates there: a
+// singular position) at constant turning rate from the two seeds before it, right while a body turns less than a
+// half turn per chunk span (an extrapolation of e itself, component by component, turns the sign before a quarter
+// turn), or, the first seed, with the sign the seeding pass reached. A seed is turned only where it is clearly
+// opposite (euler_signs.cpp).
 class EulerSeedSigns {
  public:
   explicit EulerSeedSigns(const Model& model);
   // Whether the model has a body whose sign can be wrong (else align() does nothing).
   bool empty() const { return bodies_.empty(); }
-  // Row 0's position at t0, and its q̇ and q̈ where the sweep solves them (empty otherwise).
+  // Row 0's position at t0, and its q̇ and q̈ (each empty where not known).
   void start(double t0, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd);
   // Turns `seed`'s Euler parameters, body by body, to the sign of the orientation extrapolated at t from the
   // seeds aligned before (seeds come in time order); its q̇ and q̈ there (each empty when not known) carry the
@@ -44,9 +44,9 @@ class EulerSeedSigns {
   // per body: the last two aligned seeds' (row 0's first) Euler parameters, and the last one's ė and ë
   std::vector<Quat> last_, before_, rate_, accel_;
   double t_last_ = 0.0, t_before_ = 0.0;
-  int known_ = 0;                              // seeds (row 0 included) in last_, before_
-  bool has_rate_ = false, has_accel_ = false;  // rate_, accel_ are the last seed's
-  // rate_ and accel_ (and has_rate_, has_accel_) from `qd`, `qdd` (empty: unknown), body b turned over or not
+  int known_ = 0;          // seeds (row 0 included) in last_, before_
+  bool has_rate_ = false;  // rate_ is the last seed's ė (accel_ its ë, or 0 where not known)
+  // rate_ and accel_ (and has_rate_) from `qd`, `qdd` (empty: unknown), body b turned over or not
   void keep_rates(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, std::size_t b, bool turned);
 };
 
