@@ -89,7 +89,7 @@ void expect_newton_euler(const ParallelCase& c) {
         EXPECT_NEAR(v[2 + 3 * b + static_cast<std::size_t>(i)], expected[b](i), 1e-10 * scale) << k << " " << b;
     largest = std::max(largest, std::fabs(ft));
   }
-  EXPECT_GT(largest, 0.02);  // (the motor's 1 rad/s² turns the output at a quarter to a third of it)
+  EXPECT_GT(largest, 0.02);  // (the motor's 1 rad/s² turns the output at a quarter to four times it)
 }
 
 TEST(HelicalMeshes, ParallelShaftsBearingsCarryTheTeethsPushByNewtonEuler) {
