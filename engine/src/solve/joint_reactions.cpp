@@ -9,6 +9,7 @@
 #include "phiq/constraint_block.hpp"
 #include "phiq/part_motion.hpp"
 #include "solve/minimum_norm.hpp"
+#include "solve/part_forces.hpp"
 
 namespace phiq {
 

@@ -66,10 +66,11 @@ void EulerSeedSigns::keep_rates(const Eigen::VectorXd& qd, const Eigen::VectorXd
 }
 
 void EulerSeedSigns::start(double t0, const Eigen::VectorXd& q, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
+  const Eigen::VectorXd none;  // (both sides of each choice below lvalues: no copy of q̇ or q̈ per body)
+  const Eigen::VectorXd &rate = qd.size() == q.size() ? qd : none, &accel = qdd.size() == q.size() ? qdd : none;
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     for (std::size_t k = 0; k < 4; ++k) last_[b][k] = bodies_[b][k] < 0 ? 0.0 : q[bodies_[b][k]];
-    keep_rates(qd.size() == q.size() ? qd : Eigen::VectorXd(), qdd.size() == q.size() ? qdd : Eigen::VectorXd(), b,
-               false);
+    keep_rates(rate, accel, b, false);
   }
   t_last_ = t0;
   known_ = 1;
@@ -94,6 +95,26 @@ bool EulerSeedSigns::turn_like(const double* reference, Eigen::VectorXd& q) cons
     if (dot < 0.0) turn_over(body, q), turned = true;
   }
   return turned;
+}
+
+bool EulerSeedSigns::turns_far(double span) const {
+  constexpr double kQuarterTurn = 0.5 * 3.141592653589793;
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    double turn = 0.0;
+    if (has_rate_) {
+      const Quat w = product(rate_[b], conjugate(last_[b])), a = product(accel_[b], conjugate(last_[b]));  // ½ ω, ½ α
+      turn = 2.0 * (std::sqrt(w[1] * w[1] + w[2] * w[2] + w[3] * w[3]) * span +
+                    0.5 * std::sqrt(a[1] * a[1] + a[2] * a[2] + a[3] * a[3]) * span * span);
+    } else if (known_ >= 2) {
+      const Quat r = product(last_[b], conjugate(before_[b]));
+      turn = 2.0 * std::atan2(std::sqrt(r[1] * r[1] + r[2] * r[2] + r[3] * r[3]), std::fabs(r[0])) * span /
+             (t_last_ - t_before_);
+    } else {
+      return true;  // nothing known: solve them
+    }
+    if (!(turn < kQuarterTurn)) return true;
+  }
+  return false;
 }
 
 bool EulerSeedSigns::align(double t, Eigen::VectorXd& seed, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {

@@ -34,6 +34,10 @@ class EulerSeedSigns {
   // seeds aligned before (seeds come in time order); its q̇ and q̈ there (each empty when not known) carry the
   // extrapolation to the next seed. Returns whether any body's were turned.
   bool align(double t, Eigen::VectorXd& seed, const Eigen::VectorXd& qd = {}, const Eigen::VectorXd& qdd = {});
+  // Whether a body may turn a quarter turn or more over `span` from the last seed, by its rates there
+  // (|ω| span + |α| span²/2), else by the turn between the two seeds before (|θ| span / their span): where none
+  // does, the constant-rate extrapolation is right, and the next seed's rates need not be solved for align().
+  bool turns_far(double span) const;
   // Turns q's Euler parameters, body by body, to the sign of those of `reference` (same size). Returns whether any
   // body's were turned.
   bool turn_like(const double* reference, Eigen::VectorXd& q) const;
