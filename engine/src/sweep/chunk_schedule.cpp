@@ -111,9 +111,8 @@ void ChunkedSweep::seed_one() {
   add_counters(seeds_.work[at], w->counters, w0);
   // The seed's velocity and acceleration, for the sign of the next seed's Euler parameters (euler_signs.hpp), in a
   // model with free ones where a body may turn a quarter turn over a chunk span (else the constant-rate
-  // extrapolation is right, and the factorisation they may take, 4 % of a 3D chain's sweep, is saved): with the
-  // seeding's own factors, not counted (the summary counts the rows' solves; these steer the seeds' signs alone,
-  // and no bit of a seed)
+  // extrapolation is right, and their solves are saved): with the seeding's own factors, not counted (the summary
+  // counts the rows' solves; these steer the seeds' signs alone, and no bit of a seed)
   Eigen::VectorXd seed_qd, seed_qdd;
   if (ok && !euler_signs_.empty() && euler_signs_.turns_far(run_.time_of(row) - t0)) {
     w->q = seeder.state().q;
