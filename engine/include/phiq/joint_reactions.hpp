@@ -277,15 +277,15 @@ struct MeshFindings {
 /// |λ| tan α on the pinion's centre, the parting on the rack across its travel and the moment of its push about its
 /// reference point on its angle. A belt or chain whose strands
 /// are known (GearMesh::strands_known()) pulls its pulleys' centres by its two strands' tensions along them, which
-/// its torque −λ on pulley 1 splits (GearMesh); without them, or with overlapping pulleys, it adds nothing. A bevel
-/// or worm pair (OutputMesh::spatial) pushes its shafts at its pitch point (SpatialMesh), or adds nothing when that
-/// is not placed (appended to `found->unplaced`). A mesh with OutputMesh::unloaded adds nothing.
-/// With the row's velocities `qd`, appends to `found->working` (when not null) the meshes whose push does work along
-/// q̇ (beyond 10⁻⁶ of its terms): their bodies' reference points are not centres that keep their places on the
-/// carrier, so the row does not describe their teeth (a gear on a moving arm whose carrier is not named); and to
-/// `found->slack` the belts whose slack strand would need a negative tension. Pre-condition: `lambda` has one value
-/// per model row, `qd` (if not null) one per coordinate. `scratch` (if not null): the spatial pairs' shafts'
-/// Jacobian, its capacity reused from row to row (a sweep lends one: no allocation per row).
+/// its torque −λ on pulley 1 splits (GearMesh); without them, or with overlapping pulleys, it adds nothing. A
+/// spatial pair (OutputMesh::spatial: bevel, worm, spur or helical) pushes its shafts at its pitch point
+/// (SpatialMesh), or adds nothing when that is not placed (appended to `found->unplaced`). A mesh with
+/// OutputMesh::unloaded adds nothing. With the row's velocities `qd`, appends to `found->working` (when not null) the
+/// meshes whose push does work along q̇ (beyond 10⁻⁶ of its terms): their bodies' reference points are not centres that
+/// keep their places on the carrier, so the row does not describe their teeth (a gear on a moving arm whose carrier is
+/// not named); and to `found->slack` the belts whose slack strand would need a negative tension. Pre-condition:
+/// `lambda` has one value per model row, `qd` (if not null) one per coordinate. `scratch` (if not null): the spatial
+/// pairs' shafts' Jacobian, its capacity reused from row to row (a sweep lends one: no allocation per row).
 void add_gear_mesh_forces(const Model& model, const std::vector<OutputMesh>& meshes, const double* q,
                           const Eigen::VectorXd& lambda, Eigen::VectorXd& dq, const double* qd = nullptr,
                           MeshFindings* found = nullptr, PartJacobian* scratch = nullptr);

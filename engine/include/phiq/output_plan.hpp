@@ -104,7 +104,8 @@ struct OutputMesh {
   Frame2 first;
   Frame2 second;       ///< the body whose ψ is mesh.second (gear 2, the pinion)
   int rack_axis = -1;  ///< a rack's travel: 0 its body's x, 1 its y (−1: a gear pair)
-  /// A spatial gear pair (bevel or worm), taken from its constraint's block once; mesh, first and second unused.
+  /// A spatial gear pair (bevel, worm, spur or helical on parallel shafts), taken from its constraint's block once;
+  /// mesh, first and second unused.
   std::optional<SpatialMesh> spatial;
   /// A gear held fixed (the ground's or a fixed body's angle) in an epicyclic train: 0 gear 1, 1 gear 2 (−1: none).
   /// It is coaxial with the carrier, so its frame above is the carrier's, whose reference point stands for its

@@ -344,7 +344,8 @@ void PartSketcher::spatial_gear_pair(const JointSide3& a1, const JointSide3& b1,
   const V3 p1 = h1.apply(a1.at), p2 = h2.apply(a2.at);
   const V3 u1 = unit(derived::turn(h1, a1.axis)), u2 = unit(derived::turn(h2, a2.axis));
   const double c = kin3::dot(u1, u2), s = kin3::norm(kin3::cross(u1, u2));
-  if (!(s > 1e-9)) return parallel_gear_pair(b1, b2, p1 + mesh_offset * u1, u1, p2, z1, z2, (c > 0.0) == reversed);
+  if (!(s > 1e-9))
+    return parallel_gear_pair(b1, b2, p1 + mesh_offset * u1, u1, p2, z1, z2, parallel_pair_internal(c, reversed));
   // the common perpendicular: p1 + t1 u1 and p2 + t2 u2 nearest each other
   const V3 d = p2 - p1;
   const double t1 = (kin3::dot(d, u1) - c * kin3::dot(d, u2)) / (s * s);
@@ -366,11 +367,10 @@ void PartSketcher::spatial_gear_pair(const JointSide3& a1, const JointSide3& b1,
 // mid-plane, `on2` a point of axis 2.
 void PartSketcher::parallel_gear_pair(const JointSide3& b1, const JointSide3& b2, V3 centre1, V3 axis, V3 on2,
                                       double z1, double z2, bool internal) {
-  const V3 across = (on2 - centre1) - kin3::dot(on2 - centre1, axis) * axis;
-  const double a = kin3::norm(across), sum = internal ? std::fabs(z2 - z1) : z1 + z2;
-  if (!(a > 0.0) || !(sum > 0.0)) return;
-  const V3 centre[2] = {centre1, centre1 + across};
-  const double radius[2] = {a * z1 / sum, a * z2 / sum};
+  const ParallelPitch pitch = parallel_pitch(centre1, axis, on2, internal, z2 / z1);
+  if (!(pitch.r1 > 0.0)) return;
+  const V3 centre[2] = {centre1, centre1 + pitch.a * pitch.rho};
+  const double radius[2] = {pitch.r1, pitch.r2};
   const JointSide3* shaft[2] = {&b1, &b2};
   for (int i = 0; i < 2; ++i) {
     const Pose pose = pose_of(shaft[i]->frame);

@@ -80,21 +80,22 @@ const char* push_shafts(const SpatialMesh& g, double lambda, const double* q, Pa
   V3 p, force;
   if (!(sin_s > 1e-9)) {
     const V3 o1 = part_pose(body_frame(g.b1.frame), q, 0.0).apply(g.b1.at) + g.mesh_offset * z1;
-    const V3 across = (a2 - o1) - dot(a2 - o1, z1) * z1;
-    const double a = norm(across), k = std::fabs(g.k);
+    const bool internal = parallel_pair_internal(cos_s, g.reversed);
+    const double k = std::fabs(g.k);
+    const ParallelPitch pitch = parallel_pitch(o1, z1, a2, internal, k);
+    const double a = pitch.a;
     if (!(a > 0.0)) return "its parallel axes are one";
-    const bool internal = (cos_s > 0.0) == g.reversed;
     double r1 = g.r1, r2 = g.r2;
     if (r1 == 0.0) {
-      if (!(std::fabs(k - 1.0) > 1e-12) && internal) return "it is an internal pair of equal gears";
-      r1 = a / (internal ? std::fabs(k - 1.0) : 1.0 + k), r2 = k * r1;
+      if (pitch.r1 == 0.0) return "it is an internal pair of equal gears";
+      r1 = pitch.r1, r2 = pitch.r2;
     } else if (!(std::fabs(r2 / r1 - k) <= 1e-6 * k)) {
       return "its pitch_radii are not in its teeth's ratio, as parallel shafts' gears are";
     } else if (!(std::fabs((internal ? std::fabs(r2 - r1) : r1 + r2) - a) <= 1e-6 * a)) {
       return internal ? "its parallel axes do not stand the difference of its pitch radii apart (it is internal)"
                       : "its parallel axes do not stand its two pitch radii apart";
     }
-    const V3 rho = (1.0 / a) * across;
+    const V3 rho = pitch.rho;
     const double side = internal && r1 < r2 ? -1.0 : 1.0, f = -lambda / r1;
     p = o1 + (side * r1) * rho;
     force = (side * f) * cross(z1, rho) - (f * std::tan(g.helix_angle)) * z1 +

@@ -25,6 +25,10 @@ Quat product(const Quat& a, const Quat& b) {
           a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1], a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
 }
 Quat conjugate(const Quat& a) { return {a[0], -a[1], -a[2], -a[3]}; }
+// d ⊗ e*: from two seeds, the turn between them; from a rate ė (or ë) and e, ½ ω (the vector part of ½ α)
+Quat relative(const Quat& d, const Quat& e) { return product(d, conjugate(e)); }
+// |the vector part|
+double vector_norm(const Quat& a) { return std::sqrt(a[1] * a[1] + a[2] * a[2] + a[3] * a[3]); }
 
 // The turn by angle 2·half about the unit axis along v (any axis when v is zero).
 Quat turn(double half, double vx, double vy, double vz) {
@@ -56,11 +60,10 @@ EulerSeedSigns::EulerSeedSigns(const Model& model) {
 }
 
 void EulerSeedSigns::keep_rates(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, std::size_t b, bool turned) {
-  has_rate_ = qd.size() > 0;
-  const bool has_accel = has_rate_ && qdd.size() > 0;
+  const bool has_rate = qd.size() > 0, has_accel = has_rate && qdd.size() > 0;
   for (std::size_t k = 0; k < 4; ++k) {
     const Index j = bodies_[b][k];
-    rate_[b][k] = j < 0 || !has_rate_ ? 0.0 : (turned ? -qd[j] : qd[j]);
+    rate_[b][k] = j < 0 || !has_rate ? 0.0 : (turned ? -qd[j] : qd[j]);
     accel_[b][k] = j < 0 || !has_accel ? 0.0 : (turned ? -qdd[j] : qdd[j]);
   }
 }
@@ -72,6 +75,7 @@ void EulerSeedSigns::start(double t0, const Eigen::VectorXd& q, const Eigen::Vec
     for (std::size_t k = 0; k < 4; ++k) last_[b][k] = bodies_[b][k] < 0 ? 0.0 : q[bodies_[b][k]];
     keep_rates(rate, accel, b, false);
   }
+  has_rate_ = rate.size() > 0;
   t_last_ = t0;
   known_ = 1;
 }
@@ -102,13 +106,11 @@ bool EulerSeedSigns::turns_far(double span) const {
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     double turn = 0.0;
     if (has_rate_) {
-      const Quat w = product(rate_[b], conjugate(last_[b])), a = product(accel_[b], conjugate(last_[b]));  // ½ ω, ½ α
-      turn = 2.0 * (std::sqrt(w[1] * w[1] + w[2] * w[2] + w[3] * w[3]) * span +
-                    0.5 * std::sqrt(a[1] * a[1] + a[2] * a[2] + a[3] * a[3]) * span * span);
+      turn = 2.0 * (vector_norm(relative(rate_[b], last_[b])) * span +
+                    0.5 * vector_norm(relative(accel_[b], last_[b])) * span * span);
     } else if (known_ >= 2) {
-      const Quat r = product(last_[b], conjugate(before_[b]));
-      turn = 2.0 * std::atan2(std::sqrt(r[1] * r[1] + r[2] * r[2] + r[3] * r[3]), std::fabs(r[0])) * span /
-             (t_last_ - t_before_);
+      const Quat r = relative(last_[b], before_[b]);
+      turn = 2.0 * std::atan2(vector_norm(r), std::fabs(r[0])) * span / (t_last_ - t_before_);
     } else {
       return true;  // nothing known: solve them
     }
@@ -119,7 +121,6 @@ bool EulerSeedSigns::turns_far(double span) const {
 
 bool EulerSeedSigns::align(double t, Eigen::VectorXd& seed, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
   bool turned = false;
-  const bool from_rates = has_rate_;  // (the last seed's: keep_rates() sets it for this one, body by body)
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const std::array<Index, 4>& body = bodies_[b];
     Quat e{};
@@ -129,15 +130,15 @@ bool EulerSeedSigns::align(double t, Eigen::VectorXd& seed, const Eigen::VectorX
     // rate, the turn from the seed before last to the last carried on over (t − t_last) (with neither, the first
     // seed keeps the sign the seeding pass reached: in sub-steps where the sweep solves positions only)
     Quat expected{};
-    if (from_rates) {
+    if (has_rate_) {
       const double dt = t - t_last_;
-      const Quat w = product(rate_[b], conjugate(last_[b])), a = product(accel_[b], conjugate(last_[b]));  // ½ ω, ½ α
-      const double hx = w[1] * dt + 0.5 * a[1] * dt * dt, hy = w[2] * dt + 0.5 * a[2] * dt * dt,
-                   hz = w[3] * dt + 0.5 * a[3] * dt * dt;  // φ/2 (a is 0 without ë)
-      expected = product(turn(std::sqrt(hx * hx + hy * hy + hz * hz), hx, hy, hz), last_[b]);
+      const Quat w = relative(rate_[b], last_[b]), a = relative(accel_[b], last_[b]);  // ½ ω, ½ α
+      const Quat h{0.0, w[1] * dt + 0.5 * a[1] * dt * dt, w[2] * dt + 0.5 * a[2] * dt * dt,
+                   w[3] * dt + 0.5 * a[3] * dt * dt};  // φ/2 (a is 0 without ë)
+      expected = product(turn(vector_norm(h), h[1], h[2], h[3]), last_[b]);
     } else if (known_ >= 2) {
-      const Quat r = product(last_[b], conjugate(before_[b]));
-      const double half = std::atan2(std::sqrt(r[1] * r[1] + r[2] * r[2] + r[3] * r[3]), r[0]);
+      const Quat r = relative(last_[b], before_[b]);
+      const double half = std::atan2(vector_norm(r), r[0]);
       const double s = (t - t_last_) / (t_last_ - t_before_);
       expected = product(turn(s * half, r[1], r[2], r[3]), last_[b]);
     }
@@ -151,6 +152,7 @@ bool EulerSeedSigns::align(double t, Eigen::VectorXd& seed, const Eigen::VectorX
     before_[b] = last_[b], last_[b] = e;
     keep_rates(qd, qdd, b, turn_this);
   }
+  has_rate_ = qd.size() > 0;
   t_before_ = t_last_, t_last_ = t;
   ++known_;
   return turned;

@@ -50,7 +50,7 @@ class EulerSeedSigns {
   double t_last_ = 0.0, t_before_ = 0.0;
   int known_ = 0;          // seeds (row 0 included) in last_, before_
   bool has_rate_ = false;  // rate_ is the last seed's ė (accel_ its ë, or 0 where not known)
-  // rate_ and accel_ (and has_rate_) from `qd`, `qdd` (empty: unknown), body b turned over or not
+  // body b's rate_ and accel_ from `qd`, `qdd` (empty: unknown, 0), turned over or not (has_rate_ is the caller's)
   void keep_rates(const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd, std::size_t b, bool turned);
 };
 

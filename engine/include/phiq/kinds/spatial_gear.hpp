@@ -35,6 +35,32 @@ struct SpatialMesh {
   double mesh_offset = 0.0;     ///< parallel shafts: the gears' mid-plane, this far along axis 1 from shaft 1's point
 };
 
+/// Two gears on parallel shafts, as their push (add_gear_mesh_forces()) and their drawn pitch circles place them.
+struct ParallelPitch {
+  kin3::V3 rho;     ///< the unit from axis 1 toward axis 2, across them
+  double a = 0.0;   ///< the distance between the axes
+  double r1 = 0.0;  ///< the pitch radius of gear 1 that, with r2 = ratio r1, fills it; 0 where none does
+  double r2 = 0.0;  ///< gear 2's
+};
+
+/// Whether a pair on parallel shafts is internal (a ring gear): it turns its shafts the same way, so its ratio row
+/// is reversed where the axes point the same way (cos_axes = z1 · z2 > 0), and not where they point opposite ways.
+inline bool parallel_pair_internal(double cos_axes, bool reversed) { return (cos_axes > 0.0) == reversed; }
+
+/// Axis 1 through `centre1` along the unit `axis`, axis 2 through `on2`, parallel to it; `ratio` = r2/r1 > 0. The
+/// pitch radii fill the distance a: r1 = a/(1 + ratio), or a/|ratio − 1| for an internal pair (none for equal
+/// gears, or one axis).
+inline ParallelPitch parallel_pitch(kin3::V3 centre1, kin3::V3 axis, kin3::V3 on2, bool internal, double ratio) {
+  ParallelPitch p;
+  const kin3::V3 across = (on2 - centre1) - kin3::dot(on2 - centre1, axis) * axis;
+  p.a = kin3::norm(across);
+  if (!(p.a > 0.0)) return p;
+  p.rho = (1.0 / p.a) * across;
+  const double span = internal ? std::fabs(ratio - 1.0) : 1.0 + ratio;
+  if (span > 1e-12) p.r1 = p.a / span, p.r2 = ratio * p.r1;
+  return p;
+}
+
 /// Spatial gear pair. Each shaft turns in a joint (revolute, cylindrical or screw) whose side a is the housing —
 /// ground, or a carrier that moves — and side b the shaft; θ_i, an angle coordinate, is the shaft's turn in it (x_b
 /// about z_a from x_a, as `rotation_angle` measures it). The gears roll on each other: in the housing the relative
