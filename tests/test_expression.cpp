@@ -266,6 +266,23 @@ TEST(Expression, IntegerPowersHaveExactDerivativesAtAZeroBase) {
   }
 }
 
+TEST(Expression, AbsHasTheDerivativeSignAtAZeroArgument) {
+  // GiNaC's abs differentiates to u u'/|u|, 0/0 where u = 0; phiq's has sign(u) u' (0 there, a subgradient), and
+  // its own value's elsewhere
+  auto e = CompiledExpression::compile("yA*abs(xA - 1.3) + abs(theta2)*theta2", resolve);
+  const double at[3] = {0.0, 1.3, 2.0}, away[3] = {-0.4, 1.45, 2.0}, qd[3] = {0.5, -0.7, 0.2};
+  double g[3];
+  e->gradient(at, 0.0, g);
+  EXPECT_EQ(g[0], 0.0);  // 2 |θ| at θ = 0
+  EXPECT_EQ(g[1], 0.0);  // yA sign(0)
+  EXPECT_EQ(g[2], 0.0);  // |0|
+  e->gradient(away, 0.0, g);
+  EXPECT_DOUBLE_EQ(g[0], 2 * 0.4);
+  EXPECT_DOUBLE_EQ(g[1], 2.0);
+  EXPECT_NEAR(g[2], 0.15, 1e-15);
+  expect_derivatives_match_differences(*e, away, qd, 0.0, 10.0);
+}
+
 TEST(Expression, RealPowersAtAZeroBaseAreFiniteWhereTheirDerivativesAre) {
   // u^p at u = 0: ∂ = p u^(p−1) and the second derivative p (p − 1) u^(p−2) are 0 for p > 2, the second is
   // infinite for 1 < p < 2, both are for p < 1. Finite ones must come out exactly 0, not NaN.

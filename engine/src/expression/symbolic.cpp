@@ -1,5 +1,6 @@
-// The GiNaC side of expressions: the table of supported functions and phiq_pow, a power with a constant exponent
-// whose derivative is its closed form (symbolic.hpp says who uses them).
+// The GiNaC side of expressions: the table of supported functions, phiq_pow, a power with a constant exponent
+// whose derivative is its closed form, and phiq_abs, |u| with the derivative sign(u) (symbolic.hpp says who uses
+// them).
 #include "expression/symbolic.hpp"
 
 namespace phiq::detail {
@@ -21,7 +22,7 @@ const std::map<std::string, FunctionSpec>& supported_functions() {
       {"sinh", {Op::kSinh, 1, [](const ex& a) -> ex { return GiNaC::sinh(a); }}},
       {"cosh", {Op::kCosh, 1, [](const ex& a) -> ex { return GiNaC::cosh(a); }}},
       {"tanh", {Op::kTanh, 1, [](const ex& a) -> ex { return GiNaC::tanh(a); }}},
-      {"abs", {Op::kAbs, 1, [](const ex& a) -> ex { return GiNaC::abs(a); }}}};
+      {"abs", {Op::kAbs, 1, [](const ex& a) -> ex { return absolute_value(a); }}}};
   return table;
 }
 
@@ -63,5 +64,25 @@ bool is_constant_power(const GiNaC::ex& e) {
 }  // namespace
 
 bool is_power(const GiNaC::ex& e) { return GiNaC::is_a<GiNaC::power>(e) || is_constant_power(e); }
+
+// |u| as phiq_abs(u), whose derivative is phiq_sign(u) u' (0 at u = 0), and phiq_sign's 0. GiNaC's own abs
+// differentiates to u u'/|u|, which is 0/0 where u = 0: a drag −c ẋ|ẋ| at rest, a force of |x − x0| where x = x0
+// had a NaN gradient (and so NaN sensitivities) exactly there.
+namespace {
+GiNaC::ex sign_derivative(const GiNaC::ex&, unsigned) { return 0; }
+unsigned sign_serial() {
+  static const unsigned serial =
+      GiNaC::function::register_new(GiNaC::function_options("phiq_sign", 1).derivative_func(sign_derivative));
+  return serial;
+}
+GiNaC::ex abs_derivative(const GiNaC::ex& u, unsigned) { return GiNaC::function(sign_serial(), u); }
+unsigned abs_serial() {
+  static const unsigned serial =
+      GiNaC::function::register_new(GiNaC::function_options("phiq_abs", 1).derivative_func(abs_derivative));
+  return serial;
+}
+}  // namespace
+
+GiNaC::ex absolute_value(const GiNaC::ex& u) { return GiNaC::function(abs_serial(), u); }
 
 }  // namespace phiq::detail

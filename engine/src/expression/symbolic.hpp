@@ -27,6 +27,8 @@ std::string supported_function_list();
 
 // u^p for an exponent p that is a constant of the text, as phiq_pow(u, p) (see symbolic.cpp for why).
 GiNaC::ex constant_power(const GiNaC::ex& u, const GiNaC::ex& p);
+// |u| as phiq_abs(u), differentiated to phiq_sign(u) u' (symbolic.cpp says why not GiNaC's abs).
+GiNaC::ex absolute_value(const GiNaC::ex& u);
 // A power of either kind: GiNaC's own (numeric exponents from its derivatives, sqrt; exponents that are not
 // constant) or phiq_pow; op(0) is the base and op(1) the exponent of both.
 bool is_power(const GiNaC::ex& e);

@@ -316,8 +316,9 @@ class TapeBuilder {
     if (is_power(e)) return product({{e.op(0), e.op(1)}});
     if (is_a<function>(e)) {
       const std::string name = ex_to<function>(e).get_name();
-      if (name == "abs" && e.nops() == 1) return {push(Op::kAbs, emit(e.op(0)).reg), false};  // |−u| = |u|
-      if (name == "csgn" && e.nops() == 1) {  // GiNaC's derivative of abs; csgn(−u) = −csgn(u)
+      if ((name == "phiq_abs" || name == "abs") && e.nops() == 1)
+        return {push(Op::kAbs, emit(e.op(0)).reg), false};             // |−u| = |u|
+      if ((name == "phiq_sign" || name == "csgn") && e.nops() == 1) {  // |u|'s derivative; sign(−u) = −sign(u)
         const Signed u = emit(e.op(0));
         return {push(Op::kSign, u.reg), u.neg};
       }
