@@ -2,7 +2,8 @@
 // motor torque's closed form; springs' and torsional springs' generalized forces against central differences of
 // their potential energy, in natural, reference-point and spatial coordinates; virtual power with masses, gravity,
 // a spring, a damper, a force and a torque in all four formulations of the four-bar; a force in part axes against
-// the same force written in world axes; and the bad input the reader refuses.
+// the same force written in world axes; forces and torques of the rates (der()) against a closed form, a damper
+// and the power balance, also as a family; and the bad input the reader refuses.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -238,7 +239,8 @@ TEST(AppliedLoads, EveryModelWithMassesBalancesItsDriversPowerAtEveryRow) {
     checked.push_back(path.filename().string());
   }
   // the scenes with masses today; a new one joins by itself
-  for (const char* name : {"fourbar_motor_torque.yaml", "fourbar_pin_loads.yaml", "rssr_bearing_loads.yaml"})
+  for (const char* name :
+       {"fourbar_motor_torque.yaml", "fourbar_pin_loads.yaml", "rssr_bearing_loads.yaml", "crank_slider_drag.yaml"})
     EXPECT_NE(std::find(checked.begin(), checked.end(), name), checked.end()) << name;
 }
 
@@ -312,6 +314,101 @@ TEST(AppliedLoads, AForceInPartAxesIsTheSameForceTurnedIntoWorldAxes) {
   }
 }
 
+TEST(AppliedLoads, ARateDependentForceOnTheSliderFollowsItsClosedForm) {
+  // F = −7 ẋB − 3 ẋB |ẋB| on the massless slider (der(xB)), the crank turning at 2 rad/s: τ = −F ∂xB/∂θ with
+  // ẋB = 2 ∂xB/∂θ
+  Scene s = parse_scene(test::model_file_text("seed/crank_slider_mixed.yaml") +
+                            "\nparts:\n  slider: {frame: {at: B}}\n"
+                            "loads:\n  forces:\n"
+                            "    - {name: drag, part: slider, force: [-7*der(xB) - 3*der(xB)*abs(der(xB)), 0]}\n",
+                        "crank_slider.yaml");
+  const Model& m = *s.model;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
+  Workspace ws(m);
+  const Index theta = m.find_coordinate("theta2");
+  const double r = 0.3, L = 1.0;
+  double worst = 0.0, peak = 0.0;
+  std::vector<double> efforts;
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
+    std::string why;
+    ASSERT_EQ(driver_efforts(m, s.parts, s.loads, tr.t[k], ws, efforts, &why), SolveStatus::kSuccess) << why;
+    const double th = tr.q[k](theta), sn = std::sin(th), cs = std::cos(th);
+    const double dxb = -r * sn - r * r * sn * cs / std::sqrt(L * L - r * r * sn * sn), v = 2.0 * dxb;
+    const double exact = -(-7.0 * v - 3.0 * v * std::fabs(v)) * dxb;
+    worst = std::max(worst, std::fabs(efforts[0] - exact));
+    peak = std::max(peak, std::fabs(exact));
+  }
+  EXPECT_GT(peak, 1.0);  // newton-metres: the check is not of zeros
+  EXPECT_LT(worst, 1e-9 * peak);
+}
+
+TEST(AppliedLoads, AForceOfARateAlongItsLineIsADamper) {
+  // −c der(xB) on the slider, on y = 0, is a damper from a world point on that line: the same efforts, with the
+  // links' masses and gravity
+  const std::string scene =
+      test::model_file_text("seed/crank_slider_mixed.yaml") +
+      "\nparts:\n"
+      "  crank: {frame: {origin: O, x: A}, center_of_mass: [0.15, 0], mass: 0.5, inertia: 0.004}\n"
+      "  rod: {frame: {origin: A, x: B}, center_of_mass: [0.5, 0], mass: 1.2, inertia: 0.1}\n"
+      "  slider: {frame: {at: B}, mass: 0.8, center_of_mass: [0, 0], inertia: 0.001}\n"
+      "loads:\n  gravity: [0, -9.81]\n";
+  auto efforts = [](const std::string& text) {
+    const Scene s = parse_scene(text, "crank_slider.yaml");
+    test::Trace tr;
+    EXPECT_EQ(test::sweep(*s.model, s.sweep, &tr), SolveStatus::kSuccess);
+    Workspace ws(*s.model);
+    std::vector<double> out, row;
+    for (std::size_t k = 0; k < tr.t.size(); ++k) {
+      ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
+      EXPECT_EQ(driver_efforts(*s.model, s.parts, s.loads, tr.t[k], ws, row), SolveStatus::kSuccess);
+      out.push_back(row.at(0));
+    }
+    return out;
+  };
+  const std::vector<double> force = efforts(scene + "  forces: [{name: drag, part: slider, force: [-7*der(xB), 0]}]\n");
+  const std::vector<double> damper =
+      efforts(scene +
+              "  springs: [{name: drag, between: [{point: [-5, 0]}, {part: slider}], stiffness: 0, "
+              "free_length: 0, damping: 7}]\n");
+  const std::vector<double> none = efforts(scene);
+  ASSERT_EQ(force.size(), damper.size());
+  ASSERT_GT(force.size(), 100u);
+  double worst = 0.0, peak = 0.0, effect = 0.0;
+  for (std::size_t k = 0; k < force.size(); ++k) {
+    worst = std::max(worst, std::fabs(force[k] - damper[k]));
+    peak = std::max(peak, std::fabs(damper[k]));
+    effect = std::max(effect, std::fabs(damper[k] - none[k]));
+  }
+  EXPECT_GT(effect, 0.5);  // the damper's share of the torque, N·m
+  EXPECT_LT(worst, 1e-12 * peak);
+}
+
+TEST(AppliedLoads, DriverPowerBalancesWithForcesAndTorquesOfRatesInAFamily) {
+  // forces and a torque reading q̇ (der()), written as a family and written out: the same efforts, and the power
+  // balance with the loads' power F · v + M ω
+  const std::string base = test::model_file_text("seed/fourbar_natural.yaml") + "\nparts:\n" +
+                           test::fourbar_parts("natural") + "loads:\n  gravity: [0, -9.81]\n";
+  const std::string torque = "  torques: [{name: brake, part: rocker, torque: \"-2*der(atan2(yB, xB - L1))\"}]\n";
+  const std::string family =
+      "  forces:\n"
+      "    - for i in 0..1:\n"
+      "        - {name: \"drag{i}\", part: coupler, at: [0.3*i, 0], force: [-4*(1 + i)*der(xA), "
+      "-3*der(yB)*abs(der(yB))]}\n";
+  const std::string written =
+      "  forces:\n"
+      "    - {name: drag0, part: coupler, at: [0, 0], force: [-4*der(xA), -3*der(yB)*abs(der(yB))]}\n"
+      "    - {name: drag1, part: coupler, at: [0.3, 0], force: [-8*der(xA), -3*der(yB)*abs(der(yB))]}\n";
+  const Scene a = parse_scene(base + torque + family, "fourbar.yaml");
+  const Scene b = parse_scene(base + torque + written, "fourbar.yaml");
+  const LoadedPowerBalance pa = loaded_power_balance(a), pb = loaded_power_balance(b);
+  EXPECT_GT(pa.loads_power, 1.0);  // watts: the loads take part in the balance
+  EXPECT_LT(pa.balance, 1e-9 * pa.scale);
+  EXPECT_NEAR(pa.scale, pb.scale, 1e-12 * pb.scale);
+  EXPECT_NEAR(pa.loads_power, pb.loads_power, 1e-12 * pb.loads_power);
+}
+
 TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
   const std::string base = test::model_file_text("seed/fourbar_reference_point.yaml") + "\nloads:\n";
   auto error = [&](const std::string& loads) { return test::scene_error(base + loads); };
@@ -342,6 +439,10 @@ TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
   m = error("  torsional_springs:\n    - {angle: psi3 - psi2 + foo, stiffness: 1}\n");
   EXPECT_HAS(m, "loads.torsional_springs[0].angle:");
   EXPECT_HAS(m, "foo");
+  m = error("  torsional_springs:\n    - {angle: psi3 - der(psi2), stiffness: 1}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].angle: expression \"psi3 - der(psi2)\": der() reads velocities");
+  m = error("  forces:\n    - {part: crank, force: [der(der(psi2)), 0]}\n");
+  EXPECT_HAS(m, "loads.forces[0].force[0]: expression \"der(der(psi2))\": der() of a rate: an acceleration");
   m = error("  torques:\n    - {name: a, part: crank, torque: 1}\n    - {name: a, part: rocker, torque: 1}\n");
   EXPECT_HAS(m, "loads.torques[1].name: duplicate load name 'a'");
   m = error("  torsional_springs:\n    - {joint: O, stiffness: 1}\n");

@@ -7,8 +7,8 @@
 /// Their generalized forces are their virtual work, Q_k = Σ ∂x/∂q_k · F + ∂θ/∂q_k · M, from each part's exact
 /// Jacobian (part_jacobian(), phiq/part_motion.hpp), so they hold in every coordinate family; dampers read the
 /// points' velocities from part_motion(). Expressions are compiled once, when the scene is read; evaluating them
-/// reads the compiled tapes only. An expression cannot read q̇ (no name stands for a velocity): a velocity-dependent
-/// load is a damper.
+/// reads the compiled tapes only. A force's or torque's component may read q̇ through der(u), the rate of an
+/// expression u of the coordinates and t (`-c*der(xB)`, `-k*der(psi3 - psi2)*abs(der(psi3 - psi2))`).
 #pragma once
 
 #include <Eigen/Core>
@@ -37,7 +37,7 @@ struct AppliedForce {
   PartFrame frame;                   ///< that part's frame
   kin3::V3 at;                       ///< the point it acts at, in the part's frame
   LoadAxes axes = LoadAxes::kWorld;  ///< the axes of its components
-  /// Its components (N), expressions of t, q and the parameters; null: 0 (z in the plane).
+  /// Its components (N), expressions of t, q, q̇ (der()) and the parameters; null: 0 (z in the plane).
   std::array<std::shared_ptr<const CompiledExpression>, 3> components;
 };
 
@@ -93,13 +93,13 @@ struct AppliedLoads {
   bool empty() const { return forces.empty() && torques.empty() && springs.empty() && torsional_springs.empty(); }
 };
 
-/// A force's or torque's components at (q, t) in world axes.
+/// A force's or torque's components at (q, q̇, t) in world axes (qd null: q̇ = 0).
 kin3::V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 3>& components, LoadAxes axes,
-                          const Pose& pose, const double* q, double t);
+                          const Pose& pose, const double* q, const double* qd, double t);
 
 /// Adds to `Q` (one entry per coordinate) the generalized forces of `loads` at (q, q̇, t): their virtual work per
-/// δq_k. `qd` may be null: the dampers then exert nothing. Pre-condition: Q has an entry for every coordinate the
-/// loads read. Thread-safe.
+/// δq_k. `qd` may be null: at rest (the dampers exert nothing, der() is 0). Pre-condition: Q has an entry for every
+/// coordinate the loads read. Thread-safe.
 void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, double t, Eigen::VectorXd& Q);
 
 /// The power of `loads` at (q, q̇, t) (W): Σ F · v of the forces at their points' velocities, M · ω of the

@@ -67,7 +67,8 @@ class Tape {
     bool operator==(const Instr&) const = default;  ///< field by field
   };
 
-  /// Evaluates the program; out[k] receives register outputs()[k]. Thread-safe (scratch is thread-local).
+  /// Evaluates the program; out[k] receives register outputs()[k]; qd null reads q̇ as 0. Thread-safe (scratch is
+  /// thread-local).
   void evaluate(const double* q, const double* qd, double t, double* out) const;
   /// Second-order Taylor coefficients of output 0 along s ↦ (q + s q̇, t + s): value, d/ds and ½ d²/ds² at s = 0.
   /// Exact (no truncation). Thread-safe.
@@ -115,17 +116,19 @@ class CompiledExpression {
 
   /// Parses and differentiates `text`. Throws phiq::Error with a one-line message naming the expression and the
   /// offending name or token when the text is malformed, uses an unknown name or an unsupported function.
-  /// `allow_time` false rejects `t` (e.g. for constant fields).
+  /// `allow_time` false rejects `t` (e.g. for constant fields). `allow_rates` true admits `der(u)`, the rate of u
+  /// along the motion (Σ ∂u/∂q_j q̇_j + ∂u/∂t, differentiated exactly; not of a u that reads q̇): a load's
+  /// component (`-c*der(x)`); elsewhere it is refused, naming where rates may be read.
   static std::shared_ptr<const CompiledExpression> compile(const std::string& text, const NameResolver& resolve,
-                                                           bool allow_time = true);
+                                                           bool allow_time = true, bool allow_rates = false);
 
   /// The same function: the same text, coordinates and programs (a scene's parameter is a constant of the tapes,
   /// so a scene read at two values of a parameter its expression reads gives two different functions). Where the
   /// function came from (same_source()) is not compared.
   bool operator==(const CompiledExpression& o) const {
-    return text_ == o.text_ && coords_ == o.coords_ && depends_on_time_ == o.depends_on_time_ &&
-           angle_difference_ == o.angle_difference_ && value_ == o.value_ && gradient_ == o.gradient_ &&
-           partial_t_ == o.partial_t_;
+    return text_ == o.text_ && coords_ == o.coords_ && rate_coords_ == o.rate_coords_ &&
+           depends_on_time_ == o.depends_on_time_ && angle_difference_ == o.angle_difference_ && value_ == o.value_ &&
+           gradient_ == o.gradient_ && partial_t_ == o.partial_t_ && rate_gradient_ == o.rate_gradient_;
   }
   /// The text it was compiled from.
   const std::string& text() const { return text_; }
@@ -139,10 +142,20 @@ class CompiledExpression {
   /// g is solved with its residual wrapped to (−π, π] (EquationSpec), as the joint-angle drivers are.
   bool angle_difference() const { return angle_difference_; }
 
+  /// Coordinates whose rates q̇ g reads (through der()), ascending; rate_gradient() writes ∂g/∂q̇ for these. Empty
+  /// for every expression compiled without `allow_rates`.
+  const std::vector<Index>& rate_coordinates() const { return rate_coords_; }
   /// g(q, t). Pre-condition: q has an entry for every index in coordinates(). Thread-safe (as all below).
-  double value(const double* q, double t) const;
+  /// Where g reads rates, they are 0 (at rest).
+  double value(const double* q, double t) const { return value(q, nullptr, t); }
+  /// g(q, q̇, t); qd null: q̇ = 0. Pre-condition: qd has an entry for every index in rate_coordinates().
+  double value(const double* q, const double* qd, double t) const;
   /// ∂g/∂q_j for j in coordinates(), in that order, into dg_dq.
-  void gradient(const double* q, double t, double* dg_dq) const;
+  void gradient(const double* q, double t, double* dg_dq) const { gradient(q, nullptr, t, dg_dq); }
+  /// ∂g/∂q_j at (q, q̇, t); qd null: q̇ = 0.
+  void gradient(const double* q, const double* qd, double t, double* dg_dq) const;
+  /// ∂g/∂q̇_j for j in rate_coordinates(), in that order, into dg_dqd; qd null: q̇ = 0.
+  void rate_gradient(const double* q, const double* qd, double t, double* dg_dqd) const;
   /// ∂g/∂t.
   double partial_t(const double* q, double t) const;
   /// γ contribution: −( Σ_jk g_qjqk q̇j q̇k + 2 Σ_j g_qjt q̇j + g_tt ).
@@ -190,10 +203,10 @@ class CompiledExpression {
   std::vector<double> constants_;         // constants()
   std::vector<Index> target_;             // rebind()'s target (empty unless rebound)
   std::string text_;
-  std::vector<Index> coords_;
+  std::vector<Index> coords_, rate_coords_;
   bool depends_on_time_ = false;
   bool angle_difference_ = false;
-  Tape value_, gradient_, partial_t_;
+  Tape value_, gradient_, partial_t_, rate_gradient_;
 };
 
 /// Evaluates a constant expression (numbers, named constants, pi, functions), e.g. "L2/2" or "2*pi".

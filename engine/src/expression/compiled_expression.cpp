@@ -54,6 +54,7 @@ bool is_angle_difference(const GiNaC::ex& g) {
 struct CompiledExpression::Source {
   std::string text;
   bool allow_time = true;
+  bool allow_rates = false;
   std::vector<std::pair<std::string, NameBinding>> names;  // in the order the text first reads them; pi excluded
   std::size_t parameters = 0;                              // how many of them are constants (kConstant)
   // along_constants()' derivatives by their rates (of the parameters, then of the compiled indices): family
@@ -79,11 +80,24 @@ struct Symbols {
   std::map<std::string, Index> coord_of_symbol;        // symbol name -> coordinate index
   std::map<std::string, double> value_of_constant;     // symbol name -> value folded in by the tape builder
   std::map<Index, GiNaC::realsymbol> symbol_of_coord;  // one symbol per coordinate, however many names it has
+  std::map<Index, GiNaC::realsymbol> symbol_of_rate;   // q̇_i ("qd:<i>", which the tape builder loads as q̇)
   GiNaC::realsymbol t{"t"};
   GiNaC::ex coordinate(Index i) {
     auto [it, fresh] = symbol_of_coord.try_emplace(i, "q:" + std::to_string(i));
     if (fresh) coord_of_symbol[it->second.get_name()] = i;
     return it->second;
+  }
+  GiNaC::ex rate(Index i) { return symbol_of_rate.try_emplace(i, "qd:" + std::to_string(i)).first->second; }
+  // der(u) = Σ ∂u/∂q_i q̇_i + ∂u/∂t, exactly; a u that reads q̇ already is refused (its rate would read q̈, which
+  // no load is evaluated with)
+  GiNaC::ex rate_of(const GiNaC::ex& u, const std::string& text) {
+    for (const auto& [i, s] : symbol_of_rate)
+      if (u.has(s)) throw detail::expression_error(text, "der() of a rate: an acceleration, which a load may not read");
+    GiNaC::ex d = u.diff(t);
+    const std::vector<std::pair<Index, GiNaC::realsymbol>> coords(symbol_of_coord.begin(), symbol_of_coord.end());
+    for (const auto& [i, s] : coords)
+      if (u.has(s)) d += u.diff(s) * rate(i);
+    return d;
   }
 };
 
@@ -102,32 +116,45 @@ struct CompiledExpressionBuilder {
     }
   }
 
-  // The coordinates g depends on, its flags, and its value, gradient and ∂/∂t tapes into `out`.
+  // parse_expression()'s der(), where rates may be read
+  static detail::RateOf rate_hook(bool allow_rates, Symbols& sym, const std::string& text) {
+    if (!allow_rates) return nullptr;
+    return [&sym, &text](const GiNaC::ex& u) { return sym.rate_of(u, text); };
+  }
+
+  // The coordinates g depends on (and whose rates it reads), its flags, and its value, gradient, ∂/∂t and ∂/∂q̇
+  // tapes into `out`.
   static void finish(CompiledExpression& out, const GiNaC::ex& g, const Symbols& sym) {
     using namespace GiNaC;
     // Keep only the coordinates the expression really depends on, in ascending index order.
-    std::vector<std::pair<realsymbol, Index>> used;
+    std::vector<std::pair<realsymbol, Index>> used, used_rates;
     for (auto& [i, s] : sym.symbol_of_coord)
       if (g.has(s)) used.emplace_back(s, i);
+    for (auto& [i, s] : sym.symbol_of_rate)
+      if (g.has(s)) used_rates.emplace_back(s, i);
     out.depends_on_time_ = g.has(sym.t);
     out.angle_difference_ = is_angle_difference(g);
     const std::string& text = out.text_;
     symbolic(text, [&] {
-      std::vector<ex> grad;
+      std::vector<ex> grad, rate_grad;
       for (std::size_t k = 0; k < used.size(); ++k) grad.push_back(g.diff(used[k].first));
+      for (std::size_t k = 0; k < used_rates.size(); ++k) rate_grad.push_back(g.diff(used_rates[k].first));
       auto build = [&](const std::vector<ex>& outs) {
         return detail::compile_tape(outs, sym.coord_of_symbol, sym.value_of_constant, text);
       };
       out.value_ = build({g});
       out.gradient_ = build(grad);
       out.partial_t_ = build({g.diff(sym.t)});
-      const std::size_t size = out.value_.size() + out.gradient_.size() + out.partial_t_.size();
+      out.rate_gradient_ = build(rate_grad);
+      const std::size_t size =
+          out.value_.size() + out.gradient_.size() + out.partial_t_.size() + out.rate_gradient_.size();
       if (size > CompiledExpression::kMaxTapeSize)
         throw expression_error(text, "its derivatives compile to " + std::to_string(size) +
                                          " instructions; the limit is " +
                                          std::to_string(CompiledExpression::kMaxTapeSize));
     });
     for (auto& [s, i] : used) out.coords_.push_back(i);
+    for (auto& [s, i] : used_rates) out.rate_coords_.push_back(i);
   }
 
   // Σ_j key[j] ∂g/∂c_j of `source`'s text, key holding the rates of its parameters (source.parameters of them),
@@ -167,7 +194,8 @@ struct CompiledExpressionBuilder {
       return {std::nullopt, sym.coordinate(b.coordinate)};
     };
     const ex d = symbolic(source.text, [&] {
-      const ex g = detail::parse_expression(source.text, lookup, sym.value_of_constant);
+      const ex g = detail::parse_expression(source.text, lookup, sym.value_of_constant,
+                                            rate_hook(source.allow_rates, sym, source.text));
       for (std::size_t k = source.parameters; k < key.size(); ++k) {
         if (key[k] == 0.0) continue;
         auto it = sym.symbol_of_coord.find(static_cast<Index>(k - source.parameters));
@@ -196,7 +224,8 @@ struct CompiledExpressionBuilder {
 };
 
 std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std::string& text,
-                                                                      const NameResolver& resolve, bool allow_time) {
+                                                                      const NameResolver& resolve, bool allow_time,
+                                                                      bool allow_rates) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw Error("expression is empty");
   if (text.size() > kMaxTextLength)
     throw Error("expression of " + std::to_string(text.size()) + " characters; the limit is " +
@@ -206,6 +235,7 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
   auto source = std::make_shared<Source>();
   source->text = text;
   source->allow_time = allow_time;
+  source->allow_rates = allow_rates;
 
   const std::lock_guard<std::mutex> ginac(ginac_mutex());
   Symbols sym;
@@ -238,8 +268,10 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::compile(const std:
     return {std::nullopt, sym.coordinate(b->coordinate)};
   };
 
-  const GiNaC::ex g = CompiledExpressionBuilder::symbolic(
-      text, [&] { return detail::parse_expression(text, lookup, sym.value_of_constant); });
+  const GiNaC::ex g = CompiledExpressionBuilder::symbolic(text, [&] {
+    return detail::parse_expression(text, lookup, sym.value_of_constant,
+                                    CompiledExpressionBuilder::rate_hook(allow_rates, sym, text));
+  });
   CompiledExpressionBuilder::finish(*out, g, sym);
   out->source_ = std::move(source);
   return out;
@@ -250,7 +282,9 @@ bool CompiledExpression::same_source(const CompiledExpression& o) const {
   if (source_ == o.source_) return true;
   const Source& a = *source_;
   const Source& b = *o.source_;
-  if (a.text != b.text || a.allow_time != b.allow_time || a.names.size() != b.names.size()) return false;
+  if (a.text != b.text || a.allow_time != b.allow_time || a.allow_rates != b.allow_rates ||
+      a.names.size() != b.names.size())
+    return false;
   for (std::size_t k = 0; k < a.names.size(); ++k) {
     const auto& [na, ba] = a.names[k];
     const auto& [nb, bb] = b.names[k];
@@ -286,17 +320,22 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::along_constants(co
 }
 
 std::string CompiledExpression::listing() const {
-  return "value:\n" + value_.listing() + "gradient:\n" + gradient_.listing() + "partial_t:\n" + partial_t_.listing();
+  return "value:\n" + value_.listing() + "gradient:\n" + gradient_.listing() + "partial_t:\n" + partial_t_.listing() +
+         (rate_coords_.empty() ? "" : "rate_gradient:\n" + rate_gradient_.listing());
 }
 
-double CompiledExpression::value(const double* q, double t) const {
+double CompiledExpression::value(const double* q, const double* qd, double t) const {
   double v;
-  value_.evaluate(q, nullptr, t, &v);
+  value_.evaluate(q, qd, t, &v);
   return v;
 }
 
-void CompiledExpression::gradient(const double* q, double t, double* dg_dq) const {
-  gradient_.evaluate(q, nullptr, t, dg_dq);
+void CompiledExpression::gradient(const double* q, const double* qd, double t, double* dg_dq) const {
+  gradient_.evaluate(q, qd, t, dg_dq);
+}
+
+void CompiledExpression::rate_gradient(const double* q, const double* qd, double t, double* dg_dqd) const {
+  rate_gradient_.evaluate(q, qd, t, dg_dqd);
 }
 
 double CompiledExpression::partial_t(const double* q, double t) const {
@@ -327,17 +366,18 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::rebind(const std::
     for (std::size_t k = 0; k < target.size(); ++k)
       if (target[k] < 0) out->constants_.push_back(value[k]);
   }
+  // a compiled index bound to a constant: its value, and its rate 0
   auto patch = [&](const Tape& in) {
     Tape tape = in;
     for (Tape::Instr& ins : tape.code_) {
-      if (ins.op != Tape::Op::kLoadQ) continue;
+      if (ins.op != Tape::Op::kLoadQ && ins.op != Tape::Op::kLoadQd) continue;
       if (ins.a >= target.size()) throw Error("rebind: compiled coordinate index out of range");
       const Index j = target[ins.a];
       if (j >= 0) {
         ins.a = static_cast<std::uint32_t>(j);
       } else {
+        ins.imm = ins.op == Tape::Op::kLoadQ ? value[ins.a] : 0.0;
         ins.op = Tape::Op::kConst;
-        ins.imm = value[ins.a];
         ins.a = 0;
       }
     }
@@ -345,26 +385,30 @@ std::shared_ptr<const CompiledExpression> CompiledExpression::rebind(const std::
   };
   out->value_ = patch(value_);
   out->partial_t_ = patch(partial_t_);
-  Tape grad = patch(gradient_);
   // one gradient output per distinct target coordinate, ascending; constants drop out
-  std::vector<std::pair<Index, std::uint32_t>> cols;
-  for (std::size_t k = 0; k < coords_.size(); ++k) {
-    const auto c = static_cast<std::size_t>(coords_[k]);
-    if (c >= target.size()) throw Error("rebind: compiled coordinate index out of range");
-    if (target[c] >= 0) cols.emplace_back(target[c], grad.outputs_[k]);
-  }
-  std::stable_sort(cols.begin(), cols.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  grad.outputs_.clear();
-  for (std::size_t k = 0; k < cols.size(); ++k) {
-    if (!out->coords_.empty() && out->coords_.back() == cols[k].first) {
-      grad.code_.push_back(Tape::Instr{Tape::Op::kAdd, grad.outputs_.back(), cols[k].second, 0.0});
-      grad.outputs_.back() = static_cast<std::uint32_t>(grad.code_.size() - 1);
-    } else {
-      out->coords_.push_back(cols[k].first);
-      grad.outputs_.push_back(cols[k].second);
+  auto columns = [&](const Tape& in, const std::vector<Index>& coords, std::vector<Index>& out_coords) {
+    Tape grad = patch(in);
+    std::vector<std::pair<Index, std::uint32_t>> cols;
+    for (std::size_t k = 0; k < coords.size(); ++k) {
+      const auto c = static_cast<std::size_t>(coords[k]);
+      if (c >= target.size()) throw Error("rebind: compiled coordinate index out of range");
+      if (target[c] >= 0) cols.emplace_back(target[c], grad.outputs_[k]);
     }
-  }
-  out->gradient_ = std::move(grad);
+    std::stable_sort(cols.begin(), cols.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    grad.outputs_.clear();
+    for (std::size_t k = 0; k < cols.size(); ++k) {
+      if (!out_coords.empty() && out_coords.back() == cols[k].first) {
+        grad.code_.push_back(Tape::Instr{Tape::Op::kAdd, grad.outputs_.back(), cols[k].second, 0.0});
+        grad.outputs_.back() = static_cast<std::uint32_t>(grad.code_.size() - 1);
+      } else {
+        out_coords.push_back(cols[k].first);
+        grad.outputs_.push_back(cols[k].second);
+      }
+    }
+    return grad;
+  };
+  out->gradient_ = columns(gradient_, coords_, out->coords_);
+  out->rate_gradient_ = columns(rate_gradient_, rate_coords_, out->rate_coords_);
   return out;
 }
 

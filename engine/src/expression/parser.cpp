@@ -37,6 +37,8 @@ namespace {
 //   power    := primary ('^' exponent)?
 //   exponent := ('-' | '+') exponent | primary
 //   primary  := number | name | function '(' sum (',' sum)* ')' | '(' sum ')'
+// `der` is the one function that is no tape instruction: der(u) is u's rate along the motion, Σ ∂u/∂q_j q̇_j + ∂u/∂t,
+// built symbolically by the caller (RateOf), where velocities may be read.
 class ExpressionParser {
  public:
   struct Node {
@@ -46,8 +48,9 @@ class ExpressionParser {
   };
   using Name = ParsedName;
 
-  ExpressionParser(const std::string& text, NameLookup name, std::map<std::string, double>& value_of_constant)
-      : text_(text), name_(std::move(name)), value_of_constant_(value_of_constant) {}
+  ExpressionParser(const std::string& text, NameLookup name, std::map<std::string, double>& value_of_constant,
+                   RateOf rate_of)
+      : text_(text), name_(std::move(name)), value_of_constant_(value_of_constant), rate_of_(std::move(rate_of)) {}
 
   Node parse() {
     Node n = sum();
@@ -245,9 +248,11 @@ class ExpressionParser {
   }
 
   Node call(const std::string& name, std::size_t start) {
+    if (name == "der") return rate(start);
     auto it = supported_functions().find(name);
     if (it == supported_functions().end())
-      fail("unknown function '" + name.substr(0, 40) + "' (supported: " + supported_function_list() + ")");
+      fail("unknown function '" + name.substr(0, 40) + "' (supported: " + supported_function_list() +
+           (rate_of_ ? " der" : "") + ")");
     expect('(', "'('");
     enter_parentheses();
     std::vector<Node> args;
@@ -266,17 +271,35 @@ class ExpressionParser {
     return call_function(f, args);
   }
 
+  // der(u): the rate of u along the motion (0 for a constant u)
+  Node rate(std::size_t start) {
+    if (!rate_of_)
+      fail(
+          "der() reads velocities: only the forces and torques of `loads` may (a constraint, driver or law is of q "
+          "and t)");
+    expect('(', "'('");
+    enter_parentheses();
+    if (peek() == ')') pos_ = start, fail_at("'der' takes 1 argument, not 0");
+    Node u = sum();
+    if (peek() == ',') pos_ = start, fail_at("'der' takes 1 argument, not 2 or more");
+    expect(')', "')'");
+    --depth_;
+    return u.constant ? constant(0.0) : settle(rate_of_(u.e));
+  }
+
   const std::string& text_;
   NameLookup name_;
   std::map<std::string, double>& value_of_constant_;
+  RateOf rate_of_;
   std::size_t pos_ = 0;
   int depth_ = 0;
 };
 
 }  // namespace
 
-GiNaC::ex parse_expression(const std::string& text, NameLookup name, std::map<std::string, double>& value_of_constant) {
-  ExpressionParser parser(text, std::move(name), value_of_constant);
+GiNaC::ex parse_expression(const std::string& text, NameLookup name, std::map<std::string, double>& value_of_constant,
+                           RateOf rate_of) {
+  ExpressionParser parser(text, std::move(name), value_of_constant, std::move(rate_of));
   return parser.parse().e;
 }
 

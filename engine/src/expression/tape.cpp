@@ -26,8 +26,8 @@ void Tape::evaluate(const double* q, const double* qd, double t, double* out) co
       case Op::kLoadQ:
         r[i] = q[in.a];
         break;
-      case Op::kLoadQd:
-        r[i] = qd[in.a];
+      case Op::kLoadQd:  // (a load's der(); no constraint's tape reads q̇)
+        r[i] = qd ? qd[in.a] : 0.0;
         break;
       case Op::kLoadT:
         r[i] = t;

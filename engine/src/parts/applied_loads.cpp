@@ -106,10 +106,10 @@ AngleState angle_state(const TorsionalSpring& s, const double* q, const double* 
 }  // namespace
 
 V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 3>& components, LoadAxes axes,
-                    const Pose& pose, const double* q, double t) {
+                    const Pose& pose, const double* q, const double* qd, double t) {
   double v[3] = {0.0, 0.0, 0.0};
   for (int k = 0; k < 3; ++k)
-    if (components[static_cast<std::size_t>(k)]) v[k] = components[static_cast<std::size_t>(k)]->value(q, t);
+    if (components[static_cast<std::size_t>(k)]) v[k] = components[static_cast<std::size_t>(k)]->value(q, qd, t);
   const V3 c{v[0], v[1], v[2]};
   return axes == LoadAxes::kPart ? turned(pose.rotation, c) : c;
 }
@@ -117,11 +117,11 @@ V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 
 void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, double t, Eigen::VectorXd& Q) {
   for (const AppliedForce& f : loads.forces) {
     const Pose pose = part_pose(f.frame, q, t);
-    add_virtual_work(f.frame, pose, f.at, world_components(f.components, f.axes, pose, q, t), {}, q, t, Q);
+    add_virtual_work(f.frame, pose, f.at, world_components(f.components, f.axes, pose, q, qd, t), {}, q, t, Q);
   }
   for (const AppliedTorque& m : loads.torques) {
     const Pose pose = part_pose(m.frame, q, t);
-    add_virtual_work(m.frame, pose, {}, {}, world_components(m.components, m.axes, pose, q, t), q, t, Q);
+    add_virtual_work(m.frame, pose, {}, {}, world_components(m.components, m.axes, pose, q, qd, t), q, t, Q);
   }
   for (const LinearSpring& s : loads.springs) {
     const SpringState st = spring_state(s, q, qd, t);
@@ -141,11 +141,11 @@ double applied_power(const AppliedLoads& loads, const double* q, const double* q
   double power = 0.0;
   for (const AppliedForce& f : loads.forces) {
     const PartMotion m = part_motion(f.frame, q, qd, nullptr, t);
-    power += kin3::dot(world_components(f.components, f.axes, m.pose, q, t), m.point(f.at).first);
+    power += kin3::dot(world_components(f.components, f.axes, m.pose, q, qd, t), m.point(f.at).first);
   }
   for (const AppliedTorque& tq : loads.torques) {
     const PartMotion m = part_motion(tq.frame, q, qd, nullptr, t);
-    power += kin3::dot(world_components(tq.components, tq.axes, m.pose, q, t), m.omega);
+    power += kin3::dot(world_components(tq.components, tq.axes, m.pose, q, qd, t), m.omega);
   }
   for (const LinearSpring& s : loads.springs) {
     const SpringState st = spring_state(s, q, qd, t);

@@ -193,17 +193,23 @@ bool load_frame_rates(const std::array<const AppliedLoads*, 4>& along, const Par
   return frame_rates(own, frames, h, out);
 }
 
-// An expression's value with its rate: ∇e · s along the motion, and the difference of its copies along p.
+// An expression's value with its rate: ∇e · s + ∂e/∂q̇ · ṡ along the motion (a load's der() reads q̇; without q̇
+// on the path, at rest, it reads 0), and the difference of its copies along p.
 Dual expression_dual(const CompiledExpression& e, const std::array<const CompiledExpression*, 4>& copies, double h,
                      const DualPath& p) {
   thread_local std::vector<double> g;
   const std::vector<Index>& c = e.coordinates();
   g.resize(c.size());
-  e.gradient(p.q, p.t, g.data());
+  e.gradient(p.q, p.qd, p.t, g.data());
   double rate = 0.0, x[4];
   for (std::size_t i = 0; i < c.size(); ++i) rate += g[i] * p.s[c[i]];
-  for (std::size_t k = 0; k < 4; ++k) x[k] = copies[k]->value(p.q, p.t);
-  return {e.value(p.q, p.t), rate + copies_rate(x, h)};
+  if (const std::vector<Index>& r = e.rate_coordinates(); !r.empty() && p.qd) {
+    g.resize(r.size());
+    e.rate_gradient(p.q, p.qd, p.t, g.data());
+    for (std::size_t i = 0; i < r.size(); ++i) rate += g[i] * p.sd[r[i]];
+  }
+  for (std::size_t k = 0; k < 4; ++k) x[k] = copies[k]->value(p.q, p.qd, p.t);
+  return {e.value(p.q, p.qd, p.t), rate + copies_rate(x, h)};
 }
 
 using Components = std::array<std::shared_ptr<const CompiledExpression>, 3>;

@@ -8,13 +8,13 @@
 namespace phiq::detail::scene {
 
 template <class C>
-std::shared_ptr<const CompiledExpression> SceneReader::compile(const C& c, bool allow_time) const {
+std::shared_ptr<const CompiledExpression> SceneReader::compile(const C& c, bool allow_time, bool allow_rates) const {
   try {
     if constexpr (kInFamily<C>) {
-      return family_expression(c, allow_time, true);
+      return family_expression(c, allow_time, true, allow_rates);
     } else {
       const std::string text = c.text();
-      return CompiledExpression::compile(text, resolver(true, text), allow_time);
+      return CompiledExpression::compile(text, resolver(true, text), allow_time, allow_rates);
     }
   } catch (const Error& e) {
     c.fail(e.what());
@@ -41,14 +41,15 @@ std::string coordinate_in_law(const std::string& name) {
 
 // An equation (or law) expression of a family member: compiled once per body, rebound per member. Throws Error.
 std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const TCursor& c, bool allow_time,
-                                                                         bool allow_coordinates) const {
+                                                                         bool allow_coordinates,
+                                                                         bool allow_rates) const {
   const std::string& text = c.raw();
   ScalarPlan& plan = c.plan();
   if (!plan.equation) {
     auto eq = std::make_shared<ScalarPlan::Equation>();
     eq->allow_coordinates = allow_coordinates;
     if (!uses_member(c, text)) {
-      eq->shared = CompiledExpression::compile(text, resolver(allow_coordinates, text), allow_time);
+      eq->shared = CompiledExpression::compile(text, resolver(allow_coordinates, text), allow_time, allow_rates);
     } else {
       // each templated name becomes a placeholder identifier that the text cannot already contain
       const std::vector<NameToken> tokens = name_tokens(text, expression_label(text));
@@ -96,7 +97,7 @@ std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const T
         return std::nullopt;
       };
       try {
-        eq->compiled = CompiledExpression::compile(rewritten, resolve, allow_time);
+        eq->compiled = CompiledExpression::compile(rewritten, resolve, allow_time, allow_rates);
       } catch (const Error& e) {
         // say it with the text as written
         std::string m = e.what();
@@ -137,7 +138,7 @@ std::shared_ptr<const CompiledExpression> SceneReader::family_expression(const T
 }
 
 // Used by the constraint and driver readers.
-template std::shared_ptr<const CompiledExpression> SceneReader::compile(const Cursor&, bool) const;
-template std::shared_ptr<const CompiledExpression> SceneReader::compile(const TCursor&, bool) const;
+template std::shared_ptr<const CompiledExpression> SceneReader::compile(const Cursor&, bool, bool) const;
+template std::shared_ptr<const CompiledExpression> SceneReader::compile(const TCursor&, bool, bool) const;
 
 }  // namespace phiq::detail::scene

@@ -76,7 +76,7 @@ AppliedTorque PartReader::applied_torque(const C& m, const LoadTargets& targets,
     torque.components = load_components(value, "torque");
   } else {
     if (!value.is_scalar()) value.fail("a torque in the plane is one number or expression (about z)");
-    torque.components[2] = r_.compile(value, true);
+    torque.components[2] = r_.compile(value, true, true);
   }
   return torque;
 }
@@ -125,16 +125,16 @@ kin3::V3 PartReader::load_vector(const C& c, const char* what) const {
   return {v[0], v[1], r_.spatial_ ? v[2] : 0.0};
 }
 
-// A vector of expressions of t, the coordinates and the parameters; the plane's has no z.
+// A vector of expressions of t, the coordinates, their rates (der()) and the parameters; the plane's has no z.
 template <class C>
 std::array<std::shared_ptr<const CompiledExpression>, 3> PartReader::load_components(const C& c,
                                                                                      const char* what) const {
   const std::size_t n = r_.spatial_ ? 3 : 2;
   if (!c.is_sequence() || c.size() != n)
     c.fail(std::string(what) + " is " + (r_.spatial_ ? "[x, y, z]" : "[x, y]") +
-           " (numbers or expressions of t, the coordinates and the parameters)");
+           " (numbers or expressions of t, the coordinates, their rates der(…) and the parameters)");
   std::array<std::shared_ptr<const CompiledExpression>, 3> out;
-  for (std::size_t k = 0; k < n; ++k) out[k] = r_.compile(c.at(k), true);
+  for (std::size_t k = 0; k < n; ++k) out[k] = r_.compile(c.at(k), true, true);
   return out;
 }
 

@@ -97,10 +97,10 @@ class SceneReader {
 
   // ---- expressions (read_equations.cpp) -----------------------------------------------------------------------
   template <class C>
-  std::shared_ptr<const CompiledExpression> compile(const C& c, bool allow_time) const;
+  std::shared_ptr<const CompiledExpression> compile(const C& c, bool allow_time, bool allow_rates = false) const;
   NameResolver resolver(bool coordinates, const std::string& text) const;
-  std::shared_ptr<const CompiledExpression> family_expression(const TCursor& c, bool allow_time,
-                                                              bool allow_coordinates) const;
+  std::shared_ptr<const CompiledExpression> family_expression(const TCursor& c, bool allow_time, bool allow_coordinates,
+                                                              bool allow_rates = false) const;
 
   // ---- families (read_families.cpp, family_expansion.hpp) -----------------------------------------------------
   FamilyRange parse_range(const std::string& key, const YAML::Mark& key_mark, const std::string& path,

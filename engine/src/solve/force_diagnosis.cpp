@@ -86,11 +86,11 @@ bool load_finite(const Load& load, std::vector<Load> AppliedLoads::*list, Index 
 
 // Why a force's or torque's generalized force is not finite: its value, its part's frame, or an overflow.
 template <class Load>
-std::string vector_load_fault(const Load& l, const char* what, const double* q, double t) {
+std::string vector_load_fault(const Load& l, const char* what, const double* q, const double* qd, double t) {
   const std::string who = what + (" '" + l.name + "' on part '" + l.part + "': ");
   const Pose pose = part_pose(l.frame, q, t);
   if (!finite(pose)) return who + frame_fault(l.frame, q);
-  const V3 v = world_components(l.components, l.axes, pose, q, t);
+  const V3 v = world_components(l.components, l.axes, pose, q, qd, t);
   if (!finite(v)) return who + "its value is not finite: " + print(v);
   return who + "its generalized force overflows doubles";
 }
@@ -108,9 +108,9 @@ std::string nonfinite_force_source(const std::vector<Part>& parts, const Loads& 
   const AppliedLoads& a = *loads.applied;
   const Index n = num_coordinates;
   for (const AppliedForce& f : a.forces)
-    if (!load_finite(f, &AppliedLoads::forces, n, q, qd, t)) return vector_load_fault(f, "force", q, t);
+    if (!load_finite(f, &AppliedLoads::forces, n, q, qd, t)) return vector_load_fault(f, "force", q, qd, t);
   for (const AppliedTorque& f : a.torques)
-    if (!load_finite(f, &AppliedLoads::torques, n, q, qd, t)) return vector_load_fault(f, "torque", q, t);
+    if (!load_finite(f, &AppliedLoads::torques, n, q, qd, t)) return vector_load_fault(f, "torque", q, qd, t);
   for (const LinearSpring& s : a.springs)
     if (!load_finite(s, &AppliedLoads::springs, n, q, qd, t))
       return "spring '" + s.name + "': its tension or direction is not finite (its ends' frames or an overflow)";
