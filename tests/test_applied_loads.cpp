@@ -3,7 +3,8 @@
 // their potential energy, in natural, reference-point and spatial coordinates; virtual power with masses, gravity,
 // a spring, a damper, a force and a torque in all four formulations of the four-bar; a force in part axes against
 // the same force written in world axes; forces and torques of the rates (der()) against a closed form, a damper
-// and the power balance, also as a family; and the bad input the reader refuses.
+// and the power balance, also as a family; laws of the stroke and of t against a closed form, and a law's table
+// left; and the bad input the reader refuses.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -409,6 +410,57 @@ TEST(AppliedLoads, DriverPowerBalancesWithForcesAndTorquesOfRatesInAFamily) {
   EXPECT_NEAR(pa.loads_power, pb.loads_power, 1e-12 * pb.loads_power);
 }
 
+TEST(AppliedLoads, ALawOfTheStrokeOnTheSliderFollowsItsClosedForm) {
+  // a table of F(xB) through a cubic, 60 − 20 xB + 15 xB³ (the spline is exact for cubics), and a harmonic law of
+  // t, on the massless slider: τ = −(F(xB) + 4 sin(3t + 0.5)) ∂xB/∂θ
+  Scene s = parse_scene(test::model_file_text("seed/crank_slider_mixed.yaml") +
+                            "\nparts:\n  slider: {frame: {at: B}}\n"
+                            "loads:\n  forces:\n"
+                            "    - {name: gas, part: slider, force: [{law: {type: table, t: [0.6, 0.8, 1.0, 1.2, 1.4], "
+                            "values: [51.24, 51.68, 55.0, 61.92, 73.16]}, of: xB}, 0]}\n"
+                            "    - {name: shake, part: slider, force: [{law: {type: harmonic, amplitude: 4, "
+                            "frequency: 3, phase: 0.5}}, 0]}\n",
+                        "crank_slider.yaml");
+  const Model& m = *s.model;
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
+  Workspace ws(m);
+  const Index theta = m.find_coordinate("theta2");
+  const double r = 0.3, L = 1.0;
+  double worst = 0.0, peak = 0.0;
+  std::vector<double> efforts;
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    ws.q = tr.q[k], ws.qd = tr.qd[k], ws.qdd = tr.qdd[k];
+    ASSERT_EQ(driver_efforts(m, s.parts, s.loads, tr.t[k], ws, efforts), SolveStatus::kSuccess);
+    const double th = tr.q[k](theta), sn = std::sin(th), cs = std::cos(th);
+    const double root = std::sqrt(L * L - r * r * sn * sn);
+    const double xb = r * cs + root, dxb = -r * sn - r * r * sn * cs / root;
+    const double force = 60.0 - 20.0 * xb + 15.0 * xb * xb * xb + 4.0 * std::sin(3.0 * tr.t[k] + 0.5);
+    worst = std::max(worst, std::fabs(efforts[0] + force * dxb));
+    peak = std::max(peak, std::fabs(force * dxb));
+  }
+  EXPECT_GT(peak, 10.0);
+  EXPECT_LT(worst, 1e-9 * peak);
+}
+
+TEST(AppliedLoads, ALawsArgumentOutsideItsTableStopsTheEffortsNamingTheLoad) {
+  Scene s = parse_scene(test::model_file_text("seed/crank_slider_mixed.yaml", "output:") +
+                            "\nparts:\n  slider: {frame: {at: B}, mass: 1, center_of_mass: [0, 0], inertia: 0.01}\n"
+                            "loads:\n  forces:\n    - {name: gas, part: slider, force: [{law: {type: table, "
+                            "t: [0.8, 1.0, 1.2], values: [5, 6, 8]}, of: xB}, 0]}\n"
+                            "output: {efforts: all}\n",
+                        "crank_slider.yaml");
+  const Model& m = *s.model;  // xB runs over [0.7, 1.3]: outside the table from the first row
+  Workspace ws(m);
+  ws.q = m.initial_positions();
+  SweepSummary sum;
+  EXPECT_EQ(run_sweep(
+                m, s.sweep, ws, [](const StepView&) { return true; }, &sum),
+            SolveStatus::kNonFinite);
+  EXPECT_HAS(sum.message,
+             "force 'gas' on part 'slider': its law's argument 'xB' is 1.3, outside the table's [0.8, 1.2]");
+}
+
 TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
   const std::string base = test::model_file_text("seed/fourbar_reference_point.yaml") + "\nloads:\n";
   auto error = [&](const std::string& loads) { return test::scene_error(base + loads); };
@@ -425,7 +477,7 @@ TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
   m = error("  forces:\n    - {part: crank, force: [1, 0], axes: body}\n");
   EXPECT_HAS(m, "loads.forces[0].axes: axes is world or part, got 'body'");
   m = error("  torques:\n    - {part: crank, torque: [0, 0, 1]}\n");
-  EXPECT_HAS(m, "loads.torques[0].torque: a torque in the plane is one number or expression");
+  EXPECT_HAS(m, "loads.torques[0].torque: a torque in the plane is one number, expression or law");
   m = error(
       "  springs:\n    - {between: [{part: crank}, {point: [1, 0]}], stiffness: 10, free_length: 1, damping: -2}\n");
   EXPECT_HAS(m, "loads.springs[0].damping: must not be negative, got -2");
@@ -439,6 +491,10 @@ TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
   m = error("  torsional_springs:\n    - {angle: psi3 - psi2 + foo, stiffness: 1}\n");
   EXPECT_HAS(m, "loads.torsional_springs[0].angle:");
   EXPECT_HAS(m, "foo");
+  m = error("  forces:\n    - {part: crank, force: [{law: {type: linear, initial: 0, rate: 1}, at: t}, 0]}\n");
+  EXPECT_HAS(m, "loads.forces[0].force[0].at: unknown field 'at' (allowed: law, of)");
+  m = error("  torques:\n    - {part: crank, torque: {law: {type: cubic}}}\n");
+  EXPECT_HAS(m, "loads.torques[0].torque.law.type: unknown law type 'cubic'");
   m = error("  torsional_springs:\n    - {angle: psi3 - der(psi2), stiffness: 1}\n");
   EXPECT_HAS(m, "loads.torsional_springs[0].angle: expression \"psi3 - der(psi2)\": der() reads velocities");
   m = error("  forces:\n    - {part: crank, force: [der(der(psi2)), 0]}\n");

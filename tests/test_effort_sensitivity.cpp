@@ -2,11 +2,11 @@
 // `NAME.effort.d_P`): a pendulum driven with a constant angular acceleration against its closed form
 // τ = m g l cos θ + (I + m l²) α, and a massive crank-slider (polar crank, a load at the slider's pin) and the
 // massive four-bar of models/dynamics (natural coordinates) and a spatial RSSR, also with torsional springs on its
-// hinges' angles, parts and loads on frames of expressions, and a force of the rates (der()), against central
-// differences of whole sweeps re-solved at p ± δ, p ± δ/2 (Richardson), every row; the columns as the CSV names them. A
-// crank-slider whose parameters reach a length, a mass, a frame, gravity, a force, a spring and a torsional spring
-// carries parts and loads along p only for those that move them, and writes the same bits as with its own forces along
-// every parameter.
+// hinges' angles, parts and loads on frames of expressions, and forces of the rates (der()) and laws of them,
+// against central differences of whole sweeps re-solved at p ± δ, p ± δ/2 (Richardson), every row; the columns as the
+// CSV names them. A crank-slider whose parameters reach a length, a mass, a frame, gravity, a force, a spring and a
+// torsional spring carries parts and loads along p only for those that move them, and writes the same bits as with its
+// own forces along every parameter.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -181,6 +181,36 @@ parts:
 loads:
   gravity: [0, -9.81]
   forces: [{name: drag, part: rod, at: [L3, 0], force: ["-c*der(xB)*abs(der(xB)) - 2*der(xB)", "-c*der(yA)"]}]
+time: {start: 0, end: pi, steps: 60}
+output: {efforts: all, sensitivities: [L2, L3, c]}
+)yaml");
+}
+
+TEST(EffortSensitivity, ACrankSliderWithALawOfTheSlidersSpeedMatchesResolvedSweeps) {
+  // a drag measured against the slider's speed (a table law of der(xB)) whose values read c, and a law of the
+  // stroke: L2 and L3 move the arguments, c the table
+  expect_effort_sensitivities_match_resolved_sweeps(R"yaml(phiq: 1
+name: crank_slider
+parameters: {L2: 0.3, L3: 1.0, c: 4}
+coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}
+points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
+constraints:
+  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
+  - {name: rod, type: distance, points: [A, B], length: L3}
+drivers:
+  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
+parts:
+  crank: {frame: {origin: O, x: A}, center_of_mass: [L2/2, 0], mass: 0.5, inertia: 0.5*L2*L2/12}
+  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 1.2, inertia: 1.2*L3*L3/12}
+loads:
+  gravity: [0, -9.81]
+  forces:
+    - name: drag
+      part: rod
+      at: [L3, 0]
+      force:
+        - {law: {type: table, t: [-1, -0.5, 0, 0.5, 1], values: [6*c, 2*c, 0, -2*c, -6*c]}, of: der(xB)}
+        - {law: {type: polynomial, coefficients: [1, 0, 3]}, of: xB - L3}
 time: {start: 0, end: pi, steps: 60}
 output: {efforts: all, sensitivities: [L2, L3, c]}
 )yaml");

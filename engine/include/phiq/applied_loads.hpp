@@ -1,8 +1,10 @@
 /// @file
 /// Applied loads on a mechanism's parts (the scene's `loads` besides gravity, models/README.md): forces at points
-/// of parts and torques on parts, each a vector of expressions of t, the coordinates and the parameters, in world or
-/// part axes; linear spring-dampers between two points (of parts, or fixed in the world); torsional spring-dampers on
-/// an angle (a coordinate, an expression of the coordinates such as a relative angle ψ3 − ψ2, a spatial joint's).
+/// of parts and torques on parts, each a vector of expressions of t, the coordinates, their rates and the
+/// parameters, or of motion laws of such an expression (a table of a measured force against t, a crank angle or a
+/// speed), in world or part axes; linear spring-dampers between two points (of parts, or fixed in the world); torsional
+/// spring-dampers on an angle (a coordinate, an expression of the coordinates such as a relative angle ψ3 − ψ2, a
+/// spatial joint's).
 ///
 /// Their generalized forces are their virtual work, Q_k = Σ ∂x/∂q_k · F + ∂θ/∂q_k · M, from each part's exact
 /// Jacobian (part_jacobian(), phiq/part_motion.hpp), so they hold in every coordinate family; dampers read the
@@ -19,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "phiq/motion_law.hpp"
 #include "phiq/output_joints.hpp"
 #include "phiq/parts.hpp"
 
@@ -39,6 +42,8 @@ struct AppliedForce {
   LoadAxes axes = LoadAxes::kWorld;  ///< the axes of its components
   /// Its components (N), expressions of t, q, q̇ (der()) and the parameters; null: 0 (z in the plane).
   std::array<std::shared_ptr<const CompiledExpression>, 3> components;
+  /// Where laws[k] has a value, component k is that law of components[k] (its argument: t, or what `of` says).
+  std::array<MotionLaw, 3> laws;
 };
 
 /// A torque (a couple) on a part.
@@ -49,6 +54,7 @@ struct AppliedTorque {
   LoadAxes axes = LoadAxes::kWorld;  ///< the axes of its components
   /// Its components (N·m) as for AppliedForce: in the plane only z.
   std::array<std::shared_ptr<const CompiledExpression>, 3> components;
+  std::array<MotionLaw, 3> laws;  ///< as AppliedForce::laws
 };
 
 /// One end of a linear spring: a point of a part, or a point fixed in the world (a ground frame).
@@ -93,9 +99,11 @@ struct AppliedLoads {
   bool empty() const { return forces.empty() && torques.empty() && springs.empty() && torsional_springs.empty(); }
 };
 
-/// A force's or torque's components at (q, q̇, t) in world axes (qd null: q̇ = 0).
-kin3::V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 3>& components, LoadAxes axes,
-                          const Pose& pose, const double* q, const double* qd, double t);
+/// A force's or torque's components at (q, q̇, t) in world axes (qd null: q̇ = 0): each its expression, or its law
+/// of that expression.
+kin3::V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 3>& components,
+                          const std::array<MotionLaw, 3>& laws, LoadAxes axes, const Pose& pose, const double* q,
+                          const double* qd, double t);
 
 /// Adds to `Q` (one entry per coordinate) the generalized forces of `loads` at (q, q̇, t): their virtual work per
 /// δq_k. `qd` may be null: at rest (the dampers exert nothing, der() is 0). Pre-condition: Q has an entry for every

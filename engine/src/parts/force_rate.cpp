@@ -213,19 +213,33 @@ Dual expression_dual(const CompiledExpression& e, const std::array<const Compile
 }
 
 using Components = std::array<std::shared_ptr<const CompiledExpression>, 3>;
+using Laws = std::array<MotionLaw, 3>;
+
+// A law f of an argument u with their rates: f(u), f′(u) u̇ + the difference of the copies' laws at u along p.
+Dual law_dual(const MotionLaw& f, const std::array<const MotionLaw*, 4>& copies, double h, Dual u) {
+  const LawValue at = f.evaluate(u.v);
+  double x[4];
+  for (std::size_t k = 0; k < 4; ++k) x[k] = copies[k]->evaluate(u.v).f;
+  return {at.f, at.df * u.e + copies_rate(x, h)};
+}
 
 // A force's or torque's components in world axes with their rates (world_components()); false where a component
-// is present in one copy along p and not in another.
-bool components_dual(const Components& own, const std::array<const Components*, 4>& copies, LoadAxes axes,
-                     const DualMotion& mo, double h, const DualPath& p, DV& out) {
+// or its law is present in one copy along p and not in another.
+bool components_dual(const Components& own, const Laws& own_laws, const std::array<const Components*, 4>& copies,
+                     const std::array<const Laws*, 4>& copies_laws, LoadAxes axes, const DualMotion& mo, double h,
+                     const DualPath& p, DV& out) {
   Dual v[3];
   for (std::size_t c = 0; c < 3; ++c) {
     std::array<const CompiledExpression*, 4> along{};
+    std::array<const MotionLaw*, 4> laws{};
     for (std::size_t k = 0; k < 4; ++k) {
       along[k] = (*copies[k])[c].get();
-      if ((along[k] == nullptr) != (own[c] == nullptr)) return false;
+      laws[k] = &(*copies_laws[k])[c];
+      if ((along[k] == nullptr) != (own[c] == nullptr) || laws[k]->has_value() != own_laws[c].has_value()) return false;
     }
-    if (own[c]) v[c] = expression_dual(*own[c], along, h, p);
+    if (!own[c]) continue;
+    v[c] = expression_dual(*own[c], along, h, p);
+    if (own_laws[c].has_value()) v[c] = law_dual(own_laws[c], laws, h, v[c]);
   }
   out = {v[0], v[1], v[2]};
   if (axes == LoadAxes::kPart) out = turned(mo.rotation, out);
@@ -256,13 +270,14 @@ bool add_forces_and_torques_rate(const AppliedLoads& loads, const std::array<con
       return false;
     const DualPath path = along_motion.over(rates);
     std::array<const Components*, 4> copies{};
+    std::array<const Laws*, 4> laws{};
     for (std::size_t k = 0; k < 4; ++k) {
       if (along[k]->forces[i].axes != f.axes) return false;
-      copies[k] = &along[k]->forces[i].components;
+      copies[k] = &along[k]->forces[i].components, laws[k] = &along[k]->forces[i].laws;
     }
     const DualMotion mo = dual_motion(f.frame, path);
     DV force;
-    if (!components_dual(f.components, copies, f.axes, mo, h, path, force)) return false;
+    if (!components_dual(f.components, f.laws, copies, laws, f.axes, mo, h, path, force)) return false;
     const DV at =
         constant_vector(f.at, load_vector_rate(
                                   along, h, [](const AppliedLoads& a, std::size_t j) { return a.forces[j].at; }, i));
@@ -277,13 +292,14 @@ bool add_forces_and_torques_rate(const AppliedLoads& loads, const std::array<con
       return false;
     const DualPath path = along_motion.over(rates);
     std::array<const Components*, 4> copies{};
+    std::array<const Laws*, 4> laws{};
     for (std::size_t k = 0; k < 4; ++k) {
       if (along[k]->torques[i].axes != m.axes) return false;
-      copies[k] = &along[k]->torques[i].components;
+      copies[k] = &along[k]->torques[i].components, laws[k] = &along[k]->torques[i].laws;
     }
     const DualMotion mo = dual_motion(m.frame, path);
     DV moment;
-    if (!components_dual(m.components, copies, m.axes, mo, h, path, moment)) return false;
+    if (!components_dual(m.components, m.laws, copies, laws, m.axes, mo, h, path, moment)) return false;
     dual_jacobian(m.frame, path, jac);
     add_force_rate(jac, DV{}, DV{}, moment, dq);
   }

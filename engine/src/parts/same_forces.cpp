@@ -22,6 +22,12 @@ bool same_expressions(const std::array<std::shared_ptr<const CompiledExpression>
   return true;
 }
 
+bool same_laws(const std::array<MotionLaw, 3>& a, const std::array<MotionLaw, 3>& b) {
+  for (std::size_t i = 0; i < 3; ++i)
+    if (!(a[i] == b[i])) return false;
+  return true;
+}
+
 bool same_mass(const MassProperties& a, const MassProperties& b) {
   return a.mass == b.mass && a.center == b.center && a.inertia == b.inertia;
 }
@@ -35,12 +41,13 @@ bool same_applied(const AppliedLoads& a, const AppliedLoads& b) {
   for (std::size_t i = 0; i < a.forces.size(); ++i) {
     const AppliedForce &x = a.forces[i], &y = b.forces[i];
     if (!same_frame(x.frame, y.frame) || !(x.at == y.at) || x.axes != y.axes ||
-        !same_expressions(x.components, y.components))
+        !same_expressions(x.components, y.components) || !same_laws(x.laws, y.laws))
       return false;
   }
   for (std::size_t i = 0; i < a.torques.size(); ++i) {
     const AppliedTorque &x = a.torques[i], &y = b.torques[i];
-    if (!same_frame(x.frame, y.frame) || x.axes != y.axes || !same_expressions(x.components, y.components))
+    if (!same_frame(x.frame, y.frame) || x.axes != y.axes || !same_expressions(x.components, y.components) ||
+        !same_laws(x.laws, y.laws))
       return false;
   }
   for (std::size_t i = 0; i < a.springs.size(); ++i) {

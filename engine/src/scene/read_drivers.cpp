@@ -132,5 +132,8 @@ MotionLaw SceneReader::motion_law(const C& c) const {
 // Used by read() for plain entries and family members.
 template void SceneReader::read_driver(const Cursor&);
 template void SceneReader::read_driver(const TCursor&);
+// and by the loads' components (read_loads.cpp)
+template MotionLaw SceneReader::motion_law(const Cursor&) const;
+template MotionLaw SceneReader::motion_law(const TCursor&) const;
 
 }  // namespace phiq::detail::scene

@@ -58,7 +58,7 @@ AppliedForce PartReader::applied_force(const C& f, const LoadTargets& targets, s
   force.frame = load_frame(part, targets, "a force");
   if (auto at = f.field("at"); at.present()) force.at = load_vector(at, "at");
   force.axes = load_axes(f.field("axes"));
-  force.components = load_components(f.require("force"), "force");
+  load_components(f.require("force"), "force", force.components, force.laws);
   return force;
 }
 
@@ -73,10 +73,10 @@ AppliedTorque PartReader::applied_torque(const C& m, const LoadTargets& targets,
   torque.axes = load_axes(m.field("axes"));
   const auto value = m.require("torque");
   if (r_.spatial_) {
-    torque.components = load_components(value, "torque");
+    load_components(value, "torque", torque.components, torque.laws);
   } else {
-    if (!value.is_scalar()) value.fail("a torque in the plane is one number or expression (about z)");
-    torque.components[2] = r_.compile(value, true, true);
+    if (value.is_sequence()) value.fail("a torque in the plane is one number, expression or law (about z)");
+    torque.components[2] = load_component(value, torque.laws[2]);
   }
   return torque;
 }
@@ -125,17 +125,28 @@ kin3::V3 PartReader::load_vector(const C& c, const char* what) const {
   return {v[0], v[1], r_.spatial_ ? v[2] : 0.0};
 }
 
-// A vector of expressions of t, the coordinates, their rates (der()) and the parameters; the plane's has no z.
+// A vector of expressions of t, the coordinates, their rates (der()) and the parameters, or laws of one; the
+// plane's has no z.
 template <class C>
-std::array<std::shared_ptr<const CompiledExpression>, 3> PartReader::load_components(const C& c,
-                                                                                     const char* what) const {
+void PartReader::load_components(const C& c, const char* what,
+                                 std::array<std::shared_ptr<const CompiledExpression>, 3>& out,
+                                 std::array<MotionLaw, 3>& laws) const {
   const std::size_t n = r_.spatial_ ? 3 : 2;
   if (!c.is_sequence() || c.size() != n)
     c.fail(std::string(what) + " is " + (r_.spatial_ ? "[x, y, z]" : "[x, y]") +
-           " (numbers or expressions of t, the coordinates, their rates der(…) and the parameters)");
-  std::array<std::shared_ptr<const CompiledExpression>, 3> out;
-  for (std::size_t k = 0; k < n; ++k) out[k] = r_.compile(c.at(k), true, true);
-  return out;
+           " (numbers, expressions of t, the coordinates, their rates der(…) and the parameters, or laws of one)");
+  for (std::size_t k = 0; k < n; ++k) out[k] = load_component(c.at(k), laws[k]);
+}
+
+// A law's argument is an expression as a component is (t when `of` is absent): a table of a force measured
+// against time, a crank angle, a stroke or a speed.
+template <class C>
+std::shared_ptr<const CompiledExpression> PartReader::load_component(const C& c, MotionLaw& law) const {
+  if (!c.is_map()) return r_.compile(c, true, true);
+  c.expect_map({"law", "of"});
+  law = r_.motion_law(c.require("law"));
+  if (const auto of = c.field("of"); of.present()) return r_.compile(of, true, true);
+  return CompiledExpression::compile("t", r_.resolver(false, "t"));
 }
 
 template <class C>
