@@ -104,6 +104,21 @@ time: {start: 0, end: pi, steps: 90}
 output: {velocities: true, accelerations: true, sensitivities: [L2, {parameter: L3, step: 1e-3}]}
 )";
 
+// kCrankSlider's mechanism (crank L2, rod L3, θ = 2t) with more `parameters` (", c: 4") and `rest` (parts, loads,
+// time, output).
+inline std::string crank_slider_scene(const std::string& parameters, const std::string& rest) {
+  return "phiq: 1\nname: crank_slider\nparameters: {L2: 0.3, L3: 1.0" + parameters +
+         "}\n"
+         "coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}\n"
+         "points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}\n"
+         "constraints:\n"
+         "  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}\n"
+         "  - {name: rod, type: distance, points: [A, B], length: L3}\n"
+         "drivers:\n"
+         "  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}\n" +
+         rest;
+}
+
 // Every delivered row's sensitivities, with the row's time and state.
 struct SensitivityTrace {
   Trace rows;

@@ -163,57 +163,35 @@ output: {efforts: all, sensitivities: [L2, L3]}
 )");
 }
 
+// The crank-slider's massive crank and rod under gravity, with `loads` (forces), over half a turn.
+std::string massive_crank_slider_with(const std::string& loads, const std::string& output) {
+  return test::crank_slider_scene(
+      ", c: 4",
+      "parts:\n"
+      "  crank: {frame: {origin: O, x: A}, center_of_mass: [L2/2, 0], mass: 0.5, inertia: 0.5*L2*L2/12}\n"
+      "  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 1.2, inertia: 1.2*L3*L3/12}\n"
+      "loads:\n  gravity: [0, -9.81]\n  forces:\n" +
+          loads + "time: {start: 0, end: pi, steps: 60}\noutput: " + output + "\n");
+}
+
 TEST(EffortSensitivity, ACrankSliderWithAForceOfItsRatesMatchesResolvedSweeps) {
   // a drag on the slider's pin reading the rates (der()): L2 and L3 move ẋB, c scales the force
-  expect_effort_sensitivities_match_resolved_sweeps(R"yaml(phiq: 1
-name: crank_slider
-parameters: {L2: 0.3, L3: 1.0, c: 4}
-coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}
-points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
-constraints:
-  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
-  - {name: rod, type: distance, points: [A, B], length: L3}
-drivers:
-  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
-parts:
-  crank: {frame: {origin: O, x: A}, center_of_mass: [L2/2, 0], mass: 0.5, inertia: 0.5*L2*L2/12}
-  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 1.2, inertia: 1.2*L3*L3/12}
-loads:
-  gravity: [0, -9.81]
-  forces: [{name: drag, part: rod, at: [L3, 0], force: ["-c*der(xB)*abs(der(xB)) - 2*der(xB)", "-c*der(yA)"]}]
-time: {start: 0, end: pi, steps: 60}
-output: {efforts: all, sensitivities: [L2, L3, c]}
-)yaml");
+  expect_effort_sensitivities_match_resolved_sweeps(massive_crank_slider_with(
+      "    - {name: drag, part: rod, at: [L3, 0], force: [\"-c*der(xB)*abs(der(xB)) - 2*der(xB)\", \"-c*der(yA)\"]}\n",
+      "{efforts: all, sensitivities: [L2, L3, c]}"));
 }
 
 TEST(EffortSensitivity, ACrankSliderWithALawOfTheSlidersSpeedMatchesResolvedSweeps) {
   // a drag measured against the slider's speed (a table law of der(xB)) whose values read c, and a law of the
   // stroke: L2 and L3 move the arguments, c the table
-  expect_effort_sensitivities_match_resolved_sweeps(R"yaml(phiq: 1
-name: crank_slider
-parameters: {L2: 0.3, L3: 1.0, c: 4}
-coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}
-points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
-constraints:
-  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
-  - {name: rod, type: distance, points: [A, B], length: L3}
-drivers:
-  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
-parts:
-  crank: {frame: {origin: O, x: A}, center_of_mass: [L2/2, 0], mass: 0.5, inertia: 0.5*L2*L2/12}
-  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 1.2, inertia: 1.2*L3*L3/12}
-loads:
-  gravity: [0, -9.81]
-  forces:
-    - name: drag
-      part: rod
-      at: [L3, 0]
-      force:
-        - {law: {type: table, t: [-1, -0.5, 0, 0.5, 1], values: [6*c, 2*c, 0, -2*c, -6*c]}, of: der(xB)}
-        - {law: {type: polynomial, coefficients: [1, 0, 3]}, of: xB - L3}
-time: {start: 0, end: pi, steps: 60}
-output: {efforts: all, sensitivities: [L2, L3, c]}
-)yaml");
+  expect_effort_sensitivities_match_resolved_sweeps(massive_crank_slider_with(
+      "    - name: drag\n"
+      "      part: rod\n"
+      "      at: [L3, 0]\n"
+      "      force:\n"
+      "        - {law: {type: table, t: [-1, -0.5, 0, 0.5, 1], values: [6*c, 2*c, 0, -2*c, -6*c]}, of: der(xB)}\n"
+      "        - {law: {type: polynomial, coefficients: [1, 0, 3]}, of: xB - L3}\n",
+      "{efforts: all, sensitivities: [L2, L3, c]}"));
 }
 
 TEST(EffortSensitivity, TheMassiveFourBarsTorqueMatchesResolvedSweeps) {

@@ -168,32 +168,23 @@ TEST(ForceRate, TheEffortsSensitivitiesThroughItEqualThoseThroughTheDifferenceOf
 TEST(ForceRate, CarriesForcesOfTheRatesAndLawsOfThemExactly) {
   // der() in a force and a torque (∂Q/∂q̇ · ṡ), a table law of the slider's speed whose values read c, a polynomial
   // law of the stroke whose argument reads L3, and a harmonic law of t whose amplitude is F
-  const Scene s = parse_scene(R"yaml(phiq: 1
-name: crank_slider_rate_loads
-parameters: {L2: 0.3, L3: 1.0, c: 4, F: 2}
-coordinates: {theta2: 0.0, xA: 0.28, yA: 0.03, xB: 1.25}
-points: {O: [0, 0], A: [xA, yA], B: [xB, 0]}
-constraints:
-  - {name: crank, type: polar, point: A, origin: O, length: L2, angle: theta2}
-  - {name: rod, type: distance, points: [A, B], length: L3}
-drivers:
-  - {name: motor, coordinate: theta2, law: {type: linear, initial: 0, rate: 2}}
-parts:
-  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 1.2, inertia: 1.2*L3*L3/12}
-loads:
-  forces:
-    - {name: drag, part: rod, at: [L3, 0], force: ["-c*der(xB)*abs(der(xB))", "-c*L2*der(yA)"]}
-    - name: measured
-      part: rod
-      at: [L3/2, 0]
-      force:
-        - {law: {type: table, t: [-2, -1, 0, 1, 2], values: [20*c, 6*c, 0, -6*c, -20*c]}, of: der(xB)}
-        - {law: {type: polynomial, coefficients: [1, 0, 3]}, of: xB - L3}
-  torques: [{name: shake, part: rod, torque: {law: {type: harmonic, amplitude: F, frequency: 3}}}]
-time: {start: 0, end: 0.9, steps: 9}
-output: {efforts: all, power: true, sensitivities: [L2, L3, c, F]}
-)yaml",
-                              "crank_slider_rate_loads.yaml");
+  const Scene s = parse_scene(
+      test::crank_slider_scene(
+          ", c: 4, F: 2",
+          "parts:\n  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 1.2, inertia: 1.2*L3*L3/12}\n"
+          "loads:\n"
+          "  forces:\n"
+          "    - {name: drag, part: rod, at: [L3, 0], force: [\"-c*der(xB)*abs(der(xB))\", \"-c*L2*der(yA)\"]}\n"
+          "    - name: measured\n"
+          "      part: rod\n"
+          "      at: [L3/2, 0]\n"
+          "      force:\n"
+          "        - {law: {type: table, t: [-2, -1, 0, 1, 2], values: [20*c, 6*c, 0, -6*c, -20*c]}, of: der(xB)}\n"
+          "        - {law: {type: polynomial, coefficients: [1, 0, 3]}, of: xB - L3}\n"
+          "  torques: [{name: shake, part: rod, torque: {law: {type: harmonic, amplitude: F, frequency: 3}}}]\n"
+          "time: {start: 0, end: 0.9, steps: 9}\n"
+          "output: {efforts: all, power: true, sensitivities: [L2, L3, c, F]}\n"),
+      "crank_slider_rate_loads.yaml");
   expect_force_rate_equals_difference_of_q(s);
   expect_force_rate_paths_agree(s);
 }
