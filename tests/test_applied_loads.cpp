@@ -27,19 +27,32 @@ Eigen::VectorXd applied_q(const Scene& s, const Eigen::VectorXd& q, double t) {
   return Q;
 }
 
-// The potential energy of the scene's springs at (q, t): ½ k (L − L0)² + preload · L, ½ k (θ − θ0)².
+// ∫₀^δ of a spring's elastic force: ½ k δ², or its law's integral by 5-point Gauss–Legendre (exact for the
+// polynomials of degree ≤ 9 the tests' laws are).
+double elastic_energy(double stiffness, const MotionLaw& law, double d) {
+  if (!law.has_value()) return 0.5 * stiffness * d * d;
+  const double x[5] = {0.0, -0.5384693101056831, 0.5384693101056831, -0.9061798459386640, 0.9061798459386640};
+  const double w[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665, 0.2369268850561891,
+                       0.2369268850561891};
+  double v = 0.0;
+  for (int k = 0; k < 5; ++k) v += w[k] * law.evaluate(0.5 * d * (1.0 + x[k])).f;
+  return 0.5 * d * v;
+}
+
+// The potential energy of the scene's springs at (q, t): ½ k (L − L0)² + preload · L, ½ k (θ − θ0)² (or their
+// laws' integrals).
 double spring_energy(const AppliedLoads& loads, const Eigen::VectorXd& q, double t) {
   double v = 0.0;
   for (const LinearSpring& s : loads.springs) {
     const double l =
         kin3::norm(part_pose(s.b.frame, q.data(), t).apply(s.b.at) - part_pose(s.a.frame, q.data(), t).apply(s.a.at));
-    v += 0.5 * s.stiffness * (l - s.free_length) * (l - s.free_length) + s.preload * l;
+    v += elastic_energy(s.stiffness, s.law, l - s.free_length) + s.preload * l;
   }
   for (const TorsionalSpring& s : loads.torsional_springs) {
     const double a =
         s.angle ? s.angle->value(q.data(), t) - s.free_angle
                 : std::remainder(evaluate_joint(*s.joint, q.data(), nullptr, nullptr).value - s.free_angle, 2 * M_PI);
-    v += 0.5 * s.stiffness * a * a;
+    v += elastic_energy(s.stiffness, s.law, a);
   }
   return v;
 }
@@ -140,6 +153,24 @@ TEST(AppliedLoads, SpringForcesAreTheirEnergysGradientInEveryCoordinateFamily) {
       "  torsional_springs:\n"
       "    - {name: t1, joint: rocker_hinge, stiffness: 20, free_angle: 0.3, damping: 2}\n"
       "    - {name: t2, joint: crank_hinge, stiffness: 7, free_angle: -2.5}\n");
+  // springs of laws of their deflection: a stiffening strut (k δ + k3 δ³, no free length), a table through a
+  // quadratic, torsional ones on a relative angle and on a spatial hinge
+  expect_spring_forces_are_the_energys_gradient(
+      "seed/fourbar_reference_point.yaml",
+      "  springs:\n"
+      "    - {name: s1, between: [{part: crank, at: [0.1, 0.02]}, {part: rocker, at: [-0.2, 0.05]}],\n"
+      "       law: {type: polynomial, coefficients: [0, 300, 0, 900]}, preload: 7}\n"
+      "    - {name: s2, between: [{point: [0.5, 1.5]}, {part: coupler, at: [0.3, 0]}], free_length: 0.2,\n"
+      "       law: {type: table, t: [-1, 0, 1, 2, 3], values: [-60, 0, 100, 240, 420]}}\n"
+      "  torsional_springs:\n"
+      "    - {name: t1, angle: psi3 - psi2, law: {type: polynomial, coefficients: [2, 20, 0, 8]}, free_angle: 0.3}\n");
+  expect_spring_forces_are_the_energys_gradient(
+      "spatial/rssr.yaml",
+      "  springs:\n"
+      "    - {name: s1, between: [{part: crank, at: [a, 0.05, 0.02]}, {part: rocker, at: [0, b, 0.1]}],\n"
+      "       law: {type: harmonic, amplitude: 90, frequency: 2}, free_length: 0.4}\n"
+      "  torsional_springs:\n"
+      "    - {name: t1, joint: rocker_hinge, law: {type: polynomial, coefficients: [0, 20, 5]}, free_angle: 0.3}\n");
 }
 
 // ω · (R I Rᵀ α): the rate of a part's rotational kinetic energy ½ ω · I_world ω (the rate of I_world does no work).
@@ -464,6 +495,12 @@ TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
   m = error("  torsional_springs:\n    - {angle: psi3 - psi2 + foo, stiffness: 1}\n");
   EXPECT_HAS(m, "loads.torsional_springs[0].angle:");
   EXPECT_HAS(m, "foo");
+  m = error(
+      "  springs:\n    - {between: [{part: crank}, {point: [1, 0]}], stiffness: 10, free_length: 1, "
+      "law: {type: linear, initial: 0, rate: 1}}\n");
+  EXPECT_HAS(m, "loads.springs[0].law: a spring has a stiffness or a law of its deflection, not both");
+  m = error("  torsional_springs:\n    - {coordinate: psi2, law: {type: table, t: [0], values: [0]}}\n");
+  EXPECT_HAS(m, "loads.torsional_springs[0].law.t: a table needs at least 2 points");
   m = error("  forces:\n    - {part: crank, force: [{law: {type: linear, initial: 0, rate: 1}, at: t}, 0]}\n");
   EXPECT_HAS(m, "loads.forces[0].force[0].at: unknown field 'at' (allowed: law, of)");
   m = error("  torques:\n    - {part: crank, torque: {law: {type: cubic}}}\n");

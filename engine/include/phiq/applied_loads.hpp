@@ -64,8 +64,9 @@ struct SpringEnd {
   kin3::V3 at;       ///< the point, in that frame
 };
 
-/// A linear spring-damper between two points: the tension f = k (L − L0) + c L̇ + preload along the line between
-/// them, pulling them together when positive. Where L = 0 the line has no direction and it exerts nothing.
+/// A spring-damper between two points: the tension f = k (L − L0) + c L̇ + preload along the line between them,
+/// pulling them together when positive; with a law, f = law(L − L0) + c L̇ + preload (a gas strut's or a bump
+/// stop's curve). Where L = 0 the line has no direction and it exerts nothing.
 struct LinearSpring {
   std::string name;          ///< the scene's name for it
   SpringEnd a;               ///< its first end
@@ -74,9 +75,11 @@ struct LinearSpring {
   double free_length = 0.0;  ///< L0 (m), ≥ 0
   double damping = 0.0;      ///< c (N·s/m), ≥ 0
   double preload = 0.0;      ///< tension at L = L0 at rest (N)
+  MotionLaw law;             ///< the elastic tension of L − L0 (N) in place of k (L − L0), where it has a value
 };
 
-/// A torsional spring-damper on an angle θ(q, t): the moment τ = k (θ − θ0) + c θ̇ resisting θ's increase.
+/// A torsional spring-damper on an angle θ(q, t): the moment τ = k (θ − θ0) + c θ̇ resisting θ's increase; with a
+/// law, τ = law(θ − θ0) + c θ̇.
 struct TorsionalSpring {
   std::string name;                                 ///< the scene's name for it
   std::shared_ptr<const CompiledExpression> angle;  ///< θ: a coordinate, or an expression of them; or null and:
@@ -87,6 +90,7 @@ struct TorsionalSpring {
   double stiffness = 0.0;                ///< k (N·m/rad), ≥ 0
   double free_angle = 0.0;               ///< θ0 (rad)
   double damping = 0.0;                  ///< c (N·m·s/rad), ≥ 0
+  MotionLaw law;                         ///< the elastic moment of θ − θ0 (N·m) in place of k (θ − θ0), if any
 };
 
 /// The applied loads of a scene, read once and shared (Loads::applied holds them by pointer).

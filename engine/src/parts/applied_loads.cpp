@@ -54,7 +54,9 @@ SpringState spring_state(const LinearSpring& s, const double* q, const double* q
   if (st.length == 0.0) return st;  // no direction: no force (LinearSpring)
   st.unit = (1.0 / st.length) * d;
   if (s.damping != 0.0) st.rate = kin3::dot(st.unit, end_velocity(s.b, q, qd, t) - end_velocity(s.a, q, qd, t));
-  st.tension = s.stiffness * (st.length - s.free_length) + s.damping * st.rate + s.preload;
+  const double stretch = st.length - s.free_length;
+  st.tension =
+      (s.law.has_value() ? s.law.evaluate(stretch).f : s.stiffness * stretch) + s.damping * st.rate + s.preload;
   return st;
 }
 
@@ -99,7 +101,7 @@ AngleState angle_state(const TorsionalSpring& s, const double* q, const double* 
     st.rate = s.angle ? s.angle->partial_t(q, t) : 0.0;
     for (std::size_t i = 0; i < c.size(); ++i) st.rate += gradient[i] * qd[c[i]];
   }
-  st.moment = s.stiffness * st.from_free + s.damping * st.rate;
+  st.moment = (s.law.has_value() ? s.law.evaluate(st.from_free).f : s.stiffness * st.from_free) + s.damping * st.rate;
   return st;
 }
 

@@ -223,6 +223,18 @@ Dual law_dual(const MotionLaw& f, const std::array<const MotionLaw*, 4>& copies,
   return {at.f, at.df * u.e + copies_rate(x, h)};
 }
 
+// A spring's elastic tension or moment as its law of the deflection (its rate included), into `out`: false where a
+// copy along p has no law.
+template <class Get>
+bool spring_law_dual(const MotionLaw& law, const std::array<const AppliedLoads*, 4>& along, double h, Dual deflection,
+                     Dual& out, Get law_of) {
+  std::array<const MotionLaw*, 4> copies{};
+  for (std::size_t k = 0; k < 4; ++k)
+    if (!(copies[k] = law_of(*along[k]))->has_value()) return false;
+  out = law_dual(law, copies, h, deflection);
+  return true;
+}
+
 // A force's or torque's components in world axes with their rates (world_components()); false where a component
 // or its law is present in one copy along p and not in another.
 bool components_dual(const Components& own, const Laws& own_laws, const std::array<const Components*, 4>& copies,
@@ -336,8 +348,12 @@ bool add_springs_rate(const AppliedLoads& loads, const std::array<const AppliedL
     auto datum = [&](double LinearSpring::*field) {
       return Dual(sp.*field, load_rate(along, h, [&](const AppliedLoads& a) { return a.springs[i].*field; }));
     };
-    const Dual tension = datum(&LinearSpring::stiffness) * (length - datum(&LinearSpring::free_length)) +
-                         datum(&LinearSpring::damping) * rate + datum(&LinearSpring::preload);
+    const Dual stretch = length - datum(&LinearSpring::free_length);
+    Dual elastic = datum(&LinearSpring::stiffness) * stretch;
+    if (sp.law.has_value() &&
+        !spring_law_dual(sp.law, along, h, stretch, elastic, [i](const AppliedLoads& a) { return &a.springs[i].law; }))
+      return false;
+    const Dual tension = elastic + datum(&LinearSpring::damping) * rate + datum(&LinearSpring::preload);
     dual_jacobian(sp.a.frame, path_a, jac);
     add_force_rate(jac, ra, tension * unit, DV{}, dq);
     dual_jacobian(sp.b.frame, path_b, jac);
@@ -482,7 +498,11 @@ bool add_torsional_rate(const AppliedLoads& loads, const std::array<const Applie
     };
     Dual angle = st.angle - datum(&TorsionalSpring::free_angle);
     if (!ts.angle) angle.v = std::remainder(angle.v, 2.0 * M_PI);  // a joint's: within a turn (angle_from_free())
-    const Dual moment = datum(&TorsionalSpring::stiffness) * angle + datum(&TorsionalSpring::damping) * st.rate;
+    Dual elastic = datum(&TorsionalSpring::stiffness) * angle;
+    if (ts.law.has_value() && !spring_law_dual(ts.law, along, h, angle, elastic,
+                                               [i](const AppliedLoads& a) { return &a.torsional_springs[i].law; }))
+      return false;
+    const Dual moment = elastic + datum(&TorsionalSpring::damping) * st.rate;
     const std::vector<Index>& c = ts.angle ? ts.angle->coordinates() : ts.joint_coordinates;
     for (std::size_t l = 0; l < c.size(); ++l) dq[c[l]] -= (moment * st.gradient[l]).e;
   }
