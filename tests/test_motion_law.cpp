@@ -1,4 +1,4 @@
-// Motion laws: values and exact derivatives.
+// Motion laws: values and exact derivatives; periodic tables across their seam.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,9 +6,14 @@
 #include "phiq/expression.hpp"
 #include "phiq/model.hpp"
 #include "phiq/motion_law.hpp"
+#include "phiq/phiq.hpp"
+#include "test_support.hpp"
 
 namespace phiq {
 namespace {
+
+template <class Family>
+void check_rate(const Family& law, double p, double h, double tol);
 
 void check_derivatives(const MotionLaw& law, double t, double tol) {
   const double h = 1e-5;
@@ -61,6 +66,76 @@ TEST(MotionLaw, TableOfNonPolynomialDataHasConsistentDerivatives) {
     check_derivatives(tab, x, 1e-6);
     EXPECT_NEAR(tab.evaluate(x).f, std::sin(x), 1e-3);
   }
+}
+
+TEST(MotionLaw, APeriodicTableRepeatsAndIsC2AcrossItsSeam) {
+  // sin over one period at uneven times: the cyclic spline interpolates its points, repeats with the period at
+  // every t (before t_0 too), and its f, f′, f″ meet across the seam t_0 ≡ t_n
+  std::vector<double> t, v;
+  for (int k = 0; k <= 24; ++k) {
+    const double x = 2 * M_PI * (k + 0.3 * std::sin(k)) / 24;
+    t.push_back(x), v.push_back(std::sin(x));
+  }
+  t.front() = 0.0, t.back() = 2 * M_PI, v.front() = v.back() = 0.0;
+  const MotionLaw tab = MotionLaw::table(t, v, true);
+  EXPECT_EQ(tab.domain_begin(), -INFINITY);
+  EXPECT_EQ(tab.domain_end(), INFINITY);
+  for (std::size_t k = 0; k < t.size(); ++k) EXPECT_NEAR(tab.evaluate(t[k]).f, v[k], 1e-14) << k;
+  for (double x : {0.4, 1.3, 3.9, 5.5}) {
+    const LawValue a = tab.evaluate(x);
+    EXPECT_NEAR(a.f, std::sin(x), 2e-4) << x;
+    EXPECT_NEAR(a.df, std::cos(x), 5e-3) << x;
+    for (double shift : {-2.0, 3.0}) {
+      const LawValue b = tab.evaluate(x + shift * 2 * M_PI);
+      EXPECT_NEAR(b.f, a.f, 1e-12);
+      EXPECT_NEAR(b.df, a.df, 1e-11);
+      EXPECT_NEAR(b.ddf, a.ddf, 1e-10);
+    }
+    check_derivatives(tab, x, 1e-6);
+  }
+  const double e = 1e-9;
+  const LawValue before = tab.evaluate(2 * M_PI - e), after = tab.evaluate(2 * M_PI + e);
+  EXPECT_NEAR(before.f, after.f, 1e-8);
+  EXPECT_NEAR(before.df, after.df, 1e-7);
+  EXPECT_NEAR(before.ddf, after.ddf, 1e-6);
+  EXPECT_GT(std::fabs(tab.evaluate(1.0).ddf), 0.5);  // (the second derivative is not trivially 0)
+  // the rate along values that move with p: the periodic table of their rates
+  check_rate(
+      [](double p) {
+        return MotionLaw::table({0.0, 0.7, 1.5, 2.2, 3.0}, {p, 0.2 * p * p, -0.3, 1.0 - p, p}, true);
+      },
+      0.7, 0.07, 1e-9);
+  EXPECT_THROW(MotionLaw::table({0.0, 1.0}, {0.0, 0.0}, true), Error);            // 2 points
+  EXPECT_THROW(MotionLaw::table({0.0, 1.0, 2.0}, {0.0, 1.0, 0.5}, true), Error);  // does not close
+}
+
+TEST(MotionLaw, APeriodicTableDrivesASweepPastItsPeriod) {
+  // the seed crank-slider's crank swung by a periodic table over 1 s, swept over 3 s: no time limit, and the
+  // motion repeats each period
+  std::string text = test::model_file_text("seed/crank_slider_mixed.yaml", "time:");
+  const std::string law = "law: {type: linear, initial: 0, rate: 2}";
+  ASSERT_NE(text.find(law), std::string::npos);
+  text.replace(text.find(law), law.size(),
+               "law: {type: table, t: [0, 0.3, 0.5, 0.8, 1], values: [0, 0.8, 2.0, 0.9, 0], periodic: true}");
+  Scene s = parse_scene(text + "time: {start: 0, end: 3, steps: 60}\n", "crank_slider_periodic.yaml");
+  s.sweep.velocities = true;
+  EXPECT_GT(s.model->time_domain_end(), 1e300);  // (no driver limits it)
+  test::Trace tr;
+  ASSERT_EQ(test::sweep(*s.model, s.sweep, &tr), SolveStatus::kSuccess);
+  ASSERT_EQ(tr.t.size(), 61u);
+  ASSERT_EQ(tr.qd.size(), 61u);
+  const Index theta = s.model->find_coordinate("theta2");
+  const MotionLaw swing = MotionLaw::table({0, 0.3, 0.5, 0.8, 1}, {0, 0.8, 2.0, 0.9, 0}, true);
+  for (std::size_t k = 0; k + 20 < tr.t.size(); ++k) {
+    EXPECT_NEAR(tr.q[k](theta), swing.evaluate(tr.t[k]).f, 1e-12) << tr.t[k];
+    EXPECT_LT((tr.q[k + 20] - tr.q[k]).cwiseAbs().maxCoeff(), 1e-9) << tr.t[k];
+    EXPECT_LT((tr.qd[k + 20] - tr.qd[k]).cwiseAbs().maxCoeff(), 1e-8) << tr.t[k];
+  }
+  std::string open = text;
+  open.replace(open.find("0.9, 0]"), 7, "0.9, 0.1]");
+  EXPECT_NE(test::scene_error(open + "time: {start: 0, end: 3, steps: 60}\n")
+                .find("law.values: a periodic table ends where it starts: its last value is not its first"),
+            std::string::npos);
 }
 
 TEST(MotionLaw, ExpressionLaw) {

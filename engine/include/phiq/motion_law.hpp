@@ -30,8 +30,10 @@ class MotionLaw {
   /// f = offset + amplitude * sin(frequency * t + phase)   (frequency in rad/s)
   static MotionLaw harmonic(double offset, double amplitude, double frequency, double phase);
   /// C² cubic spline through (t_k, value_k) (Eigen's interpolating B-spline; exact for cubics); t strictly
-  /// increasing, at least 2 points (fewer than 4 lower the degree). Defined on [t_0, t_last] only.
-  static MotionLaw table(std::vector<double> t, std::vector<double> values);
+  /// increasing, at least 2 points (fewer than 4 lower the degree). Defined on [t_0, t_last] only. `periodic`:
+  /// the cyclic C² cubic spline, repeating with period t_last − t_0 and defined at every t; at least 3 points, the
+  /// last value equal to the first (a cam's lift over a turn, a gas force over an engine's cycle).
+  static MotionLaw table(std::vector<double> t, std::vector<double> values, bool periodic = false);
   /// Any function of t written as text, e.g. "0.1*t^2 + sin(t)"; derivatives are exact (see expression.hpp).
   static MotionLaw expression(std::shared_ptr<const CompiledExpression> f_of_t);
   /// f = Σ_k w_k f_k(t), terms (w_k, f_k): a superposition of laws, defined where every term is. Throws
@@ -66,6 +68,7 @@ class MotionLaw {
   /// @endcond
 
  private:
+  static MotionLaw periodic_table(const std::vector<double>& t, const std::vector<double>& values);
   std::shared_ptr<const Impl> impl_;
   std::string description_;
 };

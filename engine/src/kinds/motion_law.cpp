@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <Eigen/SparseLU>
 #include <unsupported/Eigen/Splines>
 
 #include "phiq/kinds/kind_support.hpp"
@@ -118,6 +119,43 @@ std::shared_ptr<const MotionLaw::Impl> Harmonic::rate(const std::array<const Imp
   r->rate.phase = d(&Harmonic::phase);
   return r;
 }
+
+// A table that repeats with period P = t_n − t_0 (its last value its first): the cyclic C² cubic spline through
+// the points, defined at every t (t taken modulo P into [t_0, t_n)). Per piece k, f = a + b s + c s² + d s³ with
+// s = t − t_k.
+struct PeriodicTable final : MotionLaw::Impl {
+  std::vector<double> t, a, b, c, d;
+  LawValue evaluate(double x) const override {
+    const double period = t.back() - t.front();
+    double s = std::fmod(x - t.front(), period);
+    if (s < 0.0) s += period;
+    const double u = t.front() + s;
+    const auto k = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(
+        std::upper_bound(t.begin(), t.end(), u) - t.begin() - 1, 0, static_cast<std::ptrdiff_t>(a.size()) - 1));
+    const double h = u - t[k];
+    return {a[k] + h * (b[k] + h * (c[k] + h * d[k])), b[k] + h * (2.0 * c[k] + 3.0 * h * d[k]),
+            2.0 * c[k] + 6.0 * h * d[k]};
+  }
+  bool same(const MotionLaw::Impl& other) const override {
+    const auto* o = dynamic_cast<const PeriodicTable*>(&other);
+    return o && t == o->t && a == o->a && b == o->b && c == o->c && d == o->d;
+  }
+  // The coefficients are linear in the values: with the same times the rate is the table of their rates.
+  std::shared_ptr<const Impl> rate(const std::array<const Impl*, 4>& along, double h) const override {
+    const auto o = copies_as<PeriodicTable>(along);
+    if (!all_of_kind(o)) return nullptr;
+    for (const PeriodicTable* x : o)
+      if (x->t != t) return nullptr;
+    auto r = std::make_shared<PeriodicTable>(*this);
+    auto rate_of = [&](std::vector<double> PeriodicTable::*m, std::vector<double>& out) {
+      for (std::size_t k = 0; k < out.size(); ++k)
+        out[k] = central_difference((o[0]->*m)[k], (o[1]->*m)[k], (o[2]->*m)[k], (o[3]->*m)[k], h);
+    };
+    rate_of(&PeriodicTable::a, r->a), rate_of(&PeriodicTable::b, r->b);
+    rate_of(&PeriodicTable::c, r->c), rate_of(&PeriodicTable::d, r->d);
+    return r;
+  }
+};
 
 struct Table final : MotionLaw::Impl {
   using Spline = Eigen::Spline<double, 1>;
@@ -267,7 +305,7 @@ MotionLaw MotionLaw::harmonic(double offset, double amplitude, double frequency,
   return law;
 }
 
-MotionLaw MotionLaw::table(std::vector<double> t, std::vector<double> values) {
+MotionLaw MotionLaw::table(std::vector<double> t, std::vector<double> values, bool periodic) {
   if (t.size() != values.size())
     throw Error("motion law: table has " + std::to_string(t.size()) + " times but " + std::to_string(values.size()) +
                 " values");
@@ -279,6 +317,7 @@ MotionLaw MotionLaw::table(std::vector<double> t, std::vector<double> values) {
       throw Error("motion law: table times must increase strictly (t[" + std::to_string(k) +
                   "] = " + significant(t[k], 12) + " after " + significant(t[k - 1], 12) + ")");
   }
+  if (periodic) return periodic_table(t, values);
   auto impl = std::make_shared<Table>();
   impl->t0 = t.front();
   impl->t1 = t.back();
@@ -294,6 +333,46 @@ MotionLaw MotionLaw::table(std::vector<double> t, std::vector<double> values) {
   law.impl_ = impl;
   law.description_ = "table of " + std::to_string(n) + " points on [" + significant(impl->t0, 12) + ", " +
                      significant(impl->t1, 12) + "]";
+  return law;
+}
+
+MotionLaw MotionLaw::periodic_table(const std::vector<double>& t, const std::vector<double>& values) {
+  if (t.size() < 3) throw Error("motion law: a periodic table needs at least 3 points");
+  if (values.back() != values.front())
+    throw Error("motion law: a periodic table ends where it starts (its last value " + significant(values.back(), 12) +
+                " is not its first, " + significant(values.front(), 12) + ")");
+  // Second derivatives M_k: h_{k−1} M_{k−1} + 2 (h_{k−1} + h_k) M_k + h_k M_{k+1} = 6 (slope_k − slope_{k−1}),
+  // indices cyclic over the m = n − 1 pieces (as a closed Curve's); strictly diagonally dominant.
+  const std::size_t m = t.size() - 1;
+  std::vector<double> h(m), slope(m);
+  for (std::size_t k = 0; k < m; ++k) h[k] = t[k + 1] - t[k], slope[k] = (values[k + 1] - values[k]) / h[k];
+  std::vector<Eigen::Triplet<double>> entries;
+  Eigen::VectorXd rhs(static_cast<Eigen::Index>(m));
+  for (std::size_t k = 0; k < m; ++k) {
+    const std::size_t km = (k + m - 1) % m, kp = (k + 1) % m;
+    const auto i = static_cast<Eigen::Index>(k);
+    entries.emplace_back(i, static_cast<Eigen::Index>(km), h[km]);
+    entries.emplace_back(i, i, 2.0 * (h[km] + h[k]));
+    entries.emplace_back(i, static_cast<Eigen::Index>(kp), h[k]);
+    rhs(i) = 6.0 * (slope[k] - slope[km]);
+  }
+  Eigen::SparseMatrix<double> a(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
+  a.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(a);
+  const Eigen::VectorXd M = lu.solve(rhs);
+  auto impl = std::make_shared<PeriodicTable>();
+  impl->t = t;
+  for (std::size_t k = 0; k < m; ++k) {
+    const double m0 = M(static_cast<Eigen::Index>(k)), m1 = M(static_cast<Eigen::Index>((k + 1) % m));
+    impl->a.push_back(values[k]);
+    impl->b.push_back(slope[k] - h[k] * (2.0 * m0 + m1) / 6.0);
+    impl->c.push_back(0.5 * m0);
+    impl->d.push_back((m1 - m0) / (6.0 * h[k]));
+  }
+  MotionLaw law;
+  law.impl_ = impl;
+  law.description_ =
+      "periodic table of " + std::to_string(t.size()) + " points, period " + significant(t.back() - t.front(), 12);
   return law;
 }
 

@@ -99,13 +99,17 @@ MotionLaw SceneReader::motion_law(const C& c) const {
       return MotionLaw::harmonic(off, number(c.require("amplitude")), number(c.require("frequency")), ph);
     }
     if (type == "table") {
-      c.expect_map({"type", "t", "values"});
+      c.expect_map({"type", "t", "values", "periodic"});
       auto t = numbers(c.require("t"), 0), v = numbers(c.require("values"), 0);
+      const bool periodic = c.field("periodic").present() && c.field("periodic").boolean();
       if (t.size() != v.size()) c.require("values").fail("needs as many values as times");
       if (t.size() < 2) c.require("t").fail("a table needs at least 2 points");
       for (std::size_t k = 1; k < t.size(); ++k)
         if (!(t[k] > t[k - 1])) c.require("t").at(k).fail("times must increase strictly");
-      return MotionLaw::table(t, v);
+      if (periodic && t.size() < 3) c.require("t").fail("a periodic table needs at least 3 points");
+      if (periodic && v.back() != v.front())
+        c.require("values").fail("a periodic table ends where it starts: its last value is not its first");
+      return MotionLaw::table(t, v, periodic);
     }
     if (type == "expression") {
       c.expect_map({"type", "f"});
