@@ -1,9 +1,9 @@
 // Joint reactions at natural coordinates' shared points (phiq/natural_joints.hpp): the natural four-bar's pins O, A,
-// B, C carry the forces the reference-point four-bar's revolutes carry, under gravity, forces, a torque and a spring,
-// with the same motor torque; each of its links satisfies its Newton–Euler equations written here with them; the
-// bodies' weight and inertia read from the whole model's Q (a sweep's way) give the reactions their own Q gives, bit
-// for bit, and so do the flat sites' sums on random natural chains, in both forms of Q (rigid bars' constant mass
-// matrices or their frames' motion); a point no two bodies share is refused by name.
+// B, C carry the forces the reference-point four-bar's revolutes carry, under gravity, forces, a torque (part of it
+// viscous, of der()) and a spring, with the same motor torque; each of its links satisfies its Newton–Euler equations
+// written here with them; the bodies' weight and inertia read from the whole model's Q (a sweep's way) give the
+// reactions their own Q gives, bit for bit, and so do the flat sites' sums on random natural chains, in both forms of Q
+// (rigid bars' constant mass matrices or their frames' motion); a point no two bodies share is refused by name.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -57,15 +57,18 @@ NaturalRows natural_reactions_sweep(const Scene& s) {
   return r;
 }
 
-// The loads of both forms: gravity off the vertical, a force on the coupler (part axes), a torque on the rocker, a
-// spring from the rocker to a world point; `coupler_at`, `rocker_at` the parts' origins in the reference-point
-// form's frames (the natural frames start at A and C, the reference-point bodies at the links' centres).
-std::string natural_reactions_loads(double coupler_at, double rocker_at) {
+// The loads of both forms: gravity off the vertical, a force on the coupler (part axes), a torque on the rocker
+// with a viscous part of its turning rate (der() of `rocker_angle`, that form's angle of the rocker), a spring from
+// the rocker to a world point; `coupler_at`, `rocker_at` the parts' origins in the reference-point form's frames
+// (the natural frames start at A and C, the reference-point bodies at the links' centres).
+constexpr const char* kNaturalRockerAngle = "atan2(yB, xB - L1)";
+std::string natural_reactions_loads(double coupler_at, double rocker_at,
+                                    const std::string& rocker_angle = kNaturalRockerAngle) {
   std::ostringstream s;
   s << "loads:\n  gravity: [0.8, -9.81]\n"
     << "  forces: [{name: push, part: coupler, at: [" << coupler_at + 0.1 << ", 0.05], force: [3 + sin(t), -2], "
     << "axes: part}]\n"
-    << "  torques: [{name: brake, part: rocker, torque: -1.5}]\n"
+    << "  torques: [{name: brake, part: rocker, torque: \"-1.5 - 0.7*der(" << rocker_angle << ")\"}]\n"
     << "  springs: [{name: s, between: [{part: rocker, at: [" << rocker_at + 0.3 << ", 0]}, {point: [1.5, 1]}], "
     << "stiffness: 40, free_length: 0.2}]\n";
   return s.str();
@@ -128,7 +131,7 @@ TEST(NaturalReactions, FourBarPinsAndTorqueAreTheReferencePointForms) {
   const Scene natural = natural_four_bar();
   std::string text = natural_reactions_scene("seed/fourbar_reference_point.yaml");
   text += "parts:\n" + natural_reactions_part("crank", 0, 0, "") + natural_reactions_part("coupler", 1, 0, "") +
-          natural_reactions_part("rocker", 2, 0, "") + natural_reactions_loads(0, 0) +
+          natural_reactions_part("rocker", 2, 0, "") + natural_reactions_loads(0, 0, "psi4") +
           "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
   const Scene reference = parse_scene(text, "fourbar_reference_point.yaml");
   // O, A, B, C in both: points of the natural form (on the crank, crank, coupler, rocker), revolutes of the other
@@ -188,7 +191,7 @@ TEST(NaturalReactions, EveryNaturalLinkBalancesUnderItsPinForces) {
     };
     const Link links[3] = {{"O", "A", 0, {{"O", F(0)}, {"A", F(1)}}, tau},
                            {"A", "B", 1, {{"A", -F(1)}, {"B", F(2)}}, 0.0},
-                           {"C", "B", 2, {{"B", -F(2)}, {"C", F(3)}}, -1.5}};
+                           {"C", "B", 2, {{"B", -F(2)}, {"C", F(3)}}, -1.5}};  // (and −0.7 ω below)
     for (const Link& l : links) {
       const Eigen::Vector2d o = at(rows.q[k], l.origin), d = at(rows.q[k], l.x) - o;
       const Eigen::Vector2d dv = at(rows.qd[k], l.x) - at(rows.qd[k], l.origin);
@@ -199,7 +202,7 @@ TEST(NaturalReactions, EveryNaturalLinkBalancesUnderItsPinForces) {
       const Eigen::Vector2d G = o + half * e,
                             aG = ao + alpha * half * Eigen::Vector2d(-e.y(), e.x()) - w * w * half * e;
       Eigen::Vector2d sum = mass * g;
-      double moment = l.torque;
+      double moment = l.torque + (l.index == 2 ? -0.7 * w : 0.0);
       for (const auto& [p, f] : l.forces) sum += f, moment += natural_cross(at(rows.q[k], p) - G, f);
       if (l.index == 1) {  // the push, in the coupler's axes at (0.7, 0.05) from A
         const Eigen::Vector2d n(-e.y(), e.x()), f = (3 + std::sin(t)) * e - 2 * n;
