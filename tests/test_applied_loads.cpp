@@ -57,7 +57,8 @@ double spring_energy(const AppliedLoads& loads, const Eigen::VectorXd& q, double
   return v;
 }
 
-// The seed crank-slider (crank 0.3, rod 1, θ = 2t) with a massless slider carrying `loads` (YAML), swept: its
+// The seed crank-slider (crank 0.3, rod 1, θ = 2t) with a massless slider carrying `loads` (YAML entries of the
+// `loads` map), swept: its
 // motor's effort against the closed form τ = −F ∂xB/∂θ (the motor's power balances the force's, τ θ̇ + F ẋB = 0),
 // F(t, xB, ẋB) the force along x, xB = r cos θ + √(L² − r² sin² θ). The largest difference and the largest |τ|.
 struct SliderBalance {
@@ -65,9 +66,9 @@ struct SliderBalance {
 };
 SliderBalance slider_force_balance(const std::string& loads, const std::function<double(double, double, double)>& f) {
   SliderBalance b;
-  const Scene s = parse_scene(test::model_file_text("seed/crank_slider_mixed.yaml") +
-                                  "\nparts:\n  slider: {frame: {at: B}}\nloads:\n  forces:\n" + loads,
-                              "crank_slider.yaml");
+  const Scene s = parse_scene(
+      test::model_file_text("seed/crank_slider_mixed.yaml") + "\nparts:\n  slider: {frame: {at: B}}\nloads:\n" + loads,
+      "crank_slider.yaml");
   const Model& m = *s.model;
   test::Trace tr;
   EXPECT_EQ(test::sweep(m, s.sweep, &tr), SolveStatus::kSuccess);
@@ -95,7 +96,7 @@ SliderBalance slider_force_balance(const std::string& loads, const std::function
 TEST(AppliedLoads, TheCrankSlidersMotorBalancesAForceOnTheSlider) {
   // F = −40 − 10 xB + 5 sin t on the slider along x, no masses
   const SliderBalance b =
-      slider_force_balance("    - {name: push, part: slider, force: [-40 - 10*xB + 5*sin(t), 0]}\n",
+      slider_force_balance("  forces:\n    - {name: push, part: slider, force: [-40 - 10*xB + 5*sin(t), 0]}\n",
                            [](double t, double xb, double) { return -40.0 - 10.0 * xb + 5.0 * std::sin(t); });
   EXPECT_GT(b.peak, 10.0);  // newton-metres: the check is not of zeros
   EXPECT_LT(b.worst, 1e-9 * b.peak);
@@ -361,9 +362,9 @@ TEST(AppliedLoads, AForceInPartAxesIsTheSameForceTurnedIntoWorldAxes) {
 
 TEST(AppliedLoads, ARateDependentForceOnTheSliderFollowsItsClosedForm) {
   // F = −7 ẋB − 3 ẋB |ẋB| (der(xB))
-  const SliderBalance b =
-      slider_force_balance("    - {name: drag, part: slider, force: [-7*der(xB) - 3*der(xB)*abs(der(xB)), 0]}\n",
-                           [](double, double, double v) { return -7.0 * v - 3.0 * v * std::fabs(v); });
+  const SliderBalance b = slider_force_balance(
+      "  forces:\n    - {name: drag, part: slider, force: [-7*der(xB) - 3*der(xB)*abs(der(xB)), 0]}\n",
+      [](double, double, double v) { return -7.0 * v - 3.0 * v * std::fabs(v); });
   EXPECT_GT(b.peak, 1.0);
   EXPECT_LT(b.worst, 1e-9 * b.peak);
 }
@@ -436,12 +437,27 @@ TEST(AppliedLoads, DriverPowerBalancesWithForcesAndTorquesOfRatesInAFamily) {
 TEST(AppliedLoads, ALawOfTheStrokeOnTheSliderFollowsItsClosedForm) {
   // a table of F(xB) through a cubic, 60 − 20 xB + 15 xB³ (the spline is exact for cubics), and a harmonic law of t
   const SliderBalance b = slider_force_balance(
-      "    - {name: gas, part: slider, force: [{law: {type: table, t: [0.6, 0.8, 1.0, 1.2, 1.4], "
+      "  forces:\n    - {name: gas, part: slider, force: [{law: {type: table, t: [0.6, 0.8, 1.0, 1.2, 1.4], "
       "values: [51.24, 51.68, 55.0, 61.92, 73.16]}, of: xB}, 0]}\n"
       "    - {name: shake, part: slider, force: [{law: {type: harmonic, amplitude: 4, frequency: 3, phase: 0.5}}, "
       "0]}\n",
       [](double t, double xb, double) {
         return 60.0 - 20.0 * xb + 15.0 * xb * xb * xb + 4.0 * std::sin(3.0 * t + 0.5);
+      });
+  EXPECT_GT(b.peak, 10.0);
+  EXPECT_LT(b.worst, 1e-9 * b.peak);
+}
+
+TEST(AppliedLoads, ALineActuatorOnTheSliderFollowsItsClosedForm) {
+  // a cylinder from a world point on the slider's line, its tension an expression of t and the rate (and a law of
+  // the stroke in a second one, with a linear spring): the slider feels −T along x
+  const SliderBalance b = slider_force_balance(
+      "  springs:\n"
+      "    - {name: cylinder, between: [{point: [-5, 0]}, {part: slider}], tension: 30 + 10*sin(t) + 2*der(xB)}\n"
+      "    - {name: strut, between: [{point: [-5, 0]}, {part: slider}], stiffness: 20, free_length: 5.5,\n"
+      "       tension: {law: {type: polynomial, coefficients: [0, 0, 8]}, of: xB}}\n",
+      [](double t, double xb, double v) {
+        return -(30.0 + 10.0 * std::sin(t) + 2.0 * v) - (20.0 * (xb + 5.0 - 5.5) + 8.0 * xb * xb);
       });
   EXPECT_GT(b.peak, 10.0);
   EXPECT_LT(b.worst, 1e-9 * b.peak);
@@ -499,6 +515,8 @@ TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
       "  springs:\n    - {between: [{part: crank}, {point: [1, 0]}], stiffness: 10, free_length: 1, "
       "law: {type: linear, initial: 0, rate: 1}}\n");
   EXPECT_HAS(m, "loads.springs[0].law: a spring has a stiffness or a law of its deflection, not both");
+  m = error("  springs:\n    - {between: [{part: crank}, {point: [1, 0]}], damping: 2}\n");
+  EXPECT_HAS(m, "loads.springs[0]: missing field 'stiffness'");
   m = error("  torsional_springs:\n    - {coordinate: psi2, law: {type: table, t: [0], values: [0]}}\n");
   EXPECT_HAS(m, "loads.torsional_springs[0].law.t: a table needs at least 2 points");
   m = error("  forces:\n    - {part: crank, force: [{law: {type: linear, initial: 0, rate: 1}, at: t}, 0]}\n");

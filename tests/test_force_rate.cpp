@@ -168,7 +168,8 @@ TEST(ForceRate, TheEffortsSensitivitiesThroughItEqualThoseThroughTheDifferenceOf
 TEST(ForceRate, CarriesForcesOfTheRatesAndLawsOfThemAndOfSpringsDeflectionsExactly) {
   // der() in a force and a torque (∂Q/∂q̇ · ṡ), a table law of the slider's speed whose values read c, a polynomial
   // law of the stroke whose argument reads L3, a harmonic law of t whose amplitude is F, and springs whose elastic
-  // force is a law of their deflection (c in a table's values, F in a polynomial's coefficients)
+  // force is a law of their deflection (c in a table's values, F in a polynomial's coefficients) with actuators
+  // (an expression of t and a rate, a law of the stroke)
   const Scene s = parse_scene(
       test::crank_slider_scene(
           ", c: 4, F: 2",
@@ -184,9 +185,11 @@ TEST(ForceRate, CarriesForcesOfTheRatesAndLawsOfThemAndOfSpringsDeflectionsExact
           "        - {law: {type: polynomial, coefficients: [1, 0, 3]}, of: xB - L3}\n"
           "  torques: [{name: shake, part: rod, torque: {law: {type: harmonic, amplitude: F, frequency: 3}}}]\n"
           "  springs: [{name: strut, between: [{part: rod, at: [L3/2, 0]}, {point: [0.5, 0.8]}], free_length: 0.2,\n"
-          "             law: {type: table, t: [-1, 0, 1, 2], values: [-c, 0, 3*c, 9*c]}, damping: 2}]\n"
+          "             law: {type: table, t: [-1, 0, 1, 2], values: [-c, 0, 3*c, 9*c]}, damping: 2,\n"
+          "             tension: \"F*sin(t) + c*der(xB)\"}]\n"
           "  torsional_springs: [{name: coil, angle: \"theta2 - atan2(yA, xA - xB)\", "
-          "law: {type: polynomial, coefficients: [0, F, 0, 0.5]}}]\n"
+          "law: {type: polynomial, coefficients: [0, F, 0, 0.5]}, moment: {law: {type: harmonic, amplitude: c, "
+          "frequency: 2}, of: xB}}]\n"
           "time: {start: 0, end: 0.9, steps: 9}\n"
           "output: {efforts: all, power: true, sensitivities: [L2, L3, c, F]}\n"),
       "crank_slider_rate_loads.yaml");

@@ -33,6 +33,15 @@ enum class LoadAxes {
   kPart,   ///< the part's frame, turning with it
 };
 
+/// A load's scalar given in the scene: an expression of t, q, q̇ (der()) and the parameters, or a motion law of one
+/// (`{law: LAW, of: EXPR}`); none: 0.
+struct LoadValue {
+  std::shared_ptr<const CompiledExpression> expr;  ///< the value, or the law's argument; null: none
+  MotionLaw law;                                   ///< where it has a value: the value is law(expr)
+  /// Its value at (q, q̇, t) (qd null: q̇ = 0); NaN where a law's argument is outside its table.
+  double value(const double* q, const double* qd, double t) const;
+};
+
 /// A force at a point of a part.
 struct AppliedForce {
   std::string name;                  ///< the scene's name for it
@@ -64,9 +73,10 @@ struct SpringEnd {
   kin3::V3 at;       ///< the point, in that frame
 };
 
-/// A spring-damper between two points: the tension f = k (L − L0) + c L̇ + preload along the line between them,
-/// pulling them together when positive; with a law, f = law(L − L0) + c L̇ + preload (a gas strut's or a bump
-/// stop's curve). Where L = 0 the line has no direction and it exerts nothing.
+/// A spring-damper between two points: the tension f = k (L − L0) + c L̇ + preload + T along the line between them,
+/// pulling them together when positive; with a law, law(L − L0) in place of k (L − L0) (a gas strut's or a bump
+/// stop's curve); T an actuator's tension given as an expression or a law (a cylinder's push, negative). Where L = 0
+/// the line has no direction and it exerts nothing.
 struct LinearSpring {
   std::string name;          ///< the scene's name for it
   SpringEnd a;               ///< its first end
@@ -76,10 +86,11 @@ struct LinearSpring {
   double damping = 0.0;      ///< c (N·s/m), ≥ 0
   double preload = 0.0;      ///< tension at L = L0 at rest (N)
   MotionLaw law;             ///< the elastic tension of L − L0 (N) in place of k (L − L0), where it has a value
+  LoadValue tension;         ///< T (N): an actuator's tension along the line, if any
 };
 
-/// A torsional spring-damper on an angle θ(q, t): the moment τ = k (θ − θ0) + c θ̇ resisting θ's increase; with a
-/// law, τ = law(θ − θ0) + c θ̇.
+/// A torsional spring-damper on an angle θ(q, t): the moment τ = k (θ − θ0) + c θ̇ + M resisting θ's increase; with
+/// a law, law(θ − θ0) in place of k (θ − θ0); M a rotary actuator's moment given as an expression or a law.
 struct TorsionalSpring {
   std::string name;                                 ///< the scene's name for it
   std::shared_ptr<const CompiledExpression> angle;  ///< θ: a coordinate, or an expression of them; or null and:
@@ -91,6 +102,7 @@ struct TorsionalSpring {
   double free_angle = 0.0;               ///< θ0 (rad)
   double damping = 0.0;                  ///< c (N·m·s/rad), ≥ 0
   MotionLaw law;                         ///< the elastic moment of θ − θ0 (N·m) in place of k (θ − θ0), if any
+  LoadValue moment;                      ///< M (N·m): an actuator's moment against θ, if any
 };
 
 /// The applied loads of a scene, read once and shared (Loads::applied holds them by pointer).

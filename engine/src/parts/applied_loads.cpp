@@ -57,6 +57,7 @@ SpringState spring_state(const LinearSpring& s, const double* q, const double* q
   const double stretch = st.length - s.free_length;
   st.tension =
       (s.law.has_value() ? s.law.evaluate(stretch).f : s.stiffness * stretch) + s.damping * st.rate + s.preload;
+  if (s.tension.expr) st.tension += s.tension.value(q, qd, t);
   return st;
 }
 
@@ -102,10 +103,16 @@ AngleState angle_state(const TorsionalSpring& s, const double* q, const double* 
     for (std::size_t i = 0; i < c.size(); ++i) st.rate += gradient[i] * qd[c[i]];
   }
   st.moment = (s.law.has_value() ? s.law.evaluate(st.from_free).f : s.stiffness * st.from_free) + s.damping * st.rate;
+  if (s.moment.expr) st.moment += s.moment.value(q, qd, t);
   return st;
 }
 
 }  // namespace
+
+double LoadValue::value(const double* q, const double* qd, double t) const {
+  const double u = expr->value(q, qd, t);
+  return law.has_value() ? law.evaluate(u).f : u;  // (NaN outside its table)
+}
 
 V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 3>& components,
                     const std::array<MotionLaw, 3>& laws, LoadAxes axes, const Pose& pose, const double* q,

@@ -235,6 +235,24 @@ bool spring_law_dual(const MotionLaw& law, const std::array<const AppliedLoads*,
   return true;
 }
 
+// A spring's actuator (LoadValue) with its rate, added to `out`: false where a copy along p has another form.
+template <class Get>
+bool add_value_dual(const LoadValue& own, const std::array<const AppliedLoads*, 4>& along, double h, const DualPath& p,
+                    Dual& out, Get value_of) {
+  std::array<const CompiledExpression*, 4> exprs{};
+  std::array<const MotionLaw*, 4> laws{};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const LoadValue& x = value_of(*along[k]);
+    if ((x.expr == nullptr) != (own.expr == nullptr) || x.law.has_value() != own.law.has_value()) return false;
+    exprs[k] = x.expr.get(), laws[k] = &x.law;
+  }
+  if (!own.expr) return true;
+  Dual v = expression_dual(*own.expr, exprs, h, p);
+  if (own.law.has_value()) v = law_dual(own.law, laws, h, v);
+  out = out + v;
+  return true;
+}
+
 // A force's or torque's components in world axes with their rates (world_components()); false where a component
 // or its law is present in one copy along p and not in another.
 bool components_dual(const Components& own, const Laws& own_laws, const std::array<const Components*, 4>& copies,
@@ -353,7 +371,10 @@ bool add_springs_rate(const AppliedLoads& loads, const std::array<const AppliedL
     if (sp.law.has_value() &&
         !spring_law_dual(sp.law, along, h, stretch, elastic, [i](const AppliedLoads& a) { return &a.springs[i].law; }))
       return false;
-    const Dual tension = elastic + datum(&LinearSpring::damping) * rate + datum(&LinearSpring::preload);
+    Dual tension = elastic + datum(&LinearSpring::damping) * rate + datum(&LinearSpring::preload);
+    if (!add_value_dual(sp.tension, along, h, along_motion, tension,
+                        [i](const AppliedLoads& a) -> const LoadValue& { return a.springs[i].tension; }))
+      return false;
     dual_jacobian(sp.a.frame, path_a, jac);
     add_force_rate(jac, ra, tension * unit, DV{}, dq);
     dual_jacobian(sp.b.frame, path_b, jac);
@@ -502,7 +523,10 @@ bool add_torsional_rate(const AppliedLoads& loads, const std::array<const Applie
     if (ts.law.has_value() && !spring_law_dual(ts.law, along, h, angle, elastic,
                                                [i](const AppliedLoads& a) { return &a.torsional_springs[i].law; }))
       return false;
-    const Dual moment = elastic + datum(&TorsionalSpring::damping) * st.rate;
+    Dual moment = elastic + datum(&TorsionalSpring::damping) * st.rate;
+    if (!add_value_dual(ts.moment, along, h, path, moment,
+                        [i](const AppliedLoads& a) -> const LoadValue& { return a.torsional_springs[i].moment; }))
+      return false;
     const std::vector<Index>& c = ts.angle ? ts.angle->coordinates() : ts.joint_coordinates;
     for (std::size_t l = 0; l < c.size(); ++l) dq[c[l]] -= (moment * st.gradient[l]).e;
   }

@@ -28,6 +28,8 @@ bool same_laws(const std::array<MotionLaw, 3>& a, const std::array<MotionLaw, 3>
   return true;
 }
 
+bool same_value(const LoadValue& a, const LoadValue& b) { return same_expression(a.expr, b.expr) && a.law == b.law; }
+
 bool same_mass(const MassProperties& a, const MassProperties& b) {
   return a.mass == b.mass && a.center == b.center && a.inertia == b.inertia;
 }
@@ -53,7 +55,7 @@ bool same_applied(const AppliedLoads& a, const AppliedLoads& b) {
   for (std::size_t i = 0; i < a.springs.size(); ++i) {
     const LinearSpring &x = a.springs[i], &y = b.springs[i];
     if (!same_end(x.a, y.a) || !same_end(x.b, y.b) || x.stiffness != y.stiffness || x.free_length != y.free_length ||
-        x.damping != y.damping || x.preload != y.preload || !(x.law == y.law))
+        x.damping != y.damping || x.preload != y.preload || !(x.law == y.law) || !same_value(x.tension, y.tension))
       return false;
   }
   for (std::size_t i = 0; i < a.torsional_springs.size(); ++i) {
@@ -61,7 +63,7 @@ bool same_applied(const AppliedLoads& a, const AppliedLoads& b) {
     if (!same_expression(x.angle, y.angle) || x.joint.has_value() != y.joint.has_value() ||
         (x.joint && (x.joint->measure != y.joint->measure || !(x.joint->att == y.joint->att))) ||
         x.joint_coordinates != y.joint_coordinates || x.stiffness != y.stiffness || x.free_angle != y.free_angle ||
-        x.damping != y.damping || !(x.law == y.law))
+        x.damping != y.damping || !(x.law == y.law) || !same_value(x.moment, y.moment))
       return false;
   }
   return true;

@@ -74,7 +74,7 @@ class PartReader {
   void load_components(const C& c, const char* what, std::array<std::shared_ptr<const CompiledExpression>, 3>& out,
                        std::array<MotionLaw, 3>& laws) const;
   template <class C>
-  void spring_stiffness(const C& s, double& stiffness, MotionLaw& law) const;
+  bool spring_stiffness(const C& s, double& stiffness, MotionLaw& law, bool actuator) const;
   // one component: an expression, or `{law: LAW, of: EXPRESSION}` (of: t when absent)
   template <class C>
   std::shared_ptr<const CompiledExpression> load_component(const C& c, MotionLaw& law) const;

@@ -165,22 +165,26 @@ double PartReader::non_negative(const C& c) const {
   return v;
 }
 
-// A spring's `stiffness`, or its `law` of the deflection (a motion law's map), one of them.
+// A spring's `stiffness`, or its `law` of the deflection (a motion law's map), one of them; neither where it is an
+// actuator alone (`tension`, `moment`). Returns whether it has a stiffness.
 template <class C>
-void PartReader::spring_stiffness(const C& s, double& stiffness, MotionLaw& law) const {
+bool PartReader::spring_stiffness(const C& s, double& stiffness, MotionLaw& law, bool actuator) const {
   const auto k = s.field("stiffness"), l = s.field("law");
   if (k.present() && l.present()) l.fail("a spring has a stiffness or a law of its deflection, not both");
-  if (l.present())
+  if (l.present()) {
     law = r_.motion_law(l);
-  else
-    stiffness = non_negative(s.require("stiffness"));
+    return false;
+  }
+  if (actuator && !k.present()) return false;
+  stiffness = non_negative(s.require("stiffness"));
+  return true;
 }
 
 // A torsional spring-damper on `coordinate: NAME`, `angle: EXPRESSION` of the coordinates, or a spatial `joint`'s
 // angle.
 template <class C>
 TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& names) const {
-  s.expect_map({"name", "coordinate", "angle", "joint", "stiffness", "law", "free_angle", "damping"});
+  s.expect_map({"name", "coordinate", "angle", "joint", "stiffness", "law", "moment", "free_angle", "damping"});
   TorsionalSpring spring;
   spring.name = load_name(s, names);
   const auto on_coordinate = s.field("coordinate"), angle = s.field("angle"), joint = s.field("joint");
@@ -213,7 +217,8 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
     }
     spring.joint_coordinates.assign(read.begin(), read.end());
   }
-  spring_stiffness(s, spring.stiffness, spring.law);
+  if (auto m = s.field("moment"); m.present()) spring.moment.expr = load_component(m, spring.moment.law);
+  spring_stiffness(s, spring.stiffness, spring.law, spring.moment.expr != nullptr);
   if (auto a0 = s.field("free_angle"); a0.present()) spring.free_angle = r_.number(a0);
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
   return spring;
@@ -222,7 +227,7 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
 // A linear spring-damper: `between: [END, END]`, each {part: P, at: [..]} or {point: [..]} (fixed in the world).
 template <class C>
 LinearSpring PartReader::linear_spring(const C& s, const LoadTargets& targets, std::set<std::string>& names) const {
-  s.expect_map({"name", "between", "stiffness", "law", "free_length", "damping", "preload"});
+  s.expect_map({"name", "between", "stiffness", "law", "tension", "free_length", "damping", "preload"});
   LinearSpring spring;
   spring.name = load_name(s, names);
   const auto between = s.require("between");
@@ -250,8 +255,9 @@ LinearSpring PartReader::linear_spring(const C& s, const LoadTargets& targets, s
     between.fail("the spring's two ends are the same point");
   if (frame_coordinates(spring.a.frame).empty() && frame_coordinates(spring.b.frame).empty())
     between.fail("neither end reads a coordinate: the spring does no work on the coordinates and changes no effort");
-  spring_stiffness(s, spring.stiffness, spring.law);
-  if (auto l0 = spring.law.has_value() ? s.field("free_length") : s.require("free_length"); l0.present())
+  if (auto f = s.field("tension"); f.present()) spring.tension.expr = load_component(f, spring.tension.law);
+  const bool stiff = spring_stiffness(s, spring.stiffness, spring.law, spring.tension.expr != nullptr);
+  if (auto l0 = stiff ? s.require("free_length") : s.field("free_length"); l0.present())
     spring.free_length = non_negative(l0);
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
   if (auto p = s.field("preload"); p.present()) spring.preload = r_.number(p);
