@@ -6,6 +6,7 @@
 // `phiq run` give the same bytes, and a bad --gravity is one line, exit 2.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
@@ -143,6 +144,63 @@ TEST(ImportGravity, MotorTorqueOfAPendulumIsTheClosedFormWithEachFormatsGravity)
   const ModelImport off = gravity_import("urdf", gravity_urdf(), gravity_options({{0, 0, 0}}));
   EXPECT_EQ(off.yaml.find("loads:"), std::string::npos);
   EXPECT_LT(gravity_torque_error(off, Eigen::Vector3d::Zero()).first, 1e-9);
+}
+
+// The joint's spring and damper come with it: MJCF's stiffness, damping and springref (in degrees, from the
+// joint's ref), URDF's <dynamics damping> and SDF's axis <dynamics> (friction listed as not mapped) add
+// k (θ − θ0) + c θ̇ to the pendulum's motor torque; a slide's own on its travel, an MJCF slider pushed along its axis.
+TEST(ImportGravity, JointSpringsAndDampersLoadTheMotor) {
+  const std::string mjcf =
+      "<mujoco model=\"pendulum\">\n<worldbody>\n<body name=\"arm\" pos=\"0 0 1\"><joint name=\"hinge\" type=\"hinge\" "
+      "axis=\"1 0 0\" stiffness=\"5\" damping=\"0.5\" springref=\"40\" ref=\"10\" armature=\"0.1\"/>"
+      "<inertial pos=\"0 0.4 0\" mass=\"2\" diaginertia=\"0.03 0.01 0.03\"/></body>\n</worldbody>\n</mujoco>\n";
+  std::string urdf = gravity_urdf();
+  urdf.replace(urdf.find("<axis xyz=\"1 0 0\"/>"), 19,
+               "<axis xyz=\"1 0 0\"/><dynamics damping=\"0.5\" friction=\"0.2\"/>");
+  std::string sdf = gravity_sdf(true, "");
+  sdf.replace(
+      sdf.find("<xyz>1 0 0</xyz>"), 16,
+      "<xyz>1 0 0</xyz><dynamics><damping>0.5</damping><friction>0.2</friction>"
+      "<spring_reference>0.5235987755982988</spring_reference><spring_stiffness>5</spring_stiffness></dynamics>");
+  const double theta0[3] = {30 * M_PI / 180, 0.0, M_PI / 6}, k[3] = {5.0, 0.0, 5.0};
+  int c = 0;
+  for (const auto& [format, text] : {std::pair<std::string, std::string>{"mjcf", mjcf}, {"urdf", urdf}, {"sdf", sdf}}) {
+    SCOPED_TRACE(format);
+    const ModelImport imported = gravity_import(format, text, gravity_options());
+    EXPECT_NE(imported.yaml.find("torsional_springs:"), std::string::npos) << imported.yaml;
+    const Eigen::Vector3d g(0, 0, format == "sdf" ? -9.8 : -9.81);
+    const auto [error, largest] = gravity_effort_error(imported.yaml, [&](double t) {
+      const double theta = 0.5 * t + 0.3 * t * t, rate = 0.5 + 0.6 * t, alpha = 0.6;
+      return kGravityIo * alpha -
+             kGravityMass * kGravityArm * g.dot(Eigen::Vector3d(0, -std::sin(theta), std::cos(theta))) +
+             k[c] * (theta - theta0[c]) + 0.5 * rate;
+    });
+    EXPECT_LT(error, 1e-9);
+    EXPECT_GT(largest, 0.2);
+    const std::string unmapped = format == "mjcf"   ? "<joint armature>"
+                                 : format == "urdf" ? "<dynamics friction>"
+                                                    : "<dynamics><friction>";
+    EXPECT_EQ(std::count_if(imported.skipped.begin(), imported.skipped.end(),
+                            [&](const std::string& x) { return x.find(unmapped) != x.npos; }),
+              1)
+        << unmapped;
+    ++c;
+  }
+  // a slide: k (d − d0) + c ḋ along its axis, d its travel from the file's pose
+  const std::string slider =
+      "<mujoco model=\"slider\">\n<option gravity=\"0 0 0\"/>\n<worldbody>\n<body name=\"block\" pos=\"0 0 1\">"
+      "<joint name=\"slide\" type=\"slide\" axis=\"0 1 0\" stiffness=\"40\" damping=\"3\" springref=\"0.2\"/>"
+      "<inertial pos=\"0 0 0\" mass=\"1.5\" diaginertia=\"0.01 0.01 0.01\"/></body>\n</worldbody>\n</mujoco>\n";
+  ImportOptions o;
+  o.drives = {{"slide", "0.5*t + 0.3*t^2"}};
+  o.t_end = 1, o.steps = 10, o.forces = true;
+  const ModelImport imported = import_mjcf(slider, "slider.xml", o);
+  const auto [error, largest] = gravity_effort_error(imported.yaml, [&](double t) {
+    const double d = 0.5 * t + 0.3 * t * t, rate = 0.5 + 0.6 * t;
+    return 1.5 * 0.6 + 40 * (d - 0.2) + 3 * rate;
+  });
+  EXPECT_LT(error, 1e-9);
+  EXPECT_GT(largest, 5.0);
 }
 
 // tests/data/asmt/pendulum.asmt (ConstantGravity 0 0 0) with its arm's centre (mass 1) at (1, 0, 0), turned by

@@ -48,6 +48,8 @@ class MechanismWriter {
            ", axis: " + scene_vector(s.axis.normalized()) + ", ref: " + scene_vector(s.ref.normalized()) + "}";
   }
   std::string joint_coordinate(int j, const Coupler& c);
+  std::string travel(const Joint& joint);
+  std::string joint_springs();
   std::array<std::string, 3> rotated(int b, const Eigen::Vector3d& v) const;
   void coupler(const Coupler& c);
   void drivers();
@@ -80,23 +82,41 @@ std::string MechanismWriter::joint_coordinate(int j, const Coupler& c) {
     refuse(m_.file_of(c.file), c.line,
            "'" + c.name + "' couples " + (joint.kind.empty() ? "a free" : joint.kind) + " joint '" + joint.name +
                "': phiq couples revolute angles and prismatic travels");
-  // travel = (R₁ a) · (r₂ + R₂ b − r₁) − a · p, a the axis and p the point of side 1, b the point of side 2
   const std::string name = names_.make(jname + "_travel");
+  coordinates_ << "  " << name << ": 0\n";
+  constraints_ << "  - {name: " << names_.make(name + "_def") << ", type: equation, unit: length, expr: \"" << name
+               << " - (" << travel(joint) << ")\"}\n";
+  return joint_coordinate_[j] = name;
+}
+
+// A prismatic joint's travel over the bodies' coordinates: (R₁ a) · (r₂ + R₂ b − r₁) − a · p, a the axis and p the
+// point of side 1, b the point of side 2 (0 at the file's pose).
+std::string MechanismWriter::travel(const Joint& joint) {
   const Eigen::Vector3d a = joint.parent.axis.normalized();
   const std::array<std::string, 3> u = rotated(joint.parent.body, a);
   const std::array<std::string, 3> rb = rotated(joint.child.body, joint.child.at);
-  std::string expr = name + " - (";
+  std::string expr;
   for (std::size_t i = 0; i < 3; ++i) {
     std::string w = "(" + rb[i];
     if (joint.child.body > 0) w += " + " + body_[static_cast<std::size_t>(joint.child.body)] + "_" + "xyz"[i];
     if (joint.parent.body > 0) w += " - " + body_[static_cast<std::size_t>(joint.parent.body)] + "_" + "xyz"[i];
     expr += (i ? " + " : "") + std::string("(") + u[i] + ")*" + w + ")";
   }
-  expr += " - (" + scene_number(a.dot(joint.parent.at)) + "))";
-  coordinates_ << "  " << name << ": 0\n";
-  constraints_ << "  - {name: " << names_.make(name + "_def") << ", type: equation, unit: length, expr: \"" << expr
-               << "\"}\n";
-  return joint_coordinate_[j] = name;
+  return expr + " - (" + scene_number(a.dot(joint.parent.at)) + ")";
+}
+
+// The joints' springs and dampers as torsional springs: on a revolute's angle, or on a prismatic's travel.
+std::string MechanismWriter::joint_springs() {
+  std::ostringstream s;
+  for (std::size_t j = 0; j < m_.joints.size(); ++j) {
+    const Joint& joint = m_.joints[j];
+    if (joint.stiffness == 0.0 && joint.damping == 0.0) continue;
+    s << "    - {name: " << names_.make(joint_[j] + "_spring")
+      << (joint.kind == "revolute" ? ", joint: " + joint_[j] : ", angle: \"" + travel(joint) + "\"")
+      << ", stiffness: " << scene_number(joint.stiffness) << ", free_angle: " << scene_number(joint.free)
+      << ", damping: " << scene_number(joint.damping) << "}\n";
+  }
+  return s.str();
 }
 
 // The world components of R v, R the rotation of body `b` (its Euler parameters; constants for the ground).
@@ -269,7 +289,14 @@ std::string MechanismWriter::write() {
   s << "time: {start: " << scene_number(o_.t_start) << ", end: " << scene_number(o_.t_end) << ", steps: " << o_.steps
     << "}\n";
   s << mass;
-  if (!gravity.first.isZero(0.0)) s << "loads: {gravity: " << scene_vector(gravity.first) << "}\n";
+  const std::string springs = joint_springs();
+  if (!springs.empty())
+    s << "loads:\n"
+      << (gravity.first.isZero(0.0) ? "" : "  gravity: " + scene_vector(gravity.first) + "\n")
+      << "  torsional_springs:\n"
+      << springs;
+  else if (!gravity.first.isZero(0.0))
+    s << "loads: {gravity: " << scene_vector(gravity.first) << "}\n";
   const bool joints = std::any_of(m_.joints.begin(), m_.joints.end(), [](const Joint& j) { return !j.kind.empty(); });
   s << import_output_section(m_.path, o_.rates, o_.forces, !drivers_.str().empty(), joints, massive_);
   return s.str();

@@ -410,14 +410,12 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     Joint out;
     out.line = j->GetLineNum(), out.file = b.file;
     out.name = j->Attribute("name") ? j->Attribute("name") : b.name + "_joint_" + std::to_string(k);
-    if (type == "hinge")
-      out.kind = "revolute";
-    else if (type == "slide")
-      out.kind = "prismatic";
-    else if (type == "ball")
-      out.kind = "spherical";
-    else if (type != "free")
+    static const std::map<std::string, std::string> kinds = {
+        {"hinge", "revolute"}, {"slide", "prismatic"}, {"ball", "spherical"}, {"free", ""}};
+    const auto kind = kinds.find(type);
+    if (kind == kinds.end())
       fail(j, "joint '" + out.name + "' has type '" + type + "': MJCF's are hinge, slide, ball, free");
+    out.kind = kind->second;
     const std::vector<double> p = numbers(j, "pos", jcc, {0, 0, 0}, 3, 3);
     const std::vector<double> a = numbers(j, "axis", jcc, {0, 0, 1}, 3, 3);
     const Eigen::Vector3d at = frame.p + frame.R * Eigen::Vector3d(p[0], p[1], p[2]);
@@ -432,9 +430,16 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
       out.child.ref = Eigen::Vector3d::UnitX();
     if (const std::vector<double> r = numbers(j, "ref", jcc, {0}, 1, 1); r[0] != 0.0)
       joint_ref_[static_cast<int>(m_.joints.size())] = type == "hinge" ? angle(r[0]) : r[0];
-    for (const char* ignored : {"range", "limited", "damping", "stiffness", "armature", "springref", "frictionloss"})
-      if (attr(j, ignored, jcc))
-        skip_at(j, std::string("<joint ") + ignored + ">", "limits, springs and damping are not kinematics");
+    // a hinge's or slide's spring-damper, τ = −k (q − springref) − c q̇, q = ref at the file's pose: a torsional spring
+    const bool sprung = type == "hinge" || type == "slide";
+    const auto value = [&](const char* name) { return sprung ? numbers(j, name, jcc, {0}, 1, 1)[0] : 0.0; };
+    out.stiffness = value("stiffness"), out.damping = value("damping");
+    out.free = (type == "hinge" ? angle(1.0) : 1.0) * (value("springref") - value("ref"));
+    if (!(out.stiffness >= 0.0 && out.damping >= 0.0)) fail(j, "joint '" + out.name + "': a negative spring or damper");
+    const char* const unread[] = {"range", "limited", "armature", "frictionloss", "damping", "stiffness", "springref"};
+    for (std::size_t k = 0; k < (sprung ? 4u : 7u); ++k)
+      if (attr(j, unread[k], jcc))
+        skip_at(j, std::string("<joint ") + unread[k] + ">", "limits, armature, friction: not kinematics");
     if (!joint_index_.emplace(out.name, static_cast<int>(m_.joints.size())).second)
       fail(j, "a second joint named '" + out.name + "'");
     m_.joints.push_back(out);

@@ -198,6 +198,11 @@ void SdfReader::joint(const sdf::Joint& j, const Pose& placed, const std::string
       const Eigen::Vector3d a = axis_of(0), r = perpendicular(a);
       sides(a, r, a, r);
       out.kind = j.Type() == sdf::JointType::PRISMATIC ? "prismatic" : "revolute";
+      if (const sdf::JointAxis* ax = j.Axis(0)) {  // its spring-damper (position 0 at the file's pose)
+        out.stiffness = ax->SpringStiffness(), out.damping = ax->Damping(), out.free = ax->SpringReference();
+        if (!(out.stiffness >= 0.0 && out.damping >= 0.0))
+          refuse(path_, out.line, "joint '" + out.name + "': a negative spring_stiffness or damping");
+      }
       break;
     }
     case sdf::JointType::BALL:
@@ -222,8 +227,13 @@ void SdfReader::joint(const sdf::Joint& j, const Pose& placed, const std::string
   m_.joints.push_back(out);
   const char* why = "limits, dynamics and sensors are not kinematics";
   unmapped_children(j.Element(), {"parent", "child", "pose", "axis", "axis2"}, why);
+  const bool sprung = out.kind == "revolute" || out.kind == "prismatic";
   for (const char* axis : {"axis", "axis2"})
-    if (const sdf::ElementPtr a = j.Element()->FindElement(axis)) unmapped_children(a, {"xyz"}, why);
+    if (const sdf::ElementPtr a = j.Element()->FindElement(axis)) {
+      unmapped_children(a, {"xyz", sprung && axis[4] == 0 ? "dynamics" : "xyz"}, why);
+      if (const sdf::ElementPtr d = a->FindElement("dynamics"); d && sprung && axis[4] == 0)
+        unmapped_children(d, {"damping", "spring_stiffness", "spring_reference"}, "Coulomb friction is not modelled");
+    }
 }
 
 // The world's gravity as libsdformat reads it (SDFormat's default where the world has no <gravity>); a file that

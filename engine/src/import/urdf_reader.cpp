@@ -99,6 +99,7 @@ class UrdfReader {
   std::optional<Shape> shape(const tinyxml2::XMLElement* geometry_owner, const urdf::Geometry* g,
                              const std::string& what);
   void unmapped(const tinyxml2::XMLElement* element);
+  void dynamics(const tinyxml2::XMLElement* element, Joint& joint);
 
   const std::string& text_;
   const std::string& path_;
@@ -195,10 +196,23 @@ void UrdfReader::check_tree() const {
   }
 }
 
+// <dynamics damping friction>: a revolute's or prismatic's viscous damping loads it (a torsional spring of no
+// stiffness in the scene); its Coulomb friction is not modelled.
+void UrdfReader::dynamics(const tinyxml2::XMLElement* e, Joint& j) {
+  double damping = 0.0, friction = 0.0;
+  if (e->QueryDoubleAttribute("damping", &damping) == tinyxml2::XML_WRONG_ATTRIBUTE_TYPE || !(damping >= 0.0) ||
+      !std::isfinite(damping))
+    refuse(path_, e->GetLineNum(), "joint '" + j.name + "': <dynamics damping> is not a number ≥ 0");
+  j.damping = damping;
+  if (e->QueryDoubleAttribute("friction", &friction) == tinyxml2::XML_SUCCESS && friction != 0.0)
+    m_.skip("<dynamics friction>", e->GetLineNum(),
+            "Coulomb friction is not modelled (phiq's efforts are frictionless)");
+}
+
 void UrdfReader::unmapped(const tinyxml2::XMLElement* e) {
   static const std::map<std::string, std::string> why = {
       {"limit", "joint limits are not constraints in phiq (a sweep may pass them)"},
-      {"dynamics", "damping and friction: phiq's efforts are those of the loads section"},
+      {"dynamics", "a fixed, floating or planar joint's damping and friction are not read"},
       {"safety_controller", "a controller's setting, not kinematics"},
       {"calibration", "a sensor's reference, not kinematics"},
       {"transmission", "actuators and gear trains to motors are not read (use a mimic joint for a coupling)"},
@@ -451,12 +465,16 @@ Mechanism UrdfReader::read(int* loops) {
     out.name = x.name;
     map_joint(&out, x.type, urdf_pose(j->parent_to_joint_origin_transform), urdf_vector(j->axis),
               body_of_link_.at(x.parent), body_of_link_.at(x.child), x.line);
-    joint_index[x.name] = static_cast<int>(m_.joints.size());
-    m_.joints.push_back(out);
     for (const tinyxml2::XMLElement* e = x.element->FirstChildElement(); e; e = e->NextSiblingElement()) {
       const std::string tag = e->Name();
+      if (tag == "dynamics" && (out.kind == "revolute" || out.kind == "prismatic")) {
+        dynamics(e, out);
+        continue;
+      }
       if (tag != "origin" && tag != "axis" && tag != "parent" && tag != "child" && tag != "mimic") unmapped(e);
     }
+    joint_index[x.name] = static_cast<int>(m_.joints.size());
+    m_.joints.push_back(out);
   }
   // The closing joints, read from the text as written (their elements were taken out of doc_).
   const tinyxml2::XMLElement* full_robot = full.RootElement();
