@@ -68,6 +68,27 @@ TEST_F(Cli, CheckListsEachPartsMassAndItsSource) {
   EXPECT_NE(r.out.find("\"mass_source\": \"stated\""), std::string::npos) << r.out;
 }
 
+// Each applied load as phiq took it: what it is, what it acts on, its values as written (rates, laws).
+TEST_F(Cli, CheckListsEachLoadAsWritten) {
+  const fs::path scene = write(
+      "loads.yaml", slurp(phiq::test::model_path("seed/fourbar_reference_point.yaml")) +
+                        "\nloads:\n"
+                        "  forces: [{name: drag, part: coupler, at: [0.1, 0], force: [-2*der(x3), 5], axes: part}]\n"
+                        "  torques: [{name: brake, part: rocker, torque: {law: {type: linear, initial: 1, rate: 2}}}]\n"
+                        "  springs: [{name: strut, between: [{part: crank}, {point: [1, 1]}], free_length: 0.3,\n"
+                        "             law: {type: polynomial, coefficients: [0, 40]}, tension: 3*sin(t)}]\n"
+                        "  torsional_springs: [{name: coil, angle: psi3 - psi2, stiffness: 4, damping: 0.2}]\n");
+  const Result r = run("check " + scene.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const char* line :
+       {"load          force 'drag' on 'coupler' at [0.1, 0]: [-2*der(x3), 5] (part axes) N\n",
+        "load          torque 'brake' on 'rocker': linear 1 + 2*t of t N·m\n",
+        "load          spring 'strut' between 'crank' [0, 0] and 'ground' [1, 1]: stiffness polynomial of degree 1, "
+        "free length 0.3, damping 0, preload 0, tension 3*sin(t)\n",
+        "load          torsional spring 'coil' on 'psi3 - psi2': stiffness 4, free angle 0, damping 0.2, moment 0\n"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line << r.out;
+}
+
 TEST_F(Cli, CheckJsonIsOneVersionedObject) {
   Result r = run("check --json " + phiq::test::model_path("seed/fourbar_natural.yaml"));
   ASSERT_EQ(r.code, 0) << r.err;

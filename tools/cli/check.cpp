@@ -12,6 +12,7 @@
 #include "command_support.hpp"
 #include "commands.hpp"
 #include "mode_count.hpp"
+#include "phiq/applied_loads.hpp"
 #include "phiq/phiq.hpp"
 
 namespace phiq::tools {
@@ -67,6 +68,50 @@ std::string part_line(const phiq::Part& p, int dimension) {
        "), centre [" + g6(c.x) + ", " + g6(c.y) + (dimension == 3 ? ", " + g6(c.z) : "") + "] m, " +
        inertia_text(p, dimension) + " kg·m² about the centre";
   return s;
+}
+
+// A load's scalar as written: its expression, or its law "of" it.
+std::string load_value_text(const std::shared_ptr<const phiq::CompiledExpression>& e, const phiq::MotionLaw& law) {
+  if (!e) return "0";
+  return law.has_value() ? law.description() + " of " + e->text() : e->text();
+}
+
+std::string load_vector_text(const std::array<std::shared_ptr<const phiq::CompiledExpression>, 3>& c,
+                             const std::array<phiq::MotionLaw, 3>& laws, phiq::LoadAxes axes, int dimension) {
+  std::string s = "[";
+  for (int k = 0; k < dimension; ++k)
+    s += (k ? ", " : "") + load_value_text(c[static_cast<std::size_t>(k)], laws[static_cast<std::size_t>(k)]);
+  return s + "] (" + (axes == phiq::LoadAxes::kPart ? "part" : "world") + " axes)";
+}
+
+// One line per applied load: what it is, what it acts on and its values as written (expressions, rates der(),
+// laws), so that a scene's loads can be read back as phiq took them: "force 'drag' on part 'piston' at [0, 0]:
+// [-c1*der(xB), 0] (world axes)".
+std::vector<std::string> load_lines(const phiq::AppliedLoads& a, int dimension) {
+  std::vector<std::string> out;
+  auto at = [&](const phiq::kin3::V3& v) {
+    return "[" + g6(v.x) + ", " + g6(v.y) + (dimension == 3 ? ", " + g6(v.z) : "") + "]";
+  };
+  for (const phiq::AppliedForce& f : a.forces)
+    out.push_back("force '" + f.name + "' on '" + f.part + "' at " + at(f.at) + ": " +
+                  load_vector_text(f.components, f.laws, f.axes, dimension) + " N");
+  for (const phiq::AppliedTorque& t : a.torques)
+    out.push_back("torque '" + t.name + "' on '" + t.part + "': " +
+                  (dimension == 3 ? load_vector_text(t.components, t.laws, t.axes, 3)
+                                  : load_value_text(t.components[2], t.laws[2])) +
+                  " N·m");
+  auto elastic = [](double k, const phiq::MotionLaw& law) { return law.has_value() ? law.description() : g6(k); };
+  for (const phiq::LinearSpring& s : a.springs)
+    out.push_back("spring '" + s.name + "' between '" + s.a.part + "' " + at(s.a.at) + " and '" + s.b.part + "' " +
+                  at(s.b.at) + ": stiffness " + elastic(s.stiffness, s.law) + ", free length " + g6(s.free_length) +
+                  ", damping " + g6(s.damping) + ", preload " + g6(s.preload) + ", tension " +
+                  load_value_text(s.tension.expr, s.tension.law));
+  for (const phiq::TorsionalSpring& s : a.torsional_springs)
+    out.push_back("torsional spring '" + s.name + "' on " +
+                  (s.angle ? "'" + s.angle->text() + "'" : "joint '" + s.joint->name + "'") + ": stiffness " +
+                  elastic(s.stiffness, s.law) + ", free angle " + g6(s.free_angle) + ", damping " + g6(s.damping) +
+                  ", moment " + load_value_text(s.moment.expr, s.moment.law));
+  return out;
 }
 
 nlohmann::ordered_json parts_json(const phiq::Scene& scene) {
@@ -202,6 +247,9 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
   for (const phiq::JointAngleReference& r : scene.joint_angles)
     std::cout << "joint angle   " << joint_angle_line(r) << "\n";
   for (const phiq::Part& p : scene.parts) std::cout << "part          " << part_line(p, scene.dimension) << "\n";
+  if (scene.loads.applied)
+    for (const std::string& l : load_lines(*scene.loads.applied, scene.dimension))
+      std::cout << "load          " << l << "\n";
   std::cout << "modes         " << mode_count_text(modes, "the placement") << "\n";
   if (rk.uncertain) std::cout << "uncertain     " << rk.message << "\n";
   if (!ok) std::cout << "diagnosis     " << as.message << "\n";
