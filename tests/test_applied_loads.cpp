@@ -369,6 +369,15 @@ TEST(AppliedLoads, ARateDependentForceOnTheSliderFollowsItsClosedForm) {
   EXPECT_LT(b.worst, 1e-9 * b.peak);
 }
 
+TEST(AppliedLoads, ACoulombFrictionOnTheSliderFollowsItsClosedForm) {
+  // F = −5 sign(ẋB): the motor carries 5 |∂xB/∂θ| (0 at the dead points, where the slider rests)
+  const SliderBalance b =
+      slider_force_balance("  forces:\n    - {name: friction, part: slider, force: [-5*sign(der(xB)), 0]}\n",
+                           [](double, double, double v) { return -5.0 * ((v > 0) - (v < 0)); });
+  EXPECT_GT(b.peak, 1.0);
+  EXPECT_LT(b.worst, 1e-9 * b.peak);
+}
+
 TEST(AppliedLoads, AForceOfARateAlongItsLineIsADamper) {
   // −c der(xB) on the slider, on y = 0, is a damper from a world point on that line: the same efforts, with the
   // links' masses and gravity

@@ -283,6 +283,18 @@ TEST(Expression, AbsHasTheDerivativeSignAtAZeroArgument) {
   expect_derivatives_match_differences(*e, away, qd, 0.0, 10.0);
 }
 
+TEST(Expression, SignIsMinusOneZeroOrOneWithNoSlope) {
+  auto e = CompiledExpression::compile("xA*sign(yA - 1) + sign(-2)", resolve);
+  for (const double y : {2.5, 1.0, -0.5}) {
+    const double q[3] = {0.0, 3.0, y}, s = (y > 1) - (y < 1);
+    EXPECT_EQ(e->value(q, 0.0), 3.0 * s - 1.0) << y;
+    double g[2];
+    e->gradient(q, 0.0, g);
+    EXPECT_EQ(g[0], s) << y;
+    EXPECT_EQ(g[1], 0.0) << y;
+  }
+}
+
 TEST(Expression, RealPowersAtAZeroBaseAreFiniteWhereTheirDerivativesAre) {
   // u^p at u = 0: ∂ = p u^(p−1) and the second derivative p (p − 1) u^(p−2) are 0 for p > 2, the second is
   // infinite for 1 < p < 2, both are for p < 1. Finite ones must come out exactly 0, not NaN.

@@ -22,7 +22,8 @@ const std::map<std::string, FunctionSpec>& supported_functions() {
       {"sinh", {Op::kSinh, 1, [](const ex& a) -> ex { return GiNaC::sinh(a); }}},
       {"cosh", {Op::kCosh, 1, [](const ex& a) -> ex { return GiNaC::cosh(a); }}},
       {"tanh", {Op::kTanh, 1, [](const ex& a) -> ex { return GiNaC::tanh(a); }}},
-      {"abs", {Op::kAbs, 1, [](const ex& a) -> ex { return absolute_value(a); }}}};
+      {"abs", {Op::kAbs, 1, [](const ex& a) -> ex { return absolute_value(a); }}},
+      {"sign", {Op::kSign, 1, [](const ex& a) -> ex { return sign_of(a); }}}};
   return table;
 }
 
@@ -84,5 +85,7 @@ unsigned abs_serial() {
 }  // namespace
 
 GiNaC::ex absolute_value(const GiNaC::ex& u) { return GiNaC::function(abs_serial(), u); }
+
+GiNaC::ex sign_of(const GiNaC::ex& u) { return GiNaC::function(sign_serial(), u); }
 
 }  // namespace phiq::detail

@@ -29,6 +29,8 @@ std::string supported_function_list();
 GiNaC::ex constant_power(const GiNaC::ex& u, const GiNaC::ex& p);
 // |u| as phiq_abs(u), differentiated to phiq_sign(u) u' (symbolic.cpp says why not GiNaC's abs).
 GiNaC::ex absolute_value(const GiNaC::ex& u);
+// sign(u) as phiq_sign(u) (−1, 0 or 1), its derivative 0: a Coulomb friction's direction, −F sign(der(x)).
+GiNaC::ex sign_of(const GiNaC::ex& u);
 // A power of either kind: GiNaC's own (numeric exponents from its derivatives, sqrt; exponents that are not
 // constant) or phiq_pow; op(0) is the base and op(1) the exponent of both.
 bool is_power(const GiNaC::ex& e);
