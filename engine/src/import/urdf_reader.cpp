@@ -212,7 +212,7 @@ void UrdfReader::dynamics(const tinyxml2::XMLElement* e, Joint& j) {
 void UrdfReader::unmapped(const tinyxml2::XMLElement* e) {
   static const std::map<std::string, std::string> why = {
       {"limit", "joint limits are not constraints in phiq (a sweep may pass them)"},
-      {"dynamics", "a fixed, floating or planar joint's damping and friction are not read"},
+      {"dynamics", "a closing, fixed, floating or planar joint's damping and friction are not read"},
       {"safety_controller", "a controller's setting, not kinematics"},
       {"calibration", "a sensor's reference, not kinematics"},
       {"transmission", "actuators and gear trains to motors are not read (use a mimic joint for a coupling)"},
