@@ -71,16 +71,14 @@ std::string part_line(const phiq::Part& p, int dimension) {
 }
 
 // A load's scalar as written: its expression, or its law "of" it.
-std::string load_value_text(const std::shared_ptr<const phiq::CompiledExpression>& e, const phiq::MotionLaw& law) {
-  if (!e) return "0";
-  return law.has_value() ? law.description() + " of " + e->text() : e->text();
+std::string load_value_text(const phiq::LoadValue& v) {
+  if (!v.expr) return "0";
+  return v.law.has_value() ? v.law.description() + " of " + v.expr->text() : v.expr->text();
 }
 
-std::string load_vector_text(const std::array<std::shared_ptr<const phiq::CompiledExpression>, 3>& c,
-                             const std::array<phiq::MotionLaw, 3>& laws, phiq::LoadAxes axes, int dimension) {
+std::string load_vector_text(const std::array<phiq::LoadValue, 3>& c, phiq::LoadAxes axes, int dimension) {
   std::string s = "[";
-  for (int k = 0; k < dimension; ++k)
-    s += (k ? ", " : "") + load_value_text(c[static_cast<std::size_t>(k)], laws[static_cast<std::size_t>(k)]);
+  for (int k = 0; k < dimension; ++k) s += (k ? ", " : "") + load_value_text(c[static_cast<std::size_t>(k)]);
   return s + "] (" + (axes == phiq::LoadAxes::kPart ? "part" : "world") + " axes)";
 }
 
@@ -94,23 +92,22 @@ std::vector<std::string> load_lines(const phiq::AppliedLoads& a, int dimension) 
   };
   for (const phiq::AppliedForce& f : a.forces)
     out.push_back("force '" + f.name + "' on '" + f.part + "' at " + at(f.at) + ": " +
-                  load_vector_text(f.components, f.laws, f.axes, dimension) + " N");
+                  load_vector_text(f.components, f.axes, dimension) + " N");
   for (const phiq::AppliedTorque& t : a.torques)
     out.push_back("torque '" + t.name + "' on '" + t.part + "': " +
-                  (dimension == 3 ? load_vector_text(t.components, t.laws, t.axes, 3)
-                                  : load_value_text(t.components[2], t.laws[2])) +
+                  (dimension == 3 ? load_vector_text(t.components, t.axes, 3) : load_value_text(t.components[2])) +
                   " N·m");
   auto elastic = [](double k, const phiq::MotionLaw& law) { return law.has_value() ? law.description() : g6(k); };
   for (const phiq::LinearSpring& s : a.springs)
     out.push_back("spring '" + s.name + "' between '" + s.a.part + "' " + at(s.a.at) + " and '" + s.b.part + "' " +
                   at(s.b.at) + ": stiffness " + elastic(s.stiffness, s.law) + ", free length " + g6(s.free_length) +
                   ", damping " + g6(s.damping) + ", preload " + g6(s.preload) + ", tension " +
-                  load_value_text(s.tension.expr, s.tension.law));
+                  load_value_text(s.tension));
   for (const phiq::TorsionalSpring& s : a.torsional_springs)
     out.push_back("torsional spring '" + s.name + "' on " +
                   (s.angle ? "'" + s.angle->text() + "'" : "joint '" + s.joint->name + "'") + ": stiffness " +
                   elastic(s.stiffness, s.law) + ", free angle " + g6(s.free_angle) + ", damping " + g6(s.damping) +
-                  ", moment " + load_value_text(s.moment.expr, s.moment.law));
+                  ", moment " + load_value_text(s.moment));
   return out;
 }
 

@@ -49,10 +49,9 @@ struct AppliedForce {
   PartFrame frame;                   ///< that part's frame
   kin3::V3 at;                       ///< the point it acts at, in the part's frame
   LoadAxes axes = LoadAxes::kWorld;  ///< the axes of its components
-  /// Its components (N), expressions of t, q, q̇ (der()) and the parameters; null: 0 (z in the plane).
-  std::array<std::shared_ptr<const CompiledExpression>, 3> components;
-  /// Where laws[k] has a value, component k is that law of components[k] (its argument: t, or what `of` says).
-  std::array<MotionLaw, 3> laws;
+  /// Its components (N), each an expression of t, q, q̇ (der()) and the parameters or a law of one; none: 0 (z in
+  /// the plane).
+  std::array<LoadValue, 3> components;
 };
 
 /// A torque (a couple) on a part.
@@ -62,8 +61,7 @@ struct AppliedTorque {
   PartFrame frame;                   ///< that part's frame
   LoadAxes axes = LoadAxes::kWorld;  ///< the axes of its components
   /// Its components (N·m) as for AppliedForce: in the plane only z.
-  std::array<std::shared_ptr<const CompiledExpression>, 3> components;
-  std::array<MotionLaw, 3> laws;  ///< as AppliedForce::laws
+  std::array<LoadValue, 3> components;
 };
 
 /// One end of a linear spring: a point of a part, or a point fixed in the world (a ground frame).
@@ -115,10 +113,8 @@ struct AppliedLoads {
   bool empty() const { return forces.empty() && torques.empty() && springs.empty() && torsional_springs.empty(); }
 };
 
-/// A force's or torque's components at (q, q̇, t) in world axes (qd null: q̇ = 0): each its expression, or its law
-/// of that expression.
-kin3::V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 3>& components,
-                          const std::array<MotionLaw, 3>& laws, LoadAxes axes, const Pose& pose, const double* q,
+/// A force's or torque's components at (q, q̇, t) in world axes (qd null: q̇ = 0).
+kin3::V3 world_components(const std::array<LoadValue, 3>& components, LoadAxes axes, const Pose& pose, const double* q,
                           const double* qd, double t);
 
 /// Adds to `Q` (one entry per coordinate) the generalized forces of `loads` at (q, q̇, t): their virtual work per

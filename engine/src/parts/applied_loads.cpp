@@ -114,15 +114,11 @@ double LoadValue::value(const double* q, const double* qd, double t) const {
   return law.has_value() ? law.evaluate(u).f : u;  // (NaN outside its table)
 }
 
-V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 3>& components,
-                    const std::array<MotionLaw, 3>& laws, LoadAxes axes, const Pose& pose, const double* q,
+V3 world_components(const std::array<LoadValue, 3>& components, LoadAxes axes, const Pose& pose, const double* q,
                     const double* qd, double t) {
   double v[3] = {0.0, 0.0, 0.0};
-  for (std::size_t k = 0; k < 3; ++k) {
-    if (!components[k]) continue;
-    v[k] = components[k]->value(q, qd, t);
-    if (laws[k].has_value()) v[k] = laws[k].evaluate(v[k]).f;  // (NaN outside its table)
-  }
+  for (std::size_t k = 0; k < 3; ++k)
+    if (components[k].expr) v[k] = components[k].value(q, qd, t);
   const V3 c{v[0], v[1], v[2]};
   return axes == LoadAxes::kPart ? turned(pose.rotation, c) : c;
 }
@@ -130,11 +126,11 @@ V3 world_components(const std::array<std::shared_ptr<const CompiledExpression>, 
 void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, double t, Eigen::VectorXd& Q) {
   for (const AppliedForce& f : loads.forces) {
     const Pose pose = part_pose(f.frame, q, t);
-    add_virtual_work(f.frame, pose, f.at, world_components(f.components, f.laws, f.axes, pose, q, qd, t), {}, q, t, Q);
+    add_virtual_work(f.frame, pose, f.at, world_components(f.components, f.axes, pose, q, qd, t), {}, q, t, Q);
   }
   for (const AppliedTorque& m : loads.torques) {
     const Pose pose = part_pose(m.frame, q, t);
-    add_virtual_work(m.frame, pose, {}, {}, world_components(m.components, m.laws, m.axes, pose, q, qd, t), q, t, Q);
+    add_virtual_work(m.frame, pose, {}, {}, world_components(m.components, m.axes, pose, q, qd, t), q, t, Q);
   }
   for (const LinearSpring& s : loads.springs) {
     const SpringState st = spring_state(s, q, qd, t);
@@ -154,11 +150,11 @@ double applied_power(const AppliedLoads& loads, const double* q, const double* q
   double power = 0.0;
   for (const AppliedForce& f : loads.forces) {
     const PartMotion m = part_motion(f.frame, q, qd, nullptr, t);
-    power += kin3::dot(world_components(f.components, f.laws, f.axes, m.pose, q, qd, t), m.point(f.at).first);
+    power += kin3::dot(world_components(f.components, f.axes, m.pose, q, qd, t), m.point(f.at).first);
   }
   for (const AppliedTorque& tq : loads.torques) {
     const PartMotion m = part_motion(tq.frame, q, qd, nullptr, t);
-    power += kin3::dot(world_components(tq.components, tq.laws, tq.axes, m.pose, q, qd, t), m.omega);
+    power += kin3::dot(world_components(tq.components, tq.axes, m.pose, q, qd, t), m.omega);
   }
   for (const LinearSpring& s : loads.springs) {
     const SpringState st = spring_state(s, q, qd, t);

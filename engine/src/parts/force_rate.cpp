@@ -212,8 +212,7 @@ Dual expression_dual(const CompiledExpression& e, const std::array<const Compile
   return {e.value(p.q, p.qd, p.t), rate + copies_rate(x, h)};
 }
 
-using Components = std::array<std::shared_ptr<const CompiledExpression>, 3>;
-using Laws = std::array<MotionLaw, 3>;
+using Components = std::array<LoadValue, 3>;
 
 // A law f of an argument u with their rates: f(u), f′(u) u̇ + the difference of the copies' laws at u along p.
 Dual law_dual(const MotionLaw& f, const std::array<const MotionLaw*, 4>& copies, double h, Dual u) {
@@ -235,41 +234,45 @@ bool spring_law_dual(const MotionLaw& law, const std::array<const AppliedLoads*,
   return true;
 }
 
-// A spring's actuator (LoadValue) with its rate, added to `out`: false where a copy along p has another form.
-template <class Get>
-bool add_value_dual(const LoadValue& own, const std::array<const AppliedLoads*, 4>& along, double h, const DualPath& p,
-                    Dual& out, Get value_of) {
+// A load's value (LoadValue: an expression, or a law of one) with its rate, into `out` (0 where it has none):
+// false where a copy along p has another form.
+bool value_dual(const LoadValue& own, const std::array<const LoadValue*, 4>& copies, double h, const DualPath& p,
+                Dual& out) {
   std::array<const CompiledExpression*, 4> exprs{};
   std::array<const MotionLaw*, 4> laws{};
   for (std::size_t k = 0; k < 4; ++k) {
-    const LoadValue& x = value_of(*along[k]);
+    const LoadValue& x = *copies[k];
     if ((x.expr == nullptr) != (own.expr == nullptr) || x.law.has_value() != own.law.has_value()) return false;
     exprs[k] = x.expr.get(), laws[k] = &x.law;
   }
+  out = Dual();
   if (!own.expr) return true;
-  Dual v = expression_dual(*own.expr, exprs, h, p);
-  if (own.law.has_value()) v = law_dual(own.law, laws, h, v);
+  out = expression_dual(*own.expr, exprs, h, p);
+  if (own.law.has_value()) out = law_dual(own.law, laws, h, out);
+  return true;
+}
+
+// A spring's actuator with its rate, added to `out` (value_dual() over the copies' `value_of`).
+template <class Get>
+bool add_value_dual(const LoadValue& own, const std::array<const AppliedLoads*, 4>& along, double h, const DualPath& p,
+                    Dual& out, Get value_of) {
+  std::array<const LoadValue*, 4> copies{};
+  for (std::size_t k = 0; k < 4; ++k) copies[k] = &value_of(*along[k]);
+  Dual v;
+  if (!value_dual(own, copies, h, p, v)) return false;
   out = out + v;
   return true;
 }
 
 // A force's or torque's components in world axes with their rates (world_components()); false where a component
-// or its law is present in one copy along p and not in another.
-bool components_dual(const Components& own, const Laws& own_laws, const std::array<const Components*, 4>& copies,
-                     const std::array<const Laws*, 4>& copies_laws, LoadAxes axes, const DualMotion& mo, double h,
-                     const DualPath& p, DV& out) {
+// has another form in one copy along p.
+bool components_dual(const Components& own, const std::array<const Components*, 4>& copies, LoadAxes axes,
+                     const DualMotion& mo, double h, const DualPath& p, DV& out) {
   Dual v[3];
   for (std::size_t c = 0; c < 3; ++c) {
-    std::array<const CompiledExpression*, 4> along{};
-    std::array<const MotionLaw*, 4> laws{};
-    for (std::size_t k = 0; k < 4; ++k) {
-      along[k] = (*copies[k])[c].get();
-      laws[k] = &(*copies_laws[k])[c];
-      if ((along[k] == nullptr) != (own[c] == nullptr) || laws[k]->has_value() != own_laws[c].has_value()) return false;
-    }
-    if (!own[c]) continue;
-    v[c] = expression_dual(*own[c], along, h, p);
-    if (own_laws[c].has_value()) v[c] = law_dual(own_laws[c], laws, h, v[c]);
+    std::array<const LoadValue*, 4> along{};
+    for (std::size_t k = 0; k < 4; ++k) along[k] = &(*copies[k])[c];
+    if (!value_dual(own[c], along, h, p, v[c])) return false;
   }
   out = {v[0], v[1], v[2]};
   if (axes == LoadAxes::kPart) out = turned(mo.rotation, out);
@@ -300,14 +303,13 @@ bool add_forces_and_torques_rate(const AppliedLoads& loads, const std::array<con
       return false;
     const DualPath path = along_motion.over(rates);
     std::array<const Components*, 4> copies{};
-    std::array<const Laws*, 4> laws{};
     for (std::size_t k = 0; k < 4; ++k) {
       if (along[k]->forces[i].axes != f.axes) return false;
-      copies[k] = &along[k]->forces[i].components, laws[k] = &along[k]->forces[i].laws;
+      copies[k] = &along[k]->forces[i].components;
     }
     const DualMotion mo = dual_motion(f.frame, path);
     DV force;
-    if (!components_dual(f.components, f.laws, copies, laws, f.axes, mo, h, path, force)) return false;
+    if (!components_dual(f.components, copies, f.axes, mo, h, path, force)) return false;
     const DV at =
         constant_vector(f.at, load_vector_rate(
                                   along, h, [](const AppliedLoads& a, std::size_t j) { return a.forces[j].at; }, i));
@@ -322,14 +324,13 @@ bool add_forces_and_torques_rate(const AppliedLoads& loads, const std::array<con
       return false;
     const DualPath path = along_motion.over(rates);
     std::array<const Components*, 4> copies{};
-    std::array<const Laws*, 4> laws{};
     for (std::size_t k = 0; k < 4; ++k) {
       if (along[k]->torques[i].axes != m.axes) return false;
-      copies[k] = &along[k]->torques[i].components, laws[k] = &along[k]->torques[i].laws;
+      copies[k] = &along[k]->torques[i].components;
     }
     const DualMotion mo = dual_motion(m.frame, path);
     DV moment;
-    if (!components_dual(m.components, m.laws, copies, laws, m.axes, mo, h, path, moment)) return false;
+    if (!components_dual(m.components, copies, m.axes, mo, h, path, moment)) return false;
     dual_jacobian(m.frame, path, jac);
     add_force_rate(jac, DV{}, DV{}, moment, dq);
   }

@@ -14,21 +14,11 @@ bool same_expression(const std::shared_ptr<const CompiledExpression>& a,
   return a == b || (a && b && *a == *b);
 }
 
-template <std::size_t N>
-bool same_expressions(const std::array<std::shared_ptr<const CompiledExpression>, N>& a,
-                      const std::array<std::shared_ptr<const CompiledExpression>, N>& b) {
-  for (std::size_t i = 0; i < N; ++i)
-    if (!same_expression(a[i], b[i])) return false;
-  return true;
-}
-
-bool same_laws(const std::array<MotionLaw, 3>& a, const std::array<MotionLaw, 3>& b) {
-  for (std::size_t i = 0; i < 3; ++i)
-    if (!(a[i] == b[i])) return false;
-  return true;
-}
-
 bool same_value(const LoadValue& a, const LoadValue& b) { return same_expression(a.expr, b.expr) && a.law == b.law; }
+
+bool same_values(const std::array<LoadValue, 3>& a, const std::array<LoadValue, 3>& b) {
+  return same_value(a[0], b[0]) && same_value(a[1], b[1]) && same_value(a[2], b[2]);
+}
 
 bool same_mass(const MassProperties& a, const MassProperties& b) {
   return a.mass == b.mass && a.center == b.center && a.inertia == b.inertia;
@@ -43,14 +33,12 @@ bool same_applied(const AppliedLoads& a, const AppliedLoads& b) {
   for (std::size_t i = 0; i < a.forces.size(); ++i) {
     const AppliedForce &x = a.forces[i], &y = b.forces[i];
     if (!same_frame(x.frame, y.frame) || !(x.at == y.at) || x.axes != y.axes ||
-        !same_expressions(x.components, y.components) || !same_laws(x.laws, y.laws))
+        !same_values(x.components, y.components))
       return false;
   }
   for (std::size_t i = 0; i < a.torques.size(); ++i) {
     const AppliedTorque &x = a.torques[i], &y = b.torques[i];
-    if (!same_frame(x.frame, y.frame) || x.axes != y.axes || !same_expressions(x.components, y.components) ||
-        !same_laws(x.laws, y.laws))
-      return false;
+    if (!same_frame(x.frame, y.frame) || x.axes != y.axes || !same_values(x.components, y.components)) return false;
   }
   for (std::size_t i = 0; i < a.springs.size(); ++i) {
     const LinearSpring &x = a.springs[i], &y = b.springs[i];

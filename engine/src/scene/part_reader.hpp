@@ -71,13 +71,12 @@ class PartReader {
   template <class C>
   kin3::V3 load_vector(const C& c, const char* what) const;
   template <class C>
-  void load_components(const C& c, const char* what, std::array<std::shared_ptr<const CompiledExpression>, 3>& out,
-                       std::array<MotionLaw, 3>& laws) const;
+  void load_components(const C& c, const char* what, std::array<LoadValue, 3>& out) const;
   template <class C>
   bool spring_stiffness(const C& s, double& stiffness, MotionLaw& law, bool actuator) const;
   // one component: an expression, or `{law: LAW, of: EXPRESSION}` (of: t when absent)
   template <class C>
-  std::shared_ptr<const CompiledExpression> load_component(const C& c, MotionLaw& law) const;
+  LoadValue load_component(const C& c) const;
   template <class C>
   LoadAxes load_axes(const C& c) const;
   template <class C>

@@ -58,7 +58,7 @@ AppliedForce PartReader::applied_force(const C& f, const LoadTargets& targets, s
   force.frame = load_frame(part, targets, "a force");
   if (auto at = f.field("at"); at.present()) force.at = load_vector(at, "at");
   force.axes = load_axes(f.field("axes"));
-  load_components(f.require("force"), "force", force.components, force.laws);
+  load_components(f.require("force"), "force", force.components);
   return force;
 }
 
@@ -73,10 +73,10 @@ AppliedTorque PartReader::applied_torque(const C& m, const LoadTargets& targets,
   torque.axes = load_axes(m.field("axes"));
   const auto value = m.require("torque");
   if (r_.spatial_) {
-    load_components(value, "torque", torque.components, torque.laws);
+    load_components(value, "torque", torque.components);
   } else {
     if (value.is_sequence()) value.fail("a torque in the plane is one number, expression or law (about z)");
-    torque.components[2] = load_component(value, torque.laws[2]);
+    torque.components[2] = load_component(value);
   }
   return torque;
 }
@@ -128,25 +128,25 @@ kin3::V3 PartReader::load_vector(const C& c, const char* what) const {
 // A vector of expressions of t, the coordinates, their rates (der()) and the parameters, or laws of one; the
 // plane's has no z.
 template <class C>
-void PartReader::load_components(const C& c, const char* what,
-                                 std::array<std::shared_ptr<const CompiledExpression>, 3>& out,
-                                 std::array<MotionLaw, 3>& laws) const {
+void PartReader::load_components(const C& c, const char* what, std::array<LoadValue, 3>& out) const {
   const std::size_t n = r_.spatial_ ? 3 : 2;
   if (!c.is_sequence() || c.size() != n)
     c.fail(std::string(what) + " is " + (r_.spatial_ ? "[x, y, z]" : "[x, y]") +
            " (numbers, expressions of t, the coordinates, their rates der(…) and the parameters, or laws of one)");
-  for (std::size_t k = 0; k < n; ++k) out[k] = load_component(c.at(k), laws[k]);
+  for (std::size_t k = 0; k < n; ++k) out[k] = load_component(c.at(k));
 }
 
 // A law's argument is an expression as a component is (t when `of` is absent): a table of a force measured
 // against time, a crank angle, a stroke or a speed.
 template <class C>
-std::shared_ptr<const CompiledExpression> PartReader::load_component(const C& c, MotionLaw& law) const {
-  if (!c.is_map()) return r_.compile(c, true, true);
+LoadValue PartReader::load_component(const C& c) const {
+  if (!c.is_map()) return {r_.compile(c, true, true), {}};
   c.expect_map({"law", "of"});
-  law = r_.motion_law(c.require("law"));
-  if (const auto of = c.field("of"); of.present()) return r_.compile(of, true, true);
-  return CompiledExpression::compile("t", r_.resolver(false, "t"));
+  LoadValue v;
+  v.law = r_.motion_law(c.require("law"));
+  const auto of = c.field("of");
+  v.expr = of.present() ? r_.compile(of, true, true) : CompiledExpression::compile("t", r_.resolver(false, "t"));
+  return v;
 }
 
 template <class C>
@@ -217,7 +217,7 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
     }
     spring.joint_coordinates.assign(read.begin(), read.end());
   }
-  if (auto m = s.field("moment"); m.present()) spring.moment.expr = load_component(m, spring.moment.law);
+  if (auto m = s.field("moment"); m.present()) spring.moment = load_component(m);
   spring_stiffness(s, spring.stiffness, spring.law, spring.moment.expr != nullptr);
   if (auto a0 = s.field("free_angle"); a0.present()) spring.free_angle = r_.number(a0);
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
@@ -255,7 +255,7 @@ LinearSpring PartReader::linear_spring(const C& s, const LoadTargets& targets, s
     between.fail("the spring's two ends are the same point");
   if (frame_coordinates(spring.a.frame).empty() && frame_coordinates(spring.b.frame).empty())
     between.fail("neither end reads a coordinate: the spring does no work on the coordinates and changes no effort");
-  if (auto f = s.field("tension"); f.present()) spring.tension.expr = load_component(f, spring.tension.law);
+  if (auto f = s.field("tension"); f.present()) spring.tension = load_component(f);
   const bool stiff = spring_stiffness(s, spring.stiffness, spring.law, spring.tension.expr != nullptr);
   if (auto l0 = stiff ? s.require("free_length") : s.field("free_length"); l0.present())
     spring.free_length = non_negative(l0);

@@ -91,14 +91,13 @@ std::string vector_load_fault(const Load& l, const char* what, const double* q, 
   const std::string who = what + (" '" + l.name + "' on part '" + l.part + "': ");
   const Pose pose = part_pose(l.frame, q, t);
   if (!finite(pose)) return who + frame_fault(l.frame, q);
-  const V3 v = world_components(l.components, l.laws, l.axes, pose, q, qd, t);
-  for (std::size_t k = 0; k < 3; ++k) {  // a law's argument outside the table it is defined on
-    if (!l.components[k] || !l.laws[k].has_value()) continue;
-    const double u = l.components[k]->value(q, qd, t);
-    if (!(u >= l.laws[k].domain_begin() && u <= l.laws[k].domain_end()))
-      return who + "its law's argument '" + l.components[k]->text() + "' is " + significant(u, 6) +
-             ", outside the table's [" + significant(l.laws[k].domain_begin(), 6) + ", " +
-             significant(l.laws[k].domain_end(), 6) + "]";
+  const V3 v = world_components(l.components, l.axes, pose, q, qd, t);
+  for (const LoadValue& c : l.components) {  // a law's argument outside the table it is defined on
+    if (!c.expr || !c.law.has_value()) continue;
+    const double u = c.expr->value(q, qd, t);
+    if (!(u >= c.law.domain_begin() && u <= c.law.domain_end()))
+      return who + "its law's argument '" + c.expr->text() + "' is " + significant(u, 6) + ", outside the table's [" +
+             significant(c.law.domain_begin(), 6) + ", " + significant(c.law.domain_end(), 6) + "]";
   }
   if (!finite(v)) return who + "its value is not finite: " + print(v);
   return who + "its generalized force overflows doubles";
