@@ -207,7 +207,7 @@ inline std::vector<double> first_driver_values_at(const std::string& text, const
 inline std::string rssr_with_joint_springs(const std::string& end, const std::string& output) {
   std::string text = model_file_text("spatial/rssr.yaml", "time:");
   const std::string own = "L: 0.92}";
-  text.replace(text.find(own), own.size(), "L: 0.92, kt: 15, th0: 0.4, ct: 3}");
+  text.replace(text.find(own), own.size(), "L: 0.92, kt: 15, th0: 0.4, ct: 3, J: 0.4, f: 0.6}");
   return text +
          "parts:\n"
          "  crank: {mass: 0.8, center_of_mass: [a/2, 0, 0], inertia: [0.001, 0.8*a*a/12, 0.8*a*a/12]}\n"

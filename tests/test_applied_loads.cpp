@@ -23,7 +23,7 @@ namespace {
 
 Eigen::VectorXd applied_q(const Scene& s, const Eigen::VectorXd& q, double t) {
   Eigen::VectorXd Q = Eigen::VectorXd::Zero(s.model->num_coordinates());
-  add_applied_forces(*s.loads.applied, q.data(), nullptr, t, Q);
+  add_applied_forces(*s.loads.applied, q.data(), nullptr, nullptr, t, Q);
   return Q;
 }
 
@@ -215,7 +215,7 @@ LoadedPowerBalance loaded_power_balance(const Scene& s) {
       energy_rate +=
           p.mass.mass * kin3::dot(v, a) + rotational_energy_rate(p, pm) - p.mass.mass * kin3::dot(s.loads.gravity, v);
     }
-    const double power = applied_power(*s.loads.applied, ws.q.data(), ws.qd.data(), t);
+    const double power = applied_power(*s.loads.applied, ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
     b.balance = std::max(b.balance, std::fabs(efforts[0] * 1.0 - (energy_rate - power)));
     b.scale = std::max(b.scale, std::fabs(efforts[0]));
     b.loads_power = std::max(b.loads_power, std::fabs(power));
@@ -271,7 +271,8 @@ TEST(AppliedLoads, EveryModelWithMassesBalancesItsDriversPowerAtEveryRow) {
                                      p.mass.mass * kin3::dot(s.loads.gravity, vc);
                     }
                     const double loads =
-                        s.loads.applied ? applied_power(*s.loads.applied, v.q.data(), v.qd->data(), v.t) : 0.0;
+                        s.loads.applied ? applied_power(*s.loads.applied, v.q.data(), v.qd->data(), v.qdd->data(), v.t)
+                                        : 0.0;
                     worst = std::max(worst, std::fabs(power - (energy_rate - loads)));
                     scale = std::max({scale, std::fabs(power), std::fabs(energy_rate)});
                     ++rows;
@@ -316,17 +317,18 @@ TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) 
 }
 
 TEST(AppliedLoads, DriverPowerBalancesInSpaceWithAJointSpringAndLoadsInPartAxes) {
-  Scene s =
-      parse_scene(test::model_file_text("spatial/rssr.yaml") +
-                      "\nparts:\n"
-                      "  crank: {mass: 1.0, center_of_mass: [0.1, 0, 0], inertia: [0.01, 0.02, 0.025]}\n"
-                      "  rocker: {mass: 2.0, center_of_mass: [0, 0.25, 0], inertia: [0.05, 0.01, 0.05]}\n"
-                      "loads:\n"
-                      "  gravity: [0, 0, -9.81]\n"
-                      "  forces: [{part: crank, at: [a, 0, 0], force: [5, 2*sin(t), 3], axes: part}]\n"
-                      "  torques: [{part: rocker, torque: [1 + 0.5*cos(t), 0.5, -0.2], axes: part}]\n"
-                      "  torsional_springs: [{joint: rocker_hinge, stiffness: 15, free_angle: 1.2, damping: 3}]\n",
-                  "rssr.yaml");
+  Scene s = parse_scene(
+      test::model_file_text("spatial/rssr.yaml") +
+          "\nparts:\n"
+          "  crank: {mass: 1.0, center_of_mass: [0.1, 0, 0], inertia: [0.01, 0.02, 0.025]}\n"
+          "  rocker: {mass: 2.0, center_of_mass: [0, 0.25, 0], inertia: [0.05, 0.01, 0.05]}\n"
+          "loads:\n"
+          "  gravity: [0, 0, -9.81]\n"
+          "  forces: [{part: crank, at: [a, 0, 0], force: [5, 2*sin(t), 3], axes: part}]\n"
+          "  torques: [{part: rocker, torque: [1 + 0.5*cos(t), 0.5, -0.2], axes: part}]\n"
+          "  torsional_springs: [{joint: rocker_hinge, stiffness: 15, free_angle: 1.2, damping: 3, friction: 0.4,\n"
+          "                       inertia: 0.3}]\n",
+      "rssr.yaml");
   const LoadedPowerBalance b = loaded_power_balance(s);
   const double balance = b.balance, scale = b.scale, loads_power = b.loads_power;
   EXPECT_GT(loads_power, 1.0);
@@ -524,8 +526,8 @@ TEST(AppliedLoads, BadLoadsAreRefusedInOneLineNamingTheField) {
       "  springs:\n    - {between: [{part: crank}, {point: [1, 0]}], stiffness: 10, free_length: 1, "
       "law: {type: linear, initial: 0, rate: 1}}\n");
   EXPECT_HAS(m, "loads.springs[0].law: a spring has a stiffness or a law of its deflection, not both");
-  m = error("  springs:\n    - {between: [{part: crank}, {point: [1, 0]}], damping: 2}\n");
-  EXPECT_HAS(m, "loads.springs[0]: missing field 'stiffness'");
+  m = error("  springs:\n    - {between: [{part: crank}, {point: [1, 0]}], free_length: 1}\n");
+  EXPECT_HAS(m, "loads.springs[0]: missing field 'stiffness'");  // (a damper, a friction or an actuator needs none)
   m = error("  torsional_springs:\n    - {coordinate: psi2, law: {type: table, t: [0], values: [0]}}\n");
   EXPECT_HAS(m, "loads.torsional_springs[0].law.t: a table needs at least 2 points");
   m = error("  forces:\n    - {part: crank, force: [{law: {type: linear, initial: 0, rate: 1}, at: t}, 0]}\n");

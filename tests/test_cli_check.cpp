@@ -77,7 +77,8 @@ TEST_F(Cli, CheckListsEachLoadAsWritten) {
                         "  torques: [{name: brake, part: rocker, torque: {law: {type: linear, initial: 1, rate: 2}}}]\n"
                         "  springs: [{name: strut, between: [{part: crank}, {point: [1, 1]}], free_length: 0.3,\n"
                         "             law: {type: polynomial, coefficients: [0, 40]}, tension: 3*sin(t)}]\n"
-                        "  torsional_springs: [{name: coil, angle: psi3 - psi2, stiffness: 4, damping: 0.2}]\n");
+                        "  torsional_springs: [{name: coil, angle: psi3 - psi2, stiffness: 4, damping: 0.2},\n"
+                        "                      {name: gearbox, coordinate: psi2, friction: 0.5, inertia: 0.02}]\n");
   const Result r = run("check " + scene.string());
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* line :
@@ -85,7 +86,9 @@ TEST_F(Cli, CheckListsEachLoadAsWritten) {
         "load          torque 'brake' on 'rocker': linear 1 + 2*t of t N·m\n",
         "load          spring 'strut' between 'crank' [0, 0] and 'ground' [1, 1]: stiffness polynomial of degree 1, "
         "free length 0.3, damping 0, preload 0, tension 3*sin(t)\n",
-        "load          torsional spring 'coil' on 'psi3 - psi2': stiffness 4, free angle 0, damping 0.2, moment 0\n"})
+        "load          torsional spring 'coil' on 'psi3 - psi2': stiffness 4, free angle 0, damping 0.2, moment 0\n",
+        "load          torsional spring 'gearbox' on 'psi2': stiffness 0, free angle 0, damping 0, friction 0.5, "
+        "inertia 0.02, moment 0\n"})
     EXPECT_NE(r.out.find(line), std::string::npos) << line << r.out;
 }
 

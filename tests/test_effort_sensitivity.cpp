@@ -221,6 +221,14 @@ TEST(EffortSensitivity, ARssrWithSpringsOnItsJointsAnglesMatchesResolvedSweeps) 
       test::rssr_with_joint_springs("2", "{efforts: all, sensitivities: [a, b, L, kt, th0, ct]}"));
 }
 
+TEST(EffortSensitivity, RotorsAndDryFrictionsOnJointsAnglesMatchResolvedSweeps) {
+  // a rotor and a dry friction on the rocker hinge's angle (its θ̈'s rate along p differenced in Q) and on an
+  // expression's (exact): J and f reach the torque alone, the dimensions through the motion
+  expect_effort_sensitivities_match_resolved_sweeps(test::replace_first(
+      test::rssr_with_joint_springs("2", "{efforts: all, sensitivities: [a, b, kt, J, f]}"), "damping: ct}",
+      "damping: ct, inertia: J, friction: f}\n    - {angle: \"2*atan2(rocker_e1, rocker_e0)\", inertia: J}"));
+}
+
 TEST(EffortSensitivity, PartsAndLoadsOnFramesOfExpressionsMatchResolvedSweeps) {
   // an arm on a frame of expressions (sines and products of the coordinates and t, d and L3 in them) with a mass, a
   // force and a torque, planar; a spatial one on the RSSR whose axis reads b: exact, no Q differenced

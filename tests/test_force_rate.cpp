@@ -197,6 +197,32 @@ TEST(ForceRate, CarriesForcesOfTheRatesAndLawsOfThemAndOfSpringsDeflectionsExact
   expect_force_rate_paths_agree(s);
 }
 
+TEST(ForceRate, CarriesARotorsInertiaAndDryFrictionsExactly) {
+  // a rotor J θ̈ on the rod's angle to the crank (θ̈ from the expression's jet, its third derivatives included) with a
+  // dry friction, and a seal's friction on a line: J, fr and fs reach Q alone, L2 and L3 through the motion
+  const Scene s = parse_scene(
+      test::crank_slider_scene(
+          ", J: 0.3, fr: 1.5, fs: 2",
+          "parts:\n  rod: {frame: {origin: A, x: B}, center_of_mass: [L3/2, 0], mass: 1.2, inertia: 1.2*L3*L3/12}\n"
+          "loads:\n"
+          "  springs: [{name: seal, between: [{part: rod, at: [L3/2, 0]}, {point: [0.5, 0.8]}], friction: fs}]\n"
+          "  torsional_springs: [{name: rotor, angle: \"theta2 - atan2(yA, xA - xB)\", inertia: J, friction: fr,\n"
+          "                       damping: 0.2}]\n"
+          "time: {start: 0, end: 0.9, steps: 9}\n"
+          "output: {efforts: all, power: true, sensitivities: [L2, L3, J, fr, fs]}\n"),
+      "crank_slider_rotor.yaml");
+  expect_force_rate_equals_difference_of_q(s);
+  expect_force_rate_paths_agree(s);
+  // on a spatial joint's angle the rotor's θ̈ has no exact rate along p here: Q is differenced, said so by false
+  const Scene joint =
+      parse_scene(test::replace_first(test::rssr_with_joint_springs("1.3", "{efforts: all, sensitivities: [a, kt]}"),
+                                      "damping: ct}", "damping: ct, inertia: 0.2}"),
+                  "rssr_rotor.yaml");
+  ForceRatePaths r;
+  force_rate_paths(joint, r);
+  EXPECT_EQ(r.exact_differenced, 2u);
+}
+
 TEST(ForceRate, ReachesTheNaturalFourBarAndTheSpatialRssrExactly) {
   // models/dynamics/fourbar_motor_torque.yaml (natural coordinates: L1 moves the ground pivot of the rocker's
   // frame) and models/spatial/rssr.yaml with massive bodies (reference points and Euler parameters)

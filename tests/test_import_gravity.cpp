@@ -146,9 +146,10 @@ TEST(ImportGravity, MotorTorqueOfAPendulumIsTheClosedFormWithEachFormatsGravity)
   EXPECT_LT(gravity_torque_error(off, Eigen::Vector3d::Zero()).first, 1e-9);
 }
 
-// The joint's spring and damper come with it: MJCF's stiffness, damping and springref (in degrees, from the
-// joint's ref), URDF's <dynamics damping> and SDF's axis <dynamics> (friction listed as not mapped) add
-// k (θ − θ0) + c θ̇ to the pendulum's motor torque; a slide's own on its travel, an MJCF slider pushed along its axis.
+// The joint's spring, damper, friction and rotor come with it: MJCF's stiffness, damping, springref (in degrees,
+// from the joint's ref) and armature, URDF's <dynamics damping friction> and SDF's axis <dynamics> add
+// k (θ − θ0) + c θ̇ + f sign θ̇ + J θ̈ to the pendulum's motor torque; a slide's own on its travel, an MJCF slider
+// pushed along its axis; a spring wound through more than a turn.
 TEST(ImportGravity, JointSpringsAndDampersLoadTheMotor) {
   const std::string mjcf =
       "<mujoco model=\"pendulum\">\n<worldbody>\n<body name=\"arm\" pos=\"0 0 1\"><joint name=\"hinge\" type=\"hinge\" "
@@ -162,7 +163,8 @@ TEST(ImportGravity, JointSpringsAndDampersLoadTheMotor) {
       sdf.find("<xyz>1 0 0</xyz>"), 16,
       "<xyz>1 0 0</xyz><dynamics><damping>0.5</damping><friction>0.2</friction>"
       "<spring_reference>0.5235987755982988</spring_reference><spring_stiffness>5</spring_stiffness></dynamics>");
-  const double theta0[3] = {30 * M_PI / 180, 0.0, M_PI / 6}, k[3] = {5.0, 0.0, 5.0};
+  const double theta0[3] = {30 * M_PI / 180, 0.0, M_PI / 6}, k[3] = {5.0, 0.0, 5.0}, rotor[3] = {0.1, 0.0, 0.0},
+               friction[3] = {0.0, 0.2, 0.2};
   int c = 0;
   for (const auto& [format, text] : {std::pair<std::string, std::string>{"mjcf", mjcf}, {"urdf", urdf}, {"sdf", sdf}}) {
     SCOPED_TRACE(format);
@@ -173,17 +175,15 @@ TEST(ImportGravity, JointSpringsAndDampersLoadTheMotor) {
       const double theta = 0.5 * t + 0.3 * t * t, rate = 0.5 + 0.6 * t, alpha = 0.6;
       return kGravityIo * alpha -
              kGravityMass * kGravityArm * g.dot(Eigen::Vector3d(0, -std::sin(theta), std::cos(theta))) +
-             k[c] * (theta - theta0[c]) + 0.5 * rate;
+             k[c] * (theta - theta0[c]) + 0.5 * rate + rotor[c] * alpha + friction[c];  // (θ̇ > 0)
     });
     EXPECT_LT(error, 1e-9);
     EXPECT_GT(largest, 0.2);
-    const std::string unmapped = format == "mjcf"   ? "<joint armature>"
-                                 : format == "urdf" ? "<dynamics friction>"
-                                                    : "<dynamics><friction>";
-    EXPECT_EQ(std::count_if(imported.skipped.begin(), imported.skipped.end(),
-                            [&](const std::string& x) { return x.find(unmapped) != x.npos; }),
-              1)
-        << unmapped;
+    for (const char* mapped : {"armature", "friction"})
+      EXPECT_EQ(std::count_if(imported.skipped.begin(), imported.skipped.end(),
+                              [&](const std::string& x) { return x.find(mapped) != x.npos; }),
+                0)
+          << mapped;
     ++c;
   }
   // a slide: k (d − d0) + c ḋ along its axis, d its travel from the file's pose
@@ -201,6 +201,22 @@ TEST(ImportGravity, JointSpringsAndDampersLoadTheMotor) {
   });
   EXPECT_LT(error, 1e-9);
   EXPECT_GT(largest, 5.0);
+  // a hinge's spring wound through a turn and a half, k θ over every turn (as MuJoCo's q − springref counts it),
+  // with a rotor and a dry friction that turns with it; no gravity
+  const std::string wound =
+      "<mujoco model=\"wound\">\n<compiler angle=\"radian\"/>\n<option gravity=\"0 0 0\"/>\n<worldbody>\n"
+      "<body name=\"arm\"><joint name=\"hinge\" type=\"hinge\" axis=\"0 0 1\" stiffness=\"5\" armature=\"0.3\" "
+      "frictionloss=\"0.7\"/><inertial pos=\"0.4 0 0\" mass=\"2\" diaginertia=\"0.01 0.03 0.03\"/></body>\n"
+      "</worldbody>\n</mujoco>\n";
+  o.drives = {{"hinge", "6*t - t^2"}};
+  o.t_end = 2, o.steps = 40;
+  const ModelImport turned = import_mjcf(wound, "wound.xml", o);
+  const auto [turned_error, turned_largest] = gravity_effort_error(turned.yaml, [&](double t) {
+    const double theta = 6 * t - t * t, rate = 6 - 2 * t;  // 8 rad at t = 2, turning one way throughout
+    return (0.03 + 2 * 0.4 * 0.4 + 0.3) * -2.0 + 5 * theta + 0.7 * (rate > 0 ? 1 : -1);
+  });
+  EXPECT_LT(turned_error, 1e-9);
+  EXPECT_GT(turned_largest, 39.0);
 }
 
 // tests/data/asmt/pendulum.asmt (ConstantGravity 0 0 0) with its arm's centre (mass 1) at (1, 0, 0), turned by

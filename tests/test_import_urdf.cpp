@@ -80,9 +80,12 @@ TEST(UrdfImport, FourBarClosedByItsClosingJointFollowsItsClosedFormAndTheSceneWr
                          [&](const std::string& s) { return s.rfind(start, 0) == 0; });
   };
   EXPECT_EQ(listed(path + ":" + std::to_string(UrdfLineOf(text, "<limit")) + ": <limit> (2 in all): joint limits"), 1);
-  // the crank joint's <dynamics damping> a damper on its angle (its efforts' load), not a thing left out
-  EXPECT_NE(imported.yaml.find("- {name: crank_joint_spring, joint: crank_joint, stiffness: 0, free_angle: 0, "
-                               "damping: 0.1}"),
+  // the crank joint's <dynamics damping> a damper on its angle (its efforts' load), not a thing left out: on the
+  // angle's coordinate, a rotation_angle of the joint, which counts its turns
+  EXPECT_NE(imported.yaml.find("- {name: crank_joint_spring, coordinate: crank_joint_angle, stiffness: 0, "
+                               "free_angle: 0, damping: 0.1}"),
+            std::string::npos);
+  EXPECT_NE(imported.yaml.find("type: rotation_angle, joint: crank_joint, angle: crank_joint_angle}"),
             std::string::npos);
   EXPECT_EQ(listed(path + ":" + std::to_string(UrdfLineOf(text, "<collision")) + ": <collision>:"), 1);
   EXPECT_EQ(listed(path + ":" + std::to_string(UrdfLineOf(text, "<transmission")) + ": <transmission>:"), 1);

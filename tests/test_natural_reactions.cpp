@@ -463,7 +463,7 @@ TEST(NaturalReactions, RigidBarsQIsEachBarsOwnFormAssembled) {
           detail::add_massive_part(parts[i], detail::massive_part(parts[i], i, length), e.loads->gravity, q, qd, qdd, t,
                                    each, own.data() + i);
         }
-        add_applied_forces(*e.loads->applied, q, qd, t, each);
+        add_applied_forces(*e.loads->applied, q, qd, qdd, t, each);
         ASSERT_EQ(taken, static_cast<int>(parts.size()));  // every link is a bar
         const double scale = each.cwiseAbs().maxCoeff();
         ASSERT_GT(scale, 0.1);  // (not all zero)

@@ -204,8 +204,8 @@ TEST(SceneFamilies, LoadsFromFamiliesAreTheLoadsListed) {
   Eigen::VectorXd q = a.model->initial_positions(), qd = Eigen::VectorXd::Zero(q.size());
   for (Index j = 0; j < q.size(); ++j) q(j) += 0.01 * static_cast<double>(j % 5), qd(j) = 0.1 * static_cast<double>(j);
   Eigen::VectorXd qa = Eigen::VectorXd::Zero(q.size()), qb = qa;
-  add_applied_forces(x, q.data(), qd.data(), 0.7, qa);
-  add_applied_forces(y, q.data(), qd.data(), 0.7, qb);
+  add_applied_forces(x, q.data(), qd.data(), nullptr, 0.7, qa);
+  add_applied_forces(y, q.data(), qd.data(), nullptr, 0.7, qb);
   EXPECT_EQ(qa, qb);
   EXPECT_GT(qa.norm(), 1.0);
   EXPECT_NE(error_of(parts + "loads:\n  forces:\n    - {name: push1, part: coupler0, force: [1, 0]}\n"

@@ -98,16 +98,18 @@ std::vector<std::string> load_lines(const phiq::AppliedLoads& a, int dimension) 
                   (dimension == 3 ? load_vector_text(t.components, t.axes, 3) : load_value_text(t.components[2])) +
                   " N·m");
   auto elastic = [](double k, const phiq::MotionLaw& law) { return law.has_value() ? law.description() : g6(k); };
+  auto dry = [](double f) { return f != 0.0 ? ", friction " + g6(f) : std::string(); };  // (only where it has one)
   for (const phiq::LinearSpring& s : a.springs)
     out.push_back("spring '" + s.name + "' between '" + s.a.part + "' " + at(s.a.at) + " and '" + s.b.part + "' " +
                   at(s.b.at) + ": stiffness " + elastic(s.stiffness, s.law) + ", free length " + g6(s.free_length) +
-                  ", damping " + g6(s.damping) + ", preload " + g6(s.preload) + ", tension " +
+                  ", damping " + g6(s.damping) + dry(s.friction) + ", preload " + g6(s.preload) + ", tension " +
                   load_value_text(s.tension));
   for (const phiq::TorsionalSpring& s : a.torsional_springs)
     out.push_back("torsional spring '" + s.name + "' on " +
                   (s.angle ? "'" + s.angle->text() + "'" : "joint '" + s.joint->name + "'") + ": stiffness " +
                   elastic(s.stiffness, s.law) + ", free angle " + g6(s.free_angle) + ", damping " + g6(s.damping) +
-                  ", moment " + load_value_text(s.moment));
+                  dry(s.friction) + (s.inertia != 0.0 ? ", inertia " + g6(s.inertia) : "") + ", moment " +
+                  load_value_text(s.moment));
   return out;
 }
 

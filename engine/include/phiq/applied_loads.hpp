@@ -83,12 +83,15 @@ struct LinearSpring {
   double free_length = 0.0;  ///< L0 (m), ≥ 0
   double damping = 0.0;      ///< c (N·s/m), ≥ 0
   double preload = 0.0;      ///< tension at L = L0 at rest (N)
+  double friction = 0.0;     ///< f (N), ≥ 0: a dry friction's tension f sign(L̇) (none at rest)
   MotionLaw law;             ///< the elastic tension of L − L0 (N) in place of k (L − L0), where it has a value
   LoadValue tension;         ///< T (N): an actuator's tension along the line, if any
 };
 
-/// A torsional spring-damper on an angle θ(q, t): the moment τ = k (θ − θ0) + c θ̇ + M resisting θ's increase; with
-/// a law, law(θ − θ0) in place of k (θ − θ0); M a rotary actuator's moment given as an expression or a law.
+/// A torsional spring-damper on an angle θ(q, t): the moment τ = k (θ − θ0) + c θ̇ + f sign(θ̇) + J θ̈ + M resisting
+/// θ's increase; with a law, law(θ − θ0) in place of k (θ − θ0); f a dry friction's moment (none at rest), J a rotor's
+/// inertia turning with θ (a geared motor's, MuJoCo's armature), M a rotary actuator's moment given as an expression
+/// or a law.
 struct TorsionalSpring {
   std::string name;                                 ///< the scene's name for it
   std::shared_ptr<const CompiledExpression> angle;  ///< θ: a coordinate, or an expression of them; or null and:
@@ -99,6 +102,8 @@ struct TorsionalSpring {
   double stiffness = 0.0;                ///< k (N·m/rad), ≥ 0
   double free_angle = 0.0;               ///< θ0 (rad)
   double damping = 0.0;                  ///< c (N·m·s/rad), ≥ 0
+  double friction = 0.0;                 ///< f (N·m), ≥ 0
+  double inertia = 0.0;                  ///< J (kg·m²), ≥ 0
   MotionLaw law;                         ///< the elastic moment of θ − θ0 (N·m) in place of k (θ − θ0), if any
   LoadValue moment;                      ///< M (N·m): an actuator's moment against θ, if any
 };
@@ -117,13 +122,15 @@ struct AppliedLoads {
 kin3::V3 world_components(const std::array<LoadValue, 3>& components, LoadAxes axes, const Pose& pose, const double* q,
                           const double* qd, double t);
 
-/// Adds to `Q` (one entry per coordinate) the generalized forces of `loads` at (q, q̇, t): their virtual work per
-/// δq_k. `qd` may be null: at rest (the dampers exert nothing, der() is 0). Pre-condition: Q has an entry for every
-/// coordinate the loads read. Thread-safe.
-void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, double t, Eigen::VectorXd& Q);
+/// Adds to `Q` (one entry per coordinate) the generalized forces of `loads` at (q, q̇, q̈, t): their virtual work per
+/// δq_k. `qd` may be null: at rest (the dampers exert nothing, der() is 0); `qdd` null: q̈ = 0 (a torsional
+/// spring's rotor inertia exerts nothing). Pre-condition: Q has an entry for every coordinate the loads read.
+/// Thread-safe.
+void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, const double* qdd, double t,
+                        Eigen::VectorXd& Q);
 
-/// The power of `loads` at (q, q̇, t) (W): Σ F · v of the forces at their points' velocities, M · ω of the
+/// The power of `loads` at (q, q̇, q̈, t) (W): Σ F · v of the forces at their points' velocities, M · ω of the
 /// torques, −f L̇ of the springs, −τ θ̇ of the torsional ones. With frames that do not depend on t it is Q · q̇.
-double applied_power(const AppliedLoads& loads, const double* q, const double* qd, double t);
+double applied_power(const AppliedLoads& loads, const double* q, const double* qd, const double* qdd, double t);
 
 }  // namespace phiq

@@ -68,8 +68,9 @@ struct Joint {
   Side parent, child;
   bool closing = false;  // closes a loop (not a tree edge)
   // A spring-damper on a revolute's angle or a prismatic's travel (both 0 at the file's pose): stiffness
-  // (N·m/rad, N/m), damping (N·m·s/rad, N·s/m) and its free value (rad, m): the scene's torsional spring on it.
-  double stiffness = 0.0, damping = 0.0, free = 0.0;
+  // (N·m/rad, N/m), damping (N·m·s/rad, N·s/m), its free value (rad, m), a dry friction (N·m, N) and a rotor's
+  // inertia turning with it (kg·m², kg: MuJoCo's armature): the scene's torsional spring on it.
+  double stiffness = 0.0, damping = 0.0, free = 0.0, friction = 0.0, armature = 0.0;
 };
 
 // joint = multiplier · other + offset (a URDF mimic, an MJCF joint equality), or joint = offset when other < 0.

@@ -64,7 +64,6 @@ class MechanismWriter {
   bool massive_ = false;  // a part has mass (parts())
 };
 
-// The coordinate that holds joint j's angle (a `rotation_angle` of the joint), made once.
 // The coordinate that holds joint j's angle (a `rotation_angle` of a revolute joint) or travel (a prismatic joint's
 // z₁ · (P₂ − P₁), an `equation` over the bodies' coordinates), made once.
 std::string MechanismWriter::joint_coordinate(int j, const Coupler& c) {
@@ -105,16 +104,22 @@ std::string MechanismWriter::travel(const Joint& joint) {
   return expr + " - (" + scene_number(a.dot(joint.parent.at)) + ")";
 }
 
-// The joints' springs and dampers as torsional springs: on a revolute's angle, or on a prismatic's travel.
+// The joints' springs, dampers, frictions and rotors as torsional springs: on a revolute's angle, its coordinate
+// (a rotation_angle, through any number of turns, as the file's simulator counts them), or on a prismatic's travel.
 std::string MechanismWriter::joint_springs() {
   std::ostringstream s;
   for (std::size_t j = 0; j < m_.joints.size(); ++j) {
     const Joint& joint = m_.joints[j];
-    if (joint.stiffness == 0.0 && joint.damping == 0.0) continue;
+    if (joint.stiffness == 0.0 && joint.damping == 0.0 && joint.friction == 0.0 && joint.armature == 0.0) continue;
+    const bool turns = joint.kind == "revolute";
     s << "    - {name: " << names_.make(joint_[j] + "_spring")
-      << (joint.kind == "revolute" ? ", joint: " + joint_[j] : ", angle: \"" + travel(joint) + "\"")
+      << (turns ? ", coordinate: " + joint_coordinate(static_cast<int>(j), Coupler{})
+                : ", angle: \"" + travel(joint) + "\"")
       << ", stiffness: " << scene_number(joint.stiffness) << ", free_angle: " << scene_number(joint.free)
-      << ", damping: " << scene_number(joint.damping) << "}\n";
+      << ", damping: " << scene_number(joint.damping);
+    if (joint.friction != 0.0) s << ", friction: " << scene_number(joint.friction);
+    if (joint.armature != 0.0) s << ", inertia: " << scene_number(joint.armature);
+    s << "}\n";
   }
   return s.str();
 }
@@ -263,6 +268,7 @@ std::string MechanismWriter::write() {
   for (const Coupler& c : m_.couplers) coupler(c);
   drivers();
   const std::string mass = parts();
+  const std::string springs = joint_springs();  // (before the coordinates are written: a revolute's adds one)
   for (const auto& [what, u] : m_.unmapped)
     m_.skipped.push_back(m_.file_of(u.file) + ":" + std::to_string(u.line) + ": " + what +
                          (u.count > 1 ? " (" + std::to_string(u.count) + " in all)" : "") + ": " + u.why);
@@ -289,7 +295,6 @@ std::string MechanismWriter::write() {
   s << "time: {start: " << scene_number(o_.t_start) << ", end: " << scene_number(o_.t_end) << ", steps: " << o_.steps
     << "}\n";
   s << mass;
-  const std::string springs = joint_springs();
   if (!springs.empty())
     s << "loads:\n"
       << (gravity.first.isZero(0.0) ? "" : "  gravity: " + scene_vector(gravity.first) + "\n")

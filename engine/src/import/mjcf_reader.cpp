@@ -430,16 +430,16 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
       out.child.ref = Eigen::Vector3d::UnitX();
     if (const std::vector<double> r = numbers(j, "ref", jcc, {0}, 1, 1); r[0] != 0.0)
       joint_ref_[static_cast<int>(m_.joints.size())] = type == "hinge" ? angle(r[0]) : r[0];
-    // a hinge's or slide's spring-damper, τ = −k (q − springref) − c q̇, q = ref at the file's pose: a torsional spring
+    // a hinge's or slide's spring, damper, frictionloss and armature (q = ref at the file's pose): a torsional spring
     const bool sprung = type == "hinge" || type == "slide";
     const auto value = [&](const char* name) { return sprung ? numbers(j, name, jcc, {0}, 1, 1)[0] : 0.0; };
-    out.stiffness = value("stiffness"), out.damping = value("damping");
+    double* const loads[] = {&out.stiffness, &out.damping, &out.friction, &out.armature};
+    const char* const fields[] = {"stiffness", "damping", "frictionloss", "armature", "springref", "range", "limited"};
+    for (std::size_t k = 0; k < 4; ++k)
+      if (!((*loads[k] = value(fields[k])) >= 0.0)) fail(j, "joint '" + out.name + "': a negative " + fields[k]);
     out.free = (type == "hinge" ? angle(1.0) : 1.0) * (value("springref") - value("ref"));
-    if (!(out.stiffness >= 0.0 && out.damping >= 0.0)) fail(j, "joint '" + out.name + "': a negative spring or damper");
-    const char* const unread[] = {"range", "limited", "armature", "frictionloss", "damping", "stiffness", "springref"};
-    for (std::size_t k = 0; k < (sprung ? 4u : 7u); ++k)
-      if (attr(j, unread[k], jcc))
-        skip_at(j, std::string("<joint ") + unread[k] + ">", "limits, armature, friction: not kinematics");
+    for (std::size_t k = sprung ? 5u : 0u; k < 7u; ++k)
+      if (attr(j, fields[k], jcc)) skip_at(j, std::string("<joint ") + fields[k] + ">", "not modelled");
     if (!joint_index_.emplace(out.name, static_cast<int>(m_.joints.size())).second)
       fail(j, "a second joint named '" + out.name + "'");
     m_.joints.push_back(out);

@@ -200,8 +200,9 @@ void SdfReader::joint(const sdf::Joint& j, const Pose& placed, const std::string
       out.kind = j.Type() == sdf::JointType::PRISMATIC ? "prismatic" : "revolute";
       if (const sdf::JointAxis* ax = j.Axis(0)) {  // its spring-damper (position 0 at the file's pose)
         out.stiffness = ax->SpringStiffness(), out.damping = ax->Damping(), out.free = ax->SpringReference();
-        if (!(out.stiffness >= 0.0 && out.damping >= 0.0))
-          refuse(path_, out.line, "joint '" + out.name + "': a negative spring_stiffness or damping");
+        out.friction = ax->Friction();
+        if (!(out.stiffness >= 0.0 && out.damping >= 0.0 && out.friction >= 0.0))
+          refuse(path_, out.line, "joint '" + out.name + "': a negative spring_stiffness, damping or friction");
       }
       break;
     }
@@ -232,7 +233,7 @@ void SdfReader::joint(const sdf::Joint& j, const Pose& placed, const std::string
     if (const sdf::ElementPtr a = j.Element()->FindElement(axis)) {
       unmapped_children(a, {"xyz", sprung && axis[4] == 0 ? "dynamics" : "xyz"}, why);
       if (const sdf::ElementPtr d = a->FindElement("dynamics"); d && sprung && axis[4] == 0)
-        unmapped_children(d, {"damping", "spring_stiffness", "spring_reference"}, "Coulomb friction is not modelled");
+        unmapped_children(d, {"damping", "friction", "spring_stiffness", "spring_reference"}, "not modelled");
     }
 }
 

@@ -196,17 +196,13 @@ void UrdfReader::check_tree() const {
   }
 }
 
-// <dynamics damping friction>: a revolute's or prismatic's viscous damping loads it (a torsional spring of no
-// stiffness in the scene); its Coulomb friction is not modelled.
+// <dynamics damping friction>: a revolute's or prismatic's viscous damping and Coulomb friction load it (a
+// torsional spring of no stiffness in the scene).
 void UrdfReader::dynamics(const tinyxml2::XMLElement* e, Joint& j) {
-  double damping = 0.0, friction = 0.0;
-  if (e->QueryDoubleAttribute("damping", &damping) == tinyxml2::XML_WRONG_ATTRIBUTE_TYPE || !(damping >= 0.0) ||
-      !std::isfinite(damping))
-    refuse(path_, e->GetLineNum(), "joint '" + j.name + "': <dynamics damping> is not a number ≥ 0");
-  j.damping = damping;
-  if (e->QueryDoubleAttribute("friction", &friction) == tinyxml2::XML_SUCCESS && friction != 0.0)
-    m_.skip("<dynamics friction>", e->GetLineNum(),
-            "Coulomb friction is not modelled (phiq's efforts are frictionless)");
+  for (const auto& [field, value] : {std::pair{"damping", &j.damping}, std::pair{"friction", &j.friction}})
+    if (e->QueryDoubleAttribute(field, value) == tinyxml2::XML_WRONG_ATTRIBUTE_TYPE || !(*value >= 0.0) ||
+        !std::isfinite(*value))
+      refuse(path_, e->GetLineNum(), "joint '" + j.name + "': <dynamics " + field + "> is not a number ≥ 0");
 }
 
 void UrdfReader::unmapped(const tinyxml2::XMLElement* e) {

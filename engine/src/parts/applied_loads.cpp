@@ -37,6 +37,9 @@ V3 end_velocity(const SpringEnd& e, const double* q, const double* qd, double t)
   return part_motion(e.frame, q, qd, nullptr, t).point(e.at).first;
 }
 
+// sign(v): −1, 0 or 1 (a dry friction's direction; none at rest, where static friction is not determined).
+double sign_of(double v) { return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : 0.0; }
+
 // A spring's state at (q, q̇, t): its ends in the world, the unit vector from a to b, and its tension.
 struct SpringState {
   Pose pa, pb;  // the ends' frames
@@ -53,10 +56,11 @@ SpringState spring_state(const LinearSpring& s, const double* q, const double* q
   st.length = kin3::norm(d);
   if (st.length == 0.0) return st;  // no direction: no force (LinearSpring)
   st.unit = (1.0 / st.length) * d;
-  if (s.damping != 0.0) st.rate = kin3::dot(st.unit, end_velocity(s.b, q, qd, t) - end_velocity(s.a, q, qd, t));
+  if (s.damping != 0.0 || s.friction != 0.0)
+    st.rate = kin3::dot(st.unit, end_velocity(s.b, q, qd, t) - end_velocity(s.a, q, qd, t));
   const double stretch = st.length - s.free_length;
-  st.tension =
-      (s.law.has_value() ? s.law.evaluate(stretch).f : s.stiffness * stretch) + s.damping * st.rate + s.preload;
+  st.tension = (s.law.has_value() ? s.law.evaluate(stretch).f : s.stiffness * stretch) + s.damping * st.rate +
+               s.friction * sign_of(st.rate) + s.preload;
   if (s.tension.expr) st.tension += s.tension.value(q, qd, t);
   return st;
 }
@@ -65,6 +69,16 @@ SpringState spring_state(const LinearSpring& s, const double* q, const double* q
 struct AngleState {
   double from_free = 0.0, rate = 0.0, moment = 0.0;  // θ − θ0, θ̇, τ
 };
+
+// θ̈ at (q, q̇, q̈): ∇θ · q̈ − γ for an expression (its γ holds q̇ᵀ H q̇ and the t terms), the joint's own otherwise.
+double angle_acceleration(const TorsionalSpring& s, const double* q, const double* qd, const double* qdd, double t,
+                          const std::vector<double>& gradient) {
+  if (!s.angle) return evaluate_joint(*s.joint, q, qd, qdd).acceleration;
+  const std::vector<Index>& c = s.angle->coordinates();
+  double a = -s.angle->gamma(q, qd, t);
+  for (std::size_t i = 0; i < c.size(); ++i) a += gradient[i] * qdd[c[i]];
+  return a;
+}
 
 // The coordinates a torsional spring's angle reads, increasing.
 const std::vector<Index>& angle_coordinates(const TorsionalSpring& s) {
@@ -93,7 +107,7 @@ double angle_from_free(const TorsionalSpring& s, const double* q, double t, std:
   return std::remainder(evaluate_joint(*s.joint, q, nullptr, nullptr).value - s.free_angle, 2.0 * M_PI);
 }
 
-AngleState angle_state(const TorsionalSpring& s, const double* q, const double* qd, double t,
+AngleState angle_state(const TorsionalSpring& s, const double* q, const double* qd, const double* qdd, double t,
                        std::vector<double>& gradient) {
   AngleState st;
   st.from_free = angle_from_free(s, q, t, gradient);
@@ -102,7 +116,9 @@ AngleState angle_state(const TorsionalSpring& s, const double* q, const double* 
     st.rate = s.angle ? s.angle->partial_t(q, t) : 0.0;
     for (std::size_t i = 0; i < c.size(); ++i) st.rate += gradient[i] * qd[c[i]];
   }
-  st.moment = (s.law.has_value() ? s.law.evaluate(st.from_free).f : s.stiffness * st.from_free) + s.damping * st.rate;
+  st.moment = (s.law.has_value() ? s.law.evaluate(st.from_free).f : s.stiffness * st.from_free) + s.damping * st.rate +
+              s.friction * sign_of(st.rate);
+  if (s.inertia != 0.0 && qd && qdd) st.moment += s.inertia * angle_acceleration(s, q, qd, qdd, t, gradient);
   if (s.moment.expr) st.moment += s.moment.value(q, qd, t);
   return st;
 }
@@ -123,7 +139,8 @@ V3 world_components(const std::array<LoadValue, 3>& components, LoadAxes axes, c
   return axes == LoadAxes::kPart ? turned(pose.rotation, c) : c;
 }
 
-void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, double t, Eigen::VectorXd& Q) {
+void add_applied_forces(const AppliedLoads& loads, const double* q, const double* qd, const double* qdd, double t,
+                        Eigen::VectorXd& Q) {
   for (const AppliedForce& f : loads.forces) {
     const Pose pose = part_pose(f.frame, q, t);
     add_virtual_work(f.frame, pose, f.at, world_components(f.components, f.axes, pose, q, qd, t), {}, q, t, Q);
@@ -140,13 +157,13 @@ void add_applied_forces(const AppliedLoads& loads, const double* q, const double
   }
   thread_local std::vector<double> gradient;  // (capacity kept from row to row)
   for (const TorsionalSpring& s : loads.torsional_springs) {
-    const AngleState st = angle_state(s, q, qd, t, gradient);
+    const AngleState st = angle_state(s, q, qd, qdd, t, gradient);
     const std::vector<Index>& c = angle_coordinates(s);
     for (std::size_t i = 0; i < c.size(); ++i) Q(c[i]) -= st.moment * gradient[i];
   }
 }
 
-double applied_power(const AppliedLoads& loads, const double* q, const double* qd, double t) {
+double applied_power(const AppliedLoads& loads, const double* q, const double* qd, const double* qdd, double t) {
   double power = 0.0;
   for (const AppliedForce& f : loads.forces) {
     const PartMotion m = part_motion(f.frame, q, qd, nullptr, t);
@@ -165,7 +182,7 @@ double applied_power(const AppliedLoads& loads, const double* q, const double* q
   }
   thread_local std::vector<double> gradient;
   for (const TorsionalSpring& s : loads.torsional_springs) {
-    const AngleState st = angle_state(s, q, qd, t, gradient);
+    const AngleState st = angle_state(s, q, qd, qdd, t, gradient);
     power -= st.moment * st.rate;
   }
   return power;

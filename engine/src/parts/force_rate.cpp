@@ -372,7 +372,10 @@ bool add_springs_rate(const AppliedLoads& loads, const std::array<const AppliedL
     if (sp.law.has_value() &&
         !spring_law_dual(sp.law, along, h, stretch, elastic, [i](const AppliedLoads& a) { return &a.springs[i].law; }))
       return false;
-    Dual tension = elastic + datum(&LinearSpring::damping) * rate + datum(&LinearSpring::preload);
+    // a dry friction's f sign(L̇): its rate along p f′ sign(L̇) (sign's own is 0 wherever it is defined)
+    const Dual dry(static_cast<double>((rate.v > 0.0) - (rate.v < 0.0)));
+    Dual tension = elastic + datum(&LinearSpring::damping) * rate + datum(&LinearSpring::friction) * dry +
+                   datum(&LinearSpring::preload);
     if (!add_value_dual(sp.tension, along, h, along_motion, tension,
                         [i](const AppliedLoads& a) -> const LoadValue& { return a.springs[i].tension; }))
       return false;
@@ -507,6 +510,23 @@ bool joint_angle_rates(const TorsionalSpring& ts, std::size_t i, const std::arra
   return true;
 }
 
+// A rotor's J θ̈ with its rate, added to `moment`: θ̈ from the angle's jet along the motion, exact with its third
+// derivatives (parts/expression_rate.hpp); false for a spatial joint's angle (its θ̈'s rate along p reads the
+// joint's third derivatives, which it has not: Q is differenced) or without q̈.
+bool add_rotor_dual(const TorsionalSpring& ts, std::size_t i, const std::array<const AppliedLoads*, 4>& along, double h,
+                    const DualPath& path, Dual inertia, Dual& moment) {
+  if (inertia.v == 0.0 && inertia.e == 0.0) return true;
+  if (!ts.angle || !path.qd || !path.qdd) return false;
+  std::array<const CompiledExpression*, 4> copies{};
+  for (std::size_t k = 0; k < 4; ++k)
+    if (!(copies[k] = along[k]->torsional_springs[i].angle.get()) ||
+        copies[k]->coordinates() != ts.angle->coordinates())
+      return false;
+  const MotionRates m{path.q, path.qd, path.qdd, path.s, path.sd, path.sdd, path.t};
+  moment = moment + inertia * expression_jet_rate(*ts.angle, &copies, h, m, -1).dd;
+  return true;
+}
+
 bool add_torsional_rate(const AppliedLoads& loads, const std::array<const AppliedLoads*, 4>& along, double h,
                         const DualPath& path, Index n, Eigen::VectorXd& dq) {
   thread_local AngleRates st;
@@ -524,7 +544,9 @@ bool add_torsional_rate(const AppliedLoads& loads, const std::array<const Applie
     if (ts.law.has_value() && !spring_law_dual(ts.law, along, h, angle, elastic,
                                                [i](const AppliedLoads& a) { return &a.torsional_springs[i].law; }))
       return false;
-    Dual moment = elastic + datum(&TorsionalSpring::damping) * st.rate;
+    const Dual dry(static_cast<double>((st.rate.v > 0.0) - (st.rate.v < 0.0)));  // (as a spring's friction)
+    Dual moment = elastic + datum(&TorsionalSpring::damping) * st.rate + datum(&TorsionalSpring::friction) * dry;
+    if (!add_rotor_dual(ts, i, along, h, path, datum(&TorsionalSpring::inertia), moment)) return false;
     if (!add_value_dual(ts.moment, along, h, path, moment,
                         [i](const AppliedLoads& a) -> const LoadValue& { return a.torsional_springs[i].moment; }))
       return false;

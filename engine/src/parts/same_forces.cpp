@@ -43,7 +43,8 @@ bool same_applied(const AppliedLoads& a, const AppliedLoads& b) {
   for (std::size_t i = 0; i < a.springs.size(); ++i) {
     const LinearSpring &x = a.springs[i], &y = b.springs[i];
     if (!same_end(x.a, y.a) || !same_end(x.b, y.b) || x.stiffness != y.stiffness || x.free_length != y.free_length ||
-        x.damping != y.damping || x.preload != y.preload || !(x.law == y.law) || !same_value(x.tension, y.tension))
+        x.damping != y.damping || x.preload != y.preload || x.friction != y.friction || !(x.law == y.law) ||
+        !same_value(x.tension, y.tension))
       return false;
   }
   for (std::size_t i = 0; i < a.torsional_springs.size(); ++i) {
@@ -51,7 +52,8 @@ bool same_applied(const AppliedLoads& a, const AppliedLoads& b) {
     if (!same_expression(x.angle, y.angle) || x.joint.has_value() != y.joint.has_value() ||
         (x.joint && (x.joint->measure != y.joint->measure || !(x.joint->att == y.joint->att))) ||
         x.joint_coordinates != y.joint_coordinates || x.stiffness != y.stiffness || x.free_angle != y.free_angle ||
-        x.damping != y.damping || !(x.law == y.law) || !same_value(x.moment, y.moment))
+        x.damping != y.damping || x.friction != y.friction || x.inertia != y.inertia || !(x.law == y.law) ||
+        !same_value(x.moment, y.moment))
       return false;
   }
   return true;

@@ -73,7 +73,7 @@ class PartReader {
   template <class C>
   void load_components(const C& c, const char* what, std::array<LoadValue, 3>& out) const;
   template <class C>
-  bool spring_stiffness(const C& s, double& stiffness, MotionLaw& law, bool actuator) const;
+  bool spring_stiffness(const C& s, double& stiffness, MotionLaw& law, bool other) const;
   // one component: an expression, or `{law: LAW, of: EXPRESSION}` (of: t when absent)
   template <class C>
   LoadValue load_component(const C& c) const;

@@ -165,17 +165,18 @@ double PartReader::non_negative(const C& c) const {
   return v;
 }
 
-// A spring's `stiffness`, or its `law` of the deflection (a motion law's map), one of them; neither where it is an
-// actuator alone (`tension`, `moment`). Returns whether it has a stiffness.
+// A spring's `stiffness`, or its `law` of the deflection (a motion law's map), one of them; neither where it has
+// other terms (`other`: an actuator's `tension` or `moment`, a `damping`, `friction` or `inertia`): a damper, a
+// rotor. Returns whether it has a stiffness.
 template <class C>
-bool PartReader::spring_stiffness(const C& s, double& stiffness, MotionLaw& law, bool actuator) const {
+bool PartReader::spring_stiffness(const C& s, double& stiffness, MotionLaw& law, bool other) const {
   const auto k = s.field("stiffness"), l = s.field("law");
   if (k.present() && l.present()) l.fail("a spring has a stiffness or a law of its deflection, not both");
   if (l.present()) {
     law = r_.motion_law(l);
     return false;
   }
-  if (actuator && !k.present()) return false;
+  if (other && !k.present()) return false;
   stiffness = non_negative(s.require("stiffness"));
   return true;
 }
@@ -184,7 +185,8 @@ bool PartReader::spring_stiffness(const C& s, double& stiffness, MotionLaw& law,
 // angle.
 template <class C>
 TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& names) const {
-  s.expect_map({"name", "coordinate", "angle", "joint", "stiffness", "law", "moment", "free_angle", "damping"});
+  s.expect_map({"name", "coordinate", "angle", "joint", "stiffness", "law", "moment", "free_angle", "damping",
+                "friction", "inertia"});
   TorsionalSpring spring;
   spring.name = load_name(s, names);
   const auto on_coordinate = s.field("coordinate"), angle = s.field("angle"), joint = s.field("joint");
@@ -218,16 +220,20 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
     spring.joint_coordinates.assign(read.begin(), read.end());
   }
   if (auto m = s.field("moment"); m.present()) spring.moment = load_component(m);
-  spring_stiffness(s, spring.stiffness, spring.law, spring.moment.expr != nullptr);
+  spring_stiffness(s, spring.stiffness, spring.law,
+                   spring.moment.expr || s.field("damping").present() || s.field("friction").present() ||
+                       s.field("inertia").present());
   if (auto a0 = s.field("free_angle"); a0.present()) spring.free_angle = r_.number(a0);
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
+  if (auto f = s.field("friction"); f.present()) spring.friction = non_negative(f);
+  if (auto j = s.field("inertia"); j.present()) spring.inertia = non_negative(j);
   return spring;
 }
 
 // A linear spring-damper: `between: [END, END]`, each {part: P, at: [..]} or {point: [..]} (fixed in the world).
 template <class C>
 LinearSpring PartReader::linear_spring(const C& s, const LoadTargets& targets, std::set<std::string>& names) const {
-  s.expect_map({"name", "between", "stiffness", "law", "tension", "free_length", "damping", "preload"});
+  s.expect_map({"name", "between", "stiffness", "law", "tension", "free_length", "damping", "preload", "friction"});
   LinearSpring spring;
   spring.name = load_name(s, names);
   const auto between = s.require("between");
@@ -256,11 +262,14 @@ LinearSpring PartReader::linear_spring(const C& s, const LoadTargets& targets, s
   if (frame_coordinates(spring.a.frame).empty() && frame_coordinates(spring.b.frame).empty())
     between.fail("neither end reads a coordinate: the spring does no work on the coordinates and changes no effort");
   if (auto f = s.field("tension"); f.present()) spring.tension = load_component(f);
-  const bool stiff = spring_stiffness(s, spring.stiffness, spring.law, spring.tension.expr != nullptr);
+  const bool stiff =
+      spring_stiffness(s, spring.stiffness, spring.law,
+                       spring.tension.expr || s.field("damping").present() || s.field("friction").present());
   if (auto l0 = stiff ? s.require("free_length") : s.field("free_length"); l0.present())
     spring.free_length = non_negative(l0);
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
   if (auto p = s.field("preload"); p.present()) spring.preload = r_.number(p);
+  if (auto f = s.field("friction"); f.present()) spring.friction = non_negative(f);
   return spring;
 }
 

@@ -77,11 +77,11 @@ std::string part_fault(const Part& p, V3 gravity, Index n, const double* q, cons
 
 template <class Load>
 bool load_finite(const Load& load, std::vector<Load> AppliedLoads::*list, Index n, const double* q, const double* qd,
-                 double t) {
+                 const double* qdd, double t) {
   AppliedLoads one;
   (one.*list).push_back(load);
   Eigen::VectorXd Q = Eigen::VectorXd::Zero(n);
-  add_applied_forces(one, q, qd, t, Q);
+  add_applied_forces(one, q, qd, qdd, t, Q);
   return Q.allFinite();
 }
 
@@ -116,14 +116,14 @@ std::string nonfinite_force_source(const std::vector<Part>& parts, const Loads& 
   const AppliedLoads& a = *loads.applied;
   const Index n = num_coordinates;
   for (const AppliedForce& f : a.forces)
-    if (!load_finite(f, &AppliedLoads::forces, n, q, qd, t)) return vector_load_fault(f, "force", q, qd, t);
+    if (!load_finite(f, &AppliedLoads::forces, n, q, qd, qdd, t)) return vector_load_fault(f, "force", q, qd, t);
   for (const AppliedTorque& f : a.torques)
-    if (!load_finite(f, &AppliedLoads::torques, n, q, qd, t)) return vector_load_fault(f, "torque", q, qd, t);
+    if (!load_finite(f, &AppliedLoads::torques, n, q, qd, qdd, t)) return vector_load_fault(f, "torque", q, qd, t);
   for (const LinearSpring& s : a.springs)
-    if (!load_finite(s, &AppliedLoads::springs, n, q, qd, t))
+    if (!load_finite(s, &AppliedLoads::springs, n, q, qd, qdd, t))
       return "spring '" + s.name + "': its tension or direction is not finite (its ends' frames or an overflow)";
   for (const TorsionalSpring& s : a.torsional_springs)
-    if (!load_finite(s, &AppliedLoads::torsional_springs, n, q, qd, t))
+    if (!load_finite(s, &AppliedLoads::torsional_springs, n, q, qd, qdd, t))
       return "torsional spring '" + s.name + "': its angle or moment is not finite";
   return {};
 }

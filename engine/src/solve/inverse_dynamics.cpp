@@ -178,7 +178,7 @@ void add_generalized_forces(const std::vector<Part>& parts, const Loads& loads, 
   for (std::size_t i = 0; i < parts.size(); ++i)
     if (detail::has_mass(parts[i]))
       detail::add_massive_part(parts[i], detail::massive_part(parts[i], i), loads.gravity, q, qd, qdd, t, Q);
-  if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
+  if (loads.applied) add_applied_forces(*loads.applied, q, qd, qdd, t, Q);
 }
 
 detail::PartForces::PartForces(const std::vector<Part>& parts, const Model& model, bool rigid_bars,
@@ -291,7 +291,7 @@ void detail::PartForces::add(const std::vector<Part>& parts, const Loads& loads,
       bar_force_at(bar_masses_[b.mass], weights[b.mass], accel(b.at[0]), accel(b.at[1]), accel(b.at[3]), accel(b.at[4]),
                    planar[b.part]);
   }
-  if (loads.applied) add_applied_forces(*loads.applied, q, qd, t, Q);
+  if (loads.applied) add_applied_forces(*loads.applied, q, qd, qdd, t, Q);
 }
 
 SolveStatus constraint_multipliers(const Model& model, double t, Workspace& ws, const Eigen::VectorXd& Q,

@@ -402,7 +402,7 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
     // the whole model's Q computed the part's force at this row: added at the promoted frame's slots, as
     // add_generalized_forces() of the body's part adds it
     detail::add_planar_force(part.frame(), planar[part.part], qb_);
-    if (part.applied) add_applied_forces(*part.applied, qx_.data(), qdx_.data(), t, qb_);
+    if (part.applied) add_applied_forces(*part.applied, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
     return;
   }
   const NaturalBody& body = set_->natural->bodies[b];
@@ -414,7 +414,7 @@ void JointReactions::body_forces(std::size_t b, double t, const detail::PlanarFo
     const Part& p = (*parts)[0];
     detail::add_massive_part(p, detail::massive_part(p, 0, part.bar_length), body.loads.gravity, qx_.data(),
                              qdx_.data(), qddx_.data(), t, qb_);
-    if (body.loads.applied) add_applied_forces(*body.loads.applied, qx_.data(), qdx_.data(), t, qb_);
+    if (body.loads.applied) add_applied_forces(*body.loads.applied, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
     return;
   }
   add_generalized_forces(*parts, body.loads, qx_.data(), qdx_.data(), qddx_.data(), t, qb_);
