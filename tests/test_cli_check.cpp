@@ -78,7 +78,8 @@ TEST_F(Cli, CheckListsEachLoadAsWritten) {
                         "  springs: [{name: strut, between: [{part: crank}, {point: [1, 1]}], free_length: 0.3,\n"
                         "             law: {type: polynomial, coefficients: [0, 40]}, tension: 3*sin(t)}]\n"
                         "  torsional_springs: [{name: coil, angle: psi3 - psi2, stiffness: 4, damping: 0.2},\n"
-                        "                      {name: gearbox, coordinate: psi2, friction: 0.5, inertia: 0.02}]\n");
+                        "                      {name: gearbox, coordinate: psi2, friction: 0.5, inertia: 0.02}]\n"
+                        "limits: [{name: swing, of: psi4, range: [-1, 2.5], rate: [-3, 3]}]\n");
   const Result r = run("check " + scene.string());
   ASSERT_EQ(r.code, 0) << r.err;
   for (const char* line :
@@ -88,7 +89,8 @@ TEST_F(Cli, CheckListsEachLoadAsWritten) {
         "free length 0.3, damping 0, preload 0, tension 3*sin(t)\n",
         "load          torsional spring 'coil' on 'psi3 - psi2': stiffness 4, free angle 0, damping 0.2, moment 0\n",
         "load          torsional spring 'gearbox' on 'psi2': stiffness 0, free angle 0, damping 0, friction 0.5, "
-        "inertia 0.02, moment 0\n"})
+        "inertia 0.02, moment 0\n",
+        "limit         swing: 'psi4' in [-1, 2.5]\n", "limit         swing: the rate of 'psi4' in [-3, 3]\n"})
     EXPECT_NE(r.out.find(line), std::string::npos) << line << r.out;
 }
 

@@ -249,6 +249,9 @@ int cmd_check(const std::string& scene_arg, bool json, std::optional<double> at,
   if (scene.loads.applied)
     for (const std::string& l : load_lines(*scene.loads.applied, scene.dimension))
       std::cout << "load          " << l << "\n";
+  for (const phiq::OutputLimit& l : scene.sweep.limits)  // (a scene's limits, as the sweep checks them)
+    std::cout << "limit         " << l.name << ": " << l.what << " in [" << phiq::significant(l.lo, 10) << ", "
+              << phiq::significant(l.hi, 10) << "]\n";
   std::cout << "modes         " << mode_count_text(modes, "the placement") << "\n";
   if (rk.uncertain) std::cout << "uncertain     " << rk.message << "\n";
   if (!ok) std::cout << "diagnosis     " << as.message << "\n";

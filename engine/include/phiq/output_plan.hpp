@@ -25,6 +25,7 @@
 
 namespace phiq {
 
+class CompiledExpression;   // expression.hpp
 class Model;                // model.hpp
 struct Loads;               // parts.hpp
 struct NaturalJoints;       // natural_joints.hpp
@@ -149,6 +150,23 @@ struct OutputEfforts {
   bool active() const { return !constraints.empty() || !reactions.empty(); }
 };
 
+/// A limit the sweep checks at every time point (an effort's at the written rows, where it is computed): a
+/// measure's value, or its rate, against a range [lo, hi]. Where the measure is outside it, the summary warns
+/// `limit` once per stretch of rows outside it, with the stretch and its worst value; nothing else changes (a
+/// sweep may pass its limits, as a mechanism does when its joints have no stops). Scene: `limits`.
+struct OutputLimit {
+  std::string name;  ///< the scene's (or what it measures)
+  std::string what;  ///< what it measures, for the warning: "'xB'", "the angle of joint 'elbow'"
+  /// The measure: an expression of q and t (its rate ∇e · q̇ + ∂e/∂t), or, when null, `joint`'s angle (unwrapped
+  /// over turns, as OutputPlan::joints) or distance, or, with neither, effort `effort` of OutputEfforts::constraints.
+  std::shared_ptr<const CompiledExpression> of;
+  std::optional<OutputJoint> joint;  ///< see `of`
+  Index effort = -1;                 ///< see `of`
+  bool rate = false;                 ///< the measure's rate is limited, not its value (needs q̇; not an effort's)
+  double lo = 0.0;                   ///< the range's lower end (lo < hi)
+  double hi = 0.0;                   ///< its upper end
+};
+
 /// Values a row's StepView::efforts holds for `plan`: OutputEfforts::size(), then, with sensitivities, each effort's
 /// ∂τ/∂p and each power's ∂P/∂p (EffortSensitivityLayout of phiq/effort_sensitivity.hpp: parameter by parameter,
 /// efforts in order; the powers' computed whether written or not, as the powers are).
@@ -185,6 +203,8 @@ struct OutputPlan {
   /// which read every coordinate's sensitivities: the sweep then solves them in the direct form, whatever
   /// `sensitivity_form` says (SweepSummary says so).
   OutputEfforts efforts;
+  /// Limits checked along the sweep (OutputLimit), warned as `limit` in the summary.
+  std::vector<OutputLimit> limits;
   /// Whether the sweep solves q̈: asked for, or needed by the efforts. Solved is not delivered: StepView::qdd is set
   /// as `accelerations` says.
   bool solves_accelerations() const { return accelerations || efforts.active(); }

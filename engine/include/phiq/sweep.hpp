@@ -146,7 +146,8 @@ struct SweepWarning {
   /// rows), so its bearings' written loads are not its teeth's; "unloaded_bearings": a gear or belt between bodies
   /// whose push its written bearing loads lack (OutputMesh::unloaded: a belt without tension, teeth without a pitch, a
   /// fixed gear without a carrier; at the first row); "belt_slack": a belt's slack strand would need a negative tension
-  /// at this row (once per stretch of rows)
+  /// at this row (once per stretch of rows); "limit": a measure of OutputPlan::limits outside its range over a stretch
+  /// of rows, said at the stretch's first row with its last and its worst value (after every other warning)
   std::string kind;
 
   std::string message;  ///< one line

@@ -50,6 +50,7 @@ class MechanismWriter {
   std::string joint_coordinate(int j, const Coupler& c);
   std::string travel(const Joint& joint);
   std::string joint_springs();
+  std::string joint_limits();
   std::array<std::string, 3> rotated(int b, const Eigen::Vector3d& v) const;
   void coupler(const Coupler& c);
   void drivers();
@@ -60,6 +61,7 @@ class MechanismWriter {
   SceneNames names_;
   std::vector<std::string> body_, joint_;
   std::map<int, std::string> joint_coordinate_;
+  std::map<int, std::string> driver_of_;  // a driven joint's driver
   std::ostringstream coordinates_, constraints_, drivers_;
   bool massive_ = false;  // a part has mass (parts())
 };
@@ -120,6 +122,31 @@ std::string MechanismWriter::joint_springs() {
     if (joint.friction != 0.0) s << ", friction: " << scene_number(joint.friction);
     if (joint.armature != 0.0) s << ", inertia: " << scene_number(joint.armature);
     s << "}\n";
+  }
+  return s.str();
+}
+
+// The joints' ranges, their rates' (with velocities solved) and their drivers' efforts' (with efforts), as limits.
+std::string MechanismWriter::joint_limits() {
+  std::ostringstream s;
+  for (std::size_t j = 0; j < m_.joints.size(); ++j) {
+    const Joint& joint = m_.joints[j];
+    // (a format's "none" may be an infinity or a huge value: a bound is finite, and below 1e15)
+    const auto bound = [](double v) { return std::isfinite(v) && std::fabs(v) < 1e15; };
+    const bool range = bound(joint.lower) && bound(joint.upper) && joint.lower < joint.upper;
+    const bool speed = bound(joint.velocity) && joint.velocity > 0.0, rate = speed && o_.rates;
+    if (speed && !o_.rates)
+      m_.skip("a joint's velocity limit", joint.line, "checked with --rates (velocities solved)", joint.file);
+    if (range || rate) {
+      s << "  - {joint: " << joint_[j];
+      if (range) s << ", range: [" << scene_number(joint.lower) << ", " << scene_number(joint.upper) << "]";
+      if (rate) s << ", rate: [" << scene_number(-joint.velocity) << ", " << scene_number(joint.velocity) << "]";
+      s << "}\n";
+    }
+    const auto driver = driver_of_.find(static_cast<int>(j));
+    if (bound(joint.effort) && joint.effort > 0.0 && o_.forces && driver != driver_of_.end())
+      s << "  - {name: " << joint_[j] << "_effort, effort: " << driver->second << ", range: ["
+        << scene_number(-joint.effort) << ", " << scene_number(joint.effort) << "]}\n";
   }
   return s.str();
 }
@@ -197,8 +224,8 @@ void MechanismWriter::drivers() {
     } catch (const Error& e) {
       refuse(m_.path, 0, "--drive " + joint + "=" + law + ": " + e.what());
     }
-    drivers_ << "  - {name: " << names_.make("drive_" + joint_[static_cast<std::size_t>(found)])
-             << ", joint: " << joint_[static_cast<std::size_t>(found)]
+    driver_of_[found] = names_.make("drive_" + joint_[static_cast<std::size_t>(found)]);
+    drivers_ << "  - {name: " << driver_of_[found] << ", joint: " << joint_[static_cast<std::size_t>(found)]
              << ", measure: " << (j.kind == "revolute" ? "angle" : "distance")
              << ", law: {type: expression, f: " << yaml_quoted(law) << "}}\n";
   }
@@ -269,6 +296,7 @@ std::string MechanismWriter::write() {
   drivers();
   const std::string mass = parts();
   const std::string springs = joint_springs();  // (before the coordinates are written: a revolute's adds one)
+  const std::string limits = joint_limits();    // (before the unmapped are listed: it may add one)
   for (const auto& [what, u] : m_.unmapped)
     m_.skipped.push_back(m_.file_of(u.file) + ":" + std::to_string(u.line) + ": " + what +
                          (u.count > 1 ? " (" + std::to_string(u.count) + " in all)" : "") + ": " + u.why);
@@ -304,6 +332,7 @@ std::string MechanismWriter::write() {
     s << "loads: {gravity: " << scene_vector(gravity.first) << "}\n";
   const bool joints = std::any_of(m_.joints.begin(), m_.joints.end(), [](const Joint& j) { return !j.kind.empty(); });
   s << import_output_section(m_.path, o_.rates, o_.forces, !drivers_.str().empty(), joints, massive_);
+  if (!limits.empty()) s << "limits:\n" << limits;
   return s.str();
 }
 

@@ -15,84 +15,13 @@
 #include <sstream>
 
 #include "base/quaternion_between.hpp"
-#include "import/mechanism.hpp"
-#include "import/mjcf_documents.hpp"
+#include "import/mjcf_reader.hpp"
 #include "import/mjcf_option.hpp"
 #include "phiq/scene.hpp"
 
 namespace phiq {
 
 namespace detail::mechanism {
-namespace {
-
-using Attributes = std::map<std::string, std::string>;
-
-class MjcfReader {
- public:
-  MjcfReader(const std::string& text, const std::string& path) : text_(text), path_(path) {}
-  Mechanism read(int* loops);
-
- private:
-  void compiler(const tinyxml2::XMLElement* e);
-  void defaults(const tinyxml2::XMLElement* e, const std::string& cls, const std::string& parent);
-  void assets(const tinyxml2::XMLElement* e);
-  // The attribute as the element gives it, or its class's default (the chain up to "main"); nullptr when neither.
-  const std::string* attr(const tinyxml2::XMLElement* e, const char* name, const std::string& childclass) const;
-  std::vector<double> numbers(const tinyxml2::XMLElement* e, const char* name, const std::string& childclass,
-                              std::vector<double> fallback, std::size_t count_min, std::size_t count_max) const;
-  Eigen::Matrix3d rotation(const tinyxml2::XMLElement* e, const std::string& childclass) const;
-  Pose pose(const tinyxml2::XMLElement* e, const std::string& childclass) const;
-  // A child element with the pose of the <frame>s it stands in (identity outside any) and its class in effect.
-  struct Placed {
-    const tinyxml2::XMLElement* e;
-    Pose frame;
-    std::string childclass;
-  };
-  // The children of `e`, the contents of <frame>s among them in their place.
-  std::vector<Placed> placed(const tinyxml2::XMLElement* e, const std::string& childclass, const Pose& frame = {});
-  void body(const tinyxml2::XMLElement* e, int parent, const std::string& childclass, const Pose& frame = {});
-  // A geom (as geom()) placed by its frame, or a site recorded for the equalities that name it.
-  void placed_geom_or_site(const Placed& c, int body, bool* solid_only, std::optional<double>* density);
-  void geom(const tinyxml2::XMLElement* e, Body* b, const std::string& childclass, bool* solid_only,
-            std::optional<double>* density);
-  void equality(const tinyxml2::XMLElement* e);
-  // A connect (spherical) or weld (rigid) equality between bodies (anchor, relpose) or sites, closing a loop.
-  Joint connect_or_weld(const tinyxml2::XMLElement* e, const std::string& name);
-  int body_named(const tinyxml2::XMLElement* e, const char* attribute, bool required) const;
-  double angle(double v) const { return degrees_ ? v * M_PI / 180.0 : v; }
-  void unmapped(const tinyxml2::XMLElement* e, const std::string& why) {
-    skip_at(e, std::string("<") + e->Name() + ">", why);
-  }
-  void skip_at(const tinyxml2::XMLElement* e, const std::string& what, const std::string& why) {
-    m_.skip(what, e->GetLineNum(), why, docs_.included_file(e));
-  }
-  // "FILE:LINE: what" for the element, in the file it was read from.
-  [[noreturn]] void fail(const tinyxml2::XMLElement* e, const std::string& what) const {
-    refuse(docs_.file_of(e), e->GetLineNum(), what);
-  }
-
-  const std::string& text_;
-  const std::string& path_;
-  MjcfDocuments docs_{path_};
-  bool degrees_ = true;
-  std::string eulerseq_ = "xyz", meshdir_;
-  std::map<std::string, std::map<std::string, Attributes>> defaults_;  // class → element → attributes
-  std::map<std::string, std::string> parent_class_;
-  struct MeshAsset {
-    std::string file;
-    Eigen::Vector3d scale = Eigen::Vector3d::Ones();
-  };
-  std::map<std::string, MeshAsset> meshes_;
-  std::map<std::string, int> body_index_, joint_index_;
-  struct Site {
-    int body = 0;
-    Pose at;  // in the body's frame
-  };
-  std::map<std::string, Site> sites_;
-  std::map<int, double> joint_ref_;  // a hinge's or slide's `ref` (qpos at the model's pose), by joint index
-  int loops_ = 0;
-  Mechanism m_;
-};
 
 void MjcfReader::compiler(const tinyxml2::XMLElement* e) {
   for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
@@ -430,15 +359,20 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
       out.child.ref = Eigen::Vector3d::UnitX();
     if (const std::vector<double> r = numbers(j, "ref", jcc, {0}, 1, 1); r[0] != 0.0)
       joint_ref_[static_cast<int>(m_.joints.size())] = type == "hinge" ? angle(r[0]) : r[0];
-    // a hinge's or slide's spring, damper, frictionloss and armature (q = ref at the file's pose): a torsional spring
+    // a hinge's or slide's spring, damper, frictionloss, armature and range (limited unless `limited="false"`), all
+    // of q − ref, q = ref at the file's pose: a torsional spring and a limit
     const bool sprung = type == "hinge" || type == "slide";
     const auto value = [&](const char* name) { return sprung ? numbers(j, name, jcc, {0}, 1, 1)[0] : 0.0; };
     double* const loads[] = {&out.stiffness, &out.damping, &out.friction, &out.armature};
     const char* const fields[] = {"stiffness", "damping", "frictionloss", "armature", "springref", "range", "limited"};
     for (std::size_t k = 0; k < 4; ++k)
       if (!((*loads[k] = value(fields[k])) >= 0.0)) fail(j, "joint '" + out.name + "': a negative " + fields[k]);
-    out.free = (type == "hinge" ? angle(1.0) : 1.0) * (value("springref") - value("ref"));
-    for (std::size_t k = sprung ? 5u : 0u; k < 7u; ++k)
+    const double unit = type == "hinge" ? angle(1.0) : 1.0, q0 = value("ref");
+    out.free = unit * (value("springref") - q0);
+    const std::vector<double> range = sprung ? numbers(j, "range", jcc, {0, 0}, 2, 2) : std::vector<double>{0, 0};
+    if (const std::string* l = attr(j, "limited", jcc); !(l && *l == "false"))
+      out.lower = unit * (range[0] - q0), out.upper = unit * (range[1] - q0);
+    for (std::size_t k = 0; !sprung && k < 7u; ++k)
       if (attr(j, fields[k], jcc)) skip_at(j, std::string("<joint ") + fields[k] + ">", "not modelled");
     if (!joint_index_.emplace(out.name, static_cast<int>(m_.joints.size())).second)
       fail(j, "a second joint named '" + out.name + "'");
@@ -446,88 +380,6 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     from = to;
   }
   for (const Placed& c : children) body(c.e, index, c.childclass, c.frame);
-}
-
-Joint MjcfReader::connect_or_weld(const tinyxml2::XMLElement* e, const std::string& name) {
-  const std::string tag = e->Name();
-  Joint j;
-  j.name = name, j.line = e->GetLineNum(), j.file = docs_.included_file(e), j.closing = true;
-  j.kind = tag == "connect" ? "spherical" : "rigid";
-  if (e->Attribute("site1") || e->Attribute("site2")) {  // the sites' origins (connect) or frames (weld) coincide
-    for (const char* other : {"body1", "body2", "anchor", "relpose"})
-      if (e->Attribute(other)) fail(e, "<" + tag + "> names sites and " + other + ": MuJoCo takes one or the other");
-    Side sides[2];
-    for (int k = 0; k < 2; ++k) {
-      const std::string attribute = "site" + std::to_string(k + 1);
-      const char* site = e->Attribute(attribute.c_str());
-      if (!site) fail(e, "<" + tag + "> without " + attribute);
-      const auto it = sites_.find(site);
-      if (it == sites_.end()) fail(e, attribute + " '" + site + "' is not a site of the file");
-      const Pose& at = it->second.at;
-      sides[k] = Side{it->second.body, at.p, at.R.col(2), at.R.col(0)};
-    }
-    j.parent = sides[0], j.child = sides[1];
-    return j;
-  }
-  const int b1 = body_named(e, "body1", true), b2 = body_named(e, "body2", false);
-  const std::vector<double> a = numbers(e, "anchor", "", {0, 0, 0}, 3, 3);
-  const Eigen::Vector3d anchor(a[0], a[1], a[2]);
-  const Pose& w1 = m_.bodies[static_cast<std::size_t>(b1)].world;
-  const Pose& w2 = m_.bodies[static_cast<std::size_t>(b2)].world;
-  if (tag == "connect") {  // anchor in body1's frame
-    j.parent = Side{b1, anchor};
-    j.child = Side{b2, w2.inverse().R * (w1.p + w1.R * anchor - w2.p)};
-    return j;
-  }
-  // anchor in body2's frame; body2's pose in body1's: relpose, or (its quaternion all zeros) the model's pose
-  const std::vector<double> rel = numbers(e, "relpose", "", {0, 1, 0, 0, 0, 0, 0}, 7, 7);
-  Pose in1 = w1.inverse() * w2;
-  if (rel[3] != 0 || rel[4] != 0 || rel[5] != 0 || rel[6] != 0)
-    in1 = Pose{Eigen::Vector3d(rel[0], rel[1], rel[2]),
-               Eigen::Quaterniond(rel[3], rel[4], rel[5], rel[6]).normalized().toRotationMatrix()};
-  in1 = in1 * Pose{anchor, Eigen::Matrix3d::Identity()};
-  j.parent = Side{b1, in1.p, in1.R.col(2), in1.R.col(0)};
-  j.child = Side{b2, anchor};
-  return j;
-}
-
-void MjcfReader::equality(const tinyxml2::XMLElement* list) {
-  for (const tinyxml2::XMLElement* e : docs_.children(list)) {
-    const std::string tag = e->Name();
-    const std::string name =
-        e->Attribute("name") ? e->Attribute("name") : tag + "_line" + std::to_string(e->GetLineNum());
-    if (e->Attribute("active") && std::string(e->Attribute("active")) == "false") {
-      unmapped(e, "inactive (active=\"false\")");
-      continue;
-    }
-    if (e->Attribute("solref") || e->Attribute("solimp"))
-      skip_at(e, "<" + tag + " solref/solimp>", "phiq's constraints are exact, not soft");
-    if (tag == "connect" || tag == "weld") {
-      m_.joints.push_back(connect_or_weld(e, name));
-      ++loops_;
-    } else if (tag == "joint") {
-      const char* j1 = e->Attribute("joint1");
-      const char* j2 = e->Attribute("joint2");
-      if (!j1 || !joint_index_.count(j1))
-        fail(e, std::string("<joint> equality: joint1 '") + (j1 ? j1 : "") + "' is not a joint of the file");
-      if (j2 && !joint_index_.count(j2))
-        fail(e, std::string("<joint> equality: joint2 '") + j2 + "' is not a joint of the file");
-      const std::vector<double> c = numbers(e, "polycoef", "", {0, 1, 0, 0, 0}, 1, 5);
-      for (std::size_t k = 2; k < c.size(); ++k)
-        if (c[k] != 0.0 && j2)
-          fail(e, "<joint> equality '" + name + "': polycoef of degree " + std::to_string(k) +
-                      "; phiq couples joints linearly (a coupler)");
-      // MuJoCo's q1 = c0 + c1 q2 on joint positions; phiq's angles are those minus each joint's ref.
-      const int a = joint_index_.at(j1), b = j2 ? joint_index_.at(j2) : -1;
-      const double ra = joint_ref_.count(a) ? joint_ref_.at(a) : 0.0,
-                   rb = b >= 0 && joint_ref_.count(b) ? joint_ref_.at(b) : 0.0;
-      const double c1 = c.size() > 1 ? c[1] : 0.0;
-      m_.couplers.push_back(
-          Coupler{name, e->GetLineNum(), a, b, c1, c[0] + (b >= 0 ? c1 * rb : 0.0) - ra, docs_.included_file(e)});
-    } else {
-      fail(e, "<" + tag + "> equality: not read by phiq (only connect, weld and joint)");
-    }
-  }
 }
 
 Mechanism MjcfReader::read(int* loops) {
@@ -588,7 +440,6 @@ Mechanism MjcfReader::read(int* loops) {
   return std::move(m_);
 }
 
-}  // namespace
 }  // namespace detail::mechanism
 
 ModelImport import_mjcf(const std::string& text, const std::string& path, const ImportOptions& options) {

@@ -201,6 +201,8 @@ void SdfReader::joint(const sdf::Joint& j, const Pose& placed, const std::string
       if (const sdf::JointAxis* ax = j.Axis(0)) {  // its spring-damper (position 0 at the file's pose)
         out.stiffness = ax->SpringStiffness(), out.damping = ax->Damping(), out.free = ax->SpringReference();
         out.friction = ax->Friction();
+        // its limits (SDF's "none", ±1e16, ±inf or −1, are left out as the scene is written)
+        out.lower = ax->Lower(), out.upper = ax->Upper(), out.velocity = ax->MaxVelocity(), out.effort = ax->Effort();
         if (!(out.stiffness >= 0.0 && out.damping >= 0.0 && out.friction >= 0.0))
           refuse(path_, out.line, "joint '" + out.name + "': a negative spring_stiffness, damping or friction");
       }
@@ -231,9 +233,12 @@ void SdfReader::joint(const sdf::Joint& j, const Pose& placed, const std::string
   const bool sprung = out.kind == "revolute" || out.kind == "prismatic";
   for (const char* axis : {"axis", "axis2"})
     if (const sdf::ElementPtr a = j.Element()->FindElement(axis)) {
-      unmapped_children(a, {"xyz", sprung && axis[4] == 0 ? "dynamics" : "xyz"}, why);
-      if (const sdf::ElementPtr d = a->FindElement("dynamics"); d && sprung && axis[4] == 0)
+      const bool read = sprung && axis[4] == 0;  // (a revolute's or prismatic's one axis)
+      unmapped_children(a, {"xyz", read ? "dynamics" : "xyz", read ? "limit" : "xyz"}, why);
+      if (const sdf::ElementPtr d = a->FindElement("dynamics"); d && read)
         unmapped_children(d, {"damping", "friction", "spring_stiffness", "spring_reference"}, "not modelled");
+      if (const sdf::ElementPtr l = a->FindElement("limit"); l && read)
+        unmapped_children(l, {"lower", "upper", "velocity", "effort"}, "not modelled");
     }
 }
 

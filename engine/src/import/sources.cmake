@@ -9,6 +9,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/mechanism_scene.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mjcf_documents.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mjcf_option.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mjcf_equality.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mjcf_reader.cpp
   ${CMAKE_CURRENT_LIST_DIR}/sdf_module.cpp
   ${CMAKE_CURRENT_LIST_DIR}/urdf_reader.cpp

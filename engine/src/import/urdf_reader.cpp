@@ -207,7 +207,7 @@ void UrdfReader::dynamics(const tinyxml2::XMLElement* e, Joint& j) {
 
 void UrdfReader::unmapped(const tinyxml2::XMLElement* e) {
   static const std::map<std::string, std::string> why = {
-      {"limit", "joint limits are not constraints in phiq (a sweep may pass them)"},
+      {"limit", "a closing joint's limits are not read"},
       {"dynamics", "a closing, fixed, floating or planar joint's damping and friction are not read"},
       {"safety_controller", "a controller's setting, not kinematics"},
       {"calibration", "a sensor's reference, not kinematics"},
@@ -465,6 +465,12 @@ Mechanism UrdfReader::read(int* loops) {
       const std::string tag = e->Name();
       if (tag == "dynamics" && (out.kind == "revolute" || out.kind == "prismatic")) {
         dynamics(e, out);
+        continue;
+      }
+      if (tag == "limit" && j->limits && (out.kind == "revolute" || out.kind == "prismatic")) {
+        // (urdfdom's: lower and upper a continuous joint has not; velocity and effort ≥ 0 by the format)
+        if (x.type != "continuous") out.lower = j->limits->lower, out.upper = j->limits->upper;
+        out.velocity = std::max(j->limits->velocity, 0.0), out.effort = std::max(j->limits->effort, 0.0);
         continue;
       }
       if (tag != "origin" && tag != "axis" && tag != "parent" && tag != "child" && tag != "mimic") unmapped(e);

@@ -15,7 +15,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   Cursor top(root, "", &file_, YAML::Mark());
   if (!root.IsDefined() || root.IsNull()) top.fail("the scene is empty");
   top.expect_map({"phiq", "name", "description", "dimension", "parameters", "coordinates", "points", "bodies",
-                  "vectors", "constraints", "drivers", "parts", "loads", "time", "output", "solver"});
+                  "vectors", "constraints", "drivers", "parts", "loads", "time", "output", "limits", "solver"});
   if (auto v = top.field("phiq"); v.present() && v.integer(1, 1) != 1) v.fail("unsupported format version");
 
   Scene scene;
@@ -55,6 +55,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   read_time(top.require("time"), scene.sweep);
   read_output(top.field("output"), scene.sweep);
   if (auto o = top.field("output"); o.present() && o.is_map()) read_clearance(o.field("clearance"), scene);
+  if (auto l = top.field("limits"); l.present()) read_limits(l, scene.sweep);
   scene.dimension = spatial_ ? 3 : 2;
   scene.planar_bodies = std::move(names_.planar_bodies), scene.spatial_bodies = std::move(names_.spatial_bodies);
   scene.joint_angles = std::move(names_.joint_angles);
@@ -71,6 +72,7 @@ Scene SceneReader::read(const YAML::Node& root) {
   // minimum-norm assembly (assembly.hpp) tell what they are, and `phiq run` solves the redundant ones.
   resolve_output_residuals(scene);
   resolve_output_efforts(scene);
+  resolve_limit_efforts(scene);
   return scene;
 }
 

@@ -200,6 +200,8 @@ class SceneReader {
   void resolve_output_efforts(Scene& scene) const;  // read_efforts.cpp
   void read_solver(const Cursor& c, SolverSettings& o);
   void read_clearance(const Cursor& c, Scene& scene) const;  // output.clearance (read_clearance.cpp)
+  void read_limits(const Cursor& c, OutputPlan& plan);       // read_limits.cpp
+  void resolve_limit_efforts(Scene& scene) const;            // read_limits.cpp
 
   const std::string& file_;
   const SceneLimits& limits_;
@@ -246,6 +248,7 @@ class SceneReader {
     // with `reactions`: the named natural points, kept past the tables' release for the natural joints
     std::vector<std::pair<std::string, Attachment3>> natural_points;
     std::vector<Cursor> reaction_items;
+    std::vector<std::pair<std::size_t, Cursor>> limit_efforts;  // `limits`' efforts: the limit, its driver's name
   };
   Pending pending_;
 

@@ -13,6 +13,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/read_settings.cpp
   ${CMAKE_CURRENT_LIST_DIR}/read_efforts.cpp
   ${CMAKE_CURRENT_LIST_DIR}/read_parts.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/read_limits.cpp
   ${CMAKE_CURRENT_LIST_DIR}/read_loads.cpp
   ${CMAKE_CURRENT_LIST_DIR}/read_shapes.cpp
   ${CMAKE_CURRENT_LIST_DIR}/read_clearance.cpp

@@ -55,6 +55,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   if (opt.row_buffer_bytes == 0) throw Error("SweepOptions: row_buffer_bytes must be > 0");
   detail::check_solver_settings(model, opt, opt.points, opt.sensitivities, "SweepOptions");
   detail::check_efforts(model, opt, "SweepOptions");
+  detail::check_limits(model, opt, "SweepOptions");
   for (const OutputJoint& j : opt.joints)
     if (j.max_coordinate() >= model.num_coordinates())
       throw Error("SweepOptions: output joint '" + j.name + "' reads a coordinate the model does not have");
@@ -81,7 +82,9 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // Work done in the caller's workspace between these two counts is counted in `others` already (the parallel
   // part's chunks and seeds): left out of the workspace's share.
   WorkCounters counted_begin{}, counted_end{};
+  detail::LimitWatch limits(opt.limits);
   auto done = [&](SolveStatus st) {
+    limits.finish(sum.warnings);  // (the stretches up to the last row delivered, a failed sweep's too)
     detail::once_per_stretch(sum.warnings, "slow_convergence", opt);
     detail::once_per_stretch(sum.warnings, "belt_slack", opt);
     detail::once_per_stretch(sum.warnings, "gear_centres", opt);
@@ -107,6 +110,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
 
   ws.start_afresh();  // the sweep's results depend on the model, the options and ws.q only
   Run run{opt, on_step, sum, writer};
+  run.limits = &limits;
   Sweeper sw(model, opt, ws, sum);
   if (!sw.assemble(run.time_of(0))) {
     run.failed(0);
@@ -129,8 +133,9 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // whichever thread runs it (each starts from a workspace started afresh): one thread runs them in order, with
   // their seeds, so that its rows are, to the bit, those of any other thread count.
   // (a writer reads every row as a step callback does: the chunks are cut as for one)
-  const detail::HeldRows rows = detail::held_rows(model, opt, static_cast<bool>(on_step) || writer,
-                                                  run.chunks_encode() ? writer->max_row_bytes() : 0);
+  const detail::HeldRows rows =
+      detail::held_rows(model, opt, static_cast<bool>(on_step) || writer || !opt.limits.empty(),
+                        run.chunks_encode() ? writer->max_row_bytes() : 0);
   const Index chunk = opt.chunk_steps > 0 ? opt.chunk_steps
                                           : detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows);
   const Index n_chunks = (opt.steps + chunk - 1) / chunk;  // chunk c: rows 1 + c·chunk … min(steps, (c+1)·chunk)

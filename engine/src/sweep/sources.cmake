@@ -3,6 +3,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/batch.cpp
   ${CMAKE_CURRENT_LIST_DIR}/chunk_schedule.cpp
   ${CMAKE_CURRENT_LIST_DIR}/euler_signs.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/limit_watch.cpp
   ${CMAKE_CURRENT_LIST_DIR}/parallel_sweep.cpp
   ${CMAKE_CURRENT_LIST_DIR}/predictors.cpp
   ${CMAKE_CURRENT_LIST_DIR}/resources.cpp

@@ -11,6 +11,7 @@
 
 #include "phiq/sweep.hpp"
 #include "phiq/text.hpp"
+#include "sweep/limit_watch.hpp"
 #include "sweep/sweeper.hpp"
 
 namespace phiq::detail {
@@ -24,12 +25,15 @@ struct Run {
   const std::function<bool(const StepView&)>& on_step;
   RowWriter* writer;  // in place of on_step: rows encoded, then written in order (RowWriter)
   SweepSummary& sum;
+  LimitWatch* limits = nullptr;  // the plan's limits, checked in delivery order (null or empty: none)
 
   // Whether a parallel chunk encodes its rows itself, for write_encoded(): with a writer, unless joint angles are
-  // written (each row's is unwrapped from the row before, which only the delivery in order knows).
+  // written or limits checked (each row's angle is unwrapped from the row before, and a limit's stretch runs on
+  // from it: only the delivery in order knows them).
   bool chunks_encode() const {
-    return writer && std::none_of(opt.joints.begin(), opt.joints.end(),
-                                  [](const OutputJoint& j) { return j.measure == JointMeasure::kAngle; });
+    return writer && opt.limits.empty() && std::none_of(opt.joints.begin(), opt.joints.end(), [](const OutputJoint& j) {
+             return j.measure == JointMeasure::kAngle;
+           });
   }
 
   double time_of(Index k) const { return opt.time_of(k); }  // TimeGrid::time_of
@@ -47,7 +51,11 @@ struct Run {
                double det_sign_t, const RowQuality& quality) {
     count_row(time_of(k), det_sign, det_sign_t, quality);
     unwrap_joints(k, motions.joints);
-    if (!opt.writes_row(k, time_of(k))) return true;  // solved, not written (OutputPlan::every, window)
+    const bool written_row = opt.writes_row(k, time_of(k));
+    if (limits && !limits->empty())
+      limits->row(k, time_of(k), q.data(), opt.solves_velocities() ? qd.data() : nullptr,
+                  written_row ? motions.efforts : nullptr);
+    if (!written_row) return true;  // solved, not written (OutputPlan::every, window)
     const StepView view = view_of(k, q, qd, qdd, motions, phi, rcond, joints.empty() ? nullptr : joints.data());
     return written(writer ? writer->write_row(view) : !on_step || on_step(view), k);
   }
