@@ -286,8 +286,8 @@ TEST(AppliedLoads, EveryModelWithMassesBalancesItsDriversPowerAtEveryRow) {
     checked.push_back(path.filename().string());
   }
   // the scenes with masses today; a new one joins by itself
-  for (const char* name :
-       {"fourbar_motor_torque.yaml", "fourbar_pin_loads.yaml", "rssr_bearing_loads.yaml", "crank_slider_drag.yaml"})
+  for (const char* name : {"fourbar_motor_torque.yaml", "fourbar_pin_loads.yaml", "rssr_bearing_loads.yaml",
+                           "crank_slider_drag.yaml", "fourbar_gearmotor.yaml"})
     EXPECT_NE(std::find(checked.begin(), checked.end(), name), checked.end()) << name;
 }
 
