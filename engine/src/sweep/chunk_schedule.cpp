@@ -98,9 +98,16 @@ void ChunkedSweep::seed_one() {
   // Without derivatives at row 0 (positions only), the first seed is the one extrapolated from a single position
   // over a whole chunk's span: from that constant prediction its Newton failed on nfourbar N = 10⁵ and took 0.57 s
   // of a 1.66 s sweep. In sub-steps it gives the parabola through the seeds its first rows: 1.35 s.
-  const int parts = c == 1 && !need_v_ ? kFirstSeedParts : 1;
+  int parts = c == 1 && !need_v_ ? kFirstSeedParts : 1;
   Index row = first_row(c);
   const double t0 = seeder.state().t, t1 = run_.time_of(row);
+  // A body that may turn a quarter turn or more over the span, by the last seed's rates: sub-steps of less than a
+  // quarter turn each, so that the seeder follows its Euler parameters' sign as the sweep in order does (in one
+  // step it may land on −e, which align() turns back only where its extrapolation is sure: a harmonic screw's nut,
+  // three turns a second and slowing, was refused at its seam)
+  if (!euler_signs_.empty())
+    if (const double turn = euler_signs_.largest_turn(t1 - t0); std::isfinite(turn))
+      parts = std::max(parts, static_cast<int>(std::min(std::ceil(turn / (0.5 * M_PI)), 64.0)));
   bool ok = true;
   for (int i = 1; ok && i <= parts; ++i)
     ok = seeder.advance(i == parts ? t1 : t0 + (t1 - t0) * static_cast<double>(i) / parts, 0);

@@ -1,6 +1,7 @@
 // A parallel chunk's seed turned to the sign of Euler parameters its bodies' motion continues with (euler_signs.hpp).
 #include "sweep/euler_signs.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "phiq/constraint_block.hpp"
@@ -18,6 +19,7 @@ using Quat = std::array<double, 4>;
 // output shaft, extrapolated from row 0's rate over a chunk (its speed falls from 57 times the input's), comes
 // out at −0.64 with its seed on the right sign.
 constexpr double kOpposite = -0.9;
+constexpr double kQuarterTurn = 0.5 * 3.141592653589793;
 
 // The Hamilton product a ⊗ b (scalar part first).
 Quat product(const Quat& a, const Quat& b) {
@@ -101,8 +103,8 @@ bool EulerSeedSigns::turn_like(const double* reference, Eigen::VectorXd& q) cons
   return turned;
 }
 
-bool EulerSeedSigns::turns_far(double span) const {
-  constexpr double kQuarterTurn = 0.5 * 3.141592653589793;
+double EulerSeedSigns::largest_turn(double span) const {
+  double largest = 0.0;
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     double turn = 0.0;
     if (has_rate_) {
@@ -112,12 +114,14 @@ bool EulerSeedSigns::turns_far(double span) const {
       const Quat r = relative(last_[b], before_[b]);
       turn = 2.0 * std::atan2(vector_norm(r), std::fabs(r[0])) * span / (t_last_ - t_before_);
     } else {
-      return true;  // nothing known: solve them
+      return INFINITY;  // nothing known
     }
-    if (!(turn < kQuarterTurn)) return true;
+    largest = std::max(largest, turn);
   }
-  return false;
+  return largest;
 }
+
+bool EulerSeedSigns::turns_far(double span) const { return !(largest_turn(span) < kQuarterTurn); }
 
 bool EulerSeedSigns::align(double t, Eigen::VectorXd& seed, const Eigen::VectorXd& qd, const Eigen::VectorXd& qdd) {
   bool turned = false;

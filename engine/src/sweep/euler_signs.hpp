@@ -38,6 +38,9 @@ class EulerSeedSigns {
   // (|ω| span + |α| span²/2), else by the turn between the two seeds before (|θ| span / their span): where none
   // does, the constant-rate extrapolation is right, and the next seed's rates need not be solved for align().
   bool turns_far(double span) const;
+  // The largest turn (rad) a body may make over `span` from the last seed, as turns_far() bounds it; infinite with
+  // nothing known (no seed yet, no rates).
+  double largest_turn(double span) const;
   // Turns q's Euler parameters, body by body, to the sign of those of `reference` (same size). Returns whether any
   // body's were turned.
   bool turn_like(const double* reference, Eigen::VectorXd& q) const;
