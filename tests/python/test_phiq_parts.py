@@ -185,3 +185,20 @@ def test_pendulum_pivot_reaction_is_the_closed_form():
     stepper = phiq.Stepper(scene)
     stepper.step(result.t[5])
     assert np.allclose(stepper.reactions["pivot"], (fx[5], fy[5], 0.0), rtol=0, atol=1e-9)
+
+
+def test_a_scenes_limits_are_warned_as_its_columns_leave_them():
+    # models/dynamics/fourbar_gearmotor.yaml: the motor's rated 25 N·m, left over one stretch of rows, said once
+    # with its first and last row and its worst value, as the effort column shows them; the same on two threads
+    scene = phiq.load_scene(os.path.join(MODELS, "dynamics", "fourbar_gearmotor.yaml"))
+    runs = [phiq.run_sweep(scene, threads=n) for n in (1, 2)]
+    assert [(w.t, w.message) for w in runs[0].warnings] == [(w.t, w.message) for w in runs[1].warnings]
+    limits = [w for w in runs[0].warnings if w.kind == "limit"]
+    assert [w.message.split(":")[0] for w in limits] == ["rocker_swing", "rated_torque"]
+    t = runs[0].table[:, runs[0].columns.index("t")]
+    effort = runs[0].table[:, runs[0].columns.index("motor.effort")]
+    over = np.flatnonzero(effort > 25)
+    assert len(over) > 1 and np.all(np.diff(over) == 1)  # one stretch
+    message = limits[1].message
+    assert f"above its maximum 25 from t = {t[over[0]]:.10g} to t = {t[over[-1]]:.10g} ({len(over)} rows)" in message
+    assert f"at most {effort.max():.10g} (t = {t[np.argmax(effort)]:.10g})" in message
