@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <regex>
+#include <tuple>
 
 #include "phiq/import_model.hpp"
 #include "phiq/phiq.hpp"
@@ -219,7 +220,20 @@ TEST(Limits, ARobotsJointLimitsComeFromEachFormat) {
     expect_same_stretches(value, expected_stretches("hinge", t, angle, format == "mjcf" ? -2 * M_PI / 9 : -0.5, hi),
                           1e-9);
     EXPECT_EQ(value.size(), 1u);
-    if (format == "mjcf") continue;  // (MJCF states no speed or effort of a joint)
+    if (format == "mjcf") {  // (MJCF states no speed or effort of a joint)
+      // a range limits its joint with limited="true", or "auto" (the default) under the compiler's autolimits
+      for (const auto& [limited, compiler, limits] : {std::tuple{"", "", true},
+                                                      {"limited=\"true\" ", "<compiler autolimits=\"false\"/>", true},
+                                                      {"limited=\"false\" ", "", false},
+                                                      {"", "<compiler autolimits=\"false\"/>", false},
+                                                      {"limited=\"auto\" ", "<compiler autolimits=\"true\"/>", true}}) {
+        std::string text = test::replace_first(mjcf, "range=", std::string(limited) + "range=");
+        text = test::replace_first(text, "<worldbody>", std::string(compiler) + "<worldbody>");
+        SCOPED_TRACE(text);
+        EXPECT_EQ(import_mjcf(text, "pendulum.xml", o).yaml.find("{joint: hinge, range:") != std::string::npos, limits);
+      }
+      continue;
+    }
     expect_same_stretches(speed, expected_stretches("hinge", t, rate, -0.9, 0.9), 1e-9);
     expect_same_stretches(torque, expected_stretches("hinge_effort", t, effort, -6, 6), 1e-9);
     EXPECT_EQ(speed.size(), 1u);

@@ -35,6 +35,8 @@ void MjcfReader::compiler(const tinyxml2::XMLElement* e) {
       eulerseq_ = value;
     } else if (name == "meshdir") {
       meshdir_ = value;
+    } else if (name == "autolimits") {  // whether a range alone (limited="auto") limits its joint
+      autolimits_ = value != "false";
     } else {
       skip_at(e, "<compiler " + name + ">", "a setting of MuJoCo's compiler phiq does not need");
     }
@@ -359,8 +361,8 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
       out.child.ref = Eigen::Vector3d::UnitX();
     if (const std::vector<double> r = numbers(j, "ref", jcc, {0}, 1, 1); r[0] != 0.0)
       joint_ref_[static_cast<int>(m_.joints.size())] = type == "hinge" ? angle(r[0]) : r[0];
-    // a hinge's or slide's spring, damper, frictionloss, armature and range (limited unless `limited="false"`), all
-    // of q − ref, q = ref at the file's pose: a torsional spring and a limit
+    // a hinge's or slide's spring, damper, frictionloss, armature and range (limited="true", or "auto", the default,
+    // with the compiler's autolimits), all of q − ref, q = ref at the file's pose: a torsional spring and a limit
     const bool sprung = type == "hinge" || type == "slide";
     const auto value = [&](const char* name) { return sprung ? numbers(j, name, jcc, {0}, 1, 1)[0] : 0.0; };
     double* const loads[] = {&out.stiffness, &out.damping, &out.friction, &out.armature};
@@ -370,7 +372,7 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     const double unit = type == "hinge" ? angle(1.0) : 1.0, q0 = value("ref");
     out.free = unit * (value("springref") - q0);
     const std::vector<double> range = sprung ? numbers(j, "range", jcc, {0, 0}, 2, 2) : std::vector<double>{0, 0};
-    if (const std::string* l = attr(j, "limited", jcc); !(l && *l == "false"))
+    if (const std::string* l = attr(j, "limited", jcc); l && *l != "auto" ? *l == "true" : autolimits_)
       out.lower = unit * (range[0] - q0), out.upper = unit * (range[1] - q0);
     for (std::size_t k = 0; !sprung && k < 7u; ++k)
       if (attr(j, fields[k], jcc)) skip_at(j, std::string("<joint ") + fields[k] + ">", "not modelled");

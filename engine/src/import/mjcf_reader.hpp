@@ -65,6 +65,7 @@ class MjcfReader {
   const std::string& path_;
   MjcfDocuments docs_{path_};
   bool degrees_ = true;
+  bool autolimits_ = true;  // <compiler autolimits>: MuJoCo's default since 2.2.2
   std::string eulerseq_ = "xyz", meshdir_;
   std::map<std::string, std::map<std::string, Attributes>> defaults_;  // class → element → attributes
   std::map<std::string, std::string> parent_class_;
