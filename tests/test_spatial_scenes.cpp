@@ -6,6 +6,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <functional>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -381,6 +382,29 @@ TEST(SpatialScenes, TurningBodyKeepsItsThreadsAcrossTheSignOfItsEulerParameters)
   }
 }
 
+// A sweep of `opt` with chunks of `chunk` rows on one thread and on two: no warning, every chunk delivered as
+// computed, the same bits (q̇ and q̈ too with `rates`), and the body with Euler parameters `e0`…`e3` (indices)
+// turned by theta(t) about its axis from row 0, continuously (θ modulo 4π: e, not −e).
+void expect_chunks_keep_the_sign(const Model& m, SweepOptions opt, Index chunk, bool rates, Index e0, Index e3,
+                                 const std::function<double(double)>& theta) {
+  opt.chunk_steps = chunk;
+  test::Trace one, two;
+  SweepSummary s1, s2;
+  opt.threads = 1;
+  ASSERT_EQ(test::sweep(m, opt, &one, &s1), SolveStatus::kSuccess) << s1.message;
+  opt.threads = 2;
+  ASSERT_EQ(test::sweep(m, opt, &two, &s2), SolveStatus::kSuccess) << s2.message;
+  for (const SweepWarning& w : s2.warnings) ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
+  EXPECT_EQ(s2.parallel_chunks, (opt.steps + chunk - 1) / chunk);
+  ASSERT_EQ(two.t.size(), static_cast<std::size_t>(opt.steps + 1));
+  for (std::size_t k = 0; k < two.t.size(); ++k) {
+    SCOPED_TRACE("t = " + std::to_string(two.t[k]));
+    EXPECT_TRUE(two.q[k] == one.q[k]);
+    if (rates) EXPECT_TRUE(two.qd[k] == one.qd[k] && two.qdd[k] == one.qdd[k]);
+    EXPECT_NEAR(std::remainder(2.0 * std::atan2(two.q[k][e3], two.q[k][e0]) - theta(two.t[k]), 4.0 * M_PI), 0.0, 1e-9);
+  }
+}
+
 // The same body spun up, θ = 0.25 + 10 t + 5 t² over 2 s in 40 steps, chunks of 10: 1 to 2.2 turns per chunk span;
 // and, positions only, at 30 rad/s in 80 steps, chunks of 16: 1.9 turns. A constant rate from the two seeds before
 // misses the turn by more than a half where the body speeds up, loses whole turns where it turns more than one, and
@@ -406,25 +430,8 @@ TEST(SpatialScenes, ASpunUpBodyKeepsItsThreadsAcrossTheSignOfItsEulerParameters)
     if (!c.rates) text = test::replace_first(text, "output: {velocities: true, accelerations: true}\n", "");
     const Scene s = parse_scene(text, "spun_up.yaml");
     const Model& m = *s.model;
-    const Index e0 = m.coordinate_index("b_e0"), e3 = m.coordinate_index("b_e3");
-    SweepOptions opt = s.sweep;
-    opt.chunk_steps = c.chunk;
-    test::Trace one, two;
-    SweepSummary s1, s2;
-    opt.threads = 1;
-    ASSERT_EQ(test::sweep(m, opt, &one, &s1), SolveStatus::kSuccess) << s1.message;
-    opt.threads = 2;
-    ASSERT_EQ(test::sweep(m, opt, &two, &s2), SolveStatus::kSuccess) << s2.message;
-    for (const SweepWarning& w : s2.warnings) ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
-    EXPECT_EQ(s2.parallel_chunks, (opt.steps + c.chunk - 1) / c.chunk);
-    ASSERT_EQ(two.t.size(), static_cast<std::size_t>(opt.steps + 1));
-    for (std::size_t k = 0; k < two.t.size(); ++k) {
-      SCOPED_TRACE("t = " + std::to_string(two.t[k]));
-      EXPECT_TRUE(two.q[k] == one.q[k]);
-      if (c.rates) EXPECT_TRUE(two.qd[k] == one.qd[k] && two.qdd[k] == one.qdd[k]);
-      const double t = two.t[k], theta = 0.25 + c.a1 * t + c.a2 * t * t;
-      EXPECT_NEAR(std::remainder(2.0 * std::atan2(two.q[k][e3], two.q[k][e0]) - theta, 4.0 * M_PI), 0.0, 1e-9);
-    }
+    expect_chunks_keep_the_sign(m, s.sweep, c.chunk, c.rates, m.coordinate_index("b_e0"), m.coordinate_index("b_e3"),
+                                [&](double t) { return 0.25 + c.a1 * t + c.a2 * t * t; });
   }
 }
 
@@ -436,24 +443,8 @@ TEST(SpatialScenes, ASpunUpBodyKeepsItsThreadsAcrossTheSignOfItsEulerParameters)
 TEST(SpatialScenes, AHarmonicScrewsNutKeepsItsThreads) {
   const Scene s = Load("transmissions/screw_jack.yaml");
   const Model& m = *s.model;
-  const Index e0 = m.coordinate_index("nut_e0"), e3 = m.coordinate_index("nut_e3");
-  SweepOptions opt = s.sweep;
-  opt.chunk_steps = 15;
-  test::Trace one, two;
-  SweepSummary s1, s2;
-  opt.threads = 1;
-  ASSERT_EQ(test::sweep(m, opt, &one, &s1), SolveStatus::kSuccess) << s1.message;
-  opt.threads = 2;
-  ASSERT_EQ(test::sweep(m, opt, &two, &s2), SolveStatus::kSuccess) << s2.message;
-  for (const SweepWarning& w : s2.warnings) ADD_FAILURE() << w.kind << " at t = " << w.t << ": " << w.message;
-  EXPECT_EQ(s2.parallel_chunks, 6);
-  ASSERT_EQ(two.t.size(), 91u);
-  for (std::size_t k = 0; k < two.t.size(); ++k) {
-    SCOPED_TRACE("t = " + std::to_string(two.t[k]));
-    EXPECT_TRUE(two.q[k] == one.q[k] && two.qd[k] == one.qd[k]);
-    const double theta = 3 * M_PI * std::sin(two.t[k]);
-    EXPECT_NEAR(std::remainder(2.0 * std::atan2(two.q[k][e3], two.q[k][e0]) - theta, 4.0 * M_PI), 0.0, 1e-9);
-  }
+  expect_chunks_keep_the_sign(m, s.sweep, 15, true, m.coordinate_index("nut_e0"), m.coordinate_index("nut_e3"),
+                              [](double t) { return 3 * M_PI * std::sin(t); });
 }
 
 TEST(SpatialScenes, CardanBranchSwitchFallsBackNamingTheBranch) {
