@@ -12,8 +12,7 @@ namespace phiq::detail {
 LimitWatch::LimitWatch(const std::vector<OutputLimit>& limits)
     : limits_(limits), stretch_(limits.size()), angle_(limits.size(), 0.0), angle_rate_(limits.size(), 0.0) {}
 
-void LimitWatch::row(Index k, double t, const double* q, const double* qd, const double* efforts) {
-  (void)k;
+void LimitWatch::row(double t, const double* q, const double* qd, const double* efforts) {
   for (std::size_t i = 0; i < limits_.size(); ++i) {
     const OutputLimit& l = limits_[i];
     double v = 0.0;

@@ -13,9 +13,9 @@ class LimitWatch {
  public:
   explicit LimitWatch(const std::vector<OutputLimit>& limits);
   bool empty() const { return limits_.empty(); }
-  // Row k at t, delivered in order: q always, qd null when q̇ is not solved, efforts null where not computed (a row
+  // The row at t, delivered in order: q always, qd null when q̇ is not solved, efforts null where not computed (a row
   // not written). Pre-condition: the limits read coordinates the model has and efforts it computes (check_limits).
-  void row(Index k, double t, const double* q, const double* qd, const double* efforts);
+  void row(double t, const double* q, const double* qd, const double* efforts);
   // The stretches still open at the last row delivered, said; then the warnings, in the order their stretches
   // began, appended to `warnings`.
   void finish(std::vector<SweepWarning>& warnings);

@@ -53,7 +53,7 @@ struct Run {
     unwrap_joints(k, motions.joints);
     const bool written_row = opt.writes_row(k, time_of(k));
     if (limits && !limits->empty())
-      limits->row(k, time_of(k), q.data(), opt.solves_velocities() ? qd.data() : nullptr,
+      limits->row(time_of(k), q.data(), opt.solves_velocities() ? qd.data() : nullptr,
                   written_row ? motions.efforts : nullptr);
     if (!written_row) return true;  // solved, not written (OutputPlan::every, window)
     const StepView view = view_of(k, q, qd, qdd, motions, phi, rcond, joints.empty() ? nullptr : joints.data());
