@@ -231,6 +231,19 @@ TEST_F(Plot, DriverEffortsGetAPanelPerUnitByDefault) {
   EXPECT_EQ(captures(s, "data-unit=\"([^\"]+)\""), (std::vector<std::string>{"rad", "N·m", "W"}));
   const auto [lo, hi] = range("motor.effort");
   EXPECT_GT(hi - lo, 1.0);  // newton-metres that change over the turn
+  EXPECT_EQ(count(s, "class=\"limit\""), 0u);
+}
+
+TEST_F(Plot, ALimitsEndsAreDashedAcrossItsColumnsPanel) {
+  // models/dynamics/fourbar_gearmotor.yaml's rated torque, ±25 N·m, on the motor's effort (its rocker's swing, an
+  // expression, has no column): two dashed lines spanning the torque panel, at ±25 on its scale
+  const std::string s = plot("dynamics/fourbar_gearmotor.yaml");
+  EXPECT_EQ(captures(s, "class=\"limit\"[^>]*data-limit=\"([^\"]+)\""),
+            (std::vector<std::string>{"rated_torque", "rated_torque"}));
+  EXPECT_EQ(captures(s, "class=\"limit\"[^>]*data-value=\"([^\"]+)\""), (std::vector<std::string>{"-25", "25"}));
+  const std::vector<std::string> y = captures(s, "class=\"limit\"[^>]*points=\"[0-9.]+,([0-9.]+) ");
+  ASSERT_EQ(y.size(), 2u);
+  EXPECT_GT(std::stod(y[0]), std::stod(y[1]));  // −25 below +25 (SVG's y grows downward)
 }
 
 }  // namespace

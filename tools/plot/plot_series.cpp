@@ -189,6 +189,25 @@ std::vector<std::pair<Quantity, std::vector<std::size_t>>> group(const Scene& sc
   return groups;
 }
 
+// The ends of the scene's limits (Scene's sweep.limits) on `column`: a bare coordinate's value or rate (`x`,
+// `x.v`), a joint's (`J.angle`, `J.angle.v`), a driver's effort (`NAME.effort`); each as (limit, end).
+std::vector<std::pair<std::string, double>> column_limits(const Scene& scene, const std::string& column) {
+  std::vector<std::pair<std::string, double>> out;
+  for (const OutputLimit& l : scene.sweep.limits) {
+    std::string measured;
+    if (l.of) {
+      measured = l.of->text();
+    } else if (l.joint) {
+      measured = l.joint->name + (l.joint->measure == JointMeasure::kAngle ? ".angle" : ".distance");
+    } else {
+      const Index c = scene.sweep.efforts.constraints[static_cast<std::size_t>(l.effort)];
+      measured = scene.model->constraints()[static_cast<std::size_t>(c)].name + ".effort";
+    }
+    if ((l.rate ? measured + ".v" : measured) == column) out.push_back({l.name, l.lo}), out.push_back({l.name, l.hi});
+  }
+  return out;
+}
+
 }  // namespace
 
 std::size_t panel_count(const Scene& scene, const std::vector<std::string>& series) {
@@ -211,6 +230,8 @@ std::string series_panels(const Scene& scene, const CsvTable& table, const std::
     for (std::size_t k : members) {
       const std::size_t c = col.at(series[k]);
       for (const auto& row : table.rows) vmin = std::min(vmin, row[c]), vmax = std::max(vmax, row[c]);
+      for (const auto& [name, end] : column_limits(scene, series[k]))
+        vmin = std::min(vmin, end), vmax = std::max(vmax, end);
     }
     widen(vmin, vmax);
     const Box b{x0, y0 + static_cast<double>(p) * (ph + gap), w, ph, tmin, tmax, vmin, vmax};
@@ -222,6 +243,10 @@ std::string series_panels(const Scene& scene, const CsvTable& table, const std::
       Line pts;
       for (const auto& row : table.rows) pts.push_back({b.sx(row[0]), b.sy(row[c])});
       s += polyline("series", kPalette[k % 8], 1.5, pts, " data-column=\"" + escape(series[k]) + "\"");
+      for (const auto& [name, end] : column_limits(scene, series[k]))  // a limit's ends, dashed, in its colour
+        s += polyline("limit", kPalette[k % 8], 1.0, {{b.x0, b.sy(end)}, {b.x0 + b.w, b.sy(end)}},
+                      " stroke-dasharray=\"6 4\" data-limit=\"" + escape(name) + "\" data-column=\"" +
+                          escape(series[k]) + "\" data-value=\"" + label(end) + "\"");
       s += "<text class=\"legend\" x=\"" + px(b.x0 + b.w - 6) + "\" y=\"" +
            px(b.y0 + 14 + 13 * static_cast<double>(i)) + "\" text-anchor=\"end\" fill=\"" + kPalette[k % 8] + "\">" +
            escape(series[k]) + "</text>\n";
