@@ -241,6 +241,27 @@ TEST(Limits, ARobotsJointLimitsComeFromEachFormat) {
   }
 }
 
+TEST(Limits, AStretchOpenWhenTheSweepFailsIsSaidToItsLastRow) {
+  // models/hard/crank_rocker_rocker_driven.yaml, driven past its dead point, fails at step 44 (t = 0.44): the rocker
+  // angle ψ = 2.2 + t is above 2.505 from t = 0.31 on, a stretch still open at the last row delivered, t = 0.43
+  const Scene s = parse_scene(test::model_file_text("hard/crank_rocker_rocker_driven.yaml") +
+                                  "limits: [{name: swing, of: psi, range: [2, 2.505]}]\n",
+                              "dead_point.yaml");
+  Workspace ws(*s.model);
+  SweepSummary sum;
+  EXPECT_NE(run_sweep(
+                *s.model, s.sweep, ws, [](const StepView&) { return true; }, &sum),
+            SolveStatus::kSuccess);
+  ASSERT_EQ(sum.failed_step, 44);
+  const std::vector<LimitStretch> got = limit_stretches(sum);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_TRUE(got[0].above);
+  EXPECT_NEAR(got[0].from, 0.31, 1e-9);
+  EXPECT_NEAR(got[0].to, 0.43, 1e-9);
+  EXPECT_EQ(got[0].rows, 13);
+  EXPECT_NEAR(got[0].worst, 2.63, 1e-9);
+}
+
 TEST(Limits, BadLimitsAreRefusedInOneLineNamingTheField) {
   auto error = [](const std::string& limits) {
     std::string text = kLimitedCrankSlider;
