@@ -241,6 +241,36 @@ TEST(Limits, ARobotsJointLimitsComeFromEachFormat) {
   }
 }
 
+TEST(Limits, APointsCoordinateAndItsRateAreLimitedWhereTheClosedFormSays) {
+  // the crank-slider's crank tip A, y = 0.3 sin 2t, ẏ = 0.6 cos 2t (a natural point); the RSSR's crank tip, a body
+  // point in space, x = a cos t (a = 0.2, the crank at 1 rad/s)
+  std::string text = kLimitedCrankSlider;
+  text.erase(text.find("limits:"));
+  const Scene planar =
+      parse_scene(text + "limits: [{point: A, axis: y, range: [-0.2, 0.2], rate: [-0.5, 0.5]}]\n", "point_limits.yaml");
+  std::vector<double> t, y, yd;
+  for (Index k = 0; k <= 90; ++k) {
+    const double tk = planar.sweep.time_of(k);
+    t.push_back(tk), y.push_back(0.3 * std::sin(2 * tk)), yd.push_back(0.6 * std::cos(2 * tk));
+  }
+  std::vector<LimitStretch> value, rate;
+  for (const LimitStretch& g : limit_stretches(limit_sweep(planar, 2, 1)))
+    (std::fabs(std::fabs(g.worst) - 0.6) < 1e-6 ? rate : value).push_back(g);
+  expect_same_stretches(value, expected_stretches("A.y", t, y, -0.2, 0.2), 1e-9);
+  expect_same_stretches(rate, expected_stretches("A.y", t, yd, -0.5, 0.5), 1e-9);
+  EXPECT_EQ(value.size(), 2u);
+  const Scene spatial = parse_scene(
+      test::model_file_text("spatial/rssr.yaml", "time:") +
+          "time: {start: 0, end: 6, steps: 60}\n"
+          "limits: [{name: tip, point: {name: T, body: crank, at: [a, 0, 0]}, axis: x, range: [-0.1, 0.1]}]\n",
+      "rssr_point.yaml");
+  std::vector<double> ts, x;
+  for (Index k = 0; k <= 60; ++k) ts.push_back(0.1 * static_cast<double>(k)), x.push_back(0.2 * std::cos(0.1 * k));
+  const std::vector<LimitStretch> tip = limit_stretches(limit_sweep(spatial, 1, 1));
+  expect_same_stretches(tip, expected_stretches("tip", ts, x, -0.1, 0.1), 1e-9);
+  EXPECT_EQ(tip.size(), 3u);
+}
+
 TEST(Limits, AStretchOpenWhenTheSweepFailsIsSaidToItsLastRow) {
   // models/hard/crank_rocker_rocker_driven.yaml, driven past its dead point, fails at step 44 (t = 0.44): the rocker
   // angle ψ = 2.2 + t is above 2.505 from t = 0.31 on, a stretch still open at the last row delivered, t = 0.43
@@ -279,6 +309,9 @@ TEST(Limits, BadLimitsAreRefusedInOneLineNamingTheField) {
   EXPECT_HAS(error("  - {of: der(xB), range: [0, 1]}\n"), "limits[0].of:");
   EXPECT_HAS(error("  - {of: xB, range: [0, 2]}\n  - {of: xB, range: [0, 3]}\n"),
              "limits[1]: a second limit named 'xB'");
+  EXPECT_HAS(error("  - {point: A, axis: z, range: [0, 1]}\n"), "limits[0].axis: must be x, y, not 'z'");
+  EXPECT_HAS(error("  - {point: A, range: [0, 1]}\n"), "limits[0]: `axis: x, y or z` goes with `point`, and only");
+  EXPECT_HAS(error("  - {point: Q, axis: x, range: [0, 1]}\n"), "limits[0].point: unknown point 'Q'");
 }
 
 }  // namespace

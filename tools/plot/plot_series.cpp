@@ -190,7 +190,8 @@ std::vector<std::pair<Quantity, std::vector<std::size_t>>> group(const Scene& sc
 }
 
 // The ends of the scene's limits (Scene's sweep.limits) on `column`: a bare coordinate's value or rate (`x`,
-// `x.v`), a joint's (`J.angle`, `J.angle.v`), a driver's effort (`NAME.effort`); each as (limit, end).
+// `x.v`), a joint's (`J.angle`, `J.angle.v`), an output point's (`P.x`, `P.vx`), a driver's effort
+// (`NAME.effort`); each as (limit, end).
 std::vector<std::pair<std::string, double>> column_limits(const Scene& scene, const std::string& column) {
   std::vector<std::pair<std::string, double>> out;
   for (const OutputLimit& l : scene.sweep.limits) {
@@ -199,6 +200,11 @@ std::vector<std::pair<std::string, double>> column_limits(const Scene& scene, co
       measured = l.of->text();
     } else if (l.joint) {
       measured = l.joint->name + (l.joint->measure == JointMeasure::kAngle ? ".angle" : ".distance");
+    } else if (l.point) {  // (`P.x`, its rate `P.vx`)
+      const std::string axis(1, "xyz"[l.axis]);
+      if ((l.rate ? l.point->name + ".v" + axis : l.point->name + "." + axis) == column)
+        out.push_back({l.name, l.lo}), out.push_back({l.name, l.hi});
+      continue;
     } else {
       const Index c = scene.sweep.efforts.constraints[static_cast<std::size_t>(l.effort)];
       measured = scene.model->constraints()[static_cast<std::size_t>(c)].name + ".effort";

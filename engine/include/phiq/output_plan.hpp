@@ -158,9 +158,12 @@ struct OutputLimit {
   std::string name;  ///< the scene's (or what it measures)
   std::string what;  ///< what it measures, for the warning: "'xB'", "the angle of joint 'elbow'"
   /// The measure: an expression of q and t (its rate ∇e · q̇ + ∂e/∂t), or, when null, `joint`'s angle (unwrapped
-  /// over turns, as OutputPlan::joints) or distance, or, with neither, effort `effort` of OutputEfforts::constraints.
+  /// over turns, as OutputPlan::joints) or distance, or component `axis` of `point`'s position (its velocity's), or,
+  /// with none, effort `effort` of OutputEfforts::constraints. Checked by run_sweep (a Stepper has none).
   std::shared_ptr<const CompiledExpression> of;
   std::optional<OutputJoint> joint;  ///< see `of`
+  std::optional<OutputPoint> point;  ///< see `of`
+  int axis = 0;                      ///< `point`'s component: 0 x, 1 y, 2 z
   Index effort = -1;                 ///< see `of`
   bool rate = false;                 ///< the measure's rate is limited, not its value (needs q̇; not an effort's)
   double lo = 0.0;                   ///< the range's lower end (lo < hi)

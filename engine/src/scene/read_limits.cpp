@@ -1,6 +1,6 @@
 // The scene's `limits` (SceneReader::read_limits, resolve_limit_efforts): ranges the sweep checks a measure against
 // (OutputLimit, phiq/output_plan.hpp) — an expression of the coordinates and t, a spatial joint's angle or
-// distance, or a driver's effort — each a value's range and, but for an effort, a rate's.
+// distance, a point's coordinate, or a driver's effort — each a value's range and, but for an effort, a rate's.
 #include <algorithm>
 #include <set>
 
@@ -12,10 +12,12 @@ namespace phiq::detail::scene {
 void SceneReader::read_limits(const Cursor& c, OutputPlan& plan) {
   std::set<std::string> names;
   for (const Cursor& item : c.items()) {
-    item.expect_map({"name", "of", "joint", "effort", "range", "rate"});
+    item.expect_map({"name", "of", "joint", "point", "axis", "effort", "range", "rate"});
     const auto of = item.field("of"), joint = item.field("joint"), effort = item.field("effort");
-    if (of.present() + joint.present() + effort.present() != 1)
-      item.fail("a limit bounds one of `of: EXPRESSION`, `joint: NAME` or `effort: DRIVER`");
+    const auto point = item.field("point");
+    if (of.present() + joint.present() + point.present() + effort.present() != 1)
+      item.fail("a limit bounds one of `of: EXPRESSION`, `joint: NAME`, `point: P` (with `axis`) or `effort: DRIVER`");
+    if (item.field("axis").present() != point.present()) item.fail("`axis: x, y or z` goes with `point`, and only");
     OutputLimit l;
     std::string subject;
     if (of.present()) {
@@ -39,6 +41,14 @@ void SceneReader::read_limits(const Cursor& c, OutputPlan& plan) {
         joint.fail(e.what());
       }
       l.what = std::string(m.angle ? "the angle" : "the distance") + " of joint '" + subject + "'";
+    } else if (point.present()) {
+      l.point = output_point(point);
+      const std::string axis = item.field("axis").text();
+      l.axis = axis == "x" ? 0 : axis == "y" ? 1 : axis == "z" ? 2 : -1;
+      if (l.axis < 0 || l.axis >= l.point->dimension())
+        item.field("axis").fail(std::string("must be x, y") + (spatial_ ? " or z" : "") + ", not '" + axis + "'");
+      subject = l.point->name + "." + axis;
+      l.what = "the " + axis + " of point '" + l.point->name + "'";
     } else {
       subject = effort.name();
       l.what = "the effort of driver '" + subject + "'";

@@ -35,6 +35,9 @@ void LimitWatch::row(double t, const double* q, const double* qd, const double* 
         if (!first_) v = unwrap_angle(v, angle_[i], 0.5 * (angle_rate_[i] + m.rate) * (t - last_t_));
         angle_[i] = v, angle_rate_[i] = m.rate;
       }
+    } else if (l.point) {
+      const PointMotion m = evaluate_point(*l.point, q, l.rate ? qd : nullptr, nullptr);
+      v = (l.rate ? m.v : m.r)[static_cast<std::size_t>(l.axis)];
     } else {
       if (!efforts) continue;  // (a row not written: no effort computed)
       v = efforts[l.effort];
@@ -87,6 +90,9 @@ void check_limits(const Model& model, const OutputPlan& plan, const std::string&
     } else if (l.joint) {
       if (l.joint->max_coordinate() >= model.num_coordinates())
         throw Error(at + "its joint reads a coordinate the model does not have");
+    } else if (l.point) {
+      if (l.point->max_coordinate() >= model.num_coordinates() || l.axis < 0 || l.axis >= l.point->dimension())
+        throw Error(at + "its point reads a coordinate the model does not have, or has no such axis");
     } else if (l.rate || l.effort < 0 || l.effort >= static_cast<Index>(plan.efforts.constraints.size())) {
       throw Error(at + "its effort is not one the sweep computes (OutputEfforts::constraints)");
     }
