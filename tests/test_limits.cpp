@@ -220,7 +220,7 @@ TEST(Limits, ARobotsJointLimitsComeFromEachFormat) {
     expect_same_stretches(value, expected_stretches("hinge", t, angle, format == "mjcf" ? -2 * M_PI / 9 : -0.5, hi),
                           1e-9);
     EXPECT_EQ(value.size(), 1u);
-    if (format == "mjcf") {  // (MJCF states no speed or effort of a joint)
+    if (format == "mjcf") {  // (MJCF states no speed of a joint; its actuators an effort)
       // a range limits its joint with limited="true", or "auto" (the default) under the compiler's autolimits
       for (const auto& [limited, compiler, limits] : {std::tuple{"", "", true},
                                                       {"limited=\"true\" ", "<compiler autolimits=\"false\"/>", true},
@@ -232,6 +232,22 @@ TEST(Limits, ARobotsJointLimitsComeFromEachFormat) {
         SCOPED_TRACE(text);
         EXPECT_EQ(import_mjcf(text, "pendulum.xml", o).yaml.find("{joint: hinge, range:") != std::string::npos, limits);
       }
+      // a motor on the hinge with gear 2 and forcerange ±3: ±6 N·m at the joint, its driver's effort's limit; the
+      // joint's own actuatorfrcrange, bounding every actuator on it, stands over it
+      const std::string motor = test::replace_first(
+          mjcf, "</worldbody>",
+          "</worldbody>\n<actuator><motor joint=\"hinge\" gear=\"2\" forcerange=\"-3 3\"/></actuator>");
+      const ModelImport actuated = import_mjcf(motor, "pendulum.xml", o);
+      EXPECT_NE(actuated.yaml.find("- {name: hinge_effort, effort: drive_hinge, range: [-6, 6]}"), std::string::npos)
+          << actuated.yaml;
+      std::vector<LimitStretch> rated;
+      for (const LimitStretch& x : limit_stretches(limit_sweep(parse_scene(actuated.yaml, "motor.yaml"), 1, 1)))
+        if (x.name == "hinge_effort") rated.push_back(x);
+      expect_same_stretches(rated, expected_stretches("hinge_effort", t, effort, -6, 6), 1e-9);
+      EXPECT_EQ(rated.size(), 1u);
+      EXPECT_NE(import_mjcf(test::replace_first(motor, "ref=", "actuatorfrcrange=\"-5 7\" ref="), "pendulum.xml", o)
+                    .yaml.find("- {name: hinge_effort, effort: drive_hinge, range: [-5, 7]}"),
+                std::string::npos);
       continue;
     }
     expect_same_stretches(speed, expected_stretches("hinge", t, rate, -0.9, 0.9), 1e-9);

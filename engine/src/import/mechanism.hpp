@@ -71,9 +71,10 @@ struct Joint {
   // (N·m/rad, N/m), damping (N·m·s/rad, N·s/m), its free value (rad, m), a dry friction (N·m, N) and a rotor's
   // inertia turning with it (kg·m², kg: MuJoCo's armature): the scene's torsional spring on it.
   double stiffness = 0.0, damping = 0.0, free = 0.0, friction = 0.0, armature = 0.0;
-  // Its range of motion in the same terms (none unless lower < upper), and its motor's speed and effort limits
-  // (rad/s or m/s, N·m or N; 0: none): the scene's `limits` (the effort's where the joint is driven).
-  double lower = 0.0, upper = 0.0, velocity = 0.0, effort = 0.0;
+  // Its range of motion in the same terms (none unless lower < upper), its motor's speed limit (rad/s or m/s; 0:
+  // none) and effort range (N·m or N; none unless effort_lower < effort_upper): the scene's `limits` (the effort's
+  // where the joint is driven).
+  double lower = 0.0, upper = 0.0, velocity = 0.0, effort_lower = 0.0, effort_upper = 0.0;
 };
 
 // joint = multiplier · other + offset (a URDF mimic, an MJCF joint equality), or joint = offset when other < 0.

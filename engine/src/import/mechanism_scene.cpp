@@ -144,9 +144,10 @@ std::string MechanismWriter::joint_limits() {
       s << "}\n";
     }
     const auto driver = driver_of_.find(static_cast<int>(j));
-    if (bound(joint.effort) && joint.effort > 0.0 && o_.forces && driver != driver_of_.end())
+    if (bound(joint.effort_lower) && bound(joint.effort_upper) && joint.effort_lower < joint.effort_upper &&
+        o_.forces && driver != driver_of_.end())
       s << "  - {name: " << joint_[j] << "_effort, effort: " << driver->second << ", range: ["
-        << scene_number(-joint.effort) << ", " << scene_number(joint.effort) << "]}\n";
+        << scene_number(joint.effort_lower) << ", " << scene_number(joint.effort_upper) << "]}\n";
   }
   return s.str();
 }

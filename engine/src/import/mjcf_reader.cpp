@@ -372,8 +372,9 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     const double unit = type == "hinge" ? angle(1.0) : 1.0, q0 = value("ref");
     out.free = unit * (value("springref") - q0);
     const std::vector<double> range = sprung ? numbers(j, "range", jcc, {0, 0}, 2, 2) : std::vector<double>{0, 0};
-    if (const std::string* l = attr(j, "limited", jcc); l && *l != "auto" ? *l == "true" : autolimits_)
-      out.lower = unit * (range[0] - q0), out.upper = unit * (range[1] - q0);
+    if (limited(attr(j, "limited", jcc))) out.lower = unit * (range[0] - q0), out.upper = unit * (range[1] - q0);
+    const std::vector<double> force = sprung ? numbers(j, "actuatorfrcrange", jcc, {0, 0}, 2, 2) : range;
+    if (sprung && limited(attr(j, "actuatorfrclimited", jcc))) out.effort_lower = force[0], out.effort_upper = force[1];
     for (std::size_t k = 0; !sprung && k < 7u; ++k)
       if (attr(j, fields[k], jcc)) skip_at(j, std::string("<joint ") + fields[k] + ">", "not modelled");
     if (!joint_index_.emplace(out.name, static_cast<int>(m_.joints.size())).second)
@@ -382,6 +383,24 @@ void MjcfReader::body(const tinyxml2::XMLElement* e, int parent, const std::stri
     from = to;
   }
   for (const Placed& c : children) body(c.e, index, c.childclass, c.frame);
+}
+
+void MjcfReader::actuators(const tinyxml2::XMLElement* list) {
+  std::map<int, std::pair<double, double>> sum;  // the joints' actuators' ranges, summed as MuJoCo sums their forces
+  for (const tinyxml2::XMLElement* a = list->FirstChildElement(); a; a = a->NextSiblingElement()) {
+    const char* name = a->Attribute("joint");
+    const std::vector<double> range = numbers(a, "forcerange", "", {0, 0}, 2, 2);
+    if (!name || !limited(attr(a, "forcelimited", "")) || !(range[0] < range[1])) continue;
+    const auto it = joint_index_.find(name);
+    if (it == joint_index_.end()) fail(a, "<" + std::string(a->Name()) + "> on joint '" + name + "', not in the file");
+    const double gear = numbers(a, "gear", "", {1, 0, 0, 0, 0, 0}, 1, 6)[0];  // joint effort = gear · force
+    auto& [lo, hi] = sum[it->second];
+    lo += std::min(gear * range[0], gear * range[1]), hi += std::max(gear * range[0], gear * range[1]);
+  }
+  for (const auto& [joint, range] : sum) {  // (a joint's own actuatorfrcrange bounds them all: it stands)
+    Joint& j = m_.joints[static_cast<std::size_t>(joint)];
+    if (!(j.effort_lower < j.effort_upper)) j.effort_lower = range.first, j.effort_upper = range.second;
+  }
 }
 
 Mechanism MjcfReader::read(int* loops) {
@@ -408,7 +427,7 @@ Mechanism MjcfReader::read(int* loops) {
       {"statistic", "MuJoCo's rendering"},
       {"contact", "contacts are not constraints in phiq (phiq clearance measures distances)"},
       {"tendon", "tendons are not read"},
-      {"actuator", "actuators are forces, not drivers: drive joints with --drive"},
+      {"actuator", "actuators are forces, not drivers: drive joints with --drive (a joint's forcerange is read)"},
       {"sensor", "sensors: phiq outputs points, joints and orientations instead"},
       {"keyframe", "phiq starts from the model's pose"},
       {"custom", "user data"},
@@ -438,6 +457,7 @@ Mechanism MjcfReader::read(int* loops) {
     }
   }
   for (const tinyxml2::XMLElement* e : docs_.children(root, "equality")) equality(e);
+  for (const tinyxml2::XMLElement* e : docs_.children(root, "actuator")) actuators(e);
   *loops = loops_;
   return std::move(m_);
 }

@@ -46,6 +46,12 @@ class MjcfReader {
   void geom(const tinyxml2::XMLElement* e, Body* b, const std::string& childclass, bool* solid_only,
             std::optional<double>* density);
   void equality(const tinyxml2::XMLElement* e);
+  // <actuator>'s children on joints: a force range, times the gear, is the joint's effort range.
+  void actuators(const tinyxml2::XMLElement* list);
+  // Whether a range is in force by its `…limited` attribute: "true"; "auto" (or none) under autolimits.
+  bool limited(const std::string* attribute) const {
+    return attribute && *attribute != "auto" ? *attribute == "true" : autolimits_;
+  }
   // A connect (spherical) or weld (rigid) equality between bodies (anchor, relpose) or sites, closing a loop.
   Joint connect_or_weld(const tinyxml2::XMLElement* e, const std::string& name);
   int body_named(const tinyxml2::XMLElement* e, const char* attribute, bool required) const;

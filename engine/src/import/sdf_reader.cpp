@@ -202,7 +202,8 @@ void SdfReader::joint(const sdf::Joint& j, const Pose& placed, const std::string
         out.stiffness = ax->SpringStiffness(), out.damping = ax->Damping(), out.free = ax->SpringReference();
         out.friction = ax->Friction();
         // its limits (SDF's "none", ±1e16, ±inf or −1, are left out as the scene is written)
-        out.lower = ax->Lower(), out.upper = ax->Upper(), out.velocity = ax->MaxVelocity(), out.effort = ax->Effort();
+        out.lower = ax->Lower(), out.upper = ax->Upper(), out.velocity = ax->MaxVelocity();
+        out.effort_lower = -ax->Effort(), out.effort_upper = ax->Effort();
         if (!(out.stiffness >= 0.0 && out.damping >= 0.0 && out.friction >= 0.0))
           refuse(path_, out.line, "joint '" + out.name + "': a negative spring_stiffness, damping or friction");
       }

@@ -470,7 +470,7 @@ Mechanism UrdfReader::read(int* loops) {
       if (tag == "limit" && j->limits && (out.kind == "revolute" || out.kind == "prismatic")) {
         // (urdfdom's: lower and upper a continuous joint has not; velocity and effort ≥ 0 by the format)
         if (x.type != "continuous") out.lower = j->limits->lower, out.upper = j->limits->upper;
-        out.velocity = std::max(j->limits->velocity, 0.0), out.effort = std::max(j->limits->effort, 0.0);
+        out.velocity = j->limits->velocity, out.effort_lower = -j->limits->effort, out.effort_upper = j->limits->effort;
         continue;
       }
       if (tag != "origin" && tag != "axis" && tag != "parent" && tag != "child" && tag != "mimic") unmapped(e);
