@@ -80,6 +80,15 @@ void expect_same_stretches(const std::vector<LimitStretch>& got, const std::vect
   }
 }
 
+// One stretch as read back: its side, first and last row's times, rows and worst value.
+void expect_stretch(const LimitStretch& s, bool above, double from, double to, int rows, double worst) {
+  EXPECT_EQ(s.above, above);
+  EXPECT_NEAR(s.from, from, 1e-9);
+  EXPECT_NEAR(s.to, to, 1e-9);
+  EXPECT_EQ(s.rows, rows);
+  EXPECT_NEAR(s.worst, worst, 1e-9);
+}
+
 // The warnings a scene's sweep gives, with `threads` threads and every `every` rows written.
 SweepSummary limit_sweep(const Scene& s, int threads, Index every, std::vector<std::vector<double>>* efforts = nullptr,
                          std::vector<double>* times = nullptr) {
@@ -165,14 +174,8 @@ TEST(Limits, ASpatialJointsAngleIsLimitedOverItsTurns) {
   for (int threads : {1, 2}) {
     const std::vector<LimitStretch> got = limit_stretches(limit_sweep(s, threads, 1));
     ASSERT_EQ(got.size(), 2u);
-    EXPECT_TRUE(got[0].above);  // the rate, 1 > 0.99 at every row
-    EXPECT_EQ(got[0].rows, 101);
-    EXPECT_NEAR(got[0].worst, 1.0, 1e-9);
-    EXPECT_TRUE(got[1].above);
-    EXPECT_NEAR(got[1].from, 8.1, 1e-9);
-    EXPECT_NEAR(got[1].to, 10.0, 1e-9);
-    EXPECT_EQ(got[1].rows, 20);
-    EXPECT_NEAR(got[1].worst, 10.0, 1e-9);
+    expect_stretch(got[0], true, 0.0, 10.0, 101, 1.0);  // the rate, 1 > 0.99 at every row
+    expect_stretch(got[1], true, 8.1, 10.0, 20, 10.0);
   }
 }
 
@@ -301,11 +304,7 @@ TEST(Limits, AStretchOpenWhenTheSweepFailsIsSaidToItsLastRow) {
   ASSERT_EQ(sum.failed_step, 44);
   const std::vector<LimitStretch> got = limit_stretches(sum);
   ASSERT_EQ(got.size(), 1u);
-  EXPECT_TRUE(got[0].above);
-  EXPECT_NEAR(got[0].from, 0.31, 1e-9);
-  EXPECT_NEAR(got[0].to, 0.43, 1e-9);
-  EXPECT_EQ(got[0].rows, 13);
-  EXPECT_NEAR(got[0].worst, 2.63, 1e-9);
+  expect_stretch(got[0], true, 0.31, 0.43, 13, 2.63);
 }
 
 TEST(Limits, BadLimitsAreRefusedInOneLineNamingTheField) {
