@@ -1,14 +1,11 @@
-// The curves of the higher pairs (kinds/curve.hpp): the cubic spline's fit (second derivatives from the
-// tridiagonal, or for a closed curve cyclic, system of C² continuity), evaluation, and the searches that give a
-// curve parameter its initial guess.
+// The curves of the higher pairs (kinds/curve.hpp): the cubic spline's fit (kinds/cubic_spline.hpp: open, or for a
+// closed curve cyclic), evaluation, and the searches that give a curve parameter its initial guess.
 #include "phiq/kinds/curve.hpp"
-
-#include <Eigen/Sparse>
-#include <Eigen/SparseLU>
 
 #include <algorithm>
 #include <cmath>
 
+#include "kinds/cubic_spline.hpp"
 #include "phiq/text.hpp"
 
 namespace phiq {
@@ -42,39 +39,9 @@ std::shared_ptr<const Curve> Curve::spline(std::vector<kin::V2> p, bool closed) 
     c.knots_[k + 1] = c.knots_[k] + h[k];
   }
   c.length_ = c.knots_.back();
-  // Second derivatives M_k at the points: h_{k−1} M_{k−1} + 2 (h_{k−1} + h_k) M_k + h_k M_{k+1} = 6 (slope_k −
-  // slope_{k−1}) at every inner point (every point of a closed curve, indices cyclic); M = 0 at open ends.
-  const Eigen::Index m = static_cast<Eigen::Index>(n);
-  std::vector<Eigen::Triplet<double>> t;
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(m, 2);
-  for (std::size_t k = 0; k < n; ++k) {
-    const Eigen::Index i = static_cast<Eigen::Index>(k);
-    if (!closed && (k == 0 || k == n - 1)) {
-      t.emplace_back(i, i, 1.0);
-      continue;
-    }
-    const std::size_t km = (k + n - 1) % n, kp = (k + 1) % n;
-    const double hm = h[(k + pieces - 1) % pieces], hk = h[k % pieces];
-    t.emplace_back(i, static_cast<Eigen::Index>(km), hm);
-    t.emplace_back(i, i, 2.0 * (hm + hk));
-    t.emplace_back(i, static_cast<Eigen::Index>(kp), hk);
-    const kin::V2 slope = (1.0 / hk) * (p[kp] - p[k]), before = (1.0 / hm) * (p[k] - p[km]);
-    rhs(i, 0) = 6.0 * (slope.x - before.x), rhs(i, 1) = 6.0 * (slope.y - before.y);
-  }
-  Eigen::SparseMatrix<double> a(m, m);
-  a.setFromTriplets(t.begin(), t.end());
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(a);  // strictly diagonally dominant: always factorises
-  const Eigen::MatrixXd mm = lu.solve(rhs);
-  for (std::size_t k = 0; k < pieces; ++k) {
-    const std::size_t kp = (k + 1) % n;
-    const kin::V2 m0{mm(static_cast<Eigen::Index>(k), 0), mm(static_cast<Eigen::Index>(k), 1)};
-    const kin::V2 m1{mm(static_cast<Eigen::Index>(kp), 0), mm(static_cast<Eigen::Index>(kp), 1)};
-    const double hk = h[k];
-    c.a_.push_back(p[k]);
-    c.b_.push_back((1.0 / hk) * (p[kp] - p[k]) - (hk / 6.0) * (2.0 * m0 + m1));
-    c.c_.push_back(0.5 * m0);
-    c.d_.push_back((1.0 / (6.0 * hk)) * (m1 - m0));
-  }
+  detail::CubicPieces<kin::V2> pieces_of = detail::cubic_spline(p, h, closed);  // (curve.hpp: a closed curve's cyclic)
+  c.a_ = std::move(pieces_of.a), c.b_ = std::move(pieces_of.b), c.c_ = std::move(pieces_of.c),
+  c.d_ = std::move(pieces_of.d);
   c.finish();
   return curve;
 }

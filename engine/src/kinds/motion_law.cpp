@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <Eigen/SparseLU>
 #include <unsupported/Eigen/Splines>
 
+#include "kinds/cubic_spline.hpp"
 #include "phiq/kinds/kind_support.hpp"
 #include "phiq/text.hpp"
 
@@ -341,34 +341,16 @@ MotionLaw MotionLaw::periodic_table(const std::vector<double>& t, const std::vec
   if (values.back() != values.front())
     throw Error("motion law: a periodic table ends where it starts (its last value " + significant(values.back(), 12) +
                 " is not its first, " + significant(values.front(), 12) + ")");
-  // Second derivatives M_k: h_{k−1} M_{k−1} + 2 (h_{k−1} + h_k) M_k + h_k M_{k+1} = 6 (slope_k − slope_{k−1}),
-  // indices cyclic over the m = n − 1 pieces (as a closed Curve's); strictly diagonally dominant.
+  // the cyclic C² cubic spline over the m = n − 1 pieces (kinds/cubic_spline.hpp, as a closed Curve's)
   const std::size_t m = t.size() - 1;
-  std::vector<double> h(m), slope(m);
-  for (std::size_t k = 0; k < m; ++k) h[k] = t[k + 1] - t[k], slope[k] = (values[k + 1] - values[k]) / h[k];
-  std::vector<Eigen::Triplet<double>> entries;
-  Eigen::VectorXd rhs(static_cast<Eigen::Index>(m));
-  for (std::size_t k = 0; k < m; ++k) {
-    const std::size_t km = (k + m - 1) % m, kp = (k + 1) % m;
-    const auto i = static_cast<Eigen::Index>(k);
-    entries.emplace_back(i, static_cast<Eigen::Index>(km), h[km]);
-    entries.emplace_back(i, i, 2.0 * (h[km] + h[k]));
-    entries.emplace_back(i, static_cast<Eigen::Index>(kp), h[k]);
-    rhs(i) = 6.0 * (slope[k] - slope[km]);
-  }
-  Eigen::SparseMatrix<double> a(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
-  a.setFromTriplets(entries.begin(), entries.end());
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(a);
-  const Eigen::VectorXd M = lu.solve(rhs);
+  std::vector<double> h(m);
+  for (std::size_t k = 0; k < m; ++k) h[k] = t[k + 1] - t[k];
+  detail::CubicPieces<double> pieces =
+      detail::cubic_spline(std::vector<double>(values.begin(), values.end() - 1), h, true);
   auto impl = std::make_shared<PeriodicTable>();
   impl->t = t;
-  for (std::size_t k = 0; k < m; ++k) {
-    const double m0 = M(static_cast<Eigen::Index>(k)), m1 = M(static_cast<Eigen::Index>((k + 1) % m));
-    impl->a.push_back(values[k]);
-    impl->b.push_back(slope[k] - h[k] * (2.0 * m0 + m1) / 6.0);
-    impl->c.push_back(0.5 * m0);
-    impl->d.push_back((m1 - m0) / (6.0 * h[k]));
-  }
+  impl->a = std::move(pieces.a), impl->b = std::move(pieces.b), impl->c = std::move(pieces.c),
+  impl->d = std::move(pieces.d);
   MotionLaw law;
   law.impl_ = impl;
   law.description_ =
