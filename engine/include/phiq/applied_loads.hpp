@@ -118,6 +118,10 @@ struct AppliedLoads {
   bool empty() const { return forces.empty() && torques.empty() && springs.empty() && torsional_springs.empty(); }
 };
 
+/// The sign a dry friction (LinearSpring::friction, TorsionalSpring::friction) takes of its rate: −1, 0 or 1, none
+/// at rest (where static friction is not determined).
+inline double friction_direction(double rate) { return rate > 0.0 ? 1.0 : rate < 0.0 ? -1.0 : 0.0; }
+
 /// A force's or torque's components at (q, q̇, t) in world axes (qd null: q̇ = 0).
 kin3::V3 world_components(const std::array<LoadValue, 3>& components, LoadAxes axes, const Pose& pose, const double* q,
                           const double* qd, double t);

@@ -37,9 +37,6 @@ V3 end_velocity(const SpringEnd& e, const double* q, const double* qd, double t)
   return part_motion(e.frame, q, qd, nullptr, t).point(e.at).first;
 }
 
-// sign(v): −1, 0 or 1 (a dry friction's direction; none at rest, where static friction is not determined).
-double sign_of(double v) { return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : 0.0; }
-
 // A spring's state at (q, q̇, t): its ends in the world, the unit vector from a to b, and its tension.
 struct SpringState {
   Pose pa, pb;  // the ends' frames
@@ -60,7 +57,7 @@ SpringState spring_state(const LinearSpring& s, const double* q, const double* q
     st.rate = kin3::dot(st.unit, end_velocity(s.b, q, qd, t) - end_velocity(s.a, q, qd, t));
   const double stretch = st.length - s.free_length;
   st.tension = (s.law.has_value() ? s.law.evaluate(stretch).f : s.stiffness * stretch) + s.damping * st.rate +
-               s.friction * sign_of(st.rate) + s.preload;
+               s.friction * friction_direction(st.rate) + s.preload;
   if (s.tension.expr) st.tension += s.tension.value(q, qd, t);
   return st;
 }
@@ -117,7 +114,7 @@ AngleState angle_state(const TorsionalSpring& s, const double* q, const double* 
     for (std::size_t i = 0; i < c.size(); ++i) st.rate += gradient[i] * qd[c[i]];
   }
   st.moment = (s.law.has_value() ? s.law.evaluate(st.from_free).f : s.stiffness * st.from_free) + s.damping * st.rate +
-              s.friction * sign_of(st.rate);
+              s.friction * friction_direction(st.rate);
   if (s.inertia != 0.0 && qd && qdd) st.moment += s.inertia * angle_acceleration(s, q, qd, qdd, t, gradient);
   if (s.moment.expr) st.moment += s.moment.value(q, qd, t);
   return st;

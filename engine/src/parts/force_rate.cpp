@@ -373,7 +373,7 @@ bool add_springs_rate(const AppliedLoads& loads, const std::array<const AppliedL
         !spring_law_dual(sp.law, along, h, stretch, elastic, [i](const AppliedLoads& a) { return &a.springs[i].law; }))
       return false;
     // a dry friction's f sign(L̇): its rate along p f′ sign(L̇) (sign's own is 0 wherever it is defined)
-    const Dual dry(static_cast<double>((rate.v > 0.0) - (rate.v < 0.0)));
+    const Dual dry(friction_direction(rate.v));
     Dual tension = elastic + datum(&LinearSpring::damping) * rate + datum(&LinearSpring::friction) * dry +
                    datum(&LinearSpring::preload);
     if (!add_value_dual(sp.tension, along, h, along_motion, tension,
@@ -544,7 +544,7 @@ bool add_torsional_rate(const AppliedLoads& loads, const std::array<const Applie
     if (ts.law.has_value() && !spring_law_dual(ts.law, along, h, angle, elastic,
                                                [i](const AppliedLoads& a) { return &a.torsional_springs[i].law; }))
       return false;
-    const Dual dry(static_cast<double>((st.rate.v > 0.0) - (st.rate.v < 0.0)));  // (as a spring's friction)
+    const Dual dry(friction_direction(st.rate.v));  // (as a spring's friction)
     Dual moment = elastic + datum(&TorsionalSpring::damping) * st.rate + datum(&TorsionalSpring::friction) * dry;
     if (!add_rotor_dual(ts, i, along, h, path, datum(&TorsionalSpring::inertia), moment)) return false;
     if (!add_value_dual(ts.moment, along, h, path, moment,

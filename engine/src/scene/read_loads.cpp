@@ -145,7 +145,13 @@ LoadValue PartReader::load_component(const C& c) const {
   LoadValue v;
   v.law = r_.motion_law(c.require("law"));
   const auto of = c.field("of");
-  v.expr = of.present() ? r_.compile(of, true, true) : CompiledExpression::compile("t", r_.resolver(false, "t"));
+  // (`t` itself compiled once: a family of 10⁴ loads would compile it symbolically for each)
+  static const std::shared_ptr<const CompiledExpression> time =
+      CompiledExpression::compile("t", [](const std::string& n) -> std::optional<NameBinding> {
+        if (n == "t") return NameBinding{NameBinding::Kind::kTime};
+        return std::nullopt;
+      });
+  v.expr = of.present() ? r_.compile(of, true, true) : time;
   return v;
 }
 

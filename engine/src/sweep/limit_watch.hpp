@@ -12,7 +12,6 @@ namespace phiq::detail {
 class LimitWatch {
  public:
   explicit LimitWatch(const std::vector<OutputLimit>& limits);
-  bool empty() const { return limits_.empty(); }
   // The row at t, delivered in order: q always, qd null when q̇ is not solved, efforts null where not computed (a row
   // not written). Pre-condition: the limits read coordinates the model has and efforts it computes (check_limits).
   void row(double t, const double* q, const double* qd, const double* efforts);

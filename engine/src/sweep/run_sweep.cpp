@@ -134,7 +134,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
   // their seeds, so that its rows are, to the bit, those of any other thread count.
   // (a writer reads every row as a step callback does: the chunks are cut as for one)
   const detail::HeldRows rows =
-      detail::held_rows(model, opt, static_cast<bool>(on_step) || writer || !opt.limits.empty(),
+      detail::held_rows(model, opt, static_cast<bool>(on_step) || writer || run.delivery_reads_rows(),
                         run.chunks_encode() ? writer->max_row_bytes() : 0);
   const Index chunk = opt.chunk_steps > 0 ? opt.chunk_steps
                                           : detail::automatic_chunk_steps(opt, rows.row_bytes, rows.caller_reads_rows);

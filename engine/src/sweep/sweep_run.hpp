@@ -27,13 +27,15 @@ struct Run {
   SweepSummary& sum;
   LimitWatch* limits = nullptr;  // the plan's limits, checked in delivery order (null or empty: none)
 
+  // Whether the delivery itself reads every row's q, q̇ and outputs, written or not: limits are checked there (a
+  // limit's stretch runs on from the row before, which only the delivery in order knows).
+  bool delivery_reads_rows() const { return !opt.limits.empty(); }
   // Whether a parallel chunk encodes its rows itself, for write_encoded(): with a writer, unless joint angles are
-  // written or limits checked (each row's angle is unwrapped from the row before, and a limit's stretch runs on
-  // from it: only the delivery in order knows them).
+  // written (each row's is unwrapped from the row before) or the delivery reads the rows.
   bool chunks_encode() const {
-    return writer && opt.limits.empty() && std::none_of(opt.joints.begin(), opt.joints.end(), [](const OutputJoint& j) {
-             return j.measure == JointMeasure::kAngle;
-           });
+    return writer && !delivery_reads_rows() &&
+           std::none_of(opt.joints.begin(), opt.joints.end(),
+                        [](const OutputJoint& j) { return j.measure == JointMeasure::kAngle; });
   }
 
   double time_of(Index k) const { return opt.time_of(k); }  // TimeGrid::time_of
@@ -52,7 +54,7 @@ struct Run {
     count_row(time_of(k), det_sign, det_sign_t, quality);
     unwrap_joints(k, motions.joints);
     const bool written_row = opt.writes_row(k, time_of(k));
-    if (limits && !limits->empty())
+    if (limits && delivery_reads_rows())
       limits->row(time_of(k), q.data(), opt.solves_velocities() ? qd.data() : nullptr,
                   written_row ? motions.efforts : nullptr);
     if (!written_row) return true;  // solved, not written (OutputPlan::every, window)
