@@ -128,11 +128,11 @@ std::string MechanismWriter::joint_springs() {
 
 // The joints' ranges, their rates' (with velocities solved) and their drivers' efforts' (with efforts), as limits.
 std::string MechanismWriter::joint_limits() {
+  // (a format's "none" may be an infinity or a huge value: a bound is finite, and below 1e15)
+  const auto bound = [](double v) { return std::isfinite(v) && std::fabs(v) < 1e15; };
   std::ostringstream s;
   for (std::size_t j = 0; j < m_.joints.size(); ++j) {
     const Joint& joint = m_.joints[j];
-    // (a format's "none" may be an infinity or a huge value: a bound is finite, and below 1e15)
-    const auto bound = [](double v) { return std::isfinite(v) && std::fabs(v) < 1e15; };
     const bool range = bound(joint.lower) && bound(joint.upper) && joint.lower < joint.upper;
     const bool speed = bound(joint.velocity) && joint.velocity > 0.0, rate = speed && o_.rates;
     if (speed && !o_.rates)
