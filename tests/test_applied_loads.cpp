@@ -14,6 +14,7 @@
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
+#include "phiq/joint_reactions.hpp"
 #include "phiq/part_motion.hpp"
 #include "phiq/phiq.hpp"
 #include "fourbar_parts.hpp"
@@ -247,6 +248,16 @@ TEST(AppliedLoads, EveryModelWithMassesBalancesItsDriversPowerAtEveryRow) {
     o.efforts.loads = std::make_shared<const Loads>(s.loads);
     o.efforts.constraints = rheonomic_constraints(m);
     o.efforts.power = true;
+    // bearings' friction dissipates Σ μ (r |F_r| + r_a |F_a|) |θ̇|, F their joints' reactions (in the joints' axes)
+    std::vector<const TorsionalSpring*> bearings;
+    if (s.loads.applied)
+      for (const TorsionalSpring& t : s.loads.applied->torsional_springs)
+        if (t.bearing) {
+          const Index c = m.constraint_index(t.bearing->joint);
+          o.efforts.reactions.push_back({c, reaction_width(m, c) == 6});
+          bearings.push_back(&t);
+        }
+    o.efforts.reactions_in_joint_axes = true;
     o.sensitivities.clear();
     o.velocities = o.accelerations = true;
     const std::size_t n = o.efforts.constraints.size();
@@ -256,38 +267,48 @@ TEST(AppliedLoads, EveryModelWithMassesBalancesItsDriversPowerAtEveryRow) {
     double worst = 0.0, scale = 0.0;
     std::size_t rows = 0;
     SweepSummary sum;
-    ASSERT_EQ(run_sweep(
-                  m, o, ws,
-                  [&](const StepView& v) {
-                    double power = 0.0;
-                    for (std::size_t i = 0; i < n; ++i) power += v.efforts[n + i];
-                    if (!std::isfinite(power)) return true;  // a singular row: said so, no power
-                    double energy_rate = 0.0;
-                    for (const Part& p : s.parts) {
-                      if (p.mass_source == MassSource::kNone) continue;
-                      const PartMotion pm = part_motion(p.frame, v.q.data(), v.qd->data(), v.qdd->data(), v.t);
-                      const auto [vc, ac] = pm.point(p.mass.center);
-                      energy_rate += p.mass.mass * kin3::dot(vc, ac) + rotational_energy_rate(p, pm) -
-                                     p.mass.mass * kin3::dot(s.loads.gravity, vc);
-                    }
-                    const double loads =
-                        s.loads.applied ? applied_power(*s.loads.applied, v.q.data(), v.qd->data(), v.qdd->data(), v.t)
-                                        : 0.0;
-                    worst = std::max(worst, std::fabs(power - (energy_rate - loads)));
-                    scale = std::max({scale, std::fabs(power), std::fabs(energy_rate)});
-                    ++rows;
-                    return true;
-                  },
-                  &sum),
-              SolveStatus::kSuccess);
+    ASSERT_EQ(
+        run_sweep(
+            m, o, ws,
+            [&](const StepView& v) {
+              double power = 0.0;
+              for (std::size_t i = 0; i < n; ++i) power += v.efforts[n + i];
+              if (!std::isfinite(power)) return true;  // a singular row: said so, no power
+              double energy_rate = 0.0;
+              for (const Part& p : s.parts) {
+                if (p.mass_source == MassSource::kNone) continue;
+                const PartMotion pm = part_motion(p.frame, v.q.data(), v.qd->data(), v.qdd->data(), v.t);
+                const auto [vc, ac] = pm.point(p.mass.center);
+                energy_rate += p.mass.mass * kin3::dot(vc, ac) + rotational_energy_rate(p, pm) -
+                               p.mass.mass * kin3::dot(s.loads.gravity, vc);
+              }
+              double loads =
+                  s.loads.applied ? applied_power(*s.loads.applied, v.q.data(), v.qd->data(), v.qdd->data(), v.t) : 0.0;
+              const double* f = v.efforts + 2 * n;
+              for (std::size_t i = 0; i < bearings.size(); ++i) {
+                const BearingFriction& b = *bearings[i]->bearing;
+                const bool spatial = o.efforts.reactions[i].spatial;
+                std::vector<double> gradient;
+                loads -= b.coefficient *
+                         (b.radius * std::hypot(f[0], f[1]) + (spatial ? b.thrust_radius * std::fabs(f[2]) : 0.0)) *
+                         std::fabs(angle_rate(*bearings[i], v.q.data(), v.qd->data(), v.t, gradient));
+                f += spatial ? 6 : 3;
+              }
+              worst = std::max(worst, std::fabs(power - (energy_rate - loads)));
+              scale = std::max({scale, std::fabs(power), std::fabs(energy_rate)});
+              ++rows;
+              return true;
+            },
+            &sum),
+        SolveStatus::kSuccess);
     EXPECT_GT(rows, 10u);
     EXPECT_GT(scale, 0.1);  // watts: the balance is not of zeros
     EXPECT_LT(worst, 1e-9 * scale);
     checked.push_back(path.filename().string());
   }
   // the scenes with masses today; a new one joins by itself
-  for (const char* name : {"fourbar_motor_torque.yaml", "fourbar_pin_loads.yaml", "rssr_bearing_loads.yaml",
-                           "crank_slider_drag.yaml", "fourbar_gearmotor.yaml"})
+  for (const char* name : {"fourbar_motor_torque.yaml", "fourbar_pin_loads.yaml", "fourbar_pin_friction.yaml",
+                           "rssr_bearing_loads.yaml", "crank_slider_drag.yaml", "fourbar_gearmotor.yaml"})
     EXPECT_NE(std::find(checked.begin(), checked.end(), name), checked.end()) << name;
 }
 

@@ -105,11 +105,17 @@ std::vector<std::string> load_lines(const phiq::AppliedLoads& a, int dimension) 
                   ", damping " + g6(s.damping) + dry(s.friction) + ", preload " + g6(s.preload) + ", tension " +
                   load_value_text(s.tension));
   for (const phiq::TorsionalSpring& s : a.torsional_springs)
-    out.push_back("torsional spring '" + s.name + "' on " +
-                  (s.angle ? "'" + s.angle->text() + "'" : "joint '" + s.joint->name + "'") + ": stiffness " +
-                  elastic(s.stiffness, s.law) + ", free angle " + g6(s.free_angle) + ", damping " + g6(s.damping) +
-                  dry(s.friction) + (s.inertia != 0.0 ? ", inertia " + g6(s.inertia) : "") + ", moment " +
-                  load_value_text(s.moment));
+    out.push_back(
+        "torsional spring '" + s.name + "' on " +
+        (s.angle ? "'" + s.angle->text() + "'" : "joint '" + s.joint->name + "'") + ": stiffness " +
+        elastic(s.stiffness, s.law) + ", free angle " + g6(s.free_angle) + ", damping " + g6(s.damping) +
+        dry(s.friction) + (s.inertia != 0.0 ? ", inertia " + g6(s.inertia) : "") + ", moment " +
+        load_value_text(s.moment) +
+        (s.bearing
+             ? ", bearing '" + s.bearing->joint + "' friction " + g6(s.bearing->coefficient) + " x (" +
+                   g6(s.bearing->radius) + " m x |F_r|" +
+                   (s.bearing->thrust_radius != 0.0 ? " + " + g6(s.bearing->thrust_radius) + " m x |F_a|" : "") + ")"
+             : ""));
   return out;
 }
 

@@ -88,10 +88,22 @@ struct LinearSpring {
   LoadValue tension;         ///< T (N): an actuator's tension along the line, if any
 };
 
+/// A bearing's dry friction, read off its joint's reaction (a journal's and a thrust collar's, Adams' joint friction
+/// without stiction): the moment μ (r |F_r| + r_a |F_a|) against θ̇, F_r the reaction's force across the joint's axis
+/// and F_a along it (none in the plane). It depends on the multipliers it changes, so the efforts solve for it
+/// (detail::BearingFrictions); add_applied_forces() and applied_power() leave it out.
+struct BearingFriction {
+  std::string joint;           ///< the pin, revolute or cylindrical joint (a constraint) whose reaction loads it
+  double coefficient = 0.0;    ///< μ, ≥ 0
+  double radius = 0.0;         ///< r (m), the journal's radius, ≥ 0
+  double thrust_radius = 0.0;  ///< r_a (m), the thrust collar's mean radius, ≥ 0 (spatial joints)
+  bool operator==(const BearingFriction&) const = default;  ///< datum by datum
+};
+
 /// A torsional spring-damper on an angle θ(q, t): the moment τ = k (θ − θ0) + c θ̇ + f sign(θ̇) + J θ̈ + M resisting
 /// θ's increase; with a law, law(θ − θ0) in place of k (θ − θ0); f a dry friction's moment (none at rest), J a rotor's
 /// inertia turning with θ (a geared motor's, MuJoCo's armature), M a rotary actuator's moment given as an expression
-/// or a law.
+/// or a law; and a bearing's friction, if any, from its joint's reaction.
 struct TorsionalSpring {
   std::string name;                                 ///< the scene's name for it
   std::shared_ptr<const CompiledExpression> angle;  ///< θ: a coordinate, or an expression of them; or null and:
@@ -106,6 +118,7 @@ struct TorsionalSpring {
   double inertia = 0.0;                  ///< J (kg·m²), ≥ 0
   MotionLaw law;                         ///< the elastic moment of θ − θ0 (N·m) in place of k (θ − θ0), if any
   LoadValue moment;                      ///< M (N·m): an actuator's moment against θ, if any
+  std::optional<BearingFriction> bearing;  ///< a bearing's friction, if any
 };
 
 /// The applied loads of a scene, read once and shared (Loads::applied holds them by pointer).
@@ -121,6 +134,12 @@ struct AppliedLoads {
 /// The sign a dry friction (LinearSpring::friction, TorsionalSpring::friction) takes of its rate: −1, 0 or 1, none
 /// at rest (where static friction is not determined).
 inline double friction_direction(double rate) { return rate > 0.0 ? 1.0 : rate < 0.0 ? -1.0 : 0.0; }
+
+/// A torsional spring's angle rate θ̇ at (q, q̇, t) (0 with qd null: at rest), and ∂θ/∂q_k over
+/// torsional_coordinates(s) into `gradient`.
+double angle_rate(const TorsionalSpring& s, const double* q, const double* qd, double t, std::vector<double>& gradient);
+/// The coordinates a torsional spring's angle reads, increasing.
+const std::vector<Index>& torsional_coordinates(const TorsionalSpring& s);
 
 /// A force's or torque's components at (q, q̇, t) in world axes (qd null: q̇ = 0).
 kin3::V3 world_components(const std::array<LoadValue, 3>& components, LoadAxes axes, const Pose& pose, const double* q,

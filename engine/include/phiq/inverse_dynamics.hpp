@@ -60,7 +60,8 @@ bool has_effort(const ConstraintInfo& c);
 /// The effort of each of rheonomic_constraints() at the motion in `ws` (q, q̇, q̈ at t) under `loads`: −λ of its
 /// first row, the torque or force its motor applies, conjugate to what it drives (a coordinate, a joint's angle or
 /// distance, an expression). As constraint_multipliers() for the status and `message`; kNonFinite, with the part or
-/// load nonfinite_force_source() names, where Q or λ is not finite.
+/// load nonfinite_force_source() names, where Q or λ is not finite. With bearings' friction (BearingFriction) λ is
+/// solved with it; kNotConverged, its message naming the bearing, where it does not settle (the mechanism jams).
 SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, const Loads& loads, double t,
                            Workspace& ws, std::vector<double>& efforts, std::string* message = nullptr);
 

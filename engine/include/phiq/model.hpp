@@ -335,6 +335,11 @@ class ModelBuilder {
   bool has_constraint(const std::string& name) const {
     return constraint_names_.find(name, model_.constraint_name_of()) >= 0;
   }
+  /// The kind (ConstraintInfo::kind) of the constraint of that name added so far, or empty.
+  std::string_view constraint_kind(const std::string& name) const {
+    const Index k = constraint_names_.find(name, model_.constraint_name_of());
+    return k < 0 ? std::string_view() : std::string_view(model_.constraints_[static_cast<std::size_t>(k)].kind);
+  }
   /// Makes room for that many more coordinates and constraints (an optimisation for large generated models, e.g.
   /// the members of a scene family; never required).
   void reserve(Index more_coordinates, Index more_constraints);

@@ -104,15 +104,20 @@ double angle_from_free(const TorsionalSpring& s, const double* q, double t, std:
   return std::remainder(evaluate_joint(*s.joint, q, nullptr, nullptr).value - s.free_angle, 2.0 * M_PI);
 }
 
+// θ̇ = ∂θ/∂t + ∇θ · q̇, with ∇θ in `gradient` (angle_from_free()'s).
+double rate_along(const TorsionalSpring& s, const double* q, const double* qd, double t,
+                  const std::vector<double>& gradient) {
+  const std::vector<Index>& c = angle_coordinates(s);
+  double rate = s.angle ? s.angle->partial_t(q, t) : 0.0;
+  for (std::size_t i = 0; i < c.size(); ++i) rate += gradient[i] * qd[c[i]];
+  return rate;
+}
+
 AngleState angle_state(const TorsionalSpring& s, const double* q, const double* qd, const double* qdd, double t,
                        std::vector<double>& gradient) {
   AngleState st;
   st.from_free = angle_from_free(s, q, t, gradient);
-  if (qd) {
-    const std::vector<Index>& c = angle_coordinates(s);
-    st.rate = s.angle ? s.angle->partial_t(q, t) : 0.0;
-    for (std::size_t i = 0; i < c.size(); ++i) st.rate += gradient[i] * qd[c[i]];
-  }
+  if (qd) st.rate = rate_along(s, q, qd, t, gradient);
   st.moment = (s.law.has_value() ? s.law.evaluate(st.from_free).f : s.stiffness * st.from_free) + s.damping * st.rate +
               s.friction * friction_direction(st.rate);
   if (s.inertia != 0.0 && qd && qdd) st.moment += s.inertia * angle_acceleration(s, q, qd, qdd, t, gradient);
@@ -121,6 +126,14 @@ AngleState angle_state(const TorsionalSpring& s, const double* q, const double* 
 }
 
 }  // namespace
+
+double angle_rate(const TorsionalSpring& s, const double* q, const double* qd, double t,
+                  std::vector<double>& gradient) {
+  angle_from_free(s, q, t, gradient);
+  return qd ? rate_along(s, q, qd, t, gradient) : 0.0;
+}
+
+const std::vector<Index>& torsional_coordinates(const TorsionalSpring& s) { return angle_coordinates(s); }
 
 double LoadValue::value(const double* q, const double* qd, double t) const {
   const double u = expr->value(q, qd, t);

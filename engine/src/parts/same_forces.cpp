@@ -53,7 +53,7 @@ bool same_applied(const AppliedLoads& a, const AppliedLoads& b) {
         (x.joint && (x.joint->measure != y.joint->measure || !(x.joint->att == y.joint->att))) ||
         x.joint_coordinates != y.joint_coordinates || x.stiffness != y.stiffness || x.free_angle != y.free_angle ||
         x.damping != y.damping || x.friction != y.friction || x.inertia != y.inertia || !(x.law == y.law) ||
-        !same_value(x.moment, y.moment))
+        !same_value(x.moment, y.moment) || x.bearing != y.bearing)
       return false;
   }
   return true;

@@ -10,6 +10,7 @@
 #include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/joint_reactions.hpp"
+#include "solve/bearing_friction.hpp"
 #include "phiq/kinds/registry.hpp"
 #include "phiq/natural_joints.hpp"
 #include "scene/scene_reader.hpp"
@@ -206,6 +207,11 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
         .fail(
             "no part has mass and no load is applied: every effort would be zero (give parts a mass "
             "or a density, or apply loads)");
+  if (!out.constraints.empty() && !scene.sweep.sensitivities.empty() &&
+      BearingFrictions::any(scene.loads.applied.get()))
+    pending_.efforts_field->fail(
+        "the efforts' sensitivities ∂τ/∂p are not computed with a bearing's friction (it reads the reactions it "
+        "changes): ask them without the bearings");
   out.parts = std::move(massive);
   out.loads = std::make_shared<const Loads>(scene.loads);
   out.power = pending_.efforts_power;

@@ -8,6 +8,7 @@
 #include "phiq/text.hpp"
 #include "scene/family_expansion.hpp"
 #include "scene/part_reader.hpp"
+#include "solve/bearing_friction.hpp"
 
 namespace phiq::detail::scene {
 
@@ -192,7 +193,7 @@ bool PartReader::spring_stiffness(const C& s, double& stiffness, MotionLaw& law,
 template <class C>
 TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& names) const {
   s.expect_map({"name", "coordinate", "angle", "joint", "stiffness", "law", "moment", "free_angle", "damping",
-                "friction", "inertia"});
+                "friction", "inertia", "bearing"});
   TorsionalSpring spring;
   spring.name = load_name(s, names);
   const auto on_coordinate = s.field("coordinate"), angle = s.field("angle"), joint = s.field("joint");
@@ -228,11 +229,29 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
   if (auto m = s.field("moment"); m.present()) spring.moment = load_component(m);
   spring_stiffness(s, spring.stiffness, spring.law,
                    spring.moment.expr || s.field("damping").present() || s.field("friction").present() ||
-                       s.field("inertia").present());
+                       s.field("inertia").present() || s.field("bearing").present());
   if (auto a0 = s.field("free_angle"); a0.present()) spring.free_angle = r_.number(a0);
   if (auto d = s.field("damping"); d.present()) spring.damping = non_negative(d);
   if (auto f = s.field("friction"); f.present()) spring.friction = non_negative(f);
   if (auto j = s.field("inertia"); j.present()) spring.inertia = non_negative(j);
+  if (auto b = s.field("bearing"); b.present()) {
+    b.expect_map({"joint", "coefficient", "radius", "thrust_radius"});
+    BearingFriction& f = spring.bearing.emplace();
+    const auto on = b.field("joint");
+    if (!on.present() && !joint.present()) b.fail("a bearing names its `joint` (a pin, revolute or cylindrical joint)");
+    f.joint = on.present() ? on.name() : joint.name();
+    const std::string_view kind = r_.builder_.constraint_kind(f.joint);
+    if (!BearingFrictions::turns(kind))
+      (on.present() ? on : b)
+          .fail((kind.empty() ? "unknown joint '" + f.joint + "'" : "'" + f.joint + "' is a " + std::string(kind)) +
+                ": a bearing turns in a pin, revolute or cylindrical joint of 'constraints' (whose reaction loads it)");
+    f.coefficient = non_negative(b.require("coefficient"));
+    f.radius = non_negative(b.require("radius"));
+    if (auto a = b.field("thrust_radius"); a.present()) {
+      if (!r_.spatial_) a.fail("a thrust collar carries a force along a spatial joint's axis: none in the plane");
+      f.thrust_radius = non_negative(a);
+    }
+  }
   return spring;
 }
 

@@ -12,6 +12,7 @@
 #include "phiq/kinds/distance.hpp"
 #include "phiq/kinds/registry.hpp"
 #include "phiq/part_motion.hpp"
+#include "solve/bearing_friction.hpp"
 #include "solve/part_forces.hpp"
 #include "solve/factorisation.hpp"
 
@@ -355,6 +356,15 @@ SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, c
   if (!lambda.allFinite()) {
     if (message) *message = "the multipliers are not finite (an overflow of doubles)";
     return SolveStatus::kNonFinite;
+  }
+  if (detail::BearingFrictions::any(loads.applied.get())) {  // (ensure_factorized() gave ws.lu the factors at q)
+    detail::BearingFrictions bearings(model, *loads.applied);
+    Eigen::VectorXd kept;
+    const double* qd = ws.qd.size() == model.num_coordinates() ? ws.qd.data() : nullptr;  // (none: at rest)
+    if (!bearings.solve(model, *ws.lu, ws.q.data(), qd, t, Q, lambda, kept)) {
+      if (message) *message = bearings.failed_solve() ? ws.lu->last_message() : bearings.lock_message();
+      return bearings.failed_solve() ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
+    }
   }
   for (Index c : rheonomic_constraints(model))
     efforts.push_back(-lambda(model.constraints()[static_cast<std::size_t>(c)].first_row));

@@ -51,6 +51,16 @@ bool Sweeper::row_efforts() {
     }
     return fail(SolveStatus::kNonFinite, "efforts: " + why);
   }
+  if (effort_work_.bearings) {  // the bearings' friction, from the reactions it changes
+    BearingFrictions& b = *effort_work_.bearings;
+    const bool settled = b.solve(model_, *w->lu, current_.q.data(), current_.qd.data(), t, effort_work_.q,
+                                 effort_work_.lambda, effort_work_.kept);
+    ws_->counters.effort_solves += b.solves();
+    if (!settled) {
+      if (!b.failed_solve()) sum_.warnings.push_back({t, "friction_lock", b.lock_message()});
+      return not_defined();
+    }
+  }
   // Φt at the drivers' rows only (a power reads no other; the whole model's is O(rows) at every row)
   effort_work_.phi_t.resize(model_.num_equations());
   const std::vector<ConstraintInfo>& cs = model_.constraints();

@@ -88,6 +88,7 @@ SolveStatus sweep_in_arena(const Model& model, const SweepOptions& opt, Workspac
     detail::once_per_stretch(sum.warnings, "slow_convergence", opt);
     detail::once_per_stretch(sum.warnings, "belt_slack", opt);
     detail::once_per_stretch(sum.warnings, "gear_centres", opt);
+    detail::once_per_stretch(sum.warnings, "friction_lock", opt);
     sum.status = st;
     sum.counters = others;
     add_counters(sum.counters, ws.counters, before);

@@ -1,0 +1,149 @@
+// detail::BearingFrictions (solve/bearing_friction.hpp): a bearing's friction from its joint's reaction, solved with
+// the multipliers it changes.
+#include "solve/bearing_friction.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string_view>
+
+#include "phiq/constraint_block.hpp"
+#include "phiq/inverse_dynamics.hpp"
+#include "phiq/kinds/reaction_site.hpp"
+#include "phiq/model.hpp"
+#include "phiq/text.hpp"
+
+namespace phiq::detail {
+
+bool BearingFrictions::turns(std::string_view kind) {
+  return kind == "pin" || kind == "revolute" || kind == "cylindrical";
+}
+
+bool BearingFrictions::any(const AppliedLoads* loads) {
+  return loads && std::any_of(loads->torsional_springs.begin(), loads->torsional_springs.end(),
+                              [](const TorsionalSpring& s) { return s.bearing.has_value(); });
+}
+
+Index BearingFrictions::check(const Model& model, const TorsionalSpring& s) {
+  const std::string who = "torsional spring '" + s.name + "': bearing joint '" + s.bearing->joint + "'";
+  const Index c = model.find_constraint(s.bearing->joint);
+  if (c < 0) throw Error(who + " is not a constraint of the model");
+  const std::string_view kind = model.constraints()[static_cast<std::size_t>(c)].kind;
+  if (!turns(kind) || reaction_width(model, c) == 0)
+    throw Error(who + " is a " + std::string(kind) +
+                ": a bearing turns in a pin, revolute or cylindrical joint (whose reaction loads it)");
+  return c;
+}
+
+void BearingFrictions::check_model(const Model& model, const TorsionalSpring& s) {
+  const std::string who = "torsional spring '" + s.name + "'";
+  if (!model.dropped_rows().empty())
+    throw Error(who +
+                ": a bearing's friction reads its joint's reaction, which redundant constraints leave statically "
+                "indeterminate (the model dropped " +
+                std::to_string(model.dropped_rows().size()) + " redundant rows)");
+  for (std::size_t c = 0; c < model.constraints().size(); ++c) {
+    const auto [block, index] = model.constraint_block(static_cast<Index>(c));
+    if (GearMesh g; block->gear_mesh(index, g))
+      throw Error(who + ": a bearing's friction reads its joint's reaction, which leaves out the push of '" +
+                  model.constraints()[c].name + "''s " + (g.belt ? "strands" : "teeth") +
+                  " on its bearings (bearings' friction in a geared model is not computed)");
+  }
+}
+
+BearingFrictions::BearingFrictions(const Model& model, const AppliedLoads& loads) {
+  OutputEfforts joints;
+  joints.reactions_in_joint_axes = true;  // (a spatial joint's z is its axis: F_a its z, F_r across)
+  std::size_t at = 0;
+  for (const TorsionalSpring& s : loads.torsional_springs) {
+    if (!s.bearing) continue;
+    const Index c = check(model, s);
+    const bool spatial = reaction_width(model, c) == 6;
+    joints.reactions.push_back({c, spatial});
+    bearings_.push_back({&s, at, spatial});
+    at += spatial ? 6 : 3;
+  }
+  if (bearings_.empty()) return;
+  check_model(model, *bearings_[0].spring);
+  reactions_.emplace(model, joints);
+  values_.assign(static_cast<std::size_t>(reactions_->size()), 0.0);
+  moments_.assign(bearings_.size(), 0.0), next_ = moments_, rates_ = moments_;
+  gradients_.resize(bearings_.size());
+}
+
+void BearingFrictions::moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m) {
+  reactions_->evaluate(q, t, lambda, values_.data());
+  for (std::size_t i = 0; i < bearings_.size(); ++i) {
+    const BearingFriction& b = *bearings_[i].spring->bearing;
+    const double* f = values_.data() + bearings_[i].at;
+    const double across = std::hypot(f[0], f[1]), along = bearings_[i].spatial ? std::abs(f[2]) : 0.0;
+    m[i] = b.coefficient * (b.radius * across + b.thrust_radius * along);
+  }
+}
+
+bool BearingFrictions::solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd, double t,
+                             Eigen::VectorXd& Q, Eigen::VectorXd& lambda, Eigen::VectorXd& kept) {
+  solves_ = 0, passes_ = 0, failed_solve_ = false, worst_change_ = 0.0, ratio_ = 0.0;
+  for (std::size_t i = 0; i < bearings_.size(); ++i)
+    rates_[i] = angle_rate(*bearings_[i].spring, q, qd, t, gradients_[i]);
+  lambda0_ = lambda;
+  moments_at(q, t, lambda, moments_);
+  q_f_.resize(Q.size());
+  double first_change = 0.0;
+  int growing = 0;  // passes in a row whose change grew
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    // Q_f of the moments, against each θ̇ (none at rest)
+    q_f_.setZero();
+    for (std::size_t i = 0; i < bearings_.size(); ++i) {
+      const double m = moments_[i] * friction_direction(rates_[i]);
+      const std::vector<Index>& c = torsional_coordinates(*bearings_[i].spring);
+      for (std::size_t k = 0; k < c.size(); ++k) q_f_(c[k]) -= m * gradients_[i][k];
+    }
+    if (q_f_.isZero(0.0)) return true;  // (every bearing at rest or unloaded: λ0 stands)
+    if (!multipliers_with_factors(model, lu, q_f_, kept, d_lambda_)) return failed_solve_ = true, false;
+    ++solves_;
+    lambda = lambda0_ + d_lambda_;
+    moments_at(q, t, lambda, next_);
+    // settled when no moment changes beyond rounding: λ is then the multipliers of the moments it was solved with
+    double change = 0.0, scale = 0.0;
+    for (std::size_t i = 0; i < bearings_.size(); ++i) {
+      const double d = std::abs(next_[i] - moments_[i]);
+      if (d > change) change = d, worst_ = i;
+      scale = std::max(scale, std::abs(next_[i]));
+    }
+    passes_ = pass + 1;
+    if (change <= 1e-13 * scale) {
+      Q += q_f_;
+      return true;
+    }
+    if (pass == 0) first_change = change;
+    // The pass's contraction ρ: below 1 near the solution it makes the solution unique (the friction takes more of
+    // its own load than it adds) and the passes reach it; at 1 or more there is none or several (a jam, or
+    // Painlevé's indeterminacy), which the passes cannot settle on, and which is told as such.
+    if (pass > 0) ratio_ = change / worst_change_, growing = ratio_ >= 1.0 ? growing + 1 : 0;
+    worst_change_ = change;
+    if (growing >= 3 || !(change <= 1e3 * first_change)) break;  // not settling (or not finite): it will not
+    std::swap(moments_, next_);
+  }
+  Q += q_f_;
+  return false;
+}
+
+double BearingFrictions::power() const {
+  double p = 0.0;
+  for (std::size_t i = 0; i < bearings_.size(); ++i) p -= moments_[i] * std::abs(rates_[i]);
+  return p;
+}
+
+std::string BearingFrictions::lock_message() const {
+  const TorsionalSpring& s = *bearings_[worst_].spring;
+  return "the friction of bearing '" + s.bearing->joint + "' (torsional spring '" + s.name +
+         "') adds to its own load " +
+         (ratio_ >= 1.0 ? "as much as it takes or more (a pass multiplies its change by " + significant(ratio_, 3) +
+                              "): the mechanism jams (self-locking) or its friction is not determined"
+                        : "almost as much as it takes (a pass multiplies its change by " + significant(ratio_, 3) +
+                              ", not settled in " + std::to_string(passes_) +
+                              " passes): the mechanism is at the edge of self-locking") +
+         "; no effort is written here";
+}
+
+}  // namespace phiq::detail

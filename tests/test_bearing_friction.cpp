@@ -1,0 +1,259 @@
+// A bearing's friction from its joint's reaction (BearingFriction, solve/bearing_friction.hpp): a massive four-bar
+// with a bearing at every pin satisfies every link's Newton–Euler equations written here, each pin's friction couple
+// μ r |F| against its relative turn from the written reaction F; a driven pendulum's pivot (μ r |F| added to
+// m g l cos ψ) and a spatial rotor's journal and thrust collar (μ (r m ω² e + r_a m g)) against their closed forms,
+// through driver_efforts() and the sweep; parallel chunks give the sequential bits; a jamming four-bar is told at
+// its rows; and bad input is refused in one line.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+
+#include "phiq/inverse_dynamics.hpp"
+#include "phiq/phiq.hpp"
+#include "reaction_rows.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+// models/dynamics/fourbar_pin_loads.yaml with a bearing of μ, r at each of its pins O, A, B, C, and `output`.
+std::string fourbar_with_bearings(double mu, double r, const std::string& output) {
+  std::string text = test::model_file_text("dynamics/fourbar_pin_loads.yaml", "loads:");
+  const std::string b = "coefficient: " + std::to_string(mu) + ", radius: " + std::to_string(r) + "}}\n";
+  text +=
+      "loads:\n  gravity: [0, -9.81]\n  torsional_springs:\n"
+      "    - {name: fO, angle: psi2, bearing: {joint: O, " +
+      b + "    - {name: fA, angle: psi3 - psi2, bearing: {joint: A, " + b +
+      "    - {name: fB, angle: psi4 - psi3, bearing: {joint: B, " + b +
+      "    - {name: fC, angle: psi4, bearing: {joint: C, " + b + "time: {start: 0, end: 1, steps: 72}\n" + output;
+  return text;
+}
+
+TEST(BearingFriction, FourBarPinsWithBearingsSatisfyEveryLinksNewtonEuler) {
+  const double mu = 0.3, radius = 0.05, m2 = 1.0, m3 = 2.0, m4 = 1.5, L2 = 0.4, L3 = 1.2, L4 = 1.0, g = 9.81;
+  const std::string out = "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
+  const Scene s = parse_scene(fourbar_with_bearings(mu, radius, out), "bearings.yaml");
+  SweepSummary sum;
+  const test::ReactionRows rows = test::sweep_reactions(s, &sum);
+  ASSERT_EQ(rows.q.size(), 73u);
+  EXPECT_GT(sum.counters.effort_solves, 3 * 73) << "the moments are solved for, in passes";
+  const Model& m = *s.model;
+  auto c = [&](const char* n) { return m.coordinate_index(n); };
+  auto at = [&](const Eigen::VectorXd& q, const char* x, const char* y, const char* p, double s_local) {
+    return Eigen::Vector2d(q(c(x)) + s_local * std::cos(q(c(p))), q(c(y)) + s_local * std::sin(q(c(p))));
+  };
+  auto cross2 = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); };
+  auto sign = [](double v) { return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : 0.0; };
+  double largest_couple = 0.0;
+  for (std::size_t k = 0; k < rows.q.size(); ++k) {
+    const Eigen::VectorXd &q = rows.q[k], &qd = rows.qd[k], &qdd = rows.qdd[k];
+    const std::vector<double>& v = rows.values[k];
+    const double tau = v[0];
+    auto F = [&](int j) { return Eigen::Vector2d(v[2 + 3 * j], v[3 + 3 * j]); };
+    // each pin's friction couple μ r |F| against its relative turn θ̇ (θ = ψ_b − ψ_a; O's and C's ψ against ground)
+    const double turn[4] = {qd(c("psi2")), qd(c("psi3")) - qd(c("psi2")), qd(c("psi4")) - qd(c("psi3")), qd(c("psi4"))};
+    double f[4];
+    for (int j = 0; j < 4; ++j) {
+      f[j] = mu * radius * F(j).norm() * sign(turn[j]);
+      largest_couple = std::max(largest_couple, std::fabs(f[j]));
+    }
+    const Eigen::Vector2d O = at(q, "x2", "y2", "psi2", -L2 / 2), A = at(q, "x2", "y2", "psi2", L2 / 2),
+                          B = at(q, "x3", "y3", "psi3", L3 / 2), C = at(q, "x4", "y4", "psi4", -L4 / 2);
+    struct Link {
+      double mass, inertia;
+      const char *x, *y, *p;
+      std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> forces;  // (point, force)
+      double torque;  // the motor's and the couples': −f on the turn's later body, +f on its earlier one
+    };
+    const Link links[3] = {
+        {m2, m2 * L2 * L2 / 12, "x2", "y2", "psi2", {{O, F(0)}, {A, F(1)}}, tau - f[0] + f[1]},
+        {m3, m3 * L3 * L3 / 12, "x3", "y3", "psi3", {{A, -F(1)}, {B, F(2)}}, -f[1] + f[2]},
+        {m4, m4 * L4 * L4 / 12, "x4", "y4", "psi4", {{B, -F(2)}, {C, F(3)}}, -f[2] - f[3]},
+    };
+    for (const Link& l : links) {
+      const Eigen::Vector2d G(q(c(l.x)), q(c(l.y))), a(qdd(c(l.x)), qdd(c(l.y)));
+      Eigen::Vector2d sum_f = Eigen::Vector2d(0, -l.mass * g);
+      double moment = l.torque;
+      for (const auto& [P, force] : l.forces) sum_f += force, moment += cross2(P - G, force);
+      EXPECT_NEAR((sum_f - l.mass * a).norm(), 0.0, 1e-9 * (1.0 + sum_f.norm())) << l.x << " row " << k;
+      EXPECT_NEAR(moment, l.inertia * qdd(c(l.p)), 1e-9 * (1.0 + std::fabs(moment))) << l.x << " row " << k;
+    }
+  }
+  EXPECT_GT(largest_couple, 0.3);  // the couples are felt: a frictionless solution fails the moments above
+}
+
+// A bar of mass mass pinned at its end to ground, its centre at l, driven at ψ = ω t with a pivot bearing of μ, r.
+std::string pendulum_text(double mu, double r, const std::string& output) {
+  return "phiq: 1\nname: pivot\nparameters: {l: 0.5, w: 3}\n"
+         "coordinates: {x: 0.5, y: 0, psi: 0}\nbodies: {bar: [x, y, psi]}\n"
+         "constraints:\n  - {name: pivot, type: revolute, between: [{body: bar, at: [-l, 0]}, {body: ground, at: "
+         "[0, 0]}]}\n"
+         "drivers:\n  - {name: motor, coordinate: psi, law: {type: linear, initial: 0.3, rate: w}}\n"
+         "parts:\n  bar: {mass: 2.0, center_of_mass: [0, 0], inertia: 0.1}\n"
+         "loads:\n  gravity: [0, -9.81]\n  torsional_springs:\n    - {name: journal, angle: psi, bearing: {joint: "
+         "pivot, "
+         "coefficient: " +
+         std::to_string(mu) + ", radius: " + std::to_string(r) +
+         "}}\n"
+         "time: {start: 0, end: 2, steps: 40}\n" +
+         output;
+}
+
+TEST(BearingFriction, ADrivenPendulumsPivotAddsMuRTimesItsLoad) {
+  const double mu = 0.25, r = 0.03, mass = 2.0, l = 0.5, w = 3.0, g = 9.81;
+  const Scene s = parse_scene(
+      pendulum_text(mu, r, "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n"),
+      "pivot.yaml");
+  const test::ReactionRows rows = test::sweep_reactions(s);
+  ASSERT_EQ(rows.q.size(), 41u);
+  Workspace ws(*s.model);
+  std::vector<double> efforts;
+  for (std::size_t k = 0; k < rows.q.size(); ++k) {
+    const double psi = rows.q[k](s.model->coordinate_index("psi"));
+    // the pivot's push on the bar: m a_G − m g, a_G = −ω² l (cos ψ, sin ψ) (no angular acceleration)
+    const Eigen::Vector2d F(-mass * w * w * l * std::cos(psi), -mass * w * w * l * std::sin(psi) + mass * g);
+    const double expected = mass * g * l * std::cos(psi) + mu * r * F.norm();
+    EXPECT_NEAR(rows.values[k][0], expected, 1e-10 * (1.0 + std::fabs(expected))) << "sweep, row " << k;
+    EXPECT_NEAR(rows.values[k][2], F.x(), 1e-9 * F.norm()) << "row " << k;  // a couple moves no pin force
+    ws.q = rows.q[k], ws.qd = rows.qd[k], ws.qdd = rows.qdd[k];
+    std::string why;
+    ASSERT_EQ(driver_efforts(*s.model, s.parts, s.loads, 2.0 * static_cast<double>(k) / 40.0, ws, efforts, &why),
+              SolveStatus::kSuccess)
+        << why;
+    EXPECT_NEAR(efforts.at(0), expected, 1e-10 * (1.0 + std::fabs(expected))) << "driver_efforts, row " << k;
+  }
+}
+
+TEST(BearingFriction, ASpatialRotorsJournalAndThrustCollarTakeMuTimesTheirLoads) {
+  // a disc on a vertical hinge, its centre e off the axis, turned at ω: radial load m ω² e, axial m g
+  const double mu = 0.15, r = 0.02, ra = 0.035, mass = 3.0, e = 0.1, w = 4.0, g = 9.81;
+  const std::string text =
+      "phiq: 1\nname: rotor\ndimension: 3\n"
+      "coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\nbodies: {disc: [x, y, z, e0, e1, e2, e3]}\n"
+      "constraints:\n  - {name: hinge, type: revolute, between: [{body: ground, axis: [0, 0, 1]}, {body: disc, "
+      "axis: [0, 0, 1]}]}\n"
+      "drivers:\n  - {name: motor, joint: hinge, law: {type: linear, initial: 0, rate: 4}}\n"
+      "parts:\n  disc: {mass: 3.0, center_of_mass: [0.1, 0, 0], inertia: [0.02, 0.03, 0.04]}\n"
+      "loads:\n  gravity: [0, 0, -9.81]\n"
+      "  torsional_springs: [{name: bearing, joint: hinge, bearing: {coefficient: 0.15, radius: 0.02, "
+      "thrust_radius: 0.035}}]\n"
+      "time: {start: 0, end: 1.5, steps: 30}\n"
+      "output: {velocities: true, accelerations: true, efforts: [motor]}\n";
+  const Scene s = parse_scene(text, "rotor.yaml");
+  const test::ReactionRows rows = test::sweep_reactions(s);
+  ASSERT_EQ(rows.q.size(), 31u);
+  const double expected = mu * (r * mass * w * w * e + ra * mass * g);
+  for (std::size_t k = 0; k < rows.q.size(); ++k)
+    EXPECT_NEAR(rows.values[k][0], expected, 1e-10 * expected) << "row " << k;
+}
+
+TEST(BearingFriction, ParallelChunksGiveTheSequentialBits) {
+  const Scene s = parse_scene(fourbar_with_bearings(0.3, 0.05, "output: {efforts: all, power: true, reactions: all}\n"),
+                              "bearings.yaml");
+  auto values = [&](int threads) {
+    SweepOptions opt = s.sweep;
+    opt.threads = threads;
+    std::vector<double> out;
+    Workspace ws(*s.model);
+    ws.q = s.model->initial_positions();
+    EXPECT_EQ(run_sweep(
+                  *s.model, opt, ws,
+                  [&](const StepView& v) {
+                    out.insert(out.end(), v.efforts, v.efforts + s.sweep.efforts.size());
+                    return true;
+                  },
+                  nullptr),
+              SolveStatus::kSuccess);
+    return out;
+  };
+  const std::vector<double> one = values(1), two = values(2);
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t i = 0; i < one.size(); ++i) ASSERT_EQ(one[i], two[i]) << "value " << i;
+}
+
+TEST(BearingFriction, AJammingFourBarIsToldAtItsRowsWithNoEffort) {
+  // journals as wide as the links: at some rows the friction adds to its own load more than it takes
+  const Scene s = parse_scene(fourbar_with_bearings(1.0, 1.0, "output: {efforts: [motor]}\n"), "jam.yaml");
+  Workspace ws(*s.model);
+  ws.q = s.model->initial_positions();
+  std::size_t undefined = 0, defined = 0;
+  SweepSummary sum;
+  ASSERT_EQ(run_sweep(
+                *s.model, s.sweep, ws,
+                [&](const StepView& v) {
+                  (std::isnan(v.efforts[0]) ? undefined : defined) += 1;
+                  return true;
+                },
+                &sum),
+            SolveStatus::kSuccess);
+  EXPECT_GT(undefined, 10u);
+  EXPECT_GT(defined, 5u);
+  std::size_t told = 0;
+  for (const SweepWarning& w : sum.warnings)
+    if (w.kind == "friction_lock") {
+      ++told;
+      EXPECT_NE(w.message.find("jams (self-locking)"), std::string::npos) << w.message;
+    }
+  EXPECT_GE(told, 1u);
+  // realistic bearings settle everywhere
+  const Scene fine = parse_scene(fourbar_with_bearings(0.2, 0.02, "output: {efforts: [motor]}\n"), "fine.yaml");
+  SweepSummary fine_sum;
+  Workspace fine_ws(*fine.model);
+  fine_ws.q = fine.model->initial_positions();
+  ASSERT_EQ(
+      run_sweep(
+          *fine.model, fine.sweep, fine_ws, [&](const StepView& v) { return std::isfinite(v.efforts[0]); }, &fine_sum),
+      SolveStatus::kSuccess);
+  EXPECT_TRUE(fine_sum.warnings.empty());
+}
+
+TEST(BearingFriction, BadBearingsAreRefusedInOneLine) {
+  const std::string out = "output: {efforts: [motor]}\n";
+  auto refused = [&](const std::string& text, const std::string& expected) {
+    try {
+      parse_scene(text, "bad.yaml");
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const std::exception& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(expected), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  };
+  const std::string good = pendulum_text(0.2, 0.01, out);
+  refused(test::replace_first(good, "joint: pivot,", "joint: motor,"), "'motor' is a ");
+  refused(test::replace_first(good, "joint: pivot,", "joint: nowhere,"), "unknown joint 'nowhere'");
+  refused(test::replace_first(good, "coefficient: ", "coefficient: -"), "coefficient");
+  refused(test::replace_first(good, "radius: 0.01", "thrust_radius: 0.01"), "radius");
+  refused(test::replace_first(good, "radius: 0.01", "radius: 0.01, thrust_radius: 0.02"), "none in the plane");
+  refused(test::replace_first(good, "bearing: {joint: pivot,", "bearing: {"), "names its `joint`");
+  // efforts' sensitivities read Q's rate along p, which a bearing's friction does not have: refused in the scene,
+  // and by the sweep of options put together in code
+  const std::string sens = test::replace_first(good, "output: {", "output: {sensitivities: [l], ");
+  refused(sens, "output.efforts: the efforts' sensitivities");
+  std::string damped = sens;
+  const std::size_t from = damped.find("bearing: {"), to = damped.find("}}", from);
+  ASSERT_NE(to, std::string::npos);
+  damped.replace(from, to + 1 - from, "damping: 0.01");
+  const Scene with_sens = parse_scene(damped, "damped.yaml"), bearing = parse_scene(good, "bearing.yaml");
+  SweepOptions opt = with_sens.sweep;
+  ASSERT_FALSE(opt.sensitivities.empty());
+  opt.efforts.loads = bearing.sweep.efforts.loads;
+  Workspace ws(*with_sens.model);
+  ws.q = with_sens.model->initial_positions();
+  EXPECT_THROW(
+      {
+        try {
+          (void)run_sweep(
+              *with_sens.model, opt, ws, [](const StepView&) { return true; }, nullptr);
+        } catch (const Error& e) {
+          EXPECT_NE(std::string(e.what()).find("bearing"), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      Error);
+}
+
+}  // namespace
+}  // namespace phiq
