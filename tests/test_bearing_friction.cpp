@@ -149,6 +149,43 @@ TEST(BearingFriction, ASpatialRotorsJournalAndThrustCollarTakeMuTimesTheirLoads)
     EXPECT_NEAR(rows.values[k][0], expected, 1e-10 * expected) << "row " << k;
 }
 
+TEST(BearingFriction, ACamFollowersGuideRubsByMuTimesTheCamsSidePush) {
+  // models/cams/eccentric_roller.yaml: the cam's push on the roller leans off the guide's axis; the guide takes the
+  // lean across, and its friction μ |F_across| opposes the rod's travel, so the cam pushes harder
+  const double m = 0.7, g = 9.81, mu = 0.3, e = 0.015;
+  const std::string text =
+      test::model_file_text("cams/eccentric_roller.yaml", "output:") +
+      "parts:\n  rod: {mass: 0.7, center_of_mass: [0, 0], inertia: 1e-3}\n"
+      "  disc: {mass: 2.0, center_of_mass: [0, 0], inertia: 3e-3}\n"
+      "loads:\n  gravity: [0, -9.81]\n"
+      "  torsional_springs: [{name: rub, coordinate: yf, bearing: {joint: guide, coefficient: 0.3}}]\n"
+      "output: {velocities: true, accelerations: true, efforts: [motor], power: true, "
+      "reactions: [cam, guide]}\n";
+  const Scene s = parse_scene(text, "rub.yaml");
+  const Model* swept = nullptr;
+  const test::ReactionRows rows = test::sweep_reactions(s, nullptr, &swept);
+  ASSERT_EQ(rows.q.size(), 73u);
+  const Index yf = swept->coordinate_index("yf"), th = swept->coordinate_index("th");
+  double largest_rub = 0.0;
+  for (std::size_t k = 0; k < rows.q.size(); ++k) {
+    const std::vector<double>& v = rows.values[k];
+    const Eigen::Vector2d cam(v[2], v[3]), guide(v[5], v[6]);  // each on the rod
+    const double yd = rows.qd[k](yf), ydd = rows.qdd[k](yf);
+    const double rub = -mu * guide.norm() * (yd > 0.0 ? 1.0 : yd < 0.0 ? -1.0 : 0.0);
+    largest_rub = std::max(largest_rub, std::fabs(rub));
+    // the rod, which only slides: Newton across the guide and along it, the rub in its y
+    EXPECT_NEAR(cam.x() + guide.x(), 0.0, 1e-9) << k;
+    EXPECT_NEAR(cam.y() + guide.y() + rub - m * g, m * ydd, 1e-9) << k;
+    // the cam pushes along the contact's normal, from its circle's centre to the roller's (on x = 0)
+    const double t = rows.q[k](th), nx = -e * std::cos(t), ny = rows.q[k](yf) - e * std::sin(t);
+    EXPECT_NEAR(cam.x() * ny - cam.y() * nx, 0.0, 1e-9 * cam.norm()) << k;
+    // the motor's power: the rod's kinetic and potential energy's rate and what the guide's rub dissipates (the
+    // disc turns steadily about its centre)
+    EXPECT_NEAR(v[1], m * yd * (ydd + g) - rub * yd, 1e-9 * (1.0 + std::fabs(v[1]))) << k;
+  }
+  EXPECT_GT(largest_rub, 0.05);  // the side push is felt
+}
+
 TEST(BearingFriction, ParallelChunksGiveTheSequentialBits) {
   const Scene s = parse_scene(fourbar_with_bearings(0.3, 0.05, "output: {efforts: all, power: true, reactions: all}\n"),
                               "bearings.yaml");
@@ -223,6 +260,12 @@ TEST(BearingFriction, BadBearingsAreRefusedInOneLine) {
   };
   const std::string good = pendulum_text(0.2, 0.01, out);
   refused(test::replace_first(good, "joint: pivot,", "joint: motor,"), "'motor' is a ");
+  refused(test::replace_first(test::model_file_text("cams/eccentric_roller.yaml", "output:"), "time:",
+                              "parts: {rod: {mass: 1, center_of_mass: [0, 0], inertia: 1}}\nloads: {torsional_springs: "
+                              "[{name: rub, coordinate: yf, bearing: {joint: guide, coefficient: 0.3, radius: "
+                              "0.1}}]}\ntime:") +
+              out,
+          "a prismatic pair slides");
   refused(test::replace_first(good, "joint: pivot,", "joint: nowhere,"), "unknown joint 'nowhere'");
   refused(test::replace_first(good, "coefficient: ", "coefficient: -"), "coefficient");
   refused(test::replace_first(good, "radius: 0.01", "thrust_radius: 0.01"), "radius");

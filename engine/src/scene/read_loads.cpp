@@ -238,17 +238,25 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
     b.expect_map({"joint", "coefficient", "radius", "thrust_radius"});
     BearingFriction& f = spring.bearing.emplace();
     const auto on = b.field("joint");
-    if (!on.present() && !joint.present()) b.fail("a bearing names its `joint` (a pin, revolute or cylindrical joint)");
+    if (!on.present() && !joint.present())
+      b.fail("a bearing names its `joint` (a pin, revolute, cylindrical or prismatic joint)");
     f.joint = on.present() ? on.name() : joint.name();
     const std::string_view kind = r_.builder_.constraint_kind(f.joint);
-    if (!BearingFrictions::turns(kind))
+    if (!BearingFrictions::carries(kind))
       (on.present() ? on : b)
           .fail((kind.empty() ? "unknown joint '" + f.joint + "'" : "'" + f.joint + "' is a " + std::string(kind)) +
-                ": a bearing turns in a pin, revolute or cylindrical joint of 'constraints' (whose reaction loads it)");
+                ": a bearing is a pin, revolute, cylindrical or prismatic joint of 'constraints' (whose reaction "
+                "loads it)");
     f.coefficient = non_negative(b.require("coefficient"));
-    f.radius = non_negative(b.require("radius"));
+    // a slide (a prismatic pair, a cylindrical one along its travel) has no radius: its friction is a force
+    const auto radius = b.field("radius");
+    f.slide = kind == "prismatic" || (kind == "cylindrical" && !radius.present());
+    if (kind == "prismatic" && radius.present())
+      radius.fail("a prismatic pair slides: its friction is the force μ |F_r| along its travel, with no radius");
+    if (!f.slide) f.radius = non_negative(b.require("radius"));
     if (auto a = b.field("thrust_radius"); a.present()) {
       if (!r_.spatial_) a.fail("a thrust collar carries a force along a spatial joint's axis: none in the plane");
+      if (f.slide) a.fail("a slide's friction is a force, not a moment: it has no thrust collar");
       f.thrust_radius = non_negative(a);
     }
   }

@@ -14,8 +14,8 @@
 
 namespace phiq::detail {
 
-bool BearingFrictions::turns(std::string_view kind) {
-  return kind == "pin" || kind == "revolute" || kind == "cylindrical";
+bool BearingFrictions::carries(std::string_view kind) {
+  return kind == "pin" || kind == "revolute" || kind == "cylindrical" || kind == "prismatic";
 }
 
 bool BearingFrictions::any(const AppliedLoads* loads) {
@@ -28,9 +28,13 @@ Index BearingFrictions::check(const Model& model, const TorsionalSpring& s) {
   const Index c = model.find_constraint(s.bearing->joint);
   if (c < 0) throw Error(who + " is not a constraint of the model");
   const std::string_view kind = model.constraints()[static_cast<std::size_t>(c)].kind;
-  if (!turns(kind) || reaction_width(model, c) == 0)
+  if (!carries(kind) || reaction_width(model, c) == 0)
     throw Error(who + " is a " + std::string(kind) +
-                ": a bearing turns in a pin, revolute or cylindrical joint (whose reaction loads it)");
+                ": a bearing is a pin, revolute, cylindrical or prismatic joint (whose reaction loads it)");
+  if (s.bearing->slide ? kind != "prismatic" && kind != "cylindrical" : kind == "prismatic")
+    throw Error(
+        who + " is a " + std::string(kind) + ": its friction is " +
+        (s.bearing->slide ? "a journal's moment, not a slide's force" : "a slide's force, not a journal's moment"));
   return c;
 }
 
@@ -76,7 +80,7 @@ void BearingFrictions::moments_at(const double* q, double t, const Eigen::Vector
     const BearingFriction& b = *bearings_[i].spring->bearing;
     const double* f = values_.data() + bearings_[i].at;
     const double across = std::hypot(f[0], f[1]), along = bearings_[i].spatial ? std::abs(f[2]) : 0.0;
-    m[i] = b.coefficient * (b.radius * across + b.thrust_radius * along);
+    m[i] = b.coefficient * (b.slide ? across : b.radius * across + b.thrust_radius * along);
   }
 }
 

@@ -1,12 +1,12 @@
 // Internal: the bearings' frictions (TorsionalSpring::bearing, phiq/applied_loads.hpp) in the efforts' solve.
 //
-// A bearing's moment m = μ (r |F_r| + r_a |F_a|) reads its joint's reaction, which the multipliers give, while the
-// multipliers solve Φqᵀ λ = Q + Q_f(m), Q_f = −Σ m_i sign(θ̇_i) ∇θ_i: a fixed point. With λ0 the multipliers of Q
-// alone, λ = λ0 + Φq⁻ᵀ Q_f(m) is linear in the moments, so each pass of the iteration m ← m(λ0 + Φq⁻ᵀ Q_f(m)) is one
-// transposed solve with the row's own factors and the bearings' reactions (JointReactions on their joints only).
-// The pass contracts by about μ r / (the mechanism's lever arms): a few passes for real bearings. Where it does not
-// settle, the friction feeds its own load faster than it gives it: the mechanism jams (self-locking), told at the
-// row rather than written as a number. The friction's direction is θ̇'s, fixed at the row, so the moments alone
+// A bearing's moment m = μ (r |F_r| + r_a |F_a|) (a slide's force μ |F_r|) reads its joint's reaction, which the
+// multipliers give, while the multipliers solve Φqᵀ λ = Q + Q_f(m), Q_f = −Σ m_i sign(θ̇_i) ∇θ_i: a fixed point. With λ0
+// the multipliers of Q alone, λ = λ0 + Φq⁻ᵀ Q_f(m) is linear in the moments, so each pass of the iteration m ← m(λ0 +
+// Φq⁻ᵀ Q_f(m)) is one transposed solve with the row's own factors and the bearings' reactions (JointReactions on their
+// joints only). The pass contracts by about μ r / (the mechanism's lever arms): a few passes for real bearings. Where
+// it does not settle, the friction feeds its own load faster than it gives it: the mechanism jams (self-locking), told
+// at the row rather than written as a number. The friction's direction is θ̇'s, fixed at the row, so the moments alone
 // iterate. Not with redundant rows (the reactions it reads are not unique) nor with gear meshes (their teeth's push
 // on a bearing is not in its joint's multipliers: OutputEfforts::meshes).
 #pragma once
@@ -37,9 +37,10 @@ class BearingFrictions {
   static Index check(const Model& model, const TorsionalSpring& s);
   // Throws phiq::Error, naming `s`, where `model` cannot solve a bearing's friction (above).
   static void check_model(const Model& model, const TorsionalSpring& s);
-  // Whether a constraint of kind `kind` turns a bearing: a pin (about the plane's normal), a revolute or a
-  // cylindrical joint (about its joint frame's z).
-  static bool turns(std::string_view kind);
+  // Whether a constraint of kind `kind` can be a bearing: a pin (turning about the plane's normal), a revolute or a
+  // cylindrical joint (about its joint frame's z), a prismatic pair (a slide: along its x in the plane, its z in
+  // space; a cylindrical one along its z too), whose joint axes put the load it carries across in x, y.
+  static bool carries(std::string_view kind);
   // Whether `loads` has a bearing.
   static bool any(const AppliedLoads* loads);
 
