@@ -2,8 +2,9 @@
 // with a bearing at every pin satisfies every link's Newton–Euler equations written here, each pin's friction couple
 // μ r |F| against its relative turn from the written reaction F; a driven pendulum's pivot (μ r |F| added to
 // m g l cos ψ) and a spatial rotor's journal and thrust collar (μ (r m ω² e + r_a m g)) against their closed forms,
-// through driver_efforts() and the sweep; parallel chunks give the sequential bits; a jamming four-bar is told at
-// its rows; and bad input is refused in one line.
+// through driver_efforts() and the sweep; a cam follower's guide rubs by μ times the cam's side push (Newton, the
+// power), settles where μ tan φ < 1 to the closed form and is told where it exceeds 1 (self-locking); parallel
+// chunks give the sequential bits; a jamming four-bar is told at its rows; and bad input is refused in one line.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -184,6 +185,55 @@ TEST(BearingFriction, ACamFollowersGuideRubsByMuTimesTheCamsSidePush) {
     EXPECT_NEAR(v[1], m * yd * (ydd + g) - rub * yd, 1e-9 * (1.0 + std::fabs(v[1]))) << k;
   }
   EXPECT_GT(largest_rub, 0.05);  // the side push is felt
+}
+
+TEST(BearingFriction, ACamFollowerJamsWhereMuTanPhiReachesOne) {
+  // A steeper cam (pressure angle φ up to 37°): the guide's rub μ |F sin φ| against the push's lift F cos φ, so the
+  // pass multiplies a change of the rub by ρ = μ |tan φ|, the follower's classic self-locking number. Below 1 the
+  // rub settles to its closed form; above it the rows are told (no solution, or two: never a number).
+  const double mu = 2.0, m = 0.7, g = 9.81, e = 0.015;
+  std::string text = test::model_file_text("cams/eccentric_roller.yaml", "output:");
+  text = test::replace_first(text, "{R: 0.05, e: 0.015, rho: 0.01,", "{R: 0.02, e: 0.015, rho: 0.005,");
+  text = test::replace_first(text, "yf: 0.07", "yf: 0.03");
+  text +=
+      "parts:\n  rod: {mass: 0.7, center_of_mass: [0, 0], inertia: 1e-3}\n"
+      "loads:\n  gravity: [0, -9.81]\n"
+      "  torsional_springs: [{name: rub, coordinate: yf, bearing: {joint: guide, coefficient: 2}}]\n"
+      "output: {velocities: true, accelerations: true, efforts: [motor], reactions: [cam]}\n";
+  const Scene s = parse_scene(text, "steep.yaml");
+  SquareScene square;
+  ASSERT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &square), SolveStatus::kSuccess);
+  const Model& model = square.model(*s.model);
+  const Index yf = model.coordinate_index("yf"), th = model.coordinate_index("th");
+  Workspace ws(model);
+  ws.q = square.start;
+  SweepSummary sum;
+  std::size_t settled = 0, told = 0;
+  ASSERT_EQ(run_sweep(
+                model, s.sweep, ws,
+                [&](const StepView& v) {
+                  const double y = v.q(yf), t = v.q(th), nx = -e * std::cos(t), ny = y - e * std::sin(t);
+                  const double rho = mu * std::fabs(nx / ny);
+                  if (rho < 0.9) {
+                    // the closed form: the lift F ny/|n| less the rub μ F |nx|/|n| against ẏ carries m (ÿ + g)
+                    const double yd = (*v.qd)(yf), ydd = (*v.qdd)(yf), s_rub = yd > 0 ? 1.0 : yd < 0 ? -1.0 : 0.0;
+                    const double F = m * (ydd + g) * std::hypot(nx, ny) / (ny - s_rub * mu * std::fabs(nx));
+                    EXPECT_NEAR(std::hypot(v.efforts[2], v.efforts[3]), std::fabs(F), 1e-9 * std::fabs(F)) << t;
+                    EXPECT_TRUE(std::isfinite(v.efforts[0])) << t;
+                    ++settled;
+                  } else if (rho > 1.1) {
+                    EXPECT_TRUE(std::isnan(v.efforts[0])) << "ρ = " << rho << " at θ = " << t;
+                    ++told;
+                  }
+                  return true;
+                },
+                &sum),
+            SolveStatus::kSuccess);
+  EXPECT_GT(settled, 20u);
+  EXPECT_GT(told, 5u);
+  bool warned = false;
+  for (const SweepWarning& w : sum.warnings) warned = warned || w.kind == "friction_lock";
+  EXPECT_TRUE(warned);
 }
 
 TEST(BearingFriction, ParallelChunksGiveTheSequentialBits) {
