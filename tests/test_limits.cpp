@@ -2,15 +2,18 @@
 // crank-slider's stroke and its rate leave their ranges, against the closed form row by row (first and last row,
 // count, worst value); a driver's effort's, against the efforts the sweep writes; a spatial joint's angle over more
 // than a turn (unwrapped); the same warnings on any thread count and when rows are not written; a robot's joint
-// limits from URDF, MJCF and SDF (range, velocity, effort); and the bad input the reader refuses.
+// limits from URDF, MJCF and SDF (range, velocity, effort); a Stepper's steps, each listing the limits outside and
+// warning where a stretch begins; and the bad input the reader refuses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <regex>
 #include <tuple>
 
 #include "phiq/import_model.hpp"
 #include "phiq/phiq.hpp"
+#include "phiq/stepper.hpp"
 #include "phiq/text.hpp"
 #include "sensitivity_support.hpp"
 #include "test_support.hpp"
@@ -160,6 +163,51 @@ TEST(Limits, ACrankSlidersStrokeAndItsRateLeaveTheirRangesWhereTheClosedFormSays
   tau.clear();
   for (const auto& e : efforts) tau.push_back(e[0]);
   expect_same_stretches(written, expected_stretches("motor", times, tau, -5, 5), 1e-9);
+}
+
+TEST(Limits, AStepperSaysEachStretchAtItsFirstStepAndListsTheLimitsOutsideAtEvery) {
+  // the crank-slider's limits stepped over the sweep's grid: each step lists the limits outside there (closed forms
+  // of the stroke and its rate, the effort the step delivers), and warns where a stretch begins, where the sweep's
+  // stretches begin
+  const Scene s = parse_scene(kLimitedCrankSlider, "limited.yaml");
+  StepperOptions o;
+  static_cast<SolverSettings&>(o) = s.sweep;
+  o.velocities = o.accelerations = true;
+  o.efforts = s.sweep.efforts, o.limits = s.sweep.limits;
+  ASSERT_EQ(o.limits.size(), 3u);  // stroke, its rate, the motor's effort
+  Stepper stepper(*s.model, o);
+  std::vector<double> begun;
+  std::size_t outside = 0;
+  for (Index k = 0; k <= 90; ++k) {
+    const double tk = s.sweep.time_of(k), th = 2 * tk, r = std::sqrt(1.0 - 0.09 * std::sin(th) * std::sin(th));
+    const double x = 0.3 * std::cos(th) + r, xd = -0.6 * std::sin(th) * (1 + 0.3 * std::cos(th) / r);
+    StepSummary sum;
+    ASSERT_EQ(stepper.step(tk, &sum), SolveStatus::kSuccess) << sum.message;
+    const double tau = stepper.efforts()[0];
+    const auto listed = [&](const std::string& name) {
+      return static_cast<int>(std::count(sum.limits.begin(), sum.limits.end(), name));
+    };
+    EXPECT_EQ(listed("stroke"), (x < 0.75 || x > 1.25) + (xd < -0.5 || xd > 0.5)) << tk;
+    EXPECT_EQ(listed("motor"), tau < -5 || tau > 5 ? 1 : 0) << tk;
+    outside += sum.limits.size();
+    for (const SweepWarning& w : sum.warnings)
+      if (w.kind == "limit") {
+        EXPECT_EQ(w.t, tk);
+        begun.push_back(tk);
+      }
+    // the same step again re-delivers the state: the same list, no warning
+    StepSummary again;
+    ASSERT_EQ(stepper.step(tk, &again), SolveStatus::kSuccess);
+    EXPECT_EQ(again.limits, sum.limits);
+    EXPECT_TRUE(again.warnings.empty());
+  }
+  std::vector<double> want;
+  for (const LimitStretch& g : limit_stretches(limit_sweep(s, 1, 1))) want.push_back(g.from);
+  std::sort(want.begin(), want.end());
+  std::sort(begun.begin(), begun.end());
+  ASSERT_EQ(begun.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_NEAR(begun[i], want[i], 1e-9);
+  EXPECT_GT(outside, 20u);
 }
 
 TEST(Limits, ASpatialJointsAngleIsLimitedOverItsTurns) {

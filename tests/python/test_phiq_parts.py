@@ -202,3 +202,21 @@ def test_a_scenes_limits_are_warned_as_its_columns_leave_them():
     message = limits[1].message
     assert f"above its maximum 25 from t = {t[over[0]]:.10g} to t = {t[over[-1]]:.10g} ({len(over)} rows)" in message
     assert f"at most {effort.max():.10g} (t = {t[np.argmax(effort)]:.10g})" in message
+
+
+def test_a_stepper_lists_the_limits_outside_at_each_step():
+    # the same scene stepped over its grid: the rated torque listed at exactly the rows whose effort is over 25,
+    # and warned once, at the first of them
+    scene = phiq.load_scene(os.path.join(MODELS, "dynamics", "fourbar_gearmotor.yaml"))
+    result = phiq.run_sweep(scene)
+    effort = result.table[:, result.columns.index("motor.effort")]
+    stepper = phiq.Stepper(scene)
+    listed, warned = [], []
+    for t in result.t:
+        summary = stepper.step(t)
+        assert summary.ok, summary.message
+        listed.append("rated_torque" in summary.limits)
+        warned += [w.t for w in summary.warnings if w.kind == "limit" and w.message.startswith("rated_torque")]
+    over = effort > 25
+    assert listed == list(over) and over.sum() > 1
+    assert warned == [result.t[np.flatnonzero(over)[0]]]

@@ -38,6 +38,10 @@ struct StepperOptions : SolverSettings {
   /// Driver efforts and powers every step delivers (Stepper::efforts()), as a sweep's rows (OutputPlan::efforts):
   /// q̇ and q̈ are then solved whatever `velocities` and `accelerations` say.
   OutputEfforts efforts;
+  /// Ranges every step checks (OutputPlan::limits, as a sweep's rows): a step whose value leaves one warns `limit`
+  /// there, once until it comes back (StepSummary::limits lists those outside at each step). An effort's needs it
+  /// in `efforts`, a rate q̇.
+  std::vector<OutputLimit> limits;
 };
 
 /// What one Stepper::step did.
@@ -53,6 +57,7 @@ struct StepSummary {
   WorkCounters counters;   ///< the work this step did, its failed attempts included
   Index subdivisions = 0;  ///< sub-steps this step inserted after Newton failures
   std::vector<SweepWarning> warnings;  ///< the warnings this step raised (none when it failed)
+  std::vector<std::string> limits;     ///< the names of StepperOptions::limits outside their range at this step
   double seconds = 0.0;                ///< wall time of the step
 };
 

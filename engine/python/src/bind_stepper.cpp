@@ -40,6 +40,7 @@ std::unique_ptr<PyStepper> stepper_for_scene(std::shared_ptr<const Scene> scene,
     o.sensitivities = sc.sweep.sensitivities;
   }
   o.efforts = sc.sweep.efforts;
+  o.limits = sc.sweep.limits;
   if (sc.sweep.steps > 0) o.expected_step = (sc.sweep.t_end - sc.sweep.t_begin) / static_cast<double>(sc.sweep.steps);
   s->stepper = std::make_unique<Stepper>(s->square.model(*sc.model), std::move(o));
   s->stepper->restart(s->square.start);
@@ -91,6 +92,9 @@ void bind_stepper(py::module_& m) {
       .def_readonly("counters", &StepSummary::counters, "the work this step did (WorkCounters)")
       .def_readonly("subdivisions", &StepSummary::subdivisions, "sub-steps inserted after Newton failures")
       .def_readonly("warnings", &StepSummary::warnings, "the warnings this step raised (SweepWarning objects)")
+      .def_readonly("limits", &StepSummary::limits,
+                    "names of the scene's limits outside their range at this step (a `limit` warning where each "
+                    "leaves it)")
       .def_readonly("seconds", &StepSummary::seconds, "wall time of the step")
       .def("__repr__", [](const StepSummary& s) {
         return "<StepSummary t=" + shortest(s.t) + ": " + to_string(s.status) +
@@ -110,7 +114,8 @@ void bind_stepper(py::module_& m) {
            }),
            py::arg("scene"), py::kw_only(), py::arg("velocities") = py::none(), py::arg("accelerations") = py::none(),
            py::arg("sensitivities") = py::none(),
-           "A stepper for a scene: its solver settings, output points and rough placement (a redundant scene "
+           "A stepper for a scene: its solver settings, output points, efforts, limits and rough placement (a "
+           "redundant scene "
            "assembled and solved on its independent rows, as run_sweep does); velocities and accelerations as the "
            "scene's output asks unless given; the sensitivities of its output.sensitivities, or of `sensitivities` "
            "(names or (name, step) tuples, as run_sweep's) at every step. ValueError when the scene cannot be "

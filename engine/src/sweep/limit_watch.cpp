@@ -69,6 +69,15 @@ void LimitWatch::close(std::size_t i) {
   s.open = false;
 }
 
+SweepWarning LimitWatch::beginning(std::size_t i) const {
+  const Stretch& s = stretch_[i];
+  const OutputLimit& l = limits_[i];
+  return {s.from, "limit",
+          l.name + ": " + l.what + " is " +
+              (s.above ? "above its maximum " + significant(l.hi, 10) : "below its minimum " + significant(l.lo, 10)) +
+              " from t = " + format_time(s.from) + ": " + significant(s.worst, 10)};
+}
+
 void LimitWatch::finish(std::vector<SweepWarning>& warnings) {
   for (std::size_t i = 0; i < stretch_.size(); ++i)
     if (stretch_[i].open) close(i);

@@ -18,6 +18,12 @@ class LimitWatch {
   // The stretches still open at the last row delivered, said; then the warnings, in the order their stretches
   // began, appended to `warnings`.
   void finish(std::vector<SweepWarning>& warnings);
+  // Whether limit i's value was outside its range at the last row, and whether its stretch began there.
+  bool outside(std::size_t i) const { return stretch_[i].open; }
+  bool began(std::size_t i) const { return stretch_[i].open && stretch_[i].rows == 1; }
+  // What a stretch that began at the last row says there, with the value there (a Stepper's: its steps have no
+  // last row to wait for).
+  SweepWarning beginning(std::size_t i) const;
 
  private:
   struct Stretch {

@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "phiq/text.hpp"
+#include "sweep/limit_watch.hpp"
 #include "sweep/sweep_run.hpp"
 #include "sweep/sweeper.hpp"
 
@@ -37,6 +38,23 @@ struct Stepper::Impl {
   std::optional<Sweeper> before_subdividing;
   bool started = false;
   double previous_t = NAN;  // the time of the row before the current one; NaN when the history holds none
+  std::optional<detail::LimitWatch> limits;  // the options' limits, since the last start
+
+  // The current state against the limits: a stretch begun here warned; `out` lists those outside.
+  void check_limits(StepSummary& out) {
+    if (!limits) return;
+    const Sweeper& sw = *sweeper;
+    if (sum.steps_completed > checked_steps) {
+      limits->row(sw.state().t, sw.state().q.data(), sw.state().qd.size() ? sw.state().qd.data() : nullptr,
+                  sw.motions().efforts);
+      checked_steps = sum.steps_completed;
+      for (std::size_t i = 0; i < options.limits.size(); ++i)
+        if (limits->began(i)) sum.warnings.push_back(limits->beginning(i)), out.warnings.push_back(sum.warnings.back());
+    }
+    for (std::size_t i = 0; i < options.limits.size(); ++i)
+      if (limits->outside(i)) out.limits.push_back(options.limits[i].name);
+  }
+  Index checked_steps = 0;  // steps_completed when the limits last read a row
 
   // A Sweeper for a start at t (the placement in ws.q).
   void make_sweeper(double t) {
@@ -72,6 +90,9 @@ Stepper::Stepper(const Model& model, StepperOptions options)
     if (!p.reach) p.reach = std::make_shared<const ParameterReach>(parameter_reach(model, p));
   s.efforts = o.efforts;
   detail::check_efforts(model, s, "StepperOptions");
+  s.limits = o.limits;
+  detail::check_limits(model, s, "StepperOptions");
+  if (!o.limits.empty()) impl_->limits.emplace(impl_->options.limits);
   s.threads = 1;
   impl_->make_sweeper(0.0);  // refuses a predictor whose derivatives are not solved, before any step
 }
@@ -145,7 +166,7 @@ SolveStatus Stepper::step(double t, StepSummary* summary) {
   out.t = t;
   if (s.started) {
     const double now = s.sweeper->state().t;
-    if (t == now) return SolveStatus::kSuccess;  // the current state, re-delivered
+    if (t == now) return s.check_limits(out), SolveStatus::kSuccess;  // the current state, re-delivered
     const double rounding = 8.0 * std::numeric_limits<double>::epsilon() * std::max(std::fabs(t), std::fabs(now));
     if (std::fabs(t - now) <= rounding)
       throw Error("Stepper::step: t = " + format_time(t) + " is within 8 ulps of the current time " + format_time(now) +
@@ -171,6 +192,7 @@ SolveStatus Stepper::step(double t, StepSummary* summary) {
   out.worst_rows = sum.worst_rows;
   out.subdivisions = sum.subdivisions - subdivisions;
   out.warnings.assign(sum.warnings.begin() + static_cast<std::ptrdiff_t>(warnings), sum.warnings.end());
+  if (out.status == SolveStatus::kSuccess) s.check_limits(out);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   sum.solve_seconds += out.seconds;
   return out.status;
@@ -183,6 +205,7 @@ void Stepper::restart(const Eigen::VectorXd& placement) {
                 std::to_string(s.model->num_coordinates()) + " coordinates");
   s.ws.q = placement;
   s.started = false;
+  if (s.limits) s.limits.emplace(s.options.limits);  // (a jump: no stretch goes on across it)
   s.previous_t = NAN;
   // a jump: no crossing is reported between the rows before it and those after
   s.run.last_sign = detail::Orientation{0, 0};
