@@ -20,6 +20,7 @@
 /// multipliers under which they do (a sweep does it before evaluating the reactions).
 #pragma once
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include <cstdint>
@@ -87,6 +88,15 @@ class JointReactions {
   /// not read: planar_parts_read() leaves it out); without `sum_bars` it reads it, as every other site.
   void evaluate(const double* q, const double* qd, const double* qdd, double t, const Eigen::VectorXd& lambda,
                 double* out, const detail::PlanarForce* planar = nullptr, bool sum_bars = true);
+  /// Keeps the listed joints' geometry at (q, t): each site, its body's frame Jacobian and the factors of the
+  /// equations that give its wrench, which every λ at that q shares (detail::BearingFrictions' passes). Pre-condition
+  /// as the first evaluate()'s: no natural joint listed (else phiq::Error).
+  void keep_geometry(const double* q, double t);
+  /// The first evaluate() at keep_geometry()'s (q, t), the same values to rounding, without finding the geometry
+  /// again: the reaction is linear in the joint's own multipliers, so keep_geometry() keeps its values per unit
+  /// multiplier of each row, and this sums them (six products a planar pin). Pre-condition: keep_geometry() at
+  /// this q and t.
+  void evaluate_kept(const double* q, double t, const Eigen::VectorXd& lambda, double* out);
 
  private:
   struct Site {
@@ -94,6 +104,8 @@ class JointReactions {
     std::size_t index = 0;       // in its block
     std::vector<Index> columns;  // the coordinates the constraint reads (to clear the scratch)
     bool spatial = false;
+    Index first_row = 0;  // its rows in the model's
+    int rows = 0;
   };
   // A natural joint's site. Its flat form, where the body's part is read from a sweep's Q (BodyPart::part), no load
   // is the body's alone and the model is planar: component k's Q_b is the sum of the PlanarForce values terms[k]
@@ -209,6 +221,21 @@ class JointReactions {
   void add_flat_sums(NaturalSite& s, Index n, const std::vector<Index> (&moving)[2]);
   // simple site `at`'s sums on body part `part`, a rigid bar of BarForm `form` (SimpleSite::a, and its BarSum)
   BarSum bar_sum(SimpleSite& at, const BodyPart& part, const BarForm& form, Index n) const;
+  // A constraint site's geometry at one q: its ReactionSite, its body's frame Jacobian, the factors of the normal
+  // equations J_b J_bᵀ w = J_b g whose solution is its wrench (directions no coordinate moves set to w_i = 0), and
+  // the body's origin.
+  struct SiteGeometry {
+    ReactionSite site;
+    PartJacobian jac;
+    Eigen::LDLT<Eigen::Matrix<double, 6, 6>> normal;
+    bool unmoved[6] = {};
+    kin3::V3 origin;
+    // keep_geometry()'s: the reaction's values per unit multiplier of each of the site's rows, column j row j's
+    Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6> per_row;
+  };
+  void site_geometry(const Site& s, const double* q, double t, SiteGeometry& g) const;
+  void site_reaction(const Site& s, const SiteGeometry& g, const double* q, double t, const Eigen::VectorXd& lambda,
+                     double*& out);
   void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);
   // BodyRows::entries' slots numbered afresh, own_values_ sized to them (BodyRows::own_slot_of_entry)
@@ -251,7 +278,9 @@ class JointReactions {
   Eigen::VectorXd qx_, qdx_, qddx_, qb_;  // q, q̇, q̈ with the promoted constants; a body's Q
   std::vector<double> g_;                 // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
   std::vector<double> own_values_;        // Φq's values of the natural bodies' own constraints (BodyRows' slots)
-  PartJacobian jac_;                      // the body's frame Jacobian (its capacity kept: no allocation per row)
+  SiteGeometry geometry_;                 // evaluate_site()'s (its vectors' capacity kept: no allocation per row)
+  std::vector<SiteGeometry> kept_;        // keep_geometry()'s, one per constraint site
+  Eigen::VectorXd unit_;                  // keep_geometry()'s unit multipliers
   std::vector<Part> body_part_;           // a body's parts built where they are read (body_parts_kept's others)
 };
 

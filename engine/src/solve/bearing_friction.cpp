@@ -75,7 +75,7 @@ BearingFrictions::BearingFrictions(const Model& model, const AppliedLoads& loads
 }
 
 void BearingFrictions::moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m) {
-  reactions_->evaluate(q, t, lambda, values_.data());
+  reactions_->evaluate_kept(q, t, lambda, values_.data());
   for (std::size_t i = 0; i < bearings_.size(); ++i) {
     const BearingFriction& b = *bearings_[i].spring->bearing;
     const double* f = values_.data() + bearings_[i].at;
@@ -90,6 +90,7 @@ bool BearingFrictions::solve(const Model& model, SparseLuNumeric& lu, const doub
   for (std::size_t i = 0; i < bearings_.size(); ++i)
     rates_[i] = angle_rate(*bearings_[i].spring, q, qd, t, gradients_[i]);
   lambda0_ = lambda;
+  reactions_->keep_geometry(q, t);  // (the passes' reactions differ in λ alone)
   moments_at(q, t, lambda, moments_);
   q_f_.resize(Q.size());
   double first_change = 0.0;

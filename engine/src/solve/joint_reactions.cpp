@@ -144,6 +144,7 @@ void JointReactions::add_site(const Model& model, Index c, std::vector<int>& sit
   Site s;
   s.block = b, s.index = i;
   s.spatial = b->reaction_width() == 6;
+  s.first_row = info.first_row, s.rows = static_cast<int>(info.rows);
   set_->size += b->reaction_width();
   site_of[static_cast<std::size_t>(c)] = static_cast<int>(set_->sites.size());
   set_->order.push_back({false, set_->sites.size()});
@@ -264,45 +265,97 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
   }
 }
 
+void JointReactions::site_geometry(const Site& s, const double* q, double t, SiteGeometry& g) const {
+  s.block->reaction_site(s.index, q, g.site);
+  // The wrench (F, M_O) whose virtual work on the body is g there: J_bᵀ w = g over the body's coordinates, in
+  // least squares (Euler parameters: 4 columns for 3 rotations, the fourth along e, on which no wrench works).
+  const PartFrame frame = body_frame(g.site);
+  part_jacobian(frame, q, t, g.jac);
+  Eigen::Matrix<double, 6, 6> normal = Eigen::Matrix<double, 6, 6>::Zero();
+  for (std::size_t k = 0; k < g.jac.coordinates.size(); ++k) {
+    const V3 o = g.jac.d_origin[k], a = g.jac.d_angle[k];
+    const Eigen::Matrix<double, 6, 1> col(o.x, o.y, o.z, a.x, a.y, a.z);
+    normal += col * col.transpose();
+  }
+  // Directions no coordinate moves (a planar body's z, a natural point's rotation) get no component: their rows
+  // of the normal equations are zero, set to w_i = 0 (fixed sizes: no allocation at a row).
+  for (int i = 0; i < 6; ++i)
+    if ((g.unmoved[i] = normal(i, i) == 0.0)) normal(i, i) = 1.0;
+  g.normal.compute(normal);
+  g.origin = part_pose(frame, q, t).at;
+}
+
+void JointReactions::site_reaction(const Site& s, const SiteGeometry& g, const double* q, double t,
+                                   const Eigen::VectorXd& lambda, double*& out) {
+  s.block->add_transposed_product(s.index, q, t, lambda.data(), g_.data());  // Φq,cᵀ λ_c
+  Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
+  for (std::size_t k = 0; k < g.jac.coordinates.size(); ++k) {
+    const V3 o = g.jac.d_origin[k], a = g.jac.d_angle[k];
+    const Eigen::Matrix<double, 6, 1> col(o.x, o.y, o.z, a.x, a.y, a.z);
+    rhs -= col * g_[static_cast<std::size_t>(g.jac.coordinates[k])];  // g = −Φq,cᵀ λ_c
+  }
+  for (int i = 0; i < 6; ++i)
+    if (g.unmoved[i]) rhs(i) = 0.0;
+  const Eigen::Matrix<double, 6, 1> w = g.normal.solve(rhs);
+  V3 force{w(0), w(1), w(2)};
+  const V3 moment_o{w(3), w(4), w(5)};
+  const ReactionSite& rs = g.site;
+  V3 moment = moment_o + cross(g.origin - rs.point, force);
+  if (set_->joint_axes) {  // the same force and moment, their components along the joint's own axes
+    const V3 f = force, m = moment;
+    force = {dot(rs.axes[0], f), dot(rs.axes[1], f), dot(rs.axes[2], f)};
+    moment = {dot(rs.axes[0], m), dot(rs.axes[1], m), dot(rs.axes[2], m)};
+  }
+  if (s.spatial) {
+    for (double v : {force.x, force.y, force.z, moment.x, moment.y, moment.z}) *out++ = v;
+  } else {
+    for (double v : {force.x, force.y, moment.z}) *out++ = v;
+  }
+  for (Index j : s.columns) g_[static_cast<std::size_t>(j)] = 0.0;
+}
+
 void JointReactions::evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda,
                                    double*& out) {
-  PartJacobian& jac = jac_;
-  {
-    ReactionSite rs;
-    s.block->reaction_site(s.index, q, rs);
-    s.block->add_transposed_product(s.index, q, t, lambda.data(), g_.data());  // Φq,cᵀ λ_c
-    // The wrench (F, M_O) whose virtual work on the body is g there: J_bᵀ w = g over the body's coordinates, in
-    // least squares (Euler parameters: 4 columns for 3 rotations, the fourth along e, on which no wrench works).
-    const PartFrame frame = body_frame(rs);
-    part_jacobian(frame, q, t, jac);
-    Eigen::Matrix<double, 6, 6> normal = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
-    for (std::size_t k = 0; k < jac.coordinates.size(); ++k) {
-      const V3 o = jac.d_origin[k], a = jac.d_angle[k];
-      const Eigen::Matrix<double, 6, 1> col(o.x, o.y, o.z, a.x, a.y, a.z);
-      normal += col * col.transpose();
-      rhs -= col * g_[static_cast<std::size_t>(jac.coordinates[k])];  // g = −Φq,cᵀ λ_c
+  site_geometry(s, q, t, geometry_);
+  site_reaction(s, geometry_, q, t, lambda, out);
+}
+
+void JointReactions::keep_geometry(const double* q, double t) {
+  if (!set_->natural_sites.empty())
+    throw Error("JointReactions::keep_geometry: natural joints read q̇ and q̈: give them (phiq bug)");
+  kept_.resize(set_->sites.size());
+  Index rows = 0;
+  for (const Site& s : set_->sites) rows = std::max(rows, s.first_row + s.rows);
+  if (unit_.size() < rows) unit_.setZero(rows);
+  for (std::size_t k = 0; k < set_->sites.size(); ++k) {
+    const Site& s = set_->sites[k];
+    SiteGeometry& g = kept_[k];
+    site_geometry(s, q, t, g);
+    if (s.rows > 6) throw Error("JointReactions::keep_geometry: a joint of more than 6 rows (phiq bug)");
+    g.per_row.resize(6, s.rows);
+    for (int j = 0; j < s.rows; ++j) {
+      double values[6], *out = values;
+      unit_(s.first_row + j) = 1.0;
+      site_reaction(s, g, q, t, unit_, out);
+      unit_(s.first_row + j) = 0.0;
+      for (int v = 0; v < 6; ++v) g.per_row(v, j) = v < out - values ? values[v] : 0.0;
     }
-    // Directions no coordinate moves (a planar body's z, a natural point's rotation) get no component: their rows
-    // of the normal equations are zero, set to w_i = 0 (fixed sizes: no allocation at a row).
-    for (int i = 0; i < 6; ++i)
-      if (normal(i, i) == 0.0) normal(i, i) = 1.0, rhs(i) = 0.0;
-    const Eigen::Matrix<double, 6, 1> w = normal.ldlt().solve(rhs);
-    V3 force{w(0), w(1), w(2)};
-    const V3 moment_o{w(3), w(4), w(5)};
-    const V3 at = part_pose(frame, q, t).at;
-    V3 moment = moment_o + cross(at - rs.point, force);
-    if (set_->joint_axes) {  // the same force and moment, their components along the joint's own axes
-      const V3 f = force, m = moment;
-      force = {dot(rs.axes[0], f), dot(rs.axes[1], f), dot(rs.axes[2], f)};
-      moment = {dot(rs.axes[0], m), dot(rs.axes[1], m), dot(rs.axes[2], m)};
+  }
+}
+
+void JointReactions::evaluate_kept(const double* q, double t, const Eigen::VectorXd& lambda, double* out) {
+  (void)q, (void)t;  // (the geometry's: keep_geometry()'s)
+  if (kept_.size() != set_->sites.size())
+    throw Error("JointReactions::evaluate_kept: no geometry kept (keep_geometry() first; phiq bug)");
+  for (std::size_t k = 0; k < set_->sites.size(); ++k) {
+    const Site& s = set_->sites[k];
+    const SiteGeometry& g = kept_[k];
+    const int width = s.spatial ? 6 : 3;
+    for (int v = 0; v < width; ++v) {
+      double sum = 0.0;
+      for (int j = 0; j < s.rows; ++j) sum += g.per_row(v, j) * lambda(s.first_row + j);
+      *out++ = sum;
     }
-    if (s.spatial) {
-      for (double v : {force.x, force.y, force.z, moment.x, moment.y, moment.z}) *out++ = v;
-    } else {
-      for (double v : {force.x, force.y, moment.z}) *out++ = v;
-    }
-    for (Index j : s.columns) g_[static_cast<std::size_t>(j)] = 0.0;
   }
 }
 
