@@ -10,10 +10,10 @@
 #include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/joint_reactions.hpp"
-#include "solve/bearing_friction.hpp"
 #include "phiq/kinds/registry.hpp"
 #include "phiq/natural_joints.hpp"
 #include "scene/scene_reader.hpp"
+#include "solve/bearing_friction.hpp"
 
 namespace phiq::detail::scene {
 

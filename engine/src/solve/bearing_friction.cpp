@@ -133,12 +133,6 @@ bool BearingFrictions::solve(const Model& model, SparseLuNumeric& lu, const doub
   return false;
 }
 
-double BearingFrictions::power() const {
-  double p = 0.0;
-  for (std::size_t i = 0; i < bearings_.size(); ++i) p -= moments_[i] * std::abs(rates_[i]);
-  return p;
-}
-
 std::string BearingFrictions::lock_message() const {
   const TorsionalSpring& s = *bearings_[worst_].spring;
   return "the friction of bearing '" + s.bearing->joint + "' (torsional spring '" + s.name +

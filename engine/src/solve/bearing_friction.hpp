@@ -4,11 +4,12 @@
 // multipliers give, while the multipliers solve Φqᵀ λ = Q + Q_f(m), Q_f = −Σ m_i sign(θ̇_i) ∇θ_i: a fixed point. With λ0
 // the multipliers of Q alone, λ = λ0 + Φq⁻ᵀ Q_f(m) is linear in the moments, so each pass of the iteration m ← m(λ0 +
 // Φq⁻ᵀ Q_f(m)) is one transposed solve with the row's own factors and the bearings' reactions (JointReactions on their
-// joints only). The pass contracts by about μ r / (the mechanism's lever arms): a few passes for real bearings. Where
-// it does not settle, the friction feeds its own load faster than it gives it: the mechanism jams (self-locking), told
-// at the row rather than written as a number. The friction's direction is θ̇'s, fixed at the row, so the moments alone
-// iterate. Not with redundant rows (the reactions it reads are not unique) nor with gear meshes (their teeth's push
-// on a bearing is not in its joint's multipliers: OutputEfforts::meshes).
+// joints only, their geometry kept for the row: JointReactions::keep_geometry()). The pass contracts by about μ r /
+// (the mechanism's lever arms): a few passes for real bearings. Where it does not settle, the friction feeds its own
+// load faster than it gives it: the mechanism jams (self-locking), told at the row rather than written as a number. The
+// friction's direction is θ̇'s, fixed at the row, so the moments alone iterate. Not with redundant rows (the reactions
+// it reads are not unique) nor with gear meshes (their teeth's push on a bearing is not in its joint's multipliers:
+// OutputEfforts::meshes).
 #pragma once
 
 #include <Eigen/Core>
@@ -30,10 +31,11 @@ namespace phiq::detail {
 
 class BearingFrictions {
  public:
-  // The bearings of `loads`' torsional springs. Throws phiq::Error naming one whose joint is unknown or not a pin,
-  // revolute or cylindrical joint, or a model they cannot be solved in (above).
+  // The bearings of `loads`' torsional springs. Throws phiq::Error naming one whose joint is unknown or cannot be a
+  // bearing (carries()), or one whose kind of friction its joint's is not, or a model they cannot be solved in
+  // (above).
   BearingFrictions(const Model& model, const AppliedLoads& loads);
-  // The constraint spring `s`'s bearing turns in; throws phiq::Error, naming `s`, where there is none (above).
+  // The constraint spring `s`'s bearing is; throws phiq::Error, naming `s`, where it is none or cannot be one.
   static Index check(const Model& model, const TorsionalSpring& s);
   // Throws phiq::Error, naming `s`, where `model` cannot solve a bearing's friction (above).
   static void check_model(const Model& model, const TorsionalSpring& s);
@@ -49,11 +51,9 @@ class BearingFrictions {
   // not settle in kMaxPasses (lock_message()); λ and Q then hold the last pass's.
   bool solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd, double t, Eigen::VectorXd& Q,
              Eigen::VectorXd& lambda, Eigen::VectorXd& kept);
-  int solves() const { return solves_; }                           // transposed solves of the last solve()
-  bool failed_solve() const { return failed_solve_; }              // the last solve() failed in a linear solve
-  const std::vector<double>& moments() const { return moments_; }  // m_i ≥ 0 (N·m) at the last solve()
-  double power() const;                                            // −Σ m_i |θ̇_i| (W) at the last solve()
-  std::string lock_message() const;                                // the bearing that did not settle, and why
+  int solves() const { return solves_; }               // transposed solves of the last solve()
+  bool failed_solve() const { return failed_solve_; }  // the last solve() failed in a linear solve
+  std::string lock_message() const;                    // the bearing that did not settle, and why
 
   static constexpr int kMaxPasses = 200;
 
