@@ -1,7 +1,10 @@
 // A sweep's rows with efforts and reactions, as `phiq run` sweeps them (the model with redundant rows left out):
-// what the joint-reaction and gear-mesh tests read.
+// what the joint-reaction, gear-mesh and bearing tests read; and the massive four-bar's Newton–Euler check.
 #pragma once
 
+#include <array>
+#include <cmath>
+#include <utility>
 #include <vector>
 
 #include "phiq/phiq.hpp"
@@ -37,6 +40,41 @@ inline ReactionRows sweep_reactions(const Scene& s, SweepSummary* sum = nullptr,
                 sum),
             SolveStatus::kSuccess);
   return r;
+}
+
+// The massive four-bar of models/dynamics/fourbar_pin_loads.yaml (reference-point links centred on their points,
+// masses 1, 2, 1.5 kg, lengths 0.4, 1.2, 1.0 m, slender bars, gravity 9.81 down) at one row: each link's
+// Newton–Euler equations, to `tolerance` relative, with the pins' forces read from the row's values after the effort
+// and its power (O, A, B, C, each on its side a: O and A on the crank, B on the coupler, C on the rocker) and
+// `torque[l]` the couples on link l (crank, coupler, rocker; the motor's on the crank).
+inline void expect_fourbar_links_balance(const Model& m, const Eigen::VectorXd& q, const Eigen::VectorXd& qdd,
+                                         const std::vector<double>& v, const std::array<double, 3>& torque,
+                                         double tolerance, std::size_t row) {
+  const double mass[3] = {1.0, 2.0, 1.5}, length[3] = {0.4, 1.2, 1.0}, g = 9.81;
+  const char* names[3][3] = {{"x2", "y2", "psi2"}, {"x3", "y3", "psi3"}, {"x4", "y4", "psi4"}};
+  auto c = [&](const char* n) { return m.coordinate_index(n); };
+  auto at = [&](int l, double s_local) {  // a point of link l, s_local along it from its centre
+    const double psi = q(c(names[l][2]));
+    return Eigen::Vector2d(q(c(names[l][0])) + s_local * std::cos(psi), q(c(names[l][1])) + s_local * std::sin(psi));
+  };
+  auto F = [&](int j) { return Eigen::Vector2d(v[2 + 3 * j], v[3 + 3 * j]); };
+  const Eigen::Vector2d O = at(0, -length[0] / 2), A = at(0, length[0] / 2), B = at(1, length[1] / 2),
+                        C = at(2, -length[2] / 2);
+  const std::pair<Eigen::Vector2d, Eigen::Vector2d> forces[3][2] = {
+      {{O, F(0)}, {A, F(1)}}, {{A, -F(1)}, {B, F(2)}}, {{B, -F(2)}, {C, F(3)}}};  // (point, force)
+  for (int l = 0; l < 3; ++l) {
+    const Eigen::Vector2d G(q(c(names[l][0])), q(c(names[l][1]))), a(qdd(c(names[l][0])), qdd(c(names[l][1])));
+    Eigen::Vector2d sum = Eigen::Vector2d(0, -mass[l] * g);
+    double moment = torque[static_cast<std::size_t>(l)];
+    for (const auto& [P, f] : forces[l]) {
+      const Eigen::Vector2d arm = P - G;
+      sum += f, moment += arm.x() * f.y() - arm.y() * f.x();
+    }
+    EXPECT_NEAR((sum - mass[l] * a).norm(), 0.0, tolerance * (1.0 + sum.norm())) << names[l][0] << " row " << row;
+    EXPECT_NEAR(moment, mass[l] * length[l] * length[l] / 12 * qdd(c(names[l][2])),
+                tolerance * (1.0 + std::fabs(moment)))
+        << names[l][0] << " row " << row;
+  }
 }
 
 }  // namespace phiq::test

@@ -33,54 +33,29 @@ std::string fourbar_with_bearings(double mu, double r, const std::string& output
 }
 
 TEST(BearingFriction, FourBarPinsWithBearingsSatisfyEveryLinksNewtonEuler) {
-  const double mu = 0.3, radius = 0.05, m2 = 1.0, m3 = 2.0, m4 = 1.5, L2 = 0.4, L3 = 1.2, L4 = 1.0, g = 9.81;
+  const double mu = 0.3, radius = 0.05;
   const std::string out = "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
   const Scene s = parse_scene(fourbar_with_bearings(mu, radius, out), "bearings.yaml");
   SweepSummary sum;
   const test::ReactionRows rows = test::sweep_reactions(s, &sum);
   ASSERT_EQ(rows.q.size(), 73u);
   EXPECT_GT(sum.counters.effort_solves, 3 * 73) << "the moments are solved for, in passes";
-  const Model& m = *s.model;
-  auto c = [&](const char* n) { return m.coordinate_index(n); };
-  auto at = [&](const Eigen::VectorXd& q, const char* x, const char* y, const char* p, double s_local) {
-    return Eigen::Vector2d(q(c(x)) + s_local * std::cos(q(c(p))), q(c(y)) + s_local * std::sin(q(c(p))));
-  };
-  auto cross2 = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); };
+  auto c = [&](const char* n) { return s.model->coordinate_index(n); };
   auto sign = [](double v) { return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : 0.0; };
   double largest_couple = 0.0;
   for (std::size_t k = 0; k < rows.q.size(); ++k) {
-    const Eigen::VectorXd &q = rows.q[k], &qd = rows.qd[k], &qdd = rows.qdd[k];
+    const Eigen::VectorXd& qd = rows.qd[k];
     const std::vector<double>& v = rows.values[k];
-    const double tau = v[0];
-    auto F = [&](int j) { return Eigen::Vector2d(v[2 + 3 * j], v[3 + 3 * j]); };
     // each pin's friction couple μ r |F| against its relative turn θ̇ (θ = ψ_b − ψ_a; O's and C's ψ against ground)
     const double turn[4] = {qd(c("psi2")), qd(c("psi3")) - qd(c("psi2")), qd(c("psi4")) - qd(c("psi3")), qd(c("psi4"))};
     double f[4];
     for (int j = 0; j < 4; ++j) {
-      f[j] = mu * radius * F(j).norm() * sign(turn[j]);
+      f[j] = mu * radius * std::hypot(v[2 + 3 * j], v[3 + 3 * j]) * sign(turn[j]);
       largest_couple = std::max(largest_couple, std::fabs(f[j]));
     }
-    const Eigen::Vector2d O = at(q, "x2", "y2", "psi2", -L2 / 2), A = at(q, "x2", "y2", "psi2", L2 / 2),
-                          B = at(q, "x3", "y3", "psi3", L3 / 2), C = at(q, "x4", "y4", "psi4", -L4 / 2);
-    struct Link {
-      double mass, inertia;
-      const char *x, *y, *p;
-      std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> forces;  // (point, force)
-      double torque;  // the motor's and the couples': −f on the turn's later body, +f on its earlier one
-    };
-    const Link links[3] = {
-        {m2, m2 * L2 * L2 / 12, "x2", "y2", "psi2", {{O, F(0)}, {A, F(1)}}, tau - f[0] + f[1]},
-        {m3, m3 * L3 * L3 / 12, "x3", "y3", "psi3", {{A, -F(1)}, {B, F(2)}}, -f[1] + f[2]},
-        {m4, m4 * L4 * L4 / 12, "x4", "y4", "psi4", {{B, -F(2)}, {C, F(3)}}, -f[2] - f[3]},
-    };
-    for (const Link& l : links) {
-      const Eigen::Vector2d G(q(c(l.x)), q(c(l.y))), a(qdd(c(l.x)), qdd(c(l.y)));
-      Eigen::Vector2d sum_f = Eigen::Vector2d(0, -l.mass * g);
-      double moment = l.torque;
-      for (const auto& [P, force] : l.forces) sum_f += force, moment += cross2(P - G, force);
-      EXPECT_NEAR((sum_f - l.mass * a).norm(), 0.0, 1e-9 * (1.0 + sum_f.norm())) << l.x << " row " << k;
-      EXPECT_NEAR(moment, l.inertia * qdd(c(l.p)), 1e-9 * (1.0 + std::fabs(moment))) << l.x << " row " << k;
-    }
+    // on each link: −f on the turn's later body, +f on its earlier one; the motor's torque on the crank
+    test::expect_fourbar_links_balance(*s.model, rows.q[k], rows.qdd[k], v,
+                                       {v[0] - f[0] + f[1], -f[1] + f[2], -f[2] - f[3]}, 1e-9, k);
   }
   EXPECT_GT(largest_couple, 0.3);  // the couples are felt: a frictionless solution fails the moments above
 }
