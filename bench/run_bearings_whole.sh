@@ -3,7 +3,7 @@
 # (/usr/bin/time): nfourbar N in reference-point coordinates (`phiq generate --coords reference-point`, 3N + 1
 # revolute joints) with a unit mass on every crank and coupler under gravity, its drivers' efforts and powers
 # written to HDF5, plain and with a bearing (μ 0.15, journal radius 10 mm) at every joint, whose friction the
-# efforts solve for with the reactions it changes (solve/bearing_friction.hpp). Prints the median wall time of each
+# efforts solve for with the reactions it changes (solve/friction_losses.hpp). Prints the median wall time of each
 # with its spread (fastest and slowest repeat), peak memory, effort solves (passes) and the ratio to the plain run.
 #
 #   bench/run_bearings_whole.sh [PHIQ] [N] [STEPS] [REPEATS] [THREADS]

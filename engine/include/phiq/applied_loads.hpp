@@ -92,7 +92,7 @@ struct LinearSpring {
 /// without stiction): the moment μ (r |F_r| + r_a |F_a|) against θ̇, F_r the reaction's force across the joint's axis
 /// and F_a along it (none in the plane); on a slide (`slide`: a prismatic pair, or a cylindrical one given no
 /// radius, θ its travel) the force μ |F_r| against θ̇. It depends on the multipliers it changes, so the efforts solve
-/// for it (detail::BearingFrictions); add_applied_forces() and applied_power() leave it out.
+/// for it (detail::FrictionLosses); add_applied_forces() and applied_power() leave it out.
 struct BearingFriction {
   std::string joint;  ///< the pin, revolute, cylindrical or prismatic joint (a constraint) whose reaction loads it
   double coefficient = 0.0;    ///< μ, ≥ 0
@@ -123,14 +123,28 @@ struct TorsionalSpring {
   std::optional<BearingFriction> bearing;  ///< a bearing's friction, if any
 };
 
+/// A transmission's meshing losses as a constant efficiency η (a gear pair's, a rack and pinion's, a belt's, a
+/// spatial pair's, a worm's): the member its teeth drive (the one the mesh does positive work on, relative to the
+/// carrier) receives η of the ideal mesh's effort, the rest a friction-like loss (1 − η) |e| against its turn. The
+/// same η both ways (a worm's back-driving efficiency differs: give the direction it runs). Solved with the
+/// multipliers, as a bearing's friction (detail::FrictionLosses).
+struct GearLoss {
+  std::string gear;         ///< the transmission (a constraint: gear, rack_pinion, belt or spatial_gear)
+  double efficiency = 1.0;  ///< η, in (0, 1]
+  bool operator==(const GearLoss&) const = default;  ///< datum by datum
+};
+
 /// The applied loads of a scene, read once and shared (Loads::applied holds them by pointer).
 struct AppliedLoads {
   std::vector<AppliedForce> forces;                ///< `forces`
   std::vector<AppliedTorque> torques;              ///< `torques`
   std::vector<LinearSpring> springs;               ///< `springs`
   std::vector<TorsionalSpring> torsional_springs;  ///< `torsional_springs`
+  std::vector<GearLoss> gear_losses;               ///< `gear_losses`
   /// True when there is none.
-  bool empty() const { return forces.empty() && torques.empty() && springs.empty() && torsional_springs.empty(); }
+  bool empty() const {
+    return forces.empty() && torques.empty() && springs.empty() && torsional_springs.empty() && gear_losses.empty();
+  }
 };
 
 /// The sign a dry friction (LinearSpring::friction, TorsionalSpring::friction) takes of its rate: −1, 0 or 1, none

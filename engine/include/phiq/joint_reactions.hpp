@@ -89,7 +89,7 @@ class JointReactions {
   void evaluate(const double* q, const double* qd, const double* qdd, double t, const Eigen::VectorXd& lambda,
                 double* out, const detail::PlanarForce* planar = nullptr, bool sum_bars = true);
   /// Keeps the listed joints' geometry at (q, t): each site, its body's frame Jacobian and the factors of the
-  /// equations that give its wrench, which every λ at that q shares (detail::BearingFrictions' passes). Pre-condition
+  /// equations that give its wrench, which every λ at that q shares (detail::FrictionLosses' passes). Pre-condition
   /// as the first evaluate()'s: no natural joint listed (else phiq::Error).
   void keep_geometry(const double* q, double t);
   /// The first evaluate() at keep_geometry()'s (q, t), the same values to rounding, without finding the geometry

@@ -28,7 +28,8 @@ bool same_end(const SpringEnd& a, const SpringEnd& b) { return same_frame(a.fram
 
 bool same_applied(const AppliedLoads& a, const AppliedLoads& b) {
   if (a.forces.size() != b.forces.size() || a.torques.size() != b.torques.size() ||
-      a.springs.size() != b.springs.size() || a.torsional_springs.size() != b.torsional_springs.size())
+      a.springs.size() != b.springs.size() || a.torsional_springs.size() != b.torsional_springs.size() ||
+      a.gear_losses != b.gear_losses)
     return false;
   for (std::size_t i = 0; i < a.forces.size(); ++i) {
     const AppliedForce &x = a.forces[i], &y = b.forces[i];

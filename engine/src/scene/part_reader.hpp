@@ -85,6 +85,8 @@ class PartReader {
   LinearSpring linear_spring(const C& s, const LoadTargets& targets, std::set<std::string>& names) const;
   template <class C>
   TorsionalSpring torsional_spring(const C& s, std::set<std::string>& names) const;
+  template <class C>
+  GearLoss gear_loss(const C& g) const;
 
   SceneReader& r_;  // (not const: a family's walk keeps its state there)
   // the meshes read so far, by file (as written, joined to the scene's folder) and scale

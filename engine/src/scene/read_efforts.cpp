@@ -13,7 +13,7 @@
 #include "phiq/kinds/registry.hpp"
 #include "phiq/natural_joints.hpp"
 #include "scene/scene_reader.hpp"
-#include "solve/bearing_friction.hpp"
+#include "solve/friction_losses.hpp"
 
 namespace phiq::detail::scene {
 
@@ -207,11 +207,10 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
         .fail(
             "no part has mass and no load is applied: every effort would be zero (give parts a mass "
             "or a density, or apply loads)");
-  if (!out.constraints.empty() && !scene.sweep.sensitivities.empty() &&
-      BearingFrictions::any(scene.loads.applied.get()))
+  if (!out.constraints.empty() && !scene.sweep.sensitivities.empty() && FrictionLosses::any(scene.loads.applied.get()))
     pending_.efforts_field->fail(
-        "the efforts' sensitivities ∂τ/∂p are not computed with a bearing's friction (it reads the reactions it "
-        "changes): ask them without the bearings");
+        "the efforts' sensitivities ∂τ/∂p are not computed with a bearing's friction or a gear's losses (they read "
+        "the multipliers they change): ask them without those");
   out.parts = std::move(massive);
   out.loads = std::make_shared<const Loads>(scene.loads);
   out.power = pending_.efforts_power;

@@ -8,7 +8,7 @@
 #include "phiq/text.hpp"
 #include "scene/family_expansion.hpp"
 #include "scene/part_reader.hpp"
-#include "solve/bearing_friction.hpp"
+#include "solve/friction_losses.hpp"
 
 namespace phiq::detail::scene {
 
@@ -27,7 +27,7 @@ std::string load_name(const C& c, std::set<std::string>& names) {
 }  // namespace
 
 void PartReader::read_loads(const Cursor& c, Scene& scene) const {
-  c.expect_map({"gravity", "forces", "torques", "springs", "torsional_springs"});
+  c.expect_map({"gravity", "forces", "torques", "springs", "torsional_springs", "gear_losses"});
   if (auto g = c.field("gravity"); g.present()) {
     const std::vector<double> v = r_.numbers(g, r_.spatial_ ? 3 : 2);
     scene.loads.gravity = {v[0], v[1], r_.spatial_ ? v[2] : 0.0};
@@ -46,6 +46,8 @@ void PartReader::read_loads(const Cursor& c, Scene& scene) const {
     r_.read_list(ss, [&](const auto& s) { applied->springs.push_back(linear_spring(s, targets, names)); });
   if (auto ts = c.field("torsional_springs"); ts.present())
     r_.read_list(ts, [&](const auto& s) { applied->torsional_springs.push_back(torsional_spring(s, names)); });
+  if (auto gs = c.field("gear_losses"); gs.present())
+    r_.read_list(gs, [&](const auto& g) { applied->gear_losses.push_back(gear_loss(g)); });
   if (!applied->empty()) scene.loads.applied = std::move(applied);
 }
 
@@ -242,7 +244,7 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
       b.fail("a bearing names its `joint` (a pin, revolute, cylindrical or prismatic joint)");
     f.joint = on.present() ? on.name() : joint.name();
     const std::string_view kind = r_.builder_.constraint_kind(f.joint);
-    if (!BearingFrictions::carries(kind))
+    if (!FrictionLosses::carries(kind))
       (on.present() ? on : b)
           .fail((kind.empty() ? "unknown joint '" + f.joint + "'" : "'" + f.joint + "' is a " + std::string(kind)) +
                 ": a bearing is a pin, revolute, cylindrical or prismatic joint of 'constraints' (whose reaction "
@@ -261,6 +263,23 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
     }
   }
   return spring;
+}
+
+// A transmission's meshing losses: `{gear: NAME, efficiency: η}`.
+template <class C>
+GearLoss PartReader::gear_loss(const C& g) const {
+  g.expect_map({"gear", "efficiency"});
+  GearLoss l;
+  const auto gear = g.require("gear");
+  l.gear = gear.name();
+  const std::string_view kind = r_.builder_.constraint_kind(l.gear);
+  if (!FrictionLosses::transmits(kind))
+    gear.fail((kind.empty() ? "unknown transmission '" + l.gear + "'" : "'" + l.gear + "' is a " + std::string(kind)) +
+              ": meshing losses are a gear's, rack_pinion's, belt's or spatial_gear's of 'constraints'");
+  const auto e = g.require("efficiency");
+  l.efficiency = r_.number(e);
+  if (!(l.efficiency > 0.0 && l.efficiency <= 1.0)) e.fail("an efficiency is in (0, 1], got " + shortest(l.efficiency));
+  return l;
 }
 
 // A linear spring-damper: `between: [END, END]`, each {part: P, at: [..]} or {point: [..]} (fixed in the world).

@@ -12,7 +12,7 @@
 #include "phiq/kinds/distance.hpp"
 #include "phiq/kinds/registry.hpp"
 #include "phiq/part_motion.hpp"
-#include "solve/bearing_friction.hpp"
+#include "solve/friction_losses.hpp"
 #include "solve/part_forces.hpp"
 #include "solve/factorisation.hpp"
 
@@ -357,8 +357,8 @@ SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, c
     if (message) *message = "the multipliers are not finite (an overflow of doubles)";
     return SolveStatus::kNonFinite;
   }
-  if (detail::BearingFrictions::any(loads.applied.get())) {  // (ensure_factorized() gave ws.lu the factors at q)
-    detail::BearingFrictions bearings(model, *loads.applied);
+  if (detail::FrictionLosses::any(loads.applied.get())) {  // (ensure_factorized() gave ws.lu the factors at q)
+    detail::FrictionLosses bearings(model, *loads.applied);
     Eigen::VectorXd kept;
     const double* qd = ws.qd.size() == model.num_coordinates() ? ws.qd.data() : nullptr;  // (none: at rest)
     if (!bearings.solve(model, *ws.lu, ws.q.data(), qd, t, Q, lambda, kept)) {

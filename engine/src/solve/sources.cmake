@@ -1,7 +1,7 @@
 # engine/src/solve/: the sources of this stage (engine/CMakeLists.txt includes this file).
 target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/assembly.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/bearing_friction.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/friction_losses.cpp
   ${CMAKE_CURRENT_LIST_DIR}/block_triangular.cpp
   ${CMAKE_CURRENT_LIST_DIR}/derivatives.cpp
   ${CMAKE_CURRENT_LIST_DIR}/effort_sensitivity.cpp

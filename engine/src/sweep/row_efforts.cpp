@@ -51,8 +51,8 @@ bool Sweeper::row_efforts() {
     }
     return fail(SolveStatus::kNonFinite, "efforts: " + why);
   }
-  if (effort_work_.bearings) {  // the bearings' friction, from the reactions it changes
-    BearingFrictions& b = *effort_work_.bearings;
+  if (effort_work_.losses) {  // the bearings' friction and the gears' losses, from the multipliers they change
+    FrictionLosses& b = *effort_work_.losses;
     const bool settled = b.solve(model_, *w->lu, current_.q.data(), current_.qd.data(), t, effort_work_.q,
                                  effort_work_.lambda, effort_work_.kept);
     ws_->counters.effort_solves += b.solves();

@@ -14,7 +14,7 @@
 
 #include "phiq/joint_reactions.hpp"
 #include "phiq/sweep.hpp"
-#include "solve/bearing_friction.hpp"
+#include "solve/friction_losses.hpp"
 #include "solve/minimum_norm.hpp"
 #include "solve/part_forces.hpp"
 #include "solve/sensitivity_internal.hpp"
@@ -171,7 +171,7 @@ struct EffortWork {
   std::vector<PlanarForce> planar;
   std::vector<std::size_t> dropped;
   std::optional<JointReactions> reactions;
-  std::optional<BearingFrictions> bearings;  // the bearings' frictions, if the loads have any
+  std::optional<FrictionLosses> losses;  // the bearings' friction and the gears' losses, if the loads have any
   bool reactions_noted = false;
   MinimumNormScratch minimum_norm;  // row_reactions()'s, with redundant rows
 };

@@ -1,6 +1,6 @@
-// detail::BearingFrictions (solve/bearing_friction.hpp): a bearing's friction from its joint's reaction, solved with
-// the multipliers it changes.
-#include "solve/bearing_friction.hpp"
+// detail::FrictionLosses (solve/friction_losses.hpp): a bearing's friction from its joint's reaction and a mesh's
+// losses from its multiplier, solved with the multipliers they change.
+#include "solve/friction_losses.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,21 +9,27 @@
 #include "phiq/constraint_block.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/kinds/reaction_site.hpp"
+#include "phiq/kinds/spatial_gear.hpp"
 #include "phiq/model.hpp"
 #include "phiq/text.hpp"
 
 namespace phiq::detail {
 
-bool BearingFrictions::carries(std::string_view kind) {
+bool FrictionLosses::carries(std::string_view kind) {
   return kind == "pin" || kind == "revolute" || kind == "cylindrical" || kind == "prismatic";
 }
 
-bool BearingFrictions::any(const AppliedLoads* loads) {
-  return loads && std::any_of(loads->torsional_springs.begin(), loads->torsional_springs.end(),
-                              [](const TorsionalSpring& s) { return s.bearing.has_value(); });
+bool FrictionLosses::transmits(std::string_view kind) {
+  return kind == "gear" || kind == "rack_pinion" || kind == "belt" || kind == "spatial_gear";
 }
 
-Index BearingFrictions::check(const Model& model, const TorsionalSpring& s) {
+bool FrictionLosses::any(const AppliedLoads* loads) {
+  return loads &&
+         (!loads->gear_losses.empty() || std::any_of(loads->torsional_springs.begin(), loads->torsional_springs.end(),
+                                                     [](const TorsionalSpring& s) { return s.bearing.has_value(); }));
+}
+
+Index FrictionLosses::check(const Model& model, const TorsionalSpring& s) {
   const std::string who = "torsional spring '" + s.name + "': bearing joint '" + s.bearing->joint + "'";
   const Index c = model.find_constraint(s.bearing->joint);
   if (c < 0) throw Error(who + " is not a constraint of the model");
@@ -38,13 +44,13 @@ Index BearingFrictions::check(const Model& model, const TorsionalSpring& s) {
   return c;
 }
 
-void BearingFrictions::check_model(const Model& model, const TorsionalSpring& s) {
-  const std::string who = "torsional spring '" + s.name + "'";
+void FrictionLosses::check_model(const Model& model, const std::string& who, bool bearing) {
   if (!model.dropped_rows().empty())
     throw Error(who +
-                ": a bearing's friction reads its joint's reaction, which redundant constraints leave statically "
-                "indeterminate (the model dropped " +
+                ": a loss that reads the multipliers (a bearing's reaction, a mesh's share) is statically "
+                "indeterminate where constraints are redundant (the model dropped " +
                 std::to_string(model.dropped_rows().size()) + " redundant rows)");
+  if (!bearing) return;
   for (std::size_t c = 0; c < model.constraints().size(); ++c) {
     const auto [block, index] = model.constraint_block(static_cast<Index>(c));
     if (GearMesh g; block->gear_mesh(index, g))
@@ -54,7 +60,7 @@ void BearingFrictions::check_model(const Model& model, const TorsionalSpring& s)
   }
 }
 
-BearingFrictions::BearingFrictions(const Model& model, const AppliedLoads& loads) {
+FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
   OutputEfforts joints;
   joints.reactions_in_joint_axes = true;  // (a spatial joint's z is its axis: F_a its z, F_r across)
   std::size_t at = 0;
@@ -66,31 +72,67 @@ BearingFrictions::BearingFrictions(const Model& model, const AppliedLoads& loads
     bearings_.push_back({&s, at, spatial});
     at += spatial ? 6 : 3;
   }
-  if (bearings_.empty()) return;
-  check_model(model, *bearings_[0].spring);
-  reactions_.emplace(model, joints);
-  values_.assign(static_cast<std::size_t>(reactions_->size()), 0.0);
-  moments_.assign(bearings_.size(), 0.0), next_ = moments_, rates_ = moments_;
+  for (const GearLoss& l : loads.gear_losses) {
+    const std::string who = "gear loss of '" + l.gear + "'";
+    const Index c = model.find_constraint(l.gear);
+    if (c < 0) throw Error(who + ": not a constraint of the model");
+    const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
+    if (!transmits(info.kind) || !(l.efficiency > 0.0 && l.efficiency <= 1.0))
+      throw Error(who + ": a " + std::string(info.kind) +
+                  ", or an efficiency outside (0, 1]: the loss is a gear's, rack's, belt's or spatial pair's");
+    const auto [block, index] = model.constraint_block(c);
+    Mesh m;
+    m.loss = &l, m.row = info.first_row + info.rows - 1;  // (the ratio row, a spatial pair's last)
+    if (GearMesh g; block->gear_mesh(index, g)) {
+      m.member[0] = g.first, m.member[1] = g.second, m.carrier = g.carrier, m.k = g.k;
+    } else if (SpatialMesh sm; block->spatial_mesh(index, sm)) {
+      m.member[0] = sm.theta1, m.member[1] = sm.theta2, m.carrier = Slot::constant(0.0), m.k = sm.k;
+    } else {
+      throw Error(who + ": its " + std::string(info.kind) + " states no mesh (phiq bug)");
+    }
+    meshes_.push_back(m);
+  }
+  if (bearings_.empty() && meshes_.empty()) return;
+  check_model(model,
+              bearings_.empty() ? "gear loss of '" + meshes_[0].loss->gear + "'"
+                                : "torsional spring '" + bearings_[0].spring->name + "'",
+              !bearings_.empty());
+  if (!bearings_.empty()) {
+    reactions_.emplace(model, joints);
+    values_.assign(static_cast<std::size_t>(reactions_->size()), 0.0);
+  }
+  moments_.assign(bearings_.size() + meshes_.size(), 0.0), next_ = moments_;
+  rates_.assign(bearings_.size(), 0.0);
   gradients_.resize(bearings_.size());
 }
 
-void BearingFrictions::moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m) {
-  reactions_->evaluate_kept(q, t, lambda, values_.data());
+void FrictionLosses::moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m) {
+  if (reactions_) reactions_->evaluate_kept(q, t, lambda, values_.data());
   for (std::size_t i = 0; i < bearings_.size(); ++i) {
     const BearingFriction& b = *bearings_[i].spring->bearing;
     const double* f = values_.data() + bearings_[i].at;
     const double across = std::hypot(f[0], f[1]), along = bearings_[i].spatial ? std::abs(f[2]) : 0.0;
     m[i] = b.coefficient * (b.slide ? across : b.radius * across + b.thrust_radius * along);
   }
+  for (std::size_t j = 0; j < meshes_.size(); ++j) {
+    // the row's effort on each member, −∂row/∂θ_i λ, and its power relative to the carrier: the driven member's > 0
+    Mesh& mesh = meshes_[j];
+    const double effort[2] = {-lambda(mesh.row), -mesh.k * lambda(mesh.row)};
+    mesh.driven = effort[0] * mesh.rate[0] > 0.0 ? 0 : effort[1] * mesh.rate[1] > 0.0 ? 1 : -1;
+    m[bearings_.size() + j] = mesh.driven < 0 ? 0.0 : (1.0 - mesh.loss->efficiency) * std::abs(effort[mesh.driven]);
+  }
 }
 
-bool BearingFrictions::solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd, double t,
-                             Eigen::VectorXd& Q, Eigen::VectorXd& lambda, Eigen::VectorXd& kept) {
+bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd, double t,
+                           Eigen::VectorXd& Q, Eigen::VectorXd& lambda, Eigen::VectorXd& kept) {
   solves_ = 0, passes_ = 0, failed_solve_ = false, worst_change_ = 0.0, ratio_ = 0.0;
   for (std::size_t i = 0; i < bearings_.size(); ++i)
     rates_[i] = angle_rate(*bearings_[i].spring, q, qd, t, gradients_[i]);
+  auto rate = [&](const Slot& s) { return s.is_coordinate() && qd ? qd[s.coord()] : 0.0; };
+  for (Mesh& mesh : meshes_)
+    for (int i = 0; i < 2; ++i) mesh.rate[i] = rate(mesh.member[i]) - rate(mesh.carrier);
   lambda0_ = lambda;
-  reactions_->keep_geometry(q, t);  // (the passes' reactions differ in λ alone)
+  if (reactions_) reactions_->keep_geometry(q, t);  // (the passes' reactions differ in λ alone)
   moments_at(q, t, lambda, moments_);
   q_f_.resize(Q.size());
   double first_change = 0.0;
@@ -103,6 +145,13 @@ bool BearingFrictions::solve(const Model& model, SparseLuNumeric& lu, const doub
       const std::vector<Index>& c = torsional_coordinates(*bearings_[i].spring);
       for (std::size_t k = 0; k < c.size(); ++k) q_f_(c[k]) -= m * gradients_[i][k];
     }
+    for (std::size_t j = 0; j < meshes_.size(); ++j) {  // against the driven member's turn on the carrier
+      const Mesh& mesh = meshes_[j];
+      if (mesh.driven < 0) continue;
+      const double m = moments_[bearings_.size() + j] * friction_direction(mesh.rate[mesh.driven]);
+      if (mesh.member[mesh.driven].is_coordinate()) q_f_(mesh.member[mesh.driven].coord()) -= m;
+      if (mesh.carrier.is_coordinate()) q_f_(mesh.carrier.coord()) += m;
+    }
     if (q_f_.isZero(0.0)) return true;  // (every bearing at rest or unloaded: λ0 stands)
     if (!multipliers_with_factors(model, lu, q_f_, kept, d_lambda_)) return failed_solve_ = true, false;
     ++solves_;
@@ -110,7 +159,7 @@ bool BearingFrictions::solve(const Model& model, SparseLuNumeric& lu, const doub
     moments_at(q, t, lambda, next_);
     // settled when no moment changes beyond rounding: λ is then the multipliers of the moments it was solved with
     double change = 0.0, scale = 0.0;
-    for (std::size_t i = 0; i < bearings_.size(); ++i) {
+    for (std::size_t i = 0; i < moments_.size(); ++i) {
       const double d = std::abs(next_[i] - moments_[i]);
       if (d > change) change = d, worst_ = i;
       scale = std::max(scale, std::abs(next_[i]));
@@ -133,10 +182,14 @@ bool BearingFrictions::solve(const Model& model, SparseLuNumeric& lu, const doub
   return false;
 }
 
-std::string BearingFrictions::lock_message() const {
-  const TorsionalSpring& s = *bearings_[worst_].spring;
-  return "the friction of bearing '" + s.bearing->joint + "' (torsional spring '" + s.name +
-         "') adds to its own load " +
+std::string FrictionLosses::name(std::size_t i) const {
+  if (i >= bearings_.size()) return "the meshing loss of '" + meshes_[i - bearings_.size()].loss->gear + "'";
+  const TorsionalSpring& s = *bearings_[i].spring;
+  return "the friction of bearing '" + s.bearing->joint + "' (torsional spring '" + s.name + "')";
+}
+
+std::string FrictionLosses::lock_message() const {
+  return name(worst_) + " adds to its own load " +
          (ratio_ >= 1.0 ? "as much as it takes or more (a pass multiplies its change by " + significant(ratio_, 3) +
                               "): the mechanism jams (self-locking) or its friction is not determined"
                         : "almost as much as it takes (a pass multiplies its change by " + significant(ratio_, 3) +

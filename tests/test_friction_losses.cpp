@@ -1,10 +1,12 @@
-// A bearing's friction from its joint's reaction (BearingFriction, solve/bearing_friction.hpp): a massive four-bar
+// A bearing's friction from its joint's reaction (BearingFriction, solve/friction_losses.hpp): a massive four-bar
 // with a bearing at every pin satisfies every link's Newton–Euler equations written here, each pin's friction couple
 // μ r |F| against its relative turn from the written reaction F; a driven pendulum's pivot (μ r |F| added to
 // m g l cos ψ) and a spatial rotor's journal and thrust collar (μ (r m ω² e + r_a m g)) against their closed forms,
 // through driver_efforts() and the sweep; a cam follower's guide rubs by μ times the cam's side push (Newton, the
 // power), settles where μ tan φ < 1 to the closed form and is told where it exceeds 1 (self-locking); parallel
-// chunks give the sequential bits; a jamming four-bar is told at its rows; and bad input is refused in one line.
+// chunks give the sequential bits; a jamming four-bar is told at its rows; a gear train's, a bevel pair's and a
+// planetary's meshing losses (GearLoss) against the motor torque their efficiencies give, whichever way the power
+// flows (the planetary's the textbook (1 + η0 i0) / (1 + i0)); and bad input is refused in one line.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -209,6 +211,93 @@ TEST(BearingFriction, ACamFollowerJamsWhereMuTanPhiReachesOne) {
   bool warned = false;
   for (const SweepWarning& w : sum.warnings) warned = warned || w.kind == "friction_lock";
   EXPECT_TRUE(warned);
+}
+
+// The gear train of models/transmissions/gear_train.yaml, massless, its output held back by a constant torque T
+// while the motor turns it three turns each way: the ideal motor torque −T/9, divided by η1 η2 while the motor drives
+// the load, multiplied by it while the load drives back (a constant torque, so it aids the motion on the way back).
+TEST(GearLosses, AGearTrainsMotorPaysItsTwoStagesLossesWhicheverWayThePowerFlows) {
+  const double T = -2.0, eta1 = 0.95, eta2 = 0.9;
+  const std::string text = test::model_file_text("transmissions/gear_train.yaml", "output: {") +
+                           "loads:\n  torques: [{name: load, part: output, torque: -2}]\n"
+                           "  gear_losses: [{gear: first_stage, efficiency: 0.95}, {gear: second_stage, efficiency: "
+                           "0.9}]\noutput: {velocities: true, accelerations: true, efforts: [motor], power: true}\n";
+  const Scene s = parse_scene(text, "train.yaml");
+  SweepSummary sum;
+  const test::ReactionRows rows = test::sweep_reactions(s, &sum);
+  ASSERT_EQ(rows.q.size(), 121u);
+  const Index psi1 = s.model->coordinate_index("psi1");
+  std::size_t driving = 0, driven = 0;
+  for (std::size_t k = 0; k < rows.q.size(); ++k) {
+    const double w = rows.qd[k](psi1), ideal = -T / 9.0;
+    const double expected = w > 0 ? ideal / (eta1 * eta2) : w < 0 ? ideal * eta1 * eta2 : ideal;
+    EXPECT_NEAR(rows.values[k][0], expected, 1e-12) << "row " << k << ", ω " << w;
+    // the losses' power: what the motor puts in less what the load takes, (1 − η1 η2) of the power through
+    const double lost = rows.values[k][1] + T * w / 9.0;
+    EXPECT_NEAR(lost, std::fabs(ideal * w) * (w > 0 ? 1.0 / (eta1 * eta2) - 1.0 : 1.0 - eta1 * eta2), 1e-11) << k;
+    (w > 0 ? driving : driven) += w != 0.0;
+  }
+  EXPECT_GT(driving, 30u);
+  EXPECT_GT(driven, 30u);
+  EXPECT_GT(sum.counters.effort_solves, 2 * 121) << "the losses are solved for, in passes";
+}
+
+// models/transmissions/bevel_gears.yaml (15:30, the output turning the other way at half the speed), massless, a
+// torque of ±3 N·m about the output shaft's axis: resisting, the motor pays 1.5 / η; aiding, the load drives the
+// motor, which holds back 1.5 η.
+TEST(GearLosses, ABevelPairsLossTakesEtaOfThePowerEitherWay) {
+  const double eta = 0.8;
+  for (const double torque : {3.0, -3.0}) {
+    const std::string text = test::model_file_text("transmissions/bevel_gears.yaml", "output:") +
+                             "loads:\n  torques: [{name: load, part: output_shaft, torque: [0, " +
+                             std::to_string(torque) +
+                             ", 0]}]\n  gear_losses: [{gear: bevel, efficiency: 0.8}]\n"
+                             "output: {velocities: true, accelerations: true, efforts: [motor]}\n";
+    const Scene s = parse_scene(text, "bevel.yaml");
+    const test::ReactionRows rows = test::sweep_reactions(s);
+    ASSERT_EQ(rows.q.size(), 61u);
+    // the output turns at −θ̇1/2 about y: the load's power −torque θ̇1/2, the motor's ideal torque torque/2
+    const double ideal = torque / 2.0, expected = torque > 0 ? ideal / eta : ideal * eta;
+    for (std::size_t k = 0; k < rows.q.size(); ++k)
+      EXPECT_NEAR(rows.values[k][0], expected, 1e-10 * std::fabs(expected)) << "torque " << torque << ", row " << k;
+  }
+}
+
+// models/transmissions/planetary.yaml with its ring held and a torque of 1 N·m holding back the carrier: the sun
+// drives the carrier at ω_c = 24/84 of its speed, and the meshes' losses act on the turns relative to the carrier,
+// which gives the textbook efficiency of sun to carrier, ring fixed, η = (1 + η0 i0) / (1 + i0), i0 = z_ring / z_sun,
+// η0 = η_sun_planet η_planet_ring: the sun's torque is (2/7) / η.
+TEST(GearLosses, APlanetarysLossesAreTheTextbooksSunToCarrierEfficiency) {
+  std::string text = test::model_file_text("transmissions/planetary.yaml", "output:");
+  text = test::replace_first(text, "rate: -0.2}}", "rate: 0}}");
+  text +=
+      "loads:\n  torques: [{name: load, part: carrier, torque: -1}]\n"
+      "  gear_losses: [{gear: sun_planet, efficiency: 0.95}, {gear: planet_ring, efficiency: 0.9}]\n"
+      "output: {velocities: true, accelerations: true, efforts: [sun_motor]}\n";
+  const test::ReactionRows rows = test::sweep_reactions(parse_scene(text, "planetary.yaml"));
+  ASSERT_EQ(rows.q.size(), 141u);
+  const double i0 = 60.0 / 24.0, eta0 = 0.95 * 0.9, eta = (1.0 + eta0 * i0) / (1.0 + i0);
+  for (std::size_t k = 0; k < rows.q.size(); ++k) EXPECT_NEAR(rows.values[k][0], (2.0 / 7.0) / eta, 1e-12) << k;
+}
+
+TEST(GearLosses, BadLossesAreRefusedInOneLine) {
+  const std::string base = test::model_file_text("transmissions/gear_train.yaml", "output: {") +
+                           "loads:\n  torques: [{name: load, part: output, torque: -2}]\n";
+  const std::string out = "output: {efforts: [motor]}\n";
+  for (const auto& [losses, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"[{gear: input_pivot, efficiency: 0.9}]", "'input_pivot' is a pin"},
+           {"[{gear: nowhere, efficiency: 0.9}]", "unknown transmission 'nowhere'"},
+           {"[{gear: first_stage, efficiency: 1.2}]", "an efficiency is in (0, 1]"},
+           {"[{gear: first_stage, efficiency: 0}]", "an efficiency is in (0, 1]"},
+           {"[{gear: first_stage}]", "efficiency"}}) {
+    try {
+      parse_scene(base + "  gear_losses: " + losses + "\n" + out, "bad.yaml");
+      ADD_FAILURE() << "accepted: " << losses;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(BearingFriction, ParallelChunksGiveTheSequentialBits) {
