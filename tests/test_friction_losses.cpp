@@ -244,20 +244,20 @@ TEST(GearLosses, AGearTrainsMotorPaysItsTwoStagesLossesWhicheverWayThePowerFlows
 
 // models/transmissions/bevel_gears.yaml (15:30, the output turning the other way at half the speed), massless, a
 // torque of ±3 N·m about the output shaft's axis: resisting, the motor pays 1.5 / η; aiding, the load drives the
-// motor, which holds back 1.5 η.
-TEST(GearLosses, ABevelPairsLossTakesEtaOfThePowerEitherWay) {
-  const double eta = 0.8;
+// motor, which holds back 1.5 η_r (the reverse efficiency, as a worm's back-driving one).
+TEST(GearLosses, ABevelPairsLossTakesEtaOfThePowerEachWay) {
+  const double eta = 0.8, eta_r = 0.6;
   for (const double torque : {3.0, -3.0}) {
     const std::string text = test::model_file_text("transmissions/bevel_gears.yaml", "output:") +
                              "loads:\n  torques: [{name: load, part: output_shaft, torque: [0, " +
                              std::to_string(torque) +
-                             ", 0]}]\n  gear_losses: [{gear: bevel, efficiency: 0.8}]\n"
+                             ", 0]}]\n  gear_losses: [{gear: bevel, efficiency: 0.8, reverse_efficiency: 0.6}]\n"
                              "output: {velocities: true, accelerations: true, efforts: [motor]}\n";
     const Scene s = parse_scene(text, "bevel.yaml");
     const test::ReactionRows rows = test::sweep_reactions(s);
     ASSERT_EQ(rows.q.size(), 61u);
     // the output turns at −θ̇1/2 about y: the load's power −torque θ̇1/2, the motor's ideal torque torque/2
-    const double ideal = torque / 2.0, expected = torque > 0 ? ideal / eta : ideal * eta;
+    const double ideal = torque / 2.0, expected = torque > 0 ? ideal / eta : ideal * eta_r;
     for (std::size_t k = 0; k < rows.q.size(); ++k)
       EXPECT_NEAR(rows.values[k][0], expected, 1e-10 * std::fabs(expected)) << "torque " << torque << ", row " << k;
   }
@@ -289,6 +289,7 @@ TEST(GearLosses, BadLossesAreRefusedInOneLine) {
            {"[{gear: nowhere, efficiency: 0.9}]", "unknown transmission 'nowhere'"},
            {"[{gear: first_stage, efficiency: 1.2}]", "an efficiency is in (0, 1]"},
            {"[{gear: first_stage, efficiency: 0}]", "an efficiency is in (0, 1]"},
+           {"[{gear: first_stage, efficiency: 0.9, reverse_efficiency: -1}]", "an efficiency is in (0, 1]"},
            {"[{gear: first_stage}]", "efficiency"}}) {
     try {
       parse_scene(base + "  gear_losses: " + losses + "\n" + out, "bad.yaml");

@@ -123,14 +123,15 @@ struct TorsionalSpring {
   std::optional<BearingFriction> bearing;  ///< a bearing's friction, if any
 };
 
-/// A transmission's meshing losses as a constant efficiency η (a gear pair's, a rack and pinion's, a belt's, a
+/// A transmission's meshing losses as constant efficiencies (a gear pair's, a rack and pinion's, a belt's, a
 /// spatial pair's, a worm's): the member its teeth drive (the one the mesh does positive work on, relative to the
-/// carrier) receives η of the ideal mesh's effort, the rest a friction-like loss (1 − η) |e| against its turn. The
-/// same η both ways (a worm's back-driving efficiency differs: give the direction it runs). Solved with the
-/// multipliers, as a bearing's friction (detail::FrictionLosses).
+/// carrier) receives η of the ideal mesh's effort, the rest a friction-like loss (1 − η) |e| against its turn; η
+/// `efficiency` where the first member drives the second, `reverse_efficiency` the other way (a worm back-driven by
+/// its wheel). Solved with the multipliers, as a bearing's friction (detail::FrictionLosses).
 struct GearLoss {
-  std::string gear;         ///< the transmission (a constraint: gear, rack_pinion, belt or spatial_gear)
-  double efficiency = 1.0;  ///< η, in (0, 1]
+  std::string gear;                 ///< the transmission (a constraint: gear, rack_pinion, belt or spatial_gear)
+  double efficiency = 1.0;          ///< η where the first member drives, in (0, 1]
+  double reverse_efficiency = 1.0;  ///< η where the second member drives, in (0, 1] (the scene's default: η)
   bool operator==(const GearLoss&) const = default;  ///< datum by datum
 };
 

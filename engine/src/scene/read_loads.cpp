@@ -265,10 +265,10 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
   return spring;
 }
 
-// A transmission's meshing losses: `{gear: NAME, efficiency: η}`.
+// A transmission's meshing losses: `{gear: NAME, efficiency: η, reverse_efficiency: η}`.
 template <class C>
 GearLoss PartReader::gear_loss(const C& g) const {
-  g.expect_map({"gear", "efficiency"});
+  g.expect_map({"gear", "efficiency", "reverse_efficiency"});
   GearLoss l;
   const auto gear = g.require("gear");
   l.gear = gear.name();
@@ -279,6 +279,12 @@ GearLoss PartReader::gear_loss(const C& g) const {
   const auto e = g.require("efficiency");
   l.efficiency = r_.number(e);
   if (!(l.efficiency > 0.0 && l.efficiency <= 1.0)) e.fail("an efficiency is in (0, 1], got " + shortest(l.efficiency));
+  l.reverse_efficiency = l.efficiency;
+  if (const auto r = g.field("reverse_efficiency"); r.present()) {
+    l.reverse_efficiency = r_.number(r);
+    if (!(l.reverse_efficiency > 0.0 && l.reverse_efficiency <= 1.0))
+      r.fail("an efficiency is in (0, 1], got " + shortest(l.reverse_efficiency));
+  }
   return l;
 }
 

@@ -77,7 +77,8 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
     const Index c = model.find_constraint(l.gear);
     if (c < 0) throw Error(who + ": not a constraint of the model");
     const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
-    if (!transmits(info.kind) || !(l.efficiency > 0.0 && l.efficiency <= 1.0))
+    if (!transmits(info.kind) || !(l.efficiency > 0.0 && l.efficiency <= 1.0) ||
+        !(l.reverse_efficiency > 0.0 && l.reverse_efficiency <= 1.0))
       throw Error(who + ": a " + std::string(info.kind) +
                   ", or an efficiency outside (0, 1]: the loss is a gear's, rack's, belt's or spatial pair's");
     const auto [block, index] = model.constraint_block(c);
@@ -119,7 +120,8 @@ void FrictionLosses::moments_at(const double* q, double t, const Eigen::VectorXd
     Mesh& mesh = meshes_[j];
     const double effort[2] = {-lambda(mesh.row), -mesh.k * lambda(mesh.row)};
     mesh.driven = effort[0] * mesh.rate[0] > 0.0 ? 0 : effort[1] * mesh.rate[1] > 0.0 ? 1 : -1;
-    m[bearings_.size() + j] = mesh.driven < 0 ? 0.0 : (1.0 - mesh.loss->efficiency) * std::abs(effort[mesh.driven]);
+    const double eta = mesh.driven == 1 ? mesh.loss->efficiency : mesh.loss->reverse_efficiency;
+    m[bearings_.size() + j] = mesh.driven < 0 ? 0.0 : (1.0 - eta) * std::abs(effort[mesh.driven]);
   }
 }
 
