@@ -228,10 +228,16 @@ TEST(GearLosses, AGearTrainsMotorPaysItsTwoStagesLossesWhicheverWayThePowerFlows
   ASSERT_EQ(rows.q.size(), 121u);
   const Index psi1 = s.model->coordinate_index("psi1");
   std::size_t driving = 0, driven = 0;
+  Workspace ws(*s.model);
+  std::vector<double> efforts;
   for (std::size_t k = 0; k < rows.q.size(); ++k) {
     const double w = rows.qd[k](psi1), ideal = -T / 9.0;
     const double expected = w > 0 ? ideal / (eta1 * eta2) : w < 0 ? ideal * eta1 * eta2 : ideal;
     EXPECT_NEAR(rows.values[k][0], expected, 1e-12) << "row " << k << ", ω " << w;
+    ws.q = rows.q[k], ws.qd = rows.qd[k], ws.qdd = rows.qdd[k];  // the same through driver_efforts()
+    ASSERT_EQ(driver_efforts(*s.model, s.parts, s.loads, s.sweep.time_of(static_cast<Index>(k)), ws, efforts),
+              SolveStatus::kSuccess);
+    EXPECT_NEAR(efforts.at(0), expected, 1e-12) << "driver_efforts(), row " << k;
     // the losses' power: what the motor puts in less what the load takes, (1 − η1 η2) of the power through
     const double lost = rows.values[k][1] + T * w / 9.0;
     EXPECT_NEAR(lost, std::fabs(ideal * w) * (w > 0 ? 1.0 / (eta1 * eta2) - 1.0 : 1.0 - eta1 * eta2), 1e-11) << k;

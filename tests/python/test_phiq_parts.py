@@ -220,3 +220,21 @@ def test_a_stepper_lists_the_limits_outside_at_each_step():
     over = effort > 25
     assert listed == list(over) and over.sum() > 1
     assert warned == [result.t[np.flatnonzero(over)[0]]]
+
+
+def test_a_gear_trains_losses_scale_the_motor_torque_each_way():
+    # models/transmissions/gear_train.yaml (1/9), massless, its output held back by 2 N·m, with meshing losses of
+    # 0.95 and 0.9: the motor pays (2/9)/(0.95 0.9) while it turns the output, (2/9)(0.95 0.9) while the load drives
+    with open(os.path.join(MODELS, "transmissions", "gear_train.yaml"), encoding="utf-8") as f:
+        text = f.read()
+    text = text[:text.index("output: {")] + (
+        "loads:\n  torques: [{name: load, part: output, torque: -2}]\n"
+        "  gear_losses: [{gear: first_stage, efficiency: 0.95}, {gear: second_stage, efficiency: 0.9}]\n"
+        "output: {velocities: true, accelerations: true, efforts: [motor]}\n")
+    result = phiq.run_sweep(phiq.parse_scene(text, "train.yaml"))
+    w = result.table[:, result.columns.index("psi1.v")]
+    effort = result.table[:, result.columns.index("motor.effort")]
+    eta = 0.95 * 0.9
+    expected = np.where(w > 0, (2 / 9) / eta, np.where(w < 0, (2 / 9) * eta, 2 / 9))
+    assert np.max(np.abs(effort - expected)) < 1e-12
+    assert (w > 0).sum() > 30 and (w < 0).sum() > 30
