@@ -15,6 +15,7 @@
 
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/phiq.hpp"
+#include "phiq/stepper.hpp"
 #include "reaction_rows.hpp"
 #include "test_support.hpp"
 
@@ -329,6 +330,42 @@ TEST(BearingFriction, ParallelChunksGiveTheSequentialBits) {
   const std::vector<double> one = values(1), two = values(2);
   ASSERT_EQ(one.size(), two.size());
   for (std::size_t i = 0; i < one.size(); ++i) ASSERT_EQ(one[i], two[i]) << "value " << i;
+}
+
+TEST(BearingFriction, AStepperGivesTheSweepsEffortsWithBearingsAndGearLosses) {
+  // the bearings' four-bar and the lossy gear train stepped over their grids: each step's efforts are the sequential
+  // sweep's rows, bit for bit (one chunk)
+  const std::string train = test::model_file_text("transmissions/gear_train.yaml", "output: {") +
+                            "loads:\n  torques: [{name: load, part: output, torque: -2}]\n"
+                            "  gear_losses: [{gear: first_stage, efficiency: 0.95}]\n"
+                            "output: {velocities: true, accelerations: true, efforts: [motor], power: true}\n";
+  for (const std::string& text :
+       {fourbar_with_bearings(0.3, 0.05, "output: {efforts: all, power: true, reactions: all}\n"), train}) {
+    const Scene s = parse_scene(text, "stepped.yaml");
+    SweepOptions opt = s.sweep;
+    opt.chunk_steps = opt.steps;  // (the rows in order, as a stepper's)
+    std::vector<std::vector<double>> rows;
+    Workspace ws(*s.model);
+    ws.q = s.model->initial_positions();
+    const std::size_t n = static_cast<std::size_t>(s.sweep.efforts.size());
+    ASSERT_EQ(run_sweep(
+                  *s.model, opt, ws,
+                  [&](const StepView& v) {
+                    rows.emplace_back(v.efforts, v.efforts + n);
+                    return true;
+                  },
+                  nullptr),
+              SolveStatus::kSuccess);
+    StepperOptions o;
+    static_cast<SolverSettings&>(o) = s.sweep;
+    o.efforts = s.sweep.efforts;
+    Stepper stepper(*s.model, o);
+    for (Index k = 0; k <= s.sweep.steps; ++k) {
+      ASSERT_EQ(stepper.step(s.sweep.time_of(k)), SolveStatus::kSuccess);
+      for (std::size_t i = 0; i < n; ++i)
+        ASSERT_EQ(stepper.efforts()[i], rows[static_cast<std::size_t>(k)][i]) << "row " << k << ", value " << i;
+    }
+  }
 }
 
 TEST(BearingFriction, AJammingFourBarIsToldAtItsRowsWithNoEffort) {
