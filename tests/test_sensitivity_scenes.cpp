@@ -49,10 +49,13 @@ Swept sweep_scene_at(const std::string& text, const std::string& path, const std
   s.sweep.every = 1;
   s.sweep.newton.tolerance = 1e-12;
   if (sensitivity) s.sweep.sensitivities = {*sensitivity};
-  // (∂q/∂p is checked here; a bearing's friction, which reads the reactions, refuses the efforts' ∂τ/∂p)
-  if (s.loads.applied)
-    for (const TorsionalSpring& t : s.loads.applied->torsional_springs)
-      if (t.bearing) s.sweep.efforts = OutputEfforts{};
+  // (∂q/∂p is checked here; a bearing's friction or a gear's losses, which read the multipliers, refuse the efforts'
+  // ∂τ/∂p)
+  if (s.loads.applied) {
+    bool losses = !s.loads.applied->gear_losses.empty();
+    for (const TorsionalSpring& t : s.loads.applied->torsional_springs) losses = losses || t.bearing.has_value();
+    if (losses) s.sweep.efforts = OutputEfforts{};
+  }
   SquareScene sq;
   if (prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &sq) != SolveStatus::kSuccess)
     return r.failure = "prepare: " + sq.assembly.message, r;
