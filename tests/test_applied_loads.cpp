@@ -1,7 +1,8 @@
 // Applied loads (phiq/applied_loads.hpp, the scene's `loads`): a force on a crank-slider's slider against the
 // motor torque's closed form; springs' and torsional springs' generalized forces against central differences of
 // their potential energy, in natural, reference-point and spatial coordinates; virtual power with masses, gravity,
-// a spring, a damper, a force and a torque in all four formulations of the four-bar; a force in part axes against
+// a spring, a damper, a force and a torque in all four formulations of the four-bar (every model's own balance:
+// test_power_balance.cpp); a force in part axes against
 // the same force written in world axes; forces and torques of the rates (der()) against a closed form, a damper
 // and the power balance, also as a family; laws of the stroke and of t against a closed form, and a law's table
 // left; and the bad input the reader refuses.
@@ -9,16 +10,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <functional>
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
-#include "phiq/joint_reactions.hpp"
-#include "phiq/kinds/reaction_site.hpp"
 #include "phiq/part_motion.hpp"
 #include "phiq/phiq.hpp"
 #include "fourbar_parts.hpp"
+#include "power_balance_support.hpp"
 
 namespace phiq {
 namespace {
@@ -176,20 +175,6 @@ TEST(AppliedLoads, SpringForcesAreTheirEnergysGradientInEveryCoordinateFamily) {
       "    - {name: t1, joint: rocker_hinge, law: {type: polynomial, coefficients: [0, 20, 5]}, free_angle: 0.3}\n");
 }
 
-// ω · (R I Rᵀ α): the rate of a part's rotational kinetic energy ½ ω · I_world ω (the rate of I_world does no work).
-double rotational_energy_rate(const Part& p, const PartMotion& pm) {
-  const RotationMatrix& r = pm.pose.rotation;
-  const kin3::V3 a = pm.alpha;
-  const double b[3] = {r[0] * a.x + r[3] * a.y + r[6] * a.z, r[1] * a.x + r[4] * a.y + r[7] * a.z,
-                       r[2] * a.x + r[5] * a.y + r[8] * a.z};
-  double c[3];
-  for (int i = 0; i < 3; ++i)
-    c[i] = p.mass.inertia[3 * i] * b[0] + p.mass.inertia[3 * i + 1] * b[1] + p.mass.inertia[3 * i + 2] * b[2];
-  const kin3::V3 d{r[0] * c[0] + r[1] * c[1] + r[2] * c[2], r[3] * c[0] + r[4] * c[1] + r[5] * c[2],
-                   r[6] * c[0] + r[7] * c[1] + r[8] * c[2]};
-  return kin3::dot(pm.omega, d);
-}
-
 // Over a scene's sweep, whose driver turns at 1 rad/s: the largest |τ θ̇ − (d/dt kinetic energy + d/dt gravity's
 // potential − the applied loads' power)|, the largest |τ| and the largest |applied power|.
 struct LoadedPowerBalance {
@@ -214,8 +199,8 @@ LoadedPowerBalance loaded_power_balance(const Scene& s) {
     for (const Part& p : s.parts) {
       const PartMotion pm = part_motion(p.frame, ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
       const auto [v, a] = pm.point(p.mass.center);
-      energy_rate +=
-          p.mass.mass * kin3::dot(v, a) + rotational_energy_rate(p, pm) - p.mass.mass * kin3::dot(s.loads.gravity, v);
+      energy_rate += p.mass.mass * kin3::dot(v, a) + test::rotational_energy_rate(p, pm) -
+                     p.mass.mass * kin3::dot(s.loads.gravity, v);
     }
     const double power = applied_power(*s.loads.applied, ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
     b.balance = std::max(b.balance, std::fabs(efforts[0] * 1.0 - (energy_rate - power)));
@@ -223,123 +208,6 @@ LoadedPowerBalance loaded_power_balance(const Scene& s) {
     b.loads_power = std::max(b.loads_power, std::fabs(power));
   }
   return b;
-}
-
-// Every scene under models/ with masses or loads, at every written row: its drivers' power as the sweep writes it
-// (λ Φt, the `NAME.power` columns) is d(kinetic energy)/dt + d(gravity's potential)/dt − the applied loads' power
-// (springs' and dampers' too) + what bearings and gears lose, to 1e-9 of the largest power; in whatever coordinates
-// the scene is written.
-TEST(AppliedLoads, EveryModelWithMassesBalancesItsDriversPowerAtEveryRow) {
-  std::vector<std::filesystem::path> scenes;
-  for (const auto& e : std::filesystem::recursive_directory_iterator(PHIQ_MODELS_DIR))
-    if (e.path().extension() == ".yaml") scenes.push_back(e.path());
-  std::sort(scenes.begin(), scenes.end());
-  std::vector<std::string> checked;
-  for (const std::filesystem::path& path : scenes) {
-    const Scene s = load_scene(path.string());
-    bool massive = s.loads.applied != nullptr;
-    for (const Part& p : s.parts) massive = massive || (p.mass_source != MassSource::kNone && p.mass.mass > 0.0);
-    if (!massive) continue;
-    SCOPED_TRACE(path.string());
-    SquareScene square;
-    ASSERT_EQ(prepare_scene(*s.model, s.sweep.t_begin, s.sweep.assembly, &square), SolveStatus::kSuccess);
-    const Model& m = square.model(*s.model);
-    SweepOptions o = s.sweep;  // the drivers' efforts and powers, whatever the scene writes
-    o.efforts = OutputEfforts{};
-    o.efforts.parts = std::make_shared<const std::vector<Part>>(s.parts);
-    o.efforts.loads = std::make_shared<const Loads>(s.loads);
-    o.efforts.constraints = rheonomic_constraints(m);
-    o.efforts.power = true;
-    // bearings' friction dissipates Σ μ (r |F_r| + r_a |F_a|) |θ̇|, F their joints' reactions (in the joints' axes)
-    std::vector<const TorsionalSpring*> bearings;
-    if (s.loads.applied)
-      for (const TorsionalSpring& t : s.loads.applied->torsional_springs)
-        if (t.bearing) {
-          const Index c = m.constraint_index(t.bearing->joint);
-          o.efforts.reactions.push_back({c, reaction_width(m, c) == 6});
-          bearings.push_back(&t);
-        }
-    o.efforts.reactions_in_joint_axes = true;
-    // a gear's losses dissipate (1 − η) of the power its row's multiplier carries into the member it drives: its
-    // effort on its first member (the row's −λ) written with the drivers', k times it on the second
-    struct Lossy {
-      const GearLoss* loss;
-      GearMesh mesh;
-    };
-    std::vector<Lossy> lossy;
-    const std::size_t drivers = o.efforts.constraints.size();
-    if (s.loads.applied)
-      for (const GearLoss& l : s.loads.applied->gear_losses) {
-        const Index c = m.constraint_index(l.gear);
-        const auto [block, index] = m.constraint_block(c);
-        GearMesh g;
-        ASSERT_TRUE(block->gear_mesh(index, g) && m.constraints()[static_cast<std::size_t>(c)].rows == 1)
-            << "a scene's gear loss on a spatial pair: this balance reads a one-row mesh's effort";
-        o.efforts.constraints.push_back(c);
-        lossy.push_back({&l, g});
-      }
-    o.sensitivities.clear();
-    o.velocities = o.accelerations = true;
-    const std::size_t n = o.efforts.constraints.size();
-    ASSERT_GT(n, 0u);
-    Workspace ws(m);
-    ws.q = square.start;
-    double worst = 0.0, scale = 0.0;
-    std::size_t rows = 0;
-    SweepSummary sum;
-    ASSERT_EQ(
-        run_sweep(
-            m, o, ws,
-            [&](const StepView& v) {
-              double power = 0.0;
-              for (std::size_t i = 0; i < n; ++i) power += v.efforts[n + i];
-              if (!std::isfinite(power)) return true;  // a singular row: said so, no power
-              double energy_rate = 0.0;
-              for (const Part& p : s.parts) {
-                if (p.mass_source == MassSource::kNone) continue;
-                const PartMotion pm = part_motion(p.frame, v.q.data(), v.qd->data(), v.qdd->data(), v.t);
-                const auto [vc, ac] = pm.point(p.mass.center);
-                energy_rate += p.mass.mass * kin3::dot(vc, ac) + rotational_energy_rate(p, pm) -
-                               p.mass.mass * kin3::dot(s.loads.gravity, vc);
-              }
-              double loads =
-                  s.loads.applied ? applied_power(*s.loads.applied, v.q.data(), v.qd->data(), v.qdd->data(), v.t) : 0.0;
-              const double* f = v.efforts + 2 * n;
-              for (std::size_t i = 0; i < bearings.size(); ++i) {
-                const BearingFriction& b = *bearings[i]->bearing;
-                const bool spatial = o.efforts.reactions[i].spatial;
-                std::vector<double> gradient;
-                loads -= b.coefficient *
-                         (b.radius * std::hypot(f[0], f[1]) + (spatial ? b.thrust_radius * std::fabs(f[2]) : 0.0)) *
-                         std::fabs(angle_rate(*bearings[i], v.q.data(), v.qd->data(), v.t, gradient));
-                f += spatial ? 6 : 3;
-              }
-              auto rate = [&](const Slot& x) { return x.is_coordinate() ? (*v.qd)(x.coord()) : 0.0; };
-              for (std::size_t j = 0; j < lossy.size(); ++j) {
-                const GearMesh& g = lossy[j].mesh;
-                const double e1 = v.efforts[drivers + j], e2 = g.k * e1;
-                const double p1 = e1 * (rate(g.first) - rate(g.carrier)), p2 = e2 * (rate(g.second) - rate(g.carrier));
-                // the member driven: the first (the second drives: the reverse efficiency), or the second
-                if (p1 > 0.0) loads -= (1.0 - lossy[j].loss->reverse_efficiency) * p1;
-                if (p2 > 0.0) loads -= (1.0 - lossy[j].loss->efficiency) * p2;
-              }
-              worst = std::max(worst, std::fabs(power - (energy_rate - loads)));
-              scale = std::max({scale, std::fabs(power), std::fabs(energy_rate)});
-              ++rows;
-              return true;
-            },
-            &sum),
-        SolveStatus::kSuccess);
-    EXPECT_GT(rows, 10u);
-    EXPECT_GT(scale, 0.1);  // watts: the balance is not of zeros
-    EXPECT_LT(worst, 1e-9 * scale);
-    checked.push_back(path.filename().string());
-  }
-  // the scenes with masses today; a new one joins by itself
-  for (const char* name :
-       {"fourbar_motor_torque.yaml", "fourbar_pin_loads.yaml", "fourbar_pin_friction.yaml", "hoist_gear_losses.yaml",
-        "rssr_bearing_loads.yaml", "crank_slider_drag.yaml", "fourbar_gearmotor.yaml"})
-    EXPECT_NE(std::find(checked.begin(), checked.end(), name), checked.end()) << name;
 }
 
 TEST(AppliedLoads, DriverPowerBalancesEnergyAndTheLoadsPowerInEveryFormulation) {
