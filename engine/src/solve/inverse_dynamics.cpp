@@ -358,12 +358,12 @@ SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, c
     return SolveStatus::kNonFinite;
   }
   if (detail::FrictionLosses::any(loads.applied.get())) {  // (ensure_factorized() gave ws.lu the factors at q)
-    detail::FrictionLosses bearings(model, *loads.applied);
+    detail::FrictionLosses losses(model, *loads.applied);
     Eigen::VectorXd kept;
     const double* qd = ws.qd.size() == model.num_coordinates() ? ws.qd.data() : nullptr;  // (none: at rest)
-    if (!bearings.solve(model, *ws.lu, ws.q.data(), qd, t, Q, lambda, kept)) {
-      if (message) *message = bearings.failed_solve() ? ws.lu->last_message() : bearings.lock_message();
-      return bearings.failed_solve() ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
+    if (!losses.solve(model, *ws.lu, ws.q.data(), qd, t, Q, lambda, kept)) {
+      if (message) *message = losses.failed_solve() ? ws.lu->last_message() : losses.lock_message();
+      return losses.failed_solve() ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
     }
   }
   for (Index c : rheonomic_constraints(model))

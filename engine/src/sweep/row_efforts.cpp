@@ -52,12 +52,12 @@ bool Sweeper::row_efforts() {
     return fail(SolveStatus::kNonFinite, "efforts: " + why);
   }
   if (effort_work_.losses) {  // the bearings' friction and the gears' losses, from the multipliers they change
-    FrictionLosses& b = *effort_work_.losses;
-    const bool settled = b.solve(model_, *w->lu, current_.q.data(), current_.qd.data(), t, effort_work_.q,
-                                 effort_work_.lambda, effort_work_.kept);
-    ws_->counters.effort_solves += b.solves();
+    FrictionLosses& losses = *effort_work_.losses;
+    const bool settled = losses.solve(model_, *w->lu, current_.q.data(), current_.qd.data(), t, effort_work_.q,
+                                      effort_work_.lambda, effort_work_.kept);
+    ws_->counters.effort_solves += losses.solves();
     if (!settled) {
-      if (!b.failed_solve()) sum_.warnings.push_back({t, "friction_lock", b.lock_message()});
+      if (!losses.failed_solve()) sum_.warnings.push_back({t, "friction_lock", losses.lock_message()});
       return not_defined();
     }
   }
