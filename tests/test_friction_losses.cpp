@@ -287,6 +287,37 @@ TEST(GearLosses, APlanetarysLossesAreTheTextbooksSunToCarrierEfficiency) {
   for (std::size_t k = 0; k < rows.q.size(); ++k) EXPECT_NEAR(rows.values[k][0], (2.0 / 7.0) / eta, 1e-12) << k;
 }
 
+// The worm of test_bevel_meshes.cpp (one start, pitch radius 0.01 m; a 30-tooth wheel of 0.05 m: lead angle
+// λ = atan(1/6)), massless, turned at a rising speed against a torque T about its wheel's shaft, with tooth friction μ:
+// the motor pays (T/30) / η, η = (cos φ − μ tan λ)/(cos φ + μ cot λ), when T resists; when T drives, (T/30) η_r,
+// η_r = (cos φ − μ cot λ)/(cos φ + μ tan λ), which at μ = 0.2 is negative: the worm locks itself, and the motor
+// pushes the load down.
+TEST(GearLosses, AWormsFrictionGivesItsEfficienciesAndLocksItWhereTheyTurnNegative) {
+  std::string base = test::model_file_text("transmissions/bevel_gears.yaml", "output:");
+  base =
+      test::replace_first(base, "{body: ground, axis: [0, 1, 0]}", "{body: ground, at: [0, 0, 0.06], axis: [0, 1, 0]}");
+  base = test::replace_first(base, "s2_z: 0", "s2_z: 0.06");
+  base = test::replace_first(base, "teeth: [15, 30]", "teeth: [1, 30], pitch_radii: [0.01, 0.05]");
+  base = test::replace_first(base, "coefficients: [0, 2, 0.5]", "coefficients: [0, 30, 15]");
+  base = test::replace_first(base, "time: {start: 0, end: 3, steps: 60}", "time: {start: 0, end: 1, steps: 20}");
+  const double tan_lead = 1.0 / 6.0, c = std::cos(20 * M_PI / 180);
+  for (const double mu : {0.05, 0.2})
+    for (const double T : {0.6, -0.6}) {
+      const std::string text = base + "loads:\n  torques: [{name: load, part: output_shaft, torque: [0, " +
+                               std::to_string(T) +
+                               ", 0]}]\n  gear_losses: [{gear: bevel, friction: " + std::to_string(mu) +
+                               "}]\noutput: {velocities: true, accelerations: true, efforts: [motor]}\n";
+      const test::ReactionRows rows = test::sweep_reactions(parse_scene(text, "worm.yaml"));
+      ASSERT_EQ(rows.q.size(), 21u);
+      const double eta = (c - mu * tan_lead) / (c + mu / tan_lead), eta_r = (c - mu / tan_lead) / (c + mu * tan_lead);
+      const double expected = T > 0 ? (T / 30) / eta : (T / 30) * eta_r;
+      if (mu == 0.2 && T < 0) EXPECT_GT(expected, 0.0);  // (self-locking: the motor pushes the load down)
+      for (std::size_t k = 0; k < rows.q.size(); ++k)
+        EXPECT_NEAR(rows.values[k][0], expected, 1e-10 * std::fabs(expected))
+            << "μ " << mu << ", T " << T << ", row " << k;
+    }
+}
+
 TEST(GearLosses, BadLossesAreRefusedInOneLine) {
   const std::string base = test::model_file_text("transmissions/gear_train.yaml", "output: {") +
                            "loads:\n  torques: [{name: load, part: output, torque: -2}]\n";
@@ -296,7 +327,9 @@ TEST(GearLosses, BadLossesAreRefusedInOneLine) {
            {"[{gear: nowhere, efficiency: 0.9}]", "unknown transmission 'nowhere'"},
            {"[{gear: first_stage, efficiency: 1.2}]", "an efficiency is in (0, 1]"},
            {"[{gear: first_stage, efficiency: 0}]", "an efficiency is in (0, 1]"},
-           {"[{gear: first_stage, efficiency: 0.9, reverse_efficiency: -1}]", "an efficiency is in (0, 1]"},
+           {"[{gear: first_stage, efficiency: 0.9, reverse_efficiency: 1.5}]", "a reverse efficiency is at most 1"},
+           {"[{gear: first_stage, friction: 0.1}]", "a worm pair's efficiencies (a spatial_gear)"},
+           {"[{gear: first_stage, friction: 0.1, efficiency: 0.9}]", "give one or the other"},
            {"[{gear: first_stage}]", "efficiency"}}) {
     try {
       parse_scene(base + "  gear_losses: " + losses + "\n" + out, "bad.yaml");

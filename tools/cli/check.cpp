@@ -117,8 +117,11 @@ std::vector<std::string> load_lines(const phiq::AppliedLoads& a, int dimension) 
                    (s.bearing->thrust_radius != 0.0 ? " + " + g6(s.bearing->thrust_radius) + " m x |F_a|" : "") + ")"
              : ""));
   for (const phiq::GearLoss& l : a.gear_losses)
-    out.push_back("gear loss of '" + l.gear + "': efficiency " + g6(l.efficiency) +
-                  (l.reverse_efficiency != l.efficiency ? ", reverse " + g6(l.reverse_efficiency) : ""));
+    out.push_back("gear loss of '" + l.gear + "': " +
+                  (l.friction > 0.0
+                       ? "worm friction " + g6(l.friction)
+                       : "efficiency " + g6(l.efficiency) +
+                             (l.reverse_efficiency != l.efficiency ? ", reverse " + g6(l.reverse_efficiency) : "")));
   return out;
 }
 

@@ -123,15 +123,20 @@ struct TorsionalSpring {
   std::optional<BearingFriction> bearing;  ///< a bearing's friction, if any
 };
 
-/// A transmission's meshing losses as constant efficiencies (a gear pair's, a rack and pinion's, a belt's, a
-/// spatial pair's, a worm's): the member its teeth drive (the one the mesh does positive work on, relative to the
-/// carrier) receives η of the ideal mesh's effort, the rest a friction-like loss (1 − η) |e| against its turn; η
-/// `efficiency` where the first member drives the second, `reverse_efficiency` the other way (a worm back-driven by
-/// its wheel). Solved with the multipliers, as a bearing's friction (detail::FrictionLosses).
+/// A transmission's meshing losses as efficiencies (a gear pair's, a rack and pinion's, a belt's, a spatial pair's, a
+/// worm's): the member its teeth drive (the one the mesh does positive work on, relative to the carrier) receives η
+/// of the ideal mesh's effort, the rest a friction-like loss (1 − η) |e| against its turn; η `efficiency` where the
+/// first member drives the second, `reverse_efficiency` the other way. A reverse efficiency ≤ 0 is a self-locking
+/// drive: its second member cannot drive the first, whose motor must push it even while the load goes its way. Of a
+/// worm pair (a spatial_gear with pitch radii, its axes crossed at a right angle), `friction` μ gives both from its
+/// lead angle λ (tan λ = r2 / (|k| r1)) and normal pressure angle φ: η = (cos φ − μ tan λ) / (cos φ + μ cot λ),
+/// η_r = (cos φ − μ cot λ) / (cos φ + μ tan λ). Solved with the multipliers, as a bearing's friction
+/// (detail::FrictionLosses).
 struct GearLoss {
   std::string gear;                 ///< the transmission (a constraint: gear, rack_pinion, belt or spatial_gear)
   double efficiency = 1.0;          ///< η where the first member drives, in (0, 1]
-  double reverse_efficiency = 1.0;  ///< η where the second member drives, in (0, 1] (the scene's default: η)
+  double reverse_efficiency = 1.0;  ///< η where the second member drives, ≤ 1 (the scene's default: η)
+  double friction = 0.0;            ///< μ > 0 of a worm pair's teeth, in place of the efficiencies; 0: none
   bool operator==(const GearLoss&) const = default;  ///< datum by datum
 };
 

@@ -265,10 +265,11 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
   return spring;
 }
 
-// A transmission's meshing losses: `{gear: NAME, efficiency: η, reverse_efficiency: η}`.
+// A transmission's meshing losses: `{gear: NAME, efficiency: η, reverse_efficiency: η}` or, a worm pair's,
+// `{gear: NAME, friction: μ}`.
 template <class C>
 GearLoss PartReader::gear_loss(const C& g) const {
-  g.expect_map({"gear", "efficiency", "reverse_efficiency"});
+  g.expect_map({"gear", "efficiency", "reverse_efficiency", "friction"});
   GearLoss l;
   const auto gear = g.require("gear");
   l.gear = gear.name();
@@ -276,14 +277,22 @@ GearLoss PartReader::gear_loss(const C& g) const {
   if (!FrictionLosses::transmits(kind))
     gear.fail((kind.empty() ? "unknown transmission '" + l.gear + "'" : "'" + l.gear + "' is a " + std::string(kind)) +
               ": meshing losses are a gear's, rack_pinion's, belt's or spatial_gear's of 'constraints'");
+  if (const auto f = g.field("friction"); f.present()) {
+    if (g.field("efficiency").present() || g.field("reverse_efficiency").present())
+      f.fail("a worm's friction gives its efficiencies: give one or the other");
+    if (kind != "spatial_gear") f.fail("a friction coefficient gives a worm pair's efficiencies (a spatial_gear)");
+    l.friction = r_.number(f);
+    if (!(l.friction > 0.0 && std::isfinite(l.friction))) f.fail("a friction coefficient is positive");
+    return l;
+  }
   const auto e = g.require("efficiency");
   l.efficiency = r_.number(e);
   if (!(l.efficiency > 0.0 && l.efficiency <= 1.0)) e.fail("an efficiency is in (0, 1], got " + shortest(l.efficiency));
   l.reverse_efficiency = l.efficiency;
   if (const auto r = g.field("reverse_efficiency"); r.present()) {
     l.reverse_efficiency = r_.number(r);
-    if (!(l.reverse_efficiency > 0.0 && l.reverse_efficiency <= 1.0))
-      r.fail("an efficiency is in (0, 1], got " + shortest(l.reverse_efficiency));
+    if (!(l.reverse_efficiency <= 1.0 && std::isfinite(l.reverse_efficiency)))
+      r.fail("a reverse efficiency is at most 1 (≤ 0: self-locking), got " + shortest(l.reverse_efficiency));
   }
   return l;
 }

@@ -78,16 +78,31 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
     if (c < 0) throw Error(who + ": not a constraint of the model");
     const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
     if (!transmits(info.kind) || !(l.efficiency > 0.0 && l.efficiency <= 1.0) ||
-        !(l.reverse_efficiency > 0.0 && l.reverse_efficiency <= 1.0))
+        !(l.reverse_efficiency <= 1.0 && std::isfinite(l.reverse_efficiency)) || !(l.friction >= 0.0))
       throw Error(who + ": a " + std::string(info.kind) +
-                  ", or an efficiency outside (0, 1]: the loss is a gear's, rack's, belt's or spatial pair's");
+                  ", or an efficiency outside (0, 1] (a reverse one above 1), or a negative friction: the loss is a "
+                  "gear's, rack's, belt's or spatial pair's");
     const auto [block, index] = model.constraint_block(c);
     Mesh m;
     m.loss = &l, m.row = info.first_row + info.rows - 1;  // (the ratio row, a spatial pair's last)
+    m.eta[1] = l.efficiency, m.eta[0] = l.reverse_efficiency;
+    if (l.friction > 0.0 && std::string_view(info.kind) != "spatial_gear")
+      throw Error(who + ": a friction coefficient gives a worm pair's efficiencies (a spatial_gear)");
     if (GearMesh g; block->gear_mesh(index, g)) {
       m.member[0] = g.first, m.member[1] = g.second, m.carrier = g.carrier, m.k = g.k;
     } else if (SpatialMesh sm; block->spatial_mesh(index, sm)) {
       m.member[0] = sm.theta1, m.member[1] = sm.theta2, m.carrier = Slot::constant(0.0), m.k = sm.k;
+      if (l.friction > 0.0) {  // a worm pair's efficiencies from its lead angle and pressure angle (GearLoss)
+        if (!(sm.r1 > 0.0 && sm.r2 > 0.0))
+          throw Error(who + ": a friction coefficient needs the pair's pitch radii (`pitch_radii` or `radii`)");
+        const double tan_lead = sm.r2 / (std::abs(sm.k) * sm.r1), c = std::cos(sm.pressure_angle), mu = l.friction;
+        m.eta[1] = (c - mu * tan_lead) / (c + mu / tan_lead);
+        m.eta[0] = (c - mu / tan_lead) / (c + mu * tan_lead);
+        if (!(m.eta[1] > 0.0))
+          throw Error(who + ": with friction " + shortest(mu) + " the worm cannot drive its wheel (lead angle " +
+                      significant(std::atan(tan_lead) * 180.0 / M_PI, 4) + "°): its efficiency would be " +
+                      significant(m.eta[1], 4));
+      }
     } else {
       throw Error(who + ": its " + std::string(info.kind) + " states no mesh (phiq bug)");
     }
@@ -120,7 +135,7 @@ void FrictionLosses::moments_at(const double* q, double t, const Eigen::VectorXd
     Mesh& mesh = meshes_[j];
     const double effort[2] = {-lambda(mesh.row), -mesh.k * lambda(mesh.row)};
     mesh.driven = effort[0] * mesh.rate[0] > 0.0 ? 0 : effort[1] * mesh.rate[1] > 0.0 ? 1 : -1;
-    const double eta = mesh.driven == 1 ? mesh.loss->efficiency : mesh.loss->reverse_efficiency;
+    const double eta = mesh.driven < 0 ? 1.0 : mesh.eta[mesh.driven];
     m[bearings_.size() + j] = mesh.driven < 0 ? 0.0 : (1.0 - eta) * std::abs(effort[mesh.driven]);
   }
 }

@@ -76,6 +76,7 @@ class FrictionLosses {
     Index row = 0;
     double rate[2] = {0.0, 0.0};  // each member's rate relative to the carrier, at the row
     int driven = -1;              // the member driven at the last pass (−1: none, no power through the mesh)
+    double eta[2] = {1.0, 1.0};   // the efficiency where member 0 (reverse), member 1 (forward) is driven
   };
   // m_i from the reactions and the meshes' multipliers at λ (bearings first, then meshes)
   void moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m);
