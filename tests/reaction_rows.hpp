@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cmath>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -75,6 +76,19 @@ inline void expect_fourbar_links_balance(const Model& m, const Eigen::VectorXd& 
                 tolerance * (1.0 + std::fabs(moment)))
         << names[l][0] << " row " << row;
   }
+}
+
+// models/transmissions/bevel_gears.yaml made a worm pair, up to its `output:` (to be written by the caller): a
+// one-start worm of pitch radius 0.01 about x at the origin, its 30-tooth wheel of 0.05 about y through (0, 0, 0.06),
+// the worm turned at θ1 = 30 t + 15 t², `steps` rows over one second.
+inline std::string worm_scene_text(int steps) {
+  std::string text = model_file_text("transmissions/bevel_gears.yaml", "output:");
+  text = replace_first(text, "{body: ground, axis: [0, 1, 0]}", "{body: ground, at: [0, 0, 0.06], axis: [0, 1, 0]}");
+  text = replace_first(text, "s2_z: 0", "s2_z: 0.06");
+  text = replace_first(text, "teeth: [15, 30]", "teeth: [1, 30], pitch_radii: [0.01, 0.05]");
+  text = replace_first(text, "coefficients: [0, 2, 0.5]", "coefficients: [0, 30, 15]");
+  return replace_first(text, "time: {start: 0, end: 3, steps: 60}",
+                       "time: {start: 0, end: 1, steps: " + std::to_string(steps) + "}");
 }
 
 }  // namespace phiq::test

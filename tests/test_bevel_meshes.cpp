@@ -175,13 +175,7 @@ TEST(BevelMeshes, APairInATurningHousingPushesWithoutWork) {
 // the ideal drive's power, −I θ̈2 / 30; the teeth part worm and wheel by |(Fx, Fy)| tan 20°. Each bearing holds
 // its shaft against them, the wheel's with the moment Euler asks about its point.
 TEST(BevelMeshes, AWormsBearingsCarryItsTeethsPushByNewtonEuler) {
-  std::string text = test::model_file_text("transmissions/bevel_gears.yaml", "output:");
-  text =
-      test::replace_first(text, "{body: ground, axis: [0, 1, 0]}", "{body: ground, at: [0, 0, 0.06], axis: [0, 1, 0]}");
-  text = test::replace_first(text, "s2_z: 0", "s2_z: 0.06");
-  text = test::replace_first(text, "teeth: [15, 30]", "teeth: [1, 30], pitch_radii: [0.01, 0.05]");
-  text = test::replace_first(text, "coefficients: [0, 2, 0.5]", "coefficients: [0, 30, 15]");
-  text = test::replace_first(text, "time: {start: 0, end: 3, steps: 60}", "time: {start: 0, end: 1, steps: 100}");
+  const std::string text = test::worm_scene_text(100);
   SweepSummary sum;
   const Scene s =
       parse_scene(text +

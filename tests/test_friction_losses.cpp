@@ -293,13 +293,7 @@ TEST(GearLosses, APlanetarysLossesAreTheTextbooksSunToCarrierEfficiency) {
 // η_r = (cos φ − μ cot λ)/(cos φ + μ tan λ), which at μ = 0.2 is negative: the worm locks itself, and the motor
 // pushes the load down.
 TEST(GearLosses, AWormsFrictionGivesItsEfficienciesAndLocksItWhereTheyTurnNegative) {
-  std::string base = test::model_file_text("transmissions/bevel_gears.yaml", "output:");
-  base =
-      test::replace_first(base, "{body: ground, axis: [0, 1, 0]}", "{body: ground, at: [0, 0, 0.06], axis: [0, 1, 0]}");
-  base = test::replace_first(base, "s2_z: 0", "s2_z: 0.06");
-  base = test::replace_first(base, "teeth: [15, 30]", "teeth: [1, 30], pitch_radii: [0.01, 0.05]");
-  base = test::replace_first(base, "coefficients: [0, 2, 0.5]", "coefficients: [0, 30, 15]");
-  base = test::replace_first(base, "time: {start: 0, end: 3, steps: 60}", "time: {start: 0, end: 1, steps: 20}");
+  const std::string base = test::worm_scene_text(20);
   const double tan_lead = 1.0 / 6.0, c = std::cos(20 * M_PI / 180);
   for (const double mu : {0.05, 0.2})
     for (const double T : {0.6, -0.6}) {
