@@ -312,6 +312,26 @@ TEST(GearLosses, AWormsFrictionGivesItsEfficienciesAndLocksItWhereTheyTurnNegati
     }
 }
 
+TEST(GearLosses, AFrictionCoefficientIsRefusedWhereThePairIsNoWorm) {
+  // the bevel pair with its mean pitch radii: its axes meet, where the worm's lead angle means nothing
+  std::string text = test::model_file_text("transmissions/bevel_gears.yaml", "output:");
+  text = test::replace_first(text, "teeth: [15, 30]", "radii: [0.03, 0.06]");
+  text +=
+      "loads:\n  torques: [{name: load, part: output_shaft, torque: [0, 1, 0]}]\n"
+      "  gear_losses: [{gear: bevel, friction: 0.1}]\noutput: {velocities: true, accelerations: true, efforts: "
+      "[motor]}\n";
+  const Scene s = parse_scene(text, "bevel.yaml");
+  Workspace ws(*s.model);
+  ws.q = s.model->initial_positions();
+  try {
+    (void)run_sweep(
+        *s.model, s.sweep, ws, [](const StepView&) { return true; }, nullptr);
+    ADD_FAILURE() << "a bevel pair's friction was taken for a worm's";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("its axes meet"), std::string::npos) << e.what();
+  }
+}
+
 TEST(GearLosses, BadLossesAreRefusedInOneLine) {
   const std::string base = test::model_file_text("transmissions/gear_train.yaml", "output: {") +
                            "loads:\n  torques: [{name: load, part: output, torque: -2}]\n";

@@ -11,9 +11,35 @@
 #include "phiq/kinds/reaction_site.hpp"
 #include "phiq/kinds/spatial_gear.hpp"
 #include "phiq/model.hpp"
+#include "phiq/part_motion.hpp"
 #include "phiq/text.hpp"
 
 namespace phiq::detail {
+
+namespace {
+
+// Why a spatial pair's friction cannot be a worm's, at the model's placement: its axes must cross at a right angle
+// without meeting (a worm's, or crossed helical gears' at 90°), which the lead-angle formula assumes; empty when
+// they do. (A pair's shafts stand in its housings, so their angle is the housings' at any placement.)
+std::string not_a_worm(const SpatialMesh& g, const Eigen::VectorXd& q) {
+  using kin3::V3;
+  auto axis_of = [&](const JointSide3& side, V3& point, V3& axis) {
+    PartFrame f;
+    f.kind = PartFrameKind::kSpatialBody, f.spatial = side.frame;
+    const Pose pose = part_pose(f, q.data(), 0.0);
+    point = pose.apply(side.at);
+    axis = pose.apply(side.axis) - pose.at;
+    axis = (1.0 / kin3::norm(axis)) * axis;
+  };
+  V3 a1, z1, a2, z2;
+  axis_of(g.a1, a1, z1), axis_of(g.a2, a2, z2);
+  if (!(std::abs(kin3::dot(z1, z2)) <= 1e-6)) return "its shafts are not at a right angle";
+  const double gap = std::abs(kin3::dot(a2 - a1, kin3::cross(z1, z2)));  // (|z1 × z2| = 1)
+  if (!(gap > 1e-6 * (g.r1 + g.r2))) return "its axes meet (a bevel pair: give its efficiencies)";
+  return {};
+}
+
+}  // namespace
 
 bool FrictionLosses::carries(std::string_view kind) {
   return kind == "pin" || kind == "revolute" || kind == "cylindrical" || kind == "prismatic";
@@ -95,6 +121,8 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
       if (l.friction > 0.0) {  // a worm pair's efficiencies from its lead angle and pressure angle (GearLoss)
         if (!(sm.r1 > 0.0 && sm.r2 > 0.0))
           throw Error(who + ": a friction coefficient needs the pair's pitch radii (`pitch_radii` or `radii`)");
+        if (const std::string why = not_a_worm(sm, model.initial_positions()); !why.empty())
+          throw Error(who + ": a friction coefficient gives a worm's efficiencies, but " + why);
         const double tan_lead = sm.r2 / (std::abs(sm.k) * sm.r1), c = std::cos(sm.pressure_angle), mu = l.friction;
         m.eta[1] = (c - mu * tan_lead) / (c + mu / tan_lead);
         m.eta[0] = (c - mu / tan_lead) / (c + mu * tan_lead);
