@@ -13,6 +13,7 @@
 
 #include <cmath>
 
+#include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/phiq.hpp"
 #include "phiq/stepper.hpp"
@@ -44,7 +45,6 @@ TEST(BearingFriction, FourBarPinsWithBearingsSatisfyEveryLinksNewtonEuler) {
   ASSERT_EQ(rows.q.size(), 73u);
   EXPECT_GT(sum.counters.effort_solves, 3 * 73) << "the moments are solved for, in passes";
   auto c = [&](const char* n) { return s.model->coordinate_index(n); };
-  auto sign = [](double v) { return v > 0.0 ? 1.0 : v < 0.0 ? -1.0 : 0.0; };
   double largest_couple = 0.0;
   for (std::size_t k = 0; k < rows.q.size(); ++k) {
     const Eigen::VectorXd& qd = rows.qd[k];
@@ -53,7 +53,7 @@ TEST(BearingFriction, FourBarPinsWithBearingsSatisfyEveryLinksNewtonEuler) {
     const double turn[4] = {qd(c("psi2")), qd(c("psi3")) - qd(c("psi2")), qd(c("psi4")) - qd(c("psi3")), qd(c("psi4"))};
     double f[4];
     for (int j = 0; j < 4; ++j) {
-      f[j] = mu * radius * std::hypot(v[2 + 3 * j], v[3 + 3 * j]) * sign(turn[j]);
+      f[j] = mu * radius * std::hypot(v[2 + 3 * j], v[3 + 3 * j]) * friction_direction(turn[j]);
       largest_couple = std::max(largest_couple, std::fabs(f[j]));
     }
     // on each link: −f on the turn's later body, +f on its earlier one; the motor's torque on the crank
@@ -150,7 +150,7 @@ TEST(BearingFriction, ACamFollowersGuideRubsByMuTimesTheCamsSidePush) {
     const std::vector<double>& v = rows.values[k];
     const Eigen::Vector2d cam(v[2], v[3]), guide(v[5], v[6]);  // each on the rod
     const double yd = rows.qd[k](yf), ydd = rows.qdd[k](yf);
-    const double rub = -mu * guide.norm() * (yd > 0.0 ? 1.0 : yd < 0.0 ? -1.0 : 0.0);
+    const double rub = -mu * guide.norm() * friction_direction(yd);
     largest_rub = std::max(largest_rub, std::fabs(rub));
     // the rod, which only slides: Newton across the guide and along it, the rub in its y
     EXPECT_NEAR(cam.x() + guide.x(), 0.0, 1e-9) << k;
@@ -194,7 +194,7 @@ TEST(BearingFriction, ACamFollowerJamsWhereMuTanPhiReachesOne) {
                   const double rho = mu * std::fabs(nx / ny);
                   if (rho < 0.9) {
                     // the closed form: the lift F ny/|n| less the rub μ F |nx|/|n| against ẏ carries m (ÿ + g)
-                    const double yd = (*v.qd)(yf), ydd = (*v.qdd)(yf), s_rub = yd > 0 ? 1.0 : yd < 0 ? -1.0 : 0.0;
+                    const double yd = (*v.qd)(yf), ydd = (*v.qdd)(yf), s_rub = friction_direction(yd);
                     const double F = m * (ydd + g) * std::hypot(nx, ny) / (ny - s_rub * mu * std::fabs(nx));
                     EXPECT_NEAR(std::hypot(v.efforts[2], v.efforts[3]), std::fabs(F), 1e-9 * std::fabs(F)) << t;
                     EXPECT_TRUE(std::isfinite(v.efforts[0])) << t;

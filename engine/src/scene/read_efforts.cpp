@@ -208,9 +208,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
             "no part has mass and no load is applied: every effort would be zero (give parts a mass "
             "or a density, or apply loads)");
   if (!out.constraints.empty() && !scene.sweep.sensitivities.empty() && FrictionLosses::any(scene.loads.applied.get()))
-    pending_.efforts_field->fail(
-        "the efforts' sensitivities ∂τ/∂p are not computed with a bearing's friction or a gear's losses (they read "
-        "the multipliers they change): ask them without those");
+    pending_.efforts_field->fail(FrictionLosses::kNoSensitivities);
   out.parts = std::move(massive);
   out.loads = std::make_shared<const Loads>(scene.loads);
   out.power = pending_.efforts_power;

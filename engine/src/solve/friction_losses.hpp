@@ -48,6 +48,10 @@ class FrictionLosses {
   static bool carries(std::string_view kind);
   // Whether a constraint of kind `kind` is a transmission with meshing losses (GearLoss).
   static bool transmits(std::string_view kind);
+  // Why the efforts' ∂τ/∂p are refused with these losses (the scene's reader and the sweep say it alike).
+  static constexpr const char* kNoSensitivities =
+      "the efforts' sensitivities ∂τ/∂p are not computed with a bearing's friction or a gear's losses (they read the "
+      "multipliers they change): ask them without those";
   // Whether `loads` has a bearing or a gear loss.
   static bool any(const AppliedLoads* loads);
 

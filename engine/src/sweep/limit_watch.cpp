@@ -54,28 +54,27 @@ void LimitWatch::row(double t, const double* q, const double* qd, const double* 
   first_ = false, last_t_ = t;
 }
 
+std::string LimitWatch::outside_text(std::size_t i) const {
+  const Stretch& s = stretch_[i];
+  const OutputLimit& l = limits_[i];
+  return l.name + ": " + l.what + " is " +
+         (s.above ? "above its maximum " + significant(l.hi, 10) : "below its minimum " + significant(l.lo, 10));
+}
+
 void LimitWatch::close(std::size_t i) {
   Stretch& s = stretch_[i];
-  const OutputLimit& l = limits_[i];
-  const std::string bound =
-      s.above ? "above its maximum " + significant(l.hi, 10) : "below its minimum " + significant(l.lo, 10);
   std::string where = s.rows == 1 ? "at t = " + format_time(s.from)
                                   : "from t = " + format_time(s.from) + " to t = " + format_time(s.to) + " (" +
                                         std::to_string(s.rows) + " rows)";
   found_.push_back({s.from, "limit",
-                    l.name + ": " + l.what + " is " + bound + " " + where + ", " +
-                        (s.above ? "at most " : "at least ") + significant(s.worst, 10) +
-                        (s.rows == 1 ? "" : " (t = " + format_time(s.worst_t) + ")")});
+                    outside_text(i) + " " + where + ", " + (s.above ? "at most " : "at least ") +
+                        significant(s.worst, 10) + (s.rows == 1 ? "" : " (t = " + format_time(s.worst_t) + ")")});
   s.open = false;
 }
 
 SweepWarning LimitWatch::beginning(std::size_t i) const {
   const Stretch& s = stretch_[i];
-  const OutputLimit& l = limits_[i];
-  return {s.from, "limit",
-          l.name + ": " + l.what + " is " +
-              (s.above ? "above its maximum " + significant(l.hi, 10) : "below its minimum " + significant(l.lo, 10)) +
-              " from t = " + format_time(s.from) + ": " + significant(s.worst, 10)};
+  return {s.from, "limit", outside_text(i) + " from t = " + format_time(s.from) + ": " + significant(s.worst, 10)};
 }
 
 void LimitWatch::finish(std::vector<SweepWarning>& warnings) {

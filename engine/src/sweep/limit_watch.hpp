@@ -2,6 +2,7 @@
 // stretch of rows outside its range said once, as a `limit` warning, when the stretch ends.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "phiq/output_plan.hpp"
@@ -32,6 +33,7 @@ class LimitWatch {
     double from = 0.0, to = 0.0, worst = 0.0, worst_t = 0.0;
   };
   void close(std::size_t i);
+  std::string outside_text(std::size_t i) const;  // "NAME: WHAT is above its maximum HI" (or below its minimum)
 
   const std::vector<OutputLimit>& limits_;
   std::vector<Stretch> stretch_;

@@ -23,10 +23,7 @@ Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSumm
                   effort_work_.reactions ? effort_work_.reactions->planar_parts_read(opt_.efforts.parts->size())
                                          : std::vector<char>{});
   if (opt_.efforts.active() && opt_.efforts.loads && FrictionLosses::any(opt_.efforts.loads->applied.get())) {
-    if (!opt_.sensitivities.empty() && !opt_.efforts.constraints.empty())
-      throw Error(
-          "the efforts' sensitivities ∂τ/∂p are not computed with a bearing's friction or a gear's losses (they "
-          "read the multipliers they change): ask them without those");
+    if (!opt_.sensitivities.empty() && !opt_.efforts.constraints.empty()) throw Error(FrictionLosses::kNoSensitivities);
     effort_work_.losses.emplace(model_, *opt_.efforts.loads->applied);
   }
   // what Q's planar parts add, kept for the natural joints' reactions to read (row_reactions())
