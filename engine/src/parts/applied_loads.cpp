@@ -82,25 +82,30 @@ const std::vector<Index>& angle_coordinates(const TorsionalSpring& s) {
   return s.angle ? s.angle->coordinates() : s.joint_coordinates;
 }
 
-// θ − θ0 and ∂θ/∂q_k for angle_coordinates(), into `gradient`: an expression's own gradient, or a joint angle's
-// rate along each coordinate's unit velocity (exact: the rate is linear in q̇).
-double angle_from_free(const TorsionalSpring& s, const double* q, double t, std::vector<double>& gradient) {
+// ∂θ/∂q_k for angle_coordinates(), into `gradient`: an expression's own gradient, or a joint angle's rate along
+// each coordinate's unit velocity (exact: the rate is linear in q̇).
+void angle_gradient(const TorsionalSpring& s, const double* q, double t, std::vector<double>& gradient) {
   if (s.angle) {
     gradient.resize(s.angle->coordinates().size());
     s.angle->gradient(q, t, gradient.data());
-    return s.angle->value(q, t) - s.free_angle;
+    return;
   }
   const std::vector<Index>& c = s.joint_coordinates;
   gradient.assign(c.size(), 0.0);
-  if (!c.empty()) {
-    thread_local std::vector<double> unit;  // (capacity kept from row to row; all zeros between uses)
-    unit.resize(std::max(unit.size(), static_cast<std::size_t>(c.back()) + 1), 0.0);
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      unit[static_cast<std::size_t>(c[i])] = 1.0;
-      gradient[i] = evaluate_joint(*s.joint, q, unit.data(), nullptr).rate;
-      unit[static_cast<std::size_t>(c[i])] = 0.0;
-    }
+  if (c.empty()) return;
+  thread_local std::vector<double> unit;  // (capacity kept from row to row; all zeros between uses)
+  unit.resize(std::max(unit.size(), static_cast<std::size_t>(c.back()) + 1), 0.0);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    unit[static_cast<std::size_t>(c[i])] = 1.0;
+    gradient[i] = evaluate_joint(*s.joint, q, unit.data(), nullptr).rate;
+    unit[static_cast<std::size_t>(c[i])] = 0.0;
   }
+}
+
+// θ − θ0, and ∂θ/∂q_k into `gradient` (angle_gradient()).
+double angle_from_free(const TorsionalSpring& s, const double* q, double t, std::vector<double>& gradient) {
+  angle_gradient(s, q, t, gradient);
+  if (s.angle) return s.angle->value(q, t) - s.free_angle;
   return std::remainder(evaluate_joint(*s.joint, q, nullptr, nullptr).value - s.free_angle, 2.0 * M_PI);
 }
 
@@ -129,7 +134,7 @@ AngleState angle_state(const TorsionalSpring& s, const double* q, const double* 
 
 double angle_rate(const TorsionalSpring& s, const double* q, const double* qd, double t,
                   std::vector<double>& gradient) {
-  angle_from_free(s, q, t, gradient);
+  angle_gradient(s, q, t, gradient);  // (θ itself is not needed)
   return qd ? rate_along(s, q, qd, t, gradient) : 0.0;
 }
 
