@@ -87,6 +87,7 @@ void FrictionLosses::check_model(const Model& model, const std::string& who, boo
 }
 
 FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
+  auto up = std::make_shared<SetUp>();
   OutputEfforts joints;
   joints.reactions_in_joint_axes = true;  // (a spatial joint's z is its axis: F_a its z, F_r across)
   std::size_t at = 0;
@@ -95,7 +96,7 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
     const Index c = check(model, s);
     const bool spatial = reaction_width(model, c) == 6;
     joints.reactions.push_back({c, spatial});
-    bearings_.push_back({&s, at, spatial});
+    up->bearings.push_back({&s, at, spatial});
     at += spatial ? 6 : 3;
   }
   for (const GearLoss& l : loads.gear_losses) {
@@ -134,48 +135,59 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
     } else {
       throw Error(who + ": its " + std::string(info.kind) + " states no mesh (phiq bug)");
     }
-    meshes_.push_back(m);
+    up->meshes.push_back(m);
   }
-  if (bearings_.empty() && meshes_.empty()) return;
+  if (up->bearings.empty() && up->meshes.empty()) return;
   check_model(model,
-              bearings_.empty() ? "gear loss of '" + meshes_[0].loss->gear + "'"
-                                : "torsional spring '" + bearings_[0].spring->name + "'",
-              !bearings_.empty());
-  if (!bearings_.empty()) {
-    reactions_.emplace(model, joints);
-    values_.assign(static_cast<std::size_t>(reactions_->size()), 0.0);
-  }
-  moments_.assign(bearings_.size() + meshes_.size(), 0.0), next_ = moments_;
-  rates_.assign(bearings_.size(), 0.0);
-  gradients_.resize(bearings_.size());
+              up->bearings.empty() ? "gear loss of '" + up->meshes[0].loss->gear + "'"
+                                   : "torsional spring '" + up->bearings[0].spring->name + "'",
+              !up->bearings.empty());
+  if (!up->bearings.empty()) reactions_.emplace(model, joints);
+  set_ = std::move(up);
+  size_scratch();
+}
+
+FrictionLosses::FrictionLosses(const FrictionLosses& other, SetUpOnly) : set_(other.set_) {
+  if (other.reactions_) reactions_.emplace(JointReactions::with_set_up_of(*other.reactions_));
+  size_scratch();
+}
+
+void FrictionLosses::size_scratch() {
+  if (reactions_) values_.assign(static_cast<std::size_t>(reactions_->size()), 0.0);
+  moments_.assign(set_->bearings.size() + set_->meshes.size(), 0.0), next_ = moments_;
+  rates_.assign(set_->bearings.size(), 0.0);
+  gradients_.resize(set_->bearings.size());
+  mesh_states_.assign(set_->meshes.size(), MeshState{});
 }
 
 void FrictionLosses::moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m) {
   if (reactions_) reactions_->evaluate_kept(q, t, lambda, values_.data());
-  for (std::size_t i = 0; i < bearings_.size(); ++i) {
-    const BearingFriction& b = *bearings_[i].spring->bearing;
-    const double* f = values_.data() + bearings_[i].at;
-    const double across = std::hypot(f[0], f[1]), along = bearings_[i].spatial ? std::abs(f[2]) : 0.0;
+  for (std::size_t i = 0; i < set_->bearings.size(); ++i) {
+    const BearingFriction& b = *set_->bearings[i].spring->bearing;
+    const double* f = values_.data() + set_->bearings[i].at;
+    const double across = std::hypot(f[0], f[1]), along = set_->bearings[i].spatial ? std::abs(f[2]) : 0.0;
     m[i] = b.coefficient * (b.slide ? across : b.radius * across + b.thrust_radius * along);
   }
-  for (std::size_t j = 0; j < meshes_.size(); ++j) {
+  for (std::size_t j = 0; j < set_->meshes.size(); ++j) {
     // the row's effort on each member, −∂row/∂θ_i λ, and its power relative to the carrier: the driven member's > 0
-    Mesh& mesh = meshes_[j];
+    const Mesh& mesh = set_->meshes[j];
+    MeshState& state = mesh_states_[j];
     const double effort[2] = {-lambda(mesh.row), -mesh.k * lambda(mesh.row)};
-    mesh.driven = effort[0] * mesh.rate[0] > 0.0 ? 0 : effort[1] * mesh.rate[1] > 0.0 ? 1 : -1;
-    const double eta = mesh.driven < 0 ? 1.0 : mesh.eta[mesh.driven];
-    m[bearings_.size() + j] = mesh.driven < 0 ? 0.0 : (1.0 - eta) * std::abs(effort[mesh.driven]);
+    state.driven = effort[0] * state.rate[0] > 0.0 ? 0 : effort[1] * state.rate[1] > 0.0 ? 1 : -1;
+    m[set_->bearings.size() + j] =
+        state.driven < 0 ? 0.0 : (1.0 - mesh.eta[state.driven]) * std::abs(effort[state.driven]);
   }
 }
 
 bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd, double t,
                            Eigen::VectorXd& Q, Eigen::VectorXd& lambda, Eigen::VectorXd& kept) {
   solves_ = 0, passes_ = 0, failed_solve_ = false, worst_change_ = 0.0, ratio_ = 0.0;
-  for (std::size_t i = 0; i < bearings_.size(); ++i)
-    rates_[i] = angle_rate(*bearings_[i].spring, q, qd, t, gradients_[i]);
+  for (std::size_t i = 0; i < set_->bearings.size(); ++i)
+    rates_[i] = angle_rate(*set_->bearings[i].spring, q, qd, t, gradients_[i]);
   auto rate = [&](const Slot& s) { return s.is_coordinate() && qd ? qd[s.coord()] : 0.0; };
-  for (Mesh& mesh : meshes_)
-    for (int i = 0; i < 2; ++i) mesh.rate[i] = rate(mesh.member[i]) - rate(mesh.carrier);
+  for (std::size_t j = 0; j < set_->meshes.size(); ++j)
+    for (int i = 0; i < 2; ++i)
+      mesh_states_[j].rate[i] = rate(set_->meshes[j].member[i]) - rate(set_->meshes[j].carrier);
   lambda0_ = lambda;
   if (reactions_) reactions_->keep_geometry(q, t);  // (the passes' reactions differ in λ alone)
   moments_at(q, t, lambda, moments_);
@@ -185,16 +197,17 @@ bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     // Q_f of the moments, against each θ̇ (none at rest)
     q_f_.setZero();
-    for (std::size_t i = 0; i < bearings_.size(); ++i) {
+    for (std::size_t i = 0; i < set_->bearings.size(); ++i) {
       const double m = moments_[i] * friction_direction(rates_[i]);
-      const std::vector<Index>& c = torsional_coordinates(*bearings_[i].spring);
+      const std::vector<Index>& c = torsional_coordinates(*set_->bearings[i].spring);
       for (std::size_t k = 0; k < c.size(); ++k) q_f_(c[k]) -= m * gradients_[i][k];
     }
-    for (std::size_t j = 0; j < meshes_.size(); ++j) {  // against the driven member's turn on the carrier
-      const Mesh& mesh = meshes_[j];
-      if (mesh.driven < 0) continue;
-      const double m = moments_[bearings_.size() + j] * friction_direction(mesh.rate[mesh.driven]);
-      if (mesh.member[mesh.driven].is_coordinate()) q_f_(mesh.member[mesh.driven].coord()) -= m;
+    for (std::size_t j = 0; j < set_->meshes.size(); ++j) {  // against the driven member's turn on the carrier
+      const Mesh& mesh = set_->meshes[j];
+      const MeshState& state = mesh_states_[j];
+      if (state.driven < 0) continue;
+      const double m = moments_[set_->bearings.size() + j] * friction_direction(state.rate[state.driven]);
+      if (mesh.member[state.driven].is_coordinate()) q_f_(mesh.member[state.driven].coord()) -= m;
       if (mesh.carrier.is_coordinate()) q_f_(mesh.carrier.coord()) += m;
     }
     if (q_f_.isZero(0.0)) return true;  // (every bearing at rest or unloaded: λ0 stands)
@@ -228,8 +241,9 @@ bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double
 }
 
 std::string FrictionLosses::name(std::size_t i) const {
-  if (i >= bearings_.size()) return "the meshing loss of '" + meshes_[i - bearings_.size()].loss->gear + "'";
-  const TorsionalSpring& s = *bearings_[i].spring;
+  if (i >= set_->bearings.size())
+    return "the meshing loss of '" + set_->meshes[i - set_->bearings.size()].loss->gear + "'";
+  const TorsionalSpring& s = *set_->bearings[i].spring;
   return "the friction of bearing '" + s.bearing->joint + "' (torsional spring '" + s.name + "')";
 }
 

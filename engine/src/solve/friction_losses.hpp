@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -37,6 +38,10 @@ class FrictionLosses {
   // The bearings of `loads`' torsional springs and its gear losses. Throws phiq::Error naming one whose joint or
   // transmission is unknown or cannot carry it (carries(), transmits()), or a model they cannot be solved in (above).
   FrictionLosses(const Model& model, const AppliedLoads& loads);
+  // The losses `other` solves, its set-up (the bearings, the meshes, the bearings' joints) shared rather than found
+  // again in the model, with scratch of its own: a sweep's chunks each solve on their own thread. Safe while `other`
+  // solves on another thread (its set-up is not written after construction).
+  static FrictionLosses with_set_up_of(const FrictionLosses& other) { return FrictionLosses(other, SetUpOnly{}); }
   // The constraint spring `s`'s bearing is; throws phiq::Error, naming `s`, where it is none or cannot be one.
   static Index check(const Model& model, const TorsionalSpring& s);
   // Throws phiq::Error, naming `who`, where `model` cannot solve a loss that reads its multipliers (redundant rows;
@@ -78,17 +83,29 @@ class FrictionLosses {
     Slot member[2], carrier;
     double k = 1.0;
     Index row = 0;
-    double rate[2] = {0.0, 0.0};  // each member's rate relative to the carrier, at the row
-    int driven = -1;              // the member driven at the last pass (−1: none, no power through the mesh)
-    double eta[2] = {1.0, 1.0};   // the efficiency where member 0 (reverse), member 1 (forward) is driven
+    double eta[2] = {1.0, 1.0};  // the efficiency where member 0 (reverse), member 1 (forward) is driven
   };
+  // A mesh at the row: each member's rate relative to the carrier, and the member driven at the last pass (−1:
+  // none, no power through the mesh)
+  struct MeshState {
+    double rate[2] = {0.0, 0.0};
+    int driven = -1;
+  };
+  // What construction finds, never written after it: shared by with_set_up_of()'s copies.
+  struct SetUp {
+    std::vector<Bearing> bearings;
+    std::vector<Mesh> meshes;
+  };
+  struct SetUpOnly {};
+  FrictionLosses(const FrictionLosses& other, SetUpOnly);
+  void size_scratch();
   // m_i from the reactions and the meshes' multipliers at λ (bearings first, then meshes)
   void moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m);
   std::string name(std::size_t i) const;  // loss i's, for a message
 
-  std::vector<Bearing> bearings_;
-  std::vector<Mesh> meshes_;
-  std::optional<JointReactions> reactions_;
+  std::shared_ptr<const SetUp> set_;
+  std::optional<JointReactions> reactions_;  // the bearings' joints (none without bearings)
+  std::vector<MeshState> mesh_states_;
   std::vector<double> values_, moments_, next_, rates_;
   std::vector<std::vector<double>> gradients_;
   Eigen::VectorXd lambda0_, q_f_, d_lambda_;

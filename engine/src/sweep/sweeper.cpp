@@ -24,7 +24,10 @@ Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSumm
                                          : std::vector<char>{});
   if (opt_.efforts.active() && opt_.efforts.loads && FrictionLosses::any(opt_.efforts.loads->applied.get())) {
     if (!opt_.sensitivities.empty() && !opt_.efforts.constraints.empty()) throw Error(FrictionLosses::kNoSensitivities);
-    effort_work_.losses.emplace(model_, *opt_.efforts.loads->applied);
+    if (same_sweep(like) && like->effort_work_.losses)  // (its set-up, as the reactions' and Q's parts are shared)
+      effort_work_.losses.emplace(FrictionLosses::with_set_up_of(*like->effort_work_.losses));
+    else
+      effort_work_.losses.emplace(model_, *opt_.efforts.loads->applied);
   }
   // what Q's planar parts add, kept for the natural joints' reactions to read (row_reactions())
   if (effort_work_.reactions && opt_.efforts.natural && opt_.efforts.parts)
