@@ -15,7 +15,7 @@ namespace phiq::test {
 
 struct ReactionRows {
   std::vector<Eigen::VectorXd> q, qd, qdd;
-  std::vector<std::vector<double>> values;  // efforts, powers, reactions
+  std::vector<std::vector<double>> values;  // efforts, powers, reactions, losses
 };
 
 // The rows of `s` (its output asks for velocities and accelerations), its summary into `sum` and the model swept

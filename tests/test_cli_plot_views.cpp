@@ -234,6 +234,15 @@ TEST_F(Plot, DriverEffortsGetAPanelPerUnitByDefault) {
   EXPECT_EQ(count(s, "class=\"limit\""), 0u);
 }
 
+TEST_F(Plot, LossesGetAPanelPerUnit) {
+  // two bearings' friction moments in one N·m panel, a bearing's dissipated power in a W one
+  const std::string s =
+      plot("dynamics/fourbar_pin_friction.yaml", " --columns O_bearing.friction O_bearing.loss C_bearing.friction");
+  EXPECT_EQ(captures(s, "data-quantity=\"([^\"]+)\""), (std::vector<std::string>{"torque", "power"}));
+  EXPECT_EQ(captures(s, "data-unit=\"([^\"]+)\""), (std::vector<std::string>{"N·m", "W"}));
+  EXPECT_GT(range("O_bearing.friction").second, 0.1);
+}
+
 TEST_F(Plot, ALimitsEndsAreDashedAcrossItsColumnsPanel) {
   // models/dynamics/fourbar_gearmotor.yaml's rated torque, ±25 N·m, on the motor's effort (its rocker's swing, an
   // expression, has no column): two dashed lines spanning the torque panel, at ±25 on its scale

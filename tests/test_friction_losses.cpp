@@ -356,8 +356,9 @@ TEST(GearLosses, BadLossesAreRefusedInOneLine) {
 }
 
 TEST(BearingFriction, ParallelChunksGiveTheSequentialBits) {
-  const Scene s = parse_scene(fourbar_with_bearings(0.3, 0.05, "output: {efforts: all, power: true, reactions: all}\n"),
-                              "bearings.yaml");
+  const Scene s = parse_scene(
+      fourbar_with_bearings(0.3, 0.05, "output: {efforts: all, power: true, reactions: all, losses: all}\n"),
+      "bearings.yaml");
   auto values = [&](int threads) {
     SweepOptions opt = s.sweep;
     opt.threads = threads;
@@ -380,14 +381,16 @@ TEST(BearingFriction, ParallelChunksGiveTheSequentialBits) {
 }
 
 TEST(BearingFriction, AStepperGivesTheSweepsEffortsWithBearingsAndGearLosses) {
-  // the bearings' four-bar and the lossy gear train stepped over their grids: each step's efforts are the sequential
-  // sweep's rows, bit for bit (one chunk)
+  // the bearings' four-bar and the lossy gear train stepped over their grids: each step's efforts and losses are the
+  // sequential sweep's rows, bit for bit (one chunk)
   const std::string train = test::model_file_text("transmissions/gear_train.yaml", "output: {") +
                             "loads:\n  torques: [{name: load, part: output, torque: -2}]\n"
                             "  gear_losses: [{gear: first_stage, efficiency: 0.95}]\n"
-                            "output: {velocities: true, accelerations: true, efforts: [motor], power: true}\n";
+                            "output: {velocities: true, accelerations: true, efforts: [motor], power: true, "
+                            "losses: all}\n";
   for (const std::string& text :
-       {fourbar_with_bearings(0.3, 0.05, "output: {efforts: all, power: true, reactions: all}\n"), train}) {
+       {fourbar_with_bearings(0.3, 0.05, "output: {efforts: all, power: true, reactions: all, losses: all}\n"),
+        train}) {
     const Scene s = parse_scene(text, "stepped.yaml");
     SweepOptions opt = s.sweep;
     opt.chunk_steps = opt.steps;  // (the rows in order, as a stepper's)

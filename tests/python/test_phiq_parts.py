@@ -238,3 +238,31 @@ def test_a_gear_trains_losses_scale_the_motor_torque_each_way():
     expected = np.where(w > 0, (2 / 9) / eta, np.where(w < 0, (2 / 9) * eta, 2 / 9))
     assert np.max(np.abs(effort - expected)) < 1e-12
     assert (w > 0).sum() > 30 and (w < 0).sum() > 30
+
+
+def test_a_hoists_losses_are_written_and_stepped():
+    # models/dynamics/hoist_gear_losses.yaml with `losses: all`: the motor's power is the load's, m (g + ÿ) ẏ, plus
+    # the two stages' losses, each (1 - η) of the power its driven member passes on, raising or lowering; a Stepper
+    # gives a row's losses by name
+    with open(os.path.join(MODELS, "dynamics", "hoist_gear_losses.yaml"), encoding="utf-8") as f:
+        text = f.read()
+    text = text[:text.index("output: {")] + (
+        "output: {coordinates: [hook], velocities: true, accelerations: true, efforts: all, power: true, "
+        "losses: all}\n")
+    scene = phiq.parse_scene(text, "hoist.yaml")
+    result = phiq.run_sweep(scene).raise_for_status()
+    col = lambda name: result.table[:, result.columns.index(name)]
+    load = 20 * (9.81 + col("hook.a")) * col("hook.v")
+    second = np.where(load > 0, load * (1 / 0.95 - 1), -load * (1 - 0.93))
+    first = np.where(load > 0, load / 0.95 * (1 / 0.97 - 1), -load * 0.93 * (1 - 0.96))
+    scale = 1e-11 * np.abs(load) + 1e-13
+    assert np.all(np.abs(col("second_stage.loss") - second) <= scale)
+    assert np.all(np.abs(col("first_stage.loss") - first) <= scale)
+    assert np.all(np.abs(col("motor.power") - load - first - second) <= scale)
+    assert (load > 1).sum() > 30 and (load < -1).sum() > 30
+    assert result.columns[-2:] == ["first_stage.loss", "second_stage.loss"]
+    stepper = phiq.Stepper(scene)
+    for k in range(3):
+        assert stepper.step(result.t[k]).ok
+    assert stepper.losses == {"first_stage": (col("first_stage.loss")[2],),
+                              "second_stage": (col("second_stage.loss")[2],)}

@@ -94,6 +94,10 @@ Quantity column_quantity(const Scene& scene, const std::string& column) {
     if (column.size() == name.size() + 3 && column.compare(0, name.size(), name) == 0 && column[name.size()] == '.')
       return column[name.size() + 1] == 'F' ? Quantity{"force", "N"} : Quantity{"torque", "N·m"};
   }
+  for (const OutputLoss& l : scene.sweep.efforts.losses) {  // a bearing's friction, a loss's power
+    if (column == l.name + ".loss") return {"power", "W"};
+    if (column == l.name + ".friction") return l.slide ? Quantity{"force", "N"} : Quantity{"torque", "N·m"};
+  }
   if (column_ends_with(column, ".residual")) return {"residual", ""};
   if (column_ends_with(column, ".ddf")) return {"driver law, second rate", ""};
   if (column_ends_with(column, ".df")) return {"driver law, rate", ""};

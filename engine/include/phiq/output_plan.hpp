@@ -94,6 +94,16 @@ struct OutputReaction {
   int natural = -1;      ///< a natural joint: its index in OutputEfforts::natural's joints, else −1
 };
 
+/// A loss whose values a sweep writes (OutputEfforts::losses): a bearing's friction (TorsionalSpring::bearing) or a
+/// transmission's meshing loss (GearLoss), phiq/applied_loads.hpp.
+struct OutputLoss {
+  std::string name;  ///< its columns' stem: the bearing's torsional spring's name, or the gear's
+  /// Its index among the scene's losses: the torsional springs with a bearing in order, then the gear losses.
+  std::size_t index = 0;
+  bool bearing = false;  ///< two values (its moment or force, and its power) rather than one (the power)
+  bool slide = false;    ///< a bearing that slides: its friction is a force (N), not a moment (N m)
+};
+
 /// A transmission in a sweep that writes reactions (OutputEfforts::meshes): a gear pair, rack and pinion or belt
 /// between planar bodies, whose teeth (strands) push the bodies' reference points, about which they turn, or a
 /// spatial gear pair, which pushes its shafts (add_gear_mesh_forces(), phiq/joint_reactions.hpp); or one whose push
@@ -138,16 +148,27 @@ struct OutputEfforts {
   std::vector<OutputMesh> meshes;
   /// The natural coordinates' bodies and joints the `natural` reactions index (null: none listed).
   std::shared_ptr<const NaturalJoints> natural;
+  /// Losses written after the reactions (OutputLoss): a bearing's friction, the moment (N m) or a slide's force (N)
+  /// it exerts against the motion, `NAME.friction`, and the power it dissipates, `NAME.loss` (W); a gear's
+  /// `NAME.loss`. Magnitudes, both zero at rest (no stiction).
+  std::vector<OutputLoss> losses;
   /// A reaction's name (its columns' stem): its constraint's, or its natural joint's point's.
   std::string reaction_name(const Model& model, const OutputReaction& r) const;
-  /// Values a row holds: the efforts, then the powers (always computed: one product each), then the reactions.
+  /// Values a row holds: the efforts, then the powers (always computed: one product each), the reactions and the
+  /// losses (losses_at()).
   Index size() const {
+    Index n = losses_at();
+    for (const OutputLoss& l : losses) n += l.bearing ? 2 : 1;
+    return n;
+  }
+  /// Where the losses' values begin in a row: after the efforts, powers and reactions.
+  Index losses_at() const {
     Index n = 2 * static_cast<Index>(constraints.size());
     for (const OutputReaction& r : reactions) n += r.spatial ? 6 : 3;
     return n;
   }
-  /// Whether anything is computed: efforts or reactions.
-  bool active() const { return !constraints.empty() || !reactions.empty(); }
+  /// Whether anything is computed: efforts, reactions or losses.
+  bool active() const { return !constraints.empty() || !reactions.empty() || !losses.empty(); }
 };
 
 /// A limit the sweep checks at every time point (an effort's at the written rows, where it is computed): a
@@ -282,7 +303,7 @@ struct StepView {
   /// Sensitivities to OutputPlan::sensitivities laid out as SensitivityLayout says (null when none are listed):
   /// ∂q/∂p always, ∂q̇/∂p and ∂q̈/∂p when velocities / accelerations are delivered; NaN at a singular position.
   const double* sensitivities = nullptr;
-  /// Efforts then powers and reactions of OutputPlan::efforts (OutputEfforts::size() values), then the efforts'
+  /// Efforts then powers, reactions and losses of OutputPlan::efforts (OutputEfforts::size() values), then the efforts'
   /// sensitivities with OutputPlan::sensitivities (effort_values() in all; null when none are listed); NaN at a
   /// singular position.
   const double* efforts = nullptr;

@@ -77,6 +77,20 @@ py::dict reactions_of(const PyStepper& s) {
   return out;
 }
 
+// The losses a stepper delivers by name: a bearing's (friction, power), a gear's (power,).
+py::dict losses_of(const PyStepper& s) {
+  py::dict out;
+  const OutputEfforts& e = s.stepper->options().efforts;
+  const double* v = s.stepper->efforts();
+  if (!v) return out;
+  v += e.losses_at();
+  for (const OutputLoss& l : e.losses) {
+    out[py::str(l.name)] = l.bearing ? py::make_tuple(v[0], v[1]) : py::make_tuple(v[0]);
+    v += l.bearing ? 2 : 1;
+  }
+  return out;
+}
+
 }  // namespace
 
 void bind_stepper(py::module_& m) {
@@ -219,6 +233,9 @@ void bind_stepper(py::module_& m) {
                              "the scene's output.reactions at the current state: joint name → (Fx, Fy, Mz), in "
                              "space (Fx, Fy, Fz, Mx, My, Mz), N and N m about the joint's point, in world axes or "
                              "output.reaction_axes' joint axes")
+      .def_property_readonly("losses", &losses_of,
+                             "the scene's output.losses now: a bearing's torsional spring → (friction, power), its "
+                             "moment (N m; a slide's force, N) and the power it dissipates (W); a gear → (power,)")
       .def_property_readonly(
           "summary", [](const PyStepper& s) { return s.stepper->summary(); },
           "everything the steps did so far, as a sweep's SweepSummary (to_dict() for JSON)")

@@ -134,6 +134,10 @@ std::vector<std::string> CsvFormat::dotted_names() const {
   for (const OutputReaction& r : plan_->efforts.reactions)
     for (int k = 0; k < (r.spatial ? 6 : 3); ++k)
       h.push_back(plan_->efforts.reaction_name(model_, r) + (r.spatial ? kSpatial : kPlanar)[k]);
+  for (const OutputLoss& l : plan_->efforts.losses) {
+    if (l.bearing) h.push_back(l.name + ".friction");
+    h.push_back(l.name + ".loss");
+  }
   for (const OutputSensitivity& p : plan_->sensitivities)  // ∂τ/∂p (phiq/effort_sensitivity.hpp)
     for (Index c : plan_->efforts.constraints) h.push_back(model_.constraints()[c].name + ".effort.d_" + p.name);
   if (plan_->efforts.power)  // ∂P/∂p

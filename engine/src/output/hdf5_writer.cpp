@@ -214,6 +214,10 @@ void Hdf5Writer::Impl::create(const Hdf5Options& o) {
   if (plan.efforts.power) effort_units.insert(effort_units.end(), plan.efforts.constraints.size(), "W");
   for (const OutputReaction& r : plan.efforts.reactions)  // forces, then moments (N m)
     for (int k = 0; k < (r.spatial ? 6 : 3); ++k) effort_units.push_back(k < (r.spatial ? 3 : 2) ? "N" : "N m");
+  for (const OutputLoss& l : plan.efforts.losses) {  // a bearing's friction, then the power it dissipates
+    if (l.bearing) effort_units.push_back(l.slide ? "N" : "N m");
+    effort_units.push_back("W");
+  }
   for (const OutputSensitivity& p : plan.sensitivities)  // ∂τ/∂p: the effort's unit per the parameter's ("/P")
     for (std::size_t i = 0; i < plan.efforts.constraints.size(); ++i)
       effort_units.push_back(effort_units[i] + "/" + p.name);

@@ -1,6 +1,7 @@
-// The scene's `output: efforts`, `power` and `reactions` (models/README.md): which drivers' efforts and which joints'
-// reactions a sweep writes, resolved to constraints once the model is built, with the parts and loads they are
-// computed from (OutputPlan::efforts).
+// The scene's `output: efforts`, `power`, `reactions` and `losses` (models/README.md): which drivers' efforts, which
+// joints' reactions and which bearings' and gears' losses a sweep writes, resolved to constraints once the model is
+// built, with the parts and loads they are computed from (OutputPlan::efforts).
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <set>
@@ -52,6 +53,18 @@ void SceneReader::read_output_efforts(const Cursor& output) {
       }
     }
   }
+  if (const Cursor l = output.field("losses"); l.present()) {
+    pending_.losses_field = l;
+    if (l.is_scalar()) {
+      if (l.text() != "all") l.fail("expected `all` or a list of bearings' torsional springs and gears");
+    } else {
+      std::set<std::string> seen;
+      for (const Cursor& i : l.items()) {
+        if (!seen.insert(i.name()).second) i.fail("loss listed twice");
+        pending_.loss_items.push_back(i);
+      }
+    }
+  }
   if (!e.present()) return;
   pending_.efforts_field = e;
   if (e.is_scalar()) {
@@ -68,7 +81,7 @@ void SceneReader::read_output_efforts(const Cursor& output) {
 }
 
 void SceneReader::resolve_output_efforts(Scene& scene) const {
-  if (!pending_.efforts_field && !pending_.reactions_field) return;
+  if (!pending_.efforts_field && !pending_.reactions_field && !pending_.losses_field) return;
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
   if (pending_.reactions_field) {
@@ -203,16 +216,40 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   for (const Part& p : scene.parts)
     if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0) massive->push_back(without_shapes(p));
   if (massive->empty() && !(scene.loads.applied && !scene.loads.applied->empty()))
-    (pending_.efforts_field ? *pending_.efforts_field : *pending_.reactions_field)
+    (pending_.efforts_field     ? *pending_.efforts_field
+     : pending_.reactions_field ? *pending_.reactions_field
+                                : *pending_.losses_field)
         .fail(
             "no part has mass and no load is applied: every effort would be zero (give parts a mass "
             "or a density, or apply loads)");
   if (!out.constraints.empty() && !scene.sweep.sensitivities.empty() && FrictionLosses::any(scene.loads.applied.get()))
     pending_.efforts_field->fail(FrictionLosses::kNoSensitivities);
+  if (pending_.losses_field) out.losses = resolve_output_losses(scene.loads.applied.get());
   out.parts = std::move(massive);
   out.loads = std::make_shared<const Loads>(scene.loads);
   out.power = pending_.efforts_power;
   out.reactions_in_joint_axes = pending_.reactions_in_joint_axes;
+}
+
+std::vector<OutputLoss> SceneReader::resolve_output_losses(const AppliedLoads* loads) const {
+  std::vector<OutputLoss> all;  // OutputLoss::index's order: the bearings, then the gear losses
+  if (loads) {
+    for (const TorsionalSpring& s : loads->torsional_springs)
+      if (s.bearing) all.push_back({s.name, all.size(), true, s.bearing->slide});
+    for (const GearLoss& g : loads->gear_losses) all.push_back({g.gear, all.size(), false, false});
+  }
+  const Cursor& field = *pending_.losses_field;
+  if (all.empty())
+    field.fail("the scene has no bearing (`torsional_springs[].bearing`) and no `gear_losses`: no loss to write");
+  std::vector<OutputLoss> out;
+  if (pending_.loss_items.empty()) out = all;
+  for (const Cursor& i : pending_.loss_items) {
+    const auto l = std::find_if(all.begin(), all.end(), [&](const OutputLoss& o) { return o.name == i.name(); });
+    if (l == all.end())
+      i.fail("unknown loss '" + i.name() + "': neither a bearing's torsional spring nor a gear with losses");
+    out.push_back(*l);
+  }
+  return out;  // (a spring and a gear of one name cannot meet here: bearings are refused in geared models)
 }
 
 }  // namespace phiq::detail::scene

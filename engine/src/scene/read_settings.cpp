@@ -58,9 +58,10 @@ void SceneReader::read_output(const Cursor& c, OutputPlan& plan) {
   plan.velocities = plan.accelerations = false;
   bool coordinates_listed = false;
   if (c.present()) {
-    c.expect_map({"velocities", "accelerations", "coordinates", "points", "joints", "orientations", "drivers",
-                  "residuals", "max_residual", "rcond", "every", "window", "sensitivities", "sensitivity_form",
-                  "efforts", "power", "reactions", "reaction_axes", "clearance"});
+    c.expect_map({"velocities",   "accelerations", "coordinates",   "points",           "joints",
+                  "orientations", "drivers",       "residuals",     "max_residual",     "rcond",
+                  "every",        "window",        "sensitivities", "sensitivity_form", "efforts",
+                  "power",        "reactions",     "reaction_axes", "losses",           "clearance"});
     // true / false, or the coordinates whose derivative is written (q̇ or q̈ is solved whole either way)
     auto derivative = [&](const char* key, bool& asked, std::optional<std::vector<Index>>& columns) {
       const Cursor d = c.field(key);

@@ -196,8 +196,9 @@ class SceneReader {
   void output_joints(const Cursor& js, OutputPlan& plan) const;
   void output_orientations(const Cursor& os, OutputPlan& plan) const;
   void resolve_output_residuals(Scene& scene) const;
-  void read_output_efforts(const Cursor& output);   // read_efforts.cpp
-  void resolve_output_efforts(Scene& scene) const;  // read_efforts.cpp
+  void read_output_efforts(const Cursor& output);                                  // read_efforts.cpp
+  void resolve_output_efforts(Scene& scene) const;                                 // read_efforts.cpp
+  std::vector<OutputLoss> resolve_output_losses(const AppliedLoads* loads) const;  // read_efforts.cpp
   void read_solver(const Cursor& c, SolverSettings& o);
   void read_clearance(const Cursor& c, Scene& scene) const;  // output.clearance (read_clearance.cpp)
   void read_limits(const Cursor& c, OutputPlan& plan);       // read_limits.cpp
@@ -248,6 +249,8 @@ class SceneReader {
     // with `reactions`: the named natural points, kept past the tables' release for the natural joints
     std::vector<std::pair<std::string, Attachment3>> natural_points;
     std::vector<Cursor> reaction_items;
+    std::optional<Cursor> losses_field;  // `output: losses` (its items when it lists names)
+    std::vector<Cursor> loss_items;
     std::vector<std::pair<std::size_t, Cursor>> limit_efforts;  // `limits`' efforts: the limit, its driver's name
   };
   Pending pending_;

@@ -240,6 +240,20 @@ bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double
   return false;
 }
 
+double FrictionLosses::exerted(std::size_t i) const {
+  const std::size_t nb = set_->bearings.size();
+  if (i < nb) return moments_[i] * std::abs(friction_direction(rates_[i]));
+  const MeshState& state = mesh_states_[i - nb];
+  return state.driven < 0 ? 0.0 : moments_[i] * std::abs(friction_direction(state.rate[state.driven]));
+}
+
+double FrictionLosses::dissipated(std::size_t i) const {
+  const std::size_t nb = set_->bearings.size();
+  if (i < nb) return moments_[i] * std::abs(rates_[i]);
+  const MeshState& state = mesh_states_[i - nb];
+  return state.driven < 0 ? 0.0 : moments_[i] * std::abs(state.rate[state.driven]);
+}
+
 std::string FrictionLosses::name(std::size_t i) const {
   if (i >= set_->bearings.size())
     return "the meshing loss of '" + set_->meshes[i - set_->bearings.size()].loss->gear + "'";

@@ -65,6 +65,11 @@ class FrictionLosses {
   // in kMaxPasses (lock_message()); λ and Q then hold the last pass's.
   bool solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd, double t, Eigen::VectorXd& Q,
              Eigen::VectorXd& lambda, Eigen::VectorXd& kept);
+  // Loss i's values at the last solve() that settled, i in the scene's order (the torsional springs with a bearing,
+  // then the gear losses: OutputLoss::index): the moment (a slide's force, a mesh's effort on its driven member) it
+  // exerted against the motion, and the power it dissipated; both ≥ 0, zero at rest.
+  double exerted(std::size_t i) const;
+  double dissipated(std::size_t i) const;
   int solves() const { return solves_; }               // transposed solves of the last solve()
   bool failed_solve() const { return failed_solve_; }  // the last solve() failed in a linear solve
   std::string lock_message() const;                    // the loss that did not settle, and why

@@ -60,6 +60,11 @@ bool Sweeper::row_efforts() {
       if (!losses.failed_solve()) sum_.warnings.push_back({t, "friction_lock", losses.lock_message()});
       return not_defined();
     }
+    double* out = outputs_.efforts.data() + e.losses_at();
+    for (const OutputLoss& l : e.losses) {
+      if (l.bearing) *out++ = losses.exerted(l.index);
+      *out++ = losses.dissipated(l.index);
+    }
   }
   // Φt at the drivers' rows only (a power reads no other; the whole model's is O(rows) at every row)
   effort_work_.phi_t.resize(model_.num_equations());

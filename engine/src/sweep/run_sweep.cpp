@@ -11,6 +11,7 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
+#include "phiq/applied_loads.hpp"
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/joint_reactions.hpp"
 #include "phiq/parts.hpp"
@@ -184,6 +185,16 @@ void detail::check_efforts(const Model& model, const OutputPlan& plan, const std
   for (const Part& p : *e.parts)
     if (max_coordinate(p.frame) >= model.num_coordinates())
       throw Error(who + ": part '" + p.name + "' reads a coordinate the model does not have");
+  std::vector<const BearingFriction*> bearings;  // OutputLoss::index's order: the bearings, then the gear losses
+  if (const AppliedLoads* a = e.loads->applied.get())
+    for (const TorsionalSpring& s : a->torsional_springs)
+      if (s.bearing) bearings.push_back(&*s.bearing);
+  const std::size_t gears = e.loads->applied ? e.loads->applied->gear_losses.size() : 0;
+  for (const OutputLoss& l : e.losses)
+    if (l.bearing ? l.index >= bearings.size() || l.slide != bearings[l.index]->slide
+                  : l.index < bearings.size() || l.index >= bearings.size() + gears)
+      throw Error(who + ": loss '" + l.name + "' (" + std::to_string(l.index) + ") is not one of the loads' " +
+                  (l.bearing ? (l.slide ? "slides" : "bearings") : "gear losses"));
 }
 
 void detail::check_solver_settings(const Model& model, const SolverSettings& s, const std::vector<OutputPoint>& points,
