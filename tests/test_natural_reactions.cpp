@@ -1,9 +1,10 @@
 // Joint reactions at natural coordinates' shared points (phiq/natural_joints.hpp): the natural four-bar's pins O, A,
 // B, C carry the forces the reference-point four-bar's revolutes carry, under gravity, forces, a torque (part of it
-// viscous, of der()) and a spring, with the same motor torque; each of its links satisfies its Newton–Euler equations
-// written here with them; the bodies' weight and inertia read from the whole model's Q (a sweep's way) give the
-// reactions their own Q gives, bit for bit, and so do the flat sites' sums on random natural chains, in both forms of Q
-// (rigid bars' constant mass matrices or their frames' motion); a point no two bodies share is refused by name.
+// viscous, of der()), a spring to ground and one between two links, with the same motor torque; each of its links
+// satisfies its Newton–Euler equations written here with them; the bodies' weight and inertia read from the whole
+// model's Q (a sweep's way) give the reactions their own Q gives, bit for bit, and so do the flat sites' sums on random
+// natural chains, in both forms of Q (rigid bars' constant mass matrices or their frames' motion); a point no two
+// bodies share is refused by name.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -59,7 +60,9 @@ NaturalRows natural_reactions_sweep(const Scene& s) {
 
 // The loads of both forms: gravity off the vertical, a force on the coupler (part axes), a torque on the rocker
 // with a viscous part of its turning rate (der() of `rocker_angle`, that form's angle of the rocker), a spring from
-// the rocker to a world point; `coupler_at`, `rocker_at` the parts' origins in the reference-point form's frames
+// the rocker to a world point and a spring-damper `tie` from the coupler to the rocker (a load between two bodies,
+// which the natural form's bodies must each take at their own end); `coupler_at`, `rocker_at` the parts' origins in
+// the reference-point form's frames
 // (the natural frames start at A and C, the reference-point bodies at the links' centres).
 constexpr const char* kNaturalRockerAngle = "atan2(yB, xB - L1)";
 std::string natural_reactions_loads(double coupler_at, double rocker_at,
@@ -70,7 +73,9 @@ std::string natural_reactions_loads(double coupler_at, double rocker_at,
     << "axes: part}]\n"
     << "  torques: [{name: brake, part: rocker, torque: \"-1.5 - 0.7*der(" << rocker_angle << ")\"}]\n"
     << "  springs: [{name: s, between: [{part: rocker, at: [" << rocker_at + 0.3 << ", 0]}, {point: [1.5, 1]}], "
-    << "stiffness: 40, free_length: 0.2}]\n";
+    << "stiffness: 40, free_length: 0.2},\n"
+    << "            {name: tie, between: [{part: coupler, at: [" << coupler_at + 0.2 << ", 0.1]}, {part: rocker, at: ["
+    << rocker_at + 0.3 << ", 0]}], stiffness: 25, free_length: 0.3, damping: 0.4}]\n";
   return s.str();
 }
 
@@ -213,6 +218,19 @@ TEST(NaturalReactions, EveryNaturalLinkBalancesUnderItsPinForces) {
         const Eigen::Vector2d f = 40 * (to.norm() - 0.2) * to / to.norm();
         sum += f, moment += natural_cross(p - G, f);
       }
+      if (l.index != 0) {  // the tie from (0.8, 0.1) of the coupler to (0.8, 0) of the rocker, its pull on this link
+        auto place = [&](const Eigen::VectorXd& x, const char* origin, const char* tip, double along, double across) {
+          const Eigen::Vector2d a = at(x, origin), b = at(x, tip), q = at(rows.q[k], tip) - at(rows.q[k], origin);
+          const double len = q.norm();  // (the link's length, constant: its rates move only its direction)
+          return Eigen::Vector2d(a + (along * (b - a) + across * Eigen::Vector2d(a.y() - b.y(), b.x() - a.x())) / len);
+        };
+        const Eigen::Vector2d pc = place(rows.q[k], "A", "B", 0.8, 0.1), pr = place(rows.q[k], "C", "B", 0.8, 0);
+        const Eigen::Vector2d vc = place(rows.qd[k], "A", "B", 0.8, 0.1), vr = place(rows.qd[k], "C", "B", 0.8, 0);
+        const Eigen::Vector2d u = (pr - pc) / (pr - pc).norm();
+        const double tension = 25 * ((pr - pc).norm() - 0.3) + 0.4 * u.dot(vr - vc);
+        const Eigen::Vector2d f = l.index == 1 ? Eigen::Vector2d(tension * u) : Eigen::Vector2d(-tension * u);
+        sum += f, moment += natural_cross((l.index == 1 ? pc : pr) - G, f);
+      }
       const double inertia = mass * kNaturalLength[l.index] * kNaturalLength[l.index] / 12;
       EXPECT_NEAR((sum - mass * aG).norm(), 0.0, 1e-8 * (1 + sum.norm())) << l.origin << l.x << " row " << k;
       EXPECT_NEAR(moment, inertia * alpha, 1e-8 * (1 + std::fabs(moment))) << l.origin << l.x << " row " << k;
@@ -222,7 +240,7 @@ TEST(NaturalReactions, EveryNaturalLinkBalancesUnderItsPinForces) {
 
 // A sweep's reactions read each natural body's weight and inertia where the whole model's Q left them
 // (detail::PlanarForce), rather than the body's own Q: the same numbers, bit for bit, at every row of the four-bar
-// with gravity, a force, a torque, a spring and the fixed pins O, C (constant components, promoted). In the frames'
+// with gravity, a force, a torque, two springs and the fixed pins O, C (constant components, promoted). In the frames'
 // motion's form Q itself is add_generalized_forces()' to the bit; a shifted cached force moves the reactions where
 // it acts (the cache is read, not passed over). In the rigid bars' form (the links are held at their lengths by the
 // distance constraints crank, coupler, rocker) Q differs, but only along the bars' own rows: every other multiplier
@@ -236,7 +254,8 @@ TEST(NaturalReactions, BodyForcesFromTheModelsQAreTheBodiesOwnBitForBit) {
   const std::vector<Part>& parts = *e.parts;
   ASSERT_EQ(e.natural->bodies.size(), 3u);
   for (const NaturalBody& b : e.natural->bodies) EXPECT_EQ(parts.at(b.part).name, b.name);
-  EXPECT_EQ(e.natural->promoted.size(), 4u);  // O's and C's x and y
+  EXPECT_EQ(e.natural->promoted.size(), 8u);  // O's and C's x and y, and the tie's far ends' copies of A's and B's
+  EXPECT_EQ(e.natural->mirrors.size(), 4u);
   Workspace ws(m);
   for (const bool bars : {false, true}) {
     JointReactions reactions(m, e, bars), plain(m, e);
@@ -547,6 +566,18 @@ TEST(NaturalReactions, APointNoTwoBodiesShareIsRefusedByName) {
   } catch (const std::exception& e) {  // SceneError
     EXPECT_NE(std::string(e.what()).find("point 'B' is no joint"), std::string::npos) << e.what();
   }
+}
+
+// A torsional spring's moment cannot be divided among a natural point's bodies: their reactions are refused with one
+// (the efforts are not).
+TEST(NaturalReactions, ATorsionalSpringWithANaturalPointsReactionIsRefused) {
+  std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
+  text += "parts:\n" + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +
+          natural_reactions_part("coupler", 1, 0.6, "frame: {origin: A, x: B}, ") +
+          "loads:\n  torsional_springs: [{name: return, coordinate: theta2, stiffness: 2}]\n";
+  EXPECT_HAS(test::scene_error(text + "output: {efforts: all, reactions: [A, O]}\n"),
+             "output.reactions: the reaction at natural point 'A' would hold torsional spring 'return''s moment");
+  EXPECT_EQ(parse_scene(text + "output: {efforts: all}\n", "n.yaml").sweep.efforts.constraints.size(), 1u);
 }
 
 }  // namespace

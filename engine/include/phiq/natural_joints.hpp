@@ -18,8 +18,11 @@
 /// written relative to the fixed point), and Q_b there by differentiating b's parts and loads with that component
 /// made a coordinate. A body with two points constant along one axis shares that component's load between them in a
 /// way the points do not determine: NaN. The moment at a point joint is zero (points carry forces only); shared
-/// unit vectors (a spatial revolute in natural coordinates) are not split, and a load between two bodies (a spring,
-/// a torsional spring) is counted in the joints' reactions.
+/// unit vectors (a spatial revolute in natural coordinates) are not split. A spring from b to another moving body
+/// is b's load at its own end, the far end read at its place from slots of its own (NaturalJoints::mirrors), so
+/// that its pull along the far body's points reaches no body's balance; a torsional spring between two bodies (its
+/// angle an expression that does not say which body it turns), and a spring whose far end is on a frame of
+/// expressions, are counted in the joints' reactions.
 #pragma once
 
 #include <string>
@@ -47,6 +50,8 @@ struct NaturalBody {
   /// The frame's points (origin, and x, y toward when they are points), each component's slot with the constants
   /// promoted: coordinate n + k for NaturalJoints::promoted[k], so that Q differentiates along them.
   std::vector<Attachment3> points;
+  /// The slots its loads read beyond its frame (n + k: NaturalJoints::mirrors' copies of a spring's far end).
+  std::vector<Index> load_slots;
 };
 
 /// Whether body `b`'s part has mass (its own Q counts it).
@@ -71,7 +76,14 @@ struct NaturalJoints {
   std::vector<NaturalJoint> joints;  ///< the named points two bodies share or ground holds in a component
   /// The constants made coordinates n + k (k in order): their values, appended to q where the bodies' Q is taken.
   std::vector<double> promoted;
-  bool spatial = false;  ///< dimension 3: six values per joint, else three
+  /// Promoted coordinates that copy a model coordinate at every row (a spring's far end on another body), not a
+  /// constant: promoted[slot] is then unused, q, q̇ and q̈ are the coordinate's.
+  struct Mirror {
+    std::size_t slot = 0;  ///< k, the promoted coordinate n + k
+    Index coordinate = 0;  ///< the model coordinate it copies
+  };
+  std::vector<Mirror> mirrors;  ///< see Mirror
+  bool spatial = false;         ///< dimension 3: six values per joint, else three
 };
 
 /// The natural joints of `parts` (the scene's, in order) under `loads`, among `points` (the scene's named natural

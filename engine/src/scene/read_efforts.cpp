@@ -84,50 +84,7 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   if (!pending_.efforts_field && !pending_.reactions_field && !pending_.losses_field) return;
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
-  if (pending_.reactions_field) {
-    // natural coordinates' joints: named points that parts with frames of points share (phiq/natural_joints.hpp)
-    auto natural = std::make_shared<NaturalJoints>(
-        find_natural_joints(scene.parts, scene.loads, pending_.natural_points, model.num_coordinates(), spatial_));
-    std::unordered_map<std::string_view, int> joint_index;  // (a list of 10⁴ names scanned 10⁴ joints for each)
-    if (!pending_.reaction_items.empty())
-      for (std::size_t j = 0; j < natural->joints.size(); ++j)
-        joint_index.emplace(natural->joints[j].name, static_cast<int>(j));
-    auto natural_joint = [&](const std::string& name) {
-      const auto it = joint_index.find(name);
-      return it == joint_index.end() ? -1 : it->second;
-    };
-    if (pending_.reaction_items.empty()) {  // all: every joint with a reaction that no driver moves
-      for (std::size_t c = 0; c < model.constraints().size(); ++c)
-        if (const int w = reaction_width(model, static_cast<Index>(c));
-            w > 0 && !model.constraints()[c].depends_on_time)
-          out.reactions.push_back({static_cast<Index>(c), w == 6});
-      for (std::size_t j = 0; j < natural->joints.size(); ++j)
-        out.reactions.push_back({-1, spatial_, static_cast<int>(j)});
-      if (out.reactions.empty())
-        pending_.reactions_field->fail(
-            "no constraint of the scene joins bodies (revolute, prismatic, spatial joints) and no named point is "
-            "shared by parts with frames of points: no reaction to write");
-    }
-    if (!natural->joints.empty()) out.natural = natural;
-    for (const Cursor& i : pending_.reaction_items) {
-      if (model.find_constraint(i.name()) < 0) {  // (the builder is the model now: it is asked)
-        const int j = natural_joint(i.name());
-        if (j < 0)
-          i.fail("point '" + i.name() +
-                 "' is no joint: no two parts with frames of points hold it, nor one with a component fixed");
-        out.reactions.push_back({-1, spatial_, j});
-        out.natural = natural;
-        continue;
-      }
-      const Index c = model.find_constraint(i.name());
-      const int w = reaction_width(model, c);
-      if (w == 0)
-        i.fail("'" + i.name() + "' (" + std::string(model.constraints()[static_cast<std::size_t>(c)].kind) +
-               ") is not a joint between bodies: it has no reaction (a " + type_list(reaction_types(spatial_ ? 3 : 2)) +
-               " has)");
-      out.reactions.push_back({c, w == 6});
-    }
-  }
+  resolve_output_reactions(scene);
   if (!out.reactions.empty() && spatial_) {  // gears on shafts: their bearings carry the teeth's push
     for (std::size_t c = 0; c < model.constraints().size(); ++c) {
       const auto [block, index] = model.constraint_block(static_cast<Index>(c));
@@ -229,6 +186,65 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   out.loads = std::make_shared<const Loads>(scene.loads);
   out.power = pending_.efforts_power;
   out.reactions_in_joint_axes = pending_.reactions_in_joint_axes;
+}
+
+// `output: reactions` resolved to constraints and natural points (OutputEfforts::reactions, natural).
+void SceneReader::resolve_output_reactions(Scene& scene) const {
+  const Model& model = *scene.model;
+  OutputEfforts& out = scene.sweep.efforts;
+  if (pending_.reactions_field) {
+    // natural coordinates' joints: named points that parts with frames of points share (phiq/natural_joints.hpp)
+    auto natural = std::make_shared<NaturalJoints>(
+        find_natural_joints(scene.parts, scene.loads, pending_.natural_points, model.num_coordinates(), spatial_));
+    std::unordered_map<std::string_view, int> joint_index;  // (a list of 10⁴ names scanned 10⁴ joints for each)
+    if (!pending_.reaction_items.empty())
+      for (std::size_t j = 0; j < natural->joints.size(); ++j)
+        joint_index.emplace(natural->joints[j].name, static_cast<int>(j));
+    auto natural_joint = [&](const std::string& name) {
+      const auto it = joint_index.find(name);
+      return it == joint_index.end() ? -1 : it->second;
+    };
+    if (pending_.reaction_items.empty()) {  // all: every joint with a reaction that no driver moves
+      for (std::size_t c = 0; c < model.constraints().size(); ++c)
+        if (const int w = reaction_width(model, static_cast<Index>(c));
+            w > 0 && !model.constraints()[c].depends_on_time)
+          out.reactions.push_back({static_cast<Index>(c), w == 6});
+      for (std::size_t j = 0; j < natural->joints.size(); ++j)
+        out.reactions.push_back({-1, spatial_, static_cast<int>(j)});
+      if (out.reactions.empty())
+        pending_.reactions_field->fail(
+            "no constraint of the scene joins bodies (revolute, prismatic, spatial joints) and no named point is "
+            "shared by parts with frames of points: no reaction to write");
+    }
+    if (!natural->joints.empty()) out.natural = natural;
+    for (const Cursor& i : pending_.reaction_items) {
+      if (model.find_constraint(i.name()) < 0) {  // (the builder is the model now: it is asked)
+        const int j = natural_joint(i.name());
+        if (j < 0)
+          i.fail("point '" + i.name() +
+                 "' is no joint: no two parts with frames of points hold it, nor one with a component fixed");
+        out.reactions.push_back({-1, spatial_, j});
+        out.natural = natural;
+        continue;
+      }
+      const Index c = model.find_constraint(i.name());
+      const int w = reaction_width(model, c);
+      if (w == 0)
+        i.fail("'" + i.name() + "' (" + std::string(model.constraints()[static_cast<std::size_t>(c)].kind) +
+               ") is not a joint between bodies: it has no reaction (a " + type_list(reaction_types(spatial_ ? 3 : 2)) +
+               " has)");
+      out.reactions.push_back({c, w == 6});
+    }
+  }
+  // a natural point's reaction balances its bodies' own loads, which a torsional spring's angle does not divide
+  // among them (phiq/natural_joints.hpp): refused rather than written with the spring's moment in it
+  const auto natural_listed =
+      std::find_if(out.reactions.begin(), out.reactions.end(), [](const OutputReaction& r) { return r.natural >= 0; });
+  if (natural_listed != out.reactions.end() && scene.loads.applied && !scene.loads.applied->torsional_springs.empty())
+    pending_.reactions_field->fail("the reaction at natural point '" + out.reaction_name(model, *natural_listed) +
+                                   "' would hold torsional spring '" + scene.loads.applied->torsional_springs[0].name +
+                                   "''s moment: its angle does not say which bodies it turns (list the reactions "
+                                   "of constraints only, or join the bodies by a revolute)");
 }
 
 std::vector<OutputLoss> SceneReader::resolve_output_losses(const AppliedLoads* loads) const {

@@ -198,6 +198,7 @@ class SceneReader {
   void resolve_output_residuals(Scene& scene) const;
   void read_output_efforts(const Cursor& output);                                  // read_efforts.cpp
   void resolve_output_efforts(Scene& scene) const;                                 // read_efforts.cpp
+  void resolve_output_reactions(Scene& scene) const;                               // read_efforts.cpp
   std::vector<OutputLoss> resolve_output_losses(const AppliedLoads* loads) const;  // read_efforts.cpp
   void read_solver(const Cursor& c, SolverSettings& o);
   void read_clearance(const Cursor& c, Scene& scene) const;  // output.clearance (read_clearance.cpp)

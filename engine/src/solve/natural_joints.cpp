@@ -10,6 +10,7 @@
 #include <limits>
 #include <string_view>
 #include <type_traits>
+#include <optional>
 #include <unordered_map>
 
 #include "phiq/constraint_block.hpp"
@@ -82,6 +83,34 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
       if (s.b.part != s.a.part) loads_of[s.b.part].springs.push_back(&s);
     }
   }
+  // A spring's far end on another moving body, its frame's coordinates moved to promoted slots that copy them
+  // (NaturalJoints::mirrors, one per coordinate), whose slots go to `slots`; none for a frame of expressions.
+  std::unordered_map<Index, std::size_t> mirror_of;
+  auto mirrored = [&](PartFrame f, std::vector<Index>& slots) -> std::optional<PartFrame> {
+    auto move = [&](Slot& s) {
+      if (!s.is_coordinate() || s.coord() >= coordinates) return;
+      const auto [it, fresh] = mirror_of.try_emplace(s.coord(), out.promoted.size());
+      if (fresh) out.mirrors.push_back({out.promoted.size(), s.coord()}), out.promoted.push_back(0.0);
+      s = Slot::coordinate(coordinates + static_cast<Index>(it->second));
+      slots.push_back(s.coord());
+    };
+    switch (f.kind) {
+      case PartFrameKind::kPlanarBody:
+        for (Slot* s : {&f.planar.x, &f.planar.y, &f.planar.psi}) move(*s);
+        return f;
+      case PartFrameKind::kSpatialBody:
+        for (Slot* s :
+             {&f.spatial.x, &f.spatial.y, &f.spatial.z, &f.spatial.e0, &f.spatial.e1, &f.spatial.e2, &f.spatial.e3})
+          move(*s);
+        return f;
+      case PartFrameKind::kPoints:
+        for (Attachment3* a : {&f.origin, &f.x_toward, &f.y_toward})
+          for (Slot& s : a->r) move(s);
+        return f;
+      default:
+        return std::nullopt;
+    }
+  };
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const Part& p = parts[i];
     if (p.frame.kind != PartFrameKind::kPoints || max_coordinate(p.frame) < 0) continue;  // (a frame that moves)
@@ -111,10 +140,12 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
         const LinearSpring& s = *sp;
         const bool a = s.a.part == p.name, c = s.b.part == p.name;
         const bool other_fixed = (a && (c || s.b.part == "ground")) || (c && s.a.part == "ground");
-        if (!other_fixed) continue;  // a spring to another body: counted in the joints' reactions
+        std::optional<PartFrame> far;  // a spring to another body: its end there, mirrored
+        if (!other_fixed && !(far = mirrored(a ? s.b.frame : s.a.frame, b.load_slots))) continue;
         own->springs.push_back(s);
         if (a) own->springs.back().a.frame = promoted;
         if (c) own->springs.back().b.frame = promoted;
+        if (far) (a ? own->springs.back().b : own->springs.back().a).frame = *far;
       }
       if (!own->empty()) b.loads.applied = std::move(own);
     }
@@ -262,6 +293,7 @@ void JointReactions::add_natural(const Model& model, const OutputEfforts& effort
           rows.q_columns.push_back(r.coord());
           if (r.coord() < n) coords.push_back(r.coord()), of_point[static_cast<std::size_t>(r.coord())] = 1;
         }
+    rows.q_columns.insert(rows.q_columns.end(), body.load_slots.begin(), body.load_slots.end());
     std::sort(coords.begin() + static_cast<std::ptrdiff_t>(coords_first[b]), coords.end());
     coords_first[b + 1] = coords.size(), rows.q_first[b + 1] = rows.q_columns.size();
   }
@@ -489,6 +521,10 @@ void JointReactions::evaluate_natural(const NaturalSite& s, RowMotion& row, doub
     qx_.head(n) = Eigen::Map<const Eigen::VectorXd>(row.q, n);
     qdx_.head(n) = Eigen::Map<const Eigen::VectorXd>(row.qd, n);
     qddx_.head(n) = Eigen::Map<const Eigen::VectorXd>(row.qdd, n);
+    for (const NaturalJoints::Mirror& m : set_->natural->mirrors) {
+      const Index at = n + static_cast<Index>(m.slot);
+      qx_(at) = row.q[m.coordinate], qdx_(at) = row.qd[m.coordinate], qddx_(at) = row.qdd[m.coordinate];
+    }
     row.extended = true;
   }
   add_body_constraint_forces(s.body, lambda);
