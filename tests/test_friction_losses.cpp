@@ -105,27 +105,69 @@ TEST(BearingFriction, ADrivenPendulumsPivotAddsMuRTimesItsLoad) {
   }
 }
 
+// A disc of 3 kg on a vertical hinge at the origin, its centre 0.1 off the axis at height `height`, turned at 4 rad/s,
+// with a journal of μ 0.15, r 0.02 and a thrust collar of r_a 0.035, `more` its other bearing fields.
+std::string rotor_text(double height, const std::string& more) {
+  return "phiq: 1\nname: rotor\ndimension: 3\n"
+         "coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\nbodies: {disc: [x, y, z, e0, e1, e2, e3]}\n"
+         "constraints:\n  - {name: hinge, type: revolute, between: [{body: ground, axis: [0, 0, 1]}, {body: disc, "
+         "axis: [0, 0, 1]}]}\n"
+         "drivers:\n  - {name: motor, joint: hinge, law: {type: linear, initial: 0, rate: 4}}\n"
+         "parts:\n  disc: {mass: 3.0, center_of_mass: [0.1, 0, " +
+         std::to_string(height) +
+         "], inertia: [0.02, 0.03, 0.04]}\n"
+         "loads:\n  gravity: [0, 0, -9.81]\n"
+         "  torsional_springs: [{name: bearing, joint: hinge, bearing: {coefficient: 0.15, radius: 0.02, "
+         "thrust_radius: 0.035" +
+         more +
+         "}}]\n"
+         "time: {start: 0, end: 1.5, steps: 30}\n"
+         "output: {velocities: true, accelerations: true, efforts: [motor]}\n";
+}
+
 TEST(BearingFriction, ASpatialRotorsJournalAndThrustCollarTakeMuTimesTheirLoads) {
-  // a disc on a vertical hinge, its centre e off the axis, turned at ω: radial load m ω² e, axial m g
-  const double mu = 0.15, r = 0.02, ra = 0.035, mass = 3.0, e = 0.1, w = 4.0, g = 9.81;
-  const std::string text =
-      "phiq: 1\nname: rotor\ndimension: 3\n"
-      "coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\nbodies: {disc: [x, y, z, e0, e1, e2, e3]}\n"
-      "constraints:\n  - {name: hinge, type: revolute, between: [{body: ground, axis: [0, 0, 1]}, {body: disc, "
-      "axis: [0, 0, 1]}]}\n"
-      "drivers:\n  - {name: motor, joint: hinge, law: {type: linear, initial: 0, rate: 4}}\n"
-      "parts:\n  disc: {mass: 3.0, center_of_mass: [0.1, 0, 0], inertia: [0.02, 0.03, 0.04]}\n"
-      "loads:\n  gravity: [0, 0, -9.81]\n"
-      "  torsional_springs: [{name: bearing, joint: hinge, bearing: {coefficient: 0.15, radius: 0.02, "
-      "thrust_radius: 0.035}}]\n"
-      "time: {start: 0, end: 1.5, steps: 30}\n"
-      "output: {velocities: true, accelerations: true, efforts: [motor]}\n";
-  const Scene s = parse_scene(text, "rotor.yaml");
-  const test::ReactionRows rows = test::sweep_reactions(s);
-  ASSERT_EQ(rows.q.size(), 31u);
-  const double expected = mu * (r * mass * w * w * e + ra * mass * g);
-  for (std::size_t k = 0; k < rows.q.size(); ++k)
-    EXPECT_NEAR(rows.values[k][0], expected, 1e-10 * expected) << "row " << k;
+  // radial load m ω² e, axial m g; with a bending arm a, the moment across the axis m e (h ω² + g) (the weight's
+  // lever e, and the centrifugal force's h: d(H_O)/dt = ω × I_O ω with I_O's product −m e h) presses the journal as
+  // its moment over a
+  const double mu = 0.15, r = 0.02, ra = 0.035, mass = 3.0, e = 0.1, w = 4.0, g = 9.81, h = 0.25, a = 0.04;
+  for (const bool bending : {false, true}) {
+    const Scene s = parse_scene(rotor_text(bending ? h : 0.0, bending ? ", moment_arm: 0.04" : ""), "rotor.yaml");
+    const test::ReactionRows rows = test::sweep_reactions(s);
+    ASSERT_EQ(rows.q.size(), 31u);
+    const double moment = bending ? mass * e * (h * w * w + g) / a : 0.0;
+    const double expected = mu * (r * (mass * w * w * e + moment) + ra * mass * g);
+    for (std::size_t k = 0; k < rows.q.size(); ++k)
+      EXPECT_NEAR(rows.values[k][0], expected, 1e-10 * expected) << "row " << k << (bending ? ", bending" : "");
+  }
+}
+
+TEST(BearingFriction, ASlidesTiltPressesItAsItsMomentOverTheArm) {
+  // a 2 kg block pushed along a level slide at a constant speed, its centre d = 0.3 ahead of the slide's point: the
+  // slide holds its weight m g and its tilt m g d, and the push is μ m g (1 + d / a) with a moment arm a, μ m g without
+  const double mu = 0.2, mass = 2.0, g = 9.81, d = 0.3, a = 0.15;
+  for (const bool tilt : {false, true}) {
+    const std::string text =
+        "phiq: 1\nname: block\ncoordinates: {x: 0, y: 0, psi: 0}\nbodies: {block: [x, y, psi]}\n"
+        "constraints:\n  - {name: slide, type: prismatic, between: [{body: ground}, {body: block}]}\n"
+        "drivers:\n  - {name: push, coordinate: x, law: {type: linear, initial: 0.1, rate: 0.5}}\n"
+        "parts:\n  block: {mass: 2.0, center_of_mass: [0.3, 0], inertia: 0.01}\n"
+        "loads:\n  gravity: [0, -9.81]\n"
+        "  torsional_springs: [{name: guide, coordinate: x, bearing: {joint: slide, coefficient: 0.2" +
+        std::string(tilt ? ", moment_arm: 0.15" : "") +
+        "}}]\n"
+        "time: {start: 0, end: 1, steps: 10}\noutput: {velocities: true, accelerations: true, efforts: [push], "
+        "reactions: all, reaction_axes: joint, losses: all}\n";
+    const Scene s = parse_scene(text, "block.yaml");
+    const test::ReactionRows rows = test::sweep_reactions(s);
+    ASSERT_EQ(rows.q.size(), 11u);
+    const double expected = mu * mass * g * (1.0 + (tilt ? d / a : 0.0));
+    for (std::size_t k = 0; k < rows.q.size(); ++k) {
+      const std::vector<double>& v = rows.values[k];  // push, its power, the slide's Fx, Fy, Mz, the guide's rub
+      EXPECT_NEAR(v[0], expected, 1e-10 * expected) << "row " << k;
+      EXPECT_NEAR(std::fabs(v[4]), mass * g * d, 1e-10 * mass * g) << "row " << k;  // the tilt, about the point
+      EXPECT_NEAR(v[5], expected, 1e-10 * expected) << "row " << k;
+    }
+  }
 }
 
 TEST(BearingFriction, ACamFollowersGuideRubsByMuTimesTheCamsSidePush) {
@@ -478,6 +520,9 @@ TEST(BearingFriction, BadBearingsAreRefusedInOneLine) {
   refused(test::replace_first(good, "coefficient: ", "coefficient: -"), "coefficient");
   refused(test::replace_first(good, "radius: 0.01", "thrust_radius: 0.01"), "radius");
   refused(test::replace_first(good, "radius: 0.01", "radius: 0.01, thrust_radius: 0.02"), "none in the plane");
+  refused(test::replace_first(good, "radius: 0.01", "radius: 0.01, moment_arm: 0.1"),
+          "a pin in the plane carries no moment");
+  refused(rotor_text(0.0, ", moment_arm: 0"), "a moment arm is a positive length");
   refused(test::replace_first(good, "bearing: {joint: pivot,", "bearing: {"), "names its `joint`");
   // efforts' sensitivities read Q's rate along p, which a bearing's friction does not have: refused in the scene,
   // and by the sweep of options put together in code

@@ -105,9 +105,15 @@ TEST(PowerBalance, EveryModelWithMassesBalancesItsDriversPowerAtEveryRow) {
                 const BearingFriction& b = *bearings[i]->bearing;
                 const bool spatial = o.efforts.reactions[i].spatial;
                 std::vector<double> gradient;
-                loads -= b.coefficient *
-                         (b.radius * std::hypot(f[0], f[1]) + (spatial ? b.thrust_radius * std::fabs(f[2]) : 0.0)) *
-                         std::fabs(angle_rate(*bearings[i], v.q.data(), v.qd->data(), v.t, gradient));
+                // what presses it: a journal's radial force and bending over its arm, a slide's radial force and
+                // moment over its arm (BearingFriction)
+                const double arm = b.moment_arm > 0.0 ? 1.0 / b.moment_arm : 0.0;
+                const double across = std::hypot(f[0], f[1]),
+                             load = b.slide ? across + arm * (spatial ? std::hypot(f[3], f[4], f[5]) : std::fabs(f[2]))
+                                            : b.radius * (across + arm * (spatial ? std::hypot(f[3], f[4]) : 0.0)) +
+                                                  (spatial ? b.thrust_radius * std::fabs(f[2]) : 0.0);
+                loads -=
+                    b.coefficient * load * std::fabs(angle_rate(*bearings[i], v.q.data(), v.qd->data(), v.t, gradient));
                 f += spatial ? 6 : 3;
               }
               auto rate = [&](const Slot& x) { return x.is_coordinate() ? (*v.qd)(x.coord()) : 0.0; };

@@ -89,15 +89,19 @@ struct LinearSpring {
 };
 
 /// A bearing's dry friction, read off its joint's reaction (a journal's and a thrust collar's, Adams' joint friction
-/// without stiction): the moment μ (r |F_r| + r_a |F_a|) against θ̇, F_r the reaction's force across the joint's axis
-/// and F_a along it (none in the plane); on a slide (`slide`: a prismatic pair, or a cylindrical one given no
-/// radius, θ its travel) the force μ |F_r| against θ̇. It depends on the multipliers it changes, so the efforts solve
-/// for it (detail::FrictionLosses); add_applied_forces() and applied_power() leave it out.
+/// without stiction): the moment μ (r (|F_r| + |M_b| / a) + r_a |F_a|) against θ̇, F_r the reaction's force across the
+/// joint's axis, F_a along it and M_b its moment across it (the bending a spatial journal carries; none in the plane),
+/// which presses the journal as the force |M_b| / a, a the bending arm (0: not counted); on a slide (`slide`: a
+/// prismatic pair, or a cylindrical one given no radius, θ its travel) the force μ (|F_r| + |M| / a) against θ̇, M the
+/// moment the slide carries (its tilt: Mz in the plane, every component in space). It depends on the multipliers it
+/// changes, so the efforts solve for it (detail::FrictionLosses); add_applied_forces() and applied_power() leave it
+/// out.
 struct BearingFriction {
   std::string joint;  ///< the pin, revolute, cylindrical or prismatic joint (a constraint) whose reaction loads it
   double coefficient = 0.0;    ///< μ, ≥ 0
   double radius = 0.0;         ///< r (m), the journal's radius, ≥ 0 (not on a slide)
   double thrust_radius = 0.0;  ///< r_a (m), the thrust collar's mean radius, ≥ 0 (spatial joints)
+  double moment_arm = 0.0;     ///< a (m), > 0: the moments across the joint press it as |M| / a; 0: not counted
   bool slide = false;          ///< a slide's friction: a force along its travel, not a journal's moment
   bool operator==(const BearingFriction&) const = default;  ///< datum by datum
 };

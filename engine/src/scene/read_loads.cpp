@@ -237,7 +237,7 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
   if (auto f = s.field("friction"); f.present()) spring.friction = non_negative(f);
   if (auto j = s.field("inertia"); j.present()) spring.inertia = non_negative(j);
   if (auto b = s.field("bearing"); b.present()) {
-    b.expect_map({"joint", "coefficient", "radius", "thrust_radius"});
+    b.expect_map({"joint", "coefficient", "radius", "thrust_radius", "moment_arm"});
     BearingFriction& f = spring.bearing.emplace();
     const auto on = b.field("joint");
     if (!on.present() && !joint.present())
@@ -260,6 +260,13 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
       if (!r_.spatial_) a.fail("a thrust collar carries a force along a spatial joint's axis: none in the plane");
       if (f.slide) a.fail("a slide's friction is a force, not a moment: it has no thrust collar");
       f.thrust_radius = non_negative(a);
+    }
+    if (auto a = b.field("moment_arm"); a.present()) {
+      if (!r_.spatial_ && !f.slide)
+        a.fail(
+            "a pin in the plane carries no moment across its axis: a moment arm is a spatial journal's or a slide's");
+      f.moment_arm = r_.number(a);
+      if (!(f.moment_arm > 0.0 && std::isfinite(f.moment_arm))) a.fail("a moment arm is a positive length");
     }
   }
   return spring;

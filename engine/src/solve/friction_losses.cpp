@@ -41,6 +41,16 @@ std::string not_a_worm(const SpatialMesh& g, const Eigen::VectorXd& q) {
 
 }  // namespace
 
+double bearing_load(const BearingFriction& b, const double* f, bool spatial) {
+  const double across = std::hypot(f[0], f[1]), along = spatial ? std::abs(f[2]) : 0.0;
+  if (b.slide) {  // |F_r| + |M| / a: its tilt, Mz in the plane, the whole moment in space
+    const double tilt = b.moment_arm > 0.0 ? (spatial ? std::hypot(f[3], f[4], f[5]) : std::abs(f[2])) : 0.0;
+    return across + (tilt > 0.0 ? tilt / b.moment_arm : 0.0);
+  }
+  const double bending = b.moment_arm > 0.0 && spatial ? std::hypot(f[3], f[4]) / b.moment_arm : 0.0;
+  return b.radius * (across + bending) + b.thrust_radius * along;
+}
+
 bool FrictionLosses::carries(std::string_view kind) {
   return kind == "pin" || kind == "revolute" || kind == "cylindrical" || kind == "prismatic";
 }
@@ -165,8 +175,7 @@ void FrictionLosses::moments_at(const double* q, double t, const Eigen::VectorXd
   for (std::size_t i = 0; i < set_->bearings.size(); ++i) {
     const BearingFriction& b = *set_->bearings[i].spring->bearing;
     const double* f = values_.data() + set_->bearings[i].at;
-    const double across = std::hypot(f[0], f[1]), along = set_->bearings[i].spatial ? std::abs(f[2]) : 0.0;
-    m[i] = b.coefficient * (b.slide ? across : b.radius * across + b.thrust_radius * along);
+    m[i] = b.coefficient * bearing_load(b, f, set_->bearings[i].spatial);
   }
   for (std::size_t j = 0; j < set_->meshes.size(); ++j) {
     // the row's effort on each member, −∂row/∂θ_i λ, and its power relative to the carrier: the driven member's > 0

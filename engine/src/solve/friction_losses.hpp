@@ -33,6 +33,10 @@ class SparseLuNumeric;
 
 namespace phiq::detail {
 
+// What presses bearing `b` (its friction over μ: BearingFriction's moment or, on a slide, force) at its joint's
+// reaction `f` in joint axes (Fx, Fy, Mz in the plane; Fx … Mz in space, z the joint's axis).
+double bearing_load(const BearingFriction& b, const double* f, bool spatial);
+
 class FrictionLosses {
  public:
   // The bearings of `loads`' torsional springs and its gear losses. Throws phiq::Error naming one whose joint or
