@@ -239,6 +239,88 @@ TEST(EffortSensitivity, PartsAndLoadsOnFramesOfExpressionsMatchResolvedSweeps) {
       test::rssr_with_expression_frame("[0.3, 0.4*b, 0.866]", "{efforts: all, sensitivities: [a, b]}"));
 }
 
+// With the losses that read the multipliers (solve/friction_losses.hpp): the adjoint of their fixed point, their
+// data along p and their joints' geometry along the motion. A bearing at every pin of the massive four-bar (μ a
+// parameter; the lengths move the pins and the inertias); the hoist's lossy stages (an efficiency, the drum's
+// radius); a tilted spatial hinge's journal, collar and bending arm (the speed moves the motion, e the centre).
+TEST(EffortSensitivity, BearingsAndGearLossesMatchResolvedSweeps) {
+  std::string fourbar = test::model_file_text("dynamics/fourbar_pin_friction.yaml", "output:");
+  for (const char* pin : {"O", "A", "B", "C"})
+    fourbar = test::replace_first(fourbar, std::string("joint: ") + pin + ", coefficient: 0.15",
+                                  std::string("joint: ") + pin + ", coefficient: mu");
+  // (not at t = 0 and 1, where pin B's turn is zero and its friction's sign, not differentiable, is rounding's)
+  fourbar = test::replace_first(fourbar, "time: {start: 0, end: 1, steps: 72}",
+                                "time: {start: 0.01, end: 0.99, "
+                                "steps: 49}");
+  expect_effort_sensitivities_match_resolved_sweeps(
+      test::replace_first(fourbar, "parameters: {", "parameters: {mu: 0.15, ") +
+      "output: {efforts: all, sensitivities: [L2, L3, mu]}\n");
+  const std::string hoist =
+      test::replace_first(test::replace_first(test::model_file_text("dynamics/hoist_gear_losses.yaml", "output:"),
+                                              "efficiency: 0.97,", "efficiency: eta1,"),
+                          "parameters: {", "parameters: {eta1: 0.97, ") +
+      "output: {efforts: all, sensitivities: [eta1, r]}\n";
+  expect_effort_sensitivities_match_resolved_sweeps(hoist);
+  {  // the API at the sweep's last row, the losses solved there alike
+    const Scene s = parse_scene(hoist, "hoist.yaml");
+    const EffortSensitivityRows r = effort_rows_sweep(s);
+    Workspace at_end(*s.model);
+    SweepOptions o = s.sweep;
+    o.sensitivities.clear(), o.efforts = OutputEfforts{};
+    o.velocities = o.accelerations = true, o.newton.tolerance = 1e-12;
+    ASSERT_EQ(run_sweep(
+                  *s.model, o, at_end, [](const StepView&) { return true; }, nullptr),
+              SolveStatus::kSuccess);
+    std::vector<double> d;
+    std::string why;
+    ASSERT_EQ(
+        solve_effort_sensitivities(*s.model, s.sweep.efforts, s.sweep.sensitivities, s.sweep.t_end, at_end, d, &why),
+        SolveStatus::kSuccess)
+        << why;
+    const std::size_t at = static_cast<std::size_t>(s.sweep.efforts.size());
+    for (std::size_t j = 0; j < 2; ++j) EXPECT_NEAR(d[j], r.values.back()[at + j], 1e-8 * (1 + std::fabs(d[j]))) << j;
+    EXPECT_GT(std::fabs(d[0]), 0.1);  // ∂τ/∂η1 (N m): the first stage's loss felt
+  }
+  expect_effort_sensitivities_match_resolved_sweeps(
+      "phiq: 1\nname: rotor\ndimension: 3\nparameters: {w: 4, e: 0.1, mu: 0.15}\n"
+      "coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\nbodies: {disc: [x, y, z, e0, e1, e2, e3]}\n"
+      "constraints:\n  - {name: hinge, type: revolute, between: [{body: ground, axis: [0, 0.3, 1]}, {body: disc, "
+      "axis: [0, 0, 1]}]}\n"
+      "drivers:\n  - {name: motor, joint: hinge, law: {type: polynomial, coefficients: [0, w, 0.7]}}\n"
+      "parts:\n  disc: {mass: 3.0, center_of_mass: [e, 0.05, 0.25], inertia: [0.02, 0.03, 0.04]}\n"
+      "loads:\n  gravity: [0, 0, -9.81]\n"
+      "  torsional_springs: [{name: bearing, joint: hinge, bearing: {coefficient: mu, radius: 0.02, "
+      "thrust_radius: 0.035, moment_arm: 0.04}}]\n"
+      "time: {start: 0, end: 1.5, steps: 30}\noutput: {efforts: all, sensitivities: [w, e, mu]}\n");
+}
+
+TEST(EffortSensitivity, AParameterOfALossesOwnJointIsRefusedByName) {
+  // the spatial hinge's axis read from p: the bearing's split into radial and axial load moves with it, which the
+  // losses' derivative does not follow
+  const Scene s = parse_scene(
+      "phiq: 1\nname: rotor\ndimension: 3\nparameters: {tilt: 0.3}\n"
+      "coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\nbodies: {disc: [x, y, z, e0, e1, e2, e3]}\n"
+      "constraints:\n  - {name: hinge, type: revolute, between: [{body: ground, axis: [0, tilt, 1]}, {body: disc, "
+      "axis: [0, 0, 1]}]}\n"
+      "drivers:\n  - {name: motor, joint: hinge, law: {type: linear, initial: 0, rate: 4}}\n"
+      "parts:\n  disc: {mass: 3.0, center_of_mass: [0.1, 0, 0], inertia: [0.02, 0.03, 0.04]}\n"
+      "loads:\n  gravity: [0, 0, -9.81]\n"
+      "  torsional_springs: [{name: bearing, joint: hinge, bearing: {coefficient: 0.15, radius: 0.02}}]\n"
+      "time: {start: 0, end: 1, steps: 10}\noutput: {efforts: all, sensitivities: [tilt]}\n",
+      "rotor.yaml");
+  Workspace ws(*s.model);
+  ws.q = s.model->initial_positions();
+  try {
+    run_sweep(
+        *s.model, s.sweep, ws, [](const StepView&) { return true; }, nullptr);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_HAS(std::string(e.what()),
+               "the efforts' sensitivities to 'tilt' with the bearing of 'hinge': 'tilt' "
+               "changes its joint or ratio");
+  }
+}
+
 TEST(EffortSensitivity, TheFourFormulationsOfTheFourBarGiveOneSensitivity) {
   // relative angles (the parts' frames read L2, L3 in their expressions), natural, reference-point (the pins'
   // local points read them) and mixed coordinates: ∂τ/∂L of one physical torque, alike at every row

@@ -524,31 +524,6 @@ TEST(BearingFriction, BadBearingsAreRefusedInOneLine) {
           "a pin in the plane carries no moment");
   refused(rotor_text(0.0, ", moment_arm: 0"), "a moment arm is a positive length");
   refused(test::replace_first(good, "bearing: {joint: pivot,", "bearing: {"), "names its `joint`");
-  // efforts' sensitivities read Q's rate along p, which a bearing's friction does not have: refused in the scene,
-  // and by the sweep of options put together in code
-  const std::string sens = test::replace_first(good, "output: {", "output: {sensitivities: [l], ");
-  refused(sens, "output.efforts: the efforts' sensitivities");
-  std::string damped = sens;
-  const std::size_t from = damped.find("bearing: {"), to = damped.find("}}", from);
-  ASSERT_NE(to, std::string::npos);
-  damped.replace(from, to + 1 - from, "damping: 0.01");
-  const Scene with_sens = parse_scene(damped, "damped.yaml"), bearing = parse_scene(good, "bearing.yaml");
-  SweepOptions opt = with_sens.sweep;
-  ASSERT_FALSE(opt.sensitivities.empty());
-  opt.efforts.loads = bearing.sweep.efforts.loads;
-  Workspace ws(*with_sens.model);
-  ws.q = with_sens.model->initial_positions();
-  EXPECT_THROW(
-      {
-        try {
-          (void)run_sweep(
-              *with_sens.model, opt, ws, [](const StepView&) { return true; }, nullptr);
-        } catch (const Error& e) {
-          EXPECT_NE(std::string(e.what()).find("bearing"), std::string::npos) << e.what();
-          throw;
-        }
-      },
-      Error);
 }
 
 }  // namespace

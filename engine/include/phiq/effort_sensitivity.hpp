@@ -30,6 +30,14 @@
 /// the coordinate s moves most by 10⁻³ of its scale; ~10⁻¹² relative). A co-moving coordinate
 /// (ParameterReach::comotion) is moved along p as the sensitivities move it.
 ///
+/// With a bearing's friction or a gear's losses (their moments m_i read λ: solve/friction_losses.hpp), λ solves
+/// Φqᵀ λ = Q + Q_f(λ, q, p), and the same holds with w̃ for w, (Φq − (∂Q_f/∂λ)ᵀ) w̃ = e_r (the fixed point's adjoint,
+/// solved in passes that contract as the losses' own did), and dQ/dp + dQ_f/dp at fixed λ for dQ/dp: Q_f at
+/// q ± ε (s − q̂), ±2ε, and with the losses' data of the scene at p ± h, ±2h, each a fourth-order difference, the
+/// friction's directions held. A parameter of a loss's own joint or ratio (a spatial joint's axes, a slide's line, a
+/// mesh's ratio, which split its load otherwise) is refused by name; a planar pin's journal reads λ alone. At a row
+/// where a bearing's turn passes zero its friction's sign flips and τ has no derivative.
+///
 /// A driver's power P = Σ λ_r Φt_r over its rows: dP/dp = Σ (dλ_r/dp Φt_r + λ_r dΦt_r/dp), dλ_r/dp as −dτ/dp above
 /// with w = Φq⁻¹ e_r for each row, and dΦt/dp = ∂Φt/∂p |q + Φqt (s − q̂), the latter −[γ(a) − γ(−a)]/4 at a = s − q̂.
 ///

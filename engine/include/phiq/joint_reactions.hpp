@@ -97,6 +97,13 @@ class JointReactions {
   /// multiplier of each row, and this sums them (six products a planar pin). Pre-condition: keep_geometry() at
   /// this q and t.
   void evaluate_kept(const double* q, double t, const Eigen::VectorXd& lambda, double* out);
+  /// keep_geometry()'s values of the k-th listed joint per unit multiplier of each of its rows (column j: row
+  /// kept_first_row(k) + j; a planar joint's first three values). Pre-condition: keep_geometry().
+  const Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>& kept_per_row(std::size_t k) const {
+    return kept_[k].per_row;
+  }
+  /// The k-th listed joint's first row in the model's (kept_per_row()).
+  Index kept_first_row(std::size_t k) const { return set_->sites[k].first_row; }
 
  private:
   struct Site {

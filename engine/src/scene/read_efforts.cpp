@@ -179,8 +179,6 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
         .fail(
             "no part has mass and no load is applied: every effort would be zero (give parts a mass "
             "or a density, or apply loads)");
-  if (!out.constraints.empty() && !scene.sweep.sensitivities.empty() && FrictionLosses::any(scene.loads.applied.get()))
-    pending_.efforts_field->fail(FrictionLosses::kNoSensitivities);
   if (pending_.losses_field) out.losses = resolve_output_losses(scene.loads.applied.get());
   out.parts = std::move(massive);
   out.loads = std::make_shared<const Loads>(scene.loads);

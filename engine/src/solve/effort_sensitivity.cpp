@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "phiq/inverse_dynamics.hpp"
 #include "phiq/kinds/kind_support.hpp"  // detail::central_difference
@@ -13,6 +14,7 @@
 #include "phiq/text.hpp"
 #include "parts/force_rate.hpp"
 #include "solve/factorisation.hpp"
+#include "solve/friction_losses.hpp"
 #include "solve/models_along.hpp"
 #include "solve/sensitivity_internal.hpp"
 
@@ -70,6 +72,24 @@ void total_force_rate(const Model& model, const OutputEfforts& efforts, const Ou
     generalized_forces(parts, loads, sc.qf.data(), qd, qdd, t, n, f[k]);
   }
   sc.dq += ((f[0] - f[3]) + 8.0 * (f[2] - f[1])) / (12.0 * p.step);
+}
+
+// dQ_f/dp at fixed λ into sc.friction_rate: the losses along the motion (v = s − q̂, with the difference step of
+// the forces') and along p by the loads' copies (FrictionLosses::force_rate()).
+void losses_force_rate(const Model& model, const OutputSensitivity& p, const ParameterReach& reach, const double* q,
+                       double t, const Eigen::VectorXd& lambda, detail::EffortSensitivityScratch& sc) {
+  const Index n = model.num_coordinates();
+  const double rate = detail::fastest_coordinate(sc.v.data(), model.tolerance_scales().coordinate_scale.data(), n);
+  std::array<const AppliedLoads*, 4> along{};
+  for (std::size_t k = 0; k < 4; ++k) along[k] = p.loads_along[k] ? p.loads_along[k]->applied.get() : nullptr;
+  if (!reach.comotion.empty())
+    for (std::size_t k = 0; k < 4; ++k) {
+      sc.moved[k] = Eigen::Map<const Eigen::VectorXd>(q, n);
+      for (const ParameterReach::Comotion& c : reach.comotion)
+        sc.moved[k][c.coordinate] = q[c.coordinate] * (1.0 + kShift[k] * p.step * c.rate);
+    }
+  sc.losses->force_rate(q, t, lambda, sc.v, 1e-3 / std::max(rate, 1e-3), along,
+                        reach.comotion.empty() ? nullptr : &sc.moved, p.step, sc.friction_rate);
 }
 
 // H(v, w) = (Φq v)_q w over every row into sc.plus, from γ at q by polarisation (exact: γ is quadratic in q̇).
@@ -143,6 +163,7 @@ bool detail::effort_sensitivities_with_factors(const Model& model, const OutputE
       sc.rhs[factored_row(model, r)] = 1.0;
       sc.w[used].resize(n);
       if (!lu.solve(sc.rhs.data(), sc.w[used].data())) return false;
+      if (sc.losses && !sc.losses->adjoint(lu, sc.w[used])) return false;  // (w̃: the losses' adjoint)
       sc.rows.push_back({i, r, used++});
     }
   }
@@ -171,6 +192,7 @@ bool detail::effort_sensitivities_with_factors(const Model& model, const OutputE
                        sensitivities + sl.offset(j, 2), t, sc);
       ++sc.differenced;
     }
+    if (sc.losses) losses_force_rate(model, p, reach, q, t, lambda, sc);
     time_rate_along(model, p, reach, q, t, sc);
     sc.power.assign(ne, 0.0);
     for (const EffortSensitivityScratch::DriverRow& dr : sc.rows) {
@@ -187,7 +209,8 @@ bool detail::effort_sensitivities_with_factors(const Model& model, const OutputE
       for (const Index r : reach.rows) along_p += lambda[r] * 0.5 * (at_w[r] - sc.minus[r]);
       second_derivative(model, q, sc.v, w, qd_rate, t, sc);
       // −dλ_r/dp: the effort's rate where r is the driver's first row
-      const double minus_rate = along_p + lambda.dot(sc.plus) - w.dot(sc.dq);
+      const double minus_rate =
+          along_p + lambda.dot(sc.plus) - w.dot(sc.dq) - (sc.losses ? w.dot(sc.friction_rate) : 0.0);
       const ConstraintInfo& c = model.constraints()[static_cast<std::size_t>(efforts.constraints[dr.effort])];
       if (dr.row == c.first_row) out[layout.offset(j, dr.effort)] = minus_rate;
       // P = Σ λ_r Φt_r over the driver's rows
@@ -221,8 +244,25 @@ SolveStatus solve_effort_sensitivities(const Model& model, const OutputEfforts& 
   Eigen::VectorXd Q = Eigen::VectorXd::Zero(model.num_coordinates()), kept, lambda;
   add_generalized_forces(*efforts.parts, *efforts.loads, ws.q.data(), ws.qd.data(), ws.qdd.data(), t, Q);
   detail::EffortSensitivityScratch sc;
-  if (!multipliers_with_factors(model, *ws.lu, Q, kept, lambda) ||
-      !detail::effort_sensitivities_with_factors(model, efforts, with_reach, t, ws.q.data(), ws.qd.data(),
+  if (!multipliers_with_factors(model, *ws.lu, Q, kept, lambda)) {
+    if (message) *message = "sparse LU solve failed: " + ws.lu->last_message();
+    return SolveStatus::kLinearSolverFailed;
+  }
+  // the losses that read the multipliers, solved with them as a sweep solves them (row_efforts.cpp)
+  std::optional<detail::FrictionLosses> losses;
+  if (detail::FrictionLosses::any(efforts.loads->applied.get())) {
+    losses.emplace(model, *efforts.loads->applied);
+    for (const OutputSensitivity& p : with_reach)
+      if (const std::string who = losses->reach_not_followed(model, p.reach->rows); !who.empty())
+        throw Error("solve_effort_sensitivities: the sensitivity to '" + p.name + "' with " + who +
+                    ": it changes its joint or ratio, which the losses' derivative does not follow");
+    if (!losses->solve(model, *ws.lu, ws.q.data(), ws.qd.data(), t, Q, lambda, kept)) {
+      if (message) *message = losses->failed_solve() ? ws.lu->last_message() : losses->lock_message();
+      return losses->failed_solve() ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
+    }
+    sc.losses = &*losses;
+  }
+  if (!detail::effort_sensitivities_with_factors(model, efforts, with_reach, t, ws.q.data(), ws.qd.data(),
                                                  ws.qdd.data(), lambda, sens.data(), *ws.lu, sc, out.data())) {
     std::fill(out.begin(), out.end(), std::numeric_limits<double>::quiet_NaN());
     if (message) *message = "sparse LU solve failed: " + ws.lu->last_message();

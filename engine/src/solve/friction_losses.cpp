@@ -13,6 +13,7 @@
 #include "phiq/model.hpp"
 #include "phiq/part_motion.hpp"
 #include "phiq/text.hpp"
+#include "solve/models_along.hpp"  // kShift
 
 namespace phiq::detail {
 
@@ -49,6 +50,23 @@ double bearing_load(const BearingFriction& b, const double* f, bool spatial) {
   }
   const double bending = b.moment_arm > 0.0 && spatial ? std::hypot(f[3], f[4]) / b.moment_arm : 0.0;
   return b.radius * (across + bending) + b.thrust_radius * along;
+}
+
+void bearing_load_gradient(const BearingFriction& b, const double* f, bool spatial, double* d) {
+  std::fill(d, d + 6, 0.0);
+  const double across = std::hypot(f[0], f[1]), scale = b.slide ? 1.0 : b.radius;
+  if (across > 0.0) d[0] = scale * f[0] / across, d[1] = scale * f[1] / across;
+  if (b.slide && b.moment_arm > 0.0 && !spatial) d[2] = friction_direction(f[2]) / b.moment_arm;
+  if (b.slide || !spatial) {
+    const double tilt = b.slide && spatial && b.moment_arm > 0.0 ? std::hypot(f[3], f[4], f[5]) : 0.0;
+    if (tilt > 0.0)
+      for (int k = 3; k < 6; ++k) d[k] = f[k] / (b.moment_arm * tilt);
+    return;
+  }
+  d[2] = b.thrust_radius * friction_direction(f[2]);
+  const double bending = b.moment_arm > 0.0 ? std::hypot(f[3], f[4]) : 0.0;
+  if (bending > 0.0)
+    d[3] = b.radius * f[3] / (b.moment_arm * bending), d[4] = b.radius * f[4] / (b.moment_arm * bending);
 }
 
 bool FrictionLosses::carries(std::string_view kind) {
@@ -106,7 +124,7 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
     const Index c = check(model, s);
     const bool spatial = reaction_width(model, c) == 6;
     joints.reactions.push_back({c, spatial});
-    up->bearings.push_back({&s, at, spatial});
+    up->bearings.push_back({&s, c, at, spatial});
     at += spatial ? 6 : 3;
   }
   for (const GearLoss& l : loads.gear_losses) {
@@ -135,6 +153,7 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
         if (const std::string why = not_a_worm(sm, model.initial_positions()); !why.empty())
           throw Error(who + ": a friction coefficient gives a worm's efficiencies, but " + why);
         const double tan_lead = sm.r2 / (std::abs(sm.k) * sm.r1), c = std::cos(sm.pressure_angle), mu = l.friction;
+        m.tan_lead = tan_lead, m.cos_pressure = c;
         m.eta[1] = (c - mu * tan_lead) / (c + mu / tan_lead);
         m.eta[0] = (c - mu / tan_lead) / (c + mu * tan_lead);
         if (!(m.eta[1] > 0.0))
@@ -183,6 +202,7 @@ void FrictionLosses::moments_at(const double* q, double t, const Eigen::VectorXd
     MeshState& state = mesh_states_[j];
     const double effort[2] = {-lambda(mesh.row), -mesh.k * lambda(mesh.row)};
     state.driven = effort[0] * state.rate[0] > 0.0 ? 0 : effort[1] * state.rate[1] > 0.0 ? 1 : -1;
+    state.effort_sign = state.driven < 0 ? 0.0 : friction_direction(effort[state.driven]);
     m[set_->bearings.size() + j] =
         state.driven < 0 ? 0.0 : (1.0 - mesh.eta[state.driven]) * std::abs(effort[state.driven]);
   }
@@ -247,6 +267,126 @@ bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double
   }
   Q += q_f_;
   return false;
+}
+
+bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
+  const std::size_t nb = set_->bearings.size();
+  w0_ = w;
+  adjoint_rhs_.resize(w.size());
+  double d[6];
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    // (∂Q_f/∂λ)ᵀ w̃ = Σ_i ∂m_i/∂λ (u_iᵀ w̃), over the rows of each loss's joint or mesh
+    adjoint_rhs_.setZero();
+    for (std::size_t i = 0; i < nb; ++i) {
+      const double dir = friction_direction(rates_[i]);
+      const std::vector<Index>& c = torsional_coordinates(*set_->bearings[i].spring);
+      double along = 0.0;  // u_iᵀ w̃, u_i = −dir ∇θ_i
+      for (std::size_t k = 0; k < c.size(); ++k) along -= dir * gradients_[i][k] * w(c[k]);
+      if (along == 0.0) continue;
+      const Bearing& b = set_->bearings[i];
+      bearing_load_gradient(*b.spring->bearing, values_.data() + b.at, b.spatial, d);
+      const auto& per_row = reactions_->kept_per_row(i);
+      const Index first = reactions_->kept_first_row(i);
+      for (Index j = 0; j < per_row.cols(); ++j) {
+        double g = 0.0;
+        for (int v = 0; v < 6; ++v) g += d[v] * per_row(v, j);
+        adjoint_rhs_(first + j) += along * b.spring->bearing->coefficient * g;
+      }
+    }
+    for (std::size_t j = 0; j < set_->meshes.size(); ++j) {
+      const Mesh& mesh = set_->meshes[j];
+      const MeshState& state = mesh_states_[j];
+      if (state.driven < 0) continue;
+      const double dir = friction_direction(state.rate[state.driven]);
+      double along = 0.0;
+      if (mesh.member[state.driven].is_coordinate()) along -= dir * w(mesh.member[state.driven].coord());
+      if (mesh.carrier.is_coordinate()) along += dir * w(mesh.carrier.coord());
+      // m = (1 − η) |e|, e = −c λ_row (c: 1 for member 0, k for member 1)
+      const double c = state.driven == 0 ? 1.0 : mesh.k;
+      adjoint_rhs_(mesh.row) -= along * (1.0 - mesh.eta[state.driven]) * state.effort_sign * c;
+    }
+    if (adjoint_rhs_.isZero(0.0)) return w = w0_, true;  // (no loss turns: w̃ = w)
+    adjoint_step_.resize(w.size());
+    if (!lu.solve(adjoint_rhs_.data(), adjoint_step_.data())) return false;
+    double change = 0.0, scale = 0.0;
+    for (Index k = 0; k < w.size(); ++k) {
+      const double next = w0_(k) + adjoint_step_(k);
+      change = std::max(change, std::abs(next - w(k))), scale = std::max(scale, std::abs(next));
+      w(k) = next;
+    }
+    if (change <= 1e-14 * scale) return true;
+  }
+  return false;
+}
+
+void FrictionLosses::frozen_forces(const double* q, double t, const Eigen::VectorXd& lambda, const AppliedLoads* data,
+                                   Eigen::VectorXd& out) {
+  out.setZero(q_f_.size());
+  if (reactions_) frozen_values_.resize(values_.size()), reactions_->evaluate(q, t, lambda, frozen_values_.data());
+  std::size_t in_data = 0;  // the next torsional spring of `data` to look at
+  for (std::size_t i = 0; i < set_->bearings.size(); ++i) {
+    const Bearing& b = set_->bearings[i];
+    const TorsionalSpring* s = b.spring;
+    if (data) {  // the same bearing in the data along p: the i-th spring with one
+      while (in_data < data->torsional_springs.size() && !data->torsional_springs[in_data].bearing) ++in_data;
+      if (in_data == data->torsional_springs.size())
+        throw Error("the loads along a parameter lost a bearing (phiq bug)");
+      s = &data->torsional_springs[in_data++];
+    }
+    const double dir = friction_direction(rates_[i]);
+    if (dir == 0.0) continue;
+    const double m = s->bearing->coefficient * bearing_load(*s->bearing, frozen_values_.data() + b.at, b.spatial);
+    angle_rate(*s, q, nullptr, t, frozen_gradient_);
+    const std::vector<Index>& c = torsional_coordinates(*s);
+    for (std::size_t k = 0; k < c.size(); ++k) out(c[k]) -= m * dir * frozen_gradient_[k];
+  }
+  for (std::size_t j = 0; j < set_->meshes.size(); ++j) {
+    const Mesh& mesh = set_->meshes[j];
+    const MeshState& state = mesh_states_[j];
+    if (state.driven < 0) continue;
+    double eta = mesh.eta[state.driven];
+    if (data) {
+      const GearLoss& l = data->gear_losses.at(j);
+      const double mu = l.friction, c = mesh.cos_pressure, tl = mesh.tan_lead;
+      eta = l.friction > 0.0 ? (state.driven == 1 ? (c - mu * tl) / (c + mu / tl) : (c - mu / tl) / (c + mu * tl))
+                             : (state.driven == 1 ? l.efficiency : l.reverse_efficiency);
+    }
+    const double effort = (state.driven == 0 ? 1.0 : mesh.k) * lambda(mesh.row);
+    const double m = (1.0 - eta) * std::abs(effort) * friction_direction(state.rate[state.driven]);
+    if (mesh.member[state.driven].is_coordinate()) out(mesh.member[state.driven].coord()) -= m;
+    if (mesh.carrier.is_coordinate()) out(mesh.carrier.coord()) += m;
+  }
+}
+
+void FrictionLosses::force_rate(const double* q, double t, const Eigen::VectorXd& lambda, const Eigen::VectorXd& v,
+                                double e, const std::array<const AppliedLoads*, 4>& along,
+                                const std::array<Eigen::VectorXd, 4>* moved, double h, Eigen::VectorXd& out) {
+  const Index n = q_f_.size();
+  const Eigen::Map<const Eigen::VectorXd> qv(q, n);
+  for (std::size_t k = 0; k < 4; ++k) {
+    qk_ = qv + (kShift[k] * e) * v;
+    frozen_forces(qk_.data(), t, lambda, nullptr, forces_[k]);
+  }
+  out = ((forces_[0] - forces_[3]) + 8.0 * (forces_[2] - forces_[1])) / (12.0 * e);
+  if (std::none_of(along.begin(), along.end(), [](const AppliedLoads* a) { return a != nullptr; }) && !moved) return;
+  for (std::size_t k = 0; k < 4; ++k) frozen_forces(moved ? (*moved)[k].data() : q, t, lambda, along[k], forces_[k]);
+  out += ((forces_[0] - forces_[3]) + 8.0 * (forces_[2] - forces_[1])) / (12.0 * h);
+}
+
+std::string FrictionLosses::reach_not_followed(const Model& model, const std::vector<Index>& reached) const {
+  auto touched = [&](Index first, Index rows) {
+    const auto it = std::lower_bound(reached.begin(), reached.end(), first);
+    return it != reached.end() && *it < first + rows;
+  };
+  for (const Bearing& b : set_->bearings) {
+    const ConstraintInfo& c = model.constraints()[static_cast<std::size_t>(b.constraint)];
+    const std::string_view kind = c.kind;
+    const bool planar_journal = !b.spatial && !b.spring->bearing->slide && (kind == "pin" || kind == "revolute");
+    if (!planar_journal && touched(c.first_row, c.rows)) return "the bearing of '" + c.name + "'";
+  }
+  for (const Mesh& m : set_->meshes)
+    if (touched(m.row, 1)) return "the gear losses of '" + m.loss->gear + "'";
+  return {};
 }
 
 double FrictionLosses::exerted(std::size_t i) const {

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -36,6 +37,8 @@ namespace phiq::detail {
 // What presses bearing `b` (its friction over μ: BearingFriction's moment or, on a slide, force) at its joint's
 // reaction `f` in joint axes (Fx, Fy, Mz in the plane; Fx … Mz in space, z the joint's axis).
 double bearing_load(const BearingFriction& b, const double* f, bool spatial);
+// Its derivative along each of f's values, into d[0, 6) (zero where a magnitude it reads is zero).
+void bearing_load_gradient(const BearingFriction& b, const double* f, bool spatial, double* d);
 
 class FrictionLosses {
  public:
@@ -57,10 +60,6 @@ class FrictionLosses {
   static bool carries(std::string_view kind);
   // Whether a constraint of kind `kind` is a transmission with meshing losses (GearLoss).
   static bool transmits(std::string_view kind);
-  // Why the efforts' ∂τ/∂p are refused with these losses (the scene's reader and the sweep say it alike).
-  static constexpr const char* kNoSensitivities =
-      "the efforts' sensitivities ∂τ/∂p are not computed with a bearing's friction or a gear's losses (they read the "
-      "multipliers they change): ask them without those";
   // Whether `loads` has a bearing or a gear loss.
   static bool any(const AppliedLoads* loads);
 
@@ -74,6 +73,22 @@ class FrictionLosses {
   // exerted against the motion, and the power it dissipated; both ≥ 0, zero at rest.
   double exerted(std::size_t i) const;
   double dissipated(std::size_t i) const;
+  // The efforts' sensitivities with the losses (phiq/effort_sensitivity.hpp), at the last solve() that settled, its
+  // directions and driven members held. λ solves R = Φqᵀ λ − Q − Q_f(λ, q, p) = 0, so dλ_r/dp = −w̃ᵀ dR/dp|λ with
+  // (Φq − (∂Q_f/∂λ)ᵀ) w̃ = e_r: adjoint() turns w = Φq⁻¹ e_r into w̃ by the passes w̃ = w + Φq⁻¹ (∂Q_f/∂λ)ᵀ w̃, which
+  // contract as solve()'s did (∂Q_f/∂λ = Σ_i u_i ∂m_i/∂λ, u_i the loss's direction in Q, m_i linear in the reaction
+  // of its joint, kept per unit multiplier). False where a solve fails or the passes do not settle.
+  bool adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w);
+  // dQ_f/dp at fixed λ into `out`: along the motion v by Q_f at q + kShift[k] e v, and along p by the losses' data in
+  // `along` (the scene's loads at p + kShift[k] h, in order; null: the loads' own, or all null: none) at q with the
+  // co-moving coordinates `moved` (same as q but where p moves them), each by the fourth-order central difference.
+  void force_rate(const double* q, double t, const Eigen::VectorXd& lambda, const Eigen::VectorXd& v, double e,
+                  const std::array<const AppliedLoads*, 4>& along, const std::array<Eigen::VectorXd, 4>* moved,
+                  double h, Eigen::VectorXd& out);
+  // Whether parameter rows `reached` (ParameterReach::rows) change a loss's constraint in a way force_rate() does not
+  // follow (a spatial joint's axes, a slide's direction or point, a mesh's ratio): its name, else empty. A planar
+  // pin's or revolute's journal reads the multipliers alone.
+  std::string reach_not_followed(const Model& model, const std::vector<Index>& reached) const;
   int solves() const { return solves_; }               // transposed solves of the last solve()
   bool failed_solve() const { return failed_solve_; }  // the last solve() failed in a linear solve
   std::string lock_message() const;                    // the loss that did not settle, and why
@@ -83,7 +98,8 @@ class FrictionLosses {
  private:
   struct Bearing {
     const TorsionalSpring* spring = nullptr;
-    std::size_t at = 0;  // its reaction's first value in the reactions' row
+    Index constraint = 0;  // its joint's
+    std::size_t at = 0;    // its reaction's first value in the reactions' row
     bool spatial = false;
   };
   // A mesh: its row θ1 + k θ2 − (1 + k) θc − φ (the last of its constraint's), the loss 1 − η
@@ -92,13 +108,15 @@ class FrictionLosses {
     Slot member[2], carrier;
     double k = 1.0;
     Index row = 0;
-    double eta[2] = {1.0, 1.0};  // the efficiency where member 0 (reverse), member 1 (forward) is driven
+    double eta[2] = {1.0, 1.0};                 // the efficiency where member 0 (reverse), member 1 (forward) is driven
+    double tan_lead = 0.0, cos_pressure = 1.0;  // a worm's (GearLoss::friction > 0), whose η reads μ
   };
   // A mesh at the row: each member's rate relative to the carrier, and the member driven at the last pass (−1:
   // none, no power through the mesh)
   struct MeshState {
     double rate[2] = {0.0, 0.0};
     int driven = -1;
+    double effort_sign = 0.0;  // the sign of the driven member's effort at the last pass
   };
   // What construction finds, never written after it: shared by with_set_up_of()'s copies.
   struct SetUp {
@@ -111,12 +129,19 @@ class FrictionLosses {
   // m_i from the reactions and the meshes' multipliers at λ (bearings first, then meshes)
   void moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m);
   std::string name(std::size_t i) const;  // loss i's, for a message
+  // Q_f at q under λ with the last solve()'s directions and driven members, the losses' data of `data` (null: the
+  // loads' own), into `out` (zeroed first)
+  void frozen_forces(const double* q, double t, const Eigen::VectorXd& lambda, const AppliedLoads* data,
+                     Eigen::VectorXd& out);
 
   std::shared_ptr<const SetUp> set_;
   std::optional<JointReactions> reactions_;  // the bearings' joints (none without bearings)
   std::vector<MeshState> mesh_states_;
   std::vector<double> values_, moments_, next_, rates_;
   std::vector<std::vector<double>> gradients_;
+  std::vector<double> frozen_values_, load_gradient_;
+  std::vector<double> frozen_gradient_;
+  Eigen::VectorXd w0_, adjoint_rhs_, adjoint_step_, qk_, forces_[4];
   Eigen::VectorXd lambda0_, q_f_, d_lambda_;
   int solves_ = 0, passes_ = 0;
   bool failed_solve_ = false;

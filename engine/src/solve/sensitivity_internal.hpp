@@ -75,6 +75,8 @@ double fastest_coordinate(const double* v, const double* scale, Index n);
 // factors of Φq at q. NaN for an effort whose first row the model dropped, for a power with any row dropped.
 // Pre-condition: every parameter's reach is set (run_sweep(), the Stepper and solve_effort_sensitivities() find it
 // once); else phiq::Error. Returns false when a solve fails.
+class FrictionLosses;  // solve/friction_losses.hpp
+
 struct EffortSensitivityScratch {
   SensitivityScratch along;        // along_parameter()'s
   std::vector<Eigen::VectorXd> w;  // Φq⁻¹ e_r per row of a driver (rows)
@@ -94,6 +96,11 @@ struct EffortSensitivityScratch {
   // p and the motion, and `differenced` counts it (the tests compare the two)
   bool difference_forces = false;
   std::size_t differenced = 0;
+  // The row's losses that read the multipliers, solved with them (FrictionLosses::solve()), or null: then each w is
+  // the adjoint's w̃ and dQ_f/dp at fixed λ (`friction_rate`) joins dQ/dp (FrictionLosses::adjoint(), force_rate())
+  FrictionLosses* losses = nullptr;
+  Eigen::VectorXd friction_rate;
+  std::array<Eigen::VectorXd, 4> moved;  // q with the co-moving coordinates moved along p
 };
 bool effort_sensitivities_with_factors(const Model& model, const OutputEfforts& efforts,
                                        const std::vector<OutputSensitivity>& parameters, double t, const double* q,

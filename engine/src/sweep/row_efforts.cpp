@@ -88,6 +88,7 @@ bool Sweeper::row_efforts() {
   // sensitivities (sweep_sensitivity_form()): after the reactions in outputs_.efforts
   if (n > 0 && !opt_.sensitivities.empty()) {
     double* out = outputs_.efforts.data() + e.size();
+    effort_work_.sensitivity_scratch.losses = effort_work_.losses ? &*effort_work_.losses : nullptr;
     const EffortSensitivityLayout layout{n};
     if (!effort_sensitivities_with_factors(model_, e, opt_.sensitivities, t, current_.q.data(), current_.qd.data(),
                                            current_.qdd.data(), effort_work_.lambda, outputs_.sensitivities.data(),
