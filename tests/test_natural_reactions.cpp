@@ -66,7 +66,8 @@ NaturalRows natural_reactions_sweep(const Scene& s) {
 // (the natural frames start at A and C, the reference-point bodies at the links' centres).
 constexpr const char* kNaturalRockerAngle = "atan2(yB, xB - L1)";
 std::string natural_reactions_loads(double coupler_at, double rocker_at,
-                                    const std::string& rocker_angle = kNaturalRockerAngle) {
+                                    const std::string& rocker_angle = kNaturalRockerAngle,
+                                    const std::string& crank_angle = "theta2") {
   std::ostringstream s;
   s << "loads:\n  gravity: [0.8, -9.81]\n"
     << "  forces: [{name: push, part: coupler, at: [" << coupler_at + 0.1 << ", 0.05], force: [3 + sin(t), -2], "
@@ -75,7 +76,9 @@ std::string natural_reactions_loads(double coupler_at, double rocker_at,
     << "  springs: [{name: s, between: [{part: rocker, at: [" << rocker_at + 0.3 << ", 0]}, {point: [1.5, 1]}], "
     << "stiffness: 40, free_length: 0.2},\n"
     << "            {name: tie, between: [{part: coupler, at: [" << coupler_at + 0.2 << ", 0.1]}, {part: rocker, at: ["
-    << rocker_at + 0.3 << ", 0]}], stiffness: 25, free_length: 0.3, damping: 0.4}]\n";
+    << rocker_at + 0.3 << ", 0]}], stiffness: 25, free_length: 0.3, damping: 0.4}]\n"
+    << "  torsional_springs: [{name: return, coordinate: " << crank_angle
+    << ", stiffness: 3, free_angle: 0.2, damping: 0.1}]\n";
   return s.str();
 }
 
@@ -136,7 +139,7 @@ TEST(NaturalReactions, FourBarPinsAndTorqueAreTheReferencePointForms) {
   const Scene natural = natural_four_bar();
   std::string text = natural_reactions_scene("seed/fourbar_reference_point.yaml");
   text += "parts:\n" + natural_reactions_part("crank", 0, 0, "") + natural_reactions_part("coupler", 1, 0, "") +
-          natural_reactions_part("rocker", 2, 0, "") + natural_reactions_loads(0, 0, "psi4") +
+          natural_reactions_part("rocker", 2, 0, "") + natural_reactions_loads(0, 0, "psi4", "psi2") +
           "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
   const Scene reference = parse_scene(text, "fourbar_reference_point.yaml");
   // O, A, B, C in both: points of the natural form (on the crank, crank, coupler, rocker), revolutes of the other
@@ -194,7 +197,10 @@ TEST(NaturalReactions, EveryNaturalLinkBalancesUnderItsPinForces) {
       std::vector<std::pair<const char*, Eigen::Vector2d>> forces;  // at points
       double torque;
     };
-    const Link links[3] = {{"O", "A", 0, {{"O", F(0)}, {"A", F(1)}}, tau},
+    // the crank's return spring on its angle θ2 (a coordinate no point holds: the crank's segment angle)
+    const Index th = m.coordinate_index("theta2");
+    const double spring = 3 * (rows.q[k](th) - 0.2) + 0.1 * rows.qd[k](th);
+    const Link links[3] = {{"O", "A", 0, {{"O", F(0)}, {"A", F(1)}}, tau - spring},
                            {"A", "B", 1, {{"A", -F(1)}, {"B", F(2)}}, 0.0},
                            {"C", "B", 2, {{"B", -F(2)}, {"C", F(3)}}, -1.5}};  // (and −0.7 ω below)
     for (const Link& l : links) {
@@ -568,16 +574,22 @@ TEST(NaturalReactions, APointNoTwoBodiesShareIsRefusedByName) {
   }
 }
 
-// A torsional spring's moment cannot be divided among a natural point's bodies: their reactions are refused with one
-// (the efforts are not).
-TEST(NaturalReactions, ATorsionalSpringWithANaturalPointsReactionIsRefused) {
+// A torsional spring whose angle reads the natural points cannot be divided among a point's bodies: their reactions
+// are refused with one (the efforts are not); one on a coordinate of its own is its constraint's (tested above).
+TEST(NaturalReactions, ATorsionalSpringOnThePointsWithANaturalPointsReactionIsRefused) {
   std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
   text += "parts:\n" + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +
           natural_reactions_part("coupler", 1, 0.6, "frame: {origin: A, x: B}, ") +
-          "loads:\n  torsional_springs: [{name: return, coordinate: theta2, stiffness: 2}]\n";
+          "loads:\n  torsional_springs: [{name: return, angle: \"atan2(yA, xA)\", stiffness: 2}]\n";
   EXPECT_HAS(test::scene_error(text + "output: {efforts: all, reactions: [A, O]}\n"),
-             "output.reactions: the reaction at natural point 'A' would hold torsional spring 'return''s moment");
+             "output.reactions: the reaction at natural point 'A' would hold torsional spring 'return''s moment: its "
+             "angle reads the points");
   EXPECT_EQ(parse_scene(text + "output: {efforts: all}\n", "n.yaml").sweep.efforts.constraints.size(), 1u);
+  EXPECT_EQ(parse_scene(test::replace_first(text, "angle: \"atan2(yA, xA)\"", "coordinate: theta2") +
+                            "output: {efforts: all, reactions: [A, O]}\n",
+                        "n.yaml")
+                .sweep.efforts.reactions.size(),
+            2u);
 }
 
 }  // namespace

@@ -20,9 +20,10 @@
 /// way the points do not determine: NaN. The moment at a point joint is zero (points carry forces only); shared
 /// unit vectors (a spatial revolute in natural coordinates) are not split. A spring from b to another moving body
 /// is b's load at its own end, the far end read at its place from slots of its own (NaturalJoints::mirrors), so
-/// that its pull along the far body's points reaches no body's balance; a torsional spring between two bodies (its
-/// angle an expression that does not say which body it turns), and a spring whose far end is on a frame of
-/// expressions, are counted in the joints' reactions.
+/// that its pull along the far body's points reaches no body's balance. A torsional spring on a coordinate of its own
+/// (a segment_angle's) acts through that constraint's multiplier, its body's; one whose angle reads the points does
+/// not say which bodies it turns (the scene's reader refuses it with natural reactions), and a spring whose far end
+/// is on a frame of expressions is counted in the joints' reactions.
 #pragma once
 
 #include <string>

@@ -234,15 +234,25 @@ void SceneReader::resolve_output_reactions(Scene& scene) const {
       out.reactions.push_back({c, w == 6});
     }
   }
-  // a natural point's reaction balances its bodies' own loads, which a torsional spring's angle does not divide
-  // among them (phiq/natural_joints.hpp): refused rather than written with the spring's moment in it
+  // A natural point's reaction balances its bodies' own loads at their points: a torsional spring whose angle reads
+  // the points (an expression of them) pushes them in a way that does not say which bodies it turns, and is refused
+  // rather than written into the reactions; one on a coordinate of its own (a segment_angle's) acts through that
+  // constraint's multiplier, which its body owns.
   const auto natural_listed =
       std::find_if(out.reactions.begin(), out.reactions.end(), [](const OutputReaction& r) { return r.natural >= 0; });
-  if (natural_listed != out.reactions.end() && scene.loads.applied && !scene.loads.applied->torsional_springs.empty())
-    pending_.reactions_field->fail("the reaction at natural point '" + out.reaction_name(model, *natural_listed) +
-                                   "' would hold torsional spring '" + scene.loads.applied->torsional_springs[0].name +
-                                   "''s moment: its angle does not say which bodies it turns (list the reactions "
-                                   "of constraints only, or join the bodies by a revolute)");
+  if (natural_listed == out.reactions.end() || !scene.loads.applied) return;
+  std::vector<char> of_point(static_cast<std::size_t>(model.num_coordinates()), 0);
+  for (const NaturalBody& b : out.natural->bodies)
+    for (const Attachment3& p : b.points)
+      for (const Slot& r : p.r)
+        if (r.is_coordinate() && r.coord() < model.num_coordinates()) of_point[static_cast<std::size_t>(r.coord())] = 1;
+  for (const TorsionalSpring& ts : scene.loads.applied->torsional_springs)
+    for (const Index c : torsional_coordinates(ts))
+      if (of_point[static_cast<std::size_t>(c)])
+        pending_.reactions_field->fail("the reaction at natural point '" + out.reaction_name(model, *natural_listed) +
+                                       "' would hold torsional spring '" + ts.name +
+                                       "''s moment: its angle reads the points, and does not say which bodies it "
+                                       "turns (give the angle a coordinate, as a segment_angle does)");
 }
 
 std::vector<OutputLoss> SceneReader::resolve_output_losses(const AppliedLoads* loads) const {
