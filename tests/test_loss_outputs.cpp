@@ -8,7 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "output/hdf5_handle.hpp"
+#include "efforts_files.hpp"
 #include "phiq/applied_loads.hpp"
 #include "phiq/phiq.hpp"
 #include "reaction_rows.hpp"
@@ -98,33 +98,12 @@ TEST(LossOutputs, TheirColumnsAreNamedAndTheirUnitsStated) {
   CsvFormat f(*s.model, s.sweep);
   EXPECT_EQ(f.header(), "t,psi2,C_bearing.friction,C_bearing.loss,A_bearing.friction,A_bearing.loss\n");
   const std::filesystem::path path = test::scratch_path("losses.h5");
-  std::string csv;
-  {
-    Hdf5Writer h5(path.string(), *s.model, s.sweep);
-    Workspace ws(*s.model);
-    ws.q = s.model->initial_positions();
-    ASSERT_EQ(run_sweep(
-                  *s.model, s.sweep, ws,
-                  [&](const StepView& v) {
-                    f.append_row(v, csv);
-                    h5.append_row(v);
-                    return true;
-                  },
-                  nullptr),
-              SolveStatus::kSuccess);
-    h5.close();
-  }
+  const std::string csv = test::write_efforts_files(s, path.string());
   const CsvTable table = read_hdf5_table(path.string());
   ASSERT_EQ(table.rows.size(), 73u);
+  EXPECT_EQ(table.rows.back(), parse_csv_table(csv, "r.csv").rows.back());
   EXPECT_GT(table.rows[10][2], 0.05);  // C's friction, N m: the bearing is loaded
-  const detail::h5::QuietErrors quiet;
-  {
-    const detail::h5::Hid file =
-        detail::h5::checked(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, path.string());
-    const detail::h5::Hid d = detail::h5::checked(H5Dopen2(file.get(), "efforts", H5P_DEFAULT), H5Dclose, "efforts");
-    EXPECT_EQ(detail::h5::read_strings_attribute(d.get(), "units", "efforts"),
-              (std::vector<std::string>{"N m", "W", "N m", "W"}));
-  }
+  EXPECT_EQ(test::hdf5_strings(path.string(), "efforts", "units"), (std::vector<std::string>{"N m", "W", "N m", "W"}));
   std::filesystem::remove(path);
 }
 
@@ -141,15 +120,7 @@ TEST(LossOutputs, BadListsAndPlansAreRefusedInOneLine) {
   // a plan built in code: a loss the loads do not have
   Scene s = parse_scene(base + "output: {losses: all}\n", "friction.yaml");
   s.sweep.efforts.losses.push_back({"ghost", 4, true, false});
-  Workspace ws(*s.model);
-  ws.q = s.model->initial_positions();
-  try {
-    run_sweep(
-        *s.model, s.sweep, ws, [](const StepView&) { return true; }, nullptr);
-    ADD_FAILURE() << "no error";
-  } catch (const Error& e) {
-    EXPECT_HAS(std::string(e.what()), "SweepOptions: loss 'ghost' (4) is not one of the loads' bearings");
-  }
+  EXPECT_HAS(test::sweep_error(*s.model, s.sweep), "SweepOptions: loss 'ghost' (4) is not one of the loads' bearings");
 }
 
 }  // namespace

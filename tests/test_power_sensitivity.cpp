@@ -7,8 +7,8 @@
 #include <cmath>
 #include <filesystem>
 
-#include "output/hdf5_handle.hpp"
 #include "phiq/effort_sensitivity.hpp"
+#include "efforts_files.hpp"
 #include "phiq/phiq.hpp"
 #include "sensitivity_support.hpp"
 #include "test_support.hpp"
@@ -185,38 +185,16 @@ TEST(PowerSensitivity, AnHdf5FileHoldsTheColumnsOfTheCsvWithTheirUnits) {
   // the efforts dataset: motor.effort (N m), motor.power (W), ∂τ/∂p per parameter ("N m/L" …), ∂P/∂p ("W/L" …)
   const Scene s = parse_scene(kPowerPendulum, "pendulum.yaml");
   const std::filesystem::path path = phiq::test::scratch_path("phiq_power_sensitivity").concat(".h5");
-  std::string csv;
-  {
-    CsvFormat f(*s.model, s.sweep);
-    csv = f.header();
-    Hdf5Writer h5(path.string(), *s.model, s.sweep);
-    Workspace ws(*s.model);
-    ASSERT_EQ(run_sweep(
-                  *s.model, s.sweep, ws,
-                  [&](const StepView& v) {
-                    f.append_row(v, csv);
-                    h5.append_row(v);
-                    return true;
-                  },
-                  nullptr),
-              SolveStatus::kSuccess);
-    h5.close();
-  }
+  const std::string csv = test::write_efforts_files(s, path.string());
   const CsvTable a = read_hdf5_table(path.string()), b = parse_csv_table(csv, "r.csv");
   EXPECT_EQ(a.columns, b.columns);
   ASSERT_EQ(a.rows.size(), 41u);
   EXPECT_EQ(a.rows.back().back(), b.rows.back().back());
-  const detail::h5::QuietErrors quiet;
-  {
-    const detail::h5::Hid file =
-        detail::h5::checked(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, path.string());
-    const detail::h5::Hid d = detail::h5::checked(H5Dopen2(file.get(), "efforts", H5P_DEFAULT), H5Dclose, "efforts");
-    EXPECT_EQ(detail::h5::read_strings_attribute(d.get(), "columns", "efforts"),
-              (std::vector<std::string>{"motor.effort", "motor.power", "motor.effort.d_L", "motor.effort.d_mb",
-                                        "motor.effort.d_w", "motor.power.d_L", "motor.power.d_mb", "motor.power.d_w"}));
-    EXPECT_EQ(detail::h5::read_strings_attribute(d.get(), "units", "efforts"),
-              (std::vector<std::string>{"N m", "W", "N m/L", "N m/mb", "N m/w", "W/L", "W/mb", "W/w"}));
-  }
+  EXPECT_EQ(test::hdf5_strings(path.string(), "efforts", "columns"),
+            (std::vector<std::string>{"motor.effort", "motor.power", "motor.effort.d_L", "motor.effort.d_mb",
+                                      "motor.effort.d_w", "motor.power.d_L", "motor.power.d_mb", "motor.power.d_w"}));
+  EXPECT_EQ(test::hdf5_strings(path.string(), "efforts", "units"),
+            (std::vector<std::string>{"N m", "W", "N m/L", "N m/mb", "N m/w", "W/L", "W/mb", "W/w"}));
   std::filesystem::remove(path);
 }
 

@@ -71,6 +71,21 @@ inline std::string scene_error(const std::string& text, const std::string& file 
 
 #define EXPECT_HAS(msg, part) EXPECT_NE((msg).find(part), std::string::npos) << (msg)
 
+// The phiq::Error a sweep of `model` under `opt` throws, from the model's initial positions (a failure, and "", if
+// it throws none).
+inline std::string sweep_error(const Model& model, const SweepOptions& opt) {
+  Workspace ws(model);
+  ws.q = model.initial_positions();
+  try {
+    run_sweep(
+        model, opt, ws, [](const StepView&) { return true; }, nullptr);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "the sweep threw no error";
+  return "";
+}
+
 // The same doubles bit for bit (a NaN equal to itself: what "the same results" means across runs and threads).
 inline bool same_bits(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return a.size() == b.size() &&
