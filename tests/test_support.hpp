@@ -77,7 +77,7 @@ inline std::string sweep_error(const Model& model, const SweepOptions& opt) {
   Workspace ws(model);
   ws.q = model.initial_positions();
   try {
-    run_sweep(
+    (void)run_sweep(
         model, opt, ws, [](const StepView&) { return true; }, nullptr);
   } catch (const Error& e) {
     return e.what();

@@ -18,6 +18,19 @@
 
 namespace phiq::detail::scene {
 
+// The named points, read before their table is freed (the natural joints are found with the model).
+void SceneReader::keep_natural_points() {
+  if (!pending_.natural_points.empty()) return;
+  if (spatial_)
+    for (Index k = 0; k < names_.points3.size(); ++k)
+      pending_.natural_points.emplace_back(names_.points3.name(k), Attachment3::natural(names_.points3[k]));
+  else
+    for (Index k = 0; k < names_.points.size(); ++k)
+      pending_.natural_points.emplace_back(
+          names_.points.name(k),
+          Attachment3::natural(Point3{names_.points[k].x, names_.points[k].y, Slot::constant(0)}));
+}
+
 void SceneReader::read_output_efforts(const Cursor& output) {
   const Cursor e = output.field("efforts");
   if (auto p = output.field("power"); p.present()) {
@@ -31,15 +44,7 @@ void SceneReader::read_output_efforts(const Cursor& output) {
   }
   if (const Cursor r = output.field("reactions"); r.present()) {
     pending_.reactions_field = r;
-    // the named points, read before their table is freed (the natural joints are found with the model)
-    if (spatial_)
-      for (Index k = 0; k < names_.points3.size(); ++k)
-        pending_.natural_points.emplace_back(names_.points3.name(k), Attachment3::natural(names_.points3[k]));
-    else
-      for (Index k = 0; k < names_.points.size(); ++k)
-        pending_.natural_points.emplace_back(
-            names_.points.name(k),
-            Attachment3::natural(Point3{names_.points[k].x, names_.points[k].y, Slot::constant(0)}));
+    keep_natural_points();
     if (r.is_scalar()) {
       if (r.text() != "all") r.fail("expected `all` or a list of joints");
     } else {
@@ -85,6 +90,9 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
   resolve_output_reactions(scene);
+  if (pending_.natural_bearings && !out.natural)  // (the natural joints a bearing may name, with no reaction listed)
+    out.natural = std::make_shared<NaturalJoints>(
+        find_natural_joints(scene.parts, scene.loads, pending_.natural_points, model.num_coordinates(), spatial_));
   if (!out.reactions.empty() && spatial_) {  // gears on shafts: their bearings carry the teeth's push
     for (std::size_t c = 0; c < model.constraints().size(); ++c) {
       const auto [block, index] = model.constraint_block(static_cast<Index>(c));

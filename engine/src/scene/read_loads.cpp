@@ -244,11 +244,14 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
       b.fail("a bearing names its `joint` (a pin, revolute, cylindrical or prismatic joint)");
     f.joint = on.present() ? on.name() : joint.name();
     const std::string_view kind = r_.builder_.constraint_kind(f.joint);
-    if (!FrictionLosses::carries(kind))
+    // or a named point of the plane, where bodies' frames of points may meet (found with the model)
+    const bool point = kind.empty() && !r_.spatial_ && r_.names_.points.contains(f.joint);
+    if (point) r_.keep_natural_points(), r_.pending_.natural_bearings = true;
+    if (!point && !FrictionLosses::carries(kind))
       (on.present() ? on : b)
           .fail((kind.empty() ? "unknown joint '" + f.joint + "'" : "'" + f.joint + "' is a " + std::string(kind)) +
                 ": a bearing is a pin, revolute, cylindrical or prismatic joint of 'constraints' (whose reaction "
-                "loads it)");
+                "loads it), or a point two parts' frames share");
     f.coefficient = non_negative(b.require("coefficient"));
     // a slide (a prismatic pair, a cylindrical one along its travel) has no radius: its friction is a force
     const auto radius = b.field("radius");

@@ -196,6 +196,7 @@ class SceneReader {
   void output_joints(const Cursor& js, OutputPlan& plan) const;
   void output_orientations(const Cursor& os, OutputPlan& plan) const;
   void resolve_output_residuals(Scene& scene) const;
+  void keep_natural_points();  // pending_.natural_points from the named points, once (read_efforts.cpp)
   void read_output_efforts(const Cursor& output);                                  // read_efforts.cpp
   void resolve_output_efforts(Scene& scene) const;                                 // read_efforts.cpp
   void resolve_output_reactions(Scene& scene) const;                               // read_efforts.cpp
@@ -250,6 +251,7 @@ class SceneReader {
     // with `reactions`: the named natural points, kept past the tables' release for the natural joints
     std::vector<std::pair<std::string, Attachment3>> natural_points;
     std::vector<Cursor> reaction_items;
+    bool natural_bearings = false;       // a bearing names a point (natural_points kept for its joint)
     std::optional<Cursor> losses_field;  // `output: losses` (its items when it lists names)
     std::vector<Cursor> loss_items;
     std::vector<std::pair<std::size_t, Cursor>> limit_efforts;  // `limits`' efforts: the limit, its driver's name

@@ -251,12 +251,11 @@ SolveStatus solve_effort_sensitivities(const Model& model, const OutputEfforts& 
   // the losses that read the multipliers, solved with them as a sweep solves them (row_efforts.cpp)
   std::optional<detail::FrictionLosses> losses;
   if (detail::FrictionLosses::any(efforts.loads->applied.get())) {
-    losses.emplace(model, *efforts.loads->applied);
+    losses.emplace(model, *efforts.loads->applied, &efforts);
     for (const OutputSensitivity& p : with_reach)
-      if (const std::string who = losses->reach_not_followed(model, p.reach->rows); !who.empty())
-        throw Error("solve_effort_sensitivities: the sensitivity to '" + p.name + "' with " + who +
-                    ": it changes its joint or ratio, which the losses' derivative does not follow");
-    if (!losses->solve(model, *ws.lu, ws.q.data(), ws.qd.data(), t, Q, lambda, kept)) {
+      if (const std::string why = losses->sensitivity_refusal(model, p); !why.empty())
+        throw Error("solve_effort_sensitivities: " + why);
+    if (!losses->solve(model, *ws.lu, ws.q.data(), ws.qd.data(), ws.qdd.data(), t, Q, lambda, kept)) {
       if (message) *message = losses->failed_solve() ? ws.lu->last_message() : losses->lock_message();
       return losses->failed_solve() ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
     }

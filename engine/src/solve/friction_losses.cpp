@@ -11,6 +11,7 @@
 #include "phiq/kinds/reaction_site.hpp"
 #include "phiq/kinds/spatial_gear.hpp"
 #include "phiq/model.hpp"
+#include "phiq/natural_joints.hpp"
 #include "phiq/part_motion.hpp"
 #include "phiq/text.hpp"
 #include "solve/models_along.hpp"  // kShift
@@ -38,6 +39,33 @@ std::string not_a_worm(const SpatialMesh& g, const Eigen::VectorXd& q) {
   const double gap = std::abs(kin3::dot(a2 - a1, kin3::cross(z1, z2)));  // (|z1 × z2| = 1)
   if (!(gap > 1e-6 * (g.r1 + g.r2))) return "its axes meet (a bevel pair: give its efficiencies)";
   return {};
+}
+
+}  // namespace
+
+namespace {
+
+// The natural joint bearing spring `s` names (a point two bodies' frames share, efforts->natural's), else −1 (a
+// constraint, or nothing: check() says which). Throws phiq::Error for one in space (a point has no axis to split
+// its load along) or whose angle reads the points (its moment would not say which bodies it turns).
+int natural_bearing(const Model& model, const TorsionalSpring& s, const OutputEfforts* efforts) {
+  if (model.find_constraint(s.bearing->joint) >= 0 || !efforts || !efforts->natural) return -1;
+  const NaturalJoints& natural = *efforts->natural;
+  const auto it = std::find_if(natural.joints.begin(), natural.joints.end(),
+                               [&](const NaturalJoint& j) { return j.name == s.bearing->joint; });
+  if (it == natural.joints.end()) return -1;
+  const std::string who = "torsional spring '" + s.name + "': bearing at natural point '" + s.bearing->joint + "'";
+  if (natural.spatial)
+    throw Error(who + ": a point carries no axis in space to split its load along (join the bodies by a revolute)");
+  for (const NaturalBody& b : natural.bodies)
+    for (const Attachment3& p : b.points)
+      for (const Index c : torsional_coordinates(s))
+        for (const Slot& r : p.r)
+          if (r.is_coordinate() && r.coord() == c)
+            throw Error(who +
+                        ": its angle reads the points, so its moment does not say which bodies it turns (give "
+                        "the angle coordinates, as segment_angle constraints do)");
+  return static_cast<int>(it - natural.joints.begin());
 }
 
 }  // namespace
@@ -114,17 +142,30 @@ void FrictionLosses::check_model(const Model& model, const std::string& who, boo
   }
 }
 
-FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
+bool FrictionLosses::at_points(const Model& model, const AppliedLoads* loads) {
+  return loads &&
+         std::any_of(loads->torsional_springs.begin(), loads->torsional_springs.end(), [&](const TorsionalSpring& s) {
+           return s.bearing && model.find_constraint(s.bearing->joint) < 0;
+         });
+}
+
+FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads, const OutputEfforts* efforts) {
   auto up = std::make_shared<SetUp>();
   OutputEfforts joints;
   joints.reactions_in_joint_axes = true;  // (a spatial joint's z is its axis: F_a its z, F_r across)
   std::size_t at = 0;
   for (const TorsionalSpring& s : loads.torsional_springs) {
     if (!s.bearing) continue;
+    if (const int j = natural_bearing(model, s, efforts); j >= 0) {  // a point two bodies share (planar)
+      joints.reactions.push_back({-1, false, j});
+      up->bearings.push_back({&s, -1, s.bearing->joint, at, false});
+      at += 3, natural_ = true;
+      continue;
+    }
     const Index c = check(model, s);
     const bool spatial = reaction_width(model, c) == 6;
     joints.reactions.push_back({c, spatial});
-    up->bearings.push_back({&s, c, at, spatial});
+    up->bearings.push_back({&s, c, {}, at, spatial});
     at += spatial ? 6 : 3;
   }
   for (const GearLoss& l : loads.gear_losses) {
@@ -171,12 +212,13 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads) {
               up->bearings.empty() ? "gear loss of '" + up->meshes[0].loss->gear + "'"
                                    : "torsional spring '" + up->bearings[0].spring->name + "'",
               !up->bearings.empty());
+  if (natural_) joints.parts = efforts->parts, joints.loads = efforts->loads, joints.natural = efforts->natural;
   if (!up->bearings.empty()) reactions_.emplace(model, joints);
   set_ = std::move(up);
   size_scratch();
 }
 
-FrictionLosses::FrictionLosses(const FrictionLosses& other, SetUpOnly) : set_(other.set_) {
+FrictionLosses::FrictionLosses(const FrictionLosses& other, SetUpOnly) : set_(other.set_), natural_(other.natural_) {
   if (other.reactions_) reactions_.emplace(JointReactions::with_set_up_of(*other.reactions_));
   size_scratch();
 }
@@ -190,7 +232,10 @@ void FrictionLosses::size_scratch() {
 }
 
 void FrictionLosses::moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m) {
-  if (reactions_) reactions_->evaluate_kept(q, t, lambda, values_.data());
+  if (natural_)  // (a natural point's reaction reads its bodies' motion: evaluated whole)
+    reactions_->evaluate(q, qd_, qdd_, t, lambda, values_.data());
+  else if (reactions_)
+    reactions_->evaluate_kept(q, t, lambda, values_.data());
   for (std::size_t i = 0; i < set_->bearings.size(); ++i) {
     const BearingFriction& b = *set_->bearings[i].spring->bearing;
     const double* f = values_.data() + set_->bearings[i].at;
@@ -208,9 +253,12 @@ void FrictionLosses::moments_at(const double* q, double t, const Eigen::VectorXd
   }
 }
 
-bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd, double t,
-                           Eigen::VectorXd& Q, Eigen::VectorXd& lambda, Eigen::VectorXd& kept) {
+bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd,
+                           const double* qdd, double t, Eigen::VectorXd& Q, Eigen::VectorXd& lambda,
+                           Eigen::VectorXd& kept) {
   solves_ = 0, passes_ = 0, failed_solve_ = false, worst_change_ = 0.0, ratio_ = 0.0;
+  qd_ = qd, qdd_ = qdd;
+  if (natural_ && (!qd || !qdd)) throw Error("FrictionLosses: a natural point's bearing reads q̇ and q̈ (phiq bug)");
   for (std::size_t i = 0; i < set_->bearings.size(); ++i)
     rates_[i] = angle_rate(*set_->bearings[i].spring, q, qd, t, gradients_[i]);
   auto rate = [&](const Slot& s) { return s.is_coordinate() && qd ? qd[s.coord()] : 0.0; };
@@ -218,7 +266,7 @@ bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double
     for (int i = 0; i < 2; ++i)
       mesh_states_[j].rate[i] = rate(set_->meshes[j].member[i]) - rate(set_->meshes[j].carrier);
   lambda0_ = lambda;
-  if (reactions_) reactions_->keep_geometry(q, t);  // (the passes' reactions differ in λ alone)
+  if (reactions_ && !natural_) reactions_->keep_geometry(q, t);  // (the passes' reactions differ in λ alone)
   moments_at(q, t, lambda, moments_);
   q_f_.resize(Q.size());
   double first_change = 0.0;
@@ -373,12 +421,28 @@ void FrictionLosses::force_rate(const double* q, double t, const Eigen::VectorXd
   out += ((forces_[0] - forces_[3]) + 8.0 * (forces_[2] - forces_[1])) / (12.0 * h);
 }
 
+std::string FrictionLosses::sensitivity_refusal(const Model& model, const OutputSensitivity& p) const {
+  const std::string with = "the efforts' sensitivities to '" + p.name + "' with ";
+  for (const Bearing& b : set_->bearings)
+    if (b.constraint < 0)
+      return with + "the bearing at natural point '" + b.point +
+             "': its reaction is its bodies' balance, not kept per multiplier as the losses' derivative reads it "
+             "(ask them without the bearing, or join the bodies by a revolute)";
+  if (!p.reach) return {};
+  const std::string who = reach_not_followed(model, p.reach->rows);
+  return who.empty() ? who
+                     : with + who + ": '" + p.name +
+                           "' changes its joint or ratio, which the losses' derivative does not follow (ask them "
+                           "without it)";
+}
+
 std::string FrictionLosses::reach_not_followed(const Model& model, const std::vector<Index>& reached) const {
   auto touched = [&](Index first, Index rows) {
     const auto it = std::lower_bound(reached.begin(), reached.end(), first);
     return it != reached.end() && *it < first + rows;
   };
   for (const Bearing& b : set_->bearings) {
+    if (b.constraint < 0) return "the bearing at natural point '" + b.point + "'";
     const ConstraintInfo& c = model.constraints()[static_cast<std::size_t>(b.constraint)];
     const std::string_view kind = c.kind;
     const bool planar_journal = !b.spatial && !b.spring->bearing->slide && (kind == "pin" || kind == "revolute");

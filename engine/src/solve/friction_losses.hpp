@@ -10,7 +10,10 @@
 // μ r / (the mechanism's lever arms), or 1 − η: a few passes for real bearings and gears. Where it does not settle,
 // the loss feeds its own load faster than it gives it: the mechanism jams (self-locking), told at the row rather than
 // written as a number. A bearing's direction is θ̇'s, fixed at the row; a mesh's driven member is the one its
-// multiplier does positive work on (relative to the carrier), found at each pass. Not with redundant rows (the
+// multiplier does positive work on (relative to the carrier), found at each pass. A bearing at a natural point (a
+// planar point two bodies' frames share) reads the point's reaction, their balance there (phiq/natural_joints.hpp),
+// evaluated whole at each pass; its angle must be of coordinates (segment angles), whose multipliers carry its
+// moment to its bodies, not of the points. Not with redundant rows (the
 // reactions and the meshes' shares are not unique); bearings not with gear meshes (their teeth's push on a bearing
 // is not in its joint's multipliers: OutputEfforts::meshes).
 #pragma once
@@ -44,7 +47,12 @@ class FrictionLosses {
  public:
   // The bearings of `loads`' torsional springs and its gear losses. Throws phiq::Error naming one whose joint or
   // transmission is unknown or cannot carry it (carries(), transmits()), or a model they cannot be solved in (above).
-  FrictionLosses(const Model& model, const AppliedLoads& loads);
+  // `efforts`, when given, holds the natural joints a bearing may name (a point two bodies' frames share, planar: its
+  // reaction is their balance at the point, phiq/natural_joints.hpp) with the parts and loads that balance reads.
+  FrictionLosses(const Model& model, const AppliedLoads& loads, const OutputEfforts* efforts = nullptr);
+  // Whether a bearing of `loads` names no constraint of `model` (a natural point: its reaction reads Q in the frames'
+  // motion's form, which a sweep's Q must then take).
+  static bool at_points(const Model& model, const AppliedLoads* loads);
   // The losses `other` solves, its set-up (the bearings, the meshes, the bearings' joints) shared rather than found
   // again in the model, with scratch of its own: a sweep's chunks each solve on their own thread. Safe while `other`
   // solves on another thread (its set-up is not written after construction).
@@ -66,8 +74,9 @@ class FrictionLosses {
   // At (q, q̇, t) with the row's factors: `lambda` in, the multipliers of `Q` (the parts' and loads'); out, those
   // with the losses, which are added to Q. False where a solve fails (failed_solve()) or the moments do not settle
   // in kMaxPasses (lock_message()); λ and Q then hold the last pass's.
-  bool solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd, double t, Eigen::VectorXd& Q,
-             Eigen::VectorXd& lambda, Eigen::VectorXd& kept);
+  // q̈ is read by a natural point's bearing only (its bodies' inertia), and may be null without one.
+  bool solve(const Model& model, SparseLuNumeric& lu, const double* q, const double* qd, const double* qdd, double t,
+             Eigen::VectorXd& Q, Eigen::VectorXd& lambda, Eigen::VectorXd& kept);
   // Loss i's values at the last solve() that settled, i in the scene's order (the torsional springs with a bearing,
   // then the gear losses: OutputLoss::index): the moment (a slide's force, a mesh's effort on its driven member) it
   // exerted against the motion, and the power it dissipated; both ≥ 0, zero at rest.
@@ -85,9 +94,13 @@ class FrictionLosses {
   void force_rate(const double* q, double t, const Eigen::VectorXd& lambda, const Eigen::VectorXd& v, double e,
                   const std::array<const AppliedLoads*, 4>& along, const std::array<Eigen::VectorXd, 4>* moved,
                   double h, Eigen::VectorXd& out);
-  // Whether parameter rows `reached` (ParameterReach::rows) change a loss's constraint in a way force_rate() does not
-  // follow (a spatial joint's axes, a slide's direction or point, a mesh's ratio): its name, else empty. A planar
-  // pin's or revolute's journal reads the multipliers alone.
+  // Why the efforts' sensitivities to `p` (its reach known) are refused with these losses, else empty: p changes a
+  // loss's constraint in a way force_rate() does not follow (a spatial joint's axes, a slide's direction or point, a
+  // mesh's ratio; a planar pin's or revolute's journal reads the multipliers alone), or a bearing is a natural
+  // point's (its reaction is not kept per unit multiplier, which adjoint() reads).
+  std::string sensitivity_refusal(const Model& model, const OutputSensitivity& p) const;
+  // The loss whose constraint parameter rows `reached` (ParameterReach::rows) change where force_rate() does not
+  // follow it, else empty (sensitivity_refusal()).
   std::string reach_not_followed(const Model& model, const std::vector<Index>& reached) const;
   int solves() const { return solves_; }               // transposed solves of the last solve()
   bool failed_solve() const { return failed_solve_; }  // the last solve() failed in a linear solve
@@ -98,8 +111,9 @@ class FrictionLosses {
  private:
   struct Bearing {
     const TorsionalSpring* spring = nullptr;
-    Index constraint = 0;  // its joint's
-    std::size_t at = 0;    // its reaction's first value in the reactions' row
+    Index constraint = 0;  // its joint's (−1: a natural point, `point` its name)
+    std::string point;
+    std::size_t at = 0;  // its reaction's first value in the reactions' row
     bool spatial = false;
   };
   // A mesh: its row θ1 + k θ2 − (1 + k) θc − φ (the last of its constraint's), the loss 1 − η
@@ -135,7 +149,9 @@ class FrictionLosses {
                      Eigen::VectorXd& out);
 
   std::shared_ptr<const SetUp> set_;
-  std::optional<JointReactions> reactions_;  // the bearings' joints (none without bearings)
+  std::optional<JointReactions> reactions_;      // the bearings' joints (none without bearings)
+  bool natural_ = false;                         // a bearing at a natural point: reactions_ evaluated whole, each pass
+  const double *qd_ = nullptr, *qdd_ = nullptr;  // solve()'s, which a natural point's reaction reads
   std::vector<MeshState> mesh_states_;
   std::vector<double> values_, moments_, next_, rates_;
   std::vector<std::vector<double>> gradients_;

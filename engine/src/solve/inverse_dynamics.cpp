@@ -361,7 +361,8 @@ SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, c
     detail::FrictionLosses losses(model, *loads.applied);
     Eigen::VectorXd kept;
     const double* qd = ws.qd.size() == model.num_coordinates() ? ws.qd.data() : nullptr;  // (none: at rest)
-    if (!losses.solve(model, *ws.lu, ws.q.data(), qd, t, Q, lambda, kept)) {
+    const double* qdd = ws.qdd.size() == model.num_coordinates() ? ws.qdd.data() : nullptr;
+    if (!losses.solve(model, *ws.lu, ws.q.data(), qd, qdd, t, Q, lambda, kept)) {
       if (message) *message = losses.failed_solve() ? ws.lu->last_message() : losses.lock_message();
       return losses.failed_solve() ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
     }

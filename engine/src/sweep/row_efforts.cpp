@@ -53,8 +53,8 @@ bool Sweeper::row_efforts() {
   }
   if (effort_work_.losses) {  // the bearings' friction and the gears' losses, from the multipliers they change
     FrictionLosses& losses = *effort_work_.losses;
-    const bool settled = losses.solve(model_, *w->lu, current_.q.data(), current_.qd.data(), t, effort_work_.q,
-                                      effort_work_.lambda, effort_work_.kept);
+    const bool settled = losses.solve(model_, *w->lu, current_.q.data(), current_.qd.data(), current_.qdd.data(), t,
+                                      effort_work_.q, effort_work_.lambda, effort_work_.kept);
     ws_->counters.effort_solves += losses.solves();
     if (!settled) {
       if (!losses.failed_solve()) sum_.warnings.push_back({t, "friction_lock", losses.lock_message()});

@@ -26,15 +26,11 @@ Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSumm
     if (same_sweep(like) && like->effort_work_.losses)  // (its set-up, as the reactions' and Q's parts are shared)
       effort_work_.losses.emplace(FrictionLosses::with_set_up_of(*like->effort_work_.losses));
     else
-      effort_work_.losses.emplace(model_, *opt_.efforts.loads->applied);
+      effort_work_.losses.emplace(model_, *opt_.efforts.loads->applied, &opt_.efforts);
     // the efforts' ∂τ/∂p follow the losses' data and the motion, not a loss's own geometry along p
     if (!opt_.efforts.constraints.empty())
       for (const OutputSensitivity& p : opt_.sensitivities)
-        if (const std::string who = p.reach ? effort_work_.losses->reach_not_followed(model_, p.reach->rows) : "";
-            !who.empty())
-          throw Error("the efforts' sensitivities to '" + p.name + "' with " + who + ": '" + p.name +
-                      "' changes its joint or ratio, which the losses' derivative does not follow (ask them without " +
-                      "it)");
+        if (const std::string why = effort_work_.losses->sensitivity_refusal(model_, p); !why.empty()) throw Error(why);
   }
   // what Q's planar parts add, kept for the natural joints' reactions to read (row_reactions())
   if (effort_work_.reactions && opt_.efforts.natural && opt_.efforts.parts)

@@ -355,7 +355,12 @@ class Sweeper {
   bool same_sweep(const Sweeper* like) const;
   // Whether Q takes rigid bars' constant mass matrices (solve/part_forces.hpp): unless ∂τ/∂p is asked, whose formula
   // holds with the frames' motion's Q alone. Q and the reactions read it alike.
-  bool rigid_bars() const { return opt_.sensitivities.empty(); }
+  // (not with a natural point's bearing either: its reaction, solved with λ in passes, reads Q in the frames'
+  // motion's form, FrictionLosses::at_points())
+  bool rigid_bars() const {
+    return opt_.sensitivities.empty() &&
+           !FrictionLosses::at_points(model_, opt_.efforts.loads ? opt_.efforts.loads->applied.get() : nullptr);
+  }
   // The reactions of the row (after the efforts) from effort_work_.lambda: minimum-norm multipliers first where rows
   // were dropped, and at the sweep's first row a warning naming the joints whose share that makes up.
   void row_reactions(SparseLuNumeric& lu);

@@ -1,0 +1,97 @@
+// A bearing at a natural point (BearingFriction on a point two bodies' frames share, solve/friction_losses.hpp): the
+// natural four-bar, its links' angles coordinates of segment_angle constraints, with a journal at each of O, A, B, C
+// needs the motor torque and carries the pin loads of the reference-point four-bar with the same journals on its
+// revolutes, at every row; what cannot be split is refused in one line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "phiq/phiq.hpp"
+#include "reaction_rows.hpp"
+#include "test_support.hpp"
+
+namespace phiq {
+namespace {
+
+constexpr const char* kNaturalBearingsParts =
+    "  crank: {%sframe: {origin: O, x: A}, mass: 1.0, center_of_mass: [0.2, 0], inertia: 0.013333333333333334}\n"
+    "  coupler: {frame: {origin: A, x: B}, mass: 2.0, center_of_mass: [0.6, 0], inertia: 0.24}\n"
+    "  rocker: {frame: {origin: C, x: B}, mass: 1.5, center_of_mass: [0.5, 0], inertia: 0.125}\n";
+
+// Each link's bearing (μ 0.2, r 0.05) on the relative turn `turn[k]` of pin k (O, A, B, C).
+std::string natural_bearings_loads(const char* const (&turn)[4]) {
+  std::string s = "loads:\n  gravity: [0, -9.81]\n  torsional_springs:\n";
+  const char* pins[4] = {"O", "A", "B", "C"};
+  for (int k = 0; k < 4; ++k)
+    s += std::string("    - {name: f") + pins[k] + ", angle: \"" + turn[k] + "\", bearing: {joint: " + pins[k] +
+         ", coefficient: 0.2, radius: 0.05}}\n";
+  return s + "time: {start: 0, end: 2*pi, steps: 48}\n" +
+         "output: {velocities: true, accelerations: true, efforts: [motor], reactions: [O, A, B, C], losses: all}\n";
+}
+
+// seed/fourbar_natural.yaml with the coupler's and rocker's angles θ3, θ4 (segment_angle constraints), massive links
+// and a bearing at each point; `angle_of_a` replaces the turn at A (θ3 − θ2).
+std::string natural_four_bar_with_bearings(const std::string& angle_of_a = "theta3 - theta2") {
+  std::string text = test::model_file_text("seed/fourbar_natural.yaml", "time:");
+  text = test::replace_first(text, "  theta2: 0.0\n", "  theta2: 0.0\n  theta3: 1.0\n  theta4: 1.5\n");
+  text = test::replace_first(text, "drivers:",
+                             "  - {name: coupler_angle, type: segment_angle, segment: [A, B], angle: theta3}\n"
+                             "  - {name: rocker_angle, type: segment_angle, segment: [C, B], angle: theta4}\n"
+                             "drivers:");
+  const char* const turn[4] = {"theta2", angle_of_a.c_str(), "theta4 - theta3", "theta4"};
+  std::string parts = kNaturalBearingsParts;
+  parts.replace(parts.find("%s"), 2, "");
+  return text + "parts:\n" + parts + natural_bearings_loads(turn);
+}
+
+TEST(NaturalBearings, TheNaturalFourBarsJournalsAreTheReferencePointForms) {
+  const Scene natural = parse_scene(natural_four_bar_with_bearings(), "natural.yaml");
+  std::string text = test::model_file_text("seed/fourbar_reference_point.yaml", "time:");
+  const char* const turn[4] = {"psi2", "psi3 - psi2", "psi4 - psi3", "psi4"};
+  text +=
+      "parts:\n"
+      "  crank: {mass: 1.0, center_of_mass: [0, 0], inertia: 0.013333333333333334}\n"
+      "  coupler: {mass: 2.0, center_of_mass: [0, 0], inertia: 0.24}\n"
+      "  rocker: {mass: 1.5, center_of_mass: [0, 0], inertia: 0.125}\n" +
+      natural_bearings_loads(turn);
+  const Scene reference = parse_scene(text, "reference.yaml");
+  SweepSummary sum;
+  const test::ReactionRows a = test::sweep_reactions(natural, &sum), b = test::sweep_reactions(reference);
+  ASSERT_EQ(a.values.size(), 49u);
+  ASSERT_EQ(b.values.size(), 49u);
+  EXPECT_GT(sum.counters.effort_solves, 3u * 49u);  // the moments are solved for, in passes
+  double largest_friction = 0.0;
+  for (std::size_t k = 0; k < a.values.size(); ++k) {
+    const std::vector<double>&u = a.values[k], &v = b.values[k];
+    ASSERT_EQ(u.size(), v.size());
+    EXPECT_NEAR(u[0], v[0], 1e-8 * (1 + std::fabs(v[0]))) << "motor torque, row " << k;
+    for (std::size_t j = 0; j < 4; ++j)
+      for (std::size_t c = 0; c < 2; ++c)
+        EXPECT_NEAR(u[2 + 3 * j + c], v[2 + 3 * j + c], 1e-8 * (1 + std::fabs(v[2 + 3 * j + c])))
+            << "pin " << j << ", row " << k;
+    for (std::size_t j = 0; j < 8; ++j)  // each bearing's friction and power
+      EXPECT_NEAR(u[14 + j], v[14 + j], 1e-8 * (1 + std::fabs(v[14 + j]))) << "loss value " << j << ", row " << k;
+    largest_friction = std::max(largest_friction, u[14]);
+  }
+  EXPECT_GT(largest_friction, 0.2);  // N m at O: the journals are felt
+}
+
+TEST(NaturalBearings, WhatCannotBeSplitIsRefusedInOneLine) {
+  // a turn that reads the points: its moment does not say which bodies it turns
+  // (with the points' reactions listed, the scene's reader refuses it first: test_natural_reactions.cpp)
+  const Scene s = parse_scene(test::replace_first(natural_four_bar_with_bearings("atan2(yB - yA, xB - xA) - theta2"),
+                                                  "reactions: [O, A, B, C], ", ""),
+                              "natural.yaml");
+  EXPECT_HAS(test::sweep_error(*s.model, s.sweep),
+             "torsional spring 'fA': bearing at natural point 'A': its angle reads the points");
+  // efforts' sensitivities: a point's reaction is not kept per multiplier
+  Scene with = parse_scene(test::replace_first(natural_four_bar_with_bearings(), "efforts: [motor]",
+                                               "efforts: [motor], sensitivities: [L2]"),
+                           "natural.yaml");
+  EXPECT_HAS(test::sweep_error(*with.model, with.sweep),
+             "the efforts' sensitivities to 'L2' with the bearing at natural point 'O'");
+}
+
+}  // namespace
+}  // namespace phiq
