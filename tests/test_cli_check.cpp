@@ -94,6 +94,25 @@ TEST_F(Cli, CheckListsEachLoadAsWritten) {
     EXPECT_NE(r.out.find(line), std::string::npos) << line << r.out;
 }
 
+TEST_F(Cli, CheckListsWhatPressesEachBearing) {
+  // a pin's journal (models/dynamics/fourbar_pin_friction.yaml) and a cam follower's guide with a tilt arm
+  const Result pins = run("check " + phiq::test::model_path("dynamics/fourbar_pin_friction.yaml"));
+  ASSERT_EQ(pins.code, 0) << pins.err;
+  EXPECT_NE(pins.out.find("torsional spring 'O_bearing' on 'psi2': stiffness 0, free angle 0, damping 0, moment 0, "
+                          "bearing 'O' friction 0.15 x (0.01 m x |F_r|)\n"),
+            std::string::npos)
+      << pins.out;
+  const fs::path scene =
+      write("slide.yaml",
+            phiq::test::replace_first(phiq::test::model_file_text("cams/eccentric_roller.yaml", "output:"), "time:",
+                                      "parts: {rod: {mass: 1, center_of_mass: [0, 0], inertia: 1}}\n"
+                                      "loads: {torsional_springs: [{name: rub, coordinate: yf, bearing: {joint: guide, "
+                                      "coefficient: 0.3, moment_arm: 0.1}}]}\ntime:"));
+  const Result slide = run("check " + scene.string());
+  ASSERT_EQ(slide.code, 0) << slide.err;
+  EXPECT_NE(slide.out.find("bearing 'guide' friction 0.3 x (|F_r| + |M| / 0.1 m)\n"), std::string::npos) << slide.out;
+}
+
 TEST_F(Cli, CheckJsonIsOneVersionedObject) {
   Result r = run("check --json " + phiq::test::model_path("seed/fourbar_natural.yaml"));
   ASSERT_EQ(r.code, 0) << r.err;

@@ -37,6 +37,15 @@ std::string g6(double v) {
   return b;
 }
 
+// What presses a bearing (BearingFriction): a journal's r (|F_r| + |M_b| / a) + r_a |F_a|, a slide's |F_r| + |M| / a.
+std::string bearing_load_text(const phiq::BearingFriction& b) {
+  const std::string arm =
+      b.moment_arm > 0.0 ? " + |M" + std::string(b.slide ? "" : "_b") + "| / " + g6(b.moment_arm) + " m" : "";
+  if (b.slide) return "|F_r|" + arm;
+  return g6(b.radius) + " m x " + (arm.empty() ? "|F_r|" : "(|F_r|" + arm + ")") +
+         (b.thrust_radius != 0.0 ? " + " + g6(b.thrust_radius) + " m x |F_a|" : "");
+}
+
 const char* mass_source(const phiq::Part& p) {
   switch (p.mass_source) {
     case phiq::MassSource::kStated:
@@ -105,17 +114,14 @@ std::vector<std::string> load_lines(const phiq::AppliedLoads& a, int dimension) 
                   ", damping " + g6(s.damping) + dry(s.friction) + ", preload " + g6(s.preload) + ", tension " +
                   load_value_text(s.tension));
   for (const phiq::TorsionalSpring& s : a.torsional_springs)
-    out.push_back(
-        "torsional spring '" + s.name + "' on " +
-        (s.angle ? "'" + s.angle->text() + "'" : "joint '" + s.joint->name + "'") + ": stiffness " +
-        elastic(s.stiffness, s.law) + ", free angle " + g6(s.free_angle) + ", damping " + g6(s.damping) +
-        dry(s.friction) + (s.inertia != 0.0 ? ", inertia " + g6(s.inertia) : "") + ", moment " +
-        load_value_text(s.moment) +
-        (s.bearing
-             ? ", bearing '" + s.bearing->joint + "' friction " + g6(s.bearing->coefficient) + " x (" +
-                   g6(s.bearing->radius) + " m x |F_r|" +
-                   (s.bearing->thrust_radius != 0.0 ? " + " + g6(s.bearing->thrust_radius) + " m x |F_a|" : "") + ")"
-             : ""));
+    out.push_back("torsional spring '" + s.name + "' on " +
+                  (s.angle ? "'" + s.angle->text() + "'" : "joint '" + s.joint->name + "'") + ": stiffness " +
+                  elastic(s.stiffness, s.law) + ", free angle " + g6(s.free_angle) + ", damping " + g6(s.damping) +
+                  dry(s.friction) + (s.inertia != 0.0 ? ", inertia " + g6(s.inertia) : "") + ", moment " +
+                  load_value_text(s.moment) +
+                  (s.bearing ? ", bearing '" + s.bearing->joint + "' friction " + g6(s.bearing->coefficient) + " x (" +
+                                   bearing_load_text(*s.bearing) + ")"
+                             : ""));
   for (const phiq::GearLoss& l : a.gear_losses)
     out.push_back("gear loss of '" + l.gear + "': " +
                   (l.friction > 0.0
