@@ -94,6 +94,11 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
                                   const std::vector<std::pair<std::string, Attachment3>>& points, Index coordinates,
                                   bool spatial);
 
+/// Per coordinate of a model of `coordinates`, whether a body of `joints` holds it in a point: a torsional spring whose
+/// angle reads one pushes the points without saying which of their bodies it turns, which a point's reaction cannot
+/// hold (the file comment).
+std::vector<char> point_coordinates(const NaturalJoints& joints, Index coordinates);
+
 /// Where natural joint `j`'s reaction acts, and the axes it is written along where they are asked for
 /// (OutputEfforts::reactions_in_joint_axes): the joint's point, and the axes of the frame of the body it is reported
 /// on (its first; x toward the frame's x point: along a bar and across it). Only `point` and `axes` are set.

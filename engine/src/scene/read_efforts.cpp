@@ -249,11 +249,7 @@ void SceneReader::resolve_output_reactions(Scene& scene) const {
   const auto natural_listed =
       std::find_if(out.reactions.begin(), out.reactions.end(), [](const OutputReaction& r) { return r.natural >= 0; });
   if (natural_listed == out.reactions.end() || !scene.loads.applied) return;
-  std::vector<char> of_point(static_cast<std::size_t>(model.num_coordinates()), 0);
-  for (const NaturalBody& b : out.natural->bodies)
-    for (const Attachment3& p : b.points)
-      for (const Slot& r : p.r)
-        if (r.is_coordinate() && r.coord() < model.num_coordinates()) of_point[static_cast<std::size_t>(r.coord())] = 1;
+  const std::vector<char> of_point = point_coordinates(*out.natural, model.num_coordinates());
   for (const TorsionalSpring& ts : scene.loads.applied->torsional_springs)
     for (const Index c : torsional_coordinates(ts))
       if (of_point[static_cast<std::size_t>(c)])

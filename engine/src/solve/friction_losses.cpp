@@ -41,10 +41,6 @@ std::string not_a_worm(const SpatialMesh& g, const Eigen::VectorXd& q) {
   return {};
 }
 
-}  // namespace
-
-namespace {
-
 // The natural joint bearing spring `s` names (a point two bodies' frames share, efforts->natural's), else −1 (a
 // constraint, or nothing: check() says which). Throws phiq::Error for one in space (a point has no axis to split
 // its load along) or whose angle reads the points (its moment would not say which bodies it turns).
@@ -57,14 +53,12 @@ int natural_bearing(const Model& model, const TorsionalSpring& s, const OutputEf
   const std::string who = "torsional spring '" + s.name + "': bearing at natural point '" + s.bearing->joint + "'";
   if (natural.spatial)
     throw Error(who + ": a point carries no axis in space to split its load along (join the bodies by a revolute)");
-  for (const NaturalBody& b : natural.bodies)
-    for (const Attachment3& p : b.points)
-      for (const Index c : torsional_coordinates(s))
-        for (const Slot& r : p.r)
-          if (r.is_coordinate() && r.coord() == c)
-            throw Error(who +
-                        ": its angle reads the points, so its moment does not say which bodies it turns (give "
-                        "the angle coordinates, as segment_angle constraints do)");
+  const std::vector<char> of_point = point_coordinates(natural, model.num_coordinates());
+  for (const Index c : torsional_coordinates(s))
+    if (of_point[static_cast<std::size_t>(c)])
+      throw Error(who +
+                  ": its angle reads the points, so its moment does not say which bodies it turns (give the "
+                  "angle coordinates, as segment_angle constraints do)");
   return static_cast<int>(it - natural.joints.begin());
 }
 

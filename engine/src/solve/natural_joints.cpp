@@ -9,8 +9,8 @@
 #include <functional>
 #include <limits>
 #include <string_view>
-#include <type_traits>
 #include <optional>
+#include <type_traits>
 #include <unordered_map>
 
 #include "phiq/constraint_block.hpp"
@@ -169,6 +169,15 @@ NaturalJoints find_natural_joints(const std::vector<Part>& parts, const Loads& l
     for (int k = 0; k < dimension; ++k) held = held || !point.r[k].is_coordinate();
     if (j.bodies.size() >= 2 || (j.bodies.size() == 1 && held)) out.joints.push_back(std::move(j));
   }
+  return out;
+}
+
+std::vector<char> point_coordinates(const NaturalJoints& joints, Index coordinates) {
+  std::vector<char> out(static_cast<std::size_t>(coordinates), 0);
+  for (const NaturalBody& b : joints.bodies)
+    for (const Attachment3& p : b.points)
+      for (const Slot& r : p.r)
+        if (r.is_coordinate() && r.coord() < coordinates) out[static_cast<std::size_t>(r.coord())] = 1;
   return out;
 }
 
