@@ -91,4 +91,22 @@ inline std::string worm_scene_text(int steps) {
                        "time: {start: 0, end: 1, steps: " + std::to_string(steps) + "}");
 }
 
+// A 2 kg block (a carriage) pushed along x at 0.5 m/s on a spatial prismatic slide, side 1 its origin (the
+// reaction's point: the carriage's bearing), its centre at (d, e, 0) (parameters), under gravity along −z, with a
+// slide bearing of μ (parameter mu = 0.2) and moment arm 0.15, and `output`.
+inline std::string spatial_slide_text(double d, double e, const std::string& output) {
+  return "phiq: 1\nname: block\ndimension: 3\nparameters: {d: " + std::to_string(d) + ", e: " + std::to_string(e) +
+         ", mu: 0.2}\n"
+         "coordinates: {x: 0.1, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\nbodies: {block: [x, y, z, e0, e1, e2, e3]}\n"
+         "constraints:\n  - {name: slide, type: prismatic, between: [{body: block, axis: [1, 0, 0]}, {body: ground, "
+         "axis: [1, 0, 0]}]}\n"
+         "drivers:\n  - {name: push, joint: slide, law: {type: linear, initial: -0.1, rate: -0.5}}\n"
+         "parts:\n  block: {mass: 2.0, center_of_mass: [d, e, 0], inertia: [0.01, 0.02, 0.03]}\n"
+         "loads:\n  gravity: [0, 0, -9.81]\n"
+         "  torsional_springs: [{name: guide, coordinate: x, bearing: {joint: slide, coefficient: mu, moment_arm: "
+         "0.15}}]\n"
+         "time: {start: 0, end: 1, steps: 10}\n" +
+         output;
+}
+
 }  // namespace phiq::test

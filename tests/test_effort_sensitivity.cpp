@@ -17,6 +17,7 @@
 #include "phiq/effort_sensitivity.hpp"
 #include "phiq/phiq.hpp"
 #include "fourbar_parts.hpp"
+#include "reaction_rows.hpp"
 #include "sensitivity_support.hpp"
 #include "test_support.hpp"
 
@@ -292,6 +293,9 @@ TEST(EffortSensitivity, BearingsAndGearLossesMatchResolvedSweeps) {
       "  torsional_springs: [{name: bearing, joint: hinge, bearing: {coefficient: mu, radius: 0.02, "
       "thrust_radius: 0.035, moment_arm: 0.04}}]\n"
       "time: {start: 0, end: 1.5, steps: 30}\noutput: {efforts: all, sensitivities: [w, e, mu]}\n");
+  // a spatial slide's whole moment over its arm (the centre's offsets and μ)
+  expect_effort_sensitivities_match_resolved_sweeps(
+      test::spatial_slide_text(0.3, 0.1, "output: {efforts: all, sensitivities: [d, e, mu]}\n"));
 }
 
 TEST(EffortSensitivity, AParameterOfALossesOwnJointIsRefusedByName) {

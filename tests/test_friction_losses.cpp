@@ -170,6 +170,24 @@ TEST(BearingFriction, ASlidesTiltPressesItAsItsMomentOverTheArm) {
   }
 }
 
+TEST(BearingFriction, ASpatialSlidesMomentPressesItOverTheArm) {
+  // the block's weight m g across the slide and its moment m g √(d² + e²) about the block's point, the reaction's
+  // (its centre off the point along and across the travel): the push is μ m g (1 + √(d² + e²) / a)
+  const double mu = 0.2, mass = 2.0, g = 9.81, d = 0.3, e = 0.1, a = 0.15;
+  const Scene s = parse_scene(test::spatial_slide_text(d, e,
+                                                       "output: {velocities: true, accelerations: true, "
+                                                       "efforts: [push], reactions: all, losses: all}\n"),
+                              "block.yaml");
+  const test::ReactionRows rows = test::sweep_reactions(s);
+  ASSERT_EQ(rows.q.size(), 11u);
+  const double expected = mu * mass * g * (1.0 + std::hypot(d, e) / a);
+  for (std::size_t k = 0; k < rows.q.size(); ++k) {
+    // (the joint's distance, ground's along the block's axis, falls as the block moves along x: the push is −effort)
+    EXPECT_NEAR(-rows.values[k][0], expected, 1e-10 * expected) << "row " << k;
+    EXPECT_NEAR(rows.values[k].at(8), expected, 1e-10 * expected) << "row " << k;  // the guide's rub, written
+  }
+}
+
 TEST(BearingFriction, ACamFollowersGuideRubsByMuTimesTheCamsSidePush) {
   // models/cams/eccentric_roller.yaml: the cam's push on the roller leans off the guide's axis; the guide takes the
   // lean across, and its friction μ |F_across| opposes the rod's travel, so the cam pushes harder

@@ -93,7 +93,9 @@ struct LinearSpring {
 /// joint's axis, F_a along it and M_b its moment across it (the bending a spatial journal carries; none in the plane),
 /// which presses the journal as the force |M_b| / a, a the bending arm (0: not counted); on a slide (`slide`: a
 /// prismatic pair, or a cylindrical one given no radius, θ its travel) the force μ (|F_r| + |M| / a) against θ̇, M the
-/// moment the slide carries (its tilt: Mz in the plane, every component in space). It depends on the multipliers it
+/// moment the slide carries (its tilt: Mz in the plane, every component in space). Moments are about the point the
+/// joint's reaction is written about (ReactionSite: a planar slide's slider point, a spatial joint's side-1 point, so
+/// that side 1 is the member that holds the bearing). It depends on the multipliers it
 /// changes, so the efforts solve for it (detail::FrictionLosses); add_applied_forces() and applied_power() leave it
 /// out.
 struct BearingFriction {
