@@ -1,7 +1,8 @@
 // A bearing at a natural point (BearingFriction on a point two bodies' frames share, solve/friction_losses.hpp): the
 // natural four-bar, its links' angles coordinates of segment_angle constraints, with a journal at each of O, A, B, C
 // needs the motor torque and carries the pin loads of the reference-point four-bar with the same journals on its
-// revolutes, at every row; what cannot be split is refused in one line.
+// revolutes, at every row, in a sweep and through the API's DriverEfforts; what cannot be split is refused in one
+// line.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -75,6 +76,31 @@ TEST(NaturalBearings, TheNaturalFourBarsJournalsAreTheReferencePointForms) {
     largest_friction = std::max(largest_friction, u[14]);
   }
   EXPECT_GT(largest_friction, 0.2);  // N m at O: the journals are felt
+}
+
+TEST(NaturalBearings, DriverEffortsGiveTheSweepsTorqueRowByRow) {
+  // the API's loop over rows (its losses set up once, the scene's natural joints given): the sweep's motor torque;
+  // without the natural joints the bearing names no joint it knows
+  const Scene s = parse_scene(natural_four_bar_with_bearings(), "natural.yaml");
+  const test::ReactionRows rows = test::sweep_reactions(s);
+  ASSERT_EQ(rows.q.size(), 49u);
+  DriverEfforts efforts(*s.model, s.parts, s.loads, s.sweep.efforts.natural);
+  Workspace ws(*s.model);
+  std::vector<double> e;
+  for (std::size_t k = 0; k < rows.q.size(); ++k) {
+    ws.q = rows.q[k], ws.qd = rows.qd[k], ws.qdd = rows.qdd[k];
+    std::string why;
+    ASSERT_EQ(efforts(s.sweep.time_of(static_cast<Index>(k)), ws, e, &why), SolveStatus::kSuccess) << why;
+    ASSERT_EQ(e.size(), 1u);
+    EXPECT_NEAR(e[0], rows.values[k][0], 1e-9 * (1 + std::fabs(rows.values[k][0]))) << "row " << k;
+  }
+  std::string why;
+  try {
+    (void)driver_efforts(*s.model, s.parts, s.loads, 0.0, ws, e, &why);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& error) {
+    EXPECT_HAS(std::string(error.what()), "bearing joint 'O' is not a constraint of the model");
+  }
 }
 
 TEST(NaturalBearings, WhatCannotBeSplitIsRefusedInOneLine) {

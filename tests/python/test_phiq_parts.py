@@ -266,3 +266,33 @@ def test_a_hoists_losses_are_written_and_stepped():
         assert stepper.step(result.t[k]).ok
     assert stepper.losses == {"first_stage": (col("first_stage.loss")[2],),
                               "second_stage": (col("second_stage.loss")[2],)}
+
+
+def test_driver_efforts_with_bearings_at_natural_points_are_the_sweeps():
+    # models/seed/fourbar_natural.yaml with the links' angles as coordinates (segment_angle), masses and a journal at
+    # each shared point: phiq.driver_efforts over the sweep's motion gives its motor torque, the bearings included
+    with open(os.path.join(MODELS, "seed", "fourbar_natural.yaml"), encoding="utf-8") as f:
+        text = f.read()
+    text = text[:text.index("time:")].replace("  theta2: 0.0\n", "  theta2: 0.0\n  theta3: 1.0\n  theta4: 1.5\n")
+    text = text.replace("drivers:", "  - {name: ca, type: segment_angle, segment: [A, B], angle: theta3}\n"
+                        "  - {name: ra, type: segment_angle, segment: [C, B], angle: theta4}\ndrivers:")
+    bar = "mass: {m}, center_of_mass: [{c}, 0], inertia: {i}"
+    text += ("parts:\n"
+             "  crank: {frame: {origin: O, x: A}, " + bar.format(m=1, c=0.2, i=0.0133) + "}\n"
+             "  coupler: {frame: {origin: A, x: B}, " + bar.format(m=2, c=0.6, i=0.24) + "}\n"
+             "  rocker: {frame: {origin: C, x: B}, " + bar.format(m=1.5, c=0.5, i=0.125) + "}\n"
+             "loads:\n  gravity: [0, -9.81]\n  torsional_springs:\n")
+    for name, angle in (("O", "theta2"), ("A", "theta3 - theta2"), ("B", "theta4 - theta3"), ("C", "theta4")):
+        text += f"    - {{name: f{name}, angle: {angle}, bearing: {{joint: {name}, coefficient: 0.2, radius: 0.05}}}}\n"
+    text += ("time: {start: 0, end: 2*pi, steps: 24}\n"
+             "output: {velocities: true, accelerations: true, efforts: all}\n")
+    scene = phiq.parse_scene(text, "natural.yaml")
+    result = phiq.run_sweep(scene).raise_for_status()
+    names, efforts = phiq.driver_efforts(scene, result)
+    assert names == ["motor"]
+    torque = result.table[:, result.columns.index("motor.effort")]
+    assert np.max(np.abs(efforts[:, 0] - torque)) < 1e-9 * (1 + np.max(np.abs(torque)))
+    # the journals are felt: the same motion without them needs another torque
+    plain = phiq.parse_scene(text.replace("coefficient: 0.2", "coefficient: 0"), "plain.yaml")
+    _, frictionless = phiq.driver_efforts(plain, result)
+    assert np.max(np.abs(frictionless[:, 0] - torque)) > 0.1

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,8 @@
 #include "phiq/workspace.hpp"
 
 namespace phiq {
+
+struct NaturalJoints;  // natural_joints.hpp
 
 /// Adds to `Q` (one entry per coordinate) the generalized forces of `loads` and of the parts' inertia at (q, q̇, q̈,
 /// t) (file comment). Parts without mass contribute nothing. Pre-condition: Q has a size the parts' coordinates fit.
@@ -64,5 +67,26 @@ bool has_effort(const ConstraintInfo& c);
 /// solved with it; kNotConverged, its message naming the bearing, where it does not settle (the mechanism jams).
 SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, const Loads& loads, double t,
                            Workspace& ws, std::vector<double>& efforts, std::string* message = nullptr);
+
+/// driver_efforts() at many motions of one model, its parts and loads (a loop over a sweep's rows: Python's
+/// phiq.driver_efforts): what the losses that read the multipliers need (their joints, their reactions' sites) is
+/// found once, at construction, rather than at every call. `natural`, when not null, holds the natural joints a
+/// bearing may name (a scene's OutputEfforts::natural, phiq/natural_joints.hpp). The model, parts and loads must
+/// outlive it; one per thread.
+class DriverEfforts {
+ public:
+  /// Throws phiq::Error where driver_efforts() would for a loss (its joint unknown, or not one to carry it).
+  DriverEfforts(const Model& model, const std::vector<Part>& parts, const Loads& loads,
+                std::shared_ptr<const NaturalJoints> natural = nullptr);
+  ~DriverEfforts();
+  DriverEfforts(const DriverEfforts&) = delete;
+  DriverEfforts& operator=(const DriverEfforts&) = delete;
+  /// As driver_efforts() at the motion in `ws` (q, q̇, q̈ at t).
+  SolveStatus operator()(double t, Workspace& ws, std::vector<double>& efforts, std::string* message = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace phiq

@@ -93,11 +93,12 @@ void bind_parts(py::module_& m) {
         {
           py::gil_scoped_release free;
           Workspace ws(model);
+          DriverEfforts efforts(model, s.parts, s.loads, s.sweep.efforts.natural);  // (its losses set up once)
           std::vector<double> e;
           for (Index k = 0; k < t.size(); ++k) {
             ws.q = q.row(k).transpose(), ws.qd = qd.row(k).transpose(), ws.qdd = qdd.row(k).transpose();
             std::string why;
-            if (driver_efforts(model, s.parts, s.loads, t(k), ws, e, &why) != SolveStatus::kSuccess)
+            if (efforts(t(k), ws, e, &why) != SolveStatus::kSuccess)
               throw Error("driver_efforts: at t = " + std::to_string(t(k)) + ": " + why);
             for (std::size_t j = 0; j < e.size(); ++j) out(k, static_cast<Index>(j)) = e[j];
           }

@@ -86,13 +86,14 @@ void SceneReader::read_output_efforts(const Cursor& output) {
 }
 
 void SceneReader::resolve_output_efforts(Scene& scene) const {
-  if (!pending_.efforts_field && !pending_.reactions_field && !pending_.losses_field) return;
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
-  resolve_output_reactions(scene);
-  if (pending_.natural_bearings && !out.natural)  // (the natural joints a bearing may name, with no reaction listed)
+  // the natural joints a bearing may name, whatever the output lists (driver_efforts() of the scene reads them too)
+  if (pending_.natural_bearings)
     out.natural = std::make_shared<NaturalJoints>(
         find_natural_joints(scene.parts, scene.loads, pending_.natural_points, model.num_coordinates(), spatial_));
+  if (!pending_.efforts_field && !pending_.reactions_field && !pending_.losses_field) return;
+  resolve_output_reactions(scene);
   if (!out.reactions.empty() && spatial_) {  // gears on shafts: their bearings carry the teeth's push
     for (std::size_t c = 0; c < model.constraints().size(); ++c) {
       const auto [block, index] = model.constraint_block(static_cast<Index>(c));
@@ -199,9 +200,12 @@ void SceneReader::resolve_output_reactions(Scene& scene) const {
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
   if (pending_.reactions_field) {
-    // natural coordinates' joints: named points that parts with frames of points share (phiq/natural_joints.hpp)
-    auto natural = std::make_shared<NaturalJoints>(
-        find_natural_joints(scene.parts, scene.loads, pending_.natural_points, model.num_coordinates(), spatial_));
+    // natural coordinates' joints: named points that parts with frames of points share (phiq/natural_joints.hpp),
+    // found already where a bearing names one
+    auto natural = out.natural
+                       ? out.natural
+                       : std::make_shared<NaturalJoints>(find_natural_joints(
+                             scene.parts, scene.loads, pending_.natural_points, model.num_coordinates(), spatial_));
     std::unordered_map<std::string_view, int> joint_index;  // (a list of 10⁴ names scanned 10⁴ joints for each)
     if (!pending_.reaction_items.empty())
       for (std::size_t j = 0; j < natural->joints.size(); ++j)

@@ -6,6 +6,7 @@
 #include <climits>
 #include <cstdint>
 #include <map>
+#include <optional>
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/constraint_block.hpp"
@@ -338,15 +339,39 @@ std::vector<Index> rheonomic_constraints(const Model& model) {
   return out;
 }
 
-SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, const Loads& loads, double t,
-                           Workspace& ws, std::vector<double>& efforts, std::string* message) {
-  Eigen::VectorXd Q = Eigen::VectorXd::Zero(model.num_coordinates()), lambda;
-  add_generalized_forces(parts, loads, ws.q.data(), ws.qd.data(), ws.qdd.data(), t, Q);
+struct DriverEfforts::Impl {
+  const Model& model;
+  const std::vector<Part>& parts;
+  const Loads& loads;
+  OutputEfforts natural;                         // the natural joints a bearing may name, with their parts and loads
+  std::optional<detail::FrictionLosses> losses;  // the loads' losses that read λ, set up once
+  Eigen::VectorXd Q, lambda, kept;
+};
+
+DriverEfforts::DriverEfforts(const Model& model, const std::vector<Part>& parts, const Loads& loads,
+                             std::shared_ptr<const NaturalJoints> natural)
+    : impl_(new Impl{model, parts, loads, {}, {}, {}, {}, {}}) {
+  if (!detail::FrictionLosses::any(loads.applied.get())) return;
+  if (natural) {  // (a natural point's reaction reads its bodies' parts and loads)
+    impl_->natural.natural = std::move(natural);
+    impl_->natural.parts = std::make_shared<const std::vector<Part>>(parts);
+    impl_->natural.loads = std::make_shared<const Loads>(loads);
+  }
+  impl_->losses.emplace(model, *loads.applied, impl_->natural.natural ? &impl_->natural : nullptr);
+}
+
+DriverEfforts::~DriverEfforts() = default;
+
+SolveStatus DriverEfforts::operator()(double t, Workspace& ws, std::vector<double>& efforts, std::string* message) {
+  const Model& model = impl_->model;
+  Eigen::VectorXd &Q = impl_->Q, &lambda = impl_->lambda;
+  Q.setZero(model.num_coordinates());
+  add_generalized_forces(impl_->parts, impl_->loads, ws.q.data(), ws.qd.data(), ws.qdd.data(), t, Q);
   efforts.clear();
   if (!Q.allFinite()) {
     if (message) {
-      *message =
-          nonfinite_force_source(parts, loads, model.num_coordinates(), ws.q.data(), ws.qd.data(), ws.qdd.data(), t);
+      *message = nonfinite_force_source(impl_->parts, impl_->loads, model.num_coordinates(), ws.q.data(), ws.qd.data(),
+                                        ws.qdd.data(), t);
       if (message->empty()) *message = "the parts' and loads' forces, each finite, overflow doubles in their sum";
     }
     return SolveStatus::kNonFinite;
@@ -357,12 +382,11 @@ SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, c
     if (message) *message = "the multipliers are not finite (an overflow of doubles)";
     return SolveStatus::kNonFinite;
   }
-  if (detail::FrictionLosses::any(loads.applied.get())) {  // (ensure_factorized() gave ws.lu the factors at q)
-    detail::FrictionLosses losses(model, *loads.applied);
-    Eigen::VectorXd kept;
+  if (impl_->losses) {  // (ensure_factorized() gave ws.lu the factors at q)
+    detail::FrictionLosses& losses = *impl_->losses;
     const double* qd = ws.qd.size() == model.num_coordinates() ? ws.qd.data() : nullptr;  // (none: at rest)
     const double* qdd = ws.qdd.size() == model.num_coordinates() ? ws.qdd.data() : nullptr;
-    if (!losses.solve(model, *ws.lu, ws.q.data(), qd, qdd, t, Q, lambda, kept)) {
+    if (!losses.solve(model, *ws.lu, ws.q.data(), qd, qdd, t, Q, lambda, impl_->kept)) {
       if (message) *message = losses.failed_solve() ? ws.lu->last_message() : losses.lock_message();
       return losses.failed_solve() ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
     }
@@ -370,6 +394,11 @@ SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, c
   for (Index c : rheonomic_constraints(model))
     efforts.push_back(-lambda(model.constraints()[static_cast<std::size_t>(c)].first_row));
   return st;
+}
+
+SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, const Loads& loads, double t,
+                           Workspace& ws, std::vector<double>& efforts, std::string* message) {
+  return DriverEfforts(model, parts, loads)(t, ws, efforts, message);
 }
 
 }  // namespace phiq
