@@ -108,7 +108,10 @@ bool FrictionLosses::any(const AppliedLoads* loads) {
 Index FrictionLosses::check(const Model& model, const TorsionalSpring& s) {
   const std::string who = "torsional spring '" + s.name + "': bearing joint '" + s.bearing->joint + "'";
   const Index c = model.find_constraint(s.bearing->joint);
-  if (c < 0) throw Error(who + " is not a constraint of the model");
+  if (c < 0)
+    throw Error(who +
+                " is not a constraint of the model, nor a point two parts' frames of points share (a natural "
+                "joint of the scene's)");
   const std::string_view kind = model.constraints()[static_cast<std::size_t>(c)].kind;
   if (!carries(kind) || reaction_width(model, c) == 0)
     throw Error(who + " is a " + std::string(kind) +
