@@ -42,9 +42,11 @@ std::string not_a_worm(const SpatialMesh& g, const Eigen::VectorXd& q) {
 }
 
 // The natural joint bearing spring `s` names (a point two bodies' frames share, efforts->natural's), else −1 (a
-// constraint, or nothing: check() says which). Throws phiq::Error for one in space (a point has no axis to split
-// its load along) or whose angle reads the points (its moment would not say which bodies it turns).
-int natural_bearing(const Model& model, const TorsionalSpring& s, const OutputEfforts* efforts) {
+// constraint, or nothing: check() says which); `of_point` the natural bodies' point coordinates, found here once.
+// Throws phiq::Error for one in space (a point has no axis to split its load along) or whose angle reads the points
+// (its moment would not say which bodies it turns).
+int natural_bearing(const Model& model, const TorsionalSpring& s, const OutputEfforts* efforts,
+                    std::vector<char>& of_point) {
   if (model.find_constraint(s.bearing->joint) >= 0 || !efforts || !efforts->natural) return -1;
   const NaturalJoints& natural = *efforts->natural;
   const auto it = std::find_if(natural.joints.begin(), natural.joints.end(),
@@ -53,7 +55,7 @@ int natural_bearing(const Model& model, const TorsionalSpring& s, const OutputEf
   const std::string who = "torsional spring '" + s.name + "': bearing at natural point '" + s.bearing->joint + "'";
   if (natural.spatial)
     throw Error(who + ": a point carries no axis in space to split its load along (join the bodies by a revolute)");
-  const std::vector<char> of_point = point_coordinates(natural, model.num_coordinates());
+  if (of_point.empty()) of_point = point_coordinates(natural, model.num_coordinates());  // (once: every bearing's)
   for (const Index c : torsional_coordinates(s))
     if (of_point[static_cast<std::size_t>(c)])
       throw Error(who +
@@ -151,9 +153,10 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads, co
   OutputEfforts joints;
   joints.reactions_in_joint_axes = true;  // (a spatial joint's z is its axis: F_a its z, F_r across)
   std::size_t at = 0;
+  std::vector<char> of_point;  // the natural bodies' point coordinates, found at the first natural bearing
   for (const TorsionalSpring& s : loads.torsional_springs) {
     if (!s.bearing) continue;
-    if (const int j = natural_bearing(model, s, efforts); j >= 0) {  // a point two bodies share (planar)
+    if (const int j = natural_bearing(model, s, efforts, of_point); j >= 0) {  // a point two bodies share (planar)
       joints.reactions.push_back({-1, false, j});
       up->bearings.push_back({&s, -1, s.bearing->joint, at, false});
       at += 3, natural_ = true;
@@ -254,7 +257,7 @@ bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double
                            const double* qdd, double t, Eigen::VectorXd& Q, Eigen::VectorXd& lambda,
                            Eigen::VectorXd& kept) {
   solves_ = 0, passes_ = 0, failed_solve_ = false, worst_change_ = 0.0, ratio_ = 0.0;
-  qd_ = qd, qdd_ = qdd;
+  qd_ = qd, qdd_ = qdd, adjoint_ready_ = false;
   if (natural_ && (!qd || !qdd)) throw Error("FrictionLosses: a natural point's bearing reads q̇ and q̈ (phiq bug)");
   for (std::size_t i = 0; i < set_->bearings.size(); ++i)
     rates_[i] = angle_rate(*set_->bearings[i].spring, q, qd, t, gradients_[i]);
@@ -316,9 +319,23 @@ bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double
 
 bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
   const std::size_t nb = set_->bearings.size();
+  if (!adjoint_ready_) {  // ∂m_i/∂λ over each bearing's joint's rows: the row's, the same for every driver row
+    load_rows_.assign(6 * nb, 0.0);
+    double d[6];
+    for (std::size_t i = 0; i < nb; ++i) {
+      const Bearing& b = set_->bearings[i];
+      bearing_load_gradient(*b.spring->bearing, values_.data() + b.at, b.spatial, d);
+      const auto& per_row = reactions_->kept_per_row(i);
+      for (Index j = 0; j < per_row.cols(); ++j) {
+        double g = 0.0;
+        for (int v = 0; v < 6; ++v) g += d[v] * per_row(v, j);
+        load_rows_[6 * i + static_cast<std::size_t>(j)] = b.spring->bearing->coefficient * g;
+      }
+    }
+    adjoint_ready_ = true;
+  }
   w0_ = w;
   adjoint_rhs_.resize(w.size());
-  double d[6];
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     // (∂Q_f/∂λ)ᵀ w̃ = Σ_i ∂m_i/∂λ (u_iᵀ w̃), over the rows of each loss's joint or mesh
     adjoint_rhs_.setZero();
@@ -328,15 +345,9 @@ bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
       double along = 0.0;  // u_iᵀ w̃, u_i = −dir ∇θ_i
       for (std::size_t k = 0; k < c.size(); ++k) along -= dir * gradients_[i][k] * w(c[k]);
       if (along == 0.0) continue;
-      const Bearing& b = set_->bearings[i];
-      bearing_load_gradient(*b.spring->bearing, values_.data() + b.at, b.spatial, d);
-      const auto& per_row = reactions_->kept_per_row(i);
-      const Index first = reactions_->kept_first_row(i);
-      for (Index j = 0; j < per_row.cols(); ++j) {
-        double g = 0.0;
-        for (int v = 0; v < 6; ++v) g += d[v] * per_row(v, j);
-        adjoint_rhs_(first + j) += along * b.spring->bearing->coefficient * g;
-      }
+      const Index first = reactions_->kept_first_row(i), rows = reactions_->kept_per_row(i).cols();
+      for (Index j = 0; j < rows; ++j)
+        adjoint_rhs_(first + j) += along * load_rows_[6 * i + static_cast<std::size_t>(j)];
     }
     for (std::size_t j = 0; j < set_->meshes.size(); ++j) {
       const Mesh& mesh = set_->meshes[j];

@@ -155,7 +155,9 @@ class FrictionLosses {
   std::vector<MeshState> mesh_states_;
   std::vector<double> values_, moments_, next_, rates_;
   std::vector<std::vector<double>> gradients_;
-  std::vector<double> frozen_values_, load_gradient_;
+  std::vector<double> frozen_values_;
+  std::vector<double> load_rows_;  // adjoint()'s ∂m_i/∂λ over bearing i's joint's rows (6 a bearing), once a row
+  bool adjoint_ready_ = false;     // load_rows_ is the last solve()'s
   std::vector<double> frozen_gradient_;
   Eigen::VectorXd w0_, adjoint_rhs_, adjoint_step_, qk_, forces_[4];
   Eigen::VectorXd lambda0_, q_f_, d_lambda_;

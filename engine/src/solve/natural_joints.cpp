@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
-#include <string_view>
 #include <optional>
+#include <string_view>
 #include <type_traits>
 #include <unordered_map>
 
