@@ -255,10 +255,8 @@ SolveStatus solve_effort_sensitivities(const Model& model, const OutputEfforts& 
     for (const OutputSensitivity& p : with_reach)
       if (const std::string why = losses->sensitivity_refusal(model, p); !why.empty())
         throw Error("solve_effort_sensitivities: " + why);
-    if (!losses->solve(model, *ws.lu, ws.q.data(), ws.qd.data(), ws.qdd.data(), t, Q, lambda, kept)) {
-      if (message) *message = losses->failed_solve() ? ws.lu->last_message() : losses->lock_message();
-      return losses->failed_solve() ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
-    }
+    if (!losses->solve(model, *ws.lu, ws.q.data(), ws.qd.data(), ws.qdd.data(), t, Q, lambda, kept))
+      return losses->failure(*ws.lu, message);
     sc.losses = &*losses;
   }
   if (!detail::effort_sensitivities_with_factors(model, efforts, with_reach, t, ws.q.data(), ws.qd.data(),

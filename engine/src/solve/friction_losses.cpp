@@ -482,6 +482,11 @@ std::string FrictionLosses::name(std::size_t i) const {
   return "the friction of bearing '" + s.bearing->joint + "' (torsional spring '" + s.name + "')";
 }
 
+SolveStatus FrictionLosses::failure(const SparseLuNumeric& lu, std::string* message) const {
+  if (message) *message = failed_solve_ ? lu.last_message() : lock_message();
+  return failed_solve_ ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
+}
+
 std::string FrictionLosses::lock_message() const {
   return name(worst_) + " adds to its own load " +
          (ratio_ >= 1.0 ? "as much as it takes or more (a pass multiplies its change by " + significant(ratio_, 3) +

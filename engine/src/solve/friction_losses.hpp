@@ -102,6 +102,9 @@ class FrictionLosses {
   // The loss whose constraint parameter rows `reached` (ParameterReach::rows) change where force_rate() does not
   // follow it, else empty (sensitivity_refusal()).
   std::string reach_not_followed(const Model& model, const std::vector<Index>& reached) const;
+  // The status a solve() that returned false stands for, its message into `message` (when not null): the linear
+  // solve's failure (`lu`'s) or the lock.
+  SolveStatus failure(const SparseLuNumeric& lu, std::string* message) const;
   int solves() const { return solves_; }               // transposed solves of the last solve()
   bool failed_solve() const { return failed_solve_; }  // the last solve() failed in a linear solve
   std::string lock_message() const;                    // the loss that did not settle, and why

@@ -346,11 +346,12 @@ struct DriverEfforts::Impl {
   OutputEfforts natural;                         // the natural joints a bearing may name, with their parts and loads
   std::optional<detail::FrictionLosses> losses;  // the loads' losses that read λ, set up once
   Eigen::VectorXd Q, lambda, kept;
+  std::vector<Index> drivers;  // rheonomic_constraints(model): the efforts' rows, found once
 };
 
 DriverEfforts::DriverEfforts(const Model& model, const std::vector<Part>& parts, const Loads& loads,
                              std::shared_ptr<const NaturalJoints> natural)
-    : impl_(new Impl{model, parts, loads, {}, {}, {}, {}, {}}) {
+    : impl_(new Impl{model, parts, loads, {}, {}, {}, {}, {}, rheonomic_constraints(model)}) {
   if (!detail::FrictionLosses::any(loads.applied.get())) return;
   if (natural) {  // (a natural point's reaction reads its bodies' parts and loads)
     impl_->natural.natural = std::move(natural);
@@ -386,13 +387,10 @@ SolveStatus DriverEfforts::operator()(double t, Workspace& ws, std::vector<doubl
     detail::FrictionLosses& losses = *impl_->losses;
     const double* qd = ws.qd.size() == model.num_coordinates() ? ws.qd.data() : nullptr;  // (none: at rest)
     const double* qdd = ws.qdd.size() == model.num_coordinates() ? ws.qdd.data() : nullptr;
-    if (!losses.solve(model, *ws.lu, ws.q.data(), qd, qdd, t, Q, lambda, impl_->kept)) {
-      if (message) *message = losses.failed_solve() ? ws.lu->last_message() : losses.lock_message();
-      return losses.failed_solve() ? SolveStatus::kLinearSolverFailed : SolveStatus::kNotConverged;
-    }
+    if (!losses.solve(model, *ws.lu, ws.q.data(), qd, qdd, t, Q, lambda, impl_->kept))
+      return losses.failure(*ws.lu, message);
   }
-  for (Index c : rheonomic_constraints(model))
-    efforts.push_back(-lambda(model.constraints()[static_cast<std::size_t>(c)].first_row));
+  for (Index c : impl_->drivers) efforts.push_back(-lambda(model.constraints()[static_cast<std::size_t>(c)].first_row));
   return st;
 }
 
