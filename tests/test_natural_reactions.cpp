@@ -1,10 +1,10 @@
 // Joint reactions at natural coordinates' shared points (phiq/natural_joints.hpp): the natural four-bar's pins O, A,
 // B, C carry the forces the reference-point four-bar's revolutes carry, under gravity, forces, a torque (part of it
-// viscous, of der()), a spring to ground and one between two links, with the same motor torque; each of its links
-// satisfies its Newton–Euler equations written here with them; the bodies' weight and inertia read from the whole
-// model's Q (a sweep's way) give the reactions their own Q gives, bit for bit, and so do the flat sites' sums on random
-// natural chains, in both forms of Q (rigid bars' constant mass matrices or their frames' motion); a point no two
-// bodies share is refused by name.
+// viscous, of der()), a spring to ground and one between two links (or to a part of expressions moved by t), with the
+// same motor torque; each of its links satisfies its Newton–Euler equations written here with them; the bodies'
+// weight and inertia read from the whole model's Q (a sweep's way) give the reactions their own Q gives, bit for bit,
+// and so do the flat sites' sums on random natural chains, in both forms of Q (rigid bars' constant mass matrices or
+// their frames' motion). What is refused: test_natural_reaction_refusals.cpp.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -20,15 +20,12 @@
 #include "phiq/joint_reactions.hpp"
 #include "phiq/natural_joints.hpp"
 #include "phiq/phiq.hpp"
+#include "natural_four_bar_text.hpp"
 #include "solve/part_forces.hpp"
 #include "test_support.hpp"
 
 namespace phiq {
 namespace {
-
-std::string natural_reactions_scene(const std::string& rel) {
-  return test::model_file_text(rel, "time:") + "time: {start: 0, end: 2*pi, steps: 40}\n";
-}
 
 struct NaturalRows {
   std::vector<double> t;
@@ -65,9 +62,10 @@ NaturalRows natural_reactions_sweep(const Scene& s) {
 // the reference-point form's frames
 // (the natural frames start at A and C, the reference-point bodies at the links' centres).
 constexpr const char* kNaturalRockerAngle = "atan2(yB, xB - L1)";
+// `tie_end`: the tie's second end, the rocker's point when empty.
 std::string natural_reactions_loads(double coupler_at, double rocker_at,
                                     const std::string& rocker_angle = kNaturalRockerAngle,
-                                    const std::string& crank_angle = "theta2") {
+                                    const std::string& crank_angle = "theta2", const std::string& tie_end = "") {
   std::ostringstream s;
   s << "loads:\n  gravity: [0.8, -9.81]\n"
     << "  forces: [{name: push, part: coupler, at: [" << coupler_at + 0.1 << ", 0.05], force: [3 + sin(t), -2], "
@@ -75,31 +73,65 @@ std::string natural_reactions_loads(double coupler_at, double rocker_at,
     << "  torques: [{name: brake, part: rocker, torque: \"-1.5 - 0.7*der(" << rocker_angle << ")\"}]\n"
     << "  springs: [{name: s, between: [{part: rocker, at: [" << rocker_at + 0.3 << ", 0]}, {point: [1.5, 1]}], "
     << "stiffness: 40, free_length: 0.2},\n"
-    << "            {name: tie, between: [{part: coupler, at: [" << coupler_at + 0.2 << ", 0.1]}, {part: rocker, at: ["
-    << rocker_at + 0.3 << ", 0]}], stiffness: 25, free_length: 0.3, damping: 0.4}]\n"
+    << "            {name: tie, between: [{part: coupler, at: [" << coupler_at + 0.2 << ", 0.1]}, ";
+  if (tie_end.empty())
+    s << "{part: rocker, at: [" << rocker_at + 0.3 << ", 0]}";
+  else
+    s << tie_end;
+  s << "], stiffness: 25, free_length: 0.3, damping: 0.4}]\n"
     << "  torsional_springs: [{name: return, coordinate: " << crank_angle
     << ", stiffness: 3, free_angle: 0.2, damping: 0.1}]\n";
   return s.str();
 }
 
-// Mass properties of the three links (bars with their centres at mid-length): crank, coupler, rocker.
-constexpr double kNaturalMass[3] = {1.0, 2.0, 1.5}, kNaturalLength[3] = {0.4, 1.2, 1.0};
-
-std::string natural_reactions_part(const char* name, int k, double centre, const std::string& frame) {
-  std::ostringstream s;
-  s << "  " << name << ": {" << frame << "mass: " << kNaturalMass[k] << ", center_of_mass: [" << centre
-    << ", 0], inertia: " << kNaturalMass[k] * kNaturalLength[k] * kNaturalLength[k] / 12 << "}\n";
-  return s.str();
-}
-
 // `first`: parts listed before the links (a massless one shifts their indices among the parts with mass).
-Scene natural_four_bar(const std::string& first = "") {
+Scene natural_four_bar(const std::string& first = "", const std::string& tie_end = "") {
   std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
   text += "parts:\n" + first + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +
           natural_reactions_part("coupler", 1, 0.6, "frame: {origin: A, x: B}, ") +
-          natural_reactions_part("rocker", 2, 0.5, "frame: {origin: C, x: B}, ") + natural_reactions_loads(0.6, 0.5) +
+          natural_reactions_part("rocker", 2, 0.5, "frame: {origin: C, x: B}, ") +
+          natural_reactions_loads(0.6, 0.5, kNaturalRockerAngle, "theta2", tie_end) +
           "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
   return parse_scene(text, "fourbar_natural.yaml");
+}
+
+// The reference-point four-bar with the same parts, loads and outputs.
+Scene reference_four_bar(const std::string& first = "", const std::string& tie_end = "") {
+  std::string text = natural_reactions_scene("seed/fourbar_reference_point.yaml");
+  text += "parts:\n" + first + natural_reactions_part("crank", 0, 0, "") + natural_reactions_part("coupler", 1, 0, "") +
+          natural_reactions_part("rocker", 2, 0, "") + natural_reactions_loads(0, 0, "psi4", "psi2", tie_end) +
+          "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
+  return parse_scene(text, "fourbar_reference_point.yaml");
+}
+
+// The natural form's motor torque and pins' forces are the reference-point form's at every row (1e-8), and a
+// point carries no moment.
+void expect_four_bar_forms_agree(const Scene& natural, const Scene& reference) {
+  ASSERT_EQ(natural.sweep.efforts.reactions.size(), 4u);
+  ASSERT_EQ(reference.sweep.efforts.reactions.size(), 4u);
+  for (std::size_t j = 0; j < 4; ++j)
+    EXPECT_EQ(natural.sweep.efforts.reaction_name(*natural.model, natural.sweep.efforts.reactions[j]),
+              reference.sweep.efforts.reaction_name(*reference.model, reference.sweep.efforts.reactions[j]));
+  const NaturalRows a = natural_reactions_sweep(natural), b = natural_reactions_sweep(reference);
+  ASSERT_EQ(a.values.size(), b.values.size());
+  double largest = 0.0;
+  for (std::size_t k = 0; k < a.values.size(); ++k) {
+    ASSERT_EQ(a.t[k], b.t[k]);
+    const std::vector<double>&u = a.values[k], &v = b.values[k];
+    ASSERT_EQ(u.size(), 2u + 12u);
+    EXPECT_NEAR(u[0], v[0], 1e-8 * (1 + std::fabs(v[0]))) << "motor torque, row " << k;
+    for (std::size_t j = 0; j < 4; ++j) {
+      for (std::size_t c = 0; c < 2; ++c) {
+        const double x = u[2 + 3 * j + c], y = v[2 + 3 * j + c];
+        EXPECT_NEAR(x, y, 1e-8 * (1 + std::fabs(y))) << "pin " << j << " F"
+                                                     << "xy"[c] << ", row " << k;
+        largest = std::max(largest, std::fabs(y));
+      }
+      EXPECT_EQ(u[4 + 3 * j], 0.0);                                          // a point carries no moment
+      EXPECT_NEAR(v[4 + 3 * j], 0.0, 1e-9 * (1 + std::fabs(v[2 + 3 * j])));  // nor does a revolute
+    }
+  }
+  EXPECT_GT(largest, 10.0);  // the weights at least: not a comparison of zeros
 }
 
 // A natural body keeps its part's mass, not a copy of the part: natural_body_parts() builds it, named as the body,
@@ -136,38 +168,17 @@ TEST(NaturalReactions, ABodysPartIsBuiltOnItsPromotedPoints) {
 }
 
 TEST(NaturalReactions, FourBarPinsAndTorqueAreTheReferencePointForms) {
-  const Scene natural = natural_four_bar();
-  std::string text = natural_reactions_scene("seed/fourbar_reference_point.yaml");
-  text += "parts:\n" + natural_reactions_part("crank", 0, 0, "") + natural_reactions_part("coupler", 1, 0, "") +
-          natural_reactions_part("rocker", 2, 0, "") + natural_reactions_loads(0, 0, "psi4", "psi2") +
-          "output: {velocities: true, accelerations: true, efforts: [motor], reactions: all}\n";
-  const Scene reference = parse_scene(text, "fourbar_reference_point.yaml");
-  // O, A, B, C in both: points of the natural form (on the crank, crank, coupler, rocker), revolutes of the other
-  ASSERT_EQ(natural.sweep.efforts.reactions.size(), 4u);
-  ASSERT_EQ(reference.sweep.efforts.reactions.size(), 4u);
-  for (std::size_t j = 0; j < 4; ++j)
-    EXPECT_EQ(natural.sweep.efforts.reaction_name(*natural.model, natural.sweep.efforts.reactions[j]),
-              reference.sweep.efforts.reaction_name(*reference.model, reference.sweep.efforts.reactions[j]));
-  const NaturalRows a = natural_reactions_sweep(natural), b = natural_reactions_sweep(reference);
-  ASSERT_EQ(a.values.size(), b.values.size());
-  double largest = 0.0;
-  for (std::size_t k = 0; k < a.values.size(); ++k) {
-    ASSERT_EQ(a.t[k], b.t[k]);
-    const std::vector<double>&u = a.values[k], &v = b.values[k];
-    ASSERT_EQ(u.size(), 2u + 12u);
-    EXPECT_NEAR(u[0], v[0], 1e-8 * (1 + std::fabs(v[0]))) << "motor torque, row " << k;
-    for (std::size_t j = 0; j < 4; ++j) {
-      for (std::size_t c = 0; c < 2; ++c) {
-        const double x = u[2 + 3 * j + c], y = v[2 + 3 * j + c];
-        EXPECT_NEAR(x, y, 1e-8 * (1 + std::fabs(y))) << "pin " << j << " F"
-                                                     << "xy"[c] << ", row " << k;
-        largest = std::max(largest, std::fabs(y));
-      }
-      EXPECT_EQ(u[4 + 3 * j], 0.0);                                          // a point carries no moment
-      EXPECT_NEAR(v[4 + 3 * j], 0.0, 1e-9 * (1 + std::fabs(v[2 + 3 * j])));  // nor does a revolute
-    }
-  }
-  EXPECT_GT(largest, 10.0);  // the weights at least: not a comparison of zeros
+  expect_four_bar_forms_agree(natural_four_bar(), reference_four_bar());
+}
+
+// The tie's far end on a part of expressions moved by t alone (a frame that reads no coordinate, so no body's): the
+// coupler takes the tie's pull at its own end, its damping from the far end's velocity, as in the reference-point
+// form. Before the far end was placed at slots of its own, the coupler's balance left the tie out and its pins
+// carried the pull.
+TEST(NaturalReactions, ASpringToAFrameOfExpressionsPullsItsNaturalBodyAtItsEnd) {
+  const std::string beacon = "  beacon: {frame: {at: [\"1.2 + 0.2*sin(3*t)\", \"0.9 - 0.1*t\"], angle: \"0.5*t\"}}\n";
+  const std::string end = "{part: beacon, at: [0.1, 0.05]}";
+  expect_four_bar_forms_agree(natural_four_bar(beacon, end), reference_four_bar(beacon, end));
 }
 
 double natural_cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
@@ -558,38 +569,6 @@ TEST(NaturalReactions, ASecondPartOnABarsPointsKeepsItsReactionsTheFramesMotions
         EXPECT_NEAR(rows.values[k][2 + j], r[j], 1e-9 * (1 + std::fabs(r[j]))) << second << j << ", row " << k;
     }
   }
-}
-
-TEST(NaturalReactions, APointNoTwoBodiesShareIsRefusedByName) {
-  std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
-  text += "parts:\n" + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +
-          natural_reactions_part("coupler", 1, 0.6, "frame: {origin: A, x: B}, ");
-  EXPECT_EQ(parse_scene(text + "output: {efforts: all, reactions: [A, O]}\n", "n.yaml").sweep.efforts.reactions.size(),
-            2u);
-  try {
-    (void)parse_scene(text + "output: {efforts: all, reactions: [B]}\n", "n.yaml");
-    ADD_FAILURE() << "B is on the coupler alone (no rocker part) and moves in x and y: no joint";
-  } catch (const std::exception& e) {  // SceneError
-    EXPECT_NE(std::string(e.what()).find("point 'B' is no joint"), std::string::npos) << e.what();
-  }
-}
-
-// A torsional spring whose angle reads the natural points cannot be divided among a point's bodies: their reactions
-// are refused with one (the efforts are not); one on a coordinate of its own is its constraint's (tested above).
-TEST(NaturalReactions, ATorsionalSpringOnThePointsWithANaturalPointsReactionIsRefused) {
-  std::string text = natural_reactions_scene("seed/fourbar_natural.yaml");
-  text += "parts:\n" + natural_reactions_part("crank", 0, 0.2, "frame: {origin: O, x: A}, ") +
-          natural_reactions_part("coupler", 1, 0.6, "frame: {origin: A, x: B}, ") +
-          "loads:\n  torsional_springs: [{name: return, angle: \"atan2(yA, xA)\", stiffness: 2}]\n";
-  EXPECT_HAS(test::scene_error(text + "output: {efforts: all, reactions: [A, O]}\n"),
-             "output.reactions: the reaction at natural point 'A' would hold torsional spring 'return''s moment: its "
-             "angle reads the points");
-  EXPECT_EQ(parse_scene(text + "output: {efforts: all}\n", "n.yaml").sweep.efforts.constraints.size(), 1u);
-  EXPECT_EQ(parse_scene(test::replace_first(text, "angle: \"atan2(yA, xA)\"", "coordinate: theta2") +
-                            "output: {efforts: all, reactions: [A, O]}\n",
-                        "n.yaml")
-                .sweep.efforts.reactions.size(),
-            2u);
 }
 
 }  // namespace

@@ -19,11 +19,12 @@
 /// made a coordinate. A body with two points constant along one axis shares that component's load between them in a
 /// way the points do not determine: NaN. The moment at a point joint is zero (points carry forces only); shared
 /// unit vectors (a spatial revolute in natural coordinates) are not split. A spring from b to another moving body
-/// is b's load at its own end, the far end read at its place from slots of its own (NaturalJoints::mirrors), so
-/// that its pull along the far body's points reaches no body's balance. A torsional spring on a coordinate of its own
-/// (a segment_angle's) acts through that constraint's multiplier, its body's; one whose angle reads the points does
-/// not say which bodies it turns (the scene's reader refuses it with natural reactions), and a spring whose far end
-/// is on a frame of expressions is counted in the joints' reactions.
+/// is b's load at its own end, the far end read at its place from slots of its own (NaturalJoints::mirrors, or
+/// far_points on a frame of expressions), so that its pull along the far body's points reaches no body's balance. A
+/// torsional spring on a coordinate of its own (a segment_angle's) acts through that constraint's multiplier, its
+/// body's; one whose angle reads the points does not say which bodies it turns, and a part on a frame of expressions
+/// that reads the points moves with them as none of their bodies: the scene's reader refuses both with natural
+/// reactions (their loads, or its mass, would sit in the joints' reactions).
 #pragma once
 
 #include <string>
@@ -51,7 +52,7 @@ struct NaturalBody {
   /// The frame's points (origin, and x, y toward when they are points), each component's slot with the constants
   /// promoted: coordinate n + k for NaturalJoints::promoted[k], so that Q differentiates along them.
   std::vector<Attachment3> points;
-  /// The slots its loads read beyond its frame (n + k: NaturalJoints::mirrors' copies of a spring's far end).
+  /// The slots its loads read beyond its frame (n + k: a spring's far end, NaturalJoints::mirrors or far_points).
   std::vector<Index> load_slots;
 };
 
@@ -84,7 +85,16 @@ struct NaturalJoints {
     Index coordinate = 0;  ///< the model coordinate it copies
   };
   std::vector<Mirror> mirrors;  ///< see Mirror
-  bool spatial = false;         ///< dimension 3: six values per joint, else three
+  /// A spring's far end on a frame of expressions, which reads q through expressions of its own: its world point at
+  /// the promoted coordinates n + slot, n + slot + 1 (and + 2 in space), their q, q̇ and q̈ the point's motion at
+  /// every row (promoted[] there unused), and the spring's end moved to them.
+  struct FarPoint {
+    std::size_t slot = 0;  ///< the first promoted coordinate
+    PartFrame frame;       ///< the far part's frame (PartFrameKind::kExpressions)
+    kin3::V3 at;           ///< the end, in that frame
+  };
+  std::vector<FarPoint> far_points;  ///< see FarPoint
+  bool spatial = false;              ///< dimension 3: six values per joint, else three
 };
 
 /// The natural joints of `parts` (the scene's, in order) under `loads`, among `points` (the scene's named natural

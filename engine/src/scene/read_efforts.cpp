@@ -195,6 +195,43 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   out.reactions_in_joint_axes = pending_.reactions_in_joint_axes;
 }
 
+namespace {
+
+// Why part `name` cannot carry a load when natural points' reactions are written.
+std::string why_no_body(const std::string& name) {
+  return "part '" + name + "' moves with the points but is none of their bodies (give it a frame of points)";
+}
+
+// A part that is no body of points (a frame of expressions, say) but moves with the natural points: its mass and
+// the loads on it push the points in no body's balance, so a point's reaction would hold them; refused by name.
+// `refuse(what, why)` does not return.
+template <class Refuse>
+void refuse_loads_on_no_body(const Scene& scene, const std::vector<char>& of_point, const Refuse& refuse) {
+  std::set<std::string_view> moved;  // such parts, by name
+  std::vector<Index> read;
+  for (const Part& p : scene.parts) {
+    if (p.frame.kind == PartFrameKind::kPoints) continue;  // (a body, or fixed)
+    frame_coordinates(p.frame, read);
+    if (std::none_of(read.begin(), read.end(), [&](Index c) { return of_point[static_cast<std::size_t>(c)]; }))
+      continue;
+    moved.insert(p.name);
+    if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0)
+      refuse("the weight and inertia of part '" + p.name + "'", why_no_body(p.name));
+  }
+  if (moved.empty() || !scene.loads.applied) return;
+  const AppliedLoads& l = *scene.loads.applied;
+  auto on = [&](const std::string& part) { return moved.count(part) > 0; };
+  for (const AppliedForce& f : l.forces)
+    if (on(f.part)) refuse("force '" + f.name + "'", why_no_body(f.part));
+  for (const AppliedTorque& f : l.torques)
+    if (on(f.part)) refuse("torque '" + f.name + "'", why_no_body(f.part));
+  for (const LinearSpring& s : l.springs)
+    for (const SpringEnd* e : {&s.a, &s.b})
+      if (on(e->part)) refuse("spring '" + s.name + "''s pull", why_no_body(e->part));
+}
+
+}  // namespace
+
 // `output: reactions` resolved to constraints and natural points (OutputEfforts::reactions, natural).
 void SceneReader::resolve_output_reactions(Scene& scene) const {
   const Model& model = *scene.model;
@@ -252,15 +289,20 @@ void SceneReader::resolve_output_reactions(Scene& scene) const {
   // constraint's multiplier, which its body owns.
   const auto natural_listed =
       std::find_if(out.reactions.begin(), out.reactions.end(), [](const OutputReaction& r) { return r.natural >= 0; });
-  if (natural_listed == out.reactions.end() || !scene.loads.applied) return;
+  if (natural_listed == out.reactions.end()) return;
   const std::vector<char> of_point = point_coordinates(*out.natural, model.num_coordinates());
+  auto refuse = [&](const std::string& what, const std::string& why) {
+    pending_.reactions_field->fail("the reaction at natural point '" + out.reaction_name(model, *natural_listed) +
+                                   "' would hold " + what + ": " + why);
+  };
+  refuse_loads_on_no_body(scene, of_point, refuse);
+  if (!scene.loads.applied) return;
   for (const TorsionalSpring& ts : scene.loads.applied->torsional_springs)
     for (const Index c : torsional_coordinates(ts))
       if (of_point[static_cast<std::size_t>(c)])
-        pending_.reactions_field->fail("the reaction at natural point '" + out.reaction_name(model, *natural_listed) +
-                                       "' would hold torsional spring '" + ts.name +
-                                       "''s moment: its angle reads the points, and does not say which bodies it "
-                                       "turns (give the angle a coordinate, as a segment_angle does)");
+        refuse("torsional spring '" + ts.name + "''s moment",
+               "its angle reads the points, and does not say which bodies it turns (give the angle a coordinate, as "
+               "a segment_angle does)");
 }
 
 std::vector<OutputLoss> SceneReader::resolve_output_losses(const AppliedLoads* loads) const {

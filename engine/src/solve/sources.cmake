@@ -8,6 +8,7 @@ target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/inverse_dynamics.cpp
   ${CMAKE_CURRENT_LIST_DIR}/joint_reactions.cpp
   ${CMAKE_CURRENT_LIST_DIR}/natural_joints.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/natural_reactions.cpp
   ${CMAKE_CURRENT_LIST_DIR}/natural_flat_sites.cpp
   ${CMAKE_CURRENT_LIST_DIR}/evaluation.cpp
   ${CMAKE_CURRENT_LIST_DIR}/force_diagnosis.cpp
