@@ -298,22 +298,57 @@ TEST(EffortSensitivity, BearingsAndGearLossesMatchResolvedSweeps) {
       test::spatial_slide_text(0.3, 0.1, "output: {efforts: all, sensitivities: [d, e, mu]}\n"));
 }
 
-TEST(EffortSensitivity, AParameterOfALossesOwnJointIsRefusedByName) {
-  // the spatial hinge's axis read from p: the bearing's split into radial and axial load moves with it, which the
-  // losses' derivative does not follow
-  const Scene s = parse_scene(
-      "phiq: 1\nname: rotor\ndimension: 3\nparameters: {tilt: 0.3}\n"
+// An offset crank-slider whose slide's friction reads its reaction (across it, and its tilt over an arm): the line's
+// offset e and tilt move the slide's own data (at fixed multipliers a planar slide's load, |λ across| + |λ turn| / a,
+// does not move with them: what moves τ is the motion and the load's direction); the crank's length and μ beside.
+TEST(EffortSensitivity, ASlidesOffsetAndTiltUnderItsFrictionMatchResolvedSweeps) {
+  expect_effort_sensitivities_match_resolved_sweeps(R"yaml(phiq: 1
+name: offset_slider
+parameters: {L2: 0.1, L3: 0.35, e: 0.03, tilt: 0.2, mu: 0.15}
+coordinates: {x2: 0.045, y2: 0.02, psi2: 0.4, x3: 0.25, y3: 0.06, psi3: 0.0, x4: 0.42, y4: 0.11, psi4: 0.2}
+bodies: {crank: [x2, y2, psi2], rod: [x3, y3, psi3], slider: [x4, y4, psi4]}
+constraints:
+  - {name: O, type: revolute, between: [{body: ground, at: [0, 0]}, {body: crank, at: [-L2/2, 0]}]}
+  - {name: A, type: revolute, between: [{body: crank, at: [L2/2, 0]}, {body: rod, at: [-L3/2, 0]}]}
+  - {name: B, type: revolute, between: [{body: rod, at: [L3/2, 0]}, {body: slider, at: [0, 0]}]}
+  - {name: slide, type: prismatic, between: [{body: ground, at: [0, e]}, {body: slider}],
+     axis: ["cos(tilt)", "sin(tilt)"], angle: tilt}
+drivers:
+  - {name: motor, coordinate: psi2, law: {type: linear, initial: 0.4, rate: 2}}
+parts:
+  crank: {mass: 0.5, center_of_mass: [0, 0], inertia: 0.0005}
+  rod: {mass: 0.8, center_of_mass: [0, 0], inertia: 0.008}
+  slider: {mass: 1.2, center_of_mass: [0.02, 0.01], inertia: 0.002}
+loads:
+  gravity: [0, -9.81]
+  forces: [{name: gas, part: slider, force: ["-40*cos(tilt)", "-40*sin(tilt)"]}]
+  torsional_springs: [{name: guide, angle: "x4*cos(tilt) + y4*sin(tilt)",
+                       bearing: {joint: slide, coefficient: mu, moment_arm: 0.05}}]
+time: {start: 0, end: 1, steps: 20}
+output: {efforts: all, sensitivities: [e, tilt, L2, mu]}
+)yaml");
+}
+
+// Parameters of a loss's own constraint: a spatial hinge's axes, ground's (tilt) and the disc's (ta), the side its
+// reaction is written on, whose axis splits the journal's load into radial, axial and bending parts (the hinge's
+// sides moved along their data's rates: without them ∂τ/∂ta is off by 7%), and a gear's pitch radius, its mesh's
+// ratio (the hoist's first stage, raising and lowering: without it, off by 3% of its largest).
+TEST(EffortSensitivity, ParametersOfALossesOwnJointOrRatioMatchResolvedSweeps) {
+  expect_effort_sensitivities_match_resolved_sweeps(
+      "phiq: 1\nname: rotor\ndimension: 3\nparameters: {tilt: 0.3, ta: 0.2}\n"
       "coordinates: {x: 0, y: 0, z: 0, e0: 1, e1: 0, e2: 0, e3: 0}\nbodies: {disc: [x, y, z, e0, e1, e2, e3]}\n"
-      "constraints:\n  - {name: hinge, type: revolute, between: [{body: ground, axis: [0, tilt, 1]}, {body: disc, "
-      "axis: [0, 0, 1]}]}\n"
-      "drivers:\n  - {name: motor, joint: hinge, law: {type: linear, initial: 0, rate: 4}}\n"
-      "parts:\n  disc: {mass: 3.0, center_of_mass: [0.1, 0, 0], inertia: [0.02, 0.03, 0.04]}\n"
+      "constraints:\n  - {name: hinge, type: revolute, between: [{body: disc, at: [0.01, 0, 0.02], axis: [0, ta, 1]}, "
+      "{body: ground, axis: [0, tilt, 1]}]}\n"
+      "drivers:\n  - {name: motor, joint: hinge, law: {type: polynomial, coefficients: [0, 4, 0.7]}}\n"
+      "parts:\n  disc: {mass: 3.0, center_of_mass: [0.1, 0.05, 0.25], inertia: [0.02, 0.03, 0.04]}\n"
       "loads:\n  gravity: [0, 0, -9.81]\n"
-      "  torsional_springs: [{name: bearing, joint: hinge, bearing: {coefficient: 0.15, radius: 0.02}}]\n"
-      "time: {start: 0, end: 1, steps: 10}\noutput: {efforts: all, sensitivities: [tilt]}\n",
-      "rotor.yaml");
-  EXPECT_HAS(test::sweep_error(*s.model, s.sweep),
-             "the efforts' sensitivities to 'tilt' with the bearing of 'hinge': 'tilt' changes its joint or ratio");
+      "  torsional_springs: [{name: bearing, joint: hinge, bearing: {coefficient: 0.15, radius: 0.02, "
+      "thrust_radius: 0.035, moment_arm: 0.04}}]\n"
+      "time: {start: 0, end: 1.5, steps: 30}\noutput: {efforts: all, sensitivities: [tilt, ta]}\n");
+  std::string hoist = test::model_file_text("dynamics/hoist_gear_losses.yaml", "output:");
+  hoist = test::replace_first(hoist, "teeth: [12, 36]", "radii: [r1, 0.09]");
+  hoist = test::replace_first(hoist, "parameters: {", "parameters: {r1: 0.03, ");
+  expect_effort_sensitivities_match_resolved_sweeps(hoist + "output: {efforts: all, sensitivities: [r1]}\n");
 }
 
 TEST(EffortSensitivity, TheFourFormulationsOfTheFourBarGiveOneSensitivity) {

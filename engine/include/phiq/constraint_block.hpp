@@ -153,6 +153,15 @@ class ConstraintBlock {
                                                       double /*h*/) const {
     return nullptr;
   }
+  /// A block of this kind holding one copy of constraint `i` (its rows included) with each datum moved by `s` times
+  /// its rate, `rates` being what data_rates() made, constraint `j` of it: the constraint along the line
+  /// p + s of the data's rates, whose derivative at s = 0 is the constraint's along p (the joints a bearing reads,
+  /// detail::FrictionLosses). Null when the kind does not differentiate its data or lists a datum that cannot be
+  /// moved so (a spatial joint's sides: their rates are not kept).
+  virtual std::unique_ptr<ConstraintBlock> data_moved(std::size_t /*i*/, const ConstraintBlock& /*rates*/,
+                                                      std::size_t /*j*/, double /*s*/) const {
+    return nullptr;
+  }
   /// Writes the derivative along a design parameter, at fixed (q, q̇, q̈, t), of Φ (`order` 0), Φq q̇ + Φt (1) or
   /// Φq q̈ − γ (2) of constraints [begin, end) into `out` at their global rows, `rates` being what data_rates() made
   /// for that range: exact, one evaluation (DistanceSpec::data_derivative()). `qd` is read for order ≥ 1, `qdd`
@@ -398,6 +407,19 @@ class TypedBlock final : public ConstraintBlock {
         rates->entries_.push_back(e);
       }
       return rates;
+    } else {
+      return nullptr;
+    }
+  }
+  std::unique_ptr<ConstraintBlock> data_moved(std::size_t i, const ConstraintBlock& rates, std::size_t j,
+                                              double s) const override {
+    if constexpr (DataDifferentiable<Spec>) {
+      const auto* r = dynamic_cast<const TypedBlock*>(&rates);
+      if (!r || i >= entries_.size() || j >= r->entries_.size()) return nullptr;
+      auto moved = std::make_unique<TypedBlock>();
+      moved->entries_.push_back(entries_[i]);
+      if (!detail::spec_data_moved(r->entries_[j].spec, s, moved->entries_.back().spec)) return nullptr;
+      return moved;
     } else {
       return nullptr;
     }

@@ -47,6 +47,12 @@ class BarLengths;
 /// model's constraints.
 int reaction_width(const Model& model, Index c);
 
+/// A constraint of a block other than the model's, standing for a listed joint's (JointReactions::evaluate_along()).
+struct ReactionBlockAt {
+  const ConstraintBlock* block = nullptr;  ///< null: the model's own
+  std::size_t index = 0;                   ///< in `block`
+};
+
 /// The reactions of a list of joints, evaluated at any (q, t, λ): built once per model (which block holds each
 /// constraint, which coordinates it reads), with scratch for evaluate(). Not thread-safe: one per thread.
 class JointReactions {
@@ -97,6 +103,14 @@ class JointReactions {
   /// multiplier of each row, and this sums them (six products a planar pin). Pre-condition: keep_geometry() at
   /// this q and t.
   void evaluate_kept(const double* q, double t, const Eigen::VectorXd& lambda, double* out);
+  /// A constraint of a block other than the model's, standing for a listed joint's (evaluate_along()).
+  using BlockAt = ReactionBlockAt;
+  /// The first evaluate() with the k-th listed joint's constraint read from along[k] where its block is not null:
+  /// the same constraint in a model along a design parameter (its rows and coordinates the model's), whose reaction
+  /// under the same λ the losses' derivative along p reads (detail::FrictionLosses::force_rate()). Pre-condition:
+  /// as the first evaluate(); along.size() is the number of listed joints.
+  void evaluate_along(const std::vector<BlockAt>& along, const double* q, double t, const Eigen::VectorXd& lambda,
+                      double* out);
   /// keep_geometry()'s values of the k-th listed joint per unit multiplier of each of its rows (column j: row
   /// kept_first_row(k) + j; a planar joint's first three values). Pre-condition: keep_geometry().
   const Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>& kept_per_row(std::size_t k) const {
@@ -240,10 +254,12 @@ class JointReactions {
     // keep_geometry()'s: the reaction's values per unit multiplier of each of the site's rows, column j row j's
     Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6> per_row;
   };
-  void site_geometry(const Site& s, const double* q, double t, SiteGeometry& g) const;
+  // (`at`: the site's constraint read elsewhere, evaluate_along())
+  void site_geometry(const Site& s, const double* q, double t, SiteGeometry& g, BlockAt at = {}) const;
   void site_reaction(const Site& s, const SiteGeometry& g, const double* q, double t, const Eigen::VectorXd& lambda,
-                     double*& out);
-  void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out);
+                     double*& out, BlockAt at = {});
+  void evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda, double*& out,
+                     BlockAt at = {});
   void body_forces(std::size_t b, double t, const detail::PlanarForce* planar);
   // BodyRows::entries' slots numbered afresh, own_values_ sized to them (BodyRows::own_slot_of_entry)
   void number_own_entries(const Model& model);

@@ -75,7 +75,7 @@ void total_force_rate(const Model& model, const OutputEfforts& efforts, const Ou
 }
 
 // dQ_f/dp at fixed λ into sc.friction_rate: the losses along the motion (v = s − q̂, with the difference step of
-// the forces') and along p by the loads' copies (FrictionLosses::force_rate()).
+// the forces') and along p by the loads' copies and the bearings' joints along p (FrictionLosses::force_rate()).
 void losses_force_rate(const Model& model, const OutputSensitivity& p, const ParameterReach& reach, const double* q,
                        double t, const Eigen::VectorXd& lambda, detail::EffortSensitivityScratch& sc) {
   const Index n = model.num_coordinates();
@@ -88,7 +88,7 @@ void losses_force_rate(const Model& model, const OutputSensitivity& p, const Par
       for (const ParameterReach::Comotion& c : reach.comotion)
         sc.moved[k][c.coordinate] = q[c.coordinate] * (1.0 + kShift[k] * p.step * c.rate);
     }
-  sc.losses->force_rate(q, t, lambda, sc.v, 1e-3 / std::max(rate, 1e-3), along,
+  sc.losses->force_rate(q, t, lambda, sc.v, 1e-3 / std::max(rate, 1e-3), along, sc.losses->joints_along(model, p),
                         reach.comotion.empty() ? nullptr : &sc.moved, p.step, sc.friction_rate);
 }
 

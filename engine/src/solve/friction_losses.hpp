@@ -88,20 +88,35 @@ class FrictionLosses {
   // contract as solve()'s did (∂Q_f/∂λ = Σ_i u_i ∂m_i/∂λ, u_i the loss's direction in Q, m_i linear in the reaction
   // of its joint, kept per unit multiplier). False where a solve fails or the passes do not settle.
   bool adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w);
+  // The bearings' joints in the four models along a design parameter (at p + kShift[k] h), where it reaches them:
+  // at[k][i] bearing i's constraint there (its block null where p does not reach it or its load does not read it).
+  // A mesh's data in a model along the parameter, where it reaches the mesh's constraint.
+  struct MeshAlong {
+    bool moved = false;
+    double k = 1.0, tan_lead = 0.0, cos_pressure = 1.0;  // Mesh's
+  };
+  struct JointsAlong {
+    const ParameterReach* reach = nullptr;                      // the parameter's (its identity)
+    std::array<std::vector<JointReactions::BlockAt>, 4> at;     // empty: p reaches no bearing's joint
+    std::array<std::vector<MeshAlong>, 4> meshes;               // empty: p reaches no mesh
+    std::vector<std::shared_ptr<const ConstraintBlock>> owned;  // the constraints moved along their data's rates
+  };
+  // Parameter p's (its reach known), found once per parameter and kept; null where p reaches no bearing's joint and
+  // no mesh.
+  // Pre-condition: sensitivity_refusal() passed for p (else phiq::Error).
+  const JointsAlong* joints_along(const Model& model, const OutputSensitivity& p);
   // dQ_f/dp at fixed λ into `out`: along the motion v by Q_f at q + kShift[k] e v, and along p by the losses' data in
-  // `along` (the scene's loads at p + kShift[k] h, in order; null: the loads' own, or all null: none) at q with the
-  // co-moving coordinates `moved` (same as q but where p moves them), each by the fourth-order central difference.
+  // `along` (the scene's loads at p + kShift[k] h, in order; null: the loads' own, or all null: none) and the
+  // bearings' joints in `joints` (null: none reached) at q with the co-moving coordinates `moved` (same as q but
+  // where p moves them), each by the fourth-order central difference.
   void force_rate(const double* q, double t, const Eigen::VectorXd& lambda, const Eigen::VectorXd& v, double e,
-                  const std::array<const AppliedLoads*, 4>& along, const std::array<Eigen::VectorXd, 4>* moved,
-                  double h, Eigen::VectorXd& out);
+                  const std::array<const AppliedLoads*, 4>& along, const JointsAlong* joints,
+                  const std::array<Eigen::VectorXd, 4>* moved, double h, Eigen::VectorXd& out);
   // Why the efforts' sensitivities to `p` (its reach known) are refused with these losses, else empty: p changes a
-  // loss's constraint in a way force_rate() does not follow (a spatial joint's axes, a slide's direction or point, a
-  // mesh's ratio; a planar pin's or revolute's journal reads the multipliers alone), or a bearing is a natural
-  // point's (its reaction is not kept per unit multiplier, which adjoint() reads).
+  // loss's constraint where its copies along p are not kept and its kind cannot move its data along their rates
+  // (ConstraintBlock::data_moved()), or a bearing is a natural point's (its reaction is not kept per unit
+  // multiplier, which adjoint() reads).
   std::string sensitivity_refusal(const Model& model, const OutputSensitivity& p) const;
-  // The loss whose constraint parameter rows `reached` (ParameterReach::rows) change where force_rate() does not
-  // follow it, else empty (sensitivity_refusal()).
-  std::string reach_not_followed(const Model& model, const std::vector<Index>& reached) const;
   // The status a solve() that returned false stands for, its message into `message` (when not null): the linear
   // solve's failure (`lu`'s) or the lock.
   SolveStatus failure(const SparseLuNumeric& lu, std::string* message) const;
@@ -147,9 +162,12 @@ class FrictionLosses {
   void moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m);
   std::string name(std::size_t i) const;  // loss i's, for a message
   // Q_f at q under λ with the last solve()'s directions and driven members, the losses' data of `data` (null: the
-  // loads' own), into `out` (zeroed first)
+  // loads' own) and the bearings' joints and meshes of `joints` in model k along p (null: the model's), into `out`
+  // (zeroed first)
   void frozen_forces(const double* q, double t, const Eigen::VectorXd& lambda, const AppliedLoads* data,
-                     Eigen::VectorXd& out);
+                     const JointsAlong* joints, std::size_t k, Eigen::VectorXd& out);
+  // p's bearings' joints along it into `out` (JointsAlong), else the first loss p reaches that they cannot follow
+  std::string find_joints_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const;
 
   std::shared_ptr<const SetUp> set_;
   std::optional<JointReactions> reactions_;      // the bearings' joints (none without bearings)
@@ -162,6 +180,7 @@ class FrictionLosses {
   std::vector<double> load_rows_;  // adjoint()'s ∂m_i/∂λ over bearing i's joint's rows (6 a bearing), once a row
   bool adjoint_ready_ = false;     // load_rows_ is the last solve()'s
   std::vector<double> frozen_gradient_;
+  std::vector<JointsAlong> joints_along_;  // joints_along()'s, one per parameter asked
   Eigen::VectorXd w0_, adjoint_rhs_, adjoint_step_, qk_, forces_[4];
   Eigen::VectorXd lambda0_, q_f_, d_lambda_;
   int solves_ = 0, passes_ = 0;

@@ -265,8 +265,11 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
   }
 }
 
-void JointReactions::site_geometry(const Site& s, const double* q, double t, SiteGeometry& g) const {
-  s.block->reaction_site(s.index, q, g.site);
+void JointReactions::site_geometry(const Site& s, const double* q, double t, SiteGeometry& g, BlockAt at) const {
+  if (at.block)
+    at.block->reaction_site(at.index, q, g.site);
+  else
+    s.block->reaction_site(s.index, q, g.site);
   // The wrench (F, M_O) whose virtual work on the body is g there: J_bᵀ w = g over the body's coordinates, in
   // least squares (Euler parameters: 4 columns for 3 rotations, the fourth along e, on which no wrench works).
   const PartFrame frame = body_frame(g.site);
@@ -286,8 +289,11 @@ void JointReactions::site_geometry(const Site& s, const double* q, double t, Sit
 }
 
 void JointReactions::site_reaction(const Site& s, const SiteGeometry& g, const double* q, double t,
-                                   const Eigen::VectorXd& lambda, double*& out) {
-  s.block->add_transposed_product(s.index, q, t, lambda.data(), g_.data());  // Φq,cᵀ λ_c
+                                   const Eigen::VectorXd& lambda, double*& out, BlockAt at) {
+  if (at.block)
+    at.block->add_transposed_product(at.index, q, t, lambda.data(), g_.data());
+  else
+    s.block->add_transposed_product(s.index, q, t, lambda.data(), g_.data());  // Φq,cᵀ λ_c
   Eigen::Matrix<double, 6, 1> rhs = Eigen::Matrix<double, 6, 1>::Zero();
   for (std::size_t k = 0; k < g.jac.coordinates.size(); ++k) {
     const V3 o = g.jac.d_origin[k], a = g.jac.d_angle[k];
@@ -315,9 +321,17 @@ void JointReactions::site_reaction(const Site& s, const SiteGeometry& g, const d
 }
 
 void JointReactions::evaluate_site(const Site& s, const double* q, double t, const Eigen::VectorXd& lambda,
-                                   double*& out) {
-  site_geometry(s, q, t, geometry_);
-  site_reaction(s, geometry_, q, t, lambda, out);
+                                   double*& out, BlockAt at) {
+  site_geometry(s, q, t, geometry_, at);
+  site_reaction(s, geometry_, q, t, lambda, out, at);
+}
+
+void JointReactions::evaluate_along(const std::vector<BlockAt>& along, const double* q, double t,
+                                    const Eigen::VectorXd& lambda, double* out) {
+  if (!set_->natural_sites.empty())
+    throw Error("JointReactions::evaluate_along: natural joints have no constraint to read elsewhere (phiq bug)");
+  if (along.size() != set_->sites.size()) throw Error("JointReactions::evaluate_along: one per joint (phiq bug)");
+  for (std::size_t k = 0; k < along.size(); ++k) evaluate_site(set_->sites[k], q, t, lambda, out, along[k]);
 }
 
 void JointReactions::keep_geometry(const double* q, double t) {

@@ -2,6 +2,7 @@
 target_sources(phiq_engine PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/assembly.cpp
   ${CMAKE_CURRENT_LIST_DIR}/friction_losses.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/friction_losses_along.cpp
   ${CMAKE_CURRENT_LIST_DIR}/block_triangular.cpp
   ${CMAKE_CURRENT_LIST_DIR}/derivatives.cpp
   ${CMAKE_CURRENT_LIST_DIR}/effort_sensitivity.cpp

@@ -265,6 +265,37 @@ bool spec_data_rate(const Spec& at, const std::array<const Spec*, 4>& along, dou
   return ok;
 }
 
+// A datum moved by s times its rate (ConstraintBlock::data_moved()): numbers, constant slots and the points, frames
+// and vectors made of them; a coordinate slot is no datum and stays. Any other datum cannot be moved so: false.
+inline bool datum_moved(double& d, const double& rate, double s) {
+  d += s * rate;
+  return true;
+}
+inline bool datum_moved(Slot& d, const Slot& rate, double s) {
+  if (!d.is_coordinate()) d = Slot::constant(d.value() + s * rate.value());
+  return true;
+}
+inline bool datum_moved(Point2& d, const Point2& rate, double s) {
+  return datum_moved(d.x, rate.x, s) && datum_moved(d.y, rate.y, s);
+}
+inline bool datum_moved(Frame2& d, const Frame2& rate, double s) {
+  return datum_moved(d.x, rate.x, s) && datum_moved(d.y, rate.y, s) && datum_moved(d.psi, rate.psi, s);
+}
+inline bool datum_moved(kin::V2& d, const kin::V2& rate, double s) {
+  return datum_moved(d.x, rate.x, s) && datum_moved(d.y, rate.y, s);
+}
+template <class T>
+bool datum_moved(T&, const T&, double) {
+  return false;
+}
+// `spec` with each datum of Spec::data_members() moved by s times its rate in `rate` (spec_data_rate()'s).
+template <class Spec>
+bool spec_data_moved(const Spec& rate, double s, Spec& spec) {
+  bool ok = true;
+  std::apply([&](auto... m) { ((ok = ok && datum_moved(spec.*m, rate.*m, s)), ...); }, Spec::data_members());
+  return ok;
+}
+
 // A planar pair (pin, prismatic) between bodies or ground removes 2 freedoms; with a natural point on either side
 // it is no joint of the count.
 inline JointCount planar_pair_joint_count(const Frame2& a, const Frame2& b) {

@@ -147,8 +147,35 @@ void side_slots(const JointSide3& s, F& f) {
 
 /// A joint's side, as given, is not what its rows read: its attachments (`att`, derived from the sides) are, and
 /// they carry the side's rates (a side that turns from a body to ground changes their slots and is refused there).
-/// The side's "rate" is left as the side itself, and never read.
-inline bool datum_rate(JointSide3&, const std::array<const JointSide3*, 4>&, double) { return true; }
+/// Its reaction's site reads the side (joint_reaction_site()), which a bearing's load along a parameter moves
+/// (ConstraintBlock::data_moved()): the rates of its frame's constants, its point, axis, reference and vector; false
+/// where a reference or vector is given in some of the four models only.
+inline bool datum_rate(JointSide3& rate, const std::array<const JointSide3*, 4>& v, double h) {
+  auto slot = [&](Slot& r, Slot Frame3::*m) {
+    return detail::datum_rate(r, {&(v[0]->frame.*m), &(v[1]->frame.*m), &(v[2]->frame.*m), &(v[3]->frame.*m)}, h);
+  };
+  bool ok = true;
+  for (Slot Frame3::*m : {&Frame3::x, &Frame3::y, &Frame3::z, &Frame3::e0, &Frame3::e1, &Frame3::e2, &Frame3::e3})
+    ok = slot(rate.frame.*m, m) && ok;
+  auto vector = [&](kin3::V3& r, auto get) {
+    for (double kin3::V3::*c : {&kin3::V3::x, &kin3::V3::y, &kin3::V3::z})
+      ok = detail::datum_rate(r.*c, {&(get(*v[0]).*c), &(get(*v[1]).*c), &(get(*v[2]).*c), &(get(*v[3]).*c)}, h) && ok;
+  };
+  vector(rate.at, [](const JointSide3& x) -> const kin3::V3& { return x.at; });
+  vector(rate.axis, [](const JointSide3& x) -> const kin3::V3& { return x.axis; });
+  for (const JointSide3* x : v) ok = ok && x->ref.has_value() == rate.ref.has_value() && x->vector == rate.vector;
+  if (ok && rate.ref) vector(*rate.ref, [](const JointSide3& x) -> const kin3::V3& { return *x.ref; });
+  return ok;
+}
+/// A side moved by s times its rates (datum_rate() above; a natural side's vector is the model's, as its slots).
+inline bool datum_moved(JointSide3& side, const JointSide3& rate, double s) {
+  for (Slot Frame3::*m : {&Frame3::x, &Frame3::y, &Frame3::z, &Frame3::e0, &Frame3::e1, &Frame3::e2, &Frame3::e3})
+    detail::datum_moved(side.frame.*m, rate.frame.*m, s);
+  auto move = [&](kin3::V3& x, const kin3::V3& r) { x = {x.x + s * r.x, x.y + s * r.y, x.z + s * r.z}; };
+  move(side.at, rate.at), move(side.axis, rate.axis);
+  if (side.ref && rate.ref) move(*side.ref, *rate.ref);
+  return true;
+}
 /// A spatial joint between two sides, its rows given by `Traits` (one struct per joint type below). The sides
 /// are data; setup() (called by ModelBuilder::add, or by hand before evaluating a spec built in code) validates
 /// them and derives the attachments the rows read.

@@ -237,6 +237,19 @@ bool datum_rate(std::array<Attachment3, N>& rate, const std::array<const std::ar
     if (!datum_rate(rate[i], {&(*v[0])[i], &(*v[1])[i], &(*v[2])[i], &(*v[3])[i]}, h)) return false;
   return true;
 }
+/// An attachment moved by s times its rates (detail::datum_moved(), ConstraintBlock::data_moved()).
+inline bool datum_moved(Attachment3& a, const Attachment3& rate, double s) {
+  for (int k = 0; k < 3; ++k) detail::datum_moved(a.r[k], rate.r[k], s);
+  for (int k = 0; k < 4; ++k) detail::datum_moved(a.p[k], rate.p[k], s);
+  a.s = {a.s.x + s * rate.s.x, a.s.y + s * rate.s.y, a.s.z + s * rate.s.z};
+  return true;
+}
+/// A list of attachments moved, each.
+template <std::size_t N>
+bool datum_moved(std::array<Attachment3, N>& a, const std::array<Attachment3, N>& rate, double s) {
+  for (std::size_t i = 0; i < N; ++i) datum_moved(a[i], rate[i], s);
+  return true;
+}
 /// The rates of a spatial point's slots (detail::datum_rate): a natural point's coordinates have none, a fixed
 /// component its constant's.
 inline bool datum_rate(Point3& rate, const std::array<const Point3*, 4>& v, double h) {
