@@ -249,6 +249,9 @@ class JointReactions {
     ReactionSite site;
     PartJacobian jac;
     Eigen::LDLT<Eigen::Matrix<double, 6, 6>> normal;
+    // The normal equations are the identity (a planar reference-point body's: its x, y, ψ move its origin and its
+    // angle one each): the wrench is the right-hand side, which normal's solve would give bit for bit.
+    bool identity = false;
     bool unmoved[6] = {};
     kin3::V3 origin;
     // keep_geometry()'s: the reaction's values per unit multiplier of each of the site's rows, column j row j's

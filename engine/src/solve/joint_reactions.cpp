@@ -284,8 +284,11 @@ void JointReactions::site_geometry(const Site& s, const double* q, double t, Sit
   // of the normal equations are zero, set to w_i = 0 (fixed sizes: no allocation at a row).
   for (int i = 0; i < 6; ++i)
     if ((g.unmoved[i] = normal(i, i) == 0.0)) normal(i, i) = 1.0;
-  g.normal.compute(normal);
-  g.origin = part_pose(frame, q, t).at;
+  g.identity = normal == Eigen::Matrix<double, 6, 6>::Identity();
+  if (!g.identity) g.normal.compute(normal);
+  g.origin = frame.kind == PartFrameKind::kPlanarBody  // (its origin alone: no rotation to find)
+                 ? V3{frame.planar.x.of(q), frame.planar.y.of(q), 0.0}
+                 : part_pose(frame, q, t).at;
 }
 
 void JointReactions::site_reaction(const Site& s, const SiteGeometry& g, const double* q, double t,
@@ -302,7 +305,7 @@ void JointReactions::site_reaction(const Site& s, const SiteGeometry& g, const d
   }
   for (int i = 0; i < 6; ++i)
     if (g.unmoved[i]) rhs(i) = 0.0;
-  const Eigen::Matrix<double, 6, 1> w = g.normal.solve(rhs);
+  const Eigen::Matrix<double, 6, 1> w = g.identity ? rhs : Eigen::Matrix<double, 6, 1>(g.normal.solve(rhs));
   V3 force{w(0), w(1), w(2)};
   const V3 moment_o{w(3), w(4), w(5)};
   const ReactionSite& rs = g.site;
