@@ -365,7 +365,9 @@ TEST(GearLosses, AWormsFrictionGivesItsEfficienciesAndLocksItWhereTheyTurnNegati
       ASSERT_EQ(rows.q.size(), 21u);
       const double eta = (c - mu * tan_lead) / (c + mu / tan_lead), eta_r = (c - mu / tan_lead) / (c + mu * tan_lead);
       const double expected = T > 0 ? (T / 30) / eta : (T / 30) * eta_r;
-      if (mu == 0.2 && T < 0) EXPECT_GT(expected, 0.0);  // (self-locking: the motor pushes the load down)
+      if (mu == 0.2 && T < 0) {
+        EXPECT_GT(expected, 0.0);  // (self-locking: the motor pushes the load down)
+      }
       for (std::size_t k = 0; k < rows.q.size(); ++k)
         EXPECT_NEAR(rows.values[k][0], expected, 1e-10 * std::fabs(expected))
             << "μ " << mu << ", T " << T << ", row " << k;

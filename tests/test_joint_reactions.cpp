@@ -200,7 +200,9 @@ TEST(JointReactions, AlongTheJointsAxesTheLoadsItCannotCarryAreZero) {
       EXPECT_EQ(j[2], w[2]);
       for (int c : k.cannot_carry) {
         EXPECT_NEAR(j[static_cast<std::size_t>(c)], 0.0, 1e-13) << "component " << c;
-        if (c == 0) EXPECT_GT(std::fabs(w[0]), 1e-3);  // (in world axes the slide's force has an x)
+        if (c == 0) {
+          EXPECT_GT(std::fabs(w[0]), 1e-3);  // (in world axes the slide's force has an x)
+        }
       }
     }
   }
@@ -252,8 +254,9 @@ TEST(JointReactions, AlongTheJointsAxesTheLoadsItCannotCarryAreZero) {
         EXPECT_NEAR(j[5], -pitch / (2 * M_PI) * j[2], 1e-12 * scale);
         EXPECT_GT(std::fabs(j[2]), 1e-3 * scale);
       }
-      if (std::string(type) == "revolute")  // about world z it carries a moment: the axes matter
+      if (std::string(type) == "revolute") {  // about world z it carries a moment: the axes matter
         EXPECT_GT(std::fabs(w[5]), 1e-3 * scale);
+      }
     }
   }
 }

@@ -287,7 +287,9 @@ TEST(NaturalReactions, BodyForcesFromTheModelsQAreTheBodiesOwnBitForBit) {
       forces.add(parts, *e.loads, q, qd, qdd, t, Q, planar.data());
       add_generalized_forces(parts, *e.loads, q, qd, qdd, t, own);
       const bool same_q = std::memcmp(Q.data(), own.data(), sizeof(double) * static_cast<std::size_t>(Q.size())) == 0;
-      if (!bars) ASSERT_TRUE(same_q) << k;
+      if (!bars) {
+        ASSERT_TRUE(same_q) << k;
+      }
       for (const NaturalBody& b : e.natural->bodies) ASSERT_TRUE(planar[b.part].valid) << b.name << ", row " << k;
       ws.q = rows.q[k];
       ASSERT_EQ(constraint_multipliers(m, t, ws, Q, lambda), SolveStatus::kSuccess);
@@ -308,7 +310,9 @@ TEST(NaturalReactions, BodyForcesFromTheModelsQAreTheBodiesOwnBitForBit) {
         // the sweep's, whose λ comes from its own factors
         EXPECT_NEAR(rows.values[k][2 + j], general[j], 1e-9 * (1 + std::fabs(general[j]))) << j << ", row " << k;
       }
-      if (!bars) ASSERT_EQ(std::memcmp(general.data(), cached.data(), sizeof(double) * n), 0) << "row " << k;
+      if (!bars) {
+        ASSERT_EQ(std::memcmp(general.data(), cached.data(), sizeof(double) * n), 0) << "row " << k;
+      }
       std::vector<detail::PlanarForce> unread = planar;  // each body's own force, in the same form
       for (detail::PlanarForce& f : unread) f.valid = false;
       reactions.evaluate(q, qd, qdd, t, lambda, own_bars.data(), unread.data());
