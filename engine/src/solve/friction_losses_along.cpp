@@ -177,7 +177,9 @@ std::string FrictionLosses::find_joints_along(const Model& model, const OutputSe
   // constraint c in the four models along p: their copies kept of its span, or the span's data moved along its
   // rates (ConstraintBlock::data_moved()), or the models themselves; false where none stands for it
   auto along_p = [&](Index c, std::array<JointReactions::BlockAt, 4>& at) {
-    const auto [block, index] = model.constraint_block(c);
+    const auto found = model.constraint_block(c);  // (not a structured binding: the lambda below reads index)
+    const ConstraintBlock* const block = found.first;
+    const std::size_t index = found.second;
     std::size_t bi = 0;
     while (bi < blocks.size() && blocks[bi].get() != block) ++bi;
     const auto span = std::find_if(reach.spans.begin(), reach.spans.end(), [&](const ParameterReach::Span& s) {
