@@ -114,6 +114,12 @@ TEST(NaturalBearings, WhatCannotBeSplitIsRefusedInOneLine) {
                               "natural.yaml");
   EXPECT_HAS(test::sweep_error(*s.model, s.sweep),
              "torsional spring 'fA': bearing at natural point 'A': its angle reads the points");
+  // a bearing at a point no two parts hold (the rocker gone, B is the coupler's alone): refused where it is named
+  EXPECT_HAS(test::scene_error(test::replace_first(
+                 test::replace_first(natural_four_bar_with_bearings(), "reactions: [O, A, B, C], ", ""),
+                 "  rocker: {frame: {origin: C, x: B}, mass: 1.5, center_of_mass: [0.5, 0], inertia: 0.125}\n", "")),
+             "loads.torsional_springs[2].bearing.joint: point 'B' is no joint: no two parts with frames of points hold "
+             "it");
   // efforts' sensitivities: a point's reaction is not kept per multiplier
   Scene with = parse_scene(test::replace_first(natural_four_bar_with_bearings(), "efforts: [motor]",
                                                "efforts: [motor], sensitivities: [L2]"),

@@ -89,9 +89,16 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
   // the natural joints a bearing may name, whatever the output lists (driver_efforts() of the scene reads them too)
-  if (pending_.natural_bearings)
+  if (pending_.natural_bearings) {
     out.natural = std::make_shared<NaturalJoints>(
         find_natural_joints(scene.parts, scene.loads, pending_.natural_points, model.num_coordinates(), spatial_));
+    for (const Pending::BearingPoint& b : pending_.bearing_points)  // (else the sweep's set-up would refuse it)
+      if (std::none_of(out.natural->joints.begin(), out.natural->joints.end(),
+                       [&](const NaturalJoint& j) { return j.name == b.name; }))
+        fail_at(file_, b.mark, b.path,
+                "point '" + b.name +
+                    "' is no joint: no two parts with frames of points hold it, nor one with a component fixed");
+  }
   if (!pending_.efforts_field && !pending_.reactions_field && !pending_.losses_field) return;
   resolve_output_reactions(scene);
   if (!out.reactions.empty() && spatial_) {  // gears on shafts: their bearings carry the teeth's push

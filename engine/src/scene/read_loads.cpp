@@ -246,7 +246,11 @@ TorsionalSpring PartReader::torsional_spring(const C& s, std::set<std::string>& 
     const std::string_view kind = r_.builder_.constraint_kind(f.joint);
     // or a named point of the plane, where bodies' frames of points may meet (found with the model)
     const bool point = kind.empty() && !r_.spatial_ && r_.names_.points.contains(f.joint);
-    if (point) r_.keep_natural_points(), r_.pending_.natural_bearings = true;
+    if (point) {
+      r_.keep_natural_points(), r_.pending_.natural_bearings = true;
+      const auto& at = on.present() ? on : joint;
+      r_.pending_.bearing_points.push_back({f.joint, at.path(), at.mark()});
+    }
     if (!point && !FrictionLosses::carries(kind))
       (on.present() ? on : b)
           .fail((kind.empty() ? "unknown joint '" + f.joint + "'" : "'" + f.joint + "' is a " + std::string(kind)) +

@@ -251,7 +251,14 @@ class SceneReader {
     // with `reactions`: the named natural points, kept past the tables' release for the natural joints
     std::vector<std::pair<std::string, Attachment3>> natural_points;
     std::vector<Cursor> reaction_items;
-    bool natural_bearings = false;       // a bearing names a point (natural_points kept for its joint)
+    bool natural_bearings = false;  // a bearing names a point (natural_points kept for its joint)
+    // the `joint` fields that name a point, checked with the natural joints once the model is built: the name, and
+    // where a message points (fail_at())
+    struct BearingPoint {
+      std::string name, path;
+      YAML::Mark mark;
+    };
+    std::vector<BearingPoint> bearing_points;
     std::optional<Cursor> losses_field;  // `output: losses` (its items when it lists names)
     std::vector<Cursor> loss_items;
     std::vector<std::pair<std::size_t, Cursor>> limit_efforts;  // `limits`' efforts: the limit, its driver's name
