@@ -79,8 +79,8 @@ TEST(NaturalBearings, TheNaturalFourBarsJournalsAreTheReferencePointForms) {
 }
 
 TEST(NaturalBearings, DriverEffortsGiveTheSweepsTorqueRowByRow) {
-  // the API's loop over rows (its losses set up once, the scene's natural joints given): the sweep's motor torque;
-  // without the natural joints the bearing names no joint it knows
+  // the API's loop over rows (its losses set up once, the scene's natural joints given): the sweep's motor torque,
+  // and the one-row function's given them; without the natural joints the bearing names no joint it knows
   const Scene s = parse_scene(natural_four_bar_with_bearings(), "natural.yaml");
   const test::ReactionRows rows = test::sweep_reactions(s);
   ASSERT_EQ(rows.q.size(), 49u);
@@ -94,6 +94,12 @@ TEST(NaturalBearings, DriverEffortsGiveTheSweepsTorqueRowByRow) {
     ASSERT_EQ(e.size(), 1u);
     EXPECT_NEAR(e[0], rows.values[k][0], 1e-9 * (1 + std::fabs(rows.values[k][0]))) << "row " << k;
   }
+  // the one-row function, given them, gives the last row's (set up again at its call)
+  std::vector<double> once;
+  ASSERT_EQ(driver_efforts(*s.model, s.parts, s.loads, s.sweep.t_end, ws, once, nullptr, s.sweep.efforts.natural),
+            SolveStatus::kSuccess);
+  ASSERT_EQ(once.size(), 1u);
+  EXPECT_EQ(once[0], e[0]);
   EXPECT_THROW(
       {
         try {

@@ -65,8 +65,11 @@ bool has_effort(const ConstraintInfo& c);
 /// distance, an expression). As constraint_multipliers() for the status and `message`; kNonFinite, with the part or
 /// load nonfinite_force_source() names, where Q or λ is not finite. With bearings' friction (BearingFriction) λ is
 /// solved with it; kNotConverged, its message naming the bearing, where it does not settle (the mechanism jams).
+/// `natural`: as DriverEfforts' (a bearing at a natural point names one of its joints). One motion: its losses' set-up
+/// is found at each call, which DriverEfforts does once for many.
 SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, const Loads& loads, double t,
-                           Workspace& ws, std::vector<double>& efforts, std::string* message = nullptr);
+                           Workspace& ws, std::vector<double>& efforts, std::string* message = nullptr,
+                           std::shared_ptr<const NaturalJoints> natural = nullptr);
 
 /// driver_efforts() at many motions of one model, its parts and loads (a loop over a sweep's rows: Python's
 /// phiq.driver_efforts): what the losses that read the multipliers need (their joints, their reactions' sites) is

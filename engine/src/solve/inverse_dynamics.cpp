@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <utility>
 
 #include "phiq/applied_loads.hpp"
 #include "phiq/constraint_block.hpp"
@@ -395,8 +396,9 @@ SolveStatus DriverEfforts::operator()(double t, Workspace& ws, std::vector<doubl
 }
 
 SolveStatus driver_efforts(const Model& model, const std::vector<Part>& parts, const Loads& loads, double t,
-                           Workspace& ws, std::vector<double>& efforts, std::string* message) {
-  return DriverEfforts(model, parts, loads)(t, ws, efforts, message);
+                           Workspace& ws, std::vector<double>& efforts, std::string* message,
+                           std::shared_ptr<const NaturalJoints> natural) {
+  return DriverEfforts(model, parts, loads, std::move(natural))(t, ws, efforts, message);
 }
 
 }  // namespace phiq
