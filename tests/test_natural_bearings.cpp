@@ -113,13 +113,42 @@ TEST(NaturalBearings, DriverEffortsGiveTheSweepsTorqueRowByRow) {
 }
 
 TEST(NaturalBearings, WhatCannotBeSplitIsRefusedInOneLine) {
-  // a turn that reads the points: its moment does not say which bodies it turns
-  // (with the points' reactions listed, the scene's reader refuses it first: test_natural_reactions.cpp)
-  const Scene s = parse_scene(test::replace_first(natural_four_bar_with_bearings("atan2(yB - yA, xB - xA) - theta2"),
-                                                  "reactions: [O, A, B, C], ", ""),
-                              "natural.yaml");
-  EXPECT_HAS(test::sweep_error(*s.model, s.sweep),
-             "torsional spring 'fA': bearing at natural point 'A': its angle reads the points");
+  // a turn that reads the points: its moment does not say which bodies it turns, so the points' reactions, which the
+  // bearings read, cannot hold it: the scene's reader refuses it at the first bearing at a point
+  const std::string reads_points = "atan2(yB - yA, xB - xA) - theta2";
+  EXPECT_HAS(test::scene_error(
+                 test::replace_first(natural_four_bar_with_bearings(reads_points), "reactions: [O, A, B, C], ", "")),
+             "loads.torsional_springs[0].bearing.joint: the bearing at natural point 'O' would hold torsional spring "
+             "'fA''s moment: its angle reads the points");
+  {  // and the losses' set-up, for loads built in code: that spring put in place of fA, with fA's bearing
+    const Scene good = parse_scene(natural_four_bar_with_bearings(), "natural.yaml");
+    std::string bare =
+        test::replace_first(natural_four_bar_with_bearings(reads_points), "reactions: [O, A, B, C], losses: all", "");
+    for (const char* pin : {"O", "A", "B", "C"})
+      bare = test::replace_first(bare, std::string(", bearing: {joint: ") + pin + ", coefficient: 0.2, radius: 0.05}",
+                                 ", stiffness: 0");
+    const Scene spring = parse_scene(bare, "natural.yaml");  // (no bearing: nothing to refuse)
+    Loads loads = good.loads;
+    auto applied = std::make_shared<AppliedLoads>(*loads.applied);
+    TorsionalSpring& fA = applied->torsional_springs.at(1);
+    ASSERT_EQ(fA.name, "fA");
+    const BearingFriction bearing = *fA.bearing;
+    fA = spring.loads.applied->torsional_springs.at(1);
+    fA.bearing = bearing;
+    loads.applied = applied;
+    EXPECT_THROW(
+        {
+          try {
+            DriverEfforts efforts(*good.model, good.parts, loads, good.sweep.efforts.natural);
+          } catch (const Error& e) {
+            EXPECT_HAS(std::string(e.what()),
+                       "torsional spring 'fA': bearing at natural point 'A': its angle reads "
+                       "the points");
+            throw;
+          }
+        },
+        Error);
+  }
   // a bearing at a point no two parts hold (the rocker gone, B is the coupler's alone): refused where it is named
   EXPECT_HAS(test::scene_error(test::replace_first(
                  test::replace_first(natural_four_bar_with_bearings(), "reactions: [O, A, B, C], ", ""),

@@ -157,7 +157,7 @@ class ConstraintBlock {
   /// its rate, `rates` being what data_rates() made, constraint `j` of it: the constraint along the line
   /// p + s of the data's rates, whose derivative at s = 0 is the constraint's along p (the joints a bearing reads,
   /// detail::FrictionLosses). Null when the kind does not differentiate its data or lists a datum that cannot be
-  /// moved so (a spatial joint's sides: their rates are not kept).
+  /// moved so (a motion law, an expression, a curve: detail::datum_moved()).
   virtual std::unique_ptr<ConstraintBlock> data_moved(std::size_t /*i*/, const ConstraintBlock& /*rates*/,
                                                       std::size_t /*j*/, double /*s*/) const {
     return nullptr;

@@ -85,6 +85,52 @@ void SceneReader::read_output_efforts(const Cursor& output) {
   }
 }
 
+namespace {
+
+// Why part `name` cannot carry a load when natural points' reactions are written.
+std::string why_no_body(const std::string& name) {
+  return "part '" + name + "' moves with the points but is none of their bodies (give it a frame of points)";
+}
+
+// What a natural point's reaction (its bodies' balance there) cannot split among its bodies, refused by name through
+// `refuse(what, why)`, which does not return: a part that is no body of points (a frame of expressions, say) but
+// moves with the points, whose mass and loads push them in no body's balance, and a torsional spring whose angle
+// reads the points (an expression of them), which pushes them without saying which bodies it turns; one on a
+// coordinate of its own (a segment_angle's) acts through that constraint's multiplier, which its body owns.
+template <class Refuse>
+void refuse_unsplit_loads(const Scene& scene, const std::vector<char>& of_point, const Refuse& refuse) {
+  if (scene.loads.applied)
+    for (const TorsionalSpring& ts : scene.loads.applied->torsional_springs)
+      for (const Index c : torsional_coordinates(ts))
+        if (of_point[static_cast<std::size_t>(c)])
+          refuse("torsional spring '" + ts.name + "''s moment",
+                 "its angle reads the points, and does not say which bodies it turns (give the angle a coordinate, "
+                 "as a segment_angle does)");
+  std::set<std::string_view> moved;  // such parts, by name
+  std::vector<Index> read;
+  for (const Part& p : scene.parts) {
+    if (p.frame.kind == PartFrameKind::kPoints) continue;  // (a body, or fixed)
+    frame_coordinates(p.frame, read);
+    if (std::none_of(read.begin(), read.end(), [&](Index c) { return of_point[static_cast<std::size_t>(c)]; }))
+      continue;
+    moved.insert(p.name);
+    if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0)
+      refuse("the weight and inertia of part '" + p.name + "'", why_no_body(p.name));
+  }
+  if (moved.empty() || !scene.loads.applied) return;
+  const AppliedLoads& l = *scene.loads.applied;
+  auto on = [&](const std::string& part) { return moved.count(part) > 0; };
+  for (const AppliedForce& f : l.forces)
+    if (on(f.part)) refuse("force '" + f.name + "'", why_no_body(f.part));
+  for (const AppliedTorque& f : l.torques)
+    if (on(f.part)) refuse("torque '" + f.name + "'", why_no_body(f.part));
+  for (const LinearSpring& s : l.springs)
+    for (const SpringEnd* e : {&s.a, &s.b})
+      if (on(e->part)) refuse("spring '" + s.name + "''s pull", why_no_body(e->part));
+}
+
+}  // namespace
+
 void SceneReader::resolve_output_efforts(Scene& scene) const {
   const Model& model = *scene.model;
   OutputEfforts& out = scene.sweep.efforts;
@@ -98,6 +144,15 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
         fail_at(file_, b.mark, b.path,
                 "point '" + b.name +
                     "' is no joint: no two parts with frames of points hold it, nor one with a component fixed");
+    // its load is the point's reaction, which holds what its bodies' balance cannot split
+    if (!pending_.bearing_points.empty()) {
+      const Pending::BearingPoint& b = pending_.bearing_points.front();
+      refuse_unsplit_loads(scene, point_coordinates(*out.natural, model.num_coordinates()),
+                           [&](const std::string& what, const std::string& why) {
+                             fail_at(file_, b.mark, b.path,
+                                     "the bearing at natural point '" + b.name + "' would hold " + what + ": " + why);
+                           });
+    }
   }
   if (!pending_.efforts_field && !pending_.reactions_field && !pending_.losses_field) return;
   resolve_output_reactions(scene);
@@ -202,43 +257,6 @@ void SceneReader::resolve_output_efforts(Scene& scene) const {
   out.reactions_in_joint_axes = pending_.reactions_in_joint_axes;
 }
 
-namespace {
-
-// Why part `name` cannot carry a load when natural points' reactions are written.
-std::string why_no_body(const std::string& name) {
-  return "part '" + name + "' moves with the points but is none of their bodies (give it a frame of points)";
-}
-
-// A part that is no body of points (a frame of expressions, say) but moves with the natural points: its mass and
-// the loads on it push the points in no body's balance, so a point's reaction would hold them; refused by name.
-// `refuse(what, why)` does not return.
-template <class Refuse>
-void refuse_loads_on_no_body(const Scene& scene, const std::vector<char>& of_point, const Refuse& refuse) {
-  std::set<std::string_view> moved;  // such parts, by name
-  std::vector<Index> read;
-  for (const Part& p : scene.parts) {
-    if (p.frame.kind == PartFrameKind::kPoints) continue;  // (a body, or fixed)
-    frame_coordinates(p.frame, read);
-    if (std::none_of(read.begin(), read.end(), [&](Index c) { return of_point[static_cast<std::size_t>(c)]; }))
-      continue;
-    moved.insert(p.name);
-    if (p.mass_source != MassSource::kNone && p.mass.mass > 0.0)
-      refuse("the weight and inertia of part '" + p.name + "'", why_no_body(p.name));
-  }
-  if (moved.empty() || !scene.loads.applied) return;
-  const AppliedLoads& l = *scene.loads.applied;
-  auto on = [&](const std::string& part) { return moved.count(part) > 0; };
-  for (const AppliedForce& f : l.forces)
-    if (on(f.part)) refuse("force '" + f.name + "'", why_no_body(f.part));
-  for (const AppliedTorque& f : l.torques)
-    if (on(f.part)) refuse("torque '" + f.name + "'", why_no_body(f.part));
-  for (const LinearSpring& s : l.springs)
-    for (const SpringEnd* e : {&s.a, &s.b})
-      if (on(e->part)) refuse("spring '" + s.name + "''s pull", why_no_body(e->part));
-}
-
-}  // namespace
-
 // `output: reactions` resolved to constraints and natural points (OutputEfforts::reactions, natural).
 void SceneReader::resolve_output_reactions(Scene& scene) const {
   const Model& model = *scene.model;
@@ -290,10 +308,8 @@ void SceneReader::resolve_output_reactions(Scene& scene) const {
       out.reactions.push_back({c, w == 6});
     }
   }
-  // A natural point's reaction balances its bodies' own loads at their points: a torsional spring whose angle reads
-  // the points (an expression of them) pushes them in a way that does not say which bodies it turns, and is refused
-  // rather than written into the reactions; one on a coordinate of its own (a segment_angle's) acts through that
-  // constraint's multiplier, which its body owns.
+  // A natural point's reaction balances its bodies' own loads at their points: what it cannot split is refused
+  // rather than written into the reactions (refuse_unsplit_loads()).
   const auto natural_listed =
       std::find_if(out.reactions.begin(), out.reactions.end(), [](const OutputReaction& r) { return r.natural >= 0; });
   if (natural_listed == out.reactions.end()) return;
@@ -302,14 +318,7 @@ void SceneReader::resolve_output_reactions(Scene& scene) const {
     pending_.reactions_field->fail("the reaction at natural point '" + out.reaction_name(model, *natural_listed) +
                                    "' would hold " + what + ": " + why);
   };
-  refuse_loads_on_no_body(scene, of_point, refuse);
-  if (!scene.loads.applied) return;
-  for (const TorsionalSpring& ts : scene.loads.applied->torsional_springs)
-    for (const Index c : torsional_coordinates(ts))
-      if (of_point[static_cast<std::size_t>(c)])
-        refuse("torsional spring '" + ts.name + "''s moment",
-               "its angle reads the points, and does not say which bodies it turns (give the angle a coordinate, as "
-               "a segment_angle does)");
+  refuse_unsplit_loads(scene, of_point, refuse);
 }
 
 std::vector<OutputLoss> SceneReader::resolve_output_losses(const AppliedLoads* loads) const {
