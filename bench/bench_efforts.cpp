@@ -7,7 +7,8 @@
 // summed (issue target ≤ 1.3, with torques and reactions); `cpu_ratio` the same in the process's CPU time.
 // BM_EffortSensitivitySweep: the efforts' sensitivities ∂τ/∂p (phiq/effort_sensitivity.hpp) on
 // models/dynamics/fourbar_motor_torque.yaml, 2000 steps on one thread, to the motor's speed w (it reaches the
-// driver alone) or to the crank's length L2 (it moves a centre and an inertia too: their rates enter dQ/dp).
+// driver alone) or to the crank's length L2 (it moves a centre and an inertia too: their rates enter dQ/dp), and on
+// fourbar_pin_friction.yaml to its journals' μ or L2 (the losses solved with λ: their adjoint and forces' rate).
 // Counters: `ratio`, the sweep with efforts and their sensitivities ÷ the sweep with the sensitivities of q only.
 //
 //   build/bench/phiq_bench --benchmark_filter='EffortsSweep|EffortSensitivitySweep' --benchmark_counters_tabular=true
@@ -120,30 +121,41 @@ BENCHMARK(BM_EffortsSweep)
     ->Unit(benchmark::kMillisecond);
 
 // models/dynamics/fourbar_motor_torque.yaml with the motor's speed a parameter w, 2000 steps, its efforts (or
-// none) and the sensitivities to `parameter`.
-Scene motor_torque_scene(const std::string& parameter, bool efforts) {
-  std::ifstream in(std::string(PHIQ_MODELS_DIR) + "/dynamics/fourbar_motor_torque.yaml");
+// none) and the sensitivities to `parameter`; `friction`: fourbar_pin_friction.yaml instead, its pins' journals'
+// coefficient a parameter mu.
+Scene motor_torque_scene(const std::string& parameter, bool efforts, bool friction = false) {
+  const std::string file = friction ? "fourbar_pin_friction.yaml" : "fourbar_motor_torque.yaml";
+  std::ifstream in(std::string(PHIQ_MODELS_DIR) + "/dynamics/" + file);
   std::stringstream read;
   read << in.rdbuf();
   std::string text = read.str();
   auto replace = [&](const std::string& from, const std::string& to) {
     const std::size_t at = text.find(from);
-    if (at == std::string::npos) throw Error("fourbar_motor_torque.yaml: no '" + from + "'");
+    if (at == std::string::npos) throw Error(file + ": no '" + from + "'");
     text.replace(at, from.size(), to);
   };
-  replace("L4: 1.0}", "L4: 1.0, w: 6.283185307179586}");
-  replace("rate: 2*pi", "rate: w");
-  replace("steps: 120", "steps: 2000");
+  if (friction) {
+    replace("L4: 1.0}", "L4: 1.0, mu: 0.15}");
+    for (int pin = 0; pin < 4; ++pin) replace("coefficient: 0.15", "coefficient: mu");
+    replace("steps: 72", "steps: 2000");
+  } else {
+    replace("L4: 1.0}", "L4: 1.0, w: 6.283185307179586}");
+    replace("rate: 2*pi", "rate: w");
+    replace("steps: 120", "steps: 2000");
+  }
   text.erase(text.find("output:"));
   text += "output: {velocities: true, accelerations: true, " + std::string(efforts ? "efforts: all, " : "") +
           "sensitivities: [" + parameter + "]}\n";
   return parse_scene(text, "fourbar_motor_torque.yaml");
 }
 
-// range(0) = param: 0 the parameter w, 1 L2. Manual time: the sweep with efforts and their sensitivities.
+// range(0) = param: 0 the parameter w, 1 L2; 2 mu, 3 L2 of the four-bar with its pins' journals (the losses'
+// adjoint and their forces' rate). Manual time: the sweep with efforts and their sensitivities.
 void BM_EffortSensitivitySweep(benchmark::State& state) {
-  const std::string parameter = state.range(0) == 0 ? "w" : "L2";
-  const Scene with = motor_torque_scene(parameter, true), plain = motor_torque_scene(parameter, false);
+  const std::string parameter = state.range(0) == 0 ? "w" : state.range(0) == 2 ? "mu" : "L2";
+  const bool friction = state.range(0) >= 2;
+  const Scene with = motor_torque_scene(parameter, true, friction),
+              plain = motor_torque_scene(parameter, false, friction);
   SweepOptions a_options = with.sweep, b_options = plain.sweep;
   a_options.threads = b_options.threads = 1;
   double a_sum = 0, b_sum = 0;
@@ -156,6 +168,10 @@ void BM_EffortSensitivitySweep(benchmark::State& state) {
   state.counters["moves_forces"] = p.parts_along[0] || p.loads_along[0] ? 1.0 : 0.0;
   state.counters["ratio"] = a_sum / b_sum;
 }
-BENCHMARK(BM_EffortSensitivitySweep)->Arg(0)->Arg(1)->ArgName("param")->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EffortSensitivitySweep)
+    ->DenseRange(0, 3)
+    ->ArgName("param")
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
