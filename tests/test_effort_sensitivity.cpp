@@ -25,45 +25,8 @@ namespace phiq {
 namespace {
 
 using test::effort_rows_sweep;
+using test::expect_effort_sensitivities_match_resolved_sweeps;
 using EffortSensitivityRows = test::EffortRows;
-
-// The scene with `parameter` = value, without sensitivities: its first effort at every row.
-std::vector<double> effort_sensitivity_efforts_at(const std::string& text, const std::string& parameter, double value) {
-  return test::first_driver_values_at(text, parameter, value, false);
-}
-
-// Every row's ∂τ/∂p of the first effort against central differences of re-solved sweeps (Richardson over δ and
-// δ/2, δ = 10⁻³ |p|): within 1e-8 of the largest |∂τ/∂p|, and that not zero.
-void expect_effort_sensitivities_match_resolved_sweeps(const std::string& text) {
-  const Scene s = parse_scene(text, "efforts.yaml");
-  ASSERT_EQ(s.sweep.efforts.constraints.size(), 1u);
-  ASSERT_FALSE(s.sweep.sensitivities.empty());
-  const EffortSensitivityRows base = effort_rows_sweep(s);
-  EXPECT_EQ(base.summary.sensitivity_form, SensitivityForm::kDirect);
-  const std::size_t offset = static_cast<std::size_t>(s.sweep.efforts.size());
-  for (std::size_t j = 0; j < s.sweep.sensitivities.size(); ++j) {
-    const OutputSensitivity& p = s.sweep.sensitivities[j];
-    const double delta = 1e-3 * std::fabs(p.value);
-    const std::vector<double> up = effort_sensitivity_efforts_at(text, p.name, p.value + delta);
-    const std::vector<double> down = effort_sensitivity_efforts_at(text, p.name, p.value - delta);
-    const std::vector<double> up2 = effort_sensitivity_efforts_at(text, p.name, p.value + delta / 2);
-    const std::vector<double> down2 = effort_sensitivity_efforts_at(text, p.name, p.value - delta / 2);
-    ASSERT_EQ(up.size(), base.t.size());
-    ASSERT_EQ(up2.size(), base.t.size());
-    double scale = 0.0, worst = 0.0, worst_t = 0.0;
-    for (std::size_t k = 0; k < base.t.size(); ++k) {
-      const double exact = base.values[k][offset + j];
-      ASSERT_TRUE(std::isfinite(exact)) << p.name << " t = " << base.t[k];
-      const double d1 = (up[k] - down[k]) / (2 * delta), d2 = (up2[k] - down2[k]) / delta;
-      const double fd = (4 * d2 - d1) / 3;
-      scale = std::max(scale, std::fabs(exact));
-      if (std::fabs(exact - fd) > worst) worst = std::fabs(exact - fd), worst_t = base.t[k];
-    }
-    ::testing::Test::RecordProperty("worst_relative_" + p.name, scientific(worst / scale, 2));
-    EXPECT_GT(scale, 1e-2) << p.name;
-    EXPECT_LE(worst, 1e-8 * scale) << p.name << ": worst at t = " << worst_t << " (largest " << scale << ")";
-  }
-}
 
 const char* const kEffortPendulum = R"(phiq: 1
 name: pendulum

@@ -111,6 +111,18 @@ class JointReactions {
   /// as the first evaluate(); along.size() is the number of listed joints.
   void evaluate_along(const std::vector<BlockAt>& along, const double* q, double t, const Eigen::VectorXd& lambda,
                       double* out);
+  /// The listed joints' constraints, and the natural bodies' own constraints, read from a model along a design
+  /// parameter (their rows and Jacobian entries the model's) by the evaluate()s that follow: `listed[k]` for the
+  /// k-th listed joint where its block is not null (empty: none), `own` each a constraint and where to read it. For
+  /// the losses' derivative along p where natural points' bearings read their bodies' balance
+  /// (detail::FrictionLosses::force_rate()).
+  void read_along(const std::vector<BlockAt>& listed, const std::vector<std::pair<Index, BlockAt>>& own,
+                  const Model& model);
+  /// The natural bodies' own constraints whose Φq values the natural joints' balances read (read_along()'s `own`).
+  std::vector<Index> own_constraints(const Model& model) const;
+  /// The k-th listed joint, a planar natural one: its force's derivative along each multiplier it reads (its body's
+  /// own constraints' rows), in world axes, at the last evaluate()'s q: `rows[i]` and (∂Fx, ∂Fy)/∂λ at `d[2 i]`.
+  void natural_force_rows(std::size_t k, std::vector<Index>& rows, std::vector<double>& d) const;
   /// keep_geometry()'s values of the k-th listed joint per unit multiplier of each of its rows (column j: row
   /// kept_first_row(k) + j; a planar joint's first three values). Pre-condition: keep_geometry().
   const Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>& kept_per_row(std::size_t k) const {
@@ -304,10 +316,18 @@ class JointReactions {
   Eigen::VectorXd qx_, qdx_, qddx_, qb_;  // q, q̇, q̈ with the promoted constants; a body's Q
   std::vector<double> g_;                 // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
   std::vector<double> own_values_;        // Φq's values of the natural bodies' own constraints (BodyRows' slots)
-  SiteGeometry geometry_;                 // evaluate_site()'s (its vectors' capacity kept: no allocation per row)
-  std::vector<SiteGeometry> kept_;        // keep_geometry()'s, one per constraint site
-  Eigen::VectorXd unit_;                  // keep_geometry()'s unit multipliers
-  std::vector<Part> body_part_;           // a body's parts built where they are read (body_parts_kept's others)
+  // read_own_along()'s: per own constraint read elsewhere, its model block and index, and where it is read
+  struct OwnAlong {
+    const ConstraintBlock* block = nullptr;
+    std::size_t index = 0;
+    BlockAt at;
+  };
+  std::vector<OwnAlong> own_along_;
+  std::vector<BlockAt> sites_along_;  // read_along()'s, per site (empty: none)
+  SiteGeometry geometry_;             // evaluate_site()'s (its vectors' capacity kept: no allocation per row)
+  std::vector<SiteGeometry> kept_;    // keep_geometry()'s, one per constraint site
+  Eigen::VectorXd unit_;              // keep_geometry()'s unit multipliers
+  std::vector<Part> body_part_;       // a body's parts built where they are read (body_parts_kept's others)
 };
 
 /// What add_gear_mesh_forces() finds at a row: the meshes it names, in `meshes`' order.

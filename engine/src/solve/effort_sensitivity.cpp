@@ -77,7 +77,8 @@ void total_force_rate(const Model& model, const OutputEfforts& efforts, const Ou
 // dQ_f/dp at fixed λ into sc.friction_rate: the losses along the motion (v = s − q̂, with the difference step of
 // the forces') and along p by the loads' copies and the bearings' joints along p (FrictionLosses::force_rate()).
 void losses_force_rate(const Model& model, const OutputSensitivity& p, const ParameterReach& reach, const double* q,
-                       double t, const Eigen::VectorXd& lambda, detail::EffortSensitivityScratch& sc) {
+                       double t, const Eigen::VectorXd& lambda, const double* sd, const double* sdd,
+                       detail::EffortSensitivityScratch& sc) {
   const Index n = model.num_coordinates();
   const double rate = detail::fastest_coordinate(sc.v.data(), model.tolerance_scales().coordinate_scale.data(), n);
   std::array<const AppliedLoads*, 4> along{};
@@ -89,7 +90,7 @@ void losses_force_rate(const Model& model, const OutputSensitivity& p, const Par
         sc.moved[k][c.coordinate] = q[c.coordinate] * (1.0 + kShift[k] * p.step * c.rate);
     }
   sc.losses->force_rate(q, t, lambda, sc.v, 1e-3 / std::max(rate, 1e-3), along, sc.losses->joints_along(model, p),
-                        reach.comotion.empty() ? nullptr : &sc.moved, p.step, sc.friction_rate);
+                        reach.comotion.empty() ? nullptr : &sc.moved, p.step, sc.friction_rate, sd, sdd);
 }
 
 // H(v, w) = (Φq v)_q w over every row into sc.plus, from γ at q by polarisation (exact: γ is quadratic in q̇).
@@ -192,7 +193,9 @@ bool detail::effort_sensitivities_with_factors(const Model& model, const OutputE
                        sensitivities + sl.offset(j, 2), t, sc);
       ++sc.differenced;
     }
-    if (sc.losses) losses_force_rate(model, p, reach, q, t, lambda, sc);
+    if (sc.losses)
+      losses_force_rate(model, p, reach, q, t, lambda, sensitivities + sl.offset(j, 1), sensitivities + sl.offset(j, 2),
+                        sc);
     time_rate_along(model, p, reach, q, t, sc);
     sc.power.assign(ne, 0.0);
     for (const EffortSensitivityScratch::DriverRow& dr : sc.rows) {

@@ -214,12 +214,21 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads, co
               !up->bearings.empty());
   if (natural_) joints.parts = efforts->parts, joints.loads = efforts->loads, joints.natural = efforts->natural;
   if (!up->bearings.empty()) reactions_.emplace(model, joints);
+  if (natural_) {  // (the efforts' sensitivities' adjoint keeps the other bearings' joints' geometry apart)
+    OutputEfforts others;
+    others.reactions_in_joint_axes = true;
+    for (const OutputReaction& r : joints.reactions)
+      if (r.natural < 0) others.reactions.push_back(r);
+    if (!others.reactions.empty()) kept_reactions_.emplace(model, others);
+  }
+  up->joints = std::move(joints);
   set_ = std::move(up);
   size_scratch();
 }
 
 FrictionLosses::FrictionLosses(const FrictionLosses& other, SetUpOnly) : set_(other.set_), natural_(other.natural_) {
   if (other.reactions_) reactions_.emplace(JointReactions::with_set_up_of(*other.reactions_));
+  if (other.kept_reactions_) kept_reactions_.emplace(JointReactions::with_set_up_of(*other.kept_reactions_));
   size_scratch();
 }
 
@@ -257,7 +266,7 @@ bool FrictionLosses::solve(const Model& model, SparseLuNumeric& lu, const double
                            const double* qdd, double t, Eigen::VectorXd& Q, Eigen::VectorXd& lambda,
                            Eigen::VectorXd& kept) {
   solves_ = 0, passes_ = 0, failed_solve_ = false, worst_change_ = 0.0, ratio_ = 0.0;
-  qd_ = qd, qdd_ = qdd, adjoint_ready_ = false;
+  q_ = q, qd_ = qd, qdd_ = qdd, t_ = t, adjoint_ready_ = false;
   if (natural_ && (!qd || !qdd)) throw Error("FrictionLosses: a natural point's bearing reads q̇ and q̈ (phiq bug)");
   for (std::size_t i = 0; i < set_->bearings.size(); ++i)
     rates_[i] = angle_rate(*set_->bearings[i].spring, q, qd, t, gradients_[i]);

@@ -85,8 +85,9 @@ class FrictionLosses {
   // The efforts' sensitivities with the losses (phiq/effort_sensitivity.hpp), at the last solve() that settled, its
   // directions and driven members held. λ solves R = Φqᵀ λ − Q − Q_f(λ, q, p) = 0, so dλ_r/dp = −w̃ᵀ dR/dp|λ with
   // (Φq − (∂Q_f/∂λ)ᵀ) w̃ = e_r: adjoint() turns w = Φq⁻¹ e_r into w̃ by the passes w̃ = w + Φq⁻¹ (∂Q_f/∂λ)ᵀ w̃, which
-  // contract as solve()'s did (∂Q_f/∂λ = Σ_i u_i ∂m_i/∂λ, u_i the loss's direction in Q, m_i linear in the reaction
-  // of its joint, kept per unit multiplier). False where a solve fails or the passes do not settle.
+  // contract as solve()'s did (∂Q_f/∂λ = Σ_i u_i ∂m_i/∂λ, u_i the loss's direction in Q, m_i reading the reaction
+  // of its joint, kept per unit multiplier, or at a natural point its body's balance, affine in its own constraints'
+  // multipliers: JointReactions::natural_force_rows()). False where a solve fails or the passes do not settle.
   bool adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w);
   // The bearings' joints in the four models along a design parameter (at p + kShift[k] h), where it reaches them:
   // at[k][i] bearing i's constraint there (its block null where p does not reach it or its load does not read it).
@@ -100,6 +101,9 @@ class FrictionLosses {
     std::array<std::vector<JointReactions::BlockAt>, 4> at;     // empty: p reaches no bearing's joint
     std::array<std::vector<MeshAlong>, 4> meshes;               // empty: p reaches no mesh
     std::vector<std::shared_ptr<const ConstraintBlock>> owned;  // the constraints moved along their data's rates
+    // natural points' bearings: their reactions as the models along p hold their bodies (their parts, loads and own
+    // constraints there); null without natural bearings
+    std::array<std::shared_ptr<JointReactions>, 4> natural;
   };
   // Parameter p's (its reach known), found once per parameter and kept; null where p reaches no bearing's joint and
   // no mesh.
@@ -109,13 +113,15 @@ class FrictionLosses {
   // `along` (the scene's loads at p + kShift[k] h, in order; null: the loads' own, or all null: none) and the
   // bearings' joints in `joints` (null: none reached) at q with the co-moving coordinates `moved` (same as q but
   // where p moves them), each by the fourth-order central difference.
+  // `sd`, `sdd`: q̇'s and q̈'s rates along p (with v), which a natural point's reaction reads (may be null without).
   void force_rate(const double* q, double t, const Eigen::VectorXd& lambda, const Eigen::VectorXd& v, double e,
                   const std::array<const AppliedLoads*, 4>& along, const JointsAlong* joints,
-                  const std::array<Eigen::VectorXd, 4>* moved, double h, Eigen::VectorXd& out);
+                  const std::array<Eigen::VectorXd, 4>* moved, double h, Eigen::VectorXd& out,
+                  const double* sd = nullptr, const double* sdd = nullptr);
   // Why the efforts' sensitivities to `p` (its reach known) are refused with these losses, else empty: p changes a
-  // loss's constraint where its copies along p are not kept and its kind cannot move its data along their rates
-  // (ConstraintBlock::data_moved()), or a bearing is a natural point's (its reaction is not kept per unit
-  // multiplier, which adjoint() reads).
+  // loss's constraint (or a natural point's bearing's bodies' own) where its copies along p are not kept and its
+  // kind cannot move its data along their rates (ConstraintBlock::data_moved()), or the bodies a natural point's
+  // bearing reads change with p.
   std::string sensitivity_refusal(const Model& model, const OutputSensitivity& p) const;
   // The status a solve() that returned false stands for, its message into `message` (when not null): the linear
   // solve's failure (`lu`'s) or the lock.
@@ -154,6 +160,7 @@ class FrictionLosses {
   struct SetUp {
     std::vector<Bearing> bearings;
     std::vector<Mesh> meshes;
+    OutputEfforts joints;  // the bearings' joints as reactions_ lists them (with natural ones, their bodies')
   };
   struct SetUpOnly {};
   FrictionLosses(const FrictionLosses& other, SetUpOnly);
@@ -161,18 +168,33 @@ class FrictionLosses {
   // m_i from the reactions and the meshes' multipliers at λ (bearings first, then meshes)
   void moments_at(const double* q, double t, const Eigen::VectorXd& lambda, std::vector<double>& m);
   std::string name(std::size_t i) const;  // loss i's, for a message
-  // Q_f at q under λ with the last solve()'s directions and driven members, the losses' data of `data` (null: the
-  // loads' own) and the bearings' joints and meshes of `joints` in model k along p (null: the model's), into `out`
-  // (zeroed first)
-  void frozen_forces(const double* q, double t, const Eigen::VectorXd& lambda, const AppliedLoads* data,
-                     const JointsAlong* joints, std::size_t k, Eigen::VectorXd& out);
+  // Q_f at the motion (q, q̇, q̈) under λ with the last solve()'s directions and driven members, the losses' data of
+  // `data` (null: the loads' own) and the bearings' joints and meshes of `joints` in model k along p (null: the
+  // model's), into `out` (zeroed first)
+  void frozen_forces(const double* q, const double* qd, const double* qdd, double t, const Eigen::VectorXd& lambda,
+                     const AppliedLoads* data, const JointsAlong* joints, std::size_t k, Eigen::VectorXd& out);
+  // JointsAlong::natural for p (natural bearings): the bodies' parts and loads along p, their own constraints too
+  std::string natural_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const;
+  // constraint c in the four models along p (its kept copies, its data moved along their rates, or the models'):
+  // false where none stands for it
+  bool constraint_along(const Model& model, const OutputSensitivity& p, Index c,
+                        std::array<JointReactions::BlockAt, 4>& at, JointsAlong& out) const;
   // p's bearings' joints along it into `out` (JointsAlong), else the first loss p reaches that they cannot follow
   std::string find_joints_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const;
 
   std::shared_ptr<const SetUp> set_;
-  std::optional<JointReactions> reactions_;      // the bearings' joints (none without bearings)
+  std::optional<JointReactions> reactions_;  // the bearings' joints (none without bearings)
+  // with a natural point's bearing, the others' joints alone (in order), whose geometry adjoint() keeps, which
+  // reactions_ cannot
+  std::optional<JointReactions> kept_reactions_;
   bool natural_ = false;                         // a bearing at a natural point: reactions_ evaluated whole, each pass
   const double *qd_ = nullptr, *qdd_ = nullptr;  // solve()'s, which a natural point's reaction reads
+  const double* q_ = nullptr;                    // solve()'s (adjoint() turns a natural point's force to its axes)
+  double t_ = 0.0;
+  std::vector<std::vector<std::pair<Index, double>>> natural_load_rows_;  // adjoint()'s, natural bearings'
+  std::vector<Index> force_rows_;                                         // scratch of adjoint()
+  std::vector<double> force_row_values_;
+  Eigen::VectorXd qdk_, qddk_;  // force_rate()'s motion, a natural point's reaction reading q̇ and q̈
   std::vector<MeshState> mesh_states_;
   std::vector<double> values_, moments_, next_, rates_;
   std::vector<std::vector<double>> gradients_;

@@ -8,6 +8,7 @@
 #include "phiq/constraint_block.hpp"
 #include "phiq/kinds/spatial_gear.hpp"
 #include "phiq/model.hpp"
+#include "phiq/natural_joints.hpp"
 #include "phiq/sensitivity.hpp"
 #include "solve/friction_losses.hpp"
 #include "solve/models_along.hpp"  // kShift
@@ -16,17 +17,39 @@ namespace phiq::detail {
 
 bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
   const std::size_t nb = set_->bearings.size();
+  // the joints whose geometry is kept per unit multiplier: all the bearings', or the others than natural points'
+  JointReactions* kept = natural_ ? (kept_reactions_ ? &*kept_reactions_ : nullptr)
+                                  : (reactions_ ? &*reactions_ : nullptr);  // (none: gear losses alone)
+  auto kept_index = [&](std::size_t i) {                                    // bearing i's among `kept`'s joints
+    std::size_t k = 0;
+    for (std::size_t j = 0; j < i; ++j) k += set_->bearings[j].constraint >= 0 ? 1 : 0;
+    return natural_ ? k : i;
+  };
   if (!adjoint_ready_) {  // ∂m_i/∂λ over each bearing's joint's rows: the row's, the same for every driver row
     load_rows_.assign(6 * nb, 0.0);
+    natural_load_rows_.resize(nb);
+    if (natural_ && kept) kept->keep_geometry(q_, t_);
     double d[6];
     for (std::size_t i = 0; i < nb; ++i) {
       const Bearing& b = set_->bearings[i];
+      const double mu = b.spring->bearing->coefficient;
       bearing_load_gradient(*b.spring->bearing, values_.data() + b.at, b.spatial, d);
-      const auto& per_row = reactions_->kept_per_row(i);
+      natural_load_rows_[i].clear();
+      if (b.constraint < 0) {  // its force's rows, world axes: f_k = a_k · F in its body's axes a_k
+        const int j = set_->joints.reactions[i].natural;
+        const ReactionSite rs = natural_reaction_site(*set_->joints.natural, static_cast<std::size_t>(j), q_, t_);
+        const double gx = d[0] * rs.axes[0].x + d[1] * rs.axes[1].x, gy = d[0] * rs.axes[0].y + d[1] * rs.axes[1].y;
+        reactions_->natural_force_rows(i, force_rows_, force_row_values_);
+        for (std::size_t r = 0; r < force_rows_.size(); ++r)
+          natural_load_rows_[i].emplace_back(force_rows_[r],
+                                             mu * (gx * force_row_values_[2 * r] + gy * force_row_values_[2 * r + 1]));
+        continue;
+      }
+      const auto& per_row = kept->kept_per_row(kept_index(i));
       for (Index j = 0; j < per_row.cols(); ++j) {
         double g = 0.0;
         for (int v = 0; v < 6; ++v) g += d[v] * per_row(v, j);
-        load_rows_[6 * i + static_cast<std::size_t>(j)] = b.spring->bearing->coefficient * g;
+        load_rows_[6 * i + static_cast<std::size_t>(j)] = mu * g;
       }
     }
     adjoint_ready_ = true;
@@ -42,7 +65,12 @@ bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
       double along = 0.0;  // u_iᵀ w̃, u_i = −dir ∇θ_i
       for (std::size_t k = 0; k < c.size(); ++k) along -= dir * gradients_[i][k] * w(c[k]);
       if (along == 0.0) continue;
-      const Index first = reactions_->kept_first_row(i), rows = reactions_->kept_per_row(i).cols();
+      if (set_->bearings[i].constraint < 0) {
+        for (const auto& [row, value] : natural_load_rows_[i]) adjoint_rhs_(row) += along * value;
+        continue;
+      }
+      const std::size_t k = kept_index(i);
+      const Index first = kept->kept_first_row(k), rows = kept->kept_per_row(k).cols();
       for (Index j = 0; j < rows; ++j)
         adjoint_rhs_(first + j) += along * load_rows_[6 * i + static_cast<std::size_t>(j)];
     }
@@ -72,10 +100,15 @@ bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
   return false;
 }
 
-void FrictionLosses::frozen_forces(const double* q, double t, const Eigen::VectorXd& lambda, const AppliedLoads* data,
-                                   const JointsAlong* joints, std::size_t k, Eigen::VectorXd& out) {
+void FrictionLosses::frozen_forces(const double* q, const double* qd, const double* qdd, double t,
+                                   const Eigen::VectorXd& lambda, const AppliedLoads* data, const JointsAlong* joints,
+                                   std::size_t k, Eigen::VectorXd& out) {
   out.setZero(q_f_.size());
-  if (reactions_) {
+  if (natural_) {  // (a natural point's reaction reads its bodies' motion, as the models along p hold them)
+    frozen_values_.resize(values_.size());
+    JointReactions& r = joints && joints->natural[k] ? *joints->natural[k] : *reactions_;
+    r.evaluate(q, qd, qdd, t, lambda, frozen_values_.data());
+  } else if (reactions_) {
     frozen_values_.resize(values_.size());
     if (joints && !joints->at[k].empty())
       reactions_->evaluate_along(joints->at[k], q, t, lambda, frozen_values_.data());
@@ -123,39 +156,44 @@ void FrictionLosses::frozen_forces(const double* q, double t, const Eigen::Vecto
 
 void FrictionLosses::force_rate(const double* q, double t, const Eigen::VectorXd& lambda, const Eigen::VectorXd& v,
                                 double e, const std::array<const AppliedLoads*, 4>& along, const JointsAlong* joints,
-                                const std::array<Eigen::VectorXd, 4>* moved, double h, Eigen::VectorXd& out) {
+                                const std::array<Eigen::VectorXd, 4>* moved, double h, Eigen::VectorXd& out,
+                                const double* sd, const double* sdd) {
   const Index n = q_f_.size();
   const Eigen::Map<const Eigen::VectorXd> qv(q, n);
+  if (natural_ && (!sd || !sdd || !qd_ || !qdd_))
+    throw Error("FrictionLosses::force_rate: a natural point's bearing reads q̇, q̈ and their rates (phiq bug)");
   for (std::size_t k = 0; k < 4; ++k) {
     qk_ = qv + (kShift[k] * e) * v;
-    frozen_forces(qk_.data(), t, lambda, nullptr, nullptr, k, forces_[k]);
+    if (natural_) {
+      qdk_ = Eigen::Map<const Eigen::VectorXd>(qd_, n) + (kShift[k] * e) * Eigen::Map<const Eigen::VectorXd>(sd, n);
+      qddk_ = Eigen::Map<const Eigen::VectorXd>(qdd_, n) + (kShift[k] * e) * Eigen::Map<const Eigen::VectorXd>(sdd, n);
+    }
+    frozen_forces(qk_.data(), natural_ ? qdk_.data() : qd_, natural_ ? qddk_.data() : qdd_, t, lambda, nullptr, nullptr,
+                  k, forces_[k]);
   }
   out = ((forces_[0] - forces_[3]) + 8.0 * (forces_[2] - forces_[1])) / (12.0 * e);
   if (std::none_of(along.begin(), along.end(), [](const AppliedLoads* a) { return a != nullptr; }) && !moved && !joints)
     return;
   for (std::size_t k = 0; k < 4; ++k)
-    frozen_forces(moved ? (*moved)[k].data() : q, t, lambda, along[k], joints, k, forces_[k]);
+    frozen_forces(moved ? (*moved)[k].data() : q, qd_, qdd_, t, lambda, along[k], joints, k, forces_[k]);
   out += ((forces_[0] - forces_[3]) + 8.0 * (forces_[2] - forces_[1])) / (12.0 * h);
 }
 
 std::string FrictionLosses::sensitivity_refusal(const Model& model, const OutputSensitivity& p) const {
   const std::string with = "the efforts' sensitivities to '" + p.name + "' with ";
-  for (const Bearing& b : set_->bearings)
-    if (b.constraint < 0)
-      return with + "the bearing at natural point '" + b.point +
-             "': its reaction is its bodies' balance, not kept per multiplier as the losses' derivative reads it "
-             "(ask them without the bearing, or join the bodies by a revolute)";
   if (!p.reach) return {};
   JointsAlong joints;
   const std::string who = find_joints_along(model, p, joints);
   return who.empty() ? who
                      : with + who + ": '" + p.name +
-                           "' changes its joint or ratio, which the losses' derivative does not follow (ask them "
-                           "without it)";
+                           "' moves a constraint whose data the losses' derivative cannot move along it (an "
+                           "expression's, a law's or a curve's; ask them without it)";
 }
 
 const FrictionLosses::JointsAlong* FrictionLosses::joints_along(const Model& model, const OutputSensitivity& p) {
-  auto found = [](const JointsAlong& j) { return j.at[0].empty() && j.meshes[0].empty() ? nullptr : &j; };
+  auto found = [](const JointsAlong& j) {
+    return j.at[0].empty() && j.meshes[0].empty() && !j.natural[0] ? nullptr : &j;
+  };
   for (const JointsAlong& j : joints_along_)
     if (j.reach == p.reach.get()) return found(j);
   JointsAlong& j = joints_along_.emplace_back();
@@ -165,54 +203,53 @@ const FrictionLosses::JointsAlong* FrictionLosses::joints_along(const Model& mod
   return found(j);
 }
 
-std::string FrictionLosses::find_joints_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const {
+bool FrictionLosses::constraint_along(const Model& model, const OutputSensitivity& p, Index c,
+                                      std::array<JointReactions::BlockAt, 4>& at, JointsAlong& out) const {
   const ParameterReach& reach = *p.reach;
-  const std::vector<Index>& reached = reach.rows;
+  const ReachedConstraints* kept = p.reached && p.reached->reach.get() == &reach ? p.reached.get() : nullptr;
+  const auto& blocks = model.blocks();
+  const auto [block, index] = model.constraint_block(c);
+  std::size_t bi = 0;
+  while (bi < blocks.size() && blocks[bi].get() != block) ++bi;
+  std::size_t j = 0;  // its span
+  while (j < reach.spans.size() &&
+         !(reach.spans[j].block == bi && reach.spans[j].begin <= index && index < reach.spans[j].end))
+    ++j;
+  if (reach.everything || j == reach.spans.size()) return false;
+  const std::size_t in_span = index - reach.spans[j].begin;
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (kept && kept->rates[j]) {  // its copies' data's rates: the constraint moved along them
+      out.owned.push_back(block->data_moved(index, *kept->rates[j], in_span, kShift[k] * p.step));
+      if (!out.owned.back()) return false;
+      at[k] = {out.owned.back().get(), 0};
+    } else if (kept && kept->along[k][j] && in_span < kept->along[k][j]->size()) {  // its copies
+      at[k] = {kept->along[k][j].get(), in_span};
+    } else if (!kept && p.models[k]) {  // the models themselves
+      at[k] = {p.models[k]->blocks()[bi].get(), index};
+    } else {
+      return false;
+    }
+  }
+  return true;
+}
+
+std::string FrictionLosses::find_joints_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const {
+  const std::vector<Index>& reached = p.reach->rows;
   auto touched = [&](Index first, Index rows) {
     const auto it = std::lower_bound(reached.begin(), reached.end(), first);
     return it != reached.end() && *it < first + rows;
-  };
-  const ReachedConstraints* kept = p.reached && p.reached->reach.get() == &reach ? p.reached.get() : nullptr;
-  const auto& blocks = model.blocks();
-  // constraint c in the four models along p: their copies kept of its span, or the span's data moved along its
-  // rates (ConstraintBlock::data_moved()), or the models themselves; false where none stands for it
-  auto along_p = [&](Index c, std::array<JointReactions::BlockAt, 4>& at) {
-    const auto found = model.constraint_block(c);  // (not a structured binding: the lambda below reads index)
-    const ConstraintBlock* const block = found.first;
-    const std::size_t index = found.second;
-    std::size_t bi = 0;
-    while (bi < blocks.size() && blocks[bi].get() != block) ++bi;
-    const auto span = std::find_if(reach.spans.begin(), reach.spans.end(), [&](const ParameterReach::Span& s) {
-      return s.block == bi && s.begin <= index && index < s.end;
-    });
-    if (reach.everything || span == reach.spans.end()) return false;
-    const std::size_t j = static_cast<std::size_t>(span - reach.spans.begin()), in_span = index - span->begin;
-    for (std::size_t k = 0; k < 4; ++k) {
-      if (kept && kept->rates[j]) {
-        out.owned.push_back(block->data_moved(index, *kept->rates[j], in_span, kShift[k] * p.step));
-        if (!out.owned.back()) return false;
-        at[k] = {out.owned.back().get(), 0};
-      } else if (kept && kept->along[k][j] && in_span < kept->along[k][j]->size()) {
-        at[k] = {kept->along[k][j].get(), in_span};
-      } else if (!kept && p.models[k]) {
-        at[k] = {p.models[k]->blocks()[bi].get(), index};
-      } else {
-        return false;
-      }
-    }
-    return true;
   };
   std::array<JointReactions::BlockAt, 4> at;
   const std::size_t nb = set_->bearings.size(), nm = set_->meshes.size();
   for (std::size_t i = 0; i < nb; ++i) {
     const Bearing& b = set_->bearings[i];
-    if (b.constraint < 0) return "the bearing at natural point '" + b.point + "'";
+    if (b.constraint < 0) continue;  // (a natural point's: natural_along())
     const ConstraintInfo& c = model.constraints()[static_cast<std::size_t>(b.constraint)];
     // a planar journal's load is its force's size, which its multipliers alone give: no geometry read along p
     const std::string_view kind = c.kind;
     const bool planar_journal = !b.spatial && !b.spring->bearing->slide && (kind == "pin" || kind == "revolute");
     if (planar_journal || !touched(c.first_row, c.rows)) continue;
-    if (!along_p(b.constraint, at)) return "the bearing of '" + c.name + "'";
+    if (!constraint_along(model, p, b.constraint, at, out)) return "the bearing of '" + c.name + "'";
     if (out.at[0].empty())
       for (auto& a : out.at) a.assign(nb, {});
     for (std::size_t k = 0; k < 4; ++k) out.at[k][i] = at[k];
@@ -221,7 +258,7 @@ std::string FrictionLosses::find_joints_along(const Model& model, const OutputSe
     const Mesh& m = set_->meshes[j];
     if (!touched(m.row, 1)) continue;
     const std::string who = "the gear losses of '" + m.loss->gear + "'";
-    if (!along_p(model.find_constraint(m.loss->gear), at)) return who;
+    if (!constraint_along(model, p, model.find_constraint(m.loss->gear), at, out)) return who;
     if (out.meshes[0].empty())
       for (auto& a : out.meshes) a.assign(nm, {});
     for (std::size_t k = 0; k < 4; ++k) {
@@ -237,6 +274,61 @@ std::string FrictionLosses::find_joints_along(const Model& model, const OutputSe
         return who;
       }
     }
+  }
+  return natural_ ? natural_along(model, p, out) : std::string();
+}
+
+namespace {
+
+// Frame f's points in order (origin, x toward and y toward where they are points): NaturalBody::points' order.
+std::vector<const Attachment3*> frame_points_of(const PartFrame& f) {
+  std::vector<const Attachment3*> out{&f.origin};
+  if (f.x_is_point) out.push_back(&f.x_toward);
+  if (f.spatial_frame && f.y_is_point) out.push_back(&f.y_toward);
+  return out;
+}
+
+}  // namespace
+
+std::string FrictionLosses::natural_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const {
+  const OutputEfforts& joints = set_->joints;
+  const NaturalJoints& natural = *joints.natural;
+  const std::vector<Part>& parts = *joints.parts;
+  // the bodies' own constraints in the four models, where p reaches them
+  std::array<std::vector<std::pair<Index, JointReactions::BlockAt>>, 4> own;
+  std::array<JointReactions::BlockAt, 4> at;
+  const std::vector<Index>& reached = p.reach->rows;
+  for (const Index c : reactions_->own_constraints(model)) {
+    const ConstraintInfo& info = model.constraints()[static_cast<std::size_t>(c)];
+    const auto it = std::lower_bound(reached.begin(), reached.end(), info.first_row);
+    if (it == reached.end() || *it >= info.first_row + info.rows) continue;
+    if (!constraint_along(model, p, c, at, out))
+      return "the bearings at natural points (their bodies' '" + info.name + "')";
+    for (std::size_t k = 0; k < 4; ++k) own[k].emplace_back(c, at[k]);
+  }
+  for (std::size_t k = 0; k < 4; ++k) {
+    // the bodies, their parts and loads as the scene along p holds them, their joints at the same places of their
+    // frames (a fixed pivot's constant moved with p)
+    auto along = std::make_shared<const std::vector<Part>>(p.parts_along[k] ? *p.parts_along[k] : parts);
+    const std::shared_ptr<const Loads> loads = p.loads_along[k] ? p.loads_along[k] : joints.loads;
+    std::vector<std::pair<std::string, Attachment3>> points;
+    for (const NaturalJoint& j : natural.joints) {
+      const std::size_t part = natural.bodies[j.bodies.front()].part;
+      const std::vector<const Attachment3*> here = frame_points_of(parts.at(part).frame),
+                                            there = frame_points_of(along->at(part).frame);
+      std::size_t m = 0;
+      while (m < here.size() && !(here[m]->r[0] == j.point.r[0] && here[m]->r[1] == j.point.r[1])) ++m;
+      if (m == here.size() || there.size() != here.size()) return "the bearing at natural point '" + j.name + "'";
+      points.emplace_back(j.name, *there[m]);
+    }
+    auto bodies = std::make_shared<const NaturalJoints>(
+        find_natural_joints(*along, *loads, points, model.num_coordinates(), natural.spatial));
+    if (bodies->joints.size() != natural.joints.size() || bodies->bodies.size() != natural.bodies.size())
+      return "the bearings at natural points (their bodies change with it)";
+    OutputEfforts e = joints;
+    e.parts = along, e.loads = loads, e.natural = bodies;
+    out.natural[k] = std::make_shared<JointReactions>(model, e);
+    out.natural[k]->read_along(out.at[k], own[k], model);
   }
   return {};
 }

@@ -233,7 +233,7 @@ void JointReactions::evaluate(const double* q, const double* qd, const double* q
   const BarSum* const bar_sums = set_->bar_sums.data();
   for (const auto& [natural, k] : set_->order) {
     if (!natural) {
-      evaluate_site(set_->sites[k], q, t, lambda, out);
+      evaluate_site(set_->sites[k], q, t, lambda, out, sites_along_.empty() ? BlockAt{} : sites_along_[k]);
       continue;
     }
     const SimpleSite* e = simple && k < simple_count ? simple_sites + k : nullptr;

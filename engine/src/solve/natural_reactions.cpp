@@ -305,8 +305,71 @@ void JointReactions::evaluate_own_jacobian(const double* q, double t) {
   const BodyRows& rows = set_->body_rows;
   if (rows.runs.empty()) return;
   if (!rows.overwrite) std::fill(own_values_.begin(), own_values_.end(), 0.0);  // (entries that share a slot add)
-  for (const OwnRun& r : rows.runs)
-    r.block->jacobian(r.begin, r.end, q, t, rows.slot_of_entry, own_values_.data(), rows.overwrite);
+  for (const OwnRun& r : rows.runs) {
+    if (own_along_.empty()) {
+      r.block->jacobian(r.begin, r.end, q, t, rows.slot_of_entry, own_values_.data(), rows.overwrite);
+      continue;
+    }
+    for (std::size_t i = r.begin; i < r.end; ++i) {  // (a copy keeps its entries' places in the pattern)
+      const auto along = std::find_if(own_along_.begin(), own_along_.end(),
+                                      [&](const OwnAlong& o) { return o.block == r.block && o.index == i; });
+      const ConstraintBlock& b = along == own_along_.end() ? *r.block : *along->at.block;
+      const std::size_t at = along == own_along_.end() ? i : along->at.index;
+      b.jacobian(at, at + 1, q, t, rows.slot_of_entry, own_values_.data(), rows.overwrite);
+    }
+  }
+}
+
+void JointReactions::read_along(const std::vector<BlockAt>& listed, const std::vector<std::pair<Index, BlockAt>>& own,
+                                const Model& model) {
+  own_along_.clear(), sites_along_.clear();
+  for (const auto& [c, at] : own) {
+    if (!at.block) continue;
+    const auto [block, index] = model.constraint_block(c);
+    own_along_.push_back({block, index, at});
+  }
+  if (listed.empty()) return;
+  sites_along_.assign(set_->sites.size(), BlockAt{});
+  for (std::size_t k = 0; k < listed.size() && k < set_->order.size(); ++k)
+    if (!set_->order[k].first) sites_along_[set_->order[k].second] = listed[k];
+}
+
+std::vector<Index> JointReactions::own_constraints(const Model& model) const {
+  std::vector<Index> out;
+  for (const OwnRun& r : set_->body_rows.runs)
+    for (std::size_t i = r.begin; i < r.end; ++i) out.push_back(model.constraint_of_row(r.block->first_row(i)));
+  return out;
+}
+
+void JointReactions::natural_force_rows(std::size_t k, std::vector<Index>& rows, std::vector<double>& d) const {
+  rows.clear(), d.clear();
+  const auto [natural, at] = set_->order.at(k);
+  if (!natural || set_->natural->spatial)
+    throw Error("JointReactions::natural_force_rows: not a planar natural joint (phiq bug)");
+  const NaturalSite& s = set_->natural_sites[at];
+  const BodyRows& own = set_->body_rows;
+  const Index n = static_cast<Index>(g_.size());
+  const NaturalBody& body = set_->natural->bodies[s.body];
+  // R_k = Σ own entries in column at[k] × λ_row (a moving component), or −Σ those in the body's points' moving
+  // k-columns (a fixed one: translation invariance), less Q_b, which λ does not move
+  for (std::size_t e = own.entries_first[s.body]; e < own.entries_first[s.body + 1]; ++e) {
+    const OwnEntry& entry = own.entries[e];
+    double v[2] = {0.0, 0.0};
+    for (int c = 0; c < 2; ++c) {
+      if (s.at[c] < n) {
+        if (entry.column == s.at[c]) v[c] = own_values_[static_cast<std::size_t>(entry.slot)];
+        continue;
+      }
+      for (const Attachment3& p : body.points)
+        if (p.r[c].coord() < n && entry.column == p.r[c].coord())
+          v[c] -= own_values_[static_cast<std::size_t>(entry.slot)];
+    }
+    if (v[0] == 0.0 && v[1] == 0.0) continue;
+    const auto it = std::find(rows.begin(), rows.end(), entry.row);
+    const std::size_t i = static_cast<std::size_t>(it - rows.begin());
+    if (it == rows.end()) rows.push_back(entry.row), d.push_back(0.0), d.push_back(0.0);
+    d[2 * i] += v[0], d[2 * i + 1] += v[1];
+  }
 }
 
 void JointReactions::add_body_constraint_forces(std::size_t b, const Eigen::VectorXd& lambda) {
