@@ -116,7 +116,7 @@ TEST(NaturalBearings, DriverEffortsGiveTheSweepsTorqueRowByRow) {
 // The efforts' ∂τ/∂p with the journals at the points: their loads are their bodies' balances, affine in λ (the losses'
 // adjoint reads their own constraints' rows), and along p those balances read the bodies' motion, parts, loads, own
 // constraints and fixed pivots as the scene along p holds them: the crank's length, the ground pivots' distance
-// (C's constant) and μ, against re-solved sweeps.
+// (C's constant) and μ, against re-solved sweeps, also with a massless part listed first.
 TEST(NaturalBearings, TheEffortsSensitivitiesMatchResolvedSweeps) {
   std::string text = natural_four_bar_with_bearings();
   for (int pin = 0; pin < 4; ++pin) text = test::replace_first(text, "coefficient: 0.2", "coefficient: mu");
@@ -126,6 +126,9 @@ TEST(NaturalBearings, TheEffortsSensitivitiesMatchResolvedSweeps) {
       text, "output: {velocities: true, accelerations: true, efforts: [motor], reactions: [O, A, B, C], losses: all}",
       "output: {efforts: [motor], sensitivities: [L2, L1, mu]}");
   test::expect_effort_sensitivities_match_resolved_sweeps(text);
+  // a massless part before the links (the efforts' parts keep those with mass: the links' indices shift)
+  test::expect_effort_sensitivities_match_resolved_sweeps(
+      test::replace_first(text, "parts:\n", "parts:\n  stand: {frame: {at: [0, 0], angle: 0}}\n"));
 }
 
 TEST(NaturalBearings, WhatCannotBeSplitIsRefusedInOneLine) {

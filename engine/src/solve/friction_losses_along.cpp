@@ -293,7 +293,7 @@ std::vector<const Attachment3*> frame_points_of(const PartFrame& f) {
 std::string FrictionLosses::natural_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const {
   const OutputEfforts& joints = set_->joints;
   const NaturalJoints& natural = *joints.natural;
-  const std::vector<Part>& parts = *joints.parts;
+  const std::vector<Part>& parts = *joints.parts;  // (with mass only)
   // the bodies' own constraints in the four models, where p reaches them
   std::array<std::vector<std::pair<Index, JointReactions::BlockAt>>, 4> own;
   std::array<JointReactions::BlockAt, 4> at;
@@ -307,26 +307,40 @@ std::string FrictionLosses::natural_along(const Model& model, const OutputSensit
     for (std::size_t k = 0; k < 4; ++k) own[k].emplace_back(c, at[k]);
   }
   for (std::size_t k = 0; k < 4; ++k) {
-    // the bodies, their parts and loads as the scene along p holds them, their joints at the same places of their
-    // frames (a fixed pivot's constant moved with p)
-    auto along = std::make_shared<const std::vector<Part>>(p.parts_along[k] ? *p.parts_along[k] : parts);
+    // the bodies in their order, each with its part as the scene along p holds it (the efforts' parts have mass: a
+    // massless body keeps its frame), their loads there, and their joints at the same places of their frames (a
+    // fixed pivot's constant moved with p)
+    const std::vector<Part>& along = p.parts_along[k] ? *p.parts_along[k] : parts;
+    auto bodies = std::make_shared<std::vector<Part>>();
+    bodies->reserve(natural.bodies.size());
+    for (const NaturalBody& b : natural.bodies) {
+      const auto it = std::find_if(along.begin(), along.end(), [&](const Part& x) { return x.name == b.name; });
+      if (it != along.end()) {
+        bodies->push_back(*it);
+      } else {
+        bodies->emplace_back().name = b.name;
+        bodies->back().frame = b.frame;
+      }
+    }
     const std::shared_ptr<const Loads> loads = p.loads_along[k] ? p.loads_along[k] : joints.loads;
     std::vector<std::pair<std::string, Attachment3>> points;
     for (const NaturalJoint& j : natural.joints) {
-      const std::size_t part = natural.bodies[j.bodies.front()].part;
-      const std::vector<const Attachment3*> here = frame_points_of(parts.at(part).frame),
-                                            there = frame_points_of(along->at(part).frame);
+      const std::size_t b = j.bodies.front();
+      const std::vector<const Attachment3*> here = frame_points_of(natural.bodies[b].frame),
+                                            there = frame_points_of((*bodies)[b].frame);
       std::size_t m = 0;
       while (m < here.size() && !(here[m]->r[0] == j.point.r[0] && here[m]->r[1] == j.point.r[1])) ++m;
       if (m == here.size() || there.size() != here.size()) return "the bearing at natural point '" + j.name + "'";
       points.emplace_back(j.name, *there[m]);
     }
-    auto bodies = std::make_shared<const NaturalJoints>(
-        find_natural_joints(*along, *loads, points, model.num_coordinates(), natural.spatial));
-    if (bodies->joints.size() != natural.joints.size() || bodies->bodies.size() != natural.bodies.size())
-      return "the bearings at natural points (their bodies change with it)";
+    auto found = std::make_shared<const NaturalJoints>(
+        find_natural_joints(*bodies, *loads, points, model.num_coordinates(), natural.spatial));
+    bool same = found->joints.size() == natural.joints.size() && found->bodies.size() == natural.bodies.size();
+    for (std::size_t j = 0; same && j < natural.joints.size(); ++j)
+      same = found->joints[j].bodies == natural.joints[j].bodies;
+    if (!same) return "the bearings at natural points (their bodies change with it)";
     OutputEfforts e = joints;
-    e.parts = along, e.loads = loads, e.natural = bodies;
+    e.parts = bodies, e.loads = loads, e.natural = found;
     out.natural[k] = std::make_shared<JointReactions>(model, e);
     out.natural[k]->read_along(out.at[k], own[k], model);
   }
