@@ -129,6 +129,26 @@ TEST(NaturalBearings, TheEffortsSensitivitiesMatchResolvedSweeps) {
   // a massless part before the links (the efforts' parts keep those with mass: the links' indices shift)
   test::expect_effort_sensitivities_match_resolved_sweeps(
       test::replace_first(text, "parts:\n", "parts:\n  stand: {frame: {at: [0, 0], angle: 0}}\n"));
+  // with a reference-point arm on a revolute at (0, 0.3), turned at twice the crank's rate and tied to the coupler by
+  // a spring, its journal (radius ra) a bearing of a constraint beside the points' (its geometry kept per multiplier
+  // apart from theirs)
+  std::string arm = test::replace_first(text, "  theta4: 1.5\n", "  theta4: 1.5\n  xa: 0\n  ya: 0.3\n  pa: 0\n");
+  arm = test::replace_first(arm, "points:", "bodies: {arm: [xa, ya, pa]}\npoints:");
+  arm = test::replace_first(
+      arm, "drivers:",
+      "  - {name: arm_pivot, type: revolute, between: [{body: ground, at: [0, 0.3]}, {body: arm}]}\n"
+      "  - {name: arm_follows, type: equation, expr: \"pa - 2*theta2\", unit: angle}\n"
+      "drivers:");
+  arm = test::replace_first(arm, "parts:\n", "parts:\n  arm: {mass: 0.5, center_of_mass: [0.1, 0], inertia: 0.01}\n");
+  arm = test::replace_first(
+      arm, "  torsional_springs:\n",
+      "  springs: [{name: tie, between: [{part: arm, at: [0.2, 0]}, {part: coupler, at: [0.5, 0]}], "
+      "stiffness: 40, free_length: 0.3}]\n"
+      "  torsional_springs:\n    - {name: fa, angle: pa, bearing: {joint: arm_pivot, coefficient: "
+      "mu, radius: ra}}\n");
+  arm = test::replace_first(arm, "parameters: {", "parameters: {ra: 0.03, ");
+  test::expect_effort_sensitivities_match_resolved_sweeps(
+      test::replace_first(arm, "sensitivities: [L2, L1, mu]", "sensitivities: [L2, mu, ra]"));
 }
 
 TEST(NaturalBearings, WhatCannotBeSplitIsRefusedInOneLine) {
