@@ -192,7 +192,8 @@ class FrictionLosses {
   const double* q_ = nullptr;                    // solve()'s (adjoint() turns a natural point's force to its axes)
   double t_ = 0.0;
   std::vector<std::vector<std::pair<Index, double>>> natural_load_rows_;  // adjoint()'s, natural bearings'
-  std::vector<Index> force_rows_;                                         // scratch of adjoint()
+  std::vector<std::size_t> kept_index_;  // adjoint()'s: each bearing's joint among kept_reactions_' (or reactions_')
+  std::vector<Index> force_rows_;        // scratch of adjoint()
   std::vector<double> force_row_values_;
   Eigen::VectorXd qdk_, qddk_;  // force_rate()'s motion, a natural point's reaction reading q̇ and q̈
   std::vector<MeshState> mesh_states_;

@@ -20,14 +20,14 @@ bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
   // the joints whose geometry is kept per unit multiplier: all the bearings', or the others than natural points'
   JointReactions* kept = natural_ ? (kept_reactions_ ? &*kept_reactions_ : nullptr)
                                   : (reactions_ ? &*reactions_ : nullptr);  // (none: gear losses alone)
-  auto kept_index = [&](std::size_t i) {                                    // bearing i's among `kept`'s joints
-    std::size_t k = 0;
-    for (std::size_t j = 0; j < i; ++j) k += set_->bearings[j].constraint >= 0 ? 1 : 0;
-    return natural_ ? k : i;
-  };
   if (!adjoint_ready_) {  // ∂m_i/∂λ over each bearing's joint's rows: the row's, the same for every driver row
     load_rows_.assign(6 * nb, 0.0);
     natural_load_rows_.resize(nb);
+    kept_index_.resize(nb);  // bearing i's joint among `kept`'s
+    for (std::size_t i = 0, k = 0; i < nb; ++i) {
+      kept_index_[i] = natural_ ? k : i;
+      k += set_->bearings[i].constraint >= 0 ? 1 : 0;
+    }
     if (natural_ && kept) kept->keep_geometry(q_, t_);
     double d[6];
     for (std::size_t i = 0; i < nb; ++i) {
@@ -45,7 +45,7 @@ bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
                                              mu * (gx * force_row_values_[2 * r] + gy * force_row_values_[2 * r + 1]));
         continue;
       }
-      const auto& per_row = kept->kept_per_row(kept_index(i));
+      const auto& per_row = kept->kept_per_row(kept_index_[i]);
       for (Index j = 0; j < per_row.cols(); ++j) {
         double g = 0.0;
         for (int v = 0; v < 6; ++v) g += d[v] * per_row(v, j);
@@ -69,7 +69,7 @@ bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
         for (const auto& [row, value] : natural_load_rows_[i]) adjoint_rhs_(row) += along * value;
         continue;
       }
-      const std::size_t k = kept_index(i);
+      const std::size_t k = kept_index_[i];
       const Index first = kept->kept_first_row(k), rows = kept->kept_per_row(k).cols();
       for (Index j = 0; j < rows; ++j)
         adjoint_rhs_(first + j) += along * load_rows_[6 * i + static_cast<std::size_t>(j)];
