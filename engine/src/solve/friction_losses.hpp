@@ -174,13 +174,15 @@ class FrictionLosses {
   void frozen_forces(const double* q, const double* qd, const double* qdd, double t, const Eigen::VectorXd& lambda,
                      const AppliedLoads* data, const JointsAlong* joints, std::size_t k, Eigen::VectorXd& out);
   // JointsAlong::natural for p (natural bearings): the bodies' parts and loads along p, their own constraints too
-  std::string natural_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const;
+  // (`build` false: checked, no reactions built)
+  std::string natural_along(const Model& model, const OutputSensitivity& p, JointsAlong& out, bool build) const;
   // constraint c in the four models along p (its kept copies, its data moved along their rates, or the models'):
   // false where none stands for it
   bool constraint_along(const Model& model, const OutputSensitivity& p, Index c,
                         std::array<JointReactions::BlockAt, 4>& at, JointsAlong& out) const;
   // p's bearings' joints along it into `out` (JointsAlong), else the first loss p reaches that they cannot follow
-  std::string find_joints_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const;
+  std::string find_joints_along(const Model& model, const OutputSensitivity& p, JointsAlong& out,
+                                bool build = true) const;
 
   std::shared_ptr<const SetUp> set_;
   std::optional<JointReactions> reactions_;  // the bearings' joints (none without bearings)

@@ -183,7 +183,7 @@ std::string FrictionLosses::sensitivity_refusal(const Model& model, const Output
   const std::string with = "the efforts' sensitivities to '" + p.name + "' with ";
   if (!p.reach) return {};
   JointsAlong joints;
-  const std::string who = find_joints_along(model, p, joints);
+  const std::string who = find_joints_along(model, p, joints, false);
   return who.empty() ? who
                      : with + who + ": '" + p.name +
                            "' moves a constraint whose data the losses' derivative cannot move along it (an "
@@ -233,7 +233,8 @@ bool FrictionLosses::constraint_along(const Model& model, const OutputSensitivit
   return true;
 }
 
-std::string FrictionLosses::find_joints_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const {
+std::string FrictionLosses::find_joints_along(const Model& model, const OutputSensitivity& p, JointsAlong& out,
+                                              bool build) const {
   const std::vector<Index>& reached = p.reach->rows;
   auto touched = [&](Index first, Index rows) {
     const auto it = std::lower_bound(reached.begin(), reached.end(), first);
@@ -275,7 +276,7 @@ std::string FrictionLosses::find_joints_along(const Model& model, const OutputSe
       }
     }
   }
-  return natural_ ? natural_along(model, p, out) : std::string();
+  return natural_ ? natural_along(model, p, out, build) : std::string();
 }
 
 namespace {
@@ -290,7 +291,8 @@ std::vector<const Attachment3*> frame_points_of(const PartFrame& f) {
 
 }  // namespace
 
-std::string FrictionLosses::natural_along(const Model& model, const OutputSensitivity& p, JointsAlong& out) const {
+std::string FrictionLosses::natural_along(const Model& model, const OutputSensitivity& p, JointsAlong& out,
+                                          bool build) const {
   const OutputEfforts& joints = set_->joints;
   const NaturalJoints& natural = *joints.natural;
   const std::vector<Part>& parts = *joints.parts;  // (with mass only)
@@ -339,6 +341,7 @@ std::string FrictionLosses::natural_along(const Model& model, const OutputSensit
     for (std::size_t j = 0; same && j < natural.joints.size(); ++j)
       same = found->joints[j].bodies == natural.joints[j].bodies;
     if (!same) return "the bearings at natural points (their bodies change with it)";
+    if (!build) continue;  // (a check: the balances are built where they are read)
     OutputEfforts e = joints;
     e.parts = bodies, e.loads = loads, e.natural = found;
     out.natural[k] = std::make_shared<JointReactions>(model, e);

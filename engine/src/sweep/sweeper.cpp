@@ -23,12 +23,13 @@ Sweeper::Sweeper(const Model& m, const SweepOptions& o, Workspace& ws, SweepSumm
                   effort_work_.reactions ? effort_work_.reactions->planar_parts_read(opt_.efforts.parts->size())
                                          : std::vector<char>{});
   if (opt_.efforts.active() && opt_.efforts.loads && FrictionLosses::any(opt_.efforts.loads->applied.get())) {
-    if (same_sweep(like) && like->effort_work_.losses)  // (its set-up, as the reactions' and Q's parts are shared)
+    const bool copied = same_sweep(like) && like->effort_work_.losses;
+    if (copied)  // (its set-up, as the reactions' and Q's parts are shared; its parameters checked there)
       effort_work_.losses.emplace(FrictionLosses::with_set_up_of(*like->effort_work_.losses));
     else
       effort_work_.losses.emplace(model_, *opt_.efforts.loads->applied, &opt_.efforts);
-    // the efforts' ∂τ/∂p follow the losses' data and the motion, not a loss's own geometry along p
-    if (!opt_.efforts.constraints.empty())
+    // the efforts' ∂τ/∂p follow the losses along p where the constraints they read can be moved there
+    if (!opt_.efforts.constraints.empty() && !copied)
       for (const OutputSensitivity& p : opt_.sensitivities)
         if (const std::string why = effort_work_.losses->sensitivity_refusal(model_, p); !why.empty()) throw Error(why);
   }
