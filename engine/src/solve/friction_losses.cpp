@@ -214,6 +214,10 @@ FrictionLosses::FrictionLosses(const Model& model, const AppliedLoads& loads, co
               !up->bearings.empty());
   if (natural_) joints.parts = efforts->parts, joints.loads = efforts->loads, joints.natural = efforts->natural;
   if (!up->bearings.empty()) reactions_.emplace(model, joints);
+  for (std::size_t i = 0, k = 0; i < up->bearings.size(); ++i) {
+    up->bearings[i].kept = natural_ ? k : i;
+    k += up->bearings[i].constraint >= 0 ? 1 : 0;
+  }
   if (natural_) {  // (the efforts' sensitivities' adjoint keeps the other bearings' joints' geometry apart)
     OutputEfforts others;
     others.reactions_in_joint_axes = true;

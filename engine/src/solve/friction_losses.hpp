@@ -139,6 +139,9 @@ class FrictionLosses {
     std::string point;
     std::size_t at = 0;  // its reaction's first value in the reactions' row
     bool spatial = false;
+    // its joint among those whose geometry adjoint() keeps: reactions_', or with a natural point's bearing
+    // kept_reactions_' (the others')
+    std::size_t kept = 0;
   };
   // A mesh: its row θ1 + k θ2 − (1 + k) θc − φ (the last of its constraint's), the loss 1 − η
   struct Mesh {
@@ -194,8 +197,7 @@ class FrictionLosses {
   const double* q_ = nullptr;                    // solve()'s (adjoint() turns a natural point's force to its axes)
   double t_ = 0.0;
   std::vector<std::vector<std::pair<Index, double>>> natural_load_rows_;  // adjoint()'s, natural bearings'
-  std::vector<std::size_t> kept_index_;  // adjoint()'s: each bearing's joint among kept_reactions_' (or reactions_')
-  std::vector<Index> force_rows_;        // scratch of adjoint()
+  std::vector<Index> force_rows_;                                         // scratch of adjoint()
   std::vector<double> force_row_values_;
   Eigen::VectorXd qdk_, qddk_;  // force_rate()'s motion, a natural point's reaction reading q̇ and q̈
   std::vector<MeshState> mesh_states_;

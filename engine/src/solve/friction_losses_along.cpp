@@ -12,6 +12,7 @@
 #include "phiq/sensitivity.hpp"
 #include "solve/friction_losses.hpp"
 #include "solve/models_along.hpp"  // kShift
+#include "solve/natural_frame_points.hpp"
 
 namespace phiq::detail {
 
@@ -23,11 +24,6 @@ bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
   if (!adjoint_ready_) {  // ∂m_i/∂λ over each bearing's joint's rows: the row's, the same for every driver row
     load_rows_.assign(6 * nb, 0.0);
     natural_load_rows_.resize(nb);
-    kept_index_.resize(nb);  // bearing i's joint among `kept`'s
-    for (std::size_t i = 0, k = 0; i < nb; ++i) {
-      kept_index_[i] = natural_ ? k : i;
-      k += set_->bearings[i].constraint >= 0 ? 1 : 0;
-    }
     if (natural_ && kept) kept->keep_geometry(q_, t_);
     double d[6];
     for (std::size_t i = 0; i < nb; ++i) {
@@ -45,7 +41,7 @@ bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
                                              mu * (gx * force_row_values_[2 * r] + gy * force_row_values_[2 * r + 1]));
         continue;
       }
-      const auto& per_row = kept->kept_per_row(kept_index_[i]);
+      const auto& per_row = kept->kept_per_row(set_->bearings[i].kept);
       for (Index j = 0; j < per_row.cols(); ++j) {
         double g = 0.0;
         for (int v = 0; v < 6; ++v) g += d[v] * per_row(v, j);
@@ -69,7 +65,7 @@ bool FrictionLosses::adjoint(SparseLuNumeric& lu, Eigen::VectorXd& w) {
         for (const auto& [row, value] : natural_load_rows_[i]) adjoint_rhs_(row) += along * value;
         continue;
       }
-      const std::size_t k = kept_index_[i];
+      const std::size_t k = set_->bearings[i].kept;
       const Index first = kept->kept_first_row(k), rows = kept->kept_per_row(k).cols();
       for (Index j = 0; j < rows; ++j)
         adjoint_rhs_(first + j) += along * load_rows_[6 * i + static_cast<std::size_t>(j)];
@@ -279,18 +275,6 @@ std::string FrictionLosses::find_joints_along(const Model& model, const OutputSe
   return natural_ ? natural_along(model, p, out, build) : std::string();
 }
 
-namespace {
-
-// Frame f's points in order (origin, x toward and y toward where they are points): NaturalBody::points' order.
-std::vector<const Attachment3*> frame_points_of(const PartFrame& f) {
-  std::vector<const Attachment3*> out{&f.origin};
-  if (f.x_is_point) out.push_back(&f.x_toward);
-  if (f.spatial_frame && f.y_is_point) out.push_back(&f.y_toward);
-  return out;
-}
-
-}  // namespace
-
 std::string FrictionLosses::natural_along(const Model& model, const OutputSensitivity& p, JointsAlong& out,
                                           bool build) const {
   const OutputEfforts& joints = set_->joints;
@@ -328,8 +312,7 @@ std::string FrictionLosses::natural_along(const Model& model, const OutputSensit
     std::vector<std::pair<std::string, Attachment3>> points;
     for (const NaturalJoint& j : natural.joints) {
       const std::size_t b = j.bodies.front();
-      const std::vector<const Attachment3*> here = frame_points_of(natural.bodies[b].frame),
-                                            there = frame_points_of((*bodies)[b].frame);
+      const auto here = frame_points(natural.bodies[b].frame), there = frame_points(std::as_const((*bodies)[b].frame));
       std::size_t m = 0;
       while (m < here.size() && !(here[m]->r[0] == j.point.r[0] && here[m]->r[1] == j.point.r[1])) ++m;
       if (m == here.size() || there.size() != here.size()) return "the bearing at natural point '" + j.name + "'";

@@ -9,27 +9,13 @@
 #include <type_traits>
 #include <unordered_map>
 
+#include "solve/natural_frame_points.hpp"
+
 namespace phiq {
 
-namespace {
+using detail::frame_points;
 
-// The frame's points: the origin, and x and y toward when they are points (a vector has no place to act). In place,
-// not a vector: set-up asks for them several times per body, 10⁵ allocations at nfourbar 10⁴.
-template <class Point>
-struct FramePoints {
-  Point* at[3];
-  int count = 0;
-  Point* const* begin() const { return at; }
-  Point* const* end() const { return at + count; }
-};
-template <class Frame>  // PartFrame or const PartFrame
-auto frame_points(Frame& f) {
-  FramePoints<std::remove_reference_t<decltype(f.origin)>> out;
-  out.at[out.count++] = &f.origin;
-  if (f.x_is_point) out.at[out.count++] = &f.x_toward;
-  if (f.spatial_frame && f.y_is_point) out.at[out.count++] = &f.y_toward;
-  return out;
-}
+namespace {
 
 // A point's slots as a key: per component whether it is a coordinate, and its index or value.
 std::array<double, 6> point_key(const Attachment3& a) {
