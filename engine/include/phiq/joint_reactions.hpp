@@ -47,7 +47,7 @@ class BarLengths;
 /// model's constraints.
 int reaction_width(const Model& model, Index c);
 
-/// A constraint of a block other than the model's, standing for a listed joint's (JointReactions::evaluate_along()).
+/// A constraint of a block other than the model's, standing for one of the model's (JointReactions::Along).
 struct ReactionBlockAt {
   const ConstraintBlock* block = nullptr;  ///< null: the model's own
   std::size_t index = 0;                   ///< in `block`
@@ -57,6 +57,20 @@ struct ReactionBlockAt {
 /// constraint, which coordinates it reads), with scratch for evaluate(). Not thread-safe: one per thread.
 class JointReactions {
  public:
+  /// A constraint of a block other than the model's, standing for one of the model's.
+  using BlockAt = ReactionBlockAt;
+  /// The constraints an evaluate() reads from a model along a design parameter (their rows and Jacobian entries the
+  /// model's: its copies, or the constraint with its data moved), where the losses' derivative along p reads the
+  /// reactions under the same λ (detail::FrictionLosses::force_rate()). Made by along().
+  struct Along {
+    std::vector<BlockAt> sites;  // per constraint site (empty: none read elsewhere)
+    struct Own {
+      const ConstraintBlock* block = nullptr;  // the model's
+      std::size_t index = 0;
+      BlockAt at;
+    };
+    std::vector<Own> own;  // the natural bodies' own constraints read elsewhere
+  };
   /// Pre-condition: each of `constraints` has a reaction (reaction_width() > 0); else phiq::Error naming it.
   JointReactions(const Model& model, std::vector<Index> constraints);
   /// The reactions `efforts` lists (OutputEfforts::reactions, in order): a constraint's, or a natural joint's of
@@ -83,7 +97,8 @@ class JointReactions {
   /// Writes the reactions at (q, t) under multipliers `lambda` (one per model row) to out[0, size()).
   /// Pre-condition: q has the model's coordinates; the model is the one given to the constructor.
   /// No natural joint may be listed (they read q̇ and q̈: the overload below; else phiq::Error).
-  void evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out);
+  /// `along`: constraints read elsewhere (Along).
+  void evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out, const Along* along = nullptr);
   /// The same at the motion (q, q̇, q̈, t), which natural joints read (their bodies' inertia). `planar`, when not
   /// null, is what detail::PartForces::add() left of OutputEfforts::parts' forces at this (q, q̇, q̈, t) (internal: a
   /// sweep's, whose Q has computed them): a natural body's part's weight and inertia are read there rather than
@@ -93,7 +108,8 @@ class JointReactions {
   /// reaction is one of its force's values) sums that value from q̈ itself, bit for bit (its part's PlanarForce is
   /// not read: planar_parts_read() leaves it out); without `sum_bars` it reads it, as every other site.
   void evaluate(const double* q, const double* qd, const double* qdd, double t, const Eigen::VectorXd& lambda,
-                double* out, const detail::PlanarForce* planar = nullptr, bool sum_bars = true);
+                double* out, const detail::PlanarForce* planar = nullptr, bool sum_bars = true,
+                const Along* along = nullptr);
   /// Keeps the listed joints' geometry at (q, t): each site, its body's frame Jacobian and the factors of the
   /// equations that give its wrench, which every λ at that q shares (detail::FrictionLosses' passes). Pre-condition
   /// as the first evaluate()'s: no natural joint listed (else phiq::Error).
@@ -103,22 +119,11 @@ class JointReactions {
   /// multiplier of each row, and this sums them (six products a planar pin). Pre-condition: keep_geometry() at
   /// this q and t.
   void evaluate_kept(const double* q, double t, const Eigen::VectorXd& lambda, double* out);
-  /// A constraint of a block other than the model's, standing for a listed joint's (evaluate_along()).
-  using BlockAt = ReactionBlockAt;
-  /// The first evaluate() with the k-th listed joint's constraint read from along[k] where its block is not null:
-  /// the same constraint in a model along a design parameter (its rows and coordinates the model's), whose reaction
-  /// under the same λ the losses' derivative along p reads (detail::FrictionLosses::force_rate()). Pre-condition:
-  /// as the first evaluate(); along.size() is the number of listed joints.
-  void evaluate_along(const std::vector<BlockAt>& along, const double* q, double t, const Eigen::VectorXd& lambda,
-                      double* out);
-  /// The listed joints' constraints, and the natural bodies' own constraints, read from a model along a design
-  /// parameter (their rows and Jacobian entries the model's) by the evaluate()s that follow: `listed[k]` for the
-  /// k-th listed joint where its block is not null (empty: none), `own` each a constraint and where to read it. For
-  /// the losses' derivative along p where natural points' bearings read their bodies' balance
-  /// (detail::FrictionLosses::force_rate()).
-  void read_along(const std::vector<BlockAt>& listed, const std::vector<std::pair<Index, BlockAt>>& own,
-                  const Model& model);
-  /// The natural bodies' own constraints whose Φq values the natural joints' balances read (read_along()'s `own`).
+  /// `listed[k]` for the k-th listed joint where its block is not null (empty: none), `own` each a natural body's
+  /// own constraint and where to read it. Pre-condition: the blocks outlive the result's use.
+  Along along(const std::vector<BlockAt>& listed, const std::vector<std::pair<Index, BlockAt>>& own,
+              const Model& model) const;
+  /// The natural bodies' own constraints whose Φq values the natural joints' balances read (along()'s `own`).
   std::vector<Index> own_constraints(const Model& model) const;
   /// The k-th listed joint, a planar natural one: its force's derivative along each multiplier it reads (its body's
   /// own constraints' rows), in world axes, at the last evaluate()'s q: `rows[i]` and (∂Fx, ∂Fy)/∂λ at `d[2 i]`.
@@ -269,7 +274,7 @@ class JointReactions {
     // keep_geometry()'s: the reaction's values per unit multiplier of each of the site's rows, column j row j's
     Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6> per_row;
   };
-  // (`at`: the site's constraint read elsewhere, evaluate_along())
+  // (`at`: the site's constraint read elsewhere, Along)
   void site_geometry(const Site& s, const double* q, double t, SiteGeometry& g, BlockAt at = {}) const;
   void site_reaction(const Site& s, const SiteGeometry& g, const double* q, double t, const Eigen::VectorXd& lambda,
                      double*& out, BlockAt at = {});
@@ -279,7 +284,7 @@ class JointReactions {
   // BodyRows::entries' slots numbered afresh, own_values_ sized to them (BodyRows::own_slot_of_entry)
   void number_own_entries(const Model& model);
   // own_values_ = Φq's values of BodyRows::runs at (q, t), once a row
-  void evaluate_own_jacobian(const double* q, double t);
+  void evaluate_own_jacobian(const double* q, double t, const Along* along = nullptr);
   // g_ += Φq,cᵀ λ_c over body b's own constraints (own_values_), and g_'s entries those touch cleared again
   void add_body_constraint_forces(std::size_t b, const Eigen::VectorXd& lambda);
   void clear_body_constraint_forces(std::size_t b);
@@ -316,18 +321,10 @@ class JointReactions {
   Eigen::VectorXd qx_, qdx_, qddx_, qb_;  // q, q̇, q̈ with the promoted constants; a body's Q
   std::vector<double> g_;                 // −Φq,cᵀ λ_c, one entry per coordinate, zero between evaluations
   std::vector<double> own_values_;        // Φq's values of the natural bodies' own constraints (BodyRows' slots)
-  // read_own_along()'s: per own constraint read elsewhere, its model block and index, and where it is read
-  struct OwnAlong {
-    const ConstraintBlock* block = nullptr;
-    std::size_t index = 0;
-    BlockAt at;
-  };
-  std::vector<OwnAlong> own_along_;
-  std::vector<BlockAt> sites_along_;  // read_along()'s, per site (empty: none)
-  SiteGeometry geometry_;             // evaluate_site()'s (its vectors' capacity kept: no allocation per row)
-  std::vector<SiteGeometry> kept_;    // keep_geometry()'s, one per constraint site
-  Eigen::VectorXd unit_;              // keep_geometry()'s unit multipliers
-  std::vector<Part> body_part_;       // a body's parts built where they are read (body_parts_kept's others)
+  SiteGeometry geometry_;                 // evaluate_site()'s (its vectors' capacity kept: no allocation per row)
+  std::vector<SiteGeometry> kept_;        // keep_geometry()'s, one per constraint site
+  Eigen::VectorXd unit_;                  // keep_geometry()'s unit multipliers
+  std::vector<Part> body_part_;           // a body's parts built where they are read (body_parts_kept's others)
 };
 
 /// What add_gear_mesh_forces() finds at a row: the meshes it names, in `meshes`' order.

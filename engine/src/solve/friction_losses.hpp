@@ -104,6 +104,8 @@ class FrictionLosses {
     // natural points' bearings: their reactions as the models along p hold their bodies (their parts, loads and own
     // constraints there); null without natural bearings
     std::array<std::shared_ptr<JointReactions>, 4> natural;
+    // what each model's reactions (natural[k], else the losses' own) read there instead of the model's constraints
+    std::array<JointReactions::Along, 4> along;
   };
   // Parameter p's (its reach known), found once per parameter and kept; null where p reaches no bearing's joint and
   // no mesh.

@@ -100,16 +100,14 @@ void FrictionLosses::frozen_forces(const double* q, const double* qd, const doub
                                    const Eigen::VectorXd& lambda, const AppliedLoads* data, const JointsAlong* joints,
                                    std::size_t k, Eigen::VectorXd& out) {
   out.setZero(q_f_.size());
+  const JointReactions::Along* along = joints ? &joints->along[k] : nullptr;
   if (natural_) {  // (a natural point's reaction reads its bodies' motion, as the models along p hold them)
     frozen_values_.resize(values_.size());
     JointReactions& r = joints && joints->natural[k] ? *joints->natural[k] : *reactions_;
-    r.evaluate(q, qd, qdd, t, lambda, frozen_values_.data());
+    r.evaluate(q, qd, qdd, t, lambda, frozen_values_.data(), nullptr, true, along);
   } else if (reactions_) {
     frozen_values_.resize(values_.size());
-    if (joints && !joints->at[k].empty())
-      reactions_->evaluate_along(joints->at[k], q, t, lambda, frozen_values_.data());
-    else
-      reactions_->evaluate(q, t, lambda, frozen_values_.data());
+    reactions_->evaluate(q, t, lambda, frozen_values_.data(), along);
   }
   std::size_t in_data = 0;  // the next torsional spring of `data` to look at
   for (std::size_t i = 0; i < set_->bearings.size(); ++i) {
@@ -272,7 +270,10 @@ std::string FrictionLosses::find_joints_along(const Model& model, const OutputSe
       }
     }
   }
-  return natural_ ? natural_along(model, p, out, build) : std::string();
+  if (natural_) return natural_along(model, p, out, build);
+  if (!out.at[0].empty())
+    for (std::size_t k = 0; k < 4; ++k) out.along[k] = reactions_->along(out.at[k], {}, model);
+  return {};
 }
 
 std::string FrictionLosses::natural_along(const Model& model, const OutputSensitivity& p, JointsAlong& out,
@@ -328,7 +329,7 @@ std::string FrictionLosses::natural_along(const Model& model, const OutputSensit
     OutputEfforts e = joints;
     e.parts = bodies, e.loads = loads, e.natural = found;
     out.natural[k] = std::make_shared<JointReactions>(model, e);
-    out.natural[k]->read_along(out.at[k], own[k], model);
+    out.along[k] = out.natural[k]->along(out.at[k], own[k], model);
   }
   return {};
 }

@@ -216,24 +216,26 @@ JointReactions::JointReactions(const JointReactions& other, SetUpOnly)
   if (!set_->natural_sites.empty()) size_natural_scratch();
 }
 
-void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out) {
+void JointReactions::evaluate(const double* q, double t, const Eigen::VectorXd& lambda, double* out,
+                              const Along* along) {
   if (!set_->natural_sites.empty())
     throw Error("JointReactions::evaluate: natural joints read q̇ and q̈: give them (phiq bug)");
-  for (const Site& s : set_->sites) evaluate_site(s, q, t, lambda, out);
+  for (std::size_t k = 0; k < set_->sites.size(); ++k)
+    evaluate_site(set_->sites[k], q, t, lambda, out, along && !along->sites.empty() ? along->sites[k] : BlockAt{});
 }
 
 void JointReactions::evaluate(const double* q, const double* qd, const double* qdd, double t,
                               const Eigen::VectorXd& lambda, double* out, const detail::PlanarForce* planar,
-                              bool sum_bars) {
+                              bool sum_bars, const Along* along) {
   RowMotion row{q, qd, qdd, false};
-  evaluate_own_jacobian(q, t);
+  evaluate_own_jacobian(q, t, along);
   const bool simple = planar && !set_->joint_axes;  // (NaturalSite::simple's sums are in world axes)
   const SimpleSite* const simple_sites = set_->simple_sites.data();
   const std::size_t simple_count = set_->simple_sites.size();
   const BarSum* const bar_sums = set_->bar_sums.data();
   for (const auto& [natural, k] : set_->order) {
     if (!natural) {
-      evaluate_site(set_->sites[k], q, t, lambda, out, sites_along_.empty() ? BlockAt{} : sites_along_[k]);
+      evaluate_site(set_->sites[k], q, t, lambda, out, along && !along->sites.empty() ? along->sites[k] : BlockAt{});
       continue;
     }
     const SimpleSite* e = simple && k < simple_count ? simple_sites + k : nullptr;
@@ -327,14 +329,6 @@ void JointReactions::evaluate_site(const Site& s, const double* q, double t, con
                                    double*& out, BlockAt at) {
   site_geometry(s, q, t, geometry_, at);
   site_reaction(s, geometry_, q, t, lambda, out, at);
-}
-
-void JointReactions::evaluate_along(const std::vector<BlockAt>& along, const double* q, double t,
-                                    const Eigen::VectorXd& lambda, double* out) {
-  if (!set_->natural_sites.empty())
-    throw Error("JointReactions::evaluate_along: natural joints have no constraint to read elsewhere (phiq bug)");
-  if (along.size() != set_->sites.size()) throw Error("JointReactions::evaluate_along: one per joint (phiq bug)");
-  for (std::size_t k = 0; k < along.size(); ++k) evaluate_site(set_->sites[k], q, t, lambda, out, along[k]);
 }
 
 void JointReactions::keep_geometry(const double* q, double t) {

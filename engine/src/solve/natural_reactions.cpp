@@ -301,37 +301,39 @@ void JointReactions::number_own_entries(const Model& model) {
   own_values_.assign(static_cast<std::size_t>(own), 0.0);
 }
 
-void JointReactions::evaluate_own_jacobian(const double* q, double t) {
+void JointReactions::evaluate_own_jacobian(const double* q, double t, const Along* along) {
   const BodyRows& rows = set_->body_rows;
   if (rows.runs.empty()) return;
   if (!rows.overwrite) std::fill(own_values_.begin(), own_values_.end(), 0.0);  // (entries that share a slot add)
   for (const OwnRun& r : rows.runs) {
-    if (own_along_.empty()) {
+    if (!along || along->own.empty()) {
       r.block->jacobian(r.begin, r.end, q, t, rows.slot_of_entry, own_values_.data(), rows.overwrite);
       continue;
     }
     for (std::size_t i = r.begin; i < r.end; ++i) {  // (a copy keeps its entries' places in the pattern)
-      const auto along = std::find_if(own_along_.begin(), own_along_.end(),
-                                      [&](const OwnAlong& o) { return o.block == r.block && o.index == i; });
-      const ConstraintBlock& b = along == own_along_.end() ? *r.block : *along->at.block;
-      const std::size_t at = along == own_along_.end() ? i : along->at.index;
+      const auto o = std::find_if(along->own.begin(), along->own.end(),
+                                  [&](const Along::Own& x) { return x.block == r.block && x.index == i; });
+      const ConstraintBlock& b = o == along->own.end() ? *r.block : *o->at.block;
+      const std::size_t at = o == along->own.end() ? i : o->at.index;
       b.jacobian(at, at + 1, q, t, rows.slot_of_entry, own_values_.data(), rows.overwrite);
     }
   }
 }
 
-void JointReactions::read_along(const std::vector<BlockAt>& listed, const std::vector<std::pair<Index, BlockAt>>& own,
-                                const Model& model) {
-  own_along_.clear(), sites_along_.clear();
+JointReactions::Along JointReactions::along(const std::vector<BlockAt>& listed,
+                                            const std::vector<std::pair<Index, BlockAt>>& own,
+                                            const Model& model) const {
+  Along out;
   for (const auto& [c, at] : own) {
     if (!at.block) continue;
     const auto [block, index] = model.constraint_block(c);
-    own_along_.push_back({block, index, at});
+    out.own.push_back({block, index, at});
   }
-  if (listed.empty()) return;
-  sites_along_.assign(set_->sites.size(), BlockAt{});
+  if (listed.empty()) return out;
+  out.sites.assign(set_->sites.size(), BlockAt{});
   for (std::size_t k = 0; k < listed.size() && k < set_->order.size(); ++k)
-    if (!set_->order[k].first) sites_along_[set_->order[k].second] = listed[k];
+    if (!set_->order[k].first) out.sites[set_->order[k].second] = listed[k];
+  return out;
 }
 
 std::vector<Index> JointReactions::own_constraints(const Model& model) const {
