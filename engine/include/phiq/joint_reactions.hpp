@@ -63,13 +63,14 @@ class JointReactions {
   /// model's: its copies, or the constraint with its data moved), where the losses' derivative along p reads the
   /// reactions under the same λ (detail::FrictionLosses::force_rate()). Made by along().
   struct Along {
-    std::vector<BlockAt> sites;  // per constraint site (empty: none read elsewhere)
+    std::vector<BlockAt> sites;  ///< per constraint site (empty: none read elsewhere)
+    /// A natural body's own constraint read elsewhere.
     struct Own {
-      const ConstraintBlock* block = nullptr;  // the model's
-      std::size_t index = 0;
-      BlockAt at;
+      const ConstraintBlock* block = nullptr;  ///< the model's block
+      std::size_t index = 0;                   ///< the constraint's index there
+      BlockAt at;                              ///< where it is read
     };
-    std::vector<Own> own;  // the natural bodies' own constraints read elsewhere
+    std::vector<Own> own;  ///< the natural bodies' own constraints read elsewhere
   };
   /// Pre-condition: each of `constraints` has a reaction (reaction_width() > 0); else phiq::Error naming it.
   JointReactions(const Model& model, std::vector<Index> constraints);
